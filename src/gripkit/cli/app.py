@@ -1,0 +1,28 @@
+"""The ``gripkit`` command: typer apps and the error boundary.
+
+Command groups live in their own modules (``identify_*.py``, ``zoo.py``, ``demo.py``, ...), each
+adding commands to the apps defined here. Heavy imports happen inside commands so that
+``gripkit --help`` stays fast.
+"""
+
+from __future__ import annotations
+
+import typer
+
+from .. import progress
+
+app = typer.Typer(name="gripkit", no_args_is_help=True, add_completion=False,
+                  pretty_exceptions_enable=False,
+                  help="Model, simulate, identify, estimate and control robotic grippers and fingers.")
+identify_app = typer.Typer(no_args_is_help=True, pretty_exceptions_enable=False,
+                           help="Identify models from logged data (prints a summary, or JSON with --json).")
+zoo_app = typer.Typer(no_args_is_help=True, pretty_exceptions_enable=False,
+                      help="The reference systems of the seeds, with parameters and provenance.")
+app.add_typer(identify_app, name="identify")
+app.add_typer(zoo_app, name="zoo")
+
+
+@app.callback()
+def _root(debug: bool = typer.Option(False, "--debug", help="Show tracebacks on errors."),
+          quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress output.")):
+    progress.set_quiet(quiet)

@@ -1,0 +1,54 @@
+"""Helpers shared by CLI commands: data loading options, JSON output, result printing."""
+
+from __future__ import annotations
+
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import typer
+
+__all__ = ["emit_json", "load_data", "complex_pairs", "FsOpt", "TimeOpt", "FillOpt", "JsonOpt"]
+
+FsOpt = typer.Option(None, "--fs", help="Sampling rate in Hz, when the file has no time column.")
+TimeOpt = typer.Option(None, "--time", help="Name of the time column (default: t/time/timestamp).")
+FillOpt = typer.Option(None, "--fill", help="Missing values: 'drop' rows or 'interpolate' (default: error).")
+JsonOpt = typer.Option(False, "--json", help="Print one JSON object on stdout.")
+
+
+def load_data(path: Path, columns: list[str], fs: float | None, time: str | None, fill: str | None):
+    from ..io import load
+
+    return load(path, columns=columns, fs=fs, time=time, fill=fill)
+
+
+def _clean(obj):
+    if isinstance(obj, dict):
+        return {str(k): _clean(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_clean(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return _clean(obj.tolist())
+    if isinstance(obj, (np.floating, float)):
+        v = float(obj)
+        return v if math.isfinite(v) else None
+    if isinstance(obj, (np.integer,)):
+        return int(obj)
+    if isinstance(obj, (np.bool_,)):
+        return bool(obj)
+    if isinstance(obj, complex):
+        return [obj.real, obj.imag]
+    return obj
+
+
+def emit_json(obj) -> None:
+    """Write ``obj`` as one JSON object on stdout (NaN/inf become null)."""
+    sys.stdout.write(json.dumps(_clean(obj), allow_nan=False) + "\n")
+    sys.stdout.flush()
+
+
+def complex_pairs(values) -> list[list[float]]:
+    """Complex numbers as ``[[re, im], ...]``."""
+    return [[float(np.real(v)), float(np.imag(v))] for v in np.atleast_1d(values)]

@@ -1,0 +1,94 @@
+"""gripkit's error and warning hierarchy.
+
+Every message names the argument or column, what was expected and what was found, and, where it
+can, says how to fix it::
+
+    DataError: column 'force' has 3 NaN values (first at t=1.205 s); drop or interpolate them
+    with fill='interpolate' (CLI: --fill interpolate)
+
+The CLI prints ``str(error)`` on one line and exits non-zero; ``--debug`` shows the traceback.
+"""
+
+from __future__ import annotations
+
+__all__ = [
+    "GripkitError",
+    "DataError",
+    "ModelError",
+    "ParameterError",
+    "IdentificationError",
+    "UnidentifiableError",
+    "SimulationError",
+    "ConfigError",
+    "GripkitWarning",
+    "ConsistencyWarning",
+    "StabilityWarning",
+    "AccuracyWarning",
+]
+
+
+class GripkitError(Exception):
+    """Base class of every error gripkit raises on purpose.
+
+    Parameters
+    ----------
+    message
+        What went wrong: the argument/column, what was expected and what was found.
+    hint
+        How to fix it (optional); appended after a semicolon.
+    """
+
+    def __init__(self, message: str, *, hint: str | None = None):
+        self.message = message
+        self.hint = hint
+        super().__init__(message)
+
+    def __str__(self) -> str:
+        return f"{self.message}; {self.hint}" if self.hint else self.message
+
+
+class DataError(GripkitError, ValueError):
+    """Bad experiment data: NaN/inf, non-monotonic or non-uniform time, too few samples, missing
+    or mistyped columns, unreadable files, signals that cannot identify the requested model."""
+
+
+class ModelError(GripkitError, ValueError):
+    """A model or parameter set that cannot be built as asked."""
+
+
+class ParameterError(ModelError):
+    """A parameter value outside its bounds, without a unit, or otherwise invalid."""
+
+
+class IdentificationError(GripkitError):
+    """An identification that cannot return trustworthy numbers."""
+
+
+class UnidentifiableError(IdentificationError):
+    """The experiment does not determine the requested parameters (rank-deficient or
+    ill-conditioned regressor or Jacobian)."""
+
+
+class SimulationError(GripkitError):
+    """A simulation that would return garbage (step too coarse, divergence, bad inputs)."""
+
+
+class ConfigError(GripkitError, ValueError):
+    """A model/sweep description file (TOML) that is malformed or incomplete."""
+
+
+class GripkitWarning(UserWarning):
+    """Base class of gripkit's warnings."""
+
+
+class ConsistencyWarning(GripkitWarning):
+    """A parameter set contradicts itself (for example a stated natural frequency that its own
+    mass and stiffness do not give)."""
+
+
+class StabilityWarning(GripkitWarning):
+    """An identified or simulated model is unstable where stability was expected."""
+
+
+class AccuracyWarning(GripkitWarning):
+    """A result is computed but may be inaccurate (poor excitation, coarse step, few samples)."""

@@ -1,0 +1,208 @@
+"""Readers and writers for CSV, Parquet and HDF5 behind :func:`load` and :func:`save`.
+
+* CSV: one header row; units in headers (``force [N]``). Read with pyarrow.
+* Parquet: one column per channel; units in the field metadata key ``unit`` (or in headers).
+* HDF5: a group holding one 1-D dataset per channel (attribute ``unit``), or one 2-D dataset
+  with a ``columns`` attribute (and optionally ``units``); ``key=`` names the group/dataset.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import DataError
+from ..signals.trajectory import Trajectory
+from .table import columns_to_trajectory
+
+__all__ = ["load", "save", "FORMATS"]
+
+FORMATS = {".csv": "csv", ".txt": "csv", ".tsv": "csv", ".parquet": "parquet", ".pq": "parquet",
+           ".h5": "hdf5", ".hdf5": "hdf5", ".hdf": "hdf5"}
+
+
+def _format(path: Path, fmt: str | None) -> str:
+    if fmt is not None:
+        if fmt not in set(FORMATS.values()):
+            raise DataError(f"format: expected one of csv, parquet, hdf5, found {fmt!r}")
+        return fmt
+    try:
+        return FORMATS[path.suffix.lower()]
+    except KeyError:
+        raise DataError(f"cannot tell the format of {str(path)!r} from its suffix {path.suffix!r}",
+                        hint="use .csv, .parquet or .h5, or pass format=") from None
+
+
+def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
+         fs: float | None = None, units: Mapping[str, str] | None = None,
+         fill: str | None = None, format: str | None = None, key: str | None = None,
+         delimiter: str | None = None) -> Trajectory:
+    """Read experiment data into a validated :class:`Trajectory` (SI units).
+
+    Parameters
+    ----------
+    path
+        A ``.csv``, ``.parquet`` or ``.h5`` file.
+    columns
+        Channels to keep (default: all but the time column).
+    time
+        Name of the time column; else one named t/time/timestamp, else ``fs`` must be given.
+    fs
+        Sampling rate in Hz when the file has no time column.
+    units
+        Units per channel, overriding those in headers or metadata (``{"force": "mN"}``).
+    fill
+        Missing values: ``None`` (error), ``'drop'`` rows, or ``'interpolate'`` linearly in time.
+    format
+        Force a format ('csv', 'parquet', 'hdf5') instead of the suffix.
+    key
+        HDF5 group or dataset path.
+
+    Raises
+    ------
+    DataError
+        Missing file or column, truncated or corrupt file, mixed types, NaN/inf, bad time stamps.
+    """
+    path = Path(path)
+    if not path.exists():
+        raise DataError(f"data file {str(path)!r} not found")
+    if path.is_dir():
+        raise DataError(f"{str(path)!r} is a folder, expected a data file")
+    if path.stat().st_size == 0:
+        raise DataError(f"data file {str(path)!r} is empty")
+    fmt = _format(path, format)
+    reader = {"csv": _read_csv, "parquet": _read_parquet, "hdf5": _read_hdf5}[fmt]
+    raw, meta_units = reader(path, key=key, delimiter=delimiter)
+    return columns_to_trajectory(raw, source=path.name, columns=columns, time=time, fs=fs,
+                                 units=units, meta_units=meta_units, fill=fill)
+
+
+def _read_csv(path: Path, key=None, delimiter=None):
+    import pyarrow as pa
+    from pyarrow import csv as pacsv
+
+    if delimiter is None:
+        delimiter = "\t" if path.suffix.lower() == ".tsv" else ","
+    try:
+        table = pacsv.read_csv(
+            path, parse_options=pacsv.ParseOptions(delimiter=delimiter),
+            convert_options=pacsv.ConvertOptions(strings_can_be_null=True,
+                                                 null_values=["", "NaN", "nan", "NA", "null"]))
+    except (pa.ArrowInvalid, pa.ArrowTypeError, UnicodeDecodeError) as exc:
+        raise DataError(f"{path.name}: not a readable CSV file (truncated or corrupt?): "
+                        f"{str(exc).splitlines()[0]}") from None
+    return _arrow_columns(table), {}
+
+
+def _arrow_columns(table) -> dict[str, object]:
+    import pyarrow as pa
+
+    out = {}
+    for name, col in zip(table.column_names, table.columns):
+        if pa.types.is_integer(col.type) or pa.types.is_floating(col.type) or pa.types.is_boolean(col.type):
+            out[name] = col.to_numpy(zero_copy_only=False).astype(np.float64)
+        elif pa.types.is_null(col.type):
+            out[name] = np.full(len(col), np.nan)
+        else:
+            out[name] = np.asarray(col.to_pylist(), dtype=object)
+    return out
+
+
+def _read_parquet(path: Path, key=None, delimiter=None):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    try:
+        table = pq.read_table(path)
+    except (pa.ArrowInvalid, OSError) as exc:
+        raise DataError(f"{path.name}: not a readable Parquet file (truncated or corrupt?): "
+                        f"{str(exc).splitlines()[0]}") from None
+    units = {}
+    for f in table.schema:
+        md = f.metadata or {}
+        if b"unit" in md:
+            units[f.name] = md[b"unit"].decode()
+    return _arrow_columns(table), units
+
+
+def _read_hdf5(path: Path, key=None, delimiter=None):
+    import h5py
+
+    try:
+        fh = h5py.File(path, "r")
+    except OSError as exc:
+        raise DataError(f"{path.name}: not a readable HDF5 file (truncated or corrupt?): {exc}") from None
+    with fh:
+        node = fh if key is None else fh.get(key)
+        if node is None:
+            raise DataError(f"{path.name}: no group or dataset {key!r}",
+                            hint=f"top-level entries: {', '.join(fh.keys())}")
+        raw, units = {}, {}
+        try:
+            if isinstance(node, h5py.Dataset):
+                arr = node[()]
+                cols = node.attrs.get("columns")
+                if arr.ndim != 2 or cols is None:
+                    raise DataError(f"{path.name}: dataset {node.name!r} must be 2-D with a 'columns' attribute")
+                cols = [c.decode() if isinstance(c, bytes) else str(c) for c in cols]
+                if len(cols) != arr.shape[1]:
+                    raise DataError(f"{path.name}: 'columns' names {len(cols)} columns, data has {arr.shape[1]}")
+                ulist = node.attrs.get("units")
+                for j, c in enumerate(cols):
+                    raw[c] = arr[:, j]
+                    if ulist is not None:
+                        u = ulist[j]
+                        units[c] = u.decode() if isinstance(u, bytes) else str(u)
+            else:
+                order = [c.decode() if isinstance(c, bytes) else str(c) for c in node.attrs.get("columns", [])]
+                items = sorted(node.items(), key=lambda kv: order.index(kv[0]) if kv[0] in order else len(order))
+                for name, ds in items:
+                    if isinstance(ds, h5py.Dataset) and ds.ndim == 1:
+                        raw[name] = ds[()]
+                        if "unit" in ds.attrs:
+                            u = ds.attrs["unit"]
+                            units[name] = u.decode() if isinstance(u, bytes) else str(u)
+                if not raw:
+                    raise DataError(f"{path.name}: group {node.name!r} holds no 1-D datasets",
+                                    hint="pass key= to point at the group holding the channels")
+        except OSError as exc:
+            raise DataError(f"{path.name}: HDF5 data cannot be read (truncated or corrupt?): {exc}") from None
+    lengths = {k: len(v) for k, v in raw.items()}
+    if len(set(lengths.values())) > 1:
+        raise DataError(f"{path.name}: datasets have different lengths {lengths}")
+    return raw, units
+
+
+def save(tr: Trajectory, path, *, format: str | None = None, key: str = "/") -> None:
+    """Write a trajectory: time as ``t`` (s) then each channel with its SI unit. Writes to a
+    temporary file and renames it, so an interrupted save never leaves a half-written file."""
+    path = Path(path)
+    fmt = _format(path, format)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    tmp = path.with_name(f".{path.name}.tmp")
+    cols = {"t": tr.t, **{n: tr[n] for n in tr.names}}
+    units = {"t": "s", **tr.units}
+    if fmt == "csv":
+        header = ",".join(f"{n} [{u}]" if u != "1" else n for n, u in units.items())
+        np.savetxt(tmp, np.column_stack(list(cols.values())), delimiter=",", header=header,
+                   comments="", fmt="%.17g")
+    elif fmt == "parquet":
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        fields = [pa.field(n, pa.float64(), metadata={"unit": units[n]}) for n in cols]
+        table = pa.Table.from_arrays([pa.array(v) for v in cols.values()], schema=pa.schema(fields))
+        pq.write_table(table, tmp)
+    else:
+        import h5py
+
+        with h5py.File(tmp, "w", track_order=True) as fh:
+            g = fh.require_group(key)
+            g.attrs["columns"] = list(cols)
+            for n, v in cols.items():
+                ds = g.create_dataset(n, data=v)
+                ds.attrs["unit"] = units[n]
+    os.replace(tmp, path)

@@ -1,0 +1,159 @@
+"""From named columns (as read from any file format) to a validated :class:`Trajectory`.
+
+Rules shared by every reader:
+
+* a column header may carry its unit, ``"force [mN]"`` or ``"force (mN)"``; values are converted
+  to SI and the channel is named ``force``. Units may also come from file metadata or ``units=``;
+* the time base is the column named by ``time=``; else a uniform one built from ``fs=``; else a
+  column named ``t``, ``time``, ``timestamp`` or ``time_s`` (its unit converted to seconds);
+* ``columns=`` selects channels by name; ``fill='drop'|'interpolate'`` handles missing values.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from ..errors import DataError
+from ..signals.trajectory import Trajectory
+
+__all__ = ["columns_to_trajectory", "split_header"]
+
+_TIME_NAMES = ("t", "time", "timestamp", "time_s", "times")
+_HEADER = re.compile(r"^\s*(.*?)\s*[\[(]\s*([^\])]+?)\s*[\])]\s*$")
+
+
+def split_header(header: str) -> tuple[str, str | None]:
+    """``'force [mN]'`` → ``('force', 'mN')``; ``'force'`` → ``('force', None)``."""
+    m = _HEADER.match(header)
+    if m and m.group(1):
+        return m.group(1), m.group(2)
+    return header.strip(), None
+
+
+def _to_si(name: str, values: np.ndarray, unit: str | None) -> tuple[np.ndarray, str]:
+    if unit is None:
+        return values, "1"
+    from ..units import _si_factor
+
+    try:
+        scale, offset, si = _si_factor(unit)
+    except Exception:
+        raise DataError(f"column {name!r}: unit {unit!r} is not a unit gripkit can read",
+                        hint="write units like [N], [mN], [um], [V], [mA], [bar], [s]") from None
+    return values * scale + offset, si
+
+
+def _numeric(name: str, values, row_offset: int = 0) -> np.ndarray:
+    """Float64 array, or a DataError naming the first non-numeric cell."""
+    a = np.asarray(values)
+    if a.dtype == bool:
+        return a.astype(np.float64)
+    if np.issubdtype(a.dtype, np.number):
+        return a.astype(np.float64)
+    out = np.empty(a.shape[0], dtype=np.float64)
+    for i, v in enumerate(a):
+        if v is None:
+            out[i] = np.nan
+            continue
+        try:
+            out[i] = float(v)
+        except (TypeError, ValueError):
+            raise DataError(
+                f"column {name!r} mixes numbers and text: row {i + row_offset} holds {str(v)!r}",
+                hint="fix or remove that cell, or leave it empty to be treated as missing",
+            ) from None
+    return out
+
+
+def _fill(t: np.ndarray, data: dict[str, np.ndarray], fill: str | None):
+    if fill is None:
+        return t, data
+    missing = np.zeros(t.shape[0], dtype=bool)
+    for v in data.values():
+        missing |= ~np.isfinite(v)
+    if not missing.any():
+        return t, data
+    if fill == "drop":
+        keep = ~missing
+        return t[keep], {k: v[keep] for k, v in data.items()}
+    if fill == "interpolate":
+        out = {}
+        for k, v in data.items():
+            bad = ~np.isfinite(v)
+            if bad.all():
+                raise DataError(f"column {k!r} has no finite values to interpolate from")
+            v = v.copy()
+            v[bad] = np.interp(t[bad], t[~bad], v[~bad])
+            out[k] = v
+        return t, out
+    raise DataError(f"fill: expected None, 'drop' or 'interpolate', found {fill!r}")
+
+
+def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
+                          columns: Sequence[str] | None = None, time: str | None = None,
+                          fs: float | None = None, units: Mapping[str, str] | None = None,
+                          meta_units: Mapping[str, str] | None = None,
+                          fill: str | None = None) -> Trajectory:
+    """Build a Trajectory from raw columns ``{header: values}``."""
+    units = dict(units or {})
+    meta_units = dict(meta_units or {})
+    cols: dict[str, tuple[object, str | None]] = {}
+    for header, values in raw.items():
+        name, unit = split_header(str(header))
+        if name in cols:
+            raise DataError(f"{source}: column {name!r} appears twice")
+        cols[name] = (values, units.get(name) or unit or meta_units.get(header) or meta_units.get(name))
+    if not cols:
+        raise DataError(f"{source}: the file holds no columns")
+    available = ", ".join(cols)
+
+    # time base
+    tname = time
+    if tname is None and fs is None:
+        tname = next((c for c in cols if c.lower() in _TIME_NAMES), None)
+        if tname is None:
+            raise DataError(f"{source}: no time column found (looked for {', '.join(_TIME_NAMES)})",
+                            hint="name it with time=COL (CLI: --time COL) or give the sampling rate fs (CLI: --fs HZ)")
+    if tname is not None and tname not in cols:
+        raise DataError(f"{source}: time column {tname!r} not found", hint=f"available columns: {available}")
+    if tname is not None and fs is not None and time is not None:
+        raise DataError("give either a time column or a sampling rate fs, not both")
+
+    names = (list(columns) if columns is not None
+             else [c for c in cols if c != tname and c.lower() not in _TIME_NAMES])
+    for c in names:
+        if c not in cols:
+            raise DataError(f"{source}: column {c!r} not found", hint=f"available columns: {available}")
+    if not names:
+        raise DataError(f"{source}: no data columns besides the time column")
+
+    n = None
+    data: dict[str, np.ndarray] = {}
+    su: dict[str, str] = {}
+    for c in names:
+        vals, unit = cols[c]
+        arr = _numeric(c, vals)
+        data[c], su[c] = _to_si(c, arr, unit)
+        n = arr.shape[0]
+    if tname is not None:
+        tvals, tunit = cols[tname]
+        t, tsi = _to_si(tname, _numeric(tname, tvals), tunit or "s")
+        if tsi != "s":
+            raise DataError(f"{source}: time column {tname!r} has unit {tunit!r}, which is not a time")
+        meta = {"source": source, "time_column": tname}
+    else:
+        if not (np.isfinite(fs) and fs > 0):
+            raise DataError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
+        t = np.arange(n) / float(fs)
+        meta = {"source": source, "fs": float(fs)}
+    t, data = _fill(t, data, fill)
+    if tname is not None:
+        bad = ~np.isfinite(t)
+        if bad.any():
+            i = int(np.argmax(bad))
+            raise DataError(f"{source}: time column {tname!r} has {int(bad.sum())} missing or non-finite "
+                            f"values (first at row {i})", hint="drop those rows (fill='drop')")
+    return Trajectory(t, data, su, meta)

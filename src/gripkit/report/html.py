@@ -1,0 +1,157 @@
+"""A report made of sections, written as one self-contained HTML file.
+
+>>> rep = Report("AMADEUS finger identification")
+>>> sec = rep.section("Least squares", "ARX models of Table II ...")
+>>> sec.table(["model", "loss"], [["[2 2 2]", 27.6]])
+>>> # sec.figure(fig, "caption"); rep.write("report")  -> report/index.html
+
+Figures are embedded as PNG (base64) and also saved under ``<out>/figures/`` so they can be
+linked from elsewhere (the README shows one).
+"""
+
+from __future__ import annotations
+
+import base64
+import datetime as _dt
+import html
+import io
+import os
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+__all__ = ["Report", "Section"]
+
+
+@dataclass
+class _Figure:
+    png: bytes
+    caption: str
+    slug: str
+
+
+@dataclass
+class _Table:
+    headers: list[str]
+    rows: list[list]
+    caption: str
+
+
+@dataclass
+class Section:
+    """One section: paragraphs, tables and figures, shown in the order they were added."""
+
+    title: str
+    items: list = field(default_factory=list)
+
+    def text(self, paragraph: str) -> "Section":
+        self.items.append(("text", paragraph))
+        return self
+
+    def table(self, headers, rows, caption: str = "") -> "Section":
+        self.items.append(("table", _Table([str(h) for h in headers], [list(r) for r in rows], caption)))
+        return self
+
+    def figure(self, fig, caption: str = "", name: str | None = None, dpi: int = 110) -> "Section":
+        """Add a matplotlib figure (closed after rendering)."""
+        import matplotlib.pyplot as plt
+
+        buf = io.BytesIO()
+        fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight")
+        plt.close(fig)
+        slug = _slug(name or f"{self.title}-{len(self.items)}")
+        self.items.append(("figure", _Figure(buf.getvalue(), caption, slug)))
+        return self
+
+    def findings(self, report) -> "Section":
+        """Add a consistency report (see :mod:`gripkit.consistency`) as a table."""
+        rows = [["ok" if f.consistent else "INCONSISTENT", f.check, f.message, f.used] for f in report]
+        return self.table(["status", "check", "finding", "gripkit uses"], rows,
+                          caption=f"Consistency checks: {report.subject}")
+
+
+def _slug(s: str) -> str:
+    return re.sub(r"[^a-z0-9]+", "-", s.lower()).strip("-")[:60] or "figure"
+
+
+def _cell(v) -> str:
+    if isinstance(v, float):
+        return html.escape(f"{v:.6g}")
+    return html.escape(str(v))
+
+
+_CSS = """
+body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;max-width:1100px;margin:2em auto;
+padding:0 1em;color:#222;line-height:1.45}
+h1{border-bottom:2px solid #345;padding-bottom:.2em}h2{color:#234;margin-top:2em;border-bottom:1px solid #ccd}
+table{border-collapse:collapse;margin:1em 0;font-size:.92em}th,td{border:1px solid #ccd;padding:.25em .6em;
+text-align:right}th{background:#eef2f7}td:first-child,th:first-child{text-align:left}
+figure{margin:1.2em 0}figure img{max-width:100%;border:1px solid #dde}figcaption,.cap{font-size:.9em;color:#555}
+nav ul{columns:2}.meta{color:#666;font-size:.9em}
+"""
+
+
+class Report:
+    """An HTML report made of :class:`Section` objects."""
+
+    def __init__(self, title: str, subtitle: str = ""):
+        self.title = title
+        self.subtitle = subtitle
+        self.sections: list[Section] = []
+
+    def section(self, title: str, intro: str = "") -> Section:
+        sec = Section(title)
+        if intro:
+            sec.text(intro)
+        self.sections.append(sec)
+        return sec
+
+    def render(self) -> str:
+        from jinja2 import Template
+
+        body = []
+        for i, sec in enumerate(self.sections):
+            parts = [f'<h2 id="s{i}">{html.escape(sec.title)}</h2>']
+            for kind, item in sec.items:
+                if kind == "text":
+                    parts.append(f"<p>{html.escape(item)}</p>")
+                elif kind == "table":
+                    head = "".join(f"<th>{html.escape(h)}</th>" for h in item.headers)
+                    rows = "".join("<tr>" + "".join(f"<td>{_cell(c)}</td>" for c in r) + "</tr>" for r in item.rows)
+                    cap = f'<div class="cap">{html.escape(item.caption)}</div>' if item.caption else ""
+                    parts.append(f"{cap}<table><tr>{head}</tr>{rows}</table>")
+                else:
+                    b64 = base64.b64encode(item.png).decode()
+                    parts.append(f'<figure><img alt="{html.escape(item.caption)}" '
+                                 f'src="data:image/png;base64,{b64}"/>'
+                                 f"<figcaption>{html.escape(item.caption)}</figcaption></figure>")
+            body.append("\n".join(parts))
+        tmpl = Template(
+            "<!DOCTYPE html><html><head><meta charset='utf-8'><title>{{title}}</title>"
+            "<style>{{css}}</style></head><body><h1>{{title}}</h1>"
+            "{% if subtitle %}<p>{{subtitle}}</p>{% endif %}"
+            "<p class='meta'>Generated by gripkit on {{when}}.</p>"
+            "<nav><ul>{% for s in sections %}<li><a href='#s{{loop.index0}}'>{{s.title}}</a></li>{% endfor %}</ul></nav>"
+            "{{body}}</body></html>")
+        return tmpl.render(title=self.title, subtitle=self.subtitle, css=_CSS, sections=self.sections,
+                           when=_dt.datetime.now().strftime("%Y-%m-%d %H:%M"), body="\n".join(body))
+
+    def write(self, out_dir) -> Path:
+        """Write ``out_dir/index.html`` (and ``out_dir/figures/*.png``); returns the HTML path.
+        Each file is written to a temporary name and renamed, so a failure leaves no half file."""
+        out = Path(out_dir)
+        figs = out / "figures"
+        figs.mkdir(parents=True, exist_ok=True)
+        for sec in self.sections:
+            for kind, item in sec.items:
+                if kind == "figure":
+                    _atomic_write(figs / f"{item.slug}.png", item.png)
+        index = out / "index.html"
+        _atomic_write(index, self.render().encode())
+        return index
+
+
+def _atomic_write(path: Path, data: bytes) -> None:
+    tmp = path.with_name(f".{path.name}.tmp")
+    tmp.write_bytes(data)
+    os.replace(tmp, path)
