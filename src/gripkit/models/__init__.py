@@ -1,0 +1,3 @@
+"""Physical model components (one concept per module)."""
+
+from .mass_spring_damper import MassSpringDamper as MassSpringDamper

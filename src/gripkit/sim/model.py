@@ -1,0 +1,199 @@
+"""The simulation-model base class: immutable parameters, pure numba kernels, Trajectory results.
+
+A model subclass declares its signals and implements one method, ``_simulate_batch``, which calls
+a module-level numba kernel::
+
+    class MassSpringDamper(Model):
+        inputs = (Signal("F", "N", "applied force"),)
+        outputs = (Signal("x", "m", "position"),)
+        states = (Signal("x", "m", "position"), Signal("v", "m/s", "velocity"))
+        def _simulate_batch(self, thetas, u, dt, substeps, x0, y):
+            _msd_batch(thetas, u, dt, substeps, x0, y)      # @njit(parallel=True) kernel
+        def modes(self, theta):
+            m, b, k = theta
+            wn = (k / m) ** 0.5
+            return [(wn, b / (2 * (k * m) ** 0.5))]
+
+``simulate`` returns a :class:`Trajectory`; ``simulate_batch`` runs many parameter vectors against
+one input in parallel (``prange``) and is what the grey-box engine and the batch runner use.
+Before integrating, the step is checked against ``modes`` (:mod:`gripkit.sim.steps`): unstable
+steps are refused and internal substeps are chosen so every mode is resolved.
+"""
+
+from __future__ import annotations
+
+import abc
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..consistency import Finding, warn_inconsistent
+from ..errors import ParameterError, SimulationError
+from ..params import ParameterSet
+from ..signals.trajectory import Trajectory
+from .steps import check_step, substeps_for
+
+__all__ = ["Signal", "Model", "simulate"]
+
+
+@dataclass(frozen=True)
+class Signal:
+    """A named input, output or state with its SI unit."""
+
+    name: str
+    unit: str
+    doc: str = ""
+
+
+class Model(abc.ABC):
+    """Base class of gripkit's simulation models. See the module docstring."""
+
+    name: str = "model"
+    description: str = ""
+    inputs: tuple[Signal, ...] = ()
+    outputs: tuple[Signal, ...] = ()
+    states: tuple[Signal, ...] = ()
+    #: integration scheme of the kernel: 'rk4', 'semi-implicit' or 'zoh' (exact discretisation)
+    integrator: str = "rk4"
+
+    def __init__(self, parameters: ParameterSet, *, check: bool = True):
+        if not isinstance(parameters, ParameterSet):
+            raise ParameterError(f"{type(self).__name__}: expected a ParameterSet, found {type(parameters).__name__}")
+        self.parameters = parameters
+        if check:
+            warn_inconsistent(self.consistency_checks(), stacklevel=3)
+
+    # --- to override -------------------------------------------------------------------------
+    @abc.abstractmethod
+    def _simulate_batch(self, thetas: np.ndarray, u: np.ndarray, dt: float, substeps: int,
+                        x0: np.ndarray, y: np.ndarray) -> None:
+        """Simulate every row of ``thetas`` (P, n_params) against ``u`` (N, n_inputs) from
+        ``x0`` (P, n_states), ``substeps`` internal steps per sample, writing ``y`` (P, N, n_outputs)."""
+
+    def modes(self, theta: np.ndarray) -> list[tuple[float, float]]:
+        """Natural frequencies (rad/s) and damping ratios of the model's modes at ``theta``."""
+        return []
+
+    def initial_state(self, theta: np.ndarray) -> np.ndarray:
+        return np.zeros(len(self.states))
+
+    def consistency_checks(self) -> list[Finding]:
+        return []
+
+    # --- shared machinery ----------------------------------------------------------------------
+    def with_parameters(self, check: bool = True, **values) -> "Model":
+        """A copy with some parameter values replaced (``'1.37 mg'`` strings are parsed)."""
+        new = object.__new__(type(self))
+        new.__dict__.update(self.__dict__)
+        new.parameters = self.parameters.replace(**values)
+        if check:
+            warn_inconsistent(new.consistency_checks(), stacklevel=3)
+        return new
+
+    def theta(self, params: ParameterSet | Mapping[str, float] | None = None) -> np.ndarray:
+        """The full parameter vector (SI, in ``parameters.names`` order)."""
+        if params is None:
+            return self.parameters.vector()
+        if isinstance(params, ParameterSet):
+            return params.vector(self.parameters.names)
+        return self.parameters.replace(**params).vector()
+
+    def _check_thetas(self, thetas: np.ndarray) -> np.ndarray:
+        thetas = np.ascontiguousarray(np.atleast_2d(np.asarray(thetas, dtype=np.float64)))
+        n = len(self.parameters)
+        if thetas.ndim != 2 or thetas.shape[1] != n:
+            raise ParameterError(f"{self.name}: expected parameter vectors of length {n} "
+                                 f"({', '.join(self.parameters.names)}), found shape {thetas.shape}")
+        if not np.isfinite(thetas).all():
+            raise ParameterError(f"{self.name}: parameter vectors contain NaN or inf")
+        lo, hi = self.parameters.bounds_arrays()
+        bad = (thetas < lo) | (thetas > hi)
+        if bad.any():
+            i, j = map(int, np.argwhere(bad)[0])
+            p = self.parameters[self.parameters.names[j]]
+            raise ParameterError(f"{self.name}: {p.name} = {thetas[i, j]:g} {p.unit} is outside its "
+                                 f"bounds [{lo[j]:g}, {hi[j]:g}] (parameter vector {i})")
+        return thetas
+
+    def _inputs_array(self, u, dt: float | None) -> tuple[np.ndarray, float, float]:
+        names = [s.name for s in self.inputs]
+        t0 = 0.0
+        if isinstance(u, Trajectory):
+            fs = u.require_uniform(why=f"simulating {self.name}")
+            arr = u.as_array(*names)
+            t0 = float(u.t[0])
+            if dt is not None and abs(dt * fs - 1.0) > 1e-6:
+                raise SimulationError(f"dt={dt} s given, but the input trajectory is sampled at {fs:g} Hz")
+            dt = 1.0 / fs
+        elif isinstance(u, Mapping):
+            missing = [n for n in names if n not in u]
+            if missing:
+                raise SimulationError(f"{self.name}: inputs {missing} missing", hint=f"inputs are {names}")
+            arr = np.column_stack([np.asarray(u[n], dtype=np.float64) for n in names])
+        else:
+            arr = np.asarray(u, dtype=np.float64)
+            arr = arr.reshape(-1, 1) if arr.ndim == 1 else arr
+            if arr.ndim != 2 or arr.shape[1] != len(names):
+                raise SimulationError(f"{self.name}: expected inputs of shape (N, {len(names)}) for {names}, "
+                                      f"found {np.shape(u)}")
+        if dt is None:
+            raise SimulationError(f"{self.name}: give the sample time dt (or a Trajectory input)")
+        if not (np.isfinite(dt) and dt > 0):
+            raise SimulationError(f"dt: expected a positive number of seconds, found {dt!r}")
+        if not np.isfinite(arr).all():
+            raise SimulationError(f"{self.name}: inputs contain NaN or inf")
+        return np.ascontiguousarray(arr), float(dt), t0
+
+    def substeps(self, dt: float, thetas: np.ndarray) -> int:
+        """Internal steps per sample so that every mode of every parameter vector is resolved."""
+        if self.integrator == "zoh":
+            return 1
+        n = 1
+        for th in thetas:
+            n = max(n, substeps_for(dt, self.modes(th), self.integrator))
+        return n
+
+    def simulate_batch(self, thetas, u, dt: float | None = None, x0: np.ndarray | None = None,
+                       substeps: int | None = None) -> np.ndarray:
+        """Outputs (P, N, n_outputs) for parameter vectors ``thetas`` (P, n_params)."""
+        thetas = self._check_thetas(thetas)
+        arr, dt, _ = self._inputs_array(u, dt)
+        if substeps is None:
+            substeps = self.substeps(dt, thetas)
+        elif int(substeps) != substeps or substeps < 1:
+            raise SimulationError(f"substeps: expected a positive integer, found {substeps!r}")
+        if self.integrator != "zoh":
+            for th in thetas:
+                check_step(dt / substeps, self.modes(th), self.integrator, what=self.name)
+        P = thetas.shape[0]
+        if x0 is None:
+            x0 = np.stack([self.initial_state(th) for th in thetas]) if len(self.states) else np.zeros((P, 0))
+        x0 = np.ascontiguousarray(np.broadcast_to(np.asarray(x0, dtype=np.float64), (P, len(self.states))))
+        y = np.empty((P, arr.shape[0], len(self.outputs)))
+        self._simulate_batch(thetas, arr, dt, int(substeps), x0.copy(), y)
+        if not np.isfinite(y).all():
+            raise SimulationError(f"{self.name}: the simulation diverged (non-finite outputs)",
+                                  hint="check the parameters and the input amplitude")
+        return y
+
+    def simulate(self, u, *, dt: float | None = None, x0: np.ndarray | None = None,
+                 params: ParameterSet | Mapping[str, float] | None = None,
+                 substeps: int | None = None) -> Trajectory:
+        """Simulate one parameter set; returns a Trajectory of the inputs and outputs."""
+        arr, dt, t0 = self._inputs_array(u, dt)
+        y = self.simulate_batch(self.theta(params)[None, :], arr, dt,
+                                None if x0 is None else np.asarray(x0)[None, :], substeps)[0]
+        t = t0 + np.arange(arr.shape[0]) * dt
+        ch = {s.name: arr[:, i] for i, s in enumerate(self.inputs)}
+        ch.update({s.name: y[:, i] for i, s in enumerate(self.outputs)})
+        units = {s.name: s.unit for s in (*self.inputs, *self.outputs)}
+        return Trajectory(t, ch, units, {"fs": 1.0 / dt, "model": self.name})
+
+    def __repr__(self) -> str:
+        return f"{type(self).__name__}({self.parameters!r})"
+
+
+def simulate(model: Model, u, **kwargs) -> Trajectory:
+    """Simulate ``model`` for inputs ``u`` (Trajectory, mapping or array with ``dt=``)."""
+    return model.simulate(u, **kwargs)
