@@ -223,17 +223,22 @@ def fit(model, data: Trajectory, *, outputs: Sequence[str] | Mapping[str, str] |
     lo, hi = lo_all[idx], hi_all[idx]
     theta0 = base[idx]
     s = _scales(theta0, lo, hi)
+    # optimisation variables: z = θ/s; for 'lm' (no bounds) positive parameters use z = log(θ/s)
+    logvar = (method == "lm") & (lo >= 0) & (theta0 > 0)
+
+    def to_theta(z):
+        return np.where(logvar, s * np.exp(np.where(logvar, z, 0.0)), s * z)
+
+    def to_z(theta):
+        return np.where(logvar, np.log(np.where(logvar, theta, s) / s), theta / s)
+
     x0_arr = None if x0 is None else np.asarray(x0, dtype=np.float64)[None, :]
     nfev = [0]
     substeps = [1]  # only ever grows, so finite differences never straddle a change of step
 
-    def thetas_for(z_rows: np.ndarray) -> np.ndarray:
-        T = np.repeat(base[None, :], z_rows.shape[0], axis=0)
-        T[:, idx] = z_rows * s
-        return T
-
     def simulate_rows(z_rows: np.ndarray) -> np.ndarray:
-        T = thetas_for(z_rows)
+        T = np.repeat(base[None, :], z_rows.shape[0], axis=0)
+        T[:, idx] = to_theta(z_rows)
         nfev[0] += T.shape[0]
         substeps[0] = max(substeps[0], model.substeps(dt, T))
         return model.simulate_batch(T, u, dt, x0_arr, substeps=substeps[0])[:, :, out_idx]
@@ -250,7 +255,7 @@ def fit(model, data: Trajectory, *, outputs: Sequence[str] | Mapping[str, str] |
     def jacobian(z):
         r0 = residual(z)
         h = np.sqrt(np.finfo(float).eps) * np.maximum(np.abs(z), 1.0)
-        step = np.where(z + h <= hi / s, h, -h)  # step away from an upper bound
+        step = np.where(logvar | (z + h <= hi / s), h, -h)  # step away from an upper bound
         Z = np.repeat(z[None, :], n_free, axis=0) + np.diag(step)
         R = (simulate_rows(Z) - y[None, :, :]) / w
         return ((R.reshape(n_free, -1) - r0[None, :]) / step[:, None]).T
@@ -261,23 +266,26 @@ def fit(model, data: Trajectory, *, outputs: Sequence[str] | Mapping[str, str] |
     best = None
     tried = []
     for th in track(starts, description="grey-box starts", enabled=progress and len(starts) > 1):
-        z0 = np.clip(th / s, bounds[0], bounds[1]) if method != "lm" else th / s
+        z0 = np.clip(to_z(th), bounds[0], bounds[1])
         try:
             sol = least_squares(residual, z0, jac=jacobian, bounds=bounds, method=method, loss=loss,
                                 max_nfev=max_nfev, x_scale="jac")
+        except ParameterError as exc:
+            raise IdentificationError(f"the fit left the parameters' physical range: {exc}",
+                                      hint="use method='trf' to enforce the bounds, or better starting values") from None
         except ValueError as exc:
             raise IdentificationError(f"least squares failed to start: {exc}") from None
-        tried.append((float(sol.cost), sol.x * s))
+        tried.append((float(sol.cost), to_theta(sol.x)))
         if best is None or sol.cost < best.cost:
             best = sol
     z = best.x
-    theta = z * s
+    theta = to_theta(z)
     if method == "lm" and ((theta < lo) | (theta > hi)).any():
         j = int(np.argmax((theta < lo) | (theta > hi)))
         raise IdentificationError(f"Levenberg-Marquardt converged outside the bounds: {free[j]} = {theta[j]:g}",
                                   hint="use method='trf' to enforce the bounds")
     r = residual(z)
-    J = jacobian(z) / s[None, :]  # d r / d theta
+    J = jacobian(z) / np.where(logvar, theta, s)[None, :]  # d r / d theta (chain rule through z)
     n_res = r.size
     dof = max(n_res - n_free, 1)
     sigma2 = float(r @ r) / dof
