@@ -1,0 +1,446 @@
+"""Friction identification: stiction from breakaway tests, dynamic friction from constant-velocity
+runs (lookup table or fitted Stribeck curve with uncertainty), and inverse-dynamics least squares
+(IDIM-LS).
+
+Stiction (``002_ddea254371185ad3.txt`` §6.2, Appendix C). The joint is held at a position and
+driven by PWM pulses of increasing amplitude (500 → 1500 in steps of 50), each followed by a
+pause. A pulse "moves" the joint when the velocity is non-zero for more than a given number of
+samples (Appendix C counts samples with ``velocity ~= 0`` and requires more than 1000). The first
+moving pulse of a series is the breakaway PWM (Table 6.1); through the motor model at zero speed
+and the gear ratio it gives the stiction torque. The true breakaway level lies between the last
+still and the first moving pulse: gripkit reports the midpoint with the quantisation uncertainty
+(step/√12) combined with the spread over positions.
+
+Dynamic friction (§6.2, Appendix D). At constant PWM the joint settles to a constant velocity
+(acceleration ≈ 0), where friction = motor torque(PWM, v) − gravity (eq 6.6 without the inertial
+term). Each run gives one (v, F) point; the points form the lookup table of §6.3, or are fitted
+with a Stribeck curve plus viscous and cubic terms (:func:`fit_stribeck`) whose covariance gives
+the uncertainty.
+
+IDIM-LS (the standard robot identification method, e.g. Gautier & Khalil; Swevers et al.). For one
+axis with position q and effort τ (= K × a logged column):
+
+    τ = J q̈ + F_v q̇ + F_c sign(q̇) + τ₀.
+
+Position and effort are low-pass filtered with the same zero-phase Butterworth filter (parallel
+filtering keeps the linear relation exact), q̇ and q̈ come from central differences of the filtered
+position, the filtered signals are decimated (keeping every q-th sample: fewer, less correlated
+rows), the filter's edge transients and the samples with |q̇| below a threshold (where sign(q̇)
+is ill-defined and the joint may stick) are dropped, and the overdetermined system is solved by
+least squares. Standard deviations: σ̂² = RSS/(N − 4), Cov = σ̂² (XᵀX)⁻¹; relative error
+100·‖τ − Xθ‖/‖τ‖.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import DataError, IdentificationError, UnidentifiableError
+from ..models.friction import FrictionTable
+
+__all__ = ["Pulse", "BreakawayResult", "detect_breakaway", "ConstantVelocityPoint",
+           "constant_velocity_friction", "table_from_points", "StribeckFit", "fit_stribeck",
+           "IdimResult", "idim_ls"]
+
+
+# --- stiction -----------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class Pulse:
+    """One PWM pulse of a breakaway test."""
+
+    start: int
+    stop: int
+    pwm: float
+    moved: bool
+    position: float  # at the pulse start
+    moving_samples: int
+
+
+@dataclass(frozen=True)
+class BreakawayResult:
+    """Result of :func:`detect_breakaway`.
+
+    ``breakaway`` holds one row per series: position at the first moving pulse, its PWM (the
+    thesis's Table 6.1 value), the last still PWM before it, and the stiction torque estimate
+    (midpoint) with its quantisation std, when a motor model was given.
+    """
+
+    pulses: tuple[Pulse, ...]
+    breakaway: tuple[dict, ...]
+    stiction: float | None = None
+    stiction_std: float | None = None
+    pwm_mean: float | None = None
+
+    def table(self) -> list[list]:
+        return [[b["position"], b["pwm"], b["pwm_still"], b.get("torque")] for b in self.breakaway]
+
+
+def _pulses(pwm: np.ndarray) -> list[tuple[int, int]]:
+    on = pwm != 0
+    d = np.diff(on.astype(np.int8))
+    starts = list(np.flatnonzero(d == 1) + 1)
+    stops = list(np.flatnonzero(d == -1) + 1)
+    if on[0]:
+        starts.insert(0, 0)
+    if on[-1]:
+        stops.append(len(pwm))
+    return list(zip(starts, stops))
+
+
+def detect_breakaway(pwm, velocity, position=None, *, velocity_threshold: float = 0.0,
+                     min_moving_samples: int = 1,
+                     torque_at: Callable[[float, float], float] | None = None) -> BreakawayResult:
+    """Breakaway PWM of each series of increasing PWM pulses (§6.2, Appendix C).
+
+    Parameters
+    ----------
+    pwm, velocity, position
+        Logged PWM command, joint velocity (rad/s) and, optionally, joint position (rad), one
+        value per sample.
+    velocity_threshold
+        A sample "moves" when |velocity| > threshold (Appendix C: ``~= 0``, i.e. 0).
+    min_moving_samples
+        A pulse moved the joint when more than this many samples moved (Appendix C: 1000 at its
+        logging rate).
+    torque_at
+        ``torque_at(pwm, position)`` → joint torque (N·m) the motor exerts at zero speed minus any
+        load at that position; when given, the stiction torque is estimated.
+    """
+    u = np.asarray(pwm, dtype=np.float64)
+    v = np.asarray(velocity, dtype=np.float64)
+    if u.ndim != 1 or v.shape != u.shape:
+        raise DataError(f"pwm and velocity: expected 1-D arrays of equal length, found {u.shape}, {v.shape}")
+    x = np.zeros_like(u) if position is None else np.asarray(position, dtype=np.float64)
+    if x.shape != u.shape:
+        raise DataError(f"position: expected {u.shape[0]} samples, found {x.shape}")
+    for name, a in (("pwm", u), ("velocity", v), ("position", x)):
+        if not np.isfinite(a).all():
+            raise DataError(f"{name} contains NaN or inf")
+    pulses = []
+    for a, b in _pulses(u):
+        seg = u[a:b]
+        if np.ptp(seg) != 0:
+            raise DataError(f"pulse at samples {a}..{b} does not hold a constant PWM "
+                            f"({seg.min():g}..{seg.max():g})", hint="give the raw command, one pulse per step")
+        nmov = int((np.abs(v[a:b]) > velocity_threshold).sum())
+        pulses.append(Pulse(a, b, float(seg[0]), nmov > min_moving_samples, float(x[a]), nmov))
+    if not pulses:
+        raise DataError("no PWM pulses found (the PWM column is zero everywhere)")
+    rows = []
+    prev = None
+    found = False
+    still = math.nan
+    for pl in pulses:
+        new_series = prev is None or abs(pl.pwm) <= abs(prev.pwm) or np.sign(pl.pwm) != np.sign(prev.pwm)
+        if new_series:
+            found = False
+            still = math.nan
+        if not found:
+            if pl.moved:
+                row = dict(position=pl.position, pwm=pl.pwm, pwm_still=still)
+                if torque_at is not None:
+                    lo = still if math.isfinite(still) else pl.pwm
+                    t_hi = float(torque_at(pl.pwm, pl.position))
+                    t_lo = float(torque_at(lo, pl.position))
+                    row["torque"] = 0.5 * (t_hi + t_lo)
+                    row["torque_std"] = abs(t_hi - t_lo) / math.sqrt(12.0)
+                rows.append(row)
+                found = True
+            else:
+                still = pl.pwm
+        prev = pl
+    if not rows:
+        raise IdentificationError("no pulse moved the joint: the PWM never exceeded stiction",
+                                  hint="extend the PWM ramp or lower velocity_threshold")
+    stiction = stiction_std = None
+    pwm_mean = float(np.mean([abs(r["pwm"]) for r in rows]))
+    if torque_at is not None:
+        t = np.array([abs(r["torque"]) for r in rows])
+        q = np.array([r["torque_std"] for r in rows])
+        stiction = float(t.mean())
+        spread = t.std(ddof=1) if t.size > 1 else 0.0
+        # std of the mean: scatter over positions and the (correlated) quantisation
+        stiction_std = float(math.sqrt(spread ** 2 / t.size + np.mean(q) ** 2))
+    return BreakawayResult(tuple(pulses), tuple(rows), stiction, stiction_std, pwm_mean)
+
+
+# --- dynamic friction from constant-velocity runs -----------------------------------------------
+
+@dataclass(frozen=True)
+class ConstantVelocityPoint:
+    pwm: float
+    velocity: float
+    velocity_std: float
+    friction: float
+    friction_std: float
+    n_samples: int
+
+
+def constant_velocity_friction(pwm, velocity, *, motor_torque: Callable[[float, float], float],
+                               load: Callable[[int], float] | None = None,
+                               plateau: float = 0.05, min_samples: int = 10) -> list[ConstantVelocityPoint]:
+    """One friction point per constant-PWM run (Appendix D).
+
+    The plateau of each run is the set of samples whose velocity lies within ``plateau``
+    (relative) of the run's peak speed; friction = ``motor_torque(pwm, v)`` − ``load(i)`` at the
+    plateau's mean velocity. The friction std propagates the plateau's velocity scatter through the
+    motor's torque-speed slope.
+    """
+    u = np.asarray(pwm, dtype=np.float64)
+    v = np.asarray(velocity, dtype=np.float64)
+    if u.ndim != 1 or v.shape != u.shape:
+        raise DataError(f"pwm and velocity: expected 1-D arrays of equal length, found {u.shape}, {v.shape}")
+    if not (np.isfinite(u).all() and np.isfinite(v).all()):
+        raise DataError("pwm or velocity contains NaN or inf")
+    pts = []
+    for a, b in _pulses(u):
+        seg = v[a:b]
+        peak = np.max(np.abs(seg))
+        if peak == 0:
+            continue
+        sel = np.abs(seg) >= (1.0 - plateau) * peak
+        if sel.sum() < min_samples:
+            continue
+        vv = seg[sel]
+        vm = float(vv.mean())
+        vs = float(vv.std(ddof=1) / math.sqrt(vv.size)) if vv.size > 1 else 0.0
+        tau = float(motor_torque(u[a], vm))
+        dv = max(abs(vm) * 1e-6, 1e-9)
+        slope = (float(motor_torque(u[a], vm + dv)) - float(motor_torque(u[a], vm - dv))) / (2 * dv)
+        ld = 0.0 if load is None else float(np.mean([load(i) for i in range(a, b)][::max(1, (b - a) // 20)]))
+        pts.append(ConstantVelocityPoint(float(u[a]), vm, vs, tau - ld, abs(slope) * vs, int(sel.sum())))
+    if len(pts) < 2:
+        raise IdentificationError(f"only {len(pts)} constant-PWM runs reached a plateau",
+                                  hint="log longer runs, or lower min_samples")
+    return pts
+
+
+def table_from_points(points: Sequence[ConstantVelocityPoint], name: str = "identified friction") -> FrictionTable:
+    """A lookup table (§6.3) from constant-velocity points, sorted by velocity; points at equal
+    velocity are averaged."""
+    v = np.array([p.velocity for p in points])
+    f = np.array([p.friction for p in points])
+    order = np.argsort(v)
+    v, f = v[order], f[order]
+    uv, inv = np.unique(v, return_inverse=True)
+    uf = np.bincount(inv, weights=f) / np.bincount(inv)
+    return FrictionTable(uv, uf, name=name, source="identified from constant-velocity runs")
+
+
+@dataclass(frozen=True)
+class StribeckFit:
+    """Result of :func:`fit_stribeck`: parameter values and standard deviations (SI), the
+    covariance over the free ones, residual RMS (N·m)."""
+
+    values: dict
+    std: dict
+    free: tuple[str, ...]
+    covariance: np.ndarray
+    rms: float
+    n: int
+
+    def __call__(self, v) -> np.ndarray:
+        p = self.values
+        v = np.asarray(v, dtype=np.float64)
+        mag = p["fc"] + (p["fs"] - p["fc"]) * np.exp(-np.abs(v / p["vs"]) ** p["delta"])
+        return np.where(v == 0, 0.0, np.sign(v) * mag + p["sigma"] * v + p["cubic"] * v ** 3)
+
+
+_STRIBECK = ("fc", "fs", "vs", "delta", "sigma", "cubic")
+
+
+def fit_stribeck(velocity, friction, *, weights=None, fixed: dict | None = None,
+                 initial: dict | None = None) -> StribeckFit:
+    """Fit F(v) = sign(v)(F_c + (F_s − F_c) e^{−|v/v_s|^δ}) + σ v + σ₃ v³ (eq 6.5 plus the cubic
+    term of [50]) by nonlinear least squares.
+
+    ``fixed`` holds parameters known from elsewhere (e.g. ``fs`` from a breakaway test; ``vs`` and
+    ``delta`` when the data hold no low-velocity points — constant-velocity tables rarely do);
+    ``weights`` are per-point 1/σ. Raises :class:`UnidentifiableError` when the data do not
+    determine the free parameters (and names them).
+    """
+    from scipy.optimize import least_squares
+
+    v = np.asarray(velocity, dtype=np.float64)
+    f = np.asarray(friction, dtype=np.float64)
+    if v.ndim != 1 or f.shape != v.shape:
+        raise DataError(f"velocity and friction: expected 1-D arrays of equal length, found {v.shape}, {f.shape}")
+    if not (np.isfinite(v).all() and np.isfinite(f).all()):
+        raise DataError("velocity or friction contains NaN or inf")
+    if (v == 0).any():
+        raise DataError("friction at zero velocity is stiction, not kinetic friction; drop those points")
+    fixed = dict(fixed or {})
+    unknown = set(fixed) - set(_STRIBECK)
+    if unknown:
+        raise DataError(f"fixed: unknown parameters {sorted(unknown)}; known: {_STRIBECK}")
+    lo_mag = float(np.min(np.abs(f)))
+    start = dict(fc=0.8 * lo_mag, fs=1.2 * lo_mag, vs=0.1 * float(np.max(np.abs(v))), delta=2.0,
+                 sigma=0.0, cubic=0.0)
+    start.update(initial or {})
+    start.update(fixed)
+    free = tuple(n for n in _STRIBECK if n not in fixed)
+    if v.size <= len(free):
+        raise DataError(f"{v.size} points cannot determine {len(free)} parameters {free}")
+    w = np.ones_like(v) if weights is None else np.asarray(weights, dtype=np.float64)
+    scale = np.array([max(abs(start[n]), 1e-3) for n in free])
+    vmax = float(np.max(np.abs(v)))
+
+    def unpack(z):
+        p = dict(start)
+        p.update(dict(zip(free, z * scale)))
+        return p
+
+    def model(p):
+        mag = p["fc"] + (p["fs"] - p["fc"]) * np.exp(-np.abs(v / p["vs"]) ** p["delta"])
+        return np.sign(v) * mag + p["sigma"] * v + p["cubic"] * v ** 3
+
+    lb = {"fc": 0.0, "fs": 0.0, "vs": 1e-6 * vmax, "delta": 0.2, "sigma": -np.inf, "cubic": -np.inf}
+    ub = {"fc": np.inf, "fs": np.inf, "vs": 10 * vmax, "delta": 10.0, "sigma": np.inf, "cubic": np.inf}
+    res = least_squares(lambda z: (model(unpack(z)) - f) * w, np.array([start[n] for n in free]) / scale,
+                        bounds=(np.array([lb[n] for n in free]) / scale, np.array([ub[n] for n in free]) / scale),
+                        x_scale="jac")
+    p = {k: float(val) for k, val in unpack(res.x).items()}
+    J = res.jac / scale  # d r / d θ
+    dof = v.size - len(free)
+    s2 = float(np.sum(res.fun ** 2) / dof)
+    U, sv, Vt = np.linalg.svd(J * scale, full_matrices=False)
+    if sv[-1] < 1e-10 * sv[0]:
+        null = Vt[-1]
+        names = [free[i] for i in np.argsort(-np.abs(null))[:2]]
+        raise UnidentifiableError(f"the data do not determine {' and '.join(names)} (singular "
+                                  f"Jacobian, condition {sv[0] / max(sv[-1], 1e-300):.3g})",
+                                  hint="fix one of them (fixed={...}) or add low-velocity points")
+    cov = s2 * np.linalg.inv(J.T @ J)
+    std = {n: float(math.sqrt(max(cov[i, i], 0.0))) for i, n in enumerate(free)}
+    std.update({n: 0.0 for n in fixed})
+    rms = float(np.sqrt(np.mean((model(p) - f) ** 2)))
+    return StribeckFit(p, std, free, cov, rms, int(v.size))
+
+
+# --- IDIM-LS ------------------------------------------------------------------------------------
+
+@dataclass(frozen=True)
+class IdimResult:
+    """Single-axis IDIM-LS result: ``params`` and ``std`` hold ``inertia`` (kg·m² or kg),
+    ``viscous`` (N·m·s/rad or N·s/m), ``coulomb`` and ``offset`` (N·m or N)."""
+
+    params: dict
+    std: dict
+    covariance: np.ndarray
+    relative_error_percent: float
+    n_samples: int
+    fs: float
+    cutoff: float
+    decimation: int
+    condition_number: float
+    residual_std: float
+    notes: list = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        return dict(params=self.params, std=self.std, relative_error_percent=self.relative_error_percent,
+                    n_samples=self.n_samples, fs=self.fs, cutoff_hz=self.cutoff, decimation=self.decimation,
+                    condition_number=self.condition_number, residual_std=self.residual_std,
+                    covariance=self.covariance.tolist(), notes=list(self.notes))
+
+
+_IDIM = ("inertia", "viscous", "coulomb", "offset")
+
+
+def idim_ls(position, effort, fs: float, *, effort_scale: float = 1.0, cutoff: float | None = None,
+            order: int = 4, decimation: int | None = None,
+            velocity_threshold: float | None = None) -> IdimResult:
+    """Identify τ = J q̈ + F_v q̇ + F_c sign(q̇) + τ₀ from position and effort logs (module doc).
+
+    Parameters
+    ----------
+    position
+        Joint position samples (rad, or m), uniformly sampled at ``fs`` Hz.
+    effort
+        Effort column; the effort is ``effort_scale × effort`` (e.g. a current in A times the
+        torque constant and gear ratio, or a PWM count times N·m per count).
+    cutoff
+        Low-pass cutoff (Hz) of the zero-phase Butterworth filter; default fs/20.
+    order
+        Filter order (the zero-phase filter has twice this order).
+    decimation
+        Keep every q-th filtered sample; default the largest q with fs/(2q) ≥ 2.5·cutoff.
+    velocity_threshold
+        Drop samples with |q̇| below it; default 2 % of the largest |q̇|.
+    """
+    from ..signals.filters import apply_sos, butter_sos
+
+    x = np.asarray(position, dtype=np.float64)
+    e = np.asarray(effort, dtype=np.float64)
+    if x.ndim != 1 or e.shape != x.shape:
+        raise DataError(f"position and effort: expected 1-D arrays of equal length, found {x.shape}, {e.shape}")
+    for name, a in (("position", x), ("effort", e)):
+        bad = ~np.isfinite(a)
+        if bad.any():
+            raise DataError(f"{name} has {int(bad.sum())} non-finite values (first at sample {int(np.argmax(bad))})")
+    if not (np.isfinite(fs) and fs > 0):
+        raise DataError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
+    if not (np.isfinite(effort_scale) and effort_scale != 0):
+        raise DataError(f"effort scale: expected a finite non-zero factor, found {effort_scale!r}")
+    cutoff = fs / 20.0 if cutoff is None else float(cutoff)
+    if not 0 < cutoff < fs / 2:
+        raise DataError(f"cutoff {cutoff:g} Hz must lie between 0 and fs/2 = {fs / 2:g} Hz")
+    q = decimation if decimation is not None else max(1, int(fs / (2 * 2.5 * cutoff)))
+    if int(q) != q or q < 1:
+        raise DataError(f"decimation: expected a positive integer, found {decimation!r}")
+    q = int(q)
+    notes = []
+    if fs / (2 * q) < cutoff:
+        notes.append(f"decimation {q} puts the new Nyquist frequency {fs / (2 * q):g} Hz below the "
+                     f"cutoff {cutoff:g} Hz: the decimated rows alias")
+    edge = int(math.ceil(3 * fs / cutoff))
+    if x.size < 2 * edge + 50 * q:
+        raise DataError(f"{x.size} samples are too few for IDIM-LS at fs = {fs:g} Hz with a {cutoff:g} Hz "
+                        f"filter (need more than {2 * edge + 50 * q})", hint="log a longer run")
+    sos = butter_sos(order, cutoff, fs)
+    xf = apply_sos(sos, x, zero_phase=True)
+    ef = apply_sos(sos, e * effort_scale, zero_phase=True)
+    dt = 1.0 / fs
+    vel = np.gradient(xf, dt)
+    acc = np.gradient(vel, dt)
+    sl = slice(edge, x.size - edge, q)
+    vel, acc, y = vel[sl], acc[sl], ef[sl]
+    vmax = float(np.max(np.abs(vel)))
+    if vmax == 0:
+        raise UnidentifiableError("the position never changes: the data cannot identify friction or inertia")
+    thr = 0.02 * vmax if velocity_threshold is None else float(velocity_threshold)
+    keep = np.abs(vel) > thr
+    if keep.sum() < 20:
+        raise UnidentifiableError(f"only {int(keep.sum())} samples move faster than {thr:.3g}",
+                                  hint="excite the joint more, or lower --velocity-threshold")
+    vel, acc, y = vel[keep], acc[keep], y[keep]
+    if (vel > 0).all() or (vel < 0).all():
+        raise UnidentifiableError("the joint moves in one direction only: Coulomb friction and the "
+                                  "offset cannot be told apart", hint="excite both directions")
+    X = np.column_stack([acc, vel, np.sign(vel), np.ones_like(vel)])
+    colscale = np.sqrt(np.mean(X ** 2, axis=0))
+    if (colscale == 0).any():
+        raise UnidentifiableError("a regressor column is zero (no acceleration or no motion)")
+    Xs = X / colscale
+    sv = np.linalg.svd(Xs, compute_uv=False)
+    cond = float(sv[0] / max(sv[-1], 1e-300))
+    if cond > 1e8:
+        raise UnidentifiableError(f"the regressor is ill-conditioned (condition number {cond:.3g}): the "
+                                  f"motion does not separate inertia, viscous and Coulomb friction",
+                                  hint="use a richer excitation (several frequencies, both directions)")
+    theta_s, *_ = np.linalg.lstsq(Xs, y, rcond=None)
+    theta = theta_s / colscale
+    r = y - X @ theta
+    n = y.size
+    s2 = float(r @ r / (n - 4))
+    cov = s2 * np.linalg.inv(X.T @ X)
+    std = np.sqrt(np.diag(cov))
+    rel = float(100.0 * np.linalg.norm(r) / max(np.linalg.norm(y), 1e-300))
+    if cond > 1e4:
+        notes.append(f"regressor condition number {cond:.3g}: weak excitation")
+    return IdimResult(dict(zip(_IDIM, map(float, theta))), dict(zip(_IDIM, map(float, std))), cov,
+                      rel, int(n), float(fs), float(cutoff), q, cond, float(math.sqrt(s2)), notes)

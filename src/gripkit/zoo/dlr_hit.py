@@ -1,0 +1,440 @@
+"""The DLR/HIT Hand II finger and five-finger hand (``002_ddea254371185ad3.txt``), with the
+thesis's parameters and their provenance, and the checks of where its printed numbers disagree.
+
+Finger parameters (Appendices B and F, SI units): l1 = 55 mm, l2 = l3 = 25 mm; m1, m2, m3 and the
+centre-of-mass vectors pc1..pc3 as printed, in the DH frames of the links they belong to (link 2
+= proximal phalanx after the flexion joint, link 3 and link 4 after the proximal and distal joints;
+the zero-length link between the two base joints is massless, Appendix A sets l0 = m0 = 0).
+
+Inertia tensors — the thesis does not print them. Its printed mass term (Appendix F, M1) contains
+every centre-of-mass term twice (``2·l1c²·m1·cos(t2)²``, ``l2c²·m2 + l2c²·m2·cos(2t2+2t3)``, ...):
+once as the point mass and once as the link's own inertia. That is exactly a thin-rod tensor with
+the centre of mass on the link axis at distance lc = |pc|, I_C = diag(0, m·lc², m·lc²) in the link
+frame (x along the link). gripkit uses these tensors (with the printed pc vectors, not their
+norms) and its tests reproduce M1 and the centrifugal terms C2, C3 of Appendices B/F exactly when
+the centres of mass are put on the link axes as the thesis does.
+
+Rotor inertia I_m = 5.1·10⁻⁷ kg·m² (Appendix A), reflected through N = 208.3 (distal) and
+234.3 (base): 0.0221 and 0.0280 kg·m² — a hundred times the links' own inertia.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+from numba import prange
+
+from ..consistency import Finding, compare
+from ..errors import ModelError, SimulationError
+from ..models.bldc import BLDCMotor, motor_parameters
+from ..models.dlr_finger import (ACTUATORS, FINGER_PARAMETERS, FRICTION_MODES, INTEGRATORS, NTH,
+                                 NX, NY, DLRFinger, finger_run)
+from ..models.friction import dlr_hit_table
+from ..params import Parameter, ParameterSet
+from ..sim.model import Model, Signal
+
+__all__ = ["finger_parameters", "finger_tables", "finger", "hand", "DLRHITFinger", "DLRHand",
+           "FINGERS", "palm_frames", "TABLE_6_1", "BASE2_CORRECTION"]
+
+SEED = "002_ddea254371185ad3.txt"
+DEG = math.pi / 180.0
+#: Table 6.1 (distal stiction): (position °, breakaway PWM); the PWMs of the last seven positions
+#: (43–59°) are lost in the extraction
+TABLE_6_1 = ((8, -1300), (8, 1200), (11, -1250), (13, 1250), (19, -1350), (23, 1250), (24, 1300),
+             (27, -1300), (29, 1300), (33, -1350), (34, 1350), (37, -1350), (38, 1100), (43, -1200))
+#: friction correction factor of base joint 2 (§6.3, §7: base 1's table "multiplied with a
+#: correcting factor"; its value is not printed). Derived: Fig. 6.6 (base 2) reaches −1 N·m on
+#: its friction axis where Fig. 6.5 (base 1) ends at −0.8 N·m.
+BASE2_CORRECTION = 1.25
+#: §6.3: "The maximum influence of dynamics (equations 4.18–4.20) is 7.1 mNm"
+DYNAMICS_INFLUENCE = 7.1e-3
+FINGERS = ("thumb", "index", "middle", "ring", "little")
+
+
+def _pc(k):
+    return {1: (3.0164510e-02, -1.0130813e-03, 5.0813186e-04),
+            2: (5.7271879e-03, -1.6164173e-03, -1.1567914e-03),
+            3: (6.1007977e-03, -8.3348211e-04, 1.7728256e-03)}[k]
+
+
+def finger_parameters(**overrides) -> ParameterSet:
+    """The finger's parameters (every name of :data:`FINGER_PARAMETERS`) with provenance;
+    ``overrides`` replace values (SI, or strings with units)."""
+    F = f"{SEED}, Appendix F"
+    masses = (4.4370598e-02, 2.7110192e-02, 1.8179709e-02)
+    ps = [
+        Parameter("l1", 55e-3, "m", "proximal phalanx length (flexion → proximal joint)", bounds=(0, None), source=F, display_unit="mm"),
+        Parameter("l2", 25e-3, "m", "middle phalanx length (proximal → distal joint)", bounds=(0, None), source=F, display_unit="mm"),
+        Parameter("l3", 25e-3, "m", "distal phalanx length (distal joint → fingertip)", bounds=(0, None), source=F, display_unit="mm"),
+    ]
+    for k in range(3):
+        ps.append(Parameter(f"m{k + 1}", masses[k], "kg", f"mass of phalanx {k + 1}", bounds=(0, None), source=F, display_unit="g"))
+    for k in range(3):
+        for j, ax in enumerate("xyz"):
+            ps.append(Parameter(f"pc{k + 1}_{ax}", _pc(k + 1)[j], "m", f"centre of mass of phalanx {k + 1}, {ax} (link frame)",
+                                source=F, display_unit="mm"))
+    for k in range(3):
+        lc2 = float(np.sum(np.square(_pc(k + 1))))
+        I = masses[k] * lc2  # noqa: E741
+        src = "derived: Appendix F's M1 implies a thin rod, I = m·|pc|² about axes ⟂ the link"
+        ps += [Parameter(f"I{k + 1}_xx", 0.0, "kg*m^2", f"phalanx {k + 1} inertia about its axis (COM)", bounds=(0, None), source=src),
+               Parameter(f"I{k + 1}_yy", I, "kg*m^2", f"phalanx {k + 1} inertia ⟂ axis, y (COM)", bounds=(0, None), source=src),
+               Parameter(f"I{k + 1}_zz", I, "kg*m^2", f"phalanx {k + 1} inertia ⟂ axis, z (COM)", bounds=(0, None), source=src)]
+    ps += [
+        Parameter("I_m", 5.1e-7, "kg*m^2", "motor rotor inertia", bounds=(0, None), source=f"{SEED}, Appendix A (Im1m = 5.1e-07)"),
+        Parameter("beta", math.pi / 4, "rad", "angle of the base motors to the dynamics axes", bounds=(0.01, 1.56),
+                  fixed=True, source=f"{SEED}, Fig. 7.2 (±45°)", display_unit="deg"),
+        Parameter("g_x", 0.0, "m/s^2", "gravity in the finger base frame, x", source="assumed: palm horizontal, facing down"),
+        Parameter("g_y", 0.0, "m/s^2", "gravity in the finger base frame, y", source="assumed: palm horizontal, facing down"),
+        Parameter("g_z", -9.81, "m/s^2", "gravity in the finger base frame, z (abduction axis)",
+                  source=f"{SEED}, Appendix F (g = 9.81); direction assumed"),
+        Parameter("N_hd", 100.0, "1", "harmonic drive reduction", bounds=(1e-3, None), source=f"{SEED}, §3.1 and Appendix E"),
+        Parameter("N_belt", 2.083, "1", "timing belt motor → harmonic drive", bounds=(1e-3, None), source=f"{SEED}, Appendix E"),
+        Parameter("N_belt_base", 1.125, "1", "timing belt harmonic drive → bevel gears (base)", bounds=(1e-3, None),
+                  source=f"{SEED}, Appendix E"),
+        Parameter("eta", 1.0, "1", "transmission efficiency (losses are in the friction tables)", bounds=(0.05, 1.0),
+                  source=f"{SEED}, Appendix E (no losses)"),
+    ]
+    ps += list(motor_parameters().values())
+    fric = [
+        Parameter("fs_base1", 0.36, "N*m", "stiction of base drive 1", bounds=(0, None), source=f"{SEED}, Appendix F (stiction = 0.36)"),
+        Parameter("fs_base2", 0.36, "N*m", "stiction of base drive 2", bounds=(0, None), source=f"{SEED}, Appendix F (stiction = 0.36)"),
+        Parameter("fs_distal", 0.36, "N*m", "stiction of the proximal/distal drive", bounds=(0, None),
+                  source=f"{SEED}, Appendix F (stiction = 0.36; PWM 1200 via eq 5.7 × 208.3)"),
+        Parameter("scale_base1", 1.0, "1", "factor on Appendix G's base table, base drive 1", bounds=(0, None), source=f"{SEED}, §6.3"),
+        Parameter("scale_base2", BASE2_CORRECTION, "1", "correction factor on the base table, base drive 2", bounds=(0, None),
+                  source=f"derived: {SEED}, Fig. 6.6 vs Fig. 6.5 friction axes (−1 vs −0.8 N·m); §6.3 prints no value"),
+        Parameter("scale_distal", 1.0, "1", "factor on Appendix G's distal table", bounds=(0, None), source=f"{SEED}, §6.3"),
+        Parameter("fc_base1", 0.0940, "N*m", "Coulomb friction (Stribeck option), base 1", bounds=(0, None),
+                  source="fitted to Appendix G's base table (fs = 0.36, v_s = 0.1 rad/s, δ = 2 fixed): 0.094 ± 0.021"),
+        Parameter("fc_base2", 0.0940 * BASE2_CORRECTION, "N*m", "Coulomb friction (Stribeck option), base 2", bounds=(0, None),
+                  source="base 1 value × the base-2 correction factor"),
+        Parameter("fc_distal", 0.1877, "N*m", "Coulomb friction (Stribeck option), distal", bounds=(0, None),
+                  source="fitted to Appendix G's distal table (fs = 0.36, v_s = 0.1 rad/s, δ = 2 fixed): 0.188 ± 0.011"),
+        Parameter("visc_base1", 0.0555, "N*m*s/rad", "viscous friction (Stribeck option), base 1", bounds=(0, None),
+                  source="fitted to Appendix G's base table: 0.055 ± 0.014"),
+        Parameter("visc_base2", 0.0555 * BASE2_CORRECTION, "N*m*s/rad", "viscous friction (Stribeck option), base 2", bounds=(0, None),
+                  source="base 1 value × the base-2 correction factor"),
+        Parameter("visc_distal", 0.0, "N*m*s/rad", "viscous friction (Stribeck option), distal", bounds=(0, None),
+                  source="fitted to Appendix G's distal table: -0.001 ± 0.007, i.e. 0"),
+        Parameter("cubic_base1", 0.00578, "N*m*s^3/rad^3", "cubic velocity friction (Stribeck option), base 1",
+                  source="fitted to Appendix G's base table: 0.0058 ± 0.0008 (cubic term of [50], §3.2.2)"),
+        Parameter("cubic_base2", 0.00578 * BASE2_CORRECTION, "N*m*s^3/rad^3", "cubic velocity friction, base 2",
+                  source="base 1 value × the base-2 correction factor"),
+        Parameter("cubic_distal", 0.00352, "N*m*s^3/rad^3", "cubic velocity friction (Stribeck option), distal",
+                  source="fitted to Appendix G's distal table: 0.0035 ± 0.0003"),
+        Parameter("v_s", 0.1, "rad/s", "Stribeck velocity (Stribeck and LuGre options)", bounds=(1e-9, None),
+                  source="assumed: below the tables' lowest velocity (20 °/s)"),
+        Parameter("delta", 2.0, "1", "Stribeck shape factor", bounds=(-10.0, 10.0), source="assumed (Gaussian Stribeck)"),
+        Parameter("sigma0", 360.0, "N*m/rad", "LuGre bristle stiffness", bounds=(1e-9, None),
+                  source="assumed: pre-sliding deflection fs/σ0 = 1 mrad"),
+        Parameter("sigma1", 2.8, "N*m*s/rad", "LuGre bristle damping", bounds=(0, None),
+                  source="assumed: σ1 = sqrt(σ0·J), damping ratio ~0.5 in pre-sliding"),
+        Parameter("ripple_amp", 0.0, "N*m", "harmonic-drive friction ripple amplitude", bounds=(0, None),
+                  source=f"{SEED}, §3.2.2 (not quantified; off)"),
+        Parameter("ripple_cycles", 200.0, "1", "ripple periods per output revolution",
+                  bounds=(0, None), source="assumed: two per wave-generator turn, 100:1"),
+        Parameter("v_stick", 1e-5, "rad/s", "Karnopp zero-velocity band", bounds=(0, None), source="assumed"),
+        Parameter("abd_min", -30 * DEG, "rad", "abduction limit, lower", source="assumed (range not printed)", display_unit="deg"),
+        Parameter("abd_max", 30 * DEG, "rad", "abduction limit, upper", source="assumed (range not printed)", display_unit="deg"),
+        Parameter("flex_min", 0.0, "rad", "base flexion limit, lower", source="assumed (range not printed)", display_unit="deg"),
+        Parameter("flex_max", 90 * DEG, "rad", "base flexion limit, upper", source="assumed (range not printed)", display_unit="deg"),
+        Parameter("prox_min", 0.0, "rad", "proximal (= distal) limit, lower", source="assumed (range not printed)", display_unit="deg"),
+        Parameter("prox_max", 90 * DEG, "rad", "proximal (= distal) limit, upper", source="assumed (range not printed)", display_unit="deg"),
+        Parameter("k_stop", 60.0, "N*m/rad", "end-stop stiffness (belt and harmonic-drive elasticity)", bounds=(0, None),
+                  source="assumed: brakes the finger within ~30 ms (§7.1, 'high negative slope')"),
+        Parameter("d_stop", 0.45, "N*m*s/rad", "end-stop damping", bounds=(0, None),
+                  source="assumed: damping ratio ~0.2, 'resilience ... after the braking' (§7.1)"),
+    ]
+    ps += fric
+    pset = ParameterSet(ps, "dlr-hit-finger")
+    if tuple(pset.names) != FINGER_PARAMETERS:
+        raise ModelError("internal: finger parameter order does not match FINGER_PARAMETERS")
+    return pset.replace(**overrides) if overrides else pset
+
+
+def finger_tables(base2_scale: float = 1.0):
+    """Appendix G's tables for (base1, base2, distal); the base-2 correction factor is the
+    ``scale_base2`` parameter, so the tables themselves are unscaled by default."""
+    base = dlr_hit_table("base")
+    return (base, base.scaled(base2_scale), dlr_hit_table("distal"))
+
+
+class DLRHITFinger(DLRFinger):
+    """:class:`~gripkit.models.dlr_finger.DLRFinger` with the thesis's numbers and its checks."""
+
+    def consistency_checks(self) -> list[Finding]:
+        return _finger_checks(self)
+
+
+def finger(*, friction: str = "table", integrator: str = "semi-implicit", thermal: bool = False,
+           check: bool = True, **overrides) -> DLRHITFinger:
+    """The DLR/HIT Hand II finger of chapter 7 (Fig. 7.1)."""
+    return DLRHITFinger(finger_parameters(**overrides), finger_tables(), friction=friction,
+                        integrator=integrator, thermal=thermal, check=check)
+
+
+# --- consistency checks ---------------------------------------------------------------------------
+
+def _motor(model) -> BLDCMotor:
+    names = motor_parameters().names
+    return BLDCMotor(ParameterSet([model.parameters[n] for n in names], "bldc"))
+
+
+def _thesis_M1(model, t2: float, t3: float) -> float:
+    """Appendix F's printed M1 (abduction mass term) with lc = |pc| (the thesis's simplification)."""
+    v = model.parameters.value
+    l1, l2 = v("l1"), v("l2")
+    m1, m2, m3 = v("m1"), v("m2"), v("m3")
+    l1c, l2c, l3c = (math.sqrt(v(f"pc{k}_x") ** 2 + v(f"pc{k}_y") ** 2 + v(f"pc{k}_z") ** 2) for k in (1, 2, 3))
+    N1 = v("N_hd") * v("N_belt") * v("N_belt_base")
+    c = math.cos
+    return (v("I_m") * N1 ** 2 + (l2 ** 2 * m3) / 2 + l2c ** 2 * m2 + l3c ** 2 * m3
+            + (l2 ** 2 * m3 * c(2 * t2 + 2 * t3)) / 2 + l2c ** 2 * m2 * c(2 * t2 + 2 * t3)
+            + l3c ** 2 * m3 * c(2 * t2 + 4 * t3) + l1 ** 2 * m2 * c(t2) ** 2 + l1 ** 2 * m3 * c(t2) ** 2
+            + 2 * l1c ** 2 * m1 * c(t2) ** 2 + l1 * l3c * m3 * c(2 * t2 + 2 * t3)
+            + l2 * l3c * m3 * c(2 * t2 + 3 * t3) + l1 * l2 * m3 * c(t3) + l1 * l2c * m2 * c(t3)
+            + l2 * l3c * m3 * c(t3) + l1 * l2 * m3 * c(2 * t2 + t3) + l1 * l2c * m2 * c(2 * t2 + t3)
+            + l1 * l3c * m3 * c(2 * t3))
+
+
+def max_gravity_torque(model, n: int = 19) -> np.ndarray:
+    """Largest |G| per joint (abduction, flexion, proximal incl. the coupled distal torque) over a
+    grid of the joint ranges, N·m."""
+    v = model.parameters.value
+    ch = model.chain()
+    grids = [np.linspace(v(f"{j}_min"), v(f"{j}_max"), n) for j in ("abd", "flex", "prox")]
+    Q = np.array(np.meshgrid(*grids, indexing="ij")).reshape(3, -1).T
+    q4 = np.column_stack([Q, Q[:, 2]])
+    g = ch.chain.gravity_torque(q4)
+    return np.array([np.abs(g[:, 0]).max(), np.abs(g[:, 1]).max(), np.abs(g[:, 2] + g[:, 3]).max()])
+
+
+def _finger_checks(model) -> list[Finding]:
+    subj = model.name
+    v = model.parameters.value
+    out = list(_motor(model).consistency_checks())
+    N = model.ratios()
+    c = v("c_pwm")
+    # stiction: §6.2's procedure (PWM 1200 through eq 5.7 and the gear ratio) vs Appendix F's 0.36
+    for k, a in enumerate(ACTUATORS):
+        out.append(compare(f"stiction-{a}", subj, computed=c * 1200 * N[k], stated=v(f"fs_{a}"), rtol=0.03,
+                           what=f"§6.2: PWM 1200 × eq 5.7 × N = {N[k]:.4g}", unit="N*m",
+                           used=f"gripkit uses fs_{a} = {v(f'fs_{a}'):.3g} N·m (Appendix F, the value the thesis "
+                                f"simulated); set fs_{a}={c * 1200 * N[k]:.3g} to follow §6.2",
+                           source=f"{SEED}, §6.2 and Appendix F"))
+    pw = np.array([abs(p) for _, p in TABLE_6_1], dtype=float)
+    out.append(compare("table-6.1-mean", subj, computed=float(pw.mean()), stated=1200.0, rtol=0.05,
+                       what=f"mean |PWM| of the {pw.size} legible rows of Table 6.1 (distal breakaway)",
+                       used="gripkit uses PWM 1200 (0.36 N·m) as the thesis does; the distal mean would give "
+                            f"{c * pw.mean() * N[2]:.3g} N·m (seven rows, 43–59°, are lost in the extraction)",
+                       source=f"{SEED}, Table 6.1 and §6.2"))
+    # dynamics influence: §6.3 says at most 7.1 mNm
+    gmax = max_gravity_torque(model)
+    out.append(compare("dynamics-influence-distal", subj, computed=float(gmax[2]), stated=DYNAMICS_INFLUENCE,
+                       rtol=0.25, what="largest gravity torque on the proximal/distal joints (θ4 = θ3)", unit="N*m",
+                       used="gripkit keeps all dynamic terms, as the thesis finally does",
+                       source=f"{SEED}, §6.3"))
+    out.append(compare("dynamics-influence-flexion", subj, computed=float(gmax[1]), stated=DYNAMICS_INFLUENCE,
+                       rtol=0.25, what="largest gravity torque on the base flexion joint", unit="N*m",
+                       used="gripkit keeps all dynamic terms: at the base, gravity reaches "
+                            f"{1e3 * gmax[1]:.3g} mN·m, {100 * gmax[1] / 0.2:.0f} % of the smallest friction (200 mN·m)",
+                       source=f"{SEED}, §6.3 ('maximum influence of dynamics is 7.1 mNm')"))
+    # Appendix G: the fastest breakpoint of each table is where PWM ±4000 balances friction
+    for a, k in (("distal", 2), ("base1", 0)):
+        t = model.tables[k]
+        for i, sgn in ((-1, 1.0), (0, -1.0)):
+            vb = t.velocity[i]
+            tau = float(model.motor_torque(a, sgn * 4000.0, vb))
+            out.append(compare(f"appendix-G-{a}-{'max' if sgn > 0 else 'min'}", subj, computed=tau,
+                               stated=float(t.friction[i] * t.scale), rtol=0.03,
+                               what=f"eq 5.10 at PWM {sgn * 4000:+.0f} and the table's last breakpoint "
+                                    f"{vb / DEG:.4g} °/s", unit="N*m",
+                               used="confirms the recovered table assignment (distal spans ±290 °/s, base ±240 °/s)",
+                               source=f"{SEED}, Appendix G with eq 5.10"))
+    # the lowest breakpoints should be reached at the lowest PWM of Appendix D (1500)
+    t = model.tables[2]
+    vlow = float(np.min(t.velocity[t.velocity > 0]))
+    v1500 = model.steady_velocity("distal", 1500.0)
+    out.append(compare("appendix-G-distal-lowest-velocity", subj, computed=v1500 / DEG, stated=vlow / DEG, rtol=0.25,
+                       what="steady velocity of eq 5.10 against the distal table at PWM 1500 (lowest PWM of §6.2)",
+                       unit="deg/s",
+                       used="gripkit uses eq 5.10 and the table as printed; the table's slowest points imply PWM "
+                            "≈ 1000, below the stiction level, so motor model and table disagree at low speed",
+                       source=f"{SEED}, §6.2 and Appendix G"))
+    out.append(compare("belt-ratio", subj, computed=v("N_belt"), stated=2.1, rtol=0.02,
+                       what="Appendix E's belt ratio 2.083 against §3.1's '1:2.1'",
+                       used="gripkit uses 2.083 (Appendix E)", source=f"{SEED}, §3.1 and Appendix E"))
+    # the thesis's Appendix F mass term (lc = |pc|) against gripkit's (full pc vectors)
+    ch = model.chain()
+    M = ch.mass_matrix(np.zeros(3))
+    # M1 is the abduction term in joint coordinates: Γ is orthogonal at β = 45°, so M_q = Γ M_p Γᵀ
+    G = ch.coupling.matrix[:3]
+    Mq = G @ M @ G.T
+    out.append(compare("appendix-F-M1", subj, computed=float(Mq[0, 0]), stated=_thesis_M1(model, 0.0, 0.0), rtol=0.01,
+                       what="abduction mass term at θ = 0 with the printed pc vectors", unit="kg*m^2",
+                       used="gripkit uses the full pc vectors; the thesis puts the centres of mass on the link axes",
+                       source=f"{SEED}, Appendix F (M1)"))
+    return out
+
+
+# --- the five-finger hand -------------------------------------------------------------------------
+
+def _rot(axis: str, a: float) -> np.ndarray:
+    c, s = math.cos(a), math.sin(a)
+    if axis == "x":
+        return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+    if axis == "y":
+        return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
+    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
+
+
+def palm_frames() -> np.ndarray:
+    """Finger base frames in the palm frame (5, 4, 4): thumb, index, middle, ring, little.
+
+    Palm frame: x towards the fingertips, y towards the thumb, z out of the back of the hand.
+    A finger's base frame has x along the straight finger and z on its abduction axis (the palm
+    normal); positive flexion curls towards the palm. The four fingers sit side by side 22 mm
+    apart at the end of a 90 mm palm, the middle finger 5 mm further out; the thumb is fixed
+    (§3.1: "the thumb is fixed in an appropriate orientation of the palm") at the palm's side,
+    turned 60° towards the fingers and rolled 90° to oppose them. These distances and angles are
+    assumed: the thesis does not give the palm geometry.
+    """
+    T = np.tile(np.eye(4), (5, 1, 1))
+    for i, (y, x) in enumerate(((0.033, 0.090), (0.011, 0.095), (-0.011, 0.090), (-0.033, 0.082)), start=1):
+        T[i, :3, 3] = (x, y, 0.0)
+    T[0, :3, :3] = _rot("z", 60 * DEG) @ _rot("x", 90 * DEG)
+    T[0, :3, 3] = (0.020, 0.045, -0.015)
+    return T
+
+
+@numba.njit(cache=True, parallel=True)
+def _hand_batch(thetas, u, dt, substeps, x0, y, tv, tf, tn, tipos, rot, mode, integ,
+                thermal):  # pragma: no cover - compiled
+    """Five fingers per parameter vector: thetas[p] = shared finger parameters (gravity in the palm
+    frame) followed by 15 friction scales (finger-major: base1, base2, distal)."""
+    P = thetas.shape[0]
+    fail = np.zeros(P * 5, dtype=np.int64)
+    i_scale = 47  # FINGER_PARAMETERS.index("scale_base1") (checked at import)
+    i_g = 26  # FINGER_PARAMETERS.index("g_x")
+    nth = 74  # len(FINGER_PARAMETERS)
+    for job in prange(P * 5):
+        p = job // 5
+        f = job % 5
+        th = thetas[p, :nth].copy()
+        for k in range(3):
+            th[i_scale + k] = thetas[p, nth + 3 * f + k]
+        gx = thetas[p, i_g]
+        gy = thetas[p, i_g + 1]
+        gz = thetas[p, i_g + 2]
+        for k in range(3):  # g in the finger frame = Rᵀ g_palm
+            th[i_g + k] = rot[f, 0, k] * gx + rot[f, 1, k] * gy + rot[f, 2, k] * gz
+        x = x0[p, 15 * f:15 * f + 15].copy()
+        fail[job] = finger_run(th, u, 3 * f, dt, substeps, x, y[p], 18 * f, tv, tf, tn, tipos, mode,
+                               integ, thermal)
+    return fail
+
+
+if (FINGER_PARAMETERS.index("scale_base1"), FINGER_PARAMETERS.index("g_x"), NTH) != (47, 26, 74):
+    raise ImportError("gripkit.zoo.dlr_hit: _hand_batch's parameter indices are out of date")
+
+
+def _hand_parameters(finger_ps: ParameterSet, scales: dict | None) -> ParameterSet:
+    ps = list(finger_ps.values())
+    for i, n in enumerate(("g_x", "g_y", "g_z")):
+        idx = finger_ps.names.index(n)
+        p = ps[idx]
+        ps[idx] = Parameter(p.name, p.value, p.unit, f"gravity in the palm frame, {'xyz'[i]}",
+                            p.bounds, p.fixed, "assumed: palm horizontal, facing down")
+    for f in FINGERS:
+        for a in ACTUATORS:
+            base = finger_ps.value(f"scale_{a}")
+            val = (scales or {}).get(f, {}).get(a, 1.0) * base
+            ps.append(Parameter(f"{f}_scale_{a}", val, "1", f"friction factor, {f} finger, {a} drive",
+                                bounds=(0, None),
+                                source=f"{SEED}, §6.3 (friction differs from finger to finger); default: the measured finger"))
+    return ParameterSet(ps, "dlr-hit-hand")
+
+
+class DLRHand(Model):
+    """Five DLR/HIT II fingers on a palm (§3.1): four fingers and a thumb fixed in its
+    orientation, each with its own friction factors (§6.3). Every finger is a
+    :class:`~gripkit.models.dlr_finger.DLRFinger`; gravity is given in the palm frame and rotated
+    into each finger's base frame (:func:`palm_frames`).
+
+    Inputs: 15 PWM counts, finger-major (``thumb_pwm_base1``, ..., ``little_pwm_distal``);
+    outputs: the 18 finger outputs per finger, prefixed with the finger name; states: 15 per finger.
+    """
+
+    name = "dlr-hit-hand"
+    description = "DLR/HIT Hand II: five identical modular fingers (thumb fixed) on a palm"
+    inputs = tuple(Signal(f"{f}_{s.name}", s.unit, s.doc) for f in FINGERS for s in DLRFinger.inputs)
+    outputs = tuple(Signal(f"{f}_{s.name}", s.unit, s.doc) for f in FINGERS for s in DLRFinger.outputs)
+    states = tuple(Signal(f"{f}_{s.name}", s.unit, s.doc) for f in FINGERS for s in DLRFinger.states)
+
+    def __init__(self, parameters: ParameterSet | None = None, *, friction: str = "table",
+                 integrator: str = "semi-implicit", thermal: bool = False, check: bool = True,
+                 scales: dict | None = None):
+        ps = parameters if parameters is not None else _hand_parameters(finger_parameters(), scales)
+        if ps.names[:NTH] != FINGER_PARAMETERS or len(ps) != NTH + 15:
+            raise ModelError("DLRHand: expected the finger parameters followed by 15 friction factors")
+        self.frames = palm_frames()
+        self._finger = DLRHITFinger(ParameterSet([ps[n] for n in FINGER_PARAMETERS], "dlr-hit-finger"),
+                                    finger_tables(), friction=friction, integrator=integrator,
+                                    thermal=thermal, check=False)
+        self.friction = friction
+        self.integrator = integrator
+        self.thermal = bool(thermal)
+        super().__init__(ps, check=check)
+
+    def finger_model(self, which: str) -> DLRHITFinger:
+        """The finger ``which`` as a stand-alone model (its friction factors and gravity applied)."""
+        i = FINGERS.index(which)
+        p = self.parameters.value
+        g = self.frames[i, :3, :3].T @ np.array([p("g_x"), p("g_y"), p("g_z")])
+        ov = {f"scale_{a}": p(f"{which}_scale_{a}") for a in ACTUATORS}
+        ov.update(g_x=g[0], g_y=g[1], g_z=g[2])
+        fp = ParameterSet([self.parameters[n] for n in FINGER_PARAMETERS], "dlr-hit-finger").replace(**ov)
+        return DLRHITFinger(fp, finger_tables(), friction=self.friction, integrator=self.integrator,
+                            thermal=self.thermal, check=False, name=f"dlr-hit-{which}")
+
+    def state(self, q=None, **kw) -> np.ndarray:
+        """Initial state (75): ``q`` maps finger names to joint angles (abd, flex, prox)."""
+        x = np.concatenate([self._finger.state(q=(q or {}).get(f, (0.0, 0.0, 0.0)), **kw) for f in FINGERS])
+        return x
+
+    def initial_state(self, theta):
+        return self.state()
+
+    def _simulate_batch(self, thetas, u, dt, substeps, x0, y):
+        tv, tf, tn, tipos = self._finger._tab
+        rot = np.ascontiguousarray(self.frames[:, :3, :3])
+        fail = _hand_batch(thetas, u, dt, substeps, x0, y, tv, tf, tn, tipos, rot,
+                           FRICTION_MODES[self.friction], INTEGRATORS[self.integrator], self.thermal)
+        if fail.any():
+            raise SimulationError(f"{self.name}: a finger's mass matrix lost positive definiteness")
+
+    def modes(self, theta):
+        return self._finger.modes(theta[:NTH])
+
+    def fingertips(self, trajectory) -> dict:
+        """Fingertip positions in the palm frame, {finger: (N, 3)}, from a simulated trajectory."""
+        out = {}
+        for i, f in enumerate(FINGERS):
+            ch = self._finger.chain(base=self.frames[i])
+            q = np.column_stack([trajectory[f"{f}_{j}"] for j in ("abd", "flex", "prox")])
+            p = np.linalg.solve(ch.coupling.matrix[:3], q.T).T
+            out[f] = ch.tip_position(p)
+        return out
+
+    def consistency_checks(self):
+        return _finger_checks(self._finger)
+
+
+def hand(*, friction: str = "table", integrator: str = "semi-implicit", thermal: bool = False,
+         check: bool = True, scales: dict | None = None) -> DLRHand:
+    """The five-finger DLR/HIT Hand II; ``scales`` = {finger: {actuator: factor}} sets per-finger
+    friction relative to the measured finger."""
+    return DLRHand(friction=friction, integrator=integrator, thermal=thermal, check=check, scales=scales)
