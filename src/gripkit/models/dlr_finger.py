@@ -51,16 +51,18 @@ from numba import prange
 from ..errors import ModelError, SimulationError
 from ..multibody.coupling import CoupledChain, Coupling, differential_matrix
 from ..multibody.dh import DHChain
-from ..multibody.kernels import (hot, WORK_PER_LINK, chain_links, cholesky_solve, coupled_mass_bias,
-                                 joints_from_actuators)
+from ..multibody.kernels import (WORK_PER_LINK, chain_links, cholesky_solve, coupled_mass_bias,
+                                 frames_into, hot, joints_from_actuators, point_jacobian, rnea_pass)
 from ..params import ParameterSet
 from ..sim.model import Model, Signal
 from .bldc import bldc_torque, motor_heat_step, temperature_factor
-from .friction import FrictionTable, lugre_force, lugre_update, ripple, stribeck, table_friction
+from .friction import (FrictionTable, lugre_force, lugre_update, ripple, stribeck, table_arrays,
+                       table_friction)
 from .transmission import transmit_torque
 
 __all__ = ["FINGER_PARAMETERS", "ACTUATORS", "JOINTS", "FRICTION_MODES", "DLRFinger",
-           "finger_step", "finger_setup", "finger_context", "finger_run", "finger_loop"]
+           "finger_step", "finger_step_rk4", "finger_setup", "finger_context", "finger_run",
+           "finger_loop", "run_open_loop"]
 
 #: parameter names in kernel order (see gripkit.zoo.dlr_hit.finger_parameters for meaning/units)
 FINGER_PARAMETERS = (
@@ -301,10 +303,10 @@ def _forces(th, n_stuck_iter, mode, thermal, dh, jt, mass, com, inertia, armq, G
     return True
 
 
-@numba.njit(cache=True, error_model="numpy")
-def finger_context(th):  # pragma: no cover - compiled
-    """Constant arrays of one finger (chain, coupling, drives) and its scratch arrays, allocated
-    once per simulation: ``(ctx, ws)`` for :func:`finger_step`."""
+def _make_context(th):
+    """Constant arrays of one finger (chain, coupling, drives), the plant's scratch arrays and the
+    controller's: ``(ctx, ws, cs)``. Plain numpy code, run by Python for single simulations (no
+    compilation) and compiled as :func:`finger_context` for the parallel kernels."""
     dh = np.empty((4, 6))
     jt = np.zeros(4, dtype=np.int64)
     mass = np.empty(4)
@@ -323,86 +325,114 @@ def finger_context(th):  # pragma: no cover - compiled
           np.empty(3), np.empty((3, 3)), np.empty(3), np.empty(3), np.empty(3), np.empty(3),
           np.empty(3), np.empty(3), np.empty(12), np.empty(3), np.empty(3), np.empty(3), np.empty(3),
           np.empty(3), np.empty(3))
-    return ctx, ws
+    cs = (np.empty(4), np.empty(4), np.empty((4, 9)), np.empty((4, 3)), np.empty((4, 16)),
+          np.empty((6, 4)), np.empty((3, 3)), np.empty(3), np.empty(3), np.empty(3), np.empty(4),
+          np.empty(WORK_PER_LINK * 4), np.zeros(4), np.empty(NX), np.empty(3), np.zeros(3),
+          np.zeros(3), np.zeros(3))
+    return ctx, ws, cs
+
+
+finger_context = numba.njit(cache=True, error_model="numpy")(_make_context)
 
 
 @hot
-def finger_step(th, mode, integ, thermal, ctx, tv, tf, tn, tipos, x, pwm, ext, h, taum, fric,
+def _slow_states(th, mode, thermal, x, v0, tshaft, h):  # pragma: no cover - compiled
+    """Motor temperatures (explicit step) and LuGre bristles (exact for v held over the step)."""
+    if thermal:
+        for k in range(3):
+            x[6 + k] = motor_heat_step(x[6 + k], tshaft[k], h, th[I_TAMB], th[I_ALPHA], th[I_R0],
+                                       th[I_KT], th[I_RTH], th[I_CTH])
+    if mode == 2:
+        for k in range(3):
+            x[9 + k] = lugre_update(x[9 + k], v0[k], h, th[I_FC + k], th[I_FS + k], th[I_VS],
+                                    th[I_S0])
+
+
+@hot
+def _stick(th, mode, x, v0):  # pragma: no cover - compiled
+    """Karnopp: a sliding actuator whose velocity crosses zero comes to rest; if its holding torque
+    exceeds stiction it breaks away again at the next step."""
+    if mode < 2:
+        vst = th[I_VST]
+        for k in range(3):
+            if x[12 + k] == 0.0 and (x[3 + k] * v0[k] < 0.0 or abs(x[3 + k]) <= vst):
+                x[3 + k] = 0.0
+                x[12 + k] = 1.0
+
+
+@hot
+def finger_step(th, mode, thermal, ctx, tv, tf, tn, tipos, x, pwm, ext, h, taum, fric,
                 ws):  # pragma: no cover - compiled
-    """Advance one finger's state ``x`` (15) by one step h under PWM (3) and external actuator
-    torques ``ext`` (3); ``taum``/``fric`` receive the motor and friction torques at the start of
-    the step. ``ctx``, ``ws`` come from :func:`finger_context`. Returns False if the mass matrix
-    lost positive definiteness."""
-    m = 3
+    """Advance one finger's state ``x`` (15) by one semi-implicit Euler step h under PWM (3) and
+    external actuator torques ``ext`` (3); ``taum``/``fric`` receive the motor and friction
+    torques at the start of the step. ``ctx``, ``ws`` come from :func:`finger_context`. Returns
+    False if the mass matrix lost positive definiteness."""
     dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav, ratio = ctx
     (R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, Ms, xs, rs, acc, tshaft, p0, v0, ka, ps, vs,
      tm2, fr2, ts2, dirn) = ws
-    p = x[0:3]
-    pd = x[3:6]
-    T = x[6:9]
-    z = x[9:12]
-    stuck = x[12:15]
     if not _forces(th, 4, mode, thermal, dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav,
-                   ratio, tv, tf, tn, tipos, p, pd, T, z, stuck, pwm, ext, acc, taum, tshaft, fric,
-                   R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, Ms, xs, rs, dirn):
+                   ratio, tv, tf, tn, tipos, x[0:3], x[3:6], x[6:9], x[9:12], x[12:15], pwm, ext,
+                   acc, taum, tshaft, fric, R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, Ms, xs,
+                   rs, dirn):
         return False
-    for k in range(m):
-        p0[k] = p[k]
-        v0[k] = pd[k]
-    if integ == 0:
-        for k in range(m):
-            pd[k] = v0[k] + h * acc[k]
-    else:
-        # RK4 with the stuck set frozen over the step (stuck actuators keep v = 0, a = 0):
-        # stage s uses p = p0 + c·v_{s}, v = v0 + c·a_{s} with c = h/2, h/2, h
-        for k in range(m):
-            ka[k] = acc[k]
-        for stage in range(3):
-            c = 0.5 * h if stage < 2 else h
-            for k in range(m):
-                if stuck[k] != 0.0:
-                    ps[k] = p0[k]
-                    vs[k] = 0.0
-                    continue
-                ps[k] = p0[k] + c * (v0[k] if stage == 0 else vs[k])
-                vs[k] = v0[k] + c * ka[3 * stage + k]
-            _forces(th, 0, mode, thermal, dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav,
-                    ratio, tv, tf, tn, tipos, ps, vs, T, z, stuck, pwm, ext, acc, tm2, ts2, fr2,
-                    R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, Ms, xs, rs, dirn)
-            for k in range(m):
-                ka[3 * (stage + 1) + k] = acc[k]
-        # combine: x' = v, v' = a  ->  standard RK4 weights
-        for k in range(m):
-            if stuck[k] != 0.0:
-                pd[k] = 0.0
-                continue
-            a1 = ka[k]
-            a2 = ka[3 + k]
-            a3 = ka[6 + k]
-            a4 = ka[9 + k]
-            p[k] = p0[k] + h * v0[k] + h * h / 6.0 * (a1 + a2 + a3)
-            pd[k] = v0[k] + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
-    # stick detection (Karnopp): a sliding actuator whose velocity crosses zero comes to rest;
-    # if the holding torque exceeds stiction it breaks away again at the next step
-    if mode < 2:
-        vst = th[I_VST]
-        for k in range(m):
-            if stuck[k] == 0.0 and (pd[k] * v0[k] < 0.0 or abs(pd[k]) <= vst):
-                pd[k] = 0.0
-                stuck[k] = 1.0
-    if integ == 0:
-        for k in range(m):
-            p[k] = p0[k] + h * pd[k]
-    # slow states: motor temperature, LuGre bristles (exact for v held over the step)
-    if thermal:
-        for k in range(m):
-            T[k] = motor_heat_step(T[k], tshaft[k], h, th[I_TAMB], th[I_ALPHA], th[I_R0],
-                                   th[I_KT], th[I_RTH], th[I_CTH])
-    if mode == 2:
-        for k in range(m):
-            z[k] = lugre_update(z[k], v0[k], h, th[I_FC + k], th[I_FS + k], th[I_VS], th[I_S0])
+    for k in range(3):
+        v0[k] = x[3 + k]
+        x[3 + k] = v0[k] + h * acc[k]
+    _stick(th, mode, x, v0)
+    for k in range(3):
+        x[k] += h * x[3 + k]
+    _slow_states(th, mode, thermal, x, v0, tshaft, h)
     return True
 
+
+@hot
+def finger_step_rk4(th, mode, thermal, ctx, tv, tf, tn, tipos, x, pwm, ext, h, taum, fric,
+                    ws):  # pragma: no cover - compiled
+    """As :func:`finger_step` with classical RK4 on (p, ṗ); the stick/slip set is decided at the
+    start of the step and frozen over it (stuck actuators keep v = 0, a = 0); sticking is
+    detected at the end."""
+    dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav, ratio = ctx
+    (R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, Ms, xs, rs, acc, tshaft, p0, v0, ka, ps, vs,
+     tm2, fr2, ts2, dirn) = ws
+    stuck = x[12:15]
+    T = x[6:9]
+    z = x[9:12]
+    if not _forces(th, 4, mode, thermal, dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav,
+                   ratio, tv, tf, tn, tipos, x[0:3], x[3:6], T, z, stuck, pwm, ext, acc, taum,
+                   tshaft, fric, R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, Ms, xs, rs, dirn):
+        return False
+    for k in range(3):
+        p0[k] = x[k]
+        v0[k] = x[3 + k]
+        ka[k] = acc[k]
+    # stage s uses p = p0 + c·v_s, v = v0 + c·a_s with c = h/2, h/2, h
+    for stage in range(3):
+        c = 0.5 * h if stage < 2 else h
+        for k in range(3):
+            if stuck[k] != 0.0:
+                ps[k] = p0[k]
+                vs[k] = 0.0
+                continue
+            ps[k] = p0[k] + c * (v0[k] if stage == 0 else vs[k])
+            vs[k] = v0[k] + c * ka[3 * stage + k]
+        _forces(th, 0, mode, thermal, dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav, ratio,
+                tv, tf, tn, tipos, ps, vs, T, z, stuck, pwm, ext, acc, tm2, ts2, fr2, R, P, work,
+                q, qd, zq, Mq, tau, Mp, hp, L, rhs, Ms, xs, rs, dirn)
+        for k in range(3):
+            ka[3 * (stage + 1) + k] = acc[k]
+    for k in range(3):
+        if stuck[k] != 0.0:
+            x[3 + k] = 0.0
+            continue
+        a1 = ka[k]
+        a2 = ka[3 + k]
+        a3 = ka[6 + k]
+        a4 = ka[9 + k]
+        x[k] = p0[k] + h * v0[k] + h * h / 6.0 * (a1 + a2 + a3)
+        x[3 + k] = v0[k] + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
+    _stick(th, mode, x, v0)
+    _slow_states(th, mode, thermal, x, v0, tshaft, h)
+    return True
 
 
 @hot
@@ -423,69 +453,272 @@ def finger_outputs(G, q0, x, taum, fric, y, yrow, ycol):  # pragma: no cover - c
         y[yrow, ycol + 15 + k] = x[6 + k]
 
 
+# --- impedance control (used by gripkit.control.impedance) ----------------------------------------
+
 @hot
-def finger_loop(th, u, ucol, dt, substeps, x, y, ycol, tv, tf, tn, tipos, mode, integ, thermal,
-                ctx, ws, pwm, ext, taum, fric, xs):  # pragma: no cover - compiled
-    """The time loop of :func:`finger_run` (allocation-free)."""
+def _tip(ctx, th, q, R, P, T, J, Jp, tip):  # pragma: no cover - compiled
+    """Fingertip position (3, finger base frame) and actuator-space linear Jacobian Jp (3×3)."""
+    dh = ctx[0]
+    jt = ctx[1]
+    G = ctx[6]
+    chain_links(4, dh, jt, q, R, P)
+    frames_into(4, R, P, T)
+    l3 = th[I_L1 + 2]
+    px = T[3, 3] + T[3, 0] * l3
+    py = T[3, 7] + T[3, 4] * l3
+    pz = T[3, 11] + T[3, 8] * l3
+    tip[0] = px
+    tip[1] = py
+    tip[2] = pz
+    point_jacobian(4, jt, T, px, py, pz, J)
+    for r in range(3):
+        for j in range(3):
+            s = 0.0
+            for k in range(4):
+                s += J[r, k] * G[k * 3 + j]
+            Jp[r, j] = s
+
+
+@hot
+def _pwm_for(tau_out, omega_m, N, th):  # pragma: no cover - compiled
+    """PWM that yields output torque ``tau_out`` at motor speed omega_m (inverse of eq 5.10 at
+    T_ref), clipped to ±pwm_max."""
+    c = th[I_C]
+    b1 = th[I_B1]
+    b0 = th[I_B0]
+    pmax = th[I_PMAX]
+    tm = tau_out / N
+    den = c + b1 * omega_m
+    u = (tm - b0 * omega_m) / den if den > 0.0 else pmax
+    if u < 0.0:
+        den = c - b1 * omega_m
+        u = (tm - b0 * omega_m) / den if den > 0.0 else -pmax
+        if u > 0.0:
+            u = 0.0
+    if u > pmax:
+        u = pmax
+    elif u < -pmax:
+        u = -pmax
+    return u
+
+
+@hot
+def _impedance(th, ctx, cs, x, n, ctrl, gains, ctv, ctf, ctn, ctipos, ref, refd,
+               pwm):  # pragma: no cover - compiled
+    """Impedance law (joint: ctrl = 1, Cartesian: ctrl = 2) with gravity and friction
+    compensation → PWM; the commanded torques stay in cs[9] (see gripkit.control.impedance)."""
+    dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav, ratio = ctx
+    q, qd, R, P, T, J, Jp, tip, tipd, tauq, gp, work, zq = (cs[0], cs[1], cs[2], cs[3], cs[4],
+                                                          cs[5], cs[6], cs[7], cs[8], cs[9],
+                                                          cs[10], cs[11], cs[12])
+    joints_from_actuators(4, 3, G, q0, x[0:3], q)
+    joints_from_actuators(4, 3, G, zq, x[3:6], qd)
+    _tip(ctx, th, q, R, P, T, J, Jp, tip)
+    for r in range(3):
+        s = 0.0
+        for j in range(3):
+            s += Jp[r, j] * x[3 + j]
+        tipd[r] = s
+        tauq[r] = 0.0
+    if ctrl == 2:
+        for r in range(3):
+            f = gains[r] * (ref[n, r] - tip[r]) + gains[3 + r] * (refd[n, r] - tipd[r])
+            for j in range(3):
+                tauq[j] += Jp[r, j] * f
+    else:
+        for j in range(3):  # τ_p = Γ_qᵀ τ_q on (θ1, θ2, θ3)
+            f = gains[j] * (ref[n, j] - q[j]) + gains[3 + j] * (refd[n, j] - qd[j])
+            for k in range(3):
+                tauq[k] += G[j * 3 + k] * f
+    if gains[6] != 0.0:
+        rnea_pass(4, R, P, jt, mass, com, inertia, armq, zq, zq, grav[0], grav[1], grav[2], False,
+                  gp, work)
+        for k in range(3):
+            s = 0.0
+            for j in range(4):
+                s += G[j * 3 + k] * gp[j]
+            tauq[k] += s
+    vdb = gains[8]
+    eps = gains[9]
+    for k in range(3):
+        tau = tauq[k]
+        if gains[7] != 0.0 and tau != 0.0:
+            # compensate only in the direction the impedance pushes (never into a reversal)
+            v = x[3 + k]
+            if v * tau >= 0.0:
+                if abs(v) < vdb:
+                    v = vdb if tau > 0.0 else -vdb
+                tau += table_friction(v, ctv[k], ctf[k], ctn[k], ctipos[k]) * math.tanh(abs(tau) / eps)
+        tauq[k] = tau
+        pwm[k] = _pwm_for(tau, ratio[k] * x[3 + k], ratio[k], th)
+
+
+@hot
+def _wall(th, ctx, cs, x, wall, ext, force):  # pragma: no cover - compiled
+    """Contact force of a planar wall (nx, ny, nz, px, py, pz, k, d, on) on the fingertip, mapped
+    to the actuators: ext = J_pᵀ F; ``force`` receives F (finger base frame)."""
     G = ctx[6]
     q0 = ctx[7]
+    q, R, P, T, J, Jp, tip = cs[0], cs[2], cs[3], cs[4], cs[5], cs[6], cs[7]
+    for k in range(3):
+        ext[k] = 0.0
+        force[k] = 0.0
+    if wall[8] == 0.0:
+        return
+    joints_from_actuators(4, 3, G, q0, x[0:3], q)
+    _tip(ctx, th, q, R, P, T, J, Jp, tip)
+    pen = -(wall[0] * (tip[0] - wall[3]) + wall[1] * (tip[1] - wall[4]) + wall[2] * (tip[2] - wall[5]))
+    if pen <= 0.0:
+        return
+    vn = 0.0
+    for r in range(3):
+        s = 0.0
+        for j in range(3):
+            s += Jp[r, j] * x[3 + j]
+        vn += wall[r] * s
+    fmag = wall[6] * pen - wall[7] * vn  # δ̇ = −n·ẋ
+    if fmag < 0.0:
+        fmag = 0.0
+    for r in range(3):
+        force[r] = fmag * wall[r]
+    for j in range(3):
+        ext[j] = Jp[0, j] * force[0] + Jp[1, j] * force[1] + Jp[2, j] * force[2]
+
+
+@hot
+def finger_loop(th, mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucol, dt, substeps, x, y,
+                ycol, ctrl, gains, ctv, ctf, ctn, ctipos, ref, refd, wall):  # pragma: no cover
+    """The time loop (allocation-free, semi-implicit Euler). ``ctrl = 0``: PWM from u[:, ucol:],
+    outputs as DLRFinger.outputs at y[:, ycol:ycol+18]; ``ctrl = 1/2``: joint/Cartesian impedance
+    on ``ref``/``refd`` with the ``wall``, closed-loop outputs (24 columns)."""
+    G = ctx[6]
+    q0 = ctx[7]
+    pwm, ext, taum, fric, xs, force = cs[14], cs[15], cs[16], cs[17], cs[13], cs[8]
     h = dt / substeps
-    N = u.shape[0]
+    N = ref.shape[0] if ctrl else u.shape[0]
     for n in range(N):
-        for k in range(3):
-            pwm[k] = u[n, ucol + k]
+        if ctrl:
+            _impedance(th, ctx, cs, x, n, ctrl, gains, ctv, ctf, ctn, ctipos, ref, refd, pwm)
+        else:
+            for k in range(3):
+                pwm[k] = u[n, ucol + k]
         for k in range(NX):
             xs[k] = x[k]
         for s in range(substeps):
-            ok = finger_step(th, mode, integ, thermal, ctx, tv, tf, tn, tipos, x, pwm, ext, h, taum,
-                             fric, ws)
-            if not ok:
+            if ctrl:
+                _wall(th, ctx, cs, x, wall, ext, force)
+                if s == 0:
+                    for k in range(3):
+                        y[n, 12 + k] = force[k]
+            if not finger_step(th, mode, thermal, ctx, tv, tf, tn, tipos, x, pwm, ext, h, taum, fric,
+                               ws):
+                return n + 1
+            if s == 0 and not ctrl:
+                # sample n reports the state at t_n and the torques acting at t_n
+                finger_outputs(G, q0, xs, taum, fric, y, n, ycol)
+        if ctrl:
+            q, qd, R, P, T, J, Jp, tip = cs[0], cs[1], cs[2], cs[3], cs[4], cs[5], cs[6], cs[7]
+            joints_from_actuators(4, 3, G, q0, xs[0:3], q)
+            joints_from_actuators(4, 3, G, cs[12], xs[3:6], qd)
+            _tip(ctx, th, q, R, P, T, J, Jp, tip)
+            for k in range(3):
+                y[n, k] = q[k]
+                y[n, 3 + k] = qd[k]
+                y[n, 6 + k] = tip[k]
+                s = 0.0
+                for j in range(3):
+                    s += Jp[k, j] * xs[3 + j]
+                y[n, 9 + k] = s
+                y[n, 15 + k] = pwm[k]
+                y[n, 18 + k] = cs[9][k]
+                y[n, 21 + k] = fric[k]
+    return 0
+
+
+@hot
+def finger_loop_rk4(th, mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucol, dt, substeps, x, y,
+                    ycol):  # pragma: no cover - compiled
+    """Open-loop time loop with RK4 steps."""
+    G = ctx[6]
+    q0 = ctx[7]
+    pwm, ext, taum, fric, xs = cs[14], cs[15], cs[16], cs[17], cs[13]
+    h = dt / substeps
+    for n in range(u.shape[0]):
+        for k in range(3):
+            pwm[k] = u[n, ucol + k]
+            ext[k] = 0.0
+        for k in range(NX):
+            xs[k] = x[k]
+        for s in range(substeps):
+            if not finger_step_rk4(th, mode, thermal, ctx, tv, tf, tn, tipos, x, pwm, ext, h, taum,
+                                   fric, ws):
                 return n + 1
             if s == 0:
-                # sample n reports the state at t_n and the torques acting at t_n
                 finger_outputs(G, q0, xs, taum, fric, y, n, ycol)
     return 0
 
 
-@numba.njit(cache=True, error_model="numpy")
-def finger_run(th, u, ucol, dt, substeps, x, y, ycol, tv, tf, tn, tipos, mode, integ,
-               thermal):  # pragma: no cover - compiled
-    """Simulate one finger over all samples of ``u`` (PWM columns ucol..ucol+2), writing
-    y[:, ycol:ycol+18]. Returns the index of the first failed sample + 1, or 0."""
-    ctx, ws = finger_context(th)
-    return finger_loop(th, u, ucol, dt, substeps, x, y, ycol, tv, tf, tn, tipos, mode, integ,
-                       thermal, ctx, ws, np.empty(3), np.zeros(3), np.zeros(3), np.zeros(3),
-                       np.empty(NX))
+def finger_run(th, mode, thermal, tv, tf, tn, tipos, u, ucol, dt, substeps, x, y, ycol, ctrl, gains,
+               ctv, ctf, ctn, ctipos, ref, refd, wall) -> int:
+    """Simulate one finger (open loop: ``ctrl = 0`` with PWM columns ucol..ucol+2 of ``u``; closed
+    loop: ``ctrl = 1`` joint or ``2`` Cartesian impedance). Returns the index of the first failed
+    sample + 1, or 0. Scratch arrays are allocated here, in Python, so the only compiled function
+    is the time loop itself."""
+    ctx, ws, cs = _make_context(th)
+    return int(finger_loop(th, mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucol, dt, substeps,
+                           x, y, ycol, ctrl, gains, ctv, ctf, ctn, ctipos, ref, refd, wall))
+
+
+def finger_run_rk4(th, mode, thermal, tv, tf, tn, tipos, u, ucol, dt, substeps, x, y, ycol) -> int:
+    """Open-loop simulation with RK4 steps (compiled only when asked for)."""
+    ctx, ws, cs = _make_context(th)
+    return int(finger_loop_rk4(th, mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucol, dt,
+                               substeps, x, y, ycol))
+
+
+_NO_CTRL = (np.zeros(10), np.zeros((3, 4)), np.zeros((3, 4)), np.full(3, 4, dtype=np.int64),
+            np.full(3, 2, dtype=np.int64), np.zeros((1, 3)), np.zeros((1, 3)), np.zeros(9))
+
+
+def run_open_loop(th, mode, integ, thermal, tab, u, dt, substeps, x, y, ucol=0, ycol=0) -> int:
+    """One finger, open loop (Python entry used by the models and the hand)."""
+    tv, tf, tn, tipos = tab
+    if integ == 1:
+        return int(finger_run_rk4(th, mode, thermal, tv, tf, tn, tipos, u, ucol, dt, substeps, x, y,
+                                  ycol))
+    return int(finger_run(th, mode, thermal, tv, tf, tn, tipos, u, ucol, dt, substeps, x, y, ycol, 0,
+                          *_NO_CTRL))
 
 
 @numba.njit(cache=True, parallel=True, error_model="numpy")
-def _finger_batch(thetas, u, dt, substeps, x0, y, tv, tf, tn, tipos, mode, integ,
-                  thermal):  # pragma: no cover - compiled
-    P = thetas.shape[0]
-    fail = np.zeros(P, dtype=np.int64)
-    for p in prange(P):
-        x = x0[p].copy()
-        fail[p] = finger_run(thetas[p], u, 0, dt, substeps, x, y[p], 0, tv, tf, tn, tipos, mode,
-                             integ, thermal)
+def _jobs_parallel(thetas, u, ucols, dt, substeps, x0, y, yidx, ycols, tv, tf, tn, tipos, mode,
+                   thermal, gains, ctv, ctf, ctn, ctipos, ref, refd, wall):  # pragma: no cover
+    """Open-loop finger simulations in parallel: job j simulates thetas[j] from x0[j] on PWM
+    columns ucols[j].. of u, writing y[yidx[j], :, ycols[j]:ycols[j]+18]."""
+    J = thetas.shape[0]
+    fail = np.zeros(J, dtype=np.int64)
+    for j in prange(J):
+        x = x0[j].copy()
+        ctx, ws, cs = finger_context(thetas[j])
+        fail[j] = finger_loop(thetas[j], mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucols[j],
+                              dt, substeps, x, y[yidx[j]], ycols[j], 0, gains, ctv, ctf, ctn, ctipos,
+                              ref, refd, wall)
     return fail
 
 
-def table_arrays(tables) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Pad three FrictionTables (base1, base2, distal) into kernel arrays (unscaled values; the
-    scale factors are parameters)."""
-    K = max(t.velocity.size for t in tables)
-    tv = np.zeros((3, K))
-    tf = np.zeros((3, K))
-    tn = np.zeros(3, dtype=np.int64)
-    tipos = np.zeros(3, dtype=np.int64)
-    for k, t in enumerate(tables):
-        n = t.velocity.size
-        tv[k, :n] = t.velocity
-        tf[k, :n] = t.friction * t.scale
-        tv[k, n:] = t.velocity[-1]
-        tn[k] = n
-        tipos[k] = t.ipos
-    return tv, tf, tn, tipos
+def run_jobs(thetas, u, ucols, dt, substeps, x0, y, yidx, ycols, tab, mode, integ, thermal,
+             parallel: bool) -> np.ndarray:
+    """Several open-loop finger simulations (a batch of parameter vectors, or the fingers of a
+    hand); parallel threads only when asked for (and semi-implicit), else one after another."""
+    J = thetas.shape[0]
+    if parallel and integ == 0 and J > 1:
+        tv, tf, tn, tipos = tab
+        return _jobs_parallel(thetas, u, np.asarray(ucols, dtype=np.int64), dt, substeps, x0, y,
+                              np.asarray(yidx, dtype=np.int64), np.asarray(ycols, dtype=np.int64),
+                              tv, tf, tn, tipos, mode, thermal, *_NO_CTRL)
+    return np.array([run_open_loop(thetas[j], mode, integ, thermal, tab, u, dt, substeps,
+                                   x0[j].copy(), y[yidx[j]], int(ucols[j]), int(ycols[j]))
+                     for j in range(J)])
 
 
 class DLRFinger(Model):
@@ -613,9 +846,10 @@ class DLRFinger(Model):
 
     # --- simulation -----------------------------------------------------------------------------
     def _simulate_batch(self, thetas, u, dt, substeps, x0, y):
-        tv, tf, tn, tipos = self._tab
-        fail = _finger_batch(thetas, u, dt, substeps, x0, y, tv, tf, tn, tipos,
-                             FRICTION_MODES[self.friction], INTEGRATORS[self.integrator], self.thermal)
+        P = thetas.shape[0]
+        fail = run_jobs(thetas, u, np.zeros(P), dt, substeps, x0, y, np.arange(P), np.zeros(P),
+                        self._tab, FRICTION_MODES[self.friction], INTEGRATORS[self.integrator],
+                        self.thermal, parallel=P >= 4)
         if fail.any():
             raise SimulationError(f"{self.name}: the mass matrix lost positive definiteness at sample "
                                   f"{int(fail[fail > 0][0]) - 1}", hint="check the inertial parameters")

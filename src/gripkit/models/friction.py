@@ -54,7 +54,7 @@ from ..sim.model import Model, Signal
 
 __all__ = ["coulomb_viscous", "stribeck", "table_friction", "ripple", "lugre_g", "lugre_update",
            "lugre_force", "FrictionTable", "Stribeck", "dlr_hit_table", "FrictionDrive",
-           "friction_drive_parameters"]
+           "friction_drive_parameters", "table_arrays"]
 
 DEG = math.pi / 180.0
 
@@ -147,9 +147,9 @@ def lugre_force(z, v, fc, fs, vs, sigma0, sigma1, sigma2):  # pragma: no cover -
     return sigma0 * z + sigma1 * zd + sigma2 * v
 
 
-@numba.njit(cache=True, parallel=True, error_model="numpy")
+@numba.njit(cache=True, error_model="numpy")
 def _table_eval(bp, fr, n, ipos, v, out):  # pragma: no cover - compiled
-    for i in prange(v.shape[0]):
+    for i in range(v.shape[0]):
         out[i] = table_friction(v[i], bp, fr, n, ipos)
 
 
@@ -245,6 +245,25 @@ def dlr_hit_table(joint: str, scale: float = 1.0) -> FrictionTable:
     text = resources.files("gripkit.zoo").joinpath("data", fname).read_text()
     return FrictionTable._parse(text, f"DLR/HIT II {joint} friction",
                                 f"002_ddea254371185ad3.txt, Appendix G (gripkit/zoo/data/{fname})", scale)
+
+
+def table_arrays(tables) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Pad FrictionTables into kernel arrays: breakpoints (m, K), scaled values (m, K), lengths
+    (m,) and first-positive indices (m,)."""
+    m = len(tables)
+    K = max(t.velocity.size for t in tables)
+    tv = np.zeros((m, K))
+    tf = np.zeros((m, K))
+    tn = np.zeros(m, dtype=np.int64)
+    tipos = np.zeros(m, dtype=np.int64)
+    for k, t in enumerate(tables):
+        n = t.velocity.size
+        tv[k, :n] = t.velocity
+        tf[k, :n] = t.values
+        tv[k, n:] = t.velocity[-1]
+        tn[k] = n
+        tipos[k] = t.ipos
+    return tv, tf, tn, tipos
 
 
 @dataclass(frozen=True)

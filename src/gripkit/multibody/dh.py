@@ -17,61 +17,13 @@ array([1., 1., 0.])
 
 from __future__ import annotations
 
-import numba
 import numpy as np
-from numba import prange
 
 from ..errors import ModelError
 from . import rnea as _dyn
-from .kernels import chain_links, dh_table, frames_into, joints_from_actuators, point_jacobian
+from .kernels import dh_table
 
 __all__ = ["DHChain", "Dynamics"]
-
-_CHUNK = 128
-
-
-@numba.njit(cache=True, parallel=True)
-def _frames_batch(dh, jtype, G, q0, pos, out):  # pragma: no cover - compiled
-    n = dh.shape[0]
-    m = pos.shape[1]
-    B = pos.shape[0]
-    for c in prange((B + _CHUNK - 1) // _CHUNK):
-        R = np.empty((n, 9))
-        P = np.empty((n, 3))
-        q = np.empty(n)
-        for b in range(c * _CHUNK, min(B, (c + 1) * _CHUNK)):
-            joints_from_actuators(n, m, G, q0, pos[b], q)
-            chain_links(n, dh, jtype, q, R, P)
-            frames_into(n, R, P, out[b])
-
-
-@numba.njit(cache=True, parallel=True)
-def _jacobian_batch(dh, jtype, G, q0, tool, pos, out):  # pragma: no cover - compiled
-    n = dh.shape[0]
-    m = pos.shape[1]
-    B = pos.shape[0]
-    for c in prange((B + _CHUNK - 1) // _CHUNK):
-        R = np.empty((n, 9))
-        P = np.empty((n, 3))
-        T = np.empty((n, 16))
-        q = np.empty(n)
-        J = np.empty((6, n))
-        for b in range(c * _CHUNK, min(B, (c + 1) * _CHUNK)):
-            joints_from_actuators(n, m, G, q0, pos[b], q)
-            chain_links(n, dh, jtype, q, R, P)
-            frames_into(n, R, P, T)
-            e = n - 1
-            px = T[e, 3] + T[e, 0] * tool[0] + T[e, 1] * tool[1] + T[e, 2] * tool[2]
-            py = T[e, 7] + T[e, 4] * tool[0] + T[e, 5] * tool[1] + T[e, 6] * tool[2]
-            pz = T[e, 11] + T[e, 8] * tool[0] + T[e, 9] * tool[1] + T[e, 10] * tool[2]
-            point_jacobian(n, jtype, T, px, py, pz, J)
-            for r in range(6):
-                for j in range(m):
-                    s = 0.0
-                    for k in range(n):
-                        s += J[r, k] * G[k * m + j]
-                    out[b, r, j] = s
-
 
 def _as_transform(T, what: str) -> np.ndarray:
     if T is None:
@@ -93,9 +45,9 @@ class Dynamics:
     ``base``, ``tool`` and ``kernel_arrays()``."""
 
     # --- dynamics (thesis eq 4.17) ---
-    def rnea(self, q, qd, qdd, *, gravity: bool = True) -> np.ndarray:
+    def rnea(self, q, qd, qdd, *, gravity: bool = True, parallel: bool | None = None) -> np.ndarray:
         """τ = M q̈ + C + G (RNEA, eqs 4.8–4.16)."""
-        return _dyn.rnea(self, q, qd, qdd, gravity=gravity)
+        return _dyn.rnea(self, q, qd, qdd, gravity=gravity, parallel=parallel)
 
     def mass_matrix(self, q) -> np.ndarray:
         """M(q), including reflected rotor inertia."""
@@ -135,10 +87,9 @@ class Dynamics:
     def frames(self, q) -> np.ndarray:
         """World transforms of every link frame, shape (n, 4, 4) or (B, n, 4, 4)."""
         (q,), single = _dyn._states(self, q)
-        a = self.kernel_arrays()
-        n = a[0].shape[0]
+        n = self.chain.n
         T = np.empty((q.shape[0], n, 16))
-        _frames_batch(a[0], a[1], a[6], a[7], q, T)
+        _dyn.run_op(self, _dyn.OP_FRAMES, q, fout=T)
         T = self.base @ T.reshape(q.shape[0], n, 4, 4)
         return T[0] if single else T
 
@@ -155,9 +106,8 @@ class Dynamics:
         """Geometric Jacobian of the tip in the world frame, rows (v_x, v_y, v_z, ω_x, ω_y, ω_z),
         shape (6, dof) or (B, 6, dof): tip twist = J q̇."""
         (q,), single = _dyn._states(self, q)
-        a = self.kernel_arrays()
         J = np.empty((q.shape[0], 6, self.dof))
-        _jacobian_batch(a[0], a[1], a[6], a[7], np.ascontiguousarray(self.tool[:3, 3]), q, J)
+        _dyn.run_op(self, _dyn.OP_JACOBIAN, q, tool=self.tool[:3, 3], fout=J)
         Rb = self.base[:3, :3]
         J[:, :3] = Rb @ J[:, :3]
         J[:, 3:] = Rb @ J[:, 3:]

@@ -27,88 +27,21 @@ from numba import prange
 
 from ..errors import ModelError, SimulationError
 from .kernels import (WORK_PER_LINK, chain_links, cholesky_solve, coupled_mass_bias, frames_into,
-                      joints_from_actuators, rnea_pass)
+                      hot, joints_from_actuators, point_jacobian, rnea_pass)
 
 __all__ = ["rnea", "mass_matrix", "coriolis", "gravity", "bias", "forward_dynamics",
            "kinetic_energy", "potential_energy", "simulate_free"]
 
 _CHUNK = 128
+#: batches at least this large run in parallel (prange) unless told otherwise; smaller ones on one
+#: thread (0.1–0.5 µs per state), so that a script that evaluates a few thousand states never
+#: pays the parallel kernel's compile time (~10 s)
+PARALLEL_MIN = 100_000
+
+OP_RNEA, OP_MASS_BIAS, OP_BIAS, OP_FD, OP_POTENTIAL, OP_FRAMES, OP_JACOBIAN = range(7)
 
 
-@numba.njit(cache=True)
-def _nchunks(B):  # pragma: no cover - compiled
-    return (B + _CHUNK - 1) // _CHUNK
-
-
-@numba.njit(cache=True, parallel=True)
-def _rnea_batch(dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, pos, vel, acc, gscale,
-                out):  # pragma: no cover - compiled
-    n = dh.shape[0]
-    m = pos.shape[1]
-    B = pos.shape[0]
-    for c in prange(_nchunks(B)):
-        R = np.empty((n, 9))
-        P = np.empty((n, 3))
-        work = np.empty(WORK_PER_LINK * n)
-        q = np.empty(n)
-        qd = np.empty(n)
-        qdd = np.empty(n)
-        tau = np.empty(n)
-        zq = np.zeros(n)
-        for b in range(c * _CHUNK, min(B, (c + 1) * _CHUNK)):
-            joints_from_actuators(n, m, G, q0, pos[b], q)
-            joints_from_actuators(n, m, G, zq, vel[b], qd)
-            joints_from_actuators(n, m, G, zq, acc[b], qdd)
-            chain_links(n, dh, jtype, q, R, P)
-            rnea_pass(n, R, P, jtype, mass, com, inertia, arm_q, qd, qdd, gscale * g[0],
-                      gscale * g[1], gscale * g[2], True, tau, work)
-            for i in range(m):
-                s = arm_p[i] * acc[b, i]
-                for k in range(n):
-                    s += G[k * m + i] * tau[k]
-                out[b, i] = s
-
-
-@numba.njit(cache=True, parallel=True)
-def _mass_bias_batch(dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, pos, vel, gscale,
-                     want_mass, Mout, hout):  # pragma: no cover - compiled
-    n = dh.shape[0]
-    m = pos.shape[1]
-    B = pos.shape[0]
-    for c in prange(_nchunks(B)):
-        R = np.empty((n, 9))
-        P = np.empty((n, 3))
-        work = np.empty(WORK_PER_LINK * n)
-        q = np.empty(n)
-        qd = np.empty(n)
-        zq = np.zeros(n)
-        Mq = np.empty((n, n))
-        tau = np.empty(n)
-        Mp = np.empty((m, m))
-        hp = np.empty(m)
-        for b in range(c * _CHUNK, min(B, (c + 1) * _CHUNK)):
-            joints_from_actuators(n, m, G, q0, pos[b], q)
-            joints_from_actuators(n, m, G, zq, vel[b], qd)
-            chain_links(n, dh, jtype, q, R, P)
-            if want_mass:
-                coupled_mass_bias(n, m, R, P, jtype, mass, com, inertia, arm_q, G, arm_p, qd,
-                                  gscale * g[0], gscale * g[1], gscale * g[2], Mp, hp, zq, Mq,
-                                  tau, work)
-                for i in range(m):
-                    hout[b, i] = hp[i]
-                    for j in range(m):
-                        Mout[b, i, j] = Mp[i, j]
-            else:
-                rnea_pass(n, R, P, jtype, mass, com, inertia, arm_q, qd, zq, gscale * g[0],
-                          gscale * g[1], gscale * g[2], True, tau, work)
-                for i in range(m):
-                    s = 0.0
-                    for k in range(n):
-                        s += G[k * m + i] * tau[k]
-                    hout[b, i] = s
-
-
-@numba.njit(cache=True)
+@hot
 def _accel(n, m, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, p, pd, tau_p, a, R, P,
            work, q, qd, zq, Mq, tau, Mp, hp, L, rhs):  # pragma: no cover - compiled
     joints_from_actuators(n, m, G, q0, p, q)
@@ -121,68 +54,172 @@ def _accel(n, m, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, p, pd, t
     return cholesky_solve(m, Mp, rhs, a, L)
 
 
-@numba.njit(cache=True, parallel=True)
-def _fd_batch(dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, pos, vel, torque,
-              out):  # pragma: no cover - compiled
+@hot
+def _range_dyn(op, b0, b1, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, gscale, pos, vel,
+               acc, vout, mout, R, P, work, q, qd, qdd, zq, Mq, tau, Mp, hp):  # pragma: no cover
+    """Inverse dynamics (OP_RNEA), bias (OP_BIAS) or mass matrix and bias (OP_MASS_BIAS) for
+    states b0..b1−1 (allocation-free; scratch passed in): ``vout`` (B, m), ``mout`` (B, m, m)."""
+    n = dh.shape[0]
+    m = pos.shape[1]
+    gx = gscale * g[0]
+    gy = gscale * g[1]
+    gz = gscale * g[2]
+    for b in range(b0, b1):
+        joints_from_actuators(n, m, G, q0, pos[b], q)
+        joints_from_actuators(n, m, G, zq, vel[b], qd)
+        chain_links(n, dh, jtype, q, R, P)
+        if op == OP_MASS_BIAS:
+            coupled_mass_bias(n, m, R, P, jtype, mass, com, inertia, arm_q, G, arm_p, qd, gx, gy,
+                              gz, Mp, hp, zq, Mq, tau, work)
+            for i in range(m):
+                vout[b, i] = hp[i]
+                for j in range(m):
+                    mout[b, i, j] = Mp[i, j]
+            continue
+        if op == OP_RNEA:
+            joints_from_actuators(n, m, G, zq, acc[b], qdd)
+        else:
+            for k in range(n):
+                qdd[k] = 0.0
+        rnea_pass(n, R, P, jtype, mass, com, inertia, arm_q, qd, qdd, gx, gy, gz, True, tau, work)
+        for i in range(m):
+            s = arm_p[i] * acc[b, i] if op == OP_RNEA else 0.0
+            for k in range(n):
+                s += G[k * m + i] * tau[k]
+            vout[b, i] = s
+
+
+@hot
+def _range_kin(op, b0, b1, dh, jtype, mass, com, G, q0, g, tool, pos, vout, fout, R, P, q, T,
+               J):  # pragma: no cover - compiled
+    """Link frames (OP_FRAMES → fout (B, n, 16)), the tool point's Jacobian (OP_JACOBIAN → fout
+    (B, 6, m)) or the potential energy (OP_POTENTIAL → vout (B, 1))."""
+    n = dh.shape[0]
+    m = pos.shape[1]
+    for b in range(b0, b1):
+        joints_from_actuators(n, m, G, q0, pos[b], q)
+        chain_links(n, dh, jtype, q, R, P)
+        frames_into(n, R, P, T)
+        if op == OP_FRAMES:
+            for k in range(n):
+                for i in range(16):
+                    fout[b, k, i] = T[k, i]
+        elif op == OP_POTENTIAL:
+            u = 0.0
+            for k in range(n):
+                for i in range(3):
+                    pc = T[k, 4 * i + 3]
+                    for j in range(3):
+                        pc += T[k, 4 * i + j] * com[k, j]
+                    u -= mass[k] * g[i] * pc
+            vout[b, 0] = u
+        else:
+            e = n - 1
+            px = T[e, 3] + T[e, 0] * tool[0] + T[e, 1] * tool[1] + T[e, 2] * tool[2]
+            py = T[e, 7] + T[e, 4] * tool[0] + T[e, 5] * tool[1] + T[e, 6] * tool[2]
+            pz = T[e, 11] + T[e, 8] * tool[0] + T[e, 9] * tool[1] + T[e, 10] * tool[2]
+            point_jacobian(n, jtype, T, px, py, pz, J)
+            for r in range(6):
+                for j in range(m):
+                    s = 0.0
+                    for k in range(n):
+                        s += J[r, k] * G[k * m + j]
+                    fout[b, r, j] = s
+
+
+@hot
+def _range_fd(b0, b1, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, pos, vel, tau_p, vout,
+              ok, R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, a):  # pragma: no cover
+    """Forward dynamics q̈ = M⁻¹(τ − h) for states b0..b1−1."""
+    n = dh.shape[0]
+    m = pos.shape[1]
+    for b in range(b0, b1):
+        ok[b] = _accel(n, m, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, pos[b], vel[b],
+                       tau_p[b], a, R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs)
+        for i in range(m):
+            vout[b, i] = a[i]
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _dyn_serial(op, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, gscale, pos, vel, acc,
+                vout, mout):  # pragma: no cover - compiled
+    n = dh.shape[0]
+    m = pos.shape[1]
+    _range_dyn(op, 0, pos.shape[0], dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, gscale,
+               pos, vel, acc, vout, mout, np.empty((n, 9)), np.empty((n, 3)),
+               np.empty(WORK_PER_LINK * n), np.empty(n), np.empty(n), np.empty(n), np.zeros(n),
+               np.empty((n, n)), np.empty(n), np.empty((m, m)), np.empty(m))
+
+
+@numba.njit(cache=True, parallel=True, error_model="numpy")
+def _dyn_parallel(op, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, gscale, pos, vel, acc,
+                  vout, mout):  # pragma: no cover - compiled
     n = dh.shape[0]
     m = pos.shape[1]
     B = pos.shape[0]
-    ok_all = np.ones(B, dtype=np.bool_)
-    for c in prange(_nchunks(B)):
-        R = np.empty((n, 9))
-        P = np.empty((n, 3))
-        work = np.empty(WORK_PER_LINK * n)
-        q = np.empty(n)
-        qd = np.empty(n)
-        zq = np.zeros(n)
-        Mq = np.empty((n, n))
-        tau = np.empty(n)
-        Mp = np.empty((m, m))
-        hp = np.empty(m)
-        L = np.empty((m, m))
-        rhs = np.empty(m)
-        a = np.empty(m)
-        for b in range(c * _CHUNK, min(B, (c + 1) * _CHUNK)):
-            ok = _accel(n, m, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, pos[b],
-                        vel[b], torque[b], a, R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs)
-            ok_all[b] = ok
-            for i in range(m):
-                out[b, i] = a[i]
-    return ok_all
+    for c in prange((B + _CHUNK - 1) // _CHUNK):
+        _range_dyn(op, c * _CHUNK, min(B, (c + 1) * _CHUNK), dh, jtype, mass, com, inertia, arm_q,
+                   G, q0, arm_p, g, gscale, pos, vel, acc, vout, mout, np.empty((n, 9)),
+                   np.empty((n, 3)), np.empty(WORK_PER_LINK * n), np.empty(n), np.empty(n),
+                   np.empty(n), np.zeros(n), np.empty((n, n)), np.empty(n), np.empty((m, m)),
+                   np.empty(m))
 
 
-@numba.njit(cache=True, parallel=True)
-def _simulate_batch(dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, p0, pd0, torque, dt,
-                    substeps, method, pos_out, vel_out):  # pragma: no cover - compiled
-    """Fixed-step integration of τ_p = M_p p̈ + h_p from each initial state (B of them), torque
-    held over each sample (N, m). method 0: classical RK4; 1: semi-implicit (symplectic) Euler."""
+@numba.njit(cache=True, error_model="numpy")
+def _kin_serial(op, dh, jtype, mass, com, G, q0, g, tool, pos, vout, fout):  # pragma: no cover
+    n = dh.shape[0]
+    _range_kin(op, 0, pos.shape[0], dh, jtype, mass, com, G, q0, g, tool, pos, vout, fout,
+               np.empty((n, 9)), np.empty((n, 3)), np.empty(n), np.empty((n, 16)), np.empty((6, n)))
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _fd_serial(dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, pos, vel, tau_p, vout,
+               ok):  # pragma: no cover - compiled
+    n = dh.shape[0]
+    m = pos.shape[1]
+    _range_fd(0, pos.shape[0], dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, pos, vel,
+              tau_p, vout, ok, np.empty((n, 9)), np.empty((n, 3)), np.empty(WORK_PER_LINK * n),
+              np.empty(n), np.empty(n), np.zeros(n), np.empty((n, n)), np.empty(n),
+              np.empty((m, m)), np.empty(m), np.empty((m, m)), np.empty(m), np.empty(m))
+
+
+def run_op(system, op: int, pos, vel=None, acc=None, *, gscale: float = 1.0, tool=None,
+           vout=None, mout=None, fout=None, parallel: bool | None = None):
+    """Evaluate a kernel operation over a batch of states. Inverse dynamics, bias and mass
+    matrices use all cores from PARALLEL_MIN states on (or as ``parallel`` says); forward
+    dynamics and kinematics run on one thread. Returns the solver flags (forward dynamics)."""
+    a = system.kernel_arrays()
+    dh, jt, mass, com, inertia, arm_q, G, q0, arm_p, g = a
+    B = pos.shape[0]
+    vel = pos if vel is None else vel
+    acc = pos if acc is None else acc
+    vout = np.empty((1, 1)) if vout is None else vout
+    ok = np.ones(B, dtype=np.bool_)
+    if op in (OP_RNEA, OP_BIAS, OP_MASS_BIAS):
+        mout = np.empty((1, 1, 1)) if mout is None else mout
+        fn = _dyn_parallel if (B >= PARALLEL_MIN if parallel is None else parallel) else _dyn_serial
+        fn(op, dh, jt, mass, com, inertia, arm_q, G, q0, arm_p, g, float(gscale), pos, vel, acc,
+           vout, mout)
+    elif op == OP_FD:
+        _fd_serial(dh, jt, mass, com, inertia, arm_q, G, q0, arm_p, g, pos, vel, acc, vout, ok)
+    else:
+        fout = np.empty((1, 1, 1)) if fout is None else fout
+        tool = np.zeros(3) if tool is None else np.ascontiguousarray(tool, dtype=np.float64)
+        _kin_serial(op, dh, jt, mass, com, G, q0, g, tool, pos, vout, fout)
+    return ok
+
+
+@hot
+def _simulate_range(b0, b1, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, p0, pd0,
+                    torque, dt, substeps, method, pos_out, vel_out, fail, R, P, work, q, qd, zq, Mq,
+                    tau, Mp, hp, L, rhs, x, v, xs, vs, k1, k2, k3, k4):  # pragma: no cover
+    """Fixed-step integration of τ_p = M_p p̈ + h_p from initial states b0..b1−1, torque held
+    over each sample (N, m). method 0: classical RK4; 1: semi-implicit (symplectic) Euler."""
     n = dh.shape[0]
     m = p0.shape[1]
-    B = p0.shape[0]
     N = torque.shape[0]
     h = dt / substeps
-    fail = np.zeros(B, dtype=np.int64)
-    for b in prange(B):
-        R = np.empty((n, 9))
-        P = np.empty((n, 3))
-        work = np.empty(WORK_PER_LINK * n)
-        q = np.empty(n)
-        qd = np.empty(n)
-        zq = np.zeros(n)
-        Mq = np.empty((n, n))
-        tau = np.empty(n)
-        Mp = np.empty((m, m))
-        hp = np.empty(m)
-        L = np.empty((m, m))
-        rhs = np.empty(m)
-        x = np.empty(m)
-        v = np.empty(m)
-        xs = np.empty(m)
-        vs = np.empty(m)
-        k1 = np.empty(m)
-        k2 = np.empty(m)
-        k3 = np.empty(m)
-        k4 = np.empty(m)
+    for b in range(b0, b1):
         for i in range(m):
             x[i] = p0[b, i]
             v[i] = pd0[b, i]
@@ -200,53 +237,67 @@ def _simulate_batch(dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, p0, p
                         v[i] += h * k1[i]
                         x[i] += h * v[i]
                     continue
-                # RK4 on (x, v)
-                _accel(n, m, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, x, v,
-                       torque[s], k1, R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs)
-                for i in range(m):
-                    xs[i] = x[i] + 0.5 * h * v[i]
-                    vs[i] = v[i] + 0.5 * h * k1[i]
-                _accel(n, m, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, xs, vs,
-                       torque[s], k2, R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs)
-                for i in range(m):
-                    xs[i] = x[i] + 0.5 * h * (v[i] + 0.5 * h * k1[i])
-                    vs[i] = v[i] + 0.5 * h * k2[i]
-                _accel(n, m, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, xs, vs,
-                       torque[s], k3, R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs)
-                for i in range(m):
-                    xs[i] = x[i] + h * (v[i] + 0.5 * h * k2[i])
-                    vs[i] = v[i] + h * k3[i]
-                _accel(n, m, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, xs, vs,
-                       torque[s], k4, R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs)
+                # classical RK4 on (x, v); stage c uses x + c·v_prev, v + c·a_prev
+                for st in range(4):
+                    if st == 0:
+                        for i in range(m):
+                            xs[i] = x[i]
+                            vs[i] = v[i]
+                        kk = k1
+                    elif st == 1:
+                        for i in range(m):
+                            xs[i] = x[i] + 0.5 * h * v[i]
+                            vs[i] = v[i] + 0.5 * h * k1[i]
+                        kk = k2
+                    elif st == 2:
+                        for i in range(m):
+                            xs[i] = x[i] + 0.5 * h * (v[i] + 0.5 * h * k1[i])
+                            vs[i] = v[i] + 0.5 * h * k2[i]
+                        kk = k3
+                    else:
+                        for i in range(m):
+                            xs[i] = x[i] + h * (v[i] + 0.5 * h * k2[i])
+                            vs[i] = v[i] + h * k3[i]
+                        kk = k4
+                    if not _accel(n, m, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g,
+                                  xs, vs, torque[s], kk, R, P, work, q, qd, zq, Mq, tau, Mp, hp,
+                                  L, rhs):
+                        fail[b] = s + 1
                 for i in range(m):
                     x[i] += h * v[i] + h * h / 6.0 * (k1[i] + k2[i] + k3[i])
                     v[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-    return fail
 
 
-@numba.njit(cache=True, parallel=True)
-def _potential_batch(dh, jtype, mass, com, G, q0, g, pos, out):  # pragma: no cover - compiled
-    """U = −Σ m_k gᵀ p_Ck (base frame)."""
+@numba.njit(cache=True, error_model="numpy")
+def _sim_scratch(n, m):  # pragma: no cover - compiled
+    return (np.empty((n, 9)), np.empty((n, 3)), np.empty(WORK_PER_LINK * n), np.empty(n),
+            np.empty(n), np.zeros(n), np.empty((n, n)), np.empty(n), np.empty((m, m)), np.empty(m),
+            np.empty((m, m)), np.empty(m), np.empty(m))
+
+
+@numba.njit(cache=True, parallel=True, error_model="numpy")
+def _simulate_parallel(dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, p0, pd0, torque, dt,
+                       substeps, method, pos_out, vel_out, fail):  # pragma: no cover - compiled
     n = dh.shape[0]
-    m = pos.shape[1]
-    B = pos.shape[0]
-    for c in prange(_nchunks(B)):
-        R = np.empty((n, 9))
-        P = np.empty((n, 3))
-        T = np.empty((n, 16))
-        q = np.empty(n)
-        for b in range(c * _CHUNK, min(B, (c + 1) * _CHUNK)):
-            joints_from_actuators(n, m, G, q0, pos[b], q)
-            chain_links(n, dh, jtype, q, R, P)
-            frames_into(n, R, P, T)
-            u = 0.0
-            for k in range(n):
-                for i in range(3):
-                    pc = T[k, 4 * i + 3]
-                    for j in range(3):
-                        pc += T[k, 4 * i + j] * com[k, j]
-                    u -= mass[k] * g[i] * pc
-            out[b] = u
+    m = p0.shape[1]
+    for b in prange(p0.shape[0]):
+        R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, a = _sim_scratch(n, m)
+        _simulate_range(b, b + 1, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, p0, pd0,
+                        torque, dt, substeps, method, pos_out, vel_out, fail, R, P, work, q, qd, zq,
+                        Mq, tau, Mp, hp, L, rhs, np.empty(m), np.empty(m), np.empty(m), np.empty(m),
+                        a, np.empty(m), np.empty(m), np.empty(m))
+
+
+@numba.njit(cache=True, error_model="numpy")
+def _simulate_serial(dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, p0, pd0, torque, dt,
+                     substeps, method, pos_out, vel_out, fail):  # pragma: no cover - compiled
+    n = dh.shape[0]
+    m = p0.shape[1]
+    R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, a = _sim_scratch(n, m)
+    _simulate_range(0, p0.shape[0], dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, p0, pd0,
+                    torque, dt, substeps, method, pos_out, vel_out, fail, R, P, work, q, qd, zq, Mq,
+                    tau, Mp, hp, L, rhs, np.empty(m), np.empty(m), np.empty(m), np.empty(m),
+                    a, np.empty(m), np.empty(m), np.empty(m))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -283,21 +334,25 @@ def _states(system, *arrays, names=("q",)):
     return out, single
 
 
-def rnea(system, q, qd, qdd, *, gravity: bool = True) -> np.ndarray:
-    """Inverse dynamics τ = M q̈ + C(q, q̇) + G(q) (thesis eqs 4.8–4.17), shape like ``q``."""
+def rnea(system, q, qd, qdd, *, gravity: bool = True, parallel: bool | None = None) -> np.ndarray:
+    """Inverse dynamics τ = M q̈ + C(q, q̇) + G(q) (thesis eqs 4.8–4.17), shape like ``q``.
+    ``parallel``: run a batch on all cores (default: from PARALLEL_MIN states on)."""
     (q, qd, qdd), single = _states(system, q, qd, qdd, names=("q", "qd", "qdd"))
     out = np.empty_like(q)
-    _rnea_batch(*system.kernel_arrays(), q, qd, qdd, 1.0 if gravity else 0.0, out)
+    run_op(system, OP_RNEA, q, qd, qdd, gscale=1.0 if gravity else 0.0, vout=out, parallel=parallel)
     return out[0] if single else out
 
 
 def _mass_bias(system, q, qd, gscale, want_mass):
     (q, qd), single = _states(system, q, qd, names=("q", "qd"))
     B, m = q.shape
-    M = np.empty((B, m, m)) if want_mass else np.empty((1, m, m))
     h = np.empty((B, m))
-    _mass_bias_batch(*system.kernel_arrays(), q, qd, gscale, want_mass, M, h)
-    return (M[0] if single else M), (h[0] if single else h)
+    if want_mass:
+        M = np.empty((B, m, m))
+        run_op(system, OP_MASS_BIAS, q, qd, gscale=gscale, vout=h, mout=M)
+        return (M[0] if single else M), (h[0] if single else h)
+    run_op(system, OP_BIAS, q, qd, gscale=gscale, vout=h)
+    return None, (h[0] if single else h)
 
 
 def mass_matrix(system, q) -> np.ndarray:
@@ -327,7 +382,7 @@ def forward_dynamics(system, q, qd, tau) -> np.ndarray:
     """Accelerations q̈ = M⁻¹ (τ − C − G)."""
     (q, qd, tau), single = _states(system, q, qd, tau, names=("q", "qd", "tau"))
     out = np.empty_like(q)
-    ok = _fd_batch(*system.kernel_arrays(), q, qd, tau, out)
+    ok = run_op(system, OP_FD, q, qd, tau, vout=out)
     if not ok.all():
         raise ModelError(f"{system.name}: the mass matrix is not positive definite at state "
                          f"{int(np.argmin(ok))}", hint="check masses, inertias and the armature")
@@ -344,11 +399,9 @@ def kinetic_energy(system, q, qd) -> np.ndarray:
 def potential_energy(system, q) -> np.ndarray:
     """U = −Σ m_k gᵀ p_Ck (J), zero at the base origin."""
     (q,), single = _states(system, q)
-    out = np.empty(q.shape[0])
-    a = system.kernel_arrays()
-    # dh, jtype, mass, com, G, q0, g
-    _potential_batch(a[0], a[1], a[2], a[3], a[6], a[7], a[9], q, out)
-    return out[0] if single else out
+    out = np.empty((q.shape[0], 1))
+    run_op(system, OP_POTENTIAL, q, vout=out)
+    return out[0, 0] if single else out[:, 0]
 
 
 def simulate_free(system, q0, qd0, torque, dt: float, *, substeps: int = 1,
@@ -384,8 +437,10 @@ def simulate_free(system, q0, qd0, torque, dt: float, *, substeps: int = 1,
     N = tq.shape[0]
     pos = np.empty((B, N, m))
     vel = np.empty((B, N, m))
-    fail = _simulate_batch(*system.kernel_arrays(), q0, qd0, tq, float(dt), int(substeps),
-                           0 if method == "rk4" else 1, pos, vel)
+    fail = np.zeros(B, dtype=np.int64)
+    fn = _simulate_parallel if B >= 8 else _simulate_serial
+    fn(*system.kernel_arrays(), q0, qd0, tq, float(dt), int(substeps), 0 if method == "rk4" else 1,
+       pos, vel, fail)
     if fail.any() or not np.isfinite(pos).all():
         raise SimulationError(f"{system.name}: the simulation diverged or met a singular mass matrix",
                               hint="reduce dt or check the inertial parameters")

@@ -22,15 +22,13 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
-from numba import prange
 
 from ..consistency import Finding, compare
 from ..errors import ModelError, SimulationError
 from ..models.bldc import BLDCMotor, motor_parameters
 from ..models.dlr_finger import (ACTUATORS, FINGER_PARAMETERS, FRICTION_MODES, INTEGRATORS, NTH,
-                                 NX, NY, DLRFinger, finger_run)
+                                 NX, DLRFinger, run_jobs)
 from ..models.friction import dlr_hit_table
 from ..params import Parameter, ParameterSet
 from ..sim.model import Model, Signal
@@ -200,7 +198,7 @@ def _thesis_M1(model, t2: float, t3: float) -> float:
             + l1 * l3c * m3 * c(2 * t3))
 
 
-def max_gravity_torque(model, n: int = 19) -> np.ndarray:
+def max_gravity_torque(model, n: int = 13) -> np.ndarray:
     """Largest |G| per joint (abduction, flexion, proximal incl. the coupled distal torque) over a
     grid of the joint ranges, N·m."""
     v = model.parameters.value
@@ -310,37 +308,6 @@ def palm_frames() -> np.ndarray:
     return T
 
 
-@numba.njit(cache=True, parallel=True)
-def _hand_batch(thetas, u, dt, substeps, x0, y, tv, tf, tn, tipos, rot, mode, integ,
-                thermal):  # pragma: no cover - compiled
-    """Five fingers per parameter vector: thetas[p] = shared finger parameters (gravity in the palm
-    frame) followed by 15 friction scales (finger-major: base1, base2, distal)."""
-    P = thetas.shape[0]
-    fail = np.zeros(P * 5, dtype=np.int64)
-    i_scale = 47  # FINGER_PARAMETERS.index("scale_base1") (checked at import)
-    i_g = 26  # FINGER_PARAMETERS.index("g_x")
-    nth = 74  # len(FINGER_PARAMETERS)
-    for job in prange(P * 5):
-        p = job // 5
-        f = job % 5
-        th = thetas[p, :nth].copy()
-        for k in range(3):
-            th[i_scale + k] = thetas[p, nth + 3 * f + k]
-        gx = thetas[p, i_g]
-        gy = thetas[p, i_g + 1]
-        gz = thetas[p, i_g + 2]
-        for k in range(3):  # g in the finger frame = Rᵀ g_palm
-            th[i_g + k] = rot[f, 0, k] * gx + rot[f, 1, k] * gy + rot[f, 2, k] * gz
-        x = x0[p, 15 * f:15 * f + 15].copy()
-        fail[job] = finger_run(th, u, 3 * f, dt, substeps, x, y[p], 18 * f, tv, tf, tn, tipos, mode,
-                               integ, thermal)
-    return fail
-
-
-if (FINGER_PARAMETERS.index("scale_base1"), FINGER_PARAMETERS.index("g_x"), NTH) != (47, 26, 74):
-    raise ImportError("gripkit.zoo.dlr_hit: _hand_batch's parameter indices are out of date")
-
-
 def _hand_parameters(finger_ps: ParameterSet, scales: dict | None) -> ParameterSet:
     ps = list(finger_ps.values())
     for i, n in enumerate(("g_x", "g_y", "g_z")):
@@ -408,11 +375,29 @@ class DLRHand(Model):
     def initial_state(self, theta):
         return self.state()
 
+    #: run the fingers on parallel threads (compiles a parallel kernel on first use)
+    parallel = False
+
+    def finger_thetas(self, theta: np.ndarray) -> np.ndarray:
+        """The five finger parameter vectors (5, 74) of a hand parameter vector: the shared
+        parameters with each finger's friction factors and its gravity (Rᵀ g_palm)."""
+        th = np.tile(theta[:NTH], (5, 1))
+        i_s = FINGER_PARAMETERS.index("scale_base1")
+        i_g = FINGER_PARAMETERS.index("g_x")
+        g = theta[i_g:i_g + 3]
+        for f in range(5):
+            th[f, i_s:i_s + 3] = theta[NTH + 3 * f:NTH + 3 * f + 3]
+            th[f, i_g:i_g + 3] = self.frames[f, :3, :3].T @ g
+        return th
+
     def _simulate_batch(self, thetas, u, dt, substeps, x0, y):
-        tv, tf, tn, tipos = self._finger._tab
-        rot = np.ascontiguousarray(self.frames[:, :3, :3])
-        fail = _hand_batch(thetas, u, dt, substeps, x0, y, tv, tf, tn, tipos, rot,
-                           FRICTION_MODES[self.friction], INTEGRATORS[self.integrator], self.thermal)
+        P = thetas.shape[0]
+        ths = np.concatenate([self.finger_thetas(t) for t in thetas])
+        x0f = np.ascontiguousarray(x0.reshape(P * 5, NX))
+        jobs = np.arange(P * 5)
+        fail = run_jobs(ths, u, 3 * (jobs % 5), dt, substeps, x0f, y, jobs // 5, 18 * (jobs % 5),
+                        self._finger._tab, FRICTION_MODES[self.friction],
+                        INTEGRATORS[self.integrator], self.thermal, self.parallel)
         if fail.any():
             raise SimulationError(f"{self.name}: a finger's mass matrix lost positive definiteness")
 
