@@ -8,8 +8,8 @@ removed, §3.1) the inertia is left as the finger's own, M_I = Λ(q) = (J M⁻¹
 control law is the compliance form used on the hand (§3.1: "joint and Cartesian impedance control
 with friction and gravity compensation", [40])::
 
-    τ_p = J_pᵀ [K_k (x_d − x) + D_k (ẋ_d − ẋ)] + G_p(p) + F̂(ṗ)          (Cartesian)
-    τ_p = Γ_qᵀ [K (q_d − q) + D (q̇_d − q̇)] + G_p(p) + F̂(ṗ)              (joint)
+    τ_p = J_pᵀ [K_k (x_d − x) + D_k (ẋ_d − ẋ)] − D_a ṗ + G_p(p) + F̂(ṗ)     (Cartesian)
+    τ_p = Γ_qᵀ [K (q_d − q) + D (q̇_d − q̇)] − D_a ṗ + G_p(p) + F̂(ṗ)         (joint)
 
 in actuator coordinates p (J_p = J Γ, Γ_q the joint rows of the coupling). G_p is the gravity
 torque of the multibody model and F̂ the identified kinetic friction (a lookup table), applied in
@@ -49,7 +49,7 @@ from ..models.friction import FrictionTable, table_arrays
 from ..signals.trajectory import Trajectory
 
 __all__ = ["ImpedanceController", "Wall", "simulate_impedance", "stability_margins",
-           "impedance_margins"]
+           "impedance_margins", "model_friction_tables"]
 
 @dataclass(frozen=True)
 class ImpedanceController:
@@ -58,9 +58,12 @@ class ImpedanceController:
     ``kind='joint'``: stiffness (N·m/rad) and damping (N·m·s/rad) per joint (abduction, flexion,
     proximal). ``kind='cartesian'``: per fingertip axis of the finger base frame, N/m and N·s/m.
     ``friction_tables``: the identified kinetic friction of (base1, base2, distal) used for
-    compensation (default: the finger model's own tables); ``velocity_deadband`` (rad/s): below
+    compensation (default: the finger model's own friction, :func:`model_friction_tables`);
+    ``velocity_deadband`` (rad/s): below
     it an actuator counts as at rest; ``smoothing`` (N·m): at rest the friction compensation
-    fades in as tanh(|τ|/smoothing) of the impedance torque τ.
+    fades in as tanh(|τ|/smoothing) of the impedance torque τ. ``actuator_damping``
+    (N·m·s/rad per actuator) adds −D_a·ṗ: a Cartesian stiffness acts weakly along the directions
+    J_p maps to small fingertip motion, and this damps them.
     """
 
     kind: str = "joint"
@@ -71,11 +74,12 @@ class ImpedanceController:
     friction_tables: tuple | None = None
     velocity_deadband: float = 0.02
     smoothing: float = 0.02
+    actuator_damping: tuple = (0.0, 0.0, 0.0)
 
     def __post_init__(self):
         if self.kind not in ("joint", "cartesian"):
             raise ModelError(f"kind: expected 'joint' or 'cartesian', found {self.kind!r}")
-        for name in ("stiffness", "damping"):
+        for name in ("stiffness", "damping", "actuator_damping"):
             v = np.asarray(getattr(self, name), dtype=np.float64)
             if v.shape != (3,) or not np.isfinite(v).all() or (v < 0).any():
                 raise ModelError(f"{name}: expected three non-negative gains, found {getattr(self, name)!r}")
@@ -111,11 +115,23 @@ class Wall:
             raise ModelError(f"wall stiffness must be > 0 and damping >= 0, found {self.stiffness!r}, {self.damping!r}")
 
 
+def model_friction_tables(finger: DLRFinger, v_max: float = 8.0, n: int = 200) -> tuple:
+    """The finger's own kinetic friction as lookup tables (base1, base2, distal): its Appendix G
+    tables with their scale factors, or its Stribeck/LuGre/no-friction curve tabulated on
+    ±[v_max/n·…, v_max] rad/s — the default model of the controller's friction compensation."""
+    if finger.friction == "table":
+        return tuple(t.scaled(finger.parameters.value(f"scale_{a}")) for t, a in zip(finger.tables, ACTUATORS))
+    v = np.geomspace(v_max / n, v_max, n)
+    v = np.r_[-v[::-1], v]
+    return tuple(FrictionTable(v, finger.kinetic_friction(a, v), name=f"{finger.friction} friction, {a}")
+                 for a in ACTUATORS)
+
+
 _OUT = (["abd", "flex", "prox"], ["abd_vel", "flex_vel", "prox_vel"], ["tip_x", "tip_y", "tip_z"],
         ["tip_vx", "tip_vy", "tip_vz"], ["force_x", "force_y", "force_z"],
         [f"pwm_{a}" for a in ACTUATORS], [f"tau_cmd_{a}" for a in ACTUATORS],
-        [f"fric_{a}" for a in ACTUATORS])
-_UNITS = ("rad", "rad/s", "m", "m/s", "N", "1", "N*m", "N*m")
+        [f"fric_{a}" for a in ACTUATORS], [f"tau_{a}" for a in ACTUATORS])
+_UNITS = ("rad", "rad/s", "m", "m/s", "N", "1", "N*m", "N*m", "N*m")
 
 
 def simulate_impedance(finger: DLRFinger, controller: ImpedanceController, reference,
@@ -136,8 +152,10 @@ def simulate_impedance(finger: DLRFinger, controller: ImpedanceController, refer
     wall
         Optional :class:`Wall`.
 
-    Returns a Trajectory with joint angles and velocities, fingertip position and velocity,
-    contact force on the finger (N), PWM commands, commanded actuator torques and friction.
+    Returns a Trajectory with joint angles (``abd``, ``flex``, ``prox``) and velocities, fingertip
+    position and velocity (``tip_x``..), contact force on the finger (``force_x``.., N), PWM
+    commands (``pwm_base1``..), commanded actuator torques (``tau_cmd_*``), friction (``fric_*``)
+    and the motor torques delivered (``tau_*``, N·m), and the references (``ref_*``).
     """
     if not isinstance(finger, DLRFinger):
         raise ModelError(f"finger: expected a DLRFinger, found {type(finger).__name__}")
@@ -162,11 +180,8 @@ def simulate_impedance(finger: DLRFinger, controller: ImpedanceController, refer
     x = np.array(x0, dtype=np.float64)
     if x.shape != (NX,):
         raise SimulationError(f"x0: expected a finger state of {NX} values, found {x.shape}")
-    tables = controller.friction_tables or finger.tables
+    tables = controller.friction_tables or model_friction_tables(finger)
     ctv, ctf, ctn, ctip = table_arrays(tables)
-    if controller.friction_tables is None:
-        sc = np.array([finger.parameters.value(f"scale_{a}") for a in ACTUATORS])
-        ctf = ctf * sc[:, None]
     tv, tf, tn, tip = finger._tab
     w = np.zeros(9)
     if wall is not None:
@@ -175,10 +190,10 @@ def simulate_impedance(finger: DLRFinger, controller: ImpedanceController, refer
         w[6] = wall.stiffness
         w[7] = wall.damping
         w[8] = 1.0
-    y = np.empty((ref.shape[0], 24))
+    y = np.empty((ref.shape[0], 27))
     gains = np.array([*controller.stiffness, *controller.damping, float(controller.gravity_compensation),
                       float(controller.friction_compensation), controller.velocity_deadband,
-                      controller.smoothing])
+                      controller.smoothing, *controller.actuator_damping])
     fail = finger_run(th, FRICTION_MODES[finger.friction], finger.thermal, tv, tf, tn, tip,
                       np.zeros((1, 3)), 0, float(dt), int(substeps), x, y, 0,
                       2 if controller.kind == "cartesian" else 1, gains, ctv, ctf, ctn, ctip, ref, refd, w)
@@ -275,6 +290,7 @@ def impedance_margins(finger: DLRFinger, controller: ImpedanceController, q=(0.0
     else:
         Kp = G[:3].T @ K @ G[:3]
         Dp = G[:3].T @ D @ G[:3]
+    Dp = Dp + np.diag(controller.actuator_damping)
     Ke = np.zeros((3, 3))
     if wall is not None:
         Jp = ch.jacobian(p)[:3]

@@ -16,9 +16,10 @@ removes the need for an acceleration signal (H[s·v] = a(v − H[v])):
     y = H[τ_m − h] − J·a·(v − H[v]) = s·H[F_table(v)] + o·H[sign(v)] = φᵀθ.
 
 RLS with forgetting factor λ (per sample of period T_s) updates θ = (s, o) on the samples where
-the actuator slides (|v| and |H[v]| above ``v_min``: at rest friction is a reaction, not a
-function of v) — neither estimates nor covariance change while it sticks, so the covariance
-cannot wind up. The standard deviations are σ̂·sqrt(diag P) with σ̂² an exponentially weighted
+the actuator has slid in one direction (|v| above ``v_min``) for three filter time constants: at
+rest friction is a reaction, not a function of v, and right after a stick phase or a reversal the
+filtered signals still carry it. Neither estimates nor covariance change otherwise, so the
+covariance cannot wind up. The standard deviations are σ̂·sqrt(diag P) with σ̂² an exponentially weighted
 average of the a-priori residuals.
 
 Convergence time. After a change of friction, the weight of data older than k sliding samples is
@@ -46,11 +47,12 @@ __all__ = ["FrictionAdapter", "AdaptationResult", "adapt_finger_friction"]
 def _rls_run(tau, bias, vel, J, tv, tf, tn, tipos, lam, a_filt, dt, vmin, p0, s0, o0,
              theta, P, filt, sig2, out_theta, out_std, out_active):  # pragma: no cover - compiled
     """RLS over N samples for m actuators. State arrays (updated in place so a later call
-    continues): theta (m, 2), P (m, 2, 2), filt (m, 5) = H[τ−h], H[v], H[F], H[sign], unused;
-    sig2 (m,)."""
+    continues): theta (m, 2), P (m, 2, 2), filt (m, 5) = H[τ−h], H[v], H[F], H[sign], samples
+    sliding in the current direction; sig2 (m,)."""
     N = tau.shape[0]
     m = tau.shape[1]
     al = 1.0 - math.exp(-a_filt * dt)  # exact discretisation of a/(s + a)
+    hold = math.ceil(3.0 / (a_filt * dt))  # three filter time constants
     for n in range(N):
         for k in range(m):
             v = vel[n, k]
@@ -61,7 +63,13 @@ def _rls_run(tau, bias, vel, J, tv, tf, tn, tipos, lam, a_filt, dt, vmin, p0, s0
             filt[k, 1] += al * (v - filt[k, 1])
             filt[k, 2] += al * (fr - filt[k, 2])
             filt[k, 3] += al * (sg - filt[k, 3])
-            active = abs(v) > vmin and abs(filt[k, 1]) > vmin
+            # sliding in one direction for `hold` samples: the filtered signals no longer carry
+            # the holding torque of a stick phase or the friction step of a reversal
+            if abs(v) > vmin and sg * filt[k, 4] >= 0.0:
+                filt[k, 4] += sg
+            else:
+                filt[k, 4] = sg if abs(v) > vmin else 0.0
+            active = abs(filt[k, 4]) > hold
             out_active[n, k] = 1.0 if active else 0.0
             if active:
                 # y = H[τ − h] − J·H[v̇], with H[v̇] = d/dt H[v] as a difference of the filter state

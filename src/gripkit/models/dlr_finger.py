@@ -20,7 +20,8 @@ efficiency), h_p the Coriolis/centrifugal and gravity torques, and F_k friction:
   it breaks away when its holding torque exceeds its stiction);
 * ``friction='stribeck'``: eq 6.5 per actuator plus a cubic velocity term (the harmonic-drive
   friction model of [50] quoted in §3.2.2), with the same stiction logic;
-* ``friction='lugre'``: LuGre per actuator (no state machine; creeps below stiction);
+* ``friction='lugre'``: LuGre per actuator (no state machine; moves by a pre-sliding
+  displacement under loads below stiction);
 * ``friction='none'``: frictionless (energy-conservation studies).
 
 An optional harmonic-drive ripple A·sin(k·p)·sign(ṗ) adds to F (§3.2.2).
@@ -530,6 +531,8 @@ def _impedance(th, ctx, cs, x, n, ctrl, gains, ctv, ctf, ctn, ctipos, ref, refd,
             f = gains[j] * (ref[n, j] - q[j]) + gains[3 + j] * (refd[n, j] - qd[j])
             for k in range(3):
                 tauq[k] += G[j * 3 + k] * f
+    for k in range(3):  # joint-space damping on the actuators (damps directions J_p makes soft)
+        tauq[k] -= gains[10 + k] * x[3 + k]
     if gains[6] != 0.0:
         rnea_pass(4, R, P, jt, mass, com, inertia, armq, zq, zq, grav[0], grav[1], grav[2], False,
                   gp, work)
@@ -590,7 +593,8 @@ def finger_loop(th, mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucol, dt, 
                 ycol, ctrl, gains, ctv, ctf, ctn, ctipos, ref, refd, wall):  # pragma: no cover
     """The time loop (allocation-free, semi-implicit Euler). ``ctrl = 0``: PWM from u[:, ucol:],
     outputs as DLRFinger.outputs at y[:, ycol:ycol+18]; ``ctrl = 1/2``: joint/Cartesian impedance
-    on ``ref``/``refd`` with the ``wall``, closed-loop outputs (24 columns)."""
+    on ``ref``/``refd`` with the ``wall``, closed-loop outputs (27 columns, see
+    gripkit.control.impedance)."""
     G = ctx[6]
     q0 = ctx[7]
     pwm, ext, taum, fric, xs, force = cs[14], cs[15], cs[16], cs[17], cs[13], cs[8]
@@ -632,6 +636,7 @@ def finger_loop(th, mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucol, dt, 
                 y[n, 15 + k] = pwm[k]
                 y[n, 18 + k] = cs[9][k]
                 y[n, 21 + k] = fric[k]
+                y[n, 24 + k] = taum[k]
     return 0
 
 
@@ -901,8 +906,9 @@ class DLRFinger(Model):
 
     def steady_velocity(self, actuator: str, pwm: float, load: float = 0.0) -> float:
         """Velocity (rad/s) at which motor torque balances kinetic friction plus a constant
-        ``load`` torque (N·m) for a constant PWM — the plateau of Figs 7.3–7.5 without gravity.
-        0 when the motor cannot overcome stiction."""
+        ``load`` torque (N·m) for a constant PWM — the plateau of Figs 7.3–7.5 without gravity:
+        the first balance reached when accelerating from rest (a table with a spike can hold the
+        joint below a faster balance). 0 when the motor cannot overcome stiction."""
         from scipy.optimize import brentq
 
         k = ACTUATORS.index(actuator)
@@ -917,12 +923,15 @@ class DLRFinger(Model):
         v_guard = c * u / (slope * N) if slope > 0 else 1e3
 
         def f(v):
-            return float(self.motor_torque(actuator, pwm, sgn * v) - load
-                         - self.kinetic_friction(actuator, sgn * v)) * sgn
+            return (self.motor_torque(actuator, pwm, sgn * v) - load
+                    - self.kinetic_friction(actuator, sgn * v)) * sgn
 
-        lo, hi = 1e-9, v_guard * (1 - 1e-12)
-        if f(lo) <= 0:
+        grid = np.linspace(1e-9, v_guard * (1 - 1e-12), 4001)
+        vals = f(grid)
+        neg = np.flatnonzero(vals <= 0)
+        if neg.size == 0:
+            return sgn * grid[-1]
+        i = int(neg[0])
+        if i == 0:
             return 0.0
-        if f(hi) > 0:
-            return sgn * hi
-        return sgn * brentq(f, lo, hi, xtol=1e-12)
+        return sgn * brentq(lambda v: float(f(np.array(v))), grid[i - 1], grid[i], xtol=1e-12)

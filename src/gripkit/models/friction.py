@@ -32,8 +32,8 @@ PWM 1200–1500).
 
     ż = v − σ₀|v| z / g(v),  g(v) = F_c + (F_s − F_c) exp(−(v/v_s)²),  F = σ₀ z + σ₁ ż + σ₂ v;
 
-it reproduces pre-sliding displacement and frictional lag, but unlike Karnopp it creeps under a
-constant sub-stiction load. gripkit integrates z exactly for the velocity held over a step
+it reproduces pre-sliding displacement and frictional lag, but unlike Karnopp it moves under a
+constant sub-stiction load (a pre-sliding displacement of many times F_s/σ₀ before it settles). gripkit integrates z exactly for the velocity held over a step
 (z relaxes exponentially towards sign(v)·g(v)/σ₀ at rate σ₀|v|/g(v)), stable for any step.
 """
 
@@ -206,6 +206,27 @@ class FrictionTable:
         """The (scaled) friction values at the breakpoints (N·m)."""
         return self.friction * self.scale
 
+    def outliers(self, rtol: float = 0.3, half_width: int = 2) -> list[tuple[int, float]]:
+        """Breakpoints whose value lies more than ``rtol`` (relative) from the median of its
+        ``half_width`` neighbours on each side (same-sign branch only): ``[(index, median)]``."""
+        out = []
+        for lo, hi in ((0, self.ipos), (self.ipos, self.velocity.size)):
+            f = self.friction[lo:hi]
+            for i in range(f.size):
+                nb = np.r_[f[max(0, i - half_width):i], f[i + 1:i + 1 + half_width]]
+                if nb.size >= 2:
+                    med = float(np.median(nb))
+                    if abs(f[i] - med) > rtol * abs(med):
+                        out.append((lo + i, med))
+        return out
+
+    def without_outliers(self, rtol: float = 0.3) -> "FrictionTable":
+        """A copy without the :meth:`outliers` (measurement points the thesis meant to delete)."""
+        bad = {i for i, _ in self.outliers(rtol)}
+        keep = np.array([i not in bad for i in range(self.velocity.size)])
+        return FrictionTable(self.velocity[keep], self.friction[keep], name=f"{self.name} (outliers removed)",
+                             source=self.source, scale=self.scale)
+
     @classmethod
     def from_csv(cls, path, *, name: str | None = None, scale: float = 1.0) -> "FrictionTable":
         """Read ``velocity_deg_s,friction_N_m`` CSV (``#`` lines are comments)."""
@@ -330,30 +351,30 @@ def _drive_batch(thetas, u, dt, substeps, x0, y, lugre):  # pragma: no cover - c
         f = 0.0
         for n in range(N):
             tau = u[n, 0]
-            for _ in range(substeps):
+            y[p, n, 0] = x  # sample n: the state at t_n and the friction acting at t_n
+            y[p, n, 1] = v
+            for s in range(substeps):
                 if lugre:
                     f = lugre_force(z, v, fc, fs, vs, s0, s1, sigma)
                     z = lugre_update(z, v, h, fc, fs, vs, s0)
                     v += h * (tau - f) / J
                     x += h * v
-                    continue
-                if stuck:
-                    if abs(tau) <= fs:
-                        f = tau
-                        continue
-                    stuck = False
-                    f = stribeck(1e-300 if tau > 0 else -1e-300, fc, fs, vs, delta, sigma)
+                elif stuck and abs(tau) <= fs:
+                    f = tau
                 else:
-                    f = stribeck(v, fc, fs, vs, delta, sigma)
-                vn = v + h * (tau - f) / J
-                if (vn * v < 0.0 or abs(vn) <= vstick) and abs(tau) <= fs:
-                    vn = 0.0
-                    stuck = True
-                v = vn
-                x += h * v
-            y[p, n, 0] = x
-            y[p, n, 1] = v
-            y[p, n, 2] = f
+                    if stuck:  # breakaway: kinetic friction in the direction of the torque
+                        stuck = False
+                        f = stribeck(1e-300 if tau > 0 else -1e-300, fc, fs, vs, delta, sigma)
+                    else:
+                        f = stribeck(v, fc, fs, vs, delta, sigma)
+                    vn = v + h * (tau - f) / J
+                    if (vn * v < 0.0 or abs(vn) <= vstick) and abs(tau) <= fs:
+                        vn = 0.0
+                        stuck = True
+                    v = vn
+                    x += h * v
+                if s == 0:
+                    y[p, n, 2] = f
 
 
 class FrictionDrive(Model):

@@ -25,8 +25,9 @@ axis with position q and effort τ (= K × a logged column):
 Position and effort are low-pass filtered with the same zero-phase Butterworth filter (parallel
 filtering keeps the linear relation exact), q̇ and q̈ come from central differences of the filtered
 position, the filtered signals are decimated (keeping every q-th sample: fewer, less correlated
-rows), the filter's edge transients and the samples with |q̇| below a threshold (where sign(q̇)
-is ill-defined and the joint may stick) are dropped, and the overdetermined system is solved by
+rows), the filter's edge transients, the samples with |q̇| below a threshold (where the joint may
+stick) and those within about one filter time constant of a velocity reversal (where the filtered
+Coulomb step no longer follows sign(q̇)) are dropped, and the overdetermined system is solved by
 least squares. Standard deviations: σ̂² = RSS/(N − 4), Cov = σ̂² (XᵀX)⁻¹; relative error
 100·‖τ − Xθ‖/‖τ‖.
 """
@@ -182,14 +183,17 @@ class ConstantVelocityPoint:
 
 
 def constant_velocity_friction(pwm, velocity, *, motor_torque: Callable[[float, float], float],
-                               load: Callable[[int], float] | None = None,
-                               plateau: float = 0.05, min_samples: int = 10) -> list[ConstantVelocityPoint]:
+                               load: Callable[[int], float] | None = None, inertia: float | None = None,
+                               fs: float | None = None, plateau: float = 0.05,
+                               min_samples: int = 10) -> list[ConstantVelocityPoint]:
     """One friction point per constant-PWM run (Appendix D).
 
     The plateau of each run is the set of samples whose velocity lies within ``plateau``
     (relative) of the run's peak speed; friction = ``motor_torque(pwm, v)`` − ``load(i)`` at the
-    plateau's mean velocity. The friction std propagates the plateau's velocity scatter through the
-    motor's torque-speed slope.
+    plateau's mean velocity. A short run (the joint reaches its end stop) may still be speeding up
+    on its plateau: given the joint's ``inertia`` and the sampling rate ``fs``, the inertial torque
+    J·a (a from a line fitted to the plateau's velocity) is subtracted too. The friction std
+    propagates the plateau's velocity scatter through the motor's torque-speed slope.
     """
     u = np.asarray(pwm, dtype=np.float64)
     v = np.asarray(velocity, dtype=np.float64)
@@ -213,6 +217,12 @@ def constant_velocity_friction(pwm, velocity, *, motor_torque: Callable[[float, 
         dv = max(abs(vm) * 1e-6, 1e-9)
         slope = (float(motor_torque(u[a], vm + dv)) - float(motor_torque(u[a], vm - dv))) / (2 * dv)
         ld = 0.0 if load is None else float(np.mean([load(i) for i in range(a, b)][::max(1, (b - a) // 20)]))
+        if inertia is not None:
+            if fs is None:
+                raise DataError("constant_velocity_friction: give fs (Hz) with inertia")
+            idx = np.flatnonzero(sel)
+            acc = float(np.polyfit(idx / fs, vv, 1)[0]) if idx.size > 2 else 0.0
+            ld += inertia * acc
         pts.append(ConstantVelocityPoint(float(u[a]), vm, vs, tau - ld, abs(slope) * vs, int(sel.sum())))
     if len(pts) < 2:
         raise IdentificationError(f"only {len(pts)} constant-PWM runs reached a plateau",
@@ -353,7 +363,7 @@ _IDIM = ("inertia", "viscous", "coulomb", "offset")
 
 def idim_ls(position, effort, fs: float, *, effort_scale: float = 1.0, cutoff: float | None = None,
             order: int = 4, decimation: int | None = None,
-            velocity_threshold: float | None = None) -> IdimResult:
+            velocity_threshold: float | None = None, guard: float = 1.0) -> IdimResult:
     """Identify τ = J q̈ + F_v q̇ + F_c sign(q̇) + τ₀ from position and effort logs (module doc).
 
     Parameters
@@ -364,13 +374,17 @@ def idim_ls(position, effort, fs: float, *, effort_scale: float = 1.0, cutoff: f
         Effort column; the effort is ``effort_scale × effort`` (e.g. a current in A times the
         torque constant and gear ratio, or a PWM count times N·m per count).
     cutoff
-        Low-pass cutoff (Hz) of the zero-phase Butterworth filter; default fs/20.
+        Low-pass cutoff (Hz) of the zero-phase Butterworth filter; default fs/50 (20 Hz at 1 kHz).
+        Choose 5–10 times the bandwidth of the motion: higher lets the position noise into q̈.
     order
         Filter order (the zero-phase filter has twice this order).
     decimation
         Keep every q-th filtered sample; default the largest q with fs/(2q) ≥ 2.5·cutoff.
     velocity_threshold
         Drop samples with |q̇| below it; default 2 % of the largest |q̇|.
+    guard
+        Also drop the samples within ``guard/cutoff`` seconds of a velocity reversal, where the
+        filtered Coulomb step does not follow sign(q̇).
     """
     from ..signals.filters import apply_sos, butter_sos
 
@@ -386,7 +400,7 @@ def idim_ls(position, effort, fs: float, *, effort_scale: float = 1.0, cutoff: f
         raise DataError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
     if not (np.isfinite(effort_scale) and effort_scale != 0):
         raise DataError(f"effort scale: expected a finite non-zero factor, found {effort_scale!r}")
-    cutoff = fs / 20.0 if cutoff is None else float(cutoff)
+    cutoff = fs / 50.0 if cutoff is None else float(cutoff)
     if not 0 < cutoff < fs / 2:
         raise DataError(f"cutoff {cutoff:g} Hz must lie between 0 and fs/2 = {fs / 2:g} Hz")
     q = decimation if decimation is not None else max(1, int(fs / (2 * 2.5 * cutoff)))
@@ -407,13 +421,26 @@ def idim_ls(position, effort, fs: float, *, effort_scale: float = 1.0, cutoff: f
     dt = 1.0 / fs
     vel = np.gradient(xf, dt)
     acc = np.gradient(vel, dt)
+    # the filter smears the friction step of each velocity reversal over ~1/cutoff: those samples
+    # do not obey the sign(q̇) model of the filtered signals, so a guard band around every
+    # reversal is left out (besides the slow samples)
+    near = np.zeros(x.size, dtype=bool)
+    rev = np.flatnonzero(np.sign(vel[1:]) != np.sign(vel[:-1]))
+    g = int(math.ceil(guard * fs / cutoff))
+    if rev.size and g > 0:
+        lo = np.clip(rev - g, 0, x.size)
+        hi = np.clip(rev + g + 1, 0, x.size)
+        cover = np.zeros(x.size + 1, dtype=np.int64)
+        np.add.at(cover, lo, 1)
+        np.add.at(cover, hi, -1)
+        near = np.cumsum(cover[:-1]) > 0
     sl = slice(edge, x.size - edge, q)
-    vel, acc, y = vel[sl], acc[sl], ef[sl]
+    vel, acc, y, near = vel[sl], acc[sl], ef[sl], near[sl]
     vmax = float(np.max(np.abs(vel)))
     if vmax == 0:
         raise UnidentifiableError("the position never changes: the data cannot identify friction or inertia")
     thr = 0.02 * vmax if velocity_threshold is None else float(velocity_threshold)
-    keep = np.abs(vel) > thr
+    keep = (np.abs(vel) > thr) & ~near
     if keep.sum() < 20:
         raise UnidentifiableError(f"only {int(keep.sum())} samples move faster than {thr:.3g}",
                                   hint="excite the joint more, or lower --velocity-threshold")

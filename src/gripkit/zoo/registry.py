@@ -39,6 +39,13 @@ _ENTRIES: tuple[ZooEntry, ...] = (
              "Finger force dynamics, ARX [2 2 2] LS model of Table II (9 Hz filtered data), valve "
              "current (A) to fingertip force (N) at 200 Hz, two-sample valve delay",
              _AMADEUS, "gripkit.zoo.amadeus:finger_force_model"),
+    ZooEntry("dlr-hit-finger", "DLR/HIT Hand II",
+             "Modular finger of ch. 7: PWM → BLDC motor (eq 5.10) → belts and harmonic drive → "
+             "Appendix G friction with stick-slip → coupled Newton-Euler dynamics",
+             _DLR, "gripkit.zoo.dlr_hit:finger"),
+    ZooEntry("dlr-hit-hand", "DLR/HIT Hand II",
+             "Five identical fingers on a palm, thumb fixed, per-finger friction (§3.1, §6.3)",
+             _DLR, "gripkit.zoo.dlr_hit:hand"),
 )
 
 

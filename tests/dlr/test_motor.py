@@ -1,0 +1,143 @@
+"""BLDC motor model (``002_ddea254371185ad3.txt`` ch. 5, Appendix E) and its identification."""
+
+import math
+
+import numpy as np
+import pytest
+
+from gripkit.errors import DataError, ModelError, UnidentifiableError
+from gripkit.models.bldc import NCM, RPM, SLOPES_5_4_2, BLDCMotor, MotorTestBed, motor_parameters
+from gripkit.models.transmission import DLR_BASE, DLR_DISTAL, Transmission, harmonic_drive
+from gripkit.sysid.motor import characterize_motor, fit_motor
+
+MOTOR = BLDCMotor()
+
+
+def test_stall_torque_follows_eq_5_7():
+    """Eq 5.7: τ = 1.43e-4 Ncm × PWM at n = 0 (and T_ref); PWM 4000 → 0.572 Ncm; negative PWM
+    reverses; |PWM| is clipped at 4096 (§5.2)."""
+    pwm = np.arange(-4000, 4001, 250.0)
+    np.testing.assert_allclose(MOTOR.torque(pwm, 0.0) / NCM, 1.43e-4 * pwm, rtol=1e-12, atol=1e-15)
+    assert MOTOR.torque(5000, 0.0) / NCM == pytest.approx(1.43e-4 * 4096)
+
+
+def test_slopes_of_section_5_4_2():
+    """Eq 5.8 reproduces the printed torque-speed slopes within 5 % (§5.4.2; printed as magnitudes,
+    the torque falls with speed)."""
+    for pwm, stated in SLOPES_5_4_2.items():
+        assert MOTOR.slope(pwm) * RPM / NCM == pytest.approx(stated, rel=0.05)
+        # the torque actually falls with that slope
+        w = 1500 * RPM
+        assert (MOTOR.torque(pwm, w) - MOTOR.torque(pwm, 0.0)) / 1500 / NCM == pytest.approx(MOTOR.slope(pwm) * RPM / NCM)
+
+
+def test_appendix_e_guard():
+    """Appendix E: if |speed term| exceeds |PWM term| the torque is zero; PWM 0 gives no torque."""
+    w0 = 1.43e-4 * 2000 / -(1.215e-8 * 2000 - 7.711e-5) * RPM  # speed where the terms cancel (rad/s)
+    assert MOTOR.torque(2000, 0.99 * w0) > 0
+    assert MOTOR.torque(2000, 1.01 * w0) == 0.0
+    assert MOTOR.torque(0, 100.0) == 0.0
+    assert MOTOR.torque(-2000, -1.01 * w0) == 0.0
+
+
+def test_inverse_model_round_trip():
+    pwm = np.array([-3500.0, -1200.0, 800.0, 2500.0, 3900.0])
+    w = np.array([-200.0, 50.0, 100.0, 300.0, -150.0])
+    np.testing.assert_allclose(MOTOR.pwm_for_torque(MOTOR.torque(pwm, w), w), pwm, rtol=1e-9)
+
+
+def test_fig_5_7_temperature_drop():
+    """Fig. 5.7: PWM 4000 held at stall gives ~1 Ncm at room temperature, falling below 0.6 Ncm
+    as the motor reaches ~80 °C within the figure's 120 s."""
+    tb = MotorTestBed(check=False)
+    tr = tb.simulate(np.column_stack([np.full(1201, 4000.0), np.zeros(1201)]), dt=0.1)
+    tau = tr["torque"] / NCM
+    T = tr["temperature"] - 273.15
+    assert tau[0] == pytest.approx(1.0, rel=0.03)
+    assert tau[-1] < 0.6
+    assert 75.0 < T[-1] < 90.0
+    assert np.all(np.diff(tau) <= 1e-12)  # monotone decay while heating
+    # eq 5.5: R(T) = R0(1 + α(T − T0))
+    assert MOTOR.resistance(298.15 + 50) == pytest.approx(9.32 * (1 + 0.0136 * 50))
+
+
+def test_consistency_reports_the_temperature_coefficient():
+    f = {x.check: x for x in MOTOR.consistency_checks()}
+    assert not f["fig5.7-temperature-coefficient"].consistent
+    assert all(f[f"eq5.8-slope-pwm{p}"].consistent for p in SLOPES_5_4_2)
+
+
+def test_transmissions_of_appendix_e():
+    assert DLR_DISTAL.ratio == pytest.approx(208.3)
+    assert DLR_BASE.ratio == pytest.approx(234.3375)
+    assert DLR_DISTAL.reflected_inertia(5.1e-7) == pytest.approx(0.02213, rel=1e-3)
+    hd = harmonic_drive(100, efficiency=0.8)
+    assert hd.output_torque(0.01, 1.0) == pytest.approx(0.8)  # driving
+    assert hd.output_torque(0.01, -1.0) == pytest.approx(1.25)  # back-driven
+    with pytest.raises(ModelError, match="efficiency"):
+        Transmission(10.0, 1.5)
+
+
+def synthetic_test_bed(seed, noise_ncm=0.005):
+    """Stall sweep PWM 0..4000 step 50 (§5.4.1) and torque-speed runs at PWM 2000..4000 with speeds
+    0..2500 rpm (§5.4.2), generated with eqs 5.7/5.8 plus sensor noise (0.05 % of 5 Ncm, §5.3)."""
+    rng = np.random.default_rng(seed)
+    stall = np.arange(0, 4001, 50.0)
+    t_stall = MOTOR.torque(stall, 0.0) + rng.normal(0, noise_ncm * NCM, stall.size)
+    runs = []
+    for pwm in (2000, 2500, 3000, 3500, 4000):
+        w = np.repeat(np.arange(0, 2501, 500.0), 40) * RPM
+        runs.append((pwm, w, MOTOR.torque(pwm, w) + rng.normal(0, noise_ncm * NCM, w.size)))
+    return stall, t_stall, runs
+
+
+def test_two_stage_characterisation_recovers_eqs_5_7_and_5_8():
+    stall, t_stall, runs = synthetic_test_bed(1)
+    ch = characterize_motor(stall, t_stall, runs)
+    p = motor_parameters()
+    assert abs(ch.c - p.value("c_pwm")) < 3 * ch.c_std and ch.c_std / ch.c < 0.005
+    assert abs(ch.b1 - p.value("b_pwm")) < 3 * ch.b1_std
+    assert abs(ch.b0 - p.value("b_0")) < 3 * ch.b0_std
+    for pwm, slope, std in ch.table():
+        assert slope == pytest.approx(MOTOR.slope(pwm) * RPM / NCM, abs=4 * std * RPM / NCM + 1e-9)
+
+
+def test_one_shot_fit_with_std_matching_the_scatter():
+    ests, stds = [], []
+    for seed in range(20):
+        stall, t_stall, runs = synthetic_test_bed(100 + seed, noise_ncm=0.02)
+        u = np.concatenate([stall] + [np.full(r[1].size, r[0]) for r in runs])
+        w = np.concatenate([np.zeros(stall.size)] + [r[1] for r in runs])
+        t = np.concatenate([t_stall] + [r[2] for r in runs])
+        fit = fit_motor(u, w, t)
+        ests.append([fit.values[k] for k in ("c_pwm", "b_pwm", "b_0")])
+        stds.append([fit.std[k] for k in ("c_pwm", "b_pwm", "b_0")])
+    ests, stds = np.array(ests), np.array(stds)
+    truth = motor_parameters().vector(["c_pwm", "b_pwm", "b_0"])
+    np.testing.assert_allclose(ests.mean(0), truth, rtol=0.01)
+    np.testing.assert_allclose(ests.std(0, ddof=1), stds.mean(0), rtol=0.4)
+    c, _ = fit.thesis_units()["c_pwm"]
+    assert c == pytest.approx(1.43e-4, rel=0.01)
+
+
+def test_fit_with_temperature_recovers_alpha():
+    """Heating runs (Fig. 5.2-like): torque at several PWM, speeds and temperatures, generated with
+    eq 5.10 × R(T_ref)/R(T); the fit returns α of eq 5.5."""
+    rng = np.random.default_rng(7)
+    u = rng.choice([1500.0, 2500.0, 3500.0, 4000.0], 3000)
+    w = rng.uniform(0, 2000, 3000) * RPM
+    T = rng.uniform(298.15, 363.15, 3000)
+    tau = MOTOR.torque(u, w, T) + rng.normal(0, 0.005 * NCM, 3000)
+    fit = fit_motor(u, w, tau, T, T_ref=353.15, T_amb=298.15)
+    assert abs(fit.values["alpha_R"] - 0.0136) < 3 * fit.std["alpha_R"]
+    assert fit.values["c_pwm"] == pytest.approx(1.43e-6, rel=0.01)
+
+
+def test_bad_motor_data():
+    with pytest.raises(DataError, match="non-finite"):
+        fit_motor([1000, 2000, np.nan], [0, 0, 0], [1, 2, 3])
+    with pytest.raises(UnidentifiableError, match="collinear|excite"):
+        fit_motor(np.full(20, 2000.0), np.zeros(20), np.ones(20))
+    with pytest.raises(DataError, match="three or more"):
+        characterize_motor([1000, 2000], [0.1, 0.2], [(2000, np.arange(5.0), np.arange(5.0))])
+    assert math.isfinite(MOTOR.torque(10000, 0.0))
