@@ -295,31 +295,27 @@ def _finger_checks(model) -> list[Finding]:
 
 # --- the five-finger hand -------------------------------------------------------------------------
 
-def _rot(axis: str, a: float) -> np.ndarray:
-    c, s = math.cos(a), math.sin(a)
-    if axis == "x":
-        return np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
-    if axis == "y":
-        return np.array([[c, 0, s], [0, 1, 0], [-s, 0, c]])
-    return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
-
-
 def palm_frames() -> np.ndarray:
     """Finger base frames in the palm frame (5, 4, 4): thumb, index, middle, ring, little.
 
     Palm frame: x towards the fingertips, y towards the thumb, z out of the back of the hand.
     A finger's base frame has x along the straight finger and z on its abduction axis (the palm
-    normal); positive flexion curls towards the palm. The four fingers sit side by side 22 mm
-    apart at the end of a 90 mm palm, the middle finger 5 mm further out; the thumb is fixed
+    normal); positive flexion curls towards −z, the palm side. The four fingers sit side by side
+    22 mm apart at the end of a 90 mm palm, the middle finger 5 mm further out. The thumb is fixed
     (§3.1: "the thumb is fixed in an appropriate orientation of the palm") at the palm's side,
-    turned 60° towards the fingers and rolled 90° to oppose them. These distances and angles are
-    assumed: the thesis does not give the palm geometry.
+    pointing forward, outward and down, its flexion curling towards the fingers (−z of its frame
+    along −y of the palm). These distances and angles are assumed: the thesis does not give the
+    palm geometry.
     """
     T = np.tile(np.eye(4), (5, 1, 1))
     for i, (y, x) in enumerate(((0.033, 0.090), (0.011, 0.095), (-0.011, 0.090), (-0.033, 0.082)), start=1):
         T[i, :3, 3] = (x, y, 0.0)
-    T[0, :3, :3] = _rot("z", 60 * DEG) @ _rot("x", 90 * DEG)
-    T[0, :3, 3] = (0.020, 0.045, -0.015)
+    x0 = np.array([0.9, 0.3, -0.3])
+    x0 /= np.linalg.norm(x0)
+    z0 = np.array([0.0, 1.0, 0.0]) - x0[1] * x0
+    z0 /= np.linalg.norm(z0)
+    T[0, :3, :3] = np.column_stack([x0, np.cross(z0, x0), z0])
+    T[0, :3, 3] = (0.030, 0.050, -0.020)
     return T
 
 
