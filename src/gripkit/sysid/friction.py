@@ -48,6 +48,20 @@ __all__ = ["Pulse", "BreakawayResult", "detect_breakaway", "ConstantVelocityPoin
            "IdimResult", "idim_ls"]
 
 
+def _same_length(**named) -> list[np.ndarray]:
+    """The named sequences as finite 1-D float arrays of one length (DataError otherwise)."""
+    arrays = [np.asarray(a, dtype=np.float64) for a in named.values()]
+    shapes = [a.shape for a in arrays]
+    if any(a.ndim != 1 for a in arrays) or len(set(shapes)) != 1:
+        raise DataError(f"{', '.join(named)}: expected 1-D arrays of equal length, found "
+                        f"{', '.join(map(str, shapes))}")
+    for name, a in zip(named, arrays):
+        bad = ~np.isfinite(a)
+        if bad.any():
+            raise DataError(f"{name} has {int(bad.sum())} non-finite values (first at sample {int(np.argmax(bad))})")
+    return arrays
+
+
 # --- stiction -----------------------------------------------------------------------------------
 
 @dataclass(frozen=True)
@@ -112,16 +126,8 @@ def detect_breakaway(pwm, velocity, position=None, *, velocity_threshold: float 
         ``torque_at(pwm, position)`` → joint torque (N·m) the motor exerts at zero speed minus any
         load at that position; when given, the stiction torque is estimated.
     """
-    u = np.asarray(pwm, dtype=np.float64)
-    v = np.asarray(velocity, dtype=np.float64)
-    if u.ndim != 1 or v.shape != u.shape:
-        raise DataError(f"pwm and velocity: expected 1-D arrays of equal length, found {u.shape}, {v.shape}")
-    x = np.zeros_like(u) if position is None else np.asarray(position, dtype=np.float64)
-    if x.shape != u.shape:
-        raise DataError(f"position: expected {u.shape[0]} samples, found {x.shape}")
-    for name, a in (("pwm", u), ("velocity", v), ("position", x)):
-        if not np.isfinite(a).all():
-            raise DataError(f"{name} contains NaN or inf")
+    u, v, x = _same_length(pwm=pwm, velocity=velocity,
+                           position=np.zeros(np.shape(pwm)) if position is None else position)
     pulses = []
     for a, b in _pulses(u):
         seg = u[a:b]
@@ -195,12 +201,7 @@ def constant_velocity_friction(pwm, velocity, *, motor_torque: Callable[[float, 
     J·a (a from a line fitted to the plateau's velocity) is subtracted too. The friction std
     propagates the plateau's velocity scatter through the motor's torque-speed slope.
     """
-    u = np.asarray(pwm, dtype=np.float64)
-    v = np.asarray(velocity, dtype=np.float64)
-    if u.ndim != 1 or v.shape != u.shape:
-        raise DataError(f"pwm and velocity: expected 1-D arrays of equal length, found {u.shape}, {v.shape}")
-    if not (np.isfinite(u).all() and np.isfinite(v).all()):
-        raise DataError("pwm or velocity contains NaN or inf")
+    u, v = _same_length(pwm=pwm, velocity=velocity)
     pts = []
     for a, b in _pulses(u):
         seg = v[a:b]
@@ -276,12 +277,7 @@ def fit_stribeck(velocity, friction, *, weights=None, fixed: dict | None = None,
     """
     from scipy.optimize import least_squares
 
-    v = np.asarray(velocity, dtype=np.float64)
-    f = np.asarray(friction, dtype=np.float64)
-    if v.ndim != 1 or f.shape != v.shape:
-        raise DataError(f"velocity and friction: expected 1-D arrays of equal length, found {v.shape}, {f.shape}")
-    if not (np.isfinite(v).all() and np.isfinite(f).all()):
-        raise DataError("velocity or friction contains NaN or inf")
+    v, f = _same_length(velocity=velocity, friction=friction)
     if (v == 0).any():
         raise DataError("friction at zero velocity is stiction, not kinetic friction; drop those points")
     fixed = dict(fixed or {})
@@ -388,14 +384,7 @@ def idim_ls(position, effort, fs: float, *, effort_scale: float = 1.0, cutoff: f
     """
     from ..signals.filters import apply_sos, butter_sos
 
-    x = np.asarray(position, dtype=np.float64)
-    e = np.asarray(effort, dtype=np.float64)
-    if x.ndim != 1 or e.shape != x.shape:
-        raise DataError(f"position and effort: expected 1-D arrays of equal length, found {x.shape}, {e.shape}")
-    for name, a in (("position", x), ("effort", e)):
-        bad = ~np.isfinite(a)
-        if bad.any():
-            raise DataError(f"{name} has {int(bad.sum())} non-finite values (first at sample {int(np.argmax(bad))})")
+    x, e = _same_length(position=position, effort=effort)
     if not (np.isfinite(fs) and fs > 0):
         raise DataError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
     if not (np.isfinite(effort_scale) and effort_scale != 0):
