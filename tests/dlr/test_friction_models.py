@@ -112,3 +112,24 @@ def test_fit_stribeck_recovers_synthetic_parameters_within_3_sigma():
         # data only far above v_s: the Stribeck part is undetermined
         vv = np.r_[-np.linspace(3, 5, 20), np.linspace(3, 5, 20)]
         fit_stribeck(vv, np.sign(vv) * 0.2 + 0.04 * vv, fixed=dict(cubic=0.0))
+
+
+def test_coulomb_viscous_kernel_is_stribeck_without_stiction_peak():
+    from gripkit.models.friction import coulomb_viscous, stribeck
+
+    for v in (-2.0, -0.01, 0.0, 0.3, 4.0):
+        assert coulomb_viscous(v, 0.2, 0.05) == pytest.approx(stribeck(v, 0.2, 0.2, 0.1, 2.0, 0.05))
+
+
+def test_harmonic_drive_ripple_in_the_finger():
+    """§3.2.2: friction varying sinusoidally with the output position. With ripple_amp = 0.03 N·m
+    and 200 periods per revolution, the distal friction of a constant-PWM run deviates from the
+    table by 0.03·sin(200·p)·sign(v)."""
+    from gripkit.zoo.dlr_hit import finger
+
+    f = finger(check=False, ripple_amp=0.03, g_x=0.0, g_y=-9.81, g_z=0.0)
+    tr = f.simulate(np.tile([0.0, 0.0, 3000.0], (300, 1)), dt=1e-3, x0=f.state(q=(0.0, 0.0, 0.1)))
+    moving = tr["distal_vel"] > 0
+    p = tr["prox"][moving]
+    expected = f.tables[2](tr["distal_vel"][moving]) + 0.03 * np.sin(200 * p)
+    np.testing.assert_allclose(tr["fric_distal"][moving], expected, atol=1e-12)

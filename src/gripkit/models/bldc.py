@@ -43,8 +43,8 @@ import numpy as np
 from numba import prange
 
 from ..consistency import Finding, compare
-from ..multibody.kernels import hot
 from ..errors import ModelError
+from ..multibody.kernels import hot
 from ..params import Parameter, ParameterSet
 from ..sim.model import Model, Signal
 

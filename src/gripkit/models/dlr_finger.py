@@ -126,8 +126,6 @@ I_DS = _I["d_stop"]
 
 # state layout: p(3) pd(3) T(3) z(3) stuck(3)
 NX = 15
-# outputs: q(3) qd(3) pd(3) tau_motor(3) friction(3) temperature(3)
-NY = 18
 
 
 @hot

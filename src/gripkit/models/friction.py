@@ -47,8 +47,8 @@ import numba
 import numpy as np
 from numba import prange
 
-from ..multibody.kernels import hot
 from ..errors import DataError, ModelError
+from ..multibody.kernels import hot
 from ..params import Parameter, ParameterSet
 from ..sim.model import Model, Signal
 

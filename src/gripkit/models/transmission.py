@@ -17,11 +17,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numba
 import numpy as np
 
-from ..multibody.kernels import hot
 from ..errors import ModelError
+from ..multibody.kernels import hot
 
 __all__ = ["Transmission", "harmonic_drive", "timing_belt", "transmit_torque", "DLR_DISTAL",
            "DLR_BASE"]
