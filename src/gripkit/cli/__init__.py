@@ -13,6 +13,7 @@ __all__ = ["main"]
 
 def _build():
     from . import demo, zoo  # noqa: F401  (commands register themselves)
+    from . import identify_tsfm, simulate  # noqa: F401
     from .app import app
 
     return app

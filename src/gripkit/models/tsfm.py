@@ -369,7 +369,8 @@ class TSFMFinger(Model):
                 source: str = "") -> "TSFMFingerContact":
         """This finger pressing on a part whose face is ``x_w`` (m) from the tip's rest position."""
         return TSFMFingerContact(self.parameters.merged(contact_parameters(x_w, k_e, c_e, F_po, source=source)),
-                                 reference=self.reference, printed=self.printed, check=False)
+                                 reference=self.reference, printed=self.printed, check=False,
+                                 finger_name=self.name)
 
 
 def contact_parameters(x_w: float, k_e: float, c_e: float = 0.0, F_po: float = 0.0, *,
@@ -526,13 +527,14 @@ class TSFMFingerContact(Model):
     integrator = "zoh"
     levels = DEFAULT_LEVELS
 
-    def __init__(self, parameters: ParameterSet, *, reference=None, printed=None, check: bool = True):
+    def __init__(self, parameters: ParameterSet, *, reference=None, printed=None, check: bool = True,
+                 finger_name: str | None = None):
         missing = [n for n in FINGER_NAMES + CONTACT_NAMES if n not in parameters]
         if missing:
             raise ParameterError(f"{self.name}: missing parameters {missing}",
                                  hint="use TSFMFinger(...).contact(x_w=..., k_e=...)")
         self.finger = TSFMFinger(ParameterSet([parameters[n] for n in FINGER_NAMES], parameters.name),
-                                 reference=reference, printed=printed, check=False)
+                                 reference=reference, printed=printed, check=False, name=finger_name)
         super().__init__(ParameterSet([parameters[n] for n in FINGER_NAMES + CONTACT_NAMES], parameters.name),
                          check=check)
 

@@ -39,6 +39,12 @@ _ENTRIES: tuple[ZooEntry, ...] = (
              "Finger force dynamics, ARX [2 2 2] LS model of Table II (9 Hz filtered data), valve "
              "current (A) to fingertip force (N) at 200 Hz, two-sample valve delay",
              _AMADEUS, "gripkit.zoo.amadeus:finger_force_model"),
+    ZooEntry("tsfm-left", "TSFM piezo microgripper", "Left finger, Table II: Bouc-Wen + D(s) actuator, lever, force "
+             "sensor (8.52 kHz, ζ = 0.006), eqs 3-13", _TSFM, "gripkit.zoo.tsfm:left_finger"),
+    ZooEntry("tsfm-right", "TSFM piezo microgripper", "Right finger, Table II (as tsfm-left)", _TSFM,
+             "gripkit.zoo.tsfm:right_finger"),
+    ZooEntry("tsfm-gripper", "TSFM piezo microgripper", "Both fingers, 400 µm gap, a 300 µm micropart of Table III "
+             "stiffness; hybrid contacts", _TSFM, "gripkit.zoo.tsfm:gripper"),
 )
 
 
