@@ -149,6 +149,9 @@ class ParameterSet(Mapping[str, Parameter]):
                 hint=f"available: {', '.join(self._params)}",
             ) from None
 
+    def __contains__(self, key) -> bool:  # Mapping's default relies on KeyError, __getitem__ raises ParameterError
+        return key in self._params
+
     def __iter__(self) -> Iterator[str]:
         return iter(self._params)
 

@@ -33,7 +33,7 @@ from ..sim.model import Model, Signal
 from .hysteresis import bouc_wen_advance, bouc_wen_parameters
 
 __all__ = ["PiezoActuator", "actuator_dynamics", "actuator_state_space", "actuator_parameters",
-           "bw_lti_batch", "lti_modes"]
+           "bw_lti_batch", "bw_lti_row", "run_bw_lti", "lti_modes"]
 
 
 def actuator_dynamics(a: float, b: float) -> StateSpace:
@@ -89,6 +89,46 @@ def lti_modes(A: np.ndarray) -> list[tuple[float, float]]:
     return out
 
 
+@numba.njit(cache=True)
+def bw_lti_row(bw, Phi, Gam, C, D, u, x0, y):  # pragma: no cover - compiled
+    """One parameter row of :func:`bw_lti_batch` (bw (4,), Phi (n, n), … , x0 (2 + n,), y (N, p))."""
+    N = u.shape[0]
+    n = Phi.shape[0]
+    m = Gam.shape[1]
+    p_out = C.shape[0]
+    x = np.empty(n)
+    xt = np.empty(n)
+    w = np.empty(m)
+    for i in range(n):
+        x[i] = x0[2 + i]
+    H = x0[0]
+    Uh = x0[1]
+    d_p, lam, beta, gamma = bw[0], bw[1], bw[2], bw[3]
+    for k in range(N):
+        U = u[k, 0]
+        H = bouc_wen_advance(H, U - Uh, lam, beta, gamma)
+        Uh = U
+        w[0] = d_p * U - H
+        for j in range(1, m):
+            w[j] = u[k, j]
+        for i in range(p_out):
+            acc = 0.0
+            for j in range(n):
+                acc += C[i, j] * x[j]
+            for j in range(m):
+                acc += D[i, j] * w[j]
+            y[k, i] = acc
+        for i in range(n):
+            acc = 0.0
+            for j in range(n):
+                acc += Phi[i, j] * x[j]
+            for j in range(m):
+                acc += Gam[i, j] * w[j]
+            xt[i] = acc
+        for i in range(n):
+            x[i] = xt[i]
+
+
 @numba.njit(cache=True, parallel=True)
 def bw_lti_batch(bw, Phi, Gam, C, D, u, x0, y):  # pragma: no cover - compiled
     """Bouc-Wen then an exactly discretised LTI system, for P parameter rows in parallel.
@@ -96,47 +136,18 @@ def bw_lti_batch(bw, Phi, Gam, C, D, u, x0, y):  # pragma: no cover - compiled
     bw (P, 4): d_p, λ, β, γ; Phi (P, n, n), Gam (P, n, m), C (P, p, n), D (P, p, m): the LTI
     system whose inputs are [W = d_p U − H, u[:, 1], …, u[:, m−1]]; u (N, m) with the voltage
     in column 0; x0 (P, 2 + n): H, the voltage last applied, then the LTI states; y (P, N, p).
+    The row body is a plain function (the body of a prange loop optimises worse, measured).
     """
-    P = bw.shape[0]
-    N = u.shape[0]
-    n = Phi.shape[1]
-    m = Gam.shape[2]
-    p_out = C.shape[1]
-    for p in prange(P):
-        x = np.empty(n)
-        xt = np.empty(n)
-        w = np.empty(m)
-        for i in range(n):
-            x[i] = x0[p, 2 + i]
-        H = x0[p, 0]
-        Uh = x0[p, 1]
-        d_p = bw[p, 0]
-        lam = bw[p, 1]
-        beta = bw[p, 2]
-        gamma = bw[p, 3]
-        for k in range(N):
-            U = u[k, 0]
-            H = bouc_wen_advance(H, U - Uh, lam, beta, gamma)
-            Uh = U
-            w[0] = d_p * U - H
-            for j in range(1, m):
-                w[j] = u[k, j]
-            for i in range(p_out):
-                acc = 0.0
-                for j in range(n):
-                    acc += C[p, i, j] * x[j]
-                for j in range(m):
-                    acc += D[p, i, j] * w[j]
-                y[p, k, i] = acc
-            for i in range(n):
-                acc = 0.0
-                for j in range(n):
-                    acc += Phi[p, i, j] * x[j]
-                for j in range(m):
-                    acc += Gam[p, i, j] * w[j]
-                xt[i] = acc
-            for i in range(n):
-                x[i] = xt[i]
+    for p in prange(bw.shape[0]):
+        bw_lti_row(bw[p], Phi[p], Gam[p], C[p], D[p], u, x0[p], y[p])
+
+
+def run_bw_lti(bw, Phi, Gam, C, D, u, x0, y) -> None:
+    """:func:`bw_lti_batch`, or its row function directly for a single row (no parallel region)."""
+    if bw.shape[0] == 1:
+        bw_lti_row(bw[0], Phi[0], Gam[0], C[0], D[0], u, x0[0], y[0])
+    else:
+        bw_lti_batch(bw, Phi, Gam, C, D, u, x0, y)
 
 
 class PiezoActuator(Model):
@@ -186,7 +197,7 @@ class PiezoActuator(Model):
     def _simulate_batch(self, thetas, u, dt, substeps, x0, y):
         A, B, C, D, bw = self.matrices(thetas)
         Phi, Gam = zoh_levels(A, B, dt, 0)
-        bw_lti_batch(bw, Phi[:, 0], Gam[:, 0], C, D, u, x0, y)
+        run_bw_lti(bw, Phi[:, 0], Gam[:, 0], C, D, u, x0, y)
 
     def modes(self, theta):
         v = dict(zip(self.parameters.names, theta))

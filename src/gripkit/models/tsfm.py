@@ -61,7 +61,7 @@ from ..sim.linear import StateSpace
 from ..sim.model import Model, Signal
 from .end_effector import end_effector_parameters, lever_coefficients, sensor_state_space
 from .hysteresis import bouc_wen_advance
-from .piezo import actuator_parameters, actuator_state_space, bw_lti_batch, lti_modes
+from .piezo import actuator_parameters, actuator_state_space, lti_modes, run_bw_lti
 
 __all__ = ["FINGER_NAMES", "finger_parameters", "finger_state_space", "finger_minimal_state_space",
            "finger_coefficients", "finger_transfer_functions", "finger_hybrid", "sensor_from_modal",
@@ -239,11 +239,11 @@ def finger_checks(values: Mapping[str, float], reference: Mapping[str, tuple[flo
                            what="b_s/(2√(k_s m_s))", used=used, source=src))
     if "sensor_stiffness" in reference:
         s0, src = reference["sensor_stiffness"]
-        out.append(compare("sensor-stiffness", subject, computed=k, stated=s0, rtol=0.05, what="k_s",
+        out.append(compare("sensor-stiffness", subject, computed=k, stated=s0, rtol=0.10, what="k_s",
                            unit="N/m", used="k_s of the finger's parameter set", source=src))
     if "actuator_stiffness" in reference:
         s0, src = reference["actuator_stiffness"]
-        out.append(compare("actuator-stiffness", subject, computed=1.0 / v["s_p"], stated=s0, rtol=0.05,
+        out.append(compare("actuator-stiffness", subject, computed=1.0 / v["s_p"], stated=s0, rtol=0.10,
                            what="1/s_p (stiffness at tip A)", unit="N/m", used="s_p of the finger's parameter set",
                            source=src))
     if "sensitivity_uN_per_V" in reference and v.get("sensitivity", 0) > 0:
@@ -343,7 +343,7 @@ class TSFMFinger(Model):
     def _simulate_batch(self, thetas, u, dt, substeps, x0, y):
         A, B, C, bw = self._matrices(thetas)
         Phi, Gam = zoh_levels(A, B, dt, 0)
-        bw_lti_batch(bw, Phi[:, 0], Gam[:, 0], C, np.zeros((len(thetas), C.shape[1], 2)), u, x0, y)
+        run_bw_lti(bw, Phi[:, 0], Gam[:, 0], C, np.zeros((len(thetas), C.shape[1], 2)), u, x0, y)
 
     def consistency_checks(self) -> list[Finding]:
         v = self.values()
@@ -366,11 +366,12 @@ class TSFMFinger(Model):
         return out
 
     def contact(self, *, x_w: float, k_e: float, c_e: float = 0.0, F_po: float = 0.0,
-                source: str = "") -> "TSFMFingerContact":
-        """This finger pressing on a part whose face is ``x_w`` (m) from the tip's rest position."""
+                source: str = "", realisation: str = "component") -> "TSFMFingerContact":
+        """This finger pressing on a part whose face is ``x_w`` (m) from the tip's rest position
+        (``realisation='minimal'``: eq 11's four states, output y_D instead of y_B)."""
         return TSFMFingerContact(self.parameters.merged(contact_parameters(x_w, k_e, c_e, F_po, source=source)),
                                  reference=self.reference, printed=self.printed, check=False,
-                                 finger_name=self.name)
+                                 finger_name=self.name, realisation=realisation)
 
 
 def contact_parameters(x_w: float, k_e: float, c_e: float = 0.0, F_po: float = 0.0, *,
@@ -528,7 +529,15 @@ class TSFMFingerContact(Model):
     levels = DEFAULT_LEVELS
 
     def __init__(self, parameters: ParameterSet, *, reference=None, printed=None, check: bool = True,
-                 finger_name: str | None = None):
+                 finger_name: str | None = None, realisation: str = "component"):
+        if realisation not in ("component", "minimal"):
+            raise ModelError(f"realisation: expected 'component' or 'minimal', found {realisation!r}")
+        self.realisation = realisation
+        if realisation == "minimal":  # eq 11's four states: y_D replaces y_B, states y_D, v_D, y_C, v_C
+            self.outputs = (self.outputs[0], Signal("y_D", "m", "lever tip D"), *self.outputs[2:])
+            self.states = TSFMFinger.states[:2] + (Signal("y_D", "m", ""), Signal("v_D", "m/s", ""),
+                                                   Signal("y_C", "m", ""), Signal("v_C", "m/s", ""),
+                                                   Signal("mode", "1", "0 free, 1 contact"))
         missing = [n for n in FINGER_NAMES + CONTACT_NAMES if n not in parameters]
         if missing:
             raise ParameterError(f"{self.name}: missing parameters {missing}",
@@ -547,15 +556,20 @@ class TSFMFingerContact(Model):
     def hybrid_system(self, theta=None) -> HybridSystem:
         th = self.theta() if theta is None else np.asarray(theta)
         v = dict(zip(self.parameters.names, th))
-        return finger_hybrid(v, v["k_e"], v["c_e"], v["F_po"])
+        return finger_hybrid(v, v["k_e"], v["c_e"], v["F_po"], self.realisation)
 
     def _simulate_batch(self, thetas, u, dt, substeps, x0, y):
         nf = len(FINGER_NAMES)
         rows = [(th[:nf], th[nf + 1], th[nf + 2], th[nf + 3]) for th in thetas]
-        d = _hybrid_arrays(rows, dt, self.levels)
+        d = _hybrid_arrays(rows, dt, self.levels, self.realisation)
         bw = np.ascontiguousarray(thetas[:, [0, 2, 3, 4]])
-        _bw_pwa_batch(bw, d["Phi"], d["Gam"], d["C"], d["D"], d["G"], d["H"], d["target"], d["ng"],
-                      self.levels, np.ascontiguousarray(thetas[:, nf]), u, x0, y)
+        xw = np.ascontiguousarray(thetas[:, nf])
+        if len(thetas) == 1:  # one row: skip the parallel region (its thread wake-up costs more than it gives)
+            _bw_pwa_row(bw[0], d["Phi"][0], d["Gam"][0], d["C"][0], d["D"][0], d["G"][0], d["H"][0], d["target"],
+                        d["ng"], self.levels, xw[0], u, x0[0], y[0])
+        else:
+            _bw_pwa_batch(bw, d["Phi"], d["Gam"], d["C"], d["D"], d["G"], d["H"], d["target"], d["ng"],
+                          self.levels, xw, u, x0, y)
 
 
 # ---- two fingers and a part --------------------------------------------------------------------
