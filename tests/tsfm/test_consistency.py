@@ -64,3 +64,15 @@ def test_zoo_check_cli(capsys):
     assert params["k_s"]["value"] == 130.8 and "Table II" in params["k_s"]["source"]
     assert params["L_a"]["source"].startswith("assumed")
     assert params["lam"]["unit"] == "m/V" and params["lam"]["value"] == pytest.approx(0.39e-6)
+
+
+def test_gripper_zoo_entry_checks_table_iii():
+    """Table III's stated errors (3, 2, 5 %) follow from its measured and estimated stiffnesses;
+    §V-C's width example 400 − (62.42 + 39.4) = 298.18 µm."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rep = check(z.gripper())
+    for i in (1, 2, 3):
+        assert rep.find(f"table-iii-error-{i}").consistent
+    assert rep.find("width-example").consistent
+    assert {"sensor-natural-frequency", "eq13-a2"} <= {f.check for f in rep.inconsistent}

@@ -169,3 +169,26 @@ def test_finger_errors():
         from gripkit.params import ParameterSet
 
         TSFMFinger(ParameterSet([z.table_ii("left")["d_p"]]))
+
+
+@pytest.mark.parametrize("kind", ["finger", "contact", "bouc-wen"])
+def test_parallel_batch_equals_single_runs(left, kind):
+    """simulate_batch over several parameter sets (prange over rows) equals one run per set."""
+    if kind == "finger":
+        m, names, u = left, ("d_p", "k_s"), {"U": 40 * np.sin(np.arange(3000) / 300), "F_g": np.zeros(3000)}
+    elif kind == "contact":
+        m, names = left.contact(x_w=20e-6, k_e=72.5), ("k_e", "x_w")
+        u = {"U": 40 * np.sin(np.arange(3000) / 300)}
+    else:
+        m, names, u = BoucWen(**BW), ("lam", "beta"), {"U": 40 * np.sin(np.arange(3000) / 300)}
+    base = m.theta()
+    thetas = np.array([base, base, base])
+    for i, n in enumerate(names):
+        j = m.parameters.names.index(n)
+        thetas[1, j] *= 1.1
+        thetas[2, j] *= 0.8 + 0.05 * i
+    Y = m.simulate_batch(thetas, u, dt=5e-5)
+    for i in range(3):
+        one = m.simulate_batch(thetas[i:i + 1], u, dt=5e-5)[0]
+        np.testing.assert_array_equal(Y[i], one)
+    assert not np.array_equal(Y[0], Y[1])

@@ -495,9 +495,24 @@ def _bw_pwa_row(bw, Phi, Gam, C, D, G, Hg, target, ng, K, xw, u, x0, y):  # prag
         H = bouc_wen_advance(H, U - Uh, lam, beta, gamma)
         Uh = U
         ua[0] = d_p * U - H
-        pwa_output(C, D, mode, x, ua, yk)
-        for i in range(p_out):
-            y[k, i] = yk[i]
+        # outputs y = C x + D u; the sizes of the finger (4 outputs, 4 or 6 states) get loops with
+        # constant trip counts (unrolled by LLVM), as in pwa_step
+        if n == 4 and p_out == 4:
+            for i in range(4):
+                acc = D[mode, i, 0] * ua[0] + D[mode, i, 1] * ua[1] + D[mode, i, 2]
+                for j in range(4):
+                    acc += C[mode, i, j] * x[j]
+                y[k, i] = acc
+        elif n == 6 and p_out == 4:
+            for i in range(4):
+                acc = D[mode, i, 0] * ua[0] + D[mode, i, 1] * ua[1] + D[mode, i, 2]
+                for j in range(6):
+                    acc += C[mode, i, j] * x[j]
+                y[k, i] = acc
+        else:
+            pwa_output(C, D, mode, x, ua, yk)
+            for i in range(p_out):
+                y[k, i] = yk[i]
         y[k, p_out] = mode
         mode, nev = pwa_step(x, mode, ua, Phi, Gam, G, Hg, target, ng, K, xt, ev_frac, ev_to)
 

@@ -383,7 +383,8 @@ def identify_finger(loops: Trajectory, step: Trajectory, compliance: Trajectory,
            "b": "identified: step response (Fig. 10), whole-finger model",
            "s_p": "identified: force-displacement at B (eq 15, Fig. 11)",
            "m_s": "identified: free vibration (Fig. 8) and k_s", "b_s": "identified: free vibration (Fig. 8) and k_s",
-           "k_s": "given (sensor calibration)"}
+           "k_s": "given (sensor calibration)", "L_r": "given", "L_s": "given", "L_a": "given",
+           "sensitivity": "given (nominal 200 µN/V, 001_0b92a7da96e7aa46.txt §IV-B)"}
     params = finger_parameters(d_p=at_a["d_p"], s_p=comp.s_p, lam=at_a["lambda"], beta=bw.params["beta"],
                                gamma=bw.params["gamma"], a=dyn.a, b=dyn.b, m_s=sensor.value("m_s"),
                                b_s=sensor.value("b_s"), k_s=k_s, L_r=L_r, L_s=L_s, L_a=L_a, sensitivity=sensitivity,
