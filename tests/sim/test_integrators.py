@@ -97,3 +97,18 @@ def test_bad_arguments():
         zoh_levels(np.eye(2), np.ones((3, 1)), 1.0)
     with pytest.raises(ModelError, match="method"):
         integrate_lti(np.eye(1), np.eye(1), np.eye(1), np.eye(1), np.ones(3), 0.1, method="euler")
+
+
+def test_rk4_paths_check_the_step():
+    """The TSFM sensor (8.52 kHz, ζ = 0.006, §IV-B) integrated by RK4 at 10 kHz is refused
+    (ω h = 5.4 > 2.83); at 20 kHz without substeps it is computed but flagged as under-resolved."""
+    from gripkit.errors import AccuracyWarning, SimulationError
+
+    w = 2 * math.pi * 8520.0
+    A = np.array([[0.0, 1.0], [-w * w, -2 * 0.006 * w]])
+    B, C = np.array([[0.0], [1.0]]), np.array([[1.0, 0.0]])
+    with pytest.raises(SimulationError, match="stability limit"):
+        integrate_lti(A, B, C, [[0.0]], np.ones(10), 1e-4, method="rk4")
+    with pytest.warns(AccuracyWarning, match="under-resolves"):
+        integrate_lti(A, B, C, [[0.0]], np.ones(10), 5e-5, method="rk4")
+    integrate_lti(A, B, C, [[0.0]], np.ones(10), 5e-5, method="rk4", substeps=20)  # resolved: silent

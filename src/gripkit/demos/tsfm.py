@@ -199,7 +199,7 @@ def _contact(report, z, fingers, ident, summary, quick):
     tr = z.contact_experiment(f, 72.5, seed=60)
     est = TipPositionEstimator(ident["left"].finger, 1 / tr.fs)
     yhat = est.run(tr["U"], tr["F_meas"])
-    det, avg = ContactDetector(5e-6).run(tr["F_meas"])
+    det, _ = ContactDetector(5e-6).run(tr["F_meas"])
     c = tr["contact"] > 0.5
     i_on = int(np.argmax(c))
     i_off = i_on + int(np.argmax(~c[i_on:]))

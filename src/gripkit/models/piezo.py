@@ -27,7 +27,7 @@ import numpy as np
 from numba import prange
 
 from ..params import Parameter, ParameterSet
-from ..sim.integrators import zoh_levels
+from ..sim.integrators import modes_of, zoh_levels
 from ..sim.linear import StateSpace
 from ..sim.model import Model, Signal
 from .hysteresis import bouc_wen_advance, bouc_wen_parameters
@@ -79,14 +79,7 @@ def actuator_parameters(d_p: float, s_p: float, lam: float, beta: float, gamma: 
 
 def lti_modes(A: np.ndarray) -> list[tuple[float, float]]:
     """(ω_n rad/s, ζ) of the eigenvalues of A (one entry per complex pair or real pole)."""
-    out = []
-    for lam in np.linalg.eigvals(A):
-        if lam.imag < 0:
-            continue
-        wn = abs(lam)
-        if wn > 0:
-            out.append((float(wn), float(-lam.real / wn)))
-    return out
+    return modes_of(A)
 
 
 @numba.njit(cache=True)

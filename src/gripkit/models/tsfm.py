@@ -490,6 +490,11 @@ def _bw_pwa_row(bw, Phi, Gam, C, D, G, Hg, target, ng, K, xw, u, x0, y):  # prag
     d_p, lam, beta, gamma = bw[0], bw[1], bw[2], bw[3]
     ua[1] = xw
     ua[2] = 1.0
+    # the part face is fixed here: the outputs' input terms D[:, :, 1:] u are constants per mode
+    dc = np.empty((C.shape[0], p_out))
+    for q in range(C.shape[0]):
+        for i in range(p_out):
+            dc[q, i] = D[q, i, 1] * xw + D[q, i, 2]
     for k in range(N):
         U = u[k, 0]
         H = bouc_wen_advance(H, U - Uh, lam, beta, gamma)
@@ -499,13 +504,13 @@ def _bw_pwa_row(bw, Phi, Gam, C, D, G, Hg, target, ng, K, xw, u, x0, y):  # prag
         # constant trip counts (unrolled by LLVM), as in pwa_step
         if n == 4 and p_out == 4:
             for i in range(4):
-                acc = D[mode, i, 0] * ua[0] + D[mode, i, 1] * ua[1] + D[mode, i, 2]
+                acc = D[mode, i, 0] * ua[0] + dc[mode, i]
                 for j in range(4):
                     acc += C[mode, i, j] * x[j]
                 y[k, i] = acc
         elif n == 6 and p_out == 4:
             for i in range(4):
-                acc = D[mode, i, 0] * ua[0] + D[mode, i, 1] * ua[1] + D[mode, i, 2]
+                acc = D[mode, i, 0] * ua[0] + dc[mode, i]
                 for j in range(6):
                     acc += C[mode, i, j] * x[j]
                 y[k, i] = acc
@@ -514,7 +519,7 @@ def _bw_pwa_row(bw, Phi, Gam, C, D, G, Hg, target, ng, K, xw, u, x0, y):  # prag
             for i in range(p_out):
                 y[k, i] = yk[i]
         y[k, p_out] = mode
-        mode, nev = pwa_step(x, mode, ua, Phi, Gam, G, Hg, target, ng, K, xt, ev_frac, ev_to)
+        mode, _nev = pwa_step(x, mode, ua, Phi, Gam, G, Hg, target, ng, K, xt, ev_frac, ev_to)
 
 
 @numba.njit(cache=True, parallel=True)
@@ -630,7 +635,7 @@ def gripper_advance(U1, U2, X, modes, hyst, ps, bw, Phi, Gam, C, D, G, Hg, targe
         hyst[2 + i] = U
         ua[0] = bw[i, 0] * U - hyst[i]
         ua[1] = _face(i, Xp, part)
-        q, nev = pwa_step(X[i], modes[i], ua, Phi[i], Gam[i], G[i], Hg[i], target, ng, K, xt, ev_frac, ev_to)
+        q, _nev = pwa_step(X[i], modes[i], ua, Phi[i], Gam[i], G[i], Hg[i], target, ng, K, xt, ev_frac, ev_to)
         modes[i] = q
     gripper_measure(X, modes, Xp, C, D, part, ua, yout)
     net = yout[0, 2] - yout[1, 2]  # finger 1 pushes towards +X, finger 2 towards −X

@@ -35,7 +35,8 @@ import numpy as np
 
 from ..errors import ModelError, SimulationError
 from ..signals.trajectory import Trajectory
-from .integrators import rk4_lti_step, zoh_levels
+from .integrators import modes_of, rk4_lti_step, zoh_levels
+from .steps import check_step
 
 __all__ = ["Mode", "Guard", "HybridSystem", "DiscreteHybrid", "HybridResult", "pwa_step", "pwa_output",
            "DEFAULT_LEVELS", "MAX_EVENTS_PER_STEP"]
@@ -397,8 +398,11 @@ class HybridSystem:
 
     def simulate_reference(self, u, dt: float | None = None, x0=None, mode0: str | int = 0,
                            substeps: int = 1000) -> HybridResult:
-        """Fine-step RK4 reference (``substeps`` per sample, guard checked after each substep)."""
+        """Fine-step RK4 reference (``substeps`` per sample, guard checked after each substep).
+        The substep is checked against every mode's natural frequencies (gripkit.sim.steps)."""
         u2, dt, x, mode = self._prepare(u, dt, x0, mode0)
+        for q, name in enumerate(self.names):
+            check_step(dt / substeps, modes_of(self.A[q]), "rk4", what=f"{self.name} mode {name!r}")
         N = u2.shape[0]
         y = np.empty((N, self.n_outputs))
         modes = np.empty(N, dtype=np.int64)

@@ -31,9 +31,10 @@ import numba
 import numpy as np
 
 from ..errors import ModelError
+from .steps import check_step
 
 __all__ = ["rk4_lti_step", "rk4_msd_step", "semi_implicit_msd_step", "lti_step", "zoh_levels", "expm_small",
-           "integrate_lti"]
+           "integrate_lti", "modes_of"]
 
 
 @numba.njit(cache=True)
@@ -285,6 +286,16 @@ def _integrate_lti(A, B, Phi, Gam, u, h, substeps, method, x, y, C, D):  # pragm
                 rk4_lti_step(A, B, x, ui, h, k1, k2, k3, k4, tmp)
 
 
+def modes_of(A: np.ndarray) -> list[tuple[float, float]]:
+    """(ω_n rad/s, ζ) of each eigenvalue of A (one entry per complex pair; zero eigenvalues skipped)."""
+    out = []
+    for lam in np.linalg.eigvals(np.asarray(A, dtype=np.float64)):
+        if lam.imag < 0 or abs(lam) == 0:
+            continue
+        out.append((float(abs(lam)), float(-lam.real / abs(lam))))
+    return out
+
+
 def integrate_lti(A, B, C, D, u, dt: float, x0=None, *, method: str = "zoh", substeps: int = 1) -> np.ndarray:
     """Outputs (N, p) of ẋ = A x + B u, y = C x + D u for inputs ``u`` (N, m) held over each
     sample ``dt``: ``method='zoh'`` (exact) or ``'rk4'`` with ``substeps`` RK4 steps per sample."""
@@ -293,6 +304,8 @@ def integrate_lti(A, B, C, D, u, dt: float, x0=None, *, method: str = "zoh", sub
     x = np.zeros(A.shape[0]) if x0 is None else np.array(x0, dtype=np.float64)
     if method not in ("zoh", "rk4"):
         raise ModelError(f"method: expected 'zoh' or 'rk4', found {method!r}")
+    if method == "rk4":  # refuse an unstable step, warn on an under-resolved mode (gripkit.sim.steps)
+        check_step(dt / substeps, modes_of(A), "rk4", what="integrate_lti")
     Phi, Gam = zoh_levels(A, B, dt, 0) if method == "zoh" else (np.eye(A.shape[0])[None], B[None])
     y = np.empty((u2.shape[0], C.shape[0]))
     _integrate_lti(A, B, Phi[0], Gam[0], np.ascontiguousarray(u2), dt / substeps, int(substeps),
