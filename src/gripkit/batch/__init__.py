@@ -5,6 +5,8 @@ from .executors import DaskExecutor as DaskExecutor
 from .executors import InProcessExecutor as InProcessExecutor
 from .executors import ProcessExecutor as ProcessExecutor
 from .executors import make_executor as make_executor
+from .identify_many import IDENTIFIERS as IDENTIFIERS
+from .identify_many import identify_many as identify_many
 from .montecarlo import Estimate as Estimate
 from .montecarlo import binned_probability as binned_probability
 from .montecarlo import probability as probability
