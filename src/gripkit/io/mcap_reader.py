@@ -56,7 +56,8 @@ def _get(msg, path: list, spec: str) -> float:
 
 def read_mcap(path: Path, columns, stamp: str = "log") -> tuple[dict, dict]:
     try:
-        from mcap_ros2.reader import read_ros2_messages
+        from mcap.reader import make_reader
+        from mcap_ros2.decoder import DecoderFactory
     except ImportError:
         raise DataError("reading MCAP files needs the optional extra", hint="pip install 'gripkit[mcap]'") from None
     if not columns:
@@ -67,18 +68,20 @@ def read_mcap(path: Path, columns, stamp: str = "log") -> tuple[dict, dict]:
     series: dict[str, tuple[list, list]] = {alias: ([], []) for alias, _, _ in specs}
     seen: set[str] = set()
     try:
-        for m in read_ros2_messages(str(path), topics=list(topics)):
-            topic = m.channel.topic
-            seen.add(topic)
-            if stamp == "header":
-                st = m.ros_msg.header.stamp
-                t = st.sec + 1e-9 * st.nanosec
-            else:
-                t = 1e-9 * m.log_time_ns
-            for (alias, top, fpath), spec in zip(specs, columns):
-                if top == topic:
-                    series[alias][0].append(t)
-                    series[alias][1].append(_get(m.ros_msg, fpath, spec))
+        with open(path, "rb") as fh:
+            reader = make_reader(fh, decoder_factories=[DecoderFactory()])
+            for _schema, channel, message, msg in reader.iter_decoded_messages(topics=list(topics)):
+                topic = channel.topic
+                seen.add(topic)
+                if stamp == "header":
+                    st = msg.header.stamp
+                    t = st.sec + 1e-9 * st.nanosec
+                else:
+                    t = 1e-9 * message.log_time
+                for (alias, top, fpath), spec in zip(specs, columns):
+                    if top == topic:
+                        series[alias][0].append(t)
+                        series[alias][1].append(_get(msg, fpath, spec))
     except DataError:
         raise
     except Exception as exc:
