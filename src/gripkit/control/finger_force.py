@@ -114,6 +114,9 @@ class DiscretePlant:
     def __post_init__(self):
         A = _poly(self.A, "A")
         B = _poly(self.B, "B")
+        # trailing zeros are padding in the q⁻¹ layout (not factors): drop them
+        A = _poly(A[: max(1, np.flatnonzero(A)[-1] + 1)] if np.any(A) else A, "A")
+        B = _poly(B[: np.flatnonzero(B)[-1] + 1] if np.any(B) else B, "B")
         if A[0] != 1.0:
             if A[0] == 0.0:
                 raise ModelError("A must start with a nonzero (monic) coefficient")
@@ -211,7 +214,7 @@ class DiscretePlant:
         from ..sim.linear import StateSpace
 
         num, den = self._padded()
-        Ass, Bss, Css, Dss = signal.tf2ss(num, den)
+        Ass, Bss, Css, Dss = signal.tf2ss(np.trim_zeros(num, "f"), den)
         return StateSpace(Ass, Bss, Css, Dss, self.dt, (self.input_name,), (self.output_name,),
                           (self.input_unit,), (self.output_unit,))
 
@@ -229,24 +232,33 @@ class DiscretePlant:
 class RSTController:
     """R(q) u = T(q) r − S(q) y with anti-windup (A_aw v = T r − S y + (A_aw − R) u, u = sat(v)).
 
+    ``A_aw`` is a stable monic polynomial (default 1: dead-beat anti-windup; :func:`design_rst`
+    uses the observer polynomial A_o); ``anti_windup=False`` gives the plain, clamped RST law.
     ``step(r, y)`` returns u for the current sample. Limits ``u_min``/``u_max`` are in the plant's
     input unit (deviation from the operating point). ``reset(u0, y0)`` initialises a bumpless start
     at the steady state (u0, y0 = r0).
     """
 
     def __init__(self, R, S, T, *, A_aw=None, u_min: float = -math.inf, u_max: float = math.inf,
-                 plant: DiscretePlant | None = None, design: dict | None = None):
+                 plant: DiscretePlant | None = None, design: dict | None = None, anti_windup: bool = True):
         self.R = _poly(R, "R")
         self.S = _poly(S, "S")
         self.T = _poly(T, "T")
         if abs(self.R[0] - 1.0) > 1e-12:
             raise ModelError(f"R must be monic (R[0] = 1), found {self.R[0]:g}")
-        aw = self.R.copy() if A_aw is None else _poly(A_aw, "A_aw")
+        if not anti_windup:  # A_aw = R: the plain RST law, clamped (winds up when saturated)
+            aw = self.R.copy()
+        elif A_aw is None:
+            aw = np.ones(1)
+        else:
+            aw = _poly(A_aw, "A_aw")
         if abs(aw[0] - 1.0) > 1e-12 or aw.size > self.R.size:
             raise ModelError("A_aw must be monic with degree <= deg R")
         self.A_aw = np.pad(aw, (0, self.R.size - aw.size))
-        if np.any(np.abs(np.roots(np.trim_zeros(self.A_aw, "b"))) >= 1.0) if np.trim_zeros(self.A_aw, "b").size > 1 else False:
+        trimmed = np.trim_zeros(self.A_aw, "b")
+        if anti_windup and trimmed.size > 1 and np.any(np.abs(np.roots(trimmed)) >= 1.0):
             raise ModelError("A_aw must be stable (roots inside the unit circle)")
+        self.anti_windup = bool(anti_windup)
         if not u_min < u_max:
             raise ModelError(f"u_min = {u_min} must be below u_max = {u_max}")
         self.u_min = float(u_min)

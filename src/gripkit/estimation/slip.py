@@ -56,13 +56,17 @@ __all__ = [
 
 
 @numba.njit(cache=True)
-def _band_energy(x, sos, zi, ring, rpos, E):  # pragma: no cover - compiled
+def _band_energy(x, sos, zi, ring, rstate, E):  # pragma: no cover - compiled
     """Causal band energy: cascade of second-order sections (transposed direct form II, as
     scipy.signal.sosfilt; ``zi`` (n_sections, 2) carried), squared, averaged over the ring buffer
-    of the last W squares (``ring`` (W,), write position ``rpos[0]``). Writes E (len(x),)."""
+    of the last W squares. ``rstate`` = [write position, absolute sample count, running sum]; the
+    running sum is recomputed exactly every 1024 absolute samples, so the result does not depend on
+    how the record is chunked. Writes E (len(x),)."""
     ns = sos.shape[0]
     W = ring.shape[0]
-    pos = int(rpos[0])
+    pos = int(rstate[0])
+    count = int(rstate[1])
+    acc = rstate[2]
     for n in range(x.shape[0]):
         v = x[n]
         for j in range(ns):
@@ -70,15 +74,21 @@ def _band_energy(x, sos, zi, ring, rpos, E):  # pragma: no cover - compiled
             zi[j, 0] = sos[j, 1] * v - sos[j, 4] * y + zi[j, 1]
             zi[j, 1] = sos[j, 2] * v - sos[j, 5] * y
             v = y
-        ring[pos] = v * v
+        e2 = v * v
+        acc += e2 - ring[pos]
+        ring[pos] = e2
         pos += 1
         if pos == W:
             pos = 0
-        acc = 0.0
-        for i in range(W):
-            acc += ring[i]
+        count += 1
+        if count % 1024 == 0:
+            acc = 0.0
+            for i in range(W):
+                acc += ring[i]
         E[n] = acc / W
-    rpos[0] = pos
+    rstate[0] = pos
+    rstate[1] = count
+    rstate[2] = acc
 
 
 @numba.njit(cache=True)
@@ -349,7 +359,7 @@ class SlipDetector:
         from scipy import signal as sg
 
         zi = np.ascontiguousarray(sg.sosfilt_zi(self.sos) * x0)
-        return zi, np.zeros(self.window), np.zeros(1)
+        return zi, np.zeros(self.window), np.zeros(3)
 
     def calibrate(self, nonslip_signal, *, quantile: float = 0.9999, margin: float = 2.0) -> "SlipDetector":
         """Set θ = ``margin`` × the ``quantile`` of the band energy of a record without slip."""
@@ -378,13 +388,12 @@ class SlipDetector:
         x = _signal(signal)
         E = self.energy(x)
         state = np.zeros(E.size)
-        max_ev = max(16, E.size // max(self.n_on, 1) // 4 + 1)
+        max_ev = E.size // (self.n_on + self.n_off) + 2  # an event needs n_on samples up and n_off down
         ev = np.zeros((max_ev, 3))
         st = np.zeros(5)
         ne = _slip_state(E, self.threshold, self.release, float(self.n_on), float(self.n_off), st, state, ev, max_ev)
-        if ne > max_ev:
-            raise DataError(f"more than {max_ev} slip events: the threshold is far too low",
-                            hint="calibrate the detector on a non-slip record")
+        if ne > max_ev:  # cannot happen (see max_ev); kept as a guard against silent truncation
+            raise DataError(f"more than {max_ev} slip events in {E.size} samples")
         t = t0 + np.arange(E.size) / self.fs
         fn = None if normal_force is None else np.broadcast_to(np.asarray(normal_force, dtype=np.float64), x.shape)
         events = [self._event(x, ev[i], t0, fn) for i in range(ne)]

@@ -16,8 +16,10 @@ Object sizes. A straight finger's fingertip is at radius ρ(θ) = R_p + L sin θ
 L = knuckle_offset + (bellows length + tip length); three pads of radius r_pad touch a cylinder or
 sphere of diameter D when ρ = D/2 + r_pad. The seed says the knuckle "is sufficient to enable the
 finger tips to touch and grasp small objects (∅ 10 mm) or move apart so that larger objects (up
-to ∅ 150 mm) may be considered": :meth:`AmadeusHand.consistency_checks` computes the knuckle
-angles these need with the (assumed) palm geometry and checks they lie within ±20°.
+to ∅ 150 mm) may be considered". The palm radius is not given; gripkit derives it from the first
+half of that sentence (fully closed knuckles, −20°, bring the pads onto a ∅10 mm object) and
+:meth:`AmadeusHand.consistency_checks` checks the second: the ∅150 mm object needs a knuckle angle
+inside ±20°.
 
 Force closure (precision grasp, §I "fingertip precision grasps")
 ---------------------------------------------------------------
@@ -52,13 +54,15 @@ _SEED = "000_8f66dcc7ab06470c.txt"
 FINGER_AZIMUTHS = np.deg2rad([90.0, 210.0, 330.0])
 
 
-def hand_parameters(*, palm_radius: float = 0.045, knuckle_offset: float = 0.015,
+def hand_parameters(*, palm_radius: float = 0.0756, knuckle_offset: float = 0.015,
                     knuckle_range: float = math.radians(20.0), pad_radius: float = 0.008,
                     pot_gain: float = 2.0 / math.radians(20.0), pot_offset: float = 2.5) -> ParameterSet:
     """Palm, knuckle and potentiometer parameters (SI)."""
     return ParameterSet([
         Parameter("palm_radius", palm_radius, "m", "radius of the knuckle pivots' circle on the palm",
-                  bounds=(0.0, 1.0), source="assumed: Fig. 2(a) palm (not dimensioned in the text)",
+                  bounds=(0.0, 1.0),
+                  source=f"derived: at -20° the pads just touch a ∅10 mm object ({_SEED} §II-B), with the "
+                         "assumed finger reach; AmadeusHand.palm_radius_for() recomputes it",
                   display_unit="mm"),
         Parameter("knuckle_offset", knuckle_offset, "m", "from knuckle pivot to the bellows base",
                   bounds=(0.0, 1.0), source="assumed: knuckle manifold (Fig. 2(b))", display_unit="mm"),
@@ -171,6 +175,9 @@ class AmadeusHand:
     def __init__(self, finger: BellowsFinger | None = None, parameters: ParameterSet | None = None, *,
                  check: bool = True, **kw):
         self.finger = finger if finger is not None else BellowsFinger(check=False)
+        if parameters is None and "palm_radius" not in kw:
+            self.hand_parameters = hand_parameters(**kw)
+            kw["palm_radius"] = self.palm_radius_for(0.010)
         self.hand_parameters = parameters if parameters is not None else hand_parameters(**kw)
         if check:
             warn_inconsistent(self.consistency_checks(), stacklevel=3)
@@ -232,6 +239,12 @@ class AmadeusHand:
             raise DataError(f"pressures: expected (3,) or (3 fingers, 3 tubes), found {P.shape}")
         tips = self.finger.bending(P).tip
         return np.array([o + R @ tip for (o, R), tip in zip(self.finger_frames(angle), tips)])
+
+    def palm_radius_for(self, smallest_object: float, mean_pressure: float = 21.0 * BAR) -> float:
+        """Palm radius (m) at which fully closed knuckles (−range) bring the straight fingers' pads
+        onto an object of diameter ``smallest_object`` (§II-B: ∅10 mm)."""
+        return (0.5 * smallest_object + self._hp("pad_radius")
+                + self.reach(mean_pressure) * math.sin(self._hp("knuckle_range")))
 
     def reach(self, mean_pressure: float = 21.0 * BAR) -> float:
         """L (m): knuckle pivot to the straight fingertip at ``mean_pressure``."""

@@ -53,7 +53,7 @@ from ..params import Parameter, ParameterSet
 from ..sim.model import Model, Signal
 
 __all__ = ["PVDFFilm", "pvdf_parameters", "StickSlipContact", "SlipTestbed", "contact_parameters",
-           "pvdf_noise", "contact_step"]
+           "pvdf_noise", "contact_step", "nonslip_grasp_inputs", "slip_onset_inputs"]
 
 _SEED = "000_8f66dcc7ab06470c.txt"
 
@@ -328,6 +328,13 @@ class StickSlipContact(Model):
     def _simulate_batch(self, thetas, u, dt, substeps, x0, y):
         _contact_batch(thetas, self._mode, u, dt, substeps, x0, y)
 
+    def equilibrium_state(self, F_load: float = 0.0) -> np.ndarray:
+        """A state at rest and stuck, the pad sheared by a held tangential load ``F_load`` (N):
+        x_pad = F_load / k_t (start a record without an artificial loading transient)."""
+        st = self.initial_state(self.theta())
+        st[0] = float(F_load) / self.parameters.value("k_t")
+        return st
+
     # streaming use inside a control loop ---------------------------------------------------
     def new_state(self) -> np.ndarray:
         """A fresh state vector for :meth:`advance` (stuck, at rest)."""
@@ -375,3 +382,50 @@ def pvdf_noise(n: int, fs: float, rng=None, *, white: float = 2e-3, ripple: floa
         if k * ripple_hz < fs / 2:
             x += (ripple / k) * wander * np.sin(2 * np.pi * k * ripple_hz * t + rng.uniform(0, 2 * np.pi))
     return x
+
+
+def nonslip_grasp_inputs(duration: float, fs: float, rng=None, *, normal_force: float = 2.0,
+                         load: float = 0.4, load_std: float = 0.12, grip_std: float = 0.05,
+                         tap_rate: float = 0.5, tap_amplitude=(0.1, 0.3), tap_duration=(0.004, 0.02),
+                         grip_step_rate: float = 0.2, grip_step: float = 0.3, min_normal: float = 1.6) -> np.ndarray:
+    """(N, 2) inputs [F_n, F_load] (N) of a held object that does not slip: a slowly wandering
+    tangential load (3 Hz band-limited, std ``load_std``) and grip force, handling taps (half-cosine
+    load pulses, Poisson ``tap_rate`` per s) and grip-force steps of the controller (10 ms ramps).
+    The defaults keep |F_load| well under μ_s F_n; check the contact's ``slipping`` output for the
+    ground truth."""
+    from scipy.signal import butter, sosfilt
+
+    rng = np.random.default_rng(rng)
+    n = int(round(duration * fs))
+    if n < 10:
+        raise DataError(f"duration {duration} s at {fs} Hz gives fewer than 10 samples")
+    sos = butter(2, 3.0, fs=fs, output="sos")
+    w1 = sosfilt(sos, rng.standard_normal(n))
+    w2 = sosfilt(sos, rng.standard_normal(n))
+    w1 /= w1.std()
+    w2 /= w2.std()
+    Fl = load + load_std * w1
+    Fn = normal_force + grip_std * w2
+    for t0 in rng.uniform(0, duration, rng.poisson(tap_rate * duration)):
+        i0 = int(t0 * fs)
+        L = max(2, int(rng.uniform(*tap_duration) * fs))
+        amp = rng.uniform(*tap_amplitude) * rng.choice([-1.0, 1.0])
+        m = min(L, n - i0)
+        Fl[i0:i0 + m] += amp * 0.5 * (1 - np.cos(2 * np.pi * np.arange(m) / L))
+    for t0 in rng.uniform(0, duration, rng.poisson(grip_step_rate * duration)):
+        i0 = int(t0 * fs)
+        amp = rng.uniform(-grip_step, grip_step)
+        L = max(1, int(0.01 * fs))
+        ramp = np.minimum(np.arange(n - i0) / L, 1.0) * amp
+        Fn[i0:] += ramp
+    return np.column_stack([np.maximum(Fn, min_normal), Fl])
+
+
+def slip_onset_inputs(duration: float, fs: float, *, normal_force: float = 2.0, load0: float = 0.6,
+                      start: float = 0.3, rate: float = 3.0) -> np.ndarray:
+    """(N, 2) inputs [F_n, F_load]: a constant grip and a tangential load that ramps from ``load0``
+    at ``start`` s at ``rate`` N/s until the object slips (μ_s F_n is crossed)."""
+    n = int(round(duration * fs))
+    t = np.arange(n) / fs
+    Fl = np.where(t > start, load0 + (t - start) * rate, load0)
+    return np.column_stack([np.full(n, float(normal_force)), Fl])
