@@ -1,6 +1,5 @@
 """PVDF slip sensing and slip detection (000_8f66dcc7ab06470c.txt §IV-B, Figs 12-13)."""
 
-import math
 
 import numpy as np
 import pytest

@@ -1,7 +1,6 @@
 """Proportional valve: static curve with hysteresis (Fig. 5), leakage floor and supply (§II-D), delay
 (Fig. 15, §V-C) and first-order pressure dynamics (000_8f66dcc7ab06470c.txt)."""
 
-import math
 
 import numpy as np
 import pytest

@@ -53,11 +53,11 @@ transfer to force control, a rate-limited reference and a hard cap keep the forc
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import DataError, ModelError, SimulationError, StabilityWarning
+from ..errors import DataError, ModelError, SimulationError
 
 __all__ = [
     "DiscretePlant",
@@ -555,7 +555,6 @@ class GraspScenario:
     slip_blanking: float = 0.25
     pvdf_rate: float = 2000.0
     seed: int = 0
-    extra: dict = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -608,6 +607,8 @@ def simulate_grasp(controller: RSTController, plant=None, scenario: GraspScenari
     N = int(round(sc.duration / h))
     if N < 10:
         raise SimulationError(f"duration {sc.duration} s is shorter than 10 control samples")
+    if p.nk < 1:
+        raise ModelError("simulate_grasp needs a plant with at least one sample of input delay (nk >= 1)")
     if sc.force_limit <= sc.force_target:
         raise DataError(f"force_limit {sc.force_limit} N must exceed force_target {sc.force_target} N")
     if sc.slip and (detector is None or detector.threshold is None):

@@ -67,9 +67,10 @@ def _bending(report, z, rng, summary):
                                  f"{math.degrees(float(b.direction)) % 360:.2f}", f"{b.deflection * 1e3:.2f}",
                                  *[f"{p / BAR:.2f}" for p in delivered], f"{dpsi:+.2f}", f"{bd.deflection * 1e3:.2f}"])
         ax.set_title(f"{'lowest' if variant == 'min' else 'highest'} total pressure", pad=14)
-        ax.set_rmax(20)
     axes[0].plot([], [], "o", color="C0", label="model, demanded pressures")
     axes[0].plot([], [], "x", color="C3", label="model, valve-delivered pressures")
+    for ax in axes:
+        ax.set_rmax(20)
     fig.legend(loc="lower center", ncol=2)
     sec.figure(fig, "End-plate deflection (mm, radius) and bending direction ψ (angle) at 5, 10, 15 mm for the "
                     "six principal directions (cf. Fig. 8) and the six between them.",

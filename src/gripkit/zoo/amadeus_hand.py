@@ -83,7 +83,7 @@ def force_plant() -> tuple:
 
 
 def _sig3(x: float) -> str:
-    return np.format_float_positional(x, precision=3, unique=False, fractional=False, trim="k")
+    return format(x, "#.3g")
 
 
 def table1_findings() -> list[Finding]:
