@@ -451,9 +451,9 @@ def step_metrics(y, dt: float, final: float = 1.0, band: float = 0.02) -> StepMe
     yn = y / final
     i10 = np.flatnonzero(yn >= 0.1)
     i90 = np.flatnonzero(yn >= 0.9)
-    rise = (i90[0] - i10[0]) * dt if (i10.size and i90.size) else math.inf
+    rise = float((i90[0] - i10[0]) * dt) if (i10.size and i90.size) else math.inf
     out = np.flatnonzero(np.abs(yn - 1.0) > band)
-    settle = (out[-1] + 1) * dt if out.size else 0.0
+    settle = float((out[-1] + 1) * dt) if out.size else 0.0
     if out.size and out[-1] == yn.size - 1:
         settle = math.inf
     return StepMetrics(rise, max(0.0, float(yn.max() - 1.0)), max(0.0, float(-yn.min())), settle,
