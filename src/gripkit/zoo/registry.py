@@ -39,6 +39,10 @@ _ENTRIES: tuple[ZooEntry, ...] = (
              "Finger force dynamics, ARX [2 2 2] LS model of Table II (9 Hz filtered data), valve "
              "current (A) to fingertip force (N) at 200 Hz, two-sample valve delay",
              _AMADEUS, "gripkit.zoo.amadeus:finger_force_model"),
+    ZooEntry("amadeus-hand", "AMADEUS subsea hand",
+             "Three-bellows finger (eqs 1-8), proportional valves, six-bridge force sensor with fusion "
+             "(eqs 9-19, Table I), PVDF slip sensor, Table II force dynamics in SI units",
+             _AMADEUS, "gripkit.zoo.amadeus_hand:amadeus_hand"),
 )
 
 

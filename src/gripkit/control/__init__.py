@@ -1,0 +1,15 @@
+"""Control: force control, hybrid force/position, impedance, compensation.
+
+A flat list of explicit re-exports; each developer adds the names of their own modules.
+"""
+
+from .finger_force import DiscretePlant as DiscretePlant
+from .finger_force import GraspResult as GraspResult
+from .finger_force import GraspScenario as GraspScenario
+from .finger_force import LoopResult as LoopResult
+from .finger_force import RSTController as RSTController
+from .finger_force import StepMetrics as StepMetrics
+from .finger_force import design_rst as design_rst
+from .finger_force import simulate_grasp as simulate_grasp
+from .finger_force import simulate_loop as simulate_loop
+from .finger_force import step_metrics as step_metrics
