@@ -12,7 +12,7 @@ __all__ = ["main"]
 
 
 def _build():
-    from . import demo, zoo  # noqa: F401  (commands register themselves)
+    from . import demo, identify_linear, zoo  # noqa: F401  (commands register themselves)
     from .app import app
 
     return app

@@ -70,7 +70,7 @@ def io_data(data: Trajectory, *, input: str, output: str, detrend: str = "mean",
         raise DataError(f"input and output must be different columns, both are {input!r}")
     u = np.array(data[input], dtype=np.float64)
     y = np.array(data[output], dtype=np.float64)
-    fs = data.require_uniform(why=why)
+    fs = float(f"{data.require_uniform(why=why):.9g}")  # time stamps in files carry rounding noise
     if detrend not in ("mean", "linear", "none"):
         raise DataError(f"detrend: expected 'mean', 'linear' or 'none', found {detrend!r}")
     u0 = y0 = 0.0

@@ -109,7 +109,8 @@ def structure_search(u, y, na=range(1, 5), nb=range(1, 5), nk=range(1, 11), *,
     criterion
         ``'aic'``, ``'fpe'`` or ``'loss'``.
     progress
-        Show a progress bar on stderr (:func:`gripkit.progress.track`).
+        Show a progress bar on stderr (:func:`gripkit.progress.track`) when the search is long
+        (more than 2·10⁶ candidate-samples).
     """
     u, y = check_io(u, y)
     check_dt(dt, fs)
@@ -129,7 +130,7 @@ def structure_search(u, y, na=range(1, 5), nb=range(1, 5), nk=range(1, 11), *,
     m = y.size - t0
     grid = [(a, b, k) for a in nas for b in nbs for k in nks]
     found, skipped = [], []
-    for a, b, k in track(grid, description="ARX structure search", enabled=progress and len(grid) > 1):
+    for a, b, k in track(grid, description="ARX structure search", enabled=progress and len(grid) * y.size > 2e6):
         names = tuple(f"a{i}" for i in range(1, a + 1)) + tuple(f"b{k + j}" for j in range(b))
         try:
             sol = qr_solve(arx_regression(u, y, a, b, k, t0=t0), names, overwrite=True)
