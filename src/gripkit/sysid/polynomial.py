@@ -444,7 +444,9 @@ class PolynomialModel:
     def _tf_arrays(self) -> tuple[np.ndarray, np.ndarray]:
         b, a = self.B, self.denominator
         n = max(a.size, b.size)
-        return np.pad(b, (0, n - b.size)), np.pad(a, (0, n - a.size))
+        num = np.pad(b, (0, n - b.size))
+        # positive powers of z: leading zeros of the numerator (the delay) carry no information
+        return np.trim_zeros(num, "f") if np.any(num) else num, np.pad(a, (0, n - a.size))
 
     def to_scipy(self):
         """``scipy.signal.dlti`` transfer function B/(A F) with ``dt`` (the delay appears as

@@ -46,7 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from ..errors import DataError
+from ..errors import DataError, IdentificationError
 from ._data import check_dt, check_excitation, check_io, check_order, require_samples
 from .polynomial import PolynomialModel
 
@@ -420,6 +420,12 @@ class RLS:
         n0 = self.n_updates
         _rls_run(self._s, u, y, theta, std, yhat, (0.0,) * p)
         np.sqrt(std, out=std)  # the kernel wrote variances
+        if not (np.isfinite(self.P).all() and np.isfinite(self.theta).all()):
+            raise IdentificationError(
+                f"RLS [{self.na} {self.nb} {self.nk}] diverged: P or θ is no longer finite after "
+                f"{self.n_updates} updates (forgetting λ = {self.forgetting:g}, windup={self.windup!r}); "
+                f"the covariance wound up on data that do not excite every direction",
+                hint="use windup='trace' or 'directional', or a forgetting factor closer to 1")
         e = y - yhat
         nupd = self.n_updates - n0
         if nupd == 0:
