@@ -60,6 +60,19 @@ def arx_regression(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int,
     return X
 
 
+def _qr_r(X: np.ndarray, overwrite: bool) -> np.ndarray:
+    """The (q, q) triangular factor R of ``X = QR`` (LAPACK ``geqrf`` called directly: scipy's
+    ``qr(mode='r')`` also applies ``triu`` to the whole m×q array, which costs more than the
+    factorisation itself for tall matrices)."""
+    q = X.shape[1]
+    (geqrf,) = sla.get_lapack_funcs(("geqrf",), (X,))
+    lwork = int(geqrf(X, lwork=-1)[2][0])
+    qr, _, _, info = geqrf(X, lwork=max(lwork, q), overwrite_a=overwrite)
+    if info != 0:  # pragma: no cover - LAPACK argument error
+        raise RuntimeError(f"LAPACK geqrf failed (info={info})")
+    return np.triu(qr[:q, :q])
+
+
 @dataclass(frozen=True)
 class QRSolution:
     """Least-squares solution of ``Y ≈ Φ θ`` from the QR factorisation of ``[Φ | Y]``.
@@ -100,8 +113,7 @@ def qr_solve(X: np.ndarray, names: tuple[str, ...], overwrite: bool = False) -> 
     if m <= p:
         raise UnidentifiableError(f"{m} equations cannot determine {p} parameters ({', '.join(names)})",
                                   hint="use a longer record or a smaller model")
-    R = sla.qr(X, mode="r", overwrite_a=overwrite, check_finite=False)[0]
-    R = np.triu(R[:q, :q])
+    R = _qr_r(X, overwrite)
     r1 = R[:p, :p]
     col = np.sqrt(np.sum(r1 * r1, axis=0))  # column norms of Φ (Q is orthogonal)
     zero = col <= 1e-300
