@@ -22,6 +22,9 @@ OutputOpt = typer.Option(..., "--output", help="Output column (e.g. the force)."
 DetrendOpt = typer.Option("mean", "--detrend",
                           help="Operating-point removal before fitting: mean, linear or none.")
 ValidateOpt = typer.Option(None, "--validate", help="Second record for free-run validation (same columns).")
+NaOpt = typer.Option(..., "--na", help="Number of A coefficients (after the leading 1).")
+NbOpt = typer.Option(..., "--nb", help="Number of B coefficients.")
+NkOpt = typer.Option(..., "--nk", help="Input delay in samples (B's leading zeros).")
 
 
 def _warn_lines(caught) -> list[str]:
@@ -96,9 +99,7 @@ def _print_model(model, val) -> None:
 
 @identify_app.command("arx")
 def identify_arx(data: Path = DataArg, input: str = InputOpt, output: str = OutputOpt,
-                 na: int = typer.Option(..., "--na", help="Number of A coefficients (after the 1)."),
-                 nb: int = typer.Option(..., "--nb", help="Number of B coefficients."),
-                 nk: int = typer.Option(..., "--nk", help="Input delay in samples (B's leading zeros)."),
+                 na: int = NaOpt, nb: int = NbOpt, nk: int = NkOpt,
                  fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                  validate: Path = ValidateOpt, json_out: bool = JsonOpt):
     """ARX [na nb nk] by least squares (QR), with σ, loss (eq 29), fit, AIC, poles and zeros."""
@@ -110,10 +111,10 @@ def identify_arx(data: Path = DataArg, input: str = InputOpt, output: str = Outp
 
 @identify_app.command("armax")
 def identify_armax(data: Path = DataArg, input: str = InputOpt, output: str = OutputOpt,
-                   na: int = typer.Option(..., "--na", help="Number of A coefficients."),
-                   nb: int = typer.Option(..., "--nb", help="Number of B coefficients."),
+                   na: int = NaOpt,
+                   nb: int = NbOpt,
                    nc: int = typer.Option(..., "--nc", help="Number of C coefficients."),
-                   nk: int = typer.Option(..., "--nk", help="Input delay in samples."),
+                   nk: int = NkOpt,
                    fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                    validate: Path = ValidateOpt, json_out: bool = JsonOpt):
     """ARMAX [na nb nc nk] by prediction-error minimisation."""
@@ -125,9 +126,9 @@ def identify_armax(data: Path = DataArg, input: str = InputOpt, output: str = Ou
 
 @identify_app.command("oe")
 def identify_oe(data: Path = DataArg, input: str = InputOpt, output: str = OutputOpt,
-                nb: int = typer.Option(..., "--nb", help="Number of B coefficients."),
+                nb: int = NbOpt,
                 nf: int = typer.Option(..., "--nf", "--na", help="Number of F (denominator) coefficients."),
-                nk: int = typer.Option(..., "--nk", help="Input delay in samples."),
+                nk: int = NkOpt,
                 fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                 validate: Path = ValidateOpt, json_out: bool = JsonOpt):
     """Output-error [nb nf nk] by prediction-error minimisation."""
@@ -139,9 +140,7 @@ def identify_oe(data: Path = DataArg, input: str = InputOpt, output: str = Outpu
 
 @identify_app.command("rls")
 def identify_rls(data: Path = DataArg, input: str = InputOpt, output: str = OutputOpt,
-                 na: int = typer.Option(..., "--na", help="Number of A coefficients."),
-                 nb: int = typer.Option(..., "--nb", help="Number of B coefficients."),
-                 nk: int = typer.Option(..., "--nk", help="Input delay in samples."),
+                 na: int = NaOpt, nb: int = NbOpt, nk: int = NkOpt,
                  forgetting: float = typer.Option(1.0, "--forgetting", help="Forgetting factor λ in (0, 1]."),
                  p0: float = typer.Option(1e4, "--p0", help="Initial covariance P0 = p0·I."),
                  windup: str = typer.Option("trace", "--windup", help="Anti-windup: trace, directional or none."),

@@ -12,7 +12,8 @@ import numpy as np
 
 from ..errors import DataError, UnidentifiableError
 
-__all__ = ["as_signal", "check_io", "check_order", "check_dt", "require_samples", "check_excitation"]
+__all__ = ["as_signal", "check_io", "check_order", "check_dt", "require_samples", "check_excitation",
+           "check_output_varies", "checked_problem", "check_identifiable"]
 
 
 def as_signal(x, name: str) -> np.ndarray:
@@ -96,3 +97,19 @@ def check_output_varies(y: np.ndarray, name: str = "output y") -> None:
         raise UnidentifiableError(f"{name} is constant ({y[0]:.6g} for all {y.size} samples): "
                                   f"there are no dynamics to identify; no estimate returned",
                                   hint="check that the output column is the measured response")
+
+
+def checked_problem(u, y, dt: float | None, fs: float | None, **orders):
+    """The common start of every estimator: signals checked (:func:`check_io`), orders checked
+    (``nb`` >= 1, the others >= 0), sample interval resolved. Returns ``(u, y, dt, *orders)`` with
+    the orders as ints in the order given."""
+    u, y = check_io(u, y)
+    ints = [check_order(v, name, 1 if name == "nb" else 0) for name, v in orders.items()]
+    return (u, y, check_dt(dt, fs), *ints)
+
+
+def check_identifiable(u: np.ndarray, y: np.ndarray, n_min: int, what: str) -> None:
+    """Enough samples, a varying input and a varying output, or a clear error."""
+    require_samples(y.size, n_min, what)
+    check_excitation(u)
+    check_output_varies(y)

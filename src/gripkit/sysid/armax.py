@@ -16,8 +16,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import signal as _sig
 
-from ._data import (check_dt, check_excitation, check_io, check_order, check_output_varies,
-                    require_samples)
+from ._data import check_identifiable, checked_problem
 from ._pem import covariance, is_stable_poly, levenberg_marquardt, stabilize
 from .arx import arx
 from .polynomial import PolynomialModel
@@ -57,21 +56,14 @@ def armax(u, y, na: int, nb: int, nc: int, nk: int = 1, *, dt: float | None = No
     :class:`PolynomialModel` with ``structure='armax'``, ``C`` and ``C_std``. Warns
     :class:`~gripkit.errors.AccuracyWarning` if the iteration does not converge.
     """
-    u, y = check_io(u, y)
-    na = check_order(na, "na", 0)
-    nb = check_order(nb, "nb", 1)
-    nc = check_order(nc, "nc", 0)
-    nk = check_order(nk, "nk", 0)
-    step = check_dt(dt, fs)
+    u, y, step, na, nb, nc, nk = checked_problem(u, y, dt, fs, na=na, nb=nb, nc=nc, nk=nk)
     if nc == 0:
         m = arx(u, y, na, nb, nk, dt=step, **meta)
         return m
     p = na + nb + nc
     t0 = max(na, nk + nb - 1)
     label = f"ARMAX [{na} {nb} {nc} {nk}]"
-    require_samples(y.size, t0 + 10 * p, f"{label} ({p} parameters)")
-    check_excitation(u)
-    check_output_varies(y)
+    check_identifiable(u, y, t0 + 10 * p, f"{label} ({p} parameters)")
     theta0 = _hannan_rissanen(u, y, na, nb, nc, nk)
     theta0[na + nb:] = stabilize(np.concatenate([[1.0], theta0[na + nb:]]))[1:]
 

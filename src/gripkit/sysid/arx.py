@@ -16,8 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._data import (check_dt, check_excitation, check_io, check_order, check_output_varies,
-                    require_samples)
+from ._data import check_identifiable, checked_problem
 from .polynomial import PolynomialModel
 from .regression import arx_regression, arx_start, qr_solve
 from .validation import fit_percent, loss_vn
@@ -57,16 +56,10 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None, fs: flo
         Constant input (it cannot identify B), constant output, or a regressor whose
         column-scaled condition number exceeds 1e10 (the message names the parameters involved).
     """
-    u, y = check_io(u, y)
-    na = check_order(na, "na", 0)
-    nb = check_order(nb, "nb", 1)
-    nk = check_order(nk, "nk", 0)
-    step = check_dt(dt, fs)
+    u, y, step, na, nb, nk = checked_problem(u, y, dt, fs, na=na, nb=nb, nk=nk)
     p = na + nb
     t0 = arx_start(na, nb, nk)
-    require_samples(y.size, t0 + p + 1, f"ARX [{na} {nb} {nk}] ({p} parameters, {t0} initial samples)")
-    check_excitation(u)
-    check_output_varies(y)
+    check_identifiable(u, y, t0 + p + 1, f"ARX [{na} {nb} {nk}] ({p} parameters, {t0} initial samples)")
     names = tuple(f"a{i}" for i in range(1, na + 1)) + tuple(f"b{nk + j}" for j in range(nb))
     sol = qr_solve(arx_regression(u, y, na, nb, nk), names, overwrite=True)
     A = np.concatenate([[1.0], sol.theta[:na]])

@@ -19,8 +19,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import signal as _sig
 
-from ._data import (check_dt, check_excitation, check_io, check_order, check_output_varies,
-                    require_samples)
+from ._data import check_identifiable, checked_problem
 from ._pem import covariance, is_stable_poly, levenberg_marquardt, stabilize
 from .arx import arx
 from .polynomial import PolynomialModel
@@ -59,17 +58,11 @@ def oe(u, y, nb: int, nf: int, nk: int = 1, *, dt: float | None = None, fs: floa
     leading 1) in place of ``na``. Returns a :class:`PolynomialModel` with ``structure='oe'``,
     ``A = [1]``, ``F`` and ``F_std``; its poles are the roots of F.
     """
-    u, y = check_io(u, y)
-    nb = check_order(nb, "nb", 1)
-    nf = check_order(nf, "nf", 0)
-    nk = check_order(nk, "nk", 0)
-    step = check_dt(dt, fs)
+    u, y, step, nb, nf, nk = checked_problem(u, y, dt, fs, nb=nb, nf=nf, nk=nk)
     p = nb + nf
     t0 = max(nf, nk + nb - 1)
     label = f"OE [{nb} {nf} {nk}]"
-    require_samples(y.size, t0 + 10 * p, f"{label} ({p} parameters)")
-    check_excitation(u)
-    check_output_varies(y)
+    check_identifiable(u, y, t0 + 10 * p, f"{label} ({p} parameters)")
     theta0 = np.concatenate([_iv_start(u, y, nb, nf, nk, t0), y[t0 - nf:t0][::-1]])
     n = y.size
     ub = np.column_stack([u[t0 - nk - j:n - nk - j] for j in range(nb)])

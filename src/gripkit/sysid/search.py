@@ -18,8 +18,7 @@ import numpy as np
 
 from ..errors import DataError, UnidentifiableError
 from ..progress import track
-from ._data import (check_dt, check_excitation, check_io, check_order, check_output_varies,
-                    require_samples)
+from ._data import check_dt, check_identifiable, check_io, check_order
 from .regression import arx_regression, qr_solve
 
 __all__ = ["Candidate", "SearchResult", "structure_search", "parse_range"]
@@ -121,10 +120,7 @@ def structure_search(u, y, na=range(1, 5), nb=range(1, 5), nk=range(1, 11), *,
     nks = [check_order(v, "nk", 0) for v in parse_range(nk, "nk")]
     t0 = max(max(nas), max(nks) + max(nbs) - 1)
     pmax = max(nas) + max(nbs)
-    require_samples(y.size, t0 + pmax + 1,
-                    f"structure search up to na={max(nas)}, nb={max(nbs)}, nk={max(nks)}")
-    check_excitation(u)
-    check_output_varies(y)
+    check_identifiable(u, y, t0 + pmax + 1, f"structure search up to na={max(nas)}, nb={max(nbs)}, nk={max(nks)}")
     yt = y[t0:]
     sst = float(np.sum((yt - yt.mean()) ** 2))
     m = y.size - t0
