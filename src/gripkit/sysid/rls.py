@@ -56,29 +56,70 @@ __all__ = ["RLS", "RLSResult", "rls"]
 _COUNT, _LAM, _MODE, _MAXTR, _V, _W1, _W2, _TRACE, _NUPD, _NA, _NB, _NK = range(12)
 _HDR = 16
 _MODES = {"none": 0, "trace": 1, "directional": 2}
+#: Records at least this long run through a batch kernel compiled for their number of parameters.
+SPECIALISE_ABOVE = 100_000
 
 
-@njit(cache=True, inline="always")
-def _gain_terms(lam, mode, r, trace):
-    """(1/den, sign, sqrt|coef|, scale) of the covariance update P ← (P + sign·q qᵀ)·scale with
-    q = Pφ·sqrt|coef| (see the module docstring); ``den`` is the gain denominator."""
-    if mode == 2:
-        if r <= 1e-12 * trace:  # no new direction: plain update, no forgetting
-            inv = 1.0 / (1.0 + r)
-            return inv, -1.0, math.sqrt(inv), 1.0
+@njit(cache=True)
+def _core(P, th, phi, q, p, size, lam, mode, maxtr, trace, y):
+    """One RLS update of θ (``th``, shape (p,)) and P (``P``, row-major (p·p,)) for regressor
+    ``phi`` and output ``y``; ``q`` is a work vector. Returns (a-priori error, r = φᵀPφ, trace).
+
+    ``size``: an empty tuple (p at run time) or a tuple of p zeros (p known to the compiler, loops
+    unrolled). The covariance update is ``P ← (P + sign·q qᵀ)·scale`` with ``q = Pφ·sqrt|coef|``
+    (see the module docstring for ``coef``, ``scale`` and the three ``windup`` modes).
+    """
+    if len(size) > 0:
+        p = len(size)
+    yhat = 0.0
+    for i in range(p):
+        yhat += phi[i] * th[i]
+    e = y - yhat
+    for i in range(p):
+        q[i] = 0.0
+    for j in range(p):
+        pj = phi[j]
+        row = j * p
+        for i in range(p):
+            q[i] += P[row + i] * pj
+    r = 0.0
+    for i in range(p):
+        r += phi[i] * q[i]
+    if mode == 2 and r <= 1e-12 * trace:  # directional, no new direction: no forgetting
+        inv = 1.0 / (1.0 + r)
+        sgn, sq, scale = -1.0, math.sqrt(inv), 1.0
+    elif mode == 2:  # directional forgetting
         inv = 1.0 / (lam + r)
         coef = (1.0 - lam - r) / r * inv
-        if coef >= 0.0:
-            return inv, 1.0, math.sqrt(coef), 1.0
-        return inv, -1.0, math.sqrt(-coef), 1.0
-    inv = 1.0 / (lam + r)
-    return inv, -1.0, math.sqrt(inv), 1.0 / lam
+        sgn = 1.0 if coef >= 0.0 else -1.0
+        sq, scale = math.sqrt(abs(coef)), 1.0
+    else:  # exponential forgetting
+        inv = 1.0 / (lam + r)
+        sgn, sq, scale = -1.0, math.sqrt(inv), 1.0 / lam
+    g = e * inv
+    for i in range(p):
+        th[i] += q[i] * g
+    for i in range(p):
+        q[i] *= sq
+    tr = 0.0
+    for i in range(p):
+        qi = sgn * q[i]
+        row = i * p
+        for j in range(p):
+            P[row + j] = (P[row + j] + qi * q[j]) * scale
+        tr += P[row + i]
+    if mode == 1 and tr > maxtr:  # bounded trace
+        f = maxtr / tr
+        for k in range(p * p):
+            P[k] *= f
+        tr = maxtr
+    return e, r, tr
 
 
 @njit(cache=True)
 def _rls_step(s, u, y):
     """One RLS update in place on the state vector ``s``; returns the a-priori error (0 while
-    the regressor is not yet filled). Same arithmetic, in the same order, as :func:`_rls_run`."""
+    the regressor is not yet filled). Same arithmetic as :func:`_rls_run` (both call :func:`_core`)."""
     na = int(s[_NA])
     nb = int(s[_NB])
     nk = int(s[_NK])
@@ -100,39 +141,9 @@ def _rls_step(s, u, y):
             s[oph + i] = -s[oy + i]
         for j in range(nb):
             s[oph + na + j] = s[ou + nk + j]
-        yhat = 0.0
-        for i in range(p):
-            yhat += s[oph + i] * s[oth + i]
-        e = y - yhat
-        for i in range(p):
-            s[oq + i] = 0.0
-        for j in range(p):
-            pj = s[oph + j]
-            row = op + j * p
-            for i in range(p):
-                s[oq + i] += s[row + i] * pj
-        r = 0.0
-        for i in range(p):
-            r += s[oph + i] * s[oq + i]
         lam = s[_LAM]
-        inv, sgn, sq, scale = _gain_terms(lam, int(s[_MODE]), r, s[_TRACE])
-        g = e * inv
-        for i in range(p):
-            s[oth + i] += s[oq + i] * g
-        for i in range(p):
-            s[oq + i] *= sq
-        tr = 0.0
-        for i in range(p):
-            qi = sgn * s[oq + i]
-            row = op + i * p
-            for j in range(p):
-                s[row + j] = (s[row + j] + qi * s[oq + j]) * scale
-            tr += s[row + i]
-        if int(s[_MODE]) == 1 and tr > s[_MAXTR]:
-            f = s[_MAXTR] / tr
-            for k in range(p * p):
-                s[op + k] *= f
-            tr = s[_MAXTR]
+        e, r, tr = _core(s[op:oph], s[oth:op], s[oph:oq], s[oq:oq + p], p, (), lam, int(s[_MODE]),
+                         s[_MAXTR], s[_TRACE], y)
         s[_TRACE] = tr
         s[_V] = lam * (s[_V] + e * e / (lam + r))
         s[_W1] = lam * s[_W1] + 1.0
@@ -160,18 +171,19 @@ def _rls_run(s, u, y, theta_out, var_out, yhat_out, size):
     """Batch RLS: updates ``s`` over the record; writes θ, σ² and the a-priori prediction at
     every step when the output arrays have N rows (pass arrays with 0 rows to skip storing).
 
-    ``size`` is a tuple of p zeros: its length is a compile-time constant, so numba compiles
-    (and caches) one kernel per number of parameters with fully unrolled p-loops (measured 1.5–2×
-    faster than a run-time p). The first ``t0`` samples go through :func:`_rls_step` (their
-    regressors need the buffered past); the rest take the regressor straight from ``u`` and ``y``
-    and keep θ and P in local arrays, with the same arithmetic in the same order as
-    :func:`_rls_step` (the two give bit-identical results), then write the state back.
+    ``size``: an empty tuple (generic kernel, p at run time) or a tuple of p zeros, whose length
+    numba knows at compile time: it compiles (and caches) one kernel per number of parameters with
+    unrolled p-loops (measured 1.5–2× faster); :meth:`RLS.run` uses it for records of at least
+    :data:`SPECIALISE_ABOVE` samples, where the extra compilation (1–2 s, once) pays off. The first
+    ``t0`` samples go through :func:`_rls_step` (their regressors need the buffered past); the rest
+    take the regressor straight from ``u`` and ``y`` with θ and P in local arrays. Both call
+    :func:`_core`, so streaming and batch results are bit-identical.
     """
     n = u.shape[0]
     na = int(s[_NA])
     nb = int(s[_NB])
     nk = int(s[_NK])
-    p = len(size)
+    p = na + nb
     nu = nk + nb
     oth = _HDR + na + nu
     op = oth + p
@@ -190,8 +202,12 @@ def _rls_run(s, u, y, theta_out, var_out, yhat_out, size):
                 var_out[t, i] = f * s[op + i * p + i]
     if n <= nstart:
         return
-    th = s[oth:oth + p].copy()
-    P = s[op:op + p * p].copy()
+    th = np.empty(p)
+    P = np.empty(p * p)
+    for i in range(p):  # explicit loops: slice assignment costs seconds of numba compile time
+        th[i] = s[oth + i]
+    for i in range(p * p):
+        P[i] = s[op + i]
     phi = np.empty(p)
     q = np.empty(p)
     lam = s[_LAM]
@@ -207,52 +223,22 @@ def _rls_run(s, u, y, theta_out, var_out, yhat_out, size):
             phi[i] = -y[t - 1 - i]
         for j in range(nb):
             phi[na + j] = u[t - nk - j]
-        yhat = 0.0
-        for i in range(p):
-            yhat += phi[i] * th[i]
-        e = y[t] - yhat
-        for i in range(p):
-            q[i] = 0.0
-        for j in range(p):
-            pj = phi[j]
-            row = j * p
-            for i in range(p):
-                q[i] += P[row + i] * pj
-        r = 0.0
-        for i in range(p):
-            r += phi[i] * q[i]
-        inv, sgn, sq, scale = _gain_terms(lam, mode, r, trace)
-        g = e * inv
-        for i in range(p):
-            th[i] += q[i] * g
-        for i in range(p):
-            q[i] *= sq
-        tr = 0.0
-        for i in range(p):
-            qi = sgn * q[i]
-            row = i * p
-            for j in range(p):
-                P[row + j] = (P[row + j] + qi * q[j]) * scale
-            tr += P[row + i]
-        if mode == 1 and tr > maxtr:
-            f = maxtr / tr
-            for k in range(p * p):
-                P[k] *= f
-            tr = maxtr
-        trace = tr
+        e, r, trace = _core(P, th, phi, q, p, size, lam, mode, maxtr, trace, y[t])
         V = lam * (V + e * e / (lam + r))
         w1 = lam * w1 + 1.0
         w2 = lam * lam * w2 + 1.0
         nupd += 1.0
         if pred:
-            yhat_out[t] = yhat
+            yhat_out[t] = y[t] - e
         if store:
             f = V / (w1 - p) * (w2 / w1) if (nupd > p and w1 > p) else np.nan
             for i in range(p):
                 theta_out[t, i] = th[i]
                 var_out[t, i] = f * P[i * p + i]
-    s[oth:oth + p] = th
-    s[op:op + p * p] = P
+    for i in range(p):
+        s[oth + i] = th[i]
+    for i in range(p * p):
+        s[op + i] = P[i]
     s[_TRACE] = trace
     s[_V] = V
     s[_W1] = w1
@@ -418,7 +404,7 @@ class RLS:
         std = np.empty((rows, p))
         yhat = np.empty(n)
         n0 = self.n_updates
-        _rls_run(self._s, u, y, theta, std, yhat, (0.0,) * p)
+        _rls_run(self._s, u, y, theta, std, yhat, (0.0,) * p if n >= SPECIALISE_ABOVE else ())
         np.sqrt(std, out=std)  # the kernel wrote variances
         if not (np.isfinite(self.P).all() and np.isfinite(self.theta).all()):
             raise IdentificationError(
