@@ -46,7 +46,11 @@ def test_unstable_model_warns_and_reports_no_fit():
     assert c.fit_percent is None and not c.stable
     with pytest.warns(StabilityWarning):
         v = unstable.validate(u, y)
-    assert v.fit_percent is None and np.isfinite(v.prediction_fit_percent)
+    assert v.fit_percent is None and np.isfinite(v.prediction_fit_percent)  # ARX predictor is FIR
+    unstable_oe = PolynomialModel.from_coefficients([1.0], [0.0, 0.0, 0.2], F=[1.0, -2.1, 1.1])
+    with pytest.warns(StabilityWarning):
+        v = unstable_oe.validate(u, y)  # its predictor is the diverging simulation itself
+    assert v.fit_percent is None and v.prediction_fit_percent is None and v.tests is None
 
 
 def test_residual_tests_accept_white_and_reject_coloured():

@@ -91,6 +91,9 @@ def _print_model(model, val) -> None:
     if val is not None:
         fit = "— (unstable model)" if val.fit_percent is None else f"{val.fit_percent:.2f} %"
         tt = val.tests
+        if tt is None:
+            con.print(f"validation: free-run fit {fit}; the one-step predictor diverges (unstable model)")
+            return
         con.print(f"validation: free-run fit {fit}, 1-step fit {val.prediction_fit_percent:.2f} %, "
                   f"residuals {'white' if tt.white else 'NOT white'} (p = {tt.whiteness_p:.3g}), "
                   f"{'independent of' if tt.independent else 'CORRELATED with'} past input "

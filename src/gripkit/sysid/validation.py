@@ -234,23 +234,24 @@ class Validation:
     simulation
         :class:`Comparison` (free run; ``fit_percent`` None for an unstable model).
     prediction_fit_percent
-        One-step-ahead prediction fit.
+        One-step-ahead prediction fit (None when the predictor 1/(C F) is unstable, e.g. an
+        unstable OE model, whose predictor is its diverging simulation).
     y_pred
         One-step prediction, shape (N,).
     residuals
         One-step prediction errors from ``model.start`` on.
     loss
-        V_N (eq 29) of those errors.
+        V_N (eq 29) of those errors (None when they diverge).
     tests
-        :class:`ResidualTests` of the errors against the input.
+        :class:`ResidualTests` of the errors against the input (None when they diverge).
     """
 
     simulation: Comparison
-    prediction_fit_percent: float
+    prediction_fit_percent: float | None
     y_pred: np.ndarray
     residuals: np.ndarray
-    loss: float
-    tests: ResidualTests
+    loss: float | None
+    tests: ResidualTests | None
 
     @property
     def fit_percent(self) -> float | None:
@@ -258,10 +259,11 @@ class Validation:
         return self.simulation.fit_percent
 
     def to_dict(self) -> dict:
+        tests = None if self.tests is None else {k: v for k, v in self.tests.to_dict().items()
+                                                 if k not in ("lags", "autocorr", "crosscorr")}
         return dict(fit_percent=self.fit_percent, prediction_fit_percent=self.prediction_fit_percent,
                     loss=self.loss, initial=self.simulation.initial, stable=self.simulation.stable,
-                    residual_tests={k: v for k, v in self.tests.to_dict().items()
-                                    if k not in ("lags", "autocorr", "crosscorr")})
+                    residual_tests=tests)
 
 
 def validate(model, u, y, *, initial: str = "estimate", lags: int = 25, alpha: float = 0.01) -> Validation:
@@ -271,9 +273,13 @@ def validate(model, u, y, *, initial: str = "estimate", lags: int = 25, alpha: f
 
     u, y = check_io(u, y)
     sim = compare(model, u, y, initial=initial)
-    e = model.prediction_errors(u, y)
+    with np.errstate(over="ignore", invalid="ignore"):
+        e = model.prediction_errors(u, y)
     t0 = model.start
     yp = y.copy()
     yp[t0:] = y[t0:] - e
+    cf = np.convolve(model.C, model.F)  # the predictor filters by 1/(C F)
+    if cf.size > 1 and np.any(np.abs(np.roots(cf)) >= 1.0) or not np.isfinite(e).all():
+        return Validation(sim, None, yp, e, None, None)  # diverging predictor: no numbers
     return Validation(sim, fit_percent(y[t0:], yp[t0:]), yp, e, loss_vn(e),
                       residual_tests(e, u[t0:], lags=lags, alpha=alpha))
