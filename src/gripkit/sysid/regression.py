@@ -66,8 +66,8 @@ def _qr_r(X: np.ndarray, overwrite: bool) -> np.ndarray:
     factorisation itself for tall matrices)."""
     q = X.shape[1]
     (geqrf,) = sla.get_lapack_funcs(("geqrf",), (X,))
-    lwork = int(geqrf(X, lwork=-1)[2][0])
-    qr, _, _, info = geqrf(X, lwork=max(lwork, q), overwrite_a=overwrite)
+    # workspace n·nb with a generous block size (a workspace query would copy X first)
+    qr, _, _, info = geqrf(X, lwork=64 * q, overwrite_a=overwrite)
     if info != 0:  # pragma: no cover - LAPACK argument error
         raise RuntimeError(f"LAPACK geqrf failed (info={info})")
     return np.triu(qr[:q, :q])
