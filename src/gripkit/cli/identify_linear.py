@@ -105,7 +105,7 @@ def identify_arx(data: Path = DataArg, input: str = InputOpt, output: str = Outp
                  na: int = NaOpt, nb: int = NbOpt, nk: int = NkOpt,
                  fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                  validate: Path = ValidateOpt, json_out: bool = JsonOpt):
-    """ARX [na nb nk] by least squares (QR), with σ, loss (eq 29), fit, AIC, poles and zeros."""
+    """ARX (orders na, nb, nk) by least squares (QR), with σ, loss (eq 29), fit, AIC, poles and zeros."""
     from ..sysid import arx
 
     _fit_and_report("arx", data, input, output, fs, time, fill, detrend, validate, json_out,
@@ -120,7 +120,7 @@ def identify_armax(data: Path = DataArg, input: str = InputOpt, output: str = Ou
                    nk: int = NkOpt,
                    fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                    validate: Path = ValidateOpt, json_out: bool = JsonOpt):
-    """ARMAX [na nb nc nk] by prediction-error minimisation."""
+    """ARMAX (orders na, nb, nc, nk) by prediction-error minimisation."""
     from ..sysid import armax
 
     _fit_and_report("armax", data, input, output, fs, time, fill, detrend, validate, json_out,
@@ -134,7 +134,7 @@ def identify_oe(data: Path = DataArg, input: str = InputOpt, output: str = Outpu
                 nk: int = NkOpt,
                 fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                 validate: Path = ValidateOpt, json_out: bool = JsonOpt):
-    """Output-error [nb nf nk] by prediction-error minimisation."""
+    """Output-error (orders nb, nf, nk) by prediction-error minimisation."""
     from ..sysid import oe
 
     _fit_and_report("oe", data, input, output, fs, time, fill, detrend, validate, json_out,
@@ -151,7 +151,7 @@ def identify_rls(data: Path = DataArg, input: str = InputOpt, output: str = Outp
                                                  help="Write θ(t), σ(t), prediction and error to this file."),
                  fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                  json_out: bool = JsonOpt):
-    """Recursive least squares ARX [na nb nk] with forgetting; θ and σ at every sample."""
+    """Recursive least squares ARX (orders na, nb, nk) with forgetting; θ and σ at every sample."""
     from ..sysid import rls
 
     with warnings.catch_warnings(record=True) as caught:

@@ -33,7 +33,7 @@ gains φφᵀ), and the trace limit bounds it above.
 
 Uncertainty: the noise variance is tracked as σ̂² = V/(w₁ − p) with the weighted residual sum
 ``V ← λV + λe²/(λ + r)`` and effective sample count ``w₁ ← λw₁ + 1``; the parameter covariance
-is ``σ̂² P · w₂/w₁`` with ``w₂ ← λ²w₂ + 1`` (exact for stationary regressors: weighted least
+is ``σ̂² P · w₂/w₁`` with ``w₂ ← λ²w₂ + 1`` (asymptotically exact for stationary regressors: weighted least
 squares with weights λᵏ has covariance σ² R⁻¹(Σλ²ᵏφφᵀ)R⁻¹; for λ = 1 it is σ̂²P, the least-squares
 covariance). With λ = 1 and a large P0 the RLS estimate equals the least-squares one.
 """
