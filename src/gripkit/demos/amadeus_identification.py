@@ -47,6 +47,9 @@ def _fmt_pm(v, s) -> str:
 
 
 def run(report, *, quick: bool = False) -> dict:
+    """Add the section to ``report``; returns the summary numbers. The records are the paper's
+    (400 and 4000 samples), so the section takes a few seconds once numba's RLS kernel is compiled
+    (about 10 s the first time); ``quick`` changes nothing."""
     from ..excitation import bandlimited_noise, multisine
     from ..report import plots
     from ..signals.filters import apply_sos
