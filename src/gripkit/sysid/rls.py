@@ -397,6 +397,10 @@ class RLS:
         """Process a whole record from the current state (batch kernel); returns θ and σ at every
         step when ``store`` (else only the final values)."""
         u, y = check_io(u, y)
+        return self._run(u, y, store)
+
+    def _run(self, u: np.ndarray, y: np.ndarray, store: bool) -> "RLSResult":
+        """:meth:`run` on checked float64 arrays."""
         n = u.size
         p = self.n_params
         rows = n if store else 0
@@ -520,4 +524,4 @@ def rls(u, y, na: int, nb: int, nk: int = 1, *, forgetting: float = 1.0, p0: flo
     p = est.n_params
     require_samples(u.size, t0 + p + 1, f"RLS ARX [{est.na} {est.nb} {est.nk}] ({p} parameters)")
     check_excitation(u)
-    return est.run(u, y, store=store)
+    return est._run(u, y, store)
