@@ -27,13 +27,17 @@ def test_registry_builds_the_plant(plant):
 
 
 def test_coefficients_units_and_provenance(plant):
-    """SI: B in N/A = 1000 × the printed per-mA values; displayed in N/mA as printed."""
+    """SI: B in N/A = 1000 × force_scale × the printed units-per-mA values, force_scale =
+    15.45 N / (1.235 units/mA × 500 mA) = 0.02502 N/unit (Fig. 2(c) peak force over the valve span)."""
+    from gripkit.zoo.amadeus import FORCE_SCALE
+
+    assert FORCE_SCALE == pytest.approx(15.45 / (0.0326 / 0.0264 * 500), rel=1e-9)
     np.testing.assert_allclose(plant.model.A, [1.0, -1.8732, 0.8996])
-    np.testing.assert_allclose(plant.model.B, [0.0, 0.0, 195.0, -227.6])
+    np.testing.assert_allclose(plant.model.B, np.array([0.0, 0.0, 195.0, -227.6]) * FORCE_SCALE)
     ps = plant.parameters
     for p in ps.values():
         assert p.unit and p.doc and "000_8f66dcc7ab06470c.txt" in p.source
-    assert ps["b2"].unit == "N/A" and ps["b2"].display() == "b2 = 0.195 ± 0.022 N/mA"
+    assert ps["b2"].unit == "N/A" and ps["b2"].display() == "b2 = 0.00488 ± 0.00055 N/mA"
     assert "Table II" in ps["a1"].source and ps["a1"].std == 0.0117  # σ from Table III
     assert ps["operating_point"].display() == "operating_point = 850 mA"
 
@@ -60,15 +64,15 @@ def test_simulated_plant_is_identified_back(plant):
     estimates contain the plant's coefficients within 3σ (equation-error noise is not what we add,
     so use a small noise: the ARX bias stays well below σ)."""
     s1 = multisine(range(1, 11), 2.0, 200.0, operating_point=0.850, limits=(0.600, 1.100), unit="A")
-    tr = plant.simulate(np.tile(s1.u, 3), noise_std=0.05, seed=1)
+    tr = plant.simulate(np.tile(s1.u, 3), noise_std=0.00125, seed=1)
     dev = tr.with_channels(current=tr["current"] - plant.operating_point)  # the plant's input variable
     m = identify(dev, "arx", input="current", output="force", na=2, nb=2, nk=2, detrend="none")
     assert np.all(np.abs(m.theta - plant.model.theta) < 3 * m.theta_std)
-    assert np.std(tr["force"] - tr["force_true"]) == pytest.approx(0.05, rel=0.1)
+    assert np.std(tr["force"] - tr["force_true"]) == pytest.approx(0.00125, rel=0.1)
 
 
 def test_prefilter_and_exports(plant):
-    tr = plant.simulate(np.full(400, 0.95), noise_std=5.0, seed=2, prefilter=True)
+    tr = plant.simulate(np.full(400, 0.95), noise_std=0.125, seed=2, prefilter=True)
     # the filtered force keeps the step's steady state (unit DC gain) and removes most noise
     ff, f = tr["force_filtered"], tr["force"]
     assert np.std(ff[300:] - tr["force_true"][300:]) < 0.5 * np.std(f[300:] - tr["force_true"][300:])

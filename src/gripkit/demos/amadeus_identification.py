@@ -24,9 +24,9 @@ import warnings
 
 import numpy as np
 
-__all__ = ["run", "NOISE_STD"]
+__all__ = ["run", "NOISE_UNITS"]
 
-NOISE_STD = 20.0  # N, white measurement noise on the force (≈ 7 % of the S1 force RMS)
+NOISE_UNITS = 20.0  # force-sensor units: white measurement noise (≈ 7 % of the S1 force RMS)
 STRUCT_II = [(1, 1, 2), (2, 2, 2), (3, 2, 2), (4, 4, 2), (2, 2, 10)]
 VARIANTS = ("raw", "filtered y", "prefiltered u, y")
 
@@ -54,7 +54,7 @@ def run(report, *, quick: bool = False) -> dict:
     from ..report import plots
     from ..signals.filters import apply_sos
     from ..sysid import arx, oe, rls
-    from ..zoo.amadeus import FS, TABLE_II, TABLE_III, reference, seed_checks
+    from ..zoo.amadeus import FORCE_SCALE, FS, TABLE_II, TABLE_III, reference, seed_checks
     from ..zoo.amadeus import finger_force_model as build_plant
 
     t_start = time.perf_counter()
@@ -63,8 +63,9 @@ def run(report, *, quick: bool = False) -> dict:
     sos = plant.prefilter_sos()
     s1 = multisine(range(1, 11), 2.0, FS, operating_point=0.850, limits=(0.600, 1.100), unit="A")
     s2 = bandlimited_noise(0.3, 10.0, 20.0, FS, operating_point=0.850, limits=(0.600, 1.100), seed=7, unit="A")
-    rec = {"S1": plant.simulate(s1.u, noise_std=NOISE_STD, seed=1),
-           "S2": plant.simulate(s2.u, noise_std=NOISE_STD, seed=2)}
+    noise_std = NOISE_UNITS * FORCE_SCALE  # N
+    rec = {"S1": plant.simulate(s1.u, noise_std=noise_std, seed=1),
+           "S2": plant.simulate(s2.u, noise_std=noise_std, seed=2)}
     other = {"S1": "S2", "S2": "S1"}
 
     def signals(name: str, variant: str):
@@ -80,11 +81,12 @@ def run(report, *, quick: bool = False) -> dict:
     sec = report.section(
         "AMADEUS finger force identification (§V)",
         "The study of §V of 000_8f66dcc7ab06470c.txt on simulated data. True finger: the Table II "
-        "[2 2 2] model (valve current deviation from 850 mA in A → force in N; the seed prints B per mA "
-        "and gives no force unit, so 1 sensor unit = 1 N is assumed). Excitations as in §V-E: S1, a "
+        "[2 2 2] model (valve current deviation from 850 mA in A → force in N; the seed prints B in sensor "
+        f"units per mA and gives no force unit: gripkit assumes {FORCE_SCALE:.4f} N per unit, from the "
+        "15.45 N peak force of Fig. 2(c) over the 500 mA valve span). Excitations as in §V-E: S1, a "
         "1–10 Hz multisine, 400 samples at 200 Hz (crest factor "
         f"{s1.crest_factor:.2f}); S2, band-limited noise 0.3–10 Hz, 4000 samples; both between 600 and "
-        f"1100 mA. White measurement noise of {NOISE_STD:g} N on the force. Three processings: raw; "
+        f"1100 mA. White measurement noise of {noise_std:.3g} N ({NOISE_UNITS:g} sensor units) on the force. Three processings: raw; "
         "'filtered y', the paper's 9 Hz Butterworth on the force only (§V-E, not part of the model); and "
         "'prefiltered u, y', the same filter on input and output, which keeps the input-output relation.")
 
@@ -101,7 +103,7 @@ def run(report, *, quick: bool = False) -> dict:
                     m = arx(u, y, *st, fs=FS, input_name="current", output_name="force",
                             input_unit="A", output_unit="N")
                     fits[(name, st, var)] = m
-                    row.append(m.loss)
+                    row.append(m.loss / FORCE_SCALE**2)
                 uv, yv = signals(other[name], "prefiltered u, y")
                 val = fits[(name, st, "prefiltered u, y")].validate(uv, yv)
                 row.append("—" if val.fit_percent is None else f"{val.fit_percent:.1f}")
@@ -109,8 +111,9 @@ def run(report, *, quick: bool = False) -> dict:
                 row.append(paper[0].loss if paper else "—")
                 rows.append(row)
     sec.table(["structure", "data", "V_N raw", "V_N filtered y (§V-E)", "V_N prefiltered u, y",
-               "free-run fit % on the other record (prefiltered)", "Table II V_N (paper units)"], rows,
-              caption="LS (QR) over the structures of Table II. Loss V_N of eq (29) on the estimation record.")
+               "free-run fit % on the other record (prefiltered)", "Table II V_N"], rows,
+              caption="LS (QR) over the structures of Table II. Loss V_N of eq (29) on the estimation record, "
+                      "in the seed's force-sensor units² (V_N in N² divided by force_scale²).")
     winners = {}
     for var in VARIANTS:
         best = min(STRUCT_II, key=lambda st: fits[("S1", st, var)].loss)
@@ -207,10 +210,12 @@ def run(report, *, quick: bool = False) -> dict:
         var = "prefiltered u, y" if ref.filtered else "raw"
         u, y = signals("S1", var)
         res = rls(u, y, ref.na, ref.nb, ref.nk, forgetting=1.0, p0=1e6, fs=FS)
-        th = ", ".join(_fmt_pm(v * (1 if n[0] == "a" else 1e-3), s * (1 if n[0] == "a" else 1e-3))
+        bscale = 1e-3 / FORCE_SCALE  # N/A -> sensor units per mA, the seed's scale
+        th = ", ".join(_fmt_pm(v * (1 if n[0] == "a" else bscale), s * (1 if n[0] == "a" else bscale))
                        for n, v, s in zip(res.names, res.theta_final, res.theta_std_final))
-        rrows.append([ref.label, "9 Hz" if ref.filtered else "no", th, res.loss, ref.loss])
-    sec.table(["structure", "filter", "final θ ± σ (b in N/mA)", "V_N (a-priori errors)", "Table III V_N (paper)"],
+        rrows.append([ref.label, "9 Hz" if ref.filtered else "no", th, res.loss / FORCE_SCALE**2, ref.loss])
+    sec.table(["structure", "filter", "final θ ± σ (b in sensor units/mA, as Table III)",
+               "V_N (a-priori errors, units²)", "Table III V_N"],
               rrows, caption="RLS (λ = 1, P0 = 10⁶·I) over the structures of Table III on S1 (400 samples).")
     u, y = signals("S2", "prefiltered u, y")
     res = rls(u, y, 2, 2, 2, forgetting=1.0, p0=1e6, fs=FS)

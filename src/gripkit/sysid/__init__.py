@@ -31,3 +31,5 @@ from .validation import compare as compare
 from .validation import fit_percent as fit_percent
 from .validation import residual_tests as residual_tests
 from .validation import validate as validate
+from .greybox import GreyboxResult as GreyboxResult
+from .greybox import fit as fit_greybox

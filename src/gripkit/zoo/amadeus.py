@@ -21,10 +21,13 @@ Units
 printed coefficients relate the current in **mA** to the force: with u in A the loss of eq (29)
 (27.62 for ``[2 2 2]``, an error of about 7.4 force units RMS) would dwarf the output the model
 predicts (about 0.3 units for a ±250 mA swing), so the printed B must be per mA. The loss values
-suggest the force is in raw sensor units; gripkit takes **one sensor unit as 1 N** (assumed,
-unverified). The plant is in SI: input = valve current deviation from 850 mA in A, output =
-force deviation in N (the force was AC-coupled, §V-F), so ``B_SI = 1000 × B_printed`` N/A
-(parameters show the printed value with display unit N/mA).
+show the force is in raw sensor units. Their static gain is B(1)/A(1) = −0.0326/0.0264 = −1.235
+units per mA (negative: the driven tube faces the plate, the other two were held at 1100 mA), so
+the full 500 mA valve span moves the reading by 617 units. The one force scale the seed supports
+is the fingertip's 15.45 N peak force (Fig. 2(c)) over that span: **one sensor unit = 0.0250 N**
+(``force_scale``, assumed). The plant is in SI: input = valve current deviation from 850 mA in A,
+output = force deviation in N (the force was AC-coupled, §V-F), so
+``B_SI = 1000 × force_scale × B_printed`` N/A. Losses in the seed's units are ``V_N / force_scale²``.
 """
 
 from __future__ import annotations
@@ -38,7 +41,7 @@ from ..consistency import Finding, compare, warn_inconsistent
 from ..params import Parameter, ParameterSet
 
 __all__ = ["ReferenceModel", "TABLE_II", "TABLE_III", "FingerForcePlant", "finger_force_model",
-           "seed_checks", "SEED", "FS", "PREFILTER_ORDER", "PREFILTER_CUTOFF"]
+           "seed_checks", "SEED", "FS", "PREFILTER_ORDER", "PREFILTER_CUTOFF", "FORCE_SCALE", "PEAK_FORCE"]
 
 SEED = "000_8f66dcc7ab06470c.txt"
 FS = 200.0  # Hz, §V-C
@@ -46,6 +49,7 @@ PREFILTER_ORDER = 2  # §V-D
 PREFILTER_CUTOFF = 9.0  # Hz, §V-D
 OPERATING_POINT = 0.850  # A, §V-E
 CURRENT_LIMITS = (0.600, 1.100)  # A, §V-E
+PEAK_FORCE = 15.45  # N, Fig. 2(c)
 
 
 @dataclass(frozen=True)
@@ -133,6 +137,16 @@ TABLE_III: tuple[ReferenceModel, ...] = (
 )
 
 
+def _force_scale() -> float:
+    row = next(r for r in TABLE_II if (r.na, r.nb, r.nk, r.data) == (2, 2, 2, "S1"))
+    gain_per_mA = sum(row.B) / sum(row.A)
+    return PEAK_FORCE / (abs(gain_per_mA) * 1e3 * (CURRENT_LIMITS[1] - CURRENT_LIMITS[0]))
+
+
+#: newtons per force-sensor unit of Tables II/III (assumed, see the module docstring): 0.0250 N
+FORCE_SCALE = _force_scale()
+
+
 def reference(table: str, na: int, nb: int, nk: int, *, filtered: bool = True, data: str = "S1") -> ReferenceModel:
     """Look up a row: ``reference("II", 2, 2, 2)``."""
     rows = TABLE_II if table == "II" else TABLE_III
@@ -147,8 +161,8 @@ def reference(table: str, na: int, nb: int, nk: int, *, filtered: bool = True, d
 class FingerForcePlant:
     """AMADEUS finger force plant: Table II ``[2 2 2]`` (S1, 9 Hz-filtered data) at 200 Hz.
 
-    ``A(q) F(t) = B(q) i(t)`` with ``A = [1, −1.8732, 0.8996]``, ``B = [0, 0, 195.0, −227.6]`` N/A
-    (0.1950, −0.2276 N/mA as printed): F is the force deviation (N, assumed = sensor units) and
+    ``A(q) F(t) = B(q) i(t)`` with ``A = [1, −1.8732, 0.8996]``, ``B = [0, 0, 4.87, −5.69]`` N/A
+    (0.1950, −0.2276 units/mA as printed, × 0.0250 N/unit): F is the force deviation (N) and
     i the valve current deviation from 850 mA (A); the two leading zeros of B are the two-sample
     valve delay (§V-C, ≈ 0.01 s). The model was identified on force data low-passed by a
     2nd-order 9 Hz Butterworth that is *not* part of the model structure (§V-E), so it maps the
@@ -180,17 +194,20 @@ class FingerForcePlant:
         sig = reference("III", 2, 2, 2)  # same coefficients, with σ (§V-F: RLS = LS)
         src = f"{SEED}, Table II"
         srcs = f"σ: {SEED}, Table III [2,2,2] 9 Hz"
-        k = 1e3  # printed B is per mA (see module docstring)
+        k = 1e3 * FORCE_SCALE  # printed B is sensor units per mA (see module docstring)
         P = Parameter
         self.parameters = ParameterSet([
             P("a1", row.A[1], "1", "coefficient of q^-1 in A(q)", source=f"{src}; {srcs}", std=sig.A_std[1]),
             P("a2", row.A[2], "1", "coefficient of q^-2 in A(q)", source=f"{src}; {srcs}", std=sig.A_std[2]),
             P("b2", k * row.B[2], "N/A", "coefficient of q^-2 in B(q) (current to force)",
-              source=f"{src} (printed per mA; force unit assumed N); {srcs}", std=k * sig.B_std[2],
+              source=f"{src} (printed in units/mA; × force_scale); {srcs}", std=k * sig.B_std[2],
               display_unit="N/mA"),
             P("b3", k * row.B[3], "N/A", "coefficient of q^-3 in B(q) (current to force)",
-              source=f"{src} (printed per mA; force unit assumed N); {srcs}", std=k * sig.B_std[3],
+              source=f"{src} (printed in units/mA; × force_scale); {srcs}", std=k * sig.B_std[3],
               display_unit="N/mA"),
+            P("force_scale", FORCE_SCALE, "N", "newtons per force-sensor unit of Tables II/III",
+              bounds=(0, None), source=f"assumed: the 500 mA valve span moves the force over the 15.45 N "
+                                       f"peak of {SEED} Fig. 2(c)"),
             P("fs", FS, "Hz", "sampling rate", bounds=(0, None), source=f"{SEED}, §V-C"),
             P("delay", float(row.nk), "1", "valve transport delay in samples (about 0.01 s)",
               bounds=(0, None), source=f"{SEED}, §V-C, Fig. 15"),

@@ -14,15 +14,9 @@ force dynamics (``000_8f66dcc7ab06470c.txt``).
 
 and the seed's consistency checks (Table I, Fig. 2(c) against the models).
 
-Force model units. Table II prints the ``[2 2 2]`` coefficients without units; the input was the
-valve current in mA (600–1100 mA, §V-E) and the output the (filtered) force-sensor reading. Its
-static gain is B(1)/A(1) = −0.0326/0.0264 = −1.235 per mA: negative, because the driven tube is
-the one facing the plate — raising its pressure straightens the finger (the other two tubes were
-held at 1100 mA). gripkit converts the output to newtons with the one scale the seed supports:
-the full valve span (500 mA) moves the fingertip force over its 15.45 N peak (Fig. 2(c)), so one
-reading unit is 15.45 / (1.235 × 500) = 0.0250 N (``force_scale``, assumed). When
-``gripkit.zoo.amadeus.finger_force_model`` (the identification developer's Table II model) is
-importable its coefficients are used; otherwise the printed ones.
+Force model units: see :mod:`gripkit.zoo.amadeus` — the Table II coefficients are in force-sensor
+units per mA; gripkit's SI plant (A → N) scales them with ``FORCE_SCALE`` = 0.0250 N per unit
+(assumed: the 500 mA valve span moves the fingertip force over its 15.45 N peak, Fig. 2(c)).
 """
 
 from __future__ import annotations
@@ -34,6 +28,7 @@ import numpy as np
 
 from ..consistency import Finding, compare, warn_inconsistent
 from ..params import Parameter, ParameterSet
+from .amadeus import PEAK_FORCE
 
 __all__ = ["AmadeusHandSystem", "amadeus_hand", "force_plant", "table2_plant", "TABLE_I", "table1_findings"]
 
@@ -49,37 +44,27 @@ TABLE2_A = (1.0, -1.8732, 0.8996)
 TABLE2_B = (0.0, 0.0, 0.1950, -0.2276)
 TABLE2_STD = {"A": (0.0, 0.0117, 0.0117), "B": (0.0, 0.0, 0.0221, 0.0225)}  # Table III σ
 FS = 200.0
-I_SPAN = 0.5  # A, 600-1100 mA (§V-E)
-PEAK_FORCE = 15.45  # N, Fig. 2(c)
 
 
 def table2_plant():
     """The ``[2 2 2]`` model in the seed's units (mA → force-sensor units), as a
-    :class:`~gripkit.control.DiscretePlant`: from ``gripkit.zoo.amadeus.finger_force_model()`` when
-    that module exists, else from the printed Table II coefficients."""
+    :class:`~gripkit.control.DiscretePlant`."""
     from ..control.finger_force import DiscretePlant
 
-    try:
-        from .amadeus import finger_force_model  # the identification developer's zoo model
-    except ImportError:
-        finger_force_model = None
-    if finger_force_model is not None:
-        m = finger_force_model()
-        p = DiscretePlant.from_model(m)
-        return DiscretePlant(p.A, p.B, p.dt, input_name="i", input_unit="mA", output_name="F",
-                             output_unit="force units", source="gripkit.zoo.amadeus.finger_force_model")
     return DiscretePlant(TABLE2_A, TABLE2_B, 1.0 / FS, input_name="i", input_unit="mA", output_name="F",
                          output_unit="force units", source=f"{_SEED} Table II [2 2 2] (S_1, 9 Hz filter)")
 
 
 def force_plant() -> tuple:
-    """(plant in SI (A → N), force_scale N/unit): the Table II model with its output scaled so
-    that the 500 mA valve span covers the 15.45 N peak force (see the module docstring)."""
-    raw = table2_plant()
-    scale = PEAK_FORCE / (abs(raw.dc_gain()) * I_SPAN * 1e3)
-    si = raw.scaled(scale * 1e3, input_name="i", input_unit="A", output_name="F", output_unit="N",
-                    source=f"{raw.source}; output x {scale:.4g} N/unit, input mA -> A")
-    return si, scale
+    """(plant in SI (A → N), force_scale N/unit): the zoo model ``amadeus-finger-force``
+    (:func:`gripkit.zoo.amadeus.finger_force_model`) as a DiscretePlant, and its force scale."""
+    from ..control.finger_force import DiscretePlant
+    from .amadeus import FORCE_SCALE, finger_force_model
+
+    m = finger_force_model().model
+    plant = DiscretePlant(m.A, m.B, m.dt, input_name="i", input_unit="A", output_name="F", output_unit="N",
+                          source="gripkit.zoo.amadeus.finger_force_model (Table II [2 2 2] x force_scale)")
+    return plant, FORCE_SCALE
 
 
 def _sig3(x: float) -> str:
