@@ -13,6 +13,7 @@ __all__ = ["main"]
 
 def _build():
     from . import demo, zoo  # noqa: F401  (commands register themselves)
+    from . import identify_step, zoo_discretize  # noqa: F401  (FT-G100: identify step, zoo discretize)
     from .app import app
 
     return app

@@ -127,6 +127,7 @@ class PID:
         ts = _finite("ts", ts, positive=True)
         if tf is None:
             tf = kd / (10.0 * abs(kp)) if (kd != 0 and kp != 0) else (ts if kd != 0 else 0.0)
+            tf = tf if math.isfinite(tf) else ts
         tf = _finite("tf", tf)
         if tf < 0:
             raise ConfigError(f"PID tf: expected a time constant >= 0 s, found {tf!r}")

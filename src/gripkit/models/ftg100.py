@@ -156,6 +156,8 @@ def ftg100_parameters() -> ParameterSet:
         P("K_fb", 0.71e-3, "N*s/m", "damping factor of the sensing subsystem", (0, 1.0), source=_S + "§III-D, LM estimate (printed unit mNs²/m read as mN·s/m)", display_unit="mN*s/m"),
         P("K_sb", 235.36, "N/m", "sensor suspension stiffness", (0, None), source=_S + "§III-C, eq 13 value stated"),
         P("D_b", 6.05, "1", "sensing-arm amplification x_b/x_eb", (0, None), source=_S + "§III-C, eq 12 value stated"),
+        P("x_off", 0.0, "m", "output offset (sensor zero) of a displacement record", (-1e-3, 1e-3),
+          source="measurement offset, not in the seed", display_unit="um"),
         P("r", R_SENSITIVITY, "N/V", "readout sensitivity (force per output volt)", (0, None), source=_S + "eq 18, printed '50 N/Volts', read as 50 µN/V (see module docstring)", display_unit="uN/V"),
     ], "ftg100")
 
@@ -270,15 +272,14 @@ class _SecondOrderFTG(Model):
 
     integrator = "zoh"
 
-    def _coefficients(self, thetas: np.ndarray) -> np.ndarray:  # (P, 5): m, c, k, gain, u0
+    def _coefficients(self, thetas: np.ndarray) -> np.ndarray:  # (P, 6): m, c, k, gain, u0, y0
         raise NotImplementedError
 
     def _simulate_batch(self, thetas, u, dt, substeps, x0, y):
-        co = self._coefficients(thetas)
-        second_order_batch(np.column_stack([co, np.zeros(len(co))]), u, dt, x0, y)
+        second_order_batch(self._coefficients(thetas), u, dt, x0, y)
 
     def modes(self, theta):
-        m, c, k = self._coefficients(np.atleast_2d(theta))[0, :3]
+        m, c, k = self._coefficients(np.atleast_2d(np.asarray(theta, float)))[0, :3]
         if k <= 0:
             return []
         return [(math.sqrt(k / m), c / (2 * math.sqrt(k * m)))]
@@ -291,7 +292,7 @@ class _SecondOrderFTG(Model):
 
     def state_space(self) -> StateSpace:
         """Continuous state space, states [y, ẏ] (output coordinates)."""
-        m, c, k, gain, _ = self._coefficients(self.theta()[None, :])[0]
+        m, c, k, gain, _, _ = self._coefficients(self.theta()[None, :])[0]
         A = [[0.0, 1.0], [-k / m, -c / m]]
         B = [[0.0], [gain / m]]
         return StateSpace(A, B, [[1.0, 0.0]], None, None, (self.inputs[0].name,), (self.outputs[0].name,),
@@ -299,7 +300,7 @@ class _SecondOrderFTG(Model):
 
     def transfer_function(self) -> tuple[np.ndarray, np.ndarray]:
         """(num, den) of G(s) in SI, highest power first (eqs 9, 15)."""
-        m, c, k, gain, _ = self._coefficients(self.theta()[None, :])[0]
+        m, c, k, gain, _, _ = self._coefficients(self.theta()[None, :])[0]
         return np.array([gain]), np.array([m, c, k])
 
     def discrete(self, fs: float = 20000.0, form: str = "canonical") -> StateSpace:
@@ -324,7 +325,8 @@ class FTG100Actuated(_SecondOrderFTG):
         k_k = k0 k2/(k0 + k2).
 
     Input ``V_in`` (V, absolute actuation voltage); output ``x_a`` (m, tip displacement from the
-    operating point). Free by default: M_a, K_fa, k0 (the LM estimates of §III-B).
+    operating point, plus the sensor zero ``x_off``, 0 by default). Free by default: M_a, K_fa, k0
+    (the LM estimates of §III-B).
     """
 
     name = "ftg100-actuated"
@@ -333,7 +335,7 @@ class FTG100Actuated(_SecondOrderFTG):
     outputs = (Signal("x_a", "m", "actuated-arm tip displacement from the operating point"),)
     states = (Signal("x_a", "m", "tip displacement"), Signal("v_a", "m/s", "tip velocity"))
     _seed_unit_factor = 1e6  # eq 10 is in µm per V
-    _names = ("M_a", "K_fa", "k0", "K_sa", "D_a", "k2", "N_a", "eps", "h", "g", "V0")
+    _names = ("M_a", "K_fa", "k0", "K_sa", "D_a", "k2", "N_a", "eps", "h", "g", "V0", "x_off")
 
     def __init__(self, parameters: ParameterSet | None = None, *, check: bool = True, **values):
         ps = parameters if parameters is not None else _sub(self._names).fix(*self._names[3:])
@@ -342,10 +344,10 @@ class FTG100Actuated(_SecondOrderFTG):
         super().__init__(ps, check=check)
 
     def _coefficients(self, thetas):
-        M, c, k0, Ksa, Da, k2, Na, eps, h, g, V0 = thetas.T
+        M, c, k0, Ksa, Da, k2, Na, eps, h, g, V0, off = thetas.T
         kk = k0 * k2 / (k0 + k2)
         gain = Da * Na * eps * h * V0 / g
-        return np.column_stack([M, c, Ksa + Da * Da * kk, gain, V0])
+        return np.column_stack([M, c, Ksa + Da * Da * kk, gain, V0, off])
 
     def series_stiffness(self) -> float:
         """k_k = k0 k2/(k0 + k2) [N/m] (eq 7)."""
@@ -385,8 +387,8 @@ class FTG100Actuated(_SecondOrderFTG):
 class FTG100Sensing(_SecondOrderFTG):
     """Sensing subsystem (eqs 14-15): M_b ẍ_b + K_fb ẋ_b + K_sb x_b = D_b² F_c.
 
-    Input ``F_c`` (N, gripping force at the sensing-arm tip); output ``x_b`` (m, tip deflection).
-    Free by default: M_b, K_fb (§III-D).
+    Input ``F_c`` (N, gripping force at the sensing-arm tip); output ``x_b`` (m, tip deflection,
+    plus the sensor zero ``x_off``, 0 by default). Free by default: M_b, K_fb (§III-D).
     """
 
     name = "ftg100-sensing"
@@ -395,17 +397,17 @@ class FTG100Sensing(_SecondOrderFTG):
     outputs = (Signal("x_b", "m", "sensing-arm tip deflection"),)
     states = (Signal("x_b", "m", "tip deflection"), Signal("v_b", "m/s", "tip velocity"))
     _seed_unit_factor = 1.0  # eq 17 is in µm per µN = m/N
-    _names = ("M_b", "K_fb", "K_sb", "D_b")
+    _names = ("M_b", "K_fb", "K_sb", "D_b", "x_off")
 
     def __init__(self, parameters: ParameterSet | None = None, *, check: bool = True, **values):
-        ps = parameters if parameters is not None else _sub(self._names).fix("K_sb", "D_b")
+        ps = parameters if parameters is not None else _sub(self._names).fix("K_sb", "D_b", "x_off")
         if values:
             ps = ps.replace(**values)
         super().__init__(ps, check=check)
 
     def _coefficients(self, thetas):
-        M, c, K, D = thetas.T
-        return np.column_stack([M, c, K, D * D, np.zeros_like(M)])
+        M, c, K, D, off = thetas.T
+        return np.column_stack([M, c, K, D * D, np.zeros_like(M), off])
 
     def stiffness(self) -> float:
         """k2 = K_sb/D_b² [N/m] (eq 16)."""
@@ -469,7 +471,7 @@ class FTG100Coupled(Model):
                Signal("V_out", "V", "force-sensor readout voltage k2 x_b / r"))
     states = (Signal("x_a", "m"), Signal("v_a", "m/s"), Signal("x_b", "m"), Signal("v_b", "m/s"))
     integrator = "zoh"
-    _names = FTG100Actuated._names + FTG100Sensing._names + ("r",)
+    _names = FTG100Actuated._names[:-1] + FTG100Sensing._names[:-1] + ("r",)
 
     def __init__(self, parameters: ParameterSet | None = None, *, check: bool = True, **values):
         ps = parameters if parameters is not None else _sub(self._names).fix(
@@ -479,10 +481,14 @@ class FTG100Coupled(Model):
         super().__init__(ps, check=check)
 
     def actuated(self) -> FTG100Actuated:
-        return FTG100Actuated(ParameterSet([self.parameters[n] for n in FTG100Actuated._names], "ftg100"), check=False)
+        return FTG100Actuated(self._subset(FTG100Actuated._names), check=False)
 
     def sensing(self) -> FTG100Sensing:
-        return FTG100Sensing(ParameterSet([self.parameters[n] for n in FTG100Sensing._names], "ftg100"), check=False)
+        return FTG100Sensing(self._subset(FTG100Sensing._names), check=False)
+
+    def _subset(self, names) -> ParameterSet:
+        full = ftg100_parameters()
+        return ParameterSet([self.parameters[n] if n in self.parameters else full[n] for n in names], "ftg100")
 
     def _matrices(self, theta):
         ps = self.parameters.from_vector(theta, self.parameters.names)
@@ -513,6 +519,18 @@ class FTG100Coupled(Model):
         A, _, _, _ = self._matrices(theta)
         lam = np.linalg.eigvals(A)
         return [(abs(v), -v.real / abs(v)) for v in lam if v.imag >= 0]
+
+    def discrete(self, fs: float = 20000.0, form: str = "canonical") -> StateSpace:
+        """``form='canonical'``: the seed's eq 18 block form (:meth:`discrete_eq18`); ``'physical'``:
+        the exact zero-order hold of the continuous cascade (states [x̃_a, ẋ̃_a, x_b, ẋ_b])."""
+        if form == "canonical":
+            return self.discrete_eq18(fs)
+        if form != "physical":
+            raise ModelError(f"form: expected 'canonical' or 'physical', found {form!r}")
+        fs = float(fs)
+        if not (math.isfinite(fs) and fs > 0):
+            raise ModelError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
+        return self.state_space().discretize(1.0 / fs)
 
     def discrete_eq18(self, fs: float = 20000.0) -> StateSpace:
         """The seed's eq 18: [[A_a, 0], [B_c k_k C_a, A_c]] from the canonical subsystems (eqs 10, 17);

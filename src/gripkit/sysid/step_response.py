@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import AccuracyWarning, DataError, IdentificationError
+from ..errors import AccuracyWarning, DataError, IdentificationError, SimulationError
 from ..models.second_order import SecondOrderSystem, second_order_step
 from ..signals.trajectory import Trajectory
 from .greybox import GreyboxResult, fit
@@ -235,29 +235,37 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
         raise DataError(f"output column {output!r} does not change: nothing to identify",
                         hint="check the column, or whether the system was powered")
     dt = 1.0 / fs
-    start = _arx_start((u - u[0]) / u_scale, (y - y[0]) / y_scale, dt)
+    # fit in normalised units, u_n = (u − u₀)/Δu and y_n = (y − y₀,ref)/Δy, so that every
+    # parameter is of order one whatever the physical units; mapped back below
+    u0, y_ref = float(u[0]), float(y[0])
+    un, yn = (u - u0) / u_scale, (y - y_ref) / y_scale
+    start = _arx_start(un, yn, dt)
     if start is None or not (0 < start[1] < math.pi * fs):
-        start = _level_start(data.t, (u - u[0]) / u_scale, (y - y[0]) / y_scale)
+        start = _level_start(data.t, un, yn)
     K0, wn0, z0 = start
-    K0 *= y_scale / u_scale
     wn0 = min(wn0, 0.9 * math.pi * fs)
     z0 = min(max(z0, 1e-3), 5.0)
-    in_unit, out_unit = data.unit(input), data.unit(output)
-    model = SecondOrderSystem(gain=K0, wn=wn0, zeta=z0, y0=float(y[0]), u0=float(u[0]),
-                              input_unit=in_unit, output_unit=out_unit, input_name=input, output_name=output)
-    sub = Trajectory(data.t, {input: u, output: y}, {input: in_unit, output: out_unit}, data.meta)
+    model = SecondOrderSystem(gain=K0, wn=wn0, zeta=z0, y0=0.0, u0=0.0, input_name="u", output_name="y")
+    sub = Trajectory(data.t, {"u": un, "y": yn}, meta=data.meta)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", AccuracyWarning)  # re-issued below with the step's names
-        res = fit(model, sub, outputs=[output], free=["gain", "wn", "zeta", "y0"], method="lm",
-                  multistart=multistart, progress=progress, output_scale=[y_scale])
-    K, wn, zeta, y0 = (res.value(n) for n in ("gain", "wn", "zeta", "y0"))
+        try:
+            res = fit(model, sub, outputs=["y"], free=["gain", "wn", "zeta", "y0"], method="lm",
+                      multistart=multistart, progress=progress, output_scale=[1.0])
+        except SimulationError:
+            raise IdentificationError(
+                f"the response of {output!r} to {input!r} is not a second-order response resolved at "
+                f"{fs:g} Hz: the fit diverged", hint="check the columns, or record at a higher sampling rate") from None
+    Kn, wn, zeta, y0n = (res.value(n) for n in ("gain", "wn", "zeta", "y0"))
     if wn >= math.pi * fs:
         raise IdentificationError(
             f"the fitted natural frequency {wn / (2 * math.pi):.4g} Hz is above the Nyquist frequency "
             f"{fs / 2:.4g} Hz of the data", hint="record at a higher sampling rate")
     if not res.identifiability.ok:
         warnings.warn(f"step-response fit of {output!r}: {res.identifiability}", AccuracyWarning, stacklevel=2)
-    J = np.diag([1.0, 1.0 / (2 * math.pi), 1.0, 1.0])
+    K = Kn * y_scale / u_scale
+    y0 = y_ref + y0n * y_scale
+    J = np.diag([y_scale / u_scale, 1.0 / (2 * math.pi), 1.0, y_scale])
     cov = J @ res.covariance @ J
     std = np.sqrt(np.clip(np.diag(cov), 0, None))
     std = np.where(np.isfinite(res.std), std, np.inf)
@@ -268,7 +276,9 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
         warnings.warn(f"step-response fit of {output!r}: the fitted response settles in "
                       f"{m['settling_time']:.3g} s, longer than the {data.duration:.3g} s record; the gain "
                       f"is extrapolated", AccuracyWarning, stacklevel=2)
-    gunit = model.parameters["gain"].unit
+    from ..models.second_order import _ratio_unit
+
+    gunit = _ratio_unit(data.unit(output), data.unit(input))
     return StepResponseResult(
         gain=K, gain_std=float(std[0]), natural_frequency_hz=wn / (2 * math.pi),
         natural_frequency_hz_std=float(std[1]), damping_ratio=zeta, damping_ratio_std=float(std[2]),
@@ -276,4 +286,4 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
         covariance=cov, correlation=corr, fit_percent=float(res.fit_percent[0]),
         residual_std=float(res.residual_std[0]), n_samples=int(data.n), fs=float(fs),
         overshoot_percent=m["overshoot_percent"], peak_time=m["peak_time"], rise_time=m["rise_time"],
-        settling_time=m["settling_time"], y_model=res.y_model[:, 0], greybox=res)
+        settling_time=m["settling_time"], y_model=y_ref + res.y_model[:, 0] * y_scale, greybox=res)
