@@ -17,6 +17,7 @@ __all__ = ["SECTIONS", "run_demo"]
 
 SECTIONS: dict[str, str] = {
     "amadeus-identification": "gripkit.demos.amadeus_identification",
+    "ftg100": "gripkit.demos.ftg100",
 }
 
 

@@ -24,16 +24,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ParameterError
+from .beams import _pos
 
 __all__ = ["comb_drive_coefficient", "comb_drive_force", "comb_drive_gain", "comb_drive_voltage"]
-
-
-def _positive(name: str, value: float) -> float:
-    v = float(value)
-    if not np.isfinite(v) or v <= 0:
-        raise ParameterError(f"{name}: expected a positive finite number (SI), found {value!r}")
-    return v
 
 
 def comb_drive_coefficient(n_pairs: float, eps: float, thickness: float, gap: float) -> float:
@@ -42,8 +35,8 @@ def comb_drive_coefficient(n_pairs: float, eps: float, thickness: float, gap: fl
     Parameters: ``n_pairs`` electrode pairs (1), ``eps`` permittivity (F/m), ``thickness`` h (m),
     ``gap`` g (m).
     """
-    n = _positive("n_pairs", n_pairs)
-    return n * _positive("eps", eps) * _positive("thickness", thickness) / (2.0 * _positive("gap", gap))
+    n = _pos("n_pairs", n_pairs)
+    return n * _pos("eps", eps) * _pos("thickness", thickness) / (2.0 * _pos("gap", gap))
 
 
 def comb_drive_force(voltage, n_pairs: float, eps: float, thickness: float, gap: float):
@@ -59,5 +52,5 @@ def comb_drive_gain(v0: float, n_pairs: float, eps: float, thickness: float, gap
 def comb_drive_voltage(force, coefficient: float, v_max: float = np.inf):
     """Voltage that produces ``force`` (N): V = √(F/c), clipped to [0, v_max] (square-law inversion
     used by force-commanding controllers; a negative force request gives 0 V: comb drives only pull)."""
-    c = _positive("coefficient", coefficient)
+    c = _pos("coefficient", coefficient)
     return np.clip(np.sqrt(np.clip(np.asarray(force, dtype=np.float64), 0.0, None) / c), 0.0, v_max)

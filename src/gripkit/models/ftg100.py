@@ -481,27 +481,43 @@ class FTG100Coupled(Model):
         super().__init__(ps, check=check)
 
     def actuated(self) -> FTG100Actuated:
-        return FTG100Actuated(self._subset(FTG100Actuated._names), check=False)
+        return self._parts(self.parameters)[0]
 
     def sensing(self) -> FTG100Sensing:
-        return FTG100Sensing(self._subset(FTG100Sensing._names), check=False)
+        return self._parts(self.parameters)[1]
 
-    def _subset(self, names) -> ParameterSet:
+    @staticmethod
+    def _parts(ps: ParameterSet):
+        """(actuated, sensing, k_k, k2/r) for the coupled parameter set ``ps``."""
         full = ftg100_parameters()
-        return ParameterSet([self.parameters[n] if n in self.parameters else full[n] for n in names], "ftg100")
 
-    def _matrices(self, theta):
-        ps = self.parameters.from_vector(theta, self.parameters.names)
-        m = FTG100Coupled.__new__(FTG100Coupled)
-        m.parameters = ps
-        a, b = m.actuated().state_space(), m.sensing().state_space()
+        def pick(names):
+            return ParameterSet([ps[n] if n in ps else full[n] for n in names], "ftg100")
+
         kk = ps.value("k0") * ps.value("k2") / (ps.value("k0") + ps.value("k2"))
+        return (FTG100Actuated(pick(FTG100Actuated._names), check=False),
+                FTG100Sensing(pick(FTG100Sensing._names), check=False), kk, ps.value("k2") / ps.value("r"))
+
+    @staticmethod
+    def _cascade(a: StateSpace, b: StateSpace, kk: float, readout: float):
+        """Eq 18's structure for two subsystems (continuous or discrete): the sensing input is
+        F_c = k_k x_a; outputs x_a, x_b, F_c, V_out = (k2/r) x_b."""
         A = np.zeros((4, 4))
         A[:2, :2] = a.A
         A[2:, 2:] = b.A
         A[2:, :2] = b.B @ (kk * a.C)
         B = np.vstack([a.B, np.zeros((2, 1))])
-        C = np.array([[1, 0, 0, 0], [0, 0, 1, 0], [kk, 0, 0, 0], [0, 0, ps.value("k2") / ps.value("r"), 0]], float)
+        C = np.zeros((4, 4))
+        C[0, :2] = a.C[0]
+        C[1, 2:] = b.C[0]
+        C[2, :2] = kk * a.C[0]
+        C[3, 2:] = readout * b.C[0]
+        return A, B, C
+
+    def _matrices(self, theta):
+        ps = self.parameters.from_vector(theta, self.parameters.names)
+        act, sen, kk, readout = self._parts(ps)
+        A, B, C = self._cascade(act.state_space(), sen.state_space(), kk, readout)
         return A, B, C, ps.value("V0")
 
     def state_space(self) -> StateSpace:
@@ -536,20 +552,8 @@ class FTG100Coupled(Model):
         """The seed's eq 18: [[A_a, 0], [B_c k_k C_a, A_c]] from the canonical subsystems (eqs 10, 17);
         outputs x_a, x_b, F_c, V_out (SI). The sensing subsystem sees F_c = k_k x_a held over each
         sample (a ZOH approximation of the continuous cascade; the DC gain is exact)."""
-        a = self.actuated().discrete(fs)
-        b = self.sensing().discrete(fs)
-        ps = self.parameters
-        kk = ps.value("k0") * ps.value("k2") / (ps.value("k0") + ps.value("k2"))
-        A = np.zeros((4, 4))
-        A[:2, :2] = a.A
-        A[2:, 2:] = b.A
-        A[2:, :2] = b.B @ (kk * a.C)
-        B = np.vstack([a.B, np.zeros((2, 1))])
-        C = np.zeros((4, 4))
-        C[0, :2] = a.C[0]
-        C[1, 2:] = b.C[0]
-        C[2, :2] = kk * a.C[0]
-        C[3, 2:] = ps.value("k2") / ps.value("r") * b.C[0]
+        act, sen, kk, readout = self._parts(self.parameters)
+        A, B, C = self._cascade(act.discrete(fs), sen.discrete(fs), kk, readout)
         return StateSpace(A, B, C, None, 1.0 / fs, ("V_in",), tuple(s.name for s in self.outputs), ("V",),
                           tuple(s.unit for s in self.outputs), {"model": self.name, "form": "eq 18 block form"})
 
@@ -669,40 +673,43 @@ def advance_plant(th, s, mode, V, h, substeps):  # pragma: no cover - compiled
         rem = h
         events = 0
         while rem > 0.0:
-            n0, n1, n2, n3 = _plant_rk4(th, s0, s1, s2, s3, V, mode, rem)
-            d1 = _gap(th, n0, n2)
-            crossed = (mode == 0 and d1 > 0.0) or (mode == 1 and d1 < 0.0)
-            if th[11] <= 0.0 or not crossed or events >= 4:
-                s0, s1, s2, s3 = n0, n1, n2, n3
-                break
+            # one RK4 call site (compile time): the first trial is the whole remaining step, later
+            # trials are Illinois iterations on the fraction theta of it
             d0 = _gap(th, s0, s2)
-            lo, hi = 0.0, 1.0
-            flo, fhi = d0, d1
-            side = 0
+            lo, hi, flo, fhi = 0.0, 1.0, d0, 0.0
             theta = 1.0
-            m0, m1, m2, m3 = n0, n1, n2, n3
-            for _it in range(40):
-                if fhi == flo:
-                    break
-                theta = (lo * fhi - hi * flo) / (fhi - flo)
-                m0, m1, m2, m3 = _plant_rk4(th, s0, s1, s2, s3, V, mode, theta * rem)
-                fm = _gap(th, m0, m2)
-                if fm == 0.0 or (hi - lo) * rem < 1e-15:
-                    break
-                if (fm > 0.0) == (fhi > 0.0):
-                    hi, fhi = theta, fm
-                    if side == 1:
-                        flo *= 0.5
-                    side = 1
+            side = 0
+            located = False
+            for it in range(41):
+                n0, n1, n2, n3 = _plant_rk4(th, s0, s1, s2, s3, V, mode, theta * rem)
+                fm = _gap(th, n0, n2)
+                if it == 0:
+                    crossed = (mode == 0 and fm > 0.0) or (mode == 1 and fm < 0.0)
+                    if th[11] <= 0.0 or not crossed or events >= 4:
+                        break
+                    fhi = fm
                 else:
-                    lo, flo = theta, fm
-                    if side == -1:
-                        fhi *= 0.5
-                    side = -1
-                if abs(fm) <= 1e-13 * (abs(d0) + abs(d1)):
+                    if fm == 0.0 or (hi - lo) * rem < 1e-15 or abs(fm) <= 1e-13 * (abs(flo) + abs(fhi)):
+                        located = True
+                        break
+                    if (fm > 0.0) == (fhi > 0.0):
+                        hi, fhi = theta, fm
+                        if side == 1:
+                            flo *= 0.5
+                        side = 1
+                    else:
+                        lo, flo = theta, fm
+                        if side == -1:
+                            fhi *= 0.5
+                        side = -1
+                if fhi == flo:
+                    located = True
                     break
-            s0, s1, s2, s3 = m0, m1, m2, m3
-            mode = 1 - mode
+                theta = min(max((lo * fhi - hi * flo) / (fhi - flo), 0.0), 1.0)
+            s0, s1, s2, s3 = n0, n1, n2, n3
+            if it == 0:  # no event in this step
+                break
+            mode = 1 - mode  # (if not located after 41 iterations, the last iterate is the best estimate)
             rem -= theta * rem
             events += 1
             if rem <= 1e-15 * h:
