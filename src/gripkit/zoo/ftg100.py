@@ -24,12 +24,11 @@ k2/(k0 + k2) = 0.0052: doubling k0 moves the step response by half a percent. Wi
 
 from __future__ import annotations
 
-import math
 import warnings
 
 import numpy as np
 
-from ..errors import AccuracyWarning, ConsistencyWarning, DataError, IdentificationError
+from ..errors import ConsistencyWarning, DataError, IdentificationError
 from ..models.ftg100 import FTG100Actuated, FTG100Coupled, FTG100Plant, FTG100Sensing
 from ..signals.trajectory import Trajectory
 from ..sysid.greybox import GreyboxResult, fit
@@ -223,7 +222,3 @@ def _shift_offset(res: GreyboxResult, off0: float) -> GreyboxResult:
     theta = np.array([ps.value(n) for n in res.free])
     return dataclasses.replace(res, parameters=ps, theta=theta)
 
-
-def natural_frequency_hz(model) -> float:
-    """f_n (Hz) of a linear FT-G100 subsystem."""
-    return model.modes(model.theta())[0][0] / (2 * math.pi)
