@@ -38,30 +38,14 @@ def resolve(name):
 
 
 def step_metrics(t: np.ndarray, y: np.ndarray, band: float = 0.02) -> dict[str, np.ndarray]:
-    """Step-response metrics of each row of ``y`` (P, N): final value (mean of the last 5 %),
-    peak, overshoot %, 10–90 % rise time and settling time into ±``band`` of the final value."""
-    P, N = y.shape
-    tail = max(N // 20, 1)
-    final = y[:, -tail:].mean(axis=1)
-    sign = np.where(final >= 0, 1.0, -1.0)
-    ys = y * sign[:, None]
-    fin = np.abs(final)
-    peak = ys.max(axis=1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        overshoot = np.where(fin > 0, 100.0 * (peak - fin) / fin, np.nan)
-    rise = np.full(P, np.nan)
-    settle = np.full(P, np.nan)
-    for i in range(P):
-        if fin[i] <= 0:
-            continue
-        above10 = np.flatnonzero(ys[i] >= 0.1 * fin[i])
-        above90 = np.flatnonzero(ys[i] >= 0.9 * fin[i])
-        if above10.size and above90.size:
-            rise[i] = t[above90[0]] - t[above10[0]]
-        outside = np.flatnonzero(np.abs(ys[i] - fin[i]) > band * fin[i])
-        settle[i] = t[0] if outside.size == 0 else (t[outside[-1] + 1] if outside[-1] + 1 < N else np.nan)
-    return {"final": final, "peak": peak * sign, "overshoot_percent": np.maximum(overshoot, 0.0),
-            "rise_time": rise, "settling_time": settle - t[0]}
+    """Step-response metrics of each row of ``y`` (P, N) from rest: final value (mean of the last
+    10 %), peak, overshoot %, 10–90 % rise time and settling time into ±``band``
+    (:func:`gripkit.sysid.step_response.step_metrics` per row)."""
+    from ..sysid.step_response import step_metrics as one
+
+    rows = [one(t, yi, y_initial=0.0, band=band) for yi in np.atleast_2d(y)]
+    return {"final": np.array([r["y_final"] for r in rows]), "peak": np.array([r["peak"] for r in rows]),
+            **{k: np.array([r[k] for r in rows]) for k in ("overshoot_percent", "rise_time", "settling_time")}}
 
 
 def step_response(model, params: dict[str, np.ndarray], settings: dict) -> dict[str, np.ndarray]:

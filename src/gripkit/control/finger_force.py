@@ -444,20 +444,18 @@ class StepMetrics:
 
 
 def step_metrics(y, dt: float, final: float = 1.0, band: float = 0.02) -> StepMetrics:
-    """Metrics of a step response ``y`` toward ``final`` (starting from 0)."""
+    """Metrics of a step response ``y`` toward ``final`` (starting from 0), by
+    :func:`gripkit.sysid.step_response.step_metrics` plus the undershoot a non-minimum-phase zero
+    causes."""
+    from ..sysid.step_response import step_metrics as general
+
     y = np.asarray(y, dtype=np.float64).reshape(-1)
     if y.size < 3 or final == 0:
         raise DataError("step_metrics needs a response of >= 3 samples and a nonzero final value")
+    m = general(np.arange(y.size) * dt, y, y_initial=0.0, y_final=final, band=band)
     yn = y / final
-    i10 = np.flatnonzero(yn >= 0.1)
-    i90 = np.flatnonzero(yn >= 0.9)
-    rise = float((i90[0] - i10[0]) * dt) if (i10.size and i90.size) else math.inf
-    out = np.flatnonzero(np.abs(yn - 1.0) > band)
-    settle = float((out[-1] + 1) * dt) if out.size else 0.0
-    if out.size and out[-1] == yn.size - 1:
-        settle = math.inf
-    return StepMetrics(rise, max(0.0, float(yn.max() - 1.0)), max(0.0, float(-yn.min())), settle,
-                       float(y[-1]), float(abs(1.0 - yn[-1])))
+    return StepMetrics(m["rise_time"], m["overshoot_percent"] / 100.0, max(0.0, float(-yn.min())),
+                       m["settling_time"], float(y[-1]), float(abs(1.0 - yn[-1])))
 
 
 # ------------------------------------------------------------------------------- loop simulation
