@@ -149,11 +149,11 @@ class ParameterSet(Mapping[str, Parameter]):
                 hint=f"available: {', '.join(self._params)}",
             ) from None
 
-    def __contains__(self, key) -> bool:  # Mapping's default relies on KeyError, __getitem__ raises ParameterError
-        return key in self._params
-
     def __iter__(self) -> Iterator[str]:
         return iter(self._params)
+
+    def __contains__(self, key) -> bool:  # Mapping's default would leak ParameterError
+        return key in self._params
 
     def __len__(self) -> int:
         return len(self._params)

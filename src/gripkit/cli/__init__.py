@@ -12,7 +12,7 @@ __all__ = ["main"]
 
 
 def _build():
-    from . import demo, zoo  # noqa: F401  (commands register themselves)
+    from . import demo, identify_linear, identify_step, sweep, zoo, zoo_discretize  # noqa: F401  (commands register themselves)
     from . import identify_tsfm, simulate  # noqa: F401
     from .app import app
 

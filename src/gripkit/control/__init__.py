@@ -1,8 +1,21 @@
-"""Control: force control, hybrid force/position, impedance, compensation.
+"""Control: force control of the AMADEUS finger (RST pole placement), discrete PID with
+anti-windup and bumpless transfer, hybrid force/position control, impedance control.
 
-A flat list of explicit re-exports; each developer adds the names of their own modules.
+A flat list of explicit re-exports.
 """
 
+from .finger_force import DiscretePlant as DiscretePlant
+from .finger_force import GraspResult as GraspResult
+from .finger_force import GraspScenario as GraspScenario
+from .finger_force import LoopResult as LoopResult
+from .finger_force import RSTController as RSTController
+from .finger_force import StepMetrics as StepMetrics
+from .finger_force import design_rst as design_rst
+from .finger_force import simulate_grasp as simulate_grasp
+from .finger_force import simulate_loop as simulate_loop
+from .finger_force import step_metrics as step_metrics
+from .hybrid import HybridForcePosition as HybridForcePosition
+from .pid import PID as PID
 from .two_finger_grasp import GraspSettings as GraspSettings
 from .two_finger_grasp import TwoFingerGrasp as TwoFingerGrasp
 from .two_finger_grasp import TwoFingerGraspResult as TwoFingerGraspResult
