@@ -152,6 +152,9 @@ class ParameterSet(Mapping[str, Parameter]):
     def __iter__(self) -> Iterator[str]:
         return iter(self._params)
 
+    def __contains__(self, key) -> bool:  # Mapping's default would leak ParameterError
+        return key in self._params
+
     def __len__(self) -> int:
         return len(self._params)
 

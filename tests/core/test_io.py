@@ -101,3 +101,42 @@ def test_hdf5_2d_dataset(tmp_path):
         ds.attrs["units"] = ["s", "mN"]
     tr = load(p, key="run1")
     assert tr["force"][0] == pytest.approx(1e-3) and tr.unit("force") == "N"
+
+
+FLOAT64_ARRAY = ("std_msgs/MultiArrayLayout layout\nfloat64[] data\n" + "=" * 80 + "\nMSG: std_msgs/MultiArrayLayout\n"
+                 "MultiArrayDimension[] dim\nuint32 data_offset\n" + "=" * 80 + "\nMSG: std_msgs/MultiArrayDimension\n"
+                 "string label\nuint32 size\nuint32 stride\n")
+
+
+def write_mcap(path, topics):
+    from mcap_ros2.writer import Writer
+
+    with open(path, "wb") as f:
+        w = Writer(f)
+        schema = w.register_msgdef("std_msgs/Float64MultiArray", FLOAT64_ARRAY)
+        for topic, times, values in topics:
+            for t, v in zip(times, values):
+                w.write_message(topic, schema, {"layout": {"dim": [], "data_offset": 0}, "data": list(v)},
+                                log_time=int(round(t * 1e9)), publish_time=int(round(t * 1e9)))
+        w.finish()
+
+
+def test_mcap_topics_aligned_on_first_column(tmp_path):
+    """Force at 200 Hz, pressure at 100 Hz: pressure is interpolated onto the force time stamps."""
+    pytest.importorskip("mcap_ros2")
+    p = tmp_path / "run.mcap"
+    tf = 0.02 + np.arange(40) / 200.0
+    tp = np.arange(24) / 100.0
+    write_mcap(p, [("/finger/force", tf, np.column_stack([np.sin(tf), 2 * tf])),
+                   ("/finger/pressure", tp, np.column_stack([3.0 * tp]))])
+    tr = load(p, columns=["force=/finger/force:data[1]", "p=/finger/pressure:data[0]"],
+              units={"p": "bar"})
+    np.testing.assert_allclose(tr.t, tf - tf[0], atol=1e-9)
+    np.testing.assert_allclose(tr["force"], 2 * tf, atol=1e-12)
+    np.testing.assert_allclose(tr["p"], 3.0 * tf * 1e5, rtol=1e-9)  # linear, so interpolation is exact
+    with pytest.raises(DataError, match="no field 'wrench'"):
+        load(p, columns=["/finger/force:wrench.force.z"])
+    with pytest.raises(DataError, match="no messages on topics"):
+        load(p, columns=["/nope:data[0]"])
+    with pytest.raises(DataError, match="alias=.*topic:field"):
+        load(p, columns=["force"])

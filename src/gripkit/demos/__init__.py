@@ -17,6 +17,9 @@ __all__ = ["SECTIONS", "run_demo"]
 
 SECTIONS: dict[str, str] = {
     "amadeus-identification": "gripkit.demos.amadeus_identification",
+    "amadeus-hand": "gripkit.demos.amadeus_hand",
+    "ftg100": "gripkit.demos.ftg100",
+    "tsfm": "gripkit.demos.tsfm",
     "dlr-hit": "gripkit.demos.dlr_hit",
 }
 

@@ -4,6 +4,8 @@
 * Parquet: one column per channel; units in the field metadata key ``unit`` (or in headers).
 * HDF5: a group holding one 1-D dataset per channel (attribute ``unit``), or one 2-D dataset
   with a ``columns`` attribute (and optionally ``units``); ``key=`` names the group/dataset.
+* MCAP (ROS 2 logs, optional extra): columns ``[alias=]/topic:field.path[i]``, see
+  :mod:`gripkit.io.mcap_reader`.
 """
 
 from __future__ import annotations
@@ -21,13 +23,13 @@ from .table import columns_to_trajectory
 __all__ = ["load", "save", "FORMATS"]
 
 FORMATS = {".csv": "csv", ".txt": "csv", ".tsv": "csv", ".parquet": "parquet", ".pq": "parquet",
-           ".h5": "hdf5", ".hdf5": "hdf5", ".hdf": "hdf5"}
+           ".h5": "hdf5", ".hdf5": "hdf5", ".hdf": "hdf5", ".mcap": "mcap"}
 
 
 def _format(path: Path, fmt: str | None) -> str:
     if fmt is not None:
         if fmt not in set(FORMATS.values()):
-            raise DataError(f"format: expected one of csv, parquet, hdf5, found {fmt!r}")
+            raise DataError(f"format: expected one of csv, parquet, hdf5, mcap, found {fmt!r}")
         return fmt
     try:
         return FORMATS[path.suffix.lower()]
@@ -39,7 +41,7 @@ def _format(path: Path, fmt: str | None) -> str:
 def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
          fs: float | None = None, units: Mapping[str, str] | None = None,
          fill: str | None = None, format: str | None = None, key: str | None = None,
-         delimiter: str | None = None) -> Trajectory:
+         delimiter: str | None = None, stamp: str = "log") -> Trajectory:
     """Read experiment data into a validated :class:`Trajectory` (SI units).
 
     Parameters
@@ -60,6 +62,8 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
         Force a format ('csv', 'parquet', 'hdf5') instead of the suffix.
     key
         HDF5 group or dataset path.
+    stamp
+        MCAP time stamps: 'log' (log time) or 'header' (``header.stamp`` of each message).
 
     Raises
     ------
@@ -74,6 +78,12 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
     if path.stat().st_size == 0:
         raise DataError(f"data file {str(path)!r} is empty")
     fmt = _format(path, format)
+    if fmt == "mcap":
+        from .mcap_reader import read_mcap
+
+        raw, meta_units = read_mcap(path, columns, stamp)
+        return columns_to_trajectory(raw, source=path.name, time="t", units=units,
+                                     meta_units=meta_units, fill=fill)
     reader = {"csv": _read_csv, "parquet": _read_parquet, "hdf5": _read_hdf5}[fmt]
     raw, meta_units = reader(path, key=key, delimiter=delimiter)
     return columns_to_trajectory(raw, source=path.name, columns=columns, time=time, fs=fs,
@@ -181,6 +191,8 @@ def save(tr: Trajectory, path, *, format: str | None = None, key: str = "/") -> 
     temporary file and renames it, so an interrupted save never leaves a half-written file."""
     path = Path(path)
     fmt = _format(path, format)
+    if fmt == "mcap":
+        raise DataError("gripkit reads MCAP logs but writes CSV, Parquet or HDF5", hint="save as .parquet")
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_name(f".{path.name}.tmp")
     cols = {"t": tr.t, **{n: tr[n] for n in tr.names}}

@@ -1,4 +1,5 @@
-"""Simulation core: the Model base class, simulate(), step-resolution checks, linear systems."""
+"""Simulation core: the Model base class, simulate(), step-resolution checks, linear systems,
+fixed-step integrators, hybrid (contact) dynamics, TOML model descriptions."""
 
 from .linear import StateSpace as StateSpace
 from .linear import c2d_zoh as c2d_zoh
@@ -8,3 +9,8 @@ from .model import simulate as simulate
 from .steps import check_step as check_step
 from .steps import step_report as step_report
 from .steps import substeps_for as substeps_for
+from .hybrid import Guard as Guard
+from .hybrid import HybridSystem as HybridSystem
+from .hybrid import Mode as Mode
+from .integrators import integrate_lti as integrate_lti
+from .integrators import zoh_levels as zoh_levels

@@ -146,7 +146,7 @@ def fit(model, data: Trajectory, *, outputs: Sequence[str] | Mapping[str, str] |
         initial: ParameterSet | Mapping[str, float] | None = None, x0: np.ndarray | None = None,
         output_scale: Sequence[float] | None = None, multistart: int = 0, seed: int = 0,
         method: str = "trf", max_nfev: int = 200, rcond: float = 1e-8, max_rel_std: float = 1.0,
-        loss: str = "linear",
+        loss: str = "linear", burn_in: int = 0,
         progress: bool = True) -> GreyboxResult:
     """Identify the free parameters of ``model`` from ``data`` (see the module docstring).
 
@@ -174,6 +174,9 @@ def fit(model, data: Trajectory, *, outputs: Sequence[str] | Mapping[str, str] |
         the best cost wins.
     method
         'trf' (bounds) or 'lm' (Levenberg-Marquardt; ignores bounds, checked afterwards).
+    burn_in
+        Samples simulated but left out of the cost (the transient of an unknown initial state,
+        e.g. the hysteresis state of a record that starts mid-loop). Default 0.
     rcond, max_rel_std
         Identifiability diagnosis: a Jacobian direction (in parameters scaled to their starting
         values) is undetermined if its singular value is below ``rcond`` times the largest, or if
@@ -193,6 +196,10 @@ def fit(model, data: Trajectory, *, outputs: Sequence[str] | Mapping[str, str] |
         raise ParameterError("no free parameters to identify", hint="pass free=[...] or unfix some parameters")
 
     in_map = {s.name: (inputs or {}).get(s.name, s.name) for s in model.inputs}
+    missing = [c for c in in_map.values() if c not in data]
+    if missing:
+        raise DataError(f"data has no column {missing[0]!r} for the input of {model.name}",
+                        hint=f"map it with inputs={{model_input: column}}; columns: {', '.join(data.names)}")
     u = np.column_stack([data[c] for c in in_map.values()])
     model_out = [s.name for s in model.outputs]
     if outputs is None:
@@ -210,11 +217,15 @@ def fit(model, data: Trajectory, *, outputs: Sequence[str] | Mapping[str, str] |
     out_idx = [model_out.index(o) for o in out_map]
     y = np.column_stack([data[c] for c in out_map.values()])
     n_free = len(free)
-    data.require_samples(2 * n_free + 1, f"fitting {n_free} parameters")
-    w = np.asarray(output_scale, dtype=np.float64) if output_scale is not None else y.std(axis=0)
+    burn_in = int(burn_in)
+    if burn_in < 0:
+        raise DataError(f"burn_in: expected a number of samples >= 0, found {burn_in}")
+    data.require_samples(burn_in + 2 * n_free + 1, f"fitting {n_free} parameters after {burn_in} burn-in samples")
+    w = np.asarray(output_scale, dtype=np.float64) if output_scale is not None else y[burn_in:].std(axis=0)
     if w.shape != (y.shape[1],) or not np.all(w > 0):
         raise DataError(f"output scale: expected {y.shape[1]} positive weights (a measured output may be "
                         f"constant), found {w}", hint="pass output_scale=[...] explicitly")
+    y = y[burn_in:]  # the fitted samples (y_model, residuals and n_samples refer to these)
 
     names = params.names
     idx = np.array([names.index(n) for n in free])
@@ -241,7 +252,7 @@ def fit(model, data: Trajectory, *, outputs: Sequence[str] | Mapping[str, str] |
         T[:, idx] = to_theta(z_rows)
         nfev[0] += T.shape[0]
         substeps[0] = max(substeps[0], model.substeps(dt, T))
-        return model.simulate_batch(T, u, dt, x0_arr, substeps=substeps[0])[:, :, out_idx]
+        return model.simulate_batch(T, u, dt, x0_arr, substeps=substeps[0])[:, burn_in:, out_idx]
 
     cache: dict = {}
 

@@ -1,0 +1,261 @@
+"""Executors: run many independent tasks in-process, in a local process pool, or on Dask.
+
+All three share one interface, :meth:`Executor.map_unordered`, which yields ``(key, ok, value)``
+as tasks finish (``value`` is the error text when ``ok`` is False). A task that raises is reported,
+never fatal. Tasks are whole chunks of jobs (≥ 0.1 s each, see :mod:`gripkit.batch.sweep`), so
+per-task overhead stays small.
+
+* :class:`InProcessExecutor` — runs tasks one after another in this process; a chunk function
+  that calls a numba ``prange`` kernel uses every core.
+* :class:`ProcessExecutor` (the default) — ``workers`` subprocesses started with
+  ``python -m gripkit.batch.worker`` and BLAS/OpenMP/numba threads pinned to one. Workers never fork
+  the caller and never re-import its script, so no ``if __name__ == "__main__"`` guard is needed.
+  A worker that dies (killed, out of memory) is replaced and its task is re-run; a task that kills
+  workers repeatedly is reported as failed.
+* :class:`DaskExecutor` — a ``dask.distributed`` cluster given its scheduler address, or a
+  ``LocalCluster`` started for the purpose (optional extra ``gripkit[dask]``).
+"""
+
+from __future__ import annotations
+
+import abc
+import collections
+import multiprocessing
+import os
+import pickle
+import selectors
+import subprocess
+import sys
+import tempfile
+from collections.abc import Callable, Iterable, Iterator, Sequence
+
+from ..errors import ConfigError
+from .worker import PIN_ENV, read_frame, write_frame
+
+__all__ = ["Executor", "InProcessExecutor", "ProcessExecutor", "DaskExecutor", "make_executor",
+           "check_not_bootstrapping"]
+
+Task = tuple[object, Callable, Sequence]
+
+
+def check_not_bootstrapping() -> None:
+    """Raise a clear error when a sweep is started while a spawned worker re-imports the user's
+    script (a script without a ``__main__`` guard, run with a backend that spawns processes)."""
+    if multiprocessing.current_process().name != "MainProcess" or \
+            getattr(sys.modules.get("__main__"), "__name__", "") == "__mp_main__":
+        raise ConfigError(
+            "a gripkit sweep was started while a worker process was importing your script",
+            hint="put the code that starts the sweep under `if __name__ == \"__main__\":`, or use the "
+                 "default process backend, which needs no guard")
+
+
+class Executor(abc.ABC):
+    """Runs tasks ``fn(*args)`` and yields ``(key, ok, value)`` as they finish."""
+
+    name = "executor"
+    workers = 1
+
+    @abc.abstractmethod
+    def map_unordered(self, tasks: Iterable[Task]) -> Iterator[tuple[object, bool, object]]:
+        ...
+
+    def close(self) -> None:
+        pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+
+class InProcessExecutor(Executor):
+    """Tasks one after another in this process."""
+
+    name = "in-process"
+
+    def map_unordered(self, tasks):
+        for key, fn, args in tasks:
+            try:
+                value = fn(*args)
+            except Exception as exc:
+                yield key, False, f"{type(exc).__name__}: {exc}"
+                continue
+            yield key, True, value
+
+
+class _Worker:
+    def __init__(self, log):
+        env = dict(os.environ)
+        env.update(PIN_ENV)
+        self.proc = subprocess.Popen([sys.executable, "-m", "gripkit.batch.worker"], stdin=subprocess.PIPE,
+                                     stdout=subprocess.PIPE, stderr=log, env=env)
+        self.task: Task | None = None
+
+    @property
+    def pid(self) -> int:
+        return self.proc.pid
+
+    def send(self, task: Task) -> None:
+        import cloudpickle
+
+        self.task = task
+        write_frame(self.proc.stdin, cloudpickle.dumps(task, protocol=pickle.HIGHEST_PROTOCOL))
+
+    def stop(self) -> None:
+        try:
+            self.proc.stdin.close()
+        except OSError:
+            pass
+        try:
+            self.proc.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            self.proc.kill()
+            self.proc.wait()
+
+
+class ProcessExecutor(Executor):
+    """A pool of ``workers`` subprocesses (default: the number of cores)."""
+
+    name = "process"
+
+    def __init__(self, workers: int | None = None, max_attempts: int = 3):
+        n = (os.cpu_count() or 1) if workers is None else int(workers)
+        if n < 1:
+            raise ConfigError(f"workers: expected a positive number, found {workers!r}")
+        self.workers = n
+        self.max_attempts = max_attempts
+        self._log = tempfile.TemporaryFile()
+        self._pool: list[_Worker] = []
+
+    @property
+    def pids(self) -> list[int]:
+        """Process ids of the live workers (tests kill one to check recovery)."""
+        return [w.pid for w in self._pool]
+
+    def _spawn(self) -> _Worker:
+        w = _Worker(self._log)
+        self._pool.append(w)
+        return w
+
+    def map_unordered(self, tasks):
+        pending = collections.deque(tasks)
+        attempts: dict = collections.defaultdict(int)
+        sel = selectors.DefaultSelector()
+        try:
+            while len(self._pool) < min(self.workers, max(len(pending), 1)):
+                self._spawn()
+            idle = list(self._pool)
+            busy = 0
+            while pending or busy:
+                while idle and pending:
+                    w = idle.pop()
+                    task = pending.popleft()
+                    try:
+                        w.send(task)
+                    except (BrokenPipeError, OSError):
+                        pending.appendleft(task)
+                        self._retire(w, sel)
+                        idle.append(self._spawn())
+                        continue
+                    sel.register(w.proc.stdout, selectors.EVENT_READ, w)
+                    busy += 1
+                for skey, _ in sel.select():
+                    w: _Worker = skey.data
+                    sel.unregister(w.proc.stdout)
+                    busy -= 1
+                    frame = read_frame(w.proc.stdout)
+                    task, w.task = w.task, None
+                    if frame is None:  # the worker died while running ``task``
+                        code = w.proc.wait()
+                        self._retire(w, sel)
+                        attempts[task[0]] += 1
+                        if attempts[task[0]] >= self.max_attempts:
+                            yield task[0], False, (f"WorkerDied: a worker exited with code {code} while "
+                                                   f"running this task ({attempts[task[0]]} attempts)")
+                        else:
+                            pending.appendleft(task)
+                        if pending:
+                            idle.append(self._spawn())
+                        continue
+                    key, ok, value = pickle.loads(frame)
+                    idle.append(w)
+                    yield key, ok, value
+        finally:
+            sel.close()
+
+    def _retire(self, w: _Worker, sel) -> None:
+        try:
+            sel.unregister(w.proc.stdout)
+        except (KeyError, ValueError):
+            pass
+        if w in self._pool:
+            self._pool.remove(w)
+        w.stop()
+
+    def close(self) -> None:
+        for w in list(self._pool):
+            w.stop()
+        self._pool.clear()
+        self._log.close()
+
+
+class DaskExecutor(Executor):
+    """Tasks on a ``dask.distributed`` cluster (``address``) or a new LocalCluster."""
+
+    name = "dask"
+
+    def __init__(self, address: str | None = None, workers: int | None = None):
+        check_not_bootstrapping()
+        try:
+            from distributed import Client, LocalCluster
+        except ImportError:
+            raise ConfigError("the Dask backend needs dask.distributed",
+                              hint="pip install 'gripkit[dask]'") from None
+        self._cluster = None
+        if address:
+            try:
+                self.client = Client(address, timeout=10)
+            except OSError as exc:
+                raise ConfigError(f"cannot reach the Dask scheduler at {address!r}: {exc}") from None
+        else:
+            n = workers or os.cpu_count() or 1
+            self._cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                                         dashboard_address=None, env=dict(PIN_ENV))
+            self.client = Client(self._cluster)
+        self.workers = len(self.client.scheduler_info().get("workers", {})) or (workers or 1)
+
+    def map_unordered(self, tasks):
+        from distributed import as_completed
+
+        futures = {}
+        for key, fn, args in tasks:
+            fut = self.client.submit(fn, *args, pure=False, retries=2)
+            futures[fut] = key
+        for fut in as_completed(list(futures)):
+            key = futures[fut]
+            try:
+                value = fut.result()
+            except Exception as exc:
+                yield key, False, f"{type(exc).__name__}: {exc}"
+                continue
+            yield key, True, value
+
+    def close(self) -> None:
+        self.client.close()
+        if self._cluster is not None:
+            self._cluster.close()
+
+
+def make_executor(backend: str = "process", workers: int | None = None,
+                  scheduler: str | None = None) -> Executor:
+    """``backend``: 'in-process', 'process' or 'dask' (a ``scheduler`` address implies 'dask')."""
+    if scheduler:
+        return DaskExecutor(scheduler, workers)
+    if backend == "in-process":
+        return InProcessExecutor()
+    if backend == "process":
+        return ProcessExecutor(workers)
+    if backend == "dask":
+        return DaskExecutor(None, workers)
+    raise ConfigError(f"backend: expected 'in-process', 'process' or 'dask', found {backend!r}")

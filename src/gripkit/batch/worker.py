@@ -1,0 +1,63 @@
+"""A gripkit batch worker: ``python -m gripkit.batch.worker``.
+
+Started by :class:`gripkit.batch.executors.ProcessExecutor` as a plain subprocess (never by
+forking, never by re-importing the user's script), with BLAS/OpenMP/numba threads pinned to one.
+It reads tasks from stdin and writes results to stdout, each a length-prefixed pickle frame:
+
+    task:   (key, fn, args)        fn and args serialised with cloudpickle
+    result: (key, ok, value)       value is the return value, or "Type: message" when fn raised
+"""
+
+from __future__ import annotations
+
+import os
+import struct
+import sys
+
+PIN_ENV = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
+           "NUMBA_NUM_THREADS": "1", "VECLIB_MAXIMUM_THREADS": "1", "NUMEXPR_NUM_THREADS": "1"}
+_HEADER = struct.Struct("<Q")
+
+
+def write_frame(stream, payload: bytes) -> None:
+    stream.write(_HEADER.pack(len(payload)))
+    stream.write(payload)
+    stream.flush()
+
+
+def read_frame(stream) -> bytes | None:
+    head = stream.read(_HEADER.size)
+    if len(head) < _HEADER.size:
+        return None
+    (n,) = _HEADER.unpack(head)
+    data = stream.read(n)
+    if len(data) < n:
+        return None
+    return data
+
+
+def main() -> int:
+    for k, v in PIN_ENV.items():
+        os.environ.setdefault(k, v)
+    import pickle
+
+    import cloudpickle
+
+    stdin, stdout = sys.stdin.buffer, sys.stdout.buffer
+    sys.stdout = sys.stderr  # stray prints from jobs must not corrupt the frame stream
+    while True:
+        frame = read_frame(stdin)
+        if frame is None:
+            return 0
+        key, fn, args = cloudpickle.loads(frame)
+        try:
+            out = (key, True, fn(*args))
+            payload = pickle.dumps(out, protocol=pickle.HIGHEST_PROTOCOL)
+        except Exception as exc:  # recorded by the coordinator, never fatal to the sweep
+            payload = pickle.dumps((key, False, f"{type(exc).__name__}: {exc}"),
+                                   protocol=pickle.HIGHEST_PROTOCOL)
+        write_frame(stdout, payload)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,211 @@
+"""``gripkit identify arx|armax|oe|rls|search``: linear identification from a data file.
+
+Every command reads DATA (CSV, Parquet or HDF5) with ``--input COL --output COL``, removes the
+operating point (``--detrend mean`` by default), and prints a summary table, or one JSON object
+(a list for ``search``) with ``--json``. Warnings (an unstable model in validation, a
+non-converged iteration) go to stderr as ``warning: ...`` lines and into the JSON ``warnings``.
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import typer
+
+from .app import identify_app
+from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data
+
+DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
+InputOpt = typer.Option(..., "--input", help="Input column (e.g. the valve current).")
+OutputOpt = typer.Option(..., "--output", help="Output column (e.g. the force).")
+DetrendOpt = typer.Option("mean", "--detrend",
+                          help="Operating-point removal before fitting: mean, linear or none.")
+ValidateOpt = typer.Option(None, "--validate", help="Second record for free-run validation (same columns).")
+NaOpt = typer.Option(..., "--na", help="Number of A coefficients (after the leading 1).")
+NbOpt = typer.Option(..., "--nb", help="Number of B coefficients.")
+NkOpt = typer.Option(..., "--nk", help="Input delay in samples (B's leading zeros).")
+
+
+def _warn_lines(caught) -> list[str]:
+    import sys
+
+    lines = []
+    for w in caught:
+        line = f"{w.category.__name__}: {w.message}"
+        lines.append(line)
+        print(f"warning: {line}", file=sys.stderr)
+    return lines
+
+
+def _io(path: Path, input: str, output: str, fs, time, fill, detrend: str, why: str):
+    from ..sysid import io_data
+
+    tr = load_data(path, [input, output], fs, time, fill)
+    return io_data(tr, input=input, output=output, detrend=detrend, why=why)
+
+
+def _fit_and_report(method: str, data: Path, input: str, output: str, fs, time, fill, detrend: str,
+                    validate: Path | None, json_out: bool, fit):
+    """Shared body of arx/armax/oe: load, fit (``fit(io) -> model``), validate, print."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        io = _io(data, input, output, fs, time, fill, detrend, f"{method.upper()} identification")
+        model = fit(io)
+        out = model.to_dict()
+        out.update(data=str(data), detrend=detrend)
+        val = None
+        if validate is not None:
+            vio = _io(validate, input, output, fs, time, fill, detrend, "validation")
+            if abs(vio.dt - io.dt) > 1e-9 * io.dt:
+                from ..errors import DataError
+
+                raise DataError(f"validation data {str(validate)!r} is sampled at {1 / vio.dt:g} Hz, the "
+                                f"estimation data at {1 / io.dt:g} Hz", hint="resample one of them")
+            val = model.validate(vio.u, vio.y)
+            out["validation_fit_percent"] = val.fit_percent
+            out["validation"] = val.to_dict()
+    out["warnings"] = _warn_lines(caught)
+    if json_out:
+        emit_json(out)
+    else:
+        _print_model(model, val)
+
+
+def _print_model(model, val) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    con = Console()
+    t = Table("parameter", "value", "σ", title=f"{model.label}  ({model.input_name} → {model.output_name}, "
+                                               f"fs = {model.fs:g} Hz, N = {model.n_samples})")
+    std = model.theta_std
+    for i, (n, v) in enumerate(zip(model.parameter_names, model.theta)):
+        t.add_row(n, f"{v:.6g}", "—" if std is None else f"{std[i]:.3g}")
+    con.print(t)
+    con.print(f"loss V_N (eq 29) = {model.loss:.6g}   fit (1-step) = {model.fit_percent:.2f} %   "
+              f"AIC = {model.aic:.6g}   FPE = {model.fpe:.6g}")
+    fmt = lambda z: ", ".join(f"{v.real:.4g}{v.imag:+.4g}j" for v in z) or "none"  # noqa: E731
+    con.print(f"poles: {fmt(model.poles())}   ({'stable' if model.stable else 'UNSTABLE'})")
+    con.print(f"zeros: {fmt(model.zeros())}   ({'minimum' if model.minimum_phase else 'NON-minimum'} phase)")
+    if val is not None:
+        fit = "— (unstable model)" if val.fit_percent is None else f"{val.fit_percent:.2f} %"
+        tt = val.tests
+        if tt is None:
+            con.print(f"validation: free-run fit {fit}; the one-step predictor diverges (unstable model)")
+            return
+        con.print(f"validation: free-run fit {fit}, 1-step fit {val.prediction_fit_percent:.2f} %, "
+                  f"residuals {'white' if tt.white else 'NOT white'} (p = {tt.whiteness_p:.3g}), "
+                  f"{'independent of' if tt.independent else 'CORRELATED with'} past input "
+                  f"(p = {tt.independence_p:.3g})")
+
+
+@identify_app.command("arx")
+def identify_arx(data: Path = DataArg, input: str = InputOpt, output: str = OutputOpt,
+                 na: int = NaOpt, nb: int = NbOpt, nk: int = NkOpt,
+                 fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
+                 validate: Path = ValidateOpt, json_out: bool = JsonOpt):
+    """ARX (orders na, nb, nk) by least squares (QR), with σ, loss (eq 29), fit, AIC, poles and zeros."""
+    from ..sysid import arx
+
+    _fit_and_report("arx", data, input, output, fs, time, fill, detrend, validate, json_out,
+                    lambda io: arx(io.u, io.y, na, nb, nk, dt=io.dt, **io.meta))
+
+
+@identify_app.command("armax")
+def identify_armax(data: Path = DataArg, input: str = InputOpt, output: str = OutputOpt,
+                   na: int = NaOpt,
+                   nb: int = NbOpt,
+                   nc: int = typer.Option(..., "--nc", help="Number of C coefficients."),
+                   nk: int = NkOpt,
+                   fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
+                   validate: Path = ValidateOpt, json_out: bool = JsonOpt):
+    """ARMAX (orders na, nb, nc, nk) by prediction-error minimisation."""
+    from ..sysid import armax
+
+    _fit_and_report("armax", data, input, output, fs, time, fill, detrend, validate, json_out,
+                    lambda io: armax(io.u, io.y, na, nb, nc, nk, dt=io.dt, **io.meta))
+
+
+@identify_app.command("oe")
+def identify_oe(data: Path = DataArg, input: str = InputOpt, output: str = OutputOpt,
+                nb: int = NbOpt,
+                nf: int = typer.Option(..., "--nf", "--na", help="Number of F (denominator) coefficients."),
+                nk: int = NkOpt,
+                fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
+                validate: Path = ValidateOpt, json_out: bool = JsonOpt):
+    """Output-error (orders nb, nf, nk) by prediction-error minimisation."""
+    from ..sysid import oe
+
+    _fit_and_report("oe", data, input, output, fs, time, fill, detrend, validate, json_out,
+                    lambda io: oe(io.u, io.y, nb, nf, nk, dt=io.dt, **io.meta))
+
+
+@identify_app.command("rls")
+def identify_rls(data: Path = DataArg, input: str = InputOpt, output: str = OutputOpt,
+                 na: int = NaOpt, nb: int = NbOpt, nk: int = NkOpt,
+                 forgetting: float = typer.Option(1.0, "--forgetting", help="Forgetting factor λ in (0, 1]."),
+                 p0: float = typer.Option(1e4, "--p0", help="Initial covariance P0 = p0·I."),
+                 windup: str = typer.Option("trace", "--windup", help="Anti-windup: trace, directional or none."),
+                 trajectory: Path = typer.Option(None, "--trajectory",
+                                                 help="Write θ(t), σ(t), prediction and error to this file."),
+                 fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
+                 json_out: bool = JsonOpt):
+    """Recursive least squares ARX (orders na, nb, nk) with forgetting; θ and σ at every sample."""
+    from ..sysid import rls
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        io = _io(data, input, output, fs, time, fill, detrend, "RLS identification")
+        res = rls(io.u, io.y, na, nb, nk, forgetting=forgetting, p0=p0, windup=windup, dt=io.dt)
+        if trajectory is not None:
+            res.to_trajectory().save(trajectory)
+    out = res.to_dict()
+    out.update(data=str(data), detrend=detrend, input=input, output=output,
+               trajectory=None if trajectory is None else str(trajectory), warnings=_warn_lines(caught))
+    if json_out:
+        emit_json(out)
+        return
+    from rich.console import Console
+    from rich.table import Table
+
+    t = Table("parameter", "final value", "σ", title=f"RLS ARX [{na} {nb} {nk}], λ = {forgetting:g}, "
+                                                      f"N = {res.n_samples}")
+    std = res.theta_std_final
+    for i, n in enumerate(res.names):
+        t.add_row(n, f"{res.theta_final[i]:.6g}", "—" if std is None else f"{std[i]:.3g}")
+    con = Console()
+    con.print(t)
+    con.print(f"loss V_N of the a-priori errors (eq 29) = {res.loss:.6g}")
+    if trajectory is not None:
+        con.print(f"parameter trajectory written to {trajectory}")
+
+
+@identify_app.command("search")
+def identify_search(data: Path = DataArg, input: str = InputOpt, output: str = OutputOpt,
+                    na: str = typer.Option("1:4", "--na", help="Range of na, e.g. 1:4."),
+                    nb: str = typer.Option("1:4", "--nb", help="Range of nb, e.g. 1:4."),
+                    nk: str = typer.Option("1:10", "--nk", help="Range of nk, e.g. 1:10."),
+                    criterion: str = typer.Option("aic", "--criterion", help="Ranking: aic, fpe or loss."),
+                    top: int = typer.Option(10, "--top", help="Rows shown in the table (JSON lists all)."),
+                    fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
+                    json_out: bool = JsonOpt):
+    """Fit every ARX structure of the ranges and rank them (best first)."""
+    from ..sysid import structure_search
+
+    io = _io(data, input, output, fs, time, fill, detrend, "ARX structure search")
+    res = structure_search(io.u, io.y, na, nb, nk, criterion=criterion, dt=io.dt)
+    if json_out:
+        emit_json(res.to_list())
+        return
+    from rich.console import Console
+    from rich.table import Table
+
+    t = Table("rank", "na", "nb", "nk", "loss V_N", "AIC", "FPE", "fit %",
+              title=f"ARX structures ranked by {criterion.upper()} ({res.n_used} common samples)")
+    for i, c in enumerate(res.candidates[:top], 1):
+        t.add_row(str(i), str(c.na), str(c.nb), str(c.nk), f"{c.loss:.5g}", f"{c.aic:.6g}", f"{c.fpe:.5g}",
+                  f"{c.fit_percent:.2f}")
+    Console().print(t)
+    if res.skipped:
+        typer.echo(f"{len(res.skipped)} structure(s) skipped (not identifiable from these data)", err=True)

@@ -1,0 +1,27 @@
+"""``gripkit identify step DATA --input COL --output COL [--fs HZ] [--json]``: second-order
+step-response identification (gain, natural frequency, damping ratio, each with its σ)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from .app import identify_app
+from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data
+
+
+@identify_app.command("step")
+def identify_step(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 file with the step record."),
+                  input_col: str = typer.Option(..., "--input", help="Input column (the commanded step)."),
+                  output_col: str = typer.Option(..., "--output", help="Output column (the response)."),
+                  fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, json_out: bool = JsonOpt):
+    """Fit K ω_n²/(s² + 2ζω_n s + ω_n²) to a step response (gain, natural frequency, damping, σ)."""
+    from ..sysid.step_response import identify_step as _identify
+
+    tr = load_data(data, [input_col, output_col], fs, time, fill)
+    res = _identify(tr, input=input_col, output=output_col)
+    if json_out:
+        emit_json({"data": str(data), "input": input_col, "output": output_col, **res.to_dict()})
+    else:
+        typer.echo(res.summary())

@@ -1,0 +1,107 @@
+"""ROS 2 logs in MCAP files (optional extra ``gripkit[mcap]``).
+
+Columns are named ``[alias=]TOPIC:FIELD``, where FIELD is a dotted path into the message with
+optional indices, e.g. ``force=/fingertip/wrench:wrench.force.z`` or ``q3=/joint_states:position[2]``.
+Each topic has its own time stamps (the log time, or ``header.stamp`` with ``stamp='header'``);
+the first column's topic sets the time base and the other columns are interpolated linearly onto
+it, over the interval where every topic has data.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import DataError
+
+__all__ = ["read_mcap", "parse_column"]
+
+_COL = re.compile(r"^(?:(?P<alias>[A-Za-z_][\w]*)=)?(?P<topic>/[^:]*):(?P<field>[A-Za-z_][\w.\[\]]*)$")
+_PART = re.compile(r"^([A-Za-z_]\w*)((?:\[\d+\])*)$")
+
+
+def parse_column(spec: str) -> tuple[str, str, list]:
+    """``'force=/ft:wrench.force.z'`` → ``('force', '/ft', ['wrench', 'force', 'z'])``."""
+    m = _COL.match(spec)
+    if not m:
+        raise DataError(f"MCAP column {spec!r}: expected [alias=]/topic:field.path[index]",
+                        hint="for example force=/fingertip/wrench:wrench.force.z or /joint_states:position[2]")
+    path: list = []
+    for part in m.group("field").split("."):
+        pm = _PART.match(part)
+        if not pm:
+            raise DataError(f"MCAP column {spec!r}: cannot read field part {part!r}")
+        path.append(pm.group(1))
+        path += [int(i) for i in re.findall(r"\[(\d+)\]", pm.group(2))]
+    alias = m.group("alias") or re.sub(r"\W+", "_", f"{m.group('topic')}_{m.group('field')}").strip("_")
+    return alias, m.group("topic"), path
+
+
+def _get(msg, path: list, spec: str) -> float:
+    v = msg
+    for p in path:
+        try:
+            v = v[p] if isinstance(p, int) else getattr(v, p)
+        except (AttributeError, IndexError, TypeError):
+            raise DataError(f"MCAP column {spec!r}: the message has no field {p!r} "
+                            f"(fields: {', '.join(getattr(v, '__slots__', []) or dir(v)[:10])})") from None
+    try:
+        return float(v)
+    except (TypeError, ValueError):
+        raise DataError(f"MCAP column {spec!r}: field is not a number ({type(v).__name__})",
+                        hint="index into arrays (position[2]) or descend into messages (wrench.force.z)") from None
+
+
+def read_mcap(path: Path, columns, stamp: str = "log") -> tuple[dict, dict]:
+    try:
+        from mcap.reader import make_reader
+        from mcap_ros2.decoder import DecoderFactory
+    except ImportError:
+        raise DataError("reading MCAP files needs the optional extra", hint="pip install 'gripkit[mcap]'") from None
+    if not columns:
+        raise DataError(f"{path.name}: name the MCAP columns to read (columns=[...], CLI: repeat --column)",
+                        hint="columns look like force=/fingertip/wrench:wrench.force.z")
+    specs = [parse_column(c) for c in columns]
+    topics = {t for _, t, _ in specs}
+    series: dict[str, tuple[list, list]] = {alias: ([], []) for alias, _, _ in specs}
+    seen: set[str] = set()
+    try:
+        with open(path, "rb") as fh:
+            reader = make_reader(fh, decoder_factories=[DecoderFactory()])
+            for _schema, channel, message, msg in reader.iter_decoded_messages(topics=list(topics)):
+                topic = channel.topic
+                seen.add(topic)
+                if stamp == "header":
+                    st = msg.header.stamp
+                    t = st.sec + 1e-9 * st.nanosec
+                else:
+                    t = 1e-9 * message.log_time
+                for (alias, top, fpath), spec in zip(specs, columns):
+                    if top == topic:
+                        series[alias][0].append(t)
+                        series[alias][1].append(_get(msg, fpath, spec))
+    except DataError:
+        raise
+    except Exception as exc:
+        raise DataError(f"{path.name}: not a readable MCAP file (truncated or corrupt?): {exc}") from None
+    missing = sorted(topics - seen)
+    if missing:
+        raise DataError(f"{path.name}: no messages on topics {missing}")
+    base_alias = specs[0][0]
+    tb = np.asarray(series[base_alias][0])
+    ob = np.argsort(tb, kind="stable")
+    tb = tb[ob]
+    lo = max(np.min(series[a][0]) for a in series)
+    hi = min(np.max(series[a][0]) for a in series)
+    keep = (tb >= lo) & (tb <= hi)
+    if keep.sum() < 2:
+        raise DataError(f"{path.name}: the topics' time spans do not overlap")
+    t = tb[keep]
+    raw = {"t": t - t[0]}
+    for alias, _, _ in specs:
+        ts, vs = np.asarray(series[alias][0]), np.asarray(series[alias][1])
+        order = np.argsort(ts, kind="stable")
+        raw[alias] = vs[ob][keep] if alias == base_alias else np.interp(t, ts[order], vs[order])
+    return raw, {"t": "s"}

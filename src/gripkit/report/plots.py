@@ -1,0 +1,162 @@
+"""Reusable matplotlib figures for reports (Agg backend; add them with ``section.figure(fig, ...)``).
+
+* :func:`measured_vs_model` — measured output against model outputs (seed Figs. 19–22 style);
+* :func:`residual_correlation` — residual autocorrelation and input–residual cross-correlation with
+  their confidence bands (:class:`gripkit.sysid.ResidualTests`);
+* :func:`pole_zero_map` — z-plane poles (×) and zeros (○) with the unit circle (Figs. 20b, 21b);
+* :func:`bode` — magnitude and phase of discrete-time models against frequency in Hz;
+* :func:`parameter_convergence` — recursive estimates with ±2σ bands and optional true values.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+__all__ = ["measured_vs_model", "residual_correlation", "pole_zero_map", "bode", "parameter_convergence"]
+
+
+def _plt():
+    import matplotlib
+
+    matplotlib.use("Agg", force=False)
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def measured_vs_model(t: np.ndarray, measured: np.ndarray, models: Mapping[str, np.ndarray], *,
+                      ylabel: str = "output", title: str = "", measured_label: str = "measured",
+                      extra: Mapping[str, np.ndarray] | None = None):
+    """Measured output (solid) and model outputs (dashed) against time ``t`` (s)."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(10, 3.6))
+    ax.plot(t, measured, color="0.55", lw=0.9, label=measured_label)
+    for label, v in (extra or {}).items():
+        ax.plot(t, v, lw=1.2, label=label)
+    for label, v in models.items():
+        ax.plot(t, v, "--", lw=1.4, label=label)
+    ax.set_xlabel("time [s]")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    fig.tight_layout()
+    return fig
+
+
+def residual_correlation(tests: Mapping[str, object], *, title: str = ""):
+    """Autocorrelation r_e(τ), τ ≥ 1, and cross-correlation r_eu(τ), τ ≥ 0, with ±bound bands.
+
+    ``tests`` maps a label to a :class:`gripkit.sysid.ResidualTests`.
+    """
+    plt = _plt()
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 3.4))
+    width = 0.8 / max(len(tests), 1)
+    for k, (label, rt) in enumerate(tests.items()):
+        off = (k - (len(tests) - 1) / 2) * width
+        a1.bar(rt.lags[1:] + off, rt.autocorr[1:], width=width,
+               label=f"{label} (whiteness p = {rt.whiteness_p:.2g})")
+        a2.bar(rt.lags + off, rt.crosscorr, width=width,
+               label=f"{label} (independence p = {rt.independence_p:.2g})")
+        for ax in (a1, a2):
+            ax.axhline(rt.bound, color=f"C{k}", ls=":", lw=1)
+            ax.axhline(-rt.bound, color=f"C{k}", ls=":", lw=1)
+    a1.set_title("residual autocorrelation")
+    a2.set_title("cross-correlation residual / past input")
+    a1.set_xlabel("lag τ [samples]")
+    a2.set_xlabel("lag τ [samples]")
+    for ax in (a1, a2):
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def pole_zero_map(models: Mapping[str, tuple[Sequence[complex], Sequence[complex]]], *, title: str = ""):
+    """z-plane map: ``models`` maps a label to ``(poles, zeros)``."""
+    plt = _plt()
+    fig, ax = plt.subplots(figsize=(5.6, 5.2))
+    th = np.linspace(0, 2 * np.pi, 400)
+    ax.plot(np.cos(th), np.sin(th), color="0.4", lw=0.8)
+    ax.axhline(0, color="0.8", lw=0.6)
+    ax.axvline(0, color="0.8", lw=0.6)
+    allz = [1.0]
+    for k, (label, (p, z)) in enumerate(models.items()):
+        p = np.atleast_1d(np.asarray(p, dtype=complex))
+        z = np.atleast_1d(np.asarray(z, dtype=complex))
+        c = f"C{k}"
+        ax.plot(p.real, p.imag, "x", color=c, ms=9, mew=2, label=f"{label} poles")
+        ax.plot(z.real, z.imag, "o", color=c, ms=9, mfc="none", mew=1.6, label=f"{label} zeros")
+        allz += list(np.abs(p)) + list(np.abs(z))
+    lim = 1.1 * max(allz)
+    ax.set_xlim(-lim, lim)
+    ax.set_ylim(-lim, lim)
+    ax.set_aspect("equal")
+    ax.set_xlabel("Re z")
+    ax.set_ylabel("Im z")
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, loc="lower left")
+    fig.tight_layout()
+    return fig
+
+
+def bode(models: Mapping[str, object], *, n: int = 512, title: str = "", magnitude_unit: str = ""):
+    """Magnitude (dB) and phase (deg) of models with ``frequency_response(n=...)`` (e.g.
+    :class:`gripkit.sysid.PolynomialModel`), or of ``(f_Hz, H)`` pairs, up to Nyquist."""
+    plt = _plt()
+    fig, (am, ap) = plt.subplots(2, 1, figsize=(8, 5.6), sharex=True)
+    for label, m in models.items():
+        f, h = m if isinstance(m, tuple) else m.frequency_response(n=n)
+        sel = f > 0
+        am.semilogx(f[sel], 20 * np.log10(np.maximum(np.abs(h[sel]), 1e-300)), label=label)
+        ap.semilogx(f[sel], np.degrees(np.unwrap(np.angle(h[sel]))), label=label)
+    am.set_ylabel(f"magnitude [dB{' ' + magnitude_unit if magnitude_unit else ''}]")
+    ap.set_ylabel("phase [deg]")
+    ap.set_xlabel("frequency [Hz]")
+    for ax in (am, ap):
+        ax.grid(alpha=0.3, which="both")
+    am.legend(fontsize=8)
+    am.set_title(title)
+    fig.tight_layout()
+    return fig
+
+
+def parameter_convergence(t: np.ndarray, theta: np.ndarray, std: np.ndarray, names: Sequence[str], *,
+                          truth: Sequence[float] | None = None, title: str = ""):
+    """One panel per parameter: estimate θ_i(t) with a ±2σ band and the true value (dashed)."""
+    plt = _plt()
+    p = len(names)
+    ncol = 2 if p > 1 else 1
+    nrow = (p + ncol - 1) // ncol
+    fig, axes = plt.subplots(nrow, ncol, figsize=(9, 2.3 * nrow), sharex=True, squeeze=False)
+    for i, name in enumerate(names):
+        ax = axes[i // ncol][i % ncol]
+        ax.plot(t, theta[:, i], color="C0", lw=1.2, label="estimate")
+        ok = np.isfinite(std[:, i])
+        ax.fill_between(t[ok], theta[ok, i] - 2 * std[ok, i], theta[ok, i] + 2 * std[ok, i], color="C0",
+                        alpha=0.25, label="±2σ")
+        if truth is not None:
+            ax.axhline(truth[i], color="C3", ls="--", lw=1, label="true")
+        fin = theta[ok, i]
+        if fin.size:
+            lo, hi = np.percentile(fin, [2, 100])
+            if truth is not None:
+                lo, hi = min(lo, truth[i]), max(hi, truth[i])
+            pad = 0.3 * (hi - lo) + 1e-12
+            ax.set_ylim(lo - pad, hi + pad)
+        ax.set_ylabel(name)
+        ax.grid(alpha=0.3)
+    for j in range(p, nrow * ncol):
+        axes[j // ncol][j % ncol].set_visible(False)
+    axes[0][0].legend(fontsize=7)
+    for ax in axes[-1]:
+        ax.set_xlabel("time [s]")
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return fig

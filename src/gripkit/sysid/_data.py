@@ -1,0 +1,115 @@
+"""Checks shared by every linear identification: signals, orders, sample counts, excitation.
+
+Each check raises a :class:`~gripkit.errors.GripkitError` whose message names the argument, what
+was expected and what was found (DEVELOPING.md, "Errors").
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import DataError, UnidentifiableError
+
+__all__ = ["as_signal", "check_io", "check_order", "check_dt", "require_samples", "check_excitation",
+           "check_output_varies", "checked_problem", "check_identifiable"]
+
+
+def as_signal(x, name: str) -> np.ndarray:
+    """``x`` as a finite 1-D float64 array, or a :class:`DataError` naming ``name``."""
+    try:
+        a = np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise DataError(f"{name}: expected a 1-D array of numbers, found {type(x).__name__}") from None
+    if a.ndim != 1:
+        raise DataError(f"{name}: expected a 1-D array of samples, found shape {a.shape}",
+                        hint="pass one channel at a time (single-input single-output models)")
+    if a.size == 0:
+        raise DataError(f"{name}: the signal holds no samples")
+    if not np.isfinite(a).all():
+        for label, mask in (("NaN", np.isnan(a)), ("infinite", np.isinf(a))):
+            if mask.any():
+                raise DataError(
+                    f"{name} has {int(mask.sum())} {label} values (first at sample {int(np.argmax(mask))})",
+                    hint="drop or interpolate them before identification (CLI: --fill)")
+    return a
+
+
+def check_io(u, y) -> tuple[np.ndarray, np.ndarray]:
+    """Input and output as finite 1-D float64 arrays of equal length."""
+    u = as_signal(u, "input u")
+    y = as_signal(y, "output y")
+    if u.shape != y.shape:
+        raise DataError(f"input u and output y must have the same length, found {u.size} and {y.size}")
+    return u, y
+
+
+def check_order(value, name: str, minimum: int = 0) -> int:
+    """A model order or delay: an integer >= ``minimum``."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        if isinstance(value, (float, np.floating)) and float(value).is_integer():
+            value = int(value)
+        else:
+            raise DataError(f"{name}: expected an integer >= {minimum}, found {value!r}")
+    if value < minimum:
+        raise DataError(f"{name}: expected an integer >= {minimum}, found {value}")
+    return int(value)
+
+
+def check_dt(dt: float | None, fs: float | None) -> float:
+    """Sample interval in seconds from ``dt`` or ``fs`` (1.0 — 'one sample' — when neither)."""
+    if dt is not None and fs is not None:
+        if not math.isclose(float(dt) * float(fs), 1.0, rel_tol=1e-9):
+            raise DataError(f"dt={dt} s and fs={fs} Hz disagree; give one of them")
+    if fs is not None:
+        if not (math.isfinite(fs) and fs > 0):
+            raise DataError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
+        return 1.0 / float(fs)
+    if dt is None:
+        return 1.0
+    if not (math.isfinite(dt) and dt > 0):
+        raise DataError(f"dt: expected a positive sample interval in s, found {dt!r}")
+    return float(dt)
+
+
+def require_samples(n: int, n_min: int, what: str) -> None:
+    """``n`` samples must be at least ``n_min`` for ``what`` (e.g. "ARX [2 2 2] (4 parameters)")."""
+    if n < n_min:
+        raise DataError(f"{what} needs at least {n_min} samples, found {n}",
+                        hint="use a longer record or a smaller model")
+
+
+def check_excitation(u: np.ndarray, name: str = "input u") -> None:
+    """Refuse a constant input: it cannot identify the numerator B (the input-output dynamics)."""
+    span = float(np.max(u) - np.min(u))
+    scale = max(float(np.max(np.abs(u))), 1e-300)
+    if span <= 1e-12 * scale or span == 0.0:
+        raise UnidentifiableError(
+            f"{name} is constant ({u[0]:.6g} for all {u.size} samples): a constant input cannot "
+            f"identify B, the input-output dynamics; no estimate returned",
+            hint="record data with a varying input (multisine, PRBS, noise: gripkit.excitation)")
+
+
+def check_output_varies(y: np.ndarray, name: str = "output y") -> None:
+    """Refuse a constant output: there is nothing to fit (and the fit % is undefined)."""
+    if float(np.max(y) - np.min(y)) <= 1e-12 * max(float(np.max(np.abs(y))), 1e-300):
+        raise UnidentifiableError(f"{name} is constant ({y[0]:.6g} for all {y.size} samples): "
+                                  f"there are no dynamics to identify; no estimate returned",
+                                  hint="check that the output column is the measured response")
+
+
+def checked_problem(u, y, dt: float | None, fs: float | None, **orders):
+    """The common start of every estimator: signals checked (:func:`check_io`), orders checked
+    (``nb`` >= 1, the others >= 0), sample interval resolved. Returns ``(u, y, dt, *orders)`` with
+    the orders as ints in the order given."""
+    u, y = check_io(u, y)
+    ints = [check_order(v, name, 1 if name == "nb" else 0) for name, v in orders.items()]
+    return (u, y, check_dt(dt, fs), *ints)
+
+
+def check_identifiable(u: np.ndarray, y: np.ndarray, n_min: int, what: str) -> None:
+    """Enough samples, a varying input and a varying output, or a clear error."""
+    require_samples(y.size, n_min, what)
+    check_excitation(u)
+    check_output_varies(y)

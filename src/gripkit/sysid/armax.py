@@ -1,0 +1,102 @@
+"""ARMAX identification by prediction-error minimisation, eqs (24)–(27) of ``000_8f66dcc7ab06470c.txt``.
+
+Model: ``A(q) y(t) = B(q) u(t) + C(q) e(t)``; θ = [a_1..a_na, b_nk..b_{nk+nb-1}, c_1..c_nc] (eq 27).
+Predictor: ``C(q) e(t) = A(q) y(t) − B(q) u(t)``, so ``ŷ(t|t−1) = y(t) − e(t)``, with e(t) = 0
+before the first predicted sample. Gradients (Ljung, §10.2)::
+
+    ∂e/∂a_i = y(t−i)/C(q),   ∂e/∂b_j = −u(t−j)/C(q),   ∂e/∂c_k = −e(t−k)/C(q)
+
+Initialisation (Hannan–Rissanen): a high-order ARX model gives estimates ê(t) of the innovations;
+the linear regression of y(t) on −y(t−i), u(t−j), ê(t−k) gives A, B, C (C reflected into the
+unit circle if needed). Then Levenberg–Marquardt (:mod:`gripkit.sysid._pem`) minimises eq (29).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import signal as _sig
+
+from ._data import check_identifiable, checked_problem
+from ._pem import covariance, is_stable_poly, levenberg_marquardt, stabilize
+from .arx import arx
+from .polynomial import PolynomialModel
+from .regression import qr_solve
+from .validation import fit_percent, loss_vn
+
+__all__ = ["armax"]
+
+
+def _hannan_rissanen(u, y, na, nb, nc, nk) -> np.ndarray:
+    n = y.size
+    nh = int(min(max(3 * (na + nb + nc), 10), max((n - nk) // 10, nc + 1)))
+    ehat = np.zeros(n)
+    ehat[max(nh, nk + nh - 1):] = arx(u, y, nh, nh, nk).residuals
+    t0 = max(na, nk + nb - 1, nc) + max(nh, nk + nh - 1)
+    m = n - t0
+    p = na + nb + nc
+    X = np.empty((m, p + 1), order="F")
+    for i in range(na):
+        X[:, i] = -y[t0 - 1 - i:n - 1 - i]
+    for j in range(nb):
+        X[:, na + j] = u[t0 - nk - j:n - nk - j]
+    for k in range(nc):
+        X[:, na + nb + k] = ehat[t0 - 1 - k:n - 1 - k]
+    X[:, p] = y[t0:]
+    names = tuple(f"p{i}" for i in range(p))
+    return qr_solve(X, names, overwrite=True).theta
+
+
+def armax(u, y, na: int, nb: int, nc: int, nk: int = 1, *, dt: float | None = None,
+          fs: float | None = None, maxiter: int = 100, tol: float = 1e-10, **meta) -> PolynomialModel:
+    """ARMAX model ``A y = B u + C e`` by prediction-error minimisation (MATLAB ``armax``
+    orders ``[na nb nc nk]``).
+
+    Parameters as :func:`gripkit.sysid.arx`, plus ``nc`` (number of C coefficients after the
+    leading 1), ``maxiter`` and ``tol`` of the Levenberg–Marquardt iteration. Returns a
+    :class:`PolynomialModel` with ``structure='armax'``, ``C`` and ``C_std``. Warns
+    :class:`~gripkit.errors.AccuracyWarning` if the iteration does not converge.
+    """
+    u, y, step, na, nb, nc, nk = checked_problem(u, y, dt, fs, na=na, nb=nb, nc=nc, nk=nk)
+    if nc == 0:
+        m = arx(u, y, na, nb, nk, dt=step, **meta)
+        return m
+    p = na + nb + nc
+    t0 = max(na, nk + nb - 1)
+    label = f"ARMAX [{na} {nb} {nc} {nk}]"
+    check_identifiable(u, y, t0 + 10 * p, f"{label} ({p} parameters)")
+    theta0 = _hannan_rissanen(u, y, na, nb, nc, nk)
+    theta0[na + nb:] = stabilize(np.concatenate([[1.0], theta0[na + nb:]]))[1:]
+
+    ya = np.column_stack([y[t0 - i:y.size - i] for i in range(1, na + 1)]) if na else np.zeros((y.size - t0, 0))
+    ub = np.column_stack([u[t0 - nk - j:u.size - nk - j] for j in range(nb)])
+    yt = y[t0:]
+
+    def fun(theta):
+        a, b, c = theta[:na], theta[na:na + nb], theta[na + nb:]
+        C = np.concatenate([[1.0], c])
+        v = yt + ya @ a - ub @ b
+        e = _sig.lfilter([1.0], C, v)
+        es = np.zeros((e.size, nc))
+        for k in range(1, nc + 1):
+            es[k:, k - 1] = e[:-k]
+        J = _sig.lfilter([1.0], C, np.hstack([ya, -ub, -es]), axis=0)
+        return e, J
+
+    def admissible(theta):
+        return is_stable_poly(np.concatenate([[1.0], theta[na + nb:]]))
+
+    res = levenberg_marquardt(fun, theta0, admissible, maxiter=maxiter, tol=tol, label=label)
+    names = tuple(f"a{i}" for i in range(1, na + 1)) + tuple(f"b{nk + j}" for j in range(nb)) + \
+        tuple(f"c{k}" for k in range(1, nc + 1))
+    cov, sigma2, cond = covariance(res, names)
+    th = res.theta
+    A = np.concatenate([[1.0], th[:na]])
+    B = np.concatenate([np.zeros(nk), th[na:na + nb]])
+    C = np.concatenate([[1.0], th[na + nb:]])
+    e = res.e
+    return PolynomialModel(A, B, nk, C=C, dt=step, structure="armax", covariance=cov, noise_variance=sigma2,
+                           loss=loss_vn(e), fit_percent=fit_percent(yt, yt - e), n_samples=int(y.size),
+                           n_used=int(e.size), residuals=e,
+                           info={"method": "prediction-error minimisation (Levenberg-Marquardt), "
+                                           "Hannan-Rissanen start", "iterations": res.iterations,
+                                 "converged": res.converged, "cond": cond}, **meta)

@@ -1,0 +1,136 @@
+"""One entry point for identifying a linear model from a :class:`~gripkit.signals.Trajectory`.
+
+>>> import numpy as np
+>>> from gripkit import Trajectory
+>>> from gripkit.sysid import identify
+>>> rng = np.random.default_rng(1)
+>>> u = 0.85 + 0.1 * rng.standard_normal(2000)          # valve current around 850 mA (A)
+>>> y = np.zeros(2000)
+>>> for t in range(3, 2000):
+...     y[t] = 1.8732*y[t-1] - 0.8996*y[t-2] + 195.0*(u[t-2]-0.85) - 227.6*(u[t-3]-0.85)
+>>> tr = Trajectory.uniform(200.0, current=u, force=y, units={"current": "A", "force": "N"})
+>>> m = identify(tr, "arx", input="current", output="force", na=2, nb=2, nk=2)
+>>> m.label, round(m.fs), m.parameters["b2"].unit
+('ARX [2 2 2]', 200, 'N/A')
+
+The array functions (:func:`~gripkit.sysid.arx`, :func:`~gripkit.sysid.armax`,
+:func:`~gripkit.sysid.oe`, :func:`~gripkit.sysid.rls`, :func:`~gripkit.sysid.structure_search`)
+take the signals as they are; :func:`identify` adds what a data file needs: column selection,
+the uniform-sampling check, the sampling rate, units, and removal of the operating point
+(``detrend='mean'`` by default: an ARX model has no constant term, so an input centred on 850 mA
+would otherwise bias every coefficient).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import DataError
+from ..signals.trajectory import Trajectory
+
+__all__ = ["IOData", "io_data", "identify", "METHODS"]
+
+METHODS = ("arx", "armax", "oe", "rls", "search")
+
+
+@dataclass(frozen=True)
+class IOData:
+    """Input/output arrays taken from a trajectory, ready for identification."""
+
+    u: np.ndarray
+    y: np.ndarray
+    dt: float
+    input: str
+    output: str
+    input_unit: str
+    output_unit: str
+    u_offset: float
+    y_offset: float
+
+    @property
+    def meta(self) -> dict:
+        """Model metadata keywords for the identification functions."""
+        return dict(input_name=self.input, output_name=self.output, input_unit=self.input_unit,
+                    output_unit=self.output_unit, u_offset=self.u_offset, y_offset=self.y_offset)
+
+
+def io_data(data: Trajectory, *, input: str, output: str, detrend: str = "mean",
+            why: str = "discrete-time identification") -> IOData:
+    """Select the input and output channels of a uniformly sampled trajectory.
+
+    ``detrend``: ``'mean'`` removes each channel's mean (recorded as ``u_offset``/``y_offset``),
+    ``'linear'`` a least-squares line, ``'none'`` keeps the data as they are.
+    """
+    if not isinstance(data, Trajectory):
+        raise DataError(f"data: expected a gripkit Trajectory, found {type(data).__name__}",
+                        hint="use gripkit.io.load(path) or Trajectory.uniform(fs, u=..., y=...)")
+    if input == output:
+        raise DataError(f"input and output must be different columns, both are {input!r}")
+    u = np.array(data[input], dtype=np.float64)
+    y = np.array(data[output], dtype=np.float64)
+    fs = float(f"{data.require_uniform(why=why):.9g}")  # time stamps in files carry rounding noise
+    if detrend not in ("mean", "linear", "none"):
+        raise DataError(f"detrend: expected 'mean', 'linear' or 'none', found {detrend!r}")
+    u0 = y0 = 0.0
+    if detrend == "mean":
+        u0, y0 = float(u.mean()), float(y.mean())
+        u -= u0
+        y -= y0
+    elif detrend == "linear":
+        from ..signals.processing import detrend as _detrend
+
+        d = _detrend(data.select(input, output), kind="linear")
+        u0, y0 = float(u.mean()), float(y.mean())
+        u, y = np.array(d[input]), np.array(d[output])
+    return IOData(u, y, 1.0 / fs, input, output, data.unit(input), data.unit(output), u0, y0)
+
+
+def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, na: int = 2, nb: int = 2,
+             nk: int = 1, nc: int = 1, nf: int | None = None, detrend: str = "mean", **options):
+    """Identify a linear model of ``output`` driven by ``input`` from a trajectory.
+
+    Parameters
+    ----------
+    data
+        A uniformly sampled :class:`~gripkit.signals.Trajectory` (e.g. from
+        :func:`gripkit.io.load`).
+    method
+        ``'arx'`` (least squares), ``'armax'`` (orders na, nb, nc, nk), ``'oe'`` (orders nb, nf,
+        nk; ``nf`` defaults to ``na``), ``'rls'`` (recursive least squares; options
+        ``forgetting``, ``p0``, ``windup``), or ``'search'`` (``na``, ``nb``, ``nk`` may be ranges
+        such as ``'1:4'``; option ``criterion``).
+    input, output
+        Column names.
+    detrend
+        ``'mean'`` (default), ``'linear'`` or ``'none'``; see :func:`io_data`.
+    **options
+        Passed to the method's function.
+
+    Returns
+    -------
+    PolynomialModel, RLSResult or SearchResult
+    """
+    if method not in METHODS:
+        raise DataError(f"method: expected one of {', '.join(METHODS)}, found {method!r}")
+    io = io_data(data, input=input, output=output, detrend=detrend, why=f"{method.upper()} identification")
+    if method == "arx":
+        from .arx import arx
+
+        return arx(io.u, io.y, na, nb, nk, dt=io.dt, **io.meta, **options)
+    if method == "armax":
+        from .armax import armax
+
+        return armax(io.u, io.y, na, nb, nc, nk, dt=io.dt, **io.meta, **options)
+    if method == "oe":
+        from .oe import oe
+
+        return oe(io.u, io.y, nb, na if nf is None else nf, nk, dt=io.dt, **io.meta, **options)
+    if method == "rls":
+        from .rls import rls
+
+        return rls(io.u, io.y, na, nb, nk, dt=io.dt, **options)
+    from .search import structure_search
+
+    return structure_search(io.u, io.y, na, nb, nk, dt=io.dt, **options)

@@ -1,0 +1,523 @@
+"""Discrete-time polynomial input-output models (ARX, ARMAX, OE) in MATLAB's layout.
+
+The general form (``000_8f66dcc7ab06470c.txt`` eqs 20–27, with Ljung's F for output error)::
+
+    A(q) y(t) = B(q)/F(q) u(t) + C(q) e(t)
+
+    A(q) = 1 + a_1 q⁻¹ + ... + a_na q⁻ⁿᵃ          (eq 22)
+    B(q) = b_nk q⁻ⁿᵏ + ... + b_{nk+nb-1} q⁻⁽ⁿᵏ⁺ⁿᵇ⁻¹⁾  (eq 22 has nk = 1)
+    C(q) = 1 + c_1 q⁻¹ + ... + c_nc q⁻ⁿᶜ          (eq 25)
+    F(q) = 1 + f_1 q⁻¹ + ... + f_nf q⁻ⁿᶠ
+
+Arrays hold the coefficients in increasing powers of q⁻¹: ``A = [1, a_1, ..., a_na]`` and
+``B = [0]*nk + [b_nk, ..., b_{nk+nb-1}]`` (``B`` carries ``nk`` leading zeros, as MATLAB's
+``idpoly``). ARX: C = F = 1; ARMAX: F = 1; OE: A = C = 1.
+
+Parameter names follow the powers of q⁻¹ (Table III of the seed: ``a1 a2 b2 b3`` for ``[2 2 2]``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import signal as _sig
+
+from ..errors import DataError, ModelError
+
+__all__ = ["PolynomialModel"]
+
+_STRUCTURES = ("arx", "armax", "oe")
+
+
+def _coeffs(x, name: str, monic: bool) -> np.ndarray:
+    a = np.array(x, dtype=np.float64, copy=True).ravel()
+    if a.size == 0:
+        raise ModelError(f"{name}: expected at least one coefficient")
+    if not np.isfinite(a).all():
+        raise ModelError(f"{name} has non-finite coefficients: {a.tolist()}")
+    if monic and a[0] != 1.0:
+        raise ModelError(f"{name} must start with 1 (monic polynomial), found {a[0]:g}")
+    a.flags.writeable = False
+    return a
+
+
+def _ratio_unit(num: str, den: str) -> str:
+    if den in ("1", ""):
+        return num or "1"
+    if num in ("1", ""):
+        return f"1/{den}"
+    return f"{num}/{den}"
+
+
+@dataclass(frozen=True, eq=False)
+class PolynomialModel:
+    """A discrete-time SISO polynomial model with its uncertainty and fit diagnostics.
+
+    Build one with :func:`gripkit.sysid.arx`, :func:`~gripkit.sysid.armax`,
+    :func:`~gripkit.sysid.oe`, or from known coefficients with :meth:`from_coefficients`.
+
+    Attributes
+    ----------
+    A, B, C, F
+        Coefficients in increasing powers of q⁻¹ (see the module docstring); ``B`` has ``nk``
+        leading zeros. Read-only float64 arrays.
+    nk
+        Input delay in samples.
+    dt
+        Sample interval (s); ``fs = 1/dt``.
+    structure
+        ``'arx'``, ``'armax'`` or ``'oe'``.
+    parameter_names
+        Free parameters in the order of ``theta`` and ``covariance``: ``a1..a_na``,
+        ``b_nk..b_{nk+nb-1}``, ``c1..c_nc``, ``f1..f_nf``.
+    covariance
+        Covariance of the free parameters, shape (p, p), or None for a model with known
+        coefficients.
+    noise_variance
+        Estimate of var e(t): ``Σe²/(M − p)``.
+    loss
+        V_N of eq (29): ``(1/M) Σ ½ e²(t)`` over the M one-step prediction errors.
+    fit_percent
+        One-step-ahead prediction fit on the estimation data, ``100 (1 − ‖y − ŷ‖/‖y − ȳ‖)``.
+    n_samples
+        Samples in the estimation record (N); ``n_used`` = M = N − start prediction errors.
+    residuals
+        One-step prediction errors e(t), t = start … N−1.
+    input_name, output_name, input_unit, output_unit
+        Channel names and SI units of the data.
+    u_offset, y_offset
+        Means removed from the data before estimation (0 when not detrended); the model relates
+        the deviations ``u − u_offset`` and ``y − y_offset``.
+    info
+        Method details: solver, iterations, condition number, source.
+    """
+
+    A: np.ndarray
+    B: np.ndarray
+    nk: int
+    C: np.ndarray = field(default_factory=lambda: np.ones(1))
+    F: np.ndarray = field(default_factory=lambda: np.ones(1))
+    dt: float = 1.0
+    structure: str = "arx"
+    covariance: np.ndarray | None = None
+    noise_variance: float | None = None
+    loss: float | None = None
+    fit_percent: float | None = None
+    n_samples: int | None = None
+    n_used: int | None = None
+    residuals: np.ndarray | None = None
+    input_name: str = "u"
+    output_name: str = "y"
+    input_unit: str = "1"
+    output_unit: str = "1"
+    u_offset: float = 0.0
+    y_offset: float = 0.0
+    info: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        set_ = object.__setattr__
+        set_(self, "A", _coeffs(self.A, "A", True))
+        set_(self, "B", _coeffs(self.B, "B", False))
+        set_(self, "C", _coeffs(self.C, "C", True))
+        set_(self, "F", _coeffs(self.F, "F", True))
+        if self.structure not in _STRUCTURES:
+            raise ModelError(f"structure: expected one of {', '.join(_STRUCTURES)}, found {self.structure!r}")
+        nk = int(self.nk)
+        if nk < 0 or nk >= self.B.size:
+            raise ModelError(f"nk={self.nk} must lie in [0, len(B)-1 = {self.B.size - 1}]")
+        if np.any(self.B[:nk] != 0):
+            raise ModelError(f"B must start with nk={nk} zeros (MATLAB layout), found {self.B[:nk].tolist()}")
+        set_(self, "nk", nk)
+        if not (math.isfinite(self.dt) and self.dt > 0):
+            raise ModelError(f"dt: expected a positive sample interval in s, found {self.dt!r}")
+        if self.structure == "oe" and self.A.size > 1:
+            raise ModelError("an OE model has A = 1; use F for its denominator")
+        if self.structure != "armax" and self.C.size > 1:
+            raise ModelError(f"an {self.structure.upper()} model has C = 1")
+        if self.structure != "oe" and self.F.size > 1:
+            raise ModelError(f"an {self.structure.upper()} model has F = 1")
+        if self.covariance is not None:
+            cov = np.array(self.covariance, dtype=np.float64)
+            p = self.n_params
+            if cov.shape != (p, p):
+                raise ModelError(f"covariance: expected shape ({p}, {p}), found {cov.shape}")
+            cov.flags.writeable = False
+            set_(self, "covariance", cov)
+        if self.residuals is not None:
+            r = np.array(self.residuals, dtype=np.float64)
+            r.flags.writeable = False
+            set_(self, "residuals", r)
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def from_coefficients(cls, A, B, *, nk: int | None = None, C=(1.0,), F=(1.0,), dt: float = 1.0,
+                          structure: str | None = None, std: dict | None = None, **kw) -> "PolynomialModel":
+        """A model with known coefficients (no estimation diagnostics).
+
+        ``nk`` defaults to the number of leading zeros of ``B``. ``std`` may give one-sigma
+        uncertainties per coefficient array (``{"A": [...], "B": [...]}``, MATLAB layout, 0 for
+        fixed entries); they become a diagonal covariance.
+        """
+        B = np.asarray(B, dtype=np.float64)
+        if nk is None:
+            nz = np.flatnonzero(B)
+            if nz.size == 0:
+                raise ModelError("B is all zeros: the model has no input path")
+            nk = int(nz[0])
+        if structure is None:
+            structure = "oe" if np.size(F) > 1 else ("armax" if np.size(C) > 1 else "arx")
+        m = cls(A=A, B=B, nk=nk, C=C, F=F, dt=dt, structure=structure, **kw)
+        if std is None:
+            return m
+        var = []
+        for k, arr, sl in m._blocks():
+            s = np.asarray(std.get(k, np.zeros(arr.size)), dtype=np.float64)
+            if s.shape != arr.shape:
+                raise ModelError(f"std[{k!r}]: expected {arr.size} values (the layout of {k}), found {s.size}")
+            var.append(s[sl] ** 2)
+        return m.replace(covariance=np.diag(np.concatenate(var)))
+
+    def replace(self, **changes) -> "PolynomialModel":
+        """A copy with some fields changed."""
+        import dataclasses
+
+        return dataclasses.replace(self, **changes)
+
+    # ------------------------------------------------------------------ orders and parameters
+    @property
+    def na(self) -> int:
+        return self.A.size - 1
+
+    @property
+    def nb(self) -> int:
+        return self.B.size - self.nk
+
+    @property
+    def nc(self) -> int:
+        return self.C.size - 1
+
+    @property
+    def nf(self) -> int:
+        return self.F.size - 1
+
+    @property
+    def orders(self) -> tuple[int, ...]:
+        """``(na, nb, nk)`` for ARX, ``(na, nb, nc, nk)`` for ARMAX, ``(nb, nf, nk)`` for OE."""
+        return {"arx": (self.na, self.nb, self.nk), "armax": (self.na, self.nb, self.nc, self.nk),
+                "oe": (self.nb, self.nf, self.nk)}[self.structure]
+
+    @property
+    def label(self) -> str:
+        """``'ARX [2 2 2]'``."""
+        return f"{self.structure.upper()} [{' '.join(str(o) for o in self.orders)}]"
+
+    @property
+    def fs(self) -> float:
+        return 1.0 / self.dt
+
+    def _blocks(self):
+        """(array name, array, slice of its free entries) in parameter order."""
+        return [("A", self.A, slice(1, None)), ("B", self.B, slice(self.nk, None)),
+                ("C", self.C, slice(1, None)), ("F", self.F, slice(1, None))]
+
+    @property
+    def parameter_names(self) -> tuple[str, ...]:
+        names = [f"a{i}" for i in range(1, self.na + 1)]
+        names += [f"b{self.nk + j}" for j in range(self.nb)]
+        names += [f"c{i}" for i in range(1, self.nc + 1)]
+        names += [f"f{i}" for i in range(1, self.nf + 1)]
+        return tuple(names)
+
+    @property
+    def n_params(self) -> int:
+        return self.na + self.nb + self.nc + self.nf
+
+    @property
+    def theta(self) -> np.ndarray:
+        """Free parameters in ``parameter_names`` order (eq 21 / eq 27)."""
+        return np.concatenate([arr[sl] for _, arr, sl in self._blocks()])
+
+    @property
+    def theta_std(self) -> np.ndarray | None:
+        if self.covariance is None:
+            return None
+        return np.sqrt(np.clip(np.diag(self.covariance), 0.0, None))
+
+    def _std_layout(self, which: str) -> np.ndarray | None:
+        s = self.theta_std
+        if s is None:
+            return None
+        i = 0
+        for name, arr, sl in self._blocks():
+            n = arr[sl].size
+            if name == which:
+                out = np.zeros(arr.size)
+                out[sl] = s[i:i + n]
+                return out
+            i += n
+        raise KeyError(which)
+
+    @property
+    def A_std(self) -> np.ndarray | None:
+        """One-sigma uncertainty of each entry of ``A`` (0 for the fixed leading 1)."""
+        return self._std_layout("A")
+
+    @property
+    def B_std(self) -> np.ndarray | None:
+        """One-sigma uncertainty of each entry of ``B`` (0 for the ``nk`` fixed leading zeros)."""
+        return self._std_layout("B")
+
+    @property
+    def C_std(self) -> np.ndarray | None:
+        return self._std_layout("C")
+
+    @property
+    def F_std(self) -> np.ndarray | None:
+        return self._std_layout("F")
+
+    @property
+    def parameters(self):
+        """The free coefficients as a :class:`~gripkit.params.ParameterSet` (SI units: ``b``
+        in output unit per input unit, the others dimensionless), with their std."""
+        from ..params import Parameter, ParameterSet
+
+        bunit = _ratio_unit(self.output_unit, self.input_unit)
+        std = self.theta_std
+        src = self.info.get("source", f"identified ({self.label})")
+        params = []
+        for i, (n, v) in enumerate(zip(self.parameter_names, self.theta)):
+            doc = {"a": f"coefficient of q^-{n[1:]} in A(q)", "b": f"coefficient of q^-{n[1:]} in B(q)",
+                   "c": f"coefficient of q^-{n[1:]} in C(q)", "f": f"coefficient of q^-{n[1:]} in F(q)"}[n[0]]
+            params.append(Parameter(n, float(v), bunit if n[0] == "b" else "1", doc, source=src,
+                                    std=None if std is None else float(std[i])))
+        return ParameterSet(params, name=self.label)
+
+    # ------------------------------------------------------------------ criteria
+    @property
+    def start(self) -> int:
+        """First sample index whose one-step prediction uses only measured past data."""
+        return max(self.na, self.nf, self.B.size - 1)
+
+    @property
+    def aic(self) -> float | None:
+        """Akaike's information criterion for Gaussian errors: ``M ln(2π V) + M + 2p`` with
+        ``V = Σe²/M`` (MATLAB's ``aic``, same constant)."""
+        if self.loss is None or not self.n_used:
+            return None
+        v = 2.0 * self.loss
+        if v <= 0:
+            return -math.inf
+        return self.n_used * math.log(2 * math.pi * v) + self.n_used + 2 * self.n_params
+
+    @property
+    def fpe(self) -> float | None:
+        """Akaike's final prediction error ``V (1 + p/M) / (1 − p/M)``, ``V = Σe²/M``."""
+        if self.loss is None or not self.n_used or self.n_used <= self.n_params:
+            return None
+        r = self.n_params / self.n_used
+        return 2.0 * self.loss * (1 + r) / (1 - r)
+
+    # ------------------------------------------------------------------ analysis
+    @property
+    def denominator(self) -> np.ndarray:
+        """A(q)·F(q): the denominator of the input-output transfer function B/(A F)."""
+        return np.convolve(self.A, self.F)
+
+    def poles(self) -> np.ndarray:
+        """Roots of A(z)·F(z) (the delay's poles at the origin are not listed)."""
+        d = self.denominator
+        return np.roots(d) if d.size > 1 else np.zeros(0, dtype=complex)
+
+    def zeros(self) -> np.ndarray:
+        """Roots of B(z) without its delay: the ``nb − 1`` roots of ``[b_nk, ..., b_last]``."""
+        b = np.trim_zeros(self.B[self.nk:], "b")
+        b = np.trim_zeros(b, "f")
+        return np.roots(b) if b.size > 1 else np.zeros(0, dtype=complex)
+
+    @property
+    def stable(self) -> bool:
+        """All poles strictly inside the unit circle."""
+        p = self.poles()
+        return bool(np.all(np.abs(p) < 1.0))
+
+    @property
+    def minimum_phase(self) -> bool:
+        """All zeros strictly inside the unit circle (the [2 2 2] model of Table II is not: its
+        zero lies at z ≈ 1.167, §V-F)."""
+        z = self.zeros()
+        return bool(np.all(np.abs(z) < 1.0))
+
+    @property
+    def dc_gain(self) -> float:
+        """Static gain B(1)/(A(1)F(1)) (±inf with an integrator)."""
+        num = float(np.sum(self.B))
+        den = float(np.sum(self.denominator))
+        if den == 0.0:
+            return math.copysign(math.inf, num) if num != 0 else math.nan
+        return num / den
+
+    def step(self, n: int) -> np.ndarray:
+        """Response to a unit step applied at sample 0, from rest, ``n`` samples."""
+        return _sig.lfilter(self.B, self.denominator, np.ones(int(n)))
+
+    def impulse(self, n: int) -> np.ndarray:
+        """Response to a unit pulse at sample 0, from rest, ``n`` samples."""
+        x = np.zeros(int(n))
+        x[0] = 1.0
+        return _sig.lfilter(self.B, self.denominator, x)
+
+    def frequency_response(self, f=None, n: int = 512) -> tuple[np.ndarray, np.ndarray]:
+        """``(f_Hz, H)``: the complex response of B/(A F) at ``f`` (Hz; default ``n`` points up to
+        the Nyquist frequency), ``H = B(e^{-jωdt}) / (A F)(e^{-jωdt})``."""
+        worN = int(n) if f is None else np.asarray(f, dtype=np.float64)
+        freq, h = _sig.freqz(self.B, self.denominator, worN=worN, fs=self.fs)
+        return freq, h
+
+    # ------------------------------------------------------------------ simulation and prediction
+    def simulate(self, u, *, initial: str = "rest", y_past=None, u_past=None) -> np.ndarray:
+        """Free-run output ``ŷ = B/(A F) u`` (no noise), shape (N,), in deviation units.
+
+        Parameters
+        ----------
+        u
+            Input samples u(0) … u(N−1), shape (N,).
+        initial
+            ``'rest'``: zero past inputs and outputs (say so explicitly: gripkit never assumes
+            it silently in validation). ``'given'``: use ``y_past`` and ``u_past``.
+        y_past, u_past
+            The samples before u(0), in time order (most recent last); at least
+            ``len(A F) − 1`` outputs and ``len(B) − 1`` inputs are used (missing ones count 0).
+        """
+        u = np.asarray(u, dtype=np.float64)
+        if initial == "rest":
+            if y_past is not None or u_past is not None:
+                raise DataError("initial='rest' takes no y_past/u_past; use initial='given'")
+            return _sig.lfilter(self.B, self.denominator, u)
+        if initial != "given":
+            raise DataError(f"initial: expected 'rest' or 'given', found {initial!r}")
+        return self._filter_from_past(u, y_past, u_past)
+
+    def _filter_from_past(self, u, y_past, u_past) -> np.ndarray:
+        b, a = self.B, self.denominator
+        yp = np.zeros(0) if y_past is None else np.asarray(y_past, dtype=np.float64)
+        up = np.zeros(0) if u_past is None else np.asarray(u_past, dtype=np.float64)
+        if max(a.size, b.size) == 1:  # a static gain has no past
+            return _sig.lfilter(b, a, u)
+        zi = _sig.lfiltic(b, a, yp[::-1][:a.size - 1], up[::-1][:b.size - 1])
+        return _sig.lfilter(b, a, u, zi=zi)[0]
+
+    def prediction_errors(self, u, y) -> np.ndarray:
+        """One-step prediction errors e(t), t = ``start`` … N−1 (``u``, ``y`` in deviation units).
+
+        ARX/ARMAX: ``C(q) e(t) = A(q) y(t) − B(q) u(t)`` with e(t) = 0 before ``start``.
+        OE: ``e = y − B/F u`` with the filter's past outputs taken from the measured y.
+        """
+        u = np.asarray(u, dtype=np.float64)
+        y = np.asarray(y, dtype=np.float64)
+        t0 = self.start
+        if y.size <= t0:
+            raise DataError(f"one-step prediction with {self.label} needs more than {t0} samples, found {y.size}")
+        if self.structure == "oe":
+            w = self._filter_from_past(u[t0:], y[:t0], u[:t0])
+            return y[t0:] - w
+        v = _sig.lfilter(self.A, [1.0], y)[t0:] - _sig.lfilter(self.B, [1.0], u)[t0:]
+        return _sig.lfilter([1.0], self.C, v) if self.nc else v
+
+    def predict(self, u, y) -> np.ndarray:
+        """One-step-ahead prediction ŷ(t | t−1), shape (N,). The first ``start`` samples are the
+        record's own values (they are the initial conditions of the predictor)."""
+        y = np.asarray(y, dtype=np.float64)
+        out = y.copy()
+        out[self.start:] = y[self.start:] - self.prediction_errors(u, y)
+        return out
+
+    def validate(self, u, y, **kw):
+        """Free-run and one-step validation on a separate record; see
+        :func:`gripkit.sysid.validate`."""
+        from .validation import validate
+
+        return validate(self, u, y, **kw)
+
+    # ------------------------------------------------------------------ exports
+    def _tf_arrays(self) -> tuple[np.ndarray, np.ndarray]:
+        b, a = self.B, self.denominator
+        n = max(a.size, b.size)
+        num = np.pad(b, (0, n - b.size))
+        # positive powers of z: leading zeros of the numerator (the delay) carry no information
+        return np.trim_zeros(num, "f") if np.any(num) else num, np.pad(a, (0, n - a.size))
+
+    def to_scipy(self):
+        """``scipy.signal.dlti`` transfer function B/(A F) with ``dt`` (the delay appears as
+        poles at the origin)."""
+        num, den = self._tf_arrays()
+        return _sig.dlti(num, den, dt=self.dt)
+
+    def to_statespace(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Discrete state-space matrices ``(Ad, Bd, Cd, Dd)`` of B/(A F) (controller canonical form,
+        delay included as states): ``x⁺ = Ad x + Bd u``, ``y = Cd x + Dd u``."""
+        num, den = self._tf_arrays()
+        return _sig.tf2ss(num, den)
+
+    def to_control(self):
+        """``control.TransferFunction`` B/(A F) with ``dt`` (needs python-control:
+        ``pip install 'gripkit[interop]'``)."""
+        try:
+            import control
+        except ImportError:
+            raise ModelError("to_control() needs the python-control package, which is not installed",
+                             hint="pip install 'gripkit[interop]' (or pip install control)") from None
+        num, den = self._tf_arrays()
+        return control.tf(num, den, self.dt)
+
+    def to_dict(self) -> dict:
+        """JSON-ready summary (complex numbers as ``[re, im]`` pairs)."""
+        def pairs(z):
+            return [[float(np.real(v)), float(np.imag(v))] for v in z]
+
+        def lst(a):
+            return None if a is None else [float(v) for v in a]
+
+        d = {"structure": self.structure, "na": self.na, "nb": self.nb, "nk": self.nk}
+        if self.structure == "armax":
+            d["nc"] = self.nc
+        if self.structure == "oe":
+            d["nf"] = self.nf
+        d.update(A=lst(self.A), B=lst(self.B), A_std=lst(self.A_std), B_std=lst(self.B_std))
+        if self.structure == "armax":
+            d.update(C=lst(self.C), C_std=lst(self.C_std))
+        if self.structure == "oe":
+            d.update(F=lst(self.F), F_std=lst(self.F_std))
+        d.update(parameter_names=list(self.parameter_names), theta=lst(self.theta),
+                 theta_std=lst(self.theta_std), loss=self.loss, fit_percent=self.fit_percent,
+                 aic=self.aic, fpe=self.fpe, noise_variance=self.noise_variance,
+                 poles=pairs(self.poles()), zeros=pairs(self.zeros()),
+                 minimum_phase=self.minimum_phase, stable=self.stable, dc_gain=self.dc_gain,
+                 n_samples=self.n_samples, dt=self.dt, fs=self.fs,
+                 input=self.input_name, output=self.output_name, input_unit=self.input_unit,
+                 output_unit=self.output_unit, u_offset=self.u_offset, y_offset=self.y_offset)
+        return d
+
+    def summary(self) -> str:
+        """Several lines: structure, coefficients ± σ, loss, fit, poles and zeros."""
+        lines = [f"{self.label}  dt = {self.dt:g} s"]
+        for name, arr, _ in self._blocks():
+            if arr.size == 1 and name in ("C", "F"):
+                continue
+            if name == "A" and self.structure == "oe":
+                continue
+            std = self._std_layout(name)
+            terms = [f"{v:.5g}" + (f"±{s:.2g}" if std is not None and s > 0 else "")
+                     for v, s in zip(arr, std if std is not None else np.zeros(arr.size))]
+            lines.append(f"  {name} = [{', '.join(terms)}]")
+        if self.loss is not None:
+            lines.append(f"  loss V_N = {self.loss:.5g}, fit = {self.fit_percent:.2f} %, "
+                         f"AIC = {self.aic:.5g}, N = {self.n_samples}")
+        fmt = lambda z: ", ".join(f"{v.real:.4g}{v.imag:+.4g}j" for v in z) or "none"  # noqa: E731
+        lines.append(f"  poles: {fmt(self.poles())}")
+        lines.append(f"  zeros: {fmt(self.zeros())} ({'minimum' if self.minimum_phase else 'NON-minimum'} phase)")
+        return "\n".join(lines)
+
+    def __repr__(self) -> str:
+        return f"PolynomialModel({self.label}, A={self.A.tolist()}, B={self.B.tolist()}, dt={self.dt:g})"

@@ -1,0 +1,289 @@
+"""Second-order step-response identification: static gain, natural frequency and damping ratio,
+each with its standard deviation, from a recorded step (or any piecewise-constant input).
+
+Model (``gripkit.models.second_order.SecondOrderSystem``):
+
+    y(t) = y₀ + G(s)·(u − u₀),   G(s) = K ω_n² / (s² + 2ζω_n s + ω_n²),
+
+with u₀ the input at the start of the record (the system is assumed at rest there) and y₀ the
+output there. Simulated exactly (zero-order hold at the data's sampling rate), so any lightly
+damped mode below the Nyquist frequency is resolved.
+
+Procedure (:func:`identify_step`):
+
+1. Starting values from a least-squares ARX(2, 2) fit with a constant,
+   y_k = −a₁y_{k−1} − a₂y_{k−2} + b₁u_{k−1} + b₂u_{k−2} + c: its poles z = e^{sT} give ω_n = |s|
+   and ζ = −Re s/|s|, its static gain (b₁ + b₂)/(1 + a₁ + a₂) gives K. When the ARX poles are not
+   a stable pair (heavy noise), the step's levels and its 63 % time are used instead.
+2. Output-error Levenberg-Marquardt on (K, ω_n, ζ, y₀) with the grey-box engine
+   (:func:`gripkit.sysid.greybox.fit`, ``method='lm'``: ω_n and ζ in log space).
+3. Uncertainty: the asymptotic covariance σ̂²(JᵀJ)⁻¹ of the grey-box engine; σ(f_n) = σ(ω_n)/2π.
+
+The result also carries the step metrics the fitted model predicts (overshoot, peak, rise and 2 %
+settling times) and :func:`step_metrics` measures them on any response (used for controllers).
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import AccuracyWarning, DataError, IdentificationError, SimulationError
+from ..models.second_order import SecondOrderSystem, second_order_step
+from ..signals.trajectory import Trajectory
+from .greybox import GreyboxResult, fit
+
+__all__ = ["StepResponseResult", "identify_step", "step_metrics", "second_order_metrics"]
+
+
+@dataclass(frozen=True)
+class StepResponseResult:
+    """Result of :func:`identify_step`. Frequencies in Hz and rad/s, times in s, ``gain`` in output
+    unit per input unit (``gain_unit``). ``covariance``/``correlation`` are over
+    (gain, natural_frequency_hz, damping_ratio, offset)."""
+
+    gain: float
+    gain_std: float
+    natural_frequency_hz: float
+    natural_frequency_hz_std: float
+    damping_ratio: float
+    damping_ratio_std: float
+    offset: float
+    offset_std: float
+    input_offset: float
+    gain_unit: str
+    covariance: np.ndarray
+    correlation: np.ndarray
+    fit_percent: float
+    residual_std: float
+    n_samples: int
+    fs: float
+    overshoot_percent: float
+    peak_time: float
+    rise_time: float
+    settling_time: float
+    y_model: np.ndarray = field(repr=False)
+    greybox: GreyboxResult = field(repr=False)
+
+    @property
+    def natural_frequency(self) -> float:
+        """ω_n in rad/s."""
+        return 2 * math.pi * self.natural_frequency_hz
+
+    def transfer_function(self) -> tuple[np.ndarray, np.ndarray]:
+        """(num, den) of K ω_n²/(s² + 2ζω_n s + ω_n²)."""
+        w = self.natural_frequency
+        return np.array([self.gain * w * w]), np.array([1.0, 2 * self.damping_ratio * w, w * w])
+
+    def to_dict(self) -> dict:
+        keys = ("gain", "gain_std", "natural_frequency_hz", "natural_frequency_hz_std", "damping_ratio",
+                "damping_ratio_std", "offset", "offset_std", "input_offset", "gain_unit", "fit_percent",
+                "residual_std", "n_samples", "fs", "overshoot_percent", "peak_time", "rise_time",
+                "settling_time")
+        d = {k: getattr(self, k) for k in keys}
+        d["covariance"] = self.covariance.tolist()
+        d["correlation"] = self.correlation.tolist()
+        d["covariance_order"] = ["gain", "natural_frequency_hz", "damping_ratio", "offset"]
+        d["identifiability"] = str(self.greybox.identifiability)
+        return d
+
+    def summary(self) -> str:
+        return (f"second-order step fit ({self.n_samples} samples at {self.fs:g} Hz, fit {self.fit_percent:.2f} %):\n"
+                f"  gain K = {self.gain:.6g} ± {self.gain_std:.2g} {self.gain_unit}\n"
+                f"  natural frequency f_n = {self.natural_frequency_hz:.6g} ± {self.natural_frequency_hz_std:.2g} Hz\n"
+                f"  damping ratio ζ = {self.damping_ratio:.5g} ± {self.damping_ratio_std:.2g}\n"
+                f"  predicted step: overshoot {self.overshoot_percent:.3g} %, peak {self.peak_time:.4g} s, "
+                f"rise (10-90 %) {self.rise_time:.4g} s, settling (2 %) {self.settling_time:.4g} s")
+
+
+def _arx_start(u: np.ndarray, y: np.ndarray, dt: float):
+    """(K, ω_n, ζ) from an ARX(2, 2) least-squares fit, or None if it gives no stable pair."""
+    n = len(y)
+    if n < 8:
+        return None
+    Phi = np.column_stack([-y[1:-1], -y[:-2], u[1:-1], u[:-2], np.ones(n - 2)])
+    try:
+        th, *_ = np.linalg.lstsq(Phi, y[2:], rcond=None)
+    except np.linalg.LinAlgError:
+        return None
+    a1, a2, b1, b2, _ = th
+    z = np.roots([1.0, a1, a2])
+    if np.any(np.abs(z) >= 1.0) or np.any(np.abs(z) < 1e-9):
+        return None
+    s = np.log(z.astype(complex)) / dt
+    if np.any(np.abs(s.imag) >= math.pi / dt * 0.999) or np.any(s.real >= 0):
+        return None
+    wn = float(math.sqrt(abs(s[0] * s[1])))
+    zeta = float(-(s[0] + s[1]).real / (2 * wn))
+    den = 1.0 + a1 + a2
+    if not (wn > 0 and zeta > 0 and abs(den) > 1e-12):
+        return None
+    return float((b1 + b2) / den), wn, zeta
+
+
+def _level_start(t: np.ndarray, u: np.ndarray, y: np.ndarray):
+    """(K, ω_n, ζ) from the levels of the largest input change and the 63 % time after it."""
+    du = np.diff(u)
+    k = int(np.argmax(np.abs(du))) + 1
+    stop = k + 1 + int(np.argmax(np.abs(du[k:]) > 0)) if np.any(np.abs(du[k:]) > 0) else len(u)
+    stop = max(stop, k + 2)
+    y_before = y[max(0, k - 10):k].mean() if k > 0 else y[0]
+    tail = y[k + max(1, (stop - k) * 3 // 4):stop]
+    y_after = tail.mean() if tail.size else y[stop - 1]
+    K = (y_after - y_before) / du[k - 1]
+    seg = (y[k:stop] - y_before) / (y_after - y_before) if y_after != y_before else np.zeros(stop - k)
+    i63 = int(np.argmax(seg >= 0.63)) if np.any(seg >= 0.63) else max(1, (stop - k) // 4)
+    t63 = max(t[k + i63] - t[k], t[1] - t[0])
+    return float(K), 1.5 / t63, 0.7
+
+
+def second_order_metrics(wn: float, zeta: float, band: float = 0.02) -> dict:
+    """Overshoot (%), peak time, 10-90 % rise time and settling time (±``band``) of the unit step
+    of ω_n²/(s² + 2ζω_n s + ω_n²), evaluated on the closed form."""
+    T = (12.0 + 4.0 / max(zeta, 1e-3)) / wn if zeta < 1 else 12.0 * (zeta + 1.0) ** 2 / wn
+    t = np.linspace(0.0, T, 20001)
+    r = second_order_step(t, 1.0, wn, zeta)
+    m = step_metrics(t, r, t_step=0.0, y_initial=0.0, y_final=1.0, band=band)
+    if zeta >= 1.0:
+        m["peak_time"] = math.inf  # monotonic: no peak
+    return m
+
+
+def step_metrics(t, y, *, t_step: float | None = None, y_initial: float | None = None,
+                 y_final: float | None = None, band: float = 0.02) -> dict:
+    """Step-response metrics of a measured or simulated response.
+
+    ``y_initial`` defaults to the mean before ``t_step`` (or y[0]); ``y_final`` to the mean of the
+    last 10 % of the record (pass the command for tracking metrics). Returns ``overshoot_percent``
+    (beyond ``y_final``, relative to the step amplitude), ``peak`` and ``peak_time``, ``rise_time``
+    (10 → 90 %), ``settling_time`` (last time outside ±``band``·|amplitude| around ``y_final``; inf
+    when the record ends outside), all times measured from ``t_step`` (default t[0]).
+    """
+    t = np.asarray(t, dtype=np.float64)
+    y = np.asarray(y, dtype=np.float64)
+    if t.shape != y.shape or t.ndim != 1 or t.size < 3:
+        raise DataError(f"step_metrics: expected two 1-D arrays of equal length ≥ 3, found shapes {t.shape}, {y.shape}")
+    if not (np.isfinite(t).all() and np.isfinite(y).all()):
+        raise DataError("step_metrics: t or y contains NaN or inf")
+    t0 = float(t[0]) if t_step is None else float(t_step)
+    after = t >= t0
+    if after.sum() < 2:
+        raise DataError(f"step_metrics: no samples after t_step = {t0:g} s (record ends at {t[-1]:g} s)")
+    if y_initial is None:
+        before = ~after
+        y_initial = float(y[before].mean()) if before.any() else float(y[0])
+    if y_final is None:
+        y_final = float(y[-max(2, y.size // 10):].mean())
+    amp = y_final - y_initial
+    if amp == 0 or not math.isfinite(amp):
+        raise DataError("step_metrics: the response has no step (final level equals initial level)")
+    ta, ya = t[after], y[after]
+    norm = (ya - y_initial) / amp
+    ip = int(np.argmax(norm))
+    overshoot = max(0.0, (norm[ip] - 1.0) * 100.0)
+    i10 = np.flatnonzero(norm >= 0.1)
+    i90 = np.flatnonzero(norm >= 0.9)
+    rise = float(ta[i90[0]] - ta[i10[0]]) if i10.size and i90.size else math.inf
+    outside = np.flatnonzero(np.abs(ya - y_final) > band * abs(amp))
+    if outside.size == 0:
+        settling = 0.0
+    elif outside[-1] == ya.size - 1:
+        settling = math.inf
+    else:
+        settling = float(ta[outside[-1] + 1] - t0)
+    return dict(overshoot_percent=float(overshoot), peak=float(ya[ip]), peak_time=float(ta[ip] - t0),
+                rise_time=rise, settling_time=settling, y_initial=float(y_initial), y_final=float(y_final))
+
+
+def identify_step(data: Trajectory, *, input: str, output: str, multistart: int = 0,
+                  progress: bool = False) -> StepResponseResult:
+    """Identify K, ω_n, ζ (and the output offset) of a second-order response (module docstring).
+
+    Parameters
+    ----------
+    data
+        Uniformly sampled record holding ``input`` and ``output``; the system must be at rest at
+        the start (the input's first value is the operating point u₀).
+    input, output
+        Column names.
+    multistart
+        Extra random starts of the Levenberg-Marquardt search.
+
+    Raises
+    ------
+    DataError
+        Missing columns, non-uniform sampling, fewer than 20 samples, a constant input (no step) or
+        an output that does not respond.
+    IdentificationError
+        A fitted natural frequency above the Nyquist frequency, or a fit that fails.
+    """
+    if not isinstance(data, Trajectory):
+        raise DataError(f"data: expected a Trajectory, found {type(data).__name__}")
+    fs = data.require_uniform(why="step-response identification")
+    data.require_samples(20, "step-response identification")
+    u = np.asarray(data[input], dtype=np.float64)
+    y = np.asarray(data[output], dtype=np.float64)
+    if np.ptp(u) == 0:
+        raise DataError(f"input column {input!r} is constant ({u[0]:g}): a step response needs a step in the input",
+                        hint="choose the column that holds the commanded step")
+    u_scale = np.ptp(u)
+    y_scale = np.ptp(y)
+    if y_scale == 0 or y_scale <= 1e-12 * max(1.0, np.max(np.abs(y))):
+        raise DataError(f"output column {output!r} does not change: nothing to identify",
+                        hint="check the column, or whether the system was powered")
+    dt = 1.0 / fs
+    # fit in normalised units, u_n = (u − u₀)/Δu and y_n = (y − y₀,ref)/Δy, so that every
+    # parameter is of order one whatever the physical units; mapped back below
+    u0, y_ref = float(u[0]), float(y[0])
+    un, yn = (u - u0) / u_scale, (y - y_ref) / y_scale
+    start = _arx_start(un, yn, dt)
+    if start is None or not (0 < start[1] < math.pi * fs):
+        start = _level_start(data.t, un, yn)
+    K0, wn0, z0 = start
+    wn0 = min(wn0, 0.9 * math.pi * fs)
+    z0 = min(max(z0, 1e-3), 5.0)
+    model = SecondOrderSystem(gain=K0, wn=wn0, zeta=z0, y0=0.0, u0=0.0, input_name="u", output_name="y")
+    sub = Trajectory(data.t, {"u": un, "y": yn}, meta=data.meta)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", AccuracyWarning)  # re-issued below with the step's names
+        try:
+            res = fit(model, sub, outputs=["y"], free=["gain", "wn", "zeta", "y0"], method="lm",
+                      multistart=multistart, progress=progress, output_scale=[1.0])
+        except SimulationError:
+            raise IdentificationError(
+                f"the response of {output!r} to {input!r} is not a second-order response resolved at "
+                f"{fs:g} Hz: the fit diverged", hint="check the columns, or record at a higher sampling rate") from None
+    Kn, wn, zeta, y0n = (res.value(n) for n in ("gain", "wn", "zeta", "y0"))
+    if wn >= math.pi * fs:
+        raise IdentificationError(
+            f"the fitted natural frequency {wn / (2 * math.pi):.4g} Hz is above the Nyquist frequency "
+            f"{fs / 2:.4g} Hz of the data", hint="record at a higher sampling rate")
+    if not res.identifiability.ok:
+        warnings.warn(f"step-response fit of {output!r}: {res.identifiability}", AccuracyWarning, stacklevel=2)
+    K = Kn * y_scale / u_scale
+    y0 = y_ref + y0n * y_scale
+    J = np.diag([y_scale / u_scale, 1.0 / (2 * math.pi), 1.0, y_scale])
+    cov = J @ res.covariance @ J
+    std = np.sqrt(np.clip(np.diag(cov), 0, None))
+    std = np.where(np.isfinite(res.std), std, np.inf)
+    d = np.where(std > 0, std, 1.0)
+    corr = cov / np.outer(d, d)
+    m = second_order_metrics(wn, zeta)
+    if m["settling_time"] > data.duration:
+        warnings.warn(f"step-response fit of {output!r}: the fitted response settles in "
+                      f"{m['settling_time']:.3g} s, longer than the {data.duration:.3g} s record; the gain "
+                      f"is extrapolated", AccuracyWarning, stacklevel=2)
+    from ..models.second_order import _ratio_unit
+
+    gunit = _ratio_unit(data.unit(output), data.unit(input))
+    return StepResponseResult(
+        gain=K, gain_std=float(std[0]), natural_frequency_hz=wn / (2 * math.pi),
+        natural_frequency_hz_std=float(std[1]), damping_ratio=zeta, damping_ratio_std=float(std[2]),
+        offset=y0, offset_std=float(std[3]), input_offset=float(u[0]), gain_unit=gunit,
+        covariance=cov, correlation=corr, fit_percent=float(res.fit_percent[0]),
+        residual_std=float(res.residual_std[0]), n_samples=int(data.n), fs=float(fs),
+        overshoot_percent=m["overshoot_percent"], peak_time=m["peak_time"], rise_time=m["rise_time"],
+        settling_time=m["settling_time"], y_model=y_ref + res.y_model[:, 0] * y_scale, greybox=res)

@@ -1,0 +1,131 @@
+"""Sweeps on every backend give the same table; failures are recorded; crashes lose nothing;
+resumed sweeps recompute nothing already on disk."""
+
+import math
+import os
+import signal
+import sys
+from pathlib import Path
+
+import cloudpickle
+import numpy as np
+import pytest
+
+from gripkit.batch import ProcessExecutor, SweepSpec, sweep
+from gripkit.batch.montecarlo import binned_probability, probability, quantile
+
+cloudpickle.register_pickle_by_value(sys.modules[__name__])
+
+MSD = {"sweep": {"scenario": "step-response", "model": "mass-spring-damper", "chunk_size": 3},
+       "parameters": {"k": {"grid": [1.0, 2.0, 4.0, 8.0]}, "b": {"uniform": [0.5, 1.0]}},
+       "scenario": {"duration": 120.0, "fs": 20.0, "amplitude": 2.0}}
+
+
+def msd_spec(**kw):
+    d = {k: dict(v) for k, v in MSD.items()}
+    d["sweep"].update(kw)
+    d["sweep"]["samples"] = 3
+    return SweepSpec.from_dict(d)
+
+
+def analytic_overshoot(m, b, k):
+    z = b / (2 * math.sqrt(k * m))
+    return 100 * math.exp(-math.pi * z / math.sqrt(1 - z * z)) if z < 1 else 0.0
+
+
+@pytest.fixture(scope="module")
+def reference():
+    return sweep(msd_spec(), backend="in-process", progress=False)
+
+
+def test_in_process_metrics_are_right(reference):
+    """Overshoot of m x'' + b x' + k x = F against the analytic 100 exp(-πζ/√(1-ζ²))."""
+    for k, b, ov, fin in zip(reference["k"], reference["b"], reference["overshoot_percent"], reference["final"]):
+        assert ov == pytest.approx(analytic_overshoot(1.0, b, k), abs=0.5)
+        assert fin == pytest.approx(2.0 / k, rel=0.02)
+    assert not reference.failed.any() and reference.n_jobs == 12
+
+
+def test_process_pool_matches_in_process(reference, tmp_path):
+    res = sweep(msd_spec(), backend="process", workers=2, out=tmp_path / "pp", progress=False)
+    for col in ("job_id", "k", "b", "overshoot_percent", "settling_time", "final"):
+        np.testing.assert_array_equal(res[col], reference[col])
+
+
+def test_dask_local_cluster_matches_in_process(reference):
+    pytest.importorskip("distributed")
+    res = sweep(msd_spec(), backend="dask", workers=2, progress=False)
+    for col in ("job_id", "overshoot_percent", "final"):
+        np.testing.assert_array_equal(res[col], reference[col])
+
+
+def flaky_scenario(model, params, settings):
+    """Raises for k == 4; kills its own worker process the first time it sees k == 8."""
+    k = params["k"]
+    if (k == 4.0).any():
+        raise ValueError("object slipped out of the gripper")
+    marker = Path(settings["marker"])
+    if (k == 8.0).any() and not marker.exists() and settings.get("kill"):
+        marker.write_text("killed")
+        os.kill(os.getpid(), signal.SIGKILL)
+    return {"twice_k": 2.0 * k}
+
+
+def flaky_spec(tmp_path, kill):
+    return SweepSpec.from_dict({"sweep": {"scenario": flaky_scenario, "chunk_size": 2, "samples": 2},
+                                "parameters": {"k": {"grid": [1.0, 2.0, 4.0, 8.0, 16.0]}},
+                                "scenario": {"marker": str(tmp_path / "marker"), "kill": kill}})
+
+
+def test_failing_jobs_are_recorded_and_the_sweep_finishes(tmp_path):
+    res = sweep(flaky_spec(tmp_path, kill=False), backend="in-process", progress=False)
+    bad = res["k"] == 4.0
+    assert all("object slipped" in e for e in res["error"][bad])
+    assert all(e is None for e in res["error"][~bad])
+    np.testing.assert_array_equal(res["twice_k"][~bad], 2 * res["k"][~bad])
+    assert np.isnan(res["twice_k"][bad]).all()
+
+
+def test_killed_worker_leaves_every_result_exactly_once(tmp_path):
+    out = tmp_path / "run"
+    res = sweep(flaky_spec(tmp_path, kill=True), backend="process", workers=2, out=out, progress=False)
+    assert (tmp_path / "marker").exists()  # a worker really was killed mid-sweep
+    ids = res["job_id"]
+    assert sorted(ids.tolist()) == list(range(10))  # every job exactly once
+    ok = res["k"] != 4.0
+    np.testing.assert_array_equal(res["twice_k"][ok], 2 * res["k"][ok])
+    import pyarrow.parquet as pq
+
+    on_disk = np.concatenate([pq.read_table(p)["job_id"].to_numpy() for p in (out / "chunks").glob("*.parquet")])
+    assert sorted(on_disk.tolist()) == list(range(10))
+
+
+def test_resume_recomputes_nothing_on_disk(tmp_path):
+    out = tmp_path / "run"
+    first = sweep(msd_spec(), backend="in-process", out=out, progress=False)
+    chunks = sorted((out / "chunks").glob("*.parquet"))
+    # simulate an interrupted sweep: drop the last two chunks, remember the others' mtimes
+    for p in chunks[-2:]:
+        p.unlink()
+    mtimes = {p.name: p.stat().st_mtime_ns for p in chunks[:-2]}
+    again = sweep(msd_spec(), backend="in-process", out=out, resume=True, progress=False)
+    assert again.computed_chunks == 2
+    for p in chunks[:-2]:
+        assert p.stat().st_mtime_ns == mtimes[p.name]
+    np.testing.assert_array_equal(again["overshoot_percent"], first["overshoot_percent"])
+    with pytest.raises(Exception, match="already holds results"):
+        sweep(msd_spec(), backend="in-process", out=out, progress=False)
+
+
+def test_wilson_interval_and_quantiles():
+    """Wilson interval for 0/20 and 10/20 (reference values from the closed form)."""
+    e = probability(np.zeros(20))
+    assert e.value == 0 and e.low == 0 and e.high == pytest.approx(0.1611, abs=1e-4)
+    e = probability(np.r_[np.ones(10), np.zeros(10)])
+    assert (e.low, e.high) == pytest.approx((0.2993, 0.7007), abs=1e-4)
+    rng = np.random.default_rng(0)
+    x = rng.standard_normal(4000)
+    q = quantile(x, 0.5)
+    assert q.low < 0.0 < q.high and q.high - q.low < 0.1
+    rows = binned_probability(np.arange(100.0), np.arange(100) >= 50, [0, 50, 100])
+    assert rows[0]["p"] == 0 and rows[1]["p"] == 1
