@@ -9,6 +9,7 @@ import pytest
 from gripkit.cli import main
 from gripkit.errors import ModelError, SimulationError
 from gripkit.models.dlr_finger import ACTUATORS, DLRFinger
+from gripkit.params import ParameterSet
 from gripkit.zoo.dlr_hit import FINGERS, finger, finger_parameters, finger_tables, hand
 
 DEG = math.pi / 180
@@ -167,7 +168,7 @@ def test_zoo_check_reports_the_thesis_contradictions(capsys):
 def test_bad_finger_inputs():
     ps = finger_parameters()
     with pytest.raises(ModelError, match="FINGER_PARAMETERS"):
-        DLRFinger(ps.merged(ps.__class__([])) if False else ps.__class__(list(ps.values())[:-1]), finger_tables())
+        DLRFinger(ParameterSet(list(ps.values())[:-1]), finger_tables())
     with pytest.raises(ModelError, match="friction"):
         finger(check=False, friction="coulomb")
     with pytest.raises(ModelError, match="FrictionTables"):
