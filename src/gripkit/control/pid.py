@@ -139,10 +139,8 @@ class PID:
                 tt = 0.0
             elif kp == 0:
                 tt = ts
-            else:
-                ti = kp / ki
-                td = kd / kp
-                tt = math.sqrt(abs(ti * td)) if td != 0 else abs(ti)
+            else:  # Åström's T_t = sqrt(T_i T_d) = sqrt(kd/ki) (kp cancels), T_i without derivative
+                tt = math.sqrt(abs(kd / ki)) if kd != 0 else abs(kp / ki)
                 tt = max(tt, ts)
         tt = _finite("tt", tt, allow_inf=True)
         if tt < 0:
