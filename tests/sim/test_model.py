@@ -50,3 +50,14 @@ def test_errors_name_the_problem():
         model.simulate(np.ones(10))
     with pytest.raises(SimulationError, match="NaN"):
         model.simulate(np.array([1.0, np.nan]), dt=0.1)
+
+
+def test_output_buffer_is_reused_and_checked():
+    model = MassSpringDamper(m=1.0, b=0.3, k=4.0)
+    u = np.sin(np.arange(200) * 0.05)
+    buf = np.empty((1, 200, 1))
+    y = model.simulate_batch(model.theta()[None, :], u, dt=0.01, out=buf)
+    assert y is buf
+    np.testing.assert_array_equal(buf[0, :, 0], model.simulate(u, dt=0.01)["x"])
+    with pytest.raises(SimulationError, match="shape"):
+        model.simulate_batch(model.theta()[None, :], u, dt=0.01, out=np.empty((1, 100, 1)))

@@ -155,8 +155,10 @@ class Model(abc.ABC):
         return n
 
     def simulate_batch(self, thetas, u, dt: float | None = None, x0: np.ndarray | None = None,
-                       substeps: int | None = None) -> np.ndarray:
-        """Outputs (P, N, n_outputs) for parameter vectors ``thetas`` (P, n_params)."""
+                       substeps: int | None = None, out: np.ndarray | None = None) -> np.ndarray:
+        """Outputs (P, N, n_outputs) for parameter vectors ``thetas`` (P, n_params). ``out``: a
+        preallocated float64 array of that shape to write into (a loop that simulates many times
+        saves the allocation)."""
         thetas = self._check_thetas(thetas)
         arr, dt, _ = self._inputs_array(u, dt)
         if substeps is None:
@@ -170,9 +172,17 @@ class Model(abc.ABC):
         if x0 is None:
             x0 = np.stack([self.initial_state(th) for th in thetas]) if len(self.states) else np.zeros((P, 0))
         x0 = np.ascontiguousarray(np.broadcast_to(np.asarray(x0, dtype=np.float64), (P, len(self.states))))
-        y = np.empty((P, arr.shape[0], len(self.outputs)))
+        shape = (P, arr.shape[0], len(self.outputs))
+        if out is None:
+            y = np.empty(shape)
+        elif out.shape != shape or out.dtype != np.float64 or not out.flags.c_contiguous:
+            raise SimulationError(f"out: expected a C-contiguous float64 array of shape {shape}, found "
+                                  f"{out.dtype} {out.shape}")
+        else:
+            y = out
         self._simulate_batch(thetas, arr, dt, int(substeps), x0.copy(), y)
-        if not np.isfinite(y).all():
+        # one pass without a temporary; the exact test only if the sum is not finite (overflow)
+        if not np.isfinite(y.sum()) and not np.isfinite(y).all():
             raise SimulationError(f"{self.name}: the simulation diverged (non-finite outputs)",
                                   hint="check the parameters and the input amplitude")
         return y
