@@ -76,7 +76,8 @@ class RobustnessResult:
                 "damage_vs_stiffness": self.damage_vs_stiffness, "lost_vs_stiffness": self.lost_vs_stiffness,
                 "seconds": self.seconds, "backend": self.backend}
 
-    def report(self, report, title: str = "Monte Carlo grasp robustness", intro: str = ""):
+    def report(self, report, title: str = "Monte Carlo grasp robustness", intro: str = "",
+               name: str = "batch-robustness"):
         """Add a section: the estimates as a table, histograms of the peak force and of the settling
         time, and P(damage), P(lost) against stiffness with their confidence bands."""
         from ..report.plots import _plt
@@ -107,12 +108,12 @@ class RobustnessResult:
         fin = st[np.isfinite(st)] * 1e3
         ax[1].hist(fin, bins=40, color="C2", alpha=0.8,
                    label=f"settled ({fin.size}); never: {int(np.isinf(st).sum())}")
-        for e, name, ls in ((self.settling_median, "median", "-"), (self.settling_q90, "90 %", "--")):
+        for e, label, ls in ((self.settling_median, "median", "-"), (self.settling_q90, "90 %", "--")):
             if math.isfinite(e.value):
-                ax[1].axvline(e.value * 1e3, color="k", ls=ls, label=f"{name} {e.value * 1e3:.1f} ms")
+                ax[1].axvline(e.value * 1e3, color="k", ls=ls, label=f"{label} {e.value * 1e3:.1f} ms")
         ax[1].set_xlabel("settling time of the grip force (ms)")
         ax[1].legend(fontsize=8)
-        for rows_, name, col in ((self.damage_vs_stiffness, "P(damage)", "C3"), (self.lost_vs_stiffness, "P(lost)", "C1")):
+        for rows_, label, col in ((self.damage_vs_stiffness, "P(damage)", "C3"), (self.lost_vs_stiffness, "P(lost)", "C1")):
             if not rows_:
                 continue
             x = np.array([math.sqrt(r["low"] * r["high"]) for r in rows_])
@@ -120,15 +121,18 @@ class RobustnessResult:
             lo = np.array([r["p_low"] for r in rows_])
             hi = np.array([r["p_high"] for r in rows_])
             ax[2].fill_between(x, lo, hi, color=col, alpha=0.2)
-            ax[2].plot(x, p, "o-", color=col, label=f"{name} ({100 * self.p_damage.confidence:.0f} % band)")
+            ax[2].plot(x, p, "o-", color=col, label=f"{label} ({100 * self.p_damage.confidence:.0f} % band)")
         ax[2].set_xscale("log")
+        from matplotlib.ticker import NullFormatter
+
+        ax[2].xaxis.set_minor_formatter(NullFormatter())
         ax[2].set_ylim(-0.02, 1.02)
         ax[2].set_xlabel(f"{self.stiffness} (N/m)")
         ax[2].set_ylabel("probability")
         ax[2].legend(fontsize=8)
         fig.tight_layout()
         sec.figure(fig, "Peak contact force and settling time over the population; probabilities against the "
-                        "object's stiffness (Wilson intervals per bin)", name="batch-robustness")
+                        "object's stiffness (Wilson intervals per bin)", name=name)
         return sec
 
 

@@ -20,6 +20,7 @@ SECTIONS: dict[str, str] = {
     "amadeus-hand": "gripkit.demos.amadeus_hand",
     "ftg100": "gripkit.demos.ftg100",
     "tsfm": "gripkit.demos.tsfm",
+    "batch-robustness": "gripkit.demos.batch_robustness",
 }
 
 
