@@ -152,7 +152,10 @@ def _grasp_core(bw, Phi, Gam, C, D, G, Hg, target, ng, K, part, noise, nstd, see
     det1 = False
     det2 = False
     last_out = -1
-    tail = n_steps - max(1, n_steps // 10)
+    n_tail_max = n_steps // 10   # builtin max/min are avoided here: numba.cuda cannot retarget them
+    if n_tail_max < 1:
+        n_tail_max = 1
+    tail = n_steps - n_tail_max
     sum_f = 0.0
     sum_fm = 0.0
     sum_s = 0.0
@@ -213,7 +216,9 @@ def _grasp_core(bw, Phi, Gam, C, D, G, Hg, target, ng, K, part, noise, nstd, see
     if t_sq < 0.0 or last_out == n_steps - 1:
         met[8] = math.inf
     else:
-        met[8] = max(0.0, (last_out + 1) * dt - t_sq)
+        met[8] = (last_out + 1) * dt - t_sq
+        if met[8] < 0.0:
+            met[8] = 0.0
     met[9] = (sum_f / n_tail - fcmd) / fcmd
     met[10] = sum_f / n_tail
     if det1 and det2:
