@@ -14,3 +14,5 @@ from .montecarlo import quantile as quantile
 from .spec import SweepSpec as SweepSpec
 from .sweep import SweepResult as SweepResult
 from .sweep import sweep as sweep
+from .robustness import RobustnessResult as RobustnessResult
+from .robustness import robustness_study as robustness_study

@@ -53,8 +53,11 @@ def probability(flags, confidence: float = 0.95) -> Estimate:
 
 
 def quantile(x, q: float, confidence: float = 0.95) -> Estimate:
-    """The ``q`` quantile of ``x`` (NaN excluded) with an order-statistic confidence interval."""
-    v = np.sort(np.asarray(x, dtype=np.float64)[np.isfinite(np.asarray(x, dtype=np.float64))])
+    """The ``q`` quantile of ``x`` with an order-statistic confidence interval. NaN entries are
+    excluded; +inf is kept as a value larger than all others (e.g. "never settled"), so a quantile
+    or a bound that falls on such entries is inf."""
+    x = np.asarray(x, dtype=np.float64)
+    v = np.sort(x[~np.isnan(x)])
     n = v.size
     if n == 0:
         raise DataError("a quantile needs at least one finite value")
@@ -65,7 +68,8 @@ def quantile(x, q: float, confidence: float = 0.95) -> Estimate:
     hi_rank = int(stats.binom.ppf(1 - a, n, q)) + 1
     lo = v[max(lo_rank - 1, 0)] if lo_rank >= 1 else -math.inf
     hi = v[hi_rank - 1] if hi_rank <= n else math.inf
-    return Estimate(float(np.quantile(v, q)), float(lo), float(hi), n, confidence)
+    value = np.quantile(v, q, method="inverted_cdf" if np.isinf(v).any() else "linear")
+    return Estimate(float(value), float(lo), float(hi), n, confidence)
 
 
 def binned_probability(x, flags, bins, confidence: float = 0.95) -> list[dict]:

@@ -67,7 +67,10 @@ def run_chunk(scenario: str, model_ref: str | None, settings: dict, job_ids: np.
     n = len(job_ids)
     errors = np.full(n, None, dtype=object)
     try:
-        res = fn(model, params, settings)
+        # a scenario that draws random numbers per job (noise) seeds them by job id, so results do
+        # not depend on the chunking: it declares ``fn.uses_job_id = True`` and gets params["job_id"]
+        res = fn(model, {**params, "job_id": np.asarray(job_ids)} if getattr(fn, "uses_job_id", False) else params,
+                 settings)
         res = {k: np.asarray(v, dtype=np.float64) for k, v in res.items()}
         for k, v in res.items():
             if v.shape != (n,):

@@ -122,7 +122,9 @@ def grasp_step(F1, F2, det, buf, est, bw, Phi, Gam, cy, cs, cp, xt, out):  # pra
     for i in range(2):
         y = out[i, 1]
         if cs[i, _PHASE] == SQUEEZE:
-            step = (cp[3] - cs[i, _FREF]) * dt / max(cp[4], dt)
+            # (conditional expressions, not builtin max/min: numba.cuda cannot compile those in an
+            # @njit callee, and gripkit.batch.gpu runs this step on the GPU; same values)
+            step = (cp[3] - cs[i, _FREF]) * dt / (dt if dt > cp[4] else cp[4])
             if abs(cp[3] - cs[i, _FREF]) <= abs(step):
                 cs[i, _FREF] = cp[3]
             else:
@@ -130,11 +132,14 @@ def grasp_step(F1, F2, det, buf, est, bw, Phi, Gam, cy, cs, cp, xt, out):  # pra
             d = y - cs[i, _YC]
             k = cp[11]
             if d > 50e-9:
-                k = min(max((out[i, 2] - cs[i, _FC]) / d, cp[10]), cp[11])
+                k = (out[i, 2] - cs[i, _FC]) / d
+                k = cp[10] if cp[10] > k else k
+                k = cp[11] if cp[11] < k else k
             cs[i, _REF] += dt * cp[2] * (cs[i, _FREF] - out[i, 2]) / k
         # inner loop: integral position control on the estimate, voltage clipped
         U = cs[i, _U] + dt * cp[1] * (cs[i, _REF] - y) / cp[7 + i]
-        U = min(max(U, cp[5]), cp[6])
+        U = cp[5] if cp[5] > U else U
+        U = cp[6] if cp[6] < U else U
         cs[i, _U] = U
         out[i, 0] = U
         out[i, 4] = cs[i, _PHASE]

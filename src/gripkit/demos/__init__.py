@@ -21,6 +21,7 @@ SECTIONS: dict[str, str] = {
     "ftg100": "gripkit.demos.ftg100",
     "tsfm": "gripkit.demos.tsfm",
     "dlr-hit": "gripkit.demos.dlr_hit",
+    "batch-robustness": "gripkit.demos.batch_robustness",
 }
 
 

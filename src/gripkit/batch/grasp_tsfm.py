@@ -1,0 +1,590 @@
+"""Many TSFM two-finger grasps at once, metrics only: the batch form of
+:func:`gripkit.control.two_finger_grasp.simulate_two_finger_grasp` (``001_0b92a7da96e7aa46.txt``
+§I, §V), registered as the sweep scenario ``tsfm-grasp``.
+
+Each job is one closed-loop grasp of a micropart drawn from a population: stiffness ``k_e``
+(N/m), width ``w`` (m), position (``X_p``, m from finger 1's rest tip, or ``offset`` from the
+centre of the gap), damping ``c_e``, pull-off ``F_po``, substrate friction ``F_stick``, the
+approach speed (contact timing: with the part's faces ``(gap − w)/2 ± offset`` away, the fingers
+touch after gap/speed) and the force-sensor noise ``noise_std`` (N). The loop is the same numba
+code as the single grasp (:func:`~gripkit.control.two_finger_grasp.grasp_step` and
+:func:`~gripkit.models.tsfm.gripper_advance`, called in the same order), but instead of a
+(N, 15) record each job reduces its samples on the fly to the :data:`METRICS` — 10 000 grasps of
+2000 samples would otherwise be 2.4 GB.
+
+Per-job setup. Only the contact mode of each finger depends on the part (k_side = 2 k_e,
+c_side = 2 c_e per side, pull-off F_po/k_side, see :class:`~gripkit.models.tsfm.TSFMGripper`):
+its ZOH matrices (13 dyadic levels) are recomputed per job in numba (:func:`_job_setup`: two
+9×9 matrix exponentials per finger, ≈ 40 µs: 2 % of a 0.1 s grasp, measured); the free mode, the estimators and
+the fingers' hysteresis come from one template per gripper. The contact mode is built exactly as
+:func:`~gripkit.models.tsfm.finger_hybrid` builds it (A + b_F kᵀ, [B_W, −k b_F]), so a job
+reproduces the single-grasp simulation bit for bit (tested).
+
+Metrics (times in s from the start; forces are the true contact forces at the samples):
+
+* ``t_contact1``, ``t_contact2``: first sample in contact (NaN if never);
+* ``t_squeeze``: both fingers detected, force control starts (NaN if never);
+* ``peak_force``: largest contact force of either finger; ``damage`` = peak > ``damage_force``;
+* ``max_displacement``: largest |X_p − X_p(0)| of the part (it slides on the substrate when the
+  finger forces differ by more than F_stick);
+* ``grasped``: at the last sample both fingers touch the part and squeeze it;
+  ``lost`` = not grasped, or displaced by more than ``lost_displacement``;
+* ``settling_time``: from ``t_squeeze`` until the grip force (F₁ + F₂)/2 stays within
+  ± ``band`` × ``grip_force`` (inf if it never does within the record);
+* ``final_error``: mean grip-force error over the last 10 % of the record, relative to the command;
+  ``final_force`` the mean grip force there (N);
+* ``width_error``: the seed's threshold width gap − (ŷ₁c + ŷ₂c) minus the true width (m, §V-C);
+* ``stiffness_error``: eq 16's k̂ = F̄/δ (measured force and estimated deformation, both averaged
+  over the last 10 %) relative to k_e, minus 1.
+"""
+
+from __future__ import annotations
+
+import math
+import threading
+import warnings
+from dataclasses import replace
+
+import numba
+import numpy as np
+from numba import prange
+
+from ..control.hybrid import _randn
+from ..control.two_finger_grasp import GraspSettings, _est_stack, _static_gain, _values, grasp_step
+from ..errors import ConfigError, ConsistencyWarning
+from ..models.tsfm import FINGER_NAMES, finger_state_space, gripper_advance, gripper_measure
+from ..sim.hybrid import MAX_EVENTS_PER_STEP
+from ..sim.integrators import _zoh_levels
+
+__all__ = ["METRICS", "FAST_GRASP", "tsfm_grasp_batch", "record_metrics", "tsfm_grasp", "GraspTemplate",
+           "POPULATION_NAMES"]
+
+METRICS = ("t_contact1", "t_contact2", "t_squeeze", "peak_force", "damage", "max_displacement", "grasped",
+           "lost", "settling_time", "final_error", "final_force", "width_error", "stiffness_error")
+_NM = len(METRICS)
+#: per-job parameters a population may vary (with ``offset`` as an alternative to ``X_p``)
+POPULATION_NAMES = ("k_e", "w", "X_p", "offset", "c_e", "F_po", "F_stick", "approach_speed", "noise_std")
+
+#: a grasp that finishes in ~0.1 s (1 mm/s approach, 10 ms force ramp, 40 Hz force loop), used by
+#: the batch scenario unless told otherwise; the single-grasp defaults (40 µm/s, 0.3 s) take seconds
+FAST_GRASP = GraspSettings(approach_speed=1e-3, force_ramp_time=0.01, force_bandwidth_hz=40.0)
+
+_SQUEEZE = 2.0
+_PHASE, _CONTACT_T = 0, 6
+
+
+# ------------------------------------------------------------------------------------------------
+# numba kernels
+# ------------------------------------------------------------------------------------------------
+
+@numba.njit(cache=True)
+def _job_setup(A, B0, bF, iy, part, dt, K, Phi, Gam, C, D, Hg, Ac, Bc, PhiC, GamC):  # pragma: no cover
+    """Write the contact mode (index 1) of both fingers for the part ``part`` = [w, gap, k_side,
+    c_side, F_po, F_stick] into Phi (2, 2, K+1, n, n), Gam (2, 2, K+1, n, 3), C (2, 2, 4, n),
+    D (2, 2, 4, 3), Hg (2, 2, J, 3); the free mode (index 0) is left as it is. Mirrors
+    :func:`gripkit.models.tsfm.finger_hybrid`: A_c = A + b_F kᵀ (k = k_side at y_C, c_side at
+    ẏ_C), B_c = [B_W, −k_side b_F, 0], F_g = kᵀ x − k_side x_face, release at −F_po/k_side."""
+    n = A.shape[1]
+    k = part[2]
+    c = part[3]
+    for i in range(2):
+        for r in range(n):
+            for q in range(n):
+                kv = k if q == iy else (c if q == iy + 1 else 0.0)
+                Ac[i, r, q] = A[i, r, q] + bF[i, r] * kv
+            Bc[i, r, 0] = B0[i, r]
+            Bc[i, r, 1] = -k * bF[i, r]
+            Bc[i, r, 2] = 0.0
+    _zoh_levels(Ac, Bc, dt, K, PhiC, GamC)
+    for i in range(2):
+        for lev in range(K + 1):
+            for r in range(n):
+                for q in range(n):
+                    Phi[i, 1, lev, r, q] = PhiC[i, lev, r, q]
+                for q in range(3):
+                    Gam[i, 1, lev, r, q] = GamC[i, lev, r, q]
+        for q in range(n):
+            C[i, 1, 2, q] = k if q == iy else (c if q == iy + 1 else 0.0)
+        D[i, 1, 2, 0] = 0.0
+        D[i, 1, 2, 1] = -k
+        D[i, 1, 2, 2] = 0.0
+        Hg[i, 1, 0, 2] = part[4] / k
+
+
+@numba.njit(cache=True)
+def _grasp_core(bw, Phi, Gam, C, D, G, Hg, target, ng, K, part, noise, nstd, seed, n_steps, ebw, ePhi, eGam,
+                ecy, cp, mset, det, buf, est, cs, X, modes, hyst, ps, ext, out, ua, xt, ev_frac, ev_to, yout,
+                rng, met):  # pragma: no cover - compiled
+    """One grasp from rest, reduced to the metrics ``met`` (len(METRICS)); no allocation (every
+    work array is passed in, so the function also compiles for CUDA, one job per thread).
+
+    ``noise`` (N, 2): the force-sensor noise per sample when it has rows, else white noise of std
+    ``nstd`` from a splitmix64 stream seeded with ``seed``. ``mset`` = [damage_force,
+    lost_displacement, band]. The loop is the one of ``_grasp_run`` (two_finger_grasp.py)."""
+    dt = cp[15]
+    fcmd = cp[3]
+    for i in range(2):
+        for j in range(det.shape[1]):
+            det[i, j] = 0.0
+        for j in range(buf.shape[1]):
+            buf[i, j] = 0.0
+        for j in range(est.shape[1]):
+            est[i, j] = 0.0
+        for j in range(cs.shape[1]):
+            cs[i, j] = 0.0
+        cs[i, _CONTACT_T] = -1.0
+        for j in range(X.shape[1]):
+            X[i, j] = 0.0
+        modes[i] = 0
+    for j in range(4):
+        hyst[j] = 0.0
+    x0p = part[6]
+    ps[0] = x0p
+    rng[0] = np.uint64(seed) * np.uint64(0x2545F4914F6CDD1D) + np.uint64(1)
+    explicit = noise.shape[0] > 0
+    t_c1 = -1.0
+    t_c2 = -1.0
+    t_sq = -1.0
+    peak = 0.0
+    maxd = 0.0
+    y1c = 0.0
+    y2c = 0.0
+    det1 = False
+    det2 = False
+    last_out = -1
+    n_tail_max = n_steps // 10   # builtin max/min are avoided here: numba.cuda cannot retarget them
+    if n_tail_max < 1:
+        n_tail_max = 1
+    tail = n_steps - n_tail_max
+    sum_f = 0.0
+    sum_fm = 0.0
+    sum_s = 0.0
+    n_tail = 0
+    grasped = False
+    gripper_measure(X, modes, ps[0], C, D, part, ua, yout)
+    for k in range(n_steps):
+        if explicit:
+            F1 = yout[0, 3] + noise[k, 0]
+            F2 = yout[1, 3] + noise[k, 1]
+        else:
+            F1 = yout[0, 3] + nstd * _randn(rng)
+            F2 = yout[1, 3] + nstd * _randn(rng)
+        grasp_step(F1, F2, det, buf, est, ebw, ePhi, eGam, ecy, cs, cp, ext, out)
+        # --- metrics of sample k (the record row k of the single grasp)
+        fg1 = yout[0, 2]
+        fg2 = yout[1, 2]
+        if fg1 > peak:
+            peak = fg1
+        if fg2 > peak:
+            peak = fg2
+        d = abs(ps[0] - x0p)
+        if d > maxd:
+            maxd = d
+        if t_c1 < 0.0 and modes[0] == 1:
+            t_c1 = k * dt
+        if t_c2 < 0.0 and modes[1] == 1:
+            t_c2 = k * dt
+        if not det1 and out[0, 3] > 0.5:
+            det1 = True
+            y1c = out[0, 1]
+        if not det2 and out[1, 3] > 0.5:
+            det2 = True
+            y2c = out[1, 1]
+        if t_sq < 0.0 and out[0, 4] == _SQUEEZE:
+            t_sq = k * dt
+        fbar = 0.5 * (fg1 + fg2)
+        if t_sq >= 0.0 and abs(fbar - fcmd) > mset[2] * fcmd:
+            last_out = k
+        if k >= tail:
+            sum_f += fbar
+            sum_fm += 0.5 * (F1 + F2)
+            sum_s += out[0, 1] + out[1, 1]
+            n_tail += 1
+        if k == n_steps - 1:
+            grasped = modes[0] == 1 and modes[1] == 1 and out[0, 4] == _SQUEEZE and out[1, 4] == _SQUEEZE
+        gripper_advance(out[0, 0], out[1, 0], X, modes, hyst, ps, bw, Phi, Gam, C, D, G, Hg, target, ng, K, part,
+                        ua, xt, ev_frac, ev_to, yout)
+    nan = math.nan
+    met[0] = t_c1 if t_c1 >= 0.0 else nan
+    met[1] = t_c2 if t_c2 >= 0.0 else nan
+    met[2] = t_sq if t_sq >= 0.0 else nan
+    met[3] = peak
+    met[4] = 1.0 if peak > mset[0] else 0.0
+    met[5] = maxd
+    met[6] = 1.0 if grasped else 0.0
+    met[7] = 1.0 if (not grasped or maxd > mset[1]) else 0.0
+    if t_sq < 0.0 or last_out == n_steps - 1:
+        met[8] = math.inf
+    else:
+        met[8] = (last_out + 1) * dt - t_sq
+        if met[8] < 0.0:
+            met[8] = 0.0
+    met[9] = (sum_f / n_tail - fcmd) / fcmd
+    met[10] = sum_f / n_tail
+    if det1 and det2:
+        met[11] = part[1] - (y1c + y2c) - part[0]
+        delta = sum_s / n_tail - (y1c + y2c)
+        met[12] = (sum_fm / n_tail) / delta / (0.5 * part[2]) - 1.0 if (grasped and delta > 0.0) else nan
+    else:
+        met[11] = nan
+        met[12] = nan
+
+
+@numba.njit(cache=True, nogil=True)
+def _grasp_jobs(tA, tB0, tbF, iy, tPhi, tGam, tC, tD, G, tH, target, ng, K, bw, parts, noise, nstd, seeds, n_steps,
+                window, ebw, ePhi, eGam, ecy, cps, mset, met):  # pragma: no cover - compiled
+    """Jobs one after another on this core (rows of parts, cps, nstd, seeds, met): for each, the
+    template's matrices with the contact mode of its part (:func:`_job_setup`), then
+    :func:`_grasp_core`. ``noise`` (P, N, 2) explicit noise per job, or (1, 0, 2) for generated
+    noise. ``nogil``: :func:`tsfm_grasp_batch` runs slices of the jobs on several threads.
+
+    Compile time (measured, cold cache): one level of calls above :func:`_grasp_core` — each
+    extra level, and a ``prange`` variant (+15 s), re-optimises the whole linked grasp step."""
+    n = tA.shape[1]
+    L = K + 1
+    Phi = tPhi.copy()
+    Gam = tGam.copy()
+    C = tC.copy()
+    D = tD.copy()
+    Hg = tH.copy()
+    Ac, Bc, PhiC, GamC = np.empty((2, n, n)), np.empty((2, n, 3)), np.empty((2, L, n, n)), np.empty((2, L, n, 3))
+    det, buf, est, cs = np.empty((2, 5)), np.empty((2, window)), np.empty((2, 6)), np.empty((2, 7))
+    X, modes, hyst, ps = np.empty((2, n)), np.empty(2, dtype=np.int64), np.empty(4), np.empty(1)
+    ext, out, ua, xt = np.empty(4), np.empty((2, 5)), np.empty(3), np.empty(n)
+    ev_frac, ev_to = np.empty(MAX_EVENTS_PER_STEP), np.empty(MAX_EVENTS_PER_STEP, dtype=np.int64)
+    yout, rng = np.empty((2, tC.shape[2])), np.empty(1, dtype=np.uint64)
+    for p in range(parts.shape[0]):
+        q = p if noise.shape[0] > 1 else 0
+        _job_setup(tA, tB0, tbF, iy, parts[p], cps[p, 15], K, Phi, Gam, C, D, Hg, Ac, Bc, PhiC, GamC)
+        _grasp_core(bw, Phi, Gam, C, D, G, Hg, target, ng, K, parts[p], noise[q],
+                    nstd[p], seeds[p], n_steps, ebw, ePhi, eGam, ecy, cps[p], mset, det, buf, est, cs, X, modes,
+                    hyst, ps, ext, out, ua, xt, ev_frac, ev_to, yout, rng, met[p])
+
+
+@numba.njit(cache=True, parallel=True)
+def _setup_jobs(tA, tB0, tbF, iy, parts, dt, K, Phi, Gam, C, D, Hg):  # pragma: no cover - compiled
+    """Contact modes of every job into stacks with a leading job index (the GPU path's setup)."""
+    n = tA.shape[1]
+    L = K + 1
+    for p in prange(parts.shape[0]):
+        _job_setup(tA, tB0, tbF, iy, parts[p], dt, K, Phi[p], Gam[p], C[p], D[p], Hg[p], np.empty((2, n, n)),
+                   np.empty((2, n, 3)), np.empty((2, L, n, n)), np.empty((2, L, n, 3)))
+
+
+# ------------------------------------------------------------------------------------------------
+# Python side
+# ------------------------------------------------------------------------------------------------
+
+class GraspTemplate:
+    """What the jobs of one gripper share: the discretised free modes, the fingers' continuous
+    matrices for the per-job contact modes, the Bouc-Wen parameters, the estimators (of
+    ``estimator_fingers``, default the gripper's own) and the nominal part."""
+
+    def __init__(self, gripper, dt: float, estimator_fingers=None):
+        th = gripper.theta()
+        names = gripper.parameters.names
+        self.names = names
+        self.theta = th
+        d = gripper.arrays(th[None, :], dt)
+        nf = len(FINGER_NAMES)
+        A, B0, bF = [], [], []
+        for i in range(2):
+            ss = finger_state_space(th[i * nf:(i + 1) * nf])
+            A.append(ss.A)
+            B0.append(ss.B[:, 0])
+            bF.append(ss.B[:, 1])
+        c = np.ascontiguousarray
+        self.A, self.B0, self.bF = c(np.array(A)), c(np.array(B0)), c(np.array(bF))
+        self.iy = 4  # y_C in the component-wise state (finger_state_space)
+        self.Phi, self.Gam, self.C, self.D = (c(d[k][0]) for k in ("Phi", "Gam", "C", "D"))
+        self.G, self.H, self.bw = c(d["G"][0]), c(d["H"][0]), c(d["bw"][0])
+        self.target, self.ng, self.K = d["target"], d["ng"], int(d["K"])
+        self.part = d["part"][0].copy()
+        fingers = estimator_fingers or gripper.fingers
+        vals = [_values(f) for f in fingers]
+        e, _ = _est_stack(vals, dt)
+        self.est = (e["bw"], e["Phi"], e["Gam"], e["cy"])
+        self.gains = (_static_gain(vals[0]), _static_gain(vals[1]))
+        self.dt = float(dt)
+
+    def value(self, name: str) -> float:
+        return float(self.theta[self.names.index(name)])
+
+    def kernel_args(self) -> tuple:
+        return (self.A, self.B0, self.bF, self.iy, self.Phi, self.Gam, self.C, self.D, self.G, self.H, self.target,
+                self.ng, self.K, self.bw)
+
+
+_TEMPLATES: dict = {}
+_LOCK = threading.Lock()
+
+
+def _template(gripper, dt, estimator_fingers) -> GraspTemplate:
+    """One template per (gripper, dt, estimator fingers) and process (a sweep's chunks share it)."""
+    key = (id(gripper), float(dt), id(estimator_fingers))
+    with _LOCK:
+        hit = _TEMPLATES.get(key)
+        if hit is None or hit[0] is not gripper or hit[1] is not estimator_fingers:
+            if len(_TEMPLATES) > 16:
+                _TEMPLATES.clear()
+            hit = (gripper, estimator_fingers, GraspTemplate(gripper, dt, estimator_fingers))
+            _TEMPLATES[key] = hit
+    return hit[2]
+
+
+def _default_gripper():
+    from ..zoo import tsfm as z
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ConsistencyWarning)
+        return z.gripper(check=False)
+
+
+def _jobs(tpl: GraspTemplate, settings: GraspSettings, n_jobs: int, arrays: dict, noise_seed: int, job_ids):
+    """Per-job part vectors, controller vectors, noise std and seeds; ConfigError on a bad job."""
+    P = n_jobs
+
+    def col(name, default):
+        v = arrays.get(name)
+        out = np.full(P, float(default)) if v is None else np.asarray(v, dtype=np.float64).reshape(-1)
+        if out.shape != (P,):
+            raise ConfigError(f"{name}: expected one value or {P}, found shape {np.shape(v)}")
+        if not np.isfinite(out).all():
+            raise ConfigError(f"{name}: expected finite values, found {out[~np.isfinite(out)][:3]}")
+        return out
+
+    gap = col("gap", tpl.value("gap"))
+    w = col("w", tpl.value("w"))
+    k_e = col("k_e", tpl.value("k_e"))
+    c_e = col("c_e", tpl.value("c_e"))
+    F_po = col("F_po", tpl.value("F_po"))
+    F_stick = col("F_stick", tpl.value("F_stick"))
+    if arrays.get("X_p") is not None and arrays.get("offset") is not None:
+        raise ConfigError("give the part's position as X_p or as offset (from the centre), not both")
+    X_p = col("X_p", 0.0) if arrays.get("X_p") is not None else gap / 2 + col("offset", 0.0)
+    speed = col("approach_speed", settings.approach_speed)
+    nstd = col("noise_std", arrays.get("_noise_default", 2e-6))
+    for name, v, lo in (("k_e", k_e, 0.0), ("w", w, 0.0), ("approach_speed", speed, 0.0)):
+        if (v <= lo).any():
+            raise ConfigError(f"{name}: expected positive values, found {v[v <= lo][:3]}")
+    for name, v in (("c_e", c_e), ("F_po", F_po), ("F_stick", F_stick), ("noise_std", nstd)):
+        if (v < 0).any():
+            raise ConfigError(f"{name}: expected values >= 0, found {v[v < 0][:3]}")
+    bad = (w >= gap) | (X_p < w / 2) | (X_p > gap - w / 2)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise ConfigError(f"part {i}: width {w[i] * 1e6:.4g} µm at X_p = {X_p[i] * 1e6:.4g} µm does not fit between "
+                          f"the fingers (gap {gap[i] * 1e6:.4g} µm)", hint="keep w/2 <= X_p <= gap - w/2")
+    parts = np.ascontiguousarray(np.column_stack([w, gap, 2 * k_e, 2 * c_e, F_po, F_stick, X_p]))
+    cp0 = settings.vector(tpl.gains, tpl.dt)
+    cps = np.repeat(cp0[None, :], P, axis=0)
+    cps[:, 0] = speed
+    ids = np.arange(P, dtype=np.int64) if job_ids is None else np.asarray(job_ids, dtype=np.int64).reshape(-1)
+    seeds = (ids + np.int64(noise_seed) * np.int64(1_000_003)).astype(np.int64)
+    cols = dict(k_e=k_e, w=w, X_p=X_p, c_e=c_e, F_po=F_po, F_stick=F_stick, gap=gap, approach_speed=speed,
+                noise_std=nstd)
+    return parts, np.ascontiguousarray(cps), np.ascontiguousarray(nstd), seeds, cols
+
+
+def tsfm_grasp_batch(gripper=None, *, settings: GraspSettings = FAST_GRASP, duration: float = 0.1,
+                     fs: float = 20000.0, k_e=None, w=None, X_p=None, offset=None, c_e=None, F_po=None,
+                     F_stick=None, gap=None, approach_speed=None, noise_std=2e-6, noise_seed: int = 0,
+                     job_ids=None, noise=None, damage_force: float | None = None, lost_displacement: float = 10e-6,
+                     band: float = 0.05, estimator_fingers=None, backend: str = "cpu", serial: bool = False,
+                     progress: bool = False) -> dict[str, np.ndarray]:
+    """Simulate many grasps of the two-finger loop on ``gripper`` (default: the zoo's
+    ``tsfm-gripper``) and return their :data:`METRICS` and the per-job parameters as columns.
+
+    Per-job arrays (broadcast against each other; unset ones take the gripper's values): ``k_e``
+    (N/m), ``w`` (m), ``X_p`` (m from finger 1's rest tip) or ``offset`` (m from mid-gap),
+    ``c_e`` (N·s/m), ``F_po``, ``F_stick`` (N), ``gap`` (m), ``approach_speed`` (m/s, default the
+    settings'), ``noise_std`` (N). The noise of job j comes from its own splitmix64 stream seeded
+    by ``job_ids[j]`` (default j) and ``noise_seed``: results do not depend on chunking or thread
+    scheduling. ``noise`` (P, N, 2), if given, is used instead (N = duration·fs samples).
+    ``damage_force`` defaults to 1.25 × ``settings.grip_force``. ``backend``: 'cpu' (the
+    nogil numba kernel on ``numba.get_num_threads()`` threads, one with ``serial=True``) or 'cuda'
+    (:mod:`gripkit.batch.gpu`, needs a CUDA device).
+    """
+    if not (math.isfinite(duration) and duration > 0 and math.isfinite(fs) and fs > 0):
+        raise ConfigError(f"duration and fs must be positive, found {duration!r} s, {fs!r} Hz")
+    if not (math.isfinite(band) and 0 < band < 1):
+        raise ConfigError(f"band: expected a fraction in (0, 1), found {band!r}")
+    if not isinstance(settings, GraspSettings):
+        raise ConfigError(f"settings: expected a GraspSettings, found {type(settings).__name__}")
+    gripper = gripper if gripper is not None else _default_gripper()
+    dt = 1.0 / fs
+    n_steps = int(round(duration * fs))
+    tpl = _template(gripper, dt, estimator_fingers)
+    given = dict(k_e=k_e, w=w, X_p=X_p, offset=offset, c_e=c_e, F_po=F_po, F_stick=F_stick, gap=gap,
+                 approach_speed=approach_speed, noise_std=noise_std)
+    present = {k: np.asarray(v, dtype=np.float64) for k, v in given.items() if v is not None}
+    shape = np.broadcast_shapes(*(v.shape for v in present.values()), () if job_ids is None else np.shape(job_ids))
+    P = int(np.prod(shape)) if shape else 1
+    arrays = {k: np.broadcast_to(v, shape).reshape(-1) if shape else v.reshape(1) for k, v in present.items()}
+    parts, cps, nstd, seeds, cols = _jobs(tpl, settings, P, arrays, noise_seed, job_ids)
+    dmg = 1.25 * settings.grip_force if damage_force is None else float(damage_force)
+    if not (dmg > 0 and lost_displacement > 0):
+        raise ConfigError("damage_force and lost_displacement must be positive")
+    mset = np.array([dmg, float(lost_displacement), float(band)])
+    if noise is None:
+        nz = np.zeros((1, 0, 2))
+    else:
+        nz = np.ascontiguousarray(np.asarray(noise, dtype=np.float64))
+        if nz.shape != (P, n_steps, 2) or not np.isfinite(nz).all():
+            raise ConfigError(f"noise: expected finite values of shape ({P}, {n_steps}, 2), found {nz.shape}")
+    met = np.empty((P, _NM))
+    if backend == "cuda":
+        from .gpu import run_cuda
+
+        run_cuda(tpl, parts, nz, nstd, seeds, n_steps, settings.window, cps, mset, met)
+    elif backend == "cpu":
+        _run_cpu(tpl, parts, nz, nstd, seeds, n_steps, settings.window, cps, mset, met, 1 if serial else None,
+                 progress)
+    else:
+        raise ConfigError(f"backend: expected 'cpu' or 'cuda', found {backend!r}")
+    return {**cols, **{m: met[:, i] for i, m in enumerate(METRICS)}}
+
+
+def _run_cpu(tpl, parts, nz, nstd, seeds, n_steps, window, cps, mset, met, threads=None, progress=False):
+    """Slices of the jobs on ``threads`` threads (default numba's thread count, 1 in a pinned
+    worker process) running the nogil kernel :func:`_grasp_jobs`; the results land in ``met``."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from ..progress import track
+
+    P = parts.shape[0]
+    threads = max(1, min(numba.get_num_threads() if threads is None else int(threads), P))
+    size = max(1, min(64, -(-P // (4 * threads))))   # small slices: even load, a live progress bar
+
+    def run(a):
+        b = min(P, a + size)
+        _grasp_jobs(*tpl.kernel_args(), parts[a:b], nz if nz.shape[0] == 1 else nz[a:b], nstd[a:b], seeds[a:b],
+                    n_steps, window, *tpl.est, cps[a:b], mset, met[a:b])
+        return b - a
+
+    starts = range(0, P, size)
+    if threads == 1:
+        done = map(run, starts)
+        for _ in track(done, total=len(starts), description="TSFM grasps", enabled=progress and P > 256):
+            pass
+        return
+    with ThreadPoolExecutor(threads) as pool:
+        for _ in track(pool.map(run, starts), total=len(starts), description="TSFM grasps",
+                       enabled=progress and P > 256):
+            pass
+
+
+def record_metrics(result, *, gap: float | None = None, width: float | None = None, stiffness: float | None = None,
+                   damage_force: float | None = None, lost_displacement: float = 10e-6,
+                   band: float = 0.05) -> dict[str, float]:
+    """The :data:`METRICS` of one recorded grasp (a
+    :class:`~gripkit.control.two_finger_grasp.TwoFingerGraspResult`), computed from its record with
+    numpy: the reference the batch kernel is tested against. ``gap``, ``width`` (m) and
+    ``stiffness`` (N/m) are the truth for the estimate errors (NaN without them)."""
+    from ..estimation.contact_detection import ContactDetector
+
+    tr = result.trajectory
+    s = result.settings
+    dt = 1.0 / tr.meta["fs"]
+    n = tr.t.size
+    fcmd = s.grip_force
+    dmg = 1.25 * fcmd if damage_force is None else damage_force
+    F1, F2 = tr["F_g1"], tr["F_g2"]
+
+    def first(mask):
+        idx = np.flatnonzero(mask)
+        return int(idx[0]) if idx.size else -1
+
+    c1, c2 = first(tr["contact1"] > 0.5), first(tr["contact2"] > 0.5)
+    sq = first(tr["phase1"] == _SQUEEZE)
+    peak = float(max(F1.max(), F2.max(), 0.0))
+    maxd = float(np.abs(tr["X_p"] - tr["X_p"][0]).max())
+    grasped = bool(tr["contact1"][-1] == 1 and tr["contact2"][-1] == 1 and tr["phase1"][-1] == _SQUEEZE
+                   and tr["phase2"][-1] == _SQUEEZE)
+    fbar = 0.5 * (F1 + F2)
+    settle = math.inf
+    if sq >= 0:
+        out = np.flatnonzero(np.abs(fbar[sq:] - fcmd) > band * fcmd)
+        last = sq + int(out[-1]) if out.size else -1
+        settle = math.inf if last == n - 1 else max(0.0, (last + 1) * dt - sq * dt)
+    tail = slice(n - max(1, n // 10), n)
+    nan = math.nan
+    m = dict(t_contact1=c1 * dt if c1 >= 0 else nan, t_contact2=c2 * dt if c2 >= 0 else nan,
+             t_squeeze=sq * dt if sq >= 0 else nan, peak_force=peak, damage=float(peak > dmg),
+             max_displacement=maxd, grasped=float(grasped), lost=float((not grasped) or maxd > lost_displacement),
+             settling_time=settle, final_error=float((fbar[tail].mean() - fcmd) / fcmd),
+             final_force=float(fbar[tail].mean()), width_error=nan, stiffness_error=nan)
+    i1, i2 = (first(ContactDetector(s.threshold, window=s.window, release=s.release).run(tr[f"F_meas{i}"])[0])
+              for i in (1, 2))
+    if i1 >= 0 and i2 >= 0 and gap is not None and width is not None:
+        ysum = float(tr["y_hat1"][i1] + tr["y_hat2"][i2])
+        m["width_error"] = gap - ysum - width
+        delta = float((tr["y_hat1"] + tr["y_hat2"])[tail].mean()) - ysum
+        if grasped and delta > 0 and stiffness is not None:
+            m["stiffness_error"] = float((0.5 * (tr["F_meas1"] + tr["F_meas2"]))[tail].mean()) / delta / stiffness - 1
+    return m
+
+
+# ------------------------------------------------------------------------------------------------
+# the sweep scenario
+# ------------------------------------------------------------------------------------------------
+
+_SETTING_KEYS = {"grip_force": "N", "approach_speed": "m/s", "position_bandwidth_hz": "Hz",
+                 "force_bandwidth_hz": "Hz", "force_ramp_time": "s", "threshold": "N", "release": "N",
+                 "window": "1", "u_min": "V", "u_max": "V", "max_closing": "m", "k_min": "N/m", "k_max": "N/m",
+                 "wait_for_other": "bool"}
+_OTHER_KEYS = ("duration", "fs", "damage_force", "lost_displacement", "band", "noise_std", "noise_seed", "backend")
+
+
+def settings_from_table(table: dict) -> tuple[GraspSettings, dict]:
+    """(GraspSettings, other options) from a sweep's ``[scenario]`` table; numbers in SI or
+    strings with units ("200 uN"). Starts from :data:`FAST_GRASP`."""
+    from .spec import _si
+
+    unknown = sorted(set(table) - set(_SETTING_KEYS) - set(_OTHER_KEYS))
+    if unknown:
+        raise ConfigError(f"[scenario] (tsfm-grasp): unknown keys {unknown}",
+                          hint=f"allowed: {', '.join([*_SETTING_KEYS, *_OTHER_KEYS])}")
+    changes = {}
+    for k, kind in _SETTING_KEYS.items():
+        if k in table:
+            if kind == "bool":
+                changes[k] = bool(table[k])
+            elif kind == "1":
+                changes[k] = int(table[k])
+            else:
+                changes[k] = _si(table[k], f"[scenario] {k}")
+    opts = {k: table[k] for k in _OTHER_KEYS if k in table}
+    for k in ("duration", "fs", "damage_force", "lost_displacement", "noise_std"):
+        if k in opts:
+            opts[k] = _si(opts[k], f"[scenario] {k}")
+    return replace(FAST_GRASP, **changes), opts
+
+
+def tsfm_grasp(model, params: dict[str, np.ndarray], settings: dict) -> dict[str, np.ndarray]:
+    """Sweep scenario ``tsfm-grasp``: one TSFM grasp per job (see the module docstring).
+    ``model``: a :class:`~gripkit.models.tsfm.TSFMGripper` (``model = "tsfm-gripper"``) or None
+    (the zoo's). Parameters: any of :data:`POPULATION_NAMES`; ``[scenario]``: the
+    :class:`GraspSettings` fields and duration, fs, damage_force, lost_displacement, band,
+    noise_std (when not a parameter), noise_seed, backend ('cpu' | 'cuda')."""
+    from ..models.tsfm import TSFMGripper
+
+    if model is not None and not isinstance(model, TSFMGripper):
+        raise ConfigError(f"scenario 'tsfm-grasp' needs a TSFM gripper model, found {type(model).__name__}",
+                          hint='model = "tsfm-gripper"')
+    unknown = [k for k in params if k not in POPULATION_NAMES and k not in ("job_id", "gap")]
+    if unknown:
+        raise ConfigError(f"tsfm-grasp: unknown parameters {unknown}", hint=f"allowed: {', '.join(POPULATION_NAMES)}")
+    gs, opts = settings_from_table(settings)
+    kw = {k: v for k, v in params.items() if k != "job_id"}
+    if "noise_std" not in kw:
+        kw["noise_std"] = opts.get("noise_std", 2e-6)
+    res = tsfm_grasp_batch(model, settings=gs, duration=opts.get("duration", 0.1), fs=opts.get("fs", 20000.0),
+                           job_ids=params.get("job_id"), noise_seed=int(opts.get("noise_seed", 0)),
+                           damage_force=opts.get("damage_force"),
+                           lost_displacement=opts.get("lost_displacement", 10e-6), band=float(opts.get("band", 0.05)),
+                           backend=str(opts.get("backend", "cpu")), **kw)
+    return {m: res[m] for m in METRICS}
+
+
+tsfm_grasp.uses_job_id = True
