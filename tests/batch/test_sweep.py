@@ -129,3 +129,26 @@ def test_wilson_interval_and_quantiles():
     assert q.low < 0.0 < q.high and q.high - q.low < 0.1
     rows = binned_probability(np.arange(100.0), np.arange(100) >= 50, [0, 50, 100])
     assert rows[0]["p"] == 0 and rows[1]["p"] == 1
+
+
+def square(x):
+    return x * x
+
+
+def test_many_tiny_tasks_never_stall_the_pool():
+    """Results of prefetched tasks arrive back to back: every one is read (a frame left in a
+    buffered reader while select() waits would stall the pool forever). Run in a thread so a
+    regression fails in 120 s instead of hanging."""
+    import threading
+
+    out = {}
+
+    def work():
+        with ProcessExecutor(2) as ex:
+            out["res"] = sorted(v for _, ok, v in ex.map_unordered((i, square, (i,)) for i in range(400)))
+
+    th = threading.Thread(target=work, daemon=True)
+    th.start()
+    th.join(120)
+    assert not th.is_alive(), "the process pool stalled"
+    assert out["res"] == sorted(i * i for i in range(400))

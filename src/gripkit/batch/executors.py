@@ -88,19 +88,18 @@ class _Worker:
     def __init__(self, log):
         env = dict(os.environ)
         env.update(PIN_ENV)
+        # unbuffered pipes: a frame must never hide in a Python buffer while select() waits
         self.proc = subprocess.Popen([sys.executable, "-m", "gripkit.batch.worker"], stdin=subprocess.PIPE,
-                                     stdout=subprocess.PIPE, stderr=log, env=env)
-        self.task: Task | None = None
+                                     stdout=subprocess.PIPE, stderr=log, env=env, bufsize=0)
+        self.tasks: collections.deque = collections.deque()  # sent, not yet answered (oldest first)
 
     @property
     def pid(self) -> int:
         return self.proc.pid
 
-    def send(self, task: Task) -> None:
-        import cloudpickle
-
-        self.task = task
-        write_frame(self.proc.stdin, cloudpickle.dumps(task, protocol=pickle.HIGHEST_PROTOCOL))
+    def send(self, task: Task, payload: bytes) -> None:
+        self.tasks.append(task)
+        write_frame(self.proc.stdin, payload)
 
     def stop(self) -> None:
         try:
@@ -138,48 +137,59 @@ class ProcessExecutor(Executor):
         self._pool.append(w)
         return w
 
+    #: tasks queued ahead in a worker's pipe so it never waits for the coordinator between tasks
+    #: (only frames this small: a full pipe must not block the coordinator)
+    PREFETCH = 2
+    PREFETCH_MAX_BYTES = 32 * 1024
+
     def map_unordered(self, tasks):
+        import cloudpickle
+
         pending = collections.deque(tasks)
         attempts: dict = collections.defaultdict(int)
         sel = selectors.DefaultSelector()
         try:
             while len(self._pool) < min(self.workers, max(len(pending), 1)):
                 self._spawn()
-            idle = list(self._pool)
-            busy = 0
-            while pending or busy:
-                while idle and pending:
-                    w = idle.pop()
-                    task = pending.popleft()
-                    try:
-                        w.send(task)
-                    except (BrokenPipeError, OSError):
-                        pending.appendleft(task)
-                        self._retire(w, sel)
-                        idle.append(self._spawn())
-                        continue
-                    sel.register(w.proc.stdout, selectors.EVENT_READ, w)
-                    busy += 1
+            for w in self._pool:
+                sel.register(w.proc.stdout, selectors.EVENT_READ, w)
+            while pending or any(w.tasks for w in self._pool):
+                for w in list(self._pool):  # fill every worker up to its prefetch depth
+                    while pending and len(w.tasks) < self.PREFETCH:
+                        task = pending[0]
+                        payload = cloudpickle.dumps(task, protocol=pickle.HIGHEST_PROTOCOL)
+                        if w.tasks and len(payload) > self.PREFETCH_MAX_BYTES:
+                            break
+                        pending.popleft()
+                        try:
+                            w.send(task, payload)
+                        except (BrokenPipeError, OSError):
+                            break  # it died: its death is read below and its tasks re-queued
                 for skey, _ in sel.select():
                     w: _Worker = skey.data
-                    sel.unregister(w.proc.stdout)
-                    busy -= 1
                     frame = read_frame(w.proc.stdout)
-                    task, w.task = w.task, None
-                    if frame is None:  # the worker died while running ``task``
+                    if frame is None:  # the worker died while running its oldest task
                         code = w.proc.wait()
+                        lost = list(w.tasks)
                         self._retire(w, sel)
-                        attempts[task[0]] += 1
-                        if attempts[task[0]] >= self.max_attempts:
-                            yield task[0], False, (f"WorkerDied: a worker exited with code {code} while "
-                                                   f"running this task ({attempts[task[0]]} attempts)")
-                        else:
+                        culprit = lost[0] if lost else None
+                        for task in reversed(lost[1:]):  # never started: not at fault
                             pending.appendleft(task)
-                        if pending:
-                            idle.append(self._spawn())
+                        if culprit is not None:
+                            attempts[culprit[0]] += 1
+                            if attempts[culprit[0]] >= self.max_attempts:
+                                yield culprit[0], False, (
+                                    f"WorkerDied: a worker exited with code {code} while running this task "
+                                    f"({attempts[culprit[0]]} attempts)")
+                            else:
+                                pending.appendleft(culprit)
+                        if pending or any(x.tasks for x in self._pool) or not self._pool:
+                            if pending:
+                                nw = self._spawn()
+                                sel.register(nw.proc.stdout, selectors.EVENT_READ, nw)
                         continue
+                    w.tasks.popleft()
                     key, ok, value = pickle.loads(frame)
-                    idle.append(w)
                     yield key, ok, value
         finally:
             sel.close()

@@ -20,20 +20,33 @@ _HEADER = struct.Struct("<Q")
 
 
 def write_frame(stream, payload: bytes) -> None:
-    stream.write(_HEADER.pack(len(payload)))
-    stream.write(payload)
+    """Write one length-prefixed frame (handles partial writes of unbuffered pipes)."""
+    data = memoryview(_HEADER.pack(len(payload)) + payload)
+    while data:
+        n = stream.write(data)
+        data = data[n if n is not None else len(data):]
     stream.flush()
 
 
+def _read_exact(stream, n: int) -> bytes | None:
+    chunks = []
+    while n > 0:
+        b = stream.read(n)
+        if not b:
+            return None
+        chunks.append(b)
+        n -= len(b)
+    return b"".join(chunks)
+
+
 def read_frame(stream) -> bytes | None:
-    head = stream.read(_HEADER.size)
-    if len(head) < _HEADER.size:
+    """Read one frame; None at end of stream. The coordinator reads its workers' pipes unbuffered,
+    so that ``select`` never misses a frame sitting in a Python-side buffer."""
+    head = _read_exact(stream, _HEADER.size)
+    if head is None:
         return None
     (n,) = _HEADER.unpack(head)
-    data = stream.read(n)
-    if len(data) < n:
-        return None
-    return data
+    return _read_exact(stream, n)
 
 
 def main() -> int:

@@ -167,8 +167,8 @@ def _var_factor(s, p):
 
 
 @njit(cache=True)
-def _rls_run(s, u, y, theta_out, var_out, yhat_out, size):
-    """Batch RLS: updates ``s`` over the record; writes θ, σ² and the a-priori prediction at
+def _rls_run(s, u, y, theta_out, std_out, yhat_out, size):
+    """Batch RLS: updates ``s`` over the record; writes θ, σ and the a-priori prediction at
     every step when the output arrays have N rows (pass arrays with 0 rows to skip storing).
 
     ``size``: an empty tuple (generic kernel, p at run time) or a tuple of p zeros, whose length
@@ -199,7 +199,7 @@ def _rls_run(s, u, y, theta_out, var_out, yhat_out, size):
             f = _var_factor(s, p)
             for i in range(p):
                 theta_out[t, i] = s[oth + i]
-                var_out[t, i] = f * s[op + i * p + i]
+                std_out[t, i] = math.sqrt(f * s[op + i * p + i])
     if n <= nstart:
         return
     th = np.empty(p)
@@ -234,7 +234,7 @@ def _rls_run(s, u, y, theta_out, var_out, yhat_out, size):
             f = V / (w1 - p) * (w2 / w1) if (nupd > p and w1 > p) else np.nan
             for i in range(p):
                 theta_out[t, i] = th[i]
-                var_out[t, i] = f * P[i * p + i]
+                std_out[t, i] = math.sqrt(f * P[i * p + i])
     for i in range(p):
         s[oth + i] = th[i]
     for i in range(p * p):
@@ -409,7 +409,6 @@ class RLS:
         yhat = np.empty(n)
         n0 = self.n_updates
         _rls_run(self._s, u, y, theta, std, yhat, (0.0,) * p if n >= SPECIALISE_ABOVE else ())
-        np.sqrt(std, out=std)  # the kernel wrote variances
         if not (np.isfinite(self.P).all() and np.isfinite(self.theta).all()):
             raise IdentificationError(
                 f"RLS [{self.na} {self.nb} {self.nk}] diverged: P or θ is no longer finite after "
