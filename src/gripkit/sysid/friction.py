@@ -453,7 +453,11 @@ def idim_ls(position, effort, fs: float, *, effort_scale: float = 1.0, cutoff: f
     r = y - X @ theta
     n = y.size
     s2 = float(r @ r / (n - 4))
-    cov = s2 * np.linalg.inv(X.T @ X)
+    # filtering, differentiation and decimation leave the residuals autocorrelated: the
+    # Newey-West covariance, not s²(XᵀX)⁻¹ (which would understate σ)
+    from .regression import hac_covariance
+
+    cov = hac_covariance(X, r)
     std = np.sqrt(np.diag(cov))
     rel = float(100.0 * np.linalg.norm(r) / max(np.linalg.norm(y), 1e-300))
     if cond > 1e4:

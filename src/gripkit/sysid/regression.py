@@ -27,7 +27,7 @@ import scipy.linalg as sla
 
 from ..errors import UnidentifiableError
 
-__all__ = ["arx_start", "arx_regression", "QRSolution", "qr_solve", "COND_LIMIT"]
+__all__ = ["arx_start", "arx_regression", "QRSolution", "qr_solve", "COND_LIMIT", "hac_covariance"]
 
 #: Largest acceptable condition number of the column-scaled regressor. Beyond it the data do
 #: not determine the parameters (1e10 keeps about 6 significant digits in float64).
@@ -136,3 +136,34 @@ def qr_solve(X: np.ndarray, names: tuple[str, ...], overwrite: bool = False) -> 
     rinv = sla.solve_triangular(r1, np.eye(p), check_finite=False)
     cov = rinv @ rinv.T
     return QRSolution(theta, float(R[p, p] ** 2), r1.copy(), 0.5 * (cov + cov.T), cond, m)
+
+
+def hac_covariance(X: np.ndarray, r: np.ndarray, lags: int | None = None) -> np.ndarray:
+    """Newey-West (Bartlett-kernel) covariance of least-squares estimates θ̂ = (XᵀX)⁻¹Xᵀy whose
+    residuals ``r`` are autocorrelated (filtered, differentiated or decimated signals):
+
+        Cov(θ̂) = (XᵀX)⁻¹ S (XᵀX)⁻¹,  S = Γ₀ + Σ_{l=1..L} (1 − l/(L+1)) (Γ_l + Γ_lᵀ),
+        Γ_l = Σ_t x_t r_t r_{t−l} x_{t−l}ᵀ,
+
+    with the lag L chosen from the data by Andrews' (1991) AR(1) plug-in for the Bartlett kernel,
+    ``L = ⌈1.1447 (α n)^{1/3}⌉``, ``α = 4ρ̂²/((1−ρ̂)²(1+ρ̂)²)``, ρ̂ the residuals' lag-1
+    autocorrelation. For white residuals it tends to the usual σ̂²(XᵀX)⁻¹; for correlated ones it
+    is the honest (larger) one. Systematic errors (a biased filter, a wrong model) are not in it."""
+    X = np.asarray(X, dtype=np.float64)
+    r = np.asarray(r, dtype=np.float64)
+    n, p = X.shape
+    if lags is None:
+        rc = r - r.mean()
+        rho = float(np.clip((rc[1:] @ rc[:-1]) / max(rc @ rc, 1e-300), -0.97, 0.97))
+        alpha = 4 * rho**2 / ((1 - rho) ** 2 * (1 + rho) ** 2)
+        L = int(np.ceil(1.1447 * (alpha * n) ** (1.0 / 3.0)))
+    else:
+        L = int(lags)
+    L = max(0, min(L, n // 4))
+    g = X * r[:, None]
+    S = g.T @ g
+    for lag in range(1, L + 1):
+        G = g[lag:].T @ g[:-lag]
+        S += (1.0 - lag / (L + 1.0)) * (G + G.T)
+    Xi = np.linalg.inv(X.T @ X)
+    return Xi @ S @ Xi * (n / max(n - p, 1))
