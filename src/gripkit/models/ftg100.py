@@ -59,6 +59,7 @@ with the contact instant located inside the integration step (see :func:`advance
 
 from __future__ import annotations
 
+import abc
 import math
 
 import numba
@@ -272,8 +273,9 @@ class _SecondOrderFTG(Model):
 
     integrator = "zoh"
 
-    def _coefficients(self, thetas: np.ndarray) -> np.ndarray:  # (P, 6): m, c, k, gain, u0, y0
-        raise NotImplementedError
+    @abc.abstractmethod
+    def _coefficients(self, thetas: np.ndarray) -> np.ndarray:
+        """(P, 6): m, c, k, gain, u0, y0 of each parameter vector (each subsystem's own reading)."""
 
     def _simulate_batch(self, thetas, u, dt, substeps, x0, y):
         second_order_batch(self._coefficients(thetas), u, dt, x0, y)
