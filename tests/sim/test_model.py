@@ -61,3 +61,21 @@ def test_output_buffer_is_reused_and_checked():
     np.testing.assert_array_equal(buf[0, :, 0], model.simulate(u, dt=0.01)["x"])
     with pytest.raises(SimulationError, match="shape"):
         model.simulate_batch(model.theta()[None, :], u, dt=0.01, out=np.empty((1, 100, 1)))
+
+
+def test_simulated_trajectory_owns_read_only_contiguous_channels():
+    """simulate() hands its arrays to the Trajectory without a second copy: they must not alias
+    the caller's input, must be read-only, and each channel must be contiguous."""
+    model = MassSpringDamper(m=1.0, b=0.3, k=4.0)
+    u = np.sin(np.arange(200) * 0.05)
+    tr = model.simulate(u, dt=0.01)
+    for name in ("F", "x"):
+        a = tr[name]
+        assert a.flags.c_contiguous and not a.flags.writeable
+        with pytest.raises(ValueError):
+            a[0] = 1.0
+    u[0] = 99.0
+    assert tr["F"][0] == 0.0
+    np.testing.assert_array_equal(tr["x"], model.simulate_batch(model.theta()[None], np.sin(np.arange(200) * 0.05),
+                                                                dt=0.01)[0, :, 0])
+
