@@ -6,7 +6,7 @@ STAMP  := $(VENV)/.installed
 # pytest workers; CI machines have 2 cores
 JOBS   ?= 2
 
-.PHONY: install demo test test-all bench clean
+.PHONY: install demo test test-all bench clean clean-cache
 
 install: $(STAMP)
 
@@ -28,5 +28,8 @@ test-all: install
 bench: install
 	$(PY) benchmarks/run.py --out benchmarks/results
 
-clean:
+clean-cache:
+	find src benchmarks examples tests \( -name '*.nbi' -o -name '*.nbc' \) -delete
+
+clean: clean-cache
 	rm -rf $(VENV) report build src/*.egg-info .pytest_cache

@@ -6,6 +6,7 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import datetime as dt
 import importlib.util
 import json
@@ -25,13 +26,11 @@ def machine() -> dict:
     import scipy
 
     cpu = platform.processor() or ""
-    try:
+    with contextlib.suppress(OSError):  # no /proc/cpuinfo off Linux: keep platform.processor()
         for line in Path("/proc/cpuinfo").read_text().splitlines():
             if line.startswith("model name"):
                 cpu = line.split(":", 1)[1].strip()
                 break
-    except OSError:
-        pass
     return dict(cpu=cpu, cores=os.cpu_count(), python=platform.python_version(),
                 numpy=numpy.__version__, scipy=scipy.__version__, numba=numba.__version__,
                 platform=platform.platform(), date=dt.datetime.now().isoformat(timespec="seconds"))

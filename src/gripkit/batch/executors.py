@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import abc
 import collections
+import contextlib
 import multiprocessing
 import os
 import pickle
@@ -60,7 +61,7 @@ class Executor(abc.ABC):
         ...
 
     def close(self) -> None:
-        pass
+        """Release workers (the in-process executor holds none)."""
 
     def __enter__(self):
         return self
@@ -102,10 +103,8 @@ class _Worker:
         write_frame(self.proc.stdin, payload)
 
     def stop(self) -> None:
-        try:
+        with contextlib.suppress(OSError):  # the worker already closed its end
             self.proc.stdin.close()
-        except OSError:
-            pass
         try:
             self.proc.wait(timeout=10)
         except subprocess.TimeoutExpired:
@@ -195,10 +194,8 @@ class ProcessExecutor(Executor):
             sel.close()
 
     def _retire(self, w: _Worker, sel) -> None:
-        try:
+        with contextlib.suppress(KeyError, ValueError):  # not registered, or its pipe already closed
             sel.unregister(w.proc.stdout)
-        except (KeyError, ValueError):
-            pass
         if w in self._pool:
             self._pool.remove(w)
         w.stop()

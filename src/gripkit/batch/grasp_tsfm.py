@@ -40,6 +40,8 @@ Metrics (times in s from the start; forces are the true contact forces at the sa
 
 from __future__ import annotations
 
+import collections
+import contextlib
 import math
 import threading
 import warnings
@@ -463,15 +465,11 @@ def _run_cpu(tpl, parts, nz, nstd, seeds, n_steps, window, cps, mset, met, threa
         return b - a
 
     starts = range(0, P, size)
-    if threads == 1:
-        done = map(run, starts)
-        for _ in track(done, total=len(starts), description="TSFM grasps", enabled=progress and P > 256):
-            pass
-        return
-    with ThreadPoolExecutor(threads) as pool:
-        for _ in track(pool.map(run, starts), total=len(starts), description="TSFM grasps",
-                       enabled=progress and P > 256):
-            pass
+    with ThreadPoolExecutor(threads) if threads > 1 else contextlib.nullcontext() as pool:
+        slices = pool.map(run, starts) if pool else map(run, starts)
+        # drain the slices (each writes its rows of met in place) while the bar advances
+        collections.deque(track(slices, total=len(starts), description="TSFM grasps",
+                                enabled=progress and P > 256), maxlen=0)
 
 
 def record_metrics(result, *, gap: float | None = None, width: float | None = None, stiffness: float | None = None,

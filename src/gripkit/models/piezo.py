@@ -27,7 +27,7 @@ import numpy as np
 from numba import prange
 
 from ..params import Parameter, ParameterSet
-from ..sim.integrators import modes_of, zoh_levels
+from ..sim.integrators import lti_rhs, lti_step, modes_of, zoh_levels
 from ..sim.linear import StateSpace
 from ..sim.model import Model, Signal
 from .hysteresis import bouc_wen_advance, bouc_wen_parameters
@@ -92,6 +92,7 @@ def bw_lti_row(bw, Phi, Gam, C, D, u, x0, y):  # pragma: no cover - compiled
     x = np.empty(n)
     xt = np.empty(n)
     w = np.empty(m)
+    yk = np.empty(p_out)
     for i in range(n):
         x[i] = x0[2 + i]
     H = x0[0]
@@ -104,22 +105,10 @@ def bw_lti_row(bw, Phi, Gam, C, D, u, x0, y):  # pragma: no cover - compiled
         w[0] = d_p * U - H
         for j in range(1, m):
             w[j] = u[k, j]
+        lti_rhs(C, D, x, w, yk)
         for i in range(p_out):
-            acc = 0.0
-            for j in range(n):
-                acc += C[i, j] * x[j]
-            for j in range(m):
-                acc += D[i, j] * w[j]
-            y[k, i] = acc
-        for i in range(n):
-            acc = 0.0
-            for j in range(n):
-                acc += Phi[i, j] * x[j]
-            for j in range(m):
-                acc += Gam[i, j] * w[j]
-            xt[i] = acc
-        for i in range(n):
-            x[i] = xt[i]
+            y[k, i] = yk[i]
+        lti_step(Phi, Gam, x, w, xt)
 
 
 @numba.njit(cache=True, parallel=True)

@@ -114,6 +114,21 @@ class HybridResult:
 
 
 @numba.njit(cache=True, inline="always")
+def first_crossed_guard(G, H, n_guards, mode, x, u):  # pragma: no cover - compiled
+    """Index of the first guard of ``mode`` with G·x + H·u < 0 (u ends with the constant 1 that
+    carries c), or −1. Inlined: indexes the stacks in place, no slices."""
+    for g in range(n_guards[mode]):
+        acc = 0.0
+        for k in range(x.shape[0]):
+            acc += G[mode, g, k] * x[k]
+        for k in range(u.shape[0]):
+            acc += H[mode, g, k] * u[k]
+        if acc < 0.0:
+            return g
+    return -1
+
+
+@numba.njit(cache=True, inline="always")
 def pwa_step(x, mode, u, Phi, Gam, G, H, target, n_guards, K, xt, ev_frac, ev_to):  # pragma: no cover
     """Advance ``x`` (n,) in place over one sample step with the held input ``u`` (m+1,, last
     entry 1). Returns (new mode, number of events); event i happened at fraction ``ev_frac[i]``
@@ -160,17 +175,7 @@ def pwa_step(x, mode, u, Phi, Gam, G, H, target, n_guards, K, xt, ev_frac, ev_to
                     for k in range(m):
                         acc += Gam[mode, j, i, k] * u[k]
                     xt[i] = acc
-            hit = -1
-            if nev < MAX_EVENTS_PER_STEP:
-                for g in range(n_guards[mode]):
-                    acc = 0.0
-                    for k in range(n):
-                        acc += G[mode, g, k] * xt[k]
-                    for k in range(m):
-                        acc += H[mode, g, k] * u[k]
-                    if acc < 0.0:
-                        hit = g
-                        break
+            hit = first_crossed_guard(G, H, n_guards, mode, xt, u) if nev < MAX_EVENTS_PER_STEP else -1
             if hit < 0:
                 for i in range(n):
                     x[i] = xt[i]
@@ -254,15 +259,9 @@ def _hybrid_rk4(A, B, C, D, G, H, target, n_guards, u, h, nsub, x, mode, y, mode
         modes[k] = mode
         for _ in range(nsub):
             rk4_lti_step(A[mode], B[mode], x, ua, h, k1, k2, k3, k4, tmp)
-            for g in range(n_guards[mode]):
-                acc = 0.0
-                for j in range(n):
-                    acc += G[mode, g, j] * x[j]
-                for j in range(m1):
-                    acc += H[mode, g, j] * ua[j]
-                if acc < 0.0:
-                    mode = target[mode, g]
-                    break
+            g = first_crossed_guard(G, H, n_guards, mode, x, ua)
+            if g >= 0:
+                mode = target[mode, g]
 
 
 class HybridSystem:

@@ -37,12 +37,13 @@ __all__ = ["rk4_lti_step", "rk4_msd_step", "semi_implicit_msd_step", "lti_step",
            "integrate_lti", "modes_of"]
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def lti_rhs(A, B, x, u, out):  # pragma: no cover - compiled
-    """out = A x + B u."""
-    n = A.shape[0]
+    """out = A x + B u: the right-hand side ẋ of a linear system, and any other affine map of a
+    state and an input (a ZOH step Φ x + Γ u, an output C x + D u)."""
+    n = A.shape[1]
     m = B.shape[1]
-    for i in range(n):
+    for i in range(A.shape[0]):
         acc = 0.0
         for j in range(n):
             acc += A[i, j] * x[j]
@@ -93,19 +94,11 @@ def semi_implicit_msd_step(x, v, F, m, b, k, h):  # pragma: no cover - compiled
     return x + h * v1, v1
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def lti_step(Phi, Gam, x, u, xt):  # pragma: no cover - compiled
     """Exact ZOH step x ← Φ x + Γ u (``xt``: work array (n,))."""
-    n = Phi.shape[0]
-    m = Gam.shape[1]
-    for i in range(n):
-        acc = 0.0
-        for j in range(n):
-            acc += Phi[i, j] * x[j]
-        for j in range(m):
-            acc += Gam[i, j] * u[j]
-        xt[i] = acc
-    for i in range(n):
+    lti_rhs(Phi, Gam, x, u, xt)
+    for i in range(x.shape[0]):
         x[i] = xt[i]
 
 

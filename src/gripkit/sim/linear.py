@@ -21,6 +21,7 @@ import numpy as np
 from scipy.linalg import expm
 
 from ..errors import ModelError, SimulationError
+from .integrators import lti_rhs, lti_step
 
 __all__ = ["StateSpace", "c2d_zoh", "simulate_discrete"]
 
@@ -161,24 +162,15 @@ def c2d_zoh(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.nda
 @numba.njit(cache=True)
 def simulate_discrete(Ad, Bd, C, D, u, x, y):  # pragma: no cover - compiled
     """x[k+1] = Ad x[k] + Bd u[k];  y[k] = C x[k] + D u[k].  ``x`` holds x[0] and ends as x[N]."""
-    n = Ad.shape[0]
     m = Bd.shape[1]
     p = C.shape[0]
-    xn = np.empty(n)
+    xn = np.empty(Ad.shape[0])
+    uk = np.empty(m)
+    yk = np.empty(p)
     for k in range(u.shape[0]):
+        for j in range(m):
+            uk[j] = u[k, j]
+        lti_rhs(C, D, x, uk, yk)
         for i in range(p):
-            acc = 0.0
-            for j in range(n):
-                acc += C[i, j] * x[j]
-            for j in range(m):
-                acc += D[i, j] * u[k, j]
-            y[k, i] = acc
-        for i in range(n):
-            acc = 0.0
-            for j in range(n):
-                acc += Ad[i, j] * x[j]
-            for j in range(m):
-                acc += Bd[i, j] * u[k, j]
-            xn[i] = acc
-        for i in range(n):
-            x[i] = xn[i]
+            y[k, i] = yk[i]
+        lti_step(Ad, Bd, x, uk, xn)
