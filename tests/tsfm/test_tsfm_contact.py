@@ -1,7 +1,6 @@
 """Free ↔ constrained motion of a TSFM finger (Fig. 5, Fig. 13; 001_0b92a7da96e7aa46.txt §III-A,
 §V-B): exact ZOH with in-step events against a fine RK4 reference, conservation at the contact."""
 
-import warnings
 
 import numpy as np
 import pytest
@@ -10,13 +9,6 @@ from gripkit.models.hysteresis import bouc_wen_response
 from gripkit.zoo import tsfm as z
 
 FS = 20000.0
-
-
-@pytest.fixture(scope="module")
-def left():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return z.left_finger()
 
 
 @pytest.fixture(scope="module")

@@ -3,7 +3,6 @@ the seed's noise levels (laser 20 nm, FemtoTools 0.4 µN, force sensor 1 %)."""
 
 import json
 import math
-import warnings
 
 import numpy as np
 import pytest
@@ -18,13 +17,6 @@ from gripkit.sysid.modal import free_vibration
 from gripkit.zoo import tsfm as z
 
 AMPS = (100.0, 60.0, 30.0)
-
-
-@pytest.fixture(scope="module")
-def left():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return z.left_finger()
 
 
 @pytest.fixture(scope="module")

@@ -2,7 +2,6 @@
 end-effector lever, and the whole finger in its three forms."""
 
 import math
-import warnings
 
 import numpy as np
 import pytest
@@ -20,13 +19,6 @@ from gripkit.models.tsfm import (finger_coefficients, finger_minimal_state_space
 from gripkit.zoo import tsfm as z
 
 BW = dict(d_p=0.77e-6, lam=0.43e-6, beta=0.108, gamma=7.5e-3)  # Table II, left finger (λ in µm/V → m/V)
-
-
-@pytest.fixture(scope="module")
-def left():
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        return z.left_finger()
 
 
 def test_bouc_wen_is_exact_against_a_tight_ode_solution():

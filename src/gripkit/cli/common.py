@@ -52,3 +52,12 @@ def emit_json(obj) -> None:
 def complex_pairs(values) -> list[list[float]]:
     """Complex numbers as ``[[re, im], ...]``."""
     return [[float(np.real(v)), float(np.imag(v))] for v in np.atleast_1d(values)]
+
+
+def report_warnings(caught) -> list[str]:
+    """Print each distinct recorded warning as one ``warning: …`` line on stderr; return the lines
+    (for the JSON output)."""
+    lines = list(dict.fromkeys(f"{w.category.__name__}: {w.message}" for w in caught))
+    for line in lines:
+        print(f"warning: {line}", file=sys.stderr)
+    return lines

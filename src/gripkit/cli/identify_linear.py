@@ -14,7 +14,7 @@ from pathlib import Path
 import typer
 
 from .app import identify_app
-from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data
+from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data, report_warnings
 
 DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
 InputOpt = typer.Option(..., "--input", help="Input column (e.g. the valve current).")
@@ -25,17 +25,6 @@ ValidateOpt = typer.Option(None, "--validate", help="Second record for free-run 
 NaOpt = typer.Option(..., "--na", help="Number of A coefficients (after the leading 1).")
 NbOpt = typer.Option(..., "--nb", help="Number of B coefficients.")
 NkOpt = typer.Option(..., "--nk", help="Input delay in samples (B's leading zeros).")
-
-
-def _warn_lines(caught) -> list[str]:
-    import sys
-
-    lines = []
-    for w in caught:
-        line = f"{w.category.__name__}: {w.message}"
-        lines.append(line)
-        print(f"warning: {line}", file=sys.stderr)
-    return lines
 
 
 def _io(path: Path, input: str, output: str, fs, time, fill, detrend: str, why: str):
@@ -65,7 +54,7 @@ def _fit_and_report(method: str, data: Path, input: str, output: str, fs, time, 
             val = model.validate(vio.u, vio.y)
             out["validation_fit_percent"] = val.fit_percent
             out["validation"] = val.to_dict()
-    out["warnings"] = _warn_lines(caught)
+    out["warnings"] = report_warnings(caught)
     if json_out:
         emit_json(out)
     else:
@@ -162,7 +151,7 @@ def identify_rls(data: Path = DataArg, input: str = InputOpt, output: str = Outp
             res.to_trajectory().save(trajectory)
     out = res.to_dict()
     out.update(data=str(data), detrend=detrend, input=input, output=output,
-               trajectory=None if trajectory is None else str(trajectory), warnings=_warn_lines(caught))
+               trajectory=None if trajectory is None else str(trajectory), warnings=report_warnings(caught))
     if json_out:
         emit_json(out)
         return

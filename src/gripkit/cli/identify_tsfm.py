@@ -14,25 +14,15 @@ Warnings go to stderr as ``warning: ...`` lines and into the JSON ``warnings`` l
 
 from __future__ import annotations
 
-import sys
 import warnings
 from pathlib import Path
 
 import typer
 
 from .app import identify_app
-from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data
+from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data, report_warnings
 
 DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
-
-
-def _warnings(caught) -> list[str]:
-    lines = []
-    for w in caught:
-        line = f"{w.category.__name__}: {w.message}"
-        lines.append(line)
-        print(f"warning: {line}", file=sys.stderr)
-    return lines
 
 
 @identify_app.command("modal")
@@ -52,7 +42,7 @@ def identify_modal(data: Path = DataArg,
         i0 = None if start is None else int(round((start - tr.t[0]) * rate))
         res = free_vibration(tr[signal], rate, start=i0)
     out = res.to_dict()
-    out.update(data=str(data), signal=signal, unit=tr.unit(signal), warnings=_warnings(caught))
+    out.update(data=str(data), signal=signal, unit=tr.unit(signal), warnings=report_warnings(caught))
     if json_out:
         emit_json(out)
         return
@@ -78,7 +68,7 @@ def identify_bouc_wen_cmd(data: Path = DataArg,
         tr = load_data(data, [input, output], fs, time, fill)
         res = identify_bouc_wen(tr, input=input, output=output, delay=delay, burn_in=burn_in, progress=not json_out)
     out = res.to_dict()
-    out.update(data=str(data), input=input, output=output, delay=delay, warnings=_warnings(caught))
+    out.update(data=str(data), input=input, output=output, delay=delay, warnings=report_warnings(caught))
     if json_out:
         emit_json(out)
         return

@@ -8,7 +8,7 @@ from pathlib import Path
 import typer
 
 from .app import app
-from .common import JsonOpt, emit_json
+from .common import JsonOpt, emit_json, report_warnings
 
 
 @app.command()
@@ -17,7 +17,6 @@ def simulate(model: Path = typer.Argument(..., help="Model description (.toml)."
                                                           "default: [output] file of the description."),
              json_out: bool = JsonOpt):
     """Simulate a model described in a TOML file."""
-    import sys
     import warnings
 
     import numpy as np
@@ -31,9 +30,7 @@ def simulate(model: Path = typer.Argument(..., help="Model description (.toml)."
         d = load_description(model)
         status(f"simulating {d.model.name}: {d.inputs.n} samples at {d.inputs.fs:g} Hz")
         tr = d.model.simulate(d.inputs)
-    lines = list(dict.fromkeys(f"{w.category.__name__}: {w.message}" for w in caught))
-    for line in lines:
-        print(f"warning: {line}", file=sys.stderr)
+    lines = report_warnings(caught)
     target = out or d.output
     if target is not None:
         save(tr, target)

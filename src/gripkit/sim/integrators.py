@@ -262,16 +262,13 @@ def _integrate_lti(A, B, Phi, Gam, u, h, substeps, method, x, y, C, D):  # pragm
     k4 = np.empty(n)
     tmp = np.empty(n)
     ui = np.empty(m)
+    yk = np.empty(p)
     for t in range(u.shape[0]):
         for j in range(m):
             ui[j] = u[t, j]
+        lti_rhs(C, D, x, ui, yk)
         for i in range(p):
-            acc = 0.0
-            for j in range(n):
-                acc += C[i, j] * x[j]
-            for j in range(m):
-                acc += D[i, j] * ui[j]
-            y[t, i] = acc
+            y[t, i] = yk[i]
         if method == 0:
             lti_step(Phi, Gam, x, ui, tmp)
         else:
