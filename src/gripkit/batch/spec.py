@@ -31,13 +31,13 @@ Jobs = (grid points × table rows) × samples; ``job_id`` numbers them 0..N-1.
 from __future__ import annotations
 
 import itertools
-import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 from ..errors import ConfigError
+from ..io.toml_file import read_toml
 
 __all__ = ["SweepSpec"]
 
@@ -76,14 +76,7 @@ class SweepSpec:
 
     @classmethod
     def from_toml(cls, path) -> "SweepSpec":
-        path = Path(path)
-        if not path.exists():
-            raise ConfigError(f"sweep file {str(path)!r} not found")
-        try:
-            d = tomllib.loads(path.read_text())
-        except tomllib.TOMLDecodeError as exc:
-            raise ConfigError(f"{path.name}: not valid TOML: {exc}") from None
-        return cls.from_dict(d, base_dir=str(path.parent))
+        return cls.from_dict(read_toml(path, "sweep file"), base_dir=str(Path(path).parent))
 
     @classmethod
     def from_dict(cls, d: dict, base_dir: str = ".") -> "SweepSpec":

@@ -38,7 +38,6 @@ Other developers add model types with :func:`register_model_type`.
 from __future__ import annotations
 
 import math
-import tomllib
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -46,6 +45,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ConfigError, GripkitError
+from ..io.toml_file import read_toml
 from ..signals.trajectory import Trajectory
 
 __all__ = ["Description", "MODEL_TYPES", "register_model_type", "load_description", "simulate_description",
@@ -186,12 +186,7 @@ def input_signal(spec: Mapping, t: np.ndarray, where: str, base: Path | None = N
 def load_description(path, overrides: Mapping | None = None) -> Description:
     """Read a TOML description (see the module docstring) and build its model and inputs."""
     path = Path(path)
-    if not path.exists():
-        raise ConfigError(f"model description {str(path)!r} not found")
-    try:
-        raw = tomllib.loads(path.read_text())
-    except tomllib.TOMLDecodeError as exc:
-        raise ConfigError(f"{path.name}: not valid TOML: {exc}") from None
+    raw = read_toml(path, "model description")
     unknown = set(raw) - {"model", "parameters", "simulation", "inputs", "output"}
     if unknown:
         raise ConfigError(f"{path.name}: unknown sections {sorted(unknown)}",
