@@ -10,7 +10,8 @@ from pathlib import Path
 import numpy as np
 import typer
 
-__all__ = ["emit_json", "load_data", "complex_pairs", "FsOpt", "TimeOpt", "FillOpt", "JsonOpt"]
+__all__ = ["emit_json", "load_data", "check_data_options", "check_choice", "check_number", "complex_pairs",
+           "FsOpt", "TimeOpt", "FillOpt", "JsonOpt"]
 
 FsOpt = typer.Option(None, "--fs", help="Sampling rate in Hz, when the file has no time column.")
 TimeOpt = typer.Option(None, "--time", help="Name of the time column (default: t/time/timestamp).")
@@ -22,6 +23,40 @@ def load_data(path: Path, columns: list[str], fs: float | None, time: str | None
     from ..io import load
 
     return load(path, columns=columns, fs=fs, time=time, fill=fill)
+
+
+def check_data_options(fs: float | None, fill: str | None) -> None:
+    """``--fs`` and ``--fill``, checked before any file is read (commands call this first, with
+    their own option checks, so that a bad option is reported before a long load)."""
+    from ..io.table import check_fill, check_fs
+
+    check_fill(fill)
+    check_fs(fs)
+
+
+def check_choice(value: str, option: str, choices: tuple[str, ...]) -> None:
+    """A :class:`~gripkit.errors.DataError` unless ``value`` is one of ``choices``."""
+    from ..errors import DataError
+
+    if value not in choices:
+        raise DataError(f"{option}: expected one of {', '.join(choices)}, found {value!r}")
+
+
+def check_number(value, option: str, *, minimum: float | None = None, above: float | None = None,
+                 integer: bool = False, nonzero: bool = False) -> None:
+    """A :class:`~gripkit.errors.DataError` unless ``value`` (when given) is a finite number
+    ``>= minimum`` / ``> above`` (an integer if ``integer``, non-zero if ``nonzero``)."""
+    from ..errors import DataError
+
+    if value is None:
+        return
+    want = ("an integer" if integer else "a finite number") + (
+        f" >= {minimum:g}" if minimum is not None else f" > {above:g}" if above is not None else "") + (
+        ", not zero" if nonzero else "")
+    ok = (math.isfinite(value) and (minimum is None or value >= minimum) and (above is None or value > above)
+          and (not integer or float(value).is_integer()) and not (nonzero and value == 0))
+    if not ok:
+        raise DataError(f"{option}: expected {want}, found {value!r}")
 
 
 def _clean(obj):

@@ -3,12 +3,14 @@ step-response identification (gain, natural frequency, damping ratio, each with 
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import typer
 
 from .app import identify_app
-from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data
+from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, emit_json, load_data,
+                     report_warnings)
 
 
 @identify_app.command("step")
@@ -19,9 +21,14 @@ def identify_step(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
     """Fit K ω_n²/(s² + 2ζω_n s + ω_n²) to a step response (gain, natural frequency, damping, σ)."""
     from ..sysid.step_response import identify_step as _identify
 
-    tr = load_data(data, [input_col, output_col], fs, time, fill)
-    res = _identify(tr, input=input_col, output=output_col)
+    check_data_options(fs, fill)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        tr = load_data(data, [input_col, output_col], fs, time, fill)
+        res = _identify(tr, input=input_col, output=output_col)
+    lines = report_warnings(caught)
     if json_out:
-        emit_json({"data": str(data), "input": input_col, "output": output_col, **res.to_dict()})
+        emit_json({"data": str(data), "input": input_col, "output": output_col, **res.to_dict(),
+                   "warnings": lines})
     else:
         typer.echo(res.summary())

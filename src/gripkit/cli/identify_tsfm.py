@@ -20,7 +20,8 @@ from pathlib import Path
 import typer
 
 from .app import identify_app
-from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data, report_warnings
+from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, check_number, emit_json,
+                     load_data, report_warnings)
 
 DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
 
@@ -35,6 +36,8 @@ def identify_modal(data: Path = DataArg,
     decrement, Hilbert envelope, damped-sine least squares)."""
     from ..sysid.modal import free_vibration
 
+    check_data_options(fs, fill)
+    check_number(start, "--start")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         tr = load_data(data, [signal], fs, time, fill)
@@ -63,6 +66,9 @@ def identify_bouc_wen_cmd(data: Path = DataArg,
     """Static Bouc-Wen parameters (eq 3) from a quasi-static voltage/displacement sweep."""
     from ..sysid.bouc_wen import identify_bouc_wen
 
+    check_data_options(fs, fill)
+    check_number(delay, "--delay", minimum=0)
+    check_number(burn_in, "--burn-in", minimum=0, integer=True)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         tr = load_data(data, [input, output], fs, time, fill)

@@ -23,7 +23,7 @@ from .regression import arx_regression, qr_solve
 
 __all__ = ["Candidate", "SearchResult", "structure_search", "parse_range"]
 
-_CRITERIA = ("aic", "fpe", "loss")
+CRITERIA = ("aic", "fpe", "loss")
 
 
 @dataclass(frozen=True)
@@ -113,8 +113,8 @@ def structure_search(u, y, na=range(1, 5), nb=range(1, 5), nk=range(1, 11), *,
     """
     u, y = check_io(u, y)
     check_dt(dt, fs)
-    if criterion not in _CRITERIA:
-        raise DataError(f"criterion: expected one of {', '.join(_CRITERIA)}, found {criterion!r}")
+    if criterion not in CRITERIA:
+        raise DataError(f"criterion: expected one of {', '.join(CRITERIA)}, found {criterion!r}")
     nas = [check_order(v, "na", 0) for v in parse_range(na, "na")]
     nbs = [check_order(v, "nb", 1) for v in parse_range(nb, "nb")]
     nks = [check_order(v, "nk", 0) for v in parse_range(nk, "nk")]
