@@ -129,7 +129,7 @@ def structure_search(u, y, na=range(1, 5), nb=range(1, 5), nk=range(1, 11), *,
     for a, b, k in track(grid, description="ARX structure search", enabled=progress and len(grid) * y.size > 2e6):
         names = tuple(f"a{i}" for i in range(1, a + 1)) + tuple(f"b{k + j}" for j in range(b))
         try:
-            sol = qr_solve(arx_regression(u, y, a, b, k, t0=t0), names, overwrite=True)
+            sol = qr_solve(arx_regression(u, y, a, b, k, t0=t0), names, overwrite=True, warn=False)
         except UnidentifiableError as exc:
             skipped.append((a, b, k, str(exc)))
             continue
