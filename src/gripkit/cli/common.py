@@ -5,12 +5,14 @@ from __future__ import annotations
 import json
 import math
 import sys
+import warnings
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 import typer
 
-__all__ = ["emit_json", "load_data", "check_data_options", "check_choice", "check_number", "complex_pairs",
+__all__ = ["emit_json", "load_data", "collected_warnings", "report_warnings", "check_data_options", "check_choice", "check_number", "complex_pairs",
            "FsOpt", "TimeOpt", "FillOpt", "JsonOpt"]
 
 FsOpt = typer.Option(None, "--fs", help="Sampling rate in Hz, when the file has no time column.")
@@ -87,6 +89,20 @@ def emit_json(obj) -> None:
 def complex_pairs(values) -> list[list[float]]:
     """Complex numbers as ``[[re, im], ...]``."""
     return [[float(np.real(v)), float(np.imag(v))] for v in np.atleast_1d(values)]
+
+
+@contextmanager
+def collected_warnings():
+    """Record every warning raised inside the block (``with collected_warnings() as caught``);
+    if the block fails, print them (:func:`report_warnings`) before the error propagates, so that a
+    warning that explains the error (a corrupt sample, a truncated file) is not lost."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            yield caught
+        except Exception:
+            report_warnings(caught)
+            raise
 
 
 def report_warnings(caught) -> list[str]:

@@ -10,14 +10,13 @@ Butterworth-filtered position, the effort filtered alike, decimated (see
 
 from __future__ import annotations
 
-import warnings
 from pathlib import Path
 
 import typer
 
 from .app import identify_app
-from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, check_number, emit_json,
-                     load_data, report_warnings)
+from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, check_number,
+                     collected_warnings, emit_json, load_data, report_warnings)
 
 
 @identify_app.command("friction")
@@ -43,8 +42,7 @@ def identify_friction(
     check_number(cutoff, "--cutoff", above=0)
     check_number(decimate, "--decimate", minimum=1, integer=True)
     check_number(velocity_threshold, "--velocity-threshold", minimum=0)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
+    with collected_warnings() as caught:
         tr = load_data(data, [position, effort], fs, time, fill)
         rate = tr.require_uniform(why="IDIM-LS (filtering and differentiation)")
         res = idim_ls(tr[position], tr[effort], rate, effort_scale=effort_scale, cutoff=cutoff,

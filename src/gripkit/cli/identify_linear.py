@@ -8,14 +8,13 @@ non-converged iteration) go to stderr as ``warning: ...`` lines and into the JSO
 
 from __future__ import annotations
 
-import warnings
 from pathlib import Path
 
 import typer
 
 from .app import identify_app
-from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_choice, check_data_options, emit_json, load_data,
-                     report_warnings)
+from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_choice, check_data_options,
+                     collected_warnings, emit_json, load_data, report_warnings)
 
 DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
 InputOpt = typer.Option(..., "--input", help="Input column (e.g. the valve current).")
@@ -55,8 +54,7 @@ def _io(path: Path, input: str, output: str, fs, time, fill, detrend: str, why: 
 def _fit_and_report(method: str, data: Path, input: str, output: str, fs, time, fill, detrend: str,
                     validate: Path | None, json_out: bool, fit):
     """Shared body of arx/armax/oe: load, fit (``fit(io) -> model``), validate, print."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
+    with collected_warnings() as caught:
         io = _io(data, input, output, fs, time, fill, detrend, f"{method.upper()} identification")
         model = fit(io)
         out = model.to_dict()
@@ -166,8 +164,7 @@ def identify_rls(data: Path = DataArg, input: str = InputOpt, output: str = Outp
 
     _check_options(fs, fill, detrend)
     RLS(na, nb, nk, forgetting=forgetting, p0=p0, windup=windup)  # checks the orders and the options
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
+    with collected_warnings() as caught:
         io = _io(data, input, output, fs, time, fill, detrend, "RLS identification")
         res = rls(io.u, io.y, na, nb, nk, forgetting=forgetting, p0=p0, windup=windup, dt=io.dt)
         if trajectory is not None:
@@ -210,8 +207,7 @@ def identify_search(data: Path = DataArg, input: str = InputOpt, output: str = O
     check_choice(criterion, "--criterion", CRITERIA)
     for name, text in (("--na", na), ("--nb", nb), ("--nk", nk)):
         parse_range(text, name)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
+    with collected_warnings() as caught:
         io = _io(data, input, output, fs, time, fill, detrend, "ARX structure search")
         res = structure_search(io.u, io.y, na, nb, nk, criterion=criterion, dt=io.dt)
     report_warnings(caught)

@@ -3,14 +3,13 @@ step-response identification (gain, natural frequency, damping ratio, each with 
 
 from __future__ import annotations
 
-import warnings
 from pathlib import Path
 
 import typer
 
 from .app import identify_app
-from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, emit_json, load_data,
-                     report_warnings)
+from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, collected_warnings,
+                     emit_json, load_data, report_warnings)
 
 
 @identify_app.command("step")
@@ -22,8 +21,7 @@ def identify_step(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
     from ..sysid.step_response import identify_step as _identify
 
     check_data_options(fs, fill)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
+    with collected_warnings() as caught:
         tr = load_data(data, [input_col, output_col], fs, time, fill)
         res = _identify(tr, input=input_col, output=output_col)
     lines = report_warnings(caught)

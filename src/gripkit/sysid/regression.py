@@ -38,6 +38,9 @@ COND_LIMIT = 1e10
 #: parameters: at 1/3 its 3σ interval reaches zero, i.e. the data no longer determine it at the 3σ
 #: level (see :func:`warn_threshold`).
 WARN_RELATIVE_ERROR = 1.0 / 3.0
+#: The warning is about conditioning: below this κ the weakest parameter combination is known at
+#: most 100 times worse than the best one, and large σ come from the noise (σ reports them).
+COND_NOTABLE = 100.0
 
 
 def warn_threshold(sigma_rel: float, tan_phi: float | None = None) -> float:
@@ -51,14 +54,15 @@ def warn_threshold(sigma_rel: float, tan_phi: float | None = None) -> float:
     first-order error bound of a QR least-squares solution (Golub & Van Loan, *Matrix
     Computations*, 4th ed., Thm 5.3.1), ``tan φ = ‖r‖/‖Φθ‖`` the residual-to-fit ratio. The
     threshold is the κ at which either reaches δ = :data:`WARN_RELATIVE_ERROR`:
-    ``min(δ/sigma_rel, √(δ/(u·tan φ)), δ/(2u))``, and never more than :data:`COND_LIMIT`.
+    ``min(δ/sigma_rel, √(δ/(u·tan φ)), δ/(2u))``, never below :data:`COND_NOTABLE` and never above
+    :data:`COND_LIMIT`.
     Noise-free data warn only near the hard limit; 1 % noise over 2000 samples warns near κ ≈ 1e3.
     """
     u = 2.0**-53
     d = WARN_RELATIVE_ERROR
     stat = d / sigma_rel if sigma_rel > 0 else math.inf
     rounding = math.sqrt(d / (u * tan_phi)) if tan_phi else math.inf
-    return min(stat, rounding, d / (2 * u), COND_LIMIT)
+    return max(COND_NOTABLE, min(stat, rounding, d / (2 * u), COND_LIMIT))
 
 
 def arx_start(na: int, nb: int, nk: int) -> int:
