@@ -33,7 +33,7 @@ __all__ = ["corrupt_samples", "THRESHOLD", "MAX_RUN"]
 #: K·σ is N·2Φ(−K); with N up to 1e9 samples per channel and a false-alarm probability of 1e-6 per
 #: channel, K = Φ⁻¹(1 − 1e-6 / (2·1e9)) = 8.03. The corrupt values this check is meant for sit
 #: orders of magnitude further out.
-THRESHOLD = NormalDist().inv_cdf(1.0 - 1e-6 / (2.0 * 1e9))
+THRESHOLD = -NormalDist().inv_cdf(1e-6 / (2.0 * 1e9))
 #: Longest run of consecutive outlying samples still reported as corrupt samples.
 MAX_RUN = 3
 
@@ -48,7 +48,7 @@ def corrupt_samples(x: np.ndarray) -> np.ndarray:
     if n < 2 * m + 2 * MAX_RUN + 1:
         return np.empty(0, dtype=np.intp)
     lo, mid, hi = np.partition(x, [m, n // 2, n - 1 - m])[[m, n // 2, n - 1 - m]]
-    z = NormalDist().inv_cdf(1.0 - (m + 0.5) / n)
+    z = -NormalDist().inv_cdf((m + 0.5) / n)
     with np.errstate(over="ignore", invalid="ignore"):
         scale = (hi - lo) / (2.0 * z)
         out = np.abs(x - mid) > THRESHOLD * scale

@@ -34,11 +34,11 @@ def in_user_units(model, cu: float, cy: float):
         return model
     g = cu / cy
     changes = {"B": model.B * g}
-    if model.covariance is not None:
-        d = np.ones(model.n_params)
-        d[model.na:model.na + model.nb] = g
-        changes["covariance"] = model.covariance * np.outer(d, d)
-    with np.errstate(over="ignore", under="ignore"):
+    with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+        if model.covariance is not None:  # variances of B beyond ~1e308 overflow to inf: not representable
+            d = np.ones(model.n_params)
+            d[model.na:model.na + model.nb] = g
+            changes["covariance"] = model.covariance * d[:, None] * d[None, :]
         if model.noise_variance is not None:
             changes["noise_variance"] = model.noise_variance / cy / cy
         if model.loss is not None:

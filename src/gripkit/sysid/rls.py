@@ -481,6 +481,11 @@ class RLS:
             if not len(idx):
                 continue
             mx = float(np.max(np.abs(x)))
+            if mx == 0.0:
+                raise IdentificationError(
+                    f"RLS [{self.na} {self.nb} {self.nk}]: the {label} is zero throughout, so "
+                    f"{', '.join(self.names[i] for i in idx)} cannot be estimated",
+                    hint="check that the columns are the measured input and output")
             log_energy = -math.inf if mx == 0 else 2 * (math.log10(mx) + math.log10(np.linalg.norm(x / mx)))
             prior = float(np.max(np.diag(P)[list(idx)]))
             if log_energy + math.log10(prior) < 0.0:
