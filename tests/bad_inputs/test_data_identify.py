@@ -6,18 +6,26 @@ y(t) = 1.5 y(t−1) − 0.7 y(t−2) + 1.0 u(t−1) + 0.5 u(t−2) + e(t) (poles
 
 from __future__ import annotations
 
+import importlib.util
 import math
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import assert_user_error, assert_warned
 
 from gripkit import DataError, DataWarning, IdentificationError
 from gripkit.errors import AccuracyWarning
 from gripkit.io import load
 from gripkit.signals.outliers import THRESHOLD, corrupt_samples
-from gripkit.sysid import RLS, armax, arx, oe, rls
+from gripkit.sysid import RLS, armax, arx, oe, rls, structure_search
+
+# the corpus's helpers, loaded from this folder's conftest.py by path: tests/ has no packages and
+# several conftest.py files, so `import conftest` may find another one
+_helpers = importlib.util.spec_from_file_location("bad_inputs_helpers", Path(__file__).with_name("conftest.py"))
+_module = importlib.util.module_from_spec(_helpers)
+_helpers.loader.exec_module(_module)
+assert_user_error, assert_warned = _module.assert_user_error, _module.assert_warned
 
 TRUE = np.array([-1.5, 0.7, 1.0, 0.5])  # a1, a2, b1, b2
 FS = 200.0
@@ -236,6 +244,18 @@ def test_only_the_output_at_1e300_scales_b_by_1e300():
     m = arx(u, y * 1e300, 2, 2, 1)
     np.testing.assert_allclose(m.A[1:], TRUE[:2], atol=0.01)
     np.testing.assert_allclose(m.B[1:] / 1e300, TRUE[2:], atol=0.01)
+
+
+@pytest.mark.parametrize("scale", [1e300, 1e-300])
+def test_structure_search_at_extreme_scales_ranks_as_at_unit_scale(scale):
+    """Same ranking and fit % as at unit scale; the AIC shifts by the constant −2M·ln(scale)."""
+    u, y = simulate(1000, noise=0.05)
+    ref = structure_search(u, y, "1:3", "1:3", "1:2", progress=False)
+    res = structure_search(u * scale, y * scale, "1:3", "1:3", "1:2", progress=False)
+    assert [(c.na, c.nb, c.nk) for c in res] == [(c.na, c.nb, c.nk) for c in ref]
+    assert res.best.na >= 2 and res.best.nb >= 2 and res.best.nk == 1  # holds the true [2 2 1]
+    assert res.best.fit_percent == pytest.approx(ref.best.fit_percent, rel=1e-9)
+    assert res.best.aic - ref.best.aic == pytest.approx(2 * res.n_used * math.log(scale), rel=1e-9)
 
 
 def test_cli_identifies_a_file_at_1e_minus_300(cli, tmp_path):

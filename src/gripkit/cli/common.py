@@ -15,7 +15,8 @@ import typer
 __all__ = ["emit_json", "load_data", "collected_warnings", "report_warnings", "check_data_options", "check_choice", "check_number", "complex_pairs",
            "FsOpt", "TimeOpt", "FillOpt", "JsonOpt"]
 
-FsOpt = typer.Option(None, "--fs", help="Sampling rate in Hz, when the file has no time column.")
+FsOpt = typer.Option(None, "--fs", help="Sampling rate in Hz, when the file has no time column "
+                                         "(with one, it must agree with the time stamps).")
 TimeOpt = typer.Option(None, "--time", help="Name of the time column (default: t/time/timestamp).")
 FillOpt = typer.Option(None, "--fill", help="Missing values: 'drop' rows or 'interpolate' (default: error).")
 JsonOpt = typer.Option(False, "--json", help="Print one JSON object on stdout.")

@@ -54,7 +54,8 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
     time
         Name of the time column; else one named t/time/timestamp, else ``fs`` must be given.
     fs
-        Sampling rate in Hz when the file has no time column.
+        Sampling rate in Hz when the file has no time column. With a time column it must agree
+        with the stamps (within half a sample at every sample), else :class:`DataError`.
     units
         Units per channel, overriding those in headers or metadata (``{"force": "mN"}``).
     fill
@@ -69,7 +70,15 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
     Raises
     ------
     DataError
-        Missing file or column, truncated or corrupt file, mixed types, NaN/inf, bad time stamps.
+        Missing file or column, truncated or corrupt file (a CSV line with missing fields names
+        the line), mixed types, NaN/inf, bad time stamps, ``fs`` contradicting the time column,
+        an invalid ``fill`` or ``fs`` (checked before the file is read).
+
+    Warns
+    -----
+    DataWarning
+        A CSV whose last line has no line ending (the file looks truncated); a sample far outside
+        the rest of its channel (a corrupt value), naming its time.
     """
     path = Path(path)
     if not path.exists():

@@ -19,6 +19,7 @@ import numpy as np
 from ..errors import DataError, UnidentifiableError
 from ..progress import track
 from ._data import check_dt, check_identifiable, check_io, check_order
+from ._scaling import unit_scale
 from .regression import arx_regression, qr_solve
 
 __all__ = ["Candidate", "SearchResult", "structure_search", "parse_range"]
@@ -121,6 +122,8 @@ def structure_search(u, y, na=range(1, 5), nb=range(1, 5), nk=range(1, 11), *,
     t0 = max(max(nas), max(nks) + max(nbs) - 1)
     pmax = max(nas) + max(nbs)
     check_identifiable(u, y, t0 + pmax + 1, f"structure search up to na={max(nas)}, nb={max(nbs)}, nk={max(nks)}")
+    cu, cy = unit_scale(u), unit_scale(y)  # exact powers of two (see _scaling): any data scale
+    u, y = u * cu, y * cy
     yt = y[t0:]
     sst = float(np.sum((yt - yt.mean()) ** 2))
     m = y.size - t0
@@ -134,11 +137,11 @@ def structure_search(u, y, na=range(1, 5), nb=range(1, 5), nk=range(1, 11), *,
             skipped.append((a, b, k, str(exc)))
             continue
         p = a + b
-        v = sol.rss / m
-        aic = m * math.log(2 * math.pi * v) + m + 2 * p if v > 0 else -math.inf
-        fpe = v * (1 + p / m) / (1 - p / m)
+        v = sol.rss / m  # in the scaled units: V_user = V / cy²
+        aic = m * (math.log(2 * math.pi * v) - 2 * math.log(cy)) + m + 2 * p if v > 0 else -math.inf
+        fpe = v * (1 + p / m) / (1 - p / m) / cy / cy
         fit = 100.0 * (1.0 - math.sqrt(sol.rss / sst))
-        found.append(Candidate(a, b, k, p, 0.5 * v, aic, fpe, fit))
+        found.append(Candidate(a, b, k, p, 0.5 * v / cy / cy, aic, fpe, fit))
     if not found:
         raise UnidentifiableError("no structure of the search could be identified: "
                                   + (skipped[0][3] if skipped else "empty grid"))
