@@ -94,7 +94,7 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
         from .mcap_reader import read_mcap
 
         raw, meta_units = read_mcap(path, columns, stamp)
-        return columns_to_trajectory(raw, source=path.name, time="t", units=units,
+        return columns_to_trajectory(raw, source=path.name, time="t", fs=fs, units=units,
                                      meta_units=meta_units, fill=fill)
     reader = {"csv": _read_csv, "parquet": _read_parquet, "hdf5": _read_hdf5}[fmt]
     raw, meta_units = reader(path, key=key, delimiter=delimiter)
