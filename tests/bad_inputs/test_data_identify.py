@@ -214,7 +214,8 @@ def test_outlier_check_is_silent_on_gaussian_data(n):
 
 
 def test_outlier_check_is_silent_on_structured_signals():
-    """Steps, PRBS, a fast-decaying vibration and a decaying σ(t) trajectory are not corrupt."""
+    """Steps, PRBS, a fast-decaying vibration, a decaying σ(t) trajectory and a train of 50
+    one-sample trigger pulses (more than the 2m = 10 samples a corruption may touch) are not corrupt."""
     t = np.arange(5000) / 1000
     rng = np.random.default_rng(0)
     signals = {
@@ -222,6 +223,7 @@ def test_outlier_check_is_silent_on_structured_signals():
         "PRBS": np.sign(rng.standard_normal(5000)),
         "decay": np.exp(-30 * t) * np.sin(2 * np.pi * 30 * t),
         "sigma(t)": 1.0 / np.sqrt(np.arange(1, 5001)),
+        "trigger pulses": (np.arange(5000) % 100 == 0).astype(float),
     }
     for name, x in signals.items():
         assert corrupt_samples(x).size == 0, name

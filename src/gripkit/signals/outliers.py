@@ -12,9 +12,12 @@ A sample is flagged when both hold:
 
   which equals σ for Gaussian data and is not moved by up to ``m`` corrupt values;
 * it belongs to a run of at most :data:`MAX_RUN` consecutive such samples, and the run jumps away
-  from the samples next to it by more than ``K·s`` as well. A step, a pulse or a decaying
+  from the samples next to it by more than ``K·s`` as well. A step, a longer pulse or a decaying
   transient lasts longer than that or joins the rest of the record smoothly; a corrupt value does
   neither.
+
+More than ``2m`` such samples are a property of the signal (a trigger or pulse train), not
+corruption, and are not reported.
 
 Whole signals at extreme but valid scales (1e300, 1e-300) are never flagged: the test is
 scale-free.
@@ -67,4 +70,6 @@ def corrupt_samples(x: np.ndarray) -> np.ndarray:
         if b < n and not abs(x[b - 1] - x[b]) > bound:
             continue
         keep.extend(range(a, b))
+    if len(keep) > 2 * m:  # more than the scale estimate sets aside: pulses of the signal, not corruption
+        return np.empty(0, dtype=np.intp)
     return np.asarray(keep, dtype=np.intp)
