@@ -31,14 +31,16 @@ def keyword_names(fn: Callable, exclude: Iterable[str] = ()) -> list[str]:
     return [n for n, p in inspect.signature(fn).parameters.items() if p.kind not in _VARIADIC and n not in skip]
 
 
-def check_keywords(given: Mapping | Iterable[str], accepted: Iterable[str], where: str) -> None:
-    """Raise :class:`ArgumentError` naming each keyword of ``given`` that is not in ``accepted``."""
+def check_keywords(given: Mapping | Iterable[str], accepted: Iterable[str], where: str,
+                   hint: str | None = None) -> None:
+    """Raise :class:`ArgumentError` naming each keyword of ``given`` that is not in ``accepted``
+    (``hint``: the list of what is accepted, when it says more than ``accepted``)."""
     accepted = list(accepted)
     unknown = [k for k in given if k not in accepted]
     if unknown:
         s = "s" if len(unknown) > 1 else ""
         raise ArgumentError(f"{where}: unknown keyword{s} {', '.join(map(repr, unknown))}",
-                            hint=f"accepted: {', '.join(accepted) if accepted else 'none'}")
+                            hint=hint or f"accepted: {', '.join(accepted) if accepted else 'none'}")
 
 
 def check_path(value, name: str, where: str) -> None:
@@ -65,7 +67,8 @@ def entry_point(fn: Callable) -> Callable:
             try:
                 sig.bind(*args, **kwargs)
             except TypeError as refused:  # the call itself did not fit: nothing of fn has run
-                accepted = ", ".join(n for n, p in sig.parameters.items() if p.kind not in _VARIADIC)
+                accepted = ", ".join(n if p.kind not in _VARIADIC else f"*{n}" if p.kind is p.VAR_POSITIONAL
+                                     else f"**{n}" for n, p in sig.parameters.items())
                 unknown = [k for k in kwargs if k not in sig.parameters]
                 if unknown and not any(p.kind is inspect.Parameter.VAR_KEYWORD for p in sig.parameters.values()):
                     s = "s" if len(unknown) > 1 else ""
