@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..arguments import entry_point
 from ..errors import AccuracyWarning, DataError, IdentificationError, SimulationError
 from ..models.second_order import SecondOrderSystem, second_order_step
 from ..signals.trajectory import Trajectory
@@ -204,6 +205,7 @@ def step_metrics(t, y, *, t_step: float | None = None, y_initial: float | None =
 STEP_METHODS = ("lm", "trf")
 
 
+@entry_point
 def identify_step(data: Trajectory, *, input: str, output: str, multistart: int = 0, method: str = "lm",
                   progress: bool = False) -> StepResponseResult:
     """Identify K, ω_n, ζ (and the output offset) of a second-order response (module docstring).
