@@ -27,20 +27,18 @@ def _build():
 
 
 def _click_classes(name: str) -> tuple[type, ...]:
-    """``name`` (an exception class) from click and from the copy of click that typer ≥ 0.17 vendors."""
-    import click.exceptions
+    """The exception class ``name`` of click and of the copy of click that recent typer vendors
+    (``typer._click``; typer then no longer needs click installed)."""
+    import importlib
 
-    found = [getattr(click.exceptions, name)]
-    try:
-        from typer import _click
-
-        found.append(getattr(_click.exceptions, name))
-    except (ImportError, AttributeError):
-        pass
-    if name in ("Exit", "Abort"):
-        import typer
-
-        found.append(getattr(typer, name))
+    found = []
+    for module in ("click.exceptions", "typer._click.exceptions", "typer"):
+        try:
+            cls = getattr(importlib.import_module(module), name, None)
+        except ImportError:
+            continue
+        if isinstance(cls, type):
+            found.append(cls)
     return tuple(dict.fromkeys(found))
 
 
