@@ -15,7 +15,6 @@ input with one clear line naming the argument and what is accepted, never "unexp
 from __future__ import annotations
 
 import errno
-import json
 import pathlib
 from importlib import metadata
 
@@ -23,7 +22,8 @@ import numpy as np
 import pytest
 
 import gripkit
-from gripkit.errors import ArgumentError, ConfigError, DataError, IdentificationError, ModelError, ParameterError, PathError
+from gripkit.errors import (ArgumentError, ConfigError, DataError, IdentificationError, ModelError,
+                            ParameterError, PathError)
 
 from conftest import assert_user_error
 
@@ -167,6 +167,18 @@ def test_unreadable_toml_is_a_config_error(cli, files, monkeypatch):
     monkeypatch.setattr(pathlib.Path, "read_bytes", denied)
     assert_user_error(cli("simulate", files / "msd.toml"), "ConfigError", "cannot be read: permission denied")
     assert_user_error(cli("sweep", files / "sweep.toml"), "ConfigError", "cannot be read: permission denied")
+
+
+def test_toml_errors_in_the_python_api(files):
+    from gripkit.batch import SweepSpec
+    from gripkit.sim.description import load_description
+
+    with pytest.raises(ConfigError, match="model description .* is not UTF-8 text"):
+        load_description(files / "junk.toml")
+    with pytest.raises(ConfigError, match="sweep file .* is a folder"):
+        SweepSpec.from_toml(files / "folder")
+    with pytest.raises(ArgumentError, match="model description must be a file path"):
+        load_description(42)
 
 
 def test_toml_with_a_byte_order_mark_is_read(tmp_path):

@@ -13,10 +13,9 @@ __all__ = ["output_file", "output_folder"]
 _WRITABLE_FORMATS = ("csv", "parquet", "hdf5")
 
 
-def output_file(path: Path | None, option: str, *, data: bool = True) -> Path | None:
-    """``path`` if a file can be written there (its folders may not exist yet), else
-    :class:`PathError` naming ``option``. ``data``: the suffix must be one :func:`gripkit.io.save`
-    writes (.csv, .parquet, .h5)."""
+def output_file(path: Path | None, option: str) -> Path | None:
+    """``path`` if a data file can be written there (its folders may not exist yet) in a format
+    :func:`gripkit.io.save` writes (.csv, .parquet, .h5), else :class:`PathError` naming ``option``."""
     if path is None:
         return None
     path = Path(path)
@@ -27,12 +26,11 @@ def output_file(path: Path | None, option: str, *, data: bool = True) -> Path | 
     if path.exists() and not os.access(path, os.W_OK):
         raise PathError(f"{option} {str(path)!r}: permission denied (the file is read-only)",
                         hint="choose another path, or make it writable")
-    if data:
-        from ..io import FORMATS
+    from ..io import FORMATS
 
-        if FORMATS.get(path.suffix.lower()) not in _WRITABLE_FORMATS:
-            raise PathError(f"{option} {str(path)!r}: cannot tell the format from the suffix {path.suffix!r}",
-                            hint="use .csv, .parquet or .h5")
+    if FORMATS.get(path.suffix.lower()) not in _WRITABLE_FORMATS:
+        raise PathError(f"{option} {str(path)!r}: cannot tell the format from the suffix {path.suffix!r}",
+                        hint="use .csv, .parquet or .h5")
     return path
 
 

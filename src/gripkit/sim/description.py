@@ -44,6 +44,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..arguments import check_path
 from ..errors import ConfigError, GripkitError
 from ..io.toml_file import read_toml
 from ..signals.trajectory import Trajectory
@@ -208,6 +209,7 @@ def input_signal(spec: Mapping, t: np.ndarray, where: str, base: Path | None = N
 
 def load_description(path, overrides: Mapping | None = None) -> Description:
     """Read a TOML description (see the module docstring) and build its model and inputs."""
+    check_path(path, "model description", "load_description()")
     path = Path(path)
     raw = read_toml(path, "model description")
     unknown = set(raw) - {"model", "parameters", "simulation", "inputs", "output"}

@@ -142,7 +142,8 @@ class Model(abc.ABC):
         if dt is None:
             raise SimulationError(f"{self.name}: give the sample time dt (or a Trajectory input)")
         if isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating)):
-            raise ArgumentError(f"dt: expected a sample time in seconds (a number), found {type(dt).__name__} {dt!r:.40}")
+            raise ArgumentError(f"dt: expected a sample time in seconds (a number), found "
+                                f"{type(dt).__name__} {dt!r:.40}")
         if not (np.isfinite(dt) and dt > 0):
             raise SimulationError(f"dt: expected a positive number of seconds, found {dt!r}")
         if not np.isfinite(arr).all():
