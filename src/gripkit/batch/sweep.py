@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..arguments import entry_point
 from ..errors import ConfigError, ConsistencyWarning
 from ..progress import status, track
 from .executors import Executor, make_executor
@@ -144,6 +145,7 @@ def _calibrate(spec: SweepSpec, jobs: dict[str, np.ndarray], target_s: float) ->
     return max(1, math.ceil(target_s / per_job))
 
 
+@entry_point
 def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "process", workers: int | None = None,
           scheduler: str | None = None, out: str | Path | None = None, resume: bool = False,
           progress: bool = True, executor: Executor | None = None,

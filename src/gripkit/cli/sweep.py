@@ -21,7 +21,9 @@ def sweep(spec: Path = typer.Argument(..., help="Sweep specification (TOML)."),
     """Run the sweep SPEC (jobs chunked, results streamed to OUT/chunks/*.parquet)."""
     from ..batch import SweepSpec
     from ..batch import sweep as run
+    from .paths import output_folder
 
+    output_folder(out, "--out")
     s = SweepSpec.from_toml(spec)
     out = out or Path(f"sweep-{s.name}")
     res = run(s, backend=backend, workers=workers, scheduler=scheduler, out=out, resume=resume)
