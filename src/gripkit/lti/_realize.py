@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import linalg
 
-__all__ = ["tf2ss", "ss2tf", "minreal", "ss_zeros", "MINREAL_TOL"]
+__all__ = ["tf2ss", "ss2tf", "balance", "minreal", "ss_zeros", "MINREAL_TOL"]
 
 _EPS = np.finfo(float).eps
 #: Relative rank tolerance of minimal realisations (MATLAB's ``minreal`` default, √ε): a pole and
@@ -30,7 +30,8 @@ def siso_observable_form(num: np.ndarray, den: np.ndarray):
     b = num / den[0]
     n = a.size - 1
     A = np.zeros((n, n), dtype=np.result_type(a, b))
-    A[:, 0] = -a[1:]
+    if n:
+        A[:, 0] = -a[1:]
     A[np.arange(n - 1), np.arange(1, n)] = 1.0
     B = (b[1:] - a[1:] * b[0]).reshape(n, 1)
     C = np.zeros((1, n), dtype=A.dtype)
@@ -119,9 +120,35 @@ def _reachable_basis(A, B, tol):
     return Q
 
 
+def balance(A, B, C, sweeps: int = 20):
+    """A diagonal similarity T = diag(2^k) making each state's row [A_i·, B_i·] and column
+    [A_·i; C_·i] of similar size (as MATLAB's ``ssbal``): (T⁻¹AT, T⁻¹B, CT). Rank decisions and
+    eigenvalues of badly scaled realisations (a 8.5 kHz mode in SI units) need it."""
+    n = A.shape[0]
+    A, B, C = A.copy(), B.copy(), C.copy()
+    for _ in range(sweeps):
+        changed = False
+        for i in range(n):
+            r = np.abs(A[i]).sum() - abs(A[i, i]) + np.abs(B[i]).sum()
+            c = np.abs(A[:, i]).sum() - abs(A[i, i]) + np.abs(C[:, i]).sum()
+            if r == 0 or c == 0:
+                continue
+            f = 2.0 ** np.round(0.5 * np.log2(c / r))
+            if f != 1.0:
+                A[i] *= f
+                B[i] *= f
+                A[:, i] /= f
+                C[:, i] /= f
+                changed = True
+        if not changed:
+            break
+    return A, B, C
+
+
 def minreal(A, B, C, D, tol: float = MINREAL_TOL):
-    """A minimal realisation: project onto the reachable subspace, then onto the observable one
-    (orthogonal bases, so the kept part is well conditioned)."""
+    """A minimal realisation: balance (:func:`balance`), project onto the reachable subspace,
+    then onto the observable one (orthogonal bases, so the kept part is well conditioned)."""
+    A, B, C = balance(A, B, C)
     Q = _reachable_basis(A, B, tol)
     A1, B1, C1 = Q.T @ A @ Q, Q.T @ B, C @ Q
     P = _reachable_basis(A1.T, C1.T, tol)

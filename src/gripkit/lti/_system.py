@@ -659,22 +659,27 @@ class StateSpace(LinearSystem):
 
 # ====================================================================== transfer function
 def _parse_polys(x, name):
-    """(p, m) nested list of 1-D coefficient arrays from a 1-D array, a nested list or a 3-D array."""
-    if isinstance(x, np.ndarray) and x.ndim == 3:
-        return [[np.asarray(x[i, j], dtype=np.float64) for j in range(x.shape[1])] for i in range(x.shape[0])]
-    if np.ndim(x) <= 1 and not (isinstance(x, (list, tuple)) and x and isinstance(x[0], (list, tuple, np.ndarray))
-                                and np.ndim(x[0]) >= 1 and isinstance(x[0][0] if len(x[0]) else 0, (list, tuple, np.ndarray))):
+    """(p, m) nested list of 1-D coefficient arrays from a 1-D sequence (SISO), a p × m nested
+    list of 1-D sequences (MIMO) or an array of shape (p, m, L)."""
+    def poly(c, where):
         try:
-            return [[np.atleast_1d(np.asarray(x, dtype=np.float64))]]
+            a = np.atleast_1d(np.asarray(c, dtype=np.float64))
         except (TypeError, ValueError):
-            pass
-    try:
-        rows = [[np.atleast_1d(np.asarray(c, dtype=np.float64)) for c in row] for row in x]
-    except (TypeError, ValueError):
-        raise ModelError(f"{name}: expected coefficients (1-D for SISO, a list of lists of 1-D "
-                         "arrays for MIMO)") from None
-    if not rows or any(len(r) != len(rows[0]) for r in rows) or not rows[0]:
-        raise ModelError(f"{name}: expected a rectangular (p × m) list of lists of polynomials")
+            a = None
+        if a is None or a.ndim != 1 or a.size == 0:
+            raise ModelError(f"{name}{where}: expected a 1-D sequence of coefficients, found {c!r}")
+        return a
+
+    if isinstance(x, np.ndarray) and x.ndim == 3:
+        return [[poly(x[i, j], f"[{i},{j}]") for j in range(x.shape[1])] for i in range(x.shape[0])]
+    nested = isinstance(x, (list, tuple)) and len(x) > 0 and all(isinstance(r, (list, tuple)) for r in x) \
+        and all(isinstance(c, (list, tuple, np.ndarray)) for r in x for c in r)
+    if not nested:
+        return [[poly(x, "")]]
+    rows = [[poly(c, f"[{i},{j}]") for j, c in enumerate(r)] for i, r in enumerate(x)]
+    if any(len(r) != len(rows[0]) for r in rows) or not rows[0]:
+        raise ModelError(f"{name}: expected a rectangular p × m list of lists of polynomials, found rows of "
+                         f"lengths {[len(r) for r in rows]}")
     return rows
 
 
