@@ -86,9 +86,22 @@ def ss2tf(A, B, C, D, minimal: bool = True, tol: float = MINREAL_TOL):
             a, b, c = A, B[:, j:j + 1], C[i:i + 1]
             if minimal:
                 a, b, c, _ = minreal(a, b, c, D[i:i + 1, j:j + 1], tol)
-            den = np.poly(a) if a.shape[0] else np.ones(1)
-            num = np.poly(a - b @ c) + (D[i, j] - 1.0) * den if a.shape[0] else D[i, j] * np.ones(1)
-            entries.append((np.real_if_close(num, tol=1e6).real, np.real_if_close(den, tol=1e6).real))
+            if a.shape[0] == 0:
+                entries.append((D[i, j] * np.ones(1), np.ones(1)))
+                continue
+            lam, mu = np.linalg.eigvals(a), np.linalg.eigvals(a - b @ c)
+            den = np.poly(lam).real
+            num = np.poly(mu).real + (D[i, j] - 1.0) * den
+            # leading coefficients that are zero in exact arithmetic (relative degree) come out as
+            # rounding noise of the subtraction: bounded by n ε times the coefficients of
+            # Π(s + |λ_i|) and Π(s + |μ_i|); 100× that is taken as zero
+            noise = 100 * a.shape[0] * _EPS * (np.poly(-np.abs(lam)).real + np.poly(-np.abs(mu)).real
+                                                * max(1.0, abs(D[i, j] - 1.0)))
+            k = 0
+            while k < num.size - 1 and abs(num[k]) <= noise[k]:
+                num[k] = 0.0
+                k += 1
+            entries.append((num, den))
     L = max(e[1].size for e in entries)
     num = np.zeros((p, m, L))
     den = np.zeros((p, m, L))
