@@ -90,6 +90,10 @@ def ss2tf(A, B, C, D, minimal: bool = True, tol: float = MINREAL_TOL):
                 entries.append((D[i, j] * np.ones(1), np.ones(1)))
                 continue
             lam, mu = np.linalg.eigvals(a), np.linalg.eigvals(a - b @ c)
+            # eigenvalues within the eigen-solver's backward error (10 n ε ‖·‖₁) of the origin are
+            # zero (delays: poles at z = 0), so the polynomials get exact trailing zeros
+            lam[np.abs(lam) <= 10 * a.shape[0] * _EPS * np.abs(a).sum(0).max()] = 0.0
+            mu[np.abs(mu) <= 10 * a.shape[0] * _EPS * np.abs(a - b @ c).sum(0).max()] = 0.0
             den = np.poly(lam).real
             num = np.poly(mu).real + (D[i, j] - 1.0) * den
             # leading coefficients that are zero in exact arithmetic (relative degree) come out as

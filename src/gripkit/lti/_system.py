@@ -72,6 +72,13 @@ class LinearSystem:
     Every system has ``dt`` (None: continuous; > 0: sample time in s), ``inputs``/``outputs``
     (names), ``input_units``/``output_units`` (SI strings, ``''`` when not declared), ``meta``
     (free-form provenance) and ``uncertainty`` (an :class:`Uncertainty` or None).
+
+    Examples
+    --------
+    >>> from gripkit.lti import LinearSystem, StateSpace, TransferFunction
+    >>> all(isinstance(g, LinearSystem) for g in (StateSpace([[-1.0]], [[1.0]], [[1.0]]),
+    ...                                           TransferFunction([1.0], [1.0, 1.0])))
+    True
     """
 
     # ------------------------------------------------------------------ shape and time base
@@ -92,7 +99,14 @@ class LinearSystem:
         return self.n_inputs == 1 and self.n_outputs == 1
 
     def replace(self, **changes):
-        """A copy with some fields changed (validated again)."""
+        """A copy with some fields changed (validated again).
+
+        Examples
+        --------
+        >>> from gripkit.lti import TransferFunction
+        >>> TransferFunction([1.0], [1.0, 1.0]).replace(inputs="V").inputs
+        ('V',)
+        """
         return dataclasses.replace(self, **changes)
 
     def _signals(self, **over) -> dict:
@@ -301,15 +315,36 @@ class LinearSystem:
 
     # ------------------------------------------------------------------ interconnection
     def series(self, other):
-        """``other ∘ self``: u → self → other → y (G = G_other · G_self). See :func:`series`."""
+        """``other ∘ self``: u → self → other → y (G = G_other · G_self). See :func:`series`.
+
+        Examples
+        --------
+        >>> from gripkit.lti import TransferFunction
+        >>> TransferFunction([1.0], [1.0, 1.0]).series(TransferFunction([3.0], [1.0, 3.0])).dc_gain().tolist()
+        [[1.0]]
+        """
         return series(self, other)
 
     def parallel(self, other):
-        """``self + other`` on shared inputs, outputs summed. See :func:`parallel`."""
+        """``self + other`` on shared inputs, outputs summed. See :func:`parallel`.
+
+        Examples
+        --------
+        >>> from gripkit.lti import TransferFunction
+        >>> TransferFunction([1.0], [1.0, 1.0]).parallel(TransferFunction([3.0], [1.0, 3.0])).dc_gain().tolist()
+        [[2.0]]
+        """
         return parallel(self, other)
 
     def feedback(self, other=1.0, sign: float = -1.0):
-        """Closed loop ``G / (I − sign·K G)``. See :func:`feedback`."""
+        """Closed loop ``(I − sign·G K)⁻¹ G``. See :func:`feedback`.
+
+        Examples
+        --------
+        >>> from gripkit.lti import TransferFunction
+        >>> TransferFunction([3.0], [1.0, 1.0]).feedback().dc_gain().tolist()
+        [[0.75]]
+        """
         return feedback(self, other, sign)
 
     def __mul__(self, other):
@@ -467,7 +502,7 @@ class StateSpace(LinearSystem):
         if self.uncertainty is not None:
             if not isinstance(self.uncertainty, Uncertainty):
                 raise ModelError(f"uncertainty: expected an Uncertainty, found {type(self.uncertainty).__name__}")
-            self.uncertainty.check_shapes(self._arrays())
+            self.uncertainty._check_shapes(self._arrays())
 
     # ------------------------------------------------------------------ plumbing
     def _arrays(self):
@@ -771,7 +806,7 @@ class TransferFunction(LinearSystem):
         if stored:
             if not isinstance(self.uncertainty, Uncertainty):
                 raise ModelError(f"uncertainty: expected an Uncertainty, found {type(self.uncertainty).__name__}")
-            self.uncertainty.check_shapes(self._arrays())
+            self.uncertainty._check_shapes(self._arrays())
 
     # ------------------------------------------------------------------ construction
     @classmethod
