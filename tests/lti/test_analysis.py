@@ -168,3 +168,18 @@ def test_validation_errors():
         TransferFunction([1.0], [1.0, 1.0]).den_zinv()
     with pytest.raises(DataError, match="samples spaced by dt"):
         TransferFunction([1.0], [1.0, -0.5], dt=0.1).step(np.linspace(0, 1, 7))
+
+
+def test_names_and_units_survive_conversions():
+    s = second_order(10.0, 0.3).replace(states=("x", "v"), state_units=("m", "m/s"))
+    for t in (s.c2d(0.01), s.c2d(0.01).d2c(), s.to_tf(), s.to_tf().to_ss(), s.c2d(0.01, "tustin"), 2.0 * s, -s):
+        assert (t.inputs, t.outputs, t.input_units, t.output_units) == (("F",), ("x",), ("N",), ("m",))
+    d = s.c2d(0.01)
+    assert d.states == ("x", "v") and d.state_units == ("m", "m/s") and d.dt == 0.01
+
+
+def test_minimum_phase():
+    """(s − 1)/(s + 2)² is not minimum phase, (s + 1)/(s + 2)² is (analytic)."""
+    assert not TransferFunction([1.0, -1.0], [1.0, 4.0, 4.0]).is_minimum_phase()
+    assert TransferFunction([1.0, 1.0], [1.0, 4.0, 4.0]).is_minimum_phase()
+    assert TransferFunction([1.0, 1.0], [1.0, 4.0, 4.0]).to_ss().is_minimum_phase()

@@ -158,3 +158,19 @@ def test_covariance_errors():
         g.with_covariance([[-1.0]], ["den[1]"])
     with pytest.raises(ModelError, match="names like 'A"):
         StateSpace([[1.0]], [[1.0]], [[1.0]]).with_covariance([[1.0]], ["Q[0,0]"])
+
+
+def test_damping_and_its_sigma_match_monte_carlo(g, draws):
+    """ω_n = √a2 and ζ = a1/(2√a2) of s² + a1 s + a2 (analytic), and their σ against Monte Carlo;
+    for the ZOH-discretised system the same ω_n and ζ come back from ln(z)/dt."""
+    d = g.damping()
+    assert d.wn[0] == pytest.approx(10.0, rel=1e-12) and d.zeta[0] == pytest.approx(0.2, rel=1e-12)
+    wn_mc = np.sqrt(draws[:, 2])
+    zeta_mc = draws[:, 1] / (2 * wn_mc)
+    assert np.std(wn_mc, ddof=1) == pytest.approx(d.wn_std[0], rel=REL)
+    assert np.std(zeta_mc, ddof=1) == pytest.approx(d.zeta_std[0], rel=REL)
+    dd = g.c2d(0.02).damping()
+    np.testing.assert_allclose(dd.wn, d.wn, rtol=1e-9)
+    np.testing.assert_allclose(dd.zeta, d.zeta, rtol=1e-9)
+    np.testing.assert_allclose(dd.wn_std, d.wn_std, rtol=1e-5)
+    np.testing.assert_allclose(dd.zeta_std, d.zeta_std, rtol=1e-5)

@@ -28,7 +28,7 @@ from ._kernels import simulate_ss
 from ._pycontrol import control_module
 from ._uncertainty import Uncertainty, complex_covariance, push
 
-__all__ = ["LinearSystem", "StateSpace", "TransferFunction", "c2d", "d2c", "series", "parallel", "feedback"]
+__all__ = ["Damping", "LinearSystem", "StateSpace", "TransferFunction", "c2d", "d2c", "series", "parallel", "feedback"]
 
 _EPS = np.finfo(float).eps
 
@@ -63,6 +63,30 @@ def _ss_frequency(A, B, C, D, s):
     X = np.linalg.solve(M, np.broadcast_to(B.astype(complex), (s.size,) + B.shape))
     Y = np.swapaxes(np.linalg.solve(np.swapaxes(M, 1, 2), np.broadcast_to(C.T.astype(complex), (s.size,) + C.T.shape)), 1, 2)
     return C @ X + D, X, Y
+
+
+@dataclass(frozen=True, eq=False)
+class Damping:
+    """Poles with their natural frequencies ``wn`` (rad/s) and damping ratios ``zeta``, and the
+    one-sigma ``wn_std``/``zeta_std`` (None without covariance). See :meth:`LinearSystem.damping`.
+
+    Examples
+    --------
+    >>> from gripkit.lti import StateSpace
+    >>> float(StateSpace([[-3.0]], [[1.0]], [[1.0]]).damping().zeta[0])
+    1.0
+    """
+
+    poles: np.ndarray
+    wn: np.ndarray
+    zeta: np.ndarray
+    wn_std: np.ndarray | None = None
+    zeta_std: np.ndarray | None = None
+
+    @property
+    def f_hz(self) -> np.ndarray:
+        """Natural frequencies in Hz, ω_n/2π."""
+        return self.wn / (2 * np.pi)
 
 
 class LinearSystem:
@@ -133,6 +157,58 @@ class LinearSystem:
         """
         p = self.poles()
         return bool(np.all(np.abs(p) < 1.0)) if self.is_discrete else bool(np.all(p.real < 0.0))
+
+    def is_minimum_phase(self) -> bool:
+        """Every (transmission) zero with Re z < 0 (continuous) or |z| < 1 (discrete).
+
+        Examples
+        --------
+        >>> from gripkit.lti import TransferFunction
+        >>> TransferFunction.from_polynomials([1, -1.8732, 0.8996], [0, 0, 0.1950, -0.2276], dt=0.005).is_minimum_phase()
+        False
+        """
+        z = self.zeros()
+        return bool(np.all(np.abs(z) < 1.0)) if self.is_discrete else bool(np.all(z.real < 0.0))
+
+    def damping(self) -> Damping:
+        """Natural frequency ω_n (rad/s) and damping ratio ζ of each pole, with their one-sigma
+        when the system carries a covariance.
+
+        Continuous pole s: ``ω_n = |s|``, ``ζ = −Re s / |s|``. Discrete pole z: the same of
+        ``s = ln(z)/dt`` (the continuous pole that ZOH maps to z). σ by linearisation of the pole
+        covariance: ∂ω_n/∂(x, y) = (x, y)/ω_n and ∂ζ/∂(x, y) = (−y², x y)/ω_n³ for s = x + j y,
+        and ds/dz = 1/(z dt).
+
+        Examples
+        --------
+        >>> from gripkit.lti import TransferFunction
+        >>> d = TransferFunction([100.0], [1.0, 4.0, 100.0]).damping()
+        >>> d.wn.round(9).tolist(), d.zeta.round(9).tolist()
+        ([10.0, 10.0], [0.2, 0.2])
+        """
+        if self.uncertainty is not None:
+            p, cov = self.pole_covariance()
+        else:
+            p, cov = self.poles(), None
+        if self.is_discrete:
+            if np.any(np.abs(p) == 0):
+                raise ModelError("damping: a pole at z = 0 has no continuous equivalent (ln 0)")
+            s = np.log(p.astype(complex)) / self.dt
+            c = 1.0 / (p * self.dt)
+        else:
+            s, c = p.astype(complex), np.ones(p.size, dtype=complex)
+        wn = np.abs(s)
+        zeta = np.where(wn > 0, -s.real / np.where(wn > 0, wn, 1.0), -1.0)
+        if cov is None:
+            return Damping(p, wn, zeta, None, None)
+        Jz = np.stack([np.stack([c.real, -c.imag], -1), np.stack([c.imag, c.real], -1)], -2)  # d(Re s, Im s)/d(Re p, Im p)
+        cs = Jz @ cov @ np.swapaxes(Jz, -1, -2)
+        x, y = s.real, s.imag
+        w = np.where(wn > 0, wn, np.inf)
+        gw = np.stack([x / w, y / w], -1)
+        gz = np.stack([-y ** 2 / w ** 3, x * y / w ** 3], -1)
+        var = lambda g: np.einsum("ka,kab,kb->k", g, cs, g)  # noqa: E731
+        return Damping(p, wn, zeta, np.sqrt(np.clip(var(gw), 0, None)), np.sqrt(np.clip(var(gz), 0, None)))
 
     def pole_covariance(self) -> tuple[np.ndarray, np.ndarray]:
         """Poles and the covariance of (Re p, Im p) of each, shape (n, 2, 2), to first order:
@@ -356,6 +432,9 @@ class LinearSystem:
         return self._scaled(other)
 
     def __add__(self, other):
+        return parallel(self, other)
+
+    def __radd__(self, other):
         return parallel(self, other)
 
     def __neg__(self):
