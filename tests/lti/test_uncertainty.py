@@ -174,3 +174,27 @@ def test_damping_and_its_sigma_match_monte_carlo(g, draws):
     np.testing.assert_allclose(dd.zeta, d.zeta, rtol=1e-9)
     np.testing.assert_allclose(dd.wn_std, d.wn_std, rtol=1e-5)
     np.testing.assert_allclose(dd.zeta_std, d.zeta_std, rtol=1e-5)
+
+
+def test_delay_poles_have_zero_sigma_and_agree_with_the_realisation():
+    """ARX [2 2 3]: two poles at z = 0 from the delay are exact (σ = 0), and the root-sensitivity
+    σ of the others equals the eigenvector formula on the state-space realisation."""
+    cov = np.diag([1e-3, 1e-3, 2e-3, 2e-3]) ** 2
+    g = TransferFunction.from_polynomials([1.0, -1.8732, 0.8996], [0, 0, 0, 0.1950, -0.2276], dt=0.005,
+                                          covariance=cov)
+    p, c = g.pole_covariance()
+    assert np.count_nonzero(p == 0) == 2 and np.all(c[p == 0] == 0)
+    d = g.damping()
+    assert np.all(np.isinf(d.wn[p == 0])) and np.all(d.zeta[p == 0] == 1.0)
+    # the same σ from the eigenvalues of a realisation without the delay states
+    g2 = TransferFunction.from_polynomials([1.0, -1.8732, 0.8996], [0.1950, -0.2276], dt=0.005, covariance=cov)
+    p2, c2 = g2.to_ss(minimal=False).pole_covariance()
+    order = [int(np.argmin(np.abs(p2 - x))) for x in p[p != 0]]
+    np.testing.assert_allclose(c[p != 0], c2[order], rtol=1e-6)
+
+
+def test_frequency_response_at_a_pole_is_an_error():
+    with pytest.raises(ModelError, match="is a pole of the system"):
+        TransferFunction([1.0], [1.0, 0.0]).frequency_response([0.0])
+    with pytest.raises(ModelError, match="is a pole of the system"):
+        StateSpace([[0.0]], [[1.0]], [[1.0]]).frequency_response([0.0])

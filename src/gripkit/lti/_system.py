@@ -53,6 +53,15 @@ def _simulate_arrays(A, B, C, D, u, x0):
     return y
 
 
+def _vector_as(x, shape):
+    """A 1-D sequence reshaped (a column of B, a row of C); anything else unchanged."""
+    try:
+        a = np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError):
+        return x
+    return a.reshape(shape) if a.ndim == 1 else x
+
+
 def _ss_frequency(A, B, C, D, s):
     """G(s_k) = C (s_k I − A)⁻¹ B + D, and X = (sI − A)⁻¹ B, Y = C (sI − A)⁻¹, for each s_k."""
     n = A.shape[0]
@@ -60,6 +69,11 @@ def _ss_frequency(A, B, C, D, s):
         H = np.broadcast_to(D, (s.size,) + D.shape).astype(complex)
         return H, np.zeros((s.size, 0, D.shape[1])), np.zeros((s.size, D.shape[0], 0))
     M = s[:, None, None] * np.eye(n) - A
+    sv = np.linalg.svd(M, compute_uv=False)
+    bad = sv[:, -1] <= n * _EPS * np.maximum(sv[:, 0], 1.0)
+    if np.any(bad):
+        raise ModelError(f"frequency response: s = {s[bad][0]:.6g} is a pole of the system (sI − A is singular)",
+                         hint="evaluate away from the poles on the imaginary axis (or the unit circle)")
     X = np.linalg.solve(M, np.broadcast_to(B.astype(complex), (s.size,) + B.shape))
     Y = np.swapaxes(np.linalg.solve(np.swapaxes(M, 1, 2), np.broadcast_to(C.T.astype(complex), (s.size,) + C.T.shape)), 1, 2)
     return C @ X + D, X, Y
@@ -191,20 +205,22 @@ class LinearSystem:
         else:
             p, cov = self.poles(), None
         if self.is_discrete:
-            if np.any(np.abs(p) == 0):
-                raise ModelError("damping: a pole at z = 0 has no continuous equivalent (ln 0)")
-            s = np.log(p.astype(complex)) / self.dt
-            c = 1.0 / (p * self.dt)
+            # a pole at z = 0 (a delay) is s = ln 0 = −∞: ω_n = ∞, ζ = 1 (as MATLAB's damp)
+            at0 = p == 0
+            pz = np.where(at0, 1.0, p).astype(complex)
+            s = np.where(at0, -np.inf, np.log(pz) / self.dt)
+            c = np.where(at0, 0.0, 1.0 / (pz * self.dt))
         else:
             s, c = p.astype(complex), np.ones(p.size, dtype=complex)
         wn = np.abs(s)
-        zeta = np.where(wn > 0, -s.real / np.where(wn > 0, wn, 1.0), -1.0)
+        with np.errstate(invalid="ignore"):
+            zeta = np.where(np.isinf(wn), 1.0, np.where(wn > 0, -s.real / np.where(wn > 0, wn, 1.0), -1.0))
         if cov is None:
             return Damping(p, wn, zeta, None, None)
         Jz = np.stack([np.stack([c.real, -c.imag], -1), np.stack([c.imag, c.real], -1)], -2)  # d(Re s, Im s)/d(Re p, Im p)
         cs = Jz @ cov @ np.swapaxes(Jz, -1, -2)
-        x, y = s.real, s.imag
-        w = np.where(wn > 0, wn, np.inf)
+        x, y = np.where(np.isinf(wn), 0.0, s.real), np.where(np.isinf(wn), 0.0, s.imag)
+        w = np.where((wn > 0) & np.isfinite(wn), wn, np.inf)
         gw = np.stack([x / w, y / w], -1)
         gz = np.stack([-y ** 2 / w ** 3, x * y / w ** 3], -1)
         var = lambda g: np.einsum("ka,kab,kb->k", g, cs, g)  # noqa: E731
@@ -558,11 +574,10 @@ class StateSpace(LinearSystem):
         n = A.shape[0]
         if A.shape != (n, n):
             raise ModelError(f"A: expected a square matrix, found shape {A.shape}")
-        B = np.asarray(self.B, dtype=np.float64) if np.ndim(self.B) == 1 else self.B
-        B = as_matrix(np.reshape(B, (-1, 1)) if np.ndim(B) == 1 else B, "B")
+        B = as_matrix(_vector_as(self.B, (-1, 1)), "B")
         if B.shape[0] != n:
             raise ModelError(f"B: expected shape ({n}, m) (one row per state), found {B.shape}")
-        C = as_matrix(np.reshape(self.C, (1, -1)) if np.ndim(self.C) == 1 else self.C, "C")
+        C = as_matrix(_vector_as(self.C, (1, -1)), "C")
         if C.shape[1] != n:
             raise ModelError(f"C: expected shape (p, {n}) (one column per state), found {C.shape}")
         p, m = C.shape[0], B.shape[1]
@@ -1077,6 +1092,45 @@ class TransferFunction(LinearSystem):
         return d[:np.flatnonzero(d)[-1] + 1].copy()
 
     # ------------------------------------------------------------------ analysis
+    def pole_covariance(self) -> tuple[np.ndarray, np.ndarray]:
+        """Poles and the covariance of (Re p, Im p) of each, shape (n, 2, 2), to first order.
+
+        SISO: root sensitivity of the monic denominator D, ``∂r/∂θ_i = −(∂D/∂θ_i)(r) / D'(r)``;
+        roots at z = 0 that no parameter moves (a delay's trailing zeros of D) have σ = 0.
+        MIMO: as :meth:`LinearSystem.pole_covariance`, on the realisation.
+
+        Examples
+        --------
+        >>> from gripkit.lti import TransferFunction
+        >>> g = TransferFunction.from_polynomials([1, -0.5], [0, 0, 0, 1.0], dt=1.0, covariance=[[1e-4, 0], [0, 0]])
+        >>> p, cov = g.pole_covariance()
+        >>> p.real.tolist(), cov[:, 0, 0].round(12).tolist()
+        ([0.5, 0.0, 0.0], [0.0001, 0.0, 0.0])
+        """
+        if not self.is_siso:
+            return super().pole_covariance()
+        if self.uncertainty is None:
+            raise ModelError("pole_covariance: the system carries no covariance",
+                             hint="build it with with_covariance(...) or from an identified model")
+        den = self.denominator()
+        d = den.size - 1
+        dden = self.uncertainty.tangents[1][:, 0, 0, self.den.shape[2] - 1 - d:]
+        t = 0
+        while t < d and den[d - t] == 0.0 and not np.any(dden[:, d - t]):
+            t += 1
+        core, dcore = den[:d + 1 - t], dden[:, :d + 1 - t]
+        r = np.roots(core).astype(complex) if core.size > 1 else np.zeros(0, dtype=complex)
+        slope = np.polyval(np.polyder(core), r) if r.size else r
+        J = -np.array([np.polyval(row, r) for row in dcore]).reshape(-1, r.size) / slope
+        cov = complex_covariance(J, self.uncertainty.covariance)
+        # a repeated root has D'(r) ≈ 0 (within the rounding of D' at r): its first-order σ is undefined
+        bad = np.abs(slope) <= 100 * core.size * _EPS * np.polyval(np.abs(np.polyder(core)), np.abs(r))
+        if np.any(bad):
+            warnings.warn(f"pole_covariance: {int(bad.sum())} pole(s) are (nearly) repeated; their "
+                          "first-order σ is undefined and set to inf", AccuracyWarning, stacklevel=2)
+            cov[bad] = np.inf
+        return np.r_[r, np.zeros(t, dtype=complex)], np.concatenate([cov, np.zeros((t, 2, 2))])
+
     def poles(self) -> np.ndarray:
         """SISO: the roots of the denominator. MIMO: the eigenvalues of a minimal realisation.
 
@@ -1121,7 +1175,14 @@ class TransferFunction(LinearSystem):
         >>> TransferFunction([1.0], [1.0, 1.0]).frequency_response([1.0])[0, 0, 0]
         np.complex128(0.5-0.5j)
         """
-        nu, de, _ = self._eval(self._s(w))
+        s = self._s(w)
+        nu, de, powers = self._eval(s)
+        # |den(s)| below its rounding error L ε Σ|a_k s^k| is a pole on the evaluation contour
+        bad = np.abs(de) <= self.num.shape[2] * _EPS * np.einsum("fl,pml->fpm", np.abs(powers), np.abs(self.den))
+        if np.any(bad):
+            f = np.argwhere(bad)[0, 0]
+            raise ModelError(f"frequency response: {'z' if self.is_discrete else 's'} = {s[f]:.6g} is a pole of the system",
+                             hint="evaluate away from the poles on the imaginary axis (or the unit circle)")
         return nu / de
 
     def _frequency_jacobian(self, s):
