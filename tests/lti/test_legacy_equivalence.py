@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from gripkit.control.finger_force import DiscretePlant
-from gripkit.lti import StateSpace, TransferFunction, as_system
+from gripkit.lti import StateSpace, as_system
 from gripkit.sim.linear import StateSpace as OldStateSpace
 from gripkit.sim.linear import c2d_zoh
 from gripkit.sysid.polynomial import PolynomialModel

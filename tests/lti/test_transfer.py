@@ -81,7 +81,8 @@ def test_mimo_tf_response_matches_python_control():
     np.testing.assert_allclose(g.to_ss().frequency_response(w), g.frequency_response(w), rtol=1e-10)
     # entry 00 is (s+2)/((s+1)(s+2)) = 1/(s+1) and row 0 is rank one: McMillan degree 4,
     # poles −1, −4, −1 ± 2j
-    np.testing.assert_allclose(np.sort_complex(g.poles().round(9)), np.sort_complex([-4.0, -1 - 2j, -1 + 2j, -1.0]), atol=1e-9)
+    expect = np.sort_complex([-4.0, -1 - 2j, -1 + 2j, -1.0])
+    np.testing.assert_allclose(np.sort_complex(g.poles().round(9)), expect, atol=1e-9)
 
 
 def test_from_polynomials_table_ii():

@@ -33,5 +33,5 @@ from ._system import parallel as parallel
 from ._system import series as series
 from ._uncertainty import Uncertainty as Uncertainty
 
-__all__ = ["Bode", "Damping", "LinearSystem", "StateSpace", "TransferFunction", "Uncertainty", "as_system", "c2d", "d2c",
-           "feedback", "from_control", "from_scipy", "parallel", "series"]
+__all__ = ["Bode", "Damping", "LinearSystem", "StateSpace", "TransferFunction", "Uncertainty", "as_system",
+           "c2d", "d2c", "feedback", "from_control", "from_scipy", "parallel", "series"]

@@ -75,7 +75,8 @@ def _ss_frequency(A, B, C, D, s):
         raise ModelError(f"frequency response: s = {s[bad][0]:.6g} is a pole of the system (sI − A is singular)",
                          hint="evaluate away from the poles on the imaginary axis (or the unit circle)")
     X = np.linalg.solve(M, np.broadcast_to(B.astype(complex), (s.size,) + B.shape))
-    Y = np.swapaxes(np.linalg.solve(np.swapaxes(M, 1, 2), np.broadcast_to(C.T.astype(complex), (s.size,) + C.T.shape)), 1, 2)
+    Ct = np.broadcast_to(C.T.astype(complex), (s.size,) + C.T.shape)
+    Y = np.swapaxes(np.linalg.solve(np.swapaxes(M, 1, 2), Ct), 1, 2)
     return C @ X + D, X, Y
 
 
@@ -178,7 +179,8 @@ class LinearSystem:
         Examples
         --------
         >>> from gripkit.lti import TransferFunction
-        >>> TransferFunction.from_polynomials([1, -1.8732, 0.8996], [0, 0, 0.1950, -0.2276], dt=0.005).is_minimum_phase()
+        >>> g = TransferFunction.from_polynomials([1, -1.8732, 0.8996], [0, 0, 0.1950, -0.2276], dt=0.005)
+        >>> g.is_minimum_phase()     # zero at z = 1.167 (000_8f66dcc7ab06470c.txt §V-F)
         False
         """
         z = self.zeros()
@@ -217,7 +219,8 @@ class LinearSystem:
             zeta = np.where(np.isinf(wn), 1.0, np.where(wn > 0, -s.real / np.where(wn > 0, wn, 1.0), -1.0))
         if cov is None:
             return Damping(p, wn, zeta, None, None)
-        Jz = np.stack([np.stack([c.real, -c.imag], -1), np.stack([c.imag, c.real], -1)], -2)  # d(Re s, Im s)/d(Re p, Im p)
+        # ∂(Re s, Im s)/∂(Re p, Im p): multiplication by the complex number c = ds/dp
+        Jz = np.stack([np.stack([c.real, -c.imag], -1), np.stack([c.imag, c.real], -1)], -2)
         cs = Jz @ cov @ np.swapaxes(Jz, -1, -2)
         x, y = np.where(np.isinf(wn), 0.0, s.real), np.where(np.isinf(wn), 0.0, s.imag)
         w = np.where((wn > 0) & np.isfinite(wn), wn, np.inf)
@@ -636,7 +639,8 @@ class StateSpace(LinearSystem):
         """
         arrays = dict(zip("ABCD", self._arrays()))
         if parameters is None:
-            parameters = [f"{k}[{i},{j}]" for k, a in arrays.items() for i in range(a.shape[0]) for j in range(a.shape[1])]
+            parameters = [f"{k}[{i},{j}]" for k, a in arrays.items()
+                          for i in range(a.shape[0]) for j in range(a.shape[1])]
         parameters = list(parameters)
         tangents = [np.zeros((len(parameters),) + a.shape) for a in arrays.values()]
         for q, name in enumerate(parameters):
@@ -1181,7 +1185,8 @@ class TransferFunction(LinearSystem):
         bad = np.abs(de) <= self.num.shape[2] * _EPS * np.einsum("fl,pml->fpm", np.abs(powers), np.abs(self.den))
         if np.any(bad):
             f = np.argwhere(bad)[0, 0]
-            raise ModelError(f"frequency response: {'z' if self.is_discrete else 's'} = {s[f]:.6g} is a pole of the system",
+            var = "z" if self.is_discrete else "s"
+            raise ModelError(f"frequency response: {var} = {s[f]:.6g} is a pole of the system",
                              hint="evaluate away from the poles on the imaginary axis (or the unit circle)")
         return nu / de
 
