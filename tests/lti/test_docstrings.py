@@ -24,12 +24,12 @@ def _public_callables():
         yield name, obj
         if inspect.isclass(obj):
             for attr, member in vars(obj).items():
-                if not attr.startswith("_") and (inspect.isfunction(member) or isinstance(member, classmethod)):
+                if not attr.startswith("_") and (inspect.isfunction(member) or isinstance(member, (classmethod, staticmethod))):
                     yield f"{name}.{attr}", member
 
 
 @pytest.mark.parametrize("name, obj", list(_public_callables()))
 def test_every_public_callable_has_an_example(name, obj):
-    fn = obj.__func__ if isinstance(obj, classmethod) else obj
+    fn = obj.__func__ if isinstance(obj, (classmethod, staticmethod)) else obj
     doc = inspect.getdoc(fn) or ""
     assert ">>>" in doc, f"{name} has no runnable example"

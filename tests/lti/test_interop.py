@@ -67,3 +67,28 @@ def test_as_system_reads_tuples_and_polynomial_like_objects():
     assert as_system(g) is g
     with pytest.raises(ModelError, match="cannot read a linear system from int"):
         as_system(3)
+
+
+def test_dict_round_trip_through_json_is_exact():
+    """to_dict → JSON → from_dict returns the same arrays, names, units and covariance (JSON keeps
+    floats by their shortest repr, which round-trips exactly)."""
+    import json
+
+    s = StateSpace([[0.0, 1.0], [-4.0, -0.4]], [[0.0], [1.0 / 3.0]], [[1.0, 0.0]], dt=0.01, inputs="V",
+                   outputs="x", states=("p", "v"), input_units="V", output_units="m", meta={"source": "test"})
+    s = s.with_covariance(np.diag([1e-4, 2e-4]), ["A[1,0]", "A[1,1]"])
+    g = TransferFunction.from_polynomials([1.0, -1.8732, 0.8996], [0, 0, 0.1950, -0.2276], dt=0.005,
+                                          covariance=np.diag([1e-6, 1e-6, 4e-6, 4e-6]), outputs="F")
+    for sys in (s, g, g.to_ss(minimal=False)):
+        back = type(sys).from_dict(json.loads(json.dumps(sys.to_dict())))
+        assert type(back) is type(sys)
+        for X, Y in zip(back._arrays(), sys._arrays()):
+            np.testing.assert_array_equal(X, Y)
+        assert (back.dt, back.inputs, back.outputs, back.input_units, back.output_units, back.meta) == \
+            (sys.dt, sys.inputs, sys.outputs, sys.input_units, sys.output_units, sys.meta)
+        np.testing.assert_array_equal(back.uncertainty.covariance, sys.uncertainty.covariance)
+        assert back.uncertainty.names == sys.uncertainty.names
+    with pytest.raises(ModelError, match="expected a dict with type"):
+        StateSpace.from_dict({"type": "Polynomial"})
+    with pytest.raises(ModelError, match="lacks 'C'"):
+        StateSpace.from_dict({"type": "StateSpace", "A": [[1.0]], "B": [[1.0]]})

@@ -472,6 +472,63 @@ class LinearSystem:
         return self._map_self(lambda *arrs: self._scale_arrays(arrs, k))
 
     # ------------------------------------------------------------------ uncertainty
+    # ------------------------------------------------------------------ files
+    def to_dict(self) -> dict:
+        """A JSON-ready description: ``type`` (``'StateSpace'``/``'TransferFunction'``), the
+        arrays as nested lists (stored form), ``dt``, names, units, ``meta`` and ``uncertainty``
+        (``names``, ``covariance``, ``tangents``) or None. :meth:`from_dict` reads it back
+        exactly (floats survive JSON's shortest repr).
+
+        Examples
+        --------
+        >>> import json
+        >>> from gripkit.lti import LinearSystem, TransferFunction
+        >>> g = TransferFunction([1.0], [1.0, 0.5], dt=0.1, inputs="V")
+        >>> back = LinearSystem.from_dict(json.loads(json.dumps(g.to_dict())))
+        >>> back.inputs, back.denominator().tolist()
+        (('V',), [1.0, 0.5])
+        """
+        keys = ("A", "B", "C", "D") if isinstance(self, StateSpace) else ("num", "den")
+        d = {"type": type(self).__name__}
+        d.update({k: a.tolist() for k, a in zip(keys, self._arrays())})
+        d.update(dt=self.dt, inputs=list(self.inputs), outputs=list(self.outputs),
+                 input_units=list(self.input_units), output_units=list(self.output_units), meta=dict(self.meta))
+        if isinstance(self, StateSpace):
+            d.update(states=list(self.states), state_units=list(self.state_units))
+        u = self.uncertainty
+        d["uncertainty"] = None if u is None else {"names": list(u.names), "covariance": u.covariance.tolist(),
+                                                   "tangents": [t.tolist() for t in u.tangents]}
+        return d
+
+    @staticmethod
+    def from_dict(d: dict) -> LinearSystem:
+        """The system :meth:`to_dict` described (validated as any new system).
+
+        Examples
+        --------
+        >>> from gripkit.lti import LinearSystem
+        >>> LinearSystem.from_dict({"type": "StateSpace", "A": [[-1.0]], "B": [[1.0]], "C": [[2.0]]}).dc_gain().tolist()
+        [[2.0]]
+        """
+        if not isinstance(d, dict) or d.get("type") not in ("StateSpace", "TransferFunction"):
+            found = d.get("type") if isinstance(d, dict) else type(d).__name__
+            raise ModelError(f"from_dict: expected a dict with type 'StateSpace' or 'TransferFunction', found {found!r}")
+        kw = {k: d[k] for k in ("dt", "inputs", "outputs", "input_units", "output_units", "meta") if d.get(k) is not None}
+        u = d.get("uncertainty")
+        if u is not None:
+            try:
+                kw["uncertainty"] = Uncertainty(tuple(u["names"]), u["covariance"],
+                                                tuple(np.asarray(t, dtype=np.float64) for t in u["tangents"]))
+            except (KeyError, TypeError) as e:
+                raise ModelError(f"from_dict: uncertainty needs names, covariance and tangents ({e})") from None
+        try:
+            if d["type"] == "StateSpace":
+                kw.update({k: d[k] for k in ("states", "state_units") if d.get(k) is not None})
+                return StateSpace(np.asarray(d["A"], dtype=np.float64), d["B"], d["C"], d.get("D"), **kw)
+            return TransferFunction(np.asarray(d["num"], dtype=np.float64), np.asarray(d["den"], dtype=np.float64), **kw)
+        except KeyError as e:
+            raise ModelError(f"from_dict: the {d['type']} description lacks {e}") from None
+
     def sample(self, n: int, seed=None) -> list:
         """``n`` systems drawn from the linearised parameter distribution, θ ~ N(θ̂, Σ):
         each array becomes ``X + Σ_i δθ_i ∂X/∂θ_i`` (for Monte Carlo studies).
