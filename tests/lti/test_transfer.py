@@ -130,3 +130,15 @@ def test_initial_state_continues_like_lfiltic():
     zi = signal.lfiltic(B222, A222, y_past[::-1], u_past[::-1])
     ref = signal.lfilter(B222, A222, u, zi=zi)[0]
     np.testing.assert_allclose(g.simulate(u, g.initial_state(u_past, y_past))[:, 0], ref, rtol=1e-12, atol=1e-13)
+
+
+def test_controllable_form_is_scipys_tf2ss_bit_for_bit():
+    """form='controllable' reproduces scipy.signal.tf2ss (the realisation DiscretePlant and
+    PolynomialModel exported) with the same arithmetic: equality, not closeness."""
+    g = TransferFunction.from_polynomials(A222, B222, dt=0.005)
+    ref = signal.tf2ss(np.trim_zeros(np.array(B222), "f"), np.r_[A222, 0.0])
+    s = g.to_ss(form="controllable")
+    for X, R in zip(s._arrays(), ref):
+        np.testing.assert_array_equal(X, R)
+    with pytest.raises(ModelError, match="form: expected one of observable, controllable"):
+        g.to_ss(form="jordan")

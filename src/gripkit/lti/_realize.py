@@ -40,22 +40,35 @@ def siso_observable_form(num: np.ndarray, den: np.ndarray):
     return A, B, C, np.array([[b[0]]])
 
 
-def tf2ss(num: np.ndarray, den: np.ndarray):
+def siso_controllable_form(num: np.ndarray, den: np.ndarray):
+    """Controller canonical form of num/den (the realisation of ``scipy.signal.tf2ss``, with the
+    same arithmetic): ``A = [[-a1, -a2, …], [1, 0, …], …]``, ``B = e₁``, ``C = b[1:] − b₀ a[1:]``,
+    ``D = b₀`` (a = den/den[0], b = num/den[0])."""
+    A, B, C, D = siso_observable_form(num, den)
+    return A.T.copy(), C.T.copy(), B.T.copy(), D
+
+
+FORMS = ("observable", "controllable")
+
+
+def tf2ss(num: np.ndarray, den: np.ndarray, form: str = "observable"):
     """(A, B, C, D) of a (p, m) matrix of SISO transfer functions.
 
-    ``num``, ``den``: shape (p, m, L), descending powers, common length. Each entry becomes an
-    observable canonical block of its own degree (leading zeros of its denominator dropped),
+    ``num``, ``den``: shape (p, m, L), descending powers, common length. Each entry becomes a
+    canonical block (``form``: observable, the state of ``lfilter``; or controllable, that of
+    ``scipy.signal.tf2ss``) of its own degree (leading zeros of its denominator dropped),
     stacked in parallel: x = [x_11; x_12; …], B places block ij on input j, C on output i. The
     result is controllable and observable entry by entry, not necessarily as a whole: call
     :func:`minreal` for a minimal realisation.
     """
+    siso = siso_observable_form if form == "observable" else siso_controllable_form
     p, m, _ = num.shape
     blocks = []
     for i in range(p):
         for j in range(m):
             d = den[i, j]
             k = np.flatnonzero(d)[0]
-            blocks.append((i, j) + siso_observable_form(num[i, j, k:], d[k:]))
+            blocks.append((i, j) + siso(num[i, j, k:], d[k:]))
     n = sum(b[2].shape[0] for b in blocks)
     A = np.zeros((n, n))
     B = np.zeros((n, m))

@@ -1330,10 +1330,14 @@ class TransferFunction(LinearSystem):
         """
         return self
 
-    def to_ss(self, minimal: bool = True) -> StateSpace:
-        """A state-space realisation: each entry in observable canonical form (the state of
-        ``lfilter``), in parallel; with ``minimal`` (and no covariance) reduced to a minimal
-        realisation. A SISO entry with coprime num/den is minimal already.
+    def to_ss(self, minimal: bool = True, form: str = "observable") -> StateSpace:
+        """A state-space realisation: each entry in canonical form, in parallel.
+
+        ``form='observable'``: ``A = [[-a1, 1, 0, …], [-a2, 0, 1, …], …]``, ``C = e₁ᵀ``: the state
+        of ``lfilter`` (:meth:`initial_state`). ``form='controllable'``: its transpose, exactly
+        ``scipy.signal.tf2ss``'s realisation. With ``minimal`` (and no covariance) states are
+        removed when some cancel (the canonical form is then lost); a SISO entry with coprime
+        num/den is minimal already and keeps its form.
 
         Examples
         --------
@@ -1341,10 +1345,16 @@ class TransferFunction(LinearSystem):
         >>> s = TransferFunction([1.0, 2.0], [1.0, 3.0, 2.0]).to_ss()   # (s+2)/((s+1)(s+2))
         >>> s.n_states, s.poles().real.round(9).tolist()
         (1, [-1.0])
+        >>> TransferFunction([1.0], [1.0, 3.0, 2.0]).to_ss(form="controllable").A.tolist()
+        [[-3.0, -2.0], [1.0, 0.0]]
         """
-        arrs, unc = push(_realize.tf2ss, [self._arrays()], [self.uncertainty])
+        if form not in _realize.FORMS:
+            raise ModelError(f"form: expected one of {', '.join(_realize.FORMS)}, found {form!r}")
+        arrs, unc = push(lambda n, d: _realize.tf2ss(n, d, form), [self._arrays()], [self.uncertainty])
         if minimal and self.uncertainty is None:
-            arrs = _realize.minreal(*arrs)
+            reduced = _realize.minreal(*arrs)
+            if reduced[0].shape[0] < arrs[0].shape[0]:
+                arrs = reduced
         return StateSpace(*arrs, **self._signals(), uncertainty=unc)
 
     def to_control(self):
