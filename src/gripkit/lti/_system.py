@@ -318,7 +318,7 @@ class LinearSystem:
         ss = self.to_ss(minimal=False)
         if self.is_discrete:
             return ss.A, ss.B, ss.C, ss.D
-        return _discretize.c2d_arrays(ss.A, ss.B, ss.C, ss.D, h, "zoh")
+        return _discretize.c2d_matrices(ss.A, ss.B, ss.C, ss.D, h, "zoh")
 
     def step(self, t) -> np.ndarray:
         """Unit-step responses from rest, shape (N, p, m): column j is the response to a step on
@@ -383,7 +383,7 @@ class LinearSystem:
                              hint="use d2c() first to resample, or keep it as it is")
         dt = require_discrete(dt, "c2d")
         m = _discretize.check_method(method, prewarp)
-        return self._map_ss(lambda A, B, C, D: _discretize.c2d_arrays(A, B, C, D, dt, m, prewarp), dt=dt,
+        return self._map_ss(lambda A, B, C, D: _discretize.c2d_matrices(A, B, C, D, dt, m, prewarp), dt=dt,
                             meta={**self.meta, "c2d": m})
 
     def d2c(self, method: str = "zoh", prewarp: float | None = None):
@@ -405,7 +405,7 @@ class LinearSystem:
             raise ModelError("d2c: the system is already continuous")
         dt = self.dt
         m = _discretize.check_method(method, prewarp)
-        return self._map_ss(lambda A, B, C, D: _discretize.d2c_arrays(A, B, C, D, dt, m, prewarp), dt=None,
+        return self._map_ss(lambda A, B, C, D: _discretize.d2c_matrices(A, B, C, D, dt, m, prewarp), dt=None,
                             meta={**self.meta, "d2c": m})
 
     # ------------------------------------------------------------------ interconnection
