@@ -85,6 +85,10 @@ def format_bytes(n: float) -> str:
     return f"{int(n)} B"
 
 
+def _count(n: int, noun: str) -> str:
+    return f"{n:,} {noun}" + ("" if n == 1 else "s")
+
+
 def memory_limit(override=None) -> tuple[int, str]:
     """(limit in bytes, where it comes from) for a sweep in this process."""
     if override is not None:
@@ -120,10 +124,10 @@ class MemoryEstimate:
         if total <= limit:
             return
         raise ConfigError(
-            f"{what}: {self.n_jobs:,} jobs need an estimated {format_bytes(total)} of memory (job table "
-            f"and results {format_bytes(self.table_bytes)} for {self.n_parameters} parameters and "
-            f"{self.n_metrics} metrics; {in_flight} task(s) of {chunk_size} jobs in flight, "
-            f"{format_bytes(self.task_bytes(chunk_size))} each), above {limit_text}",
+            f"{what}: {_count(self.n_jobs, 'job')} need an estimated {format_bytes(total)} of memory (job table "
+            f"and results {format_bytes(self.table_bytes)} for {_count(self.n_parameters, 'parameter')} and "
+            f"{_count(self.n_metrics, 'metric')}; {_count(in_flight, 'task')} of {_count(chunk_size, 'job')} "
+            f"in flight, {format_bytes(self.task_bytes(chunk_size))} each), above {limit_text}",
             hint="use fewer grid points, samples or time samples, split the sweep, lower chunk_size, "
                  "or raise the limit with --memory-limit (Python: memory_limit=)")
 

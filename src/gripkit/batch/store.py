@@ -167,7 +167,8 @@ class ResultStore:
             return None, f"holds the metrics {values}, expected {list(metrics)}"
         ids = table["job_id"].to_numpy()
         if not np.array_equal(ids, np.arange(expected.start, expected.stop)):
-            found = f"{ids.min()}..{ids.max()} ({len(ids)} jobs)" if len(ids) else "no jobs"
+            found = f"{ids.min()}..{ids.max()}" if len(ids) else "none"
+            found += "" if not len(ids) or len(ids) == ids.max() - ids.min() + 1 else f" ({len(ids)} jobs)"
             return None, f"holds job ids {found}, expected {expected.start}..{expected.stop - 1}"
         cols = {"job_id": ids, "error": np.array(table["error"].to_pylist(), dtype=object)}
         cols.update({k: table[k].to_numpy().astype(np.float64) for k in values})
