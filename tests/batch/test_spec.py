@@ -69,3 +69,20 @@ def test_toml_roundtrip(tmp_path):
     with pytest.raises(ConfigError, match="not valid TOML"):
         (tmp_path / "bad.toml").write_text("[sweep\n")
         SweepSpec.from_toml(tmp_path / "bad.toml")
+
+
+def test_job_order_is_the_nested_loop(tmp_path):
+    """job = ((grid point) × table row) × sample, the first grid varying slowest: the table built
+    by index arithmetic equals the nested loops written out."""
+    import itertools
+
+    (tmp_path / "rows.csv").write_text("r\n10\n20\n30\n")
+    s = SweepSpec.from_dict({"sweep": {"scenario": "step-response", "samples": 2},
+                             "parameters": {"a": {"grid": [1.0, 2.0]}, "t": {"table": "rows.csv", "column": "r"},
+                                            "b": {"linspace": [0.0, 1.0, 3]}}}, base_dir=str(tmp_path))
+    jobs = s.jobs()
+    loops = [(a, b, t) for a, b in itertools.product([1.0, 2.0], [0.0, 0.5, 1.0]) for t in (10.0, 20.0, 30.0)
+             for _ in range(2)]
+    assert s.n_jobs() == len(loops) == 36
+    assert list(zip(jobs["a"], jobs["b"], jobs["t"])) == loops
+    np.testing.assert_array_equal(jobs["job_id"], np.arange(36))

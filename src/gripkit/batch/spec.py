@@ -3,8 +3,8 @@
 ```toml
 [sweep]
 name = "msd-robustness"
-scenario = "step-response"         # a registered scenario or "package.module:function"
-model = "mass-spring-damper"       # a zoo name, "package.module:factory", or left out
+scenario = "step-response"         # a registered scenario ("package.module:function": allow_code only)
+model = "mass-spring-damper"       # a registered model, left out ("package.module:factory": allow_code only)
 samples = 200                      # random draws per grid point (default 1)
 seed = 1
 chunk_size = 50                    # jobs per task (default: chosen from a timing run, >= 0.1 s)
