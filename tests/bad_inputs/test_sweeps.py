@@ -275,3 +275,12 @@ def test_unreadable_manifest(sweep_cli, finished, tmp_path):
     (tmp_path / "out" / "manifest.json").write_text("{not json")
     res = sweep_cli(finished, "--allow-code", "--resume")
     assert_user_error(res, "ConfigError", "manifest.json is unreadable")
+
+
+def test_backend_and_workers_checked_before_the_output_folder(cli, write, tmp_path):
+    path = write(MSD + '[parameters]\nk = { grid = [1.0] }' + SCENARIO)
+    assert_user_error(cli("sweep", path, "--out", tmp_path / "o", "--backend", "banana"), "ConfigError",
+                      "backend: expected 'in-process', 'process' or 'dask', found 'banana'")
+    assert_user_error(cli("sweep", path, "--out", tmp_path / "o", "--workers", "0"), "ConfigError",
+                      "workers: expected a positive integer, found 0")
+    assert not (tmp_path / "o").exists()

@@ -86,3 +86,17 @@ def test_job_order_is_the_nested_loop(tmp_path):
     assert s.n_jobs() == len(loops) == 36
     assert list(zip(jobs["a"], jobs["b"], jobs["t"])) == loops
     np.testing.assert_array_equal(jobs["job_id"], np.arange(36))
+
+
+@pytest.mark.parametrize("name", ["sweep_mass_spring_damper.toml", "sweep_tsfm_robustness.toml"])
+def test_example_sweep_files_pass_the_checks(name):
+    """The shipped sweep files use registered names only and pass every check made before a run
+    (names, units, settings, metrics), without --allow-code."""
+    from pathlib import Path
+
+    from gripkit.batch.scenarios import prepare
+
+    spec = SweepSpec.from_toml(Path(__file__).resolve().parents[2] / "examples" / name)
+    prep = prepare(spec)
+    assert set(spec.parameters) <= set(prep.interface.parameters)
+    assert set(spec.metrics) <= set(prep.interface.metrics)

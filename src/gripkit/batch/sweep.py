@@ -115,7 +115,7 @@ class SweepResult:
 
     def summary(self) -> str:
         failed = f"{self.n_failed} of them FAILED (see the error column)" if self.n_failed else "none failed"
-        return (f"{self.n_jobs} jobs, {failed}, in {self.seconds:.2f} s on "
+        return (f"{self.n_jobs} job{'s' if self.n_jobs != 1 else ''}, {failed}, in {self.seconds:.2f} s on "
                 f"{self.backend}, chunks of {self.chunk_size}, {self.computed_chunks} computed"
                 + (f"; results in {self.path}" if self.path else ""))
 
@@ -158,6 +158,10 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "process", work
         spec = SweepSpec.from_dict(spec) if isinstance(spec, dict) else SweepSpec.from_toml(spec)
     if resume and out is None:
         raise ConfigError("resume needs the output folder of the interrupted sweep (out=...)")
+    if executor is None and not scheduler and backend not in ("in-process", "process", "dask"):
+        raise ConfigError(f"backend: expected 'in-process', 'process' or 'dask', found {backend!r}")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise ConfigError(f"workers: expected a positive integer, found {workers!r}")
     prep = prepare(spec, allow_code)
     n_jobs = spec.n_jobs()
     limit, limit_text = _memory_limit(memory_limit)
