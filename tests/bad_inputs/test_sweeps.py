@@ -284,3 +284,10 @@ def test_backend_and_workers_checked_before_the_output_folder(cli, write, tmp_pa
     assert_user_error(cli("sweep", path, "--out", tmp_path / "o", "--workers", "0"), "ConfigError",
                       "workers: expected a positive integer, found 0")
     assert not (tmp_path / "o").exists()
+
+
+def test_controller_settings_checked_before_the_run(sweep_cli, write):
+    """ftg100-grasp builds its controller once up front: its own checks refuse the sweep."""
+    base = '[sweep]\nscenario = "ftg100-grasp"\n[parameters]\nk0 = { grid = [520.0] }\n[scenario]\n'
+    assert_user_error(sweep_cli(write(base + 'v_min = 250.0\n')), "ConfigError", "expected 0 <= v_min < v_max")
+    assert_user_error(sweep_cli(write(base + 'band = 1.0\n')), "ConfigError", "[scenario] band: expected a value < 1")

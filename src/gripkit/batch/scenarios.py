@@ -18,6 +18,7 @@ CLI ``--allow-code``): a sweep file is then code, to be trusted like a Python sc
 from __future__ import annotations
 
 import importlib
+import numbers
 import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
@@ -43,8 +44,8 @@ MODELS: dict[str, str] = {"mass-spring-damper": "gripkit.models:MassSpringDamper
 @dataclass(frozen=True)
 class Setting:
     """One ``[scenario]`` entry. ``kind``: an SI unit for a quantity (``"s"``, ``"Hz"``, ``"1"``),
-    or ``"int"``, ``"bool"``, ``"str"``; numbers must lie in [``low``, ``high``] (``low`` excluded
-    when ``strict``); strings must be one of ``choices`` when given."""
+    or ``"int"``, ``"bool"``, ``"str"``; numbers must lie in [``low``, ``high``] (the ends
+    excluded when ``strict``); strings must be one of ``choices`` when given."""
 
     kind: str
     low: float | None = None
@@ -65,17 +66,18 @@ class Setting:
                                   if self.choices else f"{where}: expected a string, found {value!r}")
             return value
         if self.kind == "int":
-            if isinstance(value, bool) or not isinstance(value, int):
+            if isinstance(value, bool) or not isinstance(value, numbers.Integral):
                 raise ConfigError(f"{where}: expected an integer, found {value!r}")
-            v = value
+            v = int(value)
         else:
             v = quantity(value, where, self.kind)
         unit = "" if self.kind in ("int", "1") else f" {self.kind}"
         if self.low is not None and (v <= self.low if self.strict else v < self.low):
             raise ConfigError(f"{where}: expected a value {'>' if self.strict else '>='} {self.low:g}{unit}, "
                               f"found {value!r}")
-        if self.high is not None and v > self.high:
-            raise ConfigError(f"{where}: expected a value <= {self.high:g}{unit}, found {value!r}")
+        if self.high is not None and (v >= self.high if self.strict else v > self.high):
+            raise ConfigError(f"{where}: expected a value {'<' if self.strict else '<='} {self.high:g}{unit}, "
+                              f"found {value!r}")
         return v
 
 
@@ -299,8 +301,18 @@ def _ftg100_interface(model, settings: dict) -> Interface:
         raise ConfigError(f"scenario 'ftg100-grasp' needs an FT-G100 plant, found {type(model).__name__}",
                           hint="leave [sweep] model out (the nominal plant)")
     schema = {**_FTG100_OPTS, **{k: Setting(u) for k, u in _HYBRID_UNITS.items()}}
-    return Interface(parameters=_FTG100_PARAMS, settings=read_settings(settings, schema, "ftg100-grasp"),
-                     metrics=METRICS, bytes_per_job=8 * (len(METRICS) + 64))
+    s = read_settings(settings, schema, "ftg100-grasp")
+    _ftg100_controller(model, s)  # the controller's own checks (positive ts, v_min < v_max, ...)
+    return Interface(parameters=_FTG100_PARAMS, settings=s, metrics=METRICS, bytes_per_job=8 * (len(METRICS) + 64))
+
+
+def _ftg100_controller(model, settings: dict):
+    from ..control.hybrid import HybridForcePosition
+    from ..models.ftg100 import FTG100Plant
+
+    plant = model if model is not None else FTG100Plant(check=False)
+    gains = {k: v for k, v in settings.items() if k in _HYBRID_UNITS}
+    return plant, HybridForcePosition.for_plant(plant.parameters, **gains)
 
 
 def ftg100_grasp(model, params: dict[str, np.ndarray], settings: dict) -> dict[str, np.ndarray]:
@@ -314,15 +326,13 @@ def ftg100_grasp(model, params: dict[str, np.ndarray], settings: dict) -> dict[s
     approach_speed, ...). ``model``: None (the nominal plant) or an
     :class:`~gripkit.models.ftg100.FTG100Plant` factory (``"module:factory"``, with
     ``allow_code``). Metrics: :data:`gripkit.control.hybrid.METRICS`."""
-    from ..control.hybrid import METRICS, HybridForcePosition, grasp_batch
-    from ..models.ftg100 import FTG100Plant
+    from ..control.hybrid import METRICS, grasp_batch
 
     s = _ftg100_interface(model, settings).settings
-    plant = model if model is not None else FTG100Plant(check=False)
+    plant, ctrl = _ftg100_controller(model, s)
     unknown = [k for k in params if k not in (*_FTG100_PARAMS, "job_id")]
     if unknown:
         raise ConfigError(f"ftg100-grasp: unknown parameters {unknown}", hint=f"allowed: {', '.join(_FTG100_PARAMS)}")
-    ctrl = HybridForcePosition.for_plant(plant.parameters, **{k: v for k, v in s.items() if k in _HYBRID_UNITS})
     n = len(params["job_id"])
     seed = np.asarray(params["job_id"], dtype=np.int64) + s.get("noise_seed", 0) * 1_000_003
     kw = {k: params[k] for k in _FTG100_PARAMS if k in params}

@@ -36,6 +36,7 @@ scenario declares (:func:`gripkit.batch.scenarios.prepare`).
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -62,7 +63,7 @@ def quantity(v, where: str, unit: str | None = None) -> float:
     from ..units import same_dimension, si_unit, to_si
 
     expected = f" in {unit}" if unit else ""
-    if isinstance(v, bool) or not isinstance(v, (int, float, str)):
+    if isinstance(v, bool) or not isinstance(v, (numbers.Real, str)):
         raise ConfigError(f"{where}: expected a number{expected} or a quantity like '3 mg', found {v!r}")
     if isinstance(v, str):
         try:
@@ -88,9 +89,9 @@ _si = quantity  # the name scenarios import
 
 
 def _integer(v, where: str, low: int) -> int:
-    if isinstance(v, bool) or not isinstance(v, int) or v < low:
+    if isinstance(v, bool) or not isinstance(v, numbers.Integral) or v < low:
         raise ConfigError(f"{where}: expected an integer >= {low}, found {v!r}")
-    return v
+    return int(v)
 
 
 @dataclass(frozen=True)

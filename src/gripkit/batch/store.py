@@ -177,6 +177,8 @@ class ResultStore:
     def check_chunks(self, chunk_size: int, n_jobs: int, metrics=None) -> set[int]:
         """The chunks on disk that are sound; each bad one is set aside (``.bad``) with a warning,
         so that it is computed again."""
+        for stale in self.chunks_dir.glob(".chunk-*.tmp") if self.chunks_dir.exists() else ():
+            stale.unlink(missing_ok=True)  # a write cut short by a crash
         good = set()
         for c in sorted(self.done_chunks()):
             cols, problem = self._load(c, chunk_size, n_jobs, metrics)
