@@ -168,14 +168,14 @@ def test_failed_jobs_in_json(sweep_cli, write, own_module):
 # --- 3. job count and memory, estimated up front ---------------------------------------------
 def test_a_billion_samples(sweep_cli, write, eight_gb):
     res = sweep_cli(write(MSD + 'samples = 1000000000\n[parameters]\nk = { uniform = [1.0, 2.0] }' + SCENARIO))
-    assert_user_error(res, "ConfigError", "1,000,000,000 jobs need an estimated 80 GB of memory")
+    assert_user_error(res, "ConfigError", "1,000,000,000 jobs need an estimated 192 GB of memory")
     assert "above the limit of 4 GB (half the 8 GB available)" in res.err
 
 
 def test_two_grids_of_1e5_points(sweep_cli, write, eight_gb):
     res = sweep_cli(write(MSD + '[parameters]\nk = { linspace = [1.0, 2.0, 100000] }\n'
                                 'b = { linspace = [0.1, 0.2, 100000] }' + SCENARIO))
-    assert_user_error(res, "ConfigError", "10,000,000,000 jobs need an estimated 960 GB")
+    assert_user_error(res, "ConfigError", "10,000,000,000 jobs need an estimated 2.16 TB")
     assert "above the limit of 4 GB" in res.err
 
 
@@ -189,8 +189,8 @@ def test_no_machine_holds_1e15_jobs(sweep_cli, write):
 
 def test_a_billion_time_samples_per_job(sweep_cli, write, eight_gb):
     res = sweep_cli(write(MSD + '[parameters]\nk = { grid = [1.0] }\n[scenario]\nduration = 50000.0\nfs = 20000\n'))
-    assert_user_error(res, "ConfigError", "1 job need an estimated 64 GB")
-    assert "1 task of 1 job in flight, 64 GB each" in res.err
+    assert_user_error(res, "ConfigError", "1 job needs an estimated 48 GB")
+    assert "1 task of 1 job in flight, 48 GB each" in res.err
 
 
 def test_explicit_memory_limit(sweep_cli, write):
@@ -207,7 +207,7 @@ def test_memory_limit_not_a_size(sweep_cli, write):
 def test_api_memory_limit():
     d = {"sweep": {"scenario": "step-response", "model": "mass-spring-damper", "samples": 10**6},
          "parameters": {"k": {"uniform": [1.0, 2.0]}}}
-    with pytest.raises(ConfigError, match="1,000,000 jobs need an estimated 80.1 MB of memory"):
+    with pytest.raises(ConfigError, match="1,000,000 jobs need an estimated 192 MB of memory"):
         sweep(d, backend="in-process", progress=False, memory_limit="1 MB")
 
 
