@@ -291,3 +291,10 @@ def test_controller_settings_checked_before_the_run(sweep_cli, write):
     base = '[sweep]\nscenario = "ftg100-grasp"\n[parameters]\nk0 = { grid = [520.0] }\n[scenario]\n'
     assert_user_error(sweep_cli(write(base + 'v_min = 250.0\n')), "ConfigError", "expected 0 <= v_min < v_max")
     assert_user_error(sweep_cli(write(base + 'band = 1.0\n')), "ConfigError", "[scenario] band: expected a value < 1")
+
+
+def test_api_spec_built_directly_is_checked_too():
+    with pytest.raises(ConfigError, match=r"\[sweep\] samples: expected an integer >= 1, found 0"):
+        SweepSpec(scenario="step-response", parameters={"k": {"grid": [1.0]}}, samples=0)
+    with pytest.raises(ConfigError, match=r"\[metrics\] record: expected a non-empty list of metric names"):
+        SweepSpec(scenario="step-response", parameters={}, metrics="peak")

@@ -137,30 +137,43 @@ class SweepSpec:
                          "on the command line (Python: sweep(..., allow_code=True))")
             raise ConfigError(f"[sweep]: unknown keys {unknown}", hint=hint)
         params, settings, metrics = d.get("parameters", {}), d.get("scenario", {}), d.get("metrics", {})
-        for table, value in (("parameters", params), ("scenario", settings), ("metrics", metrics)):
-            if not isinstance(value, dict):
-                raise ConfigError(f"[{table}]: expected a table, found {value!r}")
+        if not isinstance(metrics, dict):
+            raise ConfigError(f"[metrics]: expected a table, found {metrics!r}")
         if set(metrics) - {"record"}:
             raise ConfigError(f"[metrics]: unknown keys {sorted(set(metrics) - {'record'})}", hint="allowed: record")
         record = metrics.get("record")
-        if record is not None and (not isinstance(record, list) or not record
+        return cls(scenario=sw["scenario"], parameters=params, model=sw.get("model"), name=sw.get("name", "sweep"),
+                   settings=settings, metrics=record, samples=sw.get("samples", 1), seed=sw.get("seed", 0),
+                   chunk_size=sw.get("chunk_size"), base_dir=base_dir)
+
+    def __post_init__(self):
+        """Check the types and ranges of every field, and count the jobs (reading every
+        parameter), so that an error surfaces before any work starts."""
+        for table, value in (("parameters", self.parameters), ("scenario", self.settings)):
+            if not isinstance(value, dict):
+                raise ConfigError(f"[{table}]: expected a table, found {value!r}")
+        record = self.metrics
+        if record is not None and (isinstance(record, str) or not isinstance(record, (list, tuple)) or not record
                                    or not all(isinstance(m, str) for m in record)):
             raise ConfigError(f"[metrics] record: expected a non-empty list of metric names, found {record!r}")
-        scen, model, name = sw["scenario"], sw.get("model"), sw.get("name", "sweep")
-        if not (callable(scen) or isinstance(scen, str)):
-            raise ConfigError(f"[sweep] scenario: expected a scenario name, found {scen!r}")
-        if model is not None and not isinstance(model, str):
-            raise ConfigError(f"[sweep] model: expected a model name, found {model!r}")
+        if not (callable(self.scenario) or isinstance(self.scenario, str)):
+            raise ConfigError(f"[sweep] scenario: expected a scenario name, found {self.scenario!r}")
+        if self.model is not None and not isinstance(self.model, str):
+            raise ConfigError(f"[sweep] model: expected a model name, found {self.model!r}")
+        name = self.name
         if not isinstance(name, str) or not name or any(c in name for c in "/\\\0"):
             raise ConfigError(f"[sweep] name: expected a short name without slashes, found {name!r}")
-        cs = sw.get("chunk_size")
-        spec = cls(scenario=scen, parameters=dict(params), model=model, name=name, settings=dict(settings),
-                   metrics=tuple(record) if record else None,
-                   samples=_integer(sw.get("samples", 1), "[sweep] samples", 1),
-                   seed=_integer(sw.get("seed", 0), "[sweep] seed", 0),
-                   chunk_size=None if cs is None else _integer(cs, "[sweep] chunk_size", 1), base_dir=base_dir)
-        spec.n_jobs()  # every parameter read and the job count known before any work starts
-        return spec
+        cs = self.chunk_size
+        fix = object.__setattr__  # frozen: normalise once, here
+        fix(self, "parameters", dict(self.parameters))
+        fix(self, "settings", dict(self.settings))
+        fix(self, "metrics", tuple(record) if record else None)
+        fix(self, "samples", _integer(self.samples, "[sweep] samples", 1))
+        fix(self, "seed", _integer(self.seed, "[sweep] seed", 0))
+        fix(self, "chunk_size", None if cs is None else _integer(cs, "[sweep] chunk_size", 1))
+        if self.n_jobs() == 0:
+            raise ConfigError("sweep specification: the parameter table has no rows, so there are no jobs",
+                              hint="check the table files named in [parameters]")
 
     def to_dict(self) -> dict:
         scen = self.scenario if isinstance(self.scenario, str) else \

@@ -120,16 +120,13 @@ class SweepResult:
                 + (f"; results in {self.path}" if self.path else ""))
 
 
-def _calibrate(args: tuple, n_jobs: int, target_s: float) -> int:
-    """Jobs per chunk so a chunk takes >= target_s, timed on a warm (compiled) run of 2 jobs;
-    ``args`` are :func:`run_chunk`'s for the whole table."""
-    scenario, model, settings, job_ids, params, metrics, allow_code = args
-    k = min(2, n_jobs)
-    first = (scenario, model, settings, job_ids[:k], {n: v[:k] for n, v in params.items()}, metrics, allow_code)
+def _calibrate(first: tuple, target_s: float) -> int:
+    """Jobs per chunk so a chunk takes >= target_s, timed on a warm (compiled) run of the first
+    jobs (``first``: :func:`run_chunk`'s arguments for them)."""
     run_chunk(*first)  # compile
     t0 = time.perf_counter()
     run_chunk(*first)
-    per_job = max((time.perf_counter() - t0) / k, 1e-7)
+    per_job = max((time.perf_counter() - t0) / len(first[3]), 1e-7)
     return max(1, math.ceil(target_s / per_job))
 
 
@@ -177,10 +174,15 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "process", work
     estimate.check(min(chunk_size or 2, n_jobs), max(in_flight, 1), limit, limit_text, f"sweep {spec.name!r}")
     jobs = spec.jobs(dict(iface.parameters or {}))
     names = [k for k in jobs if k != "job_id"]
-    args = (spec.scenario, spec.model, prep.settings, jobs["job_id"], {n: jobs[n] for n in names}, spec.metrics,
-            allow_code)
+
+    def chunk_args(r: range) -> tuple:
+        sl = slice(r.start, r.stop)
+        return (spec.scenario, spec.model, prep.settings, jobs["job_id"][sl], {n: jobs[n][sl] for n in names},
+                spec.metrics, allow_code)
+
     if chunk_size is None:
-        chunk_size = min(_calibrate(args, n_jobs, target_task_s), max(estimate.largest_chunk(in_flight, limit), 1))
+        chunk_size = min(_calibrate(chunk_args(range(min(2, n_jobs))), target_task_s),
+                         max(estimate.largest_chunk(in_flight, limit), 1))
     chunk_size = int(min(chunk_size, n_jobs))
     estimate.check(chunk_size, in_flight, limit, limit_text, f"sweep {spec.name!r}")
     record = spec.to_dict()
@@ -195,9 +197,7 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "process", work
     for c in range(n_chunks):
         if c in done:
             continue
-        r = chunk_range(c, chunk_size, n_jobs)
-        sl = slice(r.start, r.stop)
-        tasks.append((c, run_chunk, (*args[:3], args[3][sl], {n: v[sl] for n, v in args[4].items()}, *args[5:])))
+        tasks.append((c, run_chunk, chunk_args(chunk_range(c, chunk_size, n_jobs))))
     own = executor is None
     ex = executor or make_executor(backend, workers, scheduler)
     t0 = time.perf_counter()
