@@ -298,3 +298,13 @@ def test_api_spec_built_directly_is_checked_too():
         SweepSpec(scenario="step-response", parameters={"k": {"grid": [1.0]}}, samples=0)
     with pytest.raises(ConfigError, match=r"\[metrics\] record: expected a non-empty list of metric names"):
         SweepSpec(scenario="step-response", parameters={}, metrics="peak")
+
+
+def test_values_outside_the_parameter_bounds(sweep_cli, write):
+    """k >= 0 (the mass-spring-damper's bound): a normal draw that goes negative is refused with
+    the count, instead of failing those jobs one by one."""
+    res = sweep_cli(write(MSD + 'samples = 200\n[parameters]\nk = { normal = [1.0, 1.0] }' + SCENARIO))
+    assert_user_error(res, "ConfigError", "[parameters] k: ")
+    assert "of 200 jobs have values outside its bounds [0, inf] N/m" in res.err and "clip" in res.err
+    ok = sweep_cli(write(MSD + 'samples = 20\n[parameters]\nk = { normal = [1.0, 1.0], clip = [0.1, 10] }' + SCENARIO))
+    assert ok.code == 0, ok.err

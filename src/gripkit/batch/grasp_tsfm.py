@@ -566,8 +566,11 @@ def _interface(model, settings: dict):
     if model is not None and not isinstance(model, TSFMGripper):
         raise ConfigError(f"scenario 'tsfm-grasp' needs a TSFM gripper model, found {type(model).__name__}",
                           hint='model = "tsfm-gripper"')
+    positive, non_negative = (np.finfo(float).tiny, None), (0.0, None)  # as _jobs checks them
+    bounds = {**{k: positive for k in ("k_e", "w", "approach_speed", "gap")},
+              **{k: non_negative for k in ("c_e", "F_po", "F_stick", "noise_std")}}
     return Interface(parameters=POPULATION_UNITS, settings=read_settings(settings, _settings_schema(), "tsfm-grasp"),
-                     metrics=METRICS, bytes_per_job=8 * (_NM + 64))
+                     metrics=METRICS, bytes_per_job=8 * (_NM + 64), bounds=bounds)
 
 
 def tsfm_grasp(model, params: dict[str, np.ndarray], settings: dict) -> dict[str, np.ndarray]:

@@ -106,6 +106,23 @@ class Interface:
     metrics: tuple[str, ...] | None = None
     bytes_per_job: int = 0
     bytes_per_task: int = 0
+    bounds: Mapping[str, tuple[float | None, float | None]] = field(default_factory=dict)
+
+    def check_values(self, jobs: Mapping[str, np.ndarray]) -> None:
+        """Refuse a job table with values outside the parameters' ``bounds`` (inclusive; None:
+        unbounded): such jobs would all fail."""
+        for name, (lo, hi) in self.bounds.items():
+            if name not in jobs:
+                continue
+            v = jobs[name]
+            bad = (v < (-np.inf if lo is None else lo)) | (v > (np.inf if hi is None else hi))
+            if bad.any():
+                i = int(np.argmax(bad))
+                unit = (self.parameters or {}).get(name, "")
+                raise ConfigError(
+                    f"[parameters] {name}: {int(bad.sum()):,} of {len(v):,} jobs have values outside its bounds "
+                    f"[{-np.inf if lo is None else lo:g}, {np.inf if hi is None else hi:g}] {unit} (job {i}: {v[i]:g})",
+                    hint="narrow the grid or range, or give a random draw clip = [low, high]")
 
 
 # --- names to code -----------------------------------------------------------------------------
@@ -252,7 +269,8 @@ def _step_interface(model, settings: dict) -> Interface:
     # step-metric temporaries of one row. Measured: 193 MB peak for a task of 10 jobs of 10⁶
     # samples (mass-spring-damper), estimated 264 MB.
     return Interface(parameters={name: p[name].unit for name in p.names}, settings=s, metrics=_STEP_METRICS,
-                     bytes_per_job=8 * n * (len(outs) + 2), bytes_per_task=8 * n * (len(ins) + 2))
+                     bytes_per_job=8 * n * (len(outs) + 2), bytes_per_task=8 * n * (len(ins) + 2),
+                     bounds={name: p[name].bounds for name in p.names})
 
 
 def step_response(model, params: dict[str, np.ndarray], settings: dict) -> dict[str, np.ndarray]:
