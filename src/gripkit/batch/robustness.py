@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..arguments import entry_point
 from ..errors import ConfigError, DataError
 from .montecarlo import Estimate, binned_probability, probability, quantile
 
@@ -199,6 +200,7 @@ def analyse(columns: dict | str | Path, *, stiffness: str | None = None, bins=No
         damage_vs_stiffness=res_bins[0], lost_vs_stiffness=res_bins[1], damage_force=damage_force)
 
 
+@entry_point
 def robustness_study(population: dict | None = None, *, settings: dict | None = None, n: int = 600,
                      seed: int = 1, model: str | None = "tsfm-gripper", scenario: str = "tsfm-grasp",
                      backend: str = "in-process", workers: int | None = None, scheduler: str | None = None,

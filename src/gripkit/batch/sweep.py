@@ -29,6 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..arguments import entry_point
 from ..errors import ConfigError
 from ..progress import status, track
 from .budget import UNDECLARED_METRICS, MemoryEstimate, memory_limit as _memory_limit
@@ -139,6 +140,7 @@ def _in_flight(executor: Executor | None, backend: str, workers: int | None, sch
     return 1 if backend == "in-process" else int(workers or os.cpu_count() or 1)
 
 
+@entry_point
 def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "process", workers: int | None = None,
           scheduler: str | None = None, out: str | Path | None = None, resume: bool = False,
           progress: bool = True, executor: Executor | None = None, target_task_s: float = 0.1,

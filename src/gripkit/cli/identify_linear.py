@@ -142,7 +142,9 @@ def identify_rls(data: Path = DataArg, input: str = InputOpt, output: str = Outp
                  json_out: bool = JsonOpt):
     """Recursive least squares ARX (orders na, nb, nk) with forgetting; θ and σ at every sample."""
     from ..sysid import rls
+    from .paths import output_file
 
+    output_file(trajectory, "--trajectory")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         io = _io(data, input, output, fs, time, fill, detrend, "RLS identification")

@@ -36,7 +36,9 @@ def sweep(spec: Path = typer.Argument(..., help="Sweep specification (TOML)."),
 
     from ..batch import SweepSpec
     from ..batch import sweep as run
+    from .paths import output_folder
 
+    output_folder(out, "--out")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         s = SweepSpec.from_toml(spec)
