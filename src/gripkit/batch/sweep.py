@@ -160,7 +160,7 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "process", work
     if executor is None and not scheduler and backend not in ("in-process", "process", "dask"):
         raise ConfigError(f"backend: expected 'in-process', 'process' or 'dask', found {backend!r}")
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
-        raise ConfigError(f"workers: expected a positive integer, found {workers!r}")
+        raise ConfigError(f"workers: expected a positive number, found {workers!r}")
     prep = prepare(spec, allow_code)
     n_jobs = spec.n_jobs()
     limit, limit_text = _memory_limit(memory_limit)
