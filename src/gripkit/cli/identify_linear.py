@@ -161,9 +161,11 @@ def identify_rls(data: Path = DataArg, input: str = InputOpt, output: str = Outp
                  json_out: bool = JsonOpt):
     """Recursive least squares ARX (orders na, nb, nk) with forgetting; θ and σ at every sample."""
     from ..sysid import RLS, rls
+    from .paths import output_file
 
     _check_options(fs, fill, detrend)
     RLS(na, nb, nk, forgetting=forgetting, p0=p0, windup=windup)  # checks the orders and the options
+    output_file(trajectory, "--trajectory")
     with collected_warnings() as caught:
         io = _io(data, input, output, fs, time, fill, detrend, "RLS identification")
         res = rls(io.u, io.y, na, nb, nk, forgetting=forgetting, p0=p0, windup=windup, dt=io.dt)

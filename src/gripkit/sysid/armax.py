@@ -20,7 +20,7 @@ from ._data import check_identifiable, checked_problem
 from ._pem import covariance, is_stable_poly, levenberg_marquardt, stabilize
 from ._scaling import in_user_units, unit_scale
 from .arx import _arx, arx
-from .polynomial import PolynomialModel
+from .polynomial import PolynomialModel, check_meta
 from .regression import qr_solve
 from .validation import fit_percent, loss_vn
 
@@ -57,6 +57,7 @@ def armax(u, y, na: int, nb: int, nc: int, nk: int = 1, *, dt: float | None = No
     :class:`PolynomialModel` with ``structure='armax'``, ``C`` and ``C_std``. Warns
     :class:`~gripkit.errors.AccuracyWarning` if the iteration does not converge.
     """
+    check_meta(meta, armax)
     u, y, step, na, nb, nc, nk = checked_problem(u, y, dt, fs, na=na, nb=nb, nc=nc, nk=nk)
     if nc == 0:
         return arx(u, y, na, nb, nk, dt=step, **meta)

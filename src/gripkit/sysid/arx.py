@@ -18,7 +18,7 @@ import numpy as np
 
 from ._data import check_identifiable, checked_problem
 from ._scaling import in_user_units, unit_scale
-from .polynomial import PolynomialModel
+from .polynomial import PolynomialModel, check_meta
 from .regression import arx_regression, arx_start, qr_solve
 from .validation import fit_percent, loss_vn
 
@@ -61,12 +61,14 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None, fs: flo
     -----
     AccuracyWarning
         A column-scaled condition number above :func:`~gripkit.sysid.regression.warn_threshold`
-        (the κ at which the least-determined parameter combination may be off by 10 %, from the
-        noise or from rounding): the message names those parameters and their relative σ.
+        (the κ at which the least-determined parameter combination may be off by a third of the
+        parameters' size, from the noise or from rounding): the message names those parameters
+        and their relative σ.
 
     The signals are scaled to unit size internally (exact powers of two, :mod:`._scaling`), so data
     at any scale (1e-300 … 1e300) are identified; the model is in the units of ``u`` and ``y``.
     """
+    check_meta(meta, arx)
     u, y, step, na, nb, nk = checked_problem(u, y, dt, fs, na=na, nb=nb, nk=nk)
     cu, cy = unit_scale(u), unit_scale(y)
     return in_user_units(_arx(u * cu, y * cy, na, nb, nk, step, **meta), cu, cy)

@@ -23,7 +23,7 @@ from ._data import check_identifiable, checked_problem
 from ._pem import covariance, is_stable_poly, levenberg_marquardt, stabilize
 from ._scaling import in_user_units, unit_scale
 from .arx import _arx
-from .polynomial import PolynomialModel
+from .polynomial import PolynomialModel, check_meta
 from .validation import fit_percent, loss_vn
 
 __all__ = ["oe"]
@@ -59,6 +59,7 @@ def oe(u, y, nb: int, nf: int, nk: int = 1, *, dt: float | None = None, fs: floa
     leading 1) in place of ``na``. Returns a :class:`PolynomialModel` with ``structure='oe'``,
     ``A = [1]``, ``F`` and ``F_std``; its poles are the roots of F.
     """
+    check_meta(meta, oe)
     u, y, step, nb, nf, nk = checked_problem(u, y, dt, fs, nb=nb, nf=nf, nk=nk)
     cu, cy = unit_scale(u), unit_scale(y)
     return in_user_units(_oe(u * cu, y * cy, nb, nf, nk, step, maxiter, tol, meta), cu, cy)

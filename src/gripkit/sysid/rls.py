@@ -48,6 +48,7 @@ import numpy as np
 from numba import njit
 from numba.core.errors import TypingError
 
+from ..arguments import entry_point
 from ..errors import DataError, IdentificationError
 from ._data import check_dt, check_excitation, check_io, check_order, require_samples
 from .polynomial import PolynomialModel
@@ -603,6 +604,7 @@ class RLSResult:
                                 "structure": f"ARX [{self.na} {self.nb} {self.nk}]"})
 
 
+@entry_point
 def rls(u, y, na: int, nb: int, nk: int = 1, *, forgetting: float = 1.0, p0: float = 1e4, theta0=None,
         windup: str = "trace", max_trace: float | None = None, dt: float | None = None,
         fs: float | None = None, store: bool = True) -> RLSResult:
