@@ -38,9 +38,11 @@ def _check_options(fs, fill, detrend: str, validate: Path | None = None, **order
     check_choice(detrend, "--detrend", DETREND_CHOICES)
     for name, value in orders.items():
         check_order(value, f"--{name}", 1 if name == "nb" else 0)
-    if validate is not None and not validate.is_file():
+    if validate is not None and not validate.is_file():  # the same words as gripkit.io.load
         from ..errors import DataError
 
+        if validate.is_dir():
+            raise DataError(f"--validate: {str(validate)!r} is a folder, expected a data file")
         raise DataError(f"--validate: data file {str(validate)!r} not found")
 
 

@@ -33,10 +33,14 @@ def identify_modal(data: Path = DataArg,
                    json_out: bool = JsonOpt):
     """Natural frequency and damping ratio from a free vibration (FFT peak, half-power, log
     decrement, Hilbert envelope, damped-sine least squares)."""
+    import math
+
+    from ..errors import DataError
     from ..sysid.modal import free_vibration
 
     check_data_options(fs, fill)
-    check_number(start, "--start")
+    if start is not None and not math.isfinite(start):
+        raise DataError(f"--start: expected the release time in s (a finite number), found {start}")
     with collected_warnings() as caught:
         tr = load_data(data, [signal], fs, time, fill)
         rate = tr.require_uniform(why="free-vibration analysis")
