@@ -260,6 +260,50 @@ def test_structure_search_at_extreme_scales_ranks_as_at_unit_scale(scale):
     assert res.best.aic - ref.best.aic == pytest.approx(2 * res.n_used * math.log(scale), rel=1e-9)
 
 
+@pytest.mark.parametrize("scale", [1e300, 1e-300])
+def test_step_and_modal_identification_at_extreme_scales(scale):
+    """A 1 kHz, ζ = 0.05 second-order system (gain 0.2): the step fit and the free-vibration
+    analysis give the same frequency, damping and gain as at unit scale (before: "output does not
+    change" and "damped-sine fit is singular" at 1e-300)."""
+    from scipy import signal
+
+    from gripkit import Trajectory
+    from gripkit.sysid.modal import free_vibration
+    from gripkit.sysid.step_response import identify_step
+
+    fs, wn, zeta = 20000.0, 2 * np.pi * 1000, 0.05
+    t = np.arange(4000) / fs
+    u = (t > 0.01).astype(float)
+    y = signal.lsim(([0.2 * wn**2], [1, 2 * zeta * wn, wn**2]), u, t)[1]
+    y = y + 1e-4 * np.random.default_rng(0).standard_normal(t.size)
+    ref = identify_step(Trajectory(t, {"u": u, "y": y}), input="u", output="y").to_dict()
+    res = identify_step(Trajectory(t, {"u": u * scale, "y": y * scale}), input="u", output="y").to_dict()
+    for key in ("gain", "natural_frequency_hz", "damping_ratio"):
+        assert res[key] == pytest.approx(ref[key], rel=1e-6), key
+    x = np.exp(-zeta * wn * t) * np.cos(wn * np.sqrt(1 - zeta**2) * t)
+    x = x + 1e-4 * np.random.default_rng(1).standard_normal(t.size)
+    ref, res = free_vibration(x, fs), free_vibration(x * scale, fs)
+    assert res.natural_frequency_hz == pytest.approx(ref.natural_frequency_hz, rel=1e-9)
+    assert res.damping_ratio == pytest.approx(ref.damping_ratio, rel=1e-6)
+    assert res.amplitude / scale == pytest.approx(ref.amplitude, rel=1e-6)
+
+
+@pytest.mark.parametrize("scale", [1e300, 1e-300])
+def test_friction_identification_at_extreme_scales(scale):
+    """IDIM-LS of τ = J q̈ + F_v q̇ + F_c sign(q̇) with both signals scaled: J and F_v (ratios of
+    effort to motion) unchanged, F_c in the effort's units (before: "ill-conditioned 4e301" and
+    "a regressor column is zero")."""
+    from gripkit.sysid.friction import idim_ls
+
+    q = np.sin(2 * np.pi * np.arange(20000) / 1000)
+    qd = np.gradient(q) * 1000
+    tau = 0.01 * np.gradient(qd) * 1000 + 0.1 * qd + 0.5 * np.sign(qd)
+    ref, res = idim_ls(q, tau, 1000.0), idim_ls(q * scale, tau * scale, 1000.0)
+    for k in ("inertia", "viscous"):
+        assert res.params[k] == pytest.approx(ref.params[k], rel=1e-2), k
+    assert res.params["coulomb"] / scale == pytest.approx(ref.params["coulomb"], rel=1e-2)
+
+
 def test_cli_identifies_a_file_at_1e_minus_300(cli, tmp_path):
     u, y = simulate(2000, noise=0.01)
     p = write_csv(tmp_path / "tiny.csv", u * 1e-300, y * 1e-300)
