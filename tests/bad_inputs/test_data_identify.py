@@ -155,6 +155,7 @@ def test_cli_fill_banana_on_clean_data_is_refused(cli, clean_csv):
      "forgetting factor: expected 0 < λ <= 1"),
     (("search", "--input", "u", "--output", "y", "--criterion", "bic"), "--criterion: expected one of aic, fpe, loss"),
     (("search", "--input", "u", "--output", "y", "--na", "1:x"), "--na: expected a range like '1:4'"),
+    (("search", "--input", "u", "--output", "y", "--top", 0), "--top: expected an integer >= 1"),
     (("step", "--input", "u", "--output", "y", "--fs", 0), "fs: expected a positive sampling rate"),
     (("modal", "--signal", "y", "--fill", "banana"), "fill: expected None"),
     (("bouc-wen", "--input", "u", "--output", "y", "--burn-in", -3), "--burn-in: expected an integer >= 0"),

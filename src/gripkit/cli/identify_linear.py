@@ -13,7 +13,7 @@ from pathlib import Path
 import typer
 
 from .app import identify_app
-from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_choice, check_data_options,
+from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_choice, check_data_options, check_number,
                      collected_warnings, emit_json, load_data, report_warnings)
 
 DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
@@ -209,6 +209,7 @@ def identify_search(data: Path = DataArg, input: str = InputOpt, output: str = O
 
     _check_options(fs, fill, detrend)
     check_choice(criterion, "--criterion", CRITERIA)
+    check_number(top, "--top", minimum=1, integer=True)
     for name, text in (("--na", na), ("--nb", nb), ("--nk", nk)):
         parse_range(text, name)
     with collected_warnings() as caught:
