@@ -15,7 +15,6 @@ input with one clear line naming the argument and what is accepted, never "unexp
 from __future__ import annotations
 
 import errno
-import importlib.util
 import pathlib
 from importlib import metadata
 
@@ -25,14 +24,8 @@ import pytest
 import gripkit
 from gripkit.errors import (ArgumentError, ConfigError, DataError, IdentificationError, ModelError,
                             ParameterError, PathError)
+from corpus import assert_user_error
 
-# the corpus's helpers, loaded from this folder's conftest.py by path: tests/ has no packages and
-# several conftest.py files, so `import conftest` may find another one (tests/sysid's)
-_helpers = importlib.util.spec_from_file_location("bad_inputs_helpers",
-                                                  pathlib.Path(__file__).with_name("conftest.py"))
-_module = importlib.util.module_from_spec(_helpers)
-_helpers.loader.exec_module(_module)
-assert_user_error = _module.assert_user_error
 
 MSD = """
 [model]

@@ -6,10 +6,8 @@ y(t) = 1.5 y(t−1) − 0.7 y(t−2) + 1.0 u(t−1) + 0.5 u(t−2) + e(t) (poles
 
 from __future__ import annotations
 
-import importlib.util
 import math
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,13 +17,8 @@ from gripkit.errors import AccuracyWarning
 from gripkit.io import load
 from gripkit.signals.outliers import THRESHOLD, corrupt_samples
 from gripkit.sysid import RLS, armax, arx, oe, rls, structure_search
+from corpus import assert_user_error, assert_warned
 
-# the corpus's helpers, loaded from this folder's conftest.py by path: tests/ has no packages and
-# several conftest.py files, so `import conftest` may find another one
-_helpers = importlib.util.spec_from_file_location("bad_inputs_helpers", Path(__file__).with_name("conftest.py"))
-_module = importlib.util.module_from_spec(_helpers)
-_helpers.loader.exec_module(_module)
-assert_user_error, assert_warned = _module.assert_user_error, _module.assert_warned
 
 TRUE = np.array([-1.5, 0.7, 1.0, 0.5])  # a1, a2, b1, b2
 FS = 200.0
