@@ -403,3 +403,17 @@ def test_rls_update_detects_windup_divergence_like_run():
     with pytest.raises(IdentificationError, match=r"diverged after \d+ updates"):
         y = 1e-3 * np.random.default_rng(0).standard_normal(10_000)  # excites a1, a2; u excites b only once
         RLS(2, 2, 1, forgetting=0.9, windup="none").run(np.r_[1.0, np.zeros(9999)], y)
+
+
+def test_one_row_csv_names_the_file(cli, tmp_path):
+    p = tmp_path / "one.csv"
+    p.write_text("t,u,y\n0,1,2\n")
+    res = cli("identify", "arx", p, "--input", "u", "--output", "y", "--na", 1, "--nb", 1, "--nk", 1)
+    assert_user_error(res, "DataError", "one.csv: 1 sample(s) have no sample interval")
+
+
+def test_junk_mcap_is_not_read_as_mcap(cli, tmp_path):
+    p = tmp_path / "log.mcap"
+    p.write_text("junk\n")
+    res = cli("identify", "arx", p, "--input", "u", "--output", "y", "--na", 1, "--nb", 1, "--nk", 1)
+    assert_user_error(res, "DataError", "log.mcap: not an MCAP file")
