@@ -417,3 +417,17 @@ def test_junk_mcap_is_not_read_as_mcap(cli, tmp_path):
     p.write_text("junk\n")
     res = cli("identify", "arx", p, "--input", "u", "--output", "y", "--na", 1, "--nb", 1, "--nk", 1)
     assert_user_error(res, "DataError", "log.mcap: not an MCAP file")
+
+
+def test_repeated_column_name_is_refused(cli, tmp_path):
+    p = tmp_path / "dup.csv"
+    p.write_text("t,u,u\n" + "".join(f"{k / 100},{np.sin(k)},{np.cos(k)}\n" for k in range(50)))
+    res = cli("identify", "arx", p, "--input", "u", "--output", "u", "--na", 1, "--nb", 1, "--nk", 1)
+    assert_user_error(res, "DataError", "column name 'u' appears 2 times")
+
+
+def test_header_without_rows_names_the_file(cli, tmp_path):
+    p = tmp_path / "hdr.csv"
+    p.write_text("t,u,y\n")
+    res = cli("identify", "arx", p, "--input", "u", "--output", "y", "--na", 1, "--nb", 1, "--nk", 1)
+    assert_user_error(res, "DataError", "hdr.csv: the file has column names but no data rows")
