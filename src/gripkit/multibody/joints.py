@@ -244,12 +244,12 @@ class JointChain(Dynamics):
 
     def jacobian(self, q) -> np.ndarray:
         """Geometric Jacobian of the tip, rows (v, ω) in the base frame, (6, m) or (B, 6, m)."""
-        from . import rnea as _dyn
+        from .rnea import OP_JACOBIAN, _states, run_op
 
-        (qq,), single = _dyn._states(self, q)
+        (qq,), single = _states(self, q)
         self.kernel_arrays()
         J = np.empty((qq.shape[0], 6, self.dof))
-        _dyn.run_op(self, _dyn.OP_JACOBIAN, qq, tool=self._kernel_tool[:3, 3], fout=J)
+        run_op(self, OP_JACOBIAN, qq, tool=self._kernel_tool[:3, 3], fout=J)
         return J[0] if single else J
 
     def parameter_map(self):
