@@ -136,9 +136,10 @@ def _parameter_wrench(c, wx, wy, wz, ax, ay, az, vx, vy, vz):  # pragma: no cove
 
 
 @hot
-def regressor_state(n, m, R, P, jtype, G, qd, qdd, gx, gy, gz, kin, Yq, Y, b):  # pragma: no cover
+def regressor_state(n, m, R, P, jtype, G, qd, qdd, gx, gy, gz, kin, W, Yq, Y, b):  # pragma: no cover
     """Joint-space regressor Yq (n × 10n) of one state (link transforms R, P already filled) and
-    its actuator-space projection Y[b] = Γᵀ Yq (m × 10n)."""
+    its actuator-space projection Y[b] = Γᵀ Yq (m × 10n). ``W`` is 6 × 10 scratch: the wrenches
+    of one link's ten parameters, carried down the chain together."""
     outward_kinematics(n, R, P, jtype, qd, qdd, gx, gy, gz, kin)
     for i in range(n):
         for col in range(10 * n):
@@ -149,27 +150,34 @@ def regressor_state(n, m, R, P, jtype, G, qd, qdd, gx, gy, gz, kin, Yq, Y, b):  
         vx = kin[j, 6]; vy = kin[j, 7]; vz = kin[j, 8]  # noqa: E702
         for c in range(10):
             fx, fy, fz, nx, ny, nz = _parameter_wrench(c, wx, wy, wz, ax, ay, az, vx, vy, vz)
-            col = 10 * j + c
-            for i in range(j, -1, -1):
-                Yq[i, col] = nz if jtype[i] == 0 else fz
-                if i == 0:
-                    break
-                r0 = R[i, 0]; r1 = R[i, 1]; r2 = R[i, 2]  # noqa: E702
-                r3 = R[i, 3]; r4 = R[i, 4]; r5 = R[i, 5]  # noqa: E702
-                r6 = R[i, 6]; r7 = R[i, 7]; r8 = R[i, 8]  # noqa: E702
+            W[0, c] = fx
+            W[1, c] = fy
+            W[2, c] = fz
+            W[3, c] = nx
+            W[4, c] = ny
+            W[5, c] = nz
+        for i in range(j, -1, -1):
+            row = 5 if jtype[i] == 0 else 2
+            for c in range(10):
+                Yq[i, 10 * j + c] = W[row, c]
+            if i == 0:
+                break
+            r0 = R[i, 0]; r1 = R[i, 1]; r2 = R[i, 2]  # noqa: E702
+            r3 = R[i, 3]; r4 = R[i, 4]; r5 = R[i, 5]  # noqa: E702
+            r6 = R[i, 6]; r7 = R[i, 7]; r8 = R[i, 8]  # noqa: E702
+            px = P[i, 0]; py = P[i, 1]; pz = P[i, 2]  # noqa: E702
+            for c in range(10):
+                fx = W[0, c]; fy = W[1, c]; fz = W[2, c]  # noqa: E702
+                nx = W[3, c]; ny = W[4, c]; nz = W[5, c]  # noqa: E702
                 gfx = r0 * fx + r1 * fy + r2 * fz
                 gfy = r3 * fx + r4 * fy + r5 * fz
                 gfz = r6 * fx + r7 * fy + r8 * fz
-                px = P[i, 0]; py = P[i, 1]; pz = P[i, 2]  # noqa: E702
-                tnx = r0 * nx + r1 * ny + r2 * nz + py * gfz - pz * gfy
-                tny = r3 * nx + r4 * ny + r5 * nz + pz * gfx - px * gfz
-                tnz = r6 * nx + r7 * ny + r8 * nz + px * gfy - py * gfx
-                fx = gfx
-                fy = gfy
-                fz = gfz
-                nx = tnx
-                ny = tny
-                nz = tnz
+                W[0, c] = gfx
+                W[1, c] = gfy
+                W[2, c] = gfz
+                W[3, c] = r0 * nx + r1 * ny + r2 * nz + py * gfz - pz * gfy
+                W[4, c] = r3 * nx + r4 * ny + r5 * nz + pz * gfx - px * gfz
+                W[5, c] = r6 * nx + r7 * ny + r8 * nz + px * gfy - py * gfx
     for a in range(m):
         for col in range(10 * n):
             s = 0.0
@@ -181,8 +189,8 @@ def regressor_state(n, m, R, P, jtype, G, qd, qdd, gx, gy, gz, kin, Yq, Y, b):  
 
 
 @hot
-def _regressor_range(b0, b1, dh, jtype, G, q0, g, gscale, pos, vel, acc, Y, R, P, kin, Yq, q, qd,
-                     qdd):  # pragma: no cover - compiled
+def _regressor_range(b0, b1, dh, jtype, G, q0, g, gscale, pos, vel, acc, Y, R, P, kin, W, Yq, q,
+                     qd, qdd):  # pragma: no cover - compiled
     n = dh.shape[0]
     m = pos.shape[1]
     for b in range(b0, b1):
@@ -200,14 +208,14 @@ def _regressor_range(b0, b1, dh, jtype, G, q0, g, gscale, pos, vel, acc, Y, R, P
             qdd[k] = sdd
         chain_links(n, dh, jtype, q, R, P)
         regressor_state(n, m, R, P, jtype, G, qd, qdd, gscale * g[0], gscale * g[1], gscale * g[2],
-                        kin, Yq, Y, b)
+                        kin, W, Yq, Y, b)
 
 
 @hot
-def _regressor_batch(dh, jtype, G, q0, g, gscale, pos, vel, acc, Y, R, P, kin, Yq, q, qd,
+def _regressor_batch(dh, jtype, G, q0, g, gscale, pos, vel, acc, Y, R, P, kin, W, Yq, q, qd,
                      qdd):  # pragma: no cover - compiled
-    _regressor_range(0, pos.shape[0], dh, jtype, G, q0, g, gscale, pos, vel, acc, Y, R, P, kin, Yq,
-                     q, qd, qdd)
+    _regressor_range(0, pos.shape[0], dh, jtype, G, q0, g, gscale, pos, vel, acc, Y, R, P, kin, W,
+                     Yq, q, qd, qdd)
 
 
 def regressor(system, q, qd, qdd, *, gravity: bool = True) -> np.ndarray:
@@ -232,7 +240,8 @@ def regressor(system, q, qd, qdd, *, gravity: bool = True) -> np.ndarray:
     B, m = q.shape
     Y = np.empty((B, m, PARAMETERS_PER_LINK * n))
     _regressor_batch(dh, jt, G, q0, g, 1.0 if gravity else 0.0, q, qd, qdd, Y, np.empty((n, 9)),
-                     np.empty((n, 3)), np.empty((n, 9)), np.empty((n, PARAMETERS_PER_LINK * n)),
+                     np.empty((n, 3)), np.empty((n, 9)), np.empty((6, 10)),
+                     np.empty((n, PARAMETERS_PER_LINK * n)),
                      np.empty(n), np.empty(n), np.empty(n))
     L = system.parameter_map()
     if L is not None:
