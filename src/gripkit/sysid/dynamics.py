@@ -18,8 +18,8 @@ so Y φ = Y₁ (φ₁ + β φ₂) = Y₁ φ_b. Each base parameter is named as t
 (``Izz_link3 + 0.003·m_link4 + ...``).
 
 **Estimation.** Weighted least squares on the stacked rows (sample, joint) of [Y₁, friction
-columns]; ``weights=None`` takes each joint's weight as 1/σ̂ⱼ² from an ordinary least-squares pass
-(Gautier & Poignet 2001), so joints with different noise levels are weighted by their noise.
+columns]; each joint's rows are weighted by 1/σ̂ⱼ² from a first pass (Gautier & Poignet 2001), so
+joints with different noise levels count by their noise, times the user's ``weights``.
 Cov = σ̂² (XᵀWX)⁻¹, σ̂² = rᵀWr/(N_rows − p) (``covariance="ols"``, white noise), or the Newey-West
 covariance of :func:`gripkit.sysid.regression.hac_covariance` for filtered, differentiated or
 decimated logs (``covariance="hac"``).
@@ -267,7 +267,7 @@ def _as_states(name, a, N, m, names):
 
 def identify_dynamics(chain, q, qd, qdd, tau, *, friction: str = "coulomb-viscous", weights=None,
                       armature: bool = False, covariance: str = "ols", constrained: bool = False,
-                      check_consistency: bool = True) -> DynamicsResult:
+                      check_consistency: bool = True, joint_weighting: bool = True) -> DynamicsResult:
     """Identify a chain's base inertial parameters and per-joint friction from joint states and
     efforts (module doc).
 
@@ -282,8 +282,10 @@ def identify_dynamics(chain, q, qd, qdd, tau, *, friction: str = "coulomb-viscou
     friction
         ``'coulomb-viscous'``, ``'coulomb-viscous-offset'`` or ``'none'``.
     weights
-        None (per-joint 1/σ̂² from a first pass), or (N,) or (N, m) non-negative row weights
-        (0 drops a row: e.g. samples near a velocity reversal).
+        None, or (N,) or (N, m) non-negative row weights (0 drops a row: e.g. samples near a
+        velocity reversal).
+    joint_weighting
+        Multiply the weights by each joint's 1/σ̂² from a first pass (module doc).
     armature
         Also identify a rotor inertia I_a per actuated joint (geared motors).
     covariance
@@ -355,10 +357,12 @@ def identify_dynamics(chain, q, qd, qdd, tau, *, friction: str = "coulomb-viscou
                                   f"the weakest direction mixes {', '.join(names[k] for k in top)}",
                                   hint="use a richer excitation (gripkit.excitation.fourier_trajectory)")
     r = (y - X @ theta).reshape(N, m)
-    if w is None:  # Gautier-Poignet: each joint weighted by its own residual variance
-        s_j = np.sqrt(np.sum(r ** 2, axis=0) / max(N - P / m, 1.0))
-        s_j[s_j == 0] = 1.0
-        rows_w = np.repeat((1.0 / s_j ** 2)[None, :], N, axis=0)
+    if joint_weighting and m > 1:  # Gautier-Poignet: each joint weighted by its residual variance
+        mk = keep.reshape(N, m)
+        s_j = np.array([np.sqrt(np.sum((rows_w[:, j] * r[:, j] ** 2)[mk[:, j]]) / max(mk[:, j].sum() - P / m, 1.0))
+                        for j in range(m)])
+        s_j[~(s_j > 0)] = 1.0
+        rows_w = rows_w / s_j[None, :] ** 2
         Xw, yw, Gm, theta, cond, _ = solve(rows_w)
         r = (y - X @ theta).reshape(N, m)
     rw = (yw - Xw @ (theta * scale))
