@@ -138,8 +138,13 @@ def _parameter_wrench(c, wx, wy, wz, ax, ay, az, vx, vy, vz):  # pragma: no cove
 @hot
 def regressor_state(n, m, R, P, jtype, G, qd, qdd, gx, gy, gz, kin, W, Yq, Y, b):  # pragma: no cover
     """Joint-space regressor Yq (n × 10n) of one state (link transforms R, P already filled) and
-    its actuator-space projection Y[b] = Γᵀ Yq (m × 10n). ``W`` is 6 × 10 scratch: the wrenches
-    of one link's ten parameters, carried down the chain together."""
+    its actuator-space projection Y[b] = Γᵀ Yq (m × 10n).
+
+    Link j's ten parameter wrenches (f, n) at its origin, in its frame, are kept in ``W`` (6 × 10)
+    and projected on each joint i ≤ j: with u the axis of joint i and d the vector from joint i's
+    origin to link j's, both in frame j, τ_i = u·n + (u × d)·f (revolute) or u·f (prismatic).
+    u and d come from carrying frame j down to frame i (R_{i←j} = R_{i+1}·R_{i+1←j},
+    p_i = R_{i+1} p_{i+1} + P_{i+1}): u = R_{i←j}ᵀ ẑ, u × d = R_{i←j}ᵀ (ẑ × p_i)."""
     outward_kinematics(n, R, P, jtype, qd, qdd, gx, gy, gz, kin)
     for i in range(n):
         for col in range(10 * n):
@@ -156,28 +161,49 @@ def regressor_state(n, m, R, P, jtype, G, qd, qdd, gx, gy, gz, kin, W, Yq, Y, b)
             W[3, c] = nx
             W[4, c] = ny
             W[5, c] = nz
+        # R_{i←j} row-major in a0..a8, p = origin of frame j in frame i
+        a0 = 1.0; a1 = 0.0; a2 = 0.0  # noqa: E702
+        a3 = 0.0; a4 = 1.0; a5 = 0.0  # noqa: E702
+        a6 = 0.0; a7 = 0.0; a8 = 1.0  # noqa: E702
+        px = 0.0; py = 0.0; pz = 0.0  # noqa: E702
         for i in range(j, -1, -1):
-            row = 5 if jtype[i] == 0 else 2
-            for c in range(10):
-                Yq[i, 10 * j + c] = W[row, c]
-            if i == 0:
-                break
-            r0 = R[i, 0]; r1 = R[i, 1]; r2 = R[i, 2]  # noqa: E702
-            r3 = R[i, 3]; r4 = R[i, 4]; r5 = R[i, 5]  # noqa: E702
-            r6 = R[i, 6]; r7 = R[i, 7]; r8 = R[i, 8]  # noqa: E702
-            px = P[i, 0]; py = P[i, 1]; pz = P[i, 2]  # noqa: E702
-            for c in range(10):
-                fx = W[0, c]; fy = W[1, c]; fz = W[2, c]  # noqa: E702
-                nx = W[3, c]; ny = W[4, c]; nz = W[5, c]  # noqa: E702
-                gfx = r0 * fx + r1 * fy + r2 * fz
-                gfy = r3 * fx + r4 * fy + r5 * fz
-                gfz = r6 * fx + r7 * fy + r8 * fz
-                W[0, c] = gfx
-                W[1, c] = gfy
-                W[2, c] = gfz
-                W[3, c] = r0 * nx + r1 * ny + r2 * nz + py * gfz - pz * gfy
-                W[4, c] = r3 * nx + r4 * ny + r5 * nz + pz * gfx - px * gfz
-                W[5, c] = r6 * nx + r7 * ny + r8 * nz + px * gfy - py * gfx
+            if i < j:
+                k = i + 1
+                r0 = R[k, 0]; r1 = R[k, 1]; r2 = R[k, 2]  # noqa: E702
+                r3 = R[k, 3]; r4 = R[k, 4]; r5 = R[k, 5]  # noqa: E702
+                r6 = R[k, 6]; r7 = R[k, 7]; r8 = R[k, 8]  # noqa: E702
+                b0 = r0 * a0 + r1 * a3 + r2 * a6
+                b1 = r0 * a1 + r1 * a4 + r2 * a7
+                b2 = r0 * a2 + r1 * a5 + r2 * a8
+                b3 = r3 * a0 + r4 * a3 + r5 * a6
+                b4 = r3 * a1 + r4 * a4 + r5 * a7
+                b5 = r3 * a2 + r4 * a5 + r5 * a8
+                b6 = r6 * a0 + r7 * a3 + r8 * a6
+                b7 = r6 * a1 + r7 * a4 + r8 * a7
+                b8 = r6 * a2 + r7 * a5 + r8 * a8
+                a0 = b0; a1 = b1; a2 = b2; a3 = b3; a4 = b4; a5 = b5; a6 = b6; a7 = b7; a8 = b8  # noqa: E702
+                qx = r0 * px + r1 * py + r2 * pz + P[k, 0]
+                qy = r3 * px + r4 * py + r5 * pz + P[k, 1]
+                qz = r6 * px + r7 * py + r8 * pz + P[k, 2]
+                px = qx
+                py = qy
+                pz = qz
+            ux = a6
+            uy = a7
+            uz = a8
+            col = 10 * j
+            if jtype[i] == 0:
+                ex = -py * a0 + px * a3
+                ey = -py * a1 + px * a4
+                ez = -py * a2 + px * a5
+                for c in range(4):
+                    Yq[i, col + c] = (ux * W[3, c] + uy * W[4, c] + uz * W[5, c]
+                                      + ex * W[0, c] + ey * W[1, c] + ez * W[2, c])
+                for c in range(4, 10):
+                    Yq[i, col + c] = ux * W[3, c] + uy * W[4, c] + uz * W[5, c]
+            else:
+                for c in range(4):
+                    Yq[i, col + c] = ux * W[0, c] + uy * W[1, c] + uz * W[2, c]
     for a in range(m):
         for col in range(10 * n):
             s = 0.0

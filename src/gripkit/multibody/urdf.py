@@ -414,7 +414,7 @@ def _describe(chain):
     if isinstance(chain, JointChain):
         return (chain.placements, chain.axes, chain.joint_types, chain.mass, chain.com, chain.inertia,
                 chain.coupling, chain.offset, chain.names, chain.link_names, chain.tool, chain.armature,
-                chain.limits, chain.actuated)
+                chain.limits)
     if isinstance(chain, CoupledChain):
         dh, c = chain.chain, chain.coupling
         G, q0, arm = c.matrix, c.offset, c.armature
@@ -436,7 +436,7 @@ def _describe(chain):
     arm_q = dh.armature
     arm_total = np.concatenate([arm, arm_q])
     return (X, np.tile([0.0, 0.0, 1.0], (dh.n, 1)), dh.joint_types, dh.mass, dh.com, dh.inertia, G, q0,
-            dh.names, tuple(f"link{k + 1}" for k in range(dh.n)), dh.tool, arm_total, None, None)
+            dh.names, tuple(f"link{k + 1}" for k in range(dh.n)), dh.tool, arm_total, None)
 
 
 def to_urdf(chain, path, *, name: str | None = None, base_link: str = "base",
@@ -454,8 +454,7 @@ def to_urdf(chain, path, *, name: str | None = None, base_link: str = "base",
     inertia, or a coupling that mixes actuators (the file's coordinates are then its independent
     joints q_u = Γ_u p + q₀_u, and τ_p = Γ_uᵀ τ_u).
     """
-    (X, axes, types, mass, com, inertia, G, q0, names, link_names, tool, arm, limits,
-     actuated_given) = _describe(chain)
+    X, axes, types, mass, com, inertia, G, q0, names, link_names, tool, arm, limits = _describe(chain)
     n, m = G.shape
     left_out = []
     if np.any(np.asarray(arm) != 0):
@@ -488,8 +487,7 @@ def to_urdf(chain, path, *, name: str | None = None, base_link: str = "base",
     robot = ET.Element("robot", name=name or getattr(chain, "name", "chain"))
     robot.append(ET.Comment(f" written by gripkit.multibody.to_urdf; gravity in {base_link!r}: "
                             f"{_vec(getattr(chain, 'chain', chain).gravity)} m/s^2 "))
-    base = ET.SubElement(robot, "link", name=base_link)
-    del base
+    ET.SubElement(robot, "link", name=base_link)
     parent = base_link
     actuated_rank = {k: r for r, k in enumerate(independent)}
     for k in range(n):

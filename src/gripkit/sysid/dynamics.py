@@ -31,8 +31,10 @@ parameters reproduce it with every link's pseudo-inertia
 
 (positive mass, centre of mass inside the inertia ellipsoid, triangle inequality). gripkit writes
 each J = L Lᵀ (Cholesky factor L, always consistent) and minimises the Mahalanobis distance
-d² = (θ(L) − θ̂)ᵀ Cov⁻¹ (θ(L) − θ̂) over L: d ≈ 0 means consistent; otherwise the links whose
-pseudo-inertia sits on the boundary at the optimum are the ones that fail. ``constrained=True``
+d² = (θ(L) − θ̂)ᵀ Cov⁻¹ (θ(L) − θ̂) over L: d ≈ 0 means consistent. First, though, the standard
+parameters that keep the chain's own values for what the data cannot see are tried: if every link
+is consistent there, so is the estimate, without a search. The failing links are those whose
+pseudo-inertia is indefinite there (or, if none, those pushed onto the boundary by the search). ``constrained=True``
 returns that nearest consistent estimate (Coulomb and viscous friction ≥ 0) as the result; for a
 linear model this minimum-distance fit equals the constrained weighted least-squares fit on the
 data, without another pass over it.
@@ -137,8 +139,9 @@ def _friction_columns(qd, kinds) -> np.ndarray:
 @dataclass(frozen=True)
 class Consistency:
     """Physical consistency of the estimate (module doc): ``consistent``, the Mahalanobis distance
-    ``distance`` (σ units) to the nearest consistent parameters, the ``failing_links`` (pseudo-
-    inertia on the boundary there) and those nearest ``standard_parameters``."""
+    ``distance`` (σ units) to the nearest consistent parameters found (a search of at most 80
+    steps: an upper bound of the true distance), the ``failing_links`` and those
+    ``standard_parameters``."""
 
     consistent: bool
     distance: float
@@ -151,7 +154,7 @@ class Consistency:
             return "physically consistent: standard parameters with positive mass and positive-definite pseudo-inertia reproduce the base parameters"
         links = ", ".join(self.failing_links) or "(no single link: the optimiser stopped)"
         return (f"physically inconsistent: no standard parameters with positive-definite pseudo-inertia reproduce "
-                f"the base parameters (the nearest consistent ones are {self.distance:.3g} σ away); failing: {links}")
+                f"the base parameters (the nearest consistent ones found are {self.distance:.3g} σ away); failing: {links}")
 
     def to_dict(self) -> dict:
         return dict(consistent=self.consistent, distance_sigma=self.distance, failing_links=list(self.failing_links),
@@ -318,65 +321,77 @@ def identify_dynamics(chain, q, qd, qdd, tau, *, friction: str = "coulomb-viscou
     X3 = np.concatenate([Y, _friction_columns(qd, kinds)], axis=2) if kinds else Y
     names = st.names + tuple(f"{k}_{j}" for j in jn for k in kinds)
     P = X3.shape[2]
-    X = X3.reshape(N * m, P)
-    y = tau.reshape(N * m)
     rows_w = np.ones((N, m)) if w is None else w
-    keep = rows_w.reshape(-1) > 0
-    n_rows = int(keep.sum())
+    n_j = (rows_w > 0).sum(axis=0)
+    n_rows = int(n_j.sum())
     if n_rows < 2 * P:
         raise DataError(f"{n_rows} weighted rows are too few for {P} parameters (need at least {2 * P})",
                         hint="log a longer run")
-    scale = np.sqrt(np.mean(X[keep] ** 2, axis=0))
+    # one pass over the data: each joint's weighted Gram matrix XⱼᵀWⱼXⱼ, XⱼᵀWⱼτⱼ and τⱼᵀWⱼτⱼ; the
+    # per-joint reweighting, the solution, the residual sums and the covariance follow from them
+    Gj = np.empty((m, P, P))
+    bj = np.empty((m, P))
+    yy = np.empty(m)
+    for j in range(m):
+        sw = np.sqrt(rows_w[:, j])
+        Xj = X3[:, j, :] * sw[:, None]
+        yj = tau[:, j] * sw
+        Gj[j] = Xj.T @ Xj
+        bj[j] = Xj.T @ yj
+        yy[j] = yj @ yj
+    scale = np.sqrt(np.diagonal(Gj.sum(axis=0)) / n_rows)
     weak = np.flatnonzero(scale == 0)
     if weak.size:
         raise UnidentifiableError(f"the data never excite {', '.join(names[k] for k in weak[:3])}",
                                   hint="move every joint, in both directions, with accelerations")
+    S = np.outer(scale, scale)
 
-    def solve(wr):
-        """Scaled weighted rows, their QR factor R and the least-squares solution."""
-        sw = np.sqrt(wr.reshape(-1))[keep]
-        Xw = X[keep] * sw[:, None] / scale
-        yw = y[keep] * sw
-        # normal equations on the scaled columns (fast for long logs); their condition number is
-        # the square of the regressor's, so beyond 1e6 the orthogonal (lstsq) route is taken
-        Gm = Xw.T @ Xw
-        ev, V = np.linalg.eigh(Gm)
+    def solve(jw):
+        """θ for per-joint weights jw (normal equations on the scaled columns; their condition
+        number is the square of the regressor's, so beyond 1e6 the orthogonal route is taken)."""
+        Gs = np.tensordot(jw, Gj, axes=1) / S
+        ev, V = np.linalg.eigh(Gs)
         cnd = float(np.sqrt(ev[-1] / max(ev[0], 1e-300)))
         if cnd < 1e6:
-            th = np.linalg.solve(Gm, Xw.T @ yw)
+            th = np.linalg.solve(Gs, (jw @ bj) / scale)
         else:
-            th = np.linalg.lstsq(Xw, yw, rcond=None)[0]
-        return Xw, yw, Gm, th / scale, cnd, V
+            sw = np.sqrt(rows_w * jw)
+            Xw = (X3 * sw[:, :, None]).reshape(N * m, P) / scale
+            th = np.linalg.lstsq(Xw, (tau * sw).reshape(-1), rcond=None)[0]
+        return Gs, th / scale, cnd, V
 
-    Xw, yw, Gm, theta, cond, V = solve(rows_w)
-    Vt = V[:, ::-1].T
+    def rss(th):
+        """Weighted residual sum of squares of each joint."""
+        return np.maximum(yy - 2 * bj @ th + np.einsum("i,jik,k->j", th, Gj, th), 0.0)
+
+    jw = np.ones(m)
+    Gs, theta, cond, V = solve(jw)
     if cond > 1e10:
-        v = Vt[-1] / scale
+        v = V[:, 0] / scale
         top = np.argsort(-np.abs(v / np.max(np.abs(v))))[:3]
         raise UnidentifiableError(f"the data do not excite every base parameter (condition number {cond:.3g}); "
                                   f"the weakest direction mixes {', '.join(names[k] for k in top)}",
                                   hint="use a richer excitation (gripkit.excitation.fourier_trajectory)")
-    r = (y - X @ theta).reshape(N, m)
     if joint_weighting and m > 1:  # Gautier-Poignet: each joint weighted by its residual variance
-        mk = keep.reshape(N, m)
-        s_j = np.array([np.sqrt(np.sum((rows_w[:, j] * r[:, j] ** 2)[mk[:, j]]) / max(mk[:, j].sum() - P / m, 1.0))
-                        for j in range(m)])
-        s_j[~(s_j > 0)] = 1.0
-        rows_w = rows_w / s_j[None, :] ** 2
-        Xw, yw, Gm, theta, cond, _ = solve(rows_w)
-        r = (y - X @ theta).reshape(N, m)
-    rw = (yw - Xw @ (theta * scale))
+        s2_j = rss(theta) / np.maximum(n_j - P / m, 1.0)
+        s2_j[~(s2_j > 0)] = 1.0
+        jw = 1.0 / s2_j
+        Gs, theta, cond, _ = solve(jw)
+    r2 = rss(theta)
     if covariance == "hac":
         from .regression import hac_covariance
 
-        C = hac_covariance(Xw, rw) / np.outer(scale, scale)
+        sw = np.sqrt(rows_w * jw)
+        Xw = (X3 * sw[:, :, None]).reshape(N * m, P) / scale
+        rw = ((tau - X3 @ theta) * sw).reshape(-1)
+        keep = sw.reshape(-1) > 0
+        C = hac_covariance(Xw[keep], rw[keep]) / S
     else:
-        s2 = float(rw @ rw / max(n_rows - P, 1))
-        C = s2 * np.linalg.inv(Gm) / np.outer(scale, scale)
-    mask = keep.reshape(N, m)
-    res_std = {j: float(np.sqrt(np.mean(r[mask[:, k], k] ** 2))) if mask[:, k].any() else float("nan")
-               for k, j in enumerate(jn)}
-    rel = float(100.0 * np.linalg.norm(r[mask]) / max(np.linalg.norm(tau[mask]), 1e-300))
+        s2 = float(jw @ r2 / max(n_rows - P, 1))
+        C = s2 * np.linalg.inv(Gs) / S
+    wsum = rows_w.sum(axis=0)
+    res_std = {j: float(np.sqrt(r2[k] / wsum[k])) if wsum[k] > 0 else float("nan") for k, j in enumerate(jn)}
+    rel = float(100.0 * np.sqrt(r2.sum() / max(yy.sum(), 1e-300)))
     notes = []
     if cond > 1e5:
         notes.append(f"regressor condition number {cond:.3g}: weak excitation, large σ")
@@ -514,7 +529,7 @@ def _consistency(chain, st: BaseStructure, theta, C, kinds, m, armature) -> Cons
     if links_ok and fr_ok and (not n_arm or (phi_p[p_std:] >= 0).all()):
         return Consistency(True, 0.0, (), phi_p, theta.copy())
     sol = least_squares(resid, x0, jac=jac, bounds=(lo, hi), x_scale="jac", xtol=1e-10, ftol=1e-10,
-                        gtol=1e-10, max_nfev=200)
+                        gtol=1e-10, max_nfev=80)
     th, phi = params(sol.x)
     d = float(np.linalg.norm(Ci.T @ (th - theta)))
     failing = []
