@@ -12,9 +12,12 @@ I_a optional rotor inertias (``armature=True``) and per-joint Coulomb F_c, visco
 
 **Base parameters.** Not every column of Y is independent: some are zero (a link that cannot move
 a parameter), some are combinations of others (parameters that only act together). The structure
-is found from the model alone, on random states: the QR decomposition with column pivoting
-Y P = Q [R₁₁ R₁₂] gives the rank r, the independent columns Y₁ and Y₂ = Y₁ β with β = R₁₁⁻¹R₁₂,
-so Y φ = Y₁ (φ₁ + β φ₂) = Y₁ φ_b. Each base parameter is named as the combination it stands for
+is found from the model alone, on random states: the QR decomposition of the columns taken in a
+fixed order (distal links first; inertias before first moments before the mass, as in Khalil's
+regrouping; rotor inertias last) keeps a column when it is not in the span
+of those before it (|R_kk| against its norm), which gives the rank r, the independent columns Y₁
+and Y₂ = Y₁ β (least squares, exact here), so Y φ = Y₁ (φ₁ + β φ₂) = Y₁ φ_b. The fixed order makes
+the choice among equal columns reproducible (a pivoted QR would pick by rounding). Each base parameter is named as the combination it stands for
 (``Izz_link3 + 0.003·m_link4 + ...``).
 
 **Estimation.** Weighted least squares on the stacked rows (sample, joint) of [Y₁, friction
@@ -34,7 +37,9 @@ each J = L Lᵀ (Cholesky factor L, always consistent) and minimises the Mahalan
 d² = (θ(L) − θ̂)ᵀ Cov⁻¹ (θ(L) − θ̂) over L: d ≈ 0 means consistent. First, though, the standard
 parameters that keep the chain's own values for what the data cannot see are tried: if every link
 is consistent there, so is the estimate, without a search. The failing links are those whose
-pseudo-inertia is indefinite there (or, if none, those pushed onto the boundary by the search). ``constrained=True``
+pseudo-inertia is indefinite there (or, if none, those pushed onto the boundary by the search).
+"Those standard parameters" are the least change from the chain's own values (each parameter
+relative to its size, so a massless link stays massless) that reproduces the estimate. ``constrained=True``
 returns that nearest consistent estimate (Coulomb and viscous friction ≥ 0) as the result; for a
 linear model this minimum-distance fit equals the constrained weighted least-squares fit on the
 data, without another pass over it.
@@ -89,7 +94,7 @@ def _combination_name(names, i, dep, beta_row) -> str:
 def base_structure(chain, *, armature: bool = False, seed: int = 0, tol: float = 1e-9) -> BaseStructure:
     """Base parameters of ``chain`` from its regressor on random states (module doc); with
     ``armature`` a rotor-inertia column per actuated joint joins the standard parameters."""
-    from scipy.linalg import qr, solve_triangular
+    from scipy.linalg import qr
 
     rng = np.random.default_rng(seed)
     m = chain.dof
@@ -102,16 +107,24 @@ def base_structure(chain, *, armature: bool = False, seed: int = 0, tol: float =
     qd = rng.normal(size=(B, m))
     qdd = rng.normal(size=(B, m))
     X = _inertial_columns(chain, q, qd, qdd, armature).reshape(B * m, p)
-    _, R, piv = qr(X, mode="economic", pivoting=True)
+    # greedy in a fixed order (distal links first; in a link the inertias, then the first moments,
+    # then the mass; rotor inertias last, so that they join the link terms they act with): a
+    # column is independent when it is not in the span of the columns before it, |R_kk| of the
+    # unpivoted QR against its norm; ties between equal columns then always go the same way
+    link = np.array([k // 10 if k < 10 * (p // 10) else -1 for k in range(p)])
+    order = np.array(sorted(range(p), key=lambda k: (link[k] if link[k] >= 0 else p, -(k % 10) if link[k] >= 0 else k)))
+    norms = np.linalg.norm(X, axis=0)
+    R = qr(X[:, order], mode="r")[0]
     d = np.abs(np.diag(R))
-    r = int(np.sum(d > tol * d[0])) if d.size and d[0] > 0 else 0
-    if r == 0:
+    live = norms[order] > 1e-10 * norms.max() if norms.max() > 0 else np.zeros(p, dtype=bool)
+    is_ind = live & (d > tol * np.maximum(norms[order], 1e-300))
+    ind, dep = order[is_ind], order[~is_ind]
+    if ind.size == 0:
         raise UnidentifiableError(f"{chain.name}: the regressor is zero: no inertial parameter acts on the joints")
-    beta = solve_triangular(R[:r, :r], R[:r, r:]) if r < p else np.zeros((r, 0))
-    beta[np.abs(beta) < 1e-10] = 0.0
-    ind, dep = piv[:r], piv[r:]
-    order = np.argsort(ind)  # keep the standard order
-    ind, beta = ind[order], beta[order]
+    beta = np.linalg.lstsq(X[:, ind], X[:, dep], rcond=None)[0] if dep.size else np.zeros((ind.size, 0))
+    beta[np.abs(beta) < 1e-8] = 0.0
+    keep = np.argsort(ind)  # the standard order
+    ind, beta = ind[keep], beta[keep]
     base_names = tuple(_combination_name(names, i, dep, beta[k]) for k, i in enumerate(ind))
     return BaseStructure(ind, dep, beta, base_names, tuple(names))
 
@@ -455,11 +468,11 @@ def _consistency(chain, st: BaseStructure, theta, C, kinds, m, armature) -> Cons
     K = st.matrix
     phi0 = chain.standard_parameters()
     # start: the chain's own (nominal) links, made strictly positive definite
-    L0 = []
-    for k in range(n_links):
-        J = pseudo_inertia(phi0[10 * k:10 * k + 10])
-        s = max(np.trace(J), 1e-6)
-        L0.append(np.linalg.cholesky(J + 1e-6 * s * np.eye(4))[np.tril_indices(4)])
+    # (a massless link, J = 0, gets a small body: at L = 0 the gradient of L Lᵀ vanishes)
+    Js = [pseudo_inertia(phi0[10 * k:10 * k + 10]) for k in range(n_links)]
+    typical = max(np.mean([np.trace(J) for J in Js]), 1e-12)
+    L0 = [np.linalg.cholesky(J + 1e-3 * max(np.trace(J), 1e-2 * typical) * np.eye(4))[np.tril_indices(4)]
+          for J in Js]
     n_arm = m if armature else 0
     x0 = np.concatenate([*L0, np.full(n_arm, 0.0), theta[nb:]])
     try:
@@ -513,12 +526,23 @@ def _consistency(chain, st: BaseStructure, theta, C, kinds, m, armature) -> Cons
         Dreg[:, :10 * n_links] = reg * np.eye(10 * n_links)
         return np.vstack([Ci.T @ Dth, Dreg])
 
-    # first the particular solution that keeps the chain's own values of the dependent parameters:
-    # consistent there means consistent (d = 0) without a search
-    phi_p = phi0.copy()
+    # first the standard parameters nearest to the chain's own that reproduce the estimate (least
+    # change, each parameter relative to its own size, so that a massless link stays massless):
+    # φ = φ₀ + S²Kᵀ(K S² Kᵀ)⁻¹(θ_b − K φ₀). Consistent there means consistent (d = 0), no search.
+    phi_nom = np.concatenate([phi0, np.zeros(n_arm)]) if n_arm else phi0.copy()
+    # sizes: each parameter's own value plus 1e-3 of its link's scale of that kind (mass, first
+    # moment, inertia), so that zero off-diagonal products may move; a massless link has none
+    sz = np.abs(phi_nom)
+    for k in range(n_links):
+        f = phi_nom[10 * k:10 * k + 10]
+        kind = (abs(f[0]), np.abs(f[1:4]).max(), np.abs(f[[4, 6, 9]]).max())
+        sz[10 * k:10 * k + 10] += 1e-3 * np.array([kind[0]] + [kind[1]] * 3 + [kind[2]] * 6)
     if n_arm:
-        phi_p = np.concatenate([phi_p, np.zeros(n_arm)])
-    phi_p[st.independent] = theta[:nb] - st.beta @ phi_p[st.dependent]
+        sz[p_std:] += 1e-3 * max(sz[:p_std].max(), 1e-300)
+    KS = K * sz ** 2
+    phi_p = phi_nom + KS.T @ np.linalg.lstsq(KS @ K.T, theta[:nb] - K @ phi_nom, rcond=None)[0]
+    reproduces = np.allclose(K @ phi_p, theta[:nb], rtol=1e-9, atol=1e-12 * np.abs(theta[:nb]).max())
+
     def psd(J):
         ev = np.linalg.eigvalsh(J)
         return ev[0] >= -1e-9 * max(ev[-1], 1e-300)
@@ -526,16 +550,23 @@ def _consistency(chain, st: BaseStructure, theta, C, kinds, m, armature) -> Cons
     links_ok = all(psd(pseudo_inertia(phi_p[10 * k:10 * k + 10])) for k in range(n_links))
     fr_ok = all(theta[nb + j * len(kinds) + c] >= 0 for j in range(m) for c, kind in enumerate(kinds)
                 if kind in ("coulomb", "viscous"))
-    if links_ok and fr_ok and (not n_arm or (phi_p[p_std:] >= 0).all()):
+    if reproduces and links_ok and fr_ok and (not n_arm or (phi_p[p_std:] >= 0).all()):
         return Consistency(True, 0.0, (), phi_p, theta.copy())
+    # search from that solution with each link's pseudo-inertia projected onto the consistent set
+    for k in range(n_links):
+        ev, V = np.linalg.eigh(pseudo_inertia(phi_p[10 * k:10 * k + 10]))
+        eps = 1e-6 * max(ev[-1], 1e-2 * typical)
+        x0[10 * k:10 * k + 10] = np.linalg.cholesky((V * np.maximum(ev, 0.0)) @ V.T + eps * np.eye(4))[tri]
+    if n_arm:
+        x0[10 * n_links:fr0] = np.maximum(phi_p[p_std:], 1e-15)
     sol = least_squares(resid, x0, jac=jac, bounds=(lo, hi), x_scale="jac", xtol=1e-10, ftol=1e-10,
                         gtol=1e-10, max_nfev=80)
     th, phi = params(sol.x)
     d = float(np.linalg.norm(Ci.T @ (th - theta)))
     failing = []
     if d > 1e-2:
-        # the links whose pseudo-inertia is indefinite when the parameters the data cannot see keep
-        # the chain's own values; if none, those pushed onto the boundary by the nearest fit
+        # the links whose pseudo-inertia is indefinite in that least-change solution; if none,
+        # those pushed onto the boundary by the search
         for k, name in enumerate(chain.link_names):
             if not psd(pseudo_inertia(phi_p[10 * k:10 * k + 10])):
                 failing.append(f"link {name!r}")
