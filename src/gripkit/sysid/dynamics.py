@@ -12,12 +12,14 @@ I_a optional rotor inertias (``armature=True``) and per-joint Coulomb F_c, visco
 
 **Base parameters.** Not every column of Y is independent: some are zero (a link that cannot move
 a parameter), some are combinations of others (parameters that only act together). The structure
-is found from the model alone, on random states: the QR decomposition of the columns taken in a
-fixed order (distal links first; inertias before first moments before the mass, as in Khalil's
-regrouping; rotor inertias last) keeps a column when it is not in the span
-of those before it (|R_kk| against its norm), which gives the rank r, the independent columns Y₁
-and Y₂ = Y₁ β (least squares, exact here), so Y φ = Y₁ (φ₁ + β φ₂) = Y₁ φ_b. The fixed order makes
-the choice among equal columns reproducible (a pivoted QR would pick by rounding). Each base parameter is named as the combination it stands for
+is found from the model alone, on random states. The rank r comes from the QR decomposition with
+column pivoting (|R_kk| above 1e-9·|R_00|). Which r columns stand for the others is then chosen
+in a fixed order — proximal links first, within a link the inertias before the first moments
+before the mass (Khalil's regrouping), rotor inertias last — keeping a column when it is not in the
+span of those before it (|R_kk| of the QR in that order against the column's norm): equal columns
+(the DLR/HIT finger has four) would otherwise be picked by rounding, and the names with them. With
+Y₁ the kept columns and Y₂ = Y₁ β (least squares, exact here), Y φ = Y₁ (φ₁ + β φ₂) = Y₁ φ_b.
+Each base parameter is named as the combination it stands for
 (``Izz_link3 + 0.003·m_link4 + ...``).
 
 **Estimation.** Weighted least squares on the stacked rows (sample, joint) of [Y₁, friction
@@ -107,20 +109,23 @@ def base_structure(chain, *, armature: bool = False, seed: int = 0, tol: float =
     qd = rng.normal(size=(B, m))
     qdd = rng.normal(size=(B, m))
     X = _inertial_columns(chain, q, qd, qdd, armature).reshape(B * m, p)
-    # greedy in a fixed order (distal links first; in a link the inertias, then the first moments,
-    # then the mass; rotor inertias last, so that they join the link terms they act with): a
-    # column is independent when it is not in the span of the columns before it, |R_kk| of the
-    # unpivoted QR against its norm; ties between equal columns then always go the same way
+    # greedy in a fixed order (module doc): a column is independent when it is not in the span of
+    # the columns before it, |R_kk| of the QR in that order against its norm
     link = np.array([k // 10 if k < 10 * (p // 10) else -1 for k in range(p)])
-    order = np.array(sorted(range(p), key=lambda k: (link[k] if link[k] >= 0 else p, -(k % 10) if link[k] >= 0 else k)))
+    order = np.array(sorted(range(p), key=lambda k: (link[k], -(k % 10)) if link[k] >= 0 else (p, k)))
     norms = np.linalg.norm(X, axis=0)
     R = qr(X[:, order], mode="r")[0]
     d = np.abs(np.diag(R))
     live = norms[order] > 1e-10 * norms.max() if norms.max() > 0 else np.zeros(p, dtype=bool)
     is_ind = live & (d > tol * np.maximum(norms[order], 1e-300))
-    ind, dep = order[is_ind], order[~is_ind]
-    if ind.size == 0:
+    _, Rp, piv = qr(X, mode="economic", pivoting=True)
+    dp = np.abs(np.diag(Rp))
+    rank = int(np.sum(dp > tol * dp[0])) if dp.size and dp[0] > 0 else 0
+    if rank == 0:
         raise UnidentifiableError(f"{chain.name}: the regressor is zero: no inertial parameter acts on the joints")
+    if int(is_ind.sum()) != rank:  # the fixed order disagrees with the pivoted rank: take the pivots
+        is_ind = np.isin(order, piv[:rank])
+    ind, dep = order[is_ind], order[~is_ind]
     beta = np.linalg.lstsq(X[:, ind], X[:, dep], rcond=None)[0] if dep.size else np.zeros((ind.size, 0))
     beta[np.abs(beta) < 1e-8] = 0.0
     keep = np.argsort(ind)  # the standard order
