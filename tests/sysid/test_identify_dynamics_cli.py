@@ -116,3 +116,32 @@ def test_cli_bad_urdf_one_line(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert code == 1 and err == ["error: ModelError: joint 'j' has type 'floating', which gripkit does not support"
                                  "; gripkit builds serial chains of revolute, continuous, prismatic and fixed joints"]
+
+
+class Pendulum:
+    """A duck-typed 'chain' (no gripkit.multibody): τ = I q̈ + m g l sin q, two parameters."""
+
+    name = "pendulum"
+    dof = 1
+    coordinate_names = ("q",)
+    parameter_names = ("I", "mgl")
+
+    def regressor(self, q, qd, qdd):
+        return np.stack([qdd, np.sin(q)], axis=-1)
+
+
+def test_fourier_design_takes_any_chain_object():
+    import sys
+
+    tr = fourier_trajectory(Pendulum(), f0=0.5, harmonics=2, fs=100.0, friction=False, samples_per_period=100,
+                            position_limits=(-0.5, 0.5), velocity_limits=1.0, acceleration_limits=3.0)
+    assert np.all(np.abs(tr.q) <= 0.5 + 1e-9) and np.all(np.abs(tr.qd) <= 1.0 + 1e-9)
+    assert np.all(np.abs(tr.qdd) <= 3.0 + 1e-9)
+    # the design's condition number is the scaled regressor's over one period
+    X = Pendulum().regressor(tr.q[:200], tr.qd[:200], tr.qdd[:200]).reshape(-1, 2)
+    X = X / np.sqrt(np.mean(X ** 2, axis=0))
+    sv = np.linalg.svd(X, compute_uv=False)
+    assert sv[0] / sv[-1] == pytest.approx(tr.condition_number, rel=0.05)
+    assert tr.condition_number <= tr.initial_condition_number
+    src = open(sys.modules["gripkit._fourier_trajectory"].__file__).read()
+    assert "multibody" not in src.split('"""', 2)[2]  # no import of gripkit.multibody below the docstring
