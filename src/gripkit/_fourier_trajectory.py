@@ -27,6 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .arguments import entry_point
 from .errors import DataError, IdentificationError
 
 __all__ = ["FourierTrajectory", "fourier_trajectory", "fourier_states"]
@@ -103,6 +104,7 @@ def _limit(name, given, from_chain, m, default):
     return v
 
 
+@entry_point
 def fourier_trajectory(chain, *, f0: float = 0.1, harmonics: int = 5, fs: float = 100.0, periods: int = 1,
                        position_limits=None, velocity_limits=None, acceleration_limits=None,
                        q0=None, friction: bool = True, samples_per_period: int = 200, seed: int = 0,

@@ -20,10 +20,13 @@ __all__ = [
     "UnidentifiableError",
     "SimulationError",
     "ConfigError",
+    "ArgumentError",
+    "PathError",
     "GripkitWarning",
     "ConsistencyWarning",
     "StabilityWarning",
     "AccuracyWarning",
+    "DataWarning",
 ]
 
 
@@ -77,6 +80,16 @@ class ConfigError(GripkitError, ValueError):
     """A model/sweep description file (TOML) that is malformed or incomplete."""
 
 
+class ArgumentError(GripkitError, TypeError):
+    """A Python call with an unknown keyword or an argument of the wrong type; the message names
+    the argument and lists what is accepted. A ``TypeError``, as Python raises for such calls."""
+
+
+class PathError(GripkitError, OSError):
+    """A file or folder that cannot be used as asked: missing, a folder where a file is expected
+    (or the reverse), not readable or not writable. An ``OSError``, as Python raises for such paths."""
+
+
 class GripkitWarning(UserWarning):
     """Base class of gripkit's warnings."""
 
@@ -92,3 +105,8 @@ class StabilityWarning(GripkitWarning):
 
 class AccuracyWarning(GripkitWarning):
     """A result is computed but may be inaccurate (poor excitation, coarse step, few samples)."""
+
+
+class DataWarning(GripkitWarning):
+    """Data that could be read but look damaged: a file whose last line is cut short, a sample far
+    outside the rest of its channel (a corrupt value). The data are used as read; check them."""

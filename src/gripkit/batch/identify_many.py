@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..arguments import entry_point
 from ..errors import ConfigError, DataError
 from ..progress import track
 from .executors import Executor, make_executor
@@ -71,6 +72,7 @@ def _files(paths) -> list[str]:
     return files
 
 
+@entry_point
 def identify_many(paths: str | Path | Iterable, identifier, options: dict | None = None, *,
                   load_options: dict | None = None, backend: str = "process", workers: int | None = None,
                   scheduler: str | None = None, executor: Executor | None = None,

@@ -39,6 +39,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..arguments import entry_point
 from ..errors import GripkitWarning, ModelError
 from .joints import JointChain, JointLimits
 
@@ -227,6 +228,7 @@ def _read_root(source):
     return root
 
 
+@entry_point
 def from_urdf(source, *, base_link: str | None = None, tip_link: str | None = None,
               gravity=(0.0, 0.0, -9.81)) -> JointChain:
     """The serial chain from ``base_link`` to ``tip_link`` of a URDF (module doc).
@@ -439,6 +441,7 @@ def _describe(chain):
             dh.names, tuple(f"link{k + 1}" for k in range(dh.n)), dh.tool, arm_total, None)
 
 
+@entry_point
 def to_urdf(chain, path, *, name: str | None = None, base_link: str = "base",
             tip_link: str = "tip") -> Path:
     """Write ``chain`` (DH, coupled or URDF) as a URDF file (module doc) and return its path.

@@ -54,6 +54,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..arguments import entry_point
 from ..errors import DataError, IdentificationError, UnidentifiableError
 
 __all__ = ["identify_dynamics", "DynamicsResult", "base_structure", "BaseStructure"]
@@ -286,6 +287,7 @@ def _as_states(name, a, N, m, names):
     return x
 
 
+@entry_point
 def identify_dynamics(chain, q, qd, qdd, tau, *, friction: str = "coulomb-viscous", weights=None,
                       armature: bool = False, covariance: str = "ols", constrained: bool = False,
                       check_consistency: bool = True, joint_weighting: bool = True) -> DynamicsResult:
