@@ -2,18 +2,9 @@
 one ``error:`` line naming the class and the culprit (URDF element, option, column), no
 traceback."""
 
-import importlib.util
-from pathlib import Path
-
 import numpy as np
 import pytest
-
-# the corpus's helpers, loaded from this folder's conftest.py by path (several conftest.py files
-# exist under tests/, so `import conftest` may find another one)
-_spec = importlib.util.spec_from_file_location("bad_inputs_helpers_urdf", Path(__file__).with_name("conftest.py"))
-_helpers = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(_helpers)
-assert_user_error = _helpers.assert_user_error
+from corpus import assert_user_error
 
 LINK = '<link name="{}"><inertial><mass value="0.1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4"/></inertial></link>'
 JOINT = ('<joint name="{}" type="revolute"><parent link="{}"/><child link="{}"/><axis xyz="0 0 1"/>'
