@@ -15,7 +15,7 @@ from gripkit.cli import main
 from gripkit.excitation import bandlimited_noise, multisine
 from gripkit.io import load
 from gripkit.sysid import identify
-from gripkit.zoo.amadeus import finger_force_model
+from gripkit.systems.amadeus.force_dynamics import finger_force_model
 
 SRC = str(Path(__file__).resolve().parents[2] / "src")
 

@@ -16,8 +16,8 @@ from ..progress import status
 __all__ = ["SECTIONS", "run_demo"]
 
 SECTIONS: dict[str, str] = {
-    "amadeus-identification": "gripkit.demos.amadeus_identification",
-    "amadeus-hand": "gripkit.demos.amadeus_hand",
+    "amadeus-identification": "gripkit.systems.amadeus.demo_identification",
+    "amadeus-hand": "gripkit.systems.amadeus.demo_hand",
     "ftg100": "gripkit.demos.ftg100",
     "tsfm": "gripkit.demos.tsfm",
     "dlr-hit": "gripkit.demos.dlr_hit",

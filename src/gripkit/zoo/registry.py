@@ -38,11 +38,11 @@ _ENTRIES: tuple[ZooEntry, ...] = (
     ZooEntry("amadeus-finger-force", "AMADEUS subsea hand",
              "Finger force dynamics, ARX [2 2 2] LS model of Table II (9 Hz filtered data), valve "
              "current (A) to fingertip force (N) at 200 Hz, two-sample valve delay",
-             _AMADEUS, "gripkit.zoo.amadeus:finger_force_model"),
+             _AMADEUS, "gripkit.systems.amadeus.force_dynamics:finger_force_model"),
     ZooEntry("amadeus-hand", "AMADEUS subsea hand",
              "Three-bellows finger (eqs 1-8), proportional valves, six-bridge force sensor with fusion "
              "(eqs 9-19, Table I), PVDF slip sensor, Table II force dynamics in SI units",
-             _AMADEUS, "gripkit.zoo.amadeus_hand:amadeus_hand"),
+             _AMADEUS, "gripkit.systems.amadeus.parameters:amadeus_hand"),
     ZooEntry("ftg100-actuated", "FemtoTools FT-G100 microgripper",
              "Actuated subsystem linearised at 70 V with the 80 um glass ball grasped (eqs 8-10): "
              "voltage (V) to tip displacement (m), M_a, K_fa, k0 identified in §III-B",

@@ -29,8 +29,10 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from ..errors import AccuracyWarning, DataError, IdentificationError, ModelError, UnidentifiableError
-from ..models.strain_gauge_sensor import StrainGaugeSensor, sensitivity_matrix, sensor_parameters
+from ...errors import (
+    AccuracyWarning, DataError, IdentificationError, ModelError, UnidentifiableError,
+)
+from .strain_gauge_sensor import StrainGaugeSensor, sensitivity_matrix, sensor_parameters
 
 __all__ = [
     "calibrate",
@@ -450,7 +452,7 @@ class ForceDynamics:
 
         ``plant`` is anything :meth:`gripkit.control.DiscretePlant.from_model` accepts; its output
         must be in N and its input is what ``u`` will hold (deviation from the operating point)."""
-        from ..control.finger_force import DiscretePlant
+        from ...control.rst import DiscretePlant
 
         p = DiscretePlant.from_model(plant)
         ss = p.to_state_space()

@@ -38,7 +38,7 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
-from ..errors import DataError, IdentificationError
+from ...errors import DataError, IdentificationError
 
 __all__ = [
     "SlipDetector",
@@ -320,7 +320,7 @@ class SlipDetector:
                  min_duration: float = 0.002, release: float = 0.5, hold: float = 0.05,
                  threshold: float | None = None, feature_window: float = 0.1,
                  speed_calibration: SpeedCalibration | None = None):
-        from ..signals.filters import butter_sos
+        from ...signals.filters import butter_sos
 
         if not (np.isfinite(fs) and fs > 0):
             raise DataError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")

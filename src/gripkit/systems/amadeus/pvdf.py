@@ -48,9 +48,9 @@ import numba
 import numpy as np
 from numba import prange
 
-from ..errors import DataError, SimulationError
-from ..params import Parameter, ParameterSet
-from ..sim.model import Model, Signal
+from ...errors import DataError, SimulationError
+from ...params import Parameter, ParameterSet
+from ...sim.model import Model, Signal
 
 __all__ = ["PVDFFilm", "pvdf_parameters", "StickSlipContact", "SlipTestbed", "contact_parameters",
            "pvdf_noise", "contact_step", "nonslip_grasp_inputs", "slip_onset_inputs"]

@@ -10,11 +10,11 @@ import math
 import numpy as np
 import pytest
 
-from gripkit.control import (DiscretePlant, GraspScenario, RSTController, design_rst, simulate_grasp,
-                             simulate_loop, step_metrics)
+from gripkit.control import DiscretePlant, RSTController, design_rst, simulate_loop
+from gripkit.systems.amadeus import GraspScenario, simulate_finger_grasp, step_metrics
 from gripkit.errors import ModelError
 from gripkit.sim import StateSpace
-from gripkit.zoo.amadeus_hand import TABLE2_A, TABLE2_B, force_plant
+from gripkit.systems.amadeus.parameters import TABLE2_A, TABLE2_B, force_plant
 
 RAW = DiscretePlant(TABLE2_A, TABLE2_B, 0.005)
 PLANT, _ = force_plant()
@@ -155,8 +155,8 @@ def test_integral_action_impossible_with_zero_at_one():
 
 @pytest.fixture(scope="module")
 def detector():
-    from gripkit.estimation import SlipDetector
-    from gripkit.models.pvdf import StickSlipContact, nonslip_grasp_inputs, pvdf_noise
+    from gripkit.systems.amadeus import SlipDetector
+    from gripkit.systems.amadeus.pvdf import StickSlipContact, nonslip_grasp_inputs, pvdf_noise
 
     rng = np.random.default_rng(8)
     c = StickSlipContact()
@@ -173,7 +173,7 @@ def test_grasp_respects_the_force_limit_and_arrests_slip(rst, detector, k_object
     rigid-plate model, is slower on a very soft object (300 N/m: 28 % of the loop gain), hence the
     looser hold tolerance there."""
     sc = GraspScenario(k_object=k_object, seed=3)
-    g = simulate_grasp(rst, PLANT, sc, detector=detector)
+    g = simulate_finger_grasp(rst, PLANT, sc, detector=detector)
     assert g.contact_time is not None and g.contact_time < 1.0
     assert g.max_force <= sc.force_limit
     hold = (g.t > 1.8) & (g.t < 2.2)

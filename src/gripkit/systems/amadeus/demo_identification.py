@@ -2,7 +2,7 @@
 repeated on simulated data.
 
 The "true finger" is the zoo plant (Table II ``[2 2 2]``, SI units, see
-:mod:`gripkit.zoo.amadeus`), driven by the paper's excitations S1 (multisine 1–10 Hz, 400 samples)
+:mod:`gripkit.systems.amadeus.force_dynamics`), driven by the paper's excitations S1 (multisine 1–10 Hz, 400 samples)
 and S2 (band-limited noise 0.3–10 Hz, 4000 samples) between 600 and 1100 mA, with white
 measurement noise on the force. Three ways of processing the data are compared:
 
@@ -50,12 +50,12 @@ def run(report, *, quick: bool = False) -> dict:
     """Add the section to ``report``; returns the summary numbers. The records are the paper's
     (400 and 4000 samples), so the section takes a few seconds once numba's RLS kernel is compiled
     (about 10 s the first time); ``quick`` changes nothing."""
-    from ..excitation import bandlimited_noise, multisine
-    from ..report import plots
-    from ..signals.filters import apply_sos
-    from ..sysid import arx, oe, rls
-    from ..zoo.amadeus import FORCE_SCALE, FS, TABLE_II, TABLE_III, reference, seed_checks
-    from ..zoo.amadeus import finger_force_model as build_plant
+    from ...excitation import bandlimited_noise, multisine
+    from ...report import plots
+    from ...signals.filters import apply_sos
+    from ...sysid import arx, oe, rls
+    from .force_dynamics import FORCE_SCALE, FS, TABLE_II, TABLE_III, reference, seed_checks
+    from .force_dynamics import finger_force_model as build_plant
 
     t_start = time.perf_counter()
     plant = build_plant()
@@ -226,7 +226,7 @@ def run(report, *, quick: bool = False) -> dict:
                "Recursive estimates with ±2σ bands and the true values (dashed).", name="amadeus-rls-convergence")
 
     # ---- consistency of the seed's statements ------------------------------------------------
-    from ..consistency import ConsistencyReport, check
+    from ...consistency import ConsistencyReport, check
 
     sec.findings(check(plant))
     sec.findings(ConsistencyReport(seed_checks(), "AMADEUS Tables II/III (§V-F statements)"))

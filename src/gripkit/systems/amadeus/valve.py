@@ -51,10 +51,10 @@ import numba
 import numpy as np
 from numba import prange
 
-from ..consistency import Finding, compare
-from ..errors import DataError, SimulationError
-from ..params import Parameter, ParameterSet
-from ..sim.model import Model, Signal
+from ...consistency import Finding, compare
+from ...errors import DataError, SimulationError
+from ...params import Parameter, ParameterSet
+from ...sim.model import Model, Signal
 
 __all__ = ["ProportionalValve", "valve_parameters", "valve_static", "pressure_to_force_plant"]
 
@@ -292,7 +292,7 @@ def pressure_to_force_plant(force_plant, valve: ProportionalValve):
     B(q) is divided by the valve's central slope k_v (the input becomes the static pressure
     demand in the linear region, as in the seed's Fig. 14). ``force_plant`` is anything
     :meth:`gripkit.control.DiscretePlant.from_model` accepts."""
-    from ..control.finger_force import DiscretePlant
+    from ...control.rst import DiscretePlant
 
     plant = DiscretePlant.from_model(force_plant)
     return DiscretePlant(plant.A, np.asarray(plant.B) / valve.gain, plant.dt, input_name="p_demand",

@@ -42,9 +42,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..consistency import Finding, compare, warn_inconsistent
-from ..errors import DataError, ModelError
-from ..params import Parameter, ParameterSet
+from ...consistency import Finding, compare, warn_inconsistent
+from ...errors import DataError, ModelError
+from ...params import Parameter, ParameterSet
 from .bellows_finger import BAR, BellowsFinger
 
 __all__ = ["AmadeusHand", "hand_parameters", "force_closure", "ForceClosure", "FINGER_AZIMUTHS"]

@@ -9,8 +9,8 @@ from hypothesis import strategies as st
 
 from gripkit.consistency import check
 from gripkit.errors import DataError, ModelError
-from gripkit.models.amadeus_hand import AmadeusHand, force_closure
-from gripkit.models.bellows_finger import BAR
+from gripkit.systems.amadeus.hand import AmadeusHand, force_closure
+from gripkit.systems.amadeus.bellows_finger import BAR
 
 HAND = AmadeusHand()
 

@@ -14,7 +14,7 @@ import time
 
 import numpy as np
 
-from ..progress import status
+from ...progress import status
 
 FS_PVDF = 2000.0
 
@@ -29,7 +29,7 @@ def _fig(*args, **kw):
 
 
 def _bending(report, z, rng, summary):
-    from ..models.bellows_finger import BAR, PRINCIPAL_DIRECTIONS
+    from .bellows_finger import BAR, PRINCIPAL_DIRECTIONS
 
     f, valve = z.finger, z.valve
     sec = report.section(
@@ -88,9 +88,10 @@ def _bending(report, z, rng, summary):
 
 
 def _fusion(report, z, rng, summary, quick):
-    from ..estimation import calibrate_force_sensor, estimate_force, fused_variance, implied_correlation
-    from ..models.strain_gauge_sensor import single_bridge_estimates
-    from ..zoo.amadeus_hand import TABLE_I
+    from . import calibrate_force_sensor, estimate_force
+    from ...estimation import fused_variance, implied_correlation
+    from .strain_gauge_sensor import single_bridge_estimates
+    from .parameters import TABLE_I
 
     s = z.sensor
     sec = report.section(
@@ -156,8 +157,8 @@ def _fusion(report, z, rng, summary, quick):
 
 
 def _slip(report, z, rng, summary, quick):
-    from ..estimation import SlipDetector, calibrate_speed, false_alarm_rate, spectral_features
-    from ..models.pvdf import (SlipTestbed, nonslip_grasp_inputs, pvdf_noise, slip_onset_inputs)
+    from . import SlipDetector, calibrate_speed, false_alarm_rate, spectral_features
+    from .pvdf import SlipTestbed, nonslip_grasp_inputs, pvdf_noise, slip_onset_inputs
 
     c = z.contact
     sec = report.section(
@@ -250,7 +251,8 @@ def _slip(report, z, rng, summary, quick):
 
 
 def _control(report, z, det, rng, summary, quick):
-    from ..control import GraspScenario, design_rst, simulate_grasp, simulate_loop, step_metrics
+    from . import GraspScenario, simulate_finger_grasp, step_metrics
+    from ...control import design_rst, simulate_loop
 
     p = z.plant
     sec = report.section(
@@ -302,7 +304,7 @@ def _control(report, z, det, rng, summary, quick):
     shown = None
     for k_obj in (500.0, 2000.0, math.inf):
         sc = GraspScenario(k_object=k_obj, seed=int(rng.integers(1 << 31)))
-        g = simulate_grasp(c, p, sc, valve=z.valve, sensor=z.sensor, contact=z.contact, detector=det)
+        g = simulate_finger_grasp(c, p, sc, valve=z.valve, sensor=z.sensor, contact=z.contact, detector=det)
         slip_t = g.t[g.slipping > 0]
         rows.append(["rigid" if math.isinf(k_obj) else f"{k_obj:.0f}", g.contact_time, g.max_force,
                      sc.force_limit, len([a for a in g.alarms if a > (g.contact_time or 0) + sc.slip_blanking]),
@@ -337,8 +339,8 @@ def _control(report, z, det, rng, summary, quick):
 
 
 def run(report, *, quick: bool = False) -> dict:
-    from ..consistency import check
-    from ..zoo.amadeus_hand import amadeus_hand
+    from ...consistency import check
+    from .parameters import amadeus_hand
 
     rng = np.random.default_rng(20240611)
     z = amadeus_hand(check=False)

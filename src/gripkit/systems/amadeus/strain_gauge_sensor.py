@@ -22,7 +22,7 @@ of the measured signal", so each reading carries noise of standard deviation
 √(σ²_Nj R_j² + σ₀_j²): a signal-proportional part with normalised variance σ²_Nj plus an electronics
 floor σ₀_j (Fig. 16 shows noise with no load). The seed's K_j, φ, l and per-gauge noise are not
 printed; the zoo values are assumed and labelled so, except the normalised variances, which are
-Table I's (see :mod:`gripkit.zoo.amadeus_hand`).
+Table I's (see :mod:`gripkit.systems.amadeus.parameters`).
 """
 
 from __future__ import annotations
@@ -31,9 +31,9 @@ import math
 
 import numpy as np
 
-from ..consistency import Finding
-from ..errors import DataError, ModelError
-from ..params import Parameter, ParameterSet
+from ...consistency import Finding
+from ...errors import DataError, ModelError
+from ...params import Parameter, ParameterSet
 
 __all__ = ["StrainGaugeSensor", "sensor_parameters", "sensitivity_matrix", "single_bridge_estimates"]
 

@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 from gripkit.errors import DataError
 from gripkit.estimation import (fuse, fuse_proportional, fuse_update, fused_variance, implied_correlation,
                                 normalised_variances, proportional_variance)
-from gripkit.zoo.amadeus_hand import TABLE_I, table1_findings
+from gripkit.systems.amadeus.parameters import TABLE_I, table1_findings
 
 
 def _sig3(x):

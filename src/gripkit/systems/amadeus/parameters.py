@@ -3,18 +3,18 @@ force dynamics (``000_8f66dcc7ab06470c.txt``).
 
 :func:`amadeus_hand` builds :class:`AmadeusHandSystem`, which holds
 
-* ``finger`` — :class:`~gripkit.models.bellows_finger.BellowsFinger` (§II-A, §III, eqs 1–8),
-* ``valve`` — :class:`~gripkit.models.valve.ProportionalValve` (§II-D, Fig. 5, Fig. 15),
-* ``sensor`` — :class:`~gripkit.models.strain_gauge_sensor.StrainGaugeSensor` (§IV-A, eqs 9–19,
+* ``finger`` — :class:`~gripkit.systems.amadeus.bellows_finger.BellowsFinger` (§II-A, §III, eqs 1–8),
+* ``valve`` — :class:`~gripkit.systems.amadeus.valve.ProportionalValve` (§II-D, Fig. 5, Fig. 15),
+* ``sensor`` — :class:`~gripkit.systems.amadeus.strain_gauge_sensor.StrainGaugeSensor` (§IV-A, eqs 9–19,
   with Table I's measured normalised variances),
-* ``hand`` — :class:`~gripkit.models.amadeus_hand.AmadeusHand` (§II-B, §II-C),
-* ``contact`` — :class:`~gripkit.models.pvdf.StickSlipContact` with the PVDF film (§IV-B),
+* ``hand`` — :class:`~gripkit.systems.amadeus.hand.AmadeusHand` (§II-B, §II-C),
+* ``contact`` — :class:`~gripkit.systems.amadeus.pvdf.StickSlipContact` with the PVDF film (§IV-B),
 * ``plant`` — the Table II ``[2 2 2]`` force model in SI units (valve current deviation, A → N) and
   ``plant_raw`` in the seed's units,
 
 and the seed's consistency checks (Table I, Fig. 2(c) against the models).
 
-Force model units: see :mod:`gripkit.zoo.amadeus` — the Table II coefficients are in force-sensor
+Force model units: see :mod:`gripkit.systems.amadeus.force_dynamics` — the Table II coefficients are in force-sensor
 units per mA; gripkit's SI plant (A → N) scales them with ``FORCE_SCALE`` = 0.0250 N per unit
 (assumed: the 500 mA valve span moves the fingertip force over its 15.45 N peak, Fig. 2(c)).
 """
@@ -26,9 +26,9 @@ import math
 
 import numpy as np
 
-from ..consistency import Finding, compare, warn_inconsistent
-from ..params import Parameter, ParameterSet
-from .amadeus import PEAK_FORCE
+from ...consistency import Finding, compare, warn_inconsistent
+from ...params import Parameter, ParameterSet
+from .force_dynamics import PEAK_FORCE
 
 __all__ = ["AmadeusHandSystem", "amadeus_hand", "force_plant", "table2_plant", "TABLE_I", "table1_findings"]
 
@@ -49,7 +49,7 @@ FS = 200.0
 def table2_plant():
     """The ``[2 2 2]`` model in the seed's units (mA → force-sensor units), as a
     :class:`~gripkit.control.DiscretePlant`."""
-    from ..control.finger_force import DiscretePlant
+    from ...control.rst import DiscretePlant
 
     return DiscretePlant(TABLE2_A, TABLE2_B, 1.0 / FS, input_name="i", input_unit="mA", output_name="F",
                          output_unit="force units", source=f"{_SEED} Table II [2 2 2] (S_1, 9 Hz filter)")
@@ -57,13 +57,13 @@ def table2_plant():
 
 def force_plant() -> tuple:
     """(plant in SI (A → N), force_scale N/unit): the zoo model ``amadeus-finger-force``
-    (:func:`gripkit.zoo.amadeus.finger_force_model`) as a DiscretePlant, and its force scale."""
-    from ..control.finger_force import DiscretePlant
-    from .amadeus import FORCE_SCALE, finger_force_model
+    (:func:`gripkit.systems.amadeus.force_dynamics.finger_force_model`) as a DiscretePlant, and its force scale."""
+    from ...control.rst import DiscretePlant
+    from .force_dynamics import FORCE_SCALE, finger_force_model
 
     m = finger_force_model().model
     plant = DiscretePlant(m.A, m.B, m.dt, input_name="i", input_unit="A", output_name="F", output_unit="N",
-                          source="gripkit.zoo.amadeus.finger_force_model (Table II [2 2 2] x force_scale)")
+                          source="gripkit.systems.amadeus.force_dynamics.finger_force_model (Table II [2 2 2] x force_scale)")
     return plant, FORCE_SCALE
 
 
@@ -75,7 +75,7 @@ def table1_findings() -> list[Finding]:
     """Table I checked: the theoretical column from eq 18 (generalised) of the measured single
     variances, and the measured fused variances against that theory (with the correlation between
     combinations that would explain the excess)."""
-    from ..estimation.fusion import fused_variance, implied_correlation
+    from ...estimation.fusion import fused_variance, implied_correlation
 
     a, th = TABLE_I["actual"], TABLE_I["theoretical"]
     combos = {"e12": ("e1", "e2"), "e23": ("e2", "e3"), "e123": ("e1", "e2", "e3")}
@@ -115,11 +115,11 @@ class AmadeusHandSystem:
                    "force sensor (eqs 9-19), PVDF slip sensor, Table II force dynamics")
 
     def __init__(self, *, check: bool = True):
-        from ..models.amadeus_hand import AmadeusHand
-        from ..models.bellows_finger import BellowsFinger
-        from ..models.pvdf import StickSlipContact
-        from ..models.strain_gauge_sensor import StrainGaugeSensor
-        from ..models.valve import ProportionalValve
+        from .hand import AmadeusHand
+        from .bellows_finger import BellowsFinger
+        from .pvdf import StickSlipContact
+        from .strain_gauge_sensor import StrainGaugeSensor
+        from .valve import ProportionalValve
 
         self.finger = BellowsFinger(check=False)
         self.valve = ProportionalValve(check=False)

@@ -74,14 +74,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..consistency import Finding, compare, warn_inconsistent
-from ..errors import DataError, ModelError, ParameterError
-from ..params import Parameter, ParameterSet
+from ...consistency import Finding, compare, warn_inconsistent
+from ...errors import DataError, ModelError, ParameterError
+from ...params import Parameter, ParameterSet
 
 __all__ = [
     "BellowsFinger",
     "BendingState",
-    "finger_parameters",
+    "bellows_parameters",
     "calibrate_bending_stiffness",
     "TUBE_PUSH_ANGLES",
     "PRINCIPAL_DIRECTIONS",
@@ -98,7 +98,7 @@ PRINCIPAL_DIRECTIONS = np.deg2rad([0.0, 60.0, 120.0, 180.0, 240.0, 300.0])
 _SIN60 = math.sqrt(3.0) / 2.0
 
 
-def finger_parameters(*, pcd: float = 0.030, tube_area: float | None = None, length: float = 0.125,
+def bellows_parameters(*, pcd: float = 0.030, tube_area: float | None = None, length: float = 0.125,
                       bending_stiffness: float | None = None, tip_length: float = 0.035,
                       p_min: float = 7.5 * BAR, p_max: float = 30.0 * BAR, p_operating: float = 12.0 * BAR,
                       max_deflection: float = 0.020, source_k: str = "") -> ParameterSet:
@@ -227,7 +227,7 @@ class BellowsFinger:
     description = "AMADEUS three-bellows continuum finger: static bending model (eqs 1-8)"
 
     def __init__(self, parameters: ParameterSet | None = None, *, check: bool = True, **kw):
-        self.parameters = parameters if parameters is not None else finger_parameters(**kw)
+        self.parameters = parameters if parameters is not None else bellows_parameters(**kw)
         p = self.parameters
         if p.value("p_min") >= p.value("p_max"):
             raise ParameterError(f"p_min = {p.value('p_min') / BAR:g} bar must be below p_max = "
