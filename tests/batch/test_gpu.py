@@ -10,7 +10,7 @@ import textwrap
 import numpy as np
 import pytest
 
-from gripkit.batch.grasp_tsfm import METRICS, tsfm_grasp_batch
+from gripkit.systems.tsfm.grasp_batch import METRICS, tsfm_grasp_batch
 
 JOBS = dict(k_e=[72.5, 800.0], w=[396e-6, 394e-6], offset=[0.0, 1e-6], approach_speed=[1e-3, 1.5e-3],
             noise_std=[2e-6, 1e-6])
@@ -19,8 +19,8 @@ DUR = 0.006   # 120 samples: contact after ~40, detection, hold, the start of th
 SCRIPT = textwrap.dedent(f"""
     import json, warnings
     warnings.simplefilter("ignore")
-    from gripkit.batch.grasp_tsfm import tsfm_grasp_batch
-    from gripkit.batch.gpu import cuda_available
+    from gripkit.systems.tsfm.grasp_batch import tsfm_grasp_batch
+    from gripkit.systems.tsfm.grasp_gpu import cuda_available
     assert cuda_available()            # the simulator stands in for a device
     res = tsfm_grasp_batch(backend="cuda", duration={DUR}, **{JOBS!r})
     print(json.dumps({{k: [None if v != v else v for v in map(float, res[k])] for k in {list(METRICS)!r}}}))
@@ -55,7 +55,7 @@ def _nvvm():
 def test_the_grasp_kernel_compiles_to_ptx():
     """Every function the GPU kernel calls (grasp step, gripper step, hybrid contact step,
     Bouc-Wen, detector, estimator, noise) compiles for the device: no allocation, no object."""
-    from gripkit.batch.gpu import compile_ptx
+    from gripkit.systems.tsfm.grasp_gpu import compile_ptx
 
     ptx = compile_ptx((8, 0))
     assert ".entry" in ptx and "_kernel_py" in ptx

@@ -39,7 +39,7 @@ DEFAULT_POPULATION = {
     "approach_speed": {"uniform": ["1 mm/s", "2 mm/s"]},
     "noise_std": {"uniform": ["0.5 uN", "3 uN"]},
 }
-#: the controller (:data:`gripkit.batch.grasp_tsfm.FAST_GRASP`, 200 µN) and the pass criteria
+#: the controller (:data:`gripkit.systems.tsfm.grasp_batch.FAST_GRASP`, 200 µN) and the pass criteria
 DEFAULT_SETTINGS = {"duration": 0.15, "grip_force": "200 uN", "damage_force": "250 uN",
                     "lost_displacement": "10 um", "band": 0.05}
 

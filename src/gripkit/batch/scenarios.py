@@ -18,7 +18,7 @@ __all__ = ["SCENARIOS", "resolve", "step_response", "step_metrics", "ftg100_gras
 
 SCENARIOS: dict[str, str] = {
     "step-response": "gripkit.batch.scenarios:step_response",
-    "tsfm-grasp": "gripkit.batch.grasp_tsfm:tsfm_grasp",
+    "tsfm-grasp": "gripkit.systems.tsfm.grasp_batch:tsfm_grasp",
     "ftg100-grasp": "gripkit.batch.scenarios:ftg100_grasp",
 }
 

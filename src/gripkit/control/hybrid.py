@@ -46,9 +46,10 @@ import numba
 import numpy as np
 
 from ..errors import ConfigError, SimulationError
+from ..models.ftg100 import advance_plant, plant_outputs
 from ..params import ParameterSet
 from ..signals.trajectory import Trajectory
-from ..models.ftg100 import advance_plant, plant_outputs
+from ..sim.noise import normal_draw
 from .pid import PID, PID_NPARAM, pid_step, pid_transfer
 
 __all__ = ["HybridForcePosition", "HybridController", "hybrid_step", "simulate_grasp", "grasp_batch",
@@ -287,26 +288,6 @@ class HybridController:
 # ------------------------------------------------------------------------------------------------
 
 @numba.njit(cache=True)
-def _uniform(rng):  # pragma: no cover - compiled
-    """Uniform in [0, 1) from a splitmix64 stream held in rng[0] (uint64): deterministic per seed,
-    allocation free, independent of thread scheduling (unlike numpy's global state in prange)."""
-    rng[0] += np.uint64(0x9E3779B97F4A7C15)
-    z = rng[0]
-    z = (z ^ (z >> np.uint64(30))) * np.uint64(0xBF58476D1CE4E5B9)
-    z = (z ^ (z >> np.uint64(27))) * np.uint64(0x94D049BB133111EB)
-    z = z ^ (z >> np.uint64(31))
-    return (z >> np.uint64(11)) * (1.0 / 9007199254740992.0)
-
-
-@numba.njit(cache=True)
-def _randn(rng):  # pragma: no cover - compiled
-    """Standard normal deviate (Box-Muller on two :func:`_uniform` draws)."""
-    u1 = 1.0 - _uniform(rng)  # (0, 1]
-    u2 = _uniform(rng)
-    return math.sqrt(-2.0 * math.log(u1)) * math.cos(2.0 * math.pi * u2)
-
-
-@numba.njit(cache=True)
 def _grasp_one(th, cp, fprof, sig_f, sig_x, seed, dt, substeps, band, damage, n_steps, rec,
                traj, met):  # pragma: no cover - compiled
     """One closed-loop grasp from rest; writes the trajectory (if ``rec``) and the metrics.
@@ -335,8 +316,8 @@ def _grasp_one(th, cp, fprof, sig_f, sig_x, seed, dt, substeps, band, damage, n_
     tail = n_steps - max(1, n_steps // 10)
     for n in range(n_steps):
         plant_outputs(th, s, mode, o)
-        fm = o[3] + sig_f * _randn(rng)
-        xm = o[0] + sig_x * _randn(rng)
+        fm = o[3] + sig_f * normal_draw(rng)
+        xm = o[0] + sig_x * normal_draw(rng)
         V = hybrid_step(cp, cs, xm, fm, fprof[n] if varying else fcmd)
         if rec:
             traj[n, 0] = n * dt

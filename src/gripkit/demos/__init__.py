@@ -19,7 +19,7 @@ SECTIONS: dict[str, str] = {
     "amadeus-identification": "gripkit.systems.amadeus.demo_identification",
     "amadeus-hand": "gripkit.systems.amadeus.demo_hand",
     "ftg100": "gripkit.demos.ftg100",
-    "tsfm": "gripkit.demos.tsfm",
+    "tsfm": "gripkit.systems.tsfm.demo",
     "dlr-hit": "gripkit.demos.dlr_hit",
     "batch-robustness": "gripkit.demos.batch_robustness",
 }

@@ -8,7 +8,7 @@ from __future__ import annotations
 import time
 from dataclasses import asdict
 
-from ..batch.grasp_tsfm import FAST_GRASP
+from ..systems.tsfm.grasp_batch import FAST_GRASP
 
 
 def run(report, *, quick: bool = False) -> dict:

@@ -15,8 +15,5 @@ from .fusion import fused_variance as fused_variance
 from .fusion import implied_correlation as implied_correlation
 from .fusion import normalised_variances as normalised_variances
 from .fusion import proportional_variance as proportional_variance
-from .micropart import MicropartEstimate as MicropartEstimate
-from .micropart import estimate_micropart as estimate_micropart
-from .tip_position import TipPositionEstimator as TipPositionEstimator
 from .friction_adaptation import FrictionAdapter as FrictionAdapter
 from .friction_adaptation import adapt_finger_friction as adapt_finger_friction

@@ -71,7 +71,7 @@ def _piezo(params, options):
 
 
 def _finger(params, options):
-    from ..zoo import tsfm
+    from ..systems.tsfm import parameters as tsfm
 
     side = {"tsfm-left": "left", "tsfm-right": "right"}.get(options.get("zoo", "tsfm-left"))
     if side is None:
@@ -89,7 +89,7 @@ def _finger_contact(params, options):
 
 
 def _gripper(params, options):
-    from ..zoo import tsfm
+    from ..systems.tsfm import parameters as tsfm
 
     return tsfm.gripper(check=False)
 

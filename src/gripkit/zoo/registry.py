@@ -56,11 +56,11 @@ _ENTRIES: tuple[ZooEntry, ...] = (
              "readout voltage through the object stiffness k0",
              _FTG, "gripkit.zoo.ftg100:coupled_model"),
     ZooEntry("tsfm-left", "TSFM piezo microgripper", "Left finger, Table II: Bouc-Wen + D(s) actuator, lever, force "
-             "sensor (8.52 kHz, ζ = 0.006), eqs 3-13", _TSFM, "gripkit.zoo.tsfm:left_finger"),
+             "sensor (8.52 kHz, ζ = 0.006), eqs 3-13", _TSFM, "gripkit.systems.tsfm.parameters:left_finger"),
     ZooEntry("tsfm-right", "TSFM piezo microgripper", "Right finger, Table II (as tsfm-left)", _TSFM,
-             "gripkit.zoo.tsfm:right_finger"),
+             "gripkit.systems.tsfm.parameters:right_finger"),
     ZooEntry("tsfm-gripper", "TSFM piezo microgripper", "Both fingers, 400 µm gap, a 300 µm micropart of Table III "
-             "stiffness; hybrid contacts", _TSFM, "gripkit.zoo.tsfm:gripper"),
+             "stiffness; hybrid contacts", _TSFM, "gripkit.systems.tsfm.parameters:gripper"),
     ZooEntry("dlr-hit-finger", "DLR/HIT Hand II",
              "Modular finger of ch. 7: PWM → BLDC motor (eq 5.10) → belts and harmonic drive → "
              "Appendix G friction with stick-slip → coupled Newton-Euler dynamics",

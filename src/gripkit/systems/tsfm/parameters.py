@@ -30,11 +30,11 @@ import dataclasses
 
 import numpy as np
 
-from ..consistency import Finding, compare
-from ..models.tsfm import (TSFMFinger, TSFMGripper, finger_parameters, micropart_parameters,
-                           sensor_from_modal)
-from ..params import ParameterSet
-from ..signals.trajectory import Trajectory
+from ...consistency import Finding, compare
+from .end_effector import sensor_parameters
+from .gripper import TSFMFinger, TSFMGripper, finger_parameter_set, micropart_parameters
+from ...params import ParameterSet
+from ...signals.trajectory import Trajectory
 
 __all__ = ["TABLE_II", "REFERENCE", "ASSUMED_LENGTHS", "TABLE_III", "left_finger", "right_finger", "gripper",
            "table_ii", "finger", "hysteresis_experiment", "step_experiment", "compliance_experiment",
@@ -86,7 +86,7 @@ def table_ii(side: str = "left") -> ParameterSet:
     v = TABLE_II[side]
     sources = {n: f"{_T2}, {side} finger" for n in v}
     sources.update(_LEN_SRC)
-    return finger_parameters(**v, **ASSUMED_LENGTHS, sources=sources, name=f"tsfm-{side} (Table II)")
+    return finger_parameter_set(**v, **ASSUMED_LENGTHS, sources=sources, name=f"tsfm-{side} (Table II)")
 
 
 def finger(side: str = "left", *, as_printed: bool = False, check: bool = True) -> TSFMFinger:
@@ -97,7 +97,8 @@ def finger(side: str = "left", *, as_printed: bool = False, check: bool = True) 
     if not as_printed:
         k = printed.value("k_s")
         f0, z = REFERENCE["sensor_f0_hz"][0], REFERENCE["sensor_zeta"][0]
-        m, b = sensor_from_modal(k, f0, z)
+        sensor = sensor_parameters(f0, z, k_s=k)
+        m, b = sensor.value("m_s"), sensor.value("b_s")
         params = ParameterSet([
             p if p.name not in ("m_s", "b_s") else p.with_value(
                 m if p.name == "m_s" else b,
@@ -185,7 +186,7 @@ def compliance_experiment(finger: TSFMFinger, max_force: float = 1e-3, *, fs: fl
     """§IV-C3 / Fig. 11: the FemtoTools probe (resolution 0.4 µN) pushes on the tip B with a slow
     force ramp, no voltage; the actuator (eq 4 with F_A = F, M_A = L_r F) responds dynamically,
     the laser (20 nm) reads y_B. Channels F (N, measured), y_B (m)."""
-    from ..models.piezo import PiezoActuator
+    from ...models.piezo import PiezoActuator
 
     v = finger.values()
     act = PiezoActuator(ParameterSet([finger.parameters[n] for n in ("d_p", "s_p", "lam", "beta", "gamma", "a", "b",
@@ -205,7 +206,7 @@ def free_vibration_experiment(finger: TSFMFinger, preload: float = 150e-6, *, fs
     """§IV-B / Fig. 8: the sensor alone (before integration), preloaded with ``preload`` N and
     released at t = ``pre``; the force it reads, k_s × deflection, with white noise of ``noise``
     times the preload, for ``duration`` s after the release. Channel F (N)."""
-    from ..models.mass_spring_damper import MassSpringDamper
+    from ...models.mass_spring_damper import MassSpringDamper
 
     v = finger.values()
     msd = MassSpringDamper(m=v["m_s"], b=v["b_s"], k=v["k_s"], check=False)

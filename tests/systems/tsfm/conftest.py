@@ -4,7 +4,7 @@ import warnings
 
 import pytest
 
-from gripkit.zoo import tsfm as z
+from gripkit.systems.tsfm import parameters as z
 
 
 @pytest.fixture(scope="module")

@@ -7,7 +7,7 @@ movement of the finger in contact with the micropart if the other finger has not
 contact yet." The strategy, per finger, sample by sample at 20 kHz:
 
 1. **approach** under position control: the reference closes at ``approach_speed``; the position
-   fed back is the eq-11 estimate (:class:`~gripkit.estimation.TipPositionEstimator`) from the
+   fed back is the eq-11 estimate (:class:`~gripkit.systems.tsfm.TipPositionEstimator`) from the
    voltage and the measured force;
 2. **hold**: once the finger's force exceeds the threshold (5 µN, :class:`ContactDetector`) it
    holds the position it had at contact — it does not push — until the other finger touches;
@@ -23,7 +23,7 @@ held by substrate friction it pushes the part away.
 
 :func:`grasp_step` is the numba step (detectors, estimators and controller of both fingers),
 used by :class:`TwoFingerGrasp` for a real loop and by :func:`simulate_two_finger_grasp`, which
-closes the loop on the hybrid two-finger model :class:`~gripkit.models.tsfm.TSFMGripper`.
+closes the loop on the hybrid two-finger model :class:`~gripkit.systems.tsfm.gripper.TSFMGripper`.
 """
 
 from __future__ import annotations
@@ -34,13 +34,13 @@ from dataclasses import asdict, dataclass, field
 import numba
 import numpy as np
 
-from ..errors import DataError, IdentificationError, SimulationError
-from ..estimation.contact_detection import detector_step
-from ..estimation.micropart import MicropartEstimate, estimate_micropart
-from ..estimation.tip_position import estimator_arrays, estimator_step
-from ..models.end_effector import lever_coefficients
-from ..models.tsfm import TSFMGripper, gripper_advance, gripper_measure, gripper_work
-from ..signals.trajectory import Trajectory
+from ...errors import DataError, IdentificationError, SimulationError
+from ...estimation.contact_detection import detector_step
+from .micropart import MicropartEstimate, estimate_micropart
+from .tip_position import estimator_arrays, estimator_step
+from .end_effector import lever_coefficients
+from .gripper import TSFMGripper, gripper_advance, gripper_measure, gripper_work
+from ...signals.trajectory import Trajectory
 
 __all__ = ["GraspSettings", "TwoFingerGrasp", "TwoFingerGraspResult", "simulate_two_finger_grasp", "grasp_step"]
 
@@ -123,7 +123,7 @@ def grasp_step(F1, F2, det, buf, est, bw, Phi, Gam, cy, cs, cp, xt, out):  # pra
         y = out[i, 1]
         if cs[i, _PHASE] == SQUEEZE:
             # (conditional expressions, not builtin max/min: numba.cuda cannot compile those in an
-            # @njit callee, and gripkit.batch.gpu runs this step on the GPU; same values)
+            # @njit callee, and gripkit.systems.tsfm.grasp_gpu runs this step on the GPU; same values)
             step = (cp[3] - cs[i, _FREF]) * dt / (dt if dt > cp[4] else cp[4])
             if abs(cp[3] - cs[i, _FREF]) <= abs(step):
                 cs[i, _FREF] = cp[3]

@@ -1,5 +1,5 @@
 """The TSFM grasp batch on a CUDA GPU (optional): the same scalar kernel as the CPU path,
-:func:`gripkit.batch.grasp_tsfm._grasp_core`, compiled by ``numba.cuda`` — one grasp per thread.
+:func:`gripkit.systems.tsfm.grasp_kernels._grasp_core`, compiled by ``numba.cuda`` — one grasp per thread.
 
 numba compiles an ``@njit`` function called from a CUDA kernel for the device (with every njit
 function it calls: ``grasp_step``, ``gripper_advance``, ``pwa_step``, ``bouc_wen_advance``, the
@@ -7,7 +7,7 @@ detector and estimator steps), so there is one source for both targets. The core
 nothing: every work array (controller, detector, estimator and finger states, the part's contact-
 mode matrices) is a slice, per thread, of arrays allocated on the device before the launch. The
 per-job contact-mode ZOH matrices (matrix exponentials, which allocate) are computed on the CPU
-by the numba kernel :func:`~gripkit.batch.grasp_tsfm._setup_jobs` (≈ 40 µs per job and core) and
+by the numba kernel :func:`~gripkit.systems.tsfm.grasp_kernels._setup_jobs` (≈ 40 µs per job and core) and
 copied to the device with the jobs, in launches of at most ``batch`` jobs.
 
 Use: ``tsfm_grasp_batch(..., backend="cuda")`` or ``backend = "cuda"`` in a sweep's
@@ -23,9 +23,9 @@ from __future__ import annotations
 import numpy as np
 from numba import cuda
 
-from ..errors import ConfigError
-from ..sim.hybrid import MAX_EVENTS_PER_STEP
-from .grasp_tsfm import _grasp_core, _setup_jobs
+from ...errors import ConfigError
+from ...sim.hybrid import MAX_EVENTS_PER_STEP
+from .grasp_kernels import _default_gripper, _grasp_core, _setup_jobs, _template
 
 __all__ = ["cuda_available", "run_cuda", "compile_ptx"]
 
@@ -106,8 +106,6 @@ def compile_ptx(cc: tuple[int, int] = (8, 0)) -> str:
     import numba
     from numba import typeof
     from numba.cuda import dispatcher
-
-    from .grasp_tsfm import _default_gripper, _template
 
     tpl = _template(_default_gripper(), 5e-5, None)
     f8, i8 = numba.float64, numba.int64

@@ -29,15 +29,17 @@ F_m = k_s (y_D − y_C); in statics F_m = F_g, dynamically it also shows the 8.5
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..params import Parameter
-from ..sim.linear import StateSpace
+from ...errors import DataError
+from ...params import Parameter, ParameterSet
+from ...sim.linear import StateSpace
 
 __all__ = ["LeverCoefficients", "lever_coefficients", "sensor_state_space", "sensor_transfer_functions",
-           "end_effector_parameters"]
+           "end_effector_parameters", "sensor_parameters"]
 
 
 @dataclass(frozen=True)
@@ -91,3 +93,47 @@ def end_effector_parameters(m_s: float, b_s: float, k_s: float, L_r: float, L_s:
                   source=length_source or source, display_unit="mm"),
     ]
 
+
+def sensor_parameters(f0_hz: float, zeta: float, *, k_s: float | None = None, m_s: float | None = None,
+                      b_s: float | None = None, f0_std: float = 0.0, zeta_std: float = 0.0,
+                      known_std: float = 0.0, source: str = "identified from free vibration") -> ParameterSet:
+    """m_s, b_s, k_s of the force sensor (eq 8) from its natural frequency ``f0_hz``, damping ratio
+    ``zeta`` and exactly one of them known (with its std ``known_std``), §IV-B:
+
+        k_s = m_s ω₀²,   b_s = 2ζ √(k_s m_s) = 2ζ m_s ω₀,   ω₀ = 2π f0.
+
+    First-order error propagation gives the std of the other two (independent errors assumed)."""
+    given = {k: v for k, v in (("k_s", k_s), ("m_s", m_s), ("b_s", b_s)) if v is not None}
+    if len(given) != 1:
+        raise DataError(f"give exactly one of k_s, m_s, b_s (found {sorted(given) or 'none'})")
+    if not (f0_hz > 0 and (zeta > 0 or (zeta == 0 and b_s is None))):
+        raise DataError(f"f0 must be positive and ζ positive (or 0 when b_s is not the given one), "
+                        f"found f0 = {f0_hz!r} Hz, ζ = {zeta!r}")
+    w = 2.0 * math.pi * f0_hz
+    rw, rz = f0_std / f0_hz, (zeta_std / zeta if zeta > 0 else 0.0)
+    (name, val), = given.items()
+    rk = known_std / val
+    if name == "k_s":
+        k = val
+        m = k / w**2
+        b = 2.0 * zeta * k / w
+        sk, sm, sb = known_std, m * math.hypot(rk, 2 * rw), b * math.sqrt(rz**2 + rk**2 + rw**2)
+    elif name == "m_s":
+        m = val
+        k = m * w**2
+        b = 2.0 * zeta * m * w
+        sm, sk, sb = known_std, k * math.hypot(rk, 2 * rw), b * math.sqrt(rz**2 + rk**2 + rw**2)
+    else:
+        b = val
+        m = b / (2.0 * zeta * w)
+        k = m * w**2
+        sb, sm, sk = known_std, m * math.sqrt(rk**2 + rz**2 + rw**2), k * math.sqrt(rk**2 + rz**2 + rw**2)
+    src = f"{source} (f0 = {f0_hz:.6g} Hz, ζ = {zeta:.4g}, {name} given)"
+    return ParameterSet([
+        Parameter("m_s", m, "kg", "force-sensor effective mass (eq 8)", (0.0, None), source=src if name != "m_s" else "given",
+                  std=sm, display_unit="mg"),
+        Parameter("b_s", b, "N*s/m", "force-sensor damping (eq 8)", (0.0, None), source=src if name != "b_s" else "given",
+                  std=sb),
+        Parameter("k_s", k, "N/m", "force-sensor stiffness (eq 8)", (0.0, None), source=src if name != "k_s" else "given",
+                  std=sk),
+    ], "force-sensor")

@@ -10,11 +10,11 @@ import pytest
 from gripkit import Trajectory
 from gripkit.cli import main
 from gripkit.errors import DataError
-from gripkit.models.tsfm import sensor_from_modal
-from gripkit.sysid.bouc_wen import (identify_actuator_dynamics, identify_bouc_wen, identify_compliance, loop_error,
-                                    sensor_parameters, to_tip_a)
+from gripkit.sysid.bouc_wen import identify_actuator_dynamics, identify_bouc_wen, loop_error
+from gripkit.systems.tsfm.identification import identify_compliance, to_tip_a
+from gripkit.systems.tsfm.end_effector import sensor_parameters
 from gripkit.sysid.modal import free_vibration
-from gripkit.zoo import tsfm as z
+from gripkit.systems.tsfm import parameters as z
 
 AMPS = (100.0, 60.0, 30.0)
 
@@ -109,7 +109,8 @@ def test_modal_std_agrees_with_the_spread(ringing):
 
 def test_sensor_parameters_from_f0_zeta_and_k():
     """§IV-B: m_s = k_s/(2π f0)², b_s = 2ζ√(k_s m_s), whichever one is given."""
-    m, b = sensor_from_modal(128.0, 8520.0, 0.006)
+    m = 128.0 / (2 * math.pi * 8520.0) ** 2
+    b = 2 * 0.006 * math.sqrt(128.0 * m)
     ps = sensor_parameters(8520.0, 0.006, k_s=128.0, f0_std=1.0, zeta_std=1e-4)
     assert ps.value("m_s") == pytest.approx(m) and ps.value("b_s") == pytest.approx(b)
     assert ps["m_s"].std == pytest.approx(m * 2 / 8520.0)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from gripkit.models.hysteresis import bouc_wen_response
-from gripkit.zoo import tsfm as z
+from gripkit.systems.tsfm import parameters as z
 
 FS = 20000.0
 

@@ -28,8 +28,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from ..errors import DataError, IdentificationError
-from .contact_detection import ContactDetector
+from ...errors import DataError, IdentificationError
+from ...estimation.contact_detection import ContactDetector
 
 __all__ = ["MicropartEstimate", "estimate_micropart"]
 

@@ -52,19 +52,21 @@ import numba
 import numpy as np
 from numba import prange
 
-from ..consistency import Finding, compare
-from ..errors import ModelError, ParameterError
-from ..params import Parameter, ParameterSet
-from ..sim.hybrid import DEFAULT_LEVELS, MAX_EVENTS_PER_STEP, Guard, HybridSystem, Mode, pwa_output, pwa_step
-from ..sim.integrators import zoh_levels
-from ..sim.linear import StateSpace
-from ..sim.model import Model, Signal
-from .end_effector import end_effector_parameters, lever_coefficients, sensor_state_space
-from .hysteresis import bouc_wen_advance
-from .piezo import actuator_parameters, actuator_state_space, lti_modes, run_bw_lti
+from ...consistency import Finding, compare
+from ...errors import ModelError, ParameterError
+from ...params import Parameter, ParameterSet
+from ...sim.hybrid import (
+    DEFAULT_LEVELS, MAX_EVENTS_PER_STEP, Guard, HybridSystem, Mode, pwa_output, pwa_step,
+)
+from ...sim.integrators import zoh_levels
+from ...sim.linear import StateSpace
+from ...sim.model import Model, Signal
+from .end_effector import end_effector_parameters, lever_coefficients, sensor_parameters, sensor_state_space
+from ...models.hysteresis import bouc_wen_advance
+from ...models.piezo import actuator_parameters, actuator_state_space, lti_modes, run_bw_lti
 
-__all__ = ["FINGER_NAMES", "finger_parameters", "finger_state_space", "finger_minimal_state_space",
-           "finger_coefficients", "finger_transfer_functions", "finger_hybrid", "sensor_from_modal",
+__all__ = ["FINGER_NAMES", "finger_parameter_set", "finger_state_space", "finger_minimal_state_space",
+           "finger_coefficients", "finger_transfer_functions", "finger_hybrid",
            "micropart_parameters", "finger_checks", "TSFMFinger", "TSFMFingerContact", "TSFMGripper",
            "gripper_measure", "gripper_advance", "gripper_work"]
 
@@ -74,7 +76,7 @@ CONTACT_NAMES = ("x_w", "k_e", "c_e", "F_po")
 PART_NAMES = ("w", "k_e", "c_e", "F_po", "F_stick", "X_p", "gap")
 
 
-def finger_parameters(*, d_p: float, s_p: float, lam: float, beta: float, gamma: float, a: float, b: float,
+def finger_parameter_set(*, d_p: float, s_p: float, lam: float, beta: float, gamma: float, a: float, b: float,
                       m_s: float, b_s: float, k_s: float, L_r: float, L_s: float, L_a: float,
                       sensitivity: float = 5e3, source: str = "", sources: Mapping[str, str] | None = None,
                       name: str = "tsfm-finger") -> ParameterSet:
@@ -184,14 +186,6 @@ def finger_transfer_functions(p, a2: str = "derived") -> dict[str, tuple[np.ndar
     return {"G_u": (num_u, den), "G_f": (num_c, num_u), "force": (num_c, den)}
 
 
-def sensor_from_modal(k_s: float, f0_hz: float, zeta: float) -> tuple[float, float]:
-    """(m_s, b_s) of a mass-spring-damper with stiffness ``k_s`` that rings at ``f0_hz`` with
-    damping ratio ``zeta``: m_s = k_s/(2π f0)², b_s = 2 ζ √(k_s m_s)."""
-    w0 = 2.0 * math.pi * f0_hz
-    m = k_s / w0**2
-    return m, 2.0 * zeta * math.sqrt(k_s * m)
-
-
 def d_bandwidth_hz(a: float, b: float) -> float:
     """−3 dB bandwidth of D(s) = 1/(a s² + b s + 1) (Hz)."""
     # |D(jω)|² = 1/((1 − a ω²)² + b² ω²) = 1/2  →  a² x² + (b² − 2a) x − 1 = 0, x = ω²
@@ -221,7 +215,7 @@ def finger_checks(values: Mapping[str, float], reference: Mapping[str, tuple[flo
         what = "√(k_s/m_s)/2π"
         if rad:
             what += f" (√(k_s/m_s) = {math.sqrt(k / m):.5g} rad/s matches {f0:g} taken as rad/s: 2π dropped)"
-        m_fix, _ = sensor_from_modal(k, f0, 0.0)
+        m_fix = sensor_parameters(f0, 0.0, k_s=k).value("m_s")
         used = (f"gripkit keeps k_s = {k:g} N/m and the measured f0 = {f0:g} Hz: m_s = k_s/(2π f0)² = {m_fix:.4g} kg"
                 if printed else f"simulated with the model's own m_s, k_s ({f:.4g} Hz); m_s = {m_fix:.4g} kg "
                                 f"would give {f0:g} Hz")
@@ -231,7 +225,8 @@ def finger_checks(values: Mapping[str, float], reference: Mapping[str, tuple[flo
         z0, src = reference["sensor_zeta"]
         z = bs / (2.0 * math.sqrt(k * m))
         if printed and "sensor_f0_hz" in reference:
-            m_fix, b_fix = sensor_from_modal(k, reference["sensor_f0_hz"][0], z0)
+            fix = sensor_parameters(reference["sensor_f0_hz"][0], z0, k_s=k)
+            m_fix, b_fix = fix.value("m_s"), fix.value("b_s")
             used = f"gripkit uses the measured ζ = {z0:g}: b_s = 2ζ√(k_s m_s) = {b_fix:.4g} N·s/m"
         else:
             used = f"simulated with the model's own b_s (ζ = {z:.4g})"
@@ -305,7 +300,7 @@ class TSFMFinger(Model):
                  printed: ParameterSet | None = None, name: str | None = None, check: bool = True):
         missing = [n for n in FINGER_NAMES if n not in parameters]
         if missing:
-            raise ParameterError(f"TSFM finger parameters: missing {missing}", hint="build them with finger_parameters(...)")
+            raise ParameterError(f"TSFM finger parameters: missing {missing}", hint="build them with finger_parameter_set(...)")
         parameters = ParameterSet([parameters[n] for n in FINGER_NAMES]
                                   + [parameters[n] for n in parameters if n not in FINGER_NAMES], parameters.name)
         self.reference = dict(reference or {})
@@ -532,7 +527,7 @@ class TSFMFingerContact(Model):
     """One finger pressing on a part (Fig. 5, Fig. 13): free ↔ constrained motion through the gap
     x_w − y_C, with the switching located inside the sample step.
 
-    Parameters: the finger's (see :func:`finger_parameters`) plus ``x_w`` (m, part face from the
+    Parameters: the finger's (see :func:`finger_parameter_set`) plus ``x_w`` (m, part face from the
     tip's rest position), ``k_e`` (N/m), ``c_e`` (N·s/m), ``F_po`` (N). Input ``U`` (V); outputs
     ``y_C``, ``y_B`` (m), ``F_g`` (N, the contact force), ``F_m`` (N, the sensor's reading) and
     ``contact`` (0 free, 1 in contact).

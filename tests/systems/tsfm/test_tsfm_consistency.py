@@ -10,8 +10,8 @@ import pytest
 from gripkit.cli import main
 from gripkit.consistency import check
 from gripkit.errors import ConsistencyWarning
-from gripkit.models import TSFMFinger
-from gripkit.zoo import tsfm as z
+from gripkit.systems.tsfm import TSFMFinger
+from gripkit.systems.tsfm import parameters as z
 
 
 def _findings(side):

@@ -16,7 +16,7 @@ import warnings
 
 import numpy as np
 
-from ..progress import status
+from ...progress import status
 
 
 def _fig(*args, **kw):
@@ -29,7 +29,7 @@ def _fig(*args, **kw):
 
 
 def _consistency(report, z, summary):
-    from ..consistency import check
+    from ...consistency import check
 
     sec = report.section(
         "TSFM: the printed parameters and their contradictions",
@@ -77,7 +77,8 @@ def _loops(report, z, fingers, summary, quick):
 
 
 def _identify(report, z, fingers, loops, summary, quick):
-    from ..sysid.bouc_wen import identify_finger, loop_error
+    from .identification import identify_finger
+    from ...sysid.bouc_wen import loop_error
 
     sec = report.section(
         "Identification back from simulated measurements (§IV)",
@@ -151,7 +152,7 @@ def _identify(report, z, fingers, loops, summary, quick):
 
 
 def _sines(report, z, fingers, ident, summary, quick):
-    from ..sysid.bouc_wen import loop_error
+    from ...sysid.bouc_wen import loop_error
 
     sec = report.section(
         "Sine responses at 10, 50, 100 and 500 Hz (Fig. 12)",
@@ -187,7 +188,8 @@ def _sines(report, z, fingers, ident, summary, quick):
 
 
 def _contact(report, z, fingers, ident, summary, quick):
-    from ..estimation import ContactDetector, TipPositionEstimator
+    from ...estimation import ContactDetector
+    from . import TipPositionEstimator
 
     sec = report.section(
         "The contact experiment of Fig. 13",
@@ -234,7 +236,7 @@ def _contact(report, z, fingers, ident, summary, quick):
 
 
 def _microparts(report, z, ident, summary, quick):
-    from ..control import GraspSettings, simulate_two_finger_grasp
+    from . import GraspSettings, simulate_two_finger_grasp
 
     sec = report.section(
         "Width and stiffness of the three microparts of Table III (§V-C, §V-D, eq 16)",
@@ -294,7 +296,7 @@ def _microparts(report, z, ident, summary, quick):
 
 
 def _strategy(report, z, ident, grasps, summary, quick):
-    from ..control import GraspSettings, simulate_two_finger_grasp
+    from . import GraspSettings, simulate_two_finger_grasp
 
     sec = report.section(
         "The two-finger grasp of §I: hold the first contact, or push the part away",
@@ -327,7 +329,7 @@ def _strategy(report, z, ident, grasps, summary, quick):
 
 
 def run(report, *, quick: bool = False) -> dict:
-    from ..zoo import tsfm as z
+    from . import parameters as z
 
     t0 = time.perf_counter()
     summary: dict = {}

@@ -6,7 +6,7 @@
 The TSFM has no position sensor: the model itself, driven by the applied voltage and by the force
 the integrated sensor measures, is the estimator. :class:`TipPositionEstimator` runs it one sample
 at a time — exact Bouc-Wen update, then the minimal 4-state realisation of eq 11
-(:func:`gripkit.models.tsfm.finger_minimal_state_space`) discretised exactly (ZOH) at the loop's
+(:func:`gripkit.systems.tsfm.gripper.finger_minimal_state_space`) discretised exactly (ZOH) at the loop's
 sample time — in a numba step (:func:`estimator_step`) that a control loop can call at 20 kHz
 (≈ 1 µs per call from Python, ≈ 20 ns inside a numba loop).
 
@@ -20,11 +20,11 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ..errors import DataError, ModelError
-from ..models.hysteresis import bouc_wen_advance
-from ..models.tsfm import FINGER_NAMES, TSFMFinger, finger_minimal_state_space
-from ..params import ParameterSet
-from ..sim.integrators import zoh_levels
+from ...errors import DataError, ModelError
+from ...models.hysteresis import bouc_wen_advance
+from .gripper import FINGER_NAMES, TSFMFinger, finger_minimal_state_space
+from ...params import ParameterSet
+from ...sim.integrators import zoh_levels
 
 __all__ = ["TipPositionEstimator", "estimator_step", "estimator_arrays"]
 
@@ -81,12 +81,12 @@ class TipPositionEstimator:
     Parameters
     ----------
     finger
-        A :class:`~gripkit.models.tsfm.TSFMFinger`, its ParameterSet or a mapping of values
+        A :class:`~gripkit.systems.tsfm.gripper.TSFMFinger`, its ParameterSet or a mapping of values
         (d_p, s_p, lam, beta, gamma, a, b, m_s, b_s, k_s, L_r, L_s, L_a; SI).
     dt
         Sample time of the loop (s), e.g. 1/20000.
 
-    >>> from gripkit.zoo.tsfm import left_finger
+    >>> from gripkit.systems.tsfm.parameters import left_finger
     >>> est = TipPositionEstimator(left_finger(check=False), 5e-5)
     >>> for _ in range(2000):
     ...     y = est.update(44.0, 0.0)            # 44 V held, no force
