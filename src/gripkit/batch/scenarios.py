@@ -14,12 +14,12 @@ import numpy as np
 
 from ..errors import ConfigError
 
-__all__ = ["SCENARIOS", "resolve", "step_response", "step_metrics", "ftg100_grasp"]
+__all__ = ["SCENARIOS", "resolve", "step_response", "step_metrics"]
 
 SCENARIOS: dict[str, str] = {
     "step-response": "gripkit.batch.scenarios:step_response",
     "tsfm-grasp": "gripkit.systems.tsfm.grasp_batch:tsfm_grasp",
-    "ftg100-grasp": "gripkit.batch.scenarios:ftg100_grasp",
+    "ftg100-grasp": "gripkit.systems.ftg100.scenario:ftg100_grasp",
 }
 
 
@@ -82,53 +82,3 @@ def step_response(model, params: dict[str, np.ndarray], settings: dict) -> dict[
     u[:, in_names.index(inp)] = amplitude
     y = model.simulate_batch(thetas, u, 1.0 / fs)[:, :, out_names.index(out)]
     return step_metrics(np.arange(n) / fs, y, float(settings.get("band", 0.02)))
-
-
-_FTG100_PARAMS = ("force", "k0", "gap", "noise_force", "noise_position")
-_FTG100_OPTS = ("duration", "damage_threshold", "band", "noise_seed")
-
-
-def ftg100_grasp(model, params: dict[str, np.ndarray], settings: dict) -> dict[str, np.ndarray]:
-    """FT-G100 approach-and-grasp under the hybrid force/position controller
-    (:func:`gripkit.control.hybrid.grasp_batch`, already parallel): one grasp per job.
-
-    Parameters (per job): ``force`` (N, commanded), ``k0`` (N/m), ``gap`` (m), ``noise_force``
-    (N), ``noise_position`` (m). ``[scenario]``: ``duration`` (s, default 0.06),
-    ``damage_threshold`` (N, default 1.5 × force), ``band`` (settling band, default 0.02),
-    ``noise_seed``, and any :class:`~gripkit.control.hybrid.HybridForcePosition` field (gains,
-    approach_speed, ...). ``model``: an :class:`~gripkit.models.ftg100.FTG100Plant`
-    (``model = "gripkit.models.ftg100:FTG100Plant"``, a factory) or None (the nominal plant). Metrics: :data:`gripkit.control.hybrid.METRICS`."""
-    import dataclasses
-
-    from ..control.hybrid import METRICS, HybridForcePosition, grasp_batch
-    from ..models.ftg100 import FTG100Plant
-    from .spec import _si
-
-    if model is not None and not isinstance(model, FTG100Plant):
-        raise ConfigError(f"scenario 'ftg100-grasp' needs an FT-G100 plant, found {type(model).__name__}",
-                          hint='leave [sweep] model out, or model = "gripkit.models.ftg100:FTG100Plant"')
-    plant = model if model is not None else FTG100Plant(check=False)
-    unknown = [k for k in params if k not in (*_FTG100_PARAMS, "job_id")]
-    if unknown:
-        raise ConfigError(f"ftg100-grasp: unknown parameters {unknown}", hint=f"allowed: {', '.join(_FTG100_PARAMS)}")
-    fields = {f.name for f in dataclasses.fields(HybridForcePosition)}
-    bad = sorted(set(settings) - fields - set(_FTG100_OPTS))
-    if bad:
-        raise ConfigError(f"[scenario] (ftg100-grasp): unknown keys {bad}",
-                          hint=f"allowed: {', '.join(_FTG100_OPTS)} and HybridForcePosition fields")
-    gains = {k: (v if isinstance(v, bool) else _si(v, f"[scenario] {k}")) for k, v in settings.items() if k in fields}
-    ctrl = HybridForcePosition.for_plant(plant.parameters, **gains)
-    n = len(params["job_id"])
-    seed = np.asarray(params["job_id"], dtype=np.int64) + int(settings.get("noise_seed", 0)) * 1_000_003
-    kw = {k: params[k] for k in _FTG100_PARAMS if k in params}
-    kw.setdefault("force", 20e-6)
-    dmg = settings.get("damage_threshold")
-    b = grasp_batch(ctrl, plant, seed=seed if n else 0, duration=_si(settings.get("duration", 0.06), "[scenario] duration"),
-                    damage_threshold=None if dmg is None else _si(dmg, "[scenario] damage_threshold"),
-                    band=float(settings.get("band", 0.02)), progress=False, **kw)
-    if len(b) != n:
-        raise ConfigError(f"ftg100-grasp: {len(b)} results for {n} jobs")
-    return {m: b[m] for m in METRICS}
-
-
-ftg100_grasp.uses_job_id = True

@@ -18,7 +18,7 @@ __all__ = ["SECTIONS", "run_demo"]
 SECTIONS: dict[str, str] = {
     "amadeus-identification": "gripkit.systems.amadeus.demo_identification",
     "amadeus-hand": "gripkit.systems.amadeus.demo_hand",
-    "ftg100": "gripkit.demos.ftg100",
+    "ftg100": "gripkit.systems.ftg100.demo",
     "tsfm": "gripkit.systems.tsfm.demo",
     "dlr-hit": "gripkit.demos.dlr_hit",
     "batch-robustness": "gripkit.demos.batch_robustness",

@@ -46,15 +46,15 @@ _ENTRIES: tuple[ZooEntry, ...] = (
     ZooEntry("ftg100-actuated", "FemtoTools FT-G100 microgripper",
              "Actuated subsystem linearised at 70 V with the 80 um glass ball grasped (eqs 8-10): "
              "voltage (V) to tip displacement (m), M_a, K_fa, k0 identified in §III-B",
-             _FTG, "gripkit.zoo.ftg100:actuated_model"),
+             _FTG, "gripkit.systems.ftg100.parameters:actuated_model"),
     ZooEntry("ftg100-sensing", "FemtoTools FT-G100 microgripper",
              "Sensing subsystem (eqs 14-17): gripping force (N) to sensing-arm tip deflection (m), "
              "M_b, K_fb identified in §III-D; checks the printed eq 17",
-             _FTG, "gripkit.zoo.ftg100:sensing_model"),
+             _FTG, "gripkit.systems.ftg100.parameters:sensing_model"),
     ZooEntry("ftg100-coupled", "FemtoTools FT-G100 microgripper",
              "Coupled gripper model (eq 18): voltage (V) to tip displacements, gripping force and "
              "readout voltage through the object stiffness k0",
-             _FTG, "gripkit.zoo.ftg100:coupled_model"),
+             _FTG, "gripkit.systems.ftg100.parameters:coupled_model"),
     ZooEntry("tsfm-left", "TSFM piezo microgripper", "Left finger, Table II: Bouc-Wen + D(s) actuator, lever, force "
              "sensor (8.52 kHz, ζ = 0.006), eqs 3-13", _TSFM, "gripkit.systems.tsfm.parameters:left_finger"),
     ZooEntry("tsfm-right", "TSFM piezo microgripper", "Right finger, Table II (as tsfm-left)", _TSFM,

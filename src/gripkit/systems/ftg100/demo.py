@@ -10,8 +10,8 @@ import warnings
 
 import numpy as np
 
-from ..consistency import check
-from ..errors import AccuracyWarning, ConsistencyWarning
+from ...consistency import check
+from ...errors import AccuracyWarning, ConsistencyWarning
 
 SEED = "003_abd62b560633beaf.txt"
 
@@ -32,15 +32,21 @@ def _pm(v, s, scale=1.0, digits=4):
 
 
 def run(report, *, quick: bool = False) -> dict:
-    from ..control.hybrid import HybridForcePosition, grasp_batch, impact_speed_limit, simulate_grasp
-    from ..models.beams import clamped_clamped_stiffness
-    from ..models.comb_drive import comb_drive_force, comb_drive_gain
-    from ..models.ftg100 import (SEED_EQ10, SEED_EQ17, FTG100Actuated, FTG100Coupled, FTG100Plant,
-                                 FTG100Sensing, amplification_ratio, ftg100_geometry, seed_state_space)
-    from ..signals.trajectory import Trajectory
-    from ..sysid.step_response import identify_step
-    from ..zoo.ftg100 import (PAPER_VALUES, identify_actuated, identify_sensing, release_experiment,
-                              step_experiment)
+    from .hybrid_control import (
+        HybridForcePosition, grasp_batch, impact_speed_limit, simulate_hybrid_grasp,
+    )
+    from ...models.beams import clamped_clamped_stiffness
+    from ...models.comb_drive import comb_drive_force, comb_drive_gain
+    from .model import (
+        SEED_EQ10, SEED_EQ17, FTG100Actuated, FTG100Coupled, FTG100Plant, FTG100Sensing,
+        amplification_ratio, ftg100_geometry, seed_state_space,
+    )
+    from ...signals.trajectory import Trajectory
+    from ...sysid.step_response import identify_step
+    from .parameters import PAPER_VALUES
+    from .identification import (
+        identify_actuated, identify_sensing, release_experiment, step_experiment,
+    )
 
     plt = _plt()
     summary: dict = {}
@@ -224,7 +230,7 @@ def run(report, *, quick: bool = False) -> dict:
         "(2 %) is timed from the first contact. The object is the seed's pure spring: the ball between the "
         "two light tips rings at 35-60 kHz, above the 20 kHz loop, so the approach speed is bounded by "
         f"v ≤ 0.1 F/√(k0 m_r) = {impact_speed_limit(20e-6, 1560.0) * 1e3:.2g} mm/s for 20 µN on 1560 N/m.")
-    nom = simulate_grasp(ctrl, plant, force=20e-6, duration=0.05)
+    nom = simulate_hybrid_grasp(ctrl, plant, force=20e-6, duration=0.05)
     tr = nom.trajectory
     tc = nom.metrics["t_contact"]
     fig, ax = plt.subplots(3, 1, figsize=(9, 7), sharex=True)
@@ -293,9 +299,9 @@ def run(report, *, quick: bool = False) -> dict:
     # anti-windup and bumpless transfer, and two sensitivities
     ns = int(round(0.12 / ctrl.ts))
     prof = np.where(np.arange(ns) < int(0.07 / ctrl.ts), 400e-6, 50e-6)
-    aw = {f: simulate_grasp(ctrl.with_(anti_windup=f), plant, force_profile=prof, duration=0.12) for f in (True, False)}
+    aw = {f: simulate_hybrid_grasp(ctrl.with_(anti_windup=f), plant, force_profile=prof, duration=0.12) for f in (True, False)}
     stiff = plant.with_parameters(check=False, K_sa=25.4 * 1.15)
-    bl = {f: simulate_grasp(ctrl.with_(bumpless=f), stiff, duration=0.06) for f in (True, False)}
+    bl = {f: simulate_hybrid_grasp(ctrl.with_(bumpless=f), stiff, duration=0.06) for f in (True, False)}
     fig, ax = plt.subplots(1, 2, figsize=(12, 3.5))
     for f, r in aw.items():
         ax[0].plot(r.trajectory.t * 1e3, r.trajectory["F_c"] * 1e6, lw=0.8,

@@ -66,14 +66,14 @@ import numba
 import numpy as np
 from scipy.optimize import brentq
 
-from ..consistency import Finding, compare
-from ..errors import ModelError
-from ..params import Parameter, ParameterSet
-from ..sim.linear import StateSpace, c2d_zoh, simulate_discrete
-from ..sim.model import Model, Signal
-from .beams import STRETCHING_BETA, clamped_clamped_stiffness
-from .comb_drive import comb_drive_coefficient
-from .second_order import second_order_batch
+from ...consistency import Finding, compare
+from ...errors import ModelError
+from ...params import Parameter, ParameterSet
+from ...sim.linear import StateSpace, c2d_zoh, simulate_discrete
+from ...sim.model import Model, Signal
+from ...models.beams import STRETCHING_BETA, clamped_clamped_stiffness
+from ...models.comb_drive import comb_drive_coefficient
+from ...models.second_order import second_order_batch
 
 __all__ = [
     "SEED", "amplification_ratio", "ftg100_geometry", "ftg100_parameters", "controllable_form",

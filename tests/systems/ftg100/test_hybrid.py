@@ -4,10 +4,11 @@
 import numpy as np
 import pytest
 
-from gripkit.control.hybrid import (METRICS, HybridForcePosition, grasp_batch, impact_speed_limit,
-                                    simulate_grasp)
+from gripkit.systems.ftg100.hybrid_control import (
+    METRICS, HybridForcePosition, grasp_batch, impact_speed_limit, simulate_hybrid_grasp,
+)
 from gripkit.errors import ConfigError
-from gripkit.models.ftg100 import FTG100Plant
+from gripkit.systems.ftg100.model import FTG100Plant
 
 F_CMD = 20e-6
 
@@ -36,12 +37,12 @@ def test_specification_over_k0_and_gap(sweep):
 
 def test_measured_noise_and_determinism():
     """The force measurement carries σ = 50 nN before contact; the same seed gives the same run."""
-    a = simulate_grasp(seed=7, duration=0.03)
-    b = simulate_grasp(seed=7, duration=0.03)
+    a = simulate_hybrid_grasp(seed=7, duration=0.03)
+    b = simulate_hybrid_grasp(seed=7, duration=0.03)
     np.testing.assert_array_equal(a.trajectory["F_meas"], b.trajectory["F_meas"])
     free = a.trajectory["F_meas"][a.trajectory.t < 0.03]
     assert np.std(free) == pytest.approx(50e-9, rel=0.1) and abs(np.mean(free)) < 5e-9
-    c = simulate_grasp(seed=8, duration=0.03)
+    c = simulate_hybrid_grasp(seed=8, duration=0.03)
     assert not np.array_equal(a.trajectory["F_meas"], c.trajectory["F_meas"])
     # batch (parallel) equals single runs
     bb = grasp_batch(seed=[7, 8], duration=0.03, progress=False)
@@ -55,7 +56,7 @@ def test_bumpless_switch():
     plant = FTG100Plant(check=False, K_sa=25.4 * 1.15)
     res = {}
     for bumpless in (True, False):
-        r = simulate_grasp(HybridForcePosition.for_plant(bumpless=bumpless), plant, duration=0.06)
+        r = simulate_hybrid_grasp(HybridForcePosition.for_plant(bumpless=bumpless), plant, duration=0.06)
         tr = r.trajectory
         k = int(np.flatnonzero(np.diff(tr["mode"]) > 0)[0]) + 1
         res[bumpless] = (abs(tr["V"][k] - tr["V"][k - 1]), r.metrics["overshoot_percent"])
@@ -70,7 +71,7 @@ def test_anti_windup_at_200_V():
     prof = np.where(np.arange(n) < int(0.07 / 5e-5), 400e-6, 50e-6)
     t_settle = {}
     for aw in (True, False):
-        r = simulate_grasp(HybridForcePosition.for_plant(anti_windup=aw), force_profile=prof, duration=0.12)
+        r = simulate_hybrid_grasp(HybridForcePosition.for_plant(anti_windup=aw), force_profile=prof, duration=0.12)
         tr = r.trajectory
         assert r.metrics["max_voltage"] == pytest.approx(200.0)
         after = tr.t >= 0.07
@@ -92,9 +93,9 @@ def test_configuration_errors():
     with pytest.raises(ConfigError, match="force"):
         grasp_batch(force=-1e-6, progress=False)
     with pytest.raises(ConfigError, match="one number"):
-        simulate_grasp(k0=[500.0, 600.0])
+        simulate_hybrid_grasp(k0=[500.0, 600.0])
     with pytest.raises(ConfigError, match="duration"):
-        simulate_grasp(duration=1e-6)
+        simulate_hybrid_grasp(duration=1e-6)
     with pytest.raises(ConfigError, match="force_profile"):
-        simulate_grasp(force_profile=np.ones(3), duration=0.01)
+        simulate_hybrid_grasp(force_profile=np.ones(3), duration=0.01)
     assert len(METRICS) == 10

@@ -12,7 +12,7 @@ from gripkit.models.beams import (STRETCHING_BETA, clamped_clamped_stiffness, cu
                                   suspension_force, tangent_stiffness)
 from gripkit.models.comb_drive import (comb_drive_coefficient, comb_drive_force, comb_drive_gain,
                                        comb_drive_voltage)
-from gripkit.models.ftg100 import amplification_ratio, ftg100_geometry
+from gripkit.systems.ftg100.model import amplification_ratio, ftg100_geometry
 
 GEO = ftg100_geometry()
 g = GEO.value

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from gripkit.cli import main
-from gripkit.models.ftg100 import SEED_EQ10
-from gripkit.zoo.ftg100 import step_experiment
+from gripkit.systems.ftg100.model import SEED_EQ10
+from gripkit.systems.ftg100.identification import step_experiment
 
 
 def run(capsys, *args):

@@ -28,8 +28,8 @@ linearises the quadratic actuator (eq 5) exactly:
   back-calculation.
 
 Kernels: :func:`hybrid_step` (one sample, scalar numba, parameters ``cp`` and state ``cs`` as
-float arrays) and the closed-loop grasp simulation on :class:`gripkit.models.ftg100.FTG100Plant`
-(:func:`simulate_grasp`, :func:`grasp_batch`): the controller sees the force sensor reading
+float arrays) and the closed-loop grasp simulation on :class:`gripkit.systems.ftg100.model.FTG100Plant`
+(:func:`simulate_hybrid_grasp`, :func:`grasp_batch`): the controller sees the force sensor reading
 k2·x_b plus white noise of σ = 50 nN (the seed's resolution) and the tip position plus white noise
 (σ = 1 nm, an interferometer as in the seed's experiments, assumed). Metrics per grasp: contact
 and detection times, peak true contact force (checked after every RK4 substep, so impact spikes
@@ -45,15 +45,15 @@ from dataclasses import asdict, dataclass, replace
 import numba
 import numpy as np
 
-from ..errors import ConfigError, SimulationError
-from ..models.ftg100 import advance_plant, plant_outputs
-from ..params import ParameterSet
-from ..signals.trajectory import Trajectory
-from ..sim.noise import normal_draw
-from .pid import PID, PID_NPARAM, pid_step, pid_transfer
+from ...errors import ConfigError, SimulationError
+from .model import advance_plant, plant_outputs
+from ...params import ParameterSet
+from ...signals.trajectory import Trajectory
+from ...sim.noise import normal_draw
+from ...control.pid import PID, PID_NPARAM, pid_step, pid_transfer
 
-__all__ = ["HybridForcePosition", "HybridController", "hybrid_step", "simulate_grasp", "grasp_batch",
-           "GraspResult", "GraspBatch", "METRICS", "impact_speed_limit"]
+__all__ = ["HybridForcePosition", "HybridController", "hybrid_step", "simulate_hybrid_grasp", "grasp_batch",
+           "HybridGraspResult", "GraspBatch", "METRICS", "impact_speed_limit"]
 
 # controller parameter layout
 _TS, _PX, _PF = 0, 1, 1 + PID_NPARAM
@@ -206,8 +206,8 @@ class HybridForcePosition:
     @classmethod
     def for_plant(cls, plant_parameters: ParameterSet | None = None, **overrides) -> "HybridForcePosition":
         """Tuned defaults with the actuator model (D_a, K_sa, K₃, c_e, V_max) taken from an
-        :class:`~gripkit.models.ftg100.FTG100Plant` parameter set (the nominal one by default)."""
-        from ..models.ftg100 import plant_parameters as _pp
+        :class:`~gripkit.systems.ftg100.model.FTG100Plant` parameter set (the nominal one by default)."""
+        from .model import plant_parameters as _pp
 
         ps = plant_parameters if plant_parameters is not None else _pp()
         base = dict(lever=ps.value("D_a"), k1=ps.value("K_sa"), k3=ps.value("K3_a"), c_e=ps.value("c_e"),
@@ -370,7 +370,7 @@ def _grasp_batch(thetas, cps, fprofs, sig_f, sig_x, seeds, dt, substeps, band, d
 
 
 @dataclass(frozen=True)
-class GraspResult:
+class HybridGraspResult:
     """One closed-loop grasp: ``trajectory`` (t, x_a, x_b, F_c true, F_meas, V, mode) and
     ``metrics`` (see :data:`METRICS`; times in s from the start, settling from first contact)."""
 
@@ -422,7 +422,7 @@ class GraspBatch:
 
 def _prepare(controller, plant, force, k0, gap, seed, noise_force, noise_position, damage_threshold,
              duration):
-    from ..models.ftg100 import FTG100Plant
+    from .model import FTG100Plant
 
     plant = plant if plant is not None else FTG100Plant(check=False)
     if not isinstance(plant, FTG100Plant):
@@ -489,7 +489,7 @@ def grasp_batch(controller: HybridForcePosition | list | None = None, plant=None
 
 
 def _run(thetas, cps, fprofs, NF, NX, S, ts, sub, band, dmg, n_steps, record, progress):
-    from ..progress import track
+    from ...progress import track
 
     P = thetas.shape[0]
     if not (math.isfinite(band) and 0 < band < 1):
@@ -504,17 +504,17 @@ def _run(thetas, cps, fprofs, NF, NX, S, ts, sub, band, dmg, n_steps, record, pr
     return met, traj
 
 
-def simulate_grasp(controller: HybridForcePosition | None = None, plant=None, *, force: float = 20e-6,
+def simulate_hybrid_grasp(controller: HybridForcePosition | None = None, plant=None, *, force: float = 20e-6,
                    k0: float | None = None, gap: float | None = None, seed: int = 0, duration: float = 0.1,
                    noise_force: float = 50e-9, noise_position: float = 1e-9,
                    damage_threshold: float | None = None, band: float = 0.02,
-                   force_profile=None) -> GraspResult:
+                   force_profile=None) -> HybridGraspResult:
     """One closed-loop approach-and-grasp on the FT-G100 plant (see :func:`grasp_batch`), with its
     trajectory. ``force_profile`` (optional, N, one value per controller sample over ``duration``)
     replaces the constant command; the metrics then refer to its last value."""
     for name, v in (("force", force), ("k0", k0), ("gap", gap)):
         if v is not None and np.ndim(v) != 0:
-            raise ConfigError(f"{name}: expected one number for simulate_grasp (use grasp_batch for arrays)")
+            raise ConfigError(f"{name}: expected one number for simulate_hybrid_grasp (use grasp_batch for arrays)")
     plant, thetas, cps, F, K0, G, S, NF, NX, dmg, ts, n_steps, sub = _prepare(
         controller, plant, force, k0, gap, seed, noise_force, noise_position, damage_threshold, duration)
     prof = F[:, None]
@@ -533,7 +533,7 @@ def simulate_grasp(controller: HybridForcePosition | None = None, plant=None, *,
                                  "V": tr[:, 5], "mode": tr[:, 6]},
                       {"x_a": "m", "x_b": "m", "F_c": "N", "F_meas": "N", "V": "V", "mode": "1"},
                       {"fs": 1.0 / ts, "model": "ftg100-plant + hybrid force/position"})
-    return GraspResult(traj, b.rows()[0], float(F[0]), float(dmg[0]), float(K0[0]), float(G[0]))
+    return HybridGraspResult(traj, b.rows()[0], float(F[0]), float(dmg[0]), float(K0[0]), float(G[0]))
 
 
 def impact_speed_limit(force: float, k0: float, plant_parameters: ParameterSet | None = None,
@@ -546,7 +546,7 @@ def impact_speed_limit(force: float, k0: float, plant_parameters: ParameterSet |
     FT-G100 and a glass ball; damped only by the structure and the contact, ζ ≈ 0.002 with the
     seed's pure spring). Hence v ≤ fraction · F / √(k0 m_r): 0.48 mm/s for 20 µN, k0 = 1560 N/m.
     """
-    from ..models.ftg100 import plant_parameters as _pp
+    from .model import plant_parameters as _pp
 
     ps = plant_parameters if plant_parameters is not None else _pp()
     ma = ps.value("M_a") / ps.value("D_a") ** 2

@@ -112,13 +112,13 @@ def test_scenario_is_independent_of_chunking_and_backend(tmp_path):
 
 def test_ftg100_scenario_matches_grasp_batch():
     """The ftg100-grasp scenario is grasp_batch (seed = job id) in sweep form."""
-    from gripkit.control.hybrid import grasp_batch
+    from gripkit.systems.ftg100.hybrid_control import grasp_batch
 
     spec = SweepSpec.from_dict({"sweep": {"scenario": "ftg100-grasp"},
                                 "parameters": {"k0": {"grid": [520.0, 1560.0]}},
                                 "scenario": {"duration": "30 ms", "approach_speed": "0.4 mm/s"}})
     res = sweep(spec, backend="in-process", progress=False)
-    from gripkit.control.hybrid import HybridForcePosition
+    from gripkit.systems.ftg100.hybrid_control import HybridForcePosition
 
     ref = grasp_batch(HybridForcePosition.for_plant(approach_speed=4e-4), k0=np.array([520.0, 1560.0]),
                       seed=np.arange(2), duration=0.03, progress=False)

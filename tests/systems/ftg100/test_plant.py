@@ -8,7 +8,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from gripkit.consistency import check
-from gripkit.models.ftg100 import FTG100Plant, advance_plant
+from gripkit.systems.ftg100.model import FTG100Plant, advance_plant
 
 FS = 20000.0
 

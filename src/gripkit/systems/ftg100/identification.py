@@ -1,6 +1,5 @@
-"""The FemtoTools FT-G100 microgripper (seed ``003_abd62b560633beaf.txt``) in the zoo: model
-factories, the seed's identification experiments (simulated) and their Levenberg-Marquardt
-identification (§III-B, §III-D).
+"""The FemtoTools FT-G100 microgripper (seed ``003_abd62b560633beaf.txt``): the seed's
+identification experiments (simulated) and their Levenberg-Marquardt identification (§III-B, §III-D).
 
 §III-B: "the electrostatic actuator has been excited with a 10V step voltage around the operating
 point while the object seizure was happening ... p = [M_a K_fa k0]ᵀ which minimize a quadratic
@@ -28,39 +27,13 @@ import warnings
 
 import numpy as np
 
-from ..errors import ConsistencyWarning, DataError, IdentificationError
-from ..models.ftg100 import FTG100Actuated, FTG100Coupled, FTG100Plant, FTG100Sensing
-from ..signals.trajectory import Trajectory
-from ..sysid.greybox import GreyboxResult, fit
-from ..sysid.step_response import identify_step
+from ...errors import ConsistencyWarning, DataError, IdentificationError
+from .model import FTG100Actuated, FTG100Sensing
+from ...signals.trajectory import Trajectory
+from ...sysid.greybox import GreyboxResult, fit
+from ...sysid.step_response import identify_step
 
-__all__ = ["actuated_model", "sensing_model", "coupled_model", "plant_model", "step_experiment",
-           "release_experiment", "identify_actuated", "identify_sensing", "PAPER_VALUES"]
-
-#: The seed's identified values (SI) with their section.
-PAPER_VALUES = {"M_a": (1.37e-6, "§III-B"), "K_fa": (1.3e-3, "§III-B"), "k0": (1043.0, "§III-B"),
-                "M_b": (0.5e-6, "§III-D"), "K_fb": (0.71e-3, "§III-D")}
-
-
-def actuated_model(**values) -> FTG100Actuated:
-    """Zoo ``ftg100-actuated``: eqs 8-10 at the seed's values (M_a, K_fa, k0 free)."""
-    return FTG100Actuated(**values)
-
-
-def sensing_model(**values) -> FTG100Sensing:
-    """Zoo ``ftg100-sensing``: eqs 14-17 at the seed's values (M_b, K_fb free)."""
-    return FTG100Sensing(**values)
-
-
-def coupled_model(**values) -> FTG100Coupled:
-    """Zoo ``ftg100-coupled``: eq 18 (actuated and sensing subsystems through k_k, readout r)."""
-    return FTG100Coupled(**values)
-
-
-def plant_model(**values) -> FTG100Plant:
-    """The nonlinear plant (stiffening suspensions, V² actuation, contact with the object)."""
-    return FTG100Plant(**values)
-
+__all__ = ["step_experiment", "release_experiment", "identify_actuated", "identify_sensing"]
 
 def _noise(y: np.ndarray, sigma: float, seed: int) -> np.ndarray:
     return y + sigma * np.random.default_rng(seed).standard_normal(y.shape)
