@@ -20,7 +20,7 @@ SECTIONS: dict[str, str] = {
     "amadeus-hand": "gripkit.systems.amadeus.demo_hand",
     "ftg100": "gripkit.systems.ftg100.demo",
     "tsfm": "gripkit.systems.tsfm.demo",
-    "dlr-hit": "gripkit.demos.dlr_hit",
+    "dlr-hit": "gripkit.systems.dlr_hit.demo",
     "batch-robustness": "gripkit.demos.batch_robustness",
 }
 

@@ -16,4 +16,3 @@ from .fusion import implied_correlation as implied_correlation
 from .fusion import normalised_variances as normalised_variances
 from .fusion import proportional_variance as proportional_variance
 from .friction_adaptation import FrictionAdapter as FrictionAdapter
-from .friction_adaptation import adapt_finger_friction as adapt_finger_friction

@@ -64,10 +64,10 @@ _ENTRIES: tuple[ZooEntry, ...] = (
     ZooEntry("dlr-hit-finger", "DLR/HIT Hand II",
              "Modular finger of ch. 7: PWM → BLDC motor (eq 5.10) → belts and harmonic drive → "
              "Appendix G friction with stick-slip → coupled Newton-Euler dynamics",
-             _DLR, "gripkit.zoo.dlr_hit:finger"),
+             _DLR, "gripkit.systems.dlr_hit.parameters:finger"),
     ZooEntry("dlr-hit-hand", "DLR/HIT Hand II",
              "Five identical fingers on a palm, thumb fixed, per-finger friction (§3.1, §6.3)",
-             _DLR, "gripkit.zoo.dlr_hit:hand"),
+             _DLR, "gripkit.systems.dlr_hit.hand:hand"),
 )
 
 

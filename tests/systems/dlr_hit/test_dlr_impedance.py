@@ -7,10 +7,12 @@ import math
 import numpy as np
 import pytest
 
-from gripkit.control.impedance import ImpedanceController, Wall, impedance_margins, simulate_impedance
-from gripkit.control.impedance import stability_margins
+from gripkit.systems.dlr_hit.impedance import (
+    ImpedanceController, Wall, impedance_margins, simulate_impedance,
+)
+from gripkit.systems.dlr_hit.impedance import stability_margins
 from gripkit.errors import ModelError, SimulationError
-from gripkit.zoo.dlr_hit import finger
+from gripkit.systems.dlr_hit.parameters import finger
 
 DEG = math.pi / 180
 Q0 = (0.0, 30 * DEG, 45 * DEG)

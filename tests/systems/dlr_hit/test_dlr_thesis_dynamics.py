@@ -10,9 +10,9 @@ import pytest
 from numpy import cos, sin
 
 from gripkit.multibody import CoupledChain, Coupling, DHChain
-from gripkit.zoo.dlr_hit import finger, finger_parameters
+from gripkit.systems.dlr_hit.parameters import finger, thesis_finger_parameters
 
-P = finger_parameters().value
+P = thesis_finger_parameters().value
 L1, L2 = P("l1"), P("l2")
 M1_, M2_, M3_ = P("m1"), P("m2"), P("m3")
 LC = [math.sqrt(sum(P(f"pc{k}_{a}") ** 2 for a in "xyz")) for k in (1, 2, 3)]

@@ -49,23 +49,26 @@ import numba
 import numpy as np
 from numba import prange
 
-from ..errors import ModelError, SimulationError
-from ..multibody.coupling import CoupledChain, Coupling, differential_matrix
-from ..multibody.dh import DHChain
-from ..multibody.kernels import (WORK_PER_LINK, chain_links, cholesky_solve, coupled_mass_bias,
-                                 frames_into, hot, joints_from_actuators, point_jacobian, rnea_pass)
-from ..params import ParameterSet
-from ..sim.model import Model, Signal
-from .bldc import bldc_torque, motor_heat_step, temperature_factor
-from .friction import (FrictionTable, lugre_force, lugre_update, ripple, stribeck, table_arrays,
-                       table_friction)
-from .transmission import transmit_torque
+from ...errors import ModelError, SimulationError
+from ...multibody.coupling import CoupledChain, Coupling, differential_matrix
+from ...multibody.dh import DHChain
+from ...multibody.kernels import (
+    WORK_PER_LINK, chain_links, cholesky_solve, coupled_mass_bias, frames_into, hot,
+    joints_from_actuators, point_jacobian, rnea_pass,
+)
+from ...params import ParameterSet
+from ...sim.model import Model, Signal
+from ...models.bldc import bldc_torque, motor_heat_step, temperature_factor
+from ...models.friction import (
+    FrictionTable, lugre_force, lugre_update, ripple, stribeck, table_arrays, table_friction,
+)
+from ...models.transmission import transmit_torque
 
 __all__ = ["FINGER_PARAMETERS", "ACTUATORS", "JOINTS", "FRICTION_MODES", "DLRFinger",
            "finger_step", "finger_step_rk4", "finger_setup", "finger_context", "finger_run",
            "finger_loop", "run_open_loop"]
 
-#: parameter names in kernel order (see gripkit.zoo.dlr_hit.finger_parameters for meaning/units)
+#: parameter names in kernel order (see gripkit.systems.dlr_hit.parameters.thesis_finger_parameters for meaning/units)
 FINGER_PARAMETERS = (
     "l1", "l2", "l3", "m1", "m2", "m3",
     "pc1_x", "pc1_y", "pc1_z", "pc2_x", "pc2_y", "pc2_z", "pc3_x", "pc3_y", "pc3_z",
@@ -452,7 +455,7 @@ def finger_outputs(G, q0, x, taum, fric, y, yrow, ycol):  # pragma: no cover - c
         y[yrow, ycol + 15 + k] = x[6 + k]
 
 
-# --- impedance control (used by gripkit.control.impedance) ----------------------------------------
+# --- impedance control (used by gripkit.systems.dlr_hit.impedance) ----------------------------------------
 
 @hot
 def _tip(ctx, th, q, R, P, T, J, Jp, tip):  # pragma: no cover - compiled
@@ -505,7 +508,7 @@ def _pwm_for(tau_out, omega_m, N, th):  # pragma: no cover - compiled
 def _impedance(th, ctx, cs, x, n, ctrl, gains, ctv, ctf, ctn, ctipos, ref, refd,
                pwm):  # pragma: no cover - compiled
     """Impedance law (joint: ctrl = 1, Cartesian: ctrl = 2) with gravity and friction
-    compensation → PWM; the commanded torques stay in cs[9] (see gripkit.control.impedance)."""
+    compensation → PWM; the commanded torques stay in cs[9] (see gripkit.systems.dlr_hit.impedance)."""
     dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav, ratio = ctx
     q, qd, R, P, T, J, Jp, tip, tipd, tauq, gp, work, zq = (cs[0], cs[1], cs[2], cs[3], cs[4],
                                                           cs[5], cs[6], cs[7], cs[8], cs[9],
@@ -592,7 +595,7 @@ def finger_loop(th, mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucol, dt, 
     """The time loop (allocation-free, semi-implicit Euler). ``ctrl = 0``: PWM from u[:, ucol:],
     outputs as DLRFinger.outputs at y[:, ycol:ycol+18]; ``ctrl = 1/2``: joint/Cartesian impedance
     on ``ref``/``refd`` with the ``wall``, closed-loop outputs (27 columns, see
-    gripkit.control.impedance)."""
+    gripkit.systems.dlr_hit.impedance)."""
     G = ctx[6]
     q0 = ctx[7]
     pwm, ext, taum, fric, xs, force = cs[14], cs[15], cs[16], cs[17], cs[13], cs[8]
@@ -731,7 +734,7 @@ class DLRFinger(Model):
     ----------
     parameters
         A ParameterSet holding every name of :data:`FINGER_PARAMETERS` (in that order), e.g.
-        :func:`gripkit.zoo.dlr_hit.finger_parameters`.
+        :func:`gripkit.systems.dlr_hit.parameters.thesis_finger_parameters`.
     tables
         Friction lookup tables (base motor 1, base motor 2, distal), :class:`FrictionTable`,
         used by ``friction='table'``; their ``scale`` multiplies the ``scale_*`` parameters.
@@ -881,7 +884,7 @@ class DLRFinger(Model):
         if self.friction == "table":
             return p(f"scale_{actuator}") * self.tables[k](v)
         if self.friction in ("stribeck", "lugre"):
-            from .friction import Stribeck
+            from ...models.friction import Stribeck
 
             s = Stribeck(p(f"fc_{actuator}"), p(f"fs_{actuator}"), p("v_s"),
                          p("delta") if self.friction == "stribeck" else 2.0, p(f"visc_{actuator}"))
@@ -891,7 +894,7 @@ class DLRFinger(Model):
 
     def motor_torque(self, actuator: str, pwm, v, T=None) -> np.ndarray:
         """Motor torque at the actuator output (N·m) for PWM and actuator velocity v (rad/s)."""
-        from .bldc import BLDCMotor
+        from ...models.bldc import BLDCMotor
 
         k = ACTUATORS.index(actuator)
         N = self.ratios()[k]

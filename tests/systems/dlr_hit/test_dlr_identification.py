@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 from gripkit.cli import main
-from gripkit.control.impedance import ImpedanceController, simulate_impedance
+from gripkit.systems.dlr_hit.impedance import ImpedanceController, simulate_impedance
 from gripkit.errors import DataError, IdentificationError, UnidentifiableError
 from gripkit.sysid.friction import (constant_velocity_friction, detect_breakaway, fit_stribeck, idim_ls,
                                     table_from_points)
-from gripkit.zoo.dlr_hit import finger
+from gripkit.systems.dlr_hit.parameters import finger
 
 DEG = math.pi / 180
 FS = 1000.0

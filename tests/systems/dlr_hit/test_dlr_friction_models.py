@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 
 from gripkit.errors import DataError, UnidentifiableError
-from gripkit.models.friction import FrictionDrive, FrictionTable, Stribeck, dlr_hit_table
+from gripkit.models.friction import FrictionDrive, FrictionTable, Stribeck
+from gripkit.systems.dlr_hit.parameters import dlr_hit_table
 from gripkit.sysid.friction import fit_stribeck
-from gripkit.zoo.dlr_hit import finger_parameters
+from gripkit.systems.dlr_hit.parameters import thesis_finger_parameters
 
 DEG = math.pi / 180
 
@@ -88,7 +89,7 @@ def test_stick_slip_velocity_reversal():
 def test_stribeck_defaults_are_the_fits_of_the_tables():
     """The zoo's Stribeck option parameters are fit_stribeck's estimates on Appendix G's tables
     (F_s = 0.36 N·m, v_s = 0.1 rad/s, δ = 2 fixed), within their standard deviations."""
-    p = finger_parameters().value
+    p = thesis_finger_parameters().value
     for table, name in ((dlr_hit_table("distal"), "distal"), (dlr_hit_table("base"), "base1")):
         fit = fit_stribeck(table.velocity, table.values, fixed=dict(fs=0.36, vs=0.1, delta=2.0))
         assert abs(fit.values["fc"] - p(f"fc_{name}")) < fit.std["fc"]
@@ -125,7 +126,7 @@ def test_harmonic_drive_ripple_in_the_finger():
     """§3.2.2: friction varying sinusoidally with the output position. With ripple_amp = 0.03 N·m
     and 200 periods per revolution, the distal friction of a constant-PWM run deviates from the
     table by 0.03·sin(200·p)·sign(v)."""
-    from gripkit.zoo.dlr_hit import finger
+    from gripkit.systems.dlr_hit.parameters import finger
 
     f = finger(check=False, ripple_amp=0.03, g_x=0.0, g_y=-9.81, g_z=0.0)
     tr = f.simulate(np.tile([0.0, 0.0, 3000.0], (300, 1)), dt=1e-3, x0=f.state(q=(0.0, 0.0, 0.1)))

@@ -8,9 +8,10 @@ import pytest
 
 from gripkit.cli import main
 from gripkit.errors import ModelError, SimulationError
-from gripkit.models.dlr_finger import ACTUATORS, DLRFinger
+from gripkit.systems.dlr_hit.finger import ACTUATORS, DLRFinger
 from gripkit.params import ParameterSet
-from gripkit.zoo.dlr_hit import FINGERS, finger, finger_parameters, finger_tables, hand
+from gripkit.systems.dlr_hit.parameters import FINGERS, finger, thesis_finger_parameters, finger_tables
+from gripkit.systems.dlr_hit.hand import hand
 
 DEG = math.pi / 180
 # start configurations at one end of the travel of each actuator (joint angles abd, flex, prox)
@@ -166,7 +167,7 @@ def test_zoo_check_reports_the_thesis_contradictions(capsys):
 
 
 def test_bad_finger_inputs():
-    ps = finger_parameters()
+    ps = thesis_finger_parameters()
     with pytest.raises(ModelError, match="FINGER_PARAMETERS"):
         DLRFinger(ParameterSet(list(ps.values())[:-1]), finger_tables())
     with pytest.raises(ModelError, match="friction"):

@@ -21,20 +21,19 @@ Rotor inertia I_m = 5.1·10⁻⁷ kg·m² (Appendix A), reflected through N = 20
 from __future__ import annotations
 
 import math
+from importlib import resources
 
 import numpy as np
 
-from ..consistency import Finding, compare
-from ..errors import ModelError, SimulationError
-from ..models.bldc import BLDCMotor, motor_parameters
-from ..models.dlr_finger import (ACTUATORS, FINGER_PARAMETERS, FRICTION_MODES, INTEGRATORS, NTH,
-                                 NX, DLRFinger, run_jobs)
-from ..models.friction import dlr_hit_table
-from ..params import Parameter, ParameterSet
-from ..sim.model import Model, Signal
+from ...consistency import Finding, compare
+from ...errors import ModelError
+from ...models.bldc import BLDCMotor, motor_parameters
+from .finger import ACTUATORS, FINGER_PARAMETERS, DLRFinger
+from ...models.friction import FrictionTable
+from ...params import Parameter, ParameterSet
 
-__all__ = ["finger_parameters", "finger_tables", "finger", "hand", "DLRHITFinger", "DLRHand",
-           "FINGERS", "palm_frames", "TABLE_6_1", "BASE2_CORRECTION"]
+__all__ = ["thesis_finger_parameters", "dlr_hit_table", "finger_tables", "finger", "DLRHITFinger", "FINGERS",
+           "TABLE_6_1", "BASE2_CORRECTION"]
 
 SEED = "002_ddea254371185ad3.txt"
 DEG = math.pi / 180.0
@@ -51,13 +50,25 @@ DYNAMICS_INFLUENCE = 7.1e-3
 FINGERS = ("thumb", "index", "middle", "ring", "little")
 
 
+def dlr_hit_table(joint: str, scale: float = 1.0) -> FrictionTable:
+    """Appendix G's friction table for ``'distal'`` or ``'base'`` (recovered from the extraction;
+    see the comment header of the shipped CSV files)."""
+    if joint not in ("distal", "base"):
+        raise ModelError(f"joint: expected 'distal' or 'base', found {joint!r}")
+    fname = f"dlr_hit_friction_{joint}.csv"
+    text = resources.files("gripkit.systems.dlr_hit").joinpath("data", fname).read_text()
+    return FrictionTable.from_text(text, f"DLR/HIT II {joint} friction",
+                                   f"002_ddea254371185ad3.txt, Appendix G "
+                                   f"(gripkit/systems/dlr_hit/data/{fname})", scale)
+
+
 def _pc(k):
     return {1: (3.0164510e-02, -1.0130813e-03, 5.0813186e-04),
             2: (5.7271879e-03, -1.6164173e-03, -1.1567914e-03),
             3: (6.1007977e-03, -8.3348211e-04, 1.7728256e-03)}[k]
 
 
-def finger_parameters(**overrides) -> ParameterSet:
+def thesis_finger_parameters(**overrides) -> ParameterSet:
     """The finger's parameters (every name of :data:`FINGER_PARAMETERS`) with provenance;
     ``overrides`` replace values (SI, or strings with units)."""
     F = f"{SEED}, Appendix F"
@@ -165,17 +176,17 @@ def finger_tables(base2_scale: float = 1.0, clean: bool = False):
 
 
 class DLRHITFinger(DLRFinger):
-    """:class:`~gripkit.models.dlr_finger.DLRFinger` with the thesis's numbers and its checks."""
+    """:class:`~gripkit.systems.dlr_hit.finger.DLRFinger` with the thesis's numbers and its checks."""
 
     def consistency_checks(self) -> list[Finding]:
-        return _finger_checks(self)
+        return finger_consistency_checks(self)
 
 
 def finger(*, friction: str = "table", integrator: str = "semi-implicit", thermal: bool = False,
            check: bool = True, clean_tables: bool = False, **overrides) -> DLRHITFinger:
     """The DLR/HIT Hand II finger of chapter 7 (Fig. 7.1); ``overrides`` replace parameter values
     (SI), ``clean_tables`` drops Appendix G's two outlying points."""
-    return DLRHITFinger(finger_parameters(**overrides), finger_tables(clean=clean_tables),
+    return DLRHITFinger(thesis_finger_parameters(**overrides), finger_tables(clean=clean_tables),
                         friction=friction, integrator=integrator, thermal=thermal, check=check)
 
 
@@ -215,7 +226,7 @@ def max_gravity_torque(model, n: int = 13) -> np.ndarray:
     return np.array([np.abs(g[:, 0]).max(), np.abs(g[:, 1]).max(), np.abs(g[:, 2] + g[:, 3]).max()])
 
 
-def _finger_checks(model) -> list[Finding]:
+def finger_consistency_checks(model) -> list[Finding]:
     subj = model.name
     v = model.parameters.value
     out = list(_motor(model).consistency_checks())
@@ -291,146 +302,3 @@ def _finger_checks(model) -> list[Finding]:
                        used="gripkit uses the full pc vectors; the thesis puts the centres of mass on the link axes",
                        source=f"{SEED}, Appendix F (M1)"))
     return out
-
-
-# --- the five-finger hand -------------------------------------------------------------------------
-
-def palm_frames() -> np.ndarray:
-    """Finger base frames in the palm frame (5, 4, 4): thumb, index, middle, ring, little.
-
-    Palm frame: x towards the fingertips, y towards the thumb, z out of the back of the hand.
-    A finger's base frame has x along the straight finger and z on its abduction axis (the palm
-    normal); positive flexion curls towards −z, the palm side. The four fingers sit side by side
-    22 mm apart at the end of a 90 mm palm, the middle finger 5 mm further out. The thumb is fixed
-    (§3.1: "the thumb is fixed in an appropriate orientation of the palm") at the palm's side,
-    pointing forward, outward and down, its flexion curling towards the fingers (−z of its frame
-    along −y of the palm). These distances and angles are assumed: the thesis does not give the
-    palm geometry.
-    """
-    T = np.tile(np.eye(4), (5, 1, 1))
-    for i, (y, x) in enumerate(((0.033, 0.090), (0.011, 0.095), (-0.011, 0.090), (-0.033, 0.082)), start=1):
-        T[i, :3, 3] = (x, y, 0.0)
-    x0 = np.array([0.9, 0.3, -0.3])
-    x0 /= np.linalg.norm(x0)
-    z0 = np.array([0.0, 1.0, 0.0]) - x0[1] * x0
-    z0 /= np.linalg.norm(z0)
-    T[0, :3, :3] = np.column_stack([x0, np.cross(z0, x0), z0])
-    T[0, :3, 3] = (0.030, 0.050, -0.020)
-    return T
-
-
-def _hand_parameters(finger_ps: ParameterSet, scales: dict | None) -> ParameterSet:
-    ps = list(finger_ps.values())
-    for i, n in enumerate(("g_x", "g_y", "g_z")):
-        idx = finger_ps.names.index(n)
-        p = ps[idx]
-        ps[idx] = Parameter(p.name, p.value, p.unit, f"gravity in the palm frame, {'xyz'[i]}",
-                            p.bounds, p.fixed, "assumed: palm horizontal, facing down")
-    for f in FINGERS:
-        for a in ACTUATORS:
-            base = finger_ps.value(f"scale_{a}")
-            val = (scales or {}).get(f, {}).get(a, 1.0) * base
-            ps.append(Parameter(f"{f}_scale_{a}", val, "1", f"friction factor, {f} finger, {a} drive",
-                                bounds=(0, None),
-                                source=f"{SEED}, §6.3 (friction differs from finger to finger); default: the measured finger"))
-    return ParameterSet(ps, "dlr-hit-hand")
-
-
-class DLRHand(Model):
-    """Five DLR/HIT II fingers on a palm (§3.1): four fingers and a thumb fixed in its
-    orientation, each with its own friction factors (§6.3). Every finger is a
-    :class:`~gripkit.models.dlr_finger.DLRFinger`; gravity is given in the palm frame and rotated
-    into each finger's base frame (:func:`palm_frames`).
-
-    Inputs: 15 PWM counts, finger-major (``thumb_pwm_base1``, ..., ``little_pwm_distal``);
-    outputs: the 18 finger outputs per finger, prefixed with the finger name; states: 15 per finger.
-    """
-
-    name = "dlr-hit-hand"
-    description = "DLR/HIT Hand II: five identical modular fingers (thumb fixed) on a palm"
-    inputs = tuple(Signal(f"{f}_{s.name}", s.unit, s.doc) for f in FINGERS for s in DLRFinger.inputs)
-    outputs = tuple(Signal(f"{f}_{s.name}", s.unit, s.doc) for f in FINGERS for s in DLRFinger.outputs)
-    states = tuple(Signal(f"{f}_{s.name}", s.unit, s.doc) for f in FINGERS for s in DLRFinger.states)
-
-    def __init__(self, parameters: ParameterSet | None = None, *, friction: str = "table",
-                 integrator: str = "semi-implicit", thermal: bool = False, check: bool = True,
-                 scales: dict | None = None):
-        ps = parameters if parameters is not None else _hand_parameters(finger_parameters(), scales)
-        if ps.names[:NTH] != FINGER_PARAMETERS or len(ps) != NTH + 15:
-            raise ModelError("DLRHand: expected the finger parameters followed by 15 friction factors")
-        self.frames = palm_frames()
-        self._finger = DLRHITFinger(ParameterSet([ps[n] for n in FINGER_PARAMETERS], "dlr-hit-finger"),
-                                    finger_tables(), friction=friction, integrator=integrator,
-                                    thermal=thermal, check=False)
-        self.friction = friction
-        self.integrator = integrator
-        self.thermal = bool(thermal)
-        super().__init__(ps, check=check)
-
-    def finger_model(self, which: str) -> DLRHITFinger:
-        """The finger ``which`` as a stand-alone model (its friction factors and gravity applied)."""
-        i = FINGERS.index(which)
-        p = self.parameters.value
-        g = self.frames[i, :3, :3].T @ np.array([p("g_x"), p("g_y"), p("g_z")])
-        ov = {f"scale_{a}": p(f"{which}_scale_{a}") for a in ACTUATORS}
-        ov.update(g_x=g[0], g_y=g[1], g_z=g[2])
-        fp = ParameterSet([self.parameters[n] for n in FINGER_PARAMETERS], "dlr-hit-finger").replace(**ov)
-        return DLRHITFinger(fp, finger_tables(), friction=self.friction, integrator=self.integrator,
-                            thermal=self.thermal, check=False, name=f"dlr-hit-{which}")
-
-    def state(self, q=None, **kw) -> np.ndarray:
-        """Initial state (75): ``q`` maps finger names to joint angles (abd, flex, prox)."""
-        x = np.concatenate([self._finger.state(q=(q or {}).get(f, (0.0, 0.0, 0.0)), **kw) for f in FINGERS])
-        return x
-
-    def initial_state(self, theta):
-        return self.state()
-
-    #: run the fingers on parallel threads (compiles a parallel kernel on first use)
-    parallel = False
-
-    def finger_thetas(self, theta: np.ndarray) -> np.ndarray:
-        """The five finger parameter vectors (5, 74) of a hand parameter vector: the shared
-        parameters with each finger's friction factors and its gravity (Rᵀ g_palm)."""
-        th = np.tile(theta[:NTH], (5, 1))
-        i_s = FINGER_PARAMETERS.index("scale_base1")
-        i_g = FINGER_PARAMETERS.index("g_x")
-        g = theta[i_g:i_g + 3]
-        for f in range(5):
-            th[f, i_s:i_s + 3] = theta[NTH + 3 * f:NTH + 3 * f + 3]
-            th[f, i_g:i_g + 3] = self.frames[f, :3, :3].T @ g
-        return th
-
-    def _simulate_batch(self, thetas, u, dt, substeps, x0, y):
-        P = thetas.shape[0]
-        ths = np.concatenate([self.finger_thetas(t) for t in thetas])
-        x0f = np.ascontiguousarray(x0.reshape(P * 5, NX))
-        jobs = np.arange(P * 5)
-        fail = run_jobs(ths, u, 3 * (jobs % 5), dt, substeps, x0f, y, jobs // 5, 18 * (jobs % 5),
-                        self._finger._tab, FRICTION_MODES[self.friction],
-                        INTEGRATORS[self.integrator], self.thermal, self.parallel)
-        if fail.any():
-            raise SimulationError(f"{self.name}: a finger's mass matrix lost positive definiteness")
-
-    def modes(self, theta):
-        return self._finger.modes(theta[:NTH])
-
-    def fingertips(self, trajectory) -> dict:
-        """Fingertip positions in the palm frame, {finger: (N, 3)}, from a simulated trajectory."""
-        out = {}
-        for i, f in enumerate(FINGERS):
-            ch = self._finger.chain(base=self.frames[i])
-            q = np.column_stack([trajectory[f"{f}_{j}"] for j in ("abd", "flex", "prox")])
-            p = np.linalg.solve(ch.coupling.matrix[:3], q.T).T
-            out[f] = ch.tip_position(p)
-        return out
-
-    def consistency_checks(self):
-        return _finger_checks(self._finger)
-
-
-def hand(*, friction: str = "table", integrator: str = "semi-implicit", thermal: bool = False,
-         check: bool = True, scales: dict | None = None) -> DLRHand:
-    """The five-finger DLR/HIT Hand II; ``scales`` = {finger: {actuator: factor}} sets per-finger
-    friction relative to the measured finger."""
-    return DLRHand(friction=friction, integrator=integrator, thermal=thermal, check=check, scales=scales)

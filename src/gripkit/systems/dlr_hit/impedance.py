@@ -22,7 +22,7 @@ torque becomes a PWM count through the inverse of eq 5.10 at the measured motor 
 ±4096, held over the 1 kHz control period.
 
 The control law and the wall run inside the finger's own simulation kernel
-(:func:`gripkit.models.dlr_finger.finger_run` with ``ctrl`` = 1 or 2), so closed-loop studies
+(:func:`gripkit.systems.dlr_hit.finger.finger_run` with ``ctrl`` = 1 or 2), so closed-loop studies
 cost no extra compilation.
 
 Contact: a planar wall (unit normal n pointing out of the wall, a point on it) of stiffness k_w
@@ -43,10 +43,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import ModelError, SimulationError
-from ..models.dlr_finger import ACTUATORS, FRICTION_MODES, NX, DLRFinger, finger_run
-from ..models.friction import FrictionTable, table_arrays
-from ..signals.trajectory import Trajectory
+from ...errors import ModelError, SimulationError
+from .finger import ACTUATORS, FRICTION_MODES, NX, DLRFinger, finger_run
+from ...models.friction import FrictionTable, table_arrays
+from ...signals.trajectory import Trajectory
 
 __all__ = ["ImpedanceController", "Wall", "simulate_impedance", "stability_margins",
            "impedance_margins", "model_friction_tables"]

@@ -24,16 +24,17 @@ def _fig(n, w=11.0, h=3.4):
 
 
 def run(report, *, quick: bool = False) -> dict:
-    from ..consistency import check
-    from ..control.impedance import ImpedanceController, Wall, impedance_margins, simulate_impedance
-    from ..errors import ConsistencyWarning
-    from ..estimation.friction_adaptation import adapt_finger_friction
-    from ..models.bldc import RPM, SLOPES_5_4_2, BLDCMotor, MotorTestBed
-    from ..models.dlr_finger import ACTUATORS
-    from ..signals import Trajectory
-    from ..sysid.friction import detect_breakaway, fit_stribeck, idim_ls
-    from ..sysid.motor import characterize_motor
-    from ..zoo.dlr_hit import finger, hand
+    from ...consistency import check
+    from .impedance import ImpedanceController, Wall, impedance_margins, simulate_impedance
+    from ...errors import ConsistencyWarning
+    from .friction_adaptation import adapt_finger_friction
+    from ...models.bldc import RPM, SLOPES_5_4_2, BLDCMotor, MotorTestBed
+    from .finger import ACTUATORS
+    from ...signals import Trajectory
+    from ...sysid.friction import detect_breakaway, fit_stribeck, idim_ls
+    from ...sysid.motor import characterize_motor
+    from .parameters import finger
+    from .hand import hand
 
     summary: dict = {}
     with warnings.catch_warnings():
