@@ -44,35 +44,33 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ConfigError, GripkitError
-from ..io.toml_file import read_toml
-from ..signals.trajectory import Trajectory
+from . import zoo
+from .errors import ConfigError, GripkitError
+from .io import load
+from .io.toml_file import read_toml
+from .models.hysteresis import BoucWen
+from .models.mass_spring_damper import MassSpringDamper
+from .models.piezo import PiezoActuator
+from .signals.trajectory import Trajectory
+from .systems.tsfm import parameters as tsfm
 
 __all__ = ["Description", "MODEL_TYPES", "register_model_type", "load_description", "simulate_description",
            "input_signal"]
 
 
 def _msd(params, options):
-    from ..models.mass_spring_damper import MassSpringDamper
-
     return MassSpringDamper(check=False)
 
 
 def _bouc_wen(params, options):
-    from ..models.hysteresis import BoucWen
-
     return BoucWen(check=False)
 
 
 def _piezo(params, options):
-    from ..models.piezo import PiezoActuator
-
     return PiezoActuator(loads=bool(options.get("loads", True)), check=False)
 
 
 def _finger(params, options):
-    from ..systems.tsfm import parameters as tsfm
-
     side = {"tsfm-left": "left", "tsfm-right": "right"}.get(options.get("zoo", "tsfm-left"))
     if side is None:
         raise ConfigError(f"[model] zoo = {options.get('zoo')!r}: a TSFM finger type starts from 'tsfm-left' "
@@ -89,8 +87,6 @@ def _finger_contact(params, options):
 
 
 def _gripper(params, options):
-    from ..systems.tsfm import parameters as tsfm
-
     return tsfm.gripper(check=False)
 
 
@@ -172,7 +168,6 @@ def input_signal(spec: Mapping, t: np.ndarray, where: str, base: Path | None = N
         for v, a, b in zip(lv, edges[:-1], edges[1:]):
             out[(t >= a) & (t < b)] = float(v)
         return out
-    from ..io import load
 
     if "path" not in spec or "column" not in spec:
         raise ConfigError(f"{where}: kind 'file' needs 'path' and 'column'")
@@ -199,8 +194,6 @@ def load_description(path, overrides: Mapping | None = None) -> Description:
     mtype = mspec.get("type")
     try:
         if mtype is None:
-            from .. import zoo
-
             model = zoo.build(mspec["zoo"])
         elif mtype in MODEL_TYPES:
             model = MODEL_TYPES[mtype](params, mspec)

@@ -22,6 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ConfigError, DataError
+from ..io import load
 from ..progress import track
 from .executors import Executor, make_executor
 
@@ -47,8 +48,6 @@ def _resolve(identifier) -> Callable:
 
 def identify_file(path: str, identifier, options: dict, load_options: dict) -> dict:
     """Load one file and identify (runs inside a worker)."""
-    from ..io import load
-
     tr = load(path, **load_options)
     res = _resolve(identifier)(tr, **options)
     if not isinstance(res, dict) or "params" not in res:

@@ -25,7 +25,11 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ConfigError, DataError
+from ..units import to_si
 from .montecarlo import Estimate, binned_probability, probability, quantile
+from .spec import SweepSpec
+from .store import ResultStore
+from .sweep import sweep
 
 __all__ = ["DEFAULT_POPULATION", "DEFAULT_SETTINGS", "RobustnessResult", "robustness_study", "analyse"]
 
@@ -162,8 +166,6 @@ def analyse(columns: dict | str | Path, *, stiffness: str | None = None, bins=No
     ``settling_time``; ``lost`` when present. ``stiffness``: the column to bin by (default
     ``k_e``, or ``k0`` for the FT-G100); ``bins``: edges (default 6 log-spaced bins over its range)."""
     if isinstance(columns, (str, Path)):
-        from .store import ResultStore
-
         columns = ResultStore(columns).read()
     elif hasattr(columns, "columns") and not isinstance(columns, dict):
         columns = columns.columns
@@ -208,10 +210,6 @@ def robustness_study(population: dict | None = None, *, settings: dict | None = 
     ``[parameters]`` entries; default :data:`DEFAULT_POPULATION`) with the controller and pass
     criteria ``settings`` (the sweep's ``[scenario]`` table; default :data:`DEFAULT_SETTINGS`), and
     analyse them (:func:`analyse`). ``backend`` etc. as in :func:`gripkit.batch.sweep`."""
-    from ..units import to_si
-    from .spec import SweepSpec
-    from .sweep import sweep
-
     if n < 1:
         raise ConfigError(f"n: expected a positive number of grasps, found {n}")
     pop = dict(DEFAULT_POPULATION if population is None else population)

@@ -13,6 +13,9 @@ import importlib
 import numpy as np
 
 from ..errors import ConfigError
+from ..sim.model import Model
+from ..sysid.step_response import step_metrics as one
+from .spec import _si
 
 __all__ = ["SCENARIOS", "resolve", "step_response", "step_metrics"]
 
@@ -43,8 +46,6 @@ def step_metrics(t: np.ndarray, y: np.ndarray, band: float = 0.02) -> dict[str, 
     """Step-response metrics of each row of ``y`` (P, N) from rest: final value (mean of the last
     10 %), peak, overshoot %, 10–90 % rise time and settling time into ±``band``
     (:func:`gripkit.sysid.step_response.step_metrics` per row)."""
-    from ..sysid.step_response import step_metrics as one
-
     rows = [one(t, yi, y_initial=0.0, band=band) for yi in np.atleast_2d(y)]
     return {"final": np.array([r["y_final"] for r in rows]), "peak": np.array([r["peak"] for r in rows]),
             **{k: np.array([r[k] for r in rows]) for k in ("overshoot_percent", "rise_time", "settling_time")}}
@@ -53,11 +54,8 @@ def step_metrics(t: np.ndarray, y: np.ndarray, band: float = 0.02) -> dict[str, 
 def step_response(model, params: dict[str, np.ndarray], settings: dict) -> dict[str, np.ndarray]:
     """Step of ``amplitude`` on input ``input`` (default: the first) for ``duration`` s at ``fs`` Hz;
     metrics of output ``output`` (default: the first), see :func:`step_metrics`."""
-    from ..sim.model import Model
-
     if not isinstance(model, Model):
         raise ConfigError("scenario 'step-response' needs a simulation model ([sweep] model = ...)")
-    from .spec import _si
 
     fs = _si(settings.get("fs", 20000.0), "[scenario] fs")
     duration = _si(settings.get("duration", 0.05), "[scenario] duration")

@@ -42,6 +42,8 @@ import numpy as np
 
 from ..errors import DataError, IdentificationError, UnidentifiableError
 from ..models.friction import FrictionTable
+from ..signals.filters import apply_sos, butter_sos
+from .regression import hac_covariance
 
 __all__ = ["Pulse", "BreakawayResult", "detect_breakaway", "ConstantVelocityPoint",
            "constant_velocity_friction", "table_from_points", "StribeckFit", "fit_stribeck",
@@ -382,8 +384,6 @@ def idim_ls(position, effort, fs: float, *, effort_scale: float = 1.0, cutoff: f
         Also drop the samples within ``guard/cutoff`` seconds of a velocity reversal, where the
         filtered Coulomb step does not follow sign(q̇).
     """
-    from ..signals.filters import apply_sos, butter_sos
-
     x, e = _same_length(position=position, effort=effort)
     if not (np.isfinite(fs) and fs > 0):
         raise DataError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
@@ -455,7 +455,6 @@ def idim_ls(position, effort, fs: float, *, effort_scale: float = 1.0, cutoff: f
     s2 = float(r @ r / (n - 4))
     # filtering, differentiation and decimation leave the residuals autocorrelated: the
     # Newey-West covariance, not s²(XᵀX)⁻¹ (which would understate σ)
-    from .regression import hac_covariance
 
     cov = hac_covariance(X, r)
     std = np.sqrt(np.diag(cov))

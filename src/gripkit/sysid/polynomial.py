@@ -25,6 +25,8 @@ import numpy as np
 from scipy import signal as _sig
 
 from ..errors import DataError, ModelError
+from ..params import Parameter, ParameterSet
+from .validation import validate
 
 __all__ = ["PolynomialModel"]
 
@@ -281,8 +283,6 @@ class PolynomialModel:
     def parameters(self):
         """The free coefficients as a :class:`~gripkit.params.ParameterSet` (SI units: ``b``
         in output unit per input unit, the others dimensionless), with their std."""
-        from ..params import Parameter, ParameterSet
-
         bunit = _ratio_unit(self.output_unit, self.input_unit)
         std = self.theta_std
         src = self.info.get("source", f"identified ({self.label})")
@@ -436,8 +436,6 @@ class PolynomialModel:
     def validate(self, u, y, **kw):
         """Free-run and one-step validation on a separate record; see
         :func:`gripkit.sysid.validate`."""
-        from .validation import validate
-
         return validate(self, u, y, **kw)
 
     # ------------------------------------------------------------------ exports

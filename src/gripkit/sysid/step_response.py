@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import AccuracyWarning, DataError, IdentificationError, SimulationError
-from ..models.second_order import SecondOrderSystem, second_order_step
+from ..models.second_order import SecondOrderSystem, _ratio_unit, second_order_step
 from ..signals.trajectory import Trajectory
 from .greybox import GreyboxResult, fit
 
@@ -276,7 +276,6 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
         warnings.warn(f"step-response fit of {output!r}: the fitted response settles in "
                       f"{m['settling_time']:.3g} s, longer than the {data.duration:.3g} s record; the gain "
                       f"is extrapolated", AccuracyWarning, stacklevel=2)
-    from ..models.second_order import _ratio_unit
 
     gunit = _ratio_unit(data.unit(output), data.unit(input))
     return StepResponseResult(

@@ -9,6 +9,7 @@ import pytest
 from gripkit.cli import main
 from gripkit.systems.ftg100.model import SEED_EQ10
 from gripkit.systems.ftg100.identification import step_experiment
+from gripkit.io import save
 
 
 def run(capsys, *args):
@@ -58,7 +59,7 @@ def test_identify_step_json(capsys, tmp_path):
     """`gripkit identify step DATA --input V_in --output x_a --json` on the simulated §III-B step:
     f_n = 1757 Hz and ζ = 0.043 of eq 9 at the seed's values, within 3σ."""
     path = tmp_path / "step.csv"
-    step_experiment(duration=0.05, seed=4).save(path)
+    save(step_experiment(duration=0.05, seed=4), path)
     code, out, err = run(capsys, "identify", "step", str(path), "--input", "V_in", "--output", "x_a", "--json")
     assert code == 0
     d = json.loads(out)
@@ -91,7 +92,7 @@ def test_identify_step_bad_input(capsys, tmp_path, make, args, pattern):
     if make == "const":
         d = d.with_channels(V_in=np.full(d.n, 70.0))
     if make != "missing":
-        d.save(path)
+        save(d, path)
     if make == "nan":
         text = path.read_text().splitlines()
         text[10] = text[10].rsplit(",", 1)[0] + ",nan"

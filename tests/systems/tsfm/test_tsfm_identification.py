@@ -15,6 +15,7 @@ from gripkit.systems.tsfm.identification import identify_compliance, to_tip_a
 from gripkit.systems.tsfm.end_effector import sensor_parameters
 from gripkit.sysid.modal import free_vibration
 from gripkit.systems.tsfm import parameters as z
+from gripkit.io import save
 
 AMPS = (100.0, 60.0, 30.0)
 
@@ -142,13 +143,13 @@ def test_bad_data():
 
 def test_cli_identify(tmp_path, capsys, left, loops, ringing):
     """The interfaces of the issue: JSON keys and values of `gripkit identify modal|bouc-wen`."""
-    ringing[0].save(tmp_path / "ring.csv")
+    save(ringing[0], tmp_path / "ring.csv")
     assert main(["identify", "modal", str(tmp_path / "ring.csv"), "--signal", "F", "--json"]) == 0
     r = json.loads(capsys.readouterr().out)
     assert r["natural_frequency_hz"] == pytest.approx(8520.0, rel=0.002)
     assert r["damping_ratio"] == pytest.approx(0.006, rel=0.1)
     assert r["natural_frequency_std_hz"] > 0 and r["damping_ratio_std"] > 0
-    loops.save(tmp_path / "loops.parquet")
+    save(loops, tmp_path / "loops.parquet")
     assert main(["identify", "bouc-wen", str(tmp_path / "loops.parquet"), "--input", "U", "--output", "y_B",
                  "--json"]) == 0
     r = json.loads(capsys.readouterr().out)

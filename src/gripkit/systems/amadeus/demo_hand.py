@@ -14,7 +14,16 @@ import time
 
 import numpy as np
 
+from ...consistency import check
+from ...control import design_rst, simulate_loop
+from ...estimation import fused_variance, implied_correlation
 from ...progress import status
+from . import (GraspScenario, SlipDetector, calibrate_force_sensor, calibrate_speed, estimate_force,
+               false_alarm_rate, simulate_finger_grasp, spectral_features, step_metrics)
+from .bellows_finger import BAR, PRINCIPAL_DIRECTIONS
+from .parameters import TABLE_I, amadeus_hand
+from .pvdf import SlipTestbed, nonslip_grasp_inputs, pvdf_noise, slip_onset_inputs
+from .strain_gauge_sensor import single_bridge_estimates
 
 FS_PVDF = 2000.0
 
@@ -29,8 +38,6 @@ def _fig(*args, **kw):
 
 
 def _bending(report, z, rng, summary):
-    from .bellows_finger import BAR, PRINCIPAL_DIRECTIONS
-
     f, valve = z.finger, z.valve
     sec = report.section(
         "AMADEUS finger: bending in the six principal directions (Fig. 8)",
@@ -88,11 +95,6 @@ def _bending(report, z, rng, summary):
 
 
 def _fusion(report, z, rng, summary, quick):
-    from . import calibrate_force_sensor, estimate_force
-    from ...estimation import fused_variance, implied_correlation
-    from .strain_gauge_sensor import single_bridge_estimates
-    from .parameters import TABLE_I
-
     s = z.sensor
     sec = report.section(
         "Fingertip force sensor: calibration and stochastic fusion (Table I, Fig. 10)",
@@ -157,9 +159,6 @@ def _fusion(report, z, rng, summary, quick):
 
 
 def _slip(report, z, rng, summary, quick):
-    from . import SlipDetector, calibrate_speed, false_alarm_rate, spectral_features
-    from .pvdf import SlipTestbed, nonslip_grasp_inputs, pvdf_noise, slip_onset_inputs
-
     c = z.contact
     sec = report.section(
         "Slip detection with the PVDF film (Figs 12-13)",
@@ -251,9 +250,6 @@ def _slip(report, z, rng, summary, quick):
 
 
 def _control(report, z, det, rng, summary, quick):
-    from . import GraspScenario, simulate_finger_grasp, step_metrics
-    from ...control import design_rst, simulate_loop
-
     p = z.plant
     sec = report.section(
         "Finger force control on the Table II [2 2 2] model (§V-G)",
@@ -339,9 +335,6 @@ def _control(report, z, det, rng, summary, quick):
 
 
 def run(report, *, quick: bool = False) -> dict:
-    from ...consistency import check
-    from .parameters import amadeus_hand
-
     rng = np.random.default_rng(20240611)
     z = amadeus_hand(check=False)
     summary: dict = {}

@@ -23,6 +23,12 @@ import time
 import warnings
 
 import numpy as np
+from ...consistency import ConsistencyReport, check
+from ...excitation import bandlimited_noise, multisine
+from ...signals.filters import apply_sos
+from ...sysid import arx, oe, rls
+from .force_dynamics import (FORCE_SCALE, FS, TABLE_II, TABLE_III,
+                             finger_force_model as build_plant, reference, seed_checks)
 
 __all__ = ["run", "NOISE_UNITS"]
 
@@ -50,12 +56,7 @@ def run(report, *, quick: bool = False) -> dict:
     """Add the section to ``report``; returns the summary numbers. The records are the paper's
     (400 and 4000 samples), so the section takes a few seconds once numba's RLS kernel is compiled
     (about 10 s the first time); ``quick`` changes nothing."""
-    from ...excitation import bandlimited_noise, multisine
     from ...report import plots
-    from ...signals.filters import apply_sos
-    from ...sysid import arx, oe, rls
-    from .force_dynamics import FORCE_SCALE, FS, TABLE_II, TABLE_III, reference, seed_checks
-    from .force_dynamics import finger_force_model as build_plant
 
     t_start = time.perf_counter()
     plant = build_plant()
@@ -226,7 +227,6 @@ def run(report, *, quick: bool = False) -> dict:
                "Recursive estimates with ±2σ bands and the true values (dashed).", name="amadeus-rls-convergence")
 
     # ---- consistency of the seed's statements ------------------------------------------------
-    from ...consistency import ConsistencyReport, check
 
     sec.findings(check(plant))
     sec.findings(ConsistencyReport(seed_checks(), "AMADEUS Tables II/III (§V-F statements)"))

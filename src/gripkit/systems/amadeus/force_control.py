@@ -35,6 +35,12 @@ import numpy as np
 
 from ...control.rst import RSTController
 from ...errors import DataError, ModelError, SimulationError
+from ...sysid.step_response import step_metrics as general
+from .force_sensor import ForceDynamics, ForceKalmanFilter
+from .pvdf import StickSlipContact, pvdf_noise
+from .slip import SlipReflex
+from .strain_gauge_sensor import StrainGaugeSensor
+from .valve import ProportionalValve
 
 __all__ = [
     "StepMetrics",
@@ -64,8 +70,6 @@ def step_metrics(y, dt: float, final: float = 1.0, band: float = 0.02) -> StepMe
     """Metrics of a step response ``y`` toward ``final`` (starting from 0), by
     :func:`gripkit.sysid.step_response.step_metrics` plus the undershoot a non-minimum-phase zero
     causes."""
-    from ...sysid.step_response import step_metrics as general
-
     y = np.asarray(y, dtype=np.float64).reshape(-1)
     if y.size < 3 or final == 0:
         raise DataError("step_metrics needs a response of >= 3 samples and a nonzero final value")
@@ -150,10 +154,6 @@ def simulate_finger_grasp(controller: RSTController, plant=None, scenario: Grasp
     ``contact`` a :class:`~gripkit.systems.amadeus.pvdf.StickSlipContact`, ``detector`` a calibrated
     :class:`~gripkit.systems.amadeus.slip.SlipDetector` (required when ``scenario.slip``).
     """
-    from .force_sensor import ForceDynamics, ForceKalmanFilter
-    from .slip import SlipReflex
-    from .valve import ProportionalValve
-
     sc = scenario or GraspScenario()
     p = controller.resolve_plant(plant)
     rng = np.random.default_rng(sc.seed if rng is None else rng)
@@ -169,8 +169,6 @@ def simulate_finger_grasp(controller: RSTController, plant=None, scenario: Grasp
     if sc.slip and (detector is None or detector.threshold is None):
         raise DataError("scenario.slip needs a calibrated SlipDetector (detector=...)")
     if sc.slip and contact is None:
-        from .pvdf import StickSlipContact
-
         contact = StickSlipContact(check=False)
     cap = sc.force_limit - sc.limit_margin
     g_obj = 1.0 if math.isinf(sc.k_object) else sc.k_object / (sc.k_finger + sc.k_object)
@@ -194,8 +192,6 @@ def simulate_finger_grasp(controller: RSTController, plant=None, scenario: Grasp
     kf = None
     if sc.sensor_noise:
         if sensor is None:
-            from .strain_gauge_sensor import StrainGaugeSensor
-
             sensor = StrainGaugeSensor()
         H_sensor = sensor.H
         kf = ForceKalmanFilter(sensor, ForceDynamics.random_walk([50.0, 50.0, kalman_q], h),
@@ -214,7 +210,6 @@ def simulate_finger_grasp(controller: RSTController, plant=None, scenario: Grasp
     contact_t = None
     ref_now = 0.0
     alarms = []
-    from .pvdf import pvdf_noise
 
     noise_pv = pvdf_noise(N * n_sub, sc.pvdf_rate, rng) if sc.slip else None
     for k in range(N):

@@ -38,7 +38,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...consistency import Finding, compare, warn_inconsistent
+from ...errors import DataError, ModelError
 from ...params import Parameter, ParameterSet
+from ...signals.filters import apply_sos, butter_sos, butter_zpk
+from ...signals.trajectory import Trajectory
+from ...sysid._data import as_signal
+from ...sysid.polynomial import PolynomialModel
 
 __all__ = ["ReferenceModel", "TABLE_II", "TABLE_III", "FingerForcePlant", "finger_force_model",
            "seed_checks", "SEED", "FS", "PREFILTER_ORDER", "PREFILTER_CUTOFF", "FORCE_SCALE", "PEAK_FORCE"]
@@ -84,8 +89,6 @@ class ReferenceModel:
 
     def model(self, dt: float = 1.0 / FS):
         """A :class:`~gripkit.sysid.PolynomialModel` with these coefficients (paper units)."""
-        from ...sysid.polynomial import PolynomialModel
-
         std = None if self.A_std is None else {"A": self.A_std, "B": self.B_std}
         return PolynomialModel.from_coefficients(self.A, self.B, nk=self.nk, dt=dt, std=std,
                                                  input_unit="mA", info={"source": self.source})
@@ -153,7 +156,6 @@ def reference(table: str, na: int, nb: int, nk: int, *, filtered: bool = True, d
     for r in rows:
         if (r.na, r.nb, r.nk, r.filtered, r.data) == (na, nb, nk, filtered, data):
             return r
-    from ...errors import ModelError
 
     raise ModelError(f"no row [{na} {nb} {nk}] (data {data}, filtered={filtered}) in Table {table}")
 
@@ -188,8 +190,6 @@ class FingerForcePlant:
                    "AC-coupled), ARX [2 2 2] of Table II (9 Hz-filtered data), 200 Hz, 2-sample delay")
 
     def __init__(self):
-        from ...sysid.polynomial import PolynomialModel
-
         row = reference("II", 2, 2, 2)
         sig = reference("III", 2, 2, 2)  # same coefficients, with σ (§V-F: RLS = LS)
         src = f"{SEED}, Table II"
@@ -253,8 +253,6 @@ class FingerForcePlant:
 
     def prefilter_sos(self) -> np.ndarray:
         """The §V-D Butterworth (2nd order, 9 Hz at 200 Hz) as second-order sections."""
-        from ...signals.filters import butter_sos
-
         return butter_sos(PREFILTER_ORDER, PREFILTER_CUTOFF, FS)
 
     def simulate(self, current, *, noise_std: float = 0.0, seed: int | None = None, prefilter: bool = False,
@@ -283,10 +281,6 @@ class FingerForcePlant:
             Channels ``current`` (A), ``force`` (N, deviation, noisy if ``noise_std``),
             ``force_true`` (N, noise-free) and optionally ``force_filtered`` (N).
         """
-        from ...errors import DataError
-        from ...signals.trajectory import Trajectory
-        from ...sysid._data import as_signal
-
         i = as_signal(current, "current")
         up = None if current_past is None else np.asarray(current_past, dtype=np.float64) - OPERATING_POINT
         f_true = self.model.simulate(i - OPERATING_POINT, initial=initial, y_past=force_past, u_past=up)
@@ -295,8 +289,6 @@ class FingerForcePlant:
         f = f_true + noise_std * np.random.default_rng(seed).standard_normal(i.size) if noise_std else f_true
         ch = {"current": i, "force": f, "force_true": f_true}
         if prefilter:
-            from ...signals.filters import apply_sos
-
             ch["force_filtered"] = apply_sos(self.prefilter_sos(), f)
         return Trajectory.uniform(FS, units={k: ("A" if k == "current" else "N") for k in ch},
                                   meta={"source": f"simulated {self.name}"}, **ch)
@@ -315,8 +307,6 @@ class FingerForcePlant:
 
     def consistency_checks(self) -> list[Finding]:
         """§V statements the plant's numbers must satisfy (see also :func:`seed_checks`)."""
-        from ...signals.filters import butter_zpk
-
         out = []
         subj = self.name
         z222 = reference("II", 2, 2, 2).model().zeros()

@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from ...control.rst import DiscretePlant
 from ...errors import (
     AccuracyWarning, DataError, IdentificationError, ModelError, UnidentifiableError,
 )
@@ -452,8 +453,6 @@ class ForceDynamics:
 
         ``plant`` is anything :meth:`gripkit.control.DiscretePlant.from_model` accepts; its output
         must be in N and its input is what ``u`` will hold (deviation from the operating point)."""
-        from ...control.rst import DiscretePlant
-
         p = DiscretePlant.from_model(plant)
         ss = p.to_state_space()
         npl = ss.n_states

@@ -27,8 +27,15 @@ import math
 import numpy as np
 
 from ...consistency import Finding, compare, warn_inconsistent
+from ...control.rst import DiscretePlant
+from ...estimation.fusion import fused_variance, implied_correlation
 from ...params import Parameter, ParameterSet
-from .force_dynamics import PEAK_FORCE
+from .bellows_finger import BellowsFinger
+from .force_dynamics import FORCE_SCALE, PEAK_FORCE, finger_force_model
+from .hand import AmadeusHand
+from .pvdf import StickSlipContact
+from .strain_gauge_sensor import StrainGaugeSensor
+from .valve import ProportionalValve
 
 __all__ = ["AmadeusHandSystem", "amadeus_hand", "force_plant", "table2_plant", "TABLE_I", "table1_findings"]
 
@@ -49,8 +56,6 @@ FS = 200.0
 def table2_plant():
     """The ``[2 2 2]`` model in the seed's units (mA → force-sensor units), as a
     :class:`~gripkit.control.DiscretePlant`."""
-    from ...control.rst import DiscretePlant
-
     return DiscretePlant(TABLE2_A, TABLE2_B, 1.0 / FS, input_name="i", input_unit="mA", output_name="F",
                          output_unit="force units", source=f"{_SEED} Table II [2 2 2] (S_1, 9 Hz filter)")
 
@@ -58,9 +63,6 @@ def table2_plant():
 def force_plant() -> tuple:
     """(plant in SI (A → N), force_scale N/unit): the zoo model ``amadeus-finger-force``
     (:func:`gripkit.systems.amadeus.force_dynamics.finger_force_model`) as a DiscretePlant, and its force scale."""
-    from ...control.rst import DiscretePlant
-    from .force_dynamics import FORCE_SCALE, finger_force_model
-
     m = finger_force_model().model
     plant = DiscretePlant(m.A, m.B, m.dt, input_name="i", input_unit="A", output_name="F", output_unit="N",
                           source="gripkit.systems.amadeus.force_dynamics.finger_force_model (Table II [2 2 2] x force_scale)")
@@ -75,8 +77,6 @@ def table1_findings() -> list[Finding]:
     """Table I checked: the theoretical column from eq 18 (generalised) of the measured single
     variances, and the measured fused variances against that theory (with the correlation between
     combinations that would explain the excess)."""
-    from ...estimation.fusion import fused_variance, implied_correlation
-
     a, th = TABLE_I["actual"], TABLE_I["theoretical"]
     combos = {"e12": ("e1", "e2"), "e23": ("e2", "e3"), "e123": ("e1", "e2", "e3")}
     out = []
@@ -115,12 +115,6 @@ class AmadeusHandSystem:
                    "force sensor (eqs 9-19), PVDF slip sensor, Table II force dynamics")
 
     def __init__(self, *, check: bool = True):
-        from .hand import AmadeusHand
-        from .bellows_finger import BellowsFinger
-        from .pvdf import StickSlipContact
-        from .strain_gauge_sensor import StrainGaugeSensor
-        from .valve import ProportionalValve
-
         self.finger = BellowsFinger(check=False)
         self.valve = ProportionalValve(check=False)
         self.sensor = StrainGaugeSensor()

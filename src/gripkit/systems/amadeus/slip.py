@@ -39,6 +39,7 @@ import numba
 import numpy as np
 
 from ...errors import DataError, IdentificationError
+from ...signals.filters import butter_sos
 
 __all__ = [
     "SlipDetector",
@@ -320,8 +321,6 @@ class SlipDetector:
                  min_duration: float = 0.002, release: float = 0.5, hold: float = 0.05,
                  threshold: float | None = None, feature_window: float = 0.1,
                  speed_calibration: SpeedCalibration | None = None):
-        from ...signals.filters import butter_sos
-
         if not (np.isfinite(fs) and fs > 0):
             raise DataError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
         self.fs = float(fs)

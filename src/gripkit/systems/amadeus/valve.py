@@ -52,6 +52,7 @@ import numpy as np
 from numba import prange
 
 from ...consistency import Finding, compare
+from ...control.rst import DiscretePlant
 from ...errors import DataError, SimulationError
 from ...params import Parameter, ParameterSet
 from ...sim.model import Model, Signal
@@ -292,8 +293,6 @@ def pressure_to_force_plant(force_plant, valve: ProportionalValve):
     B(q) is divided by the valve's central slope k_v (the input becomes the static pressure
     demand in the linear region, as in the seed's Fig. 14). ``force_plant`` is anything
     :meth:`gripkit.control.DiscretePlant.from_model` accepts."""
-    from ...control.rst import DiscretePlant
-
     plant = DiscretePlant.from_model(force_plant)
     return DiscretePlant(plant.A, np.asarray(plant.B) / valve.gain, plant.dt, input_name="p_demand",
                          input_unit="Pa", output_name=plant.output_name, output_unit=plant.output_unit,

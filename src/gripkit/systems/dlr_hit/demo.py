@@ -8,6 +8,17 @@ import math
 import warnings
 
 import numpy as np
+from ...consistency import check
+from ...errors import ConsistencyWarning
+from ...models.bldc import RPM, SLOPES_5_4_2, BLDCMotor, MotorTestBed
+from ...signals import Trajectory
+from ...sysid.friction import detect_breakaway, fit_stribeck, idim_ls
+from ...sysid.motor import characterize_motor
+from .finger import ACTUATORS
+from .friction_adaptation import adapt_finger_friction
+from .hand import hand
+from .impedance import ImpedanceController, Wall, impedance_margins, simulate_impedance
+from .parameters import finger
 
 DEG = math.pi / 180
 NCM = 0.01
@@ -24,18 +35,6 @@ def _fig(n, w=11.0, h=3.4):
 
 
 def run(report, *, quick: bool = False) -> dict:
-    from ...consistency import check
-    from .impedance import ImpedanceController, Wall, impedance_margins, simulate_impedance
-    from ...errors import ConsistencyWarning
-    from .friction_adaptation import adapt_finger_friction
-    from ...models.bldc import RPM, SLOPES_5_4_2, BLDCMotor, MotorTestBed
-    from .finger import ACTUATORS
-    from ...signals import Trajectory
-    from ...sysid.friction import detect_breakaway, fit_stribeck, idim_ls
-    from ...sysid.motor import characterize_motor
-    from .parameters import finger
-    from .hand import hand
-
     summary: dict = {}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ConsistencyWarning)

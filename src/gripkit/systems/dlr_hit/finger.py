@@ -50,6 +50,10 @@ import numpy as np
 from numba import prange
 
 from ...errors import ModelError, SimulationError
+from ...models.bldc import BLDCMotor, bldc_torque, motor_heat_step, temperature_factor
+from ...models.friction import (FrictionTable, Stribeck, lugre_force, lugre_update, ripple,
+                                stribeck, table_arrays, table_friction)
+from ...models.transmission import transmit_torque
 from ...multibody.coupling import CoupledChain, Coupling, differential_matrix
 from ...multibody.dh import DHChain
 from ...multibody.kernels import (
@@ -58,11 +62,6 @@ from ...multibody.kernels import (
 )
 from ...params import ParameterSet
 from ...sim.model import Model, Signal
-from ...models.bldc import bldc_torque, motor_heat_step, temperature_factor
-from ...models.friction import (
-    FrictionTable, lugre_force, lugre_update, ripple, stribeck, table_arrays, table_friction,
-)
-from ...models.transmission import transmit_torque
 
 __all__ = ["FINGER_PARAMETERS", "ACTUATORS", "JOINTS", "FRICTION_MODES", "DLRFinger",
            "finger_step", "finger_step_rk4", "finger_setup", "finger_context", "finger_run",
@@ -884,8 +883,6 @@ class DLRFinger(Model):
         if self.friction == "table":
             return p(f"scale_{actuator}") * self.tables[k](v)
         if self.friction in ("stribeck", "lugre"):
-            from ...models.friction import Stribeck
-
             s = Stribeck(p(f"fc_{actuator}"), p(f"fs_{actuator}"), p("v_s"),
                          p("delta") if self.friction == "stribeck" else 2.0, p(f"visc_{actuator}"))
             cubic = p(f"cubic_{actuator}") * v ** 3 if self.friction == "stribeck" else 0.0
@@ -894,8 +891,6 @@ class DLRFinger(Model):
 
     def motor_torque(self, actuator: str, pwm, v, T=None) -> np.ndarray:
         """Motor torque at the actuator output (N·m) for PWM and actuator velocity v (rad/s)."""
-        from ...models.bldc import BLDCMotor
-
         k = ACTUATORS.index(actuator)
         N = self.ratios()[k]
         ps = ParameterSet([self.parameters[n] for n in ("c_pwm", "b_pwm", "b_0", "pwm_max", "T_ref",

@@ -12,6 +12,16 @@ import numpy as np
 
 from ...consistency import check
 from ...errors import AccuracyWarning, ConsistencyWarning
+from ...models.beams import clamped_clamped_stiffness
+from ...models.comb_drive import comb_drive_force, comb_drive_gain
+from ...signals.trajectory import Trajectory
+from ...sysid.step_response import identify_step
+from .hybrid_control import (HybridForcePosition, grasp_batch, impact_speed_limit,
+                             simulate_hybrid_grasp)
+from .identification import identify_actuated, identify_sensing, release_experiment, step_experiment
+from .model import (SEED_EQ10, SEED_EQ17, FTG100Actuated, FTG100Coupled, FTG100Plant, FTG100Sensing,
+                    amplification_ratio, ftg100_geometry, seed_state_space)
+from .parameters import PAPER_VALUES
 
 SEED = "003_abd62b560633beaf.txt"
 
@@ -32,22 +42,6 @@ def _pm(v, s, scale=1.0, digits=4):
 
 
 def run(report, *, quick: bool = False) -> dict:
-    from .hybrid_control import (
-        HybridForcePosition, grasp_batch, impact_speed_limit, simulate_hybrid_grasp,
-    )
-    from ...models.beams import clamped_clamped_stiffness
-    from ...models.comb_drive import comb_drive_force, comb_drive_gain
-    from .model import (
-        SEED_EQ10, SEED_EQ17, FTG100Actuated, FTG100Coupled, FTG100Plant, FTG100Sensing,
-        amplification_ratio, ftg100_geometry, seed_state_space,
-    )
-    from ...signals.trajectory import Trajectory
-    from ...sysid.step_response import identify_step
-    from .parameters import PAPER_VALUES
-    from .identification import (
-        identify_actuated, identify_sensing, release_experiment, step_experiment,
-    )
-
     plt = _plt()
     summary: dict = {}
     with warnings.catch_warnings():

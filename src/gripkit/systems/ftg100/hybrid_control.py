@@ -45,12 +45,13 @@ from dataclasses import asdict, dataclass, replace
 import numba
 import numpy as np
 
+from ...control.pid import PID, PID_NPARAM, pid_step, pid_transfer
 from ...errors import ConfigError, SimulationError
-from .model import advance_plant, plant_outputs
 from ...params import ParameterSet
+from ...progress import track
 from ...signals.trajectory import Trajectory
 from ...sim.noise import normal_draw
-from ...control.pid import PID, PID_NPARAM, pid_step, pid_transfer
+from .model import FTG100Plant, advance_plant, plant_outputs, plant_parameters as _pp
 
 __all__ = ["HybridForcePosition", "HybridController", "hybrid_step", "simulate_hybrid_grasp", "grasp_batch",
            "HybridGraspResult", "GraspBatch", "METRICS", "impact_speed_limit"]
@@ -207,8 +208,6 @@ class HybridForcePosition:
     def for_plant(cls, plant_parameters: ParameterSet | None = None, **overrides) -> "HybridForcePosition":
         """Tuned defaults with the actuator model (D_a, K_sa, K₃, c_e, V_max) taken from an
         :class:`~gripkit.systems.ftg100.model.FTG100Plant` parameter set (the nominal one by default)."""
-        from .model import plant_parameters as _pp
-
         ps = plant_parameters if plant_parameters is not None else _pp()
         base = dict(lever=ps.value("D_a"), k1=ps.value("K_sa"), k3=ps.value("K3_a"), c_e=ps.value("c_e"),
                     v_max=ps.value("V_max"), k_contact=ps.value("K_sb") / ps.value("D_b") ** 2)
@@ -422,8 +421,6 @@ class GraspBatch:
 
 def _prepare(controller, plant, force, k0, gap, seed, noise_force, noise_position, damage_threshold,
              duration):
-    from .model import FTG100Plant
-
     plant = plant if plant is not None else FTG100Plant(check=False)
     if not isinstance(plant, FTG100Plant):
         raise ConfigError(f"plant: expected an FTG100Plant, found {type(plant).__name__}")
@@ -489,8 +486,6 @@ def grasp_batch(controller: HybridForcePosition | list | None = None, plant=None
 
 
 def _run(thetas, cps, fprofs, NF, NX, S, ts, sub, band, dmg, n_steps, record, progress):
-    from ...progress import track
-
     P = thetas.shape[0]
     if not (math.isfinite(band) and 0 < band < 1):
         raise ConfigError(f"band: expected a fraction in (0, 1), found {band!r}")
@@ -546,8 +541,6 @@ def impact_speed_limit(force: float, k0: float, plant_parameters: ParameterSet |
     FT-G100 and a glass ball; damped only by the structure and the contact, ζ ≈ 0.002 with the
     seed's pure spring). Hence v ≤ fraction · F / √(k0 m_r): 0.48 mm/s for 20 µN, k0 = 1560 N/m.
     """
-    from .model import plant_parameters as _pp
-
     ps = plant_parameters if plant_parameters is not None else _pp()
     ma = ps.value("M_a") / ps.value("D_a") ** 2
     mb = ps.value("M_b") / ps.value("D_b") ** 2

@@ -16,7 +16,12 @@ import warnings
 
 import numpy as np
 
+from ...consistency import check
+from ...estimation import ContactDetector
 from ...progress import status
+from ...sysid.bouc_wen import loop_error
+from . import GraspSettings, TipPositionEstimator, parameters as z, simulate_two_finger_grasp
+from .identification import identify_finger
 
 
 def _fig(*args, **kw):
@@ -29,8 +34,6 @@ def _fig(*args, **kw):
 
 
 def _consistency(report, z, summary):
-    from ...consistency import check
-
     sec = report.section(
         "TSFM: the printed parameters and their contradictions",
         "Table II (p. 7) identifies both fingers; §IV-B measured the force sensor's free vibration at 8.52 kHz "
@@ -77,9 +80,6 @@ def _loops(report, z, fingers, summary, quick):
 
 
 def _identify(report, z, fingers, loops, summary, quick):
-    from .identification import identify_finger
-    from ...sysid.bouc_wen import loop_error
-
     sec = report.section(
         "Identification back from simulated measurements (§IV)",
         "Each finger identified as in §IV from noisy simulated records: Bouc-Wen from the 100 V external loop "
@@ -152,8 +152,6 @@ def _identify(report, z, fingers, loops, summary, quick):
 
 
 def _sines(report, z, fingers, ident, summary, quick):
-    from ...sysid.bouc_wen import loop_error
-
     sec = report.section(
         "Sine responses at 10, 50, 100 and 500 Hz (Fig. 12)",
         "100 V sines on the left finger, tip B: the 'measurement' (true model, 20 nm noise) against the identified "
@@ -188,9 +186,6 @@ def _sines(report, z, fingers, ident, summary, quick):
 
 
 def _contact(report, z, fingers, ident, summary, quick):
-    from ...estimation import ContactDetector
-    from . import TipPositionEstimator
-
     sec = report.section(
         "The contact experiment of Fig. 13",
         "The left finger driven by U = 25 (1 − cos 2π 0.1 t) V (0 → 50 → 0 V) against a part (72.5 N/m) whose face "
@@ -236,8 +231,6 @@ def _contact(report, z, fingers, ident, summary, quick):
 
 
 def _microparts(report, z, ident, summary, quick):
-    from . import GraspSettings, simulate_two_finger_grasp
-
     sec = report.section(
         "Width and stiffness of the three microparts of Table III (§V-C, §V-D, eq 16)",
         "Each 300 µm part sits 30 µm off-centre in the 400 µm gap, held by 20 µN of substrate friction. The fingers "
@@ -296,8 +289,6 @@ def _microparts(report, z, ident, summary, quick):
 
 
 def _strategy(report, z, ident, grasps, summary, quick):
-    from . import GraspSettings, simulate_two_finger_grasp
-
     sec = report.section(
         "The two-finger grasp of §I: hold the first contact, or push the part away",
         "The same 72.5 N/m part, 30 µm off-centre, with the naive strategy (both fingers keep closing until both "
@@ -329,8 +320,6 @@ def _strategy(report, z, ident, grasps, summary, quick):
 
 
 def run(report, *, quick: bool = False) -> dict:
-    from . import parameters as z
-
     t0 = time.perf_counter()
     summary: dict = {}
     with warnings.catch_warnings():

@@ -48,11 +48,14 @@ from dataclasses import replace
 import numba
 import numpy as np
 
-from .grasp import GraspSettings
 from ...errors import ConfigError
+from ...estimation.contact_detection import ContactDetector
+from ...progress import track
 from ...units import setting_si
+from .grasp import GraspSettings
 from .grasp_kernels import (_NM, _SQUEEZE, METRICS, GraspTemplate, _default_gripper, _grasp_jobs,
                             _template)
+from .gripper import TSFMGripper
 
 __all__ = ["METRICS", "FAST_GRASP", "tsfm_grasp_batch", "record_metrics", "tsfm_grasp", "GraspTemplate",
            "POPULATION_NAMES"]
@@ -174,8 +177,6 @@ def _run_cpu(tpl, parts, nz, nstd, seeds, n_steps, window, cps, mset, met, threa
     worker process) running the nogil kernel :func:`_grasp_jobs`; the results land in ``met``."""
     from concurrent.futures import ThreadPoolExecutor
 
-    from ...progress import track
-
     P = parts.shape[0]
     threads = max(1, min(numba.get_num_threads() if threads is None else int(threads), P))
     size = max(1, min(64, -(-P // (4 * threads))))   # small slices: even load, a live progress bar
@@ -201,8 +202,6 @@ def record_metrics(result, *, gap: float | None = None, width: float | None = No
     :class:`~gripkit.systems.tsfm.grasp.TwoFingerGraspResult`), computed from its record with
     numpy: the reference the batch kernel is tested against. ``gap``, ``width`` (m) and
     ``stiffness`` (N/m) are the truth for the estimate errors (NaN without them)."""
-    from ...estimation.contact_detection import ContactDetector
-
     tr = result.trajectory
     s = result.settings
     dt = 1.0 / tr.meta["fs"]
@@ -285,8 +284,6 @@ def tsfm_grasp(model, params: dict[str, np.ndarray], settings: dict) -> dict[str
     (the zoo's). Parameters: any of :data:`POPULATION_NAMES`; ``[scenario]``: the
     :class:`GraspSettings` fields and duration, fs, damage_force, lost_displacement, band,
     noise_std (when not a parameter), noise_seed, backend ('cpu' | 'cuda')."""
-    from .gripper import TSFMGripper
-
     if model is not None and not isinstance(model, TSFMGripper):
         raise ConfigError(f"scenario 'tsfm-grasp' needs a TSFM gripper model, found {type(model).__name__}",
                           hint='model = "tsfm-gripper"')

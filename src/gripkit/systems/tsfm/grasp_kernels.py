@@ -12,12 +12,13 @@ import numba
 import numpy as np
 from numba import prange
 
-from ...sim.noise import normal_draw
-from .grasp import _est_stack, _static_gain, _values, grasp_step
 from ...errors import ConsistencyWarning
-from .gripper import FINGER_NAMES, finger_state_space, gripper_advance, gripper_measure
 from ...sim.hybrid import MAX_EVENTS_PER_STEP
 from ...sim.integrators import zoh_levels_into
+from ...sim.noise import normal_draw
+from . import parameters as z
+from .grasp import _est_stack, _static_gain, _values, grasp_step
+from .gripper import FINGER_NAMES, finger_state_space, gripper_advance, gripper_measure
 
 METRICS = ("t_contact1", "t_contact2", "t_squeeze", "peak_force", "damage", "max_displacement", "grasped",
            "lost", "settling_time", "final_error", "final_force", "width_error", "stiffness_error")
@@ -286,8 +287,6 @@ def _template(gripper, dt, estimator_fingers) -> GraspTemplate:
 
 
 def _default_gripper():
-    from . import parameters as z
-
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ConsistencyWarning)
         return z.gripper(check=False)

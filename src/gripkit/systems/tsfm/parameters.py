@@ -31,10 +31,12 @@ import dataclasses
 import numpy as np
 
 from ...consistency import Finding, compare
-from .end_effector import sensor_parameters
-from .gripper import TSFMFinger, TSFMGripper, finger_parameter_set, micropart_parameters
+from ...models.mass_spring_damper import MassSpringDamper
+from ...models.piezo import PiezoActuator
 from ...params import ParameterSet
 from ...signals.trajectory import Trajectory
+from .end_effector import sensor_parameters
+from .gripper import TSFMFinger, TSFMGripper, finger_parameter_set, micropart_parameters
 
 __all__ = ["TABLE_II", "REFERENCE", "ASSUMED_LENGTHS", "TABLE_III", "left_finger", "right_finger", "gripper",
            "table_ii", "finger", "hysteresis_experiment", "step_experiment", "compliance_experiment",
@@ -186,8 +188,6 @@ def compliance_experiment(finger: TSFMFinger, max_force: float = 1e-3, *, fs: fl
     """§IV-C3 / Fig. 11: the FemtoTools probe (resolution 0.4 µN) pushes on the tip B with a slow
     force ramp, no voltage; the actuator (eq 4 with F_A = F, M_A = L_r F) responds dynamically,
     the laser (20 nm) reads y_B. Channels F (N, measured), y_B (m)."""
-    from ...models.piezo import PiezoActuator
-
     v = finger.values()
     act = PiezoActuator(ParameterSet([finger.parameters[n] for n in ("d_p", "s_p", "lam", "beta", "gamma", "a", "b",
                                                                      "L_a")]), check=False)
@@ -206,8 +206,6 @@ def free_vibration_experiment(finger: TSFMFinger, preload: float = 150e-6, *, fs
     """§IV-B / Fig. 8: the sensor alone (before integration), preloaded with ``preload`` N and
     released at t = ``pre``; the force it reads, k_s × deflection, with white noise of ``noise``
     times the preload, for ``duration`` s after the release. Channel F (N)."""
-    from ...models.mass_spring_damper import MassSpringDamper
-
     v = finger.values()
     msd = MassSpringDamper(m=v["m_s"], b=v["b_s"], k=v["k_s"], check=False)
     n = int(round(duration * fs))

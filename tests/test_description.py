@@ -10,7 +10,7 @@ from gripkit.cli import main
 from gripkit.errors import ConfigError
 from gripkit.io import load
 from gripkit.models import MassSpringDamper
-from gripkit.sim.description import input_signal, load_description, simulate_description
+from gripkit.description import input_signal, load_description, simulate_description
 
 MSD = """
 [model]
