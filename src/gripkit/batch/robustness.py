@@ -84,9 +84,9 @@ class RobustnessResult:
                name: str = "batch-robustness"):
         """Add a section: the estimates as a table, histograms of the peak force and of the settling
         time, and P(damage), P(lost) against stiffness with their confidence bands."""
-        from ..report.plots import _plt
+        from ..report.plots import pyplot
 
-        plt = _plt()
+        plt = pyplot()
         sec = report.section(title, intro)
         rows = [["P(damage)", _fmt_p(self.p_damage)]]
         if self.p_lost is not None:

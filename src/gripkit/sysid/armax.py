@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from scipy import signal as _sig
 
-from ._data import check_identifiable, checked_problem
+from .checks import check_identifiable, checked_problem
 from ._pem import covariance, is_stable_poly, levenberg_marquardt, stabilize
 from .arx import arx
 from .polynomial import PolynomialModel

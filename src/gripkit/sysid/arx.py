@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._data import check_identifiable, checked_problem
+from .checks import check_identifiable, checked_problem
 from .polynomial import PolynomialModel
 from .regression import arx_regression, arx_start, qr_solve
 from .validation import fit_percent, loss_vn

@@ -26,6 +26,7 @@ from scipy import signal as _sig
 
 from ..errors import DataError, ModelError
 from ..params import Parameter, ParameterSet
+from ..units import ratio_unit
 from .validation import validate
 
 __all__ = ["PolynomialModel"]
@@ -43,14 +44,6 @@ def _coeffs(x, name: str, monic: bool) -> np.ndarray:
         raise ModelError(f"{name} must start with 1 (monic polynomial), found {a[0]:g}")
     a.flags.writeable = False
     return a
-
-
-def _ratio_unit(num: str, den: str) -> str:
-    if den in ("1", ""):
-        return num or "1"
-    if num in ("1", ""):
-        return f"1/{den}"
-    return f"{num}/{den}"
 
 
 @dataclass(frozen=True, eq=False)
@@ -283,7 +276,7 @@ class PolynomialModel:
     def parameters(self):
         """The free coefficients as a :class:`~gripkit.params.ParameterSet` (SI units: ``b``
         in output unit per input unit, the others dimensionless), with their std."""
-        bunit = _ratio_unit(self.output_unit, self.input_unit)
+        bunit = ratio_unit(self.output_unit, self.input_unit)
         std = self.theta_std
         src = self.info.get("source", f"identified ({self.label})")
         params = []

@@ -47,7 +47,7 @@ import numpy as np
 from numba import njit
 
 from ..errors import DataError, IdentificationError
-from ._data import check_dt, check_excitation, check_io, check_order, require_samples
+from .checks import check_dt, check_excitation, check_io, check_order, require_samples
 from .polynomial import PolynomialModel
 
 __all__ = ["RLS", "RLSResult", "rls"]

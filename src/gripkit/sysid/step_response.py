@@ -32,8 +32,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import AccuracyWarning, DataError, IdentificationError, SimulationError
-from ..models.second_order import SecondOrderSystem, _ratio_unit, second_order_step
+from ..models.second_order import SecondOrderSystem, second_order_step
 from ..signals.trajectory import Trajectory
+from ..units import ratio_unit
 from .greybox import GreyboxResult, fit
 
 __all__ = ["StepResponseResult", "identify_step", "step_metrics", "second_order_metrics"]
@@ -277,7 +278,7 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
                       f"{m['settling_time']:.3g} s, longer than the {data.duration:.3g} s record; the gain "
                       f"is extrapolated", AccuracyWarning, stacklevel=2)
 
-    gunit = _ratio_unit(data.unit(output), data.unit(input))
+    gunit = ratio_unit(data.unit(output), data.unit(input))
     return StepResponseResult(
         gain=K, gain_std=float(std[0]), natural_frequency_hz=wn / (2 * math.pi),
         natural_frequency_hz_std=float(std[1]), damping_ratio=zeta, damping_ratio_std=float(std[2]),

@@ -28,7 +28,7 @@ import numpy as np
 from scipy import stats
 
 from ..errors import DataError, StabilityWarning
-from ._data import check_io
+from .checks import check_io
 
 __all__ = ["fit_percent", "loss_vn", "Comparison", "compare", "ResidualTests", "residual_tests",
            "Validation", "validate"]

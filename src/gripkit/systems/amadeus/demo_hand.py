@@ -18,23 +18,17 @@ from ...consistency import check
 from ...control import design_rst, simulate_loop
 from ...estimation import fused_variance, implied_correlation
 from ...progress import status
-from . import (GraspScenario, SlipDetector, calibrate_force_sensor, calibrate_speed, estimate_force,
-               false_alarm_rate, simulate_finger_grasp, spectral_features, step_metrics)
+from ...report.plots import subplots
 from .bellows_finger import BAR, PRINCIPAL_DIRECTIONS
+from .force_control import GraspScenario, simulate_finger_grasp, step_metrics
+from .force_sensor import calibrate as calibrate_force_sensor
+from .force_sensor import estimate_force
 from .parameters import TABLE_I, amadeus_hand
 from .pvdf import SlipTestbed, nonslip_grasp_inputs, pvdf_noise, slip_onset_inputs
+from .slip import SlipDetector, calibrate_speed, false_alarm_rate, spectral_features
 from .strain_gauge_sensor import single_bridge_estimates
 
 FS_PVDF = 2000.0
-
-
-def _fig(*args, **kw):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt.subplots(*args, **kw)
 
 
 def _bending(report, z, rng, summary):
@@ -52,7 +46,7 @@ def _bending(report, z, rng, summary):
         "pressure, so valve errors change the amount of bending but not its direction (symmetry); midway "
         "between them they turn the direction too.")
     rows = []
-    fig, axes = _fig(1, 2, figsize=(11, 5.2), subplot_kw={"projection": "polar"})
+    fig, axes = subplots(1, 2, figsize=(11, 5.2), subplot_kw={"projection": "polar"})
     err_max = {"min": 0.0, "max": 0.0}
     for ax, variant in zip(axes, ("min", "max")):
         for psi in np.deg2rad(np.arange(0.0, 360.0, 30.0)):
@@ -137,7 +131,7 @@ def _fusion(report, z, rng, summary, quick):
     floor_n = (s.noise_floor / np.array([H[0, 2], H[1, 2], H[2, 2]]) / f0[2]) ** 2
     var_single_th = s.sigma_n2[:3] + floor_n
     theory = fused_variance(var_single_th)
-    fig, ax = _fig(figsize=(8, 4.6))
+    fig, ax = subplots(figsize=(8, 4.6))
     x = np.linspace(0.6, 1.4, 400)
     for j in range(3):
         v = single[:, j].var()
@@ -183,7 +177,7 @@ def _slip(report, z, rng, summary, quick):
                 show[v] = x
     det.speed_calibration = calibrate_speed(recs, sp, FS_PVDF, normal_forces=fn)
     sc = det.speed_calibration
-    fig, axes = _fig(len(show), 1, figsize=(9, 6), sharex=True)
+    fig, axes = subplots(len(show), 1, figsize=(9, 6), sharex=True)
     for ax, (v, x) in zip(axes, show.items()):
         tt = np.arange(x.size) / FS_PVDF
         ax.plot(tt, x * 1e3, lw=0.7)
@@ -201,7 +195,7 @@ def _slip(report, z, rng, summary, quick):
     d = det.detect(x, normal_force=u[:, 0])
     ev = d.events[0]
     tt = np.arange(x.size) / FS_PVDF
-    fig, axes = _fig(3, 1, figsize=(9, 7.5))
+    fig, axes = subplots(3, 1, figsize=(9, 7.5))
     axes[0].plot(tt, x * 1e3, lw=0.6)
     axes[0].axvline(t_on, color="g", ls="--", label="true onset")
     axes[0].axvline(ev.alarm, color="r", label="alarm")
@@ -277,7 +271,7 @@ def _control(report, z, det, rng, summary, quick):
     r = np.r_[np.zeros(20), np.full(n - 20, 2.0)]
     d_in = np.r_[np.zeros(300), np.full(n - 300, 0.01)]
     res = simulate_loop(c, p, r, d_in=d_in)
-    fig, axes = _fig(1, 2, figsize=(11, 4.2))
+    fig, axes = subplots(1, 2, figsize=(11, 4.2))
     axes[0].plot(res.t, res.r, "k--", label="reference")
     axes[0].plot(res.t, res.y, label="force (N)")
     axes[0].axvline(300 * p.dt, color="gray", ls=":", label="input disturbance 10 mA")
@@ -296,7 +290,7 @@ def _control(report, z, det, rng, summary, quick):
                name="amadeus-force-step")
     # grasps of compliant objects with the slip reflex
     rows = []
-    fig, axes = _fig(3, 1, figsize=(10, 8.5), sharex=True)
+    fig, axes = subplots(3, 1, figsize=(10, 8.5), sharex=True)
     shown = None
     for k_obj in (500.0, 2000.0, math.inf):
         sc = GraspScenario(k_object=k_obj, seed=int(rng.integers(1 << 31)))

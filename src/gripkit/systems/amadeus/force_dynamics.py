@@ -42,7 +42,7 @@ from ...errors import DataError, ModelError
 from ...params import Parameter, ParameterSet
 from ...signals.filters import apply_sos, butter_sos, butter_zpk
 from ...signals.trajectory import Trajectory
-from ...sysid._data import as_signal
+from ...sysid.checks import as_signal
 from ...sysid.polynomial import PolynomialModel
 
 __all__ = ["ReferenceModel", "TABLE_II", "TABLE_III", "FingerForcePlant", "finger_force_model",

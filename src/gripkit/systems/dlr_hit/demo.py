@@ -8,9 +8,11 @@ import math
 import warnings
 
 import numpy as np
+
 from ...consistency import check
 from ...errors import ConsistencyWarning
 from ...models.bldc import RPM, SLOPES_5_4_2, BLDCMotor, MotorTestBed
+from ...report.plots import subplots
 from ...signals import Trajectory
 from ...sysid.friction import detect_breakaway, fit_stribeck, idim_ls
 from ...sysid.motor import characterize_motor
@@ -25,12 +27,7 @@ NCM = 0.01
 
 
 def _fig(n, w=11.0, h=3.4):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, ax = plt.subplots(1, n, figsize=(w, h))
+    fig, ax = subplots(1, n, figsize=(w, h))
     return fig, np.atleast_1d(ax)
 
 

@@ -14,6 +14,7 @@ from ...consistency import check
 from ...errors import AccuracyWarning, ConsistencyWarning
 from ...models.beams import clamped_clamped_stiffness
 from ...models.comb_drive import comb_drive_force, comb_drive_gain
+from ...report.plots import pyplot
 from ...signals.trajectory import Trajectory
 from ...sysid.step_response import identify_step
 from .hybrid_control import (HybridForcePosition, grasp_batch, impact_speed_limit,
@@ -26,15 +27,6 @@ from .parameters import PAPER_VALUES
 SEED = "003_abd62b560633beaf.txt"
 
 
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
 def _pm(v, s, scale=1.0, digits=4):
     if s is None or not math.isfinite(s):
         return f"{v * scale:.{digits}g} ± ∞"
@@ -42,7 +34,7 @@ def _pm(v, s, scale=1.0, digits=4):
 
 
 def run(report, *, quick: bool = False) -> dict:
-    plt = _plt()
+    plt = pyplot()
     summary: dict = {}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ConsistencyWarning)  # shown as findings tables instead

@@ -19,18 +19,12 @@ import numpy as np
 from ...consistency import check
 from ...estimation import ContactDetector
 from ...progress import status
+from ...report.plots import subplots
 from ...sysid.bouc_wen import loop_error
-from . import GraspSettings, TipPositionEstimator, parameters as z, simulate_two_finger_grasp
+from . import parameters as z
+from .grasp import GraspSettings, simulate_two_finger_grasp
 from .identification import identify_finger
-
-
-def _fig(*args, **kw):
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt.subplots(*args, **kw)
+from .tip_position import TipPositionEstimator
 
 
 def _consistency(report, z, summary):
@@ -65,7 +59,7 @@ def _loops(report, z, fingers, summary, quick):
         "other, simulated at 20 kHz with the whole-finger model (Bouc-Wen eq 3, D(s), lever, sensor) and kept at "
         "2 kHz. Bouc-Wen's loop is rate independent; at 0.1 Hz D(s) adds only its lag b.")
     data = {side: z.hysteresis_experiment(fingers[side], amps, seed=10 + i) for i, side in enumerate(fingers)}
-    fig, axes = _fig(1, 2, figsize=(11, 4.2))
+    fig, axes = subplots(1, 2, figsize=(11, 4.2))
     for ax, (side, tr) in zip(axes, data.items()):
         for k, A in enumerate(amps):
             m = tr["loop"] == k
@@ -119,7 +113,7 @@ def _identify(report, z, fingers, loops, summary, quick):
     res = ident["left"]
     f = fingers["left"]
     st = z.step_experiment(f, seed=30)
-    fig, axes = _fig(1, 3, figsize=(14, 3.8))
+    fig, axes = subplots(1, 3, figsize=(14, 3.8))
     model = res.finger.simulate({"U": st["U"], "F_g": np.zeros(st.n)}, dt=1 / st.fs)
     y0, y1 = st["y_B"][:10].mean(), model["y_B"][-1]
     axes[0].plot(st.t * 1e3, (st["y_B"] - y0) / (y1 - y0), ".", ms=3, label="measured (simulated)")
@@ -160,7 +154,7 @@ def _sines(report, z, fingers, ident, summary, quick):
     f, fi = fingers["left"], ident["left"].finger
     fs = 20000.0
     rng = np.random.default_rng(50)
-    fig, axes = _fig(1, 4, figsize=(16, 3.8))
+    fig, axes = subplots(1, 4, figsize=(16, 3.8))
     rows = []
     for ax, fr in zip(axes, (10.0, 50.0, 100.0, 500.0)):
         n = int(round(3 * fs / fr))
@@ -204,7 +198,7 @@ def _contact(report, z, fingers, ident, summary, quick):
     summary.update(contact_on_V=float(tr["U"][i_on]), contact_off_V=float(tr["U"][i_off]),
                    peak_force_uN=float(tr["F_g"].max() * 1e6), location_um=float(yhat[i_det] * 1e6),
                    estimate_max_err_um=float(np.max(np.abs(yhat - tr["y_C"])) * 1e6))
-    fig, axes = _fig(1, 2, figsize=(12, 4.2))
+    fig, axes = subplots(1, 2, figsize=(12, 4.2))
     ax = axes[0]
     ax.plot(tr["U"], tr["y_C"] * 1e6, lw=1.6, label="true y_C")
     ax.plot(tr["U"], yhat * 1e6, "--", lw=1, label="estimated (eq 11)")
@@ -255,7 +249,7 @@ def _microparts(report, z, ident, summary, quick):
                "part moved (µm)"], rows, caption="Table III reproduced: 300 µm parts, 2 µN force noise")
     r = grasps[72.5]
     tr = r.trajectory
-    fig, axes = _fig(1, 3, figsize=(15, 4))
+    fig, axes = subplots(1, 3, figsize=(15, 4))
     axes[0].plot(tr.t, tr["y_C1"] * 1e6, label="finger 1 true")
     axes[0].plot(tr.t, tr["y_hat1"] * 1e6, "--", label="finger 1 estimate")
     axes[0].plot(tr.t, tr["y_C2"] * 1e6, label="finger 2 true")
@@ -301,7 +295,7 @@ def _strategy(report, z, ident, grasps, summary, quick):
                                       settings=GraspSettings(approach_speed=60e-6, wait_for_other=False), seed=72)
     smart = grasps[72.5]
     summary.update(part_moved_strategy_um=smart.part_displacement * 1e6, part_moved_naive_um=naive.part_displacement * 1e6)
-    fig, axes = _fig(1, 2, figsize=(12, 4))
+    fig, axes = subplots(1, 2, figsize=(12, 4))
     for r, lab in ((smart, "§I strategy"), (naive, "naive")):
         tr = r.trajectory
         axes[0].plot(tr.t, (tr["X_p"] - tr["X_p"][0]) * 1e6, label=lab)
