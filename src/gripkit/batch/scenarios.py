@@ -15,7 +15,7 @@ import numpy as np
 from ..errors import ConfigError
 from ..sim.model import Model
 from ..sysid.step_response import step_metrics as one
-from .spec import _si
+from ..units import setting_si
 
 __all__ = ["SCENARIOS", "resolve", "step_response", "step_metrics"]
 
@@ -57,9 +57,9 @@ def step_response(model, params: dict[str, np.ndarray], settings: dict) -> dict[
     if not isinstance(model, Model):
         raise ConfigError("scenario 'step-response' needs a simulation model ([sweep] model = ...)")
 
-    fs = _si(settings.get("fs", 20000.0), "[scenario] fs")
-    duration = _si(settings.get("duration", 0.05), "[scenario] duration")
-    amplitude = _si(settings.get("amplitude", 1.0), "[scenario] amplitude")
+    fs = setting_si(settings.get("fs", 20000.0), "[scenario] fs")
+    duration = setting_si(settings.get("duration", 0.05), "[scenario] duration")
+    amplitude = setting_si(settings.get("amplitude", 1.0), "[scenario] amplitude")
     in_names = [s.name for s in model.inputs]
     out_names = [s.name for s in model.outputs]
     inp = settings.get("input", in_names[0])

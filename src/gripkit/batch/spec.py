@@ -38,25 +38,12 @@ import numpy as np
 
 from ..errors import ConfigError
 from ..io.toml_file import read_toml
+from ..units import setting_si as _si
 
 __all__ = ["SweepSpec"]
 
 _GRID_KINDS = ("grid", "values", "linspace", "logspace")
 _RANDOM_KINDS = ("uniform", "normal", "loguniform")
-
-
-def _si(v, where: str) -> float:
-    if isinstance(v, str):
-        from ..units import to_si
-
-        try:
-            return to_si(v)[0]
-        except Exception as exc:
-            raise ConfigError(f"{where}: cannot read {v!r} as a quantity ({exc})") from None
-    try:
-        return float(v)
-    except (TypeError, ValueError):
-        raise ConfigError(f"{where}: expected a number or a quantity like '3 mg', found {v!r}") from None
 
 
 @dataclass(frozen=True)
