@@ -14,10 +14,10 @@ import numpy as np
 
 from ..errors import ConfigError
 from ..sim.model import Model
-from ..sysid.step_response import step_metrics as one
+from ..sysid.step_response import step_metrics
 from ..units import setting_si
 
-__all__ = ["SCENARIOS", "resolve", "step_response", "step_metrics"]
+__all__ = ["SCENARIOS", "resolve", "step_response", "step_metrics_rows"]
 
 SCENARIOS: dict[str, str] = {
     "step-response": "gripkit.batch.scenarios:step_response",
@@ -42,18 +42,18 @@ def resolve(name):
         raise ConfigError(f"scenario {name!r}: cannot import {target!r} ({exc})") from None
 
 
-def step_metrics(t: np.ndarray, y: np.ndarray, band: float = 0.02) -> dict[str, np.ndarray]:
+def step_metrics_rows(t: np.ndarray, y: np.ndarray, band: float = 0.02) -> dict[str, np.ndarray]:
     """Step-response metrics of each row of ``y`` (P, N) from rest: final value (mean of the last
     10 %), peak, overshoot %, 10–90 % rise time and settling time into ±``band``
     (:func:`gripkit.sysid.step_response.step_metrics` per row)."""
-    rows = [one(t, yi, y_initial=0.0, band=band) for yi in np.atleast_2d(y)]
+    rows = [step_metrics(t, yi, y_initial=0.0, band=band) for yi in np.atleast_2d(y)]
     return {"final": np.array([r["y_final"] for r in rows]), "peak": np.array([r["peak"] for r in rows]),
             **{k: np.array([r[k] for r in rows]) for k in ("overshoot_percent", "rise_time", "settling_time")}}
 
 
 def step_response(model, params: dict[str, np.ndarray], settings: dict) -> dict[str, np.ndarray]:
     """Step of ``amplitude`` on input ``input`` (default: the first) for ``duration`` s at ``fs`` Hz;
-    metrics of output ``output`` (default: the first), see :func:`step_metrics`."""
+    metrics of output ``output`` (default: the first), see :func:`step_metrics_rows`."""
     if not isinstance(model, Model):
         raise ConfigError("scenario 'step-response' needs a simulation model ([sweep] model = ...)")
 
@@ -79,4 +79,4 @@ def step_response(model, params: dict[str, np.ndarray], settings: dict) -> dict[
     u = np.zeros((n, len(in_names)))
     u[:, in_names.index(inp)] = amplitude
     y = model.simulate_batch(thetas, u, 1.0 / fs)[:, :, out_names.index(out)]
-    return step_metrics(np.arange(n) / fs, y, float(settings.get("band", 0.02)))
+    return step_metrics_rows(np.arange(n) / fs, y, float(settings.get("band", 0.02)))

@@ -44,6 +44,4 @@ from .slip import spectral_features as spectral_features
 from .slip import stick_slip_rate as stick_slip_rate
 from .force_control import FingerGraspResult as FingerGraspResult
 from .force_control import GraspScenario as GraspScenario
-from .force_control import StepMetrics as StepMetrics
 from .force_control import simulate_finger_grasp as simulate_finger_grasp
-from .force_control import step_metrics as step_metrics

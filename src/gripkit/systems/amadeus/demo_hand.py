@@ -18,9 +18,10 @@ from ...consistency import check
 from ...control import design_rst, simulate_loop
 from ...estimation import fused_variance, implied_correlation
 from ...progress import status
+from ...sysid.step_response import step_metrics
 from ...report.plots import subplots
 from .bellows_finger import BAR, PRINCIPAL_DIRECTIONS
-from .force_control import GraspScenario, simulate_finger_grasp, step_metrics
+from .force_control import GraspScenario, simulate_finger_grasp
 from .force_sensor import calibrate as calibrate_force_sensor
 from .force_sensor import estimate_force
 from .parameters import TABLE_I, amadeus_hand
@@ -253,16 +254,16 @@ def _control(report, z, det, rng, summary, quick):
         f"({z.force_scale:.4g} N per unit, assumed: the 500 mA span covers the 15.45 N peak force).")
     c = design_rst(p, wn=15.0, zeta=0.9, u_min=-0.25, u_max=0.25)
     y = c.reference_response(240)
-    m = step_metrics(y, p.dt)
+    m = step_metrics(np.arange(y.size) * p.dt, y, y_initial=0.0, y_final=1.0)
     mg = c.margins()
     poles = c.closed_loop_poles()
     sec.table(["quantity", "value", "specification"], [
         ["plant zeros", ", ".join(f"{complex(zz).real:.4f}" for zz in p.zeros()), "NMP zero kept"],
         ["closed-loop pole radius (max)", float(np.abs(poles).max()), "< 1"],
-        ["rise time 10-90 % (s)", m.rise_time, "<= 0.20"],
-        ["overshoot (%)", 100 * m.overshoot, "<= 2"],
-        ["undershoot, NMP (%)", 100 * m.undershoot, "<= 10"],
-        ["settling time 2 % (s)", m.settling_time, "<= 0.40"],
+        ["rise time 10-90 % (s)", m["rise_time"], "<= 0.20"],
+        ["overshoot (%)", m["overshoot_percent"], "<= 2"],
+        ["undershoot, NMP (%)", m["undershoot_percent"], "<= 10"],
+        ["settling time 2 % (s)", m["settling_time"], "<= 0.40"],
         ["gain margin (dB)", mg["gain_margin_db"], ">= 6"],
         ["phase margin (deg)", mg["phase_margin_deg"], ">= 45"],
         ["sensitivity peak Ms", mg["sensitivity_peak"], "<= 2"],
@@ -323,7 +324,7 @@ def _control(report, z, det, rng, summary, quick):
     sec.table(["object stiffness (N/m)", "contact (s)", "max force (N)", "limit (N)", "slip alarms",
                "slip interval (s)", "slide after 2 s (mm)"], rows,
               caption="Force-limited grasps with the slip reflex in the loop.")
-    summary.update(rise_time_s=m.rise_time, overshoot_pct=100 * m.overshoot, undershoot_pct=100 * m.undershoot,
+    summary.update(rise_time_s=m["rise_time"], overshoot_pct=m["overshoot_percent"], undershoot_pct=m["undershoot_percent"],
                    gain_margin_db=mg["gain_margin_db"], phase_margin_deg=mg["phase_margin_deg"],
                    grasp_max_force=max(r[2] for r in rows))
 

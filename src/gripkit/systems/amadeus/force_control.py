@@ -35,7 +35,6 @@ import numpy as np
 
 from ...control.rst import RSTController
 from ...errors import DataError, ModelError, SimulationError
-from ...sysid.step_response import step_metrics as general
 from .force_sensor import ForceDynamics, ForceKalmanFilter
 from .pvdf import StickSlipContact, pvdf_noise
 from .slip import SlipReflex
@@ -43,40 +42,10 @@ from .strain_gauge_sensor import StrainGaugeSensor
 from .valve import ProportionalValve
 
 __all__ = [
-    "StepMetrics",
-    "step_metrics",
     "GraspScenario",
     "FingerGraspResult",
     "simulate_finger_grasp",
 ]
-
-
-# ------------------------------------------------------------------------------- metrics
-@dataclass(frozen=True)
-class StepMetrics:
-    """Step-response figures: ``rise_time`` (10–90 %, s), ``overshoot`` and ``undershoot``
-    (fractions of the final value), ``settling_time`` (s, within ``band`` of the final value),
-    ``final`` value and ``steady_state_error`` (fraction)."""
-
-    rise_time: float
-    overshoot: float
-    undershoot: float
-    settling_time: float
-    final: float
-    steady_state_error: float
-
-
-def step_metrics(y, dt: float, final: float = 1.0, band: float = 0.02) -> StepMetrics:
-    """Metrics of a step response ``y`` toward ``final`` (starting from 0), by
-    :func:`gripkit.sysid.step_response.step_metrics` plus the undershoot a non-minimum-phase zero
-    causes."""
-    y = np.asarray(y, dtype=np.float64).reshape(-1)
-    if y.size < 3 or final == 0:
-        raise DataError("step_metrics needs a response of >= 3 samples and a nonzero final value")
-    m = general(np.arange(y.size) * dt, y, y_initial=0.0, y_final=final, band=band)
-    yn = y / final
-    return StepMetrics(m["rise_time"], m["overshoot_percent"] / 100.0, max(0.0, float(-yn.min())),
-                       m["settling_time"], float(y[-1]), float(abs(1.0 - yn[-1])))
 
 
 # ------------------------------------------------------------------------------- grasp scenario
