@@ -116,7 +116,7 @@ def sensor_parameters(f0_hz: float, zeta: float, *, k_s: float | None = None, m_
     if name == "k_s":
         k = val
         m = k / w**2
-        b = 2.0 * zeta * k / w
+        b = 2.0 * zeta * math.sqrt(k * m)
         sk, sm, sb = known_std, m * math.hypot(rk, 2 * rw), b * math.sqrt(rz**2 + rk**2 + rw**2)
     elif name == "m_s":
         m = val
