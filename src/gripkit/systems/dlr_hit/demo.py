@@ -48,7 +48,20 @@ def run(report, *, quick: bool = False) -> dict:
     sec.findings(rep)
     summary["inconsistent_checks"] = [x.check for x in rep.inconsistent]
 
-    # --- motor maps -------------------------------------------------------------------------------
+    # ---- motor maps -------------------------------------------------------------------------------
+    rng = _motor_maps(sec, summary, quick)
+    _friction(sec, f)
+    _velocity_responses(sec, f, summary)
+    _stiction_and_idim(sec, summary, quick, rng)
+    _adaptation(sec, f, summary, quick)
+    _impedance(sec, f, summary)
+    _hand(sec, summary)
+    return summary
+
+
+def _motor_maps(sec, summary, quick):
+    """BLDC motor maps and their two-stage identification (§5.4); returns the random stream the
+    later parts continue."""
     motor = BLDCMotor()
     fig, ax = _fig(2)
     pwm = np.linspace(0, 4096, 50)
@@ -94,7 +107,12 @@ def run(report, *, quick: bool = False) -> dict:
                       "0.005 Ncm): eq 5.7 and eq 5.8 are recovered; the printed slopes differ from eq 5.8 "
                       "by up to 4.9 %.")
 
-    # --- friction ---------------------------------------------------------------------------------
+    # ---- friction ---------------------------------------------------------------------------------
+    return rng
+
+
+def _friction(sec, f):
+    """Appendix G friction tables and the fitted Stribeck curves."""
     fig, ax = _fig(2)
     fits = []
     for a_i, (name, tab) in enumerate((("distal", f.tables[2]), ("base 1", f.tables[0]))):
@@ -122,7 +140,11 @@ def run(report, *, quick: bool = False) -> dict:
     sec.table(["table", "F_c [N·m]", "±", "σ [N·m·s/rad]", "±", "σ₃ [N·m·s³/rad³]", "±", "rms [N·m]"], fits,
               caption="Stribeck + cubic fits of the tables (the data hold no point below 20 °/s, so v_s is fixed).")
 
-    # --- velocity responses (Figs 7.3–7.5) --------------------------------------------------------
+    # ---- velocity responses (Figs 7.3–7.5) --------------------------------------------------------
+
+
+def _velocity_responses(sec, f, summary):
+    """Velocity responses of the finger (Figs 7.3-7.5)."""
     start = {"distal": (0.0, 0.0, 0.0), "base1": (30 * DEG, 0.0, 0.0), "base2": (-30 * DEG, 0.0, 0.0)}
     fig, ax = _fig(3, 12.0, 3.3)
     rows = []
@@ -149,7 +171,11 @@ def run(report, *, quick: bool = False) -> dict:
                       "at PWM 4000 settles on Appendix G's outlying point at 172 °/s without gravity.")
     summary["steady_velocity_deg_s"] = steady
 
-    # --- stiction and IDIM-LS ----------------------------------------------------------------------
+    # ---- stiction and IDIM-LS ----------------------------------------------------------------------
+
+
+def _stiction_and_idim(sec, summary, quick, rng):
+    """Breakaway detection and IDIM-LS friction identification on a simulated log."""
     fz = finger(check=False, g_x=0.0, g_y=-9.81, g_z=0.0)
     pw, vel, pos = [], [], []
     for q3 in (20, 60):
@@ -192,7 +218,11 @@ def run(report, *, quick: bool = False) -> dict:
                       f"{res.relative_error_percent:.2f} %.")
     summary["idim_error_percent"] = {k: 100 * (res.params[k] - truth[k]) / truth[k] for k in ("inertia", "viscous", "coulomb")}
 
-    # --- adaptation --------------------------------------------------------------------------------
+    # ---- adaptation --------------------------------------------------------------------------------
+
+
+def _adaptation(sec, f, summary, quick):
+    """Online friction adaptation on a finger whose friction drifts."""
     n = 10_000 if quick else 20_000
     t = np.arange(2 * n) * 1e-3
     ref = np.column_stack([10 * DEG * np.sin(2 * np.pi * 0.4 * t), (40 + 30 * np.sin(2 * np.pi * 0.5 * t)) * DEG,
@@ -223,7 +253,11 @@ def run(report, *, quick: bool = False) -> dict:
     summary["adaptation_settling_s"] = settle
     summary["adaptation_stated_s"] = ad.convergence_time()
 
-    # --- impedance experiment ----------------------------------------------------------------------
+    # ---- impedance experiment ----------------------------------------------------------------------
+
+
+def _impedance(sec, f, summary):
+    """Joint and Cartesian impedance control against a wall."""
     N = 4000
     t = np.arange(N) * 1e-3
     ref = np.column_stack([0 * t, (30 + 20 * np.sin(2 * np.pi * 0.5 * t)) * DEG,
@@ -279,7 +313,11 @@ def run(report, *, quick: bool = False) -> dict:
     summary["tracking_rms_deg"] = track
     summary["contact_force_N"] = {"expected": expect, "on": force[True], "off": force[False]}
 
-    # --- the hand ----------------------------------------------------------------------------------
+    # ---- the hand ----------------------------------------------------------------------------------
+
+
+def _hand(sec, summary):
+    """The five-finger hand (§3.1)."""
     h = hand(check=False, scales={"thumb": {"distal": 1.3}, "little": {"distal": 0.8}})
     uh = np.tile([0.0, 0.0, 3000.0] * 5, (600, 1))
     trh = h.simulate(uh, dt=1e-3)
@@ -294,4 +332,3 @@ def run(report, *, quick: bool = False) -> dict:
                     "in an opposing orientation; the thumb's distal friction is 30 % above, the little "
                     "finger's 20 % below the measured finger (§6.3: friction differs from finger to finger).",
                "dlr-hand")
-    return summary

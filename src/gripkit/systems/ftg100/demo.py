@@ -34,17 +34,24 @@ def _pm(v, s, scale=1.0, digits=4):
 
 
 def run(report, *, quick: bool = False) -> dict:
-    plt = pyplot()
     summary: dict = {}
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ConsistencyWarning)  # shown as findings tables instead
         act, sen, cpl = FTG100Actuated(), FTG100Sensing(), FTG100Coupled()
         plant = FTG100Plant()
     fs = 20000.0
+    _model_section(report, summary, act, sen, cpl, plant, fs)
+    free = _step_section(report, act, sen, plant, fs)
+    _resonance_section(report, summary, free, fs, quick)
+    _identification_section(report, summary, quick)
+    _hybrid_section(report, summary, plant, quick)
+    return summary
+
+
+def _model_section(report, summary, act, sen, cpl, plant, fs):
+    """The knowledge-based model and the printed numbers (eqs 3-18)."""
     geo = ftg100_geometry()
     g = geo.value
-
-    # ---------------------------------------------------------------- model and printed numbers
     sec = report.section(
         "FT-G100 MEMS microgripper: knowledge-based model (seed 003)",
         "Boudaoud, Haddab & Le Gorrec (IROS 2010): an electrostatic comb drive closes the actuated arm, a "
@@ -85,6 +92,11 @@ def run(report, *, quick: bool = False) -> dict:
     summary["dc_gain_um_per_V"] = act.dc_gain() * 1e6
 
     # ---------------------------------------------------------------- step responses
+
+
+def _step_section(report, act, sen, plant, fs):
+    """Step responses of the linear subsystems against the printed matrices; returns the free arm."""
+    plt = pyplot()
     sec = report.section("FT-G100: step responses",
                          "Left: the actuated subsystem with the ball grasped, 10 V step at 70 V (eq 9), simulated "
                          "exactly and through the seed's printed eq 10. Middle: the sensing arm released from a "
@@ -125,6 +137,12 @@ def run(report, *, quick: bool = False) -> dict:
     sec.figure(fig, "Step responses: linear subsystems vs the printed matrices; nonlinear free arm", name="ftg100-steps")
 
     # ---------------------------------------------------------------- resonance vs voltage (Fig. 5)
+    return free
+
+
+def _resonance_section(report, summary, free, fs, quick):
+    """Resonance against the actuation voltage (Fig. 5): linearised and identified."""
+    plt = pyplot()
     sec = report.section("FT-G100: resonance vs actuation voltage (Fig. 5)",
                          "The nonlinear plant's free actuated arm linearised at each voltage (line), and the "
                          "resonance identified from simulated ±2 V steps around it with 1 % noise by the general "
@@ -159,6 +177,11 @@ def run(report, *, quick: bool = False) -> dict:
     summary["resonance_hz_0_70_150V"] = [float(free.resonance(v)[0]) for v in (0.0, 70.0, 150.0)]
 
     # ---------------------------------------------------------------- identification
+
+
+def _identification_section(report, summary, quick):
+    """Levenberg-Marquardt identification of the actuated and sensing subsystems (§III-B, §III-D)."""
+    plt = pyplot()
     sec = report.section(
         "FT-G100: Levenberg-Marquardt identification (§III-B, III-D)",
         "Simulated experiments with the seed's values as truth and 1 % output noise. Actuated: 10 V steps "
@@ -204,6 +227,12 @@ def run(report, *, quick: bool = False) -> dict:
     summary["k0_rel_std_20ms"] = r_short.stdev("k0") / r_short.value("k0")
 
     # ---------------------------------------------------------------- hybrid control
+
+
+def _hybrid_section(report, summary, plant, quick):
+    """Hybrid force/position control of a grasp on the nonlinear plant, anti-windup, bumpless switch,
+    sensitivities."""
+    plt = pyplot()
     ctrl = HybridForcePosition.for_plant(plant.parameters)
     sec = report.section(
         "FT-G100: hybrid force/position control of a grasp",
