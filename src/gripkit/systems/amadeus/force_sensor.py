@@ -144,28 +144,9 @@ def _variance_model(pred: np.ndarray, resid: np.ndarray, proportional: bool) -> 
     return a, b, sb
 
 
-def calibrate(loads, readings, *, beam_length: float, phi: tuple[float, float] | None = None,
-              offsets: bool = True, noise: str = "proportional", initial_phi=(0.4, 0.7)) -> SensorCalibration:
-    """Calibrate the six-bridge sensor from readings under known loads (eqs 9–14, 19).
-
-    Parameters
-    ----------
-    loads
-        (n, 3) applied forces [f_x, f_y, f_z] (N). Must load all three axes; φ₁, φ₂ need loads
-        with both x and y components.
-    readings
-        (n, 6) bridge readings R₁..R₆ (V).
-    beam_length
-        l (m); only the products K_j l are identifiable, so l must be given.
-    phi
-        (φ₁, φ₂) in rad if known; ``None`` estimates them (from bridges 4 and 5).
-    offsets
-        Estimate a zero offset per bridge (recommended: real bridges are never balanced).
-    noise
-        ``'proportional'`` (eq 19 plus a floor, fitted to the residuals) or ``'constant'``.
-    """
-    from scipy.optimize import least_squares
-
+def _calibration_data(loads, readings, beam_length, phi, offsets, noise):
+    """Loads F (n, 3), readings R (n, 6) and the regressor Fc (with a column of ones for the
+    offsets), checked: shapes, finite values, enough load cases, all axes excited."""
     F = np.asarray(loads, dtype=np.float64)
     R = np.asarray(readings, dtype=np.float64)
     if F.ndim != 2 or F.shape[1] != 3:
@@ -193,8 +174,14 @@ def calibrate(loads, readings, *, beam_length: float, phi: tuple[float, float] |
     if phi is None and (np.ptp(F[:, 0]) == 0 or np.ptp(F[:, 1]) == 0):
         raise UnidentifiableError("φ₁, φ₂ need loads with varying x and y components",
                                   hint="add x and y loads, or pass phi=(φ1, φ2)")
+    return F, R, Fc
 
-    # step 1: free per-bridge rows (linear LS, reweighted) -> start values, noise model, cross-talk
+
+def _free_rows(Fc, R, offsets, noise):
+    """Step 1: free per-bridge rows by linear least squares, reweighted with the fitted noise model
+    (three passes); the weights W (n, 6) and the cross-talk z-scores of the entries eqs 9-14 say
+    are zero."""
+    n = Fc.shape[0]
     rows = np.zeros((6, Fc.shape[1]))
     W = np.ones((n, 6))
     for _ in range(3):
@@ -213,9 +200,12 @@ def calibrate(loads, readings, *, beam_length: float, phi: tuple[float, float] |
         cov = np.linalg.inv(X.T @ X) * (res @ res) / dof
         se = np.sqrt(np.diag(cov))[:3]
         cross[j] = np.where(_STRUCT_ZERO[j], rows[j, :3] / np.maximum(se, 1e-300), 0.0)
+    return rows, W, cross
 
-    # closed-form start values from the free rows (module docstring of strain_gauge_sensor)
-    l = float(beam_length)
+
+def _start_values(rows, l, phi, offsets, initial_phi):
+    """Closed-form start values from the free rows (module docstring of strain_gauge_sensor):
+    φ₁, φ₂ (unless given), K_j, the offsets; and the parameter names in vector order."""
     h = rows[:, :3]
     if phi is None:
         p2 = math.atan2(-h[3, 0], h[3, 1])
@@ -234,6 +224,36 @@ def calibrate(loads, readings, *, beam_length: float, phi: tuple[float, float] |
     x0 = list(K0) + ([] if phi is not None else [p1, p2]) + (list(rows[:, 3]) if offsets else [])
     names = tuple([f"K{j}" for j in range(1, 7)] + ([] if phi is not None else ["phi1", "phi2"])
                   + ([f"offset{j}" for j in range(1, 7)] if offsets else []))
+    return p1, p2, x0, names
+
+
+def calibrate(loads, readings, *, beam_length: float, phi: tuple[float, float] | None = None,
+              offsets: bool = True, noise: str = "proportional", initial_phi=(0.4, 0.7)) -> SensorCalibration:
+    """Calibrate the six-bridge sensor from readings under known loads (eqs 9–14, 19).
+
+    Parameters
+    ----------
+    loads
+        (n, 3) applied forces [f_x, f_y, f_z] (N). Must load all three axes; φ₁, φ₂ need loads
+        with both x and y components.
+    readings
+        (n, 6) bridge readings R₁..R₆ (V).
+    beam_length
+        l (m); only the products K_j l are identifiable, so l must be given.
+    phi
+        (φ₁, φ₂) in rad if known; ``None`` estimates them (from bridges 4 and 5).
+    offsets
+        Estimate a zero offset per bridge (recommended: real bridges are never balanced).
+    noise
+        ``'proportional'`` (eq 19 plus a floor, fitted to the residuals) or ``'constant'``.
+    """
+    from scipy.optimize import least_squares
+
+    F, R, Fc = _calibration_data(loads, readings, beam_length, phi, offsets, noise)
+    n = F.shape[0]
+    rows, W, cross = _free_rows(Fc, R, offsets, noise)
+    l = float(beam_length)
+    p1, p2, x0, names = _start_values(rows, l, phi, offsets, initial_phi)
 
     def unpack(x):
         K = x[:6]
@@ -291,7 +311,7 @@ def calibrate(loads, readings, *, beam_length: float, phi: tuple[float, float] |
     q2n = (q2 + math.pi) % (2 * math.pi) - math.pi
     params = sensor_parameters(K=K, phi1=q1n, phi2=q2n, beam_length=l, sigma_n2=b,
                                floor=float(np.sqrt(np.mean(a))), k_std=K_std, phi_std=phi_std,
-                               source=f"calibrated from {n} known loads (gripkit.estimation.calibrate)")
+                               source=f"calibrated from {n} known loads (gripkit.systems.amadeus.force_sensor.calibrate)")
     return SensorCalibration(StrainGaugeSensor(params), K, K_std, (q1n, q2n), phi_std,
                              off, off_std, names, cov, b, sb, floor, chi2, cross, n)
 
