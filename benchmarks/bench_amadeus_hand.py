@@ -51,9 +51,8 @@ def _kf_numpy(H, sn2, floor2, Z, q, dt):
 
 def run(quick: bool = False) -> list[dict]:
     from gripkit.control import design_rst
-    from gripkit.systems.amadeus import (
-        ForceDynamics, ForceKalmanFilter, SlipDetector, estimate_force,
-    )
+    from gripkit.systems.amadeus import (ForceDynamics, ForceKalmanFilter, SlipDetector,
+                                         estimate_force)
     from gripkit.systems.amadeus.pvdf import StickSlipContact, nonslip_grasp_inputs, pvdf_noise
     from gripkit.systems.amadeus.strain_gauge_sensor import StrainGaugeSensor
     from gripkit.systems.amadeus.parameters import force_plant

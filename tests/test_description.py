@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 from gripkit.cli import main
+from gripkit.description import input_signal, load_description, simulate_description
 from gripkit.errors import ConfigError
 from gripkit.io import load
 from gripkit.models import MassSpringDamper
-from gripkit.description import input_signal, load_description, simulate_description
 
 MSD = """
 [model]

@@ -14,9 +14,9 @@ import pytest
 from gripkit.cli import main
 from gripkit.excitation import bandlimited_noise, multisine
 from gripkit.io import load
+from gripkit.io import save
 from gripkit.sysid import identify
 from gripkit.systems.amadeus.force_dynamics import finger_force_model
-from gripkit.io import save
 
 SRC = str(Path(__file__).resolve().parents[2] / "src")
 

@@ -16,9 +16,9 @@ from __future__ import annotations
 import numpy as np
 from scipy import signal as _sig
 
-from .checks import check_identifiable, checked_problem
 from ._pem import covariance, is_stable_poly, levenberg_marquardt, stabilize
 from .arx import arx
+from .checks import check_identifiable, checked_problem
 from .polynomial import PolynomialModel
 from .regression import qr_solve
 from .validation import fit_percent, loss_vn

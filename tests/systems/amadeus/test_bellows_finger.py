@@ -8,10 +8,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from gripkit.errors import DataError, ModelError
-from gripkit.systems.amadeus.bellows_finger import (
-    BAR, PRINCIPAL_DIRECTIONS, TUBE_PUSH_ANGLES, BellowsFinger, bending_direction,
-    calibrate_bending_stiffness,
-)
+from gripkit.systems.amadeus.bellows_finger import (BAR, PRINCIPAL_DIRECTIONS, TUBE_PUSH_ANGLES,
+                                                    BellowsFinger, bending_direction,
+                                                    calibrate_bending_stiffness)
 
 F = BellowsFinger()
 pressure = st.floats(7.5, 30.0).map(lambda b: b * BAR)

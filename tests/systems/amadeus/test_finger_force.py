@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 from gripkit.control import DiscretePlant, RSTController, design_rst, simulate_loop
-from gripkit.systems.amadeus import GraspScenario, simulate_finger_grasp
-from gripkit.sysid.step_response import step_metrics
 from gripkit.errors import ModelError
 from gripkit.sim import StateSpace
+from gripkit.sysid.step_response import step_metrics
+from gripkit.systems.amadeus import GraspScenario, simulate_finger_grasp
 from gripkit.systems.amadeus.parameters import TABLE2_A, TABLE2_B, force_plant
 
 RAW = DiscretePlant(TABLE2_A, TABLE2_B, 0.005)

@@ -7,12 +7,11 @@ import numpy as np
 import pytest
 
 from gripkit.errors import DataError, UnidentifiableError
-from gripkit.systems.amadeus import (
-    ForceDynamics, ForceKalmanFilter, calibrate_force_sensor, estimate_force,
-)
 from gripkit.estimation import fuse, fused_variance
-from gripkit.systems.amadeus.strain_gauge_sensor import StrainGaugeSensor, single_bridge_estimates
+from gripkit.systems.amadeus import (ForceDynamics, ForceKalmanFilter, calibrate_force_sensor,
+                                     estimate_force)
 from gripkit.systems.amadeus.parameters import force_plant
+from gripkit.systems.amadeus.strain_gauge_sensor import StrainGaugeSensor, single_bridge_estimates
 
 S = StrainGaugeSensor()
 

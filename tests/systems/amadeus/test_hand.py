@@ -9,8 +9,8 @@ from hypothesis import strategies as st
 
 from gripkit.consistency import check
 from gripkit.errors import DataError, ModelError
-from gripkit.systems.amadeus.hand import AmadeusHand, force_closure
 from gripkit.systems.amadeus.bellows_finger import BAR
+from gripkit.systems.amadeus.hand import AmadeusHand, force_closure
 
 HAND = AmadeusHand()
 

@@ -5,12 +5,10 @@ import numpy as np
 import pytest
 
 from gripkit.errors import DataError
-from gripkit.systems.amadeus import (
-    SlipDetector, SlipReflex, calibrate_speed, false_alarm_rate, stick_slip_rate,
-)
-from gripkit.systems.amadeus.pvdf import (
-    PVDFFilm, SlipTestbed, StickSlipContact, nonslip_grasp_inputs, pvdf_noise, slip_onset_inputs,
-)
+from gripkit.systems.amadeus import (SlipDetector, SlipReflex, calibrate_speed, false_alarm_rate,
+                                     stick_slip_rate)
+from gripkit.systems.amadeus.pvdf import (PVDFFilm, SlipTestbed, StickSlipContact,
+                                          nonslip_grasp_inputs, pvdf_noise, slip_onset_inputs)
 
 FS = 2000.0
 C = StickSlipContact()

@@ -7,8 +7,8 @@ import pytest
 
 from gripkit.consistency import check
 from gripkit.errors import DataError
-from gripkit.systems.amadeus.valve import ProportionalValve, pressure_to_force_plant
 from gripkit.systems.amadeus.parameters import force_plant
+from gripkit.systems.amadeus.valve import ProportionalValve, pressure_to_force_plant
 
 BAR = 1e5
 V = ProportionalValve()

@@ -7,12 +7,12 @@ import math
 import numpy as np
 import pytest
 
-from gripkit.systems.dlr_hit.impedance import ImpedanceController, simulate_impedance
 from gripkit.errors import DataError, ModelError
 from gripkit.estimation.friction_adaptation import FrictionAdapter
-from gripkit.systems.dlr_hit.friction_adaptation import adapt_finger_friction
-from gripkit.systems.dlr_hit.parameters import dlr_hit_table
 from gripkit.signals import Trajectory
+from gripkit.systems.dlr_hit.friction_adaptation import adapt_finger_friction
+from gripkit.systems.dlr_hit.impedance import ImpedanceController, simulate_impedance
+from gripkit.systems.dlr_hit.parameters import dlr_hit_table
 from gripkit.systems.dlr_hit.parameters import finger
 
 DEG = math.pi / 180

@@ -8,10 +8,10 @@ import pytest
 
 from gripkit.cli import main
 from gripkit.errors import ModelError, SimulationError
-from gripkit.systems.dlr_hit.finger import ACTUATORS, DLRFinger
 from gripkit.params import ParameterSet
-from gripkit.systems.dlr_hit.parameters import FINGERS, finger, thesis_finger_parameters, finger_tables
+from gripkit.systems.dlr_hit.finger import ACTUATORS, DLRFinger
 from gripkit.systems.dlr_hit.hand import hand
+from gripkit.systems.dlr_hit.parameters import FINGERS, finger, thesis_finger_parameters, finger_tables
 
 DEG = math.pi / 180
 # start configurations at one end of the travel of each actuator (joint angles abd, flex, prox)

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 from gripkit.cli import main
-from gripkit.systems.dlr_hit.impedance import ImpedanceController, simulate_impedance
 from gripkit.errors import DataError, IdentificationError, UnidentifiableError
 from gripkit.sysid.friction import (constant_velocity_friction, detect_breakaway, fit_stribeck, idim_ls,
                                     table_from_points)
+from gripkit.systems.dlr_hit.impedance import ImpedanceController, simulate_impedance
 from gripkit.systems.dlr_hit.parameters import finger
 
 DEG = math.pi / 180

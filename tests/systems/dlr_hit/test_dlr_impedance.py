@@ -7,11 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from gripkit.systems.dlr_hit.impedance import (
-    ImpedanceController, Wall, impedance_margins, simulate_impedance,
-)
-from gripkit.systems.dlr_hit.impedance import stability_margins
 from gripkit.errors import ModelError, SimulationError
+from gripkit.systems.dlr_hit.impedance import (ImpedanceController, Wall, impedance_margins,
+                                               simulate_impedance)
+from gripkit.systems.dlr_hit.impedance import stability_margins
 from gripkit.systems.dlr_hit.parameters import finger
 
 DEG = math.pi / 180

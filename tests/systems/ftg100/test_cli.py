@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from gripkit.cli import main
-from gripkit.systems.ftg100.model import SEED_EQ10
-from gripkit.systems.ftg100.identification import step_experiment
 from gripkit.io import save
+from gripkit.systems.ftg100.identification import step_experiment
+from gripkit.systems.ftg100.model import SEED_EQ10
 
 
 def run(capsys, *args):

@@ -9,10 +9,9 @@ from scipy import signal
 
 from gripkit.consistency import check
 from gripkit.errors import ConsistencyWarning, ModelError
-from gripkit.systems.ftg100.model import (
-    SEED_EQ10, SEED_EQ17, FTG100Actuated, FTG100Coupled, FTG100Sensing, balancing_scale,
-    controllable_form, seed_state_space,
-)
+from gripkit.systems.ftg100.model import (SEED_EQ10, SEED_EQ17, FTG100Actuated, FTG100Coupled,
+                                          FTG100Sensing, balancing_scale, controllable_form,
+                                          seed_state_space)
 
 FS = 20000.0
 

@@ -4,10 +4,9 @@
 import numpy as np
 import pytest
 
-from gripkit.systems.ftg100.hybrid_control import (
-    METRICS, HybridForcePosition, grasp_batch, impact_speed_limit, simulate_hybrid_grasp,
-)
 from gripkit.errors import ConfigError
+from gripkit.systems.ftg100.hybrid_control import (METRICS, HybridForcePosition, grasp_batch,
+                                                   impact_speed_limit, simulate_hybrid_grasp)
 from gripkit.systems.ftg100.model import FTG100Plant
 
 F_CMD = 20e-6

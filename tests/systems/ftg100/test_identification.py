@@ -6,10 +6,9 @@ import pytest
 
 from gripkit import Trajectory
 from gripkit.errors import DataError, IdentificationError
+from gripkit.systems.ftg100.identification import (identify_actuated, identify_sensing,
+                                                   release_experiment, step_experiment)
 from gripkit.systems.ftg100.parameters import PAPER_VALUES
-from gripkit.systems.ftg100.identification import (
-    identify_actuated, identify_sensing, release_experiment, step_experiment,
-)
 
 
 @pytest.fixture(scope="module")

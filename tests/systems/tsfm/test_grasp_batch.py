@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 
 from gripkit.batch import SweepSpec, sweep
-from gripkit.systems.tsfm.grasp_batch import FAST_GRASP, METRICS, record_metrics, tsfm_grasp_batch
-from gripkit.systems.tsfm import simulate_two_finger_grasp
 from gripkit.errors import ConfigError
+from gripkit.systems.tsfm import simulate_two_finger_grasp
 from gripkit.systems.tsfm import parameters as z
+from gripkit.systems.tsfm.grasp_batch import FAST_GRASP, METRICS, record_metrics, tsfm_grasp_batch
 
 FS, DUR = 20000.0, 0.06
 EXACT = [m for m in METRICS if m not in ("final_error", "final_force", "stiffness_error")]  # sums: order-dependent

@@ -7,11 +7,11 @@ import warnings
 import numpy as np
 import pytest
 
-from gripkit.systems.tsfm import GraspSettings, TwoFingerGrasp, simulate_two_finger_grasp
 from gripkit.errors import DataError
 from gripkit.estimation import ContactDetector
-from gripkit.systems.tsfm import TipPositionEstimator, estimate_micropart
 from gripkit.estimation.contact_detection import false_alarm_probability
+from gripkit.systems.tsfm import GraspSettings, TwoFingerGrasp, simulate_two_finger_grasp
+from gripkit.systems.tsfm import TipPositionEstimator, estimate_micropart
 from gripkit.systems.tsfm import parameters as z
 
 FS = 20000.0

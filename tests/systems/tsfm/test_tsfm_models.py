@@ -12,12 +12,11 @@ from scipy.integrate import solve_ivp
 
 from gripkit.errors import ModelError, ParameterError
 from gripkit.models import BoucWen, PiezoActuator
-from gripkit.systems.tsfm.end_effector import lever_coefficients
 from gripkit.models.hysteresis import bouc_wen_advance, bouc_wen_response
-from gripkit.systems.tsfm.gripper import (
-    finger_coefficients, finger_minimal_state_space, finger_state_space, finger_transfer_functions,
-)
 from gripkit.systems.tsfm import parameters as z
+from gripkit.systems.tsfm.end_effector import lever_coefficients
+from gripkit.systems.tsfm.gripper import (finger_coefficients, finger_minimal_state_space,
+                                          finger_state_space, finger_transfer_functions)
 
 BW = dict(d_p=0.77e-6, lam=0.43e-6, beta=0.108, gamma=7.5e-3)  # Table II, left finger (λ in µm/V → m/V)
 

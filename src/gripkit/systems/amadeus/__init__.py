@@ -14,15 +14,13 @@
 A flat list of explicit re-exports.
 """
 
+from .bellows_finger import BellowsFinger as BellowsFinger
+from .force_control import FingerGraspResult as FingerGraspResult
+from .force_control import GraspScenario as GraspScenario
+from .force_control import simulate_finger_grasp as simulate_finger_grasp
 from .force_dynamics import FingerForcePlant as FingerForcePlant
 from .force_dynamics import ReferenceModel as ReferenceModel
 from .force_dynamics import finger_force_model as finger_force_model
-from .parameters import AmadeusHandSystem as AmadeusHandSystem
-from .parameters import amadeus_hand as amadeus_hand
-from .bellows_finger import BellowsFinger as BellowsFinger
-from .hand import AmadeusHand as AmadeusHand
-from .valve import ProportionalValve as ProportionalValve
-from .strain_gauge_sensor import StrainGaugeSensor as StrainGaugeSensor
 from .force_sensor import ForceDynamics as ForceDynamics
 from .force_sensor import ForceEstimate as ForceEstimate
 from .force_sensor import ForceKalmanFilter as ForceKalmanFilter
@@ -30,6 +28,9 @@ from .force_sensor import KalmanResult as KalmanResult
 from .force_sensor import SensorCalibration as SensorCalibration
 from .force_sensor import calibrate as calibrate_force_sensor
 from .force_sensor import estimate_force as estimate_force
+from .hand import AmadeusHand as AmadeusHand
+from .parameters import AmadeusHandSystem as AmadeusHandSystem
+from .parameters import amadeus_hand as amadeus_hand
 from .pvdf import SlipTestbed as SlipTestbed
 from .pvdf import StickSlipContact as StickSlipContact
 from .slip import SlipDetection as SlipDetection
@@ -42,6 +43,5 @@ from .slip import calibrate_speed as calibrate_speed
 from .slip import false_alarm_rate as false_alarm_rate
 from .slip import spectral_features as spectral_features
 from .slip import stick_slip_rate as stick_slip_rate
-from .force_control import FingerGraspResult as FingerGraspResult
-from .force_control import GraspScenario as GraspScenario
-from .force_control import simulate_finger_grasp as simulate_finger_grasp
+from .strain_gauge_sensor import StrainGaugeSensor as StrainGaugeSensor
+from .valve import ProportionalValve as ProportionalValve

@@ -99,9 +99,9 @@ _SIN60 = math.sqrt(3.0) / 2.0
 
 
 def bellows_parameters(*, pcd: float = 0.030, tube_area: float | None = None, length: float = 0.125,
-                      bending_stiffness: float | None = None, tip_length: float = 0.035,
-                      p_min: float = 7.5 * BAR, p_max: float = 30.0 * BAR, p_operating: float = 12.0 * BAR,
-                      max_deflection: float = 0.020, source_k: str = "") -> ParameterSet:
+                       bending_stiffness: float | None = None, tip_length: float = 0.035,
+                       p_min: float = 7.5 * BAR, p_max: float = 30.0 * BAR, p_operating: float = 12.0 * BAR,
+                       max_deflection: float = 0.020, source_k: str = "") -> ParameterSet:
     """The finger's ParameterSet (SI). Defaults are the AMADEUS phase-I values (seed §II)."""
     if tube_area is None:
         od, idia = 14.3e-3, 9.0e-3

@@ -18,8 +18,8 @@ from ...consistency import check
 from ...control import design_rst, simulate_loop
 from ...estimation import fused_variance, implied_correlation
 from ...progress import status
-from ...sysid.step_response import step_metrics
 from ...report.plots import subplots
+from ...sysid.step_response import step_metrics
 from .bellows_finger import BAR, PRINCIPAL_DIRECTIONS
 from .force_control import GraspScenario, simulate_finger_grasp
 from .force_sensor import calibrate as calibrate_force_sensor

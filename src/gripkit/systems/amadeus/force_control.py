@@ -112,8 +112,8 @@ class FingerGraspResult:
 
 
 def simulate_finger_grasp(controller: RSTController, plant=None, scenario: GraspScenario | None = None, *,
-                   valve=None, sensor=None, contact=None, detector=None, kalman_q: float = 400.0,
-                   rng=None) -> FingerGraspResult:
+                          valve=None, sensor=None, contact=None, detector=None, kalman_q: float = 400.0,
+                          rng=None) -> FingerGraspResult:
     """Closed-loop grasp with a guarded approach, force control, force sensing and the slip reflex.
 
     ``controller`` is an :class:`RSTController` for ``plant`` (valve current deviation in A →
@@ -249,5 +249,5 @@ def simulate_finger_grasp(controller: RSTController, plant=None, scenario: Grasp
         out["mode"][k] = mode
         out["load"][k] = load
     return FingerGraspResult(np.arange(N) * h, out["force"], out["force_est"], out["force_std"], out["ref"],
-                       out["current"], out["mode"], out["slipping"], out["slip_alarm"], out["load"],
-                       out["x_obj"], pv, sc.pvdf_rate, alarms, contact_t, float(out["force"].max()))
+                             out["current"], out["mode"], out["slipping"], out["slip_alarm"], out["load"],
+                             out["x_obj"], pv, sc.pvdf_rate, alarms, contact_t, float(out["force"].max()))

@@ -30,9 +30,8 @@ import numba
 import numpy as np
 
 from ...control.rst import DiscretePlant
-from ...errors import (
-    AccuracyWarning, DataError, IdentificationError, ModelError, UnidentifiableError,
-)
+from ...errors import (AccuracyWarning, DataError, IdentificationError, ModelError,
+                       UnidentifiableError)
 from .strain_gauge_sensor import StrainGaugeSensor, sensitivity_matrix, sensor_parameters
 
 __all__ = [

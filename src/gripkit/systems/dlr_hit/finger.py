@@ -56,10 +56,9 @@ from ...models.friction import (FrictionTable, Stribeck, lugre_force, lugre_upda
 from ...models.transmission import transmit_torque
 from ...multibody.coupling import CoupledChain, Coupling, differential_matrix
 from ...multibody.dh import DHChain
-from ...multibody.kernels import (
-    WORK_PER_LINK, chain_links, cholesky_solve, coupled_mass_bias, frames_into, hot,
-    joints_from_actuators, point_jacobian, rnea_pass,
-)
+from ...multibody.kernels import (WORK_PER_LINK, chain_links, cholesky_solve, coupled_mass_bias,
+                                  frames_into, hot, joints_from_actuators, point_jacobian,
+                                  rnea_pass)
 from ...params import ParameterSet
 from ...sim.model import Model, Signal
 

@@ -44,9 +44,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import ModelError, SimulationError
-from .finger import ACTUATORS, FRICTION_MODES, NX, DLRFinger, finger_run
 from ...models.friction import FrictionTable, table_arrays
 from ...signals.trajectory import Trajectory
+from .finger import ACTUATORS, FRICTION_MODES, NX, DLRFinger, finger_run
 
 __all__ = ["ImpedanceController", "Wall", "simulate_impedance", "stability_margins",
            "impedance_margins", "model_friction_tables"]

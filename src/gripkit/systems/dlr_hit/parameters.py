@@ -28,9 +28,9 @@ import numpy as np
 from ...consistency import Finding, compare
 from ...errors import ModelError
 from ...models.bldc import BLDCMotor, motor_parameters
-from .finger import ACTUATORS, FINGER_PARAMETERS, DLRFinger
 from ...models.friction import FrictionTable
 from ...params import Parameter, ParameterSet
+from .finger import ACTUATORS, FINGER_PARAMETERS, DLRFinger
 
 __all__ = ["thesis_finger_parameters", "dlr_hit_table", "finger_tables", "finger", "DLRHITFinger", "FINGERS",
            "TABLE_6_1", "BASE2_CORRECTION"]

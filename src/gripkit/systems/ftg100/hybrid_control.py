@@ -500,10 +500,10 @@ def _run(thetas, cps, fprofs, NF, NX, S, ts, sub, band, dmg, n_steps, record, pr
 
 
 def simulate_hybrid_grasp(controller: HybridForcePosition | None = None, plant=None, *, force: float = 20e-6,
-                   k0: float | None = None, gap: float | None = None, seed: int = 0, duration: float = 0.1,
-                   noise_force: float = 50e-9, noise_position: float = 1e-9,
-                   damage_threshold: float | None = None, band: float = 0.02,
-                   force_profile=None) -> HybridGraspResult:
+                          k0: float | None = None, gap: float | None = None, seed: int = 0, duration: float = 0.1,
+                          noise_force: float = 50e-9, noise_position: float = 1e-9,
+                          damage_threshold: float | None = None, band: float = 0.02,
+                          force_profile=None) -> HybridGraspResult:
     """One closed-loop approach-and-grasp on the FT-G100 plant (see :func:`grasp_batch`), with its
     trajectory. ``force_profile`` (optional, N, one value per controller sample over ``duration``)
     replaces the constant command; the metrics then refer to its last value."""

@@ -28,10 +28,10 @@ import warnings
 import numpy as np
 
 from ...errors import ConsistencyWarning, DataError, IdentificationError
-from .model import FTG100Actuated, FTG100Sensing
 from ...signals.trajectory import Trajectory
 from ...sysid.greybox import GreyboxResult, fit
 from ...sysid.step_response import identify_step
+from .model import FTG100Actuated, FTG100Sensing
 
 __all__ = ["step_experiment", "release_experiment", "identify_actuated", "identify_sensing"]
 

@@ -68,12 +68,12 @@ from scipy.optimize import brentq
 
 from ...consistency import Finding, compare
 from ...errors import ModelError
-from ...params import Parameter, ParameterSet
-from ...sim.linear import StateSpace, c2d_zoh, simulate_discrete
-from ...sim.model import Model, Signal
 from ...models.beams import STRETCHING_BETA, clamped_clamped_stiffness
 from ...models.comb_drive import comb_drive_coefficient
 from ...models.second_order import second_order_batch
+from ...params import Parameter, ParameterSet
+from ...sim.linear import StateSpace, c2d_zoh, simulate_discrete
+from ...sim.model import Model, Signal
 
 __all__ = [
     "SEED", "amplification_ratio", "ftg100_geometry", "ftg100_parameters", "controllable_form",

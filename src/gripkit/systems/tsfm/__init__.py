@@ -14,13 +14,13 @@
 A flat list of explicit re-exports.
 """
 
-from .gripper import TSFMFinger as TSFMFinger
-from .gripper import TSFMFingerContact as TSFMFingerContact
-from .gripper import TSFMGripper as TSFMGripper
 from .grasp import GraspSettings as GraspSettings
 from .grasp import TwoFingerGrasp as TwoFingerGrasp
 from .grasp import TwoFingerGraspResult as TwoFingerGraspResult
 from .grasp import simulate_two_finger_grasp as simulate_two_finger_grasp
+from .gripper import TSFMFinger as TSFMFinger
+from .gripper import TSFMFingerContact as TSFMFingerContact
+from .gripper import TSFMGripper as TSFMGripper
 from .identification import FingerIdentification as FingerIdentification
 from .identification import identify_finger as identify_finger
 from .micropart import MicropartEstimate as MicropartEstimate

@@ -36,11 +36,11 @@ import numpy as np
 
 from ...errors import DataError, IdentificationError, SimulationError
 from ...estimation.contact_detection import detector_step
-from .micropart import MicropartEstimate, estimate_micropart
-from .tip_position import estimator_arrays, estimator_step
+from ...signals.trajectory import Trajectory
 from .end_effector import lever_coefficients
 from .gripper import TSFMGripper, gripper_advance, gripper_measure, gripper_work
-from ...signals.trajectory import Trajectory
+from .micropart import MicropartEstimate, estimate_micropart
+from .tip_position import estimator_arrays, estimator_step
 
 __all__ = ["GraspSettings", "TwoFingerGrasp", "TwoFingerGraspResult", "simulate_two_finger_grasp", "grasp_step"]
 

@@ -54,16 +54,15 @@ from numba import prange
 
 from ...consistency import Finding, compare
 from ...errors import ModelError, ParameterError
+from ...models.hysteresis import bouc_wen_advance
+from ...models.piezo import actuator_parameters, actuator_state_space, lti_modes, run_bw_lti
 from ...params import Parameter, ParameterSet
-from ...sim.hybrid import (
-    DEFAULT_LEVELS, MAX_EVENTS_PER_STEP, Guard, HybridSystem, Mode, pwa_output, pwa_step,
-)
+from ...sim.hybrid import (DEFAULT_LEVELS, MAX_EVENTS_PER_STEP, Guard, HybridSystem, Mode,
+                           pwa_output, pwa_step)
 from ...sim.integrators import zoh_levels
 from ...sim.linear import StateSpace
 from ...sim.model import Model, Signal
 from .end_effector import end_effector_parameters, lever_coefficients, sensor_parameters, sensor_state_space
-from ...models.hysteresis import bouc_wen_advance
-from ...models.piezo import actuator_parameters, actuator_state_space, lti_modes, run_bw_lti
 
 __all__ = ["FINGER_NAMES", "finger_parameter_set", "finger_state_space", "finger_minimal_state_space",
            "finger_coefficients", "finger_transfer_functions", "finger_hybrid",
@@ -77,9 +76,9 @@ PART_NAMES = ("w", "k_e", "c_e", "F_po", "F_stick", "X_p", "gap")
 
 
 def finger_parameter_set(*, d_p: float, s_p: float, lam: float, beta: float, gamma: float, a: float, b: float,
-                      m_s: float, b_s: float, k_s: float, L_r: float, L_s: float, L_a: float,
-                      sensitivity: float = 5e3, source: str = "", sources: Mapping[str, str] | None = None,
-                      name: str = "tsfm-finger") -> ParameterSet:
+                         m_s: float, b_s: float, k_s: float, L_r: float, L_s: float, L_a: float,
+                         sensitivity: float = 5e3, source: str = "", sources: Mapping[str, str] | None = None,
+                         name: str = "tsfm-finger") -> ParameterSet:
     """ParameterSet of one finger (SI). ``sources`` overrides ``source`` per parameter.
 
     d_p, lam (m/V); s_p (m/N); beta, gamma (1/V); a (s²), b (s); m_s (kg), b_s (N·s/m), k_s (N/m);

@@ -22,9 +22,9 @@ import numpy as np
 
 from ...errors import DataError, ModelError
 from ...models.hysteresis import bouc_wen_advance
-from .gripper import FINGER_NAMES, TSFMFinger, finger_minimal_state_space
 from ...params import ParameterSet
 from ...sim.integrators import zoh_levels
+from .gripper import FINGER_NAMES, TSFMFinger, finger_minimal_state_space
 
 __all__ = ["TipPositionEstimator", "estimator_step", "estimator_arrays"]
 
