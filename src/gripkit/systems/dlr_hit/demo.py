@@ -47,8 +47,6 @@ def run(report, *, quick: bool = False) -> dict:
     rep = check(f)
     sec.findings(rep)
     summary["inconsistent_checks"] = [x.check for x in rep.inconsistent]
-
-    # ---- motor maps -------------------------------------------------------------------------------
     rng = _motor_maps(sec, summary, quick)
     _friction(sec, f)
     _velocity_responses(sec, f, summary)
@@ -106,8 +104,6 @@ def _motor_maps(sec, summary, quick):
               caption="Two-stage motor characterisation (§5.4) on simulated test-bed data (sensor noise "
                       "0.005 Ncm): eq 5.7 and eq 5.8 are recovered; the printed slopes differ from eq 5.8 "
                       "by up to 4.9 %.")
-
-    # ---- friction ---------------------------------------------------------------------------------
     return rng
 
 
@@ -140,8 +136,6 @@ def _friction(sec, f):
     sec.table(["table", "F_c [N·m]", "±", "σ [N·m·s/rad]", "±", "σ₃ [N·m·s³/rad³]", "±", "rms [N·m]"], fits,
               caption="Stribeck + cubic fits of the tables (the data hold no point below 20 °/s, so v_s is fixed).")
 
-    # ---- velocity responses (Figs 7.3–7.5) --------------------------------------------------------
-
 
 def _velocity_responses(sec, f, summary):
     """Velocity responses of the finger (Figs 7.3-7.5)."""
@@ -170,8 +164,6 @@ def _velocity_responses(sec, f, summary):
               caption="Velocities gripkit predicts (Figs 7.3–7.5 show 100–300 °/s, distal fastest). Base 2 "
                       "at PWM 4000 settles on Appendix G's outlying point at 172 °/s without gravity.")
     summary["steady_velocity_deg_s"] = steady
-
-    # ---- stiction and IDIM-LS ----------------------------------------------------------------------
 
 
 def _stiction_and_idim(sec, summary, quick, rng):
@@ -218,8 +210,6 @@ def _stiction_and_idim(sec, summary, quick, rng):
                       f"{res.relative_error_percent:.2f} %.")
     summary["idim_error_percent"] = {k: 100 * (res.params[k] - truth[k]) / truth[k] for k in ("inertia", "viscous", "coulomb")}
 
-    # ---- adaptation --------------------------------------------------------------------------------
-
 
 def _adaptation(sec, f, summary, quick):
     """Online friction adaptation on a finger whose friction drifts."""
@@ -252,8 +242,6 @@ def _adaptation(sec, f, summary, quick):
               caption=f"Stated convergence time dt·ln 20/(−ln λ) = {ad.convergence_time():.2f} s of sliding.")
     summary["adaptation_settling_s"] = settle
     summary["adaptation_stated_s"] = ad.convergence_time()
-
-    # ---- impedance experiment ----------------------------------------------------------------------
 
 
 def _impedance(sec, f, summary):
@@ -312,8 +300,6 @@ def _impedance(sec, f, summary):
                       "finger before it reaches the wall.")
     summary["tracking_rms_deg"] = track
     summary["contact_force_N"] = {"expected": expect, "on": force[True], "off": force[False]}
-
-    # ---- the hand ----------------------------------------------------------------------------------
 
 
 def _hand(sec, summary):

@@ -14,7 +14,7 @@ from ...consistency import check
 from ...errors import AccuracyWarning, ConsistencyWarning
 from ...models.beams import clamped_clamped_stiffness
 from ...models.comb_drive import comb_drive_force, comb_drive_gain
-from ...report.plots import pyplot
+from ...report.plots import subplots
 from ...signals.trajectory import Trajectory
 from ...sysid.step_response import identify_step
 from .hybrid_control import (HybridForcePosition, grasp_batch, impact_speed_limit,
@@ -91,12 +91,9 @@ def _model_section(report, summary, act, sen, cpl, plant, fs):
     summary["eq17_consistent"] = check(sen).ok
     summary["dc_gain_um_per_V"] = act.dc_gain() * 1e6
 
-    # ---------------------------------------------------------------- step responses
-
 
 def _step_section(report, act, sen, plant, fs):
     """Step responses of the linear subsystems against the printed matrices; returns the free arm."""
-    plt = pyplot()
     sec = report.section("FT-G100: step responses",
                          "Left: the actuated subsystem with the ball grasped, 10 V step at 70 V (eq 9), simulated "
                          "exactly and through the seed's printed eq 10. Middle: the sensing arm released from a "
@@ -116,7 +113,7 @@ def _step_section(report, act, sen, plant, fs):
     F0 = 27e-6 * sen.stiffness()
     x0 = np.linalg.solve(np.eye(2) - s17.A, s17.B[:, 0] * F0 * (27e-6 / (float(s17.dc_gain()[0, 0]) * F0)))
     y17 = s17.simulate(np.where(t < 1e-3, F0 * 27e-6 / (float(s17.dc_gain()[0, 0]) * F0), 0.0), x0=x0)[:, 0]
-    fig, ax = plt.subplots(1, 3, figsize=(13, 3.6))
+    fig, ax = subplots(1, 3, figsize=(13, 3.6))
     ax[0].plot(t * 1e3, ya * 1e6, label="eq 9 (exact ZOH)")
     ax[0].plot(t * 1e3, ys10 * 1e6, "--", label="seed eq 10 matrices")
     ax[0].set(xlabel="t (ms)", ylabel="x̃_a (µm)", title="actuated, 70→80 V, grasped")
@@ -135,22 +132,19 @@ def _step_section(report, act, sen, plant, fs):
     ax[2].legend(fontsize=8)
     fig.tight_layout()
     sec.figure(fig, "Step responses: linear subsystems vs the printed matrices; nonlinear free arm", name="ftg100-steps")
-
-    # ---------------------------------------------------------------- resonance vs voltage (Fig. 5)
     return free
 
 
 def _resonance_section(report, summary, free, fs, quick):
     """Resonance against the actuation voltage (Fig. 5): linearised and identified."""
-    plt = pyplot()
+    Vgrid = np.linspace(0, 200, 41)
+    f_lin = np.array([free.resonance(v)[0] for v in Vgrid])
     sec = report.section("FT-G100: resonance vs actuation voltage (Fig. 5)",
                          "The nonlinear plant's free actuated arm linearised at each voltage (line), and the "
                          "resonance identified from simulated ±2 V steps around it with 1 % noise by the general "
                          "step-response identification (`gripkit identify step`), with 2σ bars. The suspension "
                          "stiffens as K_sa(1 + β(x/w)²), β = π⁴/128 (beam stretching), so the resonance rises from "
                          "685 Hz at rest; the seed's Fig. 5 shows the same trend (its data are not in the text).")
-    Vgrid = np.linspace(0, 200, 41)
-    f_lin = np.array([free.resonance(v)[0] for v in Vgrid])
     Vid = np.arange(20, 200, 40 if quick else 20)
     f_id, f_sd = [], []
     rng = np.random.default_rng(0)
@@ -167,7 +161,7 @@ def _resonance_section(report, summary, free, fs, quick):
             r = identify_step(Trajectory(ti, {"V": u, "x_a": y}, {"V": "V", "x_a": "m"}), input="V", output="x_a")
         f_id.append(r.natural_frequency_hz)
         f_sd.append(r.natural_frequency_hz_std)
-    fig, ax = plt.subplots(figsize=(6.5, 3.8))
+    fig, ax = subplots(figsize=(6.5, 3.8))
     ax.plot(Vgrid, f_lin, label="linearised plant")
     ax.errorbar(Vid, f_id, yerr=2 * np.array(f_sd), fmt="o", ms=4, label="identified from ±2 V steps (2σ)")
     ax.set(xlabel="actuation voltage (V)", ylabel="resonance (Hz)", title="actuated arm, free")
@@ -176,12 +170,9 @@ def _resonance_section(report, summary, free, fs, quick):
     sec.figure(fig, "Resonance frequency of the actuated subsystem vs voltage", name="ftg100-resonance")
     summary["resonance_hz_0_70_150V"] = [float(free.resonance(v)[0]) for v in (0.0, 70.0, 150.0)]
 
-    # ---------------------------------------------------------------- identification
-
 
 def _identification_section(report, summary, quick):
     """Levenberg-Marquardt identification of the actuated and sensing subsystems (§III-B, §III-D)."""
-    plt = pyplot()
     sec = report.section(
         "FT-G100: Levenberg-Marquardt identification (§III-B, III-D)",
         "Simulated experiments with the seed's values as truth and 1 % output noise. Actuated: 10 V steps "
@@ -211,7 +202,7 @@ def _identification_section(report, summary, quick):
     corr = r_long.correlation[:3, :3]
     sec.table(["", "M_a", "K_fa", "k0"], [[n, *[f"{c:+.3f}" for c in corr[i]]] for i, n in enumerate(("M_a", "K_fa", "k0"))],
               caption=f"Correlation of the estimates from the {long_d.duration:.0f} s record")
-    fig, ax = plt.subplots(1, 2, figsize=(11, 3.4))
+    fig, ax = subplots(1, 2, figsize=(11, 3.4))
     ax[0].plot(short.t * 1e3, short["x_a"] * 1e6, ".", ms=2, label="measured (simulated, 1 % noise)")
     ax[0].plot(short.t * 1e3, r_short.y_model[:, 0] * 1e6 + r_short.value("x_off") * 1e6, label="LM fit")
     ax[0].set(xlabel="t (ms)", ylabel="x_a (µm)", title="actuated: 10 V step at 70 V, grasped")
@@ -226,13 +217,10 @@ def _identification_section(report, summary, quick):
     summary["identified"].update({n: [r_sen.value(n), r_sen.stdev(n)] for n in ("M_b", "K_fb")})
     summary["k0_rel_std_20ms"] = r_short.stdev("k0") / r_short.value("k0")
 
-    # ---------------------------------------------------------------- hybrid control
-
 
 def _hybrid_section(report, summary, plant, quick):
     """Hybrid force/position control of a grasp on the nonlinear plant, anti-windup, bumpless switch,
     sensitivities."""
-    plt = pyplot()
     ctrl = HybridForcePosition.for_plant(plant.parameters)
     sec = report.section(
         "FT-G100: hybrid force/position control of a grasp",
@@ -248,7 +236,7 @@ def _hybrid_section(report, summary, plant, quick):
     nom = simulate_hybrid_grasp(ctrl, plant, force=20e-6, duration=0.05)
     tr = nom.trajectory
     tc = nom.metrics["t_contact"]
-    fig, ax = plt.subplots(3, 1, figsize=(9, 7), sharex=True)
+    fig, ax = subplots(3, 1, figsize=(9, 7), sharex=True)
     tt = (tr.t - tc) * 1e3
     ax[0].plot(tt, tr["F_c"] * 1e6, lw=0.8, label="contact force (true)")
     ax[0].plot(tt, tr["F_meas"] * 1e6, lw=0.6, alpha=0.7, label="sensor reading (50 nN noise)")
@@ -286,7 +274,7 @@ def _hybrid_section(report, summary, plant, quick):
             return sum(len(x) for x in batches)
 
     b = _All()
-    fig, ax = plt.subplots(1, 3, figsize=(13, 3.6))
+    fig, ax = subplots(1, 3, figsize=(13, 3.6))
     for j, gp in enumerate(gaps):
         sel = np.isclose(b.gap, gp)
         for a_, m, sc in ((ax[0], "overshoot_percent", 1), (ax[1], "settling_time", 1e3), (ax[2], "peak_force", 1e6)):
@@ -317,7 +305,7 @@ def _hybrid_section(report, summary, plant, quick):
     aw = {f: simulate_hybrid_grasp(ctrl.with_(anti_windup=f), plant, force_profile=prof, duration=0.12) for f in (True, False)}
     stiff = plant.with_parameters(check=False, K_sa=25.4 * 1.15)
     bl = {f: simulate_hybrid_grasp(ctrl.with_(bumpless=f), stiff, duration=0.06) for f in (True, False)}
-    fig, ax = plt.subplots(1, 2, figsize=(12, 3.5))
+    fig, ax = subplots(1, 2, figsize=(12, 3.5))
     for f, r in aw.items():
         ax[0].plot(r.trajectory.t * 1e3, r.trajectory["F_c"] * 1e6, lw=0.8,
                    label="back-calculation anti-windup" if f else "no anti-windup")
