@@ -46,14 +46,14 @@ def run(quick: bool = False) -> list[dict]:
     import numba
 
     from gripkit.batch import DaskExecutor, ProcessExecutor, sweep
+    from gripkit.batch.scenarios import build_model
     from gripkit.systems.tsfm.grasp_batch import FAST_GRASP, tsfm_grasp_batch
-    from gripkit.batch.sweep import _model
 
     warnings.simplefilter("ignore")
     n = 1000 if quick else 10000
     spec = _spec(n)
     jobs = spec.jobs()
-    grip = _model("tsfm-gripper")
+    grip = build_model("tsfm-gripper")
     kw = {k: jobs[k] for k in ("k_e", "w", "offset", "approach_speed", "noise_std")}
     rows = []
     bench = "batch: 10k TSFM grasps" if not quick else "batch: 1k TSFM grasps (quick)"

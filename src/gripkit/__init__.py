@@ -9,6 +9,7 @@ Importing gripkit has no side effects and does not compile anything.
 from .consistency import ConsistencyReport as ConsistencyReport
 from .consistency import Finding as Finding
 from .consistency import check as check_consistency
+from .errors import ArgumentError as ArgumentError
 from .errors import ConfigError as ConfigError
 from .errors import ConsistencyWarning as ConsistencyWarning
 from .errors import DataError as DataError
@@ -17,6 +18,7 @@ from .errors import GripkitWarning as GripkitWarning
 from .errors import IdentificationError as IdentificationError
 from .errors import ModelError as ModelError
 from .errors import ParameterError as ParameterError
+from .errors import PathError as PathError
 from .errors import SimulationError as SimulationError
 from .errors import UnidentifiableError as UnidentifiableError
 from .params import Parameter as Parameter

@@ -45,6 +45,7 @@ from pathlib import Path
 import numpy as np
 
 from . import zoo
+from .arguments import check_path
 from .errors import ConfigError, GripkitError
 from .io import load
 from .io.toml_file import read_toml
@@ -123,12 +124,29 @@ def _num(spec: Mapping, key: str, where: str, default=None) -> float:
         if default is None:
             raise ConfigError(f"{where}: missing {key!r}")
         return float(default)
-    v = spec[key]
+    return _number(spec[key], f"{where}: {key!r}")
+
+
+def _number(v, what: str) -> float:
     if isinstance(v, bool) or not isinstance(v, (int, float)):
-        raise ConfigError(f"{where}: {key!r} must be a number, found {v!r}")
+        raise ConfigError(f"{what} must be a number, found {v!r:.60}")
     if not math.isfinite(v):
-        raise ConfigError(f"{where}: {key!r} must be finite, found {v!r}")
+        raise ConfigError(f"{what} must be finite, found {v!r}")
     return float(v)
+
+
+def _numbers(spec: Mapping, key: str, where: str) -> list[float]:
+    v = spec.get(key)
+    if not isinstance(v, list) or not v:
+        raise ConfigError(f"{where}: {key!r} must be a non-empty list of numbers, found {v!r:.60}")
+    return [_number(x, f"{where}: {key}[{i}]") for i, x in enumerate(v)]
+
+
+def _table(raw: Mapping, key: str, where: str) -> dict:
+    v = raw.get(key) or {}
+    if not isinstance(v, Mapping):
+        raise ConfigError(f"{where}: {key!r} must be a table ([{key}]), found {v!r:.60}")
+    return dict(v)
 
 
 _KINDS = {"constant": {"value"}, "step": {"initial", "final", "time"}, "ramp": {"start", "end", "t0", "t1"},
@@ -160,17 +178,23 @@ def input_signal(spec: Mapping, t: np.ndarray, where: str, base: Path | None = N
         return (_num(spec, "offset", where, 0.0) + _num(spec, "amplitude", where)
                 * np.sin(2 * np.pi * f * t + math.radians(_num(spec, "phase_deg", where, 0.0))))
     if kind == "steps":
-        lv, du = spec.get("levels"), spec.get("durations")
-        if not isinstance(lv, list) or not lv or not isinstance(du, list) or len(du) != len(lv):
-            raise ConfigError(f"{where}: steps needs lists 'levels' and 'durations' of the same length")
-        edges = np.cumsum([0.0] + [float(d) for d in du])
-        out = np.full(t.size, float(lv[-1]))
+        lv, du = _numbers(spec, "levels", where), _numbers(spec, "durations", where)
+        if len(du) != len(lv):
+            raise ConfigError(f"{where}: steps needs lists 'levels' and 'durations' of the same length, "
+                              f"found {len(lv)} and {len(du)}")
+        if min(du) <= 0:
+            raise ConfigError(f"{where}: durations must be positive (s), found {min(du):g}")
+        edges = np.cumsum([0.0] + du)
+        out = np.full(t.size, lv[-1])
         for v, a, b in zip(lv, edges[:-1], edges[1:]):
-            out[(t >= a) & (t < b)] = float(v)
+            out[(t >= a) & (t < b)] = v
         return out
 
     if "path" not in spec or "column" not in spec:
         raise ConfigError(f"{where}: kind 'file' needs 'path' and 'column'")
+    for key in ("path", "column", "time"):
+        if key in spec and not isinstance(spec[key], str):
+            raise ConfigError(f"{where}: {key!r} must be a string, found {spec[key]!r:.60}")
     path = Path(spec["path"])
     if base is not None and not path.is_absolute():
         path = base / path
@@ -180,15 +204,19 @@ def input_signal(spec: Mapping, t: np.ndarray, where: str, base: Path | None = N
 
 def load_description(path, overrides: Mapping | None = None) -> Description:
     """Read a TOML description (see the module docstring) and build its model and inputs."""
+    check_path(path, "model description", "load_description()")
     path = Path(path)
     raw = read_toml(path, "model description")
     unknown = set(raw) - {"model", "parameters", "simulation", "inputs", "output"}
     if unknown:
         raise ConfigError(f"{path.name}: unknown sections {sorted(unknown)}",
                           hint="sections: model, parameters, simulation, inputs, output")
-    mspec = dict(raw.get("model") or {})
-    params = dict(raw.get("parameters") or {})
+    mspec = _table(raw, "model", path.name)
+    params = _table(raw, "parameters", path.name)
     params.update(overrides or {})
+    for key in ("type", "zoo"):
+        if key in mspec and not isinstance(mspec[key], str):
+            raise ConfigError(f"{path.name}: [model] {key} must be a string, found {mspec[key]!r:.60}")
     if "type" not in mspec and "zoo" not in mspec:
         raise ConfigError(f"{path.name}: [model] needs 'type' (one of {', '.join(MODEL_TYPES)}) or 'zoo'")
     mtype = mspec.get("type")
@@ -213,7 +241,7 @@ def load_description(path, overrides: Mapping | None = None) -> Description:
         raise
     except GripkitError as exc:
         raise ConfigError(f"{path.name}: {exc}") from None
-    sim = dict(raw.get("simulation") or {})
+    sim = _table(raw, "simulation", path.name)
     bad = set(sim) - {"fs", "dt", "duration"}
     if bad:
         raise ConfigError(f"{path.name}: [simulation] unknown keys {sorted(bad)}", hint="keys: fs or dt, duration")
@@ -223,11 +251,12 @@ def load_description(path, overrides: Mapping | None = None) -> Description:
     duration = _num(sim, "duration", "[simulation]")
     if fs <= 0 or duration <= 0:
         raise ConfigError(f"{path.name}: [simulation] fs and duration must be positive")
-    n = int(round(duration * fs))
-    if n < 1 or n > 50_000_000:
-        raise ConfigError(f"{path.name}: {n} samples requested; expected 1 to 50 million")
+    n = duration * fs
+    if not 1 <= round(n) <= 50_000_000:
+        raise ConfigError(f"{path.name}: [simulation] duration × fs = {n:.4g} samples; expected 1 to 50 million")
+    n = int(round(n))
     t = np.arange(n) / fs
-    ispec = dict(raw.get("inputs") or {})
+    ispec = _table(raw, "inputs", path.name)
     names = [s.name for s in model.inputs]
     missing = [nm for nm in names if nm not in ispec]
     if missing:
@@ -235,10 +264,15 @@ def load_description(path, overrides: Mapping | None = None) -> Description:
     extra = sorted(set(ispec) - set(names))
     if extra:
         raise ConfigError(f"{path.name}: [inputs] {extra} are not inputs of {model.name}", hint=f"inputs: {names}")
+    for nm in names:
+        if not isinstance(ispec[nm], Mapping):
+            raise ConfigError(f"{path.name}: inputs.{nm} must be a table ([inputs.{nm}]), found {ispec[nm]!r:.60}")
     ch = {nm: input_signal(ispec[nm], t, f"{path.name} [inputs.{nm}]", path.parent) for nm in names}
     units = {s.name: s.unit for s in model.inputs}
     inputs = Trajectory(t, ch, units, {"fs": fs, "source": path.name})
-    out = (raw.get("output") or {}).get("file")
+    out = _table(raw, "output", path.name).get("file")
+    if out is not None and not isinstance(out, str):
+        raise ConfigError(f"{path.name}: [output] file must be a string (a path), found {out!r:.60}")
     return Description(model, inputs, (path.parent / out) if out else None, raw)
 
 

@@ -20,6 +20,8 @@ __all__ = [
     "UnidentifiableError",
     "SimulationError",
     "ConfigError",
+    "ArgumentError",
+    "PathError",
     "GripkitWarning",
     "ConsistencyWarning",
     "StabilityWarning",
@@ -75,6 +77,16 @@ class SimulationError(GripkitError):
 
 class ConfigError(GripkitError, ValueError):
     """A model/sweep description file (TOML) that is malformed or incomplete."""
+
+
+class ArgumentError(GripkitError, TypeError):
+    """A Python call with an unknown keyword or an argument of the wrong type; the message names
+    the argument and lists what is accepted. A ``TypeError``, as Python raises for such calls."""
+
+
+class PathError(GripkitError, OSError):
+    """A file or folder that cannot be used as asked: missing, a folder where a file is expected
+    (or the reverse), not readable or not writable. An ``OSError``, as Python raises for such paths."""
 
 
 class GripkitWarning(UserWarning):

@@ -203,6 +203,9 @@ class ParameterSet(Mapping[str, Parameter]):
                         f"parameter {name!r}: expected a value in {p.unit!r}, found {v!r} ({unit})"
                     )
                 v = si
+            elif isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
+                raise ParameterError(f"parameter {name!r}: expected a number (in {p.unit!r}) or a string with "
+                                     f"its unit, found {type(v).__name__} {v!r:.40}")
             new[name] = p.with_value(float(v))
         return ParameterSet(new.values(), self.name)
 

@@ -15,9 +15,9 @@ import functools
 import math
 import re
 
-from .errors import ConfigError, ParameterError
+from .errors import ParameterError
 
-__all__ = ["to_si", "setting_si", "si_factor", "ratio_unit", "si_unit", "convert", "check_unit",
+__all__ = ["to_si", "si_factor", "ratio_unit", "si_unit", "convert", "check_unit",
            "format_quantity", "same_dimension"]
 
 # Unit strings gripkit uses, spelled for pint; "1" is dimensionless.
@@ -131,20 +131,6 @@ def to_si(quantity: str | float, unit: str | None = None) -> tuple[float, str]:
         value, unit = float(quantity), unit or "1"
     scale, offset, si = si_factor(unit)
     return scale * value + offset, si
-
-
-def setting_si(value, where: str) -> float:
-    """A setting as an SI float: a number as it is, a quantity string (``"3 mg"``, ``"200 uN"``)
-    converted to SI; :class:`~gripkit.errors.ConfigError` naming ``where`` otherwise."""
-    if isinstance(value, str):
-        try:
-            return to_si(value)[0]
-        except Exception as exc:
-            raise ConfigError(f"{where}: cannot read {value!r} as a quantity ({exc})") from None
-    try:
-        return float(value)
-    except (TypeError, ValueError):
-        raise ConfigError(f"{where}: expected a number or a quantity like '3 mg', found {value!r}") from None
 
 
 def convert(value: float, from_unit: str, to_unit: str) -> float:

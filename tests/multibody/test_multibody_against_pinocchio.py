@@ -10,7 +10,7 @@ import math
 import numpy as np
 import pytest
 
-pin = pytest.importorskip("pinocchio")
+import pinocchio as pin  # a dev dependency: the cross-checks fail, never skip, without it
 
 from gripkit.multibody import CoupledChain, Coupling, DHChain  # noqa: E402
 from gripkit.multibody.pinocchio import to_pinocchio  # noqa: E402

@@ -223,8 +223,9 @@ class DaskExecutor(Executor):
         if address:
             try:
                 self.client = Client(address, timeout=10)
-            except OSError as exc:
-                raise ConfigError(f"cannot reach the Dask scheduler at {address!r}: {exc}") from None
+            except (OSError, ValueError, TypeError) as exc:  # unreachable, or not an address (ValueError)
+                raise ConfigError(f"cannot reach the Dask scheduler at {address!r}: {exc}",
+                                  hint="give its address as tcp://host:8786") from None
         else:
             n = workers or os.cpu_count() or 1
             self._cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,

@@ -21,6 +21,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..arguments import entry_point
 from ..errors import ConfigError, DataError
 from ..io import load
 from ..progress import track
@@ -70,6 +71,7 @@ def _files(paths) -> list[str]:
     return files
 
 
+@entry_point
 def identify_many(paths: str | Path | Iterable, identifier, options: dict | None = None, *,
                   load_options: dict | None = None, backend: str = "process", workers: int | None = None,
                   scheduler: str | None = None, executor: Executor | None = None,

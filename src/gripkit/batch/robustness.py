@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..arguments import entry_point
 from ..errors import ConfigError, DataError
 from ..units import to_si
 from .montecarlo import Estimate, binned_probability, probability, quantile
@@ -201,15 +202,17 @@ def analyse(columns: dict | str | Path, *, stiffness: str | None = None, bins=No
         damage_vs_stiffness=res_bins[0], lost_vs_stiffness=res_bins[1], damage_force=damage_force)
 
 
+@entry_point
 def robustness_study(population: dict | None = None, *, settings: dict | None = None, n: int = 600,
                      seed: int = 1, model: str | None = "tsfm-gripper", scenario: str = "tsfm-grasp",
                      backend: str = "in-process", workers: int | None = None, scheduler: str | None = None,
                      out=None, resume: bool = False, bins=None, confidence: float = 0.95,
-                     progress: bool = True, name: str = "grasp-robustness") -> RobustnessResult:
+                     progress: bool = True, name: str = "grasp-robustness",
+                     allow_code: bool = False) -> RobustnessResult:
     """Run ``n`` grasps of ``scenario`` on ``model`` for objects drawn from ``population`` (sweep
     ``[parameters]`` entries; default :data:`DEFAULT_POPULATION`) with the controller and pass
     criteria ``settings`` (the sweep's ``[scenario]`` table; default :data:`DEFAULT_SETTINGS`), and
-    analyse them (:func:`analyse`). ``backend`` etc. as in :func:`gripkit.batch.sweep`."""
+    analyse them (:func:`analyse`). ``backend``, ``allow_code`` etc. as in :func:`gripkit.batch.sweep`."""
     if n < 1:
         raise ConfigError(f"n: expected a positive number of grasps, found {n}")
     pop = dict(DEFAULT_POPULATION if population is None else population)
@@ -220,7 +223,7 @@ def robustness_study(population: dict | None = None, *, settings: dict | None = 
     if len(spec.jobs()["job_id"]) != n:
         raise ConfigError("population: use random draws (uniform, normal, loguniform) only: grids would multiply n")
     res = sweep(spec, backend=backend, workers=workers, scheduler=scheduler, out=out, resume=resume,
-                progress=progress)
+                progress=progress, allow_code=allow_code)
     dmg = sett.get("damage_force", sett.get("damage_threshold"))
     dmg = to_si(dmg)[0] if isinstance(dmg, str) else (None if dmg is None else float(dmg))
     out_ = analyse(res.columns, bins=bins, confidence=confidence, damage_force=dmg)

@@ -3,8 +3,8 @@
 ```toml
 [sweep]
 name = "msd-robustness"
-scenario = "step-response"         # a registered scenario or "package.module:function"
-model = "mass-spring-damper"       # a zoo name, "package.module:factory", or left out
+scenario = "step-response"         # a registered scenario ("package.module:function": allow_code only)
+model = "mass-spring-damper"       # a registered model, left out ("package.module:factory": allow_code only)
 samples = 200                      # random draws per grid point (default 1)
 seed = 1
 chunk_size = 50                    # jobs per task (default: chosen from a timing run, >= 0.1 s)
@@ -26,31 +26,83 @@ record = ["peak", "overshoot_percent", "settling_time"]   # default: everything 
 ```
 
 Jobs = (grid points × table rows) × samples; ``job_id`` numbers them 0..N-1.
+
+Everything is checked before any job runs: the file's structure and types here
+(:meth:`SweepSpec.from_dict`), the job count without building the table (:meth:`SweepSpec.n_jobs`),
+and the parameter names, their units' dimensions and the ``[scenario]`` settings against what the
+scenario declares (:func:`gripkit.batch.scenarios.prepare`).
 """
 
 from __future__ import annotations
 
-import itertools
+import math
+import numbers
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import ConfigError
+from ..errors import ConfigError, GripkitError
 from ..io.toml_file import read_toml
-from ..units import setting_si as _si
 
-__all__ = ["SweepSpec"]
+__all__ = ["SweepSpec", "quantity"]
 
 _GRID_KINDS = ("grid", "values", "linspace", "logspace")
 _RANDOM_KINDS = ("uniform", "normal", "loguniform")
+_KINDS = (*_GRID_KINDS, *_RANDOM_KINDS, "table")
+_OPTIONS = {"clip": _RANDOM_KINDS, "column": ("table",)}  # extra keys and the kinds they go with
+_SWEEP_KEYS = ("name", "scenario", "model", "samples", "seed", "chunk_size")
+_TOP_KEYS = ("sweep", "parameters", "scenario", "metrics")
+
+
+def quantity(v, where: str, unit: str | None = None) -> float:
+    """``v`` (a number in SI, or a string such as ``"3 mg"``) as an SI float.
+
+    ``unit``: the SI unit the value must measure (``"N/m"``); a string with a unit of another
+    dimension (``"3 furlong"`` for a stiffness) is refused. Non-finite values are refused."""
+    from ..units import same_dimension, si_unit, to_si
+
+    expected = f" in {unit}" if unit else ""
+    if isinstance(v, bool) or not isinstance(v, (numbers.Real, str)):
+        raise ConfigError(f"{where}: expected a number{expected} or a quantity like '3 mg', found {v!r}")
+    if isinstance(v, str):
+        try:
+            value = float(v)  # a bare number in a string: SI
+        except ValueError:
+            try:
+                value, si = to_si(v)
+            except GripkitError as exc:
+                raise ConfigError(f"{where}: cannot read {v!r} as a quantity ({exc.message})",
+                                  hint="write a number followed by a unit, like '3 mg' or '25 N/m'") from None
+            if unit is not None and not same_dimension(si, unit):
+                raise ConfigError(f"{where}: {v!r} is a quantity in {si}, expected one in {si_unit(unit)}",
+                                  hint=f"give it in {unit} (or a unit of the same dimension), or as a "
+                                       f"plain number in {si_unit(unit)}")
+    else:
+        value = float(v)
+    if not math.isfinite(value):
+        raise ConfigError(f"{where}: expected a finite number{expected}, found {v!r}")
+    return value
+
+
+_si = quantity  # the name scenarios import
+
+
+def _integer(v, where: str, low: int) -> int:
+    if isinstance(v, bool) or not isinstance(v, numbers.Integral) or v < low:
+        raise ConfigError(f"{where}: expected an integer >= {low}, found {v!r}")
+    return int(v)
 
 
 @dataclass(frozen=True)
 class SweepSpec:
-    """A parameter sweep: a scenario run for every job of a parameter table."""
+    """A parameter sweep: a scenario run for every job of a parameter table.
 
-    scenario: object  # a registered name, "module:function", or a callable
+    ``scenario``: a registered name, ``"module:function"`` (imported only with ``allow_code``, see
+    :func:`gripkit.batch.sweep`), or a callable; ``model`` likewise a registered name,
+    ``"module:factory"`` or None."""
+
+    scenario: object
     parameters: dict
     model: str | None = None
     name: str = "sweep"
@@ -67,31 +119,61 @@ class SweepSpec:
 
     @classmethod
     def from_dict(cls, d: dict, base_dir: str = ".") -> "SweepSpec":
+        """Read and check a sweep description (the tables of a sweep file)."""
+        if not isinstance(d, dict):
+            raise ConfigError(f"sweep specification: expected a table, found {type(d).__name__}")
+        unknown = sorted(set(d) - set(_TOP_KEYS))
+        if unknown:
+            raise ConfigError(f"sweep specification: unknown tables {unknown}",
+                              hint=f"allowed: {', '.join(_TOP_KEYS)}")
         sw = d.get("sweep")
         if not isinstance(sw, dict) or "scenario" not in sw:
             raise ConfigError("sweep specification: a [sweep] table with a 'scenario' is required")
-        unknown = set(sw) - {"name", "scenario", "model", "samples", "seed", "chunk_size"}
+        unknown = sorted(set(sw) - set(_SWEEP_KEYS))
         if unknown:
-            raise ConfigError(f"[sweep]: unknown keys {sorted(unknown)}",
-                              hint="allowed: name, scenario, model, samples, seed, chunk_size")
-        params = d.get("parameters", {})
-        if not isinstance(params, dict):
-            raise ConfigError("[parameters] must be a table of name = { kind = ... }")
-        metrics = d.get("metrics", {}).get("record")
-        samples = int(sw.get("samples", 1))
-        if samples < 1:
-            raise ConfigError(f"[sweep] samples: expected a positive integer, found {samples}")
-        cs = sw.get("chunk_size")
-        if cs is not None and int(cs) < 1:
-            raise ConfigError(f"[sweep] chunk_size: expected a positive integer, found {cs}")
-        scen = sw["scenario"]
-        spec = cls(scenario=scen if callable(scen) else str(scen), parameters=dict(params), model=sw.get("model"),
-                   name=str(sw.get("name", "sweep")), settings=dict(d.get("scenario", {})),
-                   metrics=tuple(metrics) if metrics else None, samples=samples,
-                   seed=int(sw.get("seed", 0)), chunk_size=None if cs is None else int(cs),
-                   base_dir=base_dir)
-        spec.jobs()  # validate now: errors surface before any work starts
-        return spec
+            hint = f"allowed: {', '.join(_SWEEP_KEYS)}"
+            if any("allow" in k or "code" in k for k in unknown):
+                hint += ("; importing code cannot be allowed from inside a sweep file: pass --allow-code "
+                         "on the command line (Python: sweep(..., allow_code=True))")
+            raise ConfigError(f"[sweep]: unknown keys {unknown}", hint=hint)
+        params, settings, metrics = d.get("parameters", {}), d.get("scenario", {}), d.get("metrics", {})
+        if not isinstance(metrics, dict):
+            raise ConfigError(f"[metrics]: expected a table, found {metrics!r}")
+        if set(metrics) - {"record"}:
+            raise ConfigError(f"[metrics]: unknown keys {sorted(set(metrics) - {'record'})}", hint="allowed: record")
+        record = metrics.get("record")
+        return cls(scenario=sw["scenario"], parameters=params, model=sw.get("model"), name=sw.get("name", "sweep"),
+                   settings=settings, metrics=record, samples=sw.get("samples", 1), seed=sw.get("seed", 0),
+                   chunk_size=sw.get("chunk_size"), base_dir=base_dir)
+
+    def __post_init__(self):
+        """Check the types and ranges of every field, and count the jobs (reading every
+        parameter), so that an error surfaces before any work starts."""
+        for table, value in (("parameters", self.parameters), ("scenario", self.settings)):
+            if not isinstance(value, dict):
+                raise ConfigError(f"[{table}]: expected a table, found {value!r}")
+        record = self.metrics
+        if record is not None and (isinstance(record, str) or not isinstance(record, (list, tuple)) or not record
+                                   or not all(isinstance(m, str) for m in record)):
+            raise ConfigError(f"[metrics] record: expected a non-empty list of metric names, found {record!r}")
+        if not (callable(self.scenario) or isinstance(self.scenario, str)):
+            raise ConfigError(f"[sweep] scenario: expected a scenario name, found {self.scenario!r}")
+        if self.model is not None and not isinstance(self.model, str):
+            raise ConfigError(f"[sweep] model: expected a model name, found {self.model!r}")
+        name = self.name
+        if not isinstance(name, str) or not name or any(c in name for c in "/\\\0"):
+            raise ConfigError(f"[sweep] name: expected a short name without slashes, found {name!r}")
+        cs = self.chunk_size
+        fix = object.__setattr__  # frozen: normalise once, here
+        fix(self, "parameters", dict(self.parameters))
+        fix(self, "settings", dict(self.settings))
+        fix(self, "metrics", tuple(record) if record else None)
+        fix(self, "samples", _integer(self.samples, "[sweep] samples", 1))
+        fix(self, "seed", _integer(self.seed, "[sweep] seed", 0))
+        fix(self, "chunk_size", None if cs is None else _integer(cs, "[sweep] chunk_size", 1))
+        if self.n_jobs() == 0:
+            raise ConfigError("sweep specification: the parameter table has no rows, so there are no jobs",
+                              hint="check the table files named in [parameters]")
 
     def to_dict(self) -> dict:
         scen = self.scenario if isinstance(self.scenario, str) else \
@@ -101,65 +183,110 @@ class SweepSpec:
                 "parameters": self.parameters, "scenario": self.settings,
                 "metrics": {"record": list(self.metrics) if self.metrics else None}}
 
-    def jobs(self) -> dict[str, np.ndarray]:
-        """The job table: ``job_id`` and one float column per parameter."""
+    # --- the parameter table ------------------------------------------------------------------
+    def _axes(self, units: dict[str, str] | None = None):
+        """Each parameter read (values in SI, checked against ``units`` where given) without
+        building any array longer than the file states: (grids, linspaces, randoms, tables)."""
         grids: dict[str, np.ndarray] = {}
+        spaces: dict[str, tuple[str, float, float, int]] = {}
         randoms: dict[str, tuple[str, list, list | None]] = {}
         tables: dict[str, list[str]] = {}
         for name, desc in self.parameters.items():
             where = f"[parameters] {name}"
+            unit = (units or {}).get(name)
             if not isinstance(desc, dict) or not desc:
                 raise ConfigError(f"{where}: expected {{ grid = [...] }}, {{ uniform = [lo, hi] }}, ...")
-            kinds = [k for k in desc if k in (*_GRID_KINDS, *_RANDOM_KINDS, "table")]
+            kinds = [k for k in desc if k in _KINDS]
             if len(kinds) != 1:
-                raise ConfigError(f"{where}: give exactly one of {', '.join((*_GRID_KINDS, *_RANDOM_KINDS, 'table'))}")
+                raise ConfigError(f"{where}: give exactly one of {', '.join(_KINDS)}, found {sorted(desc)}")
             kind = kinds[0]
+            extra = sorted(k for k in desc if k != kind and kind not in _OPTIONS.get(k, ()))
+            if extra:
+                raise ConfigError(f"{where}: unknown keys {extra} for a {kind}",
+                                  hint="'clip' goes with uniform/normal/loguniform, 'column' with table")
             arg = desc[kind]
             if kind in ("grid", "values"):
-                vals = np.array([_si(v, where) for v in (arg if isinstance(arg, list) else [arg])])
+                vals = np.array([quantity(v, where, unit) for v in (arg if isinstance(arg, list) else [arg])])
                 if vals.size == 0:
                     raise ConfigError(f"{where}: empty grid")
                 grids[name] = vals
             elif kind in ("linspace", "logspace"):
                 if not (isinstance(arg, list) and len(arg) == 3):
-                    raise ConfigError(f"{where}: {kind} = [start, stop, count]")
-                a, b, n = _si(arg[0], where), _si(arg[1], where), int(arg[2])
+                    raise ConfigError(f"{where}: {kind} = [start, stop, count], found {arg!r}")
+                a, b = quantity(arg[0], where, unit), quantity(arg[1], where, unit)
+                n = _integer(arg[2], f"{where} ({kind} count)", 1)
                 if kind == "logspace" and (a <= 0 or b <= 0):
-                    raise ConfigError(f"{where}: logspace needs positive ends")
-                grids[name] = np.linspace(a, b, n) if kind == "linspace" else np.geomspace(a, b, n)
+                    raise ConfigError(f"{where}: logspace needs positive ends, found {a}, {b}")
+                spaces[name] = (kind, a, b, n)
             elif kind == "table":
-                tables.setdefault(str(arg), []).append(name)
+                if not isinstance(arg, str) or not isinstance(desc.get("column", name), str):
+                    raise ConfigError(f"{where}: table = \"file.csv\" (and column = \"name\"), found {arg!r}")
+                tables.setdefault(arg, []).append(name)
             else:
                 if not (isinstance(arg, list) and len(arg) == 2):
-                    raise ConfigError(f"{where}: {kind} = [a, b]")
-                lo, hi = _si(arg[0], where), _si(arg[1], where)
+                    raise ConfigError(f"{where}: {kind} = [a, b], found {arg!r}")
+                lo = quantity(arg[0], where, unit)
+                hi = quantity(arg[1], where, unit)
                 if kind in ("uniform", "loguniform") and not lo < hi:
                     raise ConfigError(f"{where}: {kind} needs a < b, found {lo} >= {hi}")
                 if kind == "loguniform" and lo <= 0:
-                    raise ConfigError(f"{where}: loguniform needs positive bounds")
+                    raise ConfigError(f"{where}: loguniform needs positive bounds, found {lo}")
                 if kind == "normal" and hi < 0:
-                    raise ConfigError(f"{where}: normal = [mean, std] needs std >= 0")
+                    raise ConfigError(f"{where}: normal = [mean, std] needs std >= 0, found {hi}")
                 clip = desc.get("clip")
-                randoms[name] = (kind, [lo, hi], None if clip is None else [_si(c, where) for c in clip])
-        # table rows (each file zips its columns)
-        table_rows: list[dict[str, float]] = [{}]
-        for file, names in tables.items():
-            from ..io import load
+                if clip is not None:
+                    if not (isinstance(clip, list) and len(clip) == 2):
+                        raise ConfigError(f"{where}: clip = [low, high], found {clip!r}")
+                    clip = [quantity(c, f"{where} clip", unit) for c in clip]
+                    if not clip[0] <= clip[1]:
+                        raise ConfigError(f"{where}: clip needs low <= high, found {clip}")
+                randoms[name] = (kind, [lo, hi], clip)
+        return grids, spaces, randoms, tables
 
+    def _table_rows(self, tables: dict[str, list[str]]) -> dict[str, np.ndarray]:
+        """Rows of the parameter files (each file zips its columns; files are crossed)."""
+        from ..io import load
+
+        cols_out: dict[str, np.ndarray] = {}
+        n_rows = 1
+        for file, names in tables.items():
             path = Path(file) if Path(file).is_absolute() else Path(self.base_dir) / file
             cols = [self.parameters[n].get("column", n) for n in names]
             tr = load(path, columns=cols, fs=1.0)
-            rows = [{n: float(tr[c][i]) for n, c in zip(names, cols)} for i in range(tr.n)]
-            table_rows = [{**a, **b} for a in table_rows for b in rows]
-        grid_names = list(grids)
-        points = list(itertools.product(*(grids[n] for n in grid_names))) or [()]
-        n_jobs = len(points) * len(table_rows) * self.samples
+            idx = np.arange(n_rows * tr.n)
+            cols_out = {k: v[idx // tr.n] for k, v in cols_out.items()}
+            for n, c in zip(names, cols):
+                cols_out[n] = np.asarray(tr[c], dtype=np.float64)[idx % tr.n]
+            n_rows *= tr.n
+        return cols_out
+
+    def n_jobs(self) -> int:
+        """The number of jobs, counted without building the table (a Python int: no overflow)."""
+        grids, spaces, _, tables = self._axes()
+        rows = self._table_rows(tables)
+        n = math.prod([g.size for g in grids.values()] + [s[3] for s in spaces.values()])
+        return n * (len(next(iter(rows.values()))) if rows else 1) * self.samples
+
+    def jobs(self, units: dict[str, str] | None = None) -> dict[str, np.ndarray]:
+        """The job table: ``job_id`` and one float column per parameter (values checked against
+        ``units``, name -> SI unit, where given)."""
+        grids, spaces, randoms, tables = self._axes(units)
+        for name, (kind, a, b, n) in spaces.items():
+            grids[name] = np.linspace(a, b, n) if kind == "linspace" else np.geomspace(a, b, n)
+        grids = {n: grids[n] for n in self.parameters if n in grids}  # file order: first varies slowest
+        rows = self._table_rows(tables)
+        n_rows = len(next(iter(rows.values()))) if rows else 1
+        n_points = math.prod(g.size for g in grids.values())
+        n_jobs = n_points * n_rows * self.samples
         out: dict[str, np.ndarray] = {"job_id": np.arange(n_jobs, dtype=np.int64)}
-        base = [(dict(zip(grid_names, p)), r) for p in points for r in table_rows]
-        for n in grid_names:
-            out[n] = np.repeat([b[0][n] for b in base], self.samples).astype(np.float64)
-        for n in (n for names in tables.values() for n in names):
-            out[n] = np.repeat([b[1][n] for b in base], self.samples).astype(np.float64)
+        base = out["job_id"] // self.samples  # job = ((point * n_rows) + row) * samples + draw
+        point, row = base // n_rows, base % n_rows
+        stride = n_points
+        for n, g in grids.items():
+            stride //= g.size
+            out[n] = g[(point // stride) % g.size].astype(np.float64)
+        for n, col in rows.items():
+            out[n] = col[row]
         rng = np.random.default_rng(self.seed)
         for n, (kind, (a, b), clip) in randoms.items():
             if kind == "uniform":
@@ -169,4 +296,4 @@ class SweepSpec:
             else:
                 v = rng.normal(a, b, n_jobs)
             out[n] = np.clip(v, *clip) if clip else v
-        return out
+        return {"job_id": out["job_id"], **{n: out[n] for n in self.parameters}}

@@ -8,8 +8,13 @@ Layout of an output folder::
 
 A chunk file is written to a temporary name and renamed, so it is either complete or absent: a
 crash loses at most the chunks in flight, a resumed sweep skips every chunk already on disk, and a
-chunk computed twice (a worker killed after finishing) replaces its file with identical content —
-each job's result is present exactly once.
+chunk computed twice (a worker killed after finishing) replaces its file with identical content.
+
+Files can still be damaged after the fact (a full disk, a copy gone wrong, a hand edit), so a
+resumed sweep trusts no chunk unread: :meth:`ResultStore.check_chunks` reads every one and checks
+its schema (``job_id`` integers, ``error`` text, float metrics) and that its job ids are exactly
+its range; a bad file is set aside as ``chunk-NNNNNN.parquet.bad`` with a warning and its jobs are
+computed again. :func:`collect` refuses a result that does not hold each job exactly once.
 """
 
 from __future__ import annotations
@@ -18,15 +23,48 @@ import hashlib
 import json
 import os
 import re
+import warnings
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import ConfigError, DataError
+from ..errors import ConfigError, DataError, GripkitWarning
 
-__all__ = ["ResultStore"]
+__all__ = ["ResultStore", "chunk_range", "collect"]
 
 _CHUNK = re.compile(r"^chunk-(\d{6})\.parquet$")
+
+
+def chunk_range(chunk: int, chunk_size: int, n_jobs: int) -> range:
+    """The job ids of chunk ``chunk``."""
+    return range(chunk * chunk_size, min((chunk + 1) * chunk_size, n_jobs))
+
+
+def collect(jobs: dict[str, np.ndarray], parts) -> dict[str, np.ndarray]:
+    """Every job's parameters joined with its results from ``parts`` (dicts with ``job_id``,
+    metrics and ``error``), ordered by job id. Raises :class:`DataError` unless the parts hold
+    each job exactly once."""
+    parts = list(parts)
+    n = len(jobs["job_id"])
+    ids = np.concatenate([np.asarray(p["job_id"], dtype=np.int64) for p in parts]) if parts else np.zeros(0, np.int64)
+    if ids.size and (ids.min() < 0 or ids.max() >= n):
+        raise DataError(f"sweep results: job ids outside 0..{n - 1} (found {ids.min()}..{ids.max()})")
+    count = np.bincount(ids, minlength=n)
+    if (count != 1).any():
+        missing, twice = np.flatnonzero(count == 0), np.flatnonzero(count > 1)
+        raise DataError(f"sweep results: {len(missing)} jobs missing (first {missing[:5].tolist()}) and "
+                        f"{len(twice)} held more than once (first {twice[:5].tolist()}); each job must appear "
+                        "exactly once", hint="resume the sweep to recompute the missing chunks")
+    out = dict(jobs)
+    for p in parts:
+        rows = np.asarray(p["job_id"], dtype=np.int64)
+        for k, v in p.items():
+            if k == "job_id":
+                continue
+            if k not in out:
+                out[k] = np.full(n, None, dtype=object) if k == "error" else np.full(n, np.nan)
+            out[k][rows] = v
+    return out
 
 
 def _atomic_write_table(table, path: Path) -> None:
@@ -50,14 +88,28 @@ class ResultStore:
         self.chunks_dir = self.root / "chunks"
 
     # --- setup -----------------------------------------------------------------------------
+    def manifest(self) -> dict | None:
+        """The recorded manifest, or None where there is none."""
+        path = self.root / "manifest.json"
+        if not path.exists():
+            return None
+        try:
+            m = json.loads(path.read_text())
+            m["spec"]["sweep"]
+            return m
+        except (OSError, ValueError, KeyError, TypeError) as exc:
+            raise ConfigError(f"output folder {str(self.root)!r}: manifest.json is unreadable ({type(exc).__name__})",
+                              hint="choose another --out folder, or delete this one and run the sweep again") from None
+
     def initialise(self, spec: dict, jobs: dict[str, np.ndarray], resume: bool) -> None:
         """Create the folder, or check that an existing one belongs to the same sweep."""
         import pyarrow as pa
 
         fp = fingerprint(spec)
-        manifest = self.root / "manifest.json"
-        if manifest.exists():
-            old = json.loads(manifest.read_text())
+        if self.root.exists() and not self.root.is_dir():
+            raise ConfigError(f"output folder {str(self.root)!r} is a file", hint="choose another --out folder")
+        old = self.manifest()
+        if old is not None:
             if old.get("fingerprint") != fp:
                 raise ConfigError(
                     f"output folder {str(self.root)!r} holds a different sweep (fingerprint "
@@ -66,6 +118,7 @@ class ResultStore:
                 raise ConfigError(f"output folder {str(self.root)!r} already holds results of this sweep",
                                   hint="pass --resume (resume=True) to continue it, or choose another folder")
         self.chunks_dir.mkdir(parents=True, exist_ok=True)
+        manifest = self.root / "manifest.json"
         tmp = manifest.with_name(".manifest.json.tmp")
         tmp.write_text(json.dumps({"fingerprint": fp, "spec": spec}, indent=2, default=str))
         os.replace(tmp, manifest)
@@ -89,32 +142,85 @@ class ResultStore:
             arrays[k] = pa.array(a.tolist(), type=pa.string()) if a.dtype == object else pa.array(a)
         _atomic_write_table(pa.table(arrays), self.chunk_path(chunk))
 
-    # --- reading ---------------------------------------------------------------------------
-    def read(self) -> dict[str, np.ndarray]:
-        """Every job's parameters joined with its results, ordered by job_id."""
+    def _load(self, chunk: int, chunk_size: int, n_jobs: int, metrics) -> tuple[dict | None, str]:
+        """(the chunk's columns, "") when its file is sound, else (None, what is wrong)."""
         import pyarrow as pa
         import pyarrow.parquet as pq
 
-        jobs_path = self.root / "jobs.parquet"
-        if not jobs_path.exists():
-            raise DataError(f"{str(self.root)!r} holds no sweep (jobs.parquet missing)")
-        jobs = pq.read_table(jobs_path).to_pydict()
-        out = {k: np.asarray(v) for k, v in jobs.items()}
-        n = len(out["job_id"])
-        position = {int(j): i for i, j in enumerate(out["job_id"])}
+        expected = chunk_range(chunk, chunk_size, n_jobs)
+        if not expected:
+            return None, f"lies beyond the last chunk ({-(-n_jobs // chunk_size) - 1})"
+        try:
+            table = pq.read_table(self.chunk_path(chunk))
+        except Exception as exc:  # pyarrow raises several types for damaged files
+            return None, f"is unreadable ({type(exc).__name__}: {str(exc).splitlines()[0][:120] if str(exc) else ''})"
+        types = dict(zip(table.column_names, table.schema.types))
+        if "job_id" not in types or not pa.types.is_integer(types["job_id"]):
+            return None, "has no integer job_id column"
+        if "error" not in types or not (pa.types.is_string(types["error"]) or pa.types.is_null(types["error"])):
+            return None, "has no text error column"
+        values = [k for k in types if k not in ("job_id", "error")]
+        bad = [k for k in values if not pa.types.is_floating(types[k])]
+        if bad:
+            return None, f"has non-float metric columns {bad}"
+        if metrics is not None and values and sorted(values) != sorted(metrics):
+            return None, f"holds the metrics {values}, expected {list(metrics)}"
+        ids = table["job_id"].to_numpy()
+        if not np.array_equal(ids, np.arange(expected.start, expected.stop)):
+            found = f"{ids.min()}..{ids.max()}" if len(ids) else "none"
+            found += "" if not len(ids) or len(ids) == ids.max() - ids.min() + 1 else f" ({len(ids)} jobs)"
+            return None, f"holds job ids {found}, expected {expected.start}..{expected.stop - 1}"
+        cols = {"job_id": ids, "error": np.array(table["error"].to_pylist(), dtype=object)}
+        cols.update({k: table[k].to_numpy().astype(np.float64) for k in values})
+        return cols, ""
+
+    def check_chunks(self, chunk_size: int, n_jobs: int, metrics=None) -> set[int]:
+        """The chunks on disk that are sound; each bad one is set aside (``.bad``) with a warning,
+        so that it is computed again."""
+        for stale in self.chunks_dir.glob(".chunk-*.tmp") if self.chunks_dir.exists() else ():
+            stale.unlink(missing_ok=True)  # a write cut short by a crash
+        good = set()
         for c in sorted(self.done_chunks()):
-            part = pq.read_table(self.chunk_path(c))
-            rows = np.array([position[int(j)] for j in part["job_id"].to_pylist()], dtype=np.int64)
-            for name in part.column_names:
-                if name == "job_id":
-                    continue
-                col = part[name]
-                if name not in out:
-                    is_text = pa.types.is_string(col.type) or pa.types.is_null(col.type)
-                    out[name] = np.full(n, None, dtype=object) if is_text else np.full(n, np.nan)
-                vals = col.to_pylist()
-                if out[name].dtype == object:
-                    out[name][rows] = np.array(vals, dtype=object)
-                else:
-                    out[name][rows] = np.array([np.nan if v is None else v for v in vals], dtype=np.float64)
-        return out
+            cols, problem = self._load(c, chunk_size, n_jobs, metrics)
+            if cols is not None:
+                good.add(c)
+                continue
+            path = self.chunk_path(c)
+            os.replace(path, path.with_name(path.name + ".bad"))
+            r = chunk_range(c, chunk_size, n_jobs)
+            again = f"its jobs {r.start}..{r.stop - 1} are computed again" if r else "it is not used"
+            warnings.warn(f"sweep output {str(self.root)!r}: chunk {c} ({path.name}) {problem}; {again} "
+                          f"(the file is kept as {path.name}.bad)", GripkitWarning, stacklevel=2)
+        return good
+
+    # --- reading ---------------------------------------------------------------------------
+    def read_parts(self, chunk_size: int, n_jobs: int, metrics=None) -> list[dict]:
+        """The columns of every chunk on disk, each checked as in :meth:`check_chunks`; a bad
+        one raises :class:`DataError` (a sweep's output must not change under it)."""
+        parts = []
+        for c in sorted(self.done_chunks()):
+            cols, problem = self._load(c, chunk_size, n_jobs, metrics)
+            if cols is None:
+                raise DataError(f"sweep output {str(self.root)!r}: chunk {c} {problem}",
+                                hint="resume the sweep (--resume) to compute it again")
+            parts.append(cols)
+        return parts
+
+    def read(self) -> dict[str, np.ndarray]:
+        """Every job's parameters joined with its results, ordered by job_id (each job exactly
+        once, else :class:`DataError`)."""
+        import pyarrow.parquet as pq
+
+        jobs_path = self.root / "jobs.parquet"
+        manifest = self.manifest()
+        if manifest is None or not jobs_path.exists():
+            raise DataError(f"{str(self.root)!r} holds no sweep (manifest.json or jobs.parquet missing)")
+        try:
+            table = pq.read_table(jobs_path)
+            jobs = {k: table[k].to_numpy() for k in table.column_names}
+        except Exception as exc:
+            raise DataError(f"{str(jobs_path)!r} is unreadable ({type(exc).__name__})") from None
+        sw = manifest["spec"]["sweep"]
+        metrics = (manifest["spec"].get("metrics") or {}).get("record")
+        n = len(jobs["job_id"])
+        return collect(jobs, self.read_parts(int(sw["chunk_size"]), n, metrics))

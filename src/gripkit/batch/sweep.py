@@ -11,59 +11,42 @@ each chunk is one task for the executor and one Parquet file in the output folde
 (:class:`~gripkit.batch.store.ResultStore`). A job that raises is recorded with its error in the
 ``error`` column and the sweep goes on; a chunk whose task fails as a whole (its worker died three
 times) records the failure for each of its jobs.
+
+Before any job runs, :func:`sweep` checks the description against its scenario
+(:func:`~gripkit.batch.scenarios.prepare`: parameter names and units, settings, metrics), counts the
+jobs and estimates the memory they need (:mod:`gripkit.batch.budget`), and on resume checks every
+chunk on disk (:meth:`~gripkit.batch.store.ResultStore.check_chunks`). The returned table holds
+each job exactly once (:func:`~gripkit.batch.store.collect` raises otherwise).
 """
 
 from __future__ import annotations
 
-import json
 import math
+import os
 import time
-import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import ConfigError, ConsistencyWarning
+from ..arguments import entry_point
+from ..errors import ConfigError
 from ..progress import status, track
+from .budget import UNDECLARED_METRICS, MemoryEstimate, memory_limit as _memory_limit
 from .executors import Executor, make_executor
-from .scenarios import resolve
+from .scenarios import build_model, prepare, resolve
 from .spec import SweepSpec
-from .store import ResultStore
+from .store import ResultStore, chunk_range, collect
 
 __all__ = ["sweep", "run_chunk", "SweepResult"]
 
-_MODELS: dict = {}
 
-
-def _model(ref: str | None):
-    """Build (once per process) the model a sweep names: a zoo entry or 'module:factory'."""
-    if ref is None:
-        return None
-    if ref not in _MODELS:
-        import importlib
-
-        with warnings.catch_warnings():  # consistency findings are reported by `gripkit zoo check`
-            warnings.simplefilter("ignore", ConsistencyWarning)
-            if ":" in ref:
-                module, func = ref.split(":", 1)
-                _MODELS[ref] = getattr(importlib.import_module(module), func)()
-            elif ref == "mass-spring-damper":
-                from ..models import MassSpringDamper
-
-                _MODELS[ref] = MassSpringDamper()
-            else:
-                from .. import zoo
-
-                _MODELS[ref] = zoo.build(ref)
-    return _MODELS[ref]
-
-
-def run_chunk(scenario: str, model_ref: str | None, settings: dict, job_ids: np.ndarray,
-              params: dict[str, np.ndarray], metrics: tuple[str, ...] | None) -> dict[str, np.ndarray]:
+def run_chunk(scenario, model_ref: str | None, settings: dict, job_ids: np.ndarray,
+              params: dict[str, np.ndarray], metrics: tuple[str, ...] | None,
+              allow_code: bool = False) -> dict[str, np.ndarray]:
     """Compute one chunk: the scenario on every job, failures recorded per job."""
-    fn = resolve(scenario)
-    model = _model(model_ref)
+    fn = resolve(scenario, allow_code)
+    model = build_model(model_ref, allow_code)
     n = len(job_ids)
     errors = np.full(n, None, dtype=object)
     try:
@@ -82,7 +65,7 @@ def run_chunk(scenario: str, model_ref: str | None, settings: dict, job_ids: np.
             rows = []
             for i in range(n):
                 part = run_chunk(scenario, model_ref, settings, job_ids[i:i + 1],
-                                 {k: v[i:i + 1] for k, v in params.items()}, metrics)
+                                 {k: v[i:i + 1] for k, v in params.items()}, metrics, allow_code)
                 rows.append(part)
                 errors[i] = part["error"][0]
             keys = sorted({k for r in rows for k in r if k not in ("job_id", "error")})
@@ -119,51 +102,92 @@ class SweepResult:
     @property
     def failed(self) -> np.ndarray:
         err = self.columns.get("error")
-        return np.zeros(self.n_jobs, bool) if err is None else np.array([e is not None for e in err])
+        return np.zeros(self.n_jobs, bool) if err is None else np.array([e is not None for e in err], dtype=bool)
+
+    @property
+    def n_failed(self) -> int:
+        return int(self.failed.sum())
 
     @property
     def failures(self) -> list[tuple[int, str]]:
+        if "error" not in self.columns:
+            return []
         return [(int(j), e) for j, e in zip(self.columns["job_id"], self.columns["error"]) if e is not None]
 
     def summary(self) -> str:
-        return (f"{self.n_jobs} jobs ({int(self.failed.sum())} failed) in {self.seconds:.2f} s on "
+        failed = f"{self.n_failed} of them FAILED (see the error column)" if self.n_failed else "none failed"
+        return (f"{self.n_jobs} job{'s' if self.n_jobs != 1 else ''}, {failed}, in {self.seconds:.2f} s on "
                 f"{self.backend}, chunks of {self.chunk_size}, {self.computed_chunks} computed"
                 + (f"; results in {self.path}" if self.path else ""))
 
 
-def _calibrate(spec: SweepSpec, jobs: dict[str, np.ndarray], target_s: float) -> int:
-    """Jobs per chunk so a chunk takes >= target_s, timed on a warm (compiled) run of 2 jobs."""
-    names = [k for k in jobs if k != "job_id"]
-    k = min(2, len(jobs["job_id"]))
-    args = (spec.scenario, spec.model, spec.settings, jobs["job_id"][:k],
-            {n: jobs[n][:k] for n in names}, spec.metrics)
-    run_chunk(*args)  # compile
+def _calibrate(first: tuple, target_s: float) -> int:
+    """Jobs per chunk so a chunk takes >= target_s, timed on a warm (compiled) run of the first
+    jobs (``first``: :func:`run_chunk`'s arguments for them)."""
+    run_chunk(*first)  # compile
     t0 = time.perf_counter()
-    run_chunk(*args)
-    per_job = max((time.perf_counter() - t0) / k, 1e-7)
+    run_chunk(*first)
+    per_job = max((time.perf_counter() - t0) / len(first[3]), 1e-7)
     return max(1, math.ceil(target_s / per_job))
 
 
+def _in_flight(executor: Executor | None, backend: str, workers: int | None, scheduler: str | None) -> int:
+    """Tasks that run at once on this machine (a remote scheduler's workers use their own)."""
+    if executor is not None:
+        return 0 if executor.name == "dask" and scheduler else max(int(executor.workers), 1)
+    if scheduler:
+        return 0
+    return 1 if backend == "in-process" else int(workers or os.cpu_count() or 1)
+
+
+@entry_point
 def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "process", workers: int | None = None,
           scheduler: str | None = None, out: str | Path | None = None, resume: bool = False,
-          progress: bool = True, executor: Executor | None = None,
-          target_task_s: float = 0.1) -> SweepResult:
+          progress: bool = True, executor: Executor | None = None, target_task_s: float = 0.1,
+          allow_code: bool = False, memory_limit: int | float | str | None = None) -> SweepResult:
     """Run a sweep. ``backend``: 'process' (default), 'in-process' or 'dask' (``scheduler`` address
-    or a LocalCluster); ``out``: folder for checkpointed results (required for ``resume``)."""
+    or a LocalCluster); ``out``: folder for checkpointed results (required for ``resume``).
+
+    ``allow_code``: let the description name code to import (``scenario``/``model`` =
+    ``"module:function"``); only registered names otherwise. Such a sweep file is code: run only
+    files you trust as you would a script. ``memory_limit``: bytes (or ``"8 GB"``) the sweep may
+    use; default half the memory available. A sweep that would not fit is refused up front with
+    the estimate. Jobs that fail are recorded (``result.failures``), not raised."""
     if not isinstance(spec, SweepSpec):
         spec = SweepSpec.from_dict(spec) if isinstance(spec, dict) else SweepSpec.from_toml(spec)
     if resume and out is None:
         raise ConfigError("resume needs the output folder of the interrupted sweep (out=...)")
-    jobs = spec.jobs()
-    n_jobs = len(jobs["job_id"])
+    if executor is None and not scheduler and backend not in ("in-process", "process", "dask"):
+        raise ConfigError(f"backend: expected 'in-process', 'process' or 'dask', found {backend!r}")
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+        raise ConfigError(f"workers: expected a positive number, found {workers!r}")
+    prep = prepare(spec, allow_code)
+    n_jobs = spec.n_jobs()
+    limit, limit_text = _memory_limit(memory_limit)
+    iface = prep.interface
+    n_metrics = len(spec.metrics or iface.metrics or ()) or UNDECLARED_METRICS
+    estimate = MemoryEstimate(n_jobs, len(spec.parameters), n_metrics, iface.bytes_per_job, iface.bytes_per_task)
+    in_flight = _in_flight(executor, backend, workers, scheduler)
     store = ResultStore(out) if out is not None else None
     chunk_size = spec.chunk_size
-    manifest = Path(out) / "manifest.json" if out is not None else None
-    if chunk_size is None and resume and manifest is not None and manifest.exists():
-        chunk_size = json.loads(manifest.read_text())["spec"]["sweep"]["chunk_size"]
+    if chunk_size is None and resume and store is not None and (m := store.manifest()) is not None:
+        chunk_size = m["spec"]["sweep"].get("chunk_size")
+    # the table, the results and a first small task must fit before anything is built
+    estimate.check(min(chunk_size or 2, n_jobs), max(in_flight, 1), limit, limit_text, f"sweep {spec.name!r}")
+    jobs = spec.jobs(dict(iface.parameters or {}))
+    iface.check_values(jobs)
+    names = [k for k in jobs if k != "job_id"]
+
+    def chunk_args(r: range) -> tuple:
+        sl = slice(r.start, r.stop)
+        return (spec.scenario, spec.model, prep.settings, jobs["job_id"][sl], {n: jobs[n][sl] for n in names},
+                spec.metrics, allow_code)
+
     if chunk_size is None:
-        chunk_size = _calibrate(spec, jobs, target_task_s)
+        chunk_size = min(_calibrate(chunk_args(range(min(2, n_jobs))), target_task_s),
+                         max(estimate.largest_chunk(in_flight, limit), 1))
     chunk_size = int(min(chunk_size, n_jobs))
+    estimate.check(chunk_size, in_flight, limit, limit_text, f"sweep {spec.name!r}")
     record = spec.to_dict()
     record["sweep"]["chunk_size"] = chunk_size
     n_chunks = math.ceil(n_jobs / chunk_size)
@@ -171,15 +195,12 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "process", work
     mem: dict[int, dict] = {}
     if store is not None:
         store.initialise(record, jobs, resume)
-        done = store.done_chunks()
-    names = [k for k in jobs if k != "job_id"]
+        done = store.check_chunks(chunk_size, n_jobs, spec.metrics)
     tasks = []
     for c in range(n_chunks):
         if c in done:
             continue
-        sl = slice(c * chunk_size, min((c + 1) * chunk_size, n_jobs))
-        tasks.append((c, run_chunk, (spec.scenario, spec.model, spec.settings, jobs["job_id"][sl],
-                                     {n: jobs[n][sl] for n in names}, spec.metrics)))
+        tasks.append((c, run_chunk, chunk_args(chunk_range(c, chunk_size, n_jobs))))
     own = executor is None
     ex = executor or make_executor(backend, workers, scheduler)
     t0 = time.perf_counter()
@@ -190,8 +211,8 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "process", work
                                   description=f"{spec.name} ({ex.name}, {chunk_size} jobs/chunk)",
                                   enabled=progress):
             if not ok:
-                sl = slice(c * chunk_size, min((c + 1) * chunk_size, n_jobs))
-                value = {"job_id": jobs["job_id"][sl], "error": np.full(sl.stop - sl.start, value, dtype=object)}
+                r = chunk_range(c, chunk_size, n_jobs)
+                value = {"job_id": jobs["job_id"][r.start:r.stop], "error": np.full(len(r), value, dtype=object)}
             if store is not None:
                 store.write_chunk(c, value)
             else:
@@ -200,16 +221,6 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "process", work
         if own:
             ex.close()
     seconds = time.perf_counter() - t0
-    if store is not None:
-        cols = store.read()
-    else:
-        cols = dict(jobs)
-        parts = [mem[c] for c in sorted(mem)]
-        keys = [k for k in dict.fromkeys(k for p in parts for k in p) if k != "job_id"]
-        for k in keys:
-            arr = np.full(n_jobs, None if k == "error" else np.nan, dtype=object if k == "error" else np.float64)
-            for p in parts:
-                if k in p:
-                    arr[np.asarray(p["job_id"])] = p[k]
-            cols[k] = arr
+    parts = store.read_parts(chunk_size, n_jobs, spec.metrics) if store is not None else mem.values()
+    cols = collect(jobs, parts)  # raises unless each job is there exactly once
     return SweepResult(cols, None if out is None else Path(out), ex.name, chunk_size, seconds, len(tasks))

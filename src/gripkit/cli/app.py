@@ -22,7 +22,28 @@ app.add_typer(identify_app, name="identify")
 app.add_typer(zoo_app, name="zoo")
 
 
+def version() -> str:
+    """gripkit's version: the installed package's metadata, else ``gripkit.__version__`` (a source
+    tree on the path without an install)."""
+    from importlib import metadata
+
+    try:
+        return metadata.version("gripkit")
+    except metadata.PackageNotFoundError:
+        from .. import __version__
+
+        return __version__
+
+
+def _print_version(value: bool) -> None:
+    if value:
+        typer.echo(f"gripkit {version()}")
+        raise typer.Exit(0)
+
+
 @app.callback()
 def _root(debug: bool = typer.Option(False, "--debug", help="Show tracebacks on errors."),
-          quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress output.")):
+          quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress output."),
+          show_version: bool = typer.Option(False, "--version", is_eager=True, callback=_print_version,
+                                            help="Print gripkit's version and exit.")):
     progress.set_quiet(quiet)

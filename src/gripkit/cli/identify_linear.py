@@ -143,7 +143,9 @@ def identify_rls(data: Path = DataArg, input: str = InputOpt, output: str = Outp
     """Recursive least squares ARX (orders na, nb, nk) with forgetting; θ and σ at every sample."""
     from ..io import save
     from ..sysid import rls
+    from .paths import output_file
 
+    output_file(trajectory, "--trajectory")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         io = _io(data, input, output, fs, time, fill, detrend, "RLS identification")

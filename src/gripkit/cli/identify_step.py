@@ -15,13 +15,23 @@ from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data
 def identify_step(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 file with the step record."),
                   input_col: str = typer.Option(..., "--input", help="Input column (the commanded step)."),
                   output_col: str = typer.Option(..., "--output", help="Output column (the response)."),
-                  fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, json_out: bool = JsonOpt):
+                  fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
+                  method: str = typer.Option("lm", "--method",
+                                             help="Least squares: lm (Levenberg-Marquardt) or trf (trust-region "
+                                                  "reflective, keeps the parameters within their bounds)."),
+                  json_out: bool = JsonOpt):
     """Fit K ω_n²/(s² + 2ζω_n s + ω_n²) to a step response (gain, natural frequency, damping, σ)."""
+    from ..errors import DataError
+    from ..sysid.step_response import STEP_METHODS
     from ..sysid.step_response import identify_step as _identify
 
+    if method not in STEP_METHODS:  # before the data are read
+        raise DataError(f"--method: expected one of {', '.join(STEP_METHODS)}, found {method!r}",
+                        hint="lm (Levenberg-Marquardt) or trf (bounded trust-region reflective)")
     tr = load_data(data, [input_col, output_col], fs, time, fill)
-    res = _identify(tr, input=input_col, output=output_col)
+    res = _identify(tr, input=input_col, output=output_col, method=method)
     if json_out:
-        emit_json({"data": str(data), "input": input_col, "output": output_col, **res.to_dict()})
+        emit_json({"data": str(data), "input": input_col, "output": output_col, "method": method,
+                   **res.to_dict()})
     else:
         typer.echo(res.summary())

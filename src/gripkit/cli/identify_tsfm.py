@@ -33,8 +33,13 @@ def identify_modal(data: Path = DataArg,
                    json_out: bool = JsonOpt):
     """Natural frequency and damping ratio from a free vibration (FFT peak, half-power, log
     decrement, Hilbert envelope, damped-sine least squares)."""
+    import math
+
+    from ..errors import DataError
     from ..sysid.modal import free_vibration
 
+    if start is not None and not math.isfinite(start):
+        raise DataError(f"--start: expected the release time in s (a finite number), found {start}")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         tr = load_data(data, [signal], fs, time, fill)

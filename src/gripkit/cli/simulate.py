@@ -24,10 +24,14 @@ def simulate(model: Path = typer.Argument(..., help="Model description (.toml)."
     from ..io import save
     from ..progress import status
     from ..description import load_description
+    from .paths import output_file
 
+    output_file(out, "--out")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         d = load_description(model)
+        if out is None:
+            output_file(d.output, f"[output] file of {model.name}")
         status(f"simulating {d.model.name}: {d.inputs.n} samples at {d.inputs.fs:g} Hz")
         tr = d.model.simulate(d.inputs)
     lines = report_warnings(caught)

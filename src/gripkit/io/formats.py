@@ -16,7 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import DataError
+from ..arguments import check_path, entry_point
+from ..errors import ArgumentError, DataError
 from ..signals.trajectory import Trajectory
 from .table import columns_to_trajectory
 
@@ -38,6 +39,7 @@ def _format(path: Path, fmt: str | None) -> str:
                         hint="use .csv, .parquet or .h5, or pass format=") from None
 
 
+@entry_point
 def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
          fs: float | None = None, units: Mapping[str, str] | None = None,
          fill: str | None = None, format: str | None = None, key: str | None = None,
@@ -69,7 +71,17 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
     ------
     DataError
         Missing file or column, truncated or corrupt file, mixed types, NaN/inf, bad time stamps.
+    ArgumentError
+        An unknown keyword, or an argument of the wrong type (``path`` not a path, ``units`` not a
+        mapping, ``fs`` not a number).
     """
+    check_path(path, "path", "load()")
+    if units is not None and not isinstance(units, Mapping):
+        raise ArgumentError(f"load(): units must be a mapping {{column: unit}}, found {type(units).__name__}",
+                            hint='e.g. units={"force": "mN"}')
+    if fs is not None and (isinstance(fs, bool) or not isinstance(fs, (int, float, np.integer, np.floating))):
+        raise ArgumentError(f"load(): fs must be a sampling rate in Hz (a number), found {type(fs).__name__} "
+                            f"{fs!r:.40}")
     path = Path(path)
     if not path.exists():
         raise DataError(f"data file {str(path)!r} not found")
@@ -186,9 +198,13 @@ def _read_hdf5(path: Path, key=None, delimiter=None):
     return raw, units
 
 
+@entry_point
 def save(tr: Trajectory, path, *, format: str | None = None, key: str = "/") -> None:
     """Write a trajectory: time as ``t`` (s) then each channel with its SI unit. Writes to a
     temporary file and renames it, so an interrupted save never leaves a half-written file."""
+    if not isinstance(tr, Trajectory):
+        raise ArgumentError(f"save(): tr must be a gripkit Trajectory, found {type(tr).__name__}")
+    check_path(path, "path", "save()")
     path = Path(path)
     fmt = _format(path, format)
     if fmt == "mcap":

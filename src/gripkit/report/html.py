@@ -5,8 +5,12 @@
 >>> sec.table(["model", "loss"], [["[2 2 2]", 27.6]])
 >>> # sec.figure(fig, "caption"); rep.write("report")  -> report/index.html
 
-Figures are embedded as PNG (base64) and also saved under ``<out>/figures/`` so they can be
-linked from elsewhere (the README shows one).
+Figures are embedded as PNG (base64), so the page is one self-contained file; each is also saved
+under ``<out>/figures/`` and linked from its caption, for a full-size view or to cite elsewhere.
+
+Tables: numbers are right-aligned and shown to 4 significant digits, prose is left-aligned, a
+missing value (None or NaN) reads "not given", and a row that reports ``INCONSISTENT`` is
+highlighted.
 """
 
 from __future__ import annotations
@@ -15,6 +19,8 @@ import base64
 import datetime as _dt
 import html
 import io
+import math
+import numbers
 import os
 import re
 from dataclasses import dataclass, field
@@ -75,19 +81,39 @@ def _slug(s: str) -> str:
 
 
 def _cell(v) -> str:
-    if isinstance(v, float):
-        return html.escape(f"{v:.6g}")
-    return html.escape(str(v))
+    """One ``<td>``: numbers right-aligned to 4 significant digits, prose left-aligned."""
+    if v is None or (isinstance(v, float) and math.isnan(v)):
+        return '<td class="txt na">not given</td>'
+    if isinstance(v, bool):
+        return f'<td class="txt">{v}</td>'
+    if isinstance(v, numbers.Real):
+        text = f"{v:.4g}" if isinstance(v, float) or not float(v).is_integer() else str(v)
+        return f"<td>{html.escape(text)}</td>"
+    text = str(v)
+    cls = "txt" if _NUMBER.fullmatch(text.strip()) is None else ""
+    return f'<td class="{cls}">{html.escape(text)}</td>' if cls else f"<td>{html.escape(text)}</td>"
+
+
+_NUMBER = re.compile(r"[-+±−]?\s*[0-9.]+([eE][-+]?[0-9]+)?\s*(%|[a-zA-Zµ°/*^·²³]+)?")
+
+
+def _row(cells) -> str:
+    flagged = any(isinstance(c, str) and c.strip() == "INCONSISTENT" for c in cells)
+    tds = "".join(_cell(c) for c in cells)
+    return f'<tr class="bad">{tds}</tr>' if flagged else f"<tr>{tds}</tr>"
 
 
 _CSS = """
 body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;max-width:1100px;margin:2em auto;
 padding:0 1em;color:#222;line-height:1.45}
 h1{border-bottom:2px solid #345;padding-bottom:.2em}h2{color:#234;margin-top:2em;border-bottom:1px solid #ccd}
-table{border-collapse:collapse;margin:1em 0;font-size:.92em}th,td{border:1px solid #ccd;padding:.25em .6em;
-text-align:right}th{background:#eef2f7}td:first-child,th:first-child{text-align:left}
-figure{margin:1.2em 0}figure img{max-width:100%;border:1px solid #dde}figcaption,.cap{font-size:.9em;color:#555}
-nav ul{columns:2}.meta{color:#666;font-size:.9em}
+.tbl{overflow-x:auto}table{border-collapse:collapse;margin:1em 0;font-size:.92em}
+th,td{border:1px solid #ccd;padding:.25em .6em;text-align:right;vertical-align:top}th{background:#eef2f7}
+td.txt,th:first-child,td:first-child{text-align:left}td.na{color:#888;font-style:italic}
+tr.bad td{background:#fde8e6}tr.bad td:first-child{font-weight:600;color:#a31515}
+figure{margin:1.2em 0}figure img{max-width:100%;height:auto;border:1px solid #dde}
+figcaption,.cap{font-size:.9em;color:#555}nav ul{columns:2}.meta{color:#666;font-size:.9em}
+@media (max-width:700px){body{margin:1em auto;font-size:.95em}nav ul{columns:1}table{font-size:.85em}}
 """
 
 
@@ -117,17 +143,19 @@ class Report:
                     parts.append(f"<p>{html.escape(item)}</p>")
                 elif kind == "table":
                     head = "".join(f"<th>{html.escape(h)}</th>" for h in item.headers)
-                    rows = "".join("<tr>" + "".join(f"<td>{_cell(c)}</td>" for c in r) + "</tr>" for r in item.rows)
+                    rows = "".join(_row(r) for r in item.rows)
                     cap = f'<div class="cap">{html.escape(item.caption)}</div>' if item.caption else ""
-                    parts.append(f"{cap}<table><tr>{head}</tr>{rows}</table>")
+                    parts.append(f'{cap}<div class="tbl"><table><tr>{head}</tr>{rows}</table></div>')
                 else:
                     b64 = base64.b64encode(item.png).decode()
                     parts.append(f'<figure><img alt="{html.escape(item.caption)}" '
                                  f'src="data:image/png;base64,{b64}"/>'
-                                 f"<figcaption>{html.escape(item.caption)}</figcaption></figure>")
+                                 f"<figcaption>{html.escape(item.caption)} "
+                                 f'(<a href="figures/{item.slug}.png">full size</a>)</figcaption></figure>')
             body.append("\n".join(parts))
         tmpl = Template(
-            "<!DOCTYPE html><html><head><meta charset='utf-8'><title>{{title}}</title>"
+            "<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
+            "<meta name='viewport' content='width=device-width, initial-scale=1'><title>{{title}}</title>"
             "<style>{{css}}</style></head><body><h1>{{title}}</h1>"
             "{% if subtitle %}<p>{{subtitle}}</p>{% endif %}"
             "<p class='meta'>Generated by gripkit on {{when}}.</p>"

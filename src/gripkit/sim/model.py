@@ -23,13 +23,15 @@ steps are refused and internal substeps are chosen so every mode is resolved.
 from __future__ import annotations
 
 import abc
+import inspect
 from collections.abc import Mapping
 from dataclasses import dataclass
 
 import numpy as np
 
+from ..arguments import check_keywords, entry_point, keyword_names
 from ..consistency import Finding, warn_inconsistent
-from ..errors import ParameterError, SimulationError
+from ..errors import ArgumentError, ParameterError, SimulationError
 from ..params import ParameterSet
 from ..signals.trajectory import Trajectory
 from .steps import check_step, substeps_for
@@ -130,15 +132,18 @@ class Model(abc.ABC):
             missing = [n for n in names if n not in u]
             if missing:
                 raise SimulationError(f"{self.name}: inputs {missing} missing", hint=f"inputs are {names}")
-            arr = np.column_stack([np.asarray(u[n], dtype=np.float64) for n in names])
+            arr = np.column_stack([_float_array(u[n], f"input {n!r}") for n in names])
         else:
-            arr = np.asarray(u, dtype=np.float64)
+            arr = _float_array(u, "u")
             arr = arr.reshape(-1, 1) if arr.ndim == 1 else arr
             if arr.ndim != 2 or arr.shape[1] != len(names):
                 raise SimulationError(f"{self.name}: expected inputs of shape (N, {len(names)}) for {names}, "
                                       f"found {np.shape(u)}")
         if dt is None:
             raise SimulationError(f"{self.name}: give the sample time dt (or a Trajectory input)")
+        if isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating)):
+            raise ArgumentError(f"dt: expected a sample time in seconds (a number), found "
+                                f"{type(dt).__name__} {dt!r:.40}")
         if not (np.isfinite(dt) and dt > 0):
             raise SimulationError(f"dt: expected a positive number of seconds, found {dt!r}")
         if not np.isfinite(arr).all():
@@ -206,6 +211,27 @@ class Model(abc.ABC):
         return f"{type(self).__name__}({self.parameters!r})"
 
 
+def _float_array(values, name: str) -> np.ndarray:
+    try:
+        return np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ArgumentError(f"{name}: expected numbers (an array of float), found {type(values).__name__} "
+                            f"{values!r:.40}") from None
+
+
+@entry_point
 def simulate(model: Model, u, **kwargs) -> Trajectory:
-    """Simulate ``model`` for inputs ``u`` (Trajectory, mapping or array with ``dt=``)."""
-    return model.simulate(u, **kwargs)
+    """Simulate ``model`` for inputs ``u`` (Trajectory, mapping or array with ``dt=``); keywords as
+    :meth:`Model.simulate` (``dt``, ``x0``, ``params``, ``substeps``).
+
+    Raises :class:`~gripkit.errors.ArgumentError` for a ``model`` that cannot be simulated or an
+    unknown keyword."""
+    if not callable(getattr(model, "simulate", None)):
+        raise ArgumentError(f"simulate(): model must be a gripkit model (gripkit.sim.Model), found "
+                            f"{type(model).__name__} {model!r:.40}",
+                            hint="build one, e.g. gripkit.zoo.build('tsfm-left') or gripkit.models.MassSpringDamper()")
+    method = model.simulate
+    if not any(p.kind is inspect.Parameter.VAR_KEYWORD for p in inspect.signature(method).parameters.values()):
+        check_keywords(kwargs, keyword_names(method, exclude=("u",)), f"simulate({model.name})"
+                       if hasattr(model, "name") else "simulate()")
+    return method(u, **kwargs)

@@ -19,7 +19,7 @@ from scipy import signal as _sig
 from ._pem import covariance, is_stable_poly, levenberg_marquardt, stabilize
 from .arx import arx
 from .checks import check_identifiable, checked_problem
-from .polynomial import PolynomialModel
+from .polynomial import PolynomialModel, check_meta
 from .regression import qr_solve
 from .validation import fit_percent, loss_vn
 
@@ -56,6 +56,7 @@ def armax(u, y, na: int, nb: int, nc: int, nk: int = 1, *, dt: float | None = No
     :class:`PolynomialModel` with ``structure='armax'``, ``C`` and ``C_std``. Warns
     :class:`~gripkit.errors.AccuracyWarning` if the iteration does not converge.
     """
+    check_meta(meta, armax)
     u, y, step, na, nb, nc, nk = checked_problem(u, y, dt, fs, na=na, nb=nb, nc=nc, nk=nk)
     if nc == 0:
         m = arx(u, y, na, nb, nk, dt=step, **meta)

@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from .checks import check_identifiable, checked_problem
-from .polynomial import PolynomialModel
+from .polynomial import PolynomialModel, check_meta
 from .regression import arx_regression, arx_start, qr_solve
 from .validation import fit_percent, loss_vn
 
@@ -56,6 +56,7 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None, fs: flo
         Constant input (it cannot identify B), constant output, or a regressor whose
         column-scaled condition number exceeds 1e10 (the message names the parameters involved).
     """
+    check_meta(meta, arx)
     u, y, step, na, nb, nk = checked_problem(u, y, dt, fs, na=na, nb=nb, nk=nk)
     p = na + nb
     t0 = arx_start(na, nb, nk)

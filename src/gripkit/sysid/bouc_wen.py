@@ -22,6 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..arguments import entry_point
 from ..errors import AccuracyWarning, DataError
 from ..models.hysteresis import BoucWen, bouc_wen_parameters, bouc_wen_response
 from ..models.piezo import PiezoActuator, actuator_parameters
@@ -94,6 +95,7 @@ def _branch_gap(U: np.ndarray, y: np.ndarray) -> float:
     return gaps[1] - gaps[0]
 
 
+@entry_point
 def identify_bouc_wen(data: Trajectory, input: str = "U", output: str = "y", *,
                       initial: dict | None = None, burn_in: int = 0, multistart: int = 2,
                       H0: float = 0.0, delay: float = 0.0, progress: bool = True) -> BoucWenResult:

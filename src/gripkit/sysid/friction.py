@@ -40,6 +40,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..arguments import entry_point
 from ..errors import DataError, IdentificationError, UnidentifiableError
 from ..models.friction import FrictionTable
 from ..signals.filters import apply_sos, butter_sos
@@ -359,6 +360,7 @@ class IdimResult:
 _IDIM = ("inertia", "viscous", "coulomb", "offset")
 
 
+@entry_point
 def idim_ls(position, effort, fs: float, *, effort_scale: float = 1.0, cutoff: float | None = None,
             order: int = 4, decimation: int | None = None,
             velocity_threshold: float | None = None, guard: float = 1.0) -> IdimResult:

@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import least_squares
 
+from ..arguments import entry_point
 from ..errors import AccuracyWarning, DataError, IdentificationError, ParameterError
 from ..params import ParameterSet
 from ..progress import track
@@ -141,6 +142,7 @@ def _random_starts(theta0, lo, hi, n, rng) -> list[np.ndarray]:
     return starts
 
 
+@entry_point
 def fit(model, data: Trajectory, *, outputs: Sequence[str] | Mapping[str, str] | None = None,
         inputs: Mapping[str, str] | None = None, free: Sequence[str] | None = None,
         initial: ParameterSet | Mapping[str, float] | None = None, x0: np.ndarray | None = None,

@@ -27,10 +27,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import DataError
+from ..arguments import check_keywords, entry_point, keyword_names
+from ..errors import ArgumentError, DataError
 from ..signals.trajectory import Trajectory
 
-__all__ = ["IOData", "io_data", "identify", "METHODS"]
+__all__ = ["IOData", "io_data", "identify", "method_options", "METHODS"]
 
 METHODS = ("arx", "armax", "oe", "rls", "search")
 
@@ -87,6 +88,31 @@ def io_data(data: Trajectory, *, input: str, output: str, detrend: str = "mean",
     return IOData(u, y, 1.0 / fs, input, output, data.unit(input), data.unit(output), u0, y0)
 
 
+def _method_function(method: str):
+    if method == "arx":
+        from .arx import arx as fn
+    elif method == "armax":
+        from .armax import armax as fn
+    elif method == "oe":
+        from .oe import oe as fn
+    elif method == "rls":
+        from .rls import rls as fn
+    else:
+        from .search import structure_search as fn
+    return fn
+
+
+#: what identify() itself passes to the method's function (not accepted as an option)
+_SUPPLIED = ("u", "y", "na", "nb", "nc", "nf", "nk", "dt", "fs", *IOData.__dataclass_fields__, "input_name",
+             "output_name", "input_unit", "output_unit")
+
+
+def method_options(method: str) -> list[str]:
+    """The ``**options`` that :func:`identify` accepts for ``method``."""
+    return keyword_names(_method_function(method), exclude=_SUPPLIED)
+
+
+@entry_point
 def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, na: int = 2, nb: int = 2,
              nk: int = 1, nc: int = 1, nf: int | None = None, detrend: str = "mean", **options):
     """Identify a linear model of ``output`` driven by ``input`` from a trajectory.
@@ -106,14 +132,25 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
     detrend
         ``'mean'`` (default), ``'linear'`` or ``'none'``; see :func:`io_data`.
     **options
-        Passed to the method's function.
+        Passed to the method's function: for 'armax' and 'oe' ``maxiter``, ``tol``; for 'rls'
+        ``forgetting``, ``p0``, ``theta0``, ``windup``, ``max_trace``, ``store``; for 'search'
+        ``criterion``, ``progress`` (:func:`method_options`).
 
     Returns
     -------
     PolynomialModel, RLSResult or SearchResult
     """
-    if method not in METHODS:
+    if not isinstance(method, str) or method not in METHODS:
         raise DataError(f"method: expected one of {', '.join(METHODS)}, found {method!r}")
+    opts = method_options(method)
+    check_keywords(options, opts, f"identify(method={method!r})",
+                   hint=f"identify accepts {', '.join(keyword_names(identify))} and, for method {method!r}, "
+                        + (", ".join(opts) if opts else "no other options"))
+    for name, col in (("input", input), ("output", output)):
+        if not isinstance(col, str):
+            raise ArgumentError(f"identify(): {name} must be a column name (str), found {type(col).__name__} "
+                                f"{col!r:.40}", hint=f"columns: {', '.join(data.names)}"
+                                if isinstance(data, Trajectory) else None)
     io = io_data(data, input=input, output=output, detrend=detrend, why=f"{method.upper()} identification")
     if method == "arx":
         from .arx import arx

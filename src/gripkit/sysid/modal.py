@@ -35,6 +35,7 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.signal import find_peaks, hilbert, resample_poly
 
+from ..arguments import entry_point
 from ..errors import AccuracyWarning, DataError, IdentificationError
 
 __all__ = ["ModalResult", "free_vibration"]
@@ -111,6 +112,7 @@ def _half_power(f: np.ndarray, X: np.ndarray, k: int) -> float:
     return float(fr - fl)
 
 
+@entry_point
 def free_vibration(y, fs: float, *, start: int | None = None, end: int | None = None,
                    noise_std: float | None = None) -> ModalResult:
     """Estimate the natural frequency and damping ratio of a free vibration.

@@ -22,7 +22,7 @@ from scipy import signal as _sig
 from ._pem import covariance, is_stable_poly, levenberg_marquardt, stabilize
 from .arx import arx
 from .checks import check_identifiable, checked_problem
-from .polynomial import PolynomialModel
+from .polynomial import PolynomialModel, check_meta
 from .validation import fit_percent, loss_vn
 
 __all__ = ["oe"]
@@ -58,6 +58,7 @@ def oe(u, y, nb: int, nf: int, nk: int = 1, *, dt: float | None = None, fs: floa
     leading 1) in place of ``na``. Returns a :class:`PolynomialModel` with ``structure='oe'``,
     ``A = [1]``, ``F`` and ``F_std``; its poles are the roots of F.
     """
+    check_meta(meta, oe)
     u, y, step, nb, nf, nk = checked_problem(u, y, dt, fs, nb=nb, nf=nf, nk=nk)
     p = nb + nf
     t0 = max(nf, nk + nb - 1)

@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import signal as _sig
 
+from ..arguments import check_keywords, keyword_names
 from ..errors import DataError, ModelError
 from ..params import Parameter, ParameterSet
 from ..units import ratio_unit
@@ -512,3 +513,15 @@ class PolynomialModel:
 
     def __repr__(self) -> str:
         return f"PolynomialModel({self.label}, A={self.A.tolist()}, B={self.B.tolist()}, dt={self.dt:g})"
+
+
+#: the ``**meta`` keywords of :func:`~gripkit.sysid.arx`, :func:`~gripkit.sysid.armax` and :func:`~gripkit.sysid.oe`
+META_KEYS = ("input_name", "output_name", "input_unit", "output_unit", "u_offset", "y_offset")
+
+
+def check_meta(meta: dict, fn) -> None:
+    """Refuse an unknown ``**meta`` keyword of ``fn`` (arx, armax or oe) before any fitting: it
+    would otherwise fail only when the model is built, after the work."""
+    name = fn.__name__
+    check_keywords(meta, META_KEYS, f"{name}()", hint=f"{name} accepts {', '.join(keyword_names(fn))} and the "
+                                                      f"metadata {', '.join(META_KEYS)}")

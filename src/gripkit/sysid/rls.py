@@ -46,6 +46,7 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
+from ..arguments import entry_point
 from ..errors import DataError, IdentificationError
 from .checks import check_dt, check_excitation, check_io, check_order, require_samples
 from .polynomial import PolynomialModel
@@ -508,6 +509,7 @@ class RLSResult:
                                 "structure": f"ARX [{self.na} {self.nb} {self.nk}]"})
 
 
+@entry_point
 def rls(u, y, na: int, nb: int, nk: int = 1, *, forgetting: float = 1.0, p0: float = 1e4, theta0=None,
         windup: str = "trace", max_trace: float | None = None, dt: float | None = None,
         fs: float | None = None, store: bool = True) -> RLSResult:

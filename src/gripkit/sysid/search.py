@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..arguments import entry_point
 from ..errors import DataError, UnidentifiableError
 from ..progress import track
 from .checks import check_dt, check_identifiable, check_io, check_order
@@ -94,6 +95,7 @@ def parse_range(text: str | int | Iterable[int], name: str) -> list[int]:
         raise DataError(f"{name}: expected a range like '1:4', '1:2:9' or '1,3,5', found {text!r}") from None
 
 
+@entry_point
 def structure_search(u, y, na=range(1, 5), nb=range(1, 5), nk=range(1, 11), *,
                      criterion: str = "aic", dt: float | None = None, fs: float | None = None,
                      progress: bool = True) -> SearchResult:

@@ -15,8 +15,10 @@ Procedure (:func:`identify_step`):
    y_k = −a₁y_{k−1} − a₂y_{k−2} + b₁u_{k−1} + b₂u_{k−2} + c: its poles z = e^{sT} give ω_n = |s|
    and ζ = −Re s/|s|, its static gain (b₁ + b₂)/(1 + a₁ + a₂) gives K. When the ARX poles are not
    a stable pair (heavy noise), the step's levels and its 63 % time are used instead.
-2. Output-error Levenberg-Marquardt on (K, ω_n, ζ, y₀) with the grey-box engine
-   (:func:`gripkit.sysid.greybox.fit`, ``method='lm'``: ω_n and ζ in log space).
+2. Output-error least squares on (K, ω_n, ζ, y₀) with the grey-box engine
+   (:func:`gripkit.sysid.greybox.fit`): Levenberg-Marquardt by default (``method='lm'``: ω_n and ζ
+   in log space, so they stay positive), or the bounded trust-region reflective method
+   (``method='trf'``, CLI ``--method trf``), which keeps every parameter within its bounds.
 3. Uncertainty: the asymptotic covariance σ̂²(JᵀJ)⁻¹ of the grey-box engine; σ(f_n) = σ(ω_n)/2π.
 
 The result also carries the step metrics the fitted model predicts (overshoot, peak, rise and 2 %
@@ -31,13 +33,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..arguments import entry_point
 from ..errors import AccuracyWarning, DataError, IdentificationError, SimulationError
 from ..models.second_order import SecondOrderSystem, second_order_step
 from ..signals.trajectory import Trajectory
 from ..units import ratio_unit
 from .greybox import GreyboxResult, fit
 
-__all__ = ["StepResponseResult", "identify_step", "step_metrics", "second_order_metrics"]
+__all__ = ["StepResponseResult", "identify_step", "step_metrics", "second_order_metrics", "STEP_METHODS"]
 
 
 @dataclass(frozen=True)
@@ -204,7 +207,12 @@ def step_metrics(t, y, *, t_step: float | None = None, y_initial: float | None =
                 y_initial=float(y_initial), y_final=float(y_final))
 
 
-def identify_step(data: Trajectory, *, input: str, output: str, multistart: int = 0,
+#: least-squares methods of :func:`identify_step`
+STEP_METHODS = ("lm", "trf")
+
+
+@entry_point
+def identify_step(data: Trajectory, *, input: str, output: str, multistart: int = 0, method: str = "lm",
                   progress: bool = False) -> StepResponseResult:
     """Identify K, ω_n, ζ (and the output offset) of a second-order response (module docstring).
 
@@ -216,7 +224,9 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
     input, output
         Column names.
     multistart
-        Extra random starts of the Levenberg-Marquardt search.
+        Extra random starts of the least-squares search.
+    method
+        ``'lm'`` (Levenberg-Marquardt, default) or ``'trf'`` (trust-region reflective, bounded).
 
     Raises
     ------
@@ -228,6 +238,9 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
     """
     if not isinstance(data, Trajectory):
         raise DataError(f"data: expected a Trajectory, found {type(data).__name__}")
+    if method not in STEP_METHODS:
+        raise DataError(f"method: expected one of {', '.join(STEP_METHODS)}, found {method!r}",
+                        hint="'lm' (Levenberg-Marquardt) or 'trf' (bounded trust-region; CLI: --method trf)")
     fs = data.require_uniform(why="step-response identification")
     data.require_samples(20, "step-response identification")
     u = np.asarray(data[input], dtype=np.float64)
@@ -256,8 +269,13 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", AccuracyWarning)  # re-issued below with the step's names
         try:
-            res = fit(model, sub, outputs=["y"], free=["gain", "wn", "zeta", "y0"], method="lm",
+            res = fit(model, sub, outputs=["y"], free=["gain", "wn", "zeta", "y0"], method=method,
                       multistart=multistart, progress=progress, output_scale=[1.0])
+        except IdentificationError as exc:
+            if method == "lm" and "method='trf'" in str(exc):
+                raise IdentificationError(exc.message, hint="use method='trf' (CLI: --method trf) to keep the "
+                                                            "parameters within their bounds") from None
+            raise
         except SimulationError:
             raise IdentificationError(
                 f"the response of {output!r} to {input!r} is not a second-order response resolved at "

@@ -9,9 +9,11 @@ works on every entry.
 from __future__ import annotations
 
 import importlib
+import inspect
 from dataclasses import dataclass
 
-from ..errors import ModelError
+from ..arguments import check_keywords, keyword_names
+from ..errors import ArgumentError, ModelError
 
 __all__ = ["ZooEntry", "entries", "get", "build"]
 
@@ -26,7 +28,10 @@ class ZooEntry:
 
     def build(self, **kwargs):
         module, func = self.factory.split(":")
-        return getattr(importlib.import_module(module), func)(**kwargs)
+        fn = getattr(importlib.import_module(module), func)
+        if not any(p.kind is inspect.Parameter.VAR_KEYWORD for p in inspect.signature(fn).parameters.values()):
+            check_keywords(kwargs, keyword_names(fn), f"zoo.build({self.name!r})")
+        return fn(**kwargs)
 
 
 _AMADEUS = "000_8f66dcc7ab06470c.txt"
@@ -76,6 +81,9 @@ def entries() -> tuple[ZooEntry, ...]:
 
 
 def get(name: str) -> ZooEntry:
+    if not isinstance(name, str):
+        raise ArgumentError(f"zoo model name: expected a str, found {type(name).__name__} {name!r:.40}",
+                            hint=f"available: {', '.join(e.name for e in _ENTRIES)}")
     for e in _ENTRIES:
         if e.name == name:
             return e

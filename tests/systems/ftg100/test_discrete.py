@@ -58,9 +58,15 @@ def test_canonical_form_matches_scipy_and_control(act):
     nd, dd, _ = signal.cont2discrete((num, den), 1 / FS, method="zoh")
     d = act.discrete(FS)
     n2, d2 = signal.ss2tf(d.A, d.B, d.C, d.D)
-    np.testing.assert_allclose(d2, dd, rtol=1e-10)
-    np.testing.assert_allclose(n2[0], np.ravel(nd), rtol=1e-8, atol=1e-22)
-    control = pytest.importorskip("control")
+    # Denominators: sums of products of the two eigenvalues, each route accurate to a few ε.
+    # Numerators: ss2tf forms them as poly(A − BC) − poly(A), a difference of O(1) coefficients that
+    # leaves O(1e-8) ones, so they carry a relative error of about ε·Σ|den|/|num| (≈ 3e-8 here);
+    # 8 such roundings make the bound.
+    eps = np.finfo(np.float64).eps
+    np.testing.assert_allclose(d2, dd, rtol=8 * eps * np.abs(dd).sum())
+    num_rtol = 8 * eps * np.abs(dd).sum() / np.abs(nd[np.nonzero(nd)]).min()
+    np.testing.assert_allclose(n2[0], np.ravel(nd), rtol=num_rtol, atol=0)
+    import control  # a dev dependency: the cross-check fails, never skips, without it
     sysd = control.c2d(control.tf(num, den), 1 / FS, "zoh")
     np.testing.assert_allclose(np.sort_complex(control.poles(sysd)), np.sort_complex(d.poles()), rtol=1e-10)
     # physical-coordinate ZOH is similar: same poles and DC gain

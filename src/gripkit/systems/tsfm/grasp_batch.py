@@ -48,10 +48,11 @@ from dataclasses import replace
 import numba
 import numpy as np
 
+from ...batch.scenarios import (FRACTION, POSITIVE_RATE, POSITIVE_TIME, Interface, Setting,
+                                read_settings)
 from ...errors import ConfigError
 from ...estimation.contact_detection import ContactDetector
 from ...progress import track
-from ...units import setting_si
 from .grasp import GraspSettings
 from .grasp_kernels import (_NM, _SQUEEZE, METRICS, GraspTemplate, _default_gripper, _grasp_jobs,
                             _template)
@@ -62,6 +63,9 @@ __all__ = ["METRICS", "FAST_GRASP", "tsfm_grasp_batch", "record_metrics", "tsfm_
 
 #: per-job parameters a population may vary (with ``offset`` as an alternative to ``X_p``)
 POPULATION_NAMES = ("k_e", "w", "X_p", "offset", "c_e", "F_po", "F_stick", "approach_speed", "noise_std")
+#: their SI units (those of the part parameters of :class:`~gripkit.systems.tsfm.gripper.TSFMGripper`); ``gap`` too
+POPULATION_UNITS = {"k_e": "N/m", "w": "m", "X_p": "m", "offset": "m", "c_e": "N*s/m", "F_po": "N", "F_stick": "N",
+                    "approach_speed": "m/s", "noise_std": "N", "gap": "m"}
 
 #: a grasp that finishes in ~0.1 s (1 mm/s approach, 10 ms force ramp, 40 Hz force loop), used by
 #: the batch scenario unless told otherwise; the single-grasp defaults (40 µm/s, 0.3 s) take seconds
@@ -255,27 +259,33 @@ _SETTING_KEYS = {"grip_force": "N", "approach_speed": "m/s", "position_bandwidth
 _OTHER_KEYS = ("duration", "fs", "damage_force", "lost_displacement", "band", "noise_std", "noise_seed", "backend")
 
 
+def _settings_schema() -> dict:
+    kinds = {"bool": Setting("bool"), "1": Setting("int", low=1)}
+    return {**{k: kinds.get(u, Setting(u)) for k, u in _SETTING_KEYS.items()},
+            "duration": POSITIVE_TIME, "fs": POSITIVE_RATE, "damage_force": Setting("N", low=0.0, strict=True),
+            "lost_displacement": Setting("m", low=0.0, strict=True), "band": FRACTION,
+            "noise_std": Setting("N", low=0.0), "noise_seed": Setting("int", low=0),
+            "backend": Setting("str", choices=("cpu", "cuda"))}
+
+
 def settings_from_table(table: dict) -> tuple[GraspSettings, dict]:
     """(GraspSettings, other options) from a sweep's ``[scenario]`` table; numbers in SI or
-    strings with units ("200 uN"). Starts from :data:`FAST_GRASP`."""
-    unknown = sorted(set(table) - set(_SETTING_KEYS) - set(_OTHER_KEYS))
-    if unknown:
-        raise ConfigError(f"[scenario] (tsfm-grasp): unknown keys {unknown}",
-                          hint=f"allowed: {', '.join([*_SETTING_KEYS, *_OTHER_KEYS])}")
-    changes = {}
-    for k, kind in _SETTING_KEYS.items():
-        if k in table:
-            if kind == "bool":
-                changes[k] = bool(table[k])
-            elif kind == "1":
-                changes[k] = int(table[k])
-            else:
-                changes[k] = setting_si(table[k], f"[scenario] {k}")
-    opts = {k: table[k] for k in _OTHER_KEYS if k in table}
-    for k in ("duration", "fs", "damage_force", "lost_displacement", "noise_std"):
-        if k in opts:
-            opts[k] = setting_si(opts[k], f"[scenario] {k}")
-    return replace(FAST_GRASP, **changes), opts
+    strings with units ("200 uN"), checked (:func:`gripkit.batch.scenarios.read_settings`).
+    Starts from :data:`FAST_GRASP`."""
+    s = read_settings(table, _settings_schema(), "tsfm-grasp")
+    return replace(FAST_GRASP, **{k: v for k, v in s.items() if k in _SETTING_KEYS}), \
+        {k: v for k, v in s.items() if k in _OTHER_KEYS}
+
+
+def _interface(model, settings: dict):
+    if model is not None and not isinstance(model, TSFMGripper):
+        raise ConfigError(f"scenario 'tsfm-grasp' needs a TSFM gripper model, found {type(model).__name__}",
+                          hint='model = "tsfm-gripper"')
+    positive, non_negative = (np.finfo(float).tiny, None), (0.0, None)  # as _jobs checks them
+    bounds = {**{k: positive for k in ("k_e", "w", "approach_speed", "gap")},
+              **{k: non_negative for k in ("c_e", "F_po", "F_stick", "noise_std")}}
+    return Interface(parameters=POPULATION_UNITS, settings=read_settings(settings, _settings_schema(), "tsfm-grasp"),
+                     metrics=METRICS, bytes_per_job=8 * (_NM + 64), bounds=bounds)
 
 
 def tsfm_grasp(model, params: dict[str, np.ndarray], settings: dict) -> dict[str, np.ndarray]:
@@ -303,3 +313,4 @@ def tsfm_grasp(model, params: dict[str, np.ndarray], settings: dict) -> dict[str
 
 
 tsfm_grasp.uses_job_id = True
+tsfm_grasp.interface = _interface

@@ -110,14 +110,14 @@ def finger(side: str = "left", *, as_printed: bool = False, check: bool = True) 
     return TSFMFinger(params, reference=REFERENCE, printed=printed, name=f"tsfm-{side}", check=check)
 
 
-def left_finger(**kw) -> TSFMFinger:
-    """Left finger of Table II (zoo entry ``tsfm-left``)."""
-    return finger("left", **kw)
+def left_finger(*, as_printed: bool = False, check: bool = True) -> TSFMFinger:
+    """Left finger of Table II (zoo entry ``tsfm-left``); keywords as :func:`finger`."""
+    return finger("left", as_printed=as_printed, check=check)
 
 
-def right_finger(**kw) -> TSFMFinger:
-    """Right finger of Table II (zoo entry ``tsfm-right``)."""
-    return finger("right", **kw)
+def right_finger(*, as_printed: bool = False, check: bool = True) -> TSFMFinger:
+    """Right finger of Table II (zoo entry ``tsfm-right``); keywords as :func:`finger`."""
+    return finger("right", as_printed=as_printed, check=check)
 
 
 class _Gripper(TSFMGripper):
