@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._scaling import in_user_units, unit_scale
 from .checks import check_identifiable, checked_problem
 from .polynomial import PolynomialModel, check_meta
 from .regression import arx_regression, arx_start, qr_solve
@@ -55,14 +56,33 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None, fs: flo
     UnidentifiableError
         Constant input (it cannot identify B), constant output, or a regressor whose
         column-scaled condition number exceeds 1e10 (the message names the parameters involved).
+
+    Warns
+    -----
+    AccuracyWarning
+        A column-scaled condition number above :func:`~gripkit.sysid.regression.warn_threshold`
+        (the κ at which the least-determined parameter combination may be off by a third of the
+        parameters' size, from the noise or from rounding): the message names those parameters
+        and their relative σ.
+
+    The signals are scaled to unit size internally (exact powers of two, :mod:`._scaling`), so data
+    at any scale (1e-300 … 1e300) are identified; the model is in the units of ``u`` and ``y``.
     """
     check_meta(meta, arx)
     u, y, step, na, nb, nk = checked_problem(u, y, dt, fs, na=na, nb=nb, nk=nk)
+    cu, cy = unit_scale(u), unit_scale(y)
+    return in_user_units(_arx(u * cu, y * cy, na, nb, nk, step, **meta), cu, cy)
+
+
+def _arx(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int, step: float, *, warn: bool = True,
+         **meta) -> PolynomialModel:
+    """:func:`arx` on checked signals, without scaling; ``warn=False`` for the internal fits of
+    other estimators (their own diagnostics speak for the final model)."""
     p = na + nb
     t0 = arx_start(na, nb, nk)
     check_identifiable(u, y, t0 + p + 1, f"ARX [{na} {nb} {nk}] ({p} parameters, {t0} initial samples)")
     names = tuple(f"a{i}" for i in range(1, na + 1)) + tuple(f"b{nk + j}" for j in range(nb))
-    sol = qr_solve(arx_regression(u, y, na, nb, nk), names, overwrite=True)
+    sol = qr_solve(arx_regression(u, y, na, nb, nk), names, overwrite=True, warn=warn)
     A = np.concatenate([[1.0], sol.theta[:na]])
     B = np.concatenate([np.zeros(nk), sol.theta[na:]])
     model = PolynomialModel(A, B, nk, dt=step, structure="arx", n_samples=int(y.size), **meta)
