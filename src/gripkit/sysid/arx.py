@@ -16,8 +16,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._data import check_identifiable, checked_problem
 from ._scaling import in_user_units, unit_scale
+from .checks import check_identifiable, checked_problem
 from .polynomial import PolynomialModel, check_meta
 from .regression import arx_regression, arx_start, qr_solve
 from .validation import fit_percent, loss_vn
