@@ -53,7 +53,7 @@ def _setup():
         warnings.simplefilter("ignore")
         ch = zoo.build("dlr-hit-finger").chain()
         path = to_urdf(ch, Path(tempfile.mkdtemp()) / "dlr_hit_finger.urdf")
-    g = ch.chain.gravity
+    g = ch.chain.gravity_vector
     chain = from_urdf(path, gravity=g)
     model = pin.buildModelFromUrdf(str(path), mimic=True)
     model.gravity.linear = g

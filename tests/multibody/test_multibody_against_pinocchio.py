@@ -78,7 +78,7 @@ def test_dh_chain_dynamics_match_pinocchio(types):
     tau = chain.rnea(q, qd, qdd)
     M = chain.mass_matrix(q)
     C = chain.coriolis(q, qd)
-    G = chain.gravity_torque(q)
+    G = chain.gravity(q)
     for b in range(B):
         np.testing.assert_allclose(tau[b], pin.rnea(model, data, q[b], qd[b], qdd[b]), atol=TOL, rtol=0)
         np.testing.assert_allclose(M[b], full_crba(model, data, q[b]), atol=TOL, rtol=0)
@@ -120,7 +120,7 @@ def test_coupled_finger_matches_pinocchio_reduced_model():
     c = ch.chain
     I = c.inertia  # noqa: E741
     model, data = pinocchio_model(c.dh[:, 0], c.dh[:, 1], c.dh[:, 2], c.dh[:, 3], "RRRR", c.mass, c.com, I,
-                                  np.zeros(4), c.gravity)
+                                  np.zeros(4), c.gravity_vector)
     Gm = ch.coupling.matrix
     arm = ch.coupling.armature
     # the coupling reproduces the thesis: θ4 = θ3, abduction/flexion from the ±45° motors
@@ -133,7 +133,7 @@ def test_coupled_finger_matches_pinocchio_reduced_model():
     p, pd, pdd = (rng.normal(size=(B, 3)) for _ in range(3))
     tau = ch.rnea(p, pd, pdd)
     M = ch.mass_matrix(p)
-    G = ch.gravity_torque(p)
+    G = ch.gravity(p)
     C = ch.coriolis(p, pd)
     for b in range(B):
         q, qd, qdd = Gm @ p[b], Gm @ pd[b], Gm @ pdd[b]

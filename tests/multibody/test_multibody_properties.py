@@ -113,7 +113,7 @@ def test_bad_states_and_couplings_are_refused():
     with pytest.raises(ModelError, match=r"expected shape \(3,\)"):
         ch.mass_matrix(np.zeros(4))
     with pytest.raises(ModelError, match="NaN"):
-        ch.gravity_torque([0.0, np.nan, 0.0])
+        ch.gravity([0.0, np.nan, 0.0])
     with pytest.raises(ModelError, match="full column rank"):
         Coupling(np.ones((3, 2)), np.zeros(3), np.zeros(2), ("a", "b"))
     with pytest.raises(ModelError, match="joint rows"):

@@ -114,7 +114,7 @@ def test_rnea_mass_gravity_fd(pair):
     q, qd, qdd = (rng.uniform(-1.5, 1.5, size=(B, m)) for _ in range(3))
     tau = chain.rnea(q, qd, qdd)
     M = chain.mass_matrix(q)
-    G = chain.gravity_torque(q)
+    G = chain.gravity(q)
     for b in range(B):
         ref = pin.rnea(model, data, q[b], qd[b], qdd[b])
         np.testing.assert_allclose(tau[b], ref, atol=TOL, rtol=0)
@@ -137,7 +137,7 @@ def test_regressor_matches_pinocchio(pair):
     # Pinocchio's regressor does not take mimic joints: use the full model (every joint free) and
     # project, Y = Γᵀ Y_full(Γ q + q₀, Γ q̇, Γ q̈)
     full = pin.buildModelFromXML(chain.urdf_text, mimic=False)
-    full.gravity.linear = chain.gravity
+    full.gravity.linear = chain.gravity_vector
     fdata = full.createData()
     Gm = chain.coupling
     moving = list(range(1, full.njoints))

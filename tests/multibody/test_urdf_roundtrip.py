@@ -45,7 +45,7 @@ def _states(rng, m, B=25):
 
 
 def test_finger_urdf_structure(finger_urdf, finger_chain):
-    u = from_urdf(finger_urdf, gravity=finger_chain.chain.gravity)
+    u = from_urdf(finger_urdf, gravity=finger_chain.chain.gravity_vector)
     assert u.joint_names == ("theta1", "theta2", "theta3")
     assert u.names == ("theta1", "theta2", "theta3", "theta4")
     np.testing.assert_array_equal(u.coupling, [[1, 0, 0], [0, 1, 0], [0, 0, 1], [0, 0, 1]])
@@ -54,12 +54,12 @@ def test_finger_urdf_structure(finger_urdf, finger_chain):
 
 
 def test_finger_round_trip_dynamics(finger_urdf, finger_chain):
-    u = from_urdf(finger_urdf, gravity=finger_chain.chain.gravity)
+    u = from_urdf(finger_urdf, gravity=finger_chain.chain.gravity_vector)
     ref = _joint_space(finger_chain)
     q, qd, qdd = _states(np.random.default_rng(1), 3)
     np.testing.assert_allclose(u.rnea(q, qd, qdd), ref.rnea(q, qd, qdd), atol=TOL, rtol=0)
     np.testing.assert_allclose(u.mass_matrix(q), ref.mass_matrix(q), atol=TOL, rtol=0)
-    np.testing.assert_allclose(u.gravity_torque(q), ref.gravity_torque(q), atol=TOL, rtol=0)
+    np.testing.assert_allclose(u.gravity(q), ref.gravity(q), atol=TOL, rtol=0)
     np.testing.assert_allclose(u.regressor(q, qd, qdd), ref.regressor(q, qd, qdd), atol=TOL, rtol=0)
     np.testing.assert_allclose(u.standard_parameters(), ref.standard_parameters(), atol=1e-15, rtol=0)
     np.testing.assert_allclose(u.fk(q), ref.fk(q), atol=TOL, rtol=0)
@@ -69,7 +69,7 @@ def test_finger_round_trip_dynamics(finger_urdf, finger_chain):
 def test_finger_actuator_space_from_urdf(finger_urdf, finger_chain):
     """The motors' dynamics follow from the URDF's by the differential u = T p and the rotor
     inertia that the URDF cannot hold: τ_p = Tᵀ τ_u(T p, T ṗ, T p̈) + diag(I_m N²) p̈."""
-    u = from_urdf(finger_urdf, gravity=finger_chain.chain.gravity)
+    u = from_urdf(finger_urdf, gravity=finger_chain.chain.gravity_vector)
     T = finger_chain.coupling.matrix[:3]
     p, pd, pdd = _states(np.random.default_rng(2), 3)
     tau_p = (u.rnea(p @ T.T, pd @ T.T, pdd @ T.T)) @ T + pdd * finger_chain.coupling.armature
@@ -79,7 +79,7 @@ def test_finger_actuator_space_from_urdf(finger_urdf, finger_chain):
 def test_finger_urdf_in_pinocchio(finger_urdf, finger_chain):
     pin = pytest.importorskip("pinocchio")
     model = pin.buildModelFromUrdf(str(finger_urdf), mimic=True)
-    model.gravity.linear = finger_chain.chain.gravity
+    model.gravity.linear = finger_chain.chain.gravity_vector
     data = model.createData()
     assert model.nq == 3
     ref = _joint_space(finger_chain)
@@ -123,13 +123,13 @@ def test_dh_round_trip(types, tmp_path):
     ch = _random_dh(rng, types, base=base)
     path = to_urdf(ch, tmp_path / "c.urdf")
     # URDF's root is the world frame: gravity rotates with the base
-    u = from_urdf(path, gravity=base[:3, :3] @ ch.gravity)
+    u = from_urdf(path, gravity=base[:3, :3] @ ch.gravity_vector)
     q, qd, qdd = _states(rng, len(types))
     np.testing.assert_allclose(u.rnea(q, qd, qdd), ch.rnea(q, qd, qdd), atol=TOL, rtol=0)
     np.testing.assert_allclose(u.mass_matrix(q), ch.mass_matrix(q), atol=TOL, rtol=0)
     np.testing.assert_allclose(u.fk(q), ch.fk(q), atol=TOL, rtol=0)
     # and once more through the URDF chain itself
-    u2 = from_urdf(to_urdf(u, tmp_path / "c2.urdf"), gravity=u.gravity)
+    u2 = from_urdf(to_urdf(u, tmp_path / "c2.urdf"), gravity=u.gravity_vector)
     np.testing.assert_allclose(u2.rnea(q, qd, qdd), u.rnea(q, qd, qdd), atol=TOL, rtol=0)
     np.testing.assert_array_equal(u2.limits.lower, u.limits.lower)
 

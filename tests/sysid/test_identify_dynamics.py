@@ -38,7 +38,7 @@ def finger(tmp_path_factory):
             I[k, 0, 0] = 0.2 * I[k, 1, 1]
         ch = CoupledChain(ch.chain.replace(inertia=I), ch.coupling, ch.name)
         path = to_urdf(ch, tmp_path_factory.mktemp("u") / "finger.urdf")
-    return from_urdf(path, gravity=ch.chain.gravity)
+    return from_urdf(path, gravity=ch.chain.gravity_vector)
 
 
 def fourier_states(n, fs, rng, m=3, harmonics=5, f0=0.1, amp=0.3):

@@ -107,8 +107,8 @@ class Dynamics:
         """Coriolis/centrifugal vector C(q, q̇)."""
         return _dyn.coriolis(self, q, qd)
 
-    def gravity_torque(self, q) -> np.ndarray:
-        """Gravity vector G(q)."""
+    def gravity(self, q) -> np.ndarray:
+        """Gravity torques G(q) (N·m or N per joint) for the gravity vector ``gravity_vector``."""
         return _dyn.gravity(self, q)
 
     def bias(self, q, qd) -> np.ndarray:
@@ -242,7 +242,7 @@ class DHChain(Dynamics):
         self.com = np.ascontiguousarray(com)
         self.inertia = inertia
         self.armature = armature
-        self.gravity = g
+        self.gravity_vector = g
         self.tool = _as_transform(tool, "tool")
         self.base = _as_transform(base, "base")
         self.names = tuple(names) if names is not None else tuple(f"q{k + 1}" for k in range(n))
@@ -272,7 +272,7 @@ class DHChain(Dynamics):
         i6 = np.ascontiguousarray(np.stack([I[:, 0, 0], I[:, 1, 1], I[:, 2, 2], I[:, 0, 1],
                                             I[:, 0, 2], I[:, 1, 2]], axis=1))
         jt = np.array([0 if c == "R" else 1 for c in self.joint_types], dtype=np.int64)
-        return dh_table(*self.dh.T), jt, self.mass, self.com, i6, self.armature, self.gravity
+        return dh_table(*self.dh.T), jt, self.mass, self.com, i6, self.armature, self.gravity_vector
 
     def kernel_arrays(self):
         if self._arrays is None:
@@ -286,7 +286,7 @@ class DHChain(Dynamics):
         """A copy with some constructor arguments changed (``gravity=``, ``base=``, ...)."""
         kw = dict(alpha=self.dh[:, 0], a=self.dh[:, 1], d=self.dh[:, 2], theta_offset=self.dh[:, 3],
                   joint_types=self.joint_types, mass=self.mass, com=self.com, inertia=self.inertia,
-                  armature=self.armature, gravity=self.gravity, tool=self.tool, base=self.base,
+                  armature=self.armature, gravity=self.gravity_vector, tool=self.tool, base=self.base,
                   names=self.names, name=self.name)
         unknown = set(changes) - set(kw)
         if unknown:

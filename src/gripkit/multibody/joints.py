@@ -176,7 +176,7 @@ class JointChain(Dynamics):
         self.actuated = actuated
         self._link_names = link_names
         self.limits = limits if limits is not None else JointLimits.unbounded(m)
-        self.gravity = np.asarray(gravity, dtype=np.float64).reshape(3).copy()
+        self.gravity_vector = np.asarray(gravity, dtype=np.float64).reshape(3).copy()
         self.tool = _as_transform(tool, "tool")
         self.base = np.eye(4)
         self.armature = arm
@@ -229,7 +229,7 @@ class JointChain(Dynamics):
             jt = np.array([0 if c == "R" else 1 for c in self.joint_types], dtype=np.int64)
             self._arrays = (np.ascontiguousarray(table), jt, self.mass, np.ascontiguousarray(com), i6,
                             np.zeros(n), np.ascontiguousarray(self.coupling.ravel()), self.offset,
-                            self.armature, self.gravity)
+                            self.armature, self.gravity_vector)
             self._kernel_tool = self.tool.copy()
             self._kernel_tool[:3] = A[-1].T @ self.tool[:3]
         return self._arrays
@@ -277,7 +277,7 @@ class JointChain(Dynamics):
         kw = dict(placements=self.placements, axes=self.axes, joint_types=self.joint_types,
                   mass=self.mass, com=self.com, inertia=self.inertia, coupling=self.coupling,
                   offset=self.offset, names=self.names, actuated=self.actuated,
-                  link_names=self._link_names, limits=self.limits, gravity=self.gravity,
+                  link_names=self._link_names, limits=self.limits, gravity=self.gravity_vector,
                   tool=self.tool, armature=self.armature, name=self.name)
         unknown = set(changes) - set(kw)
         if unknown:

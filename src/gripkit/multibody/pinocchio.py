@@ -36,5 +36,5 @@ def to_pinocchio(chain):
                                 pin.SE3.Identity())
         parent = jid
     model.armature = np.asarray(chain.armature, dtype=np.float64).copy()
-    model.gravity.linear = np.asarray(chain.gravity, dtype=np.float64)
+    model.gravity.linear = np.asarray(chain.gravity_vector, dtype=np.float64)
     return model, model.createData()

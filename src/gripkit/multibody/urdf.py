@@ -245,7 +245,7 @@ def from_urdf(source, *, base_link: str | None = None, tip_link: str | None = No
     Returns
     -------
     JointChain
-        ``rnea``, ``mass_matrix``, ``forward_dynamics``, ``gravity_torque``, ``regressor``, ...
+        ``rnea``, ``mass_matrix``, ``forward_dynamics``, ``gravity``, ``regressor``, ...
         in the actuated joints' coordinates (``joint_names``), limits in ``limits``.
     """
     robot = _read_root(source)
@@ -489,7 +489,7 @@ def to_urdf(chain, path, *, name: str | None = None, base_link: str = "base",
                       GripkitWarning, stacklevel=2)
     robot = ET.Element("robot", name=name or getattr(chain, "name", "chain"))
     robot.append(ET.Comment(f" written by gripkit.multibody.to_urdf; gravity in {base_link!r}: "
-                            f"{_vec(getattr(chain, 'chain', chain).gravity)} m/s^2 "))
+                            f"{_vec(getattr(chain, 'chain', chain).gravity_vector)} m/s^2 "))
     ET.SubElement(robot, "link", name=base_link)
     parent = base_link
     actuated_rank = {k: r for r, k in enumerate(independent)}

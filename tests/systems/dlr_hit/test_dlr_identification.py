@@ -131,7 +131,7 @@ def test_breakaway_detection_recovers_stiction_with_gravity():
     pwm, vel, pos = (np.concatenate(c) for c in zip(*logs))
 
     def torque_at(u, q3):
-        g = ch.gravity_torque(np.linalg.solve(ch.coupling.matrix[:3], [0.0, 0.0, q3]))[2]
+        g = ch.gravity(np.linalg.solve(ch.coupling.matrix[:3], [0.0, 0.0, q3]))[2]
         return float(f.motor_torque("distal", u, 0.0)) - g
 
     res = detect_breakaway(pwm, vel, pos, torque_at=torque_at)

@@ -59,7 +59,7 @@ def test_joint_impedance_gravity_compensation():
     np.testing.assert_allclose(q_on, ref[0], atol=1e-6)
     ch = f.chain()
     G = ch.coupling.matrix[:3]
-    g_p = ch.gravity_torque(np.linalg.solve(G, q_off))
+    g_p = ch.gravity(np.linalg.solve(G, q_off))
     g_q = np.linalg.solve(G.T, g_p)  # joint-space gravity (θ4's torque on θ3)
     np.testing.assert_allclose(ref[0] - q_off, g_q / K, rtol=0.01, atol=1e-7)
 

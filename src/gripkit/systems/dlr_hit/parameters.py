@@ -222,7 +222,7 @@ def max_gravity_torque(model, n: int = 13) -> np.ndarray:
     grids = [np.linspace(v(f"{j}_min"), v(f"{j}_max"), n) for j in ("abd", "flex", "prox")]
     Q = np.array(np.meshgrid(*grids, indexing="ij")).reshape(3, -1).T
     q4 = np.column_stack([Q, Q[:, 2]])
-    g = ch.chain.gravity_torque(q4)
+    g = ch.chain.gravity(q4)
     return np.array([np.abs(g[:, 0]).max(), np.abs(g[:, 1]).max(), np.abs(g[:, 2] + g[:, 3]).max()])
 
 
