@@ -1,0 +1,290 @@
+"""Prediction-error refinement of discrete MIMO state-space models (ssest-like).
+
+Predictor of the innovation form (``K = 0``: output error)::
+
+    ŷ[t] = C x[t] + D u[t],   e[t] = y[t] − ŷ[t],   x[t+1] = A x[t] + B u[t] + K e[t],   x[0] = x0.
+
+Criterion: ``V = Σ_t e[t]ᵀ Λ⁻¹ e[t]`` with Λ the innovation covariance of the starting model (fixed,
+so that outputs in different units weigh alike). Parameters: the entries of (A, B, C[, D][, K])
+move only in the directions orthogonal to the similarity transformations at the current model,
+the data-driven local coordinates of McKelvey, Helmersson & Ribarits (2004) — the tangent of
+``(T A T⁻¹, T B, C T⁻¹, T K)`` at T = I + X is ``(XA − AX, XB, −CX, XK)``; its orthogonal complement
+is a basis of d = nm + pn (+ pm) (+ np) identifiable directions — plus x0.
+
+Jacobians are exact, from the sensitivity equations (a numba kernel), for each direction
+θ_q with matrix tangents (dA, dB, dC, dD, dK)::
+
+    ∂ŷ[t] = C s[t] + dC x[t] + dD u[t],
+    s[t+1] = A s[t] + dA x[t] + dB u[t] + dK e[t] − K ∂ŷ[t],      s[0] = 0 (s[0] = e_i for x0_i).
+
+Levenberg-Marquardt steps re-centre the coordinates after every accepted step and reject any step
+that makes A (or the predictor A − KC) unstable, so stability is kept. The covariance of the
+directions is ``σ² (JᵀJ)⁻¹`` (J of the whitened errors, σ² = V/(Np − d − n)); it is carried as the
+:class:`gripkit.lti.Uncertainty` of the model's (A, B, C, D) with the directions as tangents, from
+which poles and frequency responses get their σ by linearisation.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from ..errors import DataError, IdentificationError
+from ..lti import StateSpace, Uncertainty
+from .linear_model import LinearModel, as_io_matrix, fit_per_output, free_run
+
+__all__ = ["pem", "PEM_FORMS"]
+
+PEM_FORMS = ("oe", "innovation")
+
+
+@numba.njit(cache=True)
+def _predict(A, B, C, D, K, x0, u, y, e):  # pragma: no cover - compiled
+    """Prediction errors e (N, p) of the predictor of the module docstring."""
+    n, m, p = A.shape[0], B.shape[1], C.shape[0]
+    x = x0.copy()
+    xn = np.empty(n)
+    for t in range(u.shape[0]):
+        for i in range(p):
+            acc = 0.0
+            for j in range(n):
+                acc += C[i, j] * x[j]
+            for j in range(m):
+                acc += D[i, j] * u[t, j]
+            e[t, i] = y[t, i] - acc
+        for r in range(n):
+            acc = 0.0
+            for j in range(n):
+                acc += A[r, j] * x[j]
+            for j in range(m):
+                acc += B[r, j] * u[t, j]
+            for j in range(p):
+                acc += K[r, j] * e[t, j]
+            xn[r] = acc
+        for r in range(n):
+            x[r] = xn[r]
+
+
+@numba.njit(cache=True)
+def _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, y, e, J):  # pragma: no cover - compiled
+    """Prediction errors e (N, p) and J (N·p, d + n) = ∂ŷ/∂θ (rows t·p + i): d model directions
+    with tangents dA (d, n, n), dB, dC, dD, dK, then the n entries of x0."""
+    n, m, p = A.shape[0], B.shape[1], C.shape[0]
+    d = dA.shape[0]
+    nd = d + n
+    x = x0.copy()
+    xn = np.empty(n)
+    s = np.zeros((nd, n))
+    sn = np.empty((nd, n))
+    dy = np.empty(p)
+    for i in range(n):
+        s[d + i, i] = 1.0
+    for t in range(u.shape[0]):
+        for i in range(p):
+            acc = 0.0
+            for j in range(n):
+                acc += C[i, j] * x[j]
+            for j in range(m):
+                acc += D[i, j] * u[t, j]
+            e[t, i] = y[t, i] - acc
+        for q in range(nd):
+            for i in range(p):
+                acc = 0.0
+                for j in range(n):
+                    acc += C[i, j] * s[q, j]
+                if q < d:
+                    for j in range(n):
+                        acc += dC[q, i, j] * x[j]
+                    for j in range(m):
+                        acc += dD[q, i, j] * u[t, j]
+                J[t * p + i, q] = acc
+                dy[i] = acc
+            for r in range(n):
+                acc = 0.0
+                for j in range(n):
+                    acc += A[r, j] * s[q, j]
+                if q < d:
+                    for j in range(n):
+                        acc += dA[q, r, j] * x[j]
+                    for j in range(m):
+                        acc += dB[q, r, j] * u[t, j]
+                    for j in range(p):
+                        acc += dK[q, r, j] * e[t, j]
+                for j in range(p):
+                    acc -= K[r, j] * dy[j]
+                sn[q, r] = acc
+        for q in range(nd):
+            for r in range(n):
+                s[q, r] = sn[q, r]
+        for r in range(n):
+            acc = 0.0
+            for j in range(n):
+                acc += A[r, j] * x[j]
+            for j in range(m):
+                acc += B[r, j] * u[t, j]
+            for j in range(p):
+                acc += K[r, j] * e[t, j]
+            xn[r] = acc
+        for r in range(n):
+            x[r] = xn[r]
+
+
+def _directions(A, B, C, D, K, feedthrough: bool, innovation: bool):
+    """Orthonormal basis of the parameter directions orthogonal to the similarity orbit, as
+    matrix tangents (dA, dB, dC, dD, dK), each with a leading axis of d."""
+    n, m, p = A.shape[0], B.shape[1], C.shape[0]
+    blocks = [n * n, n * m, p * n, p * m if feedthrough else 0, n * p if innovation else 0]
+    T = np.empty((sum(blocks), n * n))
+    for a in range(n):
+        for b in range(n):
+            X = np.zeros((n, n))
+            X[a, b] = 1.0
+            parts = [X @ A - A @ X, X @ B, -C @ X]
+            if feedthrough:
+                parts.append(np.zeros((p, m)))
+            if innovation:
+                parts.append(X @ K)
+            T[:, a * n + b] = np.concatenate([q.ravel() for q in parts])
+    U, sv, _ = np.linalg.svd(T, full_matrices=True)
+    rank = int(np.sum(sv > 1e-10 * max(sv[0], 1e-300))) if sv.size else 0
+    Qp = U[:, rank:]
+    d = Qp.shape[1]
+    out, c = [], 0
+    for size, shape in zip(blocks, [(n, n), (n, m), (p, n), (p, m), (n, p)]):
+        if size:
+            out.append(np.ascontiguousarray(Qp[c:c + size].T.reshape((d,) + shape)))
+            c += size
+        else:
+            out.append(np.zeros((d,) + shape))
+    return out
+
+
+def _radius(A):
+    return float(np.max(np.abs(np.linalg.eigvals(A)))) if A.shape[0] else 0.0
+
+
+def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovation", feedthrough: bool | None = None,
+        max_iterations: int = 50, tol: float = 1e-9) -> LinearModel:
+    """Refine a discrete state-space model by prediction-error minimisation.
+
+    Parameters
+    ----------
+    model
+        A :class:`LinearModel` with a discrete ``StateSpace`` (e.g. from :func:`gripkit.sysid.n4sid`).
+    data
+        A :class:`~gripkit.signals.Trajectory` with the model's input and output columns (offsets
+        removed as recorded in the model), or give ``u`` (N, m) and ``y`` (N, p) in deviation units.
+    form
+        ``'innovation'`` (estimate K too; needs the model's K as a start) or ``'oe'`` (K = 0).
+    feedthrough
+        Estimate D (default: when the starting model has a non-zero D).
+    max_iterations, tol
+        Levenberg-Marquardt iterations and the relative decrease of V that stops them.
+
+    Returns
+    -------
+    LinearModel
+        Structure ``'pem-oe'`` or ``'pem-innovation'``; ``.system`` carries the covariance of the
+        identifiable directions (σ of poles: ``system.pole_covariance()``; of the frequency
+        response: ``system.bode(w)``).
+    """
+    if form not in PEM_FORMS:
+        raise DataError(f"form: expected 'oe' or 'innovation', found {form!r}")
+    if not isinstance(model, LinearModel) or not isinstance(model.system, StateSpace) or not model.system.is_discrete:
+        raise DataError("model: expected a discrete state-space LinearModel (e.g. from gripkit.sysid.n4sid)")
+    ss = model.system
+    if data is not None:
+        dt = 1.0 / data.require_uniform(why="PEM refinement")
+        if abs(dt - ss.dt) > 1e-9 * ss.dt:
+            raise DataError(f"data: sampled every {dt:g} s, the model every {ss.dt:g} s")
+        u = model._columns(data, model.inputs, model.u_offset, "input")
+        y = model._columns(data, model.outputs, model.y_offset, "output")
+    u = as_io_matrix(u, "input u")
+    y = as_io_matrix(y, "output y", u.shape[0])
+    n, m, p = ss.n_states, ss.n_inputs, ss.n_outputs
+    if u.shape[1] != m or y.shape[1] != p:
+        raise DataError(f"data: the model has {m} input(s) and {p} output(s), the data {u.shape[1]} and {y.shape[1]}")
+    innovation = form == "innovation"
+    feedthrough = bool(np.any(ss.D != 0)) if feedthrough is None else bool(feedthrough)
+    A, B, C = ss.A.copy(), ss.B.copy(), ss.C.copy()
+    D = ss.D.copy() if feedthrough else np.zeros((p, m))
+    K = (model.K.copy() if model.K is not None else np.zeros((n, p))) if innovation else np.zeros((n, p))
+    if innovation and _radius(A - K @ C) >= 1.0:
+        K = np.zeros((n, p))
+    x0 = np.zeros(n) if model.x0 is None else np.array(model.x0, dtype=np.float64)
+    N = u.shape[0]
+    e = np.empty((N, p))
+    _predict(A, B, C, D, K, x0, u, y, e)
+    w, V = np.linalg.eigh(e.T @ e / N)
+    if w.min() <= 0:
+        raise IdentificationError("pem: the starting model predicts an output exactly (zero error variance)")
+    # whiten the outputs once: ỹ = W y, C̃ = W C, D̃ = W D, K̃ = K W⁻¹ (W = Λ^{-1/2}), V = Σ ẽᵀẽ
+    W, Winv = (V / np.sqrt(w)) @ V.T, (V * np.sqrt(w)) @ V.T
+    yw = np.ascontiguousarray(y @ W.T)
+    C, D, K = W @ C, W @ D, K @ Winv
+    _predict(A, B, C, D, K, x0, u, yw, e)
+    V0 = Vc = float(np.sum(e * e))
+    lam, it, converged = 1e-3, 0, False
+    for it in range(1, max_iterations + 1):
+        dA, dB, dC, dD, dK = _directions(A, B, C, D, K, feedthrough, innovation)
+        d = dA.shape[0]
+        J = np.empty((N * p, d + n))
+        _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, yw, e, J)
+        H = J.T @ J
+        g = J.T @ e.reshape(-1)
+        hd = np.maximum(np.diag(H), 1e-300)
+        improved, rel = False, 0.0
+        for _ in range(30):
+            try:
+                delta = np.linalg.solve(H + lam * np.diag(hd), g)
+            except np.linalg.LinAlgError:
+                lam *= 10
+                continue
+            th = delta[:d]
+            An, Cn, Kn = A + np.tensordot(th, dA, 1), C + np.tensordot(th, dC, 1), K + np.tensordot(th, dK, 1)
+            if _radius(An) >= 1.0 or (innovation and _radius(An - Kn @ Cn) >= 1.0):
+                lam *= 10
+                continue
+            Bn, Dn, x0n = B + np.tensordot(th, dB, 1), D + np.tensordot(th, dD, 1), x0 + delta[d:]
+            en = np.empty((N, p))
+            _predict(An, Bn, Cn, Dn, Kn, x0n, u, yw, en)
+            Vn = float(np.sum(en * en))
+            if np.isfinite(Vn) and Vn < Vc:
+                improved, rel = True, (Vc - Vn) / max(Vc, 1e-300)
+                A, B, C, D, K, x0, Vc = An, Bn, Cn, Dn, Kn, x0n, Vn
+                lam = max(lam / 5, 1e-12)
+                break
+            lam *= 10
+        if not improved or rel < tol:
+            converged = True
+            break
+    # covariance at the final point
+    dA, dB, dC, dD, dK = _directions(A, B, C, D, K, feedthrough, innovation)
+    d = dA.shape[0]
+    J = np.empty((N * p, d + n))
+    _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, yw, e, J)
+    dof = N * p - d - n
+    if dof <= 0:
+        raise DataError(f"pem: {N} samples of {p} output(s) cannot determine {d + n} parameters",
+                        hint="use a longer record or a lower order")
+    s2 = float(np.sum(e * e)) / dof
+    try:
+        cov_full = s2 * np.linalg.inv(J.T @ J)
+    except np.linalg.LinAlgError:
+        raise IdentificationError("pem: the Jacobian is singular at the optimum: the data do not determine the "
+                                  "model (a non-minimal order or a poorly exciting input)",
+                                  hint="lower the order or excite the system more richly") from None
+    cov = 0.5 * (cov_full[:d, :d] + cov_full[:d, :d].T)
+    # back to physical output units
+    C, D, K = Winv @ C, Winv @ D, K @ W
+    dC, dD = np.einsum("ij,qjk->qik", Winv, dC), np.einsum("ij,qjk->qik", Winv, dD)
+    e = e @ Winv.T
+    Lam = e.T @ e / N
+    unc = Uncertainty(tuple(f"theta{i}" for i in range(d)), cov, (dA, dB, dC, dD))
+    sysn = StateSpace(A, B, C, D, **ss._signals(meta={**ss.meta, "refined_by": f"pem-{form}"}), states=ss.states,
+                      state_units=ss.state_units, uncertainty=unc)
+    ys = free_run(A, B, C, D, u, x0)
+    info = {**model.info, "pem": {"form": form, "iterations": it, "converged": converged, "loss_start": V0 / N,
+                                  "loss": Vc / N, "parameters": d, "feedthrough": feedthrough}}
+    return model.replace(system=sysn, structure=f"pem-{form}", K=K if innovation else None, x0=x0,
+                         noise_covariance=Lam, fit_percent=fit_per_output(y, ys), n_samples=N, info=info)
