@@ -42,3 +42,12 @@ from .friction import fit_stribeck as fit_stribeck
 from .friction import idim_ls as idim_ls
 from .motor import characterize_motor as characterize_motor
 from .motor import fit_motor as fit_motor
+from .linear_model import LinearModel as LinearModel
+from .subspace import n4sid as n4sid
+from .subspace import moesp as moesp
+from .pem_ss import pem as pem
+from .frf import FRF as FRF
+from .frf import frf as frf
+from .tfest import tfest as tfest
+from .tfest import tfest_frf as tfest_frf
+from .model_file import load_model as load_model
