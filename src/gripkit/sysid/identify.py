@@ -32,7 +32,7 @@ from ..signals.trajectory import Trajectory
 
 __all__ = ["IOData", "io_data", "identify", "METHODS"]
 
-METHODS = ("arx", "armax", "oe", "rls", "search")
+METHODS = ("arx", "armax", "oe", "rls", "search", "ss", "frf", "tf")
 
 
 @dataclass(frozen=True)
@@ -100,7 +100,11 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
         ``'arx'`` (least squares), ``'armax'`` (orders na, nb, nc, nk), ``'oe'`` (orders nb, nf,
         nk; ``nf`` defaults to ``na``), ``'rls'`` (recursive least squares; options
         ``forgetting``, ``p0``, ``windup``), or ``'search'`` (``na``, ``nb``, ``nk`` may be ranges
-        such as ``'1:4'``; option ``criterion``).
+        such as ``'1:4'``; option ``criterion``); ``'ss'`` (state space by subspace + PEM,
+        options of :func:`gripkit.sysid.identify_mimo.identify_ss`), ``'frf'`` (frequency
+        response, options of :func:`gripkit.sysid.frf`), ``'tf'`` (continuous-time transfer
+        function, options ``poles``, ``zeros``). For these three ``input``/``output`` may name
+        several columns (``'a,b'`` or a list).
     input, output
         Column names.
     detrend
@@ -114,6 +118,12 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
     """
     if method not in METHODS:
         raise DataError(f"method: expected one of {', '.join(METHODS)}, found {method!r}")
+    if method in ("ss", "frf", "tf"):  # MIMO: input/output may name several columns
+        from . import identify_mimo
+
+        fn = {"ss": identify_mimo.identify_ss, "frf": identify_mimo.identify_frf, "tf": identify_mimo.identify_tf}
+        out = fn[method](data, input=input, output=output, detrend=detrend, **options)
+        return out[0] if method == "ss" else out
     io = io_data(data, input=input, output=output, detrend=detrend, why=f"{method.upper()} identification")
     if method == "arx":
         from .arx import arx
