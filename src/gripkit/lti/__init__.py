@@ -11,7 +11,9 @@ Views: :class:`StateSpace` (A, B, C, D) and :class:`TransferFunction` (num/den p
 descending powers; ``from_polynomials``/``num_zinv``/``den_zinv`` for the q⁻¹ layout of ARX and
 RST code), both :class:`LinearSystem`. Operations: :func:`c2d`/:func:`d2c` (ZOH, FOH, Tustin),
 :func:`series`, :func:`parallel`, :func:`feedback`, poles, (transmission) zeros, DC gain,
-frequency response and Bode data, step/impulse responses, simulation (numba), stability.
+frequency response and Bode data, natural frequencies and damping, step/impulse responses,
+simulation (numba), stability, minimum phase; every one with σ where the system carries a
+covariance.
 Interop: ``to_control()``/:func:`from_control` (python-control, optional), ``to_scipy()``/
 :func:`from_scipy`, :func:`as_system` (coerce older gripkit models).
 """
@@ -20,6 +22,7 @@ from ._frequency import Bode as Bode
 from ._interop import as_system as as_system
 from ._interop import from_control as from_control
 from ._interop import from_scipy as from_scipy
+from ._system import Damping as Damping
 from ._system import LinearSystem as LinearSystem
 from ._system import StateSpace as StateSpace
 from ._system import TransferFunction as TransferFunction
@@ -30,5 +33,5 @@ from ._system import parallel as parallel
 from ._system import series as series
 from ._uncertainty import Uncertainty as Uncertainty
 
-__all__ = ["Bode", "LinearSystem", "StateSpace", "TransferFunction", "Uncertainty", "as_system", "c2d", "d2c",
-           "feedback", "from_control", "from_scipy", "parallel", "series"]
+__all__ = ["Bode", "Damping", "LinearSystem", "StateSpace", "TransferFunction", "Uncertainty", "as_system",
+           "c2d", "d2c", "feedback", "from_control", "from_scipy", "parallel", "series"]

@@ -64,5 +64,6 @@ def tf_feedback(n, d, nk, dk, sign: float):
     """G/(1 − sign G K) = (n dk)/(d dk − sign n nk)."""
     den = _padd(np.convolve(d, dk), -sign * np.convolve(n, nk))
     if not np.any(den):
-        raise ModelError("feedback: the closed loop's denominator is zero (1 − sign·G·K ≡ 0)")
+        raise ModelError("feedback: an algebraic loop with no solution (the closed loop's denominator "
+                         "d_G d_K − sign n_G n_K is identically zero)")
     return np.convolve(n, dk), den

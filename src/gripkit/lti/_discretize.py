@@ -91,7 +91,8 @@ def _real_logm(M, what):
     if bad.size:
         raise ModelError(f"{what}: a pole at z = {bad[0].real:.6g} lies on the closed negative real axis, "
                          "where no continuous-time pole maps to under sampling",
-                         hint="use method='tustin', or identify at a sample rate where no pole sits at or beyond Nyquist")
+                         hint="use method='tustin', or identify at a sample rate where no pole sits at "
+                              "or beyond Nyquist")
     L = linalg.logm(M)
     if np.iscomplexobj(L):
         if np.abs(L.imag).max() > 1e-9 * max(np.abs(L).max(), 1.0):

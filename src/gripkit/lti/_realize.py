@@ -40,22 +40,35 @@ def siso_observable_form(num: np.ndarray, den: np.ndarray):
     return A, B, C, np.array([[b[0]]])
 
 
-def tf2ss(num: np.ndarray, den: np.ndarray):
+def siso_controllable_form(num: np.ndarray, den: np.ndarray):
+    """Controller canonical form of num/den (the realisation of ``scipy.signal.tf2ss``, with the
+    same arithmetic): ``A = [[-a1, -a2, …], [1, 0, …], …]``, ``B = e₁``, ``C = b[1:] − b₀ a[1:]``,
+    ``D = b₀`` (a = den/den[0], b = num/den[0])."""
+    A, B, C, D = siso_observable_form(num, den)
+    return A.T.copy(), C.T.copy(), B.T.copy(), D
+
+
+FORMS = ("observable", "controllable")
+
+
+def tf2ss(num: np.ndarray, den: np.ndarray, form: str = "observable"):
     """(A, B, C, D) of a (p, m) matrix of SISO transfer functions.
 
-    ``num``, ``den``: shape (p, m, L), descending powers, common length. Each entry becomes an
-    observable canonical block of its own degree (leading zeros of its denominator dropped),
+    ``num``, ``den``: shape (p, m, L), descending powers, common length. Each entry becomes a
+    canonical block (``form``: observable, the state of ``lfilter``; or controllable, that of
+    ``scipy.signal.tf2ss``) of its own degree (leading zeros of its denominator dropped),
     stacked in parallel: x = [x_11; x_12; …], B places block ij on input j, C on output i. The
     result is controllable and observable entry by entry, not necessarily as a whole: call
     :func:`minreal` for a minimal realisation.
     """
+    siso = siso_observable_form if form == "observable" else siso_controllable_form
     p, m, _ = num.shape
     blocks = []
     for i in range(p):
         for j in range(m):
             d = den[i, j]
             k = np.flatnonzero(d)[0]
-            blocks.append((i, j) + siso_observable_form(num[i, j, k:], d[k:]))
+            blocks.append((i, j) + siso(num[i, j, k:], d[k:]))
     n = sum(b[2].shape[0] for b in blocks)
     A = np.zeros((n, n))
     B = np.zeros((n, m))
@@ -86,9 +99,26 @@ def ss2tf(A, B, C, D, minimal: bool = True, tol: float = MINREAL_TOL):
             a, b, c = A, B[:, j:j + 1], C[i:i + 1]
             if minimal:
                 a, b, c, _ = minreal(a, b, c, D[i:i + 1, j:j + 1], tol)
-            den = np.poly(a) if a.shape[0] else np.ones(1)
-            num = np.poly(a - b @ c) + (D[i, j] - 1.0) * den if a.shape[0] else D[i, j] * np.ones(1)
-            entries.append((np.real_if_close(num, tol=1e6).real, np.real_if_close(den, tol=1e6).real))
+            if a.shape[0] == 0:
+                entries.append((D[i, j] * np.ones(1), np.ones(1)))
+                continue
+            lam, mu = np.linalg.eigvals(a), np.linalg.eigvals(a - b @ c)
+            # eigenvalues within the eigen-solver's backward error (10 n ε ‖·‖₁) of the origin are
+            # zero (delays: poles at z = 0), so the polynomials get exact trailing zeros
+            lam[np.abs(lam) <= 10 * a.shape[0] * _EPS * np.abs(a).sum(0).max()] = 0.0
+            mu[np.abs(mu) <= 10 * a.shape[0] * _EPS * np.abs(a - b @ c).sum(0).max()] = 0.0
+            den = np.poly(lam).real
+            num = np.poly(mu).real + (D[i, j] - 1.0) * den
+            # leading coefficients that are zero in exact arithmetic (relative degree) come out as
+            # rounding noise of the subtraction: bounded by n ε times the coefficients of
+            # Π(s + |λ_i|) and Π(s + |μ_i|); 100× that is taken as zero
+            noise = 100 * a.shape[0] * _EPS * (np.poly(-np.abs(lam)).real + np.poly(-np.abs(mu)).real
+                                                * max(1.0, abs(D[i, j] - 1.0)))
+            k = 0
+            while k < num.size - 1 and abs(num[k]) <= noise[k]:
+                num[k] = 0.0
+                k += 1
+            entries.append((num, den))
     L = max(e[1].size for e in entries)
     num = np.zeros((p, m, L))
     den = np.zeros((p, m, L))

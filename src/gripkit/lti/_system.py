@@ -28,7 +28,7 @@ from ._kernels import simulate_ss
 from ._pycontrol import control_module
 from ._uncertainty import Uncertainty, complex_covariance, push
 
-__all__ = ["LinearSystem", "StateSpace", "TransferFunction", "c2d", "d2c", "series", "parallel", "feedback"]
+__all__ = ["Damping", "LinearSystem", "StateSpace", "TransferFunction", "c2d", "d2c", "series", "parallel", "feedback"]
 
 _EPS = np.finfo(float).eps
 
@@ -53,6 +53,15 @@ def _simulate_arrays(A, B, C, D, u, x0):
     return y
 
 
+def _vector_as(x, shape):
+    """A 1-D sequence reshaped (a column of B, a row of C); anything else unchanged."""
+    try:
+        a = np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError):
+        return x
+    return a.reshape(shape) if a.ndim == 1 else x
+
+
 def _ss_frequency(A, B, C, D, s):
     """G(s_k) = C (s_k I − A)⁻¹ B + D, and X = (sI − A)⁻¹ B, Y = C (sI − A)⁻¹, for each s_k."""
     n = A.shape[0]
@@ -60,9 +69,39 @@ def _ss_frequency(A, B, C, D, s):
         H = np.broadcast_to(D, (s.size,) + D.shape).astype(complex)
         return H, np.zeros((s.size, 0, D.shape[1])), np.zeros((s.size, D.shape[0], 0))
     M = s[:, None, None] * np.eye(n) - A
+    sv = np.linalg.svd(M, compute_uv=False)
+    bad = sv[:, -1] <= n * _EPS * np.maximum(sv[:, 0], 1.0)
+    if np.any(bad):
+        raise ModelError(f"frequency response: s = {s[bad][0]:.6g} is a pole of the system (sI − A is singular)",
+                         hint="evaluate away from the poles on the imaginary axis (or the unit circle)")
     X = np.linalg.solve(M, np.broadcast_to(B.astype(complex), (s.size,) + B.shape))
-    Y = np.swapaxes(np.linalg.solve(np.swapaxes(M, 1, 2), np.broadcast_to(C.T.astype(complex), (s.size,) + C.T.shape)), 1, 2)
+    Ct = np.broadcast_to(C.T.astype(complex), (s.size,) + C.T.shape)
+    Y = np.swapaxes(np.linalg.solve(np.swapaxes(M, 1, 2), Ct), 1, 2)
     return C @ X + D, X, Y
+
+
+@dataclass(frozen=True, eq=False)
+class Damping:
+    """Poles with their natural frequencies ``wn`` (rad/s) and damping ratios ``zeta``, and the
+    one-sigma ``wn_std``/``zeta_std`` (None without covariance). See :meth:`LinearSystem.damping`.
+
+    Examples
+    --------
+    >>> from gripkit.lti import StateSpace
+    >>> float(StateSpace([[-3.0]], [[1.0]], [[1.0]]).damping().zeta[0])
+    1.0
+    """
+
+    poles: np.ndarray
+    wn: np.ndarray
+    zeta: np.ndarray
+    wn_std: np.ndarray | None = None
+    zeta_std: np.ndarray | None = None
+
+    @property
+    def f_hz(self) -> np.ndarray:
+        """Natural frequencies in Hz, ω_n/2π."""
+        return self.wn / (2 * np.pi)
 
 
 class LinearSystem:
@@ -72,6 +111,13 @@ class LinearSystem:
     Every system has ``dt`` (None: continuous; > 0: sample time in s), ``inputs``/``outputs``
     (names), ``input_units``/``output_units`` (SI strings, ``''`` when not declared), ``meta``
     (free-form provenance) and ``uncertainty`` (an :class:`Uncertainty` or None).
+
+    Examples
+    --------
+    >>> from gripkit.lti import LinearSystem, StateSpace, TransferFunction
+    >>> all(isinstance(g, LinearSystem) for g in (StateSpace([[-1.0]], [[1.0]], [[1.0]]),
+    ...                                           TransferFunction([1.0], [1.0, 1.0])))
+    True
     """
 
     # ------------------------------------------------------------------ shape and time base
@@ -92,7 +138,14 @@ class LinearSystem:
         return self.n_inputs == 1 and self.n_outputs == 1
 
     def replace(self, **changes):
-        """A copy with some fields changed (validated again)."""
+        """A copy with some fields changed (validated again).
+
+        Examples
+        --------
+        >>> from gripkit.lti import TransferFunction
+        >>> TransferFunction([1.0], [1.0, 1.0]).replace(inputs="V").inputs
+        ('V',)
+        """
         return dataclasses.replace(self, **changes)
 
     def _signals(self, **over) -> dict:
@@ -119,6 +172,62 @@ class LinearSystem:
         """
         p = self.poles()
         return bool(np.all(np.abs(p) < 1.0)) if self.is_discrete else bool(np.all(p.real < 0.0))
+
+    def is_minimum_phase(self) -> bool:
+        """Every (transmission) zero with Re z < 0 (continuous) or |z| < 1 (discrete).
+
+        Examples
+        --------
+        >>> from gripkit.lti import TransferFunction
+        >>> g = TransferFunction.from_polynomials([1, -1.8732, 0.8996], [0, 0, 0.1950, -0.2276], dt=0.005)
+        >>> g.is_minimum_phase()     # zero at z = 1.167 (000_8f66dcc7ab06470c.txt §V-F)
+        False
+        """
+        z = self.zeros()
+        return bool(np.all(np.abs(z) < 1.0)) if self.is_discrete else bool(np.all(z.real < 0.0))
+
+    def damping(self) -> Damping:
+        """Natural frequency ω_n (rad/s) and damping ratio ζ of each pole, with their one-sigma
+        when the system carries a covariance.
+
+        Continuous pole s: ``ω_n = |s|``, ``ζ = −Re s / |s|``. Discrete pole z: the same of
+        ``s = ln(z)/dt`` (the continuous pole that ZOH maps to z). σ by linearisation of the pole
+        covariance: ∂ω_n/∂(x, y) = (x, y)/ω_n and ∂ζ/∂(x, y) = (−y², x y)/ω_n³ for s = x + j y,
+        and ds/dz = 1/(z dt).
+
+        Examples
+        --------
+        >>> from gripkit.lti import TransferFunction
+        >>> d = TransferFunction([100.0], [1.0, 4.0, 100.0]).damping()
+        >>> d.wn.round(9).tolist(), d.zeta.round(9).tolist()
+        ([10.0, 10.0], [0.2, 0.2])
+        """
+        if self.uncertainty is not None:
+            p, cov = self.pole_covariance()
+        else:
+            p, cov = self.poles(), None
+        if self.is_discrete:
+            # a pole at z = 0 (a delay) is s = ln 0 = −∞: ω_n = ∞, ζ = 1 (as MATLAB's damp)
+            at0 = p == 0
+            pz = np.where(at0, 1.0, p).astype(complex)
+            s = np.where(at0, -np.inf, np.log(pz) / self.dt)
+            c = np.where(at0, 0.0, 1.0 / (pz * self.dt))
+        else:
+            s, c = p.astype(complex), np.ones(p.size, dtype=complex)
+        wn = np.abs(s)
+        with np.errstate(invalid="ignore"):
+            zeta = np.where(np.isinf(wn), 1.0, np.where(wn > 0, -s.real / np.where(wn > 0, wn, 1.0), -1.0))
+        if cov is None:
+            return Damping(p, wn, zeta, None, None)
+        # ∂(Re s, Im s)/∂(Re p, Im p): multiplication by the complex number c = ds/dp
+        Jz = np.stack([np.stack([c.real, -c.imag], -1), np.stack([c.imag, c.real], -1)], -2)
+        cs = Jz @ cov @ np.swapaxes(Jz, -1, -2)
+        x, y = np.where(np.isinf(wn), 0.0, s.real), np.where(np.isinf(wn), 0.0, s.imag)
+        w = np.where((wn > 0) & np.isfinite(wn), wn, np.inf)
+        gw = np.stack([x / w, y / w], -1)
+        gz = np.stack([-y ** 2 / w ** 3, x * y / w ** 3], -1)
+        var = lambda g: np.einsum("ka,kab,kb->k", g, cs, g)  # noqa: E731
+        return Damping(p, wn, zeta, np.sqrt(np.clip(var(gw), 0, None)), np.sqrt(np.clip(var(gz), 0, None)))
 
     def pole_covariance(self) -> tuple[np.ndarray, np.ndarray]:
         """Poles and the covariance of (Re p, Im p) of each, shape (n, 2, 2), to first order:
@@ -301,15 +410,36 @@ class LinearSystem:
 
     # ------------------------------------------------------------------ interconnection
     def series(self, other):
-        """``other ∘ self``: u → self → other → y (G = G_other · G_self). See :func:`series`."""
+        """``other ∘ self``: u → self → other → y (G = G_other · G_self). See :func:`series`.
+
+        Examples
+        --------
+        >>> from gripkit.lti import TransferFunction
+        >>> TransferFunction([1.0], [1.0, 1.0]).series(TransferFunction([3.0], [1.0, 3.0])).dc_gain().tolist()
+        [[1.0]]
+        """
         return series(self, other)
 
     def parallel(self, other):
-        """``self + other`` on shared inputs, outputs summed. See :func:`parallel`."""
+        """``self + other`` on shared inputs, outputs summed. See :func:`parallel`.
+
+        Examples
+        --------
+        >>> from gripkit.lti import TransferFunction
+        >>> TransferFunction([1.0], [1.0, 1.0]).parallel(TransferFunction([3.0], [1.0, 3.0])).dc_gain().tolist()
+        [[2.0]]
+        """
         return parallel(self, other)
 
     def feedback(self, other=1.0, sign: float = -1.0):
-        """Closed loop ``G / (I − sign·K G)``. See :func:`feedback`."""
+        """Closed loop ``(I − sign·G K)⁻¹ G``. See :func:`feedback`.
+
+        Examples
+        --------
+        >>> from gripkit.lti import TransferFunction
+        >>> TransferFunction([3.0], [1.0, 1.0]).feedback().dc_gain().tolist()
+        [[0.75]]
+        """
         return feedback(self, other, sign)
 
     def __mul__(self, other):
@@ -321,6 +451,9 @@ class LinearSystem:
         return self._scaled(other)
 
     def __add__(self, other):
+        return parallel(self, other)
+
+    def __radd__(self, other):
         return parallel(self, other)
 
     def __neg__(self):
@@ -339,6 +472,63 @@ class LinearSystem:
         return self._map_self(lambda *arrs: self._scale_arrays(arrs, k))
 
     # ------------------------------------------------------------------ uncertainty
+    # ------------------------------------------------------------------ files
+    def to_dict(self) -> dict:
+        """A JSON-ready description: ``type`` (``'StateSpace'``/``'TransferFunction'``), the
+        arrays as nested lists (stored form), ``dt``, names, units, ``meta`` and ``uncertainty``
+        (``names``, ``covariance``, ``tangents``) or None. :meth:`from_dict` reads it back
+        exactly (floats survive JSON's shortest repr).
+
+        Examples
+        --------
+        >>> import json
+        >>> from gripkit.lti import LinearSystem, TransferFunction
+        >>> g = TransferFunction([1.0], [1.0, 0.5], dt=0.1, inputs="V")
+        >>> back = LinearSystem.from_dict(json.loads(json.dumps(g.to_dict())))
+        >>> back.inputs, back.denominator().tolist()
+        (('V',), [1.0, 0.5])
+        """
+        keys = ("A", "B", "C", "D") if isinstance(self, StateSpace) else ("num", "den")
+        d = {"type": type(self).__name__}
+        d.update({k: a.tolist() for k, a in zip(keys, self._arrays())})
+        d.update(dt=self.dt, inputs=list(self.inputs), outputs=list(self.outputs),
+                 input_units=list(self.input_units), output_units=list(self.output_units), meta=dict(self.meta))
+        if isinstance(self, StateSpace):
+            d.update(states=list(self.states), state_units=list(self.state_units))
+        u = self.uncertainty
+        d["uncertainty"] = None if u is None else {"names": list(u.names), "covariance": u.covariance.tolist(),
+                                                   "tangents": [t.tolist() for t in u.tangents]}
+        return d
+
+    @staticmethod
+    def from_dict(d: dict) -> LinearSystem:
+        """The system :meth:`to_dict` described (validated as any new system).
+
+        Examples
+        --------
+        >>> from gripkit.lti import LinearSystem
+        >>> LinearSystem.from_dict({"type": "StateSpace", "A": [[-1.0]], "B": [[1.0]], "C": [[2.0]]}).dc_gain().tolist()
+        [[2.0]]
+        """
+        if not isinstance(d, dict) or d.get("type") not in ("StateSpace", "TransferFunction"):
+            found = d.get("type") if isinstance(d, dict) else type(d).__name__
+            raise ModelError(f"from_dict: expected a dict with type 'StateSpace' or 'TransferFunction', found {found!r}")
+        kw = {k: d[k] for k in ("dt", "inputs", "outputs", "input_units", "output_units", "meta") if d.get(k) is not None}
+        u = d.get("uncertainty")
+        if u is not None:
+            try:
+                kw["uncertainty"] = Uncertainty(tuple(u["names"]), u["covariance"],
+                                                tuple(np.asarray(t, dtype=np.float64) for t in u["tangents"]))
+            except (KeyError, TypeError) as e:
+                raise ModelError(f"from_dict: uncertainty needs names, covariance and tangents ({e})") from None
+        try:
+            if d["type"] == "StateSpace":
+                kw.update({k: d[k] for k in ("states", "state_units") if d.get(k) is not None})
+                return StateSpace(np.asarray(d["A"], dtype=np.float64), d["B"], d["C"], d.get("D"), **kw)
+            return TransferFunction(np.asarray(d["num"], dtype=np.float64), np.asarray(d["den"], dtype=np.float64), **kw)
+        except KeyError as e:
+            raise ModelError(f"from_dict: the {d['type']} description lacks {e}") from None
+
     def sample(self, n: int, seed=None) -> list:
         """``n`` systems drawn from the linearised parameter distribution, θ ~ N(θ̂, Σ):
         each array becomes ``X + Σ_i δθ_i ∂X/∂θ_i`` (for Monte Carlo studies).
@@ -444,11 +634,10 @@ class StateSpace(LinearSystem):
         n = A.shape[0]
         if A.shape != (n, n):
             raise ModelError(f"A: expected a square matrix, found shape {A.shape}")
-        B = np.asarray(self.B, dtype=np.float64) if np.ndim(self.B) == 1 else self.B
-        B = as_matrix(np.reshape(B, (-1, 1)) if np.ndim(B) == 1 else B, "B")
+        B = as_matrix(_vector_as(self.B, (-1, 1)), "B")
         if B.shape[0] != n:
             raise ModelError(f"B: expected shape ({n}, m) (one row per state), found {B.shape}")
-        C = as_matrix(np.reshape(self.C, (1, -1)) if np.ndim(self.C) == 1 else self.C, "C")
+        C = as_matrix(_vector_as(self.C, (1, -1)), "C")
         if C.shape[1] != n:
             raise ModelError(f"C: expected shape (p, {n}) (one column per state), found {C.shape}")
         p, m = C.shape[0], B.shape[1]
@@ -467,7 +656,7 @@ class StateSpace(LinearSystem):
         if self.uncertainty is not None:
             if not isinstance(self.uncertainty, Uncertainty):
                 raise ModelError(f"uncertainty: expected an Uncertainty, found {type(self.uncertainty).__name__}")
-            self.uncertainty.check_shapes(self._arrays())
+            self.uncertainty._check_shapes(self._arrays())
 
     # ------------------------------------------------------------------ plumbing
     def _arrays(self):
@@ -507,7 +696,8 @@ class StateSpace(LinearSystem):
         """
         arrays = dict(zip("ABCD", self._arrays()))
         if parameters is None:
-            parameters = [f"{k}[{i},{j}]" for k, a in arrays.items() for i in range(a.shape[0]) for j in range(a.shape[1])]
+            parameters = [f"{k}[{i},{j}]" for k, a in arrays.items()
+                          for i in range(a.shape[0]) for j in range(a.shape[1])]
         parameters = list(parameters)
         tangents = [np.zeros((len(parameters),) + a.shape) for a in arrays.values()]
         for q, name in enumerate(parameters):
@@ -771,7 +961,7 @@ class TransferFunction(LinearSystem):
         if stored:
             if not isinstance(self.uncertainty, Uncertainty):
                 raise ModelError(f"uncertainty: expected an Uncertainty, found {type(self.uncertainty).__name__}")
-            self.uncertainty.check_shapes(self._arrays())
+            self.uncertainty._check_shapes(self._arrays())
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -963,6 +1153,45 @@ class TransferFunction(LinearSystem):
         return d[:np.flatnonzero(d)[-1] + 1].copy()
 
     # ------------------------------------------------------------------ analysis
+    def pole_covariance(self) -> tuple[np.ndarray, np.ndarray]:
+        """Poles and the covariance of (Re p, Im p) of each, shape (n, 2, 2), to first order.
+
+        SISO: root sensitivity of the monic denominator D, ``∂r/∂θ_i = −(∂D/∂θ_i)(r) / D'(r)``;
+        roots at z = 0 that no parameter moves (a delay's trailing zeros of D) have σ = 0.
+        MIMO: as :meth:`LinearSystem.pole_covariance`, on the realisation.
+
+        Examples
+        --------
+        >>> from gripkit.lti import TransferFunction
+        >>> g = TransferFunction.from_polynomials([1, -0.5], [0, 0, 0, 1.0], dt=1.0, covariance=[[1e-4, 0], [0, 0]])
+        >>> p, cov = g.pole_covariance()
+        >>> p.real.tolist(), cov[:, 0, 0].round(12).tolist()
+        ([0.5, 0.0, 0.0], [0.0001, 0.0, 0.0])
+        """
+        if not self.is_siso:
+            return super().pole_covariance()
+        if self.uncertainty is None:
+            raise ModelError("pole_covariance: the system carries no covariance",
+                             hint="build it with with_covariance(...) or from an identified model")
+        den = self.denominator()
+        d = den.size - 1
+        dden = self.uncertainty.tangents[1][:, 0, 0, self.den.shape[2] - 1 - d:]
+        t = 0
+        while t < d and den[d - t] == 0.0 and not np.any(dden[:, d - t]):
+            t += 1
+        core, dcore = den[:d + 1 - t], dden[:, :d + 1 - t]
+        r = np.roots(core).astype(complex) if core.size > 1 else np.zeros(0, dtype=complex)
+        slope = np.polyval(np.polyder(core), r) if r.size else r
+        J = -np.array([np.polyval(row, r) for row in dcore]).reshape(-1, r.size) / slope
+        cov = complex_covariance(J, self.uncertainty.covariance)
+        # a repeated root has D'(r) ≈ 0 (within the rounding of D' at r): its first-order σ is undefined
+        bad = np.abs(slope) <= 100 * core.size * _EPS * np.polyval(np.abs(np.polyder(core)), np.abs(r))
+        if np.any(bad):
+            warnings.warn(f"pole_covariance: {int(bad.sum())} pole(s) are (nearly) repeated; their "
+                          "first-order σ is undefined and set to inf", AccuracyWarning, stacklevel=2)
+            cov[bad] = np.inf
+        return np.r_[r, np.zeros(t, dtype=complex)], np.concatenate([cov, np.zeros((t, 2, 2))])
+
     def poles(self) -> np.ndarray:
         """SISO: the roots of the denominator. MIMO: the eigenvalues of a minimal realisation.
 
@@ -1007,7 +1236,15 @@ class TransferFunction(LinearSystem):
         >>> TransferFunction([1.0], [1.0, 1.0]).frequency_response([1.0])[0, 0, 0]
         np.complex128(0.5-0.5j)
         """
-        nu, de, _ = self._eval(self._s(w))
+        s = self._s(w)
+        nu, de, powers = self._eval(s)
+        # |den(s)| below its rounding error L ε Σ|a_k s^k| is a pole on the evaluation contour
+        bad = np.abs(de) <= self.num.shape[2] * _EPS * np.einsum("fl,pml->fpm", np.abs(powers), np.abs(self.den))
+        if np.any(bad):
+            f = np.argwhere(bad)[0, 0]
+            var = "z" if self.is_discrete else "s"
+            raise ModelError(f"frequency response: {var} = {s[f]:.6g} is a pole of the system",
+                             hint="evaluate away from the poles on the imaginary axis (or the unit circle)")
         return nu / de
 
     def _frequency_jacobian(self, s):
@@ -1093,10 +1330,14 @@ class TransferFunction(LinearSystem):
         """
         return self
 
-    def to_ss(self, minimal: bool = True) -> StateSpace:
-        """A state-space realisation: each entry in observable canonical form (the state of
-        ``lfilter``), in parallel; with ``minimal`` (and no covariance) reduced to a minimal
-        realisation. A SISO entry with coprime num/den is minimal already.
+    def to_ss(self, minimal: bool = True, form: str = "observable") -> StateSpace:
+        """A state-space realisation: each entry in canonical form, in parallel.
+
+        ``form='observable'``: ``A = [[-a1, 1, 0, …], [-a2, 0, 1, …], …]``, ``C = e₁ᵀ``: the state
+        of ``lfilter`` (:meth:`initial_state`). ``form='controllable'``: its transpose, exactly
+        ``scipy.signal.tf2ss``'s realisation. With ``minimal`` (and no covariance) states are
+        removed when some cancel (the canonical form is then lost); a SISO entry with coprime
+        num/den is minimal already and keeps its form.
 
         Examples
         --------
@@ -1104,10 +1345,16 @@ class TransferFunction(LinearSystem):
         >>> s = TransferFunction([1.0, 2.0], [1.0, 3.0, 2.0]).to_ss()   # (s+2)/((s+1)(s+2))
         >>> s.n_states, s.poles().real.round(9).tolist()
         (1, [-1.0])
+        >>> TransferFunction([1.0], [1.0, 3.0, 2.0]).to_ss(form="controllable").A.tolist()
+        [[-3.0, -2.0], [1.0, 0.0]]
         """
-        arrs, unc = push(_realize.tf2ss, [self._arrays()], [self.uncertainty])
+        if form not in _realize.FORMS:
+            raise ModelError(f"form: expected one of {', '.join(_realize.FORMS)}, found {form!r}")
+        arrs, unc = push(lambda n, d: _realize.tf2ss(n, d, form), [self._arrays()], [self.uncertainty])
         if minimal and self.uncertainty is None:
-            arrs = _realize.minreal(*arrs)
+            reduced = _realize.minreal(*arrs)
+            if reduced[0].shape[0] < arrs[0].shape[0]:
+                arrs = reduced
         return StateSpace(*arrs, **self._signals(), uncertainty=unc)
 
     def to_control(self):

@@ -93,7 +93,7 @@ class Uncertainty:
         """One-sigma of each parameter, √diag Σ."""
         return np.sqrt(np.clip(np.diag(self.covariance), 0.0, None))
 
-    def check_shapes(self, arrays) -> None:
+    def _check_shapes(self, arrays) -> None:
         if len(arrays) != len(self.tangents):
             raise ModelError(f"uncertainty: expected {len(arrays)} tangent arrays, found {len(self.tangents)}")
         for a, t in zip(arrays, self.tangents):
@@ -101,7 +101,16 @@ class Uncertainty:
                 raise ModelError(f"uncertainty: tangent shape {t.shape[1:]} does not match its array {a.shape}")
 
     def draws(self, n: int, rng) -> np.ndarray:
-        """``n`` parameter deviations δθ ~ N(0, Σ), shape (n, k) (Σ may be singular)."""
+        """``n`` parameter deviations δθ ~ N(0, Σ), shape (n, k) (Σ may be singular).
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> u = Uncertainty(("a", "b"), np.diag([1.0, 0.0]), (np.zeros((2, 1)),))
+        >>> d = u.draws(1000, np.random.default_rng(0))
+        >>> d.shape, float(np.abs(d[:, 1]).max())
+        ((1000, 2), 0.0)
+        """
         w, V = np.linalg.eigh(self.covariance)
         L = V * np.sqrt(np.clip(w, 0.0, None))
         return rng.standard_normal((int(n), self.n_params)) @ L.T
