@@ -148,7 +148,7 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     if rng is None:
         n = select_order(fac.s, min(n_hi, fac.s.size - 1))
         model = build(n)
-        model.info["order_selection"] = "largest singular-value gap"
+        model.info["order_selection"] = "singular values above the noise floor"
     elif rng[0] == rng[1]:
         model = build(rng[0])
         model.info["order_selection"] = "given"

@@ -6,9 +6,9 @@ A file holds (schema ``gripkit.linear-model``, version 1)::
      "structure": "pem-innovation", "kind": "ss" | "tf", "dt": 0.01 | null,
      "inputs":  [{"name": "current", "unit": "A", "offset": 0.85}, ...],
      "outputs": [{"name": "force", "unit": "N", "offset": 0.0}, ...],
-     "ss": {"A": …, "B": …, "C": …, "D": …, "K": … | null, "x0": … | null, "noise_covariance": …},
-     "tf": {"num": (p, m, L) lists, "den": (p, m, L) lists},
-     "covariance": {"names": […], "matrix": (k, k), "tangents": [(k, …) per array]} | null,
+     "system": {…},       the lti system's own description (LinearSystem.to_dict: arrays,
+                          names, units, dt, covariance with its tangents)
+     "innovation": {"K": … | null, "x0": … | null, "noise_covariance": … | null},
      "fit_percent": […], "singular_values": […] | null, "n_samples": N, "info": {…},
      "data": {"file": "run1.csv", "sha256": "…"} | null,
      "content_sha256": "…"}
@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import AccuracyWarning, DataError, ModelError
-from ..lti import StateSpace, TransferFunction, Uncertainty
+from ..lti import LinearSystem, StateSpace
 
 __all__ = ["save_model", "load_model", "file_sha256", "SCHEMA", "SCHEMA_VERSION"]
 
@@ -77,16 +77,10 @@ def model_document(model) -> dict:
            "inputs": [{"name": n, "unit": u, "offset": o} for n, u, o in zip(s.inputs, s.input_units, model.u_offset)],
            "outputs": [{"name": n, "unit": u, "offset": o}
                        for n, u, o in zip(s.outputs, s.output_units, model.y_offset)]}
-    if isinstance(s, StateSpace):
-        doc["ss"] = {"A": s.A, "B": s.B, "C": s.C, "D": s.D, "K": model.K, "x0": model.x0,
-                     "noise_covariance": model.noise_covariance, "states": list(s.states)}
-    else:
-        doc["tf"] = {"num": s.num, "den": s.den}
-    unc = s.uncertainty
-    doc["covariance"] = None if unc is None else {"names": list(unc.names), "matrix": unc.covariance,
-                                                  "tangents": [t for t in unc.tangents]}
+    doc["system"] = s.to_dict()
+    doc["innovation"] = {"K": model.K, "x0": model.x0, "noise_covariance": model.noise_covariance}
     doc.update(fit_percent=model.fit_percent, singular_values=model.singular_values, n_samples=model.n_samples,
-               info=model.info, meta=s.meta,
+               info=model.info,
                data=None if model.data_file is None else {"file": model.data_file, "sha256": model.data_hash})
     doc = _plain(doc)
     doc["content_sha256"] = _content_hash(doc)
@@ -154,36 +148,11 @@ def load_model(path):
                       f"using it as it is", AccuracyWarning, stacklevel=2)
     try:
         ins, outs = doc["inputs"], doc["outputs"]
-        sig = dict(dt=doc["dt"], inputs=[d["name"] for d in ins], outputs=[d["name"] for d in outs],
-                   input_units=[d["unit"] for d in ins], output_units=[d["unit"] for d in outs],
-                   meta=doc.get("meta") or {})
-        cov = doc.get("covariance")
-        unc = None
-        if cov is not None:
-            unc = Uncertainty(tuple(cov["names"]), _arr(cov["matrix"], "covariance.matrix", where),
-                              tuple(_arr(t, "covariance.tangents", where) for t in cov["tangents"]))
-        if doc["kind"] == "ss":
-            s = doc["ss"]
-            n = len(s["A"])
-            k = len(cov["names"]) if cov is not None else 0
-            def mat(x, shape):  # noqa: E306 - an empty matrix loses its shape in JSON
-                a = _arr(x, "ss", where)
-                return a.reshape(shape) if a.size == 0 else a
-            m_, p_ = len(ins), len(outs)
-            if unc is not None and n == 0:
-                unc = Uncertainty(unc.names, unc.covariance, (np.zeros((k, 0, 0)), np.zeros((k, 0, m_)),
-                                                              np.zeros((k, p_, 0)), unc.tangents[3]))
-            system = StateSpace(mat(s["A"], (n, n)), mat(s["B"], (n, m_)), mat(s["C"], (p_, n)),
-                                _arr(s["D"], "ss.D", where), states=s.get("states"), uncertainty=unc, **sig)
-            K = None if s.get("K") is None else _arr(s["K"], "ss.K", where)
-            x0 = None if s.get("x0") is None else _arr(s["x0"], "ss.x0", where)
-            lam = None if s.get("noise_covariance") is None else _arr(s["noise_covariance"], "noise", where)
-        elif doc["kind"] == "tf":
-            system = TransferFunction(_arr(doc["tf"]["num"], "tf.num", where), _arr(doc["tf"]["den"], "tf.den", where),
-                                      uncertainty=unc, **sig)
-            K = x0 = lam = None
-        else:
-            raise ModelError(f"model file {where}: expected kind 'ss' or 'tf', found {doc['kind']!r}")
+        system = LinearSystem.from_dict(doc["system"])
+        if list(system.inputs) != [d["name"] for d in ins] or list(system.outputs) != [d["name"] for d in outs]:
+            raise ModelError(f"model file {where}: the inputs/outputs lists disagree with the system's names")
+        inn = doc.get("innovation") or {}
+        K, x0, lam = (None if inn.get(k) is None else _arr(inn[k], k, where) for k in ("K", "x0", "noise_covariance"))
         data = doc.get("data") or {}
         sv = doc.get("singular_values")
         return LinearModel(system, doc["structure"], K=K, x0=x0, noise_covariance=lam,

@@ -16,7 +16,8 @@ is that of the extended observability matrix Γ_k = [C; CA; …; CA^{k−1}]. Th
 * MOESP: W1 = I, W2 = Π_{U_f⊥}       → SVD of ``L32``;
 * CVA:   W1 = (Y_f Π_{U_f⊥} Y_fᵀ)^{−½} → SVD of ``W1 L32``, W1 = (L32 L32ᵀ + L33 L33ᵀ)^{−½}.
 
-The order n is where the singular values drop most (largest gap in log s_i), unless given.
+The order n is the number of singular values that stand above the noise floor (five times the
+median of those beyond the largest order considered; :func:`select_order`), unless given.
 Then Γ = W1⁻¹ U_n S_n^{½}, ``C = Γ[0:p]`` and ``A = Γ_↑⁺ Γ_↓`` (shift invariance). When that A is
 unstable, ``A = Γ⁺ [Γ_↓; 0]`` is used instead, which is stable by construction (Chui &
 Maciejowski, 1996) and the reason is recorded. B, D and x0 follow by linear least squares on the
@@ -145,11 +146,18 @@ def subspace_factor(u, y, *, horizon: int, method: str) -> SubspaceFactor:
     return SubspaceFactor(u, y, horizon, method)
 
 
+NOISE_FACTOR = 5.0
+
+
 def select_order(s: np.ndarray, n_max: int) -> int:
-    """The order at the largest drop of log10 singular values among 1 … n_max."""
-    ls = np.log10(np.maximum(s, 1e-300))
-    gaps = ls[:n_max] - ls[1:n_max + 1]
-    return int(np.argmax(gaps)) + 1
+    """The number of singular values among the first ``n_max`` that stand above the noise floor:
+    ``n = max{i ≤ n_max : s_i > 5 s_noise}``, s_noise the median of the singular values beyond
+    n_max (the horizon gives k·p ≥ 2(n_max + 1) of them, so at least half are noise). Noise-free
+    data (a floor below 1e-10 s_1) take the same rule with the floor at 1e-10 s_1."""
+    tail = s[n_max:] if s.size > n_max else s[-1:]
+    floor = max(float(np.median(tail)), 1e-10 * float(s[0]))
+    above = np.flatnonzero(s[:n_max] > NOISE_FACTOR * floor)
+    return int(above[-1]) + 1 if above.size else 1
 
 
 def _check_supported(fac: SubspaceFactor, n: int) -> None:
@@ -274,8 +282,8 @@ def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int
         Inputs (N, m) and outputs (N, p) (1-D: one channel), deviation units (operating point
         removed), uniformly sampled.
     order
-        Number of states n; None: chosen at the largest drop of the singular values
-        (1 … ``max_order``).
+        Number of states n; None: the number of singular values above the noise floor
+        (1 … ``max_order``, :func:`select_order`).
     method
         ``'n4sid'``, ``'moesp'`` or ``'cva'`` (weightings, see the module docstring).
     horizon
@@ -323,7 +331,7 @@ def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int
     n = order if order is not None else select_order(fac.s, min(n_max, fac.s.size - 1))
     signals = dict(inputs=inputs, outputs=outputs, input_units=input_units, output_units=output_units)
     model = from_factor(fac, n, dt=step, feedthrough=feedthrough, stable=stable, signals=signals)
-    model.info["order_selection"] = "given" if order is not None else "largest singular-value gap"
+    model.info["order_selection"] = "given" if order is not None else "singular values above the noise floor"
     return model.replace(u_offset=u_offset, y_offset=y_offset)
 
 
