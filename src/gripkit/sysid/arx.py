@@ -42,6 +42,9 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None, fs: flo
         Model metadata: ``input_name``, ``output_name``, ``input_unit``, ``output_unit``,
         ``u_offset``, ``y_offset``.
 
+    With several input or output columns (``u`` (N, m), ``y`` (N, p)) the model is a MIMO ARX
+    of matrix polynomials: see :func:`gripkit.sysid.arx_mimo.arx_mimo`.
+
     Returns
     -------
     PolynomialModel
@@ -56,6 +59,10 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None, fs: flo
         Constant input (it cannot identify B), constant output, or a regressor whose
         column-scaled condition number exceeds 1e10 (the message names the parameters involved).
     """
+    if any(np.ndim(x) == 2 and np.shape(x)[1] > 1 for x in (u, y)):  # several inputs or outputs
+        from .arx_mimo import arx_mimo
+
+        return arx_mimo(u, y, na, nb, nk, dt=dt, fs=fs, **meta)
     u, y, step, na, nb, nk = checked_problem(u, y, dt, fs, na=na, nb=nb, nk=nk)
     p = na + nb
     t0 = arx_start(na, nb, nk)
