@@ -178,23 +178,30 @@ def identify_search(data: Path = DataArg, input: str = InputOpt, output: str = O
                     criterion: str = typer.Option("aic", "--criterion", help="Ranking: aic, fpe or loss."),
                     top: int = typer.Option(10, "--top", help="Rows shown in the table (JSON lists all)."),
                     fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
-                    json_out: bool = JsonOpt):
-    """Fit every ARX structure of the ranges and rank them (best first)."""
+                    validate: Path = ValidateOpt, json_out: bool = JsonOpt):
+    """Fit every ARX structure of the ranges and rank them (best first; by free-run fit on --validate)."""
     from ..sysid import structure_search
 
-    io = _io(data, input, output, fs, time, fill, detrend, "ARX structure search")
-    res = structure_search(io.u, io.y, na, nb, nk, criterion=criterion, dt=io.dt)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        io = _io(data, input, output, fs, time, fill, detrend, "ARX structure search")
+        vio = None if validate is None else _io(validate, input, output, fs, time, fill, detrend, "validation")
+        res = structure_search(io.u, io.y, na, nb, nk, criterion=criterion, dt=io.dt,
+                               validate=None if vio is None else (vio.u, vio.y))
+    report_warnings(caught)
+    criterion = res.criterion
     if json_out:
         emit_json(res.to_list())
         return
     from rich.console import Console
     from rich.table import Table
 
-    t = Table("rank", "na", "nb", "nk", "loss V_N", "AIC", "FPE", "fit %",
+    t = Table("rank", "na", "nb", "nk", "loss V_N", "AIC", "FPE", "1-step fit %", "validation fit %",
               title=f"ARX structures ranked by {criterion.upper()} ({res.n_used} common samples)")
     for i, c in enumerate(res.candidates[:top], 1):
+        v = c.validation_fit_percent
         t.add_row(str(i), str(c.na), str(c.nb), str(c.nk), f"{c.loss:.5g}", f"{c.aic:.6g}", f"{c.fpe:.5g}",
-                  f"{c.fit_percent:.2f}")
+                  f"{c.fit_percent:.2f}", "—" if v is None else f"{v:.2f}")
     Console().print(t)
     if res.skipped:
         typer.echo(f"{len(res.skipped)} structure(s) skipped (not identifiable from these data)", err=True)
