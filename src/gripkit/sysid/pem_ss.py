@@ -32,10 +32,12 @@ import numpy as np
 from ..errors import DataError, IdentificationError
 from ..lti import StateSpace, Uncertainty
 from .linear_model import LinearModel, as_io_matrix, fit_per_output, free_run
+from .subspace import _gram
 
 __all__ = ["pem", "PEM_FORMS"]
 
 PEM_FORMS = ("oe", "innovation")
+_WARM_START_SAMPLES = 20000
 
 
 @numba.njit(cache=True)
@@ -163,8 +165,54 @@ def _radius(A):
     return float(np.max(np.abs(np.linalg.eigvals(A)))) if A.shape[0] else 0.0
 
 
+def _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough, innovation, max_iterations, tol):
+    """Levenberg-Marquardt on the whitened prediction errors, re-centring the local coordinates
+    after every accepted step and rejecting steps that leave the stable set."""
+    N, p = yw.shape
+    n = A.shape[0]
+    e = np.empty((N, p))
+    _predict(A, B, C, D, K, x0, u, yw, e)
+    Vc = float(np.sum(e * e))
+    lam, it, converged = 1e-3, 0, False
+    for it in range(1, max_iterations + 1):
+        dA, dB, dC, dD, dK = _directions(A, B, C, D, K, feedthrough, innovation)
+        d = dA.shape[0]
+        J = np.empty((N * p, d + n))
+        _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, yw, e, J)
+        H = _gram(J)
+        g = J.T @ e.reshape(-1)
+        hd = np.maximum(np.diag(H), 1e-300)
+        improved, rel = False, 0.0
+        for _ in range(30):
+            try:
+                delta = np.linalg.solve(H + lam * np.diag(hd), g)
+            except np.linalg.LinAlgError:
+                lam *= 10
+                continue
+            th = delta[:d]
+            An, Cn, Kn = A + np.tensordot(th, dA, 1), C + np.tensordot(th, dC, 1), K + np.tensordot(th, dK, 1)
+            if _radius(An) >= 1.0 or (innovation and _radius(An - Kn @ Cn) >= 1.0):
+                lam *= 10
+                continue
+            Bn, Dn, x0n = B + np.tensordot(th, dB, 1), D + np.tensordot(th, dD, 1), x0 + delta[d:]
+            en = np.empty((N, p))
+            _predict(An, Bn, Cn, Dn, Kn, x0n, u, yw, en)
+            Vn = float(np.sum(en * en))
+            if np.isfinite(Vn) and Vn < Vc:
+                improved, rel = True, (Vc - Vn) / max(Vc, 1e-300)
+                A, B, C, D, K, x0, Vc = An, Bn, Cn, Dn, Kn, x0n, Vn
+                lam = max(lam / 5, 1e-12)
+                break
+            lam *= 10
+        if not improved or rel < tol:
+            converged = True
+            break
+    at_final = (J, (dA, dB, dC, dD, dK), e) if not improved else None   # J at the returned point
+    return A, B, C, D, K, x0, Vc, it, converged, at_final
+
+
 def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovation", feedthrough: bool | None = None,
-        max_iterations: int = 50, tol: float = 1e-9) -> LinearModel:
+        max_iterations: int = 50, tol: float = 1e-7) -> LinearModel:
     """Refine a discrete state-space model by prediction-error minimisation.
 
     Parameters
@@ -179,7 +227,9 @@ def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovatio
     feedthrough
         Estimate D (default: when the starting model has a non-zero D).
     max_iterations, tol
-        Levenberg-Marquardt iterations and the relative decrease of V that stops them.
+        Levenberg-Marquardt iterations and the relative decrease of V that stops them. Records
+        longer than 20 000 samples are first fitted on their first 20 000 samples, then polished
+        on the whole record (the same optimum, a fraction of the full-length Jacobians).
 
     Returns
     -------
@@ -223,53 +273,30 @@ def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovatio
     yw = np.ascontiguousarray(y @ W.T)
     C, D, K = W @ C, W @ D, K @ Winv
     _predict(A, B, C, D, K, x0, u, yw, e)
-    V0 = Vc = float(np.sum(e * e))
-    lam, it, converged = 1e-3, 0, False
-    for it in range(1, max_iterations + 1):
-        dA, dB, dC, dD, dK = _directions(A, B, C, D, K, feedthrough, innovation)
-        d = dA.shape[0]
-        J = np.empty((N * p, d + n))
-        _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, yw, e, J)
-        H = J.T @ J
-        g = J.T @ e.reshape(-1)
-        hd = np.maximum(np.diag(H), 1e-300)
-        improved, rel = False, 0.0
-        for _ in range(30):
-            try:
-                delta = np.linalg.solve(H + lam * np.diag(hd), g)
-            except np.linalg.LinAlgError:
-                lam *= 10
-                continue
-            th = delta[:d]
-            An, Cn, Kn = A + np.tensordot(th, dA, 1), C + np.tensordot(th, dC, 1), K + np.tensordot(th, dK, 1)
-            if _radius(An) >= 1.0 or (innovation and _radius(An - Kn @ Cn) >= 1.0):
-                lam *= 10
-                continue
-            Bn, Dn, x0n = B + np.tensordot(th, dB, 1), D + np.tensordot(th, dD, 1), x0 + delta[d:]
-            en = np.empty((N, p))
-            _predict(An, Bn, Cn, Dn, Kn, x0n, u, yw, en)
-            Vn = float(np.sum(en * en))
-            if np.isfinite(Vn) and Vn < Vc:
-                improved, rel = True, (Vc - Vn) / max(Vc, 1e-300)
-                A, B, C, D, K, x0, Vc = An, Bn, Cn, Dn, Kn, x0n, Vn
-                lam = max(lam / 5, 1e-12)
-                break
-            lam *= 10
-        if not improved or rel < tol:
-            converged = True
-            break
+    V0 = float(np.sum(e * e))
+    it = 0
+    if N > _WARM_START_SAMPLES:  # converge on the first samples, then polish on all of them
+        A, B, C, D, K, x0, _, it, _, _ = _levenberg_marquardt(A, B, C, D, K, x0, u[:_WARM_START_SAMPLES],
+                                                           yw[:_WARM_START_SAMPLES], feedthrough, innovation,
+                                                           max_iterations, tol)
+    A, B, C, D, K, x0, Vc, it2, converged, at_final = _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough,
+                                                                           innovation, max_iterations, tol)
+    it += it2
     # covariance at the final point
-    dA, dB, dC, dD, dK = _directions(A, B, C, D, K, feedthrough, innovation)
+    if at_final is not None:
+        J, (dA, dB, dC, dD, dK), e = at_final
+    else:
+        dA, dB, dC, dD, dK = _directions(A, B, C, D, K, feedthrough, innovation)
+        J = np.empty((N * p, dA.shape[0] + n))
+        _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, yw, e, J)
     d = dA.shape[0]
-    J = np.empty((N * p, d + n))
-    _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, yw, e, J)
     dof = N * p - d - n
     if dof <= 0:
         raise DataError(f"pem: {N} samples of {p} output(s) cannot determine {d + n} parameters",
                         hint="use a longer record or a lower order")
     s2 = float(np.sum(e * e)) / dof
     try:
-        cov_full = s2 * np.linalg.inv(J.T @ J)
+        cov_full = s2 * np.linalg.inv(_gram(J))
     except np.linalg.LinAlgError:
         raise IdentificationError("pem: the Jacobian is singular at the optimum: the data do not determine the "
                                   "model (a non-minimal order or a poorly exciting input)",

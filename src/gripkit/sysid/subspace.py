@@ -56,12 +56,21 @@ def default_horizon(n_max: int, p: int) -> int:
     return max(int(math.ceil(2 * (n_max + 1) / p)), 5)
 
 
+def _gram(Z: np.ndarray) -> np.ndarray:
+    """ZᵀZ by BLAS ``dsyrk`` (half the flops of a product, and free of numpy's matmul dispatch)."""
+    from scipy.linalg.blas import dsyrk
+
+    G = dsyrk(1.0, np.asfortranarray(Z), trans=1)
+    return np.triu(G) + np.triu(G, 1).T
+
+
 def _lower_factor(Z: np.ndarray) -> np.ndarray:
-    """L with ``L Lᵀ = ZᵀZ / j`` (the LQ factor of Zᵀ/√j): Cholesky of the Gram matrix (BLAS
-    ``syrk``, a few times faster than Householder QR for j ≫ q), falling back to QR when the Gram
-    matrix is numerically singular (noise-free or rank-deficient data)."""
+    """L with ``L Lᵀ = ZᵀZ / j`` (the LQ factor of Zᵀ/√j): Cholesky of the Gram matrix (a few times
+    faster than Householder QR for j ≫ q), falling back to QR when the Gram matrix is numerically
+    singular (noise-free or rank-deficient data), where squaring the condition number would lose
+    the small singular values that decide the order."""
     j = Z.shape[0]
-    G = Z.T @ Z / j
+    G = _gram(Z) / j
     try:
         L = np.linalg.cholesky(G)
         if np.min(np.abs(np.diag(L))) > 1e-6 * np.sqrt(np.max(np.diag(G))):
@@ -69,6 +78,19 @@ def _lower_factor(Z: np.ndarray) -> np.ndarray:
     except np.linalg.LinAlgError:
         pass
     return _qr_r(np.asfortranarray(Z), overwrite=True).T / math.sqrt(j)
+
+
+def _least_squares(Phi: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """argmin ‖Φθ − r‖: normal equations on column-scaled Φ (dsyrk + Cholesky) when their
+    condition number stays below 1e8, else LAPACK ``gelsy`` on Φ itself."""
+    col = np.sqrt(np.einsum("ij,ij->j", Phi, Phi))
+    col[col == 0] = 1.0
+    G = _gram(Phi) / np.outer(col, col)
+    w = np.linalg.eigvalsh(G)
+    if w[0] > 1e-8 * w[-1]:
+        c = sla.cho_factor(G)
+        return sla.cho_solve(c, (Phi.T @ rhs) / col) / col
+    return sla.lstsq(Phi, rhs, lapack_driver="gelsy", check_finite=False)[0]
 
 
 class SubspaceFactor:
@@ -233,7 +255,7 @@ def from_factor(fac: SubspaceFactor, n: int, *, dt: float, feedthrough: bool = F
     us, ys = fac.us, fac.ys
     N = us.shape[0]
     Phi = _bdx_regressor(A, C, us, feedthrough)
-    theta = sla.lstsq(Phi, ys.reshape(-1), lapack_driver="gelsy", check_finite=False)[0]
+    theta = _least_squares(Phi, ys.reshape(-1))
     Bs = theta[:n * m].reshape(n, m)
     c = n * m
     Ds = np.zeros((p, m))
