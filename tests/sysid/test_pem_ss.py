@@ -26,9 +26,7 @@ def test_sensitivity_jacobian_matches_finite_differences(feedthrough, innovation
     dA, dB, dC, dD, dK = _directions(A, B, C, D, K, feedthrough, innovation)
     d = dA.shape[0]
     assert d == n * m + p * n + (p * m if feedthrough else 0) + (n * p if innovation else 0)
-    e = np.empty((N, p))
-    J = np.empty((N * p, d + n))
-    _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, y, e, J)
+    e, J = _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, y)
     h = 1e-6
     for q in range(d + n):
         th, dx = np.zeros(d), np.zeros(n)

@@ -11,11 +11,12 @@ the data-driven local coordinates of McKelvey, Helmersson & Ribarits (2004) — 
 ``(T A T⁻¹, T B, C T⁻¹, T K)`` at T = I + X is ``(XA − AX, XB, −CX, XK)``; its orthogonal complement
 is a basis of d = nm + pn (+ pm) (+ np) identifiable directions — plus x0.
 
-Jacobians are exact, from the sensitivity equations (a numba kernel), for each direction
-θ_q with matrix tangents (dA, dB, dC, dD, dK)::
+Jacobians are exact, from the sensitivity equations (a numba kernel, parallel over the
+directions), for each direction θ_q with matrix tangents (dA, dB, dC, dD, dK)::
 
     ∂ŷ[t] = C s[t] + dC x[t] + dD u[t],
-    s[t+1] = A s[t] + dA x[t] + dB u[t] + dK e[t] − K ∂ŷ[t],      s[0] = 0 (s[0] = e_i for x0_i).
+    s[t+1] = A s[t] + dA x[t] + dB u[t] + dK e[t] − K ∂ŷ[t]
+           = (A − KC) s[t] + (dA − K dC) x[t] + (dB − K dD) u[t] + dK e[t],   s[0] = 0 (e_i for x0_i).
 
 Levenberg-Marquardt steps re-centre the coordinates after every accepted step and reject any step
 that makes A (or the predictor A − KC) unstable, so stability is kept. The covariance of the
@@ -68,20 +69,14 @@ def _predict(A, B, C, D, K, x0, u, y, e):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, y, e, J):  # pragma: no cover - compiled
-    """Prediction errors e (N, p) and J (N·p, d + n) = ∂ŷ/∂θ (rows t·p + i): d model directions
-    with tangents dA (d, n, n), dB, dC, dD, dK, then the n entries of x0."""
+def _predict_states(A, B, C, D, K, x0, u, y, e, X):  # pragma: no cover - compiled
+    """Prediction errors e (N, p) and predictor states X (N, n) (X[t] = x[t])."""
     n, m, p = A.shape[0], B.shape[1], C.shape[0]
-    d = dA.shape[0]
-    nd = d + n
     x = x0.copy()
     xn = np.empty(n)
-    s = np.zeros((nd, n))
-    sn = np.empty((nd, n))
-    dy = np.empty(p)
-    for i in range(n):
-        s[d + i, i] = 1.0
     for t in range(u.shape[0]):
+        for r in range(n):
+            X[t, r] = x[r]
         for i in range(p):
             acc = 0.0
             for j in range(n):
@@ -89,35 +84,6 @@ def _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, y, e, J):  # 
             for j in range(m):
                 acc += D[i, j] * u[t, j]
             e[t, i] = y[t, i] - acc
-        for q in range(nd):
-            for i in range(p):
-                acc = 0.0
-                for j in range(n):
-                    acc += C[i, j] * s[q, j]
-                if q < d:
-                    for j in range(n):
-                        acc += dC[q, i, j] * x[j]
-                    for j in range(m):
-                        acc += dD[q, i, j] * u[t, j]
-                J[t * p + i, q] = acc
-                dy[i] = acc
-            for r in range(n):
-                acc = 0.0
-                for j in range(n):
-                    acc += A[r, j] * s[q, j]
-                if q < d:
-                    for j in range(n):
-                        acc += dA[q, r, j] * x[j]
-                    for j in range(m):
-                        acc += dB[q, r, j] * u[t, j]
-                    for j in range(p):
-                        acc += dK[q, r, j] * e[t, j]
-                for j in range(p):
-                    acc -= K[r, j] * dy[j]
-                sn[q, r] = acc
-        for q in range(nd):
-            for r in range(n):
-                s[q, r] = sn[q, r]
         for r in range(n):
             acc = 0.0
             for j in range(n):
@@ -129,6 +95,62 @@ def _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, y, e, J):  # 
             xn[r] = acc
         for r in range(n):
             x[r] = xn[r]
+
+
+@numba.njit(cache=True, parallel=True)
+def _sensitivities(Abar, C, F, G, S0, Z, J):  # pragma: no cover - compiled
+    """Column q of J (N·p, nd), rows t·p + i: ∂ŷ_i[t]/∂θ_q from
+
+        s[t+1] = Ā s[t] + F_q z[t],   ∂ŷ[t] = C s[t] + G_q z[t][:n+m],   s[0] = S0[q],
+
+    z[t] = [x[t]; u[t]; e[t]] (Z, shape (N, n + m + p)), Ā = A − KC. Directions run in parallel."""
+    n = Abar.shape[0]
+    p = C.shape[0]
+    nz = Z.shape[1]
+    ng = G.shape[2]
+    for q in numba.prange(F.shape[0]):
+        s = S0[q].copy()
+        sn = np.empty(n)
+        for t in range(Z.shape[0]):
+            for i in range(p):
+                acc = 0.0
+                for j in range(n):
+                    acc += C[i, j] * s[j]
+                for j in range(ng):
+                    acc += G[q, i, j] * Z[t, j]
+                J[t * p + i, q] = acc
+            for r in range(n):
+                acc = 0.0
+                for j in range(n):
+                    acc += Abar[r, j] * s[j]
+                for j in range(nz):
+                    acc += F[q, r, j] * Z[t, j]
+                sn[r] = acc
+            for r in range(n):
+                s[r] = sn[r]
+
+
+def _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, y):
+    """Prediction errors e (N, p) and J (N·p, d + n), Fortran order, = ∂ŷ/∂θ: d model directions
+    with tangents dA (d, n, n), dB, dC, dD, dK, then the n entries of x0 (module docstring)."""
+    N, p = y.shape
+    n, m = A.shape[0], B.shape[1]
+    d = dA.shape[0]
+    e = np.empty((N, p))
+    X = np.empty((N, n))
+    _predict_states(A, B, C, D, K, x0, u, y, e, X)
+    F = np.zeros((d + n, n, n + m + p))
+    F[:d, :, :n] = dA - np.einsum("rj,qjk->qrk", K, dC)
+    F[:d, :, n:n + m] = dB - np.einsum("rj,qjk->qrk", K, dD)
+    F[:d, :, n + m:] = dK
+    G = np.zeros((d + n, p, n + m))
+    G[:d, :, :n] = dC
+    G[:d, :, n:] = dD
+    S0 = np.zeros((d + n, n))
+    S0[d:] = np.eye(n)
+    J = np.empty((N * p, d + n), order="F")
+    _sensitivities(np.ascontiguousarray(A - K @ C), np.ascontiguousarray(C), F, G, S0, np.hstack([X, u, e]), J)
+    return e, J
 
 
 def _directions(A, B, C, D, K, feedthrough: bool, innovation: bool):
@@ -177,8 +199,7 @@ def _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough, innovation, max_
     for it in range(1, max_iterations + 1):
         dA, dB, dC, dD, dK = _directions(A, B, C, D, K, feedthrough, innovation)
         d = dA.shape[0]
-        J = np.empty((N * p, d + n))
-        _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, yw, e, J)
+        e, J = _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, yw)
         H = _gram(J)
         g = J.T @ e.reshape(-1)
         hd = np.maximum(np.diag(H), 1e-300)
@@ -281,14 +302,13 @@ def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovatio
                                                            max_iterations, tol)
     A, B, C, D, K, x0, Vc, it2, converged, at_final = _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough,
                                                                            innovation, max_iterations, tol)
-    it += it2
+    it_warm, it = it, it + it2
     # covariance at the final point
     if at_final is not None:
         J, (dA, dB, dC, dD, dK), e = at_final
     else:
         dA, dB, dC, dD, dK = _directions(A, B, C, D, K, feedthrough, innovation)
-        J = np.empty((N * p, dA.shape[0] + n))
-        _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, yw, e, J)
+        e, J = _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, yw)
     d = dA.shape[0]
     dof = N * p - d - n
     if dof <= 0:
@@ -311,7 +331,7 @@ def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovatio
     sysn = StateSpace(A, B, C, D, **ss._signals(meta={**ss.meta, "refined_by": f"pem-{form}"}), states=ss.states,
                       state_units=ss.state_units, uncertainty=unc)
     ys = free_run(A, B, C, D, u, x0)
-    info = {**model.info, "pem": {"form": form, "iterations": it, "converged": converged, "loss_start": V0 / N,
+    info = {**model.info, "pem": {"form": form, "iterations": it, "iterations_warm_start": it_warm, "converged": converged, "loss_start": V0 / N,
                                   "loss": Vc / N, "parameters": d, "feedthrough": feedthrough}}
     return model.replace(system=sysn, structure=f"pem-{form}", K=K if innovation else None, x0=x0,
                          noise_covariance=Lam, fit_percent=fit_per_output(y, ys), n_samples=N, info=info)
