@@ -47,7 +47,8 @@ def run(capsys, *args):
 def test_identify_ss_json_fields(capsys, files):
     model = files["dir"] / "m.json"
     code, out, err = run(capsys, "identify", "ss", files["est"], "--input", "a,b", "--output", "d,c",
-                         "--validate", files["val"], "--out", model, "--json")
+                         "--validate", files["val"], "--out", model, "--report", files["dir"] / "ssrep", "--json")
+    assert "Subspace singular values" in (files["dir"] / "ssrep" / "index.html").read_text()
     assert code == 0, err
     r = json.loads(out)
     for k in ("A", "B", "C", "D", "K", "dt", "order", "singular_values", "stable", "fit_percent"):
@@ -114,8 +115,10 @@ def test_identify_frf_json(capsys, files):
 
 
 def test_identify_tf_json(capsys, files):
+    rep = files["dir"] / "tfrep"
     code, out, err = run(capsys, "identify", "tf", files["siso"], "--input", "v", "--output", "x", "--poles", "2",
-                         "--zeros", "1", "--json")
+                         "--zeros", "1", "--out", files["dir"] / "tf.json", "--report", rep, "--json")
+    assert "Poles and zeros" in (rep / "index.html").read_text()
     assert code == 0, err
     r = json.loads(out)
     assert len(r["num"]) == 2 and len(r["den"]) == 3 and len(r["num_std"]) == 2 and len(r["den_std"]) == 3
