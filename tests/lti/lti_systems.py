@@ -6,6 +6,17 @@ import numpy as np
 EPS = np.finfo(float).eps
 
 
+def recursion_bound(A, B, C, u, x_max):
+    """Bound on the difference of two evaluations of x⁺ = A x + B u, y = C x + D u that round
+    differently: a rounding at step k (≤ 4 ε (‖A‖ ‖x‖∞ + ‖B‖ ‖u‖∞) per state) reaches y[n]
+    through C A^(n−k), so |Δy| ≤ 4 ε Σ_k ‖C A^k‖ (‖A‖ ‖x‖∞ + ‖B‖ ‖u‖∞) (sums of |entries|)."""
+    Ak, h1 = np.eye(A.shape[0]), 0.0
+    for _ in range(u.shape[0]):
+        h1 += np.abs(C @ Ak).sum()
+        Ak = A @ Ak
+    return 4 * EPS * h1 * (np.abs(A).sum() * x_max + np.abs(B).sum() * np.abs(u).max())
+
+
 def random_ss(rng, n, m, p, *, dt=None, pole_radius=(0.3, 3.0), max_angle=None, cond=3.0):
     """A random stable system with prescribed poles and an eigenvector matrix of condition ≤ ~cond.
 

@@ -9,7 +9,7 @@ import pytest
 import gripkit.lti as lti
 
 MODULES = ["gripkit.lti", "gripkit.lti._system", "gripkit.lti._interop", "gripkit.lti._uncertainty",
-           "gripkit.lti._frequency"]
+           "gripkit.lti._frequency", "gripkit.lti._discretize", "gripkit.lti._kernels"]
 
 
 @pytest.mark.parametrize("name", MODULES)

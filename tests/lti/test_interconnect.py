@@ -18,13 +18,15 @@ def _resp(sys):
     return np.moveaxis(sys(1j * W), -1, 0) if sys.ninputs * sys.noutputs > 1 else sys(1j * W).reshape(-1, 1, 1)
 
 
-def _close(ours, ref_ctrl, kappa=1.0):
-    """Same frequency response; the realisations differ, so the tolerance is the solve's
-    n ε κ(sI − A) bound, taken generously (1e4 n ε κ) since python-control and gripkit build
-    differently conditioned state matrices."""
+def _close(ours, ref_ctrl):
+    """Same frequency response. Each side solves (sI − A) X = B for its own realisation, with
+    error ≲ n ε κ(sI − A) |G|; python-control's realisation is conditioned like ours within a
+    factor of ~10 here, so 1e3 n ε κ_ours bounds the difference."""
     H, R = ours.frequency_response(W), _resp(ref_ctrl)
-    n = max(ours.to_ss(minimal=False).n_states, 1)
-    assert np.abs(H - R).max() <= 1e4 * n * EPS * kappa * max(np.abs(R).max(), 1.0)
+    s = ours.to_ss(minimal=False)
+    n = max(s.n_states, 1)
+    kappa = max([np.linalg.cond(1j * w * np.eye(s.n_states) - s.A) for w in W] if s.n_states else [1.0])
+    assert np.abs(H - R).max() <= 1e3 * n * EPS * kappa * max(np.abs(R).max(), 1.0)
 
 
 def test_siso_tf_series_parallel_feedback_match_python_control():

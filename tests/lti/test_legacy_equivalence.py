@@ -88,3 +88,22 @@ def test_discrete_plant():
     np.testing.assert_allclose(ss_new.to_tf().num_zinv(), back.B, atol=1e-12)
     c_old, c_new = old.to_control(), new.to_control()
     np.testing.assert_allclose(c_new(np.exp(0.3j)), c_old(np.exp(0.3j)), rtol=1e-12)
+
+
+def test_as_system_reads_old_state_space_and_armax_oe_covariances():
+    old = OldStateSpace([[-1.0, 0.0], [1.0, -2.0]], [[1.0], [0.0]], [[0.0, 1.0]], None, 0.1, ("V",), ("x",),
+                        ("V",), ("m",))
+    new = as_system(old)
+    assert isinstance(new, StateSpace) and new.inputs == ("V",) and new.output_units == ("m",) and new.dt == 0.1
+    # ARMAX: the covariance over a1 b1 c1 keeps its order; c1 does not move B/A (zero tangent)
+    armax = PolynomialModel.from_coefficients([1.0, -0.5], [0.0, 1.0], C=[1.0, 0.3], dt=0.1,
+                                              std={"A": [0, 0.01], "B": [0, 0.02], "C": [0, 0.05]})
+    g = as_system(armax)
+    assert g.uncertainty.names == ("a1", "b1", "c1") == armax.parameter_names
+    assert np.all(g.uncertainty.tangents[0][2] == 0) and np.all(g.uncertainty.tangents[1][2] == 0)
+    # OE: B/F with f's as the denominator's parameters
+    oe = PolynomialModel.from_coefficients([1.0], [0.0, 1.0], F=[1.0, -0.7], dt=0.1,
+                                           std={"B": [0, 0.02], "F": [0, 0.01]})
+    h = as_system(oe)
+    assert h.uncertainty.names == ("b1", "f1") and h.den_zinv().tolist() == [1.0, -0.7]
+    np.testing.assert_allclose(h.pole_covariance()[1][0, 0, 0], 0.01 ** 2, rtol=1e-12)  # ∂p/∂f1 = −1

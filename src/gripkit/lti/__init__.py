@@ -15,13 +15,18 @@ frequency response and Bode data, natural frequencies and damping, step/impulse 
 simulation (numba), stability, minimum phase; every one with σ where the system carries a
 covariance.
 Interop: ``to_control()``/:func:`from_control` (python-control, optional), ``to_scipy()``/
-:func:`from_scipy`, :func:`as_system` (coerce older gripkit models).
+:func:`from_scipy`, :func:`as_system` (coerce older gripkit models). Array level, for kernels
+and batch code: :func:`c2d_matrices`, :func:`d2c_matrices` and the numba kernel
+:func:`simulate_ss`.
 """
 
+from ._discretize import c2d_matrices as c2d_matrices
+from ._discretize import d2c_matrices as d2c_matrices
 from ._frequency import Bode as Bode
 from ._interop import as_system as as_system
 from ._interop import from_control as from_control
 from ._interop import from_scipy as from_scipy
+from ._kernels import simulate_ss as simulate_ss
 from ._system import Damping as Damping
 from ._system import LinearSystem as LinearSystem
 from ._system import StateSpace as StateSpace
@@ -34,4 +39,5 @@ from ._system import series as series
 from ._uncertainty import Uncertainty as Uncertainty
 
 __all__ = ["Bode", "Damping", "LinearSystem", "StateSpace", "TransferFunction", "Uncertainty", "as_system",
-           "c2d", "d2c", "feedback", "from_control", "from_scipy", "parallel", "series"]
+           "c2d", "c2d_matrices", "d2c", "d2c_matrices", "feedback", "from_control", "from_scipy", "parallel",
+           "series", "simulate_ss"]

@@ -22,7 +22,7 @@ from scipy import linalg
 
 from ..errors import ModelError
 
-__all__ = ["METHODS", "c2d_arrays", "d2c_arrays", "tustin_step"]
+__all__ = ["METHODS", "c2d_matrices", "d2c_matrices", "tustin_step"]
 
 METHODS = ("zoh", "foh", "tustin")
 
@@ -56,7 +56,19 @@ def _foh_blocks(A, B, dt):
     return E[:n, :n], E[:n, n:n + m], E[:n, n + m:]
 
 
-def c2d_arrays(A, B, C, D, dt: float, method: str, prewarp=None):
+def c2d_matrices(A, B, C, D, dt: float, method: str = "zoh", prewarp=None):
+    """Discrete (Φ, Γ, C_d, D_d) of continuous (A, B, C, D) at ``dt`` (s), by ``method``
+    (``'zoh'``, ``'foh'``, ``'tustin'``; equations in the module docstring). Array level, for
+    kernels and batch code; systems use :meth:`gripkit.lti.LinearSystem.c2d`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> Phi, Gam, _, _ = c2d_matrices(np.array([[-1.0]]), np.array([[1.0]]), np.eye(1), np.zeros((1, 1)), 0.1)
+    >>> round(float(Phi[0, 0]), 6), round(float(Gam[0, 0]), 6)      # e^{-0.1}, 1 − e^{-0.1}
+    (0.904837, 0.095163)
+    """
+    method = check_method(method, prewarp)
     n, m = B.shape
     if method == "zoh":
         M = np.zeros((n + m, n + m))
@@ -101,7 +113,18 @@ def _real_logm(M, what):
     return L
 
 
-def d2c_arrays(Ad, Bd, Cd, Dd, dt: float, method: str, prewarp=None):
+def d2c_matrices(Ad, Bd, Cd, Dd, dt: float, method: str = "zoh", prewarp=None):
+    """Continuous (A, B, C, D) whose ``c2d_matrices(…, dt, method)`` is (Φ, Γ, C_d, D_d).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> A, B, _, _ = d2c_matrices(np.array([[np.exp(-0.1)]]), np.array([[1 - np.exp(-0.1)]]),
+    ...                           np.eye(1), np.zeros((1, 1)), 0.1)
+    >>> round(float(A[0, 0]), 12), round(float(B[0, 0]), 12)
+    (-1.0, 1.0)
+    """
+    method = check_method(method, prewarp)
     n, m = Bd.shape
     if method == "zoh":
         M = np.zeros((n + m, n + m))

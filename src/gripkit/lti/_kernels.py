@@ -12,7 +12,16 @@ def simulate_ss(A, B, C, D, u, x, xn, y):  # pragma: no cover - compiled
     """x[k+1] = A x[k] + B u[k],  y[k] = C x[k] + D u[k],  k = 0 … N−1.
 
     ``u`` (N, m), ``y`` (N, p) written in place; ``x`` (n,) holds x[0] and ends as x[N];
-    ``xn`` (n,) is work space.
+    ``xn`` (n,) is work space. Scalar loops, no allocation: callable from other kernels.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> y, x = np.empty((3, 1)), np.zeros(1)
+    >>> simulate_ss(np.array([[0.5]]), np.array([[1.0]]), np.array([[1.0]]), np.zeros((1, 1)),
+    ...             np.array([[1.0], [0.0], [0.0]]), x, np.empty(1), y)
+    >>> y[:, 0].tolist(), x.tolist()
+    ([0.0, 1.0, 0.5], [0.25])
     """
     n = A.shape[0]
     m = B.shape[1]

@@ -318,12 +318,22 @@ class LinearSystem:
         ss = self.to_ss(minimal=False)
         if self.is_discrete:
             return ss.A, ss.B, ss.C, ss.D
-        return _discretize.c2d_arrays(ss.A, ss.B, ss.C, ss.D, h, "zoh")
+        return _discretize.c2d_matrices(ss.A, ss.B, ss.C, ss.D, h, "zoh")
 
     def step(self, t) -> np.ndarray:
         """Unit-step responses from rest, shape (N, p, m): column j is the response to a step on
-        input j. ``t``: a number of samples (discrete), or uniform times from 0 (s). Continuous
-        systems are sampled with ZOH at the grid's step, which is exact for a step input.
+        input j. Continuous systems are sampled with ZOH at the grid's step, which is exact for a
+        step input: y[k] = Σ_{i<k} C A_d^{k−1−i} B_d + D.
+
+        Parameters
+        ----------
+        t
+            Discrete: a number of samples N, or times spaced by ``dt``. Continuous: uniform times
+            from 0 (s), shape (N,).
+
+        Returns
+        -------
+        ndarray, shape (N, p, m)
 
         Examples
         --------
@@ -343,6 +353,15 @@ class LinearSystem:
         """Impulse responses from rest, shape (N, p, m). Discrete: the response to a unit pulse
         u[0] = 1 (``scipy.signal.dimpulse``). Continuous: ``y(t) = C e^{At} B`` (the D δ(t) term
         is left out, as in ``scipy.signal.impulse``).
+
+        Parameters
+        ----------
+        t
+            As for :meth:`step`.
+
+        Returns
+        -------
+        ndarray, shape (N, p, m)
 
         Examples
         --------
@@ -371,6 +390,20 @@ class LinearSystem:
         piecewise-constant inputs: Φ = e^{A dt}, Γ = ∫₀^dt e^{As} ds B), ``'foh'`` (triangle
         hold), ``'tustin'`` (s = (2/T)(z−1)/(z+1); ``prewarp`` ω_p in rad/s matches G at ω_p).
 
+        Parameters
+        ----------
+        dt
+            Sample time (s), > 0.
+        method
+            ``'zoh'``, ``'foh'`` or ``'tustin'`` (alias ``'bilinear'``).
+        prewarp
+            Tustin only: the frequency ω_p (rad/s, below π/dt) where the response is kept exact.
+
+        Returns
+        -------
+        LinearSystem
+            The same view (StateSpace or TransferFunction), names, units and covariance carried.
+
         Examples
         --------
         >>> from gripkit.lti import TransferFunction
@@ -383,7 +416,7 @@ class LinearSystem:
                              hint="use d2c() first to resample, or keep it as it is")
         dt = require_discrete(dt, "c2d")
         m = _discretize.check_method(method, prewarp)
-        return self._map_ss(lambda A, B, C, D: _discretize.c2d_arrays(A, B, C, D, dt, m, prewarp), dt=dt,
+        return self._map_ss(lambda A, B, C, D: _discretize.c2d_matrices(A, B, C, D, dt, m, prewarp), dt=dt,
                             meta={**self.meta, "c2d": m})
 
     def d2c(self, method: str = "zoh", prewarp: float | None = None):
@@ -392,6 +425,16 @@ class LinearSystem:
         ZOH and FOH need log Φ: a real pole on the closed negative real axis (z ≤ 0: at or
         beyond the Nyquist frequency, or a pure delay) has no continuous preimage and raises
         ModelError; Tustin needs no pole at z = −1.
+
+        Parameters
+        ----------
+        method, prewarp
+            As for :meth:`c2d`.
+
+        Returns
+        -------
+        LinearSystem
+            Continuous, same view, names, units and covariance carried.
 
         Examples
         --------
@@ -405,7 +448,7 @@ class LinearSystem:
             raise ModelError("d2c: the system is already continuous")
         dt = self.dt
         m = _discretize.check_method(method, prewarp)
-        return self._map_ss(lambda A, B, C, D: _discretize.d2c_arrays(A, B, C, D, dt, m, prewarp), dt=None,
+        return self._map_ss(lambda A, B, C, D: _discretize.d2c_matrices(A, B, C, D, dt, m, prewarp), dt=None,
                             meta={**self.meta, "d2c": m})
 
     # ------------------------------------------------------------------ interconnection
@@ -759,6 +802,15 @@ class StateSpace(LinearSystem):
         """G at angular frequencies ``w`` (rad/s), shape (len(w), p, m):
         ``C (sI − A)⁻¹ B + D`` with s = jω, or z = e^{jω dt} when discrete.
 
+        Parameters
+        ----------
+        w
+            Angular frequencies (rad/s), shape (N,).
+
+        Returns
+        -------
+        ndarray of complex, shape (N, p, m)
+
         Examples
         --------
         >>> from gripkit.lti import StateSpace
@@ -777,7 +829,18 @@ class StateSpace(LinearSystem):
     def simulate(self, u, x0=None) -> np.ndarray:
         """Outputs y (N, p) of a discrete system for inputs ``u`` (N, m) (or (N,) with one
         input) from state ``x0`` (default 0), by the recursion of the class docstring (a numba
-        kernel).
+        kernel, :func:`gripkit.lti.simulate_ss`).
+
+        Parameters
+        ----------
+        u
+            Inputs, shape (N, m) in the units of ``input_units``.
+        x0
+            Initial state, shape (n,); default zero.
+
+        Returns
+        -------
+        ndarray, shape (N, p)
 
         Examples
         --------
@@ -975,6 +1038,21 @@ class TransferFunction(LinearSystem):
         ``covariance`` can be the identified model's whole covariance over
         ``a1…a_na, b_nk…, c1…c_nc, f1…f_nf`` (in that order; the c's get zero tangents). Trailing
         zeros are padding, and a non-monic A (without covariance) is divided out.
+
+        Parameters
+        ----------
+        A, B, C, F
+            Coefficient arrays in increasing powers of q⁻¹.
+        dt
+            Sample time (s), > 0.
+        covariance
+            Covariance of the free coefficients in the order above (names ``a1 … f_nf``).
+        **signals
+            ``inputs``, ``outputs``, ``input_units``, ``output_units``, ``meta``.
+
+        Returns
+        -------
+        TransferFunction
 
         Examples
         --------
@@ -1230,6 +1308,15 @@ class TransferFunction(LinearSystem):
         """G at angular frequencies ``w`` (rad/s), shape (len(w), p, m): num(s)/den(s) at
         s = jω, or z = e^{jω dt} when discrete.
 
+        Parameters
+        ----------
+        w
+            Angular frequencies (rad/s), shape (N,).
+
+        Returns
+        -------
+        ndarray of complex, shape (N, p, m)
+
         Examples
         --------
         >>> from gripkit.lti import TransferFunction
@@ -1304,6 +1391,18 @@ class TransferFunction(LinearSystem):
         """Outputs y (N, p) for inputs ``u`` (N, m) (or (N,)) of a discrete system, through its
         observable canonical realisation (:meth:`to_ss` with ``minimal=False``), from ``x0``
         (default rest; see :meth:`initial_state`).
+
+        Parameters
+        ----------
+        u
+            Inputs, shape (N, m).
+        x0
+            Initial state of the observable realisation (its size is the sum of the entries'
+            degrees); default rest.
+
+        Returns
+        -------
+        ndarray, shape (N, p)
 
         Examples
         --------
@@ -1436,9 +1535,20 @@ def series(*systems: LinearSystem) -> LinearSystem:
     """u → G₁ → G₂ → … → y: ``G = G_k ⋯ G₂ G₁`` (the first system acts first).
 
     Inputs (names, units) come from the first system, outputs from the last; each output count
-    must equal the next input count, and declared units must agree. Two SISO transfer functions
-    give a transfer function (num₁num₂)/(den₁den₂); otherwise a state space with state
-    [x₁; x₂]. Parameters of different systems are taken as independent.
+    must equal the next input count, and declared units must agree (``''`` and ``'1'`` match
+    anything). Two SISO transfer functions give a transfer function (num₁num₂)/(den₁den₂);
+    otherwise a state space with state [x₁; x₂]: ``A = [[A₁, 0], [B₂C₁, A₂]]``,
+    ``B = [B₁; B₂D₁]``, ``C = [D₂C₁, C₂]``, ``D = D₂D₁``. Parameters of different systems are
+    taken as independent.
+
+    Parameters
+    ----------
+    *systems
+        Two or more systems on one time base, in signal-flow order.
+
+    Returns
+    -------
+    LinearSystem
 
     Examples
     --------
@@ -1494,6 +1604,15 @@ def parallel(g1: LinearSystem, g2: LinearSystem) -> LinearSystem:
     Two SISO transfer functions give (n₁d₂ + n₂d₁)/(d₁d₂); otherwise a state space with
     ``A = diag(A₁, A₂)``, ``B = [B₁; B₂]``, ``C = [C₁, C₂]``, ``D = D₁ + D₂``.
 
+    Parameters
+    ----------
+    g1, g2
+        Systems of the same shape and time base; ``g2`` may be a static gain.
+
+    Returns
+    -------
+    LinearSystem
+
     Examples
     --------
     >>> from gripkit.lti import TransferFunction, parallel
@@ -1523,6 +1642,20 @@ def feedback(plant: LinearSystem, controller=1.0, sign: float = -1.0) -> LinearS
     Two SISO transfer functions give ``n_G d_K / (d_G d_K − sign n_G n_K)``; otherwise a state
     space (:func:`gripkit.lti._connect.ss_feedback`). ``controller`` may be a static gain.
     An algebraic loop with I − sign·D_G D_K singular raises ModelError.
+
+    Parameters
+    ----------
+    plant
+        G, p outputs and m inputs.
+    controller
+        K (m outputs, p inputs) in the feedback path, or a static gain (scalar or matrix).
+    sign
+        −1 for negative feedback, +1 for positive.
+
+    Returns
+    -------
+    LinearSystem
+        Inputs r and outputs y, named and united as the plant's.
 
     Examples
     --------
