@@ -24,8 +24,7 @@ from scipy import optimize
 from scipy import signal as _signal
 
 from ..errors import DataError, IdentificationError
-from ..lti import TransferFunction
-from ..lti._discretize import c2d_arrays
+from ..lti import StateSpace, TransferFunction
 from ._data import check_dt, check_order
 from .frf import FRF, frf
 from .linear_model import LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run
@@ -171,9 +170,8 @@ def tfest_frf(response: FRF, n_poles: int, n_zeros: int, *, signals: dict | None
 
 def _simulate_ct(theta, npo, nz, u, dt, x0=None):
     a = np.concatenate([[1.0], theta[:npo]])
-    A, B, C, D = _signal.tf2ss(theta[npo:], a)
-    Ad, Bd, Cd, Dd = c2d_arrays(A, B, C, D, dt, "zoh")
-    return Ad, Bd, Cd, Dd
+    d = StateSpace(*_signal.tf2ss(theta[npo:], a)).c2d(dt)
+    return d.A, d.B, d.C, d.D
 
 
 def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None, fs: float | None = None,
