@@ -8,7 +8,20 @@ import pytest
 from gripkit import Trajectory
 from gripkit.lti import StateSpace
 
-from conftest import assert_user_error, assert_warned
+
+def _helpers():
+    """The corpus helpers of tests/bad_inputs/conftest.py, loaded by path: a plain
+    ``from conftest import`` can pick another directory's conftest when suites run together."""
+    import importlib.util
+    from pathlib import Path
+
+    spec = importlib.util.spec_from_file_location("bad_inputs_conftest", Path(__file__).with_name("conftest.py"))
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod.assert_user_error, mod.assert_warned
+
+
+assert_user_error, assert_warned = _helpers()
 
 
 @pytest.fixture(scope="module")
@@ -23,7 +36,8 @@ def files(tmp_path_factory):
     Trajectory.uniform(100.0, a=u[:, 0], c=y[:, 0]).save(d / "only_a.csv")
     n = np.arange(64 * 60)
     v = np.cos(2 * np.pi * 8 * n / 64) + np.cos(2 * np.pi * 20 * n / 64)
-    Trajectory.uniform(100.0, v=v, x=np.convolve(v, [0.5, 0.3], "same"), w=rng.standard_normal(n.size)).save(d / "tones.csv")
+    tones = Trajectory.uniform(100.0, v=v, x=np.convolve(v, [0.5, 0.3], "same"), w=rng.standard_normal(n.size))
+    tones.save(d / "tones.csv")
     return d
 
 

@@ -24,7 +24,8 @@ def test_recovers_matrix_polynomials_within_sigma():
     u, y = _data()
     m = arx(u, y, 1, 2, 1, dt=0.01)
     info = m.info
-    for est, sd, true in ((info["A_poly"][0], info["A_poly_std"][0], A1), (info["B_poly"][0], info["B_poly_std"][0], B1),
+    for est, sd, true in ((info["A_poly"][0], info["A_poly_std"][0], A1),
+                          (info["B_poly"][0], info["B_poly_std"][0], B1),
                           (info["B_poly"][1], info["B_poly_std"][1], B2)):
         assert np.all(np.abs(np.asarray(est) - true) <= 4 * np.asarray(sd))
     assert m.noise_covariance == pytest.approx(0.01 * np.eye(2), abs=0.002)

@@ -8,10 +8,9 @@ import pytest
 from gripkit.errors import GripkitWarning
 from gripkit.sysid import structure_search
 
-from conftest import simulate_arx
 
-
-def test_ranked_by_validation_fit():
+def test_ranked_by_validation_fit(arx_data):
+    simulate_arx = arx_data
     u, y = simulate_arx(3000, noise=1.0, seed=0)
     uv, yv = simulate_arx(3000, noise=1.0, seed=1)
     with warnings.catch_warnings():
@@ -28,7 +27,7 @@ def test_ranked_by_validation_fit():
     assert max(one_step) - min(one_step[:5]) < max(v) - min(v)   # validation separates, one-step does not
 
 
-def test_edge_of_range_warned():
-    u, y = simulate_arx(2000, noise=1.0, seed=0)
+def test_edge_of_range_warned(arx_data):
+    u, y = arx_data(2000, noise=1.0, seed=0)
     with pytest.warns(GripkitWarning, match="edge of the searched range: na = 3"):
         structure_search(u, y, "3:5", "2", "2", progress=False)

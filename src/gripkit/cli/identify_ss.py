@@ -138,7 +138,8 @@ def identify_frf_cmd(data: Path = DataArg, input: str = InputsOpt, output: str =
     step = max(1, r.frequency_hz.size // 20)
     for k in range(0, r.frequency_hz.size, step):
         h, s = r.H[k, 0, 0], r.H_std[k, 0, 0]
-        typer.echo(f"  {r.frequency_hz[k]:10.4g} Hz  |H| {abs(h):.4g}  phase {np.degrees(np.angle(h)):7.1f}°  σ {s:.2g}")
+        typer.echo(f"  {r.frequency_hz[k]:10.4g} Hz  |H| {abs(h):.4g}  "
+                   f"phase {np.degrees(np.angle(h)):7.1f}°  σ {s:.2g}")
 
 
 @identify_app.command("tf")

@@ -70,7 +70,7 @@ def arx_mimo(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None, fs
     >>> for t in range(1, 3000):
     ...     y[t] = [[0.5, 0.1], [0.0, 0.7]] @ y[t - 1] + u[t - 1] + 0.01 * rng.standard_normal(2)
     >>> m = arx(u, y, 1, 1, 1)
-    >>> np.round(-np.asarray(m.info["A_poly"][0]), 2).tolist()
+    >>> (np.round(-np.asarray(m.info["A_poly"][0]), 2) + 0.0).tolist()
     [[0.5, 0.1], [0.0, 0.7]]
     """
     u = as_io_matrix(u, "input u")

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import DataError, GripkitWarning
+from ..progress import status
 from ..signals.trajectory import Trajectory
 
 __all__ = ["MimoData", "mimo_data", "identify_ss", "identify_frf", "identify_tf", "parse_names", "parse_order"]
@@ -128,7 +129,8 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     orders of a range), ``validation_fit_percent`` (per output, with ``validate``) and
     ``criterion``."""
     from .pem_ss import pem
-    from .subspace import DEFAULT_MAX_ORDER, SUBSPACE_METHODS, default_horizon, from_factor, select_order, subspace_factor
+    from .subspace import (DEFAULT_MAX_ORDER, SUBSPACE_METHODS, default_horizon, from_factor, select_order,
+                           subspace_factor)
 
     if method not in SUBSPACE_METHODS:
         raise DataError(f"method: expected one of {', '.join(SUBSPACE_METHODS)}, found {method!r}")
@@ -142,6 +144,7 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     rng = parse_order(order)
     n_hi = rng[1] if rng else DEFAULT_MAX_ORDER
     k = default_horizon(n_hi, d.y.shape[1]) if horizon is None else int(horizon)
+    status(f"{method}: {d.u.shape[0]} samples, {len(d.inputs)} input(s), {len(d.outputs)} output(s), horizon {k}")
     fac = subspace_factor(d.u, d.y, horizon=k, method=method)
     extras: dict = {}
     build = lambda n: from_factor(fac, n, dt=d.dt, feedthrough=feedthrough, signals=d.signals)  # noqa: E731
@@ -182,6 +185,7 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
                           GripkitWarning, stacklevel=2)
     model = model.replace(u_offset=d.u_offset, y_offset=d.y_offset)
     if refine:
+        status(f"PEM refinement ({form} form) of the order-{model.order} model")
         model = pem(model, u=d.u, y=d.y, form=form)
     if vd is not None:
         extras["validation_fit_percent"] = _validation_fit(model, vd)

@@ -331,7 +331,8 @@ def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovatio
     sysn = StateSpace(A, B, C, D, **ss._signals(meta={**ss.meta, "refined_by": f"pem-{form}"}), states=ss.states,
                       state_units=ss.state_units, uncertainty=unc)
     ys = free_run(A, B, C, D, u, x0)
-    info = {**model.info, "pem": {"form": form, "iterations": it, "iterations_warm_start": it_warm, "converged": converged, "loss_start": V0 / N,
+    info = {**model.info, "pem": {"form": form, "iterations": it, "iterations_warm_start": it_warm,
+                                  "converged": converged, "loss_start": V0 / N,
                                   "loss": Vc / N, "parameters": d, "feedthrough": feedthrough}}
     return model.replace(system=sysn, structure=f"pem-{form}", K=K if innovation else None, x0=x0,
                          noise_covariance=Lam, fit_percent=fit_per_output(y, ys), n_samples=N, info=info)

@@ -156,7 +156,8 @@ def structure_search(u, y, na=range(1, 5), nb=range(1, 5), nk=range(1, 11), *,
         raise UnidentifiableError("no structure of the search could be identified: "
                                   + (skipped[0][3] if skipped else "empty grid"))
     key = {"aic": lambda c: c.aic, "fpe": lambda c: c.fpe, "loss": lambda c: c.loss,
-           "validation": lambda c: math.inf if c.validation_fit_percent is None else -c.validation_fit_percent}[criterion]
+           "validation": lambda c: (math.inf if c.validation_fit_percent is None
+                                    else -c.validation_fit_percent)}[criterion]
     found.sort(key=lambda c: (key(c), c.n_params))
     _warn_edge(found[0], {"na": nas, "nb": nbs, "nk": nks})
     return SearchResult(tuple(found), criterion, m, tuple(skipped))

@@ -128,7 +128,9 @@ def tfest_frf(response: FRF, n_poles: int, n_zeros: int, *, signals: dict | None
     sd = response.H_std[:, 0, 0]
     ok = np.isfinite(H) & np.isfinite(sd) & (sd > 0) & (response.frequency_hz > 0)
     w = response.w[ok]
-    H, sd = H[ok], sd[ok]
+    # weights 1/σ with a 0.1 % relative floor: noise-free data have σ ≈ 0 on some lines, and the
+    # estimate's own systematic errors (leakage, the hold) are not in σ
+    H, sd = H[ok], np.hypot(sd[ok], 1e-3 * np.abs(H[ok]))
     k = npo + nz + 1
     if 2 * w.size <= k:
         raise DataError(f"tfest: {w.size} usable FRF lines cannot determine {k} coefficients",
@@ -209,7 +211,7 @@ def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None, fs: floa
         raise DataError(f"tfest: {N} samples are too few for {k} coefficients (need at least {10 * k + 64})",
                         hint="use a longer record or fewer poles/zeros")
     start = tfest_frf(frf(u, y, dt=step, nperseg=max(64, min(N // 4, 2048))), npo, nz)
-    th0 = np.concatenate([start.system.denominator()[1:], start.system.numerator()[-(nz + 1):]])
+    th0 = _stabilise(np.concatenate([start.system.denominator()[1:], start.system.numerator()[-(nz + 1):]]), npo)
     uu, yy = u, y[:, 0]
     scale = np.abs(th0) + 1e-8
 
