@@ -39,6 +39,9 @@ __all__ = ["pem", "PEM_FORMS"]
 
 PEM_FORMS = ("oe", "innovation")
 _WARM_START_SAMPLES = 20000
+# A decrease of the whitened criterion below 0.01 means the last step moved the parameters by less
+# than 0.1σ (jointly, ΔV ≈ δᵀ Σ⁻¹ δ): further iterations cannot change the answer.
+_NEGLIGIBLE_DROP = 0.01
 
 
 @numba.njit(cache=True)
@@ -220,7 +223,7 @@ def _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough, innovation, max_
             _predict(An, Bn, Cn, Dn, Kn, x0n, u, yw, en)
             Vn = float(np.sum(en * en))
             if np.isfinite(Vn) and Vn < Vc:
-                improved, rel = True, (Vc - Vn) / max(Vc, 1e-300)
+                improved, rel, drop = True, (Vc - Vn) / max(Vc, 1e-300), Vc - Vn
                 A, B, C, D, K, x0, Vc = An, Bn, Cn, Dn, Kn, x0n, Vn
                 lam = max(lam / 5, 1e-12)
                 break
@@ -228,7 +231,10 @@ def _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough, innovation, max_
         if not improved or rel < tol:
             converged = True
             break
-    at_final = (J, (dA, dB, dC, dD, dK), e) if not improved else None   # J at the returned point
+        if drop < _NEGLIGIBLE_DROP:  # the step moved θ by ≪ 1σ: J before it serves at the optimum
+            converged, improved = True, False
+            break
+    at_final = (J, (dA, dB, dC, dD, dK), e) if not improved else None   # J at (or ≪ 1σ from) the end
     return A, B, C, D, K, x0, Vc, it, converged, at_final
 
 
@@ -248,7 +254,8 @@ def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovatio
     feedthrough
         Estimate D (default: when the starting model has a non-zero D).
     max_iterations, tol
-        Levenberg-Marquardt iterations and the relative decrease of V that stops them. Records
+        Levenberg-Marquardt iterations and the relative decrease of V that stops them (they also
+        stop when a step lowers the whitened V by less than 0.01, a move of less than 0.1σ). Records
         longer than 20 000 samples are first fitted on their first 20 000 samples, then polished
         on the whole record (the same optimum, a fraction of the full-length Jacobians).
 
