@@ -133,3 +133,18 @@ def test_identify_python_dispatch(files):
     tr = load(files["est"])
     m = identify(tr, "ss", input="a,b", output=["c", "d"], order=4)
     assert m.order == 4 and m.inputs == ("a", "b") and m.u_offset[0] == pytest.approx(1.0, abs=0.05)
+
+
+def test_identify_arx_out_then_compare(capsys, files):
+    """`identify arx --out` writes the model file; `compare` on it reproduces the ARX's own free-run
+    validation fit (two code paths, the same number within 0.1 point: they differ only in how the
+    initial condition is estimated)."""
+    model = files["dir"] / "arx.json"
+    code, out, err = run(capsys, "identify", "arx", files["siso"], "--input", "v", "--output", "x", "--na", "2",
+                         "--nb", "2", "--nk", "1", "--validate", files["siso"], "--out", model, "--json")
+    assert code == 0, err
+    own = json.loads(out)["validation_fit_percent"]
+    code, out, err = run(capsys, "compare", model, files["siso"], "--json")
+    assert code == 0, err
+    r = json.loads(out)
+    assert abs(r["fit_percent"][0] - own) < 0.1 and r["estimation_data"] is True

@@ -91,3 +91,21 @@ def test_simulate_and_compare_data_by_name(model):
         warnings.simplefilter("error")
         sim = model.simulate_data(tr)
     assert np.allclose(sim, model.simulate(u, dt=0.01) + [3.0, -1.0])
+
+
+def test_polynomial_model_saves_as_model_file(tmp_path, arx_data):
+    """An ARX [2 2 2] (Table II of 000_8f66dcc7ab06470c.txt) saves through the same file format: the
+    reloaded transfer function has the same poles, and the σ of its coefficients are the ARX σ."""
+    from gripkit.sysid import arx
+
+    u, y = arx_data(2000, noise=1.0, seed=0)
+    pm = arx(u, y, 2, 2, 2, dt=0.005, input_name="current", output_name="force", input_unit="A",
+             output_unit="N", u_offset=0.85, y_offset=0.0)
+    pm.save(tmp_path / "arx.json")
+    m = load_model(tmp_path / "arx.json")
+    assert m.structure == "arx" and m.inputs == ("current",) and m.system.output_units == ("N",)
+    assert m.u_offset == (0.85,) and m.dt == 0.005
+    p = m.system.poles()
+    p = p[np.abs(p) > 1e-9]                       # the delay's poles at z = 0 are states of B/(A F)
+    assert np.allclose(np.sort_complex(p), np.sort_complex(pm.poles()), atol=1e-12)
+    assert np.allclose(m.system.uncertainty.std, pm.theta_std, rtol=1e-12)

@@ -22,6 +22,7 @@ OutputOpt = typer.Option(..., "--output", help="Output column (e.g. the force)."
 DetrendOpt = typer.Option("mean", "--detrend",
                           help="Operating-point removal before fitting: mean, linear or none.")
 ValidateOpt = typer.Option(None, "--validate", help="Second record for free-run validation (same columns).")
+ModelOutOpt = typer.Option(None, "--out", help="Write the identified model to this JSON file.")
 NaOpt = typer.Option(..., "--na", help="Number of A coefficients (after the leading 1).")
 NbOpt = typer.Option(..., "--nb", help="Number of B coefficients.")
 NkOpt = typer.Option(..., "--nk", help="Input delay in samples (B's leading zeros).")
@@ -35,12 +36,17 @@ def _io(path: Path, input: str, output: str, fs, time, fill, detrend: str, why: 
 
 
 def _fit_and_report(method: str, data: Path, input: str, output: str, fs, time, fill, detrend: str,
-                    validate: Path | None, json_out: bool, fit):
+                    validate: Path | None, json_out: bool, fit, out_file: Path | None = None):
     """Shared body of arx/armax/oe: load, fit (``fit(io) -> model``), validate, print."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         io = _io(data, input, output, fs, time, fill, detrend, f"{method.upper()} identification")
         model = fit(io)
+        if out_file is not None:  # the model file (issue 13), with the data's name and hash
+            from ..sysid.linear_model import from_polynomial
+            from ..sysid.model_file import file_sha256
+
+            from_polynomial(model).replace(data_file=Path(data).name, data_hash=file_sha256(data)).save(out_file)
         out = model.to_dict()
         out.update(data=str(data), detrend=detrend)
         val = None
@@ -93,12 +99,12 @@ def _print_model(model, val) -> None:
 def identify_arx(data: Path = DataArg, input: str = InputOpt, output: str = OutputOpt,
                  na: int = NaOpt, nb: int = NbOpt, nk: int = NkOpt,
                  fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
-                 validate: Path = ValidateOpt, json_out: bool = JsonOpt):
+                 validate: Path = ValidateOpt, json_out: bool = JsonOpt, out: Path = ModelOutOpt):
     """ARX (orders na, nb, nk) by least squares (QR), with σ, loss (eq 29), fit, AIC, poles and zeros."""
     from ..sysid import arx
 
     _fit_and_report("arx", data, input, output, fs, time, fill, detrend, validate, json_out,
-                    lambda io: arx(io.u, io.y, na, nb, nk, dt=io.dt, **io.meta))
+                    lambda io: arx(io.u, io.y, na, nb, nk, dt=io.dt, **io.meta), out)
 
 
 @identify_app.command("armax")
@@ -108,12 +114,12 @@ def identify_armax(data: Path = DataArg, input: str = InputOpt, output: str = Ou
                    nc: int = typer.Option(..., "--nc", help="Number of C coefficients."),
                    nk: int = NkOpt,
                    fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
-                   validate: Path = ValidateOpt, json_out: bool = JsonOpt):
+                   validate: Path = ValidateOpt, json_out: bool = JsonOpt, out: Path = ModelOutOpt):
     """ARMAX (orders na, nb, nc, nk) by prediction-error minimisation."""
     from ..sysid import armax
 
     _fit_and_report("armax", data, input, output, fs, time, fill, detrend, validate, json_out,
-                    lambda io: armax(io.u, io.y, na, nb, nc, nk, dt=io.dt, **io.meta))
+                    lambda io: armax(io.u, io.y, na, nb, nc, nk, dt=io.dt, **io.meta), out)
 
 
 @identify_app.command("oe")
@@ -122,12 +128,12 @@ def identify_oe(data: Path = DataArg, input: str = InputOpt, output: str = Outpu
                 nf: int = typer.Option(..., "--nf", "--na", help="Number of F (denominator) coefficients."),
                 nk: int = NkOpt,
                 fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
-                validate: Path = ValidateOpt, json_out: bool = JsonOpt):
+                validate: Path = ValidateOpt, json_out: bool = JsonOpt, out: Path = ModelOutOpt):
     """Output-error (orders nb, nf, nk) by prediction-error minimisation."""
     from ..sysid import oe
 
     _fit_and_report("oe", data, input, output, fs, time, fill, detrend, validate, json_out,
-                    lambda io: oe(io.u, io.y, nb, nf, nk, dt=io.dt, **io.meta))
+                    lambda io: oe(io.u, io.y, nb, nf, nk, dt=io.dt, **io.meta), out)
 
 
 @identify_app.command("rls")

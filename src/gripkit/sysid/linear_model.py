@@ -25,7 +25,7 @@ from ..errors import DataError, ModelError
 from ..lti import LinearSystem, StateSpace, TransferFunction
 from ..lti._kernels import simulate_ss
 
-__all__ = ["LinearModel", "as_io_matrix", "estimate_x0", "free_run", "fit_per_output"]
+__all__ = ["LinearModel", "as_io_matrix", "estimate_x0", "free_run", "fit_per_output", "from_polynomial"]
 
 
 def as_io_matrix(x, name: str, n: int | None = None) -> np.ndarray:
@@ -270,3 +270,20 @@ class LinearModel:
     def __repr__(self) -> str:
         return (f"LinearModel({self.structure}, order={self.order}, inputs={list(self.inputs)}, "
                 f"outputs={list(self.outputs)}, dt={self.dt})")
+
+
+def from_polynomial(pm) -> LinearModel:
+    """A :class:`~gripkit.sysid.PolynomialModel` (ARX/ARMAX/OE) as a :class:`LinearModel` on the
+    discrete transfer function B/(A F) (:meth:`gripkit.lti.TransferFunction.from_polynomials`),
+    with the parameter covariance (the noise polynomial C keeps its place in it, with zero
+    tangents, and is recorded in ``info``), names, units and offsets."""
+    g = TransferFunction.from_polynomials(pm.A, pm.B, C=pm.C if pm.C.size > 1 else None, F=pm.F, dt=pm.dt,
+                                          covariance=pm.covariance, inputs=pm.input_name, outputs=pm.output_name,
+                                          input_units=pm.input_unit, output_units=pm.output_unit)
+    info = {"label": pm.label, "A": pm.A, "B": pm.B, "C": pm.C, "F": pm.F, "nk": pm.nk,
+            "one_step_fit_percent": pm.fit_percent, "noise_variance": pm.noise_variance,
+            "parameter_names": list(pm.parameter_names), **{k: v for k, v in pm.info.items()
+                                                            if isinstance(v, (str, int, float))}}
+    return LinearModel(g, pm.structure, u_offset=(pm.u_offset,), y_offset=(pm.y_offset,), n_samples=pm.n_samples,
+                       noise_covariance=None if pm.noise_variance is None else np.array([[pm.noise_variance]]),
+                       info=info)

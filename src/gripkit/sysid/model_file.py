@@ -88,7 +88,12 @@ def model_document(model) -> dict:
 
 
 def save_model(model, path) -> None:
-    """Write ``model`` to ``path`` as JSON (see the module docstring)."""
+    """Write ``model`` (a :class:`~gripkit.sysid.linear_model.LinearModel`, or a
+    :class:`~gripkit.sysid.PolynomialModel`, converted) to ``path`` as JSON."""
+    from .linear_model import LinearModel, from_polynomial
+
+    if not isinstance(model, LinearModel):
+        model = from_polynomial(model)
     path = Path(path)
     if path.suffix.lower() != ".json":
         raise DataError(f"model file: expected a .json path, found {str(path)!r}")
