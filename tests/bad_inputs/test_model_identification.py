@@ -34,6 +34,7 @@ def files(tmp_path_factory):
     Trajectory.uniform(100.0, a=u[:, 0], b=u[:, 1], c=y[:, 0], d=y[:, 1]).save(d / "clean.csv")
     Trajectory.uniform(100.0, a=u[:40, 0], b=u[:40, 1], c=y[:40, 0], d=y[:40, 1]).save(d / "short.csv")
     Trajectory.uniform(100.0, a=u[:, 0], c=y[:, 0]).save(d / "only_a.csv")
+    Trajectory.uniform(100.0, a=u[:, 0], b=np.full(3000, 0.85), c=y[:, 0], d=y[:, 1]).save(d / "flat_b.csv")
     n = np.arange(64 * 60)
     v = np.cos(2 * np.pi * 8 * n / 64) + np.cos(2 * np.pi * 20 * n / 64)
     tones = Trajectory.uniform(100.0, v=v, x=np.convolve(v, [0.5, 0.3], "same"), w=rng.standard_normal(n.size))
@@ -89,3 +90,13 @@ def test_simulate_data_missing_an_input_column(cli, files, tmp_path):
                "--out", p).code == 0
     res = cli("simulate", p, "--data", files / "only_a.csv")
     assert_user_error(res, "DataError", "input column(s) 'b' are missing")
+
+
+def test_constant_input_column(cli, files):
+    res = cli("identify", "ss", files / "flat_b.csv", "--input", "a,b", "--output", "c,d")
+    assert_user_error(res, "DataError", "input column 'b' is constant")
+
+
+def test_bad_order_text(cli, files):
+    res = cli("identify", "ss", files / "clean.csv", "--input", "a,b", "--output", "c,d", "--order", "4-8")
+    assert_user_error(res, "DataError", "expected N or LO:HI")

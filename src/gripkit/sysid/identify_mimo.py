@@ -94,6 +94,13 @@ def mimo_data(data: Trajectory, inputs, outputs, detrend: str = "mean", why: str
     fs = float(f"{data.require_uniform(why=why):.9g}")
     u = np.column_stack([np.asarray(data[n], dtype=np.float64) for n in ins])
     y = np.column_stack([np.asarray(data[n], dtype=np.float64) for n in outs])
+    for names, x, what in ((ins, u, "input"), (outs, y, "output")):
+        flat = np.ptp(x, axis=0) <= 1e-12 * np.maximum(np.max(np.abs(x), axis=0), 1e-300)
+        if flat.any():
+            name = names[int(np.argmax(flat))]
+            raise DataError(f"{what} column {name!r} is constant ({x[0, int(np.argmax(flat))]:.6g} for all "
+                            f"{x.shape[0]} samples): it carries no information",
+                            hint="drop it from --input/--output or check the data")
     u0 = u.mean(axis=0) if detrend == "mean" else np.zeros(len(ins))
     y0 = y.mean(axis=0) if detrend == "mean" else np.zeros(len(outs))
     return MimoData(u - u0, y - y0, 1.0 / fs, ins, outs, tuple(data.unit(n) for n in ins),
