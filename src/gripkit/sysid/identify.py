@@ -118,12 +118,14 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
     """
     if method not in METHODS:
         raise DataError(f"method: expected one of {', '.join(METHODS)}, found {method!r}")
-    if method in ("ss", "frf", "tf"):  # MIMO: input/output may name several columns
-        from . import identify_mimo
+    from . import identify_mimo
 
+    if method in ("ss", "frf", "tf"):  # MIMO: input/output may name several columns
         fn = {"ss": identify_mimo.identify_ss, "frf": identify_mimo.identify_frf, "tf": identify_mimo.identify_tf}
         out = fn[method](data, input=input, output=output, detrend=detrend, **options)
         return out[0] if method == "ss" else out
+    if method == "arx" and identify_mimo.several(input, output):  # matrix-polynomial ARX
+        return identify_mimo.identify_arx(data, input=input, output=output, na=na, nb=nb, nk=nk, detrend=detrend)
     io = io_data(data, input=input, output=output, detrend=detrend, why=f"{method.upper()} identification")
     if method == "arx":
         from .arx import arx

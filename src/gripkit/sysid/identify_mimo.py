@@ -25,7 +25,8 @@ from ..errors import DataError, GripkitWarning
 from ..progress import status
 from ..signals.trajectory import Trajectory
 
-__all__ = ["MimoData", "mimo_data", "identify_ss", "identify_frf", "identify_tf", "parse_names", "parse_order"]
+__all__ = ["MimoData", "mimo_data", "identify_ss", "identify_frf", "identify_tf", "identify_arx", "several",
+           "parse_names", "parse_order"]
 
 
 def parse_names(x, what: str) -> tuple[str, ...]:
@@ -213,3 +214,16 @@ def identify_tf(data: Trajectory, *, input, output, poles: int, zeros: int, detr
 
     d = mimo_data(data, input, output, detrend, why="transfer-function estimation")
     return tfest(d.u, d.y, poles, zeros, dt=d.dt, u_offset=d.u_offset, y_offset=d.y_offset, **d.signals)
+
+
+def several(*names) -> bool:
+    """Whether any of the column specifications names more than one column."""
+    return any(len(parse_names(n, "column")) > 1 for n in names)
+
+
+def identify_arx(data: Trajectory, *, input, output, na: int, nb: int, nk: int = 1, detrend: str = "mean"):
+    """MIMO ARX of the named columns (:func:`gripkit.sysid.arx_mimo.arx_mimo`)."""
+    from .arx_mimo import arx_mimo
+
+    d = mimo_data(data, input, output, detrend, why="ARX identification")
+    return arx_mimo(d.u, d.y, na, nb, nk, dt=d.dt, u_offset=d.u_offset, y_offset=d.y_offset, **d.signals)
