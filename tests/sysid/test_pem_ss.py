@@ -23,10 +23,13 @@ def test_sensitivity_jacobian_matches_finite_differences(feedthrough, innovation
     K = 0.1 * rng.standard_normal((n, p)) if innovation else np.zeros((n, p))
     x0 = rng.standard_normal(n)
     u, y = rng.standard_normal((N, m)), rng.standard_normal((N, p))
-    dA, dB, dC, dD, dK = _directions(A, B, C, D, K, feedthrough, innovation)
+    dA, dB, dC, dD, dK, entries = _directions(A, B, C, D, K, feedthrough, innovation)
     d = dA.shape[0]
     assert d == n * m + p * n + (p * m if feedthrough else 0) + (n * p if innovation else 0)
-    e, J = _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, y)
+    e, J = _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, y, entries)
+    # the dense kernel (any tangents) gives the same Jacobian
+    assert np.allclose(_predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, y)[1], J, rtol=1e-12,
+                       atol=1e-12 * np.abs(J).max())
     h = 1e-6
     for q in range(d + n):
         th, dx = np.zeros(d), np.zeros(n)

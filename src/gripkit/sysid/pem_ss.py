@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import numba
 import numpy as np
+import scipy.linalg as sla
 
 from ..errors import DataError, IdentificationError
 from ..lti import StateSpace, Uncertainty
@@ -133,7 +134,54 @@ def _sensitivities(Abar, C, F, G, S0, Z, J):  # pragma: no cover - compiled
                 s[r] = sn[r]
 
 
-def _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, y):
+@numba.njit(cache=True, parallel=True)
+def _sensitivities_entries(Abar, C, K, entries, n_x0, X, U, E, J):  # pragma: no cover - compiled
+    """As :func:`_sensitivities` for unit directions: entry (kind, r, c) of A, B, C, D or K
+    (kind 0 … 4) forces s with e_r x_c, e_r u_c, −K[:, r] x_c, −K[:, r] u_c or e_r e_c, and the
+    C, D entries add x_c, u_c to output r; then ``n_x0`` directions of x0 (s[0] = e_i)."""
+    n = Abar.shape[0]
+    p = C.shape[0]
+    d = entries.shape[0]
+    for q in numba.prange(d + n_x0):
+        s = np.zeros(n)
+        sn = np.empty(n)
+        kind, r, c = -1, 0, 0
+        if q < d:
+            kind, r, c = entries[q, 0], entries[q, 1], entries[q, 2]
+        else:
+            s[q - d] = 1.0
+        for t in range(X.shape[0]):
+            for i in range(p):
+                acc = 0.0
+                for j in range(n):
+                    acc += C[i, j] * s[j]
+                J[t * p + i, q] = acc
+            if kind == 2:
+                J[t * p + r, q] += X[t, c]
+            elif kind == 3:
+                J[t * p + r, q] += U[t, c]
+            for i in range(n):
+                acc = 0.0
+                for j in range(n):
+                    acc += Abar[i, j] * s[j]
+                sn[i] = acc
+            if kind == 0:
+                sn[r] += X[t, c]
+            elif kind == 1:
+                sn[r] += U[t, c]
+            elif kind == 4:
+                sn[r] += E[t, c]
+            elif kind == 2:
+                for i in range(n):
+                    sn[i] -= K[i, r] * X[t, c]
+            elif kind == 3:
+                for i in range(n):
+                    sn[i] -= K[i, r] * U[t, c]
+            for i in range(n):
+                s[i] = sn[i]
+
+
+def _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, y, entries=None):
     """Prediction errors e (N, p) and J (N·p, d + n), Fortran order, = ∂ŷ/∂θ: d model directions
     with tangents dA (d, n, n), dB, dC, dD, dK, then the n entries of x0 (module docstring)."""
     N, p = y.shape
@@ -142,6 +190,11 @@ def _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, y):
     e = np.empty((N, p))
     X = np.empty((N, n))
     _predict_states(A, B, C, D, K, x0, u, y, e, X)
+    if entries is not None:  # unit directions: the sparse kernel
+        J = np.empty((N * p, d + n), order="F")
+        _sensitivities_entries(np.ascontiguousarray(A - K @ C), np.ascontiguousarray(C), np.ascontiguousarray(K),
+                               entries, n, X, np.ascontiguousarray(u), e, J)
+        return e, J
     F = np.zeros((d + n, n, n + m + p))
     F[:d, :, :n] = dA - np.einsum("rj,qjk->qrk", K, dC)
     F[:d, :, n:n + m] = dB - np.einsum("rj,qjk->qrk", K, dD)
@@ -157,8 +210,10 @@ def _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, y):
 
 
 def _directions(A, B, C, D, K, feedthrough: bool, innovation: bool):
-    """Orthonormal basis of the parameter directions orthogonal to the similarity orbit, as
-    matrix tangents (dA, dB, dC, dD, dK), each with a leading axis of d."""
+    """The d free entries at the current model (d = the dimension of the orthogonal complement of
+    the similarity orbit), chosen so that they complement the orbit best, as unit matrix tangents
+    (dA, dB, dC, dD, dK), each with a leading axis of d, and their (kind, row, column), kind 0 … 4
+    for A, B, C, D, K."""
     n, m, p = A.shape[0], B.shape[1], C.shape[0]
     blocks = [n * n, n * m, p * n, p * m if feedthrough else 0, n * p if innovation else 0]
     T = np.empty((sum(blocks), n * n))
@@ -176,14 +231,19 @@ def _directions(A, B, C, D, K, feedthrough: bool, innovation: bool):
     rank = int(np.sum(sv > 1e-10 * max(sv[0], 1e-300))) if sv.size else 0
     Qp = U[:, rank:]
     d = Qp.shape[1]
-    out, c = [], 0
-    for size, shape in zip(blocks, [(n, n), (n, m), (p, n), (p, m), (n, p)]):
-        if size:
-            out.append(np.ascontiguousarray(Qp[c:c + size].T.reshape((d,) + shape)))
-            c += size
-        else:
-            out.append(np.zeros((d,) + shape))
-    return out
+    # the d entries whose unit directions best complement the orbit (pivoted QR of Qpᵀ): moving
+    # only them reaches every neighbouring system, with sparse tangents (cheap sensitivities)
+    piv = sla.qr(Qp.T, pivoting=True, mode="r")[1][:d]
+    shapes = [(n, n), (n, m), (p, n), (p, m), (n, p)]
+    starts = np.cumsum([0] + blocks)
+    out = [np.zeros((d,) + sh) for sh in shapes]
+    entries = np.empty((d, 3), dtype=np.int64)
+    for q, g in enumerate(np.sort(piv)):
+        kind = int(np.searchsorted(starts, g, side="right") - 1)
+        r, c = divmod(int(g - starts[kind]), shapes[kind][1])
+        out[kind][q, r, c] = 1.0
+        entries[q] = (kind, r, c)
+    return (*out, entries)
 
 
 def _radius(A):
@@ -200,9 +260,9 @@ def _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough, innovation, max_
     Vc = float(np.sum(e * e))
     lam, it, converged = 1e-3, 0, False
     for it in range(1, max_iterations + 1):
-        dA, dB, dC, dD, dK = _directions(A, B, C, D, K, feedthrough, innovation)
+        dA, dB, dC, dD, dK, ent = _directions(A, B, C, D, K, feedthrough, innovation)
         d = dA.shape[0]
-        e, J = _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, yw)
+        e, J = _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, yw, ent)
         H = _gram(J)
         g = J.T @ e.reshape(-1)
         hd = np.maximum(np.diag(H), 1e-300)
@@ -314,8 +374,8 @@ def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovatio
     if at_final is not None:
         J, (dA, dB, dC, dD, dK), e = at_final
     else:
-        dA, dB, dC, dD, dK = _directions(A, B, C, D, K, feedthrough, innovation)
-        e, J = _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, yw)
+        dA, dB, dC, dD, dK, ent = _directions(A, B, C, D, K, feedthrough, innovation)
+        e, J = _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, yw, ent)
     d = dA.shape[0]
     dof = N * p - d - n
     if dof <= 0:
