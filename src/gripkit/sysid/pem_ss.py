@@ -5,13 +5,16 @@ Predictor of the innovation form (``K = 0``: output error)::
     ŷ[t] = C x[t] + D u[t],   e[t] = y[t] − ŷ[t],   x[t+1] = A x[t] + B u[t] + K e[t],   x[0] = x0.
 
 Criterion: ``V = Σ_t e[t]ᵀ Λ⁻¹ e[t]`` with Λ the innovation covariance of the starting model (fixed,
-so that outputs in different units weigh alike). Parameters: the entries of (A, B, C[, D][, K])
-move only in the directions orthogonal to the similarity transformations at the current model,
-the data-driven local coordinates of McKelvey, Helmersson & Ribarits (2004) — the tangent of
-``(T A T⁻¹, T B, C T⁻¹, T K)`` at T = I + X is ``(XA − AX, XB, −CX, XK)``; its orthogonal complement
-is a basis of d = nm + pn (+ pm) (+ np) identifiable directions — plus x0.
+so that outputs in different units weigh alike). Parameters: a state-space model is defined up
+to a similarity transformation, whose tangent at the current model, ``(T A T⁻¹, T B, C T⁻¹, T K)``
+at T = I + X, is ``(XA − AX, XB, −CX, XK)``. As in the data-driven local coordinates of McKelvey,
+Helmersson & Ribarits (2004) only d = nm + pn (+ pm) (+ np) directions complementing that orbit
+are free; here they are d *entries* of (A, B, C[, D][, K]), the ones whose unit directions
+complement the orbit best (QR with column pivoting of a basis of its orthogonal complement),
+re-chosen at every iterate; the other entries stay where they are during the step. Unit
+directions make the sensitivity equations sparse (cheap). x0 is estimated too.
 
-Jacobians are exact, from the sensitivity equations (a numba kernel, parallel over the
+Jacobians are exact, from the sensitivity equations (numba kernels, parallel over the
 directions), for each direction θ_q with matrix tangents (dA, dB, dC, dD, dK)::
 
     ∂ŷ[t] = C s[t] + dC x[t] + dD u[t],
