@@ -148,3 +148,14 @@ def test_identify_arx_out_then_compare(capsys, files):
     assert code == 0, err
     r = json.loads(out)
     assert abs(r["fit_percent"][0] - own) < 0.1 and r["estimation_data"] is True
+
+
+def test_simulate_without_out_prints_csv(capsys, files):
+    model = files["dir"] / "m3.json"
+    assert run(capsys, "identify", "ss", files["est"], "--input", "a,b", "--output", "c,d", "--order", "4",
+               "--no-refine", "--out", model)[0] == 0
+    code, out, err = run(capsys, "simulate", model, "--data", files["val"])
+    assert code == 0, err
+    lines = out.splitlines()
+    assert lines[0] == "t [s],c [N],d [m]" and len(lines) == 4001
+    assert float(lines[2].split(",")[0]) == pytest.approx(0.01)

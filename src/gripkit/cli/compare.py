@@ -91,7 +91,7 @@ def simulate_model_file(model: Path, data: Path | None, out: Path | None, fs, ti
 
         import numpy as np
 
-        cols = ["t"] + [f"{n} [{units[n]}]" if n in units else n for n in m.outputs]
+        cols = ["t [s]"] + [f"{n} [{units[n]}]" if n in units else n for n in m.outputs]
         sys.stdout.write(",".join(cols) + "\n")
         np.savetxt(sys.stdout, np.column_stack([tr.t, ys]), delimiter=",", fmt="%.10g")
         return
