@@ -159,3 +159,12 @@ def test_simulate_without_out_prints_csv(capsys, files):
     lines = out.splitlines()
     assert lines[0] == "t [s],c [N],d [m]" and len(lines) == 4001
     assert float(lines[2].split(",")[0]) == pytest.approx(0.01)
+
+
+def test_identify_search_ranked_by_validation(capsys, files):
+    code, out, err = run(capsys, "identify", "search", files["siso"], "--input", "v", "--output", "x", "--na", "1:3",
+                         "--nb", "1:3", "--nk", "0:2", "--validate", files["siso"], "--json")
+    assert code == 0, err
+    rows = json.loads(out)
+    v = [r["validation_fit_percent"] for r in rows if r["validation_fit_percent"] is not None]
+    assert v == sorted(v, reverse=True) and rows[0]["validation_fit_percent"] == v[0]
