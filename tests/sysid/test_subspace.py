@@ -117,3 +117,19 @@ def test_names_units_and_dt_carried(data):
     g, u, y = data
     m = n4sid(u, y, 4, dt=0.01, inputs=["a", "b"], outputs=["c", "d"], output_units=["N", "m"])
     assert m.system.inputs == ("a", "b") and m.system.output_units == ("N", "m") and m.dt == 0.01
+
+
+def test_stable_by_construction_or_stated_reason():
+    """Data from an unstable system (pole 1.01): the shift-invariance estimate is unstable, so the
+    default replaces it by A = Γ⁺[Γ↓; 0], stable (Chui & Maciejowski 1996), and says so; with
+    stable=False the unstable model is kept with a StabilityWarning."""
+    from gripkit.errors import StabilityWarning
+
+    g = StateSpace([[1.01, 0.0], [0.0, 0.5]], [[1.0], [1.0]], [[1.0, 1.0]], dt=1.0)
+    u = np.random.default_rng(0).standard_normal((400, 1))
+    y = g.simulate(u)
+    m = n4sid(u, y, 2)
+    assert m.stable and "stable by construction" in m.info["stability"]
+    with pytest.warns(StabilityWarning, match="unstable"):
+        k = n4sid(u, y, 2, stable=False)
+    assert not k.stable and np.max(np.abs(k.system.poles())) == pytest.approx(1.01, abs=1e-3)
