@@ -100,3 +100,19 @@ def test_sigma_honest_monte_carlo_small():
 @pytest.mark.slow
 def test_sigma_honest_monte_carlo_large():
     assert _mc_pem(300, 600, seed=12) >= 0.95
+
+
+def test_sigma_honest_mimo_monte_carlo_small():
+    """2×2 system of order 4, 12 records of 1500 samples with 10 % output noise: the true poles lie
+    within 3σ (Re and Im each) of the PEM estimate in at least 90 % of the pole-runs."""
+    g = two_by_two()
+    hits = []
+    for k in range(12):
+        u, y = oe_data(g, 1500, 0.1, seed=200 + k)
+        r = pem(n4sid(u, y, 4, dt=0.01), u=u, y=y, form="oe")
+        p, cov = r.system.pole_covariance()
+        i = match_poles(p, TRUE_POLES)
+        d = p[i] - TRUE_POLES
+        hits += list((np.abs(d.real) <= 3 * np.sqrt(cov[i, 0, 0])) & (np.abs(d.imag) <= 3 * np.sqrt(cov[i, 1, 1])
+                                                                      + 1e-12))
+    assert np.mean(hits) >= 0.9
