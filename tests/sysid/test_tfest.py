@@ -33,12 +33,15 @@ def test_from_periodic_frf_within_sigma():
     ex = periodic_multisine(0.02, 5.0, 20.0, 2000, 5, amplitude=1.0)
     rng = np.random.default_rng(1)
     y = G.c2d(0.05).simulate(ex.u)[:, 0] + 0.02 * rng.standard_normal(ex.u.size)
-    # ZOH-sampled data seen by a continuous model: fit the FRF up to 1/4 of Nyquist where the
-    # hold's distortion (sinc and half-sample delay) is below the noise
+    # the data were sampled with a zero-order hold: the FRF is compared with G's ZOH equivalent
     r = frf(ex.u, y, fs=20.0, periods=5)
-    m = tfest_frf(r, 2, 1)
-    den = m.system.denominator()
-    assert np.all(np.abs(den[1:] - [0.8, 4.0]) <= 0.05 * np.array([0.8, 4.0]))
+    m = tfest_frf(r, 2, 1, dt=0.05)
+    den, num = m.system.denominator(), m.system.numerator()
+    assert np.all(np.abs(den[1:] - [0.8, 4.0]) <= 4 * m.info["den_std"][1:])
+    assert np.all(np.abs(num - [2.0, 4.0]) <= 4 * m.info["num_std"])
+    # without the hold the continuous fit is biased by more than 4σ
+    biased = tfest_frf(r, 2, 1)
+    assert np.max(np.abs(biased.system.denominator()[1:] - [0.8, 4.0]) / biased.info["den_std"][1:]) > 4
 
 
 def test_more_zeros_than_poles_refused():

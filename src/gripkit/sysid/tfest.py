@@ -6,7 +6,9 @@
   (linear least squares of ``(A(jω)Ĥ − B(jω))/(A_prev(jω) σ)``, frequency scaled to 1 for
   conditioning) give the start; then weighted nonlinear least squares of
   ``(Ĥ_k − G(jω_k))/σ_k`` with the exact Jacobian ``∂G/∂b_i = s^{nz−i}/A``,
-  ``∂G/∂a_i = −G s^{np−i}/A``.
+  ``∂G/∂a_i = −G s^{np−i}/A``. An FRF of sampled data whose input was held (``dt`` given) is
+  compared with G's zero-order-hold equivalent ``G_d(e^{jωT})`` instead (the hold's half-sample
+  delay would bias a continuous fit by several σ).
 * From time-domain data (``tfest(u, y, ...)``): the model is sampled with a zero-order hold
   between samples (the assumption of MATLAB's iddata, ``InterSample='zoh'``) and the output error
   ``y − ŷ(θ)`` from rest is minimised, starting from the FRF fit of an H1 estimate of the data.
@@ -119,8 +121,14 @@ def _model(theta, cov, npo, nz, *, fit, structure, info, signals, u_offset=None,
     return LinearModel(g, structure, fit_percent=fit, u_offset=u_offset, y_offset=y_offset, n_samples=n, info=info)
 
 
-def tfest_frf(response: FRF, n_poles: int, n_zeros: int, *, signals: dict | None = None) -> LinearModel:
-    """Fit G(s) to an estimated frequency response (weighted by its σ); see the module docstring."""
+def tfest_frf(response: FRF, n_poles: int, n_zeros: int, *, dt: float | None = None,
+              signals: dict | None = None) -> LinearModel:
+    """Fit G(s) to an estimated frequency response (weighted by its σ); see the module docstring.
+
+    ``dt``: the sample time of the data the FRF was estimated from, when their input was held
+    between samples (zero-order hold): the model is then compared as its ZOH equivalent
+    G_d(e^{jωT}) (the hold's half-sample delay and sinc would otherwise bias the fit), after the
+    continuous fit has given the start."""
     npo, nz = _check_orders(n_poles, n_zeros)
     if response.H.shape[1:] != (1, 1):
         raise DataError("tfest: the FRF must be single-input single-output")
@@ -152,6 +160,20 @@ def tfest_frf(response: FRF, n_poles: int, n_zeros: int, *, signals: dict | None
         return np.vstack([J.real, J.imag])
 
     sol = optimize.least_squares(res, th, jac=jac, method="lm", xtol=1e-12, ftol=1e-12)
+    T = np.diag(_unscale(np.ones(k), ws, npo, nz))
+    if dt is not None:  # through the zero-order hold, in the scaled coordinates (finite differences)
+        z = np.exp(1j * w * float(dt))
+
+        def res_zoh(theta):
+            th_ = _unscale(theta, ws, npo, nz)
+            if np.any(np.roots(np.concatenate([[1.0], th_[:npo]])).real >= 0):
+                return np.full(2 * w.size, 1e6)
+            Ad, Bd, Cd, Dd = _simulate_ct(th_, npo, nz, None, float(dt))
+            G = (Cd @ np.linalg.solve(z[:, None, None] * np.eye(npo) - Ad, np.broadcast_to(Bd, (z.size,) + Bd.shape)))
+            r = (H - (G[:, 0, 0] + Dd[0, 0])) / sd
+            return np.concatenate([r.real, r.imag])
+
+        sol = optimize.least_squares(res_zoh, sol.x, method="lm", xtol=1e-12, ftol=1e-12)
     dof = 2 * w.size - k
     J = sol.jac
     s2 = 2 * sol.cost / dof
@@ -161,13 +183,13 @@ def tfest_frf(response: FRF, n_poles: int, n_zeros: int, *, signals: dict | None
         raise IdentificationError("tfest: the FRF does not determine the coefficients (singular Jacobian)",
                                   hint="fewer poles/zeros or a wider frequency band") from None
     theta = _unscale(sol.x, ws, npo, nz)
-    T = np.diag(_unscale(np.ones(k), ws, npo, nz))
     cov = T @ cov_s @ T
     sig = dict(signals or {})
     sig.setdefault("inputs", response.inputs)
     sig.setdefault("outputs", response.outputs)
     return _model(theta, 0.5 * (cov + cov.T), npo, nz, fit=None, structure="tfest",
-                  info={"source": f"frf ({response.method})", "chi2_per_dof": s2}, signals=sig)
+                  info={"source": f"frf ({response.method}{', zero-order hold' if dt else ''})",
+                        "chi2_per_dof": s2}, signals=sig)
 
 
 def _simulate_ct(theta, npo, nz, u, dt, x0=None):
@@ -210,7 +232,7 @@ def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None, fs: floa
     if N < 10 * k + 64:
         raise DataError(f"tfest: {N} samples are too few for {k} coefficients (need at least {10 * k + 64})",
                         hint="use a longer record or fewer poles/zeros")
-    start = tfest_frf(frf(u, y, dt=step, nperseg=max(64, min(N // 4, 2048))), npo, nz)
+    start = tfest_frf(frf(u, y, dt=step, nperseg=max(64, min(N // 4, 2048))), npo, nz, dt=step)
     th0 = _stabilise(np.concatenate([start.system.denominator()[1:], start.system.numerator()[-(nz + 1):]]), npo)
     uu, yy = u, y[:, 0]
     scale = np.abs(th0) + 1e-8
