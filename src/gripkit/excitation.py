@@ -26,8 +26,8 @@ from .errors import DataError
 from .signals.filters import apply_sos, butter_sos
 from .signals.trajectory import Trajectory
 
-__all__ = ["Excitation", "multisine", "bandlimited_noise", "prbs", "chirp", "steps", "crest_factor",
-           "FourierTrajectory", "fourier_trajectory"]
+__all__ = ["Excitation", "multisine", "periodic_multisine", "bandlimited_noise", "prbs", "chirp", "steps",
+           "crest_factor", "FourierTrajectory", "fourier_trajectory"]
 
 
 @dataclass(frozen=True)
@@ -147,6 +147,58 @@ def multisine(frequencies: Sequence[float], duration: float, fs: float, *, opera
     info = {"frequencies_hz": f.tolist(), "phases_rad": phi.tolist(), "phase_method": phases,
             "periodic": bool(on_grid), "crest_factor": crest_factor(u - operating_point)}
     return Excitation("multisine", t, u, float(fs), float(operating_point), (lo, hi), unit, info)
+
+
+def periodic_multisine(f_min: float, f_max: float, fs: float, period_samples: int, periods: int, *,
+                       lines: str = "all", operating_point: float = 0.0, limits: tuple[float, float] = (-1.0, 1.0),
+                       amplitude: float | None = None, seed: int = 0, iterations: int = 200,
+                       unit: str = "1") -> Excitation:
+    """A crest-factor-optimised multisine on chosen DFT lines of one period, repeated an integer
+    number of times: the design that :func:`gripkit.sysid.frf` with ``periods`` expects.
+
+    One period has L = ``period_samples`` samples; line k is the frequency k·fs/L (Hz), so every
+    period is exactly periodic and leakage-free. Lines between ``f_min`` and ``f_max``:
+    ``'all'``; ``'odd'`` (odd k only: even nonlinear distortions fall on the even lines);
+    ``'random-odd'`` (odd k with one of every three consecutive odd lines left out at random,
+    ``seed``: detection lines for odd distortions; Pintelon & Schoukens 2012, §3.7). Phases: the
+    minimum crest factor found by iterative clipping from Schroeder phases (:func:`multisine`).
+
+    ``info`` records ``lines`` (the excited k), ``period_samples`` and ``periods``.
+
+    Examples
+    --------
+    >>> from gripkit.excitation import periodic_multisine
+    >>> ex = periodic_multisine(1.0, 20.0, 200.0, 400, 4, lines="odd")
+    >>> ex.u.size, ex.info["lines"][:3], ex.info["periods"]
+    (1600, [3, 5, 7], 4)
+    """
+    L = int(period_samples)
+    P = int(periods)
+    if L < 4 or L != period_samples:
+        raise DataError(f"period_samples: expected an integer >= 4, found {period_samples!r}")
+    if P < 1 or P != periods:
+        raise DataError(f"periods: expected a positive integer, found {periods!r}")
+    if not (np.isfinite(fs) and fs > 0):
+        raise DataError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
+    k = np.arange(max(1, int(math.ceil(f_min * L / fs))), int(math.floor(f_max * L / fs)) + 1)
+    k = k[k < L / 2]
+    if lines == "odd" or lines == "random-odd":
+        k = k[k % 2 == 1]
+        if lines == "random-odd" and k.size >= 3:
+            rng = np.random.default_rng(seed)
+            drop = [g + rng.integers(0, 3) for g in range(0, k.size - 2, 3)]
+            k = np.delete(k, drop)
+    elif lines != "all":
+        raise DataError(f"lines: expected 'all', 'odd' or 'random-odd', found {lines!r}")
+    if k.size == 0:
+        raise DataError(f"no DFT line of a {L}-sample period at {fs:g} Hz (resolution {fs / L:g} Hz) lies in "
+                        f"[{f_min:g}, {f_max:g}] Hz", hint="lengthen the period or widen the band")
+    one = multisine(k * fs / L, L / fs, fs, operating_point=operating_point, limits=limits, amplitude=amplitude,
+                    phases="min-crest", seed=seed, iterations=iterations, unit=unit)
+    u = np.tile(one.u, P)
+    t = np.arange(u.size) / fs
+    info = {**one.info, "lines": k.tolist(), "line_selection": lines, "period_samples": L, "periods": P}
+    return Excitation("multisine", t, u, float(fs), float(operating_point), one.limits, unit, info)
 
 
 def _min_crest_phases(bins: np.ndarray, phi0: np.ndarray, n: int, iterations: int) -> np.ndarray:

@@ -97,7 +97,8 @@ def test_unstable_fitted_model_in_free_run_validation():
 def test_mismatched_lengths_and_shapes():
     with pytest.raises(DataError, match="same length, found 400 and 399"):
         arx(U, Y[:-1], 2, 2, 2)
-    with pytest.raises(DataError, match="expected a 1-D array"):
+    # two inputs are a MIMO ARX (issue 13); two identical input columns cannot be told apart
+    with pytest.raises(UnidentifiableError, match="poorly determined combination involves B2"):
         arx(np.c_[U, U], Y, 2, 2, 2)
     with pytest.raises(DataError, match="nb: expected an integer >= 1, found 0"):
         arx(U, Y, 2, 0, 2)

@@ -22,6 +22,7 @@ OutputOpt = typer.Option(..., "--output", help="Output column (e.g. the force)."
 DetrendOpt = typer.Option("mean", "--detrend",
                           help="Operating-point removal before fitting: mean, linear or none.")
 ValidateOpt = typer.Option(None, "--validate", help="Second record for free-run validation (same columns).")
+ModelOutOpt = typer.Option(None, "--out", help="Write the identified model to this JSON file.")
 NaOpt = typer.Option(..., "--na", help="Number of A coefficients (after the leading 1).")
 NbOpt = typer.Option(..., "--nb", help="Number of B coefficients.")
 NkOpt = typer.Option(..., "--nk", help="Input delay in samples (B's leading zeros).")
@@ -54,11 +55,16 @@ def _io(path: Path, input: str, output: str, fs, time, fill, detrend: str, why: 
 
 
 def _fit_and_report(method: str, data: Path, input: str, output: str, fs, time, fill, detrend: str,
-                    validate: Path | None, json_out: bool, fit):
+                    validate: Path | None, json_out: bool, fit, out_file: Path | None = None):
     """Shared body of arx/armax/oe: load, fit (``fit(io) -> model``), validate, print."""
     with collected_warnings() as caught:
         io = _io(data, input, output, fs, time, fill, detrend, f"{method.upper()} identification")
         model = fit(io)
+        if out_file is not None:  # the model file (issue 13), with the data's name and hash
+            from ..sysid.linear_model import from_polynomial
+            from ..sysid.model_file import file_sha256
+
+            from_polynomial(model).replace(data_file=Path(data).name, data_hash=file_sha256(data)).save(out_file)
         out = model.to_dict()
         out.update(data=str(data), detrend=detrend)
         val = None
@@ -111,13 +117,13 @@ def _print_model(model, val) -> None:
 def identify_arx(data: Path = DataArg, input: str = InputOpt, output: str = OutputOpt,
                  na: int = NaOpt, nb: int = NbOpt, nk: int = NkOpt,
                  fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
-                 validate: Path = ValidateOpt, json_out: bool = JsonOpt):
+                 validate: Path = ValidateOpt, json_out: bool = JsonOpt, out: Path = ModelOutOpt):
     """ARX (orders na, nb, nk) by least squares (QR), with σ, loss (eq 29), fit, AIC, poles and zeros."""
     from ..sysid import arx
 
     _check_options(fs, fill, detrend, validate, na=na, nb=nb, nk=nk)
     _fit_and_report("arx", data, input, output, fs, time, fill, detrend, validate, json_out,
-                    lambda io: arx(io.u, io.y, na, nb, nk, dt=io.dt, **io.meta))
+                    lambda io: arx(io.u, io.y, na, nb, nk, dt=io.dt, **io.meta), out)
 
 
 @identify_app.command("armax")
@@ -127,13 +133,13 @@ def identify_armax(data: Path = DataArg, input: str = InputOpt, output: str = Ou
                    nc: int = typer.Option(..., "--nc", help="Number of C coefficients."),
                    nk: int = NkOpt,
                    fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
-                   validate: Path = ValidateOpt, json_out: bool = JsonOpt):
+                   validate: Path = ValidateOpt, json_out: bool = JsonOpt, out: Path = ModelOutOpt):
     """ARMAX (orders na, nb, nc, nk) by prediction-error minimisation."""
     from ..sysid import armax
 
     _check_options(fs, fill, detrend, validate, na=na, nb=nb, nc=nc, nk=nk)
     _fit_and_report("armax", data, input, output, fs, time, fill, detrend, validate, json_out,
-                    lambda io: armax(io.u, io.y, na, nb, nc, nk, dt=io.dt, **io.meta))
+                    lambda io: armax(io.u, io.y, na, nb, nc, nk, dt=io.dt, **io.meta), out)
 
 
 @identify_app.command("oe")
@@ -142,13 +148,13 @@ def identify_oe(data: Path = DataArg, input: str = InputOpt, output: str = Outpu
                 nf: int = typer.Option(..., "--nf", "--na", help="Number of F (denominator) coefficients."),
                 nk: int = NkOpt,
                 fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
-                validate: Path = ValidateOpt, json_out: bool = JsonOpt):
+                validate: Path = ValidateOpt, json_out: bool = JsonOpt, out: Path = ModelOutOpt):
     """Output-error (orders nb, nf, nk) by prediction-error minimisation."""
     from ..sysid import oe
 
     _check_options(fs, fill, detrend, validate, nb=nb, nf=nf, nk=nk)
     _fit_and_report("oe", data, input, output, fs, time, fill, detrend, validate, json_out,
-                    lambda io: oe(io.u, io.y, nb, nf, nk, dt=io.dt, **io.meta))
+                    lambda io: oe(io.u, io.y, nb, nf, nk, dt=io.dt, **io.meta), out)
 
 
 @identify_app.command("rls")
@@ -203,31 +209,35 @@ def identify_search(data: Path = DataArg, input: str = InputOpt, output: str = O
                     criterion: str = typer.Option("aic", "--criterion", help="Ranking: aic, fpe or loss."),
                     top: int = typer.Option(10, "--top", help="Rows shown in the table (JSON lists all)."),
                     fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
-                    json_out: bool = JsonOpt):
-    """Fit every ARX structure of the ranges and rank them (best first)."""
+                    validate: Path = ValidateOpt, json_out: bool = JsonOpt):
+    """Fit every ARX structure of the ranges and rank them (best first; by free-run fit on --validate)."""
     from ..sysid import structure_search
     from ..sysid.search import CRITERIA, parse_range
 
-    _check_options(fs, fill, detrend)
+    _check_options(fs, fill, detrend, validate)
     check_choice(criterion, "--criterion", CRITERIA)
     check_number(top, "--top", minimum=1, integer=True)
     for name, text in (("--na", na), ("--nb", nb), ("--nk", nk)):
         parse_range(text, name)
     with collected_warnings() as caught:
         io = _io(data, input, output, fs, time, fill, detrend, "ARX structure search")
-        res = structure_search(io.u, io.y, na, nb, nk, criterion=criterion, dt=io.dt)
+        vio = None if validate is None else _io(validate, input, output, fs, time, fill, detrend, "validation")
+        res = structure_search(io.u, io.y, na, nb, nk, criterion=criterion, dt=io.dt,
+                               validate=None if vio is None else (vio.u, vio.y))
     report_warnings(caught)
+    criterion = res.criterion
     if json_out:
         emit_json(res.to_list())
         return
     from rich.console import Console
     from rich.table import Table
 
-    t = Table("rank", "na", "nb", "nk", "loss V_N", "AIC", "FPE", "fit %",
+    t = Table("rank", "na", "nb", "nk", "loss V_N", "AIC", "FPE", "1-step fit %", "validation fit %",
               title=f"ARX structures ranked by {criterion.upper()} ({res.n_used} common samples)")
     for i, c in enumerate(res.candidates[:top], 1):
+        v = c.validation_fit_percent
         t.add_row(str(i), str(c.na), str(c.nb), str(c.nk), f"{c.loss:.5g}", f"{c.aic:.6g}", f"{c.fpe:.5g}",
-                  f"{c.fit_percent:.2f}")
+                  f"{c.fit_percent:.2f}", "—" if v is None else f"{v:.2f}")
     Console().print(t)
     if res.skipped:
         typer.echo(f"{len(res.skipped)} structure(s) skipped (not identifiable from these data)", err=True)

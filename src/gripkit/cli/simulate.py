@@ -1,5 +1,7 @@
 """``gripkit simulate MODEL.toml [--out FILE.parquet] [--json]``: simulate a model described in
-TOML (:mod:`gripkit.description`) and write the trajectory (CSV, Parquet or HDF5 by suffix)."""
+TOML (:mod:`gripkit.description`) and write the trajectory (CSV, Parquet or HDF5 by suffix).
+``gripkit simulate MODEL.json --data DATA [--out FILE]`` simulates an identified model file on the
+input columns of DATA (:func:`gripkit.cli.compare.simulate_model_file`)."""
 
 from __future__ import annotations
 
@@ -8,16 +10,24 @@ from pathlib import Path
 import typer
 
 from .app import app
-from .common import JsonOpt, emit_json, report_warnings
+from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, report_warnings
 
 
 @app.command()
-def simulate(model: Path = typer.Argument(..., help="Model description (.toml).", show_default=False),
+def simulate(model: Path = typer.Argument(..., help="Model description (.toml) or identified model (.json).",
+                                          show_default=False),
              out: Path = typer.Option(None, "--out", help="Write the trajectory here (.parquet, .csv, .h5); "
                                                           "default: [output] file of the description."),
+             data: Path = typer.Option(None, "--data", help="Input data for a .json model (columns by name)."),
+             fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
              json_out: bool = JsonOpt):
-    """Simulate a model described in a TOML file."""
+    """Simulate a model described in a TOML file, or an identified model file on DATA's inputs."""
     import warnings
+
+    if model.suffix.lower() == ".json":
+        from .compare import simulate_model_file
+
+        return simulate_model_file(model, data, out, fs, time, fill, json_out)
 
     import numpy as np
 

@@ -43,3 +43,12 @@ from .dynamics import DynamicsResult as DynamicsResult
 from .dynamics import identify_dynamics as identify_dynamics
 from .motor import characterize_motor as characterize_motor
 from .motor import fit_motor as fit_motor
+from .linear_model import LinearModel as LinearModel
+from .subspace import n4sid as n4sid
+from .subspace import moesp as moesp
+from .pem_ss import pem as pem
+from .frf import FRF as FRF
+from .frf import frf as frf
+from .tfest import tfest as tfest
+from .tfest import tfest_frf as tfest_frf
+from .model_file import load_model as load_model

@@ -43,6 +43,9 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None, fs: flo
         Model metadata: ``input_name``, ``output_name``, ``input_unit``, ``output_unit``,
         ``u_offset``, ``y_offset``.
 
+    With several input or output columns (``u`` (N, m), ``y`` (N, p)) the model is a MIMO ARX
+    of matrix polynomials: see :func:`gripkit.sysid.arx_mimo.arx_mimo`.
+
     Returns
     -------
     PolynomialModel
@@ -69,6 +72,10 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None, fs: flo
     at any scale (1e-300 … 1e300) are identified; the model is in the units of ``u`` and ``y``.
     """
     check_meta(meta, arx)
+    if any(np.ndim(x) == 2 and np.shape(x)[1] > 1 for x in (u, y)):  # several inputs or outputs
+        from .arx_mimo import arx_mimo
+
+        return arx_mimo(u, y, na, nb, nk, dt=dt, fs=fs, **meta)
     u, y, step, na, nb, nk = checked_problem(u, y, dt, fs, na=na, nb=nb, nk=nk)
     cu, cy = unit_scale(u), unit_scale(y)
     return in_user_units(_arx(u * cu, y * cy, na, nb, nk, step, **meta), cu, cy)

@@ -30,10 +30,11 @@ import numpy as np
 from ..arguments import check_keywords, entry_point, keyword_names
 from ..errors import ArgumentError, DataError
 from ..signals.trajectory import Trajectory
+from . import identify_mimo
 
 __all__ = ["IOData", "io_data", "identify", "method_options", "METHODS"]
 
-METHODS = ("arx", "armax", "oe", "rls", "search")
+METHODS = ("arx", "armax", "oe", "rls", "search", "ss", "frf", "tf")
 
 
 @dataclass(frozen=True)
@@ -97,6 +98,12 @@ def _method_function(method: str):
         from .oe import oe as fn
     elif method == "rls":
         from .rls import rls as fn
+    elif method == "ss":
+        fn = identify_mimo.identify_ss
+    elif method == "frf":
+        from .frf import frf as fn
+    elif method == "tf":
+        fn = identify_mimo.identify_tf
     else:
         from .search import structure_search as fn
     return fn
@@ -126,7 +133,11 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
         ``'arx'`` (least squares), ``'armax'`` (orders na, nb, nc, nk), ``'oe'`` (orders nb, nf,
         nk; ``nf`` defaults to ``na``), ``'rls'`` (recursive least squares; options
         ``forgetting``, ``p0``, ``windup``), or ``'search'`` (``na``, ``nb``, ``nk`` may be ranges
-        such as ``'1:4'``; option ``criterion``).
+        such as ``'1:4'``; option ``criterion``); ``'ss'`` (state space by subspace + PEM,
+        options of :func:`gripkit.sysid.identify_mimo.identify_ss`), ``'frf'`` (frequency
+        response, options of :func:`gripkit.sysid.frf`), ``'tf'`` (continuous-time transfer
+        function, options ``poles``, ``zeros``). For these three ``input``/``output`` may name
+        several columns (``'a,b'`` or a list).
     input, output
         Column names.
     detrend
@@ -147,10 +158,17 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
                    hint=f"identify accepts {', '.join(keyword_names(identify))} and, for method {method!r}, "
                         + (", ".join(opts) if opts else "no other options"))
     for name, col in (("input", input), ("output", output)):
-        if not isinstance(col, str):
+        if not (isinstance(col, str) or (method in ("ss", "frf", "tf", "arx") and isinstance(col, (list, tuple))
+                                         and all(isinstance(c, str) for c in col))):
             raise ArgumentError(f"identify(): {name} must be a column name (str), found {type(col).__name__} "
                                 f"{col!r:.40}", hint=f"columns: {', '.join(data.names)}"
                                 if isinstance(data, Trajectory) else None)
+    if method in ("ss", "frf", "tf"):  # MIMO: input/output may name several columns
+        fn = {"ss": identify_mimo.identify_ss, "frf": identify_mimo.identify_frf, "tf": identify_mimo.identify_tf}
+        out = fn[method](data, input=input, output=output, detrend=detrend, **options)
+        return out[0] if method == "ss" else out
+    if method == "arx" and identify_mimo.several(input, output):  # matrix-polynomial ARX
+        return identify_mimo.identify_arx(data, input=input, output=output, na=na, nb=nb, nk=nk, detrend=detrend)
     io = io_data(data, input=input, output=output, detrend=detrend, why=f"{method.upper()} identification")
     if method == "arx":
         from .arx import arx

@@ -463,6 +463,13 @@ class PolynomialModel:
         num, den = self._tf_arrays()
         return control.tf(num, den, self.dt)
 
+    def save(self, path) -> None:
+        """Write the model file (JSON, :mod:`gripkit.sysid.model_file`); reload it with
+        :func:`gripkit.sysid.load_model` (as a :class:`gripkit.sysid.LinearModel`)."""
+        from .model_file import save_model
+
+        save_model(self, path)
+
     def to_dict(self) -> dict:
         """JSON-ready summary (complex numbers as ``[re, im]`` pairs)."""
         def pairs(z):

@@ -25,7 +25,7 @@ from .regression import arx_regression, qr_solve
 
 __all__ = ["Candidate", "SearchResult", "structure_search", "parse_range"]
 
-CRITERIA = ("aic", "fpe", "loss")
+CRITERIA = ("aic", "fpe", "loss", "validation")
 
 
 @dataclass(frozen=True)
@@ -40,10 +40,14 @@ class Candidate:
     aic: float
     fpe: float
     fit_percent: float
+    validation_fit_percent: float | None = None
 
     def to_dict(self) -> dict:
-        return dict(na=self.na, nb=self.nb, nk=self.nk, n_params=self.n_params, loss=self.loss,
-                    aic=self.aic, fpe=self.fpe, fit_percent=self.fit_percent)
+        d = dict(na=self.na, nb=self.nb, nk=self.nk, n_params=self.n_params, loss=self.loss,
+                 aic=self.aic, fpe=self.fpe, fit_percent=self.fit_percent)
+        if self.validation_fit_percent is not None:
+            d["validation_fit_percent"] = self.validation_fit_percent
+        return d
 
 
 @dataclass(frozen=True)
@@ -99,7 +103,7 @@ def parse_range(text: str | int | Iterable[int], name: str) -> list[int]:
 @entry_point
 def structure_search(u, y, na=range(1, 5), nb=range(1, 5), nk=range(1, 11), *,
                      criterion: str = "aic", dt: float | None = None, fs: float | None = None,
-                     progress: bool = True) -> SearchResult:
+                     progress: bool = True, validate=None) -> SearchResult:
     """Fit every ARX ``[na nb nk]`` of the given ranges and rank them.
 
     Parameters
@@ -109,13 +113,21 @@ def structure_search(u, y, na=range(1, 5), nb=range(1, 5), nk=range(1, 11), *,
     na, nb, nk
         Iterables of orders (or ``'1:4'`` strings, see :func:`parse_range`).
     criterion
-        ``'aic'``, ``'fpe'`` or ``'loss'``.
+        ``'aic'``, ``'fpe'`` or ``'loss'``; ``'validation'`` (the default when ``validate`` is
+        given): free-run fit on the validation record, best first.
+    validate
+        ``(u2, y2)``: a second record (deviation units) for free-run validation of every candidate.
     progress
         Show a progress bar on stderr (:func:`gripkit.progress.track`) when the search is long
         (more than 2·10⁶ candidate-samples).
     """
     u, y = check_io(u, y)
-    check_dt(dt, fs)
+    step = check_dt(dt, fs)
+    if validate is not None:
+        uv, yv = check_io(*validate)
+        criterion = "validation"
+    elif criterion == "validation":
+        raise DataError("criterion 'validation' needs a validation record (validate=(u2, y2); CLI: --validate)")
     if criterion not in CRITERIA:
         raise DataError(f"criterion: expected one of {', '.join(CRITERIA)}, found {criterion!r}")
     nas = [check_order(v, "na", 0) for v in parse_range(na, "na")]
@@ -143,10 +155,41 @@ def structure_search(u, y, na=range(1, 5), nb=range(1, 5), nk=range(1, 11), *,
         aic = m * (math.log(2 * math.pi * v) - 2 * math.log(cy)) + m + 2 * p if v > 0 else -math.inf
         fpe = v * (1 + p / m) / (1 - p / m) / cy / cy
         fit = 100.0 * (1.0 - math.sqrt(sol.rss / sst))
-        found.append(Candidate(a, b, k, p, 0.5 * v / cy / cy, aic, fpe, fit))
+        vfit = _validation_fit(sol.theta, a, b, k, step, uv * cu, yv * cy) if validate is not None else None
+        found.append(Candidate(a, b, k, p, 0.5 * v / cy / cy, aic, fpe, fit, vfit))
     if not found:
         raise UnidentifiableError("no structure of the search could be identified: "
                                   + (skipped[0][3] if skipped else "empty grid"))
-    key = {"aic": lambda c: c.aic, "fpe": lambda c: c.fpe, "loss": lambda c: c.loss}[criterion]
+    key = {"aic": lambda c: c.aic, "fpe": lambda c: c.fpe, "loss": lambda c: c.loss,
+           "validation": lambda c: (math.inf if c.validation_fit_percent is None
+                                    else -c.validation_fit_percent)}[criterion]
     found.sort(key=lambda c: (key(c), c.n_params))
+    _warn_edge(found[0], {"na": nas, "nb": nbs, "nk": nks})
     return SearchResult(tuple(found), criterion, m, tuple(skipped))
+
+
+def _validation_fit(theta, na, nb, nk, dt, u, y) -> float | None:
+    """Free-run fit (%) of the ARX [na nb nk] with coefficients θ on (u, y); None if unstable."""
+    import warnings
+
+    from .polynomial import PolynomialModel
+    from .validation import compare
+
+    model = PolynomialModel(np.concatenate([[1.0], theta[:na]]), np.concatenate([np.zeros(nk), theta[na:]]), nk,
+                            dt=dt, structure="arx")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # an unstable candidate simply ranks last
+        return compare(model, u, y).fit_percent
+
+
+def _warn_edge(best: Candidate, ranges: dict) -> None:
+    import warnings
+
+    from ..errors import GripkitWarning
+
+    edges = [f"{name} = {getattr(best, name)} (searched {min(r)}:{max(r)})" for name, r in ranges.items()
+             if len(set(r)) >= 3 and getattr(best, name) in (min(r), max(r))]
+    if edges:
+        warnings.warn(f"structure search: the best structure lies on the edge of the searched range: "
+                      f"{', '.join(edges)}; the best may lie outside it, widen the range", GripkitWarning,
+                      stacklevel=3)

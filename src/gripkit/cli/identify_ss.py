@@ -1,0 +1,178 @@
+"""``gripkit identify ss|frf|tf``: MIMO state space (subspace + PEM), frequency response and
+continuous-time transfer function from a data file, with ``--out MODEL.json`` and ``--json``.
+
+JSON fields (exact, other tools read them):
+
+* ``ss``: ``A``, ``B``, ``C``, ``D``, ``K``, ``dt``, ``order``, ``singular_values``, ``stable``,
+  ``fit_percent`` (list per output, in ``--output`` order) and, with ``--validate``,
+  ``validation.fit_percent`` (list per output, free run, estimated initial state);
+* ``frf``: ``frequency_hz``, ``H_real``, ``H_imag``, ``H_std``, ``coherence`` (where defined);
+* ``tf``: ``num``, ``den`` (continuous time, descending powers of s), ``num_std``, ``den_std``,
+  ``natural_frequency_hz``, ``damping_ratio`` (complex poles), ``fit_percent``.
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import numpy as np
+import typer
+
+from .app import identify_app
+from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data, report_warnings
+
+DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
+InputsOpt = typer.Option(..., "--input", help="Input column(s), comma-separated (e.g. a,b).")
+OutputsOpt = typer.Option(..., "--output", help="Output column(s), comma-separated (e.g. c,d).")
+DetrendOpt = typer.Option("mean", "--detrend", help="Operating-point removal before fitting: mean or none.")
+ModelOutOpt = typer.Option(None, "--out", help="Write the identified model to this JSON file.")
+ReportOpt = typer.Option(None, "--report", help="Write an HTML report of the model on the data to this folder.")
+
+
+def _load(path: Path, inputs: str, outputs: str, fs, time, fill):
+    from ..sysid.identify_mimo import parse_names
+
+    cols = list(parse_names(inputs, "input")) + list(parse_names(outputs, "output"))
+    return load_data(path, cols, fs, time, fill)
+
+
+def _with_provenance(model, data: Path):
+    from ..sysid.model_file import file_sha256
+
+    return model.replace(data_file=Path(data).name, data_hash=file_sha256(data))
+
+
+def _finish(model, data, tr, out, report, caught_lines_fn):
+    """Save and report (shared tail of the three commands)."""
+    if out is not None:
+        model.save(out)
+    if report is not None:
+        from ..report.model_report import write_model_report
+
+        write_model_report(model, tr, report, data_name=Path(data).name)
+
+
+@identify_app.command("ss")
+def identify_ss_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = OutputsOpt,
+                    order: str = typer.Option(None, "--order", help="Order N, or a range LO:HI to search "
+                                                                     "(default: from the singular values)."),
+                    method: str = typer.Option("n4sid", "--method", help="Subspace weighting: n4sid, moesp or cva."),
+                    form: str = typer.Option("innovation", "--form", help="PEM refinement: oe or innovation."),
+                    no_refine: bool = typer.Option(False, "--no-refine", help="Keep the subspace model (no PEM)."),
+                    validate: Path = typer.Option(None, "--validate", help="Second record: free-run validation "
+                                                                           "(and order ranking for a range)."),
+                    out: Path = ModelOutOpt, report: Path = ReportOpt,
+                    fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
+                    json_out: bool = JsonOpt):
+    """MIMO state space: subspace (N4SID/MOESP/CVA, order from the singular values), then PEM."""
+    from ..errors import DataError
+    from ..sysid.identify_mimo import identify_ss
+
+    if form not in ("oe", "innovation"):
+        raise DataError(f"--form: expected oe or innovation, found {form!r}")
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        tr = _load(data, input, output, fs, time, fill)
+        vtr = _load(validate, input, output, fs, time, fill) if validate is not None else None
+        model, extras = identify_ss(tr, input=input, output=output, order=order, method=method, form=form,
+                                    refine=not no_refine, validate=vtr, detrend=detrend)
+        model = _with_provenance(model, data)
+        _finish(model, data, tr, out, report, None)
+    res = model.to_dict()
+    res.update(data=str(data), method=method, refined=not no_refine, out=None if out is None else str(out))
+    if "validation_fit_percent" in extras:
+        res["validation"] = {"fit_percent": extras["validation_fit_percent"], "data": str(validate),
+                             "initial_state": "estimated"}
+    if "search" in extras:
+        res["search"] = extras["search"]
+        res["search_criterion"] = extras["criterion"]
+    res["warnings"] = report_warnings(caught)
+    if json_out:
+        emit_json(res)
+        return
+    ss = model.system
+    typer.echo(f"{model.structure}: order {ss.n_states}, {ss.n_inputs} input(s) {list(ss.inputs)} → "
+               f"{ss.n_outputs} output(s) {list(ss.outputs)}, dt = {ss.dt:g} s, "
+               f"{'stable' if model.stable else 'UNSTABLE'}")
+    sv = model.singular_values
+    if sv is not None:
+        typer.echo("singular values: " + " ".join(f"{v:.3g}" for v in sv[:min(sv.size, 12)]))
+    for name, f in zip(ss.outputs, model.fit_percent):
+        typer.echo(f"  {name}: free-run fit {f:.2f} %")
+    if "validation_fit_percent" in extras and extras["validation_fit_percent"] is not None:
+        typer.echo("validation free-run fit: " + ", ".join(f"{n} {f:.2f} %" for n, f in
+                                                           zip(ss.outputs, extras["validation_fit_percent"])))
+    p, cov = (ss.pole_covariance() if ss.uncertainty is not None else (ss.poles(), None))
+    for i, z in enumerate(p):
+        sd = "" if cov is None else f" ± ({np.sqrt(cov[i, 0, 0]):.2g}, {np.sqrt(cov[i, 1, 1]):.2g})"
+        typer.echo(f"  pole {z.real:.6g}{z.imag:+.6g}j{sd}")
+    if out is not None:
+        typer.echo(f"model written to {out}")
+
+
+@identify_app.command("frf")
+def identify_frf_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = OutputsOpt,
+                     periods: int = typer.Option(None, "--periods", help="Number of periods of a periodic input "
+                                                                         "(averaging; the first is dropped)."),
+                     keep_transient: bool = typer.Option(False, "--keep-transient",
+                                                         help="Keep the first period with --periods."),
+                     method: str = typer.Option("auto", "--method", help="auto, periodic, h1 or spa."),
+                     nperseg: int = typer.Option(None, "--nperseg", help="Samples per Welch segment (h1)."),
+                     fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
+                     json_out: bool = JsonOpt):
+    """Frequency response with σ on every line (periodic averaging, Welch H1 with coherence, SPA)."""
+    from ..sysid.identify_mimo import identify_frf
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        tr = _load(data, input, output, fs, time, fill)
+        r = identify_frf(tr, input=input, output=output, detrend=detrend, method=method, periods=periods,
+                         keep_transient=keep_transient, nperseg=nperseg)
+    res = r.to_dict()
+    res.update(data=str(data), warnings=report_warnings(caught))
+    if json_out:
+        emit_json(res)
+        return
+    typer.echo(f"FRF ({r.method}): {r.frequency_hz.size} lines, {list(r.inputs)} → {list(r.outputs)}")
+    step = max(1, r.frequency_hz.size // 20)
+    for k in range(0, r.frequency_hz.size, step):
+        h, s = r.H[k, 0, 0], r.H_std[k, 0, 0]
+        typer.echo(f"  {r.frequency_hz[k]:10.4g} Hz  |H| {abs(h):.4g}  "
+                   f"phase {np.degrees(np.angle(h)):7.1f}°  σ {s:.2g}")
+
+
+@identify_app.command("tf")
+def identify_tf_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = OutputsOpt,
+                    poles: int = typer.Option(..., "--poles", help="Number of poles."),
+                    zeros: int = typer.Option(..., "--zeros", help="Number of zeros."),
+                    out: Path = ModelOutOpt, report: Path = ReportOpt,
+                    fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
+                    json_out: bool = JsonOpt):
+    """Continuous-time transfer function (zero-order hold between samples) with σ."""
+    from ..sysid.identify_mimo import identify_tf
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        tr = _load(data, input, output, fs, time, fill)
+        model = _with_provenance(identify_tf(tr, input=input, output=output, poles=poles, zeros=zeros,
+                                             detrend=detrend), data)
+        _finish(model, data, tr, out, report, None)
+    g, info = model.system, model.info
+    res = {"num": g.numerator(), "den": g.denominator(), "num_std": info["num_std"][-(zeros + 1):],
+           "den_std": info["den_std"], "natural_frequency_hz": info["natural_frequency_hz"],
+           "natural_frequency_hz_std": info["natural_frequency_hz_std"], "damping_ratio": info["damping_ratio"],
+           "damping_ratio_std": info["damping_ratio_std"], "fit_percent": model.fit_percent,
+           "poles": [[float(z.real), float(z.imag)] for z in g.poles()], "inputs": list(g.inputs),
+           "outputs": list(g.outputs), "data": str(data), "out": None if out is None else str(out),
+           "warnings": report_warnings(caught)}
+    if json_out:
+        emit_json(res)
+        return
+    fmt = lambda v, s: " ".join(f"{a:.6g}±{b:.2g}" for a, b in zip(v, s))  # noqa: E731
+    typer.echo(f"G(s) = num/den, {poles} pole(s), {zeros} zero(s); free-run fit {model.fit_percent[0]:.2f} %")
+    typer.echo(f"  num: {fmt(res['num'], res['num_std'])}")
+    typer.echo(f"  den: {fmt(res['den'], res['den_std'])}")
+    for f, sf, z, sz in zip(res["natural_frequency_hz"], res["natural_frequency_hz_std"], res["damping_ratio"],
+                            res["damping_ratio_std"]):
+        typer.echo(f"  mode: f_n = {f:.6g} ± {sf:.2g} Hz, ζ = {z:.4g} ± {sz:.2g}")

@@ -1,0 +1,229 @@
+"""Identification from a :class:`~gripkit.signals.Trajectory` with several inputs and outputs:
+state space (subspace, then PEM), frequency response and continuous-time transfer function.
+
+Column selection by name (``input='a,b'`` or ``['a', 'b']``), the uniform-sampling check, units,
+and removal of the operating point (``detrend='mean'``: each channel's mean, recorded as the
+model's offsets) as in :func:`gripkit.sysid.identify`.
+
+Order search (``order='2:8'``): every order of the range is fitted from one factorisation and
+ranked by the free-run fit on ``validate`` data (mean over outputs, x0 estimated) when given,
+the lowest order within 0.05 fit points of the best winning (higher orders that fit the noise tie),
+otherwise by Akaike's criterion of the innovation predictor,
+``AIC = N log det Λ̂ + 2 d``, d = n(m + 2p) (+ pm with D) free parameters. A best order on the
+edge of a range of three or more orders is warned about: the true order may lie outside it.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import DataError, GripkitWarning
+from ..progress import status
+from ..signals.trajectory import Trajectory
+
+__all__ = ["MimoData", "mimo_data", "identify_ss", "identify_frf", "identify_tf", "identify_arx", "several",
+           "parse_names", "parse_order"]
+
+
+def parse_names(x, what: str) -> tuple[str, ...]:
+    """Column names from ``'a,b'`` or a sequence."""
+    names = [s.strip() for s in x.split(",")] if isinstance(x, str) else [str(s).strip() for s in x]
+    if not names or any(not n for n in names):
+        raise DataError(f"{what}: expected one or more column names separated by commas, found {x!r}")
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise DataError(f"{what}: column(s) {', '.join(map(repr, dup))} listed twice")
+    return tuple(names)
+
+
+def parse_order(order) -> tuple[int, int] | None:
+    """None, N, 'N' or 'LO:HI' as an inclusive (lo, hi) range."""
+    if order is None:
+        return None
+    if isinstance(order, (int, np.integer)) and not isinstance(order, bool):
+        lo = hi = int(order)
+    else:
+        txt = str(order).strip()
+        try:
+            lo, hi = (int(v) for v in txt.split(":")) if ":" in txt else (int(txt),) * 2
+        except ValueError:
+            raise DataError(f"order: expected N or LO:HI (positive integers), found {order!r}") from None
+    if lo < 1 or hi < lo:
+        raise DataError(f"order: expected 1 <= LO <= HI, found {order!r}")
+    return lo, hi
+
+
+@dataclass(frozen=True)
+class MimoData:
+    """Inputs (N, m) and outputs (N, p) in deviation units, with names, units and offsets."""
+
+    u: np.ndarray
+    y: np.ndarray
+    dt: float
+    inputs: tuple[str, ...]
+    outputs: tuple[str, ...]
+    input_units: tuple[str, ...]
+    output_units: tuple[str, ...]
+    u_offset: tuple[float, ...]
+    y_offset: tuple[float, ...]
+
+    @property
+    def signals(self) -> dict:
+        return dict(inputs=self.inputs, outputs=self.outputs, input_units=self.input_units,
+                    output_units=self.output_units)
+
+
+def mimo_data(data: Trajectory, inputs, outputs, detrend: str = "mean", why: str = "identification") -> MimoData:
+    """Select and detrend the input and output columns of a uniformly sampled trajectory."""
+    if not isinstance(data, Trajectory):
+        raise DataError(f"data: expected a gripkit Trajectory, found {type(data).__name__}",
+                        hint="use gripkit.io.load(path) or Trajectory.uniform(fs, u=..., y=...)")
+    ins, outs = parse_names(inputs, "input"), parse_names(outputs, "output")
+    both = sorted(set(ins) & set(outs))
+    if both:
+        raise DataError(f"input and output must be different columns, {', '.join(map(repr, both))} is both")
+    missing = [n for n in ins + outs if n not in data.names]
+    if missing:
+        raise DataError(f"data: column(s) {', '.join(map(repr, missing))} not found; the data have "
+                        f"{', '.join(map(repr, data.names))}")
+    if detrend not in ("mean", "none"):
+        raise DataError(f"detrend: expected 'mean' or 'none', found {detrend!r}")
+    fs = float(f"{data.require_uniform(why=why):.9g}")
+    u = np.column_stack([np.asarray(data[n], dtype=np.float64) for n in ins])
+    y = np.column_stack([np.asarray(data[n], dtype=np.float64) for n in outs])
+    for names, x, what in ((ins, u, "input"), (outs, y, "output")):
+        flat = np.ptp(x, axis=0) <= 1e-12 * np.maximum(np.max(np.abs(x), axis=0), 1e-300)
+        if flat.any():
+            name = names[int(np.argmax(flat))]
+            raise DataError(f"{what} column {name!r} is constant ({x[0, int(np.argmax(flat))]:.6g} for all "
+                            f"{x.shape[0]} samples): it carries no information",
+                            hint="drop it from --input/--output or check the data")
+    u0 = u.mean(axis=0) if detrend == "mean" else np.zeros(len(ins))
+    y0 = y.mean(axis=0) if detrend == "mean" else np.zeros(len(outs))
+    return MimoData(u - u0, y - y0, 1.0 / fs, ins, outs, tuple(data.unit(n) for n in ins),
+                    tuple(data.unit(n) for n in outs), tuple(map(float, u0)), tuple(map(float, y0)))
+
+
+def _validation_fit(model, vd: MimoData) -> list[float] | None:
+    if not model.stable:
+        return None
+    return model.compare(vd.u, vd.y, dt=vd.dt)[0]
+
+
+def _aic(model, d: MimoData) -> float:
+    from .pem_ss import _predict
+
+    ss = model.system
+    K = model.K if model.K is not None else np.zeros((ss.n_states, ss.n_outputs))
+    x0 = model.x0 if model.x0 is not None else np.zeros(ss.n_states)
+    e = np.empty_like(d.y)
+    _predict(ss.A, ss.B, ss.C, ss.D, K, x0, d.u, d.y, e)
+    N, p = d.y.shape
+    m = d.u.shape[1]
+    sign, logdet = np.linalg.slogdet(e.T @ e / N)
+    k = ss.n_states * (m + 2 * p) + (p * m if np.any(ss.D) else 0)
+    return float(N * logdet + 2 * k) if sign > 0 else -math.inf
+
+
+def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n4sid", form: str = "innovation",
+                refine: bool = True, validate: Trajectory | None = None, detrend: str = "mean",
+                horizon: int | None = None, feedthrough: bool = False):
+    """State-space model of the named columns: subspace (``method``), then PEM in ``form``
+    unless ``refine=False``. Returns ``(model, extras)``; ``extras`` holds ``search`` (the ranked
+    orders of a range), ``validation_fit_percent`` (per output, with ``validate``) and
+    ``criterion``."""
+    from .pem_ss import pem
+    from .subspace import (DEFAULT_MAX_ORDER, SUBSPACE_METHODS, default_horizon, from_factor, select_order,
+                           subspace_factor)
+
+    if method not in SUBSPACE_METHODS:
+        raise DataError(f"method: expected one of {', '.join(SUBSPACE_METHODS)}, found {method!r}")
+    d = mimo_data(data, input, output, detrend, why="state-space identification")
+    vd = None
+    if validate is not None:
+        vd = mimo_data(validate, d.inputs, d.outputs, detrend, why="validation")
+        if abs(vd.dt - d.dt) > 1e-9 * d.dt:
+            raise DataError(f"validation data are sampled at {1 / vd.dt:g} Hz, the estimation data at {1 / d.dt:g} Hz",
+                            hint="resample one of them")
+    rng = parse_order(order)
+    n_hi = rng[1] if rng else DEFAULT_MAX_ORDER
+    k = default_horizon(n_hi, d.y.shape[1]) if horizon is None else int(horizon)
+    status(f"{method}: {d.u.shape[0]} samples, {len(d.inputs)} input(s), {len(d.outputs)} output(s), horizon {k}")
+    fac = subspace_factor(d.u, d.y, horizon=k, method=method)
+    extras: dict = {}
+    build = lambda n: from_factor(fac, n, dt=d.dt, feedthrough=feedthrough, signals=d.signals)  # noqa: E731
+    if rng is None:
+        n = select_order(fac.s, min(n_hi, fac.s.size - 1))
+        model = build(n)
+        model.info["order_selection"] = "singular values above the noise floor"
+    elif rng[0] == rng[1]:
+        model = build(rng[0])
+        model.info["order_selection"] = "given"
+    else:
+        rows = []
+        criterion = "validation_fit" if vd is not None else "aic"
+        for n in range(rng[0], rng[1] + 1):
+            cand = build(n)
+            row = {"order": n, "fit_percent": cand.fit_percent, "aic": _aic(cand, d)}
+            if vd is not None:
+                vf = _validation_fit(cand, vd)
+                row["validation_fit_percent"] = vf
+                row["score"] = -math.inf if vf is None else float(np.mean(vf))
+            else:
+                row["score"] = -row["aic"]
+            rows.append((row, cand))
+        rows.sort(key=lambda rc: -rc[0]["score"])
+        if vd is not None:  # parsimony: the lowest order within 0.05 fit points of the best
+            top = rows[0][0]["score"]
+            close = [rc for rc in rows if rc[0]["score"] >= top - 0.05]
+            pick = min(close, key=lambda rc: rc[0]["order"])
+            rows.remove(pick)
+            rows.insert(0, pick)
+        best_row, model = rows[0]
+        model.info["order_selection"] = f"best of {rng[0]}:{rng[1]} by {criterion}"
+        extras["search"] = [r for r, _ in rows]
+        extras["criterion"] = criterion
+        if best_row["order"] in rng and rng[1] - rng[0] >= 2:
+            warnings.warn(f"order search: the best order {best_row['order']} lies on the edge of the searched range "
+                          f"{rng[0]}:{rng[1]}; the true order may lie outside it, widen the range",
+                          GripkitWarning, stacklevel=2)
+    model = model.replace(u_offset=d.u_offset, y_offset=d.y_offset)
+    if refine:
+        status(f"PEM refinement ({form} form) of the order-{model.order} model")
+        model = pem(model, u=d.u, y=d.y, form=form)
+    if vd is not None:
+        extras["validation_fit_percent"] = _validation_fit(model, vd)
+    return model, extras
+
+
+def identify_frf(data: Trajectory, *, input, output, detrend: str = "mean", **options):
+    """Frequency response of the named columns (:func:`gripkit.sysid.frf` options)."""
+    from .frf import frf
+
+    d = mimo_data(data, input, output, detrend, why="frequency-response estimation")
+    return frf(d.u, d.y, dt=d.dt, inputs=d.inputs, outputs=d.outputs, **options)
+
+
+def identify_tf(data: Trajectory, *, input, output, poles: int, zeros: int, detrend: str = "mean"):
+    """Continuous-time transfer function of the named columns (:func:`gripkit.sysid.tfest`)."""
+    from .tfest import tfest
+
+    d = mimo_data(data, input, output, detrend, why="transfer-function estimation")
+    return tfest(d.u, d.y, poles, zeros, dt=d.dt, u_offset=d.u_offset, y_offset=d.y_offset, **d.signals)
+
+
+def several(*names) -> bool:
+    """Whether any of the column specifications names more than one column."""
+    return any(len(parse_names(n, "column")) > 1 for n in names)
+
+
+def identify_arx(data: Trajectory, *, input, output, na: int, nb: int, nk: int = 1, detrend: str = "mean"):
+    """MIMO ARX of the named columns (:func:`gripkit.sysid.arx_mimo.arx_mimo`)."""
+    from .arx_mimo import arx_mimo
+
+    d = mimo_data(data, input, output, detrend, why="ARX identification")
+    return arx_mimo(d.u, d.y, na, nb, nk, dt=d.dt, u_offset=d.u_offset, y_offset=d.y_offset, **d.signals)

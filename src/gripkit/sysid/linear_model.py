@@ -1,0 +1,289 @@
+"""An identified linear model: a :mod:`gripkit.lti` system plus what identification knows about it
+(innovation gain K, initial state, offsets, fit, singular values, data provenance).
+
+Discrete innovation form (the subspace and PEM models)::
+
+    x[t+1] = A x[t] + B u[t] + K e[t],   y[t] = C x[t] + D u[t] + e[t],   e white, cov Λ.
+
+``K = 0`` is the output-error form. Signals are in deviation units: the model's ``u_offset`` and
+``y_offset`` (one per input and output, the operating point removed before fitting) are applied by
+:meth:`LinearModel.simulate_data` and :meth:`LinearModel.compare_data`, which take a
+:class:`~gripkit.signals.Trajectory` and pick its columns by name.
+
+Free-run fit per output, ``100 (1 − ‖y_i − ŷ_i‖/‖y_i − ȳ_i‖)``, uses an initial state estimated by
+least squares (the output is affine in x0: ``y = O x0 + G u``, ``O`` the rows ``C A^t``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import DataError, ModelError
+from ..lti import LinearSystem, StateSpace, TransferFunction
+from ..lti._kernels import simulate_ss
+
+__all__ = ["LinearModel", "as_io_matrix", "estimate_x0", "free_run", "fit_per_output", "from_polynomial"]
+
+
+def as_io_matrix(x, name: str, n: int | None = None) -> np.ndarray:
+    """``x`` as a finite (N, k) float64 array (a 1-D signal is one column)."""
+    try:
+        a = np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise DataError(f"{name}: expected an array of numbers, found {type(x).__name__}") from None
+    if a.ndim == 1:
+        a = a[:, None]
+    if a.ndim != 2 or a.shape[0] == 0 or a.shape[1] == 0:
+        raise DataError(f"{name}: expected shape (N,) or (N, channels), found {a.shape}")
+    if n is not None and a.shape[0] != n:
+        raise DataError(f"{name}: expected {n} samples (as many as the other signal), found {a.shape[0]}")
+    bad = ~np.isfinite(a)
+    if bad.any():
+        r, c = np.argwhere(bad)[0]
+        raise DataError(f"{name} has {int(bad.sum())} NaN/inf values (first at sample {r}, channel {c})",
+                        hint="drop or interpolate them before identification (CLI: --fill)")
+    return np.ascontiguousarray(a)
+
+
+def _sim(A, B, C, D, u, x0):
+    y = np.empty((u.shape[0], C.shape[0]))
+    simulate_ss(A, B, C, D, u, np.array(x0, dtype=np.float64), np.empty(A.shape[0]), y)
+    return y
+
+
+def free_run(A, B, C, D, u, x0=None) -> np.ndarray:
+    """Outputs (N, p) of ``x[t+1] = A x + B u, y = C x + D u`` from ``x0`` (numba kernel)."""
+    A, B, C, D = (np.ascontiguousarray(M, dtype=np.float64) for M in (A, B, C, D))
+    return _sim(A, B, C, D, np.ascontiguousarray(u, dtype=np.float64), np.zeros(A.shape[0]) if x0 is None else x0)
+
+
+def observability_regressor(A, C, N: int) -> np.ndarray:
+    """``O`` of shape (N, p, n): ``O[t] = C A^t`` (the response of each output to each unit x0)."""
+    n, p = A.shape[0], C.shape[0]
+    O = np.empty((N, p, n))
+    Ac, Cc = np.ascontiguousarray(A), np.ascontiguousarray(C)
+    z = np.zeros((N, 1))
+    for i in range(n):
+        e = np.zeros(n)
+        e[i] = 1.0
+        O[:, :, i] = _sim(Ac, np.zeros((n, 1)), Cc, np.zeros((p, 1)), z, e)
+    return O
+
+
+def estimate_x0(A, B, C, D, u, y) -> np.ndarray:
+    """Least-squares initial state: ``argmin ‖y − G u − O x0‖`` (``O[t] = C A^t``)."""
+    n = A.shape[0]
+    if n == 0:
+        return np.zeros(0)
+    r = y - free_run(A, B, C, D, u)
+    O = observability_regressor(A, C, y.shape[0]).reshape(-1, n)
+    return np.linalg.lstsq(O, r.reshape(-1), rcond=None)[0]
+
+
+def fit_per_output(y, yhat) -> list[float]:
+    """Fit (%) of each output column; DataError for a constant output."""
+    out = []
+    for i in range(y.shape[1]):
+        den = float(np.linalg.norm(y[:, i] - y[:, i].mean()))
+        if den == 0.0:
+            raise DataError(f"output {i}: the fit is undefined for a constant output (‖y − ȳ‖ = 0)")
+        out.append(100.0 * (1.0 - float(np.linalg.norm(y[:, i] - yhat[:, i])) / den))
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class LinearModel:
+    """An identified linear model.
+
+    Attributes
+    ----------
+    system
+        The :mod:`gripkit.lti` system (``StateSpace`` for subspace/PEM models, continuous
+        ``TransferFunction`` for tfest), with names, units, dt and parameter covariance.
+    structure
+        ``'n4sid'``, ``'moesp'``, ``'cva'``, ``'pem-oe'``, ``'pem-innovation'``, ``'tfest'``.
+    K
+        Innovation gain (n, p) or None (output-error form).
+    x0
+        Initial state estimated on the estimation data (n,) or None.
+    noise_covariance
+        Λ, covariance of the innovations (p, p), or None.
+    u_offset, y_offset
+        Operating point removed from each input / output before fitting.
+    fit_percent
+        Free-run fit per output on the estimation data (estimated x0).
+    singular_values
+        Of the weighted subspace matrix (subspace models), else None.
+    data_file, data_hash
+        Provenance of the estimation data (file name, sha256 of its bytes).
+    info
+        Method details (horizon, weighting, iterations, stability notes, ...).
+    """
+
+    system: LinearSystem
+    structure: str
+    K: np.ndarray | None = None
+    x0: np.ndarray | None = None
+    noise_covariance: np.ndarray | None = None
+    u_offset: tuple[float, ...] | None = None
+    y_offset: tuple[float, ...] | None = None
+    fit_percent: list[float] | None = None
+    singular_values: np.ndarray | None = None
+    n_samples: int | None = None
+    data_file: str | None = None
+    data_hash: str | None = None
+    info: dict = field(default_factory=dict)
+
+    def __post_init__(self):
+        s = self.system
+        if not isinstance(s, LinearSystem):
+            raise ModelError(f"system: expected a gripkit.lti system, found {type(s).__name__}")
+        set_ = object.__setattr__
+        set_(self, "u_offset", tuple(float(v) for v in (self.u_offset or (0.0,) * s.n_inputs)))
+        set_(self, "y_offset", tuple(float(v) for v in (self.y_offset or (0.0,) * s.n_outputs)))
+        if len(self.u_offset) != s.n_inputs or len(self.y_offset) != s.n_outputs:
+            raise ModelError(f"offsets: expected {s.n_inputs} input and {s.n_outputs} output offsets, found "
+                             f"{len(self.u_offset)} and {len(self.y_offset)}")
+        if self.K is not None:
+            K = np.array(self.K, dtype=np.float64).reshape(-1, s.n_outputs)
+            if not isinstance(s, StateSpace) or K.shape != (s.n_states, s.n_outputs):
+                raise ModelError(f"K: expected shape (n_states, {s.n_outputs}) on a StateSpace, found {K.shape}")
+            set_(self, "K", K)
+
+    # ------------------------------------------------------------------ views
+    @property
+    def inputs(self) -> tuple[str, ...]:
+        return self.system.inputs
+
+    @property
+    def outputs(self) -> tuple[str, ...]:
+        return self.system.outputs
+
+    @property
+    def dt(self) -> float | None:
+        return self.system.dt
+
+    @property
+    def order(self) -> int:
+        return self.system.to_ss(minimal=False).n_states
+
+    @property
+    def stable(self) -> bool:
+        return self.system.is_stable()
+
+    def replace(self, **changes) -> LinearModel:
+        return dataclasses.replace(self, **changes)
+
+    def discrete(self, dt: float) -> StateSpace:
+        """The state-space system sampled at ``dt`` (ZOH for a continuous model)."""
+        ss = self.system.to_ss(minimal=False)
+        if ss.is_discrete:
+            if abs(ss.dt - dt) > 1e-9 * dt:
+                raise DataError(f"data: sampled every {dt:g} s, the model every {ss.dt:g} s",
+                                hint="resample the data to the model's rate")
+            return ss
+        return ss.c2d(dt)
+
+    # ------------------------------------------------------------------ arrays in
+    def simulate(self, u, x0=None, dt: float | None = None) -> np.ndarray:
+        """Free-run outputs (N, p) in deviation units for deviation inputs ``u`` (N, m)."""
+        ss = self.discrete(dt or self.dt)
+        u = as_io_matrix(u, "u")
+        if u.shape[1] != ss.n_inputs:
+            raise DataError(f"u: expected {ss.n_inputs} input columns, found {u.shape[1]}")
+        return free_run(ss.A, ss.B, ss.C, ss.D, u, x0)
+
+    def compare(self, u, y, dt: float | None = None) -> tuple[list[float], np.ndarray, np.ndarray]:
+        """Free-run fit (%) per output with the initial state estimated by least squares;
+        returns ``(fit_percent, y_sim, x0)``."""
+        ss = self.discrete(dt or self.dt)
+        u = as_io_matrix(u, "u")
+        y = as_io_matrix(y, "y", u.shape[0])
+        if not ss.is_stable():
+            raise ModelError("compare: the model is unstable (a pole outside the unit circle): its free run "
+                             "diverges, so no fit is reported")
+        x0 = estimate_x0(ss.A, ss.B, ss.C, ss.D, u, y)
+        ys = free_run(ss.A, ss.B, ss.C, ss.D, u, x0)
+        return fit_per_output(y, ys), ys, x0
+
+    # ------------------------------------------------------------------ trajectories in
+    def _columns(self, data, names, offsets, what):
+        missing = [n for n in names if n not in data.names]
+        if missing:
+            raise DataError(f"data: the model's {what} column(s) {', '.join(map(repr, missing))} are missing; "
+                            f"the data have {', '.join(map(repr, data.names))}",
+                            hint="rename the columns or identify the model from matching data")
+        return np.column_stack([np.asarray(data[n], dtype=np.float64) - o for n, o in zip(names, offsets)])
+
+    def simulate_data(self, data) -> np.ndarray:
+        """Simulated outputs (N, p), offsets added back, for the input columns of a trajectory
+        (picked by name; the model's input offsets removed first), from x0 = 0."""
+        dt = 1.0 / data.require_uniform(why="simulation of an identified model")
+        u = self._columns(data, self.inputs, self.u_offset, "input")
+        return self.simulate(u, dt=dt) + np.asarray(self.y_offset)
+
+    def compare_data(self, data) -> tuple[list[float], np.ndarray]:
+        """Free-run fit per output on a trajectory (columns by name, offsets applied, x0
+        estimated); returns ``(fit_percent, y_sim with offsets)``."""
+        dt = 1.0 / data.require_uniform(why="comparison of an identified model")
+        u = self._columns(data, self.inputs, self.u_offset, "input")
+        y = self._columns(data, self.outputs, self.y_offset, "output")
+        fit, ys, _ = self.compare(u, y, dt=dt)
+        return fit, ys + np.asarray(self.y_offset)
+
+    # ------------------------------------------------------------------ interop and files
+    def to_control(self):
+        """``control.StateSpace`` or ``control.TransferFunction``, with names."""
+        return self.system.to_control()
+
+    def save(self, path) -> None:
+        """Write the model to a JSON file (see :mod:`gripkit.sysid.model_file`)."""
+        from .model_file import save_model
+
+        save_model(self, path)
+
+    def to_dict(self) -> dict:
+        """JSON-ready summary (arrays as lists)."""
+        ss = self.system.to_ss(minimal=False)
+        out = {"structure": self.structure, "inputs": list(self.inputs), "outputs": list(self.outputs),
+               "dt": self.dt, "order": ss.n_states, "stable": self.stable,
+               "fit_percent": self.fit_percent}
+        if isinstance(self.system, StateSpace):
+            out.update(A=ss.A, B=ss.B, C=ss.C, D=ss.D,
+                       K=np.zeros((ss.n_states, ss.n_outputs)) if self.K is None else self.K,
+                       x0=self.x0, noise_covariance=self.noise_covariance)
+        if isinstance(self.system, TransferFunction):
+            out.update(num=self.system.num, den=self.system.den)
+        if self.singular_values is not None:
+            out["singular_values"] = self.singular_values
+        p, cov = (self.system.pole_covariance() if self.system.uncertainty is not None
+                  else (self.system.poles(), None))
+        out["poles"] = [[float(z.real), float(z.imag)] for z in p]
+        if cov is not None:
+            out["poles_std"] = [[float(np.sqrt(c[0, 0])), float(np.sqrt(c[1, 1]))] for c in cov]
+        out["info"] = self.info
+        return out
+
+    def __repr__(self) -> str:
+        return (f"LinearModel({self.structure}, order={self.order}, inputs={list(self.inputs)}, "
+                f"outputs={list(self.outputs)}, dt={self.dt})")
+
+
+def from_polynomial(pm) -> LinearModel:
+    """A :class:`~gripkit.sysid.PolynomialModel` (ARX/ARMAX/OE) as a :class:`LinearModel` on the
+    discrete transfer function B/(A F) (:meth:`gripkit.lti.TransferFunction.from_polynomials`),
+    with the parameter covariance (the noise polynomial C keeps its place in it, with zero
+    tangents, and is recorded in ``info``), names, units and offsets."""
+    g = TransferFunction.from_polynomials(pm.A, pm.B, C=pm.C if pm.C.size > 1 else None, F=pm.F, dt=pm.dt,
+                                          covariance=pm.covariance, inputs=pm.input_name, outputs=pm.output_name,
+                                          input_units=pm.input_unit, output_units=pm.output_unit)
+    info = {"label": pm.label, "A": pm.A, "B": pm.B, "C": pm.C, "F": pm.F, "nk": pm.nk,
+            "one_step_fit_percent": pm.fit_percent, "noise_variance": pm.noise_variance,
+            "parameter_names": list(pm.parameter_names), **{k: v for k, v in pm.info.items()
+                                                            if isinstance(v, (str, int, float))}}
+    return LinearModel(g, pm.structure, u_offset=(pm.u_offset,), y_offset=(pm.y_offset,), n_samples=pm.n_samples,
+                       noise_covariance=None if pm.noise_variance is None else np.array([[pm.noise_variance]]),
+                       info=info)

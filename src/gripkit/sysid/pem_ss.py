@@ -1,0 +1,408 @@
+"""Prediction-error refinement of discrete MIMO state-space models (ssest-like).
+
+Predictor of the innovation form (``K = 0``: output error)::
+
+    ŷ[t] = C x[t] + D u[t],   e[t] = y[t] − ŷ[t],   x[t+1] = A x[t] + B u[t] + K e[t],   x[0] = x0.
+
+Criterion: ``V = Σ_t e[t]ᵀ Λ⁻¹ e[t]`` with Λ the innovation covariance of the starting model (fixed,
+so that outputs in different units weigh alike). Parameters: a state-space model is defined up
+to a similarity transformation, whose tangent at the current model, ``(T A T⁻¹, T B, C T⁻¹, T K)``
+at T = I + X, is ``(XA − AX, XB, −CX, XK)``. As in the data-driven local coordinates of McKelvey,
+Helmersson & Ribarits (2004) only d = nm + pn (+ pm) (+ np) directions complementing that orbit
+are free; here they are d *entries* of (A, B, C[, D][, K]), the ones whose unit directions
+complement the orbit best (QR with column pivoting of a basis of its orthogonal complement),
+re-chosen at every iterate; the other entries stay where they are during the step. Unit
+directions make the sensitivity equations sparse (cheap). x0 is estimated too.
+
+Jacobians are exact, from the sensitivity equations (numba kernels, parallel over the
+directions), for each direction θ_q with matrix tangents (dA, dB, dC, dD, dK)::
+
+    ∂ŷ[t] = C s[t] + dC x[t] + dD u[t],
+    s[t+1] = A s[t] + dA x[t] + dB u[t] + dK e[t] − K ∂ŷ[t]
+           = (A − KC) s[t] + (dA − K dC) x[t] + (dB − K dD) u[t] + dK e[t],   s[0] = 0 (e_i for x0_i).
+
+Levenberg-Marquardt steps re-centre the coordinates after every accepted step and reject any step
+that makes A (or the predictor A − KC) unstable, so stability is kept. The covariance of the
+directions is ``σ² (JᵀJ)⁻¹`` (J of the whitened errors, σ² = V/(Np − d − n)); it is carried as the
+:class:`gripkit.lti.Uncertainty` of the model's (A, B, C, D) with the directions as tangents, from
+which poles and frequency responses get their σ by linearisation.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+import scipy.linalg as sla
+
+from ..errors import DataError, IdentificationError
+from ..lti import StateSpace, Uncertainty
+from .linear_model import LinearModel, as_io_matrix, fit_per_output, free_run
+from .subspace import _gram
+
+__all__ = ["pem", "PEM_FORMS"]
+
+PEM_FORMS = ("oe", "innovation")
+_WARM_START_SAMPLES = 20000
+# A decrease of the whitened criterion below 0.01 means the last step moved the parameters by less
+# than 0.1σ (jointly, ΔV ≈ δᵀ Σ⁻¹ δ): further iterations cannot change the answer.
+_NEGLIGIBLE_DROP = 0.01
+
+
+@numba.njit(cache=True)
+def _predict(A, B, C, D, K, x0, u, y, e):  # pragma: no cover - compiled
+    """Prediction errors e (N, p) of the predictor of the module docstring."""
+    n, m, p = A.shape[0], B.shape[1], C.shape[0]
+    x = x0.copy()
+    xn = np.empty(n)
+    for t in range(u.shape[0]):
+        for i in range(p):
+            acc = 0.0
+            for j in range(n):
+                acc += C[i, j] * x[j]
+            for j in range(m):
+                acc += D[i, j] * u[t, j]
+            e[t, i] = y[t, i] - acc
+        for r in range(n):
+            acc = 0.0
+            for j in range(n):
+                acc += A[r, j] * x[j]
+            for j in range(m):
+                acc += B[r, j] * u[t, j]
+            for j in range(p):
+                acc += K[r, j] * e[t, j]
+            xn[r] = acc
+        for r in range(n):
+            x[r] = xn[r]
+
+
+@numba.njit(cache=True)
+def _predict_states(A, B, C, D, K, x0, u, y, e, X):  # pragma: no cover - compiled
+    """Prediction errors e (N, p) and predictor states X (N, n) (X[t] = x[t])."""
+    n, m, p = A.shape[0], B.shape[1], C.shape[0]
+    x = x0.copy()
+    xn = np.empty(n)
+    for t in range(u.shape[0]):
+        for r in range(n):
+            X[t, r] = x[r]
+        for i in range(p):
+            acc = 0.0
+            for j in range(n):
+                acc += C[i, j] * x[j]
+            for j in range(m):
+                acc += D[i, j] * u[t, j]
+            e[t, i] = y[t, i] - acc
+        for r in range(n):
+            acc = 0.0
+            for j in range(n):
+                acc += A[r, j] * x[j]
+            for j in range(m):
+                acc += B[r, j] * u[t, j]
+            for j in range(p):
+                acc += K[r, j] * e[t, j]
+            xn[r] = acc
+        for r in range(n):
+            x[r] = xn[r]
+
+
+@numba.njit(cache=True, parallel=True)
+def _sensitivities(Abar, C, F, G, S0, Z, J):  # pragma: no cover - compiled
+    """Column q of J (N·p, nd), rows t·p + i: ∂ŷ_i[t]/∂θ_q from
+
+        s[t+1] = Ā s[t] + F_q z[t],   ∂ŷ[t] = C s[t] + G_q z[t][:n+m],   s[0] = S0[q],
+
+    z[t] = [x[t]; u[t]; e[t]] (Z, shape (N, n + m + p)), Ā = A − KC. Directions run in parallel."""
+    n = Abar.shape[0]
+    p = C.shape[0]
+    nz = Z.shape[1]
+    ng = G.shape[2]
+    for q in numba.prange(F.shape[0]):
+        s = S0[q].copy()
+        sn = np.empty(n)
+        for t in range(Z.shape[0]):
+            for i in range(p):
+                acc = 0.0
+                for j in range(n):
+                    acc += C[i, j] * s[j]
+                for j in range(ng):
+                    acc += G[q, i, j] * Z[t, j]
+                J[t * p + i, q] = acc
+            for r in range(n):
+                acc = 0.0
+                for j in range(n):
+                    acc += Abar[r, j] * s[j]
+                for j in range(nz):
+                    acc += F[q, r, j] * Z[t, j]
+                sn[r] = acc
+            for r in range(n):
+                s[r] = sn[r]
+
+
+@numba.njit(cache=True, parallel=True)
+def _sensitivities_entries(Abar, C, K, entries, n_x0, X, U, E, J):  # pragma: no cover - compiled
+    """As :func:`_sensitivities` for unit directions: entry (kind, r, c) of A, B, C, D or K
+    (kind 0 … 4) forces s with e_r x_c, e_r u_c, −K[:, r] x_c, −K[:, r] u_c or e_r e_c, and the
+    C, D entries add x_c, u_c to output r; then ``n_x0`` directions of x0 (s[0] = e_i)."""
+    n = Abar.shape[0]
+    p = C.shape[0]
+    d = entries.shape[0]
+    for q in numba.prange(d + n_x0):
+        s = np.zeros(n)
+        sn = np.empty(n)
+        kind, r, c = -1, 0, 0
+        if q < d:
+            kind, r, c = entries[q, 0], entries[q, 1], entries[q, 2]
+        else:
+            s[q - d] = 1.0
+        for t in range(X.shape[0]):
+            for i in range(p):
+                acc = 0.0
+                for j in range(n):
+                    acc += C[i, j] * s[j]
+                J[t * p + i, q] = acc
+            if kind == 2:
+                J[t * p + r, q] += X[t, c]
+            elif kind == 3:
+                J[t * p + r, q] += U[t, c]
+            for i in range(n):
+                acc = 0.0
+                for j in range(n):
+                    acc += Abar[i, j] * s[j]
+                sn[i] = acc
+            if kind == 0:
+                sn[r] += X[t, c]
+            elif kind == 1:
+                sn[r] += U[t, c]
+            elif kind == 4:
+                sn[r] += E[t, c]
+            elif kind == 2:
+                for i in range(n):
+                    sn[i] -= K[i, r] * X[t, c]
+            elif kind == 3:
+                for i in range(n):
+                    sn[i] -= K[i, r] * U[t, c]
+            for i in range(n):
+                s[i] = sn[i]
+
+
+def _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, y, entries=None):
+    """Prediction errors e (N, p) and J (N·p, d + n), Fortran order, = ∂ŷ/∂θ: d model directions
+    with tangents dA (d, n, n), dB, dC, dD, dK, then the n entries of x0 (module docstring)."""
+    N, p = y.shape
+    n, m = A.shape[0], B.shape[1]
+    d = dA.shape[0]
+    e = np.empty((N, p))
+    X = np.empty((N, n))
+    _predict_states(A, B, C, D, K, x0, u, y, e, X)
+    if entries is not None:  # unit directions: the sparse kernel
+        J = np.empty((N * p, d + n), order="F")
+        _sensitivities_entries(np.ascontiguousarray(A - K @ C), np.ascontiguousarray(C), np.ascontiguousarray(K),
+                               entries, n, X, np.ascontiguousarray(u), e, J)
+        return e, J
+    F = np.zeros((d + n, n, n + m + p))
+    F[:d, :, :n] = dA - np.einsum("rj,qjk->qrk", K, dC)
+    F[:d, :, n:n + m] = dB - np.einsum("rj,qjk->qrk", K, dD)
+    F[:d, :, n + m:] = dK
+    G = np.zeros((d + n, p, n + m))
+    G[:d, :, :n] = dC
+    G[:d, :, n:] = dD
+    S0 = np.zeros((d + n, n))
+    S0[d:] = np.eye(n)
+    J = np.empty((N * p, d + n), order="F")
+    _sensitivities(np.ascontiguousarray(A - K @ C), np.ascontiguousarray(C), F, G, S0, np.hstack([X, u, e]), J)
+    return e, J
+
+
+def _directions(A, B, C, D, K, feedthrough: bool, innovation: bool):
+    """The d free entries at the current model (d = the dimension of the orthogonal complement of
+    the similarity orbit), chosen so that they complement the orbit best, as unit matrix tangents
+    (dA, dB, dC, dD, dK), each with a leading axis of d, and their (kind, row, column), kind 0 … 4
+    for A, B, C, D, K."""
+    n, m, p = A.shape[0], B.shape[1], C.shape[0]
+    blocks = [n * n, n * m, p * n, p * m if feedthrough else 0, n * p if innovation else 0]
+    T = np.empty((sum(blocks), n * n))
+    for a in range(n):
+        for b in range(n):
+            X = np.zeros((n, n))
+            X[a, b] = 1.0
+            parts = [X @ A - A @ X, X @ B, -C @ X]
+            if feedthrough:
+                parts.append(np.zeros((p, m)))
+            if innovation:
+                parts.append(X @ K)
+            T[:, a * n + b] = np.concatenate([q.ravel() for q in parts])
+    U, sv, _ = np.linalg.svd(T, full_matrices=True)
+    rank = int(np.sum(sv > 1e-10 * max(sv[0], 1e-300))) if sv.size else 0
+    Qp = U[:, rank:]
+    d = Qp.shape[1]
+    # the d entries whose unit directions best complement the orbit (pivoted QR of Qpᵀ): moving
+    # only them reaches every neighbouring system, with sparse tangents (cheap sensitivities)
+    piv = sla.qr(Qp.T, pivoting=True, mode="r")[1][:d]
+    shapes = [(n, n), (n, m), (p, n), (p, m), (n, p)]
+    starts = np.cumsum([0] + blocks)
+    out = [np.zeros((d,) + sh) for sh in shapes]
+    entries = np.empty((d, 3), dtype=np.int64)
+    for q, g in enumerate(np.sort(piv)):
+        kind = int(np.searchsorted(starts, g, side="right") - 1)
+        r, c = divmod(int(g - starts[kind]), shapes[kind][1])
+        out[kind][q, r, c] = 1.0
+        entries[q] = (kind, r, c)
+    return (*out, entries)
+
+
+def _radius(A):
+    return float(np.max(np.abs(np.linalg.eigvals(A)))) if A.shape[0] else 0.0
+
+
+def _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough, innovation, max_iterations, tol):
+    """Levenberg-Marquardt on the whitened prediction errors, re-centring the local coordinates
+    after every accepted step and rejecting steps that leave the stable set."""
+    N, p = yw.shape
+    n = A.shape[0]
+    e = np.empty((N, p))
+    _predict(A, B, C, D, K, x0, u, yw, e)
+    Vc = float(np.sum(e * e))
+    lam, it, converged = 1e-3, 0, False
+    for it in range(1, max_iterations + 1):
+        dA, dB, dC, dD, dK, ent = _directions(A, B, C, D, K, feedthrough, innovation)
+        d = dA.shape[0]
+        e, J = _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, yw, ent)
+        H = _gram(J)
+        g = J.T @ e.reshape(-1)
+        hd = np.maximum(np.diag(H), 1e-300)
+        improved, rel = False, 0.0
+        for _ in range(30):
+            try:
+                delta = np.linalg.solve(H + lam * np.diag(hd), g)
+            except np.linalg.LinAlgError:
+                lam *= 10
+                continue
+            th = delta[:d]
+            An, Cn, Kn = A + np.tensordot(th, dA, 1), C + np.tensordot(th, dC, 1), K + np.tensordot(th, dK, 1)
+            if _radius(An) >= 1.0 or (innovation and _radius(An - Kn @ Cn) >= 1.0):
+                lam *= 10
+                continue
+            Bn, Dn, x0n = B + np.tensordot(th, dB, 1), D + np.tensordot(th, dD, 1), x0 + delta[d:]
+            en = np.empty((N, p))
+            _predict(An, Bn, Cn, Dn, Kn, x0n, u, yw, en)
+            Vn = float(np.sum(en * en))
+            if np.isfinite(Vn) and Vn < Vc:
+                improved, rel, drop = True, (Vc - Vn) / max(Vc, 1e-300), Vc - Vn
+                A, B, C, D, K, x0, Vc = An, Bn, Cn, Dn, Kn, x0n, Vn
+                lam = max(lam / 5, 1e-12)
+                break
+            lam *= 10
+        if not improved or rel < tol:
+            converged = True
+            break
+        if drop < _NEGLIGIBLE_DROP:  # the step moved θ by ≪ 1σ: J before it serves at the optimum
+            converged, improved = True, False
+            break
+    at_final = (J, (dA, dB, dC, dD, dK), e) if not improved else None   # J at (or ≪ 1σ from) the end
+    return A, B, C, D, K, x0, Vc, it, converged, at_final
+
+
+def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovation", feedthrough: bool | None = None,
+        max_iterations: int = 50, tol: float = 1e-7) -> LinearModel:
+    """Refine a discrete state-space model by prediction-error minimisation.
+
+    Parameters
+    ----------
+    model
+        A :class:`LinearModel` with a discrete ``StateSpace`` (e.g. from :func:`gripkit.sysid.n4sid`).
+    data
+        A :class:`~gripkit.signals.Trajectory` with the model's input and output columns (offsets
+        removed as recorded in the model), or give ``u`` (N, m) and ``y`` (N, p) in deviation units.
+    form
+        ``'innovation'`` (estimate K too; needs the model's K as a start) or ``'oe'`` (K = 0).
+    feedthrough
+        Estimate D (default: when the starting model has a non-zero D).
+    max_iterations, tol
+        Levenberg-Marquardt iterations and the relative decrease of V that stops them (they also
+        stop when a step lowers the whitened V by less than 0.01, a move of less than 0.1σ). Records
+        longer than 20 000 samples are first fitted on their first 20 000 samples, then polished
+        on the whole record (the same optimum, a fraction of the full-length Jacobians).
+
+    Returns
+    -------
+    LinearModel
+        Structure ``'pem-oe'`` or ``'pem-innovation'``; ``.system`` carries the covariance of the
+        identifiable directions (σ of poles: ``system.pole_covariance()``; of the frequency
+        response: ``system.bode(w)``).
+    """
+    if form not in PEM_FORMS:
+        raise DataError(f"form: expected 'oe' or 'innovation', found {form!r}")
+    if not isinstance(model, LinearModel) or not isinstance(model.system, StateSpace) or not model.system.is_discrete:
+        raise DataError("model: expected a discrete state-space LinearModel (e.g. from gripkit.sysid.n4sid)")
+    ss = model.system
+    if data is not None:
+        dt = 1.0 / data.require_uniform(why="PEM refinement")
+        if abs(dt - ss.dt) > 1e-9 * ss.dt:
+            raise DataError(f"data: sampled every {dt:g} s, the model every {ss.dt:g} s")
+        u = model._columns(data, model.inputs, model.u_offset, "input")
+        y = model._columns(data, model.outputs, model.y_offset, "output")
+    u = as_io_matrix(u, "input u")
+    y = as_io_matrix(y, "output y", u.shape[0])
+    n, m, p = ss.n_states, ss.n_inputs, ss.n_outputs
+    if u.shape[1] != m or y.shape[1] != p:
+        raise DataError(f"data: the model has {m} input(s) and {p} output(s), the data {u.shape[1]} and {y.shape[1]}")
+    innovation = form == "innovation"
+    feedthrough = bool(np.any(ss.D != 0)) if feedthrough is None else bool(feedthrough)
+    A, B, C = ss.A.copy(), ss.B.copy(), ss.C.copy()
+    D = ss.D.copy() if feedthrough else np.zeros((p, m))
+    K = (model.K.copy() if model.K is not None else np.zeros((n, p))) if innovation else np.zeros((n, p))
+    if innovation and _radius(A - K @ C) >= 1.0:
+        K = np.zeros((n, p))
+    x0 = np.zeros(n) if model.x0 is None else np.array(model.x0, dtype=np.float64)
+    N = u.shape[0]
+    e = np.empty((N, p))
+    _predict(A, B, C, D, K, x0, u, y, e)
+    w, V = np.linalg.eigh(e.T @ e / N)
+    if w.min() <= 0:
+        raise IdentificationError("pem: the starting model predicts an output exactly (zero error variance)")
+    # whiten the outputs once: ỹ = W y, C̃ = W C, D̃ = W D, K̃ = K W⁻¹ (W = Λ^{-1/2}), V = Σ ẽᵀẽ
+    W, Winv = (V / np.sqrt(w)) @ V.T, (V * np.sqrt(w)) @ V.T
+    yw = np.ascontiguousarray(y @ W.T)
+    C, D, K = W @ C, W @ D, K @ Winv
+    _predict(A, B, C, D, K, x0, u, yw, e)
+    V0 = float(np.sum(e * e))
+    it = 0
+    if N > _WARM_START_SAMPLES:  # converge on the first samples, then polish on all of them
+        A, B, C, D, K, x0, _, it, _, _ = _levenberg_marquardt(A, B, C, D, K, x0, u[:_WARM_START_SAMPLES],
+                                                           yw[:_WARM_START_SAMPLES], feedthrough, innovation,
+                                                           max_iterations, tol)
+    A, B, C, D, K, x0, Vc, it2, converged, at_final = _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough,
+                                                                           innovation, max_iterations, tol)
+    it_warm, it = it, it + it2
+    # covariance at the final point
+    if at_final is not None:
+        J, (dA, dB, dC, dD, dK), e = at_final
+    else:
+        dA, dB, dC, dD, dK, ent = _directions(A, B, C, D, K, feedthrough, innovation)
+        e, J = _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, yw, ent)
+    d = dA.shape[0]
+    dof = N * p - d - n
+    if dof <= 0:
+        raise DataError(f"pem: {N} samples of {p} output(s) cannot determine {d + n} parameters",
+                        hint="use a longer record or a lower order")
+    s2 = float(np.sum(e * e)) / dof
+    try:
+        cov_full = s2 * np.linalg.inv(_gram(J))
+    except np.linalg.LinAlgError:
+        raise IdentificationError("pem: the Jacobian is singular at the optimum: the data do not determine the "
+                                  "model (a non-minimal order or a poorly exciting input)",
+                                  hint="lower the order or excite the system more richly") from None
+    cov = 0.5 * (cov_full[:d, :d] + cov_full[:d, :d].T)
+    # back to physical output units
+    C, D, K = Winv @ C, Winv @ D, K @ W
+    dC, dD = np.einsum("ij,qjk->qik", Winv, dC), np.einsum("ij,qjk->qik", Winv, dD)
+    e = e @ Winv.T
+    Lam = e.T @ e / N
+    unc = Uncertainty(tuple(f"theta{i}" for i in range(d)), cov, (dA, dB, dC, dD))
+    sysn = StateSpace(A, B, C, D, **ss._signals(meta={**ss.meta, "refined_by": f"pem-{form}"}), states=ss.states,
+                      state_units=ss.state_units, uncertainty=unc)
+    ys = free_run(A, B, C, D, u, x0)
+    info = {**model.info, "pem": {"form": form, "iterations": it, "iterations_warm_start": it_warm,
+                                  "converged": converged, "loss_start": V0 / N,
+                                  "loss": Vc / N, "parameters": d, "feedthrough": feedthrough}}
+    return model.replace(system=sysn, structure=f"pem-{form}", K=K if innovation else None, x0=x0,
+                         noise_covariance=Lam, fit_percent=fit_per_output(y, ys), n_samples=N, info=info)

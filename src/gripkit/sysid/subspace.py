@@ -1,0 +1,362 @@
+"""Subspace identification of MIMO state-space models: N4SID, MOESP and CVA in one implementation
+(Van Overschee & De Moor, *Subspace Identification for Linear Systems*, 1996, Theorem 12, the
+"unifying theorem"; Verhaegen's PO-MOESP).
+
+With horizon k, block-Hankel matrices of future inputs ``U_f``, past inputs and outputs
+``W_p = [U_p; Y_p]`` and future outputs ``Y_f`` (each column one time t, j = N − 2k + 1 columns),
+the LQ factorisation
+
+    [U_f; W_p; Y_f] = [[L11, 0, 0], [L21, L22, 0], [L31, L32, L33]] [Q1; Q2; Q3]
+
+gives the oblique projection of Y_f along U_f onto W_p, ``O = L32 L22⁻¹ W_p``, whose column space
+is that of the extended observability matrix Γ_k = [C; CA; …; CA^{k−1}]. The weighted SVD
+``W1 O W2 = U S Vᵀ`` fixes the method:
+
+* N4SID: W1 = I, W2 = I              → SVD of ``[L32 L22⁻¹ L21, L32]``;
+* MOESP: W1 = I, W2 = Π_{U_f⊥}       → SVD of ``L32``;
+* CVA:   W1 = (Y_f Π_{U_f⊥} Y_fᵀ)^{−½} → SVD of ``W1 L32``, W1 = (L32 L32ᵀ + L33 L33ᵀ)^{−½}.
+
+The order n is the number of singular values that stand above the noise floor (five times the
+median of those beyond the largest order considered; :func:`select_order`), unless given.
+Then Γ = W1⁻¹ U_n S_n^{½}, ``C = Γ[0:p]`` and ``A = Γ_↑⁺ Γ_↓`` (shift invariance). When that A is
+unstable, ``A = Γ⁺ [Γ_↓; 0]`` is used instead, which is stable by construction (Chui &
+Maciejowski, 1996) and the reason is recorded. B, D and x0 follow by linear least squares on the
+whole record (the output is linear in them for fixed A, C). The state sequence ``X̂ = Γ⁺ O`` gives
+the process and measurement residuals w = x̂[t+1] − A x̂ − B u, v = y − C x̂ − D u, their
+covariances (Q, S, R) and the Kalman gain of the innovation form from the Riccati equation
+``P = A P Aᵀ + Q − (A P Cᵀ + S)(C P Cᵀ + R)⁻¹(A P Cᵀ + S)ᵀ``, ``K = (A P Cᵀ + S)(C P Cᵀ + R)⁻¹``.
+
+Inputs and outputs are scaled to unit RMS before the factorisation (the weighting would otherwise
+depend on the units) and the model is scaled back.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+
+import numpy as np
+import scipy.linalg as sla
+
+from ..errors import DataError, IdentificationError, StabilityWarning
+from ..lti import StateSpace
+from ._data import check_dt
+from .linear_model import LinearModel, as_io_matrix, fit_per_output, free_run, observability_regressor
+from .regression import _qr_r
+
+__all__ = ["n4sid", "moesp", "SUBSPACE_METHODS", "default_horizon", "subspace_factor", "SubspaceFactor"]
+
+SUBSPACE_METHODS = ("n4sid", "moesp", "cva")
+DEFAULT_MAX_ORDER = 10
+
+
+def default_horizon(n_max: int, p: int) -> int:
+    """Block rows k: Γ_k must have more rows than states (k p > n) with room for the shift;
+    ``k = max(⌈2 (n_max + 1) / p⌉, 5)``."""
+    return max(int(math.ceil(2 * (n_max + 1) / p)), 5)
+
+
+def _gram(Z: np.ndarray) -> np.ndarray:
+    """ZᵀZ by BLAS ``dsyrk`` (half the flops of a product, and free of numpy's matmul dispatch)."""
+    from scipy.linalg.blas import dsyrk
+
+    G = dsyrk(1.0, np.asfortranarray(Z), trans=1)
+    return np.triu(G) + np.triu(G, 1).T
+
+
+def _lower_factor(Z: np.ndarray) -> np.ndarray:
+    """L with ``L Lᵀ = ZᵀZ / j`` (the LQ factor of Zᵀ/√j): Cholesky of the Gram matrix (a few times
+    faster than Householder QR for j ≫ q), falling back to QR when the Gram matrix is numerically
+    singular (noise-free or rank-deficient data), where squaring the condition number would lose
+    the small singular values that decide the order."""
+    j = Z.shape[0]
+    G = _gram(Z) / j
+    try:
+        L = np.linalg.cholesky(G)
+        if np.min(np.abs(np.diag(L))) > 1e-6 * np.sqrt(np.max(np.diag(G))):
+            return L
+    except np.linalg.LinAlgError:
+        pass
+    return _qr_r(np.asfortranarray(Z), overwrite=True).T / math.sqrt(j)
+
+
+def _least_squares(Phi: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """argmin ‖Φθ − r‖: normal equations on column-scaled Φ (dsyrk + Cholesky) when their
+    condition number stays below 1e8, else LAPACK ``gelsy`` on Φ itself."""
+    col = np.sqrt(np.einsum("ij,ij->j", Phi, Phi))
+    col[col == 0] = 1.0
+    G = _gram(Phi) / np.outer(col, col)
+    w = np.linalg.eigvalsh(G)
+    if w[0] > 1e-8 * w[-1]:
+        c = sla.cho_factor(G)
+        return sla.cho_solve(c, (Phi.T @ rhs) / col) / col
+    return sla.lstsq(Phi, rhs, lapack_driver="gelsy", check_finite=False)[0]
+
+
+class SubspaceFactor:
+    """The LQ factor of the scaled data and what every order shares (computed once, so that an
+    order search does not repeat the factorisation)."""
+
+    def __init__(self, u, y, k, method):
+        self.u, self.y, self.k, self.method = u, y, k, method
+        N, m = u.shape
+        p = y.shape[1]
+        self.m, self.p = m, p
+        j = N - 2 * k + 1
+        q = 2 * k * (m + p)
+        self.su = np.sqrt(np.mean(u * u, axis=0))
+        self.sy = np.sqrt(np.mean(y * y, axis=0))
+        us, ys = u / self.su, y / self.sy
+        self.us, self.ys = us, ys
+        Z = np.empty((j, q), order="F")
+        a, b = k * m, k * (m + p)
+        for i in range(k):
+            Z[:, i * m:(i + 1) * m] = us[k + i:k + i + j]                 # U_f
+            Z[:, a + i * m:a + (i + 1) * m] = us[i:i + j]                 # U_p
+            Z[:, a + k * m + i * p:a + k * m + (i + 1) * p] = ys[i:i + j]  # Y_p
+            Z[:, a + b + i * p:a + b + (i + 1) * p] = ys[k + i:k + i + j]  # Y_f
+        L = _lower_factor(Z)
+        del Z
+        L21, L22 = L[a:a + b, :a], L[a:a + b, a:a + b]
+        L32, L33 = L[a + b:, a:a + b], L[a + b:, a + b:]
+        self.L32_L22inv = np.linalg.lstsq(L22.T, L32.T, rcond=1e-12)[0].T  # L32 L22⁻¹
+        self.W1inv = None
+        if method == "n4sid":
+            M = np.hstack([self.L32_L22inv @ L21, L32])
+        elif method == "moesp":
+            M = L32
+        else:  # cva
+            Syy = L32 @ L32.T + L33 @ L33.T
+            w, V = np.linalg.eigh(Syy)
+            w = np.maximum(w, 1e-12 * w.max())
+            W1 = (V / np.sqrt(w)) @ V.T
+            self.W1inv = (V * np.sqrt(w)) @ V.T
+            M = W1 @ L32
+        self.U, self.s, _ = np.linalg.svd(M, full_matrices=False)
+        self.j = j
+
+    def gamma(self, n: int) -> np.ndarray:
+        G = self.U[:, :n] * np.sqrt(self.s[:n])
+        return G if self.W1inv is None else self.W1inv @ G
+
+    def past_windows(self) -> np.ndarray:
+        """W_p as a (j, k(m + p)) array (one row per time k … k + j − 1)."""
+        k, m, p, j = self.k, self.m, self.p, self.j
+        W = np.empty((j, k * (m + p)))
+        for i in range(k):
+            W[:, i * m:(i + 1) * m] = self.us[i:i + j]
+            W[:, k * m + i * p:k * m + (i + 1) * p] = self.ys[i:i + j]
+        return W
+
+
+def subspace_factor(u, y, *, horizon: int, method: str) -> SubspaceFactor:
+    """Check sizes and factor the data (see :class:`SubspaceFactor`)."""
+    N, m = u.shape
+    p = y.shape[1]
+    j = N - 2 * horizon + 1
+    q = 2 * horizon * (m + p)
+    if j < 2 * q:
+        raise DataError(f"data: {N} samples of {m} input(s) and {p} output(s) with horizon k = {horizon} give "
+                        f"{max(j, 0)} Hankel columns, fewer than the {2 * q} needed (2 × 2k(m + p)); "
+                        f"at least {2 * q + 2 * horizon - 1} samples are required",
+                        hint="use a longer record, fewer outputs or a smaller --order/horizon")
+    for name, x in (("input", u), ("output", y)):
+        rms = np.sqrt(np.mean(x * x, axis=0))
+        if np.any(rms == 0):
+            raise DataError(f"{name} channel {int(np.argmin(rms))} is identically zero: it carries no information",
+                            hint="drop that column or check the data")
+    return SubspaceFactor(u, y, horizon, method)
+
+
+NOISE_FACTOR = 5.0
+
+
+def select_order(s: np.ndarray, n_max: int) -> int:
+    """The number of singular values among the first ``n_max`` that stand above the noise floor:
+    ``n = max{i ≤ n_max : s_i > 5 s_noise}``, s_noise the median of the singular values beyond
+    n_max (the horizon gives k·p ≥ 2(n_max + 1) of them, so at least half are noise). Noise-free
+    data (a floor below 1e-10 s_1) take the same rule with the floor at 1e-10 s_1."""
+    tail = s[n_max:] if s.size > n_max else s[-1:]
+    floor = max(float(np.median(tail)), 1e-10 * float(s[0]))
+    above = np.flatnonzero(s[:n_max] > NOISE_FACTOR * floor)
+    return int(above[-1]) + 1 if above.size else 1
+
+
+def _check_supported(fac: SubspaceFactor, n: int) -> None:
+    kp = fac.s.size
+    if n >= kp:
+        raise IdentificationError(f"order: {n} states need a horizon k with k·p > {n}; the horizon k = {fac.k} "
+                                  f"with p = {fac.p} output(s) supports at most {kp - 1}",
+                                  hint="lower --order or pass a larger horizon")
+    if fac.s[n - 1] <= 1e-10 * fac.s[0]:
+        r = int(np.sum(fac.s > 1e-10 * fac.s[0]))
+        raise IdentificationError(f"order: the data support at most {r} state(s) (singular value {n} is "
+                                  f"{fac.s[n - 1] / fac.s[0]:.2g} of the first), found order = {n}",
+                                  hint=f"use --order {r} or less, or excite the system more richly")
+
+
+def _bdx_regressor(A, C, u, feedthrough: bool):
+    """Columns of the output's linear dependence on vec(B) (row-major), vec(D) and x0."""
+    N, m = u.shape
+    n, p = A.shape[0], C.shape[0]
+    cols = n * m + (p * m if feedthrough else 0) + n
+    Phi = np.empty((N, p, cols))
+    Ac, Cc = np.ascontiguousarray(A), np.ascontiguousarray(C)
+    for i in range(n):
+        Bi = np.zeros((n, 1))
+        Bi[i, 0] = 1.0
+        for jj in range(m):
+            Phi[:, :, i * m + jj] = free_run(Ac, Bi, Cc, np.zeros((p, 1)), u[:, jj:jj + 1])
+    c = n * m
+    if feedthrough:
+        for r in range(p):
+            for jj in range(m):
+                Phi[:, :, c] = 0.0
+                Phi[:, r, c] = u[:, jj]
+                c += 1
+    Phi[:, :, c:] = observability_regressor(A, C, N)
+    return Phi.reshape(N * p, cols)
+
+
+def _kalman_gain(A, C, Q, S, R):
+    """Innovation gain and innovation covariance from the Riccati equation (None on failure)."""
+    try:
+        P = sla.solve_discrete_are(A.T, C.T, Q, R, s=S)
+        Lam = C @ P @ C.T + R
+        K = np.linalg.solve(Lam.T, (A @ P @ C.T + S).T).T
+    except (np.linalg.LinAlgError, ValueError):
+        return None, None
+    if not np.isfinite(K).all() or np.max(np.abs(np.linalg.eigvals(A - K @ C))) >= 1.0:
+        return None, None
+    return K, 0.5 * (Lam + Lam.T)
+
+
+def from_factor(fac: SubspaceFactor, n: int, *, dt: float, feedthrough: bool = False, stable: bool = True,
+                signals: dict | None = None, meta: dict | None = None) -> LinearModel:
+    """The order-n model from a factored data set (see the module docstring)."""
+    _check_supported(fac, n)
+    p, m = fac.p, fac.m
+    G = fac.gamma(n)
+    C = G[:p].copy()
+    A = np.linalg.lstsq(G[:-p], G[p:], rcond=None)[0]
+    info = {"method": fac.method, "horizon": fac.k, "hankel_columns": fac.j}
+    rho = float(np.max(np.abs(np.linalg.eigvals(A))))
+    if rho >= 1.0:
+        if stable:
+            A = np.linalg.lstsq(G, np.vstack([G[p:], np.zeros((p, n))]), rcond=None)[0]
+            info["stability"] = (f"shift-invariance estimate unstable (largest |pole| {rho:.4g}); replaced by "
+                                 "A = Γ⁺[Γ↓; 0], stable by construction (Chui & Maciejowski 1996)")
+        else:
+            info["stability"] = f"unstable model kept as asked (largest |pole| {rho:.4g})"
+            warnings.warn(f"subspace: the order-{n} model is unstable (largest |pole| {rho:.4g})", StabilityWarning,
+                          stacklevel=3)
+    else:
+        info["stability"] = "stable (shift-invariance estimate)"
+    us, ys = fac.us, fac.ys
+    N = us.shape[0]
+    Phi = _bdx_regressor(A, C, us, feedthrough)
+    theta = _least_squares(Phi, ys.reshape(-1))
+    Bs = theta[:n * m].reshape(n, m)
+    c = n * m
+    Ds = np.zeros((p, m))
+    if feedthrough:
+        Ds = theta[c:c + p * m].reshape(p, m)
+        c += p * m
+    x0s = theta[c:]
+    yhat = (Phi @ theta).reshape(N, p)
+    # innovation gain from the state sequence X̂ = Γ⁺ L32 L22⁻¹ W_p
+    Mx = np.linalg.pinv(G) @ fac.L32_L22inv
+    X = fac.past_windows() @ Mx.T                        # x̂ at t = k … k + j − 1
+    k0 = fac.k
+    t = np.arange(k0, k0 + X.shape[0] - 1)
+    w = X[1:] - X[:-1] @ A.T - us[t] @ Bs.T
+    v = ys[t] - X[:-1] @ C.T - us[t] @ Ds.T
+    nw = w.shape[0]
+    Q, S, R = w.T @ w / nw, w.T @ v / nw, v.T @ v / nw
+    Ks, Lam = _kalman_gain(A, C, Q, S, R)
+    if Ks is None:
+        info["noise_model"] = "Riccati equation without a stabilising solution: K = 0 (output-error form)"
+        Ks, Lam = np.zeros((n, p)), R
+    # back to physical units
+    su, sy = fac.su, fac.sy
+    B = Bs / su
+    Cp = C * sy[:, None]
+    D = Ds * sy[:, None] / su
+    K = Ks / sy
+    Lam = Lam * np.outer(sy, sy)
+    yhat = yhat * sy
+    sig = dict(signals or {})
+    sys = StateSpace(A, B, Cp, D, dt=dt, meta={"identified_by": fac.method, **(meta or {})}, **sig)
+    fit = fit_per_output(fac.y, yhat)
+    return LinearModel(sys, fac.method, K=K, x0=x0s, noise_covariance=Lam, fit_percent=fit,
+                       singular_values=fac.s.copy(), n_samples=N, info=info)
+
+
+def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int | None = None,
+          dt: float | None = None, fs: float | None = None, feedthrough: bool = False, stable: bool = True,
+          max_order: int = DEFAULT_MAX_ORDER, inputs=None, outputs=None, input_units=None, output_units=None,
+          u_offset=None, y_offset=None) -> LinearModel:
+    """Subspace identification of a discrete MIMO state-space model in innovation form.
+
+    Parameters
+    ----------
+    u, y
+        Inputs (N, m) and outputs (N, p) (1-D: one channel), deviation units (operating point
+        removed), uniformly sampled.
+    order
+        Number of states n; None: the number of singular values above the noise floor
+        (1 … ``max_order``, :func:`select_order`).
+    method
+        ``'n4sid'``, ``'moesp'`` or ``'cva'`` (weightings, see the module docstring).
+    horizon
+        Block rows k of the Hankel matrices (default :func:`default_horizon`).
+    dt, fs
+        Sample interval (s) or rate (Hz).
+    feedthrough
+        Estimate D (default False: D = 0, a sampled physical system with a zero-order hold).
+    stable
+        Replace an unstable shift-invariance estimate of A by a stable one (default True).
+    inputs, outputs, input_units, output_units, u_offset, y_offset
+        Names, SI units and removed operating points (carried by the model).
+
+    Returns
+    -------
+    LinearModel
+        ``.system`` (:class:`gripkit.lti.StateSpace`), ``.K``, ``.x0``, ``.noise_covariance``,
+        ``.singular_values``, ``.fit_percent`` (free run per output), ``.info`` (horizon,
+        stability note).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gripkit.sysid import n4sid
+    >>> from gripkit.lti import StateSpace
+    >>> g = StateSpace([[0.9, 0.2], [0.0, 0.7]], [[0.0], [1.0]], [[1.0, 0.0]], dt=1.0)
+    >>> u = np.random.default_rng(0).standard_normal(2000)
+    >>> m = n4sid(u, g.simulate(u), None)
+    >>> m.order, np.sort(m.system.poles().real).round(3).tolist()
+    (2, [0.7, 0.9])
+    """
+    if method not in SUBSPACE_METHODS:
+        raise DataError(f"method: expected one of {', '.join(SUBSPACE_METHODS)}, found {method!r}")
+    u = as_io_matrix(u, "input u")
+    y = as_io_matrix(y, "output y", u.shape[0])
+    step = check_dt(dt, fs)
+    if order is not None:
+        if isinstance(order, bool) or not float(order).is_integer() or int(order) < 1:
+            raise DataError(f"order: expected a positive integer, found {order!r}")
+        order = int(order)
+    n_max = order if order is not None else int(max_order)
+    p = y.shape[1]
+    k = default_horizon(n_max, p) if horizon is None else int(horizon)
+    fac = subspace_factor(u, y, horizon=k, method=method)
+    n = order if order is not None else select_order(fac.s, min(n_max, fac.s.size - 1))
+    signals = dict(inputs=inputs, outputs=outputs, input_units=input_units, output_units=output_units)
+    model = from_factor(fac, n, dt=step, feedthrough=feedthrough, stable=stable, signals=signals)
+    model.info["order_selection"] = "given" if order is not None else "singular values above the noise floor"
+    return model.replace(u_offset=u_offset, y_offset=y_offset)
+
+
+def moesp(u, y, order: int | None = None, **options) -> LinearModel:
+    """PO-MOESP: :func:`n4sid` with ``method='moesp'``."""
+    return n4sid(u, y, order, method="moesp", **options)

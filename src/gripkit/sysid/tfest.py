@@ -1,0 +1,263 @@
+"""Continuous-time transfer-function estimation (tfest-like), SISO::
+
+    G(s) = (b_0 s^nz + … + b_nz) / (s^np + a_1 s^{np−1} + … + a_np),   θ = [a_1 … a_np, b_0 … b_nz].
+
+* From an FRF (:class:`~gripkit.sysid.frf.FRF` with σ per line): Sanathanan-Koerner iterations
+  (linear least squares of ``(A(jω)Ĥ − B(jω))/(A_prev(jω) σ)``, frequency scaled to 1 for
+  conditioning) give the start; then weighted nonlinear least squares of
+  ``(Ĥ_k − G(jω_k))/σ_k`` with the exact Jacobian ``∂G/∂b_i = s^{nz−i}/A``,
+  ``∂G/∂a_i = −G s^{np−i}/A``. An FRF of sampled data whose input was held (``dt`` given) is
+  compared with G's zero-order-hold equivalent ``G_d(e^{jωT})`` instead (the hold's half-sample
+  delay would bias a continuous fit by several σ).
+* From time-domain data (``tfest(u, y, ...)``): the model is sampled with a zero-order hold
+  between samples (the assumption of MATLAB's iddata, ``InterSample='zoh'``) and the output error
+  ``y − ŷ(θ)`` from rest is minimised, starting from the FRF fit of an H1 estimate of the data.
+
+Covariance ``σ̂² (JᵀJ)⁻¹`` (σ̂² = residual sum of squares / (N − dim θ)); σ of each coefficient and,
+for every complex pole pair p = −ζω_n ± jω_n√(1−ζ²), of the natural frequency ω_n = |p| and
+damping ζ = −Re p/|p|, by linearisation (the roots' derivatives with respect to θ by the implicit
+function theorem: ``∂p/∂a_i = −p^{np−i}/A'(p)``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import optimize
+from scipy import signal as _signal
+
+from ..errors import DataError, IdentificationError
+from ..lti import StateSpace, TransferFunction
+from ._data import check_dt, check_order
+from .frf import FRF, frf
+from .linear_model import LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run
+
+__all__ = ["tfest", "tfest_frf", "modal_parameters"]
+
+
+def _check_orders(n_poles, n_zeros):
+    n_poles = check_order(n_poles, "poles", 1)
+    n_zeros = check_order(n_zeros, "zeros", 0)
+    if n_zeros > n_poles:
+        raise DataError(f"zeros: expected at most as many zeros as poles ({n_poles}), found {n_zeros}",
+                        hint="an improper transfer function cannot be simulated")
+    return n_poles, n_zeros
+
+
+def _eval(theta, s, npo, nz):
+    a = np.concatenate([[1.0], theta[:npo]])
+    b = theta[npo:]
+    A = np.polyval(a, s)
+    B = np.polyval(b, s)
+    return A, B
+
+
+def _sk(s, H, wgt, npo, nz, iterations=20):
+    """Sanathanan-Koerner start on scaled frequencies s (|s| ≤ 1)."""
+    Aprev = np.ones_like(s)
+    theta = None
+    for _ in range(iterations):
+        # A(s) H − B(s) = 0 → Σ a_i s^{np−i} H − Σ b_i s^{nz−i} = −s^np H
+        cols = [s ** (npo - i) * H for i in range(1, npo + 1)] + [-s ** (nz - i) for i in range(nz + 1)]
+        M = np.column_stack(cols) * (wgt / np.abs(Aprev))[:, None]
+        rhs = -s ** npo * H * wgt / np.abs(Aprev)
+        Mr = np.vstack([M.real, M.imag])
+        rr = np.concatenate([rhs.real, rhs.imag])
+        th = np.linalg.lstsq(Mr, rr, rcond=None)[0]
+        Aprev = _eval(th, s, npo, nz)[0]
+        if theta is not None and np.allclose(th, theta, rtol=1e-10, atol=1e-12):
+            theta = th
+            break
+        theta = th
+    return theta
+
+
+def _unscale(theta, ws, npo, nz):
+    """Coefficients for s' = s/ws back to s."""
+    a = theta[:npo] * ws ** np.arange(1, npo + 1)
+    b = theta[npo:] * ws ** (npo - nz + np.arange(nz + 1))
+    return np.concatenate([a, b])
+
+
+def _stabilise(theta, npo):
+    a = np.concatenate([[1.0], theta[:npo]])
+    r = np.roots(a)
+    if np.any(r.real >= 0):
+        r = np.where(r.real >= 0, -np.abs(r.real) - 1e-6 + 1j * r.imag, r)
+        theta = theta.copy()
+        theta[:npo] = np.real(np.poly(r))[1:]
+    return theta
+
+
+def modal_parameters(den, cov_den=None):
+    """Natural frequencies ω_n (rad/s) and damping ratios ζ of the complex pole pairs of a monic
+    ``den`` (descending powers), with their σ when ``cov_den`` (covariance of den[1:]) is given."""
+    den = np.asarray(den, dtype=np.float64)
+    npo = den.size - 1
+    r = np.roots(den)
+    pairs = r[r.imag > 0]
+    wn, zeta = np.abs(pairs), -pairs.real / np.abs(pairs)
+    if cov_den is None:
+        return wn, zeta, None, None
+    dA = np.polyval(np.polyder(den), pairs)
+    # ∂p/∂a_i = −p^{np−i}/A'(p)
+    Jp = np.stack([-pairs ** (npo - i) / dA for i in range(1, npo + 1)], axis=1)   # (q, np)
+    Jwn = np.real(pairs.conj()[:, None] * Jp) / wn[:, None]
+    Jre = Jp.real
+    Jz = -(Jre * wn[:, None] - pairs.real[:, None] * Jwn) / wn[:, None] ** 2
+    s_wn = np.sqrt(np.einsum("qi,ij,qj->q", Jwn, cov_den, Jwn))
+    s_z = np.sqrt(np.einsum("qi,ij,qj->q", Jz, cov_den, Jz))
+    return wn, zeta, s_wn, s_z
+
+
+def _model(theta, cov, npo, nz, *, fit, structure, info, signals, u_offset=None, y_offset=None, n=None):
+    num = np.concatenate([np.zeros(npo - nz), theta[npo:]])
+    den = np.concatenate([[1.0], theta[:npo]])
+    names = [f"den[{i}]" for i in range(1, npo + 1)] + [f"num[{npo - nz + i}]" for i in range(nz + 1)]
+    g = TransferFunction(num, den, **signals).with_covariance(cov, names)
+    wn, z, swn, sz = modal_parameters(den, cov[:npo, :npo])
+    info = {**info, "natural_frequency_hz": wn / (2 * np.pi), "natural_frequency_hz_std": swn / (2 * np.pi),
+            "damping_ratio": z, "damping_ratio_std": sz, "num_std": np.sqrt(np.diag(cov))[npo:],
+            "den_std": np.concatenate([[0.0], np.sqrt(np.diag(cov))[:npo]])}
+    return LinearModel(g, structure, fit_percent=fit, u_offset=u_offset, y_offset=y_offset, n_samples=n, info=info)
+
+
+def tfest_frf(response: FRF, n_poles: int, n_zeros: int, *, dt: float | None = None,
+              signals: dict | None = None) -> LinearModel:
+    """Fit G(s) to an estimated frequency response (weighted by its σ); see the module docstring.
+
+    ``dt``: the sample time of the data the FRF was estimated from, when their input was held
+    between samples (zero-order hold): the model is then compared as its ZOH equivalent
+    G_d(e^{jωT}) (the hold's half-sample delay and sinc would otherwise bias the fit), after the
+    continuous fit has given the start."""
+    npo, nz = _check_orders(n_poles, n_zeros)
+    if response.H.shape[1:] != (1, 1):
+        raise DataError("tfest: the FRF must be single-input single-output")
+    H = response.H[:, 0, 0]
+    sd = response.H_std[:, 0, 0]
+    ok = np.isfinite(H) & np.isfinite(sd) & (sd > 0) & (response.frequency_hz > 0)
+    w = response.w[ok]
+    # weights 1/σ with a 0.1 % relative floor: noise-free data have σ ≈ 0 on some lines, and the
+    # estimate's own systematic errors (leakage, the hold) are not in σ
+    H, sd = H[ok], np.hypot(sd[ok], 1e-3 * np.abs(H[ok]))
+    k = npo + nz + 1
+    if 2 * w.size <= k:
+        raise DataError(f"tfest: {w.size} usable FRF lines cannot determine {k} coefficients",
+                        hint="use a finer FRF (more lines) or fewer poles/zeros")
+    ws = float(w.max())
+    s = 1j * w / ws
+    th = _stabilise(_sk(s, H, 1.0 / sd, npo, nz), npo)
+
+    def res(theta):
+        A, B = _eval(theta, s, npo, nz)
+        r = (H - B / A) / sd
+        return np.concatenate([r.real, r.imag])
+
+    def jac(theta):
+        A, B = _eval(theta, s, npo, nz)
+        G = B / A
+        cols = [G * s ** (npo - i) / A for i in range(1, npo + 1)] + [-s ** (nz - i) / A for i in range(nz + 1)]
+        J = np.column_stack(cols) / sd[:, None]
+        return np.vstack([J.real, J.imag])
+
+    sol = optimize.least_squares(res, th, jac=jac, method="lm", xtol=1e-12, ftol=1e-12)
+    T = np.diag(_unscale(np.ones(k), ws, npo, nz))
+    if dt is not None:  # through the zero-order hold, in the scaled coordinates (finite differences)
+        z = np.exp(1j * w * float(dt))
+
+        def res_zoh(theta):
+            th_ = _unscale(theta, ws, npo, nz)
+            if np.any(np.roots(np.concatenate([[1.0], th_[:npo]])).real >= 0):
+                return np.full(2 * w.size, 1e6)
+            Ad, Bd, Cd, Dd = _simulate_ct(th_, npo, nz, None, float(dt))
+            G = (Cd @ np.linalg.solve(z[:, None, None] * np.eye(npo) - Ad, np.broadcast_to(Bd, (z.size,) + Bd.shape)))
+            r = (H - (G[:, 0, 0] + Dd[0, 0])) / sd
+            return np.concatenate([r.real, r.imag])
+
+        sol = optimize.least_squares(res_zoh, sol.x, method="lm", xtol=1e-12, ftol=1e-12)
+    dof = 2 * w.size - k
+    J = sol.jac
+    s2 = 2 * sol.cost / dof
+    try:
+        cov_s = s2 * np.linalg.inv(J.T @ J)
+    except np.linalg.LinAlgError:
+        raise IdentificationError("tfest: the FRF does not determine the coefficients (singular Jacobian)",
+                                  hint="fewer poles/zeros or a wider frequency band") from None
+    theta = _unscale(sol.x, ws, npo, nz)
+    cov = T @ cov_s @ T
+    sig = dict(signals or {})
+    sig.setdefault("inputs", response.inputs)
+    sig.setdefault("outputs", response.outputs)
+    return _model(theta, 0.5 * (cov + cov.T), npo, nz, fit=None, structure="tfest",
+                  info={"source": f"frf ({response.method}{', zero-order hold' if dt else ''})",
+                        "chi2_per_dof": s2}, signals=sig)
+
+
+def _simulate_ct(theta, npo, nz, u, dt, x0=None):
+    a = np.concatenate([[1.0], theta[:npo]])
+    d = StateSpace(*_signal.tf2ss(theta[npo:], a)).c2d(dt)
+    return d.A, d.B, d.C, d.D
+
+
+def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None, fs: float | None = None,
+          inputs=None, outputs=None, input_units=None, output_units=None, u_offset=None,
+          y_offset=None) -> LinearModel:
+    """Continuous-time G(s) with ``n_poles`` poles and ``n_zeros`` zeros from sampled data
+    (deviation units), zero-order hold between samples; see the module docstring.
+
+    Returns a :class:`LinearModel` whose ``system`` is a continuous
+    :class:`gripkit.lti.TransferFunction` with the coefficient covariance, and whose ``info`` has
+    ``num_std``, ``den_std``, ``natural_frequency_hz``(``_std``), ``damping_ratio``(``_std``).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gripkit.lti import TransferFunction
+    >>> from gripkit.sysid import tfest
+    >>> g = TransferFunction([4.0], [1.0, 0.8, 4.0])
+    >>> u = np.random.default_rng(0).standard_normal(4000)
+    >>> y = g.c2d(0.05).simulate(u)[:, 0]
+    >>> m = tfest(u, y, 2, 0, dt=0.05)
+    >>> np.round(m.system.denominator(), 4).tolist()
+    [1.0, 0.8, 4.0]
+    """
+    npo, nz = _check_orders(n_poles, n_zeros)
+    u = as_io_matrix(u, "input u")
+    y = as_io_matrix(y, "output y", u.shape[0])
+    if u.shape[1] != 1 or y.shape[1] != 1:
+        raise DataError(f"tfest: expected one input and one output, found {u.shape[1]} and {y.shape[1]}",
+                        hint="estimate one input-output pair at a time, or use gripkit identify ss")
+    step = check_dt(dt, fs)
+    N = u.shape[0]
+    k = npo + nz + 1
+    if N < 10 * k + 64:
+        raise DataError(f"tfest: {N} samples are too few for {k} coefficients (need at least {10 * k + 64})",
+                        hint="use a longer record or fewer poles/zeros")
+    start = tfest_frf(frf(u, y, dt=step, nperseg=max(64, min(N // 4, 2048))), npo, nz, dt=step)
+    th0 = _stabilise(np.concatenate([start.system.denominator()[1:], start.system.numerator()[-(nz + 1):]]), npo)
+    uu, yy = u, y[:, 0]
+    scale = np.abs(th0) + 1e-8
+
+    def res(z):
+        theta = z * scale
+        if np.any(np.roots(np.concatenate([[1.0], theta[:npo]])).real >= 0):
+            return np.full(N, 1e3 * (np.abs(yy).max() + 1.0))
+        Ad, Bd, Cd, Dd = _simulate_ct(theta, npo, nz, uu, step)
+        return yy - free_run(Ad, Bd, Cd, Dd, uu)[:, 0]
+
+    sol = optimize.least_squares(res, th0 / scale, method="trf", x_scale="jac", xtol=1e-10, ftol=1e-10)
+    theta = sol.x * scale
+    J = sol.jac / scale[None, :]
+    dof = N - k
+    s2 = 2 * sol.cost / dof
+    try:
+        cov = s2 * np.linalg.inv(J.T @ J)
+    except np.linalg.LinAlgError:
+        raise IdentificationError("tfest: the data do not determine the coefficients (singular Jacobian)",
+                                  hint="fewer poles/zeros or a richer input") from None
+    Ad, Bd, Cd, Dd = _simulate_ct(theta, npo, nz, uu, step)
+    x0 = estimate_x0(Ad, Bd, Cd, Dd, uu, y)
+    fit = fit_per_output(y, free_run(Ad, Bd, Cd, Dd, uu, x0))
+    signals = dict(inputs=inputs, outputs=outputs, input_units=input_units, output_units=output_units)
+    return _model(theta, 0.5 * (cov + cov.T), npo, nz, fit=fit, structure="tfest",
+                  info={"source": "time domain (zero-order hold, output error from rest)", "nfev": int(sol.nfev)},
+                  signals=signals, u_offset=u_offset, y_offset=y_offset, n=N)
