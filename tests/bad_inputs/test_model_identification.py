@@ -9,6 +9,7 @@ from gripkit import Trajectory
 from gripkit.lti import StateSpace
 from corpus import assert_user_error, assert_warned
 
+
 @pytest.fixture(scope="module")
 def files(tmp_path_factory):
     d = tmp_path_factory.mktemp("bad13")
