@@ -48,7 +48,7 @@ def _finish(model, data, tr, out, report, caught_lines_fn):
     if out is not None:
         model.save(out)
     if report is not None:
-        from ..report.model_report import write_model_report
+        from ..sysid.model_report import write_model_report
 
         write_model_report(model, tr, report, data_name=Path(data).name)
 

@@ -1,5 +1,5 @@
 """``gripkit report MODEL.json DATA --out DIR``: one self-contained HTML page of a saved model on a
-record (:mod:`gripkit.report.model_report`)."""
+record (:mod:`gripkit.sysid.model_report`)."""
 
 from __future__ import annotations
 
@@ -20,7 +20,7 @@ def report_model(model: Path = typer.Argument(..., help="Model file written by i
                  out: Path = typer.Option(..., "--out", help="Folder for index.html."),
                  fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, json_out: bool = JsonOpt):
     """HTML report: measured vs simulated per output, residual correlations, poles with σ, Bode with σ."""
-    from ..report.model_report import write_model_report
+    from ..sysid.model_report import write_model_report
     from .compare import _model_and_data
 
     with warnings.catch_warnings(record=True) as caught:

@@ -51,4 +51,4 @@ from .frf import FRF as FRF
 from .frf import frf as frf
 from .tfest import tfest as tfest
 from .tfest import tfest_frf as tfest_frf
-from .model_file import load_model as load_model
+from .linear_model import load_model as load_model

@@ -23,9 +23,11 @@ import numpy as np
 
 from ..errors import DataError, ModelError
 from ..lti import LinearSystem, StateSpace, TransferFunction
-from ..lti._kernels import simulate_ss
+from ..lti import simulate_ss
+from .model_file import SCHEMA, SCHEMA_VERSION, read_document, write_document
 
-__all__ = ["LinearModel", "as_io_matrix", "estimate_x0", "free_run", "fit_per_output", "from_polynomial"]
+__all__ = ["LinearModel", "as_io_matrix", "estimate_x0", "free_run", "fit_per_output", "from_polynomial",
+           "model_document", "save_model", "load_model"]
 
 
 def as_io_matrix(x, name: str, n: int | None = None) -> np.ndarray:
@@ -240,10 +242,8 @@ class LinearModel:
         return self.system.to_control()
 
     def save(self, path) -> None:
-        """Write the model to a JSON file (see :mod:`gripkit.sysid.model_file`)."""
-        from .model_file import save_model
-
-        save_model(self, path)
+        """Write the model to a JSON file (:func:`model_document`; reload with :func:`load_model`)."""
+        write_document(model_document(self), path)
 
     def to_dict(self) -> dict:
         """JSON-ready summary (arrays as lists)."""
@@ -287,3 +287,84 @@ def from_polynomial(pm) -> LinearModel:
     return LinearModel(g, pm.structure, u_offset=(pm.u_offset,), y_offset=(pm.y_offset,), n_samples=pm.n_samples,
                        noise_covariance=None if pm.noise_variance is None else np.array([[pm.noise_variance]]),
                        info=info)
+
+
+def model_document(model: LinearModel) -> dict:
+    """The JSON document of ``model`` (schema ``gripkit.linear-model``, :mod:`.model_file`)::
+
+        {"schema": "gripkit.linear-model", "schema_version": 1, "gripkit_version": "0.1.0",
+         "structure": "pem-innovation", "kind": "ss" | "tf", "dt": 0.01 | null,
+         "inputs":  [{"name": "current", "unit": "A", "offset": 0.85}, ...],
+         "outputs": [{"name": "force", "unit": "N", "offset": 0.0}, ...],
+         "system": {…},       the lti system's own description (LinearSystem.to_dict: arrays,
+                              names, units, dt, covariance with its tangents)
+         "innovation": {"K": … | null, "x0": … | null, "noise_covariance": … | null},
+         "fit_percent": […], "singular_values": […] | null, "n_samples": N, "info": {…},
+         "data": {"file": "run1.csv", "sha256": "…"} | null,
+         "content_sha256": "…"}
+    """
+    from .. import __version__
+
+    s = model.system
+    doc = {"schema": SCHEMA, "schema_version": SCHEMA_VERSION, "gripkit_version": __version__,
+           "structure": model.structure, "kind": "ss" if isinstance(s, StateSpace) else "tf", "dt": s.dt,
+           "inputs": [{"name": n, "unit": u, "offset": o} for n, u, o in zip(s.inputs, s.input_units, model.u_offset)],
+           "outputs": [{"name": n, "unit": u, "offset": o}
+                       for n, u, o in zip(s.outputs, s.output_units, model.y_offset)]}
+    doc["system"] = s.to_dict()
+    doc["innovation"] = {"K": model.K, "x0": model.x0, "noise_covariance": model.noise_covariance}
+    doc.update(fit_percent=model.fit_percent, singular_values=model.singular_values, n_samples=model.n_samples,
+               info=model.info,
+               data=None if model.data_file is None else {"file": model.data_file, "sha256": model.data_hash})
+    return doc
+
+
+def save_model(model, path) -> None:
+    """Write ``model`` (a :class:`LinearModel`, or a :class:`~gripkit.sysid.PolynomialModel`,
+    converted by :func:`from_polynomial`) to ``path`` as JSON."""
+    write_document(model_document(model if isinstance(model, LinearModel) else from_polynomial(model)), path)
+
+
+def _arr(x, name, where):
+    try:
+        return np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise ModelError(f"model file {where}: field {name!r} is not an array of numbers") from None
+
+
+def load_model(path) -> LinearModel:
+    """Read a model written by ``model.save(path)``.
+
+    Raises ModelError for a file that is not a gripkit model (wrong ``schema``), of a newer
+    ``schema_version``, or with missing fields; warns (AccuracyWarning) when the content hash does
+    not match (the file was edited after it was saved).
+
+    Examples
+    --------
+    >>> import tempfile, os
+    >>> from gripkit.lti import StateSpace
+    >>> from gripkit.sysid import LinearModel, load_model
+    >>> m = LinearModel(StateSpace([[0.5]], [[1.0]], [[1.0]], dt=0.1, inputs="V", outputs="x"), "n4sid")
+    >>> p = os.path.join(tempfile.mkdtemp(), "m.json"); m.save(p)
+    >>> load_model(p).system.A.tolist(), load_model(p).inputs
+    ([[0.5]], ('V',))
+    """
+    doc = read_document(path)
+    where = repr(str(path))
+    try:
+        ins, outs = doc["inputs"], doc["outputs"]
+        system = LinearSystem.from_dict(doc["system"])
+        if list(system.inputs) != [d["name"] for d in ins] or list(system.outputs) != [d["name"] for d in outs]:
+            raise ModelError(f"model file {where}: the inputs/outputs lists disagree with the system's names")
+        inn = doc.get("innovation") or {}
+        K, x0, lam = (None if inn.get(k) is None else _arr(inn[k], k, where) for k in ("K", "x0", "noise_covariance"))
+        data = doc.get("data") or {}
+        sv = doc.get("singular_values")
+        return LinearModel(system, doc["structure"], K=K, x0=x0, noise_covariance=lam,
+                           u_offset=[d["offset"] for d in ins], y_offset=[d["offset"] for d in outs],
+                           fit_percent=doc.get("fit_percent"), singular_values=None if sv is None else np.asarray(sv),
+                           n_samples=doc.get("n_samples"), data_file=data.get("file"), data_hash=data.get("sha256"),
+                           info=doc.get("info") or {})
+    except (KeyError, TypeError) as exc:
+        raise ModelError(f"model file {where}: a required field is missing or malformed ({exc})",
+                         hint="regenerate the file with gripkit identify --out") from None

@@ -49,7 +49,7 @@ _NEGLIGIBLE_DROP = 0.01
 
 
 @numba.njit(cache=True)
-def _predict(A, B, C, D, K, x0, u, y, e):  # pragma: no cover - compiled
+def predict_errors(A, B, C, D, K, x0, u, y, e):  # pragma: no cover - compiled
     """Prediction errors e (N, p) of the predictor of the module docstring."""
     n, m, p = A.shape[0], B.shape[1], C.shape[0]
     x = x0.copy()
@@ -259,7 +259,7 @@ def _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough, innovation, max_
     N, p = yw.shape
     n = A.shape[0]
     e = np.empty((N, p))
-    _predict(A, B, C, D, K, x0, u, yw, e)
+    predict_errors(A, B, C, D, K, x0, u, yw, e)
     Vc = float(np.sum(e * e))
     lam, it, converged = 1e-3, 0, False
     for it in range(1, max_iterations + 1):
@@ -283,7 +283,7 @@ def _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough, innovation, max_
                 continue
             Bn, Dn, x0n = B + np.tensordot(th, dB, 1), D + np.tensordot(th, dD, 1), x0 + delta[d:]
             en = np.empty((N, p))
-            _predict(An, Bn, Cn, Dn, Kn, x0n, u, yw, en)
+            predict_errors(An, Bn, Cn, Dn, Kn, x0n, u, yw, en)
             Vn = float(np.sum(en * en))
             if np.isfinite(Vn) and Vn < Vc:
                 improved, rel, drop = True, (Vc - Vn) / max(Vc, 1e-300), Vc - Vn
@@ -355,7 +355,7 @@ def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovatio
     x0 = np.zeros(n) if model.x0 is None else np.array(model.x0, dtype=np.float64)
     N = u.shape[0]
     e = np.empty((N, p))
-    _predict(A, B, C, D, K, x0, u, y, e)
+    predict_errors(A, B, C, D, K, x0, u, y, e)
     w, V = np.linalg.eigh(e.T @ e / N)
     if w.min() <= 0:
         raise IdentificationError("pem: the starting model predicts an output exactly (zero error variance)")
@@ -363,7 +363,7 @@ def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovatio
     W, Winv = (V / np.sqrt(w)) @ V.T, (V * np.sqrt(w)) @ V.T
     yw = np.ascontiguousarray(y @ W.T)
     C, D, K = W @ C, W @ D, K @ Winv
-    _predict(A, B, C, D, K, x0, u, yw, e)
+    predict_errors(A, B, C, D, K, x0, u, yw, e)
     V0 = float(np.sum(e * e))
     it = 0
     if N > _WARM_START_SAMPLES:  # converge on the first samples, then polish on all of them

@@ -28,6 +28,7 @@ from ..arguments import check_keywords, keyword_names
 from ..errors import DataError, ModelError
 from ..params import Parameter, ParameterSet
 from ..units import ratio_unit
+from .linear_model import save_model
 from .validation import validate
 
 __all__ = ["PolynomialModel"]
@@ -464,10 +465,8 @@ class PolynomialModel:
         return control.tf(num, den, self.dt)
 
     def save(self, path) -> None:
-        """Write the model file (JSON, :mod:`gripkit.sysid.model_file`); reload it with
+        """Write the model file (JSON, :func:`gripkit.sysid.linear_model.save_model`); reload it with
         :func:`gripkit.sysid.load_model` (as a :class:`gripkit.sysid.LinearModel`)."""
-        from .model_file import save_model
-
         save_model(self, path)
 
     def to_dict(self) -> dict:

@@ -16,8 +16,10 @@ from pathlib import Path
 
 import numpy as np
 
-from .html import Report
-from .plots import _plt, measured_vs_model
+from ..report.html import Report
+from ..report.plots import measured_vs_model, pyplot
+from .frf import frf
+from .pem_ss import predict_errors
 
 __all__ = ["write_model_report", "model_report"]
 
@@ -30,7 +32,7 @@ def _xcorr(a, b, lags):
 
 
 def _residual_figure(e, u, outputs, inputs):
-    plt = _plt()
+    plt = pyplot()
     p, m = e.shape[1], u.shape[1]
     L = min(25, e.shape[0] // 4)
     lags = np.arange(0, L + 1)
@@ -55,7 +57,7 @@ def _residual_figure(e, u, outputs, inputs):
 
 
 def _pz_figure(system):
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(5.4, 5.0))
     discrete = system.is_discrete
     if discrete:
@@ -92,7 +94,7 @@ def _pz_figure(system):
 
 
 def _bode_figure(system, dt, estimate):
-    plt = _plt()
+    plt = pyplot()
     p, m = system.n_outputs, system.n_inputs
     nyq = np.pi / dt
     w = np.logspace(np.log10(nyq) - 3.5, np.log10(nyq * 0.999), 400)
@@ -133,7 +135,7 @@ def _bode_figure(system, dt, estimate):
 
 
 def _sv_figure(sv, order):
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 3.2))
     k = np.arange(1, sv.size + 1)
     ax.semilogy(k, sv, "o-", ms=4)
@@ -148,9 +150,6 @@ def _sv_figure(sv, order):
 
 def model_report(model, data, *, data_name: str = "data", warnings_list=()) -> Report:
     """Build the :class:`~gripkit.report.html.Report` of ``model`` on the trajectory ``data``."""
-    from ..sysid.frf import frf
-    from ..sysid.pem_ss import _predict
-
     ss = model.system.to_ss(minimal=False)
     dt = 1.0 / data.require_uniform(why="a model report")
     caught_lines = list(warnings_list)
@@ -174,7 +173,7 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=()) -> R
         K = model.K if model.K is not None else np.zeros((dss.n_states, dss.n_outputs))
         e = np.empty_like(y)
         x0 = np.zeros(dss.n_states)
-        _predict(dss.A, dss.B, dss.C, dss.D, K, x0, u, y, e)
+        predict_errors(dss.A, dss.B, dss.C, dss.D, K, x0, u, y, e)
         rep.section("Residual analysis",
                     f"{'One-step prediction errors of the innovation form' if model.K is not None else 'Output errors'}"
                     "; the dotted lines are ±1.96/√N, the 95 % band of white residuals independent of past inputs."
