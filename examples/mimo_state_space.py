@@ -13,6 +13,7 @@ from pathlib import Path
 import numpy as np
 
 from gripkit import Trajectory
+from gripkit.io import save
 from gripkit.excitation import periodic_multisine
 from gripkit.lti import StateSpace
 from gripkit.sysid import frf, identify, load_model
@@ -38,8 +39,8 @@ work = Path(tempfile.mkdtemp(prefix="gripkit-mimo-"))
 #    one periodic multisine per input on the same lines would not separate the two inputs)
 est = record(0.2 * rng.standard_normal((6000, 2)), seed=1)
 val = record(0.2 * rng.standard_normal((4000, 2)), seed=2)
-est.save(work / "est.csv")
-val.save(work / "val.csv")
+save(est, work / "est.csv")
+save(val, work / "val.csv")
 # a single-input periodic test: crest-factor-optimised multisine, 5 periods → FRF averaged over periods
 ex = periodic_multisine(0.1, 45.0, 100.0, 1000, 5, amplitude=0.2)
 siso = record(np.column_stack([ex.u, np.zeros_like(ex.u)]), seed=3)
@@ -68,17 +69,17 @@ fit, y_sim = back.compare_data(val)
 print("reloaded model, free-run fit on validation data: " + ", ".join(f"{f:.2f} %" for f in fit))
 
 # 5. the report
-from gripkit.report.model_report import write_model_report  # noqa: E402
+from gripkit.sysid.model_report import write_model_report  # noqa: E402
 
 print(f"report: {write_model_report(back, val, work / 'report', data_name='val.csv')}")
 
 if "--figures" in sys.argv:  # the pictures of docs/sysid.md
-    from gripkit.report.model_report import _bode_figure, _sv_figure
+    from gripkit.sysid.model_report import bode_figure, singular_value_figure
     from gripkit.report.plots import measured_vs_model
 
     out = Path(sys.argv[sys.argv.index("--figures") + 1])
-    _sv_figure(np.asarray(model.singular_values), model.order).savefig(out / "sysid-mimo-singular-values.png", dpi=90)
-    _bode_figure(model.system, 0.01, r).savefig(out / "sysid-mimo-bode.png", dpi=80)
+    singular_value_figure(np.asarray(model.singular_values), model.order).savefig(out / "sysid-mimo-singular-values.png", dpi=90)
+    bode_figure(model.system, 0.01, r).savefig(out / "sysid-mimo-bode.png", dpi=80)
     t = val.t[:600] - val.t[0]
     measured_vs_model(t, val["c"][:600], {"model (free run)": y_sim[:600, 0]}, ylabel="c [N]",
                       title="fingertip force c, validation record").savefig(out / "sysid-mimo-validation.png", dpi=90)

@@ -133,7 +133,8 @@ def test_usage_mistakes_are_one_line_usage_errors(cli, files, monkeypatch, args,
 
 def test_unknown_option_names_the_command_help(cli, files):
     res = cli(*arx_args(files / "io.csv", "--bogus"))
-    assert_user_error(res, "UsageError", "no such option: --bogus; see 'gripkit identify arx --help'")
+    assert_user_error(res, "UsageError", "no such option: --bogus")  # click may add its guesses here
+    assert res.error_lines[0].endswith("see 'gripkit identify arx --help'")
     res = cli(*arx_args(files / "io.csv")[:-2])  # no --nk
     assert_user_error(res, "UsageError", "missing option '--nk'")
     res = cli("identify", "arx", files / "io.csv", "--input", "u", "--output", "y", "--na", "two", "--nb", 2, "--nk", 1)

@@ -11,7 +11,7 @@ import pytest
 from gripkit import Trajectory
 from gripkit.cli import main
 from gripkit.excitation import periodic_multisine
-from gripkit.io import load
+from gripkit.io import load, save
 from gripkit.lti import TransferFunction
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "sysid"))
@@ -28,12 +28,12 @@ def files(tmp_path_factory):
         tr = Trajectory.uniform(100.0, a=u[:, 0] + 1.0, b=u[:, 1], c=y[:, 0] + 3.0, d=y[:, 1],
                                 units={"a": "V", "b": "V", "c": "N", "d": "m"})
         out[name] = d / f"{name}.csv"
-        tr.save(out[name])
+        save(tr, out[name])
     ex = periodic_multisine(0.05, 5.0, 20.0, 400, 5, amplitude=1.0)
     y = TransferFunction([2.0, 4.0], [1.0, 0.8, 4.0]).c2d(0.05).simulate(ex.u)[:, 0]
     y = y + 0.01 * np.random.default_rng(0).standard_normal(y.size)
     out["siso"] = d / "siso.csv"
-    Trajectory.uniform(20.0, v=ex.u, x=y, units={"v": "V", "x": "m"}).save(out["siso"])
+    save(Trajectory.uniform(20.0, v=ex.u, x=y, units={"v": "V", "x": "m"}), out["siso"])
     out["dir"] = d
     return out
 

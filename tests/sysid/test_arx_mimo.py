@@ -35,14 +35,14 @@ def test_recovers_matrix_polynomials_within_sigma():
 
 def test_one_step_predictor_of_the_realisation_is_the_arx_predictor():
     """The state-space realisation with K = [I; 0] predicts exactly φ(t)ᵀθ (rounding only)."""
-    from gripkit.sysid.pem_ss import _predict
+    from gripkit.sysid.pem_ss import predict_errors
 
     u, y = _data(500, seed=1)
     m = arx(u, y, 1, 2, 1)
     s = m.system
     e = np.empty_like(y[2:])
     x0 = np.concatenate([y[1], u[1], u[0]])            # state at t = 2: y(1), u(1), u(0)
-    _predict(s.A, s.B, s.C, s.D, m.K, x0, u[2:], y[2:], e)
+    predict_errors(s.A, s.B, s.C, s.D, m.K, x0, u[2:], y[2:], e)
     A, B1e, B2e = -np.asarray(m.info["A_poly"][0]), np.asarray(m.info["B_poly"][0]), np.asarray(m.info["B_poly"][1])
     direct = y[2:] - (y[1:-1] @ A.T + u[1:-1] @ B1e.T + u[:-2] @ B2e.T)
     assert np.allclose(e, direct, atol=1e-12)

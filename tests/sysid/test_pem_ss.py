@@ -6,7 +6,7 @@ import pytest
 
 from gripkit.lti import StateSpace
 from gripkit.sysid import n4sid, pem
-from gripkit.sysid.pem_ss import _directions, _predict, _predict_sensitivity
+from gripkit.sysid.pem_ss import _directions, predict_errors, _predict_sensitivity
 
 from mimo_systems import TRUE_POLES, match_poles, oe_data, two_by_two
 
@@ -39,7 +39,7 @@ def test_sensitivity_jacobian_matches_finite_differences(feedthrough, innovation
             dx[q - d] = h
         def errs(s):  # noqa: E306
             out = np.empty((N, p))
-            _predict(A + s * np.tensordot(th, dA, 1), B + s * np.tensordot(th, dB, 1), C + s * np.tensordot(th, dC, 1),
+            predict_errors(A + s * np.tensordot(th, dA, 1), B + s * np.tensordot(th, dB, 1), C + s * np.tensordot(th, dC, 1),
                      D + s * np.tensordot(th, dD, 1), K + s * np.tensordot(th, dK, 1), x0 + s * dx, u, y, out)
             return out
         fd = -(errs(1) - errs(-1)).reshape(-1) / (2 * h)

@@ -115,13 +115,13 @@ def _validation_fit(model, vd: MimoData) -> list[float] | None:
 
 
 def _aic(model, d: MimoData) -> float:
-    from .pem_ss import _predict
+    from .pem_ss import predict_errors
 
     ss = model.system
     K = model.K if model.K is not None else np.zeros((ss.n_states, ss.n_outputs))
     x0 = model.x0 if model.x0 is not None else np.zeros(ss.n_states)
     e = np.empty_like(d.y)
-    _predict(ss.A, ss.B, ss.C, ss.D, K, x0, d.u, d.y, e)
+    predict_errors(ss.A, ss.B, ss.C, ss.D, K, x0, d.u, d.y, e)
     N, p = d.y.shape
     m = d.u.shape[1]
     sign, logdet = np.linalg.slogdet(e.T @ e / N)

@@ -93,7 +93,7 @@ def _pz_figure(system):
     return fig
 
 
-def _bode_figure(system, dt, estimate):
+def bode_figure(system, dt, estimate):
     plt = pyplot()
     p, m = system.n_outputs, system.n_inputs
     nyq = np.pi / dt
@@ -134,7 +134,7 @@ def _bode_figure(system, dt, estimate):
     return fig
 
 
-def _sv_figure(sv, order):
+def singular_value_figure(sv, order):
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 3.2))
     k = np.arange(1, sv.size + 1)
@@ -190,11 +190,11 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=()) -> R
                 caught_lines.append(f"FRF estimate skipped: {exc}")
         rep.section("Frequency response", "Model magnitude and phase with ±2σ bands (from the parameter "
                     "covariance) and the data's Welch H1 estimate with ±2σ where the data allow."
-                    ).figure(_bode_figure(model.system, dt, est), "Bode",
+                    ).figure(bode_figure(model.system, dt, est), "Bode",
                              name="bode")
         if model.singular_values is not None:
             rep.section("Subspace singular values", "Singular values of the weighted subspace matrix; the order is "
-                        "where they drop.").figure(_sv_figure(np.asarray(model.singular_values), ss.n_states),
+                        "where they drop.").figure(singular_value_figure(np.asarray(model.singular_values), ss.n_states),
                                                    "singular values", name="sv")
     lines = caught_lines + [f"{w.category.__name__}: {w.message}" for w in caught]
     sec = rep.section("Warnings")
