@@ -1,4 +1,4 @@
-"""ARX identification by least squares (QR), eq (20)–(23) and (29) of ``000_8f66dcc7ab06470c.txt``.
+"""ARX identification by least squares, eq (20)–(23) and (29) of ``000_8f66dcc7ab06470c.txt``.
 
 >>> import numpy as np
 >>> from gripkit.sysid import arx
@@ -15,11 +15,13 @@
 from __future__ import annotations
 
 import numpy as np
+import scipy.linalg as sla
 
 from ._data import check_identifiable, checked_problem
+from .lagged_sums import arx_gram, arx_residuals, gram_triangle
 from .polynomial import PolynomialModel, check_meta
-from .regression import arx_regression, arx_start, qr_solve
-from .validation import fit_percent, loss_vn
+from .regression import arx_regression, arx_start, qr_solve, triangular_solve
+from .validation import fit_percent
 
 __all__ = ["arx"]
 
@@ -62,13 +64,40 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None, fs: flo
     t0 = arx_start(na, nb, nk)
     check_identifiable(u, y, t0 + p + 1, f"ARX [{na} {nb} {nk}] ({p} parameters, {t0} initial samples)")
     names = tuple(f"a{i}" for i in range(1, na + 1)) + tuple(f"b{nk + j}" for j in range(nb))
-    sol = qr_solve(arx_regression(u, y, na, nb, nk), names, overwrite=True)
-    A = np.concatenate([[1.0], sol.theta[:na]])
-    B = np.concatenate([np.zeros(nk), sol.theta[na:]])
-    model = PolynomialModel(A, B, nk, dt=step, structure="arx", n_samples=int(y.size), **meta)
-    e = model.prediction_errors(u, y)
-    m = e.size
-    sigma2 = float(e @ e) / (m - p)
-    return model.replace(covariance=sigma2 * sol.cov_unscaled, noise_variance=sigma2, loss=loss_vn(e),
-                         fit_percent=fit_percent(y[t0:], y[t0:] - e), n_used=m, residuals=e,
-                         info={"method": "least squares (QR of [Φ | Y])", "cond": sol.cond})
+    m = y.size - t0
+    sol = _normal_equations(u, y, na, nb, nk, t0, names)
+    if sol is None:  # ill-conditioned: QR of the materialised [Φ | Y]
+        sol = qr_solve(arx_regression(u, y, na, nb, nk), names, overwrite=True)
+        method = "least squares (QR of [Φ | Y])"
+        model = _model(sol.theta, na, nk, step, y.size, meta)
+        e = model.prediction_errors(u, y)
+        see, fit = float(e @ e), fit_percent(y[t0:], y[t0:] - e)
+    else:
+        method = "least squares (normal equations from compensated lagged sums, Cholesky)"
+        model = _model(sol.theta, na, nk, step, y.size, meta)
+        e, see, syy = arx_residuals(u, y, sol.theta, na, nb, nk, t0)
+        fit = 100.0 * (1.0 - np.sqrt(see / syy))
+    sigma2 = see / (m - p)
+    return model.replace(covariance=sigma2 * sol.cov_unscaled, noise_variance=sigma2, loss=0.5 * see / m,
+                         fit_percent=fit, n_used=m, residuals=e, info={"method": method, "cond": sol.cond})
+
+
+def _model(theta, na, nk, step, n, meta) -> PolynomialModel:
+    A = np.concatenate([[1.0], theta[:na]])
+    B = np.concatenate([np.zeros(nk), theta[na:]])
+    return PolynomialModel(A, B, nk, dt=step, structure="arx", n_samples=int(n), **meta)
+
+
+def _normal_equations(u, y, na, nb, nk, t0, names):
+    """The solution from the Gram matrix of ``[Φ | Y]`` (:mod:`.lagged_sums`: one pass, O(q²)
+    memory), or None when Φ is too ill-conditioned for it (then QR is used)."""
+    G = arx_gram(u, y, na, nb, nk, t0)
+    r1 = gram_triangle(G)
+    if r1 is None:
+        return None
+    p = na + nb
+    R = np.zeros((p + 1, p + 1))
+    R[:p, :p] = r1
+    R[:p, p] = sla.solve_triangular(r1, G[:p, p], trans="T", check_finite=False)  # R1ᵀ r = ΦᵀY
+    R[p, p] = np.sqrt(max(G[p, p] - R[:p, p] @ R[:p, p], 0.0))  # ρ² = YᵀY − rᵀr
+    return triangular_solve(R, names, y.size - t0)

@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-__all__ = ["BLOCK", "arx_gram", "arx_residuals"]
+__all__ = ["BLOCK", "GRAM_COND_LIMIT", "arx_gram", "arx_residuals", "gram_triangle"]
 
 #: Products summed in plain floating point before a compensated addition.
 BLOCK = 256
@@ -156,3 +156,24 @@ def arx_residuals(u: np.ndarray, y: np.ndarray, theta: np.ndarray, na: int, nb: 
     see, syy = _residuals(u, y, np.ascontiguousarray(theta, dtype=np.float64), kind[:-1], lag[:-1],
                           sign[:-1], t0, ybar, res)
     return res, float(see), float(syy)
+
+
+#: Largest column-scaled condition number κ of Φ for which the normal equations are used: their
+#: rounding error in θ is about κ²·δ with δ ≤ BLOCK·u the relative error of the compensated Gram
+#: entries; at this κ it is 1e-8, below the statistical error of any noisy record (beyond it,
+#: :func:`gripkit.sysid.arx` factors the regressor by QR instead).
+GRAM_COND_LIMIT = float(np.sqrt(1e-8 / (BLOCK * 2.0**-53)))
+
+
+def gram_triangle(G: np.ndarray) -> np.ndarray | None:
+    """Upper Cholesky factor ``R1`` of ``ΦᵀΦ = G[:p, :p]`` (``R1ᵀR1 = ΦᵀΦ``), or None when Φ is
+    too ill-conditioned for the normal equations (not positive definite, or column-scaled
+    condition number above :data:`GRAM_COND_LIMIT`)."""
+    from .regression import scaled_condition
+
+    p = G.shape[0] - 1
+    try:
+        r1 = np.linalg.cholesky(G[:p, :p]).T
+    except np.linalg.LinAlgError:
+        return None
+    return r1 if scaled_condition(r1)[0] <= GRAM_COND_LIMIT else None
