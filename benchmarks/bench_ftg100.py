@@ -11,7 +11,7 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
-from common import best_time, row
+from common import measure, row
 
 
 def _scipy_grasp(duration: float, gap: float, noise: bool = True, seed: int = 0):
@@ -68,8 +68,8 @@ def run(quick: bool) -> list[dict]:
     # 1. closed-loop grasp: approach (gap 5 µm), contact, force control; 20 kHz controller
     dur = 0.02 if quick else 0.03
     simulate_grasp(gap=5e-6, duration=dur)  # compile
-    g = best_time(lambda: simulate_grasp(gap=5e-6, duration=dur), repeat=5)
-    p = best_time(lambda: _scipy_grasp(dur, 5e-6), repeat=1, warmup=0)
+    g = measure(lambda: simulate_grasp(gap=5e-6, duration=dur))
+    p = measure(lambda: _scipy_grasp(dur, 5e-6))
     # without noise both must give the same contact force (gripkit records F_c at the start of a
     # sample, the scipy loop after it: shift by one)
     a = simulate_grasp(gap=5e-6, duration=dur, noise_force=0.0, noise_position=0.0).trajectory["F_c"][1:]
@@ -81,8 +81,8 @@ def run(quick: bool) -> list[dict]:
     # 2. LM identification of M_a, K_fa, k0 (+ sensor zero)
     data = step_experiment(duration=1.0 if quick else 2.0, period=0.05, seed=1)
     identify_actuated(data)
-    g = best_time(lambda: identify_actuated(data), repeat=3)
-    p = best_time(lambda: _scipy_lm(data), repeat=1, warmup=0)
+    g = measure(lambda: identify_actuated(data))
+    p = measure(lambda: _scipy_lm(data))
     ours = identify_actuated(data)
     theirs = _scipy_lm(data)
     rel = max(abs(ours.value(n) / theirs[i] - 1) for i, n in enumerate(("M_a", "K_fa", "k0")))

@@ -19,7 +19,7 @@ import time
 import warnings
 
 import numpy as np
-from common import best_time, row
+from common import measure, row
 
 
 def _contact_peer(finger, x_w, k_e, U, fs):
@@ -73,7 +73,7 @@ def _kernel_time(m, th, U, fs, repeat):
     bw = np.ascontiguousarray(th[0, [0, 2, 3, 4]])
     y = np.empty((U.shape[0], len(m.outputs)))
     x0 = np.zeros(len(m.states))
-    return best_time(lambda: T._bw_pwa_row(bw, d["Phi"][0], d["Gam"][0], d["C"][0], d["D"][0], d["G"][0], d["H"][0],
+    return measure(lambda: T._bw_pwa_row(bw, d["Phi"][0], d["Gam"][0], d["C"][0], d["D"][0], d["G"][0], d["H"][0],
                                            d["target"], d["ng"], m.levels, th[0, nf], U, x0.copy(), y), repeat=repeat)
 
 
@@ -136,8 +136,8 @@ def run(quick: bool = False) -> list[dict]:
         th = m.theta()[None, :]
         y = m.simulate_batch(th, U, 1 / fs)
         buf = np.empty_like(y)  # a loop simulating many times reuses its output buffer
-        tg = best_time(lambda: m.simulate_batch(th, U, 1 / fs, out=buf), repeat=3 if quick else 25)
-        tk = _kernel_time(m, th, U, fs, repeat=3 if quick else 25)
+        tg = measure(lambda: m.simulate_batch(th, U, 1 / fs, out=buf))
+        tk = _kernel_time(m, th, U, fs)
         rows.append(row("tsfm", f"finger: Bouc-Wen + {states}-state linear + contact, {dur:g} s at 20 kHz "
                                 f"(one Fig. 13 cycle)", tg, "real time", dur,
                         target="≥ 1000× faster than real time" if states == 4 else "",
@@ -152,7 +152,7 @@ def run(quick: bool = False) -> list[dict]:
     m = f.contact(x_w=x_w, k_e=72.5, realisation="minimal")
     th = m.theta()[None, :]
     yg = m.simulate_batch(th, U1[:, None], 1 / fs)[0, :, 0]
-    tg = best_time(lambda: m.simulate_batch(th, U1[:, None], 1 / fs), repeat=5)
+    tg = measure(lambda: m.simulate_batch(th, U1[:, None], 1 / fs))
     t0 = time.perf_counter()
     yp = _contact_peer(f, x_w, 72.5, U1, fs)
     tp = time.perf_counter() - t0
@@ -166,7 +166,7 @@ def run(quick: bool = False) -> list[dict]:
     start = PiezoActuator(loads=False, check=False, d_p=1.49e-6 * START[0], lam=0.83e-6 * START[1],
                           beta=0.108 * START[2], gamma=7.5e-3, a=2.5e-8 * START[3], b=8e-5 * START[4])
     res = fit(start, data, outputs=["y_A"], free=list(FREE), progress=False)
-    tg = best_time(lambda: fit(start, data, outputs=["y_A"], free=list(FREE), progress=False), repeat=3 if quick else 5)
+    tg = measure(lambda: fit(start, data, outputs=["y_A"], free=list(FREE), progress=False))
     err = max(abs(res.value(n) / true.parameters.value(n) - 1) for n in FREE)
     if quick:  # estimate: one peer simulation × the simulations gripkit needed
         _, _, _, simulate = _peer_fit(data, true, max_nfev=1)
