@@ -18,7 +18,6 @@ import gc
 import statistics
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
 
 #: Warm-up calls before timing, on both sides.
 WARMUP = 1
@@ -28,20 +27,25 @@ REPEAT = 7
 BUDGET_S = 60.0
 
 
-@dataclass(frozen=True)
-class Timing:
-    """Median and minimum seconds per call over ``runs`` timed runs; scales by a number
-    (``t / n_samples``) for per-sample figures."""
+class Timing(float):
+    """Seconds per call: the median over ``runs`` timed runs (the float value), with ``.min``.
+    Dividing or multiplying by a number scales both (``t / n_samples`` for per-sample figures)."""
 
-    median: float
-    min: float
-    runs: int
+    def __new__(cls, median: float, minimum: float, runs: int):
+        obj = super().__new__(cls, median)
+        obj.min = minimum
+        obj.runs = runs
+        return obj
 
-    def __truediv__(self, k: float) -> "Timing":
-        return Timing(self.median / k, self.min / k, self.runs)
+    @property
+    def median(self) -> float:
+        return float(self)
 
-    def __mul__(self, k: float) -> "Timing":
-        return Timing(self.median * k, self.min * k, self.runs)
+    def __truediv__(self, k):
+        return Timing(float(self) / k, self.min / k, self.runs)
+
+    def __mul__(self, k):
+        return Timing(float(self) * k, self.min * k, self.runs)
 
     __rmul__ = __mul__
 
