@@ -13,6 +13,7 @@ from .errors import ArgumentError as ArgumentError
 from .errors import ConfigError as ConfigError
 from .errors import ConsistencyWarning as ConsistencyWarning
 from .errors import DataError as DataError
+from .errors import DataWarning as DataWarning
 from .errors import GripkitError as GripkitError
 from .errors import GripkitWarning as GripkitWarning
 from .errors import IdentificationError as IdentificationError

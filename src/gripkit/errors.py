@@ -26,6 +26,7 @@ __all__ = [
     "ConsistencyWarning",
     "StabilityWarning",
     "AccuracyWarning",
+    "DataWarning",
 ]
 
 
@@ -104,3 +105,8 @@ class StabilityWarning(GripkitWarning):
 
 class AccuracyWarning(GripkitWarning):
     """A result is computed but may be inaccurate (poor excitation, coarse step, few samples)."""
+
+
+class DataWarning(GripkitWarning):
+    """Data that could be read but look damaged: a file whose last line is cut short, a sample far
+    outside the rest of its channel (a corrupt value). The data are used as read; check them."""

@@ -1,27 +1,11 @@
-"""Shared helpers of the bad-input corpus (issue 11): every case runs the CLI in-process (or the
-Python API) and asserts the error class and a key phrase of the one-line message, or the warning."""
+"""The ``cli`` fixture of the bad-input corpus; the assertions live in ``corpus.py``."""
 
 from __future__ import annotations
 
-import json
-
 import pytest
+from corpus import CliResult
 
 from gripkit.cli import main
-
-
-class CliResult:
-    """Exit code, stdout and stderr of one in-process ``gripkit`` call."""
-
-    def __init__(self, code: int, out: str, err: str):
-        self.code, self.out, self.err = code, out, err
-
-    @property
-    def error_lines(self) -> list[str]:
-        return [ln for ln in self.err.splitlines() if ln.startswith("error:")]
-
-    def json(self) -> dict:
-        return json.loads(self.out)
 
 
 @pytest.fixture
@@ -34,22 +18,3 @@ def cli(capsys):
         return CliResult(code, out, err)
 
     return run
-
-
-def assert_user_error(res: CliResult, error_class: str, phrase: str) -> None:
-    """A user error: non-zero exit, exactly one ``error:`` line on stderr naming ``error_class`` and
-    containing ``phrase`` (case-insensitive), no traceback and never the word 'unexpected'."""
-    assert res.code != 0, (res.out, res.err)
-    assert "Traceback" not in res.err, res.err
-    assert len(res.error_lines) == 1, res.err
-    line = res.error_lines[0]
-    assert "unexpected" not in line, line
-    assert error_class in line, line
-    assert phrase.lower() in line.lower(), line
-
-
-def assert_warned(res: CliResult, phrase: str) -> None:
-    """A warning: the phrase on stderr and, for ``--json`` output, in the JSON ``warnings`` list."""
-    assert phrase.lower() in res.err.lower(), res.err
-    if res.out.lstrip().startswith("{"):
-        assert any(phrase.lower() in w.lower() for w in res.json().get("warnings", [])), res.out

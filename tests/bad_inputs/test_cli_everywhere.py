@@ -24,8 +24,8 @@ import pytest
 import gripkit
 from gripkit.errors import (ArgumentError, ConfigError, DataError, IdentificationError, ModelError,
                             ParameterError, PathError)
+from corpus import assert_user_error
 
-from conftest import assert_user_error
 
 MSD = """
 [model]

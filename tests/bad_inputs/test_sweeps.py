@@ -7,22 +7,15 @@ file needs --allow-code; 5. damaged chunks on resume."""
 
 from __future__ import annotations
 
-import importlib.util
 import shutil
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from gripkit.batch import SweepSpec, budget, sweep
 from gripkit.errors import ConfigError, GripkitWarning
+from corpus import assert_user_error, assert_warned
 
-# the corpus's helpers, loaded from this folder's conftest.py by path: tests/ has no packages and
-# several conftest.py files, so `import conftest` may find another one
-_helpers = importlib.util.spec_from_file_location("bad_inputs_helpers", Path(__file__).with_name("conftest.py"))
-_module = importlib.util.module_from_spec(_helpers)
-_helpers.loader.exec_module(_module)
-assert_user_error, assert_warned = _module.assert_user_error, _module.assert_warned
 
 MSD = '[sweep]\nscenario = "step-response"\nmodel = "mass-spring-damper"\n'
 SCENARIO = '\n[scenario]\nduration = 2.0\nfs = 50.0\n'

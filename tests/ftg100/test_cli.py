@@ -95,7 +95,7 @@ def test_identify_step_bad_input(capsys, tmp_path, make, args, pattern):
     if make == "nan":
         text = path.read_text().splitlines()
         text[10] = text[10].rsplit(",", 1)[0] + ",nan"
-        path.write_text("\n".join(text))
+        path.write_text("\n".join(text) + "\n")
     code, out, err = run(capsys, "identify", "step", str(path), *args)
     assert code != 0 and out == ""
     lines = err.strip().splitlines()

@@ -5,14 +5,18 @@ from __future__ import annotations
 import json
 import math
 import sys
+import warnings
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
 import typer
 
-__all__ = ["emit_json", "load_data", "complex_pairs", "FsOpt", "TimeOpt", "FillOpt", "JsonOpt"]
+__all__ = ["emit_json", "load_data", "collected_warnings", "report_warnings", "check_data_options", "check_choice", "check_number", "complex_pairs",
+           "FsOpt", "TimeOpt", "FillOpt", "JsonOpt"]
 
-FsOpt = typer.Option(None, "--fs", help="Sampling rate in Hz, when the file has no time column.")
+FsOpt = typer.Option(None, "--fs", help="Sampling rate in Hz, when the file has no time column "
+                                         "(with one, it must agree with the time stamps).")
 TimeOpt = typer.Option(None, "--time", help="Name of the time column (default: t/time/timestamp).")
 FillOpt = typer.Option(None, "--fill", help="Missing values: 'drop' rows or 'interpolate' (default: error).")
 JsonOpt = typer.Option(False, "--json", help="Print one JSON object on stdout.")
@@ -22,6 +26,40 @@ def load_data(path: Path, columns: list[str], fs: float | None, time: str | None
     from ..io import load
 
     return load(path, columns=columns, fs=fs, time=time, fill=fill)
+
+
+def check_data_options(fs: float | None, fill: str | None) -> None:
+    """``--fs`` and ``--fill``, checked before any file is read (commands call this first, with
+    their own option checks, so that a bad option is reported before a long load)."""
+    from ..io.table import check_fill, check_fs
+
+    check_fill(fill)
+    check_fs(fs)
+
+
+def check_choice(value: str, option: str, choices: tuple[str, ...]) -> None:
+    """A :class:`~gripkit.errors.DataError` unless ``value`` is one of ``choices``."""
+    from ..errors import DataError
+
+    if value not in choices:
+        raise DataError(f"{option}: expected one of {', '.join(choices)}, found {value!r}")
+
+
+def check_number(value, option: str, *, minimum: float | None = None, above: float | None = None,
+                 integer: bool = False, nonzero: bool = False) -> None:
+    """A :class:`~gripkit.errors.DataError` unless ``value`` (when given) is a finite number
+    ``>= minimum`` / ``> above`` (an integer if ``integer``, non-zero if ``nonzero``)."""
+    from ..errors import DataError
+
+    if value is None:
+        return
+    want = ("an integer" if integer else "a finite number") + (
+        f" >= {minimum:g}" if minimum is not None else f" > {above:g}" if above is not None else "") + (
+        ", not zero" if nonzero else "")
+    ok = (math.isfinite(value) and (minimum is None or value >= minimum) and (above is None or value > above)
+          and (not integer or float(value).is_integer()) and not (nonzero and value == 0))
+    if not ok:
+        raise DataError(f"{option}: expected {want}, found {value!r}")
 
 
 def _clean(obj):
@@ -52,6 +90,20 @@ def emit_json(obj) -> None:
 def complex_pairs(values) -> list[list[float]]:
     """Complex numbers as ``[[re, im], ...]``."""
     return [[float(np.real(v)), float(np.imag(v))] for v in np.atleast_1d(values)]
+
+
+@contextmanager
+def collected_warnings():
+    """Record every warning raised inside the block (``with collected_warnings() as caught``);
+    if the block fails, print them (:func:`report_warnings`) before the error propagates, so that a
+    warning that explains the error (a corrupt sample, a truncated file) is not lost."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            yield caught
+        except Exception:
+            report_warnings(caught)
+            raise
 
 
 def report_warnings(caught) -> list[str]:

@@ -15,7 +15,8 @@ from pathlib import Path
 import typer
 
 from .app import identify_app
-from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data
+from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, check_number,
+                     collected_warnings, emit_json, load_data, report_warnings)
 
 
 @identify_app.command("friction")
@@ -36,17 +37,23 @@ def identify_friction(
     """Identify inertia, viscous and Coulomb friction and an offset of one axis (IDIM-LS)."""
     from ..sysid.friction import idim_ls
 
-    tr = load_data(data, [position, effort], fs, time, fill)
-    rate = tr.require_uniform(why="IDIM-LS (filtering and differentiation)")
-    res = idim_ls(tr[position], tr[effort], rate, effort_scale=effort_scale, cutoff=cutoff,
-                  decimation=decimate, velocity_threshold=velocity_threshold)
+    check_data_options(fs, fill)
+    check_number(effort_scale, "--effort-scale", nonzero=True)
+    check_number(cutoff, "--cutoff", above=0)
+    check_number(decimate, "--decimate", minimum=1, integer=True)
+    check_number(velocity_threshold, "--velocity-threshold", minimum=0)
+    with collected_warnings() as caught:
+        tr = load_data(data, [position, effort], fs, time, fill)
+        rate = tr.require_uniform(why="IDIM-LS (filtering and differentiation)")
+        res = idim_ls(tr[position], tr[effort], rate, effort_scale=effort_scale, cutoff=cutoff,
+                      decimation=decimate, velocity_threshold=velocity_threshold)
     pu = tr.unit(position)
     eu = tr.unit(effort) if effort_scale == 1.0 else f"{effort_scale:g}*{tr.unit(effort)}"
     units = {"inertia": f"({eu})*s^2/{pu}", "viscous": f"({eu})*s/{pu}", "coulomb": eu, "offset": eu}
     out = {"params": res.params, "std": res.std, "relative_error_percent": res.relative_error_percent,
            "units": units, "n_samples": res.n_samples, "fs": res.fs, "cutoff_hz": res.cutoff,
            "decimation": res.decimation, "condition_number": res.condition_number,
-           "notes": res.notes}
+           "notes": res.notes, "warnings": report_warnings(caught)}
     if json_out:
         emit_json(out)
         return

@@ -8,13 +8,13 @@ non-converged iteration) go to stderr as ``warning: ...`` lines and into the JSO
 
 from __future__ import annotations
 
-import warnings
 from pathlib import Path
 
 import typer
 
 from .app import identify_app
-from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data, report_warnings
+from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_choice, check_data_options, check_number,
+                     collected_warnings, emit_json, load_data, report_warnings)
 
 DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
 InputOpt = typer.Option(..., "--input", help="Input column (e.g. the valve current).")
@@ -27,6 +27,25 @@ NbOpt = typer.Option(..., "--nb", help="Number of B coefficients.")
 NkOpt = typer.Option(..., "--nk", help="Input delay in samples (B's leading zeros).")
 
 
+DETREND_CHOICES = ("mean", "linear", "none")
+
+
+def _check_options(fs, fill, detrend: str, validate: Path | None = None, **orders) -> None:
+    """Every option of a linear identification command, checked before the data are read."""
+    from ..sysid._data import check_order
+
+    check_data_options(fs, fill)
+    check_choice(detrend, "--detrend", DETREND_CHOICES)
+    for name, value in orders.items():
+        check_order(value, f"--{name}", 1 if name == "nb" else 0)
+    if validate is not None and not validate.is_file():  # the same words as gripkit.io.load
+        from ..errors import DataError
+
+        if validate.is_dir():
+            raise DataError(f"--validate: {str(validate)!r} is a folder, expected a data file")
+        raise DataError(f"--validate: data file {str(validate)!r} not found")
+
+
 def _io(path: Path, input: str, output: str, fs, time, fill, detrend: str, why: str):
     from ..sysid import io_data
 
@@ -37,8 +56,7 @@ def _io(path: Path, input: str, output: str, fs, time, fill, detrend: str, why: 
 def _fit_and_report(method: str, data: Path, input: str, output: str, fs, time, fill, detrend: str,
                     validate: Path | None, json_out: bool, fit):
     """Shared body of arx/armax/oe: load, fit (``fit(io) -> model``), validate, print."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
+    with collected_warnings() as caught:
         io = _io(data, input, output, fs, time, fill, detrend, f"{method.upper()} identification")
         model = fit(io)
         out = model.to_dict()
@@ -97,6 +115,7 @@ def identify_arx(data: Path = DataArg, input: str = InputOpt, output: str = Outp
     """ARX (orders na, nb, nk) by least squares (QR), with σ, loss (eq 29), fit, AIC, poles and zeros."""
     from ..sysid import arx
 
+    _check_options(fs, fill, detrend, validate, na=na, nb=nb, nk=nk)
     _fit_and_report("arx", data, input, output, fs, time, fill, detrend, validate, json_out,
                     lambda io: arx(io.u, io.y, na, nb, nk, dt=io.dt, **io.meta))
 
@@ -112,6 +131,7 @@ def identify_armax(data: Path = DataArg, input: str = InputOpt, output: str = Ou
     """ARMAX (orders na, nb, nc, nk) by prediction-error minimisation."""
     from ..sysid import armax
 
+    _check_options(fs, fill, detrend, validate, na=na, nb=nb, nc=nc, nk=nk)
     _fit_and_report("armax", data, input, output, fs, time, fill, detrend, validate, json_out,
                     lambda io: armax(io.u, io.y, na, nb, nc, nk, dt=io.dt, **io.meta))
 
@@ -126,6 +146,7 @@ def identify_oe(data: Path = DataArg, input: str = InputOpt, output: str = Outpu
     """Output-error (orders nb, nf, nk) by prediction-error minimisation."""
     from ..sysid import oe
 
+    _check_options(fs, fill, detrend, validate, nb=nb, nf=nf, nk=nk)
     _fit_and_report("oe", data, input, output, fs, time, fill, detrend, validate, json_out,
                     lambda io: oe(io.u, io.y, nb, nf, nk, dt=io.dt, **io.meta))
 
@@ -141,12 +162,13 @@ def identify_rls(data: Path = DataArg, input: str = InputOpt, output: str = Outp
                  fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                  json_out: bool = JsonOpt):
     """Recursive least squares ARX (orders na, nb, nk) with forgetting; θ and σ at every sample."""
-    from ..sysid import rls
+    from ..sysid import RLS, rls
     from .paths import output_file
 
+    _check_options(fs, fill, detrend)
+    RLS(na, nb, nk, forgetting=forgetting, p0=p0, windup=windup)  # checks the orders and the options
     output_file(trajectory, "--trajectory")
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
+    with collected_warnings() as caught:
         io = _io(data, input, output, fs, time, fill, detrend, "RLS identification")
         res = rls(io.u, io.y, na, nb, nk, forgetting=forgetting, p0=p0, windup=windup, dt=io.dt)
         if trajectory is not None:
@@ -183,9 +205,17 @@ def identify_search(data: Path = DataArg, input: str = InputOpt, output: str = O
                     json_out: bool = JsonOpt):
     """Fit every ARX structure of the ranges and rank them (best first)."""
     from ..sysid import structure_search
+    from ..sysid.search import CRITERIA, parse_range
 
-    io = _io(data, input, output, fs, time, fill, detrend, "ARX structure search")
-    res = structure_search(io.u, io.y, na, nb, nk, criterion=criterion, dt=io.dt)
+    _check_options(fs, fill, detrend)
+    check_choice(criterion, "--criterion", CRITERIA)
+    check_number(top, "--top", minimum=1, integer=True)
+    for name, text in (("--na", na), ("--nb", nb), ("--nk", nk)):
+        parse_range(text, name)
+    with collected_warnings() as caught:
+        io = _io(data, input, output, fs, time, fill, detrend, "ARX structure search")
+        res = structure_search(io.u, io.y, na, nb, nk, criterion=criterion, dt=io.dt)
+    report_warnings(caught)
     if json_out:
         emit_json(res.to_list())
         return

@@ -8,7 +8,8 @@ from pathlib import Path
 import typer
 
 from .app import identify_app
-from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data
+from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, collected_warnings,
+                     emit_json, load_data, report_warnings)
 
 
 @identify_app.command("step")
@@ -28,10 +29,13 @@ def identify_step(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
     if method not in STEP_METHODS:  # before the data are read
         raise DataError(f"--method: expected one of {', '.join(STEP_METHODS)}, found {method!r}",
                         hint="lm (Levenberg-Marquardt) or trf (bounded trust-region reflective)")
-    tr = load_data(data, [input_col, output_col], fs, time, fill)
-    res = _identify(tr, input=input_col, output=output_col, method=method)
+    check_data_options(fs, fill)
+    with collected_warnings() as caught:
+        tr = load_data(data, [input_col, output_col], fs, time, fill)
+        res = _identify(tr, input=input_col, output=output_col, method=method)
+    lines = report_warnings(caught)
     if json_out:
         emit_json({"data": str(data), "input": input_col, "output": output_col, "method": method,
-                   **res.to_dict()})
+                   **res.to_dict(), "warnings": lines})
     else:
         typer.echo(res.summary())

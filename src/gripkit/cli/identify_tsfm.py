@@ -14,13 +14,13 @@ Warnings go to stderr as ``warning: ...`` lines and into the JSON ``warnings`` l
 
 from __future__ import annotations
 
-import warnings
 from pathlib import Path
 
 import typer
 
 from .app import identify_app
-from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data, report_warnings
+from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, check_number,
+                     collected_warnings, emit_json, load_data, report_warnings)
 
 DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
 
@@ -38,10 +38,10 @@ def identify_modal(data: Path = DataArg,
     from ..errors import DataError
     from ..sysid.modal import free_vibration
 
+    check_data_options(fs, fill)
     if start is not None and not math.isfinite(start):
         raise DataError(f"--start: expected the release time in s (a finite number), found {start}")
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
+    with collected_warnings() as caught:
         tr = load_data(data, [signal], fs, time, fill)
         rate = tr.require_uniform(why="free-vibration analysis")
         i0 = None if start is None else int(round((start - tr.t[0]) * rate))
@@ -68,8 +68,10 @@ def identify_bouc_wen_cmd(data: Path = DataArg,
     """Static Bouc-Wen parameters (eq 3) from a quasi-static voltage/displacement sweep."""
     from ..sysid.bouc_wen import identify_bouc_wen
 
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
+    check_data_options(fs, fill)
+    check_number(delay, "--delay", minimum=0)
+    check_number(burn_in, "--burn-in", minimum=0, integer=True)
+    with collected_warnings() as caught:
         tr = load_data(data, [input, output], fs, time, fill)
         res = identify_bouc_wen(tr, input=input, output=output, delay=delay, burn_in=burn_in, progress=not json_out)
     out = res.to_dict()

@@ -11,15 +11,16 @@
 from __future__ import annotations
 
 import os
+import warnings
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
 
 from ..arguments import check_path, entry_point
-from ..errors import ArgumentError, DataError
+from ..errors import ArgumentError, DataError, DataWarning
 from ..signals.trajectory import Trajectory
-from .table import columns_to_trajectory
+from .table import check_fill, check_fs, columns_to_trajectory
 
 __all__ = ["load", "save", "FORMATS"]
 
@@ -55,7 +56,8 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
     time
         Name of the time column; else one named t/time/timestamp, else ``fs`` must be given.
     fs
-        Sampling rate in Hz when the file has no time column.
+        Sampling rate in Hz when the file has no time column. With a time column it must agree
+        with the stamps (within half a sample at every sample), else :class:`DataError`.
     units
         Units per channel, overriding those in headers or metadata (``{"force": "mN"}``).
     fill
@@ -70,10 +72,18 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
     Raises
     ------
     DataError
-        Missing file or column, truncated or corrupt file, mixed types, NaN/inf, bad time stamps.
+        Missing file or column, truncated or corrupt file (a CSV line with missing fields names
+        the line), mixed types, NaN/inf, bad time stamps, ``fs`` contradicting the time column,
+        an invalid ``fill`` or ``fs`` (checked before the file is read).
     ArgumentError
         An unknown keyword, or an argument of the wrong type (``path`` not a path, ``units`` not a
         mapping, ``fs`` not a number).
+
+    Warns
+    -----
+    DataWarning
+        A CSV whose last line has no line ending (the file looks truncated); a sample far outside
+        the rest of its channel (a corrupt value), naming its time.
     """
     check_path(path, "path", "load()")
     if units is not None and not isinstance(units, Mapping):
@@ -89,12 +99,14 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
         raise DataError(f"{str(path)!r} is a folder, expected a data file")
     if path.stat().st_size == 0:
         raise DataError(f"data file {str(path)!r} is empty")
+    check_fill(fill)
+    check_fs(fs)
     fmt = _format(path, format)
     if fmt == "mcap":
         from .mcap_reader import read_mcap
 
         raw, meta_units = read_mcap(path, columns, stamp)
-        return columns_to_trajectory(raw, source=path.name, time="t", units=units,
+        return columns_to_trajectory(raw, source=path.name, time="t", fs=fs, units=units,
                                      meta_units=meta_units, fill=fill)
     reader = {"csv": _read_csv, "parquet": _read_parquet, "hdf5": _read_hdf5}[fmt]
     raw, meta_units = reader(path, key=key, delimiter=delimiter)
@@ -114,9 +126,48 @@ def _read_csv(path: Path, key=None, delimiter=None):
             convert_options=pacsv.ConvertOptions(strings_can_be_null=True,
                                                  null_values=["", "NaN", "nan", "NA", "null"]))
     except (pa.ArrowInvalid, pa.ArrowTypeError, UnicodeDecodeError) as exc:
+        _refuse_ragged_line(path, delimiter)
         raise DataError(f"{path.name}: not a readable CSV file (truncated or corrupt?): "
                         f"{str(exc).splitlines()[0]}") from None
+    _warn_unterminated(path)
     return _arrow_columns(table), {}
+
+
+def _refuse_ragged_line(path: Path, delimiter: str) -> None:
+    """Raise a DataError naming the first line whose number of fields differs from the header's
+    (pyarrow's own message does not say which line)."""
+    text = path.read_bytes().decode("utf-8", errors="replace")
+    lines = text.splitlines()
+    if not lines:
+        return
+    sep = delimiter
+    expected = lines[0].count(sep) + 1
+    for k, line in enumerate(lines[1:], start=2):
+        if not line.strip() or '"' in line:
+            continue
+        got = line.count(sep) + 1
+        if got != expected:
+            last = k == len(lines)
+            cut = " and is the last line, without a line ending" if last and not text.endswith(("\n", "\r")) else ""
+            raise DataError(
+                f"{path.name}: line {k} has {got} fields, the header has {expected}{cut}: the file looks "
+                f"{'truncated' if last else 'truncated or corrupt'}",
+                hint=f"repair or remove line {k}")
+
+
+def _warn_unterminated(path: Path) -> None:
+    """Warn when the file's last line has no line ending: a file cut short while being written or
+    copied ends that way, and its last values may be cut (1.529 read as 1)."""
+    with open(path, "rb") as fh:
+        fh.seek(-1, os.SEEK_END)
+        if fh.read(1) in (b"\n", b"\r"):
+            return
+    data = path.read_bytes()
+    k = data.count(b"\n") + 1 if b"\n" in data else data.count(b"\r") + 1
+    last = data.splitlines()[-1].decode("utf-8", errors="replace")
+    warnings.warn(f"{path.name}: line {k}, the last, has no line ending: the file looks truncated and "
+                  f"that line's values may be cut short ({last[:60]!r}); check the end of the file, and end "
+                  f"it with a newline if it is complete", DataWarning, stacklevel=4)
 
 
 def _arrow_columns(table) -> dict[str, object]:

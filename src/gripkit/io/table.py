@@ -4,22 +4,28 @@ Rules shared by every reader:
 
 * a column header may carry its unit, ``"force [mN]"`` or ``"force (mN)"``; values are converted
   to SI and the channel is named ``force``. Units may also come from file metadata or ``units=``;
-* the time base is the column named by ``time=``; else a uniform one built from ``fs=``; else a
-  column named ``t``, ``time``, ``timestamp`` or ``time_s`` (its unit converted to seconds);
+* the time base is the column named by ``time=``, else a column named ``t``, ``time``,
+  ``timestamp`` or ``time_s`` (its unit converted to seconds), else a uniform one built from
+  ``fs=``. Given both a time column and ``fs``, they must agree (within half a sample at every
+  sample), or a :class:`DataError` says by how much they differ;
+* a sample far outside the rest of its channel (a corrupt value) gives a
+  :class:`~gripkit.errors.DataWarning` naming its time (:mod:`gripkit.signals.outliers`);
 * ``columns=`` selects channels by name; ``fill='drop'|'interpolate'`` handles missing values.
 """
 
 from __future__ import annotations
 
+import math
 import re
+import warnings
 from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from ..errors import DataError
+from ..errors import DataError, DataWarning
 from ..signals.trajectory import Trajectory
 
-__all__ = ["columns_to_trajectory", "split_header"]
+__all__ = ["columns_to_trajectory", "split_header", "check_fill", "check_fs", "FILL_CHOICES"]
 
 _TIME_NAMES = ("t", "time", "timestamp", "time_s", "times")
 _HEADER = re.compile(r"^\s*(.*?)\s*[\[(]\s*([^\])]+?)\s*[\])]\s*$")
@@ -68,7 +74,75 @@ def _numeric(name: str, values, row_offset: int = 0) -> np.ndarray:
     return out
 
 
+FILL_CHOICES = ("drop", "interpolate")
+
+
+def check_fill(fill) -> None:
+    """``fill`` must be None, 'drop' or 'interpolate' (checked before any data are read)."""
+    if fill is not None and fill not in FILL_CHOICES:
+        raise DataError(f"fill: expected None, 'drop' or 'interpolate', found {fill!r}",
+                        hint="CLI: --fill drop or --fill interpolate, or leave it out to refuse missing values")
+
+
+def check_fs(fs) -> None:
+    """``fs`` must be None or a positive finite sampling rate in Hz."""
+    if fs is None:
+        return
+    try:
+        ok = math.isfinite(float(fs)) and float(fs) > 0
+    except (TypeError, ValueError):
+        ok = False
+    if not ok:
+        raise DataError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
+
+
+def _check_fs_against_time(source: str, tname: str, t: np.ndarray, fs: float) -> None:
+    """Refuse a sampling rate ``fs`` that contradicts the file's time column ``t`` (s).
+
+    The two time bases agree when the stamps stay within half a sample interval of the uniform grid
+    ``t[0] + k/fs`` at every sample k: each stamp is then nearest to its own grid point, so both
+    label the same samples with the same times. Rounding of the stamps (a few digits written to the
+    file) and clock jitter far below a sample pass; a different rate drifts by more than half a sample
+    over a record of N samples as soon as the rates differ by more than 1/(2N), relative.
+    """
+    k = np.flatnonzero(np.isfinite(t))
+    if k.size < 2:
+        return
+    drift = (t[k] - t[k[0]]) - (k - k[0]) / fs
+    i = int(np.argmax(np.abs(drift)))
+    if abs(drift[i]) <= 0.5 / fs:
+        return
+    rate = (k[-1] - k[0]) / (t[k[-1]] - t[k[0]]) if t[k[-1]] != t[k[0]] else float("inf")
+    raise DataError(
+        f"{source}: fs={fs:g} Hz disagrees with the time column {tname!r} (its stamps give "
+        f"{rate:.6g} Hz): at t={t[k[i]]:.6g} s the two time bases are {abs(drift[i]) * fs:.3g} samples "
+        f"apart (tolerance: half a sample)",
+        hint="leave out fs (CLI: --fs) to use the file's time stamps; if the stamps are wrong, fix or "
+             "rename the time column")
+
+
+def _warn_corrupt(source: str, t: np.ndarray, data: dict[str, np.ndarray], units: dict[str, str]) -> None:
+    """One :class:`~gripkit.errors.DataWarning` per channel holding corrupt samples, naming their times."""
+    from ..signals.outliers import corrupt_samples
+
+    for name, x in data.items():
+        if not np.isfinite(x).all():
+            continue  # missing values are refused (or filled) elsewhere
+        idx = corrupt_samples(x)
+        if idx.size == 0:
+            continue
+        u = units.get(name, "1")
+        u = "" if u == "1" else f" {u}"
+        shown = ", ".join(f"{x[i]:.6g}{u} at t={t[i]:.6g} s" for i in idx[:3])
+        more = f" and {idx.size - 3} more" if idx.size > 3 else ""
+        warnings.warn(
+            f"{source}: column {name!r} has {idx.size} sample{'s' if idx.size > 1 else ''} far outside the "
+            f"rest of the channel, which look{'s' if idx.size == 1 else ''} corrupt: {shown}{more}; check "
+            f"the file (drop or repair those rows) unless the spike is real", DataWarning, stacklevel=4)
+
+
 def _fill(t: np.ndarray, data: dict[str, np.ndarray], fill: str | None):
+    check_fill(fill)
     if fill is None:
         return t, data
     missing = np.zeros(t.shape[0], dtype=bool)
@@ -89,7 +163,6 @@ def _fill(t: np.ndarray, data: dict[str, np.ndarray], fill: str | None):
             v[bad] = np.interp(t[bad], t[~bad], v[~bad])
             out[k] = v
         return t, out
-    raise DataError(f"fill: expected None, 'drop' or 'interpolate', found {fill!r}")
 
 
 def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
@@ -110,17 +183,17 @@ def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
         raise DataError(f"{source}: the file holds no columns")
     available = ", ".join(cols)
 
-    # time base
+    # time base: the time column (named, or found by name) and/or the sampling rate fs, which must agree
+    check_fill(fill)
+    check_fs(fs)
     tname = time
-    if tname is None and fs is None:
+    if tname is None:
         tname = next((c for c in cols if c.lower() in _TIME_NAMES), None)
-        if tname is None:
+        if tname is None and fs is None:
             raise DataError(f"{source}: no time column found (looked for {', '.join(_TIME_NAMES)})",
                             hint="name it with time=COL (CLI: --time COL) or give the sampling rate fs (CLI: --fs HZ)")
     if tname is not None and tname not in cols:
         raise DataError(f"{source}: time column {tname!r} not found", hint=f"available columns: {available}")
-    if tname is not None and fs is not None and time is not None:
-        raise DataError("give either a time column or a sampling rate fs, not both")
 
     names = (list(columns) if columns is not None
              else [c for c in cols if c != tname and c.lower() not in _TIME_NAMES])
@@ -144,12 +217,14 @@ def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
         if tsi != "s":
             raise DataError(f"{source}: time column {tname!r} has unit {tunit!r}, which is not a time")
         meta = {"source": source, "time_column": tname}
+        if fs is not None:
+            _check_fs_against_time(source, tname, t, float(fs))
+            meta["fs"] = float(fs)
     else:
-        if not (np.isfinite(fs) and fs > 0):
-            raise DataError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
         t = np.arange(n) / float(fs)
         meta = {"source": source, "fs": float(fs)}
     t, data = _fill(t, data, fill)
+    _warn_corrupt(source, t, data, su)
     if tname is not None:
         bad = ~np.isfinite(t)
         if bad.any():

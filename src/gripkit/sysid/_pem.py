@@ -106,6 +106,6 @@ def covariance(res: PEMResult, names: tuple[str, ...]) -> tuple[np.ndarray, floa
     X = np.empty((m, p + 1), order="F")
     X[:, :p] = res.J
     X[:, p] = -res.e
-    sol = qr_solve(X, names, overwrite=True)
+    sol = qr_solve(X, names, overwrite=True, values=res.theta)
     sigma2 = float(res.e @ res.e) / (m - p)
     return sigma2 * sol.cov_unscaled, sigma2, sol.cond

@@ -18,7 +18,8 @@ from scipy import signal as _sig
 
 from ._data import check_identifiable, checked_problem
 from ._pem import covariance, is_stable_poly, levenberg_marquardt, stabilize
-from .arx import arx
+from ._scaling import in_user_units, unit_scale
+from .arx import _arx, arx
 from .polynomial import PolynomialModel, check_meta
 from .regression import qr_solve
 from .validation import fit_percent, loss_vn
@@ -30,7 +31,7 @@ def _hannan_rissanen(u, y, na, nb, nc, nk) -> np.ndarray:
     n = y.size
     nh = int(min(max(3 * (na + nb + nc), 10), max((n - nk) // 10, nc + 1)))
     ehat = np.zeros(n)
-    ehat[max(nh, nk + nh - 1):] = arx(u, y, nh, nh, nk).residuals
+    ehat[max(nh, nk + nh - 1):] = _arx(u, y, nh, nh, nk, 1.0, warn=False).residuals
     t0 = max(na, nk + nb - 1, nc) + max(nh, nk + nh - 1)
     m = n - t0
     p = na + nb + nc
@@ -43,7 +44,7 @@ def _hannan_rissanen(u, y, na, nb, nc, nk) -> np.ndarray:
         X[:, na + nb + k] = ehat[t0 - 1 - k:n - 1 - k]
     X[:, p] = y[t0:]
     names = tuple(f"p{i}" for i in range(p))
-    return qr_solve(X, names, overwrite=True).theta
+    return qr_solve(X, names, overwrite=True, warn=False).theta
 
 
 def armax(u, y, na: int, nb: int, nc: int, nk: int = 1, *, dt: float | None = None,
@@ -59,8 +60,13 @@ def armax(u, y, na: int, nb: int, nc: int, nk: int = 1, *, dt: float | None = No
     check_meta(meta, armax)
     u, y, step, na, nb, nc, nk = checked_problem(u, y, dt, fs, na=na, nb=nb, nc=nc, nk=nk)
     if nc == 0:
-        m = arx(u, y, na, nb, nk, dt=step, **meta)
-        return m
+        return arx(u, y, na, nb, nk, dt=step, **meta)
+    cu, cy = unit_scale(u), unit_scale(y)
+    return in_user_units(_armax(u * cu, y * cy, na, nb, nc, nk, step, maxiter, tol, meta), cu, cy)
+
+
+def _armax(u, y, na, nb, nc, nk, step, maxiter, tol, meta) -> PolynomialModel:
+    """:func:`armax` (nc >= 1) on checked signals scaled to unit size."""
     p = na + nb + nc
     t0 = max(na, nk + nb - 1)
     label = f"ARMAX [{na} {nb} {nc} {nk}]"

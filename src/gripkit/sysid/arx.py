@@ -18,6 +18,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from ._data import check_identifiable, checked_problem
+from ._scaling import in_user_units, unit_scale
 from .lagged_sums import arx_gram, arx_residuals, gram_triangle
 from .polynomial import PolynomialModel, check_meta
 from .regression import arx_regression, arx_start, qr_solve, triangular_solve
@@ -57,25 +58,53 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None, fs: flo
     UnidentifiableError
         Constant input (it cannot identify B), constant output, or a regressor whose
         column-scaled condition number exceeds 1e10 (the message names the parameters involved).
+
+    Warns
+    -----
+    AccuracyWarning
+        A column-scaled condition number above :func:`~gripkit.sysid.regression.warn_threshold`
+        (the κ at which the least-determined parameter combination may be off by a third of the
+        parameters' size, from the noise or from rounding): the message names those parameters
+        and their relative σ.
+
+    The signals are scaled to unit size internally (exact powers of two, :mod:`._scaling`), so data
+    at any scale (1e-300 … 1e300) are identified; the model is in the units of ``u`` and ``y``.
     """
     check_meta(meta, arx)
     u, y, step, na, nb, nk = checked_problem(u, y, dt, fs, na=na, nb=nb, nk=nk)
+    cu, cy = unit_scale(u), unit_scale(y)
+    if max(abs(np.log2(cu)), abs(np.log2(cy))) <= _NO_SCALING_WITHIN:
+        cu = cy = 1.0  # scaling by powers of two is exact: skip the two copies where it changes nothing
+    return in_user_units(_arx(u * cu if cu != 1.0 else u, y * cy if cy != 1.0 else y, na, nb, nk, step, **meta),
+                         cu, cy)
+
+
+#: Signals whose peak lies within 2^±this are fitted unscaled: their squares summed over up to 2^60
+#: samples stay far inside float64's normal range (2^±1022), and a power-of-two scaling would give
+#: bit-identical estimates (every operation commutes with it exactly), at the cost of two copies.
+_NO_SCALING_WITHIN = 100
+
+
+def _arx(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int, step: float, *, warn: bool = True,
+         **meta) -> PolynomialModel:
+    """:func:`arx` on checked signals, without scaling; ``warn=False`` for the internal fits of
+    other estimators (their own diagnostics speak for the final model)."""
     p = na + nb
     t0 = arx_start(na, nb, nk)
     check_identifiable(u, y, t0 + p + 1, f"ARX [{na} {nb} {nk}] ({p} parameters, {t0} initial samples)")
     names = tuple(f"a{i}" for i in range(1, na + 1)) + tuple(f"b{nk + j}" for j in range(nb))
     m = y.size - t0
-    sol = _normal_equations(u, y, na, nb, nk, t0, names)
-    if sol is None:  # ill-conditioned: QR of the materialised [Φ | Y]
-        sol = qr_solve(arx_regression(u, y, na, nb, nk), names, overwrite=True)
+    gram = _normal_equations(u, y, na, nb, nk, t0, names, warn)
+    if gram is None:  # ill-conditioned: QR of the materialised [Φ | Y]
+        sol = qr_solve(arx_regression(u, y, na, nb, nk), names, overwrite=True, warn=warn)
         method = "least squares (QR of [Φ | Y])"
         model = _model(sol.theta, na, nk, step, y.size, meta)
         e = model.prediction_errors(u, y)
         see, fit = float(e @ e), fit_percent(y[t0:], y[t0:] - e)
     else:
         method = "least squares (normal equations from compensated lagged sums, Cholesky)"
+        sol, e, see, syy = gram
         model = _model(sol.theta, na, nk, step, y.size, meta)
-        e, see, syy = arx_residuals(u, y, sol.theta, na, nb, nk, t0)
         fit = 100.0 * (1.0 - np.sqrt(see / syy))
     sigma2 = see / (m - p)
     return model.replace(covariance=sigma2 * sol.cov_unscaled, noise_variance=sigma2, loss=0.5 * see / m,
@@ -88,9 +117,11 @@ def _model(theta, na, nk, step, n, meta) -> PolynomialModel:
     return PolynomialModel(A, B, nk, dt=step, structure="arx", n_samples=int(n), **meta)
 
 
-def _normal_equations(u, y, na, nb, nk, t0, names):
+def _normal_equations(u, y, na, nb, nk, t0, names, warn):
     """The solution from the Gram matrix of ``[Φ | Y]`` (:mod:`.lagged_sums`: one pass, O(q²)
-    memory), or None when Φ is too ill-conditioned for it (then QR is used)."""
+    memory) with the residuals and their sums ``(sol, e, Σe², Σ(y − ȳ)²)``, or None when Φ is too
+    ill-conditioned for it (then QR is used). ρ² is the residuals' compensated Σe², not
+    ``YᵀY − rᵀr`` (which cancels when the fit is good)."""
     G = arx_gram(u, y, na, nb, nk, t0)
     r1 = gram_triangle(G)
     if r1 is None:
@@ -99,5 +130,7 @@ def _normal_equations(u, y, na, nb, nk, t0, names):
     R = np.zeros((p + 1, p + 1))
     R[:p, :p] = r1
     R[:p, p] = sla.solve_triangular(r1, G[:p, p], trans="T", check_finite=False)  # R1ᵀ r = ΦᵀY
-    R[p, p] = np.sqrt(max(G[p, p] - R[:p, p] @ R[:p, p], 0.0))  # ρ² = YᵀY − rᵀr
-    return triangular_solve(R, names, y.size - t0)
+    theta = sla.solve_triangular(r1, R[:p, p], check_finite=False)
+    e, see, syy = arx_residuals(u, y, theta, na, nb, nk, t0)
+    R[p, p] = np.sqrt(see)
+    return triangular_solve(R, names, y.size - t0, warn, stacklevel=5), e, see, syy

@@ -43,6 +43,7 @@ import numpy as np
 from ..arguments import entry_point
 from ..errors import DataError, IdentificationError, UnidentifiableError
 from ..models.friction import FrictionTable
+from ._scaling import unit_scale
 
 __all__ = ["Pulse", "BreakawayResult", "detect_breakaway", "ConstantVelocityPoint",
            "constant_velocity_friction", "table_from_points", "StribeckFit", "fit_stribeck",
@@ -391,6 +392,12 @@ def idim_ls(position, effort, fs: float, *, effort_scale: float = 1.0, cutoff: f
         raise DataError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
     if not (np.isfinite(effort_scale) and effort_scale != 0):
         raise DataError(f"effort scale: expected a finite non-zero factor, found {effort_scale!r}")
+    # work at unit size (exact powers of two: data at any scale); q' = cx·q, τ' = ce·τ give
+    # J' = J·ce/cx, F_v' = F_v·ce/cx, F_c' = F_c·ce, τ₀' = τ₀·ce, mapped back at the end
+    cx, ce = unit_scale(x), unit_scale(e * effort_scale)
+    x, e = x * cx, e * ce
+    if velocity_threshold is not None:
+        velocity_threshold = float(velocity_threshold) * cx
     cutoff = fs / 50.0 if cutoff is None else float(cutoff)
     if not 0 < cutoff < fs / 2:
         raise DataError(f"cutoff {cutoff:g} Hz must lie between 0 and fs/2 = {fs / 2:g} Hz")
@@ -433,7 +440,7 @@ def idim_ls(position, effort, fs: float, *, effort_scale: float = 1.0, cutoff: f
     thr = 0.02 * vmax if velocity_threshold is None else float(velocity_threshold)
     keep = (np.abs(vel) > thr) & ~near
     if keep.sum() < 20:
-        raise UnidentifiableError(f"only {int(keep.sum())} samples move faster than {thr:.3g}",
+        raise UnidentifiableError(f"only {int(keep.sum())} samples move faster than {thr / cx:.3g}",
                                   hint="excite the joint more, or lower --velocity-threshold")
     vel, acc, y = vel[keep], acc[keep], y[keep]
     if (vel > 0).all() or (vel < 0).all():
@@ -464,5 +471,8 @@ def idim_ls(position, effort, fs: float, *, effort_scale: float = 1.0, cutoff: f
     rel = float(100.0 * np.linalg.norm(r) / max(np.linalg.norm(y), 1e-300))
     if cond > 1e4:
         notes.append(f"regressor condition number {cond:.3g}: weak excitation")
+    d = np.array([cx / ce, cx / ce, 1.0 / ce, 1.0 / ce])  # back to the data's units
+    with np.errstate(over="ignore", under="ignore"):
+        theta, std, cov = theta * d, std * d, cov * d[:, None] * d[None, :]
     return IdimResult(dict(zip(_IDIM, map(float, theta))), dict(zip(_IDIM, map(float, std))), cov,
-                      rel, int(n), float(fs), float(cutoff), q, cond, float(math.sqrt(s2)), notes)
+                      rel, int(n), float(fs), float(cutoff), q, cond, float(math.sqrt(s2)) / ce, notes)

@@ -67,13 +67,13 @@ def io_data(data: Trajectory, *, input: str, output: str, detrend: str = "mean",
     if not isinstance(data, Trajectory):
         raise DataError(f"data: expected a gripkit Trajectory, found {type(data).__name__}",
                         hint="use gripkit.io.load(path) or Trajectory.uniform(fs, u=..., y=...)")
+    if detrend not in ("mean", "linear", "none"):
+        raise DataError(f"detrend: expected 'mean', 'linear' or 'none', found {detrend!r}")
     if input == output:
         raise DataError(f"input and output must be different columns, both are {input!r}")
     u = np.array(data[input], dtype=np.float64)
     y = np.array(data[output], dtype=np.float64)
     fs = float(f"{data.require_uniform(why=why):.9g}")  # time stamps in files carry rounding noise
-    if detrend not in ("mean", "linear", "none"):
-        raise DataError(f"detrend: expected 'mean', 'linear' or 'none', found {detrend!r}")
     u0 = y0 = 0.0
     if detrend == "mean":
         u0, y0 = float(u.mean()), float(y.mean())

@@ -37,6 +37,7 @@ from scipy.signal import find_peaks, hilbert, resample_poly
 
 from ..arguments import entry_point
 from ..errors import AccuracyWarning, DataError, IdentificationError
+from ._scaling import unit_scale
 
 __all__ = ["ModalResult", "free_vibration"]
 
@@ -142,6 +143,10 @@ def free_vibration(y, fs: float, *, start: int | None = None, end: int | None = 
                         hint="drop or interpolate them (CLI: --fill)")
     if y.size < 64:
         raise DataError(f"free-vibration analysis needs at least 64 samples, found {y.size}")
+    # work at unit size (an exact power of two: any scale, 1e-300 … 1e300); amplitudes mapped back below
+    cy = unit_scale(y)
+    y = y * cy
+    noise_std = None if noise_std is None else float(noise_std) * cy
     i0 = _start_index(y) if start is None else int(start)
     i1 = y.size if end is None else int(end)
     seg = y[i0:i1]
@@ -249,5 +254,7 @@ def free_vibration(y, fs: float, *, start: int | None = None, end: int | None = 
     if abs(f_fft - w / (2 * math.pi)) > max(0.01 * fn, 20 * f_std):
         warnings.warn(f"free vibration: the FFT peak {f_fft:.6g} Hz disagrees with the fitted damped frequency "
                       f"{w / (2 * math.pi):.6g} Hz", AccuracyWarning, stacklevel=2)
-    return ModalResult(fn, zeta, f_std, z_std, float(A), float(c + c0), float(i0 / fs), int(seg.size), float(fs),
-                       math.sqrt(s2), methods)
+    if "hilbert" in methods:
+        methods["hilbert"]["amplitude"] /= cy
+    return ModalResult(fn, zeta, f_std, z_std, float(A) / cy, float(c + c0) / cy, float(i0 / fs),
+                       int(seg.size), float(fs), math.sqrt(s2) / cy, methods)

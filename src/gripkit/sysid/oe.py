@@ -21,7 +21,8 @@ from scipy import signal as _sig
 
 from ._data import check_identifiable, checked_problem
 from ._pem import covariance, is_stable_poly, levenberg_marquardt, stabilize
-from .arx import arx
+from ._scaling import in_user_units, unit_scale
+from .arx import _arx
 from .polynomial import PolynomialModel, check_meta
 from .validation import fit_percent, loss_vn
 
@@ -30,7 +31,7 @@ __all__ = ["oe"]
 
 def _iv_start(u, y, nb, nf, nk, t0) -> np.ndarray:
     """ARX [nf nb nk] then one instrumental-variable step; returns θ = [b, f]."""
-    m0 = arx(u, y, nf, nb, nk)
+    m0 = _arx(u, y, nf, nb, nk, 1.0, warn=False)
     F0 = stabilize(m0.A)
     theta = np.concatenate([m0.B[nk:], F0[1:]])
     if nf == 0:
@@ -60,6 +61,12 @@ def oe(u, y, nb: int, nf: int, nk: int = 1, *, dt: float | None = None, fs: floa
     """
     check_meta(meta, oe)
     u, y, step, nb, nf, nk = checked_problem(u, y, dt, fs, nb=nb, nf=nf, nk=nk)
+    cu, cy = unit_scale(u), unit_scale(y)
+    return in_user_units(_oe(u * cu, y * cy, nb, nf, nk, step, maxiter, tol, meta), cu, cy)
+
+
+def _oe(u, y, nb, nf, nk, step, maxiter, tol, meta) -> PolynomialModel:
+    """:func:`oe` on checked signals scaled to unit size."""
     p = nb + nf
     t0 = max(nf, nk + nb - 1)
     label = f"OE [{nb} {nf} {nk}]"

@@ -3,7 +3,8 @@
 Two front ends share one numba kernel and one state vector:
 
 * :class:`RLS`, a streaming estimator for a control loop: ``e = est.update(u, y)`` per sample
-  (a few hundred nanoseconds: one call into a compiled kernel working in place);
+  (a few hundred nanoseconds: one call into a compiled kernel working in place). A NaN/inf sample,
+  a divergence or an overflow raises and leaves θ and P as they were (the kernel keeps a backup);
 * :func:`rls`, the batch form, which returns θ and σ at every step (:class:`RLSResult`).
 
 At each sample t with regressor φ(t) = [−y(t−1) … −y(t−na), u(t−nk) … u(t−nk−nb+1)] (eq 21)::
@@ -45,6 +46,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from numba import njit
+from numba.core.errors import TypingError
 
 from ..arguments import entry_point
 from ..errors import DataError, IdentificationError
@@ -54,7 +56,7 @@ from .polynomial import PolynomialModel
 __all__ = ["RLS", "RLSResult", "rls"]
 
 # state vector layout (float64): header, then buffers, θ, P and work vectors
-_COUNT, _LAM, _MODE, _MAXTR, _V, _W1, _W2, _TRACE, _NUPD, _NA, _NB, _NK = range(12)
+_COUNT, _LAM, _MODE, _MAXTR, _V, _W1, _W2, _TRACE, _NUPD, _NA, _NB, _NK, _STATUS = range(13)
 _HDR = 16
 _MODES = {"none": 0, "trace": 1, "directional": 2}
 #: Records at least this long run through a batch kernel compiled for their number of parameters.
@@ -120,7 +122,15 @@ def _core(P, th, phi, q, p, size, lam, mode, maxtr, trace, y):
 @njit(cache=True)
 def _rls_step(s, u, y):
     """One RLS update in place on the state vector ``s``; returns the a-priori error (0 while
-    the regressor is not yet filled). Same arithmetic as :func:`_rls_run` (both call :func:`_core`)."""
+    the regressor is not yet filled). Same arithmetic as :func:`_rls_run` (both call :func:`_core`).
+
+    A failed update returns NaN and leaves ``s`` as it was (θ and P are restored from a backup
+    taken before the update), with the reason in ``s[_STATUS]``: 1 = ``u`` or ``y`` not finite,
+    2 = P or θ no longer finite (divergence), 3 = φᵀPφ overflowed (signals too large for P).
+    """
+    if not (math.isfinite(u) and math.isfinite(y)):
+        s[_STATUS] = 1.0
+        return np.nan
     na = int(s[_NA])
     nb = int(s[_NB])
     nk = int(s[_NK])
@@ -132,24 +142,35 @@ def _rls_step(s, u, y):
     op = oth + p
     oph = op + p * p
     oq = oph + p
-    for i in range(nu - 1, 0, -1):
-        s[ou + i] = s[ou + i - 1]
-    s[ou] = u
+    ob = oq + p  # backup of θ and P
     e = 0.0
     t0 = na if na > nk + nb - 1 else nk + nb - 1
     if s[_COUNT] >= t0:
         for i in range(na):
             s[oph + i] = -s[oy + i]
-        for j in range(nb):
-            s[oph + na + j] = s[ou + nk + j]
+        for j in range(nb):  # u(t-nk-j): the buffer is shifted only once the update succeeded
+            s[oph + na + j] = u if nk + j == 0 else s[ou + nk + j - 1]
+        for i in range(p + p * p):
+            s[ob + i] = s[oth + i]
         lam = s[_LAM]
         e, r, tr = _core(s[op:oph], s[oth:op], s[oph:oq], s[oq:oq + p], p, (), lam, int(s[_MODE]),
                          s[_MAXTR], s[_TRACE], y)
+        ok = math.isfinite(tr) and math.isfinite(e)
+        for i in range(p):
+            ok = ok and math.isfinite(s[oth + i])
+        if not (ok and math.isfinite(r)):
+            for i in range(p + p * p):
+                s[oth + i] = s[ob + i]
+            s[_STATUS] = 2.0 if math.isfinite(r) else 3.0
+            return np.nan
         s[_TRACE] = tr
         s[_V] = lam * (s[_V] + e * e / (lam + r))
         s[_W1] = lam * s[_W1] + 1.0
         s[_W2] = lam * lam * s[_W2] + 1.0
         s[_NUPD] += 1.0
+    for i in range(nu - 1, 0, -1):
+        s[ou + i] = s[ou + i - 1]
+    s[ou] = u
     for i in range(na - 1, 0, -1):
         s[oy + i] = s[oy + i - 1]
     if na > 0:
@@ -309,7 +330,8 @@ class RLS:
         self._p0 = float(p0)
         self._theta0 = theta0.copy()
         self._maxtr = maxtr
-        self._s = np.zeros(_HDR + self.na + self.nk + self.nb + p + p * p + 2 * p)  # see _rls_step
+        # header, y and u buffers, θ, P, φ, q, backup of θ and P: see _rls_step
+        self._s = np.zeros(_HDR + self.na + self.nk + self.nb + 2 * (p + p * p) + 2 * p)
         self.reset()
 
     def reset(self) -> None:
@@ -340,8 +362,48 @@ class RLS:
         return tuple(f"a{i}" for i in range(1, self.na + 1)) + tuple(f"b{self.nk + j}" for j in range(self.nb))
 
     def update(self, u: float, y: float) -> float:
-        """Process one sample (input u(t), output y(t)); returns the a-priori prediction error."""
-        return _rls_step(self._s, u, y)
+        """Process one sample (input u(t), output y(t)); returns the a-priori prediction error.
+
+        Raises :class:`DataError` for a NaN/inf or non-numeric sample and
+        :class:`IdentificationError` when the update would make P or θ non-finite (divergence, or
+        signals too large for P); either way the estimator is left as it was before the call.
+        """
+        try:
+            e = _rls_step(self._s, u, y)
+        except TypingError:
+            raise DataError(f"RLS.update(u, y): expected two numbers, found {type(u).__name__} "
+                            f"{u!r:.40} and {type(y).__name__} {y!r:.40}") from None
+        if e != e:  # NaN: the kernel refused the sample and left the state unchanged
+            self._refuse(u, y)
+        return e
+
+    def _refuse(self, u, y):
+        status = self._s[_STATUS]
+        self._s[_STATUS] = 0.0
+        if status == 1.0:
+            raise DataError(f"RLS.update: sample {self.n_samples} is not finite (u={u:.6g}, y={y:.6g}); "
+                            f"the estimator is unchanged",
+                            hint="skip or interpolate missing samples before passing them")
+        if status == 3.0:
+            raise IdentificationError(
+                f"RLS [{self.na} {self.nb} {self.nk}]: φᵀPφ overflows at sample {self.n_samples} "
+                f"(u={u:.6g}, y={y:.6g}, trace P = {self._s[_TRACE]:.3g}): the regressor's values are too "
+                f"large for float64 with this P; the estimator is unchanged",
+                hint="scale u and y to order 1 (other units) and reset() the estimator")
+        raise self._diverged(f"at update {self.n_updates + 1}; the estimator is left at its last finite "
+                             f"state (reset() it)")
+
+    def _diverged(self, when: str) -> IdentificationError:
+        return IdentificationError(
+            f"RLS [{self.na} {self.nb} {self.nk}] diverged {when}: P or θ is no longer finite "
+            f"(forgetting λ = {self.forgetting:g}, windup={self.windup!r}); the covariance wound up on "
+            f"data that do not excite every direction",
+            hint="use windup='trace' or 'directional', or a forgetting factor closer to 1")
+
+    @property
+    def n_samples(self) -> int:
+        """Samples processed so far."""
+        return int(self._s[_COUNT])
 
     @property
     def ready(self) -> bool:
@@ -400,8 +462,45 @@ class RLS:
         u, y = check_io(u, y)
         return self._run(u, y, store)
 
+    def _check_scale(self, u: np.ndarray, y: np.ndarray) -> None:
+        """Refuse signals whose scale the recursion cannot represent next to the current P:
+
+        * φᵀPφ <= ‖φ‖²·trace P must stay finite: ``p·max(|u|,|y|)²·trace P`` below the float64 limit;
+        * the data must outweigh the prior: the RLS estimate minimises
+          ``Σe² + (θ − θ0)ᵀP0⁻¹(θ − θ0)``, so a parameter whose regressor energy ``Σφ_j²`` is below
+          ``1/P_jj`` stays (more than half-way) at its prior value: θ0 returned as if estimated.
+        """
+        p = self.n_params
+        P = self.P
+        tr = float(np.trace(P))
+        peak = max(float(np.max(np.abs(u))), float(np.max(np.abs(y))))
+        if peak > 0 and math.log10(p) + 2 * math.log10(peak) + math.log10(tr) > 307.0:
+            raise DataError(
+                f"RLS [{self.na} {self.nb} {self.nk}]: values up to {peak:.3g} in u and y make φᵀPφ "
+                f"overflow float64 (trace P = {tr:.3g}), so the recursion cannot run on them",
+                hint="scale u and y to order 1 (other units); arx(), armax() and oe() scale internally")
+        for label, x, idx in (("output y", y, range(self.na)), ("input u", u, range(self.na, p))):
+            if not len(idx):
+                continue
+            mx = float(np.max(np.abs(x)))
+            if mx == 0.0:
+                raise IdentificationError(
+                    f"RLS [{self.na} {self.nb} {self.nk}]: the {label} is zero throughout, so "
+                    f"{', '.join(self.names[i] for i in idx)} cannot be estimated",
+                    hint="check that the columns are the measured input and output")
+            log_energy = -math.inf if mx == 0 else 2 * (math.log10(mx) + math.log10(np.linalg.norm(x / mx)))
+            prior = float(np.max(np.diag(P)[list(idx)]))
+            if log_energy + math.log10(prior) < 0.0:
+                names = ", ".join(self.names[i] for i in idx)
+                raise IdentificationError(
+                    f"RLS [{self.na} {self.nb} {self.nk}]: the {label} (values up to {mx:.3g}) carries "
+                    f"almost no information next to the prior P = {prior:.3g}·I: Σ{label[-1]}² = "
+                    f"10^{log_energy:.0f} is below 1/P, so {names} would stay at their initial values",
+                    hint=f"scale u and y to order 1 (other units), or raise p0 above 1/Σ{label[-1]}²")
+
     def _run(self, u: np.ndarray, y: np.ndarray, store: bool) -> "RLSResult":
         """:meth:`run` on checked float64 arrays."""
+        self._check_scale(u, y)
         n = u.size
         p = self.n_params
         rows = n if store else 0
@@ -411,11 +510,7 @@ class RLS:
         n0 = self.n_updates
         _rls_run(self._s, u, y, theta, std, yhat, (0.0,) * p if n >= SPECIALISE_ABOVE else ())
         if not (np.isfinite(self.P).all() and np.isfinite(self.theta).all()):
-            raise IdentificationError(
-                f"RLS [{self.na} {self.nb} {self.nk}] diverged: P or θ is no longer finite after "
-                f"{self.n_updates} updates (forgetting λ = {self.forgetting:g}, windup={self.windup!r}); "
-                f"the covariance wound up on data that do not excite every direction",
-                hint="use windup='trace' or 'directional', or a forgetting factor closer to 1")
+            raise self._diverged(f"after {self.n_updates} updates")
         e = y - yhat
         nupd = self.n_updates - n0
         if nupd == 0:

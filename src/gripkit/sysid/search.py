@@ -20,11 +20,12 @@ from ..arguments import entry_point
 from ..errors import DataError, UnidentifiableError
 from ..progress import track
 from ._data import check_dt, check_identifiable, check_io, check_order
+from ._scaling import unit_scale
 from .regression import arx_regression, qr_solve
 
 __all__ = ["Candidate", "SearchResult", "structure_search", "parse_range"]
 
-_CRITERIA = ("aic", "fpe", "loss")
+CRITERIA = ("aic", "fpe", "loss")
 
 
 @dataclass(frozen=True)
@@ -115,14 +116,16 @@ def structure_search(u, y, na=range(1, 5), nb=range(1, 5), nk=range(1, 11), *,
     """
     u, y = check_io(u, y)
     check_dt(dt, fs)
-    if criterion not in _CRITERIA:
-        raise DataError(f"criterion: expected one of {', '.join(_CRITERIA)}, found {criterion!r}")
+    if criterion not in CRITERIA:
+        raise DataError(f"criterion: expected one of {', '.join(CRITERIA)}, found {criterion!r}")
     nas = [check_order(v, "na", 0) for v in parse_range(na, "na")]
     nbs = [check_order(v, "nb", 1) for v in parse_range(nb, "nb")]
     nks = [check_order(v, "nk", 0) for v in parse_range(nk, "nk")]
     t0 = max(max(nas), max(nks) + max(nbs) - 1)
     pmax = max(nas) + max(nbs)
     check_identifiable(u, y, t0 + pmax + 1, f"structure search up to na={max(nas)}, nb={max(nbs)}, nk={max(nks)}")
+    cu, cy = unit_scale(u), unit_scale(y)  # exact powers of two (see _scaling): any data scale
+    u, y = u * cu, y * cy
     yt = y[t0:]
     sst = float(np.sum((yt - yt.mean()) ** 2))
     m = y.size - t0
@@ -131,16 +134,16 @@ def structure_search(u, y, na=range(1, 5), nb=range(1, 5), nk=range(1, 11), *,
     for a, b, k in track(grid, description="ARX structure search", enabled=progress and len(grid) * y.size > 2e6):
         names = tuple(f"a{i}" for i in range(1, a + 1)) + tuple(f"b{k + j}" for j in range(b))
         try:
-            sol = qr_solve(arx_regression(u, y, a, b, k, t0=t0), names, overwrite=True)
+            sol = qr_solve(arx_regression(u, y, a, b, k, t0=t0), names, overwrite=True, warn=False)
         except UnidentifiableError as exc:
             skipped.append((a, b, k, str(exc)))
             continue
         p = a + b
-        v = sol.rss / m
-        aic = m * math.log(2 * math.pi * v) + m + 2 * p if v > 0 else -math.inf
-        fpe = v * (1 + p / m) / (1 - p / m)
+        v = sol.rss / m  # in the scaled units: V_user = V / cy²
+        aic = m * (math.log(2 * math.pi * v) - 2 * math.log(cy)) + m + 2 * p if v > 0 else -math.inf
+        fpe = v * (1 + p / m) / (1 - p / m) / cy / cy
         fit = 100.0 * (1.0 - math.sqrt(sol.rss / sst))
-        found.append(Candidate(a, b, k, p, 0.5 * v, aic, fpe, fit))
+        found.append(Candidate(a, b, k, p, 0.5 * v / cy / cy, aic, fpe, fit))
     if not found:
         raise UnidentifiableError("no structure of the search could be identified: "
                                   + (skipped[0][3] if skipped else "empty grid"))

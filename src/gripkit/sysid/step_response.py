@@ -244,7 +244,7 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
                         hint="choose the column that holds the commanded step")
     u_scale = np.ptp(u)
     y_scale = np.ptp(y)
-    if y_scale == 0 or y_scale <= 1e-12 * max(1.0, np.max(np.abs(y))):
+    if y_scale == 0 or y_scale <= 1e-12 * np.max(np.abs(y)):  # relative: data at any scale
         raise DataError(f"output column {output!r} does not change: nothing to identify",
                         hint="check the column, or whether the system was powered")
     dt = 1.0 / fs
@@ -283,12 +283,13 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
         warnings.warn(f"step-response fit of {output!r}: {res.identifiability}", AccuracyWarning, stacklevel=2)
     K = Kn * y_scale / u_scale
     y0 = y_ref + y0n * y_scale
-    J = np.diag([y_scale / u_scale, 1.0 / (2 * math.pi), 1.0, y_scale])
-    cov = J @ res.covariance @ J
-    std = np.sqrt(np.clip(np.diag(cov), 0, None))
-    std = np.where(np.isfinite(res.std), std, np.inf)
-    d = np.where(std > 0, std, 1.0)
-    corr = cov / np.outer(d, d)
+    jd = np.array([y_scale / u_scale, 1.0 / (2 * math.pi), 1.0, y_scale])
+    with np.errstate(over="ignore", under="ignore"):  # variances of data at 1e300 do not fit in float64
+        cov = res.covariance * jd[:, None] * jd[None, :]
+    std_n = np.sqrt(np.clip(np.diag(res.covariance), 0, None))  # σ and correlation without squaring
+    std = np.where(np.isfinite(res.std), std_n * jd, np.inf)  # the scales: finite at any data scale
+    d = np.where(std_n > 0, std_n, 1.0)
+    corr = res.covariance / np.outer(d, d)
     m = second_order_metrics(wn, zeta)
     if m["settling_time"] > data.duration:
         warnings.warn(f"step-response fit of {output!r}: the fitted response settles in "
