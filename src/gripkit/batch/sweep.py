@@ -143,8 +143,8 @@ def _auto_backend(work_s: float, workers: int) -> tuple[str, str]:
     """'in-process' when the estimated work cannot win back the pool's start-up
     (``work ≤ startup + work / workers``), else 'process'; with the reason for the summary."""
     if workers <= 1 or work_s <= POOL_STARTUP_S + work_s / workers:
-        return "in-process", (f"backend auto: in-process, the estimated work ({work_s:.2g} s) is below what a "
-                              f"pool of {workers} would save over its start-up (~{POOL_STARTUP_S:g} s)")
+        return "in-process", (f"backend auto: in-process, the estimated work ({work_s:.2g} s) is too small for "
+                              f"a pool of {workers} to win back its start-up (~{POOL_STARTUP_S:g} s)")
     return "process", (f"backend auto: process pool of {workers}, the estimated work ({work_s:.2g} s) "
                        f"outweighs its start-up (~{POOL_STARTUP_S:g} s)")
 
@@ -205,7 +205,8 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "auto", workers
 
     choice = ""
     auto = backend == "auto" and executor is None and not scheduler
-    per_job = _seconds_per_job(chunk_args(range(min(2, n_jobs)))) if (chunk_size is None or auto) else None
+    # timed on up to 8 jobs: a chunk's fixed cost (model set-up) spread over 2 would inflate it
+    per_job = _seconds_per_job(chunk_args(range(min(8, n_jobs)))) if (chunk_size is None or auto) else None
     if auto:
         backend, choice = _auto_backend(per_job * n_jobs, int(workers or os.cpu_count() or 1))
         in_flight = _in_flight(None, backend, workers, None)
