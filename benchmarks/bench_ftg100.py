@@ -76,7 +76,7 @@ def run(quick: bool) -> list[dict]:
     b = _scipy_grasp(dur, 5e-6, noise=False)[:-1]
     err = float(np.max(np.abs(a - b)) / 20e-6)
     rows.append(row("ftg100", f"closed-loop grasp, {dur * 1e3:.0f} ms at 20 kHz (plant with contact events + hybrid controller)",
-                    g, "scipy solve_ivp RK45 + events, Python loop", p,
+                    g, "scipy solve_ivp RK45 + events, once per sample in a Python loop", p, pure_python_peer=True,
                     notes=f"same controller, no noise: contact force agrees within {100 * err:.2g} % of the command at every sample"))
     # 2. LM identification of M_a, K_fa, k0 (+ sensor zero)
     data = step_experiment(duration=1.0 if quick else 2.0, period=0.05, seed=1)
@@ -87,7 +87,7 @@ def run(quick: bool) -> list[dict]:
     theirs = _scipy_lm(data)
     rel = max(abs(ours.value(n) / theirs[i] - 1) for i, n in enumerate(("M_a", "K_fa", "k0")))
     rows.append(row("ftg100", f"LM identification of M_a, K_fa, k0 ({data.n} samples, §III-B)", g,
-                    "scipy least_squares(lm) + signal.dlsim", p,
+                    "scipy least_squares(lm) + signal.dlsim", p, pure_python_peer=True,
                     notes=f"same start (step fit), estimates agree to {rel:.1e}; gripkit adds σ/covariance"))
     return rows
 
