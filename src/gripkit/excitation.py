@@ -25,7 +25,8 @@ import numpy as np
 from .errors import DataError
 from .signals.trajectory import Trajectory
 
-__all__ = ["Excitation", "multisine", "bandlimited_noise", "prbs", "chirp", "steps", "crest_factor"]
+__all__ = ["Excitation", "multisine", "bandlimited_noise", "prbs", "chirp", "steps", "crest_factor",
+           "FourierTrajectory", "fourier_trajectory"]
 
 
 @dataclass(frozen=True)
@@ -265,3 +266,9 @@ def steps(levels: Sequence[float], durations: Sequence[float] | float, fs: float
     t = np.arange(u.size) / fs
     return Excitation("steps", t, u, float(fs), op, (float(lo), float(hi)), unit,
                       {"levels": levels, "durations_s": durs})
+
+
+# multi-joint excitation for inverse-dynamics identification (a module of its own: it designs
+# for any chain object without importing gripkit.multibody)
+from ._fourier_trajectory import FourierTrajectory as FourierTrajectory  # noqa: E402
+from ._fourier_trajectory import fourier_trajectory as fourier_trajectory  # noqa: E402

@@ -403,3 +403,31 @@ def test_rls_update_detects_windup_divergence_like_run():
     with pytest.raises(IdentificationError, match=r"diverged after \d+ updates"):
         y = 1e-3 * np.random.default_rng(0).standard_normal(10_000)  # excites a1, a2; u excites b only once
         RLS(2, 2, 1, forgetting=0.9, windup="none").run(np.r_[1.0, np.zeros(9999)], y)
+
+
+def test_one_row_csv_names_the_file(cli, tmp_path):
+    p = tmp_path / "one.csv"
+    p.write_text("t,u,y\n0,1,2\n")
+    res = cli("identify", "arx", p, "--input", "u", "--output", "y", "--na", 1, "--nb", 1, "--nk", 1)
+    assert_user_error(res, "DataError", "one.csv: 1 sample(s) have no sample interval")
+
+
+def test_junk_mcap_is_not_read_as_mcap(cli, tmp_path):
+    p = tmp_path / "log.mcap"
+    p.write_text("junk\n")
+    res = cli("identify", "arx", p, "--input", "u", "--output", "y", "--na", 1, "--nb", 1, "--nk", 1)
+    assert_user_error(res, "DataError", "log.mcap: not an MCAP file")
+
+
+def test_repeated_column_name_is_refused(cli, tmp_path):
+    p = tmp_path / "dup.csv"
+    p.write_text("t,u,u\n" + "".join(f"{k / 100},{np.sin(k)},{np.cos(k)}\n" for k in range(50)))
+    res = cli("identify", "arx", p, "--input", "u", "--output", "u", "--na", 1, "--nb", 1, "--nk", 1)
+    assert_user_error(res, "DataError", "column name 'u' appears 2 times")
+
+
+def test_header_without_rows_names_the_file(cli, tmp_path):
+    p = tmp_path / "hdr.csv"
+    p.write_text("t,u,y\n")
+    res = cli("identify", "arx", p, "--input", "u", "--output", "y", "--na", 1, "--nb", 1, "--nk", 1)
+    assert_user_error(res, "DataError", "hdr.csv: the file has column names but no data rows")

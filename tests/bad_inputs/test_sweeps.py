@@ -301,3 +301,27 @@ def test_values_outside_the_parameter_bounds(sweep_cli, write):
     assert "of 200 jobs have values outside its bounds [0, inf] N/m" in res.err and "clip" in res.err
     ok = sweep_cli(write(MSD + 'samples = 20\n[parameters]\nk = { normal = [1.0, 1.0], clip = [0.1, 10] }' + SCENARIO))
     assert ok.code == 0, ok.err
+
+
+# --- an executor that cannot start leaves --out untouched; a folder without results is reused -----
+def test_unreachable_executor_writes_nothing_and_the_retry_runs(sweep_cli, cli, write, tmp_path, monkeypatch,
+                                                               own_module):
+    import importlib
+
+    sweep_module = importlib.import_module("gripkit.batch.sweep")
+
+    def unreachable(*args, **kwargs):
+        raise ConfigError("cannot reach the Dask scheduler at 'tcp://127.0.0.1:1'")
+
+    path = write(OWN)
+    with monkeypatch.context() as m:
+        m.setattr(sweep_module, "make_executor", unreachable)
+        res = cli("sweep", path, "--out", tmp_path / "out", "--backend", "dask", "--allow-code")
+    assert_user_error(res, "ConfigError", "cannot reach the Dask scheduler")
+    assert not (tmp_path / "out").exists()
+    # a folder holding a manifest but no results (an earlier run stopped before its first chunk)
+    # is reused, whatever chunk size that run had calibrated
+    (tmp_path / "out" / "chunks").mkdir(parents=True)
+    (tmp_path / "out" / "manifest.json").write_text('{"fingerprint": "0000", "spec": {"sweep": {}}}')
+    res = sweep_cli(path, "--allow-code")
+    assert res.code == 0, res.err

@@ -109,12 +109,12 @@ class ResultStore:
         if self.root.exists() and not self.root.is_dir():
             raise ConfigError(f"output folder {str(self.root)!r} is a file", hint="choose another --out folder")
         old = self.manifest()
-        if old is not None:
+        if old is not None and self.done_chunks():  # a folder without results may be reused
             if old.get("fingerprint") != fp:
                 raise ConfigError(
                     f"output folder {str(self.root)!r} holds a different sweep (fingerprint "
                     f"{old.get('fingerprint')} vs {fp})", hint="choose another --out folder or delete it")
-            if not resume and self.done_chunks():
+            if not resume:
                 raise ConfigError(f"output folder {str(self.root)!r} already holds results of this sweep",
                                   hint="pass --resume (resume=True) to continue it, or choose another folder")
         self.chunks_dir.mkdir(parents=True, exist_ok=True)

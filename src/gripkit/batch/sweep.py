@@ -219,16 +219,22 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "auto", workers
     n_chunks = math.ceil(n_jobs / chunk_size)
     done: set[int] = set()
     mem: dict[int, dict] = {}
-    if store is not None:
-        store.initialise(record, jobs, resume)
-        done = store.check_chunks(chunk_size, n_jobs, spec.metrics)
+    own = executor is None
+    # the executor first: a scheduler that cannot be reached leaves the output folder untouched
+    ex = executor or make_executor(backend, workers, scheduler)
+    try:
+        if store is not None:
+            store.initialise(record, jobs, resume)
+            done = store.check_chunks(chunk_size, n_jobs, spec.metrics)
+    except BaseException:
+        if own:
+            ex.close()
+        raise
     tasks = []
     for c in range(n_chunks):
         if c in done:
             continue
         tasks.append((c, run_chunk, chunk_args(chunk_range(c, chunk_size, n_jobs))))
-    own = executor is None
-    ex = executor or make_executor(backend, workers, scheduler)
     t0 = time.perf_counter()
     if done:
         status(f"resuming {spec.name}: {len(done)} of {n_chunks} chunks already on disk")

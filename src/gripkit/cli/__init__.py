@@ -21,6 +21,7 @@ def _build():
     from . import demo, identify_linear, identify_step, sweep, zoo, zoo_discretize  # noqa: F401  (commands register themselves)
     from . import identify_tsfm, simulate  # noqa: F401
     from . import identify_friction  # noqa: F401
+    from . import excitation_fourier, identify_dynamics  # noqa: F401
     from .app import app
 
     return app

@@ -130,7 +130,7 @@ def _read_csv(path: Path, key=None, delimiter=None):
         raise DataError(f"{path.name}: not a readable CSV file (truncated or corrupt?): "
                         f"{str(exc).splitlines()[0]}") from None
     _warn_unterminated(path)
-    return _arrow_columns(table), {}
+    return _arrow_columns(table, path.name), {}
 
 
 def _refuse_ragged_line(path: Path, delimiter: str) -> None:
@@ -170,9 +170,14 @@ def _warn_unterminated(path: Path) -> None:
                   f"it with a newline if it is complete", DataWarning, stacklevel=4)
 
 
-def _arrow_columns(table) -> dict[str, object]:
+def _arrow_columns(table, source: str) -> dict[str, object]:
     import pyarrow as pa
 
+    names = table.column_names
+    repeated = sorted({n for n in names if names.count(n) > 1})
+    if repeated:
+        raise DataError(f"{source}: column name {repeated[0]!r} appears {names.count(repeated[0])} times in "
+                        f"the header; each column needs its own name", hint="rename the repeated columns")
     out = {}
     for name, col in zip(table.column_names, table.columns):
         if pa.types.is_integer(col.type) or pa.types.is_floating(col.type) or pa.types.is_boolean(col.type):
@@ -198,7 +203,7 @@ def _read_parquet(path: Path, key=None, delimiter=None):
         md = f.metadata or {}
         if b"unit" in md:
             units[f.name] = md[b"unit"].decode()
-    return _arrow_columns(table), units
+    return _arrow_columns(table, path.name), units
 
 
 def _read_hdf5(path: Path, key=None, delimiter=None):

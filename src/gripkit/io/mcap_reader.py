@@ -20,6 +20,7 @@ __all__ = ["read_mcap", "parse_column"]
 
 _COL = re.compile(r"^(?:(?P<alias>[A-Za-z_][\w]*)=)?(?P<topic>/[^:]*):(?P<field>[A-Za-z_][\w.\[\]]*)$")
 _PART = re.compile(r"^([A-Za-z_]\w*)((?:\[\d+\])*)$")
+_MAGIC = b"\x89MCAP0\r\n"  # the MCAP specification's leading magic bytes
 
 
 def parse_column(spec: str) -> tuple[str, str, list]:
@@ -60,6 +61,10 @@ def read_mcap(path: Path, columns, stamp: str = "log") -> tuple[dict, dict]:
         from mcap_ros2.decoder import DecoderFactory
     except ImportError:
         raise DataError("reading MCAP files needs the optional extra", hint="pip install 'gripkit[mcap]'") from None
+    with open(path, "rb") as fh:
+        if fh.read(len(_MAGIC)) != _MAGIC:
+            raise DataError(f"{path.name}: not an MCAP file (it does not start with the MCAP magic bytes)",
+                            hint="check the file, or force another format with format='csv'|'parquet'|'hdf5'")
     if not columns:
         raise DataError(f"{path.name}: name the MCAP columns to read (columns=[...], CLI: repeat --column)",
                         hint="columns look like force=/fingertip/wrench:wrench.force.z")

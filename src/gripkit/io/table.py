@@ -211,6 +211,9 @@ def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
         arr = _numeric(c, vals)
         data[c], su[c] = _to_si(c, arr, unit)
         n = arr.shape[0]
+    if n == 0:
+        raise DataError(f"{source}: the file has column names but no data rows",
+                        hint="check that the file is complete")
     if tname is not None:
         tvals, tunit = cols[tname]
         t, tsi = _to_si(tname, _numeric(tname, tvals), tunit or "s")

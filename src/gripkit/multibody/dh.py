@@ -44,10 +44,60 @@ class Dynamics:
     coupled chain). Subclasses provide ``dof``, ``coordinate_names``, ``name``, ``chain``,
     ``base``, ``tool`` and ``kernel_arrays()``."""
 
+    _one = None  # the packed model of the one-state path (gripkit.multibody.onestate)
+
     # --- dynamics (thesis eq 4.17) ---
     def rnea(self, q, qd, qdd, *, gravity: bool = True, parallel: bool | None = None) -> np.ndarray:
-        """τ = M q̈ + C + G (RNEA, eqs 4.8–4.16)."""
+        """τ = M q̈ + C + G (RNEA, eqs 4.8–4.16); one float64 state takes the low-overhead path
+        of :mod:`gripkit.multibody.onestate`."""
+        one = self._one
+        if one is None:
+            from .onestate import prepare
+            one = self._one = prepare(self)
+        kernel, fl, it, work, m = one
+        if gravity:
+            out = np.empty(m)
+            try:  # the kernel takes only 1-D float64 arrays: anything else goes the validating way
+                if kernel(fl, it, q, qd, qdd, out, work):
+                    return out
+            except TypeError:
+                pass
         return _dyn.rnea(self, q, qd, qdd, gravity=gravity, parallel=parallel)
+
+    def regressor(self, q, qd, qdd, *, gravity: bool = True) -> np.ndarray:
+        """Y(q, q̇, q̈), (m, p) or (B, m, p): τ = Y φ + diag(armature) q̈ with φ the standard
+        inertial parameters (:mod:`gripkit.multibody.regressor`)."""
+        from .regressor import regressor
+        return regressor(self, q, qd, qdd, gravity=gravity)
+
+    @property
+    def link_names(self) -> tuple[str, ...]:
+        """Names of the moving links, one per regressor block of 10 parameters."""
+        return tuple(f"link{k + 1}" for k in range(self.chain.n))
+
+    @property
+    def parameter_names(self) -> tuple[str, ...]:
+        """``'<parameter>_<link>'`` per regressor column (m, mx, my, mz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz)."""
+        from .regressor import parameter_names
+        return parameter_names(self)
+
+    def standard_parameters(self) -> np.ndarray:
+        """φ, the standard inertial parameters of the moving links (kg, kg·m, kg·m²; inertia about
+        each link frame's origin), in :attr:`parameter_names` order."""
+        from .regressor import kernel_parameters
+        _, _, mass, com, i6, *_ = self.kernel_arrays()
+        return kernel_parameters(mass, com, i6)
+
+    def parameter_map(self):
+        """None: the regressor's link frames are the kernel's (a URDF chain maps them)."""
+        return None
+
+    def armature_matrix(self) -> np.ndarray:
+        """A = Γᵀ diag(armature_q) Γ + diag(armature_p) (m×m): the rotor-inertia term outside φ,
+        τ = Y φ + A q̈."""
+        dh, _, _, _, _, arm_q, G, _, arm_p, _ = self.kernel_arrays()
+        Gm = G.reshape(dh.shape[0], -1)
+        return Gm.T @ (arm_q[:, None] * Gm) + np.diag(arm_p)
 
     def mass_matrix(self, q) -> np.ndarray:
         """M(q), including reflected rotor inertia."""

@@ -81,10 +81,43 @@ def dh_link(ca, sa, a, d, theta, R, P, k):  # pragma: no cover - compiled
 
 
 @hot
+def placement_links(n, table, jtype, q, R, P):  # pragma: no cover - compiled
+    """Link transforms of a chain described by joint placements (URDF, Pinocchio): ``table[k] =
+    (F_R row-major (9), F_P (3))`` is the fixed transform F_k from frame k to joint k+1's frame,
+    whose z axis is the joint axis, so ^{k}_{k+1}T = F_k · Rz(q_k) (revolute) or F_k · Dz(q_k)
+    (prismatic): R = F_R·Rz(q), P = F_P, or R = F_R, P = F_P + q·F_R ẑ."""
+    for k in range(n):
+        if jtype[k] == 0:
+            c = math.cos(q[k])
+            s = math.sin(q[k])
+            for i in range(3):
+                a = table[k, 3 * i]
+                b = table[k, 3 * i + 1]
+                R[k, 3 * i] = a * c + b * s
+                R[k, 3 * i + 1] = b * c - a * s
+                R[k, 3 * i + 2] = table[k, 3 * i + 2]
+                P[k, i] = table[k, 9 + i]
+        else:
+            for i in range(3):
+                R[k, 3 * i] = table[k, 3 * i]
+                R[k, 3 * i + 1] = table[k, 3 * i + 1]
+                R[k, 3 * i + 2] = table[k, 3 * i + 2]
+                P[k, i] = table[k, 9 + i] + q[k] * table[k, 3 * i + 2]
+
+
+#: width of a :func:`placement_links` table (a DH table, :func:`dh_table`, has 6 columns)
+PLACEMENT_WIDTH = 12
+
+
+@hot
 def chain_links(n, dh, jtype, q, R, P):  # pragma: no cover - compiled
     """All link transforms for joint positions q. ``dh[k] = (α_{k}, a_{k}, d_{k+1}, θ0_{k+1},
     cos α_k, sin α_k)`` (see :func:`dh_table`); a revolute joint variable adds to θ0, a prismatic
-    one to d."""
+    one to d. A table of :data:`PLACEMENT_WIDTH` columns holds joint placements instead
+    (:func:`placement_links`): DH and URDF chains share every kernel below."""
+    if dh.shape[1] == PLACEMENT_WIDTH:
+        placement_links(n, dh, jtype, q, R, P)
+        return
     for k in range(n):
         if jtype[k] == 0:
             dh_link(dh[k, 4], dh[k, 5], dh[k, 1], dh[k, 2], dh[k, 3] + q[k], R, P, k)

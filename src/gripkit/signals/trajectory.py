@@ -159,7 +159,9 @@ class Trajectory:
     def dt(self) -> float:
         """Median sample interval (s)."""
         if self.n < 2:
-            raise DataError("a single sample has no sample interval")
+            source = self.meta.get("source")
+            raise DataError(f"{source + ': ' if source else ''}{self.n} sample(s) have no sample interval",
+                            hint="a record needs at least 2 samples; check that the file is complete")
         return float(np.median(np.diff(self.t)))
 
     @property

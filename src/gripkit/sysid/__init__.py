@@ -40,5 +40,7 @@ from .friction import constant_velocity_friction as constant_velocity_friction
 from .friction import detect_breakaway as detect_breakaway
 from .friction import fit_stribeck as fit_stribeck
 from .friction import idim_ls as idim_ls
+from .dynamics import DynamicsResult as DynamicsResult
+from .dynamics import identify_dynamics as identify_dynamics
 from .motor import characterize_motor as characterize_motor
 from .motor import fit_motor as fit_motor

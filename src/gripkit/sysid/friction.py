@@ -47,7 +47,7 @@ from ._scaling import unit_scale
 
 __all__ = ["Pulse", "BreakawayResult", "detect_breakaway", "ConstantVelocityPoint",
            "constant_velocity_friction", "table_from_points", "StribeckFit", "fit_stribeck",
-           "IdimResult", "idim_ls"]
+           "IdimResult", "IdimSamples", "idim_samples", "idim_ls"]
 
 
 def _same_length(**named) -> list[np.ndarray]:
@@ -359,6 +359,80 @@ class IdimResult:
 _IDIM = ("inertia", "viscous", "coulomb", "offset")
 
 
+@dataclass(frozen=True)
+class IdimSamples:
+    """Filtered, differentiated and decimated samples for inverse-dynamics least squares (columns:
+    joints). ``near_reversal`` marks the samples within the guard band of a velocity reversal of
+    that joint, where the filtered Coulomb step does not follow sign(q̇)."""
+
+    position: np.ndarray
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    effort: np.ndarray
+    near_reversal: np.ndarray
+    fs: float
+    cutoff: float
+    decimation: int
+    notes: tuple
+
+
+def idim_samples(position, effort, fs: float, *, cutoff: float | None = None, order: int = 4,
+                 decimation: int | None = None, guard: float = 1.0) -> IdimSamples:
+    """The signal chain of IDIM-LS (module doc), for one joint (1-D arrays) or several ((N, m)
+    arrays): the same zero-phase Butterworth filter on position and effort, q̇ and q̈ by central
+    differences, the filter's edge transients cut, decimation by ``decimation`` (default: the
+    largest q with fs/(2q) ≥ 2.5·cutoff), and the guard bands (``guard/cutoff`` s) around every
+    velocity reversal marked."""
+    from ..signals.filters import apply_sos, butter_sos
+
+    x = np.asarray(position, dtype=np.float64)
+    e = np.asarray(effort, dtype=np.float64)
+    x = x[:, None] if x.ndim == 1 else x
+    e = e[:, None] if e.ndim == 1 else e
+    if x.ndim != 2 or x.shape != e.shape:
+        raise DataError(f"position and effort: expected arrays of one shape (N,) or (N, m), found "
+                        f"{np.shape(position)} and {np.shape(effort)}")
+    if not (np.isfinite(fs) and fs > 0):
+        raise DataError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
+    cutoff = fs / 50.0 if cutoff is None else float(cutoff)
+    if not 0 < cutoff < fs / 2:
+        raise DataError(f"cutoff {cutoff:g} Hz must lie between 0 and fs/2 = {fs / 2:g} Hz")
+    q = decimation if decimation is not None else max(1, int(fs / (2 * 2.5 * cutoff)))
+    if int(q) != q or q < 1:
+        raise DataError(f"decimation: expected a positive integer, found {decimation!r}")
+    q = int(q)
+    notes = []
+    if fs / (2 * q) < cutoff:
+        notes.append(f"decimation {q} puts the new Nyquist frequency {fs / (2 * q):g} Hz below the "
+                     f"cutoff {cutoff:g} Hz: the decimated rows alias")
+    n = x.shape[0]
+    edge = int(math.ceil(3 * fs / cutoff))
+    if n < 2 * edge + 50 * q:
+        raise DataError(f"{n} samples are too few for IDIM-LS at fs = {fs:g} Hz with a {cutoff:g} Hz "
+                        f"filter (need more than {2 * edge + 50 * q})", hint="log a longer run")
+    sos = butter_sos(order, cutoff, fs)
+    xf = apply_sos(sos, x, zero_phase=True)
+    ef = apply_sos(sos, e, zero_phase=True)
+    dt = 1.0 / fs
+    vel = np.gradient(xf, dt, axis=0)
+    acc = np.gradient(vel, dt, axis=0)
+    # the filter smears the friction step of each velocity reversal over ~1/cutoff: those samples
+    # do not obey the sign(q̇) model of the filtered signals
+    near = np.zeros(x.shape, dtype=bool)
+    g = int(math.ceil(guard * fs / cutoff))
+    for j in range(x.shape[1]):
+        rev = np.flatnonzero(np.sign(vel[1:, j]) != np.sign(vel[:-1, j]))
+        if rev.size and g > 0:
+            lo = np.clip(rev - g, 0, n)
+            hi = np.clip(rev + g + 1, 0, n)
+            cover = np.zeros(n + 1, dtype=np.int64)
+            np.add.at(cover, lo, 1)
+            np.add.at(cover, hi, -1)
+            near[:, j] = np.cumsum(cover[:-1]) > 0
+    sl = slice(edge, n - edge, q)
+    return IdimSamples(xf[sl], vel[sl], acc[sl], ef[sl], near[sl], float(fs), cutoff, q, tuple(notes))
+
+
 @entry_point
 def idim_ls(position, effort, fs: float, *, effort_scale: float = 1.0, cutoff: float | None = None,
             order: int = 4, decimation: int | None = None,
@@ -385,11 +459,7 @@ def idim_ls(position, effort, fs: float, *, effort_scale: float = 1.0, cutoff: f
         Also drop the samples within ``guard/cutoff`` seconds of a velocity reversal, where the
         filtered Coulomb step does not follow sign(q̇).
     """
-    from ..signals.filters import apply_sos, butter_sos
-
     x, e = _same_length(position=position, effort=effort)
-    if not (np.isfinite(fs) and fs > 0):
-        raise DataError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
     if not (np.isfinite(effort_scale) and effort_scale != 0):
         raise DataError(f"effort scale: expected a finite non-zero factor, found {effort_scale!r}")
     # work at unit size (exact powers of two: data at any scale); q' = cx·q, τ' = ce·τ give
@@ -398,42 +468,9 @@ def idim_ls(position, effort, fs: float, *, effort_scale: float = 1.0, cutoff: f
     x, e = x * cx, e * ce
     if velocity_threshold is not None:
         velocity_threshold = float(velocity_threshold) * cx
-    cutoff = fs / 50.0 if cutoff is None else float(cutoff)
-    if not 0 < cutoff < fs / 2:
-        raise DataError(f"cutoff {cutoff:g} Hz must lie between 0 and fs/2 = {fs / 2:g} Hz")
-    q = decimation if decimation is not None else max(1, int(fs / (2 * 2.5 * cutoff)))
-    if int(q) != q or q < 1:
-        raise DataError(f"decimation: expected a positive integer, found {decimation!r}")
-    q = int(q)
-    notes = []
-    if fs / (2 * q) < cutoff:
-        notes.append(f"decimation {q} puts the new Nyquist frequency {fs / (2 * q):g} Hz below the "
-                     f"cutoff {cutoff:g} Hz: the decimated rows alias")
-    edge = int(math.ceil(3 * fs / cutoff))
-    if x.size < 2 * edge + 50 * q:
-        raise DataError(f"{x.size} samples are too few for IDIM-LS at fs = {fs:g} Hz with a {cutoff:g} Hz "
-                        f"filter (need more than {2 * edge + 50 * q})", hint="log a longer run")
-    sos = butter_sos(order, cutoff, fs)
-    xf = apply_sos(sos, x, zero_phase=True)
-    ef = apply_sos(sos, e * effort_scale, zero_phase=True)
-    dt = 1.0 / fs
-    vel = np.gradient(xf, dt)
-    acc = np.gradient(vel, dt)
-    # the filter smears the friction step of each velocity reversal over ~1/cutoff: those samples
-    # do not obey the sign(q̇) model of the filtered signals, so a guard band around every
-    # reversal is left out (besides the slow samples)
-    near = np.zeros(x.size, dtype=bool)
-    rev = np.flatnonzero(np.sign(vel[1:]) != np.sign(vel[:-1]))
-    g = int(math.ceil(guard * fs / cutoff))
-    if rev.size and g > 0:
-        lo = np.clip(rev - g, 0, x.size)
-        hi = np.clip(rev + g + 1, 0, x.size)
-        cover = np.zeros(x.size + 1, dtype=np.int64)
-        np.add.at(cover, lo, 1)
-        np.add.at(cover, hi, -1)
-        near = np.cumsum(cover[:-1]) > 0
-    sl = slice(edge, x.size - edge, q)
-    vel, acc, y, near = vel[sl], acc[sl], ef[sl], near[sl]
+    st = idim_samples(x, e * effort_scale, fs, cutoff=cutoff, order=order, decimation=decimation, guard=guard)
+    vel, acc, y, near = st.velocity[:, 0], st.acceleration[:, 0], st.effort[:, 0], st.near_reversal[:, 0]
+    cutoff, q, notes = st.cutoff, st.decimation, list(st.notes)
     vmax = float(np.max(np.abs(vel)))
     if vmax == 0:
         raise UnidentifiableError("the position never changes: the data cannot identify friction or inertia")

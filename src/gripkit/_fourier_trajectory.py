@@ -1,0 +1,234 @@
+"""Optimal excitation trajectories for multi-joint dynamics identification (Swevers, Ganseman,
+Tükel, De Schutter & Van Brussel, "Optimal robot excitation and identification", IEEE T-RA 13(5),
+1997): every joint follows a finite Fourier series of base frequency f₀,
+
+    q_j(t) = q0_j + Σ_{l=1..H} [ a_jl/(ω_f l)·sin(ω_f l t) − b_jl/(ω_f l)·cos(ω_f l t) ],   ω_f = 2π f₀,
+    q̇_j(t) = Σ_l [ a_jl cos(ω_f l t) + b_jl sin(ω_f l t) ],
+    q̈_j(t) = Σ_l ω_f l [ −a_jl sin(ω_f l t) + b_jl cos(ω_f l t) ],
+
+periodic (so periods can be averaged), and the coefficients minimise the condition number of the
+identification regressor — the base-parameter columns of ``chain.regressor`` plus the Coulomb and
+viscous friction columns, each column scaled to unit RMS — over one period. The limits are kept
+by the conservative bounds (c_jl = √(a_jl² + b_jl²))
+
+    |q_j − q0_j| ≤ Σ_l c_jl/(ω_f l),   |q̇_j| ≤ Σ_l c_jl,   |q̈_j| ≤ Σ_l ω_f l·c_jl,
+
+so the trajectory stays inside the position, velocity and acceleration limits at every instant,
+not only at the samples. The chain is any object with ``regressor``, ``dof``,
+``coordinate_names``, ``parameter_names`` (and optionally ``limits``): this module does not import
+:mod:`gripkit.multibody`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from .arguments import entry_point
+from .errors import DataError, IdentificationError
+
+__all__ = ["FourierTrajectory", "fourier_trajectory", "fourier_states"]
+
+
+def fourier_states(a, b, q0, f0: float, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """q, q̇, q̈ (N, m) of the Fourier series (module doc) with coefficients a, b (m, H)."""
+    a = np.asarray(a, dtype=np.float64)
+    b = np.asarray(b, dtype=np.float64)
+    t = np.asarray(t, dtype=np.float64)
+    H = a.shape[1]
+    w = 2 * math.pi * f0 * np.arange(1, H + 1)
+    s = np.sin(np.outer(t, w))
+    c = np.cos(np.outer(t, w))
+    q = np.asarray(q0, dtype=np.float64) + s @ (a / w).T - c @ (b / w).T
+    qd = c @ a.T + s @ b.T
+    qdd = -s @ (a * w).T + c @ (b * w).T
+    return q, qd, qdd
+
+
+@dataclass(frozen=True)
+class FourierTrajectory:
+    """A designed excitation: time ``t`` (s), ``q``, ``qd``, ``qdd`` (N, m) in the chain's
+    coordinates ``joint_names``; coefficients ``a``, ``b`` (m, H), centre ``q0``, base frequency
+    ``f0`` (Hz); ``condition_number`` of the scaled identification regressor over one period, and
+    the ``limits`` that hold (position lower/upper, velocity, acceleration per joint)."""
+
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+    q0: np.ndarray
+    f0: float
+    fs: float
+    joint_names: tuple
+    condition_number: float
+    initial_condition_number: float
+    limits: dict
+    info: dict = field(default_factory=dict)
+
+    def columns(self) -> dict:
+        """``{'t': ..., 'q_<joint>': ..., 'qd_<joint>': ..., 'qdd_<joint>': ...}``."""
+        out = {"t": self.t}
+        for prefix, x in (("q", self.q), ("qd", self.qd), ("qdd", self.qdd)):
+            for j, name in enumerate(self.joint_names):
+                out[f"{prefix}_{name}"] = x[:, j]
+        return out
+
+    def to_csv(self, path) -> Path:
+        """Write :meth:`columns` as CSV (header row, SI units: s, rad or m, per s, per s²)."""
+        cols = self.columns()
+        path = Path(path)
+        data = np.column_stack(list(cols.values()))
+        np.savetxt(path, data, delimiter=",", header=",".join(cols), comments="", fmt="%.10g")
+        return path
+
+    def to_dict(self) -> dict:
+        return dict(f0_hz=self.f0, fs_hz=self.fs, harmonics=int(self.a.shape[1]), joints=list(self.joint_names),
+                    q0=self.q0.tolist(), a=self.a.tolist(), b=self.b.tolist(), n_samples=int(self.t.size),
+                    duration_s=float(self.t.size / self.fs), condition_number=self.condition_number,
+                    initial_condition_number=self.initial_condition_number,
+                    limits={k: np.asarray(v).tolist() for k, v in self.limits.items()}, info=self.info)
+
+
+def _limit(name, given, from_chain, m, default):
+    v = given if given is not None else from_chain
+    if v is None:
+        v = default
+    v = np.broadcast_to(np.asarray(v, dtype=np.float64), (m,)).copy()
+    if np.isnan(v).any() or (v <= 0).any():
+        raise DataError(f"{name}: expected positive limits for the {m} joints, found {v.tolist()}")
+    return v
+
+
+@entry_point
+def fourier_trajectory(chain, *, f0: float = 0.1, harmonics: int = 5, fs: float = 100.0, periods: int = 1,
+                       position_limits=None, velocity_limits=None, acceleration_limits=None,
+                       q0=None, friction: bool = True, samples_per_period: int = 200, seed: int = 0,
+                       restarts: int = 0, max_iterations: int = 200) -> FourierTrajectory:
+    """Design the excitation trajectory of ``chain`` (module doc).
+
+    Parameters
+    ----------
+    chain
+        Any object with ``regressor(q, qd, qdd)``, ``dof``, ``coordinate_names``,
+        ``parameter_names`` (a gripkit chain); its ``limits`` (URDF) are the defaults.
+    f0, harmonics
+        Base frequency (Hz; the trajectory's period is 1/f0) and number of harmonics H.
+    fs, periods
+        Sampling rate (Hz) and number of periods of the returned trajectory.
+    position_limits
+        (lower, upper), each scalar or (m,) (rad or m); default the chain's, else ±π/2.
+    velocity_limits, acceleration_limits
+        Per joint, > 0; default the chain's velocity limits, else 2 rad/s and 10 rad/s².
+    q0
+        Centre of the motion (default: the middle of the position limits).
+    friction
+        Include the Coulomb and viscous friction columns in the condition number.
+    restarts
+        Random starting points besides the first; the best design is kept.
+    """
+    from scipy.optimize import minimize
+
+    from .sysid.dynamics import _friction_columns, base_structure
+
+    m = int(chain.dof)
+    names = tuple(chain.coordinate_names)
+    if not (math.isfinite(f0) and f0 > 0) or not (math.isfinite(fs) and fs > 2 * f0 * harmonics):
+        raise DataError(f"f0 = {f0!r} Hz and fs = {fs!r} Hz: need f0 > 0 and fs above twice the highest "
+                        f"harmonic {f0 * harmonics:g} Hz")
+    if int(harmonics) != harmonics or harmonics < 1 or int(periods) != periods or periods < 1:
+        raise DataError(f"harmonics and periods: expected positive integers, found {harmonics!r}, {periods!r}")
+    H = int(harmonics)
+    lim = getattr(chain, "limits", None)
+    lo_c = getattr(lim, "lower", None)
+    hi_c = getattr(lim, "upper", None)
+    if position_limits is not None:
+        lo = np.broadcast_to(np.asarray(position_limits[0], dtype=np.float64), (m,)).copy()
+        hi = np.broadcast_to(np.asarray(position_limits[1], dtype=np.float64), (m,)).copy()
+    else:
+        lo = np.where(np.isfinite(lo_c), lo_c, -math.pi / 2) if lo_c is not None else np.full(m, -math.pi / 2)
+        hi = np.where(np.isfinite(hi_c), hi_c, math.pi / 2) if hi_c is not None else np.full(m, math.pi / 2)
+    if not (np.isfinite(lo).all() and np.isfinite(hi).all() and (hi > lo).all()):
+        raise DataError(f"position_limits: expected finite lower < upper per joint, found {lo.tolist()}, {hi.tolist()}")
+    v_c = getattr(lim, "velocity", None)
+    vmax = _limit("velocity_limits", velocity_limits, None if v_c is None else np.where(np.isfinite(v_c), v_c, 2.0), m, 2.0)
+    amax = _limit("acceleration_limits", acceleration_limits, None, m, 10.0)
+    q0 = 0.5 * (lo + hi) if q0 is None else np.broadcast_to(np.asarray(q0, dtype=np.float64), (m,)).copy()
+    if ((q0 <= lo) | (q0 >= hi)).any():
+        raise DataError(f"q0: the centre {q0.tolist()} must lie inside the position limits")
+    half = np.minimum(q0 - lo, hi - q0)
+    w = 2 * math.pi * f0 * np.arange(1, H + 1)
+    st = base_structure(chain)
+    t_eval = np.arange(samples_per_period) / (samples_per_period * f0)
+
+    def unpack(x):
+        return x[:m * H].reshape(m, H), x[m * H:].reshape(m, H)
+
+    def objective(x):
+        a, b = unpack(x)
+        q, qd, qdd = fourier_states(a, b, q0, f0, t_eval)
+        X = chain.regressor(q, qd, qdd)[:, :, st.independent]
+        if friction:
+            X = np.concatenate([X, _friction_columns(qd, ("coulomb", "viscous"))], axis=2)
+        X = X.reshape(-1, X.shape[2])
+        s = np.sqrt(np.mean(X ** 2, axis=0))
+        if (s == 0).any():
+            return 1e3
+        sv = np.linalg.svd(X / s, compute_uv=False)
+        return float(np.log10(sv[0] / max(sv[-1], 1e-300)))
+
+    def bounds_margin(x):
+        a, b = unpack(x)
+        c = np.sqrt(a ** 2 + b ** 2 + 1e-30)
+        return np.concatenate([half - c @ (1 / w), vmax - c.sum(axis=1), amax - c @ w])
+
+    rng = np.random.default_rng(seed)
+
+    def start():
+        a = rng.normal(size=(m, H))
+        b = rng.normal(size=(m, H))
+        c = np.sqrt(a ** 2 + b ** 2)
+        # scale each joint into its limits with a margin
+        k = np.min(np.column_stack([half / (c @ (1 / w)), vmax / c.sum(axis=1), amax / (c @ w)]), axis=1) * 0.8
+        return np.concatenate([(a * k[:, None]).ravel(), (b * k[:, None]).ravel()])
+
+    def shrink(x):
+        """Scale each joint's coefficients back inside its bounds (SLSQP may end just outside)."""
+        a, b = unpack(x)
+        c = np.sqrt(a ** 2 + b ** 2)
+        with np.errstate(divide="ignore"):
+            k = np.min(np.column_stack([half / (c @ (1 / w)), vmax / c.sum(axis=1), amax / (c @ w)]), axis=1)
+        k = np.minimum(1.0, k * (1 - 1e-9))[:, None]
+        return np.concatenate([(a * k).ravel(), (b * k).ravel()])
+
+    best = None
+    first_cond = None
+    for _ in range(1 + int(restarts)):
+        x0 = start()
+        f_start = objective(x0)
+        first_cond = 10 ** f_start if first_cond is None else first_cond
+        sol = minimize(objective, x0, method="SLSQP", constraints=[{"type": "ineq", "fun": bounds_margin}],
+                       options=dict(maxiter=int(max_iterations), ftol=1e-6))
+        x = shrink(sol.x) if np.isfinite(sol.x).all() else x0
+        f = objective(x)
+        if f > f_start:
+            x, f = x0, f_start
+        if best is None or f < best[0]:
+            best = (f, x)
+    f, x = best
+    if not math.isfinite(f) or f >= 3:
+        raise IdentificationError(f"no excitation found that excites every base parameter of {getattr(chain, 'name', 'the chain')} "
+                                  f"within the limits (best condition number {10 ** f:.3g})",
+                                  hint="widen the limits, add harmonics or lower f0")
+    a, b = unpack(x)
+    n = int(round(periods * fs / f0))
+    t = np.arange(n) / fs
+    q, qd, qdd = fourier_states(a, b, q0, f0, t)
+    return FourierTrajectory(t, q, qd, qdd, a, b, q0, float(f0), float(fs), names, float(10 ** f), float(first_cond),
+                             dict(lower=lo, upper=hi, velocity=vmax, acceleration=amax),
+                             dict(n_base_parameters=int(st.independent.size), friction_columns=bool(friction),
+                                  restarts=int(restarts), seed=int(seed)))

@@ -1,0 +1,55 @@
+"""``gripkit excitation fourier URDF --out TRAJ.csv [--f0 HZ] [--harmonics H] [--fs HZ]
+[--periods P] [--velocity-limit V] [--acceleration-limit A] [--json]``: design a periodic
+Fourier-series excitation of every actuated joint of a URDF chain that minimises the condition
+number of the identification regressor within the position (URDF), velocity and acceleration
+limits (:func:`gripkit.excitation.fourier_trajectory`), and write it as CSV (columns ``t``,
+``q_<joint>``, ``qd_<joint>``, ``qdd_<joint>``; SI units)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from .app import app
+from .common import JsonOpt, emit_json
+
+excitation_app = typer.Typer(no_args_is_help=True, pretty_exceptions_enable=False,
+                             help="Design excitation trajectories.")
+app.add_typer(excitation_app, name="excitation")
+
+
+@excitation_app.command("fourier")
+def excitation_fourier(
+    urdf: Path = typer.Argument(..., help="URDF file of the chain."),
+    out: Path = typer.Option(..., "--out", help="CSV file to write the trajectory to."),
+    f0: float = typer.Option(0.1, "--f0", help="Base frequency in Hz (the period is 1/f0)."),
+    harmonics: int = typer.Option(5, "--harmonics", help="Number of harmonics per joint."),
+    fs: float = typer.Option(100.0, "--fs", help="Sampling rate of the written trajectory, Hz."),
+    periods: int = typer.Option(1, "--periods", help="Number of periods written."),
+    velocity_limit: float = typer.Option(None, "--velocity-limit", help="|q̇| limit for every joint (default: URDF, else 2)."),
+    acceleration_limit: float = typer.Option(None, "--acceleration-limit", help="|q̈| limit for every joint (default 10)."),
+    base_link: str = typer.Option(None, "--base-link", help="Base link of the chain."),
+    tip_link: str = typer.Option(None, "--tip-link", help="Tip link of the chain."),
+    restarts: int = typer.Option(0, "--restarts", help="Extra random starting points of the optimisation."),
+    seed: int = typer.Option(0, "--seed", help="Seed of the starting points."),
+    json_out: bool = JsonOpt,
+):
+    """Design an optimal Fourier excitation trajectory for a URDF chain and write it as CSV."""
+    from ..excitation import fourier_trajectory
+    from ..multibody import from_urdf
+    from ..progress import status
+
+    chain = from_urdf(urdf, base_link=base_link, tip_link=tip_link)
+    status(f"optimising {2 * chain.dof * harmonics} Fourier coefficients of {chain.name} ...")
+    tr = fourier_trajectory(chain, f0=f0, harmonics=harmonics, fs=fs, periods=periods,
+                            velocity_limits=velocity_limit, acceleration_limits=acceleration_limit,
+                            restarts=restarts, seed=seed)
+    tr.to_csv(out)
+    d = tr.to_dict()
+    d["out"] = str(out)
+    if json_out:
+        emit_json(d)
+        return
+    typer.echo(f"wrote {out}: {tr.t.size} samples at {fs:g} Hz of joints {', '.join(tr.joint_names)}; "
+               f"regressor condition number {tr.condition_number:.3g} (start {tr.initial_condition_number:.3g})")

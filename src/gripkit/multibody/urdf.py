@@ -1,0 +1,531 @@
+"""URDF chains: read a serial chain from a URDF file (:func:`from_urdf`) and write any gripkit
+chain as one (:func:`to_urdf`).
+
+Reading (standard library ``xml.etree.ElementTree``; URDF as specified at wiki.ros.org/urdf/XML):
+
+* the chain runs from ``base_link`` (default: the only root of the tree) to ``tip_link``
+  (default: where the tree stops having moving joints; a branch of moving joints needs an
+  explicit ``tip_link``);
+* ``revolute``, ``continuous`` and ``prismatic`` joints move; ``fixed`` joints are merged: a
+  link fixed to a moving link adds its inertia to it, the links fixed to the base are ignored
+  (they do not move), and fixed joints between two moving joints fold into the placement;
+* ``<origin xyz rpy>``: translation and R = Rz(yaw)·Ry(pitch)·Rx(roll); ``<axis>`` defaults to
+  (1, 0, 0); inertials may be rotated (``<inertial><origin rpy>``): I_link = R I Rᵀ;
+* ``<mimic joint multiplier offset>`` joints follow their leader: q_full = Γ q + q₀ and
+  τ = Γᵀ τ_full (:mod:`gripkit.multibody.joints`); ``joint_names`` are the actuated joints;
+* ``<limit lower upper velocity effort>`` of the actuated joints are kept (``chain.limits``);
+  a ``velocity`` or ``effort`` of 0, which many URDF files write for "unspecified", reads as no
+  limit, and a continuous joint has no position limits.
+
+Errors name the element: a link with two parents (a closed loop), several roots without
+``base_link``, a branching chain without ``tip_link``, a moving link without ``<inertial>``, an
+unsupported joint type (floating, planar), malformed numbers, mimic joints off the chain.
+
+Writing: each joint of a DH chain becomes a URDF joint whose origin is Craig's fixed transform
+Rx(α)·Dx(a)·Rz(θ₀)·Dz(d) and whose axis is z, with the link's inertial in the DH frame; a coupled
+chain's joints whose rows of Γ are multiples of an earlier joint's row become ``<mimic>`` joints
+(the DLR/HIT finger's distal joint). What URDF cannot hold — a transmission that mixes actuators
+(the finger's bevel-gear differential) and rotor inertia — is left out with a warning: the file's
+coordinates are then the independent joints, not the actuators.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import warnings
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+
+from ..arguments import entry_point
+from ..errors import GripkitWarning, ModelError
+from .joints import JointChain, JointLimits
+
+__all__ = ["from_urdf", "to_urdf"]
+
+_MOVING = {"revolute": "R", "continuous": "R", "prismatic": "P"}
+_SUPPORTED = set(_MOVING) | {"fixed"}
+
+
+# --- reading --------------------------------------------------------------------------------------
+
+def _numbers(text: str | None, count: int, where: str, default=None) -> np.ndarray:
+    if text is None:
+        if default is None:
+            raise ModelError(f"{where}: missing, expected {count} numbers")
+        return np.asarray(default, dtype=np.float64)
+    parts = text.split()
+    try:
+        v = np.array([float(p) for p in parts], dtype=np.float64)
+    except ValueError:
+        raise ModelError(f"{where}: expected {count} numbers, found {text!r}") from None
+    if v.size != count or not np.isfinite(v).all():
+        raise ModelError(f"{where}: expected {count} finite numbers, found {text!r}")
+    return v
+
+
+def _number(el, attr: str, where: str, default: float | None = None) -> float:
+    text = el.get(attr) if el is not None else None
+    if text is None:
+        if default is None:
+            raise ModelError(f"{where}: attribute {attr!r} is missing")
+        return float(default)
+    try:
+        v = float(text)
+    except ValueError:
+        raise ModelError(f"{where}: {attr}={text!r} is not a number") from None
+    if math.isnan(v):
+        raise ModelError(f"{where}: {attr} is NaN")
+    return v
+
+
+def rpy_matrix(rpy) -> np.ndarray:
+    """R = Rz(yaw)·Ry(pitch)·Rx(roll) (URDF's fixed-axis roll-pitch-yaw)."""
+    r, p, y = rpy
+    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
+    return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+                     [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+                     [-sp, cp * sr, cp * cr]])
+
+
+def matrix_rpy(R) -> tuple[float, float, float]:
+    """Roll, pitch, yaw of a rotation (inverse of :func:`rpy_matrix`)."""
+    sp = -R[2, 0]
+    if abs(sp) < 1.0 - 1e-12:
+        return (math.atan2(R[2, 1], R[2, 2]), math.asin(max(-1.0, min(1.0, sp))), math.atan2(R[1, 0], R[0, 0]))
+    # gimbal lock: roll and yaw share one axis; put it all in yaw
+    pitch = math.copysign(math.pi / 2, sp)
+    return (0.0, pitch, math.atan2(-R[0, 1], R[1, 1]))
+
+
+def _origin(el, where: str) -> np.ndarray:
+    T = np.eye(4)
+    o = el.find("origin") if el is not None else None
+    if o is not None:
+        T[:3, 3] = _numbers(o.get("xyz"), 3, f"{where} <origin xyz>", default=(0, 0, 0))
+        T[:3, :3] = rpy_matrix(_numbers(o.get("rpy"), 3, f"{where} <origin rpy>", default=(0, 0, 0)))
+    return T
+
+
+def _inertial(link, where: str):
+    """(mass, com, inertia about the COM) in the link frame, or None without <inertial>."""
+    el = link.find("inertial")
+    if el is None:
+        return None
+    m_el = el.find("mass")
+    if m_el is None:
+        raise ModelError(f"{where} <inertial>: <mass> is missing")
+    mass = _number(m_el, "value", f"{where} <mass>")
+    i_el = el.find("inertia")
+    if i_el is None:
+        raise ModelError(f"{where} <inertial>: <inertia> is missing")
+    v = {a: _number(i_el, a, f"{where} <inertia>", default=0.0) for a in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
+    Ic = np.array([[v["ixx"], v["ixy"], v["ixz"]], [v["ixy"], v["iyy"], v["iyz"]], [v["ixz"], v["iyz"], v["izz"]]])
+    T = _origin(el, f"{where} <inertial>")
+    R = T[:3, :3]
+    return mass, T[:3, 3].copy(), R @ Ic @ R.T
+
+
+def _combine(a, b):
+    """Inertial data of two rigid bodies welded together (same frame)."""
+    m1, c1, I1 = a
+    m2, c2, I2 = b
+    m = m1 + m2
+    if m == 0.0:
+        return 0.0, np.zeros(3), I1 + I2
+    c = (m1 * c1 + m2 * c2) / m
+
+    def shift(mk, ck, Ik):
+        d = ck - c
+        return Ik + mk * (d @ d * np.eye(3) - np.outer(d, d))
+
+    return m, c, shift(m1, c1, I1) + shift(m2, c2, I2)
+
+
+def _transform_inertial(T, data):
+    m, c, I = data  # noqa: E741
+    R = T[:3, :3]
+    return m, R @ c + T[:3, 3], R @ I @ R.T
+
+
+class _Tree:
+    def __init__(self, robot):
+        self.links = {}
+        for el in robot.findall("link"):
+            name = el.get("name")
+            if not name:
+                raise ModelError("<link> without a name attribute")
+            if name in self.links:
+                raise ModelError(f"link {name!r} is defined twice")
+            self.links[name] = el
+        if not self.links:
+            raise ModelError("the URDF has no <link>")
+        self.joints = {}
+        self.parent = {}      # child link -> joint name
+        self.children = {name: [] for name in self.links}
+        for el in robot.findall("joint"):
+            name = el.get("name")
+            if not name:
+                raise ModelError("<joint> without a name attribute")
+            if name in self.joints:
+                raise ModelError(f"joint {name!r} is defined twice")
+            jtype = el.get("type")
+            p_el, c_el = el.find("parent"), el.find("child")
+            if p_el is None or c_el is None:
+                raise ModelError(f"joint {name!r}: <parent link> and <child link> are required")
+            parent, child = p_el.get("link"), c_el.get("link")
+            for role, link in (("parent", parent), ("child", child)):
+                if link not in self.links:
+                    raise ModelError(f"joint {name!r}: {role} link {link!r} is not defined")
+            if child in self.parent:
+                raise ModelError(f"link {child!r} is the child of joints {self.parent[child]!r} and {name!r}: "
+                                 f"the URDF has a closed loop; gripkit needs a tree",
+                                 hint="cut the loop (keep one parent joint) and model it as a mimic or a constraint")
+            self.joints[name] = (el, jtype, parent, child)
+            self.parent[child] = name
+            self.children[parent].append(name)
+        self.roots = [name for name in self.links if name not in self.parent]
+        if not self.roots:
+            raise ModelError("every link has a parent joint: the URDF's joints form a closed loop")
+        reach = set()
+        stack = list(self.roots)
+        while stack:
+            link = stack.pop()
+            reach.add(link)
+            stack.extend(self.joints[j][3] for j in self.children[link])
+        lost = [name for name in self.links if name not in reach]
+        if lost:
+            raise ModelError(f"links {lost[:3]} are not reachable from a root: their joints form a closed loop")
+
+    def subtree_moves(self, link) -> bool:
+        for j in self.children[link]:
+            if self.joints[j][1] != "fixed" or self.subtree_moves(self.joints[j][3]):
+                return True
+        return False
+
+    def check_type(self, joint):
+        jtype = self.joints[joint][1]
+        if jtype not in _SUPPORTED:
+            raise ModelError(f"joint {joint!r} has type {jtype!r}, which gripkit does not support",
+                             hint="gripkit builds serial chains of revolute, continuous, prismatic and fixed joints")
+
+
+def _read_root(source):
+    text = str(source)
+    try:
+        if text.lstrip().startswith("<"):
+            root = ET.fromstring(text)
+        else:
+            if not Path(text).is_file():
+                raise ModelError(f"URDF file {text!r} does not exist")
+            root = ET.parse(text).getroot()
+    except ET.ParseError as exc:
+        raise ModelError(f"the URDF is not well-formed XML: {exc}") from None
+    if root.tag != "robot":
+        raise ModelError(f"expected a <robot> root element, found <{root.tag}>")
+    return root
+
+
+@entry_point
+def from_urdf(source, *, base_link: str | None = None, tip_link: str | None = None,
+              gravity=(0.0, 0.0, -9.81)) -> JointChain:
+    """The serial chain from ``base_link`` to ``tip_link`` of a URDF (module doc).
+
+    Parameters
+    ----------
+    source
+        Path of a ``.urdf`` file, or the XML text itself.
+    base_link, tip_link
+        Link names; defaults: the tree's only root, and the end of its only chain of moving joints.
+    gravity
+        Gravity in the base link's frame (m/s²).
+
+    Returns
+    -------
+    JointChain
+        ``rnea``, ``mass_matrix``, ``forward_dynamics``, ``gravity_torque``, ``regressor``, ...
+        in the actuated joints' coordinates (``joint_names``), limits in ``limits``.
+    """
+    robot = _read_root(source)
+    tree = _Tree(robot)
+    if base_link is None:
+        if len(tree.roots) > 1:
+            raise ModelError(f"the URDF holds several trees (roots {', '.join(map(repr, tree.roots[:5]))})",
+                             hint="choose one with base_link=")
+        base_link = tree.roots[0]
+    elif base_link not in tree.links:
+        raise ModelError(f"base_link {base_link!r} is not a link of the URDF")
+    # the path of joints from base_link to the tip
+    if tip_link is None:
+        path = []
+        link = base_link
+        while True:
+            moving = [j for j in tree.children[link] if tree.subtree_moves(tree.joints[j][3]) or tree.joints[j][1] != "fixed"]
+            if len(moving) > 1:
+                if path and any(tree.joints[j][1] != "fixed" for j in path):
+                    raise ModelError(f"the chain branches at link {link!r} into joints {', '.join(map(repr, moving))}",
+                                     hint="choose the chain's end with tip_link=")
+                raise ModelError(f"link {link!r} carries several chains (joints {', '.join(map(repr, moving))})",
+                                 hint="choose the chain's end with tip_link= (and base_link=)")
+            if moving:
+                path.append(moving[0])
+                link = tree.joints[moving[0]][3]
+                continue
+            # no more moving joints: follow a single fixed path to a tip frame, if there is one
+            fixed = tree.children[link]
+            if len(fixed) == 1 and path:
+                path.append(fixed[0])
+                link = tree.joints[fixed[0]][3]
+                continue
+            break
+        tip_link = link
+    else:
+        if tip_link not in tree.links:
+            raise ModelError(f"tip_link {tip_link!r} is not a link of the URDF")
+        path = []
+        link = tip_link
+        while link != base_link:
+            if link not in tree.parent:
+                raise ModelError(f"tip_link {tip_link!r} does not hang below base_link {base_link!r}")
+            j = tree.parent[link]
+            path.append(j)
+            link = tree.joints[j][2]
+        path.reverse()
+    for j in path:
+        tree.check_type(j)
+    moving_idx = [i for i, j in enumerate(path) if tree.joints[j][1] != "fixed"]
+    if not moving_idx:
+        raise ModelError(f"no moving joint between {base_link!r} and {tip_link!r}")
+    on_path = set(path)
+
+    # placements: fixed joints before a moving joint fold into its placement
+    placements, axes, types, names, links, inertials, limits_raw, mimic = [], [], [], [], [], [], [], {}
+    T_acc = np.eye(4)
+    for i, j in enumerate(path):
+        el, jtype, parent, child = tree.joints[j]
+        T_acc = T_acc @ _origin(el, f"joint {j!r}")
+        if jtype == "fixed":
+            continue
+        placements.append(T_acc)
+        T_acc = np.eye(4)
+        ax_el = el.find("axis")
+        axis = _numbers(ax_el.get("xyz") if ax_el is not None else None, 3, f"joint {j!r} <axis xyz>", default=(1, 0, 0))
+        if np.linalg.norm(axis) < 1e-12:
+            raise ModelError(f"joint {j!r}: <axis xyz> is the zero vector")
+        axes.append(axis / np.linalg.norm(axis))
+        types.append(_MOVING[jtype])
+        names.append(j)
+        links.append(child)
+        lim = el.find("limit")
+        where = f"joint {j!r} <limit>"
+        if jtype == "continuous" or lim is None:
+            lo, hi = -np.inf, np.inf
+        else:
+            lo, hi = _number(lim, "lower", where, 0.0), _number(lim, "upper", where, 0.0)
+            if lo > hi:
+                raise ModelError(f"{where}: lower {lo:g} > upper {hi:g}")
+        vel = _number(lim, "velocity", where, 0.0) if lim is not None else 0.0
+        eff = _number(lim, "effort", where, 0.0) if lim is not None else 0.0
+        limits_raw.append((lo, hi, vel if vel > 0 else np.inf, eff if eff > 0 else np.inf))
+        mm = el.find("mimic")
+        if mm is not None:
+            leader = mm.get("joint")
+            if leader is None:
+                raise ModelError(f"joint {j!r} <mimic>: attribute 'joint' is missing")
+            mimic[j] = (leader, _number(mm, "multiplier", f"joint {j!r} <mimic>", 1.0),
+                        _number(mm, "offset", f"joint {j!r} <mimic>", 0.0))
+        # the moving link with everything fixed to it (off the path, or up to the next moving joint)
+        data = _inertial(tree.links[child], f"link {child!r}")
+        if data is None:
+            raise ModelError(f"link {child!r}, moved by joint {j!r}, has no <inertial>",
+                             hint="add one (<mass value='0'/> for a massless link)")
+        inertials.append(data)
+
+    # merge everything fixed to a moving link into it (fixed joints on or off the path)
+    def merge(link, T, k):
+        for j in tree.children[link]:
+            el, jtype, _, child = tree.joints[j]
+            if jtype == "fixed":
+                Tc = T @ _origin(el, f"joint {j!r}")
+                data = _inertial(tree.links[child], f"link {child!r}")
+                if data is not None:
+                    inertials[k] = _combine(inertials[k], _transform_inertial(Tc, data))
+                merge(child, Tc, k)
+            elif j not in on_path:
+                tree.check_type(j)
+                raise ModelError(f"joint {j!r} ({jtype}) branches off the chain at link {link!r}: gripkit "
+                                 f"models serial chains", hint="choose base_link/tip_link so that the chain does "
+                                 "not carry the branch, or make the joint fixed")
+
+    for k, link in enumerate(links):
+        merge(link, np.eye(4), k)
+    tool = T_acc
+
+    # mimic joints -> coupling
+    n = len(names)
+    index = {name: k for k, name in enumerate(names)}
+    actuated = [k for k, name in enumerate(names) if name not in mimic]
+    col = {k: c for c, k in enumerate(actuated)}
+    G = np.zeros((n, len(actuated)))
+    q0 = np.zeros(n)
+    for k, name in enumerate(names):
+        mult, off, cur, seen = 1.0, 0.0, name, {name}
+        while cur in mimic:
+            leader, a, b = mimic[cur]
+            if leader not in index:
+                raise ModelError(f"joint {cur!r} mimics {leader!r}, which is not a moving joint of the chain "
+                                 f"{base_link!r} → {tip_link!r}")
+            if leader in seen:
+                raise ModelError(f"mimic joints {sorted(seen)} follow each other in a circle")
+            seen.add(leader)
+            off = off + mult * b
+            mult = mult * a
+            cur = leader
+        G[k, col[index[cur]]] = mult
+        q0[k] = off
+    lim = np.array([limits_raw[k] for k in actuated]).reshape(-1, 4)
+    limits = JointLimits(lim[:, 0].copy(), lim[:, 1].copy(), lim[:, 2].copy(), lim[:, 3].copy())
+    return JointChain(np.array(placements), np.array(axes), "".join(types),
+                      [d[0] for d in inertials], [d[1] for d in inertials], [d[2] for d in inertials],
+                      coupling=G, offset=q0, names=names, actuated=actuated, link_names=links,
+                      limits=limits, gravity=gravity, tool=tool, name=robot.get("name") or "urdf")
+
+
+# --- writing --------------------------------------------------------------------------------------
+
+def _fmt(x: float) -> str:
+    return repr(float(x))
+
+
+def _vec(v) -> str:
+    return " ".join(_fmt(x) for x in v)
+
+
+def _origin_el(parent, T):
+    ET.SubElement(parent, "origin", xyz=_vec(T[:3, 3]), rpy=_vec(matrix_rpy(T[:3, :3])))
+
+
+def _describe(chain):
+    """(placements, axes, types, mass, com, inertia, Γ, q₀, names, link names, tool, armature,
+    limits or None) of a DH, coupled or joint chain, in joint coordinates."""
+    from .coupling import CoupledChain
+    from .dh import DHChain
+
+    if isinstance(chain, JointChain):
+        return (chain.placements, chain.axes, chain.joint_types, chain.mass, chain.com, chain.inertia,
+                chain.coupling, chain.offset, chain.names, chain.link_names, chain.tool, chain.armature,
+                chain.limits)
+    if isinstance(chain, CoupledChain):
+        dh, c = chain.chain, chain.coupling
+        G, q0, arm = c.matrix, c.offset, c.armature
+    elif isinstance(chain, DHChain):
+        dh = chain
+        G, q0, arm = np.eye(dh.n), np.zeros(dh.n), np.zeros(dh.n)
+    else:
+        raise ModelError(f"chain: expected a DHChain, CoupledChain or JointChain, found {type(chain).__name__}")
+    X = np.zeros((dh.n, 4, 4))
+    for k in range(dh.n):
+        alpha, a, d, off = dh.dh[k]
+        ca, sa, co, so = math.cos(alpha), math.sin(alpha), math.cos(off), math.sin(off)
+        Rx = np.array([[1, 0, 0], [0, ca, -sa], [0, sa, ca]])
+        Rz = np.array([[co, -so, 0], [so, co, 0], [0, 0, 1]])
+        X[k, :3, :3] = Rx @ Rz
+        X[k, :3, 3] = np.array([a, 0.0, 0.0]) + Rx @ np.array([0.0, 0.0, d])
+        X[k, 3, 3] = 1.0
+    X[0] = dh.base @ X[0]
+    arm_q = dh.armature
+    arm_total = np.concatenate([arm, arm_q])
+    return (X, np.tile([0.0, 0.0, 1.0], (dh.n, 1)), dh.joint_types, dh.mass, dh.com, dh.inertia, G, q0,
+            dh.names, tuple(f"link{k + 1}" for k in range(dh.n)), dh.tool, arm_total, None)
+
+
+@entry_point
+def to_urdf(chain, path, *, name: str | None = None, base_link: str = "base",
+            tip_link: str = "tip") -> Path:
+    """Write ``chain`` (DH, coupled or URDF) as a URDF file (module doc) and return its path.
+
+    The base link is ``base_link`` (the chain's frame 0, or the world frame when the DH chain has
+    a ``base`` transform: then pass ``gravity = base_R · g`` to :func:`from_urdf`), the tip frame
+    a massless link ``tip_link`` on a fixed joint. Joint positions without limits are written as
+    revolute/prismatic joints with ``lower = -π, upper = π`` (revolute) or ±1 m (prismatic) and
+    ``effort = velocity = 0`` (read back as unlimited), since Pinocchio reads ``continuous`` as a
+    (cos, sin) joint.
+
+    Warns (:class:`~gripkit.errors.GripkitWarning`) when the chain holds what URDF cannot: rotor
+    inertia, or a coupling that mixes actuators (the file's coordinates are then its independent
+    joints q_u = Γ_u p + q₀_u, and τ_p = Γ_uᵀ τ_u).
+    """
+    X, axes, types, mass, com, inertia, G, q0, names, link_names, tool, arm, limits = _describe(chain)
+    n, m = G.shape
+    left_out = []
+    if np.any(np.asarray(arm) != 0):
+        left_out.append("rotor inertia (armature) " + ", ".join(f"{a:.4g}" for a in np.asarray(arm) if a != 0))
+    # independent joints and mimic joints: row k = c·row j (j earlier, independent)
+    leader, mult, mimic_off = {}, {}, {}
+    independent = []
+    for k in range(n):
+        row = G[k]
+        if not row.any():
+            raise ModelError(f"joint {names[k]!r} is moved by no actuator: URDF has no joint for it",
+                             hint="fold it into a fixed transform first")
+        for j in independent:
+            rj = G[j]
+            i = int(np.argmax(np.abs(rj)))
+            c = row[i] / rj[i]
+            if np.allclose(row, c * rj, rtol=0, atol=1e-14 * max(1.0, np.abs(row).max())):
+                leader[k], mult[k], mimic_off[k] = j, c, q0[k] - c * q0[j]
+                break
+        else:
+            independent.append(k)
+    Gu = G[independent]
+    if not np.array_equal(Gu, np.eye(m)) or np.any(q0[independent] != 0):
+        left_out.append(f"the transmission from the actuators to the joints {[names[k] for k in independent]} "
+                        f"(q_u = Γ_u p + q₀_u, Γ_u = {np.round(Gu, 6).tolist()}): the URDF's coordinates are "
+                        f"these joints")
+    if left_out:
+        warnings.warn(f"to_urdf: URDF cannot hold {'; '.join(left_out)}; they are left out of {os.fspath(path)}",
+                      GripkitWarning, stacklevel=2)
+    robot = ET.Element("robot", name=name or getattr(chain, "name", "chain"))
+    robot.append(ET.Comment(f" written by gripkit.multibody.to_urdf; gravity in {base_link!r}: "
+                            f"{_vec(getattr(chain, 'chain', chain).gravity)} m/s^2 "))
+    ET.SubElement(robot, "link", name=base_link)
+    parent = base_link
+    actuated_rank = {k: r for r, k in enumerate(independent)}
+    for k in range(n):
+        link = ET.SubElement(robot, "link", name=link_names[k])
+        inert = ET.SubElement(link, "inertial")
+        ET.SubElement(inert, "origin", xyz=_vec(com[k]), rpy="0 0 0")
+        ET.SubElement(inert, "mass", value=_fmt(mass[k]))
+        I = inertia[k]  # noqa: E741
+        ET.SubElement(inert, "inertia", ixx=_fmt(I[0, 0]), ixy=_fmt(I[0, 1]), ixz=_fmt(I[0, 2]),
+                      iyy=_fmt(I[1, 1]), iyz=_fmt(I[1, 2]), izz=_fmt(I[2, 2]))
+        joint = ET.SubElement(robot, "joint", name=names[k], type="revolute" if types[k] == "R" else "prismatic")
+        _origin_el(joint, X[k])
+        ET.SubElement(joint, "parent", link=parent)
+        ET.SubElement(joint, "child", link=link_names[k])
+        ET.SubElement(joint, "axis", xyz=_vec(axes[k]))
+        lo, hi, vel, eff = -math.pi, math.pi, 0.0, 0.0
+        if types[k] == "P":
+            lo, hi = -1.0, 1.0
+        if limits is not None and k in actuated_rank:
+            r = actuated_rank[k]
+            vals = [limits.lower[r], limits.upper[r], limits.velocity[r], limits.effort[r]]
+            lo = vals[0] if np.isfinite(vals[0]) else lo
+            hi = vals[1] if np.isfinite(vals[1]) else hi
+            vel = vals[2] if np.isfinite(vals[2]) else 0.0
+            eff = vals[3] if np.isfinite(vals[3]) else 0.0
+        ET.SubElement(joint, "limit", lower=_fmt(lo), upper=_fmt(hi), effort=_fmt(eff), velocity=_fmt(vel))
+        if k in leader:
+            ET.SubElement(joint, "mimic", joint=names[leader[k]], multiplier=_fmt(mult[k]), offset=_fmt(mimic_off[k]))
+        parent = link_names[k]
+    ET.SubElement(robot, "link", name=tip_link)
+    tj = ET.SubElement(robot, "joint", name=f"{tip_link}_joint", type="fixed")
+    _origin_el(tj, tool)
+    ET.SubElement(tj, "parent", link=parent)
+    ET.SubElement(tj, "child", link=tip_link)
+    ET.indent(robot)
+    path = Path(path)
+    ET.ElementTree(robot).write(path, encoding="unicode", xml_declaration=True)
+    return path

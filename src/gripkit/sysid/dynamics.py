@@ -1,0 +1,593 @@
+"""Multi-joint inverse-dynamics identification (IDIM-LS on all joints of a chain), with base
+parameters, per-joint friction, uncertainties and a physical-consistency check.
+
+The model (Khalil & Dombre, *Modeling, Identification and Control of Robots*, ch. 12; Gautier &
+Khalil 1990 for the base parameters; Wensing, Kim & Slotine 2017 for consistency):
+
+    τ = Y(q, q̇, q̈) φ + diag(I_a) q̈ + F_c ∘ sign(q̇) + F_v ∘ q̇ (+ τ₀)          (per actuated joint)
+
+with φ the standard inertial parameters of every link (:mod:`gripkit.multibody.regressor`),
+I_a optional rotor inertias (``armature=True``) and per-joint Coulomb F_c, viscous F_v and offset
+τ₀ friction.
+
+**Base parameters.** Not every column of Y is independent: some are zero (a link that cannot move
+a parameter), some are combinations of others (parameters that only act together). The structure
+is found from the model alone, on random states. The rank r comes from the QR decomposition with
+column pivoting (|R_kk| above 1e-9·|R_00|). Which r columns stand for the others is then chosen
+in a fixed order — proximal links first, within a link the inertias before the first moments
+before the mass (Khalil's regrouping), rotor inertias last — keeping a column when it is not in the
+span of those before it (|R_kk| of the QR in that order against the column's norm): equal columns
+(the DLR/HIT finger has four) would otherwise be picked by rounding, and the names with them. With
+Y₁ the kept columns and Y₂ = Y₁ β (least squares, exact here), Y φ = Y₁ (φ₁ + β φ₂) = Y₁ φ_b.
+Each base parameter is named as the combination it stands for
+(``Izz_link3 + 0.003·m_link4 + ...``).
+
+**Estimation.** Weighted least squares on the stacked rows (sample, joint) of [Y₁, friction
+columns]; each joint's rows are weighted by 1/σ̂ⱼ² from a first pass (Gautier & Poignet 2001), so
+joints with different noise levels count by their noise, times the user's ``weights``.
+Cov = σ̂² (XᵀWX)⁻¹, σ̂² = rᵀWr/(N_rows − p) (``covariance="ols"``, white noise), or the Newey-West
+covariance of :func:`gripkit.sysid.regression.hac_covariance` for filtered, differentiated or
+decimated logs (``covariance="hac"``).
+
+**Physical consistency.** A base-parameter estimate is physically consistent when some standard
+parameters reproduce it with every link's pseudo-inertia
+
+    J = [[½tr(I_o)·1 − I_o, h], [hᵀ, m]]   positive definite
+
+(positive mass, centre of mass inside the inertia ellipsoid, triangle inequality). gripkit writes
+each J = L Lᵀ (Cholesky factor L, always consistent) and minimises the Mahalanobis distance
+d² = (θ(L) − θ̂)ᵀ Cov⁻¹ (θ(L) − θ̂) over L: d ≈ 0 means consistent. First, though, the standard
+parameters that keep the chain's own values for what the data cannot see are tried: if every link
+is consistent there, so is the estimate, without a search. The failing links are those whose
+pseudo-inertia is indefinite there (or, if none, those pushed onto the boundary by the search).
+"Those standard parameters" are the least change from the chain's own values (each parameter
+relative to its size, so a massless link stays massless) that reproduces the estimate. ``constrained=True``
+returns that nearest consistent estimate (Coulomb and viscous friction ≥ 0) as the result; for a
+linear model this minimum-distance fit equals the constrained weighted least-squares fit on the
+data, without another pass over it.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..arguments import entry_point
+from ..errors import DataError, IdentificationError, UnidentifiableError
+
+__all__ = ["identify_dynamics", "DynamicsResult", "base_structure", "BaseStructure"]
+
+FRICTION_MODELS = {"none": (), "coulomb-viscous": ("coulomb", "viscous"),
+                   "coulomb-viscous-offset": ("coulomb", "viscous", "offset")}
+
+
+@dataclass(frozen=True)
+class BaseStructure:
+    """The base parameters of a chain: φ_b = φ[independent] + β φ[dependent] (module doc)."""
+
+    independent: np.ndarray   # column indices (r,)
+    dependent: np.ndarray     # column indices (p − r,)
+    beta: np.ndarray          # (r, p − r)
+    names: tuple              # (r,) combination names
+    standard_names: tuple     # (p,)
+
+    @property
+    def matrix(self) -> np.ndarray:
+        """K (r × p) with φ_b = K φ."""
+        K = np.zeros((self.independent.size, len(self.standard_names)))
+        K[np.arange(self.independent.size), self.independent] = 1.0
+        K[:, self.dependent] = self.beta
+        return K
+
+    def base(self, phi) -> np.ndarray:
+        return self.matrix @ np.asarray(phi, dtype=np.float64)
+
+
+def _combination_name(names, i, dep, beta_row) -> str:
+    s = names[i]
+    for j, b in zip(dep, beta_row):
+        if b == 0.0:
+            continue
+        s += f" {'+' if b > 0 else '-'} {abs(b):.6g}·{names[j]}"
+    return s
+
+
+def base_structure(chain, *, armature: bool = False, seed: int = 0, tol: float = 1e-9) -> BaseStructure:
+    """Base parameters of ``chain`` from its regressor on random states (module doc); with
+    ``armature`` a rotor-inertia column per actuated joint joins the standard parameters."""
+    from scipy.linalg import qr
+
+    rng = np.random.default_rng(seed)
+    m = chain.dof
+    names = list(chain.parameter_names)
+    if armature:
+        names += [f"armature_{j}" for j in chain.coordinate_names]
+    p = len(names)
+    B = max(20, 4 * p // m + 10)
+    q = rng.uniform(-math.pi, math.pi, (B, m))
+    qd = rng.normal(size=(B, m))
+    qdd = rng.normal(size=(B, m))
+    X = _inertial_columns(chain, q, qd, qdd, armature).reshape(B * m, p)
+    # greedy in a fixed order (module doc): a column is independent when it is not in the span of
+    # the columns before it, |R_kk| of the QR in that order against its norm
+    link = np.array([k // 10 if k < 10 * (p // 10) else -1 for k in range(p)])
+    order = np.array(sorted(range(p), key=lambda k: (link[k], -(k % 10)) if link[k] >= 0 else (p, k)))
+    norms = np.linalg.norm(X, axis=0)
+    R = qr(X[:, order], mode="r")[0]
+    d = np.abs(np.diag(R))
+    live = norms[order] > 1e-10 * norms.max() if norms.max() > 0 else np.zeros(p, dtype=bool)
+    is_ind = live & (d > tol * np.maximum(norms[order], 1e-300))
+    _, Rp, piv = qr(X, mode="economic", pivoting=True)
+    dp = np.abs(np.diag(Rp))
+    rank = int(np.sum(dp > tol * dp[0])) if dp.size and dp[0] > 0 else 0
+    if rank == 0:
+        raise UnidentifiableError(f"{chain.name}: the regressor is zero: no inertial parameter acts on the joints")
+    if int(is_ind.sum()) != rank:  # the fixed order disagrees with the pivoted rank: take the pivots
+        is_ind = np.isin(order, piv[:rank])
+    ind, dep = order[is_ind], order[~is_ind]
+    beta = np.linalg.lstsq(X[:, ind], X[:, dep], rcond=None)[0] if dep.size else np.zeros((ind.size, 0))
+    beta[np.abs(beta) < 1e-8] = 0.0
+    keep = np.argsort(ind)  # the standard order
+    ind, beta = ind[keep], beta[keep]
+    base_names = tuple(_combination_name(names, i, dep, beta[k]) for k, i in enumerate(ind))
+    return BaseStructure(ind, dep, beta, base_names, tuple(names))
+
+
+def _inertial_columns(chain, q, qd, qdd, armature: bool) -> np.ndarray:
+    Y = chain.regressor(q, qd, qdd)
+    if armature:
+        B, m, _ = Y.shape
+        A = np.zeros((B, m, m))
+        A[:, np.arange(m), np.arange(m)] = qdd
+        Y = np.concatenate([Y, A], axis=2)
+    return Y
+
+
+def _friction_columns(qd, kinds) -> np.ndarray:
+    B, m = qd.shape
+    F = np.zeros((B, m, m * len(kinds)))
+    for j in range(m):
+        for c, kind in enumerate(kinds):
+            col = j * len(kinds) + c
+            F[:, j, col] = np.sign(qd[:, j]) if kind == "coulomb" else qd[:, j] if kind == "viscous" else 1.0
+    return F
+
+
+@dataclass(frozen=True)
+class Consistency:
+    """Physical consistency of the estimate (module doc): ``consistent``, the Mahalanobis distance
+    ``distance`` (σ units) to the nearest consistent parameters found (a search of at most 80
+    steps: an upper bound of the true distance), the ``failing_links`` and those
+    ``standard_parameters``."""
+
+    consistent: bool
+    distance: float
+    failing_links: tuple
+    standard_parameters: np.ndarray
+    theta: np.ndarray
+
+    def message(self) -> str:
+        if self.consistent:
+            return "physically consistent: standard parameters with positive mass and positive-definite pseudo-inertia reproduce the base parameters"
+        links = ", ".join(self.failing_links) or "(no single link: the optimiser stopped)"
+        return (f"physically inconsistent: no standard parameters with positive-definite pseudo-inertia reproduce "
+                f"the base parameters (the nearest consistent ones found are {self.distance:.3g} σ away); failing: {links}")
+
+    def to_dict(self) -> dict:
+        return dict(consistent=self.consistent, distance_sigma=self.distance, failing_links=list(self.failing_links),
+                    message=self.message())
+
+
+@dataclass(frozen=True)
+class DynamicsResult:
+    """Result of :func:`identify_dynamics`.
+
+    ``base_parameters`` / ``base_parameters_std``: dicts, combination name → value (SI: kg, kg·m,
+    kg·m²); ``friction``: joint name → {``coulomb``, ``coulomb_std``, ``viscous``, ``viscous_std``
+    (, ``offset``, ``offset_std``)} in N·m, N·m·s/rad (N, N·s/m for prismatic joints);
+    ``armature`` likewise when identified. ``theta``, ``covariance`` and ``names`` hold every
+    estimated parameter in column order.
+    """
+
+    chain: object
+    structure: BaseStructure
+    friction_model: str
+    armature_identified: bool
+    names: tuple
+    theta: np.ndarray
+    covariance: np.ndarray
+    residual_std: dict
+    relative_error_percent: float
+    condition_number: float
+    n_samples: int
+    consistency: Consistency | None
+    constrained: bool
+    unconstrained_theta: np.ndarray
+    warnings: list = field(default_factory=list)
+
+    @property
+    def std(self) -> np.ndarray:
+        return np.sqrt(np.diag(self.covariance))
+
+    @property
+    def n_base(self) -> int:
+        return self.structure.independent.size
+
+    @property
+    def base_parameters(self) -> dict:
+        return dict(zip(self.structure.names, map(float, self.theta[:self.n_base])))
+
+    @property
+    def base_parameters_std(self) -> dict:
+        return dict(zip(self.structure.names, map(float, self.std[:self.n_base])))
+
+    def _per_joint(self, offset: int, kinds) -> dict:
+        out = {}
+        std = self.std
+        for j, name in enumerate(self.chain.coordinate_names):
+            d = {}
+            for c, kind in enumerate(kinds):
+                k = offset + j * len(kinds) + c
+                d[kind] = float(self.theta[k])
+                d[f"{kind}_std"] = float(std[k])
+            out[name] = d
+        return out
+
+    @property
+    def friction(self) -> dict:
+        kinds = FRICTION_MODELS[self.friction_model]
+        return self._per_joint(len(self.names) - self.chain.dof * len(kinds), kinds) if kinds else {}
+
+    @property
+    def armature(self) -> dict:
+        """Rotor inertia per joint (identified with ``armature=True``; it appears in the base
+        parameters, alone or combined)."""
+        return {n: v for n, v in self.base_parameters.items() if "armature_" in n}
+
+    def regressor(self, q, qd, qdd) -> np.ndarray:
+        """The identified model's regressor X (B, m, n_params): τ = X θ."""
+        q, qd, qdd = (np.atleast_2d(np.asarray(a, dtype=np.float64)) for a in (q, qd, qdd))
+        Y = _inertial_columns(self.chain, q, qd, qdd, self.armature_identified)[:, :, self.structure.independent]
+        kinds = FRICTION_MODELS[self.friction_model]
+        return np.concatenate([Y, _friction_columns(qd, kinds)], axis=2) if kinds else Y
+
+    def predict(self, q, qd, qdd) -> np.ndarray:
+        """τ (B, m) (or (m,) for one state) of the identified model."""
+        single = np.asarray(q).ndim == 1
+        tau = self.regressor(q, qd, qdd) @ self.theta
+        return tau[0] if single else tau
+
+    def to_dict(self) -> dict:
+        d = dict(base_parameters=self.base_parameters, base_parameters_std=self.base_parameters_std,
+                 friction=self.friction, friction_model=self.friction_model,
+                 residual_std=self.residual_std, relative_error_percent=self.relative_error_percent,
+                 condition_number=self.condition_number, n_samples=self.n_samples, constrained=self.constrained,
+                 joints=list(self.chain.coordinate_names), n_standard_parameters=len(self.structure.standard_names),
+                 n_base_parameters=self.n_base, warnings=list(self.warnings))
+        if self.consistency is not None:
+            d["consistency"] = self.consistency.to_dict()
+        return d
+
+
+def _as_states(name, a, N, m, names):
+    x = np.asarray(a, dtype=np.float64)
+    if x.ndim == 1 and m == 1:
+        x = x[:, None]
+    if x.ndim != 2 or x.shape[1] != m:
+        raise DataError(f"{name}: expected shape (N, {m}) for the joints {', '.join(names)}, found {x.shape}")
+    if N is not None and x.shape[0] != N:
+        raise DataError(f"{name}: {x.shape[0]} samples, but q has {N}")
+    bad = ~np.isfinite(x)
+    if bad.any():
+        i, j = np.argwhere(bad)[0]
+        raise DataError(f"{name}: {int(bad.sum())} NaN or inf values (first at sample {i}, joint {names[j]})",
+                        hint="drop or interpolate them before identification")
+    return x
+
+
+@entry_point
+def identify_dynamics(chain, q, qd, qdd, tau, *, friction: str = "coulomb-viscous", weights=None,
+                      armature: bool = False, covariance: str = "ols", constrained: bool = False,
+                      check_consistency: bool = True, joint_weighting: bool = True) -> DynamicsResult:
+    """Identify a chain's base inertial parameters and per-joint friction from joint states and
+    efforts (module doc).
+
+    Parameters
+    ----------
+    chain
+        A gripkit chain (DH, coupled or URDF: ``gripkit.multibody.from_urdf``); its inertial
+        values are only the starting point of the consistency check.
+    q, qd, qdd, tau
+        Positions (rad or m), velocities, accelerations and efforts (N·m or N) of the actuated
+        joints, shape (N, m).
+    friction
+        ``'coulomb-viscous'``, ``'coulomb-viscous-offset'`` or ``'none'``.
+    weights
+        None, or (N,) or (N, m) non-negative row weights (0 drops a row: e.g. samples near a
+        velocity reversal).
+    joint_weighting
+        Multiply the weights by each joint's 1/σ̂² from a first pass (module doc).
+    armature
+        Also identify a rotor inertia I_a per actuated joint (geared motors).
+    covariance
+        ``'ols'`` (white noise) or ``'hac'`` (filtered or decimated data).
+    constrained
+        Return the nearest physically consistent estimate instead of the unconstrained one.
+    """
+    if friction not in FRICTION_MODELS:
+        raise DataError(f"friction: expected one of {', '.join(FRICTION_MODELS)}, found {friction!r}")
+    if covariance not in ("ols", "hac"):
+        raise DataError(f"covariance: expected 'ols' or 'hac', found {covariance!r}")
+    m = chain.dof
+    jn = chain.coordinate_names
+    q = _as_states("q", q, None, m, jn)
+    N = q.shape[0]
+    qd = _as_states("qd", qd, N, m, jn)
+    qdd = _as_states("qdd", qdd, N, m, jn)
+    tau = _as_states("tau", tau, N, m, jn)
+    if weights is None:
+        w = None
+    else:
+        w = np.asarray(weights, dtype=np.float64)
+        if w.ndim == 1:
+            w = np.repeat(w[:, None], m, axis=1)
+        if w.shape != (N, m) or not np.isfinite(w).all() or (w < 0).any():
+            raise DataError(f"weights: expected (N,) or (N, {m}) finite non-negative values, found shape {np.shape(weights)}")
+    st = base_structure(chain, armature=armature)
+    kinds = FRICTION_MODELS[friction]
+    Y = _inertial_columns(chain, q, qd, qdd, armature)[:, :, st.independent]
+    X3 = np.concatenate([Y, _friction_columns(qd, kinds)], axis=2) if kinds else Y
+    names = st.names + tuple(f"{k}_{j}" for j in jn for k in kinds)
+    P = X3.shape[2]
+    rows_w = np.ones((N, m)) if w is None else w
+    n_j = (rows_w > 0).sum(axis=0)
+    n_rows = int(n_j.sum())
+    if n_rows < 2 * P:
+        raise DataError(f"{n_rows} weighted rows are too few for {P} parameters (need at least {2 * P})",
+                        hint="log a longer run")
+    # one pass over the data: each joint's weighted Gram matrix XⱼᵀWⱼXⱼ, XⱼᵀWⱼτⱼ and τⱼᵀWⱼτⱼ; the
+    # per-joint reweighting, the solution, the residual sums and the covariance follow from them
+    Gj = np.empty((m, P, P))
+    bj = np.empty((m, P))
+    yy = np.empty(m)
+    for j in range(m):
+        sw = np.sqrt(rows_w[:, j])
+        Xj = X3[:, j, :] * sw[:, None]
+        yj = tau[:, j] * sw
+        Gj[j] = Xj.T @ Xj
+        bj[j] = Xj.T @ yj
+        yy[j] = yj @ yj
+    scale = np.sqrt(np.diagonal(Gj.sum(axis=0)) / n_rows)
+    weak = np.flatnonzero(scale == 0)
+    if weak.size:
+        raise UnidentifiableError(f"the data never excite {', '.join(names[k] for k in weak[:3])}",
+                                  hint="move every joint, in both directions, with accelerations")
+    S = np.outer(scale, scale)
+
+    def solve(jw):
+        """θ for per-joint weights jw (normal equations on the scaled columns; their condition
+        number is the square of the regressor's, so beyond 1e6 the orthogonal route is taken)."""
+        Gs = np.tensordot(jw, Gj, axes=1) / S
+        ev, V = np.linalg.eigh(Gs)
+        cnd = float(np.sqrt(ev[-1] / max(ev[0], 1e-300)))
+        if cnd < 1e6:
+            th = np.linalg.solve(Gs, (jw @ bj) / scale)
+        else:
+            sw = np.sqrt(rows_w * jw)
+            Xw = (X3 * sw[:, :, None]).reshape(N * m, P) / scale
+            th = np.linalg.lstsq(Xw, (tau * sw).reshape(-1), rcond=None)[0]
+        return Gs, th / scale, cnd, V
+
+    def rss(th):
+        """Weighted residual sum of squares of each joint."""
+        return np.maximum(yy - 2 * bj @ th + np.einsum("i,jik,k->j", th, Gj, th), 0.0)
+
+    jw = np.ones(m)
+    Gs, theta, cond, V = solve(jw)
+    if cond > 1e10:
+        v = V[:, 0] / scale
+        top = np.argsort(-np.abs(v / np.max(np.abs(v))))[:3]
+        raise UnidentifiableError(f"the data do not excite every base parameter (condition number {cond:.3g}); "
+                                  f"the weakest direction mixes {', '.join(names[k] for k in top)}",
+                                  hint="use a richer excitation (gripkit.excitation.fourier_trajectory)")
+    if joint_weighting and m > 1:  # Gautier-Poignet: each joint weighted by its residual variance
+        s2_j = rss(theta) / np.maximum(n_j - P / m, 1.0)
+        s2_j[~(s2_j > 0)] = 1.0
+        jw = 1.0 / s2_j
+        Gs, theta, cond, _ = solve(jw)
+    r2 = rss(theta)
+    if covariance == "hac":
+        from .regression import hac_covariance
+
+        sw = np.sqrt(rows_w * jw)
+        Xw = (X3 * sw[:, :, None]).reshape(N * m, P) / scale
+        rw = ((tau - X3 @ theta) * sw).reshape(-1)
+        keep = sw.reshape(-1) > 0
+        C = hac_covariance(Xw[keep], rw[keep]) / S
+    else:
+        s2 = float(jw @ r2 / max(n_rows - P, 1))
+        C = s2 * np.linalg.inv(Gs) / S
+    wsum = rows_w.sum(axis=0)
+    res_std = {j: float(np.sqrt(r2[k] / wsum[k])) if wsum[k] > 0 else float("nan") for k, j in enumerate(jn)}
+    rel = float(100.0 * np.sqrt(r2.sum() / max(yy.sum(), 1e-300)))
+    notes = []
+    if cond > 1e5:
+        notes.append(f"regressor condition number {cond:.3g}: weak excitation, large σ")
+    theta_u = theta.copy()
+    cons = None
+    if check_consistency or constrained:
+        cons = _consistency(chain, st, theta, C, kinds, m, armature)
+        if not cons.consistent:
+            notes.append(cons.message())
+        if constrained:
+            theta = cons.theta
+    return DynamicsResult(chain, st, friction, armature, names, theta, C, res_std, rel, cond, N, cons,
+                          constrained, theta_u, notes)
+
+
+# --- physical consistency -------------------------------------------------------------------------
+
+def _phi_from_factor(Lv: np.ndarray) -> np.ndarray:
+    """Standard parameters (10) of J = L Lᵀ, L lower-triangular 4×4 from its 10 entries."""
+    L = np.zeros((4, 4))
+    L[np.tril_indices(4)] = Lv
+    J = L @ L.T
+    Sigma = J[:3, :3]
+    Io = np.trace(Sigma) * np.eye(3) - Sigma
+    return np.array([J[3, 3], J[0, 3], J[1, 3], J[2, 3], Io[0, 0], Io[0, 1], Io[1, 1], Io[0, 2], Io[1, 2], Io[2, 2]])
+
+
+def _j_to_phi() -> np.ndarray:
+    """The linear map vec(J) (16) → φ (10) of :func:`_phi_from_factor`."""
+    A = np.zeros((10, 16))
+    for e in range(16):
+        J = np.zeros(16)
+        J[e] = 1.0
+        J = J.reshape(4, 4)
+        Sigma = J[:3, :3]
+        Io = np.trace(Sigma) * np.eye(3) - Sigma
+        A[:, e] = [J[3, 3], J[0, 3], J[1, 3], J[2, 3], Io[0, 0], Io[0, 1], Io[1, 1], Io[0, 2], Io[1, 2], Io[2, 2]]
+    return A
+
+
+_J_TO_PHI = _j_to_phi()
+
+
+def pseudo_inertia(phi10) -> np.ndarray:
+    """J = [[½tr(I_o)·1 − I_o, h], [hᵀ, m]] of one link's standard parameters."""
+    m, hx, hy, hz, xx, xy, yy, xz, yz, zz = phi10
+    Io = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+    J = np.zeros((4, 4))
+    J[:3, :3] = 0.5 * np.trace(Io) * np.eye(3) - Io
+    J[:3, 3] = J[3, :3] = hx, hy, hz
+    J[3, 3] = m
+    return J
+
+
+def _consistency(chain, st: BaseStructure, theta, C, kinds, m, armature) -> Consistency:
+    from scipy.optimize import least_squares
+
+    nb = st.independent.size
+    p_std = len(chain.parameter_names)
+    n_links = p_std // 10
+    K = st.matrix
+    phi0 = chain.standard_parameters()
+    # start: the chain's own (nominal) links, made strictly positive definite
+    # (a massless link, J = 0, gets a small body: at L = 0 the gradient of L Lᵀ vanishes)
+    Js = [pseudo_inertia(phi0[10 * k:10 * k + 10]) for k in range(n_links)]
+    typical = max(np.mean([np.trace(J) for J in Js]), 1e-12)
+    L0 = [np.linalg.cholesky(J + 1e-3 * max(np.trace(J), 1e-2 * typical) * np.eye(4))[np.tril_indices(4)]
+          for J in Js]
+    n_arm = m if armature else 0
+    x0 = np.concatenate([*L0, np.full(n_arm, 0.0), theta[nb:]])
+    try:
+        Ci = np.linalg.cholesky(np.linalg.inv(C))
+    except np.linalg.LinAlgError:
+        raise IdentificationError("the covariance of the estimate is not positive definite") from None
+    lo = np.full(x0.size, -np.inf)
+    hi = np.full(x0.size, np.inf)
+    fr0 = 10 * n_links + n_arm
+    lo[10 * n_links:fr0] = 0.0        # rotor inertia ≥ 0
+    x0[10 * n_links:fr0] = 1e-12
+    for j in range(m):
+        for c, kind in enumerate(kinds):
+            if kind in ("coulomb", "viscous"):
+                lo[fr0 + j * len(kinds) + c] = 0.0
+    x0 = np.clip(x0, lo + 1e-15 * (lo > -np.inf), hi)
+
+    tri = np.tril_indices(4)
+    # dφ/dL of one link: φ is linear in J (the map _J_TO_PHI), J = L Lᵀ
+    def link_jac(Lv):
+        L = np.zeros((4, 4))
+        L[tri] = Lv
+        D = np.empty((10, 10))
+        for c, (a, b) in enumerate(zip(*tri)):
+            E = np.zeros((4, 4))
+            E[a, b] = 1.0
+            D[:, c] = _J_TO_PHI @ (E @ L.T + L @ E.T).ravel()
+        return D
+
+    def params(x):
+        phi = np.concatenate([_phi_from_factor(x[10 * k:10 * k + 10]) for k in range(n_links)])
+        if n_arm:
+            phi = np.concatenate([phi, x[10 * n_links:fr0]])
+        return np.concatenate([K @ phi, x[fr0:]]), phi
+
+    reg = 1e-3  # a weak pull towards the chain's own values fixes the directions the data cannot see
+
+    def resid(x):
+        return np.concatenate([Ci.T @ (params(x)[0] - theta), reg * (x[:10 * n_links] - x0[:10 * n_links])])
+
+    def jac(x):
+        Dphi = np.zeros((K.shape[1], fr0))
+        for k in range(n_links):
+            Dphi[10 * k:10 * k + 10, 10 * k:10 * k + 10] = link_jac(x[10 * k:10 * k + 10])
+        if n_arm:
+            Dphi[p_std:, 10 * n_links:fr0] = np.eye(n_arm)
+        Dth = np.zeros((theta.size, x.size))
+        Dth[:nb, :fr0] = K @ Dphi
+        Dth[nb:, fr0:] = np.eye(theta.size - nb)
+        Dreg = np.zeros((10 * n_links, x.size))
+        Dreg[:, :10 * n_links] = reg * np.eye(10 * n_links)
+        return np.vstack([Ci.T @ Dth, Dreg])
+
+    # first the standard parameters nearest to the chain's own that reproduce the estimate (least
+    # change, each parameter relative to its own size, so that a massless link stays massless):
+    # φ = φ₀ + S²Kᵀ(K S² Kᵀ)⁻¹(θ_b − K φ₀). Consistent there means consistent (d = 0), no search.
+    phi_nom = np.concatenate([phi0, np.zeros(n_arm)]) if n_arm else phi0.copy()
+    # sizes: each parameter's own value plus 1e-3 of its link's scale of that kind (mass, first
+    # moment, inertia), so that zero off-diagonal products may move; a massless link has none
+    sz = np.abs(phi_nom)
+    for k in range(n_links):
+        f = phi_nom[10 * k:10 * k + 10]
+        kind = (abs(f[0]), np.abs(f[1:4]).max(), np.abs(f[[4, 6, 9]]).max())
+        sz[10 * k:10 * k + 10] += 1e-3 * np.array([kind[0]] + [kind[1]] * 3 + [kind[2]] * 6)
+    if n_arm:
+        sz[p_std:] += 1e-3 * max(sz[:p_std].max(), 1e-300)
+    KS = K * sz ** 2
+    phi_p = phi_nom + KS.T @ np.linalg.lstsq(KS @ K.T, theta[:nb] - K @ phi_nom, rcond=None)[0]
+    reproduces = np.allclose(K @ phi_p, theta[:nb], rtol=1e-9, atol=1e-12 * np.abs(theta[:nb]).max())
+
+    def psd(J):
+        ev = np.linalg.eigvalsh(J)
+        return ev[0] >= -1e-9 * max(ev[-1], 1e-300)
+
+    links_ok = all(psd(pseudo_inertia(phi_p[10 * k:10 * k + 10])) for k in range(n_links))
+    fr_ok = all(theta[nb + j * len(kinds) + c] >= 0 for j in range(m) for c, kind in enumerate(kinds)
+                if kind in ("coulomb", "viscous"))
+    if reproduces and links_ok and fr_ok and (not n_arm or (phi_p[p_std:] >= 0).all()):
+        return Consistency(True, 0.0, (), phi_p, theta.copy())
+    # search from that solution with each link's pseudo-inertia projected onto the consistent set
+    for k in range(n_links):
+        ev, V = np.linalg.eigh(pseudo_inertia(phi_p[10 * k:10 * k + 10]))
+        eps = 1e-6 * max(ev[-1], 1e-2 * typical)
+        x0[10 * k:10 * k + 10] = np.linalg.cholesky((V * np.maximum(ev, 0.0)) @ V.T + eps * np.eye(4))[tri]
+    if n_arm:
+        x0[10 * n_links:fr0] = np.maximum(phi_p[p_std:], 1e-15)
+    sol = least_squares(resid, x0, jac=jac, bounds=(lo, hi), x_scale="jac", xtol=1e-10, ftol=1e-10,
+                        gtol=1e-10, max_nfev=80)
+    th, phi = params(sol.x)
+    d = float(np.linalg.norm(Ci.T @ (th - theta)))
+    failing = []
+    if d > 1e-2:
+        # the links whose pseudo-inertia is indefinite in that least-change solution; if none,
+        # those pushed onto the boundary by the search
+        for k, name in enumerate(chain.link_names):
+            if not psd(pseudo_inertia(phi_p[10 * k:10 * k + 10])):
+                failing.append(f"link {name!r}")
+        if not failing:
+            for k, name in enumerate(chain.link_names):
+                ev = np.linalg.eigvalsh(pseudo_inertia(phi[10 * k:10 * k + 10]))
+                if ev[0] <= 1e-6 * max(ev[-1], 1e-300):
+                    failing.append(f"link {name!r}")
+        if n_arm:
+            failing += [f"armature of {j!r} (< 0)" for i, j in enumerate(chain.coordinate_names)
+                        if sol.x[10 * n_links + i] <= 1e-15]
+        for j, jn in enumerate(chain.coordinate_names):
+            for c, kind in enumerate(kinds):
+                k = fr0 + j * len(kinds) + c
+                if kind in ("coulomb", "viscous") and sol.x[k] <= 0.0 and theta[nb + j * len(kinds) + c] < 0:
+                    failing.append(f"{kind} friction of {jn!r} (< 0)")
+    return Consistency(d <= 1e-2, d, tuple(failing), phi, th)
