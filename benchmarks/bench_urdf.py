@@ -20,27 +20,20 @@ results). Numba compile time is excluded (warm-up call), as everywhere in the be
 
 from __future__ import annotations
 
-import statistics
 import tempfile
 import time
 import warnings
 from pathlib import Path
 
 import numpy as np
-from common import row
+from common import measure, row
 
 
-def timed(fn, repeat: int, number: int = 1, warmup: int = 1) -> tuple[float, float]:
-    """(median, min) seconds per call of ``number`` calls over ``repeat`` runs after ``warmup``."""
-    for _ in range(warmup):
-        fn()
-    ts = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        for _ in range(number):
-            fn()
-        ts.append((time.perf_counter() - t0) / number)
-    return statistics.median(ts), min(ts)
+def timed(fn, repeat: int, number: int = 1) -> tuple:
+    """(Timing, min) per call through the shared harness :func:`common.measure` (same warm-up and
+    runs for both sides; ``repeat`` is kept for the call sites and ignored)."""
+    t = measure(fn, number)
+    return t, t.min
 
 
 def _setup():
