@@ -122,21 +122,28 @@ def _scipy_lstsq(u, y, driver):
 
 
 _CHILD = r"""
-import json, resource, statistics, sys, time
+import json, statistics, sys, time
 import numpy as np
 sys.path.insert(0, {here!r})
 from bench_sysid import _data, _normal_equations
 from gripkit.sysid import arx
 what, n = sys.argv[1], int(sys.argv[2])
-u, y = _data(n)
+if what == "memory":  # data from a file: generating them here would set the peak before the call
+    uy = np.load(sys.argv[3])
+    u, y = uy[0], uy[1]
+else:
+    u, y = _data(n)
 arx(u[:2000], y[:2000], 4, 4, 2); _normal_equations(u[:2000], y[:2000])
 if what == "memory":
-    base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
-    cur = int(open("/proc/self/statm").read().split()[1]) * resource.getpagesize()
+    def status(key):
+        for line in open("/proc/self/status"):
+            if line.startswith(key):
+                return int(line.split()[1]) * 1024
+    open("/proc/self/clear_refs", "w").write("5")  # reset the peak (VmHWM) to the current RSS
+    cur = status("VmRSS:")
     m = arx(u, y, 4, 4, 2)
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
-    print(json.dumps(dict(input=u.nbytes + y.nbytes, rss_before=cur, peak_before=base, peak=peak,
-                          residuals=m.residuals.nbytes)))
+    peak = status("VmHWM:")
+    print(json.dumps(dict(input=u.nbytes + y.nbytes, rss_before=cur, peak=peak, residuals=m.residuals.nbytes)))
 else:
     out = {{}}
     for name, f in (("gripkit", lambda: arx(u, y, 4, 4, 2)), ("numpy", lambda: _normal_equations(u, y))):
@@ -154,11 +161,18 @@ def _child(what: str, n: int) -> dict:
     import os
     import subprocess
     import sys
+    import tempfile
     from pathlib import Path
 
     here = str(Path(__file__).resolve().parent)
-    out = subprocess.run([sys.executable, "-c", _CHILD.format(here=here), what, str(n)], env=os.environ.copy(),
-                         capture_output=True, text=True, check=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        args = [what, str(n)]
+        if what == "memory":
+            path = os.path.join(tmp, "uy.npy")
+            np.save(path, np.stack(_data(n)))
+            args.append(path)
+        out = subprocess.run([sys.executable, "-c", _CHILD.format(here=here), *args], env=os.environ.copy(),
+                             capture_output=True, text=True, check=True)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
@@ -251,11 +265,12 @@ def run(quick: bool = False) -> list[dict]:
         over = (mem["peak"] - mem["rss_before"]) / mem["input"]
         rows.append(row("sysid", "ARX [4 4 2], N = 1e7: peak RSS during the call", None, "—", None,
                         target="≤ 1.3× the input arrays",
-                        notes=f"inputs u, y {mem['input'] / 1e6:.0f} MB; peak RSS − RSS before the call = "
+                        notes=f"inputs u, y {mem['input'] / 1e6:.0f} MB; peak RSS = {mem['peak'] / 1e6:.0f} MB; "
+                              f"peak RSS − RSS before the call = "
                               f"{(mem['peak'] - mem['rss_before']) / 1e6:.0f} MB = {over:.2f}× the inputs, of which "
                               f"the returned residuals are {mem['residuals'] / 1e6:.0f} MB "
                               f"({mem['residuals'] / mem['input']:.2f}×); measured in a fresh process "
-                              f"(resource.getrusage ru_maxrss, /proc/self/statm)",
+                              f"(/proc/self/status VmHWM after resetting it through /proc/self/clear_refs)",
                         extra=mem))
 
     # sysidentpy, sippy_unipi: pure-Python per-row work, timed at a smaller N when too slow

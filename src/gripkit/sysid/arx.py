@@ -107,6 +107,7 @@ def _arx(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int, step: float, *
         model = _model(sol.theta, na, nk, step, y.size, meta)
         fit = 100.0 * (1.0 - np.sqrt(see / syy))
     sigma2 = see / (m - p)
+    e.flags.writeable = False  # handed to the model without a copy
     return model.replace(covariance=sigma2 * sol.cov_unscaled, noise_variance=sigma2, loss=0.5 * see / m,
                          fit_percent=fit, n_used=m, residuals=e, info={"method": method, "cond": sol.cond})
 
