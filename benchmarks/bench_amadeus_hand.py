@@ -51,10 +51,11 @@ def _kf_numpy(H, sn2, floor2, Z, q, dt):
 
 def run(quick: bool = False) -> list[dict]:
     from gripkit.control import design_rst
-    from gripkit.estimation import ForceDynamics, ForceKalmanFilter, SlipDetector, estimate_force
-    from gripkit.models.pvdf import StickSlipContact, nonslip_grasp_inputs, pvdf_noise
-    from gripkit.models.strain_gauge_sensor import StrainGaugeSensor
-    from gripkit.zoo.amadeus_hand import force_plant
+    from gripkit.systems.amadeus import (ForceDynamics, ForceKalmanFilter, SlipDetector,
+                                         estimate_force)
+    from gripkit.systems.amadeus.pvdf import StickSlipContact, nonslip_grasp_inputs, pvdf_noise
+    from gripkit.systems.amadeus.strain_gauge_sensor import StrainGaugeSensor
+    from gripkit.systems.amadeus.parameters import force_plant
 
     rows = []
     fs = 2000.0

@@ -46,8 +46,8 @@ def run(quick: bool = False) -> list[dict]:
     import numba
 
     from gripkit.batch import DaskExecutor, ProcessExecutor, sweep
-    from gripkit.batch.grasp_tsfm import FAST_GRASP, tsfm_grasp_batch
     from gripkit.batch.scenarios import build_model
+    from gripkit.systems.tsfm.grasp_batch import FAST_GRASP, tsfm_grasp_batch
 
     warnings.simplefilter("ignore")
     n = 1000 if quick else 10000
@@ -151,7 +151,7 @@ def run(quick: bool = False) -> list[dict]:
     rows.extend(_small_sweep_rows(quick))
 
     # CUDA
-    from gripkit.batch.gpu import cuda_available
+    from gripkit.systems.tsfm.grasp_gpu import cuda_available
 
     if cuda_available():  # pragma: no cover - needs a GPU
         tsfm_grasp_batch(grip, settings=FAST_GRASP, duration=0.1, backend="cuda",

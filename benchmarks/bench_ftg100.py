@@ -19,8 +19,8 @@ def _scipy_grasp(duration: float, gap: float, noise: bool = True, seed: int = 0)
     integrated between samples by solve_ivp (RK45, rtol 1e-9) with a terminal contact event."""
     from scipy.integrate import solve_ivp
 
-    from gripkit.control.hybrid import HybridForcePosition
-    from gripkit.models.ftg100 import FTG100Plant
+    from gripkit.systems.ftg100.hybrid_control import HybridForcePosition
+    from gripkit.systems.ftg100.model import FTG100Plant
 
     pl = FTG100Plant(check=False, gap=gap)
     p = dict(zip(pl.parameters.names, pl.theta()))
@@ -60,19 +60,19 @@ def _scipy_grasp(duration: float, gap: float, noise: bool = True, seed: int = 0)
 
 
 def run(quick: bool) -> list[dict]:
-    from gripkit.control.hybrid import simulate_grasp
-    from gripkit.zoo.ftg100 import identify_actuated, step_experiment
+    from gripkit.systems.ftg100.hybrid_control import simulate_hybrid_grasp
+    from gripkit.systems.ftg100.identification import identify_actuated, step_experiment
 
     warnings.simplefilter("ignore")
     rows = []
     # 1. closed-loop grasp: approach (gap 5 µm), contact, force control; 20 kHz controller
     dur = 0.02 if quick else 0.03
-    simulate_grasp(gap=5e-6, duration=dur)  # compile
-    g = measure(lambda: simulate_grasp(gap=5e-6, duration=dur))
+    simulate_hybrid_grasp(gap=5e-6, duration=dur)  # compile
+    g = measure(lambda: simulate_hybrid_grasp(gap=5e-6, duration=dur))
     p = measure(lambda: _scipy_grasp(dur, 5e-6))
     # without noise both must give the same contact force (gripkit records F_c at the start of a
     # sample, the scipy loop after it: shift by one)
-    a = simulate_grasp(gap=5e-6, duration=dur, noise_force=0.0, noise_position=0.0).trajectory["F_c"][1:]
+    a = simulate_hybrid_grasp(gap=5e-6, duration=dur, noise_force=0.0, noise_position=0.0).trajectory["F_c"][1:]
     b = _scipy_grasp(dur, 5e-6, noise=False)[:-1]
     err = float(np.max(np.abs(a - b)) / 20e-6)
     rows.append(row("ftg100", f"closed-loop grasp, {dur * 1e3:.0f} ms at 20 kHz (plant with contact events + hybrid controller)",

@@ -24,7 +24,7 @@ from common import measure, row
 def _setup():
     from gripkit.errors import ConsistencyWarning
     from gripkit.multibody.pinocchio import to_pinocchio
-    from gripkit.zoo.dlr_hit import finger
+    from gripkit.systems.dlr_hit.parameters import finger
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ConsistencyWarning)

@@ -28,7 +28,7 @@ def _contact_peer(finger, x_w, k_e, U, fs):
     """The finger with contact as a user writes it with solve_ivp (eqs 7, 9, 3; smooth contact)."""
     from scipy.integrate import solve_ivp
 
-    from gripkit.models.tsfm import finger_minimal_state_space
+    from gripkit.systems.tsfm.gripper import finger_minimal_state_space
 
     v = finger.values()
     ss = finger_minimal_state_space(v)
@@ -67,7 +67,7 @@ def _fit_data(seed=0):
 
 def _kernel_time(m, th, U, fs):
     """The numba row kernel alone, on arrays prepared once (what a loop calling it would pay)."""
-    from gripkit.models import tsfm as T
+    from gripkit.systems.tsfm import gripper as T
 
     nf = len(T.FINGER_NAMES)
     d = T._hybrid_arrays([(th[0, :nf], th[0, nf + 1], th[0, nf + 2], th[0, nf + 3])], 1 / fs, m.levels,
@@ -150,7 +150,7 @@ def _compiled_peer_fit(start, data):
 
 def run(quick: bool = False) -> list[dict]:
     from gripkit.sysid.greybox import fit
-    from gripkit.zoo import tsfm as z
+    from gripkit.systems.tsfm import parameters as z
 
     warnings.simplefilter("ignore")
     rows = []

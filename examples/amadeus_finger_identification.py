@@ -6,7 +6,7 @@ import numpy as np
 
 from gripkit import sysid
 from gripkit.excitation import bandlimited_noise, multisine
-from gripkit.zoo.amadeus import finger_force_model
+from gripkit.systems.amadeus.force_dynamics import finger_force_model
 
 plant = finger_force_model()  # Table II [2 2 2] at 200 Hz, valve current (A) -> force (N)
 s2 = bandlimited_noise(0.3, 10.0, 20.0, 200.0, operating_point=0.850, limits=(0.600, 1.100), unit="A", seed=7)

@@ -5,8 +5,8 @@ sensor noise — for object stiffnesses from 520 to 1560 N/m (k0 = 1043 N/m ± 5
 
 import numpy as np
 
-from gripkit.control.hybrid import HybridForcePosition, grasp_batch
-from gripkit.models.ftg100 import FTG100Plant
+from gripkit.systems.ftg100.hybrid_control import HybridForcePosition, grasp_batch
+from gripkit.systems.ftg100.model import FTG100Plant
 
 plant = FTG100Plant()
 ctrl = HybridForcePosition.for_plant(plant.parameters)

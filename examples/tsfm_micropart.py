@@ -3,8 +3,8 @@
 the tips are estimated from voltage and force (eq 11), contact is detected at 5 µN, and the width
 w = gap − (y1 + y2) and stiffness k = F/δ (eq 16) come out with their uncertainties."""
 
-from gripkit.control.two_finger_grasp import GraspSettings, simulate_two_finger_grasp
-from gripkit.zoo import tsfm
+from gripkit.systems.tsfm import parameters as tsfm
+from gripkit.systems.tsfm.grasp import GraspSettings, simulate_two_finger_grasp
 
 gripper = tsfm.gripper(stiffness=72.5, width=300e-6, centre=220e-6, check=False)  # 20 µm off-centre
 # (check=False: the Table II contradictions are reported by `gripkit zoo check tsfm-gripper`)

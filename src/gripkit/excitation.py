@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .errors import DataError
+from .signals.filters import apply_sos, butter_sos
 from .signals.trajectory import Trajectory
 
 __all__ = ["Excitation", "multisine", "bandlimited_noise", "prbs", "chirp", "steps", "crest_factor",
@@ -174,8 +175,6 @@ def bandlimited_noise(f_low: float, f_high: float, duration: float, fs: float, *
                       unit: str = "1") -> Excitation:
     """Gaussian white noise through a zero-phase Butterworth band-pass ``[f_low, f_high]`` Hz
     (``f_low = 0`` gives a low-pass), scaled so its extreme just fits the limits."""
-    from .signals.filters import apply_sos, butter_sos
-
     n, lo, hi = _check_common(duration, fs, operating_point, limits)
     if not 0 <= f_low < f_high < fs / 2:
         raise DataError(f"band: expected 0 <= f_low < f_high < fs/2 = {fs / 2:g} Hz, found ({f_low}, {f_high})")

@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .errors import ParameterError
+from .units import convert, format_quantity, same_dimension, to_si
 
 __all__ = ["Parameter", "ParameterSet"]
 
@@ -107,8 +108,6 @@ class Parameter:
 
     def display(self, digits: int = 4) -> str:
         """``'k_s = 128 N/m'`` in the display unit, with ± std when known."""
-        from .units import format_quantity
-
         return f"{self.name} = " + format_quantity(
             self.value, self.unit, self.display_unit, digits=digits, std=self.std
         )
@@ -194,8 +193,6 @@ class ParameterSet(Mapping[str, Parameter]):
     def replace(self, **values: float | str) -> "ParameterSet":
         """New set with some values replaced. A string value is parsed with its unit
         (``replace(M_a="1.37 mg")``) and must have the parameter's dimension."""
-        from .units import same_dimension, to_si
-
         new = dict(self._params)
         for name, v in values.items():
             p = self[name]
@@ -267,8 +264,6 @@ class ParameterSet(Mapping[str, Parameter]):
 
     def table(self) -> list[dict]:
         """Rows for reports: name, value (display unit), std, unit, fixed, doc, source."""
-        from .units import convert
-
         rows = []
         for p in self._params.values():
             u = p.display_unit or p.unit

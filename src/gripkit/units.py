@@ -17,7 +17,8 @@ import re
 
 from .errors import ParameterError
 
-__all__ = ["to_si", "si_unit", "convert", "check_unit", "format_quantity", "same_dimension"]
+__all__ = ["to_si", "si_factor", "ratio_unit", "si_unit", "convert", "check_unit",
+           "format_quantity", "same_dimension"]
 
 # Unit strings gripkit uses, spelled for pint; "1" is dimensionless.
 _ALIASES = {
@@ -76,7 +77,7 @@ _ANGLE = ("rad", "rad/s", "rad/s**2", "N*m/rad", "N*m*s/rad", "rad/V")
 
 
 @functools.lru_cache(maxsize=512)
-def _si_factor(unit: str) -> tuple[float, float, str]:
+def si_factor(unit: str) -> tuple[float, float, str]:
     """(scale, offset, si_unit_string) such that value_si = scale*value + offset."""
     ureg = _registry()
     u = _parse_unit(unit)
@@ -98,9 +99,19 @@ def _si_factor(unit: str) -> tuple[float, float, str]:
     return scale, offset, si
 
 
+def ratio_unit(num: str, den: str) -> str:
+    """The unit of a ratio: 'm' over 'V' -> 'm/V'; compound units are parenthesised ('N*s' over
+    'm' -> '(N*s)/m'); a dimensionless numerator gives '1/V', a dimensionless denominator the
+    numerator itself."""
+    if den in ("1", ""):
+        return num or "1"
+    wrap = lambda u: u if all(c not in u for c in "*/ ") else f"({u})"  # noqa: E731
+    return f"{wrap(num or '1')}/{wrap(den)}"
+
+
 def si_unit(unit: str) -> str:
     """The SI base-unit spelling of ``unit`` (``'mN*s/m'`` → ``'kg/s'``)."""
-    return _si_factor(unit)[2]
+    return si_factor(unit)[2]
 
 
 _QTY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*)$")
@@ -118,7 +129,7 @@ def to_si(quantity: str | float, unit: str | None = None) -> tuple[float, str]:
         value, unit = float(m.group(1)), (m.group(2) or (unit or "1"))
     else:
         value, unit = float(quantity), unit or "1"
-    scale, offset, si = _si_factor(unit)
+    scale, offset, si = si_factor(unit)
     return scale * value + offset, si
 
 
@@ -129,8 +140,8 @@ def convert(value: float, from_unit: str, to_unit: str) -> float:
             f"cannot convert from {from_unit!r} to {to_unit!r}: different dimensions",
             hint=f"{from_unit!r} is {si_unit(from_unit)!r} in SI, {to_unit!r} is {si_unit(to_unit)!r}",
         )
-    s1, o1, _ = _si_factor(from_unit)
-    s2, o2, _ = _si_factor(to_unit)
+    s1, o1, _ = si_factor(from_unit)
+    s2, o2, _ = si_factor(to_unit)
     return ((s1 * value + o1) - o2) / s2
 
 

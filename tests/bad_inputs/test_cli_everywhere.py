@@ -79,7 +79,7 @@ def files(tmp_path_factory):
     for k in range(2, 400):
         y[k] = 1.5 * y[k - 1] - 0.7 * y[k - 2] + u[k - 1] + 0.5 * u[k - 2]
     y += 0.01 * rng.standard_normal(400)
-    gripkit.Trajectory.uniform(100.0, u=u, y=y).save(d / "io.csv")
+    gripkit.io.save(gripkit.Trajectory.uniform(100.0, u=u, y=y), d / "io.csv")
     (d / "msd.toml").write_text(MSD)
     (d / "sweep.toml").write_text(SWEEP)
     (d / "junk.toml").write_bytes(JUNK)
@@ -171,7 +171,7 @@ def test_unreadable_toml_is_a_config_error(cli, files, monkeypatch):
 
 def test_toml_errors_in_the_python_api(files):
     from gripkit.batch import SweepSpec
-    from gripkit.sim.description import load_description
+    from gripkit.description import load_description
 
     with pytest.raises(ConfigError, match="model description .* is not UTF-8 text"):
         load_description(files / "junk.toml")
@@ -182,7 +182,7 @@ def test_toml_errors_in_the_python_api(files):
 
 
 def test_toml_with_a_byte_order_mark_is_read(tmp_path):
-    from gripkit.sim.description import load_description
+    from gripkit.description import load_description
 
     p = tmp_path / "bom.toml"
     p.write_bytes(b"\xef\xbb\xbf" + MSD.encode())
@@ -192,7 +192,7 @@ def test_toml_with_a_byte_order_mark_is_read(tmp_path):
 # output paths: checked before any work (IsADirectoryError, NotADirectoryError, bad suffix)
 
 def test_simulate_out_folder_refused_before_the_model_is_loaded(cli, files, monkeypatch):
-    import gripkit.sim.description as description
+    import gripkit.description as description
 
     monkeypatch.setattr(description, "load_description", lambda *a, **k: pytest.fail("work started"))
     res = cli("simulate", files / "msd.toml", "--out", files / "folder")
@@ -515,10 +515,10 @@ def test_version_without_package_metadata(cli, monkeypatch):
 
 @pytest.fixture(scope="module")
 def step_file(tmp_path_factory):
-    from gripkit.zoo.ftg100 import step_experiment
+    from gripkit.systems.ftg100.identification import step_experiment
 
     path = tmp_path_factory.mktemp("step") / "step.csv"
-    step_experiment(duration=0.05, seed=4).save(path)
+    gripkit.io.save(step_experiment(duration=0.05, seed=4), path)
     return path
 
 

@@ -14,8 +14,9 @@ import pytest
 from gripkit.cli import main
 from gripkit.excitation import bandlimited_noise, multisine
 from gripkit.io import load
+from gripkit.io import save
 from gripkit.sysid import identify
-from gripkit.zoo.amadeus import finger_force_model
+from gripkit.systems.amadeus.force_dynamics import finger_force_model
 
 SRC = str(Path(__file__).resolve().parents[2] / "src")
 
@@ -29,8 +30,8 @@ def data(tmp_path_factory):
     est = plant.simulate(s2.u, noise_std=0.0125, seed=1).select("current", "force")
     val = plant.simulate(np.tile(s1.u, 2), noise_std=0.0125, seed=2).select("current", "force")
     paths = {"est": d / "s2.parquet", "val": d / "s1.csv"}
-    est.save(paths["est"])
-    val.save(paths["val"])
+    save(est, paths["est"])
+    save(val, paths["val"])
     return paths
 
 

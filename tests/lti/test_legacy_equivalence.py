@@ -10,7 +10,7 @@ where the arithmetic is identical: roots of the same polynomial, sums of the sam
 import numpy as np
 import pytest
 
-from gripkit.control.finger_force import DiscretePlant
+from gripkit.control.rst import DiscretePlant
 from gripkit.lti import StateSpace, as_system
 from gripkit.sim.linear import StateSpace as OldStateSpace
 from gripkit.sim.linear import c2d_zoh

@@ -14,7 +14,7 @@ import pinocchio as pin  # a dev dependency: the cross-checks fail, never skip, 
 
 from gripkit.multibody import CoupledChain, Coupling, DHChain  # noqa: E402
 from gripkit.multibody.pinocchio import to_pinocchio  # noqa: E402
-from gripkit.zoo.dlr_hit import finger  # noqa: E402
+from gripkit.systems.dlr_hit.parameters import finger
 
 TOL = 1e-10
 

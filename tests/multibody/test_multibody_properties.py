@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from gripkit.errors import ModelError, SimulationError
 from gripkit.multibody import Coupling, CoupledChain, DHChain
-from gripkit.zoo.dlr_hit import finger
+from gripkit.systems.dlr_hit.parameters import finger
 
 
 def chain_from(seed, n, prismatic=False):

@@ -8,7 +8,7 @@ from gripkit.report import Report
 
 @pytest.mark.slow
 def test_demo_section_reproduces_the_studys_findings(tmp_path):
-    from gripkit.demos import amadeus_identification
+    from gripkit.systems.amadeus import demo_identification as amadeus_identification
 
     rep = Report("test")
     s = amadeus_identification.run(rep, quick=True)

@@ -9,7 +9,7 @@ from scipy import signal
 
 from gripkit import ModelError
 from gripkit.sysid import PolynomialModel
-from gripkit.zoo.amadeus import reference
+from gripkit.systems.amadeus.force_dynamics import reference
 
 M222 = reference("II", 2, 2, 2).model()  # Table II [2 2 2], 000_8f66dcc7ab06470c.txt
 M442 = reference("II", 4, 4, 2).model()

@@ -7,7 +7,8 @@ import pytest
 
 from gripkit.consistency import check
 from gripkit.sysid import PolynomialModel
-from gripkit.zoo.amadeus import TABLE_II, TABLE_III, finger_force_model, reference, seed_checks
+from gripkit.systems.amadeus.force_dynamics import (TABLE_II, TABLE_III, finger_force_model,
+                                                    reference, seed_checks)
 
 
 def test_table2_222_zero_is_non_minimum_phase():

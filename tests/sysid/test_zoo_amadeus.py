@@ -11,7 +11,7 @@ from gripkit import zoo
 from gripkit.errors import ConsistencyWarning
 from gripkit.excitation import multisine
 from gripkit.sysid import identify
-from gripkit.zoo.amadeus import FingerForcePlant, finger_force_model
+from gripkit.systems.amadeus.force_dynamics import FingerForcePlant, finger_force_model
 
 
 @pytest.fixture(scope="module")
@@ -29,7 +29,7 @@ def test_registry_builds_the_plant(plant):
 def test_coefficients_units_and_provenance(plant):
     """SI: B in N/A = 1000 × force_scale × the printed units-per-mA values, force_scale =
     15.45 N / (1.235 units/mA × 500 mA) = 0.02502 N/unit (Fig. 2(c) peak force over the valve span)."""
-    from gripkit.zoo.amadeus import FORCE_SCALE
+    from gripkit.systems.amadeus.force_dynamics import FORCE_SCALE
 
     assert FORCE_SCALE == pytest.approx(15.45 / (0.0326 / 0.0264 * 500), rel=1e-9)
     np.testing.assert_allclose(plant.model.A, [1.0, -1.8732, 0.8996])

@@ -23,6 +23,7 @@ import numpy as np
 
 from ..arguments import entry_point
 from ..errors import ConfigError, DataError
+from ..io import load
 from ..progress import track
 from .executors import Executor, make_executor
 
@@ -48,8 +49,6 @@ def _resolve(identifier) -> Callable:
 
 def identify_file(path: str, identifier, options: dict, load_options: dict) -> dict:
     """Load one file and identify (runs inside a worker)."""
-    from ..io import load
-
     tr = load(path, **load_options)
     res = _resolve(identifier)(tr, **options)
     if not isinstance(res, dict) or "params" not in res:

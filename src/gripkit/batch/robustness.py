@@ -26,7 +26,11 @@ import numpy as np
 
 from ..arguments import entry_point
 from ..errors import ConfigError, DataError
+from ..units import to_si
 from .montecarlo import Estimate, binned_probability, probability, quantile
+from .spec import SweepSpec
+from .store import ResultStore
+from .sweep import sweep
 
 __all__ = ["DEFAULT_POPULATION", "DEFAULT_SETTINGS", "RobustnessResult", "robustness_study", "analyse"]
 
@@ -40,7 +44,7 @@ DEFAULT_POPULATION = {
     "approach_speed": {"uniform": ["1 mm/s", "2 mm/s"]},
     "noise_std": {"uniform": ["0.5 uN", "3 uN"]},
 }
-#: the controller (:data:`gripkit.batch.grasp_tsfm.FAST_GRASP`, 200 µN) and the pass criteria
+#: the controller (:data:`gripkit.systems.tsfm.grasp_batch.FAST_GRASP`, 200 µN) and the pass criteria
 DEFAULT_SETTINGS = {"duration": 0.15, "grip_force": "200 uN", "damage_force": "250 uN",
                     "lost_displacement": "10 um", "band": 0.05}
 
@@ -81,9 +85,9 @@ class RobustnessResult:
                name: str = "batch-robustness"):
         """Add a section: the estimates as a table, histograms of the peak force and of the settling
         time, and P(damage), P(lost) against stiffness with their confidence bands."""
-        from ..report.plots import _plt
+        from ..report.plots import pyplot
 
-        plt = _plt()
+        plt = pyplot()
         sec = report.section(title, intro)
         rows = [["P(damage)", _fmt_p(self.p_damage)]]
         if self.p_lost is not None:
@@ -163,8 +167,6 @@ def analyse(columns: dict | str | Path, *, stiffness: str | None = None, bins=No
     ``settling_time``; ``lost`` when present. ``stiffness``: the column to bin by (default
     ``k_e``, or ``k0`` for the FT-G100); ``bins``: edges (default 6 log-spaced bins over its range)."""
     if isinstance(columns, (str, Path)):
-        from .store import ResultStore
-
         columns = ResultStore(columns).read()
     elif hasattr(columns, "columns") and not isinstance(columns, dict):
         columns = columns.columns
@@ -211,10 +213,6 @@ def robustness_study(population: dict | None = None, *, settings: dict | None = 
     ``[parameters]`` entries; default :data:`DEFAULT_POPULATION`) with the controller and pass
     criteria ``settings`` (the sweep's ``[scenario]`` table; default :data:`DEFAULT_SETTINGS`), and
     analyse them (:func:`analyse`). ``backend``, ``allow_code`` etc. as in :func:`gripkit.batch.sweep`."""
-    from ..units import to_si
-    from .spec import SweepSpec
-    from .sweep import sweep
-
     if n < 1:
         raise ConfigError(f"n: expected a positive number of grasps, found {n}")
     pop = dict(DEFAULT_POPULATION if population is None else population)

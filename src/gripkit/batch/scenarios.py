@@ -25,15 +25,19 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import zoo
 from ..errors import ConfigError, ConsistencyWarning, GripkitError
+from ..sim.model import Model
+from ..sysid.step_response import step_metrics
+from .spec import quantity
 
 __all__ = ["SCENARIOS", "MODELS", "Setting", "Interface", "Prepared", "read_settings", "resolve", "build_model",
-           "prepare", "step_response", "step_metrics", "ftg100_grasp"]
+           "prepare", "step_response", "step_metrics_rows", "POSITIVE_TIME", "POSITIVE_RATE", "FRACTION"]
 
 SCENARIOS: dict[str, str] = {
     "step-response": "gripkit.batch.scenarios:step_response",
-    "tsfm-grasp": "gripkit.batch.grasp_tsfm:tsfm_grasp",
-    "ftg100-grasp": "gripkit.batch.scenarios:ftg100_grasp",
+    "tsfm-grasp": "gripkit.systems.tsfm.grasp_batch:tsfm_grasp",
+    "ftg100-grasp": "gripkit.systems.ftg100.scenario:ftg100_grasp",
 }
 
 #: models a sweep may name besides the zoo's (:func:`gripkit.zoo.entries`)
@@ -54,8 +58,6 @@ class Setting:
     choices: tuple[str, ...] = ()
 
     def read(self, value, where: str):
-        from .spec import quantity
-
         if self.kind == "bool":
             if not isinstance(value, bool):
                 raise ConfigError(f"{where}: expected true or false, found {value!r}")
@@ -169,8 +171,6 @@ def build_model(ref: str | None, allow_code: bool = False):
         return None
     key = (ref, allow_code)
     if key not in _MODELS:
-        from .. import zoo
-
         zoo_names = [e.name for e in zoo.entries()]
         if ref in MODELS:
             factory = _import(MODELS[ref], f"model {ref!r}")
@@ -230,13 +230,11 @@ def prepare(spec, allow_code: bool = False) -> Prepared:
     return Prepared(fn, model, iface)
 
 
-def step_metrics(t: np.ndarray, y: np.ndarray, band: float = 0.02) -> dict[str, np.ndarray]:
+def step_metrics_rows(t: np.ndarray, y: np.ndarray, band: float = 0.02) -> dict[str, np.ndarray]:
     """Step-response metrics of each row of ``y`` (P, N) from rest: final value (mean of the last
     10 %), peak, overshoot %, 10–90 % rise time and settling time into ±``band``
     (:func:`gripkit.sysid.step_response.step_metrics` per row)."""
-    from ..sysid.step_response import step_metrics as one
-
-    rows = [one(t, yi, y_initial=0.0, band=band) for yi in np.atleast_2d(y)]
+    rows = [step_metrics(t, yi, y_initial=0.0, band=band) for yi in np.atleast_2d(y)]
     return {"final": np.array([r["y_final"] for r in rows]), "peak": np.array([r["peak"] for r in rows]),
             **{k: np.array([r[k] for r in rows]) for k in ("overshoot_percent", "rise_time", "settling_time")}}
 
@@ -248,8 +246,6 @@ _STEP_METRICS = ("final", "peak", "overshoot_percent", "rise_time", "settling_ti
 def _step_interface(model, settings: dict) -> Interface:
     """step-response: the model's parameters; fs (Hz) and duration (s) > 0 giving >= 2 samples,
     amplitude in the input's unit, input/output among the model's, band in (0, 1]."""
-    from ..sim.model import Model
-
     if not isinstance(model, Model):
         raise ConfigError("scenario 'step-response' needs a simulation model ([sweep] model = ...), found "
                           f"{type(model).__name__ if model is not None else 'none'}",
@@ -275,7 +271,7 @@ def _step_interface(model, settings: dict) -> Interface:
 
 def step_response(model, params: dict[str, np.ndarray], settings: dict) -> dict[str, np.ndarray]:
     """Step of ``amplitude`` on input ``input`` (default: the first) for ``duration`` s at ``fs`` Hz;
-    metrics of output ``output`` (default: the first), see :func:`step_metrics`. ``settings``:
+    metrics of output ``output`` (default: the first), see :func:`step_metrics_rows`. ``settings``:
     as read by :func:`_step_interface`."""
     s = _step_interface(model, settings).settings
     in_names = [x.name for x in model.inputs]
@@ -295,73 +291,7 @@ def step_response(model, params: dict[str, np.ndarray], settings: dict) -> dict[
     u = np.zeros((n, len(in_names)))
     u[:, in_names.index(inp)] = s["amplitude"]
     y = model.simulate_batch(thetas, u, 1.0 / s["fs"])[:, :, out_names.index(out)]
-    return step_metrics(np.arange(n) / s["fs"], y, s["band"])
+    return step_metrics_rows(np.arange(n) / s["fs"], y, s["band"])
 
 
 step_response.interface = _step_interface
-
-
-#: ftg100-grasp: per-job parameters and the units of the HybridForcePosition fields (its docstring)
-_FTG100_PARAMS = {"force": "N", "k0": "N/m", "gap": "m", "noise_force": "N", "noise_position": "m"}
-_HYBRID_UNITS = {"ts": "s", "kp_x": "N/m", "ki_x": "N/(m*s)", "kd_x": "N*s/m", "tf_x": "s", "kp_f": "1",
-                 "ki_f": "1/s", "kd_f": "s", "kv": "N*s/m", "tf_v": "s", "approach_speed": "m/s", "x_limit": "m",
-                 "contact_threshold": "N", "confirm": "int", "force_ramp": "s", "force_tau": "s",
-                 "k_contact": "N/m", "anti_windup": "bool", "bumpless": "bool", "lever": "1", "k1": "N/m",
-                 "k3": "N/m**3", "c_e": "N/V**2", "v_max": "V", "v_min": "V"}
-_FTG100_OPTS = {"duration": POSITIVE_TIME, "damage_threshold": Setting("N", low=0.0, strict=True),
-                "band": FRACTION, "noise_seed": Setting("int", low=0)}
-
-
-def _ftg100_interface(model, settings: dict) -> Interface:
-    from ..control.hybrid import METRICS
-    from ..models.ftg100 import FTG100Plant
-
-    if model is not None and not isinstance(model, FTG100Plant):
-        raise ConfigError(f"scenario 'ftg100-grasp' needs an FT-G100 plant, found {type(model).__name__}",
-                          hint="leave [sweep] model out (the nominal plant)")
-    schema = {**_FTG100_OPTS, **{k: Setting(u) for k, u in _HYBRID_UNITS.items()}}
-    s = read_settings(settings, schema, "ftg100-grasp")
-    _ftg100_controller(model, s)  # the controller's own checks (positive ts, v_min < v_max, ...)
-    return Interface(parameters=_FTG100_PARAMS, settings=s, metrics=METRICS, bytes_per_job=8 * (len(METRICS) + 64))
-
-
-def _ftg100_controller(model, settings: dict):
-    from ..control.hybrid import HybridForcePosition
-    from ..models.ftg100 import FTG100Plant
-
-    plant = model if model is not None else FTG100Plant(check=False)
-    gains = {k: v for k, v in settings.items() if k in _HYBRID_UNITS}
-    return plant, HybridForcePosition.for_plant(plant.parameters, **gains)
-
-
-def ftg100_grasp(model, params: dict[str, np.ndarray], settings: dict) -> dict[str, np.ndarray]:
-    """FT-G100 approach-and-grasp under the hybrid force/position controller
-    (:func:`gripkit.control.hybrid.grasp_batch`, already parallel): one grasp per job.
-
-    Parameters (per job): ``force`` (N, commanded), ``k0`` (N/m), ``gap`` (m), ``noise_force``
-    (N), ``noise_position`` (m). ``[scenario]``: ``duration`` (s, default 0.06),
-    ``damage_threshold`` (N, default 1.5 × force), ``band`` (settling band, default 0.02),
-    ``noise_seed``, and any :class:`~gripkit.control.hybrid.HybridForcePosition` field (gains,
-    approach_speed, ...). ``model``: None (the nominal plant) or an
-    :class:`~gripkit.models.ftg100.FTG100Plant` factory (``"module:factory"``, with
-    ``allow_code``). Metrics: :data:`gripkit.control.hybrid.METRICS`."""
-    from ..control.hybrid import METRICS, grasp_batch
-
-    s = _ftg100_interface(model, settings).settings
-    plant, ctrl = _ftg100_controller(model, s)
-    unknown = [k for k in params if k not in (*_FTG100_PARAMS, "job_id")]
-    if unknown:
-        raise ConfigError(f"ftg100-grasp: unknown parameters {unknown}", hint=f"allowed: {', '.join(_FTG100_PARAMS)}")
-    n = len(params["job_id"])
-    seed = np.asarray(params["job_id"], dtype=np.int64) + s.get("noise_seed", 0) * 1_000_003
-    kw = {k: params[k] for k in _FTG100_PARAMS if k in params}
-    kw.setdefault("force", 20e-6)
-    b = grasp_batch(ctrl, plant, seed=seed if n else 0, duration=s.get("duration", 0.06),
-                    damage_threshold=s.get("damage_threshold"), band=s.get("band", 0.02), progress=False, **kw)
-    if len(b) != n:
-        raise ConfigError(f"ftg100-grasp: {len(b)} results for {n} jobs")
-    return {m: b[m] for m in METRICS}
-
-
-ftg100_grasp.uses_job_id = True
-ftg100_grasp.interface = _ftg100_interface

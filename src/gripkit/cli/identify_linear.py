@@ -32,7 +32,7 @@ DETREND_CHOICES = ("mean", "linear", "none")
 
 def _check_options(fs, fill, detrend: str, validate: Path | None = None, **orders) -> None:
     """Every option of a linear identification command, checked before the data are read."""
-    from ..sysid._data import check_order
+    from ..sysid.checks import check_order
 
     check_data_options(fs, fill)
     check_choice(detrend, "--detrend", DETREND_CHOICES)
@@ -162,6 +162,7 @@ def identify_rls(data: Path = DataArg, input: str = InputOpt, output: str = Outp
                  fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                  json_out: bool = JsonOpt):
     """Recursive least squares ARX (orders na, nb, nk) with forgetting; θ and σ at every sample."""
+    from ..io import save
     from ..sysid import RLS, rls
     from .paths import output_file
 
@@ -172,7 +173,7 @@ def identify_rls(data: Path = DataArg, input: str = InputOpt, output: str = Outp
         io = _io(data, input, output, fs, time, fill, detrend, "RLS identification")
         res = rls(io.u, io.y, na, nb, nk, forgetting=forgetting, p0=p0, windup=windup, dt=io.dt)
         if trajectory is not None:
-            res.to_trajectory().save(trajectory)
+            save(res.to_trajectory(), trajectory)
     out = res.to_dict()
     out.update(data=str(data), detrend=detrend, input=input, output=output,
                trajectory=None if trajectory is None else str(trajectory), warnings=report_warnings(caught))

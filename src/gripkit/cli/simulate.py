@@ -1,5 +1,5 @@
 """``gripkit simulate MODEL.toml [--out FILE.parquet] [--json]``: simulate a model described in
-TOML (:mod:`gripkit.sim.description`) and write the trajectory (CSV, Parquet or HDF5 by suffix)."""
+TOML (:mod:`gripkit.description`) and write the trajectory (CSV, Parquet or HDF5 by suffix)."""
 
 from __future__ import annotations
 
@@ -23,7 +23,7 @@ def simulate(model: Path = typer.Argument(..., help="Model description (.toml)."
 
     from ..io import save
     from ..progress import status
-    from ..sim.description import load_description
+    from ..description import load_description
     from .paths import output_file
 
     output_file(out, "--out")

@@ -16,11 +16,11 @@ from ..progress import status
 __all__ = ["SECTIONS", "run_demo"]
 
 SECTIONS: dict[str, str] = {
-    "amadeus-identification": "gripkit.demos.amadeus_identification",
-    "amadeus-hand": "gripkit.demos.amadeus_hand",
-    "ftg100": "gripkit.demos.ftg100",
-    "tsfm": "gripkit.demos.tsfm",
-    "dlr-hit": "gripkit.demos.dlr_hit",
+    "amadeus-identification": "gripkit.systems.amadeus.demo_identification",
+    "amadeus-hand": "gripkit.systems.amadeus.demo_hand",
+    "ftg100": "gripkit.systems.ftg100.demo",
+    "tsfm": "gripkit.systems.tsfm.demo",
+    "dlr-hit": "gripkit.systems.dlr_hit.demo",
     "batch-robustness": "gripkit.demos.batch_robustness",
 }
 

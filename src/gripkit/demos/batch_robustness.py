@@ -8,12 +8,11 @@ from __future__ import annotations
 import time
 from dataclasses import asdict
 
-from ..batch.grasp_tsfm import FAST_GRASP
+from ..batch.robustness import DEFAULT_POPULATION, DEFAULT_SETTINGS, robustness_study
+from ..systems.tsfm.grasp_batch import FAST_GRASP
 
 
 def run(report, *, quick: bool = False) -> dict:
-    from ..batch.robustness import DEFAULT_POPULATION, DEFAULT_SETTINGS, robustness_study
-
     n = 120 if quick else 400
     t0 = time.perf_counter()
     hold = robustness_study(n=n, seed=1, backend="in-process", progress=False, name="demo-hold")

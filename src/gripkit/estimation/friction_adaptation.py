@@ -39,7 +39,7 @@ from ..errors import DataError, ModelError
 from ..models.friction import FrictionTable, table_arrays, table_friction
 from ..multibody.kernels import hot
 
-__all__ = ["FrictionAdapter", "AdaptationResult", "adapt_finger_friction"]
+__all__ = ["FrictionAdapter", "AdaptationResult"]
 
 
 @hot
@@ -217,31 +217,3 @@ class FrictionAdapter:
     def corrected_tables(self) -> tuple[FrictionTable, ...]:
         """The tables with the current scale applied (offsets are reported, not tabulated)."""
         return tuple(t.scaled(float(s)) for t, s in zip(self.tables, self.theta[:, 0]))
-
-
-def adapt_finger_friction(finger, trajectory, *, forgetting: float = 0.999, filter_hz: float = 10.0,
-                          v_min: float = 0.05, tables=None, adapter: FrictionAdapter | None = None):
-    """Run a :class:`FrictionAdapter` on a DLR/HIT finger log (a Trajectory with the finger's
-    PWM inputs and joint angle/velocity outputs, as :meth:`DLRFinger.simulate` returns or a real
-    log with the same channel names). The motor torque comes from eq 5.10 at the logged speed, the
-    bias torque from the multibody model, the inertia from the diagonal of M_p at the log's
-    median configuration. Returns ``(adapter, result)``."""
-    from ..models.dlr_finger import ACTUATORS
-
-    fs = trajectory.require_uniform(why="friction adaptation")
-    ch = finger.chain()
-    G = ch.coupling.matrix[:3]
-    q = np.column_stack([trajectory[j] for j in ("abd", "flex", "prox")])
-    qd = np.column_stack([trajectory[f"{j}_vel"] for j in ("abd", "flex", "prox")])
-    p = np.linalg.solve(G, q.T).T
-    pd = np.linalg.solve(G, qd.T).T
-    pwm = np.column_stack([trajectory[f"pwm_{a}"] for a in ACTUATORS])
-    tau = np.column_stack([finger.motor_torque(a, pwm[:, k], pd[:, k]) for k, a in enumerate(ACTUATORS)])
-    h = ch.bias(p, pd)
-    if adapter is None:
-        J = np.diag(ch.mass_matrix(np.median(p, axis=0)))
-        tabs = tables if tables is not None else tuple(
-            t.scaled(finger.parameters.value(f"scale_{a}")) for t, a in zip(finger.tables, ACTUATORS))
-        adapter = FrictionAdapter(tabs, J, 1.0 / fs, forgetting=forgetting, filter_hz=filter_hz,
-                                  v_min=v_min, names=ACTUATORS)
-    return adapter, adapter.update(tau, h, pd)

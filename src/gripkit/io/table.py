@@ -42,7 +42,7 @@ def split_header(header: str) -> tuple[str, str | None]:
 def _to_si(name: str, values: np.ndarray, unit: str | None) -> tuple[np.ndarray, str]:
     if unit is None:
         return values, "1"
-    from ..units import _si_factor
+    from ..units import si_factor as _si_factor
 
     try:
         scale, offset, si = _si_factor(unit)

@@ -41,7 +41,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from importlib import resources
 
 import numba
 import numpy as np
@@ -53,7 +52,7 @@ from ..params import Parameter, ParameterSet
 from ..sim.model import Model, Signal
 
 __all__ = ["coulomb_viscous", "stribeck", "table_friction", "ripple", "lugre_g", "lugre_update",
-           "lugre_force", "FrictionTable", "Stribeck", "dlr_hit_table", "FrictionDrive",
+           "lugre_force", "FrictionTable", "Stribeck", "FrictionDrive",
            "friction_drive_parameters", "table_arrays"]
 
 DEG = math.pi / 180.0
@@ -237,10 +236,11 @@ class FrictionTable:
             text = p.read_text()
         except OSError as exc:
             raise DataError(f"friction table {str(p)!r}: {exc}") from None
-        return cls._parse(text, name or p.stem, str(p), scale)
+        return cls.from_text(text, name or p.stem, str(p), scale)
 
     @classmethod
-    def _parse(cls, text: str, name: str, source: str, scale: float) -> "FrictionTable":
+    def from_text(cls, text: str, name: str, source: str, scale: float = 1.0) -> "FrictionTable":
+        """Parse ``velocity_deg_s,friction_N_m`` CSV text (``#`` lines are comments)."""
         rows = [ln for ln in text.splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
         if not rows or rows[0].replace(" ", "") != "velocity_deg_s,friction_N_m":
             raise DataError(f"{name}: expected the header 'velocity_deg_s,friction_N_m'")
@@ -255,17 +255,6 @@ class FrictionTable:
     def __repr__(self) -> str:
         return (f"FrictionTable({self.name!r}, {self.velocity.size} breakpoints "
                 f"{self.velocity[0] / DEG:.4g}..{self.velocity[-1] / DEG:.4g} deg/s, scale {self.scale:g})")
-
-
-def dlr_hit_table(joint: str, scale: float = 1.0) -> FrictionTable:
-    """Appendix G's friction table for ``'distal'`` or ``'base'`` (recovered from the extraction;
-    see the comment header of the shipped CSV files)."""
-    if joint not in ("distal", "base"):
-        raise ModelError(f"joint: expected 'distal' or 'base', found {joint!r}")
-    fname = f"dlr_hit_friction_{joint}.csv"
-    text = resources.files("gripkit.zoo").joinpath("data", fname).read_text()
-    return FrictionTable._parse(text, f"DLR/HIT II {joint} friction",
-                                f"002_ddea254371185ad3.txt, Appendix G (gripkit/zoo/data/{fname})", scale)
 
 
 def table_arrays(tables) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:

@@ -17,6 +17,7 @@ import numpy as np
 
 from ..params import Parameter, ParameterSet
 from ..sim.model import Model, Signal
+from ..units import ratio_unit
 from .mass_spring_damper import _msd_batch
 
 __all__ = ["second_order_batch", "SecondOrderSystem", "second_order_step"]
@@ -54,14 +55,6 @@ def second_order_step(t, gain: float, wn: float, zeta: float) -> np.ndarray:
     return gain * np.where(t >= 0, r, 0.0)
 
 
-def _ratio_unit(num: str, den: str) -> str:
-    """'m' over 'V' -> 'm/V'; compound units are parenthesised: 'N*s' over 'm' -> '(N*s)/m'."""
-    if den in ("1", ""):
-        return num
-    wrap = lambda u: u if all(c not in u for c in "*/ ") else f"({u})"  # noqa: E731
-    return f"{wrap(num)}/{wrap(den)}"
-
-
 class SecondOrderSystem(Model):
     """y = y₀ + K ω_n²/(s² + 2ζω_n s + ω_n²) (u − u₀), exact ZOH simulation.
 
@@ -77,7 +70,7 @@ class SecondOrderSystem(Model):
     def __init__(self, parameters: ParameterSet | None = None, *, gain: float = 1.0, wn: float = 1.0,
                  zeta: float = 0.5, y0: float = 0.0, u0: float = 0.0, input_unit: str = "1",
                  output_unit: str = "1", input_name: str = "u", output_name: str = "y", check: bool = True):
-        gunit = _ratio_unit(output_unit, input_unit)
+        gunit = ratio_unit(output_unit, input_unit)
         if parameters is None:
             parameters = ParameterSet([
                 Parameter("gain", gain, gunit, "static gain K"),

@@ -17,7 +17,8 @@ import numpy as np
 __all__ = ["measured_vs_model", "residual_correlation", "pole_zero_map", "bode", "parameter_convergence"]
 
 
-def _plt():
+def pyplot():
+    """matplotlib.pyplot on the Agg backend (imported on first use: matplotlib is heavy)."""
     import matplotlib
 
     matplotlib.use("Agg", force=False)
@@ -26,11 +27,16 @@ def _plt():
     return plt
 
 
+def subplots(*args, **kw):
+    """``pyplot().subplots(...)``: a new figure and its axes."""
+    return pyplot().subplots(*args, **kw)
+
+
 def measured_vs_model(t: np.ndarray, measured: np.ndarray, models: Mapping[str, np.ndarray], *,
                       ylabel: str = "output", title: str = "", measured_label: str = "measured",
                       extra: Mapping[str, np.ndarray] | None = None):
     """Measured output (solid) and model outputs (dashed) against time ``t`` (s)."""
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(10, 3.6))
     ax.plot(t, measured, color="0.55", lw=0.9, label=measured_label)
     for label, v in (extra or {}).items():
@@ -51,7 +57,7 @@ def residual_correlation(tests: Mapping[str, object], *, title: str = ""):
 
     ``tests`` maps a label to a :class:`gripkit.sysid.ResidualTests`.
     """
-    plt = _plt()
+    plt = pyplot()
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 3.4))
     width = 0.8 / max(len(tests), 1)
     for k, (label, rt) in enumerate(tests.items()):
@@ -78,7 +84,7 @@ def residual_correlation(tests: Mapping[str, object], *, title: str = ""):
 
 def pole_zero_map(models: Mapping[str, tuple[Sequence[complex], Sequence[complex]]], *, title: str = ""):
     """z-plane map: ``models`` maps a label to ``(poles, zeros)``."""
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(5.6, 5.2))
     th = np.linspace(0, 2 * np.pi, 400)
     ax.plot(np.cos(th), np.sin(th), color="0.4", lw=0.8)
@@ -108,7 +114,7 @@ def pole_zero_map(models: Mapping[str, tuple[Sequence[complex], Sequence[complex
 def bode(models: Mapping[str, object], *, n: int = 512, title: str = "", magnitude_unit: str = ""):
     """Magnitude (dB) and phase (deg) of models with ``frequency_response(n=...)`` (e.g.
     :class:`gripkit.sysid.PolynomialModel`), or of ``(f_Hz, H)`` pairs, up to Nyquist."""
-    plt = _plt()
+    plt = pyplot()
     fig, (am, ap) = plt.subplots(2, 1, figsize=(8, 5.6), sharex=True)
     for label, m in models.items():
         f, h = m if isinstance(m, tuple) else m.frequency_response(n=n)
@@ -129,7 +135,7 @@ def bode(models: Mapping[str, object], *, n: int = 512, title: str = "", magnitu
 def parameter_convergence(t: np.ndarray, theta: np.ndarray, std: np.ndarray, names: Sequence[str], *,
                           truth: Sequence[float] | None = None, title: str = ""):
     """One panel per parameter: estimate θ_i(t) with a ±2σ band and the true value (dashed)."""
-    plt = _plt()
+    plt = pyplot()
     p = len(names)
     ncol = 2 if p > 1 else 1
     nrow = (p + ncol - 1) // ncol

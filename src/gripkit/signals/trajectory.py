@@ -265,9 +265,3 @@ class Trajectory:
                 and all(np.array_equal(self._ch[k], other._ch[k]) for k in self._ch))
 
     __hash__ = None  # type: ignore[assignment]
-
-    def save(self, path, **kw) -> None:
-        """Write to CSV, Parquet or HDF5 (by suffix); see :func:`gripkit.io.save`."""
-        from ..io import save
-
-        save(self, path, **kw)

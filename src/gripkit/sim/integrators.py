@@ -33,8 +33,8 @@ import numpy as np
 from ..errors import ModelError
 from .steps import check_step
 
-__all__ = ["rk4_lti_step", "rk4_msd_step", "semi_implicit_msd_step", "lti_step", "zoh_levels", "expm_small",
-           "integrate_lti", "modes_of"]
+__all__ = ["rk4_lti_step", "rk4_msd_step", "semi_implicit_msd_step", "lti_step", "zoh_levels", "zoh_levels_into",
+           "expm_small", "integrate_lti", "modes_of"]
 
 
 @numba.njit(cache=True, inline="always")
@@ -191,8 +191,9 @@ def expm_small(M, out):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _zoh_levels(A, B, dt, levels, Phi, Gam):  # pragma: no cover - compiled
-    """Stacks A (P, n, n), B (P, n, m) → Phi (P, L+1, n, n), Gam (P, L+1, n, m). The full step
+def zoh_levels_into(A, B, dt, levels, Phi, Gam):  # pragma: no cover - compiled
+    """Kernel of :func:`zoh_levels`, writing into preallocated arrays (callable from other kernels):
+    stacks A (P, n, n), B (P, n, m) → Phi (P, L+1, n, n), Gam (P, L+1, n, m). The full step
     (level L, used at every sample) is one expm of the augmented matrix; the finer levels (used
     only to locate events inside a step) come from the finest one by squaring, e^{2Mh} = (e^{Mh})²."""
     P, n, m = B.shape[0], B.shape[1], B.shape[2]
@@ -247,7 +248,7 @@ def zoh_levels(A: np.ndarray, B: np.ndarray, dt: float, levels: int = 0) -> tupl
     B2 = np.ascontiguousarray(B.reshape(-1, n, m))
     Phi = np.empty((A2.shape[0], levels + 1, n, n))
     Gam = np.empty((A2.shape[0], levels + 1, n, m))
-    _zoh_levels(A2, B2, float(dt), int(levels), Phi, Gam)
+    zoh_levels_into(A2, B2, float(dt), int(levels), Phi, Gam)
     return Phi.reshape(lead + Phi.shape[1:]), Gam.reshape(lead + Gam.shape[1:])
 
 

@@ -34,7 +34,6 @@ from .validation import validate as validate
 from .greybox import GreyboxResult as GreyboxResult
 from .greybox import fit as fit_greybox
 from .bouc_wen import identify_bouc_wen as identify_bouc_wen
-from .bouc_wen import identify_finger as identify_finger
 from .modal import free_vibration as free_vibration
 from .friction import constant_velocity_friction as constant_velocity_friction
 from .friction import detect_breakaway as detect_breakaway

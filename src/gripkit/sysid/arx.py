@@ -17,8 +17,8 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 
-from ._data import check_identifiable, checked_problem
 from ._scaling import in_user_units, unit_scale
+from .checks import check_identifiable, checked_problem
 from .lagged_sums import arx_gram, arx_residuals, gram_triangle
 from .polynomial import PolynomialModel, check_meta
 from .regression import arx_regression, arx_start, qr_solve, triangular_solve

@@ -43,7 +43,9 @@ import numpy as np
 from ..arguments import entry_point
 from ..errors import DataError, IdentificationError, UnidentifiableError
 from ..models.friction import FrictionTable
+from ..signals.filters import apply_sos, butter_sos
 from ._scaling import unit_scale
+from .regression import hac_covariance
 
 __all__ = ["Pulse", "BreakawayResult", "detect_breakaway", "ConstantVelocityPoint",
            "constant_velocity_friction", "table_from_points", "StribeckFit", "fit_stribeck",
@@ -501,7 +503,6 @@ def idim_ls(position, effort, fs: float, *, effort_scale: float = 1.0, cutoff: f
     s2 = float(r @ r / (n - 4))
     # filtering, differentiation and decimation leave the residuals autocorrelated: the
     # Newey-West covariance, not s²(XᵀX)⁻¹ (which would understate σ)
-    from .regression import hac_covariance
 
     cov = hac_covariance(X, r)
     std = np.sqrt(np.diag(cov))

@@ -19,10 +19,10 @@ from __future__ import annotations
 import numpy as np
 from scipy import signal as _sig
 
-from ._data import check_identifiable, checked_problem
 from ._pem import covariance, is_stable_poly, levenberg_marquardt, stabilize
 from ._scaling import in_user_units, unit_scale
 from .arx import _arx
+from .checks import check_identifiable, checked_problem
 from .polynomial import PolynomialModel, check_meta
 from .validation import fit_percent, loss_vn
 

@@ -24,7 +24,11 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import signal as _sig
 
+from ..arguments import check_keywords, keyword_names
 from ..errors import DataError, ModelError
+from ..params import Parameter, ParameterSet
+from ..units import ratio_unit
+from .validation import validate
 
 __all__ = ["PolynomialModel"]
 
@@ -41,14 +45,6 @@ def _coeffs(x, name: str, monic: bool) -> np.ndarray:
         raise ModelError(f"{name} must start with 1 (monic polynomial), found {a[0]:g}")
     a.flags.writeable = False
     return a
-
-
-def _ratio_unit(num: str, den: str) -> str:
-    if den in ("1", ""):
-        return num or "1"
-    if num in ("1", ""):
-        return f"1/{den}"
-    return f"{num}/{den}"
 
 
 @dataclass(frozen=True, eq=False)
@@ -285,9 +281,7 @@ class PolynomialModel:
     def parameters(self):
         """The free coefficients as a :class:`~gripkit.params.ParameterSet` (SI units: ``b``
         in output unit per input unit, the others dimensionless), with their std."""
-        from ..params import Parameter, ParameterSet
-
-        bunit = _ratio_unit(self.output_unit, self.input_unit)
+        bunit = ratio_unit(self.output_unit, self.input_unit)
         std = self.theta_std
         src = self.info.get("source", f"identified ({self.label})")
         params = []
@@ -440,8 +434,6 @@ class PolynomialModel:
     def validate(self, u, y, **kw):
         """Free-run and one-step validation on a separate record; see
         :func:`gripkit.sysid.validate`."""
-        from .validation import validate
-
         return validate(self, u, y, **kw)
 
     # ------------------------------------------------------------------ exports
@@ -534,8 +526,6 @@ META_KEYS = ("input_name", "output_name", "input_unit", "output_unit", "u_offset
 def check_meta(meta: dict, fn) -> None:
     """Refuse an unknown ``**meta`` keyword of ``fn`` (arx, armax or oe) before any fitting: it
     would otherwise fail only when the model is built, after the work."""
-    from ..arguments import check_keywords, keyword_names
-
     name = fn.__name__
     check_keywords(meta, META_KEYS, f"{name}()", hint=f"{name} accepts {', '.join(keyword_names(fn))} and the "
                                                       f"metadata {', '.join(META_KEYS)}")

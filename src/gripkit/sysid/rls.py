@@ -50,7 +50,7 @@ from numba.core.errors import TypingError
 
 from ..arguments import entry_point
 from ..errors import DataError, IdentificationError
-from ._data import check_dt, check_excitation, check_io, check_order, require_samples
+from .checks import check_dt, check_excitation, check_io, check_order, require_samples
 from .polynomial import PolynomialModel
 
 __all__ = ["RLS", "RLSResult", "rls"]

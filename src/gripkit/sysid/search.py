@@ -19,8 +19,8 @@ import numpy as np
 from ..arguments import entry_point
 from ..errors import DataError, UnidentifiableError
 from ..progress import track
-from ._data import check_dt, check_identifiable, check_io, check_order
 from ._scaling import unit_scale
+from .checks import check_dt, check_identifiable, check_io, check_order
 from .regression import arx_regression, qr_solve
 
 __all__ = ["Candidate", "SearchResult", "structure_search", "parse_range"]

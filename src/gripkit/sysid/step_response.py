@@ -37,6 +37,7 @@ from ..arguments import entry_point
 from ..errors import AccuracyWarning, DataError, IdentificationError, SimulationError
 from ..models.second_order import SecondOrderSystem, second_order_step
 from ..signals.trajectory import Trajectory
+from ..units import ratio_unit
 from .greybox import GreyboxResult, fit
 
 __all__ = ["StepResponseResult", "identify_step", "step_metrics", "second_order_metrics", "STEP_METHODS"]
@@ -161,9 +162,12 @@ def step_metrics(t, y, *, t_step: float | None = None, y_initial: float | None =
 
     ``y_initial`` defaults to the mean before ``t_step`` (or y[0]); ``y_final`` to the mean of the
     last 10 % of the record (pass the command for tracking metrics). Returns ``overshoot_percent``
-    (beyond ``y_final``, relative to the step amplitude), ``peak`` and ``peak_time``, ``rise_time``
-    (10 → 90 %), ``settling_time`` (last time outside ±``band``·|amplitude| around ``y_final``; inf
-    when the record ends outside), all times measured from ``t_step`` (default t[0]).
+    (beyond ``y_final``, relative to the step amplitude), ``undershoot_percent`` (the largest
+    excursion against the step's direction, as a non-minimum-phase zero causes), ``peak`` and
+    ``peak_time``, ``rise_time`` (10 → 90 %), ``settling_time`` (last time outside
+    ±``band``·|amplitude| around ``y_final``; inf when the record ends outside),
+    ``steady_state_error_percent`` (|y(end) − y_final| relative to the amplitude), ``y_initial`` and
+    ``y_final``; all times measured from ``t_step`` (default t[0]).
     """
     t = np.asarray(t, dtype=np.float64)
     y = np.asarray(y, dtype=np.float64)
@@ -197,8 +201,10 @@ def step_metrics(t, y, *, t_step: float | None = None, y_initial: float | None =
         settling = math.inf
     else:
         settling = float(ta[outside[-1] + 1] - t0)
-    return dict(overshoot_percent=float(overshoot), peak=float(ya[ip]), peak_time=float(ta[ip] - t0),
-                rise_time=rise, settling_time=settling, y_initial=float(y_initial), y_final=float(y_final))
+    return dict(overshoot_percent=float(overshoot), undershoot_percent=max(0.0, float(-norm.min()) * 100.0),
+                peak=float(ya[ip]), peak_time=float(ta[ip] - t0), rise_time=rise, settling_time=settling,
+                steady_state_error_percent=float(abs(ya[-1] - y_final) / abs(amp) * 100.0),
+                y_initial=float(y_initial), y_final=float(y_final))
 
 
 #: least-squares methods of :func:`identify_step`
@@ -295,9 +301,8 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
         warnings.warn(f"step-response fit of {output!r}: the fitted response settles in "
                       f"{m['settling_time']:.3g} s, longer than the {data.duration:.3g} s record; the gain "
                       f"is extrapolated", AccuracyWarning, stacklevel=2)
-    from ..models.second_order import _ratio_unit
 
-    gunit = _ratio_unit(data.unit(output), data.unit(input))
+    gunit = ratio_unit(data.unit(output), data.unit(input))
     return StepResponseResult(
         gain=K, gain_std=float(std[0]), natural_frequency_hz=wn / (2 * math.pi),
         natural_frequency_hz_std=float(std[1]), damping_ratio=zeta, damping_ratio_std=float(std[2]),

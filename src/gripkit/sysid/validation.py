@@ -28,6 +28,7 @@ import numpy as np
 from scipy import stats
 
 from ..errors import DataError, StabilityWarning
+from .checks import check_io
 
 __all__ = ["fit_percent", "loss_vn", "Comparison", "compare", "ResidualTests", "residual_tests",
            "Validation", "validate"]
@@ -83,8 +84,6 @@ def compare(model, u, y, *, initial: str = "estimate") -> Comparison:
     See the module docstring for ``initial``. Warns :class:`StabilityWarning` and returns
     ``fit_percent=None`` when the model is unstable.
     """
-    from ._data import check_io
-
     u, y = check_io(u, y)
     if initial not in ("estimate", "past", "zero"):
         raise DataError(f"initial: expected 'estimate', 'past' or 'zero', found {initial!r}")
@@ -269,8 +268,6 @@ class Validation:
 def validate(model, u, y, *, initial: str = "estimate", lags: int = 25, alpha: float = 0.01) -> Validation:
     """Validate ``model`` on (u, y) (deviation units, same sampling as the estimation data):
     free-run simulation fit, one-step prediction fit, residual whiteness and independence."""
-    from ._data import check_io
-
     u, y = check_io(u, y)
     sim = compare(model, u, y, initial=initial)
     with np.errstate(over="ignore", invalid="ignore"):

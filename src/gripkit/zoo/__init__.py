@@ -1,4 +1,5 @@
-"""The four seed systems with parameters and provenance (see :mod:`gripkit.zoo.registry`)."""
+"""The zoo: a registry of the reference models of :mod:`gripkit.systems`, each a named factory with
+provenance (see :mod:`gripkit.zoo.registry`); building one imports its system on demand."""
 
 from .registry import ZooEntry as ZooEntry
 from .registry import build as build

@@ -43,36 +43,36 @@ _ENTRIES: tuple[ZooEntry, ...] = (
     ZooEntry("amadeus-finger-force", "AMADEUS subsea hand",
              "Finger force dynamics, ARX [2 2 2] LS model of Table II (9 Hz filtered data), valve "
              "current (A) to fingertip force (N) at 200 Hz, two-sample valve delay",
-             _AMADEUS, "gripkit.zoo.amadeus:finger_force_model"),
+             _AMADEUS, "gripkit.systems.amadeus.force_dynamics:finger_force_model"),
     ZooEntry("amadeus-hand", "AMADEUS subsea hand",
              "Three-bellows finger (eqs 1-8), proportional valves, six-bridge force sensor with fusion "
              "(eqs 9-19, Table I), PVDF slip sensor, Table II force dynamics in SI units",
-             _AMADEUS, "gripkit.zoo.amadeus_hand:amadeus_hand"),
+             _AMADEUS, "gripkit.systems.amadeus.parameters:amadeus_hand"),
     ZooEntry("ftg100-actuated", "FemtoTools FT-G100 microgripper",
              "Actuated subsystem linearised at 70 V with the 80 um glass ball grasped (eqs 8-10): "
              "voltage (V) to tip displacement (m), M_a, K_fa, k0 identified in §III-B",
-             _FTG, "gripkit.zoo.ftg100:actuated_model"),
+             _FTG, "gripkit.systems.ftg100.parameters:actuated_model"),
     ZooEntry("ftg100-sensing", "FemtoTools FT-G100 microgripper",
              "Sensing subsystem (eqs 14-17): gripping force (N) to sensing-arm tip deflection (m), "
              "M_b, K_fb identified in §III-D; checks the printed eq 17",
-             _FTG, "gripkit.zoo.ftg100:sensing_model"),
+             _FTG, "gripkit.systems.ftg100.parameters:sensing_model"),
     ZooEntry("ftg100-coupled", "FemtoTools FT-G100 microgripper",
              "Coupled gripper model (eq 18): voltage (V) to tip displacements, gripping force and "
              "readout voltage through the object stiffness k0",
-             _FTG, "gripkit.zoo.ftg100:coupled_model"),
+             _FTG, "gripkit.systems.ftg100.parameters:coupled_model"),
     ZooEntry("tsfm-left", "TSFM piezo microgripper", "Left finger, Table II: Bouc-Wen + D(s) actuator, lever, force "
-             "sensor (8.52 kHz, ζ = 0.006), eqs 3-13", _TSFM, "gripkit.zoo.tsfm:left_finger"),
+             "sensor (8.52 kHz, ζ = 0.006), eqs 3-13", _TSFM, "gripkit.systems.tsfm.parameters:left_finger"),
     ZooEntry("tsfm-right", "TSFM piezo microgripper", "Right finger, Table II (as tsfm-left)", _TSFM,
-             "gripkit.zoo.tsfm:right_finger"),
+             "gripkit.systems.tsfm.parameters:right_finger"),
     ZooEntry("tsfm-gripper", "TSFM piezo microgripper", "Both fingers, 400 µm gap, a 300 µm micropart of Table III "
-             "stiffness; hybrid contacts", _TSFM, "gripkit.zoo.tsfm:gripper"),
+             "stiffness; hybrid contacts", _TSFM, "gripkit.systems.tsfm.parameters:gripper"),
     ZooEntry("dlr-hit-finger", "DLR/HIT Hand II",
              "Modular finger of ch. 7: PWM → BLDC motor (eq 5.10) → belts and harmonic drive → "
              "Appendix G friction with stick-slip → coupled Newton-Euler dynamics",
-             _DLR, "gripkit.zoo.dlr_hit:finger"),
+             _DLR, "gripkit.systems.dlr_hit.parameters:finger"),
     ZooEntry("dlr-hit-hand", "DLR/HIT Hand II",
              "Five identical fingers on a palm, thumb fixed, per-finger friction (§3.1, §6.3)",
-             _DLR, "gripkit.zoo.dlr_hit:hand"),
+             _DLR, "gripkit.systems.dlr_hit.hand:hand"),
 )
 
 

@@ -1,0 +1,249 @@
+"""Demo section: the AMADEUS finger-force identification study (``000_8f66dcc7ab06470c.txt`` §V)
+repeated on simulated data.
+
+The "true finger" is the zoo plant (Table II ``[2 2 2]``, SI units, see
+:mod:`gripkit.systems.amadeus.force_dynamics`), driven by the paper's excitations S1 (multisine 1–10 Hz, 400 samples)
+and S2 (band-limited noise 0.3–10 Hz, 4000 samples) between 600 and 1100 mA, with white
+measurement noise on the force. Three ways of processing the data are compared:
+
+* ``raw``: no filter;
+* ``filtered y`` (the paper's §V-E): the 9 Hz Butterworth on the force only, not part of the
+  model structure;
+* ``prefiltered u, y``: the same filter on input and output (Ljung, §14.4), which keeps the
+  input-output relation and removes noise above the finger's bandwidth.
+
+LS over Table II's structures and RLS over Table III's, validation on the other record, the zeros
+of ``[2 2 2]`` (non-minimum phase) and ``[2 2 10]``, and an output-error fit that removes the ARX
+noise bias.
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+
+import numpy as np
+from ...consistency import ConsistencyReport, check
+from ...excitation import bandlimited_noise, multisine
+from ...signals.filters import apply_sos
+from ...sysid import arx, oe, rls
+from .force_dynamics import (FORCE_SCALE, FS, TABLE_II, TABLE_III,
+                             finger_force_model as build_plant, reference, seed_checks)
+
+__all__ = ["run", "NOISE_UNITS"]
+
+NOISE_UNITS = 20.0  # force-sensor units: white measurement noise (≈ 7 % of the S1 force RMS)
+STRUCT_II = [(1, 1, 2), (2, 2, 2), (3, 2, 2), (4, 4, 2), (2, 2, 10)]
+VARIANTS = ("raw", "filtered y", "prefiltered u, y")
+
+
+def _zero_and_std(model) -> tuple[float, float]:
+    """The single zero −b_{nk+1}/b_nk of an nb = 2 model and its σ (first-order propagation)."""
+    b0, b1 = model.B[model.nk], model.B[model.nk + 1]
+    z = -b1 / b0
+    i = model.parameter_names.index(f"b{model.nk}")
+    g = np.zeros(model.n_params)
+    g[i] = b1 / b0 ** 2
+    g[i + 1] = -1.0 / b0
+    return float(z), float(np.sqrt(g @ model.covariance @ g))
+
+
+def _fmt_pm(v, s) -> str:
+    return f"{v:.4g} ± {s:.2g}"
+
+
+def run(report, *, quick: bool = False) -> dict:
+    """Add the section to ``report``; returns the summary numbers. The records are the paper's
+    (400 and 4000 samples), so the section takes a few seconds once numba's RLS kernel is compiled
+    (about 10 s the first time); ``quick`` changes nothing."""
+    from ...report import plots
+
+    t_start = time.perf_counter()
+    plant = build_plant()
+    truth = plant.model
+    sos = plant.prefilter_sos()
+    s1 = multisine(range(1, 11), 2.0, FS, operating_point=0.850, limits=(0.600, 1.100), unit="A")
+    s2 = bandlimited_noise(0.3, 10.0, 20.0, FS, operating_point=0.850, limits=(0.600, 1.100), seed=7, unit="A")
+    noise_std = NOISE_UNITS * FORCE_SCALE  # N
+    rec = {"S1": plant.simulate(s1.u, noise_std=noise_std, seed=1),
+           "S2": plant.simulate(s2.u, noise_std=noise_std, seed=2)}
+    other = {"S1": "S2", "S2": "S1"}
+
+    def signals(name: str, variant: str):
+        tr = rec[name]
+        u = tr["current"] - plant.operating_point
+        y = tr["force"]
+        if variant == "filtered y":
+            y = apply_sos(sos, y)
+        elif variant == "prefiltered u, y":
+            u, y = apply_sos(sos, u), apply_sos(sos, y)
+        return u, y
+
+    sec = report.section(
+        "AMADEUS finger force identification (§V)",
+        "The study of §V of 000_8f66dcc7ab06470c.txt on simulated data. True finger: the Table II "
+        "[2 2 2] model (valve current deviation from 850 mA in A → force in N; the seed prints B in sensor "
+        f"units per mA and gives no force unit: gripkit assumes {FORCE_SCALE:.4f} N per unit, from the "
+        "15.45 N peak force of Fig. 2(c) over the 500 mA valve span). Excitations as in §V-E: S1, a "
+        "1–10 Hz multisine, 400 samples at 200 Hz (crest factor "
+        f"{s1.crest_factor:.2f}); S2, band-limited noise 0.3–10 Hz, 4000 samples; both between 600 and "
+        f"1100 mA. White measurement noise of {noise_std:.3g} N ({NOISE_UNITS:g} sensor units) on the force. Three processings: raw; "
+        "'filtered y', the paper's 9 Hz Butterworth on the force only (§V-E, not part of the model); and "
+        "'prefiltered u, y', the same filter on input and output, which keeps the input-output relation.")
+
+    # ---- LS over Table II's structures --------------------------------------------------------
+    fits: dict[tuple, object] = {}
+    rows = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # validation of poor raw models is reported in the table
+        for name in ("S1", "S2"):
+            for st in STRUCT_II:
+                row = [f"[{st[0]} {st[1]} {st[2]}]", name]
+                for var in VARIANTS:
+                    u, y = signals(name, var)
+                    m = arx(u, y, *st, fs=FS, input_name="current", output_name="force",
+                            input_unit="A", output_unit="N")
+                    fits[(name, st, var)] = m
+                    row.append(m.loss / FORCE_SCALE**2)
+                uv, yv = signals(other[name], "prefiltered u, y")
+                val = fits[(name, st, "prefiltered u, y")].validate(uv, yv)
+                row.append("—" if val.fit_percent is None else f"{val.fit_percent:.1f}")
+                paper = [r for r in TABLE_II if (r.na, r.nb, r.nk, r.data) == (*st, name)]
+                row.append(paper[0].loss if paper else "—")
+                rows.append(row)
+    sec.table(["structure", "data", "V_N raw", "V_N filtered y (§V-E)", "V_N prefiltered u, y",
+               "free-run fit % on the other record (prefiltered)", "Table II V_N"], rows,
+              caption="LS (QR) over the structures of Table II. Loss V_N of eq (29) on the estimation record, "
+                      "in the seed's force-sensor units² (V_N in N² divided by force_scale²).")
+    winners = {}
+    for var in VARIANTS:
+        best = min(STRUCT_II, key=lambda st: fits[("S1", st, var)].loss)
+        best_aic = min(STRUCT_II, key=lambda st: fits[("S1", st, var)].aic)
+        winners[var] = (best, best_aic)
+    wl = winners["filtered y"][0]
+    ratio = {v: fits[("S1", (2, 2, 2), v)].loss / fits[("S1", (4, 4, 2), v)].loss for v in VARIANTS}
+    sec.text(
+        "Which structure wins (S1): on loss, "
+        + ", ".join(f"{v} {list(w[0])}" for v, w in winners.items()) + "; on AIC, "
+        + ", ".join(f"{v} {list(w[1])}" for v, w in winners.items())
+        + ". As in Table II, more coefficients always lower the loss. The loss ratio [2 2 2]/[4 4 2] is "
+        + ", ".join(f"{ratio[v]:.3g} ({v})" for v in VARIANTS)
+        + ": with the force filtered but not the input (the paper's procedure) the model must also "
+        "describe the filter's two poles, which only the higher orders can. That the largest structure "
+        "also wins on AIC does not make the finger fourth order: the true plant here is [2 2 2], but an "
+        "ARX model's noise model 1/A cannot describe measurement noise, so extra coefficients absorb its "
+        "colour. The [2 2 2] model on prefiltered data and the output-error model below recover the "
+        "true coefficients.")
+
+    # ---- zeros: non-minimum-phase [2 2 2], minimum-phase [2 2 10] ------------------------------
+    zrows = []
+    zsum = {}
+    for name in ("S1", "S2"):
+        for st in [(2, 2, 2), (2, 2, 10)]:
+            m = fits[(name, st, "prefiltered u, y")]
+            z, zs = _zero_and_std(m)
+            zsum[(name, st)] = (z, zs)
+            zrows.append([f"[{st[0]} {st[1]} {st[2]}]", name, _fmt_pm(z, zs),
+                          "minimum phase" if abs(z) < 1 else "NON-minimum phase"])
+    for r in (reference("II", 2, 2, 2), reference("II", 2, 2, 10)):
+        z = float(r.model().zeros()[0].real)
+        zrows.append([r.label, "Table II (paper, S1)", f"{z:.4g}", "minimum phase" if abs(z) < 1 else "NON-minimum phase"])
+    zrows.append(["[2 2 2]", "true plant", f"{truth.zeros()[0].real:.4g}", "NON-minimum phase"])
+    sec.table(["structure", "estimated on", "zero z (±σ)", "phase"], zrows,
+              caption="Zeros of B(z) (prefiltered u, y). σ by first-order propagation of the parameter covariance.")
+    sec.text("§V-F: the [2 2 2] model is non-minimum phase (zero outside the unit circle, so pole-zero "
+             "cancelling controllers are risky), while the model with a ten-sample delay has its zero "
+             "inside. On the simulated finger the [2 2 2] estimate recovers the true zero at z = 1.167 "
+             "within its σ; the [2 2 10] model, which has the wrong delay for this plant, again puts its "
+             "zero inside the unit circle.")
+    m222 = fits[("S2", (2, 2, 2), "prefiltered u, y")]
+    m2210 = fits[("S2", (2, 2, 10), "prefiltered u, y")]
+    r222, r2210 = reference("II", 2, 2, 2).model(), reference("II", 2, 2, 10).model()
+    sec.figure(plots.pole_zero_map({"[2 2 2] estimated (S2)": (m222.poles(), m222.zeros()),
+                                    "[2 2 10] estimated (S2)": (m2210.poles(), m2210.zeros()),
+                                    "[2 2 2] Table II": (r222.poles(), r222.zeros()),
+                                    "[2 2 10] Table II": (r2210.poles(), r2210.zeros())},
+                                   title="Pole-zero map (cf. Figs. 20b and 21b)"),
+               "Poles (×) and zeros (○): the [2 2 2] zero lies outside the unit circle, the [2 2 10] zero inside.",
+               name="amadeus-pole-zero")
+
+    # ---- output error removes the ARX bias; residual tests ----------------------------------
+    u2, y2 = signals("S2", "raw")
+    moe = oe(u2, y2, 2, 2, 2, fs=FS, input_name="current", output_name="force", input_unit="A", output_unit="N")
+    marx = fits[("S2", (2, 2, 2), "raw")]
+    names = ["a1 / f1", "a2 / f2", "b2 [N/mA]", "b3 [N/mA]"]
+    scale = np.array([1, 1, 1e-3, 1e-3])
+    tr_theta = truth.theta * scale
+    prow = []
+    for i, n in enumerate(names):
+        prow.append([n, f"{tr_theta[i]:.4g}",
+                     _fmt_pm(marx.theta[i] * scale[i], marx.theta_std[i] * scale[i]),
+                     _fmt_pm(m222.theta[i] * scale[i], m222.theta_std[i] * scale[i]),
+                     _fmt_pm(moe.theta[[2, 3, 0, 1][i]] * scale[i], moe.theta_std[[2, 3, 0, 1][i]] * scale[i])])
+    sec.table(["parameter", "true", "ARX raw (S2)", "ARX prefiltered (S2)", "OE raw (S2)"], prow,
+              caption="[2 2 2] estimates ± σ. Output (measurement) noise biases ARX; the output-error "
+                      "model is consistent for it.")
+    u1r, y1r = signals("S1", "raw")
+    val_arx = marx.validate(u1r, y1r)
+    val_oe = moe.validate(u1r, y1r)
+    sec.figure(plots.residual_correlation({"ARX [2 2 2]": val_arx.tests, "OE [2 2 2]": val_oe.tests},
+                                          title="Residual tests on the S1 record (models estimated on S2, raw data)"),
+               "Residual autocorrelation and input-residual cross-correlation with 99 % bands: the ARX "
+               "residuals (equation error under output noise) are coloured and correlated with the input; "
+               "the OE residuals pass.", name="amadeus-residuals")
+    t = rec["S1"].t
+    sec.figure(plots.measured_vs_model(
+        t, y1r, {f"OE [2 2 2] free run (fit {val_oe.fit_percent:.1f} %)": val_oe.simulation.y_sim,
+                 f"ARX [2 2 2] free run (fit {val_arx.fit_percent:.1f} %)": val_arx.simulation.y_sim},
+        extra={"noise-free force": rec["S1"]["force_true"]}, ylabel="force deviation [N]",
+        title="Measured and modelled force on S1 (models estimated on S2; initial conditions estimated)"),
+        "Measured (grey) and modelled (dashed) force, cf. Figs. 19–22.", name="amadeus-measured-vs-model")
+    sec.figure(plots.bode({"true plant [2 2 2]": truth, "OE [2 2 2] raw": moe, "ARX [2 2 2] raw": marx,
+                           "ARX [2 2 2] prefiltered": m222, "ARX [4 4 2] filtered y": fits[("S2", (4, 4, 2), "filtered y")],
+                           "9 Hz prefilter (×1000)": _scaled_filter(plant, 1000.0)},
+                          title="Frequency responses (current → force)", magnitude_unit="re 1 N/A"),
+               "Bode plot: the [4 4 2] model of the force-only filtered data contains the filter's roll-off.",
+               name="amadeus-bode")
+
+    # ---- RLS over Table III's structures --------------------------------------------------------
+    rrows = []
+    for ref in TABLE_III:
+        var = "prefiltered u, y" if ref.filtered else "raw"
+        u, y = signals("S1", var)
+        res = rls(u, y, ref.na, ref.nb, ref.nk, forgetting=1.0, p0=1e6, fs=FS)
+        bscale = 1e-3 / FORCE_SCALE  # N/A -> sensor units per mA, the seed's scale
+        th = ", ".join(_fmt_pm(v * (1 if n[0] == "a" else bscale), s * (1 if n[0] == "a" else bscale))
+                       for n, v, s in zip(res.names, res.theta_final, res.theta_std_final))
+        rrows.append([ref.label, "9 Hz" if ref.filtered else "no", th, res.loss / FORCE_SCALE**2, ref.loss])
+    sec.table(["structure", "filter", "final θ ± σ (b in sensor units/mA, as Table III)",
+               "V_N (a-priori errors, units²)", "Table III V_N"],
+              rrows, caption="RLS (λ = 1, P0 = 10⁶·I) over the structures of Table III on S1 (400 samples).")
+    u, y = signals("S2", "prefiltered u, y")
+    res = rls(u, y, 2, 2, 2, forgetting=1.0, p0=1e6, fs=FS)
+    sc = np.array([1, 1, 1e-3, 1e-3])
+    sec.figure(plots.parameter_convergence(rec["S2"].t, res.theta * sc, res.theta_std * sc,
+                                           ["a1", "a2", "b2 [N/mA]", "b3 [N/mA]"], truth=truth.theta * sc,
+                                           title="RLS [2 2 2] on S2 (prefiltered): convergence with ±2σ"),
+               "Recursive estimates with ±2σ bands and the true values (dashed).", name="amadeus-rls-convergence")
+
+    # ---- consistency of the seed's statements ------------------------------------------------
+
+    sec.findings(check(plant))
+    sec.findings(ConsistencyReport(seed_checks(), "AMADEUS Tables II/III (§V-F statements)"))
+
+    z222, z222s = zsum[("S2", (2, 2, 2))]
+    z2210, _ = zsum[("S2", (2, 2, 10))]
+    return {"winner_on_loss_filtered_y": list(wl),
+            "winner_on_aic_prefiltered": list(winners["prefiltered u, y"][1]),
+            "zero_222": z222, "zero_222_std": z222s, "non_minimum_phase_222": bool(abs(z222) > 1),
+            "zero_2210": z2210, "minimum_phase_2210": bool(abs(z2210) < 1),
+            "oe_validation_fit_percent": val_oe.fit_percent, "arx_validation_fit_percent": val_arx.fit_percent,
+            "seconds": round(time.perf_counter() - t_start, 2)}
+
+
+def _scaled_filter(plant, gain: float):
+    from scipy import signal as sig
+
+    b, a = sig.sos2tf(plant.prefilter_sos())
+    f, h = sig.freqz(b, a, worN=512, fs=plant.fs)
+    return f, gain * h

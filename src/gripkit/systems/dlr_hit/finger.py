@@ -1,0 +1,932 @@
+"""The complete DLR/HIT Hand II finger (``002_ddea254371185ad3.txt`` chapter 7, Fig. 7.1):
+PWM → BLDC motor → transmission → friction → coupled multibody dynamics, with the velocity fed
+back into the motor and friction models, and compliant end stops.
+
+Coordinates. Three actuators (base motor 1, base motor 2, proximal/distal motor) with output
+angles p = (p₁, p₂, p₃) drive the four DH joints q = (θ₁ abduction, θ₂ flexion, θ₃ proximal,
+θ₄ distal) through q = Γ p: the bevel-gear differential maps the two base motors at ±45° onto
+abduction and flexion (Fig. 7.2) and the distal joint follows the proximal one (θ₄ = θ₃), see
+:mod:`gripkit.multibody.coupling`. Each actuator k sees
+
+    M_p(p) p̈ = τ_m,k(PWM_k, N_k ṗ_k, T_k) + τ_stop + τ_ext − h_p(p, ṗ) − F_k(ṗ_k, p_k)
+
+with M_p = Γᵀ M Γ + diag(I_m N_k²) (Appendix A), τ_m the motor torque of eq 5.10 (Appendix E's
+guard, PWM clipped to ±4096) through the reduction N_k (208.3 distal, 234.3 base; optional
+efficiency), h_p the Coriolis/centrifugal and gravity torques, and F_k friction:
+
+* ``friction='table'`` (the thesis's model): Appendix G's lookup tables, the base table scaled by
+  a correction factor for base joint 2 (§6.3, §7), stiction 0.36 N·m (Appendix F) with Karnopp
+  stick-slip solved jointly for the coupled actuators (a stuck actuator is a constraint p̈_k = 0;
+  it breaks away when its holding torque exceeds its stiction);
+* ``friction='stribeck'``: eq 6.5 per actuator plus a cubic velocity term (the harmonic-drive
+  friction model of [50] quoted in §3.2.2), with the same stiction logic;
+* ``friction='lugre'``: LuGre per actuator (no state machine; moves by a pre-sliding
+  displacement under loads below stiction);
+* ``friction='none'``: frictionless (energy-conservation studies).
+
+An optional harmonic-drive ripple A·sin(k·p)·sign(ṗ) adds to F (§3.2.2).
+
+End stops. The thesis's Simulink model zeroes the velocity at the end of the movement range and
+notes that "the real finger has a high negative slope ... a result of the elasticity of the belts"
+with "resilience ... after the braking" (§7.1). gripkit models that elasticity: beyond a joint
+limit a one-sided spring-damper (k_stop, d_stop) acts on the joint; with the rotors' reflected
+inertia it brakes the finger within tens of milliseconds and lets it bounce back.
+
+Motor temperature. By default the winding stays at T_ref, where eq 5.10 holds (the thesis assumes
+the operating temperature, §5.4.3); ``thermal=True`` integrates each motor's first-order thermal
+model (:mod:`gripkit.models.bldc`) from the initial temperature in the state.
+
+Integration. Fixed steps (``substeps`` per sample): semi-implicit Euler (default; one
+force evaluation per step, ≥ 1000× real time at 1 kHz) or RK4 (``integrator='rk4'``) with the
+stick/slip set held over a step and events detected at step boundaries.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+from numba import prange
+
+from ...errors import ModelError, SimulationError
+from ...models.bldc import BLDCMotor, bldc_torque, motor_heat_step, temperature_factor
+from ...models.friction import (FrictionTable, Stribeck, lugre_force, lugre_update, ripple,
+                                stribeck, table_arrays, table_friction)
+from ...models.transmission import transmit_torque
+from ...multibody.coupling import CoupledChain, Coupling, differential_matrix
+from ...multibody.dh import DHChain
+from ...multibody.kernels import (WORK_PER_LINK, chain_links, cholesky_solve, coupled_mass_bias,
+                                  frames_into, hot, joints_from_actuators, point_jacobian,
+                                  rnea_pass)
+from ...params import ParameterSet
+from ...sim.model import Model, Signal
+
+__all__ = ["FINGER_PARAMETERS", "ACTUATORS", "JOINTS", "FRICTION_MODES", "DLRFinger",
+           "finger_step", "finger_step_rk4", "finger_setup", "finger_context", "finger_run",
+           "finger_loop", "run_open_loop"]
+
+#: parameter names in kernel order (see gripkit.systems.dlr_hit.parameters.thesis_finger_parameters for meaning/units)
+FINGER_PARAMETERS = (
+    "l1", "l2", "l3", "m1", "m2", "m3",
+    "pc1_x", "pc1_y", "pc1_z", "pc2_x", "pc2_y", "pc2_z", "pc3_x", "pc3_y", "pc3_z",
+    "I1_xx", "I1_yy", "I1_zz", "I2_xx", "I2_yy", "I2_zz", "I3_xx", "I3_yy", "I3_zz",
+    "I_m", "beta", "g_x", "g_y", "g_z",
+    "N_hd", "N_belt", "N_belt_base", "eta",
+    "c_pwm", "b_pwm", "b_0", "pwm_max", "T_ref", "T_amb", "alpha_R", "k_t", "R_0", "R_th", "C_th",
+    "fs_base1", "fs_base2", "fs_distal", "scale_base1", "scale_base2", "scale_distal",
+    "fc_base1", "fc_base2", "fc_distal", "visc_base1", "visc_base2", "visc_distal",
+    "cubic_base1", "cubic_base2", "cubic_distal", "v_s", "delta", "sigma0", "sigma1", "ripple_amp", "ripple_cycles", "v_stick",
+    "abd_min", "abd_max", "flex_min", "flex_max", "prox_min", "prox_max", "k_stop", "d_stop",
+)
+_I = {n: i for i, n in enumerate(FINGER_PARAMETERS)}
+NTH = len(FINGER_PARAMETERS)
+ACTUATORS = ("base1", "base2", "distal")
+JOINTS = ("abd", "flex", "prox")
+FRICTION_MODES = {"table": 0, "stribeck": 1, "lugre": 2, "none": 3}
+INTEGRATORS = {"semi-implicit": 0, "rk4": 1}
+
+# indices as module constants (numba treats globals as compile-time constants)
+I_L1 = _I["l1"]
+I_M1 = _I["m1"]
+I_PC1 = _I["pc1_x"]
+I_IN1 = _I["I1_xx"]
+I_IM = _I["I_m"]
+I_BETA = _I["beta"]
+I_GX = _I["g_x"]
+I_NHD = _I["N_hd"]
+I_NB = _I["N_belt"]
+I_NBB = _I["N_belt_base"]
+I_ETA = _I["eta"]
+I_C = _I["c_pwm"]
+I_B1 = _I["b_pwm"]
+I_B0 = _I["b_0"]
+I_PMAX = _I["pwm_max"]
+I_TREF = _I["T_ref"]
+I_TAMB = _I["T_amb"]
+I_ALPHA = _I["alpha_R"]
+I_KT = _I["k_t"]
+I_R0 = _I["R_0"]
+I_RTH = _I["R_th"]
+I_CTH = _I["C_th"]
+I_FS = _I["fs_base1"]
+I_SCALE = _I["scale_base1"]
+I_FC = _I["fc_base1"]
+I_VISC = _I["visc_base1"]
+I_CUB = _I["cubic_base1"]
+I_VS = _I["v_s"]
+I_DELTA = _I["delta"]
+I_S0 = _I["sigma0"]
+I_S1 = _I["sigma1"]
+I_RA = _I["ripple_amp"]
+I_RC = _I["ripple_cycles"]
+I_VST = _I["v_stick"]
+I_LIM = _I["abd_min"]
+I_KS = _I["k_stop"]
+I_DS = _I["d_stop"]
+
+# state layout: p(3) pd(3) T(3) z(3) stuck(3)
+NX = 15
+
+
+@hot
+def finger_setup(th, dh, mass, com, inertia, G, arm_p, grav, ratio):  # pragma: no cover - compiled
+    """Fill the chain, coupling and drive arrays of one finger from its parameter vector."""
+    for k in range(4):
+        for j in range(4):
+            dh[k, j] = 0.0
+        dh[k, 4] = 1.0  # cos α
+        dh[k, 5] = 0.0  # sin α
+        mass[k] = 0.0
+        for j in range(3):
+            com[k, j] = 0.0
+        for j in range(6):
+            inertia[k, j] = 0.0
+    dh[1, 0] = -0.5 * math.pi  # α1 = −90°: flexion axis ⟂ abduction axis (Appendix A, Rx(−90°))
+    dh[1, 4] = 0.0
+    dh[1, 5] = -1.0
+    dh[2, 1] = th[I_L1]  # a2 = l1
+    dh[3, 1] = th[I_L1 + 1]  # a3 = l2
+    for k in range(3):
+        mass[k + 1] = th[I_M1 + k]
+        for j in range(3):
+            com[k + 1, j] = th[I_PC1 + 3 * k + j]
+            inertia[k + 1, j] = th[I_IN1 + 3 * k + j]
+    # Γ (4×3, row-major): differential on (abd, flex) × (base1, base2), θ3 = θ4 = p3
+    b = th[I_BETA]
+    a00 = math.sin(-b)
+    a01 = math.sin(b)
+    a10 = math.cos(-b)
+    a11 = math.cos(b)
+    det = a00 * a11 - a01 * a10
+    # Γ = A^{-T}: inv(A) = [[a11, -a01], [-a10, a00]]/det, transposed
+    for k in range(12):
+        G[k] = 0.0
+    G[0] = a11 / det
+    G[1] = -a10 / det
+    G[3] = -a01 / det
+    G[4] = a00 / det
+    G[8] = 1.0
+    G[11] = 1.0
+    nd = th[I_NHD] * th[I_NB]
+    nb = nd * th[I_NBB]
+    ratio[0] = nb
+    ratio[1] = nb
+    ratio[2] = nd
+    for k in range(3):
+        arm_p[k] = th[I_IM] * ratio[k] * ratio[k]
+        grav[k] = th[I_GX + k]
+
+
+@hot
+def _kinetic(th, k, v, p, mode, tv, tf, tn, tipos):  # pragma: no cover - compiled
+    """Kinetic friction of actuator k at velocity v (never 0 for v ≠ 0)."""
+    if mode == 0:
+        f = th[I_SCALE + k] * table_friction(v, tv[k], tf[k], tn[k], tipos[k])
+    else:
+        f = (stribeck(v, th[I_FC + k], th[I_FS + k], th[I_VS], th[I_DELTA], th[I_VISC + k])
+             + th[I_CUB + k] * v * v * v)
+    return f + ripple(p, v, th[I_RA], th[I_RC], 0.0)
+
+
+@hot
+def _forces(th, n_stuck_iter, mode, thermal, dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav,
+            ratio, tv, tf, tn, tipos, p, pd, T, z, stuck, pwm, ext, acc, taum, tshaft, fric,
+            R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, Ms, xs, rs, dirn):  # pragma: no cover
+    """Accelerations ``acc`` for the state (p, ṗ) with the stuck set ``stuck``; fills motor
+    torques (output side and shaft) and friction. With ``n_stuck_iter > 0`` actuators at rest are
+    flagged and those whose holding torque exceeds stiction are released (the flags change in
+    place, ``dirn`` records the breakaway direction); ``n_stuck_iter = 0`` keeps the set frozen
+    (RK4 stages)."""
+    m = 3
+    joints_from_actuators(4, m, G, q0, p, q)
+    joints_from_actuators(4, m, G, zq, pd, qd)
+    chain_links(4, dh, jt, q, R, P)
+    coupled_mass_bias(4, m, R, P, jt, mass, com, inertia, armq, G, arm_p, qd, grav[0], grav[1],
+                      grav[2], Mp, hp, zq, Mq, tau, work)
+    # motors through the transmissions
+    for k in range(m):
+        rho = 1.0
+        if thermal:
+            rho = temperature_factor(T[k], th[I_TREF], th[I_TAMB], th[I_ALPHA])
+        ts = bldc_torque(pwm[k], ratio[k] * pd[k], th[I_C], th[I_B1], th[I_B0], th[I_PMAX], rho)
+        tshaft[k] = ts
+        taum[k] = transmit_torque(ts, pd[k], ratio[k], th[I_ETA])
+    # applied torque on each actuator (before friction): motor + end stops + external − bias
+    for k in range(m):
+        rhs[k] = taum[k] + ext[k] - hp[k]
+    ks = th[I_KS]
+    ds = th[I_DS]
+    for j in range(3):  # joint limits on θ1, θ2, θ3 (θ4 = θ3)
+        lo = th[I_LIM + 2 * j]
+        hi = th[I_LIM + 2 * j + 1]
+        ts = 0.0
+        if q[j] > hi:
+            ts = -ks * (q[j] - hi) - ds * qd[j]
+            if ts > 0.0:
+                ts = 0.0
+        elif q[j] < lo:
+            ts = ks * (lo - q[j]) - ds * qd[j]
+            if ts < 0.0:
+                ts = 0.0
+        if ts != 0.0:
+            for k in range(m):
+                rhs[k] += G[j * m + k] * ts
+    if mode >= 2:
+        for k in range(m):
+            if mode == 2:
+                f = lugre_force(z[k], pd[k], th[I_FC + k], th[I_FS + k], th[I_VS], th[I_S0],
+                                th[I_S1], th[I_VISC + k]) + ripple(p[k], pd[k], th[I_RA], th[I_RC], 0.0)
+            else:
+                f = 0.0
+            fric[k] = f
+            rs[k] = rhs[k] - f
+        return cholesky_solve(m, Mp, rs, acc, L)
+    # Karnopp: actuators at rest (flagged, or exactly zero velocity) are constraints
+    frozen = n_stuck_iter == 0
+    if not frozen:
+        for k in range(m):
+            dirn[k] = 0.0
+            if pd[k] == 0.0:
+                stuck[k] = 1.0
+            elif stuck[k] != 0.0:
+                stuck[k] = 0.0
+    for _ in range(max(n_stuck_iter, 1)):
+        # solve the free subsystem
+        nf = 0
+        for k in range(m):
+            if stuck[k] == 0.0:
+                v = pd[k]
+                if v == 0.0:
+                    v = dirn[k] * 1e-300
+                fric[k] = _kinetic(th, k, v, p[k], mode, tv, tf, tn, tipos)
+        for i in range(m):
+            if stuck[i] != 0.0:
+                continue
+            ni = 0
+            for j in range(m):
+                if stuck[j] == 0.0:
+                    Ms[nf, ni] = Mp[i, j]
+                    ni += 1
+            rs[nf] = rhs[i] - fric[i]
+            nf += 1
+        if nf > 0:
+            if not cholesky_solve(nf, Ms, rs, xs, L):
+                return False
+        c = 0
+        for k in range(m):
+            if stuck[k] == 0.0:
+                acc[k] = xs[c]
+                c += 1
+            else:
+                acc[k] = 0.0
+        # holding torque of each stuck actuator; release the one that exceeds stiction most
+        worst = -1
+        excess = 1.0
+        for k in range(m):
+            if stuck[k] == 0.0:
+                continue
+            lam = rhs[k]
+            for j in range(m):
+                if stuck[j] == 0.0:
+                    lam -= Mp[k, j] * acc[j]
+            fric[k] = lam
+            fs = th[I_FS + k]
+            r = abs(lam) / fs if fs > 0.0 else (math.inf if lam != 0.0 else 0.0)
+            if r > excess:
+                excess = r
+                worst = k
+        if worst < 0 or frozen:
+            return True
+        stuck[worst] = 0.0
+        dirn[worst] = 1.0 if fric[worst] > 0.0 else -1.0
+    return True
+
+
+def _make_context(th):
+    """Constant arrays of one finger (chain, coupling, drives), the plant's scratch arrays and the
+    controller's: ``(ctx, ws, cs)``. Plain numpy code, run by Python for single simulations (no
+    compilation) and compiled as :func:`finger_context` for the parallel kernels."""
+    dh = np.empty((4, 6))
+    jt = np.zeros(4, dtype=np.int64)
+    mass = np.empty(4)
+    com = np.empty((4, 3))
+    inertia = np.empty((4, 6))
+    armq = np.zeros(4)
+    G = np.empty(12)
+    q0 = np.zeros(4)
+    arm_p = np.empty(3)
+    grav = np.empty(3)
+    ratio = np.empty(3)
+    finger_setup(th, dh, mass, com, inertia, G, arm_p, grav, ratio)
+    ctx = (dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav, ratio)
+    ws = (np.empty((4, 9)), np.empty((4, 3)), np.empty(WORK_PER_LINK * 4), np.empty(4), np.empty(4),
+          np.zeros(4), np.empty((4, 4)), np.empty(4), np.empty((3, 3)), np.empty(3), np.empty((3, 3)),
+          np.empty(3), np.empty((3, 3)), np.empty(3), np.empty(3), np.empty(3), np.empty(3),
+          np.empty(3), np.empty(3), np.empty(12), np.empty(3), np.empty(3), np.empty(3), np.empty(3),
+          np.empty(3), np.empty(3))
+    cs = (np.empty(4), np.empty(4), np.empty((4, 9)), np.empty((4, 3)), np.empty((4, 16)),
+          np.empty((6, 4)), np.empty((3, 3)), np.empty(3), np.empty(3), np.empty(3), np.empty(4),
+          np.empty(WORK_PER_LINK * 4), np.zeros(4), np.empty(NX), np.empty(3), np.zeros(3),
+          np.zeros(3), np.zeros(3))
+    return ctx, ws, cs
+
+
+finger_context = numba.njit(cache=True, error_model="numpy")(_make_context)
+
+
+@hot
+def _slow_states(th, mode, thermal, x, v0, tshaft, h):  # pragma: no cover - compiled
+    """Motor temperatures (explicit step) and LuGre bristles (exact for v held over the step)."""
+    if thermal:
+        for k in range(3):
+            x[6 + k] = motor_heat_step(x[6 + k], tshaft[k], h, th[I_TAMB], th[I_ALPHA], th[I_R0],
+                                       th[I_KT], th[I_RTH], th[I_CTH])
+    if mode == 2:
+        for k in range(3):
+            x[9 + k] = lugre_update(x[9 + k], v0[k], h, th[I_FC + k], th[I_FS + k], th[I_VS],
+                                    th[I_S0])
+
+
+@hot
+def _stick(th, mode, x, v0):  # pragma: no cover - compiled
+    """Karnopp: a sliding actuator whose velocity crosses zero comes to rest; if its holding torque
+    exceeds stiction it breaks away again at the next step."""
+    if mode < 2:
+        vst = th[I_VST]
+        for k in range(3):
+            if x[12 + k] == 0.0 and (x[3 + k] * v0[k] < 0.0 or abs(x[3 + k]) <= vst):
+                x[3 + k] = 0.0
+                x[12 + k] = 1.0
+
+
+@hot
+def finger_step(th, mode, thermal, ctx, tv, tf, tn, tipos, x, pwm, ext, h, taum, fric,
+                ws):  # pragma: no cover - compiled
+    """Advance one finger's state ``x`` (15) by one semi-implicit Euler step h under PWM (3) and
+    external actuator torques ``ext`` (3); ``taum``/``fric`` receive the motor and friction
+    torques at the start of the step. ``ctx``, ``ws`` come from :func:`finger_context`. Returns
+    False if the mass matrix lost positive definiteness."""
+    dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav, ratio = ctx
+    (R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, Ms, xs, rs, acc, tshaft, p0, v0, ka, ps, vs,
+     tm2, fr2, ts2, dirn) = ws
+    if not _forces(th, 4, mode, thermal, dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav,
+                   ratio, tv, tf, tn, tipos, x[0:3], x[3:6], x[6:9], x[9:12], x[12:15], pwm, ext,
+                   acc, taum, tshaft, fric, R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, Ms, xs,
+                   rs, dirn):
+        return False
+    for k in range(3):
+        v0[k] = x[3 + k]
+        x[3 + k] = v0[k] + h * acc[k]
+    _stick(th, mode, x, v0)
+    for k in range(3):
+        x[k] += h * x[3 + k]
+    _slow_states(th, mode, thermal, x, v0, tshaft, h)
+    return True
+
+
+@hot
+def finger_step_rk4(th, mode, thermal, ctx, tv, tf, tn, tipos, x, pwm, ext, h, taum, fric,
+                    ws):  # pragma: no cover - compiled
+    """As :func:`finger_step` with classical RK4 on (p, ṗ); the stick/slip set is decided at the
+    start of the step and frozen over it (stuck actuators keep v = 0, a = 0); sticking is
+    detected at the end."""
+    dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav, ratio = ctx
+    (R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, Ms, xs, rs, acc, tshaft, p0, v0, ka, ps, vs,
+     tm2, fr2, ts2, dirn) = ws
+    stuck = x[12:15]
+    T = x[6:9]
+    z = x[9:12]
+    if not _forces(th, 4, mode, thermal, dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav,
+                   ratio, tv, tf, tn, tipos, x[0:3], x[3:6], T, z, stuck, pwm, ext, acc, taum,
+                   tshaft, fric, R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, Ms, xs, rs, dirn):
+        return False
+    for k in range(3):
+        p0[k] = x[k]
+        v0[k] = x[3 + k]
+        ka[k] = acc[k]
+    # stage s uses p = p0 + c·v_s, v = v0 + c·a_s with c = h/2, h/2, h
+    for stage in range(3):
+        c = 0.5 * h if stage < 2 else h
+        for k in range(3):
+            if stuck[k] != 0.0:
+                ps[k] = p0[k]
+                vs[k] = 0.0
+                continue
+            ps[k] = p0[k] + c * (v0[k] if stage == 0 else vs[k])
+            vs[k] = v0[k] + c * ka[3 * stage + k]
+        _forces(th, 0, mode, thermal, dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav, ratio,
+                tv, tf, tn, tipos, ps, vs, T, z, stuck, pwm, ext, acc, tm2, ts2, fr2, R, P, work,
+                q, qd, zq, Mq, tau, Mp, hp, L, rhs, Ms, xs, rs, dirn)
+        for k in range(3):
+            ka[3 * (stage + 1) + k] = acc[k]
+    for k in range(3):
+        if stuck[k] != 0.0:
+            x[3 + k] = 0.0
+            continue
+        a1 = ka[k]
+        a2 = ka[3 + k]
+        a3 = ka[6 + k]
+        a4 = ka[9 + k]
+        x[k] = p0[k] + h * v0[k] + h * h / 6.0 * (a1 + a2 + a3)
+        x[3 + k] = v0[k] + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
+    _stick(th, mode, x, v0)
+    _slow_states(th, mode, thermal, x, v0, tshaft, h)
+    return True
+
+
+@hot
+def finger_outputs(G, q0, x, taum, fric, y, yrow, ycol):  # pragma: no cover - compiled
+    """Write the 18 outputs of one finger (see DLRFinger.outputs) into y[yrow, ycol:ycol+18]."""
+    for j in range(3):
+        s = q0[j]
+        sd = 0.0
+        for k in range(3):
+            s += G[j * 3 + k] * x[k]
+            sd += G[j * 3 + k] * x[3 + k]
+        y[yrow, ycol + j] = s
+        y[yrow, ycol + 3 + j] = sd
+    for k in range(3):
+        y[yrow, ycol + 6 + k] = x[3 + k]
+        y[yrow, ycol + 9 + k] = taum[k]
+        y[yrow, ycol + 12 + k] = fric[k]
+        y[yrow, ycol + 15 + k] = x[6 + k]
+
+
+# --- impedance control (used by gripkit.systems.dlr_hit.impedance) ----------------------------------------
+
+@hot
+def _tip(ctx, th, q, R, P, T, J, Jp, tip):  # pragma: no cover - compiled
+    """Fingertip position (3, finger base frame) and actuator-space linear Jacobian Jp (3×3)."""
+    dh = ctx[0]
+    jt = ctx[1]
+    G = ctx[6]
+    chain_links(4, dh, jt, q, R, P)
+    frames_into(4, R, P, T)
+    l3 = th[I_L1 + 2]
+    px = T[3, 3] + T[3, 0] * l3
+    py = T[3, 7] + T[3, 4] * l3
+    pz = T[3, 11] + T[3, 8] * l3
+    tip[0] = px
+    tip[1] = py
+    tip[2] = pz
+    point_jacobian(4, jt, T, px, py, pz, J)
+    for r in range(3):
+        for j in range(3):
+            s = 0.0
+            for k in range(4):
+                s += J[r, k] * G[k * 3 + j]
+            Jp[r, j] = s
+
+
+@hot
+def _pwm_for(tau_out, omega_m, N, th):  # pragma: no cover - compiled
+    """PWM that yields output torque ``tau_out`` at motor speed omega_m (inverse of eq 5.10 at
+    T_ref), clipped to ±pwm_max."""
+    c = th[I_C]
+    b1 = th[I_B1]
+    b0 = th[I_B0]
+    pmax = th[I_PMAX]
+    tm = tau_out / N
+    den = c + b1 * omega_m
+    u = (tm - b0 * omega_m) / den if den > 0.0 else pmax
+    if u < 0.0:
+        den = c - b1 * omega_m
+        u = (tm - b0 * omega_m) / den if den > 0.0 else -pmax
+        if u > 0.0:
+            u = 0.0
+    if u > pmax:
+        u = pmax
+    elif u < -pmax:
+        u = -pmax
+    return u
+
+
+@hot
+def _impedance(th, ctx, cs, x, n, ctrl, gains, ctv, ctf, ctn, ctipos, ref, refd,
+               pwm):  # pragma: no cover - compiled
+    """Impedance law (joint: ctrl = 1, Cartesian: ctrl = 2) with gravity and friction
+    compensation → PWM; the commanded torques stay in cs[9] (see gripkit.systems.dlr_hit.impedance)."""
+    dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav, ratio = ctx
+    q, qd, R, P, T, J, Jp, tip, tipd, tauq, gp, work, zq = (cs[0], cs[1], cs[2], cs[3], cs[4],
+                                                          cs[5], cs[6], cs[7], cs[8], cs[9],
+                                                          cs[10], cs[11], cs[12])
+    joints_from_actuators(4, 3, G, q0, x[0:3], q)
+    joints_from_actuators(4, 3, G, zq, x[3:6], qd)
+    _tip(ctx, th, q, R, P, T, J, Jp, tip)
+    for r in range(3):
+        s = 0.0
+        for j in range(3):
+            s += Jp[r, j] * x[3 + j]
+        tipd[r] = s
+        tauq[r] = 0.0
+    if ctrl == 2:
+        for r in range(3):
+            f = gains[r] * (ref[n, r] - tip[r]) + gains[3 + r] * (refd[n, r] - tipd[r])
+            for j in range(3):
+                tauq[j] += Jp[r, j] * f
+    else:
+        for j in range(3):  # τ_p = Γ_qᵀ τ_q on (θ1, θ2, θ3)
+            f = gains[j] * (ref[n, j] - q[j]) + gains[3 + j] * (refd[n, j] - qd[j])
+            for k in range(3):
+                tauq[k] += G[j * 3 + k] * f
+    for k in range(3):  # joint-space damping on the actuators (damps directions J_p makes soft)
+        tauq[k] -= gains[10 + k] * x[3 + k]
+    if gains[6] != 0.0:
+        rnea_pass(4, R, P, jt, mass, com, inertia, armq, zq, zq, grav[0], grav[1], grav[2], False,
+                  gp, work)
+        for k in range(3):
+            s = 0.0
+            for j in range(4):
+                s += G[j * 3 + k] * gp[j]
+            tauq[k] += s
+    vdb = gains[8]
+    eps = gains[9]
+    for k in range(3):
+        tau = tauq[k]
+        if gains[7] != 0.0 and tau != 0.0:
+            # compensate only in the direction the impedance pushes (never into a reversal)
+            v = x[3 + k]
+            if v * tau >= 0.0:
+                if abs(v) < vdb:
+                    v = vdb if tau > 0.0 else -vdb
+                tau += table_friction(v, ctv[k], ctf[k], ctn[k], ctipos[k]) * math.tanh(abs(tau) / eps)
+        tauq[k] = tau
+        pwm[k] = _pwm_for(tau, ratio[k] * x[3 + k], ratio[k], th)
+
+
+@hot
+def _wall(th, ctx, cs, x, wall, ext, force):  # pragma: no cover - compiled
+    """Contact force of a planar wall (nx, ny, nz, px, py, pz, k, d, on) on the fingertip, mapped
+    to the actuators: ext = J_pᵀ F; ``force`` receives F (finger base frame)."""
+    G = ctx[6]
+    q0 = ctx[7]
+    q, R, P, T, J, Jp, tip = cs[0], cs[2], cs[3], cs[4], cs[5], cs[6], cs[7]
+    for k in range(3):
+        ext[k] = 0.0
+        force[k] = 0.0
+    if wall[8] == 0.0:
+        return
+    joints_from_actuators(4, 3, G, q0, x[0:3], q)
+    _tip(ctx, th, q, R, P, T, J, Jp, tip)
+    pen = -(wall[0] * (tip[0] - wall[3]) + wall[1] * (tip[1] - wall[4]) + wall[2] * (tip[2] - wall[5]))
+    if pen <= 0.0:
+        return
+    vn = 0.0
+    for r in range(3):
+        s = 0.0
+        for j in range(3):
+            s += Jp[r, j] * x[3 + j]
+        vn += wall[r] * s
+    fmag = wall[6] * pen - wall[7] * vn  # δ̇ = −n·ẋ
+    if fmag < 0.0:
+        fmag = 0.0
+    for r in range(3):
+        force[r] = fmag * wall[r]
+    for j in range(3):
+        ext[j] = Jp[0, j] * force[0] + Jp[1, j] * force[1] + Jp[2, j] * force[2]
+
+
+@hot
+def finger_loop(th, mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucol, dt, substeps, x, y,
+                ycol, ctrl, gains, ctv, ctf, ctn, ctipos, ref, refd, wall):  # pragma: no cover
+    """The time loop (allocation-free, semi-implicit Euler). ``ctrl = 0``: PWM from u[:, ucol:],
+    outputs as DLRFinger.outputs at y[:, ycol:ycol+18]; ``ctrl = 1/2``: joint/Cartesian impedance
+    on ``ref``/``refd`` with the ``wall``, closed-loop outputs (27 columns, see
+    gripkit.systems.dlr_hit.impedance)."""
+    G = ctx[6]
+    q0 = ctx[7]
+    pwm, ext, taum, fric, xs, force = cs[14], cs[15], cs[16], cs[17], cs[13], cs[8]
+    h = dt / substeps
+    N = ref.shape[0] if ctrl else u.shape[0]
+    for n in range(N):
+        if ctrl:
+            _impedance(th, ctx, cs, x, n, ctrl, gains, ctv, ctf, ctn, ctipos, ref, refd, pwm)
+        else:
+            for k in range(3):
+                pwm[k] = u[n, ucol + k]
+        for k in range(NX):
+            xs[k] = x[k]
+        for s in range(substeps):
+            if ctrl:
+                _wall(th, ctx, cs, x, wall, ext, force)
+                if s == 0:
+                    for k in range(3):
+                        y[n, 12 + k] = force[k]
+            if not finger_step(th, mode, thermal, ctx, tv, tf, tn, tipos, x, pwm, ext, h, taum, fric,
+                               ws):
+                return n + 1
+            if s == 0 and not ctrl:
+                # sample n reports the state at t_n and the torques acting at t_n
+                finger_outputs(G, q0, xs, taum, fric, y, n, ycol)
+        if ctrl:
+            q, qd, R, P, T, J, Jp, tip = cs[0], cs[1], cs[2], cs[3], cs[4], cs[5], cs[6], cs[7]
+            joints_from_actuators(4, 3, G, q0, xs[0:3], q)
+            joints_from_actuators(4, 3, G, cs[12], xs[3:6], qd)
+            _tip(ctx, th, q, R, P, T, J, Jp, tip)
+            for k in range(3):
+                y[n, k] = q[k]
+                y[n, 3 + k] = qd[k]
+                y[n, 6 + k] = tip[k]
+                s = 0.0
+                for j in range(3):
+                    s += Jp[k, j] * xs[3 + j]
+                y[n, 9 + k] = s
+                y[n, 15 + k] = pwm[k]
+                y[n, 18 + k] = cs[9][k]
+                y[n, 21 + k] = fric[k]
+                y[n, 24 + k] = taum[k]
+    return 0
+
+
+@hot
+def finger_loop_rk4(th, mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucol, dt, substeps, x, y,
+                    ycol):  # pragma: no cover - compiled
+    """Open-loop time loop with RK4 steps."""
+    G = ctx[6]
+    q0 = ctx[7]
+    pwm, ext, taum, fric, xs = cs[14], cs[15], cs[16], cs[17], cs[13]
+    h = dt / substeps
+    for n in range(u.shape[0]):
+        for k in range(3):
+            pwm[k] = u[n, ucol + k]
+            ext[k] = 0.0
+        for k in range(NX):
+            xs[k] = x[k]
+        for s in range(substeps):
+            if not finger_step_rk4(th, mode, thermal, ctx, tv, tf, tn, tipos, x, pwm, ext, h, taum,
+                                   fric, ws):
+                return n + 1
+            if s == 0:
+                finger_outputs(G, q0, xs, taum, fric, y, n, ycol)
+    return 0
+
+
+def finger_run(th, mode, thermal, tv, tf, tn, tipos, u, ucol, dt, substeps, x, y, ycol, ctrl, gains,
+               ctv, ctf, ctn, ctipos, ref, refd, wall) -> int:
+    """Simulate one finger (open loop: ``ctrl = 0`` with PWM columns ucol..ucol+2 of ``u``; closed
+    loop: ``ctrl = 1`` joint or ``2`` Cartesian impedance). Returns the index of the first failed
+    sample + 1, or 0. Scratch arrays are allocated here, in Python, so the only compiled function
+    is the time loop itself."""
+    ctx, ws, cs = _make_context(th)
+    return int(finger_loop(th, mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucol, dt, substeps,
+                           x, y, ycol, ctrl, gains, ctv, ctf, ctn, ctipos, ref, refd, wall))
+
+
+def finger_run_rk4(th, mode, thermal, tv, tf, tn, tipos, u, ucol, dt, substeps, x, y, ycol) -> int:
+    """Open-loop simulation with RK4 steps (compiled only when asked for)."""
+    ctx, ws, cs = _make_context(th)
+    return int(finger_loop_rk4(th, mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucol, dt,
+                               substeps, x, y, ycol))
+
+
+_NO_CTRL = (np.zeros(10), np.zeros((3, 4)), np.zeros((3, 4)), np.full(3, 4, dtype=np.int64),
+            np.full(3, 2, dtype=np.int64), np.zeros((1, 3)), np.zeros((1, 3)), np.zeros(9))
+
+
+def run_open_loop(th, mode, integ, thermal, tab, u, dt, substeps, x, y, ucol=0, ycol=0) -> int:
+    """One finger, open loop (Python entry used by the models and the hand)."""
+    tv, tf, tn, tipos = tab
+    if integ == 1:
+        return int(finger_run_rk4(th, mode, thermal, tv, tf, tn, tipos, u, ucol, dt, substeps, x, y,
+                                  ycol))
+    return int(finger_run(th, mode, thermal, tv, tf, tn, tipos, u, ucol, dt, substeps, x, y, ycol, 0,
+                          *_NO_CTRL))
+
+
+@numba.njit(cache=True, parallel=True, error_model="numpy")
+def _jobs_parallel(thetas, u, ucols, dt, substeps, x0, y, yidx, ycols, tv, tf, tn, tipos, mode,
+                   thermal, gains, ctv, ctf, ctn, ctipos, ref, refd, wall):  # pragma: no cover
+    """Open-loop finger simulations in parallel: job j simulates thetas[j] from x0[j] on PWM
+    columns ucols[j].. of u, writing y[yidx[j], :, ycols[j]:ycols[j]+18]."""
+    J = thetas.shape[0]
+    fail = np.zeros(J, dtype=np.int64)
+    for j in prange(J):
+        x = x0[j].copy()
+        ctx, ws, cs = finger_context(thetas[j])
+        fail[j] = finger_loop(thetas[j], mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucols[j],
+                              dt, substeps, x, y[yidx[j]], ycols[j], 0, gains, ctv, ctf, ctn, ctipos,
+                              ref, refd, wall)
+    return fail
+
+
+def run_jobs(thetas, u, ucols, dt, substeps, x0, y, yidx, ycols, tab, mode, integ, thermal,
+             parallel: bool) -> np.ndarray:
+    """Several open-loop finger simulations (a batch of parameter vectors, or the fingers of a
+    hand); parallel threads only when asked for (and semi-implicit), else one after another."""
+    J = thetas.shape[0]
+    if parallel and integ == 0 and J > 1:
+        tv, tf, tn, tipos = tab
+        return _jobs_parallel(thetas, u, np.asarray(ucols, dtype=np.int64), dt, substeps, x0, y,
+                              np.asarray(yidx, dtype=np.int64), np.asarray(ycols, dtype=np.int64),
+                              tv, tf, tn, tipos, mode, thermal, *_NO_CTRL)
+    return np.array([run_open_loop(thetas[j], mode, integ, thermal, tab, u, dt, substeps,
+                                   x0[j].copy(), y[yidx[j]], int(ucols[j]), int(ycols[j]))
+                     for j in range(J)])
+
+
+class DLRFinger(Model):
+    """The complete finger of Fig. 7.1 (see the module docstring).
+
+    Parameters
+    ----------
+    parameters
+        A ParameterSet holding every name of :data:`FINGER_PARAMETERS` (in that order), e.g.
+        :func:`gripkit.systems.dlr_hit.parameters.thesis_finger_parameters`.
+    tables
+        Friction lookup tables (base motor 1, base motor 2, distal), :class:`FrictionTable`,
+        used by ``friction='table'``; their ``scale`` multiplies the ``scale_*`` parameters.
+    friction
+        ``'table'`` (default, the thesis's model), ``'stribeck'``, ``'lugre'`` or ``'none'``.
+    integrator
+        ``'semi-implicit'`` (default) or ``'rk4'``.
+    thermal
+        Integrate the motor temperatures (default False: windings at T_ref, eq 5.10 as printed).
+
+    Inputs: ``pwm_base1``, ``pwm_base2``, ``pwm_distal`` (counts, ±4096). Outputs (18): joint
+    angles ``abd``, ``flex``, ``prox`` (rad; the distal joint equals ``prox``), their velocities
+    ``abd_vel``, ``flex_vel``, ``prox_vel`` (rad/s), actuator velocities ``base1_vel``,
+    ``base2_vel``, ``distal_vel`` (rad/s, the "base joint 1/2" velocities of Figs 7.4–7.5),
+    motor torques at the actuator outputs ``tau_base1``.. (N·m), friction torques ``fric_base1``..
+    (N·m), winding temperatures ``T_base1``.. (K).
+    """
+
+    name = "dlr-hit-finger"
+    description = "DLR/HIT Hand II finger: PWM → BLDC → transmission → friction → coupled dynamics"
+    inputs = tuple(Signal(f"pwm_{a}", "1", f"PWM count of the {a} motor") for a in ACTUATORS)
+    outputs = (tuple(Signal(j, "rad", f"joint angle {j}") for j in JOINTS)
+               + tuple(Signal(f"{j}_vel", "rad/s", f"joint velocity {j}") for j in JOINTS)
+               + tuple(Signal(f"{a}_vel", "rad/s", f"{a} actuator velocity") for a in ACTUATORS)
+               + tuple(Signal(f"tau_{a}", "N*m", f"{a} motor torque at the actuator output") for a in ACTUATORS)
+               + tuple(Signal(f"fric_{a}", "N*m", f"{a} friction torque (opposing)") for a in ACTUATORS)
+               + tuple(Signal(f"T_{a}", "K", f"{a} winding temperature") for a in ACTUATORS))
+    states = (tuple(Signal(f"p_{a}", "rad") for a in ACTUATORS)
+              + tuple(Signal(f"v_{a}", "rad/s") for a in ACTUATORS)
+              + tuple(Signal(f"T_{a}", "K") for a in ACTUATORS)
+              + tuple(Signal(f"z_{a}", "rad", "LuGre bristle deflection") for a in ACTUATORS)
+              + tuple(Signal(f"stuck_{a}", "1", "1 while held by stiction") for a in ACTUATORS))
+
+    def __init__(self, parameters: ParameterSet, tables=None, *, friction: str = "table",
+                 integrator: str = "semi-implicit", thermal: bool = False, check: bool = True,
+                 name: str | None = None):
+        if not isinstance(parameters, ParameterSet):
+            raise ModelError(f"DLRFinger: expected a ParameterSet, found {type(parameters).__name__}")
+        if parameters.names != FINGER_PARAMETERS:
+            missing = [n for n in FINGER_PARAMETERS if n not in parameters.names]
+            raise ModelError("DLRFinger: the parameter set must hold FINGER_PARAMETERS in order",
+                             hint=f"missing: {missing}" if missing else "reorder the set")
+        if friction not in FRICTION_MODES:
+            raise ModelError(f"friction: expected one of {sorted(FRICTION_MODES)}, found {friction!r}")
+        if integrator not in INTEGRATORS:
+            raise ModelError(f"integrator: expected 'semi-implicit' or 'rk4', found {integrator!r}")
+        if tables is None and friction == "table":
+            raise ModelError("friction='table' needs three FrictionTables (base1, base2, distal)")
+        if tables is not None:
+            if len(tables) != 3 or not all(isinstance(t, FrictionTable) for t in tables):
+                raise ModelError("tables: expected three FrictionTables (base1, base2, distal)")
+            self.tables = tuple(tables)
+        else:
+            dummy = FrictionTable([-2.0, -1.0, 1.0, 2.0], [-1.0, -1.0, 1.0, 1.0], name="unused")
+            self.tables = (dummy, dummy, dummy)
+        self._tab = table_arrays(self.tables)
+        self.friction = friction
+        self.integrator = integrator
+        self.thermal = bool(thermal)
+        if name:
+            self.name = name
+        super().__init__(parameters, check=check)
+
+    # --- structure ------------------------------------------------------------------------------
+    def chain(self, params: ParameterSet | None = None, base=None) -> CoupledChain:
+        """The coupled multibody model (actuator coordinates) of this finger."""
+        p = (params or self.parameters)
+        v = p.value
+        I = np.zeros((4, 3, 3))  # noqa: E741
+        com = np.zeros((4, 3))
+        for k in range(3):
+            I[k + 1] = np.diag([v(f"I{k + 1}_xx"), v(f"I{k + 1}_yy"), v(f"I{k + 1}_zz")])
+            com[k + 1] = [v(f"pc{k + 1}_x"), v(f"pc{k + 1}_y"), v(f"pc{k + 1}_z")]
+        tool = np.eye(4)
+        tool[0, 3] = v("l3")
+        ch = DHChain(alpha=[0.0, -math.pi / 2, 0.0, 0.0], a=[0.0, 0.0, v("l1"), v("l2")],
+                     d=np.zeros(4), mass=[0.0, v("m1"), v("m2"), v("m3")], com=com, inertia=I,
+                     gravity=[v("g_x"), v("g_y"), v("g_z")], tool=tool, base=base,
+                     names=("theta1", "theta2", "theta3", "theta4"), name=self.name)
+        ratios = self.ratios(p)
+        G = np.zeros((4, 3))
+        G[:2, :2] = differential_matrix(v("beta"))
+        G[2, 2] = G[3, 2] = 1.0
+        cp = Coupling(G, np.zeros(4), v("I_m") * ratios ** 2, ACTUATORS)
+        return CoupledChain(ch, cp, name=self.name)
+
+    def ratios(self, params: ParameterSet | None = None) -> np.ndarray:
+        """Reductions (base1, base2, distal): N_belt·N_hd·N_belt_base for the base, N_belt·N_hd distal."""
+        v = (params or self.parameters).value
+        nd = v("N_hd") * v("N_belt")
+        return np.array([nd * v("N_belt_base"), nd * v("N_belt_base"), nd])
+
+    def state(self, q=(0.0, 0.0, 0.0), qd=(0.0, 0.0, 0.0), T=None, *, degrees: bool = False) -> np.ndarray:
+        """Initial state vector (15) from joint angles (abd, flex, prox) and velocities; motors at
+        ``T`` (K, default T_ref); at rest → held by stiction."""
+        q = np.asarray(q, dtype=np.float64)
+        qd = np.asarray(qd, dtype=np.float64)
+        if q.shape != (3,) or qd.shape != (3,):
+            raise SimulationError(f"q and qd: expected 3 joint values (abd, flex, prox), found {q.shape}, {qd.shape}")
+        if degrees:
+            q, qd = np.radians(q), np.radians(qd)
+        G = self.chain().coupling.matrix[:3]
+        p = np.linalg.solve(G, q)
+        pd = np.linalg.solve(G, qd)
+        Tm = self.parameters.value("T_ref") if T is None else float(T)
+        x = np.zeros(NX)
+        x[0:3] = p
+        x[3:6] = pd
+        x[6:9] = Tm
+        x[12:15] = (pd == 0).astype(float)
+        return x
+
+    def initial_state(self, theta):
+        return self.state()
+
+    # --- simulation -----------------------------------------------------------------------------
+    def _simulate_batch(self, thetas, u, dt, substeps, x0, y):
+        P = thetas.shape[0]
+        fail = run_jobs(thetas, u, np.zeros(P), dt, substeps, x0, y, np.arange(P), np.zeros(P),
+                        self._tab, FRICTION_MODES[self.friction], INTEGRATORS[self.integrator],
+                        self.thermal, parallel=P >= 4)
+        if fail.any():
+            raise SimulationError(f"{self.name}: the mass matrix lost positive definiteness at sample "
+                                  f"{int(fail[fail > 0][0]) - 1}", hint="check the inertial parameters")
+
+    def modes(self, theta):
+        """End-stop contact mode (belt elasticity on the rotor inertia), LuGre bristles, and the
+        motor/friction velocity time constant, at the lightest actuator."""
+        v = dict(zip(FINGER_PARAMETERS, theta))
+        nd = v["N_hd"] * v["N_belt"]
+        J = v["I_m"] * nd * nd
+        out = []
+        if v["k_stop"] > 0:
+            out.append((math.sqrt(v["k_stop"] / J), v["d_stop"] / (2 * math.sqrt(v["k_stop"] * J))))
+        if self.friction == "lugre":
+            out.append((math.sqrt(v["sigma0"] / J), (v["sigma1"] + v["visc_distal"]) / (2 * math.sqrt(v["sigma0"] * J))))
+        # back-EMF damping of eq 5.8 reflected: |b(0)|·N²
+        out.append((abs(v["b_0"]) * nd * nd / J, 1.0))
+        return out
+
+    # --- analysis -------------------------------------------------------------------------------
+    def kinetic_friction(self, actuator: str, v) -> np.ndarray:
+        """Kinetic friction of an actuator at velocities v (rad/s), as the simulation uses it."""
+        k = ACTUATORS.index(actuator)
+        p = self.parameters.value
+        v = np.asarray(v, dtype=np.float64)
+        if self.friction == "table":
+            return p(f"scale_{actuator}") * self.tables[k](v)
+        if self.friction in ("stribeck", "lugre"):
+            s = Stribeck(p(f"fc_{actuator}"), p(f"fs_{actuator}"), p("v_s"),
+                         p("delta") if self.friction == "stribeck" else 2.0, p(f"visc_{actuator}"))
+            cubic = p(f"cubic_{actuator}") * v ** 3 if self.friction == "stribeck" else 0.0
+            return s(v) + cubic
+        return np.zeros_like(v)
+
+    def motor_torque(self, actuator: str, pwm, v, T=None) -> np.ndarray:
+        """Motor torque at the actuator output (N·m) for PWM and actuator velocity v (rad/s)."""
+        k = ACTUATORS.index(actuator)
+        N = self.ratios()[k]
+        ps = ParameterSet([self.parameters[n] for n in ("c_pwm", "b_pwm", "b_0", "pwm_max", "T_ref",
+                                                         "T_amb", "alpha_R", "k_t", "R_0", "R_th", "C_th")])
+        tau = BLDCMotor(ps).torque(pwm, N * np.asarray(v, dtype=np.float64), T)
+        eta = self.parameters.value("eta")
+        drive = tau * np.asarray(v) >= 0
+        return np.where(drive, N * eta * tau, N * tau / eta)
+
+    def steady_velocity(self, actuator: str, pwm: float, load: float = 0.0) -> float:
+        """Velocity (rad/s) at which motor torque balances kinetic friction plus a constant
+        ``load`` torque (N·m) for a constant PWM — the plateau of Figs 7.3–7.5 without gravity:
+        the first balance reached when accelerating from rest (a table with a spike can hold the
+        joint below a faster balance). 0 when the motor cannot overcome stiction."""
+        from scipy.optimize import brentq
+
+        k = ACTUATORS.index(actuator)
+        sgn = 1.0 if pwm >= 0 else -1.0
+        if abs(self.motor_torque(actuator, pwm, 0.0) - load) <= self.parameters.value(f"fs_{actuator}"):
+            return 0.0
+        N = self.ratios()[k]
+        p = self.parameters.value
+        c, b1, b0 = p("c_pwm"), p("b_pwm"), p("b_0")
+        u = min(abs(pwm), p("pwm_max"))
+        slope = -(b1 * u + b0)
+        v_guard = c * u / (slope * N) if slope > 0 else 1e3
+
+        def f(v):
+            return (self.motor_torque(actuator, pwm, sgn * v) - load
+                    - self.kinetic_friction(actuator, sgn * v)) * sgn
+
+        grid = np.linspace(1e-9, v_guard * (1 - 1e-12), 4001)
+        vals = f(grid)
+        neg = np.flatnonzero(vals <= 0)
+        if neg.size == 0:
+            return sgn * grid[-1]
+        i = int(neg[0])
+        if i == 0:
+            return 0.0
+        return sgn * brentq(lambda v: float(f(np.array(v))), grid[i - 1], grid[i], xtol=1e-12)

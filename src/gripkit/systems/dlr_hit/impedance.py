@@ -1,0 +1,306 @@
+"""Joint and Cartesian impedance control of the DLR/HIT II finger with gravity and friction
+compensation, simulated in closed loop with the complete finger model, and its stability margins.
+
+Cartesian impedance (``002_ddea254371185ad3.txt`` eq 3.1, after Hogan [9]) prescribes the
+mass-damper-spring relation F = M_I ẍ + D_k ẋ + K_k x between the fingertip displacement x from
+its set point and the external force F. Without a fingertip force sensor (the DLR/HIT II's was
+removed, §3.1) the inertia is left as the finger's own, M_I = Λ(q) = (J M⁻¹ Jᵀ)⁻¹, and the
+control law is the compliance form used on the hand (§3.1: "joint and Cartesian impedance control
+with friction and gravity compensation", [40])::
+
+    τ_p = J_pᵀ [K_k (x_d − x) + D_k (ẋ_d − ẋ)] − D_a ṗ + G_p(p) + F̂(ṗ)     (Cartesian)
+    τ_p = Γ_qᵀ [K (q_d − q) + D (q̇_d − q̇)] − D_a ṗ + G_p(p) + F̂(ṗ)         (joint)
+
+in actuator coordinates p (J_p = J Γ, Γ_q the joint rows of the coupling). G_p is the gravity
+torque of the multibody model and F̂ the identified kinetic friction (a lookup table), applied in
+the direction the impedance torque τ pushes: at the measured speed while the actuator moves that
+way, at the lowest tabulated speed while it rests (so breaking away needs F_s − F_c instead of
+F_s), faded in as tanh(|τ|/ε), and not at all while the actuator moves against τ (friction then
+brakes it; compensating along the measured velocity would push every reversal — a bounce off a
+wall — further and sustain a limit cycle). The commanded actuator
+torque becomes a PWM count through the inverse of eq 5.10 at the measured motor speed, clipped to
+±4096, held over the 1 kHz control period.
+
+The control law and the wall run inside the finger's own simulation kernel
+(:func:`gripkit.systems.dlr_hit.finger.finger_run` with ``ctrl`` = 1 or 2), so closed-loop studies
+cost no extra compilation.
+
+Contact: a planar wall (unit normal n pointing out of the wall, a point on it) of stiffness k_w
+and damping d_w pushes on the fingertip when it penetrates: F = (k_w δ − d_w δ̇)·n with
+δ = −nᵀ(x_tip − x_w) > 0 (never pulling); it enters the actuators as Γᵀ Jᵀ F.
+
+Stability margins (:func:`stability_margins`): per actuator the loop is linearised around rest:
+plant 1/(J s² + b s + k_e) with J the actuator's apparent inertia, b its viscous friction, k_e the
+environment stiffness reflected to the actuator, controller K + D s, sampled with a zero-order
+hold at dt and one sample of computation delay. The gain and phase margins are read from the
+discrete loop's frequency response.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...errors import ModelError, SimulationError
+from ...models.friction import FrictionTable, table_arrays
+from ...signals.trajectory import Trajectory
+from .finger import ACTUATORS, FRICTION_MODES, NX, DLRFinger, finger_run
+
+__all__ = ["ImpedanceController", "Wall", "simulate_impedance", "stability_margins",
+           "impedance_margins", "model_friction_tables"]
+
+@dataclass(frozen=True)
+class ImpedanceController:
+    """Impedance gains and compensation switches.
+
+    ``kind='joint'``: stiffness (N·m/rad) and damping (N·m·s/rad) per joint (abduction, flexion,
+    proximal). ``kind='cartesian'``: per fingertip axis of the finger base frame, N/m and N·s/m.
+    ``friction_tables``: the identified kinetic friction of (base1, base2, distal) used for
+    compensation (default: the finger model's own friction, :func:`model_friction_tables`);
+    ``velocity_deadband`` (rad/s): below
+    it an actuator counts as at rest; ``smoothing`` (N·m): at rest the friction compensation
+    fades in as tanh(|τ|/smoothing) of the impedance torque τ. ``actuator_damping``
+    (N·m·s/rad per actuator) adds −D_a·ṗ: a Cartesian stiffness acts weakly along the directions
+    J_p maps to small fingertip motion, and this damps them.
+    """
+
+    kind: str = "joint"
+    stiffness: tuple = (2.0, 2.0, 2.0)
+    damping: tuple = (0.3, 0.3, 0.3)
+    gravity_compensation: bool = True
+    friction_compensation: bool = True
+    friction_tables: tuple | None = None
+    velocity_deadband: float = 0.02
+    smoothing: float = 0.02
+    actuator_damping: tuple = (0.0, 0.0, 0.0)
+
+    def __post_init__(self):
+        if self.kind not in ("joint", "cartesian"):
+            raise ModelError(f"kind: expected 'joint' or 'cartesian', found {self.kind!r}")
+        for name in ("stiffness", "damping", "actuator_damping"):
+            v = np.asarray(getattr(self, name), dtype=np.float64)
+            if v.shape != (3,) or not np.isfinite(v).all() or (v < 0).any():
+                raise ModelError(f"{name}: expected three non-negative gains, found {getattr(self, name)!r}")
+            object.__setattr__(self, name, tuple(float(x) for x in v))
+        if self.friction_tables is not None and (len(self.friction_tables) != 3 or not all(
+                isinstance(t, FrictionTable) for t in self.friction_tables)):
+            raise ModelError("friction_tables: expected three FrictionTables (base1, base2, distal)")
+        if not self.velocity_deadband > 0 or not self.smoothing > 0:
+            raise ModelError(f"velocity_deadband (rad/s) and smoothing (N·m) must be > 0, found "
+                             f"{self.velocity_deadband!r}, {self.smoothing!r}")
+
+
+@dataclass(frozen=True)
+class Wall:
+    """A planar wall: ``normal`` (unit vector out of the wall, finger base frame), ``point`` on
+    its surface (m), ``stiffness`` (N/m) and ``damping`` (N·s/m)."""
+
+    normal: tuple
+    point: tuple
+    stiffness: float
+    damping: float = 0.0
+
+    def __post_init__(self):
+        n = np.asarray(self.normal, dtype=np.float64)
+        if n.shape != (3,) or not np.isfinite(n).all() or np.linalg.norm(n) == 0:
+            raise ModelError(f"wall normal: expected a non-zero 3-vector, found {self.normal!r}")
+        object.__setattr__(self, "normal", tuple(n / np.linalg.norm(n)))
+        p = np.asarray(self.point, dtype=np.float64)
+        if p.shape != (3,) or not np.isfinite(p).all():
+            raise ModelError(f"wall point: expected a 3-vector, found {self.point!r}")
+        object.__setattr__(self, "point", tuple(p))
+        if not (self.stiffness > 0 and self.damping >= 0):
+            raise ModelError(f"wall stiffness must be > 0 and damping >= 0, found {self.stiffness!r}, {self.damping!r}")
+
+
+def model_friction_tables(finger: DLRFinger, v_max: float = 8.0, n: int = 200) -> tuple:
+    """The finger's own kinetic friction as lookup tables (base1, base2, distal): its Appendix G
+    tables with their scale factors, or its Stribeck/LuGre/no-friction curve tabulated on
+    ±[v_max/n·…, v_max] rad/s — the default model of the controller's friction compensation."""
+    if finger.friction == "table":
+        return tuple(t.scaled(finger.parameters.value(f"scale_{a}")) for t, a in zip(finger.tables, ACTUATORS))
+    v = np.geomspace(v_max / n, v_max, n)
+    v = np.r_[-v[::-1], v]
+    return tuple(FrictionTable(v, finger.kinetic_friction(a, v), name=f"{finger.friction} friction, {a}")
+                 for a in ACTUATORS)
+
+
+_OUT = (["abd", "flex", "prox"], ["abd_vel", "flex_vel", "prox_vel"], ["tip_x", "tip_y", "tip_z"],
+        ["tip_vx", "tip_vy", "tip_vz"], ["force_x", "force_y", "force_z"],
+        [f"pwm_{a}" for a in ACTUATORS], [f"tau_cmd_{a}" for a in ACTUATORS],
+        [f"fric_{a}" for a in ACTUATORS], [f"tau_{a}" for a in ACTUATORS])
+_UNITS = ("rad", "rad/s", "m", "m/s", "N", "1", "N*m", "N*m", "N*m")
+
+
+def simulate_impedance(finger: DLRFinger, controller: ImpedanceController, reference,
+                       reference_velocity=None, *, dt: float = 1e-3, x0=None, wall: Wall | None = None,
+                       substeps: int = 1) -> Trajectory:
+    """Closed-loop simulation of ``finger`` under ``controller``.
+
+    Parameters
+    ----------
+    reference
+        (N, 3) set points sampled at ``dt``: joint angles (rad; abduction, flexion, proximal) for a
+        joint controller, fingertip positions in the finger base frame (m) for a Cartesian one.
+    reference_velocity
+        (N, 3) their time derivatives (default: central differences of ``reference``).
+    x0
+        Initial finger state (default: at rest at the first joint reference, or at the finger's
+        default state for a Cartesian reference).
+    wall
+        Optional :class:`Wall`.
+
+    Returns a Trajectory with joint angles (``abd``, ``flex``, ``prox``) and velocities, fingertip
+    position and velocity (``tip_x``..), contact force on the finger (``force_x``.., N), PWM
+    commands (``pwm_base1``..), commanded actuator torques (``tau_cmd_*``), friction (``fric_*``)
+    and the motor torques delivered (``tau_*``, N·m), and the references (``ref_*``).
+    """
+    if not isinstance(finger, DLRFinger):
+        raise ModelError(f"finger: expected a DLRFinger, found {type(finger).__name__}")
+    if finger.integrator != "semi-implicit":
+        raise SimulationError("closed-loop simulation integrates the finger with semi-implicit Euler",
+                              hint="build the finger with integrator='semi-implicit'")
+    ref = np.ascontiguousarray(np.asarray(reference, dtype=np.float64))
+    if ref.ndim != 2 or ref.shape[1] != 3 or ref.shape[0] < 2:
+        raise SimulationError(f"reference: expected shape (N, 3) with N >= 2, found {ref.shape}")
+    if not np.isfinite(ref).all():
+        raise SimulationError("reference contains NaN or inf")
+    if not (math.isfinite(dt) and dt > 0) or int(substeps) != substeps or substeps < 1:
+        raise SimulationError(f"dt must be > 0 s and substeps a positive integer; found {dt!r}, {substeps!r}")
+    refd = (np.gradient(ref, dt, axis=0) if reference_velocity is None
+            else np.asarray(reference_velocity, dtype=np.float64))
+    if refd.shape != ref.shape or not np.isfinite(refd).all():
+        raise SimulationError(f"reference_velocity: expected a finite array of shape {ref.shape}")
+    refd = np.ascontiguousarray(refd)
+    th = finger.theta()
+    if x0 is None:
+        x0 = finger.state(q=ref[0]) if controller.kind == "joint" else finger.state()
+    x = np.array(x0, dtype=np.float64)
+    if x.shape != (NX,):
+        raise SimulationError(f"x0: expected a finger state of {NX} values, found {x.shape}")
+    tables = controller.friction_tables or model_friction_tables(finger)
+    ctv, ctf, ctn, ctip = table_arrays(tables)
+    tv, tf, tn, tip = finger._tab
+    w = np.zeros(9)
+    if wall is not None:
+        w[:3] = wall.normal
+        w[3:6] = wall.point
+        w[6] = wall.stiffness
+        w[7] = wall.damping
+        w[8] = 1.0
+    y = np.empty((ref.shape[0], 27))
+    gains = np.array([*controller.stiffness, *controller.damping, float(controller.gravity_compensation),
+                      float(controller.friction_compensation), controller.velocity_deadband,
+                      controller.smoothing, *controller.actuator_damping])
+    fail = finger_run(th, FRICTION_MODES[finger.friction], finger.thermal, tv, tf, tn, tip,
+                      np.zeros((1, 3)), 0, float(dt), int(substeps), x, y, 0,
+                      2 if controller.kind == "cartesian" else 1, gains, ctv, ctf, ctn, ctip, ref, refd, w)
+    if fail or not np.isfinite(y).all():
+        raise SimulationError(f"closed loop diverged at sample {max(int(fail) - 1, 0)}",
+                              hint="lower the gains or check stability_margins")
+    t = np.arange(ref.shape[0]) * dt
+    ch, units = {}, {}
+    col = 0
+    for names, unit in zip(_OUT, _UNITS):
+        for nme in names:
+            ch[nme] = y[:, col]
+            units[nme] = unit
+            col += 1
+    suffix = ("x", "y", "z") if controller.kind == "cartesian" else ("abd", "flex", "prox")
+    for i, sfx in enumerate(suffix):
+        ch[f"ref_{sfx}"] = ref[:, i]
+        units[f"ref_{sfx}"] = "m" if controller.kind == "cartesian" else "rad"
+    return Trajectory(t, ch, units, {"fs": 1.0 / dt, "model": finger.name, "controller": controller.kind})
+
+
+# --- stability margins ----------------------------------------------------------------------------
+
+def stability_margins(J: float, K: float, D: float, dt: float, *, viscous: float = 0.0,
+                      k_env: float = 0.0, delay: int = 1, n_freq: int = 4000) -> dict:
+    """Gain and phase margins of one linearised impedance axis.
+
+    Plant P(s) = 1/(J s² + b s + k_e) sampled with a zero-order hold at ``dt``; controller
+    C = K + D·(1 − z⁻¹)/dt (backward-difference velocity, as a sampled controller measures it)
+    with ``delay`` samples of computation delay. Returns the gain margin (factor; inf when the
+    phase never crosses −180°), phase margin (deg), the crossover frequencies (Hz), the delay
+    margin (s) and whether the closed loop is stable (all closed-loop poles inside the unit
+    circle)."""
+    from scipy import signal as sig
+
+    if not (J > 0 and dt > 0 and K >= 0 and D >= 0 and viscous >= 0 and k_env >= 0):
+        raise ModelError("stability_margins: need J > 0, dt > 0 and non-negative gains")
+    num_c = [1.0]
+    den_c = [J, viscous, k_env]
+    Pd = sig.cont2discrete((num_c, den_c), dt, method="zoh")
+    bp = np.trim_zeros(np.ravel(Pd[0]), "f")
+    ap = np.ravel(Pd[1])
+    # controller in z⁻¹: C = (K + D/dt) − (D/dt) z⁻¹, times z^-delay
+    bc = np.array([K + D / dt, -D / dt])
+    w = np.logspace(-2, math.log10(math.pi / dt * 0.999), n_freq)
+    z = np.exp(1j * w * dt)
+    P = np.polyval(bp, z) / np.polyval(ap, z)
+    C = (bc[0] + bc[1] / z) * z ** (-delay)
+    L = P * C
+    mag = np.abs(L)
+    ph = np.unwrap(np.angle(L))
+    # closed-loop poles: 1 + L = 0 -> ap(z)·z^(delay+1) + bp(z)·(bc0 z + bc1)·... in z
+    num_L = np.polymul(bp, bc)  # bp(z)·(bc0 z + bc1) / (ap(z)·z·z^delay)
+    den_L = np.polymul(ap, np.r_[1.0, np.zeros(delay + 1)])
+    num_pad = np.r_[np.zeros(len(den_L) - len(num_L)), num_L] if len(num_L) < len(den_L) else num_L
+    char = np.polyadd(den_L, num_pad)
+    poles = np.roots(char)
+    stable = bool(np.all(np.abs(poles) < 1.0))
+    out = dict(gain_margin=math.inf, phase_margin_deg=math.inf, gain_crossover_hz=math.nan,
+               phase_crossover_hz=math.nan, delay_margin_s=math.inf, stable=stable,
+               max_pole_radius=float(np.max(np.abs(poles))))
+    idx = np.flatnonzero((mag[:-1] >= 1.0) & (mag[1:] < 1.0))
+    if idx.size:
+        i = idx[-1]
+        wc = w[i] + (w[i + 1] - w[i]) * (mag[i] - 1) / (mag[i] - mag[i + 1])
+        phc = np.interp(wc, w, ph)
+        pm = math.degrees(phc) + 180.0
+        pm = (pm + 180.0) % 360.0 - 180.0
+        out.update(phase_margin_deg=pm, gain_crossover_hz=wc / (2 * math.pi),
+                   delay_margin_s=math.radians(pm) / wc if pm > 0 else 0.0)
+    cross = np.flatnonzero(np.diff(np.floor((ph + math.pi) / (2 * math.pi))) != 0)
+    if cross.size:
+        i = cross[0]
+        w180 = w[i]
+        out.update(gain_margin=1.0 / float(np.interp(w180, w, mag)), phase_crossover_hz=w180 / (2 * math.pi))
+    return out
+
+
+def impedance_margins(finger: DLRFinger, controller: ImpedanceController, q=(0.0, 0.3, 0.3), *,
+                      dt: float = 1e-3, wall: Wall | None = None) -> list[dict]:
+    """Stability margins per actuator at joint configuration ``q`` (rad), free or against
+    ``wall``: the impedance and the wall stiffness are mapped to actuator space and the diagonal
+    of each is used with the actuator's apparent inertia (diagonal of M_p)."""
+    ch = finger.chain()
+    G = ch.coupling.matrix
+    p = np.linalg.solve(G[:3], np.asarray(q, dtype=np.float64))
+    M = ch.mass_matrix(p)
+    K = np.diag(controller.stiffness)
+    D = np.diag(controller.damping)
+    if controller.kind == "cartesian":
+        Jp = ch.jacobian(p)[:3]
+        Kp = Jp.T @ K @ Jp
+        Dp = Jp.T @ D @ Jp
+    else:
+        Kp = G[:3].T @ K @ G[:3]
+        Dp = G[:3].T @ D @ G[:3]
+    Dp = Dp + np.diag(controller.actuator_damping)
+    Ke = np.zeros((3, 3))
+    if wall is not None:
+        Jp = ch.jacobian(p)[:3]
+        n = np.asarray(wall.normal)
+        Ke = wall.stiffness * (Jp.T @ np.outer(n, n) @ Jp)
+    v = finger.parameters.value
+    out = []
+    for k, a in enumerate(ACTUATORS):
+        visc = v(f"visc_{a}") if finger.friction in ("stribeck", "lugre") else 0.0
+        m = stability_margins(M[k, k], Kp[k, k], Dp[k, k], dt, viscous=visc, k_env=Ke[k, k])
+        out.append(dict(actuator=a, inertia=float(M[k, k]), stiffness=float(Kp[k, k]),
+                        damping=float(Dp[k, k]), k_env=float(Ke[k, k]), **m))
+    return out

@@ -1,0 +1,21 @@
+"""The FemtoTools FT-G100 electrostatic MEMS microgripper (``003_abd62b560633beaf.txt``).
+
+- :mod:`.model` — the knowledge-based models: actuated and sensing subsystems, the coupled model,
+  the nonlinear plant, the discrete state space at 20 kHz (eqs 1–18);
+- :mod:`.parameters` — the seed's identified values and the zoo's model factories;
+- :mod:`.identification` — the seed's identification experiments, simulated, and their
+  Levenberg-Marquardt identification (§III-B, §III-D);
+- :mod:`.hybrid_control` — hybrid force/position control of the gripper arm (the seed's future
+  work); :mod:`.scenario` — the ``ftg100-grasp`` sweep scenario;
+- :mod:`.demo` — the demo-report section.
+
+A flat list of explicit re-exports.
+"""
+
+from .hybrid_control import HybridForcePosition as HybridForcePosition
+from .hybrid_control import HybridGraspResult as HybridGraspResult
+from .hybrid_control import simulate_hybrid_grasp as simulate_hybrid_grasp
+from .model import FTG100Actuated as FTG100Actuated
+from .model import FTG100Coupled as FTG100Coupled
+from .model import FTG100Plant as FTG100Plant
+from .model import FTG100Sensing as FTG100Sensing

@@ -1,0 +1,895 @@
+"""FemtoTools FT-G100 electrostatic MEMS microgripper: knowledge-based models (seed
+``003_abd62b560633beaf.txt``, Boudaoud, Haddab & Le Gorrec, IROS 2010, §II-III, eqs 1-18).
+
+The extracted text interleaves the paper's two columns and loses Greek letters, minus signs and
+fraction bars. The equations as gripkit reconstructs them (SI units throughout; the seed's own
+numbers are in µm, µN, mg, mN·s/m):
+
+Actuated subsystem (comb drive + actuated arm), eq 2, electrode displacement x_ea:
+    M_a ẍ_ea + K_fa ẋ_ea + K_sa x_ea = F_x − D_a F_c
+  F_x = N_a ε h V²/(2g) (eq 5, :mod:`gripkit.models.comb_drive`), K_sa = 32 E h w³/L₁³ (eq 4,
+  :mod:`gripkit.models.beams`), F_c the gripping force at the arm tip, x_a = D_a x_ea.
+
+Amplification (eqs 3, 12). The extracted ``Da = (H  l / 2)/(a l / 2)`` lost both signs. With a
+hinge at l/2 from the arm's clamp (Fig. 6) the four candidates give, for H = 5300, l = 300,
+a = 950, b = 700 µm:
+    (H − l/2)/(a + l/2) = 4.682 | 6.059   <- the seed's D_a = 4.7, D_b = 6.05
+    (H + l/2)/(a + l/2) = 4.955 | 6.412
+    (H − l/2)/(a − l/2) = 6.438 | 9.364
+    (H + l/2)/(a − l/2) = 6.813 | 9.909
+  so D = x_tip/x_e = (H − l/2)/(arm + l/2) (:func:`amplification_ratio`).
+
+Object and coupling (eqs 6-7): the grasped object is a spring k0 between the arm tips,
+    F_c = k0 (x_a − x_b) = k2 x_b   ⇒   x_b = k0/(k0 + k2) x_a,   F_c = k_k x_a,
+    k_k = k0 k2/(k0 + k2)  (k0 and the sensing arm's stiffness k2 in series).
+
+Linearisation at V_in0 = 70 V (eqs 8-9). Writing x_ea = x̃_a/D_a and F_c = k_k x̃_a in eq 2 and
+expanding F_x to first order (∂F_x/∂V = N_a ε h V₀/g; eq 8 writes h as ``t`` and ε as ``H``):
+    (M_a/D_a) x̃_a'' + (K_fa/D_a) x̃_a' + (K_sa/D_a + D_a k_k) x̃_a = N_a ε h V₀/g · Ṽ_in   (eq 8)
+    G_a(s) = X̃_a/Ṽ_in = D_a N_a ε h V₀/g / (M_a s² + K_fa s + K_sa + D_a² k_k)          (eq 9)
+
+Sensing subsystem (eqs 11-16), electrode displacement x_eb, x_b = D_b x_eb:
+    M_b ẍ_eb + K_fb ẋ_eb + K_sb x_eb = D_b F_c                                           (eq 11)
+    M_b ẍ_b + K_fb ẋ_b + K_sb x_b = D_b² F_c,  G_b(s) = D_b²/(M_b s² + K_fb s + K_sb)   (eqs 14-15)
+    K_sb = 32 E h w³/L₂³ (eq 13),  k2 = K_sb/D_b² (eq 16: the tip stiffness of the sensing arm).
+
+Discrete models (eqs 10, 17, 18). G_a and G_b are discretised with a zero-order hold at 20 kHz and
+written in MATLAB's controllable canonical form x(k+1) = [[−a₁, −a₂], [1, 0]] x + [s, 0]ᵀ u,
+y = [b₁, b₂]/s · x, where G(z) = (b₁z + b₂)/(z² + a₁z + a₂) in the seed's units (µm/V, µm/µN)
+and s is a power-of-two balancing scale (:func:`controllable_form`). The coupled model (eq 18):
+    [x1; x2](k+1) = [[A_a, 0], [B_c k_k C_a, A_c]] [x1; x2](k) + [B_a; 0] V_in(k)
+    V_out(k) = [0, (k2/r) C_c] [x1; x2](k)
+  with r the readout sensitivity. The seed prints "r ... (50 N/Volts)". Fig. 10's sensor reads up
+  to 140 µN: with r = 50 N/V that is 2.8 µV at the MS3110 readout's output, which delivers volts;
+  in the seed's own unit system (µm, µN, V: k2 in µN/µm times x_b in µm is µN) the number 50 is
+  50 µN/V, giving 2.8 V at 140 µN. gripkit uses r = 50 µN/V = 5e-5 N/V and reports the printed unit
+  as a finding.
+
+Damping units. The seed prints K_fa = 1.3 "mNs²/m" and K_fb = 0.71 "mNs²/m"; a damping coefficient
+is force per velocity, N·s/m, and with K_fa = 1.3 mN·s/m eq 10's pole radius √0.9536 = 0.9765 is
+reproduced to 0.01 % (a check below), so the unit is mN·s/m.
+
+Nonlinear plant (the paper's future work, :class:`FTG100Plant`): both arms as second-order
+systems in electrode coordinates, suspensions stiffening as K x (1 + β (x/w)²) (beams.py), the
+quadratic comb-drive force clipped to 0-200 V, and the object as a unilateral spring(-damper)
+between the tips that engages when the free gap closes:
+    δ = x_a − x_b − gap,   F_c = max(0, k0 δ + c0 δ̇) while δ > 0, else 0,
+with the contact instant located inside the integration step (see :func:`advance_plant`).
+"""
+
+from __future__ import annotations
+
+import abc
+import math
+
+import numba
+import numpy as np
+from scipy.optimize import brentq
+
+from ...consistency import Finding, compare
+from ...errors import ModelError
+from ...models.beams import STRETCHING_BETA, clamped_clamped_stiffness
+from ...models.comb_drive import comb_drive_coefficient
+from ...models.second_order import second_order_batch
+from ...params import Parameter, ParameterSet
+from ...sim.linear import StateSpace, c2d_zoh, simulate_discrete
+from ...sim.model import Model, Signal
+
+__all__ = [
+    "SEED", "amplification_ratio", "ftg100_geometry", "ftg100_parameters", "controllable_form",
+    "balancing_scale", "seed_state_space", "SEED_EQ10", "SEED_EQ17", "FTG100Actuated",
+    "FTG100Sensing", "FTG100Coupled", "FTG100Plant", "plant_parameters", "advance_plant",
+    "R_SENSITIVITY",
+]
+
+SEED = "003_abd62b560633beaf.txt"
+_S = SEED + ", "
+#: Readout sensitivity r of eq 18 as gripkit reads it: 50 µN/V (the seed prints "50 N/Volts").
+R_SENSITIVITY = 50e-6
+
+# Eq 10 and eq 17 as printed (seed units: V -> µm for eq 10, µN -> µm for eq 17), 20 kHz.
+SEED_EQ10 = dict(A=[[1.6621, -0.9536], [1.0, 0.0]], B=[[0.25], [0.0]], C=[[0.1104, 0.1086]],
+                 fs=20000.0, input="V_in", input_unit="V", output="x_a", output_unit="um",
+                 source=_S + "eq 10")
+SEED_EQ17 = dict(A=[[1.142174, -0.947527], [1.0, 0.0]], B=[[0.5], [0.0]], C=[[0.132080, 0.129656]],
+                 fs=20000.0, input="F_c", input_unit="uN", output="x_b", output_unit="um",
+                 source=_S + "eq 17")
+
+_UNIT = {"um": 1e-6, "uN": 1e-6, "V": 1.0, "m": 1.0, "N": 1.0}
+
+
+def amplification_ratio(H: float, l: float, arm: float) -> float:
+    """Tip-to-electrode displacement ratio D = (H − l/2)/(arm + l/2) (eqs 3, 12; signs reconstructed
+    in the module docstring). ``H``, ``l``, ``arm`` (a or b) in any one length unit."""
+    H, l, arm = float(H), float(l), float(arm)
+    if not (H > 0 and l > 0 and arm > 0) or H <= l / 2:
+        raise ModelError(f"amplification ratio: expected positive dimensions with H > l/2, found "
+                         f"H={H:g}, l={l:g}, arm={arm:g}")
+    return (H - l / 2.0) / (arm + l / 2.0)
+
+
+def ftg100_geometry() -> ParameterSet:
+    """The FT-G100 dimensions and materials the seed gives (§III-A, III-C, Fig. 2, Fig. 6)."""
+    um = 1e-6
+    P = Parameter
+    return ParameterSet([
+        P("E", 190e9, "Pa", "Young's modulus of the silicon beams", (0, None), source=_S + "§III-A, after eq 4", display_unit="GPa"),
+        P("h", 50 * um, "m", "structure (beam and finger) thickness", (0, None), source=_S + "§III-A, after eq 4", display_unit="um"),
+        P("w", 8 * um, "m", "suspension beam width", (0, None), source=_S + "§III-A, after eq 4", display_unit="um"),
+        P("L1", 1830 * um, "m", "actuator suspension beam length", (0, None), source=_S + "§III-A, after eq 4", display_unit="um"),
+        P("L2", 870 * um, "m", "sensor suspension beam length", (0, None), source=_S + "§III-C, after eq 15", display_unit="um"),
+        P("H", 5300 * um, "m", "arm length dimension of eqs 3/12", (0, None), source=_S + "§III-A, after eq 3", display_unit="um"),
+        P("l", 300 * um, "m", "hinge dimension of eqs 3/12 (hinge at l/2 from the clamp)", (0, None), source=_S + "§III-A, after eq 3", display_unit="um"),
+        P("a", 950 * um, "m", "actuated-arm lever dimension of eq 3", (0, None), source=_S + "§III-A, after eq 3", display_unit="um"),
+        P("b", 700 * um, "m", "sensing-arm lever dimension of eq 12", (0, None), source=_S + "§III-C, after eq 15", display_unit="um"),
+        P("N_a", 1300.0, "1", "electrode pairs of the lateral comb drive", (1, None), source=_S + "§III-A, after eq 5"),
+        P("eps", 8.85e-12, "F/m", "permittivity of the comb gaps (air)", (0, None), source=_S + "§III-A, after eq 5", display_unit="pF/m"),
+        P("g", 6 * um, "m", "gap between comb fingers", (0, None), source=_S + "§III-A, after eq 5", display_unit="um"),
+        P("V_max", 200.0, "V", "maximum actuation voltage (full close)", (0, None), source=_S + "§II-A"),
+        P("opening", 100 * um, "m", "initial opening between the arm tips", (0, None), source=_S + "§II-A", display_unit="um"),
+        P("resolution", 50e-9, "N", "force sensor resolution", (0, None), source=_S + "§II-A", display_unit="uN"),
+        P("force_range", 140e-6, "N", "largest force of the static sensor characteristic", (0, None), source=_S + "§III-D, Fig. 10", display_unit="uN"),
+        P("k2_measured", 6.48, "N/m", "sensing-arm stiffness measured from Fig. 10", (0, None), source=_S + "§III-D, Fig. 10"),
+        P("x_a70", 20e-6, "m", "static tip displacement at 70 V (free arm)", (0, None), source=_S + "§III-A, after Fig. 4", display_unit="um"),
+    ], "ftg100-geometry")
+
+
+def ftg100_parameters() -> ParameterSet:
+    """Every FT-G100 model parameter at the seed's values (SI), with provenance.
+
+    Stated values are used as printed (D_a = 4.7, K_sa = 25.4 N/m, ...); the consistency checks of
+    the models compare them with what eqs 3, 4, 12, 13, 16 give from the dimensions.
+    """
+    P = Parameter
+    return ParameterSet([
+        P("M_a", 1.37e-6, "kg", "total (effective) mass of the actuated subsystem", (1e-12, 1e-3), source=_S + "§III-B, LM estimate", display_unit="mg"),
+        P("K_fa", 1.3e-3, "N*s/m", "damping factor of the actuated subsystem", (0, 1.0), source=_S + "§III-B, LM estimate (printed unit mNs²/m read as mN·s/m)", display_unit="mN*s/m"),
+        P("k0", 1043.0, "N/m", "stiffness of the grasped object (80 µm glass ball)", (0, 1e7), source=_S + "§III-B, LM estimate"),
+        P("K_sa", 25.4, "N/m", "actuator suspension stiffness (two pairs of clamped-clamped beams)", (0, None), source=_S + "§III-A, eq 4 value stated after Fig. 7"),
+        P("D_a", 4.7, "1", "actuated-arm amplification x_a/x_ea", (0, None), source=_S + "§III-A, eq 3 value stated after Fig. 7"),
+        P("k2", 6.45, "N/m", "sensing-arm tip stiffness K_sb/D_b²", (0, None), source=_S + "§III-C, eq 16"),
+        P("N_a", 1300.0, "1", "electrode pairs of the lateral comb drive", (1, None), source=_S + "§III-A, after eq 5"),
+        P("eps", 8.85e-12, "F/m", "permittivity of the comb gaps (air)", (0, None), source=_S + "§III-A, after eq 5", display_unit="pF/m"),
+        P("h", 50e-6, "m", "comb-finger thickness", (0, None), source=_S + "§III-A, after eq 4", display_unit="um"),
+        P("g", 6e-6, "m", "gap between comb fingers", (0, None), source=_S + "§III-A, after eq 5", display_unit="um"),
+        P("V0", 70.0, "V", "operating voltage V_in0 of the linearisation", (0, 200), source=_S + "§III-A, before eq 8"),
+        P("M_b", 0.5e-6, "kg", "total mass of the sensing subsystem", (1e-12, 1e-3), source=_S + "§III-D, LM estimate", display_unit="mg"),
+        P("K_fb", 0.71e-3, "N*s/m", "damping factor of the sensing subsystem", (0, 1.0), source=_S + "§III-D, LM estimate (printed unit mNs²/m read as mN·s/m)", display_unit="mN*s/m"),
+        P("K_sb", 235.36, "N/m", "sensor suspension stiffness", (0, None), source=_S + "§III-C, eq 13 value stated"),
+        P("D_b", 6.05, "1", "sensing-arm amplification x_b/x_eb", (0, None), source=_S + "§III-C, eq 12 value stated"),
+        P("x_off", 0.0, "m", "output offset (sensor zero) of a displacement record", (-1e-3, 1e-3),
+          source="measurement offset, not in the seed", display_unit="um"),
+        P("r", R_SENSITIVITY, "N/V", "readout sensitivity (force per output volt)", (0, None), source=_S + "eq 18, printed '50 N/Volts', read as 50 µN/V (see module docstring)", display_unit="uN/V"),
+    ], "ftg100")
+
+
+# ------------------------------------------------------------------------------------------------
+# discrete canonical forms
+# ------------------------------------------------------------------------------------------------
+
+def balancing_scale(num: np.ndarray, unit_factor: float = 1.0) -> float:
+    """Power-of-two input scale s of MATLAB's controllable form: s = 2^round(log₂ √Σ|b_i|), with the
+    numerator b in the units the seed printed (``unit_factor`` converts SI to them, e.g. 1e6 for
+    m/V -> µm/V). This rule reproduces both printed forms: B_a = 0.25 (eq 10, Σ|b| = 0.0548 µm/V)
+    and B_c = 0.5 (eq 17, Σ|b| = 0.131 µm/µN). The scale is a similarity transform: poles, DC gain
+    and the transfer function do not depend on it."""
+    total = float(np.sum(np.abs(num))) * float(unit_factor)
+    if not total > 0:
+        return 1.0
+    return float(2.0 ** round(math.log2(math.sqrt(total))))
+
+
+def controllable_form(sys: StateSpace, *, scale: float | str = "balanced",
+                      unit_factor: float = 1.0) -> StateSpace:
+    """A SISO system in controllable canonical form (MATLAB's ``ss(tf(...))`` layout):
+
+        x(k+1) = [[−a₁, −a₂, …, −a_n], [1, 0, …], …] x(k) + [s, 0, …]ᵀ u(k),
+        y(k)   = [b₁, …, b_n]/s · x(k) + b₀ u(k),
+
+    for G = (b₀zⁿ + b₁zⁿ⁻¹ + … + b_n)/(zⁿ + a₁zⁿ⁻¹ + … + a_n) (or the same in s). ``scale`` is the
+    input scale s: ``'balanced'`` (:func:`balancing_scale` with ``unit_factor``), ``1.0`` for the
+    plain form, or any positive number.
+    """
+    from scipy.signal import ss2tf
+
+    if sys.B.shape[1] != 1 or sys.C.shape[0] != 1:
+        raise ModelError(f"controllable_form: expected a single-input single-output system, found "
+                         f"{sys.B.shape[1]} inputs and {sys.C.shape[0]} outputs")
+    num, den = ss2tf(sys.A, sys.B, sys.C, sys.D)
+    num = np.atleast_2d(num)[0]
+    n = sys.n_states
+    a = den[1:] / den[0]
+    b = num / den[0]
+    b0 = b[0]
+    bn = b[1:] - b0 * a  # strictly proper part
+    if scale == "balanced":
+        s = balancing_scale(bn, unit_factor)
+    else:
+        s = float(scale)
+        if not (math.isfinite(s) and s > 0):
+            raise ModelError(f"scale: expected 'balanced' or a positive number, found {scale!r}")
+    A = np.zeros((n, n))
+    A[0, :] = -a
+    A[1:, :-1] += np.eye(n - 1)
+    B = np.zeros((n, 1))
+    B[0, 0] = s
+    C = (bn / s).reshape(1, n)
+    meta = dict(sys.meta, form="controllable canonical", scale=s)
+    return StateSpace(A, B, C, np.array([[b0]]), sys.dt, sys.inputs, sys.outputs,
+                      sys.input_units, sys.output_units, meta)
+
+
+def seed_state_space(eq: dict) -> StateSpace:
+    """The seed's printed discrete system (``SEED_EQ10`` or ``SEED_EQ17``) converted to SI."""
+    fin, fout = _UNIT[eq["input_unit"]], _UNIT[eq["output_unit"]]
+    C = np.asarray(eq["C"], dtype=float) * fout / fin  # y_SI = fout y_seed, u_seed = u_SI/fin
+    return StateSpace(eq["A"], eq["B"], C, None, 1.0 / eq["fs"], (eq["input"],), (eq["output"],),
+                      ("N" if eq["input_unit"] == "uN" else "V",), ("m",), {"source": eq["source"]})
+
+
+def _canonical_findings(subject: str, computed: StateSpace, eq: dict, pole_tol: float, dc_tol: float,
+                        used: str) -> list[Finding]:
+    seed = seed_state_space(eq)
+    pc = np.sort_complex(computed.poles())
+    ps = np.sort_complex(seed.poles())
+    # worst relative pole distance (conjugate pairs sorted alike)
+    rel = float(np.max(np.abs(pc - ps) / np.abs(ps)))
+    name = eq["source"].split(", ")[-1]
+    out = [Finding(f"{name.replace(' ', '')}-poles", subject, rel <= pole_tol,
+                   f"discrete poles from the parameters {_fmt_poles(pc)} vs {name} {_fmt_poles(ps)}: "
+                   f"{100 * rel:.3g} % apart (tolerance {100 * pole_tol:.3g} %); continuous equivalents "
+                   f"{_fmt_modes(pc, computed.dt)} vs {_fmt_modes(ps, seed.dt)}",
+                   used, float(abs(pc[0])), float(abs(ps[0])), rel, pole_tol, eq["source"])]
+    dc_c = float(computed.dc_gain()[0, 0])
+    dc_s = float(seed.dc_gain()[0, 0])
+    unit = "m/V" if eq["input_unit"] == "V" else "m/N"
+    out.append(compare(f"{name.replace(' ', '')}-dc-gain", subject, computed=dc_c, stated=dc_s, rtol=dc_tol,
+                       what=f"DC gain C(I−A)⁻¹B from the parameters vs the printed {name} matrices",
+                       unit=unit, used=used, source=eq["source"]))
+    return out
+
+
+def _fmt_poles(p) -> str:
+    return "{" + ", ".join(f"{z.real:.6f}{z.imag:+.6f}j" for z in p) + "}"
+
+
+def _fmt_modes(p, dt) -> str:
+    s = np.log(p[0]) / dt
+    return f"{abs(s) / (2 * math.pi):.5g} Hz, ζ = {-s.real / abs(s):.4f}"
+
+
+# ------------------------------------------------------------------------------------------------
+# linear models (eqs 8-10, 14-17, 18)
+# ------------------------------------------------------------------------------------------------
+
+def _sub(names):
+    full = ftg100_parameters()
+    return ParameterSet([full[n] for n in names], "ftg100")
+
+
+class _SecondOrderFTG(Model):
+    """Shared machinery of the two second-order subsystems: m ẍ + c ẋ + k x = gain (u − u0),
+    simulated exactly (zero-order hold, :func:`gripkit.models.second_order.second_order_batch`)."""
+
+    integrator = "zoh"
+
+    @abc.abstractmethod
+    def _coefficients(self, thetas: np.ndarray) -> np.ndarray:
+        """(P, 6): m, c, k, gain, u0, y0 of each parameter vector (each subsystem's own reading)."""
+
+    def _simulate_batch(self, thetas, u, dt, substeps, x0, y):
+        second_order_batch(self._coefficients(thetas), u, dt, x0, y)
+
+    def modes(self, theta):
+        m, c, k = self._coefficients(np.atleast_2d(np.asarray(theta, float)))[0, :3]
+        if k <= 0:
+            return []
+        return [(math.sqrt(k / m), c / (2 * math.sqrt(k * m)))]
+
+    def natural_frequency_hz(self) -> float:
+        return self.modes(self.theta())[0][0] / (2 * math.pi)
+
+    def damping_ratio(self) -> float:
+        return self.modes(self.theta())[0][1]
+
+    def state_space(self) -> StateSpace:
+        """Continuous state space, states [y, ẏ] (output coordinates)."""
+        m, c, k, gain, _, _ = self._coefficients(self.theta()[None, :])[0]
+        A = [[0.0, 1.0], [-k / m, -c / m]]
+        B = [[0.0], [gain / m]]
+        return StateSpace(A, B, [[1.0, 0.0]], None, None, (self.inputs[0].name,), (self.outputs[0].name,),
+                          (self.inputs[0].unit,), (self.outputs[0].unit,), {"model": self.name})
+
+    def transfer_function(self) -> tuple[np.ndarray, np.ndarray]:
+        """(num, den) of G(s) in SI, highest power first (eqs 9, 15)."""
+        m, c, k, gain, _, _ = self._coefficients(self.theta()[None, :])[0]
+        return np.array([gain]), np.array([m, c, k])
+
+    def discrete(self, fs: float = 20000.0, form: str = "canonical") -> StateSpace:
+        """ZOH discretisation at ``fs`` Hz: ``form='canonical'`` is the controllable canonical form
+        the seed prints (eqs 10, 17; balancing scale chosen in the seed's units), ``'physical'``
+        keeps the states [y, ẏ]."""
+        fs = float(fs)
+        if not (math.isfinite(fs) and fs > 0):
+            raise ModelError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
+        d = self.state_space().discretize(1.0 / fs)
+        if form == "physical":
+            return d
+        if form != "canonical":
+            raise ModelError(f"form: expected 'canonical' or 'physical', found {form!r}")
+        return controllable_form(d, unit_factor=self._seed_unit_factor)
+
+
+class FTG100Actuated(_SecondOrderFTG):
+    """Actuated subsystem linearised at V_in0 while the object is grasped (eqs 8-9):
+
+        M_a x̃_a'' + K_fa x̃_a' + (K_sa + D_a² k_k) x̃_a = D_a N_a ε h V₀/g · (V_in − V₀),
+        k_k = k0 k2/(k0 + k2).
+
+    Input ``V_in`` (V, absolute actuation voltage); output ``x_a`` (m, tip displacement from the
+    operating point, plus the sensor zero ``x_off``, 0 by default). Free by default: M_a, K_fa, k0
+    (the LM estimates of §III-B).
+    """
+
+    name = "ftg100-actuated"
+    description = "FT-G100 actuated subsystem linearised at 70 V, object grasped (eqs 8-10)"
+    inputs = (Signal("V_in", "V", "actuation voltage (absolute)"),)
+    outputs = (Signal("x_a", "m", "actuated-arm tip displacement from the operating point"),)
+    states = (Signal("x_a", "m", "tip displacement"), Signal("v_a", "m/s", "tip velocity"))
+    _seed_unit_factor = 1e6  # eq 10 is in µm per V
+    _names = ("M_a", "K_fa", "k0", "K_sa", "D_a", "k2", "N_a", "eps", "h", "g", "V0", "x_off")
+
+    def __init__(self, parameters: ParameterSet | None = None, *, check: bool = True, **values):
+        ps = parameters if parameters is not None else _sub(self._names).fix(*self._names[3:])
+        if values:
+            ps = ps.replace(**values)
+        super().__init__(ps, check=check)
+
+    def _coefficients(self, thetas):
+        M, c, k0, Ksa, Da, k2, Na, eps, h, g, V0, off = thetas.T
+        kk = k0 * k2 / (k0 + k2)
+        gain = Da * Na * eps * h * V0 / g
+        return np.column_stack([M, c, Ksa + Da * Da * kk, gain, V0, off])
+
+    def series_stiffness(self) -> float:
+        """k_k = k0 k2/(k0 + k2) [N/m] (eq 7)."""
+        p = self.parameters
+        return p.value("k0") * p.value("k2") / (p.value("k0") + p.value("k2"))
+
+    def dc_gain(self) -> float:
+        """Static gain x̃_a/Ṽ_in [m/V] of eq 9."""
+        num, den = self.transfer_function()
+        return float(num[0] / den[2])
+
+    def consistency_checks(self) -> list[Finding]:
+        p = self.parameters
+        geo = ftg100_geometry()
+        gv = geo.value
+        sub = self.name
+        out = [
+            compare("K_sa-eq4", sub, computed=clamped_clamped_stiffness(gv("E"), gv("h"), gv("w"), gv("L1")),
+                    stated=p.value("K_sa"), rtol=0.005, unit="N/m", what="32 E h w³/L₁³ (eq 4)",
+                    used="the stated K_sa", source=_S + "§III-A"),
+            compare("D_a-eq3", sub, computed=amplification_ratio(gv("H"), gv("l"), gv("a")), stated=p.value("D_a"),
+                    rtol=0.01, what="(H − l/2)/(a + l/2) (eq 3, signs reconstructed)", used="the stated D_a = 4.7",
+                    source=_S + "§III-A"),
+        ]
+        # damping unit: the pole radius of eq 10 is exp(−K_fa/(2 M_a)·T) only if K_fa is in N·s/m
+        T = 1.0 / SEED_EQ10["fs"]
+        radius = math.exp(-p.value("K_fa") / (2.0 * p.value("M_a")) * T)
+        out.append(compare("damping-unit", sub, computed=radius, stated=math.sqrt(0.9536), rtol=0.002,
+                           what="pole radius exp(−K_fa T/(2 M_a)) with K_fa = 1.3 mN·s/m (the printed "
+                                "'mNs²/m' is not a damping unit)",
+                           used="K_fa in mN·s/m", source=_S + "§III-B, eq 10"))
+        out += _canonical_findings(sub, self.discrete(SEED_EQ10["fs"]), SEED_EQ10, pole_tol=0.003,
+                                   dc_tol=0.015, used="the parameters (the printed matrices are rounded)")
+        return out
+
+
+class FTG100Sensing(_SecondOrderFTG):
+    """Sensing subsystem (eqs 14-15): M_b ẍ_b + K_fb ẋ_b + K_sb x_b = D_b² F_c.
+
+    Input ``F_c`` (N, gripping force at the sensing-arm tip); output ``x_b`` (m, tip deflection,
+    plus the sensor zero ``x_off``, 0 by default). Free by default: M_b, K_fb (§III-D).
+    """
+
+    name = "ftg100-sensing"
+    description = "FT-G100 sensing subsystem, gripping force to sensing-arm tip deflection (eqs 14-17)"
+    inputs = (Signal("F_c", "N", "gripping force at the sensing-arm tip"),)
+    outputs = (Signal("x_b", "m", "sensing-arm tip deflection"),)
+    states = (Signal("x_b", "m", "tip deflection"), Signal("v_b", "m/s", "tip velocity"))
+    _seed_unit_factor = 1.0  # eq 17 is in µm per µN = m/N
+    _names = ("M_b", "K_fb", "K_sb", "D_b", "x_off")
+
+    def __init__(self, parameters: ParameterSet | None = None, *, check: bool = True, **values):
+        ps = parameters if parameters is not None else _sub(self._names).fix("K_sb", "D_b", "x_off")
+        if values:
+            ps = ps.replace(**values)
+        super().__init__(ps, check=check)
+
+    def _coefficients(self, thetas):
+        M, c, K, D, off = thetas.T
+        return np.column_stack([M, c, K, D * D, np.zeros_like(M), off])
+
+    def stiffness(self) -> float:
+        """k2 = K_sb/D_b² [N/m] (eq 16)."""
+        return self.parameters.value("K_sb") / self.parameters.value("D_b") ** 2
+
+    def consistency_checks(self) -> list[Finding]:
+        p = self.parameters
+        gv = ftg100_geometry().value
+        sub = self.name
+        out = [
+            compare("K_sb-eq13", sub, computed=clamped_clamped_stiffness(gv("E"), gv("h"), gv("w"), gv("L2")),
+                    stated=p.value("K_sb"), rtol=0.01, unit="N/m",
+                    what="32 E h w³/L₂³ (eq 13; L₂ = 871.2 µm gives the printed value)",
+                    used="the stated K_sb = 235.36 N/m", source=_S + "§III-C"),
+            compare("D_b-eq12", sub, computed=amplification_ratio(gv("H"), gv("l"), gv("b")), stated=p.value("D_b"),
+                    rtol=0.01, what="(H − l/2)/(b + l/2) (eq 12, signs reconstructed)", used="the stated D_b = 6.05",
+                    source=_S + "§III-C"),
+            compare("k2-eq16", sub, computed=self.stiffness(), stated=6.45, rtol=0.01, unit="N/m",
+                    what="K_sb/D_b² (eq 16)", used="k2 = 6.45 N/m where k2 appears", source=_S + "§III-C"),
+            compare("k2-measured", sub, computed=self.stiffness(), stated=ftg100_geometry().value("k2_measured"),
+                    rtol=0.01, unit="N/m", what="K_sb/D_b² (eq 16) vs the Fig. 10 slope",
+                    used="k2 = 6.45 N/m", source=_S + "§III-D, Fig. 10"),
+        ]
+        out += self._eq17_findings()
+        return out
+
+    def _eq17_findings(self) -> list[Finding]:
+        """Eq 17 against the stated M_b, K_fb, K_sb, D_b — and the M_b its poles imply."""
+        sub = self.name
+        used = "the stated M_b = 0.5 mg (the identified value in the text); the printed A_c is not used"
+        out = _canonical_findings(sub, self.discrete(SEED_EQ17["fs"]), SEED_EQ17, pole_tol=0.003,
+                                  dc_tol=0.015, used=used)
+        seed = seed_state_space(SEED_EQ17)
+        s = np.log(seed.poles()[0]) / seed.dt
+        wn, sigma = abs(s), -s.real
+        p = self.parameters
+        m_from_k = p.value("K_sb") / wn ** 2
+        m_from_c = p.value("K_fb") / (2.0 * sigma)
+        out.append(compare("eq17-implied-M_b", sub, computed=m_from_k, stated=p.value("M_b"), rtol=0.02, unit="kg",
+                           what=(f"the mass the printed A_c implies, K_sb/ω_n² with ω_n = 2π·{wn / (2 * math.pi):.5g} Hz "
+                                 f"(K_fb/(2σ) gives {m_from_c * 1e6:.4g} mg, {100 * abs(m_from_c / m_from_k - 1):.2g} % "
+                                 f"from it)"),
+                           used=used, source=_S + "§III-D, eq 17"))
+        return out
+
+
+class FTG100Coupled(Model):
+    """Coupled gripper model (eq 18), continuous form: the actuated subsystem (eq 9) drives the
+    sensing subsystem (eq 15) through F_c = k_k x̃_a (eq 7); the readout gives V_out = k2 x_b / r.
+
+    States [x̃_a, ẋ̃_a, x_b, ẋ_b]; input ``V_in`` (V); outputs ``x_a`` (m), ``x_b`` (m), ``F_c`` (N),
+    ``V_out`` (V). :meth:`discrete_eq18` builds the seed's discrete block form from the two
+    discretised subsystems; :meth:`simulate` uses the exact ZOH of the continuous cascade.
+    """
+
+    name = "ftg100-coupled"
+    description = "FT-G100 coupled actuated/sensing model through the object stiffness (eq 18)"
+    inputs = (Signal("V_in", "V", "actuation voltage (absolute)"),)
+    outputs = (Signal("x_a", "m", "actuated tip displacement from the operating point"),
+               Signal("x_b", "m", "sensing tip deflection"), Signal("F_c", "N", "gripping force k_k x_a"),
+               Signal("V_out", "V", "force-sensor readout voltage k2 x_b / r"))
+    states = (Signal("x_a", "m"), Signal("v_a", "m/s"), Signal("x_b", "m"), Signal("v_b", "m/s"))
+    integrator = "zoh"
+    _names = FTG100Actuated._names[:-1] + FTG100Sensing._names[:-1] + ("r",)
+
+    def __init__(self, parameters: ParameterSet | None = None, *, check: bool = True, **values):
+        ps = parameters if parameters is not None else _sub(self._names).fix(
+            *(n for n in self._names if n not in ("M_a", "K_fa", "k0", "M_b", "K_fb")))
+        if values:
+            ps = ps.replace(**values)
+        super().__init__(ps, check=check)
+
+    def actuated(self) -> FTG100Actuated:
+        return self._parts(self.parameters)[0]
+
+    def sensing(self) -> FTG100Sensing:
+        return self._parts(self.parameters)[1]
+
+    @staticmethod
+    def _parts(ps: ParameterSet):
+        """(actuated, sensing, k_k, k2/r) for the coupled parameter set ``ps``."""
+        full = ftg100_parameters()
+
+        def pick(names):
+            return ParameterSet([ps[n] if n in ps else full[n] for n in names], "ftg100")
+
+        kk = ps.value("k0") * ps.value("k2") / (ps.value("k0") + ps.value("k2"))
+        return (FTG100Actuated(pick(FTG100Actuated._names), check=False),
+                FTG100Sensing(pick(FTG100Sensing._names), check=False), kk, ps.value("k2") / ps.value("r"))
+
+    @staticmethod
+    def _cascade(a: StateSpace, b: StateSpace, kk: float, readout: float):
+        """Eq 18's structure for two subsystems (continuous or discrete): the sensing input is
+        F_c = k_k x_a; outputs x_a, x_b, F_c, V_out = (k2/r) x_b."""
+        A = np.zeros((4, 4))
+        A[:2, :2] = a.A
+        A[2:, 2:] = b.A
+        A[2:, :2] = b.B @ (kk * a.C)
+        B = np.vstack([a.B, np.zeros((2, 1))])
+        C = np.zeros((4, 4))
+        C[0, :2] = a.C[0]
+        C[1, 2:] = b.C[0]
+        C[2, :2] = kk * a.C[0]
+        C[3, 2:] = readout * b.C[0]
+        return A, B, C
+
+    def _matrices(self, theta):
+        ps = self.parameters.from_vector(theta, self.parameters.names)
+        act, sen, kk, readout = self._parts(ps)
+        A, B, C = self._cascade(act.state_space(), sen.state_space(), kk, readout)
+        return A, B, C, ps.value("V0")
+
+    def state_space(self) -> StateSpace:
+        A, B, C, _ = self._matrices(self.theta())
+        return StateSpace(A, B, C, None, None, ("V_in",), tuple(s.name for s in self.outputs), ("V",),
+                          tuple(s.unit for s in self.outputs), {"model": self.name})
+
+    def _simulate_batch(self, thetas, u, dt, substeps, x0, y):
+        for p in range(thetas.shape[0]):
+            A, B, C, V0 = self._matrices(thetas[p])
+            Ad, Bd = c2d_zoh(A, B, dt)
+            simulate_discrete(Ad, Bd, C, np.zeros((4, 1)), np.ascontiguousarray(u[:, :1] - V0), x0[p].copy(), y[p])
+
+    def modes(self, theta):
+        A, _, _, _ = self._matrices(theta)
+        lam = np.linalg.eigvals(A)
+        return [(abs(v), -v.real / abs(v)) for v in lam if v.imag >= 0]
+
+    def discrete(self, fs: float = 20000.0, form: str = "canonical") -> StateSpace:
+        """``form='canonical'``: the seed's eq 18 block form (:meth:`discrete_eq18`); ``'physical'``:
+        the exact zero-order hold of the continuous cascade (states [x̃_a, ẋ̃_a, x_b, ẋ_b])."""
+        if form == "canonical":
+            return self.discrete_eq18(fs)
+        if form != "physical":
+            raise ModelError(f"form: expected 'canonical' or 'physical', found {form!r}")
+        fs = float(fs)
+        if not (math.isfinite(fs) and fs > 0):
+            raise ModelError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
+        return self.state_space().discretize(1.0 / fs)
+
+    def discrete_eq18(self, fs: float = 20000.0) -> StateSpace:
+        """The seed's eq 18: [[A_a, 0], [B_c k_k C_a, A_c]] from the canonical subsystems (eqs 10, 17);
+        outputs x_a, x_b, F_c, V_out (SI). The sensing subsystem sees F_c = k_k x_a held over each
+        sample (a ZOH approximation of the continuous cascade; the DC gain is exact)."""
+        act, sen, kk, readout = self._parts(self.parameters)
+        A, B, C = self._cascade(act.discrete(fs), sen.discrete(fs), kk, readout)
+        return StateSpace(A, B, C, None, 1.0 / fs, ("V_in",), tuple(s.name for s in self.outputs), ("V",),
+                          tuple(s.unit for s in self.outputs), {"model": self.name, "form": "eq 18 block form"})
+
+    def consistency_checks(self) -> list[Finding]:
+        ps = self.parameters
+        out = self.actuated().consistency_checks() + self.sensing().consistency_checks()
+        out = [Finding(f.check, self.name, f.consistent, f.message, f.used, f.computed, f.stated, f.rel_error,
+                       f.tolerance, f.source) for f in out]
+        full_scale = ftg100_geometry().value("force_range")
+        printed_r = 50.0  # N/V as printed
+        out.append(Finding(
+            "readout-sensitivity-unit", self.name, False,
+            f"eq 18 prints r = 50 N/V: the {full_scale * 1e6:.0f} µN range of Fig. 10 would then be "
+            f"{full_scale / printed_r * 1e6:.3g} µV at the MS3110 readout, which outputs volts; in the seed's "
+            f"µm/µN/V units r = 50 µN/V gives {full_scale / ps.value('r'):.3g} V",
+            f"r = {ps.value('r') * 1e6:.3g} µN/V", full_scale / printed_r, full_scale / ps.value("r"),
+            math.nan, math.nan, _S + "eq 18, Fig. 10"))
+        return out
+
+
+# ------------------------------------------------------------------------------------------------
+# nonlinear plant
+# ------------------------------------------------------------------------------------------------
+
+_PLANT_NAMES = ("M_a", "K_fa", "K_sa", "K3_a", "D_a", "c_e", "M_b", "K_fb", "K_sb", "K3_b", "D_b",
+                "k0", "c0", "gap", "V_max")
+
+
+def plant_parameters(**values) -> ParameterSet:
+    """Parameters of :class:`FTG100Plant` (SI): the seed's values plus the nonlinear terms.
+
+    ``K3_a`` = K_sa β/w² with β = π⁴/128 (clamped-clamped stretching, :mod:`gripkit.models.beams`);
+    ``K3_b`` = 0 (Fig. 10: the sensor is linear up to 140 µN); ``c_e`` = N_a ε h/(2g) (eq 5);
+    ``gap`` = 100 µm opening − 80 µm ball; ``c0`` = 0 (the seed's object is a pure spring).
+    """
+    full = ftg100_parameters()
+    geo = ftg100_geometry()
+    P = Parameter
+    ce = comb_drive_coefficient(geo.value("N_a"), geo.value("eps"), geo.value("h"), geo.value("g"))
+    w = geo.value("w")
+    ps = ParameterSet([
+        full["M_a"], full["K_fa"], full["K_sa"],
+        P("K3_a", full.value("K_sa") * STRETCHING_BETA / w ** 2, "N/m**3",
+          "cubic stiffening of the actuator suspension (beam stretching)", (0, None),
+          source="assumed: Galerkin estimate K_sa·(π⁴/128)/w² (beams.py), Fig. 5 trend", display_unit="N/um**3"),
+        full["D_a"],
+        P("c_e", ce, "N/V**2", "comb-drive force coefficient N_a ε h/(2g)", (0, None), source=_S + "eq 5",
+          display_unit="nN/V**2"),
+        full["M_b"], full["K_fb"], full["K_sb"],
+        P("K3_b", 0.0, "N/m**3", "cubic stiffening of the sensor suspension", (0, None),
+          source=_S + "Fig. 10 (linear sensor up to 140 µN)"),
+        full["D_b"], full["k0"],
+        P("c0", 0.0, "N*s/m", "viscous damping of the object contact", (0, None),
+          source="assumed: the seed models the object as a pure spring (§III-E)"),
+        P("gap", 20e-6, "m", "free gap between the actuated tip and the object", (0, None),
+          source=_S + "§II-A opening 100 µm − 80 µm glass ball", display_unit="um"),
+        P("V_max", 200.0, "V", "actuation voltage limit", (0, None), source=_S + "§II-A"),
+    ], "ftg100-plant")
+    return ps.replace(**values) if values else ps
+
+
+@numba.njit(cache=True)
+def _plant_rhs(th, xa, va, xb, vb, V, contact):  # pragma: no cover - compiled
+    """Derivatives of [x_ea, v_ea, x_eb, v_eb] in mode ``contact`` (0 free, 1 touching)."""
+    fc = 0.0
+    if contact:
+        d = th[4] * xa - th[10] * xb - th[13]
+        dd = th[4] * va - th[10] * vb
+        fc = th[11] * d + th[12] * dd
+        if fc < 0.0 and th[12] > 0.0:  # a Kelvin-Voigt contact cannot pull
+            fc = 0.0
+    fx = th[5] * V * V
+    aa = (fx - th[1] * va - th[2] * xa - th[3] * xa * xa * xa - th[4] * fc) / th[0]
+    ab = (th[10] * fc - th[7] * vb - th[8] * xb - th[9] * xb * xb * xb) / th[6]
+    return va, aa, vb, ab
+
+
+@numba.njit(cache=True)
+def _plant_rk4(th, s0, s1, s2, s3, V, mode, h):  # pragma: no cover - compiled
+    k1a, k1b, k1c, k1d = _plant_rhs(th, s0, s1, s2, s3, V, mode)
+    hh = 0.5 * h
+    k2a, k2b, k2c, k2d = _plant_rhs(th, s0 + hh * k1a, s1 + hh * k1b, s2 + hh * k1c, s3 + hh * k1d, V, mode)
+    k3a, k3b, k3c, k3d = _plant_rhs(th, s0 + hh * k2a, s1 + hh * k2b, s2 + hh * k2c, s3 + hh * k2d, V, mode)
+    k4a, k4b, k4c, k4d = _plant_rhs(th, s0 + h * k3a, s1 + h * k3b, s2 + h * k3c, s3 + h * k3d, V, mode)
+    h6 = h / 6.0
+    return (s0 + h6 * (k1a + 2.0 * k2a + 2.0 * k3a + k4a), s1 + h6 * (k1b + 2.0 * k2b + 2.0 * k3b + k4b),
+            s2 + h6 * (k1c + 2.0 * k2c + 2.0 * k3c + k4c), s3 + h6 * (k1d + 2.0 * k2d + 2.0 * k3d + k4d))
+
+
+@numba.njit(cache=True)
+def _gap(th, s0, s2):  # pragma: no cover - compiled
+    return th[4] * s0 - th[10] * s2 - th[13]
+
+
+@numba.njit(cache=True)
+def advance_plant(th, s, mode, V, h, substeps):  # pragma: no cover - compiled
+    """Advance the plant state ``s`` = [x_ea, v_ea, x_eb, v_eb] (in place) by ``substeps`` RK4 steps
+    of ``h`` s at voltage ``V`` (clipped to [0, V_max]); returns the contact mode at the end.
+
+    Contact events: when the gap function δ = D_a x_ea − D_b x_eb − gap changes sign over a step
+    (δ > 0 while free, δ < 0 while touching), the crossing fraction θ of the step is found by the
+    Illinois (modified regula falsi) method on RK4 steps of θh from the step's start, the state is
+    advanced to the event, the mode switches, and the rest of the step is integrated in the new mode.
+    This keeps RK4's order across contact instead of smearing the kink over a step.
+    """
+    if th[11] <= 0.0:
+        mode = 0
+    if V < 0.0:
+        V = 0.0
+    elif V > th[14]:
+        V = th[14]
+    s0 = s[0]
+    s1 = s[1]
+    s2 = s[2]
+    s3 = s[3]
+    for _ in range(substeps):
+        rem = h
+        events = 0
+        while rem > 0.0:
+            # one RK4 call site (compile time): the first trial is the whole remaining step, later
+            # trials are Illinois iterations on the fraction theta of it
+            d0 = _gap(th, s0, s2)
+            lo, hi, flo, fhi = 0.0, 1.0, d0, 0.0
+            theta = 1.0
+            side = 0
+            located = False
+            for it in range(41):
+                n0, n1, n2, n3 = _plant_rk4(th, s0, s1, s2, s3, V, mode, theta * rem)
+                fm = _gap(th, n0, n2)
+                if it == 0:
+                    crossed = (mode == 0 and fm > 0.0) or (mode == 1 and fm < 0.0)
+                    if th[11] <= 0.0 or not crossed or events >= 4:
+                        break
+                    fhi = fm
+                else:
+                    if fm == 0.0 or (hi - lo) * rem < 1e-15 or abs(fm) <= 1e-13 * (abs(flo) + abs(fhi)):
+                        located = True
+                        break
+                    if (fm > 0.0) == (fhi > 0.0):
+                        hi, fhi = theta, fm
+                        if side == 1:
+                            flo *= 0.5
+                        side = 1
+                    else:
+                        lo, flo = theta, fm
+                        if side == -1:
+                            fhi *= 0.5
+                        side = -1
+                if fhi == flo:
+                    located = True
+                    break
+                theta = min(max((lo * fhi - hi * flo) / (fhi - flo), 0.0), 1.0)
+            s0, s1, s2, s3 = n0, n1, n2, n3
+            if it == 0:  # no event in this step
+                break
+            mode = 1 - mode  # (if not located after 41 iterations, the last iterate is the best estimate)
+            rem -= theta * rem
+            events += 1
+            if rem <= 1e-15 * h:
+                break
+    s[0] = s0
+    s[1] = s1
+    s[2] = s2
+    s[3] = s3
+    return mode
+
+
+@numba.njit(cache=True)
+def plant_outputs(th, s, mode, out):  # pragma: no cover - compiled
+    """out = [x_a, x_b, F_c (true contact force), F_s (sensor force k2 x_b)] for state ``s``."""
+    xa = th[4] * s[0]
+    xb = th[10] * s[2]
+    fc = 0.0
+    if mode == 1 and th[11] > 0.0:
+        fc = th[11] * (xa - xb - th[13]) + th[12] * (th[4] * s[1] - th[10] * s[3])
+        if fc < 0.0:
+            fc = 0.0
+    out[0] = xa
+    out[1] = xb
+    out[2] = fc
+    out[3] = th[8] / (th[10] * th[10]) * xb
+
+
+@numba.njit(cache=True, parallel=True)
+def _plant_batch(thetas, u, dt, substeps, x0, y):  # pragma: no cover - compiled
+    P = thetas.shape[0]
+    N = u.shape[0]
+    h = dt / substeps
+    for p in numba.prange(P):
+        th = thetas[p]
+        s = np.empty(4)
+        o = np.empty(4)
+        for i in range(4):
+            s[i] = x0[p, i]
+        mode = 1 if _gap(th, s[0], s[2]) > 0.0 and th[11] > 0.0 else 0
+        for n in range(N):
+            plant_outputs(th, s, mode, o)
+            for j in range(4):
+                y[p, n, j] = o[j]
+            mode = advance_plant(th, s, mode, u[n, 0], h, substeps)
+
+
+class FTG100Plant(Model):
+    """Nonlinear FT-G100 plant (the paper's deferred model): large-deflection suspensions, quadratic
+    comb-drive force with the 0-200 V limit, and the arms closing around an object (contact
+    switching located inside the step). See the module docstring for the equations.
+
+    Input ``V`` (V); outputs ``x_a``, ``x_b`` (m, tip displacements from rest), ``F_c`` (N, true
+    contact force), ``F_s`` (N, force sensor reading k2·x_b without noise). States are the
+    electrode displacements and velocities [x_ea, v_ea, x_eb, v_eb].
+    """
+
+    name = "ftg100-plant"
+    description = "FT-G100 nonlinear plant: stiffening suspensions, V² actuation, object contact"
+    inputs = (Signal("V", "V", "actuation voltage (clipped to [0, V_max])"),)
+    outputs = (Signal("x_a", "m", "actuated tip displacement"), Signal("x_b", "m", "sensing tip deflection"),
+               Signal("F_c", "N", "contact force on the object"), Signal("F_s", "N", "force sensor reading"))
+    states = (Signal("x_ea", "m", "actuator electrode displacement"), Signal("v_ea", "m/s"),
+              Signal("x_eb", "m", "sensor electrode displacement"), Signal("v_eb", "m/s"))
+    integrator = "rk4"
+
+    def __init__(self, parameters: ParameterSet | None = None, *, check: bool = True, **values):
+        ps = parameters if parameters is not None else plant_parameters()
+        if values:
+            ps = ps.replace(**values)
+        if tuple(ps.names) != _PLANT_NAMES:
+            raise ModelError(f"{self.name}: expected parameters {_PLANT_NAMES}, found {ps.names}")
+        super().__init__(ps, check=check)
+
+    def _simulate_batch(self, thetas, u, dt, substeps, x0, y):
+        _plant_batch(thetas, u, dt, substeps, x0, y)
+
+    # --- statics and linearisation --------------------------------------------------------------
+    def _p(self, theta=None):
+        th = self.theta() if theta is None else np.asarray(theta, float)
+        return dict(zip(_PLANT_NAMES, th))
+
+    @staticmethod
+    def _solve_cubic(k1, k3, f):
+        """x with k1 x + k3 x³ = f (monotonic for k1 > 0, k3 ≥ 0)."""
+        if f == 0.0:
+            return 0.0
+        hi = abs(f) / k1
+        return math.copysign(brentq(lambda x: k1 * x + k3 * x ** 3 - abs(f), 0.0, hi, xtol=1e-18, rtol=1e-14), f)
+
+    def equilibrium(self, V: float, theta=None) -> dict:
+        """Static equilibrium at voltage ``V``: electrode and tip displacements, contact force, and
+        the state vector ``x`` to start a simulation from."""
+        p = self._p(theta)
+        V = min(max(float(V), 0.0), p["V_max"])
+        fx = p["c_e"] * V * V
+        xea = self._solve_cubic(p["K_sa"], p["K3_a"], fx)
+        xeb, fc = 0.0, 0.0
+        if p["k0"] > 0 and p["D_a"] * xea - p["gap"] > 0:
+            def resid(F):
+                xeb_ = self._solve_cubic(p["K_sb"], p["K3_b"], p["D_b"] * F)
+                xa = p["gap"] + F / p["k0"] + p["D_b"] * xeb_
+                xe = xa / p["D_a"]
+                return fx - p["K_sa"] * xe - p["K3_a"] * xe ** 3 - p["D_a"] * F
+            fc = brentq(resid, 0.0, fx / p["D_a"], xtol=1e-20, rtol=1e-14)
+            xeb = self._solve_cubic(p["K_sb"], p["K3_b"], p["D_b"] * fc)
+            xea = (p["gap"] + fc / p["k0"] + p["D_b"] * xeb) / p["D_a"]
+        return dict(V=V, x_ea=xea, x_eb=xeb, x_a=p["D_a"] * xea, x_b=p["D_b"] * xeb, F_c=fc,
+                    x=np.array([xea, 0.0, xeb, 0.0]), contact=fc > 0)
+
+    def linearize(self, V: float, theta=None) -> StateSpace:
+        """Continuous small-signal model at the static equilibrium for ``V``: input ΔV (V), outputs
+        Δx_a, Δx_b, ΔF_c, ΔF_s; states [Δx_ea, Δv_ea, Δx_eb, Δv_eb]."""
+        p = self._p(theta)
+        eq = self.equilibrium(V, theta)
+        ka = p["K_sa"] + 3 * p["K3_a"] * eq["x_ea"] ** 2
+        kb = p["K_sb"] + 3 * p["K3_b"] * eq["x_eb"] ** 2
+        Da, Db, k0, c0 = p["D_a"], p["D_b"], p["k0"], p["c0"]
+        on = 1.0 if eq["contact"] else 0.0
+        Ma, Mb = p["M_a"], p["M_b"]
+        A = np.zeros((4, 4))
+        A[0, 1] = A[2, 3] = 1.0
+        A[1, 0] = -(ka + on * Da * Da * k0) / Ma
+        A[1, 1] = -(p["K_fa"] + on * Da * Da * c0) / Ma
+        A[1, 2] = on * Da * Db * k0 / Ma
+        A[1, 3] = on * Da * Db * c0 / Ma
+        A[3, 0] = on * Db * Da * k0 / Mb
+        A[3, 1] = on * Db * Da * c0 / Mb
+        A[3, 2] = -(kb + on * Db * Db * k0) / Mb
+        A[3, 3] = -(p["K_fb"] + on * Db * Db * c0) / Mb
+        B = np.array([[0.0], [2 * p["c_e"] * eq["V"] / Ma], [0.0], [0.0]])
+        C = np.array([[Da, 0, 0, 0], [0, 0, Db, 0], [on * k0 * Da, on * c0 * Da, -on * k0 * Db, -on * c0 * Db],
+                      [0, 0, p["K_sb"] / Db, 0]], float)
+        return StateSpace(A, B, C, None, None, ("V",), ("x_a", "x_b", "F_c", "F_s"), ("V",),
+                          ("m", "m", "N", "N"), {"model": self.name, "V0": eq["V"], "contact": bool(eq["contact"])})
+
+    def resonance(self, V: float, theta=None) -> tuple[float, float]:
+        """(f_n Hz, ζ) of the slowest mode of the small-signal model at ``V``."""
+        lam = self.linearize(V, theta).poles()
+        lam = lam[np.argsort(np.abs(lam))][0]
+        return abs(lam) / (2 * math.pi), -lam.real / abs(lam)
+
+    def modes(self, theta):
+        """Modes for the step-size rule: the free arms at rest and, if an object is present, the
+        arms in contact with the suspensions at their stiffest (free equilibrium at V_max)."""
+        p = self._p(theta)
+        lin = []
+        for V, contact in ((0.0, False), (p["V_max"], p["k0"] > 0)):
+            q = dict(p)
+            xe = self._solve_cubic(p["K_sa"], p["K3_a"], p["c_e"] * V * V)
+            ka = p["K_sa"] + 3 * p["K3_a"] * xe ** 2
+            on = 1.0 if contact else 0.0
+            Da, Db = q["D_a"], q["D_b"]
+            K = np.array([[ka + on * Da * Da * q["k0"], -on * Da * Db * q["k0"]],
+                          [-on * Da * Db * q["k0"], q["K_sb"] + on * Db * Db * q["k0"]]])
+            Cm = np.array([[q["K_fa"] + on * Da * Da * q["c0"], -on * Da * Db * q["c0"]],
+                           [-on * Da * Db * q["c0"], q["K_fb"] + on * Db * Db * q["c0"]]])
+            Minv = np.diag([1 / q["M_a"], 1 / q["M_b"]])
+            A = np.block([[np.zeros((2, 2)), np.eye(2)], [-Minv @ K, -Minv @ Cm]])
+            for v in np.linalg.eigvals(A):
+                if v.imag >= 0 and abs(v) > 0:
+                    lin.append((abs(v), max(-v.real / abs(v), 0.0)))
+        return lin
+
+    def consistency_checks(self) -> list[Finding]:
+        """The seed's static statements against this plant: 20 µm at 70 V and full close (100 µm
+        opening) at 200 V, both for the free arm."""
+        geo = ftg100_geometry()
+        free = self.with_parameters(check=False, k0=0.0)
+        x70 = free.equilibrium(70.0)["x_a"]
+        x200 = free.equilibrium(self.parameters.value("V_max"))["x_a"]
+        lin70 = self.parameters.value("D_a") * self.parameters.value("c_e") * 70.0 ** 2 / self.parameters.value("K_sa")
+        return [
+            compare("static-70V", self.name, computed=x70, stated=geo.value("x_a70"), rtol=0.1, unit="m",
+                    what=(f"free tip displacement at 70 V with eq 5 forces and stiffening suspensions "
+                          f"(linear suspensions: {lin70 * 1e6:.3g} µm)"),
+                    used="the physical constants (eq 5 force, eq 4 stiffness, beam stretching)",
+                    source=_S + "§III-A, after Fig. 4"),
+            compare("static-200V", self.name, computed=x200, stated=geo.value("opening"), rtol=0.1, unit="m",
+                    what="free tip displacement at 200 V (full close of the 100 µm opening)",
+                    used="the physical constants", source=_S + "§II-A"),
+        ]

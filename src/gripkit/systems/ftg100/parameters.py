@@ -1,0 +1,33 @@
+"""The FemtoTools FT-G100 microgripper (seed ``003_abd62b560633beaf.txt``) in the zoo: the seed's
+identified values and the factories of the zoo's models (the models and their parameter tables
+with provenance are in :mod:`gripkit.systems.ftg100.model`)."""
+
+from __future__ import annotations
+
+from .model import FTG100Actuated, FTG100Coupled, FTG100Plant, FTG100Sensing
+
+__all__ = ["PAPER_VALUES", "actuated_model", "sensing_model", "coupled_model", "plant_model"]
+
+#: The seed's identified values (SI) with their section.
+PAPER_VALUES = {"M_a": (1.37e-6, "§III-B"), "K_fa": (1.3e-3, "§III-B"), "k0": (1043.0, "§III-B"),
+                "M_b": (0.5e-6, "§III-D"), "K_fb": (0.71e-3, "§III-D")}
+
+
+def actuated_model(**values) -> FTG100Actuated:
+    """Zoo ``ftg100-actuated``: eqs 8-10 at the seed's values (M_a, K_fa, k0 free)."""
+    return FTG100Actuated(**values)
+
+
+def sensing_model(**values) -> FTG100Sensing:
+    """Zoo ``ftg100-sensing``: eqs 14-17 at the seed's values (M_b, K_fb free)."""
+    return FTG100Sensing(**values)
+
+
+def coupled_model(**values) -> FTG100Coupled:
+    """Zoo ``ftg100-coupled``: eq 18 (actuated and sensing subsystems through k_k, readout r)."""
+    return FTG100Coupled(**values)
+
+
+def plant_model(**values) -> FTG100Plant:
+    """The nonlinear plant (stiffening suspensions, V² actuation, contact with the object)."""
+    return FTG100Plant(**values)

@@ -1,0 +1,332 @@
+"""The two-finger grasp of ``001_0b92a7da96e7aa46.txt`` §I with the TSFM: force sensing on both
+fingers, no position sensor.
+
+"When a micropart is placed between microgripper fingers, a contact may appear between one finger
+and the micropart before the other which can lead to the loss of the micropart ... stopping the
+movement of the finger in contact with the micropart if the other finger has not reached the
+contact yet." The strategy, per finger, sample by sample at 20 kHz:
+
+1. **approach** under position control: the reference closes at ``approach_speed``; the position
+   fed back is the eq-11 estimate (:class:`~gripkit.systems.tsfm.TipPositionEstimator`) from the
+   voltage and the measured force;
+2. **hold**: once the finger's force exceeds the threshold (5 µN, :class:`ContactDetector`) it
+   holds the position it had at contact — it does not push — until the other finger touches;
+3. **squeeze**: with both in contact, both close under force control to ``grip_force``: the
+   force error (ramped reference) moves the position reference, r ← r + dt ω_f (F_ref − F)/k̂,
+   with k̂ the contact stiffness seen so far, (F − F_contact)/(ŷ − ŷ_contact) from the position
+   estimates (clipped to [k_min, k_max]) — so the loop speed does not depend on how soft the part is.
+
+The inner position loop is an integral controller, U̇ = ω_p (r − ŷ)/g, g the finger's static
+gain (m/V), with the voltage clipped to the actuator's range. ``wait_for_other=False`` gives the
+naive grasp (the first finger keeps closing until the second touches) for comparison: on a part
+held by substrate friction it pushes the part away.
+
+:func:`grasp_step` is the numba step (detectors, estimators and controller of both fingers),
+used by :class:`TwoFingerGrasp` for a real loop and by :func:`simulate_two_finger_grasp`, which
+closes the loop on the hybrid two-finger model :class:`~gripkit.systems.tsfm.gripper.TSFMGripper`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field
+
+import numba
+import numpy as np
+
+from ...errors import DataError, IdentificationError, SimulationError
+from ...estimation.contact_detection import detector_step
+from ...signals.trajectory import Trajectory
+from .end_effector import lever_coefficients
+from .gripper import TSFMGripper, gripper_advance, gripper_measure, gripper_work
+from .micropart import MicropartEstimate, estimate_micropart
+from .tip_position import estimator_arrays, estimator_step
+
+__all__ = ["GraspSettings", "TwoFingerGrasp", "TwoFingerGraspResult", "simulate_two_finger_grasp", "grasp_step"]
+
+# controller state columns (per finger)
+_PHASE, _REF, _U, _YC, _FC, _FREF, _CONTACT_T = range(7)
+APPROACH, HOLD, SQUEEZE = 0, 1, 2
+
+
+@dataclass(frozen=True)
+class GraspSettings:
+    """Settings of the grasp (SI units)."""
+
+    grip_force: float = 200e-6           #: N, force to squeeze with
+    approach_speed: float = 40e-6        #: m/s, closing speed of the position reference
+    position_bandwidth_hz: float = 100.0  #: integral position loop on the estimate
+    force_bandwidth_hz: float = 20.0     #: force loop (normalised by the stiffness seen)
+    force_ramp_time: float = 0.3         #: s, ramp of the force reference
+    threshold: float = 5e-6              #: N, contact threshold (§V-C)
+    release: float = 2.5e-6              #: N, contact released below this
+    window: int = 8                      #: samples averaged by the contact detector
+    u_min: float = -100.0                #: V
+    u_max: float = 100.0                 #: V
+    max_closing: float = 150e-6          #: m, the approach reference stops here
+    k_min: float = 5.0                   #: N/m, bounds of the stiffness used by the force loop
+    k_max: float = 2000.0
+    wait_for_other: bool = True          #: False: the naive grasp (no hold)
+
+    def vector(self, gains: tuple[float, float], dt: float) -> np.ndarray:
+        return np.array([self.approach_speed, 2 * math.pi * self.position_bandwidth_hz,
+                         2 * math.pi * self.force_bandwidth_hz, self.grip_force, self.force_ramp_time,
+                         self.u_min, self.u_max, gains[0], gains[1], self.max_closing, self.k_min, self.k_max,
+                         1.0 if self.wait_for_other else 0.0, self.threshold, self.release, dt])
+
+
+@numba.njit(cache=True)
+def grasp_step(F1, F2, det, buf, est, bw, Phi, Gam, cy, cs, cp, xt, out):  # pragma: no cover - compiled
+    """One sample of the grasp for both fingers.
+
+    F1, F2: measured forces (N). det (2, 5), buf (2, window): detector states; est (2, 6):
+    estimator states; bw (2, 4), Phi (2, 4, 4), Gam (2, 4, 2), cy (2, 4): estimator arrays;
+    cs (2, 7): controller states; cp: :meth:`GraspSettings.vector`. Writes out[i] =
+    [U (V), ŷ (m), filtered force (N), contact flag, phase] and returns nothing.
+    """
+    dt = cp[15]
+    for i in range(2):
+        F = F1 if i == 0 else F2
+        c = detector_step(det[i], buf[i], F, cp[13], cp[14])
+        out[i, 2] = det[i, 4]
+        out[i, 3] = c
+        y = 0.0
+        for j in range(4):
+            y += cy[i, j] * est[i, 2 + j]
+        out[i, 1] = y
+    both = cs[0, _CONTACT_T] >= 0.0 and cs[1, _CONTACT_T] >= 0.0
+    for i in range(2):
+        y = out[i, 1]
+        Ff = out[i, 2]
+        c = out[i, 3]
+        ph = cs[i, _PHASE]
+        if c > 0.5 and cs[i, _CONTACT_T] < 0.0:       # first contact of this finger
+            cs[i, _CONTACT_T] = 1.0
+            cs[i, _YC] = y
+            cs[i, _FC] = Ff
+            if cp[12] > 0.5:
+                cs[i, _PHASE] = HOLD
+                cs[i, _REF] = y
+        ph = cs[i, _PHASE]
+        if ph == APPROACH:
+            if cs[i, _REF] < cp[9]:
+                cs[i, _REF] += cp[0] * dt
+        elif ph == HOLD and c < 0.5:                   # lost it before the other touched: close again
+            cs[i, _PHASE] = APPROACH
+            cs[i, _CONTACT_T] = -1.0
+    both_now = cs[0, _CONTACT_T] >= 0.0 and cs[1, _CONTACT_T] >= 0.0
+    if both_now and not both:
+        for i in range(2):
+            cs[i, _PHASE] = SQUEEZE
+            cs[i, _FREF] = out[i, 2]
+    for i in range(2):
+        y = out[i, 1]
+        if cs[i, _PHASE] == SQUEEZE:
+            # (conditional expressions, not builtin max/min: numba.cuda cannot compile those in an
+            # @njit callee, and gripkit.systems.tsfm.grasp_gpu runs this step on the GPU; same values)
+            step = (cp[3] - cs[i, _FREF]) * dt / (dt if dt > cp[4] else cp[4])
+            if abs(cp[3] - cs[i, _FREF]) <= abs(step):
+                cs[i, _FREF] = cp[3]
+            else:
+                cs[i, _FREF] += step
+            d = y - cs[i, _YC]
+            k = cp[11]
+            if d > 50e-9:
+                k = (out[i, 2] - cs[i, _FC]) / d
+                k = cp[10] if cp[10] > k else k
+                k = cp[11] if cp[11] < k else k
+            cs[i, _REF] += dt * cp[2] * (cs[i, _FREF] - out[i, 2]) / k
+        # inner loop: integral position control on the estimate, voltage clipped
+        U = cs[i, _U] + dt * cp[1] * (cs[i, _REF] - y) / cp[7 + i]
+        U = cp[5] if cp[5] > U else U
+        U = cp[6] if cp[6] < U else U
+        cs[i, _U] = U
+        out[i, 0] = U
+        out[i, 4] = cs[i, _PHASE]
+        F = F1 if i == 0 else F2
+        estimator_step(est[i], bw[i], Phi[i], Gam[i], cy[i], U, F, xt)
+
+
+def _init_state(n_window: int):
+    cs = np.zeros((2, 7))
+    cs[:, _CONTACT_T] = -1.0
+    return np.zeros((2, 5)), np.zeros((2, n_window)), np.zeros((2, 6)), cs
+
+
+def _est_stack(fingers, dt):
+    arrs = [estimator_arrays(f, dt) for f in fingers]
+    return {k: np.ascontiguousarray(np.stack([a[k] for a in arrs])) for k in ("bw", "Phi", "Gam", "cy")}, arrs
+
+
+def _static_gain(values) -> float:
+    L = values["L_r"] + values["L_s"]
+    return lever_coefficients(L, values["L_a"]).alpha_u * values["d_p"]
+
+
+def _values(f) -> dict:
+    if hasattr(f, "values") and callable(f.values) and not isinstance(f, dict):
+        return f.values()
+    if hasattr(f, "value"):
+        return {n: f.value(n) for n in f}
+    return dict(f)
+
+
+class TwoFingerGrasp:
+    """The grasp controller for a real loop: call :meth:`step` once per sample with the two
+    measured forces; it returns the two voltages to apply.
+
+    ``finger1``, ``finger2``: the models used by the position estimators (TSFMFinger, its
+    ParameterSet or a mapping of values); ``dt``: sample time (s).
+    """
+
+    def __init__(self, finger1, finger2, dt: float, settings: GraspSettings = GraspSettings()):
+        if not (np.isfinite(dt) and dt > 0):
+            raise DataError(f"dt: expected a positive sample time in s, found {dt!r}")
+        self.settings = settings
+        vals = [_values(finger1), _values(finger2)]
+        self._e, _ = _est_stack(vals, dt)
+        self._cp = settings.vector((_static_gain(vals[0]), _static_gain(vals[1])), dt)
+        self._det, self._buf, self._est, self._cs = _init_state(settings.window)
+        self._xt = np.empty(4)
+        self._out = np.zeros((2, 5))
+
+    def step(self, F1: float, F2: float) -> tuple[float, float]:
+        e = self._e
+        grasp_step(float(F1), float(F2), self._det, self._buf, self._est, e["bw"], e["Phi"], e["Gam"], e["cy"],
+                   self._cs, self._cp, self._xt, self._out)
+        return float(self._out[0, 0]), float(self._out[1, 0])
+
+    @property
+    def phases(self) -> tuple[str, str]:
+        names = ("approach", "hold", "squeeze")
+        return names[int(self._cs[0, _PHASE])], names[int(self._cs[1, _PHASE])]
+
+    @property
+    def positions(self) -> tuple[float, float]:
+        """Estimated tip positions (m) at the last step."""
+        return float(self._out[0, 1]), float(self._out[1, 1])
+
+
+@numba.njit(cache=True)
+def _grasp_run(bw, Phi, Gam, C, D, G, Hg, target, ng, K, part, x0, noise, det, buf, est, ebw, ePhi, eGam, ecy, cs,
+               cp, rec, ua, xt, ev_frac, ev_to, yout):  # pragma: no cover - compiled
+    n = Phi.shape[4]
+    X = np.empty((2, n))
+    modes = np.empty(2, dtype=np.int64)
+    hyst = np.zeros(4)
+    ps = np.empty(1)
+    for i in range(2):
+        for j in range(n):
+            X[i, j] = x0[i, j]
+        modes[i] = 0
+    ps[0] = x0[2, 0]
+    ext = np.empty(4)
+    out = np.empty((2, 5))
+    gripper_measure(X, modes, ps[0], C, D, part, ua, yout)
+    for k in range(noise.shape[0]):
+        F1 = yout[0, 3] + noise[k, 0]
+        F2 = yout[1, 3] + noise[k, 1]
+        grasp_step(F1, F2, det, buf, est, ebw, ePhi, eGam, ecy, cs, cp, ext, out)
+        rec[k, 0] = out[0, 0]
+        rec[k, 1] = out[1, 0]
+        rec[k, 2] = yout[0, 0]
+        rec[k, 3] = yout[1, 0]
+        rec[k, 4] = out[0, 1]
+        rec[k, 5] = out[1, 1]
+        rec[k, 6] = yout[0, 2]
+        rec[k, 7] = yout[1, 2]
+        rec[k, 8] = F1
+        rec[k, 9] = F2
+        rec[k, 10] = ps[0]
+        rec[k, 11] = out[0, 4]
+        rec[k, 12] = out[1, 4]
+        rec[k, 13] = modes[0]
+        rec[k, 14] = modes[1]
+        gripper_advance(out[0, 0], out[1, 0], X, modes, hyst, ps, bw, Phi, Gam, C, D, G, Hg, target, ng, K, part,
+                        ua, xt, ev_frac, ev_to, yout)
+
+
+_COLUMNS = (("U1", "V"), ("U2", "V"), ("y_C1", "m"), ("y_C2", "m"), ("y_hat1", "m"), ("y_hat2", "m"),
+            ("F_g1", "N"), ("F_g2", "N"), ("F_meas1", "N"), ("F_meas2", "N"), ("X_p", "m"), ("phase1", "1"),
+            ("phase2", "1"), ("contact1", "1"), ("contact2", "1"))
+
+
+@dataclass(frozen=True)
+class TwoFingerGraspResult:
+    """A simulated grasp: the record (voltages, true and estimated tips, true and measured forces,
+    part centre, phases 0/1/2 = approach/hold/squeeze, true contacts), the part's displacement,
+    the contact times, the final forces and the micropart estimate (None if not grasped)."""
+
+    trajectory: Trajectory
+    part_displacement: float
+    contact_times: tuple[float, float]
+    final_forces: tuple[float, float]
+    estimate: MicropartEstimate | None
+    settings: GraspSettings = field(default_factory=GraspSettings)
+
+    @property
+    def grasped(self) -> bool:
+        return self.estimate is not None
+
+    def summary(self) -> dict:
+        d = {"part_displacement_um": self.part_displacement * 1e6,
+             "contact_times_s": list(self.contact_times),
+             "final_forces_uN": [f * 1e6 for f in self.final_forces]}
+        if self.estimate is not None:
+            d.update(width_um=self.estimate.width * 1e6, width_std_um=self.estimate.width_std * 1e6,
+                     stiffness=self.estimate.stiffness, stiffness_std=self.estimate.stiffness_std,
+                     width_threshold_um=self.estimate.width_threshold * 1e6)
+        return d
+
+    def to_dict(self) -> dict:
+        return {**self.summary(), "settings": asdict(self.settings)}
+
+
+def simulate_two_finger_grasp(gripper: TSFMGripper, *, estimator_fingers=None, settings: GraspSettings = GraspSettings(),
+                              duration: float = 4.0, fs: float = 20000.0, noise_std: float = 2e-6,
+                              seed: int = 0) -> TwoFingerGraspResult:
+    """Close the grasp loop on the gripper model (see the module docstring).
+
+    ``estimator_fingers``: the two finger models the estimators use (default: the gripper's own,
+    i.e. a perfect model; pass identified ones to see the effect of model errors). Force noise:
+    white, ``noise_std`` (N) on each sensor. Returns the record and the micropart estimate from
+    the estimated positions and the measured forces (:func:`estimate_micropart`).
+    """
+    if not (np.isfinite(duration) and duration > 0 and np.isfinite(fs) and fs > 0):
+        raise SimulationError(f"duration and fs must be positive, found {duration!r} s, {fs!r} Hz")
+    if noise_std < 0:
+        raise SimulationError(f"noise_std: expected >= 0 N, found {noise_std!r}")
+    dt = 1.0 / fs
+    N = int(round(duration * fs))
+    th = gripper.theta()
+    d = gripper.arrays(th[None, :], dt)
+    fingers = estimator_fingers or gripper.fingers
+    vals = [_values(f) for f in fingers]
+    e, _ = _est_stack(vals, dt)
+    cp = settings.vector((_static_gain(vals[0]), _static_gain(vals[1])), dt)
+    det, buf, est, cs = _init_state(settings.window)
+    rng = np.random.default_rng(seed)
+    noise = np.ascontiguousarray(rng.standard_normal((N, 2)) * noise_std)
+    x0 = np.zeros((3, d["Phi"].shape[-1]))
+    x0[2, 0] = th[gripper.parameters.names.index("X_p")]
+    rec = np.empty((N, len(_COLUMNS)))
+    ua, xt, ev_frac, ev_to, yout = gripper_work(d["Phi"].shape[-1], d["C"].shape[-2])
+    _grasp_run(d["bw"][0], d["Phi"][0], d["Gam"][0], d["C"][0], d["D"][0], d["G"][0], d["H"][0], d["target"],
+               d["ng"], d["K"], d["part"][0], x0, noise, det, buf, est, e["bw"], e["Phi"], e["Gam"], e["cy"], cs, cp,
+               rec, ua, xt, ev_frac, ev_to, yout)
+    if not np.isfinite(rec).all():
+        raise SimulationError("the grasp simulation diverged", hint="lower the loop bandwidths")
+    t = np.arange(N) * dt
+    tr = Trajectory(t, {n: rec[:, i] for i, (n, _) in enumerate(_COLUMNS)}, dict(_COLUMNS), {"fs": fs})
+    ct = []
+    for i in (13, 14):
+        hit = np.flatnonzero(rec[:, i] > 0.5)
+        ct.append(float(t[hit[0]]) if hit.size else math.nan)
+    gap = th[gripper.parameters.names.index("gap")]
+    try:
+        est_mp = estimate_micropart(rec[:, 4], rec[:, 8], rec[:, 5], rec[:, 9], gap, threshold=settings.threshold,
+                                    window=settings.window)
+    except (DataError, IdentificationError):  # not grasped (no squeeze with both fingers)
+        est_mp = None
+    return TwoFingerGraspResult(tr, float(rec[-1, 10] - rec[0, 10]), (ct[0], ct[1]),
+                                (float(rec[-1, 6]), float(rec[-1, 7])), est_mp, settings)

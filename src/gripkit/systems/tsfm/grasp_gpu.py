@@ -1,0 +1,133 @@
+"""The TSFM grasp batch on a CUDA GPU (optional): the same scalar kernel as the CPU path,
+:func:`gripkit.systems.tsfm.grasp_kernels._grasp_core`, compiled by ``numba.cuda`` — one grasp per thread.
+
+numba compiles an ``@njit`` function called from a CUDA kernel for the device (with every njit
+function it calls: ``grasp_step``, ``gripper_advance``, ``pwa_step``, ``bouc_wen_advance``, the
+detector and estimator steps), so there is one source for both targets. The core allocates
+nothing: every work array (controller, detector, estimator and finger states, the part's contact-
+mode matrices) is a slice, per thread, of arrays allocated on the device before the launch. The
+per-job contact-mode ZOH matrices (matrix exponentials, which allocate) are computed on the CPU
+by the numba kernel :func:`~gripkit.systems.tsfm.grasp_kernels._setup_jobs` (≈ 40 µs per job and core) and
+copied to the device with the jobs, in launches of at most ``batch`` jobs.
+
+Use: ``tsfm_grasp_batch(..., backend="cuda")`` or ``backend = "cuda"`` in a sweep's
+``[scenario]``. Without a device the call raises a ConfigError; gripkit never needs a GPU.
+Checked without a GPU by the tests: the kernel runs in numba's CUDA simulator
+(``NUMBA_ENABLE_CUDASIM=1``, with ``NUMBA_DISABLE_JIT=1`` so the njit callees run as Python too)
+and agrees with the CPU kernel; and, where the CUDA toolkit's NVVM is installed, the whole kernel
+compiles to PTX (:func:`compile_ptx`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import cuda
+
+from ...errors import ConfigError
+from ...sim.hybrid import MAX_EVENTS_PER_STEP
+from .grasp_kernels import _default_gripper, _grasp_core, _setup_jobs, _template
+
+__all__ = ["cuda_available", "run_cuda", "compile_ptx"]
+
+
+def cuda_available() -> bool:
+    """True when numba finds a usable CUDA device (or runs the CUDA simulator)."""
+    try:
+        return bool(cuda.is_available())
+    except Exception:  # no driver, no numba.cuda
+        return False
+
+
+def _kernel_py(bw, Phi, Gam, C, D, G, Hg, target, ng, K, parts, noise, nstd, seeds, n_steps, ebw, ePhi, eGam, ecy,
+               cps, mset, det, buf, est, cs, X, modes, hyst, ps, ext, out, ua, xt, ev_frac, ev_to, yout, rng,
+               met):  # pragma: no cover - runs on the device
+    """Thread p runs job p; every array with a leading job index is that job's slice."""
+    p = cuda.grid(1)
+    if p < parts.shape[0]:
+        q = p if noise.shape[0] > 1 else 0
+        _grasp_core(bw, Phi[p], Gam[p], C[p], D[p], G, Hg[p], target, ng, K, parts[p], noise[q], nstd[p], seeds[p],
+                    n_steps, ebw, ePhi, eGam, ecy, cps[p], mset, det[p], buf[p], est[p], cs[p], X[p], modes[p],
+                    hyst[p], ps[p], ext[p], out[p], ua[p], xt[p], ev_frac[p], ev_to[p], yout[p], rng[p], met[p])
+
+
+_KERNEL = []
+
+
+def _kernel():
+    if not _KERNEL:
+        _KERNEL.append(cuda.jit(_kernel_py))
+    return _KERNEL[0]
+
+
+def _host_arrays(tpl, parts):
+    """The jobs' matrices with their contact modes (computed on the CPU), leading index: job."""
+    P = parts.shape[0]
+    stack = [np.ascontiguousarray(np.broadcast_to(a, (P,) + a.shape)) for a in (tpl.Phi, tpl.Gam, tpl.C, tpl.D, tpl.H)]
+    Phi, Gam, C, D, Hg = (s.copy() for s in stack)
+    _setup_jobs(tpl.A, tpl.B0, tpl.bF, tpl.iy, parts, tpl.dt, tpl.K, Phi, Gam, C, D, Hg)
+    return Phi, Gam, C, D, Hg
+
+
+def run_cuda(tpl, parts, nz, nstd, seeds, n_steps, window, cps, mset, met, batch: int = 16384,
+             threads_per_block: int = 64) -> None:
+    """Run the jobs on the GPU (see the module docstring); fills ``met`` (P, len(METRICS))."""
+    if not cuda_available():
+        raise ConfigError("backend 'cuda': no CUDA device is available to numba",
+                          hint="use backend='cpu' (the default), or install the NVIDIA driver and CUDA toolkit")
+    kern = _kernel()
+    n = tpl.A.shape[1]
+    P = parts.shape[0]
+    for a in range(0, P, batch):
+        b = min(P, a + batch)
+        m = b - a
+        Phi, Gam, C, D, Hg = _host_arrays(tpl, np.ascontiguousarray(parts[a:b]))
+        d = cuda.to_device
+        work = [cuda.device_array(s, dtype=dt) for s, dt in (
+            ((m, 2, 5), np.float64), ((m, 2, window), np.float64), ((m, 2, 6), np.float64), ((m, 2, 7), np.float64),
+            ((m, 2, n), np.float64), ((m, 2), np.int64), ((m, 4), np.float64), ((m, 1), np.float64),
+            ((m, 4), np.float64), ((m, 2, 5), np.float64), ((m, 3), np.float64), ((m, n), np.float64),
+            ((m, MAX_EVENTS_PER_STEP), np.float64), ((m, MAX_EVENTS_PER_STEP), np.int64),
+            ((m, 2, tpl.C.shape[2]), np.float64), ((m, 1), np.uint64))]
+        out = cuda.device_array((m, met.shape[1]), dtype=np.float64)
+        noise = nz if nz.shape[0] == 1 else nz[a:b]
+        blocks = (m + threads_per_block - 1) // threads_per_block
+        kern[blocks, threads_per_block](
+            d(tpl.bw), d(Phi), d(Gam), d(C), d(D), d(tpl.G), d(Hg), d(tpl.target), d(tpl.ng), tpl.K,
+            d(np.ascontiguousarray(parts[a:b])), d(np.ascontiguousarray(noise)), d(nstd[a:b]), d(seeds[a:b]), n_steps,
+            *(d(e) for e in tpl.est), d(np.ascontiguousarray(cps[a:b])), d(mset), *work, out)
+        met[a:b] = out.copy_to_host()
+
+
+def compile_ptx(cc: tuple[int, int] = (8, 0)) -> str:
+    """PTX of the whole grasp kernel for compute capability ``cc`` — a check that every function
+    it calls compiles for the GPU, possible without a GPU where NVVM (the CUDA toolkit) is
+    installed. numba asks the current device for its compute capability when it compiles an
+    @njit callee for CUDA; without a device this answers ``cc``."""
+    import numba
+    from numba import typeof
+    from numba.cuda import dispatcher
+
+    tpl = _template(_default_gripper(), 5e-5, None)
+    f8, i8 = numba.float64, numba.int64
+
+    def arr(nd, dtype=f8):
+        return dtype[(slice(None),) * (nd - 1) + (slice(None, None, 1),)]
+
+    args = (typeof(tpl.bw), arr(6), arr(6), arr(5), arr(5), typeof(tpl.G), arr(5), typeof(tpl.target),
+            typeof(tpl.ng), i8, arr(2), arr(3), arr(1), arr(1, i8), i8, *(typeof(e) for e in tpl.est), arr(2), arr(1),
+            arr(3), arr(3), arr(3), arr(3), arr(3), arr(2, i8), arr(2), arr(2), arr(2), arr(3), arr(2), arr(2), arr(2),
+            arr(2, i8), arr(3), arr(2, numba.uint64), arr(2))
+
+    class _Device:
+        compute_capability = cc
+
+    patched = False
+    if not cuda_available():
+        orig, dispatcher.get_current_device = dispatcher.get_current_device, lambda: _Device()
+        patched = True
+    try:
+        ptx, _ = cuda.compile_ptx(_kernel_py, args, cc=cc)
+    finally:
+        if patched:
+            dispatcher.get_current_device = orig
+    return ptx

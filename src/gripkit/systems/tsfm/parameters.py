@@ -1,0 +1,243 @@
+"""The TSFM piezoelectric two-finger microgripper of ``001_0b92a7da96e7aa46.txt`` (Komati et al.),
+with the identified parameters of Table II (p. 7 of the paper: §IV, "TABLE II: The values of the
+identified parameters of each of the two fingers") and their provenance.
+
+What the zoo models simulate, and why it differs from Table II as printed:
+
+* **m_s and b_s.** Table II's k_s = 128 N/m and m_s = 1.8e-6 kg ring at √(k_s/m_s)/2π = 1.34 kHz,
+  not at the 8.52 kHz measured in §IV-B (Fig. 8) and listed as the sensing bandwidth in Table I;
+  √(k_s/m_s) = 8433 rad/s, so Table II's m_s is k_s/8520² with 8520 taken as rad/s. Table II's
+  b_s = 7e-4 N·s/m gives ζ = 0.023 with Table II's m_s (0.146 with the corrected one), not the
+  measured ζ = 0.006. gripkit keeps k_s (it agrees with Table I's 130 N/m) and the measurements
+  (f0, ζ), and simulates m_s = k_s/(2π f0)² and b_s = 2ζ√(k_s m_s).
+* **λ unit.** Table II prints λ without a unit; it is read in µm/V like d_p (see
+  :mod:`gripkit.models.hysteresis`). β and γ are in 1/V.
+* **b.** The row of D(s)'s b is printed under "Force sensor" by the table layout; it is the
+  actuator's (eq 4, §IV-C2 identifies a and b together).
+* **Lengths.** The seed gives no L_r, L_a. gripkit assumes L_a = 15 mm (a PZT bimorph with the
+  1100 N/m tip stiffness of Table I: 15 × 2 × 0.5 mm gives E w t³/(4 L³) ≈ 1.1 kN/m with
+  E ≈ 60 GPa), L_s = 1 mm (the sensor length, §II) and L_r = 7 mm, so L = 8 mm: with Table II's
+  left finger the model then places the tip C at 62.4 µm at U = 44 V on the first rising branch,
+  which is where Fig. 13 / §V-C locate the contact (62.42 µm at 44 V).
+
+Sensitivity: §IV-B gives 200 µN/V for the sensors; Table II gives 6e-3 and 5.1e-3 V/µN
+(167 and 196 µN/V): the left finger's disagrees (reported; each finger keeps its own).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from ...consistency import Finding, compare
+from ...models.mass_spring_damper import MassSpringDamper
+from ...models.piezo import PiezoActuator
+from ...params import ParameterSet
+from ...signals.trajectory import Trajectory
+from .end_effector import sensor_parameters
+from .gripper import TSFMFinger, TSFMGripper, finger_parameter_set, micropart_parameters
+
+__all__ = ["TABLE_II", "REFERENCE", "ASSUMED_LENGTHS", "TABLE_III", "left_finger", "right_finger", "gripper",
+           "table_ii", "finger", "hysteresis_experiment", "step_experiment", "compliance_experiment",
+           "free_vibration_experiment", "contact_experiment", "contact_voltage"]
+
+SEED = "001_0b92a7da96e7aa46.txt"
+_T2 = f"{SEED}, Table II (p. 7)"
+
+#: Table II as printed, in SI (λ read in µm/V; the b row belongs to the actuator)
+TABLE_II = {
+    "left": dict(d_p=0.77e-6, s_p=9.1e-4, lam=0.43e-6, beta=10.8e-2, gamma=7.5e-3, a=2.5e-8, b=8e-5,
+                 m_s=1.8e-6, b_s=7e-4, k_s=128.0, sensitivity=6e-3 * 1e6),
+    "right": dict(d_p=0.78e-6, s_p=8.5e-4, lam=0.39e-6, beta=11.1e-2, gamma=3.5e-3, a=2.5e-8, b=8e-5,
+                  m_s=1.79e-6, b_s=6.98e-4, k_s=130.8, sensitivity=5.1e-3 * 1e6),
+}
+
+#: the measurements the seed states elsewhere, (value, source)
+REFERENCE = {
+    "sensor_f0_hz": (8520.0, f"{SEED} §IV-B (Fig. 8) and Table I"),
+    "sensor_zeta": (0.006, f"{SEED} §IV-B"),
+    "sensor_stiffness": (130.0, f"{SEED} Table I"),
+    "actuator_stiffness": (1100.0, f"{SEED} Table I"),
+    "sensitivity_uN_per_V": (200.0, f"{SEED} §IV-B"),
+    "actuation_bandwidth_hz": (1000.0, f"{SEED} Table I (> 1 kHz)"),
+}
+
+ASSUMED_LENGTHS = dict(L_r=7e-3, L_s=1e-3, L_a=15e-3)
+_LEN_SRC = {
+    "L_a": "assumed: 15 mm PZT bimorph (1/s_p = 1100 N/m of Table I fits a 15 × 2 × 0.5 mm bimorph); the seed gives none",
+    "L_s": f"{SEED} §II: force sensor 1 mm long",
+    "L_r": "assumed: 7 mm socket, so that L = 8 mm puts tip C at 62.4 µm at 44 V (Fig. 13, §V-C: 62.42 µm)",
+}
+
+_PART_ASSUMED = {
+    "c_e": "assumed: no damping in the part",
+    "F_po": "assumed: no pull-off force",
+    "F_stick": "assumed: 20 µN static friction/adhesion holding the part on the substrate",
+    "X_p": "assumed: part centred unless given",
+}
+
+#: Table III: micropart stiffness measured (N/m), estimated by the TSFM (N/m), stated error
+TABLE_III = [(12.1, 11.7, 0.03), (72.5, 71.05, 0.02), (469.0, 445.55, 0.05)]
+
+
+def table_ii(side: str = "left") -> ParameterSet:
+    """Table II as printed (plus the assumed lengths), one finger."""
+    if side not in TABLE_II:
+        raise ValueError(f"side: expected 'left' or 'right', found {side!r}")
+    v = TABLE_II[side]
+    sources = {n: f"{_T2}, {side} finger" for n in v}
+    sources.update(_LEN_SRC)
+    return finger_parameter_set(**v, **ASSUMED_LENGTHS, sources=sources, name=f"tsfm-{side} (Table II)")
+
+
+def finger(side: str = "left", *, as_printed: bool = False, check: bool = True) -> TSFMFinger:
+    """A TSFM finger with Table II's parameters; m_s and b_s from the measured f0 and ζ unless
+    ``as_printed`` (see the module docstring)."""
+    printed = table_ii(side)
+    params = printed
+    if not as_printed:
+        k = printed.value("k_s")
+        f0, z = REFERENCE["sensor_f0_hz"][0], REFERENCE["sensor_zeta"][0]
+        sensor = sensor_parameters(f0, z, k_s=k)
+        m, b = sensor.value("m_s"), sensor.value("b_s")
+        params = ParameterSet([
+            p if p.name not in ("m_s", "b_s") else p.with_value(
+                m if p.name == "m_s" else b,
+                source=f"derived: {'k_s/(2π f0)²' if p.name == 'm_s' else '2ζ√(k_s m_s)'} with f0 = 8520 Hz, "
+                       f"ζ = 0.006 ({SEED} §IV-B); Table II prints {printed.value(p.name):g}")
+            for p in printed.values()], f"tsfm-{side}")
+    return TSFMFinger(params, reference=REFERENCE, printed=printed, name=f"tsfm-{side}", check=check)
+
+
+def left_finger(*, as_printed: bool = False, check: bool = True) -> TSFMFinger:
+    """Left finger of Table II (zoo entry ``tsfm-left``); keywords as :func:`finger`."""
+    return finger("left", as_printed=as_printed, check=check)
+
+
+def right_finger(*, as_printed: bool = False, check: bool = True) -> TSFMFinger:
+    """Right finger of Table II (zoo entry ``tsfm-right``); keywords as :func:`finger`."""
+    return finger("right", as_printed=as_printed, check=check)
+
+
+class _Gripper(TSFMGripper):
+    description = "TSFM: left and right fingers of Table II, 400 µm gap (§V-C), 300 µm part"
+
+    def consistency_checks(self) -> list[Finding]:
+        out = super().consistency_checks()
+        for i, (meas, est, err) in enumerate(TABLE_III, 1):
+            out.append(compare(f"table-iii-error-{i}", "Table III", computed=abs(est - meas) / meas, stated=err,
+                               rtol=0.25, what=f"|{est:g} − {meas:g}|/{meas:g}", used="Table III's measured stiffness",
+                               source=f"{SEED} Table III"))
+        w = 400.0 - (62.42 + 39.4)
+        out.append(compare("width-example", "§V-C", computed=w, stated=298.18, rtol=1e-6,
+                           what="400 − (62.42 + 39.4)", unit="um", source=f"{SEED} §V-C"))
+        return out
+
+
+def gripper(stiffness: float = 72.5, width: float = 300e-6, centre: float | None = None, *,
+            check: bool = True) -> TSFMGripper:
+    """Both fingers (finger 1 = left, finger 2 = right) and a micropart (default: 300 µm wide,
+    Table III's 72.5 N/m, centred in the 400 µm gap)."""
+    part = micropart_parameters(width, stiffness, centre=centre,
+                                source=f"{SEED} §V-C (400 µm gap, 300 µm part), Table III (stiffness)")
+    part = ParameterSet([p if p.name not in _PART_ASSUMED else dataclasses.replace(p, source=_PART_ASSUMED[p.name])
+                         for p in part.values()], part.name)
+    g = _Gripper(finger("left", check=False), finger("right", check=False), part, check=check)
+    g.name = "tsfm-gripper"
+    return g
+
+
+
+# ---- the seed's experiments, simulated (§IV, §V) ------------------------------------------------
+
+def _noise(rng, n, std):
+    return std * rng.standard_normal(n) if std > 0 else np.zeros(n)
+
+
+def hysteresis_experiment(finger: TSFMFinger, amplitudes=(100.0, 60.0, 30.0), *, frequency: float = 0.1,
+                          fs: float = 20000.0, decimate: int = 10, noise: float = 20e-9, seed: int = 0) -> Trajectory:
+    """§IV-C1 / Fig. 9: sines of the given amplitudes (V) at ``frequency`` one after another, tip B
+    measured by the laser (``noise`` m, 20 nm resolution) at ``fs``, kept every ``decimate``-th
+    sample. Channels U (V), y_B (m), loop (index of the amplitude)."""
+    t = np.arange(int(round(fs / frequency))) / fs
+    U = np.concatenate([A * np.sin(2 * np.pi * frequency * t) for A in amplitudes])
+    tr = finger.simulate({"U": U, "F_g": np.zeros_like(U)}, dt=1.0 / fs)
+    rng = np.random.default_rng(seed)
+    k = slice(None, None, decimate)
+    y = tr["y_B"][k]
+    loop = np.repeat(np.arange(len(amplitudes), dtype=float), t.size)[k]
+    return Trajectory.uniform(fs / decimate, U=U[k], y_B=y + _noise(rng, y.size, noise), loop=loop,
+                              units={"U": "V", "y_B": "m"}, meta={"source": "simulated Fig. 9 experiment"})
+
+
+def step_experiment(finger: TSFMFinger, amplitude: float = 50.0, *, fs: float = 20000.0, duration: float = 0.02,
+                    delay: float = 1e-3, noise: float = 20e-9, seed: int = 1) -> Trajectory:
+    """§IV-C2 / Fig. 10: a voltage step, tip B measured at ``fs``."""
+    n = int(round(duration * fs))
+    t = np.arange(n) / fs
+    U = np.where(t >= delay, amplitude, 0.0)
+    tr = finger.simulate({"U": U, "F_g": np.zeros(n)}, dt=1.0 / fs)
+    rng = np.random.default_rng(seed)
+    return Trajectory.uniform(fs, U=U, y_B=tr["y_B"] + _noise(rng, n, noise), units={"U": "V", "y_B": "m"},
+                              meta={"source": "simulated Fig. 10 experiment"})
+
+
+def compliance_experiment(finger: TSFMFinger, max_force: float = 1e-3, *, fs: float = 1000.0, duration: float = 2.0,
+                          noise: float = 20e-9, force_noise: float = 0.4e-6, seed: int = 2) -> Trajectory:
+    """§IV-C3 / Fig. 11: the FemtoTools probe (resolution 0.4 µN) pushes on the tip B with a slow
+    force ramp, no voltage; the actuator (eq 4 with F_A = F, M_A = L_r F) responds dynamically,
+    the laser (20 nm) reads y_B. Channels F (N, measured), y_B (m)."""
+    v = finger.values()
+    act = PiezoActuator(ParameterSet([finger.parameters[n] for n in ("d_p", "s_p", "lam", "beta", "gamma", "a", "b",
+                                                                     "L_a")]), check=False)
+    n = int(round(duration * fs))
+    F = max_force * np.clip(np.arange(n) / (0.8 * n), 0.0, 1.0)
+    out = act.simulate({"U": np.zeros(n), "F_A": F, "M_A": v["L_r"] * F}, dt=1.0 / fs)
+    yB = out["y_A"] + v["L_r"] * out["alpha_A"]
+    rng = np.random.default_rng(seed)
+    return Trajectory.uniform(fs, F=F + _noise(rng, n, force_noise), y_B=yB + _noise(rng, n, noise),
+                              units={"F": "N", "y_B": "m"}, meta={"source": "simulated Fig. 11 experiment"})
+
+
+def free_vibration_experiment(finger: TSFMFinger, preload: float = 150e-6, *, fs: float = 20000.0,
+                              duration: float = 0.1, pre: float = 0.005, noise: float = 0.01,
+                              seed: int = 3) -> Trajectory:
+    """§IV-B / Fig. 8: the sensor alone (before integration), preloaded with ``preload`` N and
+    released at t = ``pre``; the force it reads, k_s × deflection, with white noise of ``noise``
+    times the preload, for ``duration`` s after the release. Channel F (N)."""
+    v = finger.values()
+    msd = MassSpringDamper(m=v["m_s"], b=v["b_s"], k=v["k_s"], check=False)
+    n = int(round(duration * fs))
+    x = msd.simulate(np.zeros(n), dt=1.0 / fs, x0=np.array([preload / v["k_s"], 0.0]))["x"]
+    F = np.concatenate([np.full(int(round(pre * fs)), preload), v["k_s"] * x])
+    rng = np.random.default_rng(seed)
+    return Trajectory.uniform(fs, F=F + _noise(rng, F.size, noise * preload), units={"F": "N"},
+                              meta={"source": "simulated Fig. 8 experiment"})
+
+
+def contact_voltage(finger: TSFMFinger, voltage: float = 44.0) -> float:
+    """Where tip C is (m) at ``voltage`` reached from rest (0 V, virgin hysteresis) with no force:
+    the part face position that makes a contact start at that voltage (Fig. 13)."""
+    # 1 s per sample: every step settles; the voltage is held one more sample because an output
+    # sample shows the inputs up to the previous sample (zero-order hold)
+    U = np.append(np.linspace(0.0, voltage, 2001), voltage)
+    tr = finger.simulate({"U": U, "F_g": np.zeros_like(U)}, dt=1.0)
+    return float(tr["y_C"][-1])
+
+
+def contact_experiment(finger: TSFMFinger, stiffness: float = 72.5, *, contact_at: float = 44.0,
+                       peak: float = 50.0, frequency: float = 0.1, fs: float = 20000.0, pull_off: float = 0.0,
+                       noise: float = 2e-6, seed: int = 4) -> Trajectory:
+    """§V-B / Fig. 13: U = peak (1 − cos 2π f t)/2 for one period; the part face placed where tip C
+    is at ``contact_at`` V, so the contact starts there. Channels U, y_C (true), F_g (true contact
+    force), F_meas (sensor reading + noise), contact."""
+    x_w = contact_voltage(finger, contact_at)
+    m = finger.contact(x_w=x_w, k_e=stiffness, F_po=pull_off)
+    t = np.arange(int(round(fs / frequency))) / fs
+    U = 0.5 * peak * (1.0 - np.cos(2 * np.pi * frequency * t))
+    tr = m.simulate(U, dt=1.0 / fs)
+    rng = np.random.default_rng(seed)
+    return Trajectory.uniform(fs, U=U, y_C=tr["y_C"], F_g=tr["F_g"], F_meas=tr["F_m"] + _noise(rng, t.size, noise),
+                              contact=tr["contact"], units={"U": "V", "y_C": "m", "F_g": "N", "F_meas": "N"},
+                              meta={"source": "simulated Fig. 13 experiment", "x_w": x_w})
