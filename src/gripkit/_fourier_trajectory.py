@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from .arguments import entry_point
+from .sysid.dynamics import base_structure, friction_columns
 from .errors import DataError, IdentificationError
 
 __all__ = ["FourierTrajectory", "fourier_trajectory", "fourier_states"]
@@ -133,7 +134,6 @@ def fourier_trajectory(chain, *, f0: float = 0.1, harmonics: int = 5, fs: float 
     """
     from scipy.optimize import minimize
 
-    from .sysid.dynamics import _friction_columns, base_structure
 
     m = int(chain.dof)
     names = tuple(chain.coordinate_names)
@@ -173,7 +173,7 @@ def fourier_trajectory(chain, *, f0: float = 0.1, harmonics: int = 5, fs: float 
         q, qd, qdd = fourier_states(a, b, q0, f0, t_eval)
         X = chain.regressor(q, qd, qdd)[:, :, st.independent]
         if friction:
-            X = np.concatenate([X, _friction_columns(qd, ("coulomb", "viscous"))], axis=2)
+            X = np.concatenate([X, friction_columns(qd, ("coulomb", "viscous"))], axis=2)
         X = X.reshape(-1, X.shape[2])
         s = np.sqrt(np.mean(X ** 2, axis=0))
         if (s == 0).any():

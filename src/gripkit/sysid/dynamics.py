@@ -145,7 +145,9 @@ def _inertial_columns(chain, q, qd, qdd, armature: bool) -> np.ndarray:
     return Y
 
 
-def _friction_columns(qd, kinds) -> np.ndarray:
+def friction_columns(qd, kinds) -> np.ndarray:
+    """Friction regressor columns, shape (B, m, m·len(kinds)): for joint j and each kind, τ_j gains
+    sign(q̇_j) ("coulomb", N·m), q̇_j ("viscous", N·m·s/rad) or 1 ("offset", N·m)."""
     B, m = qd.shape
     F = np.zeros((B, m, m * len(kinds)))
     for j in range(m):
@@ -251,7 +253,7 @@ class DynamicsResult:
         q, qd, qdd = (np.atleast_2d(np.asarray(a, dtype=np.float64)) for a in (q, qd, qdd))
         Y = _inertial_columns(self.chain, q, qd, qdd, self.armature_identified)[:, :, self.structure.independent]
         kinds = FRICTION_MODELS[self.friction_model]
-        return np.concatenate([Y, _friction_columns(qd, kinds)], axis=2) if kinds else Y
+        return np.concatenate([Y, friction_columns(qd, kinds)], axis=2) if kinds else Y
 
     def predict(self, q, qd, qdd) -> np.ndarray:
         """τ (B, m) (or (m,) for one state) of the identified model."""
@@ -338,7 +340,7 @@ def identify_dynamics(chain, q, qd, qdd, tau, *, friction: str = "coulomb-viscou
     st = base_structure(chain, armature=armature)
     kinds = FRICTION_MODELS[friction]
     Y = _inertial_columns(chain, q, qd, qdd, armature)[:, :, st.independent]
-    X3 = np.concatenate([Y, _friction_columns(qd, kinds)], axis=2) if kinds else Y
+    X3 = np.concatenate([Y, friction_columns(qd, kinds)], axis=2) if kinds else Y
     names = st.names + tuple(f"{k}_{j}" for j in jn for k in kinds)
     P = X3.shape[2]
     rows_w = np.ones((N, m)) if w is None else w
