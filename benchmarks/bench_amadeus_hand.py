@@ -14,7 +14,7 @@
 from __future__ import annotations
 
 import numpy as np
-from common import best_time, row
+from common import measure, row
 
 
 def _slip_scipy(x, det):
@@ -64,14 +64,14 @@ def run(quick: bool = False) -> list[dict]:
     T = 60.0 if quick else 600.0
     u = nonslip_grasp_inputs(T, fs, rng)
     u[int(0.5 * u.shape[0]):, 1] += np.linspace(0, 2.0, u.shape[0] - int(0.5 * u.shape[0]))  # ends in slip
-    t_sim = best_time(lambda: c.simulate(u, dt=1 / fs, x0=c.equilibrium_state(u[0, 1])), repeat=2)
+    t_sim = measure(lambda: c.simulate(u, dt=1 / fs, x0=c.equilibrium_state(u[0, 1])))
     x = c.simulate(u, dt=1 / fs, x0=c.equilibrium_state(u[0, 1]))["v_pvdf"] + pvdf_noise(u.shape[0], fs, rng)
     det = SlipDetector(fs).calibrate(x[: int(20 * fs)])
     onsets_g = [int(round(e.alarm * fs)) for e in det.detect(x).events]
     onsets_p = list(_slip_scipy(x, det))
     assert onsets_g[:1] == [int(v) for v in onsets_p[:1]], (onsets_g[:3], onsets_p[:3])
-    tg = best_time(lambda: det.detect(x), repeat=3)
-    tp = best_time(lambda: _slip_scipy(x, det), repeat=3)
+    tg = measure(lambda: det.detect(x))
+    tp = measure(lambda: _slip_scipy(x, det))
     rows.append(row("amadeus_hand", f"slip detection, {T:.0f} s PVDF record at 2 kHz", tg,
                     "scipy.signal sosfilt+lfilter+numpy runs", tp,
                     notes="same first alarm; the peer has no release hysteresis or event features"))
@@ -91,9 +91,9 @@ def run(quick: bool = False) -> list[dict]:
     ref = _kf_numpy(s.H, s.sigma_n2, s.noise_floor ** 2, Z[:Nk], 5.0, 0.005)
     got = ForceKalmanFilter(s, dyn, x0=np.zeros(3), P0=np.eye(3) * 0.01).run(Z[:Nk]).force
     assert np.allclose(got, ref, rtol=1e-7, atol=1e-9)
-    tg = best_time(kf, repeat=3)
-    tp = best_time(lambda: _kf_numpy(s.H, s.sigma_n2, s.noise_floor ** 2, Z[:Nk], 5.0, 0.005), repeat=1) * N / Nk
-    rows.append(row("amadeus_hand", f"Kalman filter, 6 bridges, {N} samples", tg, "numpy joint update", tp,
+    tg = measure(kf)
+    tp = measure(lambda: _kf_numpy(s.H, s.sigma_n2, s.noise_floor ** 2, Z[:Nk], 5.0, 0.005)) * N / Nk
+    rows.append(row("amadeus_hand", f"Kalman filter, 6 bridges, {N} samples", tg, "numpy joint update, per sample in Python", tp, pure_python_peer=True,
                     notes=f"peer timed on {Nk} samples and scaled"))
 
     def wls_loop(R):
@@ -106,9 +106,9 @@ def run(quick: bool = False) -> list[dict]:
 
     Nw = min(N, 10_000)
     np.testing.assert_allclose(estimate_force(Z[:Nw], s, iterations=1).force, wls_loop(Z[:Nw]), rtol=1e-9, atol=1e-12)
-    tg = best_time(lambda: estimate_force(Z, s, iterations=1), repeat=3)
-    tp = best_time(lambda: wls_loop(Z[:Nw]), repeat=1) * N / Nw
-    rows.append(row("amadeus_hand", f"per-sample WLS force, {N} samples", tg, "numpy lstsq loop", tp,
+    tg = measure(lambda: estimate_force(Z, s, iterations=1))
+    tp = measure(lambda: wls_loop(Z[:Nw])) * N / Nw
+    rows.append(row("amadeus_hand", f"per-sample WLS force, {N} samples", tg, "numpy lstsq, once per sample in Python", tp, pure_python_peer=True,
                     notes=f"peer timed on {Nw} samples and scaled"))
 
     import control
@@ -126,8 +126,8 @@ def run(quick: bool = False) -> list[dict]:
     yc = np.asarray(ctl()).ravel()
     yg = rst.reference_response(400)
     assert np.allclose(yc, yg, atol=1e-6), np.abs(yc - yg).max()
-    tg = best_time(lambda: rst.reference_response(400), repeat=5)
-    tp = best_time(ctl, repeat=3)
+    tg = measure(lambda: rst.reference_response(400))
+    tp = measure(ctl)
     rows.append(row("amadeus_hand", "RST closed-loop step response (400 samples)", tg,
                     "python-control tf+step_response", tp))
     return rows

@@ -22,7 +22,7 @@ import time
 import warnings
 
 import numpy as np
-from common import row
+from common import measure, row
 
 POP = {"k_e": {"loguniform": ["10 N/m", "1000 N/m"]}, "w": {"uniform": ["340 um", "390 um"]},
        "offset": {"uniform": ["-5 um", "5 um"]}, "approach_speed": {"uniform": ["1 mm/s", "2 mm/s"]},
@@ -148,6 +148,8 @@ def run(quick: bool = False) -> list[dict]:
         finally:
             dx.close()
 
+    rows.extend(_small_sweep_rows(quick))
+
     # CUDA
     from gripkit.systems.tsfm.grasp_gpu import cuda_available
 
@@ -164,3 +166,27 @@ def run(quick: bool = False) -> list[dict]:
         rows.append(row(bench, "CUDA, one grasp per thread", None, "bare loop, 1 core", t_bare, unit="s/grasp",
                         notes="not measured: no GPU lent (numba.cuda.is_available() is False)"))
     return rows
+
+
+def _small_sweep_rows(quick: bool) -> list[dict]:
+    """1000 short jobs (mass-spring-damper step responses, 6 s at 20 Hz): 'auto' against running
+    them in-process and on a fresh process pool, each end to end (the pool's start-up included,
+    since deciding whether it pays is the point)."""
+    from gripkit.batch import SweepSpec, sweep
+
+    n = 200 if quick else 1000
+    spec = SweepSpec.from_dict({
+        "sweep": {"scenario": "step-response", "model": "mass-spring-damper", "samples": n},
+        "parameters": {"k": {"uniform": [1.0, 8.0]}, "b": {"uniform": [0.5, 1.0]}},
+        "scenario": {"duration": 6.0, "fs": 20.0, "amplitude": 2.0}})
+    sweep(spec, backend="in-process", progress=False)  # compile
+    auto = sweep(spec, backend="auto", progress=False)
+    t_auto = measure(lambda: sweep(spec, backend="auto", progress=False), budget_s=20)
+    t_in = measure(lambda: sweep(spec, backend="in-process", progress=False), budget_s=20)
+    t_pool = measure(lambda: sweep(spec, backend="process", workers=2, progress=False), budget_s=20)
+    label = f"sweep of {n} short jobs, end to end"
+    note = f"auto chose: {auto.choice}"
+    return [row("batch: small sweep", label + " (backend auto)", t_auto, "in-process", t_in, target="ratio ≥ 1 (never slower)",
+                notes=note),
+            row("batch: small sweep", label + " (backend auto)", t_auto, "process pool, 2 workers (start-up included)",
+                t_pool, notes=note)]

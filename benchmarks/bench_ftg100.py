@@ -11,7 +11,7 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
-from common import best_time, row
+from common import measure, row
 
 
 def _scipy_grasp(duration: float, gap: float, noise: bool = True, seed: int = 0):
@@ -68,26 +68,26 @@ def run(quick: bool) -> list[dict]:
     # 1. closed-loop grasp: approach (gap 5 µm), contact, force control; 20 kHz controller
     dur = 0.02 if quick else 0.03
     simulate_hybrid_grasp(gap=5e-6, duration=dur)  # compile
-    g = best_time(lambda: simulate_hybrid_grasp(gap=5e-6, duration=dur), repeat=5)
-    p = best_time(lambda: _scipy_grasp(dur, 5e-6), repeat=1, warmup=0)
+    g = measure(lambda: simulate_hybrid_grasp(gap=5e-6, duration=dur))
+    p = measure(lambda: _scipy_grasp(dur, 5e-6))
     # without noise both must give the same contact force (gripkit records F_c at the start of a
     # sample, the scipy loop after it: shift by one)
     a = simulate_hybrid_grasp(gap=5e-6, duration=dur, noise_force=0.0, noise_position=0.0).trajectory["F_c"][1:]
     b = _scipy_grasp(dur, 5e-6, noise=False)[:-1]
     err = float(np.max(np.abs(a - b)) / 20e-6)
     rows.append(row("ftg100", f"closed-loop grasp, {dur * 1e3:.0f} ms at 20 kHz (plant with contact events + hybrid controller)",
-                    g, "scipy solve_ivp RK45 + events, Python loop", p,
+                    g, "scipy solve_ivp RK45 + events, once per sample in a Python loop", p, pure_python_peer=True,
                     notes=f"same controller, no noise: contact force agrees within {100 * err:.2g} % of the command at every sample"))
     # 2. LM identification of M_a, K_fa, k0 (+ sensor zero)
     data = step_experiment(duration=1.0 if quick else 2.0, period=0.05, seed=1)
     identify_actuated(data)
-    g = best_time(lambda: identify_actuated(data), repeat=3)
-    p = best_time(lambda: _scipy_lm(data), repeat=1, warmup=0)
+    g = measure(lambda: identify_actuated(data))
+    p = measure(lambda: _scipy_lm(data))
     ours = identify_actuated(data)
     theirs = _scipy_lm(data)
     rel = max(abs(ours.value(n) / theirs[i] - 1) for i, n in enumerate(("M_a", "K_fa", "k0")))
     rows.append(row("ftg100", f"LM identification of M_a, K_fa, k0 ({data.n} samples, §III-B)", g,
-                    "scipy least_squares(lm) + signal.dlsim", p,
+                    "scipy least_squares(lm) + signal.dlsim", p, pure_python_peer=True,
                     notes=f"same start (step fit), estimates agree to {rel:.1e}; gripkit adds σ/covariance"))
     return rows
 

@@ -20,27 +20,20 @@ results). Numba compile time is excluded (warm-up call), as everywhere in the be
 
 from __future__ import annotations
 
-import statistics
 import tempfile
 import time
 import warnings
 from pathlib import Path
 
 import numpy as np
-from common import row
+from common import measure, row
 
 
-def timed(fn, repeat: int, number: int = 1, warmup: int = 1) -> tuple[float, float]:
-    """(median, min) seconds per call of ``number`` calls over ``repeat`` runs after ``warmup``."""
-    for _ in range(warmup):
-        fn()
-    ts = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        for _ in range(number):
-            fn()
-        ts.append((time.perf_counter() - t0) / number)
-    return statistics.median(ts), min(ts)
+def timed(fn, repeat: int, number: int = 1) -> tuple:
+    """(Timing, min) per call through the shared harness :func:`common.measure` (same warm-up and
+    runs for both sides; ``repeat`` is kept for the call sites and ignored)."""
+    t = measure(fn, number)
+    return t, t.min
 
 
 def _setup():
@@ -80,7 +73,7 @@ def run(quick: bool = False) -> list[dict]:
     err = float(np.max(np.abs(chain.rnea(q, qd, qdd) - pin.rnea(model, data, q, qd, qdd))))
     rows.append(row("urdf", "RNEA, one state, URDF finger (3 joints + mimic)", gk1[0], "one pin.rnea call", pn1[0],
                     target="ratio >= 0.67 (gripkit <= 1.5x pin)",
-                    notes=f"median of {R}x{n1} calls; min gripkit {gk1[1] * 1e6:.3f} µs, pin {pn1[1] * 1e6:.3f} µs; "
+                    notes=f"per call, {n1} calls per run; min gripkit {gk1[1] * 1e6:.3f} µs, pin {pn1[1] * 1e6:.3f} µs; "
                           f"max |Δτ| {err:.1e} N·m",
                     extra=dict(gripkit_min_s=gk1[1], peer_min_s=pn1[1], max_abs_diff=err)))
 
@@ -99,7 +92,7 @@ def run(quick: bool = False) -> list[dict]:
     err = float(np.max(np.abs(chain.rnea(Q, QD, QDD, parallel=False) - pin_loop())))
     rows.append(row("urdf", f"RNEA, batch of {B} states (1 thread), per state", gkb[0] / B,
                     "pin.rnea in a Python loop", pnb[0] / B, target="ratio >= 2",
-                    notes=f"median of {R}; min {gkb[1] / B * 1e9:.0f} vs {pnb[1] / B * 1e9:.0f} ns/state; "
+                    notes=f"min {gkb[1] / B * 1e9:.0f} vs {pnb[1] / B * 1e9:.0f} ns/state; "
                           f"max |Δτ| {err:.1e} N·m", extra=dict(gripkit_min_s=gkb[1] / B, peer_min_s=pnb[1] / B,
                                                               max_abs_diff=err)))
 
@@ -118,7 +111,7 @@ def run(quick: bool = False) -> list[dict]:
     err = float(np.max(np.abs(chain.regressor(Q[:Br], QD[:Br], QDD[:Br]) - pin_regressor())))
     rows.append(row("urdf", f"inertial-parameter regressor, batch of {Br}, per state", gkr[0] / Br,
                     "pin.computeJointTorqueRegressor in a loop (+ Γᵀ)", pnr[0] / Br, target="ratio >= 1",
-                    notes=f"median of {R}; min {gkr[1] / Br * 1e6:.2f} vs {pnr[1] / Br * 1e6:.2f} µs/state; "
+                    notes=f"min {gkr[1] / Br * 1e6:.2f} vs {pnr[1] / Br * 1e6:.2f} µs/state; "
                           f"max |ΔY| {err:.1e}", extra=dict(gripkit_min_s=gkr[1] / Br, peer_min_s=pnr[1] / Br,
                                                          max_abs_diff=err)))
 
@@ -159,7 +152,7 @@ def run(quick: bool = False) -> list[dict]:
     fr_err = float(np.max(np.abs(res.theta[-6:] - np.ravel(np.column_stack([fc, fv])))))
     rows.append(row("urdf", f"identify_dynamics, 3-joint finger, {N} samples (no consistency check)", gki[0],
                     "pin regressor loop + numpy lstsq", pni[0], target="< 1 s",
-                    notes=f"median of {Rid}; min {gki[1]:.3f} s vs {pni[1]:.3f} s; with the consistency check "
+                    notes=f"min {gki[1]:.3f} s vs {pni[1]:.3f} s; with the consistency check "
                           f"{gkc[0]:.3f} s; max |friction error| {fr_err:.1e} (σ {np.max(res.std[-6:]):.1e}); "
                           f"max |Δθ| vs Pinocchio+lstsq (OLS, unweighted) {np.max(np.abs(res.theta - th_pin)):.1e}",
                     extra=dict(gripkit_min_s=gki[1], peer_min_s=pni[1], with_consistency_s=gkc[0],

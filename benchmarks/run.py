@@ -19,6 +19,13 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
+#: BLAS threads for every benchmark, gripkit and peers alike, fixed before numpy is imported
+#: (threadpoolctl is not in the environment): tall-skinny least squares gain nothing from BLAS
+#: threads on 2 shared cores and vary 20× between processes with them (docs/performance.md).
+BLAS_THREADS = os.environ.get("GRIPKIT_BENCH_BLAS_THREADS", "1")
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[_var] = BLAS_THREADS
+
 
 def machine() -> dict:
     import numba
@@ -31,8 +38,14 @@ def machine() -> dict:
             if line.startswith("model name"):
                 cpu = line.split(":", 1)[1].strip()
                 break
+    blas = "?"
+    with contextlib.suppress(Exception):
+        deps = numpy.show_config(mode="dicts")["Build Dependencies"]["blas"]
+        blas = f"{deps.get('name')} {deps.get('version', '')}".strip()
+    env = {k: os.environ[k] for k in ("OPENBLAS_CORETYPE", "OPENBLAS_L2_SIZE") if k in os.environ}
     return dict(cpu=cpu, cores=os.cpu_count(), python=platform.python_version(),
-                numpy=numpy.__version__, scipy=scipy.__version__, numba=numba.__version__,
+                numpy=numpy.__version__, scipy=scipy.__version__, numba=numba.__version__, blas=blas,
+                blas_threads=BLAS_THREADS, blas_env=env, load_average=os.getloadavg(),
                 platform=platform.platform(), date=dt.datetime.now().isoformat(timespec="seconds"))
 
 
@@ -49,15 +62,30 @@ def to_markdown(results: dict) -> str:
     m = results["machine"]
     lines = [f"# gripkit benchmarks", "",
              f"Machine: {m['cpu']}, {m['cores']} cores; Python {m['python']}, numpy {m['numpy']}, "
-             f"scipy {m['scipy']}, numba {m['numba']}; {m['date']}.", "",
-             "Times are per call (best of several runs after a warm-up call, so numba compile time is "
-             "excluded). ratio = peer time / gripkit time (> 1 means gripkit is faster).", "",
-             "| benchmark | task | gripkit | peer | peer time | ratio | target | notes |",
-             "|---|---|---|---|---|---|---|---|"]
+             f"scipy {m['scipy']}, numba {m['numba']}; BLAS {m.get('blas', '?')} with "
+             f"{m.get('blas_threads', '?')} thread(s) on both sides"
+             + (f" ({', '.join(f'{k}={v}' for k, v in m['blas_env'].items())})" if m.get("blas_env") else "")
+             + f"; load average at start {', '.join(f'{x:.2f}' for x in m.get('load_average', ()))}; {m['date']}.", "",
+             "Both sides of every row are timed by one harness (benchmarks/common.py `measure`): the same "
+             "warm-up call (numba compile time excluded on both sides) and the same number of timed runs; "
+             "times are per call, median (min). ratio = peer median / gripkit median (> 1 means gripkit "
+             "is faster). Peers marked [pure-Python peer] run interpreted Python per sample or per row; "
+             "their ratios measure that, not an expert's compiled route.", "",
+             "| benchmark | task | gripkit median (min) | peer | peer median (min) | ratio | target | "
+             "accuracy: gripkit / peer | notes |",
+             "|---|---|---|---|---|---|---|---|---|"]
+
+    def t(med, mn, runs):
+        if med is None:
+            return "—"
+        return _fmt_t(med) + (f" ({_fmt_t(mn)}, {runs} runs)" if mn is not None else "")
+
     for r in results["rows"]:
         ratio = f"{r['ratio']:.3g}×" if r.get("ratio") else "—"
-        lines.append(f"| {r['benchmark']} | {r['task']} | {_fmt_t(r['gripkit_s'])} | {r['peer']} | "
-                     f"{_fmt_t(r['peer_s'])} | {ratio} | {r.get('target', '')} | {r.get('notes', '')} |")
+        accuracy = " / ".join(a for a in (r.get("gripkit_accuracy", ""), r.get("peer_accuracy", "")) if a)
+        lines.append(f"| {r['benchmark']} | {r['task']} | {t(r['gripkit_s'], r.get('gripkit_min_s'), r.get('gripkit_runs'))} "
+                     f"| {r['peer']} | {t(r['peer_s'], r.get('peer_min_s'), r.get('peer_runs'))} | {ratio} | "
+                     f"{r.get('target', '')} | {accuracy} | {r.get('notes', '')} |")
     if results.get("errors"):
         lines += ["", "## Benchmarks that failed", ""]
         lines += [f"- {k}: {v}" for k, v in results["errors"].items()]

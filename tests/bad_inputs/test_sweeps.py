@@ -273,7 +273,7 @@ def test_unreadable_manifest(sweep_cli, finished, tmp_path):
 def test_backend_and_workers_checked_before_the_output_folder(cli, write, tmp_path):
     path = write(MSD + '[parameters]\nk = { grid = [1.0] }' + SCENARIO)
     assert_user_error(cli("sweep", path, "--out", tmp_path / "o", "--backend", "banana"), "ConfigError",
-                      "backend: expected 'in-process', 'process' or 'dask', found 'banana'")
+                      "backend: expected 'auto', 'in-process', 'process' or 'dask', found 'banana'")
     assert_user_error(cli("sweep", path, "--out", tmp_path / "o", "--workers", "0"), "ConfigError",
                       "workers: expected a positive number, found 0")
     assert not (tmp_path / "o").exists()

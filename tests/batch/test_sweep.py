@@ -52,6 +52,27 @@ def test_process_pool_matches_in_process(reference, tmp_path):
         np.testing.assert_array_equal(res[col], reference[col])
 
 
+def test_auto_backend_runs_a_short_sweep_in_process_and_says_so(reference):
+    """12 jobs of a few ms cannot win back a pool's start-up: 'auto' runs them in-process, with
+    the same results, and the summary gives the reason."""
+    res = sweep(msd_spec(), backend="auto", workers=2, progress=False)
+    assert res.backend == "in-process"
+    assert "backend auto: in-process" in res.summary()
+    for col in ("job_id", "k", "b", "overshoot_percent", "settling_time", "final"):
+        np.testing.assert_array_equal(res[col], reference[col])
+
+
+def test_auto_backend_rule_is_the_break_even_of_the_pool():
+    """With w workers the pool takes startup + work/w: it wins only when work > startup·w/(w−1);
+    one worker never wins."""
+    from gripkit.batch.sweep import POOL_STARTUP_S, _auto_backend
+
+    assert _auto_backend(2.01 * POOL_STARTUP_S, 2)[0] == "process"
+    assert _auto_backend(1.99 * POOL_STARTUP_S, 2)[0] == "in-process"
+    assert _auto_backend(1.51 * POOL_STARTUP_S, 3)[0] == "process"
+    assert _auto_backend(1e6, 1)[0] == "in-process"
+
+
 def test_dask_local_cluster_matches_in_process(reference):
     import distributed  # noqa: F401  (a dev dependency: fail, never skip, without it)
     res = sweep(msd_spec(), backend="dask", workers=2, progress=False)

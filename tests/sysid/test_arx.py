@@ -105,3 +105,50 @@ def test_docstring_examples_run():
 def test_simulated_truth_matches_seed_coefficients():
     """Guard on the fixture itself: it uses Table II's [2 2 2] numbers."""
     assert A222.tolist() == [1.0, -1.8732, 0.8996] and B222.tolist() == [0, 0, 0.1950, -0.2276]
+
+
+@pytest.mark.parametrize("na, nb, nk, n", [(2, 2, 2, 4000), (4, 4, 2, 20000), (2, 3, 1, 20000), (1, 3, 7, 60), (3, 2, 0, 500),
+                                           (0, 2, 3, 30)])
+def test_lagged_sums_route_equals_qr_of_the_regressor(na, nb, nk, n):
+    """The Gram matrix from compensated lagged sums equals [Φ|Y]ᵀ[Φ|Y] of the materialised
+    regressor to rounding (BLOCK·u), and the normal-equations estimate, σ, loss and fit equal the
+    QR route's within the derived bound κ²·BLOCK·u (κ: the column-scaled condition number), or
+    the QR route is taken when κ exceeds GRAM_COND_LIMIT."""
+    from gripkit.sysid.lagged_sums import BLOCK, GRAM_COND_LIMIT, arx_gram
+    from gripkit.sysid.regression import arx_regression, arx_start, qr_solve
+
+    u, y = simulate_arx(n, noise=0.5, seed=11)
+    X = arx_regression(u, y, na, nb, nk)
+    G = arx_gram(u, y, na, nb, nk, arx_start(na, nb, nk))
+    assert np.all(np.abs(G - X.T @ X) <= 4 * BLOCK * 2**-53 * (np.abs(X).T @ np.abs(X)))
+    m = arx(u, y, na, nb, nk)
+    # an over-parameterised [4 4 2] on this second-order system is near-collinear: QR then
+    assert m.info["method"].startswith("least squares (normal equations") == (m.info["cond"] <= GRAM_COND_LIMIT)
+    names = tuple(f"p{i}" for i in range(na + nb))
+    ref = qr_solve(X, names)
+    tol = max(m.info["cond"] ** 2 * BLOCK * 2**-53, 1e-12)
+    np.testing.assert_allclose(m.theta, ref.theta, rtol=0, atol=tol * np.max(np.abs(ref.theta)))
+    e = X[:, -1] - X[:, :-1] @ ref.theta
+    assert m.loss == pytest.approx(0.5 * (e @ e) / e.size, rel=1e-9)
+    assert m.fit_percent == pytest.approx(100 * (1 - np.linalg.norm(e) / np.linalg.norm(X[:, -1] - X[:, -1].mean())),
+                                          rel=1e-9)
+    np.testing.assert_allclose(m.theta_std, np.sqrt(np.diag(ref.cov_unscaled) * (e @ e) / (e.size - na - nb)),
+                               rtol=1e-8)
+
+
+def test_ill_conditioned_regressor_takes_the_qr_route():
+    """A nearly collinear input (a slow sine plus 1e-4 noise, two adjacent lags) gives κ above
+    GRAM_COND_LIMIT: the normal equations would lose κ²·u of accuracy, so QR is used, and the
+    estimate still recovers the exact data."""
+    from gripkit.sysid.lagged_sums import GRAM_COND_LIMIT
+
+    rng = np.random.default_rng(5)
+    n = 3000
+    u = np.sin(0.001 * np.arange(n)) + 1e-4 * rng.standard_normal(n)
+    y = np.zeros(n)
+    for t in range(2, n):
+        y[t] = 0.5 * y[t - 1] + 1.0 * u[t - 1] - 0.7 * u[t - 2]
+    m = arx(u, y, 1, 2, 1)
+    assert m.info["cond"] > GRAM_COND_LIMIT
+    assert m.info["method"] == "least squares (QR of [Φ | Y])"
+    np.testing.assert_allclose(m.theta, [-0.5, 1.0, -0.7], atol=1e-6)

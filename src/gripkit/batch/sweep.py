@@ -89,6 +89,8 @@ class SweepResult:
     chunk_size: int
     seconds: float
     computed_chunks: int
+    #: why the backend was chosen (``backend='auto'``), else empty
+    choice: str = ""
 
     def __getitem__(self, name: str) -> np.ndarray:
         if name not in self.columns:
@@ -118,17 +120,33 @@ class SweepResult:
         failed = f"{self.n_failed} of them FAILED (see the error column)" if self.n_failed else "none failed"
         return (f"{self.n_jobs} job{'s' if self.n_jobs != 1 else ''}, {failed}, in {self.seconds:.2f} s on "
                 f"{self.backend}, chunks of {self.chunk_size}, {self.computed_chunks} computed"
-                + (f"; results in {self.path}" if self.path else ""))
+                + (f"; results in {self.path}" if self.path else "") + (f" ({self.choice})" if self.choice else ""))
 
 
-def _calibrate(first: tuple, target_s: float) -> int:
-    """Jobs per chunk so a chunk takes >= target_s, timed on a warm (compiled) run of the first
-    jobs (``first``: :func:`run_chunk`'s arguments for them)."""
+#: Seconds a process pool needs before its first result: starting the workers, importing gripkit
+#: and compiling (or loading from cache) the kernels in each. Measured 2.6 s for the TSFM grasp
+#: sweep on 2 cores (benchmarks/results, "pool start + warm-up"); 1.5 s is the lower end with a
+#: warm numba cache, so the automatic choice errs towards the pool only when it clearly pays.
+POOL_STARTUP_S = 1.5
+
+
+def _seconds_per_job(first: tuple) -> float:
+    """Seconds per job, timed on a warm (compiled) run of the first jobs (``first``:
+    :func:`run_chunk`'s arguments for them)."""
     run_chunk(*first)  # compile
     t0 = time.perf_counter()
     run_chunk(*first)
-    per_job = max((time.perf_counter() - t0) / len(first[3]), 1e-7)
-    return max(1, math.ceil(target_s / per_job))
+    return max((time.perf_counter() - t0) / len(first[3]), 1e-7)
+
+
+def _auto_backend(work_s: float, workers: int) -> tuple[str, str]:
+    """'in-process' when the estimated work cannot win back the pool's start-up
+    (``work ≤ startup + work / workers``), else 'process'; with the reason for the summary."""
+    if workers <= 1 or work_s <= POOL_STARTUP_S + work_s / workers:
+        return "in-process", (f"backend auto: in-process, the estimated work ({work_s:.2g} s) is too small for "
+                              f"a pool of {workers} to win back its start-up (~{POOL_STARTUP_S:g} s)")
+    return "process", (f"backend auto: process pool of {workers}, the estimated work ({work_s:.2g} s) "
+                       f"outweighs its start-up (~{POOL_STARTUP_S:g} s)")
 
 
 def _in_flight(executor: Executor | None, backend: str, workers: int | None, scheduler: str | None) -> int:
@@ -141,12 +159,14 @@ def _in_flight(executor: Executor | None, backend: str, workers: int | None, sch
 
 
 @entry_point
-def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "process", workers: int | None = None,
+def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "auto", workers: int | None = None,
           scheduler: str | None = None, out: str | Path | None = None, resume: bool = False,
           progress: bool = True, executor: Executor | None = None, target_task_s: float = 0.1,
           allow_code: bool = False, memory_limit: int | float | str | None = None) -> SweepResult:
-    """Run a sweep. ``backend``: 'process' (default), 'in-process' or 'dask' (``scheduler`` address
-    or a LocalCluster); ``out``: folder for checkpointed results (required for ``resume``).
+    """Run a sweep. ``backend``: 'auto' (default: 'in-process' when the work, estimated from two
+    timed jobs, is too small to win back a process pool's start-up :data:`POOL_STARTUP_S`, else
+    'process'; the summary says which and why), 'process', 'in-process' or 'dask' (``scheduler``
+    address or a LocalCluster); ``out``: folder for checkpointed results (required for ``resume``).
 
     ``allow_code``: let the description name code to import (``scenario``/``model`` =
     ``"module:function"``); only registered names otherwise. Such a sweep file is code: run only
@@ -157,8 +177,8 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "process", work
         spec = SweepSpec.from_dict(spec) if isinstance(spec, dict) else SweepSpec.from_toml(spec)
     if resume and out is None:
         raise ConfigError("resume needs the output folder of the interrupted sweep (out=...)")
-    if executor is None and not scheduler and backend not in ("in-process", "process", "dask"):
-        raise ConfigError(f"backend: expected 'in-process', 'process' or 'dask', found {backend!r}")
+    if executor is None and not scheduler and backend not in ("auto", "in-process", "process", "dask"):
+        raise ConfigError(f"backend: expected 'auto', 'in-process', 'process' or 'dask', found {backend!r}")
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
         raise ConfigError(f"workers: expected a positive number, found {workers!r}")
     prep = prepare(spec, allow_code)
@@ -183,9 +203,15 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "process", work
         return (spec.scenario, spec.model, prep.settings, jobs["job_id"][sl], {n: jobs[n][sl] for n in names},
                 spec.metrics, allow_code)
 
+    choice = ""
+    auto = backend == "auto" and executor is None and not scheduler
+    # timed on up to 8 jobs: a chunk's fixed cost (model set-up) spread over 2 would inflate it
+    per_job = _seconds_per_job(chunk_args(range(min(8, n_jobs)))) if (chunk_size is None or auto) else None
+    if auto:
+        backend, choice = _auto_backend(per_job * n_jobs, int(workers or os.cpu_count() or 1))
+        in_flight = _in_flight(None, backend, workers, None)
     if chunk_size is None:
-        chunk_size = min(_calibrate(chunk_args(range(min(2, n_jobs))), target_task_s),
-                         max(estimate.largest_chunk(in_flight, limit), 1))
+        chunk_size = min(max(1, math.ceil(target_task_s / per_job)), max(estimate.largest_chunk(in_flight, limit), 1))
     chunk_size = int(min(chunk_size, n_jobs))
     estimate.check(chunk_size, in_flight, limit, limit_text, f"sweep {spec.name!r}")
     record = spec.to_dict()
@@ -229,4 +255,4 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "process", work
     seconds = time.perf_counter() - t0
     parts = store.read_parts(chunk_size, n_jobs, spec.metrics) if store is not None else mem.values()
     cols = collect(jobs, parts)  # raises unless each job is there exactly once
-    return SweepResult(cols, None if out is None else Path(out), ex.name, chunk_size, seconds, len(tasks))
+    return SweepResult(cols, None if out is None else Path(out), ex.name, chunk_size, seconds, len(tasks), choice)

@@ -166,6 +166,10 @@ class Model(abc.ABC):
         saves the allocation)."""
         thetas = self._check_thetas(thetas)
         arr, dt, _ = self._inputs_array(u, dt)
+        return self._simulate_checked(thetas, arr, dt, x0, substeps, out)
+
+    def _simulate_checked(self, thetas: np.ndarray, arr: np.ndarray, dt: float, x0, substeps, out) -> np.ndarray:
+        """:meth:`simulate_batch` on parameter vectors and inputs already checked."""
         if substeps is None:
             substeps = self.substeps(dt, thetas)
         elif int(substeps) != substeps or substeps < 1:
@@ -197,13 +201,17 @@ class Model(abc.ABC):
                  substeps: int | None = None) -> Trajectory:
         """Simulate one parameter set; returns a Trajectory of the inputs and outputs."""
         arr, dt, t0 = self._inputs_array(u, dt)
-        y = self.simulate_batch(self.theta(params)[None, :], arr, dt,
-                                None if x0 is None else np.asarray(x0)[None, :], substeps)[0]
-        t = t0 + np.arange(arr.shape[0]) * dt
-        # one copy each into channel rows (y was checked finite by simulate_batch, arr by _inputs_array)
-        u_rows, y_rows = np.array(arr.T), np.array(y.T)
+        y = self._simulate_checked(self._check_thetas(self.theta(params)[None, :]), arr, dt,
+                                   None if x0 is None else np.asarray(x0)[None, :], substeps, None)[0]
+        t = np.arange(arr.shape[0], dtype=np.float64)
+        t *= dt
+        t += t0
+        # the output channels are column views of the simulated block, which nothing else
+        # references (no copy); the inputs are copied (arr may be the caller's array). Both were
+        # checked finite (simulate_batch, _inputs_array).
+        u_rows = np.array(arr.T)
         ch = {s.name: u_rows[i] for i, s in enumerate(self.inputs)}
-        ch.update({s.name: y_rows[i] for i, s in enumerate(self.outputs)})
+        ch.update({s.name: y[:, i] for i, s in enumerate(self.outputs)})
         units = {s.name: s.unit for s in (*self.inputs, *self.outputs)}
         return Trajectory._from_checked(t, ch, units, {"fs": 1.0 / dt, "model": self.name})
 

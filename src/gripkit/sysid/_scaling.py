@@ -22,7 +22,7 @@ __all__ = ["unit_scale", "in_user_units"]
 
 def unit_scale(x: np.ndarray) -> float:
     """The power of two ``c`` that brings ``max|x|`` into [0.5, 1) (1 for an all-zero signal)."""
-    peak = float(np.max(np.abs(x)))
+    peak = max(float(np.max(x)), -float(np.min(x)))  # max|x| without an N-sized temporary
     if peak == 0.0:
         return 1.0
     return float(np.ldexp(1.0, -int(np.frexp(peak)[1])))

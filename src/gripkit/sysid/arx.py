@@ -1,4 +1,4 @@
-"""ARX identification by least squares (QR), eq (20)–(23) and (29) of ``000_8f66dcc7ab06470c.txt``.
+"""ARX identification by least squares, eq (20)–(23) and (29) of ``000_8f66dcc7ab06470c.txt``.
 
 >>> import numpy as np
 >>> from gripkit.sysid import arx
@@ -15,12 +15,14 @@
 from __future__ import annotations
 
 import numpy as np
+import scipy.linalg as sla
 
 from ._scaling import in_user_units, unit_scale
 from .checks import check_identifiable, checked_problem
+from .lagged_sums import arx_gram, arx_residuals, gram_triangle
 from .polynomial import PolynomialModel, check_meta
-from .regression import arx_regression, arx_start, qr_solve
-from .validation import fit_percent, loss_vn
+from .regression import arx_regression, arx_start, qr_solve, triangular_solve
+from .validation import fit_percent
 
 __all__ = ["arx"]
 
@@ -78,7 +80,16 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None, fs: flo
         return arx_mimo(u, y, na, nb, nk, dt=dt, fs=fs, **meta)
     u, y, step, na, nb, nk = checked_problem(u, y, dt, fs, na=na, nb=nb, nk=nk)
     cu, cy = unit_scale(u), unit_scale(y)
-    return in_user_units(_arx(u * cu, y * cy, na, nb, nk, step, **meta), cu, cy)
+    if max(abs(np.log2(cu)), abs(np.log2(cy))) <= _NO_SCALING_WITHIN:
+        cu = cy = 1.0  # scaling by powers of two is exact: skip the two copies where it changes nothing
+    return in_user_units(_arx(u * cu if cu != 1.0 else u, y * cy if cy != 1.0 else y, na, nb, nk, step, **meta),
+                         cu, cy)
+
+
+#: Signals whose peak lies within 2^±this are fitted unscaled: their squares summed over up to 2^60
+#: samples stay far inside float64's normal range (2^±1022), and a power-of-two scaling would give
+#: bit-identical estimates (every operation commutes with it exactly), at the cost of two copies.
+_NO_SCALING_WITHIN = 100
 
 
 def _arx(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int, step: float, *, warn: bool = True,
@@ -89,13 +100,45 @@ def _arx(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int, step: float, *
     t0 = arx_start(na, nb, nk)
     check_identifiable(u, y, t0 + p + 1, f"ARX [{na} {nb} {nk}] ({p} parameters, {t0} initial samples)")
     names = tuple(f"a{i}" for i in range(1, na + 1)) + tuple(f"b{nk + j}" for j in range(nb))
-    sol = qr_solve(arx_regression(u, y, na, nb, nk), names, overwrite=True, warn=warn)
-    A = np.concatenate([[1.0], sol.theta[:na]])
-    B = np.concatenate([np.zeros(nk), sol.theta[na:]])
-    model = PolynomialModel(A, B, nk, dt=step, structure="arx", n_samples=int(y.size), **meta)
-    e = model.prediction_errors(u, y)
-    m = e.size
-    sigma2 = float(e @ e) / (m - p)
-    return model.replace(covariance=sigma2 * sol.cov_unscaled, noise_variance=sigma2, loss=loss_vn(e),
-                         fit_percent=fit_percent(y[t0:], y[t0:] - e), n_used=m, residuals=e,
-                         info={"method": "least squares (QR of [Φ | Y])", "cond": sol.cond})
+    m = y.size - t0
+    gram = _normal_equations(u, y, na, nb, nk, t0, names, warn)
+    if gram is None:  # ill-conditioned: QR of the materialised [Φ | Y]
+        sol = qr_solve(arx_regression(u, y, na, nb, nk), names, overwrite=True, warn=warn)
+        method = "least squares (QR of [Φ | Y])"
+        model = _model(sol.theta, na, nk, step, y.size, meta)
+        e = model.prediction_errors(u, y)
+        see, fit = float(e @ e), fit_percent(y[t0:], y[t0:] - e)
+    else:
+        method = "least squares (normal equations from compensated lagged sums, Cholesky)"
+        sol, e, see, syy = gram
+        model = _model(sol.theta, na, nk, step, y.size, meta)
+        fit = 100.0 * (1.0 - np.sqrt(see / syy))
+    sigma2 = see / (m - p)
+    e.flags.writeable = False  # handed to the model without a copy
+    return model.replace(covariance=sigma2 * sol.cov_unscaled, noise_variance=sigma2, loss=0.5 * see / m,
+                         fit_percent=fit, n_used=m, residuals=e, info={"method": method, "cond": sol.cond})
+
+
+def _model(theta, na, nk, step, n, meta) -> PolynomialModel:
+    A = np.concatenate([[1.0], theta[:na]])
+    B = np.concatenate([np.zeros(nk), theta[na:]])
+    return PolynomialModel(A, B, nk, dt=step, structure="arx", n_samples=int(n), **meta)
+
+
+def _normal_equations(u, y, na, nb, nk, t0, names, warn):
+    """The solution from the Gram matrix of ``[Φ | Y]`` (:mod:`.lagged_sums`: one pass, O(q²)
+    memory) with the residuals and their sums ``(sol, e, Σe², Σ(y − ȳ)²)``, or None when Φ is too
+    ill-conditioned for it (then QR is used). ρ² is the residuals' compensated Σe², not
+    ``YᵀY − rᵀr`` (which cancels when the fit is good)."""
+    G = arx_gram(u, y, na, nb, nk, t0)
+    r1 = gram_triangle(G)
+    if r1 is None:
+        return None
+    p = na + nb
+    R = np.zeros((p + 1, p + 1))
+    R[:p, :p] = r1
+    R[:p, p] = sla.solve_triangular(r1, G[:p, p], trans="T", check_finite=False)  # R1ᵀ r = ΦᵀY
+    theta = sla.solve_triangular(r1, R[:p, p], check_finite=False)
+    e, see, syy = arx_residuals(u, y, theta, na, nb, nk, t0)
+    R[p, p] = np.sqrt(see)
+    return triangular_solve(R, names, y.size - t0, warn, stacklevel=5), e, see, syy

@@ -82,8 +82,9 @@ def require_samples(n: int, n_min: int, what: str) -> None:
 
 def check_excitation(u: np.ndarray, name: str = "input u") -> None:
     """Refuse a constant input: it cannot identify the numerator B (the input-output dynamics)."""
-    span = float(np.max(u) - np.min(u))
-    scale = max(float(np.max(np.abs(u))), 1e-300)
+    hi, lo = float(np.max(u)), float(np.min(u))
+    span = hi - lo
+    scale = max(hi, -lo, 1e-300)  # max|u| without an N-sized temporary
     if span <= 1e-12 * scale or span == 0.0:
         raise UnidentifiableError(
             f"{name} is constant ({u[0]:.6g} for all {u.size} samples): a constant input cannot "
@@ -93,7 +94,8 @@ def check_excitation(u: np.ndarray, name: str = "input u") -> None:
 
 def check_output_varies(y: np.ndarray, name: str = "output y") -> None:
     """Refuse a constant output: there is nothing to fit (and the fit % is undefined)."""
-    if float(np.max(y) - np.min(y)) <= 1e-12 * max(float(np.max(np.abs(y))), 1e-300):
+    hi, lo = float(np.max(y)), float(np.min(y))
+    if hi - lo <= 1e-12 * max(hi, -lo, 1e-300):
         raise UnidentifiableError(f"{name} is constant ({y[0]:.6g} for all {y.size} samples): "
                                   f"there are no dynamics to identify; no estimate returned",
                                   hint="check that the output column is the measured response")

@@ -143,8 +143,12 @@ class PolynomialModel:
             cov.flags.writeable = False
             set_(self, "covariance", cov)
         if self.residuals is not None:
-            r = np.array(self.residuals, dtype=np.float64)
-            r.flags.writeable = False
+            r = self.residuals
+            # a read-only float64 array is kept as it is (an estimator's fresh residuals, or a
+            # replace()): copying N samples again would double the memory of a large fit
+            if not (isinstance(r, np.ndarray) and r.dtype == np.float64 and not r.flags.writeable):
+                r = np.array(r, dtype=np.float64)
+                r.flags.writeable = False
             set_(self, "residuals", r)
 
     # ------------------------------------------------------------------ construction

@@ -29,7 +29,8 @@ import scipy.linalg as sla
 
 from ..errors import AccuracyWarning, UnidentifiableError
 
-__all__ = ["arx_start", "arx_regression", "QRSolution", "qr_solve", "COND_LIMIT", "warn_threshold", "hac_covariance"]
+__all__ = ["arx_start", "arx_regression", "QRSolution", "qr_solve", "triangular_solve", "scaled_condition",
+           "COND_LIMIT", "warn_threshold", "hac_covariance"]
 
 #: Largest acceptable condition number of the column-scaled regressor. Beyond it the data do
 #: not determine the parameters (1e10 keeps about 6 significant digits in float64).
@@ -157,17 +158,34 @@ def qr_solve(X: np.ndarray, names: tuple[str, ...], overwrite: bool = False, war
     if m <= p:
         raise UnidentifiableError(f"{m} equations cannot determine {p} parameters ({', '.join(names)})",
                                   hint="use a longer record or a smaller model")
-    R = _qr_r(X, overwrite)
-    r1 = R[:p, :p]
+    return triangular_solve(_qr_r(X, overwrite), names, m, warn, values, stacklevel=4)
+
+
+def scaled_condition(r1: np.ndarray) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
+    """Condition number of Φ with its columns scaled to unit norm, from a triangular factor
+    ``R1`` (``ΦᵀΦ = R1ᵀR1``); returns ``(cond, sv, vt, col)``: the singular values and right
+    singular vectors of the scaled factor and the column norms of Φ (inf and empty ``sv``, ``vt``
+    when a column is zero)."""
     col = np.sqrt(np.sum(r1 * r1, axis=0))  # column norms of Φ (Q is orthogonal)
+    if np.any(col <= 1e-300):
+        return np.inf, np.empty(0), np.empty((0, r1.shape[1])), col
+    sv, vt = np.linalg.svd(r1 / col, compute_uv=True)[1:]
+    return (float(sv[0] / sv[-1]) if sv[-1] > 0 else np.inf), sv, vt, col
+
+
+def triangular_solve(R: np.ndarray, names: tuple[str, ...], m: int, warn: bool = True,
+                     values: np.ndarray | None = None, stacklevel: int = 3) -> QRSolution:
+    """:func:`qr_solve` from the (q, q) upper-triangular factor ``R`` of ``[Φ | Y]`` (m rows),
+    however it was obtained (QR of the data, or Cholesky of its Gram matrix)."""
+    p = R.shape[0] - 1
+    r1 = R[:p, :p]
+    cond, sv, vt, col = scaled_condition(r1)
     zero = col <= 1e-300
     if zero.any():
         bad = [names[i] for i in np.flatnonzero(zero)]
         raise UnidentifiableError(
             f"the regressor of {', '.join(bad)} is identically zero: the data carry no information "
             f"about {'it' if len(bad) == 1 else 'them'}", hint="check the input and output columns")
-    sv, vt = np.linalg.svd(r1 / col, compute_uv=True)[1:]
-    cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else np.inf
     if not cond <= COND_LIMIT:
         involved = [names[i] for i in _weak_combination(vt, names)]
         raise UnidentifiableError(
@@ -195,7 +213,7 @@ def qr_solve(X: np.ndarray, names: tuple[str, ...], overwrite: bool = False, war
             f"{limit:.3g}, the limit for this fit's noise and length; refused above {COND_LIMIT:.0e}): "
             f"poorly determined are {rel}; they move together along a nearly unexcited direction, so "
             f"their values may be far from the truth; excite the system more richly (more frequencies "
-            f"than parameters) or lower the orders", AccuracyWarning, stacklevel=3)
+            f"than parameters) or lower the orders", AccuracyWarning, stacklevel=stacklevel)
     return QRSolution(theta, rss, r1.copy(), 0.5 * (cov + cov.T), cond, m)
 
 

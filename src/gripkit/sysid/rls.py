@@ -105,11 +105,13 @@ def _core(P, th, phi, q, p, size, lam, mode, maxtr, trace, y):
     for i in range(p):
         q[i] *= sq
     tr = 0.0
-    for i in range(p):
+    for i in range(p):  # P stays exactly symmetric: update the upper triangle, mirror it
         qi = sgn * q[i]
         row = i * p
-        for j in range(p):
-            P[row + j] = (P[row + j] + qi * q[j]) * scale
+        for j in range(i, p):
+            v = (P[row + j] + qi * q[j]) * scale
+            P[row + j] = v
+            P[j * p + i] = v
         tr += P[row + i]
     if mode == 1 and tr > maxtr:  # bounded trace
         f = maxtr / tr
