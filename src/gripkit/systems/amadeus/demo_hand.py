@@ -22,6 +22,7 @@ from ...report.plots import subplots
 from ...sysid.step_response import step_metrics
 from .bellows_finger import BAR, PRINCIPAL_DIRECTIONS
 from .force_control import GraspScenario, simulate_finger_grasp
+from .force_dynamics import FORCE_SCALE_NOTE
 from .force_sensor import calibrate as calibrate_force_sensor
 from .force_sensor import estimate_force
 from .parameters import TABLE_I, amadeus_hand
@@ -287,7 +288,7 @@ def _control(report, z, det, rng, summary, quick):
     axes[1].set_aspect("equal")
     axes[1].set_xlim(-0.2, 1.3)
     axes[1].legend(fontsize=8)
-    sec.figure(fig, "Force step (2 N) and input-disturbance rejection; z-plane of the design.",
+    sec.figure(fig, "Force step (2 N) and input-disturbance rejection; z-plane of the design. " + FORCE_SCALE_NOTE,
                name="amadeus-force-step")
     # grasps of compliant objects with the slip reflex
     rows = []
@@ -320,10 +321,10 @@ def _control(report, z, det, rng, summary, quick):
     axes[2].legend(fontsize=8)
     sec.figure(fig, "Grasp of a 2 kN/m object: guarded approach, force control to 2 N, a load increase makes "
                     "the object slip, the PVDF detector fires and the reflex raises the grip force (capped "
-                    "below the 4 N limit).", name="amadeus-grasp")
+                    "below the 4 N limit). " + FORCE_SCALE_NOTE, name="amadeus-grasp")
     sec.table(["object stiffness (N/m)", "contact (s)", "max force (N)", "limit (N)", "slip alarms",
                "slip interval (s)", "slide after 2 s (mm)"], rows,
-              caption="Force-limited grasps with the slip reflex in the loop.")
+              caption="Force-limited grasps with the slip reflex in the loop. " + FORCE_SCALE_NOTE)
     summary.update(rise_time_s=m["rise_time"], overshoot_pct=m["overshoot_percent"], undershoot_pct=m["undershoot_percent"],
                    gain_margin_db=mg["gain_margin_db"], phase_margin_deg=mg["phase_margin_deg"],
                    grasp_max_force=max(r[2] for r in rows))
