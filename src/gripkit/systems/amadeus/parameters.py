@@ -124,7 +124,7 @@ class AmadeusHandSystem:
         self.plant_raw = table2_plant()
         self.plant, self.force_scale = force_plant(force_scale)
         if check:
-            warn_inconsistent(self.consistency_checks(), stacklevel=3)
+            warn_inconsistent(self.consistency_checks())
 
     @property
     def parameters(self) -> ParameterSet:
