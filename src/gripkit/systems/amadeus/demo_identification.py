@@ -164,7 +164,8 @@ def run(report, *, quick: bool = False) -> dict:
                                     "[2 2 2] Table II": (r222.poles(), r222.zeros()),
                                     "[2 2 10] Table II": (r2210.poles(), r2210.zeros())},
                                    title="Pole-zero map (cf. Figs. 20b and 21b)"),
-               "Poles (×) and zeros (○): the [2 2 2] zero lies outside the unit circle, the [2 2 10] zero inside.",
+               "Poles (×, +, ⋎, ✱) and zeros (open ○, □, ◇, △), one shape and size per model so coincident "
+               "markers nest: the [2 2 2] zero lies outside the unit circle, the [2 2 10] zero inside.",
                name="amadeus-pole-zero")
 
     # ---- output error removes the ARX bias; residual tests ----------------------------------
@@ -202,8 +203,10 @@ def run(report, *, quick: bool = False) -> dict:
     sec.figure(plots.bode({"true plant [2 2 2]": truth, "OE [2 2 2] raw": moe, "ARX [2 2 2] raw": marx,
                            "ARX [2 2 2] prefiltered": m222, "ARX [4 4 2] filtered y": fits[("S2", (4, 4, 2), "filtered y")],
                            "9 Hz prefilter (×1000)": _scaled_filter(plant, 1000.0)},
-                          title="Frequency responses (current → force)", magnitude_unit="re 1 N/A"),
-               "Bode plot: the [4 4 2] model of the force-only filtered data contains the filter's roll-off.",
+                          title="Frequency responses (current → force)", magnitude_unit="re 1 N/A",
+                          reference="true plant [2 2 2]"),
+               "Bode plot (true plant: wide grey band): the [4 4 2] model of the force-only filtered data contains "
+               "the filter's roll-off. " + FORCE_SCALE_NOTE,
                name="amadeus-bode")
 
     # ---- RLS over Table III's structures --------------------------------------------------------
