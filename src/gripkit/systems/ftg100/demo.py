@@ -89,8 +89,8 @@ def _model_section(report, summary, act, sen, cpl, plant, fs):
     shown = set()
     for model in (act, sen, cpl, plant):
         rep = check(model)
-        new = [f for f in rep if (f.subject, f.check, f.message) not in shown]
-        shown.update((f.subject, f.check, f.message) for f in rep)
+        new = [f for f in rep if (f.check, f.message) not in shown]
+        shown.update((f.check, f.message) for f in rep)
         if len(new) < len(rep):  # the coupled model repeats its subsystems' checks: show its own only
             rep = ConsistencyReport(new, f"{rep.subject} (its own checks; the {len(rep) - len(new)} it "
                                          "shares with the tables above are not repeated)")
