@@ -43,10 +43,9 @@ def test_pole_zero_map_gives_each_model_its_own_marker_and_size():
     p, z = [0.9 + 0.1j, 0.9 - 0.1j], [1.17]
     fig = pole_zero_map({"a": (p, z), "b": (p, z), "c": (p, z)})
     ax = fig.axes[0]
-    marks = [(ln.get_marker(), ln.get_markersize()) for ln in ax.get_lines() if ln.get_label() != "_child0"
-             and not ln.get_label().startswith("_")]
+    shown = [ln for ln in ax.get_lines() if not ln.get_label().startswith("_")]  # not the unit circle
+    marks = [(ln.get_marker(), ln.get_markersize()) for ln in shown]
     assert len(marks) == 6 and len(set(marks)) == 6
-    poles = [m for ln, m in zip([ln for ln in ax.get_lines() if not ln.get_label().startswith("_")], marks)
-             if ln.get_label().endswith("poles")]
+    poles = [m for ln, m in zip(shown, marks) if ln.get_label().endswith("poles")]
     assert len({m[0] for m in poles}) == 3 and len({m[1] for m in poles}) == 3
     assert ax.get_xlabel() and ax.get_ylabel()
