@@ -13,6 +13,15 @@ overturn the PWM term). The slopes b printed in §5.4.2 for PWM 2000/2500/3000/3
 magnitudes −5.332, −4.688, −3.876, −3.582 ·10⁻⁵ Ncm/rpm; eq 5.8 is their least-squares line
 (largest deviation 4.9 % at PWM 3000; see :meth:`BLDCMotor.consistency_checks`).
 
+**Power balance** (§5.2, eqs 5.1–5.4 and 5.6). The thesis balances the electrical input against
+mechanical output, Joule heat and friction, P_el = P_mech + P_J + P_F (5.1), with P_el = U·I (5.2),
+P_mech = π·τ·n/30000 (5.3; τ in mN·m, n in rpm, the π lost in the text extraction) and
+P_J = R(T)·I² (5.4), combined as U·I = π·τ·n/30000 + R(T)·I² + P_F (5.6). gripkit lumps P_F into
+the drive-train friction (Appendix G) and, with τ = k_t·I, divides eq 5.6 by I: U = k_t·ω + R(T)·I,
+i.e. τ = k_t(U − k_t·ω)/R(T) — the physical law behind the 1/R temperature scaling below and the
+k_t, R₀ derivation of the thermal model. The thermal model heats the winding with eq 5.4's P_J
+(:func:`motor_heat_step`).
+
 **Temperature** (eq 5.5). The winding resistance is R(T) = R₀(1 + α(T − T₀)) with T₀ the ambient
 temperature. Both terms of the physical motor law τ = k_t (u·V/4096 − k_e ω)/R scale with 1/R, so
 gripkit multiplies eq 5.10 by ρ(T) = R(T_ref)/R(T), where T_ref is the temperature at which eqs
@@ -162,11 +171,12 @@ class BLDCMotor:
         return np.clip(u, -self._p("pwm_max"), self._p("pwm_max"))
 
     def current(self, torque, T=None) -> np.ndarray:
-        """Winding current I = τ/k_t (A)."""
+        """Winding current I = τ/k_t (A): the current of eqs 5.2 and 5.4 (P_el = U·I, P_J = R(T)·I²)."""
         return np.asarray(torque, dtype=np.float64) / self._p("k_t")
 
     def resistance(self, T) -> np.ndarray:
-        """R(T) = R₀(1 + α(T − T_amb)) (Ω), eq 5.5."""
+        """R(T) = R₀(1 + α(T − T_amb)) (Ω), eq 5.5: the resistance of the Joule loss P_J = R(T)·I²
+        (eq 5.4) in the power balance of eq 5.6."""
         return self._p("R_0") * (1.0 + self._p("alpha_R") * (np.asarray(T, dtype=np.float64) - self._p("T_amb")))
 
     def consistency_checks(self) -> list[Finding]:
@@ -201,7 +211,8 @@ class BLDCMotor:
 
 @hot
 def motor_heat_step(T, tau_shaft, h, T_amb, alpha, R0, kt, Rth, Cth):  # pragma: no cover - compiled
-    """One explicit step of C_th dT/dt = R(T)(τ/k_t)² − (T − T_amb)/R_th."""
+    """One explicit step of C_th dT/dt = P_J − (T − T_amb)/R_th, with the Joule heat
+    P_J = R(T)·I² of eq 5.4, I = τ/k_t, and R(T) of eq 5.5."""
     cur = tau_shaft / kt
     R = R0 * (1.0 + alpha * (T - T_amb))
     return T + h * (R * cur * cur - (T - T_amb) / Rth) / Cth

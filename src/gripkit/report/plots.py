@@ -5,7 +5,8 @@
   their confidence bands (:class:`gripkit.sysid.ResidualTests`);
 * :func:`pole_zero_map` — z-plane poles (×) and zeros (○) with the unit circle (Figs. 20b, 21b);
 * :func:`bode` — magnitude and phase of discrete-time models against frequency in Hz;
-* :func:`parameter_convergence` — recursive estimates with ±2σ bands and optional true values.
+* :func:`parameter_convergence` — recursive estimates with ±2σ bands and optional true values;
+* :func:`log_ticks` — labelled major ticks at 1, 2, 5 per decade on every log axis of an axes.
 """
 
 from __future__ import annotations
@@ -14,7 +15,8 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-__all__ = ["measured_vs_model", "residual_correlation", "pole_zero_map", "bode", "parameter_convergence"]
+__all__ = ["measured_vs_model", "residual_correlation", "pole_zero_map", "bode", "parameter_convergence",
+           "log_ticks"]
 
 
 def pyplot():
@@ -30,6 +32,25 @@ def pyplot():
 def subplots(*args, **kw):
     """``pyplot().subplots(...)``: a new figure and its axes."""
     return pyplot().subplots(*args, **kw)
+
+
+def log_ticks(*axes) -> None:
+    """Give every log-scaled axis of ``axes`` labelled ticks at 1, 2 and 5 × 10ⁿ (unlabelled minor
+    ticks at the other integers), so that even a span under one decade shows at least three labels."""
+    from matplotlib.ticker import LogFormatterSciNotation, LogLocator, NullFormatter
+
+    for ax in axes:
+        for axis, scale in ((ax.xaxis, ax.get_xscale()), (ax.yaxis, ax.get_yscale())):
+            if scale != "log":
+                continue
+            lo, hi = sorted(axis.get_view_interval())
+            decades = np.log10(hi / lo) if lo > 0 else np.inf
+            subs = (1.0, 2.0, 5.0) if decades <= 4 else (1.0,)
+            axis.set_major_locator(LogLocator(base=10.0, subs=subs, numticks=30))
+            axis.set_major_formatter(LogFormatterSciNotation(labelOnlyBase=False, minor_thresholds=(np.inf, np.inf))
+                                     if decades <= 4 else LogFormatterSciNotation())
+            axis.set_minor_locator(LogLocator(base=10.0, subs=np.arange(2, 10), numticks=30))
+            axis.set_minor_formatter(NullFormatter())
 
 
 def measured_vs_model(t: np.ndarray, measured: np.ndarray, models: Mapping[str, np.ndarray], *,
@@ -91,12 +112,17 @@ def pole_zero_map(models: Mapping[str, tuple[Sequence[complex], Sequence[complex
     ax.axhline(0, color="0.8", lw=0.6)
     ax.axvline(0, color="0.8", lw=0.6)
     allz = [1.0]
+    # models often share poles and zeros: each gets its own marker shape and a size that shrinks
+    # with its order, drawn later on top, so coincident markers nest instead of hiding each other
+    pole_marks, zero_marks = "x+1*", "osD^"
     for k, (label, (p, z)) in enumerate(models.items()):
         p = np.atleast_1d(np.asarray(p, dtype=complex))
         z = np.atleast_1d(np.asarray(z, dtype=complex))
-        c = f"C{k}"
-        ax.plot(p.real, p.imag, "x", color=c, ms=9, mew=2, label=f"{label} poles")
-        ax.plot(z.real, z.imag, "o", color=c, ms=9, mfc="none", mew=1.6, label=f"{label} zeros")
+        c, ms = f"C{k}", max(15.0 - 3.0 * k, 5.0)
+        ax.plot(p.real, p.imag, pole_marks[k % 4], color=c, ms=ms, mew=2, zorder=3 + k,
+                label=f"{label} poles")
+        ax.plot(z.real, z.imag, zero_marks[k % 4], color=c, ms=ms, mfc="none", mew=1.6, zorder=3 + k,
+                label=f"{label} zeros")
         allz += list(np.abs(p)) + list(np.abs(z))
     lim = 1.1 * max(allz)
     ax.set_xlim(-lim, lim)
@@ -111,21 +137,33 @@ def pole_zero_map(models: Mapping[str, tuple[Sequence[complex], Sequence[complex
     return fig
 
 
-def bode(models: Mapping[str, object], *, n: int = 512, title: str = "", magnitude_unit: str = ""):
+def bode(models: Mapping[str, object], *, n: int = 512, title: str = "", magnitude_unit: str = "",
+         reference: str | None = None):
     """Magnitude (dB) and phase (deg) of models with ``frequency_response(n=...)`` (e.g.
-    :class:`gripkit.sysid.PolynomialModel`), or of ``(f_Hz, H)`` pairs, up to Nyquist."""
+    :class:`gripkit.sysid.PolynomialModel`), or of ``(f_Hz, H)`` pairs, up to Nyquist.
+
+    ``reference`` names the model the others are compared with (e.g. the true plant): it is drawn
+    as a wide grey band under the others, so that an estimate lying on it shows as a line inside
+    the band instead of hiding it."""
     plt = pyplot()
     fig, (am, ap) = plt.subplots(2, 1, figsize=(8, 5.6), sharex=True)
+    k = 0
     for label, m in models.items():
         f, h = m if isinstance(m, tuple) else m.frequency_response(n=n)
         sel = f > 0
-        am.semilogx(f[sel], 20 * np.log10(np.maximum(np.abs(h[sel]), 1e-300)), label=label)
-        ap.semilogx(f[sel], np.degrees(np.unwrap(np.angle(h[sel]))), label=label)
+        if label == reference:
+            style = dict(color="0.25", lw=6.0, alpha=0.35, zorder=1, solid_capstyle="butt")
+        else:  # estimates often coincide: cycle the dash pattern as well as the colour
+            style = dict(color=f"C{k}", lw=1.4, zorder=2, ls=("-", "--", "-.", ":")[k % 4])
+            k += 1
+        am.semilogx(f[sel], 20 * np.log10(np.maximum(np.abs(h[sel]), 1e-300)), label=label, **style)
+        ap.semilogx(f[sel], np.degrees(np.unwrap(np.angle(h[sel]))), label=label, **style)
     am.set_ylabel(f"magnitude [dB{' ' + magnitude_unit if magnitude_unit else ''}]")
     ap.set_ylabel("phase [deg]")
     ap.set_xlabel("frequency [Hz]")
     for ax in (am, ap):
         ax.grid(alpha=0.3, which="both")
+    log_ticks(am, ap)
     am.legend(fontsize=8)
     am.set_title(title)
     fig.tight_layout()

@@ -64,7 +64,7 @@ class Model(abc.ABC):
             raise ParameterError(f"{type(self).__name__}: expected a ParameterSet, found {type(parameters).__name__}")
         self.parameters = parameters
         if check:
-            warn_inconsistent(self.consistency_checks(), stacklevel=3)
+            warn_inconsistent(self.consistency_checks())
 
     # --- to override -------------------------------------------------------------------------
     @abc.abstractmethod
@@ -90,7 +90,7 @@ class Model(abc.ABC):
         new.__dict__.update(self.__dict__)
         new.parameters = self.parameters.replace(**values)
         if check:
-            warn_inconsistent(new.consistency_checks(), stacklevel=3)
+            warn_inconsistent(new.consistency_checks())
         return new
 
     def theta(self, params: ParameterSet | Mapping[str, float] | None = None) -> np.ndarray:

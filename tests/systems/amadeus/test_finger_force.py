@@ -11,7 +11,8 @@ import numpy as np
 import pytest
 
 from gripkit.control import DiscretePlant, RSTController, design_rst, simulate_loop
-from gripkit.errors import ModelError
+from gripkit import zoo
+from gripkit.errors import ModelError, ParameterError
 from gripkit.sim import StateSpace
 from gripkit.sysid.step_response import step_metrics
 from gripkit.systems.amadeus import GraspScenario, simulate_finger_grasp
@@ -196,3 +197,43 @@ def test_grasp_respects_the_force_limit_and_arrests_slip(rst, detector, k_object
     assert alarms and alarms[0] - onset <= 0.020
     assert g.slipping[g.t > 3.6].max() == 0.0  # the reflex stopped it
     assert g.force[-1] > sc.force_target + 0.5
+
+
+# -- the force scale (N per sensor unit) is an assumed, user-settable calibration ---------------------
+
+def test_force_scale_default_is_derived_from_fig2c_peak_over_the_valve_span():
+    from gripkit.systems.amadeus.force_dynamics import FORCE_SCALE, TABLE_II
+    row = next(r for r in TABLE_II if (r.na, r.nb, r.nk, r.data) == (2, 2, 2, "S1"))
+    gain = abs(sum(row.B) / sum(row.A))  # Table II [2 2 2]: 0.0326/0.0264 units/mA
+    assert gain == pytest.approx(1.235, abs=5e-4)
+    assert FORCE_SCALE == pytest.approx(15.45 / (gain * 500.0), rel=1e-12)  # Fig. 2(c), §V-E
+    p = zoo.build("amadeus-finger-force").parameters["force_scale"]
+    assert p.value == FORCE_SCALE and p.unit == "N"
+    assert p.source.startswith("assumed:") and "15.45 N" in p.source and "500 mA" in p.source
+
+
+def test_force_scale_is_user_settable_and_scales_b_only():
+    ref = zoo.build("amadeus-finger-force")
+    m = zoo.build("amadeus-finger-force", force_scale=0.04)
+    assert m.force_scale == 0.04 and m.parameters["force_scale"].source.startswith("set by the user")
+    np.testing.assert_allclose(m.model.B, ref.model.B * 0.04 / ref.force_scale, rtol=1e-12)
+    np.testing.assert_array_equal(m.model.A, ref.model.A)
+    hand = zoo.build("amadeus-hand", force_scale=0.04)
+    np.testing.assert_allclose(hand.plant.B, m.model.B, rtol=1e-12)
+    assert hand.parameters.value("force_scale") == 0.04
+
+
+@pytest.mark.parametrize("bad", [0.0, -0.025, float("nan"), float("inf"), "a lot"])
+def test_force_scale_rejects_non_positive_or_non_numbers(bad):
+    with pytest.raises(ParameterError, match="force_scale"):
+        zoo.build("amadeus-finger-force", force_scale=bad)
+
+
+def test_design_rst_accepts_the_zoo_model_directly():
+    m = zoo.build("amadeus-finger-force")
+    c = design_rst(m, wn=15.0, zeta=0.9, u_min=-0.25, u_max=0.25)
+    ref = design_rst(m.model, wn=15.0, zeta=0.9, u_min=-0.25, u_max=0.25)
+    np.testing.assert_allclose(np.sort_complex(c.closed_loop_poles()), np.sort_complex(ref.closed_loop_poles()),
+                               atol=1e-12)
+    assert np.abs(c.closed_loop_poles()).max() < 1
+    assert DiscretePlant.from_model(m).output_unit == "N"

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from gripkit.errors import DataError, ModelError, UnidentifiableError
+from gripkit import zoo
 from gripkit.models.bldc import NCM, RPM, SLOPES_5_4_2, BLDCMotor, MotorTestBed, motor_parameters
 from gripkit.models.transmission import DLR_BASE, DLR_DISTAL, Transmission, harmonic_drive
 from gripkit.sysid.motor import characterize_motor, fit_motor
@@ -29,6 +30,38 @@ def test_slopes_of_section_5_4_2():
         # the torque actually falls with that slope
         w = 1500 * RPM
         assert (MOTOR.torque(pwm, w) - MOTOR.torque(pwm, 0.0)) / 1500 / NCM == pytest.approx(MOTOR.slope(pwm) * RPM / NCM)
+
+
+#: eq 5.8 against the four slopes printed under Fig. 5.6 (§5.4.2, Ncm/rpm): (eq 5.8 value, relative
+#: deviation). Eq 5.8 is b = 1.215e-8·PWM − 7.711e-5; two printed slopes are off by more than 3 %:
+#: PWM 3000 by 4.9 % and PWM 3500 by 3.45 % (the ``eq5.8-slope-pwm*`` findings of ``zoo check``).
+FIG_5_6_SLOPES = {2000: (-5.281e-5, 0.00956), 2500: (-4.6735e-5, 0.00309),
+                  3000: (-4.066e-5, 0.0490), 3500: (-3.4585e-5, 0.0345)}
+
+
+@pytest.mark.parametrize("pwm", sorted(FIG_5_6_SLOPES))
+def test_fig_5_6_slopes_against_eq_5_8_and_the_consistency_finding(pwm):
+    """Each Fig. 5.6 slope printed in §5.4.2 against eq 5.8, with the deviation ``zoo check``
+    reports: PWM 2000 0.96 %, 2500 0.31 %, 3000 4.9 %, 3500 3.45 % (all within the 6 % tolerance)."""
+    eq58, rel = FIG_5_6_SLOPES[pwm]
+    stated = SLOPES_5_4_2[pwm]
+    b = float(MOTOR.slope(pwm)) * RPM / NCM
+    assert b == pytest.approx(1.215e-8 * pwm - 7.711e-5, rel=1e-12) == pytest.approx(eq58, rel=1e-12)
+    assert abs(b - stated) / abs(stated) == pytest.approx(rel, abs=5e-5)
+    f = {x.check: x for x in zoo.build("dlr-hit-finger").consistency_checks()}[f"eq5.8-slope-pwm{pwm}"]
+    assert f.consistent and f.tolerance == 0.06
+    assert f.computed == pytest.approx(b, rel=1e-12) and f.stated == stated
+    assert f.rel_error == pytest.approx(rel, abs=5e-5)
+
+
+def test_eq_5_8_is_the_least_squares_line_through_the_fig_5_6_slopes():
+    """Eq 5.8 (1.215e-8 Ncm/(rpm·PWM), −7.711e-5 Ncm/rpm) is the least-squares line of the four
+    printed slopes within 0.3 % (the fit gives 1.2124e-8 and −7.7036e-5); the 4.9 % and 3.45 %
+    deviations are its residuals."""
+    pwm = np.array(sorted(SLOPES_5_4_2), dtype=float)
+    slope, intercept = np.polyfit(pwm, [SLOPES_5_4_2[int(p)] for p in pwm], 1)
+    assert slope == pytest.approx(1.215e-8, rel=3e-3)
+    assert intercept == pytest.approx(-7.711e-5, rel=3e-3)
 
 
 def test_appendix_e_guard():

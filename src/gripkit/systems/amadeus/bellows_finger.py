@@ -236,7 +236,7 @@ class BellowsFinger:
             raise ParameterError(f"p_operating = {p.value('p_operating') / BAR:g} bar must lie in "
                                  f"[p_min, p_max) = [{p.value('p_min') / BAR:g}, {p.value('p_max') / BAR:g}) bar")
         if check:
-            warn_inconsistent(self.consistency_checks(), stacklevel=3)
+            warn_inconsistent(self.consistency_checks())
 
     # -- derived geometry ------------------------------------------------------------------
     @property

@@ -18,10 +18,11 @@ from ...consistency import check
 from ...control import design_rst, simulate_loop
 from ...estimation import fused_variance, implied_correlation
 from ...progress import status
-from ...report.plots import subplots
+from ...report.plots import log_ticks, subplots
 from ...sysid.step_response import step_metrics
 from .bellows_finger import BAR, PRINCIPAL_DIRECTIONS
 from .force_control import GraspScenario, simulate_finger_grasp
+from .force_dynamics import FORCE_SCALE_NOTE
 from .force_sensor import calibrate as calibrate_force_sensor
 from .force_sensor import estimate_force
 from .parameters import TABLE_I, amadeus_hand
@@ -214,6 +215,7 @@ def _slip(report, z, rng, summary, quick):
     axes[2].set_xlabel("frequency (Hz)")
     axes[2].set_ylabel("PSD (V²/Hz)")
     axes[2].legend(fontsize=8)
+    log_ticks(axes[1], axes[2])
     fig.tight_layout()
     sec.figure(fig, "A slip event: film signal, band energy against the threshold, and spectra while holding and "
                     "slipping (cf. Fig. 13).", name="amadeus-slip-event")
@@ -280,14 +282,14 @@ def _control(report, z, det, rng, summary, quick):
     axes[0].legend(fontsize=8)
     th = np.linspace(0, 2 * np.pi, 200)
     axes[1].plot(np.cos(th), np.sin(th), "k", lw=0.5)
-    axes[1].plot(poles.real, poles.imag, "x", label="closed-loop poles")
-    axes[1].plot(p.poles().real, p.poles().imag, "+", label="plant poles")
+    axes[1].plot(p.poles().real, p.poles().imag, "+", ms=14, mew=1.5, label="plant poles")
+    axes[1].plot(poles.real, poles.imag, "x", ms=8, mew=1.5, label="closed-loop poles")
     zz = p.zeros()
-    axes[1].plot(zz.real, zz.imag, "o", mfc="none", label="plant zero (kept)")
+    axes[1].plot(zz.real, zz.imag, "o", ms=10, mfc="none", label="plant zero (kept)")
     axes[1].set_aspect("equal")
     axes[1].set_xlim(-0.2, 1.3)
     axes[1].legend(fontsize=8)
-    sec.figure(fig, "Force step (2 N) and input-disturbance rejection; z-plane of the design.",
+    sec.figure(fig, "Force step (2 N) and input-disturbance rejection; z-plane of the design. " + FORCE_SCALE_NOTE,
                name="amadeus-force-step")
     # grasps of compliant objects with the slip reflex
     rows = []
@@ -320,10 +322,10 @@ def _control(report, z, det, rng, summary, quick):
     axes[2].legend(fontsize=8)
     sec.figure(fig, "Grasp of a 2 kN/m object: guarded approach, force control to 2 N, a load increase makes "
                     "the object slip, the PVDF detector fires and the reflex raises the grip force (capped "
-                    "below the 4 N limit).", name="amadeus-grasp")
+                    "below the 4 N limit). " + FORCE_SCALE_NOTE, name="amadeus-grasp")
     sec.table(["object stiffness (N/m)", "contact (s)", "max force (N)", "limit (N)", "slip alarms",
                "slip interval (s)", "slide after 2 s (mm)"], rows,
-              caption="Force-limited grasps with the slip reflex in the loop.")
+              caption="Force-limited grasps with the slip reflex in the loop. " + FORCE_SCALE_NOTE)
     summary.update(rise_time_s=m["rise_time"], overshoot_pct=m["overshoot_percent"], undershoot_pct=m["undershoot_percent"],
                    gain_margin_db=mg["gain_margin_db"], phase_margin_deg=mg["phase_margin_deg"],
                    grasp_max_force=max(r[2] for r in rows))

@@ -27,7 +27,7 @@ from ...consistency import ConsistencyReport, check
 from ...excitation import bandlimited_noise, multisine
 from ...signals.filters import apply_sos
 from ...sysid import arx, oe, rls
-from .force_dynamics import (FORCE_SCALE, FS, TABLE_II, TABLE_III,
+from .force_dynamics import (FORCE_SCALE, FORCE_SCALE_NOTE, FS, TABLE_II, TABLE_III,
                              finger_force_model as build_plant, reference, seed_checks)
 
 __all__ = ["run", "NOISE_UNITS"]
@@ -164,7 +164,8 @@ def run(report, *, quick: bool = False) -> dict:
                                     "[2 2 2] Table II": (r222.poles(), r222.zeros()),
                                     "[2 2 10] Table II": (r2210.poles(), r2210.zeros())},
                                    title="Pole-zero map (cf. Figs. 20b and 21b)"),
-               "Poles (×) and zeros (○): the [2 2 2] zero lies outside the unit circle, the [2 2 10] zero inside.",
+               "Poles (×, +, ⋎, ✱) and zeros (open ○, □, ◇, △), one shape and size per model so coincident "
+               "markers nest: the [2 2 2] zero lies outside the unit circle, the [2 2 10] zero inside.",
                name="amadeus-pole-zero")
 
     # ---- output error removes the ARX bias; residual tests ----------------------------------
@@ -182,7 +183,7 @@ def run(report, *, quick: bool = False) -> dict:
                      _fmt_pm(moe.theta[[2, 3, 0, 1][i]] * scale[i], moe.theta_std[[2, 3, 0, 1][i]] * scale[i])])
     sec.table(["parameter", "true", "ARX raw (S2)", "ARX prefiltered (S2)", "OE raw (S2)"], prow,
               caption="[2 2 2] estimates ± σ. Output (measurement) noise biases ARX; the output-error "
-                      "model is consistent for it.")
+                      "model is consistent for it. b2, b3 in N/mA: " + FORCE_SCALE_NOTE)
     u1r, y1r = signals("S1", "raw")
     val_arx = marx.validate(u1r, y1r)
     val_oe = moe.validate(u1r, y1r)
@@ -197,12 +198,15 @@ def run(report, *, quick: bool = False) -> dict:
                  f"ARX [2 2 2] free run (fit {val_arx.fit_percent:.1f} %)": val_arx.simulation.y_sim},
         extra={"noise-free force": rec["S1"]["force_true"]}, ylabel="force deviation [N]",
         title="Measured and modelled force on S1 (models estimated on S2; initial conditions estimated)"),
-        "Measured (grey) and modelled (dashed) force, cf. Figs. 19–22.", name="amadeus-measured-vs-model")
+        "Measured (grey) and modelled (dashed) force, cf. Figs. 19–22. " + FORCE_SCALE_NOTE,
+        name="amadeus-measured-vs-model")
     sec.figure(plots.bode({"true plant [2 2 2]": truth, "OE [2 2 2] raw": moe, "ARX [2 2 2] raw": marx,
                            "ARX [2 2 2] prefiltered": m222, "ARX [4 4 2] filtered y": fits[("S2", (4, 4, 2), "filtered y")],
                            "9 Hz prefilter (×1000)": _scaled_filter(plant, 1000.0)},
-                          title="Frequency responses (current → force)", magnitude_unit="re 1 N/A"),
-               "Bode plot: the [4 4 2] model of the force-only filtered data contains the filter's roll-off.",
+                          title="Frequency responses (current → force)", magnitude_unit="re 1 N/A",
+                          reference="true plant [2 2 2]"),
+               "Bode plot (true plant: wide grey band): the [4 4 2] model of the force-only filtered data contains "
+               "the filter's roll-off. " + FORCE_SCALE_NOTE,
                name="amadeus-bode")
 
     # ---- RLS over Table III's structures --------------------------------------------------------

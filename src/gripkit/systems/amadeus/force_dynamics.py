@@ -38,7 +38,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...consistency import Finding, compare, warn_inconsistent
-from ...errors import DataError, ModelError
+from ...errors import DataError, ModelError, ParameterError
 from ...params import Parameter, ParameterSet
 from ...signals.filters import apply_sos, butter_sos, butter_zpk
 from ...signals.trajectory import Trajectory
@@ -46,7 +46,8 @@ from ...sysid.checks import as_signal
 from ...sysid.polynomial import PolynomialModel
 
 __all__ = ["ReferenceModel", "TABLE_II", "TABLE_III", "FingerForcePlant", "finger_force_model",
-           "seed_checks", "SEED", "FS", "PREFILTER_ORDER", "PREFILTER_CUTOFF", "FORCE_SCALE", "PEAK_FORCE"]
+           "seed_checks", "SEED", "FS", "PREFILTER_ORDER", "PREFILTER_CUTOFF", "FORCE_SCALE", "PEAK_FORCE",
+           "FORCE_SCALE_DERIVATION", "FORCE_SCALE_NOTE", "force_scale_parameter"]
 
 SEED = "000_8f66dcc7ab06470c.txt"
 FS = 200.0  # Hz, §V-C
@@ -140,14 +141,39 @@ TABLE_III: tuple[ReferenceModel, ...] = (
 )
 
 
-def _force_scale() -> float:
+def _table2_gain_per_mA() -> tuple[float, float, float]:
+    """(B(1), A(1), B(1)/A(1)) of Table II [2 2 2]: its static gain in sensor units per mA."""
     row = next(r for r in TABLE_II if (r.na, r.nb, r.nk, r.data) == (2, 2, 2, "S1"))
-    gain_per_mA = sum(row.B) / sum(row.A)
-    return PEAK_FORCE / (abs(gain_per_mA) * 1e3 * (CURRENT_LIMITS[1] - CURRENT_LIMITS[0]))
+    return sum(row.B), sum(row.A), sum(row.B) / sum(row.A)
 
 
+_B1, _A1, _GAIN = _table2_gain_per_mA()
+_SPAN_MA = 1e3 * (CURRENT_LIMITS[1] - CURRENT_LIMITS[0])
 #: newtons per force-sensor unit of Tables II/III (assumed, see the module docstring): 0.0250 N
-FORCE_SCALE = _force_scale()
+FORCE_SCALE = PEAK_FORCE / (abs(_GAIN) * _SPAN_MA)
+#: how FORCE_SCALE follows from the seed (the ``source`` of the ``force_scale`` parameter)
+FORCE_SCALE_DERIVATION = (
+    f"assumed: the 500 mA valve span (§V-E, 600-1100 mA) moves the fingertip force over its "
+    f"{PEAK_FORCE} N peak ({SEED} Fig. 2(c)); Table II [2 2 2] static gain |B(1)/A(1)| = "
+    f"{abs(_B1):.4f}/{_A1:.4f} = {abs(_GAIN):.4g} units/mA, so {PEAK_FORCE} N / ({abs(_GAIN):.4g} units/mA × "
+    f"{_SPAN_MA:.0f} mA) = {FORCE_SCALE:.4f} N/unit")
+#: caption note for every demo force in N that rests on the assumed force scale
+FORCE_SCALE_NOTE = ("Forces in N rest on the assumed force scale (newtons per sensor unit, not stated in the "
+                    "seed; derived from the 15.45 N peak of Fig. 2(c) over the 500 mA valve span; "
+                    "settable as force_scale).")
+
+
+def force_scale_parameter(value: float = FORCE_SCALE) -> Parameter:
+    """The ``force_scale`` calibration (N per force-sensor unit of Tables II/III) as a
+    :class:`~gripkit.params.Parameter`; a value that is not a positive finite number raises
+    :class:`~gripkit.errors.ParameterError`."""
+    p = Parameter("force_scale", value, "N", "newtons per force-sensor unit of Tables II/III (calibration)",
+                  bounds=(0.0, None), source=FORCE_SCALE_DERIVATION if value == FORCE_SCALE
+                  else f"set by the user (default {FORCE_SCALE:.4f} N/unit, {FORCE_SCALE_DERIVATION})")
+    if not p.value > 0.0:
+        raise ParameterError(f"force_scale: expected a positive number of newtons per sensor unit, found {value!r}",
+                             hint=f"the default {FORCE_SCALE:.4f} N/unit is {FORCE_SCALE_DERIVATION}")
+    return p
 
 
 def reference(table: str, na: int, nb: int, nk: int, *, filtered: bool = True, data: str = "S1") -> ReferenceModel:
@@ -189,12 +215,15 @@ class FingerForcePlant:
     description = ("AMADEUS finger: valve current (A, deviation from 850 mA) to fingertip force (N, "
                    "AC-coupled), ARX [2 2 2] of Table II (9 Hz-filtered data), 200 Hz, 2-sample delay")
 
-    def __init__(self):
+    input_name, input_unit, output_name, output_unit = "current", "A", "force", "N"
+
+    def __init__(self, force_scale: float = FORCE_SCALE):
+        scale = force_scale_parameter(force_scale)
         row = reference("II", 2, 2, 2)
         sig = reference("III", 2, 2, 2)  # same coefficients, with σ (§V-F: RLS = LS)
         src = f"{SEED}, Table II"
         srcs = f"σ: {SEED}, Table III [2,2,2] 9 Hz"
-        k = 1e3 * FORCE_SCALE  # printed B is sensor units per mA (see module docstring)
+        k = 1e3 * scale.value  # printed B is sensor units per mA (see module docstring)
         P = Parameter
         self.parameters = ParameterSet([
             P("a1", row.A[1], "1", "coefficient of q^-1 in A(q)", source=f"{src}; {srcs}", std=sig.A_std[1]),
@@ -205,9 +234,7 @@ class FingerForcePlant:
             P("b3", k * row.B[3], "N/A", "coefficient of q^-3 in B(q) (current to force)",
               source=f"{src} (printed in units/mA; × force_scale); {srcs}", std=k * sig.B_std[3],
               display_unit="N/mA"),
-            P("force_scale", FORCE_SCALE, "N", "newtons per force-sensor unit of Tables II/III",
-              bounds=(0, None), source=f"assumed: the 500 mA valve span moves the force over the 15.45 N "
-                                       f"peak of {SEED} Fig. 2(c)"),
+            scale,
             P("fs", FS, "Hz", "sampling rate", bounds=(0, None), source=f"{SEED}, §V-C"),
             P("delay", float(row.nk), "1", "valve transport delay in samples (about 0.01 s)",
               bounds=(0, None), source=f"{SEED}, §V-C, Fig. 15"),
@@ -230,7 +257,20 @@ class FingerForcePlant:
             u_offset=OPERATING_POINT, info={"source": src})
         warn_inconsistent(self.consistency_checks())
 
-    # -- properties a controller designer needs
+    # -- properties a controller designer needs (A, B, dt make it a plant for design_rst)
+    @property
+    def force_scale(self) -> float:
+        """Newtons per force-sensor unit (the calibration the SI coefficients rest on)."""
+        return self.parameters.value("force_scale")
+
+    @property
+    def A(self) -> np.ndarray:
+        return self.model.A
+
+    @property
+    def B(self) -> np.ndarray:
+        return self.model.B
+
     @property
     def fs(self) -> float:
         return FS
@@ -345,9 +385,10 @@ class FingerForcePlant:
         return f"FingerForcePlant({self.model!r})"
 
 
-def finger_force_model() -> FingerForcePlant:
-    """The zoo entry ``amadeus-finger-force`` (see :class:`FingerForcePlant`)."""
-    return FingerForcePlant()
+def finger_force_model(force_scale: float = FORCE_SCALE) -> FingerForcePlant:
+    """The zoo entry ``amadeus-finger-force`` (see :class:`FingerForcePlant`); ``force_scale`` is
+    the force sensor's calibration in N per unit (default :data:`FORCE_SCALE`, assumed)."""
+    return FingerForcePlant(force_scale)
 
 
 def seed_checks() -> list[Finding]:

@@ -180,7 +180,7 @@ class AmadeusHand:
             kw["palm_radius"] = self.palm_radius_for(0.010)
         self.hand_parameters = parameters if parameters is not None else hand_parameters(**kw)
         if check:
-            warn_inconsistent(self.consistency_checks(), stacklevel=3)
+            warn_inconsistent(self.consistency_checks())
 
     @property
     def parameters(self) -> ParameterSet:

@@ -31,7 +31,7 @@ from ...control.rst import DiscretePlant
 from ...estimation.fusion import fused_variance, implied_correlation
 from ...params import Parameter, ParameterSet
 from .bellows_finger import BellowsFinger
-from .force_dynamics import FORCE_SCALE, PEAK_FORCE, finger_force_model
+from .force_dynamics import FORCE_SCALE, PEAK_FORCE, finger_force_model, force_scale_parameter
 from .hand import AmadeusHand
 from .pvdf import StickSlipContact
 from .strain_gauge_sensor import StrainGaugeSensor
@@ -60,13 +60,14 @@ def table2_plant():
                          output_unit="force units", source=f"{_SEED} Table II [2 2 2] (S_1, 9 Hz filter)")
 
 
-def force_plant() -> tuple:
+def force_plant(force_scale: float = FORCE_SCALE) -> tuple:
     """(plant in SI (A → N), force_scale N/unit): the zoo model ``amadeus-finger-force``
-    (:func:`gripkit.systems.amadeus.force_dynamics.finger_force_model`) as a DiscretePlant, and its force scale."""
-    m = finger_force_model().model
+    (:func:`gripkit.systems.amadeus.force_dynamics.finger_force_model`) as a DiscretePlant, and its
+    force scale (N per sensor unit, assumed by default)."""
+    m = finger_force_model(force_scale).model
     plant = DiscretePlant(m.A, m.B, m.dt, input_name="i", input_unit="A", output_name="F", output_unit="N",
                           source="gripkit.systems.amadeus.force_dynamics.finger_force_model (Table II [2 2 2] x force_scale)")
-    return plant, FORCE_SCALE
+    return plant, float(force_scale)
 
 
 def _sig3(x: float) -> str:
@@ -114,16 +115,16 @@ class AmadeusHandSystem:
     description = ("AMADEUS hydraulic three-finger hand: bellows finger (eqs 1-8), valves, six-bridge "
                    "force sensor (eqs 9-19), PVDF slip sensor, Table II force dynamics")
 
-    def __init__(self, *, check: bool = True):
+    def __init__(self, *, check: bool = True, force_scale: float = FORCE_SCALE):
         self.finger = BellowsFinger(check=False)
         self.valve = ProportionalValve(check=False)
         self.sensor = StrainGaugeSensor()
         self.hand = AmadeusHand(self.finger, check=False)
         self.contact = StickSlipContact(check=False)
         self.plant_raw = table2_plant()
-        self.plant, self.force_scale = force_plant()
+        self.plant, self.force_scale = force_plant(force_scale)
         if check:
-            warn_inconsistent(self.consistency_checks(), stacklevel=3)
+            warn_inconsistent(self.consistency_checks())
 
     @property
     def parameters(self) -> ParameterSet:
@@ -144,9 +145,7 @@ class AmadeusHandSystem:
         for n, v in (("b2", B[2]), ("b3", B[3])):
             params.append(Parameter(f"force_{n}", float(v), "1", f"Table II [2 2 2] numerator {n} (per mA, "
                                     "force-sensor units)", source=src, std=sd[n]))
-        params.append(Parameter("force_scale", self.force_scale, "N", "newtons per Table II force unit",
-                                bounds=(0.0, None),
-                                source="assumed: 500 mA valve span = 15.45 N peak force (Fig. 2(c))"))
+        params.append(force_scale_parameter(self.force_scale))
         params.append(Parameter("force_dt", self.plant.dt, "s", "sample time of the force model",
                                 bounds=(0.0, None), source=f"{_SEED} §V-C (200 Hz)", display_unit="ms"))
         return ParameterSet(params, "amadeus-hand")
@@ -181,6 +180,7 @@ class AmadeusHandSystem:
         return out
 
 
-def amadeus_hand(check: bool = True) -> AmadeusHandSystem:
-    """The zoo entry ``amadeus-hand``."""
-    return AmadeusHandSystem(check=check)
+def amadeus_hand(check: bool = True, force_scale: float = FORCE_SCALE) -> AmadeusHandSystem:
+    """The zoo entry ``amadeus-hand``; ``force_scale`` is the force sensor's calibration (N per
+    unit of Table II, assumed by default: see :data:`~gripkit.systems.amadeus.force_dynamics.FORCE_SCALE_DERIVATION`)."""
+    return AmadeusHandSystem(check=check, force_scale=force_scale)

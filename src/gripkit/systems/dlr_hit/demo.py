@@ -99,7 +99,7 @@ def _motor_maps(sec, summary, quick):
               [["c (eq 5.7) [Ncm/PWM]", mc.c / NCM, mc.c_std / NCM, 1.43e-4],
                ["b1 (eq 5.8) [Ncm/(rpm·PWM)]", mc.b1 * k, mc.b1_std * k, 1.215e-8],
                ["b0 (eq 5.8) [Ncm/rpm]", mc.b0 * k, mc.b0_std * k, -7.711e-5]]
-              + [[f"slope at PWM {int(p)} [Ncm/rpm]", b, s, SLOPES_5_4_2.get(int(p), float("nan"))]
+              + [[f"slope at PWM {int(p)} [Ncm/rpm]", b, s, SLOPES_5_4_2.get(int(p), "not printed (§5.4.2 lists 2000-3500)")]
                  for p, b, s in mc.table()],
               caption="Two-stage motor characterisation (§5.4) on simulated test-bed data (sensor noise "
                       "0.005 Ncm): eq 5.7 and eq 5.8 are recovered; the printed slopes differ from eq 5.8 "
@@ -203,7 +203,8 @@ def _stiction_and_idim(sec, summary, quick, rng):
     truth = dict(inertia=J, viscous=0.05, coulomb=0.19, offset=0.0)
     sec.table(["parameter", "true", "IDIM-LS", "± std", "error [%]"],
               [[k, truth[k], res.params[k], res.std[k],
-                100 * (res.params[k] - truth[k]) / truth[k] if truth[k] else float("nan")] for k in truth],
+                100 * (res.params[k] - truth[k]) / truth[k] if truth[k] else "true value 0 (absolute error in ± std)"]
+               for k in truth],
               caption=f"IDIM-LS (zero-phase Butterworth {res.cutoff:g} Hz, differentiation, decimation by "
                       f"{res.decimation}) on {N / 1000:g} s of closed-loop excitation of the distal drive; "
                       f"position quantised to 0.1° (§2.8), torque noise 5 mN·m; relative error "

@@ -10,7 +10,7 @@ import warnings
 
 import numpy as np
 
-from ...consistency import check
+from ...consistency import ConsistencyReport, check
 from ...errors import AccuracyWarning, ConsistencyWarning
 from ...models.beams import clamped_clamped_stiffness
 from ...models.comb_drive import comb_drive_force, comb_drive_gain
@@ -86,8 +86,16 @@ def _model_section(report, summary, act, sen, cpl, plant, fs):
                ["C_a (µm/V)", np.array2string(d10.C.ravel() * 1e6, precision=4),
                 np.array2string(np.array(SEED_EQ10["C"]).ravel(), precision=4)]],
               caption="Eq 10 reproduced from D_a, K_sa, M_a, K_fa, k0, k2 (poles 0.13 % apart, DC gain 0.56 %)")
+    shown = set()
     for model in (act, sen, cpl, plant):
-        sec.findings(check(model))
+        rep = check(model)
+        new = [f for f in rep if (f.check, f.message) not in shown]
+        shown.update((f.check, f.message) for f in rep)
+        if len(new) < len(rep):  # the coupled model repeats its subsystems' checks: show its own only
+            rep = ConsistencyReport(new, f"{rep.subject} (its own checks; the {len(rep) - len(new)} it "
+                                         "shares with the tables above are not repeated)")
+        if len(rep):
+            sec.findings(rep)
     summary["eq17_consistent"] = check(sen).ok
     summary["dc_gain_um_per_V"] = act.dc_gain() * 1e6
 

@@ -19,7 +19,7 @@ import numpy as np
 from ...consistency import check
 from ...estimation import ContactDetector
 from ...progress import status
-from ...report.plots import subplots
+from ...report.plots import log_ticks, subplots
 from ...sysid.bouc_wen import loop_error
 from . import parameters as z
 from .grasp import GraspSettings, simulate_two_finger_grasp
@@ -137,10 +137,13 @@ def _identify(report, z, fingers, loops, summary, quick):
                     label=f"f0 = {res.modal.natural_frequency_hz:.1f} ± {res.modal.natural_frequency_std_hz:.1f} Hz, "
                           f"ζ = {res.modal.damping_ratio:.4f}")
     axes[2].set_xlabel("f (kHz)")
+    axes[2].set_ylabel("|DFT of F| (N, unnormalised)")
     axes[2].set_title("FFT")
+    log_ticks(axes[2])
     axes[2].legend(fontsize=8)
     for ax in axes:
         ax.grid(alpha=0.3)
+    fig.tight_layout()
     sec.figure(fig, "Step response at B and the sensor's free vibration with its spectrum", name="tsfm-identification")
     return ident
 
