@@ -1,41 +1,49 @@
 """Signals: the Trajectory data type, Butterworth filtering, detrending, resampling.
 
-The names below are loaded on first use (PEP 562 ``__getattr__``): ``import gripkit`` needs only
-:class:`Trajectory`, and the filter modules' ``scipy.signal`` costs more than the rest of gripkit.
+The public names are loaded on first use (the table ``_LAZY``, :mod:`gripkit._lazy`).
 """
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING
 
+from .._lazy import lazy_exports
 from .trajectory import Trajectory as Trajectory
 
-# public name -> the module of this package that defines it
+# public name -> (module of this package, name in that module)
 _LAZY = {
-    "apply_sos": "filters", "bandpass": "filters", "butter_ba": "filters", "butter_sos": "filters",
-    "butter_zpk": "filters", "highpass": "filters", "lowpass": "filters",
-    "ac_couple": "processing", "decimate": "processing", "detrend": "processing",
-    "remove_mean": "processing", "resample": "processing", "segment_by": "processing",
-    "split": "processing", "to_uniform": "processing",
+    "apply_sos": ("filters", "apply_sos"),
+    "bandpass": ("filters", "bandpass"),
+    "butter_ba": ("filters", "butter_ba"),
+    "butter_sos": ("filters", "butter_sos"),
+    "butter_zpk": ("filters", "butter_zpk"),
+    "highpass": ("filters", "highpass"),
+    "lowpass": ("filters", "lowpass"),
+    "ac_couple": ("processing", "ac_couple"),
+    "decimate": ("processing", "decimate"),
+    "detrend": ("processing", "detrend"),
+    "remove_mean": ("processing", "remove_mean"),
+    "resample": ("processing", "resample"),
+    "segment_by": ("processing", "segment_by"),
+    "split": ("processing", "split"),
+    "to_uniform": ("processing", "to_uniform"),
 }
+__getattr__, __dir__ = lazy_exports(__name__, _LAZY)
+__all__ = ["Trajectory", *_LAZY]
 
-__all__ = ["Trajectory", *sorted(_LAZY)]
-
-if TYPE_CHECKING:  # for static readers: the same names, imported eagerly
-    from .filters import apply_sos, bandpass, butter_ba, butter_sos, butter_zpk, highpass, lowpass
-    from .processing import (ac_couple, decimate, detrend, remove_mean, resample, segment_by, split,
-                             to_uniform)
-
-
-def __getattr__(name: str):
-    module = _LAZY.get(name)
-    if module is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    value = getattr(importlib.import_module(f".{module}", __name__), name)
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY))
+if TYPE_CHECKING:  # static readers see the same names, imported eagerly
+    from .filters import apply_sos as apply_sos
+    from .filters import bandpass as bandpass
+    from .filters import butter_ba as butter_ba
+    from .filters import butter_sos as butter_sos
+    from .filters import butter_zpk as butter_zpk
+    from .filters import highpass as highpass
+    from .filters import lowpass as lowpass
+    from .processing import ac_couple as ac_couple
+    from .processing import decimate as decimate
+    from .processing import detrend as detrend
+    from .processing import remove_mean as remove_mean
+    from .processing import resample as resample
+    from .processing import segment_by as segment_by
+    from .processing import split as split
+    from .processing import to_uniform as to_uniform
