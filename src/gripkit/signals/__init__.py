@@ -1,13 +1,13 @@
 """Signals: the Trajectory data type, Butterworth filtering, detrending, resampling.
 
-The public names are loaded on first use (the table ``_LAZY``, :mod:`gripkit._lazy`).
+The public names are loaded on first use (the table ``_LAZY``, :mod:`gripkit.exports`).
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from .._lazy import lazy_exports
+from ..exports import lazy_exports
 from .trajectory import Trajectory as Trajectory
 
 # public name -> (module of this package, name in that module)

@@ -11,14 +11,14 @@ A trajectory (from :func:`gripkit.io.load`) in, model out::
 
     m = gripkit.sysid.identify(traj, "arx", input="current", output="force", na=2, nb=2, nk=2)
 
-The public names are loaded on first use (the table ``_LAZY``, :mod:`gripkit._lazy`).
+The public names are loaded on first use (the table ``_LAZY``, :mod:`gripkit.exports`).
 """
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from .._lazy import lazy_exports
+from ..exports import lazy_exports
 
 # public name -> (module of this package, name in that module)
 _LAZY = {
