@@ -13,10 +13,16 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-from scipy import signal as _sig
 
 from ..errors import DataError
 from .trajectory import Trajectory
+
+def _signal():
+    """``scipy.signal``, imported on first use: it costs ~0.7 s, more than the rest of ``import gripkit``."""
+    from scipy import signal
+
+    return signal
+
 
 __all__ = ["butter_sos", "butter_zpk", "butter_ba", "apply_sos", "lowpass", "highpass", "bandpass"]
 
@@ -44,19 +50,19 @@ def butter_sos(order: int, cutoff, fs: float, btype: str = "lowpass") -> np.ndar
     ``cutoff`` in Hz (a pair for band filters); bilinear transform with pre-warping at ``fs``.
     """
     wn = _check_design(order, cutoff, fs, btype)
-    return _sig.butter(int(order), wn if wn.size > 1 else wn[0], btype=btype, fs=fs, output="sos")
+    return _signal().butter(int(order), wn if wn.size > 1 else wn[0], btype=btype, fs=fs, output="sos")
 
 
 def butter_zpk(order: int, cutoff, fs: float, btype: str = "lowpass"):
     """Zeros, poles and gain of the digital Butterworth filter (z-plane)."""
     wn = _check_design(order, cutoff, fs, btype)
-    return _sig.butter(int(order), wn if wn.size > 1 else wn[0], btype=btype, fs=fs, output="zpk")
+    return _signal().butter(int(order), wn if wn.size > 1 else wn[0], btype=btype, fs=fs, output="zpk")
 
 
 def butter_ba(order: int, cutoff, fs: float, btype: str = "lowpass"):
     """Transfer-function coefficients (b, a) in powers of z^-1 (for analysis; filter with SOS)."""
     wn = _check_design(order, cutoff, fs, btype)
-    return _sig.butter(int(order), wn if wn.size > 1 else wn[0], btype=btype, fs=fs, output="ba")
+    return _signal().butter(int(order), wn if wn.size > 1 else wn[0], btype=btype, fs=fs, output="ba")
 
 
 def apply_sos(sos: np.ndarray, x: np.ndarray, zero_phase: bool = False) -> np.ndarray:
@@ -73,10 +79,10 @@ def apply_sos(sos: np.ndarray, x: np.ndarray, zero_phase: bool = False) -> np.nd
         padlen = 3 * (2 * sos.shape[0] + 1)
         if x.shape[0] <= padlen:
             raise DataError(f"zero-phase filtering needs more than {padlen} samples, found {x.shape[0]}")
-        return _sig.sosfiltfilt(sos, x, axis=0)
-    zi = _sig.sosfilt_zi(sos)
+        return _signal().sosfiltfilt(sos, x, axis=0)
+    zi = _signal().sosfilt_zi(sos)
     zi = zi * x[0] if x.ndim == 1 else zi[:, :, None] * x[0][None, None, :]
-    y, _ = _sig.sosfilt(sos, x, axis=0, zi=zi)
+    y, _ = _signal().sosfilt(sos, x, axis=0, zi=zi)
     return y
 
 

@@ -10,10 +10,9 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-from scipy import signal as _sig
 
 from ..errors import DataError
-from .filters import apply_sos, butter_sos
+from .filters import _signal, apply_sos, butter_sos
 from .trajectory import Trajectory
 
 __all__ = ["remove_mean", "ac_couple", "detrend", "decimate", "resample", "to_uniform", "split",
@@ -86,7 +85,7 @@ def resample(tr: Trajectory, fs: float) -> Trajectory:
 
     ratio = Fraction(float(fs) / tr.fs).limit_denominator(1000)
     up, down = ratio.numerator, ratio.denominator
-    data = {k: _sig.resample_poly(tr[k], up, down, padtype="line") for k in tr.names}
+    data = {k: _signal().resample_poly(tr[k], up, down, padtype="line") for k in tr.names}
     n = len(next(iter(data.values())))
     t = tr.t[0] + np.arange(n) / fs
     return Trajectory(t, data, tr.units, {**tr.meta, "fs": float(fs)})

@@ -14,7 +14,6 @@ unit circle if needed). Then Levenberg–Marquardt (:mod:`gripkit.sysid._pem`) m
 from __future__ import annotations
 
 import numpy as np
-from scipy import signal as _sig
 
 from ._pem import covariance, is_stable_poly, levenberg_marquardt, stabilize
 from ._scaling import in_user_units, unit_scale
@@ -67,6 +66,8 @@ def armax(u, y, na: int, nb: int, nc: int, nk: int = 1, *, dt: float | None = No
 
 def _armax(u, y, na, nb, nc, nk, step, maxiter, tol, meta) -> PolynomialModel:
     """:func:`armax` (nc >= 1) on checked signals scaled to unit size."""
+    from scipy import signal as _sig
+
     p = na + nb + nc
     t0 = max(na, nk + nb - 1)
     label = f"ARMAX [{na} {nb} {nc} {nk}]"

@@ -17,7 +17,6 @@ instruments are the ARX model's simulated output (Söderström & Stoica, *System
 from __future__ import annotations
 
 import numpy as np
-from scipy import signal as _sig
 
 from ._pem import covariance, is_stable_poly, levenberg_marquardt, stabilize
 from ._scaling import in_user_units, unit_scale
@@ -31,6 +30,8 @@ __all__ = ["oe"]
 
 def _iv_start(u, y, nb, nf, nk, t0) -> np.ndarray:
     """ARX [nf nb nk] then one instrumental-variable step; returns θ = [b, f]."""
+    from scipy import signal as _sig
+
     m0 = _arx(u, y, nf, nb, nk, 1.0, warn=False)
     F0 = stabilize(m0.A)
     theta = np.concatenate([m0.B[nk:], F0[1:]])
@@ -67,6 +68,8 @@ def oe(u, y, nb: int, nf: int, nk: int = 1, *, dt: float | None = None, fs: floa
 
 def _oe(u, y, nb, nf, nk, step, maxiter, tol, meta) -> PolynomialModel:
     """:func:`oe` on checked signals scaled to unit size."""
+    from scipy import signal as _sig
+
     p = nb + nf
     t0 = max(nf, nk + nb - 1)
     label = f"OE [{nb} {nf} {nk}]"

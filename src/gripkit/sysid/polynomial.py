@@ -22,7 +22,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import signal as _sig
 
 from ..arguments import check_keywords, keyword_names
 from ..errors import DataError, ModelError
@@ -359,10 +358,14 @@ class PolynomialModel:
 
     def step(self, n: int) -> np.ndarray:
         """Response to a unit step applied at sample 0, from rest, ``n`` samples."""
+        from scipy import signal as _sig
+
         return _sig.lfilter(self.B, self.denominator, np.ones(int(n)))
 
     def impulse(self, n: int) -> np.ndarray:
         """Response to a unit pulse at sample 0, from rest, ``n`` samples."""
+        from scipy import signal as _sig
+
         x = np.zeros(int(n))
         x[0] = 1.0
         return _sig.lfilter(self.B, self.denominator, x)
@@ -370,6 +373,8 @@ class PolynomialModel:
     def frequency_response(self, f=None, n: int = 512) -> tuple[np.ndarray, np.ndarray]:
         """``(f_Hz, H)``: the complex response of B/(A F) at ``f`` (Hz; default ``n`` points up to
         the Nyquist frequency), ``H = B(e^{-jωdt}) / (A F)(e^{-jωdt})``."""
+        from scipy import signal as _sig
+
         worN = int(n) if f is None else np.asarray(f, dtype=np.float64)
         freq, h = _sig.freqz(self.B, self.denominator, worN=worN, fs=self.fs)
         return freq, h
@@ -389,6 +394,8 @@ class PolynomialModel:
             The samples before u(0), in time order (most recent last); at least
             ``len(A F) − 1`` outputs and ``len(B) − 1`` inputs are used (missing ones count 0).
         """
+        from scipy import signal as _sig
+
         u = np.asarray(u, dtype=np.float64)
         if initial == "rest":
             if y_past is not None or u_past is not None:
@@ -399,6 +406,8 @@ class PolynomialModel:
         return self._filter_from_past(u, y_past, u_past)
 
     def _filter_from_past(self, u, y_past, u_past) -> np.ndarray:
+        from scipy import signal as _sig
+
         b, a = self.B, self.denominator
         yp = np.zeros(0) if y_past is None else np.asarray(y_past, dtype=np.float64)
         up = np.zeros(0) if u_past is None else np.asarray(u_past, dtype=np.float64)
@@ -413,6 +422,8 @@ class PolynomialModel:
         ARX/ARMAX: ``C(q) e(t) = A(q) y(t) − B(q) u(t)`` with e(t) = 0 before ``start``.
         OE: ``e = y − B/F u`` with the filter's past outputs taken from the measured y.
         """
+        from scipy import signal as _sig
+
         u = np.asarray(u, dtype=np.float64)
         y = np.asarray(y, dtype=np.float64)
         t0 = self.start
@@ -448,12 +459,16 @@ class PolynomialModel:
     def to_scipy(self):
         """``scipy.signal.dlti`` transfer function B/(A F) with ``dt`` (the delay appears as
         poles at the origin)."""
+        from scipy import signal as _sig
+
         num, den = self._tf_arrays()
         return _sig.dlti(num, den, dt=self.dt)
 
     def to_statespace(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Discrete state-space matrices ``(Ad, Bd, Cd, Dd)`` of B/(A F) (controller canonical form,
         delay included as states): ``x⁺ = Ad x + Bd u``, ``y = Cd x + Dd u``."""
+        from scipy import signal as _sig
+
         num, den = self._tf_arrays()
         return _sig.tf2ss(num, den)
 

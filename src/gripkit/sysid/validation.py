@@ -25,7 +25,6 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import stats
 
 from ..errors import DataError, StabilityWarning
 from .checks import check_io
@@ -190,6 +189,8 @@ def _xcorr(a: np.ndarray, b: np.ndarray, lags: int) -> np.ndarray:
 
 def residual_tests(e, u, *, lags: int = 25, alpha: float = 0.01) -> ResidualTests:
     """Whiteness of ``e`` and independence of ``e`` from past ``u`` (same length, aligned)."""
+    from scipy import stats
+
     e = np.asarray(e, dtype=np.float64)
     u = np.asarray(u, dtype=np.float64)
     if e.shape != u.shape:

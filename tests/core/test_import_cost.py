@@ -1,0 +1,48 @@
+"""Start-up structure (issue 14): ``import gripkit`` leaves the heavy third-party packages unloaded,
+and the lazy re-exports of the packages (:mod:`gripkit.exports`) give the same objects as eager imports.
+Structural checks in a fresh interpreter, not timings."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+HEAVY = ("scipy.signal", "scipy.stats", "scipy.optimize", "matplotlib", "pyarrow", "pint", "h5py", "numba")
+
+
+def _loaded_after(code: str) -> list[str]:
+    probe = f"import json, sys\n{code}\nprint(json.dumps(sorted(sys.modules)))"
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def test_import_gripkit_does_not_import_heavy_packages():
+    loaded = set(_loaded_after("import gripkit"))
+    assert [m for m in HEAVY if m in loaded] == []
+
+
+@pytest.mark.parametrize("package", ["gripkit.signals", "gripkit.sysid"])
+def test_lazy_package_import_does_not_import_heavy_packages(package):
+    loaded = set(_loaded_after(f"import {package}"))
+    assert [m for m in HEAVY if m in loaded] == []
+
+
+def test_lazy_names_are_the_defining_modules_objects_and_listed():
+    import gripkit.signals
+    import gripkit.sysid
+    import gripkit.sysid.arx  # a submodule spelled like a public function: the function stays public
+    import gripkit.sysid.rls
+    from gripkit.signals.filters import lowpass
+    from gripkit.sysid import arx, rls
+    from gripkit.sysid.arx import arx as arx_defined
+    from gripkit.sysid.rls import rls as rls_defined
+
+    assert arx is arx_defined and rls is rls_defined and gripkit.sysid.arx is arx_defined
+    assert gripkit.signals.lowpass is lowpass
+    for pkg in (gripkit.signals, gripkit.sysid):
+        assert set(pkg.__all__) <= set(dir(pkg))
+        for name in pkg.__all__:
+            assert getattr(pkg, name) is not None
+    with pytest.raises(AttributeError, match="no_such_name"):
+        gripkit.sysid.no_such_name  # noqa: B018
