@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from .html import Report
-from .plots import _plt, measured_vs_model
+from .plots import measured_vs_model, pyplot
 
 __all__ = ["write_model_report", "model_report"]
 
@@ -30,7 +30,7 @@ def _xcorr(a, b, lags):
 
 
 def _residual_figure(e, u, outputs, inputs):
-    plt = _plt()
+    plt = pyplot()
     p, m = e.shape[1], u.shape[1]
     L = min(25, e.shape[0] // 4)
     lags = np.arange(0, L + 1)
@@ -55,7 +55,7 @@ def _residual_figure(e, u, outputs, inputs):
 
 
 def _pz_figure(system):
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(5.4, 5.0))
     discrete = system.is_discrete
     if discrete:
@@ -92,7 +92,7 @@ def _pz_figure(system):
 
 
 def _bode_figure(system, dt, estimate):
-    plt = _plt()
+    plt = pyplot()
     p, m = system.n_outputs, system.n_inputs
     nyq = np.pi / dt
     w = np.logspace(np.log10(nyq) - 3.5, np.log10(nyq * 0.999), 400)
@@ -133,7 +133,7 @@ def _bode_figure(system, dt, estimate):
 
 
 def _sv_figure(sv, order):
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(6, 3.2))
     k = np.arange(1, sv.size + 1)
     ax.semilogy(k, sv, "o-", ms=4)

@@ -20,7 +20,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..lti import StateSpace, Uncertainty
-from ._data import check_dt, check_order
+from .checks import check_dt, check_order
 from .linear_model import LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run
 from .regression import qr_solve
 

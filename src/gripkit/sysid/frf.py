@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import AccuracyWarning, DataError
-from ._data import check_dt
+from .checks import check_dt
 from .linear_model import as_io_matrix
 
 __all__ = ["FRF", "frf", "FRF_METHODS"]

@@ -40,7 +40,7 @@ import scipy.linalg as sla
 
 from ..errors import DataError, IdentificationError, StabilityWarning
 from ..lti import StateSpace
-from ._data import check_dt
+from .checks import check_dt
 from .linear_model import LinearModel, as_io_matrix, fit_per_output, free_run, observability_regressor
 from .regression import _qr_r
 

@@ -27,7 +27,7 @@ from scipy import signal as _signal
 
 from ..errors import DataError, IdentificationError
 from ..lti import StateSpace, TransferFunction
-from ._data import check_dt, check_order
+from .checks import check_dt, check_order
 from .frf import FRF, frf
 from .linear_model import LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run
 
