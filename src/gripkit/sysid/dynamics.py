@@ -50,7 +50,7 @@ data, without another pass over it.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -208,6 +208,22 @@ class DynamicsResult:
     constrained: bool
     unconstrained_theta: np.ndarray
     warnings: list = field(default_factory=list)
+    urdf_text: str | None = None      # provenance for the model file (``save``): the URDF read,
+    base_link: str | None = None      # the chain's end links in it (None: the URDF's defaults),
+    tip_link: str | None = None
+    data_file: str | None = None      # and the log's name and SHA-256
+    data_hash: str | None = None
+
+    def replace(self, **changes) -> "DynamicsResult":
+        """A copy with ``changes`` (e.g. the provenance fields ``urdf_text``, ``data_file``)."""
+        return replace(self, **changes)
+
+    def save(self, path) -> None:
+        """Write the model as JSON (:mod:`gripkit.sysid.dynamics_file`, schema
+        ``gripkit.dynamics-model``); read it back with :func:`gripkit.sysid.load_dynamics_model`."""
+        from .dynamics_file import save_dynamics_model
+
+        save_dynamics_model(self, path)
 
     @property
     def std(self) -> np.ndarray:

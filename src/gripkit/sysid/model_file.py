@@ -30,7 +30,7 @@ import numpy as np
 from ..errors import AccuracyWarning, DataError, ModelError
 from ..lti import LinearSystem, StateSpace
 
-__all__ = ["save_model", "load_model", "file_sha256", "SCHEMA", "SCHEMA_VERSION"]
+__all__ = ["save_model", "load_model", "file_sha256", "content_hash", "json_plain", "SCHEMA", "SCHEMA_VERSION"]
 
 SCHEMA = "gripkit.linear-model"
 SCHEMA_VERSION = 1
@@ -45,13 +45,14 @@ def file_sha256(path) -> str:
     return h.hexdigest()
 
 
-def _plain(x):
+def json_plain(x):
+    """``x`` with numpy arrays and scalars made plain JSON values (non-finite floats → None)."""
     if isinstance(x, dict):
-        return {str(k): _plain(v) for k, v in x.items()}
+        return {str(k): json_plain(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
-        return [_plain(v) for v in x]
+        return [json_plain(v) for v in x]
     if isinstance(x, np.ndarray):
-        return _plain(x.tolist())
+        return json_plain(x.tolist())
     if isinstance(x, (np.floating, float)):
         v = float(x)
         return v if np.isfinite(v) else None
@@ -62,7 +63,8 @@ def _plain(x):
     return x
 
 
-def _content_hash(doc: dict) -> str:
+def content_hash(doc: dict) -> str:
+    """SHA-256 of the canonical JSON (sorted keys, no spaces) of ``doc`` less its ``content_sha256``."""
     body = {k: v for k, v in doc.items() if k != "content_sha256"}
     return hashlib.sha256(json.dumps(body, sort_keys=True, separators=(",", ":")).encode()).hexdigest()
 
@@ -82,8 +84,8 @@ def model_document(model) -> dict:
     doc.update(fit_percent=model.fit_percent, singular_values=model.singular_values, n_samples=model.n_samples,
                info=model.info,
                data=None if model.data_file is None else {"file": model.data_file, "sha256": model.data_hash})
-    doc = _plain(doc)
-    doc["content_sha256"] = _content_hash(doc)
+    doc = json_plain(doc)
+    doc["content_sha256"] = content_hash(doc)
     return doc
 
 
@@ -148,7 +150,7 @@ def load_model(path):
     if not isinstance(ver, int) or ver < 1 or ver > SCHEMA_VERSION:
         raise ModelError(f"model file {where}: expected schema_version 1 … {SCHEMA_VERSION}, found {ver!r}",
                          hint="upgrade gripkit to read files written by a newer version")
-    if doc.get("content_sha256") != _content_hash(doc):
+    if doc.get("content_sha256") != content_hash(doc):
         warnings.warn(f"model file {where}: content hash mismatch (the file was edited after it was saved); "
                       f"using it as it is", AccuracyWarning, stacklevel=2)
     try:
