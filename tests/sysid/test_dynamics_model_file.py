@@ -85,8 +85,9 @@ def test_tampered_file_warns(saved):
     assert m.theta[0] == doc["parameters"]["values"][0]
 
 
-@pytest.mark.parametrize("change, phrase", [({"schema": "gripkit.linear-model"}, "expected schema 'gripkit.dynamics-model'"),
-                                            ({"schema_version": 2}, "schema_version")])
+@pytest.mark.parametrize("change, phrase", [
+    ({"schema": "gripkit.linear-model"}, "expected schema 'gripkit.dynamics-model'"),
+    ({"schema_version": 2}, "schema_version")])
 def test_other_schema_or_newer_version_refused(saved, change, phrase):
     doc = json.loads(saved.read_text())
     doc.update(change)

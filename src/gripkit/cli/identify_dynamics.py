@@ -1,6 +1,6 @@
 """``gripkit identify dynamics URDF DATA --position COLS [--velocity COLS] --effort COLS [--fs HZ]
-[--out MODEL.json] [--report DIR] [--json]``: identify the base inertial parameters and per-joint friction of a URDF chain from a
-log (:func:`gripkit.sysid.identify_dynamics`).
+[--out MODEL.json] [--report DIR] [--json]``: identify the base inertial parameters and per-joint
+friction of a URDF chain from a log (:func:`gripkit.sysid.identify_dynamics`).
 
 COLS are comma-separated column names, one per actuated joint in the chain's order (``gripkit``
 prints the order in the error when the count is wrong). The signal chain is IDIM-LS's
@@ -123,7 +123,8 @@ def identify_dynamics_cmd(
     if report is not None:
         from ..report.dynamics_report import write_dynamics_report
 
-        write_dynamics_report(res, np.arange(q.shape[0]) * st.decimation / st.fs, q, qd, qdd, st.effort, report, weights=weights,
+        t = np.arange(q.shape[0]) * st.decimation / st.fs
+        write_dynamics_report(res, t, q, qd, qdd, st.effort, report, weights=weights,
                               data_name=Path(data).name, warnings_list=list(st.notes) + lines)
     out = dict(urdf=str(urdf), data=str(data), chain=chain.name,
                columns=dict(position=pcols, effort=ecols, velocity=vcols), fs=rate, cutoff_hz=st.cutoff,

@@ -17,7 +17,7 @@ import numpy as np
 from .html import Report
 from .plots import measured_vs_model, pyplot
 
-__all__ = ["dynamics_report", "write_dynamics_report", "parameter_unit"]
+__all__ = ["dynamics_report", "parameter_unit", "write_dynamics_report"]
 
 _UNITS = {"m": "kg", "mx": "kg·m", "my": "kg·m", "mz": "kg·m"}
 

@@ -214,7 +214,7 @@ class DynamicsResult:
     data_file: str | None = None      # and the log's name and SHA-256
     data_hash: str | None = None
 
-    def replace(self, **changes) -> "DynamicsResult":
+    def replace(self, **changes) -> DynamicsResult:
         """A copy with ``changes`` (e.g. the provenance fields ``urdf_text``, ``data_file``)."""
         return replace(self, **changes)
 

@@ -38,7 +38,7 @@ import numpy as np
 from ..errors import AccuracyWarning, DataError, ModelError
 from .model_file import content_hash, json_plain
 
-__all__ = ["save_dynamics_model", "load_dynamics_model", "dynamics_document", "SCHEMA", "SCHEMA_VERSION"]
+__all__ = ["SCHEMA", "SCHEMA_VERSION", "dynamics_document", "load_dynamics_model", "save_dynamics_model"]
 
 SCHEMA = "gripkit.dynamics-model"
 SCHEMA_VERSION = 1
