@@ -52,4 +52,4 @@ from .frf import frf as frf
 from .tfest import tfest as tfest
 from .tfest import tfest_frf as tfest_frf
 from .model_file import load_model as load_model
-from .dynamics_file import load_dynamics_model as load_dynamics_model
+from .dynamics import load_dynamics_model as load_dynamics_model

@@ -1,5 +1,5 @@
 """Identified rigid-body dynamics models as JSON files: ``result.save(path)`` on the result of
-:func:`gripkit.sysid.identify_dynamics`, and :func:`load_dynamics_model`.
+:func:`gripkit.sysid.identify_dynamics`, and :func:`gripkit.sysid.load_dynamics_model`.
 
 A file holds (schema ``gripkit.dynamics-model``, version 1; the same conventions as the linear
 models of :mod:`gripkit.sysid.model_file`)::
@@ -38,7 +38,8 @@ import numpy as np
 from ..errors import AccuracyWarning, DataError, ModelError
 from .model_file import content_hash, json_plain
 
-__all__ = ["SCHEMA", "SCHEMA_VERSION", "dynamics_document", "load_dynamics_model", "save_dynamics_model"]
+__all__ = ["SCHEMA", "SCHEMA_VERSION", "dynamics_document", "float_array", "read_dynamics_document",
+           "save_dynamics_model"]
 
 SCHEMA = "gripkit.dynamics-model"
 SCHEMA_VERSION = 1
@@ -100,7 +101,7 @@ def save_dynamics_model(result, path) -> None:
         raise DataError(f"dynamics model file {str(path)!r} cannot be written: {exc.strerror}") from None
 
 
-def _floats(x, name, where, shape=None) -> np.ndarray:
+def float_array(x, name, where, shape=None) -> np.ndarray:
     try:
         a = np.asarray(x, dtype=np.float64)  # null (a non-finite number when saved) reads as NaN
     except (TypeError, ValueError):
@@ -110,18 +111,14 @@ def _floats(x, name, where, shape=None) -> np.ndarray:
     return a
 
 
-def load_dynamics_model(path):
-    """Read a model written by ``result.save(path)``: a
-    :class:`~gripkit.sysid.dynamics.DynamicsResult` with ``predict``, ``base_parameters``,
-    ``base_parameters_std``, ``friction``, ``covariance``, ... as identified.
+def read_dynamics_document(path) -> dict:
+    """The checked JSON document of a model written by ``result.save(path)``
+    (:func:`gripkit.sysid.load_dynamics_model` builds the model from it).
 
     Raises DataError for a missing file, a file that is not JSON, of another ``schema`` or of a newer
-    ``schema_version``; ModelError for missing or malformed fields; warns (AccuracyWarning) when
+    ``schema_version``; warns (AccuracyWarning) when
     the content hash does not match (the file was edited after it was saved).
     """
-    from ..multibody import from_urdf
-    from .dynamics import BaseStructure, Consistency, DynamicsResult
-
     path = Path(path)
     where = repr(str(path))
     try:
@@ -145,41 +142,4 @@ def load_dynamics_model(path):
     if doc.get("content_sha256") != content_hash(doc):
         warnings.warn(f"dynamics model file {where}: content hash mismatch (the file was edited after it was "
                       f"saved); using it as it is", AccuracyWarning, stacklevel=2)
-    try:
-        urdf = doc["urdf"]
-        text = urdf["text"]
-        if hashlib.sha256(text.encode()).hexdigest() != urdf.get("sha256"):
-            warnings.warn(f"dynamics model file {where}: the URDF text does not match its sha256", AccuracyWarning,
-                          stacklevel=2)
-        chain = from_urdf(text, base_link=urdf.get("base_link"), tip_link=urdf.get("tip_link"),
-                          gravity=_floats(doc["gravity"], "gravity", where, (3,)))
-        if list(chain.coordinate_names) != list(doc["joints"]):
-            raise ModelError(f"dynamics model file {where}: the URDF's joints {list(chain.coordinate_names)} "
-                             f"disagree with the file's {doc['joints']}")
-        s = doc["structure"]
-        ind = np.asarray(s["independent"], dtype=np.intp)
-        dep = np.asarray(s["dependent"], dtype=np.intp)
-        beta = _floats(s["beta"], "structure.beta", where).reshape(ind.size, dep.size)
-        par = doc["parameters"]
-        names = tuple(par["names"])
-        n = len(names)
-        theta = _floats(par["values"], "parameters.values", where, (n,))
-        cov = _floats(par["covariance"], "parameters.covariance", where, (n, n))
-        base_names = names[:ind.size]
-        structure = BaseStructure(ind, dep, beta, base_names, tuple(s["standard_names"]))
-        c = doc.get("consistency")
-        consistency = None if c is None else Consistency(
-            bool(c["consistent"]), float(c["distance_sigma"]), tuple(c["failing_links"]),
-            _floats(c["standard_parameters"], "consistency.standard_parameters", where),
-            _floats(c["values"], "consistency.values", where))
-        data = doc.get("data") or {}
-        return DynamicsResult(
-            chain, structure, doc["friction_model"], bool(doc["armature"]), names, theta, cov,
-            {k: float(v) for k, v in doc["residual_std"].items()}, float(doc["relative_error_percent"]),
-            float(doc["condition_number"]), int(doc["n_samples"]), consistency, bool(doc["constrained"]),
-            _floats(doc["unconstrained_values"], "unconstrained_values", where, (n,)), list(doc.get("warnings", [])),
-            urdf_text=text, base_link=urdf.get("base_link"), tip_link=urdf.get("tip_link"),
-            data_file=data.get("file"), data_hash=data.get("sha256"))
-    except (KeyError, TypeError, ValueError) as exc:
-        raise ModelError(f"dynamics model file {where}: a required field is missing or malformed ({exc})",
-                         hint="regenerate the file with gripkit identify dynamics --out") from None
+    return doc
