@@ -1,6 +1,6 @@
 """``gripkit identify dynamics URDF DATA --position COLS [--velocity COLS] --effort COLS [--fs HZ]
-[--json]``: identify the base inertial parameters and per-joint friction of a URDF chain from a
-log (:func:`gripkit.sysid.identify_dynamics`).
+[--out MODEL.json] [--report DIR] [--json]``: identify the base inertial parameters and per-joint
+friction of a URDF chain from a log (:func:`gripkit.sysid.identify_dynamics`).
 
 COLS are comma-separated column names, one per actuated joint in the chain's order (``gripkit``
 prints the order in the error when the count is wrong). The signal chain is IDIM-LS's
@@ -9,6 +9,10 @@ DLR/HIT logs): the same zero-phase Butterworth filter on positions (or measured 
 efforts, central differences, the filter's edges cut, decimation; the rows of a joint within the
 guard band of its velocity reversals or slower than 2 % of its peak speed are left out; σ is the
 Newey-West (HAC) one, since filtering and decimation leave the residuals correlated.
+
+``--out`` writes the model file (:mod:`gripkit.sysid.dynamics_file`: the URDF text, the
+parameters with their covariance, the log's name and SHA-256), ``--report`` an HTML page
+(:mod:`gripkit.sysid.dynamics_report`); both paths are checked before the work starts.
 """
 
 from __future__ import annotations
@@ -21,6 +25,7 @@ import typer
 
 from .app import identify_app
 from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data, report_warnings
+from .identify_ss import ModelOutOpt, ReportOpt
 
 
 def _columns(option: str, text: str | None, joints) -> list[str] | None:
@@ -68,13 +73,18 @@ def identify_dynamics_cmd(
     decimate: int = typer.Option(None, "--decimate", help="Keep every q-th filtered sample (default from the cutoff)."),
     time: str = TimeOpt,
     fill: str = FillOpt,
+    out: Path = ModelOutOpt,
+    report: Path = ReportOpt,
 ):
     """Identify the base inertial parameters and the friction of every joint of a URDF chain."""
     from ..errors import DataError, UnidentifiableError
     from ..multibody import from_urdf
     from ..sysid.dynamics import identify_dynamics
     from ..sysid.friction import idim_samples
+    from .paths import output_folder, output_json
 
+    output_json(out, "--out")
+    output_folder(report, "--report")
     if not (np.isfinite(effort_scale) and effort_scale != 0):
         raise DataError(f"--effort-scale: expected a finite non-zero factor, found {effort_scale!r}")
     chain = from_urdf(urdf, base_link=base_link, tip_link=tip_link, gravity=_vector("--gravity", gravity))
@@ -104,6 +114,18 @@ def identify_dynamics_cmd(
                                 armature=armature, covariance="hac", constrained=constrained)
     lines = report_warnings(caught)
     notes = list(st.notes) + list(res.warnings)
+    if out is not None:
+        from ..sysid.model_file import file_sha256
+
+        out.parent.mkdir(parents=True, exist_ok=True)
+        res.replace(urdf_text=Path(urdf).read_text(), base_link=base_link, tip_link=tip_link,
+                    data_file=Path(data).name, data_hash=file_sha256(data)).save(out)
+    if report is not None:
+        from ..sysid.dynamics_report import write_dynamics_report
+
+        t = np.arange(q.shape[0]) * st.decimation / st.fs
+        write_dynamics_report(res, t, q, qd, qdd, st.effort, report, weights=weights,
+                              data_name=Path(data).name, warnings_list=list(st.notes) + lines)
     out = dict(urdf=str(urdf), data=str(data), chain=chain.name,
                columns=dict(position=pcols, effort=ecols, velocity=vcols), fs=rate, cutoff_hz=st.cutoff,
                decimation=st.decimation, **res.to_dict())

@@ -8,7 +8,7 @@ from pathlib import Path
 
 from ..errors import PathError
 
-__all__ = ["output_file", "output_folder"]
+__all__ = ["output_file", "output_folder", "output_json"]
 
 _WRITABLE_FORMATS = ("csv", "parquet", "hdf5")
 
@@ -18,19 +18,24 @@ def output_file(path: Path | None, option: str) -> Path | None:
     :func:`gripkit.io.save` writes (.csv, .parquet, .h5), else :class:`PathError` naming ``option``."""
     if path is None:
         return None
-    path = Path(path)
-    if path.is_dir():
-        raise PathError(f"{option} {str(path)!r} is a folder, expected a file",
-                        hint=f"give a file path such as {str(path / 'result.parquet')!r}")
-    _check_folders(path, option)
-    if path.exists() and not os.access(path, os.W_OK):
-        raise PathError(f"{option} {str(path)!r}: permission denied (the file is read-only)",
-                        hint="choose another path, or make it writable")
+    path = _writable_file(Path(path), option, "result.parquet")
     from ..io import FORMATS
 
     if FORMATS.get(path.suffix.lower()) not in _WRITABLE_FORMATS:
         raise PathError(f"{option} {str(path)!r}: cannot tell the format from the suffix {path.suffix!r}",
                         hint="use .csv, .parquet or .h5")
+    return path
+
+
+def output_json(path: Path | None, option: str) -> Path | None:
+    """``path`` if a JSON file (a model file) can be written there (its folders may not exist
+    yet), else :class:`PathError` naming ``option``."""
+    if path is None:
+        return None
+    path = _writable_file(Path(path), option, "model.json")
+    if path.suffix.lower() != ".json":
+        raise PathError(f"{option} {str(path)!r}: expected a .json file, found the suffix {path.suffix!r}",
+                        hint=f"use {str(path.with_suffix('.json'))!r}")
     return path
 
 
@@ -49,6 +54,18 @@ def output_folder(path: Path | None, option: str) -> Path | None:
                             hint="choose another folder")
         return path
     _check_folders(path, option)
+    return path
+
+
+def _writable_file(path: Path, option: str, example: str) -> Path:
+    """``path`` if it is not a folder, its folders can be made and the file (if any) is writable."""
+    if path.is_dir():
+        raise PathError(f"{option} {str(path)!r} is a folder, expected a file",
+                        hint=f"give a file path such as {str(path / example)!r}")
+    _check_folders(path, option)
+    if path.exists() and not os.access(path, os.W_OK):
+        raise PathError(f"{option} {str(path)!r}: permission denied (the file is read-only)",
+                        hint="choose another path, or make it writable")
     return path
 
 

@@ -62,6 +62,7 @@ _LAZY = {
     "tfest": ("tfest", "tfest"),
     "tfest_frf": ("tfest", "tfest_frf"),
     "load_model": ("linear_model", "load_model"),
+    "load_dynamics_model": ("dynamics", "load_dynamics_model"),
 }
 __getattr__, __dir__ = lazy_exports(__name__, _LAZY)
 __all__ = [*_LAZY]
@@ -107,3 +108,4 @@ if TYPE_CHECKING:  # static readers see the same names, imported eagerly
     from .tfest import tfest as tfest
     from .tfest import tfest_frf as tfest_frf
     from .linear_model import load_model as load_model
+    from .dynamics import load_dynamics_model as load_dynamics_model

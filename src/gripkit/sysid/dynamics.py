@@ -50,14 +50,14 @@ data, without another pass over it.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
 from ..arguments import entry_point
 from ..errors import DataError, IdentificationError, UnidentifiableError
 
-__all__ = ["identify_dynamics", "DynamicsResult", "base_structure", "BaseStructure"]
+__all__ = ["identify_dynamics", "DynamicsResult", "base_structure", "BaseStructure", "load_dynamics_model"]
 
 FRICTION_MODELS = {"none": (), "coulomb-viscous": ("coulomb", "viscous"),
                    "coulomb-viscous-offset": ("coulomb", "viscous", "offset")}
@@ -208,6 +208,22 @@ class DynamicsResult:
     constrained: bool
     unconstrained_theta: np.ndarray
     warnings: list = field(default_factory=list)
+    urdf_text: str | None = None      # provenance for the model file (``save``): the URDF read,
+    base_link: str | None = None      # the chain's end links in it (None: the URDF's defaults),
+    tip_link: str | None = None
+    data_file: str | None = None      # and the log's name and SHA-256
+    data_hash: str | None = None
+
+    def replace(self, **changes) -> DynamicsResult:
+        """A copy with ``changes`` (e.g. the provenance fields ``urdf_text``, ``data_file``)."""
+        return replace(self, **changes)
+
+    def save(self, path) -> None:
+        """Write the model as JSON (:mod:`gripkit.sysid.dynamics_file`, schema
+        ``gripkit.dynamics-model``); read it back with :func:`gripkit.sysid.load_dynamics_model`."""
+        from .dynamics_file import save_dynamics_model
+
+        save_dynamics_model(self, path)
 
     @property
     def std(self) -> np.ndarray:
@@ -593,3 +609,62 @@ def _consistency(chain, st: BaseStructure, theta, C, kinds, m, armature) -> Cons
                 if kind in ("coulomb", "viscous") and sol.x[k] <= 0.0 and theta[nb + j * len(kinds) + c] < 0:
                     failing.append(f"{kind} friction of {jn!r} (< 0)")
     return Consistency(d <= 1e-2, d, tuple(failing), phi, th)
+
+
+def load_dynamics_model(path) -> DynamicsResult:
+    """Read a model written by ``result.save(path)`` (:mod:`gripkit.sysid.dynamics_file`): a
+    :class:`DynamicsResult` with ``predict``, ``base_parameters``, ``base_parameters_std``,
+    ``friction``, ``covariance``, ... as identified.
+
+    Raises DataError for a missing file, a file that is not JSON, of another ``schema`` or of a newer
+    ``schema_version``; ModelError for missing or malformed fields; warns (AccuracyWarning) when
+    the content hash does not match (the file was edited after it was saved).
+    """
+    import hashlib
+    import warnings
+    from pathlib import Path
+
+    from ..errors import AccuracyWarning, ModelError
+    from ..multibody import from_urdf
+    from .dynamics_file import float_array, read_dynamics_document
+
+    doc = read_dynamics_document(path)
+    where = repr(str(Path(path)))
+    try:
+        urdf = doc["urdf"]
+        text = urdf["text"]
+        if hashlib.sha256(text.encode()).hexdigest() != urdf.get("sha256"):
+            warnings.warn(f"dynamics model file {where}: the URDF text does not match its sha256", AccuracyWarning,
+                          stacklevel=2)
+        chain = from_urdf(text, base_link=urdf.get("base_link"), tip_link=urdf.get("tip_link"),
+                          gravity=float_array(doc["gravity"], "gravity", where, (3,)))
+        if list(chain.coordinate_names) != list(doc["joints"]):
+            raise ModelError(f"dynamics model file {where}: the URDF's joints {list(chain.coordinate_names)} "
+                             f"disagree with the file's {doc['joints']}")
+        s = doc["structure"]
+        ind = np.asarray(s["independent"], dtype=np.intp)
+        dep = np.asarray(s["dependent"], dtype=np.intp)
+        beta = float_array(s["beta"], "structure.beta", where).reshape(ind.size, dep.size)
+        par = doc["parameters"]
+        names = tuple(par["names"])
+        n = len(names)
+        theta = float_array(par["values"], "parameters.values", where, (n,))
+        cov = float_array(par["covariance"], "parameters.covariance", where, (n, n))
+        base_names = names[:ind.size]
+        structure = BaseStructure(ind, dep, beta, base_names, tuple(s["standard_names"]))
+        c = doc.get("consistency")
+        consistency = None if c is None else Consistency(
+            bool(c["consistent"]), float(c["distance_sigma"]), tuple(c["failing_links"]),
+            float_array(c["standard_parameters"], "consistency.standard_parameters", where),
+            float_array(c["values"], "consistency.values", where))
+        data = doc.get("data") or {}
+        return DynamicsResult(
+            chain, structure, doc["friction_model"], bool(doc["armature"]), names, theta, cov,
+            {k: float(v) for k, v in doc["residual_std"].items()}, float(doc["relative_error_percent"]),
+            float(doc["condition_number"]), int(doc["n_samples"]), consistency, bool(doc["constrained"]),
+            float_array(doc["unconstrained_values"], "unconstrained_values", where, (n,)), list(doc.get("warnings", [])),
+            urdf_text=text, base_link=urdf.get("base_link"), tip_link=urdf.get("tip_link"),
+            data_file=data.get("file"), data_hash=data.get("sha256"))
+    except (KeyError, TypeError, ValueError) as exc:
+        raise ModelError(f"dynamics model file {where}: a required field is missing or malformed ({exc})",
+                         hint="regenerate the file with gripkit identify dynamics --out") from None

@@ -1,0 +1,145 @@
+"""Identified rigid-body dynamics models as JSON files: ``result.save(path)`` on the result of
+:func:`gripkit.sysid.identify_dynamics`, and :func:`gripkit.sysid.load_dynamics_model`.
+
+A file holds (schema ``gripkit.dynamics-model``, version 1; the same conventions as the linear
+models of :mod:`gripkit.sysid.model_file`)::
+
+    {"schema": "gripkit.dynamics-model", "schema_version": 1, "gripkit_version": "0.1.0",
+     "urdf": {"text": "<robot …>", "sha256": "…", "base_link": "base" | null, "tip_link": … | null},
+     "gravity": [gx, gy, gz],            m/s², in the base link's frame
+     "joints": ["theta1", …],            the actuated joints, in the columns' order
+     "friction_model": "coulomb-viscous", "armature": false,
+     "structure": {"standard_names": […], "independent": […], "dependent": […], "beta": [[…]]},
+     "parameters": {"names": […], "values": […], "std": […], "covariance": [[…]]},
+     "base_parameters": {name: {"value": v, "std": σ}}, "friction": {joint: {"coulomb": …, "coulomb_std": …}},
+     "residual_std": {joint: σ}, "relative_error_percent": …, "condition_number": …, "n_samples": N,
+     "constrained": false, "unconstrained_values": […],
+     "consistency": {"consistent": …, "distance_sigma": …, "failing_links": […],
+                     "standard_parameters": […], "values": […]} | null,
+     "warnings": […], "data": {"file": "log.csv", "sha256": "…"} | null,
+     "content_sha256": "…"}
+
+The URDF text makes the file self-contained: the chain is rebuilt from it with the stored links
+and gravity; the base structure (K of φ_b = K φ, :class:`~gripkit.sysid.dynamics.BaseStructure`)
+is stored rather than found again, so that the loaded model predicts τ = X(q, q̇, q̈) θ with the very
+columns and parameters it was identified with. ``base_parameters`` and ``friction`` repeat
+``parameters`` for a reader of the file; the loader uses ``parameters``.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import AccuracyWarning, DataError, ModelError
+from .model_file import content_hash, plain
+
+__all__ = ["SCHEMA", "SCHEMA_VERSION", "dynamics_document", "float_array", "read_dynamics_document",
+           "save_dynamics_model"]
+
+SCHEMA = "gripkit.dynamics-model"
+SCHEMA_VERSION = 1
+
+
+def _urdf_text(result) -> str:
+    """The URDF the result's chain came from, or the chain written as URDF."""
+    if result.urdf_text is not None:
+        return result.urdf_text
+    import tempfile
+
+    from ..multibody import to_urdf
+
+    with tempfile.TemporaryDirectory() as tmp:
+        return Path(to_urdf(result.chain, Path(tmp) / "chain.urdf")).read_text()
+
+
+def dynamics_document(result) -> dict:
+    """The JSON document of a :class:`~gripkit.sysid.dynamics.DynamicsResult`."""
+    from .. import __version__
+
+    text = _urdf_text(result)
+    st = result.structure
+    cons = result.consistency
+    doc = {"schema": SCHEMA, "schema_version": SCHEMA_VERSION, "gripkit_version": __version__,
+           "urdf": {"text": text, "sha256": hashlib.sha256(text.encode()).hexdigest(),
+                    "base_link": result.base_link, "tip_link": result.tip_link},
+           "gravity": result.chain.gravity_vector, "joints": list(result.chain.coordinate_names),
+           "friction_model": result.friction_model, "armature": result.armature_identified,
+           "structure": {"standard_names": st.standard_names, "independent": st.independent,
+                         "dependent": st.dependent, "beta": st.beta},
+           "parameters": {"names": result.names, "values": result.theta, "std": result.std,
+                          "covariance": result.covariance},
+           "base_parameters": {n: {"value": v, "std": result.base_parameters_std[n]}
+                               for n, v in result.base_parameters.items()},
+           "friction": result.friction, "residual_std": result.residual_std,
+           "relative_error_percent": result.relative_error_percent, "condition_number": result.condition_number,
+           "n_samples": result.n_samples, "constrained": result.constrained,
+           "unconstrained_values": result.unconstrained_theta,
+           "consistency": None if cons is None else {
+               "consistent": cons.consistent, "distance_sigma": cons.distance, "failing_links": cons.failing_links,
+               "standard_parameters": cons.standard_parameters, "values": cons.theta},
+           "warnings": list(result.warnings),
+           "data": None if result.data_file is None else {"file": result.data_file, "sha256": result.data_hash}}
+    doc = plain(doc)
+    doc["content_sha256"] = content_hash(doc)
+    return doc
+
+
+def save_dynamics_model(result, path) -> None:
+    """Write ``result`` (a :class:`~gripkit.sysid.dynamics.DynamicsResult`) to ``path`` (.json)."""
+    path = Path(path)
+    if path.suffix.lower() != ".json":
+        raise DataError(f"dynamics model file: expected a .json path, found {str(path)!r}")
+    text = json.dumps(dynamics_document(result), indent=1, allow_nan=False)
+    try:
+        path.write_text(text + "\n")
+    except OSError as exc:
+        raise DataError(f"dynamics model file {str(path)!r} cannot be written: {exc.strerror}") from None
+
+
+def float_array(x, name, where, shape=None) -> np.ndarray:
+    try:
+        a = np.asarray(x, dtype=np.float64)  # null (a non-finite number when saved) reads as NaN
+    except (TypeError, ValueError):
+        raise ModelError(f"dynamics model file {where}: field {name!r} is not an array of numbers") from None
+    if shape is not None and a.shape != shape:
+        raise ModelError(f"dynamics model file {where}: field {name!r} has shape {a.shape}, expected {shape}")
+    return a
+
+
+def read_dynamics_document(path) -> dict:
+    """The checked JSON document of a model written by ``result.save(path)``
+    (:func:`gripkit.sysid.load_dynamics_model` builds the model from it).
+
+    Raises DataError for a missing file, a file that is not JSON, of another ``schema`` or of a newer
+    ``schema_version``; warns (AccuracyWarning) when
+    the content hash does not match (the file was edited after it was saved).
+    """
+    path = Path(path)
+    where = repr(str(path))
+    try:
+        doc = json.loads(path.read_text())
+    except FileNotFoundError:
+        raise DataError(f"dynamics model file {where} does not exist") from None
+    except IsADirectoryError:
+        raise DataError(f"dynamics model file {where} is a folder, expected a JSON file") from None
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise DataError(f"dynamics model file {where} is not valid JSON ({exc})",
+                        hint="give a file written by gripkit identify dynamics --out") from None
+    if not isinstance(doc, dict) or doc.get("schema") != SCHEMA:
+        found = doc.get("schema") if isinstance(doc, dict) else type(doc).__name__
+        raise DataError(f"dynamics model file {where}: expected schema {SCHEMA!r}, found {found!r}",
+                        hint="give a file written by gripkit identify dynamics --out or result.save(); "
+                             "gripkit.sysid.load_model reads gripkit.linear-model files")
+    ver = doc.get("schema_version")
+    if not isinstance(ver, int) or ver < 1 or ver > SCHEMA_VERSION:
+        raise DataError(f"dynamics model file {where}: expected schema_version 1 … {SCHEMA_VERSION}, found {ver!r}",
+                        hint="upgrade gripkit to read files written by a newer version")
+    if doc.get("content_sha256") != content_hash(doc):
+        warnings.warn(f"dynamics model file {where}: content hash mismatch (the file was edited after it was "
+                      f"saved); using it as it is", AccuracyWarning, stacklevel=2)
+    return doc
