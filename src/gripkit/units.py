@@ -5,7 +5,7 @@ where values enter or leave: parameter files, column headers, CLI options and re
 
 >>> to_si("1.37 mg")
 (1.37e-06, 'kg')
->>> convert(0.1878e-6, "m/V", "um/V")
+>>> round(convert(0.1878e-6, "m/V", "um/V"), 9)
 0.1878
 """
 

@@ -2,8 +2,11 @@
 
 >>> rep = Report("AMADEUS finger identification")
 >>> sec = rep.section("Least squares", "ARX models of Table II ...")
->>> sec.table(["model", "loss"], [["[2 2 2]", 27.6]])
->>> # sec.figure(fig, "caption"); rep.write("report")  -> report/index.html
+>>> sec = sec.table(["model", "loss"], [["[2 2 2]", 27.6]])  # sec.figure(fig, "caption") likewise
+>>> import tempfile
+>>> with tempfile.TemporaryDirectory() as out:
+...     print(rep.write(out).name)
+index.html
 
 Figures are embedded as PNG (base64), so the page is one self-contained file; each is also saved
 under ``<out>/figures/`` and linked from its caption, for a full-size view or to cite elsewhere.
