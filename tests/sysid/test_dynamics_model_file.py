@@ -13,7 +13,7 @@ import pytest
 from test_identify_dynamics import fourier_states, torques
 
 from gripkit.cli import main
-from gripkit.errors import AccuracyWarning, DataError
+from gripkit.errors import AccuracyWarning, ModelError
 from gripkit.multibody import from_urdf, to_urdf
 from gripkit.sysid import identify_dynamics, load_dynamics_model
 
@@ -92,7 +92,7 @@ def test_other_schema_or_newer_version_refused(saved, change, phrase):
     doc = json.loads(saved.read_text())
     doc.update(change)
     saved.write_text(json.dumps(doc))
-    with pytest.raises(DataError, match=phrase):
+    with pytest.raises(ModelError, match=phrase):
         load_dynamics_model(saved)
 
 
@@ -102,7 +102,7 @@ def test_linear_model_file_refused(tmp_path):
 
     path = tmp_path / "lin.json"
     LinearModel(StateSpace([[0.5]], [[1.0]], [[1.0]], dt=0.1), "n4sid").save(path)
-    with pytest.raises(DataError, match="found 'gripkit.linear-model'"):
+    with pytest.raises(ModelError, match="found 'gripkit.linear-model'"):
         load_dynamics_model(path)
 
 

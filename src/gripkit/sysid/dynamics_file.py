@@ -30,13 +30,12 @@ from __future__ import annotations
 
 import hashlib
 import json
-import warnings
 from pathlib import Path
 
 import numpy as np
 
-from ..errors import AccuracyWarning, DataError, ModelError
-from .model_file import content_hash, plain
+from ..errors import DataError, ModelError
+from .model_file import content_hash, plain, read_document
 
 __all__ = ["SCHEMA", "SCHEMA_VERSION", "dynamics_document", "float_array", "read_dynamics_document",
            "save_dynamics_model"]
@@ -113,33 +112,10 @@ def float_array(x, name, where, shape=None) -> np.ndarray:
 
 def read_dynamics_document(path) -> dict:
     """The checked JSON document of a model written by ``result.save(path)``
-    (:func:`gripkit.sysid.load_dynamics_model` builds the model from it).
-
-    Raises DataError for a missing file, a file that is not JSON, of another ``schema`` or of a newer
-    ``schema_version``; warns (AccuracyWarning) when
-    the content hash does not match (the file was edited after it was saved).
-    """
-    path = Path(path)
-    where = repr(str(path))
-    try:
-        doc = json.loads(path.read_text())
-    except FileNotFoundError:
-        raise DataError(f"dynamics model file {where} does not exist") from None
-    except IsADirectoryError:
-        raise DataError(f"dynamics model file {where} is a folder, expected a JSON file") from None
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise DataError(f"dynamics model file {where} is not valid JSON ({exc})",
-                        hint="give a file written by gripkit identify dynamics --out") from None
-    if not isinstance(doc, dict) or doc.get("schema") != SCHEMA:
-        found = doc.get("schema") if isinstance(doc, dict) else type(doc).__name__
-        raise DataError(f"dynamics model file {where}: expected schema {SCHEMA!r}, found {found!r}",
-                        hint="give a file written by gripkit identify dynamics --out or result.save(); "
-                             "gripkit.sysid.load_model reads gripkit.linear-model files")
-    ver = doc.get("schema_version")
-    if not isinstance(ver, int) or ver < 1 or ver > SCHEMA_VERSION:
-        raise DataError(f"dynamics model file {where}: expected schema_version 1 … {SCHEMA_VERSION}, found {ver!r}",
-                        hint="upgrade gripkit to read files written by a newer version")
-    if doc.get("content_sha256") != content_hash(doc):
-        warnings.warn(f"dynamics model file {where}: content hash mismatch (the file was edited after it was "
-                      f"saved); using it as it is", AccuracyWarning, stacklevel=2)
-    return doc
+    (:func:`gripkit.sysid.load_dynamics_model` builds the model from it): DataError for a missing
+    file or a folder, ModelError for a file that is not JSON, of another ``schema`` or of a newer
+    ``schema_version``, and an AccuracyWarning when the content hash does not match (the file was
+    edited after it was saved); :func:`gripkit.sysid.model_file.read_document` does the checks."""
+    return read_document(path, SCHEMA, SCHEMA_VERSION, what="dynamics model file",
+                         hint="give a file written by gripkit identify dynamics --out or result.save(); "
+                              "gripkit.sysid.load_model reads gripkit.linear-model files")

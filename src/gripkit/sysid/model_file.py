@@ -3,18 +3,7 @@
 The models themselves (:class:`~gripkit.sysid.LinearModel`: ``model.save(path)`` and
 :func:`~gripkit.sysid.load_model`) build and read the documents; this module knows only the file.
 
-A file holds (schema ``gripkit.linear-model``, version 1)::
-
-    {"schema": "gripkit.linear-model", "schema_version": 1, "gripkit_version": "0.1.0",
-     "structure": "pem-innovation", "kind": "ss" | "tf", "dt": 0.01 | null,
-     "inputs":  [{"name": "current", "unit": "A", "offset": 0.85}, ...],
-     "outputs": [{"name": "force", "unit": "N", "offset": 0.0}, ...],
-     "system": {…},       the lti system's own description (LinearSystem.to_dict: arrays,
-                          names, units, dt, covariance with its tangents)
-     "innovation": {"K": … | null, "x0": … | null, "noise_covariance": … | null},
-     "fit_percent": […], "singular_values": […] | null, "n_samples": N, "info": {…},
-     "data": {"file": "run1.csv", "sha256": "…"} | null,
-     "content_sha256": "…"}
+The linear-model document is described at :func:`gripkit.sysid.linear_model.model_document`.
 
 ``content_sha256`` is the SHA-256 of the canonical JSON (sorted keys, no spaces) of everything
 else; :func:`load_model` warns when it does not match (the file was edited by hand) and refuses a
@@ -84,7 +73,8 @@ def write_document(doc: dict, path) -> None:
         raise DataError(f"model file {str(path)!r} cannot be written: {exc.strerror}") from None
 
 
-def read_document(path, schema: str = SCHEMA, newest: int = SCHEMA_VERSION) -> dict:
+def read_document(path, schema: str = SCHEMA, newest: int = SCHEMA_VERSION, *, what: str = "model file",
+                  hint: str = "give a file written by gripkit identify --out or model.save()") -> dict:
     """The JSON document of the model file ``path``, checked: ``schema`` and a ``schema_version``
     from 1 to ``newest`` (ModelError otherwise), and its content hash (AccuracyWarning when the
     file was edited after it was saved)."""
@@ -92,19 +82,20 @@ def read_document(path, schema: str = SCHEMA, newest: int = SCHEMA_VERSION) -> d
     try:
         doc = json.loads(path.read_text())
     except FileNotFoundError:
-        raise DataError(f"model file {str(path)!r} does not exist") from None
+        raise DataError(f"{what} {str(path)!r} does not exist") from None
+    except IsADirectoryError:
+        raise DataError(f"{what} {str(path)!r} is a folder, expected a JSON file") from None
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise ModelError(f"model file {str(path)!r} is not valid JSON ({exc})") from None
+        raise ModelError(f"{what} {str(path)!r} is not valid JSON ({exc})", hint=hint) from None
     where = repr(str(path))
     if not isinstance(doc, dict) or doc.get("schema") != schema:
         found = doc.get("schema") if isinstance(doc, dict) else type(doc).__name__
-        raise ModelError(f"model file {where}: expected schema {schema!r}, found {found!r}",
-                         hint="give a file written by gripkit identify --out or model.save()")
+        raise ModelError(f"{what} {where}: expected schema {schema!r}, found {found!r}", hint=hint)
     ver = doc.get("schema_version")
     if not isinstance(ver, int) or ver < 1 or ver > newest:
-        raise ModelError(f"model file {where}: expected schema_version 1 … {newest}, found {ver!r}",
+        raise ModelError(f"{what} {where}: expected schema_version 1 … {newest}, found {ver!r}",
                          hint="upgrade gripkit to read files written by a newer version")
     if doc.get("content_sha256") != content_hash(doc):
-        warnings.warn(f"model file {where}: content hash mismatch (the file was edited after it was saved); "
+        warnings.warn(f"{what} {where}: content hash mismatch (the file was edited after it was saved); "
                       f"using it as it is", AccuracyWarning, stacklevel=3)
     return doc
