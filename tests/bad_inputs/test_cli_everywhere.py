@@ -566,3 +566,9 @@ def test_identify_step_hint_names_the_cli_option(cli, step_file, monkeypatch):
     monkeypatch.setattr(sr, "fit", out_of_bounds)
     res = cli("identify", "step", step_file, "--input", "V_in", "--output", "x_a")
     assert_user_error(res, "IdentificationError", "use method='trf' (CLI: --method trf)")
+
+
+def test_debug_is_accepted_after_the_command(cli):
+    """The one-line errors say "run with --debug": appending it to the command works."""
+    res = cli("zoo", "show", "no-such-model", "--debug")
+    assert res.code == 1 and "UsageError" not in res.err

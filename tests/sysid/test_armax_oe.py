@@ -3,7 +3,7 @@
 
 import numpy as np
 import pytest
-from conftest import A222, B222, THETA222, simulate_arx
+from arx_cases import A222, B222, THETA222, simulate_arx
 
 from gripkit.sysid import armax, arx, oe
 

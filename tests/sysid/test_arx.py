@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 import pytest
-from conftest import A222, B222, THETA222, simulate_arx
+from arx_cases import A222, B222, THETA222, simulate_arx
 
 from gripkit.sysid import arx
 
@@ -152,3 +152,16 @@ def test_ill_conditioned_regressor_takes_the_qr_route():
     assert m.info["cond"] > GRAM_COND_LIMIT
     assert m.info["method"] == "least squares (QR of [Φ | Y])"
     np.testing.assert_allclose(m.theta, [-0.5, 1.0, -0.7], atol=1e-6)
+
+
+@pytest.mark.parametrize("u_writable, y_writable", [(True, False), (False, True), (False, False)])
+def test_read_only_signals_in_any_mix(u_writable, y_writable):
+    """Read-only arrays (a Trajectory's channels are) next to writable ones give the same model:
+    the lagged-sums kernel once failed to compile for a mixed (read-only, writable) pair."""
+    rng = np.random.default_rng(3)
+    u = rng.standard_normal(3000)
+    y = np.convolve(u, [0.0, 0.5, 0.3])[:3000] + 0.01 * rng.standard_normal(3000)
+    ref = arx(u, y, 2, 2, 1, dt=0.01)
+    uu, yy = u.copy(), y.copy()
+    uu.flags.writeable, yy.flags.writeable = u_writable, y_writable
+    np.testing.assert_array_equal(arx(uu, yy, 2, 2, 1, dt=0.01).theta, ref.theta)

@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from conftest import simulate_arx
+from arx_cases import simulate_arx
 
 from gripkit import DataError, Trajectory, UnidentifiableError
 from gripkit.errors import StabilityWarning

@@ -3,7 +3,7 @@ stays finite, symmetric and positive definite over 10⁷ samples, streaming = ba
 
 import numpy as np
 import pytest
-from conftest import A222, B222, THETA222, simulate_arx
+from arx_cases import A222, B222, THETA222, simulate_arx
 from scipy.signal import lfilter
 
 from gripkit import DataError, IdentificationError, UnidentifiableError

@@ -3,7 +3,7 @@ unstable models, residual whiteness and independence tests."""
 
 import numpy as np
 import pytest
-from conftest import A222, B222, simulate_arx
+from arx_cases import A222, B222, simulate_arx
 from scipy.signal import lfilter
 
 from gripkit import DataError

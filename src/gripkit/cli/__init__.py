@@ -91,6 +91,8 @@ def main(argv: list[str] | None = None) -> int:
     """Entry point of the ``gripkit`` command; returns the exit code."""
     argv = list(sys.argv[1:] if argv is None else argv)
     debug = "--debug" in argv
+    if debug:  # accepted anywhere on the line (the error lines say "run with --debug")
+        argv = ["--debug"] + [a for a in argv if a != "--debug"]
     try:
         app = _build()
         rv = app(args=argv, prog_name="gripkit", standalone_mode=False)

@@ -109,7 +109,15 @@ def arx_gram(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int, t0: int) -
     """``[Φ | Y]ᵀ[Φ | Y]``, shape (q, q), q = na + nb + 1, for the rows ``t = t0 … N−1`` of
     :func:`gripkit.sysid.regression.arx_regression` (same column order), from lagged sums."""
     kind, lag, sign = _columns(na, nb, nk)
-    return _gram(u, y, kind, lag, sign, t0)
+    return _gram(_read_only(u), _read_only(y), kind, lag, sign, t0)
+
+
+def _read_only(x: np.ndarray) -> np.ndarray:
+    """A read-only view (no copy): the kernel indexes the tuple ``(y, u)`` with a run-time index,
+    which numba compiles only when both arrays have the same type, writable or not."""
+    v = x.view()
+    v.flags.writeable = False
+    return v
 
 
 @njit(cache=True, fastmath=True)
