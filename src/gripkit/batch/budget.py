@@ -17,6 +17,7 @@ set), or what the caller gives (``memory_limit``, CLI ``--memory-limit``).
 
 from __future__ import annotations
 
+import contextlib
 import os
 import re
 from dataclasses import dataclass
@@ -50,13 +51,11 @@ def _cgroup_room() -> int | None:
 def available_memory() -> int:
     """Bytes of memory available to new allocations now (without swapping)."""
     avail = None
-    try:
+    with contextlib.suppress(OSError, ValueError, IndexError):  # no /proc: ask sysconf below
         for line in Path("/proc/meminfo").read_text().splitlines():
             if line.startswith("MemAvailable:"):
                 avail = int(line.split()[1]) * 1024
                 break
-    except (OSError, ValueError, IndexError):
-        pass
     if avail is None:
         try:
             avail = os.sysconf("SC_AVPHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")

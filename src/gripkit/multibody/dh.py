@@ -57,11 +57,12 @@ class Dynamics:
         kernel, fl, it, work, m = one
         if gravity:
             out = np.empty(m)
-            try:  # the kernel takes only 1-D float64 arrays: anything else goes the validating way
-                if kernel(fl, it, q, qd, qdd, out, work):
-                    return out
-            except TypeError:
-                pass
+            try:  # try/except costs nothing on this hot path, unlike a context manager
+                done = kernel(fl, it, q, qd, qdd, out, work)
+            except TypeError:  # not 1-D float64 arrays: the validating way below
+                done = False
+            if done:
+                return out
         return _dyn.rnea(self, q, qd, qdd, gravity=gravity, parallel=parallel)
 
     def regressor(self, q, qd, qdd, *, gravity: bool = True) -> np.ndarray:

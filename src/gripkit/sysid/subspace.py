@@ -32,6 +32,7 @@ depend on the units) and the model is scaled back.
 
 from __future__ import annotations
 
+import contextlib
 import math
 import warnings
 
@@ -71,12 +72,10 @@ def _lower_factor(Z: np.ndarray) -> np.ndarray:
     the small singular values that decide the order."""
     j = Z.shape[0]
     G = _gram(Z) / j
-    try:
+    with contextlib.suppress(np.linalg.LinAlgError):  # not positive definite: QR below
         L = np.linalg.cholesky(G)
         if np.min(np.abs(np.diag(L))) > 1e-6 * np.sqrt(np.max(np.diag(G))):
             return L
-    except np.linalg.LinAlgError:
-        pass
     return _qr_r(np.asfortranarray(Z), overwrite=True).T / math.sqrt(j)
 
 
