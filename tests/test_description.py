@@ -2,6 +2,7 @@
 
 import json
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -12,25 +13,7 @@ from gripkit.errors import ConfigError
 from gripkit.io import load
 from gripkit.models import MassSpringDamper
 
-MSD = """
-[model]
-type = "mass-spring-damper"
-
-[parameters]
-m = "2 g"
-b = 0.05
-k = "20 N/m"
-
-[simulation]
-fs = 1000
-duration = 0.5
-
-[inputs.F]
-kind = "step"
-initial = 0.0
-final = 0.1
-time = 0.1
-"""
+MSD = (Path(__file__).resolve().parents[1] / "examples" / "mass_spring_damper_step.toml").read_text()
 
 
 def test_description_simulates_like_the_python_api(tmp_path):

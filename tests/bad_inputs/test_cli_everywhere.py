@@ -27,25 +27,7 @@ from gripkit.errors import (ArgumentError, ConfigError, DataError, Identificatio
 from corpus import assert_user_error
 
 
-MSD = """
-[model]
-type = "mass-spring-damper"
-
-[parameters]
-m = "2 g"
-b = 0.05
-k = "20 N/m"
-
-[simulation]
-fs = 1000
-duration = 0.5
-
-[inputs.F]
-kind = "step"
-initial = 0.0
-final = 0.1
-time = 0.1
-"""
+MSD = (pathlib.Path(__file__).resolve().parents[2] / "examples" / "mass_spring_damper_step.toml").read_text()
 
 SWEEP = """
 [sweep]
