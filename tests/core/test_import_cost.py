@@ -46,3 +46,26 @@ def test_lazy_names_are_the_defining_modules_objects_and_listed():
             assert getattr(pkg, name) is not None
     with pytest.raises(AttributeError, match="no_such_name"):
         gripkit.sysid.no_such_name  # noqa: B018
+
+
+def test_small_arx_from_a_csv_file_stays_light(tmp_path):
+    """The path of `gripkit identify arx` on a small log (read the CSV, fit ARX by QR, one-step
+    residuals by np.convolve) needs neither pandas (pyarrow's to_numpy imports it), nor numba, nor
+    scipy.signal/scipy.stats: together 1.2 s of a 1.7 s fresh process before this was checked."""
+    import numpy as np
+
+    rng = np.random.default_rng(1)
+    u = rng.standard_normal(500)
+    y = np.convolve(u, [0.0, 0.5, 0.25])[:500]
+    path = tmp_path / "log.csv"
+    np.savetxt(path, np.column_stack([np.arange(500) * 1e-3, u, y]), delimiter=",", header="time,u,y", comments="")
+    loaded = set(_loaded_after(f"from gripkit.io import load\nfrom gripkit.sysid import arx\n"
+                               f"d = load({str(path)!r})\nm = arx(d['u'], d['y'], 1, 2, 1, dt=d.dt)"))
+    assert [m for m in ("pandas", "numba", "scipy.signal", "scipy.stats") if m in loaded] == []
+
+
+def test_lti_simulate_ss_loads_on_first_use():
+    loaded = set(_loaded_after("import gripkit.lti"))
+    assert "numba" not in loaded
+    loaded = set(_loaded_after("from gripkit.lti import simulate_ss"))
+    assert "numba" in loaded

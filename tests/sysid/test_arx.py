@@ -109,7 +109,7 @@ def test_simulated_truth_matches_seed_coefficients():
 
 @pytest.mark.parametrize("na, nb, nk, n", [(2, 2, 2, 4000), (4, 4, 2, 20000), (2, 3, 1, 20000), (1, 3, 7, 60), (3, 2, 0, 500),
                                            (0, 2, 3, 30)])
-def test_lagged_sums_route_equals_qr_of_the_regressor(na, nb, nk, n):
+def test_lagged_sums_route_equals_qr_of_the_regressor(na, nb, nk, n, monkeypatch):
     """The Gram matrix from compensated lagged sums equals [Φ|Y]ᵀ[Φ|Y] of the materialised
     regressor to rounding (BLOCK·u), and the normal-equations estimate, σ, loss and fit equal the
     QR route's within the derived bound κ²·BLOCK·u (κ: the column-scaled condition number), or
@@ -117,6 +117,7 @@ def test_lagged_sums_route_equals_qr_of_the_regressor(na, nb, nk, n):
     from gripkit.sysid.lagged_sums import BLOCK, GRAM_COND_LIMIT, arx_gram
     from gripkit.sysid.regression import arx_regression, arx_start, qr_solve
 
+    monkeypatch.setattr(importlib.import_module("gripkit.sysid.arx"), "QR_MAX_ELEMENTS", 0)  # the lagged-sums route at every size
     u, y = simulate_arx(n, noise=0.5, seed=11)
     X = arx_regression(u, y, na, nb, nk)
     G = arx_gram(u, y, na, nb, nk, arx_start(na, nb, nk))
@@ -136,12 +137,26 @@ def test_lagged_sums_route_equals_qr_of_the_regressor(na, nb, nk, n):
                                rtol=1e-8)
 
 
-def test_ill_conditioned_regressor_takes_the_qr_route():
+def test_small_problem_takes_the_qr_route_without_numba():
+    """2000 samples of [2 2 2] (2000·5 regressor elements, below QR_MAX_ELEMENTS) are solved by QR
+    in a fresh process without importing numba, and give the lagged-sums route's estimate."""
+    import subprocess
+    import sys
+
+    code = ("import sys, numpy as np; from gripkit.sysid import arx; rng = np.random.default_rng(0); "
+            "u = rng.standard_normal(2000); y = np.convolve(u, [0, 0, 0.195, -0.2276])[:2000]; "
+            "m = arx(u, y, 2, 2, 2); print(m.info['method'], 'numba' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.split()[-1] == "False" and "QR of" in out
+
+
+def test_ill_conditioned_regressor_takes_the_qr_route(monkeypatch):
     """A nearly collinear input (a slow sine plus 1e-4 noise, two adjacent lags) gives κ above
     GRAM_COND_LIMIT: the normal equations would lose κ²·u of accuracy, so QR is used, and the
     estimate still recovers the exact data."""
     from gripkit.sysid.lagged_sums import GRAM_COND_LIMIT
 
+    monkeypatch.setattr(importlib.import_module("gripkit.sysid.arx"), "QR_MAX_ELEMENTS", 0)  # would be small enough for QR anyway
     rng = np.random.default_rng(5)
     n = 3000
     u = np.sin(0.001 * np.arange(n)) + 1e-4 * rng.standard_normal(n)

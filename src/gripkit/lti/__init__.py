@@ -20,13 +20,15 @@ and batch code: :func:`c2d_matrices`, :func:`d2c_matrices` and the numba kernel
 :func:`simulate_ss`.
 """
 
+from typing import TYPE_CHECKING
+
+from ..exports import lazy_exports
 from ._discretize import c2d_matrices as c2d_matrices
 from ._discretize import d2c_matrices as d2c_matrices
 from ._frequency import Bode as Bode
 from ._interop import as_system as as_system
 from ._interop import from_control as from_control
 from ._interop import from_scipy as from_scipy
-from ._kernels import simulate_ss as simulate_ss
 from ._system import Damping as Damping
 from ._system import LinearSystem as LinearSystem
 from ._system import StateSpace as StateSpace
@@ -41,3 +43,9 @@ from ._uncertainty import Uncertainty as Uncertainty
 __all__ = ["Bode", "Damping", "LinearSystem", "StateSpace", "TransferFunction", "Uncertainty", "as_system",
            "c2d", "c2d_matrices", "d2c", "d2c_matrices", "feedback", "from_control", "from_scipy", "parallel",
            "series", "simulate_ss"]
+
+if TYPE_CHECKING:
+    from ._kernels import simulate_ss as simulate_ss
+
+# the numba kernel loads on first use (numba's import is 0.2 s of a fresh process)
+__getattr__, __dir__ = lazy_exports(__name__, {"simulate_ss": ("_kernels", "simulate_ss")})

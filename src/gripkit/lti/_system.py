@@ -18,13 +18,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import linalg
-from scipy import signal as _signal
 
 from ..errors import AccuracyWarning, DataError, ModelError
 from . import _connect, _discretize, _realize
 from ._checks import as_dt, as_input_array, as_matrix, as_names, as_units, require_discrete, same_dt
 from ._frequency import Bode, default_grid
-from ._kernels import simulate_ss
 from ._pycontrol import control_module
 from ._uncertainty import Uncertainty, complex_covariance, push
 
@@ -47,6 +45,8 @@ def _simulate_arrays(A, B, C, D, u, x0):
             raise DataError(f"x0: expected {n} initial states, found shape {np.shape(x0)}")
         if not np.isfinite(x).all():
             raise DataError("x0 has non-finite values")
+    from ._kernels import simulate_ss  # numba, imported on first simulation
+
     y = np.empty((u.shape[0], C.shape[0]))
     simulate_ss(np.ascontiguousarray(A), np.ascontiguousarray(B), np.ascontiguousarray(C),
                 np.ascontiguousarray(D), u, x, np.empty(n), y)
@@ -619,9 +619,11 @@ class LinearSystem:
         """
         kw = {"dt": self.dt} if self.is_discrete else {}
         if isinstance(self, TransferFunction) and self.is_siso:
-            return _signal.TransferFunction(self.numerator(), self.denominator(), **kw)
+            from scipy import signal
+            return signal.TransferFunction(self.numerator(), self.denominator(), **kw)
         ss = self.to_ss()
-        return _signal.StateSpace(ss.A, ss.B, ss.C, ss.D, **kw)
+        from scipy import signal
+        return signal.StateSpace(ss.A, ss.B, ss.C, ss.D, **kw)
 
 
 # ====================================================================== state space
@@ -1385,7 +1387,8 @@ class TransferFunction(LinearSystem):
             raise DataError("u_past/y_past have non-finite values")
         if de.size == 1:
             return np.zeros(0)
-        return _signal.lfiltic(nu, de, yp[::-1][:de.size - 1], up[::-1][:de.size - 1])
+        from scipy import signal
+        return signal.lfiltic(nu, de, yp[::-1][:de.size - 1], up[::-1][:de.size - 1])
 
     def simulate(self, u, x0=None) -> np.ndarray:
         """Outputs y (N, p) for inputs ``u`` (N, m) (or (N,)) of a discrete system, through its

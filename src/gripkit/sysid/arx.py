@@ -19,12 +19,16 @@ import scipy.linalg as sla
 
 from ._scaling import in_user_units, unit_scale
 from .checks import check_identifiable, checked_problem
-from .lagged_sums import arx_gram, arx_residuals, gram_triangle
 from .polynomial import PolynomialModel, check_meta
 from .regression import arx_regression, arx_start, qr_solve, triangular_solve
 from .validation import fit_percent
 
 __all__ = ["arx"]
+
+#: Regressors up to this many elements (``m·(p+1)``, 2 MiB of float64) are materialised and
+#: solved by QR: a few milliseconds at most, and no numba import or kernel load (0.45 s of a
+#: fresh process). Larger ones take the one-pass compensated lagged sums (O(p²) memory).
+QR_MAX_ELEMENTS = 2**18
 
 
 def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None, fs: float | None = None,
@@ -101,8 +105,9 @@ def _arx(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int, step: float, *
     check_identifiable(u, y, t0 + p + 1, f"ARX [{na} {nb} {nk}] ({p} parameters, {t0} initial samples)")
     names = tuple(f"a{i}" for i in range(1, na + 1)) + tuple(f"b{nk + j}" for j in range(nb))
     m = y.size - t0
-    gram = _normal_equations(u, y, na, nb, nk, t0, names, warn)
-    if gram is None:  # ill-conditioned: QR of the materialised [Φ | Y]
+    small = m * (p + 1) <= QR_MAX_ELEMENTS
+    gram = None if small else _normal_equations(u, y, na, nb, nk, t0, names, warn)
+    if gram is None:  # small, or ill-conditioned: QR of the materialised [Φ | Y]
         sol = qr_solve(arx_regression(u, y, na, nb, nk), names, overwrite=True, warn=warn)
         method = "least squares (QR of [Φ | Y])"
         model = _model(sol.theta, na, nk, step, y.size, meta)
@@ -130,6 +135,8 @@ def _normal_equations(u, y, na, nb, nk, t0, names, warn):
     memory) with the residuals and their sums ``(sol, e, Σe², Σ(y − ȳ)²)``, or None when Φ is too
     ill-conditioned for it (then QR is used). ρ² is the residuals' compensated Σe², not
     ``YᵀY − rᵀr`` (which cancels when the fit is good)."""
+    from .lagged_sums import arx_gram, arx_residuals, gram_triangle  # numba: only for large problems
+
     G = arx_gram(u, y, na, nb, nk, t0)
     r1 = gram_triangle(G)
     if r1 is None:

@@ -23,7 +23,6 @@ import numpy as np
 
 from ..errors import DataError, ModelError
 from ..lti import LinearSystem, StateSpace, TransferFunction
-from ..lti import simulate_ss
 from .model_file import SCHEMA, SCHEMA_VERSION, read_document, write_document
 
 __all__ = ["LinearModel", "as_io_matrix", "estimate_x0", "free_run", "fit_per_output", "from_polynomial",
@@ -51,6 +50,8 @@ def as_io_matrix(x, name: str, n: int | None = None) -> np.ndarray:
 
 
 def _sim(A, B, C, D, u, x0):
+    from ..lti import simulate_ss  # numba, loaded on first simulation
+
     y = np.empty((u.shape[0], C.shape[0]))
     simulate_ss(A, B, C, D, u, np.array(x0, dtype=np.float64), np.empty(A.shape[0]), y)
     return y
