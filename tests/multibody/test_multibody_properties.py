@@ -43,6 +43,38 @@ def test_finger_mass_matrix_spd(q):
     assert np.linalg.eigvalsh(M).min() > 0.02  # the reflected rotor inertia alone is ≥ 0.0221 kg·m²
 
 
+@given(seed=st.integers(0, 10_000), n=st.integers(1, 6), prismatic=st.booleans(), coupled=st.booleans())
+def test_one_state_path_equals_the_batched_kernels(seed, n, prismatic, coupled):
+    """``rnea`` and ``mass_matrix`` on one float64 state (the low-overhead path of
+    gripkit.multibody.onestate) give the batched kernels' values bit for bit on DH chains, with
+    and without a coupling Γ (random n×m, m ≤ n, with offsets and armature)."""
+    ch = chain_from(seed, n, prismatic)
+    rng = np.random.default_rng(seed)
+    if coupled:
+        m = int(rng.integers(1, n + 1))
+        ch = CoupledChain(ch, Coupling(rng.normal(size=(n, m)), rng.normal(size=n) * 0.1,
+                                       rng.uniform(0, 1e-3, m), tuple(f"a{k}" for k in range(m))))
+    q, qd, qdd = rng.normal(size=(3, 1, ch.dof))
+    np.testing.assert_array_equal(ch.mass_matrix(q[0]), ch.mass_matrix(q)[0])
+    np.testing.assert_array_equal(ch.rnea(q[0], qd[0], qdd[0]), ch.rnea(q, qd, qdd)[0])
+
+
+def test_one_state_path_hands_bad_states_to_the_checks():
+    """A state of the wrong length or with NaN gets the validating path's ModelError; a list, a
+    float32 array or a strided view is converted there and gives the float64 answer."""
+    ch = finger(check=False).chain()
+    q = np.array([0.1, -0.2, 0.3])
+    with pytest.raises(ModelError, match="expected shape"):
+        ch.mass_matrix(q[:2])
+    with pytest.raises(ModelError, match="NaN"):
+        ch.mass_matrix(np.array([np.nan, 0.0, 0.0]))
+    np.testing.assert_allclose(ch.mass_matrix(q.tolist()), ch.mass_matrix(q), rtol=1e-15)
+    np.testing.assert_allclose(ch.mass_matrix(q.astype(np.float32)), ch.mass_matrix(q.astype(np.float32).astype(float)),
+                               rtol=1e-15)
+    strided = np.column_stack([q, -q])[:, 0]  # a non-contiguous view: the kernel refuses it, the checks copy it
+    np.testing.assert_array_equal(ch.mass_matrix(strided), ch.mass_matrix(q))
+
+
 def test_power_balance_qd_C_equals_half_qd_Mdot_qd():
     """q̇ᵀ(Ṁ/2 − C_mat)q̇ = 0, i.e. q̇ᵀ c(q, q̇) = ½ q̇ᵀ Ṁ q̇ for the Coriolis vector c (Ṁ by central
     differences along q̇)."""

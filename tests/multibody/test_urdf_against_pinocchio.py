@@ -122,6 +122,7 @@ def test_rnea_mass_gravity_fd(pair):
         Mp = pin.crba(model, data, q[b])
         Mp = np.triu(Mp) + np.triu(Mp, 1).T
         np.testing.assert_allclose(M[b], Mp, atol=TOL, rtol=0)
+        np.testing.assert_allclose(chain.mass_matrix(q[b]), Mp, atol=TOL, rtol=0)  # one-state path
         np.testing.assert_allclose(G[b], pin.computeGeneralizedGravity(model, data, q[b]), atol=TOL, rtol=0)
     qdd_fd = chain.forward_dynamics(q, qd, tau)
     np.testing.assert_allclose(qdd_fd, qdd, atol=1e-8, rtol=0)

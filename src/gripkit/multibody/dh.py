@@ -22,6 +22,8 @@ import numpy as np
 from ..errors import ModelError
 from . import rnea as _dyn
 from .kernels import dh_table
+from .onestate import mass_matrix_one, rnea_one
+from .onestate import prepare as prepare_one_state
 
 __all__ = ["DHChain", "Dynamics"]
 
@@ -50,15 +52,11 @@ class Dynamics:
     def rnea(self, q, qd, qdd, *, gravity: bool = True, parallel: bool | None = None) -> np.ndarray:
         """τ = M q̈ + C + G (RNEA, eqs 4.8–4.16); one float64 state takes the low-overhead path
         of :mod:`gripkit.multibody.onestate`."""
-        one = self._one
-        if one is None:
-            from .onestate import prepare
-            one = self._one = prepare(self)
-        kernel, fl, it, work, m = one
         if gravity:
+            buf, m = self._one or self._one_state()
             out = np.empty(m)
             try:  # try/except costs nothing on this hot path, unlike a context manager
-                done = kernel(fl, it, q, qd, qdd, out, work)
+                done = rnea_one(buf, q, qd, qdd, out)
             except TypeError:  # not 1-D float64 arrays: the validating way below
                 done = False
             if done:
@@ -101,8 +99,20 @@ class Dynamics:
         return Gm.T @ (arm_q[:, None] * Gm) + np.diag(arm_p)
 
     def mass_matrix(self, q) -> np.ndarray:
-        """M(q), including reflected rotor inertia."""
-        return _dyn.mass_matrix(self, q)
+        """M(q), including reflected rotor inertia (CRBA, eqs 4.14–4.16); one float64 state takes
+        the low-overhead path of :mod:`gripkit.multibody.onestate`."""
+        buf, m = self._one or self._one_state()
+        out = np.empty((m, m))
+        try:
+            done = mass_matrix_one(buf, q, out)
+        except TypeError:  # not a 1-D float64 array: the validating way below
+            done = False
+        return out if done else _dyn.mass_matrix(self, q)
+
+    def _one_state(self):
+        """The packed model of the one-state path, made on first use."""
+        self._one = prepare_one_state(self)
+        return self._one
 
     def coriolis(self, q, qd) -> np.ndarray:
         """Coriolis/centrifugal vector C(q, q̇)."""

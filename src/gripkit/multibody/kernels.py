@@ -398,6 +398,13 @@ def coupled_mass_bias(n, m, R, P, jtype, mass, com, inertia, arm_q, G, arm_p, qd
             s += G[k * m + i] * tau[k]
         hp[i] = s
     crba(n, R, P, jtype, mass, com, inertia, arm_q, Mq, work)
+    project_mass(n, m, Mq, G, arm_p, Mp)
+
+
+@hot
+def project_mass(n, m, Mq, G, arm_p, Mp):  # pragma: no cover - compiled
+    """Mp (m×m) = Γᵀ Mq Γ + diag(arm_p): a joint-space mass matrix seen by the actuators (Γ is
+    n×m, row-major flat)."""
     for i in range(m):
         for j in range(i, m):
             s = 0.0

@@ -1,15 +1,17 @@
-"""One-state inverse dynamics with the least call overhead.
+"""One-state inverse dynamics and mass matrix with the least call overhead.
 
 A controller or an estimator calls ``chain.rnea(q, qd, qdd)`` on one state at a time; there the
 cost is the call, not the arithmetic (a 4-link RNEA is ~0.1 µs). The batched path validates and
 stacks its inputs and passes 17 arrays to the kernel (~11 µs per call, measured on the DLR/HIT
-finger). This path packs the model once into one float and one integer array (:func:`pack`) and
-keeps the scratch memory with the chain, so a call is one ``np.empty`` and one call of a kernel
-compiled for 1-D float64 arrays only, with seven arguments; other argument types raise TypeError
+finger). This path packs the model and its scratch memory once into one float64 array
+(:func:`pack`) kept with the chain, so a call is one ``np.empty`` and one call of a kernel compiled
+for float64 arrays only, with three (mass matrix) or five (RNEA) arguments: unboxing an argument
+is most of the cost of a call (~0.1 µs each). Other argument types raise TypeError
 at the call, and the kernel reports a state of the wrong length or with NaN/inf: the caller then
 takes the validating path, which raises the error. The scratch is shared by the calls on one
-chain, which is safe because the kernel holds the GIL. Measured in
-``benchmarks/bench_urdf.py`` against one ``pinocchio.rnea`` call.
+chain, which is safe because the kernel holds the GIL. The mass matrix (:func:`mass_matrix_one`,
+CRBA) takes the same path. Measured in ``benchmarks/bench_urdf.py`` and
+``benchmarks/bench_multibody.py`` against one ``pinocchio.rnea`` / ``pinocchio.crba`` call.
 """
 
 from __future__ import annotations
@@ -19,76 +21,102 @@ import math
 import numba
 import numpy as np
 
-from .kernels import WORK_PER_LINK, chain_links, rnea_pass
+from .kernels import WORK_PER_LINK, chain_links, crba, project_mass, rnea_pass
 
-__all__ = ["pack", "rnea_one", "prepare"]
+__all__ = ["mass_matrix_one", "pack", "prepare", "rnea_one"]
 
-_HEADER = 12
+#: header of the packed buffer: n, m, dh width, then the offsets of dh, mass, com, inertia,
+#: arm_q, Γ, q₀, arm_p, gravity, joint types and the scratch
+_HEADER = 14
 
 
-def pack(arrays):
-    """(floats, ints, work) for :func:`rnea_one` from a system's ``kernel_arrays()``."""
+def pack(arrays) -> np.ndarray:
+    """One float64 buffer for :func:`rnea_one` and :func:`mass_matrix_one` from a system's
+    ``kernel_arrays()``: a header of sizes and offsets (small integers, exact as floats), the
+    model, and the scratch the kernels write. One array is one argument to unbox per call."""
     dh, jt, mass, com, inertia, arm_q, G, q0, arm_p, g = arrays
     n, w = dh.shape
     m = arm_p.shape[0]
-    parts = [dh.ravel(), mass, com.ravel(), inertia.ravel(), arm_q, G.ravel(), q0, arm_p, g]
-    offsets = np.cumsum([0] + [p.size for p in parts])
-    fl = np.ascontiguousarray(np.concatenate(parts), dtype=np.float64)
-    it = np.zeros(_HEADER + n, dtype=np.int64)
-    it[:3] = n, m, w
-    it[3:_HEADER] = offsets[:9]
-    it[_HEADER:] = jt
-    work = np.empty(12 * n + WORK_PER_LINK * n + 4 * n)
-    return fl, it, work
+    parts = [dh.ravel(), mass, com.ravel(), inertia.ravel(), arm_q, G.ravel(), q0, arm_p, g,
+             np.asarray(jt, dtype=np.float64),
+             np.zeros(12 * n + WORK_PER_LINK * n + 4 * n + n * n)]
+    offsets = _HEADER + np.cumsum([0] + [p.size for p in parts])
+    return np.concatenate([[n, m, w], offsets[:11], *parts]).astype(np.float64)
 
 
-@numba.njit("b1(f8[::1], i8[::1], f8[::1], f8[::1], f8[::1], f8[::1], f8[::1])", cache=True,
-            error_model="numpy", _nrt=False)
-def rnea_one(fl, it, q, qd, qdd, out, work):  # pragma: no cover - compiled
+_inline = numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+
+
+@_inline
+def _model(buf):  # pragma: no cover - compiled
+    """Views of the packed buffer (no allocation): sizes, model arrays and the scratch."""
+    n = int(buf[0])
+    m = int(buf[1])
+    w = int(buf[2])
+    o = buf[3:_HEADER]
+    dh = buf[int(o[0]):int(o[0]) + n * w].reshape((n, w))
+    mass = buf[int(o[1]):int(o[1]) + n]
+    com = buf[int(o[2]):int(o[2]) + 3 * n].reshape((n, 3))
+    inertia = buf[int(o[3]):int(o[3]) + 6 * n].reshape((n, 6))
+    arm_q = buf[int(o[4]):int(o[4]) + n]
+    G = buf[int(o[5]):int(o[5]) + n * m]
+    q0 = buf[int(o[6]):int(o[6]) + n]
+    arm_p = buf[int(o[7]):int(o[7]) + m]
+    g = buf[int(o[8]):int(o[8]) + 3]
+    jtype = buf[int(o[9]):int(o[9]) + n]
+    work = buf[int(o[10]):]
+    return n, m, dh, mass, com, inertia, arm_q, G, q0, arm_p, g, jtype, work
+
+
+@_inline
+def _finite(m, q):  # pragma: no cover - compiled
+    if q.shape[0] != m:
+        return False
+    for i in range(m):
+        if not math.isfinite(q[i]):
+            return False
+    return True
+
+
+@_inline
+def _links(n, m, dh, jtype, G, q0, q, work):  # pragma: no cover - compiled
+    """Joint positions Γ p + q₀ into the scratch and the link transforms R, P for them."""
+    R = work[0:9 * n].reshape((n, 9))
+    P = work[9 * n:12 * n].reshape((n, 3))
+    qq = work[12 * n + WORK_PER_LINK * n:13 * n + WORK_PER_LINK * n]
+    for k in range(n):
+        s = q0[k]
+        for a in range(m):
+            s += G[k * m + a] * q[a]
+        qq[k] = s
+    chain_links(n, dh, jtype, qq, R, P)
+    return R, P
+
+
+@numba.njit("b1(f8[::1], f8[::1], f8[::1], f8[::1], f8[::1])", cache=True, error_model="numpy", _nrt=False)
+def rnea_one(buf, q, qd, qdd, out):  # pragma: no cover - compiled
     """τ_p = Γᵀ RNEA(Γ p + q₀, Γ ṗ, Γ p̈) + armature_p·p̈ for one state; False when the state has
     NaN or inf or the wrong length (out untouched). Compiled for 1-D float64 arrays only
     (other types raise TypeError at the call)."""
-    n = it[0]
-    m = it[1]
-    w = it[2]
-    if q.shape[0] != m or qd.shape[0] != m or qdd.shape[0] != m:
+    n, m, dh, mass, com, inertia, arm_q, G, q0, arm_p, g, jtype, work = _model(buf)
+    if not (_finite(m, q) and _finite(m, qd) and _finite(m, qdd)):
         return False
-    for i in range(m):
-        if not (math.isfinite(q[i]) and math.isfinite(qd[i]) and math.isfinite(qdd[i])):
-            return False
-    dh = fl[it[3]:it[3] + n * w].reshape((n, w))
-    mass = fl[it[4]:it[4] + n]
-    com = fl[it[5]:it[5] + 3 * n].reshape((n, 3))
-    inertia = fl[it[6]:it[6] + 6 * n].reshape((n, 6))
-    arm_q = fl[it[7]:it[7] + n]
-    G = fl[it[8]:it[8] + n * m]
-    q0 = fl[it[9]:it[9] + n]
-    arm_p = fl[it[10]:it[10] + m]
-    o = it[11]
-    jtype = it[_HEADER:_HEADER + n]
-    R = work[0:9 * n].reshape((n, 9))
-    P = work[9 * n:12 * n].reshape((n, 3))
-    wk = work[12 * n:12 * n + WORK_PER_LINK * n]
+    R, P = _links(n, m, dh, jtype, G, q0, q, work)
     b = 12 * n + WORK_PER_LINK * n
-    qq = work[b:b + n]
     qqd = work[b + n:b + 2 * n]
     qqdd = work[b + 2 * n:b + 3 * n]
     tau = work[b + 3 * n:b + 4 * n]
     for k in range(n):
-        s = q0[k]
         sd = 0.0
         sdd = 0.0
         for a in range(m):
             gk = G[k * m + a]
-            s += gk * q[a]
             sd += gk * qd[a]
             sdd += gk * qdd[a]
-        qq[k] = s
         qqd[k] = sd
         qqdd[k] = sdd
-    chain_links(n, dh, jtype, qq, R, P)
-    rnea_pass(n, R, P, jtype, mass, com, inertia, arm_q, qqd, qqdd, fl[o], fl[o + 1], fl[o + 2],
-              True, tau, wk)
+    rnea_pass(n, R, P, jtype, mass, com, inertia, arm_q, qqd, qqdd, g[0], g[1], g[2], True, tau,
+              work[12 * n:b])
     for a in range(m):
         s = arm_p[a] * qdd[a]
         for k in range(n):
@@ -97,7 +125,21 @@ def rnea_one(fl, it, q, qd, qdd, out, work):  # pragma: no cover - compiled
     return True
 
 
+@numba.njit("b1(f8[::1], f8[::1], f8[:, ::1])", cache=True, error_model="numpy", _nrt=False)
+def mass_matrix_one(buf, q, out):  # pragma: no cover - compiled
+    """M_p = Γᵀ M(Γ p + q₀) Γ + diag(armature_p) (CRBA, thesis eqs 4.14–4.16) for one state into
+    ``out`` (m×m); False when q has NaN or inf or the wrong length (out untouched)."""
+    n, m, dh, mass, com, inertia, arm_q, G, q0, arm_p, g, jtype, work = _model(buf)
+    if not _finite(m, q):
+        return False
+    R, P = _links(n, m, dh, jtype, G, q0, q, work)
+    b = 12 * n + WORK_PER_LINK * n
+    Mq = work[b + 4 * n:b + 4 * n + n * n].reshape((n, n))
+    crba(n, R, P, jtype, mass, com, inertia, arm_q, Mq, work[12 * n:b])
+    project_mass(n, m, Mq, G, arm_p, out)
+    return True
+
+
 def prepare(system):
-    """(kernel, floats, ints, work, m) of ``system`` for ``Dynamics.rnea``."""
-    fl, it, work = pack(system.kernel_arrays())
-    return rnea_one, fl, it, work, system.dof
+    """(packed buffer, m) of ``system`` for ``Dynamics.rnea`` and ``Dynamics.mass_matrix``."""
+    return pack(system.kernel_arrays()), system.dof
