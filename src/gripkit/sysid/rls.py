@@ -475,7 +475,8 @@ class RLS:
         p = self.n_params
         P = self.P
         tr = float(np.trace(P))
-        peak = max(float(np.max(np.abs(u))), float(np.max(np.abs(y))))
+        peaks = {"input u": _peak(u), "output y": _peak(y)}
+        peak = max(peaks.values())
         if peak > 0 and math.log10(p) + 2 * math.log10(peak) + math.log10(tr) > 307.0:
             raise DataError(
                 f"RLS [{self.na} {self.nb} {self.nk}]: values up to {peak:.3g} in u and y make φᵀPφ "
@@ -484,13 +485,13 @@ class RLS:
         for label, x, idx in (("output y", y, range(self.na)), ("input u", u, range(self.na, p))):
             if not len(idx):
                 continue
-            mx = float(np.max(np.abs(x)))
+            mx = peaks[label]
             if mx == 0.0:
                 raise IdentificationError(
                     f"RLS [{self.na} {self.nb} {self.nk}]: the {label} is zero throughout, so "
                     f"{', '.join(self.names[i] for i in idx)} cannot be estimated",
                     hint="check that the columns are the measured input and output")
-            log_energy = -math.inf if mx == 0 else 2 * (math.log10(mx) + math.log10(np.linalg.norm(x / mx)))
+            log_energy = 2 * math.log10(_norm(x, mx))
             prior = float(np.max(np.diag(P)[list(idx)]))
             if log_energy + math.log10(prior) < 0.0:
                 names = ", ".join(self.names[i] for i in idx)
@@ -525,6 +526,18 @@ class RLS:
                          y_pred=yhat, errors=e, first_update=n - nupd, loss=loss,
                          theta_final=self.theta, theta_std_final=self.theta_std,
                          covariance_final=self.covariance, P_final=self.P, model=self.model())
+
+
+def _peak(x: np.ndarray) -> float:
+    """max |x| without the temporary of ``np.abs``."""
+    return max(float(x.max()), -float(x.min()))
+
+
+def _norm(x: np.ndarray, peak: float) -> float:
+    """‖x‖₂ for ``peak = max |x| > 0``, without a temporary; x/peak only where x·x could overflow."""
+    if peak < 1e150:
+        return math.sqrt(float(x @ x))
+    return peak * float(np.linalg.norm(x / peak))
 
 
 @dataclass(frozen=True, eq=False)
