@@ -2,6 +2,8 @@
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 from arx_cases import simulate_arx
 
 from gripkit import DataError, Trajectory, UnidentifiableError
@@ -117,3 +119,13 @@ def test_model_built_from_bad_validation_data():
     y[3] = np.nan
     with pytest.raises(DataError, match="NaN"):
         m.validate(U, y)
+
+
+@given(values=st.lists(st.floats(allow_nan=True, allow_infinity=True, width=64), min_size=1, max_size=50))
+def test_finiteness_check_without_temporaries_agrees_with_isfinite(values):
+    """The min/max finiteness test of the signal checks (no N-element boolean temporary) says
+    exactly what ``np.isfinite(a).all()`` says, for any mix of NaN, ±inf and finite values."""
+    from gripkit.sysid.checks import _all_finite
+
+    a = np.array(values)
+    assert _all_finite(a) == bool(np.isfinite(a).all())
