@@ -51,39 +51,20 @@ _NEGLIGIBLE_DROP = 0.01
 @numba.njit(cache=True)
 def predict_errors(A, B, C, D, K, x0, u, y, e):  # pragma: no cover - compiled
     """Prediction errors e (N, p) of the predictor of the module docstring."""
-    n, m, p = A.shape[0], B.shape[1], C.shape[0]
-    x = x0.copy()
-    xn = np.empty(n)
-    for t in range(u.shape[0]):
-        for i in range(p):
-            acc = 0.0
-            for j in range(n):
-                acc += C[i, j] * x[j]
-            for j in range(m):
-                acc += D[i, j] * u[t, j]
-            e[t, i] = y[t, i] - acc
-        for r in range(n):
-            acc = 0.0
-            for j in range(n):
-                acc += A[r, j] * x[j]
-            for j in range(m):
-                acc += B[r, j] * u[t, j]
-            for j in range(p):
-                acc += K[r, j] * e[t, j]
-            xn[r] = acc
-        for r in range(n):
-            x[r] = xn[r]
+    _predict_states(A, B, C, D, K, x0, u, y, e, np.empty((0, A.shape[0])))
 
 
 @numba.njit(cache=True)
 def _predict_states(A, B, C, D, K, x0, u, y, e, X):  # pragma: no cover - compiled
-    """Prediction errors e (N, p) and predictor states X (N, n) (X[t] = x[t])."""
+    """Prediction errors e (N, p) and, when X has N rows, predictor states X (N, n) (X[t] = x[t])."""
     n, m, p = A.shape[0], B.shape[1], C.shape[0]
+    store = X.shape[0] == u.shape[0]
     x = x0.copy()
     xn = np.empty(n)
     for t in range(u.shape[0]):
-        for r in range(n):
-            X[t, r] = x[r]
+        if store:
+            for r in range(n):
+                X[t, r] = x[r]
         for i in range(p):
             acc = 0.0
             for j in range(n):
