@@ -57,6 +57,7 @@ simulation kernel can run the estimator inside its control loop (see
 from __future__ import annotations
 
 import math
+import numbers
 import warnings
 from dataclasses import dataclass
 
@@ -120,7 +121,8 @@ class AdaptationSettings:
 
     def __post_init__(self):
         for name in ("forgetting", "filter_hz", "v_min", "p0"):
-            if not isinstance(getattr(self, name), (int, float)) or not math.isfinite(getattr(self, name)):
+            x = getattr(self, name)
+            if not isinstance(x, numbers.Real) or isinstance(x, bool) or not math.isfinite(x):
                 raise ModelError(f"{name}: expected a finite number, found {getattr(self, name)!r}")
         if not (0 < self.forgetting <= 1):
             raise ModelError(f"forgetting factor must lie in (0, 1], found {self.forgetting!r}",
@@ -147,7 +149,7 @@ class AdaptationSettings:
 
     def vector(self, dt: float) -> np.ndarray:
         """The settings as the kernel reads them, for sample period ``dt`` (s)."""
-        if not (isinstance(dt, (int, float)) and math.isfinite(dt) and dt > 0):
+        if not (isinstance(dt, numbers.Real) and math.isfinite(dt) and dt > 0):
             raise ModelError(f"dt: expected a sample period > 0 s, found {dt!r}")
         if self.filter_hz >= 0.5 / dt:
             raise ModelError(f"filter_hz = {self.filter_hz:g} Hz must lie below the Nyquist frequency "
