@@ -22,7 +22,9 @@ RLS with forgetting factor λ (per sample of period T_s):
 
     e = y − φᵀθ,   g = Pφ,   k = g / (λ + φᵀg),   θ ← Π(θ + k·e),   P ← (P − k·gᵀ)/λ,
 
-with Π the projection (clipping) onto the bounds of s and o, and σ̂² ← λσ̂² + (1 − λ)e²/(1 + φᵀg/λ)
+with Π the projection onto the bounds of s and o in the metric of P⁻¹ (a coordinate clipped to
+its bound moves the other by P₀₁/P_cc times the clipping: the most probable value given the
+clipped one; plain clipping makes the nearly collinear pair bang between its bounds), and σ̂² ← λσ̂² + (1 − λ)e²/(1 + φᵀg/λ)
 the exponentially weighted variance of the a-priori residuals; the standard deviations are
 σ̂·sqrt(diag P).
 
@@ -221,11 +223,21 @@ def friction_rls_step(k, tau, bias, v, inertia, tv, tf, tn, tipos, cfg, theta, P
     k1 = g1 / den
     s = theta[k, 0] + k0 * e
     o = theta[k, 1] + k1 * e
-    theta[k, 0] = min(max(s, cfg[S_SLO]), cfg[S_SHI])
-    theta[k, 1] = min(max(o, cfg[S_OLO]), cfg[S_OHI])
     q00 = p00 - k0 * g0
     q01 = p01 - k0 * g1
     q11 = p11 - k1 * g1
+    # projection on the bounds in the metric of P⁻¹: a clipped coordinate moves the other one
+    # along the estimate's correlation (s and o are nearly collinear on a flat table)
+    sc = min(max(s, cfg[S_SLO]), cfg[S_SHI])
+    if sc != s and q00 > 0.0:
+        o += q01 / q00 * (sc - s)
+        s = sc
+    oc = min(max(o, cfg[S_OLO]), cfg[S_OHI])
+    if oc != o and q11 > 0.0:
+        s = min(max(s + q01 / q11 * (oc - o), cfg[S_SLO]), cfg[S_SHI])
+        o = oc
+    theta[k, 0] = s
+    theta[k, 1] = o
     # forget only while the trace stays bounded (no windup along an unexcited direction)
     div = lam if (q00 + q11) <= lam * cfg[S_TRACE] else 1.0
     P[k, 0, 0] = q00 / div
