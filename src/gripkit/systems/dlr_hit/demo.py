@@ -218,9 +218,7 @@ def _stiction_and_idim(sec, summary, quick, rng):
 def _adaptation(sec, f, summary, quick):
     """Online friction adaptation on a finger whose friction drifts."""
     n = 10_000 if quick else 20_000
-    t = np.arange(2 * n) * 1e-3
-    ref = np.column_stack([10 * DEG * np.sin(2 * np.pi * 0.4 * t), (40 + 30 * np.sin(2 * np.pi * 0.5 * t)) * DEG,
-                           (45 + 35 * np.sin(2 * np.pi * 0.7 * t + 1)) * DEG])
+    ref = tracking_reference(2 * n * 1e-3)
     c = ImpedanceController("joint", (8, 8, 8), (0.6, 0.6, 0.6))
     drift = dict(scale_distal=1.3, scale_base1=1.2, scale_base2=1.25 * 0.9)
     f2 = finger(check=False, **drift)
