@@ -15,4 +15,5 @@ from .fusion import fused_variance as fused_variance
 from .fusion import implied_correlation as implied_correlation
 from .fusion import normalised_variances as normalised_variances
 from .fusion import proportional_variance as proportional_variance
+from .friction_adaptation import AdaptationSettings as AdaptationSettings
 from .friction_adaptation import FrictionAdapter as FrictionAdapter

@@ -10,12 +10,11 @@ import pytest
 from gripkit.errors import DataError, ModelError
 from gripkit.estimation.friction_adaptation import FrictionAdapter
 from gripkit.signals import Trajectory
-from gripkit.systems.dlr_hit.friction_adaptation import adapt_finger_friction
+from gripkit.systems.dlr_hit.friction_adaptation import adapt_finger_friction, tracking_reference
 from gripkit.systems.dlr_hit.impedance import ImpedanceController, simulate_impedance
 from gripkit.systems.dlr_hit.parameters import dlr_hit_table
 from gripkit.systems.dlr_hit.parameters import finger
 
-DEG = math.pi / 180
 T_HALF = 20.0
 #: friction drift in the second half (ageing/temperature): distal +30 %, base 1 +20 %, base 2 −10 %
 DRIFT = dict(scale_distal=1.3, scale_base1=1.2, scale_base2=1.25 * 0.9)
@@ -25,9 +24,7 @@ TRUE_AFTER = np.array([1.2, 0.9, 1.3])
 @pytest.fixture(scope="module")
 def drifting_log():
     n = int(T_HALF * 1000)
-    t = np.arange(2 * n) / 1000
-    ref = np.column_stack([10 * DEG * np.sin(2 * np.pi * 0.4 * t), (40 + 30 * np.sin(2 * np.pi * 0.5 * t)) * DEG,
-                           (45 + 35 * np.sin(2 * np.pi * 0.7 * t + 1)) * DEG])
+    ref = tracking_reference(2 * T_HALF)
     c = ImpedanceController("joint", (8, 8, 8), (0.6, 0.6, 0.6))
     f1, f2 = finger(check=False), finger(check=False, **DRIFT)
     a = simulate_impedance(f1, c, ref[:n])

@@ -50,6 +50,7 @@ import numpy as np
 from numba import prange
 
 from ...errors import ModelError, SimulationError
+from ...estimation.friction_adaptation import friction_rls_step
 from ...models.bldc import BLDCMotor, bldc_torque, motor_heat_step, temperature_factor
 from ...models.friction import (FrictionTable, Stribeck, lugre_force, lugre_update, ripple,
                                 stribeck, table_arrays, table_friction)
@@ -328,7 +329,7 @@ def _make_context(th):
     cs = (np.empty(4), np.empty(4), np.empty((4, 9)), np.empty((4, 3)), np.empty((4, 16)),
           np.empty((6, 4)), np.empty((3, 3)), np.empty(3), np.empty(3), np.empty(3), np.empty(4),
           np.empty(WORK_PER_LINK * 4), np.zeros(4), np.empty(NX), np.empty(3), np.zeros(3),
-          np.zeros(3), np.zeros(3))
+          np.zeros(3), np.zeros(3), np.empty(4), np.zeros(3))
     return ctx, ws, cs
 
 
@@ -503,10 +504,12 @@ def _pwm_for(tau_out, omega_m, N, th):  # pragma: no cover - compiled
 
 
 @hot
-def _impedance(th, ctx, cs, x, n, ctrl, gains, ctv, ctf, ctn, ctipos, ref, refd,
+def _impedance(th, ctx, cs, x, n, ctrl, gains, ctv, ctf, ctn, ctipos, fhat, ref, refd,
                pwm):  # pragma: no cover - compiled
     """Impedance law (joint: ctrl = 1, Cartesian: ctrl = 2) with gravity and friction
-    compensation → PWM; the commanded torques stay in cs[9] (see gripkit.systems.dlr_hit.impedance)."""
+    compensation F̂(v) = s·F_table(v) + o·sign(v), (s, o) = ``fhat[k]`` → PWM; the commanded
+    torques stay in cs[9], the friction feed-forward in cs[19] (see
+    gripkit.systems.dlr_hit.impedance)."""
     dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav, ratio = ctx
     q, qd, R, P, T, J, Jp, tip, tipd, tauq, gp, work, zq = (cs[0], cs[1], cs[2], cs[3], cs[4],
                                                           cs[5], cs[6], cs[7], cs[8], cs[9],
@@ -542,15 +545,20 @@ def _impedance(th, ctx, cs, x, n, ctrl, gains, ctv, ctf, ctn, ctipos, ref, refd,
             tauq[k] += s
     vdb = gains[8]
     eps = gains[9]
+    ff = cs[19]
     for k in range(3):
         tau = tauq[k]
+        ff[k] = 0.0
         if gains[7] != 0.0 and tau != 0.0:
             # compensate only in the direction the impedance pushes (never into a reversal)
             v = x[3 + k]
             if v * tau >= 0.0:
                 if abs(v) < vdb:
                     v = vdb if tau > 0.0 else -vdb
-                tau += table_friction(v, ctv[k], ctf[k], ctn[k], ctipos[k]) * math.tanh(abs(tau) / eps)
+                fk = fhat[k, 0] * table_friction(v, ctv[k], ctf[k], ctn[k], ctipos[k])
+                fk += fhat[k, 1] if v > 0.0 else -fhat[k, 1]
+                ff[k] = fk * math.tanh(abs(tau) / eps)
+                tau += ff[k]
         tauq[k] = tau
         pwm[k] = _pwm_for(tau, ratio[k] * x[3 + k], ratio[k], th)
 
@@ -588,20 +596,84 @@ def _wall(th, ctx, cs, x, wall, ext, force):  # pragma: no cover - compiled
 
 
 @hot
+def _adapt_friction(th, ctx, cs, x, pwm, ctv, ctf, ctn, ctipos, adapt, y, n):  # pragma: no cover
+    """One step of the online friction estimator per actuator (after :func:`_impedance`, whose
+    chain arrays R, P still hold the current configuration): motor torque from the PWM just
+    commanded and the measured speed through eq 5.10 at T_ref and the transmission, bias torque
+    Γᵀ(C(q, q̇)q̇ + G(q)) by RNEA; writes the estimates and each sample's status into y[n, 27:36]."""
+    dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav, ratio = ctx
+    cfg, J, theta, P, filt, sig2 = adapt
+    qd, R, Pc, work, zq, hb = cs[1], cs[2], cs[3], cs[11], cs[12], cs[18]
+    rnea_pass(4, R, Pc, jt, mass, com, inertia, armq, qd, zq, grav[0], grav[1], grav[2], True, hb,
+              work)
+    for k in range(3):
+        v = x[3 + k]
+        ts = bldc_torque(pwm[k], ratio[k] * v, th[I_C], th[I_B1], th[I_B0], th[I_PMAX], 1.0)
+        tm = transmit_torque(ts, v, ratio[k], th[I_ETA])
+        h = 0.0
+        for j in range(4):
+            h += G[j * 3 + k] * hb[j]
+        y[n, 33 + k] = friction_rls_step(k, tm, h, v, J, ctv, ctf, ctn, ctipos, cfg, theta, P, filt,
+                                         sig2)
+        y[n, 27 + k] = theta[k, 0]
+        y[n, 30 + k] = theta[k, 1]
+
+
+@hot
+def _drift_friction(th, mode, tv, tf, tn, drift, n, thw, tfw):  # pragma: no cover - compiled
+    """The plant's friction at sample n of a drift schedule ``drift`` (N, 6) = (s_k, Δ_k):
+    F_k(v) = s_k·F_k,0(v) + Δ_k·sign(v), F_s,k = s_k·F_s,k,0 + Δ_k, written into the working
+    copies ``thw`` (parameters) and ``tfw`` (table values)."""
+    for k in range(3):
+        s = drift[n, k]
+        d = drift[n, 3 + k]
+        thw[I_FS + k] = s * th[I_FS + k] + d
+        if mode == 0:
+            sc = s * th[I_SCALE + k]
+            thw[I_SCALE + k] = 1.0
+            for i in range(tn[k]):
+                b = tv[k, i]
+                tfw[k, i] = sc * tf[k, i] + (d if b > 0.0 else (-d if b < 0.0 else 0.0))
+        else:
+            thw[I_FC + k] = s * th[I_FC + k] + d
+            thw[I_VISC + k] = s * th[I_VISC + k]
+            thw[I_CUB + k] = s * th[I_CUB + k]
+
+
+@hot
 def finger_loop(th, mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucol, dt, substeps, x, y,
-                ycol, ctrl, gains, ctv, ctf, ctn, ctipos, ref, refd, wall):  # pragma: no cover
+                ycol, ctrl, gains, ctv, ctf, ctn, ctipos, ref, refd, wall, plant,
+                adapt):  # pragma: no cover
     """The time loop (allocation-free, semi-implicit Euler). ``ctrl = 0``: PWM from u[:, ucol:],
     outputs as DLRFinger.outputs at y[:, ycol:ycol+18]; ``ctrl = 1/2``: joint/Cartesian impedance
-    on ``ref``/``refd`` with the ``wall``, closed-loop outputs (27 columns, see
-    gripkit.systems.dlr_hit.impedance)."""
+    on ``ref``/``refd`` with the ``wall``, closed-loop outputs (39 columns, see
+    gripkit.systems.dlr_hit.impedance). ``plant`` = (drift (N, 6) or (0, 6), parameter and table
+    working copies): the plant's friction drift (:func:`_drift_friction`); ``adapt`` = (settings,
+    inertias, θ, P, filters, σ̂²) of the online friction estimator, run when gains[13] ≠ 0."""
     G = ctx[6]
     q0 = ctx[7]
     pwm, ext, taum, fric, xs, force = cs[14], cs[15], cs[16], cs[17], cs[13], cs[8]
+    drift, thw, tfw = plant
+    drifting = drift.shape[0] > 0
+    thp = thw if drifting else th
+    tfp = tfw if drifting else tf
+    fhat = adapt[2]
     h = dt / substeps
     N = ref.shape[0] if ctrl else u.shape[0]
     for n in range(N):
+        if drifting:
+            _drift_friction(th, mode, tv, tf, tn, drift, n, thw, tfw)
         if ctrl:
-            _impedance(th, ctx, cs, x, n, ctrl, gains, ctv, ctf, ctn, ctipos, ref, refd, pwm)
+            _impedance(th, ctx, cs, x, n, ctrl, gains, ctv, ctf, ctn, ctipos, fhat, ref, refd, pwm)
+            if gains[13] != 0.0:
+                _adapt_friction(th, ctx, cs, x, pwm, ctv, ctf, ctn, ctipos, adapt, y, n)
+            else:
+                for k in range(3):
+                    y[n, 27 + k] = fhat[k, 0]
+                    y[n, 30 + k] = fhat[k, 1]
+                    y[n, 33 + k] = 0.0
+            for k in range(3):
+                y[n, 36 + k] = cs[19][k]
         else:
             for k in range(3):
                 pwm[k] = u[n, ucol + k]
@@ -613,8 +685,8 @@ def finger_loop(th, mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucol, dt, 
                 if s == 0:
                     for k in range(3):
                         y[n, 12 + k] = force[k]
-            if not finger_step(th, mode, thermal, ctx, tv, tf, tn, tipos, x, pwm, ext, h, taum, fric,
-                               ws):
+            if not finger_step(thp, mode, thermal, ctx, tv, tfp, tn, tipos, x, pwm, ext, h, taum,
+                               fric, ws):
                 return n + 1
             if s == 0 and not ctrl:
                 # sample n reports the state at t_n and the torques acting at t_n
@@ -663,14 +735,15 @@ def finger_loop_rk4(th, mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucol, 
 
 
 def finger_run(th, mode, thermal, tv, tf, tn, tipos, u, ucol, dt, substeps, x, y, ycol, ctrl, gains,
-               ctv, ctf, ctn, ctipos, ref, refd, wall) -> int:
+               ctv, ctf, ctn, ctipos, ref, refd, wall, plant, adapt) -> int:
     """Simulate one finger (open loop: ``ctrl = 0`` with PWM columns ucol..ucol+2 of ``u``; closed
     loop: ``ctrl = 1`` joint or ``2`` Cartesian impedance). Returns the index of the first failed
     sample + 1, or 0. Scratch arrays are allocated here, in Python, so the only compiled function
     is the time loop itself."""
     ctx, ws, cs = _make_context(th)
     return int(finger_loop(th, mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucol, dt, substeps,
-                           x, y, ycol, ctrl, gains, ctv, ctf, ctn, ctipos, ref, refd, wall))
+                           x, y, ycol, ctrl, gains, ctv, ctf, ctn, ctipos, ref, refd, wall, plant,
+                           adapt))
 
 
 def finger_run_rk4(th, mode, thermal, tv, tf, tn, tipos, u, ucol, dt, substeps, x, y, ycol) -> int:
@@ -680,8 +753,11 @@ def finger_run_rk4(th, mode, thermal, tv, tf, tn, tipos, u, ucol, dt, substeps, 
                                substeps, x, y, ycol))
 
 
-_NO_CTRL = (np.zeros(10), np.zeros((3, 4)), np.zeros((3, 4)), np.full(3, 4, dtype=np.int64),
-            np.full(3, 2, dtype=np.int64), np.zeros((1, 3)), np.zeros((1, 3)), np.zeros(9))
+_NO_CTRL = (np.zeros(14), np.zeros((3, 4)), np.zeros((3, 4)), np.full(3, 4, dtype=np.int64),
+            np.full(3, 2, dtype=np.int64), np.zeros((1, 3)), np.zeros((1, 3)), np.zeros(9),
+            (np.zeros((0, 6)), np.zeros(NTH), np.zeros((3, 1))),
+            (np.zeros(10), np.ones(3), np.array([[1.0, 0.0]] * 3), np.zeros((3, 2, 2)), np.zeros((3, 5)),
+             np.zeros(3)))
 
 
 def run_open_loop(th, mode, integ, thermal, tab, u, dt, substeps, x, y, ucol=0, ycol=0) -> int:
@@ -696,7 +772,8 @@ def run_open_loop(th, mode, integ, thermal, tab, u, dt, substeps, x, y, ucol=0, 
 
 @numba.njit(cache=True, parallel=True, error_model="numpy")
 def _jobs_parallel(thetas, u, ucols, dt, substeps, x0, y, yidx, ycols, tv, tf, tn, tipos, mode,
-                   thermal, gains, ctv, ctf, ctn, ctipos, ref, refd, wall):  # pragma: no cover
+                   thermal, gains, ctv, ctf, ctn, ctipos, ref, refd, wall, plant,
+                   adapt):  # pragma: no cover
     """Open-loop finger simulations in parallel: job j simulates thetas[j] from x0[j] on PWM
     columns ucols[j].. of u, writing y[yidx[j], :, ycols[j]:ycols[j]+18]."""
     J = thetas.shape[0]
@@ -706,7 +783,7 @@ def _jobs_parallel(thetas, u, ucols, dt, substeps, x0, y, yidx, ycols, tv, tf, t
         ctx, ws, cs = finger_context(thetas[j])
         fail[j] = finger_loop(thetas[j], mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucols[j],
                               dt, substeps, x, y[yidx[j]], ycols[j], 0, gains, ctv, ctf, ctn, ctipos,
-                              ref, refd, wall)
+                              ref, refd, wall, plant, adapt)
     return fail
 
 

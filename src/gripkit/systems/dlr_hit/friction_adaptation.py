@@ -1,29 +1,48 @@
-"""Online friction adaptation on a DLR/HIT II finger log (``002_ddea254371185ad3.txt`` §6.3): the
-generic :class:`~gripkit.estimation.friction_adaptation.FrictionAdapter` fed with the finger's
-motor torques (eq 5.10), multibody bias torques and drive inertias."""
+"""Online friction adaptation on the DLR/HIT II finger (``002_ddea254371185ad3.txt`` abstract and
+§6.3: "an algorithm to adjust the friction model", since friction "differs from finger to finger
+and the parameters may change over time").
+
+Two uses of the generic estimator (:mod:`gripkit.estimation.friction_adaptation`):
+
+* after the fact, on a log (:func:`adapt_finger_friction`): the finger's motor torques (eq 5.10),
+  multibody bias torques and drive inertias fed to a :class:`FrictionAdapter`;
+* inside the closed loop (:func:`compare_adaptation`, and ``ImpedanceController(adaptation=...)``
+  in :mod:`gripkit.systems.dlr_hit.impedance`): the estimate is updated at every control step and
+  the impedance controller's friction compensation uses it. :func:`compare_adaptation` runs the
+  loop with and without adaptation, with and without a friction drift of the plant
+  (:mod:`gripkit.systems.dlr_hit.friction_drift`), and reports the tracking errors.
+"""
 
 from __future__ import annotations
 
+import math
+from dataclasses import dataclass, replace
+
 import numpy as np
 
-from ...estimation.friction_adaptation import FrictionAdapter
-from .finger import ACTUATORS
+from ...errors import ModelError
+from ...estimation.friction_adaptation import AdaptationSettings, FrictionAdapter
+from .finger import ACTUATORS, JOINTS
+from .friction_drift import FrictionDrift
+from .impedance import LOOP_ADAPTATION, ImpedanceController, simulate_impedance
 
-__all__ = ["adapt_finger_friction"]
+__all__ = ["adapt_finger_friction", "compare_adaptation", "LoopComparison", "tracking_reference"]
 
 
 def adapt_finger_friction(finger, trajectory, *, forgetting: float = 0.999, filter_hz: float = 10.0,
-                          v_min: float = 0.05, tables=None, adapter: FrictionAdapter | None = None):
+                          v_min: float = 0.05, tables=None, adapter: FrictionAdapter | None = None,
+                          nonfinite: str = "raise"):
     """Run a :class:`FrictionAdapter` on a DLR/HIT finger log (a Trajectory with the finger's
     PWM inputs and joint angle/velocity outputs, as :meth:`DLRFinger.simulate` returns or a real
     log with the same channel names). The motor torque comes from eq 5.10 at the logged speed, the
     bias torque from the multibody model, the inertia from the diagonal of M_p at the log's
-    median configuration. Returns ``(adapter, result)``."""
+    median configuration. ``nonfinite`` as :meth:`FrictionAdapter.update`. Returns
+    ``(adapter, result)``."""
     fs = trajectory.require_uniform(why="friction adaptation")
     ch = finger.chain()
     G = ch.coupling.matrix[:3]
-    q = np.column_stack([trajectory[j] for j in ("abd", "flex", "prox")])
-    qd = np.column_stack([trajectory[f"{j}_vel"] for j in ("abd", "flex", "prox")])
+    q = np.column_stack([trajectory[j] for j in JOINTS])
+    qd = np.column_stack([trajectory[f"{j}_vel"] for j in JOINTS])
     p = np.linalg.solve(G, q.T).T
     pd = np.linalg.solve(G, qd.T).T
     pwm = np.column_stack([trajectory[f"pwm_{a}"] for a in ACTUATORS])
@@ -35,4 +54,81 @@ def adapt_finger_friction(finger, trajectory, *, forgetting: float = 0.999, filt
             t.scaled(finger.parameters.value(f"scale_{a}")) for t, a in zip(finger.tables, ACTUATORS))
         adapter = FrictionAdapter(tabs, J, 1.0 / fs, forgetting=forgetting, filter_hz=filter_hz,
                                   v_min=v_min, names=ACTUATORS)
-    return adapter, adapter.update(tau, h, pd)
+    return adapter, adapter.update(tau, h, pd, nonfinite=nonfinite)
+
+
+def tracking_reference(duration: float, dt: float = 1e-3) -> np.ndarray:
+    """(N, 3) joint reference (rad) that keeps all three drives sliding both ways: abduction
+    10° at 0.4 Hz, flexion 40 ± 30° at 0.5 Hz, proximal 45 ± 35° at 0.7 Hz (inside the joint
+    ranges, speeds up to ≈ 150 °/s as in Figs 7.3–7.5)."""
+    if not (math.isfinite(duration) and duration > 0 and math.isfinite(dt) and 0 < dt < duration):
+        raise ModelError(f"duration and dt: expected 0 < dt < duration (s), found {duration!r}, {dt!r}")
+    t = np.arange(int(round(duration / dt))) * dt
+    deg = math.pi / 180
+    return np.column_stack([10 * deg * np.sin(2 * np.pi * 0.4 * t),
+                            (40 + 30 * np.sin(2 * np.pi * 0.5 * t)) * deg,
+                            (45 + 35 * np.sin(2 * np.pi * 0.7 * t + 1)) * deg])
+
+
+def _errors(tr, skip: int):
+    e = np.column_stack([tr[j] - tr[f"ref_{j}"] for j in JOINTS])[skip:]
+    return float(np.sqrt(np.mean(e ** 2))), float(np.abs(e).max())
+
+
+@dataclass(frozen=True)
+class LoopComparison:
+    """Joint tracking errors of the impedance loop with a fixed and with an adapted friction
+    compensation, on the nominal plant and on the drifting one.
+
+    ``runs[(mode, plant)]``: the closed-loop Trajectory, mode ∈ {'fixed', 'adaptive'}, plant ∈
+    {'nominal', 'drift'}; ``rms`` and ``max`` (rad) under the same keys: RMS over samples and the
+    three joints, and the largest absolute joint error, both after ``t_skip`` s."""
+
+    runs: dict
+    rms: dict
+    max: dict
+    t_skip: float
+    drift: FrictionDrift
+
+    @property
+    def rms_ratio(self) -> float:
+        """RMS error with a fixed compensation over that with adaptation, on the drifting plant
+        (> 1: adaptation helps)."""
+        return self.rms["fixed", "drift"] / self.rms["adaptive", "drift"]
+
+    @property
+    def max_ratio(self) -> float:
+        """As :attr:`rms_ratio` for the largest error."""
+        return self.max["fixed", "drift"] / self.max["adaptive", "drift"]
+
+    @property
+    def recovered(self) -> float:
+        """Fraction of the error the drift adds (fixed compensation, RMS) that adaptation removes:
+        (e_fixed − e_adaptive)/(e_fixed − e_nominal), nominal = fixed compensation without drift."""
+        added = self.rms["fixed", "drift"] - self.rms["fixed", "nominal"]
+        return (self.rms["fixed", "drift"] - self.rms["adaptive", "drift"]) / added if added > 0 else math.nan
+
+
+def compare_adaptation(finger, controller: ImpedanceController, reference, drift: FrictionDrift, *,
+                       settings: AdaptationSettings = LOOP_ADAPTATION, dt: float = 1e-3,
+                       t_skip: float = 5.0) -> LoopComparison:
+    """Run the joint impedance loop on ``reference`` (N, 3 joint angles, rad) four times: the
+    controller's friction compensation fixed or adapted online (``settings``), on the nominal
+    plant and on the plant whose friction follows ``drift``; errors after ``t_skip`` s (the
+    initial transient)."""
+    if controller.kind != "joint":
+        raise ModelError("compare_adaptation: expected a joint impedance controller (errors are joint errors)")
+    if not isinstance(drift, FrictionDrift):
+        raise ModelError(f"drift: expected a FrictionDrift, found {type(drift).__name__}")
+    skip = int(round(t_skip / dt))
+    if not 0 <= skip < np.shape(reference)[0] - 1:
+        raise ModelError(f"t_skip: expected 0 <= t_skip < the reference's duration, found {t_skip!r} s")
+    modes = {"fixed": replace(controller, adaptation=None),
+             "adaptive": replace(controller, adaptation=settings)}
+    runs, rms, mx = {}, {}, {}
+    for mode, c in modes.items():
+        for plant, d in (("nominal", None), ("drift", drift)):
+            tr = simulate_impedance(finger, c, reference, dt=dt, friction_drift=d)
+            runs[mode, plant] = tr
+            rms[mode, plant], mx[mode, plant] = _errors(tr, skip)
+    return LoopComparison(runs, rms, mx, t_skip, drift)

@@ -21,6 +21,20 @@ wall — further and sustain a limit cycle). The commanded actuator
 torque becomes a PWM count through the inverse of eq 5.10 at the measured motor speed, clipped to
 ±4096, held over the 1 kHz control period.
 
+Online friction adaptation (§6.3: "an algorithm to adjust the friction model"; abstract). With
+``ImpedanceController(adaptation=AdaptationSettings(...))`` the friction estimator of
+:mod:`gripkit.estimation.friction_adaptation` runs inside the loop: at every control step k, after
+the PWM command u_k is computed,
+
+    τ_m,k = eq 5.10(u_k, N·ṗ_k) through the transmission,   h_k = Γᵀ(C(q, q̇)q̇ + G(q)),
+    (ŝ, ô) ← RLS step(τ_m,k, h_k, ṗ_k)
+
+(the finger has no torque sensor: the motor torque is the model's, from the command and the
+measured speed), and the compensation of the next step uses F̂(ṗ) = ŝ·F_table(ṗ) + ô·sign(ṗ). The
+estimator's inertia J is the diagonal of M_p at the initial configuration. Before any update
+(ŝ, ô) = (1, 0): the loop without adaptation. The plant's friction can drift during the run
+(``friction_drift``, :mod:`gripkit.systems.dlr_hit.friction_drift`), unknown to the controller.
+
 The control law and the wall run inside the finger's own simulation kernel
 (:func:`gripkit.systems.dlr_hit.finger.finger_run` with ``ctrl`` = 1 or 2), so closed-loop studies
 cost no extra compilation.
@@ -44,12 +58,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import ModelError, SimulationError
+from ...estimation.friction_adaptation import AdaptationSettings
 from ...models.friction import FrictionTable, table_arrays
 from ...signals.trajectory import Trajectory
 from .finger import ACTUATORS, FRICTION_MODES, NX, DLRFinger, finger_run
+from .friction_drift import FrictionDrift
 
 __all__ = ["ImpedanceController", "Wall", "simulate_impedance", "stability_margins",
-           "impedance_margins", "model_friction_tables"]
+           "impedance_margins", "model_friction_tables", "LOOP_ADAPTATION"]
 
 @dataclass(frozen=True)
 class ImpedanceController:
@@ -63,7 +79,9 @@ class ImpedanceController:
     it an actuator counts as at rest; ``smoothing`` (N·m): at rest the friction compensation
     fades in as tanh(|τ|/smoothing) of the impedance torque τ. ``actuator_damping``
     (N·m·s/rad per actuator) adds −D_a·ṗ: a Cartesian stiffness acts weakly along the directions
-    J_p maps to small fingertip motion, and this damps them.
+    J_p maps to small fingertip motion, and this damps them. ``adaptation``: settings of the
+    online friction estimator whose (scale, offset) the compensation uses (default None: the
+    tables as given); see :data:`LOOP_ADAPTATION` for the DLR/HIT defaults.
     """
 
     kind: str = "joint"
@@ -75,6 +93,7 @@ class ImpedanceController:
     velocity_deadband: float = 0.02
     smoothing: float = 0.02
     actuator_damping: tuple = (0.0, 0.0, 0.0)
+    adaptation: AdaptationSettings | None = None
 
     def __post_init__(self):
         if self.kind not in ("joint", "cartesian"):
@@ -87,9 +106,21 @@ class ImpedanceController:
         if self.friction_tables is not None and (len(self.friction_tables) != 3 or not all(
                 isinstance(t, FrictionTable) for t in self.friction_tables)):
             raise ModelError("friction_tables: expected three FrictionTables (base1, base2, distal)")
+        if self.adaptation is not None and not isinstance(self.adaptation, AdaptationSettings):
+            raise ModelError(f"adaptation: expected AdaptationSettings or None, found "
+                             f"{type(self.adaptation).__name__}")
+        if self.adaptation is not None and not self.friction_compensation:
+            raise ModelError("adaptation needs friction_compensation=True (the estimate is used there)")
         if not self.velocity_deadband > 0 or not self.smoothing > 0:
             raise ModelError(f"velocity_deadband (rad/s) and smoothing (N·m) must be > 0, found "
                              f"{self.velocity_deadband!r}, {self.smoothing!r}")
+
+
+#: online friction adaptation on the DLR/HIT finger: λ = 0.999 (3.0 s to 95 % at 1 kHz), H at
+#: 10 Hz, sliding above 0.05 rad/s; the scale kept in [0, 5] and the offset within ±1 N·m (the
+#: thesis's friction spans 0.2–1 N·m, §6.3), so a bad estimate cannot command a runaway torque
+LOOP_ADAPTATION = AdaptationSettings(forgetting=0.999, filter_hz=10.0, v_min=0.05, p0=100.0,
+                                     scale_bounds=(0.0, 5.0), offset_bounds=(-1.0, 1.0))
 
 
 @dataclass(frozen=True)
@@ -130,13 +161,15 @@ def model_friction_tables(finger: DLRFinger, v_max: float = 8.0, n: int = 200) -
 _OUT = (["abd", "flex", "prox"], ["abd_vel", "flex_vel", "prox_vel"], ["tip_x", "tip_y", "tip_z"],
         ["tip_vx", "tip_vy", "tip_vz"], ["force_x", "force_y", "force_z"],
         [f"pwm_{a}" for a in ACTUATORS], [f"tau_cmd_{a}" for a in ACTUATORS],
-        [f"fric_{a}" for a in ACTUATORS], [f"tau_{a}" for a in ACTUATORS])
-_UNITS = ("rad", "rad/s", "m", "m/s", "N", "1", "N*m", "N*m", "N*m")
+        [f"fric_{a}" for a in ACTUATORS], [f"tau_{a}" for a in ACTUATORS],
+        [f"scale_hat_{a}" for a in ACTUATORS], [f"offset_hat_{a}" for a in ACTUATORS],
+        [f"adapt_status_{a}" for a in ACTUATORS], [f"fric_ff_{a}" for a in ACTUATORS])
+_UNITS = ("rad", "rad/s", "m", "m/s", "N", "1", "N*m", "N*m", "N*m", "1", "N*m", "1", "N*m")
 
 
 def simulate_impedance(finger: DLRFinger, controller: ImpedanceController, reference,
                        reference_velocity=None, *, dt: float = 1e-3, x0=None, wall: Wall | None = None,
-                       substeps: int = 1) -> Trajectory:
+                       substeps: int = 1, friction_drift: FrictionDrift | None = None) -> Trajectory:
     """Closed-loop simulation of ``finger`` under ``controller``.
 
     Parameters
@@ -151,11 +184,18 @@ def simulate_impedance(finger: DLRFinger, controller: ImpedanceController, refer
         default state for a Cartesian reference).
     wall
         Optional :class:`Wall`.
+    friction_drift
+        Optional :class:`~gripkit.systems.dlr_hit.friction_drift.FrictionDrift`: the plant's
+        friction changes over time (s from the first sample), unknown to the controller.
 
     Returns a Trajectory with joint angles (``abd``, ``flex``, ``prox``) and velocities, fingertip
     position and velocity (``tip_x``..), contact force on the finger (``force_x``.., N), PWM
     commands (``pwm_base1``..), commanded actuator torques (``tau_cmd_*``), friction (``fric_*``)
-    and the motor torques delivered (``tau_*``, N·m), and the references (``ref_*``).
+    and the motor torques delivered (``tau_*``, N·m), the friction estimate after each step
+    (``scale_hat_*``, ``offset_hat_*`` in N·m; 1 and 0 without adaptation), the estimator's status
+    (``adapt_status_*``: 1 updated, 0 frozen, −1 skipped), the friction feed-forward torque
+    (``fric_ff_*``, N·m), the references (``ref_*``) and, with a drift, the plant's friction
+    scale and offset (``drift_scale_*``, ``drift_offset_*``).
     """
     if not isinstance(finger, DLRFinger):
         raise ModelError(f"finger: expected a DLRFinger, found {type(finger).__name__}")
@@ -190,17 +230,33 @@ def simulate_impedance(finger: DLRFinger, controller: ImpedanceController, refer
         w[6] = wall.stiffness
         w[7] = wall.damping
         w[8] = 1.0
-    y = np.empty((ref.shape[0], 27))
+    N = ref.shape[0]
+    t = np.arange(N) * dt
+    drift = np.zeros((0, 6))
+    if friction_drift is not None:
+        if not isinstance(friction_drift, FrictionDrift):
+            raise SimulationError(f"friction_drift: expected a FrictionDrift, found {type(friction_drift).__name__}")
+        if finger.friction == "none":
+            raise SimulationError("friction_drift: the finger has no friction to drift",
+                                  hint="build it with friction='table', 'stribeck' or 'lugre'")
+        drift = np.ascontiguousarray(friction_drift.at(t))
+    plant = (drift, th.copy(), tf.copy())
+    ad = controller.adaptation
+    settings = ad if ad is not None else AdaptationSettings()
+    J = np.ascontiguousarray(np.diag(finger.chain().mass_matrix(x[:3])))
+    cfg = settings.vector(float(dt)) if ad is not None else np.zeros(10)
+    adapt = (cfg, J, *settings.initial_state(3))
+    y = np.empty((N, 39))
     gains = np.array([*controller.stiffness, *controller.damping, float(controller.gravity_compensation),
                       float(controller.friction_compensation), controller.velocity_deadband,
-                      controller.smoothing, *controller.actuator_damping])
+                      controller.smoothing, *controller.actuator_damping, float(ad is not None)])
     fail = finger_run(th, FRICTION_MODES[finger.friction], finger.thermal, tv, tf, tn, tip,
                       np.zeros((1, 3)), 0, float(dt), int(substeps), x, y, 0,
-                      2 if controller.kind == "cartesian" else 1, gains, ctv, ctf, ctn, ctip, ref, refd, w)
+                      2 if controller.kind == "cartesian" else 1, gains, ctv, ctf, ctn, ctip, ref, refd, w,
+                      plant, adapt)
     if fail or not np.isfinite(y).all():
         raise SimulationError(f"closed loop diverged at sample {max(int(fail) - 1, 0)}",
                               hint="lower the gains or check stability_margins")
-    t = np.arange(ref.shape[0]) * dt
     ch, units = {}, {}
     col = 0
     for names, unit in zip(_OUT, _UNITS):
@@ -212,6 +268,10 @@ def simulate_impedance(finger: DLRFinger, controller: ImpedanceController, refer
     for i, sfx in enumerate(suffix):
         ch[f"ref_{sfx}"] = ref[:, i]
         units[f"ref_{sfx}"] = "m" if controller.kind == "cartesian" else "rad"
+    if drift.shape[0]:
+        for k, a in enumerate(ACTUATORS):
+            ch[f"drift_scale_{a}"], units[f"drift_scale_{a}"] = drift[:, k], "1"
+            ch[f"drift_offset_{a}"], units[f"drift_offset_{a}"] = drift[:, 3 + k], "N*m"
     return Trajectory(t, ch, units, {"fs": 1.0 / dt, "model": finger.name, "controller": controller.kind})
 
 
