@@ -207,8 +207,12 @@ def compliance_experiment(finger: TSFMFinger, max_force: float = 1e-3, *, fs: fl
     F = max_force * np.clip(np.arange(n) / (0.8 * n), 0.0, 1.0)
     out = act.simulate({"U": np.zeros(n), "F_A": F, "M_A": v["L_r"] * F}, dt=1.0 / fs)
     yB = out["y_A"] + v["L_r"] * out["alpha_A"]
+    # the probe reads the force acting when the laser reads y_B: an output sample shows the inputs
+    # up to the previous sample (zero-order hold), so that is F one sample back (pairing F[k] with
+    # y_B[k] biased s_p by +6e-4, +1.3σ, on the 1 ms samples of this ramp)
+    F_now = np.concatenate([[0.0], F[:-1]])
     rng = np.random.default_rng(seed)
-    return Trajectory.uniform(fs, F=F + _noise(rng, n, force_noise), y_B=yB + _noise(rng, n, noise),
+    return Trajectory.uniform(fs, F=F_now + _noise(rng, n, force_noise), y_B=yB + _noise(rng, n, noise),
                               units={"F": "N", "y_B": "m"}, meta={"source": "simulated Fig. 11 experiment"})
 
 
