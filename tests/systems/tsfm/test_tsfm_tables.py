@@ -41,7 +41,7 @@ RIGHT_FINGER = {
 
 def _block(tag: str) -> list[str]:
     text = REFERENCE.read_text(encoding="utf-8")
-    m = re.search(rf"```{tag}\n(.*?)```", text, re.S)
+    m = re.search(rf"```{tag}\n(.*?)```", text, re.DOTALL)
     assert m, f"no ```{tag} block in {REFERENCE}"
     return m.group(1).splitlines()
 
