@@ -7,6 +7,8 @@
 - :mod:`.identification` — the §IV procedure for one finger;
 - :mod:`.tip_position`, :mod:`.micropart` — end-effector position and micropart width/stiffness
   estimation (§V);
+- :mod:`.stiffness_study` — Table III reproduced by the seed's whole protocol, k̂ ± σ beside the
+  seed's "Estimated" column;
 - :mod:`.grasp` — the two-finger grasp (§I); :mod:`.grasp_batch` (with :mod:`.grasp_kernels`,
   :mod:`.grasp_gpu`) — many grasps at once, the sweep scenario ``tsfm-grasp``;
 - :mod:`.demo` — the demo-report section.
@@ -25,4 +27,7 @@ from .identification import FingerIdentification as FingerIdentification
 from .identification import identify_finger as identify_finger
 from .micropart import MicropartEstimate as MicropartEstimate
 from .micropart import estimate_micropart as estimate_micropart
+from .stiffness_study import StiffnessComparison as StiffnessComparison
+from .stiffness_study import TableIIIStudy as TableIIIStudy
+from .stiffness_study import table_iii_study as table_iii_study
 from .tip_position import TipPositionEstimator as TipPositionEstimator

@@ -18,7 +18,10 @@ averages, so the force noise that also enters the position estimates hardly bias
 hold at constant force is left out: it adds no leverage): the slope is eq 16's
 k̂ without the offset, and s₀ — where the loading line meets zero force — refines the width to
 w = gap − s₀. Both come with standard deviations from the regression; the threshold-based width
-and the single-ratio k̂ of eq 16 at the largest force are reported too.
+and the single-ratio k̂ of eq 16 at the largest force are reported too. Under force control the
+fingers move in response to the measured force's noise; ``instrument_lag`` replaces least squares
+by instrumental variables that remove the resulting closed-loop bias (used by
+:mod:`.stiffness_study`).
 """
 
 from __future__ import annotations
@@ -64,7 +67,7 @@ class MicropartEstimate:
 
 
 def estimate_micropart(y1, F1, y2, F2, gap: float, *, threshold: float = 5e-6, window: int = 8,
-                       block: int = 20, min_force: float | None = None) -> MicropartEstimate:
+                       block: int = 20, min_force: float | None = None, instrument_lag: int = 0) -> MicropartEstimate:
     """Estimate a grasped part's location, width and stiffness (see the module docstring).
 
     Parameters
@@ -82,6 +85,13 @@ def estimate_micropart(y1, F1, y2, F2, gap: float, *, threshold: float = 5e-6, w
     min_force
         Only squeeze samples whose mean force exceeds this enter the loading line (default:
         twice the threshold).
+    instrument_lag
+        0: ordinary least squares. L > 0: instrumental variables, the block sum s_{j−L} standing in
+        for s_j. Under force control the fingers move in response to the measured force, noise
+        included, so s_j is correlated with the force noise of its own block (a closed-loop bias,
+        −3e-4 relative on a 12.1 N/m part, about −1σ); s_{j−L} is not (causality), and on a
+        quasi-static squeeze it is nearly collinear with s_j, so the estimate stays as precise.
+        The first L blocks of the loading line are lost.
     """
     arrs = [np.asarray(a, dtype=np.float64).ravel() for a in (y1, F1, y2, F2)]
     n = arrs[0].size
@@ -118,13 +128,21 @@ def estimate_micropart(y1, F1, y2, F2, gap: float, *, threshold: float = 5e-6, w
     if load.size >= 3:
         idx, Fb, sb = idx[: load[-1] + 1], Fb[: load[-1] + 1], sb[: load[-1] + 1]
         nb = Fb.size
+    lag = int(instrument_lag)
+    if lag < 0 or nb - lag < 3:
+        raise DataError(f"instrument_lag: expected 0 <= lag <= {max(nb - 3, 0)} (the loading line has {nb} blocks), "
+                        f"found {instrument_lag!r}")
     if np.ptp(sb) <= 0:
         raise IdentificationError("the fingers did not move while squeezing: δ is constant, eq 16 is undefined")
-    M = np.column_stack([sb, np.ones(nb)])
-    coef, *_ = np.linalg.lstsq(M, Fb, rcond=None)
+    M = np.column_stack([sb[lag:], np.ones(nb - lag)])
+    Fb = Fb[lag:]
+    Z = np.column_stack([sb[: nb - lag], np.ones(nb - lag)])
+    # least squares (Z = M) or instrumental variables: β = (ZᵀM)⁻¹ZᵀF, cov = σ² (ZᵀM)⁻¹ ZᵀZ (MᵀZ)⁻¹
+    ZM_inv = np.linalg.inv(Z.T @ M)
+    coef = ZM_inv @ (Z.T @ Fb)
     r = Fb - M @ coef
-    s2 = float(r @ r) / max(nb - 2, 1)
-    cov = s2 * np.linalg.inv(M.T @ M)
+    s2 = float(r @ r) / max(nb - lag - 2, 1)
+    cov = s2 * ZM_inv @ (Z.T @ Z) @ ZM_inv.T
     k, c = float(coef[0]), float(coef[1])
     if k <= 0:
         raise IdentificationError(f"the force does not rise as the fingers close (slope {k:g} N/m)")
