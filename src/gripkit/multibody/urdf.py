@@ -345,7 +345,7 @@ def _moving_joints(tree: _Tree, path: list[str]) -> _MovingJoints:
     out = _MovingJoints()
     T_acc = np.eye(4)
     for j in path:
-        el, jtype, parent, child = tree.joints[j]
+        el, jtype, _, child = tree.joints[j]
         T_acc = T_acc @ _origin(el, f"joint {j!r}")
         if jtype == "fixed":
             continue

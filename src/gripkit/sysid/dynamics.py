@@ -343,7 +343,7 @@ class _JointNormalEquations:
 
     def __init__(self, X3: np.ndarray, tau: np.ndarray, rows_w: np.ndarray, n_rows: int):
         self.X3, self.tau, self.rows_w, self.n_rows = X3, tau, rows_w, n_rows
-        N, m, P = X3.shape
+        _, m, P = X3.shape
         self.Gj = np.empty((m, P, P))
         self.bj = np.empty((m, P))
         self.yy = np.empty(m)

@@ -361,7 +361,7 @@ def _uncertainty(J, r, s, free, rcond: float, max_rel_std: float):
     dof = max(r.size - len(free), 1)
     sigma2 = float(r @ r) / dof
     Js = J * s[None, :]
-    U, sv, Vt = np.linalg.svd(Js, full_matrices=False)
+    _, sv, Vt = np.linalg.svd(Js, full_matrices=False)
     cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else math.inf
     weak, bad_params, groups = _weak_directions(sv, Vt, sigma2, rcond, max_rel_std, free)
     inv_sv2 = np.where(weak, 0.0, 1.0 / np.where(sv > 0, sv, 1.0) ** 2)
