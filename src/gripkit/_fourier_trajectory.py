@@ -105,6 +105,111 @@ def _limit(name, given, from_chain, m, default):
     return v
 
 
+def _check_design(f0: float, fs: float, harmonics, periods) -> None:
+    """DataError unless f0 > 0, fs is above twice the highest harmonic, and ``harmonics`` and
+    ``periods`` are positive integers."""
+    if not (math.isfinite(f0) and f0 > 0) or not (math.isfinite(fs) and fs > 2 * f0 * harmonics):
+        raise DataError(f"f0 = {f0!r} Hz and fs = {fs!r} Hz: need f0 > 0 and fs above twice the highest "
+                        f"harmonic {f0 * harmonics:g} Hz")
+    if int(harmonics) != harmonics or harmonics < 1 or int(periods) != periods or periods < 1:
+        raise DataError(f"harmonics and periods: expected positive integers, found {harmonics!r}, {periods!r}")
+
+
+def _position_limits(position_limits, chain_limits, m: int) -> tuple[np.ndarray, np.ndarray]:
+    """(lower, upper) per joint: ``position_limits`` broadcast, else the chain's finite limits,
+    else ±π/2; finite with lower < upper."""
+    lo_c = getattr(chain_limits, "lower", None)
+    hi_c = getattr(chain_limits, "upper", None)
+    if position_limits is not None:
+        lo = np.broadcast_to(np.asarray(position_limits[0], dtype=np.float64), (m,)).copy()
+        hi = np.broadcast_to(np.asarray(position_limits[1], dtype=np.float64), (m,)).copy()
+    else:
+        lo = np.where(np.isfinite(lo_c), lo_c, -math.pi / 2) if lo_c is not None else np.full(m, -math.pi / 2)
+        hi = np.where(np.isfinite(hi_c), hi_c, math.pi / 2) if hi_c is not None else np.full(m, math.pi / 2)
+    if not (np.isfinite(lo).all() and np.isfinite(hi).all() and (hi > lo).all()):
+        raise DataError(f"position_limits: expected finite lower < upper per joint, found {lo.tolist()}, {hi.tolist()}")
+    return lo, hi
+
+
+class _Design:
+    """The optimisation problem of the module doc over x = [a, b] (2·m·H): the objective
+    log10 cond of the scaled regressor over one period (1e3 when a column is never excited),
+    the margins of the conservative bounds (≥ 0 inside the limits), random feasible starts and
+    the projection of a solution back inside the bounds."""
+
+    def __init__(self, chain, st, q0, half, vmax, amax, f0: float, H: int, friction: bool, samples_per_period: int):
+        self.chain, self.st, self.q0, self.f0, self.H, self.friction = chain, st, q0, f0, H, friction
+        self.half, self.vmax, self.amax = half, vmax, amax
+        self.m = q0.size
+        self.w = 2 * math.pi * f0 * np.arange(1, H + 1)
+        self.t_eval = np.arange(samples_per_period) / (samples_per_period * f0)
+
+    def unpack(self, x):
+        m, H = self.m, self.H
+        return x[:m * H].reshape(m, H), x[m * H:].reshape(m, H)
+
+    def objective(self, x):
+        a, b = self.unpack(x)
+        q, qd, qdd = fourier_states(a, b, self.q0, self.f0, self.t_eval)
+        X = self.chain.regressor(q, qd, qdd)[:, :, self.st.independent]
+        if self.friction:
+            X = np.concatenate([X, friction_columns(qd, ("coulomb", "viscous"))], axis=2)
+        X = X.reshape(-1, X.shape[2])
+        s = np.sqrt(np.mean(X ** 2, axis=0))
+        if (s == 0).any():
+            return 1e3
+        sv = np.linalg.svd(X / s, compute_uv=False)
+        return float(np.log10(sv[0] / max(sv[-1], 1e-300)))
+
+    def bounds_margin(self, x):
+        a, b = self.unpack(x)
+        c = np.sqrt(a ** 2 + b ** 2 + 1e-30)
+        return np.concatenate([self.half - c @ (1 / self.w), self.vmax - c.sum(axis=1), self.amax - c @ self.w])
+
+    def _joint_factors(self, c):
+        """Per joint, the factor that scales amplitudes c (m, H) onto the tightest bound."""
+        w = self.w
+        return np.min(np.column_stack([self.half / (c @ (1 / w)), self.vmax / c.sum(axis=1), self.amax / (c @ w)]), axis=1)
+
+    def start(self, rng):
+        """Random coefficients, each joint scaled into its limits with a margin (80 %)."""
+        a = rng.normal(size=(self.m, self.H))
+        b = rng.normal(size=(self.m, self.H))
+        k = self._joint_factors(np.sqrt(a ** 2 + b ** 2)) * 0.8
+        return np.concatenate([(a * k[:, None]).ravel(), (b * k[:, None]).ravel()])
+
+    def shrink(self, x):
+        """Scale each joint's coefficients back inside its bounds (SLSQP may end just outside)."""
+        a, b = self.unpack(x)
+        with np.errstate(divide="ignore"):
+            k = self._joint_factors(np.sqrt(a ** 2 + b ** 2))
+        k = np.minimum(1.0, k * (1 - 1e-9))[:, None]
+        return np.concatenate([(a * k).ravel(), (b * k).ravel()])
+
+
+def _best_design(design: _Design, restarts: int, max_iterations: int, seed: int):
+    """SLSQP from 1 + ``restarts`` random starts, each result kept only if it improves on its
+    start; returns (log10 cond, x) of the best and the condition number of the first start."""
+    from scipy.optimize import minimize
+
+    rng = np.random.default_rng(seed)
+    best = None
+    first_cond = None
+    for _ in range(1 + int(restarts)):
+        x0 = design.start(rng)
+        f_start = design.objective(x0)
+        first_cond = 10 ** f_start if first_cond is None else first_cond
+        sol = minimize(design.objective, x0, method="SLSQP", constraints=[{"type": "ineq", "fun": design.bounds_margin}],
+                       options=dict(maxiter=int(max_iterations), ftol=1e-6))
+        x = design.shrink(sol.x) if np.isfinite(sol.x).all() else x0
+        f = design.objective(x)
+        if f > f_start:
+            x, f = x0, f_start
+        if best is None or f < best[0]:
+            best = (f, x)
+    return best[0], best[1], first_cond
+
+
 @entry_point
 def fourier_trajectory(chain, *, f0: float = 0.1, harmonics: int = 5, fs: float = 100.0, periods: int = 1,
                        position_limits=None, velocity_limits=None, acceleration_limits=None,
@@ -132,101 +237,27 @@ def fourier_trajectory(chain, *, f0: float = 0.1, harmonics: int = 5, fs: float 
     restarts
         Random starting points besides the first; the best design is kept.
     """
-    from scipy.optimize import minimize
-
-
     m = int(chain.dof)
     names = tuple(chain.coordinate_names)
-    if not (math.isfinite(f0) and f0 > 0) or not (math.isfinite(fs) and fs > 2 * f0 * harmonics):
-        raise DataError(f"f0 = {f0!r} Hz and fs = {fs!r} Hz: need f0 > 0 and fs above twice the highest "
-                        f"harmonic {f0 * harmonics:g} Hz")
-    if int(harmonics) != harmonics or harmonics < 1 or int(periods) != periods or periods < 1:
-        raise DataError(f"harmonics and periods: expected positive integers, found {harmonics!r}, {periods!r}")
+    _check_design(f0, fs, harmonics, periods)
     H = int(harmonics)
     lim = getattr(chain, "limits", None)
-    lo_c = getattr(lim, "lower", None)
-    hi_c = getattr(lim, "upper", None)
-    if position_limits is not None:
-        lo = np.broadcast_to(np.asarray(position_limits[0], dtype=np.float64), (m,)).copy()
-        hi = np.broadcast_to(np.asarray(position_limits[1], dtype=np.float64), (m,)).copy()
-    else:
-        lo = np.where(np.isfinite(lo_c), lo_c, -math.pi / 2) if lo_c is not None else np.full(m, -math.pi / 2)
-        hi = np.where(np.isfinite(hi_c), hi_c, math.pi / 2) if hi_c is not None else np.full(m, math.pi / 2)
-    if not (np.isfinite(lo).all() and np.isfinite(hi).all() and (hi > lo).all()):
-        raise DataError(f"position_limits: expected finite lower < upper per joint, found {lo.tolist()}, {hi.tolist()}")
+    lo, hi = _position_limits(position_limits, lim, m)
     v_c = getattr(lim, "velocity", None)
     vmax = _limit("velocity_limits", velocity_limits, None if v_c is None else np.where(np.isfinite(v_c), v_c, 2.0), m, 2.0)
     amax = _limit("acceleration_limits", acceleration_limits, None, m, 10.0)
     q0 = 0.5 * (lo + hi) if q0 is None else np.broadcast_to(np.asarray(q0, dtype=np.float64), (m,)).copy()
     if ((q0 <= lo) | (q0 >= hi)).any():
         raise DataError(f"q0: the centre {q0.tolist()} must lie inside the position limits")
-    half = np.minimum(q0 - lo, hi - q0)
-    w = 2 * math.pi * f0 * np.arange(1, H + 1)
     st = base_structure(chain)
-    t_eval = np.arange(samples_per_period) / (samples_per_period * f0)
-
-    def unpack(x):
-        return x[:m * H].reshape(m, H), x[m * H:].reshape(m, H)
-
-    def objective(x):
-        a, b = unpack(x)
-        q, qd, qdd = fourier_states(a, b, q0, f0, t_eval)
-        X = chain.regressor(q, qd, qdd)[:, :, st.independent]
-        if friction:
-            X = np.concatenate([X, friction_columns(qd, ("coulomb", "viscous"))], axis=2)
-        X = X.reshape(-1, X.shape[2])
-        s = np.sqrt(np.mean(X ** 2, axis=0))
-        if (s == 0).any():
-            return 1e3
-        sv = np.linalg.svd(X / s, compute_uv=False)
-        return float(np.log10(sv[0] / max(sv[-1], 1e-300)))
-
-    def bounds_margin(x):
-        a, b = unpack(x)
-        c = np.sqrt(a ** 2 + b ** 2 + 1e-30)
-        return np.concatenate([half - c @ (1 / w), vmax - c.sum(axis=1), amax - c @ w])
-
-    rng = np.random.default_rng(seed)
-
-    def start():
-        a = rng.normal(size=(m, H))
-        b = rng.normal(size=(m, H))
-        c = np.sqrt(a ** 2 + b ** 2)
-        # scale each joint into its limits with a margin
-        k = np.min(np.column_stack([half / (c @ (1 / w)), vmax / c.sum(axis=1), amax / (c @ w)]), axis=1) * 0.8
-        return np.concatenate([(a * k[:, None]).ravel(), (b * k[:, None]).ravel()])
-
-    def shrink(x):
-        """Scale each joint's coefficients back inside its bounds (SLSQP may end just outside)."""
-        a, b = unpack(x)
-        c = np.sqrt(a ** 2 + b ** 2)
-        with np.errstate(divide="ignore"):
-            k = np.min(np.column_stack([half / (c @ (1 / w)), vmax / c.sum(axis=1), amax / (c @ w)]), axis=1)
-        k = np.minimum(1.0, k * (1 - 1e-9))[:, None]
-        return np.concatenate([(a * k).ravel(), (b * k).ravel()])
-
-    best = None
-    first_cond = None
-    for _ in range(1 + int(restarts)):
-        x0 = start()
-        f_start = objective(x0)
-        first_cond = 10 ** f_start if first_cond is None else first_cond
-        sol = minimize(objective, x0, method="SLSQP", constraints=[{"type": "ineq", "fun": bounds_margin}],
-                       options=dict(maxiter=int(max_iterations), ftol=1e-6))
-        x = shrink(sol.x) if np.isfinite(sol.x).all() else x0
-        f = objective(x)
-        if f > f_start:
-            x, f = x0, f_start
-        if best is None or f < best[0]:
-            best = (f, x)
-    f, x = best
+    design = _Design(chain, st, q0, np.minimum(q0 - lo, hi - q0), vmax, amax, f0, H, friction, samples_per_period)
+    f, x, first_cond = _best_design(design, restarts, max_iterations, seed)
     if not math.isfinite(f) or f >= 3:
         raise IdentificationError(f"no excitation found that excites every base parameter of {getattr(chain, 'name', 'the chain')} "
                                   f"within the limits (best condition number {10 ** f:.3g})",
                                   hint="widen the limits, add harmonics or lower f0")
-    a, b = unpack(x)
-    n = int(round(periods * fs / f0))
-    t = np.arange(n) / fs
+    a, b = design.unpack(x)
+    t = np.arange(int(round(periods * fs / f0))) / fs
     q, qd, qdd = fourier_states(a, b, q0, f0, t)
     return FourierTrajectory(t, q, qd, qdd, a, b, q0, float(f0), float(fs), names, float(10 ** f), float(first_cond),
                              dict(lower=lo, upper=hi, velocity=vmax, acceleration=amax),

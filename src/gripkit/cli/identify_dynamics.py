@@ -52,6 +52,80 @@ def _vector(option: str, text: str) -> np.ndarray:
     return v
 
 
+def _idim_states(tr, pcols, ecols, vcols, effort_scale: float, rate: float, cutoff, decimate):
+    """The IDIM-LS signal chain (:func:`gripkit.sysid.friction.idim_samples`) on the position and
+    effort columns; with measured velocities, q̇ and q̈ come from them through the same filter and
+    decimation. Returns the samples and q, q̇, q̈."""
+    from ..sysid.friction import idim_samples
+
+    P = np.column_stack([tr[c] for c in pcols])
+    E = np.column_stack([tr[c] for c in ecols]) * effort_scale
+    st = idim_samples(P, E, rate, cutoff=cutoff, decimation=decimate)
+    q, qd, qdd = st.position, st.velocity, st.acceleration
+    if vcols is not None:
+        sv = idim_samples(np.column_stack([tr[c] for c in vcols]), E, rate, cutoff=st.cutoff,
+                          decimation=st.decimation)
+        qd, qdd = sv.position, sv.velocity
+    return st, q, qd, qdd
+
+
+def _moving_rows(qd, st, joints, data: Path) -> np.ndarray:
+    """Row weights 1/0: a joint's rows count where it moves faster than 2 % of its peak speed,
+    outside the guard band of its velocity reversals; a joint that never moves is an error."""
+    from ..errors import UnidentifiableError
+
+    vmax = np.max(np.abs(qd), axis=0)
+    still = [j for j, v in zip(joints, vmax) if v == 0]
+    if still:
+        raise UnidentifiableError(f"joint(s) {', '.join(still)} never move in {data.name}",
+                                  hint="excite every joint (gripkit excitation fourier)")
+    return ((np.abs(qd) > 0.02 * vmax) & ~st.near_reversal).astype(np.float64)
+
+
+def _write_model_and_report(res, st, states, weights, lines, *, urdf: Path, data: Path, base_link, tip_link,
+                            out: Path | None, report: Path | None) -> None:
+    """``--out``: the model file with the URDF text and the log's name and SHA-256; ``--report``:
+    the HTML page of the identification on ``states`` (q, q̇, q̈)."""
+    if out is not None:
+        from ..sysid.model_file import file_sha256
+
+        out.parent.mkdir(parents=True, exist_ok=True)
+        res.replace(urdf_text=Path(urdf).read_text(), base_link=base_link, tip_link=tip_link,
+                    data_file=Path(data).name, data_hash=file_sha256(data)).save(out)
+    if report is not None:
+        from ..sysid.dynamics_report import write_dynamics_report
+
+        q, qd, qdd = states
+        t = np.arange(q.shape[0]) * st.decimation / st.fs
+        write_dynamics_report(res, t, q, qd, qdd, st.effort, report, weights=weights,
+                              data_name=Path(data).name, warnings_list=list(st.notes) + lines)
+
+
+def _print_tables(res, chain, data: Path, notes) -> None:
+    """The base parameters and the friction as tables on stdout; the consistency and the notes
+    on stderr."""
+    from rich.console import Console
+    from rich.table import Table
+
+    con = Console()
+    t = Table("base parameter (combination of standard parameters)", "value", "std",
+              title=f"{chain.name} from {data.name}: {res.n_samples} samples, {res.n_base} base parameters "
+                    f"(of {len(res.structure.standard_names)}), relative error {res.relative_error_percent:.2f} %")
+    for name, v in res.base_parameters.items():
+        t.add_row(name, f"{v:.6g}", f"{res.base_parameters_std[name]:.2g}")
+    con.print(t)
+    if res.friction:
+        kinds = [k for k in next(iter(res.friction.values())) if not k.endswith("_std")]
+        ft = Table("joint", *kinds, "residual std", title="friction (N·m, N·m·s/rad; N, N·s/m for prismatic joints)")
+        for j, f in res.friction.items():
+            ft.add_row(j, *(f"{f[k]:.4g} ± {f[k + '_std']:.2g}" for k in kinds), f"{res.residual_std[j]:.3g}")
+        con.print(ft)
+    if res.consistency is not None and res.consistency.consistent:
+        typer.echo(res.consistency.message(), err=True)
+    for n in notes:
+        typer.echo(f"note: {n}", err=True)
+
+
 @identify_app.command("dynamics")
 def identify_dynamics_cmd(
     urdf: Path = typer.Argument(..., help="URDF file of the chain."),
@@ -77,10 +151,9 @@ def identify_dynamics_cmd(
     report: Path = ReportOpt,
 ):
     """Identify the base inertial parameters and the friction of every joint of a URDF chain."""
-    from ..errors import DataError, UnidentifiableError
+    from ..errors import DataError
     from ..multibody import from_urdf
     from ..sysid.dynamics import identify_dynamics
-    from ..sysid.friction import idim_samples
     from .paths import output_folder, output_json
 
     output_json(out, "--out")
@@ -94,63 +167,22 @@ def identify_dynamics_cmd(
     vcols = _columns("--velocity", velocity, joints)
     tr = load_data(data, list(dict.fromkeys(pcols + ecols + (vcols or []))), fs, time, fill)
     rate = tr.require_uniform(why="inverse-dynamics identification (filtering and differentiation)")
-    P = np.column_stack([tr[c] for c in pcols])
-    E = np.column_stack([tr[c] for c in ecols]) * effort_scale
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        st = idim_samples(P, E, rate, cutoff=cutoff, decimation=decimate)
-        q, qd, qdd = st.position, st.velocity, st.acceleration
-        if vcols is not None:
-            sv = idim_samples(np.column_stack([tr[c] for c in vcols]), E, rate, cutoff=st.cutoff,
-                              decimation=st.decimation)
-            qd, qdd = sv.position, sv.velocity
-        vmax = np.max(np.abs(qd), axis=0)
-        still = [j for j, v in zip(joints, vmax) if v == 0]
-        if still:
-            raise UnidentifiableError(f"joint(s) {', '.join(still)} never move in {data.name}",
-                                      hint="excite every joint (gripkit excitation fourier)")
-        weights = ((np.abs(qd) > 0.02 * vmax) & ~st.near_reversal).astype(np.float64)
+        st, q, qd, qdd = _idim_states(tr, pcols, ecols, vcols, effort_scale, rate, cutoff, decimate)
+        weights = _moving_rows(qd, st, joints, data)
         res = identify_dynamics(chain, q, qd, qdd, st.effort, friction=friction, weights=weights,
                                 armature=armature, covariance="hac", constrained=constrained)
     lines = report_warnings(caught)
     notes = list(st.notes) + list(res.warnings)
-    if out is not None:
-        from ..sysid.model_file import file_sha256
-
-        out.parent.mkdir(parents=True, exist_ok=True)
-        res.replace(urdf_text=Path(urdf).read_text(), base_link=base_link, tip_link=tip_link,
-                    data_file=Path(data).name, data_hash=file_sha256(data)).save(out)
-    if report is not None:
-        from ..sysid.dynamics_report import write_dynamics_report
-
-        t = np.arange(q.shape[0]) * st.decimation / st.fs
-        write_dynamics_report(res, t, q, qd, qdd, st.effort, report, weights=weights,
-                              data_name=Path(data).name, warnings_list=list(st.notes) + lines)
-    out = dict(urdf=str(urdf), data=str(data), chain=chain.name,
-               columns=dict(position=pcols, effort=ecols, velocity=vcols), fs=rate, cutoff_hz=st.cutoff,
-               decimation=st.decimation, **res.to_dict())
-    out["notes"] = notes
-    out["warnings"] = lines
+    _write_model_and_report(res, st, (q, qd, qdd), weights, lines, urdf=urdf, data=data, base_link=base_link,
+                            tip_link=tip_link, out=out, report=report)
+    summary = dict(urdf=str(urdf), data=str(data), chain=chain.name,
+                   columns=dict(position=pcols, effort=ecols, velocity=vcols), fs=rate, cutoff_hz=st.cutoff,
+                   decimation=st.decimation, **res.to_dict())
+    summary["notes"] = notes
+    summary["warnings"] = lines
     if json_out:
-        emit_json(out)
+        emit_json(summary)
         return
-    from rich.console import Console
-    from rich.table import Table
-
-    con = Console()
-    t = Table("base parameter (combination of standard parameters)", "value", "std",
-              title=f"{chain.name} from {data.name}: {res.n_samples} samples, {res.n_base} base parameters "
-                    f"(of {len(res.structure.standard_names)}), relative error {res.relative_error_percent:.2f} %")
-    for name, v in res.base_parameters.items():
-        t.add_row(name, f"{v:.6g}", f"{res.base_parameters_std[name]:.2g}")
-    con.print(t)
-    if res.friction:
-        kinds = [k for k in next(iter(res.friction.values())) if not k.endswith("_std")]
-        ft = Table("joint", *kinds, "residual std", title="friction (N·m, N·m·s/rad; N, N·s/m for prismatic joints)")
-        for j, f in res.friction.items():
-            ft.add_row(j, *(f"{f[k]:.4g} ± {f[k + '_std']:.2g}" for k in kinds), f"{res.residual_std[j]:.3g}")
-        con.print(ft)
-    if res.consistency is not None and res.consistency.consistent:
-        typer.echo(res.consistency.message(), err=True)
-    for n in notes:
-        typer.echo(f"note: {n}", err=True)
+    _print_tables(res, chain, data, notes)

@@ -35,6 +35,7 @@ import math
 import os
 import warnings
 import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -228,6 +229,194 @@ def _read_root(source):
     return root
 
 
+def _base_link(tree: _Tree, base_link: str | None) -> str:
+    """``base_link``, checked, or the tree's only root."""
+    if base_link is None:
+        if len(tree.roots) > 1:
+            raise ModelError(f"the URDF holds several trees (roots {', '.join(map(repr, tree.roots[:5]))})",
+                             hint="choose one with base_link=")
+        return tree.roots[0]
+    if base_link not in tree.links:
+        raise ModelError(f"base_link {base_link!r} is not a link of the URDF")
+    return base_link
+
+
+def _path_to_end(tree: _Tree, base_link: str) -> tuple[list[str], str]:
+    """The joints from ``base_link`` down its only chain of moving joints, then along a single
+    fixed path to a tip frame if there is one; and the link where it ends. A branch of moving
+    joints is an error (the user must choose ``tip_link``)."""
+    path = []
+    link = base_link
+    while True:
+        moving = [j for j in tree.children[link] if tree.subtree_moves(tree.joints[j][3]) or tree.joints[j][1] != "fixed"]
+        if len(moving) > 1:
+            if path and any(tree.joints[j][1] != "fixed" for j in path):
+                raise ModelError(f"the chain branches at link {link!r} into joints {', '.join(map(repr, moving))}",
+                                 hint="choose the chain's end with tip_link=")
+            raise ModelError(f"link {link!r} carries several chains (joints {', '.join(map(repr, moving))})",
+                             hint="choose the chain's end with tip_link= (and base_link=)")
+        if moving:
+            path.append(moving[0])
+            link = tree.joints[moving[0]][3]
+            continue
+        # no more moving joints: follow a single fixed path to a tip frame, if there is one
+        fixed = tree.children[link]
+        if len(fixed) == 1 and path:
+            path.append(fixed[0])
+            link = tree.joints[fixed[0]][3]
+            continue
+        return path, link
+
+
+def _path_to_tip(tree: _Tree, base_link: str, tip_link: str) -> list[str]:
+    """The joints from ``base_link`` to ``tip_link``, which must hang below it."""
+    if tip_link not in tree.links:
+        raise ModelError(f"tip_link {tip_link!r} is not a link of the URDF")
+    path = []
+    link = tip_link
+    while link != base_link:
+        if link not in tree.parent:
+            raise ModelError(f"tip_link {tip_link!r} does not hang below base_link {base_link!r}")
+        j = tree.parent[link]
+        path.append(j)
+        link = tree.joints[j][2]
+    path.reverse()
+    return path
+
+
+@dataclass
+class _MovingJoints:
+    """The chain's moving joints in order, as read from the path: placement (fixed joints before a
+    moving joint folded in), unit axis, type letter, name, moved link, inertial data (mass, com,
+    inertia about the com), limits (lower, upper, velocity, effort) and ``<mimic>`` (leader,
+    multiplier, offset) by joint name; ``tool``: the fixed joints after the last moving one."""
+
+    placements: list = field(default_factory=list)
+    axes: list = field(default_factory=list)
+    types: list = field(default_factory=list)
+    names: list = field(default_factory=list)
+    links: list = field(default_factory=list)
+    inertials: list = field(default_factory=list)
+    limits: list = field(default_factory=list)
+    mimic: dict = field(default_factory=dict)
+    tool: np.ndarray | None = None
+
+
+def _axis(el, j: str) -> np.ndarray:
+    """The unit ``<axis xyz>`` of joint ``j`` (default (1, 0, 0))."""
+    ax_el = el.find("axis")
+    axis = _numbers(ax_el.get("xyz") if ax_el is not None else None, 3, f"joint {j!r} <axis xyz>", default=(1, 0, 0))
+    if np.linalg.norm(axis) < 1e-12:
+        raise ModelError(f"joint {j!r}: <axis xyz> is the zero vector")
+    return axis / np.linalg.norm(axis)
+
+
+def _limits(el, jtype: str, j: str) -> tuple[float, float, float, float]:
+    """(lower, upper, velocity, effort) of joint ``j``: no position limits for a continuous joint
+    or without ``<limit>``; a velocity or effort of 0 (or none) reads as no limit (module doc)."""
+    lim = el.find("limit")
+    where = f"joint {j!r} <limit>"
+    if jtype == "continuous" or lim is None:
+        lo, hi = -np.inf, np.inf
+    else:
+        lo, hi = _number(lim, "lower", where, 0.0), _number(lim, "upper", where, 0.0)
+        if lo > hi:
+            raise ModelError(f"{where}: lower {lo:g} > upper {hi:g}")
+    vel = _number(lim, "velocity", where, 0.0) if lim is not None else 0.0
+    eff = _number(lim, "effort", where, 0.0) if lim is not None else 0.0
+    return (lo, hi, vel if vel > 0 else np.inf, eff if eff > 0 else np.inf)
+
+
+def _mimic(el, j: str) -> tuple[str, float, float] | None:
+    """(leader, multiplier, offset) of joint ``j``'s ``<mimic>``, or None."""
+    mm = el.find("mimic")
+    if mm is None:
+        return None
+    leader = mm.get("joint")
+    if leader is None:
+        raise ModelError(f"joint {j!r} <mimic>: attribute 'joint' is missing")
+    return (leader, _number(mm, "multiplier", f"joint {j!r} <mimic>", 1.0),
+            _number(mm, "offset", f"joint {j!r} <mimic>", 0.0))
+
+
+def _moving_joints(tree: _Tree, path: list[str]) -> _MovingJoints:
+    """Read the moving joints along ``path``; fixed joints before a moving joint fold into its
+    placement, those after the last one into the tool frame."""
+    out = _MovingJoints()
+    T_acc = np.eye(4)
+    for j in path:
+        el, jtype, _, child = tree.joints[j]
+        T_acc = T_acc @ _origin(el, f"joint {j!r}")
+        if jtype == "fixed":
+            continue
+        out.placements.append(T_acc)
+        T_acc = np.eye(4)
+        out.axes.append(_axis(el, j))
+        out.types.append(_MOVING[jtype])
+        out.names.append(j)
+        out.links.append(child)
+        out.limits.append(_limits(el, jtype, j))
+        mimic = _mimic(el, j)
+        if mimic is not None:
+            out.mimic[j] = mimic
+        # the moving link with everything fixed to it (off the path, or up to the next moving joint)
+        data = _inertial(tree.links[child], f"link {child!r}")
+        if data is None:
+            raise ModelError(f"link {child!r}, moved by joint {j!r}, has no <inertial>",
+                             hint="add one (<mass value='0'/> for a massless link)")
+        out.inertials.append(data)
+    out.tool = T_acc
+    return out
+
+
+def _merge_fixed(tree: _Tree, link: str, T: np.ndarray, k: int, joints: _MovingJoints, on_path: set) -> None:
+    """Merge every link fixed (directly or through other fixed links) to ``link``, at ``T`` in
+    moving link ``k``'s frame, into that link's inertial data; a moving joint off the path is a
+    branch, which a serial chain cannot hold."""
+    for j in tree.children[link]:
+        el, jtype, _, child = tree.joints[j]
+        if jtype == "fixed":
+            Tc = T @ _origin(el, f"joint {j!r}")
+            data = _inertial(tree.links[child], f"link {child!r}")
+            if data is not None:
+                joints.inertials[k] = _combine(joints.inertials[k], _transform_inertial(Tc, data))
+            _merge_fixed(tree, child, Tc, k, joints, on_path)
+        elif j not in on_path:
+            tree.check_type(j)
+            raise ModelError(f"joint {j!r} ({jtype}) branches off the chain at link {link!r}: gripkit "
+                             f"models serial chains", hint="choose base_link/tip_link so that the chain does "
+                             "not carry the branch, or make the joint fixed")
+
+
+def _mimic_coupling(joints: _MovingJoints, base_link: str, tip_link: str):
+    """Γ (n × m) and q₀ (n,) with q_full = Γ q + q₀ over the actuated joints (those that mimic
+    none), following chains of mimics to their leader: q_k = (Π a) q_leader + Σ (Π a) b.
+    Returns Γ, q₀ and the indices of the actuated joints."""
+    names, mimic = joints.names, joints.mimic
+    n = len(names)
+    index = {name: k for k, name in enumerate(names)}
+    actuated = [k for k, name in enumerate(names) if name not in mimic]
+    col = {k: c for c, k in enumerate(actuated)}
+    G = np.zeros((n, len(actuated)))
+    q0 = np.zeros(n)
+    for k, name in enumerate(names):
+        mult, off, cur, seen = 1.0, 0.0, name, {name}
+        while cur in mimic:
+            leader, a, b = mimic[cur]
+            if leader not in index:
+                raise ModelError(f"joint {cur!r} mimics {leader!r}, which is not a moving joint of the chain "
+                                 f"{base_link!r} → {tip_link!r}")
+            if leader in seen:
+                raise ModelError(f"mimic joints {sorted(seen)} follow each other in a circle")
+            seen.add(leader)
+            off = off + mult * b
+            mult = mult * a
+            cur = leader
+        G[k, col[index[cur]]] = mult
+        q0[k] = off
+    return G, q0, actuated
+
+
 @entry_point
 def from_urdf(source, *, base_link: str | None = None, tip_link: str | None = None,
               gravity=(0.0, 0.0, -9.81)) -> JointChain:
@@ -250,147 +439,28 @@ def from_urdf(source, *, base_link: str | None = None, tip_link: str | None = No
     """
     robot = _read_root(source)
     tree = _Tree(robot)
-    if base_link is None:
-        if len(tree.roots) > 1:
-            raise ModelError(f"the URDF holds several trees (roots {', '.join(map(repr, tree.roots[:5]))})",
-                             hint="choose one with base_link=")
-        base_link = tree.roots[0]
-    elif base_link not in tree.links:
-        raise ModelError(f"base_link {base_link!r} is not a link of the URDF")
-    # the path of joints from base_link to the tip
+    base_link = _base_link(tree, base_link)
     if tip_link is None:
-        path = []
-        link = base_link
-        while True:
-            moving = [j for j in tree.children[link] if tree.subtree_moves(tree.joints[j][3]) or tree.joints[j][1] != "fixed"]
-            if len(moving) > 1:
-                if path and any(tree.joints[j][1] != "fixed" for j in path):
-                    raise ModelError(f"the chain branches at link {link!r} into joints {', '.join(map(repr, moving))}",
-                                     hint="choose the chain's end with tip_link=")
-                raise ModelError(f"link {link!r} carries several chains (joints {', '.join(map(repr, moving))})",
-                                 hint="choose the chain's end with tip_link= (and base_link=)")
-            if moving:
-                path.append(moving[0])
-                link = tree.joints[moving[0]][3]
-                continue
-            # no more moving joints: follow a single fixed path to a tip frame, if there is one
-            fixed = tree.children[link]
-            if len(fixed) == 1 and path:
-                path.append(fixed[0])
-                link = tree.joints[fixed[0]][3]
-                continue
-            break
-        tip_link = link
+        path, tip_link = _path_to_end(tree, base_link)
     else:
-        if tip_link not in tree.links:
-            raise ModelError(f"tip_link {tip_link!r} is not a link of the URDF")
-        path = []
-        link = tip_link
-        while link != base_link:
-            if link not in tree.parent:
-                raise ModelError(f"tip_link {tip_link!r} does not hang below base_link {base_link!r}")
-            j = tree.parent[link]
-            path.append(j)
-            link = tree.joints[j][2]
-        path.reverse()
+        path = _path_to_tip(tree, base_link, tip_link)
     for j in path:
         tree.check_type(j)
-    moving_idx = [i for i, j in enumerate(path) if tree.joints[j][1] != "fixed"]
-    if not moving_idx:
+    if not any(tree.joints[j][1] != "fixed" for j in path):
         raise ModelError(f"no moving joint between {base_link!r} and {tip_link!r}")
-    on_path = set(path)
-
-    # placements: fixed joints before a moving joint fold into its placement
-    placements, axes, types, names, links, inertials, limits_raw, mimic = [], [], [], [], [], [], [], {}
-    T_acc = np.eye(4)
-    for i, j in enumerate(path):
-        el, jtype, parent, child = tree.joints[j]
-        T_acc = T_acc @ _origin(el, f"joint {j!r}")
-        if jtype == "fixed":
-            continue
-        placements.append(T_acc)
-        T_acc = np.eye(4)
-        ax_el = el.find("axis")
-        axis = _numbers(ax_el.get("xyz") if ax_el is not None else None, 3, f"joint {j!r} <axis xyz>", default=(1, 0, 0))
-        if np.linalg.norm(axis) < 1e-12:
-            raise ModelError(f"joint {j!r}: <axis xyz> is the zero vector")
-        axes.append(axis / np.linalg.norm(axis))
-        types.append(_MOVING[jtype])
-        names.append(j)
-        links.append(child)
-        lim = el.find("limit")
-        where = f"joint {j!r} <limit>"
-        if jtype == "continuous" or lim is None:
-            lo, hi = -np.inf, np.inf
-        else:
-            lo, hi = _number(lim, "lower", where, 0.0), _number(lim, "upper", where, 0.0)
-            if lo > hi:
-                raise ModelError(f"{where}: lower {lo:g} > upper {hi:g}")
-        vel = _number(lim, "velocity", where, 0.0) if lim is not None else 0.0
-        eff = _number(lim, "effort", where, 0.0) if lim is not None else 0.0
-        limits_raw.append((lo, hi, vel if vel > 0 else np.inf, eff if eff > 0 else np.inf))
-        mm = el.find("mimic")
-        if mm is not None:
-            leader = mm.get("joint")
-            if leader is None:
-                raise ModelError(f"joint {j!r} <mimic>: attribute 'joint' is missing")
-            mimic[j] = (leader, _number(mm, "multiplier", f"joint {j!r} <mimic>", 1.0),
-                        _number(mm, "offset", f"joint {j!r} <mimic>", 0.0))
-        # the moving link with everything fixed to it (off the path, or up to the next moving joint)
-        data = _inertial(tree.links[child], f"link {child!r}")
-        if data is None:
-            raise ModelError(f"link {child!r}, moved by joint {j!r}, has no <inertial>",
-                             hint="add one (<mass value='0'/> for a massless link)")
-        inertials.append(data)
-
+    joints = _moving_joints(tree, path)
     # merge everything fixed to a moving link into it (fixed joints on or off the path)
-    def merge(link, T, k):
-        for j in tree.children[link]:
-            el, jtype, _, child = tree.joints[j]
-            if jtype == "fixed":
-                Tc = T @ _origin(el, f"joint {j!r}")
-                data = _inertial(tree.links[child], f"link {child!r}")
-                if data is not None:
-                    inertials[k] = _combine(inertials[k], _transform_inertial(Tc, data))
-                merge(child, Tc, k)
-            elif j not in on_path:
-                tree.check_type(j)
-                raise ModelError(f"joint {j!r} ({jtype}) branches off the chain at link {link!r}: gripkit "
-                                 f"models serial chains", hint="choose base_link/tip_link so that the chain does "
-                                 "not carry the branch, or make the joint fixed")
-
-    for k, link in enumerate(links):
-        merge(link, np.eye(4), k)
-    tool = T_acc
-
-    # mimic joints -> coupling
-    n = len(names)
-    index = {name: k for k, name in enumerate(names)}
-    actuated = [k for k, name in enumerate(names) if name not in mimic]
-    col = {k: c for c, k in enumerate(actuated)}
-    G = np.zeros((n, len(actuated)))
-    q0 = np.zeros(n)
-    for k, name in enumerate(names):
-        mult, off, cur, seen = 1.0, 0.0, name, {name}
-        while cur in mimic:
-            leader, a, b = mimic[cur]
-            if leader not in index:
-                raise ModelError(f"joint {cur!r} mimics {leader!r}, which is not a moving joint of the chain "
-                                 f"{base_link!r} → {tip_link!r}")
-            if leader in seen:
-                raise ModelError(f"mimic joints {sorted(seen)} follow each other in a circle")
-            seen.add(leader)
-            off = off + mult * b
-            mult = mult * a
-            cur = leader
-        G[k, col[index[cur]]] = mult
-        q0[k] = off
-    lim = np.array([limits_raw[k] for k in actuated]).reshape(-1, 4)
+    on_path = set(path)
+    for k, link in enumerate(joints.links):
+        _merge_fixed(tree, link, np.eye(4), k, joints, on_path)
+    G, q0, actuated = _mimic_coupling(joints, base_link, tip_link)
+    lim = np.array([joints.limits[k] for k in actuated]).reshape(-1, 4)
     limits = JointLimits(lim[:, 0].copy(), lim[:, 1].copy(), lim[:, 2].copy(), lim[:, 3].copy())
-    return JointChain(np.array(placements), np.array(axes), "".join(types),
+    inertials = joints.inertials
+    return JointChain(np.array(joints.placements), np.array(joints.axes), "".join(joints.types),
                       [d[0] for d in inertials], [d[1] for d in inertials], [d[2] for d in inertials],
-                      coupling=G, offset=q0, names=names, actuated=actuated, link_names=links,
-                      limits=limits, gravity=gravity, tool=tool, name=robot.get("name") or "urdf")
+                      coupling=G, offset=q0, names=joints.names, actuated=actuated, link_names=joints.links,
+                      limits=limits, gravity=gravity, tool=joints.tool, name=robot.get("name") or "urdf")
 
 
 # --- writing --------------------------------------------------------------------------------------

@@ -305,6 +305,136 @@ def _as_states(name, a, N, m, names):
     return x
 
 
+def _joint_states(q, qd, qdd, tau, m: int, names):
+    """q, q̇, q̈, τ as checked (N, m) arrays of one length N (:func:`_as_states`)."""
+    q = _as_states("q", q, None, m, names)
+    N = q.shape[0]
+    return (q, _as_states("qd", qd, N, m, names), _as_states("qdd", qdd, N, m, names),
+            _as_states("tau", tau, N, m, names))
+
+
+def _check_choices(friction: str, covariance: str) -> None:
+    """DataError unless ``friction`` is a key of :data:`FRICTION_MODELS` and ``covariance`` is
+    'ols' or 'hac'."""
+    if friction not in FRICTION_MODELS:
+        raise DataError(f"friction: expected one of {', '.join(FRICTION_MODELS)}, found {friction!r}")
+    if covariance not in ("ols", "hac"):
+        raise DataError(f"covariance: expected 'ols' or 'hac', found {covariance!r}")
+
+
+def _row_weights(weights, N: int, m: int) -> np.ndarray:
+    """The (N, m) row weights: ones, or ``weights`` ((N,) repeated over the joints, or (N, m)),
+    finite and non-negative."""
+    if weights is None:
+        return np.ones((N, m))
+    w = np.asarray(weights, dtype=np.float64)
+    if w.ndim == 1:
+        w = np.repeat(w[:, None], m, axis=1)
+    if w.shape != (N, m) or not np.isfinite(w).all() or (w < 0).any():
+        raise DataError(f"weights: expected (N,) or (N, {m}) finite non-negative values, found shape {np.shape(weights)}")
+    return w
+
+
+class _JointNormalEquations:
+    """One pass over the data: each joint's weighted Gram matrix Gⱼ = XⱼᵀWⱼXⱼ, bⱼ = XⱼᵀWⱼτⱼ and
+    τⱼᵀWⱼτⱼ of the regressor X3 (N, m, P) and the efforts τ (N, m) under the row weights (N, m);
+    the per-joint reweighting, the solution, the residual sums and the covariance follow from
+    them. The columns are scaled to unit RMS (``scale``) before solving."""
+
+    def __init__(self, X3: np.ndarray, tau: np.ndarray, rows_w: np.ndarray, n_rows: int):
+        self.X3, self.tau, self.rows_w, self.n_rows = X3, tau, rows_w, n_rows
+        _, m, P = X3.shape
+        self.Gj = np.empty((m, P, P))
+        self.bj = np.empty((m, P))
+        self.yy = np.empty(m)
+        for j in range(m):
+            sw = np.sqrt(rows_w[:, j])
+            Xj = X3[:, j, :] * sw[:, None]
+            yj = tau[:, j] * sw
+            self.Gj[j] = Xj.T @ Xj
+            self.bj[j] = Xj.T @ yj
+            self.yy[j] = yj @ yj
+        self.scale = np.sqrt(np.diagonal(self.Gj.sum(axis=0)) / n_rows)
+        self.S = np.outer(self.scale, self.scale)
+
+    def solve(self, jw):
+        """θ for per-joint weights jw (normal equations on the scaled columns; their condition
+        number is the square of the regressor's, so beyond 1e6 the orthogonal route is taken).
+        Returns the scaled Gram matrix, θ, the regressor's condition number and the eigenvectors."""
+        Gs = np.tensordot(jw, self.Gj, axes=1) / self.S
+        ev, V = np.linalg.eigh(Gs)
+        cnd = float(np.sqrt(ev[-1] / max(ev[0], 1e-300)))
+        if cnd < 1e6:
+            th = np.linalg.solve(Gs, (jw @ self.bj) / self.scale)
+        else:
+            th = np.linalg.lstsq(self._scaled_rows(jw), (self.tau * np.sqrt(self.rows_w * jw)).reshape(-1),
+                                 rcond=None)[0]
+        return Gs, th / self.scale, cnd, V
+
+    def _scaled_rows(self, jw) -> np.ndarray:
+        """The weighted stacked rows √w·X (N·m, P) with the columns scaled."""
+        N, m, P = self.X3.shape
+        sw = np.sqrt(self.rows_w * jw)
+        return (self.X3 * sw[:, :, None]).reshape(N * m, P) / self.scale
+
+    def rss(self, th):
+        """Weighted residual sum of squares of each joint."""
+        return np.maximum(self.yy - 2 * self.bj @ th + np.einsum("i,jik,k->j", th, self.Gj, th), 0.0)
+
+    def covariance(self, theta, jw, Gs, kind: str, r2) -> np.ndarray:
+        """Cov(θ̂): σ̂² (XᵀWX)⁻¹ with σ̂² = rᵀWr/(N_rows − P) (``'ols'``), or the Newey-West
+        covariance of the weighted rows (``'hac'``)."""
+        P = self.X3.shape[2]
+        if kind == "hac":
+            from .regression import hac_covariance
+
+            sw = np.sqrt(self.rows_w * jw)
+            rw = ((self.tau - self.X3 @ theta) * sw).reshape(-1)
+            keep = sw.reshape(-1) > 0
+            return hac_covariance(self._scaled_rows(jw)[keep], rw[keep]) / self.S
+        s2 = float(jw @ r2 / max(self.n_rows - P, 1))
+        return s2 * np.linalg.inv(Gs) / self.S
+
+
+def _normal_equations(X3, tau, rows_w, names) -> _JointNormalEquations:
+    """:class:`_JointNormalEquations`, refused with fewer than two weighted rows per parameter or a
+    column the data never excite."""
+    P = X3.shape[2]
+    n_rows = int((rows_w > 0).sum())
+    if n_rows < 2 * P:
+        raise DataError(f"{n_rows} weighted rows are too few for {P} parameters (need at least {2 * P})",
+                        hint="log a longer run")
+    ne = _JointNormalEquations(X3, tau, rows_w, n_rows)
+    weak = np.flatnonzero(ne.scale == 0)
+    if weak.size:
+        raise UnidentifiableError(f"the data never excite {', '.join(names[k] for k in weak[:3])}",
+                                  hint="move every joint, in both directions, with accelerations")
+    return ne
+
+
+def _solve_joint_weighted(ne: _JointNormalEquations, names, joint_weighting: bool):
+    """θ of the first pass (unit joint weights), refused beyond condition number 1e10 naming the
+    weakest direction; then, with ``joint_weighting``, again with each joint weighted by 1/σ̂ⱼ²
+    of the first pass (Gautier & Poignet 2001). Returns jw, the scaled Gram matrix, θ, the
+    condition number."""
+    m, P = ne.yy.size, ne.X3.shape[2]
+    jw = np.ones(m)
+    Gs, theta, cond, V = ne.solve(jw)
+    if cond > 1e10:
+        v = V[:, 0] / ne.scale
+        top = np.argsort(-np.abs(v / np.max(np.abs(v))))[:3]
+        raise UnidentifiableError(f"the data do not excite every base parameter (condition number {cond:.3g}); "
+                                  f"the weakest direction mixes {', '.join(names[k] for k in top)}",
+                                  hint="use a richer excitation (gripkit.excitation.fourier_trajectory)")
+    if joint_weighting and m > 1:
+        n_j = (ne.rows_w > 0).sum(axis=0)
+        s2_j = ne.rss(theta) / np.maximum(n_j - P / m, 1.0)
+        s2_j[~(s2_j > 0)] = 1.0
+        jw = 1.0 / s2_j
+        Gs, theta, cond, _ = ne.solve(jw)
+    return jw, Gs, theta, cond
+
+
 @entry_point
 def identify_dynamics(chain, q, qd, qdd, tau, *, friction: str = "coulomb-viscous", weights=None,
                       armature: bool = False, covariance: str = "ols", constrained: bool = False,
@@ -334,102 +464,24 @@ def identify_dynamics(chain, q, qd, qdd, tau, *, friction: str = "coulomb-viscou
     constrained
         Return the nearest physically consistent estimate instead of the unconstrained one.
     """
-    if friction not in FRICTION_MODELS:
-        raise DataError(f"friction: expected one of {', '.join(FRICTION_MODELS)}, found {friction!r}")
-    if covariance not in ("ols", "hac"):
-        raise DataError(f"covariance: expected 'ols' or 'hac', found {covariance!r}")
+    _check_choices(friction, covariance)
     m = chain.dof
     jn = chain.coordinate_names
-    q = _as_states("q", q, None, m, jn)
+    q, qd, qdd, tau = _joint_states(q, qd, qdd, tau, m, jn)
     N = q.shape[0]
-    qd = _as_states("qd", qd, N, m, jn)
-    qdd = _as_states("qdd", qdd, N, m, jn)
-    tau = _as_states("tau", tau, N, m, jn)
-    if weights is None:
-        w = None
-    else:
-        w = np.asarray(weights, dtype=np.float64)
-        if w.ndim == 1:
-            w = np.repeat(w[:, None], m, axis=1)
-        if w.shape != (N, m) or not np.isfinite(w).all() or (w < 0).any():
-            raise DataError(f"weights: expected (N,) or (N, {m}) finite non-negative values, found shape {np.shape(weights)}")
+    rows_w = _row_weights(weights, N, m)
     st = base_structure(chain, armature=armature)
     kinds = FRICTION_MODELS[friction]
     Y = _inertial_columns(chain, q, qd, qdd, armature)[:, :, st.independent]
     X3 = np.concatenate([Y, friction_columns(qd, kinds)], axis=2) if kinds else Y
     names = st.names + tuple(f"{k}_{j}" for j in jn for k in kinds)
-    P = X3.shape[2]
-    rows_w = np.ones((N, m)) if w is None else w
-    n_j = (rows_w > 0).sum(axis=0)
-    n_rows = int(n_j.sum())
-    if n_rows < 2 * P:
-        raise DataError(f"{n_rows} weighted rows are too few for {P} parameters (need at least {2 * P})",
-                        hint="log a longer run")
-    # one pass over the data: each joint's weighted Gram matrix XⱼᵀWⱼXⱼ, XⱼᵀWⱼτⱼ and τⱼᵀWⱼτⱼ; the
-    # per-joint reweighting, the solution, the residual sums and the covariance follow from them
-    Gj = np.empty((m, P, P))
-    bj = np.empty((m, P))
-    yy = np.empty(m)
-    for j in range(m):
-        sw = np.sqrt(rows_w[:, j])
-        Xj = X3[:, j, :] * sw[:, None]
-        yj = tau[:, j] * sw
-        Gj[j] = Xj.T @ Xj
-        bj[j] = Xj.T @ yj
-        yy[j] = yj @ yj
-    scale = np.sqrt(np.diagonal(Gj.sum(axis=0)) / n_rows)
-    weak = np.flatnonzero(scale == 0)
-    if weak.size:
-        raise UnidentifiableError(f"the data never excite {', '.join(names[k] for k in weak[:3])}",
-                                  hint="move every joint, in both directions, with accelerations")
-    S = np.outer(scale, scale)
-
-    def solve(jw):
-        """θ for per-joint weights jw (normal equations on the scaled columns; their condition
-        number is the square of the regressor's, so beyond 1e6 the orthogonal route is taken)."""
-        Gs = np.tensordot(jw, Gj, axes=1) / S
-        ev, V = np.linalg.eigh(Gs)
-        cnd = float(np.sqrt(ev[-1] / max(ev[0], 1e-300)))
-        if cnd < 1e6:
-            th = np.linalg.solve(Gs, (jw @ bj) / scale)
-        else:
-            sw = np.sqrt(rows_w * jw)
-            Xw = (X3 * sw[:, :, None]).reshape(N * m, P) / scale
-            th = np.linalg.lstsq(Xw, (tau * sw).reshape(-1), rcond=None)[0]
-        return Gs, th / scale, cnd, V
-
-    def rss(th):
-        """Weighted residual sum of squares of each joint."""
-        return np.maximum(yy - 2 * bj @ th + np.einsum("i,jik,k->j", th, Gj, th), 0.0)
-
-    jw = np.ones(m)
-    Gs, theta, cond, V = solve(jw)
-    if cond > 1e10:
-        v = V[:, 0] / scale
-        top = np.argsort(-np.abs(v / np.max(np.abs(v))))[:3]
-        raise UnidentifiableError(f"the data do not excite every base parameter (condition number {cond:.3g}); "
-                                  f"the weakest direction mixes {', '.join(names[k] for k in top)}",
-                                  hint="use a richer excitation (gripkit.excitation.fourier_trajectory)")
-    if joint_weighting and m > 1:  # Gautier-Poignet: each joint weighted by its residual variance
-        s2_j = rss(theta) / np.maximum(n_j - P / m, 1.0)
-        s2_j[~(s2_j > 0)] = 1.0
-        jw = 1.0 / s2_j
-        Gs, theta, cond, _ = solve(jw)
-    r2 = rss(theta)
-    if covariance == "hac":
-        from .regression import hac_covariance
-
-        sw = np.sqrt(rows_w * jw)
-        Xw = (X3 * sw[:, :, None]).reshape(N * m, P) / scale
-        rw = ((tau - X3 @ theta) * sw).reshape(-1)
-        keep = sw.reshape(-1) > 0
-        C = hac_covariance(Xw[keep], rw[keep]) / S
-    else:
-        s2 = float(jw @ r2 / max(n_rows - P, 1))
-        C = s2 * np.linalg.inv(Gs) / S
+    ne = _normal_equations(X3, tau, rows_w, names)
+    jw, Gs, theta, cond = _solve_joint_weighted(ne, names, joint_weighting)
+    r2 = ne.rss(theta)
+    C = ne.covariance(theta, jw, Gs, covariance, r2)
     wsum = rows_w.sum(axis=0)
     res_std = {j: float(np.sqrt(r2[k] / wsum[k])) if wsum[k] > 0 else float("nan") for k, j in enumerate(jn)}
-    rel = float(100.0 * np.sqrt(r2.sum() / max(yy.sum(), 1e-300)))
+    rel = float(100.0 * np.sqrt(r2.sum() / max(ne.yy.sum(), 1e-300)))
     notes = []
     if cond > 1e5:
         notes.append(f"regressor condition number {cond:.3g}: weak excitation, large σ")
@@ -484,7 +536,146 @@ def pseudo_inertia(phi10) -> np.ndarray:
     return J
 
 
+def _psd(J) -> bool:
+    """J positive semidefinite (to 1e-9 of its largest eigenvalue)."""
+    ev = np.linalg.eigvalsh(J)
+    return ev[0] >= -1e-9 * max(ev[-1], 1e-300)
+
+
+def _link_factor_jacobian(Lv: np.ndarray) -> np.ndarray:
+    """dφ/dL (10 × 10) of one link: φ is linear in J (the map _J_TO_PHI), J = L Lᵀ."""
+    tri = np.tril_indices(4)
+    L = np.zeros((4, 4))
+    L[tri] = Lv
+    D = np.empty((10, 10))
+    for c, (a, b) in enumerate(zip(*tri)):
+        E = np.zeros((4, 4))
+        E[a, b] = 1.0
+        D[:, c] = _J_TO_PHI @ (E @ L.T + L @ E.T).ravel()
+    return D
+
+
+class _FactorSearch:
+    """The search for the nearest consistent estimate (module doc) over x = [the Cholesky factor L
+    of every link's pseudo-inertia (10 entries each), the rotor inertias (n_arm), the friction
+    parameters (θ past the nb base parameters)]: residual Ci ᵀ(θ(x) − θ̂) (Ci Ciᵀ = Cov⁻¹) and a
+    weak pull (1e-3) of the factors towards the start ``x_start``, with its exact Jacobian."""
+
+    reg = 1e-3
+
+    def __init__(self, K, Ci, theta, x_start, n_links: int, n_arm: int, p_std: int):
+        self.K, self.Ci, self.theta, self.x_start = K, Ci, theta, x_start
+        self.n_links, self.n_arm, self.p_std = n_links, n_arm, p_std
+        self.nb = K.shape[0]
+        self.fr0 = 10 * n_links + n_arm
+
+    def params(self, x):
+        """(θ(x), the standard parameters φ(x) with the rotor inertias)."""
+        n = self.n_links
+        phi = np.concatenate([_phi_from_factor(x[10 * k:10 * k + 10]) for k in range(n)])
+        if self.n_arm:
+            phi = np.concatenate([phi, x[10 * n:self.fr0]])
+        return np.concatenate([self.K @ phi, x[self.fr0:]]), phi
+
+    def resid(self, x):
+        n = self.n_links
+        return np.concatenate([self.Ci.T @ (self.params(x)[0] - self.theta),
+                               self.reg * (x[:10 * n] - self.x_start[:10 * n])])
+
+    def jac(self, x):
+        n, fr0, nb, K = self.n_links, self.fr0, self.nb, self.K
+        Dphi = np.zeros((K.shape[1], fr0))
+        for k in range(n):
+            Dphi[10 * k:10 * k + 10, 10 * k:10 * k + 10] = _link_factor_jacobian(x[10 * k:10 * k + 10])
+        if self.n_arm:
+            Dphi[self.p_std:, 10 * n:fr0] = np.eye(self.n_arm)
+        Dth = np.zeros((self.theta.size, x.size))
+        Dth[:nb, :fr0] = K @ Dphi
+        Dth[nb:, fr0:] = np.eye(self.theta.size - nb)
+        Dreg = np.zeros((10 * n, x.size))
+        Dreg[:, :10 * n] = self.reg * np.eye(10 * n)
+        return np.vstack([self.Ci.T @ Dth, Dreg])
+
+
+def _least_change_parameters(phi_nom, K, theta_b, n_links: int, p_std: int):
+    """The standard parameters nearest to the chain's own φ₀ that reproduce the estimate (least
+    change, each parameter relative to its own size s, so that a massless link stays massless):
+    φ = φ₀ + S²Kᵀ(K S² Kᵀ)⁻¹(θ_b − K φ₀). The sizes are each parameter's own value plus 1e-3 of
+    its link's scale of that kind (mass, first moment, inertia), so that zero off-diagonal
+    products may move. Returns φ and whether K φ reproduces θ_b."""
+    sz = np.abs(phi_nom)
+    for k in range(n_links):
+        f = phi_nom[10 * k:10 * k + 10]
+        kind = (abs(f[0]), np.abs(f[1:4]).max(), np.abs(f[[4, 6, 9]]).max())
+        sz[10 * k:10 * k + 10] += 1e-3 * np.array([kind[0]] + [kind[1]] * 3 + [kind[2]] * 6)
+    if phi_nom.size > p_std:
+        sz[p_std:] += 1e-3 * max(sz[:p_std].max(), 1e-300)
+    KS = K * sz ** 2
+    phi_p = phi_nom + KS.T @ np.linalg.lstsq(KS @ K.T, theta_b - K @ phi_nom, rcond=None)[0]
+    reproduces = np.allclose(K @ phi_p, theta_b, rtol=1e-9, atol=1e-12 * np.abs(theta_b).max())
+    return phi_p, reproduces
+
+
+def _search_bounds(n_links: int, n_arm: int, n_friction: int, kinds, m: int):
+    """Bounds (lo, hi) of the search variables: rotor inertias and Coulomb and viscous friction
+    ≥ 0, the rest free."""
+    fr0 = 10 * n_links + n_arm
+    lo = np.full(fr0 + n_friction, -np.inf)
+    hi = np.full(fr0 + n_friction, np.inf)
+    lo[10 * n_links:fr0] = 0.0
+    for j in range(m):
+        for c, kind in enumerate(kinds):
+            if kind in ("coulomb", "viscous"):
+                lo[fr0 + j * len(kinds) + c] = 0.0
+    return lo, hi
+
+
+def _search_start(phi_p, theta_friction, lo, hi, n_links: int, n_arm: int, p_std: int, typical: float):
+    """The search's start: each link's pseudo-inertia in the least-change solution projected onto
+    the consistent set (negative eigenvalues to 0, plus 1e-6 of its scale so that the Cholesky
+    factor exists: at L = 0 the gradient of L Lᵀ vanishes), the rotor inertias of that solution
+    (≥ 1e-15) and the estimated friction, moved just inside its bounds."""
+    x0 = np.concatenate([np.zeros(10 * n_links + n_arm), theta_friction])
+    x0 = np.clip(x0, lo + 1e-15 * (lo > -np.inf), hi)
+    tri = np.tril_indices(4)
+    for k in range(n_links):
+        ev, V = np.linalg.eigh(pseudo_inertia(phi_p[10 * k:10 * k + 10]))
+        eps = 1e-6 * max(ev[-1], 1e-2 * typical)
+        x0[10 * k:10 * k + 10] = np.linalg.cholesky((V * np.maximum(ev, 0.0)) @ V.T + eps * np.eye(4))[tri]
+    if n_arm:
+        x0[10 * n_links:10 * n_links + n_arm] = np.maximum(phi_p[p_std:], 1e-15)
+    return x0
+
+
+def _failing_parts(chain, search: _FactorSearch, phi_p, phi, x, kinds) -> list[str]:
+    """What has no consistent values: the links whose pseudo-inertia is indefinite in the
+    least-change solution (if none, those pushed onto the boundary by the search), rotor inertias
+    and friction coefficients held at 0 while the estimate is negative."""
+    failing = []
+    for k, name in enumerate(chain.link_names):
+        if not _psd(pseudo_inertia(phi_p[10 * k:10 * k + 10])):
+            failing.append(f"link {name!r}")
+    if not failing:
+        for k, name in enumerate(chain.link_names):
+            ev = np.linalg.eigvalsh(pseudo_inertia(phi[10 * k:10 * k + 10]))
+            if ev[0] <= 1e-6 * max(ev[-1], 1e-300):
+                failing.append(f"link {name!r}")
+    if search.n_arm:
+        failing += [f"armature of {j!r} (< 0)" for i, j in enumerate(chain.coordinate_names)
+                    if x[10 * search.n_links + i] <= 1e-15]
+    for j, jn in enumerate(chain.coordinate_names):
+        for c, kind in enumerate(kinds):
+            k = search.fr0 + j * len(kinds) + c
+            if kind in ("coulomb", "viscous") and x[k] <= 0.0 and search.theta[search.nb + j * len(kinds) + c] < 0:
+                failing.append(f"{kind} friction of {jn!r} (< 0)")
+    return failing
+
+
 def _consistency(chain, st: BaseStructure, theta, C, kinds, m, armature) -> Consistency:
+    """Physical consistency of the estimate θ̂ with covariance C (module doc): first the
+    least-change standard parameters, consistent there means consistent (d = 0, no search);
+    else a search of at most 80 steps over Cholesky factors for the nearest consistent θ in the
+    Mahalanobis distance d, and the parts that fail when d > 0.01 σ."""
     from scipy.optimize import least_squares
 
     nb = st.independent.size
@@ -492,122 +683,28 @@ def _consistency(chain, st: BaseStructure, theta, C, kinds, m, armature) -> Cons
     n_links = p_std // 10
     K = st.matrix
     phi0 = chain.standard_parameters()
-    # start: the chain's own (nominal) links, made strictly positive definite
-    # (a massless link, J = 0, gets a small body: at L = 0 the gradient of L Lᵀ vanishes)
-    Js = [pseudo_inertia(phi0[10 * k:10 * k + 10]) for k in range(n_links)]
-    typical = max(np.mean([np.trace(J) for J in Js]), 1e-12)
-    L0 = [np.linalg.cholesky(J + 1e-3 * max(np.trace(J), 1e-2 * typical) * np.eye(4))[np.tril_indices(4)]
-          for J in Js]
     n_arm = m if armature else 0
-    x0 = np.concatenate([*L0, np.full(n_arm, 0.0), theta[nb:]])
     try:
         Ci = np.linalg.cholesky(np.linalg.inv(C))
     except np.linalg.LinAlgError:
         raise IdentificationError("the covariance of the estimate is not positive definite") from None
-    lo = np.full(x0.size, -np.inf)
-    hi = np.full(x0.size, np.inf)
-    fr0 = 10 * n_links + n_arm
-    lo[10 * n_links:fr0] = 0.0        # rotor inertia ≥ 0
-    x0[10 * n_links:fr0] = 1e-12
-    for j in range(m):
-        for c, kind in enumerate(kinds):
-            if kind in ("coulomb", "viscous"):
-                lo[fr0 + j * len(kinds) + c] = 0.0
-    x0 = np.clip(x0, lo + 1e-15 * (lo > -np.inf), hi)
-
-    tri = np.tril_indices(4)
-    # dφ/dL of one link: φ is linear in J (the map _J_TO_PHI), J = L Lᵀ
-    def link_jac(Lv):
-        L = np.zeros((4, 4))
-        L[tri] = Lv
-        D = np.empty((10, 10))
-        for c, (a, b) in enumerate(zip(*tri)):
-            E = np.zeros((4, 4))
-            E[a, b] = 1.0
-            D[:, c] = _J_TO_PHI @ (E @ L.T + L @ E.T).ravel()
-        return D
-
-    def params(x):
-        phi = np.concatenate([_phi_from_factor(x[10 * k:10 * k + 10]) for k in range(n_links)])
-        if n_arm:
-            phi = np.concatenate([phi, x[10 * n_links:fr0]])
-        return np.concatenate([K @ phi, x[fr0:]]), phi
-
-    reg = 1e-3  # a weak pull towards the chain's own values fixes the directions the data cannot see
-
-    def resid(x):
-        return np.concatenate([Ci.T @ (params(x)[0] - theta), reg * (x[:10 * n_links] - x0[:10 * n_links])])
-
-    def jac(x):
-        Dphi = np.zeros((K.shape[1], fr0))
-        for k in range(n_links):
-            Dphi[10 * k:10 * k + 10, 10 * k:10 * k + 10] = link_jac(x[10 * k:10 * k + 10])
-        if n_arm:
-            Dphi[p_std:, 10 * n_links:fr0] = np.eye(n_arm)
-        Dth = np.zeros((theta.size, x.size))
-        Dth[:nb, :fr0] = K @ Dphi
-        Dth[nb:, fr0:] = np.eye(theta.size - nb)
-        Dreg = np.zeros((10 * n_links, x.size))
-        Dreg[:, :10 * n_links] = reg * np.eye(10 * n_links)
-        return np.vstack([Ci.T @ Dth, Dreg])
-
-    # first the standard parameters nearest to the chain's own that reproduce the estimate (least
-    # change, each parameter relative to its own size, so that a massless link stays massless):
-    # φ = φ₀ + S²Kᵀ(K S² Kᵀ)⁻¹(θ_b − K φ₀). Consistent there means consistent (d = 0), no search.
     phi_nom = np.concatenate([phi0, np.zeros(n_arm)]) if n_arm else phi0.copy()
-    # sizes: each parameter's own value plus 1e-3 of its link's scale of that kind (mass, first
-    # moment, inertia), so that zero off-diagonal products may move; a massless link has none
-    sz = np.abs(phi_nom)
-    for k in range(n_links):
-        f = phi_nom[10 * k:10 * k + 10]
-        kind = (abs(f[0]), np.abs(f[1:4]).max(), np.abs(f[[4, 6, 9]]).max())
-        sz[10 * k:10 * k + 10] += 1e-3 * np.array([kind[0]] + [kind[1]] * 3 + [kind[2]] * 6)
-    if n_arm:
-        sz[p_std:] += 1e-3 * max(sz[:p_std].max(), 1e-300)
-    KS = K * sz ** 2
-    phi_p = phi_nom + KS.T @ np.linalg.lstsq(KS @ K.T, theta[:nb] - K @ phi_nom, rcond=None)[0]
-    reproduces = np.allclose(K @ phi_p, theta[:nb], rtol=1e-9, atol=1e-12 * np.abs(theta[:nb]).max())
-
-    def psd(J):
-        ev = np.linalg.eigvalsh(J)
-        return ev[0] >= -1e-9 * max(ev[-1], 1e-300)
-
-    links_ok = all(psd(pseudo_inertia(phi_p[10 * k:10 * k + 10])) for k in range(n_links))
+    phi_p, reproduces = _least_change_parameters(phi_nom, K, theta[:nb], n_links, p_std)
+    links_ok = all(_psd(pseudo_inertia(phi_p[10 * k:10 * k + 10])) for k in range(n_links))
     fr_ok = all(theta[nb + j * len(kinds) + c] >= 0 for j in range(m) for c, kind in enumerate(kinds)
                 if kind in ("coulomb", "viscous"))
     if reproduces and links_ok and fr_ok and (not n_arm or (phi_p[p_std:] >= 0).all()):
         return Consistency(True, 0.0, (), phi_p, theta.copy())
     # search from that solution with each link's pseudo-inertia projected onto the consistent set
-    for k in range(n_links):
-        ev, V = np.linalg.eigh(pseudo_inertia(phi_p[10 * k:10 * k + 10]))
-        eps = 1e-6 * max(ev[-1], 1e-2 * typical)
-        x0[10 * k:10 * k + 10] = np.linalg.cholesky((V * np.maximum(ev, 0.0)) @ V.T + eps * np.eye(4))[tri]
-    if n_arm:
-        x0[10 * n_links:fr0] = np.maximum(phi_p[p_std:], 1e-15)
-    sol = least_squares(resid, x0, jac=jac, bounds=(lo, hi), x_scale="jac", xtol=1e-10, ftol=1e-10,
+    typical = max(np.mean([np.trace(pseudo_inertia(phi0[10 * k:10 * k + 10])) for k in range(n_links)]), 1e-12)
+    lo, hi = _search_bounds(n_links, n_arm, theta.size - nb, kinds, m)
+    x0 = _search_start(phi_p, theta[nb:], lo, hi, n_links, n_arm, p_std, typical)
+    search = _FactorSearch(K, Ci, theta, x0, n_links, n_arm, p_std)
+    sol = least_squares(search.resid, x0, jac=search.jac, bounds=(lo, hi), x_scale="jac", xtol=1e-10, ftol=1e-10,
                         gtol=1e-10, max_nfev=80)
-    th, phi = params(sol.x)
+    th, phi = search.params(sol.x)
     d = float(np.linalg.norm(Ci.T @ (th - theta)))
-    failing = []
-    if d > 1e-2:
-        # the links whose pseudo-inertia is indefinite in that least-change solution; if none,
-        # those pushed onto the boundary by the search
-        for k, name in enumerate(chain.link_names):
-            if not psd(pseudo_inertia(phi_p[10 * k:10 * k + 10])):
-                failing.append(f"link {name!r}")
-        if not failing:
-            for k, name in enumerate(chain.link_names):
-                ev = np.linalg.eigvalsh(pseudo_inertia(phi[10 * k:10 * k + 10]))
-                if ev[0] <= 1e-6 * max(ev[-1], 1e-300):
-                    failing.append(f"link {name!r}")
-        if n_arm:
-            failing += [f"armature of {j!r} (< 0)" for i, j in enumerate(chain.coordinate_names)
-                        if sol.x[10 * n_links + i] <= 1e-15]
-        for j, jn in enumerate(chain.coordinate_names):
-            for c, kind in enumerate(kinds):
-                k = fr0 + j * len(kinds) + c
-                if kind in ("coulomb", "viscous") and sol.x[k] <= 0.0 and theta[nb + j * len(kinds) + c] < 0:
-                    failing.append(f"{kind} friction of {jn!r} (< 0)")
+    failing = _failing_parts(chain, search, phi_p, phi, sol.x, kinds) if d > 1e-2 else []
     return Consistency(d <= 1e-2, d, tuple(failing), phi, th)
 
 

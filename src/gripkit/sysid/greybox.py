@@ -142,6 +142,257 @@ def _random_starts(theta0, lo, hi, n, rng) -> list[np.ndarray]:
     return starts
 
 
+@dataclass(frozen=True)
+class _Columns:
+    """The data a fit uses: the model's inputs ``u`` (N, n_u) and the measured outputs ``y``
+    after the burn-in (N − burn_in, n_y) with their weights ``w`` (n_y,); ``out_map`` maps each
+    fitted model output to its data column, ``out_idx`` is its index among the model's outputs."""
+
+    u: np.ndarray
+    y: np.ndarray
+    w: np.ndarray
+    out_map: dict
+    out_idx: list
+    burn_in: int
+
+
+@dataclass(frozen=True)
+class _SolverOptions:
+    """How :func:`fit` runs ``scipy.optimize.least_squares``: ``method`` and ``loss``,
+    ``max_nfev`` per start, ``multistart`` extra random starts drawn from ``seed``, and whether a
+    progress bar shows the starts."""
+
+    method: str
+    loss: str
+    max_nfev: int
+    multistart: int
+    seed: int
+    progress: bool
+
+
+def _parameters_to_fit(model, initial, free) -> tuple[ParameterSet, tuple[str, ...]]:
+    """The model's parameters with the ``initial`` values in place, and the names to estimate
+    (default: the non-fixed ones); unknown names raise a ParameterError naming them."""
+    params = model.parameters
+    if initial is not None:
+        params = params.replace(**({n: initial.value(n) for n in initial} if isinstance(initial, ParameterSet) else dict(initial)))
+    free = tuple(params.free_names if free is None else free)
+    for n in free:
+        params[n]  # raises a clear ParameterError for unknown names
+    if not free:
+        raise ParameterError("no free parameters to identify", hint="pass free=[...] or unfix some parameters")
+    return params, free
+
+
+def _input_columns(model, data: Trajectory, inputs: Mapping[str, str] | None) -> np.ndarray:
+    """The data columns of the model's inputs (``inputs`` maps a model input to a column name)."""
+    in_map = {s.name: (inputs or {}).get(s.name, s.name) for s in model.inputs}
+    missing = [c for c in in_map.values() if c not in data]
+    if missing:
+        raise DataError(f"data has no column {missing[0]!r} for the input of {model.name}",
+                        hint=f"map it with inputs={{model_input: column}}; columns: {', '.join(data.names)}")
+    return np.column_stack([data[c] for c in in_map.values()])
+
+
+def _output_map(model, data: Trajectory, outputs) -> dict[str, str]:
+    """``{model_output: data_column}`` of the outputs to fit (default: every model output that
+    ``data`` holds under its own name)."""
+    model_out = [s.name for s in model.outputs]
+    if outputs is None:
+        out_map = {o: o for o in model_out if o in data}
+        if not out_map:
+            raise DataError(f"data has none of the model outputs {model_out}",
+                            hint="name the measured columns with outputs={model_output: column}")
+    elif isinstance(outputs, Mapping):
+        out_map = dict(outputs)
+    else:
+        out_map = {o: o for o in outputs}
+    for o in out_map:
+        if o not in model_out:
+            raise DataError(f"{o!r} is not an output of {model.name}", hint=f"outputs: {', '.join(model_out)}")
+    return out_map
+
+
+def _fit_columns(model, data: Trajectory, *, inputs, outputs, n_free: int, burn_in, output_scale) -> _Columns:
+    """Read and check the inputs, the outputs and their weights w_j (default: the standard
+    deviation of each measured output after the burn-in)."""
+    u = _input_columns(model, data, inputs)
+    out_map = _output_map(model, data, outputs)
+    model_out = [s.name for s in model.outputs]
+    out_idx = [model_out.index(o) for o in out_map]
+    y = np.column_stack([data[c] for c in out_map.values()])
+    burn_in = int(burn_in)
+    if burn_in < 0:
+        raise DataError(f"burn_in: expected a number of samples >= 0, found {burn_in}")
+    data.require_samples(burn_in + 2 * n_free + 1, f"fitting {n_free} parameters after {burn_in} burn-in samples")
+    w = np.asarray(output_scale, dtype=np.float64) if output_scale is not None else y[burn_in:].std(axis=0)
+    if w.shape != (y.shape[1],) or not np.all(w > 0):
+        raise DataError(f"output scale: expected {y.shape[1]} positive weights (a measured output may be "
+                        f"constant), found {w}", hint="pass output_scale=[...] explicitly")
+    # the fitted samples (y_model, residuals and n_samples refer to these)
+    return _Columns(u, y[burn_in:], w, out_map, out_idx, burn_in)
+
+
+class _OutputError:
+    """The weighted simulation-error residual r(z) = vec((ŷ(θ) − y) / w) of the free parameters,
+    in the optimisation variables z = θ/s (s: :func:`_scales`; for 'lm', which has no bounds,
+    positive parameters use z = log(θ/s)), and its forward-difference Jacobian dr/dz computed in
+    one batch simulation of all perturbed parameter vectors. ``nfev`` counts the simulations."""
+
+    def __init__(self, model, params: ParameterSet, free: tuple[str, ...], cols: _Columns, dt: float,
+                 x0, method: str):
+        names = params.names
+        self.model, self.cols, self.dt = model, cols, dt
+        self.idx = np.array([names.index(n) for n in free])
+        self.base = params.vector()
+        lo_all, hi_all = params.bounds_arrays()
+        self.lo, self.hi = lo_all[self.idx], hi_all[self.idx]
+        self.theta0 = self.base[self.idx]
+        self.s = _scales(self.theta0, self.lo, self.hi)
+        self.logvar = (method == "lm") & (self.lo >= 0) & (self.theta0 > 0)
+        self.bounds = (self.lo / self.s, self.hi / self.s) if method != "lm" else (-np.inf, np.inf)
+        self.x0 = None if x0 is None else np.asarray(x0, dtype=np.float64)[None, :]
+        self.nfev = 0
+        self._substeps = 1  # only ever grows, so finite differences never straddle a change of step
+        self._cache: dict = {}
+
+    def to_theta(self, z):
+        s, logvar = self.s, self.logvar
+        return np.where(logvar, s * np.exp(np.where(logvar, z, 0.0)), s * z)
+
+    def to_z(self, theta):
+        s, logvar = self.s, self.logvar
+        return np.where(logvar, np.log(np.where(logvar, theta, s) / s), theta / s)
+
+    def simulate_rows(self, z_rows: np.ndarray) -> np.ndarray:
+        """Fitted outputs ŷ (P, N − burn_in, n_y) for P rows of z."""
+        T = np.repeat(self.base[None, :], z_rows.shape[0], axis=0)
+        T[:, self.idx] = self.to_theta(z_rows)
+        self.nfev += T.shape[0]
+        self._substeps = max(self._substeps, self.model.substeps(self.dt, T))
+        c = self.cols
+        return self.model.simulate_batch(T, c.u, self.dt, self.x0, substeps=self._substeps)[:, c.burn_in:, c.out_idx]
+
+    def residual(self, z):
+        key = z.tobytes()
+        if key not in self._cache:
+            self._cache.clear()
+            self._cache[key] = ((self.simulate_rows(z[None, :])[0] - self.cols.y) / self.cols.w).ravel()
+        return self._cache[key]
+
+    def jacobian(self, z):
+        r0 = self.residual(z)
+        n_free = z.size
+        h = np.sqrt(np.finfo(float).eps) * np.maximum(np.abs(z), 1.0)
+        step = np.where(self.logvar | (z + h <= self.hi / self.s), h, -h)  # step away from an upper bound
+        Z = np.repeat(z[None, :], n_free, axis=0) + np.diag(step)
+        R = (self.simulate_rows(Z) - self.cols.y[None, :, :]) / self.cols.w
+        return ((R.reshape(n_free, -1) - r0[None, :]) / step[:, None]).T
+
+    def jacobian_theta(self, z, theta):
+        """dr/dθ (chain rule through z)."""
+        return self.jacobian(z) / np.where(self.logvar, theta, self.s)[None, :]
+
+
+def _best_of_starts(problem: _OutputError, opts: _SolverOptions):
+    """Run ``least_squares`` from θ₀ and ``opts.multistart`` random starts; returns the solution
+    of least cost and every start's (cost, θ)."""
+    rng = np.random.default_rng(opts.seed)
+    starts = [problem.theta0] + _random_starts(problem.theta0, problem.lo, problem.hi, opts.multistart, rng)
+    best = None
+    tried = []
+    for th in track(starts, description="grey-box starts", enabled=opts.progress and len(starts) > 1):
+        z0 = np.clip(problem.to_z(th), problem.bounds[0], problem.bounds[1])
+        try:
+            sol = least_squares(problem.residual, z0, jac=problem.jacobian, bounds=problem.bounds,
+                                method=opts.method, loss=opts.loss, max_nfev=opts.max_nfev, x_scale="jac")
+        except ParameterError as exc:
+            raise IdentificationError(f"the fit left the parameters' physical range: {exc}",
+                                      hint="use method='trf' to enforce the bounds, or better starting values") from None
+        except ValueError as exc:
+            raise IdentificationError(f"least squares failed to start: {exc}") from None
+        tried.append((float(sol.cost), problem.to_theta(sol.x)))
+        if best is None or sol.cost < best.cost:
+            best = sol
+    return best, tried
+
+
+def _check_inside_bounds(theta, problem: _OutputError, free, method: str) -> None:
+    """'lm' ignores the bounds: refuse an estimate outside them."""
+    lo, hi = problem.lo, problem.hi
+    if method == "lm" and ((theta < lo) | (theta > hi)).any():
+        j = int(np.argmax((theta < lo) | (theta > hi)))
+        raise IdentificationError(f"Levenberg-Marquardt converged outside the bounds: {free[j]} = {theta[j]:g}",
+                                  hint="use method='trf' to enforce the bounds")
+
+
+def _weak_directions(sv, Vt, sigma2: float, rcond: float, max_rel_std: float, free):
+    """The undetermined directions of the scaled Jacobian (module doc): a direction is weak when
+    its singular value is negligible against the largest, or when the noise moves the (scaled,
+    ~unit) parameters along it by more than ``max_rel_std``. Returns the weak mask, the free
+    parameters loading a weak direction (> 0.1 of its largest component), and their name groups."""
+    with np.errstate(divide="ignore"):
+        rel_std_dir = np.sqrt(sigma2) / sv
+    weak = (sv <= rcond * sv[0]) | (rel_std_dir > max_rel_std) if sv[0] > 0 else np.ones_like(sv, dtype=bool)
+    groups = []
+    bad_params = np.zeros(len(free), dtype=bool)
+    for k in np.flatnonzero(weak):
+        v = np.abs(Vt[k])
+        members = np.flatnonzero(v > 0.1 * v.max())
+        bad_params[members] = True
+        groups.append(tuple(int(i) for i in members))
+    return weak, bad_params, [tuple(free[i] for i in g) for g in sorted(set(groups))]
+
+
+def _strongly_correlated(corr, free) -> list[tuple[str, str, float]]:
+    """The pairs of free parameters correlated beyond |0.99|."""
+    pairs = []
+    for i in range(len(free)):
+        for j in range(i + 1, len(free)):
+            if np.isfinite(corr[i, j]) and abs(corr[i, j]) > 0.99:
+                pairs.append((free[i], free[j], float(corr[i, j])))
+    return pairs
+
+
+def _uncertainty(J, r, s, free, rcond: float, max_rel_std: float):
+    """σ̂² = Σ r² / (N_r − n) and Cov(θ̂) = σ̂² (JᵀJ)⁻¹ through the SVD of J·diag(s) (module
+    doc), with the weak directions left out (their parameters' σ infinite, correlations NaN).
+    Returns the covariance, σ, the correlation matrix and the :class:`Identifiability`."""
+    dof = max(r.size - len(free), 1)
+    sigma2 = float(r @ r) / dof
+    Js = J * s[None, :]
+    _, sv, Vt = np.linalg.svd(Js, full_matrices=False)
+    cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else math.inf
+    weak, bad_params, groups = _weak_directions(sv, Vt, sigma2, rcond, max_rel_std, free)
+    inv_sv2 = np.where(weak, 0.0, 1.0 / np.where(sv > 0, sv, 1.0) ** 2)
+    cov_z = (Vt.T * inv_sv2) @ Vt * sigma2
+    cov = cov_z * np.outer(s, s)
+    std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    std[bad_params] = np.inf
+    d = np.where(std > 0, std, 1.0)
+    corr = cov / np.outer(d, d)
+    corr[bad_params, :] = np.nan
+    corr[:, bad_params] = np.nan
+    np.fill_diagonal(corr, 1.0)
+    ident = Identifiability(sv, cond, tuple(groups), tuple(_strongly_correlated(corr, free)))
+    return cov, std, corr, ident
+
+
+def _result(params: ParameterSet, free, theta, cov, std, corr, ident: Identifiability, problem: _OutputError,
+            best, r, tried, *, source: str) -> GreyboxResult:
+    """The :class:`GreyboxResult` of the best start: the modelled outputs ŷ = y + r·w, their
+    residuals and fit percentages, and the parameters with their σ."""
+    y, w = problem.cols.y, problem.cols.w
+    yhat = y + (r.reshape(y.shape) * w)
+    fitted = params.from_vector(theta, free, std=std, source=f"identified from {source}")
+    return GreyboxResult(
+        parameters=fitted, free=free, theta=theta, std=std, covariance=cov, correlation=corr,
+        cost=float(best.cost), residual_std=(r.reshape(y.shape) * w).std(axis=0),
+        fit_percent=_fit_percent(y, yhat), outputs=tuple(problem.cols.out_map), y_model=yhat,
+        residuals=y - yhat, n_samples=y.shape[0], nfev=problem.nfev, success=bool(best.success),
+        message=str(best.message), identifiability=ident, starts=tuple(tried))
+
+
 @entry_point
 def fit(model, data: Trajectory, *, outputs: Sequence[str] | Mapping[str, str] | None = None,
         inputs: Mapping[str, str] | None = None, free: Sequence[str] | None = None,
@@ -187,161 +438,18 @@ def fit(model, data: Trajectory, *, outputs: Sequence[str] | Mapping[str, str] |
     if not isinstance(data, Trajectory):
         raise DataError(f"data: expected a Trajectory, found {type(data).__name__}")
     fs = data.require_uniform(why="grey-box identification")
-    dt = 1.0 / fs
-    params = model.parameters
-    if initial is not None:
-        params = params.replace(**({n: initial.value(n) for n in initial} if isinstance(initial, ParameterSet) else dict(initial)))
-    free = tuple(params.free_names if free is None else free)
-    for n in free:
-        params[n]  # raises a clear ParameterError for unknown names
-    if not free:
-        raise ParameterError("no free parameters to identify", hint="pass free=[...] or unfix some parameters")
-
-    in_map = {s.name: (inputs or {}).get(s.name, s.name) for s in model.inputs}
-    missing = [c for c in in_map.values() if c not in data]
-    if missing:
-        raise DataError(f"data has no column {missing[0]!r} for the input of {model.name}",
-                        hint=f"map it with inputs={{model_input: column}}; columns: {', '.join(data.names)}")
-    u = np.column_stack([data[c] for c in in_map.values()])
-    model_out = [s.name for s in model.outputs]
-    if outputs is None:
-        out_map = {o: o for o in model_out if o in data}
-        if not out_map:
-            raise DataError(f"data has none of the model outputs {model_out}",
-                            hint="name the measured columns with outputs={model_output: column}")
-    elif isinstance(outputs, Mapping):
-        out_map = dict(outputs)
-    else:
-        out_map = {o: o for o in outputs}
-    for o in out_map:
-        if o not in model_out:
-            raise DataError(f"{o!r} is not an output of {model.name}", hint=f"outputs: {', '.join(model_out)}")
-    out_idx = [model_out.index(o) for o in out_map]
-    y = np.column_stack([data[c] for c in out_map.values()])
-    n_free = len(free)
-    burn_in = int(burn_in)
-    if burn_in < 0:
-        raise DataError(f"burn_in: expected a number of samples >= 0, found {burn_in}")
-    data.require_samples(burn_in + 2 * n_free + 1, f"fitting {n_free} parameters after {burn_in} burn-in samples")
-    w = np.asarray(output_scale, dtype=np.float64) if output_scale is not None else y[burn_in:].std(axis=0)
-    if w.shape != (y.shape[1],) or not np.all(w > 0):
-        raise DataError(f"output scale: expected {y.shape[1]} positive weights (a measured output may be "
-                        f"constant), found {w}", hint="pass output_scale=[...] explicitly")
-    y = y[burn_in:]  # the fitted samples (y_model, residuals and n_samples refer to these)
-
-    names = params.names
-    idx = np.array([names.index(n) for n in free])
-    base = params.vector()
-    lo_all, hi_all = params.bounds_arrays()
-    lo, hi = lo_all[idx], hi_all[idx]
-    theta0 = base[idx]
-    s = _scales(theta0, lo, hi)
-    # optimisation variables: z = θ/s; for 'lm' (no bounds) positive parameters use z = log(θ/s)
-    logvar = (method == "lm") & (lo >= 0) & (theta0 > 0)
-
-    def to_theta(z):
-        return np.where(logvar, s * np.exp(np.where(logvar, z, 0.0)), s * z)
-
-    def to_z(theta):
-        return np.where(logvar, np.log(np.where(logvar, theta, s) / s), theta / s)
-
-    x0_arr = None if x0 is None else np.asarray(x0, dtype=np.float64)[None, :]
-    nfev = [0]
-    substeps = [1]  # only ever grows, so finite differences never straddle a change of step
-
-    def simulate_rows(z_rows: np.ndarray) -> np.ndarray:
-        T = np.repeat(base[None, :], z_rows.shape[0], axis=0)
-        T[:, idx] = to_theta(z_rows)
-        nfev[0] += T.shape[0]
-        substeps[0] = max(substeps[0], model.substeps(dt, T))
-        return model.simulate_batch(T, u, dt, x0_arr, substeps=substeps[0])[:, burn_in:, out_idx]
-
-    cache: dict = {}
-
-    def residual(z):
-        key = z.tobytes()
-        if key not in cache:
-            cache.clear()
-            cache[key] = ((simulate_rows(z[None, :])[0] - y) / w).ravel()
-        return cache[key]
-
-    def jacobian(z):
-        r0 = residual(z)
-        h = np.sqrt(np.finfo(float).eps) * np.maximum(np.abs(z), 1.0)
-        step = np.where(logvar | (z + h <= hi / s), h, -h)  # step away from an upper bound
-        Z = np.repeat(z[None, :], n_free, axis=0) + np.diag(step)
-        R = (simulate_rows(Z) - y[None, :, :]) / w
-        return ((R.reshape(n_free, -1) - r0[None, :]) / step[:, None]).T
-
-    bounds = (lo / s, hi / s) if method != "lm" else (-np.inf, np.inf)
-    rng = np.random.default_rng(seed)
-    starts = [theta0] + _random_starts(theta0, lo, hi, multistart, rng)
-    best = None
-    tried = []
-    for th in track(starts, description="grey-box starts", enabled=progress and len(starts) > 1):
-        z0 = np.clip(to_z(th), bounds[0], bounds[1])
-        try:
-            sol = least_squares(residual, z0, jac=jacobian, bounds=bounds, method=method, loss=loss,
-                                max_nfev=max_nfev, x_scale="jac")
-        except ParameterError as exc:
-            raise IdentificationError(f"the fit left the parameters' physical range: {exc}",
-                                      hint="use method='trf' to enforce the bounds, or better starting values") from None
-        except ValueError as exc:
-            raise IdentificationError(f"least squares failed to start: {exc}") from None
-        tried.append((float(sol.cost), to_theta(sol.x)))
-        if best is None or sol.cost < best.cost:
-            best = sol
+    params, free = _parameters_to_fit(model, initial, free)
+    cols = _fit_columns(model, data, inputs=inputs, outputs=outputs, n_free=len(free), burn_in=burn_in,
+                        output_scale=output_scale)
+    problem = _OutputError(model, params, free, cols, 1.0 / fs, x0, method)
+    best, tried = _best_of_starts(problem, _SolverOptions(method, loss, max_nfev, multistart, seed, progress))
     z = best.x
-    theta = to_theta(z)
-    if method == "lm" and ((theta < lo) | (theta > hi)).any():
-        j = int(np.argmax((theta < lo) | (theta > hi)))
-        raise IdentificationError(f"Levenberg-Marquardt converged outside the bounds: {free[j]} = {theta[j]:g}",
-                                  hint="use method='trf' to enforce the bounds")
-    r = residual(z)
-    J = jacobian(z) / np.where(logvar, theta, s)[None, :]  # d r / d theta (chain rule through z)
-    n_res = r.size
-    dof = max(n_res - n_free, 1)
-    sigma2 = float(r @ r) / dof
-    Js = J * s[None, :]
-    U, sv, Vt = np.linalg.svd(Js, full_matrices=False)
-    cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else math.inf
-    # a direction is undetermined when its singular value is negligible against the largest, or
-    # when the noise moves the (scaled, ~unit) parameters along it by more than max_rel_std
-    with np.errstate(divide="ignore"):
-        rel_std_dir = np.sqrt(sigma2) / sv
-    weak = (sv <= rcond * sv[0]) | (rel_std_dir > max_rel_std) if sv[0] > 0 else np.ones_like(sv, dtype=bool)
-    groups = []
-    bad_params = np.zeros(n_free, dtype=bool)
-    for k in np.flatnonzero(weak):
-        v = np.abs(Vt[k])
-        members = np.flatnonzero(v > 0.1 * v.max())
-        bad_params[members] = True
-        groups.append(tuple(int(i) for i in members))
-    groups = [tuple(free[i] for i in g) for g in sorted(set(groups))]
-    inv_sv2 = np.where(weak, 0.0, 1.0 / np.where(sv > 0, sv, 1.0) ** 2)
-    cov_z = (Vt.T * inv_sv2) @ Vt * sigma2
-    cov = cov_z * np.outer(s, s)
-    std = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    std[bad_params] = np.inf
-    d = np.where(std > 0, std, 1.0)
-    corr = cov / np.outer(d, d)
-    corr[bad_params, :] = np.nan
-    corr[:, bad_params] = np.nan
-    np.fill_diagonal(corr, 1.0)
-    pairs = []
-    for i in range(n_free):
-        for j in range(i + 1, n_free):
-            if np.isfinite(corr[i, j]) and abs(corr[i, j]) > 0.99:
-                pairs.append((free[i], free[j], float(corr[i, j])))
-    ident = Identifiability(sv, cond, tuple(groups), tuple(pairs))
+    theta = problem.to_theta(z)
+    _check_inside_bounds(theta, problem, free, method)
+    r = problem.residual(z)
+    cov, std, corr, ident = _uncertainty(problem.jacobian_theta(z, theta), r, problem.s, free, rcond, max_rel_std)
     if not ident.ok:
         warnings.warn(f"{model.name}: {ident}; their standard deviations are reported as infinite",
                       AccuracyWarning, stacklevel=2)
-    yhat = y + (r.reshape(y.shape) * w)
-    fitted = params.from_vector(theta, free, std=std, source=f"identified from {data.meta.get('source', 'data')}")
-    return GreyboxResult(
-        parameters=fitted, free=free, theta=theta, std=std, covariance=cov, correlation=corr,
-        cost=float(best.cost), residual_std=(r.reshape(y.shape) * w).std(axis=0),
-        fit_percent=_fit_percent(y, yhat), outputs=tuple(out_map), y_model=yhat,
-        residuals=y - yhat, n_samples=y.shape[0], nfev=nfev[0], success=bool(best.success),
-        message=str(best.message), identifiability=ident, starts=tuple(tried))
+    return _result(params, free, theta, cov, std, corr, ident, problem, best, r, tried,
+                   source=data.meta.get("source", "data"))

@@ -113,27 +113,9 @@ def _half_power(f: np.ndarray, X: np.ndarray, k: int) -> float:
     return float(fr - fl)
 
 
-@entry_point
-def free_vibration(y, fs: float, *, start: int | None = None, end: int | None = None,
-                   noise_std: float | None = None) -> ModalResult:
-    """Estimate the natural frequency and damping ratio of a free vibration.
-
-    Parameters
-    ----------
-    y
-        The signal (any unit, e.g. the force sensor's reading), shape (N,), sampled at ``fs`` Hz.
-    start, end
-        Sample range to analyse; ``start`` defaults to the release (the first large step, so a
-        record may begin with the preload plateau), ``end`` to the end of the record.
-    noise_std
-        Measurement noise (same unit as ``y``); default: estimated from the fit residuals.
-
-    Raises
-    ------
-    DataError
-        NaN/inf, fewer than 64 samples after the release, no oscillation standing out of the noise,
-        or a frequency at DC or at the Nyquist frequency.
-    """
+def _checked_signal(y, fs: float) -> np.ndarray:
+    """``y`` as a flat float64 array, refused for a non-positive ``fs``, NaN/inf values or fewer
+    than 64 samples."""
     y = np.asarray(y, dtype=np.float64).ravel()
     if not (np.isfinite(fs) and fs > 0):
         raise DataError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
@@ -143,20 +125,24 @@ def free_vibration(y, fs: float, *, start: int | None = None, end: int | None = 
                         hint="drop or interpolate them (CLI: --fill)")
     if y.size < 64:
         raise DataError(f"free-vibration analysis needs at least 64 samples, found {y.size}")
-    # work at unit size (an exact power of two: any scale, 1e-300 … 1e300); amplitudes mapped back below
-    cy = unit_scale(y)
-    y = y * cy
-    noise_std = None if noise_std is None else float(noise_std) * cy
+    return y
+
+
+def _release_segment(y: np.ndarray, start: int | None, end: int | None) -> tuple[int, np.ndarray]:
+    """The first sample analysed (default: the release, :func:`_start_index`) and the samples from
+    there to ``end``; at least 64 of them."""
     i0 = _start_index(y) if start is None else int(start)
     i1 = y.size if end is None else int(end)
     seg = y[i0:i1]
     if seg.size < 64:
         raise DataError(f"only {seg.size} samples after the release (sample {i0}); need at least 64",
                         hint="record longer, or pass start=")
-    t = np.arange(seg.size) / fs
-    tail = seg[-max(seg.size // 5, 8):]
-    c0 = float(np.median(tail))
-    x = seg - c0
+    return i0, seg
+
+
+def _spectral_peak(x: np.ndarray, fs: float):
+    """:func:`_fft_peak` (f_d, frequencies, magnitudes, peak bin), refused when the peak stands
+    less than 10× above the median of the spectrum or lies at the Nyquist frequency."""
     f_fft, f, X, k = _fft_peak(x, fs)
     floor = float(np.median(X))
     if X[k] < 10.0 * floor:
@@ -166,48 +152,69 @@ def free_vibration(y, fs: float, *, start: int | None = None, end: int | None = 
     if f_fft > 0.98 * fs / 2:
         raise DataError(f"the peak at {f_fft:.6g} Hz lies at the Nyquist frequency {fs / 2:g} Hz: the mode is "
                         f"aliased or unresolved", hint="sample faster")
-    methods: dict[str, dict] = {"fft_peak": {"damped_frequency_hz": f_fft}}
-    bw = _half_power(f, X, k)
-    if math.isfinite(bw):
-        methods["half_power"] = {"bandwidth_hz": bw, "damping_ratio": bw / (2.0 * f_fft)}
-    # Hilbert envelope and phase
+    return f_fft, f, X, k
+
+
+def _hilbert_estimate(x: np.ndarray, t: np.ndarray, per: int, noise: float) -> dict | None:
+    """σ from a straight line through log|analytic signal| and ω_d from its unwrapped phase, over
+    the first run of samples where the envelope stands 5× above ``noise`` (two periods ``per`` cut
+    at each end); None when fewer than 8 samples qualify."""
     z = hilbert(x)
     env = np.abs(z)
-    nstd_guess = float(np.std(tail - np.mean(tail))) if noise_std is None else float(noise_std)
-    per = max(int(round(fs / f_fft)), 1)
-    use = np.flatnonzero(env > max(5.0 * nstd_guess, 1e-3 * env.max()))
-    use = use[(use >= 2 * per) & (use < seg.size - 2 * per)]
-    if use.size >= 8:
-        lu = use[: np.argmax(np.diff(use) > 1) + 1] if np.any(np.diff(use) > 1) else use
-        if lu.size >= 8:
-            sl, ic = np.polyfit(t[lu], np.log(env[lu]), 1)
-            ph = np.unwrap(np.angle(z[lu]))
-            wd = np.polyfit(t[lu], ph, 1)[0]
-            sigma_h = -sl
-            wn_h = math.hypot(wd, sigma_h)
-            methods["hilbert"] = {"natural_frequency_hz": wn_h / (2 * math.pi), "damping_ratio": sigma_h / wn_h,
-                                  "amplitude": math.exp(ic)}
-    # log decrement on the band-limited 16x interpolation
+    use = np.flatnonzero(env > max(5.0 * noise, 1e-3 * env.max()))
+    use = use[(use >= 2 * per) & (use < x.size - 2 * per)]
+    if use.size < 8:
+        return None
+    lu = use[: np.argmax(np.diff(use) > 1) + 1] if np.any(np.diff(use) > 1) else use
+    if lu.size < 8:
+        return None
+    sl, ic = np.polyfit(t[lu], np.log(env[lu]), 1)
+    ph = np.unwrap(np.angle(z[lu]))
+    wd = np.polyfit(t[lu], ph, 1)[0]
+    sigma_h = -sl
+    wn_h = math.hypot(wd, sigma_h)
+    return {"natural_frequency_hz": wn_h / (2 * math.pi), "damping_ratio": sigma_h / wn_h, "amplitude": math.exp(ic)}
+
+
+def _log_decrement_estimate(x: np.ndarray, fs: float, f_d: float, per: int, noise: float) -> dict | None:
+    """δ = ln(a_i / a_{i+k})/k from a straight line through the log of the peaks of ``x``
+    upsampled 16× (band-limited), those 5× above ``noise`` and three periods from the ends;
+    ζ = δ/√(4π² + δ²). None with fewer than 3 such peaks."""
     up = 16
     xu = resample_poly(x, up, 1)
-    pk, _ = find_peaks(xu, distance=int(0.6 * up * fs / f_fft))
+    pk, _ = find_peaks(xu, distance=int(0.6 * up * fs / f_d))
     edge = 3 * up * per
     pk = pk[(pk > edge) & (pk < xu.size - edge)]
     amp = xu[pk]
-    good = pk[amp > max(5.0 * nstd_guess, 1e-3 * np.max(np.abs(x)))]
-    if good.size >= 3:
-        a_good = xu[good]
-        cycles = (good - good[0]) / (up * fs / f_fft)
-        slope = np.polyfit(cycles, np.log(a_good), 1)[0]
-        delta = -slope
-        methods["log_decrement"] = {"log_decrement": delta, "damping_ratio": delta / math.sqrt(4 * math.pi**2 + delta**2)}
-    # damped-sine least squares, started from the best of the above
-    zeta0 = methods.get("hilbert", methods.get("log_decrement", methods.get("half_power", {}))).get("damping_ratio", 0.01)
+    good = pk[amp > max(5.0 * noise, 1e-3 * np.max(np.abs(x)))]
+    if good.size < 3:
+        return None
+    cycles = (good - good[0]) / (up * fs / f_d)
+    delta = -np.polyfit(cycles, np.log(xu[good]), 1)[0]
+    return {"log_decrement": delta, "damping_ratio": delta / math.sqrt(4 * math.pi**2 + delta**2)}
+
+
+@dataclass(frozen=True)
+class _DampedSine:
+    """x(t) = A e^{−σ t} cos(ω_d t + φ) + c fitted by least squares; ``covariance`` of
+    (A, σ, ω_d, φ, c) = s² (JᵀJ)⁻¹ with s² the residual variance (unit of x)."""
+
+    amplitude: float
+    sigma: float
+    omega_d: float
+    phase: float
+    offset: float
+    covariance: np.ndarray
+    residual_variance: float
+
+
+def _fit_damped_sine(x: np.ndarray, t: np.ndarray, f_d: float, per: int, zeta0: float) -> _DampedSine:
+    """The five-parameter damped-sine least squares (module doc), started from f_d and ζ₀ with the
+    amplitude and phase of the linear fit x ≈ e^{−σt}(p cos + q sin) at those (σ, ω_d)."""
     zeta0 = min(max(zeta0, 1e-4), 0.5)
-    wd0 = 2 * math.pi * f_fft
+    wd0 = 2 * math.pi * f_d
     sig0 = zeta0 * wd0
     A0 = float(np.max(np.abs(x[:max(per, 1) + 1])))
-    # phase from a linear fit at fixed (σ, ω_d): x ≈ e^{−σt}(p cos + q sin)
     E = np.exp(-sig0 * t)
     M = np.column_stack([E * np.cos(wd0 * t), E * np.sin(wd0 * t)])
     pq, *_ = np.linalg.lstsq(M, x, rcond=None)
@@ -233,28 +240,91 @@ def free_vibration(y, fs: float, *, start: int | None = None, end: int | None = 
         cov = np.linalg.inv(J.T @ J) * s2
     except np.linalg.LinAlgError:
         raise IdentificationError("the damped-sine fit is singular (no decay or no oscillation in the record)") from None
+    return _DampedSine(A, s, w, ph, c, cov, s2)
+
+
+def _natural_frequency_and_damping(fit: _DampedSine) -> tuple[float, float, float, float]:
+    """f_n = √(ω_d² + σ²)/2π and ζ = σ/ω_n with their σ by the delta method:
+    (f_n, ζ, σ_fn, σ_ζ)."""
+    s, w, cov = fit.sigma, fit.omega_d, fit.covariance
     wn = math.hypot(w, s)
     zeta = s / wn
     g_wn = np.array([0.0, s / wn, w / wn, 0.0, 0.0])
     g_z = np.array([0.0, 1.0 / wn - s * s / wn**3, -s * w / wn**3, 0.0, 0.0])
     f_std = math.sqrt(max(g_wn @ cov @ g_wn, 0.0)) / (2 * math.pi)
     z_std = math.sqrt(max(g_z @ cov @ g_z, 0.0))
+    return wn / (2 * math.pi), zeta, f_std, z_std
+
+
+def _warn_doubtful(methods: dict, f_fft: float, omega_d: float, fn: float, zeta: float, f_std: float,
+                   z_std: float) -> None:
+    """AccuracyWarnings (attributed to the caller of :func:`free_vibration`): a fitted ζ ≤ 0, a
+    method's ζ further from the fit's than its expected scatter, an FFT peak away from the fitted
+    damped frequency."""
     if zeta <= 0:
         warnings.warn(f"the fitted damping ratio is {zeta:.3g} ≤ 0: the record does not decay", AccuracyWarning,
-                      stacklevel=2)
-    fn = wn / (2 * math.pi)
-    methods["damped_sine_fit"] = {"natural_frequency_hz": fn, "damping_ratio": zeta,
-                                  "natural_frequency_std_hz": f_std, "damping_ratio_std": z_std}
+                      stacklevel=3)
     for name, v in methods.items():
         if name in ("hilbert", "half_power", "log_decrement") and "damping_ratio" in v:
             if abs(v["damping_ratio"] - zeta) > max(0.3 * zeta, 10 * z_std):
                 warnings.warn(f"free vibration: the {name.replace('_', ' ')} damping ratio {v['damping_ratio']:.4g} "
                               f"disagrees with the least-squares fit {zeta:.4g} ± {z_std:.2g}", AccuracyWarning,
-                              stacklevel=2)
-    if abs(f_fft - w / (2 * math.pi)) > max(0.01 * fn, 20 * f_std):
+                              stacklevel=3)
+    if abs(f_fft - omega_d / (2 * math.pi)) > max(0.01 * fn, 20 * f_std):
         warnings.warn(f"free vibration: the FFT peak {f_fft:.6g} Hz disagrees with the fitted damped frequency "
-                      f"{w / (2 * math.pi):.6g} Hz", AccuracyWarning, stacklevel=2)
+                      f"{omega_d / (2 * math.pi):.6g} Hz", AccuracyWarning, stacklevel=3)
+
+
+@entry_point
+def free_vibration(y, fs: float, *, start: int | None = None, end: int | None = None,
+                   noise_std: float | None = None) -> ModalResult:
+    """Estimate the natural frequency and damping ratio of a free vibration.
+
+    Parameters
+    ----------
+    y
+        The signal (any unit, e.g. the force sensor's reading), shape (N,), sampled at ``fs`` Hz.
+    start, end
+        Sample range to analyse; ``start`` defaults to the release (the first large step, so a
+        record may begin with the preload plateau), ``end`` to the end of the record.
+    noise_std
+        Measurement noise (same unit as ``y``); default: estimated from the fit residuals.
+
+    Raises
+    ------
+    DataError
+        NaN/inf, fewer than 64 samples after the release, no oscillation standing out of the noise,
+        or a frequency at DC or at the Nyquist frequency.
+    """
+    y = _checked_signal(y, fs)
+    # work at unit size (an exact power of two: any scale, 1e-300 … 1e300); amplitudes mapped back below
+    cy = unit_scale(y)
+    y = y * cy
+    noise_std = None if noise_std is None else float(noise_std) * cy
+    i0, seg = _release_segment(y, start, end)
+    t = np.arange(seg.size) / fs
+    tail = seg[-max(seg.size // 5, 8):]
+    c0 = float(np.median(tail))
+    x = seg - c0
+    f_fft, f, X, k = _spectral_peak(x, fs)
+    methods: dict[str, dict] = {"fft_peak": {"damped_frequency_hz": f_fft}}
+    bw = _half_power(f, X, k)
+    if math.isfinite(bw):
+        methods["half_power"] = {"bandwidth_hz": bw, "damping_ratio": bw / (2.0 * f_fft)}
+    noise = float(np.std(tail - np.mean(tail))) if noise_std is None else float(noise_std)
+    per = max(int(round(fs / f_fft)), 1)
+    for name, estimate in (("hilbert", _hilbert_estimate(x, t, per, noise)),
+                           ("log_decrement", _log_decrement_estimate(x, fs, f_fft, per, noise))):
+        if estimate is not None:
+            methods[name] = estimate
+    # damped-sine least squares, started from the best of the above
+    zeta0 = methods.get("hilbert", methods.get("log_decrement", methods.get("half_power", {}))).get("damping_ratio", 0.01)
+    sine = _fit_damped_sine(x, t, f_fft, per, zeta0)
+    fn, zeta, f_std, z_std = _natural_frequency_and_damping(sine)
+    _warn_doubtful(methods, f_fft, sine.omega_d, fn, zeta, f_std, z_std)
+    methods["damped_sine_fit"] = {"natural_frequency_hz": fn, "damping_ratio": zeta,
+                                  "natural_frequency_std_hz": f_std, "damping_ratio_std": z_std}
     if "hilbert" in methods:
         methods["hilbert"]["amplitude"] /= cy
-    return ModalResult(fn, zeta, f_std, z_std, float(A) / cy, float(c + c0) / cy, float(i0 / fs),
-                       int(seg.size), float(fs), math.sqrt(s2) / cy, methods)
+    return ModalResult(fn, zeta, f_std, z_std, float(sine.amplitude) / cy, float(sine.offset + c0) / cy,
+                       float(i0 / fs), int(seg.size), float(fs), math.sqrt(sine.residual_variance) / cy, methods)

@@ -21,10 +21,13 @@ from __future__ import annotations
 
 import time
 import warnings
+from dataclasses import dataclass
 
 import numpy as np
+
 from ...consistency import ConsistencyReport, check
 from ...excitation import bandlimited_noise, multisine
+from ...report import plots
 from ...signals.filters import apply_sos
 from ...sysid import arx, oe, rls
 from .force_dynamics import (FORCE_SCALE, FORCE_SCALE_NOTE, FS, TABLE_II, TABLE_III,
@@ -52,46 +55,63 @@ def _fmt_pm(v, s) -> str:
     return f"{v:.4g} ± {s:.2g}"
 
 
-def run(report, *, quick: bool = False) -> dict:
-    """Add the section to ``report``; returns the summary numbers. The records are the paper's
-    (400 and 4000 samples), so the section takes a few seconds once numba's RLS kernel is compiled
-    (about 10 s the first time); ``quick`` changes nothing."""
-    from ...report import plots
+@dataclass(frozen=True)
+class _Study:
+    """The simulated experiment: the true finger ``plant`` (its ``truth`` model and 9 Hz
+    prefilter ``sos``), the excitations S1 and S2, the noisy records ``rec`` and the noise level."""
 
-    t_start = time.perf_counter()
+    plant: object
+    truth: object
+    sos: np.ndarray
+    s1: object
+    rec: dict
+    noise_std: float
+
+    def signals(self, name: str, variant: str):
+        """(u, y) of record ``name`` ("S1", "S2"): the current's deviation from the operating point
+        and the force, processed as ``variant`` (one of :data:`VARIANTS`)."""
+        tr = self.rec[name]
+        u = tr["current"] - self.plant.operating_point
+        y = tr["force"]
+        if variant == "filtered y":
+            y = apply_sos(self.sos, y)
+        elif variant == "prefiltered u, y":
+            u, y = apply_sos(self.sos, u), apply_sos(self.sos, y)
+        return u, y
+
+
+def _simulate_study() -> _Study:
+    """The paper's excitations (§V-E) between 600 and 1100 mA on the zoo plant, with white
+    measurement noise of :data:`NOISE_UNITS` sensor units on the force."""
     plant = build_plant()
-    truth = plant.model
-    sos = plant.prefilter_sos()
     s1 = multisine(range(1, 11), 2.0, FS, operating_point=0.850, limits=(0.600, 1.100), unit="A")
     s2 = bandlimited_noise(0.3, 10.0, 20.0, FS, operating_point=0.850, limits=(0.600, 1.100), seed=7, unit="A")
     noise_std = NOISE_UNITS * FORCE_SCALE  # N
     rec = {"S1": plant.simulate(s1.u, noise_std=noise_std, seed=1),
            "S2": plant.simulate(s2.u, noise_std=noise_std, seed=2)}
-    other = {"S1": "S2", "S2": "S1"}
+    return _Study(plant, plant.model, plant.prefilter_sos(), s1, rec, noise_std)
 
-    def signals(name: str, variant: str):
-        tr = rec[name]
-        u = tr["current"] - plant.operating_point
-        y = tr["force"]
-        if variant == "filtered y":
-            y = apply_sos(sos, y)
-        elif variant == "prefiltered u, y":
-            u, y = apply_sos(sos, u), apply_sos(sos, y)
-        return u, y
 
-    sec = report.section(
+def _intro(report, study: _Study):
+    """The section and its opening paragraph: the true finger, the excitations, the processings."""
+    return report.section(
         "AMADEUS finger force identification (§V)",
         "The study of §V of 000_8f66dcc7ab06470c.txt on simulated data. True finger: the Table II "
         "[2 2 2] model (valve current deviation from 850 mA in A → force in N; the seed prints B in sensor "
         f"units per mA and gives no force unit: gripkit assumes {FORCE_SCALE:.4f} N per unit, from the "
         "15.45 N peak force of Fig. 2(c) over the 500 mA valve span). Excitations as in §V-E: S1, a "
         "1–10 Hz multisine, 400 samples at 200 Hz (crest factor "
-        f"{s1.crest_factor:.2f}); S2, band-limited noise 0.3–10 Hz, 4000 samples; both between 600 and "
-        f"1100 mA. White measurement noise of {noise_std:.3g} N ({NOISE_UNITS:g} sensor units) on the force. Three processings: raw; "
+        f"{study.s1.crest_factor:.2f}); S2, band-limited noise 0.3–10 Hz, 4000 samples; both between 600 and "
+        f"1100 mA. White measurement noise of {study.noise_std:.3g} N ({NOISE_UNITS:g} sensor units) on the force. Three processings: raw; "
         "'filtered y', the paper's 9 Hz Butterworth on the force only (§V-E, not part of the model); and "
         "'prefiltered u, y', the same filter on input and output, which keeps the input-output relation.")
 
-    # ---- LS over Table II's structures --------------------------------------------------------
+
+def _ls_table(sec, study: _Study) -> dict:
+    """LS (QR) fits of Table II's structures on S1 and S2 under every processing, in a table with
+    the loss V_N of eq (29), the free-run fit on the other record and Table II's V_N. Returns
+    the fits, keyed (record, structure, variant)."""
+    other = {"S1": "S2", "S2": "S1"}
     fits: dict[tuple, object] = {}
     rows = []
     with warnings.catch_warnings():
@@ -100,12 +120,12 @@ def run(report, *, quick: bool = False) -> dict:
             for st in STRUCT_II:
                 row = [f"[{st[0]} {st[1]} {st[2]}]", name]
                 for var in VARIANTS:
-                    u, y = signals(name, var)
+                    u, y = study.signals(name, var)
                     m = arx(u, y, *st, fs=FS, input_name="current", output_name="force",
                             input_unit="A", output_unit="N")
                     fits[(name, st, var)] = m
                     row.append(m.loss / FORCE_SCALE**2)
-                uv, yv = signals(other[name], "prefiltered u, y")
+                uv, yv = study.signals(other[name], "prefiltered u, y")
                 val = fits[(name, st, "prefiltered u, y")].validate(uv, yv)
                 row.append("—" if val.fit_percent is None else f"{val.fit_percent:.1f}")
                 paper = [r for r in TABLE_II if (r.na, r.nb, r.nk, r.data) == (*st, name)]
@@ -115,12 +135,17 @@ def run(report, *, quick: bool = False) -> dict:
                "free-run fit % on the other record (prefiltered)", "Table II V_N"], rows,
               caption="LS (QR) over the structures of Table II. Loss V_N of eq (29) on the estimation record, "
                       "in the seed's force-sensor units² (V_N in N² divided by force_scale²).")
+    return fits
+
+
+def _winners(sec, fits: dict) -> dict:
+    """Which structure wins on S1, on loss and on AIC, per processing, with the text that explains
+    why. Returns ``{variant: (best on loss, best on AIC)}``."""
     winners = {}
     for var in VARIANTS:
         best = min(STRUCT_II, key=lambda st: fits[("S1", st, var)].loss)
         best_aic = min(STRUCT_II, key=lambda st: fits[("S1", st, var)].aic)
         winners[var] = (best, best_aic)
-    wl = winners["filtered y"][0]
     ratio = {v: fits[("S1", (2, 2, 2), v)].loss / fits[("S1", (4, 4, 2), v)].loss for v in VARIANTS}
     sec.text(
         "Which structure wins (S1): on loss, "
@@ -134,8 +159,13 @@ def run(report, *, quick: bool = False) -> dict:
         "ARX model's noise model 1/A cannot describe measurement noise, so extra coefficients absorb its "
         "colour. The [2 2 2] model on prefiltered data and the output-error model below recover the "
         "true coefficients.")
+    return winners
 
-    # ---- zeros: non-minimum-phase [2 2 2], minimum-phase [2 2 10] ------------------------------
+
+def _zeros(sec, study: _Study, fits: dict) -> dict:
+    """§V-F: the zeros of [2 2 2] (non-minimum phase) and [2 2 10] (prefiltered u, y) with σ, next
+    to Table II's and the true plant's, and the pole-zero map (cf. Figs. 20b and 21b). Returns
+    ``{(record, structure): (z, σ_z)}``."""
     zrows = []
     zsum = {}
     for name in ("S1", "S2"):
@@ -148,7 +178,7 @@ def run(report, *, quick: bool = False) -> dict:
     for r in (reference("II", 2, 2, 2), reference("II", 2, 2, 10)):
         z = float(r.model().zeros()[0].real)
         zrows.append([r.label, "Table II (paper, S1)", f"{z:.4g}", "minimum phase" if abs(z) < 1 else "NON-minimum phase"])
-    zrows.append(["[2 2 2]", "true plant", f"{truth.zeros()[0].real:.4g}", "NON-minimum phase"])
+    zrows.append(["[2 2 2]", "true plant", f"{study.truth.zeros()[0].real:.4g}", "NON-minimum phase"])
     sec.table(["structure", "estimated on", "zero z (±σ)", "phase"], zrows,
               caption="Zeros of B(z) (prefiltered u, y). σ by first-order propagation of the parameter covariance.")
     sec.text("§V-F: the [2 2 2] model is non-minimum phase (zero outside the unit circle, so pole-zero "
@@ -167,14 +197,20 @@ def run(report, *, quick: bool = False) -> dict:
                "Poles (×, +, ⋎, ✱) and zeros (open ○, □, ◇, △), one shape and size per model so coincident "
                "markers nest: the [2 2 2] zero lies outside the unit circle, the [2 2 10] zero inside.",
                name="amadeus-pole-zero")
+    return zsum
 
-    # ---- output error removes the ARX bias; residual tests ----------------------------------
-    u2, y2 = signals("S2", "raw")
+
+def _output_error(sec, study: _Study, fits: dict):
+    """The output-error [2 2 2] fit on raw S2 that removes the ARX noise bias: its estimates next to
+    ARX's, the residual tests, the free runs on S1 and the Bode plot. Returns the validations of
+    the raw ARX and the OE models on S1."""
+    u2, y2 = study.signals("S2", "raw")
     moe = oe(u2, y2, 2, 2, 2, fs=FS, input_name="current", output_name="force", input_unit="A", output_unit="N")
     marx = fits[("S2", (2, 2, 2), "raw")]
+    m222 = fits[("S2", (2, 2, 2), "prefiltered u, y")]
     names = ["a1 / f1", "a2 / f2", "b2 [N/mA]", "b3 [N/mA]"]
     scale = np.array([1, 1, 1e-3, 1e-3])
-    tr_theta = truth.theta * scale
+    tr_theta = study.truth.theta * scale
     prow = []
     for i, n in enumerate(names):
         prow.append([n, f"{tr_theta[i]:.4g}",
@@ -184,36 +220,48 @@ def run(report, *, quick: bool = False) -> dict:
     sec.table(["parameter", "true", "ARX raw (S2)", "ARX prefiltered (S2)", "OE raw (S2)"], prow,
               caption="[2 2 2] estimates ± σ. Output (measurement) noise biases ARX; the output-error "
                       "model is consistent for it. b2, b3 in N/mA: " + FORCE_SCALE_NOTE)
-    u1r, y1r = signals("S1", "raw")
+    u1r, y1r = study.signals("S1", "raw")
     val_arx = marx.validate(u1r, y1r)
     val_oe = moe.validate(u1r, y1r)
+    _validation_figures(sec, study, fits, moe, val_arx, val_oe, y1r)
+    return val_arx, val_oe
+
+
+def _validation_figures(sec, study: _Study, fits: dict, moe, val_arx, val_oe, y1r) -> None:
+    """Residual tests, measured vs modelled force on S1 (cf. Figs. 19–22) and the Bode plot of the
+    true plant and the estimated models."""
+    marx = fits[("S2", (2, 2, 2), "raw")]
     sec.figure(plots.residual_correlation({"ARX [2 2 2]": val_arx.tests, "OE [2 2 2]": val_oe.tests},
                                           title="Residual tests on the S1 record (models estimated on S2, raw data)"),
                "Residual autocorrelation and input-residual cross-correlation with 99 % bands: the ARX "
                "residuals (equation error under output noise) are coloured and correlated with the input; "
                "the OE residuals pass.", name="amadeus-residuals")
-    t = rec["S1"].t
+    t = study.rec["S1"].t
     sec.figure(plots.measured_vs_model(
         t, y1r, {f"OE [2 2 2] free run (fit {val_oe.fit_percent:.1f} %)": val_oe.simulation.y_sim,
                  f"ARX [2 2 2] free run (fit {val_arx.fit_percent:.1f} %)": val_arx.simulation.y_sim},
-        extra={"noise-free force": rec["S1"]["force_true"]}, ylabel="force deviation [N]",
+        extra={"noise-free force": study.rec["S1"]["force_true"]}, ylabel="force deviation [N]",
         title="Measured and modelled force on S1 (models estimated on S2; initial conditions estimated)"),
         "Measured (grey) and modelled (dashed) force, cf. Figs. 19–22. " + FORCE_SCALE_NOTE,
         name="amadeus-measured-vs-model")
-    sec.figure(plots.bode({"true plant [2 2 2]": truth, "OE [2 2 2] raw": moe, "ARX [2 2 2] raw": marx,
-                           "ARX [2 2 2] prefiltered": m222, "ARX [4 4 2] filtered y": fits[("S2", (4, 4, 2), "filtered y")],
-                           "9 Hz prefilter (×1000)": _scaled_filter(plant, 1000.0)},
+    sec.figure(plots.bode({"true plant [2 2 2]": study.truth, "OE [2 2 2] raw": moe, "ARX [2 2 2] raw": marx,
+                           "ARX [2 2 2] prefiltered": fits[("S2", (2, 2, 2), "prefiltered u, y")],
+                           "ARX [4 4 2] filtered y": fits[("S2", (4, 4, 2), "filtered y")],
+                           "9 Hz prefilter (×1000)": _scaled_filter(study.plant, 1000.0)},
                           title="Frequency responses (current → force)", magnitude_unit="re 1 N/A",
                           reference="true plant [2 2 2]"),
                "Bode plot (true plant: wide grey band): the [4 4 2] model of the force-only filtered data contains "
                "the filter's roll-off. " + FORCE_SCALE_NOTE,
                name="amadeus-bode")
 
-    # ---- RLS over Table III's structures --------------------------------------------------------
+
+def _rls(sec, study: _Study) -> None:
+    """RLS (λ = 1, P0 = 10⁶·I) over Table III's structures on S1, and the convergence of the
+    [2 2 2] estimates on prefiltered S2 with ±2σ bands."""
     rrows = []
     for ref in TABLE_III:
         var = "prefiltered u, y" if ref.filtered else "raw"
-        u, y = signals("S1", var)
+        u, y = study.signals("S1", var)
         res = rls(u, y, ref.na, ref.nb, ref.nk, forgetting=1.0, p0=1e6, fs=FS)
         bscale = 1e-3 / FORCE_SCALE  # N/A -> sensor units per mA, the seed's scale
         th = ", ".join(_fmt_pm(v * (1 if n[0] == "a" else bscale), s * (1 if n[0] == "a" else bscale))
@@ -222,22 +270,32 @@ def run(report, *, quick: bool = False) -> dict:
     sec.table(["structure", "filter", "final θ ± σ (b in sensor units/mA, as Table III)",
                "V_N (a-priori errors, units²)", "Table III V_N"],
               rrows, caption="RLS (λ = 1, P0 = 10⁶·I) over the structures of Table III on S1 (400 samples).")
-    u, y = signals("S2", "prefiltered u, y")
+    u, y = study.signals("S2", "prefiltered u, y")
     res = rls(u, y, 2, 2, 2, forgetting=1.0, p0=1e6, fs=FS)
     sc = np.array([1, 1, 1e-3, 1e-3])
-    sec.figure(plots.parameter_convergence(rec["S2"].t, res.theta * sc, res.theta_std * sc,
-                                           ["a1", "a2", "b2 [N/mA]", "b3 [N/mA]"], truth=truth.theta * sc,
+    sec.figure(plots.parameter_convergence(study.rec["S2"].t, res.theta * sc, res.theta_std * sc,
+                                           ["a1", "a2", "b2 [N/mA]", "b3 [N/mA]"], truth=study.truth.theta * sc,
                                            title="RLS [2 2 2] on S2 (prefiltered): convergence with ±2σ"),
                "Recursive estimates with ±2σ bands and the true values (dashed).", name="amadeus-rls-convergence")
 
-    # ---- consistency of the seed's statements ------------------------------------------------
 
-    sec.findings(check(plant))
+def run(report, *, quick: bool = False) -> dict:
+    """Add the section to ``report``; returns the summary numbers. The records are the paper's
+    (400 and 4000 samples), so the section takes a few seconds once numba's RLS kernel is compiled
+    (about 10 s the first time); ``quick`` changes nothing."""
+    t_start = time.perf_counter()
+    study = _simulate_study()
+    sec = _intro(report, study)
+    fits = _ls_table(sec, study)        # LS over Table II's structures
+    winners = _winners(sec, fits)
+    zsum = _zeros(sec, study, fits)     # non-minimum-phase [2 2 2], minimum-phase [2 2 10]
+    val_arx, val_oe = _output_error(sec, study, fits)  # OE removes the ARX bias; residual tests
+    _rls(sec, study)                    # RLS over Table III's structures
+    sec.findings(check(study.plant))    # consistency of the seed's statements
     sec.findings(ConsistencyReport(seed_checks(), "AMADEUS Tables II/III (§V-F statements)"))
-
     z222, z222s = zsum[("S2", (2, 2, 2))]
     z2210, _ = zsum[("S2", (2, 2, 10))]
-    return {"winner_on_loss_filtered_y": list(wl),
+    return {"winner_on_loss_filtered_y": list(winners["filtered y"][0]),
             "winner_on_aic_prefiltered": list(winners["prefiltered u, y"][1]),
             "zero_222": z222, "zero_222_std": z222s, "non_minimum_phase_222": bool(abs(z222) > 1),
             "zero_2210": z2210, "minimum_phase_2210": bool(abs(z2210) < 1),

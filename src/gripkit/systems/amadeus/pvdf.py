@@ -153,36 +153,81 @@ def _texture(s, a, lam):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
+def _testbed_substep(m, Fs, muk, mus, vs, Fn, spring, v_surface, h, vp, vo, stuck):  # pragma: no cover - compiled
+    """One substep of the testbed drive (mode 1): the surface moves at ``v_surface``. A stuck pad
+    moves with it while the friction that takes, m·a − spring, stays within μ_s F_n (``Fs``); a
+    slipping pad feels the Stribeck friction μ(v) F_n and sticks again when the relative
+    velocity changes sign. Returns (v_pad, v_obj, stuck, F)."""
+    ao = (v_surface - vo) / h
+    if stuck > 0.5:
+        Freq = m * ao - spring
+        if abs(Freq) <= Fs:
+            F = Freq
+            vp = v_surface
+        else:
+            stuck = 0.0
+            F = Fs if Freq > 0 else -Fs
+            vp = vp + h * (spring + F) / m
+    else:
+        vrel = v_surface - vp
+        mu = muk + (mus - muk) * math.exp(-abs(vrel) / vs)
+        F = mu * Fn if vrel > 0 else -mu * Fn
+        vp_new = vp + h * (spring + F) / m
+        if (v_surface - vp_new) * vrel <= 0.0:
+            vp_new = v_surface
+            stuck = 1.0
+        vp = vp_new
+    return vp, v_surface, stuck, F
+
+
+@numba.njit(cache=True)
+def _grasp_substep(m, M, co, Fs, muk, mus, vs, Fn, spring, F_load, h, vp, vo, stuck):  # pragma: no cover - compiled
+    """One substep of the grasp (mode 0): the object (mass M, drag c_o·v) is pulled by ``F_load``
+    and held only by friction. Stuck, pad and object accelerate together while the friction that
+    takes stays within μ_s F_n (``Fs``); slipping, each moves under its own forces with the
+    Stribeck friction, and they stick again at their common (momentum) velocity when the
+    relative velocity changes sign. Returns (v_pad, v_obj, stuck, F)."""
+    drag = -co * vo
+    if stuck > 0.5:
+        a = (F_load + drag + spring) / (m + M)
+        Freq = m * a - spring
+        if abs(Freq) <= Fs:
+            F = Freq
+            vp = vp + h * a
+            vo = vp
+        else:
+            stuck = 0.0
+            F = Fs if Freq > 0 else -Fs
+            vp = vp + h * (spring + F) / m
+            vo = vo + h * (F_load + drag - F) / M
+    else:
+        vrel = vo - vp
+        mu = muk + (mus - muk) * math.exp(-abs(vrel) / vs)
+        F = mu * Fn if vrel > 0 else -mu * Fn
+        vp_new = vp + h * (spring + F) / m
+        vo_new = vo + h * (F_load + drag - F) / M
+        if (vo_new - vp_new) * vrel <= 0.0:
+            vc = (m * vp_new + M * vo_new) / (m + M)
+            vp_new = vc
+            vo_new = vc
+            stuck = 1.0
+        vp = vp_new
+        vo = vo_new
+    return vp, vo, stuck, F
+
+
+@numba.njit(cache=True)
 def contact_step(th, mode, u, dt, substeps, st, y):  # pragma: no cover - compiled
     """Advance the contact over the rows of ``u`` (N, 2) = [F_n, drive]; ``mode`` 0: drive is the
-    load force on the object (grasp), 1: drive is the surface speed (testbed). ``st`` (8,) =
-    [x_pad, v_pad, x_obj, v_obj, stuck, s, v_film, d_prev] is updated in place. ``y`` (N, 6) =
-    [film voltage (mean over the sample), slip velocity, slipping fraction, pad shear, object
-    position, friction force]."""
-    m = th[0]
-    k = th[1]
-    c = th[2]
-    mus = th[3]
-    muk = th[4]
-    vs = th[5]
-    M = th[6]
-    co = th[7]
-    kn = th[8]
-    ta = th[9]
-    lam = th[10]
-    alpha = th[11]
-    g = th[12]
-    tau = th[13]
+    load force on the object (grasp, :func:`_grasp_substep`), 1: drive is the surface speed
+    (testbed, :func:`_testbed_substep`). ``st`` (8,) = [x_pad, v_pad, x_obj, v_obj, stuck, s,
+    v_film, d_prev] is updated in place. ``y`` (N, 6) = [film voltage (mean over the sample),
+    slip velocity, slipping fraction, pad shear, object position, friction force]."""
+    m, k, c, mus, muk, vs, M, co = th[0], th[1], th[2], th[3], th[4], th[5], th[6], th[7]
+    kn, ta, lam, alpha, g, tau = th[8], th[9], th[10], th[11], th[12], th[13]
     h = dt / substeps
     decay = math.exp(-h / tau)
-    xp = st[0]
-    vp = st[1]
-    xo = st[2]
-    vo = st[3]
-    stuck = st[4]
-    s = st[5]
-    v = st[6]
-    dprev = st[7]
+    xp, vp, xo, vo, stuck, s, v, dprev = st[0], st[1], st[2], st[3], st[4], st[5], st[6], st[7]
     if math.isnan(dprev):
         dprev = alpha * xp + u[0, 0] / kn + _texture(s, ta, lam)
     for n in range(u.shape[0]):
@@ -198,62 +243,17 @@ def contact_step(th, mode, u, dt, substeps, st, y):  # pragma: no cover - compil
             Fs = mus * Fn
             spring = -k * xp - c * vp
             if mode == 1:
-                vo_new = drive
-                ao = (vo_new - vo) / h
-                if stuck > 0.5:
-                    Freq = m * ao - spring
-                    if abs(Freq) <= Fs:
-                        F = Freq
-                        vp = vo_new
-                    else:
-                        stuck = 0.0
-                        F = Fs if Freq > 0 else -Fs
-                        vp = vp + h * (spring + F) / m
-                else:
-                    vrel = vo_new - vp
-                    mu = muk + (mus - muk) * math.exp(-abs(vrel) / vs)
-                    F = mu * Fn if vrel > 0 else -mu * Fn
-                    vp_new = vp + h * (spring + F) / m
-                    if (vo_new - vp_new) * vrel <= 0.0:
-                        vp_new = vo_new
-                        stuck = 1.0
-                    vp = vp_new
-                vo = vo_new
-                xo += vo * h
+                vp, vo, stuck, F = _testbed_substep(m, Fs, muk, mus, vs, Fn, spring, drive, h, vp, vo, stuck)
             else:
-                drag = -co * vo
-                if stuck > 0.5:
-                    a = (drive + drag + spring) / (m + M)
-                    Freq = m * a - spring
-                    if abs(Freq) <= Fs:
-                        F = Freq
-                        vp = vp + h * a
-                        vo = vp
-                    else:
-                        stuck = 0.0
-                        F = Fs if Freq > 0 else -Fs
-                        vp = vp + h * (spring + F) / m
-                        vo = vo + h * (drive + drag - F) / M
-                else:
-                    vrel = vo - vp
-                    mu = muk + (mus - muk) * math.exp(-abs(vrel) / vs)
-                    F = mu * Fn if vrel > 0 else -mu * Fn
-                    vp_new = vp + h * (spring + F) / m
-                    vo_new = vo + h * (drive + drag - F) / M
-                    if (vo_new - vp_new) * vrel <= 0.0:
-                        vc = (m * vp_new + M * vo_new) / (m + M)
-                        vp_new = vc
-                        vo_new = vc
-                        stuck = 1.0
-                    vp = vp_new
-                    vo = vo_new
-                xo += vo * h
+                vp, vo, stuck, F = _grasp_substep(m, M, co, Fs, muk, mus, vs, Fn, spring, drive, h, vp, vo, stuck)
+            xo += vo * h
             xp += vp * h
             vrel_now = vo - vp
             if stuck < 0.5:
                 s += abs(vrel_now) * h
                 slip_n += 1.0
             vrel_acc += vrel_now
+            # the film: d = g_s/g·x_pad + F_n/k_n + texture(s), high-passed (module doc)
             d = alpha * xp + Fn / kn + _texture(s, ta, lam)
             v = decay * v + g * (d - dprev)
             dprev = d
@@ -264,14 +264,7 @@ def contact_step(th, mode, u, dt, substeps, st, y):  # pragma: no cover - compil
         y[n, 3] = xp
         y[n, 4] = xo
         y[n, 5] = F
-    st[0] = xp
-    st[1] = vp
-    st[2] = xo
-    st[3] = vo
-    st[4] = stuck
-    st[5] = s
-    st[6] = v
-    st[7] = dprev
+    st[0], st[1], st[2], st[3], st[4], st[5], st[6], st[7] = xp, vp, xo, vo, stuck, s, v, dprev
 
 
 @numba.njit(cache=True, parallel=True)
