@@ -315,6 +315,44 @@ def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovatio
     if not isinstance(model, LinearModel) or not isinstance(model.system, StateSpace) or not model.system.is_discrete:
         raise DataError("model: expected a discrete state-space LinearModel (e.g. from gripkit.sysid.n4sid)")
     ss = model.system
+    u, y = _pem_data(model, data, u, y)
+    innovation = form == "innovation"
+    feedthrough = bool(np.any(ss.D != 0)) if feedthrough is None else bool(feedthrough)
+    A, B, C, D, K, x0 = _pem_start(model, u, y, feedthrough, innovation)
+    N = u.shape[0]
+    W, Winv = _output_whitening(A, B, C, D, K, x0, u, y)
+    yw = np.ascontiguousarray(y @ W.T)
+    C, D, K = W @ C, W @ D, K @ Winv
+    e = np.empty((N, ss.n_outputs))
+    predict_errors(A, B, C, D, K, x0, u, yw, e)
+    V0 = float(np.sum(e * e))
+    it_warm = 0
+    if N > _WARM_START_SAMPLES:  # converge on the first samples, then polish on all of them
+        A, B, C, D, K, x0, _, it_warm, _, _ = _levenberg_marquardt(
+            A, B, C, D, K, x0, u[:_WARM_START_SAMPLES], yw[:_WARM_START_SAMPLES], feedthrough, innovation,
+            max_iterations, tol)
+    A, B, C, D, K, x0, Vc, it, converged, at_final = _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough,
+                                                                          innovation, max_iterations, tol)
+    cov, (dA, dB, dC, dD), e = _pem_covariance(A, B, C, D, K, x0, u, yw, feedthrough, innovation, at_final)
+    # back to physical output units
+    C, D, K = Winv @ C, Winv @ D, K @ W
+    dC, dD = np.einsum("ij,qjk->qik", Winv, dC), np.einsum("ij,qjk->qik", Winv, dD)
+    e = e @ Winv.T
+    unc = Uncertainty(tuple(f"theta{i}" for i in range(dA.shape[0])), cov, (dA, dB, dC, dD))
+    sysn = StateSpace(A, B, C, D, **ss._signals(meta={**ss.meta, "refined_by": f"pem-{form}"}), states=ss.states,
+                      state_units=ss.state_units, uncertainty=unc)
+    info = {**model.info, "pem": {"form": form, "iterations": it_warm + it, "iterations_warm_start": it_warm,
+                                  "converged": converged, "loss_start": V0 / N,
+                                  "loss": Vc / N, "parameters": dA.shape[0], "feedthrough": feedthrough}}
+    return model.replace(system=sysn, structure=f"pem-{form}", K=K if innovation else None, x0=x0,
+                         noise_covariance=e.T @ e / N, fit_percent=fit_per_output(y, free_run(A, B, C, D, u, x0)),
+                         n_samples=N, info=info)
+
+
+def _pem_data(model: LinearModel, data, u, y) -> tuple[np.ndarray, np.ndarray]:
+    """Input (N, m) and output (N, p) in deviation units, from a Trajectory (its columns by the
+    model's names, offsets removed, sampled as the model) or from ``u`` and ``y``."""
+    ss = model.system
     if data is not None:
         dt = 1.0 / data.require_uniform(why="PEM refinement")
         if abs(dt - ss.dt) > 1e-9 * ss.dt:
@@ -323,44 +361,48 @@ def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovatio
         y = model._columns(data, model.outputs, model.y_offset, "output")
     u = as_io_matrix(u, "input u")
     y = as_io_matrix(y, "output y", u.shape[0])
-    n, m, p = ss.n_states, ss.n_inputs, ss.n_outputs
+    m, p = ss.n_inputs, ss.n_outputs
     if u.shape[1] != m or y.shape[1] != p:
         raise DataError(f"data: the model has {m} input(s) and {p} output(s), the data {u.shape[1]} and {y.shape[1]}")
-    innovation = form == "innovation"
-    feedthrough = bool(np.any(ss.D != 0)) if feedthrough is None else bool(feedthrough)
+    return u, y
+
+
+def _pem_start(model: LinearModel, u, y, feedthrough: bool, innovation: bool):
+    """Starting (A, B, C, D, K, x0): the model's own, with D = 0 unless estimated and K = 0 in
+    output-error form or when the starting predictor A − K C is unstable."""
+    ss = model.system
+    n, m, p = ss.n_states, ss.n_inputs, ss.n_outputs
     A, B, C = ss.A.copy(), ss.B.copy(), ss.C.copy()
     D = ss.D.copy() if feedthrough else np.zeros((p, m))
     K = (model.K.copy() if model.K is not None else np.zeros((n, p))) if innovation else np.zeros((n, p))
     if innovation and _radius(A - K @ C) >= 1.0:
         K = np.zeros((n, p))
     x0 = np.zeros(n) if model.x0 is None else np.array(model.x0, dtype=np.float64)
-    N = u.shape[0]
-    e = np.empty((N, p))
+    return A, B, C, D, K, x0
+
+
+def _output_whitening(A, B, C, D, K, x0, u, y) -> tuple[np.ndarray, np.ndarray]:
+    """W = Λ^{-1/2} and W⁻¹ for the starting model's prediction-error covariance Λ: the outputs
+    are whitened once (ỹ = W y, C̃ = W C, D̃ = W D, K̃ = K W⁻¹), so that V = Σ ẽᵀẽ."""
+    e = np.empty(y.shape)
     predict_errors(A, B, C, D, K, x0, u, y, e)
-    w, V = np.linalg.eigh(e.T @ e / N)
+    w, V = np.linalg.eigh(e.T @ e / u.shape[0])
     if w.min() <= 0:
         raise IdentificationError("pem: the starting model predicts an output exactly (zero error variance)")
-    # whiten the outputs once: ỹ = W y, C̃ = W C, D̃ = W D, K̃ = K W⁻¹ (W = Λ^{-1/2}), V = Σ ẽᵀẽ
-    W, Winv = (V / np.sqrt(w)) @ V.T, (V * np.sqrt(w)) @ V.T
-    yw = np.ascontiguousarray(y @ W.T)
-    C, D, K = W @ C, W @ D, K @ Winv
-    predict_errors(A, B, C, D, K, x0, u, yw, e)
-    V0 = float(np.sum(e * e))
-    it = 0
-    if N > _WARM_START_SAMPLES:  # converge on the first samples, then polish on all of them
-        A, B, C, D, K, x0, _, it, _, _ = _levenberg_marquardt(A, B, C, D, K, x0, u[:_WARM_START_SAMPLES],
-                                                           yw[:_WARM_START_SAMPLES], feedthrough, innovation,
-                                                           max_iterations, tol)
-    A, B, C, D, K, x0, Vc, it2, converged, at_final = _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough,
-                                                                           innovation, max_iterations, tol)
-    it_warm, it = it, it + it2
-    # covariance at the final point
+    return (V / np.sqrt(w)) @ V.T, (V * np.sqrt(w)) @ V.T
+
+
+def _pem_covariance(A, B, C, D, K, x0, u, yw, feedthrough: bool, innovation: bool, at_final):
+    """Covariance of the identifiable parameter directions at the optimum, σ²·(JᵀJ)⁻¹ with σ²
+    from the whitened errors over N·p − d − n degrees of freedom, the directions (dA, dB, dC,
+    dD) and the whitened prediction errors."""
     if at_final is not None:
         J, (dA, dB, dC, dD, dK), e = at_final
     else:
         dA, dB, dC, dD, dK, ent = _directions(A, B, C, D, K, feedthrough, innovation)
         e, J = _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, yw, ent)
-    d = dA.shape[0]
+    N, p = yw.shape
+    n, d = A.shape[0], dA.shape[0]
     dof = N * p - d - n
     if dof <= 0:
         raise DataError(f"pem: {N} samples of {p} output(s) cannot determine {d + n} parameters",
@@ -372,18 +414,4 @@ def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovatio
         raise IdentificationError("pem: the Jacobian is singular at the optimum: the data do not determine the "
                                   "model (a non-minimal order or a poorly exciting input)",
                                   hint="lower the order or excite the system more richly") from None
-    cov = 0.5 * (cov_full[:d, :d] + cov_full[:d, :d].T)
-    # back to physical output units
-    C, D, K = Winv @ C, Winv @ D, K @ W
-    dC, dD = np.einsum("ij,qjk->qik", Winv, dC), np.einsum("ij,qjk->qik", Winv, dD)
-    e = e @ Winv.T
-    Lam = e.T @ e / N
-    unc = Uncertainty(tuple(f"theta{i}" for i in range(d)), cov, (dA, dB, dC, dD))
-    sysn = StateSpace(A, B, C, D, **ss._signals(meta={**ss.meta, "refined_by": f"pem-{form}"}), states=ss.states,
-                      state_units=ss.state_units, uncertainty=unc)
-    ys = free_run(A, B, C, D, u, x0)
-    info = {**model.info, "pem": {"form": form, "iterations": it, "iterations_warm_start": it_warm,
-                                  "converged": converged, "loss_start": V0 / N,
-                                  "loss": Vc / N, "parameters": d, "feedthrough": feedthrough}}
-    return model.replace(system=sysn, structure=f"pem-{form}", K=K if innovation else None, x0=x0,
-                         noise_covariance=Lam, fit_percent=fit_per_output(y, ys), n_samples=N, info=info)
+    return 0.5 * (cov_full[:d, :d] + cov_full[:d, :d].T), (dA, dB, dC, dD), e
