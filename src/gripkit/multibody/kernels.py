@@ -283,7 +283,15 @@ def crba(n, R, P, jtype, mass, com, inertia, armature, M, work):  # pragma: no c
     revolute joint k needs f = ẑ × h, n = I_o ẑ (prismatic: f = m ẑ, n = h × ẑ); M[k, k] is ẑ·n
     (ẑ·f), and M[i, k] for i < k follows by carrying (f, n) down the chain (eqs 4.14–4.16).
     ``work`` holds at least 10·n floats."""
-    # composite inertias, initialised with each link about its own origin
+    _link_inertias(n, mass, com, inertia, work)
+    _composite_inertias(n, R, P, work)
+    _mass_matrix_columns(n, R, P, jtype, armature, M, work)
+
+
+@hot
+def _link_inertias(n, mass, com, inertia, work):  # pragma: no cover - compiled
+    """work[10k:10k+10] = (m, h = m·c, I_o = I_c + m(|c|²1 − c cᵀ) as xx, yy, zz, xy, xz, yz) of
+    each link about its own origin, in its frame: the composite bodies' starting values."""
     for k in range(n):
         o = 10 * k
         m = mass[k]
@@ -302,6 +310,12 @@ def crba(n, R, P, jtype, mass, com, inertia, armature, M, work):  # pragma: no c
         work[o + 7] = inertia[k, 3] - m * cx * cy
         work[o + 8] = inertia[k, 4] - m * cx * cz
         work[o + 9] = inertia[k, 5] - m * cy * cz
+
+
+@hot
+def _composite_inertias(n, R, P, work):  # pragma: no cover - compiled
+    """Add each composite body k+1..n, moved into frame k, to body k, from the tip down (the
+    transformation of :func:`crba`'s docstring)."""
     for k in range(n - 1, 0, -1):
         o = 10 * k
         m = work[o]
@@ -344,6 +358,12 @@ def crba(n, R, P, jtype, mass, com, inertia, armature, M, work):  # pragma: no c
         work[op + 7] += c01 - px * hy - hx * py - m * px * py
         work[op + 8] += c02 - px * hz - hx * pz - m * px * pz
         work[op + 9] += c12 - py * hz - hy * pz - m * py * pz
+
+
+@hot
+def _mass_matrix_columns(n, R, P, jtype, armature, M, work):  # pragma: no cover - compiled
+    """Column k of M from the wrench (f, n) a unit acceleration of joint k needs on composite body
+    k, carried down the chain (eqs 4.14–4.16); the armature on the diagonal."""
     for k in range(n):
         o = 10 * k
         if jtype[k] == 0:
