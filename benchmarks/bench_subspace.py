@@ -11,10 +11,15 @@ Fairness notes (also in each row):
 * gripkit ``n4sid(u, y, 8, horizon=9)`` is the full user call: checks, scaling, factorisation, A and
   C, B and x0 by least squares, Kalman gain, free-run fit.
 * SIPPY: ``system_identification(y.T, u.T, 'N4SID' | 'MOESP', SS_fixed_order=8, SS_f=9, SS_p=9)``.
-* nfoursid: ``NFourSID(df, output_columns, input_columns, num_block_rows=9)``, ``subspace_identification()``,
-  ``system_identification(rank=8)``; it is not installed in gripkit's environment today, so its row
-  says so instead of timing it.
-* Same warm-up (1 call) and repeats on both sides; the median and the minimum are reported.
+* nfoursid 1.0.2: ``NFourSID(df, output_columns, input_columns, num_block_rows=9)``,
+  ``subspace_identification()``, ``system_identification(rank=8)`` (its documented use; a pandas
+  DataFrame is its input format, built outside the timing). Its ``system_identification`` takes a
+  full SVD (``np.linalg.svd``, ``full_matrices=True``) of a p·k × (N − k + 1) matrix, whose
+  right factor alone is (N − k + 1)² float64: 74.5 GiB at N = 10⁵. It is called at N = 10⁵ only when that fits in
+  half the available memory (else the row says so, with the figures); a second pair of rows
+  compares gripkit and nfoursid at N = 10⁴ (0.75 GiB), where nfoursid runs.
+* Both sides of every row go through ``common.measure`` (same warm-up call and number of runs,
+  median and min); accuracy beside the time is the free-run validation fit.
 * Validation fit: free run on the second record with the initial state estimated by least squares
   (the same :meth:`LinearModel.compare` for every model), mean over the two outputs.
 * PEM: ``pem(model, u, y, form)`` from the subspace model, innovation and output-error forms.
@@ -26,16 +31,17 @@ from __future__ import annotations
 
 import contextlib
 import io
-import statistics
-import time
 import warnings
+from pathlib import Path
 
 import numpy as np
-from common import row
+from common import measure, row
 
 N_FULL = 100_000
+N_SMALL = 10_000
 ORDER = 8
 HORIZON = 9
+TARGET = "≥ 5× faster at equal or better validation fit"
 
 
 def _system():
@@ -57,16 +63,6 @@ def _record(g, n, seed):
     return u, y0 + 0.1 * y0.std(axis=0) * rng.standard_normal(y0.shape)
 
 
-def _times(fn, repeat):
-    fn()
-    ts = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        out = fn()
-        ts.append(time.perf_counter() - t0)
-    return statistics.median(ts), min(ts), out
-
-
 def _val_fit(A, B, C, D, uv, yv):
     from gripkit.lti import StateSpace
     from gripkit.sysid.linear_model import LinearModel
@@ -77,94 +73,135 @@ def _val_fit(A, B, C, D, uv, yv):
     return float(np.mean(m.compare(uv, yv)[0]))
 
 
-def run(quick: bool) -> list[dict]:
-    from gripkit.sysid import frf, n4sid, pem
+def _fit_text(fit):
+    return "unstable model" if fit is None else f"validation fit {fit:.2f} %"
 
-    repeat = 3 if quick else 5
+
+def _available_bytes() -> float:
+    with contextlib.suppress(OSError, ValueError, IndexError):
+        for line in Path("/proc/meminfo").read_text().splitlines():
+            if line.startswith("MemAvailable:"):
+                return float(line.split()[1]) * 1024.0
+    return 0.0  # unknown: do not attempt a huge allocation
+
+
+def _nfoursid(u, y):
+    """nfoursid's documented call; returns a function that identifies order 8 and the model's
+    (A, B, C, D)."""
+    import pandas as pd
+    from nfoursid.nfoursid import NFourSID
+
+    df = pd.DataFrame(np.hstack([u, y]), columns=["u0", "u1", "y0", "y1"])
+
+    def call():
+        nf = NFourSID(df, output_columns=["y0", "y1"], input_columns=["u0", "u1"], num_block_rows=HORIZON)
+        nf.subspace_identification()
+        ss, _ = nf.system_identification(rank=ORDER)
+        return ss.a, ss.b, ss.c, ss.d
+    return call
+
+
+def _gripkit_n4sid(u, y, method="n4sid"):
+    from gripkit.sysid import n4sid
+
+    return lambda: n4sid(u, y, ORDER, method=method, horizon=HORIZON)
+
+
+def _abcd(model):
+    s = model.system
+    return s.A, s.B, s.C, s.D
+
+
+def _nfoursid_rows(g, uv, yv, u, y, ours, model) -> list[dict]:
+    """nfoursid beside gripkit at N = 1e5 (when its N² SVD fits in memory) and at N = 1e4."""
+    try:
+        import nfoursid  # noqa: F401
+    except ImportError:  # pragma: no cover - in the lock file and the bench extra
+        return [row("subspace", "n4sid 2×2, N=1e5, order 8", ours, "nfoursid", None,
+                    notes="nfoursid not installed: not timed")]
+    rows = []
+    need = 8.0 * (u.shape[0] - HORIZON + 1) ** 2
+    avail = _available_bytes()
+    g_fit = _val_fit(*_abcd(model), uv, yv)
+    task = "n4sid 2×2, N=1e5, order 8 (median)"
+    if need <= 0.5 * avail:  # pragma: no cover - needs ~150 GiB of free memory
+        t = measure(_nfoursid(u, y))
+        fit = _val_fit(*_nfoursid(u, y)(), uv, yv)
+        rows.append(row("subspace", task, ours, "nfoursid", t, target=TARGET, gripkit_accuracy=_fit_text(g_fit),
+                        peer_accuracy=_fit_text(fit), notes="same order and horizon; free run, x0 estimated"))
+    else:
+        rows.append(row("subspace", task, ours, "nfoursid", None, target=TARGET, gripkit_accuracy=_fit_text(g_fit),
+                        notes=f"nfoursid not run at N=1e5: its system_identification takes a full SVD "
+                              f"(np.linalg.svd, full_matrices=True) whose right factor needs {need / 2**30:.1f} GiB; "
+                              f"{avail / 2**30:.1f} GiB available (MemoryError). See the N=1e4 row."))
+    us, ys = _record(g, N_SMALL, 1)
+    t_g = measure(_gripkit_n4sid(us, ys))
+    t_p = measure(_nfoursid(us, ys))
+    rows.append(row("subspace", "n4sid 2×2, N=1e4, order 8 (median)", t_g, "nfoursid", t_p, target=TARGET,
+                    gripkit_accuracy=_fit_text(_val_fit(*_abcd(_gripkit_n4sid(us, ys)()), uv, yv)),
+                    peer_accuracy=_fit_text(_val_fit(*_nfoursid(us, ys)(), uv, yv)),
+                    notes="same order and horizon; free run on the N=2e4 validation record, x0 estimated; "
+                          "nfoursid's time is mostly its N×N SVD factor (0.75 GiB)"))
+    return rows
+
+
+def run(quick: bool) -> list[dict]:
+    """All rows; ``quick`` changes nothing (the problem sizes are the issue's targets)."""
+    from gripkit.sysid import frf, pem
+
     g = _system()
     u, y = _record(g, N_FULL, 1)
     uv, yv = _record(g, 20_000, 2)
     rows = []
-    fits = {}
     ours = {}
     for method in ("n4sid", "moesp"):
-        med, best, m = _times(lambda: n4sid(u, y, ORDER, method=method, horizon=HORIZON), repeat)
-        ours[method] = (med, best, m)
-        s = m.system
-        fits[method] = _val_fit(s.A, s.B, s.C, s.D, uv, yv)
+        call = _gripkit_n4sid(u, y, method)
+        ours[method] = (measure(call), call())
     try:
         import sippy_unipi as sippy
-    except ImportError:  # pragma: no cover
+    except ImportError:  # pragma: no cover - in the lock file and the bench extra
         sippy = None
     for method, sip in (("n4sid", "N4SID"), ("moesp", "MOESP")):
-        med, best, m = ours[method]
-        peer_med = peer_best = peer_fit = None
-        note = ""
-        if sippy is not None:
-            def call():
-                with contextlib.redirect_stdout(io.StringIO()), warnings.catch_warnings():
-                    warnings.simplefilter("ignore")
-                    return sippy.system_identification(y.T, u.T, sip, SS_fixed_order=ORDER, SS_f=HORIZON, SS_p=HORIZON)
-            peer_med, peer_best, sm = _times(call, repeat)
-            peer_fit = _val_fit(np.asarray(sm.A), np.asarray(sm.B), np.asarray(sm.C), np.asarray(sm.D), uv, yv)
-        else:
-            note = "sippy_unipi not installed"
-        rows.append(row("subspace", f"{method} 2×2, N=1e5, order 8 (median)", med, f"sippy_unipi {sip}", peer_med,
-                        target="≥ 5× faster at equal or better validation fit",
-                        notes=note or "same order and horizon; validation = free run, x0 estimated",
-                        extra={"gripkit_min_s": best, "peer_min_s": peer_best,
-                               "gripkit_validation_fit_percent": fits[method],
-                               "peer_validation_fit_percent": peer_fit}))
-    try:
-        import nfoursid  # noqa: F401
-        have_nfoursid = True
-    except ImportError:
-        have_nfoursid = False
-    if have_nfoursid:  # pragma: no cover - not in the locked environment today
-        import pandas as pd
-        from nfoursid.nfoursid import NFourSID
+        t, model = ours[method]
+        g_fit = _val_fit(*_abcd(model), uv, yv)
+        task = f"{method} 2×2, N=1e5, order 8 (median)"
+        if sippy is None:  # pragma: no cover
+            rows.append(row("subspace", task, t, f"sippy_unipi {sip}", None, notes="sippy_unipi not installed"))
+            continue
 
-        df = pd.DataFrame(np.hstack([u, y]), columns=["u0", "u1", "y0", "y1"])
-
-        def call_nf():
-            nf = NFourSID(df, output_columns=["y0", "y1"], input_columns=["u0", "u1"], num_block_rows=HORIZON)
-            nf.subspace_identification()
-            ss, _ = nf.system_identification(rank=ORDER)
-            return ss
-        pm, pb, ss = _times(call_nf, repeat)
-        pf = _val_fit(ss.a, ss.b, ss.c, ss.d, uv, yv)
-        rows.append(row("subspace", "n4sid 2×2, N=1e5, order 8 (median)", ours["n4sid"][0], "nfoursid", pm,
-                        target="≥ 5× faster at equal or better validation fit",
-                        extra={"gripkit_min_s": ours["n4sid"][1], "peer_min_s": pb,
-                               "gripkit_validation_fit_percent": fits["n4sid"], "peer_validation_fit_percent": pf}))
-    else:
-        rows.append(row("subspace", "n4sid 2×2, N=1e5, order 8", ours["n4sid"][0], "nfoursid", None,
-                        notes="nfoursid is not installed in gripkit's locked environment: not timed",
-                        extra={"gripkit_min_s": ours["n4sid"][1], "gripkit_validation_fit_percent": fits["n4sid"]}))
-    start = ours["n4sid"][2]
+        def call():
+            with contextlib.redirect_stdout(io.StringIO()), warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                sm = sippy.system_identification(y.T, u.T, sip, SS_fixed_order=ORDER, SS_f=HORIZON, SS_p=HORIZON)
+            return np.asarray(sm.A), np.asarray(sm.B), np.asarray(sm.C), np.asarray(sm.D)
+        t_p = measure(call)
+        rows.append(row("subspace", task, t, f"sippy_unipi {sip}", t_p, target=TARGET,
+                        gripkit_accuracy=_fit_text(g_fit), peer_accuracy=_fit_text(_val_fit(*call(), uv, yv)),
+                        notes="same order and horizon; validation = free run, x0 estimated"))
+    rows += _nfoursid_rows(g, uv, yv, u, y, *ours["n4sid"])
+    start = ours["n4sid"][1]
     for form in ("innovation", "oe"):
-        med, best, r = _times(lambda: pem(start, u=u, y=y, form=form), 1 if quick else 3)
-        s = r.system
-        rows.append(row("subspace", f"PEM refinement ({form}) of the order-8 model, N=1e5", med, "", None,
-                        target="< 2 s", notes="from the N4SID model; exact sensitivity Jacobians",
-                        extra={"gripkit_min_s": best, "iterations": r.info["pem"]["iterations"],
-                               "validation_fit_percent": _val_fit(s.A, s.B, s.C, s.D, uv, yv)}))
+        call = lambda: pem(start, u=u, y=y, form=form)  # noqa: E731
+        t = measure(call)
+        r = call()
+        rows.append(row("subspace", f"PEM refinement ({form}) of the order-8 model, N=1e5", t, "", None,
+                        target="< 2 s", gripkit_accuracy=_fit_text(_val_fit(*_abcd(r), uv, yv)),
+                        notes="from the N4SID model; exact sensitivity Jacobians",
+                        extra={"iterations": r.info["pem"]["iterations"]}))
     # FRF of 1e6 samples
     from scipy import signal
 
     rng = np.random.default_rng(3)
     uf = rng.standard_normal(1_000_000)
     yf = signal.lfilter([0.2, 0.1], [1.0, -1.2, 0.5], uf) + 0.1 * rng.standard_normal(uf.size)
-    med, best, _ = _times(lambda: frf(uf, yf, fs=1000.0, nperseg=4096), repeat)
+    t = measure(lambda: frf(uf, yf, fs=1000.0, nperseg=4096))
 
     def scipy_h1():
         f, pyu = signal.csd(uf, yf, fs=1000.0, nperseg=4096)
         _, puu = signal.welch(uf, fs=1000.0, nperseg=4096)
         return pyu / puu
-    pm, pb, _ = _times(scipy_h1, repeat)
-    rows.append(row("subspace", "FRF (Welch H1 with σ and coherence) of 1e6 samples", med, "scipy.signal csd/welch",
-                    pm, target="< 0.5 s", notes="scipy gives H1 only (no σ, no coherence)",
-                    extra={"gripkit_min_s": best, "peer_min_s": pb}))
+    rows.append(row("subspace", "FRF (Welch H1 with σ and coherence) of 1e6 samples", t, "scipy.signal csd/welch",
+                    measure(scipy_h1), target="< 0.5 s", notes="scipy gives H1 only (no σ, no coherence)"))
     return rows
 
 
@@ -172,4 +209,4 @@ if __name__ == "__main__":
     import json
 
     for r in run(quick=True):
-        print(json.dumps(r))
+        print(json.dumps(r, default=str))

@@ -44,6 +44,44 @@ def test_from_periodic_frf_within_sigma():
     assert np.max(np.abs(biased.system.denominator()[1:] - [0.8, 4.0]) / biased.info["den_std"][1:]) > 4
 
 
+NOISE_FREE = [TransferFunction([4.0], [1.0, 0.8, 4.0]),      # ω_n = 2 rad/s, ζ = 0.2, no zero
+              TransferFunction([2.0, 4.0], [1.0, 0.8, 4.0]),
+              TransferFunction([3.0], [1.0, 0.1, 9.0])]      # ζ ≈ 0.017: a sharp resonance
+
+
+def _coefficients(g, nz):
+    return np.concatenate([g.denominator()[1:], g.numerator()[-(nz + 1):]])
+
+
+@pytest.mark.parametrize("g", NOISE_FREE)
+def test_noise_free_time_domain_exact(g):
+    """Noise-free ZOH data are the easiest case: the coefficients come back to ~1e-8 relative (the
+    fit used to stop with 'singular Jacobian' when the through-the-hold FRF refinement started
+    from an unstable continuous fit), and σ is ~0, not NaN."""
+    nz = g.numerator().size - 1
+    u = np.random.default_rng(0).standard_normal(4000)
+    y = g.c2d(0.05).simulate(u)[:, 0]
+    m = tfest(u, y, 2, nz, dt=0.05)
+    truth = _coefficients(g, nz)
+    est = _coefficients(m.system, nz)
+    assert np.max(np.abs(est - truth) / np.abs(truth)) < 1e-8
+    sd = np.concatenate([m.info["den_std"][1:], m.info["num_std"]])
+    assert np.all(np.isfinite(sd)) and np.all(sd < 1e-8 * np.abs(truth))
+    assert m.fit_percent[0] > 100 - 1e-6
+
+
+@pytest.mark.parametrize("g", NOISE_FREE[:2])
+def test_noise_free_periodic_frf_exact(g):
+    """The FRF of noise-free periodic data is G's ZOH equivalent on every line (transient dropped):
+    tfest_frf through the hold recovers G to ~1e-8 relative."""
+    nz = g.numerator().size - 1
+    ex = periodic_multisine(0.02, 5.0, 20.0, 2000, 5, amplitude=1.0)
+    r = frf(ex.u, g.c2d(0.05).simulate(ex.u)[:, 0], fs=20.0, periods=5)
+    m = tfest_frf(r, 2, nz, dt=0.05)
+    truth = _coefficients(g, nz)
+    assert np.max(np.abs(_coefficients(m.system, nz) - truth) / np.abs(truth)) < 1e-8
+
+
 def test_more_zeros_than_poles_refused():
     u, y = _data(1000, 0)
     with pytest.raises(DataError, match="zeros"):

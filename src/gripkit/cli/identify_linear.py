@@ -2,12 +2,16 @@
 
 Every command reads DATA (CSV, Parquet or HDF5) with ``--input COL --output COL``, removes the
 operating point (``--detrend mean`` by default), and prints a summary table, or one JSON object
-(a list for ``search``) with ``--json``. Warnings (an unstable model in validation, a
+(a list for ``search``) with ``--json``. ``identify arx`` also takes several columns
+(``--input a,b --output c,d``): a matrix-polynomial ARX whose fit figures (``fit_percent``,
+``one_step_fit_percent``, ``validation.fit_percent``) are lists per output in ``--output`` order;
+with one input and one output its JSON is the SISO one (``validation.fit_percent`` a number). Warnings (an unstable model in validation, a
 non-converged iteration) go to stderr as ``warning: ...`` lines and into the JSON ``warnings``.
 """
 
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import typer
@@ -26,6 +30,8 @@ ModelOutOpt = typer.Option(None, "--out", help="Write the identified model to th
 NaOpt = typer.Option(..., "--na", help="Number of A coefficients (after the leading 1).")
 NbOpt = typer.Option(..., "--nb", help="Number of B coefficients.")
 NkOpt = typer.Option(..., "--nk", help="Input delay in samples (B's leading zeros).")
+InputsOpt = typer.Option(..., "--input", help="Input column, or several comma-separated (a,b: MIMO ARX).")
+OutputsOpt = typer.Option(..., "--output", help="Output column, or several comma-separated (c,d: MIMO ARX).")
 
 
 DETREND_CHOICES = ("mean", "linear", "none")
@@ -113,15 +119,75 @@ def _print_model(model, val) -> None:
                   f"(p = {tt.independence_p:.3g})")
 
 
+def _mimo_arx(data: Path, input: str, output: str, na: int, nb: int, nk: int, fs, time, fill, detrend: str,
+              validate: Path | None, json_out: bool, out_file: Path | None) -> None:
+    """Matrix-polynomial ARX of several columns: every fit figure is a list per output, in
+    ``--output`` order (free run with estimated x0, one-step, and free run on ``--validate``)."""
+    from ..errors import DataError, StabilityWarning
+    from ..sysid.identify_mimo import identify_arx as fit_arx
+    from ..sysid.identify_mimo import parse_names, validation_fit
+    from ..sysid.model_file import file_sha256
+
+    if detrend == "linear":
+        raise DataError("--detrend: 'linear' is for one input and one output; with several columns expected "
+                        "mean or none", hint="use --detrend mean, or detrend the columns before")
+    columns = list(parse_names(input, "--input")) + list(parse_names(output, "--output"))
+    with collected_warnings() as caught:
+        tr = load_data(data, columns, fs, time, fill)
+        model = fit_arx(tr, input=input, output=output, na=na, nb=nb, nk=nk, detrend=detrend)
+        model = model.replace(data_file=Path(data).name, data_hash=file_sha256(data))
+        if out_file is not None:
+            model.save(out_file)
+        res = model.to_dict()
+        info = res.pop("info")
+        res.update(na=na, nb=nb, nk=nk, data=str(data), detrend=detrend, n_samples=model.n_samples,
+                   one_step_fit_percent=info["one_step_fit_percent"],
+                   **{k: info[k] for k in ("A_poly", "A_poly_std", "B_poly", "B_poly_std")},
+                   out=None if out_file is None else str(out_file))
+        if not model.stable:
+            warnings.warn("arx: the identified model is unstable (a pole on or outside the unit circle): "
+                          "no free-run fit is reported", StabilityWarning, stacklevel=1)
+        if validate is not None:
+            vfit = validation_fit(model, load_data(validate, columns, fs, time, fill), detrend)
+            res["validation_fit_percent"] = vfit
+            res["validation"] = {"fit_percent": vfit, "data": str(validate), "initial_state": "estimated"}
+    res["warnings"] = report_warnings(caught)
+    if json_out:
+        emit_json(res)
+        return
+    typer.echo(f"ARX [{na} {nb} {nk}]: {len(model.inputs)} input(s) {list(model.inputs)} → {len(model.outputs)} "
+               f"output(s) {list(model.outputs)}, dt = {model.dt:g} s, N = {model.n_samples}, "
+               f"{'stable' if model.stable else 'UNSTABLE'}")
+    for what, polys, stds in (("A", res["A_poly"], res["A_poly_std"]), ("B", res["B_poly"], res["B_poly_std"])):
+        first = 1 if what == "A" else nk
+        for i, (c, sd) in enumerate(zip(polys, stds)):
+            rows = "; ".join(" ".join(f"{v:.4g}±{s:.2g}" for v, s in zip(r, rs)) for r, rs in zip(c, sd))
+            typer.echo(f"  {what}{first + i} = [{rows}]")
+    for i, name in enumerate(model.outputs):
+        free = "—" if model.fit_percent is None else f"{model.fit_percent[i]:.2f} %"
+        line = f"  {name}: fit free run {free}, 1-step {res['one_step_fit_percent'][i]:.2f} %"
+        if res.get("validation_fit_percent") is not None:
+            line += f", validation free run {res['validation_fit_percent'][i]:.2f} %"
+        typer.echo(line)
+    if out_file is not None:
+        typer.echo(f"model written to {out_file}")
+
+
 @identify_app.command("arx")
-def identify_arx(data: Path = DataArg, input: str = InputOpt, output: str = OutputOpt,
+def identify_arx(data: Path = DataArg, input: str = InputsOpt, output: str = OutputsOpt,
                  na: int = NaOpt, nb: int = NbOpt, nk: int = NkOpt,
                  fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                  validate: Path = ValidateOpt, json_out: bool = JsonOpt, out: Path = ModelOutOpt):
-    """ARX (orders na, nb, nk) by least squares (QR), with σ, loss (eq 29), fit, AIC, poles and zeros."""
+    """ARX (orders na, nb, nk) by least squares (QR), with σ, loss (eq 29), fit, AIC, poles and zeros.
+    With several columns (``--input a,b --output c,d``) a matrix-polynomial ARX: fit figures are
+    lists per output, in ``--output`` order."""
     from ..sysid import arx
+    from ..sysid.identify_mimo import several
 
     _check_options(fs, fill, detrend, validate, na=na, nb=nb, nk=nk)
+    if several(input, output):
+        _mimo_arx(data, input, output, na, nb, nk, fs, time, fill, detrend, validate, json_out, out)
+        return
     _fit_and_report("arx", data, input, output, fs, time, fill, detrend, validate, json_out,
                     lambda io: arx(io.u, io.y, na, nb, nk, dt=io.dt, **io.meta), out)
 

@@ -26,7 +26,7 @@ from ..progress import status
 from ..signals.trajectory import Trajectory
 
 __all__ = ["MimoData", "mimo_data", "identify_ss", "identify_frf", "identify_tf", "identify_arx", "several",
-           "parse_names", "parse_order"]
+           "parse_names", "parse_order", "validation_fit"]
 
 
 def parse_names(x, what: str) -> tuple[str, ...]:
@@ -108,10 +108,26 @@ def mimo_data(data: Trajectory, inputs, outputs, detrend: str = "mean", why: str
                     tuple(data.unit(n) for n in outs), tuple(map(float, u0)), tuple(map(float, y0)))
 
 
+def _validation_data(validate: Trajectory, inputs, outputs, dt: float, detrend: str) -> MimoData:
+    vd = mimo_data(validate, inputs, outputs, detrend, why="validation")
+    if abs(vd.dt - dt) > 1e-9 * dt:
+        raise DataError(f"validation data are sampled at {1 / vd.dt:g} Hz, the estimation data at {1 / dt:g} Hz",
+                        hint="resample one of them")
+    return vd
+
+
 def _validation_fit(model, vd: MimoData) -> list[float] | None:
     if not model.stable:
         return None
     return model.compare(vd.u, vd.y, dt=vd.dt)[0]
+
+
+def validation_fit(model, validate: Trajectory, detrend: str = "mean") -> list[float] | None:
+    """Free-run fit (%) per output of a discrete ``model`` on the record ``validate`` (the model's
+    columns, by name, with the record's own operating point removed as ``detrend`` says; initial
+    state estimated); None for an unstable model, whose free run diverges."""
+    vd = _validation_data(validate, model.inputs, model.outputs, model.dt, detrend)
+    return _validation_fit(model, vd)
 
 
 def _aic(model, d: MimoData) -> float:
@@ -143,12 +159,7 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     if method not in SUBSPACE_METHODS:
         raise DataError(f"method: expected one of {', '.join(SUBSPACE_METHODS)}, found {method!r}")
     d = mimo_data(data, input, output, detrend, why="state-space identification")
-    vd = None
-    if validate is not None:
-        vd = mimo_data(validate, d.inputs, d.outputs, detrend, why="validation")
-        if abs(vd.dt - d.dt) > 1e-9 * d.dt:
-            raise DataError(f"validation data are sampled at {1 / vd.dt:g} Hz, the estimation data at {1 / d.dt:g} Hz",
-                            hint="resample one of them")
+    vd = None if validate is None else _validation_data(validate, d.inputs, d.outputs, d.dt, detrend)
     rng = parse_order(order)
     n_hi = rng[1] if rng else DEFAULT_MAX_ORDER
     k = default_horizon(n_hi, d.y.shape[1]) if horizon is None else int(horizon)
