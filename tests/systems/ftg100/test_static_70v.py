@@ -131,3 +131,12 @@ def test_zoo_check_lists_the_70V_findings(capsys):
     lines = {ln.split(": ")[1]: ln for ln in out.splitlines()}
     assert lines["static-70V"].startswith("[ok]") and "= 2e-05 m" in lines["static-70V"]
     assert lines["eq5-force-factor"].startswith("[INCONSISTENT]") and "κ = 0.5592" in lines["eq5-force-factor"]
+
+
+def test_zoo_discretize_refuses_the_nonlinear_plant(capsys):
+    """The plant has no linear form to discretise: one error line that lists the linear models only."""
+    code = main(["zoo", "discretize", "ftg100-plant", "--fs", "20000"])
+    out, err = capsys.readouterr()
+    assert code == 1 and out == "" and len(err.strip().splitlines()) == 1
+    assert err.startswith("error: ModelError: zoo model 'ftg100-plant' has no linear continuous-time form")
+    assert err.rstrip().endswith("discretize works on: ftg100-actuated, ftg100-sensing, ftg100-coupled")
