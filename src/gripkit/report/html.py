@@ -16,7 +16,8 @@ missing value (None or NaN) reads "not given", and a row that reports ``INCONSIS
 highlighted.
 
 Narrow screens (a ``viewport`` meta tag; checked at 1400 px and 390 px in headless Chromium by
-``scripts/screenshot_report.py``): each table scrolls sideways inside its own box, figures shrink
+``scripts/screenshot_report.py``): each table scrolls sideways inside its own box (its prose
+columns keep at least 8em, not a word per line), figures shrink
 to the page width, and a word longer than the line (a long identifier in prose or a caption)
 breaks instead of widening the page.
 """
@@ -121,7 +122,8 @@ td.txt,th:first-child,td:first-child{text-align:left}td.na{color:#888;font-style
 tr.bad td{background:#fde8e6}tr.bad td:first-child{font-weight:600;color:#a31515}
 figure{margin:1.2em 0}figure img{max-width:100%;height:auto;border:1px solid #dde}
 figcaption,.cap{font-size:.9em;color:#555}nav ul{columns:2}.meta{color:#666;font-size:.9em}
-@media (max-width:700px){body{margin:1em auto;font-size:.95em}nav ul{columns:1}table{font-size:.85em}}
+@media (max-width:700px){body{margin:1em auto;font-size:.95em}nav ul{columns:1}table{font-size:.85em}
+td.txt{min-width:8em}}
 """
 
 
