@@ -42,3 +42,7 @@ def test_viewport_and_figures_linked(tmp_path):
     assert "name='viewport'" in html and "width=device-width" in html
     assert 'href="figures/line.png"' in html and (out / "figures" / "line.png").is_file()
     assert "@media (max-width:700px)" in html
+    # phone width (measured in a browser by tests/report/test_report_browser.py): tables scroll in
+    # their own box, figures shrink, long words break
+    assert '<div class="tbl"><table>' in html and ".tbl{overflow-x:auto}" in html
+    assert "figure img{max-width:100%" in html and "overflow-wrap:break-word" in html

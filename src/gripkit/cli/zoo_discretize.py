@@ -26,7 +26,7 @@ def zoo_discretize(name: str = typer.Argument(..., help="Zoo model name (gripkit
     if not hasattr(model, "discrete"):
         from .. import zoo
 
-        ok = [e.name for e in zoo.entries() if e.name.startswith("ftg100")]
+        ok = [e.name for e in zoo.entries() if e.name.startswith("ftg100") and hasattr(_build(e.name), "discrete")]
         raise ModelError(f"zoo model {name!r} has no linear continuous-time form to discretise",
                          hint=f"discretize works on: {', '.join(ok)}")
     sys = model.discrete(fs, form=form)

@@ -60,6 +60,14 @@ _ENTRIES: tuple[ZooEntry, ...] = (
              "Coupled gripper model (eq 18): voltage (V) to tip displacements, gripping force and "
              "readout voltage through the object stiffness k0",
              _FTG, "gripkit.systems.ftg100.parameters:coupled_model"),
+    ZooEntry("ftg100-plant", "FemtoTools FT-G100 microgripper",
+             "Nonlinear plant: eq 5 comb-drive force as printed (V², 0-200 V), stiffening suspensions, "
+             "unilateral contact with the ball; 29.6 um free at 70 V against the stated 20 um (reported)",
+             _FTG, "gripkit.systems.ftg100.parameters:plant_model"),
+    ZooEntry("ftg100-plant-calibrated", "FemtoTools FT-G100 microgripper",
+             "Nonlinear plant with the comb-drive force factor fitted to the stated 20 um at 70 V "
+             "(0.559 x eq 5); the departure from eq 5 is reported",
+             _FTG, "gripkit.systems.ftg100.parameters:calibrated_plant_model"),
     ZooEntry("tsfm-left", "TSFM piezo microgripper", "Left finger, Table II: Bouc-Wen + D(s) actuator, lever, force "
              "sensor (8.52 kHz, ζ = 0.006), eqs 3-13", _TSFM, "gripkit.systems.tsfm.parameters:left_finger"),
     ZooEntry("tsfm-right", "TSFM piezo microgripper", "Right finger, Table II (as tsfm-left)", _TSFM,

@@ -4,9 +4,10 @@ with provenance are in :mod:`gripkit.systems.ftg100.model`)."""
 
 from __future__ import annotations
 
-from .model import FTG100Actuated, FTG100Coupled, FTG100Plant, FTG100Sensing
+from .model import FTG100Actuated, FTG100Coupled, FTG100Plant, FTG100Sensing, plant_parameters
 
-__all__ = ["PAPER_VALUES", "actuated_model", "sensing_model", "coupled_model", "plant_model"]
+__all__ = ["PAPER_VALUES", "actuated_model", "sensing_model", "coupled_model", "plant_model",
+           "calibrated_plant_model"]
 
 #: The seed's identified values (SI) with their section.
 PAPER_VALUES = {"M_a": (1.37e-6, "§III-B"), "K_fa": (1.3e-3, "§III-B"), "k0": (1043.0, "§III-B"),
@@ -29,5 +30,14 @@ def coupled_model(**values) -> FTG100Coupled:
 
 
 def plant_model(**values) -> FTG100Plant:
-    """The nonlinear plant (stiffening suspensions, V² actuation, contact with the object)."""
+    """Zoo ``ftg100-plant``: the nonlinear plant (stiffening suspensions, V² actuation with eq 5's
+    force as printed, contact with the object): 29.6 µm free at 70 V against the seed's 20 µm."""
     return FTG100Plant(**values)
+
+
+def calibrated_plant_model(**values) -> FTG100Plant:
+    """Zoo ``ftg100-plant-calibrated``: the nonlinear plant with the comb-drive force factor fitted
+    to the seed's 20 µm at 70 V (κ = 0.5592 × eq 5, ``plant_parameters(force_factor='static-70V')``;
+    derivation in :mod:`gripkit.systems.ftg100.model`). ``values`` replace parameters before the fit."""
+    check = values.pop("check", True)
+    return FTG100Plant(plant_parameters(force_factor="static-70V", **values), check=check)
