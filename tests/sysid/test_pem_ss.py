@@ -6,7 +6,7 @@ import pytest
 
 from gripkit.lti import StateSpace
 from gripkit.sysid import n4sid, pem
-from gripkit.sysid.pem_ss import _directions, predict_errors, _predict_sensitivity
+from gripkit.sysid.pem_ss import _directions, _gauss_newton_terms, _predict_sensitivity, predict_errors
 
 from mimo_systems import TRUE_POLES, match_poles, oe_data, two_by_two
 
@@ -26,10 +26,12 @@ def test_sensitivity_jacobian_matches_finite_differences(feedthrough, innovation
     dA, dB, dC, dD, dK, entries = _directions(A, B, C, D, K, feedthrough, innovation)
     d = dA.shape[0]
     assert d == n * m + p * n + (p * m if feedthrough else 0) + (n * p if innovation else 0)
-    e, J = _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, y, entries)
-    # the dense kernel (any tangents) gives the same Jacobian
-    assert np.allclose(_predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, y)[1], J, rtol=1e-12,
-                       atol=1e-12 * np.abs(J).max())
+    e, J = _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, y)
+    # the Gauss-Newton terms of the unit-direction kernel (J never formed) are JᵀJ and Jᵀe
+    e2, H, g = _gauss_newton_terms(A, B, C, D, K, x0, u, y, entries)
+    np.testing.assert_array_equal(e2, e)
+    np.testing.assert_allclose(H, J.T @ J, rtol=0, atol=1e-12 * np.abs(J.T @ J).max())
+    np.testing.assert_allclose(g, J.T @ e.reshape(-1), rtol=0, atol=1e-12 * np.abs(J).max() * np.abs(e).sum())
     h = 1e-6
     for q in range(d + n):
         th, dx = np.zeros(d), np.zeros(n)

@@ -37,7 +37,6 @@ import scipy.linalg as sla
 from ..errors import DataError, IdentificationError
 from ..lti import StateSpace, Uncertainty
 from .linear_model import LinearModel, as_io_matrix, fit_per_output, free_run
-from .subspace import _gram
 
 __all__ = ["pem", "PEM_FORMS"]
 
@@ -118,54 +117,99 @@ def _sensitivities(Abar, C, F, G, S0, Z, J):  # pragma: no cover - compiled
                 s[r] = sn[r]
 
 
-@numba.njit(cache=True, parallel=True)
-def _sensitivities_entries(Abar, C, K, entries, n_x0, X, U, E, J):  # pragma: no cover - compiled
-    """As :func:`_sensitivities` for unit directions: entry (kind, r, c) of A, B, C, D or K
-    (kind 0 … 4) forces s with e_r x_c, e_r u_c, −K[:, r] x_c, −K[:, r] u_c or e_r e_c, and the
-    C, D entries add x_c, u_c to output r; then ``n_x0`` directions of x0 (s[0] = e_i)."""
+#: samples per block of :func:`_sensitivity_gram` (its rows of J go to BLAS in one product)
+_GRAM_BLOCK = 256
+
+
+@numba.njit(cache=True)
+def _sensitivity_gram(Abar, C, K, entries, n_x0, X, U, E, H, g):  # pragma: no cover - compiled
+    """H = JᵀJ and g = Jᵀe for unit directions, without forming J: entry (kind, r, c) of A, B, C, D
+    or K (kind 0 … 4) forces s with e_r x_c, e_r u_c, −K[:, r] x_c, −K[:, r] u_c or e_r e_c, and
+    the C, D entries add x_c, u_c to output r; then ``n_x0`` directions of x0 (s[0] = e_i). The
+    sensitivities of all d + n_x0 directions advance together as the columns of one n × Q state
+    matrix S (the inner loops over its contiguous columns), and blocks of
+    :data:`_GRAM_BLOCK` samples' rows of J are added to H and g by one BLAS product each.
+    :func:`_predict_sensitivity` forms the same J for any tangents (the tests compare them)."""
     n = Abar.shape[0]
     p = C.shape[0]
     d = entries.shape[0]
-    for q in numba.prange(d + n_x0):
-        s = np.zeros(n)
-        sn = np.empty(n)
-        kind, r, c = -1, 0, 0
-        if q < d:
+    Q = d + n_x0
+    S = np.zeros((n, Q))
+    Sn = np.empty((n, Q))
+    for i in range(n_x0):
+        S[i, d + i] = 1.0
+    rows = np.empty((_GRAM_BLOCK * p, Q))
+    eb = np.empty(_GRAM_BLOCK * p)
+    H[:, :] = 0.0
+    g[:] = 0.0
+    fill = 0
+    for t in range(X.shape[0]):
+        for i in range(p):
+            row = rows[fill]
+            for q in range(Q):
+                row[q] = 0.0
+            for j in range(n):
+                cij = C[i, j]
+                sj = S[j]
+                for q in range(Q):
+                    row[q] += cij * sj[q]
+            eb[fill] = E[t, i]
+            fill += 1
+        for q in range(d):  # C and D entries add x_c, u_c to output r
             kind, r, c = entries[q, 0], entries[q, 1], entries[q, 2]
-        else:
-            s[q - d] = 1.0
-        for t in range(X.shape[0]):
-            for i in range(p):
-                acc = 0.0
-                for j in range(n):
-                    acc += C[i, j] * s[j]
-                J[t * p + i, q] = acc
             if kind == 2:
-                J[t * p + r, q] += X[t, c]
+                rows[fill - p + r, q] += X[t, c]
             elif kind == 3:
-                J[t * p + r, q] += U[t, c]
-            for i in range(n):
-                acc = 0.0
-                for j in range(n):
-                    acc += Abar[i, j] * s[j]
-                sn[i] = acc
+                rows[fill - p + r, q] += U[t, c]
+        if fill == rows.shape[0] or t == X.shape[0] - 1:
+            blk = rows[:fill]
+            H += np.dot(blk.T, blk)
+            g += np.dot(blk.T, eb[:fill])
+            fill = 0
+        for i in range(n):
+            sni = Sn[i]
+            for q in range(Q):
+                sni[q] = 0.0
+            for j in range(n):
+                a = Abar[i, j]
+                sj = S[j]
+                for q in range(Q):
+                    sni[q] += a * sj[q]
+        for q in range(d):
+            kind, r, c = entries[q, 0], entries[q, 1], entries[q, 2]
             if kind == 0:
-                sn[r] += X[t, c]
+                Sn[r, q] += X[t, c]
             elif kind == 1:
-                sn[r] += U[t, c]
+                Sn[r, q] += U[t, c]
             elif kind == 4:
-                sn[r] += E[t, c]
+                Sn[r, q] += E[t, c]
             elif kind == 2:
                 for i in range(n):
-                    sn[i] -= K[i, r] * X[t, c]
+                    Sn[i, q] -= K[i, r] * X[t, c]
             elif kind == 3:
                 for i in range(n):
-                    sn[i] -= K[i, r] * U[t, c]
-            for i in range(n):
-                s[i] = sn[i]
+                    Sn[i, q] -= K[i, r] * U[t, c]
+        for i in range(n):
+            for q in range(Q):
+                S[i, q] = Sn[i, q]
 
 
-def _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, y, entries=None):
+def _gauss_newton_terms(A, B, C, D, K, x0, u, y, entries):
+    """Prediction errors e (N, p), H = JᵀJ and g = Jᵀe for the unit directions ``entries`` of
+    :func:`_directions` and the n entries of x0 (J of :func:`_predict_sensitivity`)."""
+    N, p = y.shape
+    n = A.shape[0]
+    e = np.empty((N, p))
+    X = np.empty((N, n))
+    _predict_states(A, B, C, D, K, x0, u, y, e, X)
+    Q = entries.shape[0] + n
+    H, g = np.empty((Q, Q)), np.empty(Q)
+    _sensitivity_gram(np.ascontiguousarray(A - K @ C), np.ascontiguousarray(C), np.ascontiguousarray(K),
+                      entries, n, X, np.ascontiguousarray(u), e, H, g)
+    return e, H, g
+
+
+def _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, y):
     """Prediction errors e (N, p) and J (N·p, d + n), Fortran order, = ∂ŷ/∂θ: d model directions
     with tangents dA (d, n, n), dB, dC, dD, dK, then the n entries of x0 (module docstring)."""
     N, p = y.shape
@@ -174,11 +218,6 @@ def _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, y, entries=No
     e = np.empty((N, p))
     X = np.empty((N, n))
     _predict_states(A, B, C, D, K, x0, u, y, e, X)
-    if entries is not None:  # unit directions: the sparse kernel
-        J = np.empty((N * p, d + n), order="F")
-        _sensitivities_entries(np.ascontiguousarray(A - K @ C), np.ascontiguousarray(C), np.ascontiguousarray(K),
-                               entries, n, X, np.ascontiguousarray(u), e, J)
-        return e, J
     F = np.zeros((d + n, n, n + m + p))
     F[:d, :, :n] = dA - np.einsum("rj,qjk->qrk", K, dC)
     F[:d, :, n:n + m] = dB - np.einsum("rj,qjk->qrk", K, dD)
@@ -246,9 +285,7 @@ def _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough, innovation, max_
     for it in range(1, max_iterations + 1):
         dA, dB, dC, dD, dK, ent = _directions(A, B, C, D, K, feedthrough, innovation)
         d = dA.shape[0]
-        e, J = _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, yw, ent)
-        H = _gram(J)
-        g = J.T @ e.reshape(-1)
+        e, H, g = _gauss_newton_terms(A, B, C, D, K, x0, u, yw, ent)
         hd = np.maximum(np.diag(H), 1e-300)
         improved, rel = False, 0.0
         for _ in range(30):
@@ -278,7 +315,7 @@ def _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough, innovation, max_
         if drop < _NEGLIGIBLE_DROP:  # the step moved θ by ≪ 1σ: J before it serves at the optimum
             converged, improved = True, False
             break
-    at_final = (J, (dA, dB, dC, dD, dK), e) if not improved else None   # J at (or ≪ 1σ from) the end
+    at_final = (H, (dA, dB, dC, dD, dK), e) if not improved else None   # H at (or ≪ 1σ from) the end
     return A, B, C, D, K, x0, Vc, it, converged, at_final
 
 
@@ -397,10 +434,10 @@ def _pem_covariance(A, B, C, D, K, x0, u, yw, feedthrough: bool, innovation: boo
     from the whitened errors over N·p − d − n degrees of freedom, the directions (dA, dB, dC,
     dD) and the whitened prediction errors."""
     if at_final is not None:
-        J, (dA, dB, dC, dD, dK), e = at_final
+        H, (dA, dB, dC, dD, dK), e = at_final
     else:
         dA, dB, dC, dD, dK, ent = _directions(A, B, C, D, K, feedthrough, innovation)
-        e, J = _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, yw, ent)
+        e, H, _ = _gauss_newton_terms(A, B, C, D, K, x0, u, yw, ent)
     N, p = yw.shape
     n, d = A.shape[0], dA.shape[0]
     dof = N * p - d - n
@@ -409,7 +446,7 @@ def _pem_covariance(A, B, C, D, K, x0, u, yw, feedthrough: bool, innovation: boo
                         hint="use a longer record or a lower order")
     s2 = float(np.sum(e * e)) / dof
     try:
-        cov_full = s2 * np.linalg.inv(_gram(J))
+        cov_full = s2 * np.linalg.inv(H)
     except np.linalg.LinAlgError:
         raise IdentificationError("pem: the Jacobian is singular at the optimum: the data do not determine the "
                                   "model (a non-minimal order or a poorly exciting input)",

@@ -36,6 +36,7 @@ import contextlib
 import math
 import warnings
 
+import numba
 import numpy as np
 import scipy.linalg as sla
 
@@ -138,14 +139,15 @@ class SubspaceFactor:
         G = self.U[:, :n] * np.sqrt(self.s[:n])
         return G if self.W1inv is None else self.W1inv @ G
 
-    def past_windows(self) -> np.ndarray:
-        """W_p as a (j, k(m + p)) array (one row per time k … k + j − 1)."""
+    def times_past_windows(self, M: np.ndarray) -> np.ndarray:
+        """W_p Mᵀ for the past windows W_p (j, k(m + p)), one row per time k … k + j − 1, without
+        forming W_p: the sum over its k block columns of the shifted signals times M's blocks."""
         k, m, p, j = self.k, self.m, self.p, self.j
-        W = np.empty((j, k * (m + p)))
+        out = np.zeros((j, M.shape[0]))
         for i in range(k):
-            W[:, i * m:(i + 1) * m] = self.us[i:i + j]
-            W[:, k * m + i * p:k * m + (i + 1) * p] = self.ys[i:i + j]
-        return W
+            out += self.us[i:i + j] @ M[:, i * m:(i + 1) * m].T
+            out += self.ys[i:i + j] @ M[:, k * m + i * p:k * m + (i + 1) * p].T
+        return out
 
 
 def subspace_factor(u, y, *, horizon: int, method: str) -> SubspaceFactor:
@@ -217,6 +219,89 @@ def _bdx_regressor(A, C, u, feedthrough: bool):
     return Phi.reshape(N * p, cols)
 
 
+#: samples per block of :func:`_bdx_normal_equations` (its rows go to BLAS in one product)
+_BDX_BLOCK = 256
+
+
+@numba.njit(cache=True)
+def _bdx_normal_equations(A, C, u, y, feedthrough, G, r):  # pragma: no cover - compiled
+    """ΦᵀΦ into G and Φᵀy into r for the regressor of :func:`_bdx_regressor`, without forming Φ:
+    one pass that carries the n·m unit-input responses and the n free responses of the state
+    together (X[t+1] = A X[t] + [e_i u_j(t)]; the x0 columns start at the identity). Rows of
+    :data:`_BDX_BLOCK` samples are collected and added to the sums by one BLAS product each.
+    O(N·n²(m+1)) flops, O(cols²) memory beyond the block."""
+    N, m = u.shape
+    n, p = A.shape[0], C.shape[0]
+    nb = n * m
+    nd = p * m if feedthrough else 0
+    ns = nb + n  # state-carried columns: B's, then x0's
+    cols = nb + nd + n
+    X = np.zeros((n, ns))
+    Xn = np.empty((n, ns))
+    for i in range(n):
+        X[i, nb + i] = 1.0
+    rows = np.zeros((_BDX_BLOCK * p, cols))
+    yb = np.empty(_BDX_BLOCK * p)
+    G[:, :] = 0.0
+    r[:] = 0.0
+    fill = 0
+    CX = np.empty(ns)
+    for t in range(N):
+        for row in range(p):
+            for c in range(ns):  # C X, the inner loops over contiguous columns (row views)
+                CX[c] = 0.0
+            for k in range(n):
+                ck = C[row, k]
+                xk = X[k]
+                for c in range(ns):
+                    CX[c] += ck * xk[c]
+            phi = rows[fill]
+            for c in range(nb):
+                phi[c] = CX[c]
+            for c in range(nd):
+                phi[nb + c] = u[t, c % m] if c // m == row else 0.0
+            for c in range(n):
+                phi[nb + nd + c] = CX[nb + c]
+            yb[fill] = y[t, row]
+            fill += 1
+        if fill == rows.shape[0] or t == N - 1:
+            blk = rows[:fill]
+            G += np.dot(blk.T, blk)
+            r += np.dot(blk.T, yb[:fill])
+            fill = 0
+        for i in range(n):  # X ← A X + [e_i u(t)ᵀ, 0]
+            xi = Xn[i]
+            for c in range(ns):
+                xi[c] = 0.0
+            for k in range(n):
+                a = A[i, k]
+                xk = X[k]
+                for c in range(ns):
+                    xi[c] += a * xk[c]
+            for j in range(m):
+                xi[i * m + j] += u[t, j]
+        for i in range(n):
+            for c in range(ns):
+                X[i, c] = Xn[i, c]
+
+
+def _bdx_least_squares(A, C, u, y, feedthrough: bool) -> np.ndarray:
+    """θ = (vec(B) row-major, vec(D), x0) minimising ‖y − Φθ‖ (Φ of :func:`_bdx_regressor`):
+    normal equations from :func:`_bdx_normal_equations` on column-scaled Φ when their condition
+    number stays below 1e8 (no N·p × cols regressor in memory), else :func:`_least_squares` on Φ."""
+    n, m, p = A.shape[0], u.shape[1], C.shape[0]
+    cols = n * m + (p * m if feedthrough else 0) + n
+    G, rhs = np.empty((cols, cols)), np.empty(cols)
+    _bdx_normal_equations(np.ascontiguousarray(A), np.ascontiguousarray(C), u, y, feedthrough, G, rhs)
+    col = np.sqrt(np.diag(G)).copy()
+    col[col == 0] = 1.0
+    Gs = G / np.outer(col, col)
+    w = np.linalg.eigvalsh(Gs)
+    if w[0] > 1e-8 * w[-1]:
+        return sla.cho_solve(sla.cho_factor(Gs), rhs / col) / col
+    return _least_squares(_bdx_regressor(A, C, u, feedthrough), y.reshape(-1))
+
+
 def _kalman_gain(A, C, Q, S, R):
     """Innovation gain and innovation covariance from the Riccati equation (None on failure)."""
     try:
@@ -253,8 +338,7 @@ def from_factor(fac: SubspaceFactor, n: int, *, dt: float, feedthrough: bool = F
         info["stability"] = "stable (shift-invariance estimate)"
     us, ys = fac.us, fac.ys
     N = us.shape[0]
-    Phi = _bdx_regressor(A, C, us, feedthrough)
-    theta = _least_squares(Phi, ys.reshape(-1))
+    theta = _bdx_least_squares(A, C, us, ys, feedthrough)
     Bs = theta[:n * m].reshape(n, m)
     c = n * m
     Ds = np.zeros((p, m))
@@ -262,10 +346,10 @@ def from_factor(fac: SubspaceFactor, n: int, *, dt: float, feedthrough: bool = F
         Ds = theta[c:c + p * m].reshape(p, m)
         c += p * m
     x0s = theta[c:]
-    yhat = (Phi @ theta).reshape(N, p)
+    yhat = free_run(A, Bs, C, Ds, us, x0s)
     # innovation gain from the state sequence X̂ = Γ⁺ L32 L22⁻¹ W_p
     Mx = np.linalg.pinv(G) @ fac.L32_L22inv
-    X = fac.past_windows() @ Mx.T                        # x̂ at t = k … k + j − 1
+    X = fac.times_past_windows(Mx)                       # x̂ at t = k … k + j − 1
     k0 = fac.k
     t = np.arange(k0, k0 + X.shape[0] - 1)
     w = X[1:] - X[:-1] @ A.T - us[t] @ Bs.T
