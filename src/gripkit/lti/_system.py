@@ -601,8 +601,7 @@ class LinearSystem:
         """Apply an array map to the state-space arrays and return the same view."""
         ss = self.to_ss(minimal=False)
         arrs, unc = push(fn, [ss._arrays()], [ss.uncertainty])
-        out = StateSpace(*arrs, **ss._signals(**signals), states=ss.states if arrs[0].shape == ss.A.shape else None,
-                         state_units=ss.state_units if arrs[0].shape == ss.A.shape else None, uncertainty=unc)
+        out = ss._rebuild(arrs, unc, **signals)
         return out if isinstance(self, StateSpace) else out.to_tf(minimal=True)
 
     # ------------------------------------------------------------------ interop
@@ -706,8 +705,10 @@ class StateSpace(LinearSystem):
         return (self.A, self.B, self.C, self.D)
 
     def _rebuild(self, arrays, uncertainty, **signals):
+        """A system of this class (a subclass keeps its class) with new arrays; the state names
+        stay when the state count does."""
         keep = arrays[0].shape == self.A.shape
-        return StateSpace(*arrays, **self._signals(**signals), states=self.states if keep else None,
+        return type(self)(*arrays, **self._signals(**signals), states=self.states if keep else None,
                           state_units=self.state_units if keep else None, uncertainty=uncertainty)
 
     @staticmethod
