@@ -57,11 +57,6 @@ def _padd(a, b) -> np.ndarray:
     return np.pad(a, (0, n - a.size)) + np.pad(b, (0, n - b.size))
 
 
-def _pval(c: np.ndarray, zinv: np.ndarray) -> np.ndarray:
-    """Evaluate a polynomial in q⁻¹ (coefficients in increasing powers) at q⁻¹ = zinv."""
-    return np.polyval(c[::-1], zinv)
-
-
 # ------------------------------------------------------------------------------- the plant
 def as_plant(model) -> TransferFunction:
     """A discrete SISO plant as the :class:`gripkit.lti.TransferFunction` ``y = B(q)/A(q) u`` that
@@ -278,11 +273,17 @@ class RSTController:
         num = np.convolve(p.num_zinv() if where == "input" else p.den_zinv(), self.R)
         return signal.lfilter(num, self.characteristic(p), np.ones(n))
 
-    def loop_frequency_response(self, w, plant=None) -> np.ndarray:
-        """L(e^{jωh}) = B S / (A R) at angular frequencies ``w`` (rad/s)."""
+    def feedback_path(self, plant=None) -> TransferFunction:
+        """The controller's feedback path K = S(q)/R(q) as a :class:`gripkit.lti.TransferFunction`
+        on the plant's time base (u = −K y when r = 0)."""
         p = self.resolve_plant(plant)
-        zinv = np.exp(-1j * np.asarray(w, dtype=np.float64) * p.dt)
-        return _pval(p.num_zinv(), zinv) * _pval(self.S, zinv) / (_pval(p.den_zinv(), zinv) * _pval(self.R, zinv))
+        return TransferFunction.from_polynomials(self.R, self.S, dt=p.dt)
+
+    def loop_frequency_response(self, w, plant=None) -> np.ndarray:
+        """L(e^{jωh}) = B S / (A R) at angular frequencies ``w`` (rad/s): the frequency response
+        of the open loop ``K·G`` (:meth:`feedback_path` in series with the plant)."""
+        p = self.resolve_plant(plant)
+        return (self.feedback_path(p) * p).frequency_response(w)[:, 0, 0]
 
     def margins(self, plant=None, n: int = 20000) -> dict:
         """Gain margin (dB, smallest upward), phase margin (deg), gain and phase crossover
