@@ -109,7 +109,10 @@ class DiscretePlant:
     source: str = ""
 
     def __post_init__(self):
-        g = TransferFunction.from_polynomials(self.A, self.B, dt=self.dt, inputs=self.input_name,
+        # trailing zeros are padding in the q⁻¹ layout (not factors): drop them
+        A, B = (np.trim_zeros(_poly(x, k), "b") for x, k in ((self.A, "A"), (self.B, "B")))
+        g = TransferFunction.from_polynomials(A if A.size else np.zeros(1), B if B.size else np.zeros(1),
+                                              dt=self.dt, inputs=self.input_name,
                                               outputs=self.output_name, input_units=self.input_unit,
                                               output_units=self.output_unit)
         object.__setattr__(self, "lti", g)
