@@ -182,6 +182,10 @@ def test_discrete_plant_is_a_view_of_its_transfer_function():
         as_plant(lti.TransferFunction([1.0], [1.0, 1.0]))
     with pytest.raises(ModelError, match="no input path"):
         DiscretePlant([1.0, -0.5], [0.0, 0.0], DT)
+    with pytest.raises(ModelError, match="cannot build a discrete plant from object: as_system"):
+        as_plant(object())
+    with pytest.raises(ModelError, match="SISO, found 2 outputs"):
+        as_plant(lti.StateSpace([[0.5]], [[1.0]], [[1.0], [2.0]], dt=DT))
 
 
 def test_discrete_plant_from_a_zoh_state_space_matches_scipy():

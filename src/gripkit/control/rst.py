@@ -77,9 +77,9 @@ def as_plant(model) -> TransferFunction:
     try:
         g = as_system(model)
     except ModelError as e:
-        raise ModelError(f"cannot build a discrete plant from {type(model).__name__}: {e}",
-                         hint="give a gripkit.lti transfer function or state space, a gripkit.sysid polynomial "
-                              "model, a DiscretePlant, or a tuple (A, B, dt)") from None
+        raise ModelError(f"cannot build a discrete plant from {type(model).__name__}: {e.message}",
+                         hint=e.hint or "give a gripkit.lti transfer function or state space, a gripkit.sysid "
+                                        "polynomial model, a DiscretePlant, or a tuple (A, B, dt)") from None
     if not g.is_discrete:
         raise ModelError("the plant must be discrete: discretise it with c2d(dt) first")
     if not g.is_siso:
@@ -164,7 +164,9 @@ class DiscretePlant:
 
     def simulate(self, u, y_offset: float = 0.0) -> np.ndarray:
         """Output (N,) for input ``u`` (N,) from rest."""
-        return self.lti.simulate(np.asarray(u, dtype=np.float64).reshape(-1))[:, 0] + y_offset
+        y = self.lti.simulate(np.asarray(u, dtype=np.float64).reshape(-1))[:, 0]
+        y += y_offset
+        return y
 
     def to_state_space(self) -> StateSpace:
         """Controllable canonical :class:`gripkit.lti.StateSpace` at ``dt`` (scipy's ``tf2ss``

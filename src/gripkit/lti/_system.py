@@ -37,16 +37,21 @@ def _fmt_dt(dt):
     return "continuous" if dt is None else f"dt={dt:g} s"
 
 
+def _initial_state(x0, n: int) -> np.ndarray:
+    """``x0`` as a fresh float64 vector of ``n`` finite states (zeros when None)."""
+    if x0 is None:
+        return np.zeros(n)
+    x = np.array(x0, dtype=np.float64).reshape(-1)
+    if x.shape != (n,):
+        raise DataError(f"x0: expected {n} initial states, found shape {np.shape(x0)}")
+    if not np.isfinite(x).all():
+        raise DataError("x0 has non-finite values")
+    return x
+
+
 def _simulate_arrays(A, B, C, D, u, x0):
     n = A.shape[0]
-    if x0 is None:
-        x = np.zeros(n)
-    else:
-        x = np.array(x0, dtype=np.float64).reshape(-1)
-        if x.shape != (n,):
-            raise DataError(f"x0: expected {n} initial states, found shape {np.shape(x0)}")
-        if not np.isfinite(x).all():
-            raise DataError("x0 has non-finite values")
+    x = _initial_state(x0, n)
     y = np.empty((u.shape[0], C.shape[0]))
     simulate_ss(np.ascontiguousarray(A), np.ascontiguousarray(B), np.ascontiguousarray(C),
                 np.ascontiguousarray(D), u, x, np.empty(n), y)
@@ -1391,7 +1396,8 @@ class TransferFunction(LinearSystem):
     def simulate(self, u, x0=None) -> np.ndarray:
         """Outputs y (N, p) for inputs ``u`` (N, m) (or (N,)) of a discrete system, through its
         observable canonical realisation (:meth:`to_ss` with ``minimal=False``), from ``x0``
-        (default rest; see :meth:`initial_state`).
+        (default rest; see :meth:`initial_state`). A SISO system runs ``scipy.signal.lfilter``,
+        whose state (transposed direct form II) is that realisation's: O(n) per sample.
 
         Parameters
         ----------
@@ -1414,8 +1420,15 @@ class TransferFunction(LinearSystem):
         if not self.is_discrete:
             raise ModelError("simulate: the system is continuous; it needs a sample time",
                              hint="discretise it first: sys.c2d(dt)")
+        u = as_input_array(u, self.n_inputs)
+        if self.is_siso:
+            nu, de = self._entry(0, 0)
+            if de.size == 1:
+                _initial_state(x0, 0)
+                return nu[0] * u
+            return _signal.lfilter(nu, de, u[:, 0], zi=_initial_state(x0, de.size - 1))[0].reshape(-1, 1)
         A, B, C, D = _realize.tf2ss(self.num, self.den)
-        return _simulate_arrays(A, B, C, D, as_input_array(u, self.n_inputs), x0)
+        return _simulate_arrays(A, B, C, D, u, x0)
 
     # ------------------------------------------------------------------ conversions
     def to_tf(self, minimal: bool = True) -> TransferFunction:
