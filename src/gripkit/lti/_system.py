@@ -58,6 +58,17 @@ def _simulate_arrays(A, B, C, D, u, x0):
     return y
 
 
+def _polyval(c, s):
+    """Σ_k c[..., k] s^(L−1−k) (descending powers) at each s by Horner's rule, shape
+    (len(s),) + c.shape[:-1]."""
+    sb = s.reshape((s.size,) + (1,) * (c.ndim - 1))
+    out = np.zeros((s.size,) + c.shape[:-1], dtype=np.result_type(s, c))
+    for k in range(c.shape[-1]):
+        out *= sb
+        out += c[..., k]
+    return out
+
+
 def _vector_as(x, shape):
     """A 1-D sequence reshaped (a column of B, a row of C); anything else unchanged."""
     try:
@@ -1306,9 +1317,10 @@ class TransferFunction(LinearSystem):
         return _realize.ss_zeros(*_realize.tf2ss(self.num, self.den))
 
     def _eval(self, s):
-        """num and den of every entry at each s: shapes (len(s), p, m)."""
-        powers = s[:, None] ** np.arange(self.num.shape[2] - 1, -1, -1)
-        return np.einsum("fl,pml->fpm", powers, self.num), np.einsum("fl,pml->fpm", powers, self.den), powers
+        """num and den of every entry at each s, shapes (len(s), p, m), and the rounding bound
+        L ε Σ|a_k| |s|^k of each den(s) (below it, den(s) is zero within rounding)."""
+        bound = self.num.shape[2] * _EPS * _polyval(np.abs(self.den), np.abs(s))
+        return _polyval(self.num, s), _polyval(self.den, s), bound
 
     def frequency_response(self, w) -> np.ndarray:
         """G at angular frequencies ``w`` (rad/s), shape (len(w), p, m): num(s)/den(s) at
@@ -1330,9 +1342,8 @@ class TransferFunction(LinearSystem):
         np.complex128(0.5-0.5j)
         """
         s = self._s(w)
-        nu, de, powers = self._eval(s)
-        # |den(s)| below its rounding error L ε Σ|a_k s^k| is a pole on the evaluation contour
-        bad = np.abs(de) <= self.num.shape[2] * _EPS * np.einsum("fl,pml->fpm", np.abs(powers), np.abs(self.den))
+        nu, de, bound = self._eval(s)
+        bad = np.abs(de) <= bound  # a pole on the evaluation contour
         if np.any(bad):
             f = np.argwhere(bad)[0, 0]
             var = "z" if self.is_discrete else "s"
@@ -1341,10 +1352,10 @@ class TransferFunction(LinearSystem):
         return nu / de
 
     def _frequency_jacobian(self, s):
-        nu, de, powers = self._eval(s)
+        nu, de, _ = self._eval(s)
         dnum, dden = self.uncertainty.tangents
-        dn = np.einsum("fl,kpml->kfpm", powers, dnum)
-        dd = np.einsum("fl,kpml->kfpm", powers, dden)
+        dn = np.moveaxis(_polyval(dnum, s), 0, 1)
+        dd = np.moveaxis(_polyval(dden, s), 0, 1)
         return (dn * de - nu * dd) / de ** 2
 
     def dc_gain(self) -> np.ndarray:
@@ -1359,10 +1370,8 @@ class TransferFunction(LinearSystem):
         [[-1.2348]]
         """
         s0 = np.array([1.0 if self.is_discrete else 0.0])
-        nu, de, powers = self._eval(s0)
-        # a polynomial's value at s0 carries a rounding error of about L ε Σ|a_k s0^k|
-        tol = self.num.shape[2] * _EPS * np.einsum("fl,pml->fpm", np.abs(powers), np.abs(self.den))
-        if np.any(np.abs(de) <= tol):
+        nu, de, bound = self._eval(s0)
+        if np.any(np.abs(de) <= bound):
             raise ModelError("dc_gain: the system has a pole at " + ("z = 1" if self.is_discrete else "s = 0")
                              + ": its DC gain is infinite")
         return (nu / de)[0].real
