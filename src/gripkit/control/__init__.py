@@ -9,6 +9,7 @@ A flat list of explicit re-exports.
 from .pid import PID as PID
 from .rst import DiscretePlant as DiscretePlant
 from .rst import LoopResult as LoopResult
+from .rst import as_plant as as_plant
 from .rst import RSTController as RSTController
 from .rst import design_rst as design_rst
 from .rst import simulate_loop as simulate_loop

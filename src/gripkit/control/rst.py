@@ -39,9 +39,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import DataError, ModelError, SimulationError
-from ..sim.linear import StateSpace
+from ..lti import StateSpace, TransferFunction, as_system
 
-__all__ = ["DiscretePlant", "RSTController", "design_rst", "LoopResult", "simulate_loop"]
+__all__ = ["DiscretePlant", "as_plant", "RSTController", "design_rst", "LoopResult", "simulate_loop"]
 
 
 def _poly(x, name: str) -> np.ndarray:
@@ -57,20 +57,46 @@ def _padd(a, b) -> np.ndarray:
     return np.pad(a, (0, n - a.size)) + np.pad(b, (0, n - b.size))
 
 
-def _pval(c: np.ndarray, zinv: np.ndarray) -> np.ndarray:
-    """Evaluate a polynomial in q⁻¹ (coefficients in increasing powers) at q⁻¹ = zinv."""
-    return np.polyval(c[::-1], zinv)
-
-
 # ------------------------------------------------------------------------------- the plant
+def as_plant(model) -> TransferFunction:
+    """A discrete SISO plant as the :class:`gripkit.lti.TransferFunction` ``y = B(q)/A(q) u`` that
+    the RST design works on (``den_zinv()`` = A, ``num_zinv()`` = B, ``relative_degree()`` = nk).
+
+    Accepts an lti system (a state space is converted, uncontrollable and unobservable modes
+    cancelled), anything :func:`gripkit.lti.as_system` reads (an identified
+    :class:`gripkit.sysid.PolynomialModel`, a :class:`DiscretePlant`, python-control or scipy
+    systems, an object with ``A``, ``B``, ``dt`` in powers of q⁻¹), or a tuple ``(A, B, dt)``.
+
+    Examples
+    --------
+    >>> from gripkit.control import as_plant
+    >>> g = as_plant(([1.0, -1.8732, 0.8996], [0.0, 0.0, 0.1950, -0.2276], 0.005))
+    >>> g.relative_degree(), g.den_zinv().tolist()
+    (2, [1.0, -1.8732, 0.8996])
+    """
+    try:
+        g = as_system(model)
+    except ModelError as e:
+        raise ModelError(f"cannot build a discrete plant from {type(model).__name__}: {e.message}",
+                         hint=e.hint or "give a gripkit.lti transfer function or state space, a gripkit.sysid "
+                                        "polynomial model, a DiscretePlant, or a tuple (A, B, dt)") from None
+    if not g.is_discrete:
+        raise ModelError("the plant must be discrete: discretise it with c2d(dt) first")
+    if not g.is_siso:
+        raise ModelError(f"the plant must be SISO, found {g.n_outputs} outputs and {g.n_inputs} inputs")
+    return g if isinstance(g, TransferFunction) else g.to_tf()
+
+
 @dataclass(frozen=True)
 class DiscretePlant:
     """A SISO discrete-time plant y = B(q)/A(q) u, coefficients in increasing powers of q⁻¹
-    (MATLAB ``idpoly`` layout: ``A = [1, a1, ...]``, ``B = [0]*nk + [b_nk, ...]``).
+    (MATLAB ``idpoly`` layout: ``A = [1, a1, ...]``, ``B = [0]*nk + [b_nk, ...]``): a view of the
+    :class:`gripkit.lti.TransferFunction` :attr:`lti` in the q⁻¹ layout, which computes
+    everything (poles, zeros, DC gain, simulation, realisations).
 
-    Build from identified models with :meth:`from_model` (anything with ``A``, ``B``, ``dt``
-    attributes — e.g. ``gripkit.sysid`` polynomial models —, a discrete SISO
-    :class:`gripkit.sim.StateSpace`, or a tuple ``(A, B, dt)``).
+    ``A`` is made monic (B divided by the same leading coefficient) and trailing zeros (padding
+    in this layout) are dropped. Build from identified models with :meth:`from_model` (anything
+    :func:`as_plant` accepts).
     """
 
     A: np.ndarray
@@ -83,116 +109,73 @@ class DiscretePlant:
     source: str = ""
 
     def __post_init__(self):
-        A = _poly(self.A, "A")
-        B = _poly(self.B, "B")
         # trailing zeros are padding in the q⁻¹ layout (not factors): drop them
-        A = _poly(A[: max(1, np.flatnonzero(A)[-1] + 1)] if np.any(A) else A, "A")
-        B = _poly(B[: np.flatnonzero(B)[-1] + 1] if np.any(B) else B, "B")
-        if A[0] != 1.0:
-            if A[0] == 0.0:
-                raise ModelError("A must start with a nonzero (monic) coefficient")
-            B = _poly(B / A[0], "B")
-            A = _poly(A / A[0], "A")
-        if not np.any(B != 0):
-            raise ModelError("B is all zeros: the plant has no input path")
-        if not (np.isfinite(self.dt) and self.dt > 0):
-            raise ModelError(f"dt: expected a positive sample time (s), found {self.dt!r}")
-        object.__setattr__(self, "A", A)
-        object.__setattr__(self, "B", B)
+        A, B = (np.trim_zeros(_poly(x, k), "b") for x, k in ((self.A, "A"), (self.B, "B")))
+        g = TransferFunction.from_polynomials(A if A.size else np.zeros(1), B if B.size else np.zeros(1),
+                                              dt=self.dt, inputs=self.input_name,
+                                              outputs=self.output_name, input_units=self.input_unit,
+                                              output_units=self.output_unit)
+        object.__setattr__(self, "lti", g)
+        object.__setattr__(self, "A", _poly(g.den_zinv(), "A"))
+        object.__setattr__(self, "B", _poly(g.num_zinv(), "B"))
+        object.__setattr__(self, "dt", g.dt)
 
     @classmethod
     def from_model(cls, model, **kw) -> "DiscretePlant":
+        """The q⁻¹ view of :func:`as_plant` ``(model)``; ``kw`` overrides names, units and source."""
         if isinstance(model, DiscretePlant):
             return model
-        if isinstance(model, tuple) and len(model) == 3:
-            return cls(model[0], model[1], float(model[2]), **kw)
-        if isinstance(model, StateSpace):
-            if not model.is_discrete:
-                raise ModelError("the state-space plant must be discrete: call discretize(dt) first")
-            if model.B.shape[1] != 1 or model.C.shape[0] != 1:
-                raise ModelError(f"the plant must be SISO, found {model.C.shape[0]} outputs and {model.B.shape[1]} inputs")
-            from scipy import signal
-
-            num, den = signal.ss2tf(model.A, model.B, model.C, model.D)
-            num = np.real_if_close(num[0])
-            num[np.abs(num) < 1e-13 * max(np.abs(num).max(), 1e-300)] = 0.0
-            u = model.input_units[0] if model.input_units else "1"
-            y = model.output_units[0] if model.output_units else "1"
-            return cls(den, num, model.dt, input_unit=u, output_unit=y, source="state space", **kw)
-        if all(hasattr(model, k) for k in ("A", "B", "dt")):
-            extra = {}
-            for src, dst in (("input_name", "input_name"), ("input_unit", "input_unit"),
-                             ("output_name", "output_name"), ("output_unit", "output_unit")):
-                if hasattr(model, src) and dst not in kw:
-                    extra[dst] = getattr(model, src)
-            F = np.atleast_1d(getattr(model, "F", np.ones(1)))
-            if F.size > 1:  # output-error form B/F
-                return cls(F, model.B, float(model.dt), source=type(model).__name__, **extra, **kw)
-            return cls(model.A, model.B, float(model.dt), source=type(model).__name__, **extra, **kw)
-        raise ModelError(f"cannot build a discrete plant from {type(model).__name__}",
-                         hint="give a DiscretePlant, a gripkit.sysid polynomial model, a discrete "
-                              "StateSpace, or a tuple (A, B, dt)")
+        g = as_plant(model)
+        d = dict(input_name=g.inputs[0], input_unit=g.input_units[0] or "1", output_name=g.outputs[0],
+                 output_unit=g.output_units[0] or "1", source=type(model).__name__)
+        d.update(kw)
+        return cls(g.den_zinv(), g.num_zinv(), g.dt, **d)
 
     @property
     def nk(self) -> int:
         """Input delay in samples (leading zeros of B; includes the sampling delay)."""
-        return int(np.flatnonzero(self.B)[0])
+        return self.lti.relative_degree()
 
     def poles(self) -> np.ndarray:
-        return np.roots(self.A)
+        """Roots of A(z): the first ``len(A) − 1`` poles of :attr:`lti` (the delay's poles at the
+        origin come last there)."""
+        return self.lti.poles()[:self.A.size - 1]
 
     def zeros(self) -> np.ndarray:
-        b = np.trim_zeros(self.B, "fb")
-        return np.roots(b) if b.size > 1 else np.zeros(0)
+        """Roots of B(z) without the delay: the first zeros of :attr:`lti`."""
+        return self.lti.zeros()[:np.trim_zeros(self.B).size - 1]
 
     def dc_gain(self) -> float:
-        a1 = float(self.A.sum())
-        if abs(a1) < 1e-14:
-            raise ModelError("the plant has a pole at z = 1: its DC gain is infinite")
-        return float(self.B.sum()) / a1
+        """B(1)/A(1); ModelError at a pole at z = 1."""
+        return float(self.lti.dc_gain()[0, 0])
 
     def is_stable(self) -> bool:
-        return bool(np.all(np.abs(self.poles()) < 1.0))
+        return self.lti.is_stable()
 
     def is_minimum_phase(self) -> bool:
-        z = self.zeros()
-        return bool(np.all(np.abs(z) < 1.0))
+        return self.lti.is_minimum_phase()
 
     def scaled(self, gain: float, **kw) -> "DiscretePlant":
         """The plant with B multiplied by ``gain`` (unit changes, contact compliance)."""
         d = dict(input_name=self.input_name, input_unit=self.input_unit, output_name=self.output_name,
                  output_unit=self.output_unit, source=self.source)
         d.update(kw)
-        return DiscretePlant(self.A, self.B * float(gain), self.dt, **d)
+        return DiscretePlant(self.A, (float(gain) * self.lti).num_zinv(), self.dt, **d)
 
     def simulate(self, u, y_offset: float = 0.0) -> np.ndarray:
-        """Output for input ``u`` (N,) from rest (scipy.signal.lfilter)."""
-        from scipy import signal
+        """Output (N,) for input ``u`` (N,) from rest."""
+        y = self.lti.simulate(np.asarray(u, dtype=np.float64).reshape(-1))[:, 0]
+        y += y_offset
+        return y
 
-        u = np.asarray(u, dtype=np.float64).reshape(-1)
-        return signal.lfilter(self.B, self.A, u) + y_offset
-
-    def _padded(self):
-        n = max(self.A.size, self.B.size)
-        return np.pad(self.B, (0, n - self.B.size)), np.pad(self.A, (0, n - self.A.size))
-
-    def to_state_space(self):
-        """Controllable canonical :class:`gripkit.sim.StateSpace` at ``dt``."""
-        from scipy import signal
-
-        num, den = self._padded()
-        Ass, Bss, Css, Dss = signal.tf2ss(np.trim_zeros(num, "f"), den)
-        return StateSpace(Ass, Bss, Css, Dss, self.dt, (self.input_name,), (self.output_name,),
-                          (self.input_unit,), (self.output_unit,))
+    def to_state_space(self) -> StateSpace:
+        """Controllable canonical :class:`gripkit.lti.StateSpace` at ``dt`` (scipy's ``tf2ss``
+        realisation, delay states included)."""
+        return self.lti.to_ss(minimal=False, form="controllable")
 
     def to_control(self):
-        """A python-control ``TransferFunction`` (optional dependency)."""
-        try:
-            import control
-        except ImportError:
-            raise ModelError("python-control is not installed", hint="pip install 'gripkit[interop]'") from None
-        num, den = self._padded()
-        return control.tf(num, den, self.dt)
+        """A python-control ``TransferFunction`` (optional dependency), names kept."""
+        return self.lti.to_control()
 
 
 # ------------------------------------------------------------------------------- RST controller
@@ -207,7 +190,7 @@ class RSTController:
     """
 
     def __init__(self, R, S, T, *, A_aw=None, u_min: float = -math.inf, u_max: float = math.inf,
-                 plant: DiscretePlant | None = None, design: dict | None = None, anti_windup: bool = True):
+                 plant=None, design: dict | None = None, anti_windup: bool = True):
         self.R = _poly(R, "R")
         self.S = _poly(S, "S")
         self.T = _poly(T, "T")
@@ -261,16 +244,17 @@ class RSTController:
         return u
 
     # -- analysis -------------------------------------------------------------------------
-    def resolve_plant(self, plant):
+    def resolve_plant(self, plant) -> TransferFunction:
+        """``plant`` (or the design's plant when None) as :func:`as_plant` gives it."""
         p = plant if plant is not None else self.plant
         if p is None:
             raise ModelError("give the plant to analyse the closed loop")
-        return DiscretePlant.from_model(p)
+        return as_plant(p)
 
     def characteristic(self, plant=None) -> np.ndarray:
         """P = A R + B S (coefficients in q⁻¹)."""
         p = self.resolve_plant(plant)
-        return _padd(np.convolve(p.A, self.R), np.convolve(p.B, self.S))
+        return _padd(np.convolve(p.den_zinv(), self.R), np.convolve(p.num_zinv(), self.S))
 
     def closed_loop_poles(self, plant=None) -> np.ndarray:
         return np.roots(np.trim_zeros(self.characteristic(plant), "b"))
@@ -283,7 +267,7 @@ class RSTController:
         from scipy import signal
 
         p = self.resolve_plant(plant)
-        return signal.lfilter(np.convolve(p.B, self.T), self.characteristic(p), np.ones(n))
+        return signal.lfilter(np.convolve(p.num_zinv(), self.T), self.characteristic(p), np.ones(n))
 
     def disturbance_response(self, n: int, plant=None, where: str = "input") -> np.ndarray:
         """Unit-step response of y to a disturbance at the plant ``input`` (B R/P) or ``output``
@@ -291,14 +275,20 @@ class RSTController:
         from scipy import signal
 
         p = self.resolve_plant(plant)
-        num = np.convolve(p.B if where == "input" else p.A, self.R)
+        num = np.convolve(p.num_zinv() if where == "input" else p.den_zinv(), self.R)
         return signal.lfilter(num, self.characteristic(p), np.ones(n))
 
-    def loop_frequency_response(self, w, plant=None) -> np.ndarray:
-        """L(e^{jωh}) = B S / (A R) at angular frequencies ``w`` (rad/s)."""
+    def feedback_path(self, plant=None) -> TransferFunction:
+        """The controller's feedback path K = S(q)/R(q) as a :class:`gripkit.lti.TransferFunction`
+        on the plant's time base (u = −K y when r = 0)."""
         p = self.resolve_plant(plant)
-        zinv = np.exp(-1j * np.asarray(w, dtype=np.float64) * p.dt)
-        return _pval(p.B, zinv) * _pval(self.S, zinv) / (_pval(p.A, zinv) * _pval(self.R, zinv))
+        return TransferFunction.from_polynomials(self.R, self.S, dt=p.dt)
+
+    def loop_frequency_response(self, w, plant=None) -> np.ndarray:
+        """L(e^{jωh}) = B S / (A R) at angular frequencies ``w`` (rad/s): the frequency response
+        of the open loop ``K·G`` (:meth:`feedback_path` in series with the plant)."""
+        p = self.resolve_plant(plant)
+        return (self.feedback_path(p) * p).frequency_response(w)[:, 0, 0]
 
     def margins(self, plant=None, n: int = 20000) -> dict:
         """Gain margin (dB, smallest upward), phase margin (deg), gain and phase crossover
@@ -332,7 +322,8 @@ def design_rst(plant, *, wn: float = 15.0, zeta: float = 0.9, observer: float = 
     Parameters
     ----------
     plant
-        Anything :meth:`DiscretePlant.from_model` accepts (an identified model, a StateSpace, ...).
+        A discrete SISO :class:`gripkit.lti.TransferFunction`, or anything :func:`as_plant` accepts
+        (an identified model, a DiscretePlant, a discrete StateSpace, a tuple (A, B, dt), ...).
     wn, zeta
         Dominant closed-loop pair (rad/s and damping), mapped to z = e^{s h}. Keep ω_n well below
         the continuous equivalent of any NMP zero (ln|z₀|/h).
@@ -342,16 +333,16 @@ def design_rst(plant, *, wn: float = 15.0, zeta: float = 0.9, observer: float = 
     u_min, u_max
         Actuator limits (plant input units) for the anti-windup controller.
     """
-    p = DiscretePlant.from_model(plant)
-    if p.nk < 1:
+    p = as_plant(plant)
+    if p.relative_degree() < 1:
         raise ModelError("the plant has direct feedthrough (nk = 0); the RST design needs nk >= 1")
     h = p.dt
     if not (wn > 0 and 0 < zeta and math.isfinite(wn)):
         raise ModelError(f"need wn > 0 and zeta > 0, found wn={wn}, zeta={zeta}")
     nmp = [z for z in p.zeros() if abs(z) >= 1.0]
-    A1 = np.convolve(p.A, [1.0, -1.0])
+    A1 = np.convolve(p.den_zinv(), [1.0, -1.0])
     dA1 = A1.size - 1
-    B = p.B
+    B = p.num_zinv()
     dB = B.size - 1
     dP = dA1 + dB - 1
     if zeta < 1:
@@ -430,7 +421,7 @@ def simulate_loop(controller: RSTController, plant=None, r=None, *, n: int | Non
         return a
 
     di, do, nz = arr(d_in, "d_in"), arr(d_out, "d_out"), arr(noise, "noise")
-    A, B = p.A, p.B
+    A, B = p.den_zinv(), p.num_zinv()
     na, nb = A.size, B.size
     y = np.zeros(N)
     ym = np.zeros(N)

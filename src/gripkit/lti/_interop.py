@@ -75,11 +75,12 @@ def from_scipy(sys, **signals) -> LinearSystem:
 def as_system(obj, **signals) -> LinearSystem:
     """Any linear model gripkit meets, as a :class:`LinearSystem`.
 
-    Accepts a LinearSystem (returned as is), a python-control or scipy.signal system, an object
-    with ``A``, ``B``, ``dt`` coefficient arrays in powers of q⁻¹ (a polynomial model: ``y =
-    B/(A F) u`` when it has ``F``; its ``input_name``/``output_name``/units are kept), an object
-    with state-space matrices ``A, B, C, D`` and ``dt`` (and ``inputs``/``outputs``/units), or a
-    tuple ``(A, B, dt)`` of q⁻¹ polynomials. ``signals`` override names and units.
+    Accepts a LinearSystem (returned as is), an object whose ``lti`` attribute is one (an
+    identified :class:`gripkit.sysid.PolynomialModel`, a :class:`gripkit.control.DiscretePlant`),
+    a python-control or scipy.signal system, an object with ``A``, ``B``, ``dt`` coefficient
+    arrays in powers of q⁻¹ (``y = B/(A F) u`` when it has ``F``; its ``input_name``/
+    ``output_name``/units are kept), or a tuple ``(A, B, dt)`` of q⁻¹ polynomials. ``signals``
+    override names and units.
 
     Examples
     --------
@@ -88,6 +89,8 @@ def as_system(obj, **signals) -> LinearSystem:
     >>> type(g).__name__, g.dt, g.den_zinv().tolist()
     ('TransferFunction', 0.01, [1.0, -0.5])
     """
+    if not isinstance(obj, LinearSystem) and isinstance(getattr(obj, "lti", None), LinearSystem):
+        obj = obj.lti
     if isinstance(obj, LinearSystem):
         return obj.replace(**signals) if signals else obj
     if isinstance(obj, tuple) and len(obj) == 3:
@@ -98,11 +101,6 @@ def as_system(obj, **signals) -> LinearSystem:
         return g.replace(**signals) if signals else g
     if mod == "scipy":
         return from_scipy(obj, **signals)
-    if all(hasattr(obj, k) for k in ("A", "B", "C", "D", "dt")) and np.ndim(getattr(obj, "A")) == 2:
-        kw = {k: getattr(obj, k) for k in ("inputs", "outputs", "input_units", "output_units")
-              if getattr(obj, k, None)}
-        kw.update(signals)
-        return StateSpace(obj.A, obj.B, obj.C, obj.D, dt=obj.dt, meta=dict(getattr(obj, "meta", {}) or {}), **kw)
     if all(hasattr(obj, k) for k in ("A", "B", "dt")):
         kw = {}
         for src, dst in (("input_name", "inputs"), ("output_name", "outputs"), ("input_unit", "input_units"),
@@ -110,12 +108,7 @@ def as_system(obj, **signals) -> LinearSystem:
             if getattr(obj, src, None):
                 kw[dst] = getattr(obj, src)
         kw.update(signals)
-        F = getattr(obj, "F", None)
-        cov = getattr(obj, "covariance", None)
-        if cov is not None:
-            return TransferFunction.from_polynomials(obj.A, obj.B, C=getattr(obj, "C", None), F=F, dt=float(obj.dt),
-                                                     covariance=cov, **kw)
-        return TransferFunction.from_polynomials(obj.A, obj.B, F=F, dt=float(obj.dt), **kw)
+        return TransferFunction.from_polynomials(obj.A, obj.B, F=getattr(obj, "F", None), dt=float(obj.dt), **kw)
     raise ModelError(f"as_system: cannot read a linear system from {type(obj).__name__}",
                      hint="give a gripkit.lti system, a python-control or scipy.signal system, a polynomial "
                           "model (A, B, dt), or a tuple (A, B, dt)")

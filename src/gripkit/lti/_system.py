@@ -35,22 +35,38 @@ def _fmt_dt(dt):
     return "continuous" if dt is None else f"dt={dt:g} s"
 
 
+def _initial_state(x0, n: int) -> np.ndarray:
+    """``x0`` as a fresh float64 vector of ``n`` finite states (zeros when None)."""
+    if x0 is None:
+        return np.zeros(n)
+    x = np.array(x0, dtype=np.float64).reshape(-1)
+    if x.shape != (n,):
+        raise DataError(f"x0: expected {n} initial states, found shape {np.shape(x0)}")
+    if not np.isfinite(x).all():
+        raise DataError("x0 has non-finite values")
+    return x
+
+
 def _simulate_arrays(A, B, C, D, u, x0):
     n = A.shape[0]
-    if x0 is None:
-        x = np.zeros(n)
-    else:
-        x = np.array(x0, dtype=np.float64).reshape(-1)
-        if x.shape != (n,):
-            raise DataError(f"x0: expected {n} initial states, found shape {np.shape(x0)}")
-        if not np.isfinite(x).all():
-            raise DataError("x0 has non-finite values")
+    x = _initial_state(x0, n)
     from ._kernels import simulate_ss  # numba, imported on first simulation
 
     y = np.empty((u.shape[0], C.shape[0]))
     simulate_ss(np.ascontiguousarray(A), np.ascontiguousarray(B), np.ascontiguousarray(C),
                 np.ascontiguousarray(D), u, x, np.empty(n), y)
     return y
+
+
+def _polyval(c, s):
+    """Σ_k c[..., k] s^(L−1−k) (descending powers) at each s by Horner's rule, shape
+    (len(s),) + c.shape[:-1]."""
+    sb = s.reshape((s.size,) + (1,) * (c.ndim - 1))
+    out = np.zeros((s.size,) + c.shape[:-1], dtype=np.result_type(s, c))
+    for k in range(c.shape[-1]):
+        out *= sb
+        out += c[..., k]
+    return out
 
 
 def _vector_as(x, shape):
@@ -601,8 +617,7 @@ class LinearSystem:
         """Apply an array map to the state-space arrays and return the same view."""
         ss = self.to_ss(minimal=False)
         arrs, unc = push(fn, [ss._arrays()], [ss.uncertainty])
-        out = StateSpace(*arrs, **ss._signals(**signals), states=ss.states if arrs[0].shape == ss.A.shape else None,
-                         state_units=ss.state_units if arrs[0].shape == ss.A.shape else None, uncertainty=unc)
+        out = ss._rebuild(arrs, unc, **signals)
         return out if isinstance(self, StateSpace) else out.to_tf(minimal=True)
 
     # ------------------------------------------------------------------ interop
@@ -708,8 +723,10 @@ class StateSpace(LinearSystem):
         return (self.A, self.B, self.C, self.D)
 
     def _rebuild(self, arrays, uncertainty, **signals):
+        """A system of this class (a subclass keeps its class) with new arrays; the state names
+        stay when the state count does."""
         keep = arrays[0].shape == self.A.shape
-        return StateSpace(*arrays, **self._signals(**signals), states=self.states if keep else None,
+        return type(self)(*arrays, **self._signals(**signals), states=self.states if keep else None,
                           state_units=self.state_units if keep else None, uncertainty=uncertainty)
 
     @staticmethod
@@ -1302,9 +1319,10 @@ class TransferFunction(LinearSystem):
         return _realize.ss_zeros(*_realize.tf2ss(self.num, self.den))
 
     def _eval(self, s):
-        """num and den of every entry at each s: shapes (len(s), p, m)."""
-        powers = s[:, None] ** np.arange(self.num.shape[2] - 1, -1, -1)
-        return np.einsum("fl,pml->fpm", powers, self.num), np.einsum("fl,pml->fpm", powers, self.den), powers
+        """num and den of every entry at each s, shapes (len(s), p, m), and the rounding bound
+        L ε Σ|a_k| |s|^k of each den(s) (below it, den(s) is zero within rounding)."""
+        bound = self.num.shape[2] * _EPS * _polyval(np.abs(self.den), np.abs(s))
+        return _polyval(self.num, s), _polyval(self.den, s), bound
 
     def frequency_response(self, w) -> np.ndarray:
         """G at angular frequencies ``w`` (rad/s), shape (len(w), p, m): num(s)/den(s) at
@@ -1326,9 +1344,8 @@ class TransferFunction(LinearSystem):
         np.complex128(0.5-0.5j)
         """
         s = self._s(w)
-        nu, de, powers = self._eval(s)
-        # |den(s)| below its rounding error L ε Σ|a_k s^k| is a pole on the evaluation contour
-        bad = np.abs(de) <= self.num.shape[2] * _EPS * np.einsum("fl,pml->fpm", np.abs(powers), np.abs(self.den))
+        nu, de, bound = self._eval(s)
+        bad = np.abs(de) <= bound  # a pole on the evaluation contour
         if np.any(bad):
             f = np.argwhere(bad)[0, 0]
             var = "z" if self.is_discrete else "s"
@@ -1337,10 +1354,10 @@ class TransferFunction(LinearSystem):
         return nu / de
 
     def _frequency_jacobian(self, s):
-        nu, de, powers = self._eval(s)
+        nu, de, _ = self._eval(s)
         dnum, dden = self.uncertainty.tangents
-        dn = np.einsum("fl,kpml->kfpm", powers, dnum)
-        dd = np.einsum("fl,kpml->kfpm", powers, dden)
+        dn = np.moveaxis(_polyval(dnum, s), 0, 1)
+        dd = np.moveaxis(_polyval(dden, s), 0, 1)
         return (dn * de - nu * dd) / de ** 2
 
     def dc_gain(self) -> np.ndarray:
@@ -1355,10 +1372,8 @@ class TransferFunction(LinearSystem):
         [[-1.2348]]
         """
         s0 = np.array([1.0 if self.is_discrete else 0.0])
-        nu, de, powers = self._eval(s0)
-        # a polynomial's value at s0 carries a rounding error of about L ε Σ|a_k s0^k|
-        tol = self.num.shape[2] * _EPS * np.einsum("fl,pml->fpm", np.abs(powers), np.abs(self.den))
-        if np.any(np.abs(de) <= tol):
+        nu, de, bound = self._eval(s0)
+        if np.any(np.abs(de) <= bound):
             raise ModelError("dc_gain: the system has a pole at " + ("z = 1" if self.is_discrete else "s = 0")
                              + ": its DC gain is infinite")
         return (nu / de)[0].real
@@ -1393,7 +1408,8 @@ class TransferFunction(LinearSystem):
     def simulate(self, u, x0=None) -> np.ndarray:
         """Outputs y (N, p) for inputs ``u`` (N, m) (or (N,)) of a discrete system, through its
         observable canonical realisation (:meth:`to_ss` with ``minimal=False``), from ``x0``
-        (default rest; see :meth:`initial_state`).
+        (default rest; see :meth:`initial_state`). A SISO system runs ``scipy.signal.lfilter``,
+        whose state (transposed direct form II) is that realisation's: O(n) per sample.
 
         Parameters
         ----------
@@ -1416,8 +1432,17 @@ class TransferFunction(LinearSystem):
         if not self.is_discrete:
             raise ModelError("simulate: the system is continuous; it needs a sample time",
                              hint="discretise it first: sys.c2d(dt)")
+        u = as_input_array(u, self.n_inputs)
+        if self.is_siso:
+            nu, de = self._entry(0, 0)
+            if de.size == 1:
+                _initial_state(x0, 0)
+                return nu[0] * u
+            from scipy import signal  # imported on first use (0.6 s)
+
+            return signal.lfilter(nu, de, u[:, 0], zi=_initial_state(x0, de.size - 1))[0].reshape(-1, 1)
         A, B, C, D = _realize.tf2ss(self.num, self.den)
-        return _simulate_arrays(A, B, C, D, as_input_array(u, self.n_inputs), x0)
+        return _simulate_arrays(A, B, C, D, u, x0)
 
     # ------------------------------------------------------------------ conversions
     def to_tf(self, minimal: bool = True) -> TransferFunction:

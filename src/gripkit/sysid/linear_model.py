@@ -275,12 +275,10 @@ class LinearModel:
 
 def from_polynomial(pm) -> LinearModel:
     """A :class:`~gripkit.sysid.PolynomialModel` (ARX/ARMAX/OE) as a :class:`LinearModel` on the
-    discrete transfer function B/(A F) (:meth:`gripkit.lti.TransferFunction.from_polynomials`),
+    discrete transfer function B/(A F) (its :attr:`~gripkit.sysid.PolynomialModel.lti`),
     with the parameter covariance (the noise polynomial C keeps its place in it, with zero
     tangents, and is recorded in ``info``), names, units and offsets."""
-    g = TransferFunction.from_polynomials(pm.A, pm.B, C=pm.C if pm.C.size > 1 else None, F=pm.F, dt=pm.dt,
-                                          covariance=pm.covariance, inputs=pm.input_name, outputs=pm.output_name,
-                                          input_units=pm.input_unit, output_units=pm.output_unit)
+    g = pm.lti
     info = {"label": pm.label, "A": pm.A, "B": pm.B, "C": pm.C, "F": pm.F, "nk": pm.nk,
             "one_step_fit_percent": pm.fit_percent, "noise_variance": pm.noise_variance,
             "parameter_names": list(pm.parameter_names), **{k: v for k, v in pm.info.items()

@@ -18,6 +18,7 @@ Parameter names follow the powers of q⁻¹ (Table III of the seed: ``a1 a2 b2 b
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
@@ -25,6 +26,7 @@ import numpy as np
 
 from ..arguments import check_keywords, keyword_names
 from ..errors import DataError, ModelError
+from ..lti import TransferFunction
 from ..params import Parameter, ParameterSet
 from ..units import ratio_unit
 from .linear_model import save_model
@@ -317,6 +319,22 @@ class PolynomialModel:
         r = self.n_params / self.n_used
         return 2.0 * self.loss * (1 + r) / (1 - r)
 
+    # ------------------------------------------------------------------ the linear system
+    @functools.cached_property
+    def lti(self) -> TransferFunction:
+        """The input-output part ``y = B(q)/(A(q) F(q)) u`` as a discrete
+        :class:`gripkit.lti.TransferFunction`, with the channel names and units, ``dt`` and the
+        parameter covariance over ``parameter_names`` (the c's of an ARMAX model with zero
+        tangents). Poles, zeros, DC gain, responses and exports below are computed by it."""
+        return TransferFunction.from_polynomials(
+            self.A, self.B, C=self.C if self.nc else None, F=self.F, dt=self.dt, covariance=self.covariance,
+            inputs=self.input_name, outputs=self.output_name, input_units=self.input_unit,
+            output_units=self.output_unit)
+
+    def to_lti(self) -> TransferFunction:
+        """:attr:`lti` (the same object)."""
+        return self.lti
+
     # ------------------------------------------------------------------ analysis
     @property
     def denominator(self) -> np.ndarray:
@@ -324,64 +342,54 @@ class PolynomialModel:
         return np.convolve(self.A, self.F)
 
     def poles(self) -> np.ndarray:
-        """Roots of A(z)·F(z) (the delay's poles at the origin are not listed)."""
-        d = self.denominator
-        return np.roots(d) if d.size > 1 else np.zeros(0, dtype=complex)
+        """Roots of A(z)·F(z) (the delay's poles at the origin are not listed): the first
+        ``na + nf`` poles of :attr:`lti` (np.roots lists the origin roots last)."""
+        return self.lti.poles()[:self.denominator.size - 1]
 
     def zeros(self) -> np.ndarray:
-        """Roots of B(z) without its delay: the ``nb − 1`` roots of ``[b_nk, ..., b_last]``."""
-        b = np.trim_zeros(self.B[self.nk:], "b")
-        b = np.trim_zeros(b, "f")
-        return np.roots(b) if b.size > 1 else np.zeros(0, dtype=complex)
+        """Roots of B(z) without its delay: the ``nb − 1`` roots of ``[b_nk, ..., b_last]`` (the
+        first zeros of :attr:`lti`; the origin zeros of the q⁻¹ padding come last)."""
+        return self.lti.zeros()[:np.trim_zeros(self.B).size - 1]
 
     @property
     def stable(self) -> bool:
         """All poles strictly inside the unit circle."""
-        p = self.poles()
-        return bool(np.all(np.abs(p) < 1.0))
+        return self.lti.is_stable()
 
     @property
     def minimum_phase(self) -> bool:
         """All zeros strictly inside the unit circle (the [2 2 2] model of Table II is not: its
         zero lies at z ≈ 1.167, §V-F)."""
-        z = self.zeros()
-        return bool(np.all(np.abs(z) < 1.0))
+        return self.lti.is_minimum_phase()
 
     @property
     def dc_gain(self) -> float:
         """Static gain B(1)/(A(1)F(1)) (±inf with an integrator)."""
-        num = float(np.sum(self.B))
-        den = float(np.sum(self.denominator))
-        if den == 0.0:
+        try:
+            return float(self.lti.dc_gain()[0, 0])
+        except ModelError:  # a pole at z = 1
+            num = float(np.sum(self.B))
             return math.copysign(math.inf, num) if num != 0 else math.nan
-        return num / den
 
     def step(self, n: int) -> np.ndarray:
         """Response to a unit step applied at sample 0, from rest, ``n`` samples."""
-        from scipy import signal as _sig
-
-        return _sig.lfilter(self.B, self.denominator, np.ones(int(n)))
+        return self.lti.step(int(n))[:, 0, 0]
 
     def impulse(self, n: int) -> np.ndarray:
         """Response to a unit pulse at sample 0, from rest, ``n`` samples."""
-        from scipy import signal as _sig
-
-        x = np.zeros(int(n))
-        x[0] = 1.0
-        return _sig.lfilter(self.B, self.denominator, x)
+        return self.lti.impulse(int(n))[:, 0, 0]
 
     def frequency_response(self, f=None, n: int = 512) -> tuple[np.ndarray, np.ndarray]:
-        """``(f_Hz, H)``: the complex response of B/(A F) at ``f`` (Hz; default ``n`` points up to
-        the Nyquist frequency), ``H = B(e^{-jωdt}) / (A F)(e^{-jωdt})``."""
-        from scipy import signal as _sig
-
-        worN = int(n) if f is None else np.asarray(f, dtype=np.float64)
-        freq, h = _sig.freqz(self.B, self.denominator, worN=worN, fs=self.fs)
-        return freq, h
+        """``(f_Hz, H)``: the complex response of B/(A F) at ``f`` (Hz; default ``n`` points from
+        0 up to, not including, the Nyquist frequency), ``H = B(e^{-jωdt}) / (A F)(e^{-jωdt})``."""
+        f = np.linspace(0.0, 0.5 * self.fs, int(n), endpoint=False) if f is None \
+            else np.atleast_1d(np.asarray(f, dtype=np.float64))
+        return f, self.lti.frequency_response(2.0 * np.pi * f)[:, 0, 0]
 
     # ------------------------------------------------------------------ simulation and prediction
     def simulate(self, u, *, initial: str = "rest", y_past=None, u_past=None) -> np.ndarray:
-        """Free-run output ``ŷ = B/(A F) u`` (no noise), shape (N,), in deviation units.
+        """Free-run output ``ŷ = B/(A F) u`` (no noise), shape (N,), in deviation units
+        (:meth:`gripkit.lti.TransferFunction.simulate`).
 
         Parameters
         ----------
@@ -394,27 +402,15 @@ class PolynomialModel:
             The samples before u(0), in time order (most recent last); at least
             ``len(A F) − 1`` outputs and ``len(B) − 1`` inputs are used (missing ones count 0).
         """
-        from scipy import signal as _sig
-
-        u = np.asarray(u, dtype=np.float64)
         if initial == "rest":
             if y_past is not None or u_past is not None:
                 raise DataError("initial='rest' takes no y_past/u_past; use initial='given'")
-            return _sig.lfilter(self.B, self.denominator, u)
+            return self.lti.simulate(u)[:, 0]
         if initial != "given":
             raise DataError(f"initial: expected 'rest' or 'given', found {initial!r}")
-        return self._filter_from_past(u, y_past, u_past)
-
-    def _filter_from_past(self, u, y_past, u_past) -> np.ndarray:
-        from scipy import signal as _sig
-
-        b, a = self.B, self.denominator
-        yp = np.zeros(0) if y_past is None else np.asarray(y_past, dtype=np.float64)
-        up = np.zeros(0) if u_past is None else np.asarray(u_past, dtype=np.float64)
-        if max(a.size, b.size) == 1:  # a static gain has no past
-            return _sig.lfilter(b, a, u)
-        zi = _sig.lfiltic(b, a, yp[::-1][:a.size - 1], up[::-1][:b.size - 1])
-        return _sig.lfilter(b, a, u, zi=zi)[0]
+        g = self.lti
+        x0 = g.initial_state(np.zeros(0) if u_past is None else u_past, np.zeros(0) if y_past is None else y_past)
+        return g.simulate(u, x0)[:, 0]
 
     def prediction_errors(self, u, y) -> np.ndarray:
         """One-step prediction errors e(t), t = ``start`` … N−1 (``u``, ``y`` in deviation units).
@@ -428,8 +424,7 @@ class PolynomialModel:
         if y.size <= t0:
             raise DataError(f"one-step prediction with {self.label} needs more than {t0} samples, found {y.size}")
         if self.structure == "oe":
-            w = self._filter_from_past(u[t0:], y[:t0], u[:t0])
-            return y[t0:] - w
+            return y[t0:] - self.simulate(u[t0:], initial="given", y_past=y[:t0], u_past=u[:t0])
         # the FIR parts by np.convolve: scipy.signal's import is 0.9 s of a fresh ARX process
         v = np.convolve(y, self.A)[t0:y.size] - np.convolve(u, self.B)[t0:u.size]
         if not self.nc:
@@ -452,39 +447,20 @@ class PolynomialModel:
         return validate(self, u, y, **kw)
 
     # ------------------------------------------------------------------ exports
-    def _tf_arrays(self) -> tuple[np.ndarray, np.ndarray]:
-        b, a = self.B, self.denominator
-        n = max(a.size, b.size)
-        num = np.pad(b, (0, n - b.size))
-        # positive powers of z: leading zeros of the numerator (the delay) carry no information
-        return np.trim_zeros(num, "f") if np.any(num) else num, np.pad(a, (0, n - a.size))
-
     def to_scipy(self):
         """``scipy.signal.dlti`` transfer function B/(A F) with ``dt`` (the delay appears as
-        poles at the origin)."""
-        from scipy import signal as _sig
-
-        num, den = self._tf_arrays()
-        return _sig.dlti(num, den, dt=self.dt)
+        poles at the origin): ``lti.to_scipy()``."""
+        return self.lti.to_scipy()
 
     def to_statespace(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Discrete state-space matrices ``(Ad, Bd, Cd, Dd)`` of B/(A F) (controller canonical form,
-        delay included as states): ``x⁺ = Ad x + Bd u``, ``y = Cd x + Dd u``."""
-        from scipy import signal as _sig
-
-        num, den = self._tf_arrays()
-        return _sig.tf2ss(num, den)
+        delay included as states, as ``scipy.signal.tf2ss``): ``x⁺ = Ad x + Bd u``, ``y = Cd x + Dd u``."""
+        return self.lti.to_ss(minimal=False, form="controllable")._arrays()
 
     def to_control(self):
-        """``control.TransferFunction`` B/(A F) with ``dt`` (needs python-control:
-        ``pip install 'gripkit[interop]'``)."""
-        try:
-            import control
-        except ImportError:
-            raise ModelError("to_control() needs the python-control package, which is not installed",
-                             hint="pip install 'gripkit[interop]' (or pip install control)") from None
-        num, den = self._tf_arrays()
-        return control.tf(num, den, self.dt)
+        """``control.TransferFunction`` B/(A F) with ``dt`` and the channel names (needs
+        python-control: ``pip install 'gripkit[interop]'``)."""
+        return self.lti.to_control()
 
     def save(self, path) -> None:
         """Write the model file (JSON, :func:`gripkit.sysid.linear_model.save_model`); reload it with

@@ -107,7 +107,7 @@ def compare(model, u, y, *, initial: str = "estimate") -> Comparison:
     else:
         y_past = _estimate_past(model, u[t0:], y[t0:], u_past, n_y) if stable else y[t0 - n_y:t0].copy()
     with np.errstate(over="ignore", invalid="ignore"):
-        ys = model._filter_from_past(u[t0:], y_past, u_past)
+        ys = model.simulate(u[t0:], initial="given", y_past=y_past, u_past=u_past)
     y_sim = np.concatenate([y[:t0], ys])
     fit = None
     if stable and np.isfinite(ys).all():
@@ -117,7 +117,7 @@ def compare(model, u, y, *, initial: str = "estimate") -> Comparison:
 
 def _estimate_past(model, u, y, u_past, n_y: int) -> np.ndarray:
     """Least-squares estimate of the ``n_y`` past outputs (the output is affine in them)."""
-    forced = model._filter_from_past(u, np.zeros(n_y), u_past)
+    forced = model.simulate(u, initial="given", y_past=np.zeros(n_y), u_past=u_past)
     if n_y == 0:
         return np.zeros(0)
     zero_u = np.zeros_like(u)
@@ -125,7 +125,7 @@ def _estimate_past(model, u, y, u_past, n_y: int) -> np.ndarray:
     for k in range(n_y):
         e = np.zeros(n_y)
         e[k] = 1.0
-        basis[:, k] = model._filter_from_past(zero_u, e, np.zeros(model.B.size))
+        basis[:, k] = model.simulate(zero_u, initial="given", y_past=e, u_past=np.zeros(model.B.size))
     z = np.linalg.lstsq(basis, y - forced, rcond=None)[0]
     return z
 

@@ -131,7 +131,7 @@ def simulate_finger_grasp(controller: RSTController, plant=None, scenario: Grasp
     N = int(round(sc.duration / h))
     if N < 10:
         raise SimulationError(f"duration {sc.duration} s is shorter than 10 control samples")
-    if p.nk < 1:
+    if p.relative_degree() < 1:
         raise ModelError("simulate_finger_grasp needs a plant with at least one sample of input delay (nk >= 1)")
     if sc.force_limit <= sc.force_target:
         raise DataError(f"force_limit {sc.force_limit} N must exceed force_target {sc.force_target} N")
@@ -142,12 +142,12 @@ def simulate_finger_grasp(controller: RSTController, plant=None, scenario: Grasp
     cap = sc.force_limit - sc.limit_margin
     g_obj = 1.0 if math.isinf(sc.k_object) else sc.k_object / (sc.k_finger + sc.k_object)
     # plant in deviation variables around the operating current
-    A, B = p.A, p.B
+    A, B = p.den_zinv(), p.num_zinv()
     na, nb = A.size, B.size
     u_hist = np.zeros(nb)
     y_hist = np.zeros(na)
     u_lo, u_hi = sc.i_min - sc.i_op, sc.i_max - sc.i_op
-    G0 = p.dc_gain()
+    G0 = float(p.dc_gain()[0, 0])
     # steady start at i_max (finger straight): pre-fill histories
     i_start = sc.i_max
     ie0 = float(valve.demand_current(np.array([i_start]))[0])

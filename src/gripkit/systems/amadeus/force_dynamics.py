@@ -257,7 +257,12 @@ class FingerForcePlant:
             u_offset=OPERATING_POINT, info={"source": src})
         warn_inconsistent(self.consistency_checks())
 
-    # -- properties a controller designer needs (A, B, dt make it a plant for design_rst)
+    # -- properties a controller designer needs (lti, or A, B, dt, make it a plant for design_rst)
+    @property
+    def lti(self):
+        """The model as a :class:`gripkit.lti.TransferFunction` (SI, with σ): ``model.lti``."""
+        return self.model.lti
+
     @property
     def force_scale(self) -> float:
         """Newtons per force-sensor unit (the calibration the SI coefficients rest on)."""

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from ...control.rst import DiscretePlant
+from ...control.rst import as_plant
 from ...errors import (AccuracyWarning, DataError, IdentificationError, ModelError,
                        UnidentifiableError)
 from .strain_gauge_sensor import StrainGaugeSensor, sensitivity_matrix, sensor_parameters
@@ -470,10 +470,10 @@ class ForceDynamics:
         random-walk disturbance force on that axis (intensity ``q_disturbance`` N²/s, it absorbs
         model error, contact changes and offsets) and random walks (``q_other``) on the others.
 
-        ``plant`` is anything :meth:`gripkit.control.DiscretePlant.from_model` accepts; its output
+        ``plant`` is anything :func:`gripkit.control.as_plant` accepts; its output
         must be in N and its input is what ``u`` will hold (deviation from the operating point)."""
-        p = DiscretePlant.from_model(plant)
-        ss = p.to_state_space()
+        p = as_plant(plant)
+        ss = p.to_ss(minimal=False, form="controllable")
         npl = ss.n_states
         n = npl + 3
         A = np.zeros((n, n))
