@@ -534,8 +534,9 @@ def _peak(x: np.ndarray) -> float:
 
 
 def _norm(x: np.ndarray, peak: float) -> float:
-    """‖x‖₂ for ``peak = max |x| > 0``, without a temporary; x/peak only where x·x could overflow."""
-    if peak < 1e150:
+    """‖x‖₂ for ``peak = max |x| > 0``, without a temporary; x/peak only where x·x could overflow
+    or underflow."""
+    if 1e-150 < peak < 1e150:
         return math.sqrt(float(x @ x))
     return peak * float(np.linalg.norm(x / peak))
 
