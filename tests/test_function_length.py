@@ -31,8 +31,6 @@ NUMBA_KERNELS: dict[tuple[str, str], str] = {
 #: issue 12's split was made, so they were left alone. Remove each entry once that branch is
 #: merged and the function is short (test_allow_list_entries_are_still_needed says which).
 BEING_SPLIT_ELSEWHERE: set[tuple[str, str]] = {
-    ("systems/amadeus/force_control.py", "simulate_finger_grasp"),
-    ("systems/ftg100/demo.py", "_hybrid_section"),
     ("systems/tsfm/grasp_kernels.py", "_grasp_core"),  # a numba kernel
     ("systems/dlr_hit/finger.py", "_forces"),  # a numba kernel
 }

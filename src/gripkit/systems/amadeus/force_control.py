@@ -126,9 +126,42 @@ def simulate_finger_grasp(controller: RSTController, plant=None, scenario: Grasp
     sc = scenario or GraspScenario()
     p = controller.resolve_plant(plant)
     rng = np.random.default_rng(sc.seed if rng is None else rng)
-    valve = valve or ProportionalValve(check=False)
+    N = _check_grasp(p, sc, detector)
     h = p.dt
-    N = int(round(sc.duration / h))
+    cap = sc.force_limit - sc.limit_margin
+    finger = _ValveFinger(p, valve or ProportionalValve(check=False), sc)
+    sensing = _ForceSensing(sc, sensor, kalman_q, h)
+    slip = _SlipChannel(sc, contact, detector, h, N, rng) if sc.slip else None
+    supervisor = _Supervisor(sc, controller, SlipReflex(step=sc.reflex_step, rate=sc.reflex_rate, max_force=cap),
+                             cap, finger.i_start, h)
+    lt, lv = np.array([x[0] for x in sc.load]), np.array([x[1] for x in sc.load])
+    out = {k: np.zeros(N) for k in ("force", "force_est", "force_std", "ref", "current", "mode",
+                                    "slipping", "slip_alarm", "load", "x_obj")}
+    for k in range(N):
+        t = k * h
+        yb, F = finger.force()
+        load = float(np.interp(t, lt, lv))
+        Ft = slip.period(k, F, load, supervisor, out) if slip is not None else 0.0
+        Fm, Fs = sensing.measure(F, Ft, rng)
+        i_cmd = supervisor.step(t, Fm)
+        finger.advance(i_cmd, yb)
+        out["force"][k] = F
+        out["force_est"][k] = Fm
+        out["force_std"][k] = Fs
+        out["ref"][k] = supervisor.ref_now if supervisor.mode == 1 else np.nan
+        out["current"][k] = i_cmd
+        out["mode"][k] = supervisor.mode
+        out["load"][k] = load
+    pv = slip.pv if slip is not None else np.zeros(0)
+    alarms = slip.alarms if slip is not None else []
+    return FingerGraspResult(np.arange(N) * h, out["force"], out["force_est"], out["force_std"], out["ref"],
+                             out["current"], out["mode"], out["slipping"], out["slip_alarm"], out["load"],
+                             out["x_obj"], pv, sc.pvdf_rate, alarms, supervisor.contact_t, float(out["force"].max()))
+
+
+def _check_grasp(p, sc: GraspScenario, detector) -> int:
+    """The number of control samples, after checking the plant and the scenario."""
+    N = int(round(sc.duration / p.dt))
     if N < 10:
         raise SimulationError(f"duration {sc.duration} s is shorter than 10 control samples")
     if p.relative_degree() < 1:
@@ -137,117 +170,142 @@ def simulate_finger_grasp(controller: RSTController, plant=None, scenario: Grasp
         raise DataError(f"force_limit {sc.force_limit} N must exceed force_target {sc.force_target} N")
     if sc.slip and (detector is None or detector.threshold is None):
         raise DataError("scenario.slip needs a calibrated SlipDetector (detector=...)")
-    if sc.slip and contact is None:
-        contact = StickSlipContact(check=False)
-    cap = sc.force_limit - sc.limit_margin
-    g_obj = 1.0 if math.isinf(sc.k_object) else sc.k_object / (sc.k_finger + sc.k_object)
-    # plant in deviation variables around the operating current
-    A, B = p.den_zinv(), p.num_zinv()
-    na, nb = A.size, B.size
-    u_hist = np.zeros(nb)
-    y_hist = np.zeros(na)
-    u_lo, u_hi = sc.i_min - sc.i_op, sc.i_max - sc.i_op
-    G0 = float(p.dc_gain()[0, 0])
-    # steady start at i_max (finger straight): pre-fill histories
-    i_start = sc.i_max
-    ie0 = float(valve.demand_current(np.array([i_start]))[0])
-    u_hist[:] = ie0 - sc.i_op
-    y_hist[:] = G0 * (ie0 - sc.i_op)
-    play = i_start
-    hw = valve.parameters.value("hysteresis")
-    i_lo_v, p_min_v, kv = valve.parameters.value("i_lo"), valve.parameters.value("p_min"), valve.gain
-    fb0 = -G0 * (ie0 - sc.i_op) if sc.blocked_force_at_op is None else sc.blocked_force_at_op
-    # sensing
-    kf = None
-    if sc.sensor_noise:
-        if sensor is None:
-            sensor = StrainGaugeSensor()
-        H_sensor = sensor.H
-        kf = ForceKalmanFilter(sensor, ForceDynamics.random_walk([50.0, 50.0, kalman_q], h),
-                               x0=np.zeros(3), P0=np.eye(3) * 0.01)
-    reflex = SlipReflex(step=sc.reflex_step, rate=sc.reflex_rate, max_force=cap)
-    stream = detector.stream() if sc.slip else None
-    cstate = contact.new_state() if sc.slip else None
-    n_sub = int(round(sc.pvdf_rate * h)) if sc.slip else 0
-    ns_contact = contact.substeps(1.0 / sc.pvdf_rate, contact.theta()[None, :]) if sc.slip else 0
-    lt, lv = np.array([x[0] for x in sc.load]), np.array([x[1] for x in sc.load])
-    out = {k: np.zeros(N) for k in ("force", "force_est", "force_std", "ref", "current", "mode",
-                                    "slipping", "slip_alarm", "load", "x_obj")}
-    pv = np.zeros(N * n_sub)
-    mode = 0
-    i_cmd = i_start
-    contact_t = None
-    ref_now = 0.0
-    alarms = []
+    return N
 
-    noise_pv = pvdf_noise(N * n_sub, sc.pvdf_rate, rng) if sc.slip else None
-    for k in range(N):
-        t = k * h
-        # plant: blocked force from past effective currents
+
+class _ValveFinger:
+    """The finger seen by the controller: the plant's difference equation in deviation variables
+    around the operating current (blocked force from past effective currents), behind the valve's
+    static characteristic (play and saturation), starting steady at ``i_max`` (finger straight)."""
+
+    def __init__(self, p, valve, sc: GraspScenario):
+        self.sc = sc
+        self.A, self.B = p.den_zinv(), p.num_zinv()
+        self.u_hist = np.zeros(self.B.size)
+        self.y_hist = np.zeros(self.A.size)
+        G0 = float(p.dc_gain()[0, 0])
+        self.i_start = sc.i_max
+        ie0 = float(valve.demand_current(np.array([self.i_start]))[0])
+        self.u_hist[:] = ie0 - sc.i_op
+        self.y_hist[:] = G0 * (ie0 - sc.i_op)
+        self.play = self.i_start
+        self.valve = valve
+        self.hw = valve.parameters.value("hysteresis")
+        self.i_lo, self.p_min, self.kv = valve.parameters.value("i_lo"), valve.parameters.value("p_min"), valve.gain
+        self.fb0 = -G0 * (ie0 - sc.i_op) if sc.blocked_force_at_op is None else sc.blocked_force_at_op
+        self.g_obj = 1.0 if math.isinf(sc.k_object) else sc.k_object / (sc.k_finger + sc.k_object)
+
+    def force(self) -> tuple[float, float]:
+        """(blocked-force deviation, contact force on the object) at this sample."""
+        A, B, sc = self.A, self.B, self.sc
         acc = 0.0
-        for i in range(1, nb):
-            acc += B[i] * u_hist[i - 1]
-        for i in range(1, na):
-            acc -= A[i] * y_hist[i - 1]
-        yb = acc
-        Fb = fb0 + yb
-        F = g_obj * max(0.0, Fb - sc.k_finger * sc.gap)
-        load = float(np.interp(t, lt, lv))
-        # slip contact over this control period
-        Ft = 0.0
-        if sc.slip:
-            yc = contact.advance(cstate, np.full(n_sub, F), np.full(n_sub, load), h / n_sub, ns_contact)
-            seg = yc[:, 0] + noise_pv[k * n_sub:(k + 1) * n_sub]
-            pv[k * n_sub:(k + 1) * n_sub] = seg
-            Ft = float(yc[-1, 5])
-            out["slipping"][k] = yc[:, 2].mean()
-            out["x_obj"][k] = yc[-1, 4]
-            slipping_now, new_alarms = stream.update(seg)
-            out["slip_alarm"][k] = slipping_now
-            armed = mode == 1 and t - contact_t >= sc.slip_blanking
-            for a in new_alarms:
-                alarms.append(a)
-                if armed:
-                    reflex.on_slip()
-            if armed and slipping_now and not new_alarms:
-                reflex.while_slipping(h)
-        # force measurement
-        if kf is not None:
-            Rt = H_sensor @ np.array([0.0, Ft, F])
-            reading = Rt + rng.standard_normal(6) * np.sqrt(sensor.noise_variance(Rt))
-            f_est, cov = kf.step(reading)
-            Fm, Fs = float(f_est[2]), math.sqrt(max(cov[2, 2], 0.0))
-        else:
-            Fm, Fs = F, 0.0
-        # supervisor: guarded approach, then force control
-        if mode == 0:
+        for i in range(1, B.size):
+            acc += B[i] * self.u_hist[i - 1]
+        for i in range(1, A.size):
+            acc -= A[i] * self.y_hist[i - 1]
+        return acc, self.g_obj * max(0.0, self.fb0 + acc - sc.k_finger * sc.gap)
+
+    def advance(self, i_cmd: float, yb: float) -> None:
+        """The commanded current through the valve's play and static curve into the histories."""
+        self.play = min(max(self.play, i_cmd - self.hw), i_cmd + self.hw)
+        ie = self.i_lo + (float(self.valve.static_pressure(self.play)) - self.p_min) / self.kv
+        self.u_hist[1:] = self.u_hist[:-1]
+        self.u_hist[0] = ie - self.sc.i_op
+        self.y_hist[1:] = self.y_hist[:-1]
+        self.y_hist[0] = yb
+
+
+class _ForceSensing:
+    """The force the controller sees: the true force, or the Kalman estimate from six noisy
+    strain-gauge bridge readings (``scenario.sensor_noise``)."""
+
+    def __init__(self, sc: GraspScenario, sensor, kalman_q: float, h: float):
+        self.kf = None
+        if sc.sensor_noise:
+            self.sensor = sensor if sensor is not None else StrainGaugeSensor()
+            self.kf = ForceKalmanFilter(self.sensor, ForceDynamics.random_walk([50.0, 50.0, kalman_q], h),
+                                        x0=np.zeros(3), P0=np.eye(3) * 0.01)
+
+    def measure(self, F: float, Ft: float, rng) -> tuple[float, float]:
+        """(estimated normal force, its σ) for normal force F and tangential force Ft."""
+        if self.kf is None:
+            return F, 0.0
+        Rt = self.sensor.H @ np.array([0.0, Ft, F])
+        reading = Rt + rng.standard_normal(6) * np.sqrt(self.sensor.noise_variance(Rt))
+        f_est, cov = self.kf.step(reading)
+        return float(f_est[2]), math.sqrt(max(cov[2, 2], 0.0))
+
+
+class _SlipChannel:
+    """The stick-slip contact, the PVDF film with its noise and the streaming slip detector, run
+    at the PVDF rate over each control period."""
+
+    def __init__(self, sc: GraspScenario, contact, detector, h: float, N: int, rng):
+        self.sc, self.h = sc, h
+        self.contact = contact if contact is not None else StickSlipContact(check=False)
+        self.stream = detector.stream()
+        self.state = self.contact.new_state()
+        self.n_sub = int(round(sc.pvdf_rate * h))
+        self.ns_contact = self.contact.substeps(1.0 / sc.pvdf_rate, self.contact.theta()[None, :])
+        self.pv = np.zeros(N * self.n_sub)
+        self.alarms = []
+        self.noise = pvdf_noise(N * self.n_sub, sc.pvdf_rate, rng)
+
+    def period(self, k: int, F: float, load: float, supervisor: "_Supervisor", out: dict) -> float:
+        """Advance the contact over control period k; record the film voltage, slipping fraction,
+        object position and alarms, and let the supervisor's slip reflex act on them. Returns the
+        tangential force at the period's end."""
+        n, h = self.n_sub, self.h
+        yc = self.contact.advance(self.state, np.full(n, F), np.full(n, load), h / n, self.ns_contact)
+        seg = yc[:, 0] + self.noise[k * n:(k + 1) * n]
+        self.pv[k * n:(k + 1) * n] = seg
+        out["slipping"][k] = yc[:, 2].mean()
+        out["x_obj"][k] = yc[-1, 4]
+        slipping_now, new_alarms = self.stream.update(seg)
+        out["slip_alarm"][k] = slipping_now
+        self.alarms.extend(new_alarms)
+        supervisor.on_slip_signal(k * h, slipping_now, new_alarms, h)
+        return float(yc[-1, 5])
+
+
+class _Supervisor:
+    """Guarded approach (close at ``approach_rate`` until the measured force passes
+    ``contact_force``), then force control on a rate-limited reference, raised by the slip reflex."""
+
+    def __init__(self, sc: GraspScenario, controller: RSTController, reflex: SlipReflex, cap: float,
+                 i_start: float, h: float):
+        self.sc, self.controller, self.reflex, self.cap, self.h = sc, controller, reflex, cap, h
+        self.mode = 0
+        self.i_cmd = i_start
+        self.contact_t = None
+        self.ref_now = 0.0
+        self.u_lo, self.u_hi = sc.i_min - sc.i_op, sc.i_max - sc.i_op
+
+    def on_slip_signal(self, t: float, slipping_now: bool, new_alarms, h: float) -> None:
+        """Slip alarms raise the force demand once armed (in contact for ``slip_blanking``)."""
+        armed = self.mode == 1 and t - self.contact_t >= self.sc.slip_blanking
+        if armed:
+            for _ in new_alarms:
+                self.reflex.on_slip()
+            if slipping_now and not new_alarms:
+                self.reflex.while_slipping(h)
+
+    def step(self, t: float, Fm: float) -> float:
+        """The commanded valve current for this sample, from the measured force."""
+        sc, h = self.sc, self.h
+        if self.mode == 0:
             if Fm > sc.contact_force:
-                mode = 1
-                contact_t = t
-                ref_now = Fm
-                controller.reset(i_cmd - sc.i_op, Fm)
+                self.mode = 1
+                self.contact_t = t
+                self.ref_now = Fm
+                self.controller.reset(self.i_cmd - sc.i_op, Fm)
             else:
-                i_cmd = max(sc.i_min, i_cmd - sc.approach_rate * h)
-        if mode == 1:
-            target = min(reflex.demand(sc.force_target), cap)
+                self.i_cmd = max(sc.i_min, self.i_cmd - sc.approach_rate * h)
+        if self.mode == 1:
+            target = min(self.reflex.demand(sc.force_target), self.cap)
             step_max = sc.ramp_rate * h
-            ref_now = min(target, ref_now + step_max) if target > ref_now else max(target, ref_now - step_max)
-            u = controller.step(ref_now, Fm)
-            i_cmd = sc.i_op + min(max(u, u_lo), u_hi)
-        # valve static characteristic (play + saturation) -> effective current into the plant
-        play = min(max(play, i_cmd - hw), i_cmd + hw)
-        ie = i_lo_v + (float(valve.static_pressure(play)) - p_min_v) / kv
-        u_hist[1:] = u_hist[:-1]
-        u_hist[0] = ie - sc.i_op
-        y_hist[1:] = y_hist[:-1]
-        y_hist[0] = yb
-        out["force"][k] = F
-        out["force_est"][k] = Fm
-        out["force_std"][k] = Fs
-        out["ref"][k] = ref_now if mode == 1 else np.nan
-        out["current"][k] = i_cmd
-        out["mode"][k] = mode
-        out["load"][k] = load
-    return FingerGraspResult(np.arange(N) * h, out["force"], out["force_est"], out["force_std"], out["ref"],
-                             out["current"], out["mode"], out["slipping"], out["slip_alarm"], out["load"],
-                             out["x_obj"], pv, sc.pvdf_rate, alarms, contact_t, float(out["force"].max()))
+            r = self.ref_now
+            self.ref_now = min(target, r + step_max) if target > r else max(target, r - step_max)
+            u = self.controller.step(self.ref_now, Fm)
+            self.i_cmd = sc.i_op + min(max(u, self.u_lo), self.u_hi)
+        return self.i_cmd

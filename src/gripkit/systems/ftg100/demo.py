@@ -286,6 +286,15 @@ def _hybrid_section(report, summary, plant, quick):
         "(2 %) is timed from the first contact. The object is the seed's pure spring: the ball between the "
         "two light tips rings at 35-60 kHz, above the 20 kHz loop, so the approach speed is bounded by "
         f"v ≤ 0.1 F/√(k0 m_r) = {impact_speed_limit(20e-6, 1560.0) * 1e3:.2g} mm/s for 20 µN on 1560 N/m.")
+    _hybrid_nominal(sec, ctrl, plant)
+    _hybrid_robustness(sec, summary, ctrl, plant, quick)
+    _hybrid_windup_and_switch(sec, ctrl, plant)
+    _hybrid_sensitivity(sec, ctrl, plant)
+    return summary
+
+
+def _hybrid_nominal(sec, ctrl, plant):
+    """The nominal grasp of the hybrid controller: force, tips and voltage around the contact."""
     nom = simulate_hybrid_grasp(ctrl, plant, force=20e-6, duration=0.05)
     tr = nom.trajectory
     tc = nom.metrics["t_contact"]
@@ -311,6 +320,9 @@ def _hybrid_section(report, summary, plant, quick):
     fig.tight_layout()
     sec.figure(fig, "Nominal grasp (zoom on the contact)", name="ftg100-grasp")
 
+
+def _hybrid_robustness(sec, summary, ctrl, plant, quick):
+    """Grasp batches over the object stiffness k0 (±50 %) and the gap, one noise seed per run."""
     k0s = np.linspace(520, 1560, 5 if quick else 14)
     gaps = np.array([5e-6, 20e-6]) if quick else np.array([2e-6, 10e-6, 20e-6, 40e-6])
     batches = [grasp_batch(ctrl, plant, force=20e-6, k0=k0s, gap=gp, seed=np.arange(len(k0s)),
@@ -352,7 +364,9 @@ def _hybrid_section(report, summary, plant, quick):
                              max_settling_ms=float(b["settling_time"].max() * 1e3),
                              max_peak_uN=float(b["peak_force"].max() * 1e6), damage=int(b["damage"].sum()))
 
-    # anti-windup and bumpless transfer, and two sensitivities
+
+def _hybrid_windup_and_switch(sec, ctrl, plant):
+    """Anti-windup at the 200 V limit and the bumpless switch at contact, each on and off."""
     ns = int(round(0.12 / ctrl.ts))
     prof = np.where(np.arange(ns) < int(0.07 / ctrl.ts), 400e-6, 50e-6)
     aw = {f: simulate_hybrid_grasp(ctrl.with_(anti_windup=f), plant, force_profile=prof, duration=0.12) for f in (True, False)}
@@ -374,6 +388,10 @@ def _hybrid_section(report, summary, plant, quick):
     ax[1].legend(fontsize=8)
     fig.tight_layout()
     sec.figure(fig, "Anti-windup at the 200 V limit and the bumpless switch at contact", name="ftg100-aw-bumpless")
+
+
+def _hybrid_sensitivity(sec, ctrl, plant):
+    """Worst metrics when the plant differs from the controller's model in one parameter."""
     rows = []
     for label, kw in (("object damping ζ ≈ 0.02 (c0 = 0.14 mN·s/m)", dict(c0=1.4e-4)),
                       ("suspension 10 % stiffer than modelled", dict(K_sa=25.4 * 1.1)),
@@ -387,4 +405,3 @@ def _hybrid_section(report, summary, plant, quick):
                      f"{bb['peak_force'].max() * 1e6:.2f} µN"])
     sec.table(["plant differs from the controller's model", "max overshoot", "max settling", "max peak"], rows,
               caption="Sensitivity (k0 ∈ {520, 1043, 1560} N/m, 10 µm gap, 20 µN)")
-    return summary
