@@ -29,6 +29,7 @@ closes the loop on the hybrid two-finger model :class:`~gripkit.systems.tsfm.gri
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 from dataclasses import asdict, dataclass, field
 
 import numba
@@ -38,15 +39,24 @@ from ...errors import DataError, IdentificationError, SimulationError
 from ...estimation.contact_detection import detector_step
 from ...signals.trajectory import Trajectory
 from .end_effector import lever_coefficients
-from .gripper import TSFMGripper, gripper_advance, gripper_measure, gripper_work
+from .gripper import TSFMGripper, GripperState, gripper_advance, gripper_measure, gripper_model, gripper_work
 from .micropart import MicropartEstimate, estimate_micropart
 from .tip_position import estimator_arrays, estimator_step
 
-__all__ = ["GraspSettings", "TwoFingerGrasp", "TwoFingerGraspResult", "simulate_two_finger_grasp", "grasp_step"]
+__all__ = ["GraspSettings", "TwoFingerGrasp", "TwoFingerGraspResult", "simulate_two_finger_grasp", "grasp_step",
+           "Estimators", "GraspLoop"]
 
 # controller state columns (per finger)
 _PHASE, _REF, _U, _YC, _FC, _FREF, _CONTACT_T = range(7)
 APPROACH, HOLD, SQUEEZE = 0, 1, 2
+
+#: the tip-position estimators of both fingers (:func:`estimator_arrays`, stacked): ``bw`` (2, 4),
+#: ``Phi`` (2, 4, 4), ``Gam`` (2, 4, 2), ``cy`` (2, 4)
+Estimators = namedtuple("Estimators", "bw Phi Gam cy")
+#: the grasp loop of both fingers: detector states ``det`` (2, 5) and windows ``buf`` (2, window),
+#: estimator states ``est`` (2, 6), controller states ``cs`` (2, 7), estimator scratch ``xt`` (4),
+#: and ``out`` (2, 5) = [U (V), ŷ (m), filtered force (N), contact flag, phase] per finger
+GraspLoop = namedtuple("GraspLoop", "det buf est cs xt out")
 
 
 @dataclass(frozen=True)
@@ -76,14 +86,15 @@ class GraspSettings:
 
 
 @numba.njit(cache=True)
-def grasp_step(F1, F2, det, buf, est, bw, Phi, Gam, cy, cs, cp, xt, out):  # pragma: no cover - compiled
+def grasp_step(F1, F2, loop, e, cp):  # pragma: no cover - compiled
     """One sample of the grasp for both fingers.
 
-    F1, F2: measured forces (N). det (2, 5), buf (2, window): detector states; est (2, 6):
-    estimator states; bw (2, 4), Phi (2, 4, 4), Gam (2, 4, 2), cy (2, 4): estimator arrays;
-    cs (2, 7): controller states; cp: :meth:`GraspSettings.vector`. Writes out[i] =
-    [U (V), ŷ (m), filtered force (N), contact flag, phase] and returns nothing.
+    F1, F2: measured forces (N); ``loop``: the states of both fingers (:class:`GraspLoop`);
+    ``e``: the estimators (:class:`Estimators`); cp: :meth:`GraspSettings.vector`. Writes
+    loop.out[i] = [U (V), ŷ (m), filtered force (N), contact flag, phase] and returns nothing.
     """
+    det, buf, est, cs, out = loop.det, loop.buf, loop.est, loop.cs, loop.out
+    cy = e.cy
     dt = cp[15]
     for i in range(2):
         F = F1 if i == 0 else F2
@@ -144,18 +155,18 @@ def grasp_step(F1, F2, det, buf, est, bw, Phi, Gam, cy, cs, cp, xt, out):  # pra
         out[i, 0] = U
         out[i, 4] = cs[i, _PHASE]
         F = F1 if i == 0 else F2
-        estimator_step(est[i], bw[i], Phi[i], Gam[i], cy[i], U, F, xt)
+        estimator_step(est[i], e.bw[i], e.Phi[i], e.Gam[i], cy[i], U, F, loop.xt)
 
 
-def _init_state(n_window: int):
+def _init_state(n_window: int) -> GraspLoop:
     cs = np.zeros((2, 7))
     cs[:, _CONTACT_T] = -1.0
-    return np.zeros((2, 5)), np.zeros((2, n_window)), np.zeros((2, 6)), cs
+    return GraspLoop(np.zeros((2, 5)), np.zeros((2, n_window)), np.zeros((2, 6)), cs, np.empty(4), np.zeros((2, 5)))
 
 
-def _est_stack(fingers, dt):
+def _est_stack(fingers, dt) -> tuple[Estimators, list]:
     arrs = [estimator_arrays(f, dt) for f in fingers]
-    return {k: np.ascontiguousarray(np.stack([a[k] for a in arrs])) for k in ("bw", "Phi", "Gam", "cy")}, arrs
+    return Estimators(*(np.ascontiguousarray(np.stack([a[k] for a in arrs])) for k in Estimators._fields)), arrs
 
 
 def _static_gain(values) -> float:
@@ -186,47 +197,45 @@ class TwoFingerGrasp:
         vals = [_values(finger1), _values(finger2)]
         self._e, _ = _est_stack(vals, dt)
         self._cp = settings.vector((_static_gain(vals[0]), _static_gain(vals[1])), dt)
-        self._det, self._buf, self._est, self._cs = _init_state(settings.window)
-        self._xt = np.empty(4)
-        self._out = np.zeros((2, 5))
+        self._loop = _init_state(settings.window)
 
     def step(self, F1: float, F2: float) -> tuple[float, float]:
-        e = self._e
-        grasp_step(float(F1), float(F2), self._det, self._buf, self._est, e["bw"], e["Phi"], e["Gam"], e["cy"],
-                   self._cs, self._cp, self._xt, self._out)
-        return float(self._out[0, 0]), float(self._out[1, 0])
+        grasp_step(float(F1), float(F2), self._loop, self._e, self._cp)
+        out = self._loop.out
+        return float(out[0, 0]), float(out[1, 0])
 
     @property
     def phases(self) -> tuple[str, str]:
         names = ("approach", "hold", "squeeze")
-        return names[int(self._cs[0, _PHASE])], names[int(self._cs[1, _PHASE])]
+        cs = self._loop.cs
+        return names[int(cs[0, _PHASE])], names[int(cs[1, _PHASE])]
 
     @property
     def positions(self) -> tuple[float, float]:
         """Estimated tip positions (m) at the last step."""
-        return float(self._out[0, 1]), float(self._out[1, 1])
+        out = self._loop.out
+        return float(out[0, 1]), float(out[1, 1])
 
 
 @numba.njit(cache=True)
-def _grasp_run(bw, Phi, Gam, C, D, G, Hg, target, ng, K, part, x0, noise, det, buf, est, ebw, ePhi, eGam, ecy, cs,
-               cp, rec, ua, xt, ev_frac, ev_to, yout):  # pragma: no cover - compiled
-    n = Phi.shape[4]
-    X = np.empty((2, n))
-    modes = np.empty(2, dtype=np.int64)
-    hyst = np.zeros(4)
-    ps = np.empty(1)
+def _grasp_run(model, x0, noise, loop, e, cp, rec, work):  # pragma: no cover - compiled
+    """The grasp loop on the gripper ``model`` (:class:`~gripkit.systems.tsfm.gripper.GripperModel`)
+    from x0 (3, n) = [finger 1, finger 2, [X_p, ...]], force noise (N, 2): one row of ``rec`` per
+    sample (:data:`_COLUMNS`)."""
+    n = model.Phi.shape[4]
+    state = GripperState(np.empty((2, n)), np.empty(2, dtype=np.int64), np.zeros(4), np.empty(1))
+    X, modes, ps = state.X, state.modes, state.ps
     for i in range(2):
         for j in range(n):
             X[i, j] = x0[i, j]
         modes[i] = 0
     ps[0] = x0[2, 0]
-    ext = np.empty(4)
-    out = np.empty((2, 5))
-    gripper_measure(X, modes, ps[0], C, D, part, ua, yout)
+    out, yout = loop.out, work.yout
+    gripper_measure(state, model, work)
     for k in range(noise.shape[0]):
         F1 = yout[0, 3] + noise[k, 0]
         F2 = yout[1, 3] + noise[k, 1]
-        grasp_step(F1, F2, det, buf, est, ebw, ePhi, eGam, ecy, cs, cp, ext, out)
+        grasp_step(F1, F2, loop, e, cp)
         rec[k, 0] = out[0, 0]
         rec[k, 1] = out[1, 0]
         rec[k, 2] = yout[0, 0]
@@ -242,8 +251,7 @@ def _grasp_run(bw, Phi, Gam, C, D, G, Hg, target, ng, K, part, x0, noise, det, b
         rec[k, 12] = out[1, 4]
         rec[k, 13] = modes[0]
         rec[k, 14] = modes[1]
-        gripper_advance(out[0, 0], out[1, 0], X, modes, hyst, ps, bw, Phi, Gam, C, D, G, Hg, target, ng, K, part,
-                        ua, xt, ev_frac, ev_to, yout)
+        gripper_advance(out[0, 0], out[1, 0], state, model, work)
 
 
 _COLUMNS = (("U1", "V"), ("U2", "V"), ("y_C1", "m"), ("y_C2", "m"), ("y_hat1", "m"), ("y_hat2", "m"),
@@ -304,16 +312,13 @@ def simulate_two_finger_grasp(gripper: TSFMGripper, *, estimator_fingers=None, s
     vals = [_values(f) for f in fingers]
     e, _ = _est_stack(vals, dt)
     cp = settings.vector((_static_gain(vals[0]), _static_gain(vals[1])), dt)
-    det, buf, est, cs = _init_state(settings.window)
+    loop = _init_state(settings.window)
     rng = np.random.default_rng(seed)
     noise = np.ascontiguousarray(rng.standard_normal((N, 2)) * noise_std)
     x0 = np.zeros((3, d["Phi"].shape[-1]))
     x0[2, 0] = th[gripper.parameters.names.index("X_p")]
     rec = np.empty((N, len(_COLUMNS)))
-    ua, xt, ev_frac, ev_to, yout = gripper_work(d["Phi"].shape[-1], d["C"].shape[-2])
-    _grasp_run(d["bw"][0], d["Phi"][0], d["Gam"][0], d["C"][0], d["D"][0], d["G"][0], d["H"][0], d["target"],
-               d["ng"], d["K"], d["part"][0], x0, noise, det, buf, est, e["bw"], e["Phi"], e["Gam"], e["cy"], cs, cp,
-               rec, ua, xt, ev_frac, ev_to, yout)
+    _grasp_run(gripper_model(d, 0), x0, noise, loop, e, cp, rec, gripper_work(d["Phi"].shape[-1], d["C"].shape[-2]))
     if not np.isfinite(rec).all():
         raise SimulationError("the grasp simulation diverged", hint="lower the loop bandwidths")
     t = np.arange(N) * dt

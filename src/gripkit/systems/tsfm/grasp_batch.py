@@ -187,8 +187,8 @@ def _run_cpu(tpl, parts, nz, nstd, seeds, n_steps, window, cps, mset, met, threa
 
     def run(a):
         b = min(P, a + size)
-        _grasp_jobs(*tpl.kernel_args(), parts[a:b], nz if nz.shape[0] == 1 else nz[a:b], nstd[a:b], seeds[a:b],
-                    n_steps, window, *tpl.est, cps[a:b], mset, met[a:b])
+        _grasp_jobs(tpl.kernel_args(), parts[a:b], nz if nz.shape[0] == 1 else nz[a:b], nstd[a:b], seeds[a:b],
+                    n_steps, window, cps[a:b], mset, met[a:b])
         return b - a
 
     starts = range(0, P, size)

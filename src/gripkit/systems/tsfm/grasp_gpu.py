@@ -25,7 +25,9 @@ from numba import cuda
 
 from ...errors import ConfigError
 from ...sim.hybrid import MAX_EVENTS_PER_STEP
+from .grasp import Estimators, GraspLoop
 from .grasp_kernels import _default_gripper, _grasp_core, _setup_jobs, _template
+from .gripper import GripperModel, GripperState, GripperWork
 
 __all__ = ["cuda_available", "run_cuda", "compile_ptx"]
 
@@ -41,13 +43,16 @@ def cuda_available() -> bool:
 def _kernel_py(bw, Phi, Gam, C, D, G, Hg, target, ng, K, parts, noise, nstd, seeds, n_steps, ebw, ePhi, eGam, ecy,
                cps, mset, det, buf, est, cs, X, modes, hyst, ps, ext, out, ua, xt, ev_frac, ev_to, yout, rng,
                met):  # pragma: no cover - runs on the device
-    """Thread p runs job p; every array with a leading job index is that job's slice."""
+    """Thread p runs job p; every array with a leading job index is that job's slice. (A CUDA
+    kernel takes arrays; the records :func:`_grasp_core` takes are built here, on the device.)"""
     p = cuda.grid(1)
     if p < parts.shape[0]:
         q = p if noise.shape[0] > 1 else 0
-        _grasp_core(bw, Phi[p], Gam[p], C[p], D[p], G, Hg[p], target, ng, K, parts[p], noise[q], nstd[p], seeds[p],
-                    n_steps, ebw, ePhi, eGam, ecy, cps[p], mset, det[p], buf[p], est[p], cs[p], X[p], modes[p],
-                    hyst[p], ps[p], ext[p], out[p], ua[p], xt[p], ev_frac[p], ev_to[p], yout[p], rng[p], met[p])
+        _grasp_core(GripperModel(bw, Phi[p], Gam[p], C[p], D[p], G, Hg[p], target, ng, K, parts[p]), noise[q],
+                    nstd[p], seeds[p], n_steps, Estimators(ebw, ePhi, eGam, ecy), cps[p], mset,
+                    GraspLoop(det[p], buf[p], est[p], cs[p], ext[p], out[p]),
+                    GripperState(X[p], modes[p], hyst[p], ps[p]),
+                    GripperWork(ua[p], xt[p], ev_frac[p], ev_to[p], yout[p]), rng[p], met[p])
 
 
 _KERNEL = []
@@ -64,7 +69,7 @@ def _host_arrays(tpl, parts):
     P = parts.shape[0]
     stack = [np.ascontiguousarray(np.broadcast_to(a, (P,) + a.shape)) for a in (tpl.Phi, tpl.Gam, tpl.C, tpl.D, tpl.H)]
     Phi, Gam, C, D, Hg = (s.copy() for s in stack)
-    _setup_jobs(tpl.A, tpl.B0, tpl.bF, tpl.iy, parts, tpl.dt, tpl.K, Phi, Gam, C, D, Hg)
+    _setup_jobs(tpl.kernel_args(), parts, tpl.dt, Phi, Gam, C, D, Hg)
     return Phi, Gam, C, D, Hg
 
 

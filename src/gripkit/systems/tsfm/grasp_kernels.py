@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 import threading
 import warnings
+from collections import namedtuple
 
 import numba
 import numpy as np
@@ -17,8 +18,9 @@ from ...sim.hybrid import MAX_EVENTS_PER_STEP
 from ...sim.integrators import zoh_levels_into
 from ...sim.noise import normal_draw
 from . import parameters as z
-from .grasp import _est_stack, _static_gain, _values, grasp_step
-from .gripper import FINGER_NAMES, finger_state_space, gripper_advance, gripper_measure
+from .grasp import GraspLoop, _est_stack, _static_gain, _values, grasp_step
+from .gripper import (FINGER_NAMES, GripperModel, GripperState, GripperWork, finger_state_space, gripper_advance,
+                      gripper_measure)
 
 METRICS = ("t_contact1", "t_contact2", "t_squeeze", "peak_force", "damage", "max_displacement", "grasped",
            "lost", "settling_time", "final_error", "final_force", "width_error", "stiffness_error")
@@ -26,18 +28,31 @@ _NM = len(METRICS)
 _SQUEEZE = 2.0
 _PHASE, _CONTACT_T = 0, 6
 
+#: what the jobs of one gripper share (:meth:`GraspTemplate.kernel_args`): the fingers' continuous
+#: matrices for the contact modes (``A`` (2, n, n), ``B0``, ``bF`` (2, n), ``iy`` the index of y_C),
+#: the discretised free modes and outputs (``Phi``, ``Gam``, ``C``, ``D``, ``G``, ``H``: leading
+#: index finger), the hybrid step's ``target``, ``ng``, ``K``, the Bouc-Wen ``bw`` (2, 4) and the
+#: estimators ``est`` (:class:`~gripkit.systems.tsfm.grasp.Estimators`)
+JobTemplate = namedtuple("JobTemplate", "A B0 bF iy Phi Gam C D G H target ng K bw est")
+#: scratch of :func:`_job_setup`: the contact mode's continuous ``Ac`` (2, n, n), ``Bc`` (2, n, 3)
+#: and discretised ``PhiC`` (2, K+1, n, n), ``GamC`` (2, K+1, n, 3)
+ContactWork = namedtuple("ContactWork", "Ac Bc PhiC GamC")
+
 
 # ------------------------------------------------------------------------------------------------
 # numba kernels
 # ------------------------------------------------------------------------------------------------
 
 @numba.njit(cache=True)
-def _job_setup(A, B0, bF, iy, part, dt, K, Phi, Gam, C, D, Hg, Ac, Bc, PhiC, GamC):  # pragma: no cover
+def _job_setup(tpl, part, dt, Phi, Gam, C, D, Hg, cw):  # pragma: no cover - compiled
     """Write the contact mode (index 1) of both fingers for the part ``part`` = [w, gap, k_side,
     c_side, F_po, F_stick] into Phi (2, 2, K+1, n, n), Gam (2, 2, K+1, n, 3), C (2, 2, 4, n),
-    D (2, 2, 4, 3), Hg (2, 2, J, 3); the free mode (index 0) is left as it is. Mirrors
+    D (2, 2, 4, 3), Hg (2, 2, J, 3); the free mode (index 0) is left as it is. ``tpl``: the
+    :class:`JobTemplate` (A, B0, bF, iy, K used); ``cw``: :class:`ContactWork`. Mirrors
     :func:`gripkit.systems.tsfm.gripper.finger_hybrid`: A_c = A + b_F kᵀ (k = k_side at y_C, c_side at
     ẏ_C), B_c = [B_W, −k_side b_F, 0], F_g = kᵀ x − k_side x_face, release at −F_po/k_side."""
+    A, B0, bF, iy, K = tpl.A, tpl.B0, tpl.bF, tpl.iy, tpl.K
+    Ac, Bc, PhiC, GamC = cw.Ac, cw.Bc, cw.PhiC, cw.GamC
     n = A.shape[1]
     k = part[2]
     c = part[3]
@@ -66,15 +81,21 @@ def _job_setup(A, B0, bF, iy, part, dt, K, Phi, Gam, C, D, Hg, Ac, Bc, PhiC, Gam
 
 
 @numba.njit(cache=True)
-def _grasp_core(bw, Phi, Gam, C, D, G, Hg, target, ng, K, part, noise, nstd, seed, n_steps, ebw, ePhi, eGam,
-                ecy, cp, mset, det, buf, est, cs, X, modes, hyst, ps, ext, out, ua, xt, ev_frac, ev_to, yout,
-                rng, met):  # pragma: no cover - compiled
-    """One grasp from rest, reduced to the metrics ``met`` (len(METRICS)); no allocation (every
-    work array is passed in, so the function also compiles for CUDA, one job per thread).
+def _grasp_core(model, noise, nstd, seed, n_steps, e, cp, mset, loop, state, work, rng,
+                met):  # pragma: no cover - compiled
+    """One grasp from rest on the gripper ``model`` (:class:`GripperModel`, its part with the
+    initial X_p appended), reduced to the metrics ``met`` (len(METRICS)); no allocation (every
+    work array is passed in: ``loop`` (:class:`~gripkit.systems.tsfm.grasp.GraspLoop`), ``state``
+    (:class:`GripperState`), ``work`` (:class:`GripperWork`), ``rng`` (1,) uint64; so the function
+    also compiles for CUDA, one job per thread).
 
     ``noise`` (N, 2): the force-sensor noise per sample when it has rows, else white noise of std
-    ``nstd`` from a splitmix64 stream seeded with ``seed``. ``mset`` = [damage_force,
-    lost_displacement, band]. The loop is the one of ``_grasp_run`` (two_finger_grasp.py)."""
+    ``nstd`` from a splitmix64 stream seeded with ``seed``. ``e``: the estimators; ``cp``:
+    :meth:`GraspSettings.vector`; ``mset`` = [damage_force, lost_displacement, band]. The loop is
+    the one of :func:`gripkit.systems.tsfm.grasp._grasp_run`."""
+    det, buf, est, cs, out = loop.det, loop.buf, loop.est, loop.cs, loop.out
+    X, modes, hyst, ps = state.X, state.modes, state.hyst, state.ps
+    part, yout = model.part, work.yout
     dt = cp[15]
     fcmd = cp[3]
     for i in range(2):
@@ -115,7 +136,7 @@ def _grasp_core(bw, Phi, Gam, C, D, G, Hg, target, ng, K, part, noise, nstd, see
     sum_s = 0.0
     n_tail = 0
     grasped = False
-    gripper_measure(X, modes, ps[0], C, D, part, ua, yout)
+    gripper_measure(state, model, work)
     for k in range(n_steps):
         if explicit:
             F1 = yout[0, 3] + noise[k, 0]
@@ -123,7 +144,7 @@ def _grasp_core(bw, Phi, Gam, C, D, G, Hg, target, ng, K, part, noise, nstd, see
         else:
             F1 = yout[0, 3] + nstd * normal_draw(rng)
             F2 = yout[1, 3] + nstd * normal_draw(rng)
-        grasp_step(F1, F2, det, buf, est, ebw, ePhi, eGam, ecy, cs, cp, ext, out)
+        grasp_step(F1, F2, loop, e, cp)
         # --- metrics of sample k (the record row k of the single grasp)
         fg1 = yout[0, 2]
         fg2 = yout[1, 2]
@@ -156,8 +177,7 @@ def _grasp_core(bw, Phi, Gam, C, D, G, Hg, target, ng, K, part, noise, nstd, see
             n_tail += 1
         if k == n_steps - 1:
             grasped = modes[0] == 1 and modes[1] == 1 and out[0, 4] == _SQUEEZE and out[1, 4] == _SQUEEZE
-        gripper_advance(out[0, 0], out[1, 0], X, modes, hyst, ps, bw, Phi, Gam, C, D, G, Hg, target, ng, K, part,
-                        ua, xt, ev_frac, ev_to, yout)
+        gripper_advance(out[0, 0], out[1, 0], state, model, work)
     nan = math.nan
     met[0] = t_c1 if t_c1 >= 0.0 else nan
     met[1] = t_c2 if t_c2 >= 0.0 else nan
@@ -185,44 +205,46 @@ def _grasp_core(bw, Phi, Gam, C, D, G, Hg, target, ng, K, part, noise, nstd, see
 
 
 @numba.njit(cache=True, nogil=True)
-def _grasp_jobs(tA, tB0, tbF, iy, tPhi, tGam, tC, tD, G, tH, target, ng, K, bw, parts, noise, nstd, seeds, n_steps,
-                window, ebw, ePhi, eGam, ecy, cps, mset, met):  # pragma: no cover - compiled
+def _grasp_jobs(tpl, parts, noise, nstd, seeds, n_steps, window, cps, mset, met):  # pragma: no cover - compiled
     """Jobs one after another on this core (rows of parts, cps, nstd, seeds, met): for each, the
-    template's matrices with the contact mode of its part (:func:`_job_setup`), then
-    :func:`_grasp_core`. ``noise`` (P, N, 2) explicit noise per job, or (1, 0, 2) for generated
-    noise. ``nogil``: :func:`tsfm_grasp_batch` runs slices of the jobs on several threads.
+    template's (:class:`JobTemplate`) matrices with the contact mode of its part
+    (:func:`_job_setup`), then :func:`_grasp_core`. ``noise`` (P, N, 2) explicit noise per job, or
+    (1, 0, 2) for generated noise. ``nogil``: :func:`tsfm_grasp_batch` runs slices of the jobs on
+    several threads.
 
     Compile time (measured, cold cache): one level of calls above :func:`_grasp_core` — each
     extra level, and a ``prange`` variant (+15 s), re-optimises the whole linked grasp step."""
-    n = tA.shape[1]
-    L = K + 1
-    Phi = tPhi.copy()
-    Gam = tGam.copy()
-    C = tC.copy()
-    D = tD.copy()
-    Hg = tH.copy()
-    Ac, Bc, PhiC, GamC = np.empty((2, n, n)), np.empty((2, n, 3)), np.empty((2, L, n, n)), np.empty((2, L, n, 3))
-    det, buf, est, cs = np.empty((2, 5)), np.empty((2, window)), np.empty((2, 6)), np.empty((2, 7))
-    X, modes, hyst, ps = np.empty((2, n)), np.empty(2, dtype=np.int64), np.empty(4), np.empty(1)
-    ext, out, ua, xt = np.empty(4), np.empty((2, 5)), np.empty(3), np.empty(n)
-    ev_frac, ev_to = np.empty(MAX_EVENTS_PER_STEP), np.empty(MAX_EVENTS_PER_STEP, dtype=np.int64)
-    yout, rng = np.empty((2, tC.shape[2])), np.empty(1, dtype=np.uint64)
+    n = tpl.A.shape[1]
+    L = tpl.K + 1
+    Phi = tpl.Phi.copy()
+    Gam = tpl.Gam.copy()
+    C = tpl.C.copy()
+    D = tpl.D.copy()
+    Hg = tpl.H.copy()
+    cw = ContactWork(np.empty((2, n, n)), np.empty((2, n, 3)), np.empty((2, L, n, n)), np.empty((2, L, n, 3)))
+    loop = GraspLoop(np.empty((2, 5)), np.empty((2, window)), np.empty((2, 6)), np.empty((2, 7)), np.empty(4),
+                     np.empty((2, 5)))
+    state = GripperState(np.empty((2, n)), np.empty(2, dtype=np.int64), np.empty(4), np.empty(1))
+    work = GripperWork(np.empty(3), np.empty(n), np.empty(MAX_EVENTS_PER_STEP),
+                       np.empty(MAX_EVENTS_PER_STEP, dtype=np.int64), np.empty((2, tpl.C.shape[2])))
+    rng = np.empty(1, dtype=np.uint64)
     for p in range(parts.shape[0]):
         q = p if noise.shape[0] > 1 else 0
-        _job_setup(tA, tB0, tbF, iy, parts[p], cps[p, 15], K, Phi, Gam, C, D, Hg, Ac, Bc, PhiC, GamC)
-        _grasp_core(bw, Phi, Gam, C, D, G, Hg, target, ng, K, parts[p], noise[q],
-                    nstd[p], seeds[p], n_steps, ebw, ePhi, eGam, ecy, cps[p], mset, det, buf, est, cs, X, modes,
-                    hyst, ps, ext, out, ua, xt, ev_frac, ev_to, yout, rng, met[p])
+        _job_setup(tpl, parts[p], cps[p, 15], Phi, Gam, C, D, Hg, cw)
+        model = GripperModel(tpl.bw, Phi, Gam, C, D, tpl.G, Hg, tpl.target, tpl.ng, tpl.K, parts[p])
+        _grasp_core(model, noise[q], nstd[p], seeds[p], n_steps, tpl.est, cps[p], mset, loop, state, work, rng,
+                    met[p])
 
 
 @numba.njit(cache=True, parallel=True)
-def _setup_jobs(tA, tB0, tbF, iy, parts, dt, K, Phi, Gam, C, D, Hg):  # pragma: no cover - compiled
+def _setup_jobs(tpl, parts, dt, Phi, Gam, C, D, Hg):  # pragma: no cover - compiled
     """Contact modes of every job into stacks with a leading job index (the GPU path's setup)."""
-    n = tA.shape[1]
-    L = K + 1
+    n = tpl.A.shape[1]
+    L = tpl.K + 1
     for p in prange(parts.shape[0]):
-        _job_setup(tA, tB0, tbF, iy, parts[p], dt, K, Phi[p], Gam[p], C[p], D[p], Hg[p], np.empty((2, n, n)),
-                   np.empty((2, n, 3)), np.empty((2, L, n, n)), np.empty((2, L, n, 3)))
+        _job_setup(tpl, parts[p], dt, Phi[p], Gam[p], C[p], D[p], Hg[p],
+                   ContactWork(np.empty((2, n, n)), np.empty((2, n, 3)), np.empty((2, L, n, n)),
+                               np.empty((2, L, n, 3))))
 
 
 # ------------------------------------------------------------------------------------------------
@@ -256,17 +278,16 @@ class GraspTemplate:
         self.part = d["part"][0].copy()
         fingers = estimator_fingers or gripper.fingers
         vals = [_values(f) for f in fingers]
-        e, _ = _est_stack(vals, dt)
-        self.est = (e["bw"], e["Phi"], e["Gam"], e["cy"])
+        self.est, _ = _est_stack(vals, dt)
         self.gains = (_static_gain(vals[0]), _static_gain(vals[1]))
         self.dt = float(dt)
 
     def value(self, name: str) -> float:
         return float(self.theta[self.names.index(name)])
 
-    def kernel_args(self) -> tuple:
-        return (self.A, self.B0, self.bF, self.iy, self.Phi, self.Gam, self.C, self.D, self.G, self.H, self.target,
-                self.ng, self.K, self.bw)
+    def kernel_args(self) -> JobTemplate:
+        return JobTemplate(self.A, self.B0, self.bF, self.iy, self.Phi, self.Gam, self.C, self.D, self.G, self.H,
+                           self.target, self.ng, self.K, self.bw, self.est)
 
 
 _TEMPLATES: dict = {}

@@ -46,6 +46,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections import namedtuple
 from collections.abc import Mapping
 
 import numba
@@ -67,7 +68,8 @@ from .end_effector import end_effector_parameters, lever_coefficients, sensor_pa
 __all__ = ["FINGER_NAMES", "finger_parameter_set", "finger_state_space", "finger_minimal_state_space",
            "finger_coefficients", "finger_transfer_functions", "finger_hybrid",
            "micropart_parameters", "finger_checks", "TSFMFinger", "TSFMFingerContact", "TSFMGripper",
-           "gripper_measure", "gripper_advance", "gripper_work"]
+           "gripper_measure", "gripper_advance", "gripper_work", "gripper_model", "GripperModel",
+           "GripperState", "GripperWork"]
 
 FINGER_NAMES = ("d_p", "s_p", "lam", "beta", "gamma", "a", "b", "m_s", "b_s", "k_s", "L_r", "L_s", "L_a",
                 "sensitivity")
@@ -596,13 +598,35 @@ def _face(i, Xp, part):  # pragma: no cover - compiled
     return part[1] - Xp - 0.5 * part[0]
 
 
+#: one gripper's discretised model for the step kernels (:func:`gripper_model`): Bouc-Wen
+#: parameters ``bw`` (2, 4) [d_p, A, β, γ]; each finger's mode stacks ``Phi``, ``Gam``, ``C``, ``D``,
+#: ``G``, ``Hg`` (leading index: finger, see :meth:`TSFMGripper.arrays`); the hybrid step's
+#: ``target``, ``ng`` and ``K`` levels; ``part`` = [w, gap, k_side, c_side, F_po, F_stick] (the
+#: batch's jobs append the part's initial X_p)
+GripperModel = namedtuple("GripperModel", "bw Phi Gam C D G Hg target ng K part")
+#: the state of both fingers and the part: ``X`` (2, n) finger states, ``modes`` (2,),
+#: ``hyst`` [H1, H2, U1_last, U2_last], ``ps`` [X_p]
+GripperState = namedtuple("GripperState", "X modes hyst ps")
+#: scratch of :func:`gripper_advance` (:func:`gripper_work`); ``yout`` (2, p) receives the outputs
+GripperWork = namedtuple("GripperWork", "ua xt ev_frac ev_to yout")
+
+
+def gripper_model(d: dict, row: int) -> GripperModel:
+    """Row ``row`` of :meth:`TSFMGripper.arrays` as the record the kernels take."""
+    return GripperModel(d["bw"][row], d["Phi"][row], d["Gam"][row], d["C"][row], d["D"][row], d["G"][row],
+                        d["H"][row], d["target"], d["ng"], d["K"], d["part"][row])
+
+
 @numba.njit(cache=True)
-def gripper_measure(X, modes, Xp, C, D, part, ua, yout):  # pragma: no cover - compiled
-    """Outputs of both fingers: yout[i] = [y_C, y_B, F_g, F_m] for the states X (2, n).
-    C (2, Q, p, n), D (2, Q, p, 3): each finger's output matrices (see :meth:`TSFMGripper.arrays`)."""
+def gripper_measure(state, model, work):  # pragma: no cover - compiled
+    """Outputs of both fingers: work.yout[i] = [y_C, y_B, F_g, F_m] for the states state.X (2, n)
+    and the part at state.ps[0]; model.C (2, Q, p, n), model.D (2, Q, p, 3): each finger's output
+    matrices (see :meth:`TSFMGripper.arrays`)."""
+    X, modes, C, D, yout = state.X, state.modes, model.C, model.D, work.yout
+    Xp = state.ps[0]
     n = X.shape[1]
     for i in range(2):
-        face = _face(i, Xp, part)
+        face = _face(i, Xp, model.part)
         q = modes[i]
         for r in range(C.shape[2]):
             acc = D[i, q, r, 1] * face + D[i, q, r, 2]
@@ -612,15 +636,14 @@ def gripper_measure(X, modes, Xp, C, D, part, ua, yout):  # pragma: no cover - c
 
 
 @numba.njit(cache=True)
-def gripper_advance(U1, U2, X, modes, hyst, ps, bw, Phi, Gam, C, D, G, Hg, target, ng, K, part, ua, xt,
-                    ev_frac, ev_to, yout):  # pragma: no cover - compiled
-    """Advance both fingers and the part by one sample with the voltages U1, U2 held.
-
-    X (2, n) finger states; modes (2,); hyst [H1, H2, U1_last, U2_last]; ps [X_p]; bw (2, 4) and
-    the stacks Phi, Gam, C, D, G, Hg with a leading finger index (see :meth:`TSFMGripper.arrays`);
-    part = [w, gap, k_side, c_side, F_po, F_stick]. The fingers see the part faces fixed over the
-    step; after it the part slides if the finger forces differ by more than F_stick, until they
-    differ by F_stick. ``yout`` receives the outputs at the end of the step."""
+def gripper_advance(U1, U2, state, model, work):  # pragma: no cover - compiled
+    """Advance both fingers and the part (``state``, :class:`GripperState`) by one sample with the
+    voltages U1, U2 held, on the gripper ``model`` (:class:`GripperModel`). The fingers see the
+    part faces fixed over the step; after it the part slides if the finger forces differ by more
+    than F_stick, until they differ by F_stick. ``work.yout`` receives the outputs at the end of
+    the step."""
+    X, modes, hyst, ps = state.X, state.modes, state.hyst, state.ps
+    bw, part, ua, yout = model.bw, model.part, work.ua, work.yout
     Xp = ps[0]
     ua[2] = 1.0
     for i in range(2):
@@ -629,9 +652,10 @@ def gripper_advance(U1, U2, X, modes, hyst, ps, bw, Phi, Gam, C, D, G, Hg, targe
         hyst[2 + i] = U
         ua[0] = bw[i, 0] * U - hyst[i]
         ua[1] = _face(i, Xp, part)
-        q, _nev = pwa_step(X[i], modes[i], ua, Phi[i], Gam[i], G[i], Hg[i], target, ng, K, xt, ev_frac, ev_to)
+        q, _nev = pwa_step(X[i], modes[i], ua, model.Phi[i], model.Gam[i], model.G[i], model.Hg[i], model.target,
+                           model.ng, model.K, work.xt, work.ev_frac, work.ev_to)
         modes[i] = q
-    gripper_measure(X, modes, Xp, C, D, part, ua, yout)
+    gripper_measure(state, model, work)
     net = yout[0, 2] - yout[1, 2]  # finger 1 pushes towards +X, finger 2 towards −X
     if abs(net) > part[5]:
         kc = 0.0
@@ -641,24 +665,22 @@ def gripper_advance(U1, U2, X, modes, hyst, ps, bw, Phi, Gam, C, D, G, Hg, targe
         if kc > 0.0:
             shift = (abs(net) - part[5]) / kc
             ps[0] = Xp + shift if net > 0 else Xp - shift
-            gripper_measure(X, modes, ps[0], C, D, part, ua, yout)
+            gripper_measure(state, model, work)
 
 
-def gripper_work(n: int, p: int = 4) -> tuple:
-    """Work arrays for :func:`gripper_advance`: (ua, xt, ev_frac, ev_to, yout)."""
-    return (np.empty(3), np.empty(n), np.empty(MAX_EVENTS_PER_STEP), np.empty(MAX_EVENTS_PER_STEP, dtype=np.int64),
-            np.empty((2, p)))
+def gripper_work(n: int, p: int = 4) -> GripperWork:
+    """Work arrays for :func:`gripper_advance`."""
+    return GripperWork(np.empty(3), np.empty(n), np.empty(MAX_EVENTS_PER_STEP),
+                       np.empty(MAX_EVENTS_PER_STEP, dtype=np.int64), np.empty((2, p)))
 
 
 @numba.njit(cache=True)
-def _gripper_row(bw, Phi, Gam, C, D, G, Hg, target, ng, K, part, u, x0, y, ua, xt, ev_frac, ev_to,
-                 yout):  # pragma: no cover - compiled
+def _gripper_row(model, u, x0, y, work):  # pragma: no cover - compiled
     N = u.shape[0]
-    n = Phi.shape[4]
-    X = np.empty((2, n))
-    modes = np.empty(2, dtype=np.int64)
-    hyst = np.empty(4)
-    ps = np.empty(1)
+    n = model.Phi.shape[4]
+    state = GripperState(np.empty((2, n)), np.empty(2, dtype=np.int64), np.empty(4), np.empty(1))
+    X, modes, hyst, ps = state.X, state.modes, state.hyst, state.ps
+    yout = work.yout
     for i in range(2):
         off = i * (3 + n)
         hyst[i] = x0[off]
@@ -667,7 +689,7 @@ def _gripper_row(bw, Phi, Gam, C, D, G, Hg, target, ng, K, part, u, x0, y, ua, x
             X[i, j] = x0[off + 2 + j]
         modes[i] = int(x0[off + 2 + n])
     ps[0] = x0[2 * (3 + n)]
-    gripper_measure(X, modes, ps[0], C, D, part, ua, yout)
+    gripper_measure(state, model, work)
     for k in range(N):
         y[k, 0] = yout[0, 0]
         y[k, 1] = yout[1, 0]
@@ -678,8 +700,7 @@ def _gripper_row(bw, Phi, Gam, C, D, G, Hg, target, ng, K, part, u, x0, y, ua, x
         y[k, 6] = ps[0]
         y[k, 7] = modes[0]
         y[k, 8] = modes[1]
-        gripper_advance(u[k, 0], u[k, 1], X, modes, hyst, ps, bw, Phi, Gam, C, D, G, Hg, target, ng, K, part,
-                        ua, xt, ev_frac, ev_to, yout)
+        gripper_advance(u[k, 0], u[k, 1], state, model, work)
 
 
 class TSFMGripper(Model):
@@ -760,5 +781,4 @@ class TSFMGripper(Model):
         d = self.arrays(thetas, dt)
         work = gripper_work(d["Phi"].shape[-1], d["C"].shape[-2])
         for p in range(len(thetas)):
-            _gripper_row(d["bw"][p], d["Phi"][p], d["Gam"][p], d["C"][p], d["D"][p], d["G"][p], d["H"][p],
-                         d["target"], d["ng"], d["K"], d["part"][p], u, x0[p], y[p], *work)
+            _gripper_row(gripper_model(d, p), u, x0[p], y[p], work)
