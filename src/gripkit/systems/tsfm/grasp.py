@@ -85,7 +85,7 @@ class GraspSettings:
                          1.0 if self.wait_for_other else 0.0, self.threshold, self.release, dt])
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, _nrt=False)
 def grasp_step(F1, F2, loop, e, cp):  # pragma: no cover - compiled
     """One sample of the grasp for both fingers.
 

@@ -80,7 +80,7 @@ def _job_setup(tpl, part, dt, Phi, Gam, C, D, Hg, cw):  # pragma: no cover - com
         Hg[i, 1, 0, 2] = part[4] / k
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, _nrt=False)
 def _grasp_core(model, noise, nstd, seed, n_steps, e, cp, mset, loop, state, work, rng,
                 met):  # pragma: no cover - compiled
     """One grasp from rest on the gripper ``model`` (:class:`GripperModel`, its part with the
@@ -92,7 +92,10 @@ def _grasp_core(model, noise, nstd, seed, n_steps, e, cp, mset, loop, state, wor
     ``noise`` (N, 2): the force-sensor noise per sample when it has rows, else white noise of std
     ``nstd`` from a splitmix64 stream seeded with ``seed``. ``e``: the estimators; ``cp``:
     :meth:`GraspSettings.vector`; ``mset`` = [damage_force, lost_displacement, band]. The loop is
-    the one of :func:`gripkit.systems.tsfm.grasp._grasp_run`."""
+    the one of :func:`gripkit.systems.tsfm.grasp._grasp_run`. Compiled without numba's reference
+    counting (``_nrt=False``, like its callees :func:`grasp_step`, :func:`gripper_advance` and
+    :func:`gripper_measure`): taking the records apart would otherwise cost an atomic
+    incref/decref pair per array per call (docs/performance.md, "Named records in kernels")."""
     det, buf, est, cs, out = loop.det, loop.buf, loop.est, loop.cs, loop.out
     X, modes, hyst, ps = state.X, state.modes, state.hyst, state.ps
     part, yout = model.part, work.yout

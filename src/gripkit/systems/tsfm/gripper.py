@@ -590,7 +590,7 @@ class TSFMFingerContact(Model):
 
 # ---- two fingers and a part --------------------------------------------------------------------
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, _nrt=False)
 def _face(i, Xp, part):  # pragma: no cover - compiled
     """Part face position in finger i's coordinates (closing direction); part = [w, gap, ...]."""
     if i == 0:
@@ -617,7 +617,7 @@ def gripper_model(d: dict, row: int) -> GripperModel:
                         d["H"][row], d["target"], d["ng"], d["K"], d["part"][row])
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, _nrt=False)
 def gripper_measure(state, model, work):  # pragma: no cover - compiled
     """Outputs of both fingers: work.yout[i] = [y_C, y_B, F_g, F_m] for the states state.X (2, n)
     and the part at state.ps[0]; model.C (2, Q, p, n), model.D (2, Q, p, 3): each finger's output
@@ -635,7 +635,7 @@ def gripper_measure(state, model, work):  # pragma: no cover - compiled
             yout[i, r] = acc
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, _nrt=False)
 def gripper_advance(U1, U2, state, model, work):  # pragma: no cover - compiled
     """Advance both fingers and the part (``state``, :class:`GripperState`) by one sample with the
     voltages U1, U2 held, on the gripper ``model`` (:class:`GripperModel`). The fingers see the
