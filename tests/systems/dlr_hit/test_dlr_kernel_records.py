@@ -1,0 +1,80 @@
+"""A guard for refactoring the DLR/HIT finger kernels (issue 12's named records): every path of
+the kernels (four friction models, RK4, thermal, the parallel hand, joint and Cartesian impedance
+with a wall, friction drift and online adaptation) gives the trajectories recorded on main at
+76ddf75, bit for bit (tests/reference/kernel_records.json; x86-64, numba 0.68.1). A records
+version of these kernels exists on the branch ``records`` (8 % slower: not landed)."""
+
+import hashlib
+import json
+import math
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from gripkit.errors import ConsistencyWarning
+from gripkit.systems.dlr_hit.friction_adaptation import tracking_reference
+from gripkit.systems.dlr_hit.friction_drift import stiction_step, warmup_drift
+from gripkit.systems.dlr_hit.hand import hand
+from gripkit.systems.dlr_hit.impedance import LOOP_ADAPTATION, ImpedanceController, Wall, simulate_impedance
+from gripkit.systems.dlr_hit.parameters import finger
+
+DEG = math.pi / 180
+REFERENCE = json.loads((Path(__file__).parents[2] / "reference" / "kernel_records.json").read_text())["dlr_hit"]
+
+
+def _pwm(n):
+    t = np.arange(n) * 1e-3
+    return np.column_stack([2500 * np.sin(2 * math.pi * 3 * t), -3000 * np.sin(2 * math.pi * 2 * t + 0.4),
+                            np.where(t < 0.15, 3900.0, -1500.0)])
+
+
+def _trajectories():
+    """The recorded scenarios: near the proximal end stop, sign-changing PWM on all three drives
+    (stick-slip, end-stop contact); each friction model; RK4; the five-finger hand; impedance
+    loops with a warm-up drift and a stiction step, with and without adaptation; a Cartesian
+    impedance pressing on a wall with two substeps."""
+    out = {}
+    x0q = (10 * DEG, 20 * DEG, 80 * DEG)
+    for fr in ("table", "stribeck", "lugre", "none"):
+        f = finger(check=False, friction=fr, thermal=(fr == "stribeck"))
+        out[f"open_{fr}"] = f.simulate(_pwm(300), dt=1e-3, x0=f.state(q=x0q)).as_array()
+    f = finger(check=False, integrator="rk4", friction="table")
+    out["open_rk4_table"] = f.simulate(_pwm(300), dt=1e-3, x0=f.state(q=x0q)).as_array()
+    f = finger(check=False, integrator="rk4", friction="lugre", thermal=True)
+    out["open_rk4_lugre"] = f.simulate(_pwm(300), dt=1e-3, x0=f.state(q=x0q)).as_array()
+    uh = np.tile(_pwm(120), (1, 5)) * np.repeat([1.0, 0.8, -0.6, 0.5, 1.1], 3)
+    out["hand_parallel"] = hand(check=False).simulate(uh, dt=1e-3).as_array()
+    f = finger(check=False)
+    ref = tracking_reference(0.4)
+    drift = warmup_drift(0.4).combine(stiction_step(0.2))
+    joint = ImpedanceController("joint", (8, 8, 8), (0.6, 0.6, 0.6))
+    adaptive = ImpedanceController("joint", (8, 8, 8), (0.6, 0.6, 0.6), adaptation=LOOP_ADAPTATION)
+    out["joint_adapt_drift"] = simulate_impedance(f, adaptive, ref, friction_drift=drift).as_array()
+    out["joint_stribeck_drift"] = simulate_impedance(finger(check=False, friction="stribeck"), joint, ref,
+                                                     friction_drift=drift).as_array()
+    cart = ImpedanceController("cartesian", (400, 400, 400), (4, 4, 4), actuator_damping=(0.02, 0.02, 0.02))
+    x0 = f.state(q=(0.0, 30 * DEG, 30 * DEG))
+    tip0 = f.chain().tip_position(x0[:3])
+    wall = Wall(normal=(0.0, 0.0, 1.0), point=tuple(tip0 - np.array([0.0, 0.0, 0.005])), stiffness=2e3, damping=5.0)
+    out["cartesian_wall"] = simulate_impedance(f, cart, np.tile(tip0 + np.array([0.0, 0.0, -0.01]), (300, 1)),
+                                               x0=x0, wall=wall, substeps=2).as_array()
+    return out
+
+
+@pytest.fixture(scope="module")
+def trajectories():
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ConsistencyWarning)
+        return _trajectories()
+
+
+@pytest.mark.parametrize("name", sorted(REFERENCE))
+def test_trajectories_are_those_of_the_positional_kernels(trajectories, name):
+    got = trajectories[name]
+    ref = REFERENCE[name]
+    assert list(got.shape) == ref["shape"]
+    np.testing.assert_array_equal(got[-1], [float.fromhex(v) for v in ref["last_row"]])
+    digest = hashlib.sha256(np.ascontiguousarray(got, dtype="<f8").tobytes()).hexdigest()
+    assert digest == ref["sha256"], f"{name}: the trajectory differs from the recorded one"
