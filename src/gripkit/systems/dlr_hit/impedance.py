@@ -197,6 +197,37 @@ def simulate_impedance(finger: DLRFinger, controller: ImpedanceController, refer
     (``fric_ff_*``, N·m), the references (``ref_*``) and, with a drift, the plant's friction
     scale and offset (``drift_scale_*``, ``drift_offset_*``).
     """
+    ref, refd, x = _checked_loop_inputs(finger, controller, reference, reference_velocity, dt, x0, substeps)
+    th = finger.theta()
+    tables = controller.friction_tables or model_friction_tables(finger)
+    ctv, ctf, ctn, ctip = table_arrays(tables)
+    tv, tf, tn, tip = finger._tab
+    N = ref.shape[0]
+    t = np.arange(N) * dt
+    drift = _drift_schedule(finger, friction_drift, t)
+    plant = (drift, th.copy(), tf.copy())
+    ad = controller.adaptation
+    settings = ad if ad is not None else AdaptationSettings()
+    J = np.ascontiguousarray(np.diag(finger.chain().mass_matrix(x[:3])))
+    cfg = settings.vector(float(dt)) if ad is not None else np.zeros(10)
+    adapt = (cfg, J, *settings.initial_state(3))
+    y = np.empty((N, 39))
+    gains = np.array([*controller.stiffness, *controller.damping, float(controller.gravity_compensation),
+                      float(controller.friction_compensation), controller.velocity_deadband,
+                      controller.smoothing, *controller.actuator_damping, float(ad is not None)])
+    fail = finger_run(th, FRICTION_MODES[finger.friction], finger.thermal, tv, tf, tn, tip,
+                      np.zeros((1, 3)), 0, float(dt), int(substeps), x, y, 0,
+                      2 if controller.kind == "cartesian" else 1, gains, ctv, ctf, ctn, ctip, ref, refd,
+                      _wall_vector(wall), plant, adapt)
+    if fail or not np.isfinite(y).all():
+        raise SimulationError(f"closed loop diverged at sample {max(int(fail) - 1, 0)}",
+                              hint="lower the gains or check stability_margins")
+    return _loop_trajectory(t, y, ref, drift, finger, controller, dt)
+
+
+def _checked_loop_inputs(finger, controller, reference, reference_velocity, dt, x0, substeps):
+    """The reference (N, 3), its velocity and the initial state as contiguous float64 arrays,
+    after checking the finger, the step and every value."""
     if not isinstance(finger, DLRFinger):
         raise ModelError(f"finger: expected a DLRFinger, found {type(finger).__name__}")
     if finger.integrator != "semi-implicit":
@@ -213,16 +244,16 @@ def simulate_impedance(finger: DLRFinger, controller: ImpedanceController, refer
             else np.asarray(reference_velocity, dtype=np.float64))
     if refd.shape != ref.shape or not np.isfinite(refd).all():
         raise SimulationError(f"reference_velocity: expected a finite array of shape {ref.shape}")
-    refd = np.ascontiguousarray(refd)
-    th = finger.theta()
     if x0 is None:
         x0 = finger.state(q=ref[0]) if controller.kind == "joint" else finger.state()
     x = np.array(x0, dtype=np.float64)
     if x.shape != (NX,):
         raise SimulationError(f"x0: expected a finger state of {NX} values, found {x.shape}")
-    tables = controller.friction_tables or model_friction_tables(finger)
-    ctv, ctf, ctn, ctip = table_arrays(tables)
-    tv, tf, tn, tip = finger._tab
+    return ref, np.ascontiguousarray(refd), x
+
+
+def _wall_vector(wall: Wall | None) -> np.ndarray:
+    """The kernel's wall: normal, point, stiffness, damping and a 1 when present (zeros: none)."""
     w = np.zeros(9)
     if wall is not None:
         w[:3] = wall.normal
@@ -230,33 +261,23 @@ def simulate_impedance(finger: DLRFinger, controller: ImpedanceController, refer
         w[6] = wall.stiffness
         w[7] = wall.damping
         w[8] = 1.0
-    N = ref.shape[0]
-    t = np.arange(N) * dt
-    drift = np.zeros((0, 6))
-    if friction_drift is not None:
-        if not isinstance(friction_drift, FrictionDrift):
-            raise SimulationError(f"friction_drift: expected a FrictionDrift, found {type(friction_drift).__name__}")
-        if finger.friction == "none":
-            raise SimulationError("friction_drift: the finger has no friction to drift",
-                                  hint="build it with friction='table', 'stribeck' or 'lugre'")
-        drift = np.ascontiguousarray(friction_drift.at(t))
-    plant = (drift, th.copy(), tf.copy())
-    ad = controller.adaptation
-    settings = ad if ad is not None else AdaptationSettings()
-    J = np.ascontiguousarray(np.diag(finger.chain().mass_matrix(x[:3])))
-    cfg = settings.vector(float(dt)) if ad is not None else np.zeros(10)
-    adapt = (cfg, J, *settings.initial_state(3))
-    y = np.empty((N, 39))
-    gains = np.array([*controller.stiffness, *controller.damping, float(controller.gravity_compensation),
-                      float(controller.friction_compensation), controller.velocity_deadband,
-                      controller.smoothing, *controller.actuator_damping, float(ad is not None)])
-    fail = finger_run(th, FRICTION_MODES[finger.friction], finger.thermal, tv, tf, tn, tip,
-                      np.zeros((1, 3)), 0, float(dt), int(substeps), x, y, 0,
-                      2 if controller.kind == "cartesian" else 1, gains, ctv, ctf, ctn, ctip, ref, refd, w,
-                      plant, adapt)
-    if fail or not np.isfinite(y).all():
-        raise SimulationError(f"closed loop diverged at sample {max(int(fail) - 1, 0)}",
-                              hint="lower the gains or check stability_margins")
+    return w
+
+
+def _drift_schedule(finger, friction_drift, t) -> np.ndarray:
+    """The plant's friction scale and offset per sample (N, 6), or (0, 6) without a drift."""
+    if friction_drift is None:
+        return np.zeros((0, 6))
+    if not isinstance(friction_drift, FrictionDrift):
+        raise SimulationError(f"friction_drift: expected a FrictionDrift, found {type(friction_drift).__name__}")
+    if finger.friction == "none":
+        raise SimulationError("friction_drift: the finger has no friction to drift",
+                              hint="build it with friction='table', 'stribeck' or 'lugre'")
+    return np.ascontiguousarray(friction_drift.at(t))
+
+
+def _loop_trajectory(t, y, ref, drift, finger, controller, dt) -> Trajectory:
+    """The closed loop's output columns, the references and the plant's drift as a Trajectory."""
     ch, units = {}, {}
     col = 0
     for names, unit in zip(_OUT, _UNITS):
