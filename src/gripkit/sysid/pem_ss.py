@@ -36,6 +36,7 @@ import scipy.linalg as sla
 
 from ..errors import DataError, IdentificationError
 from ..lti import StateSpace, Uncertainty
+from .blocked_gram import add_rows, row_product
 from .linear_model import LinearModel, as_io_matrix, fit_per_output, free_run
 
 __all__ = ["pem", "PEM_FORMS"]
@@ -145,14 +146,7 @@ def _sensitivity_gram(Abar, C, K, entries, n_x0, X, U, E, H, g):  # pragma: no c
     fill = 0
     for t in range(X.shape[0]):
         for i in range(p):
-            row = rows[fill]
-            for q in range(Q):
-                row[q] = 0.0
-            for j in range(n):
-                cij = C[i, j]
-                sj = S[j]
-                for q in range(Q):
-                    row[q] += cij * sj[q]
+            row_product(C, i, S, rows[fill])
             eb[fill] = E[t, i]
             fill += 1
         for q in range(d):  # C and D entries add x_c, u_c to output r
@@ -162,19 +156,10 @@ def _sensitivity_gram(Abar, C, K, entries, n_x0, X, U, E, H, g):  # pragma: no c
             elif kind == 3:
                 rows[fill - p + r, q] += U[t, c]
         if fill == rows.shape[0] or t == X.shape[0] - 1:
-            blk = rows[:fill]
-            H += np.dot(blk.T, blk)
-            g += np.dot(blk.T, eb[:fill])
+            add_rows(rows, eb, fill, H, g)
             fill = 0
         for i in range(n):
-            sni = Sn[i]
-            for q in range(Q):
-                sni[q] = 0.0
-            for j in range(n):
-                a = Abar[i, j]
-                sj = S[j]
-                for q in range(Q):
-                    sni[q] += a * sj[q]
+            row_product(Abar, i, S, Sn[i])
         for q in range(d):
             kind, r, c = entries[q, 0], entries[q, 1], entries[q, 2]
             if kind == 0:

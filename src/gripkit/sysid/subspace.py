@@ -42,6 +42,7 @@ import scipy.linalg as sla
 
 from ..errors import DataError, IdentificationError, StabilityWarning
 from ..lti import StateSpace
+from .blocked_gram import add_rows, row_product
 from .checks import check_dt
 from .linear_model import LinearModel, as_io_matrix, fit_per_output, free_run, observability_regressor
 from .regression import _qr_r
@@ -248,13 +249,7 @@ def _bdx_normal_equations(A, C, u, y, feedthrough, G, r):  # pragma: no cover - 
     CX = np.empty(ns)
     for t in range(N):
         for row in range(p):
-            for c in range(ns):  # C X, the inner loops over contiguous columns (row views)
-                CX[c] = 0.0
-            for k in range(n):
-                ck = C[row, k]
-                xk = X[k]
-                for c in range(ns):
-                    CX[c] += ck * xk[c]
+            row_product(C, row, X, CX)
             phi = rows[fill]
             for c in range(nb):
                 phi[c] = CX[c]
@@ -265,21 +260,12 @@ def _bdx_normal_equations(A, C, u, y, feedthrough, G, r):  # pragma: no cover - 
             yb[fill] = y[t, row]
             fill += 1
         if fill == rows.shape[0] or t == N - 1:
-            blk = rows[:fill]
-            G += np.dot(blk.T, blk)
-            r += np.dot(blk.T, yb[:fill])
+            add_rows(rows, yb, fill, G, r)
             fill = 0
         for i in range(n):  # X ← A X + [e_i u(t)ᵀ, 0]
-            xi = Xn[i]
-            for c in range(ns):
-                xi[c] = 0.0
-            for k in range(n):
-                a = A[i, k]
-                xk = X[k]
-                for c in range(ns):
-                    xi[c] += a * xk[c]
+            row_product(A, i, X, Xn[i])
             for j in range(m):
-                xi[i * m + j] += u[t, j]
+                Xn[i, i * m + j] += u[t, j]
         for i in range(n):
             for c in range(ns):
                 X[i, c] = Xn[i, c]
