@@ -129,3 +129,17 @@ def test_finiteness_check_without_temporaries_agrees_with_isfinite(values):
 
     a = np.array(values)
     assert _all_finite(a) == bool(np.isfinite(a).all())
+
+
+@given(values=st.lists(st.floats(allow_nan=False, allow_infinity=False, width=64), min_size=1, max_size=50))
+def test_rls_scale_statistics_agree_with_numpy(values):
+    """The one-pass (max |x|, ‖x‖₂) of the RLS scale check equals numpy's, scaled so that values
+    near the float64 limits neither overflow nor underflow."""
+    from gripkit.sysid.rls import _peak_and_norm
+
+    a = np.array(values)
+    peak, norm = _peak_and_norm(a)
+    ref_peak = float(np.max(np.abs(a)))
+    assert peak == ref_peak
+    ref_norm = ref_peak * float(np.linalg.norm(a / ref_peak)) if ref_peak > 0 else 0.0
+    assert norm == pytest.approx(ref_norm, rel=1e-13)

@@ -475,8 +475,8 @@ class RLS:
         p = self.n_params
         P = self.P
         tr = float(np.trace(P))
-        peaks = {"input u": _peak(u), "output y": _peak(y)}
-        peak = max(peaks.values())
+        stats = {"input u": _peak_and_norm(u), "output y": _peak_and_norm(y)}
+        peak = max(stats["input u"][0], stats["output y"][0])
         if peak > 0 and math.log10(p) + 2 * math.log10(peak) + math.log10(tr) > 307.0:
             raise DataError(
                 f"RLS [{self.na} {self.nb} {self.nk}]: values up to {peak:.3g} in u and y make φᵀPφ "
@@ -485,13 +485,13 @@ class RLS:
         for label, x, idx in (("output y", y, range(self.na)), ("input u", u, range(self.na, p))):
             if not len(idx):
                 continue
-            mx = peaks[label]
+            mx, norm = stats[label]
             if mx == 0.0:
                 raise IdentificationError(
                     f"RLS [{self.na} {self.nb} {self.nk}]: the {label} is zero throughout, so "
                     f"{', '.join(self.names[i] for i in idx)} cannot be estimated",
                     hint="check that the columns are the measured input and output")
-            log_energy = 2 * math.log10(_norm(x, mx))
+            log_energy = 2 * math.log10(norm)
             prior = float(np.max(np.diag(P)[list(idx)]))
             if log_energy + math.log10(prior) < 0.0:
                 names = ", ".join(self.names[i] for i in idx)
@@ -528,17 +528,20 @@ class RLS:
                          covariance_final=self.covariance, P_final=self.P, model=self.model())
 
 
-def _peak(x: np.ndarray) -> float:
-    """max |x| without the temporary of ``np.abs``."""
-    return max(float(x.max()), -float(x.min()))
-
-
-def _norm(x: np.ndarray, peak: float) -> float:
-    """‖x‖₂ for ``peak = max |x| > 0``, without a temporary; x/peak only where x·x could overflow
-    or underflow."""
-    if 1e-150 < peak < 1e150:
-        return math.sqrt(float(x @ x))
-    return peak * float(np.linalg.norm(x / peak))
+@njit(cache=True)
+def _peak_and_norm(x):
+    """(max |x|, ‖x‖₂) in one pass without temporaries; the norm is scaled by the running peak
+    (the LAPACK dnrm2 way), so it neither overflows nor underflows."""
+    peak = 0.0
+    ssq = 1.0
+    for v in x:
+        a = abs(v)
+        if a > peak:
+            ssq = 1.0 + ssq * (peak / a) ** 2
+            peak = a
+        elif a > 0.0:
+            ssq += (a / peak) ** 2
+    return peak, (peak * math.sqrt(ssq) if peak > 0.0 else 0.0)
 
 
 @dataclass(frozen=True, eq=False)
