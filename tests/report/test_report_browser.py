@@ -41,7 +41,8 @@ def browser():
     except shot.BrowserError as exc:
         if os.environ.get("GRIPKIT_BROWSER_TESTS") == "1":
             pytest.fail(f"GRIPKIT_BROWSER_TESTS=1 but {exc}")
-        pytest.skip(f"{exc}; set GRIPKIT_BROWSER_TESTS=1 to make this a failure")
+        pytest.skip(f"the report's layout check needs a headless browser, a system package that pip does not "
+                    f"install: {exc}; set GRIPKIT_BROWSER_TESTS=1 to make its absence a failure")
 
 
 def _run(*args):
