@@ -133,3 +133,22 @@ def test_stable_by_construction_or_stated_reason():
     with pytest.warns(StabilityWarning, match="unstable"):
         k = n4sid(u, y, 2, stable=False)
     assert not k.stable and np.max(np.abs(k.system.poles())) == pytest.approx(1.01, abs=1e-3)
+
+
+def test_bd_x0_normal_equations_equal_least_squares_on_the_regressor():
+    """B, D and x0 from the normal equations accumulated without forming Φ equal lstsq on the
+    formed regressor; with an input that is zero throughout (two columns of Φ zero: the normal
+    equations are singular) the fallback is gelsy's minimum-norm solution on Φ."""
+    import scipy.linalg as sla
+
+    from gripkit.sysid.subspace import _bdx_least_squares, _bdx_regressor
+
+    rng = np.random.default_rng(7)
+    A = np.array([[0.9, 0.2], [-0.1, 0.7]])
+    C = rng.standard_normal((2, 2))
+    u = rng.standard_normal((400, 2))
+    y = rng.standard_normal((400, 2))
+    for uu, ft in ((u, True), (np.column_stack([u[:, 0], np.zeros(400)]), False)):
+        Phi = _bdx_regressor(A, C, uu, ft)
+        ref = sla.lstsq(Phi, y.reshape(-1), lapack_driver="gelsy")[0]
+        np.testing.assert_allclose(_bdx_least_squares(A, C, uu, y, ft), ref, rtol=1e-9, atol=1e-12)

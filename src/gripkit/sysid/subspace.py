@@ -81,19 +81,6 @@ def _lower_factor(Z: np.ndarray) -> np.ndarray:
     return _qr_r(np.asfortranarray(Z), overwrite=True).T / math.sqrt(j)
 
 
-def _least_squares(Phi: np.ndarray, rhs: np.ndarray) -> np.ndarray:
-    """argmin ‖Φθ − r‖: normal equations on column-scaled Φ (dsyrk + Cholesky) when their
-    condition number stays below 1e8, else LAPACK ``gelsy`` on Φ itself."""
-    col = np.sqrt(np.einsum("ij,ij->j", Phi, Phi))
-    col[col == 0] = 1.0
-    G = _gram(Phi) / np.outer(col, col)
-    w = np.linalg.eigvalsh(G)
-    if w[0] > 1e-8 * w[-1]:
-        c = sla.cho_factor(G)
-        return sla.cho_solve(c, (Phi.T @ rhs) / col) / col
-    return sla.lstsq(Phi, rhs, lapack_driver="gelsy", check_finite=False)[0]
-
-
 class SubspaceFactor:
     """The LQ factor of the scaled data and what every order shares (computed once, so that an
     order search does not repeat the factorisation)."""
@@ -274,7 +261,8 @@ def _bdx_normal_equations(A, C, u, y, feedthrough, G, r):  # pragma: no cover - 
 def _bdx_least_squares(A, C, u, y, feedthrough: bool) -> np.ndarray:
     """θ = (vec(B) row-major, vec(D), x0) minimising ‖y − Φθ‖ (Φ of :func:`_bdx_regressor`):
     normal equations from :func:`_bdx_normal_equations` on column-scaled Φ when their condition
-    number stays below 1e8 (no N·p × cols regressor in memory), else :func:`_least_squares` on Φ."""
+    number stays below 1e8 (no N·p × cols regressor in memory), else LAPACK ``gelsy`` on Φ itself
+    (formed only then)."""
     n, m, p = A.shape[0], u.shape[1], C.shape[0]
     cols = n * m + (p * m if feedthrough else 0) + n
     G, rhs = np.empty((cols, cols)), np.empty(cols)
@@ -285,7 +273,8 @@ def _bdx_least_squares(A, C, u, y, feedthrough: bool) -> np.ndarray:
     w = np.linalg.eigvalsh(Gs)
     if w[0] > 1e-8 * w[-1]:
         return sla.cho_solve(sla.cho_factor(Gs), rhs / col) / col
-    return _least_squares(_bdx_regressor(A, C, u, feedthrough), y.reshape(-1))
+    return sla.lstsq(_bdx_regressor(A, C, u, feedthrough), y.reshape(-1), lapack_driver="gelsy",
+                     check_finite=False)[0]
 
 
 def _kalman_gain(A, C, Q, S, R):
