@@ -8,12 +8,11 @@ The same XML text goes to both parsers (Pinocchio's own URDF reader, ``mimic=Tru
 import math
 
 import numpy as np
+import pinocchio as pin
 import pytest
 
-pin = pytest.importorskip("pinocchio")
-
-from gripkit.errors import ModelError  # noqa: E402
-from gripkit.multibody import from_urdf  # noqa: E402
+from gripkit.errors import ModelError
+from gripkit.multibody import from_urdf
 
 TOL = 1e-10
 

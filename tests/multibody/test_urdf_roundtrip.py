@@ -77,7 +77,7 @@ def test_finger_actuator_space_from_urdf(finger_urdf, finger_chain):
 
 
 def test_finger_urdf_in_pinocchio(finger_urdf, finger_chain):
-    pin = pytest.importorskip("pinocchio")
+    import pinocchio as pin
     model = pin.buildModelFromUrdf(str(finger_urdf), mimic=True)
     model.gravity.linear = finger_chain.chain.gravity_vector
     data = model.createData()

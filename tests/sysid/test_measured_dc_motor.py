@@ -78,8 +78,8 @@ def test_identify_ss_on_the_files_columns_with_validation_record(record):
 
 
 def test_as_good_as_nfoursid_on_the_same_split(record):
-    nfoursid = pytest.importorskip("nfoursid.nfoursid")
-    pd = pytest.importorskip("pandas")
+    import nfoursid.nfoursid as nfoursid
+    import pandas as pd
     ue, ye = record[3]["est"]
     nf = nfoursid.NFourSID(pd.DataFrame({"u": ue, "y": ye}), output_columns=["y"], input_columns=["u"],
                            num_block_rows=8)
