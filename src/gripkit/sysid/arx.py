@@ -86,8 +86,9 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None, fs: flo
     cu, cy = unit_scale(u), unit_scale(y)
     if max(abs(np.log2(cu)), abs(np.log2(cy))) <= _NO_SCALING_WITHIN:
         cu = cy = 1.0  # scaling by powers of two is exact: skip the two copies where it changes nothing
-    return in_user_units(_arx(u * cu if cu != 1.0 else u, y * cy if cy != 1.0 else y, na, nb, nk, step, **meta),
-                         cu, cy)
+    model = _arx(u * cu if cu != 1.0 else u, y * cy if cy != 1.0 else y, na, nb, nk, step, keep_residuals=False,
+                 **meta)
+    return in_user_units(model, cu, cy).replace(estimation_data=(u, y))
 
 
 #: Signals whose peak lies within 2^±this are fitted unscaled: their squares summed over up to 2^60
@@ -97,16 +98,17 @@ _NO_SCALING_WITHIN = 100
 
 
 def _arx(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int, step: float, *, warn: bool = True,
-         **meta) -> PolynomialModel:
+         keep_residuals: bool = True, **meta) -> PolynomialModel:
     """:func:`arx` on checked signals, without scaling; ``warn=False`` for the internal fits of
-    other estimators (their own diagnostics speak for the final model)."""
+    other estimators (their own diagnostics speak for the final model). ``keep_residuals=False``:
+    a large fit returns no residuals (the caller attaches its record to compute them on demand)."""
     p = na + nb
     t0 = arx_start(na, nb, nk)
     check_identifiable(u, y, t0 + p + 1, f"ARX [{na} {nb} {nk}] ({p} parameters, {t0} initial samples)")
     names = tuple(f"a{i}" for i in range(1, na + 1)) + tuple(f"b{nk + j}" for j in range(nb))
     m = y.size - t0
     small = m * (p + 1) <= QR_MAX_ELEMENTS
-    gram = None if small else _normal_equations(u, y, na, nb, nk, t0, names, warn)
+    gram = None if small else _normal_equations(u, y, na, nb, nk, t0, names, warn, keep_residuals)
     if gram is None:  # small, or ill-conditioned: QR of the materialised [Φ | Y]
         sol = qr_solve(arx_regression(u, y, na, nb, nk), names, overwrite=True, warn=warn)
         method = "least squares (QR of [Φ | Y])"
@@ -119,7 +121,8 @@ def _arx(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int, step: float, *
         model = _model(sol.theta, na, nk, step, y.size, meta)
         fit = 100.0 * (1.0 - np.sqrt(see / syy))
     sigma2 = see / (m - p)
-    e.flags.writeable = False  # handed to the model without a copy
+    if e is not None:
+        e.flags.writeable = False  # handed to the model without a copy
     return model.replace(covariance=sigma2 * sol.cov_unscaled, noise_variance=sigma2, loss=0.5 * see / m,
                          fit_percent=fit, n_used=m, residuals=e, info={"method": method, "cond": sol.cond})
 
@@ -130,7 +133,7 @@ def _model(theta, na, nk, step, n, meta) -> PolynomialModel:
     return PolynomialModel(A, B, nk, dt=step, structure="arx", n_samples=int(n), **meta)
 
 
-def _normal_equations(u, y, na, nb, nk, t0, names, warn):
+def _normal_equations(u, y, na, nb, nk, t0, names, warn, keep_residuals):
     """The solution from the Gram matrix of ``[Φ | Y]`` (:mod:`.lagged_sums`: one pass, O(q²)
     memory) with the residuals and their sums ``(sol, e, Σe², Σ(y − ȳ)²)``, or None when Φ is too
     ill-conditioned for it (then QR is used). ρ² is the residuals' compensated Σe², not
@@ -146,6 +149,6 @@ def _normal_equations(u, y, na, nb, nk, t0, names, warn):
     R[:p, :p] = r1
     R[:p, p] = sla.solve_triangular(r1, G[:p, p], trans="T", check_finite=False)  # R1ᵀ r = ΦᵀY
     theta = sla.solve_triangular(r1, R[:p, p], check_finite=False)
-    e, see, syy = arx_residuals(u, y, theta, na, nb, nk, t0)
+    e, see, syy = arx_residuals(u, y, theta, na, nb, nk, t0, keep_residuals)
     R[p, p] = np.sqrt(see)
     return triangular_solve(R, names, y.size - t0, warn, stacklevel=5), e, see, syy

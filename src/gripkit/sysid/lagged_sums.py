@@ -141,13 +141,17 @@ def _residual_block(u, y, theta, kind, lag, sign, ybar, b, e, out):
 
 @njit(cache=True)
 def _residuals(u, y, theta, kind, lag, sign, t0, ybar, res):
+    """Block by block into ``res``: all N − t0 errors, or, when ``res`` holds only one block, that
+    block reused (the sums alone)."""
     n = y.shape[0]
+    keep = res.shape[0] == n - t0
     total = np.zeros(2)
     comp = np.zeros(2)
     b = t0
     while b < n:
         e = min(b + BLOCK, n)
-        se, sy = _residual_block(u, y, theta, kind, lag, sign, ybar, b, e, res[b - t0:e - t0])
+        se, sy = _residual_block(u, y, theta, kind, lag, sign, ybar, b, e,
+                                 res[b - t0:e - t0] if keep else res[:e - b])
         _kahan_add(total, comp, 0, se)
         _kahan_add(total, comp, 1, sy)
         b = e
@@ -155,15 +159,17 @@ def _residuals(u, y, theta, kind, lag, sign, t0, ybar, res):
 
 
 def arx_residuals(u: np.ndarray, y: np.ndarray, theta: np.ndarray, na: int, nb: int, nk: int,
-                  t0: int) -> tuple[np.ndarray, float, float]:
+                  t0: int, keep: bool = True) -> tuple[np.ndarray | None, float, float]:
     """One-step prediction errors ``e(t) = y(t) − φ(t)ᵀθ`` for ``t = t0 … N−1``, with ``Σ e²``
-    and ``Σ (y(t) − ȳ)²`` (ȳ the mean of ``y[t0:]``)."""
+    and ``Σ (y(t) − ȳ)²`` (ȳ the mean of ``y[t0:]``); ``keep=False``: the sums only (None for the
+    errors, one block of scratch memory)."""
     kind, lag, sign = _columns(na, nb, nk)
-    res = np.empty(y.shape[0] - t0)
+    m = y.shape[0] - t0
+    res = np.empty(m if keep else min(m, BLOCK))
     ybar = float(np.mean(y[t0:]))
     see, syy = _residuals(u, y, np.ascontiguousarray(theta, dtype=np.float64), kind[:-1], lag[:-1],
                           sign[:-1], t0, ybar, res)
-    return res, float(see), float(syy)
+    return (res if keep else None), float(see), float(syy)
 
 
 #: Largest column-scaled condition number κ of Φ for which the normal equations are used: their

@@ -32,7 +32,7 @@ def _iv_start(u, y, nb, nf, nk, t0) -> np.ndarray:
     """ARX [nf nb nk] then one instrumental-variable step; returns θ = [b, f]."""
     from scipy import signal as _sig
 
-    m0 = _arx(u, y, nf, nb, nk, 1.0, warn=False)
+    m0 = _arx(u, y, nf, nb, nk, 1.0, warn=False, keep_residuals=False)
     F0 = stabilize(m0.A)
     theta = np.concatenate([m0.B[nk:], F0[1:]])
     if nf == 0:

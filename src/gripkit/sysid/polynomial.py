@@ -37,6 +37,26 @@ __all__ = ["PolynomialModel"]
 _STRUCTURES = ("arx", "armax", "oe")
 
 
+class _Residuals:
+    """The ``residuals`` field: the array an estimator passed, or, when it passed its estimation
+    record as ``estimation_data`` instead, the one-step prediction errors computed from that record
+    on first access (issue 14: a large ARX fit keeps no N-sample array a user may never read, so
+    its memory stays O(p²) beyond the data). The computed errors must reproduce the fit's loss:
+    a record changed in place after the fit raises instead of giving other residuals."""
+
+    def __get__(self, model, owner=None):
+        if model is None:
+            return None  # the dataclass default
+        r = model.__dict__.get("_residuals")
+        if r is None and model.estimation_data is not None:
+            r = model._residuals_from_record()
+            model.__dict__["_residuals"] = r
+        return r
+
+    def __set__(self, model, value):
+        model.__dict__["_residuals"] = value
+
+
 def _coeffs(x, name: str, monic: bool) -> np.ndarray:
     a = np.array(x, dtype=np.float64, copy=True).ravel()
     if a.size == 0:
@@ -82,7 +102,12 @@ class PolynomialModel:
     n_samples
         Samples in the estimation record (N); ``n_used`` = M = N − start prediction errors.
     residuals
-        One-step prediction errors e(t), t = start … N−1.
+        One-step prediction errors e(t), t = start … N−1 (read-only). :func:`gripkit.sysid.arx`
+        computes them on first access from ``estimation_data``.
+    estimation_data
+        ``(u, y)``, references to the record the model was fitted on (no copy), or None: the
+        source of ``residuals`` when the estimator did not keep them. Changing those arrays in
+        place after the fit makes ``residuals`` raise a DataError.
     input_name, output_name, input_unit, output_unit
         Channel names and SI units of the data.
     u_offset, y_offset
@@ -105,7 +130,8 @@ class PolynomialModel:
     fit_percent: float | None = None
     n_samples: int | None = None
     n_used: int | None = None
-    residuals: np.ndarray | None = None
+    residuals: np.ndarray | None = _Residuals()
+    estimation_data: tuple | None = field(default=None, repr=False)
     input_name: str = "u"
     output_name: str = "y"
     input_unit: str = "1"
@@ -143,8 +169,8 @@ class PolynomialModel:
                 raise ModelError(f"covariance: expected shape ({p}, {p}), found {cov.shape}")
             cov.flags.writeable = False
             set_(self, "covariance", cov)
-        if self.residuals is not None:
-            r = self.residuals
+        r = self.__dict__.get("_residuals")  # not self.residuals: that would compute them now
+        if r is not None:
             # a read-only float64 array is kept as it is (an estimator's fresh residuals, or a
             # replace()): copying N samples again would double the memory of a large fit
             if not (isinstance(r, np.ndarray) and r.dtype == np.float64 and not r.flags.writeable):
@@ -182,10 +208,24 @@ class PolynomialModel:
         return m.replace(covariance=np.diag(np.concatenate(var)))
 
     def replace(self, **changes) -> "PolynomialModel":
-        """A copy with some fields changed."""
+        """A copy with some fields changed (residuals not yet computed stay so)."""
         import dataclasses
 
+        changes.setdefault("residuals", self.__dict__.get("_residuals"))
         return dataclasses.replace(self, **changes)
+
+    def _residuals_from_record(self) -> np.ndarray:
+        u, y = self.estimation_data
+        e = self.prediction_errors(u, y)
+        if self.loss is not None:
+            loss = 0.5 * float(e @ e) / e.size
+            floor = 1e-24 * float(np.mean(np.square(y[self.start:])))  # rounding of noise-free fits
+            if abs(loss - self.loss) > 1e-8 * self.loss + floor:
+                raise DataError(f"residuals: the estimation record (u, y) was changed in place after the fit "
+                                f"(its one-step loss is now {loss:.6g}, the fit's was {self.loss:.6g}); compute "
+                                f"errors on the data you hold with model.prediction_errors(u, y)")
+        e.flags.writeable = False
+        return e
 
     # ------------------------------------------------------------------ orders and parameters
     @property
