@@ -39,6 +39,43 @@ def test_streaming_update_equals_batch_kernel_bit_for_bit():
     assert s.n_updates == 2500 - 3 and s.ready
 
 
+def _textbook_rls(u, y, lam, p0, windup, max_trace=None):
+    """The module docstring's updates written with numpy matrices, one sample at a time: gain
+    K = Pφ/(λ + r), exponential forgetting P ← (P − PφφᵀP/(λ + r))/λ (bounded trace for 'trace'),
+    directional P ← P + (1 − λ − r)/(r(λ + r))·PφφᵀP (plain λ = 1 step when r ≤ 1e-12·trace P)."""
+    th, P = np.zeros(4), p0 * np.eye(4)
+    max_trace = 4 * p0 if max_trace is None else max_trace
+    for t in range(3, y.size):
+        phi = np.array([-y[t - 1], -y[t - 2], u[t - 2], u[t - 3]])
+        Pphi = P @ phi
+        r = phi @ Pphi
+        e = y[t] - phi @ th
+        th = th + Pphi * e / (lam + r)
+        if windup == "directional":
+            if r <= 1e-12 * np.trace(P):
+                P = P - np.outer(Pphi, Pphi) / (1 + r)
+            else:
+                P = P + (1 - lam - r) / (r * (lam + r)) * np.outer(Pphi, Pphi)
+        else:
+            P = (P - np.outer(Pphi, Pphi) / (lam + r)) / lam
+            if windup == "trace" and np.trace(P) > max_trace:
+                P = P * (max_trace / np.trace(P))
+    return th, P
+
+
+@pytest.mark.parametrize("windup", ["none", "trace", "directional"])
+def test_kernel_equals_the_textbook_update(windup):
+    """The compiled kernel (P ← (P + coef·q qᵀ)·scale on the upper triangle) gives the textbook
+    matrix recursion's θ and P to rounding over 3000 samples, with forgetting 0.98 (trace bound
+    active with p0 = 1e4)."""
+    u, y = simulate_arx(3000, noise=0.5, seed=29)
+    est = RLS(2, 2, 2, forgetting=0.98, p0=1e4, windup=windup)
+    est.run(u, y, store=False)
+    th, P = _textbook_rls(u, y, 0.98, 1e4, windup)
+    np.testing.assert_allclose(est.theta, th, rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(est.P, P, rtol=1e-7, atol=1e-12 * np.abs(P).max())
+
+
 def test_forgetting_tracks_a_step_change_in_parameters():
     """Parameters jump at t = 3000 from Table II [2 2 2] (S1) to Table II [2 2 2] (S2,
     A = [1, −1.9258, 0.9432], B = [0, 0, 0.2382, −0.2687]); with λ = 0.98 (memory ≈ 50 samples)

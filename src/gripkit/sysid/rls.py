@@ -27,8 +27,8 @@ and the covariance update depends on ``windup``:
   never forgotten, so P stays bounded without a trace limit. When r ≤ 1e-12·trace(P) (no new
   information) the update is the plain λ = 1 one.
 
-P is updated as ``P ← (P ± q qᵀ)·scale`` with ``q = Pφ·sqrt|coef|``; since ``qᵢqⱼ = qⱼqᵢ``
-exactly in floating point, P stays exactly symmetric. It stays positive definite because each
+P is updated as ``P ← (P + coef·q qᵀ)·scale`` with ``q = Pφ``, on the upper triangle, which is
+mirrored: P stays exactly symmetric. It stays positive definite because each
 update keeps its inverse positive (the information loses at most a fraction 1 − λ along φ and
 gains φφᵀ), and the trace limit bounds it above.
 
@@ -69,8 +69,8 @@ def _core(P, th, phi, q, p, size, lam, mode, maxtr, trace, y):
     ``phi`` and output ``y``; ``q`` is a work vector. Returns (a-priori error, r = φᵀPφ, trace).
 
     ``size``: an empty tuple (p at run time) or a tuple of p zeros (p known to the compiler, loops
-    unrolled). The covariance update is ``P ← (P + sign·q qᵀ)·scale`` with ``q = Pφ·sqrt|coef|``
-    (see the module docstring for ``coef``, ``scale`` and the three ``windup`` modes).
+    unrolled). The covariance update is ``P ← (P + coef·q qᵀ)·scale`` with ``q = Pφ`` (see the
+    module docstring for ``coef``, ``scale`` and the three ``windup`` modes).
     """
     if len(size) > 0:
         p = len(size)
@@ -90,23 +90,19 @@ def _core(P, th, phi, q, p, size, lam, mode, maxtr, trace, y):
         r += phi[i] * q[i]
     if mode == 2 and r <= 1e-12 * trace:  # directional, no new direction: no forgetting
         inv = 1.0 / (1.0 + r)
-        sgn, sq, scale = -1.0, math.sqrt(inv), 1.0
+        coef, scale = -inv, 1.0
     elif mode == 2:  # directional forgetting
         inv = 1.0 / (lam + r)
-        coef = (1.0 - lam - r) / r * inv
-        sgn = 1.0 if coef >= 0.0 else -1.0
-        sq, scale = math.sqrt(abs(coef)), 1.0
+        coef, scale = (1.0 - lam - r) / r * inv, 1.0
     else:  # exponential forgetting
         inv = 1.0 / (lam + r)
-        sgn, sq, scale = -1.0, math.sqrt(inv), 1.0 / lam
+        coef, scale = -inv, 1.0 / lam
     g = e * inv
     for i in range(p):
         th[i] += q[i] * g
-    for i in range(p):
-        q[i] *= sq
     tr = 0.0
     for i in range(p):  # P stays exactly symmetric: update the upper triangle, mirror it
-        qi = sgn * q[i]
+        qi = coef * q[i]
         row = i * p
         for j in range(i, p):
             v = (P[row + j] + qi * q[j]) * scale
