@@ -123,6 +123,26 @@ def run(quick: bool = False) -> list[dict]:
                     "pin.crba, one call per state", measure(pin_one_m) / n_one, target="ratio ≥ 0.67 (≤ 1.5×)",
                     notes="both called from a Python loop; gripkit projects through Γ (3×3), Pinocchio returns 4×4"))
 
+    # the same with the caller's workspace, as Pinocchio writes into its preallocated `data`
+    tau_ws, M_ws = np.empty(3), np.empty((3, 3))
+
+    def gk_one_out():
+        for i in range(n_one):
+            ch.rnea(p1[i], pd1[i], pdd1[i], out=tau_ws)
+
+    def gk_one_m_out():
+        for i in range(n_one):
+            ch.mass_matrix(p1[i], out=M_ws)
+
+    rows.append(row("multibody", "RNEA, one state per public call, out= workspace", measure(gk_one_out) / n_one,
+                    "pin.rnea, one call per state (into its data)", measure(pin_one) / n_one,
+                    target="ratio ≥ 0.67 (≤ 1.5×)", gripkit_accuracy=f"max |τ − (Γᵀ τ_pin + arm·p̈)| = {rnea_err:.1e} N·m",
+                    notes="rnea(..., out=τ): no allocation per call; same checks of the state as without out"))
+    rows.append(row("multibody", "mass matrix (CRBA), one state per public call, out= workspace",
+                    measure(gk_one_m_out) / n_one, "pin.crba, one call per state (into its data)",
+                    measure(pin_one_m) / n_one, target="ratio ≥ 0.67 (≤ 1.5×)",
+                    notes="mass_matrix(q, out=M): no allocation per call; gripkit projects through Γ (3×3)"))
+
     T = 2.0 if quick else 10.0
     N = int(T * 1000)
     t = np.arange(N) * 1e-3

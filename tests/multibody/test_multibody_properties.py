@@ -75,6 +75,36 @@ def test_one_state_path_hands_bad_states_to_the_checks():
     np.testing.assert_array_equal(ch.mass_matrix(strided), ch.mass_matrix(q))
 
 
+def test_one_state_out_workspace():
+    """``out=``: a controller's preallocated workspace gets the same values bit for bit and is
+    returned; a strided out is filled through the validating path; an out of the wrong shape,
+    dtype or a read-only one is refused with an ArgumentError naming it (the kernel writes
+    nothing out of bounds); a bad state still gets the ModelError."""
+    from gripkit.errors import ArgumentError
+
+    ch = finger(check=False).chain()
+    q, qd, qdd = np.array([0.1, -0.2, 0.3]), np.array([1.0, 0.5, -2.0]), np.array([3.0, -1.0, 0.5])
+    M, tau = np.full((3, 3), np.nan), np.full(3, np.nan)
+    assert ch.mass_matrix(q, out=M) is M and ch.rnea(q, qd, qdd, out=tau) is tau
+    np.testing.assert_array_equal(M, ch.mass_matrix(q))
+    np.testing.assert_array_equal(tau, ch.rnea(q, qd, qdd))
+    strided = np.zeros((3, 6))[:, ::2]
+    np.testing.assert_array_equal(ch.mass_matrix(q, out=strided), M)
+    np.testing.assert_array_equal(ch.rnea(q, qd, qdd, gravity=False, out=tau),
+                                  ch.rnea(q, qd, qdd, gravity=False))
+    for bad in (np.empty((2, 2)), np.empty((3, 3), dtype=np.float32), np.empty(9), [[0.0] * 3] * 3):
+        with pytest.raises(ArgumentError, match=r"out: expected a writable float64 array of shape \(3, 3\)"):
+            ch.mass_matrix(q, out=bad)
+    ro = np.empty(3)
+    ro.flags.writeable = False
+    with pytest.raises(ArgumentError, match="read-only"):
+        ch.rnea(q, qd, qdd, out=ro)
+    with pytest.raises(ArgumentError, match=r"shape \(3,\)"):
+        ch.rnea(q, qd, qdd, out=np.empty(4))
+    with pytest.raises(ModelError, match="NaN"):
+        ch.mass_matrix(np.array([np.nan, 0.0, 0.0]), out=M)
+
+
 def test_power_balance_qd_C_equals_half_qd_Mdot_qd():
     """q̇ᵀ(Ṁ/2 − C_mat)q̇ = 0, i.e. q̇ᵀ c(q, q̇) = ½ q̇ᵀ Ṁ q̇ for the Coriolis vector c (Ṁ by central
     differences along q̇)."""

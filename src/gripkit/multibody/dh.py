@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import ModelError
+from ..errors import ArgumentError, ModelError
 from . import rnea as _dyn
 from .kernels import dh_table
 from .onestate import mass_matrix_one, rnea_one
@@ -40,6 +40,19 @@ def _as_transform(T, what: str) -> np.ndarray:
     return T
 
 
+def _into(out, value: np.ndarray) -> np.ndarray:
+    """``value``, or ``value`` copied into the caller's ``out`` after checking it fits."""
+    if out is None:
+        return value
+    if not (isinstance(out, np.ndarray) and out.dtype == np.float64 and out.shape == value.shape
+            and out.flags.writeable):
+        found = (f"{out.dtype} array of shape {out.shape}{'' if out.flags.writeable else ', read-only'}"
+                 if isinstance(out, np.ndarray) else type(out).__name__)
+        raise ArgumentError(f"out: expected a writable float64 array of shape {value.shape}, found {found}")
+    out[...] = value
+    return out
+
+
 class Dynamics:
     """Kinematics and dynamics methods shared by :class:`DHChain` and
     :class:`~gripkit.multibody.CoupledChain` (coordinates: joints of a chain, actuators of a
@@ -49,19 +62,21 @@ class Dynamics:
     _one = None  # the packed model of the one-state path (gripkit.multibody.onestate)
 
     # --- dynamics (thesis eq 4.17) ---
-    def rnea(self, q, qd, qdd, *, gravity: bool = True, parallel: bool | None = None) -> np.ndarray:
+    def rnea(self, q, qd, qdd, *, gravity: bool = True, parallel: bool | None = None,
+             out: np.ndarray | None = None) -> np.ndarray:
         """τ = M q̈ + C + G (RNEA, eqs 4.8–4.16); one float64 state takes the low-overhead path
-        of :mod:`gripkit.multibody.onestate`."""
+        of :mod:`gripkit.multibody.onestate`. ``out``: a float64 array of τ's shape to write
+        into (a controller loop's workspace, as Pinocchio's ``data``); returned."""
         if gravity:
             buf, m = self._one or self._one_state()
-            out = np.empty(m)
+            res = np.empty(m) if out is None else out
             try:  # try/except costs nothing on this hot path, unlike a context manager
-                done = rnea_one(buf, q, qd, qdd, out)
+                done = rnea_one(buf, q, qd, qdd, res)
             except TypeError:  # not 1-D float64 arrays: the validating way below
                 done = False
             if done:
-                return out
-        return _dyn.rnea(self, q, qd, qdd, gravity=gravity, parallel=parallel)
+                return res
+        return _into(out, _dyn.rnea(self, q, qd, qdd, gravity=gravity, parallel=parallel))
 
     def regressor(self, q, qd, qdd, *, gravity: bool = True) -> np.ndarray:
         """Y(q, q̇, q̈), (m, p) or (B, m, p): τ = Y φ + diag(armature) q̈ with φ the standard
@@ -98,16 +113,17 @@ class Dynamics:
         Gm = G.reshape(dh.shape[0], -1)
         return Gm.T @ (arm_q[:, None] * Gm) + np.diag(arm_p)
 
-    def mass_matrix(self, q) -> np.ndarray:
+    def mass_matrix(self, q, *, out: np.ndarray | None = None) -> np.ndarray:
         """M(q), including reflected rotor inertia (CRBA, eqs 4.14–4.16); one float64 state takes
-        the low-overhead path of :mod:`gripkit.multibody.onestate`."""
+        the low-overhead path of :mod:`gripkit.multibody.onestate`. ``out``: a float64 array of
+        M's shape to write into (a controller loop's workspace, as Pinocchio's ``data``); returned."""
         buf, m = self._one or self._one_state()
-        out = np.empty((m, m))
+        res = np.empty((m, m)) if out is None else out
         try:
-            done = mass_matrix_one(buf, q, out)
-        except TypeError:  # not a 1-D float64 array: the validating way below
+            done = mass_matrix_one(buf, q, res)
+        except TypeError:  # not a 1-D float64 state or a C-contiguous float64 out: the validating way
             done = False
-        return out if done else _dyn.mass_matrix(self, q)
+        return res if done else _into(out, _dyn.mass_matrix(self, q))
 
     def _one_state(self):
         """The packed model of the one-state path, made on first use."""

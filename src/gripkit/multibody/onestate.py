@@ -96,10 +96,10 @@ def _links(n, m, dh, jtype, G, q0, q, work):  # pragma: no cover - compiled
 @numba.njit("b1(f8[::1], f8[::1], f8[::1], f8[::1], f8[::1])", cache=True, error_model="numpy", _nrt=False)
 def rnea_one(buf, q, qd, qdd, out):  # pragma: no cover - compiled
     """τ_p = Γᵀ RNEA(Γ p + q₀, Γ ṗ, Γ p̈) + armature_p·p̈ for one state; False when the state has
-    NaN or inf or the wrong length (out untouched). Compiled for 1-D float64 arrays only
+    NaN or inf or the wrong length, or ``out`` is not of length m (out untouched). Compiled for 1-D float64 arrays only
     (other types raise TypeError at the call)."""
     n, m, dh, mass, com, inertia, arm_q, G, q0, arm_p, g, jtype, work = _model(buf)
-    if not (_finite(m, q) and _finite(m, qd) and _finite(m, qdd)):
+    if out.shape[0] != m or not (_finite(m, q) and _finite(m, qd) and _finite(m, qdd)):
         return False
     R, P = _links(n, m, dh, jtype, G, q0, q, work)
     b = 12 * n + WORK_PER_LINK * n
@@ -128,9 +128,10 @@ def rnea_one(buf, q, qd, qdd, out):  # pragma: no cover - compiled
 @numba.njit("b1(f8[::1], f8[::1], f8[:, ::1])", cache=True, error_model="numpy", _nrt=False)
 def mass_matrix_one(buf, q, out):  # pragma: no cover - compiled
     """M_p = Γᵀ M(Γ p + q₀) Γ + diag(armature_p) (CRBA, thesis eqs 4.14–4.16) for one state into
-    ``out`` (m×m); False when q has NaN or inf or the wrong length (out untouched)."""
+    ``out`` (m×m); False when q has NaN or inf or the wrong length, or ``out`` is not m×m (out
+    untouched)."""
     n, m, dh, mass, com, inertia, arm_q, G, q0, arm_p, g, jtype, work = _model(buf)
-    if not _finite(m, q):
+    if out.shape[0] != m or out.shape[1] != m or not _finite(m, q):
         return False
     R, P = _links(n, m, dh, jtype, G, q0, q, work)
     b = 12 * n + WORK_PER_LINK * n
