@@ -30,6 +30,8 @@ import sys
 import tempfile
 from collections.abc import Callable, Iterable, Iterator, Sequence
 
+import cloudpickle
+
 from ..errors import ConfigError
 from .worker import PIN_ENV, read_frame, write_frame
 
@@ -142,8 +144,6 @@ class ProcessExecutor(Executor):
     PREFETCH_MAX_BYTES = 32 * 1024
 
     def map_unordered(self, tasks):
-        import cloudpickle
-
         pending = collections.deque(tasks)
         attempts: dict = collections.defaultdict(int)
         sel = selectors.DefaultSelector()

@@ -43,7 +43,9 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import ConfigError, GripkitError
+from ..io import load
 from ..io.toml_file import read_toml
+from ..units import same_dimension, si_unit, to_si
 
 __all__ = ["SweepSpec", "quantity"]
 
@@ -60,8 +62,6 @@ def quantity(v, where: str, unit: str | None = None) -> float:
 
     ``unit``: the SI unit the value must measure (``"N/m"``); a string with a unit of another
     dimension (``"3 furlong"`` for a stiffness) is refused. Non-finite values are refused."""
-    from ..units import same_dimension, si_unit, to_si
-
     expected = f" in {unit}" if unit else ""
     if isinstance(v, bool) or not isinstance(v, (numbers.Real, str)):
         raise ConfigError(f"{where}: expected a number{expected} or a quantity like '3 mg', found {v!r}")
@@ -245,8 +245,6 @@ class SweepSpec:
 
     def _table_rows(self, tables: dict[str, list[str]]) -> dict[str, np.ndarray]:
         """Rows of the parameter files (each file zips its columns; files are crossed)."""
-        from ..io import load
-
         cols_out: dict[str, np.ndarray] = {}
         n_rows = 1
         for file, names in tables.items():

@@ -11,8 +11,11 @@ It reads tasks from stdin and writes results to stdout, each a length-prefixed p
 from __future__ import annotations
 
 import os
+import pickle
 import struct
 import sys
+
+import cloudpickle
 
 PIN_ENV = {"OMP_NUM_THREADS": "1", "OPENBLAS_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
            "NUMBA_NUM_THREADS": "1", "VECLIB_MAXIMUM_THREADS": "1", "NUMEXPR_NUM_THREADS": "1"}
@@ -52,10 +55,6 @@ def read_frame(stream) -> bytes | None:
 def main() -> int:
     for k, v in PIN_ENV.items():
         os.environ.setdefault(k, v)
-    import pickle
-
-    import cloudpickle
-
     stdin, stdout = sys.stdin.buffer, sys.stdout.buffer
     sys.stdout = sys.stderr  # stray prints from jobs must not corrupt the frame stream
     while True:

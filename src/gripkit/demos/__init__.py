@@ -12,6 +12,7 @@ from pathlib import Path
 
 from ..errors import ConfigError
 from ..progress import status
+from ..report import Report
 
 __all__ = ["SECTIONS", "run_demo"]
 
@@ -27,8 +28,6 @@ SECTIONS: dict[str, str] = {
 
 def run_demo(out_dir="report", sections: list[str] | None = None, quick: bool = False) -> tuple[Path, dict]:
     """Run the selected sections (default: all) and write ``out_dir/index.html``."""
-    from ..report import Report
-
     names = list(SECTIONS) if not sections else sections
     for n in names:
         if n not in SECTIONS:

@@ -23,7 +23,9 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 from ..errors import DataError, DataWarning
+from ..signals.outliers import corrupt_samples
 from ..signals.trajectory import Trajectory
+from ..units import si_factor
 
 __all__ = ["columns_to_trajectory", "split_header", "check_fill", "check_fs", "FILL_CHOICES"]
 
@@ -42,10 +44,8 @@ def split_header(header: str) -> tuple[str, str | None]:
 def _to_si(name: str, values: np.ndarray, unit: str | None) -> tuple[np.ndarray, str]:
     if unit is None:
         return values, "1"
-    from ..units import si_factor as _si_factor
-
     try:
-        scale, offset, si = _si_factor(unit)
+        scale, offset, si = si_factor(unit)
     except Exception:
         raise DataError(f"column {name!r}: unit {unit!r} is not a unit gripkit can read",
                         hint="write units like [N], [mN], [um], [V], [mA], [bar], [s]") from None
@@ -123,8 +123,6 @@ def _check_fs_against_time(source: str, tname: str, t: np.ndarray, fs: float) ->
 
 def _warn_corrupt(source: str, t: np.ndarray, data: dict[str, np.ndarray], units: dict[str, str]) -> None:
     """One :class:`~gripkit.errors.DataWarning` per channel holding corrupt samples, naming their times."""
-    from ..signals.outliers import corrupt_samples
-
     for name, x in data.items():
         if not np.isfinite(x).all():
             continue  # missing values are refused (or filled) elsewhere

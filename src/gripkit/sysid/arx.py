@@ -18,6 +18,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from ._scaling import in_user_units, unit_scale
+from .arx_mimo import arx_mimo
 from .checks import check_identifiable, checked_problem
 from .polynomial import PolynomialModel, check_meta
 from .regression import arx_regression, arx_start, qr_solve, triangular_solve
@@ -79,8 +80,6 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None, fs: flo
     """
     check_meta(meta, arx)
     if any(np.ndim(x) == 2 and np.shape(x)[1] > 1 for x in (u, y)):  # several inputs or outputs
-        from .arx_mimo import arx_mimo
-
         return arx_mimo(u, y, na, nb, nk, dt=dt, fs=fs, **meta)
     u, y, step, na, nb, nk = checked_problem(u, y, dt, fs, na=na, nb=nb, nk=nk)
     cu, cy = unit_scale(u), unit_scale(y)
@@ -138,7 +137,11 @@ def _normal_equations(u, y, na, nb, nk, t0, names, warn, keep_residuals):
     memory) with the residuals and their sums ``(sol, e, Σe², Σ(y − ȳ)²)``, or None when Φ is too
     ill-conditioned for it (then QR is used). ρ² is the residuals' compensated Σe², not
     ``YᵀY − rᵀr`` (which cancels when the fit is good)."""
-    from .lagged_sums import arx_gram, arx_residuals, gram_triangle  # numba: only for large problems
+    from .lagged_sums import (  # numba: only for large problems
+        arx_gram,
+        arx_residuals,
+        gram_triangle,
+    )
 
     G = arx_gram(u, y, na, nb, nk, t0)
     r1 = gram_triangle(G)

@@ -30,11 +30,14 @@ from __future__ import annotations
 
 import hashlib
 import json
+import tempfile
 from pathlib import Path
 
 import numpy as np
 
+from .. import __version__
 from ..errors import DataError, ModelError
+from ..multibody import to_urdf
 from .model_file import content_hash, plain, read_document
 
 __all__ = ["SCHEMA", "SCHEMA_VERSION", "dynamics_document", "float_array", "read_dynamics_document",
@@ -48,18 +51,12 @@ def _urdf_text(result) -> str:
     """The URDF the result's chain came from, or the chain written as URDF."""
     if result.urdf_text is not None:
         return result.urdf_text
-    import tempfile
-
-    from ..multibody import to_urdf
-
     with tempfile.TemporaryDirectory() as tmp:
         return Path(to_urdf(result.chain, Path(tmp) / "chain.urdf")).read_text()
 
 
 def dynamics_document(result) -> dict:
     """The JSON document of a :class:`~gripkit.sysid.dynamics.DynamicsResult`."""
-    from .. import __version__
-
     text = _urdf_text(result)
     st = result.structure
     cons = result.consistency

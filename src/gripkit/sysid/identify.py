@@ -29,8 +29,14 @@ import numpy as np
 
 from ..arguments import check_keywords, entry_point, keyword_names
 from ..errors import ArgumentError, DataError
+from ..signals.processing import detrend as detrend_signals
 from ..signals.trajectory import Trajectory
 from . import identify_mimo
+from .armax import armax
+from .arx import arx
+from .frf import frf
+from .oe import oe
+from .search import structure_search
 
 __all__ = ["IOData", "io_data", "identify", "method_options", "METHODS"]
 
@@ -81,32 +87,19 @@ def io_data(data: Trajectory, *, input: str, output: str, detrend: str = "mean",
         u -= u0
         y -= y0
     elif detrend == "linear":
-        from ..signals.processing import detrend as _detrend
-
-        d = _detrend(data.select(input, output), kind="linear")
+        d = detrend_signals(data.select(input, output), kind="linear")
         u0, y0 = float(u.mean()), float(y.mean())
         u, y = np.array(d[input]), np.array(d[output])
     return IOData(u, y, 1.0 / fs, input, output, data.unit(input), data.unit(output), u0, y0)
 
 
 def _method_function(method: str):
-    if method == "arx":
-        from .arx import arx as fn
-    elif method == "armax":
-        from .armax import armax as fn
-    elif method == "oe":
-        from .oe import oe as fn
-    elif method == "rls":
-        from .rls import rls as fn
-    elif method == "ss":
-        fn = identify_mimo.identify_ss
-    elif method == "frf":
-        from .frf import frf as fn
-    elif method == "tf":
-        fn = identify_mimo.identify_tf
-    else:
-        from .search import structure_search as fn
-    return fn
+    if method == "rls":
+        from .rls import rls  # numba (0.4 s): loaded only for an RLS fit
+
+        return rls
+    return {"arx": arx, "armax": armax, "oe": oe, "ss": identify_mimo.identify_ss, "frf": frf,
+            "tf": identify_mimo.identify_tf}.get(method, structure_search)
 
 
 #: what identify() itself passes to the method's function (not accepted as an option)
@@ -171,21 +164,13 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
         return identify_mimo.identify_arx(data, input=input, output=output, na=na, nb=nb, nk=nk, detrend=detrend)
     io = io_data(data, input=input, output=output, detrend=detrend, why=f"{method.upper()} identification")
     if method == "arx":
-        from .arx import arx
-
         return arx(io.u, io.y, na, nb, nk, dt=io.dt, **io.meta, **options)
     if method == "armax":
-        from .armax import armax
-
         return armax(io.u, io.y, na, nb, nc, nk, dt=io.dt, **io.meta, **options)
     if method == "oe":
-        from .oe import oe
-
         return oe(io.u, io.y, nb, na if nf is None else nf, nk, dt=io.dt, **io.meta, **options)
     if method == "rls":
-        from .rls import rls
+        from .rls import rls  # numba (0.4 s): loaded only for an RLS fit
 
         return rls(io.u, io.y, na, nb, nk, dt=io.dt, **options)
-    from .search import structure_search
-
     return structure_search(io.u, io.y, na, nb, nk, dt=io.dt, **options)

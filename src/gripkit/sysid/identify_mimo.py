@@ -24,6 +24,8 @@ import numpy as np
 from ..errors import DataError, GripkitWarning
 from ..progress import status
 from ..signals.trajectory import Trajectory
+from .arx_mimo import arx_mimo
+from .frf import frf
 
 __all__ = ["MimoData", "mimo_data", "identify_ss", "identify_frf", "identify_tf", "identify_arx", "several",
            "parse_names", "parse_order", "validation_fit"]
@@ -153,8 +155,14 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     orders of a range), ``validation_fit_percent`` (per output, with ``validate``) and
     ``criterion``."""
     from .pem_ss import pem
-    from .subspace import (DEFAULT_MAX_ORDER, SUBSPACE_METHODS, default_horizon, from_factor, select_order,
-                           subspace_factor)
+    from .subspace import (
+        DEFAULT_MAX_ORDER,
+        SUBSPACE_METHODS,
+        default_horizon,
+        from_factor,
+        select_order,
+        subspace_factor,
+    )
 
     if method not in SUBSPACE_METHODS:
         raise DataError(f"method: expected one of {', '.join(SUBSPACE_METHODS)}, found {method!r}")
@@ -213,8 +221,6 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
 
 def identify_frf(data: Trajectory, *, input, output, detrend: str = "mean", **options):
     """Frequency response of the named columns (:func:`gripkit.sysid.frf` options)."""
-    from .frf import frf
-
     d = mimo_data(data, input, output, detrend, why="frequency-response estimation")
     return frf(d.u, d.y, dt=d.dt, inputs=d.inputs, outputs=d.outputs, **options)
 
@@ -234,7 +240,5 @@ def several(*names) -> bool:
 
 def identify_arx(data: Trajectory, *, input, output, na: int, nb: int, nk: int = 1, detrend: str = "mean"):
     """MIMO ARX of the named columns (:func:`gripkit.sysid.arx_mimo.arx_mimo`)."""
-    from .arx_mimo import arx_mimo
-
     d = mimo_data(data, input, output, detrend, why="ARX identification")
     return arx_mimo(d.u, d.y, na, nb, nk, dt=d.dt, u_offset=d.u_offset, y_offset=d.y_offset, **d.signals)

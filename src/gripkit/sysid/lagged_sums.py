@@ -22,6 +22,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .regression import scaled_condition
+
 __all__ = ["BLOCK", "GRAM_COND_LIMIT", "arx_gram", "arx_residuals", "gram_triangle"]
 
 #: Products summed in plain floating point before a compensated addition.
@@ -183,8 +185,6 @@ def gram_triangle(G: np.ndarray) -> np.ndarray | None:
     """Upper Cholesky factor ``R1`` of ``ΦᵀΦ = G[:p, :p]`` (``R1ᵀR1 = ΦᵀΦ``), or None when Φ is
     too ill-conditioned for the normal equations (not positive definite, or column-scaled
     condition number above :data:`GRAM_COND_LIMIT`)."""
-    from .regression import scaled_condition
-
     p = G.shape[0] - 1
     try:
         r1 = np.linalg.cholesky(G[:p, :p]).T

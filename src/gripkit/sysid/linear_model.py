@@ -21,6 +21,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .. import __version__
 from ..errors import DataError, ModelError
 from ..lti import LinearSystem, StateSpace, TransferFunction
 from .model_file import SCHEMA, SCHEMA_VERSION, read_document, write_document
@@ -302,8 +303,6 @@ def model_document(model: LinearModel) -> dict:
          "data": {"file": "run1.csv", "sha256": "…"} | null,
          "content_sha256": "…"}
     """
-    from .. import __version__
-
     s = model.system
     doc = {"schema": SCHEMA, "schema_version": SCHEMA_VERSION, "gripkit_version": __version__,
            "structure": model.structure, "kind": "ss" if isinstance(s, StateSpace) else "tf", "dt": s.dt,

@@ -18,6 +18,7 @@ Parameter names follow the powers of q⁻¹ (Table III of the seed: ``a1 a2 b2 b
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import math
 from dataclasses import dataclass, field
@@ -209,8 +210,6 @@ class PolynomialModel:
 
     def replace(self, **changes) -> "PolynomialModel":
         """A copy with some fields changed (residuals not yet computed stay so)."""
-        import dataclasses
-
         changes.setdefault("residuals", self.__dict__.get("_residuals"))
         return dataclasses.replace(self, **changes)
 

@@ -50,6 +50,7 @@ from numba.core.errors import TypingError
 
 from ..arguments import entry_point
 from ..errors import DataError, IdentificationError
+from ..signals.trajectory import Trajectory
 from .checks import check_dt, check_excitation, check_io, check_order, require_samples
 from .polynomial import PolynomialModel
 
@@ -600,8 +601,6 @@ class RLSResult:
     def to_trajectory(self, t0: float = 0.0):
         """θ(t), σ(t), ŷ(t) and e(t) as a :class:`~gripkit.signals.Trajectory` (to save as
         Parquet/CSV/HDF5)."""
-        from ..signals.trajectory import Trajectory
-
         if self.theta is None:
             raise DataError("this RLS result kept no history (run with store=True)")
         t = t0 + np.arange(self.n_samples) * self.dt

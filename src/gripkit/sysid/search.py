@@ -11,17 +11,20 @@ cannot determine (rank-deficient regressor) are listed as skipped, with the reas
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..arguments import entry_point
-from ..errors import DataError, UnidentifiableError
+from ..errors import DataError, GripkitWarning, UnidentifiableError
 from ..progress import track
 from ._scaling import unit_scale
 from .checks import check_dt, check_identifiable, check_io, check_order
+from .polynomial import PolynomialModel
 from .regression import arx_regression, qr_solve
+from .validation import compare
 
 __all__ = ["Candidate", "SearchResult", "structure_search", "parse_range"]
 
@@ -170,11 +173,6 @@ def structure_search(u, y, na=range(1, 5), nb=range(1, 5), nk=range(1, 11), *,
 
 def _validation_fit(theta, na, nb, nk, dt, u, y) -> float | None:
     """Free-run fit (%) of the ARX [na nb nk] with coefficients θ on (u, y); None if unstable."""
-    import warnings
-
-    from .polynomial import PolynomialModel
-    from .validation import compare
-
     model = PolynomialModel(np.concatenate([[1.0], theta[:na]]), np.concatenate([np.zeros(nk), theta[na:]]), nk,
                             dt=dt, structure="arx")
     with warnings.catch_warnings():
@@ -183,10 +181,6 @@ def _validation_fit(theta, na, nb, nk, dt, u, y) -> float | None:
 
 
 def _warn_edge(best: Candidate, ranges: dict) -> None:
-    import warnings
-
-    from ..errors import GripkitWarning
-
     edges = [f"{name} = {getattr(best, name)} (searched {min(r)}:{max(r)})" for name, r in ranges.items()
              if len(set(r)) >= 3 and getattr(best, name) in (min(r), max(r))]
     if edges:

@@ -43,6 +43,7 @@ from __future__ import annotations
 import collections
 import contextlib
 import math
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import replace
 
 import numba
@@ -179,8 +180,6 @@ def tsfm_grasp_batch(gripper=None, *, settings: GraspSettings = FAST_GRASP, dura
 def _run_cpu(tpl, parts, nz, nstd, seeds, n_steps, window, cps, mset, met, threads=None, progress=False):
     """Slices of the jobs on ``threads`` threads (default numba's thread count, 1 in a pinned
     worker process) running the nogil kernel :func:`_grasp_jobs`; the results land in ``met``."""
-    from concurrent.futures import ThreadPoolExecutor
-
     P = parts.shape[0]
     threads = max(1, min(numba.get_num_threads() if threads is None else int(threads), P))
     size = max(1, min(64, -(-P // (4 * threads))))   # small slices: even load, a live progress bar
