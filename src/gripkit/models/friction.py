@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 import numba
 import numpy as np
@@ -229,8 +230,6 @@ class FrictionTable:
     @classmethod
     def from_csv(cls, path, *, name: str | None = None, scale: float = 1.0) -> "FrictionTable":
         """Read ``velocity_deg_s,friction_N_m`` CSV (``#`` lines are comments)."""
-        from pathlib import Path
-
         p = Path(path)
         try:
             text = p.read_text()

@@ -24,6 +24,7 @@ from . import rnea as _dyn
 from .kernels import dh_table
 from .onestate import mass_matrix_one, rnea_one
 from .onestate import prepare as prepare_one_state
+from .regressor import kernel_parameters, parameter_names, regressor
 
 __all__ = ["DHChain", "Dynamics"]
 
@@ -81,7 +82,6 @@ class Dynamics:
     def regressor(self, q, qd, qdd, *, gravity: bool = True) -> np.ndarray:
         """Y(q, q̇, q̈), (m, p) or (B, m, p): τ = Y φ + diag(armature) q̈ with φ the standard
         inertial parameters (:mod:`gripkit.multibody.regressor`)."""
-        from .regressor import regressor
         return regressor(self, q, qd, qdd, gravity=gravity)
 
     @property
@@ -92,13 +92,11 @@ class Dynamics:
     @property
     def parameter_names(self) -> tuple[str, ...]:
         """``'<parameter>_<link>'`` per regressor column (m, mx, my, mz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz)."""
-        from .regressor import parameter_names
         return parameter_names(self)
 
     def standard_parameters(self) -> np.ndarray:
         """φ, the standard inertial parameters of the moving links (kg, kg·m, kg·m²; inertia about
         each link frame's origin), in :attr:`parameter_names` order."""
-        from .regressor import kernel_parameters
         _, _, mass, com, i6, *_ = self.kernel_arrays()
         return kernel_parameters(mass, com, i6)
 

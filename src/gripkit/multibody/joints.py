@@ -30,6 +30,7 @@ from ..errors import ModelError
 from .dh import Dynamics, _as_transform
 from .kernels import PLACEMENT_WIDTH
 from .regressor import kernel_parameters
+from .rnea import OP_JACOBIAN, _states, run_op
 
 __all__ = ["JointChain", "JointLimits", "axis_frame"]
 
@@ -244,8 +245,6 @@ class JointChain(Dynamics):
 
     def jacobian(self, q) -> np.ndarray:
         """Geometric Jacobian of the tip, rows (v, ω) in the base frame, (6, m) or (B, 6, m)."""
-        from .rnea import OP_JACOBIAN, _states, run_op
-
         (qq,), single = _states(self, q)
         self.kernel_arrays()
         J = np.empty((qq.shape[0], 6, self.dof))

@@ -25,6 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from .kernels import chain_links, hot
+from .rnea import _states
 
 __all__ = ["regressor", "standard_parameters", "parameter_names", "PARAMETERS_PER_LINK",
            "LINK_PARAMETERS"]
@@ -258,8 +259,6 @@ def regressor(system, q, qd, qdd, *, gravity: bool = True) -> np.ndarray:
         Shape (m, p) or (B, m, p) with p = 10 × number of moving links, columns in
         :func:`parameter_names` order.
     """
-    from .rnea import _states
-
     (q, qd, qdd), single = _states(system, q, qd, qdd, names=("q", "qd", "qdd"))
     dh, jt, _, _, _, _, G, q0, _, g = system.kernel_arrays()
     n = dh.shape[0]

@@ -42,6 +42,8 @@ import numpy as np
 
 from ..arguments import entry_point
 from ..errors import GripkitWarning, ModelError
+from .coupling import CoupledChain
+from .dh import DHChain
 from .joints import JointChain, JointLimits
 
 __all__ = ["from_urdf", "to_urdf"]
@@ -480,9 +482,6 @@ def _origin_el(parent, T):
 def _describe(chain):
     """(placements, axes, types, mass, com, inertia, Γ, q₀, names, link names, tool, armature,
     limits or None) of a DH, coupled or joint chain, in joint coordinates."""
-    from .coupling import CoupledChain
-    from .dh import DHChain
-
     if isinstance(chain, JointChain):
         return (chain.placements, chain.axes, chain.joint_types, chain.mass, chain.com, chain.inertia,
                 chain.coupling, chain.offset, chain.names, chain.link_names, chain.tool, chain.armature,

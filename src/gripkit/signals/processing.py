@@ -8,6 +8,7 @@ the record itself or the mean of a separate reference record.
 from __future__ import annotations
 
 from collections.abc import Sequence
+from fractions import Fraction
 
 import numpy as np
 
@@ -81,8 +82,6 @@ def resample(tr: Trajectory, fs: float) -> Trajectory:
     interpolation onto a uniform grid otherwise."""
     if not tr.is_uniform():
         return to_uniform(tr, fs)
-    from fractions import Fraction
-
     ratio = Fraction(float(fs) / tr.fs).limit_denominator(1000)
     up, down = ratio.numerator, ratio.denominator
     data = {k: _signal().resample_poly(tr[k], up, down, padtype="line") for k in tr.names}

@@ -49,13 +49,20 @@ data, without another pass over it.
 
 from __future__ import annotations
 
+import hashlib
 import math
+import warnings
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 
 import numpy as np
+from scipy.linalg import qr
 
 from ..arguments import entry_point
-from ..errors import DataError, IdentificationError, UnidentifiableError
+from ..errors import AccuracyWarning, DataError, IdentificationError, ModelError, UnidentifiableError
+from ..multibody import from_urdf
+from .dynamics_file import float_array, read_dynamics_document, save_dynamics_model
+from .regression import hac_covariance
 
 __all__ = ["identify_dynamics", "DynamicsResult", "base_structure", "BaseStructure", "load_dynamics_model"]
 
@@ -97,8 +104,6 @@ def _combination_name(names, i, dep, beta_row) -> str:
 def base_structure(chain, *, armature: bool = False, seed: int = 0, tol: float = 1e-9) -> BaseStructure:
     """Base parameters of ``chain`` from its regressor on random states (module doc); with
     ``armature`` a rotor-inertia column per actuated joint joins the standard parameters."""
-    from scipy.linalg import qr
-
     rng = np.random.default_rng(seed)
     m = chain.dof
     names = list(chain.parameter_names)
@@ -221,8 +226,6 @@ class DynamicsResult:
     def save(self, path) -> None:
         """Write the model as JSON (:mod:`gripkit.sysid.dynamics_file`, schema
         ``gripkit.dynamics-model``); read it back with :func:`gripkit.sysid.load_dynamics_model`."""
-        from .dynamics_file import save_dynamics_model
-
         save_dynamics_model(self, path)
 
     @property
@@ -386,8 +389,6 @@ class _JointNormalEquations:
         covariance of the weighted rows (``'hac'``)."""
         P = self.X3.shape[2]
         if kind == "hac":
-            from .regression import hac_covariance
-
             sw = np.sqrt(self.rows_w * jw)
             rw = ((self.tau - self.X3 @ theta) * sw).reshape(-1)
             keep = sw.reshape(-1) > 0
@@ -717,14 +718,6 @@ def load_dynamics_model(path) -> DynamicsResult:
     ``schema_version``; ModelError for missing or malformed fields; warns (AccuracyWarning) when
     the content hash does not match (the file was edited after it was saved).
     """
-    import hashlib
-    import warnings
-    from pathlib import Path
-
-    from ..errors import AccuracyWarning, ModelError
-    from ..multibody import from_urdf
-    from .dynamics_file import float_array, read_dynamics_document
-
     doc = read_dynamics_document(path)
     where = repr(str(Path(path)))
     try:

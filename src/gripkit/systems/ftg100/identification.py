@@ -23,6 +23,7 @@ k2/(k0 + k2) = 0.0052: doubling k0 moves the step response by half a percent. Wi
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 
 import numpy as np
@@ -187,8 +188,6 @@ def identify_sensing(data: Trajectory, *, input: str = "F_c", output: str = "x_b
 
 def _shift_offset(res: GreyboxResult, off0: float) -> GreyboxResult:
     """The result with the fitted sensor zero expressed in the data's own zero (+ ``off0``)."""
-    import dataclasses
-
     off = res.parameters["x_off"]
     ps = res.parameters.from_vector(np.array([off.value + off0]), ["x_off"], std=np.array([off.std]),
                                     source=off.source)
