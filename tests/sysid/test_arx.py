@@ -201,6 +201,22 @@ def test_large_fit_computes_residuals_on_demand_from_its_record():
         assert m.replace(output_name="y2").residuals is not None
 
 
+def test_pickled_model_carries_its_residuals_not_its_record():
+    """A model sent to another process (pickle) holds its N residuals, not the 2N samples of the
+    record, and equals the original."""
+    import pickle
+
+    u, y = simulate_arx(100_000, noise=0.5, seed=24)
+    m = arx(u, y, 2, 2, 2)
+    data = pickle.dumps(m)
+    assert len(data) < 1.1 * 8 * m.n_used  # the residuals, not u and y (16 × N bytes)
+    back = pickle.loads(data)
+    assert back.estimation_data is None
+    np.testing.assert_array_equal(back.residuals, m.residuals)
+    np.testing.assert_array_equal(back.theta, m.theta)
+    assert back.loss == m.loss and back.covariance.tolist() == m.covariance.tolist()
+
+
 def test_residuals_refuse_a_record_changed_after_the_fit():
     """Changing the estimation record in place before the first access to ``residuals`` would give
     another record's errors: a DataError names the cause instead of a silent wrong answer."""

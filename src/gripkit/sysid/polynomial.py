@@ -213,6 +213,15 @@ class PolynomialModel:
         changes.setdefault("residuals", self.__dict__.get("_residuals"))
         return dataclasses.replace(self, **changes)
 
+    def __getstate__(self) -> dict:
+        """Pickled (process pools, batch results) with its residuals instead of the record they
+        come from: N numbers rather than the 2N of ``(u, y)``, and no tie to the caller's arrays."""
+        state = dict(self.__dict__)
+        if state.get("estimation_data") is not None:
+            state["_residuals"] = self.residuals
+            state["estimation_data"] = None
+        return state
+
     def _residuals_from_record(self) -> np.ndarray:
         u, y = self.estimation_data
         e = self.prediction_errors(u, y)
