@@ -69,7 +69,7 @@ class Dynamics:
         of :mod:`gripkit.multibody.onestate`. ``out``: a float64 array of τ's shape to write
         into (a controller loop's workspace, as Pinocchio's ``data``); returned."""
         if gravity:
-            buf, m = self._one or self._one_state()
+            buf, m, _ = self._one or self._one_state()
             res = np.empty(m) if out is None else out
             try:  # try/except costs nothing on this hot path, unlike a context manager
                 done = rnea_one(buf, q, qd, qdd, res)
@@ -115,8 +115,8 @@ class Dynamics:
         """M(q), including reflected rotor inertia (CRBA, eqs 4.14–4.16); one float64 state takes
         the low-overhead path of :mod:`gripkit.multibody.onestate`. ``out``: a float64 array of
         M's shape to write into (a controller loop's workspace, as Pinocchio's ``data``); returned."""
-        buf, m = self._one or self._one_state()
-        res = np.empty((m, m)) if out is None else out
+        buf, _, shape = self._one or self._one_state()
+        res = np.empty(shape) if out is None else out
         try:
             done = mass_matrix_one(buf, q, res)
         except TypeError:  # not a 1-D float64 state or a C-contiguous float64 out: the validating way

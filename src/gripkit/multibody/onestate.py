@@ -142,5 +142,7 @@ def mass_matrix_one(buf, q, out):  # pragma: no cover - compiled
 
 
 def prepare(system):
-    """(packed buffer, m) of ``system`` for ``Dynamics.rnea`` and ``Dynamics.mass_matrix``."""
-    return pack(system.kernel_arrays()), system.dof
+    """(packed buffer, m, (m, m)) of ``system`` for ``Dynamics.rnea`` and ``Dynamics.mass_matrix``
+    (the shape tuple made once: building it per call is 60 ns of a 1 µs call)."""
+    m = system.dof
+    return pack(system.kernel_arrays()), m, (m, m)
