@@ -85,9 +85,8 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None, fs: flo
     cu, cy = unit_scale(u), unit_scale(y)
     if max(abs(np.log2(cu)), abs(np.log2(cy))) <= _NO_SCALING_WITHIN:
         cu = cy = 1.0  # scaling by powers of two is exact: skip the two copies where it changes nothing
-    model = _arx(u * cu if cu != 1.0 else u, y * cy if cy != 1.0 else y, na, nb, nk, step, keep_residuals=False,
-                 **meta)
-    return in_user_units(model, cu, cy).replace(estimation_data=(u, y))
+    model = _arx(u * cu if cu != 1.0 else u, y * cy if cy != 1.0 else y, na, nb, nk, step, record=(u, y), **meta)
+    return in_user_units(model, cu, cy)
 
 
 #: Signals whose peak lies within 2^±this are fitted unscaled: their squares summed over up to 2^60
@@ -97,10 +96,12 @@ _NO_SCALING_WITHIN = 100
 
 
 def _arx(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int, step: float, *, warn: bool = True,
-         keep_residuals: bool = True, **meta) -> PolynomialModel:
+         keep_residuals: bool = True, record: tuple | None = None, **meta) -> PolynomialModel:
     """:func:`arx` on checked signals, without scaling; ``warn=False`` for the internal fits of
-    other estimators (their own diagnostics speak for the final model). ``keep_residuals=False``:
-    a large fit returns no residuals (the caller attaches its record to compute them on demand)."""
+    other estimators (their own diagnostics speak for the final model). With ``record`` (the
+    caller's ``(u, y)`` in its own units) or ``keep_residuals=False`` a large fit keeps no residual
+    array; with ``record`` its model computes them from the record on first access."""
+    keep_residuals = keep_residuals and record is None
     p = na + nb
     t0 = arx_start(na, nb, nk)
     check_identifiable(u, y, t0 + p + 1, f"ARX [{na} {nb} {nk}] ({p} parameters, {t0} initial samples)")
@@ -123,7 +124,8 @@ def _arx(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int, step: float, *
     if e is not None:
         e.flags.writeable = False  # handed to the model without a copy
     return model.replace(covariance=sigma2 * sol.cov_unscaled, noise_variance=sigma2, loss=0.5 * see / m,
-                         fit_percent=fit, n_used=m, residuals=e, info={"method": method, "cond": sol.cond})
+                         fit_percent=fit, n_used=m, residuals=e, estimation_data=record if e is None else None,
+                         info={"method": method, "cond": sol.cond})
 
 
 def _model(theta, na, nk, step, n, meta) -> PolynomialModel:
