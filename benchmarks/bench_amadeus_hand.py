@@ -62,11 +62,11 @@ def run(quick: bool = False) -> list[dict]:
     rng = np.random.default_rng(0)
     c = StickSlipContact(check=False)
     T = 60.0 if quick else 600.0
-    u = nonslip_grasp_inputs(T, fs, rng)
+    u = nonslip_grasp_inputs(T, dt=1 / fs, rng=rng)
     u[int(0.5 * u.shape[0]):, 1] += np.linspace(0, 2.0, u.shape[0] - int(0.5 * u.shape[0]))  # ends in slip
     t_sim = measure(lambda: c.simulate(u, dt=1 / fs, x0=c.equilibrium_state(u[0, 1])))
-    x = c.simulate(u, dt=1 / fs, x0=c.equilibrium_state(u[0, 1]))["v_pvdf"] + pvdf_noise(u.shape[0], fs, rng)
-    det = SlipDetector(fs).calibrate(x[: int(20 * fs)])
+    x = c.simulate(u, dt=1 / fs, x0=c.equilibrium_state(u[0, 1]))["v_pvdf"] + pvdf_noise(u.shape[0], dt=1 / fs, rng=rng)
+    det = SlipDetector(dt=1 / fs).calibrate(x[: int(20 * fs)])
     onsets_g = [int(round(e.alarm * fs)) for e in det.detect(x).events]
     onsets_p = list(_slip_scipy(x, det))
     assert onsets_g[:1] == [int(v) for v in onsets_p[:1]], (onsets_g[:3], onsets_p[:3])

@@ -110,7 +110,7 @@ def _scipy_lm(data):
     kk = (ktot - Ksa) / Da ** 2
     k0 = kk * k2 / (k2 - kk) if 0 < kk < k2 else 1e5
     z0 = np.array([np.log(M), np.log(2 * st.damping_ratio * wn * M), np.log(k0), 0.0])
-    dt = 1.0 / data.fs
+    dt = data.dt
     scale = np.std(y)
 
     def res(z):

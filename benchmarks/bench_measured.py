@@ -140,7 +140,7 @@ def run(quick: bool) -> list[dict]:
     rows.append(row("measured", f"n4sid + PEM (output error), order {ORDER}, {DATA}", t_refined, "", None,
                     gripkit_accuracy=_fit_text(fit_refined), notes="the subspace model refined; free run, x0 estimated"))
 
-    ours_arx = lambda: arx(u0, y0, LAGS, LAGS, 1, fs=1.0)  # noqa: E731
+    ours_arx = lambda: arx(u0, y0, LAGS, LAGS, 1, dt=1.0)  # noqa: E731
     fit_arx = _ss_fit(*_abcd(from_polynomial(ours_arx())), uv, yv)
     linear = _sysidentpy(1, LAGS, False, ue, ye)
     m = linear()

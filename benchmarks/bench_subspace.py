@@ -194,7 +194,7 @@ def run(quick: bool) -> list[dict]:
     rng = np.random.default_rng(3)
     uf = rng.standard_normal(1_000_000)
     yf = signal.lfilter([0.2, 0.1], [1.0, -1.2, 0.5], uf) + 0.1 * rng.standard_normal(uf.size)
-    t = measure(lambda: frf(uf, yf, fs=1000.0, nperseg=4096))
+    t = measure(lambda: frf(uf, yf, dt=0.001, nperseg=4096))
 
     def scipy_h1():
         f, pyu = signal.csd(uf, yf, fs=1000.0, nperseg=4096)

@@ -62,7 +62,7 @@ def _fit_data(seed=0):
     true = PiezoActuator(loads=False, d_p=1.49e-6, lam=0.83e-6, beta=0.108, gamma=7.5e-3, a=2.5e-8, b=8e-5,
                          check=False)
     y = true.simulate(U, dt=1 / fs)["y_A"] + 20e-9 * np.random.default_rng(seed).standard_normal(U.size)
-    return Trajectory.uniform(fs, U=U, y_A=y, units={"U": "V", "y_A": "m"}), true
+    return Trajectory.uniform(dt=1 / fs, U=U, y_A=y, units={"U": "V", "y_A": "m"}), true
 
 
 def _kernel_time(m, th, U, fs):
@@ -89,7 +89,7 @@ def _peer_fit(data, true, max_nfev=None):
     from scipy.optimize import least_squares
 
     U, y, t = data["U"], data["y_A"], data.t
-    fs = data.fs
+    fs = 1.0 / data.dt
     slope = np.append(np.diff(U) * fs, 0.0)
     gamma = true.parameters.value("gamma")
     p0 = np.array([true.parameters.value(n) * s for n, s in zip(FREE, START)])
@@ -128,7 +128,7 @@ def _compiled_peer_fit(start, data):
 
     U = np.ascontiguousarray(data["U"][:, None])
     y = data["y_A"]
-    dt = 1.0 / data.fs
+    dt = data.dt
     names = list(start.parameters.names)
     pos = [names.index(n) for n in FREE]
     th0 = start.theta()

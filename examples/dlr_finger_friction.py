@@ -22,7 +22,7 @@ for k in range(t.size):
         v += h * (tau[k] - b * v - fc * np.tanh(v / 1e-4)) / J
         x += h * v
 q = np.round(q / 1e-4) * 1e-4                         # 0.1 mrad encoder
-res = idim_ls(q, tau, fs=fs)
+res = idim_ls(q, tau, dt=1 / fs)
 for name, true in (("inertia", J), ("viscous", b), ("coulomb", fc)):  # σ covers the noise, not the filter's bias
     print(f"{name}: {res.params[name]:.4g} ± {res.std[name]:.2g} (true {true:.4g}, "
           f"{100 * (res.params[name] / true - 1):+.2f} %)")

@@ -16,7 +16,7 @@ force = np.where(np.arange(4000) < 2000, 150e-6, 0.0)  # 150 µN preload, releas
 truth = MassSpringDamper(m=1.8e-6, b=7e-4, k=128.0)
 x = truth.simulate(force, dt=1 / fs)["x"]
 x = x + 0.01 * x.std() * np.random.default_rng(1).standard_normal(x.size)
-data = Trajectory.uniform(fs, F=force, x=x, units={"F": "N", "x": "m"})
+data = Trajectory.uniform(dt=1 / fs, F=force, x=x, units={"F": "N", "x": "m"})
 
 result = fit(MassSpringDamper(m=3e-6, b=1e-3, k=100.0), data, progress=False)
 print(result.summary())

@@ -30,7 +30,7 @@ def record(u, seed):
     r = np.random.default_rng(seed)
     y = plant.simulate(u)
     y = y + 0.05 * y.std(axis=0) * r.standard_normal(y.shape)
-    return Trajectory.uniform(100.0, a=u[:, 0] + 0.85, b=u[:, 1] + 0.85, c=y[:, 0] + 2.0, d=y[:, 1],
+    return Trajectory.uniform(dt=0.01, a=u[:, 0] + 0.85, b=u[:, 1] + 0.85, c=y[:, 0] + 2.0, d=y[:, 1],
                               units={"a": "A", "b": "A", "c": "N", "d": "m"})
 
 
@@ -42,7 +42,7 @@ val = record(0.2 * rng.standard_normal((4000, 2)), seed=2)
 save(est, work / "est.csv")
 save(val, work / "val.csv")
 # a single-input periodic test: crest-factor-optimised multisine, 5 periods → FRF averaged over periods
-ex = periodic_multisine(0.1, 45.0, 100.0, 1000, 5, amplitude=0.2)
+ex = periodic_multisine(0.1, 45.0, 1000, 5, dt=0.01, amplitude=0.2)
 siso = record(np.column_stack([ex.u, np.zeros_like(ex.u)]), seed=3)
 rp = identify(siso, "frf", input="a", output="c", periods=5)
 print(f"multisine crest factor {ex.crest_factor:.2f}; periodic FRF a→c: {rp.frequency_hz.size} lines, "

@@ -31,9 +31,8 @@ NUMBA_KERNELS: dict[tuple[str, str], str] = {
 #: issue 12's split was made, so they were left alone. Remove each entry once that branch is
 #: merged and the function is short (test_allow_list_entries_are_still_needed says which).
 BEING_SPLIT_ELSEWHERE: set[tuple[str, str]] = {
-    # numba kernels: their named-records versions are on branch `records` (the TSFM one landed, still
-    # over 100 lines; the finger's was 8 % slower and did not land, docs/performance.md)
-    ("systems/tsfm/grasp_kernels.py", "_grasp_core"),
+    # numba kernel: its named-records version is on branch `records` (8 % slower, did not land;
+    # docs/performance.md "Named records in kernels")
     ("systems/dlr_hit/finger.py", "_forces"),
 }
 

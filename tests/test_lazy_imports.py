@@ -42,7 +42,6 @@ LAZY_MODULES = {
     ("sysid/linear_model.py", "..lti"): "lti's numba simulation kernel, loaded on the first simulation",
     ("systems/tsfm/grasp_batch.py", ".grasp_gpu"): "numba.cuda: the GPU path only",
     ("io/formats.py", ".mcap_reader"): "the optional mcap extra",
-    ("sysid/friction.py", "..signals.filters"): "scipy.signal (0.85 s)",
 }
 
 

@@ -64,7 +64,7 @@ class FourierTrajectory:
     b: np.ndarray
     q0: np.ndarray
     f0: float
-    fs: float
+    dt: float
     joint_names: tuple
     condition_number: float
     initial_condition_number: float
@@ -88,9 +88,9 @@ class FourierTrajectory:
         return path
 
     def to_dict(self) -> dict:
-        return dict(f0_hz=self.f0, fs_hz=self.fs, harmonics=int(self.a.shape[1]), joints=list(self.joint_names),
+        return dict(f0_hz=self.f0, dt_s=self.dt, harmonics=int(self.a.shape[1]), joints=list(self.joint_names),
                     q0=self.q0.tolist(), a=self.a.tolist(), b=self.b.tolist(), n_samples=int(self.t.size),
-                    duration_s=float(self.t.size / self.fs), condition_number=self.condition_number,
+                    duration_s=float(self.t.size * self.dt), condition_number=self.condition_number,
                     initial_condition_number=self.initial_condition_number,
                     limits={k: np.asarray(v).tolist() for k, v in self.limits.items()}, info=self.info)
 
@@ -105,12 +105,12 @@ def _limit(name, given, from_chain, m, default):
     return v
 
 
-def _check_design(f0: float, fs: float, harmonics, periods) -> None:
-    """DataError unless f0 > 0, fs is above twice the highest harmonic, and ``harmonics`` and
-    ``periods`` are positive integers."""
-    if not (math.isfinite(f0) and f0 > 0) or not (math.isfinite(fs) and fs > 2 * f0 * harmonics):
-        raise DataError(f"f0 = {f0!r} Hz and fs = {fs!r} Hz: need f0 > 0 and fs above twice the highest "
-                        f"harmonic {f0 * harmonics:g} Hz")
+def _check_design(f0: float, dt: float, harmonics, periods) -> None:
+    """DataError unless f0 > 0, dt > 0 samples the highest harmonic above twice its frequency, and
+    ``harmonics`` and ``periods`` are positive integers."""
+    if not (math.isfinite(f0) and f0 > 0) or not (math.isfinite(dt) and dt > 0 and 1.0 / dt > 2 * f0 * harmonics):
+        raise DataError(f"f0 = {f0!r} Hz and dt = {dt!r} s: need f0 > 0 and a sampling rate 1/dt above twice the "
+                        f"highest harmonic {f0 * harmonics:g} Hz")
     if int(harmonics) != harmonics or harmonics < 1 or int(periods) != periods or periods < 1:
         raise DataError(f"harmonics and periods: expected positive integers, found {harmonics!r}, {periods!r}")
 
@@ -211,7 +211,7 @@ def _best_design(design: _Design, restarts: int, max_iterations: int, seed: int)
 
 
 @entry_point
-def fourier_trajectory(chain, *, f0: float = 0.1, harmonics: int = 5, fs: float = 100.0, periods: int = 1,
+def fourier_trajectory(chain, *, f0: float = 0.1, harmonics: int = 5, dt: float = 0.01, periods: int = 1,
                        position_limits=None, velocity_limits=None, acceleration_limits=None,
                        q0=None, friction: bool = True, samples_per_period: int = 200, seed: int = 0,
                        restarts: int = 0, max_iterations: int = 200) -> FourierTrajectory:
@@ -224,8 +224,8 @@ def fourier_trajectory(chain, *, f0: float = 0.1, harmonics: int = 5, fs: float 
         ``parameter_names`` (a gripkit chain); its ``limits`` (URDF) are the defaults.
     f0, harmonics
         Base frequency (Hz; the trajectory's period is 1/f0) and number of harmonics H.
-    fs, periods
-        Sampling rate (Hz) and number of periods of the returned trajectory.
+    dt, periods
+        Sample interval (s) and number of periods of the returned trajectory.
     position_limits
         (lower, upper), each scalar or (m,) (rad or m); default the chain's, else ±π/2.
     velocity_limits, acceleration_limits
@@ -239,7 +239,7 @@ def fourier_trajectory(chain, *, f0: float = 0.1, harmonics: int = 5, fs: float 
     """
     m = int(chain.dof)
     names = tuple(chain.coordinate_names)
-    _check_design(f0, fs, harmonics, periods)
+    _check_design(f0, dt, harmonics, periods)
     H = int(harmonics)
     lim = getattr(chain, "limits", None)
     lo, hi = _position_limits(position_limits, lim, m)
@@ -257,9 +257,9 @@ def fourier_trajectory(chain, *, f0: float = 0.1, harmonics: int = 5, fs: float 
                                   f"within the limits (best condition number {10 ** f:.3g})",
                                   hint="widen the limits, add harmonics or lower f0")
     a, b = design.unpack(x)
-    t = np.arange(int(round(periods * fs / f0))) / fs
+    t = np.arange(int(round(periods / (f0 * dt)))) * dt
     q, qd, qdd = fourier_states(a, b, q0, f0, t)
-    return FourierTrajectory(t, q, qd, qdd, a, b, q0, float(f0), float(fs), names, float(10 ** f), float(first_cond),
+    return FourierTrajectory(t, q, qd, qdd, a, b, q0, float(f0), float(dt), names, float(10 ** f), float(first_cond),
                              dict(lower=lo, upper=hi, velocity=vmax, acceleration=amax),
                              dict(n_base_parameters=int(st.independent.size), friction_columns=bool(friction),
                                   restarts=int(restarts), seed=int(seed)))

@@ -247,15 +247,16 @@ def load_description(path, overrides: Mapping | None = None) -> Description:
         raise ConfigError(f"{path.name}: [simulation] unknown keys {sorted(bad)}", hint="keys: fs or dt, duration")
     if ("fs" in sim) == ("dt" in sim):
         raise ConfigError(f"{path.name}: [simulation] needs exactly one of fs (Hz) or dt (s)")
-    fs = _num(sim, "fs", "[simulation]") if "fs" in sim else 1.0 / _num(sim, "dt", "[simulation]")
+    step = _num(sim, "fs" if "fs" in sim else "dt", "[simulation]")  # the file's fs (Hz) or dt (s)
     duration = _num(sim, "duration", "[simulation]")
-    if fs <= 0 or duration <= 0:
-        raise ConfigError(f"{path.name}: [simulation] fs and duration must be positive")
-    n = duration * fs
+    if step <= 0 or duration <= 0:
+        raise ConfigError(f"{path.name}: [simulation] {'fs' if 'fs' in sim else 'dt'} and duration must be positive")
+    dt = 1.0 / step if "fs" in sim else step
+    n = duration / dt
     if not 1 <= round(n) <= 50_000_000:
-        raise ConfigError(f"{path.name}: [simulation] duration × fs = {n:.4g} samples; expected 1 to 50 million")
+        raise ConfigError(f"{path.name}: [simulation] duration / dt = {n:.4g} samples; expected 1 to 50 million")
     n = int(round(n))
-    t = np.arange(n) / fs
+    t = np.arange(n) * dt
     ispec = _table(raw, "inputs", path.name)
     names = [s.name for s in model.inputs]
     missing = [nm for nm in names if nm not in ispec]
@@ -269,7 +270,7 @@ def load_description(path, overrides: Mapping | None = None) -> Description:
             raise ConfigError(f"{path.name}: inputs.{nm} must be a table ([inputs.{nm}]), found {ispec[nm]!r:.60}")
     ch = {nm: input_signal(ispec[nm], t, f"{path.name} [inputs.{nm}]", path.parent) for nm in names}
     units = {s.name: s.unit for s in model.inputs}
-    inputs = Trajectory(t, ch, units, {"fs": fs, "source": path.name})
+    inputs = Trajectory(t, ch, units, {"dt": dt, "source": path.name})
     out = _table(raw, "output", path.name).get("file")
     if out is not None and not isinstance(out, str):
         raise ConfigError(f"{path.name}: [output] file must be a string (a path), found {out!r:.60}")

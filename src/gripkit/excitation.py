@@ -40,8 +40,8 @@ class Excitation:
         'multisine', 'noise', 'prbs', 'chirp' or 'steps'.
     t, u
         Time (s) and signal (in ``unit``), shape (N,).
-    fs
-        Sampling rate (Hz).
+    dt
+        Sample interval (s).
     operating_point, limits
         Centre value and (lower, upper) bounds, in ``unit``; ``limits[0] <= u <= limits[1]``.
     unit
@@ -53,7 +53,7 @@ class Excitation:
     kind: str
     t: np.ndarray
     u: np.ndarray
-    fs: float
+    dt: float
     operating_point: float
     limits: tuple[float, float]
     unit: str = "1"
@@ -65,7 +65,7 @@ class Excitation:
 
     def to_trajectory(self, name: str = "u") -> Trajectory:
         return Trajectory(self.t, {name: self.u}, {name: self.unit},
-                          {"fs": self.fs, "excitation": self.kind, **self.info})
+                          {"dt": self.dt, "excitation": self.kind, **self.info})
 
 
 def crest_factor(x: np.ndarray) -> float:
@@ -75,20 +75,29 @@ def crest_factor(x: np.ndarray) -> float:
     return float(np.max(np.abs(x)) / rms) if rms > 0 else math.inf
 
 
-def _check_common(duration: float, fs: float, operating_point: float, limits) -> tuple[int, float, float]:
-    if not (np.isfinite(fs) and fs > 0):
-        raise DataError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
+def _check_dt(dt) -> float:
+    """1/dt, the sampling rate the designs' frequency grids use, after checking dt."""
+    if isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating)) \
+            or not (np.isfinite(dt) and dt > 0):
+        raise DataError(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
+    return 1.0 / float(dt)
+
+
+def _check_common(duration: float, dt: float, operating_point: float,
+                  limits) -> tuple[int, float, float, float]:
+    """(samples, lower limit, upper limit, sampling rate 1/dt) of a design, after the checks."""
+    rate = _check_dt(dt)
     if not (np.isfinite(duration) and duration > 0):
         raise DataError(f"duration: expected a positive number of seconds, found {duration!r}")
-    n = int(round(duration * fs))
+    n = int(round(duration * rate))
     if n < 2:
-        raise DataError(f"duration {duration} s at {fs} Hz gives {n} samples; need at least 2")
+        raise DataError(f"duration {duration} s at dt = {dt:g} s gives {n} samples; need at least 2")
     lo, hi = (float(limits[0]), float(limits[1]))
     if not lo < hi:
         raise DataError(f"limits: expected (lower, upper) with lower < upper, found {limits!r}")
     if not lo <= operating_point <= hi:
         raise DataError(f"operating point {operating_point:g} lies outside the limits [{lo:g}, {hi:g}]")
-    return n, lo, hi
+    return n, lo, hi, rate
 
 
 def _place(dev: np.ndarray, operating_point: float, lo: float, hi: float,
@@ -112,23 +121,23 @@ def _place(dev: np.ndarray, operating_point: float, lo: float, hi: float,
     return np.clip(operating_point + scale * dev, lo, hi)
 
 
-def multisine(frequencies: Sequence[float], duration: float, fs: float, *, operating_point: float = 0.0,
+def multisine(frequencies: Sequence[float], duration: float, *, dt: float, operating_point: float = 0.0,
               limits: tuple[float, float] = (-1.0, 1.0), amplitude: float | None = None,
               phases: str = "min-crest", seed: int = 0, iterations: int = 200,
               unit: str = "1") -> Excitation:
     """Sum of equal-amplitude sines  u(t) = u0 + A·Σ_k cos(2π f_k t + φ_k).
 
     ``phases``: 'min-crest' (Schroeder start, then iterative clipping to lower the crest factor;
-    needs the frequencies on the grid fs/N of the record), 'schroeder' (φ_k = -π k(k-1)/K),
+    needs the frequencies on the grid 1/(N·dt) of the record), 'schroeder' (φ_k = -π k(k-1)/K),
     'random' (uniform, ``seed``) or 'zero'.
     """
-    n, lo, hi = _check_common(duration, fs, operating_point, limits)
+    n, lo, hi, rate = _check_common(duration, dt, operating_point, limits)
     f = np.asarray(list(frequencies), dtype=np.float64)
     if f.size == 0:
         raise DataError("multisine needs at least one frequency")
-    if (f <= 0).any() or (f >= fs / 2).any():
-        raise DataError(f"multisine frequencies must lie in (0, fs/2 = {fs / 2:g}) Hz, found {f.tolist()}")
-    t = np.arange(n) / fs
+    if (f <= 0).any() or (f >= rate / 2).any():
+        raise DataError(f"multisine frequencies must lie in (0, 1/(2 dt) = {rate / 2:g}) Hz, found {f.tolist()}")
+    t = np.arange(n) / rate
     k = np.arange(1, f.size + 1)
     if phases == "zero":
         phi = np.zeros(f.size)
@@ -138,7 +147,7 @@ def multisine(frequencies: Sequence[float], duration: float, fs: float, *, opera
         phi = -np.pi * k * (k - 1) / f.size
     else:
         raise DataError(f"phases: expected 'min-crest', 'schroeder', 'random' or 'zero', found {phases!r}")
-    bins = f * n / fs
+    bins = f * n / rate
     on_grid = np.allclose(bins, np.round(bins), atol=1e-6)
     if phases == "min-crest" and on_grid:
         phi = _min_crest_phases(np.round(bins).astype(int), phi, n, iterations)
@@ -146,17 +155,17 @@ def multisine(frequencies: Sequence[float], duration: float, fs: float, *, opera
     u = _place(dev, operating_point, lo, hi, amplitude)
     info = {"frequencies_hz": f.tolist(), "phases_rad": phi.tolist(), "phase_method": phases,
             "periodic": bool(on_grid), "crest_factor": crest_factor(u - operating_point)}
-    return Excitation("multisine", t, u, float(fs), float(operating_point), (lo, hi), unit, info)
+    return Excitation("multisine", t, u, float(dt), float(operating_point), (lo, hi), unit, info)
 
 
-def periodic_multisine(f_min: float, f_max: float, fs: float, period_samples: int, periods: int, *,
+def periodic_multisine(f_min: float, f_max: float, period_samples: int, periods: int, *, dt: float,
                        lines: str = "all", operating_point: float = 0.0, limits: tuple[float, float] = (-1.0, 1.0),
                        amplitude: float | None = None, seed: int = 0, iterations: int = 200,
                        unit: str = "1") -> Excitation:
     """A crest-factor-optimised multisine on chosen DFT lines of one period, repeated an integer
     number of times: the design that :func:`gripkit.sysid.frf` with ``periods`` expects.
 
-    One period has L = ``period_samples`` samples; line k is the frequency k·fs/L (Hz), so every
+    One period has L = ``period_samples`` samples; line k is the frequency k/(L·dt) (Hz), so every
     period is exactly periodic and leakage-free. Lines between ``f_min`` and ``f_max``:
     ``'all'``; ``'odd'`` (odd k only: even nonlinear distortions fall on the even lines);
     ``'random-odd'`` (odd k with one of every three consecutive odd lines left out at random,
@@ -168,7 +177,7 @@ def periodic_multisine(f_min: float, f_max: float, fs: float, period_samples: in
     Examples
     --------
     >>> from gripkit.excitation import periodic_multisine
-    >>> ex = periodic_multisine(1.0, 20.0, 200.0, 400, 4, lines="odd")
+    >>> ex = periodic_multisine(1.0, 20.0, 400, 4, dt=0.005, lines="odd")
     >>> ex.u.size, ex.info["lines"][:3], ex.info["periods"]
     (1600, [3, 5, 7], 4)
     """
@@ -178,9 +187,8 @@ def periodic_multisine(f_min: float, f_max: float, fs: float, period_samples: in
         raise DataError(f"period_samples: expected an integer >= 4, found {period_samples!r}")
     if P < 1 or P != periods:
         raise DataError(f"periods: expected a positive integer, found {periods!r}")
-    if not (np.isfinite(fs) and fs > 0):
-        raise DataError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
-    k = np.arange(max(1, int(math.ceil(f_min * L / fs))), int(math.floor(f_max * L / fs)) + 1)
+    rate = _check_dt(dt)
+    k = np.arange(max(1, int(math.ceil(f_min * L / rate))), int(math.floor(f_max * L / rate)) + 1)
     k = k[k < L / 2]
     if lines == "odd" or lines == "random-odd":
         k = k[k % 2 == 1]
@@ -191,14 +199,14 @@ def periodic_multisine(f_min: float, f_max: float, fs: float, period_samples: in
     elif lines != "all":
         raise DataError(f"lines: expected 'all', 'odd' or 'random-odd', found {lines!r}")
     if k.size == 0:
-        raise DataError(f"no DFT line of a {L}-sample period at {fs:g} Hz (resolution {fs / L:g} Hz) lies in "
+        raise DataError(f"no DFT line of a {L}-sample period at dt = {dt:g} s (resolution {rate / L:g} Hz) lies in "
                         f"[{f_min:g}, {f_max:g}] Hz", hint="lengthen the period or widen the band")
-    one = multisine(k * fs / L, L / fs, fs, operating_point=operating_point, limits=limits, amplitude=amplitude,
+    one = multisine(k * rate / L, L / rate, dt=dt, operating_point=operating_point, limits=limits, amplitude=amplitude,
                     phases="min-crest", seed=seed, iterations=iterations, unit=unit)
     u = np.tile(one.u, P)
-    t = np.arange(u.size) / fs
+    t = np.arange(u.size) / rate
     info = {**one.info, "lines": k.tolist(), "line_selection": lines, "period_samples": L, "periods": P}
-    return Excitation("multisine", t, u, float(fs), float(operating_point), one.limits, unit, info)
+    return Excitation("multisine", t, u, float(dt), float(operating_point), one.limits, unit, info)
 
 
 def _min_crest_phases(bins: np.ndarray, phi0: np.ndarray, n: int, iterations: int) -> np.ndarray:
@@ -221,26 +229,26 @@ def _min_crest_phases(bins: np.ndarray, phi0: np.ndarray, n: int, iterations: in
     return best_phi
 
 
-def bandlimited_noise(f_low: float, f_high: float, duration: float, fs: float, *,
+def bandlimited_noise(f_low: float, f_high: float, duration: float, *, dt: float,
                       operating_point: float = 0.0, limits: tuple[float, float] = (-1.0, 1.0),
                       amplitude: float | None = None, order: int = 4, seed: int = 0,
                       unit: str = "1") -> Excitation:
     """Gaussian white noise through a zero-phase Butterworth band-pass ``[f_low, f_high]`` Hz
     (``f_low = 0`` gives a low-pass), scaled so its extreme just fits the limits."""
-    n, lo, hi = _check_common(duration, fs, operating_point, limits)
-    if not 0 <= f_low < f_high < fs / 2:
-        raise DataError(f"band: expected 0 <= f_low < f_high < fs/2 = {fs / 2:g} Hz, found ({f_low}, {f_high})")
+    n, lo, hi, rate = _check_common(duration, dt, operating_point, limits)
+    if not 0 <= f_low < f_high < rate / 2:
+        raise DataError(f"band: expected 0 <= f_low < f_high < 1/(2 dt) = {rate / 2:g} Hz, found ({f_low}, {f_high})")
     rng = np.random.default_rng(seed)
-    pad = int(3 * fs / max(f_low, f_high / 10, 1e-3))
+    pad = int(3 * rate / max(f_low, f_high / 10, 1e-3))
     w = rng.standard_normal(n + 2 * pad)
-    sos = butter_sos(order, f_high, fs, "lowpass") if f_low == 0 else butter_sos(order, (f_low, f_high), fs, "bandpass")
+    sos = butter_sos(order, f_high, dt=dt) if f_low == 0 else butter_sos(order, (f_low, f_high), dt=dt, btype="bandpass")
     dev = apply_sos(sos, w, zero_phase=True)[pad:pad + n]
     dev -= dev.mean()
-    t = np.arange(n) / fs
+    t = np.arange(n) / rate
     u = _place(dev, operating_point, lo, hi, amplitude)
     info = {"band_hz": [float(f_low), float(f_high)], "order": order, "seed": seed,
             "crest_factor": crest_factor(u - operating_point)}
-    return Excitation("noise", t, u, float(fs), float(operating_point), (lo, hi), unit, info)
+    return Excitation("noise", t, u, float(dt), float(operating_point), (lo, hi), unit, info)
 
 
 # Feedback taps (1-based) of maximal-length Fibonacci LFSRs, register length 2..20.
@@ -250,7 +258,7 @@ _LFSR_TAPS = {2: (2, 1), 3: (3, 2), 4: (4, 3), 5: (5, 3), 6: (6, 5), 7: (7, 6), 
               19: (19, 18, 17, 14), 20: (20, 17)}
 
 
-def prbs(register: int, duration: float, fs: float, *, samples_per_bit: int = 1,
+def prbs(register: int, duration: float, *, dt: float, samples_per_bit: int = 1,
          operating_point: float = 0.0, limits: tuple[float, float] = (-1.0, 1.0),
          amplitude: float | None = None, unit: str = "1") -> Excitation:
     """Maximum-length pseudo-random binary sequence (period 2^register - 1 bits), each bit held
@@ -259,7 +267,7 @@ def prbs(register: int, duration: float, fs: float, *, samples_per_bit: int = 1,
         raise DataError(f"register length: expected 2..20, found {register!r}")
     if int(samples_per_bit) != samples_per_bit or samples_per_bit < 1:
         raise DataError(f"samples_per_bit: expected a positive integer, found {samples_per_bit!r}")
-    n, lo, hi = _check_common(duration, fs, operating_point, limits)
+    n, lo, hi, rate = _check_common(duration, dt, operating_point, limits)
     taps = _LFSR_TAPS[register]
     period = 2 ** register - 1
     state = [1] * register
@@ -272,31 +280,31 @@ def prbs(register: int, duration: float, fs: float, *, samples_per_bit: int = 1,
         state = [fb] + state[:-1]
     seq = np.repeat(2 * bits - 1, int(samples_per_bit))
     dev = np.resize(seq, n)
-    t = np.arange(n) / fs
+    t = np.arange(n) / rate
     u = _place(dev, operating_point, lo, hi, amplitude)
     info = {"register": register, "period_bits": period, "samples_per_bit": int(samples_per_bit)}
-    return Excitation("prbs", t, u, float(fs), float(operating_point), (lo, hi), unit, info)
+    return Excitation("prbs", t, u, float(dt), float(operating_point), (lo, hi), unit, info)
 
 
-def chirp(f0: float, f1: float, duration: float, fs: float, *, method: str = "logarithmic",
+def chirp(f0: float, f1: float, duration: float, *, dt: float, method: str = "logarithmic",
           operating_point: float = 0.0, limits: tuple[float, float] = (-1.0, 1.0),
           amplitude: float | None = None, unit: str = "1") -> Excitation:
     """Swept sine from ``f0`` to ``f1`` Hz ('linear' or 'logarithmic' sweep)."""
     from scipy.signal import chirp as _chirp
 
-    n, lo, hi = _check_common(duration, fs, operating_point, limits)
-    if not (0 < f0 < fs / 2 and 0 < f1 < fs / 2):
-        raise DataError(f"chirp frequencies must lie in (0, fs/2 = {fs / 2:g}) Hz, found {f0}, {f1}")
+    n, lo, hi, rate = _check_common(duration, dt, operating_point, limits)
+    if not (0 < f0 < rate / 2 and 0 < f1 < rate / 2):
+        raise DataError(f"chirp frequencies must lie in (0, 1/(2 dt) = {rate / 2:g}) Hz, found {f0}, {f1}")
     if method not in ("linear", "logarithmic"):
         raise DataError(f"method: expected 'linear' or 'logarithmic', found {method!r}")
-    t = np.arange(n) / fs
+    t = np.arange(n) / rate
     dev = _chirp(t, f0, t[-1], f1, method=method)
     u = _place(dev, operating_point, lo, hi, amplitude)
-    return Excitation("chirp", t, u, float(fs), float(operating_point), (lo, hi), unit,
+    return Excitation("chirp", t, u, float(dt), float(operating_point), (lo, hi), unit,
                       {"f0_hz": f0, "f1_hz": f1, "method": method})
 
 
-def steps(levels: Sequence[float], durations: Sequence[float] | float, fs: float, *,
+def steps(levels: Sequence[float], durations: Sequence[float] | float, *, dt: float,
           limits: tuple[float, float] | None = None, operating_point: float | None = None,
           unit: str = "1") -> Excitation:
     """Piecewise-constant input: hold ``levels[i]`` for ``durations[i]`` s (absolute values, in
@@ -309,13 +317,13 @@ def steps(levels: Sequence[float], durations: Sequence[float] | float, fs: float
         raise DataError(f"steps: {len(levels)} levels but {len(durs)} durations")
     lo, hi = limits if limits is not None else (min(levels), max(levels) if max(levels) > min(levels) else min(levels) + 1)
     op = levels[0] if operating_point is None else float(operating_point)
-    _check_common(sum(durs), fs, op, (lo, hi))
+    rate = _check_common(sum(durs), dt, op, (lo, hi))[3]
     for v in levels:
         if not lo <= v <= hi:
             raise DataError(f"step level {v:g} lies outside the limits [{lo:g}, {hi:g}]")
-    u = np.concatenate([np.full(int(round(d * fs)), v) for v, d in zip(levels, durs)])
-    t = np.arange(u.size) / fs
-    return Excitation("steps", t, u, float(fs), op, (float(lo), float(hi)), unit,
+    u = np.concatenate([np.full(int(round(d * rate)), v) for v, d in zip(levels, durs)])
+    t = np.arange(u.size) / rate
+    return Excitation("steps", t, u, float(dt), op, (float(lo), float(hi)), unit,
                       {"levels": levels, "durations_s": durs})
 
 

@@ -68,7 +68,7 @@ def test_missing_urdf(cli, tmp_path):
     (OK + ["--gravity", "0,0"], "ConfigError", "--gravity: expected three comma-separated numbers"),
     (OK + ["--effort-scale", "0"], "DataError", "--effort-scale: expected a finite non-zero factor"),
     (OK + ["--friction", "lugre"], "DataError", "friction: expected one of none, coulomb-viscous"),
-    (OK + ["--cutoff", "900"], "DataError", "cutoff 900 Hz must lie between 0 and fs/2 = 500 Hz"),
+    (OK + ["--cutoff", "900"], "DataError", "cutoff 900 Hz must lie between 0 and the Nyquist frequency 500 Hz"),
 ])
 def test_bad_options(cli, urdf, tmp_path, args, kind, phrase):
     assert_user_error(cli("identify", "dynamics", urdf, _log(tmp_path), *args), kind, phrase)

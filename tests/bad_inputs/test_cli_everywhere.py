@@ -61,7 +61,7 @@ def files(tmp_path_factory):
     for k in range(2, 400):
         y[k] = 1.5 * y[k - 1] - 0.7 * y[k - 2] + u[k - 1] + 0.5 * u[k - 2]
     y += 0.01 * rng.standard_normal(400)
-    gripkit.io.save(gripkit.Trajectory.uniform(100.0, u=u, y=y), d / "io.csv")
+    gripkit.io.save(gripkit.Trajectory.uniform(dt=0.01, u=u, y=y), d / "io.csv")
     (d / "msd.toml").write_text(MSD)
     (d / "sweep.toml").write_text(SWEEP)
     (d / "junk.toml").write_bytes(JUNK)
@@ -299,7 +299,7 @@ def test_validation_record_that_is_a_folder(cli, files):
     ('k = "20 N/m"', "k = true", "found bool true"),
     ('type = "mass-spring-damper"', 'type = ["a"]', "[model] type must be a string"),
     ("duration = 0.5", 'duration = 0.5\n[output]\nfile = 5', "[output] file must be a string"),
-    ("fs = 1000", "fs = 1e300", "duration × fs = 5e+299 samples; expected 1 to 50 million"),
+    ("fs = 1000", "fs = 1e300", "duration / dt = 5e+299 samples; expected 1 to 50 million"),
     ('[inputs.F]\nkind = "step"\ninitial = 0.0\nfinal = 0.1\ntime = 0.1', "[inputs]\nF = 3",
      "inputs.F must be a table"),
 ])

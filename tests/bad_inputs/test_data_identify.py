@@ -116,7 +116,7 @@ def test_api_fs_tolerance_is_half_a_sample_of_drift(tmp_path):
     drifts 0.6 samples (refused)."""
     u, y = simulate()
     p = write_csv(tmp_path / "r.csv", u, y)
-    assert load(p, fs=FS * (1 + 0.4 / 999)).fs == pytest.approx(FS * (1 + 0.4 / 999))
+    assert load(p, fs=FS * (1 + 0.4 / 999)).dt == pytest.approx(1 / (FS * (1 + 0.4 / 999)))
     with pytest.raises(DataError, match=r"0.6 samples apart \(tolerance: half a sample\)"):
         load(p, fs=FS * (1 + 0.6 / 999))
 
@@ -276,7 +276,7 @@ def test_step_and_modal_identification_at_extreme_scales(scale):
         assert res[key] == pytest.approx(ref[key], rel=1e-6), key
     x = np.exp(-zeta * wn * t) * np.cos(wn * np.sqrt(1 - zeta**2) * t)
     x = x + 1e-4 * np.random.default_rng(1).standard_normal(t.size)
-    ref, res = free_vibration(x, fs), free_vibration(x * scale, fs)
+    ref, res = free_vibration(x, dt=1 / fs), free_vibration(x * scale, dt=1 / fs)
     assert res.natural_frequency_hz == pytest.approx(ref.natural_frequency_hz, rel=1e-9)
     assert res.damping_ratio == pytest.approx(ref.damping_ratio, rel=1e-6)
     assert res.amplitude / scale == pytest.approx(ref.amplitude, rel=1e-6)
@@ -292,7 +292,7 @@ def test_friction_identification_at_extreme_scales(scale):
     q = np.sin(2 * np.pi * np.arange(20000) / 1000)
     qd = np.gradient(q) * 1000
     tau = 0.01 * np.gradient(qd) * 1000 + 0.1 * qd + 0.5 * np.sign(qd)
-    ref, res = idim_ls(q, tau, 1000.0), idim_ls(q * scale, tau * scale, 1000.0)
+    ref, res = idim_ls(q, tau, dt=0.001), idim_ls(q * scale, tau * scale, dt=0.001)
     for k in ("inertia", "viscous"):
         assert res.params[k] == pytest.approx(ref.params[k], rel=1e-2), k
     assert res.params["coulomb"] / scale == pytest.approx(ref.params["coulomb"], rel=1e-2)

@@ -18,13 +18,13 @@ def files(tmp_path_factory):
     rng = np.random.default_rng(0)
     u = rng.standard_normal((3000, 2))
     y = g.simulate(u)
-    save(Trajectory.uniform(100.0, a=u[:, 0], b=u[:, 1], c=y[:, 0], d=y[:, 1]), d / "clean.csv")
-    save(Trajectory.uniform(100.0, a=u[:40, 0], b=u[:40, 1], c=y[:40, 0], d=y[:40, 1]), d / "short.csv")
-    save(Trajectory.uniform(100.0, a=u[:, 0], c=y[:, 0]), d / "only_a.csv")
-    save(Trajectory.uniform(100.0, a=u[:, 0], b=np.full(3000, 0.85), c=y[:, 0], d=y[:, 1]), d / "flat_b.csv")
+    save(Trajectory.uniform(dt=0.01, a=u[:, 0], b=u[:, 1], c=y[:, 0], d=y[:, 1]), d / "clean.csv")
+    save(Trajectory.uniform(dt=0.01, a=u[:40, 0], b=u[:40, 1], c=y[:40, 0], d=y[:40, 1]), d / "short.csv")
+    save(Trajectory.uniform(dt=0.01, a=u[:, 0], c=y[:, 0]), d / "only_a.csv")
+    save(Trajectory.uniform(dt=0.01, a=u[:, 0], b=np.full(3000, 0.85), c=y[:, 0], d=y[:, 1]), d / "flat_b.csv")
     n = np.arange(64 * 60)
     v = np.cos(2 * np.pi * 8 * n / 64) + np.cos(2 * np.pi * 20 * n / 64)
-    tones = Trajectory.uniform(100.0, v=v, x=np.convolve(v, [0.5, 0.3], "same"), w=rng.standard_normal(n.size))
+    tones = Trajectory.uniform(dt=0.01, v=v, x=np.convolve(v, [0.5, 0.3], "same"), w=rng.standard_normal(n.size))
     save(tones, d / "tones.csv")
     return d
 

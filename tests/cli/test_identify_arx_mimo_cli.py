@@ -30,7 +30,7 @@ def _record(n, seed, unstable=False):
     y = np.zeros((n, 2))
     for t in range(1, n):
         y[t] = A @ y[t - 1] + B_TRUE @ u[t - 1] + NOISE * rng.standard_normal(2)
-    return Trajectory.uniform(50.0, a=u[:, 0] + 2.0, b=u[:, 1], c=y[:, 0] - 1.0, d=y[:, 1] + 5.0,
+    return Trajectory.uniform(dt=0.02, a=u[:, 0] + 2.0, b=u[:, 1], c=y[:, 0] - 1.0, d=y[:, 1] + 5.0,
                               units={"a": "V", "b": "V", "c": "N", "d": "m"})
 
 

@@ -25,8 +25,8 @@ SRC = str(Path(__file__).resolve().parents[2] / "src")
 def data(tmp_path_factory):
     d = tmp_path_factory.mktemp("cli")
     plant = finger_force_model()
-    s2 = bandlimited_noise(0.3, 10.0, 20.0, 200.0, operating_point=0.85, limits=(0.6, 1.1), unit="A")
-    s1 = multisine(range(1, 11), 2.0, 200.0, operating_point=0.85, limits=(0.6, 1.1), unit="A")
+    s2 = bandlimited_noise(0.3, 10.0, 20.0, dt=0.005, operating_point=0.85, limits=(0.6, 1.1), unit="A")
+    s1 = multisine(range(1, 11), 2.0, dt=0.005, operating_point=0.85, limits=(0.6, 1.1), unit="A")
     est = plant.simulate(s2.u, noise_std=0.0125, seed=1).select("current", "force")
     val = plant.simulate(np.tile(s1.u, 2), noise_std=0.0125, seed=2).select("current", "force")
     paths = {"est": d / "s2.parquet", "val": d / "s1.csv"}
@@ -82,7 +82,7 @@ def test_rls_json_and_trajectory(capsys, data, tmp_path):
     assert d["theta_final"][0] == pytest.approx(-1.8732, abs=0.05)
     assert d["theta_final"][2] == pytest.approx(195.0 * 0.02502, rel=0.2)  # N/A, Table II × force_scale
     tr = load(traj)
-    assert {"a1", "a2", "b2", "b3", "a1_std"} <= set(tr.names) and tr.fs == pytest.approx(200.0)
+    assert {"a1", "a2", "b2", "b3", "a1_std"} <= set(tr.names) and tr.dt == pytest.approx(0.005)
     assert tr["b3"][-1] == pytest.approx(d["theta_final"][3])
 
 

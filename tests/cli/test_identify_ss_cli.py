@@ -25,15 +25,15 @@ def files(tmp_path_factory):
     out = {}
     for name, seed in (("est", 1), ("val", 2)):
         u, y = oe_data(g, 4000, 0.05, seed)
-        tr = Trajectory.uniform(100.0, a=u[:, 0] + 1.0, b=u[:, 1], c=y[:, 0] + 3.0, d=y[:, 1],
+        tr = Trajectory.uniform(dt=0.01, a=u[:, 0] + 1.0, b=u[:, 1], c=y[:, 0] + 3.0, d=y[:, 1],
                                 units={"a": "V", "b": "V", "c": "N", "d": "m"})
         out[name] = d / f"{name}.csv"
         save(tr, out[name])
-    ex = periodic_multisine(0.05, 5.0, 20.0, 400, 5, amplitude=1.0)
+    ex = periodic_multisine(0.05, 5.0, 400, 5, dt=0.05, amplitude=1.0)
     y = TransferFunction([2.0, 4.0], [1.0, 0.8, 4.0]).c2d(0.05).simulate(ex.u)[:, 0]
     y = y + 0.01 * np.random.default_rng(0).standard_normal(y.size)
     out["siso"] = d / "siso.csv"
-    save(Trajectory.uniform(20.0, v=ex.u, x=y, units={"v": "V", "x": "m"}), out["siso"])
+    save(Trajectory.uniform(dt=0.05, v=ex.u, x=y, units={"v": "V", "x": "m"}), out["siso"])
     out["dir"] = d
     return out
 

@@ -37,7 +37,7 @@ def test_fs_instead_of_time(tmp_path):
     p = tmp_path / "d.csv"
     p.write_text("u,y\n1,2\n3,4\n5,6\n")
     tr = load(p, fs=200.0)
-    assert tr.fs == 200.0
+    assert tr.dt == 0.005
     with pytest.raises(DataError, match="no time column found.*--fs"):
         load(p)
 

@@ -7,8 +7,8 @@ from gripkit import DataError, Trajectory
 
 
 def test_uniform_construction():
-    tr = Trajectory.uniform(200.0, u=np.zeros(400), y=np.arange(400.0), units={"y": "N"})
-    assert tr.fs == 200.0 and tr.n == 400 and tr.unit("y") == "N" and tr.unit("u") == "1"
+    tr = Trajectory.uniform(dt=0.005, u=np.zeros(400), y=np.arange(400.0), units={"y": "N"})
+    assert tr.dt == 0.005 and tr.n == 400 and tr.unit("y") == "N" and tr.unit("u") == "1"
     assert tr.duration == pytest.approx(399 / 200)
     with pytest.raises(ValueError):
         tr["y"][0] = 1.0  # read-only
@@ -18,14 +18,14 @@ def test_nan_reports_count_and_first_time():
     y = np.ones(10)
     y[[3, 5, 6]] = np.nan
     with pytest.raises(DataError, match=r"column 'force' has 3 NaN values \(first at t=0.015 s\).*fill"):
-        Trajectory.uniform(200.0, force=y)
+        Trajectory.uniform(dt=0.005, force=y)
 
 
 def test_inf_reported():
     y = np.ones(10)
     y[2] = np.inf
     with pytest.raises(DataError, match="infinite"):
-        Trajectory.uniform(200.0, force=y)
+        Trajectory.uniform(dt=0.005, force=y)
 
 
 @pytest.mark.parametrize("t, kind", [([0, 1, 1, 2], "repeated"), ([0, 1, 0.5, 2], "decreasing")])
@@ -44,7 +44,7 @@ def test_non_uniform_detected_on_request():
 
 
 def test_require_samples_and_missing_column():
-    tr = Trajectory.uniform(10.0, y=np.zeros(5))
+    tr = Trajectory.uniform(dt=0.1, y=np.zeros(5))
     with pytest.raises(DataError, match="needs at least 8 samples, found 5"):
         tr.require_samples(8, "ARX [4 4 2]")
     with pytest.raises(DataError, match="column 'u' not found; available columns: y"):
@@ -59,7 +59,7 @@ def test_length_mismatch_and_text():
 
 
 def test_window_take_rename():
-    tr = Trajectory.uniform(10.0, y=np.arange(20.0))
+    tr = Trajectory.uniform(dt=0.1, y=np.arange(20.0))
     w = tr.window(0.5, 1.0)
     assert w.n == 5 and w["y"][0] == 5.0
     assert "z" in tr.rename(y="z")

@@ -37,9 +37,9 @@ def test_batch_equals_single_runs():
 
 def test_simulate_accepts_trajectory_and_returns_units():
     model = MassSpringDamper()
-    u = Trajectory.uniform(100.0, F=np.ones(50), units={"F": "N"})
+    u = Trajectory.uniform(dt=0.01, F=np.ones(50), units={"F": "N"})
     out = model.simulate(u)
-    assert out.unit("x") == "m" and out.fs == 100.0 and out.n == 50
+    assert out.unit("x") == "m" and out.dt == 0.01 and out.n == 50
 
 
 def test_errors_name_the_problem():

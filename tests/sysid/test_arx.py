@@ -89,9 +89,9 @@ def test_recovers_from_s2_like_bandlimited_excitation():
     around 850 mA; §V-E) identifies [2 2 2] within 3σ."""
     from gripkit.excitation import bandlimited_noise
 
-    s2 = bandlimited_noise(0.3, 10.0, 20.0, 200.0, operating_point=850.0, limits=(600.0, 1100.0))
+    s2 = bandlimited_noise(0.3, 10.0, 20.0, dt=0.005, operating_point=850.0, limits=(600.0, 1100.0))
     u, y = simulate_arx(4000, noise=1.0, seed=8, u=s2.u - 850.0)
-    m = arx(u, y, 2, 2, 2, fs=200.0)
+    m = arx(u, y, 2, 2, 2, dt=0.005)
     assert m.dt == 0.005
     assert np.all(np.abs(m.theta - THETA222) < 3 * m.theta_std)
 

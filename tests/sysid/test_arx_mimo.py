@@ -62,7 +62,7 @@ def test_identify_dispatches_several_columns_to_mimo_arx():
     from gripkit.sysid import identify
 
     u, y = _data(2000, seed=3)
-    tr = Trajectory.uniform(100.0, u0=u[:, 0], u1=u[:, 1], u2=u[:, 2] + 5.0, y0=y[:, 0], y1=y[:, 1])
+    tr = Trajectory.uniform(dt=0.01, u0=u[:, 0], u1=u[:, 1], u2=u[:, 2] + 5.0, y0=y[:, 0], y1=y[:, 1])
     m = identify(tr, "arx", input="u0,u1,u2", output=["y0", "y1"], na=1, nb=2, nk=1)
     assert m.inputs == ("u0", "u1", "u2") and m.u_offset[2] == pytest.approx(5.0, abs=0.1)
     assert np.all(np.abs(np.asarray(m.info["A_poly"][0]) - A1) <= 4 * np.asarray(m.info["A_poly_std"][0]))

@@ -29,7 +29,7 @@ def test_nan_in_a_trajectory_names_the_column_and_time():
     y = Y.copy()
     y[5] = np.nan
     with pytest.raises(DataError, match=r"column 'force' has 1 NaN values \(first at t=0.025 s\)"):
-        Trajectory.uniform(200.0, current=U, force=y)
+        Trajectory.uniform(dt=0.005, current=U, force=y)
 
 
 @pytest.mark.parametrize("t_bad,kind", [(0.01, "repeated"), (0.0, "decreasing")])
@@ -78,7 +78,7 @@ def test_poorly_exciting_input_names_the_undetermined_parameters():
 
 
 def test_missing_column():
-    tr = Trajectory.uniform(200.0, current=U, force=Y)
+    tr = Trajectory.uniform(dt=0.005, current=U, force=Y)
     with pytest.raises(DataError, match="column 'forse' not found; available columns: current, force"):
         identify(tr, "arx", input="current", output="forse", na=2, nb=2, nk=2)
 

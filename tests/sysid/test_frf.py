@@ -26,7 +26,7 @@ def _coverage(r, k=3.0):
 
 
 def test_periodic_multisine_design():
-    ex = periodic_multisine(0.1, 10.0, 100.0, 1000, 3, lines="odd", amplitude=1.0)
+    ex = periodic_multisine(0.1, 10.0, 1000, 3, dt=0.01, lines="odd", amplitude=1.0)
     L = 1000
     assert ex.u.size == 3 * L and np.allclose(ex.u[:L], ex.u[L:2 * L])
     spec = np.abs(np.fft.rfft(ex.u[:L]))
@@ -36,10 +36,10 @@ def test_periodic_multisine_design():
 
 
 def test_periodic_average_with_sigma():
-    ex = periodic_multisine(0.1, 10.0, 100.0, 1000, 6, amplitude=1.0)
+    ex = periodic_multisine(0.1, 10.0, 1000, 6, dt=0.01, amplitude=1.0)
     rng = np.random.default_rng(0)
     y = G.simulate(ex.u)[:, 0] + 0.01 * rng.standard_normal(ex.u.size)
-    r = frf(ex.u, y, fs=100.0, periods=6)
+    r = frf(ex.u, y, dt=0.01, periods=6)
     assert r.info["periods_used"] == 5 and r.frequency_hz.size == len(ex.info["lines"])
     assert _coverage(r) >= 0.9
     # σ from the spread: σ_H = σ_noise √(L/2)/(|U| √P') on each line within a factor 2
@@ -49,16 +49,16 @@ def test_periodic_average_with_sigma():
 
 
 def test_periodic_keep_transient_changes_periods_used():
-    ex = periodic_multisine(0.5, 10.0, 100.0, 200, 4)
+    ex = periodic_multisine(0.5, 10.0, 200, 4, dt=0.01)
     y = G.simulate(ex.u)[:, 0]
-    assert frf(ex.u, y, fs=100.0, periods=4, keep_transient=True).info["periods_used"] == 4
+    assert frf(ex.u, y, dt=0.01, periods=4, keep_transient=True).info["periods_used"] == 4
 
 
 def test_h1_coverage_and_coherence():
     rng = np.random.default_rng(1)
     u = rng.standard_normal(100000)
     y = G.simulate(u)[:, 0] + 0.05 * rng.standard_normal(u.size)
-    r = frf(u, y, fs=100.0, nperseg=512)
+    r = frf(u, y, dt=0.01, nperseg=512)
     assert _coverage(r) >= 0.9
     assert np.all((r.coherence >= 0) & (r.coherence <= 1))
     # SISO: σ² = |H|²(1 − γ²)/((K − 1)γ²) · 1.056 (Bendat & Piersol eq 9.90)
@@ -72,7 +72,7 @@ def test_spa_coverage():
     rng = np.random.default_rng(2)
     u = rng.standard_normal(20000)
     y = G.simulate(u)[:, 0] + 0.05 * rng.standard_normal(u.size)
-    assert _coverage(frf(u, y, fs=100.0, method="spa", lag_window=200)) >= 0.9
+    assert _coverage(frf(u, y, dt=0.01, method="spa", lag_window=200)) >= 0.9
 
 
 def test_mimo_h1_recovers_each_entry():
@@ -93,7 +93,7 @@ def test_line_without_excitation_has_infinite_sigma():
     y = G.simulate(u)[:, 0]
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        r = frf(u, y, fs=100.0, nperseg=64)
+        r = frf(u, y, dt=0.01, nperseg=64)
     assert any(issubclass(w.category, AccuracyWarning) and "no input power" in str(w.message) for w in caught)
     excited = np.isfinite(r.H_std[:, 0, 0])
     assert np.flatnonzero(excited).tolist() == [7, 8, 9, 19, 20, 21]
@@ -103,4 +103,4 @@ def test_line_without_excitation_has_infinite_sigma():
 def test_non_periodic_input_refused():
     u = np.random.default_rng(0).standard_normal(3000)
     with pytest.raises(DataError, match="not periodic"):
-        frf(u, u, fs=100.0, periods=3)
+        frf(u, u, dt=0.01, periods=3)

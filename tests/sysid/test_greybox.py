@@ -21,7 +21,7 @@ def measured(seed, noise=0.01, n=2000, amplitude=1e-4):
     y = model.simulate(u, dt=1 / FS)["x"]
     rng = np.random.default_rng(seed)
     y = y + noise * np.std(y) * rng.standard_normal(n)
-    return Trajectory.uniform(FS, F=u, x=y, units={"F": "N", "x": "m"})
+    return Trajectory.uniform(dt=1 / FS, F=u, x=y, units={"F": "N", "x": "m"})
 
 
 def start_model():
@@ -66,7 +66,7 @@ def test_static_data_cannot_determine_mass_and_damping():
     n, F = 1000, 1e-4
     x_eq = F / TRUE["k"]
     y = x_eq + 1e-3 * x_eq * np.random.default_rng(0).standard_normal(n)
-    data = Trajectory.uniform(FS, F=np.full(n, F), x=y)
+    data = Trajectory.uniform(dt=1 / FS, F=np.full(n, F), x=y)
     model = start_model().with_parameters(check=False, k=TRUE["k"])
     with pytest.warns(AccuracyWarning, match=r"m is not determined.*b is not determined"):
         res = fit(model, data, free=["m", "b"], x0=np.array([x_eq, 0.0]), progress=False)
@@ -80,7 +80,7 @@ def test_bad_requests():
         fit(start_model(), data, free=["q"], progress=False)
     with pytest.raises(DataError, match="none of the model outputs"):
         fit(start_model(), data.rename(x="pos"), progress=False)
-    flat = Trajectory.uniform(FS, F=np.ones(100), x=np.zeros(100))
+    flat = Trajectory.uniform(dt=1 / FS, F=np.ones(100), x=np.zeros(100))
     with pytest.raises(DataError, match="may be constant"):
         fit(start_model(), flat, progress=False)
 

@@ -66,7 +66,7 @@ def test_pem_refinement_keeps_the_validation_fit(record):
 def test_arx_validation_fit_on_held_out_half(record):
     """ARX [4 4 1]: the free-run fit on the held-out half beats the first-order ARX by > 5 points."""
     ue, ye = record[3]["est"]
-    fits = [_validation_fit(from_polynomial(arx(ue, ye, n, n, 1, fs=1.0)), record[3]) for n in (1, 4)]
+    fits = [_validation_fit(from_polynomial(arx(ue, ye, n, n, 1, dt=1.0)), record[3]) for n in (1, 4)]
     assert fits[1] >= 47.0 and fits[1] > fits[0] + 5.0
 
 

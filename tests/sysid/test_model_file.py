@@ -84,7 +84,7 @@ def test_simulate_and_compare_data_by_name(model):
 
     g = two_by_two()
     u, y = oe_data(g, 1500, 0.0, seed=8)
-    tr = Trajectory.uniform(100.0, b=u[:, 1], a=u[:, 0] + 1.0, c=y[:, 0] + 3.0, d=y[:, 1] - 1.0)
+    tr = Trajectory.uniform(dt=0.01, b=u[:, 1], a=u[:, 0] + 1.0, c=y[:, 0] + 3.0, d=y[:, 1] - 1.0)
     fit, ys = model.compare_data(tr)
     assert min(fit) > 99.0
     with warnings.catch_warnings():

@@ -157,8 +157,8 @@ def test_rls_errors():
 
 def test_trajectory_export():
     u, y = simulate_arx(500, noise=1.0, seed=25)
-    r = rls(u, y, 2, 2, 2, forgetting=0.99, fs=200.0)
+    r = rls(u, y, 2, 2, 2, forgetting=0.99, dt=0.005)
     tr = r.to_trajectory()
     assert {"a1", "b3", "a1_std", "y_pred", "error"} <= set(tr.names)
-    assert tr.fs == pytest.approx(200.0)
+    assert tr.dt == pytest.approx(0.005)
     np.testing.assert_allclose(tr["a1"][-1], r.theta_final[0])

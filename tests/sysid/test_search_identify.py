@@ -42,14 +42,13 @@ def test_parse_range():
 
 def test_identify_trajectory_removes_operating_point():
     """With the input centred on 850 mA and detrend='mean' (default) the Trajectory entry point
-    gives the same model as arx() on the centred arrays, with units and fs from the data."""
+    gives the same model as arx() on the centred arrays, with units and dt from the data."""
     u, y = simulate_arx(2000, noise=1.0, seed=52)
-    tr = Trajectory.uniform(200.0, current=0.850 + 1e-3 * u, force=12.0 + y,
-                            units={"current": "A", "force": "N"})
+    tr = Trajectory.uniform(dt=0.005, current=0.850 + 1e-3 * u, force=12.0 + y, units={"current": "A", "force": "N"})
     m = identify(tr, "arx", input="current", output="force", na=2, nb=2, nk=2)
     ref = arx(1e-3 * u - np.mean(1e-3 * u), y - y.mean(), 2, 2, 2)
     np.testing.assert_allclose(m.theta, ref.theta, rtol=1e-9)
-    assert m.fs == 200.0 and m.u_offset == pytest.approx(0.850 + 1e-3 * u.mean())
+    assert m.dt == 0.005 and m.u_offset == pytest.approx(0.850 + 1e-3 * u.mean())
     assert m.parameters["b2"].unit == "N/A" and m.input_name == "current"
     raw = identify(tr, "arx", input="current", output="force", na=2, nb=2, nk=2, detrend="none")
     assert np.max(np.abs(raw.theta - ref.theta) / ref.theta_std) > 3  # the offset biases the fit
@@ -57,7 +56,7 @@ def test_identify_trajectory_removes_operating_point():
 
 def test_identify_dispatches_every_method():
     u, y = simulate_arx(1500, noise=1.0, seed=53)
-    tr = Trajectory.uniform(200.0, u=u, y=y)
+    tr = Trajectory.uniform(dt=0.005, u=u, y=y)
     assert identify(tr, "oe", input="u", output="y", nb=2, na=2, nk=2).structure == "oe"
     assert identify(tr, "armax", input="u", output="y", na=2, nb=2, nc=1, nk=2).structure == "armax"
     assert identify(tr, "rls", input="u", output="y", na=2, nb=2, nk=2, forgetting=0.99).forgetting == 0.99

@@ -30,11 +30,11 @@ def test_time_domain_recovery_within_sigma():
 
 
 def test_from_periodic_frf_within_sigma():
-    ex = periodic_multisine(0.02, 5.0, 20.0, 2000, 5, amplitude=1.0)
+    ex = periodic_multisine(0.02, 5.0, 2000, 5, dt=0.05, amplitude=1.0)
     rng = np.random.default_rng(1)
     y = G.c2d(0.05).simulate(ex.u)[:, 0] + 0.02 * rng.standard_normal(ex.u.size)
     # the data were sampled with a zero-order hold: the FRF is compared with G's ZOH equivalent
-    r = frf(ex.u, y, fs=20.0, periods=5)
+    r = frf(ex.u, y, dt=0.05, periods=5)
     m = tfest_frf(r, 2, 1, dt=0.05)
     den, num = m.system.denominator(), m.system.numerator()
     assert np.all(np.abs(den[1:] - [0.8, 4.0]) <= 4 * m.info["den_std"][1:])
@@ -75,8 +75,8 @@ def test_noise_free_periodic_frf_exact(g):
     """The FRF of noise-free periodic data is G's ZOH equivalent on every line (transient dropped):
     tfest_frf through the hold recovers G to ~1e-8 relative."""
     nz = g.numerator().size - 1
-    ex = periodic_multisine(0.02, 5.0, 20.0, 2000, 5, amplitude=1.0)
-    r = frf(ex.u, g.c2d(0.05).simulate(ex.u)[:, 0], fs=20.0, periods=5)
+    ex = periodic_multisine(0.02, 5.0, 2000, 5, dt=0.05, amplitude=1.0)
+    r = frf(ex.u, g.c2d(0.05).simulate(ex.u)[:, 0], dt=0.05, periods=5)
     m = tfest_frf(r, 2, nz, dt=0.05)
     truth = _coefficients(g, nz)
     assert np.max(np.abs(_coefficients(m.system, nz) - truth) / np.abs(truth)) < 1e-8

@@ -73,7 +73,7 @@ def test_independence_test_is_calibrated_for_a_multisine_input():
     rejects at α = 0.05 in about 5 % of runs (a plain χ²(L+1) statistic would never reject)."""
     from gripkit.excitation import multisine
 
-    s1 = multisine(range(1, 11), 2.0, 200.0, operating_point=0.85, limits=(0.6, 1.1)).u
+    s1 = multisine(range(1, 11), 2.0, dt=0.005, operating_point=0.85, limits=(0.6, 1.1)).u
     rng = np.random.default_rng(33)
     rej = np.mean([not residual_tests(rng.standard_normal(400), s1, alpha=0.05).independent
                    for _ in range(200)])

@@ -23,7 +23,7 @@ def plant() -> FingerForcePlant:
 
 def test_registry_builds_the_plant(plant):
     assert plant.name == "amadeus-finger-force" and plant.description
-    assert plant.fs == 200.0 and plant.delay == 2 and plant.operating_point == 0.850
+    assert plant.dt == 0.005 and plant.delay == 2 and plant.operating_point == 0.850
 
 
 def test_coefficients_units_and_provenance(plant):
@@ -43,10 +43,10 @@ def test_coefficients_units_and_provenance(plant):
 
 
 def test_simulate_from_rest_and_with_given_past(plant):
-    s1 = multisine(range(1, 11), 2.0, 200.0, operating_point=0.850, limits=(0.600, 1.100), unit="A")
+    s1 = multisine(range(1, 11), 2.0, dt=0.005, operating_point=0.850, limits=(0.600, 1.100), unit="A")
     tr = plant.simulate(s1.u)
     f = tr["force"]
-    assert tr.unit("force") == "N" and tr.unit("current") == "A" and tr.fs == 200.0
+    assert tr.unit("force") == "N" and tr.unit("current") == "A" and tr.dt == 0.005
     assert f[0] == f[1] == 0.0  # two-sample delay, at rest before t = 0
     # force = B/A (i − 0.850 A): the same as the model's own simulation and the state space
     np.testing.assert_allclose(f, plant.model.simulate(s1.u - 0.850))
@@ -63,7 +63,7 @@ def test_simulated_plant_is_identified_back(plant):
     """Noisy simulation with the S1 input, identified with the Trajectory entry point: the
     estimates contain the plant's coefficients within 3σ (equation-error noise is not what we add,
     so use a small noise: the ARX bias stays well below σ)."""
-    s1 = multisine(range(1, 11), 2.0, 200.0, operating_point=0.850, limits=(0.600, 1.100), unit="A")
+    s1 = multisine(range(1, 11), 2.0, dt=0.005, operating_point=0.850, limits=(0.600, 1.100), unit="A")
     tr = plant.simulate(np.tile(s1.u, 3), noise_std=0.00125, seed=1)
     dev = tr.with_channels(current=tr["current"] - plant.operating_point)  # the plant's input variable
     m = identify(dev, "arx", input="current", output="force", na=2, nb=2, nk=2, detrend="none")

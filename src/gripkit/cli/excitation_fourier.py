@@ -42,7 +42,7 @@ def excitation_fourier(
 
     chain = from_urdf(urdf, base_link=base_link, tip_link=tip_link)
     status(f"optimising {2 * chain.dof * harmonics} Fourier coefficients of {chain.name} ...")
-    tr = fourier_trajectory(chain, f0=f0, harmonics=harmonics, fs=fs, periods=periods,
+    tr = fourier_trajectory(chain, f0=f0, harmonics=harmonics, dt=1.0 / fs, periods=periods,
                             velocity_limits=velocity_limit, acceleration_limits=acceleration_limit,
                             restarts=restarts, seed=seed)
     tr.to_csv(out)

@@ -52,7 +52,7 @@ def _vector(option: str, text: str) -> np.ndarray:
     return v
 
 
-def _idim_states(tr, pcols, ecols, vcols, effort_scale: float, rate: float, cutoff, decimate):
+def _idim_states(tr, pcols, ecols, vcols, effort_scale: float, dt: float, cutoff, decimate):
     """The IDIM-LS signal chain (:func:`gripkit.sysid.friction.idim_samples`) on the position and
     effort columns; with measured velocities, q̇ and q̈ come from them through the same filter and
     decimation. Returns the samples and q, q̇, q̈."""
@@ -60,10 +60,10 @@ def _idim_states(tr, pcols, ecols, vcols, effort_scale: float, rate: float, cuto
 
     P = np.column_stack([tr[c] for c in pcols])
     E = np.column_stack([tr[c] for c in ecols]) * effort_scale
-    st = idim_samples(P, E, rate, cutoff=cutoff, decimation=decimate)
+    st = idim_samples(P, E, dt=dt, cutoff=cutoff, decimation=decimate)
     q, qd, qdd = st.position, st.velocity, st.acceleration
     if vcols is not None:
-        sv = idim_samples(np.column_stack([tr[c] for c in vcols]), E, rate, cutoff=st.cutoff,
+        sv = idim_samples(np.column_stack([tr[c] for c in vcols]), E, dt=dt, cutoff=st.cutoff,
                           decimation=st.decimation)
         qd, qdd = sv.position, sv.velocity
     return st, q, qd, qdd
@@ -96,7 +96,7 @@ def _write_model_and_report(res, st, states, weights, lines, *, urdf: Path, data
         from ..sysid.dynamics_report import write_dynamics_report
 
         q, qd, qdd = states
-        t = np.arange(q.shape[0]) * st.decimation / st.fs
+        t = np.arange(q.shape[0]) * st.decimation * st.dt
         write_dynamics_report(res, t, q, qd, qdd, st.effort, report, weights=weights,
                               data_name=Path(data).name, warnings_list=list(st.notes) + lines)
 
@@ -166,10 +166,10 @@ def identify_dynamics_cmd(
     ecols = _columns("--effort", effort, joints)
     vcols = _columns("--velocity", velocity, joints)
     tr = load_data(data, list(dict.fromkeys(pcols + ecols + (vcols or []))), fs, time, fill)
-    rate = tr.require_uniform(why="inverse-dynamics identification (filtering and differentiation)")
+    dt = tr.require_uniform(why="inverse-dynamics identification (filtering and differentiation)")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        st, q, qd, qdd = _idim_states(tr, pcols, ecols, vcols, effort_scale, rate, cutoff, decimate)
+        st, q, qd, qdd = _idim_states(tr, pcols, ecols, vcols, effort_scale, dt, cutoff, decimate)
         weights = _moving_rows(qd, st, joints, data)
         res = identify_dynamics(chain, q, qd, qdd, st.effort, friction=friction, weights=weights,
                                 armature=armature, covariance="hac", constrained=constrained)
@@ -178,7 +178,7 @@ def identify_dynamics_cmd(
     _write_model_and_report(res, st, (q, qd, qdd), weights, lines, urdf=urdf, data=data, base_link=base_link,
                             tip_link=tip_link, out=out, report=report)
     summary = dict(urdf=str(urdf), data=str(data), chain=chain.name,
-                   columns=dict(position=pcols, effort=ecols, velocity=vcols), fs=rate, cutoff_hz=st.cutoff,
+                   columns=dict(position=pcols, effort=ecols, velocity=vcols), fs=1.0 / dt, cutoff_hz=st.cutoff,
                    decimation=st.decimation, **res.to_dict())
     summary["notes"] = notes
     summary["warnings"] = lines

@@ -44,14 +44,14 @@ def identify_friction(
     check_number(velocity_threshold, "--velocity-threshold", minimum=0)
     with collected_warnings() as caught:
         tr = load_data(data, [position, effort], fs, time, fill)
-        rate = tr.require_uniform(why="IDIM-LS (filtering and differentiation)")
-        res = idim_ls(tr[position], tr[effort], rate, effort_scale=effort_scale, cutoff=cutoff,
+        dt = tr.require_uniform(why="IDIM-LS (filtering and differentiation)")
+        res = idim_ls(tr[position], tr[effort], dt=dt, effort_scale=effort_scale, cutoff=cutoff,
                       decimation=decimate, velocity_threshold=velocity_threshold)
     pu = tr.unit(position)
     eu = tr.unit(effort) if effort_scale == 1.0 else f"{effort_scale:g}*{tr.unit(effort)}"
     units = {"inertia": f"({eu})*s^2/{pu}", "viscous": f"({eu})*s/{pu}", "coulomb": eu, "offset": eu}
     out = {"params": res.params, "std": res.std, "relative_error_percent": res.relative_error_percent,
-           "units": units, "n_samples": res.n_samples, "fs": res.fs, "cutoff_hz": res.cutoff,
+           "units": units, "n_samples": res.n_samples, "fs": 1.0 / res.dt, "cutoff_hz": res.cutoff,
            "decimation": res.decimation, "condition_number": res.condition_number,
            "notes": res.notes, "warnings": report_warnings(caught)}
     if json_out:

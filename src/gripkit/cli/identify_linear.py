@@ -97,7 +97,7 @@ def _print_model(model, val) -> None:
 
     con = Console()
     t = Table("parameter", "value", "σ", title=f"{model.label}  ({model.input_name} → {model.output_name}, "
-                                               f"fs = {model.fs:g} Hz, N = {model.n_samples})")
+                                               f"fs = {1.0 / model.dt:g} Hz, N = {model.n_samples})")
     std = model.theta_std
     for i, (n, v) in enumerate(zip(model.parameter_names, model.theta)):
         t.add_row(n, f"{v:.6g}", "—" if std is None else f"{std[i]:.3g}")

@@ -43,9 +43,9 @@ def identify_modal(data: Path = DataArg,
         raise DataError(f"--start: expected the release time in s (a finite number), found {start}")
     with collected_warnings() as caught:
         tr = load_data(data, [signal], fs, time, fill)
-        rate = tr.require_uniform(why="free-vibration analysis")
-        i0 = None if start is None else int(round((start - tr.t[0]) * rate))
-        res = free_vibration(tr[signal], rate, start=i0)
+        dt = tr.require_uniform(why="free-vibration analysis")
+        i0 = None if start is None else int(round((start - tr.t[0]) / dt))
+        res = free_vibration(tr[signal], dt=dt, start=i0)
     out = res.to_dict()
     out.update(data=str(data), signal=signal, unit=tr.unit(signal), warnings=report_warnings(caught))
     if json_out:

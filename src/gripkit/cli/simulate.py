@@ -42,7 +42,7 @@ def simulate(model: Path = typer.Argument(..., help="Model description (.toml) o
         d = load_description(model)
         if out is None:
             output_file(d.output, f"[output] file of {model.name}")
-        status(f"simulating {d.model.name}: {d.inputs.n} samples at {d.inputs.fs:g} Hz")
+        status(f"simulating {d.model.name}: {d.inputs.n} samples at {1.0 / d.inputs.dt:g} Hz")
         tr = d.model.simulate(d.inputs)
     lines = report_warnings(caught)
     target = out or d.output
@@ -50,12 +50,12 @@ def simulate(model: Path = typer.Argument(..., help="Model description (.toml) o
         save(tr, target)
     summary = {n: {"unit": tr.unit(n), "min": float(np.min(tr[n])), "max": float(np.max(tr[n])),
                    "final": float(tr[n][-1])} for n in tr.names}
-    res = {"model": d.model.name, "description": str(model), "samples": tr.n, "fs": tr.fs,
+    res = {"model": d.model.name, "description": str(model), "samples": tr.n, "fs": 1.0 / tr.dt,
            "duration_s": tr.duration, "out": None if target is None else str(target), "channels": summary,
            "warnings": lines}
     if json_out:
         emit_json(res)
         return
-    typer.echo(f"{d.model.name}: {tr.n} samples at {tr.fs:g} Hz" + (f", written to {target}" if target else ""))
+    typer.echo(f"{d.model.name}: {tr.n} samples at {1.0 / tr.dt:g} Hz" + (f", written to {target}" if target else ""))
     for n, s in summary.items():
         typer.echo(f"  {n} [{s['unit']}]: min {s['min']:.6g}, max {s['max']:.6g}, final {s['final']:.6g}")

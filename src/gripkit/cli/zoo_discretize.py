@@ -4,6 +4,8 @@ and the block form of eq 18)."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import typer
 
@@ -22,6 +24,8 @@ def zoo_discretize(name: str = typer.Argument(..., help="Zoo model name (gripkit
     from ..errors import ModelError
     from .zoo import _build
 
+    if not (math.isfinite(fs) and fs > 0):
+        raise ModelError(f"--fs: expected a positive sampling rate in Hz, found {fs!r}")
     model = _build(name)
     if not hasattr(model, "discrete"):
         from .. import zoo
@@ -29,7 +33,7 @@ def zoo_discretize(name: str = typer.Argument(..., help="Zoo model name (gripkit
         ok = [e.name for e in zoo.entries() if e.name.startswith("ftg100") and hasattr(_build(e.name), "discrete")]
         raise ModelError(f"zoo model {name!r} has no linear continuous-time form to discretise",
                          hint=f"discretize works on: {', '.join(ok)}")
-    sys = model.discrete(fs, form=form)
+    sys = model.discrete(dt=1.0 / fs, form=form)
     dc = sys.dc_gain()
     dc_out = float(dc[0, 0]) if dc.shape == (1, 1) else dc[:, 0].tolist()
     out = {"name": name, "fs": float(fs), "dt": float(sys.dt), "form": sys.meta.get("form", form),

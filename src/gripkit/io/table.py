@@ -220,10 +220,10 @@ def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
         meta = {"source": source, "time_column": tname}
         if fs is not None:
             _check_fs_against_time(source, tname, t, float(fs))
-            meta["fs"] = float(fs)
+            meta["dt"] = 1.0 / float(fs)  # the nominal interval: gripkit speaks dt inside
     else:
         t = np.arange(n) / float(fs)
-        meta = {"source": source, "fs": float(fs)}
+        meta = {"source": source, "dt": 1.0 / float(fs)}
     t, data = _fill(t, data, fill)
     _warn_corrupt(source, t, data, su)
     if tname is not None:

@@ -1,11 +1,12 @@
 """Butterworth filtering in second-order sections, causal or zero-phase.
 
 The AMADEUS identification (``000_8f66dcc7ab06470c.txt`` §V-D) filters force data with a
-second-order low-pass Butterworth, f_c = 9 Hz at fs = 200 Hz, "adding two poles at
+second-order low-pass Butterworth, f_c = 9 Hz at 200 Hz (dt = 5 ms), "adding two poles at
 z = 0.8021 ± j0.1648 and two zeros at z = -1": :func:`butter_zpk` reproduces those numbers.
 
-Filtering functions accept a 1-D array (with ``fs``) or a :class:`Trajectory` (with the
-channel names to filter; ``fs`` is taken from the trajectory, which must be uniformly sampled).
+Filtering functions accept a 1-D array (with its sample interval ``dt`` in s) or a
+:class:`Trajectory` (with the channel names to filter; ``dt`` is taken from the trajectory, which
+must be uniformly sampled). Cutoff frequencies are in Hz.
 """
 
 from __future__ import annotations
@@ -27,42 +28,47 @@ def _signal():
 __all__ = ["butter_sos", "butter_zpk", "butter_ba", "apply_sos", "lowpass", "highpass", "bandpass"]
 
 
-def _check_design(order: int, cutoff, fs: float, btype: str) -> np.ndarray:
+def _check_design(order: int, cutoff, dt: float, btype: str) -> tuple[np.ndarray, float]:
+    """(cutoff frequencies in Hz, sampling rate 1/dt) after the checks."""
     if int(order) != order or order < 1:
         raise DataError(f"filter order: expected a positive integer, found {order!r}")
-    if not (np.isfinite(fs) and fs > 0):
-        raise DataError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
+    if isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating)) \
+            or not (np.isfinite(dt) and dt > 0):
+        raise DataError(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
+    rate = 1.0 / float(dt)
     wn = np.atleast_1d(np.asarray(cutoff, dtype=np.float64))
     need = 2 if btype in ("bandpass", "bandstop") else 1
     if wn.size != need:
         raise DataError(f"{btype} filter needs {need} cutoff frequencies, found {wn.size}")
-    nyq = fs / 2
+    nyq = rate / 2
     if (wn <= 0).any() or (wn >= nyq).any():
-        raise DataError(f"cutoff {cutoff} Hz must lie strictly between 0 and fs/2 = {nyq:g} Hz")
+        raise DataError(f"cutoff {cutoff} Hz must lie strictly between 0 and the Nyquist frequency "
+                        f"1/(2 dt) = {nyq:g} Hz")
     if need == 2 and wn[0] >= wn[1]:
         raise DataError(f"band edges must increase, found {wn[0]:g} >= {wn[1]:g} Hz")
-    return wn
+    return wn, rate
 
 
-def butter_sos(order: int, cutoff, fs: float, btype: str = "lowpass") -> np.ndarray:
+def butter_sos(order: int, cutoff, *, dt: float, btype: str = "lowpass") -> np.ndarray:
     """Digital Butterworth design as second-order sections, shape (ceil(order/2), 6).
 
-    ``cutoff`` in Hz (a pair for band filters); bilinear transform with pre-warping at ``fs``.
+    ``cutoff`` in Hz (a pair for band filters); bilinear transform with pre-warping at the
+    sampling rate 1/``dt``.
     """
-    wn = _check_design(order, cutoff, fs, btype)
-    return _signal().butter(int(order), wn if wn.size > 1 else wn[0], btype=btype, fs=fs, output="sos")
+    wn, rate = _check_design(order, cutoff, dt, btype)
+    return _signal().butter(int(order), wn if wn.size > 1 else wn[0], btype=btype, fs=rate, output="sos")
 
 
-def butter_zpk(order: int, cutoff, fs: float, btype: str = "lowpass"):
+def butter_zpk(order: int, cutoff, *, dt: float, btype: str = "lowpass"):
     """Zeros, poles and gain of the digital Butterworth filter (z-plane)."""
-    wn = _check_design(order, cutoff, fs, btype)
-    return _signal().butter(int(order), wn if wn.size > 1 else wn[0], btype=btype, fs=fs, output="zpk")
+    wn, rate = _check_design(order, cutoff, dt, btype)
+    return _signal().butter(int(order), wn if wn.size > 1 else wn[0], btype=btype, fs=rate, output="zpk")
 
 
-def butter_ba(order: int, cutoff, fs: float, btype: str = "lowpass"):
+def butter_ba(order: int, cutoff, *, dt: float, btype: str = "lowpass"):
     """Transfer-function coefficients (b, a) in powers of z^-1 (for analysis; filter with SOS)."""
-    wn = _check_design(order, cutoff, fs, btype)
-    return _signal().butter(int(order), wn if wn.size > 1 else wn[0], btype=btype, fs=fs, output="ba")
+    wn, rate = _check_design(order, cutoff, dt, btype)
+    return _signal().butter(int(order), wn if wn.size > 1 else wn[0], btype=btype, fs=rate, output="ba")
 
 
 def apply_sos(sos: np.ndarray, x: np.ndarray, zero_phase: bool = False) -> np.ndarray:
@@ -86,33 +92,32 @@ def apply_sos(sos: np.ndarray, x: np.ndarray, zero_phase: bool = False) -> np.nd
     return y
 
 
-def _filter(x, sos_fn, order, cutoff, fs, zero_phase, channels):
+def _filter(x, btype, order, cutoff, dt, zero_phase, channels):
     if isinstance(x, Trajectory):
-        fs_tr = x.require_uniform(why="digital filtering")
-        if fs is not None and abs(fs - fs_tr) > 1e-9 * fs_tr:
-            raise DataError(f"fs={fs} Hz given, but the trajectory is sampled at {fs_tr:g} Hz")
-        sos = sos_fn(order, cutoff, fs_tr)
+        dt_tr = x.require_uniform(why="digital filtering")
+        if dt is not None and abs(dt - dt_tr) > 1e-9 * dt_tr:
+            raise DataError(f"dt={dt:g} s given, but the trajectory is sampled every {dt_tr:g} s")
+        sos = butter_sos(order, cutoff, dt=dt_tr, btype=btype)
         names = channels if channels is not None else x.names
         return x.with_channels(**{n: apply_sos(sos, x[n], zero_phase) for n in names})
-    if fs is None:
-        raise DataError("fs is required to filter a plain array")
-    sos = sos_fn(order, cutoff, fs)
-    return apply_sos(sos, x, zero_phase)
+    if dt is None:
+        raise DataError("dt (the sample interval in s) is required to filter a plain array")
+    return apply_sos(butter_sos(order, cutoff, dt=dt, btype=btype), x, zero_phase)
 
 
-def lowpass(x, cutoff: float, fs: float | None = None, order: int = 2, zero_phase: bool = False,
+def lowpass(x, cutoff: float, *, dt: float | None = None, order: int = 2, zero_phase: bool = False,
             channels: Sequence[str] | None = None):
     """Butterworth low-pass (``cutoff`` Hz). Causal by default; ``zero_phase`` for offline use."""
-    return _filter(x, lambda o, c, f: butter_sos(o, c, f, "lowpass"), order, cutoff, fs, zero_phase, channels)
+    return _filter(x, "lowpass", order, cutoff, dt, zero_phase, channels)
 
 
-def highpass(x, cutoff: float, fs: float | None = None, order: int = 2, zero_phase: bool = False,
+def highpass(x, cutoff: float, *, dt: float | None = None, order: int = 2, zero_phase: bool = False,
              channels: Sequence[str] | None = None):
     """Butterworth high-pass (``cutoff`` Hz)."""
-    return _filter(x, lambda o, c, f: butter_sos(o, c, f, "highpass"), order, cutoff, fs, zero_phase, channels)
+    return _filter(x, "highpass", order, cutoff, dt, zero_phase, channels)
 
 
-def bandpass(x, band: tuple[float, float], fs: float | None = None, order: int = 2,
+def bandpass(x, band: tuple[float, float], *, dt: float | None = None, order: int = 2,
              zero_phase: bool = False, channels: Sequence[str] | None = None):
     """Butterworth band-pass between ``band = (f_low, f_high)`` Hz."""
-    return _filter(x, lambda o, c, f: butter_sos(o, c, f, "bandpass"), order, band, fs, zero_phase, channels)
+    return _filter(x, "bandpass", order, band, dt, zero_phase, channels)

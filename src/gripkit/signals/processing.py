@@ -54,40 +54,47 @@ def detrend(tr: Trajectory, channels: Sequence[str] | None = None, kind: str = "
 
 
 def decimate(tr: Trajectory, q: int, order: int = 8, zero_phase: bool = True) -> Trajectory:
-    """Keep every ``q``-th sample after a Butterworth anti-alias low-pass at 0.8·fs/(2q)."""
+    """Keep every ``q``-th sample after a Butterworth anti-alias low-pass at 0.8/(2q·dt)."""
     if int(q) != q or q < 1:
         raise DataError(f"decimation factor q: expected a positive integer, found {q!r}")
     q = int(q)
     if q == 1:
         return tr
-    fs = tr.require_uniform(why="decimation")
-    sos = butter_sos(order, 0.8 * fs / (2 * q), fs)
+    dt = tr.require_uniform(why="decimation")
+    sos = butter_sos(order, 0.8 / dt / (2 * q), dt=dt)
     data = {n: apply_sos(sos, tr[n], zero_phase)[::q] for n in tr.names}
-    meta = {**tr.meta, "fs": fs / q}
+    meta = {**tr.meta, "dt": dt * q}
     return Trajectory(tr.t[::q], data, tr.units, meta)
 
 
-def to_uniform(tr: Trajectory, fs: float) -> Trajectory:
-    """Linear interpolation of a (possibly non-uniform) record onto a uniform grid at ``fs``."""
-    if not (np.isfinite(fs) and fs > 0):
-        raise DataError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
-    n = int(np.floor(tr.duration * fs + 1e-9)) + 1
-    t = tr.t[0] + np.arange(n) / fs
+def _checked_dt(dt) -> float:
+    if isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating)) \
+            or not (np.isfinite(dt) and dt > 0):
+        raise DataError(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
+    return float(dt)
+
+
+def to_uniform(tr: Trajectory, dt: float) -> Trajectory:
+    """Linear interpolation of a (possibly non-uniform) record onto a uniform grid every ``dt`` s."""
+    dt = _checked_dt(dt)
+    n = int(np.floor(tr.duration / dt + 1e-9)) + 1
+    t = tr.t[0] + np.arange(n) * dt
     data = {k: np.interp(t, tr.t, tr[k]) for k in tr.names}
-    return Trajectory(t, data, tr.units, {**tr.meta, "fs": float(fs)})
+    return Trajectory(t, data, tr.units, {**tr.meta, "dt": dt})
 
 
-def resample(tr: Trajectory, fs: float) -> Trajectory:
-    """Resample to ``fs`` Hz: polyphase filtering for uniform data (rational ratio), linear
-    interpolation onto a uniform grid otherwise."""
+def resample(tr: Trajectory, dt: float) -> Trajectory:
+    """Resample to one sample every ``dt`` s: polyphase filtering for uniform data (rational
+    ratio of the intervals), linear interpolation onto a uniform grid otherwise."""
+    dt = _checked_dt(dt)
     if not tr.is_uniform():
-        return to_uniform(tr, fs)
-    ratio = Fraction(float(fs) / tr.fs).limit_denominator(1000)
+        return to_uniform(tr, dt)
+    ratio = Fraction(tr.dt / dt).limit_denominator(1000)
     up, down = ratio.numerator, ratio.denominator
     data = {k: _signal().resample_poly(tr[k], up, down, padtype="line") for k in tr.names}
     n = len(next(iter(data.values())))
-    t = tr.t[0] + np.arange(n) / fs
-    return Trajectory(t, data, tr.units, {**tr.meta, "fs": float(fs)})
+    t = tr.t[0] + np.arange(n) * dt
+    return Trajectory(t, data, tr.units, {**tr.meta, "dt": dt})
 
 
 def split(tr: Trajectory, n_segments: int) -> list[Trajectory]:

@@ -6,9 +6,9 @@ increasing time. Methods that need more (uniform sampling, a minimum number of s
 it explicitly with :meth:`Trajectory.require_uniform` and :meth:`Trajectory.require_samples`.
 
 >>> import numpy as np
->>> tr = Trajectory.uniform(200.0, u=np.zeros(400), y=np.ones(400), units={"u": "A", "y": "N"})
->>> tr.fs, tr.n, tr.unit("y")
-(200.0, 400, 'N')
+>>> tr = Trajectory.uniform(dt=0.005, u=np.zeros(400), y=np.ones(400), units={"u": "A", "y": "N"})
+>>> tr.dt, tr.n, tr.unit("y")
+(0.005, 400, 'N')
 """
 
 from __future__ import annotations
@@ -41,7 +41,7 @@ class Trajectory:
         Mapping name → unit string (SI, e.g. ``'N'``, ``'m'``, ``'V'``, ``'A'``); missing names
         get ``'1'`` (dimensionless).
     meta
-        Free-form provenance (source file, fs, notes).
+        Free-form provenance (source file, nominal sample interval ``dt`` in s, notes).
     """
 
     __slots__ = ("t", "_ch", "_units", "meta")
@@ -119,16 +119,18 @@ class Trajectory:
         return self
 
     @classmethod
-    def uniform(cls, fs: float, t0: float = 0.0, units: Mapping[str, str] | None = None,
+    def uniform(cls, *, dt: float, t0: float = 0.0, units: Mapping[str, str] | None = None,
                 meta: Mapping | None = None, **channels) -> "Trajectory":
-        """Build from channels sampled at ``fs`` Hz starting at ``t0`` s."""
-        if not (np.isfinite(fs) and fs > 0):
-            raise DataError(f"sampling rate fs: expected a positive number of Hz, found {fs!r}")
+        """Build from channels sampled every ``dt`` s starting at ``t0`` s (``dt`` is kept as the
+        nominal interval, exact, in ``meta['dt']``)."""
+        if isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating)) \
+                or not (np.isfinite(dt) and dt > 0):
+            raise DataError(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
         if not channels:
             raise DataError("a trajectory needs at least one channel")
         n = len(next(iter(channels.values())))
-        t = t0 + np.arange(n) / float(fs)
-        m = {"fs": float(fs), **(meta or {})}
+        t = t0 + np.arange(n) * float(dt)
+        m = {"dt": float(dt), **(meta or {})}
         return cls(t, channels, units, m)
 
     # basic properties
@@ -157,19 +159,15 @@ class Trajectory:
 
     @property
     def dt(self) -> float:
-        """Median sample interval (s)."""
+        """Sample interval (s): the nominal one in ``meta['dt']`` when the record is uniform, else
+        the median interval of the time stamps."""
+        if "dt" in self.meta and self.is_uniform():
+            return float(self.meta["dt"])
         if self.n < 2:
             source = self.meta.get("source")
             raise DataError(f"{source + ': ' if source else ''}{self.n} sample(s) have no sample interval",
                             hint="a record needs at least 2 samples; check that the file is complete")
         return float(np.median(np.diff(self.t)))
-
-    @property
-    def fs(self) -> float:
-        """Sampling rate (Hz) from the median interval, or the nominal one in ``meta['fs']``."""
-        if "fs" in self.meta and self.is_uniform():
-            return float(self.meta["fs"])
-        return 1.0 / self.dt
 
     def is_uniform(self, rtol: float = 1e-3) -> bool:
         if self.n < 3:
@@ -179,7 +177,7 @@ class Trajectory:
         return bool(np.max(np.abs(d - med)) <= rtol * med)
 
     def require_uniform(self, rtol: float = 1e-3, why: str = "discrete-time identification") -> float:
-        """Return the sampling rate, or raise :class:`DataError` if sampling is not uniform."""
+        """Return the sample interval ``dt`` (s), or raise :class:`DataError` if sampling is not uniform."""
         if not self.is_uniform(rtol):
             d = np.diff(self.t)
             med = float(np.median(d))
@@ -190,7 +188,7 @@ class Trajectory:
                 f"tolerance {100 * rtol:.3g} %)",
                 hint="resample the data first (gripkit.signals.resample, or CLI --resample HZ)",
             )
-        return self.fs
+        return self.dt
 
     def require_samples(self, n_min: int, why: str) -> None:
         if self.n < n_min:
@@ -256,7 +254,7 @@ class Trajectory:
 
     def __repr__(self) -> str:
         chans = ", ".join(f"{n} [{u}]" for n, u in self._units.items())
-        rate = f", fs={self.fs:.6g} Hz" if self.n > 1 and self.is_uniform() else ""
+        rate = f", dt={self.dt:.6g} s" if self.n > 1 and self.is_uniform() else ""
         return f"Trajectory(n={self.n}, t=[{self.t[0]:.6g}, {self.t[-1]:.6g}] s{rate}; {chans})"
 
     def __eq__(self, other) -> bool:

@@ -348,8 +348,7 @@ class HybridSystem:
 
     def _prepare(self, u, dt, x0, mode0):
         if isinstance(u, Trajectory):
-            fs = u.require_uniform(why=f"simulating {self.name}")
-            dt = 1.0 / fs
+            dt = u.require_uniform(why=f"simulating {self.name}")
             u = u.as_array(*self.inputs)
         u2 = np.ascontiguousarray(np.asarray(u, dtype=np.float64).reshape(len(u), -1))
         if u2.shape[1] != self.n_inputs:
@@ -371,7 +370,7 @@ class HybridSystem:
         ch = {n: u2[:, i] for i, n in enumerate(self.inputs)}
         ch.update({n: y[:, i] for i, n in enumerate(self.outputs)})
         ch["mode"] = modes.astype(np.float64)
-        tr = Trajectory(t, ch, {k: v for k, v in self.units.items() if k in ch}, {"fs": 1.0 / dt, "model": self.name})
+        tr = Trajectory(t, ch, {k: v for k, v in self.units.items() if k in ch}, {"dt": dt, "model": self.name})
         ev = [(float(r[0]) * dt, self.names[int(r[1])], self.names[int(r[2])]) for r in rows]
         return HybridResult(tr, xs, modes, ev)
 

@@ -122,12 +122,12 @@ class Model(abc.ABC):
         names = [s.name for s in self.inputs]
         t0 = 0.0
         if isinstance(u, Trajectory):
-            fs = u.require_uniform(why=f"simulating {self.name}")
+            dt_u = u.require_uniform(why=f"simulating {self.name}")
             arr = u.as_array(*names)
             t0 = float(u.t[0])
-            if dt is not None and abs(dt * fs - 1.0) > 1e-6:
-                raise SimulationError(f"dt={dt} s given, but the input trajectory is sampled at {fs:g} Hz")
-            dt = 1.0 / fs
+            if dt is not None and abs(dt / dt_u - 1.0) > 1e-6:
+                raise SimulationError(f"dt={dt} s given, but the input trajectory is sampled every {dt_u:g} s")
+            dt = dt_u
         elif isinstance(u, Mapping):
             missing = [n for n in names if n not in u]
             if missing:
@@ -213,7 +213,7 @@ class Model(abc.ABC):
         ch = {s.name: u_rows[i] for i, s in enumerate(self.inputs)}
         ch.update({s.name: y[:, i] for i, s in enumerate(self.outputs)})
         units = {s.name: s.unit for s in (*self.inputs, *self.outputs)}
-        return Trajectory._from_checked(t, ch, units, {"fs": 1.0 / dt, "model": self.name})
+        return Trajectory._from_checked(t, ch, units, {"dt": dt, "model": self.name})
 
     def __repr__(self) -> str:
         return f"{type(self).__name__}({self.parameters!r})"

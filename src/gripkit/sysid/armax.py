@@ -47,7 +47,7 @@ def _hannan_rissanen(u, y, na, nb, nc, nk) -> np.ndarray:
 
 
 def armax(u, y, na: int, nb: int, nc: int, nk: int = 1, *, dt: float | None = None,
-          fs: float | None = None, maxiter: int = 100, tol: float = 1e-10, **meta) -> PolynomialModel:
+          maxiter: int = 100, tol: float = 1e-10, **meta) -> PolynomialModel:
     """ARMAX model ``A y = B u + C e`` by prediction-error minimisation (MATLAB ``armax``
     orders ``[na nb nc nk]``).
 
@@ -57,7 +57,7 @@ def armax(u, y, na: int, nb: int, nc: int, nk: int = 1, *, dt: float | None = No
     :class:`~gripkit.errors.AccuracyWarning` if the iteration does not converge.
     """
     check_meta(meta, armax)
-    u, y, step, na, nb, nc, nk = checked_problem(u, y, dt, fs, na=na, nb=nb, nc=nc, nk=nk)
+    u, y, step, na, nb, nc, nk = checked_problem(u, y, dt, na=na, nb=nb, nc=nc, nk=nk)
     if nc == 0:
         return arx(u, y, na, nb, nk, dt=step, **meta)
     cu, cy = unit_scale(u), unit_scale(y)

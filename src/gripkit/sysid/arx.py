@@ -32,7 +32,7 @@ __all__ = ["arx"]
 QR_MAX_ELEMENTS = 2**18
 
 
-def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None, fs: float | None = None,
+def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
         **meta) -> PolynomialModel:
     """Least-squares ARX model ``A(q) y(t) = B(q) u(t) + e(t)`` in MATLAB's ``[na nb nk]`` layout.
 
@@ -44,8 +44,8 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None, fs: flo
     na, nb, nk
         Number of A coefficients (after the leading 1), number of B coefficients, input delay in
         samples (``B`` gets ``nk`` leading zeros). Table II's ``[2 2 2]`` is ``na=2, nb=2, nk=2``.
-    dt, fs
-        Sample interval (s) or rate (Hz); default: dt = 1 (time in samples).
+    dt
+        Sample interval (s); default 1 (time in samples).
     **meta
         Model metadata: ``input_name``, ``output_name``, ``input_unit``, ``output_unit``,
         ``u_offset``, ``y_offset``.
@@ -80,8 +80,8 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None, fs: flo
     """
     check_meta(meta, arx)
     if any(np.ndim(x) == 2 and np.shape(x)[1] > 1 for x in (u, y)):  # several inputs or outputs
-        return arx_mimo(u, y, na, nb, nk, dt=dt, fs=fs, **meta)
-    u, y, step, na, nb, nk = checked_problem(u, y, dt, fs, na=na, nb=nb, nk=nk)
+        return arx_mimo(u, y, na, nb, nk, dt=dt, **meta)
+    u, y, step, na, nb, nk = checked_problem(u, y, dt, na=na, nb=nb, nk=nk)
     cu, cy = unit_scale(u), unit_scale(y)
     if max(abs(np.log2(cu)), abs(np.log2(cy))) <= _NO_SCALING_WITHIN:
         cu = cy = 1.0  # scaling by powers of two is exact: skip the two copies where it changes nothing

@@ -55,7 +55,7 @@ def _realisation(theta, p, m, na, nb, nk):
     return A, B, C, D
 
 
-def arx_mimo(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None, fs: float | None = None,
+def arx_mimo(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
              inputs=None, outputs=None, input_units=None, output_units=None, u_offset=None, y_offset=None,
              **_meta) -> LinearModel:
     """Least-squares MIMO ARX (see the module docstring); ``u`` (N, m), ``y`` (N, p).
@@ -75,7 +75,7 @@ def arx_mimo(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None, fs
     """
     u = as_io_matrix(u, "input u")
     y = as_io_matrix(y, "output y", u.shape[0])
-    step = check_dt(dt, fs)
+    step = check_dt(dt)
     na, nb, nk = check_order(na, "na"), check_order(nb, "nb", 1), check_order(nk, "nk")
     N, m = u.shape
     p = y.shape[1]

@@ -137,7 +137,7 @@ def identify_bouc_wen(data: Trajectory, input: str = "U", output: str = "y", *,
         initial = {"d_p": abs(d0), "lambda": hs * c0, "beta": 0.9 * c0, "gamma": 0.1 * c0}
     model = BoucWen(bouc_wen_parameters(initial["d_p"], initial["lambda"], initial["beta"], initial["gamma"],
                                         source="starting value"), check=False)
-    tr = Trajectory(data.t, {"U": U, "y": y}, {"U": "V", "y": "m"}, {**data.meta, "fs": data.fs})
+    tr = Trajectory(data.t, {"U": U, "y": y}, {"U": "V", "y": "m"}, {**data.meta, "dt": data.dt})
     res = fit(model, tr, outputs=["y"], x0=np.array([H0, U[0]]), multistart=multistart, burn_in=burn_in,
               progress=progress)
     params = {k: res.value(n) for k, n in _KEYS}
@@ -206,7 +206,7 @@ def identify_actuator_dynamics(data: Trajectory, static: BoucWenResult | dict, i
     params = actuator_parameters(sp["d_p"], 1e-3, sp["lambda"], sp["beta"], sp["gamma"], a0, b0, 1e-2,
                                  source="identified (static) / starting value (a, b)")
     model = PiezoActuator(params, loads=False, check=False)
-    tr = Trajectory(data.t, {"U": U, "y_A": y}, {"U": "V", "y_A": "m"}, {**data.meta, "fs": data.fs})
+    tr = Trajectory(data.t, {"U": U, "y_A": y}, {"U": "V", "y_A": "m"}, {**data.meta, "dt": data.dt})
     res = fit(model, tr, outputs=["y_A"], free=list(free), progress=progress)
     _warn_if_poor(res, "D(s) identification")
     return DynamicsResult(res.value("a"), res.value("b"), res.stdev("a"), res.stdev("b"), res)

@@ -63,19 +63,13 @@ def check_order(value, name: str, minimum: int = 0) -> int:
     return int(value)
 
 
-def check_dt(dt: float | None, fs: float | None) -> float:
-    """Sample interval in seconds from ``dt`` or ``fs`` (1.0 — 'one sample' — when neither)."""
-    if dt is not None and fs is not None:
-        if not math.isclose(float(dt) * float(fs), 1.0, rel_tol=1e-9):
-            raise DataError(f"dt={dt} s and fs={fs} Hz disagree; give one of them")
-    if fs is not None:
-        if not (math.isfinite(fs) and fs > 0):
-            raise DataError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
-        return 1.0 / float(fs)
+def check_dt(dt: float | None) -> float:
+    """The sample interval in seconds (1.0 — 'one sample' — when None)."""
     if dt is None:
         return 1.0
-    if not (math.isfinite(dt) and dt > 0):
-        raise DataError(f"dt: expected a positive sample interval in s, found {dt!r}")
+    if isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating)) \
+            or not (math.isfinite(dt) and dt > 0):
+        raise DataError(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
     return float(dt)
 
 
@@ -107,13 +101,13 @@ def check_output_varies(y: np.ndarray, name: str = "output y") -> None:
                                   hint="check that the output column is the measured response")
 
 
-def checked_problem(u, y, dt: float | None, fs: float | None, **orders):
+def checked_problem(u, y, dt: float | None, **orders):
     """The common start of every estimator: signals checked (:func:`check_io`), orders checked
     (``nb`` >= 1, the others >= 0), sample interval resolved. Returns ``(u, y, dt, *orders)`` with
     the orders as ints in the order given."""
     u, y = check_io(u, y)
     ints = [check_order(v, name, 1 if name == "nb" else 0) for name, v in orders.items()]
-    return (u, y, check_dt(dt, fs), *ints)
+    return (u, y, check_dt(dt), *ints)
 
 
 def check_identifiable(u: np.ndarray, y: np.ndarray, n_min: int, what: str) -> None:

@@ -203,7 +203,7 @@ def _spa(u, y, dt, lag_window, n_lines):
     return f, G[:, None, None], np.sqrt(var)[:, None, None], coh[:, None], {"lag_window": M, "window": "hann"}
 
 
-def frf(u, y, *, dt: float | None = None, fs: float | None = None, method: str = "auto", periods: int | None = None,
+def frf(u, y, *, dt: float | None = None, method: str = "auto", periods: int | None = None,
         keep_transient: bool = False, nperseg: int | None = None, lag_window: int | None = None,
         n_lines: int = 128, inputs=None, outputs=None) -> FRF:
     """Estimate the frequency response from input ``u`` (N, m) to output ``y`` (N, p).
@@ -217,13 +217,13 @@ def frf(u, y, *, dt: float | None = None, fs: float | None = None, method: str =
     >>> from gripkit.sysid import frf
     >>> u = np.random.default_rng(0).standard_normal(20000)
     >>> y = 0.5 * np.concatenate([[0.0], u[:-1]])            # y[t] = 0.5 u[t-1]
-    >>> r = frf(u, y, fs=100.0, nperseg=256)
+    >>> r = frf(u, y, dt=0.01, nperseg=256)
     >>> bool(np.allclose(np.abs(r.H[1:, 0, 0]), 0.5, atol=0.01))
     True
     """
     u = as_io_matrix(u, "input u")
     y = as_io_matrix(y, "output y", u.shape[0])
-    step = check_dt(dt, fs)
+    step = check_dt(dt)
     if method == "auto":
         method = "periodic" if periods is not None else "h1"
     if method not in FRF_METHODS:

@@ -194,14 +194,14 @@ class ConstantVelocityPoint:
 
 def constant_velocity_friction(pwm, velocity, *, motor_torque: Callable[[float, float], float],
                                load: Callable[[int], float] | None = None, inertia: float | None = None,
-                               fs: float | None = None, plateau: float = 0.05,
+                               dt: float | None = None, plateau: float = 0.05,
                                min_samples: int = 10) -> list[ConstantVelocityPoint]:
     """One friction point per constant-PWM run (Appendix D).
 
     The plateau of each run is the set of samples whose velocity lies within ``plateau``
     (relative) of the run's peak speed; friction = ``motor_torque(pwm, v)`` − ``load(i)`` at the
     plateau's mean velocity. A short run (the joint reaches its end stop) may still be speeding up
-    on its plateau: given the joint's ``inertia`` and the sampling rate ``fs``, the inertial torque
+    on its plateau: given the joint's ``inertia`` and the sample interval ``dt`` (s), the inertial torque
     J·a (a from a line fitted to the plateau's velocity) is subtracted too. The friction std
     propagates the plateau's velocity scatter through the motor's torque-speed slope.
     """
@@ -223,10 +223,10 @@ def constant_velocity_friction(pwm, velocity, *, motor_torque: Callable[[float, 
         slope = (float(motor_torque(u[a], vm + dv)) - float(motor_torque(u[a], vm - dv))) / (2 * dv)
         ld = 0.0 if load is None else float(np.mean([load(i) for i in range(a, b)][::max(1, (b - a) // 20)]))
         if inertia is not None:
-            if fs is None:
-                raise DataError("constant_velocity_friction: give fs (Hz) with inertia")
+            if dt is None:
+                raise DataError("constant_velocity_friction: give dt (the sample interval in s) with inertia")
             idx = np.flatnonzero(sel)
-            acc = float(np.polyfit(idx / fs, vv, 1)[0]) if idx.size > 2 else 0.0
+            acc = float(np.polyfit(idx * dt, vv, 1)[0]) if idx.size > 2 else 0.0
             ld += inertia * acc
         pts.append(ConstantVelocityPoint(float(u[a]), vm, vs, tau - ld, abs(slope) * vs, int(sel.sum())))
     if len(pts) < 2:
@@ -344,7 +344,7 @@ class IdimResult:
     covariance: np.ndarray
     relative_error_percent: float
     n_samples: int
-    fs: float
+    dt: float
     cutoff: float
     decimation: int
     condition_number: float
@@ -353,7 +353,7 @@ class IdimResult:
 
     def to_dict(self) -> dict:
         return dict(params=self.params, std=self.std, relative_error_percent=self.relative_error_percent,
-                    n_samples=self.n_samples, fs=self.fs, cutoff_hz=self.cutoff, decimation=self.decimation,
+                    n_samples=self.n_samples, dt=self.dt, cutoff_hz=self.cutoff, decimation=self.decimation,
                     condition_number=self.condition_number, residual_std=self.residual_std,
                     covariance=self.covariance.tolist(), notes=list(self.notes))
 
@@ -372,21 +372,19 @@ class IdimSamples:
     acceleration: np.ndarray
     effort: np.ndarray
     near_reversal: np.ndarray
-    fs: float
+    dt: float
     cutoff: float
     decimation: int
     notes: tuple
 
 
-def idim_samples(position, effort, fs: float, *, cutoff: float | None = None, order: int = 4,
+def idim_samples(position, effort, *, dt: float, cutoff: float | None = None, order: int = 4,
                  decimation: int | None = None, guard: float = 1.0) -> IdimSamples:
     """The signal chain of IDIM-LS (module doc), for one joint (1-D arrays) or several ((N, m)
     arrays): the same zero-phase Butterworth filter on position and effort, q̇ and q̈ by central
     differences, the filter's edge transients cut, decimation by ``decimation`` (default: the
-    largest q with fs/(2q) ≥ 2.5·cutoff), and the guard bands (``guard/cutoff`` s) around every
+    largest q with 1/(2q·dt) ≥ 2.5·cutoff), and the guard bands (``guard/cutoff`` s) around every
     velocity reversal marked."""
-    from ..signals.filters import apply_sos, butter_sos
-
     x = np.asarray(position, dtype=np.float64)
     e = np.asarray(effort, dtype=np.float64)
     x = x[:, None] if x.ndim == 1 else x
@@ -394,34 +392,35 @@ def idim_samples(position, effort, fs: float, *, cutoff: float | None = None, or
     if x.ndim != 2 or x.shape != e.shape:
         raise DataError(f"position and effort: expected arrays of one shape (N,) or (N, m), found "
                         f"{np.shape(position)} and {np.shape(effort)}")
-    if not (np.isfinite(fs) and fs > 0):
-        raise DataError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
-    cutoff = fs / 50.0 if cutoff is None else float(cutoff)
-    if not 0 < cutoff < fs / 2:
-        raise DataError(f"cutoff {cutoff:g} Hz must lie between 0 and fs/2 = {fs / 2:g} Hz")
-    q = decimation if decimation is not None else max(1, int(fs / (2 * 2.5 * cutoff)))
+    if isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating)) \
+            or not (np.isfinite(dt) and dt > 0):
+        raise DataError(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
+    rate = 1.0 / dt
+    cutoff = rate / 50.0 if cutoff is None else float(cutoff)
+    if not 0 < cutoff < rate / 2:
+        raise DataError(f"cutoff {cutoff:g} Hz must lie between 0 and the Nyquist frequency {rate / 2:g} Hz")
+    q = decimation if decimation is not None else max(1, int(rate / (2 * 2.5 * cutoff)))
     if int(q) != q or q < 1:
         raise DataError(f"decimation: expected a positive integer, found {decimation!r}")
     q = int(q)
     notes = []
-    if fs / (2 * q) < cutoff:
-        notes.append(f"decimation {q} puts the new Nyquist frequency {fs / (2 * q):g} Hz below the "
+    if rate / (2 * q) < cutoff:
+        notes.append(f"decimation {q} puts the new Nyquist frequency {rate / (2 * q):g} Hz below the "
                      f"cutoff {cutoff:g} Hz: the decimated rows alias")
     n = x.shape[0]
-    edge = int(math.ceil(3 * fs / cutoff))
+    edge = int(math.ceil(3 * rate / cutoff))
     if n < 2 * edge + 50 * q:
-        raise DataError(f"{n} samples are too few for IDIM-LS at fs = {fs:g} Hz with a {cutoff:g} Hz "
+        raise DataError(f"{n} samples are too few for IDIM-LS at dt = {dt:g} s with a {cutoff:g} Hz "
                         f"filter (need more than {2 * edge + 50 * q})", hint="log a longer run")
-    sos = butter_sos(order, cutoff, fs)
+    sos = butter_sos(order, cutoff, dt=dt)
     xf = apply_sos(sos, x, zero_phase=True)
     ef = apply_sos(sos, e, zero_phase=True)
-    dt = 1.0 / fs
     vel = np.gradient(xf, dt, axis=0)
     acc = np.gradient(vel, dt, axis=0)
     # the filter smears the friction step of each velocity reversal over ~1/cutoff: those samples
     # do not obey the sign(q̇) model of the filtered signals
     near = np.zeros(x.shape, dtype=bool)
-    g = int(math.ceil(guard * fs / cutoff))
+    g = int(math.ceil(guard * rate / cutoff))
     for j in range(x.shape[1]):
         rev = np.flatnonzero(np.sign(vel[1:, j]) != np.sign(vel[:-1, j]))
         if rev.size and g > 0:
@@ -432,11 +431,11 @@ def idim_samples(position, effort, fs: float, *, cutoff: float | None = None, or
             np.add.at(cover, hi, -1)
             near[:, j] = np.cumsum(cover[:-1]) > 0
     sl = slice(edge, n - edge, q)
-    return IdimSamples(xf[sl], vel[sl], acc[sl], ef[sl], near[sl], float(fs), cutoff, q, tuple(notes))
+    return IdimSamples(xf[sl], vel[sl], acc[sl], ef[sl], near[sl], float(dt), cutoff, q, tuple(notes))
 
 
 @entry_point
-def idim_ls(position, effort, fs: float, *, effort_scale: float = 1.0, cutoff: float | None = None,
+def idim_ls(position, effort, *, dt: float, effort_scale: float = 1.0, cutoff: float | None = None,
             order: int = 4, decimation: int | None = None,
             velocity_threshold: float | None = None, guard: float = 1.0) -> IdimResult:
     """Identify τ = J q̈ + F_v q̇ + F_c sign(q̇) + τ₀ from position and effort logs (module doc).
@@ -444,17 +443,17 @@ def idim_ls(position, effort, fs: float, *, effort_scale: float = 1.0, cutoff: f
     Parameters
     ----------
     position
-        Joint position samples (rad, or m), uniformly sampled at ``fs`` Hz.
+        Joint position samples (rad, or m), one sample every ``dt`` s.
     effort
         Effort column; the effort is ``effort_scale × effort`` (e.g. a current in A times the
         torque constant and gear ratio, or a PWM count times N·m per count).
     cutoff
-        Low-pass cutoff (Hz) of the zero-phase Butterworth filter; default fs/50 (20 Hz at 1 kHz).
+        Low-pass cutoff (Hz) of the zero-phase Butterworth filter; default 1/(50 dt) (20 Hz at 1 kHz).
         Choose 5–10 times the bandwidth of the motion: higher lets the position noise into q̈.
     order
         Filter order (the zero-phase filter has twice this order).
     decimation
-        Keep every q-th filtered sample; default the largest q with fs/(2q) ≥ 2.5·cutoff.
+        Keep every q-th filtered sample; default the largest q with 1/(2q·dt) ≥ 2.5·cutoff.
     velocity_threshold
         Drop samples with |q̇| below it; default 2 % of the largest |q̇|.
     guard
@@ -470,7 +469,7 @@ def idim_ls(position, effort, fs: float, *, effort_scale: float = 1.0, cutoff: f
     x, e = x * cx, e * ce
     if velocity_threshold is not None:
         velocity_threshold = float(velocity_threshold) * cx
-    st = idim_samples(x, e * effort_scale, fs, cutoff=cutoff, order=order, decimation=decimation, guard=guard)
+    st = idim_samples(x, e * effort_scale, dt=dt, cutoff=cutoff, order=order, decimation=decimation, guard=guard)
     vel, acc, y, near = st.velocity[:, 0], st.acceleration[:, 0], st.effort[:, 0], st.near_reversal[:, 0]
     cutoff, q, notes = st.cutoff, st.decimation, list(st.notes)
     vmax = float(np.max(np.abs(vel)))
@@ -513,4 +512,4 @@ def idim_ls(position, effort, fs: float, *, effort_scale: float = 1.0, cutoff: f
     with np.errstate(over="ignore", under="ignore"):
         theta, std, cov = theta * d, std * d, cov * d[:, None] * d[None, :]
     return IdimResult(dict(zip(_IDIM, map(float, theta))), dict(zip(_IDIM, map(float, std))), cov,
-                      rel, int(n), float(fs), float(cutoff), q, cond, float(math.sqrt(s2)) / ce, notes)
+                      rel, int(n), float(dt), float(cutoff), q, cond, float(math.sqrt(s2)) / ce, notes)

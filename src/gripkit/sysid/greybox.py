@@ -437,11 +437,11 @@ def fit(model, data: Trajectory, *, outputs: Sequence[str] | Mapping[str, str] |
     """
     if not isinstance(data, Trajectory):
         raise DataError(f"data: expected a Trajectory, found {type(data).__name__}")
-    fs = data.require_uniform(why="grey-box identification")
+    dt = data.require_uniform(why="grey-box identification")
     params, free = _parameters_to_fit(model, initial, free)
     cols = _fit_columns(model, data, inputs=inputs, outputs=outputs, n_free=len(free), burn_in=burn_in,
                         output_scale=output_scale)
-    problem = _OutputError(model, params, free, cols, 1.0 / fs, x0, method)
+    problem = _OutputError(model, params, free, cols, dt, x0, method)
     best, tried = _best_of_starts(problem, _SolverOptions(method, loss, max_nfev, multistart, seed, progress))
     z = best.x
     theta = problem.to_theta(z)

@@ -8,10 +8,10 @@
 >>> y = np.zeros(2000)
 >>> for t in range(3, 2000):
 ...     y[t] = 1.8732*y[t-1] - 0.8996*y[t-2] + 195.0*(u[t-2]-0.85) - 227.6*(u[t-3]-0.85)
->>> tr = Trajectory.uniform(200.0, current=u, force=y, units={"current": "A", "force": "N"})
+>>> tr = Trajectory.uniform(dt=0.005, current=u, force=y, units={"current": "A", "force": "N"})
 >>> m = identify(tr, "arx", input="current", output="force", na=2, nb=2, nk=2)
->>> m.label, round(m.fs), m.parameters["b2"].unit
-('ARX [2 2 2]', 200, 'N/A')
+>>> m.label, m.dt, m.parameters["b2"].unit
+('ARX [2 2 2]', 0.005, 'N/A')
 
 The array functions (:func:`~gripkit.sysid.arx`, :func:`~gripkit.sysid.armax`,
 :func:`~gripkit.sysid.oe`, :func:`~gripkit.sysid.rls`, :func:`~gripkit.sysid.structure_search`)
@@ -73,14 +73,14 @@ def io_data(data: Trajectory, *, input: str, output: str, detrend: str = "mean",
     """
     if not isinstance(data, Trajectory):
         raise DataError(f"data: expected a gripkit Trajectory, found {type(data).__name__}",
-                        hint="use gripkit.io.load(path) or Trajectory.uniform(fs, u=..., y=...)")
+                        hint="use gripkit.io.load(path) or Trajectory.uniform(dt=..., u=..., y=...)")
     if detrend not in ("mean", "linear", "none"):
         raise DataError(f"detrend: expected 'mean', 'linear' or 'none', found {detrend!r}")
     if input == output:
         raise DataError(f"input and output must be different columns, both are {input!r}")
     u = np.array(data[input], dtype=np.float64)
     y = np.array(data[output], dtype=np.float64)
-    fs = float(f"{data.require_uniform(why=why):.9g}")  # time stamps in files carry rounding noise
+    dt = float(f"{data.require_uniform(why=why):.9g}")  # time stamps in files carry rounding noise
     u0 = y0 = 0.0
     if detrend == "mean":
         u0, y0 = float(u.mean()), float(y.mean())
@@ -90,7 +90,7 @@ def io_data(data: Trajectory, *, input: str, output: str, detrend: str = "mean",
         d = detrend_signals(data.select(input, output), kind="linear")
         u0, y0 = float(u.mean()), float(y.mean())
         u, y = np.array(d[input]), np.array(d[output])
-    return IOData(u, y, 1.0 / fs, input, output, data.unit(input), data.unit(output), u0, y0)
+    return IOData(u, y, dt, input, output, data.unit(input), data.unit(output), u0, y0)
 
 
 def _method_function(method: str):
@@ -103,7 +103,7 @@ def _method_function(method: str):
 
 
 #: what identify() itself passes to the method's function (not accepted as an option)
-_SUPPLIED = ("u", "y", "na", "nb", "nc", "nf", "nk", "dt", "fs", *IOData.__dataclass_fields__, "input_name",
+_SUPPLIED = ("u", "y", "na", "nb", "nc", "nf", "nk", "dt", *IOData.__dataclass_fields__, "input_name",
              "output_name", "input_unit", "output_unit")
 
 

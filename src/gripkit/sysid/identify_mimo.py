@@ -83,7 +83,7 @@ def mimo_data(data: Trajectory, inputs, outputs, detrend: str = "mean", why: str
     """Select and detrend the input and output columns of a uniformly sampled trajectory."""
     if not isinstance(data, Trajectory):
         raise DataError(f"data: expected a gripkit Trajectory, found {type(data).__name__}",
-                        hint="use gripkit.io.load(path) or Trajectory.uniform(fs, u=..., y=...)")
+                        hint="use gripkit.io.load(path) or Trajectory.uniform(dt=..., u=..., y=...)")
     ins, outs = parse_names(inputs, "input"), parse_names(outputs, "output")
     both = sorted(set(ins) & set(outs))
     if both:
@@ -94,7 +94,7 @@ def mimo_data(data: Trajectory, inputs, outputs, detrend: str = "mean", why: str
                         f"{', '.join(map(repr, data.names))}")
     if detrend not in ("mean", "none"):
         raise DataError(f"detrend: expected 'mean' or 'none', found {detrend!r}")
-    fs = float(f"{data.require_uniform(why=why):.9g}")
+    dt = float(f"{data.require_uniform(why=why):.9g}")  # time stamps in files carry rounding noise
     u = np.column_stack([np.asarray(data[n], dtype=np.float64) for n in ins])
     y = np.column_stack([np.asarray(data[n], dtype=np.float64) for n in outs])
     for names, x, what in ((ins, u, "input"), (outs, y, "output")):
@@ -106,7 +106,7 @@ def mimo_data(data: Trajectory, inputs, outputs, detrend: str = "mean", why: str
                             hint="drop it from --input/--output or check the data")
     u0 = u.mean(axis=0) if detrend == "mean" else np.zeros(len(ins))
     y0 = y.mean(axis=0) if detrend == "mean" else np.zeros(len(outs))
-    return MimoData(u - u0, y - y0, 1.0 / fs, ins, outs, tuple(data.unit(n) for n in ins),
+    return MimoData(u - u0, y - y0, dt, ins, outs, tuple(data.unit(n) for n in ins),
                     tuple(data.unit(n) for n in outs), tuple(map(float, u0)), tuple(map(float, y0)))
 
 

@@ -225,14 +225,14 @@ class LinearModel:
     def simulate_data(self, data) -> np.ndarray:
         """Simulated outputs (N, p), offsets added back, for the input columns of a trajectory
         (picked by name; the model's input offsets removed first), from x0 = 0."""
-        dt = 1.0 / data.require_uniform(why="simulation of an identified model")
+        dt = data.require_uniform(why="simulation of an identified model")
         u = self._columns(data, self.inputs, self.u_offset, "input")
         return self.simulate(u, dt=dt) + np.asarray(self.y_offset)
 
     def compare_data(self, data) -> tuple[list[float], np.ndarray]:
         """Free-run fit per output on a trajectory (columns by name, offsets applied, x0
         estimated); returns ``(fit_percent, y_sim with offsets)``."""
-        dt = 1.0 / data.require_uniform(why="comparison of an identified model")
+        dt = data.require_uniform(why="comparison of an identified model")
         u = self._columns(data, self.inputs, self.u_offset, "input")
         y = self._columns(data, self.outputs, self.y_offset, "output")
         fit, ys, _ = self.compare(u, y, dt=dt)

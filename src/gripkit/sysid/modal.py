@@ -56,7 +56,7 @@ class ModalResult:
     offset: float
     start_time: float
     n_samples: int
-    fs: float
+    dt: float
     residual_std: float
     methods: dict = field(default_factory=dict)
 
@@ -70,7 +70,7 @@ class ModalResult:
     def summary(self) -> str:
         lines = [f"free vibration: f_n = {self.natural_frequency_hz:.6g} ± {self.natural_frequency_std_hz:.2g} Hz, "
                  f"ζ = {self.damping_ratio:.5g} ± {self.damping_ratio_std:.2g} "
-                 f"({self.n_samples} samples at {self.fs:g} Hz from t = {self.start_time:.6g} s)"]
+                 f"({self.n_samples} samples every {self.dt:g} s from t = {self.start_time:.6g} s)"]
         for k, v in self.methods.items():
             lines.append(f"  {k}: " + ", ".join(f"{a} = {b:.6g}" for a, b in v.items() if isinstance(b, float)))
         return "\n".join(lines)
@@ -84,12 +84,12 @@ def _start_index(y: np.ndarray) -> int:
     return max(int(np.argmax(d > 0.2 * d.max())), 0)
 
 
-def _fft_peak(x: np.ndarray, fs: float) -> tuple[float, np.ndarray, np.ndarray, int]:
+def _fft_peak(x: np.ndarray, rate: float) -> tuple[float, np.ndarray, np.ndarray, int]:
     n = x.size
     nfft = 1 << int(math.ceil(math.log2(16 * n)))
     X = np.abs(np.fft.rfft(x, nfft))
-    f = np.fft.rfftfreq(nfft, 1.0 / fs)
-    lo = max(int(np.ceil(2.0 * fs / n * nfft / fs)), 1)  # ignore the lowest 2 natural bins (DC)
+    f = np.fft.rfftfreq(nfft, 1.0 / rate)
+    lo = max(int(np.ceil(2.0 * rate / n * nfft / rate)), 1)  # ignore the lowest 2 natural bins (DC)
     k = lo + int(np.argmax(X[lo:-1]))
     la, lb, lc = np.log(X[k - 1:k + 2] + 1e-300)
     den = la - 2 * lb + lc
@@ -113,12 +113,13 @@ def _half_power(f: np.ndarray, X: np.ndarray, k: int) -> float:
     return float(fr - fl)
 
 
-def _checked_signal(y, fs: float) -> np.ndarray:
-    """``y`` as a flat float64 array, refused for a non-positive ``fs``, NaN/inf values or fewer
+def _checked_signal(y, dt: float) -> np.ndarray:
+    """``y`` as a flat float64 array, refused for a non-positive ``dt``, NaN/inf values or fewer
     than 64 samples."""
     y = np.asarray(y, dtype=np.float64).ravel()
-    if not (np.isfinite(fs) and fs > 0):
-        raise DataError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
+    if isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating)) \
+            or not (np.isfinite(dt) and dt > 0):
+        raise DataError(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
     if not np.isfinite(y).all():
         bad = int(np.argmax(~np.isfinite(y)))
         raise DataError(f"the signal has {int((~np.isfinite(y)).sum())} NaN/inf values (first at sample {bad})",
@@ -140,17 +141,17 @@ def _release_segment(y: np.ndarray, start: int | None, end: int | None) -> tuple
     return i0, seg
 
 
-def _spectral_peak(x: np.ndarray, fs: float):
+def _spectral_peak(x: np.ndarray, rate: float):
     """:func:`_fft_peak` (f_d, frequencies, magnitudes, peak bin), refused when the peak stands
     less than 10× above the median of the spectrum or lies at the Nyquist frequency."""
-    f_fft, f, X, k = _fft_peak(x, fs)
+    f_fft, f, X, k = _fft_peak(x, rate)
     floor = float(np.median(X))
     if X[k] < 10.0 * floor:
         raise DataError(f"no oscillation stands out of the noise: the spectral peak at {f_fft:.6g} Hz is only "
                         f"{X[k] / floor:.3g}× the median of the spectrum",
                         hint="check the signal column and that the record holds a free vibration")
-    if f_fft > 0.98 * fs / 2:
-        raise DataError(f"the peak at {f_fft:.6g} Hz lies at the Nyquist frequency {fs / 2:g} Hz: the mode is "
+    if f_fft > 0.98 * rate / 2:
+        raise DataError(f"the peak at {f_fft:.6g} Hz lies at the Nyquist frequency {rate / 2:g} Hz: the mode is "
                         f"aliased or unresolved", hint="sample faster")
     return f_fft, f, X, k
 
@@ -176,20 +177,20 @@ def _hilbert_estimate(x: np.ndarray, t: np.ndarray, per: int, noise: float) -> d
     return {"natural_frequency_hz": wn_h / (2 * math.pi), "damping_ratio": sigma_h / wn_h, "amplitude": math.exp(ic)}
 
 
-def _log_decrement_estimate(x: np.ndarray, fs: float, f_d: float, per: int, noise: float) -> dict | None:
+def _log_decrement_estimate(x: np.ndarray, rate: float, f_d: float, per: int, noise: float) -> dict | None:
     """δ = ln(a_i / a_{i+k})/k from a straight line through the log of the peaks of ``x``
     upsampled 16× (band-limited), those 5× above ``noise`` and three periods from the ends;
     ζ = δ/√(4π² + δ²). None with fewer than 3 such peaks."""
     up = 16
     xu = resample_poly(x, up, 1)
-    pk, _ = find_peaks(xu, distance=int(0.6 * up * fs / f_d))
+    pk, _ = find_peaks(xu, distance=int(0.6 * up * rate / f_d))
     edge = 3 * up * per
     pk = pk[(pk > edge) & (pk < xu.size - edge)]
     amp = xu[pk]
     good = pk[amp > max(5.0 * noise, 1e-3 * np.max(np.abs(x)))]
     if good.size < 3:
         return None
-    cycles = (good - good[0]) / (up * fs / f_d)
+    cycles = (good - good[0]) / (up * rate / f_d)
     delta = -np.polyfit(cycles, np.log(xu[good]), 1)[0]
     return {"log_decrement": delta, "damping_ratio": delta / math.sqrt(4 * math.pi**2 + delta**2)}
 
@@ -276,14 +277,14 @@ def _warn_doubtful(methods: dict, f_fft: float, omega_d: float, fn: float, zeta:
 
 
 @entry_point
-def free_vibration(y, fs: float, *, start: int | None = None, end: int | None = None,
+def free_vibration(y, *, dt: float, start: int | None = None, end: int | None = None,
                    noise_std: float | None = None) -> ModalResult:
     """Estimate the natural frequency and damping ratio of a free vibration.
 
     Parameters
     ----------
     y
-        The signal (any unit, e.g. the force sensor's reading), shape (N,), sampled at ``fs`` Hz.
+        The signal (any unit, e.g. the force sensor's reading), shape (N,), one sample every ``dt`` s.
     start, end
         Sample range to analyse; ``start`` defaults to the release (the first large step, so a
         record may begin with the preload plateau), ``end`` to the end of the record.
@@ -296,25 +297,26 @@ def free_vibration(y, fs: float, *, start: int | None = None, end: int | None = 
         NaN/inf, fewer than 64 samples after the release, no oscillation standing out of the noise,
         or a frequency at DC or at the Nyquist frequency.
     """
-    y = _checked_signal(y, fs)
+    y = _checked_signal(y, dt)
+    rate = 1.0 / dt
     # work at unit size (an exact power of two: any scale, 1e-300 … 1e300); amplitudes mapped back below
     cy = unit_scale(y)
     y = y * cy
     noise_std = None if noise_std is None else float(noise_std) * cy
     i0, seg = _release_segment(y, start, end)
-    t = np.arange(seg.size) / fs
+    t = np.arange(seg.size) / rate
     tail = seg[-max(seg.size // 5, 8):]
     c0 = float(np.median(tail))
     x = seg - c0
-    f_fft, f, X, k = _spectral_peak(x, fs)
+    f_fft, f, X, k = _spectral_peak(x, rate)
     methods: dict[str, dict] = {"fft_peak": {"damped_frequency_hz": f_fft}}
     bw = _half_power(f, X, k)
     if math.isfinite(bw):
         methods["half_power"] = {"bandwidth_hz": bw, "damping_ratio": bw / (2.0 * f_fft)}
     noise = float(np.std(tail - np.mean(tail))) if noise_std is None else float(noise_std)
-    per = max(int(round(fs / f_fft)), 1)
+    per = max(int(round(rate / f_fft)), 1)
     for name, estimate in (("hilbert", _hilbert_estimate(x, t, per, noise)),
-                           ("log_decrement", _log_decrement_estimate(x, fs, f_fft, per, noise))):
+                           ("log_decrement", _log_decrement_estimate(x, rate, f_fft, per, noise))):
         if estimate is not None:
             methods[name] = estimate
     # damped-sine least squares, started from the best of the above
@@ -327,4 +329,4 @@ def free_vibration(y, fs: float, *, start: int | None = None, end: int | None = 
     if "hilbert" in methods:
         methods["hilbert"]["amplitude"] /= cy
     return ModalResult(fn, zeta, f_std, z_std, float(sine.amplitude) / cy, float(sine.offset + c0) / cy,
-                       float(i0 / fs), int(seg.size), float(fs), math.sqrt(sine.residual_variance) / cy, methods)
+                       float(i0 / rate), int(seg.size), float(dt), math.sqrt(sine.residual_variance) / cy, methods)

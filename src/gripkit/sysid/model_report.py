@@ -151,7 +151,7 @@ def singular_value_figure(sv, order):
 def model_report(model, data, *, data_name: str = "data", warnings_list=()) -> Report:
     """Build the :class:`~gripkit.report.html.Report` of ``model`` on the trajectory ``data``."""
     ss = model.system.to_ss(minimal=False)
-    dt = 1.0 / data.require_uniform(why="a model report")
+    dt = data.require_uniform(why="a model report")
     caught_lines = list(warnings_list)
     rep = Report(f"gripkit model report: {model.structure}",
                  f"{list(model.inputs)} → {list(model.outputs)}, order {ss.n_states}, data {data_name}")

@@ -52,7 +52,7 @@ def _iv_start(u, y, nb, nf, nk, t0) -> np.ndarray:
     return theta
 
 
-def oe(u, y, nb: int, nf: int, nk: int = 1, *, dt: float | None = None, fs: float | None = None,
+def oe(u, y, nb: int, nf: int, nk: int = 1, *, dt: float | None = None,
        maxiter: int = 100, tol: float = 1e-10, **meta) -> PolynomialModel:
     """Output-error model ``y = B/F u + e`` by prediction-error minimisation.
 
@@ -61,7 +61,7 @@ def oe(u, y, nb: int, nf: int, nk: int = 1, *, dt: float | None = None, fs: floa
     ``A = [1]``, ``F`` and ``F_std``; its poles are the roots of F.
     """
     check_meta(meta, oe)
-    u, y, step, nb, nf, nk = checked_problem(u, y, dt, fs, nb=nb, nf=nf, nk=nk)
+    u, y, step, nb, nf, nk = checked_problem(u, y, dt, nb=nb, nf=nf, nk=nk)
     cu, cy = unit_scale(u), unit_scale(y)
     return in_user_units(_oe(u * cu, y * cy, nb, nf, nk, step, maxiter, tol, meta), cu, cy)
 

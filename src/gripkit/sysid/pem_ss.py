@@ -376,7 +376,7 @@ def _pem_data(model: LinearModel, data, u, y) -> tuple[np.ndarray, np.ndarray]:
     model's names, offsets removed, sampled as the model) or from ``u`` and ``y``."""
     ss = model.system
     if data is not None:
-        dt = 1.0 / data.require_uniform(why="PEM refinement")
+        dt = data.require_uniform(why="PEM refinement")
         if abs(dt - ss.dt) > 1e-9 * ss.dt:
             raise DataError(f"data: sampled every {dt:g} s, the model every {ss.dt:g} s")
         u = model._columns(data, model.inputs, model.u_offset, "input")

@@ -85,7 +85,7 @@ class PolynomialModel:
     nk
         Input delay in samples.
     dt
-        Sample interval (s); ``fs = 1/dt``.
+        Sample interval (s).
     structure
         ``'arx'``, ``'armax'`` or ``'oe'``.
     parameter_names
@@ -263,10 +263,6 @@ class PolynomialModel:
         """``'ARX [2 2 2]'``."""
         return f"{self.structure.upper()} [{' '.join(str(o) for o in self.orders)}]"
 
-    @property
-    def fs(self) -> float:
-        return 1.0 / self.dt
-
     def _blocks(self):
         """(array name, array, slice of its free entries) in parameter order."""
         return [("A", self.A, slice(1, None)), ("B", self.B, slice(self.nk, None)),
@@ -430,7 +426,7 @@ class PolynomialModel:
     def frequency_response(self, f=None, n: int = 512) -> tuple[np.ndarray, np.ndarray]:
         """``(f_Hz, H)``: the complex response of B/(A F) at ``f`` (Hz; default ``n`` points from
         0 up to, not including, the Nyquist frequency), ``H = B(e^{-jωdt}) / (A F)(e^{-jωdt})``."""
-        f = np.linspace(0.0, 0.5 * self.fs, int(n), endpoint=False) if f is None \
+        f = np.linspace(0.0, 0.5 / self.dt, int(n), endpoint=False) if f is None \
             else np.atleast_1d(np.asarray(f, dtype=np.float64))
         return f, self.lti.frequency_response(2.0 * np.pi * f)[:, 0, 0]
 
@@ -538,7 +534,7 @@ class PolynomialModel:
                  aic=self.aic, fpe=self.fpe, noise_variance=self.noise_variance,
                  poles=pairs(self.poles()), zeros=pairs(self.zeros()),
                  minimum_phase=self.minimum_phase, stable=self.stable, dc_gain=self.dc_gain,
-                 n_samples=self.n_samples, dt=self.dt, fs=self.fs,
+                 n_samples=self.n_samples, dt=self.dt,
                  input=self.input_name, output=self.output_name, input_unit=self.input_unit,
                  output_unit=self.output_unit, u_offset=self.u_offset, y_offset=self.y_offset)
         return d

@@ -614,14 +614,14 @@ class RLSResult:
         ch["error"] = self.errors
         keep = slice(min(first_sigma, self.n_samples - 1), None)
         return Trajectory(t[keep], {k: v[keep] for k, v in ch.items()},
-                          meta={"fs": 1.0 / self.dt, "forgetting": self.forgetting,
+                          meta={"dt": self.dt, "forgetting": self.forgetting,
                                 "structure": f"ARX [{self.na} {self.nb} {self.nk}]"})
 
 
 @entry_point
 def rls(u, y, na: int, nb: int, nk: int = 1, *, forgetting: float = 1.0, p0: float = 1e4, theta0=None,
         windup: str = "trace", max_trace: float | None = None, dt: float | None = None,
-        fs: float | None = None, store: bool = True) -> RLSResult:
+        store: bool = True) -> RLSResult:
     """Recursive least squares over a record (numba batch kernel): θ and σ at every step.
 
     Parameters as :class:`RLS`; ``u``, ``y`` of shape (N,). Raises :class:`DataError` for bad
@@ -629,7 +629,7 @@ def rls(u, y, na: int, nb: int, nk: int = 1, *, forgetting: float = 1.0, p0: flo
     """
     u, y = check_io(u, y)
     est = RLS(na, nb, nk, forgetting=forgetting, p0=p0, theta0=theta0, windup=windup,
-              max_trace=max_trace, dt=check_dt(dt, fs))
+              max_trace=max_trace, dt=check_dt(dt))
     t0 = max(est.na, est.nk + est.nb - 1)
     p = est.n_params
     require_samples(u.size, t0 + p + 1, f"RLS ARX [{est.na} {est.nb} {est.nk}] ({p} parameters)")

@@ -105,7 +105,7 @@ def parse_range(text: str | int | Iterable[int], name: str) -> list[int]:
 
 @entry_point
 def structure_search(u, y, na=range(1, 5), nb=range(1, 5), nk=range(1, 11), *,
-                     criterion: str = "aic", dt: float | None = None, fs: float | None = None,
+                     criterion: str = "aic", dt: float | None = None,
                      progress: bool = True, validate=None) -> SearchResult:
     """Fit every ARX ``[na nb nk]`` of the given ranges and rank them.
 
@@ -125,7 +125,7 @@ def structure_search(u, y, na=range(1, 5), nb=range(1, 5), nk=range(1, 11), *,
         (more than 2·10⁶ candidate-samples).
     """
     u, y = check_io(u, y)
-    step = check_dt(dt, fs)
+    step = check_dt(dt)
     if validate is not None:
         uv, yv = check_io(*validate)
         criterion = "validation"

@@ -64,7 +64,7 @@ class StepResponseResult:
     fit_percent: float
     residual_std: float
     n_samples: int
-    fs: float
+    dt: float
     overshoot_percent: float
     peak_time: float
     rise_time: float
@@ -85,7 +85,7 @@ class StepResponseResult:
     def to_dict(self) -> dict:
         keys = ("gain", "gain_std", "natural_frequency_hz", "natural_frequency_hz_std", "damping_ratio",
                 "damping_ratio_std", "offset", "offset_std", "input_offset", "gain_unit", "fit_percent",
-                "residual_std", "n_samples", "fs", "overshoot_percent", "peak_time", "rise_time",
+                "residual_std", "n_samples", "dt", "overshoot_percent", "peak_time", "rise_time",
                 "settling_time")
         d = {k: getattr(self, k) for k in keys}
         d["covariance"] = self.covariance.tolist()
@@ -95,7 +95,7 @@ class StepResponseResult:
         return d
 
     def summary(self) -> str:
-        return (f"second-order step fit ({self.n_samples} samples at {self.fs:g} Hz, fit {self.fit_percent:.2f} %):\n"
+        return (f"second-order step fit ({self.n_samples} samples every {self.dt:g} s, fit {self.fit_percent:.2f} %):\n"
                 f"  gain K = {self.gain:.6g} ± {self.gain_std:.2g} {self.gain_unit}\n"
                 f"  natural frequency f_n = {self.natural_frequency_hz:.6g} ± {self.natural_frequency_hz_std:.2g} Hz\n"
                 f"  damping ratio ζ = {self.damping_ratio:.5g} ± {self.damping_ratio_std:.2g}\n"
@@ -241,7 +241,8 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
     if method not in STEP_METHODS:
         raise DataError(f"method: expected one of {', '.join(STEP_METHODS)}, found {method!r}",
                         hint="'lm' (Levenberg-Marquardt) or 'trf' (bounded trust-region; CLI: --method trf)")
-    fs = data.require_uniform(why="step-response identification")
+    dt = data.require_uniform(why="step-response identification")
+    nyquist_w = math.pi / dt  # rad/s
     data.require_samples(20, "step-response identification")
     u = np.asarray(data[input], dtype=np.float64)
     y = np.asarray(data[output], dtype=np.float64)
@@ -253,16 +254,15 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
     if y_scale == 0 or y_scale <= 1e-12 * np.max(np.abs(y)):  # relative: data at any scale
         raise DataError(f"output column {output!r} does not change: nothing to identify",
                         hint="check the column, or whether the system was powered")
-    dt = 1.0 / fs
     # fit in normalised units, u_n = (u − u₀)/Δu and y_n = (y − y₀,ref)/Δy, so that every
     # parameter is of order one whatever the physical units; mapped back below
     u0, y_ref = float(u[0]), float(y[0])
     un, yn = (u - u0) / u_scale, (y - y_ref) / y_scale
     start = _arx_start(un, yn, dt)
-    if start is None or not (0 < start[1] < math.pi * fs):
+    if start is None or not (0 < start[1] < nyquist_w):
         start = _level_start(data.t, un, yn)
     K0, wn0, z0 = start
-    wn0 = min(wn0, 0.9 * math.pi * fs)
+    wn0 = min(wn0, 0.9 * nyquist_w)
     z0 = min(max(z0, 1e-3), 5.0)
     model = SecondOrderSystem(gain=K0, wn=wn0, zeta=z0, y0=0.0, u0=0.0, input_name="u", output_name="y")
     sub = Trajectory(data.t, {"u": un, "y": yn}, meta=data.meta)
@@ -279,12 +279,12 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
         except SimulationError:
             raise IdentificationError(
                 f"the response of {output!r} to {input!r} is not a second-order response resolved at "
-                f"{fs:g} Hz: the fit diverged", hint="check the columns, or record at a higher sampling rate") from None
+                f"dt = {dt:g} s: the fit diverged", hint="check the columns, or record at a higher sampling rate") from None
     Kn, wn, zeta, y0n = (res.value(n) for n in ("gain", "wn", "zeta", "y0"))
-    if wn >= math.pi * fs:
+    if wn >= nyquist_w:
         raise IdentificationError(
             f"the fitted natural frequency {wn / (2 * math.pi):.4g} Hz is above the Nyquist frequency "
-            f"{fs / 2:.4g} Hz of the data", hint="record at a higher sampling rate")
+            f"{0.5 / dt:.4g} Hz of the data", hint="record at a higher sampling rate")
     if not res.identifiability.ok:
         warnings.warn(f"step-response fit of {output!r}: {res.identifiability}", AccuracyWarning, stacklevel=2)
     K = Kn * y_scale / u_scale
@@ -308,6 +308,6 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
         natural_frequency_hz_std=float(std[1]), damping_ratio=zeta, damping_ratio_std=float(std[2]),
         offset=y0, offset_std=float(std[3]), input_offset=float(u[0]), gain_unit=gunit,
         covariance=cov, correlation=corr, fit_percent=float(res.fit_percent[0]),
-        residual_std=float(res.residual_std[0]), n_samples=int(data.n), fs=float(fs),
+        residual_std=float(res.residual_std[0]), n_samples=int(data.n), dt=float(dt),
         overshoot_percent=m["overshoot_percent"], peak_time=m["peak_time"], rise_time=m["rise_time"],
         settling_time=m["settling_time"], y_model=y_ref + res.y_model[:, 0] * y_scale, greybox=res)

@@ -351,7 +351,7 @@ def from_factor(fac: SubspaceFactor, n: int, *, dt: float, feedthrough: bool = F
 
 
 def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int | None = None,
-          dt: float | None = None, fs: float | None = None, feedthrough: bool = False, stable: bool = True,
+          dt: float | None = None, feedthrough: bool = False, stable: bool = True,
           max_order: int = DEFAULT_MAX_ORDER, inputs=None, outputs=None, input_units=None, output_units=None,
           u_offset=None, y_offset=None) -> LinearModel:
     """Subspace identification of a discrete MIMO state-space model in innovation form.
@@ -368,8 +368,8 @@ def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int
         ``'n4sid'``, ``'moesp'`` or ``'cva'`` (weightings, see the module docstring).
     horizon
         Block rows k of the Hankel matrices (default :func:`default_horizon`).
-    dt, fs
-        Sample interval (s) or rate (Hz).
+    dt
+        Sample interval (s).
     feedthrough
         Estimate D (default False: D = 0, a sampled physical system with a zero-order hold).
     stable
@@ -399,7 +399,7 @@ def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int
         raise DataError(f"method: expected one of {', '.join(SUBSPACE_METHODS)}, found {method!r}")
     u = as_io_matrix(u, "input u")
     y = as_io_matrix(y, "output y", u.shape[0])
-    step = check_dt(dt, fs)
+    step = check_dt(dt)
     if order is not None:
         if isinstance(order, bool) or not float(order).is_integer() or int(order) < 1:
             raise DataError(f"order: expected a positive integer, found {order!r}")

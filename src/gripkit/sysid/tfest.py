@@ -232,7 +232,7 @@ def _simulate_ct(theta, npo, nz, u, dt, x0=None):
     return d.A, d.B, d.C, d.D
 
 
-def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None, fs: float | None = None,
+def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None,
           inputs=None, outputs=None, input_units=None, output_units=None, u_offset=None,
           y_offset=None) -> LinearModel:
     """Continuous-time G(s) with ``n_poles`` poles and ``n_zeros`` zeros from sampled data
@@ -262,7 +262,7 @@ def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None, fs: floa
     if u.shape[1] != 1 or y.shape[1] != 1:
         raise DataError(f"tfest: expected one input and one output, found {u.shape[1]} and {y.shape[1]}",
                         hint="estimate one input-output pair at a time, or use gripkit identify ss")
-    step = check_dt(dt, fs)
+    step = check_dt(dt)
     N = u.shape[0]
     k = npo + nz + 1
     if N < 10 * k + 64:

@@ -173,9 +173,9 @@ def detector():
 
     rng = np.random.default_rng(8)
     c = StickSlipContact()
-    u = nonslip_grasp_inputs(20.0, 2000.0, rng)
-    x = c.simulate(u, dt=1 / 2000.0, x0=c.equilibrium_state(u[0, 1]))["v_pvdf"] + pvdf_noise(u.shape[0], 2000.0, rng)
-    return SlipDetector(2000.0).calibrate(x)
+    u = nonslip_grasp_inputs(20.0, dt=0.0005, rng=rng)
+    x = c.simulate(u, dt=1 / 2000.0, x0=c.equilibrium_state(u[0, 1]))["v_pvdf"] + pvdf_noise(u.shape[0], dt=0.0005, rng=rng)
+    return SlipDetector(dt=0.0005).calibrate(x)
 
 
 @pytest.mark.parametrize("k_object, hold_tol", [(300.0, 0.25), (2000.0, 0.1), (math.inf, 0.1)])

@@ -31,7 +31,7 @@ def drifting_log():
     x1 = f2.state(q=[a[j][-1] for j in ("abd", "flex", "prox")], qd=[a[f"{j}_vel"][-1] for j in ("abd", "flex", "prox")])
     b = simulate_impedance(f2, c, ref[n:], x0=x1)
     names = ("abd", "flex", "prox", "abd_vel", "flex_vel", "prox_vel", "pwm_base1", "pwm_base2", "pwm_distal")
-    return f1, Trajectory.uniform(1000.0, **{k: np.concatenate([a[k], b[k]]) for k in names})
+    return f1, Trajectory.uniform(dt=0.001, **{k: np.concatenate([a[k], b[k]]) for k in names})
 
 
 def test_adaptation_converges_to_a_changed_friction(drifting_log):

@@ -48,7 +48,7 @@ def excitation_log():
 
 def test_idim_ls_recovers_inertia_and_friction_within_2_percent(excitation_log):
     d = excitation_log
-    res = idim_ls(d["pos"], d["current"], FS, effort_scale=d["k"])
+    res = idim_ls(d["pos"], d["current"], dt=1 / FS, effort_scale=d["k"])
     assert res.params["inertia"] == pytest.approx(d["J"], rel=0.02)
     assert res.params["viscous"] == pytest.approx(TRUE["viscous"], rel=0.02)
     assert res.params["coulomb"] == pytest.approx(TRUE["coulomb"], rel=0.02)
@@ -92,13 +92,13 @@ def test_idim_ls_refuses_bad_data():
     t = np.arange(5000) / FS
     x = np.sin(t)
     with pytest.raises(DataError, match="non-finite"):
-        idim_ls(np.r_[x[:-1], np.nan], x, FS)
+        idim_ls(np.r_[x[:-1], np.nan], x, dt=1 / FS)
     with pytest.raises(DataError, match="too few"):
-        idim_ls(x[:300], x[:300], FS)
+        idim_ls(x[:300], x[:300], dt=1 / FS)
     with pytest.raises(UnidentifiableError, match="one direction"):
-        idim_ls(t, np.ones_like(t), FS)
+        idim_ls(t, np.ones_like(t), dt=1 / FS)
     with pytest.raises(UnidentifiableError, match="never changes"):
-        idim_ls(np.zeros_like(t), np.ones_like(t), FS)
+        idim_ls(np.zeros_like(t), np.ones_like(t), dt=1 / FS)
 
 
 def pulse_series(f, q0, direction, on=0.25, off=0.25):
@@ -160,7 +160,7 @@ def test_constant_velocity_runs_rebuild_the_friction_table():
     J = f.chain().mass_matrix(np.zeros(3))[2, 2]
     pts = constant_velocity_friction(np.concatenate(pwm), np.concatenate(vel),
                                      motor_torque=lambda u, v: float(f.motor_torque("distal", u, v)),
-                                     inertia=J, fs=FS, plateau=0.01)
+                                     inertia=J, dt=1 / FS, plateau=0.01)
     assert len(pts) == 22
     table = f.tables[2]
     dev = np.array([p.friction / float(table(p.velocity)) - 1 for p in pts])

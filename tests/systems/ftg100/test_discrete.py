@@ -32,7 +32,7 @@ def test_eq10_matrices_reproduced(act):
     """Eq 10 from D_a = 4.7, K_sa = 25.4 N/m, M_a = 1.37 mg, K_fa = 1.3 mN·s/m, k0 = 1043 N/m,
     k2 = 6.45 N/m: A_a = [[1.6621, -0.9536], [1, 0]], B_a = [0.25, 0], C_a = [0.1104, 0.1086] µm/V.
     Eigenvalues within 0.3 % (the printed parameters carry 2-3 digits)."""
-    d = act.discrete(FS)
+    d = act.discrete(1 / FS)
     seed = np.array(SEED_EQ10["A"])
     ev, es = np.sort_complex(np.linalg.eigvals(d.A)), np.sort_complex(np.linalg.eigvals(seed))
     assert np.max(np.abs(ev - es) / np.abs(es)) < 0.003
@@ -48,7 +48,7 @@ def test_dc_gain_0_1878_um_per_volt(act):
     seed_dc = (C @ np.linalg.solve(np.eye(2) - A, B)).item()
     assert seed_dc == pytest.approx(0.1878, abs=5e-5)
     assert act.dc_gain() * 1e6 == pytest.approx(0.1878, rel=0.015)
-    assert float(act.discrete(FS).dc_gain()[0, 0]) == pytest.approx(act.dc_gain(), rel=1e-10)
+    assert float(act.discrete(1 / FS).dc_gain()[0, 0]) == pytest.approx(act.dc_gain(), rel=1e-10)
 
 
 def test_canonical_form_matches_scipy_and_control(act):
@@ -56,7 +56,7 @@ def test_canonical_form_matches_scipy_and_control(act):
     c2d gives the same poles."""
     num, den = act.transfer_function()
     nd, dd, _ = signal.cont2discrete((num, den), 1 / FS, method="zoh")
-    d = act.discrete(FS)
+    d = act.discrete(1 / FS)
     n2, d2 = signal.ss2tf(d.A, d.B, d.C, d.D)
     # Denominators: sums of products of the two eigenvalues, each route accurate to a few ε.
     # Numerators: ss2tf forms them as poly(A − BC) − poly(A), a difference of O(1) coefficients that
@@ -70,10 +70,10 @@ def test_canonical_form_matches_scipy_and_control(act):
     sysd = control.c2d(control.tf(num, den), 1 / FS, "zoh")
     np.testing.assert_allclose(np.sort_complex(control.poles(sysd)), np.sort_complex(d.poles()), rtol=1e-10)
     # physical-coordinate ZOH is similar: same poles and DC gain
-    p = act.discrete(FS, form="physical")
+    p = act.discrete(1 / FS, form="physical")
     np.testing.assert_allclose(np.sort_complex(p.poles()), np.sort_complex(d.poles()), rtol=1e-12)
     with pytest.raises(ModelError):
-        act.discrete(FS, form="jordan")
+        act.discrete(1 / FS, form="jordan")
 
 
 def test_balancing_scale_reproduces_both_printed_forms():
@@ -100,7 +100,7 @@ def test_eq17_inconsistency_detected(sen):
     assert implied.computed == pytest.approx(0.660e-6, rel=2e-3)
     assert "0.6586 mg" in implied.message
     assert not rep.find("eq17-dc-gain").consistent
-    d = sen.discrete(FS)
+    d = sen.discrete(1 / FS)
     np.testing.assert_allclose(d.A, [[0.902582, -0.931462], [1, 0]], atol=1e-6)
     with pytest.warns(ConsistencyWarning) as rec:
         FTG100Sensing()
@@ -117,7 +117,7 @@ def test_eq18_coupled():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", ConsistencyWarning)
         cpl = FTG100Coupled()
-    d = cpl.discrete(FS)
+    d = cpl.discrete(1 / FS)
     act = cpl.actuated()
     p = cpl.parameters
     kk = p.value("k0") * p.value("k2") / (p.value("k0") + p.value("k2"))
@@ -125,10 +125,10 @@ def test_eq18_coupled():
     xb = xa * kk * p.value("D_b") ** 2 / p.value("K_sb")
     dc = d.dc_gain()[:, 0]
     np.testing.assert_allclose(dc, [xa, xb, kk * xa, p.value("k2") / 50e-6 * xb], rtol=1e-7)
-    exact = cpl.discrete(FS, form="physical")
+    exact = cpl.discrete(1 / FS, form="physical")
     np.testing.assert_allclose(exact.dc_gain()[:, 0], dc, rtol=1e-7)
     np.testing.assert_allclose(np.sort_complex(exact.poles()), np.sort_complex(d.poles()), rtol=1e-9)
-    np.testing.assert_allclose(d.A[:2, :2], act.discrete(FS).A)
+    np.testing.assert_allclose(d.A[:2, :2], act.discrete(1 / FS).A)
     # simulate: the exact cascade settles at the DC gains
     u = np.full(4000, p.value("V0") + 1.0)
     y = cpl.simulate({"V_in": u}, dt=1 / FS)

@@ -39,12 +39,12 @@ def test_batch_kernel_reproduces_the_single_grasp(gripper):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             g = z.gripper(stiffness=k, width=w, centre=xp, check=False)
-        r = simulate_two_finger_grasp(g, settings=replace(FAST_GRASP, approach_speed=v), duration=DUR, fs=FS,
+        r = simulate_two_finger_grasp(g, settings=replace(FAST_GRASP, approach_speed=v), duration=DUR, dt=1 / FS,
                                       noise_std=2e-6, seed=j)
         refs.append(record_metrics(r, gap=400e-6, width=w, stiffness=k))
         noises.append(np.random.default_rng(j).standard_normal((N, 2)) * 2e-6)  # the noise it drew
     res = tsfm_grasp_batch(gripper, k_e=[j[0] for j in jobs], w=[j[1] for j in jobs], X_p=[j[2] for j in jobs],
-                           approach_speed=[j[3] for j in jobs], noise=np.array(noises), duration=DUR, fs=FS)
+                           approach_speed=[j[3] for j in jobs], noise=np.array(noises), duration=DUR, dt=1 / FS)
     for m in METRICS:
         ref = np.array([r[m] for r in refs])
         if m in EXACT:

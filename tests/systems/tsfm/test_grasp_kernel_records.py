@@ -30,7 +30,7 @@ def results():
         g = z.gripper(stiffness=469.0, width=360e-6, centre=206e-6, check=False)
         out = {}
         r = simulate_two_finger_grasp(g, settings=replace(FAST_GRASP, approach_speed=1.5e-3), duration=0.03,
-                                      fs=20000.0, noise_std=2e-6, seed=3)
+                                      dt=5e-05, noise_std=2e-6, seed=3)
         out["single_grasp"] = r.trajectory.as_array()
         res = tsfm_grasp_batch(k_e=[72.5, 800.0, 12.1, 300.0], w=[396e-6, 394e-6, 380e-6, 370e-6],
                                offset=[0.0, 1e-6, -3e-6, 2e-6], approach_speed=[1e-3, 1.5e-3, 0.8e-3, 1.2e-3],

@@ -89,7 +89,7 @@ def test_modal_within_the_issue_tolerances(ringing):
     """0.1 s of free vibration at 20 kHz with 1 % noise (Fig. 8): f0 within 0.2 %, ζ within 10 %,
     every method (FFT peak, half-power, log decrement, Hilbert, fit) within those bounds too."""
     for tr in ringing[:5]:
-        r = free_vibration(tr["F"], tr.fs)
+        r = free_vibration(tr["F"], dt=tr.dt)
         assert r.natural_frequency_hz == pytest.approx(8520.0, rel=0.002)
         assert r.damping_ratio == pytest.approx(0.006, rel=0.10)
         assert r.methods["fft_peak"]["damped_frequency_hz"] == pytest.approx(8520.0, rel=0.002)
@@ -100,7 +100,7 @@ def test_modal_within_the_issue_tolerances(ringing):
 def test_modal_std_agrees_with_the_spread(ringing):
     """Asymptotic σ of the damped-sine fit against the spread of 20 noisy repetitions (within a
     factor 1.6: 20 draws give the sample σ to about ±16 %)."""
-    rs = [free_vibration(tr["F"], tr.fs) for tr in ringing]
+    rs = [free_vibration(tr["F"], dt=tr.dt) for tr in ringing]
     f = np.array([r.natural_frequency_hz for r in rs])
     zt = np.array([r.damping_ratio for r in rs])
     for est, sd in ((f, [r.natural_frequency_std_hz for r in rs]), (zt, [r.damping_ratio_std for r in rs])):
@@ -131,14 +131,14 @@ def test_to_tip_a_divides_by_the_lever_gains():
 
 def test_bad_data():
     with pytest.raises(DataError, match="never reverses"):
-        identify_bouc_wen(Trajectory.uniform(100.0, U=np.linspace(0, 1, 50), y=np.linspace(0, 1, 50)),
+        identify_bouc_wen(Trajectory.uniform(dt=0.01, U=np.linspace(0, 1, 50), y=np.linspace(0, 1, 50)),
                           progress=False)
     with pytest.raises(DataError, match="constant"):
-        free_vibration(np.ones(200), 1000.0)
+        free_vibration(np.ones(200), dt=0.001)
     with pytest.raises(DataError, match="no oscillation"):
-        free_vibration(np.random.default_rng(0).standard_normal(2000), 1000.0)
+        free_vibration(np.random.default_rng(0).standard_normal(2000), dt=0.001)
     with pytest.raises(DataError, match="NaN"):
-        free_vibration(np.array([0.0, np.nan] * 50), 1000.0)
+        free_vibration(np.array([0.0, np.nan] * 50), dt=0.001)
 
 
 def test_cli_identify(tmp_path, capsys, left, loops, ringing):

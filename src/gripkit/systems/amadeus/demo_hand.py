@@ -30,7 +30,8 @@ from .pvdf import SlipTestbed, nonslip_grasp_inputs, pvdf_noise, slip_onset_inpu
 from .slip import SlipDetector, calibrate_speed, false_alarm_rate, spectral_features
 from .strain_gauge_sensor import single_bridge_estimates
 
-FS_PVDF = 2000.0
+DT_PVDF = 5e-4  # s: the PVDF film sampled at 2 kHz
+PVDF_RATE = 1.0 / DT_PVDF  # samples per second, for the index arithmetic
 
 
 def _bending(report, z, rng, summary):
@@ -161,27 +162,27 @@ def _slip(report, z, rng, summary, quick):
         "A stick-slip fingertip contact drives the PVDF film (a high-pass of the deformation: charge decays, "
         "§IV-B); pump ripple and electronics noise are added. The detector thresholds the 60-800 Hz band "
         "energy (5 ms window, 2 ms persistence) at twice its 99.99 % quantile on 30 s of non-slip grasping.")
-    cal_in = nonslip_grasp_inputs(30.0, FS_PVDF, rng)
-    cal_sig = c.simulate(cal_in, dt=1 / FS_PVDF, x0=c.equilibrium_state(cal_in[0, 1]))["v_pvdf"] + pvdf_noise(cal_in.shape[0], FS_PVDF, rng)
-    det = SlipDetector(FS_PVDF).calibrate(cal_sig)
+    cal_in = nonslip_grasp_inputs(30.0, dt=DT_PVDF, rng=rng)
+    cal_sig = c.simulate(cal_in, dt=DT_PVDF, x0=c.equilibrium_state(cal_in[0, 1]))["v_pvdf"] + pvdf_noise(cal_in.shape[0], dt=DT_PVDF, rng=rng)
+    det = SlipDetector(dt=DT_PVDF).calibrate(cal_sig)
     # speed calibration on the test rig (Fig. 12(b))
     tb = SlipTestbed(check=False)
     recs, sp, fn, show = [], [], [], {}
     for v in (0.004, 0.008, 0.012, 0.016, 0.020):
         for F in (1.5, 2.5):
-            n = int(0.6 * FS_PVDF)
+            n = int(0.6 * PVDF_RATE)
             u = np.column_stack([np.full(n, F), np.full(n, v)])
-            x = tb.simulate(u, dt=1 / FS_PVDF)["v_pvdf"] + pvdf_noise(n, FS_PVDF, rng)
+            x = tb.simulate(u, dt=DT_PVDF)["v_pvdf"] + pvdf_noise(n, dt=DT_PVDF, rng=rng)
             recs.append(x)
             sp.append(v)
             fn.append(F)
             if F == 2.5:
                 show[v] = x
-    det.speed_calibration = calibrate_speed(recs, sp, FS_PVDF, normal_forces=fn)
+    det.speed_calibration = calibrate_speed(recs, sp, dt=DT_PVDF, normal_forces=fn)
     sc = det.speed_calibration
     fig, axes = subplots(len(show), 1, figsize=(9, 6), sharex=True)
     for ax, (v, x) in zip(axes, show.items()):
-        tt = np.arange(x.size) / FS_PVDF
+        tt = np.arange(x.size) / PVDF_RATE
         ax.plot(tt, x * 1e3, lw=0.7)
         ax.set_ylabel(f"{v * 1e3:.0f} mm/s", fontsize=8)
     axes[-1].set_xlabel("time (s)")
@@ -189,14 +190,14 @@ def _slip(report, z, rng, summary, quick):
     sec.figure(fig, "Test-rig slip signals at five speeds (cf. Fig. 12(b)); the stick-slip rate grows with speed.",
                name="amadeus-slip-speeds")
     # a slip event during a grasp
-    u = slip_onset_inputs(1.2, FS_PVDF, normal_force=2.0, load0=0.6, start=0.3, rate=3.0)
-    tr = c.simulate(u, dt=1 / FS_PVDF, x0=c.equilibrium_state(u[0, 1]))
-    x = tr["v_pvdf"] + pvdf_noise(u.shape[0], FS_PVDF, rng)
+    u = slip_onset_inputs(1.2, dt=DT_PVDF, normal_force=2.0, load0=0.6, start=0.3, rate=3.0)
+    tr = c.simulate(u, dt=DT_PVDF, x0=c.equilibrium_state(u[0, 1]))
+    x = tr["v_pvdf"] + pvdf_noise(u.shape[0], dt=DT_PVDF, rng=rng)
     truth = tr["slipping"]
-    t_on = float(np.argmax(truth > 0)) / FS_PVDF
+    t_on = float(np.argmax(truth > 0)) / PVDF_RATE
     d = det.detect(x, normal_force=u[:, 0])
     ev = d.events[0]
-    tt = np.arange(x.size) / FS_PVDF
+    tt = np.arange(x.size) / PVDF_RATE
     fig, axes = subplots(3, 1, figsize=(9, 7.5))
     axes[0].plot(tt, x * 1e3, lw=0.6)
     axes[0].axvline(t_on, color="g", ls="--", label="true onset")
@@ -208,8 +209,8 @@ def _slip(report, z, rng, summary, quick):
     axes[1].set_ylabel("band energy (V²)")
     axes[1].set_xlabel("time (s)")
     axes[1].legend(fontsize=8)
-    pre = spectral_features(x[int(0.05 * FS_PVDF):int(0.3 * FS_PVDF)], FS_PVDF, frame=0.064)
-    post = spectral_features(x[int((t_on + 0.05) * FS_PVDF):], FS_PVDF, frame=0.064)
+    pre = spectral_features(x[int(0.05 * PVDF_RATE):int(0.3 * PVDF_RATE)], dt=DT_PVDF, frame=0.064)
+    post = spectral_features(x[int((t_on + 0.05) * PVDF_RATE):], dt=DT_PVDF, frame=0.064)
     axes[2].semilogy(pre.freqs, pre.power.mean(0), label="holding (no slip)")
     axes[2].semilogy(post.freqs, post.power.mean(0), label="slipping")
     axes[2].set_xlabel("frequency (Hz)")
@@ -222,11 +223,11 @@ def _slip(report, z, rng, summary, quick):
     # false alarms over a non-slip record
     T = 60.0 if quick else 600.0
     t0 = time.perf_counter()
-    ns = nonslip_grasp_inputs(T, FS_PVDF, rng)
-    trn = c.simulate(ns, dt=1 / FS_PVDF, x0=c.equilibrium_state(ns[0, 1]))
-    xn = trn["v_pvdf"] + pvdf_noise(ns.shape[0], FS_PVDF, rng)
+    ns = nonslip_grasp_inputs(T, dt=DT_PVDF, rng=rng)
+    trn = c.simulate(ns, dt=DT_PVDF, x0=c.equilibrium_state(ns[0, 1]))
+    xn = trn["v_pvdf"] + pvdf_noise(ns.shape[0], dt=DT_PVDF, rng=rng)
     dn = det.detect(xn)
-    fa = false_alarm_rate(dn.slipping, trn["slipping"], FS_PVDF)
+    fa = false_alarm_rate(dn.slipping, trn["slipping"], dt=DT_PVDF)
     el = time.perf_counter() - t0
     sec.table(["quantity", "value"], [
         ["true onset (s)", t_on], ["detected onset (s)", ev.onset], ["alarm (s)", ev.alarm],
@@ -234,7 +235,7 @@ def _slip(report, z, rng, summary, quick):
         ["stick-slip rate at onset (Hz)", ev.rate],
         ["speed indication (mm/s)", f"{1e3 * ev.speed:.1f} ± {1e3 * ev.speed_std:.1f}" if ev.speed is not None else "-"],
         ["true slip speed over the feature window (mm/s)",
-         1e3 * float(np.mean(np.abs(tr["v_slip"][int(ev.onset * FS_PVDF):int((ev.onset + 0.1) * FS_PVDF)])))],
+         1e3 * float(np.mean(np.abs(tr["v_slip"][int(ev.onset * PVDF_RATE):int((ev.onset + 0.1) * PVDF_RATE)])))],
         [f"non-slip record: duration (s), true slip samples", f"{T:.0f}, {int((trn['slipping'] > 0).sum())}"],
         ["false-alarm frames (10 ms) / rate", f"{fa['n_false']} / {100 * fa['rate']:.3f} %"],
         ["false alarms per minute", fa["per_minute"]],

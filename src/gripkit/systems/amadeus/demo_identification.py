@@ -30,7 +30,7 @@ from ...excitation import bandlimited_noise, multisine
 from ...report import plots
 from ...signals.filters import apply_sos
 from ...sysid import arx, oe, rls
-from .force_dynamics import (FORCE_SCALE, FORCE_SCALE_NOTE, FS, TABLE_II, TABLE_III,
+from .force_dynamics import (FORCE_SCALE, FORCE_SCALE_NOTE, DT, TABLE_II, TABLE_III,
                              finger_force_model as build_plant, reference, seed_checks)
 
 __all__ = ["run", "NOISE_UNITS"]
@@ -84,8 +84,8 @@ def _simulate_study() -> _Study:
     """The paper's excitations (§V-E) between 600 and 1100 mA on the zoo plant, with white
     measurement noise of :data:`NOISE_UNITS` sensor units on the force."""
     plant = build_plant()
-    s1 = multisine(range(1, 11), 2.0, FS, operating_point=0.850, limits=(0.600, 1.100), unit="A")
-    s2 = bandlimited_noise(0.3, 10.0, 20.0, FS, operating_point=0.850, limits=(0.600, 1.100), seed=7, unit="A")
+    s1 = multisine(range(1, 11), 2.0, dt=DT, operating_point=0.850, limits=(0.600, 1.100), unit="A")
+    s2 = bandlimited_noise(0.3, 10.0, 20.0, dt=DT, operating_point=0.850, limits=(0.600, 1.100), seed=7, unit="A")
     noise_std = NOISE_UNITS * FORCE_SCALE  # N
     rec = {"S1": plant.simulate(s1.u, noise_std=noise_std, seed=1),
            "S2": plant.simulate(s2.u, noise_std=noise_std, seed=2)}
@@ -121,7 +121,7 @@ def _ls_table(sec, study: _Study) -> dict:
                 row = [f"[{st[0]} {st[1]} {st[2]}]", name]
                 for var in VARIANTS:
                     u, y = study.signals(name, var)
-                    m = arx(u, y, *st, fs=FS, input_name="current", output_name="force",
+                    m = arx(u, y, *st, dt=DT, input_name="current", output_name="force",
                             input_unit="A", output_unit="N")
                     fits[(name, st, var)] = m
                     row.append(m.loss / FORCE_SCALE**2)
@@ -205,7 +205,7 @@ def _output_error(sec, study: _Study, fits: dict):
     ARX's, the residual tests, the free runs on S1 and the Bode plot. Returns the validations of
     the raw ARX and the OE models on S1."""
     u2, y2 = study.signals("S2", "raw")
-    moe = oe(u2, y2, 2, 2, 2, fs=FS, input_name="current", output_name="force", input_unit="A", output_unit="N")
+    moe = oe(u2, y2, 2, 2, 2, dt=DT, input_name="current", output_name="force", input_unit="A", output_unit="N")
     marx = fits[("S2", (2, 2, 2), "raw")]
     m222 = fits[("S2", (2, 2, 2), "prefiltered u, y")]
     names = ["a1 / f1", "a2 / f2", "b2 [N/mA]", "b3 [N/mA]"]
@@ -262,7 +262,7 @@ def _rls(sec, study: _Study) -> None:
     for ref in TABLE_III:
         var = "prefiltered u, y" if ref.filtered else "raw"
         u, y = study.signals("S1", var)
-        res = rls(u, y, ref.na, ref.nb, ref.nk, forgetting=1.0, p0=1e6, fs=FS)
+        res = rls(u, y, ref.na, ref.nb, ref.nk, forgetting=1.0, p0=1e6, dt=DT)
         bscale = 1e-3 / FORCE_SCALE  # N/A -> sensor units per mA, the seed's scale
         th = ", ".join(_fmt_pm(v * (1 if n[0] == "a" else bscale), s * (1 if n[0] == "a" else bscale))
                        for n, v, s in zip(res.names, res.theta_final, res.theta_std_final))
@@ -271,7 +271,7 @@ def _rls(sec, study: _Study) -> None:
                "V_N (a-priori errors, units²)", "Table III V_N"],
               rrows, caption="RLS (λ = 1, P0 = 10⁶·I) over the structures of Table III on S1 (400 samples).")
     u, y = study.signals("S2", "prefiltered u, y")
-    res = rls(u, y, 2, 2, 2, forgetting=1.0, p0=1e6, fs=FS)
+    res = rls(u, y, 2, 2, 2, forgetting=1.0, p0=1e6, dt=DT)
     sc = np.array([1, 1, 1e-3, 1e-3])
     sec.figure(plots.parameter_convergence(study.rec["S2"].t, res.theta * sc, res.theta_std * sc,
                                            ["a1", "a2", "b2 [N/mA]", "b3 [N/mA]"], truth=study.truth.theta * sc,
@@ -307,5 +307,5 @@ def _scaled_filter(plant, gain: float):
     from scipy import signal as sig
 
     b, a = sig.sos2tf(plant.prefilter_sos())
-    f, h = sig.freqz(b, a, worN=512, fs=plant.fs)
+    f, h = sig.freqz(b, a, worN=512, fs=1.0 / plant.dt)
     return f, gain * h

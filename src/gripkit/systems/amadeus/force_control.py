@@ -249,7 +249,7 @@ class _SlipChannel:
         self.ns_contact = self.contact.substeps(1.0 / sc.pvdf_rate, self.contact.theta()[None, :])
         self.pv = np.zeros(N * self.n_sub)
         self.alarms = []
-        self.noise = pvdf_noise(N * self.n_sub, sc.pvdf_rate, rng)
+        self.noise = pvdf_noise(N * self.n_sub, dt=1.0 / sc.pvdf_rate, rng=rng)
 
     def period(self, k: int, F: float, load: float, supervisor: "_Supervisor", out: dict) -> float:
         """Advance the contact over control period k; record the film voltage, slipping fraction,

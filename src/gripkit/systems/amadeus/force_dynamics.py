@@ -46,11 +46,11 @@ from ...sysid.checks import as_signal
 from ...sysid.polynomial import PolynomialModel
 
 __all__ = ["ReferenceModel", "TABLE_II", "TABLE_III", "FingerForcePlant", "finger_force_model",
-           "seed_checks", "SEED", "FS", "PREFILTER_ORDER", "PREFILTER_CUTOFF", "FORCE_SCALE", "PEAK_FORCE",
+           "seed_checks", "SEED", "DT", "PREFILTER_ORDER", "PREFILTER_CUTOFF", "FORCE_SCALE", "PEAK_FORCE",
            "FORCE_SCALE_DERIVATION", "FORCE_SCALE_NOTE", "force_scale_parameter"]
 
 SEED = "000_8f66dcc7ab06470c.txt"
-FS = 200.0  # Hz, §V-C
+DT = 0.005  # s: sampled at 200 Hz, §V-C
 PREFILTER_ORDER = 2  # §V-D
 PREFILTER_CUTOFF = 9.0  # Hz, §V-D
 OPERATING_POINT = 0.850  # A, §V-E
@@ -88,7 +88,7 @@ class ReferenceModel:
     def source(self) -> str:
         return f"{SEED}, Table {self.table}, {self.label}" + (", 9 Hz filter" if self.filtered else "")
 
-    def model(self, dt: float = 1.0 / FS):
+    def model(self, dt: float = DT):
         """A :class:`~gripkit.sysid.PolynomialModel` with these coefficients (paper units)."""
         std = None if self.A_std is None else {"A": self.A_std, "B": self.B_std}
         return PolynomialModel.from_coefficients(self.A, self.B, nk=self.nk, dt=dt, std=std,
@@ -204,7 +204,7 @@ class FingerForcePlant:
         Zoo identity.
     parameters
         :class:`~gripkit.params.ParameterSet`: a1, a2 (1), b2, b3 (N/A, displayed N/mA, σ from
-        Table III), fs (Hz), delay (samples), prefilter order and cutoff, operating point and
+        Table III), dt (s), delay (samples), prefilter order and cutoff, operating point and
         current limits (A, displayed mA).
     model
         The :class:`~gripkit.sysid.PolynomialModel` (SI): ``poles()``, ``zeros()``, ``step()``,
@@ -235,13 +235,13 @@ class FingerForcePlant:
               source=f"{src} (printed in units/mA; × force_scale); {srcs}", std=k * sig.B_std[3],
               display_unit="N/mA"),
             scale,
-            P("fs", FS, "Hz", "sampling rate", bounds=(0, None), source=f"{SEED}, §V-C"),
+            P("dt", DT, "s", "sample interval (200 Hz)", bounds=(0, None), source=f"{SEED}, §V-C"),
             P("delay", float(row.nk), "1", "valve transport delay in samples (about 0.01 s)",
               bounds=(0, None), source=f"{SEED}, §V-C, Fig. 15"),
             P("prefilter_order", float(PREFILTER_ORDER), "1", "order of the Butterworth low-pass on force",
               source=f"{SEED}, §V-D"),
             P("prefilter_cutoff", PREFILTER_CUTOFF, "Hz", "cutoff of the Butterworth low-pass on force",
-              bounds=(0, FS / 2), source=f"{SEED}, §V-D"),
+              bounds=(0, 0.5 / DT), source=f"{SEED}, §V-D"),
             P("operating_point", OPERATING_POINT, "A", "valve current the model is linearised around",
               source=f"{SEED}, §V-E", display_unit="mA"),
             P("current_min", CURRENT_LIMITS[0], "A", "lowest valve current of the excitation",
@@ -252,7 +252,7 @@ class FingerForcePlant:
         ps = self.parameters
         self.model = PolynomialModel.from_coefficients(
             [1.0, ps.value("a1"), ps.value("a2")], [0.0, 0.0, ps.value("b2"), ps.value("b3")], nk=2,
-            dt=1.0 / FS, std={"A": [0.0, ps["a1"].std, ps["a2"].std], "B": [0, 0, ps["b2"].std, ps["b3"].std]},
+            dt=DT, std={"A": [0.0, ps["a1"].std, ps["a2"].std], "B": [0, 0, ps["b2"].std, ps["b3"].std]},
             input_name="current", output_name="force", input_unit="A", output_unit="N",
             u_offset=OPERATING_POINT, info={"source": src})
         warn_inconsistent(self.consistency_checks())
@@ -277,12 +277,8 @@ class FingerForcePlant:
         return self.model.B
 
     @property
-    def fs(self) -> float:
-        return FS
-
-    @property
     def dt(self) -> float:
-        return 1.0 / FS
+        return DT
 
     @property
     def delay(self) -> int:
@@ -298,7 +294,7 @@ class FingerForcePlant:
 
     def prefilter_sos(self) -> np.ndarray:
         """The §V-D Butterworth (2nd order, 9 Hz at 200 Hz) as second-order sections."""
-        return butter_sos(PREFILTER_ORDER, PREFILTER_CUTOFF, FS)
+        return butter_sos(PREFILTER_ORDER, PREFILTER_CUTOFF, dt=DT)
 
     def simulate(self, current, *, noise_std: float = 0.0, seed: int | None = None, prefilter: bool = False,
                  initial: str = "rest", force_past=None, current_past=None):
@@ -335,7 +331,7 @@ class FingerForcePlant:
         ch = {"current": i, "force": f, "force_true": f_true}
         if prefilter:
             ch["force_filtered"] = apply_sos(self.prefilter_sos(), f)
-        return Trajectory.uniform(FS, units={k: ("A" if k == "current" else "N") for k in ch},
+        return Trajectory.uniform(dt=DT, units={k: ("A" if k == "current" else "N") for k in ch},
                                   meta={"source": f"simulated {self.name}"}, **ch)
 
     def to_statespace(self):
@@ -366,14 +362,14 @@ class FingerForcePlant:
                            f"{'inside' if abs(z2210[0]) < 1 else 'outside'} the unit circle; §V-F states "
                            f"the ten-sample-delay model is minimum phase", computed=float(abs(z2210[0])),
                            source=f"{SEED}, §V-F, Table II"))
-        _, p, _ = butter_zpk(PREFILTER_ORDER, PREFILTER_CUTOFF, FS)
+        _, p, _ = butter_zpk(PREFILTER_ORDER, PREFILTER_CUTOFF, dt=DT)
         pp = p[np.argmax(p.imag)]
         out.append(compare("prefilter-pole-real", subj, computed=float(pp.real), stated=0.8021, rtol=1e-3,
                            what="real part of the 9 Hz/200 Hz Butterworth poles", source=f"{SEED}, §V-D"))
         out.append(compare("prefilter-pole-imag", subj, computed=float(pp.imag), stated=0.1648, rtol=1e-3,
                            what="imaginary part of the 9 Hz/200 Hz Butterworth poles", source=f"{SEED}, §V-D"))
-        out.append(compare("valve-delay", subj, computed=self.model.nk / FS, stated=0.01, rtol=0.05, unit="s",
-                           what="nk/fs of the [2 2 2] model", source=f"{SEED}, §V-C, Fig. 15"))
+        out.append(compare("valve-delay", subj, computed=self.model.nk * DT, stated=0.01, rtol=0.05, unit="s",
+                           what="nk·dt of the [2 2 2] model", source=f"{SEED}, §V-C, Fig. 15"))
         ls, rl = reference("II", 2, 2, 2), reference("III", 2, 2, 2)
         diff = float(max(np.max(np.abs(np.subtract(ls.A, rl.A))), np.max(np.abs(np.subtract(ls.B, rl.B)))))
         out.append(Finding("rls-equals-ls-222", subj, diff == 0.0,

@@ -50,13 +50,13 @@ TABLE_I = {
 TABLE2_A = (1.0, -1.8732, 0.8996)
 TABLE2_B = (0.0, 0.0, 0.1950, -0.2276)
 TABLE2_STD = {"A": (0.0, 0.0117, 0.0117), "B": (0.0, 0.0, 0.0221, 0.0225)}  # Table III σ
-FS = 200.0
+DT = 0.005  # s: sampled at 200 Hz (§V-C)
 
 
 def table2_plant():
     """The ``[2 2 2]`` model in the seed's units (mA → force-sensor units), as a
     :class:`~gripkit.control.DiscretePlant`."""
-    return DiscretePlant(TABLE2_A, TABLE2_B, 1.0 / FS, input_name="i", input_unit="mA", output_name="F",
+    return DiscretePlant(TABLE2_A, TABLE2_B, DT, input_name="i", input_unit="mA", output_name="F",
                          output_unit="force units", source=f"{_SEED} Table II [2 2 2] (S_1, 9 Hz filter)")
 
 

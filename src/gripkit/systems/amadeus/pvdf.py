@@ -359,25 +359,26 @@ class SlipTestbed(StickSlipContact):
     _mode = 1
 
 
-def pvdf_noise(n: int, fs: float, rng=None, *, white: float = 2e-3, ripple: float = 4e-3,
+def pvdf_noise(n: int, *, dt: float, rng=None, white: float = 2e-3, ripple: float = 4e-3,
                ripple_hz: float = 150.0, ripple_harmonics: int = 2) -> np.ndarray:
     """Additive PVDF-channel noise (V), shape (n,): white electronics noise of std ``white`` plus a
     hydraulic-pump ripple tone (amplitude ``ripple`` at ``ripple_hz`` and its harmonics, slowly
     wandering in amplitude). Assumed levels; the seed's Fig. 13 shows the non-slip signal is small
     but not zero."""
     rng = np.random.default_rng(rng)
-    if n < 1 or not (fs > 0):
-        raise DataError(f"pvdf_noise: need n >= 1 and fs > 0, found n={n}, fs={fs}")
-    t = np.arange(n) / fs
+    if n < 1 or not (dt > 0):
+        raise DataError(f"pvdf_noise: need n >= 1 and dt > 0 (s), found n={n}, dt={dt}")
+    rate = 1.0 / dt
+    t = np.arange(n) / rate
     x = white * rng.standard_normal(n)
     wander = 1.0 + 0.3 * np.sin(2 * np.pi * 0.05 * t + rng.uniform(0, 2 * np.pi))
     for k in range(1, ripple_harmonics + 1):
-        if k * ripple_hz < fs / 2:
+        if k * ripple_hz < rate / 2:
             x += (ripple / k) * wander * np.sin(2 * np.pi * k * ripple_hz * t + rng.uniform(0, 2 * np.pi))
     return x
 
 
-def nonslip_grasp_inputs(duration: float, fs: float, rng=None, *, normal_force: float = 2.0,
+def nonslip_grasp_inputs(duration: float, *, dt: float, rng=None, normal_force: float = 2.0,
                          load: float = 0.4, load_std: float = 0.12, grip_std: float = 0.05,
                          tap_rate: float = 0.5, tap_amplitude=(0.1, 0.3), tap_duration=(0.004, 0.02),
                          grip_step_rate: float = 0.2, grip_step: float = 0.3, min_normal: float = 1.6) -> np.ndarray:
@@ -386,13 +387,14 @@ def nonslip_grasp_inputs(duration: float, fs: float, rng=None, *, normal_force: 
     load pulses, Poisson ``tap_rate`` per s) and grip-force steps of the controller (10 ms ramps).
     The defaults keep |F_load| well under μ_s F_n; check the contact's ``slipping`` output for the
     ground truth."""
+    rate = 1.0 / dt
     from scipy.signal import butter, sosfilt
 
     rng = np.random.default_rng(rng)
-    n = int(round(duration * fs))
+    n = int(round(duration * rate))
     if n < 10:
-        raise DataError(f"duration {duration} s at {fs} Hz gives fewer than 10 samples")
-    sos = butter(2, 3.0, fs=fs, output="sos")
+        raise DataError(f"duration {duration} s at dt = {dt:g} s gives fewer than 10 samples")
+    sos = butter(2, 3.0, fs=rate, output="sos")
     w1 = sosfilt(sos, rng.standard_normal(n))
     w2 = sosfilt(sos, rng.standard_normal(n))
     w1 /= w1.std()
@@ -400,25 +402,25 @@ def nonslip_grasp_inputs(duration: float, fs: float, rng=None, *, normal_force: 
     Fl = load + load_std * w1
     Fn = normal_force + grip_std * w2
     for t0 in rng.uniform(0, duration, rng.poisson(tap_rate * duration)):
-        i0 = int(t0 * fs)
-        L = max(2, int(rng.uniform(*tap_duration) * fs))
+        i0 = int(t0 * rate)
+        L = max(2, int(rng.uniform(*tap_duration) * rate))
         amp = rng.uniform(*tap_amplitude) * rng.choice([-1.0, 1.0])
         m = min(L, n - i0)
         Fl[i0:i0 + m] += amp * 0.5 * (1 - np.cos(2 * np.pi * np.arange(m) / L))
     for t0 in rng.uniform(0, duration, rng.poisson(grip_step_rate * duration)):
-        i0 = int(t0 * fs)
+        i0 = int(t0 * rate)
         amp = rng.uniform(-grip_step, grip_step)
-        L = max(1, int(0.01 * fs))
+        L = max(1, int(0.01 * rate))
         ramp = np.minimum(np.arange(n - i0) / L, 1.0) * amp
         Fn[i0:] += ramp
     return np.column_stack([np.maximum(Fn, min_normal), Fl])
 
 
-def slip_onset_inputs(duration: float, fs: float, *, normal_force: float = 2.0, load0: float = 0.6,
+def slip_onset_inputs(duration: float, *, dt: float, normal_force: float = 2.0, load0: float = 0.6,
                       start: float = 0.3, rate: float = 3.0) -> np.ndarray:
     """(N, 2) inputs [F_n, F_load]: a constant grip and a tangential load that ramps from ``load0``
     at ``start`` s at ``rate`` N/s until the object slips (μ_s F_n is crossed)."""
-    n = int(round(duration * fs))
-    t = np.arange(n) / fs
+    n = int(round(duration / dt))
+    t = np.arange(n) * dt
     Fl = np.where(t > start, load0 + (t - start) * rate, load0)
     return np.column_stack([np.full(n, float(normal_force)), Fl])

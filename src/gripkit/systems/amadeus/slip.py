@@ -170,7 +170,7 @@ class SlipDetection:
     slipping: np.ndarray
     threshold: float
     events: list[SlipEvent]
-    fs: float
+    dt: float
 
     @property
     def onsets(self) -> np.ndarray:
@@ -210,32 +210,34 @@ def _signal(x, what="signal") -> np.ndarray:
     return a
 
 
-def spectral_features(signal, fs: float, *, frame: float = 0.016, hop: float | None = None,
+def spectral_features(signal, *, dt: float, frame: float = 0.016, hop: float | None = None,
                       band=(100.0, 800.0)) -> SpectralFeatures:
     """Short-time spectra of a PVDF record (Fig. 13(b)): Hann-windowed frames of ``frame`` s every
     ``hop`` s (default frame/2), vectorised with one rfft."""
     x = _signal(signal)
-    if not fs > 0:
-        raise DataError(f"fs: expected a positive sampling rate, found {fs!r}")
-    nf = int(round(frame * fs))
-    nh = int(round((hop if hop is not None else frame / 2) * fs))
+    if isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating)) \
+            or not (np.isfinite(dt) and dt > 0):
+        raise DataError(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
+    rate = 1.0 / dt
+    nf = int(round(frame * rate))
+    nh = int(round((hop if hop is not None else frame / 2) * rate))
     if nf < 8 or nh < 1:
-        raise DataError(f"frame {frame} s at {fs} Hz gives {nf} samples: need at least 8")
+        raise DataError(f"frame {frame} s at {rate} Hz gives {nf} samples: need at least 8")
     if x.size < nf:
         raise DataError(f"the record ({x.size} samples) is shorter than one frame ({nf})")
     nfr = 1 + (x.size - nf) // nh
     idx = np.arange(nf)[None, :] + nh * np.arange(nfr)[:, None]
     w = np.hanning(nf)
     X = np.fft.rfft((x[idx] - x[idx].mean(1, keepdims=True)) * w, axis=1)
-    P = (X.real ** 2 + X.imag ** 2) / (w @ w) / fs
-    f = np.fft.rfftfreq(nf, 1.0 / fs)
+    P = (X.real ** 2 + X.imag ** 2) / (w @ w) / rate
+    f = np.fft.rfftfreq(nf, 1.0 / rate)
     inb = (f >= band[0]) & (f <= band[1])
     df = f[1] - f[0]
     be = P[:, inb].sum(1) * df * 2
     te = P.sum(1) * df * 2
     cen = (P[:, inb] * f[inb]).sum(1) / np.maximum(P[:, inb].sum(1), 1e-300)
     dom = f[inb][np.argmax(P[:, inb], axis=1)]
-    t = (nh * np.arange(nfr) + nf / 2) / fs
+    t = (nh * np.arange(nfr) + nf / 2) / rate
     return SpectralFeatures(t, be, te, cen, dom, be / np.maximum(te, 1e-300), f, P)
 
 
@@ -273,12 +275,12 @@ class SpeedCalibration:
         return v, np.sqrt(var)
 
 
-def stick_slip_rate(signal, fs: float, *, band=(20.0, 400.0), frame: float | None = None) -> float:
+def stick_slip_rate(signal, *, dt: float, band=(20.0, 400.0), frame: float | None = None) -> float:
     """Dominant frequency (Hz) of a PVDF record in ``band``: the peak of the averaged Hann
-    spectrum, refined by parabolic interpolation of the log power (resolution ≪ fs/frame)."""
+    spectrum, refined by parabolic interpolation of the log power (resolution ≪ 1/frame)."""
     x = _signal(signal)
-    fr = frame if frame is not None else min(0.128, x.size / fs)
-    ftr = spectral_features(x, fs, frame=fr, band=band)
+    fr = frame if frame is not None else min(0.128, x.size * dt)
+    ftr = spectral_features(x, dt=dt, frame=fr, band=band)
     P = ftr.power.mean(0)
     f = ftr.freqs
     inb = np.flatnonzero((f >= band[0]) & (f <= band[1]))
@@ -299,8 +301,8 @@ class SlipDetector:
 
     Parameters
     ----------
-    fs
-        Sampling rate of the PVDF record (Hz).
+    dt
+        Sample interval of the PVDF record (s).
     band
         Pass band (Hz) of the detection filter.
     window
@@ -317,18 +319,20 @@ class SlipDetector:
         A :class:`SpeedCalibration` for speed indications.
     """
 
-    def __init__(self, fs: float, *, band=(60.0, 800.0), order: int = 4, window: float = 0.005,
+    def __init__(self, *, dt: float, band=(60.0, 800.0), order: int = 4, window: float = 0.005,
                  min_duration: float = 0.002, release: float = 0.5, hold: float = 0.05,
                  threshold: float | None = None, feature_window: float = 0.1,
                  speed_calibration: SpeedCalibration | None = None):
-        if not (np.isfinite(fs) and fs > 0):
-            raise DataError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
-        self.fs = float(fs)
+        if isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating)) \
+                or not (np.isfinite(dt) and dt > 0):
+            raise DataError(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
+        self.dt = float(dt)
+        rate = 1.0 / self.dt
         self.band = (float(band[0]), float(band[1]))
-        self.sos = np.ascontiguousarray(butter_sos(order, self.band, self.fs, "bandpass"))
-        self.window = int(max(1, round(window * fs)))
-        self.n_on = int(max(1, round(min_duration * fs)))
-        self.n_off = int(max(1, round(hold * fs)))
+        self.sos = np.ascontiguousarray(butter_sos(order, self.band, dt=self.dt, btype="bandpass"))
+        self.window = int(max(1, round(window * rate)))
+        self.n_on = int(max(1, round(min_duration * rate)))
+        self.n_off = int(max(1, round(hold * rate)))
         if not 0 < release <= 1:
             raise DataError(f"release: expected a fraction in (0, 1], found {release!r}")
         self.release = float(release)
@@ -370,7 +374,7 @@ class SlipDetector:
                                       hint="check the band and the sampling rate")
         self.threshold = margin * q
         self.calibration_info = dict(quantile=quantile, margin=margin, energy_quantile=q,
-                                     n=int(E.size), duration_s=E.size / self.fs)
+                                     n=int(E.size), duration_s=E.size * self.dt)
         return self
 
     def _need_threshold(self):
@@ -380,7 +384,7 @@ class SlipDetector:
 
     # -- detection --------------------------------------------------------------------------
     def detect(self, signal, t0: float = 0.0, normal_force=None) -> SlipDetection:
-        """Detect slip events in a PVDF record (V) sampled at ``fs``; times start at ``t0``.
+        """Detect slip events in a PVDF record (V) sampled every ``dt`` s; times start at ``t0``.
         ``normal_force`` (N, scalar or per sample) feeds the speed indication when the speed
         calibration uses it."""
         self._need_threshold()
@@ -393,23 +397,23 @@ class SlipDetector:
         ne = _slip_state(E, self.threshold, self.release, float(self.n_on), float(self.n_off), st, state, ev, max_ev)
         if ne > max_ev:  # cannot happen (see max_ev); kept as a guard against silent truncation
             raise DataError(f"more than {max_ev} slip events in {E.size} samples")
-        t = t0 + np.arange(E.size) / self.fs
+        t = t0 + np.arange(E.size) * self.dt
         fn = None if normal_force is None else np.broadcast_to(np.asarray(normal_force, dtype=np.float64), x.shape)
         events = [self._event(x, ev[i], t0, fn) for i in range(ne)]
-        return SlipDetection(t, E, state > 0.5, self.threshold, events, self.fs)
+        return SlipDetection(t, E, state > 0.5, self.threshold, events, self.dt)
 
     def _event(self, x, row, t0, fn) -> SlipEvent:
         on, al, en = int(row[0]), int(row[1]), int(row[2])
-        nfw = int(round(self.feature_window * self.fs))
+        nfw = int(round(self.feature_window / self.dt))
         seg = x[on:on + nfw]
         rate = math.nan
         if seg.size >= 32:
-            rate = stick_slip_rate(seg, self.fs, frame=seg.size / self.fs)
+            rate = stick_slip_rate(seg, dt=self.dt, frame=seg.size * self.dt)
         sp = ss = None
         cal = self.speed_calibration
         if cal is not None and np.isfinite(rate) and (fn is not None or not cal.uses_force):
             sp, ss = cal.predict(rate, None if fn is None else float(np.mean(fn[on:on + nfw])))
-        return SlipEvent(t0 + on / self.fs, t0 + al / self.fs, None if en < 0 else t0 + en / self.fs, rate, sp, ss)
+        return SlipEvent(t0 + on * self.dt, t0 + al * self.dt, None if en < 0 else t0 + en * self.dt, rate, sp, ss)
 
     def stream(self) -> "SlipStream":
         """A causal, chunk-by-chunk detector with the same settings (for control loops)."""
@@ -442,15 +446,15 @@ class SlipStream:
         ne = _slip_state(E, self.det.threshold, self.det.release, float(self.det.n_on), float(self.det.n_off),
                          self._st, state, ev, ev.shape[0])
         alarms = []
-        fs = self.det.fs
+        dt = self.det.dt
         for i in range(ne):
             on, al, en = ev[i]
             if on == -2.0:  # closes an event from an earlier chunk
                 o, a, _ = self.events[-1]
-                self.events[-1] = (o, a, en / fs)
+                self.events[-1] = (o, a, en * dt)
                 continue
-            self.events.append((on / fs, al / fs, None if en < 0 else en / fs))
-            alarms.append(al / fs)
+            self.events.append((on * dt, al * dt, None if en < 0 else en * dt))
+            alarms.append(al * dt)
         self.slipping = bool(self._st[0] > 0.5)
         return self.slipping, alarms
 
@@ -493,7 +497,7 @@ class SlipReflex:
         self.n_events = 0
 
 
-def calibrate_speed(records, speeds, fs: float, *, normal_forces=None, skip: float = 0.05,
+def calibrate_speed(records, speeds, *, dt: float, normal_forces=None, skip: float = 0.05,
                     band=(20.0, 400.0)) -> SpeedCalibration:
     """Fit slip speed against the stick-slip rate from test-rig records at known speeds
     (Fig. 12(b)).
@@ -511,7 +515,7 @@ def calibrate_speed(records, speeds, fs: float, *, normal_forces=None, skip: flo
         fn = np.broadcast_to(np.asarray(normal_forces, dtype=np.float64), sp.shape)
         if (fn <= 0).any():
             raise DataError("normal_forces must be positive (N)")
-    rates = np.array([stick_slip_rate(_signal(r, "speed-calibration record")[int(round(skip * fs)):], fs, band=band)
+    rates = np.array([stick_slip_rate(_signal(r, "speed-calibration record")[int(round(skip / dt)):], dt=dt, band=band)
                       for r in records])
     x = rates * fn if normal_forces is not None else rates
     X = np.column_stack([np.ones_like(x), x])
@@ -526,7 +530,7 @@ def calibrate_speed(records, speeds, fs: float, *, normal_forces=None, skip: flo
                             (float(sp.min()), float(sp.max())), sp, x)
 
 
-def false_alarm_rate(slipping, truth, fs: float, frame: float = 0.01) -> dict:
+def false_alarm_rate(slipping, truth, *, dt: float, frame: float = 0.01) -> dict:
     """False alarms of a detector against ground truth, per frame of ``frame`` s.
 
     A frame is a false alarm when the detector says "slipping" in any of its samples while the
@@ -536,7 +540,7 @@ def false_alarm_rate(slipping, truth, fs: float, frame: float = 0.01) -> dict:
     g = np.asarray(truth, dtype=np.float64).reshape(-1) > 0
     if d.size != g.size:
         raise DataError(f"slipping ({d.size}) and truth ({g.size}) have different lengths")
-    nf = int(round(frame * fs))
+    nf = int(round(frame / dt))
     m = d.size // nf
     if m == 0:
         raise DataError("the record is shorter than one frame")
@@ -545,6 +549,6 @@ def false_alarm_rate(slipping, truth, fs: float, frame: float = 0.01) -> dict:
     neg = ~gf
     fa = df & neg
     runs = int(np.count_nonzero(np.diff(np.concatenate([[0], fa.astype(np.int8)])) == 1))
-    minutes = d.size / fs / 60.0
+    minutes = d.size * dt / 60.0
     return dict(rate=float(fa.sum() / max(neg.sum(), 1)), n_frames=int(neg.sum()), n_false=int(fa.sum()),
                 per_minute=runs / minutes if minutes > 0 else math.nan)

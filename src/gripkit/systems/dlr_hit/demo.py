@@ -201,7 +201,7 @@ def _stiction_and_idim(sec, summary, quick, rng):
     tr = simulate_impedance(fi, ImpedanceController("joint", (10, 10, 10), (0.8, 0.8, 0.8)), ref)
     posn = np.round((tr["prox"] + rng.normal(0, 0.02 * DEG, N)) / (0.1 * DEG)) * (0.1 * DEG)
     eff = tr["tau_distal"] + rng.normal(0, 0.005, N)
-    res = idim_ls(posn, eff, 1000.0)
+    res = idim_ls(posn, eff, dt=1e-3)
     J = float(fi.chain().mass_matrix(np.array([0.0, 0.0, 45 * DEG]))[2, 2])
     truth = dict(inertia=J, viscous=0.05, coulomb=0.19, offset=0.0)
     sec.table(["parameter", "true", "IDIM-LS", "± std", "error [%]"],
@@ -226,7 +226,7 @@ def _adaptation(sec, f, summary, quick):
     x1 = f2.state(q=[a[j][-1] for j in ("abd", "flex", "prox")], qd=[a[f"{j}_vel"][-1] for j in ("abd", "flex", "prox")])
     b = simulate_impedance(f2, c, ref[n:], x0=x1)
     names = ("abd", "flex", "prox", "abd_vel", "flex_vel", "prox_vel", "pwm_base1", "pwm_base2", "pwm_distal")
-    log = Trajectory.uniform(1000.0, **{k_: np.concatenate([a[k_], b[k_]]) for k_ in names})
+    log = Trajectory.uniform(dt=1e-3, **{k_: np.concatenate([a[k_], b[k_]]) for k_ in names})
     ad, ares = adapt_finger_friction(f, log, forgetting=0.999)
     true_after = (1.2, 0.9, 1.3)
     fig, ax = _fig(1, 8.0, 3.2)

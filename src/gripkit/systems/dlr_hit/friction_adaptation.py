@@ -38,7 +38,7 @@ def adapt_finger_friction(finger, trajectory, *, forgetting: float = 0.999, filt
     bias torque from the multibody model, the inertia from the diagonal of M_p at the log's
     median configuration. ``nonfinite`` as :meth:`FrictionAdapter.update`. Returns
     ``(adapter, result)``."""
-    fs = trajectory.require_uniform(why="friction adaptation")
+    dt = trajectory.require_uniform(why="friction adaptation")
     ch = finger.chain()
     G = ch.coupling.matrix[:3]
     q = np.column_stack([trajectory[j] for j in JOINTS])
@@ -52,7 +52,7 @@ def adapt_finger_friction(finger, trajectory, *, forgetting: float = 0.999, filt
         J = np.diag(ch.mass_matrix(np.median(p, axis=0)))
         tabs = tables if tables is not None else tuple(
             t.scaled(finger.parameters.value(f"scale_{a}")) for t, a in zip(finger.tables, ACTUATORS))
-        adapter = FrictionAdapter(tabs, J, 1.0 / fs, forgetting=forgetting, filter_hz=filter_hz,
+        adapter = FrictionAdapter(tabs, J, dt, forgetting=forgetting, filter_hz=filter_hz,
                                   v_min=v_min, names=ACTUATORS)
     return adapter, adapter.update(tau, h, pd, nonfinite=nonfinite)
 

@@ -293,7 +293,7 @@ def _loop_trajectory(t, y, ref, drift, finger, controller, dt) -> Trajectory:
         for k, a in enumerate(ACTUATORS):
             ch[f"drift_scale_{a}"], units[f"drift_scale_{a}"] = drift[:, k], "1"
             ch[f"drift_offset_{a}"], units[f"drift_offset_{a}"] = drift[:, 3 + k], "N*m"
-    return Trajectory(t, ch, units, {"fs": 1.0 / dt, "model": finger.name, "controller": controller.kind})
+    return Trajectory(t, ch, units, {"dt": dt, "model": finger.name, "controller": controller.kind})
 
 
 # --- stability margins ----------------------------------------------------------------------------

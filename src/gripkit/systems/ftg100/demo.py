@@ -40,17 +40,17 @@ def run(report, *, quick: bool = False) -> dict:
         act, sen, cpl = FTG100Actuated(), FTG100Sensing(), FTG100Coupled()
         plant = FTG100Plant()
         calibrated = FTG100Plant(plant_parameters(force_factor="static-70V"))
-    fs = 20000.0
-    _model_section(report, summary, act, sen, cpl, plant, fs)
+    dt = 5e-05  # s: the seed's 20 kHz
+    _model_section(report, summary, act, sen, cpl, plant, dt)
     _static_section(report, summary, act, plant, calibrated)
-    free = _step_section(report, act, sen, plant, fs)
-    _resonance_section(report, summary, free, fs, quick)
+    free = _step_section(report, act, sen, plant, dt)
+    _resonance_section(report, summary, free, dt, quick)
     _identification_section(report, summary, quick)
     _hybrid_section(report, summary, plant, quick)
     return summary
 
 
-def _model_section(report, summary, act, sen, cpl, plant, fs):
+def _model_section(report, summary, act, sen, cpl, plant, dt):
     """The knowledge-based model and the printed numbers (eqs 3-18)."""
     geo = ftg100_geometry()
     g = geo.value
@@ -81,7 +81,7 @@ def _model_section(report, summary, act, sen, cpl, plant, fs):
     ]
     sec.table(["quantity", "gripkit (from the seed's inputs)", "seed"], rows,
               caption="Physical values recomputed from the dimensions and the identified parameters")
-    d10 = act.discrete(fs)
+    d10 = act.discrete(dt)
     sec.table(["matrix", "gripkit (ZOH 20 kHz, controllable form)", "seed eq 10"],
               [["A_a", np.array2string(d10.A, precision=4), np.array2string(np.array(SEED_EQ10["A"]), precision=4)],
                ["B_a", np.array2string(d10.B.ravel(), precision=4), "[0.25 0]"],
@@ -145,7 +145,7 @@ def _static_section(report, summary, act, plant, calibrated):
                                     stated=x_stated * 1e6, force_factor=kappa)
 
 
-def _step_section(report, act, sen, plant, fs):
+def _step_section(report, act, sen, plant, dt):
     """Step responses of the linear subsystems against the printed matrices; returns the free arm."""
     sec = report.section("FT-G100: step responses",
                          "Left: the actuated subsystem with the ball grasped, 10 V step at 70 V (eq 9), simulated "
@@ -155,11 +155,11 @@ def _step_section(report, act, sen, plant, fs):
                          "stepped from 0 V to 70, 100, 120, 150 V, normalised (Fig. 4): stiffening suspensions "
                          "raise the ringing frequency with voltage.")
     n = 400
-    t = np.arange(n) / fs
+    t = np.arange(n) * dt
     V = np.where(t >= 1e-3, 80.0, 70.0)
-    ya = act.simulate({"V_in": V}, dt=1 / fs)["x_a"]
+    ya = act.simulate({"V_in": V}, dt=dt)["x_a"]
     ys10 = seed_state_space(SEED_EQ10).simulate(V - 70.0)[:, 0]
-    rel = sen.simulate({"F_c": np.where(t < 1e-3, 27e-6 * sen.stiffness(), 0.0)}, dt=1 / fs,
+    rel = sen.simulate({"F_c": np.where(t < 1e-3, 27e-6 * sen.stiffness(), 0.0)}, dt=dt,
                        x0=np.array([27e-6, 0.0]))["x_b"]
     s17 = seed_state_space(SEED_EQ17)
     # start the printed eq 17 at rest under the same force: x = (I - A)^-1 B F0
@@ -177,9 +177,9 @@ def _step_section(report, act, sen, plant, fs):
     ax[1].legend(fontsize=8)
     free = plant.with_parameters(check=False, k0=0.0)
     nf = 240
-    tf_ = np.arange(nf) / fs
+    tf_ = np.arange(nf) * dt
     for Vs in (70, 100, 120, 150):
-        yv = free.simulate({"V": np.where(tf_ >= 1e-3, float(Vs), 0.0)}, dt=1 / fs)["x_a"]
+        yv = free.simulate({"V": np.where(tf_ >= 1e-3, float(Vs), 0.0)}, dt=dt)["x_a"]
         ax[2].plot(tf_ * 1e3, yv / free.equilibrium(Vs)["x_a"], label=f"{Vs} V")
     ax[2].set(xlabel="t (ms)", ylabel="x_a / x_a(∞)", title="nonlinear plant, free arm (Fig. 4)")
     ax[2].legend(fontsize=8)
@@ -188,7 +188,7 @@ def _step_section(report, act, sen, plant, fs):
     return free
 
 
-def _resonance_section(report, summary, free, fs, quick):
+def _resonance_section(report, summary, free, dt, quick):
     """Resonance against the actuation voltage (Fig. 5): linearised and identified."""
     Vgrid = np.linspace(0, 200, 41)
     f_lin = np.array([free.resonance(v)[0] for v in Vgrid])
@@ -202,11 +202,11 @@ def _resonance_section(report, summary, free, fs, quick):
     f_id, f_sd = [], []
     rng = np.random.default_rng(0)
     nid = 600
-    ti = np.arange(nid) / fs
+    ti = np.arange(nid) * dt
     for v in Vid:
         eq = free.equilibrium(float(v))
         u = np.where(ti >= 2e-3, v + 2.0, float(v))
-        y = free.simulate({"V": u}, dt=1 / fs, x0=eq["x"])["x_a"]
+        y = free.simulate({"V": u}, dt=dt, x0=eq["x"])["x_a"]
         amp = free.equilibrium(float(v) + 2.0)["x_a"] - eq["x_a"]
         y = y + 0.01 * amp * rng.standard_normal(nid)
         with warnings.catch_warnings():

@@ -527,7 +527,7 @@ def simulate_hybrid_grasp(controller: HybridForcePosition | None = None, plant=N
     traj = Trajectory(tr[:, 0], {"x_a": tr[:, 1], "x_b": tr[:, 2], "F_c": tr[:, 3], "F_meas": tr[:, 4],
                                  "V": tr[:, 5], "mode": tr[:, 6]},
                       {"x_a": "m", "x_b": "m", "F_c": "N", "F_meas": "N", "V": "V", "mode": "1"},
-                      {"fs": 1.0 / ts, "model": "ftg100-plant + hybrid force/position"})
+                      {"dt": ts, "model": "ftg100-plant + hybrid force/position"})
     return HybridGraspResult(traj, b.rows()[0], float(F[0]), float(dmg[0]), float(K0[0]), float(G[0]))
 
 

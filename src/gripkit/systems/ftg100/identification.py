@@ -40,50 +40,52 @@ def _noise(y: np.ndarray, sigma: float, seed: int) -> np.ndarray:
     return y + sigma * np.random.default_rng(seed).standard_normal(y.shape)
 
 
-def step_experiment(model: FTG100Actuated | None = None, *, fs: float = 20000.0, duration: float = 0.02,
+def step_experiment(model: FTG100Actuated | None = None, *, dt: float = 5e-05, duration: float = 0.02,
                     t_step: float = 1e-3, step: float = 10.0, period: float | None = None, noise: float = 0.01,
                     seed: int = 0) -> Trajectory:
     """The §III-B experiment, simulated: V_in steps from V₀ to V₀ + ``step`` at ``t_step`` with the
     object grasped (and, with ``period``, back and forth as a square wave of that period); x_a (m,
     from the operating point) with white noise of σ = ``noise`` × the step's static amplitude.
     Columns ``V_in`` (V) and ``x_a`` (m)."""
+    rate = 1.0 / dt
     m = model if model is not None else FTG100Actuated(check=False)
-    n = int(round(duration * fs))
+    n = int(round(duration * rate))
     if n < 20 or not 0 <= t_step < duration:
         raise DataError(f"step_experiment: expected duration ≥ 20 samples and 0 ≤ t_step < duration, found "
                         f"duration={duration!r} s, t_step={t_step!r} s")
     V0 = m.parameters.value("V0")
-    t = np.arange(n) / fs
+    t = np.arange(n) / rate
     on = t >= t_step
     if period is not None:
-        if not period > 2.0 / fs:
+        if not period > 2.0 / rate:
             raise DataError(f"period: expected more than two samples, found {period!r} s")
         on &= ((t - t_step) % period) < period / 2
     V = np.where(on, V0 + step, V0)
-    y = m.simulate({"V_in": V}, dt=1.0 / fs)["x_a"]
+    y = m.simulate({"V_in": V}, dt=dt)["x_a"]
     sigma = noise * abs(m.dc_gain() * step)
     return Trajectory(t, {"V_in": V, "x_a": _noise(y, sigma, seed)}, {"V_in": "V", "x_a": "m"},
-                      {"fs": fs, "source": f"simulated §III-B step ({noise:.3g} noise, seed {seed})",
+                      {"dt": dt, "source": f"simulated §III-B step ({noise:.3g} noise, seed {seed})",
                        "noise_std": sigma})
 
 
-def release_experiment(model: FTG100Sensing | None = None, *, thrust: float = 27e-6, fs: float = 20000.0,
+def release_experiment(model: FTG100Sensing | None = None, *, thrust: float = 27e-6, dt: float = 5e-05,
                        duration: float = 0.01, t_release: float = 1e-3, noise: float = 0.01,
                        seed: int = 0) -> Trajectory:
     """The §III-D experiment (Fig. 9), simulated: the sensing arm is held at ``thrust`` (m) by a
     rigid beam, which is withdrawn at ``t_release`` — a negative force step from
     F₀ = K_sb·thrust/D_b² to 0. Columns ``F_c`` (N, the beam's force) and ``x_b`` (m, from rest)
     with white noise of σ = ``noise`` × thrust."""
+    rate = 1.0 / dt
     m = model if model is not None else FTG100Sensing(check=False)
-    n = int(round(duration * fs))
+    n = int(round(duration * rate))
     if n < 20 or not 0 <= t_release < duration or not thrust > 0:
         raise DataError("release_experiment: expected thrust > 0, ≥ 20 samples and 0 ≤ t_release < duration")
     F0 = thrust * m.stiffness()
-    t = np.arange(n) / fs
+    t = np.arange(n) / rate
     F = np.where(t < t_release, F0, 0.0)
-    y = m.simulate({"F_c": F}, dt=1.0 / fs, x0=np.array([thrust, 0.0]))["x_b"]
+    y = m.simulate({"F_c": F}, dt=dt, x0=np.array([thrust, 0.0]))["x_b"]
     return Trajectory(t, {"F_c": F, "x_b": _noise(y, noise * thrust, seed)}, {"F_c": "N", "x_b": "m"},
-                      {"fs": fs, "source": f"simulated §III-D release ({noise:.3g} noise, seed {seed})",
+                      {"dt": dt, "source": f"simulated §III-D release ({noise:.3g} noise, seed {seed})",
                        "noise_std": noise * thrust})
 
 

@@ -124,12 +124,12 @@ _S = SEED + ", "
 #: Readout sensitivity r of eq 18 as gripkit reads it: 50 µN/V (the seed prints "50 N/Volts").
 R_SENSITIVITY = 50e-6
 
-# Eq 10 and eq 17 as printed (seed units: V -> µm for eq 10, µN -> µm for eq 17), 20 kHz.
+# Eq 10 and eq 17 as printed (seed units: V -> µm for eq 10, µN -> µm for eq 17), 20 kHz (dt = 50 µs).
 SEED_EQ10 = dict(A=[[1.6621, -0.9536], [1.0, 0.0]], B=[[0.25], [0.0]], C=[[0.1104, 0.1086]],
-                 fs=20000.0, input="V_in", input_unit="V", output="x_a", output_unit="um",
+                 dt=5e-05, input="V_in", input_unit="V", output="x_a", output_unit="um",
                  source=_S + "eq 10")
 SEED_EQ17 = dict(A=[[1.142174, -0.947527], [1.0, 0.0]], B=[[0.5], [0.0]], C=[[0.132080, 0.129656]],
-                 fs=20000.0, input="F_c", input_unit="uN", output="x_b", output_unit="um",
+                 dt=5e-05, input="F_c", input_unit="uN", output="x_b", output_unit="um",
                  source=_S + "eq 17")
 
 _UNIT = {"um": 1e-6, "uN": 1e-6, "V": 1.0, "m": 1.0, "N": 1.0}
@@ -260,7 +260,7 @@ def seed_state_space(eq: dict) -> StateSpace:
     """The seed's printed discrete system (``SEED_EQ10`` or ``SEED_EQ17``) converted to SI."""
     fin, fout = _UNIT[eq["input_unit"]], _UNIT[eq["output_unit"]]
     C = np.asarray(eq["C"], dtype=float) * fout / fin  # y_SI = fout y_seed, u_seed = u_SI/fin
-    return StateSpace(eq["A"], eq["B"], C, None, 1.0 / eq["fs"], (eq["input"],), (eq["output"],),
+    return StateSpace(eq["A"], eq["B"], C, None, eq["dt"], (eq["input"],), (eq["output"],),
                       ("N" if eq["input_unit"] == "uN" else "V",), ("m",), {"source": eq["source"]})
 
 
@@ -342,14 +342,14 @@ class _SecondOrderFTG(Model):
         m, c, k, gain, _, _ = self._coefficients(self.theta()[None, :])[0]
         return np.array([gain]), np.array([m, c, k])
 
-    def discrete(self, fs: float = 20000.0, form: str = "canonical") -> StateSpace:
-        """ZOH discretisation at ``fs`` Hz: ``form='canonical'`` is the controllable canonical form
+    def discrete(self, dt: float = 5e-05, form: str = "canonical") -> StateSpace:
+        """ZOH discretisation every ``dt`` s: ``form='canonical'`` is the controllable canonical form
         the seed prints (eqs 10, 17; balancing scale chosen in the seed's units), ``'physical'``
         keeps the states [y, ẏ]."""
-        fs = float(fs)
-        if not (math.isfinite(fs) and fs > 0):
-            raise ModelError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
-        d = self.state_space().discretize(1.0 / fs)
+        dt = float(dt)
+        if not (math.isfinite(dt) and dt > 0):
+            raise ModelError(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
+        d = self.state_space().discretize(dt)
         if form == "physical":
             return d
         if form != "canonical":
@@ -412,13 +412,13 @@ class FTG100Actuated(_SecondOrderFTG):
                     source=_S + "§III-A"),
         ]
         # damping unit: the pole radius of eq 10 is exp(−K_fa/(2 M_a)·T) only if K_fa is in N·s/m
-        T = 1.0 / SEED_EQ10["fs"]
+        T = SEED_EQ10["dt"]
         radius = math.exp(-p.value("K_fa") / (2.0 * p.value("M_a")) * T)
         out.append(compare("damping-unit", sub, computed=radius, stated=math.sqrt(0.9536), rtol=0.002,
                            what="pole radius exp(−K_fa T/(2 M_a)) with K_fa = 1.3 mN·s/m (the printed "
                                 "'mNs²/m' is not a damping unit)",
                            used="K_fa in mN·s/m", source=_S + "§III-B, eq 10"))
-        out += _canonical_findings(sub, self.discrete(SEED_EQ10["fs"]), SEED_EQ10, pole_tol=0.003,
+        out += _canonical_findings(sub, self.discrete(SEED_EQ10["dt"]), SEED_EQ10, pole_tol=0.003,
                                    dc_tol=0.015, used="the parameters (the printed matrices are rounded)")
         return out
 
@@ -477,7 +477,7 @@ class FTG100Sensing(_SecondOrderFTG):
         """Eq 17 against the stated M_b, K_fb, K_sb, D_b — and the M_b its poles imply."""
         sub = self.name
         used = "the stated M_b = 0.5 mg (the identified value in the text); the printed A_c is not used"
-        out = _canonical_findings(sub, self.discrete(SEED_EQ17["fs"]), SEED_EQ17, pole_tol=0.003,
+        out = _canonical_findings(sub, self.discrete(SEED_EQ17["dt"]), SEED_EQ17, pole_tol=0.003,
                                   dc_tol=0.015, used=used)
         seed = seed_state_space(SEED_EQ17)
         s = np.log(seed.poles()[0]) / seed.dt
@@ -575,25 +575,25 @@ class FTG100Coupled(Model):
         lam = np.linalg.eigvals(A)
         return [(abs(v), -v.real / abs(v)) for v in lam if v.imag >= 0]
 
-    def discrete(self, fs: float = 20000.0, form: str = "canonical") -> StateSpace:
+    def discrete(self, dt: float = 5e-05, form: str = "canonical") -> StateSpace:
         """``form='canonical'``: the seed's eq 18 block form (:meth:`discrete_eq18`); ``'physical'``:
         the exact zero-order hold of the continuous cascade (states [x̃_a, ẋ̃_a, x_b, ẋ_b])."""
         if form == "canonical":
-            return self.discrete_eq18(fs)
+            return self.discrete_eq18(dt)
         if form != "physical":
             raise ModelError(f"form: expected 'canonical' or 'physical', found {form!r}")
-        fs = float(fs)
-        if not (math.isfinite(fs) and fs > 0):
-            raise ModelError(f"fs: expected a positive sampling rate in Hz, found {fs!r}")
-        return self.state_space().discretize(1.0 / fs)
+        dt = float(dt)
+        if not (math.isfinite(dt) and dt > 0):
+            raise ModelError(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
+        return self.state_space().discretize(dt)
 
-    def discrete_eq18(self, fs: float = 20000.0) -> StateSpace:
+    def discrete_eq18(self, dt: float = 5e-05) -> StateSpace:
         """The seed's eq 18: [[A_a, 0], [B_c k_k C_a, A_c]] from the canonical subsystems (eqs 10, 17);
         outputs x_a, x_b, F_c, V_out (SI). The sensing subsystem sees F_c = k_k x_a held over each
         sample (a ZOH approximation of the continuous cascade; the DC gain is exact)."""
         act, sen, kk, readout = self._parts(self.parameters)
-        A, B, C = self._cascade(act.discrete(fs), sen.discrete(fs), kk, readout)
-        return StateSpace(A, B, C, None, 1.0 / fs, ("V_in",), tuple(s.name for s in self.outputs), ("V",),
+        A, B, C = self._cascade(act.discrete(dt), sen.discrete(dt), kk, readout)
+        return StateSpace(A, B, C, None, dt, ("V_in",), tuple(s.name for s in self.outputs), ("V",),
                           tuple(s.unit for s in self.outputs), {"model": self.name, "form": "eq 18 block form"})
 
     def consistency_checks(self) -> list[Finding]:

@@ -116,7 +116,7 @@ def _identify(report, z, fingers, loops, summary, quick):
     f = fingers["left"]
     st = z.step_experiment(f, seed=30)
     fig, axes = subplots(1, 3, figsize=(14, 3.8))
-    model = res.finger.simulate({"U": st["U"], "F_g": np.zeros(st.n)}, dt=1 / st.fs)
+    model = res.finger.simulate({"U": st["U"], "F_g": np.zeros(st.n)}, dt=st.dt)
     y0, y1 = st["y_B"][:10].mean(), model["y_B"][-1]
     axes[0].plot(st.t * 1e3, (st["y_B"] - y0) / (y1 - y0), ".", ms=3, label="measured (simulated)")
     axes[0].plot(st.t * 1e3, (model["y_B"] - y0) / (y1 - y0), lw=1, label="identified model")
@@ -130,9 +130,9 @@ def _identify(report, z, fingers, loops, summary, quick):
     axes[1].set_xlabel("t (ms)")
     axes[1].set_ylabel("F (µN)")
     axes[1].set_title("sensor free vibration (Fig. 8)")
-    x = vib["F"][int(0.005 * vib.fs):]
+    x = vib["F"][int(round(0.005 / vib.dt)):]
     X = np.abs(np.fft.rfft(x - x.mean(), 16 * x.size))
-    fr = np.fft.rfftfreq(16 * x.size, 1 / vib.fs)
+    fr = np.fft.rfftfreq(16 * x.size, vib.dt)
     axes[2].semilogy(fr / 1e3, X, lw=0.7)
     axes[2].set_ylim(np.median(X) / 10, 3 * X.max())
     axes[2].axvline(res.modal.natural_frequency_hz / 1e3, color="r", lw=0.8,
@@ -157,16 +157,16 @@ def _sines(report, z, fingers, ident, summary, quick):
         "model. The loops open with frequency: D(s)'s phase lag adds to the static hysteresis (rate-dependent "
         "hysteresis = static Bouc-Wen followed by D(s), eq 2).")
     f, fi = fingers["left"], ident["left"].finger
-    fs = 20000.0
+    dt = 5e-05  # s (20 kHz)
     rng = np.random.default_rng(50)
     fig, axes = subplots(1, 4, figsize=(16, 3.8))
     rows = []
     for ax, fr in zip(axes, (10.0, 50.0, 100.0, 500.0)):
-        n = int(round(3 * fs / fr))
-        t = np.arange(n) / fs
+        n = int(round(3 / (fr * dt)))
+        t = np.arange(n) * dt
         U = 100.0 * np.sin(2 * np.pi * fr * t)
-        meas = f.simulate({"U": U, "F_g": np.zeros(n)}, dt=1 / fs)["y_B"] + 20e-9 * rng.standard_normal(n)
-        pred = fi.simulate({"U": U, "F_g": np.zeros(n)}, dt=1 / fs)["y_B"]
+        meas = f.simulate({"U": U, "F_g": np.zeros(n)}, dt=dt)["y_B"] + 20e-9 * rng.standard_normal(n)
+        pred = fi.simulate({"U": U, "F_g": np.zeros(n)}, dt=dt)["y_B"]
         last = slice(n // 3, n)
         ax.plot(U[last], meas[last] * 1e6, ".", ms=1.5, label="measured")
         ax.plot(U[last], pred[last] * 1e6, lw=0.9, label="model")
@@ -193,7 +193,7 @@ def _contact(report, z, fingers, ident, summary, quick):
         "from the voltage and the force the sensor measures (2 µN noise); the contact is detected at 5 µN (§V-C).")
     f = fingers["left"]
     tr = z.contact_experiment(f, 72.5, seed=60)
-    est = TipPositionEstimator(ident["left"].finger, 1 / tr.fs)
+    est = TipPositionEstimator(ident["left"].finger, tr.dt)
     yhat = est.run(tr["U"], tr["F_meas"])
     det, _ = ContactDetector(5e-6).run(tr["F_meas"])
     c = tr["contact"] > 0.5

@@ -291,7 +291,7 @@ class TwoFingerGraspResult:
 
 
 def simulate_two_finger_grasp(gripper: TSFMGripper, *, estimator_fingers=None, settings: GraspSettings = GraspSettings(),
-                              duration: float = 4.0, fs: float = 20000.0, noise_std: float = 2e-6,
+                              duration: float = 4.0, dt: float = 5e-05, noise_std: float = 2e-6,
                               seed: int = 0) -> TwoFingerGraspResult:
     """Close the grasp loop on the gripper model (see the module docstring).
 
@@ -300,12 +300,11 @@ def simulate_two_finger_grasp(gripper: TSFMGripper, *, estimator_fingers=None, s
     white, ``noise_std`` (N) on each sensor. Returns the record and the micropart estimate from
     the estimated positions and the measured forces (:func:`estimate_micropart`).
     """
-    if not (np.isfinite(duration) and duration > 0 and np.isfinite(fs) and fs > 0):
-        raise SimulationError(f"duration and fs must be positive, found {duration!r} s, {fs!r} Hz")
+    if not (np.isfinite(duration) and duration > 0 and np.isfinite(dt) and dt > 0):
+        raise SimulationError(f"duration and dt must be positive, found {duration!r} s, {dt!r} s")
     if noise_std < 0:
         raise SimulationError(f"noise_std: expected >= 0 N, found {noise_std!r}")
-    dt = 1.0 / fs
-    N = int(round(duration * fs))
+    N = int(round(duration / dt))
     th = gripper.theta()
     d = gripper.arrays(th[None, :], dt)
     fingers = estimator_fingers or gripper.fingers
@@ -322,7 +321,7 @@ def simulate_two_finger_grasp(gripper: TSFMGripper, *, estimator_fingers=None, s
     if not np.isfinite(rec).all():
         raise SimulationError("the grasp simulation diverged", hint="lower the loop bandwidths")
     t = np.arange(N) * dt
-    tr = Trajectory(t, {n: rec[:, i] for i, (n, _) in enumerate(_COLUMNS)}, dict(_COLUMNS), {"fs": fs})
+    tr = Trajectory(t, {n: rec[:, i] for i, (n, _) in enumerate(_COLUMNS)}, dict(_COLUMNS), {"dt": dt})
     ct = []
     for i in (13, 14):
         hit = np.flatnonzero(rec[:, i] > 0.5)

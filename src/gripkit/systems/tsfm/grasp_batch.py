@@ -119,7 +119,7 @@ def _jobs(tpl: GraspTemplate, settings: GraspSettings, n_jobs: int, arrays: dict
 
 
 def tsfm_grasp_batch(gripper=None, *, settings: GraspSettings = FAST_GRASP, duration: float = 0.1,
-                     fs: float = 20000.0, k_e=None, w=None, X_p=None, offset=None, c_e=None, F_po=None,
+                     dt: float = 5e-05, k_e=None, w=None, X_p=None, offset=None, c_e=None, F_po=None,
                      F_stick=None, gap=None, approach_speed=None, noise_std=2e-6, noise_seed: int = 0,
                      job_ids=None, noise=None, damage_force: float | None = None, lost_displacement: float = 10e-6,
                      band: float = 0.05, estimator_fingers=None, backend: str = "cpu", serial: bool = False,
@@ -132,20 +132,19 @@ def tsfm_grasp_batch(gripper=None, *, settings: GraspSettings = FAST_GRASP, dura
     ``c_e`` (N·s/m), ``F_po``, ``F_stick`` (N), ``gap`` (m), ``approach_speed`` (m/s, default the
     settings'), ``noise_std`` (N). The noise of job j comes from its own splitmix64 stream seeded
     by ``job_ids[j]`` (default j) and ``noise_seed``: results do not depend on chunking or thread
-    scheduling. ``noise`` (P, N, 2), if given, is used instead (N = duration·fs samples).
+    scheduling. ``noise`` (P, N, 2), if given, is used instead (N = duration/dt samples).
     ``damage_force`` defaults to 1.25 × ``settings.grip_force``. ``backend``: 'cpu' (the
     nogil numba kernel on ``numba.get_num_threads()`` threads, one with ``serial=True``) or 'cuda'
     (:mod:`gripkit.systems.tsfm.grasp_gpu`, needs a CUDA device).
     """
-    if not (math.isfinite(duration) and duration > 0 and math.isfinite(fs) and fs > 0):
-        raise ConfigError(f"duration and fs must be positive, found {duration!r} s, {fs!r} Hz")
+    if not (math.isfinite(duration) and duration > 0 and math.isfinite(dt) and dt > 0):
+        raise ConfigError(f"duration and dt must be positive, found {duration!r} s, {dt!r} s")
     if not (math.isfinite(band) and 0 < band < 1):
         raise ConfigError(f"band: expected a fraction in (0, 1), found {band!r}")
     if not isinstance(settings, GraspSettings):
         raise ConfigError(f"settings: expected a GraspSettings, found {type(settings).__name__}")
     gripper = gripper if gripper is not None else _default_gripper()
-    dt = 1.0 / fs
-    n_steps = int(round(duration * fs))
+    n_steps = int(round(duration / dt))
     tpl = _template(gripper, dt, estimator_fingers)
     given = dict(k_e=k_e, w=w, X_p=X_p, offset=offset, c_e=c_e, F_po=F_po, F_stick=F_stick, gap=gap,
                  approach_speed=approach_speed, noise_std=noise_std)
@@ -207,7 +206,7 @@ def record_metrics(result, *, gap: float | None = None, width: float | None = No
     ``stiffness`` (N/m) are the truth for the estimate errors (NaN without them)."""
     tr = result.trajectory
     s = result.settings
-    dt = 1.0 / tr.meta["fs"]
+    dt = tr.meta["dt"]
     n = tr.t.size
     fcmd = s.grip_force
     dmg = 1.25 * fcmd if damage_force is None else damage_force
@@ -303,7 +302,8 @@ def tsfm_grasp(model, params: dict[str, np.ndarray], settings: dict) -> dict[str
     kw = {k: v for k, v in params.items() if k != "job_id"}
     if "noise_std" not in kw:
         kw["noise_std"] = opts.get("noise_std", 2e-6)
-    res = tsfm_grasp_batch(model, settings=gs, duration=opts.get("duration", 0.1), fs=opts.get("fs", 20000.0),
+    res = tsfm_grasp_batch(model, settings=gs, duration=opts.get("duration", 0.1),
+                           dt=1.0 / opts.get("fs", 20000.0),  # the sweep file gives a rate in Hz
                            job_ids=params.get("job_id"), noise_seed=int(opts.get("noise_seed", 0)),
                            damage_force=opts.get("damage_force"),
                            lost_displacement=opts.get("lost_displacement", 10e-6), band=float(opts.get("band", 0.05)),

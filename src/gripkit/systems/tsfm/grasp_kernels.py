@@ -80,6 +80,57 @@ def _job_setup(tpl, part, dt, Phi, Gam, C, D, Hg, cw):  # pragma: no cover - com
         Hg[i, 1, 0, 2] = part[4] / k
 
 
+@numba.njit(cache=True, _nrt=False, inline="always")
+def _grasp_reset(loop, state, part, rng, seed):  # pragma: no cover - compiled
+    """Rest before a grasp: detector, buffers, estimators and controller zero (no contact time
+    yet), fingers at rest in free mode, hysteresis states zero, the part at its initial X_p, the
+    noise stream seeded (splitmix64)."""
+    det, buf, est, cs = loop.det, loop.buf, loop.est, loop.cs
+    X, modes, hyst, ps = state.X, state.modes, state.hyst, state.ps
+    for i in range(2):
+        for j in range(det.shape[1]):
+            det[i, j] = 0.0
+        for j in range(buf.shape[1]):
+            buf[i, j] = 0.0
+        for j in range(est.shape[1]):
+            est[i, j] = 0.0
+        for j in range(cs.shape[1]):
+            cs[i, j] = 0.0
+        cs[i, _CONTACT_T] = -1.0
+        for j in range(X.shape[1]):
+            X[i, j] = 0.0
+        modes[i] = 0
+    for j in range(4):
+        hyst[j] = 0.0
+    ps[0] = part[6]
+    rng[0] = np.uint64(seed) * np.uint64(0x2545F4914F6CDD1D) + np.uint64(1)
+
+
+@numba.njit(cache=True, _nrt=False, inline="always")
+def _settling_time(t_sq, last_out, n_steps, dt):  # pragma: no cover - compiled
+    """Time from the squeeze until the mean force last left its band (inf: never squeezed, or
+    still outside at the end)."""
+    if t_sq < 0.0 or last_out == n_steps - 1:
+        return math.inf
+    ts = (last_out + 1) * dt - t_sq
+    return ts if ts > 0.0 else 0.0
+
+
+@numba.njit(cache=True, _nrt=False, inline="always")
+def _stiffness_metrics(met, part, detected, grasped, y_contact, y_sum, f_mean):  # pragma: no cover - compiled
+    """``width_error`` (the part width from the two detected contact positions) and
+    ``stiffness_error``: k̂_e/k − 1 with k̂_e = F_g/δ (eq 16 of ``001_0b92a7da96e7aa46.txt``) from
+    the tail's mean force and squeeze beyond contact, k the two sides in series (k_side/2); NaN
+    unless both contacts were detected."""
+    if not detected:
+        met[11] = math.nan
+        met[12] = math.nan
+        return
+    met[11] = part[1] - y_contact - part[0]
+    delta = y_sum - y_contact
+    met[12] = f_mean / delta / (0.5 * part[2]) - 1.0 if (grasped and delta > 0.0) else math.nan
+
+
 @numba.njit(cache=True, _nrt=False)
 def _grasp_core(model, noise, nstd, seed, n_steps, e, cp, mset, loop, state, work, rng,
                 met):  # pragma: no cover - compiled
@@ -96,29 +147,12 @@ def _grasp_core(model, noise, nstd, seed, n_steps, e, cp, mset, loop, state, wor
     counting (``_nrt=False``, like its callees :func:`grasp_step`, :func:`gripper_advance` and
     :func:`gripper_measure`): taking the records apart would otherwise cost an atomic
     incref/decref pair per array per call (docs/performance.md, "Named records in kernels")."""
-    det, buf, est, cs, out = loop.det, loop.buf, loop.est, loop.cs, loop.out
-    X, modes, hyst, ps = state.X, state.modes, state.hyst, state.ps
+    out, modes, ps = loop.out, state.modes, state.ps
     part, yout = model.part, work.yout
     dt = cp[15]
     fcmd = cp[3]
-    for i in range(2):
-        for j in range(det.shape[1]):
-            det[i, j] = 0.0
-        for j in range(buf.shape[1]):
-            buf[i, j] = 0.0
-        for j in range(est.shape[1]):
-            est[i, j] = 0.0
-        for j in range(cs.shape[1]):
-            cs[i, j] = 0.0
-        cs[i, _CONTACT_T] = -1.0
-        for j in range(X.shape[1]):
-            X[i, j] = 0.0
-        modes[i] = 0
-    for j in range(4):
-        hyst[j] = 0.0
+    _grasp_reset(loop, state, part, rng, seed)
     x0p = part[6]
-    ps[0] = x0p
-    rng[0] = np.uint64(seed) * np.uint64(0x2545F4914F6CDD1D) + np.uint64(1)
     explicit = noise.shape[0] > 0
     t_c1 = -1.0
     t_c2 = -1.0
@@ -181,30 +215,18 @@ def _grasp_core(model, noise, nstd, seed, n_steps, e, cp, mset, loop, state, wor
         if k == n_steps - 1:
             grasped = modes[0] == 1 and modes[1] == 1 and out[0, 4] == _SQUEEZE and out[1, 4] == _SQUEEZE
         gripper_advance(out[0, 0], out[1, 0], state, model, work)
-    nan = math.nan
-    met[0] = t_c1 if t_c1 >= 0.0 else nan
-    met[1] = t_c2 if t_c2 >= 0.0 else nan
-    met[2] = t_sq if t_sq >= 0.0 else nan
+    met[0] = t_c1 if t_c1 >= 0.0 else math.nan
+    met[1] = t_c2 if t_c2 >= 0.0 else math.nan
+    met[2] = t_sq if t_sq >= 0.0 else math.nan
     met[3] = peak
     met[4] = 1.0 if peak > mset[0] else 0.0
     met[5] = maxd
     met[6] = 1.0 if grasped else 0.0
     met[7] = 1.0 if (not grasped or maxd > mset[1]) else 0.0
-    if t_sq < 0.0 or last_out == n_steps - 1:
-        met[8] = math.inf
-    else:
-        met[8] = (last_out + 1) * dt - t_sq
-        if met[8] < 0.0:
-            met[8] = 0.0
+    met[8] = _settling_time(t_sq, last_out, n_steps, dt)
     met[9] = (sum_f / n_tail - fcmd) / fcmd
     met[10] = sum_f / n_tail
-    if det1 and det2:
-        met[11] = part[1] - (y1c + y2c) - part[0]
-        delta = sum_s / n_tail - (y1c + y2c)
-        met[12] = (sum_fm / n_tail) / delta / (0.5 * part[2]) - 1.0 if (grasped and delta > 0.0) else nan
-    else:
-        met[11] = nan
-        met[12] = nan
+    _stiffness_metrics(met, part, det1 and det2, grasped, y1c + y2c, sum_s / n_tail, sum_fm / n_tail)
 
 
 @numba.njit(cache=True, nogil=True)

@@ -140,7 +140,7 @@ def identify_finger(loops: Trajectory, step: Trajectory, compliance: Trajectory,
                            initial=bw.params)
     dyn = identify_actuator_dynamics(step, bw, voltage, displacement, progress=progress, initial=(dyn.a, dyn.b))
     comp = identify_compliance(compliance[force], compliance[displacement], L_r=L_r, L_a=L_a, min_force=5e-6)
-    vib = free_vibration(vibration[force], vibration.fs)
+    vib = free_vibration(vibration[force], dt=vibration.dt)
     sensor = sensor_parameters(vib.natural_frequency_hz, vib.damping_ratio, k_s=k_s, f0_std=vib.natural_frequency_std_hz,
                                zeta_std=vib.damping_ratio_std, known_std=k_s_std)
     at_a, sd_a = to_tip_a({"d_p": bw.params["d_p"], "lambda": bw.params["lambda"]}, L_r, L_a,
@@ -165,7 +165,7 @@ def identify_finger(loops: Trajectory, step: Trajectory, compliance: Trajectory,
     # inertia on the actuator (0.3 % on a with Table II), which the bare actuator model absorbs into a
     whole = TSFMFinger(params, name="identified finger", check=False)
     st = Trajectory(step.t, {"U": step[voltage], "F_g": np.zeros(step.n), "y_B": step[displacement]},
-                    {"U": "V", "F_g": "N", "y_B": "m"}, {**step.meta, "fs": step.fs})
+                    {"U": "V", "F_g": "N", "y_B": "m"}, {**step.meta, "dt": step.dt})
     ab = fit(whole, st, outputs=["y_B"], free=["a", "b"], progress=progress)
     dyn = DynamicsResult(ab.value("a"), ab.value("b"), ab.stdev("a"), ab.stdev("b"), ab)
     params = params.replace(a=dyn.a, b=dyn.b)

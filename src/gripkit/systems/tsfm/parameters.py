@@ -168,55 +168,58 @@ def _noise(rng, n, std):
 
 
 def hysteresis_experiment(finger: TSFMFinger, amplitudes=(100.0, 60.0, 30.0), *, frequency: float = 0.1,
-                          fs: float = 20000.0, decimate: int = 10, noise: float = 20e-9, seed: int = 0) -> Trajectory:
+                          dt: float = 5e-05, decimate: int = 10, noise: float = 20e-9, seed: int = 0) -> Trajectory:
     """§IV-C1 / Fig. 9: sines of the given amplitudes (V) at ``frequency`` one after another, tip B
-    measured by the laser (``noise`` m, 20 nm resolution) at ``fs``, kept every ``decimate``-th
+    measured by the laser (``noise`` m, 20 nm resolution) every ``dt`` s, kept every ``decimate``-th
     sample. Channels U (V), y_B (m), loop (index of the amplitude)."""
-    t = np.arange(int(round(fs / frequency))) / fs
+    rate = 1.0 / dt
+    t = np.arange(int(round(rate / frequency))) / rate
     U = np.concatenate([A * np.sin(2 * np.pi * frequency * t) for A in amplitudes])
-    tr = finger.simulate({"U": U, "F_g": np.zeros_like(U)}, dt=1.0 / fs)
+    tr = finger.simulate({"U": U, "F_g": np.zeros_like(U)}, dt=dt)
     rng = np.random.default_rng(seed)
     k = slice(None, None, decimate)
     y = tr["y_B"][k]
     loop = np.repeat(np.arange(len(amplitudes), dtype=float), t.size)[k]
-    return Trajectory.uniform(fs / decimate, U=U[k], y_B=y + _noise(rng, y.size, noise), loop=loop,
+    return Trajectory.uniform(dt=dt * decimate, U=U[k], y_B=y + _noise(rng, y.size, noise), loop=loop,
                               units={"U": "V", "y_B": "m"}, meta={"source": "simulated Fig. 9 experiment"})
 
 
-def step_experiment(finger: TSFMFinger, amplitude: float = 50.0, *, fs: float = 20000.0, duration: float = 0.02,
+def step_experiment(finger: TSFMFinger, amplitude: float = 50.0, *, dt: float = 5e-05, duration: float = 0.02,
                     delay: float = 1e-3, noise: float = 20e-9, seed: int = 1) -> Trajectory:
-    """§IV-C2 / Fig. 10: a voltage step, tip B measured at ``fs``."""
-    n = int(round(duration * fs))
-    t = np.arange(n) / fs
+    """§IV-C2 / Fig. 10: a voltage step, tip B measured every ``dt`` s."""
+    rate = 1.0 / dt
+    n = int(round(duration * rate))
+    t = np.arange(n) / rate
     U = np.where(t >= delay, amplitude, 0.0)
-    tr = finger.simulate({"U": U, "F_g": np.zeros(n)}, dt=1.0 / fs)
+    tr = finger.simulate({"U": U, "F_g": np.zeros(n)}, dt=dt)
     rng = np.random.default_rng(seed)
-    return Trajectory.uniform(fs, U=U, y_B=tr["y_B"] + _noise(rng, n, noise), units={"U": "V", "y_B": "m"},
+    return Trajectory.uniform(dt=dt, U=U, y_B=tr["y_B"] + _noise(rng, n, noise), units={"U": "V", "y_B": "m"},
                               meta={"source": "simulated Fig. 10 experiment"})
 
 
-def compliance_experiment(finger: TSFMFinger, max_force: float = 1e-3, *, fs: float = 1000.0, duration: float = 2.0,
+def compliance_experiment(finger: TSFMFinger, max_force: float = 1e-3, *, dt: float = 0.001, duration: float = 2.0,
                           noise: float = 20e-9, force_noise: float = 0.4e-6, seed: int = 2) -> Trajectory:
     """§IV-C3 / Fig. 11: the FemtoTools probe (resolution 0.4 µN) pushes on the tip B with a slow
     force ramp, no voltage; the actuator (eq 4 with F_A = F, M_A = L_r F) responds dynamically,
     the laser (20 nm) reads y_B. Channels F (N, measured), y_B (m)."""
+    rate = 1.0 / dt
     v = finger.values()
     act = PiezoActuator(ParameterSet([finger.parameters[n] for n in ("d_p", "s_p", "lam", "beta", "gamma", "a", "b",
                                                                      "L_a")]), check=False)
-    n = int(round(duration * fs))
+    n = int(round(duration * rate))
     F = max_force * np.clip(np.arange(n) / (0.8 * n), 0.0, 1.0)
-    out = act.simulate({"U": np.zeros(n), "F_A": F, "M_A": v["L_r"] * F}, dt=1.0 / fs)
+    out = act.simulate({"U": np.zeros(n), "F_A": F, "M_A": v["L_r"] * F}, dt=dt)
     yB = out["y_A"] + v["L_r"] * out["alpha_A"]
     # the probe reads the force acting when the laser reads y_B: an output sample shows the inputs
     # up to the previous sample (zero-order hold), so that is F one sample back (pairing F[k] with
     # y_B[k] biased s_p by +6e-4, +1.3σ, on the 1 ms samples of this ramp)
     F_now = np.concatenate([[0.0], F[:-1]])
     rng = np.random.default_rng(seed)
-    return Trajectory.uniform(fs, F=F_now + _noise(rng, n, force_noise), y_B=yB + _noise(rng, n, noise),
+    return Trajectory.uniform(dt=dt, F=F_now + _noise(rng, n, force_noise), y_B=yB + _noise(rng, n, noise),
                               units={"F": "N", "y_B": "m"}, meta={"source": "simulated Fig. 11 experiment"})
 
 
-def sensor_calibration_experiment(finger: TSFMFinger, max_force: float = 1.5e-3, *, fs: float = 1000.0,
+def sensor_calibration_experiment(finger: TSFMFinger, max_force: float = 1.5e-3, *, dt: float = 0.001,
                                   duration: float = 2.0, stage_noise: float = 1e-9, force_noise: float = 0.4e-6,
                                   seed: int = 5) -> Trajectory:
     """§IV-A/B: the force sensor alone (before integration) is calibrated against the FemtoTools
@@ -225,27 +228,29 @@ def sensor_calibration_experiment(finger: TSFMFinger, max_force: float = 1.5e-3,
     motion). Channels F (N, reference reading) and x (m, stage position = tip deflection), each with
     its white noise. k_s follows from eq 15's straight-line fit with c = 1/k_s
     (:func:`gripkit.systems.tsfm.identification.identify_compliance` of F and −x)."""
+    rate = 1.0 / dt
     k = finger.values()["k_s"]
-    n = int(round(duration * fs))
+    n = int(round(duration * rate))
     F = max_force * np.clip(np.arange(n) / (0.8 * n), 0.0, 1.0)
     rng = np.random.default_rng(seed)
-    return Trajectory.uniform(fs, F=F + _noise(rng, n, force_noise), x=F / k + _noise(rng, n, stage_noise),
+    return Trajectory.uniform(dt=dt, F=F + _noise(rng, n, force_noise), x=F / k + _noise(rng, n, stage_noise),
                               units={"F": "N", "x": "m"}, meta={"source": "simulated sensor calibration (§IV-A/B)"})
 
 
-def free_vibration_experiment(finger: TSFMFinger, preload: float = 150e-6, *, fs: float = 20000.0,
+def free_vibration_experiment(finger: TSFMFinger, preload: float = 150e-6, *, dt: float = 5e-05,
                               duration: float = 0.1, pre: float = 0.005, noise: float = 0.01,
                               seed: int = 3) -> Trajectory:
     """§IV-B / Fig. 8: the sensor alone (before integration), preloaded with ``preload`` N and
     released at t = ``pre``; the force it reads, k_s × deflection, with white noise of ``noise``
     times the preload, for ``duration`` s after the release. Channel F (N)."""
+    rate = 1.0 / dt
     v = finger.values()
     msd = MassSpringDamper(m=v["m_s"], b=v["b_s"], k=v["k_s"], check=False)
-    n = int(round(duration * fs))
-    x = msd.simulate(np.zeros(n), dt=1.0 / fs, x0=np.array([preload / v["k_s"], 0.0]))["x"]
-    F = np.concatenate([np.full(int(round(pre * fs)), preload), v["k_s"] * x])
+    n = int(round(duration * rate))
+    x = msd.simulate(np.zeros(n), dt=dt, x0=np.array([preload / v["k_s"], 0.0]))["x"]
+    F = np.concatenate([np.full(int(round(pre * rate)), preload), v["k_s"] * x])
     rng = np.random.default_rng(seed)
-    return Trajectory.uniform(fs, F=F + _noise(rng, F.size, noise * preload), units={"F": "N"},
+    return Trajectory.uniform(dt=dt, F=F + _noise(rng, F.size, noise * preload), units={"F": "N"},
                               meta={"source": "simulated Fig. 8 experiment"})
 
 
@@ -260,17 +265,18 @@ def contact_voltage(finger: TSFMFinger, voltage: float = 44.0) -> float:
 
 
 def contact_experiment(finger: TSFMFinger, stiffness: float = 72.5, *, contact_at: float = 44.0,
-                       peak: float = 50.0, frequency: float = 0.1, fs: float = 20000.0, pull_off: float = 0.0,
+                       peak: float = 50.0, frequency: float = 0.1, dt: float = 5e-05, pull_off: float = 0.0,
                        noise: float = 2e-6, seed: int = 4) -> Trajectory:
     """§V-B / Fig. 13: U = peak (1 − cos 2π f t)/2 for one period; the part face placed where tip C
     is at ``contact_at`` V, so the contact starts there. Channels U, y_C (true), F_g (true contact
     force), F_meas (sensor reading + noise), contact."""
+    rate = 1.0 / dt
     x_w = contact_voltage(finger, contact_at)
     m = finger.contact(x_w=x_w, k_e=stiffness, F_po=pull_off)
-    t = np.arange(int(round(fs / frequency))) / fs
+    t = np.arange(int(round(rate / frequency))) / rate
     U = 0.5 * peak * (1.0 - np.cos(2 * np.pi * frequency * t))
-    tr = m.simulate(U, dt=1.0 / fs)
+    tr = m.simulate(U, dt=dt)
     rng = np.random.default_rng(seed)
-    return Trajectory.uniform(fs, U=U, y_C=tr["y_C"], F_g=tr["F_g"], F_meas=tr["F_m"] + _noise(rng, t.size, noise),
+    return Trajectory.uniform(dt=dt, U=U, y_C=tr["y_C"], F_g=tr["F_g"], F_meas=tr["F_m"] + _noise(rng, t.size, noise),
                               contact=tr["contact"], units={"U": "V", "y_C": "m", "F_g": "N", "F_meas": "N"},
                               meta={"source": "simulated Fig. 13 experiment", "x_w": x_w})

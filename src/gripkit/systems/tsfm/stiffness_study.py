@@ -86,7 +86,7 @@ FORCE_CUTOFF_HZ = 100.0
 BLOCK = 200
 #: blocks between a force block and the position block that serves as its instrument
 INSTRUMENT_LAG = 2
-_FS = 20000.0
+_DT = 5e-05  # s (20 kHz)
 _PART_WIDTH, _PART_CENTRE = 300e-6, 170e-6
 # the parameters of a finger whose uncertainty is propagated into k̂
 _PROPAGATED = ("d_p", "lam", "beta", "gamma", "a", "b", "s_p", "m_s", "b_s", "k_s")
@@ -215,8 +215,8 @@ def _estimate(record, values: tuple[dict, dict], gap: float) -> MicropartEstimat
     """Step 3 on a grasp record: eq 11 offline with the given finger values, then eq 16."""
     y = []
     for i, v in enumerate(values, 1):
-        F = lowpass(record[f"F_meas{i}"], FORCE_CUTOFF_HZ, _FS, order=4, zero_phase=True)
-        y.append(TipPositionEstimator(v, 1.0 / _FS).run(record[f"U{i}"], F))
+        F = lowpass(record[f"F_meas{i}"], FORCE_CUTOFF_HZ, dt=_DT, order=4, zero_phase=True)
+        y.append(TipPositionEstimator(v, _DT).run(record[f"U{i}"], F))
     return estimate_micropart(y[0], record["F_meas1"], y[1], record["F_meas2"], gap, block=BLOCK,
                               instrument_lag=INSTRUMENT_LAG)
 
