@@ -1,10 +1,30 @@
-"""Numba kernel of the discrete state-space recursion (scalar, allocation-free)."""
+"""Numba kernels of the discrete state-space recursion (scalar, allocation-free), and the row of
+an affine map ``M x + N u`` they are made of, shared with the other state-space kernels (the PEM
+predictor, the AMADEUS force-sensor Kalman filter)."""
 
 from __future__ import annotations
 
 import numba
 
-__all__ = ["simulate_ss"]
+__all__ = ["affine_row", "simulate_ss"]
+
+
+@numba.njit(cache=True, inline="always")
+def affine_row(M, i, x, N, u, k):  # pragma: no cover - compiled
+    """Row ``i`` of ``M x + N u[k]``: Σ_j M[i, j] x[j] + Σ_j N[i, j] u[k, j], summed in that order.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> affine_row(np.array([[1.0, 2.0]]), 0, np.array([3.0, 4.0]), np.array([[10.0]]), np.array([[0.5]]), 0)
+    16.0
+    """
+    acc = 0.0
+    for j in range(M.shape[1]):
+        acc += M[i, j] * x[j]
+    for j in range(N.shape[1]):
+        acc += N[i, j] * u[k, j]
+    return acc
 
 
 @numba.njit(cache=True)
@@ -24,22 +44,11 @@ def simulate_ss(A, B, C, D, u, x, xn, y):  # pragma: no cover - compiled
     ([0.0, 1.0, 0.5], [0.25])
     """
     n = A.shape[0]
-    m = B.shape[1]
     p = C.shape[0]
     for k in range(u.shape[0]):
         for i in range(p):
-            acc = 0.0
-            for j in range(n):
-                acc += C[i, j] * x[j]
-            for j in range(m):
-                acc += D[i, j] * u[k, j]
-            y[k, i] = acc
+            y[k, i] = affine_row(C, i, x, D, u, k)
         for i in range(n):
-            acc = 0.0
-            for j in range(n):
-                acc += A[i, j] * x[j]
-            for j in range(m):
-                acc += B[i, j] * u[k, j]
-            xn[i] = acc
+            xn[i] = affine_row(A, i, x, B, u, k)
         for i in range(n):
             x[i] = xn[i]

@@ -35,7 +35,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..errors import DataError, IdentificationError
-from ..lti import StateSpace, Uncertainty
+from ..lti import StateSpace, Uncertainty, affine_row
 from .blocked_gram import add_rows, row_product
 from .linear_model import LinearModel, as_io_matrix, fit_per_output, free_run
 
@@ -57,7 +57,7 @@ def predict_errors(A, B, C, D, K, x0, u, y, e):  # pragma: no cover - compiled
 @numba.njit(cache=True)
 def _predict_states(A, B, C, D, K, x0, u, y, e, X):  # pragma: no cover - compiled
     """Prediction errors e (N, p) and, when X has N rows, predictor states X (N, n) (X[t] = x[t])."""
-    n, m, p = A.shape[0], B.shape[1], C.shape[0]
+    n, p = A.shape[0], C.shape[0]
     store = X.shape[0] == u.shape[0]
     x = x0.copy()
     xn = np.empty(n)
@@ -66,18 +66,9 @@ def _predict_states(A, B, C, D, K, x0, u, y, e, X):  # pragma: no cover - compil
             for r in range(n):
                 X[t, r] = x[r]
         for i in range(p):
-            acc = 0.0
-            for j in range(n):
-                acc += C[i, j] * x[j]
-            for j in range(m):
-                acc += D[i, j] * u[t, j]
-            e[t, i] = y[t, i] - acc
+            e[t, i] = y[t, i] - affine_row(C, i, x, D, u, t)
         for r in range(n):
-            acc = 0.0
-            for j in range(n):
-                acc += A[r, j] * x[j]
-            for j in range(m):
-                acc += B[r, j] * u[t, j]
+            acc = affine_row(A, r, x, B, u, t)
             for j in range(p):
                 acc += K[r, j] * e[t, j]
             xn[r] = acc

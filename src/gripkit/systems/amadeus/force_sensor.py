@@ -32,6 +32,7 @@ import numpy as np
 from ...control.rst import as_plant
 from ...errors import (AccuracyWarning, DataError, IdentificationError, ModelError,
                        UnidentifiableError)
+from ...lti import affine_row
 from .strain_gauge_sensor import StrainGaugeSensor, sensitivity_matrix, sensor_parameters
 
 __all__ = [
@@ -502,7 +503,6 @@ def _kf_run(A, B, HC, Q, sn2, floor2, Z, U, x, P, fout, cout, C, nis, tmp, ph, k
     Per sample: sequential scalar updates with R_j = sn2_j r̂_j² + floor2 (r̂ from the prior),
     outputs f = C x⁺ and C P⁺ Cᵀ, then the time update with input U[k]."""
     n = A.shape[0]
-    m = B.shape[1]
     N = Z.shape[0]
     for k in range(N):
         s_nis = 0.0
@@ -553,12 +553,7 @@ def _kf_run(A, B, HC, Q, sn2, floor2, Z, U, x, P, fout, cout, C, nis, tmp, ph, k
                 cout[k, a, b] = acc
         # time update: x = A x + B u ; P = A P A' + Q   (tmp rows 0..n-1 as scratch, n <= tmp rows)
         for i in range(n):
-            acc = 0.0
-            for l in range(n):
-                acc += A[i, l] * x[l]
-            for l in range(m):
-                acc += B[i, l] * U[k, l]
-            ph[i] = acc
+            ph[i] = affine_row(A, i, x, B, U, k)
         for i in range(n):
             x[i] = ph[i]
         for i in range(n):
