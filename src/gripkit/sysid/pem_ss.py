@@ -85,26 +85,15 @@ def _sensitivities(Abar, C, F, G, S0, Z, J):  # pragma: no cover - compiled
     z[t] = [x[t]; u[t]; e[t]] (Z, shape (N, n + m + p)), Ā = A − KC. Directions run in parallel."""
     n = Abar.shape[0]
     p = C.shape[0]
-    nz = Z.shape[1]
-    ng = G.shape[2]
     for q in numba.prange(F.shape[0]):
         s = S0[q].copy()
         sn = np.empty(n)
+        Gq, Fq = G[q], F[q]
         for t in range(Z.shape[0]):
             for i in range(p):
-                acc = 0.0
-                for j in range(n):
-                    acc += C[i, j] * s[j]
-                for j in range(ng):
-                    acc += G[q, i, j] * Z[t, j]
-                J[t * p + i, q] = acc
+                J[t * p + i, q] = affine_row(C, i, s, Gq, Z, t)
             for r in range(n):
-                acc = 0.0
-                for j in range(n):
-                    acc += Abar[r, j] * s[j]
-                for j in range(nz):
-                    acc += F[q, r, j] * Z[t, j]
-                sn[r] = acc
+                sn[r] = affine_row(Abar, r, s, Fq, Z, t)
             for r in range(n):
                 s[r] = sn[r]
 
@@ -253,7 +242,6 @@ def _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough, innovation, max_
     """Levenberg-Marquardt on the whitened prediction errors, re-centring the local coordinates
     after every accepted step and rejecting steps that leave the stable set."""
     N, p = yw.shape
-    n = A.shape[0]
     e = np.empty((N, p))
     predict_errors(A, B, C, D, K, x0, u, yw, e)
     Vc = float(np.sum(e * e))
