@@ -13,12 +13,13 @@ from pathlib import Path
 SRC = Path(__file__).resolve().parents[1] / "src" / "gripkit"
 LIMIT = 100
 
-#: (a) Scalar numba kernels whose split would cost speed: (path under src/gripkit, name) → the
-#: measurement that says so. The one candidate outside the files of (b),
-#: systems/amadeus/pvdf.py ``contact_step`` (119 lines), was split into per-substep helpers at no
-#: cost: numba's LLVM inlines them (min of 40 runs of 2000 samples × 20 substeps: 2216 → 2221 µs
-#: for the grasp, 2063 → 2058 µs for the testbed; outputs bit-identical). An entry here must be a
-#: numba kernel, and its reason must give the measured slowdown of the split.
+#: Scalar numba kernels whose split would cost speed: (path under src/gripkit, name) → the
+#: measurement that says so. Others were split at no cost: systems/amadeus/pvdf.py
+#: ``contact_step`` (119 lines) into per-substep helpers that numba's LLVM inlines (min of 40 runs
+#: of 2000 samples × 20 substeps: 2216 → 2221 µs for the grasp, 2063 → 2058 µs for the testbed);
+#: the TSFM ``_grasp_core`` and the DLR/HIT finger's ``_forces`` into pieces inlined at numba IR
+#: level (docs/performance.md, "Named records in kernels"); outputs bit-identical. An entry here
+#: must be a numba kernel, and its reason must give the measured slowdown of the split.
 NUMBA_KERNELS: dict[tuple[str, str], str] = {
     ("multibody/kernels.py", "rnea_pass"): (
         "the outward pass as a helper returning the 9 link velocities/accelerations (a tuple, with or "
@@ -26,16 +27,6 @@ NUMBA_KERNELS: dict[tuple[str, str], str] = {
         "alternating runs, 20 000 states, min of 9, e.g. 451-646 ns against 395-534 ns per state "
         "(2026-11-23, shared 2-core machine); crba, split into three loops, was not slower"),
 }
-
-#: (b) Being split in another branch: these files were being changed by other developers when
-#: issue 12's split was made, so they were left alone. Remove each entry once that branch is
-#: merged and the function is short (test_allow_list_entries_are_still_needed says which).
-BEING_SPLIT_ELSEWHERE: set[tuple[str, str]] = {
-    # numba kernel: its named-records version is on branch `records` (8 % slower, did not land;
-    # docs/performance.md "Named records in kernels")
-    ("systems/dlr_hit/finger.py", "_forces"),
-}
-
 
 def function_lengths(source: str) -> dict[str, tuple[int, int, ast.AST]]:
     """``{qualified name: (length, first line, node)}`` of every function in ``source``."""
@@ -81,7 +72,7 @@ LENGTHS = _all_lengths()
 
 
 def test_no_function_is_longer_than_100_lines():
-    allowed = set(NUMBA_KERNELS) | BEING_SPLIT_ELSEWHERE
+    allowed = set(NUMBA_KERNELS)
     too_long = sorted((length, f"src/gripkit/{rel}:{line} {name}")
                       for (rel, name), (length, line, _) in LENGTHS.items()
                       if length > LIMIT and (rel, name) not in allowed)
@@ -94,12 +85,12 @@ def test_no_function_is_longer_than_100_lines():
 
 def test_allow_list_entries_are_still_needed():
     """Every allowed function exists and is still too long (else its entry must go), and every
-    entry of (a) is a numba kernel with a reason."""
+    entry is a numba kernel with a reason."""
     stale = [f"{rel} {name}: " + ("no such function" if (rel, name) not in LENGTHS else
                                   f"{LENGTHS[(rel, name)][0]} lines, within the limit")
-             for rel, name in sorted(set(NUMBA_KERNELS) | BEING_SPLIT_ELSEWHERE)
+             for rel, name in sorted(NUMBA_KERNELS)
              if (rel, name) not in LENGTHS or LENGTHS[(rel, name)][0] <= LIMIT]
-    assert not stale, "remove from the allow-lists of tests/test_function_length.py: " + "; ".join(stale)
+    assert not stale, "remove from the allow-list of tests/test_function_length.py: " + "; ".join(stale)
     for (rel, name), reason in NUMBA_KERNELS.items():
         assert LENGTHS[(rel, name)][2], f"{rel} {name} is in NUMBA_KERNELS but is not a numba kernel"
         assert reason.strip(), f"{rel} {name}: give the measured slowdown of a split"

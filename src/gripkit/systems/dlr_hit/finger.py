@@ -179,6 +179,11 @@ def finger_setup(th, dh, mass, com, inertia, G, arm_p, grav, ratio):  # pragma: 
         grav[k] = th[I_GX + k]
 
 
+#: pieces of one step of :func:`_forces`, inlined into it at numba IR level (compiled as separate
+#: functions, pieces of a kernel this hot measured slower: docs/performance.md, "Named records")
+_step_piece = numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+
+
 @hot
 def _kinetic(th, k, v, p, mode, tv, tf, tn, tipos):  # pragma: no cover - compiled
     """Kinetic friction of actuator k at velocity v (never 0 for v ≠ 0)."""
@@ -190,35 +195,25 @@ def _kinetic(th, k, v, p, mode, tv, tf, tn, tipos):  # pragma: no cover - compil
     return f + ripple(p, v, th[I_RA], th[I_RC], 0.0)
 
 
-@hot
-def _forces(th, n_stuck_iter, mode, thermal, dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav,
-            ratio, tv, tf, tn, tipos, p, pd, T, z, stuck, pwm, ext, acc, taum, tshaft, fric,
-            R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, Ms, xs, rs, dirn):  # pragma: no cover
-    """Accelerations ``acc`` for the state (p, ṗ) with the stuck set ``stuck``; fills motor
-    torques (output side and shaft) and friction. With ``n_stuck_iter > 0`` actuators at rest are
-    flagged and those whose holding torque exceeds stiction are released (the flags change in
-    place, ``dirn`` records the breakaway direction); ``n_stuck_iter = 0`` keeps the set frozen
-    (RK4 stages)."""
-    m = 3
-    joints_from_actuators(4, m, G, q0, p, q)
-    joints_from_actuators(4, m, G, zq, pd, qd)
-    chain_links(4, dh, jt, q, R, P)
-    coupled_mass_bias(4, m, R, P, jt, mass, com, inertia, armq, G, arm_p, qd, grav[0], grav[1],
-                      grav[2], Mp, hp, zq, Mq, tau, work)
-    # motors through the transmissions
-    for k in range(m):
+@_step_piece
+def _drive_torques(th, thermal, ratio, T, pwm, pd, taum, tshaft):  # pragma: no cover - compiled
+    """Each motor through its transmission (eqs 5.7, 5.9; thermal derating with ``thermal``):
+    shaft torques ``tshaft`` and the output-side torques ``taum``."""
+    for k in range(3):
         rho = 1.0
         if thermal:
             rho = temperature_factor(T[k], th[I_TREF], th[I_TAMB], th[I_ALPHA])
         ts = bldc_torque(pwm[k], ratio[k] * pd[k], th[I_C], th[I_B1], th[I_B0], th[I_PMAX], rho)
         tshaft[k] = ts
         taum[k] = transmit_torque(ts, pd[k], ratio[k], th[I_ETA])
-    # applied torque on each actuator (before friction): motor + end stops + external − bias
-    for k in range(m):
-        rhs[k] = taum[k] + ext[k] - hp[k]
+
+
+@_step_piece
+def _add_end_stops(th, q, qd, G, rhs):  # pragma: no cover - compiled
+    """Spring-damper end stops on θ1, θ2, θ3 (θ4 = θ3), one-sided, mapped onto the actuators."""
     ks = th[I_KS]
     ds = th[I_DS]
-    for j in range(3):  # joint limits on θ1, θ2, θ3 (θ4 = θ3)
+    for j in range(3):
         lo = th[I_LIM + 2 * j]
         hi = th[I_LIM + 2 * j + 1]
         ts = 0.0
@@ -231,19 +226,17 @@ def _forces(th, n_stuck_iter, mode, thermal, dh, jt, mass, com, inertia, armq, G
             if ts < 0.0:
                 ts = 0.0
         if ts != 0.0:
-            for k in range(m):
-                rhs[k] += G[j * m + k] * ts
-    if mode >= 2:
-        for k in range(m):
-            if mode == 2:
-                f = lugre_force(z[k], pd[k], th[I_FC + k], th[I_FS + k], th[I_VS], th[I_S0],
-                                th[I_S1], th[I_VISC + k]) + ripple(p[k], pd[k], th[I_RA], th[I_RC], 0.0)
-            else:
-                f = 0.0
-            fric[k] = f
-            rs[k] = rhs[k] - f
-        return cholesky_solve(m, Mp, rs, acc, L)
-    # Karnopp: actuators at rest (flagged, or exactly zero velocity) are constraints
+            for k in range(3):
+                rhs[k] += G[j * 3 + k] * ts
+
+
+@hot
+def _karnopp(th, n_stuck_iter, mode, tv, tf, tn, tipos, p, pd, stuck, acc, fric, Mp, L, rhs, Ms, xs, rs,
+             dirn):  # pragma: no cover - compiled
+    """Karnopp stick-slip: actuators at rest (flagged, or exactly zero velocity) are constraints;
+    the free subsystem is solved, and the stuck actuator whose holding torque exceeds its stiction
+    most is released, up to ``n_stuck_iter`` times (0: the set stays frozen, for RK4 stages)."""
+    m = 3
     frozen = n_stuck_iter == 0
     if not frozen:
         for k in range(m):
@@ -302,6 +295,40 @@ def _forces(th, n_stuck_iter, mode, thermal, dh, jt, mass, com, inertia, armq, G
         stuck[worst] = 0.0
         dirn[worst] = 1.0 if fric[worst] > 0.0 else -1.0
     return True
+
+
+@hot
+def _forces(th, n_stuck_iter, mode, thermal, dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav,
+            ratio, tv, tf, tn, tipos, p, pd, T, z, stuck, pwm, ext, acc, taum, tshaft, fric,
+            R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, Ms, xs, rs, dirn):  # pragma: no cover
+    """Accelerations ``acc`` for the state (p, ṗ) with the stuck set ``stuck``; fills motor
+    torques (output side and shaft) and friction. With ``n_stuck_iter > 0`` actuators at rest are
+    flagged and those whose holding torque exceeds stiction are released (the flags change in
+    place, ``dirn`` records the breakaway direction); ``n_stuck_iter = 0`` keeps the set frozen
+    (RK4 stages)."""
+    m = 3
+    joints_from_actuators(4, m, G, q0, p, q)
+    joints_from_actuators(4, m, G, zq, pd, qd)
+    chain_links(4, dh, jt, q, R, P)
+    coupled_mass_bias(4, m, R, P, jt, mass, com, inertia, armq, G, arm_p, qd, grav[0], grav[1],
+                      grav[2], Mp, hp, zq, Mq, tau, work)
+    _drive_torques(th, thermal, ratio, T, pwm, pd, taum, tshaft)
+    # applied torque on each actuator (before friction): motor + end stops + external − bias
+    for k in range(m):
+        rhs[k] = taum[k] + ext[k] - hp[k]
+    _add_end_stops(th, q, qd, G, rhs)
+    if mode >= 2:
+        for k in range(m):
+            if mode == 2:
+                f = lugre_force(z[k], pd[k], th[I_FC + k], th[I_FS + k], th[I_VS], th[I_S0],
+                                th[I_S1], th[I_VISC + k]) + ripple(p[k], pd[k], th[I_RA], th[I_RC], 0.0)
+            else:
+                f = 0.0
+            fric[k] = f
+            rs[k] = rhs[k] - f
+        return cholesky_solve(m, Mp, rs, acc, L)
+    return _karnopp(th, n_stuck_iter, mode, tv, tf, tn, tipos, p, pd, stuck, acc, fric, Mp, L, rhs, Ms, xs, rs,
+                    dirn)
 
 
 def _make_context(th):
