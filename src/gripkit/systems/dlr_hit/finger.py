@@ -44,6 +44,7 @@ stick/slip set held over a step and events detected at step boundaries.
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 import numba
 import numpy as np
@@ -80,51 +81,16 @@ FINGER_PARAMETERS = (
     "cubic_base1", "cubic_base2", "cubic_distal", "v_s", "delta", "sigma0", "sigma1", "ripple_amp", "ripple_cycles", "v_stick",
     "abd_min", "abd_max", "flex_min", "flex_max", "prox_min", "prox_max", "k_stop", "d_stop",
 )
-_I = {n: i for i, n in enumerate(FINGER_PARAMETERS)}
 NTH = len(FINGER_PARAMETERS)
 ACTUATORS = ("base1", "base2", "distal")
 JOINTS = ("abd", "flex", "prox")
 FRICTION_MODES = {"table": 0, "stribeck": 1, "lugre": 2, "none": 3}
 INTEGRATORS = {"semi-implicit": 0, "rk4": 1}
 
-# indices as module constants (numba treats globals as compile-time constants)
-I_L1 = _I["l1"]
-I_M1 = _I["m1"]
-I_PC1 = _I["pc1_x"]
-I_IN1 = _I["I1_xx"]
-I_IM = _I["I_m"]
-I_BETA = _I["beta"]
-I_GX = _I["g_x"]
-I_NHD = _I["N_hd"]
-I_NB = _I["N_belt"]
-I_NBB = _I["N_belt_base"]
-I_ETA = _I["eta"]
-I_C = _I["c_pwm"]
-I_B1 = _I["b_pwm"]
-I_B0 = _I["b_0"]
-I_PMAX = _I["pwm_max"]
-I_TREF = _I["T_ref"]
-I_TAMB = _I["T_amb"]
-I_ALPHA = _I["alpha_R"]
-I_KT = _I["k_t"]
-I_R0 = _I["R_0"]
-I_RTH = _I["R_th"]
-I_CTH = _I["C_th"]
-I_FS = _I["fs_base1"]
-I_SCALE = _I["scale_base1"]
-I_FC = _I["fc_base1"]
-I_VISC = _I["visc_base1"]
-I_CUB = _I["cubic_base1"]
-I_VS = _I["v_s"]
-I_DELTA = _I["delta"]
-I_S0 = _I["sigma0"]
-I_S1 = _I["sigma1"]
-I_RA = _I["ripple_amp"]
-I_RC = _I["ripple_cycles"]
-I_VST = _I["v_stick"]
-I_LIM = _I["abd_min"]
-I_KS = _I["k_stop"]
-I_DS = _I["d_stop"]
+#: the index of each parameter in the vector ``th`` the kernels take, by name: ``th[IX.l1]``,
+#: ``th[IX.fs_base1 + k]`` for actuator k. A module-level namedtuple of ints, generated from
+#: FINGER_PARAMETERS: numba freezes it as a constant, so each index folds into the address.
+IX = namedtuple("FingerParameterIndex", FINGER_PARAMETERS)(*range(len(FINGER_PARAMETERS)))
 
 # state layout: p(3) pd(3) T(3) z(3) stuck(3)
 NX = 15
@@ -146,15 +112,15 @@ def finger_setup(th, dh, mass, com, inertia, G, arm_p, grav, ratio):  # pragma: 
     dh[1, 0] = -0.5 * math.pi  # α1 = −90°: flexion axis ⟂ abduction axis (Appendix A, Rx(−90°))
     dh[1, 4] = 0.0
     dh[1, 5] = -1.0
-    dh[2, 1] = th[I_L1]  # a2 = l1
-    dh[3, 1] = th[I_L1 + 1]  # a3 = l2
+    dh[2, 1] = th[IX.l1]  # a2 = l1
+    dh[3, 1] = th[IX.l2]  # a3 = l2
     for k in range(3):
-        mass[k + 1] = th[I_M1 + k]
+        mass[k + 1] = th[IX.m1 + k]
         for j in range(3):
-            com[k + 1, j] = th[I_PC1 + 3 * k + j]
-            inertia[k + 1, j] = th[I_IN1 + 3 * k + j]
+            com[k + 1, j] = th[IX.pc1_x + 3 * k + j]
+            inertia[k + 1, j] = th[IX.I1_xx + 3 * k + j]
     # Γ (4×3, row-major): differential on (abd, flex) × (base1, base2), θ3 = θ4 = p3
-    b = th[I_BETA]
+    b = th[IX.beta]
     a00 = math.sin(-b)
     a01 = math.sin(b)
     a10 = math.cos(-b)
@@ -169,14 +135,14 @@ def finger_setup(th, dh, mass, com, inertia, G, arm_p, grav, ratio):  # pragma: 
     G[4] = a00 / det
     G[8] = 1.0
     G[11] = 1.0
-    nd = th[I_NHD] * th[I_NB]
-    nb = nd * th[I_NBB]
+    nd = th[IX.N_hd] * th[IX.N_belt]
+    nb = nd * th[IX.N_belt_base]
     ratio[0] = nb
     ratio[1] = nb
     ratio[2] = nd
     for k in range(3):
-        arm_p[k] = th[I_IM] * ratio[k] * ratio[k]
-        grav[k] = th[I_GX + k]
+        arm_p[k] = th[IX.I_m] * ratio[k] * ratio[k]
+        grav[k] = th[IX.g_x + k]
 
 
 #: pieces of one step of :func:`_forces`, inlined into it at numba IR level (compiled as separate
@@ -188,11 +154,12 @@ _step_piece = numba.njit(cache=True, error_model="numpy", _nrt=False, inline="al
 def _kinetic(th, k, v, p, mode, tv, tf, tn, tipos):  # pragma: no cover - compiled
     """Kinetic friction of actuator k at velocity v (never 0 for v ≠ 0)."""
     if mode == 0:
-        f = th[I_SCALE + k] * table_friction(v, tv[k], tf[k], tn[k], tipos[k])
+        f = th[IX.scale_base1 + k] * table_friction(v, tv[k], tf[k], tn[k], tipos[k])
     else:
-        f = (stribeck(v, th[I_FC + k], th[I_FS + k], th[I_VS], th[I_DELTA], th[I_VISC + k])
-             + th[I_CUB + k] * v * v * v)
-    return f + ripple(p, v, th[I_RA], th[I_RC], 0.0)
+        f = (stribeck(v, th[IX.fc_base1 + k], th[IX.fs_base1 + k], th[IX.v_s], th[IX.delta],
+                      th[IX.visc_base1 + k])
+             + th[IX.cubic_base1 + k] * v * v * v)
+    return f + ripple(p, v, th[IX.ripple_amp], th[IX.ripple_cycles], 0.0)
 
 
 @_step_piece
@@ -202,20 +169,21 @@ def _drive_torques(th, thermal, ratio, T, pwm, pd, taum, tshaft):  # pragma: no 
     for k in range(3):
         rho = 1.0
         if thermal:
-            rho = temperature_factor(T[k], th[I_TREF], th[I_TAMB], th[I_ALPHA])
-        ts = bldc_torque(pwm[k], ratio[k] * pd[k], th[I_C], th[I_B1], th[I_B0], th[I_PMAX], rho)
+            rho = temperature_factor(T[k], th[IX.T_ref], th[IX.T_amb], th[IX.alpha_R])
+        ts = bldc_torque(pwm[k], ratio[k] * pd[k], th[IX.c_pwm], th[IX.b_pwm], th[IX.b_0], th[IX.pwm_max],
+                         rho)
         tshaft[k] = ts
-        taum[k] = transmit_torque(ts, pd[k], ratio[k], th[I_ETA])
+        taum[k] = transmit_torque(ts, pd[k], ratio[k], th[IX.eta])
 
 
 @_step_piece
 def _add_end_stops(th, q, qd, G, rhs):  # pragma: no cover - compiled
     """Spring-damper end stops on θ1, θ2, θ3 (θ4 = θ3), one-sided, mapped onto the actuators."""
-    ks = th[I_KS]
-    ds = th[I_DS]
+    ks = th[IX.k_stop]
+    ds = th[IX.d_stop]
     for j in range(3):
-        lo = th[I_LIM + 2 * j]
-        hi = th[I_LIM + 2 * j + 1]
+        lo = th[IX.abd_min + 2 * j]
+        hi = th[IX.abd_min + 2 * j + 1]
         ts = 0.0
         if q[j] > hi:
             ts = -ks * (q[j] - hi) - ds * qd[j]
@@ -285,7 +253,7 @@ def _karnopp(th, n_stuck_iter, mode, tv, tf, tn, tipos, p, pd, stuck, acc, fric,
                 if stuck[j] == 0.0:
                     lam -= Mp[k, j] * acc[j]
             fric[k] = lam
-            fs = th[I_FS + k]
+            fs = th[IX.fs_base1 + k]
             r = abs(lam) / fs if fs > 0.0 else (math.inf if lam != 0.0 else 0.0)
             if r > excess:
                 excess = r
@@ -320,8 +288,9 @@ def _forces(th, n_stuck_iter, mode, thermal, dh, jt, mass, com, inertia, armq, G
     if mode >= 2:
         for k in range(m):
             if mode == 2:
-                f = lugre_force(z[k], pd[k], th[I_FC + k], th[I_FS + k], th[I_VS], th[I_S0],
-                                th[I_S1], th[I_VISC + k]) + ripple(p[k], pd[k], th[I_RA], th[I_RC], 0.0)
+                f = (lugre_force(z[k], pd[k], th[IX.fc_base1 + k], th[IX.fs_base1 + k], th[IX.v_s], th[IX.sigma0],
+                                 th[IX.sigma1], th[IX.visc_base1 + k])
+                     + ripple(p[k], pd[k], th[IX.ripple_amp], th[IX.ripple_cycles], 0.0))
             else:
                 f = 0.0
             fric[k] = f
@@ -368,12 +337,12 @@ def _slow_states(th, mode, thermal, x, v0, tshaft, h):  # pragma: no cover - com
     """Motor temperatures (explicit step) and LuGre bristles (exact for v held over the step)."""
     if thermal:
         for k in range(3):
-            x[6 + k] = motor_heat_step(x[6 + k], tshaft[k], h, th[I_TAMB], th[I_ALPHA], th[I_R0],
-                                       th[I_KT], th[I_RTH], th[I_CTH])
+            x[6 + k] = motor_heat_step(x[6 + k], tshaft[k], h, th[IX.T_amb], th[IX.alpha_R], th[IX.R_0],
+                                       th[IX.k_t], th[IX.R_th], th[IX.C_th])
     if mode == 2:
         for k in range(3):
-            x[9 + k] = lugre_update(x[9 + k], v0[k], h, th[I_FC + k], th[I_FS + k], th[I_VS],
-                                    th[I_S0])
+            x[9 + k] = lugre_update(x[9 + k], v0[k], h, th[IX.fc_base1 + k], th[IX.fs_base1 + k], th[IX.v_s],
+                                    th[IX.sigma0])
 
 
 @hot
@@ -381,7 +350,7 @@ def _stick(th, mode, x, v0):  # pragma: no cover - compiled
     """Karnopp: a sliding actuator whose velocity crosses zero comes to rest; if its holding torque
     exceeds stiction it breaks away again at the next step."""
     if mode < 2:
-        vst = th[I_VST]
+        vst = th[IX.v_stick]
         for k in range(3):
             if x[12 + k] == 0.0 and (x[3 + k] * v0[k] < 0.0 or abs(x[3 + k]) <= vst):
                 x[3 + k] = 0.0
@@ -491,7 +460,7 @@ def _tip(ctx, th, q, R, P, T, J, Jp, tip):  # pragma: no cover - compiled
     G = ctx[6]
     chain_links(4, dh, jt, q, R, P)
     frames_into(4, R, P, T)
-    l3 = th[I_L1 + 2]
+    l3 = th[IX.l3]
     px = T[3, 3] + T[3, 0] * l3
     py = T[3, 7] + T[3, 4] * l3
     pz = T[3, 11] + T[3, 8] * l3
@@ -511,10 +480,10 @@ def _tip(ctx, th, q, R, P, T, J, Jp, tip):  # pragma: no cover - compiled
 def _pwm_for(tau_out, omega_m, N, th):  # pragma: no cover - compiled
     """PWM that yields output torque ``tau_out`` at motor speed omega_m (inverse of eq 5.10 at
     T_ref), clipped to ±pwm_max."""
-    c = th[I_C]
-    b1 = th[I_B1]
-    b0 = th[I_B0]
-    pmax = th[I_PMAX]
+    c = th[IX.c_pwm]
+    b1 = th[IX.b_pwm]
+    b0 = th[IX.b_0]
+    pmax = th[IX.pwm_max]
     tm = tau_out / N
     den = c + b1 * omega_m
     u = (tm - b0 * omega_m) / den if den > 0.0 else pmax
@@ -635,8 +604,8 @@ def _adapt_friction(th, ctx, cs, x, pwm, ctv, ctf, ctn, ctipos, adapt, y, n):  #
               work)
     for k in range(3):
         v = x[3 + k]
-        ts = bldc_torque(pwm[k], ratio[k] * v, th[I_C], th[I_B1], th[I_B0], th[I_PMAX], 1.0)
-        tm = transmit_torque(ts, v, ratio[k], th[I_ETA])
+        ts = bldc_torque(pwm[k], ratio[k] * v, th[IX.c_pwm], th[IX.b_pwm], th[IX.b_0], th[IX.pwm_max], 1.0)
+        tm = transmit_torque(ts, v, ratio[k], th[IX.eta])
         h = 0.0
         for j in range(4):
             h += G[j * 3 + k] * hb[j]
@@ -654,17 +623,17 @@ def _drift_friction(th, mode, tv, tf, tn, drift, n, thw, tfw):  # pragma: no cov
     for k in range(3):
         s = drift[n, k]
         d = drift[n, 3 + k]
-        thw[I_FS + k] = s * th[I_FS + k] + d
+        thw[IX.fs_base1 + k] = s * th[IX.fs_base1 + k] + d
         if mode == 0:
-            sc = s * th[I_SCALE + k]
-            thw[I_SCALE + k] = 1.0
+            sc = s * th[IX.scale_base1 + k]
+            thw[IX.scale_base1 + k] = 1.0
             for i in range(tn[k]):
                 b = tv[k, i]
                 tfw[k, i] = sc * tf[k, i] + (d if b > 0.0 else (-d if b < 0.0 else 0.0))
         else:
-            thw[I_FC + k] = s * th[I_FC + k] + d
-            thw[I_VISC + k] = s * th[I_VISC + k]
-            thw[I_CUB + k] = s * th[I_CUB + k]
+            thw[IX.fc_base1 + k] = s * th[IX.fc_base1 + k] + d
+            thw[IX.visc_base1 + k] = s * th[IX.visc_base1 + k]
+            thw[IX.cubic_base1 + k] = s * th[IX.cubic_base1 + k]
 
 
 @hot
