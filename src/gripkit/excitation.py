@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .arguments import sample_interval
 from .errors import DataError
 from .signals.filters import apply_sos, butter_sos
 from .signals.trajectory import Trajectory
@@ -77,10 +78,7 @@ def crest_factor(x: np.ndarray) -> float:
 
 def _check_dt(dt) -> float:
     """1/dt, the sampling rate the designs' frequency grids use, after checking dt."""
-    if isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating)) \
-            or not (np.isfinite(dt) and dt > 0):
-        raise DataError(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
-    return 1.0 / float(dt)
+    return 1.0 / sample_interval(dt)
 
 
 def _check_common(duration: float, dt: float, operating_point: float,

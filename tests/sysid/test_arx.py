@@ -192,9 +192,10 @@ def test_large_fit_computes_residuals_on_demand_from_its_record():
     for scale in (1.0, 2.0**120):  # the second one is fitted on scaled copies (peak beyond 2^100)
         m = arx(u, y * scale, 2, 2, 2)
         assert m.info["method"].startswith("least squares (normal equations")
-        assert m.__dict__.get("_residuals") is None  # nothing stored by the fit itself
+        assert m.stored_residuals is None  # nothing stored by the fit itself
         e_ref, see, _ = arx_residuals(u, y * scale, m.theta, 2, 2, 2, 3)
         e = m.residuals
+        assert m.stored_residuals is e  # computed once, then kept
         assert not e.flags.writeable and e.size == m.n_used == 100_000 - 3
         np.testing.assert_allclose(e, e_ref, rtol=0, atol=1e-12 * scale)
         assert m.loss == pytest.approx(0.5 * see / e.size, rel=1e-12)

@@ -15,8 +15,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from ..arguments import sample_interval
 from ..errors import DataError
 from .trajectory import Trajectory
+
 
 def _signal():
     """``scipy.signal``, imported on first use: it costs ~0.7 s, more than the rest of ``import gripkit``."""
@@ -32,10 +34,7 @@ def _check_design(order: int, cutoff, dt: float, btype: str) -> tuple[np.ndarray
     """(cutoff frequencies in Hz, sampling rate 1/dt) after the checks."""
     if int(order) != order or order < 1:
         raise DataError(f"filter order: expected a positive integer, found {order!r}")
-    if isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating)) \
-            or not (np.isfinite(dt) and dt > 0):
-        raise DataError(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
-    rate = 1.0 / float(dt)
+    rate = 1.0 / sample_interval(dt)
     wn = np.atleast_1d(np.asarray(cutoff, dtype=np.float64))
     need = 2 if btype in ("bandpass", "bandstop") else 1
     if wn.size != need:

@@ -12,6 +12,7 @@ from fractions import Fraction
 
 import numpy as np
 
+from ..arguments import sample_interval
 from ..errors import DataError
 from .filters import _signal, apply_sos, butter_sos
 from .trajectory import Trajectory
@@ -67,16 +68,9 @@ def decimate(tr: Trajectory, q: int, order: int = 8, zero_phase: bool = True) ->
     return Trajectory(tr.t[::q], data, tr.units, meta)
 
 
-def _checked_dt(dt) -> float:
-    if isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating)) \
-            or not (np.isfinite(dt) and dt > 0):
-        raise DataError(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
-    return float(dt)
-
-
 def to_uniform(tr: Trajectory, dt: float) -> Trajectory:
     """Linear interpolation of a (possibly non-uniform) record onto a uniform grid every ``dt`` s."""
-    dt = _checked_dt(dt)
+    dt = sample_interval(dt)
     n = int(np.floor(tr.duration / dt + 1e-9)) + 1
     t = tr.t[0] + np.arange(n) * dt
     data = {k: np.interp(t, tr.t, tr[k]) for k in tr.names}
@@ -86,7 +80,7 @@ def to_uniform(tr: Trajectory, dt: float) -> Trajectory:
 def resample(tr: Trajectory, dt: float) -> Trajectory:
     """Resample to one sample every ``dt`` s: polyphase filtering for uniform data (rational
     ratio of the intervals), linear interpolation onto a uniform grid otherwise."""
-    dt = _checked_dt(dt)
+    dt = sample_interval(dt)
     if not tr.is_uniform():
         return to_uniform(tr, dt)
     ratio = Fraction(tr.dt / dt).limit_denominator(1000)

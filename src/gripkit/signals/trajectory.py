@@ -17,6 +17,7 @@ from collections.abc import Iterable, Mapping
 
 import numpy as np
 
+from ..arguments import sample_interval
 from ..errors import DataError
 
 __all__ = ["Trajectory"]
@@ -123,9 +124,7 @@ class Trajectory:
                 meta: Mapping | None = None, **channels) -> "Trajectory":
         """Build from channels sampled every ``dt`` s starting at ``t0`` s (``dt`` is kept as the
         nominal interval, exact, in ``meta['dt']``)."""
-        if isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating)) \
-                or not (np.isfinite(dt) and dt > 0):
-            raise DataError(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
+        dt = sample_interval(dt)
         if not channels:
             raise DataError("a trajectory needs at least one channel")
         n = len(next(iter(channels.values())))

@@ -43,7 +43,7 @@ def in_user_units(model, cu: float, cy: float):
             changes["noise_variance"] = model.noise_variance / cy / cy
         if model.loss is not None:
             changes["loss"] = model.loss / cy / cy
-    stored = model.__dict__.get("_residuals")  # not model.residuals: those not yet computed stay so
+    stored = model.stored_residuals  # not model.residuals: those not yet computed stay so
     if stored is not None:
         changes["residuals"] = stored / cy
     if "initial_outputs" in model.info:

@@ -10,6 +10,7 @@ import math
 
 import numpy as np
 
+from ..arguments import sample_interval
 from ..errors import DataError, UnidentifiableError
 
 __all__ = ["as_signal", "check_io", "check_order", "check_dt", "require_samples", "check_excitation",
@@ -67,10 +68,7 @@ def check_dt(dt: float | None) -> float:
     """The sample interval in seconds (1.0 — 'one sample' — when None)."""
     if dt is None:
         return 1.0
-    if isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating)) \
-            or not (math.isfinite(dt) and dt > 0):
-        raise DataError(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
-    return float(dt)
+    return sample_interval(dt)
 
 
 def require_samples(n: int, n_min: int, what: str) -> None:

@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..arguments import entry_point
+from ..arguments import entry_point, sample_interval
 from ..errors import DataError, IdentificationError, UnidentifiableError
 from ..models.friction import FrictionTable
 from ..signals.filters import apply_sos, butter_sos
@@ -392,10 +392,7 @@ def idim_samples(position, effort, *, dt: float, cutoff: float | None = None, or
     if x.ndim != 2 or x.shape != e.shape:
         raise DataError(f"position and effort: expected arrays of one shape (N,) or (N, m), found "
                         f"{np.shape(position)} and {np.shape(effort)}")
-    if isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating)) \
-            or not (np.isfinite(dt) and dt > 0):
-        raise DataError(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
-    rate = 1.0 / dt
+    rate = 1.0 / sample_interval(dt)
     cutoff = rate / 50.0 if cutoff is None else float(cutoff)
     if not 0 < cutoff < rate / 2:
         raise DataError(f"cutoff {cutoff:g} Hz must lie between 0 and the Nyquist frequency {rate / 2:g} Hz")

@@ -35,7 +35,7 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.signal import find_peaks, hilbert, resample_poly
 
-from ..arguments import entry_point
+from ..arguments import entry_point, sample_interval
 from ..errors import AccuracyWarning, DataError, IdentificationError
 from ._scaling import unit_scale
 
@@ -117,9 +117,7 @@ def _checked_signal(y, dt: float) -> np.ndarray:
     """``y`` as a flat float64 array, refused for a non-positive ``dt``, NaN/inf values or fewer
     than 64 samples."""
     y = np.asarray(y, dtype=np.float64).ravel()
-    if isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating)) \
-            or not (np.isfinite(dt) and dt > 0):
-        raise DataError(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
+    sample_interval(dt)
     if not np.isfinite(y).all():
         bad = int(np.argmax(~np.isfinite(y)))
         raise DataError(f"the signal has {int((~np.isfinite(y)).sum())} NaN/inf values (first at sample {bad})",

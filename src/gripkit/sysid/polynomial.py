@@ -48,7 +48,7 @@ class _Residuals:
     def __get__(self, model, owner=None):
         if model is None:
             return None  # the dataclass default
-        r = model.__dict__.get("_residuals")
+        r = model.stored_residuals
         if r is None and model.estimation_data is not None:
             r = model._residuals_from_record()
             model.__dict__["_residuals"] = r
@@ -170,7 +170,7 @@ class PolynomialModel:
                 raise ModelError(f"covariance: expected shape ({p}, {p}), found {cov.shape}")
             cov.flags.writeable = False
             set_(self, "covariance", cov)
-        r = self.__dict__.get("_residuals")  # not self.residuals: that would compute them now
+        r = self.stored_residuals  # not self.residuals: that would compute them now
         if r is not None:
             # a read-only float64 array is kept as it is (an estimator's fresh residuals, or a
             # replace()): copying N samples again would double the memory of a large fit
@@ -210,7 +210,7 @@ class PolynomialModel:
 
     def replace(self, **changes) -> "PolynomialModel":
         """A copy with some fields changed (residuals not yet computed stay so)."""
-        changes.setdefault("residuals", self.__dict__.get("_residuals"))
+        changes.setdefault("residuals", self.stored_residuals)
         return dataclasses.replace(self, **changes)
 
     def __getstate__(self) -> dict:
@@ -221,6 +221,12 @@ class PolynomialModel:
             state["_residuals"] = self.residuals
             state["estimation_data"] = None
         return state
+
+    @property
+    def stored_residuals(self) -> np.ndarray | None:
+        """The residual array the model holds, or None while ``residuals`` has not been computed
+        from ``estimation_data`` (reading this never computes them)."""
+        return self.__dict__.get("_residuals")
 
     def _residuals_from_record(self) -> np.ndarray:
         u, y = self.estimation_data

@@ -78,3 +78,23 @@ def test_trajectories_are_those_of_the_positional_kernels(trajectories, name):
     np.testing.assert_array_equal(got[-1], [float.fromhex(v) for v in ref["last_row"]])
     digest = hashlib.sha256(np.ascontiguousarray(got, dtype="<f8").tobytes()).hexdigest()
     assert digest == ref["sha256"], f"{name}: the trajectory differs from the recorded one"
+
+
+def test_parameter_index_names_every_parameter_and_compiles_to_a_constant():
+    """``IX`` (generated from FINGER_PARAMETERS) maps each name to its position, and numba folds an
+    index read from it into the load's address: the compiled ``th[IX.fs_base1 + k]`` has the
+    constant byte offset 8·index and loads nothing from ``IX`` at run time."""
+    import numba
+
+    from gripkit.systems.dlr_hit.finger import FINGER_PARAMETERS, IX
+
+    assert list(IX._fields) == list(FINGER_PARAMETERS) and list(IX) == list(range(len(FINGER_PARAMETERS)))
+
+    @numba.njit
+    def stiction(th, k):
+        return th[IX.fs_base1 + k]
+
+    th = np.arange(len(FINGER_PARAMETERS), dtype=np.float64)
+    assert stiction(th, 1) == IX.fs_base1 + 1
+    ir = stiction.inspect_llvm(stiction.signatures[0])
+    assert f"i64 {8 * IX.fs_base1}" in ir

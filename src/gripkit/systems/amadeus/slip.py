@@ -38,6 +38,7 @@ from dataclasses import dataclass, field
 import numba
 import numpy as np
 
+from ...arguments import sample_interval
 from ...errors import DataError, IdentificationError
 from ...signals.filters import butter_sos
 
@@ -215,10 +216,7 @@ def spectral_features(signal, *, dt: float, frame: float = 0.016, hop: float | N
     """Short-time spectra of a PVDF record (Fig. 13(b)): Hann-windowed frames of ``frame`` s every
     ``hop`` s (default frame/2), vectorised with one rfft."""
     x = _signal(signal)
-    if isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating)) \
-            or not (np.isfinite(dt) and dt > 0):
-        raise DataError(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
-    rate = 1.0 / dt
+    rate = 1.0 / sample_interval(dt)
     nf = int(round(frame * rate))
     nh = int(round((hop if hop is not None else frame / 2) * rate))
     if nf < 8 or nh < 1:
@@ -323,10 +321,7 @@ class SlipDetector:
                  min_duration: float = 0.002, release: float = 0.5, hold: float = 0.05,
                  threshold: float | None = None, feature_window: float = 0.1,
                  speed_calibration: SpeedCalibration | None = None):
-        if isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating)) \
-                or not (np.isfinite(dt) and dt > 0):
-            raise DataError(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
-        self.dt = float(dt)
+        self.dt = sample_interval(dt)
         rate = 1.0 / self.dt
         self.band = (float(band[0]), float(band[1]))
         self.sos = np.ascontiguousarray(butter_sos(order, self.band, dt=self.dt, btype="bandpass"))

@@ -103,6 +103,7 @@ import numba
 import numpy as np
 from scipy.optimize import brentq
 
+from ...arguments import sample_interval
 from ...consistency import Finding, compare
 from ...errors import ModelError, ParameterError
 from ...models.beams import STRETCHING_BETA, clamped_clamped_stiffness
@@ -346,9 +347,7 @@ class _SecondOrderFTG(Model):
         """ZOH discretisation every ``dt`` s: ``form='canonical'`` is the controllable canonical form
         the seed prints (eqs 10, 17; balancing scale chosen in the seed's units), ``'physical'``
         keeps the states [y, ẏ]."""
-        dt = float(dt)
-        if not (math.isfinite(dt) and dt > 0):
-            raise ModelError(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
+        dt = sample_interval(dt, ModelError)
         d = self.state_space().discretize(dt)
         if form == "physical":
             return d
@@ -582,9 +581,7 @@ class FTG100Coupled(Model):
             return self.discrete_eq18(dt)
         if form != "physical":
             raise ModelError(f"form: expected 'canonical' or 'physical', found {form!r}")
-        dt = float(dt)
-        if not (math.isfinite(dt) and dt > 0):
-            raise ModelError(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
+        dt = sample_interval(dt, ModelError)
         return self.state_space().discretize(dt)
 
     def discrete_eq18(self, dt: float = 5e-05) -> StateSpace:
