@@ -1,10 +1,54 @@
-"""Shared test configuration: headless plotting and deterministic hypothesis runs."""
+"""Shared test configuration: headless plotting, deterministic hypothesis runs, and the check of
+kernel results against their recording (tests/reference/kernel_records.json)."""
 
 import os
 
 os.environ.setdefault("MPLBACKEND", "Agg")
 
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
 from hypothesis import settings  # noqa: E402
 
 settings.register_profile("gripkit", deadline=None, max_examples=60, derandomize=True)
 settings.load_profile("gripkit")
+
+#: agreement asked of a kernel result with its recording, relative to each entry and its column's
+#: largest value. The same code differs by ~1e-16 between CPUs (BLAS kernels and compiled code
+#: chosen per CPU); a wrong index or a swapped argument differs by far more.
+RECORD_RTOL = 1e-9
+
+
+def recorded_rows(n: int) -> np.ndarray:
+    """The rows of an n-row result that a recording keeps: about a dozen, evenly spread, and the last."""
+    return np.unique(np.r_[np.arange(0, n, max(1, n // 12)), n - 1])
+
+
+def record_of(result: np.ndarray) -> dict:
+    """A result as a recording: its shape, the kept rows and their values (float.hex, exact)."""
+    result = np.asarray(result, dtype=np.float64)
+    rows = recorded_rows(result.shape[0])
+    return {"shape": list(result.shape), "rows": rows.tolist(),
+            "values": [[float(v).hex() for v in result[r]] for r in rows]}
+
+
+@pytest.fixture(scope="session")
+def assert_matches_record():
+    """``check(name, result, record)``: the result has the recorded shape and agrees with the
+    recorded rows to RECORD_RTOL."""
+
+    def check(name, result, record):
+        result = np.asarray(result, dtype=np.float64)
+        assert list(result.shape) == record["shape"], f"{name}: shape {result.shape}, recorded {record['shape']}"
+        ref = np.array([[float.fromhex(v) for v in row] for row in record["values"]])
+        got = result[record["rows"]]
+        finite = np.where(np.isfinite(ref), ref, 0.0)
+        scale = np.abs(finite).max(axis=0, initial=0.0)
+        with np.errstate(invalid="ignore"):
+            close = np.abs(got - finite) <= RECORD_RTOL * (np.abs(finite) + scale)
+        bad = ~np.where(np.isfinite(ref), close, (got == ref) | (np.isnan(got) & np.isnan(ref)))
+        if bad.any():
+            r, c = np.argwhere(bad)[0]
+            raise AssertionError(f"{name}: row {record['rows'][r]}, column {c}: {got[r, c]!r}, "
+                                 f"recorded {ref[r, c]!r} ({int(bad.sum())} entries beyond rtol {RECORD_RTOL})")
+
+    return check
