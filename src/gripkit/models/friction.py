@@ -40,6 +40,7 @@ constant sub-stiction load (a pre-sliding displacement of many times F_s/σ₀ b
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -54,7 +55,7 @@ from ..sim.model import Model, Signal
 
 __all__ = ["coulomb_viscous", "stribeck", "table_friction", "ripple", "lugre_g", "lugre_update",
            "lugre_force", "FrictionTable", "Stribeck", "FrictionDrive",
-           "friction_drive_parameters", "table_arrays"]
+           "friction_drive_parameters", "table_arrays", "TableArrays"]
 
 DEG = math.pi / 180.0
 
@@ -256,9 +257,13 @@ class FrictionTable:
                 f"{self.velocity[0] / DEG:.4g}..{self.velocity[-1] / DEG:.4g} deg/s, scale {self.scale:g})")
 
 
-def table_arrays(tables) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Pad FrictionTables into kernel arrays: breakpoints (m, K), scaled values (m, K), lengths
-    (m,) and first-positive indices (m,)."""
+#: FrictionTables padded into kernel arrays: breakpoints (m, K), scaled values (m, K), lengths (m,)
+#: and first-positive indices (m,); a record the compiled kernels take as one argument
+TableArrays = namedtuple("TableArrays", "velocity values length ipos")
+
+
+def table_arrays(tables) -> TableArrays:
+    """Pad FrictionTables into kernel arrays (:data:`TableArrays`)."""
     m = len(tables)
     K = max(t.velocity.size for t in tables)
     tv = np.zeros((m, K))
@@ -272,7 +277,7 @@ def table_arrays(tables) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray
         tv[k, n:] = t.velocity[-1]
         tn[k] = n
         tipos[k] = t.ipos
-    return tv, tf, tn, tipos
+    return TableArrays(tv, tf, tn, tipos)
 
 
 @dataclass(frozen=True)

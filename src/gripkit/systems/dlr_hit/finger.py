@@ -53,8 +53,8 @@ from numba import prange
 from ...errors import ModelError, SimulationError
 from ...estimation.friction_adaptation import friction_rls_step
 from ...models.bldc import BLDCMotor, bldc_torque, motor_heat_step, temperature_factor
-from ...models.friction import (FrictionTable, Stribeck, lugre_force, lugre_update, ripple,
-                                stribeck, table_arrays, table_friction)
+from ...models.friction import (FrictionTable, Stribeck, TableArrays, lugre_force, lugre_update,
+                                ripple, stribeck, table_arrays, table_friction)
 from ...models.transmission import transmit_torque
 from ...multibody.coupling import CoupledChain, Coupling, differential_matrix
 from ...multibody.dh import DHChain
@@ -95,10 +95,49 @@ IX = namedtuple("FingerParameterIndex", FINGER_PARAMETERS)(*range(len(FINGER_PAR
 # state layout: p(3) pd(3) T(3) z(3) stuck(3)
 NX = 15
 
+# Named records of arrays the kernels take (namedtuples: numba resolves each field at compile
+# time, and without NRT taking an array out of one costs nothing; docs/performance.md).
+#: one finger's constant arrays (:func:`finger_setup`): DH table, joint types, link masses,
+#: centres of mass, inertias, joint armatures, coupling Γ (4×3 row-major), joint offsets,
+#: actuator armatures I_m·N², gravity, reductions N
+FingerChain = namedtuple("FingerChain", "dh jt mass com inertia armq G q0 arm_p grav ratio")
+#: scratch of the chain: link rotations and positions, RNEA/CRBA work, joint angles and rates,
+#: zeros, joint-space mass matrix and torques
+ChainWork = namedtuple("ChainWork", "R P work q qd zq Mq tau")
+#: scratch of the actuator-space solve: M_p, h_p, Cholesky factor, applied torques, the free
+#: subsystem (matrix, solution, right side) and the breakaway directions
+SolveWork = namedtuple("SolveWork", "Mp hp L rhs Ms xs rs dirn")
+#: what one force evaluation writes: accelerations, motor torques (output side), shaft torques,
+#: friction torques (all per actuator)
+Forces = namedtuple("Forces", "acc taum tshaft fric")
+#: scratch of one integration step: the two records above, the accelerations and shaft torques,
+#: the start-of-step state, the RK4 stage accelerations (4×3), stage state and stage torques
+StepWork = namedtuple("StepWork", "chain solve acc tshaft p0 v0 ka ps vs taum2 tshaft2 fric2")
+#: scratch of the time loop and the impedance controller: joint angles and rates, link frames,
+#: homogeneous transforms, Jacobians (joint and actuator space), tip position and velocity,
+#: commanded torques, gravity torques, RNEA work, zeros, the state at t_n, the PWM, external and
+#: motor torques, friction, the bias torques of the friction estimator, the friction feed-forward
+#: and the wall's contact force
+LoopWork = namedtuple("LoopWork", "q qd R P T J Jp tip tipd tauq gp work zq xs pwm ext taum fric hb "
+                                  "ff force")
+#: a closed loop: ``ctrl`` (0 open loop, 1 joint, 2 Cartesian impedance), its gains vector, the
+#: friction tables it compensates with (TableArrays), the reference and its velocity (N, 3) and
+#: the wall (nx, ny, nz, px, py, pz, k, d, on)
+ImpedanceLoop = namedtuple("ImpedanceLoop", "ctrl gains tables ref refd wall")
+#: the plant's friction drift: schedule (N, 6) = (s_k, Δ_k) or (0, 6), and working copies of the
+#: parameter vector and the table values
+PlantDrift = namedtuple("PlantDrift", "schedule th values")
+#: the online friction estimator (:func:`gripkit.estimation.friction_adaptation.friction_rls_step`):
+#: settings vector, apparent inertias, θ (3, 2) = (s, o), P (3, 2, 2), filters (3, 5), σ̂² (3)
+FrictionEstimator = namedtuple("FrictionEstimator", "cfg inertia theta P filt sig2")
+
 
 @hot
-def finger_setup(th, dh, mass, com, inertia, G, arm_p, grav, ratio):  # pragma: no cover - compiled
-    """Fill the chain, coupling and drive arrays of one finger from its parameter vector."""
+def finger_setup(th, fc):  # pragma: no cover - compiled
+    """Fill the chain, coupling and drive arrays of one finger (:data:`FingerChain`) from its
+    parameter vector."""
+    dh, mass, com, inertia, G, arm_p, grav, ratio = (fc.dh, fc.mass, fc.com, fc.inertia, fc.G,
+                                                     fc.arm_p, fc.grav, fc.ratio)
     for k in range(4):
         for j in range(4):
             dh[k, j] = 0.0
@@ -145,16 +184,17 @@ def finger_setup(th, dh, mass, com, inertia, G, arm_p, grav, ratio):  # pragma: 
         grav[k] = th[IX.g_x + k]
 
 
-#: pieces of one step of :func:`_forces`, inlined into it at numba IR level (compiled as separate
-#: functions, pieces of a kernel this hot measured slower: docs/performance.md, "Named records")
+#: pieces of the step and of the closed loop, inlined into their caller at numba IR level (compiled
+#: as separate functions they measured slower: docs/performance.md, "Named records")
 _step_piece = numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
 
 
 @hot
-def _kinetic(th, k, v, p, mode, tv, tf, tn, tipos):  # pragma: no cover - compiled
+def _kinetic(th, k, v, p, mode, tab):  # pragma: no cover - compiled
     """Kinetic friction of actuator k at velocity v (never 0 for v ≠ 0)."""
     if mode == 0:
-        f = th[IX.scale_base1 + k] * table_friction(v, tv[k], tf[k], tn[k], tipos[k])
+        f = th[IX.scale_base1 + k] * table_friction(v, tab.velocity[k], tab.values[k], tab.length[k],
+                                                    tab.ipos[k])
     else:
         f = (stribeck(v, th[IX.fc_base1 + k], th[IX.fs_base1 + k], th[IX.v_s], th[IX.delta],
                       th[IX.visc_base1 + k])
@@ -199,11 +239,13 @@ def _add_end_stops(th, q, qd, G, rhs):  # pragma: no cover - compiled
 
 
 @hot
-def _karnopp(th, n_stuck_iter, mode, tv, tf, tn, tipos, p, pd, stuck, acc, fric, Mp, L, rhs, Ms, xs, rs,
-             dirn):  # pragma: no cover - compiled
+def _karnopp(th, n_stuck_iter, mode, tab, p, pd, stuck, out, sw):  # pragma: no cover - compiled
     """Karnopp stick-slip: actuators at rest (flagged, or exactly zero velocity) are constraints;
     the free subsystem is solved, and the stuck actuator whose holding torque exceeds its stiction
-    most is released, up to ``n_stuck_iter`` times (0: the set stays frozen, for RK4 stages)."""
+    most is released, up to ``n_stuck_iter`` times (0: the set stays frozen, for RK4 stages).
+    Writes ``out.acc`` and ``out.fric`` (the holding torque of a stuck actuator)."""
+    acc, fric = out.acc, out.fric
+    Mp, L, rhs, Ms, xs, rs, dirn = sw.Mp, sw.L, sw.rhs, sw.Ms, sw.xs, sw.rs, sw.dirn
     m = 3
     frozen = n_stuck_iter == 0
     if not frozen:
@@ -221,7 +263,7 @@ def _karnopp(th, n_stuck_iter, mode, tv, tf, tn, tipos, p, pd, stuck, acc, fric,
                 v = pd[k]
                 if v == 0.0:
                     v = dirn[k] * 1e-300
-                fric[k] = _kinetic(th, k, v, p[k], mode, tv, tf, tn, tipos)
+                fric[k] = _kinetic(th, k, v, p[k], mode, tab)
         for i in range(m):
             if stuck[i] != 0.0:
                 continue
@@ -266,21 +308,26 @@ def _karnopp(th, n_stuck_iter, mode, tv, tf, tn, tipos, p, pd, stuck, acc, fric,
 
 
 @hot
-def _forces(th, n_stuck_iter, mode, thermal, dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav,
-            ratio, tv, tf, tn, tipos, p, pd, T, z, stuck, pwm, ext, acc, taum, tshaft, fric,
-            R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, Ms, xs, rs, dirn):  # pragma: no cover
-    """Accelerations ``acc`` for the state (p, ṗ) with the stuck set ``stuck``; fills motor
-    torques (output side and shaft) and friction. With ``n_stuck_iter > 0`` actuators at rest are
+def _forces(th, n_stuck_iter, mode, thermal, fc, tab, p, pd, T, z, stuck, pwm, ext, out, cw,
+            sw):  # pragma: no cover - compiled
+    """Accelerations ``out.acc`` for the state (p, ṗ, T, z) with the stuck set ``stuck``; fills
+    the motor torques (output side and shaft) and friction of ``out`` (:data:`Forces`). ``fc`` is
+    the finger's :data:`FingerChain`, ``tab`` its friction tables, ``cw``/``sw`` scratch
+    (:data:`ChainWork`, :data:`SolveWork`). With ``n_stuck_iter > 0`` actuators at rest are
     flagged and those whose holding torque exceeds stiction are released (the flags change in
-    place, ``dirn`` records the breakaway direction); ``n_stuck_iter = 0`` keeps the set frozen
-    (RK4 stages)."""
+    place, ``sw.dirn`` records the breakaway direction); ``n_stuck_iter = 0`` keeps the set
+    frozen (RK4 stages)."""
     m = 3
-    joints_from_actuators(4, m, G, q0, p, q)
+    G = fc.G
+    q, qd, zq = cw.q, cw.qd, cw.zq
+    Mp, hp, rhs, rs = sw.Mp, sw.hp, sw.rhs, sw.rs
+    joints_from_actuators(4, m, G, fc.q0, p, q)
     joints_from_actuators(4, m, G, zq, pd, qd)
-    chain_links(4, dh, jt, q, R, P)
-    coupled_mass_bias(4, m, R, P, jt, mass, com, inertia, armq, G, arm_p, qd, grav[0], grav[1],
-                      grav[2], Mp, hp, zq, Mq, tau, work)
-    _drive_torques(th, thermal, ratio, T, pwm, pd, taum, tshaft)
+    chain_links(4, fc.dh, fc.jt, q, cw.R, cw.P)
+    coupled_mass_bias(4, m, cw.R, cw.P, fc.jt, fc.mass, fc.com, fc.inertia, fc.armq, G, fc.arm_p, qd,
+                      fc.grav[0], fc.grav[1], fc.grav[2], Mp, hp, zq, cw.Mq, cw.tau, cw.work)
+    taum, fric = out.taum, out.fric
+    _drive_torques(th, thermal, fc.ratio, T, pwm, pd, taum, out.tshaft)
     # applied torque on each actuator (before friction): motor + end stops + external − bias
     for k in range(m):
         rhs[k] = taum[k] + ext[k] - hp[k]
@@ -295,38 +342,30 @@ def _forces(th, n_stuck_iter, mode, thermal, dh, jt, mass, com, inertia, armq, G
                 f = 0.0
             fric[k] = f
             rs[k] = rhs[k] - f
-        return cholesky_solve(m, Mp, rs, acc, L)
-    return _karnopp(th, n_stuck_iter, mode, tv, tf, tn, tipos, p, pd, stuck, acc, fric, Mp, L, rhs, Ms, xs, rs,
-                    dirn)
+        return cholesky_solve(m, Mp, rs, out.acc, sw.L)
+    return _karnopp(th, n_stuck_iter, mode, tab, p, pd, stuck, out, sw)
 
 
 def _make_context(th):
-    """Constant arrays of one finger (chain, coupling, drives), the plant's scratch arrays and the
-    controller's: ``(ctx, ws, cs)``. Plain numpy code, run by Python for single simulations (no
-    compilation) and compiled as :func:`finger_context` for the parallel kernels."""
-    dh = np.empty((4, 6))
-    jt = np.zeros(4, dtype=np.int64)
-    mass = np.empty(4)
-    com = np.empty((4, 3))
-    inertia = np.empty((4, 6))
-    armq = np.zeros(4)
-    G = np.empty(12)
-    q0 = np.zeros(4)
-    arm_p = np.empty(3)
-    grav = np.empty(3)
-    ratio = np.empty(3)
-    finger_setup(th, dh, mass, com, inertia, G, arm_p, grav, ratio)
-    ctx = (dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav, ratio)
-    ws = (np.empty((4, 9)), np.empty((4, 3)), np.empty(WORK_PER_LINK * 4), np.empty(4), np.empty(4),
-          np.zeros(4), np.empty((4, 4)), np.empty(4), np.empty((3, 3)), np.empty(3), np.empty((3, 3)),
-          np.empty(3), np.empty((3, 3)), np.empty(3), np.empty(3), np.empty(3), np.empty(3),
-          np.empty(3), np.empty(3), np.empty(12), np.empty(3), np.empty(3), np.empty(3), np.empty(3),
-          np.empty(3), np.empty(3))
-    cs = (np.empty(4), np.empty(4), np.empty((4, 9)), np.empty((4, 3)), np.empty((4, 16)),
-          np.empty((6, 4)), np.empty((3, 3)), np.empty(3), np.empty(3), np.empty(3), np.empty(4),
-          np.empty(WORK_PER_LINK * 4), np.zeros(4), np.empty(NX), np.empty(3), np.zeros(3),
-          np.zeros(3), np.zeros(3), np.empty(4), np.zeros(3))
-    return ctx, ws, cs
+    """Constant arrays of one finger (:data:`FingerChain`), the plant's scratch
+    (:data:`StepWork`) and the time loop's (:data:`LoopWork`): ``(fc, ws, cs)``. Plain numpy
+    code, run by Python for single simulations (no compilation) and compiled as
+    :func:`finger_context` for the parallel kernels."""
+    fc = FingerChain(np.empty((4, 6)), np.zeros(4, dtype=np.int64), np.empty(4), np.empty((4, 3)),
+                     np.empty((4, 6)), np.zeros(4), np.empty(12), np.zeros(4), np.empty(3),
+                     np.empty(3), np.empty(3))
+    finger_setup(th, fc)
+    cw = ChainWork(np.empty((4, 9)), np.empty((4, 3)), np.empty(WORK_PER_LINK * 4), np.empty(4),
+                   np.empty(4), np.zeros(4), np.empty((4, 4)), np.empty(4))
+    sw = SolveWork(np.empty((3, 3)), np.empty(3), np.empty((3, 3)), np.empty(3), np.empty((3, 3)),
+                   np.empty(3), np.empty(3), np.empty(3))
+    ws = StepWork(cw, sw, np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(12),
+                  np.empty(3), np.empty(3), np.empty(3), np.empty(3), np.empty(3))
+    cs = LoopWork(np.empty(4), np.empty(4), np.empty((4, 9)), np.empty((4, 3)), np.empty((4, 16)),
+                  np.empty((6, 4)), np.empty((3, 3)), np.empty(3), np.empty(3), np.empty(3),
+                  np.empty(4), np.empty(WORK_PER_LINK * 4), np.zeros(4), np.empty(NX), np.empty(3),
+                  np.zeros(3), np.zeros(3), np.zeros(3), np.empty(4), np.zeros(3), np.zeros(3))
+    return fc, ws, cs
 
 
 finger_context = numba.njit(cache=True, error_model="numpy")(_make_context)
@@ -358,19 +397,16 @@ def _stick(th, mode, x, v0):  # pragma: no cover - compiled
 
 
 @hot
-def finger_step(th, mode, thermal, ctx, tv, tf, tn, tipos, x, pwm, ext, h, taum, fric,
+def finger_step(th, mode, thermal, fc, tab, x, pwm, ext, h, taum, fric,
                 ws):  # pragma: no cover - compiled
     """Advance one finger's state ``x`` (15) by one semi-implicit Euler step h under PWM (3) and
     external actuator torques ``ext`` (3); ``taum``/``fric`` receive the motor and friction
-    torques at the start of the step. ``ctx``, ``ws`` come from :func:`finger_context`. Returns
-    False if the mass matrix lost positive definiteness."""
-    dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav, ratio = ctx
-    (R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, Ms, xs, rs, acc, tshaft, p0, v0, ka, ps, vs,
-     tm2, fr2, ts2, dirn) = ws
-    if not _forces(th, 4, mode, thermal, dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav,
-                   ratio, tv, tf, tn, tipos, x[0:3], x[3:6], x[6:9], x[9:12], x[12:15], pwm, ext,
-                   acc, taum, tshaft, fric, R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, Ms, xs,
-                   rs, dirn):
+    torques at the start of the step. ``fc``, ``ws`` come from :func:`finger_context`, ``tab``
+    is the finger's :data:`~gripkit.models.friction.TableArrays`. Returns False if the mass
+    matrix lost positive definiteness."""
+    acc, v0 = ws.acc, ws.v0
+    if not _forces(th, 4, mode, thermal, fc, tab, x[0:3], x[3:6], x[6:9], x[9:12], x[12:15], pwm,
+                   ext, Forces(acc, taum, ws.tshaft, fric), ws.chain, ws.solve):
         return False
     for k in range(3):
         v0[k] = x[3 + k]
@@ -378,25 +414,22 @@ def finger_step(th, mode, thermal, ctx, tv, tf, tn, tipos, x, pwm, ext, h, taum,
     _stick(th, mode, x, v0)
     for k in range(3):
         x[k] += h * x[3 + k]
-    _slow_states(th, mode, thermal, x, v0, tshaft, h)
+    _slow_states(th, mode, thermal, x, v0, ws.tshaft, h)
     return True
 
 
 @hot
-def finger_step_rk4(th, mode, thermal, ctx, tv, tf, tn, tipos, x, pwm, ext, h, taum, fric,
+def finger_step_rk4(th, mode, thermal, fc, tab, x, pwm, ext, h, taum, fric,
                     ws):  # pragma: no cover - compiled
     """As :func:`finger_step` with classical RK4 on (p, ṗ); the stick/slip set is decided at the
     start of the step and frozen over it (stuck actuators keep v = 0, a = 0); sticking is
     detected at the end."""
-    dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav, ratio = ctx
-    (R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, Ms, xs, rs, acc, tshaft, p0, v0, ka, ps, vs,
-     tm2, fr2, ts2, dirn) = ws
+    acc, p0, v0, ka, ps, vs = ws.acc, ws.p0, ws.v0, ws.ka, ws.ps, ws.vs
     stuck = x[12:15]
     T = x[6:9]
     z = x[9:12]
-    if not _forces(th, 4, mode, thermal, dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav,
-                   ratio, tv, tf, tn, tipos, x[0:3], x[3:6], T, z, stuck, pwm, ext, acc, taum,
-                   tshaft, fric, R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, Ms, xs, rs, dirn):
+    if not _forces(th, 4, mode, thermal, fc, tab, x[0:3], x[3:6], T, z, stuck, pwm, ext,
+                   Forces(acc, taum, ws.tshaft, fric), ws.chain, ws.solve):
         return False
     for k in range(3):
         p0[k] = x[k]
@@ -412,9 +445,8 @@ def finger_step_rk4(th, mode, thermal, ctx, tv, tf, tn, tipos, x, pwm, ext, h, t
                 continue
             ps[k] = p0[k] + c * (v0[k] if stage == 0 else vs[k])
             vs[k] = v0[k] + c * ka[3 * stage + k]
-        _forces(th, 0, mode, thermal, dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav, ratio,
-                tv, tf, tn, tipos, ps, vs, T, z, stuck, pwm, ext, acc, tm2, ts2, fr2, R, P, work,
-                q, qd, zq, Mq, tau, Mp, hp, L, rhs, Ms, xs, rs, dirn)
+        _forces(th, 0, mode, thermal, fc, tab, ps, vs, T, z, stuck, pwm, ext,
+                Forces(acc, ws.taum2, ws.tshaft2, ws.fric2), ws.chain, ws.solve)
         for k in range(3):
             ka[3 * (stage + 1) + k] = acc[k]
     for k in range(3):
@@ -428,7 +460,7 @@ def finger_step_rk4(th, mode, thermal, ctx, tv, tf, tn, tipos, x, pwm, ext, h, t
         x[k] = p0[k] + h * v0[k] + h * h / 6.0 * (a1 + a2 + a3)
         x[3 + k] = v0[k] + h / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4)
     _stick(th, mode, x, v0)
-    _slow_states(th, mode, thermal, x, v0, tshaft, h)
+    _slow_states(th, mode, thermal, x, v0, ws.tshaft, h)
     return True
 
 
@@ -453,12 +485,11 @@ def finger_outputs(G, q0, x, taum, fric, y, yrow, ycol):  # pragma: no cover - c
 # --- impedance control (used by gripkit.systems.dlr_hit.impedance) ----------------------------------------
 
 @hot
-def _tip(ctx, th, q, R, P, T, J, Jp, tip):  # pragma: no cover - compiled
-    """Fingertip position (3, finger base frame) and actuator-space linear Jacobian Jp (3×3)."""
-    dh = ctx[0]
-    jt = ctx[1]
-    G = ctx[6]
-    chain_links(4, dh, jt, q, R, P)
+def _tip(fc, th, q, R, P, T, J, Jp, tip):  # pragma: no cover - compiled
+    """Fingertip position ``tip`` (3, finger base frame) and actuator-space linear Jacobian
+    ``Jp`` (3×3) at the joint angles ``q`` (scratch: link frames R, P, transforms T, Jacobian J)."""
+    jt, G = fc.jt, fc.G
+    chain_links(4, fc.dh, jt, q, R, P)
     frames_into(4, R, P, T)
     l3 = th[IX.l3]
     px = T[3, 3] + T[3, 0] * l3
@@ -499,20 +530,18 @@ def _pwm_for(tau_out, omega_m, N, th):  # pragma: no cover - compiled
     return u
 
 
-@hot
-def _impedance(th, ctx, cs, x, n, ctrl, gains, ctv, ctf, ctn, ctipos, fhat, ref, refd,
-               pwm):  # pragma: no cover - compiled
-    """Impedance law (joint: ctrl = 1, Cartesian: ctrl = 2) with gravity and friction
-    compensation F̂(v) = s·F_table(v) + o·sign(v), (s, o) = ``fhat[k]`` → PWM; the commanded
-    torques stay in cs[9], the friction feed-forward in cs[19] (see
+@_step_piece
+def _impedance(th, fc, cs, x, n, loop, fhat):  # pragma: no cover - compiled
+    """Impedance law (joint: loop.ctrl = 1, Cartesian: 2) with gravity and friction compensation
+    F̂(v) = s·F_table(v) + o·sign(v), (s, o) = ``fhat[k]`` → PWM in ``cs.pwm``; the commanded
+    torques stay in ``cs.tauq``, the friction feed-forward in ``cs.ff`` (see
     gripkit.systems.dlr_hit.impedance)."""
-    dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav, ratio = ctx
-    q, qd, R, P, T, J, Jp, tip, tipd, tauq, gp, work, zq = (cs[0], cs[1], cs[2], cs[3], cs[4],
-                                                          cs[5], cs[6], cs[7], cs[8], cs[9],
-                                                          cs[10], cs[11], cs[12])
-    joints_from_actuators(4, 3, G, q0, x[0:3], q)
+    G, ratio, grav = fc.G, fc.ratio, fc.grav
+    q, qd, R, P, Jp, tip, tipd, tauq, zq = cs.q, cs.qd, cs.R, cs.P, cs.Jp, cs.tip, cs.tipd, cs.tauq, cs.zq
+    ctrl, gains, ref, refd, ctab = loop.ctrl, loop.gains, loop.ref, loop.refd, loop.tables
+    joints_from_actuators(4, 3, G, fc.q0, x[0:3], q)
     joints_from_actuators(4, 3, G, zq, x[3:6], qd)
-    _tip(ctx, th, q, R, P, T, J, Jp, tip)
+    _tip(fc, th, q, R, P, cs.T, cs.J, Jp, tip)
     for r in range(3):
         s = 0.0
         for j in range(3):
@@ -532,8 +561,9 @@ def _impedance(th, ctx, cs, x, n, ctrl, gains, ctv, ctf, ctn, ctipos, fhat, ref,
     for k in range(3):  # joint-space damping on the actuators (damps directions J_p makes soft)
         tauq[k] -= gains[10 + k] * x[3 + k]
     if gains[6] != 0.0:
-        rnea_pass(4, R, P, jt, mass, com, inertia, armq, zq, zq, grav[0], grav[1], grav[2], False,
-                  gp, work)
+        gp = cs.gp
+        rnea_pass(4, R, P, fc.jt, fc.mass, fc.com, fc.inertia, fc.armq, zq, zq, grav[0], grav[1],
+                  grav[2], False, gp, cs.work)
         for k in range(3):
             s = 0.0
             for j in range(4):
@@ -541,7 +571,8 @@ def _impedance(th, ctx, cs, x, n, ctrl, gains, ctv, ctf, ctn, ctipos, fhat, ref,
             tauq[k] += s
     vdb = gains[8]
     eps = gains[9]
-    ff = cs[19]
+    ff = cs.ff
+    pwm = cs.pwm
     for k in range(3):
         tau = tauq[k]
         ff[k] = 0.0
@@ -551,7 +582,8 @@ def _impedance(th, ctx, cs, x, n, ctrl, gains, ctv, ctf, ctn, ctipos, fhat, ref,
             if v * tau >= 0.0:
                 if abs(v) < vdb:
                     v = vdb if tau > 0.0 else -vdb
-                fk = fhat[k, 0] * table_friction(v, ctv[k], ctf[k], ctn[k], ctipos[k])
+                fk = fhat[k, 0] * table_friction(v, ctab.velocity[k], ctab.values[k], ctab.length[k],
+                                                 ctab.ipos[k])
                 fk += fhat[k, 1] if v > 0.0 else -fhat[k, 1]
                 ff[k] = fk * math.tanh(abs(tau) / eps)
                 tau += ff[k]
@@ -559,20 +591,18 @@ def _impedance(th, ctx, cs, x, n, ctrl, gains, ctv, ctf, ctn, ctipos, fhat, ref,
         pwm[k] = _pwm_for(tau, ratio[k] * x[3 + k], ratio[k], th)
 
 
-@hot
-def _wall(th, ctx, cs, x, wall, ext, force):  # pragma: no cover - compiled
+@_step_piece
+def _wall(th, fc, cs, x, wall):  # pragma: no cover - compiled
     """Contact force of a planar wall (nx, ny, nz, px, py, pz, k, d, on) on the fingertip, mapped
-    to the actuators: ext = J_pᵀ F; ``force`` receives F (finger base frame)."""
-    G = ctx[6]
-    q0 = ctx[7]
-    q, R, P, T, J, Jp, tip = cs[0], cs[2], cs[3], cs[4], cs[5], cs[6], cs[7]
+    to the actuators: ``cs.ext`` = J_pᵀ F; ``cs.force`` receives F (finger base frame)."""
+    Jp, tip, ext, force = cs.Jp, cs.tip, cs.ext, cs.force
     for k in range(3):
         ext[k] = 0.0
         force[k] = 0.0
     if wall[8] == 0.0:
         return
-    joints_from_actuators(4, 3, G, q0, x[0:3], q)
-    _tip(ctx, th, q, R, P, T, J, Jp, tip)
+    joints_from_actuators(4, 3, fc.G, fc.q0, x[0:3], cs.q)
+    _tip(fc, th, cs.q, cs.R, cs.P, cs.T, cs.J, cs.Jp, cs.tip)
     pen = -(wall[0] * (tip[0] - wall[3]) + wall[1] * (tip[1] - wall[4]) + wall[2] * (tip[2] - wall[5]))
     if pen <= 0.0:
         return
@@ -592,16 +622,15 @@ def _wall(th, ctx, cs, x, wall, ext, force):  # pragma: no cover - compiled
 
 
 @hot
-def _adapt_friction(th, ctx, cs, x, pwm, ctv, ctf, ctn, ctipos, adapt, y, n):  # pragma: no cover
-    """One step of the online friction estimator per actuator (after :func:`_impedance`, whose
-    chain arrays R, P still hold the current configuration): motor torque from the PWM just
-    commanded and the measured speed through eq 5.10 at T_ref and the transmission, bias torque
-    Γᵀ(C(q, q̇)q̇ + G(q)) by RNEA; writes the estimates and each sample's status into y[n, 27:36]."""
-    dh, jt, mass, com, inertia, armq, G, q0, arm_p, grav, ratio = ctx
-    cfg, J, theta, P, filt, sig2 = adapt
-    qd, R, Pc, work, zq, hb = cs[1], cs[2], cs[3], cs[11], cs[12], cs[18]
-    rnea_pass(4, R, Pc, jt, mass, com, inertia, armq, qd, zq, grav[0], grav[1], grav[2], True, hb,
-              work)
+def _adapt_friction(th, fc, cs, x, ctab, est, y, n):  # pragma: no cover - compiled
+    """One step of the online friction estimator ``est`` (:data:`FrictionEstimator`) per actuator
+    (after :func:`_impedance`, whose chain arrays R, P still hold the current configuration):
+    motor torque from the PWM just commanded and the measured speed through eq 5.10 at T_ref and
+    the transmission, bias torque Γᵀ(C(q, q̇)q̇ + G(q)) by RNEA; writes the estimates and each
+    sample's status into y[n, 27:36]."""
+    G, ratio, grav, pwm, hb, theta = fc.G, fc.ratio, fc.grav, cs.pwm, cs.hb, est.theta
+    rnea_pass(4, cs.R, cs.P, fc.jt, fc.mass, fc.com, fc.inertia, fc.armq, cs.qd, cs.zq, grav[0],
+              grav[1], grav[2], True, hb, cs.work)
     for k in range(3):
         v = x[3 + k]
         ts = bldc_torque(pwm[k], ratio[k] * v, th[IX.c_pwm], th[IX.b_pwm], th[IX.b_0], th[IX.pwm_max], 1.0)
@@ -609,17 +638,20 @@ def _adapt_friction(th, ctx, cs, x, pwm, ctv, ctf, ctn, ctipos, adapt, y, n):  #
         h = 0.0
         for j in range(4):
             h += G[j * 3 + k] * hb[j]
-        y[n, 33 + k] = friction_rls_step(k, tm, h, v, J, ctv, ctf, ctn, ctipos, cfg, theta, P, filt,
-                                         sig2)
+        y[n, 33 + k] = friction_rls_step(k, tm, h, v, est.inertia, ctab.velocity, ctab.values,
+                                         ctab.length, ctab.ipos, est.cfg, theta, est.P, est.filt,
+                                         est.sig2)
         y[n, 27 + k] = theta[k, 0]
         y[n, 30 + k] = theta[k, 1]
 
 
 @hot
-def _drift_friction(th, mode, tv, tf, tn, drift, n, thw, tfw):  # pragma: no cover - compiled
-    """The plant's friction at sample n of a drift schedule ``drift`` (N, 6) = (s_k, Δ_k):
-    F_k(v) = s_k·F_k,0(v) + Δ_k·sign(v), F_s,k = s_k·F_s,k,0 + Δ_k, written into the working
-    copies ``thw`` (parameters) and ``tfw`` (table values)."""
+def _drift_friction(th, mode, tab, plant, n):  # pragma: no cover - compiled
+    """The plant's friction at sample n of its drift schedule (:data:`PlantDrift`) (N, 6) =
+    (s_k, Δ_k): F_k(v) = s_k·F_k,0(v) + Δ_k·sign(v), F_s,k = s_k·F_s,k,0 + Δ_k, written into the
+    working copies ``plant.th`` (parameters) and ``plant.values`` (table values)."""
+    drift, thw, tfw = plant.schedule, plant.th, plant.values
+    tv, tf, tn = tab.velocity, tab.values, tab.length
     for k in range(3):
         s = drift[n, k]
         d = drift[n, 3 + k]
@@ -637,39 +669,37 @@ def _drift_friction(th, mode, tv, tf, tn, drift, n, thw, tfw):  # pragma: no cov
 
 
 @hot
-def finger_loop(th, mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucol, dt, substeps, x, y,
-                ycol, ctrl, gains, ctv, ctf, ctn, ctipos, ref, refd, wall, plant,
-                adapt):  # pragma: no cover
-    """The time loop (allocation-free, semi-implicit Euler). ``ctrl = 0``: PWM from u[:, ucol:],
-    outputs as DLRFinger.outputs at y[:, ycol:ycol+18]; ``ctrl = 1/2``: joint/Cartesian impedance
-    on ``ref``/``refd`` with the ``wall``, closed-loop outputs (39 columns, see
-    gripkit.systems.dlr_hit.impedance). ``plant`` = (drift (N, 6) or (0, 6), parameter and table
-    working copies): the plant's friction drift (:func:`_drift_friction`); ``adapt`` = (settings,
-    inertias, θ, P, filters, σ̂²) of the online friction estimator, run when gains[13] ≠ 0."""
-    G = ctx[6]
-    q0 = ctx[7]
-    pwm, ext, taum, fric, xs, force = cs[14], cs[15], cs[16], cs[17], cs[13], cs[8]
-    drift, thw, tfw = plant
-    drifting = drift.shape[0] > 0
-    thp = thw if drifting else th
-    tfp = tfw if drifting else tf
-    fhat = adapt[2]
+def finger_loop(th, mode, thermal, fc, ws, cs, tab, u, ucol, dt, substeps, x, y, ycol, loop, plant,
+                est):  # pragma: no cover - compiled
+    """The time loop (allocation-free, semi-implicit Euler). ``loop.ctrl = 0``: PWM from
+    u[:, ucol:], outputs as DLRFinger.outputs at y[:, ycol:ycol+18]; ``loop.ctrl = 1/2``:
+    joint/Cartesian impedance (:data:`ImpedanceLoop`), closed-loop outputs (39 columns, see
+    gripkit.systems.dlr_hit.impedance). ``plant`` (:data:`PlantDrift`): the plant's friction drift
+    (:func:`_drift_friction`); ``est`` (:data:`FrictionEstimator`): the online friction
+    estimator, run when gains[13] ≠ 0."""
+    G, q0 = fc.G, fc.q0
+    pwm, ext, taum, fric, xs, force = cs.pwm, cs.ext, cs.taum, cs.fric, cs.xs, cs.force
+    ctrl, gains = loop.ctrl, loop.gains
+    drifting = plant.schedule.shape[0] > 0
+    thp = plant.th if drifting else th
+    tabp = TableArrays(tab.velocity, plant.values, tab.length, tab.ipos) if drifting else tab
+    fhat = est.theta
     h = dt / substeps
-    N = ref.shape[0] if ctrl else u.shape[0]
+    N = loop.ref.shape[0] if ctrl else u.shape[0]
     for n in range(N):
         if drifting:
-            _drift_friction(th, mode, tv, tf, tn, drift, n, thw, tfw)
+            _drift_friction(th, mode, tab, plant, n)
         if ctrl:
-            _impedance(th, ctx, cs, x, n, ctrl, gains, ctv, ctf, ctn, ctipos, fhat, ref, refd, pwm)
+            _impedance(th, fc, cs, x, n, loop, fhat)
             if gains[13] != 0.0:
-                _adapt_friction(th, ctx, cs, x, pwm, ctv, ctf, ctn, ctipos, adapt, y, n)
+                _adapt_friction(th, fc, cs, x, loop.tables, est, y, n)
             else:
                 for k in range(3):
                     y[n, 27 + k] = fhat[k, 0]
                     y[n, 30 + k] = fhat[k, 1]
                     y[n, 33 + k] = 0.0
             for k in range(3):
-                y[n, 36 + k] = cs[19][k]
+                y[n, 36 + k] = cs.ff[k]
         else:
             for k in range(3):
                 pwm[k] = u[n, ucol + k]
@@ -677,21 +707,20 @@ def finger_loop(th, mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucol, dt, 
             xs[k] = x[k]
         for s in range(substeps):
             if ctrl:
-                _wall(th, ctx, cs, x, wall, ext, force)
+                _wall(th, fc, cs, x, loop.wall)
                 if s == 0:
                     for k in range(3):
                         y[n, 12 + k] = force[k]
-            if not finger_step(thp, mode, thermal, ctx, tv, tfp, tn, tipos, x, pwm, ext, h, taum,
-                               fric, ws):
+            if not finger_step(thp, mode, thermal, fc, tabp, x, pwm, ext, h, taum, fric, ws):
                 return n + 1
             if s == 0 and not ctrl:
                 # sample n reports the state at t_n and the torques acting at t_n
                 finger_outputs(G, q0, xs, taum, fric, y, n, ycol)
         if ctrl:
-            q, qd, R, P, T, J, Jp, tip = cs[0], cs[1], cs[2], cs[3], cs[4], cs[5], cs[6], cs[7]
+            q, qd, Jp, tip = cs.q, cs.qd, cs.Jp, cs.tip
             joints_from_actuators(4, 3, G, q0, xs[0:3], q)
-            joints_from_actuators(4, 3, G, cs[12], xs[3:6], qd)
-            _tip(ctx, th, q, R, P, T, J, Jp, tip)
+            joints_from_actuators(4, 3, G, cs.zq, xs[3:6], qd)
+            _tip(fc, th, cs.q, cs.R, cs.P, cs.T, cs.J, cs.Jp, cs.tip)
             for k in range(3):
                 y[n, k] = q[k]
                 y[n, 3 + k] = qd[k]
@@ -701,19 +730,17 @@ def finger_loop(th, mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucol, dt, 
                     s += Jp[k, j] * xs[3 + j]
                 y[n, 9 + k] = s
                 y[n, 15 + k] = pwm[k]
-                y[n, 18 + k] = cs[9][k]
+                y[n, 18 + k] = cs.tauq[k]
                 y[n, 21 + k] = fric[k]
                 y[n, 24 + k] = taum[k]
     return 0
 
 
 @hot
-def finger_loop_rk4(th, mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucol, dt, substeps, x, y,
+def finger_loop_rk4(th, mode, thermal, fc, ws, cs, tab, u, ucol, dt, substeps, x, y,
                     ycol):  # pragma: no cover - compiled
     """Open-loop time loop with RK4 steps."""
-    G = ctx[6]
-    q0 = ctx[7]
-    pwm, ext, taum, fric, xs = cs[14], cs[15], cs[16], cs[17], cs[13]
+    pwm, ext, taum, fric, xs = cs.pwm, cs.ext, cs.taum, cs.fric, cs.xs
     h = dt / substeps
     for n in range(u.shape[0]):
         for k in range(3):
@@ -722,64 +749,68 @@ def finger_loop_rk4(th, mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucol, 
         for k in range(NX):
             xs[k] = x[k]
         for s in range(substeps):
-            if not finger_step_rk4(th, mode, thermal, ctx, tv, tf, tn, tipos, x, pwm, ext, h, taum,
-                                   fric, ws):
+            if not finger_step_rk4(th, mode, thermal, fc, tab, x, pwm, ext, h, taum, fric, ws):
                 return n + 1
             if s == 0:
-                finger_outputs(G, q0, xs, taum, fric, y, n, ycol)
+                finger_outputs(fc.G, fc.q0, xs, taum, fric, y, n, ycol)
     return 0
 
 
-def finger_run(th, mode, thermal, tv, tf, tn, tipos, u, ucol, dt, substeps, x, y, ycol, ctrl, gains,
-               ctv, ctf, ctn, ctipos, ref, refd, wall, plant, adapt) -> int:
-    """Simulate one finger (open loop: ``ctrl = 0`` with PWM columns ucol..ucol+2 of ``u``; closed
-    loop: ``ctrl = 1`` joint or ``2`` Cartesian impedance). Returns the index of the first failed
-    sample + 1, or 0. Scratch arrays are allocated here, in Python, so the only compiled function
-    is the time loop itself."""
-    ctx, ws, cs = _make_context(th)
-    return int(finger_loop(th, mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucol, dt, substeps,
-                           x, y, ycol, ctrl, gains, ctv, ctf, ctn, ctipos, ref, refd, wall, plant,
-                           adapt))
+def finger_run(th, mode, thermal, tab, u, ucol, dt, substeps, x, y, ycol, loop, plant, est) -> int:
+    """Simulate one finger (open loop: ``loop.ctrl = 0`` with PWM columns ucol..ucol+2 of ``u``;
+    closed loop: ``loop.ctrl = 1`` joint or ``2`` Cartesian impedance). Returns the index of the
+    first failed sample + 1, or 0. Scratch arrays are allocated here, in Python, so the only
+    compiled function is the time loop itself."""
+    fc, ws, cs = _make_context(th)
+    return int(finger_loop(th, mode, thermal, fc, ws, cs, tab, u, ucol, dt, substeps, x, y, ycol,
+                           loop, plant, est))
 
 
-def finger_run_rk4(th, mode, thermal, tv, tf, tn, tipos, u, ucol, dt, substeps, x, y, ycol) -> int:
+def finger_run_rk4(th, mode, thermal, tab, u, ucol, dt, substeps, x, y, ycol) -> int:
     """Open-loop simulation with RK4 steps (compiled only when asked for)."""
-    ctx, ws, cs = _make_context(th)
-    return int(finger_loop_rk4(th, mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucol, dt,
-                               substeps, x, y, ycol))
+    fc, ws, cs = _make_context(th)
+    return int(finger_loop_rk4(th, mode, thermal, fc, ws, cs, tab, u, ucol, dt, substeps, x, y, ycol))
 
 
-_NO_CTRL = (np.zeros(14), np.zeros((3, 4)), np.zeros((3, 4)), np.full(3, 4, dtype=np.int64),
-            np.full(3, 2, dtype=np.int64), np.zeros((1, 3)), np.zeros((1, 3)), np.zeros(9),
-            (np.zeros((0, 6)), np.zeros(NTH), np.zeros((3, 1))),
-            (np.zeros(10), np.ones(3), np.array([[1.0, 0.0]] * 3), np.zeros((3, 2, 2)), np.zeros((3, 5)),
-             np.zeros(3)))
+def _open_loop_records():
+    """The records of an open loop: no controller, no drift, no estimator (plain numpy code, run
+    by Python and compiled as :func:`open_loop_records` for the parallel kernel)."""
+    tables = TableArrays(np.zeros((3, 4)), np.zeros((3, 4)), np.full(3, 4, dtype=np.int64),
+                         np.full(3, 2, dtype=np.int64))
+    theta = np.zeros((3, 2))
+    theta[:, 0] = 1.0
+    return (ImpedanceLoop(0, np.zeros(14), tables, np.zeros((1, 3)), np.zeros((1, 3)), np.zeros(9)),
+            PlantDrift(np.zeros((0, 6)), np.zeros(NTH), np.zeros((3, 1))),
+            FrictionEstimator(np.zeros(10), np.ones(3), theta, np.zeros((3, 2, 2)), np.zeros((3, 5)),
+                              np.zeros(3)))
+
+
+open_loop_records = numba.njit(cache=True, error_model="numpy")(_open_loop_records)
+_OPEN_LOOP = _open_loop_records()
 
 
 def run_open_loop(th, mode, integ, thermal, tab, u, dt, substeps, x, y, ucol=0, ycol=0) -> int:
     """One finger, open loop (Python entry used by the models and the hand)."""
-    tv, tf, tn, tipos = tab
     if integ == 1:
-        return int(finger_run_rk4(th, mode, thermal, tv, tf, tn, tipos, u, ucol, dt, substeps, x, y,
-                                  ycol))
-    return int(finger_run(th, mode, thermal, tv, tf, tn, tipos, u, ucol, dt, substeps, x, y, ycol, 0,
-                          *_NO_CTRL))
+        return int(finger_run_rk4(th, mode, thermal, tab, u, ucol, dt, substeps, x, y, ycol))
+    return int(finger_run(th, mode, thermal, tab, u, ucol, dt, substeps, x, y, ycol, *_OPEN_LOOP))
 
 
 @numba.njit(cache=True, parallel=True, error_model="numpy")
-def _jobs_parallel(thetas, u, ucols, dt, substeps, x0, y, yidx, ycols, tv, tf, tn, tipos, mode,
-                   thermal, gains, ctv, ctf, ctn, ctipos, ref, refd, wall, plant,
-                   adapt):  # pragma: no cover
+def _jobs_parallel(thetas, u, ucols, dt, substeps, x0, y, yidx, ycols, tab, mode,
+                   thermal):  # pragma: no cover - compiled
     """Open-loop finger simulations in parallel: job j simulates thetas[j] from x0[j] on PWM
-    columns ucols[j].. of u, writing y[yidx[j], :, ycols[j]:ycols[j]+18]."""
+    columns ucols[j].. of u, writing y[yidx[j], :, ycols[j]:ycols[j]+18]. (A prange body takes
+    arrays, not records: each job builds its own.)"""
     J = thetas.shape[0]
     fail = np.zeros(J, dtype=np.int64)
+    tv, tf, tn, tipos = tab.velocity, tab.values, tab.length, tab.ipos
     for j in prange(J):
         x = x0[j].copy()
-        ctx, ws, cs = finger_context(thetas[j])
-        fail[j] = finger_loop(thetas[j], mode, thermal, ctx, ws, cs, tv, tf, tn, tipos, u, ucols[j],
-                              dt, substeps, x, y[yidx[j]], ycols[j], 0, gains, ctv, ctf, ctn, ctipos,
-                              ref, refd, wall, plant, adapt)
+        fc, ws, cs = finger_context(thetas[j])
+        loop, plant, est = open_loop_records()
+        fail[j] = finger_loop(thetas[j], mode, thermal, fc, ws, cs, TableArrays(tv, tf, tn, tipos), u,
+                              ucols[j], dt, substeps, x, y[yidx[j]], ycols[j], loop, plant, est)
     return fail
 
 
@@ -789,10 +820,9 @@ def run_jobs(thetas, u, ucols, dt, substeps, x0, y, yidx, ycols, tab, mode, inte
     hand); parallel threads only when asked for (and semi-implicit), else one after another."""
     J = thetas.shape[0]
     if parallel and integ == 0 and J > 1:
-        tv, tf, tn, tipos = tab
         return _jobs_parallel(thetas, u, np.asarray(ucols, dtype=np.int64), dt, substeps, x0, y,
                               np.asarray(yidx, dtype=np.int64), np.asarray(ycols, dtype=np.int64),
-                              tv, tf, tn, tipos, mode, thermal, *_NO_CTRL)
+                              tab, mode, thermal)
     return np.array([run_open_loop(thetas[j], mode, integ, thermal, tab, u, dt, substeps,
                                    x0[j].copy(), y[yidx[j]], int(ucols[j]), int(ycols[j]))
                      for j in range(J)])

@@ -61,7 +61,8 @@ from ...errors import ModelError, SimulationError
 from ...estimation.friction_adaptation import AdaptationSettings
 from ...models.friction import FrictionTable, table_arrays
 from ...signals.trajectory import Trajectory
-from .finger import ACTUATORS, FRICTION_MODES, NX, DLRFinger, finger_run
+from .finger import (ACTUATORS, FRICTION_MODES, NX, DLRFinger, FrictionEstimator, ImpedanceLoop, PlantDrift,
+                     finger_run)
 from .friction_drift import FrictionDrift
 
 __all__ = ["ImpedanceController", "Wall", "simulate_impedance", "stability_margins",
@@ -200,25 +201,23 @@ def simulate_impedance(finger: DLRFinger, controller: ImpedanceController, refer
     ref, refd, x = _checked_loop_inputs(finger, controller, reference, reference_velocity, dt, x0, substeps)
     th = finger.theta()
     tables = controller.friction_tables or model_friction_tables(finger)
-    ctv, ctf, ctn, ctip = table_arrays(tables)
-    tv, tf, tn, tip = finger._tab
     N = ref.shape[0]
     t = np.arange(N) * dt
     drift = _drift_schedule(finger, friction_drift, t)
-    plant = (drift, th.copy(), tf.copy())
+    plant = PlantDrift(drift, th.copy(), finger._tab.values.copy())
     ad = controller.adaptation
     settings = ad if ad is not None else AdaptationSettings()
     J = np.ascontiguousarray(np.diag(finger.chain().mass_matrix(x[:3])))
     cfg = settings.vector(float(dt)) if ad is not None else np.zeros(10)
-    adapt = (cfg, J, *settings.initial_state(3))
+    estimator = FrictionEstimator(cfg, J, *settings.initial_state(3))
     y = np.empty((N, 39))
     gains = np.array([*controller.stiffness, *controller.damping, float(controller.gravity_compensation),
                       float(controller.friction_compensation), controller.velocity_deadband,
                       controller.smoothing, *controller.actuator_damping, float(ad is not None)])
-    fail = finger_run(th, FRICTION_MODES[finger.friction], finger.thermal, tv, tf, tn, tip,
-                      np.zeros((1, 3)), 0, float(dt), int(substeps), x, y, 0,
-                      2 if controller.kind == "cartesian" else 1, gains, ctv, ctf, ctn, ctip, ref, refd,
-                      _wall_vector(wall), plant, adapt)
+    loop = ImpedanceLoop(2 if controller.kind == "cartesian" else 1, gains, table_arrays(tables), ref, refd,
+                         _wall_vector(wall))
+    fail = finger_run(th, FRICTION_MODES[finger.friction], finger.thermal, finger._tab, np.zeros((1, 3)), 0,
+                      float(dt), int(substeps), x, y, 0, loop, plant, estimator)
     if fail or not np.isfinite(y).all():
         raise SimulationError(f"closed loop diverged at sample {max(int(fail) - 1, 0)}",
                               hint="lower the gains or check stability_margins")
