@@ -37,6 +37,7 @@ import numpy as np
 
 from ..errors import ModelError
 from .dh import DHChain, Dynamics
+from .kernels import ChainArrays
 
 __all__ = ["Coupling", "CoupledChain", "differential_matrix", "finger_coupling"]
 
@@ -168,8 +169,8 @@ class CoupledChain(Dynamics):
         if self._arrays is None:
             dh, jt, mass, com, i6, arm, g = self._chain.link_arrays()
             c = self.coupling
-            self._arrays = (dh, jt, mass, com, i6, arm, np.ascontiguousarray(c.matrix.ravel()),
-                            c.offset, c.armature, g)
+            self._arrays = ChainArrays(dh, jt, mass, com, i6, arm, np.ascontiguousarray(c.matrix.ravel()),
+                                       c.offset, c.armature, g)
         return self._arrays
 
     def joints(self, p) -> np.ndarray:

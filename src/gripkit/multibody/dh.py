@@ -21,7 +21,7 @@ import numpy as np
 
 from ..errors import ArgumentError, ModelError
 from . import rnea as _dyn
-from .kernels import dh_table
+from .kernels import ChainArrays, dh_table
 from .onestate import mass_matrix_one, rnea_one
 from .onestate import prepare as prepare_one_state
 from .regressor import kernel_parameters, parameter_names, regressor
@@ -303,8 +303,8 @@ class DHChain(Dynamics):
         if self._arrays is None:
             dh, jt, mass, com, i6, arm, g = self.link_arrays()
             n = self.n
-            self._arrays = (dh, jt, mass, com, i6, arm, np.eye(n).ravel(), np.zeros(n),
-                            np.zeros(n), g)
+            self._arrays = ChainArrays(dh, jt, mass, com, i6, arm, np.eye(n).ravel(), np.zeros(n),
+                                       np.zeros(n), g)
         return self._arrays
 
     def replace(self, **changes) -> "DHChain":

@@ -47,9 +47,20 @@ q = Γ p + q₀. By virtual work the actuator forces are Γᵀ τ, so
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 import numba
 import numpy as np
+
+#: a chain as the batched kernels take it (``system.kernel_arrays()``): link geometry (modified DH
+#: table, or the joint placements of a URDF chain), joint types, masses, centres of mass,
+#: inertias (layout above), joint armatures, the coupling Γ (n×m, row-major), joint offsets q₀,
+#: actuator armatures and gravity (m/s²)
+ChainArrays = namedtuple("ChainArrays", "links jtype mass com inertia arm_q G q0 arm_p g")
+#: scratch of the batched dynamics kernels (n links, m coordinates): link rotations and positions,
+#: RNEA/CRBA work, joint positions, rates, accelerations, zeros, joint-space mass matrix and
+#: torques, the coordinates' mass matrix, bias, Cholesky factor, right side and solution
+DynamicsWork = namedtuple("DynamicsWork", "R P work q qd qdd zq Mq tau Mp hp L rhs a")
 
 #: decorator of the allocation-free scalar kernels: compiled without numba's reference-counting
 #: runtime (NRT), so passing arrays between them costs nothing. Measured on the finger step

@@ -20,14 +20,16 @@ columns: q̇ = 0, g = 0, q̈ = e_j), :func:`coriolis` ``C``, :func:`gravity` ``G
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 import numba
 import numpy as np
 from numba import prange
 
 from ..errors import ModelError, SimulationError
-from .kernels import (WORK_PER_LINK, chain_links, cholesky_solve, coupled_mass_bias, frames_into,
-                      hot, joints_from_actuators, point_jacobian, rnea_pass)
+from .kernels import (WORK_PER_LINK, ChainArrays, DynamicsWork, chain_links, cholesky_solve,
+                      coupled_mass_bias, frames_into, hot, joints_from_actuators, point_jacobian,
+                      rnea_pass)
 
 __all__ = ["rnea", "mass_matrix", "coriolis", "gravity", "bias", "forward_dynamics",
            "kinetic_energy", "potential_energy", "simulate_free"]
@@ -40,37 +42,51 @@ PARALLEL_MIN = 100_000
 
 OP_RNEA, OP_MASS_BIAS, OP_BIAS, OP_FD, OP_POTENTIAL, OP_FRAMES, OP_JACOBIAN = range(7)
 
+#: scratch of the fixed-step integrator: state, stage state and the four RK4 stage accelerations
+RK4Work = namedtuple("RK4Work", "x v xs vs k1 k2 k3 k4")
+
+
+@numba.njit(cache=True, error_model="numpy")
+def dynamics_work(n, m):  # pragma: no cover - compiled
+    """Scratch of the dynamics kernels for n links and m coordinates (:data:`DynamicsWork`)."""
+    return DynamicsWork(np.empty((n, 9)), np.empty((n, 3)), np.empty(WORK_PER_LINK * n), np.empty(n),
+                        np.empty(n), np.empty(n), np.zeros(n), np.empty((n, n)), np.empty(n),
+                        np.empty((m, m)), np.empty(m), np.empty((m, m)), np.empty(m), np.empty(m))
+
+
 
 @hot
-def _accel(n, m, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, p, pd, tau_p, a, R, P,
-           work, q, qd, zq, Mq, tau, Mp, hp, L, rhs):  # pragma: no cover - compiled
-    joints_from_actuators(n, m, G, q0, p, q)
+def _accel(n, m, ch, p, pd, tau_p, a, w):  # pragma: no cover - compiled
+    """Accelerations ``a`` = M_p⁻¹(τ_p − h_p) at (p, ṗ) for the chain ``ch`` (:data:`ChainArrays`);
+    False if M_p is not positive definite."""
+    G, g, q, qd, zq, hp, rhs = ch.G, ch.g, w.q, w.qd, w.zq, w.hp, w.rhs
+    joints_from_actuators(n, m, G, ch.q0, p, q)
     joints_from_actuators(n, m, G, zq, pd, qd)
-    chain_links(n, dh, jtype, q, R, P)
-    coupled_mass_bias(n, m, R, P, jtype, mass, com, inertia, arm_q, G, arm_p, qd, g[0], g[1],
-                      g[2], Mp, hp, zq, Mq, tau, work)
+    chain_links(n, ch.links, ch.jtype, q, w.R, w.P)
+    coupled_mass_bias(n, m, w.R, w.P, ch.jtype, ch.mass, ch.com, ch.inertia, ch.arm_q, G, ch.arm_p, qd,
+                      g[0], g[1], g[2], w.Mp, hp, zq, w.Mq, w.tau, w.work)
     for i in range(m):
         rhs[i] = tau_p[i] - hp[i]
-    return cholesky_solve(m, Mp, rhs, a, L)
+    return cholesky_solve(m, w.Mp, rhs, a, w.L)
 
 
 @hot
-def _range_dyn(op, b0, b1, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, gscale, pos, vel,
-               acc, vout, mout, R, P, work, q, qd, qdd, zq, Mq, tau, Mp, hp):  # pragma: no cover
+def _range_dyn(op, b0, b1, ch, gscale, pos, vel, acc, vout, mout, w):  # pragma: no cover - compiled
     """Inverse dynamics (OP_RNEA), bias (OP_BIAS) or mass matrix and bias (OP_MASS_BIAS) for
-    states b0..b1−1 (allocation-free; scratch passed in): ``vout`` (B, m), ``mout`` (B, m, m)."""
-    n = dh.shape[0]
+    states b0..b1−1 (allocation-free; scratch ``w``): ``vout`` (B, m), ``mout`` (B, m, m)."""
+    n = ch.links.shape[0]
     m = pos.shape[1]
-    gx = gscale * g[0]
-    gy = gscale * g[1]
-    gz = gscale * g[2]
+    G, zq, q, qd, qdd, tau, Mp, hp = ch.G, w.zq, w.q, w.qd, w.qdd, w.tau, w.Mp, w.hp
+    gx = gscale * ch.g[0]
+    gy = gscale * ch.g[1]
+    gz = gscale * ch.g[2]
     for b in range(b0, b1):
-        joints_from_actuators(n, m, G, q0, pos[b], q)
+        joints_from_actuators(n, m, G, ch.q0, pos[b], q)
         joints_from_actuators(n, m, G, zq, vel[b], qd)
-        chain_links(n, dh, jtype, q, R, P)
+        chain_links(n, ch.links, ch.jtype, q, w.R, w.P)
         if op == OP_MASS_BIAS:
-            coupled_mass_bias(n, m, R, P, jtype, mass, com, inertia, arm_q, G, arm_p, qd, gx, gy,
-                              gz, Mp, hp, zq, Mq, tau, work)
+            coupled_mass_bias(n, m, w.R, w.P, ch.jtype, ch.mass, ch.com, ch.inertia, ch.arm_q, G,
+                              ch.arm_p, qd, gx, gy, gz, Mp, hp, zq, w.Mq, tau, w.work)
             for i in range(m):
                 vout[b, i] = hp[i]
                 for j in range(m):
@@ -81,24 +97,25 @@ def _range_dyn(op, b0, b1, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g
         else:
             for k in range(n):
                 qdd[k] = 0.0
-        rnea_pass(n, R, P, jtype, mass, com, inertia, arm_q, qd, qdd, gx, gy, gz, True, tau, work)
+        rnea_pass(n, w.R, w.P, ch.jtype, ch.mass, ch.com, ch.inertia, ch.arm_q, qd, qdd, gx, gy, gz,
+                  True, tau, w.work)
         for i in range(m):
-            s = arm_p[i] * acc[b, i] if op == OP_RNEA else 0.0
+            s = ch.arm_p[i] * acc[b, i] if op == OP_RNEA else 0.0
             for k in range(n):
                 s += G[k * m + i] * tau[k]
             vout[b, i] = s
 
 
 @hot
-def _range_kin(op, b0, b1, dh, jtype, mass, com, G, q0, g, tool, pos, vout, fout, R, P, q, T,
-               J):  # pragma: no cover - compiled
+def _range_kin(op, b0, b1, ch, tool, pos, vout, fout, R, P, q, T, J):  # pragma: no cover - compiled
     """Link frames (OP_FRAMES → fout (B, n, 16)), the tool point's Jacobian (OP_JACOBIAN → fout
     (B, 6, m)) or the potential energy (OP_POTENTIAL → vout (B, 1))."""
-    n = dh.shape[0]
+    n = ch.links.shape[0]
     m = pos.shape[1]
+    G, g, mass, com = ch.G, ch.g, ch.mass, ch.com
     for b in range(b0, b1):
-        joints_from_actuators(n, m, G, q0, pos[b], q)
-        chain_links(n, dh, jtype, q, R, P)
+        joints_from_actuators(n, m, G, ch.q0, pos[b], q)
+        chain_links(n, ch.links, ch.jtype, q, R, P)
         frames_into(n, R, P, T)
         if op == OP_FRAMES:
             for k in range(n):
@@ -118,7 +135,7 @@ def _range_kin(op, b0, b1, dh, jtype, mass, com, G, q0, g, tool, pos, vout, fout
             px = T[e, 3] + T[e, 0] * tool[0] + T[e, 1] * tool[1] + T[e, 2] * tool[2]
             py = T[e, 7] + T[e, 4] * tool[0] + T[e, 5] * tool[1] + T[e, 6] * tool[2]
             pz = T[e, 11] + T[e, 8] * tool[0] + T[e, 9] * tool[1] + T[e, 10] * tool[2]
-            point_jacobian(n, jtype, T, px, py, pz, J)
+            point_jacobian(n, ch.jtype, T, px, py, pz, J)
             for r in range(6):
                 for j in range(m):
                     s = 0.0
@@ -128,59 +145,47 @@ def _range_kin(op, b0, b1, dh, jtype, mass, com, G, q0, g, tool, pos, vout, fout
 
 
 @hot
-def _range_fd(b0, b1, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, pos, vel, tau_p, vout,
-              ok, R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, a):  # pragma: no cover
+def _range_fd(b0, b1, ch, pos, vel, tau_p, vout, ok, w):  # pragma: no cover - compiled
     """Forward dynamics q̈ = M⁻¹(τ − h) for states b0..b1−1."""
-    n = dh.shape[0]
+    n = ch.links.shape[0]
     m = pos.shape[1]
+    a = w.a
     for b in range(b0, b1):
-        ok[b] = _accel(n, m, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, pos[b], vel[b],
-                       tau_p[b], a, R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs)
+        ok[b] = _accel(n, m, ch, pos[b], vel[b], tau_p[b], a, w)
         for i in range(m):
             vout[b, i] = a[i]
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _dyn_serial(op, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, gscale, pos, vel, acc,
-                vout, mout):  # pragma: no cover - compiled
-    n = dh.shape[0]
-    m = pos.shape[1]
-    _range_dyn(op, 0, pos.shape[0], dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, gscale,
-               pos, vel, acc, vout, mout, np.empty((n, 9)), np.empty((n, 3)),
-               np.empty(WORK_PER_LINK * n), np.empty(n), np.empty(n), np.empty(n), np.zeros(n),
-               np.empty((n, n)), np.empty(n), np.empty((m, m)), np.empty(m))
+def _dyn_serial(op, ch, gscale, pos, vel, acc, vout, mout):  # pragma: no cover - compiled
+    _range_dyn(op, 0, pos.shape[0], ch, gscale, pos, vel, acc, vout, mout,
+               dynamics_work(ch.links.shape[0], pos.shape[1]))
 
 
 @numba.njit(cache=True, parallel=True, error_model="numpy")
-def _dyn_parallel(op, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, gscale, pos, vel, acc,
-                  vout, mout):  # pragma: no cover - compiled
-    n = dh.shape[0]
+def _dyn_parallel(op, ch, gscale, pos, vel, acc, vout, mout):  # pragma: no cover - compiled
+    # a prange body takes arrays, not records: each chunk builds its own
+    links, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g = ch
+    n = links.shape[0]
     m = pos.shape[1]
     B = pos.shape[0]
     for c in prange((B + _CHUNK - 1) // _CHUNK):
-        _range_dyn(op, c * _CHUNK, min(B, (c + 1) * _CHUNK), dh, jtype, mass, com, inertia, arm_q,
-                   G, q0, arm_p, g, gscale, pos, vel, acc, vout, mout, np.empty((n, 9)),
-                   np.empty((n, 3)), np.empty(WORK_PER_LINK * n), np.empty(n), np.empty(n),
-                   np.empty(n), np.zeros(n), np.empty((n, n)), np.empty(n), np.empty((m, m)),
-                   np.empty(m))
+        _range_dyn(op, c * _CHUNK, min(B, (c + 1) * _CHUNK),
+                   ChainArrays(links, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g), gscale, pos,
+                   vel, acc, vout, mout, dynamics_work(n, m))
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _kin_serial(op, dh, jtype, mass, com, G, q0, g, tool, pos, vout, fout):  # pragma: no cover
-    n = dh.shape[0]
-    _range_kin(op, 0, pos.shape[0], dh, jtype, mass, com, G, q0, g, tool, pos, vout, fout,
-               np.empty((n, 9)), np.empty((n, 3)), np.empty(n), np.empty((n, 16)), np.empty((6, n)))
+def _kin_serial(op, ch, tool, pos, vout, fout):  # pragma: no cover - compiled
+    n = ch.links.shape[0]
+    _range_kin(op, 0, pos.shape[0], ch, tool, pos, vout, fout, np.empty((n, 9)), np.empty((n, 3)),
+               np.empty(n), np.empty((n, 16)), np.empty((6, n)))
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _fd_serial(dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, pos, vel, tau_p, vout,
-               ok):  # pragma: no cover - compiled
-    n = dh.shape[0]
-    m = pos.shape[1]
-    _range_fd(0, pos.shape[0], dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, pos, vel,
-              tau_p, vout, ok, np.empty((n, 9)), np.empty((n, 3)), np.empty(WORK_PER_LINK * n),
-              np.empty(n), np.empty(n), np.zeros(n), np.empty((n, n)), np.empty(n),
-              np.empty((m, m)), np.empty(m), np.empty((m, m)), np.empty(m), np.empty(m))
+def _fd_serial(ch, pos, vel, tau_p, vout, ok):  # pragma: no cover - compiled
+    _range_fd(0, pos.shape[0], ch, pos, vel, tau_p, vout, ok,
+              dynamics_work(ch.links.shape[0], pos.shape[1]))
 
 
 def run_op(system, op: int, pos, vel=None, acc=None, *, gscale: float = 1.0, tool=None,
@@ -188,8 +193,7 @@ def run_op(system, op: int, pos, vel=None, acc=None, *, gscale: float = 1.0, too
     """Evaluate a kernel operation over a batch of states. Inverse dynamics, bias and mass
     matrices use all cores from PARALLEL_MIN states on (or as ``parallel`` says); forward
     dynamics and kinematics run on one thread. Returns the solver flags (forward dynamics)."""
-    a = system.kernel_arrays()
-    dh, jt, mass, com, inertia, arm_q, G, q0, arm_p, g = a
+    ch = system.kernel_arrays()
     B = pos.shape[0]
     vel = pos if vel is None else vel
     acc = pos if acc is None else acc
@@ -198,27 +202,27 @@ def run_op(system, op: int, pos, vel=None, acc=None, *, gscale: float = 1.0, too
     if op in (OP_RNEA, OP_BIAS, OP_MASS_BIAS):
         mout = np.empty((1, 1, 1)) if mout is None else mout
         fn = _dyn_parallel if (B >= PARALLEL_MIN if parallel is None else parallel) else _dyn_serial
-        fn(op, dh, jt, mass, com, inertia, arm_q, G, q0, arm_p, g, float(gscale), pos, vel, acc,
-           vout, mout)
+        fn(op, ch, float(gscale), pos, vel, acc, vout, mout)
     elif op == OP_FD:
-        _fd_serial(dh, jt, mass, com, inertia, arm_q, G, q0, arm_p, g, pos, vel, acc, vout, ok)
+        _fd_serial(ch, pos, vel, acc, vout, ok)
     else:
         fout = np.empty((1, 1, 1)) if fout is None else fout
         tool = np.zeros(3) if tool is None else np.ascontiguousarray(tool, dtype=np.float64)
-        _kin_serial(op, dh, jt, mass, com, G, q0, g, tool, pos, vout, fout)
+        _kin_serial(op, ch, tool, pos, vout, fout)
     return ok
 
 
 @hot
-def _simulate_range(b0, b1, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, p0, pd0,
-                    torque, dt, substeps, method, pos_out, vel_out, fail, R, P, work, q, qd, zq, Mq,
-                    tau, Mp, hp, L, rhs, x, v, xs, vs, k1, k2, k3, k4):  # pragma: no cover
+def _simulate_range(b0, b1, ch, p0, pd0, torque, dt, substeps, method, pos_out, vel_out, fail, w,
+                    rk):  # pragma: no cover - compiled
     """Fixed-step integration of τ_p = M_p p̈ + h_p from initial states b0..b1−1, torque held
-    over each sample (N, m). method 0: classical RK4; 1: semi-implicit (symplectic) Euler."""
-    n = dh.shape[0]
+    over each sample (N, m). method 0: classical RK4; 1: semi-implicit (symplectic) Euler.
+    Scratch: ``w`` (:data:`DynamicsWork`), ``rk`` (:data:`RK4Work`)."""
+    n = ch.links.shape[0]
     m = p0.shape[1]
     N = torque.shape[0]
     h = dt / substeps
+    x, v, xs, vs, k1, k2, k3, k4 = rk.x, rk.v, rk.xs, rk.vs, rk.k1, rk.k2, rk.k3, rk.k4
     for b in range(b0, b1):
         for i in range(m):
             x[i] = p0[b, i]
@@ -229,9 +233,7 @@ def _simulate_range(b0, b1, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, 
                 vel_out[b, s, i] = v[i]
             for _ in range(substeps):
                 if method == 1:
-                    if not _accel(n, m, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, x,
-                                  v, torque[s], k1, R, P, work, q, qd, zq, Mq, tau, Mp, hp, L,
-                                  rhs):
+                    if not _accel(n, m, ch, x, v, torque[s], k1, w):
                         fail[b] = s + 1
                     for i in range(m):
                         v[i] += h * k1[i]
@@ -259,9 +261,7 @@ def _simulate_range(b0, b1, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, 
                             xs[i] = x[i] + h * (v[i] + 0.5 * h * k2[i])
                             vs[i] = v[i] + h * k3[i]
                         kk = k4
-                    if not _accel(n, m, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g,
-                                  xs, vs, torque[s], kk, R, P, work, q, qd, zq, Mq, tau, Mp, hp,
-                                  L, rhs):
+                    if not _accel(n, m, ch, xs, vs, torque[s], kk, w):
                         fail[b] = s + 1
                 for i in range(m):
                     x[i] += h * v[i] + h * h / 6.0 * (k1[i] + k2[i] + k3[i])
@@ -269,35 +269,30 @@ def _simulate_range(b0, b1, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, 
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _sim_scratch(n, m):  # pragma: no cover - compiled
-    return (np.empty((n, 9)), np.empty((n, 3)), np.empty(WORK_PER_LINK * n), np.empty(n),
-            np.empty(n), np.zeros(n), np.empty((n, n)), np.empty(n), np.empty((m, m)), np.empty(m),
-            np.empty((m, m)), np.empty(m), np.empty(m))
+def _rk4_work(m):  # pragma: no cover - compiled
+    return RK4Work(np.empty(m), np.empty(m), np.empty(m), np.empty(m), np.empty(m), np.empty(m),
+                   np.empty(m), np.empty(m))
 
 
 @numba.njit(cache=True, parallel=True, error_model="numpy")
-def _simulate_parallel(dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, p0, pd0, torque, dt,
-                       substeps, method, pos_out, vel_out, fail):  # pragma: no cover - compiled
-    n = dh.shape[0]
+def _simulate_parallel(ch, p0, pd0, torque, dt, substeps, method, pos_out, vel_out,
+                       fail):  # pragma: no cover - compiled
+    # a prange body takes arrays, not records: each initial state builds its own
+    links, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g = ch
+    n = links.shape[0]
     m = p0.shape[1]
     for b in prange(p0.shape[0]):
-        R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, a = _sim_scratch(n, m)
-        _simulate_range(b, b + 1, dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, p0, pd0,
-                        torque, dt, substeps, method, pos_out, vel_out, fail, R, P, work, q, qd, zq,
-                        Mq, tau, Mp, hp, L, rhs, np.empty(m), np.empty(m), np.empty(m), np.empty(m),
-                        a, np.empty(m), np.empty(m), np.empty(m))
+        _simulate_range(b, b + 1, ChainArrays(links, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g),
+                        p0, pd0, torque, dt, substeps, method, pos_out, vel_out, fail,
+                        dynamics_work(n, m), _rk4_work(m))
 
 
 @numba.njit(cache=True, error_model="numpy")
-def _simulate_serial(dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, p0, pd0, torque, dt,
-                     substeps, method, pos_out, vel_out, fail):  # pragma: no cover - compiled
-    n = dh.shape[0]
+def _simulate_serial(ch, p0, pd0, torque, dt, substeps, method, pos_out, vel_out,
+                     fail):  # pragma: no cover - compiled
     m = p0.shape[1]
-    R, P, work, q, qd, zq, Mq, tau, Mp, hp, L, rhs, a = _sim_scratch(n, m)
-    _simulate_range(0, p0.shape[0], dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g, p0, pd0,
-                    torque, dt, substeps, method, pos_out, vel_out, fail, R, P, work, q, qd, zq, Mq,
-                    tau, Mp, hp, L, rhs, np.empty(m), np.empty(m), np.empty(m), np.empty(m),
-                    a, np.empty(m), np.empty(m), np.empty(m))
+    _simulate_range(0, p0.shape[0], ch, p0, pd0, torque, dt, substeps, method, pos_out, vel_out, fail,
+                    dynamics_work(ch.links.shape[0], m), _rk4_work(m))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -439,7 +434,7 @@ def simulate_free(system, q0, qd0, torque, dt: float, *, substeps: int = 1,
     vel = np.empty((B, N, m))
     fail = np.zeros(B, dtype=np.int64)
     fn = _simulate_parallel if B >= 8 else _simulate_serial
-    fn(*system.kernel_arrays(), q0, qd0, tq, float(dt), int(substeps), 0 if method == "rk4" else 1,
+    fn(system.kernel_arrays(), q0, qd0, tq, float(dt), int(substeps), 0 if method == "rk4" else 1,
        pos, vel, fail)
     if fail.any() or not np.isfinite(pos).all():
         raise SimulationError(f"{system.name}: the simulation diverged or met a singular mass matrix",
