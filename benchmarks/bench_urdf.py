@@ -21,7 +21,6 @@ results). Numba compile time is excluded (warm-up call), as everywhere in the be
 from __future__ import annotations
 
 import tempfile
-import time
 import warnings
 from pathlib import Path
 

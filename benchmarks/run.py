@@ -60,7 +60,7 @@ def _fmt_t(s):
 
 def to_markdown(results: dict) -> str:
     m = results["machine"]
-    lines = [f"# gripkit benchmarks", "",
+    lines = ["# gripkit benchmarks", "",
              f"Machine: {m['cpu']}, {m['cores']} cores; Python {m['python']}, numpy {m['numpy']}, "
              f"scipy {m['scipy']}, numba {m['numba']}; BLAS {m.get('blas', '?')} with "
              f"{m.get('blas_threads', '?')} thread(s) on both sides"

@@ -2,7 +2,6 @@
 ARX whose fit figures are lists per output in --output order, recovering a known 2×2 ARX system
 from noisy data within 4σ; SISO calls keep their JSON (``validation.fit_percent`` a number)."""
 
-import json
 import sys
 from pathlib import Path
 

@@ -2,7 +2,6 @@
 
 import numpy as np
 import pytest
-from scipy import signal
 
 from gripkit import DataError, Trajectory
 from gripkit.signals import (ac_couple, butter_zpk, decimate, detrend, lowpass, resample, split,

@@ -1,7 +1,6 @@
 """Report figures a reader can scan: labelled axes, enough log ticks, markers and lines that do
 not hide each other."""
 
-import numpy as np
 import pytest
 
 from gripkit.report.plots import bode, log_ticks, pole_zero_map, subplots

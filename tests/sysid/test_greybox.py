@@ -1,6 +1,5 @@
 """Grey-box engine: parameter recovery with honest uncertainty, identifiability diagnosis."""
 
-import warnings
 
 import numpy as np
 import pytest

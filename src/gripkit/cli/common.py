@@ -12,6 +12,8 @@ from pathlib import Path
 import numpy as np
 import typer
 
+from ..sysid.model_file import plain
+
 __all__ = ["emit_json", "load_data", "collected_warnings", "report_warnings", "check_data_options", "check_choice", "check_number", "complex_pairs",
            "FsOpt", "TimeOpt", "FillOpt", "JsonOpt"]
 
@@ -62,28 +64,9 @@ def check_number(value, option: str, *, minimum: float | None = None, above: flo
         raise DataError(f"{option}: expected {want}, found {value!r}")
 
 
-def _clean(obj):
-    if isinstance(obj, dict):
-        return {str(k): _clean(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_clean(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return _clean(obj.tolist())
-    if isinstance(obj, (np.floating, float)):
-        v = float(obj)
-        return v if math.isfinite(v) else None
-    if isinstance(obj, (np.integer,)):
-        return int(obj)
-    if isinstance(obj, (np.bool_,)):
-        return bool(obj)
-    if isinstance(obj, complex):
-        return [obj.real, obj.imag]
-    return obj
-
-
 def emit_json(obj) -> None:
     """Write ``obj`` as one JSON object on stdout (NaN/inf become null)."""
-    sys.stdout.write(json.dumps(_clean(obj), allow_nan=False) + "\n")
+    sys.stdout.write(json.dumps(plain(obj), allow_nan=False) + "\n")
     sys.stdout.flush()
 
 

@@ -36,7 +36,7 @@ def _columns(option: str, text: str | None, joints) -> list[str] | None:
     cols = [c.strip() for c in text.split(",") if c.strip()]
     if len(cols) != len(joints):
         raise ConfigError(f"{option}: {len(cols)} column(s) {cols} for the {len(joints)} actuated joints "
-                          f"{', '.join(joints)}", hint=f"give one column per joint, comma-separated, in that order")
+                          f"{', '.join(joints)}", hint="give one column per joint, comma-separated, in that order")
     return cols
 
 

@@ -50,19 +50,26 @@ def require_discrete(dt, what: str) -> float:
     return float(dt)
 
 
+def _labels(values, n: int, what: str, kind: str):
+    """``values`` (one string or a sequence of n) as a tuple of n strings, or None when absent."""
+    if values is None or (not isinstance(values, str) and len(values) == 0):
+        return None
+    values = (values,) if isinstance(values, str) else tuple(values)
+    if len(values) != n:
+        raise ModelError(f"{what}: expected {n} {kind}, found {len(values)} ({', '.join(map(str, values))})")
+    for s in values:
+        if not isinstance(s, str) or (kind == "names" and not s):
+            raise ModelError(f"{what}: {kind} must be {'non-empty ' if kind == 'names' else ''}strings, "
+                             f"found {s!r}")
+    return values
+
+
 def as_names(names, n: int, what: str, default: str) -> tuple[str, ...]:
     """``n`` distinct signal names; None/empty gives ``default0 .. default{n-1}`` (or ``default``
     alone when n == 1)."""
-    if names is None or (not isinstance(names, str) and len(names) == 0):
+    names = _labels(names, n, what, "names")
+    if names is None:
         return (default,) if n == 1 else tuple(f"{default}{i}" for i in range(n))
-    if isinstance(names, str):
-        names = (names,)
-    names = tuple(names)
-    if len(names) != n:
-        raise ModelError(f"{what}: expected {n} names, found {len(names)} ({', '.join(map(str, names))})")
-    for s in names:
-        if not isinstance(s, str) or not s:
-            raise ModelError(f"{what}: names must be non-empty strings, found {s!r}")
     if len(set(names)) != n:
         dup = sorted({s for s in names if names.count(s) > 1})
         raise ModelError(f"{what}: names must be distinct, found {', '.join(dup)} more than once")
@@ -71,17 +78,8 @@ def as_names(names, n: int, what: str, default: str) -> tuple[str, ...]:
 
 def as_units(units, n: int, what: str) -> tuple[str, ...]:
     """``n`` unit strings (SI spelling, ``''`` = not declared)."""
-    if units is None or (not isinstance(units, str) and len(units) == 0):
-        return ("",) * n
-    if isinstance(units, str):
-        units = (units,)
-    units = tuple(units)
-    if len(units) != n:
-        raise ModelError(f"{what}: expected {n} units, found {len(units)} ({', '.join(map(str, units))})")
-    for s in units:
-        if not isinstance(s, str):
-            raise ModelError(f"{what}: units must be strings, found {s!r}")
-    return units
+    units = _labels(units, n, what, "units")
+    return ("",) * n if units is None else units
 
 
 def same_dt(a, b, what: str) -> float | None:

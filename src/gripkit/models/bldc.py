@@ -107,7 +107,7 @@ def motor_parameters(*, name: str = "bldc") -> ParameterSet:
                   bounds=(1.0, None), fixed=True, source=f"{SEED}, §5.2"),
         Parameter("T_ref", 353.15, "K", "winding temperature at which eqs 5.7-5.8 hold",
                   bounds=(200.0, 500.0), display_unit="degC",
-                  source=f"derived: Fig. 5.7 (<0.6 Ncm near 80 °C) with eq 5.7 (0.572 Ncm)"),
+                  source="derived: Fig. 5.7 (<0.6 Ncm near 80 °C) with eq 5.7 (0.572 Ncm)"),
         Parameter("T_amb", 298.15, "K", "ambient (room) temperature T0 of eq 5.5",
                   bounds=(200.0, 400.0), display_unit="degC", source="assumed: 25 °C room"),
         Parameter("alpha_R", 0.0136, "1/K", "effective temperature coefficient of the winding resistance",

@@ -13,7 +13,7 @@ import numpy as np
 from ..arguments import sample_interval
 from ..errors import DataError, UnidentifiableError
 
-__all__ = ["as_signal", "check_io", "check_order", "check_dt", "require_samples", "check_excitation",
+__all__ = ["as_signal", "as_io_matrix", "check_io", "check_order", "check_dt", "require_samples", "check_excitation",
            "check_output_varies", "checked_problem", "check_identifiable"]
 
 
@@ -35,6 +35,32 @@ def as_signal(x, name: str) -> np.ndarray:
                     f"{name} has {int(mask.sum())} {label} values (first at sample {int(np.argmax(mask))})",
                     hint="drop or interpolate them before identification (CLI: --fill)")
     return a
+
+
+def as_io_matrix(x, name: str, n: int | None = None, channels: tuple[str, ...] | None = None,
+                 kind: str = "channel") -> np.ndarray:
+    """``x`` as a finite (N, k) float64 array (a 1-D signal is one column); ``n`` samples when
+    given; with ``channels``, k = len(channels) and the errors name the channel (of ``kind``)."""
+    try:
+        a = np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise DataError(f"{name}: expected an array of numbers, found {type(x).__name__}") from None
+    if a.ndim == 1:
+        a = a[:, None]
+    if channels is not None and (a.ndim != 2 or a.shape[1] != len(channels)):
+        raise DataError(f"{name}: expected shape (N, {len(channels)}) for the {kind}s {', '.join(channels)}, "
+                        f"found {a.shape}")
+    if a.ndim != 2 or a.shape[0] == 0 or a.shape[1] == 0:
+        raise DataError(f"{name}: expected shape (N,) or (N, {kind}s), found {a.shape}")
+    if n is not None and a.shape[0] != n:
+        raise DataError(f"{name}: expected {n} samples (as many as the other signal), found {a.shape[0]}")
+    if not _all_finite(a):
+        bad = ~np.isfinite(a)
+        r, c = np.argwhere(bad)[0]
+        raise DataError(f"{name}: {int(bad.sum())} NaN or inf values (first at sample {r}, {kind} "
+                        f"{channels[c] if channels is not None else c})",
+                        hint="drop or interpolate them before identification (CLI: --fill)")
+    return np.ascontiguousarray(a)
 
 
 def _all_finite(a: np.ndarray) -> bool:

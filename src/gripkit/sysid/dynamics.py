@@ -61,6 +61,7 @@ from scipy.linalg import qr
 from ..arguments import entry_point
 from ..errors import AccuracyWarning, DataError, IdentificationError, ModelError, UnidentifiableError
 from ..multibody import from_urdf
+from .checks import as_io_matrix
 from .dynamics_file import float_array, read_dynamics_document, save_dynamics_model
 from .regression import hac_covariance
 
@@ -292,28 +293,12 @@ class DynamicsResult:
         return d
 
 
-def _as_states(name, a, N, m, names):
-    x = np.asarray(a, dtype=np.float64)
-    if x.ndim == 1 and m == 1:
-        x = x[:, None]
-    if x.ndim != 2 or x.shape[1] != m:
-        raise DataError(f"{name}: expected shape (N, {m}) for the joints {', '.join(names)}, found {x.shape}")
-    if N is not None and x.shape[0] != N:
-        raise DataError(f"{name}: {x.shape[0]} samples, but q has {N}")
-    bad = ~np.isfinite(x)
-    if bad.any():
-        i, j = np.argwhere(bad)[0]
-        raise DataError(f"{name}: {int(bad.sum())} NaN or inf values (first at sample {i}, joint {names[j]})",
-                        hint="drop or interpolate them before identification")
-    return x
-
-
-def _joint_states(q, qd, qdd, tau, m: int, names):
-    """q, q̇, q̈, τ as checked (N, m) arrays of one length N (:func:`_as_states`)."""
-    q = _as_states("q", q, None, m, names)
+def _joint_states(q, qd, qdd, tau, names):
+    """q, q̇, q̈, τ as checked (N, m) arrays of one length N (:func:`~gripkit.sysid.checks.as_io_matrix`)."""
+    q = as_io_matrix(q, "q", None, names, "joint")
     N = q.shape[0]
-    return (q, _as_states("qd", qd, N, m, names), _as_states("qdd", qdd, N, m, names),
-            _as_states("tau", tau, N, m, names))
+    return (q, as_io_matrix(qd, "qd", N, names, "joint"), as_io_matrix(qdd, "qdd", N, names, "joint"),
+            as_io_matrix(tau, "tau", N, names, "joint"))
 
 
 def _check_choices(friction: str, covariance: str) -> None:
@@ -468,7 +453,7 @@ def identify_dynamics(chain, q, qd, qdd, tau, *, friction: str = "coulomb-viscou
     _check_choices(friction, covariance)
     m = chain.dof
     jn = chain.coordinate_names
-    q, qd, qdd, tau = _joint_states(q, qd, qdd, tau, m, jn)
+    q, qd, qdd, tau = _joint_states(q, qd, qdd, tau, jn)
     N = q.shape[0]
     rows_w = _row_weights(weights, N, m)
     st = base_structure(chain, armature=armature)

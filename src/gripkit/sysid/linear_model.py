@@ -24,30 +24,11 @@ import numpy as np
 from .. import __version__
 from ..errors import DataError, ModelError
 from ..lti import LinearSystem, StateSpace, TransferFunction
+from .checks import as_io_matrix
 from .model_file import SCHEMA, SCHEMA_VERSION, read_document, write_document
 
 __all__ = ["LinearModel", "as_io_matrix", "estimate_x0", "free_run", "fit_per_output", "from_polynomial",
            "model_document", "save_model", "load_model"]
-
-
-def as_io_matrix(x, name: str, n: int | None = None) -> np.ndarray:
-    """``x`` as a finite (N, k) float64 array (a 1-D signal is one column)."""
-    try:
-        a = np.asarray(x, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise DataError(f"{name}: expected an array of numbers, found {type(x).__name__}") from None
-    if a.ndim == 1:
-        a = a[:, None]
-    if a.ndim != 2 or a.shape[0] == 0 or a.shape[1] == 0:
-        raise DataError(f"{name}: expected shape (N,) or (N, channels), found {a.shape}")
-    if n is not None and a.shape[0] != n:
-        raise DataError(f"{name}: expected {n} samples (as many as the other signal), found {a.shape[0]}")
-    bad = ~np.isfinite(a)
-    if bad.any():
-        r, c = np.argwhere(bad)[0]
-        raise DataError(f"{name} has {int(bad.sum())} NaN/inf values (first at sample {r}, channel {c})",
-                        hint="drop or interpolate them before identification (CLI: --fill)")
-    return np.ascontiguousarray(a)
 
 
 def _sim(A, B, C, D, u, x0):

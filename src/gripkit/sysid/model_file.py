@@ -37,7 +37,8 @@ def file_sha256(path) -> str:
 
 
 def plain(x):
-    """``x`` with arrays, numpy scalars and tuples as JSON types (non-finite floats as null)."""
+    """``x`` with arrays, numpy scalars and tuples as JSON types (non-finite floats as null,
+    complex numbers as ``[re, im]``)."""
     if isinstance(x, dict):
         return {str(k): plain(v) for k, v in x.items()}
     if isinstance(x, (list, tuple)):
@@ -51,6 +52,8 @@ def plain(x):
         return int(x)
     if isinstance(x, (np.bool_,)):
         return bool(x)
+    if isinstance(x, (complex, np.complexfloating)):
+        return [plain(x.real), plain(x.imag)]
     return x
 
 

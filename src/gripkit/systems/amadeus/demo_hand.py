@@ -236,7 +236,7 @@ def _slip(report, z, rng, summary, quick):
         ["speed indication (mm/s)", f"{1e3 * ev.speed:.1f} ± {1e3 * ev.speed_std:.1f}" if ev.speed is not None else "-"],
         ["true slip speed over the feature window (mm/s)",
          1e3 * float(np.mean(np.abs(tr["v_slip"][int(ev.onset * PVDF_RATE):int((ev.onset + 0.1) * PVDF_RATE)])))],
-        [f"non-slip record: duration (s), true slip samples", f"{T:.0f}, {int((trn['slipping'] > 0).sum())}"],
+        ["non-slip record: duration (s), true slip samples", f"{T:.0f}, {int((trn['slipping'] > 0).sum())}"],
         ["false-alarm frames (10 ms) / rate", f"{fa['n_false']} / {100 * fa['rate']:.3f} %"],
         ["false alarms per minute", fa["per_minute"]],
         ["simulate + detect the non-slip record (s)", el],

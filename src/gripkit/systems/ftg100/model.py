@@ -774,7 +774,6 @@ def advance_plant(th, s, mode, V, h, substeps):  # pragma: no cover - compiled
             lo, hi, flo, fhi = 0.0, 1.0, d0, 0.0
             theta = 1.0
             side = 0
-            located = False
             for it in range(41):
                 n0, n1, n2, n3 = _plant_rk4(th, s0, s1, s2, s3, V, mode, theta * rem)
                 fm = _gap(th, n0, n2)
@@ -785,7 +784,6 @@ def advance_plant(th, s, mode, V, h, substeps):  # pragma: no cover - compiled
                     fhi = fm
                 else:
                     if fm == 0.0 or (hi - lo) * rem < 1e-15 or abs(fm) <= 1e-13 * (abs(flo) + abs(fhi)):
-                        located = True
                         break
                     if (fm > 0.0) == (fhi > 0.0):
                         hi, fhi = theta, fm
@@ -798,7 +796,6 @@ def advance_plant(th, s, mode, V, h, substeps):  # pragma: no cover - compiled
                             fhi *= 0.5
                         side = -1
                 if fhi == flo:
-                    located = True
                     break
                 theta = min(max((lo * fhi - hi * flo) / (fhi - flo), 0.0), 1.0)
             s0, s1, s2, s3 = n0, n1, n2, n3
