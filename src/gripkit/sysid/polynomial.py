@@ -311,23 +311,14 @@ class PolynomialModel:
             i += n
         raise KeyError(which)
 
-    @property
-    def A_std(self) -> np.ndarray | None:
-        """One-sigma uncertainty of each entry of ``A`` (0 for the fixed leading 1)."""
-        return self._std_layout("A")
-
-    @property
-    def B_std(self) -> np.ndarray | None:
-        """One-sigma uncertainty of each entry of ``B`` (0 for the ``nk`` fixed leading zeros)."""
-        return self._std_layout("B")
-
-    @property
-    def C_std(self) -> np.ndarray | None:
-        return self._std_layout("C")
-
-    @property
-    def F_std(self) -> np.ndarray | None:
-        return self._std_layout("F")
+    A_std = property(lambda self: self._std_layout("A"),
+                     doc="One-sigma uncertainty of each entry of ``A`` (0 for the fixed leading 1).")
+    B_std = property(lambda self: self._std_layout("B"),
+                     doc="One-sigma uncertainty of each entry of ``B`` (0 for the ``nk`` fixed leading zeros).")
+    C_std = property(lambda self: self._std_layout("C"),
+                     doc="One-sigma uncertainty of each entry of ``C`` (0 for the fixed leading 1).")
+    F_std = property(lambda self: self._std_layout("F"),
+                     doc="One-sigma uncertainty of each entry of ``F`` (0 for the fixed leading 1).")
 
     @property
     def parameters(self):
