@@ -142,6 +142,44 @@ def dh_table(alpha, a, d, offset) -> np.ndarray:
     return np.ascontiguousarray(np.column_stack([alpha, a, d, offset, np.cos(alpha), np.sin(alpha)]))
 
 
+@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+def outward_step(k, R, P, jtype, qd, qdd, wx, wy, wz, ax, ay, az, vx, vy, vz,
+                 with_velocity):  # pragma: no cover - compiled
+    """One link of the outward Newton-Euler pass (eqs 4.8–4.10): ω, ω̇ and the origin's
+    acceleration v̇ of link k+1 in its own frame from those (w, a, v) of link k. Inlined into its
+    callers at numba IR level. ``with_velocity=False`` skips the velocity products."""
+    r0 = R[k, 0]; r1 = R[k, 1]; r2 = R[k, 2]  # noqa: E702
+    r3 = R[k, 3]; r4 = R[k, 4]; r5 = R[k, 5]  # noqa: E702
+    r6 = R[k, 6]; r7 = R[k, 7]; r8 = R[k, 8]  # noqa: E702
+    px = P[k, 0]; py = P[k, 1]; pz = P[k, 2]  # noqa: E702
+    # linear acceleration of the new origin, in parent frame: ω̇×P + ω×(ω×P) + v̇
+    tx = ay * pz - az * py + vx
+    ty = az * px - ax * pz + vy
+    tz = ax * py - ay * px + vz
+    if with_velocity:
+        cx = wy * pz - wz * py
+        cy = wz * px - wx * pz
+        cz = wx * py - wy * px
+        tx += wy * cz - wz * cy
+        ty += wz * cx - wx * cz
+        tz += wx * cy - wy * cx
+    # rotate into the child frame (transpose of ^{k}_{k+1}R)
+    nvx = r0 * tx + r3 * ty + r6 * tz
+    nvy = r1 * tx + r4 * ty + r7 * tz
+    nvz = r2 * tx + r5 * ty + r8 * tz
+    rwx = r0 * wx + r3 * wy + r6 * wz
+    rwy = r1 * wx + r4 * wy + r7 * wz
+    rwz = r2 * wx + r5 * wy + r8 * wz
+    rax = r0 * ax + r3 * ay + r6 * az
+    ray = r1 * ax + r4 * ay + r7 * az
+    raz = r2 * ax + r5 * ay + r8 * az
+    if jtype[k] == 0:
+        return (rwx, rwy, rwz + qd[k], rax + rwy * qd[k], ray - rwx * qd[k], raz + qdd[k], nvx, nvy,
+                nvz)
+    # prismatic: + 2 ω × (ḋ ẑ) + d̈ ẑ
+    return rwx, rwy, rwz, rax, ray, raz, nvx + 2.0 * rwy * qd[k], nvy - 2.0 * rwx * qd[k], nvz + qdd[k]
+
+
 @hot
 def rnea_pass(n, R, P, jtype, mass, com, inertia, armature, qd, qdd, gx, gy, gz, with_velocity,
               tau, work):  # pragma: no cover - compiled
@@ -160,52 +198,8 @@ def rnea_pass(n, R, P, jtype, mass, com, inertia, armature, qd, qdd, gx, gy, gz,
     vy = -gy
     vz = -gz
     for k in range(n):
-        r0 = R[k, 0]; r1 = R[k, 1]; r2 = R[k, 2]  # noqa: E702
-        r3 = R[k, 3]; r4 = R[k, 4]; r5 = R[k, 5]  # noqa: E702
-        r6 = R[k, 6]; r7 = R[k, 7]; r8 = R[k, 8]  # noqa: E702
-        px = P[k, 0]; py = P[k, 1]; pz = P[k, 2]  # noqa: E702
-        # linear acceleration of the new origin, in parent frame: ω̇×P + ω×(ω×P) + v̇
-        tx = ay * pz - az * py + vx
-        ty = az * px - ax * pz + vy
-        tz = ax * py - ay * px + vz
-        if with_velocity:
-            cx = wy * pz - wz * py
-            cy = wz * px - wx * pz
-            cz = wx * py - wy * px
-            tx += wy * cz - wz * cy
-            ty += wz * cx - wx * cz
-            tz += wx * cy - wy * cx
-        # rotate into the child frame (transpose of ^{k}_{k+1}R)
-        nvx = r0 * tx + r3 * ty + r6 * tz
-        nvy = r1 * tx + r4 * ty + r7 * tz
-        nvz = r2 * tx + r5 * ty + r8 * tz
-        rwx = r0 * wx + r3 * wy + r6 * wz
-        rwy = r1 * wx + r4 * wy + r7 * wz
-        rwz = r2 * wx + r5 * wy + r8 * wz
-        rax = r0 * ax + r3 * ay + r6 * az
-        ray = r1 * ax + r4 * ay + r7 * az
-        raz = r2 * ax + r5 * ay + r8 * az
-        if jtype[k] == 0:
-            wx = rwx
-            wy = rwy
-            wz = rwz + qd[k]
-            ax = rax + rwy * qd[k]
-            ay = ray - rwx * qd[k]
-            az = raz + qdd[k]
-            vx = nvx
-            vy = nvy
-            vz = nvz
-        else:
-            wx = rwx
-            wy = rwy
-            wz = rwz
-            ax = rax
-            ay = ray
-            az = raz
-            # + 2 ω × (ḋ ẑ) + d̈ ẑ
-            vx = nvx + 2.0 * wy * qd[k]
-            vy = nvy - 2.0 * wx * qd[k]
-            vz = nvz + qdd[k]
+        wx, wy, wz, ax, ay, az, vx, vy, vz = outward_step(k, R, P, jtype, qd, qdd, wx, wy, wz, ax, ay, az,
+                                                          vx, vy, vz, with_velocity)
         # centre-of-mass acceleration and link wrench
         cxm = com[k, 0]; cym = com[k, 1]; czm = com[k, 2]  # noqa: E702
         bx = ay * czm - az * cym + vx

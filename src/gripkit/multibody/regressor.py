@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .kernels import chain_links, hot
+from .kernels import chain_links, hot, outward_step
 from .rnea import _states
 
 __all__ = ["regressor", "standard_parameters", "parameter_names", "PARAMETERS_PER_LINK",
@@ -49,42 +49,8 @@ def outward_kinematics(n, R, P, jtype, qd, qdd, gx, gy, gz, kin):  # pragma: no 
     vy = -gy
     vz = -gz
     for k in range(n):
-        px = P[k, 0]; py = P[k, 1]; pz = P[k, 2]  # noqa: E702
-        cx = wy * pz - wz * py
-        cy = wz * px - wx * pz
-        cz = wx * py - wy * px
-        tx = ay * pz - az * py + vx + wy * cz - wz * cy
-        ty = az * px - ax * pz + vy + wz * cx - wx * cz
-        tz = ax * py - ay * px + vz + wx * cy - wy * cx
-        r0 = R[k, 0]; r1 = R[k, 1]; r2 = R[k, 2]  # noqa: E702
-        r3 = R[k, 3]; r4 = R[k, 4]; r5 = R[k, 5]  # noqa: E702
-        r6 = R[k, 6]; r7 = R[k, 7]; r8 = R[k, 8]  # noqa: E702
-        vx = r0 * tx + r3 * ty + r6 * tz
-        vy = r1 * tx + r4 * ty + r7 * tz
-        vz = r2 * tx + r5 * ty + r8 * tz
-        rwx = r0 * wx + r3 * wy + r6 * wz
-        rwy = r1 * wx + r4 * wy + r7 * wz
-        rwz = r2 * wx + r5 * wy + r8 * wz
-        rax = r0 * ax + r3 * ay + r6 * az
-        ray = r1 * ax + r4 * ay + r7 * az
-        raz = r2 * ax + r5 * ay + r8 * az
-        if jtype[k] == 0:
-            wx = rwx
-            wy = rwy
-            wz = rwz + qd[k]
-            ax = rax + rwy * qd[k]
-            ay = ray - rwx * qd[k]
-            az = raz + qdd[k]
-        else:
-            wx = rwx
-            wy = rwy
-            wz = rwz
-            ax = rax
-            ay = ray
-            az = raz
-            vx += 2.0 * wy * qd[k]
-            vy -= 2.0 * wx * qd[k]
-            vz += qdd[k]
+        wx, wy, wz, ax, ay, az, vx, vy, vz = outward_step(k, R, P, jtype, qd, qdd, wx, wy, wz, ax, ay, az,
+                                                          vx, vy, vz, True)
         kin[k, 0] = wx
         kin[k, 1] = wy
         kin[k, 2] = wz
