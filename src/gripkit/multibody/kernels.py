@@ -143,14 +143,18 @@ def dh_table(alpha, a, d, offset) -> np.ndarray:
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+def rotation(R, k):  # pragma: no cover - compiled
+    """The nine entries of ^{k}_{k+1}R (row-major ``R[k]``) as scalars."""
+    return R[k, 0], R[k, 1], R[k, 2], R[k, 3], R[k, 4], R[k, 5], R[k, 6], R[k, 7], R[k, 8]
+
+
+@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
 def outward_step(k, R, P, jtype, qd, qdd, wx, wy, wz, ax, ay, az, vx, vy, vz,
                  with_velocity):  # pragma: no cover - compiled
     """One link of the outward Newton-Euler pass (eqs 4.8–4.10): ω, ω̇ and the origin's
     acceleration v̇ of link k+1 in its own frame from those (w, a, v) of link k. Inlined into its
     callers at numba IR level. ``with_velocity=False`` skips the velocity products."""
-    r0 = R[k, 0]; r1 = R[k, 1]; r2 = R[k, 2]  # noqa: E702
-    r3 = R[k, 3]; r4 = R[k, 4]; r5 = R[k, 5]  # noqa: E702
-    r6 = R[k, 6]; r7 = R[k, 7]; r8 = R[k, 8]  # noqa: E702
+    r0, r1, r2, r3, r4, r5, r6, r7, r8 = rotation(R, k)
     px = P[k, 0]; py = P[k, 1]; pz = P[k, 2]  # noqa: E702
     # linear acceleration of the new origin, in parent frame: ω̇×P + ω×(ω×P) + v̇
     tx = ay * pz - az * py + vx
@@ -187,16 +191,7 @@ def rnea_pass(n, R, P, jtype, mass, com, inertia, armature, qd, qdd, gx, gy, gz,
 
     ``with_velocity=False`` skips every velocity product (exact when qd = 0, e.g. gravity).
     ``work`` holds at least ``WORK_PER_LINK * n`` floats."""
-    # base: ω = ω̇ = 0, v̇ = −g
-    wx = 0.0
-    wy = 0.0
-    wz = 0.0
-    ax = 0.0
-    ay = 0.0
-    az = 0.0
-    vx = -gx
-    vy = -gy
-    vz = -gz
+    wx, wy, wz, ax, ay, az, vx, vy, vz = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -gx, -gy, -gz  # base: ω = ω̇ = 0, v̇ = −g
     for k in range(n):
         wx, wy, wz, ax, ay, az, vx, vy, vz = outward_step(k, R, P, jtype, qd, qdd, wx, wy, wz, ax, ay, az,
                                                           vx, vy, vz, with_velocity)
@@ -241,9 +236,7 @@ def rnea_pass(n, R, P, jtype, mass, com, inertia, armature, qd, qdd, gx, gy, gz,
     for k in range(n - 1, -1, -1):
         # rotate child's f, n into this frame: ^{k+1}_{k+2}R = R[k+1]
         if k < n - 1:
-            r0 = R[k + 1, 0]; r1 = R[k + 1, 1]; r2 = R[k + 1, 2]  # noqa: E702
-            r3 = R[k + 1, 3]; r4 = R[k + 1, 4]; r5 = R[k + 1, 5]  # noqa: E702
-            r6 = R[k + 1, 6]; r7 = R[k + 1, 7]; r8 = R[k + 1, 8]  # noqa: E702
+            r0, r1, r2, r3, r4, r5, r6, r7, r8 = rotation(R, k + 1)
             rfx = r0 * fx + r1 * fy + r2 * fz
             rfy = r3 * fx + r4 * fy + r5 * fz
             rfz = r6 * fx + r7 * fy + r8 * fz
@@ -324,9 +317,7 @@ def _composite_inertias(n, R, P, work):  # pragma: no cover - compiled
     for k in range(n - 1, 0, -1):
         o = 10 * k
         m = work[o]
-        r0 = R[k, 0]; r1 = R[k, 1]; r2 = R[k, 2]  # noqa: E702
-        r3 = R[k, 3]; r4 = R[k, 4]; r5 = R[k, 5]  # noqa: E702
-        r6 = R[k, 6]; r7 = R[k, 7]; r8 = R[k, 8]  # noqa: E702
+        r0, r1, r2, r3, r4, r5, r6, r7, r8 = rotation(R, k)
         hx0 = work[o + 1]; hy0 = work[o + 2]; hz0 = work[o + 3]  # noqa: E702
         hx = r0 * hx0 + r1 * hy0 + r2 * hz0
         hy = r3 * hx0 + r4 * hy0 + r5 * hz0
@@ -388,9 +379,7 @@ def _mass_matrix_columns(n, R, P, jtype, armature, M, work):  # pragma: no cover
             mz = 0.0
             M[k, k] = fz + armature[k]
         for i in range(k, 0, -1):
-            r0 = R[i, 0]; r1 = R[i, 1]; r2 = R[i, 2]  # noqa: E702
-            r3 = R[i, 3]; r4 = R[i, 4]; r5 = R[i, 5]  # noqa: E702
-            r6 = R[i, 6]; r7 = R[i, 7]; r8 = R[i, 8]  # noqa: E702
+            r0, r1, r2, r3, r4, r5, r6, r7, r8 = rotation(R, i)
             gx = r0 * fx + r1 * fy + r2 * fz
             gy = r3 * fx + r4 * fy + r5 * fz
             gz = r6 * fx + r7 * fy + r8 * fz

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .kernels import chain_links, hot, outward_step
+from .kernels import chain_links, hot, outward_step, rotation
 from .rnea import _states
 
 __all__ = ["regressor", "standard_parameters", "parameter_names", "PARAMETERS_PER_LINK",
@@ -39,15 +39,7 @@ LINK_PARAMETERS = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Iz
 def outward_kinematics(n, R, P, jtype, qd, qdd, gx, gy, gz, kin):  # pragma: no cover - compiled
     """ω, ω̇ and the origin's acceleration v̇ (gravity as −g) of every link in its own frame:
     ``kin[k] = (ω, ω̇, v̇)`` (9 floats), eqs 4.8–4.10."""
-    wx = 0.0
-    wy = 0.0
-    wz = 0.0
-    ax = 0.0
-    ay = 0.0
-    az = 0.0
-    vx = -gx
-    vy = -gy
-    vz = -gz
+    wx, wy, wz, ax, ay, az, vx, vy, vz = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -gx, -gy, -gz  # base: ω = ω̇ = 0, v̇ = −g
     for k in range(n):
         wx, wy, wz, ax, ay, az, vx, vy, vz = outward_step(k, R, P, jtype, qd, qdd, wx, wy, wz, ax, ay, az,
                                                           vx, vy, vz, True)
@@ -136,9 +128,7 @@ def regressor_state(n, m, R, P, jtype, G, qd, qdd, gx, gy, gz, kin, W, Yq, Y, b)
         for i in range(j, -1, -1):
             if i < j:
                 k = i + 1
-                r0 = R[k, 0]; r1 = R[k, 1]; r2 = R[k, 2]  # noqa: E702
-                r3 = R[k, 3]; r4 = R[k, 4]; r5 = R[k, 5]  # noqa: E702
-                r6 = R[k, 6]; r7 = R[k, 7]; r8 = R[k, 8]  # noqa: E702
+                r0, r1, r2, r3, r4, r5, r6, r7, r8 = rotation(R, k)
                 b0 = r0 * a0 + r1 * a3 + r2 * a6
                 b1 = r0 * a1 + r1 * a4 + r2 * a7
                 b2 = r0 * a2 + r1 * a5 + r2 * a8
