@@ -143,9 +143,32 @@ def dh_table(alpha, a, d, offset) -> np.ndarray:
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+def centripetal(wx, wy, wz, px, py, pz):  # pragma: no cover - compiled
+    """ω × (ω × p), the centripetal acceleration of a point p of a body turning at ω."""
+    cx = wy * pz - wz * py
+    cy = wz * px - wx * pz
+    cz = wx * py - wy * px
+    return wy * cz - wz * cy, wz * cx - wx * cz, wx * cy - wy * cx
+
+
+@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
 def rotation(R, k):  # pragma: no cover - compiled
     """The nine entries of ^{k}_{k+1}R (row-major ``R[k]``) as scalars."""
     return R[k, 0], R[k, 1], R[k, 2], R[k, 3], R[k, 4], R[k, 5], R[k, 6], R[k, 7], R[k, 8]
+
+
+@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+def rotate(R, k, x, y, z):  # pragma: no cover - compiled
+    """^{k}_{k+1}R (x, y, z): a vector of frame k+1 expressed in frame k."""
+    return (R[k, 0] * x + R[k, 1] * y + R[k, 2] * z, R[k, 3] * x + R[k, 4] * y + R[k, 5] * z,
+            R[k, 6] * x + R[k, 7] * y + R[k, 8] * z)
+
+
+@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+def rotate_back(R, k, x, y, z):  # pragma: no cover - compiled
+    """(^{k}_{k+1}R)ᵀ (x, y, z): a vector of frame k expressed in frame k+1."""
+    return (R[k, 0] * x + R[k, 3] * y + R[k, 6] * z, R[k, 1] * x + R[k, 4] * y + R[k, 7] * z,
+            R[k, 2] * x + R[k, 5] * y + R[k, 8] * z)
 
 
 @numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
@@ -154,29 +177,20 @@ def outward_step(k, R, P, jtype, qd, qdd, wx, wy, wz, ax, ay, az, vx, vy, vz,
     """One link of the outward Newton-Euler pass (eqs 4.8–4.10): ω, ω̇ and the origin's
     acceleration v̇ of link k+1 in its own frame from those (w, a, v) of link k. Inlined into its
     callers at numba IR level. ``with_velocity=False`` skips the velocity products."""
-    r0, r1, r2, r3, r4, r5, r6, r7, r8 = rotation(R, k)
     px = P[k, 0]; py = P[k, 1]; pz = P[k, 2]  # noqa: E702
     # linear acceleration of the new origin, in parent frame: ω̇×P + ω×(ω×P) + v̇
     tx = ay * pz - az * py + vx
     ty = az * px - ax * pz + vy
     tz = ax * py - ay * px + vz
     if with_velocity:
-        cx = wy * pz - wz * py
-        cy = wz * px - wx * pz
-        cz = wx * py - wy * px
-        tx += wy * cz - wz * cy
-        ty += wz * cx - wx * cz
-        tz += wx * cy - wy * cx
+        cx, cy, cz = centripetal(wx, wy, wz, px, py, pz)
+        tx += cx
+        ty += cy
+        tz += cz
     # rotate into the child frame (transpose of ^{k}_{k+1}R)
-    nvx = r0 * tx + r3 * ty + r6 * tz
-    nvy = r1 * tx + r4 * ty + r7 * tz
-    nvz = r2 * tx + r5 * ty + r8 * tz
-    rwx = r0 * wx + r3 * wy + r6 * wz
-    rwy = r1 * wx + r4 * wy + r7 * wz
-    rwz = r2 * wx + r5 * wy + r8 * wz
-    rax = r0 * ax + r3 * ay + r6 * az
-    ray = r1 * ax + r4 * ay + r7 * az
-    raz = r2 * ax + r5 * ay + r8 * az
+    nvx, nvy, nvz = rotate_back(R, k, tx, ty, tz)
+    rwx, rwy, rwz = rotate_back(R, k, wx, wy, wz)
+    rax, ray, raz = rotate_back(R, k, ax, ay, az)
     if jtype[k] == 0:
         return (rwx, rwy, rwz + qd[k], rax + rwy * qd[k], ray - rwx * qd[k], raz + qdd[k], nvx, nvy,
                 nvz)
@@ -206,12 +220,10 @@ def rnea_pass(n, R, P, jtype, mass, com, inertia, armature, qd, qdd, gx, gy, gz,
         ny = ixy * ax + iyy * ay + iyz * az
         nz = ixz * ax + iyz * ay + izz * az
         if with_velocity:
-            dx = wy * czm - wz * cym
-            dy = wz * cxm - wx * czm
-            dz = wx * cym - wy * cxm
-            bx += wy * dz - wz * dy
-            by += wz * dx - wx * dz
-            bz += wx * dy - wy * dx
+            dx, dy, dz = centripetal(wx, wy, wz, cxm, cym, czm)
+            bx += dx
+            by += dy
+            bz += dz
             lx = ixx * wx + ixy * wy + ixz * wz
             ly = ixy * wx + iyy * wy + iyz * wz
             lz = ixz * wx + iyz * wy + izz * wz
@@ -236,13 +248,8 @@ def rnea_pass(n, R, P, jtype, mass, com, inertia, armature, qd, qdd, gx, gy, gz,
     for k in range(n - 1, -1, -1):
         # rotate child's f, n into this frame: ^{k+1}_{k+2}R = R[k+1]
         if k < n - 1:
-            r0, r1, r2, r3, r4, r5, r6, r7, r8 = rotation(R, k + 1)
-            rfx = r0 * fx + r1 * fy + r2 * fz
-            rfy = r3 * fx + r4 * fy + r5 * fz
-            rfz = r6 * fx + r7 * fy + r8 * fz
-            rmx = r0 * mx + r1 * my + r2 * mz
-            rmy = r3 * mx + r4 * my + r5 * mz
-            rmz = r6 * mx + r7 * my + r8 * mz
+            rfx, rfy, rfz = rotate(R, k + 1, fx, fy, fz)
+            rmx, rmy, rmz = rotate(R, k + 1, mx, my, mz)
             px = P[k + 1, 0]; py = P[k + 1, 1]; pz = P[k + 1, 2]  # noqa: E702
             # P × (R f)
             rmx += py * rfz - pz * rfy
@@ -379,14 +386,12 @@ def _mass_matrix_columns(n, R, P, jtype, armature, M, work):  # pragma: no cover
             mz = 0.0
             M[k, k] = fz + armature[k]
         for i in range(k, 0, -1):
-            r0, r1, r2, r3, r4, r5, r6, r7, r8 = rotation(R, i)
-            gx = r0 * fx + r1 * fy + r2 * fz
-            gy = r3 * fx + r4 * fy + r5 * fz
-            gz = r6 * fx + r7 * fy + r8 * fz
+            gx, gy, gz = rotate(R, i, fx, fy, fz)
+            nx, ny, nz = rotate(R, i, mx, my, mz)
             px = P[i, 0]; py = P[i, 1]; pz = P[i, 2]  # noqa: E702
-            nx = r0 * mx + r1 * my + r2 * mz + py * gz - pz * gy
-            ny = r3 * mx + r4 * my + r5 * mz + pz * gx - px * gz
-            nz = r6 * mx + r7 * my + r8 * mz + px * gy - py * gx
+            nx += py * gz - pz * gy
+            ny += pz * gx - px * gz
+            nz += px * gy - py * gx
             fx = gx
             fy = gy
             fz = gz

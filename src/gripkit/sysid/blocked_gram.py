@@ -1,14 +1,15 @@
-"""Two numba steps shared by the kernels that accumulate normal equations without forming their
+"""Numba steps shared by the kernels that accumulate normal equations without forming their
 regressor (:func:`gripkit.sysid.subspace._bdx_normal_equations`,
-:func:`gripkit.sysid.pem_ss._sensitivity_gram`): a row of a small matrix product over contiguous
-columns, and a block of collected rows added to ΦᵀΦ and Φᵀy by BLAS."""
+:func:`gripkit.sysid.pem_ss._sensitivity_gram`): the state matrix their responses are carried in,
+a row of a small matrix product over contiguous columns, and a block of collected rows added to
+ΦᵀΦ and Φᵀy by BLAS."""
 
 from __future__ import annotations
 
 import numba
 import numpy as np
 
-__all__ = ["add_rows", "row_product"]
+__all__ = ["add_rows", "row_product", "carried_states"]
 
 
 @numba.njit(cache=True, inline="always")
@@ -30,3 +31,14 @@ def add_rows(rows, rhs, fill, G, g):  # pragma: no cover - compiled
     blk = rows[:fill]
     G += np.dot(blk.T, blk)
     g += np.dot(blk.T, rhs[:fill])
+
+
+@numba.njit(cache=True)
+def carried_states(n, cols, first_x0, n_x0):  # pragma: no cover - compiled
+    """The n × cols matrix whose columns carry responses through the state recursion, zero but
+    for the ``n_x0`` initial-state directions e_i in columns ``first_x0 …``, and its next-step
+    buffer."""
+    S = np.zeros((n, cols))
+    for i in range(n_x0):
+        S[i, first_x0 + i] = 1.0
+    return S, np.empty((n, cols))

@@ -36,7 +36,7 @@ import scipy.linalg as sla
 
 from ..errors import DataError, IdentificationError
 from ..lti import StateSpace, Uncertainty, affine_row
-from .blocked_gram import add_rows, row_product
+from .blocked_gram import add_rows, carried_states, row_product
 from .linear_model import LinearModel, as_io_matrix, fit_per_output, free_run
 
 __all__ = ["pem", "PEM_FORMS"]
@@ -115,10 +115,7 @@ def _sensitivity_gram(Abar, C, K, entries, n_x0, X, U, E, H, g):  # pragma: no c
     p = C.shape[0]
     d = entries.shape[0]
     Q = d + n_x0
-    S = np.zeros((n, Q))
-    Sn = np.empty((n, Q))
-    for i in range(n_x0):
-        S[i, d + i] = 1.0
+    S, Sn = carried_states(n, Q, d, n_x0)
     rows = np.empty((_GRAM_BLOCK * p, Q))
     eb = np.empty(_GRAM_BLOCK * p)
     H[:, :] = 0.0
