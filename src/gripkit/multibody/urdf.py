@@ -103,6 +103,14 @@ def matrix_rpy(R) -> tuple[float, float, float]:
     return (0.0, pitch, math.atan2(-R[0, 1], R[1, 1]))
 
 
+def _child(el, tag: str, where: str):
+    """The child element ``<tag>`` of ``el``, or a ModelError saying it is missing."""
+    child = el.find(tag)
+    if child is None:
+        raise ModelError(f"{where}: <{tag}> is missing")
+    return child
+
+
 def _origin(el, where: str) -> np.ndarray:
     T = np.eye(4)
     o = el.find("origin") if el is not None else None
@@ -117,13 +125,8 @@ def _inertial(link, where: str):
     el = link.find("inertial")
     if el is None:
         return None
-    m_el = el.find("mass")
-    if m_el is None:
-        raise ModelError(f"{where} <inertial>: <mass> is missing")
-    mass = _number(m_el, "value", f"{where} <mass>")
-    i_el = el.find("inertia")
-    if i_el is None:
-        raise ModelError(f"{where} <inertial>: <inertia> is missing")
+    mass = _number(_child(el, "mass", f"{where} <inertial>"), "value", f"{where} <mass>")
+    i_el = _child(el, "inertia", f"{where} <inertial>")
     v = {a: _number(i_el, a, f"{where} <inertia>", default=0.0) for a in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
     Ic = np.array([[v["ixx"], v["ixy"], v["ixz"]], [v["ixy"], v["iyy"], v["iyz"]], [v["ixz"], v["iyz"], v["izz"]]])
     T = _origin(el, f"{where} <inertial>")
@@ -153,27 +156,29 @@ def _transform_inertial(T, data):
     return m, R @ c + T[:3, 3], R @ I @ R.T
 
 
+def _named(robot, tag: str, seen: dict):
+    """(name, element) of each ``<tag>`` of ``robot``; its name must be present and not yet in
+    ``seen`` (which the caller fills as it goes)."""
+    for el in robot.findall(tag):
+        name = el.get("name")
+        if not name:
+            raise ModelError(f"<{tag}> without a name attribute")
+        if name in seen:
+            raise ModelError(f"{tag} {name!r} is defined twice")
+        yield name, el
+
+
 class _Tree:
     def __init__(self, robot):
         self.links = {}
-        for el in robot.findall("link"):
-            name = el.get("name")
-            if not name:
-                raise ModelError("<link> without a name attribute")
-            if name in self.links:
-                raise ModelError(f"link {name!r} is defined twice")
+        for name, el in _named(robot, "link", self.links):
             self.links[name] = el
         if not self.links:
             raise ModelError("the URDF has no <link>")
         self.joints = {}
         self.parent = {}      # child link -> joint name
         self.children = {name: [] for name in self.links}
-        for el in robot.findall("joint"):
-            name = el.get("name")
-            if not name:
-                raise ModelError("<joint> without a name attribute")
-            if name in self.joints:
-                raise ModelError(f"joint {name!r} is defined twice")
+        for name, el in _named(robot, "joint", self.joints):
             jtype = el.get("type")
             p_el, c_el = el.find("parent"), el.find("child")
             if p_el is None or c_el is None:
