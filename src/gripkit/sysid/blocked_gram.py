@@ -9,7 +9,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-__all__ = ["add_rows", "row_product", "carried_states"]
+__all__ = ["add_rows", "row_product", "carried_states", "start_sums"]
 
 
 @numba.njit(cache=True, inline="always")
@@ -42,3 +42,12 @@ def carried_states(n, cols, first_x0, n_x0):  # pragma: no cover - compiled
     for i in range(n_x0):
         S[i, first_x0 + i] = 1.0
     return S, np.empty((n, cols))
+
+
+@numba.njit(cache=True)
+def start_sums(n_rows, cols, G, g):  # pragma: no cover - compiled
+    """Clear the sums ΦᵀΦ (G) and Φᵀy (g); return an empty block of ``n_rows`` collected rows of
+    Φ and their right-hand sides, for :func:`add_rows`."""
+    G[:, :] = 0.0
+    g[:] = 0.0
+    return np.zeros((n_rows, cols)), np.empty(n_rows)

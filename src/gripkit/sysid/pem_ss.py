@@ -36,7 +36,7 @@ import scipy.linalg as sla
 
 from ..errors import DataError, IdentificationError
 from ..lti import StateSpace, Uncertainty, affine_row
-from .blocked_gram import add_rows, carried_states, row_product
+from .blocked_gram import add_rows, carried_states, row_product, start_sums
 from .linear_model import LinearModel, as_io_matrix, fit_per_output, free_run
 
 __all__ = ["pem", "PEM_FORMS"]
@@ -116,10 +116,7 @@ def _sensitivity_gram(Abar, C, K, entries, n_x0, X, U, E, H, g):  # pragma: no c
     d = entries.shape[0]
     Q = d + n_x0
     S, Sn = carried_states(n, Q, d, n_x0)
-    rows = np.empty((_GRAM_BLOCK * p, Q))
-    eb = np.empty(_GRAM_BLOCK * p)
-    H[:, :] = 0.0
-    g[:] = 0.0
+    rows, eb = start_sums(_GRAM_BLOCK * p, Q, H, g)
     fill = 0
     for t in range(X.shape[0]):
         for i in range(p):

@@ -42,7 +42,7 @@ import scipy.linalg as sla
 
 from ..errors import DataError, IdentificationError, StabilityWarning
 from ..lti import StateSpace
-from .blocked_gram import add_rows, carried_states, row_product
+from .blocked_gram import add_rows, carried_states, row_product, start_sums
 from .checks import check_dt
 from .linear_model import LinearModel, as_io_matrix, fit_per_output, free_run, observability_regressor
 from .regression import _qr_r
@@ -225,10 +225,7 @@ def _bdx_normal_equations(A, C, u, y, feedthrough, G, r):  # pragma: no cover - 
     ns = nb + n  # state-carried columns: B's, then x0's
     cols = nb + nd + n
     X, Xn = carried_states(n, ns, nb, n)
-    rows = np.zeros((_BDX_BLOCK * p, cols))
-    yb = np.empty(_BDX_BLOCK * p)
-    G[:, :] = 0.0
-    r[:] = 0.0
+    rows, yb = start_sums(_BDX_BLOCK * p, cols, G, r)
     fill = 0
     CX = np.empty(ns)
     for t in range(N):
