@@ -71,16 +71,13 @@ def pvdf_parameters(*, gain: float = 2.0e3, tau: float = 0.01) -> ParameterSet:
 
 @numba.njit(cache=True, parallel=True)
 def _pvdf_batch(thetas, u, dt, x0, y):  # pragma: no cover - compiled
-    P = thetas.shape[0]
-    N = u.shape[0]
-    for p in prange(P):
-        g = thetas[p, 0]
-        a = math.exp(-dt / thetas[p, 1])
-        v = x0[p, 0]
-        dprev = x0[p, 1]
+    """Film voltages y[p, n, 0] for parameter rows (g, τ) from states x0[p] = (v, previous d)."""
+    for p in prange(thetas.shape[0]):
+        g, a = thetas[p, 0], math.exp(-dt / thetas[p, 1])
+        v, dprev = x0[p, 0], x0[p, 1]
         if math.isnan(dprev):
             dprev = u[0, 0]
-        for n in range(N):
+        for n in range(u.shape[0]):
             v = a * v + g * (u[n, 0] - dprev)
             dprev = u[n, 0]
             y[p, n, 0] = v
