@@ -20,6 +20,8 @@ compiles to PTX (:func:`compile_ptx`).
 
 from __future__ import annotations
 
+from collections import namedtuple
+
 import numpy as np
 from numba import cuda
 
@@ -40,19 +42,30 @@ def cuda_available() -> bool:
         return False
 
 
-def _kernel_py(bw, Phi, Gam, C, D, G, Hg, target, ng, K, parts, noise, nstd, seeds, n_steps, ebw, ePhi, eGam, ecy,
-               cps, mset, det, buf, est, cs, X, modes, hyst, ps, ext, out, ua, xt, ev_frac, ev_to, yout, rng,
-               met):  # pragma: no cover - runs on the device
-    """Thread p runs job p; every array with a leading job index is that job's slice. (A CUDA
-    kernel takes arrays; the records :func:`_grasp_core` takes are built here, on the device.)"""
+#: what every job of a launch shares: the gripper's Bouc-Wen parameters, switching guards, contact
+#: targets, guard count and event levels K, the samples per grasp and the metric settings
+DeviceShared = namedtuple("DeviceShared", "bw G target ng K n_steps mset")
+#: the jobs' arrays, leading index: job (contact-mode matrices, parts, noise, noise levels, seeds,
+#: controller settings)
+DeviceJobs = namedtuple("DeviceJobs", "Phi Gam C D Hg parts noise nstd seeds cps")
+#: every job's work arrays on the device, leading index: job (the fields of GraspLoop,
+#: GripperState and GripperWork, and the random-number state), allocated by :func:`run_cuda`
+DeviceWork = namedtuple("DeviceWork", "det buf est cs X modes hyst ps ext out ua xt ev_frac ev_to yout rng")
+
+
+def _kernel_py(shared, estimators, jobs, work, met):  # pragma: no cover - runs on the device
+    """Thread p runs job p on its slice of every job-indexed array, into ``met[p]``; the records
+    :func:`_grasp_core` takes are built here, on the device, from those slices."""
     p = cuda.grid(1)
-    if p < parts.shape[0]:
-        q = p if noise.shape[0] > 1 else 0
-        _grasp_core(GripperModel(bw, Phi[p], Gam[p], C[p], D[p], G, Hg[p], target, ng, K, parts[p]), noise[q],
-                    nstd[p], seeds[p], n_steps, Estimators(ebw, ePhi, eGam, ecy), cps[p], mset,
-                    GraspLoop(det[p], buf[p], est[p], cs[p], ext[p], out[p]),
-                    GripperState(X[p], modes[p], hyst[p], ps[p]),
-                    GripperWork(ua[p], xt[p], ev_frac[p], ev_to[p], yout[p]), rng[p], met[p])
+    if p < jobs.parts.shape[0]:
+        q = p if jobs.noise.shape[0] > 1 else 0
+        w = work
+        _grasp_core(GripperModel(shared.bw, jobs.Phi[p], jobs.Gam[p], jobs.C[p], jobs.D[p], shared.G, jobs.Hg[p],
+                                 shared.target, shared.ng, shared.K, jobs.parts[p]),
+                    jobs.noise[q], jobs.nstd[p], jobs.seeds[p], shared.n_steps, estimators, jobs.cps[p], shared.mset,
+                    GraspLoop(w.det[p], w.buf[p], w.est[p], w.cs[p], w.ext[p], w.out[p]),
+                    GripperState(w.X[p], w.modes[p], w.hyst[p], w.ps[p]),
+                    GripperWork(w.ua[p], w.xt[p], w.ev_frac[p], w.ev_to[p], w.yout[p]), w.rng[p], met[p])
 
 
 _KERNEL = []
@@ -87,19 +100,19 @@ def run_cuda(tpl, parts, nz, nstd, seeds, n_steps, window, cps, mset, met, batch
         m = b - a
         Phi, Gam, C, D, Hg = _host_arrays(tpl, np.ascontiguousarray(parts[a:b]))
         d = cuda.to_device
-        work = [cuda.device_array(s, dtype=dt) for s, dt in (
+        work = DeviceWork(*(cuda.device_array(s, dtype=dt) for s, dt in (
             ((m, 2, 5), np.float64), ((m, 2, window), np.float64), ((m, 2, 6), np.float64), ((m, 2, 7), np.float64),
             ((m, 2, n), np.float64), ((m, 2), np.int64), ((m, 4), np.float64), ((m, 1), np.float64),
             ((m, 4), np.float64), ((m, 2, 5), np.float64), ((m, 3), np.float64), ((m, n), np.float64),
             ((m, MAX_EVENTS_PER_STEP), np.float64), ((m, MAX_EVENTS_PER_STEP), np.int64),
-            ((m, 2, tpl.C.shape[2]), np.float64), ((m, 1), np.uint64))]
+            ((m, 2, tpl.C.shape[2]), np.float64), ((m, 1), np.uint64))))
         out = cuda.device_array((m, met.shape[1]), dtype=np.float64)
         noise = nz if nz.shape[0] == 1 else nz[a:b]
         blocks = (m + threads_per_block - 1) // threads_per_block
-        kern[blocks, threads_per_block](
-            d(tpl.bw), d(Phi), d(Gam), d(C), d(D), d(tpl.G), d(Hg), d(tpl.target), d(tpl.ng), tpl.K,
-            d(np.ascontiguousarray(parts[a:b])), d(np.ascontiguousarray(noise)), d(nstd[a:b]), d(seeds[a:b]), n_steps,
-            *(d(e) for e in tpl.est), d(np.ascontiguousarray(cps[a:b])), d(mset), *work, out)
+        shared = DeviceShared(d(tpl.bw), d(tpl.G), d(tpl.target), d(tpl.ng), tpl.K, n_steps, d(mset))
+        jobs = DeviceJobs(d(Phi), d(Gam), d(C), d(D), d(Hg), d(np.ascontiguousarray(parts[a:b])),
+                          d(np.ascontiguousarray(noise)), d(nstd[a:b]), d(seeds[a:b]), d(np.ascontiguousarray(cps[a:b])))
+        kern[blocks, threads_per_block](shared, Estimators(*(d(e) for e in tpl.est)), jobs, work, out)
         met[a:b] = out.copy_to_host()
 
 
@@ -118,10 +131,15 @@ def compile_ptx(cc: tuple[int, int] = (8, 0)) -> str:
     def arr(nd, dtype=f8):
         return dtype[(slice(None),) * (nd - 1) + (slice(None, None, 1),)]
 
-    args = (typeof(tpl.bw), arr(6), arr(6), arr(5), arr(5), typeof(tpl.G), arr(5), typeof(tpl.target),
-            typeof(tpl.ng), i8, arr(2), arr(3), arr(1), arr(1, i8), i8, *(typeof(e) for e in tpl.est), arr(2), arr(1),
-            arr(3), arr(3), arr(3), arr(3), arr(3), arr(2, i8), arr(2), arr(2), arr(2), arr(3), arr(2), arr(2), arr(2),
-            arr(2, i8), arr(3), arr(2, numba.uint64), arr(2))
+    def record(cls, *types):
+        return numba.types.NamedTuple(types, cls)
+
+    args = (record(DeviceShared, typeof(tpl.bw), typeof(tpl.G), typeof(tpl.target), typeof(tpl.ng), i8, i8, arr(1)),
+            record(Estimators, *(typeof(e) for e in tpl.est)),
+            record(DeviceJobs, arr(6), arr(6), arr(5), arr(5), arr(5), arr(2), arr(3), arr(1), arr(1, i8), arr(2)),
+            record(DeviceWork, arr(3), arr(3), arr(3), arr(3), arr(3), arr(2, i8), arr(2), arr(2), arr(2), arr(3),
+                   arr(2), arr(2), arr(2), arr(2, i8), arr(3), arr(2, numba.uint64)),
+            arr(2))
 
     class _Device:
         compute_capability = cc
