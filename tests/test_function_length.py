@@ -1,5 +1,7 @@
 """No function in src/gripkit is longer than 100 lines (issue 12, "Inside the rooms": a long
-function is split into named steps, one concept each, with a docstring; docs/DEVELOPING.md).
+function is split into named steps, one concept each, with a docstring; docs/DEVELOPING.md), and
+no compiled kernel takes more than KERNEL_ARGUMENTS arguments (they take named records instead:
+docs/ARCHITECTURE.md, "Kernels take named records").
 
 A function's length is ``end_lineno − lineno + 1`` of its ``def`` as ``ast`` reports it: the
 signature, the docstring and the body, not the decorators. Every function counts: module
@@ -12,21 +14,21 @@ from pathlib import Path
 
 SRC = Path(__file__).resolve().parents[1] / "src" / "gripkit"
 LIMIT = 100
+#: the most arguments a compiled kernel takes (coupled_mass_bias: a chain's arrays, the state,
+#: gravity's three components and its scratch); the DLR/HIT ``_forces`` took 46, the batched
+#: multibody simulation 41, the TSFM CUDA kernel 38 before they took records
+KERNEL_ARGUMENTS = 21
 
 #: Scalar numba kernels whose split would cost speed: (path under src/gripkit, name) → the
-#: measurement that says so. Others were split at no cost: systems/amadeus/pvdf.py
-#: ``contact_step`` (119 lines) into per-substep helpers that numba's LLVM inlines (min of 40 runs
-#: of 2000 samples × 20 substeps: 2216 → 2221 µs for the grasp, 2063 → 2058 µs for the testbed);
-#: the TSFM ``_grasp_core`` and the DLR/HIT finger's ``_forces`` into pieces inlined at numba IR
-#: level (docs/performance.md, "Named records in kernels"); outputs bit-identical. An entry here
-#: must be a numba kernel, and its reason must give the measured slowdown of the split.
-NUMBA_KERNELS: dict[tuple[str, str], str] = {
-    ("multibody/kernels.py", "rnea_pass"): (
-        "the outward pass as a helper returning the 9 link velocities/accelerations (a tuple, with or "
-        "without numba IR inlining) made the batched RNEA of the DLR/HIT finger 10-20 % slower: "
-        "alternating runs, 20 000 states, min of 9, e.g. 451-646 ns against 395-534 ns per state "
-        "(2026-11-23, shared 2-core machine); crba, split into three loops, was not slower"),
-}
+#: measurement that says so. None is left: systems/amadeus/pvdf.py ``contact_step`` (119 lines)
+#: was split into per-substep helpers that numba's LLVM inlines (min of 40 runs of 2000 samples ×
+#: 20 substeps: 2216 → 2221 µs for the grasp, 2063 → 2058 µs for the testbed); the TSFM
+#: ``_grasp_core``, the DLR/HIT finger's ``_forces`` and ``multibody/kernels.py rnea_pass`` (its
+#: outward step shared with the regressor) into pieces inlined at numba IR level
+#: (docs/performance.md, "Named records in kernels"); outputs bit-identical. An entry here must be
+#: a numba kernel, and its reason must give the measured slowdown of the split.
+NUMBA_KERNELS: dict[tuple[str, str], str] = {}
+
 
 def function_lengths(source: str) -> dict[str, tuple[int, int, ast.AST]]:
     """``{qualified name: (length, first line, node)}`` of every function in ``source``."""
@@ -64,8 +66,13 @@ def _all_lengths():
         aliases = _numba_decorators(ast.parse(source))
         rel = path.relative_to(SRC).as_posix()
         for name, (length, line, node) in function_lengths(source).items():
-            out[(rel, name)] = (length, line, is_numba_kernel(node, aliases))
+            out[(rel, name)] = (length, line, is_numba_kernel(node, aliases), _n_arguments(node))
     return out
+
+
+def _n_arguments(node) -> int:
+    a = node.args
+    return len(a.posonlyargs) + len(a.args) + len(a.kwonlyargs)
 
 
 LENGTHS = _all_lengths()
@@ -74,13 +81,22 @@ LENGTHS = _all_lengths()
 def test_no_function_is_longer_than_100_lines():
     allowed = set(NUMBA_KERNELS)
     too_long = sorted((length, f"src/gripkit/{rel}:{line} {name}")
-                      for (rel, name), (length, line, _) in LENGTHS.items()
+                      for (rel, name), (length, line, _, _) in LENGTHS.items()
                       if length > LIMIT and (rel, name) not in allowed)
     assert not too_long, (
         f"{len(too_long)} function(s) longer than {LIMIT} lines: "
         + "; ".join(f"{where} ({length} lines)" for length, where in too_long[::-1])
         + ". Split each into named steps with docstrings (docs/DEVELOPING.md); a scalar numba kernel whose "
           "split measurably costs speed goes into NUMBA_KERNELS with that measurement.")
+
+
+def test_no_compiled_kernel_takes_more_than_21_arguments():
+    crowded = sorted((n, f"src/gripkit/{rel}:{line} {name}")
+                     for (rel, name), (_, line, kernel, n) in LENGTHS.items() if kernel and n > KERNEL_ARGUMENTS)
+    assert not crowded, (
+        f"{len(crowded)} compiled kernel(s) with more than {KERNEL_ARGUMENTS} arguments: "
+        + "; ".join(f"{where} ({n})" for n, where in crowded[::-1])
+        + ". Group the arrays into named records (namedtuples), as docs/ARCHITECTURE.md describes.")
 
 
 def test_allow_list_entries_are_still_needed():
@@ -128,3 +144,4 @@ def test_the_measure():
     assert not is_numba_kernel(lengths["Model.method"][2], _numba_decorators(tree))
     shorter = source.replace("    x97 = 97\n", "")
     assert function_lengths(shorter)["long_kernel"][0] == LIMIT
+    assert _n_arguments(ast.parse("def f(a, /, b, *args, c, **kw): pass").body[0]) == 3

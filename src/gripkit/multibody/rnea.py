@@ -54,7 +54,6 @@ def dynamics_work(n, m):  # pragma: no cover - compiled
                         np.empty((m, m)), np.empty(m), np.empty((m, m)), np.empty(m), np.empty(m))
 
 
-
 @hot
 def _accel(n, m, ch, p, pd, tau_p, a, w):  # pragma: no cover - compiled
     """Accelerations ``a`` = M_p⁻¹(τ_p − h_p) at (p, ṗ) for the chain ``ch`` (:data:`ChainArrays`);

@@ -129,17 +129,6 @@ def first_crossed_guard(G, H, n_guards, mode, x, u):  # pragma: no cover - compi
 
 
 @numba.njit(cache=True, inline="always")
-def _zoh_three_inputs(Phi, Gam, mode, j, x, u, xt, n):  # pragma: no cover - compiled
-    """xt = Φ[mode, j] x + Γ[mode, j] u for n states and 3 inputs; inlined with a constant n, so
-    that LLVM unrolls both loops."""
-    for i in range(n):
-        acc = Gam[mode, j, i, 0] * u[0] + Gam[mode, j, i, 1] * u[1] + Gam[mode, j, i, 2] * u[2]
-        for k in range(n):
-            acc += Phi[mode, j, i, k] * x[k]
-        xt[i] = acc
-
-
-@numba.njit(cache=True, inline="always")
 def pwa_step(x, mode, u, Phi, Gam, G, H, target, n_guards, K, xt, ev_frac, ev_to):  # pragma: no cover
     """Advance ``x`` (n,) in place over one sample step with the held input ``u`` (m+1,, last
     entry 1). Returns (new mode, number of events); event i happened at fraction ``ev_frac[i]``
@@ -167,9 +156,17 @@ def pwa_step(x, mode, u, Phi, Gam, G, H, target, n_guards, K, xt, ev_frac, ev_to
                 j += 1
         while True:
             if kind == 1:
-                _zoh_three_inputs(Phi, Gam, mode, j, x, u, xt, 4)
+                for i in range(4):
+                    acc = Gam[mode, j, i, 0] * u[0] + Gam[mode, j, i, 1] * u[1] + Gam[mode, j, i, 2] * u[2]
+                    for k in range(4):
+                        acc += Phi[mode, j, i, k] * x[k]
+                    xt[i] = acc
             elif kind == 2:
-                _zoh_three_inputs(Phi, Gam, mode, j, x, u, xt, 6)
+                for i in range(6):
+                    acc = Gam[mode, j, i, 0] * u[0] + Gam[mode, j, i, 1] * u[1] + Gam[mode, j, i, 2] * u[2]
+                    for k in range(6):
+                        acc += Phi[mode, j, i, k] * x[k]
+                    xt[i] = acc
             else:
                 for i in range(n):
                     acc = 0.0

@@ -97,10 +97,11 @@ NX = 15
 
 # Named records of arrays the kernels take (namedtuples: numba resolves each field at compile
 # time, and without NRT taking an array out of one costs nothing; docs/performance.md).
-#: one finger's constant arrays (:func:`finger_setup`): DH table, joint types, link masses,
-#: centres of mass, inertias, joint armatures, coupling Γ (4×3 row-major), joint offsets,
-#: actuator armatures I_m·N², gravity, reductions N
-FingerChain = namedtuple("FingerChain", "dh jt mass com inertia armq G q0 arm_p grav ratio")
+#: one finger's constant arrays (:func:`finger_setup`): the fields of
+#: :data:`gripkit.multibody.kernels.ChainArrays` (DH table, joint types, link masses, centres of
+#: mass, inertias, joint armatures, coupling Γ (4×3 row-major), joint offsets, actuator armatures
+#: I_m·N², gravity) and the reductions N
+FingerChain = namedtuple("FingerChain", "links jtype mass com inertia arm_q G q0 arm_p g ratio")
 #: scratch of the chain: link rotations and positions, RNEA/CRBA work, joint angles and rates,
 #: zeros, joint-space mass matrix and torques
 ChainWork = namedtuple("ChainWork", "R P work q qd zq Mq tau")
@@ -136,8 +137,8 @@ FrictionEstimator = namedtuple("FrictionEstimator", "cfg inertia theta P filt si
 def finger_setup(th, fc):  # pragma: no cover - compiled
     """Fill the chain, coupling and drive arrays of one finger (:data:`FingerChain`) from its
     parameter vector."""
-    dh, mass, com, inertia, G, arm_p, grav, ratio = (fc.dh, fc.mass, fc.com, fc.inertia, fc.G,
-                                                     fc.arm_p, fc.grav, fc.ratio)
+    dh, mass, com, inertia, G, arm_p, grav, ratio = (fc.links, fc.mass, fc.com, fc.inertia, fc.G,
+                                                     fc.arm_p, fc.g, fc.ratio)
     for k in range(4):
         for j in range(4):
             dh[k, j] = 0.0
@@ -323,9 +324,9 @@ def _forces(th, n_stuck_iter, mode, thermal, fc, tab, p, pd, T, z, stuck, pwm, e
     Mp, hp, rhs, rs = sw.Mp, sw.hp, sw.rhs, sw.rs
     joints_from_actuators(4, m, G, fc.q0, p, q)
     joints_from_actuators(4, m, G, zq, pd, qd)
-    chain_links(4, fc.dh, fc.jt, q, cw.R, cw.P)
-    coupled_mass_bias(4, m, cw.R, cw.P, fc.jt, fc.mass, fc.com, fc.inertia, fc.armq, G, fc.arm_p, qd,
-                      fc.grav[0], fc.grav[1], fc.grav[2], Mp, hp, zq, cw.Mq, cw.tau, cw.work)
+    chain_links(4, fc.links, fc.jtype, q, cw.R, cw.P)
+    coupled_mass_bias(4, m, cw.R, cw.P, fc.jtype, fc.mass, fc.com, fc.inertia, fc.arm_q, G, fc.arm_p, qd,
+                      fc.g[0], fc.g[1], fc.g[2], Mp, hp, zq, cw.Mq, cw.tau, cw.work)
     taum, fric = out.taum, out.fric
     _drive_torques(th, thermal, fc.ratio, T, pwm, pd, taum, out.tshaft)
     # applied torque on each actuator (before friction): motor + end stops + external − bias
@@ -488,8 +489,8 @@ def finger_outputs(G, q0, x, taum, fric, y, yrow, ycol):  # pragma: no cover - c
 def _tip(fc, th, q, R, P, T, J, Jp, tip):  # pragma: no cover - compiled
     """Fingertip position ``tip`` (3, finger base frame) and actuator-space linear Jacobian
     ``Jp`` (3×3) at the joint angles ``q`` (scratch: link frames R, P, transforms T, Jacobian J)."""
-    jt, G = fc.jt, fc.G
-    chain_links(4, fc.dh, jt, q, R, P)
+    jt, G = fc.jtype, fc.G
+    chain_links(4, fc.links, jt, q, R, P)
     frames_into(4, R, P, T)
     l3 = th[IX.l3]
     px = T[3, 3] + T[3, 0] * l3
@@ -536,7 +537,7 @@ def _impedance(th, fc, cs, x, n, loop, fhat):  # pragma: no cover - compiled
     F̂(v) = s·F_table(v) + o·sign(v), (s, o) = ``fhat[k]`` → PWM in ``cs.pwm``; the commanded
     torques stay in ``cs.tauq``, the friction feed-forward in ``cs.ff`` (see
     gripkit.systems.dlr_hit.impedance)."""
-    G, ratio, grav = fc.G, fc.ratio, fc.grav
+    G, ratio, grav = fc.G, fc.ratio, fc.g
     q, qd, R, P, Jp, tip, tipd, tauq, zq = cs.q, cs.qd, cs.R, cs.P, cs.Jp, cs.tip, cs.tipd, cs.tauq, cs.zq
     ctrl, gains, ref, refd, ctab = loop.ctrl, loop.gains, loop.ref, loop.refd, loop.tables
     joints_from_actuators(4, 3, G, fc.q0, x[0:3], q)
@@ -562,7 +563,7 @@ def _impedance(th, fc, cs, x, n, loop, fhat):  # pragma: no cover - compiled
         tauq[k] -= gains[10 + k] * x[3 + k]
     if gains[6] != 0.0:
         gp = cs.gp
-        rnea_pass(4, R, P, fc.jt, fc.mass, fc.com, fc.inertia, fc.armq, zq, zq, grav[0], grav[1],
+        rnea_pass(4, R, P, fc.jtype, fc.mass, fc.com, fc.inertia, fc.arm_q, zq, zq, grav[0], grav[1],
                   grav[2], False, gp, cs.work)
         for k in range(3):
             s = 0.0
@@ -628,8 +629,8 @@ def _adapt_friction(th, fc, cs, x, ctab, est, y, n):  # pragma: no cover - compi
     motor torque from the PWM just commanded and the measured speed through eq 5.10 at T_ref and
     the transmission, bias torque Γᵀ(C(q, q̇)q̇ + G(q)) by RNEA; writes the estimates and each
     sample's status into y[n, 27:36]."""
-    G, ratio, grav, pwm, hb, theta = fc.G, fc.ratio, fc.grav, cs.pwm, cs.hb, est.theta
-    rnea_pass(4, cs.R, cs.P, fc.jt, fc.mass, fc.com, fc.inertia, fc.armq, cs.qd, cs.zq, grav[0],
+    G, ratio, grav, pwm, hb, theta = fc.G, fc.ratio, fc.g, cs.pwm, cs.hb, est.theta
+    rnea_pass(4, cs.R, cs.P, fc.jtype, fc.mass, fc.com, fc.inertia, fc.arm_q, cs.qd, cs.zq, grav[0],
               grav[1], grav[2], True, hb, cs.work)
     for k in range(3):
         v = x[3 + k]
