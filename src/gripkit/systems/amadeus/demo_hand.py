@@ -92,7 +92,6 @@ def _bending(report, z, rng, summary):
 
 
 def _fusion(report, z, rng, summary, quick):
-    s = z.sensor
     sec = report.section(
         "Fingertip force sensor: calibration and stochastic fusion (Table I, Fig. 10)",
         "Six bridge readings (eqs 9-14) with signal-proportional noise (eq 19, Table I's normalised variances) "
@@ -109,6 +108,7 @@ def _fusion(report, z, rng, summary, quick):
               caption="Table I reproduced. The measured fused variances exceed eq 18: a common correlation "
                       "ρ ≈ 0.3-0.5 between the combinations explains the excess.")
     # calibration
+    s = z.sensor
     levels = np.array([-4.0, -2.0, -1.0, 1.0, 2.0, 4.0])
     loads = [np.eye(3)[ax] * lv for ax in range(3) for lv in levels for _ in range(10 if quick else 20)]
     loads += list(rng.uniform(-4, 4, (60 if quick else 200, 3)))
