@@ -2,6 +2,7 @@
 kernel results against their recording (tests/reference/kernel_records.json)."""
 
 import os
+from types import SimpleNamespace
 
 os.environ.setdefault("MPLBACKEND", "Agg")
 
@@ -31,24 +32,32 @@ def record_of(result: np.ndarray) -> dict:
             "values": [[float(v).hex() for v in result[r]] for r in rows]}
 
 
+def _check_record(name, result, record):
+    """The result has the recorded shape and agrees with the recorded rows to RECORD_RTOL."""
+    result = np.asarray(result, dtype=np.float64)
+    assert list(result.shape) == record["shape"], f"{name}: shape {result.shape}, recorded {record['shape']}"
+    ref = np.array([[float.fromhex(v) for v in row] for row in record["values"]])
+    got = result[record["rows"]]
+    finite = np.where(np.isfinite(ref), ref, 0.0)
+    scale = np.abs(finite).max(axis=0, initial=0.0)
+    with np.errstate(invalid="ignore"):
+        close = np.abs(got - finite) <= RECORD_RTOL * (np.abs(finite) + scale)
+    bad = ~np.where(np.isfinite(ref), close, (got == ref) | (np.isnan(got) & np.isnan(ref)))
+    if bad.any():
+        r, c = np.argwhere(bad)[0]
+        raise AssertionError(f"{name}: row {record['rows'][r]}, column {c}: {got[r, c]!r}, "
+                             f"recorded {ref[r, c]!r} ({int(bad.sum())} entries beyond rtol {RECORD_RTOL})")
+
+
 @pytest.fixture(scope="session")
 def assert_matches_record():
     """``check(name, result, record)``: the result has the recorded shape and agrees with the
     recorded rows to RECORD_RTOL."""
+    return _check_record
 
-    def check(name, result, record):
-        result = np.asarray(result, dtype=np.float64)
-        assert list(result.shape) == record["shape"], f"{name}: shape {result.shape}, recorded {record['shape']}"
-        ref = np.array([[float.fromhex(v) for v in row] for row in record["values"]])
-        got = result[record["rows"]]
-        finite = np.where(np.isfinite(ref), ref, 0.0)
-        scale = np.abs(finite).max(axis=0, initial=0.0)
-        with np.errstate(invalid="ignore"):
-            close = np.abs(got - finite) <= RECORD_RTOL * (np.abs(finite) + scale)
-        bad = ~np.where(np.isfinite(ref), close, (got == ref) | (np.isnan(got) & np.isnan(ref)))
-        if bad.any():
-            r, c = np.argwhere(bad)[0]
-            raise AssertionError(f"{name}: row {record['rows'][r]}, column {c}: {got[r, c]!r}, "
-                                 f"recorded {ref[r, c]!r} ({int(bad.sum())} entries beyond rtol {RECORD_RTOL})")
 
-    return check
+@pytest.fixture(scope="session")
+def record_tools():
+    """RECORD_RTOL and record_of, for tests of the check (a test module cannot import this file by
+    name: several test folders have a conftest.py)."""
+    return SimpleNamespace(rtol=RECORD_RTOL, record_of=record_of)

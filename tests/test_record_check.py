@@ -3,10 +3,10 @@ RECORD_RTOL and fails what does not."""
 
 import numpy as np
 import pytest
-from conftest import RECORD_RTOL, record_of
 
 
-def test_a_result_agrees_with_its_own_record_and_its_rows_are_spread(assert_matches_record):
+def test_a_result_agrees_with_its_own_record_and_its_rows_are_spread(assert_matches_record, record_tools):
+    record_of, RECORD_RTOL = record_tools.record_of, record_tools.rtol
     result = np.column_stack([np.linspace(0.0, 1.0, 300), np.full(300, np.inf), np.zeros(300)])
     record = record_of(result)
     assert record["rows"][0] == 0 and record["rows"][-1] == 299 and 12 <= len(record["rows"]) <= 14
@@ -14,7 +14,8 @@ def test_a_result_agrees_with_its_own_record_and_its_rows_are_spread(assert_matc
 
 
 @pytest.mark.parametrize("change", ["relative", "inf", "nan", "shape"])
-def test_a_result_beyond_the_tolerance_fails(assert_matches_record, change):
+def test_a_result_beyond_the_tolerance_fails(assert_matches_record, record_tools, change):
+    record_of, RECORD_RTOL = record_tools.record_of, record_tools.rtol
     result = np.column_stack([np.linspace(1.0, 2.0, 50), np.full(50, np.inf)])
     record = record_of(result)
     bad = result.copy()
