@@ -5,6 +5,7 @@ tests/systems/tsfm/test_grasp_kernel_records.py, a dozen rows each (exact, float
 Run from the repository root, with the kernels whose results are the reference:
 ``PYTHONPATH=src python tests/reference/record_kernels.py``."""
 
+import contextlib
 import json
 import platform
 import subprocess
@@ -24,12 +25,11 @@ from test_grasp_kernel_records import _results  # noqa: E402
 
 
 def _cpu() -> str:
-    try:
+    """The CPU's model name (/proc/cpuinfo on Linux), else what platform knows."""
+    with contextlib.suppress(OSError):
         for line in Path("/proc/cpuinfo").read_text().splitlines():
             if line.startswith("model name"):
                 return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
     return platform.processor() or "cpu"
 
 

@@ -66,6 +66,9 @@ DynamicsWork = namedtuple("DynamicsWork", "R P work q qd qdd zq Mq tau Mp hp L r
 #: runtime (NRT), so passing arrays between them costs nothing. Measured on the finger step
 #: (45 array arguments): 1.1 µs with NRT, 0.45 µs without. Such kernels may not allocate.
 hot = numba.njit(cache=True, error_model="numpy", _nrt=False)
+#: the same for a small piece of such a kernel, inlined into its caller at numba IR level (where a
+#: compiled call measured slower: docs/performance.md, "Named records in kernels")
+hot_inline = numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
 
 # work-array floats per link: RNEA stores F (3), N (3); CRBA a composite inertia (10)
 WORK_PER_LINK = 10
@@ -142,7 +145,7 @@ def dh_table(alpha, a, d, offset) -> np.ndarray:
     return np.ascontiguousarray(np.column_stack([alpha, a, d, offset, np.cos(alpha), np.sin(alpha)]))
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+@hot_inline
 def centripetal(wx, wy, wz, px, py, pz):  # pragma: no cover - compiled
     """ω × (ω × p), the centripetal acceleration of a point p of a body turning at ω."""
     cx = wy * pz - wz * py
@@ -151,32 +154,32 @@ def centripetal(wx, wy, wz, px, py, pz):  # pragma: no cover - compiled
     return wy * cz - wz * cy, wz * cx - wx * cz, wx * cy - wy * cx
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+@hot_inline
 def rotation(R, k):  # pragma: no cover - compiled
     """The nine entries of ^{k}_{k+1}R (row-major ``R[k]``) as scalars."""
     return R[k, 0], R[k, 1], R[k, 2], R[k, 3], R[k, 4], R[k, 5], R[k, 6], R[k, 7], R[k, 8]
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+@hot_inline
 def rotate(R, k, x, y, z):  # pragma: no cover - compiled
     """^{k}_{k+1}R (x, y, z): a vector of frame k+1 expressed in frame k."""
     return (R[k, 0] * x + R[k, 1] * y + R[k, 2] * z, R[k, 3] * x + R[k, 4] * y + R[k, 5] * z,
             R[k, 6] * x + R[k, 7] * y + R[k, 8] * z)
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+@hot_inline
 def rotate_back(R, k, x, y, z):  # pragma: no cover - compiled
     """(^{k}_{k+1}R)ᵀ (x, y, z): a vector of frame k expressed in frame k+1."""
     return (R[k, 0] * x + R[k, 3] * y + R[k, 6] * z, R[k, 1] * x + R[k, 4] * y + R[k, 7] * z,
             R[k, 2] * x + R[k, 5] * y + R[k, 8] * z)
 
 
-@numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+@hot_inline
 def outward_step(k, R, P, jtype, qd, qdd, wx, wy, wz, ax, ay, az, vx, vy, vz,
                  with_velocity):  # pragma: no cover - compiled
     """One link of the outward Newton-Euler pass (eqs 4.8–4.10): ω, ω̇ and the origin's
-    acceleration v̇ of link k+1 in its own frame from those (w, a, v) of link k. Inlined into its
-    callers at numba IR level. ``with_velocity=False`` skips the velocity products."""
+    acceleration v̇ of link k+1 in its own frame from those (w, a, v) of link k.
+    ``with_velocity=False`` skips the velocity products."""
     px = P[k, 0]; py = P[k, 1]; pz = P[k, 2]  # noqa: E702
     # linear acceleration of the new origin, in parent frame: ω̇×P + ω×(ω×P) + v̇
     tx = ay * pz - az * py + vx

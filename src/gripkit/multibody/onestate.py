@@ -21,7 +21,7 @@ import math
 import numba
 import numpy as np
 
-from .kernels import WORK_PER_LINK, chain_links, crba, project_mass, rnea_pass
+from .kernels import WORK_PER_LINK, chain_links, crba, hot_inline, project_mass, rnea_pass
 
 __all__ = ["mass_matrix_one", "pack", "prepare", "rnea_one"]
 
@@ -44,10 +44,9 @@ def pack(arrays) -> np.ndarray:
     return np.concatenate([[n, m, w], offsets[:11], *parts]).astype(np.float64)
 
 
-_inline = numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
 
 
-@_inline
+@hot_inline
 def _model(buf):  # pragma: no cover - compiled
     """Views of the packed buffer (no allocation): sizes, model arrays and the scratch."""
     n = int(buf[0])
@@ -68,7 +67,7 @@ def _model(buf):  # pragma: no cover - compiled
     return n, m, dh, mass, com, inertia, arm_q, G, q0, arm_p, g, jtype, work
 
 
-@_inline
+@hot_inline
 def _finite(m, q):  # pragma: no cover - compiled
     if q.shape[0] != m:
         return False
@@ -78,7 +77,7 @@ def _finite(m, q):  # pragma: no cover - compiled
     return True
 
 
-@_inline
+@hot_inline
 def _links(n, m, dh, jtype, G, q0, q, work):  # pragma: no cover - compiled
     """Joint positions Γ p + q₀ into the scratch and the link transforms R, P for them."""
     R = work[0:9 * n].reshape((n, 9))

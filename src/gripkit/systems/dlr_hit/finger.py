@@ -59,8 +59,8 @@ from ...models.transmission import transmit_torque
 from ...multibody.coupling import CoupledChain, Coupling, differential_matrix
 from ...multibody.dh import DHChain
 from ...multibody.kernels import (WORK_PER_LINK, chain_links, cholesky_solve, coupled_mass_bias,
-                                  frames_into, hot, joints_from_actuators, point_jacobian,
-                                  rnea_pass)
+                                  frames_into, hot, hot_inline, joints_from_actuators,
+                                  point_jacobian, rnea_pass)
 from ...params import ParameterSet
 from ...sim.model import Model, Signal
 
@@ -185,11 +185,6 @@ def finger_setup(th, fc):  # pragma: no cover - compiled
         grav[k] = th[IX.g_x + k]
 
 
-#: pieces of the step and of the closed loop, inlined into their caller at numba IR level (compiled
-#: as separate functions they measured slower: docs/performance.md, "Named records")
-_step_piece = numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
-
-
 @hot
 def _kinetic(th, k, v, p, mode, tab):  # pragma: no cover - compiled
     """Kinetic friction of actuator k at velocity v (never 0 for v ≠ 0)."""
@@ -203,7 +198,7 @@ def _kinetic(th, k, v, p, mode, tab):  # pragma: no cover - compiled
     return f + ripple(p, v, th[IX.ripple_amp], th[IX.ripple_cycles], 0.0)
 
 
-@_step_piece
+@hot_inline
 def _drive_torques(th, thermal, ratio, T, pwm, pd, taum, tshaft):  # pragma: no cover - compiled
     """Each motor through its transmission (eqs 5.7, 5.9; thermal derating with ``thermal``):
     shaft torques ``tshaft`` and the output-side torques ``taum``."""
@@ -217,7 +212,7 @@ def _drive_torques(th, thermal, ratio, T, pwm, pd, taum, tshaft):  # pragma: no 
         taum[k] = transmit_torque(ts, pd[k], ratio[k], th[IX.eta])
 
 
-@_step_piece
+@hot_inline
 def _add_end_stops(th, q, qd, G, rhs):  # pragma: no cover - compiled
     """Spring-damper end stops on θ1, θ2, θ3 (θ4 = θ3), one-sided, mapped onto the actuators."""
     ks = th[IX.k_stop]
@@ -531,7 +526,7 @@ def _pwm_for(tau_out, omega_m, N, th):  # pragma: no cover - compiled
     return u
 
 
-@_step_piece
+@hot_inline
 def _impedance(th, fc, cs, x, n, loop, fhat):  # pragma: no cover - compiled
     """Impedance law (joint: loop.ctrl = 1, Cartesian: 2) with gravity and friction compensation
     F̂(v) = s·F_table(v) + o·sign(v), (s, o) = ``fhat[k]`` → PWM in ``cs.pwm``; the commanded
@@ -592,7 +587,7 @@ def _impedance(th, fc, cs, x, n, loop, fhat):  # pragma: no cover - compiled
         pwm[k] = _pwm_for(tau, ratio[k] * x[3 + k], ratio[k], th)
 
 
-@_step_piece
+@hot_inline
 def _wall(th, fc, cs, x, wall):  # pragma: no cover - compiled
     """Contact force of a planar wall (nx, ny, nz, px, py, pz, k, d, on) on the fingertip, mapped
     to the actuators: ``cs.ext`` = J_pᵀ F; ``cs.force`` receives F (finger base frame)."""

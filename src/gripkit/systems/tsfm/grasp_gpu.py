@@ -111,7 +111,8 @@ def run_cuda(tpl, parts, nz, nstd, seeds, n_steps, window, cps, mset, met, batch
         blocks = (m + threads_per_block - 1) // threads_per_block
         shared = DeviceShared(d(tpl.bw), d(tpl.G), d(tpl.target), d(tpl.ng), tpl.K, n_steps, d(mset))
         jobs = DeviceJobs(d(Phi), d(Gam), d(C), d(D), d(Hg), d(np.ascontiguousarray(parts[a:b])),
-                          d(np.ascontiguousarray(noise)), d(nstd[a:b]), d(seeds[a:b]), d(np.ascontiguousarray(cps[a:b])))
+                          d(np.ascontiguousarray(noise)), d(nstd[a:b]), d(seeds[a:b]),
+                          d(np.ascontiguousarray(cps[a:b])))
         kern[blocks, threads_per_block](shared, Estimators(*(d(e) for e in tpl.est)), jobs, work, out)
         met[a:b] = out.copy_to_host()
 
