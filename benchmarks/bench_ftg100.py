@@ -27,7 +27,7 @@ def _scipy_grasp(duration: float, gap: float, noise: bool = True, seed: int = 0)
     ctl = HybridForcePosition.for_plant(pl.parameters).controller()
     rng = np.random.default_rng(seed)
     sx, sf = (1e-9, 50e-9) if noise else (0.0, 0.0)
-    ts = ctl.design.ts
+    ts = ctl.design.dt
 
     def rhs(t, s, V, contact):
         xa, va, xb, vb = s

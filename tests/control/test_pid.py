@@ -17,7 +17,7 @@ TS = 1e-3
 
 def test_linear_region_equals_transfer_function():
     """b = c = 1, no saturation, e[0] = 0: u = C(z) e with C(z) = kp + ki T/(z-1) + kd(z-1)/((Tf+T)z - Tf)."""
-    pid = PID(2.0, 150.0, 0.01, ts=TS, tf=0.004, c=1.0)
+    pid = PID(2.0, 150.0, 0.01, dt=TS, tf=0.004, c=1.0)
     e = np.r_[0.0, np.random.default_rng(0).standard_normal(500)]
     u = pid.run(e, np.zeros_like(e))
     num, den = pid.transfer_function()
@@ -29,14 +29,14 @@ def test_linear_region_equals_transfer_function():
 
 
 def test_first_output_and_integrator():
-    pid = PID(2.0, 100.0, ts=TS)
+    pid = PID(2.0, 100.0, dt=TS)
     assert pid.step(0.1, 0.0) == pytest.approx(0.2)        # P only at k = 0
     assert pid.step(0.1, 0.0) == pytest.approx(0.2 + 100 * TS * 0.1)
 
 
 def _windup_recovery(tt):
     """Plant y' = (u - y)/10 ms with u in [-1, 1]; the setpoint 5 is unreachable for 2 s, then 0.5."""
-    pid = PID(0.5, 50.0, ts=TS, u_min=-1.0, u_max=1.0, tt=tt)
+    pid = PID(0.5, 50.0, dt=TS, u_min=-1.0, u_max=1.0, tt=tt)
     y, out = 0.0, []
     for rk in np.r_[np.full(2000, 5.0), np.full(3000, 0.5)]:
         u = pid.step(rk, y)
@@ -56,29 +56,29 @@ def test_back_calculation_prevents_windup():
 @given(kp=st.floats(0, 10), ki=st.floats(0, 1e3), kd=st.floats(0, 0.1), r=st.floats(-5, 5), y=st.floats(-5, 5),
        ff=st.floats(-1, 1), u=st.floats(-9, 9), b=st.floats(0, 1), c=st.floats(0, 1))
 def test_bumpless_transfer_returns_the_given_output(kp, ki, kd, r, y, ff, u, b, c):
-    pid = PID(kp, ki, kd, ts=TS, b=b, c=c, u_min=-10, u_max=10)
+    pid = PID(kp, ki, kd, dt=TS, b=b, c=c, u_min=-10, u_max=10)
     pid.run(np.random.default_rng(1).standard_normal(5), np.zeros(5))  # arbitrary history
     pid.transfer(u, r, y, ff)
     assert pid.step(r, y, ff) == pytest.approx(u, abs=1e-9 * (1 + abs(u) + kp * 10))
 
 
 def test_derivative_on_measurement_has_no_setpoint_kick():
-    pid = PID(1.0, 0.0, 0.05, ts=TS, c=0.0)
+    pid = PID(1.0, 0.0, 0.05, dt=TS, c=0.0)
     pid.step(0.0, 0.0)
     assert pid.step(1.0, 0.0) == pytest.approx(1.0)   # setpoint step: P only
-    pid_e = PID(1.0, 0.0, 0.05, ts=TS, c=1.0)
+    pid_e = PID(1.0, 0.0, 0.05, dt=TS, c=1.0)
     pid_e.step(0.0, 0.0)
     assert pid_e.step(1.0, 0.0) > 5.0                  # derivative on the error kicks
 
 
 def test_configuration_errors():
-    with pytest.raises(ConfigError, match="ts"):
-        PID(1.0, ts=0.0)
+    with pytest.raises(ConfigError, match="dt"):
+        PID(1.0, dt=0.0)
     with pytest.raises(ConfigError, match="u_min < u_max"):
-        PID(1.0, ts=TS, u_min=1.0, u_max=0.0)
+        PID(1.0, dt=TS, u_min=1.0, u_max=0.0)
     with pytest.raises(ConfigError, match="finite"):
-        PID(float("nan"), ts=TS)
+        PID(float("nan"), dt=TS)
     with pytest.raises(ConfigError, match="NaN"):
-        PID(1.0, ts=TS).run([0.0, 1.0], [0.0, float("nan")])
-    assert PID(2.0, 4.0, ts=TS).tt == pytest.approx(0.5)   # T_t = T_i without derivative
-    assert math.isinf(PID(2.0, 4.0, ts=TS, tt=math.inf).tt)
+        PID(1.0, dt=TS).run([0.0, 1.0], [0.0, float("nan")])
+    assert PID(2.0, 4.0, dt=TS).tt == pytest.approx(0.5)   # T_t = T_i without derivative
+    assert math.isinf(PID(2.0, 4.0, dt=TS, tt=math.inf).tt)

@@ -6,23 +6,23 @@ At sample k, with setpoint r, measurement y and a feedforward term f (Åström &
 PID Control*, §13 "computer implementation"):
 
     P_k = K_p (b r_k − y_k)
-    D_k = (T_f D_{k−1} + K_d (e_d,k − e_d,k−1)) / (T_f + T_s),     e_d = c r − y
+    D_k = (T_f D_{k−1} + K_d (e_d,k − e_d,k−1)) / (T_f + Δt),     e_d = c r − y
           (backward-Euler discretisation of K_d s/(T_f s + 1); no kick on the first sample)
     v_k = P_k + I_k + D_k + f_k,      u_k = min(max(v_k, u_min), u_max)
-    I_{k+1} = I_k + K_i T_s (r_k − y_k) + (T_s/T_t)(u_k − v_k)       (back-calculation)
+    I_{k+1} = I_k + K_i Δt (r_k − y_k) + (Δt/T_t)(u_k − v_k)       (back-calculation)
 
 The last term bleeds the integrator while the output is saturated, so it does not wind up (T_t is
-the tracking time constant; defaults: √(T_i T_d) with a derivative, T_i = K_p/K_i without, T_s
+the tracking time constant; defaults: √(T_i T_d) with a derivative, T_i = K_p/K_i without, Δt
 for a pure integrator, which is integrator clamping). **Bumpless transfer**
 (:meth:`PID.transfer`, :func:`pid_transfer`) sets the state so that the next step with the same
 r, y, f returns a given u exactly: I = u − P − f, D = 0, e_d,prev = c r − y.
 
 Linear region, b = c = 1 (:meth:`PID.transfer_function`):
 
-    U(z)/E(z) = K_p + K_i T_s/(z − 1) + K_d (z − 1)/((T_f + T_s) z − T_f).
+    U(z)/E(z) = K_p + K_i Δt/(z − 1) + K_d (z − 1)/((T_f + Δt) z − T_f).
 
 Array layouts (for kernels): parameters ``p`` = [K_p, K_i, K_d, T_f, b, c, T_t, u_min, u_max,
-T_s] (``PID_NPARAM``); state ``s`` = [I, D, e_d,prev, started] (``PID_NSTATE``).
+Δt] (``PID_NPARAM``); state ``s`` = [I, D, e_d,prev, started] (``PID_NSTATE``).
 """
 
 from __future__ import annotations
@@ -47,22 +47,22 @@ def pid_step(p, s, r, y, ff):  # pragma: no cover - compiled
     ki = p[1]
     kd = p[2]
     tf = p[3]
-    ts = p[9]
+    dt = p[9]
     ed = p[5] * r - y
     if s[3] == 0.0:
         s[1] = 0.0
         s[2] = ed
         s[3] = 1.0
-    d = (tf * s[1] + kd * (ed - s[2])) / (tf + ts)
+    d = (tf * s[1] + kd * (ed - s[2])) / (tf + dt)
     v = kp * (p[4] * r - y) + s[0] + d + ff
     u = v
     if u < p[7]:
         u = p[7]
     elif u > p[8]:
         u = p[8]
-    s[0] += ki * ts * (r - y)
+    s[0] += ki * dt * (r - y)
     if p[6] > 0.0:
-        s[0] += ts / p[6] * (u - v)
+        s[0] += dt / p[6] * (u - v)
     s[1] = d
     s[2] = ed
     return u
@@ -103,10 +103,10 @@ class PID:
     ----------
     kp, ki, kd
         Parallel gains: output units per error unit, per (error unit·s), times seconds.
-    ts
-        Sample time (s).
+    dt
+        Sample interval Δt (s), the name gripkit uses everywhere (docs/ARCHITECTURE.md).
     tf
-        Derivative filter time constant (s); default K_d/(10 K_p) (N = 10), or T_s without K_p.
+        Derivative filter time constant (s); default K_d/(10 K_p) (N = 10), or Δt without K_p.
     b, c
         Setpoint weights of the proportional and derivative parts (c = 0: derivative on the
         measurement only, the usual choice; c = 1: on the error).
@@ -115,19 +115,19 @@ class PID:
     u_min, u_max
         Output limits (the actuator's range).
 
-    >>> pid = PID(2.0, 100.0, ts=1e-3, u_min=-1.0, u_max=1.0)
+    >>> pid = PID(2.0, 100.0, dt=1e-3, u_min=-1.0, u_max=1.0)
     >>> round(pid.step(0.1, 0.0), 6)
     0.2
     """
 
-    def __init__(self, kp: float, ki: float = 0.0, kd: float = 0.0, *, ts: float, tf: float | None = None,
+    def __init__(self, kp: float, ki: float = 0.0, kd: float = 0.0, *, dt: float, tf: float | None = None,
                  b: float = 1.0, c: float = 0.0, tt: float | None = None, u_min: float = -math.inf,
                  u_max: float = math.inf):
         kp, ki, kd = _finite("kp", kp), _finite("ki", ki), _finite("kd", kd)
-        ts = _finite("ts", ts, positive=True)
+        dt = _finite("dt", dt, positive=True)
         if tf is None:
-            tf = kd / (10.0 * abs(kp)) if (kd != 0 and kp != 0) else (ts if kd != 0 else 0.0)
-            tf = tf if math.isfinite(tf) else ts
+            tf = kd / (10.0 * abs(kp)) if (kd != 0 and kp != 0) else (dt if kd != 0 else 0.0)
+            tf = tf if math.isfinite(tf) else dt
         tf = _finite("tf", tf)
         if tf < 0:
             raise ConfigError(f"PID tf: expected a time constant >= 0 s, found {tf!r}")
@@ -138,16 +138,16 @@ class PID:
             if ki == 0:
                 tt = 0.0
             elif kp == 0:
-                tt = ts
+                tt = dt
             else:  # Åström's T_t = sqrt(T_i T_d) = sqrt(kd/ki) (kp cancels), T_i without derivative
                 tt = math.sqrt(abs(kd / ki)) if kd != 0 else abs(kp / ki)
-                tt = max(tt, ts)
+                tt = max(tt, dt)
         tt = _finite("tt", tt, allow_inf=True)
         if tt < 0:
             raise ConfigError(f"PID tt: expected a time constant >= 0 s (or inf), found {tt!r}")
         if math.isinf(tt):
             tt = 0.0  # 0 disables the back-calculation term in the kernel
-        self._p = np.array([kp, ki, kd, tf, _finite("b", b), _finite("c", c), tt, u_min, u_max, ts])
+        self._p = np.array([kp, ki, kd, tf, _finite("b", b), _finite("c", c), tt, u_min, u_max, dt])
         self._p.flags.writeable = False
         self.state = np.zeros(PID_NSTATE)
 
@@ -162,11 +162,11 @@ class PID:
     kd = property(lambda self: float(self._p[2]))
     tf = property(lambda self: float(self._p[3]))
     tt = property(lambda self: float(self._p[6]) if self._p[6] > 0 else math.inf)
-    ts = property(lambda self: float(self._p[9]))
+    dt = property(lambda self: float(self._p[9]))
     limits = property(lambda self: (float(self._p[7]), float(self._p[8])))
 
     def __repr__(self) -> str:
-        return (f"PID(kp={self.kp:g}, ki={self.ki:g}, kd={self.kd:g}, ts={self.ts:g}, tf={self.tf:g}, "
+        return (f"PID(kp={self.kp:g}, ki={self.ki:g}, kd={self.kd:g}, dt={self.dt:g}, tf={self.tf:g}, "
                 f"tt={self.tt:g}, limits={self.limits})")
 
     # --- operation -------------------------------------------------------------------------------
@@ -198,9 +198,9 @@ class PID:
 
     def transfer_function(self) -> tuple[np.ndarray, np.ndarray]:
         """(num, den) of U(z)/E(z) in powers of z (linear region, b = c = 1)."""
-        kp, ki, kd, tf, ts = self.kp, self.ki, self.kd, self.tf, self.ts
-        a = np.array([tf + ts, -tf])      # (T_f + T_s) z − T_f
+        kp, ki, kd, tf, dt = self.kp, self.ki, self.kd, self.tf, self.dt
+        a = np.array([tf + dt, -tf])      # (T_f + Δt) z − T_f
         zm1 = np.array([1.0, -1.0])       # z − 1
-        num = kp * np.polymul(zm1, a) + ki * ts * np.concatenate([[0.0], a]) + kd * np.polymul(zm1, zm1)
+        num = kp * np.polymul(zm1, a) + ki * dt * np.concatenate([[0.0], a]) + kd * np.polymul(zm1, zm1)
         den = np.polymul(zm1, a)
         return num / den[0], den / den[0]

@@ -367,8 +367,8 @@ def _hybrid_robustness(sec, summary, ctrl, plant, quick):
 
 def _hybrid_windup_and_switch(sec, ctrl, plant):
     """Anti-windup at the 200 V limit and the bumpless switch at contact, each on and off."""
-    ns = int(round(0.12 / ctrl.ts))
-    prof = np.where(np.arange(ns) < int(0.07 / ctrl.ts), 400e-6, 50e-6)
+    ns = int(round(0.12 / ctrl.dt))
+    prof = np.where(np.arange(ns) < int(0.07 / ctrl.dt), 400e-6, 50e-6)
     aw = {f: simulate_hybrid_grasp(ctrl.with_(anti_windup=f), plant, force_profile=prof, duration=0.12) for f in (True, False)}
     stiff = plant.with_parameters(check=False, K_sa=25.4 * 1.15)
     bl = {f: simulate_hybrid_grasp(ctrl.with_(bumpless=f), stiff, duration=0.06) for f in (True, False)}

@@ -164,7 +164,7 @@ class HybridForcePosition:
     ``anti_windup`` and ``bumpless`` switch those features off for comparisons. Defaults are tuned
     for the FT-G100 at 20 kHz (:meth:`for_plant` fills in the actuator model)."""
 
-    ts: float = 5e-5
+    dt: float = 5e-5
     kp_x: float = 3.0
     ki_x: float = 3000.0
     kd_x: float = 6e-4
@@ -194,7 +194,7 @@ class HybridForcePosition:
         for k, v in asdict(self).items():
             if not isinstance(v, (int, float)) or not math.isfinite(v):
                 raise ConfigError(f"hybrid controller {k}: expected a finite number, found {v!r}")
-        for k in ("ts", "approach_speed", "x_limit", "contact_threshold", "lever", "c_e", "v_max", "tf_v",
+        for k in ("dt", "approach_speed", "x_limit", "contact_threshold", "lever", "c_e", "v_max", "tf_v",
                   "k_contact"):
             if getattr(self, k) <= 0:
                 raise ConfigError(f"hybrid controller {k}: expected a positive value, found {getattr(self, k)!r}")
@@ -226,10 +226,10 @@ class HybridForcePosition:
         """The parameter array of :func:`hybrid_step`."""
         lo, hi = self.force_limit
         tt = None if self.anti_windup else math.inf
-        px = PID(self.kp_x, self.ki_x, self.kd_x, ts=self.ts, tf=self.tf_x, b=1.0, c=1.0, tt=tt, u_min=lo, u_max=hi)
-        pf = PID(self.kp_f, self.ki_f, self.kd_f, ts=self.ts, b=1.0, c=0.0, tt=tt, u_min=lo, u_max=hi)
+        px = PID(self.kp_x, self.ki_x, self.kd_x, dt=self.dt, tf=self.tf_x, b=1.0, c=1.0, tt=tt, u_min=lo, u_max=hi)
+        pf = PID(self.kp_f, self.ki_f, self.kd_f, dt=self.dt, b=1.0, c=0.0, tt=tt, u_min=lo, u_max=hi)
         cp = np.empty(_NCP)
-        cp[_TS] = self.ts
+        cp[_TS] = self.dt
         cp[_PX:_PX + PID_NPARAM] = px.params
         cp[_PF:_PF + PID_NPARAM] = pf.params
         cp[_KV] = self.kv
@@ -456,14 +456,14 @@ def _prepare(controller, plant, force, k0, gap, seed, noise_force, noise_positio
     thetas[:, names.index("gap")] = G
     thetas = plant._check_thetas(thetas)
     cps = np.stack([ctrls[i].params() for i in CI])
-    ts = ctrls[0].ts
-    if any(abs(c.ts - ts) > 1e-15 for c in ctrls):
-        raise ConfigError("controllers in one batch must share the sample time ts")
-    if not (math.isfinite(duration) and duration > ts):
-        raise ConfigError(f"duration: expected more than one sample ({ts:g} s), found {duration!r}")
-    n_steps = int(round(duration / ts))
-    substeps = plant.substeps(ts, np.unique(thetas, axis=0))
-    return plant, thetas, cps, F, K0, G, S.astype(np.int64), NF, NX, dmg, ts, n_steps, substeps
+    dt = ctrls[0].dt
+    if any(abs(c.dt - dt) > 1e-15 for c in ctrls):
+        raise ConfigError("controllers in one batch must share the sample time dt")
+    if not (math.isfinite(duration) and duration > dt):
+        raise ConfigError(f"duration: expected more than one sample ({dt:g} s), found {duration!r}")
+    n_steps = int(round(duration / dt))
+    substeps = plant.substeps(dt, np.unique(thetas, axis=0))
+    return plant, thetas, cps, F, K0, G, S.astype(np.int64), NF, NX, dmg, dt, n_steps, substeps
 
 
 def grasp_batch(controller: HybridForcePosition | list | None = None, plant=None, *, force=20e-6, k0=None,
@@ -474,18 +474,18 @@ def grasp_batch(controller: HybridForcePosition | list | None = None, plant=None
     broadcast from ``force`` (commanded force, N), ``k0`` (object stiffness, N/m; default the
     plant's), ``gap`` (free gap, m; default the plant's), ``seed`` (noise stream) and the noise
     standard deviations ``noise_force`` (N) and ``noise_position`` (m). ``controller`` may be a list
-    with one design per scenario (same ``ts``). ``damage_threshold`` defaults to 1.5 × the command;
+    with one design per scenario (same ``dt``). ``damage_threshold`` defaults to 1.5 × the command;
     ``band`` is the settling band as a fraction of the command. ``duration`` must cover the
     approach (gap / approach_speed) plus the grasp.
     """
-    plant, thetas, cps, F, K0, G, S, NF, NX, dmg, ts, n_steps, sub = _prepare(
+    plant, thetas, cps, F, K0, G, S, NF, NX, dmg, dt, n_steps, sub = _prepare(
         controller, plant, force, k0, gap, seed, noise_force, noise_position, damage_threshold, duration)
-    met, traj = _run(thetas, cps, np.ascontiguousarray(F[:, None]), NF, NX, S, ts, sub, band, dmg, n_steps,
+    met, traj = _run(thetas, cps, np.ascontiguousarray(F[:, None]), NF, NX, S, dt, sub, band, dmg, n_steps,
                      record, progress)
-    return GraspBatch(met, F, K0, G, S, dmg, ts, traj if record else None)
+    return GraspBatch(met, F, K0, G, S, dmg, dt, traj if record else None)
 
 
-def _run(thetas, cps, fprofs, NF, NX, S, ts, sub, band, dmg, n_steps, record, progress):
+def _run(thetas, cps, fprofs, NF, NX, S, dt, sub, band, dmg, n_steps, record, progress):
     P = thetas.shape[0]
     if not (math.isfinite(band) and 0 < band < 1):
         raise ConfigError(f"band: expected a fraction in (0, 1), found {band!r}")
@@ -494,7 +494,7 @@ def _run(thetas, cps, fprofs, NF, NX, S, ts, sub, band, dmg, n_steps, record, pr
     chunk = 256
     for a in track(range(0, P, chunk), description="grasp simulations", enabled=progress and P > 2 * chunk):
         b = min(P, a + chunk)
-        _grasp_batch(thetas[a:b], cps[a:b], fprofs[a:b], NF[a:b], NX[a:b], S[a:b], ts, sub, float(band),
+        _grasp_batch(thetas[a:b], cps[a:b], fprofs[a:b], NF[a:b], NX[a:b], S[a:b], dt, sub, float(band),
                      dmg[a:b], n_steps, bool(record), traj[a:b], met[a:b])
     return met, traj
 
@@ -510,24 +510,24 @@ def simulate_hybrid_grasp(controller: HybridForcePosition | None = None, plant=N
     for name, v in (("force", force), ("k0", k0), ("gap", gap)):
         if v is not None and np.ndim(v) != 0:
             raise ConfigError(f"{name}: expected one number for simulate_hybrid_grasp (use grasp_batch for arrays)")
-    plant, thetas, cps, F, K0, G, S, NF, NX, dmg, ts, n_steps, sub = _prepare(
+    plant, thetas, cps, F, K0, G, S, NF, NX, dmg, dt, n_steps, sub = _prepare(
         controller, plant, force, k0, gap, seed, noise_force, noise_position, damage_threshold, duration)
     prof = F[:, None]
     if force_profile is not None:
         prof = np.asarray(force_profile, dtype=np.float64)
         if prof.shape != (n_steps,) or not np.isfinite(prof).all() or (prof <= 0).any():
-            raise ConfigError(f"force_profile: expected {n_steps} positive forces (one per {ts:g} s sample over "
+            raise ConfigError(f"force_profile: expected {n_steps} positive forces (one per {dt:g} s sample over "
                               f"{duration:g} s), found shape {prof.shape}")
         prof = prof[None, :]
         F = prof[:, -1].copy()
         dmg = np.full(1, 1.5 * F[0]) if damage_threshold is None else dmg
-    met, tr = _run(thetas, cps, np.ascontiguousarray(prof), NF, NX, S, ts, sub, band, dmg, n_steps, True, False)
-    b = GraspBatch(met, F, K0, G, S, dmg, ts, tr)
+    met, tr = _run(thetas, cps, np.ascontiguousarray(prof), NF, NX, S, dt, sub, band, dmg, n_steps, True, False)
+    b = GraspBatch(met, F, K0, G, S, dmg, dt, tr)
     tr = tr[0]
     traj = Trajectory(tr[:, 0], {"x_a": tr[:, 1], "x_b": tr[:, 2], "F_c": tr[:, 3], "F_meas": tr[:, 4],
                                  "V": tr[:, 5], "mode": tr[:, 6]},
                       {"x_a": "m", "x_b": "m", "F_c": "N", "F_meas": "N", "V": "V", "mode": "1"},
-                      {"dt": ts, "model": "ftg100-plant + hybrid force/position"})
+                      {"dt": dt, "model": "ftg100-plant + hybrid force/position"})
     return HybridGraspResult(traj, b.rows()[0], float(F[0]), float(dmg[0]), float(K0[0]), float(G[0]))
 
 

@@ -15,7 +15,7 @@ __all__ = ["ftg100_grasp"]
 
 #: ftg100-grasp: per-job parameters and the units of the HybridForcePosition fields (its docstring)
 _PARAMS = {"force": "N", "k0": "N/m", "gap": "m", "noise_force": "N", "noise_position": "m"}
-_HYBRID_UNITS = {"ts": "s", "kp_x": "N/m", "ki_x": "N/(m*s)", "kd_x": "N*s/m", "tf_x": "s", "kp_f": "1",
+_HYBRID_UNITS = {"dt": "s", "kp_x": "N/m", "ki_x": "N/(m*s)", "kd_x": "N*s/m", "tf_x": "s", "kp_f": "1",
                  "ki_f": "1/s", "kd_f": "s", "kv": "N*s/m", "tf_v": "s", "approach_speed": "m/s", "x_limit": "m",
                  "contact_threshold": "N", "confirm": "int", "force_ramp": "s", "force_tau": "s",
                  "k_contact": "N/m", "anti_windup": "bool", "bumpless": "bool", "lever": "1", "k1": "N/m",
@@ -30,7 +30,7 @@ def _interface(model, settings: dict) -> Interface:
                           hint="leave [sweep] model out (the nominal plant)")
     schema = {**_OPTS, **{k: Setting(u) for k, u in _HYBRID_UNITS.items()}}
     s = read_settings(settings, schema, "ftg100-grasp")
-    _controller(model, s)  # the controller's own checks (positive ts, v_min < v_max, ...)
+    _controller(model, s)  # the controller's own checks (positive dt, v_min < v_max, ...)
     return Interface(parameters=_PARAMS, settings=s, metrics=METRICS, bytes_per_job=8 * (len(METRICS) + 64))
 
 
