@@ -16,3 +16,7 @@ from .sweep import SweepResult as SweepResult
 from .sweep import sweep as sweep
 from .robustness import RobustnessResult as RobustnessResult
 from .robustness import robustness_study as robustness_study
+
+__all__ = ["binned_probability", "DaskExecutor", "Estimate", "IDENTIFIERS", "identify_many",
+           "InProcessExecutor", "make_executor", "probability", "ProcessExecutor", "quantile",
+           "robustness_study", "RobustnessResult", "sweep", "SweepResult", "SweepSpec"]

@@ -13,3 +13,5 @@ from .rst import as_plant as as_plant
 from .rst import RSTController as RSTController
 from .rst import design_rst as design_rst
 from .rst import simulate_loop as simulate_loop
+
+__all__ = ["as_plant", "design_rst", "DiscretePlant", "LoopResult", "PID", "RSTController", "simulate_loop"]

@@ -17,3 +17,7 @@ from .fusion import normalised_variances as normalised_variances
 from .fusion import proportional_variance as proportional_variance
 from .friction_adaptation import AdaptationSettings as AdaptationSettings
 from .friction_adaptation import FrictionAdapter as FrictionAdapter
+
+__all__ = ["AdaptationSettings", "ContactDetector", "FrictionAdapter", "fuse", "fuse_proportional",
+           "fuse_update", "fused_variance", "implied_correlation", "normalised_variances",
+           "NormalisedVariances", "proportional_variance"]

@@ -3,3 +3,5 @@
 from .formats import FORMATS as FORMATS
 from .formats import load as load
 from .formats import save as save
+
+__all__ = ["FORMATS", "load", "save"]

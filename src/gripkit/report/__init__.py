@@ -2,3 +2,5 @@
 
 from .html import Report as Report
 from .html import Section as Section
+
+__all__ = ["Report", "Section"]

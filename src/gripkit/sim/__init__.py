@@ -14,3 +14,6 @@ from .hybrid import HybridSystem as HybridSystem
 from .hybrid import Mode as Mode
 from .integrators import integrate_lti as integrate_lti
 from .integrators import zoh_levels as zoh_levels
+
+__all__ = ["c2d_zoh", "check_step", "Guard", "HybridSystem", "integrate_lti", "Mode", "Model", "Signal",
+           "simulate", "StateSpace", "step_report", "substeps_for", "zoh_levels"]

@@ -8,3 +8,5 @@
 Each package holds the system's parameters with provenance, its models, estimators, controllers,
 identification procedures and its demo section. :mod:`gripkit.zoo` lists their reference models.
 """
+
+__all__ = ["amadeus", "dlr_hit", "ftg100", "tsfm"]

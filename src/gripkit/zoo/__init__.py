@@ -5,3 +5,5 @@ from .registry import ZooEntry as ZooEntry
 from .registry import build as build
 from .registry import entries as entries
 from .registry import get as get
+
+__all__ = ["build", "entries", "get", "ZooEntry"]

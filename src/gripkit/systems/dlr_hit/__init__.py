@@ -29,3 +29,7 @@ from .impedance import impedance_margins as impedance_margins
 from .impedance import simulate_impedance as simulate_impedance
 from .impedance import stability_margins as stability_margins
 from .parameters import DLRHITFinger as DLRHITFinger
+
+__all__ = ["adapt_finger_friction", "compare_adaptation", "DLRFinger", "DLRHand", "DLRHITFinger",
+           "FrictionDrift", "impedance_margins", "ImpedanceController", "LOOP_ADAPTATION",
+           "simulate_impedance", "stability_margins", "stiction_step", "Wall", "warmup_drift"]

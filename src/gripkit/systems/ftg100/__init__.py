@@ -19,3 +19,6 @@ from .model import FTG100Actuated as FTG100Actuated
 from .model import FTG100Coupled as FTG100Coupled
 from .model import FTG100Plant as FTG100Plant
 from .model import FTG100Sensing as FTG100Sensing
+
+__all__ = ["FTG100Actuated", "FTG100Coupled", "FTG100Plant", "FTG100Sensing", "HybridForcePosition",
+           "HybridGraspResult", "simulate_hybrid_grasp"]
