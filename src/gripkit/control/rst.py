@@ -315,6 +315,19 @@ class RSTController:
                     sensitivity_peak=ms)
 
 
+def _anti_windup_polynomial(Ao: np.ndarray, deg_r: int) -> np.ndarray:
+    """A_aw for the anti-windup form: the observer polynomial A_o when deg A_o <= deg R (Åström and
+    Wittenmark's choice), else (1 − ρ q⁻¹)^deg R with ρ the largest observer-pole magnitude. The
+    controller state driven by A_aw must fit in R's memory (deg A_aw <= deg R), and a plant of
+    deg A >= 3 has deg A_o = deg A + deg B − 2 > deg B = deg R observer poles; the slowest of them
+    keeps the recovery after saturation no faster than the unsaturated loop's observer."""
+    Ao = Ao / Ao[0]
+    if Ao.size - 1 <= deg_r:
+        return Ao
+    rho = float(np.max(np.abs(np.roots(Ao))))
+    return np.real(np.poly(np.full(deg_r, rho)))
+
+
 def design_rst(plant, *, wn: float = 15.0, zeta: float = 0.9, observer: float = 2.0, observer_poles=None,
                u_min: float = -math.inf, u_max: float = math.inf) -> RSTController:
     """RST pole placement with integral action that keeps B (delay and NMP zeros) in the loop.
@@ -329,7 +342,10 @@ def design_rst(plant, *, wn: float = 15.0, zeta: float = 0.9, observer: float = 
         the continuous equivalent of any NMP zero (ln|z₀|/h).
     observer
         The remaining closed-loop (observer) poles sit at z = e^{−observer·ω_n·h}, unless
-        ``observer_poles`` (z-plane) are given.
+        ``observer_poles`` (z-plane) are given. A plant of denominator degree n_A and numerator
+        degree n_B (q⁻¹ layout, delay included) has n_A + n_B − 2 of them; the anti-windup
+        polynomial is A_o, or (1 − ρ q⁻¹)^{n_B} when A_o is longer than R
+        (:func:`_anti_windup_polynomial`).
     u_min, u_max
         Actuator limits (plant input units) for the anti-windup controller.
     """
@@ -380,7 +396,7 @@ def design_rst(plant, *, wn: float = 15.0, zeta: float = 0.9, observer: float = 
     B1 = float(B.sum())
     T = Ao * float(Am.sum()) / B1
     R, S, T = R / r0, S / r0, T / r0
-    aw = Ao / Ao[0]
+    aw = _anti_windup_polynomial(Ao, R.size - 1)
     design = dict(wn=wn, zeta=zeta, observer=observer, Am=Am, Ao=Ao, P=P, nmp_zeros=np.array(nmp),
                   dt=h, method="RST pole placement, integral action, B not cancelled")
     return RSTController(R, S, T, A_aw=aw, u_min=u_min, u_max=u_max, plant=p, design=design)

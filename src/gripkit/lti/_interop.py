@@ -76,7 +76,9 @@ def as_system(obj, **signals) -> LinearSystem:
     """Any linear model gripkit meets, as a :class:`LinearSystem`.
 
     Accepts a LinearSystem (returned as is), an object whose ``lti`` attribute is one (an
-    identified :class:`gripkit.sysid.PolynomialModel`, a :class:`gripkit.control.DiscretePlant`),
+    identified :class:`gripkit.sysid.PolynomialModel`, a :class:`gripkit.control.DiscretePlant`)
+    or whose ``system`` attribute is one (an identified :class:`gripkit.sysid.LinearModel`, also
+    as :func:`gripkit.sysid.load_model` reads it),
     a python-control or scipy.signal system, an object with ``A``, ``B``, ``dt`` coefficient
     arrays in powers of q⁻¹ (``y = B/(A F) u`` when it has ``F``; its ``input_name``/
     ``output_name``/units are kept), or a tuple ``(A, B, dt)`` of q⁻¹ polynomials. ``signals``
@@ -89,8 +91,9 @@ def as_system(obj, **signals) -> LinearSystem:
     >>> type(g).__name__, g.dt, g.den_zinv().tolist()
     ('TransferFunction', 0.01, [1.0, -0.5])
     """
-    if not isinstance(obj, LinearSystem) and isinstance(getattr(obj, "lti", None), LinearSystem):
-        obj = obj.lti
+    for view in ("lti", "system"):  # a polynomial model or plant; an identified LinearModel
+        if not isinstance(obj, LinearSystem) and isinstance(getattr(obj, view, None), LinearSystem):
+            obj = getattr(obj, view)
     if isinstance(obj, LinearSystem):
         return obj.replace(**signals) if signals else obj
     if isinstance(obj, tuple) and len(obj) == 3:
