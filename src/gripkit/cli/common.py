@@ -14,7 +14,7 @@ import typer
 
 from ..sysid.model_file import plain
 
-__all__ = ["emit_json", "load_data", "collected_warnings", "report_warnings", "check_data_options", "check_choice", "check_number", "complex_pairs",
+__all__ = ["emit_json", "is_mcap", "load_data", "collected_warnings", "report_warnings", "check_data_options", "check_choice", "check_number", "complex_pairs",
            "FsOpt", "TimeOpt", "FillOpt", "JsonOpt"]
 
 FsOpt = typer.Option(None, "--fs", help="Sampling rate in Hz, when the file has no time column "
@@ -24,10 +24,25 @@ FillOpt = typer.Option(None, "--fill", help="Missing values: 'drop' rows or 'int
 JsonOpt = typer.Option(False, "--json", help="Print one JSON object on stdout.")
 
 
+def is_mcap(path: Path) -> bool:
+    from ..io import FORMATS
+
+    return FORMATS.get(Path(path).suffix.lower()) == "mcap"
+
+
 def load_data(path: Path, columns: list[str], fs: float | None, time: str | None, fill: str | None):
+    """The record's ``columns`` as a Trajectory. An MCAP log's channels keep the names given on
+    the command line (``/topic:field`` or ``alias=/topic:field``, as :func:`gripkit.io.load`
+    takes them in Python), so the commands find them by those names and a model identified from
+    the log names them so in its file (``gripkit compare MODEL.json LOG.mcap`` reads them again)."""
     from ..io import load
 
-    return load(path, columns=columns, fs=fs, time=time, fill=fill)
+    tr = load(path, columns=columns, fs=fs, time=time, fill=fill)
+    if is_mcap(path):
+        from ..io.mcap_reader import parse_column
+
+        tr = tr.rename(**{parse_column(c)[0]: c for c in dict.fromkeys(columns)})
+    return tr
 
 
 def check_data_options(fs: float | None, fill: str | None) -> None:

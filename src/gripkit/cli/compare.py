@@ -10,7 +10,7 @@ from pathlib import Path
 import typer
 
 from .app import app
-from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, report_warnings
+from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, is_mcap, load_data, report_warnings
 
 ModelArg = typer.Argument(..., help="Model file written by identify --out (.json).", show_default=False)
 
@@ -22,7 +22,8 @@ def _model_and_data(model_path: Path, data: Path, fs, time, fill, outputs: bool)
     cols = list(model.inputs) + (list(model.outputs) if outputs else [])
     from ..io import load
 
-    tr = load(data, fs=fs, time=time, fill=fill)
+    # an MCAP log is read by the model's channel names (the /topic:field specs it was fitted on)
+    tr = load_data(data, cols, fs, time, fill) if is_mcap(data) else load(data, fs=fs, time=time, fill=fill)
     missing = [c for c in cols if c not in tr.names]
     if missing:
         from ..errors import DataError
