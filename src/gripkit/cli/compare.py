@@ -41,6 +41,7 @@ def compare(model: Path = ModelArg,
                                         show_default=False),
             fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, json_out: bool = JsonOpt):
     """Free-run fit (%) of a saved model per output, initial state estimated."""
+    from ..sysid.linear_model import VALIDATION_FIT
     from ..sysid.model_file import file_sha256
 
     with warnings.catch_warnings(record=True) as caught:
@@ -49,12 +50,12 @@ def compare(model: Path = ModelArg,
         fit, _ = m.compare_data(tr)
     same = m.data_hash is not None and m.data_hash == file_sha256(data)
     res = {"model": str(model), "data": str(data), "structure": m.structure, "outputs": list(m.outputs),
-           "fit_percent": fit, "initial_state": "estimated", "estimation_data": same,
-           "warnings": report_warnings(caught)}
+           "fit_percent": fit, "initial_state": "estimated", "definition": VALIDATION_FIT,
+           "estimation_data": same, "warnings": report_warnings(caught)}
     if json_out:
         emit_json(res)
         return
-    typer.echo(f"{m.structure} on {data}{' (the estimation data)' if same else ''}: free-run fit, x0 estimated")
+    typer.echo(f"{m.structure} on {data}{' (the estimation data)' if same else ''}: {VALIDATION_FIT}")
     for n, f in zip(m.outputs, fit):
         typer.echo(f"  {n}: {f:.2f} %")
 

@@ -11,6 +11,7 @@ non-converged iteration) go to stderr as ``warning: ...`` lines and into the JSO
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from pathlib import Path
 
@@ -75,23 +76,33 @@ def _fit_and_report(method: str, data: Path, input: str, output: str, fs, time, 
         out.update(data=str(data), detrend=detrend)
         val = None
         if validate is not None:
-            vio = _io(validate, input, output, fs, time, fill, detrend, "validation")
+            # the validation record around the model's operating point (its offsets), as the one
+            # validation fit below and `gripkit compare` take it; a linear trend is the record's own
+            vio = _io(validate, input, output, fs, time, fill, "linear" if detrend == "linear" else "none",
+                      "validation")
+            if detrend != "linear":
+                vio = dataclasses.replace(vio, u=vio.u - model.u_offset, y=vio.y - model.y_offset,
+                                          u_offset=model.u_offset, y_offset=model.y_offset)
             if abs(vio.dt - io.dt) > 1e-9 * io.dt:
                 from ..errors import DataError
 
                 raise DataError(f"validation data {str(validate)!r} is sampled at {1 / vio.dt:g} Hz, the "
                                 f"estimation data at {1 / io.dt:g} Hz", hint="resample one of them")
-            val = model.validate(vio.u, vio.y)
-            out["validation_fit_percent"] = val.fit_percent
-            out["validation"] = val.to_dict()
+            from ..sysid.linear_model import VALIDATION_FIT, validation_fit
+
+            val = model.validate(vio.u, vio.y)  # one-step fit and residual tests
+            vfit = validation_fit(model, load_data(validate, [input, output], fs, time, fill))
+            out["validation_fit_percent"] = None if vfit is None else vfit[0]
+            out["validation"] = {**val.to_dict(), "fit_percent": out["validation_fit_percent"],
+                                 "initial": "estimated", "definition": VALIDATION_FIT}
     out["warnings"] = report_warnings(caught)
     if json_out:
         emit_json(out)
     else:
-        _print_model(model, val)
+        _print_model(model, val, out.get("validation_fit_percent"))
 
 
-def _print_model(model, val) -> None:
+def _print_model(model, val, vfit: float | None = None) -> None:
     from rich.console import Console
     from rich.table import Table
 
@@ -108,7 +119,7 @@ def _print_model(model, val) -> None:
     con.print(f"poles: {fmt(model.poles())}   ({'stable' if model.stable else 'UNSTABLE'})")
     con.print(f"zeros: {fmt(model.zeros())}   ({'minimum' if model.minimum_phase else 'NON-minimum'} phase)")
     if val is not None:
-        fit = "— (unstable model)" if val.fit_percent is None else f"{val.fit_percent:.2f} %"
+        fit = "— (unstable model)" if vfit is None else f"{vfit:.2f} %"
         tt = val.tests
         if tt is None:
             con.print(f"validation: free-run fit {fit}; the one-step predictor diverges (unstable model)")
@@ -125,7 +136,8 @@ def _mimo_arx(data: Path, input: str, output: str, na: int, nb: int, nk: int, fs
     ``--output`` order (free run with estimated x0, one-step, and free run on ``--validate``)."""
     from ..errors import DataError, StabilityWarning
     from ..sysid.identify_mimo import identify_arx as fit_arx
-    from ..sysid.identify_mimo import parse_names, validation_fit
+    from ..sysid.identify_mimo import parse_names
+    from ..sysid.linear_model import VALIDATION_FIT, validation_fit
     from ..sysid.model_file import file_sha256
 
     if detrend == "linear":
@@ -148,9 +160,10 @@ def _mimo_arx(data: Path, input: str, output: str, na: int, nb: int, nk: int, fs
             warnings.warn("arx: the identified model is unstable (a pole on or outside the unit circle): "
                           "no free-run fit is reported", StabilityWarning, stacklevel=1)
         if validate is not None:
-            vfit = validation_fit(model, load_data(validate, columns, fs, time, fill), detrend)
+            vfit = validation_fit(model, load_data(validate, columns, fs, time, fill))
             res["validation_fit_percent"] = vfit
-            res["validation"] = {"fit_percent": vfit, "data": str(validate), "initial_state": "estimated"}
+            res["validation"] = {"fit_percent": vfit, "data": str(validate), "initial_state": "estimated",
+                                 "definition": VALIDATION_FIT}
     res["warnings"] = report_warnings(caught)
     if json_out:
         emit_json(res)

@@ -79,11 +79,13 @@ def identify_ss_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = 
                                     refine=not no_refine, validate=vtr, detrend=detrend)
         model = _with_provenance(model, data)
         _finish(model, data, tr, out, report, None)
+    from ..sysid.linear_model import VALIDATION_FIT
+
     res = model.to_dict()
     res.update(data=str(data), method=method, refined=not no_refine, out=None if out is None else str(out))
     if "validation_fit_percent" in extras:
         res["validation"] = {"fit_percent": extras["validation_fit_percent"], "data": str(validate),
-                             "initial_state": "estimated"}
+                             "initial_state": "estimated", "definition": VALIDATION_FIT}
     if "search" in extras:
         res["search"] = extras["search"]
         res["search_criterion"] = extras["criterion"]
@@ -103,6 +105,7 @@ def identify_ss_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = 
     if "validation_fit_percent" in extras and extras["validation_fit_percent"] is not None:
         typer.echo("validation free-run fit: " + ", ".join(f"{n} {f:.2f} %" for n, f in
                                                            zip(ss.outputs, extras["validation_fit_percent"])))
+        typer.echo(f"  ({VALIDATION_FIT})")
     p, cov = (ss.pole_covariance() if ss.uncertainty is not None else (ss.poles(), None))
     for i, z in enumerate(p):
         sd = "" if cov is None else f" ± ({np.sqrt(cov[i, 0, 0]):.2g}, {np.sqrt(cov[i, 1, 1]):.2g})"

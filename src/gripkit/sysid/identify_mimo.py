@@ -15,6 +15,7 @@ edge of a range of three or more orders is warned about: the true order may lie 
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import warnings
 from dataclasses import dataclass
@@ -26,6 +27,7 @@ from ..progress import status
 from ..signals.trajectory import Trajectory
 from .arx_mimo import arx_mimo
 from .frf import frf
+from .linear_model import validation_fit  # the one definition, re-exported for the CLI
 
 __all__ = ["MimoData", "mimo_data", "identify_ss", "identify_frf", "identify_tf", "identify_arx", "several",
            "parse_names", "parse_order", "validation_fit"]
@@ -110,26 +112,22 @@ def mimo_data(data: Trajectory, inputs, outputs, detrend: str = "mean", why: str
                     tuple(data.unit(n) for n in outs), tuple(map(float, u0)), tuple(map(float, y0)))
 
 
-def _validation_data(validate: Trajectory, inputs, outputs, dt: float, detrend: str) -> MimoData:
-    vd = mimo_data(validate, inputs, outputs, detrend, why="validation")
-    if abs(vd.dt - dt) > 1e-9 * dt:
-        raise DataError(f"validation data are sampled at {1 / vd.dt:g} Hz, the estimation data at {1 / dt:g} Hz",
-                        hint="resample one of them")
-    return vd
+def _validation_data(validate: Trajectory, d: MimoData) -> MimoData:
+    """The validation record's columns as deviations from the *estimation* operating point
+    ``d.u_offset``/``d.y_offset`` (the model's offsets): the one validation fit of
+    :data:`gripkit.sysid.linear_model.VALIDATION_FIT`, the number ``gripkit compare`` gives."""
+    vd = mimo_data(validate, d.inputs, d.outputs, "none", why="validation")
+    if abs(vd.dt - d.dt) > 1e-9 * d.dt:
+        raise DataError(f"validation data are sampled at {1 / vd.dt:g} Hz, the estimation data at "
+                        f"{1 / d.dt:g} Hz", hint="resample one of them")
+    return dataclasses.replace(vd, u=vd.u - np.asarray(d.u_offset), y=vd.y - np.asarray(d.y_offset),
+                               u_offset=d.u_offset, y_offset=d.y_offset)
 
 
 def _validation_fit(model, vd: MimoData) -> list[float] | None:
     if not model.stable:
         return None
     return model.compare(vd.u, vd.y, dt=vd.dt)[0]
-
-
-def validation_fit(model, validate: Trajectory, detrend: str = "mean") -> list[float] | None:
-    """Free-run fit (%) per output of a discrete ``model`` on the record ``validate`` (the model's
-    columns, by name, with the record's own operating point removed as ``detrend`` says; initial
-    state estimated); None for an unstable model, whose free run diverges."""
-    vd = _validation_data(validate, model.inputs, model.outputs, model.dt, detrend)
-    return _validation_fit(model, vd)
 
 
 def _aic(model, d: MimoData) -> float:
@@ -167,7 +165,7 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     if method not in SUBSPACE_METHODS:
         raise DataError(f"method: expected one of {', '.join(SUBSPACE_METHODS)}, found {method!r}")
     d = mimo_data(data, input, output, detrend, why="state-space identification")
-    vd = None if validate is None else _validation_data(validate, d.inputs, d.outputs, d.dt, detrend)
+    vd = None if validate is None else _validation_data(validate, d)
     rng = parse_order(order)
     n_hi = rng[1] if rng else DEFAULT_MAX_ORDER
     k = default_horizon(n_hi, d.y.shape[1]) if horizon is None else int(horizon)

@@ -27,7 +27,7 @@ from ..lti import LinearSystem, StateSpace, TransferFunction
 from .checks import as_io_matrix
 from .model_file import SCHEMA, SCHEMA_VERSION, read_document, write_document
 
-__all__ = ["LinearModel", "as_io_matrix", "estimate_x0", "free_run", "fit_per_output", "from_polynomial",
+__all__ = ["VALIDATION_FIT", "validation_fit", "LinearModel", "as_io_matrix", "estimate_x0", "free_run", "fit_per_output", "from_polynomial",
            "model_document", "save_model", "load_model"]
 
 
@@ -253,6 +253,25 @@ class LinearModel:
     def __repr__(self) -> str:
         return (f"LinearModel({self.structure}, order={self.order}, inputs={list(self.inputs)}, "
                 f"outputs={list(self.outputs)}, dt={self.dt})")
+
+
+#: gripkit's one definition of a validation fit, used by ``identify --validate``, ``compare``,
+#: ``report`` and the demo, and stated in their outputs
+VALIDATION_FIT = ("free run from the model's operating point (its stored offsets), initial state "
+                  "estimated by least squares, fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) over every sample")
+
+
+def validation_fit(model, data) -> list[float] | None:
+    """Free-run fit (%) per output of ``model`` on the trajectory ``data``, by
+    :data:`VALIDATION_FIT`: the model's columns by name, its input and output offsets removed (the
+    estimation record's operating point, not the validation record's means), the initial state
+    estimated by least squares (:meth:`LinearModel.compare`). ``model`` is a
+    :class:`LinearModel` or a :class:`~gripkit.sysid.PolynomialModel`; None for an unstable
+    model, whose free run diverges."""
+    lm = model if isinstance(model, LinearModel) else from_polynomial(model)
+    if not lm.stable:
+        return None
+    return lm.compare_data(data)[0]
 
 
 def from_polynomial(pm) -> LinearModel:

@@ -19,6 +19,7 @@ import numpy as np
 from ..report.html import Report
 from ..report.plots import measured_vs_model, pyplot
 from .frf import frf
+from .linear_model import VALIDATION_FIT
 from .pem_ss import predict_errors
 
 __all__ = ["write_model_report", "model_report"]
@@ -161,8 +162,7 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=()) -> R
         y = model._columns(data, model.outputs, model.y_offset, "output")
         fit, ys, _ = model.compare(u, y, dt=dt)
         sec = rep.section("Measured and simulated outputs",
-                          "Free-run simulation of the model on the record's inputs, initial state estimated by "
-                          "least squares; fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖).")
+                          f"Validation fit on the record: {VALIDATION_FIT}.")
         sec.table(["output", "unit", "fit %"], [[n, u_ or "—", f] for n, u_, f in
                                                 zip(model.outputs, model.system.output_units, fit)])
         t = data.t - data.t[0]
