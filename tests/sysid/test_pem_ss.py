@@ -118,3 +118,23 @@ def test_sigma_honest_mimo_monte_carlo_small():
         hits += list((np.abs(d.real) <= 3 * np.sqrt(cov[i, 0, 0])) & (np.abs(d.imag) <= 3 * np.sqrt(cov[i, 1, 1])
                                                                       + 1e-12))
     assert np.mean(hits) >= 0.9
+
+
+def test_identify_ss_from_python_prints_nothing(capsys):
+    """Issue 25: ``identify(data, "ss")`` printed its stages to stderr from the library; only the
+    command line (progress=True) reports them."""
+    from gripkit import Trajectory
+    from gripkit.sysid import identify
+
+    rng = np.random.default_rng(0)
+    u = rng.standard_normal(800)
+    y = np.zeros(800)
+    for t in range(1, 800):
+        y[t] = 0.8 * y[t - 1] + 0.5 * u[t - 1]
+    tr = Trajectory.uniform(dt=0.01, u=u, y=y + 0.01 * rng.standard_normal(800))
+    capsys.readouterr()
+    model = identify(tr, "ss", input="u", output="y", order=1)
+    model = model[0] if isinstance(model, tuple) else model
+    out = capsys.readouterr()
+    assert out.err == "" and out.out == ""
+    assert abs(model.system.poles()[0] - 0.8) < 0.02

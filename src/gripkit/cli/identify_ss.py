@@ -76,7 +76,7 @@ def identify_ss_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = 
         tr = _load(data, input, output, fs, time, fill)
         vtr = _load(validate, input, output, fs, time, fill) if validate is not None else None
         model, extras = identify_ss(tr, input=input, output=output, order=order, method=method, form=form,
-                                    refine=not no_refine, validate=vtr, detrend=detrend)
+                                    refine=not no_refine, validate=vtr, detrend=detrend, progress=True)
         model = _with_provenance(model, data)
         _finish(model, data, tr, out, report, None)
     from ..sysid.linear_model import VALIDATION_FIT

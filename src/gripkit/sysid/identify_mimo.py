@@ -147,11 +147,12 @@ def _aic(model, d: MimoData) -> float:
 
 def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n4sid", form: str = "innovation",
                 refine: bool = True, validate: Trajectory | None = None, detrend: str = "mean",
-                horizon: int | None = None, feedthrough: bool = False):
+                horizon: int | None = None, feedthrough: bool = False, progress: bool = False):
     """State-space model of the named columns: subspace (``method``), then PEM in ``form``
     unless ``refine=False``. Returns ``(model, extras)``; ``extras`` holds ``search`` (the ranked
     orders of a range), ``validation_fit_percent`` (per output, with ``validate``) and
-    ``criterion``."""
+    ``criterion``. ``progress=True`` (the command line) reports each stage on stderr; a Python
+    call is silent."""
     from .pem_ss import pem
     from .subspace import (
         DEFAULT_MAX_ORDER,
@@ -169,7 +170,8 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     rng = parse_order(order)
     n_hi = rng[1] if rng else DEFAULT_MAX_ORDER
     k = default_horizon(n_hi, d.y.shape[1]) if horizon is None else int(horizon)
-    status(f"{method}: {d.u.shape[0]} samples, {len(d.inputs)} input(s), {len(d.outputs)} output(s), horizon {k}")
+    report = status if progress else (lambda line: None)
+    report(f"{method}: {d.u.shape[0]} samples, {len(d.inputs)} input(s), {len(d.outputs)} output(s), horizon {k}")
     fac = subspace_factor(d.u, d.y, horizon=k, method=method)
     extras: dict = {}
     build = lambda n: from_factor(fac, n, dt=d.dt, feedthrough=feedthrough, signals=d.signals)  # noqa: E731
@@ -210,7 +212,7 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
                           GripkitWarning, stacklevel=2)
     model = model.replace(u_offset=d.u_offset, y_offset=d.y_offset)
     if refine:
-        status(f"PEM refinement ({form} form) of the order-{model.order} model")
+        report(f"PEM refinement ({form} form) of the order-{model.order} model")
         model = pem(model, u=d.u, y=d.y, form=form)
     if vd is not None:
         extras["validation_fit_percent"] = _validation_fit(model, vd)
