@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..atomic import TEMP_SUFFIX, atomic_write, write_text
 from ..errors import ConfigError, DataError, GripkitWarning
 
 __all__ = ["ResultStore", "chunk_range", "collect"]
@@ -67,12 +68,10 @@ def collect(jobs: dict[str, np.ndarray], parts) -> dict[str, np.ndarray]:
     return out
 
 
-def _atomic_write_table(table, path: Path) -> None:
+def _write_table(table, path: Path, what: str) -> None:
     import pyarrow.parquet as pq
 
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    pq.write_table(table, tmp)
-    os.replace(tmp, path)
+    atomic_write(path, lambda tmp: pq.write_table(table, tmp), what=what)
 
 
 def fingerprint(obj) -> str:
@@ -118,11 +117,10 @@ class ResultStore:
                 raise ConfigError(f"output folder {str(self.root)!r} already holds results of this sweep",
                                   hint="pass --resume (resume=True) to continue it, or choose another folder")
         self.chunks_dir.mkdir(parents=True, exist_ok=True)
-        manifest = self.root / "manifest.json"
-        tmp = manifest.with_name(".manifest.json.tmp")
-        tmp.write_text(json.dumps({"fingerprint": fp, "spec": spec}, indent=2, default=str))
-        os.replace(tmp, manifest)
-        _atomic_write_table(pa.table({k: np.asarray(v) for k, v in jobs.items()}), self.root / "jobs.parquet")
+        manifest = json.dumps({"fingerprint": fp, "spec": spec}, indent=2, default=str)
+        write_text(self.root / "manifest.json", manifest, what="sweep manifest")
+        table = pa.table({k: np.asarray(v) for k, v in jobs.items()})
+        _write_table(table, self.root / "jobs.parquet", "sweep job table")
 
     # --- chunks ----------------------------------------------------------------------------
     def chunk_path(self, chunk: int) -> Path:
@@ -140,7 +138,7 @@ class ResultStore:
         for k, v in columns.items():
             a = np.asarray(v)
             arrays[k] = pa.array(a.tolist(), type=pa.string()) if a.dtype == object else pa.array(a)
-        _atomic_write_table(pa.table(arrays), self.chunk_path(chunk))
+        _write_table(pa.table(arrays), self.chunk_path(chunk), "sweep chunk")
 
     def _load(self, chunk: int, chunk_size: int, n_jobs: int, metrics) -> tuple[dict | None, str]:
         """(the chunk's columns, "") when its file is sound, else (None, what is wrong)."""
@@ -177,7 +175,8 @@ class ResultStore:
     def check_chunks(self, chunk_size: int, n_jobs: int, metrics=None) -> set[int]:
         """The chunks on disk that are sound; each bad one is set aside (``.bad``) with a warning,
         so that it is computed again."""
-        for stale in self.chunks_dir.glob(".chunk-*.tmp") if self.chunks_dir.exists() else ():
+        pattern = f".chunk-*{TEMP_SUFFIX}"
+        for stale in self.chunks_dir.glob(pattern) if self.chunks_dir.exists() else ():
             stale.unlink(missing_ok=True)  # a write cut short by a crash
         good = set()
         for c in sorted(self.done_chunks()):
