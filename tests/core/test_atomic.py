@@ -209,7 +209,8 @@ def test_sweep_chunk_full_disk(tmp_path, monkeypatch):
     from gripkit.batch.store import ResultStore
 
     store = ResultStore(tmp_path)
-    cols = {"job_id": np.arange(3), "peak": np.array([1.0, 2.0, 3.0]), "error": np.full(3, None, dtype=object)}
+    cols = {"job_id": np.arange(3), "peak": np.array([1.0, 2.0, 3.0]),
+            "error": np.full(3, None, dtype=object)}
     store.chunks_dir.mkdir(parents=True)
     chunk = store.chunk_path(0)
     listing = _old_file(chunk)
@@ -221,7 +222,7 @@ def test_sweep_chunk_full_disk(tmp_path, monkeypatch):
 
 
 def test_cli_model_out_full_disk_one_line(tmp_path, fail_open, capsys):
-    """``identify arx --out`` over an existing model: the CLI's one error line, the old file kept."""
+    """``identify arx --out`` over an existing model: one error line, the old file kept."""
     from gripkit.cli import main
     from gripkit.io import save
     from gripkit.signals import Trajectory
@@ -236,8 +237,8 @@ def test_cli_model_out_full_disk_one_line(tmp_path, fail_open, capsys):
     out = tmp_path / "m.json"
     listing = _old_file(out)
     fail_open(_enospc())
-    code = main(["identify", "arx", str(data), "--input", "u", "--output", "y", "--na", "1", "--nb", "1",
-                 "--nk", "1", "--out", str(out)])
+    code = main(["identify", "arx", str(data), "--input", "u", "--output", "y",
+                 "--na", "1", "--nb", "1", "--nk", "1", "--out", str(out)])
     err = capsys.readouterr().err.strip().splitlines()
     assert code != 0 and err[-1].startswith("error: PathError: model file ")
     assert "the previous file was kept unchanged" in err[-1] and "Traceback" not in "\n".join(err)
@@ -245,7 +246,8 @@ def test_cli_model_out_full_disk_one_line(tmp_path, fail_open, capsys):
 
 
 # --- excitation fourier: the format the suffix names -------------------------------------------
-_LINK = '<link name="{}"><inertial><mass value="0.1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4"/></inertial></link>'
+_LINK = ('<link name="{}"><inertial><mass value="0.1"/>'
+         '<inertia ixx="1e-4" iyy="1e-4" izz="1e-4"/></inertial></link>')
 _JOINT = ('<joint name="j{}" type="{}"><parent link="l{}"/><child link="l{}"/><axis xyz="0 0 1"/>'
           '<limit lower="-1" upper="1" effort="1" velocity="2"/></joint>')
 
@@ -261,7 +263,8 @@ def test_excitation_parquet_is_parquet(tmp_path, capsys):
 
     urdf = tmp_path / "arm.urdf"
     urdf.write_text('<robot name="arm"><link name="l0"/>' + _LINK.format("l1") + _LINK.format("l2")
-                    + _JOINT.format(0, "revolute", 0, 1) + _JOINT.format(1, "prismatic", 1, 2) + "</robot>")
+                    + _JOINT.format(0, "revolute", 0, 1) + _JOINT.format(1, "prismatic", 1, 2)
+                    + "</robot>")
     args = ["excitation", "fourier", str(urdf), "--harmonics", "1", "--f0", "0.5", "--fs", "20"]
     assert main([*args, "--out", str(tmp_path / "e.csv")]) == 0
     assert main([*args, "--out", str(tmp_path / "e.parquet")]) == 0
