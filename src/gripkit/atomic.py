@@ -4,10 +4,17 @@ A file is written to a temporary file in the target's folder, flushed and synced
 renamed over the target (``os.replace``, atomic on POSIX and Windows). A write that fails midway
 (a full disk, a file-size limit, Ctrl-C) leaves the previous file byte for byte as it was and no
 temporary file behind; an ``OSError`` becomes a :class:`~gripkit.errors.PathError` that names
-the file and says whether an old file was kept::
+the file and says whether an old file was kept:
 
-    >>> write_text("model.json", "{}\\n", what="model file")      # doctest: +SKIP
-    >>> atomic_write("t.parquet", lambda tmp: pq.write_table(table, tmp), what="trajectory")  # doctest: +SKIP
+>>> import pathlib, tempfile
+>>> folder = pathlib.Path(tempfile.mkdtemp())
+>>> write_text(folder / "model.json", "{}\\n", what="model file").read_text()
+'{}\\n'
+>>> atomic_write(folder / "x.csv", lambda tmp: pathlib.Path(tmp).write_text("t\\n0\\n")).name
+'x.csv'
+>>> sorted(p.name for p in folder.iterdir())  # no temporary file left
+['model.json', 'x.csv']
+>>> import shutil; shutil.rmtree(folder)
 
 Model files, simulated and excitation trajectories, reports and their figures, sweep manifests,
 job tables and chunks all go through :func:`atomic_write`.

@@ -35,6 +35,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..atomic import write_bytes
+from ..errors import PathError
 
 __all__ = ["Report", "Section"]
 
@@ -181,7 +182,11 @@ class Report:
         previous file as it was and raises :class:`~gripkit.errors.PathError`."""
         out = Path(out_dir)
         figs = out / "figures"
-        figs.mkdir(parents=True, exist_ok=True)
+        try:
+            figs.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise PathError(f"report folder {str(figs)!r} cannot be made ({exc.strerror or exc})",
+                            hint="choose a folder you may write to") from None
         for sec in self.sections:
             for kind, item in sec.items:
                 if kind == "figure":
