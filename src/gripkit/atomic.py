@@ -64,9 +64,12 @@ def atomic_write(path, write: Callable[[str], object], *, what: str = "file") ->
     On any failure (an exception in ``write``, the sync or the rename, KeyboardInterrupt included)
     the temporary file is removed and ``path`` is left untouched. An ``OSError`` is raised as
     :class:`PathError` naming ``what`` and ``path`` and saying that the old file was kept (or that
-    none was written); other exceptions propagate unchanged. Missing parent folders are created.
-    Returns ``path`` as a :class:`~pathlib.Path`."""
-    path = Path(path)
+    none was written); other exceptions propagate unchanged. Missing parent folders are created;
+    a ``path`` that is a symbolic link is followed (its target is replaced, the link stays), as a
+    plain write would. Returns ``path`` as a :class:`~pathlib.Path`."""
+    given = path = Path(path)
+    if path.is_symlink():
+        path = Path(os.path.realpath(path))
     existed = path.exists()
     kept = "the previous file was kept unchanged" if existed else "no file was written"
     try:
@@ -100,7 +103,7 @@ def atomic_write(path, write: Callable[[str], object], *, what: str = "file") ->
                             hint="free disk space or choose another path, then write it again") from exc
         raise
     _sync_folder(path.parent)
-    return path
+    return given
 
 
 def write_bytes(path, data: bytes, *, what: str = "file") -> Path:

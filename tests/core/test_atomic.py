@@ -99,6 +99,18 @@ def test_helper_replaces_the_file_and_keeps_permissions(tmp_path):
     assert sorted(os.listdir(tmp_path)) == ["a.txt", "sub"]
 
 
+def test_helper_writes_through_a_link(tmp_path):
+    """A model file reached through a symbolic link: the link stays, its target gets the text."""
+    (tmp_path / "real").mkdir()
+    target = tmp_path / "real" / "m.json"
+    target.write_text("old")
+    link = tmp_path / "m.json"
+    link.symlink_to(target)
+    assert atomic.write_text(link, "new") == link
+    assert link.is_symlink() and target.read_text() == "new"
+    assert os.listdir(tmp_path / "real") == ["m.json"]
+
+
 def test_helper_full_disk_midway(tmp_path, fail_open):
     p = tmp_path / "x.json"
     listing = _old_file(p)
