@@ -57,7 +57,8 @@ def _sync_folder(folder: Path) -> None:
         os.close(fd)
 
 
-def atomic_write(path, write: Callable[[str], object], *, what: str = "file") -> Path:
+def atomic_write(path, write: Callable[[str], object], *, what: str = "file",
+                 sync: bool = True) -> Path:
     """Write ``path`` atomically: ``write(tmp)`` writes the whole content to the temporary file
     ``tmp`` (a path string in the same folder), which is then synced and renamed over ``path``.
 
@@ -66,7 +67,10 @@ def atomic_write(path, write: Callable[[str], object], *, what: str = "file") ->
     :class:`PathError` naming ``what`` and ``path`` and saying that the old file was kept (or that
     none was written); other exceptions propagate unchanged. Missing parent folders are created;
     a ``path`` that is a symbolic link is followed (its target is replaced, the link stays), as a
-    plain write would. Returns ``path`` as a :class:`~pathlib.Path`."""
+    plain write would. ``sync=False`` skips the two ``fsync`` calls (file and folder): the write
+    stays atomic (the old file or the whole new one), but a power cut may lose it; only for files
+    that are checked when read back (sweep chunks, :mod:`gripkit.batch.store`). Returns ``path``
+    as a :class:`~pathlib.Path`."""
     given = path = Path(path)
     if path.is_symlink():
         path = Path(os.path.realpath(path))
@@ -81,7 +85,8 @@ def atomic_write(path, write: Callable[[str], object], *, what: str = "file") ->
                         hint="check that the folder exists and is writable") from None
     try:
         write(tmp)
-        _sync_file(tmp)
+        if sync:
+            _sync_file(tmp)
         if existed:  # keep the target's permission bits, as an in-place write would
             try:
                 os.chmod(tmp, path.stat().st_mode & 0o7777)
@@ -102,7 +107,8 @@ def atomic_write(path, write: Callable[[str], object], *, what: str = "file") ->
             raise PathError(f"{what} {str(path)!r} could not be written ({reason}); {kept}",
                             hint="free disk space or choose another path, then write it again") from exc
         raise
-    _sync_folder(path.parent)
+    if sync:
+        _sync_folder(path.parent)
     return given
 
 

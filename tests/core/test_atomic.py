@@ -99,6 +99,27 @@ def test_helper_replaces_the_file_and_keeps_permissions(tmp_path):
     assert sorted(os.listdir(tmp_path)) == ["a.txt", "sub"]
 
 
+def test_synced_before_the_rename(tmp_path, monkeypatch):
+    """The file, then its folder, are fsynced before and after the rename; sweep chunks are not
+    (checked when read back instead, see batch/store.py)."""
+    import gripkit.batch.store as store
+
+    calls = []
+    real_fsync = os.fsync
+
+    def fsync(fd):  # records whether the target exists yet
+        calls.append(os.path.exists(tmp_path / "a.txt"))
+        real_fsync(fd)
+    monkeypatch.setattr(atomic.os, "fsync", fsync)
+    atomic.write_text(tmp_path / "a.txt", "x")
+    assert calls == [False, True]  # the temporary file before the rename, the folder after
+    calls.clear()
+    s = store.ResultStore(tmp_path / "sw")
+    s.write_chunk(0, {"job_id": np.arange(2), "y": np.ones(2),
+                      "error": np.full(2, None, dtype=object)})
+    assert calls == [] and s.chunk_path(0).exists()
+
+
 def test_helper_writes_through_a_link(tmp_path):
     """A model file reached through a symbolic link: the link stays, its target gets the text."""
     (tmp_path / "real").mkdir()

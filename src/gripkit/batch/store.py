@@ -1,4 +1,5 @@
-"""Checkpointed sweep results: one Parquet file per chunk, written atomically.
+"""Checkpointed sweep results: one Parquet file per chunk, written atomically
+(:func:`gripkit.atomic.atomic_write`; the manifest and job table also synced to disk).
 
 Layout of an output folder::
 
@@ -77,10 +78,10 @@ def collect(jobs: dict[str, np.ndarray], parts) -> dict[str, np.ndarray]:
     return out
 
 
-def _write_table(table, path: Path, what: str) -> None:
+def _write_table(table, path: Path, what: str, sync: bool = True) -> None:
     import pyarrow.parquet as pq
 
-    atomic_write(path, lambda tmp: pq.write_table(table, tmp), what=what)
+    atomic_write(path, lambda tmp: pq.write_table(table, tmp), what=what, sync=sync)
 
 
 def _schema(table) -> list[list[str]]:
@@ -222,7 +223,11 @@ class ResultStore:
         table = pa.table(arrays)
         meta = {_META_SWEEP: str(getattr(self, "fingerprint", "")).encode(),
                 _META_COLUMNS: json.dumps(_schema(table)).encode()}
-        _write_table(table.replace_schema_metadata(meta), self.chunk_path(chunk), "sweep chunk")
+        # atomic but not fsynced: a chunk lost or torn by a power cut is found unreadable on resume
+        # and computed again, while an fsync per chunk made a sweep of 300 one-job chunks 1.3-1.5x
+        # slower (14.0-14.5 s against 9.4-11.2 s on a shared ext4 disk, 2026-11-26)
+        _write_table(table.replace_schema_metadata(meta), self.chunk_path(chunk), "sweep chunk",
+                     sync=False)
 
     def _load(self, chunk: int, chunk_size: int, n_jobs: int, metrics,
               fp: str | None) -> tuple[dict | None, str]:
