@@ -97,8 +97,13 @@ def test_another_sweeps_folder_with_results_is_refused(tmp_path):
 
 
 def test_empty_or_own_folder_is_used(tmp_path):
-    (tmp_path / "out").mkdir()
+    """An empty folder, or one left by a run killed while it wrote its manifest (an empty chunks
+    folder and the manifest's temporary file, removed), is used; then resumed."""
+    (tmp_path / "out" / "chunks").mkdir(parents=True)
+    (tmp_path / "out" / ".manifest.json.k2j4h.tmp").write_text('{"fingerp')
     _each_job_once(_run(tmp_path / "out"))
+    listing = sorted(p.name for p in (tmp_path / "out").iterdir())
+    assert listing == ["chunks", "jobs.parquet", "manifest.json"]
     res = _run(tmp_path / "out", resume=True)
     _each_job_once(res)
     assert res.computed_chunks == 0

@@ -145,6 +145,8 @@ class ResultStore:
     def __init__(self, root):
         self.root = Path(root)
         self.chunks_dir = self.root / "chunks"
+        #: the sweep's fingerprint, set by :meth:`initialise` and written into every chunk
+        self.fingerprint: str | None = None
 
     # --- setup -----------------------------------------------------------------------------
     def manifest(self) -> dict | None:
@@ -190,8 +192,13 @@ class ResultStore:
         run stopped before it wrote its manifest): results or files found there are another's."""
         if not self.root.is_dir():
             return
-        found = sorted(p for p in self.root.iterdir()
-                       if not (p == self.chunks_dir and p.is_dir() and not any(p.iterdir())))
+        found = []
+        for p in sorted(self.root.iterdir()):
+            own_temp = p.name.startswith((".manifest.json.", ".jobs.parquet."))
+            if own_temp and p.name.endswith(TEMP_SUFFIX):
+                p.unlink(missing_ok=True)  # this store's own write, cut short by a crash
+            elif not (p == self.chunks_dir and p.is_dir() and not any(p.iterdir())):
+                found.append(p)
         if not found:
             return
         names = [p.name + ("/" if p.is_dir() else "") for p in found]
@@ -221,7 +228,7 @@ class ResultStore:
             a = np.asarray(v)
             arrays[k] = pa.array(a.tolist(), type=pa.string()) if a.dtype == object else pa.array(a)
         table = pa.table(arrays)
-        meta = {_META_SWEEP: str(getattr(self, "fingerprint", "")).encode(),
+        meta = {_META_SWEEP: (self.fingerprint or "").encode(),
                 _META_COLUMNS: json.dumps(_schema(table)).encode()}
         # atomic but not fsynced: a chunk lost or torn by a power cut is found unreadable on resume
         # and computed again, while an fsync per chunk made a sweep of 300 one-job chunks 1.3-1.5x
