@@ -1,7 +1,8 @@
 """The import rules of docs/ARCHITECTURE.md, read from the source with ``ast`` (nothing is imported):
 no circles between modules, generic layers never import a reference system (nor the TOML front
 end, the demo or the CLI), a system never imports another one, the zoo imports no system,
-``signals`` never imports ``io``, no module imports another package's private names.
+``signals`` never imports ``io``, ``atomic`` imports only ``errors``, no module imports another
+package's private names.
 
 Every import counts, also the ones made inside functions."""
 
@@ -13,8 +14,9 @@ import pytest
 SRC = Path(__file__).resolve().parents[1] / "src" / "gripkit"
 
 #: the generic layers (a package or a top-level module of gripkit)
-GENERIC = ("errors", "progress", "arguments", "units", "params", "consistency", "signals", "io", "excitation",
-           "report", "lti", "sim", "multibody", "models", "sysid", "estimation", "control", "batch")
+GENERIC = ("errors", "atomic", "progress", "arguments", "units", "params", "consistency", "signals",
+           "io", "excitation", "report", "lti", "sim", "multibody", "models", "sysid", "estimation",
+           "control", "batch")
 #: what sits above the systems: the TOML front end, the demo, the CLI
 ABOVE_SYSTEMS = ("description", "demos", "cli")
 SYSTEMS = ("amadeus", "tsfm", "dlr_hit", "ftg100")
@@ -107,7 +109,8 @@ def test_the_import_graph_has_no_circles():
 
 @pytest.mark.parametrize("rule", ["generic layers name no system", "systems stay apart",
                                   "systems sit below description, demos and cli",
-                                  "the zoo names its factories by string", "signals never imports io"])
+                                  "the zoo names its factories by string", "signals never imports io",
+                                  "atomic writes import only errors"])
 def test_layering(rule):
     bad = []
     for a, b, names, line in IMPORTS:
@@ -121,6 +124,8 @@ def test_layering(rule):
         elif rule == "the zoo names its factories by string" and la == "zoo" and lb not in ("zoo", *GENERIC):
             bad.append((a, b, line))
         elif rule == "signals never imports io" and la == "signals" and lb == "io":
+            bad.append((a, b, line))
+        elif rule == "atomic writes import only errors" and la == "atomic" and lb != "errors":
             bad.append((a, b, line))
     assert bad == []
 
@@ -142,3 +147,4 @@ def test_the_rules_catch_what_they_forbid():
     layers = {(_layer(a), _layer(b)) for a, b, _, _ in IMPORTS}
     assert ("systems", "sim") in layers and ("systems", "batch") in layers and ("batch", "zoo") in layers
     assert ("cli", "description") in layers and ("demos", "systems") in layers
+    assert ("atomic", "errors") in layers and ("report", "atomic") in layers

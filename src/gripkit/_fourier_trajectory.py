@@ -28,6 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from .arguments import entry_point
+from .atomic import atomic_write
 from .sysid.dynamics import base_structure, friction_columns
 from .errors import DataError, IdentificationError
 
@@ -84,7 +85,10 @@ class FourierTrajectory:
         cols = self.columns()
         path = Path(path)
         data = np.column_stack(list(cols.values()))
-        np.savetxt(path, data, delimiter=",", header=",".join(cols), comments="", fmt="%.10g")
+        header = ",".join(cols)
+        atomic_write(path, lambda tmp: np.savetxt(tmp, data, delimiter=",", header=header,
+                                                  comments="", fmt="%.10g"),
+                     what="excitation trajectory")
         return path
 
     def to_dict(self) -> dict:

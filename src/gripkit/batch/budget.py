@@ -125,11 +125,12 @@ class MemoryEstimate:
         total = self.total(chunk_size, in_flight)
         if total <= limit:
             return
+        tasks = (f"; {_count(in_flight, 'task')} of {_count(chunk_size, 'job')} in flight, "
+                 f"{format_bytes(self.task_bytes(chunk_size))} each" if in_flight else "")
         raise ConfigError(
             f"{what}: {_count(self.n_jobs, 'job')} need{'s' if self.n_jobs == 1 else ''} an estimated {format_bytes(total)} of memory (job table "
             f"and results {format_bytes(self.table_bytes)} for {_count(self.n_parameters, 'parameter')} and "
-            f"{_count(self.n_metrics, 'metric')}; {_count(in_flight, 'task')} of {_count(chunk_size, 'job')} "
-            f"in flight, {format_bytes(self.task_bytes(chunk_size))} each), above {limit_text}",
+            f"{_count(self.n_metrics, 'metric')}{tasks}), above {limit_text}",
             hint="use fewer grid points, samples or time samples, split the sweep, lower chunk_size, "
                  "or raise the limit with --memory-limit (Python: memory_limit=)")
 

@@ -46,6 +46,7 @@ from ..errors import ConfigError, GripkitError
 from ..io import load
 from ..io.toml_file import read_toml
 from ..units import same_dimension, si_unit, to_si
+from .budget import MemoryEstimate, memory_limit as budget_limit
 
 __all__ = ["SweepSpec", "quantity"]
 
@@ -243,39 +244,74 @@ class SweepSpec:
                 randoms[name] = (kind, [lo, hi], clip)
         return grids, spaces, randoms, tables
 
-    def _table_rows(self, tables: dict[str, list[str]]) -> dict[str, np.ndarray]:
-        """Rows of the parameter files (each file zips its columns; files are crossed)."""
+    def _table_path(self, file: str, names: list[str]) -> Path:
+        """The parameter file ``file``, which must lie in the sweep file's folder (``base_dir``)
+        or below it: an absolute path, a ``..`` or a link that leads out of it is refused before
+        anything is read (a sweep file someone sends must not read, nor echo, other files)."""
+        base = Path(self.base_dir).resolve()
+        given = Path(file)
+        where = f"[parameters] {', '.join(names)}: table {file!r}"
+        rule = f"tables are read only from the sweep file's folder {str(base)!r} or below it"
+        fix = "copy the table into that folder and name it relative to it ('tables/objects.csv')"
+        if given.is_absolute() or given.drive or given.root:
+            raise ConfigError(f"{where} is an absolute path; {rule}", hint=fix)
+        target = (base / given).resolve()  # follows every link on the way
+        if target != base and base not in target.parents:
+            how = ("leaves that folder through '..'" if ".." in given.parts
+                   else "is a link that leads out of that folder")
+            raise ConfigError(f"{where} {how}; {rule}", hint=fix)
+        return target
+
+    def _read_tables(self, tables: dict[str, list[str]]) -> list[tuple[list[str], list]]:
+        """(parameter names, their columns) of each parameter file, read once, not yet crossed."""
+        out = []
+        for file, names in tables.items():
+            cols = [self.parameters[n].get("column", n) for n in names]
+            tr = load(self._table_path(file, names), columns=cols, fs=1.0)
+            out.append((names, [np.asarray(tr[c], dtype=np.float64) for c in cols]))
+        return out
+
+    @staticmethod
+    def _table_rows(read: list[tuple[list[str], list[np.ndarray]]]) -> dict[str, np.ndarray]:
+        """Rows of the parameter files as read by :meth:`_read_tables` (each file zips its
+        columns; files are crossed)."""
         cols_out: dict[str, np.ndarray] = {}
         n_rows = 1
-        for file, names in tables.items():
-            path = Path(file) if Path(file).is_absolute() else Path(self.base_dir) / file
-            cols = [self.parameters[n].get("column", n) for n in names]
-            tr = load(path, columns=cols, fs=1.0)
-            idx = np.arange(n_rows * tr.n)
-            cols_out = {k: v[idx // tr.n] for k, v in cols_out.items()}
-            for n, c in zip(names, cols):
-                cols_out[n] = np.asarray(tr[c], dtype=np.float64)[idx % tr.n]
-            n_rows *= tr.n
+        for names, columns in read:
+            n = len(columns[0])
+            idx = np.arange(n_rows * n)
+            cols_out = {k: v[idx // n] for k, v in cols_out.items()}
+            for name, col in zip(names, columns):
+                cols_out[name] = col[idx % n]
+            n_rows *= n
         return cols_out
 
     def n_jobs(self) -> int:
-        """The number of jobs, counted without building the table (a Python int: no overflow)."""
+        """The number of jobs, counted without building the table (a Python int: no overflow):
+        parameter files are read, but their rows are not crossed (1e5 × 1e5 rows are counted as
+        1e10 jobs, then refused by the memory estimate, not allocated)."""
         grids, spaces, _, tables = self._axes()
-        rows = self._table_rows(tables)
+        rows = math.prod(len(columns[0]) for _, columns in self._read_tables(tables))
         n = math.prod([g.size for g in grids.values()] + [s[3] for s in spaces.values()])
-        return n * (len(next(iter(rows.values()))) if rows else 1) * self.samples
+        return n * rows * self.samples
 
-    def jobs(self, units: dict[str, str] | None = None) -> dict[str, np.ndarray]:
+    def jobs(self, units: dict[str, str] | None = None, memory_limit=None) -> dict[str, np.ndarray]:
         """The job table: ``job_id`` and one float column per parameter (values checked against
-        ``units``, name -> SI unit, where given)."""
+        ``units``, name -> SI unit, where given). A table that would not fit in ``memory_limit``
+        (bytes or ``"8 GB"``; default half the memory available) is refused with the estimate
+        (:class:`~gripkit.batch.budget.MemoryEstimate`) before it is built."""
         grids, spaces, randoms, tables = self._axes(units)
         for name, (kind, a, b, n) in spaces.items():
             grids[name] = np.linspace(a, b, n) if kind == "linspace" else np.geomspace(a, b, n)
         grids = {n: grids[n] for n in self.parameters if n in grids}  # file order: first varies slowest
-        rows = self._table_rows(tables)
-        n_rows = len(next(iter(rows.values()))) if rows else 1
+        read = self._read_tables(tables)
+        n_rows = math.prod(len(columns[0]) for _, columns in read)
         n_points = math.prod(g.size for g in grids.values())
         n_jobs = n_points * n_rows * self.samples
+        limit, limit_text = budget_limit(memory_limit)
+        table = MemoryEstimate(n_jobs, len(self.parameters), 0, 0, 0)
+        table.check(0, 0, limit, limit_text, f"sweep {self.name!r}: the job table")
+        rows = self._table_rows(read)
         out: dict[str, np.ndarray] = {"job_id": np.arange(n_jobs, dtype=np.int64)}
         base = out["job_id"] // self.samples  # job = ((point * n_rows) + row) * samples + draw
         point, row = base // n_rows, base % n_rows

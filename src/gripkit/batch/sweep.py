@@ -195,7 +195,7 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "auto", workers
         chunk_size = m["spec"]["sweep"].get("chunk_size")
     # the table, the results and a first small task must fit before anything is built
     estimate.check(min(chunk_size or 2, n_jobs), max(in_flight, 1), limit, limit_text, f"sweep {spec.name!r}")
-    jobs = spec.jobs(dict(iface.parameters or {}))
+    jobs = spec.jobs(dict(iface.parameters or {}), memory_limit=limit)
     iface.check_values(jobs)
     names = [k for k in jobs if k != "job_id"]
 

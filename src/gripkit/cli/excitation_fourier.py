@@ -2,8 +2,10 @@
 [--periods P] [--velocity-limit V] [--acceleration-limit A] [--json]``: design a periodic
 Fourier-series excitation of every actuated joint of a URDF chain that minimises the condition
 number of the identification regressor within the position (URDF), velocity and acceleration
-limits (:func:`gripkit.excitation.fourier_trajectory`), and write it as CSV (columns ``t``,
-``q_<joint>``, ``qd_<joint>``, ``qdd_<joint>``; SI units)."""
+limits (:func:`gripkit.excitation.fourier_trajectory`), and write it (columns ``t``,
+``q_<joint>``, ``qd_<joint>``, ``qdd_<joint>``; SI units) in the format ``--out``'s suffix names:
+``.csv`` (a plain header of names), ``.parquet`` or ``.h5`` (:func:`gripkit.io.save`, with units);
+another suffix is refused before the design starts. Every format is written atomically."""
 
 from __future__ import annotations
 
@@ -22,7 +24,7 @@ app.add_typer(excitation_app, name="excitation")
 @excitation_app.command("fourier")
 def excitation_fourier(
     urdf: Path = typer.Argument(..., help="URDF file of the chain."),
-    out: Path = typer.Option(..., "--out", help="CSV file to write the trajectory to."),
+    out: Path = typer.Option(..., "--out", help="File for the trajectory (.csv, .parquet or .h5)."),
     f0: float = typer.Option(0.1, "--f0", help="Base frequency in Hz (the period is 1/f0)."),
     harmonics: int = typer.Option(5, "--harmonics", help="Number of harmonics per joint."),
     fs: float = typer.Option(100.0, "--fs", help="Sampling rate of the written trajectory, Hz."),
@@ -39,13 +41,18 @@ def excitation_fourier(
     from ..excitation import fourier_trajectory
     from ..multibody import from_urdf
     from ..progress import status
+    from .paths import output_file
 
+    output_file(out, "--out")
     chain = from_urdf(urdf, base_link=base_link, tip_link=tip_link)
     status(f"optimising {2 * chain.dof * harmonics} Fourier coefficients of {chain.name} ...")
     tr = fourier_trajectory(chain, f0=f0, harmonics=harmonics, dt=1.0 / fs, periods=periods,
                             velocity_limits=velocity_limit, acceleration_limits=acceleration_limit,
                             restarts=restarts, seed=seed)
-    tr.to_csv(out)
+    if out.suffix.lower() == ".csv":
+        tr.to_csv(out)
+    else:
+        _save_with_units(tr, chain, out)
     d = tr.to_dict()
     d["out"] = str(out)
     if json_out:
@@ -53,3 +60,22 @@ def excitation_fourier(
         return
     typer.echo(f"wrote {out}: {tr.t.size} samples at {fs:g} Hz of joints {', '.join(tr.joint_names)}; "
                f"regressor condition number {tr.condition_number:.3g} (start {tr.initial_condition_number:.3g})")
+
+
+def _save_with_units(tr, chain, out: Path) -> None:
+    """``tr`` through :func:`gripkit.io.save` (Parquet or HDF5), each column with its SI unit: a
+    coordinate that moves revolute joints only is in rad, prismatic only in m, else unitless."""
+    import numpy as np
+
+    from ..io import save
+    from ..signals import Trajectory
+
+    units = {}
+    for j, name in enumerate(tr.joint_names):
+        kinds = {chain.joint_types[i] for i in np.flatnonzero(chain.coupling[:, j])}
+        base = {"R": "rad", "P": "m"}.get(kinds.pop()) if len(kinds) == 1 else None
+        for prefix, per in (("q", ""), ("qd", "/s"), ("qdd", "/s**2")):
+            units[f"{prefix}_{name}"] = base + per if base else "1"
+    cols = tr.columns()
+    t = cols.pop("t")
+    save(Trajectory(t, cols, units), out)

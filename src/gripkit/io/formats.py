@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 from ..arguments import check_path, entry_point
+from ..atomic import atomic_write
 from ..errors import ArgumentError, DataError, DataWarning
 from ..signals.trajectory import Trajectory
 from .table import check_fill, check_fs, columns_to_trajectory
@@ -274,8 +275,9 @@ def _read_hdf5(path: Path, key=None, delimiter=None):
 
 @entry_point
 def save(tr: Trajectory, path, *, format: str | None = None, key: str = "/") -> None:
-    """Write a trajectory: time as ``t`` (s) then each channel with its SI unit. Writes to a
-    temporary file and renames it, so an interrupted save never leaves a half-written file."""
+    """Write a trajectory: time as ``t`` (s) then each channel with its SI unit. Written with
+    :func:`gripkit.atomic.atomic_write`: a save that fails midway leaves the old file as it was and
+    raises :class:`PathError`."""
     if not isinstance(tr, Trajectory):
         raise ArgumentError(f"save(): tr must be a gripkit Trajectory, found {type(tr).__name__}")
     check_path(path, "path", "save()")
@@ -283,28 +285,31 @@ def save(tr: Trajectory, path, *, format: str | None = None, key: str = "/") -> 
     fmt = _format(path, format)
     if fmt == "mcap":
         raise DataError("gripkit reads MCAP logs but writes CSV, Parquet or HDF5", hint="save as .parquet")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp")
     cols = {"t": tr.t, **{n: tr[n] for n in tr.names}}
     units = {"t": "s", **tr.units}
     if fmt == "csv":
         header = ",".join(f"{n} [{u}]" if u != "1" else n for n, u in units.items())
-        np.savetxt(tmp, np.column_stack(list(cols.values())), delimiter=",", header=header,
-                   comments="", fmt="%.17g")
+
+        def write(tmp):
+            np.savetxt(tmp, np.column_stack(list(cols.values())), delimiter=",", header=header,
+                       comments="", fmt="%.17g")
     elif fmt == "parquet":
         import pyarrow as pa
         import pyarrow.parquet as pq
 
         fields = [pa.field(n, pa.float64(), metadata={"unit": units[n]}) for n in cols]
         table = pa.Table.from_arrays([pa.array(v) for v in cols.values()], schema=pa.schema(fields))
-        pq.write_table(table, tmp)
+
+        def write(tmp):
+            pq.write_table(table, tmp)
     else:
         import h5py
 
-        with h5py.File(tmp, "w", track_order=True) as fh:
-            g = fh.require_group(key)
-            g.attrs["columns"] = list(cols)
-            for n, v in cols.items():
-                ds = g.create_dataset(n, data=v)
-                ds.attrs["unit"] = units[n]
-    os.replace(tmp, path)
+        def write(tmp):
+            with h5py.File(tmp, "w", track_order=True) as fh:
+                g = fh.require_group(key)
+                g.attrs["columns"] = list(cols)
+                for n, v in cols.items():
+                    ds = g.create_dataset(n, data=v)
+                    ds.attrs["unit"] = units[n]
+    atomic_write(path, write, what="trajectory file")

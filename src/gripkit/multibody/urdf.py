@@ -41,6 +41,7 @@ from pathlib import Path
 import numpy as np
 
 from ..arguments import entry_point
+from ..atomic import atomic_write
 from ..errors import GripkitWarning, ModelError
 from .coupling import CoupledChain
 from .dh import DHChain
@@ -601,5 +602,7 @@ def to_urdf(chain, path, *, name: str | None = None, base_link: str = "base",
     ET.SubElement(tj, "child", link=tip_link)
     ET.indent(robot)
     path = Path(path)
-    ET.ElementTree(robot).write(path, encoding="unicode", xml_declaration=True)
+    tree = ET.ElementTree(robot)
+    atomic_write(path, lambda tmp: tree.write(tmp, encoding="unicode", xml_declaration=True),
+                 what="URDF file")
     return path

@@ -30,10 +30,12 @@ import html
 import io
 import math
 import numbers
-import os
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
+
+from ..atomic import write_bytes
+from ..errors import PathError
 
 __all__ = ["Report", "Section"]
 
@@ -176,20 +178,19 @@ class Report:
 
     def write(self, out_dir) -> Path:
         """Write ``out_dir/index.html`` (and ``out_dir/figures/*.png``); returns the HTML path.
-        Each file is written to a temporary name and renamed, so a failure leaves no half file."""
+        Each file is written atomically (:func:`gripkit.atomic.write_bytes`): a failure leaves the
+        previous file as it was and raises :class:`~gripkit.errors.PathError`."""
         out = Path(out_dir)
         figs = out / "figures"
-        figs.mkdir(parents=True, exist_ok=True)
+        try:
+            figs.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise PathError(f"report folder {str(figs)!r} cannot be made ({exc.strerror or exc})",
+                            hint="choose a folder you may write to") from None
         for sec in self.sections:
             for kind, item in sec.items:
                 if kind == "figure":
-                    _atomic_write(figs / f"{item.slug}.png", item.png)
+                    write_bytes(figs / f"{item.slug}.png", item.png, what="report figure")
         index = out / "index.html"
-        _atomic_write(index, self.render().encode())
+        write_bytes(index, self.render().encode(), what="report page")
         return index
-
-
-def _atomic_write(path: Path, data: bytes) -> None:
-    tmp = path.with_name(f".{path.name}.tmp")
-    tmp.write_bytes(data)
-    os.replace(tmp, path)

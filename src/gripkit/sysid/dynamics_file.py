@@ -36,6 +36,7 @@ from pathlib import Path
 import numpy as np
 
 from .. import __version__
+from ..atomic import write_text
 from ..errors import DataError, ModelError
 from ..multibody import to_urdf
 from .model_file import content_hash, plain, read_document
@@ -91,10 +92,7 @@ def save_dynamics_model(result, path) -> None:
     if path.suffix.lower() != ".json":
         raise DataError(f"dynamics model file: expected a .json path, found {str(path)!r}")
     text = json.dumps(dynamics_document(result), indent=1, allow_nan=False)
-    try:
-        path.write_text(text + "\n")
-    except OSError as exc:
-        raise DataError(f"dynamics model file {str(path)!r} cannot be written: {exc.strerror}") from None
+    write_text(path, text + "\n", what="dynamics model file")
 
 
 def float_array(x, name, where, shape=None) -> np.ndarray:

@@ -19,6 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..atomic import write_text
 from ..errors import AccuracyWarning, DataError, ModelError
 
 __all__ = ["file_sha256", "plain", "write_document", "read_document", "SCHEMA", "SCHEMA_VERSION"]
@@ -70,10 +71,7 @@ def write_document(doc: dict, path) -> None:
         raise DataError(f"model file: expected a .json path, found {str(path)!r}")
     doc = plain(doc)
     doc["content_sha256"] = content_hash(doc)
-    try:
-        path.write_text(json.dumps(doc, indent=1, allow_nan=False) + "\n")
-    except OSError as exc:
-        raise DataError(f"model file {str(path)!r} cannot be written: {exc.strerror}") from None
+    write_text(path, json.dumps(doc, indent=1, allow_nan=False) + "\n", what="model file")
 
 
 def read_document(path, schema: str = SCHEMA, newest: int = SCHEMA_VERSION, *, what: str = "model file",
