@@ -12,7 +12,8 @@ from scipy.signal import freqz
 from gripkit.cli import main
 from gripkit.consistency import check
 from gripkit.errors import DataError
-from gripkit.systems.amadeus.force_dynamics import (FIG14_FREQUENCIES, finger_force_model, fig14_finding,
+from gripkit.systems.amadeus.force_dynamics import (FIG14_FREQUENCIES, finger_force_model,
+                                                     fig14_finding,
                                                      stepped_sine_experiment)
 
 A = [1.0, -1.8732, 0.8996]          # Table II, S1 [2 2 2]
@@ -45,12 +46,15 @@ def test_table_II_222_peaks_7p4_dB_at_5_Hz(plant):
     the 9 Hz Butterworth taking 0.39 dB at 5 Hz) and the other Table II rows in its message."""
     p = np.roots(A)[0]
     s = np.log(p) / 0.005
-    assert abs(s) / (2 * math.pi) == pytest.approx(5.32, abs=0.01) and -s.real / abs(s) == pytest.approx(0.32, abs=0.01)
+    assert abs(s) / (2 * math.pi) == pytest.approx(5.32, abs=0.01)
+    assert -s.real / abs(s) == pytest.approx(0.32, abs=0.01)
     ss = stepped_sine_experiment(plant)
     assert ss.peak[0] == 5.0 and ss.peak[1] == pytest.approx(7.43, abs=0.01)
     f = fig14_finding(plant)
     assert not f.consistent and f.computed == pytest.approx(7.425, abs=1e-3) and f.stated == 0.0
-    assert "+7.81 dB" in f.message and "S2 [2 2 2] +10.7 dB" in f.message and "S1 [3 2 2] +1.0 dB" in f.message
+    assert "+7.81 dB" in f.message
+    assert "S2 [2 2 2] +10.7 dB" in f.message
+    assert "S1 [3 2 2] +1.0 dB" in f.message
 
 
 def test_zoo_check_lists_fig14_and_the_sigma_factor(capsys):
@@ -64,13 +68,16 @@ def test_zoo_check_lists_fig14_and_the_sigma_factor(capsys):
     assert f["fig14-first-order-amplitude"]["computed"] == pytest.approx(7.425, abs=1e-3)
     assert not f["filter-sigma-factor-B"]["consistent"]
     assert f["filter-sigma-factor-B"]["computed"] == pytest.approx(24.7, abs=0.05)
-    assert f["filter-sigma-factor-A"]["consistent"] and f["filter-sigma-factor-A"]["computed"] == pytest.approx(3.99, abs=0.01)
-    assert check(finger_force_model()).find("fig14-first-order-amplitude").source.endswith("Table II")
+    assert f["filter-sigma-factor-A"]["consistent"]
+    assert f["filter-sigma-factor-A"]["computed"] == pytest.approx(3.99, abs=0.01)
+    fig14 = check(finger_force_model()).find("fig14-first-order-amplitude")
+    assert fig14.source.endswith("Table II")
 
 
 @pytest.mark.parametrize("kwargs, pattern", [
     (dict(amplitude=0.3), "amplitude: expected 0 < amplitude <= 0.25 A"),
-    (dict(frequencies=[5.0, 120.0]), "frequencies: expected positive frequencies below the 100 Hz Nyquist"),
+    (dict(frequencies=[5.0, 120.0]), "frequencies: expected positive frequencies below the 100 Hz "
+                                     "Nyquist"),
     (dict(frequencies=[]), "frequencies: expected positive frequencies"),
 ])
 def test_bad_stepped_sine(plant, kwargs, pattern):

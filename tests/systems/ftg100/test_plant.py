@@ -110,20 +110,24 @@ def test_resonance_rises_with_voltage():
     assert f[1] / f[0] > 1.4 and f[4] / f[0] > 2.5
     lin = FTG100Plant(check=False, k0=0.0)
     for v in (0.0, 70.0, 150.0):
-        assert lin.resonance(v)[0] == pytest.approx(math.sqrt(25.4 / 1.37e-6) / (2 * math.pi), rel=1e-12)
+        f_n = math.sqrt(25.4 / 1.37e-6) / (2 * math.pi)
+        assert lin.resonance(v)[0] == pytest.approx(f_n, rel=1e-12)
 
 
 def test_static_statements_reported():
-    """The seed's 20 µm at 70 V read as the free tip's travel (43.5 µm) and as the travel to the ball
-    (23.58 µm with the grip), and the full close (106.2 V ≤ 200 V) are reported, not hidden."""
+    """The seed's 20 µm at 70 V read as the free tip's travel (43.5 µm) and as the travel to the
+    ball (23.58 µm with the grip), and the full close (106.2 V ≤ 200 V) are reported, not hidden."""
     rep = check(FTG100Plant(check=False))
     f70, f200 = rep.find("static-70V"), rep.find("full-close-200V")
     assert f70.computed == pytest.approx(43.46e-6, rel=1e-3) and not f70.consistent
     assert rep.find("static-70V-grasp").computed == pytest.approx(23.578e-6, rel=1e-4)
     assert f200.computed == pytest.approx(106.18, rel=1e-4) and f200.consistent
     # the π⁴/128 stretching law leaves the free tip at 79.9 µm at 200 V: no full close
-    st = check(FTG100Plant(plant_parameters(suspension="stretching"), check=False)).find("full-close-200V")
-    assert not st.consistent and st.computed == pytest.approx(268.25, rel=1e-4) and "79.93 µm" in st.message
+    stretching = FTG100Plant(plant_parameters(suspension="stretching"), check=False)
+    st = check(stretching).find("full-close-200V")
+    assert not st.consistent
+    assert st.computed == pytest.approx(268.25, rel=1e-4)
+    assert "79.93 µm" in st.message
 
 
 def test_voltage_is_clipped_and_bad_parameters_refused():

@@ -41,7 +41,8 @@ def test_printed_numbers_give_43p5_um_free_not_20():
     x_nl = D_A * _cardano(K_SA, K3_A, C_EQ5 * 70 ** 2)
     assert x_lin == pytest.approx(43.46e-6, rel=1e-3)
     assert x_nl == pytest.approx(29.56e-6, rel=1e-3)
-    assert FTG100Plant(check=False, k0=0.0).equilibrium(70.0)["x_a"] == pytest.approx(x_lin, rel=1e-12)
+    free = FTG100Plant(check=False, k0=0.0)
+    assert free.equilibrium(70.0)["x_a"] == pytest.approx(x_lin, rel=1e-12)
     stretch = FTG100Plant(plant_parameters(suspension="stretching"), check=False, k0=0.0)
     assert stretch.equilibrium(70.0)["x_a"] == pytest.approx(x_nl, rel=1e-10)
     rep = check(FTG100Plant(check=False))
@@ -60,7 +61,10 @@ def _grasped_tip(k1, k3, c, V, gap, k0, k2, lever):
     from scipy.optimize import brentq
 
     kk = k0 * k2 / (k0 + k2)
-    xe = brentq(lambda x: k1 * x + k3 * x ** 3 + lever * kk * (lever * x - gap) - c * V * V, gap / lever, 1e-3,
+    def balance(x):
+        return k1 * x + k3 * x ** 3 + lever * kk * (lever * x - gap) - c * V * V
+
+    xe = brentq(balance, gap / lever, 1e-3,
                 xtol=1e-22, rtol=1e-15)
     return lever * xe, kk * (lever * xe - gap)
 
@@ -73,8 +77,10 @@ def test_gap_reading_puts_the_grasped_tip_within_13_to_18_percent():
     k2 = 235.36 / 6.05 ** 2                     # the plant's sensing arm, K_sb/D_b² (eq 16)
     x_lin, f_lin = _grasped_tip(K_SA, 0.0, C_EQ5, 70.0, 20e-6, 1043.0, k2, D_A)
     kk = 1043.0 * k2 / (1043.0 + k2)
-    assert x_lin == pytest.approx((C_EQ5 * 70 ** 2 / D_A + kk * 20e-6) / (K_SA / D_A ** 2 + kk), rel=1e-12)
-    assert x_lin == pytest.approx(23.578e-6, rel=1e-4) and f_lin == pytest.approx(22.866e-6, rel=1e-4)
+    closed_form = (C_EQ5 * 70 ** 2 / D_A + kk * 20e-6) / (K_SA / D_A ** 2 + kk)
+    assert x_lin == pytest.approx(closed_form, rel=1e-12)
+    assert x_lin == pytest.approx(23.578e-6, rel=1e-4)
+    assert f_lin == pytest.approx(22.866e-6, rel=1e-4)
     x_nl, _ = _grasped_tip(K_SA, K3_A, C_EQ5, 70.0, 20e-6, 1043.0, k2, D_A)
     assert x_nl == pytest.approx(22.627e-6, rel=1e-4)
     plant = FTG100Plant(check=False)
@@ -82,17 +88,20 @@ def test_gap_reading_puts_the_grasped_tip_within_13_to_18_percent():
     assert e["x_a"] == pytest.approx(x_lin, rel=1e-9) and e["F_c"] == pytest.approx(f_lin, rel=1e-8)
     assert e["x_b"] == pytest.approx(f_lin / k2, rel=1e-9)
     y = plant.simulate({"V": np.full(int(0.05 * 20000), 70.0)}, dt=5e-5)
-    assert y["x_a"][-1] == pytest.approx(x_lin, rel=1e-5) and y["F_c"][-1] == pytest.approx(f_lin, rel=1e-4)
+    assert y["x_a"][-1] == pytest.approx(x_lin, rel=1e-5)
+    assert y["F_c"][-1] == pytest.approx(f_lin, rel=1e-4)
     g = check(plant).find("static-70V-grasp")
     assert g.consistent and g.rel_error == pytest.approx(x_lin / 20e-6 - 1, rel=1e-9)   # 17.9 %
-    gs = check(FTG100Plant(plant_parameters(suspension="stretching"), check=False)).find("static-70V-grasp")
+    stretching = FTG100Plant(plant_parameters(suspension="stretching"), check=False)
+    gs = check(stretching).find("static-70V-grasp")
     assert gs.rel_error == pytest.approx(x_nl / 20e-6 - 1, rel=1e-6)                     # 13.1 %
 
 
 def test_default_plant_is_eq10_at_70V_the_calibrated_one_is_not():
     """Eq 10 is eq 9 at 70 V grasped. The default plant linearised there: ∂x_a/∂V =
     2 D_a c V₀/(K_sa + D_a² k_k) = 0.18936 µm/V, 0.82 % from eq 10's DC gain 0.18782 µm/V; the
-    calibrated plant's is κ = 0.4601 times that (53.6 % below); the stretching law's 10.5 % below."""
+    calibrated plant's is κ = 0.4601 times that (53.6 % below); the stretching law's 10.5 %
+    below."""
     k2 = 235.36 / 6.05 ** 2
     kk = 1043.0 * k2 / (1043.0 + k2)
     g_lin = 2 * D_A * C_EQ5 * 70.0 / (K_SA + D_A ** 2 * kk)
@@ -101,14 +110,16 @@ def test_default_plant_is_eq10_at_70V_the_calibrated_one_is_not():
     assert g10 == pytest.approx(0.18782e-6, rel=1e-4)
     rep = check(FTG100Plant(check=False))
     f = rep.find("eq10-plant-gain")
-    assert f.computed == pytest.approx(g_lin, rel=1e-9) and f.stated == pytest.approx(g10, rel=1e-12)
+    assert f.computed == pytest.approx(g_lin, rel=1e-9)
+    assert f.stated == pytest.approx(g10, rel=1e-12)
     assert f.consistent and f.rel_error == pytest.approx(0.0082, abs=1e-4)
     assert rep.find("eq5-force-factor").consistent
     cal = check(FTG100Plant(plant_parameters(force_factor="static-70V"), check=False))
     fc = cal.find("eq10-plant-gain")
     assert not fc.consistent and fc.computed == pytest.approx(g_lin * 20e-6 / 43.4646e-6, rel=1e-5)
     assert fc.rel_error == pytest.approx(0.536, abs=1e-3)
-    st = check(FTG100Plant(plant_parameters(suspension="stretching"), check=False)).find("eq10-plant-gain")
+    stretching = FTG100Plant(plant_parameters(suspension="stretching"), check=False)
+    st = check(stretching).find("eq10-plant-gain")
     assert not st.consistent and st.rel_error == pytest.approx(0.105, abs=1e-3)
 
 
@@ -124,7 +135,8 @@ def test_full_close_voltage():
     xe = 100e-6 / D_A
     v_st = math.sqrt((K_SA * xe + K3_A * xe ** 3) / C_EQ5)
     assert v_st == pytest.approx(268.25, rel=1e-4)
-    assert full_close_voltage(plant_parameters(suspension="stretching")) == pytest.approx(v_st, rel=1e-12)
+    stretching = plant_parameters(suspension="stretching")
+    assert full_close_voltage(stretching) == pytest.approx(v_st, rel=1e-12)
     free = FTG100Plant(check=False, k0=0.0)
     assert free.equilibrium(v_lin)["x_a"] == pytest.approx(100e-6, rel=1e-12)
 
@@ -139,7 +151,8 @@ def test_calibrated_force_factor_puts_the_tip_at_20_um():
     assert static_force_factor() == pytest.approx(kappa, rel=1e-12)
     kappa_st = (K_SA * xe + K3_A * xe ** 3) / (C_EQ5 * 70 ** 2)
     assert kappa_st == pytest.approx(0.5592, abs=1e-4)
-    assert static_force_factor(plant_parameters(suspension="stretching")) == pytest.approx(kappa_st, rel=1e-12)
+    stretching = plant_parameters(suspension="stretching")
+    assert static_force_factor(stretching) == pytest.approx(kappa_st, rel=1e-12)
     ps = plant_parameters(force_factor="static-70V")
     assert ps.value("c_e") == pytest.approx(kappa * C_EQ5, rel=1e-12)
     assert "κ = 0.4601" in ps["c_e"].doc and "20 µm at 70 V" in ps["c_e"].source
@@ -154,7 +167,8 @@ def test_calibrated_force_factor_puts_the_tip_at_20_um():
 
 
 def test_calibrated_plant_reports_its_departure_from_eq5():
-    """The calibrated plant meets 20 µm free but departs from eq 5 by 54 % (κ = 0.4601): reported."""
+    """The calibrated plant meets 20 µm free but departs from eq 5 by 54 % (κ = 0.4601):
+    reported."""
     rep = check(FTG100Plant(plant_parameters(force_factor="static-70V"), check=False))
     assert rep.find("static-70V").consistent
     assert not rep.find("static-70V-eq5").consistent             # the printed numbers do not change
@@ -202,17 +216,21 @@ def test_zoo_check_lists_the_70V_findings(capsys):
     assert code == 3
     f = {x["check"]: x for x in json.loads(out)["findings"]}
     assert not f["static-70V-eq5"]["consistent"] and f["static-70V-eq5"]["computed"] == pytest.approx(43.46e-6, rel=1e-3)
-    assert not f["static-70V"]["consistent"] and f["static-70V"]["computed"] == pytest.approx(43.46e-6, rel=1e-3)
+    assert not f["static-70V"]["consistent"]
+    assert f["static-70V"]["computed"] == pytest.approx(43.46e-6, rel=1e-3)
     assert f["static-70V"]["stated"] == 20e-6
-    assert f["static-70V-grasp"]["consistent"] and f["static-70V-grasp"]["computed"] == pytest.approx(23.578e-6, rel=1e-4)
+    assert f["static-70V-grasp"]["consistent"]
+    assert f["static-70V-grasp"]["computed"] == pytest.approx(23.578e-6, rel=1e-4)
     assert f["eq10-plant-gain"]["consistent"] and f["full-close-200V"]["consistent"]
     code = main(["zoo", "check", "ftg100-plant-calibrated"])
     out, _ = capsys.readouterr()
     assert code == 3
     lines = {ln.split(": ")[1]: ln for ln in out.splitlines()}
     assert lines["static-70V"].startswith("[ok]") and "= 2e-05 m" in lines["static-70V"]
-    assert lines["eq5-force-factor"].startswith("[INCONSISTENT]") and "κ = 0.4601" in lines["eq5-force-factor"]
-    assert lines["eq10-plant-gain"].startswith("[INCONSISTENT]") and "53.6 % apart" in lines["eq10-plant-gain"]
+    assert lines["eq5-force-factor"].startswith("[INCONSISTENT]")
+    assert "κ = 0.4601" in lines["eq5-force-factor"]
+    assert lines["eq10-plant-gain"].startswith("[INCONSISTENT]")
+    assert "53.6 % apart" in lines["eq10-plant-gain"]
 
 
 def test_zoo_discretize_refuses_the_nonlinear_plant(capsys):

@@ -38,7 +38,9 @@ def test_separation_voltage_from_the_hysteresis_is_36p4_not_35(left):
     on, off = _contact_window(z.contact_experiment(left, 72.5, noise=0.0))
     assert on == pytest.approx(44.0, abs=0.01) and off == pytest.approx(v, abs=0.01)
     f = check(z.gripper(check=False)).find("fig13-separation-voltage")
-    assert not f.consistent and f.stated == 35.0 and f.rel_error == pytest.approx(v / 35 - 1, rel=1e-9)
+    assert not f.consistent
+    assert f.stated == 35.0
+    assert f.rel_error == pytest.approx(v / 35 - 1, rel=1e-9)
     assert "pull-off force of 71.6 µN" in f.message and "by construction" in f.message
     _, off = _contact_window(z.contact_experiment(left, 72.5, noise=0.0, pull_off=71.6e-6))
     assert off == pytest.approx(35.0, abs=0.02)
@@ -46,7 +48,8 @@ def test_separation_voltage_from_the_hysteresis_is_36p4_not_35(left):
 
 def test_fig13_contact_and_location_are_inputs(left):
     """The 44 V contact and 62.42 µm are by construction: the face is put where tip C is at 44 V
-    (62.37 µm with the assumed L_r = 7 mm); moving L_r moves the location, not the contact voltage."""
+    (62.37 µm with the assumed L_r = 7 mm); moving L_r moves the location, not the contact
+    voltage."""
     assert z.contact_voltage(left) == pytest.approx(62.37e-6, rel=1e-3)
     other = z.finger("left", check=False).with_parameters(check=False, L_r=5e-3)
     assert z.contact_voltage(other) < 58e-6
@@ -58,7 +61,9 @@ def test_stroke_at_100V_exceeds_table_I():
     """With the lever chosen for Fig. 13, tip C is at 151.4 µm at 100 V (Table I: 100 µm range) and
     tip B at 141.7 µm, a 283 µm span for ±100 V against the laser's 250 µm (§V-A): reported."""
     f = check(z.gripper(check=False)).find("stroke-100V")
-    assert not f.consistent and f.computed == pytest.approx(151.44e-6, rel=1e-3) and f.stated == 100e-6
+    assert not f.consistent
+    assert f.computed == pytest.approx(151.44e-6, rel=1e-3)
+    assert f.stated == 100e-6
     assert "tip B 141.7 µm" in f.message and "283.3 µm" in f.message
     assert RANGES.value("stroke") == 100e-6 and "Table I" in RANGES["stroke"].source
     assert RANGES.value("force_range") == 2e-3 and "Table I" in RANGES["force_range"].source
@@ -66,14 +71,18 @@ def test_stroke_at_100V_exceeds_table_I():
 
 def test_simulations_warn_beyond_the_stroke_and_clip_the_sensor(left):
     """A 100 V ramp leaves the 100 µm stroke: AccuracyWarning naming y_C and Table I. A finger
-    pushed by 3 mN at rest reads k_s (y_D − y_C) ≈ 3 mN (2.998 mN one sample before the end), clipped to the 2 mN range with a
+    pushed by 3 mN at rest reads k_s (y_D − y_C) ≈ 3 mN (2.998 mN one sample before the end),
+    clipped to the 2 mN range with a
     DataWarning; within the ranges nothing is said."""
     U = np.append(np.linspace(0.0, 100.0, 2001), 100.0)
-    with pytest.warns(AccuracyWarning, match=r"y_C reaches 151.4 µm, beyond the finger's 100 µm displacement"):
+    pattern = r"y_C reaches 151.4 µm, beyond the finger's 100 µm displacement"
+    with pytest.warns(AccuracyWarning, match=pattern):
         left.simulate({"U": U, "F_g": np.zeros_like(U)}, dt=1.0)
     n = 2000
-    with pytest.warns(DataWarning, match=r"F_m reaches 2.99\d mN, beyond the sensor's 2 mN sensing range"):
-        tr = left.simulate({"U": np.zeros(n), "F_g": np.linspace(0.0, 3e-3, n)}, dt=1.0)  # quasi-static
+    pattern = r"F_m reaches 2.99\d mN, beyond the sensor's 2 mN sensing range"
+    with pytest.warns(DataWarning, match=pattern):
+        # quasi-static
+        tr = left.simulate({"U": np.zeros(n), "F_g": np.linspace(0.0, 3e-3, n)}, dt=1.0)
     assert tr["F_m"].max() == 2e-3
     with warnings.catch_warnings():
         warnings.simplefilter("error")
@@ -89,8 +98,9 @@ def _mobius(k, eF, eg, ec, csum):
 def test_no_fixed_calibration_error_gives_table_III_pattern():
     """Any fixed scale error gives an error monotonic in k wherever k̂ stays positive (checked on
     2000 random mixes within ±20 %; a mix that drives the denominator through zero reads a
-    negative stiffness for some part and is skipped); the printed −3.31, −2.00, −5.00 % are not, so a law through parts 1 and 3 reaches at
-    best −3.31 % at part 2 (1.31 points from −2.00). A single k_s error would need 17.7, 1.78,
+    negative stiffness for some part and is skipped); the printed −3.31, −2.00, −5.00 % are not, so
+    a law through parts 1 and 3 reaches at best −3.31 % at part 2 (1.31 points from −2.00). A single
+    k_s error would need 17.7, 1.78,
     0.69 % to first order (22.4, 1.85, 0.731 % exactly)."""
     rng = np.random.default_rng(0)
     k = np.array([12.1, 72.5, 469.0])
@@ -107,7 +117,8 @@ def test_no_fixed_calibration_error_gives_table_III_pattern():
     assert tried > 1000
     f = z.table_iii_pattern_finding()
     assert not f.consistent
-    assert f.computed == pytest.approx(11.7 / 12.1 - 1, rel=1e-12) and f.stated == pytest.approx(-0.02, rel=1e-9)
+    assert f.computed == pytest.approx(11.7 / 12.1 - 1, rel=1e-12)
+    assert f.stated == pytest.approx(-0.02, rel=1e-9)
     S = 1 / 128.0 + 1 / 130.8
     first = [abs((est / k_ - 1) / (k_ * S)) for k_, est, _ in z.TABLE_III]
     assert first == pytest.approx([0.177, 0.0178, 0.0069], abs=5e-4)

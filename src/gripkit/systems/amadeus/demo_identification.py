@@ -286,10 +286,14 @@ def _fig14(sec, study):
     sec.table(["frequency (Hz)", *[f"{f:g}" for f in ss.frequency]],
               [["gain over static (dB)", *[f"{g:+.2f}" for g in ss.gain_db]],
                ["phase (deg)", *[f"{p:.0f}" for p in ss.phase]]],
-              caption=(f"Fig. 14's stepped-sine experiment (§V-C: sinusoids 0.5–10.6 Hz, gain and phase from "
-                       f"the waveforms) simulated with Table II's [2 2 2] model, ±100 mA at 850 mA: the amplitude "
-                       f"peaks at {db_pk:+.2f} dB at {f_pk:g} Hz, where the seed measured a first-order-like "
-                       f"amplitude (cut-off between 1 and 10 Hz, no peak); the selected model contradicts the "
+              caption=("Fig. 14's stepped-sine experiment (§V-C: sinusoids 0.5–10.6 Hz, gain and "
+                       "phase from "
+                       "the waveforms) simulated with Table II's [2 2 2] model, ±100 mA at 850 "
+                       "mA: the amplitude "
+                       f"peaks at {db_pk:+.2f} dB at {f_pk:g} Hz, where the seed measured a "
+                       "first-order-like "
+                       "amplitude (cut-off between 1 and 10 Hz, no peak); the selected model "
+                       "contradicts the "
                        f"measurement it was chosen to match (finding fig14-first-order-amplitude)"))
 
 

@@ -47,7 +47,8 @@ from ...sysid.polynomial import PolynomialModel
 
 __all__ = ["ReferenceModel", "TABLE_II", "TABLE_III", "FingerForcePlant", "finger_force_model",
            "seed_checks", "SEED", "DT", "PREFILTER_ORDER", "PREFILTER_CUTOFF", "FORCE_SCALE", "PEAK_FORCE",
-           "FORCE_SCALE_DERIVATION", "FORCE_SCALE_NOTE", "force_scale_parameter", "FIG14_FREQUENCIES",
+           "FORCE_SCALE_DERIVATION", "FORCE_SCALE_NOTE", "force_scale_parameter",
+           "FIG14_FREQUENCIES",
            "SteppedSine", "stepped_sine_experiment", "fig14_finding"]
 
 SEED = "000_8f66dcc7ab06470c.txt"
@@ -356,7 +357,8 @@ class FingerForcePlant:
         return self._parameter_checks() + [fig14_finding(self)] + seed_checks()
 
     def _parameter_checks(self) -> list[Finding]:
-        """The plant's own numbers against §V (zeros, prefilter poles, delay, RLS = LS, stability)."""
+        """The plant's own numbers against §V (zeros, prefilter poles, delay, RLS = LS,
+        stability)."""
         out = []
         subj = self.name
         z222 = reference("II", 2, 2, 2).model().zeros()
@@ -423,7 +425,8 @@ class SteppedSine:
         return float(self.frequency[i]), float(self.gain_db[i])
 
 
-def stepped_sine_experiment(plant: FingerForcePlant, frequencies=FIG14_FREQUENCIES, *, amplitude: float = 0.1,
+def stepped_sine_experiment(plant: FingerForcePlant, frequencies=FIG14_FREQUENCIES, *,
+                            amplitude: float = 0.1,
                             cycles: int = 10, settle: float = 3.0) -> SteppedSine:
     """Fig. 14 simulated: one valve-current sine of ``amplitude`` A around 850 mA per frequency
     (±100 mA stays inside §V-E's 600–1100 mA), held ``settle`` s until the transient has died
@@ -434,11 +437,14 @@ def stepped_sine_experiment(plant: FingerForcePlant, frequencies=FIG14_FREQUENCI
     """
     f = np.asarray(frequencies, dtype=float)
     if f.ndim != 1 or f.size == 0 or not np.all(np.isfinite(f) & (f > 0) & (f < 0.5 / DT)):
-        raise DataError(f"frequencies: expected positive frequencies below the 100 Hz Nyquist limit, found "
+        raise DataError("frequencies: expected positive frequencies below the 100 Hz Nyquist "
+                        "limit, found "
                         f"{frequencies!r}")
     lo, hi = CURRENT_LIMITS
-    if not (math.isfinite(amplitude) and 0 < amplitude <= min(OPERATING_POINT - lo, hi - OPERATING_POINT)):
-        raise DataError(f"amplitude: expected 0 < amplitude <= 0.25 A (600–1100 mA around 850 mA), found "
+    span = min(OPERATING_POINT - lo, hi - OPERATING_POINT)
+    if not (math.isfinite(amplitude) and 0 < amplitude <= span):
+        raise DataError("amplitude: expected 0 < amplitude <= 0.25 A (600–1100 mA around 850 mA), "
+                        "found "
                         f"{amplitude!r}")
     gains, phases = [], []
     for fi in f:
@@ -448,7 +454,8 @@ def stepped_sine_experiment(plant: FingerForcePlant, frequencies=FIG14_FREQUENCI
         u = amplitude * np.sin(2 * np.pi * fi * t)
         y = plant.simulate(OPERATING_POINT + u)["force_true"][n_settle:]
         tm = t[n_settle:]
-        X = np.column_stack([np.sin(2 * np.pi * fi * tm), np.cos(2 * np.pi * fi * tm), np.ones_like(tm)])
+        w = 2 * np.pi * fi * tm
+        X = np.column_stack([np.sin(w), np.cos(w), np.ones_like(tm)])
         (c_s, c_c, _), *_ = np.linalg.lstsq(X, y, rcond=None)
         gains.append(math.hypot(c_s, c_c) / amplitude)
         phases.append(math.degrees(math.atan2(c_c, c_s)))
@@ -482,14 +489,19 @@ def fig14_finding(plant: FingerForcePlant | None = None) -> Finding:
         d = 20 * np.log10(np.abs(resp) / abs(sum(r.B) / sum(r.A)))
         others.append(f"{r.data} {r.label} {d.max():+.1f} dB at {ff[np.argmax(d)]:.1f} Hz")
     ok = bool(db_pk <= 3.0)
-    msg = (f"Fig. 14's stepped sine (0.5–10.6 Hz, ±100 mA at 850 mA) simulated with Table II S1 [2 2 2]: "
+    msg = ("Fig. 14's stepped sine (0.5–10.6 Hz, ±100 mA at 850 mA) simulated with Table II S1 [2 "
+           "2 2]: "
            f"amplitude peaks at {db_pk:+.2f} dB at {f_pk:g} Hz over its static gain "
-           f"({', '.join(f'{x:+.1f}' for x in ss.gain_db)} dB at {', '.join(f'{x:g}' for x in ss.frequency)} Hz; "
-           f"the model maps to the 9 Hz-filtered force, the filter takes {filt_db:.2f} dB at {f_pk:g} Hz, so the raw "
-           f"force would peak at {db_pk - filt_db:+.2f} dB), where §V-C measured a first-order-like amplitude "
+           f"({', '.join(f'{x:+.1f}' for x in ss.gain_db)} dB at "
+           f"{', '.join(f'{x:g}' for x in ss.frequency)} Hz; "
+           f"the model maps to the 9 Hz-filtered force, the filter takes {filt_db:.2f} dB at "
+           f"{f_pk:g} Hz, so the raw "
+           f"force would peak at {db_pk - filt_db:+.2f} dB), where §V-C measured a "
+           "first-order-like amplitude "
            f"(no peak: ≤ 0 dB; tolerance 3 dB, assumed). Other Table II rows: {'; '.join(others)}")
     return Finding("fig14-first-order-amplitude", plant.name, ok, msg,
-                   "the Table II [2 2 2] coefficients as printed (the model the seed selected)", db_pk, 0.0,
+                   "the Table II [2 2 2] coefficients as printed (the model the seed selected)",
+                   db_pk, 0.0,
                    db_pk, 3.0, f"{SEED}, §V-C, Fig. 14; Table II")
 
 

@@ -104,7 +104,8 @@ def _model_section(report, summary, act, sen, cpl, plant, dt):
 
 
 def _static_section(report, summary, act, plant, calibrated, stretching):
-    """The seed's 20 µm at 70 V in its two readings: the free tip (A) and the travel to the ball (B)."""
+    """The seed's 20 µm at 70 V in its two readings: the free tip (A) and the travel to the ball
+    (B)."""
     V0, x_stated = STATIC_70V
     geo = ftg100_geometry().value
     ce5 = geo("N_a") * geo("eps") * geo("h") / (2 * geo("g"))
@@ -114,24 +115,37 @@ def _static_section(report, summary, act, plant, calibrated, stretching):
     g10 = float(seed_state_space(SEED_EQ10).dc_gain()[0, 0])
     sec = report.section(
         "FT-G100 at 70 V: two readings of the stated 20 µm",
-        f"§III-A chooses V_in0 = 70 V \"since the size of the grasped objects is about 80 µm\": it \"allows a "
-        f"displacement of 20 µm\" at the actuated tip. Eq 5's force (N_a ε h/(2g) = {ce5 * 1e9:.4g} nN/V², "
-        f"{ce5 * V0 ** 2 * 1e6:.4g} µN at 70 V), eq 4's K_sa = 25.4 N/m and eq 3's D_a = 4.7 are also what the "
-        f"seed's own eq 10 is made of (eq 9 from the parameters {act.dc_gain() * 1e6:.4g} µm/V, printed "
+        "§III-A chooses V_in0 = 70 V \"since the size of the grasped objects is about 80 µm\": it "
+        "\"allows a "
+        "displacement of 20 µm\" at the actuated tip. Eq 5's force (N_a ε h/(2g) = "
+        f"{ce5 * 1e9:.4g} nN/V², "
+        f"{ce5 * V0 ** 2 * 1e6:.4g} µN at 70 V), eq 4's K_sa = 25.4 N/m and eq 3's D_a = 4.7 are "
+        "also what the "
+        f"seed's own eq 10 is made of (eq 9 from the parameters {act.dc_gain() * 1e6:.4g} µm/V, "
+        "printed "
         f"{g10 * 1e6:.4g} µm/V). (A) If 20 µm is the free tip's travel, these give D_a c V²/K_sa = "
-        f"{x_lin * 1e6:.3g} µm ({x_lin / x_stated:.2f}×), and fitting the force (κ = {kappa:.4f}, zoo "
-        f"ftg100-plant-calibrated) scales every small-signal gain at 70 V, eq 10's included, by κ. (B) If 20 µm "
-        f"is the travel to the ball (100 µm opening − 80 µm ball, the sentence's own reason for 70 V), eq 5 with "
-        f"the linear suspensions of eqs 4 and 8-10 closes the gap at 47.5 V and at 70 V grips the ball with the "
-        f"tip 3.6 µm beyond it, the sensing arm pushed back: no rescaling, and eq 10 holds. gripkit's default "
-        f"plant (zoo ftg100-plant) is (B); reading (A) is reported by `gripkit zoo check` (static-70V-eq5, "
-        f"static-70V, and eq10-plant-gain of the calibrated plant). The π⁴/128 stretching law (gripkit's "
-        f"assumption for Fig. 5's trend, used for the step and resonance figures below) is shown for comparison: "
+        f"{x_lin * 1e6:.3g} µm ({x_lin / x_stated:.2f}×), and fitting the force (κ = {kappa:.4f}, "
+        "zoo "
+        "ftg100-plant-calibrated) scales every small-signal gain at 70 V, eq 10's included, by κ. "
+        "(B) If 20 µm "
+        "is the travel to the ball (100 µm opening − 80 µm ball, the sentence's own reason for 70 "
+        "V), eq 5 with "
+        "the linear suspensions of eqs 4 and 8-10 closes the gap at 47.5 V and at 70 V grips the "
+        "ball with the "
+        "tip 3.6 µm beyond it, the sensing arm pushed back: no rescaling, and eq 10 holds. "
+        "gripkit's default "
+        "plant (zoo ftg100-plant) is (B); reading (A) is reported by `gripkit zoo check` "
+        "(static-70V-eq5, "
+        "static-70V, and eq10-plant-gain of the calibrated plant). The π⁴/128 stretching law "
+        "(gripkit's "
+        "assumption for Fig. 5's trend, used for the step and resonance figures below) is shown "
+        "for comparison: "
         f"the earlier 48 % gap and the full close not reached at 200 V were its artefacts.")
     rows = [["eqs 3-5, linear suspensions (printed numbers)", f"{x_lin * 1e6:.3g} µm", "—", "—",
              f"{70 * math.sqrt(geo('opening') / x_lin):.4g} V"]]
     for label, m in (("default plant: eq 5, linear (zoo ftg100-plant)", plant),
-                     (f"calibrated: κ = {kappa:.4f}, linear (zoo ftg100-plant-calibrated)", calibrated),
+                     (f"calibrated: κ = {kappa:.4f}, linear (zoo ftg100-plant-calibrated)",
+                      calibrated),
                      ("eq 5, π⁴/128 stretching (suspension='stretching')", stretching)):
         free = m.with_parameters(check=False, k0=0.0)
         rep = check(m)
@@ -140,16 +154,19 @@ def _static_section(report, summary, act, plant, calibrated, stretching):
                      f"{grasp.computed * 1e6:.4g} µm ({100 * grasp.rel_error:.1f} %)",
                      f"{gain.computed * 1e6:.4g} µm/V ({100 * gain.rel_error:.2g} %)",
                      f"{rep.find('full-close-200V').computed:.4g} V"])
-    rows.append(["seed", "20 µm, reading (A)", "20 µm + grip, reading (B)", f"{g10 * 1e6:.4g} µm/V (eq 10)",
+    rows.append(["seed", "20 µm, reading (A)", "20 µm + grip, reading (B)",
+                 f"{g10 * 1e6:.4g} µm/V (eq 10)",
                  "≤ 200 V (full close at the maximum voltage, §II-A)"])
-    sec.table(["model", "free tip at 70 V", "tip at 70 V, ball grasped", "small-signal gain at 70 V, grasped",
+    sec.table(["model", "free tip at 70 V", "tip at 70 V, ball grasped",
+               "small-signal gain at 70 V, grasped",
                "voltage closing 100 µm"], rows,
               caption="The 20 µm in both readings; in brackets the distance to the seed's number")
     shown = {(f.check, f.message) for f in check(plant)}  # in the plant's table of the section above
     for m, label in ((calibrated, "ftg100-plant-calibrated (force_factor='static-70V': reading A)"),
                      (stretching, "ftg100-plant with suspension='stretching'")):
         own = [f for f in check(m) if (f.check, f.message) not in shown]
-        sec.findings(ConsistencyReport(own, f"{label}; the printed numbers' static-70V-eq5 is in the section above"))
+        sec.findings(ConsistencyReport(own, f"{label}; the printed numbers' static-70V-eq5 is in "
+                                            "the section above"))
     summary["static_70V_um"] = dict(
         printed_linear=x_lin * 1e6, plant_free=x_lin * 1e6 * p("c_e") / ce5,
         plant_grasped=plant.equilibrium(V0)["x_a"] * 1e6,
@@ -164,9 +181,12 @@ def _step_section(report, act, sen, plant, dt):
                          "exactly and through the seed's printed eq 10. Middle: the sensing arm released from a "
                          "27 µm thrust (Fig. 9) with the stated M_b = 0.5 mg and through the printed eq 17 — the "
                          "printed matrices ring at 3.0 kHz instead of 3.45 kHz. Right: the nonlinear plant's free arm "
-                         "stepped from 0 V to 70, 100, 120, 150 V, normalised (Fig. 4), with the π⁴/128 stretching "
-                         "suspensions (plant_parameters(suspension='stretching'); the default plant's suspensions "
-                         "are eq 4's linear ones): stiffening raises the ringing frequency with voltage.")
+                         "stepped from 0 V to 70, 100, 120, 150 V, normalised (Fig. 4), with the "
+                         "π⁴/128 stretching "
+                         "suspensions (plant_parameters(suspension='stretching'); the default "
+                         "plant's suspensions "
+                         "are eq 4's linear ones): stiffening raises the ringing frequency with "
+                         "voltage.")
     n = 400
     t = np.arange(n) * dt
     V = np.where(t >= 1e-3, 80.0, 70.0)
@@ -206,13 +226,16 @@ def _resonance_section(report, summary, free, dt, quick):
     Vgrid = np.linspace(0, 200, 41)
     f_lin = np.array([free.resonance(v)[0] for v in Vgrid])
     sec = report.section("FT-G100: resonance vs actuation voltage (Fig. 5)",
-                         "The nonlinear plant with the stretching suspensions (suspension='stretching'), free "
+                         "The nonlinear plant with the stretching suspensions "
+                         "(suspension='stretching'), free "
                          "actuated arm, linearised at each voltage (line), and the "
                          "resonance identified from simulated ±2 V steps around it with 1 % noise by the general "
                          "step-response identification (`gripkit identify step`), with 2σ bars. The suspension "
                          "stiffens as K_sa(1 + β(x/w)²), β = π⁴/128 (beam stretching), so the resonance rises from "
-                         "685 Hz at rest; the seed's Fig. 5 shows the same trend (its data are not in the text). The law is gripkit's "
-                         "assumption: the default plant keeps eq 4's linear suspensions, as eqs 8-10 do.")
+                         "685 Hz at rest; the seed's Fig. 5 shows the same trend (its data are not "
+                         "in the text). The law is gripkit's "
+                         "assumption: the default plant keeps eq 4's linear suspensions, as eqs "
+                         "8-10 do.")
     Vid = np.arange(20, 200, 40 if quick else 20)
     f_id, f_sd = [], []
     rng = np.random.default_rng(0)
@@ -411,7 +434,8 @@ def _hybrid_sensitivity(sec, ctrl, plant):
     for label, kw in (("object damping ζ ≈ 0.02 (c0 = 0.14 mN·s/m)", dict(c0=1.4e-4)),
                       ("suspension 10 % stiffer than modelled", dict(K_sa=25.4 * 1.1)),
                       ("comb drive 10 % weaker than modelled", dict(c_e=plant.parameters.value("c_e") * 0.9)),
-                      ("comb drive calibrated to 20 µm free at 70 V (κ = 0.460), controller on eq 5",
+                      ("comb drive calibrated to 20 µm free at 70 V (κ = 0.460), controller on eq "
+                       "5",
                        dict(c_e=plant_parameters(force_factor="static-70V").value("c_e"))),
                       ("M_a 30 % heavier", dict(M_a=1.37e-6 * 1.3))):
         bb = grasp_batch(ctrl, plant.with_parameters(check=False, **kw), force=20e-6, k0=np.array([520.0, 1043.0, 1560.0]),

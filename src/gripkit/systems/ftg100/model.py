@@ -99,18 +99,18 @@ suspensions of eqs 4 and 8-10, so that its small-signal model at 70 V grasped *i
 ``gap`` of 20 µm is the seed's 20 µm. The full close (§II-A, "achieved while applying the maximum
 actuation voltage (200V)") is then reached at √(K_sa (100 µm/D_a)/c) = 106.2 V and holds at 200 V;
 the π⁴/128 stretching law would leave the free tip at 79.9 µm at 200 V (closing only at 268 V), so
-the earlier "full close not reached" finding was an artefact of that assumed law. Reading (A) is kept
-as ``plant_parameters(force_factor='static-70V')`` (zoo ``ftg100-plant-calibrated``: κ = 0.4601,
-linear suspensions, closing at 156.5 V) and reported: ``gripkit zoo check ftg100-plant`` lists
-``static-70V-eq5`` and ``static-70V`` (reading A, inconsistent, with the κ it needs),
+the earlier "full close not reached" finding was an artefact of that assumed law. Reading (A) is
+kept as ``plant_parameters(force_factor='static-70V')`` (zoo ``ftg100-plant-calibrated``: κ =
+0.4601, linear suspensions, closing at 156.5 V) and reported: ``gripkit zoo check ftg100-plant``
+lists ``static-70V-eq5`` and ``static-70V`` (reading A, inconsistent, with the κ it needs),
 ``static-70V-grasp`` (reading B, 17.9 %), ``eq10-plant-gain`` (0.82 %), ``full-close-200V`` and
 ``eq5-force-factor``; the calibrated entry lists the same checks with ``eq10-plant-gain`` 53.6 % off
 and ``eq5-force-factor`` 54 % off. Fig. 5's rising resonance needs some stiffening the seed does not
-quantify; ``plant_parameters(suspension='stretching')`` adds the Galerkin β = π⁴/128 (an upper bound,
-rigid anchors) for that qualitative trend, at the cost of eq 10 (10.5 % off) and the full close.
-(Meeting the free 20 µm and a full close at exactly 200 V with a V² force needs a secant-stiffness
-ratio of (200/70)²/(100/20) = 1.63 between 100 µm and 20 µm of tip travel: β ≈ 0.096 with
-κ = 0.473; gripkit does not adopt it, the seed has no stiffness data.)
+quantify; ``plant_parameters(suspension='stretching')`` adds the Galerkin β = π⁴/128 (an upper
+bound, rigid anchors) for that qualitative trend, at the cost of eq 10 (10.5 % off) and the full
+close. (Meeting the free 20 µm and a full close at exactly 200 V with a V² force needs a
+secant-stiffness ratio of (200/70)²/(100/20) = 1.63 between 100 µm and 20 µm of tip travel: β ≈
+0.096 with κ = 0.473; gripkit does not adopt it, the seed has no stiffness data.)
 """
 
 from __future__ import annotations
@@ -637,8 +637,8 @@ _PLANT_NAMES = ("M_a", "K_fa", "K_sa", "K3_a", "D_a", "c_e", "M_b", "K_fb", "K_s
                 "k0", "c0", "gap", "V_max")
 
 
-#: The seed's static statement (§III-A, after Fig. 4): 70 V "allows a displacement of 20 µm in static
-#: mode at the tip of the actuated arm". Read as the free tip's displacement it is what
+#: The seed's static statement (§III-A, after Fig. 4): 70 V "allows a displacement of 20 µm in
+#: static mode at the tip of the actuated arm". Read as the free tip's displacement it is what
 #: ``force_factor='static-70V'`` calibrates to; read as the 100 − 80 µm gap to the ball it is the
 #: plant's ``gap`` (module docstring).
 STATIC_70V = (70.0, 20e-6)
@@ -646,7 +646,8 @@ STATIC_70V = (70.0, 20e-6)
 #: Suspension laws of :func:`plant_parameters` and the provenance of their ``K3_a``.
 _SUSPENSIONS = {
     "linear": _S + "eqs 4 and 8-10 (linear suspensions: 'only small deflections are considered')",
-    "stretching": "assumed: Galerkin estimate K_sa·(π⁴/128)/w² (beams.py), Fig. 5 trend (no seed number)",
+    "stretching": ("assumed: Galerkin estimate K_sa·(π⁴/128)/w² (beams.py), Fig. 5 trend "
+                   "(no seed number)"),
 }
 
 
@@ -678,7 +679,8 @@ def static_force_factor(parameters: ParameterSet | None = None, *, voltage: floa
     return (p("K_sa") * xe + p("K3_a") * xe ** 3) / (p("c_e") * V * V)
 
 
-def full_close_voltage(parameters: ParameterSet | None = None, opening: float | None = None) -> float:
+def full_close_voltage(parameters: ParameterSet | None = None,
+                       opening: float | None = None) -> float:
     """Voltage [V] at which the free actuated tip travels ``opening`` (m, default the seed's 100 µm,
     §II-A): c_e V² = K_sa x_e + K3_a x_e³ with x_e = opening/D_a (eq 2 at rest, eq 3). 106.2 V for
     the linear plant, 268.2 V with the π⁴/128 stretching (beyond the 200 V limit)."""
@@ -698,13 +700,14 @@ def plant_parameters(*, force_factor: float | str = 1.0, suspension: str = "line
     ``suspension``: ``'linear'`` (default, ``K3_a`` = 0: the suspensions of eqs 4 and 8-10, which
     makes the plant's small-signal model at 70 V with the ball grasped eq 9/10 itself) or
     ``'stretching'`` (``K3_a`` = K_sa β/w², β = π⁴/128, the Galerkin clamped-clamped stretching of
-    :mod:`gripkit.models.beams`: gripkit's assumption for Fig. 5's rising resonance, no seed number);
-    ``K3_b`` = 0 (Fig. 10: the sensor is linear up to 140 µN); ``c_e`` = κ N_a ε h/(2g) (eq 5) with
-    κ = ``force_factor``: 1 (default, eq 5 as printed), a positive number, or ``'static-70V'`` (κ from
-    :func:`static_force_factor` with the other ``values``: the free tip at 20 µm at 70 V, κ = 0.4601
-    with linear suspensions, 0.5592 with stretching); ``gap`` = 100 µm opening − 80 µm ball; ``c0`` = 0
-    (the seed's object is a pure spring). ``values`` replace any parameter (``c_e`` only with κ = 1).
-    The two readings of the seed's "20 µm at 70 V" are in the module docstring.
+    :mod:`gripkit.models.beams`: gripkit's assumption for Fig. 5's rising resonance, no seed
+    number); ``K3_b`` = 0 (Fig. 10: the sensor is linear up to 140 µN); ``c_e`` = κ N_a ε h/(2g) (eq
+    5) with κ = ``force_factor``: 1 (default, eq 5 as printed), a positive number, or
+    ``'static-70V'`` (κ from :func:`static_force_factor` with the other ``values``: the free tip at
+    20 µm at 70 V, κ = 0.4601 with linear suspensions, 0.5592 with stretching); ``gap`` = 100 µm
+    opening − 80 µm ball; ``c0`` = 0 (the seed's object is a pure spring). ``values`` replace any
+    parameter (``c_e`` only with κ = 1). The two readings of the seed's "20 µm at 70 V" are in the
+    module docstring.
     """
     calibrate = isinstance(force_factor, str)
     if calibrate and force_factor != "static-70V":
@@ -719,7 +722,8 @@ def plant_parameters(*, force_factor: float | str = 1.0, suspension: str = "line
                                  hint="1 is eq 5 as printed; 'static-70V' fits the seed's 20 µm at 70 V")
     if suspension not in _SUSPENSIONS:
         raise ParameterError(f"suspension: expected 'linear' or 'stretching', found {suspension!r}",
-                             hint="'linear' is eqs 4 and 8-10; 'stretching' adds the π⁴/128 stiffening")
+                             hint="'linear' is eqs 4 and 8-10; 'stretching' adds the π⁴/128 "
+                                  "stiffening")
     if "c_e" in values and (calibrate or kappa != 1.0):
         raise ParameterError(f"c_e and force_factor={force_factor!r} both set the comb-drive coefficient",
                              hint="give one of them: c_e in N/V², or force_factor relative to eq 5")
@@ -729,7 +733,8 @@ def plant_parameters(*, force_factor: float | str = 1.0, suspension: str = "line
     w = ftg100_geometry().value("w")
     ps = ParameterSet([
         full["M_a"], full["K_fa"], full["K_sa"],
-        P("K3_a", full.value("K_sa") * STRETCHING_BETA / w ** 2 if suspension == "stretching" else 0.0,
+        P("K3_a",
+          full.value("K_sa") * STRETCHING_BETA / w ** 2 if suspension == "stretching" else 0.0,
           "N/m**3", "cubic stiffening of the actuator suspension (beam stretching)", (0, None),
           source=_SUSPENSIONS[suspension], display_unit="N/um**3"),
         full["D_a"],
@@ -935,7 +940,8 @@ class FTG100Plant(Model):
     @staticmethod
     def _solve_cubic(k1, k3, f):
         """x with k1 x + k3 x³ = f (monotonic for k1 > 0, k3 ≥ 0)."""
-        if f == 0.0 or k3 == 0.0:  # linear: f/k1 exactly (brentq's bracket [0, f/k1] may not change sign)
+        # linear: f/k1 exactly (brentq's bracket [0, f/k1] may not change sign)
+        if f == 0.0 or k3 == 0.0:
             return f / k1
         hi = abs(f) / k1
         return math.copysign(brentq(lambda x: k1 * x + k3 * x ** 3 - abs(f), 0.0, hi, xtol=1e-18, rtol=1e-14), f)
@@ -1018,9 +1024,9 @@ class FTG100Plant(Model):
         """The seed's static statements against each other and against this plant (module docstring,
         "Static displacement at 70 V: two readings"): ``static-70V-eq5`` (eqs 3-5 with linear
         suspensions, the printed numbers alone, free-arm reading), ``static-70V`` (this plant, free
-        arm: the free-arm reading), ``static-70V-grasp`` (this plant with the ball: the gap reading),
-        ``eq10-plant-gain`` (this plant's small-signal gain at 70 V, grasped, against eq 10),
-        ``full-close-200V`` (the voltage that closes the 100 µm opening against 200 V) and
+        arm: the free-arm reading), ``static-70V-grasp`` (this plant with the ball: the gap
+        reading), ``eq10-plant-gain`` (this plant's small-signal gain at 70 V, grasped, against eq
+        10), ``full-close-200V`` (the voltage that closes the 100 µm opening against 200 V) and
         ``eq5-force-factor`` (the plant's c_e against eq 5)."""
         p = self.parameters.value
         V0, x70_stated = STATIC_70V
@@ -1037,18 +1043,27 @@ class FTG100Plant(Model):
         return [
             compare("static-70V-eq5", self.name, computed=x_eq5, stated=x70_stated, rtol=0.1, unit="m",
                     what=(f"free tip displacement at 70 V from the printed numbers, D_a N_a ε h V²/(2g K_sa) "
-                          f"(eqs 2-5, F_x = {ce5 * V0 ** 2 * 1e6:.4g} µN; small-signal gain of eq 8 with "
-                          f"k_k = 0: {gain_eq8 * 1e6:.4g} µm/V where 20 µm at 70 V with F ∝ V² means "
-                          f"{2 * x70_stated / V0 * 1e6:.3g} µm/V), if 20 µm is the free tip's travel"),
-                    used=("20 µm read as the gap to the ball (static-70V-grasp) where force_factor = 1; "
-                          "plant_parameters(force_factor='static-70V') adopts the free-arm reading"),
+                          f"(eqs 2-5, F_x = {ce5 * V0 ** 2 * 1e6:.4g} µN; small-signal gain of eq "
+                          "8 with "
+                          f"k_k = 0: {gain_eq8 * 1e6:.4g} µm/V where 20 µm at 70 V with F ∝ V² "
+                          "means "
+                          f"{2 * x70_stated / V0 * 1e6:.3g} µm/V), if 20 µm is the free tip's "
+                          "travel"),
+                    used=("20 µm read as the gap to the ball (static-70V-grasp) where force_factor "
+                          "= 1; "
+                          "plant_parameters(force_factor='static-70V') adopts the free-arm "
+                          "reading"),
                     source=_S + "§III-A, eqs 3-5 and the statement after Fig. 4"),
             compare("static-70V", self.name, computed=x70, stated=x70_stated, rtol=0.1, unit="m",
-                    what=(f"free tip displacement at 70 V of this plant (c_e = {kappa:.4g} × eq 5, K3_a = "
-                          f"{p('K3_a'):.4g} N/m³; linear suspensions: {lin70 * 1e6:.3g} µm), if 20 µm is the "
+                    what=(f"free tip displacement at 70 V of this plant (c_e = {kappa:.4g} × eq 5, "
+                          "K3_a = "
+                          f"{p('K3_a'):.4g} N/m³; linear suspensions: {lin70 * 1e6:.3g} µm), if 20 "
+                          "µm is the "
                           f"free tip's travel"),
-                    used=(f"c_e = {p('c_e') * 1e9:.4g} nN/V²; the free-arm reading needs force_factor = "
-                          f"{kappa_free:.4g} (× eq 5): plant_parameters(force_factor='static-70V'), whose "
+                    used=(f"c_e = {p('c_e') * 1e9:.4g} nN/V²; the free-arm reading needs "
+                          "force_factor = "
+                          f"{kappa_free:.4g} (× eq 5): "
+                          "plant_parameters(force_factor='static-70V'), whose "
                           f"small-signal gain is then {kappa_free:.4g} × eq 10's"),
                     source=_S + "§III-A, after Fig. 4"),
             self._grasp_finding(V0, x70_stated),
@@ -1068,7 +1083,8 @@ class FTG100Plant(Model):
 
     def _grasp_finding(self, V0: float, x_stated: float) -> Finding:
         """The gap reading of §III-A's 20 µm: the 100 µm opening less the 80 µm ball is the travel
-        70 V must give to reach the ball; with the ball, the tip stands beyond it by the sensing arm's
+        70 V must give to reach the ball; with the ball, the tip stands beyond it by the sensing
+        arm's
         deflection x_b = F_c/k2 and the ball's compression F_c/k0 (eqs 6-7)."""
         p = self.parameters.value
         g = self._grasped()
@@ -1076,23 +1092,31 @@ class FTG100Plant(Model):
         k0 = g.parameters.value("k0")
         if e["F_c"] < 1e-12:  # the tip just reaches the ball (the calibrated plant): print zeros
             e = dict(e, F_c=0.0, x_b=0.0)
-        what = (f"tip at 70 V with the 80 µm ball (gap {p('gap') * 1e6:.3g} µm = 100 µm opening − 80 µm ball, "
-                f"F_c = {e['F_c'] * 1e6:.4g} µN: sensing arm pushed back x_b = {e['x_b'] * 1e6:.3g} µm, ball "
-                f"compressed F_c/k0 = {e['F_c'] / k0 * 1e6:.2g} µm), if 20 µm is the travel to the ball; "
+        what = (f"tip at 70 V with the 80 µm ball (gap {p('gap') * 1e6:.3g} µm = 100 µm opening − "
+                "80 µm ball, "
+                f"F_c = {e['F_c'] * 1e6:.4g} µN: sensing arm pushed back x_b = "
+                f"{e['x_b'] * 1e6:.3g} µm, ball "
+                f"compressed F_c/k0 = {e['F_c'] / k0 * 1e6:.2g} µm), if 20 µm is the travel to the "
+                "ball; "
                 f"tolerance 20 %: the excess is the grip itself (linear suspensions 17.9 %, "
                 f"stretching 13.1 %), against 117 % for the free-arm reading")
-        return compare("static-70V-grasp", self.name, computed=e["x_a"], stated=x_stated, rtol=0.2, unit="m",
+        return compare("static-70V-grasp", self.name, computed=e["x_a"], stated=x_stated,
+                       rtol=0.2, unit="m",
                        what=what, used="gap = 20 µm: 70 V closes the arm on the ball",
                        source=_S + "§II-A opening, §III-A '80 µm' and the statement after Fig. 4")
 
     def _eq10_finding(self, V0: float) -> Finding:
-        """Eq 10 is eq 9 at V_in0 = 70 V, grasped: this plant linearised there must give its DC gain."""
+        """Eq 10 is eq 9 at V_in0 = 70 V, grasped: this plant linearised there must give its DC
+        gain."""
         g = self._grasped()
         gain = float(g.linearize(V0).dc_gain()[0, 0])
         seed = float(seed_state_space(SEED_EQ10).dc_gain()[0, 0])
-        return compare("eq10-plant-gain", self.name, computed=gain, stated=seed, rtol=0.015, unit="m/V",
-                       what=("small-signal gain ∂x_a/∂V of this plant at 70 V with the ball grasped vs the DC "
-                             "gain of the printed eq 10 (eq 9 with eq 5's force: 0.56 % from it; tolerance "
+        return compare("eq10-plant-gain", self.name, computed=gain, stated=seed, rtol=0.015,
+                       unit="m/V",
+                       what=("small-signal gain ∂x_a/∂V of this plant at 70 V with the ball "
+                             "grasped vs the DC "
+                             "gain of the printed eq 10 (eq 9 with eq 5's force: 0.56 % from it; "
+                             "tolerance "
                              "1.5 % as for eq 10's own check)"),
                        used="this plant's parameters", source=_S + "eqs 9-10")
 
@@ -1111,5 +1135,6 @@ class FTG100Plant(Model):
                + ". Linear suspensions close at 106.2 V (the arms meet there; the plant has no "
                "arm-to-arm contact), β = π⁴/128 stretching reaches only 79.9 µm")
         return Finding("full-close-200V", self.name, ok, msg,
-                       f"K3_a = {p('K3_a'):.4g} N/m³, c_e = {p('c_e') * 1e9:.4g} nN/V²", V, p("V_max"),
+                       f"K3_a = {p('K3_a'):.4g} N/m³, c_e = {p('c_e') * 1e9:.4g} nN/V²", V,
+                       p("V_max"),
                        abs(V - p("V_max")) / p("V_max"), 0.0, _S + "§II-A")

@@ -96,14 +96,16 @@ def check_ranges(trajectory, positions: tuple[str, ...], forces: tuple[str, ...]
         if peak > stroke:
             warnings.warn(f"{subject}: {name} reaches {peak * 1e6:.4g} µm, beyond the finger's "
                           f"{stroke * 1e6:.3g} µm displacement range ({_SEED} Table I): the model "
-                          "extrapolates there (lower the voltage amplitude)", AccuracyWarning, stacklevel=3)
+                          "extrapolates there (lower the voltage amplitude)", AccuracyWarning,
+                          stacklevel=3)
     clipped = {}
     for name in forces:
         x = trajectory[name]
         peak = float(np.max(np.abs(x))) if x.size else 0.0
         if peak > limit:
             warnings.warn(f"{subject}: {name} reaches {peak * 1e3:.4g} mN, beyond the sensor's "
-                          f"{limit * 1e3:.3g} mN sensing range ({_SEED} Table I): the reading is clipped "
+                          f"{limit * 1e3:.3g} mN sensing range ({_SEED} Table I): the reading is "
+                          "clipped "
                           f"to ±{limit * 1e3:.3g} mN", DataWarning, stacklevel=3)
             clipped[name] = np.clip(x, -limit, limit)
     return trajectory.with_channels(**clipped) if clipped else trajectory
@@ -824,7 +826,8 @@ class TSFMGripper(Model):
 
     def simulate(self, u, **kwargs):
         """:meth:`Model.simulate`, then the ranges checked (:func:`check_ranges`)."""
-        return check_ranges(super().simulate(u, **kwargs), ("y_C1", "y_C2"), ("F_m1", "F_m2"), self.name)
+        return check_ranges(super().simulate(u, **kwargs), ("y_C1", "y_C2"), ("F_m1", "F_m2"),
+                            self.name)
 
     def _simulate_batch(self, thetas, u, dt, substeps, x0, y):
         # rows one after another: a gripper is simulated for one or a few parameter sets (a prange

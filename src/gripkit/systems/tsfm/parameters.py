@@ -149,19 +149,19 @@ def table_iii_pattern_finding() -> Finding:
     the part closes dδ = Σ dy_C = dF/k. An estimator whose gain is off by ε_g, compliance by ε_c
     and force sensitivity by ε_F (fixed scale errors, the same for every part: d_p, s_p, k_s, the
     200 µN/V calibration; errors of λ, β, γ act only on the hysteretic part, λ/(β+γ) = 3.7 µm or
-    5 % of the stroke at 100 V, which §IV identifies within 2 %) reads dδ̂ = (1 + ε_g) Σ g dU − (1 + ε_c)(1 + ε_F) Σc dF and dF̂ =
-    (1 + ε_F) dF, so
+    5 % of the stroke at 100 V, which §IV identifies within 2 %) reads dδ̂ = (1 + ε_g) Σ g dU − (1 +
+    ε_c)(1 + ε_F) Σc dF and dF̂ = (1 + ε_F) dF, so
 
         k̂/k = (1 + ε_F) / [(1 + ε_g) + k Σc ((1 + ε_g) − (1 + ε_c)(1 + ε_F))],
 
     a Möbius function of k: monotonic on k > 0 wherever k̂ stays positive (the denominator is
-    linear in k; through zero it would read a negative stiffness). Table III's errors are −3.31, −2.00, −5.00 % at
-    12.1, 72.5 and 469 N/m (rising, then falling): any monotonic law through parts 1 and 3 gives
-    part 2 an error between −5.00 and −3.31 %, at best −3.31 %, 1.31 points from the printed −2.00 %
-    (the whole-percent rounding allows 0.5). The single k_s error of the earlier explanation
-    (ε_c only) needs 17.7, 1.8 and 0.69 % for the three parts to first order (22.4, 1.85 and 0.73 %
-    exactly). The errors are also not random noise at the stated noise levels (:mod:`.stiffness_study`:
-    relative σ 0.028, 0.059 and 0.33 %, so 16-120σ). And the
+    linear in k; through zero it would read a negative stiffness). Table III's errors are −3.31,
+    −2.00, −5.00 % at 12.1, 72.5 and 469 N/m (rising, then falling): any monotonic law through parts
+    1 and 3 gives part 2 an error between −5.00 and −3.31 %, at best −3.31 %, 1.31 points from the
+    printed −2.00 % (the whole-percent rounding allows 0.5). The single k_s error of the earlier
+    explanation (ε_c only) needs 17.7, 1.8 and 0.69 % for the three parts to first order (22.4, 1.85
+    and 0.73 % exactly). The errors are also not random noise at the stated noise levels
+    (:mod:`.stiffness_study`: relative σ 0.028, 0.059 and 0.33 %, so 16-120σ). And the
     "Estimated" column equals Measured × (1 − printed error) to every printed digit for parts 2
     and 3 (72.5 × 0.98 = 71.05, 469 × 0.95 = 445.55; part 1: 12.1 × 0.97 = 11.737, printed 11.7):
     the errors look primary and the estimates derived from them, so no protocol can be tested
@@ -172,17 +172,23 @@ def table_iii_pattern_finding() -> Finding:
     lo, hi = min(e[0], e[2]), max(e[0], e[2])
     reach = min(max(e[1], lo), hi)  # the closest error a monotonic law through parts 1, 3 allows
     exact = [abs(row[0] * (1 - row[2]) - row[1]) < 5e-9 * row[0] for row in TABLE_III]
-    msg = (f"Table III errors {', '.join(f'{100 * x:+.2f} %' for x in e)} at {', '.join(f'{x:g}' for x in k)} N/m "
-           f"are not monotonic in k, while any fixed calibration error (actuator gain, finger compliance, "
-           f"sensor k_s, force sensitivity) gives k̂/k = (1 + ε_F)/[(1 + ε_g) + k Σc (…)], monotonic: through "
-           f"parts 1 and 3 it reaches at best {100 * reach:+.2f} % at part 2; a single k_s error would need "
-           f"{', '.join(f'{100 * x:.3g} %' for x in _k_s_errors(k, e, exact=False))} to first order "
+    msg = (f"Table III errors {', '.join(f'{100 * x:+.2f} %' for x in e)} at "
+           f"{', '.join(f'{x:g}' for x in k)} N/m "
+           "are not monotonic in k, while any fixed calibration error (actuator gain, finger "
+           "compliance, "
+           "sensor k_s, force sensitivity) gives k̂/k = (1 + ε_F)/[(1 + ε_g) + k Σc (…)], "
+           "monotonic: through "
+           f"parts 1 and 3 it reaches at best {100 * reach:+.2f} % at part 2; a single k_s error "
+           "would need "
+           f"{', '.join(f'{100 * x:.3g} %' for x in _k_s_errors(k, e, exact=False))} to first "
+           "order "
            f"({', '.join(f'{100 * x:.3g} %' for x in _k_s_errors(k, e))} exactly); "
            f"Estimated = Measured × (1 − error) "
            f"exactly for parts {', '.join(str(i + 1) for i, x in enumerate(exact) if x)}")
     return Finding("table-iii-calibration-pattern", "Table III", False, msg,
                    "the Measured column as the truth; no protocol reproduces the printed errors",
-                   reach, e[1], abs(reach - e[1]) / abs(e[1]), 0.005 / abs(e[1]), f"{SEED} Table III, eq 16")
+                   reach, e[1], abs(reach - e[1]) / abs(e[1]), 0.005 / abs(e[1]), f"{SEED} Table "
+                                                                                  "III, eq 16")
 
 
 def _k_s_errors(k, e, exact: bool = True) -> list[float]:
@@ -224,7 +230,8 @@ def fig13_findings(side: str = "left", stiffness: float = 72.5) -> list[Finding]
     """Fig. 13 / §V-B: the separation voltage the Table II hysteresis predicts for a contact made
     at 44 V (the contact voltage and the 62.42 µm of §V-C are inputs of gripkit's experiment, not
     predictions: the part face is placed where tip C is at 44 V, and the assumed L_r = 7 mm was
-    chosen so that C is there at 62.4 µm), and the adhesion that would move it to the stated 35 V."""
+    chosen so that C is there at 62.4 µm), and the adhesion that would move it to the stated
+    35 V."""
     f = finger(side, check=False)
     V_sep = separation_voltage(f)
     # adhesion: separation when F = −F_po; statically F = k_e (y_free − x_w)/(1 + k_e c), c = c0/a0
@@ -236,12 +243,16 @@ def fig13_findings(side: str = "left", stiffness: float = 72.5) -> list[Finding]
     y = f.simulate({"U": U, "F_g": np.zeros_like(U)}, dt=1.0)["y_C"][1:]
     y35 = float(np.interp(35.0, U[n - 1:-1][::-1], y[n - 1:][::-1]))
     F_po = stiffness * (x_w - y35) / (1.0 + stiffness * c)
-    what = (f"separation voltage of a contact made at 44 V (0 → 50 → 0 V, Table II's Bouc-Wen loop of the {side} "
-            f"finger, no adhesion; the 44 V contact and the 62.42 µm are placed by construction); the stated 35 V "
+    what = ("separation voltage of a contact made at 44 V (0 → 50 → 0 V, Table II's Bouc-Wen loop "
+            f"of the {side} "
+            "finger, no adhesion; the 44 V contact and the 62.42 µm are placed by construction); "
+            "the stated 35 V "
             f"needs the tip held {1e6 * (x_w - y35):.3g} µm short of the face, a pull-off force of "
             f"{F_po * 1e6:.3g} µN on a {stiffness:g} N/m part (the seed gives neither)")
-    return [compare("fig13-separation-voltage", f"tsfm-{side}", computed=V_sep, stated=35.0, rtol=0.02, unit="V",
-                    what=what, used="no pull-off force (F_po = 0): separation from the hysteresis alone",
+    return [compare("fig13-separation-voltage", f"tsfm-{side}", computed=V_sep, stated=35.0,
+                    rtol=0.02, unit="V",
+                    what=what, used="no pull-off force (F_po = 0): separation from the hysteresis "
+                                    "alone",
                     source=f"{SEED} §V-B, Fig. 13")]
 
 
@@ -256,10 +267,13 @@ def stroke_finding(side: str = "left") -> Finding:
         tr = f.simulate({"U": U, "F_g": np.zeros_like(U)}, dt=1.0)
     yC, yB = float(tr["y_C"][-1]), float(tr["y_B"][-1])
     stroke = RANGES.value("stroke")
-    what = (f"tip C at 100 V from rest (the amplitude of Figs 9 and 12), {side} finger with the assumed "
-            f"L_r = 7 mm, L_a = 15 mm (chosen for Fig. 13's 62.42 µm at 44 V); tip B {yB * 1e6:.4g} µm, so a "
+    what = (f"tip C at 100 V from rest (the amplitude of Figs 9 and 12), {side} finger with the "
+            "assumed "
+            "L_r = 7 mm, L_a = 15 mm (chosen for Fig. 13's 62.42 µm at 44 V); tip B "
+            f"{yB * 1e6:.4g} µm, so a "
             f"±100 V sine spans {2 * yB * 1e6:.4g} µm at B against the laser's 250 µm range (§V-A)")
-    return compare("stroke-100V", f"tsfm-{side}", computed=yC, stated=stroke, rtol=0.05, unit="m", what=what,
+    return compare("stroke-100V", f"tsfm-{side}", computed=yC, stated=stroke, rtol=0.05, unit="m",
+                   what=what,
                    used="the assumed lengths; simulations warn beyond the 100 µm stroke (RANGES)",
                    source=f"{SEED} Table I, §V-A")
 
