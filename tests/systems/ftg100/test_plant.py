@@ -8,6 +8,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from gripkit.consistency import check
+from gripkit.errors import AccuracyWarning
 from gripkit.systems.ftg100.model import FTG100Plant, advance_plant, plant_parameters
 
 FS = 20000.0
@@ -132,9 +133,34 @@ def test_static_statements_reported():
 
 def test_voltage_is_clipped_and_bad_parameters_refused():
     pl = FTG100Plant(check=False, k0=0.0)
-    a = pl.simulate({"V": np.full(200, 250.0)}, dt=1 / FS)["x_a"]
-    b = pl.simulate({"V": np.full(200, 200.0)}, dt=1 / FS)["x_a"]
+    with pytest.warns(AccuracyWarning, match="more than the 100 µm opening"):
+        a = pl.simulate({"V": np.full(200, 250.0)}, dt=1 / FS)["x_a"]
+    with pytest.warns(AccuracyWarning, match="the arms would touch"):
+        b = pl.simulate({"V": np.full(200, 200.0)}, dt=1 / FS)["x_a"]
     np.testing.assert_array_equal(a, b)
+
+
+def test_warns_where_the_arms_would_touch():
+    """The default (linear) plant's free tip closes the 100 µm opening at 106.2 V (§II-A). A step
+    to 120 V (static 127.7 µm) rings to x_s (1 + exp(−ζπ/√(1 − ζ²))) = 217.9 µm, ζ = K_fa/(2√(K_sa
+    M_a)) = 0.110: the warning gives the sampled peak (within 0.2 %); a 0 → 70 V step peaks at
+    74.2 µm, below the opening, and says nothing."""
+    import re
+    import warnings
+
+    pl = FTG100Plant(check=False, k0=0.0)
+    zeta = 1.3e-3 / (2 * math.sqrt(25.4 * 1.37e-6))
+    over = 1 + math.exp(-zeta * math.pi / math.sqrt(1 - zeta ** 2))
+    x120 = pl.equilibrium(120.0)["x_a"]
+    assert x120 == pytest.approx(43.4646e-6 * (120 / 70) ** 2, rel=1e-5)
+    with pytest.warns(AccuracyWarning, match="the arms would touch") as rec:
+        pl.simulate({"V": np.full(800, 120.0)}, dt=1 / FS)
+    peak = float(re.search(r"the tips close by ([\d.]+) µm", str(rec[0].message))[1]) * 1e-6
+    assert peak == pytest.approx(over * x120, rel=2e-3)
+    assert over * pl.equilibrium(70.0)["x_a"] < 100e-6
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        pl.simulate({"V": np.full(800, 70.0)}, dt=1 / FS)
     from gripkit.errors import ParameterError
 
     with pytest.raises(ParameterError):

@@ -117,6 +117,7 @@ from __future__ import annotations
 
 import abc
 import math
+import warnings
 
 import numba
 import numpy as np
@@ -124,7 +125,7 @@ from scipy.optimize import brentq
 
 from ...arguments import sample_interval
 from ...consistency import Finding, compare
-from ...errors import ModelError, ParameterError
+from ...errors import AccuracyWarning, ModelError, ParameterError
 from ...models.beams import STRETCHING_BETA, clamped_clamped_stiffness
 from ...models.comb_drive import comb_drive_coefficient
 from ...models.second_order import second_order_batch
@@ -931,6 +932,20 @@ class FTG100Plant(Model):
 
     def _simulate_batch(self, thetas, u, dt, substeps, x0, y):
         _plant_batch(thetas, u, dt, substeps, x0, y)
+
+    def simulate(self, u, **kwargs):
+        """:meth:`Model.simulate`; warns (AccuracyWarning) where the tips come closer than the
+        seed's 100 µm opening allows (x_a − x_b > opening, §II-A): the arms would touch there, and
+        the plant has no arm-to-arm contact (the default plant's free tip gets there at 106.2 V)."""
+        tr = super().simulate(u, **kwargs)
+        opening = ftg100_geometry().value("opening")
+        closing = float(np.max(tr["x_a"] - tr["x_b"])) if tr.n else 0.0
+        if closing > opening:
+            warnings.warn(f"{self.name}: the tips close by {closing * 1e6:.4g} µm, more than the "
+                          f"{opening * 1e6:.3g} µm opening ({SEED} §II-A): the arms would touch, which "
+                          "the plant does not model (keep the free arm below 106 V)", AccuracyWarning,
+                          stacklevel=2)
+        return tr
 
     # --- statics and linearisation --------------------------------------------------------------
     def _p(self, theta=None):
