@@ -942,9 +942,9 @@ class FTG100Plant(Model):
         closing = float(np.max(tr["x_a"] - tr["x_b"])) if tr.n else 0.0
         if closing > opening:
             warnings.warn(f"{self.name}: the tips close by {closing * 1e6:.4g} µm, more than the "
-                          f"{opening * 1e6:.3g} µm opening ({SEED} §II-A): the arms would touch, which "
-                          "the plant does not model (keep the free arm below 106 V)", AccuracyWarning,
-                          stacklevel=2)
+                          f"{opening * 1e6:.3g} µm opening ({SEED} §II-A): the arms would touch, "
+                          "which the plant does not model (keep the free arm below 106 V)",
+                          AccuracyWarning, stacklevel=2)
         return tr
 
     # --- statics and linearisation --------------------------------------------------------------
