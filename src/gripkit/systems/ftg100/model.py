@@ -904,9 +904,10 @@ def _plant_batch(thetas, u, dt, substeps, x0, y):  # pragma: no cover - compiled
 
 
 class FTG100Plant(Model):
-    """Nonlinear FT-G100 plant (the paper's deferred model): large-deflection suspensions, quadratic
-    comb-drive force with the 0-200 V limit, and the arms closing around an object (contact
-    switching located inside the step). See the module docstring for the equations.
+    """Nonlinear FT-G100 plant (the paper's deferred model): the suspensions of eqs 4 and 8-10
+    (linear by default, optionally stiffening at large deflection), quadratic comb-drive force with
+    the 0-200 V limit, and the arms closing around an object (contact switching located inside the
+    step). See the module docstring for the equations and the two readings of the seed's 20 µm.
 
     Input ``V`` (V); outputs ``x_a``, ``x_b`` (m, tip displacements from rest), ``F_c`` (N, true
     contact force), ``F_s`` (N, force sensor reading k2·x_b without noise). States are the
@@ -914,7 +915,8 @@ class FTG100Plant(Model):
     """
 
     name = "ftg100-plant"
-    description = "FT-G100 nonlinear plant: stiffening suspensions, V² actuation, object contact"
+    description = ("FT-G100 nonlinear plant: eq 4 suspensions (optionally stiffening), V² actuation, "
+                   "object contact")
     inputs = (Signal("V", "V", "actuation voltage (clipped to [0, V_max])"),)
     outputs = (Signal("x_a", "m", "actuated tip displacement"), Signal("x_b", "m", "sensing tip deflection"),
                Signal("F_c", "N", "contact force on the object"), Signal("F_s", "N", "force sensor reading"))
