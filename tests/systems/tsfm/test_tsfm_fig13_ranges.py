@@ -140,3 +140,23 @@ def test_zoo_check_tsfm_gripper_lists_the_new_findings(capsys):
         assert not f[name]["consistent"], name
     assert f["fig13-separation-voltage"]["computed"] == pytest.approx(36.43, abs=0.01)
     assert math.isclose(f["stroke-100V"]["stated"], 100e-6)
+
+
+def test_gripper_reading_clipped_at_the_sensing_range():
+    """Two voltage ramps (0 → 60 and 0 → 55 V in 20 ms) squeeze a 469 N/m part until the sensors'
+    readings k_s (y_D − y_C) reach 5.45 and 5.42 mN (the kernel's outputs, simulate_batch);
+    Model.simulate reports them clipped at Table I's 2 mN with a DataWarning each, the true
+    contact forces unclipped."""
+    g = z.gripper(stiffness=469.0, width=360e-6, centre=206e-6, check=False)
+    u = np.column_stack([np.linspace(0, 60, 400), np.linspace(0, 55, 400)])
+    raw = g.simulate_batch(g.theta()[None, :], u, dt=5e-5)[0]
+    col = {s.name: i for i, s in enumerate(g.outputs)}
+    assert raw[:, col["F_m1"]].max() == pytest.approx(5.448e-3, rel=1e-3)
+    pattern = r"F_m\d reaches 5.4\d\d mN, beyond the sensor's 2 mN"
+    with pytest.warns(DataWarning, match=pattern) as rec:
+        tr = g.simulate(u, dt=5e-5)
+    assert len([w for w in rec if issubclass(w.category, DataWarning)]) == 2
+    assert tr["F_m1"].max() == 2e-3 and tr["F_m2"].max() == 2e-3
+    np.testing.assert_array_equal(tr["F_g1"], raw[:, col["F_g1"]])
+    unclipped = np.abs(raw[:, col["F_m1"]]) < 2e-3
+    np.testing.assert_array_equal(tr["F_m1"][unclipped], raw[unclipped, col["F_m1"]])

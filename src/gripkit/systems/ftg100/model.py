@@ -915,7 +915,8 @@ class FTG100Plant(Model):
     """
 
     name = "ftg100-plant"
-    description = ("FT-G100 nonlinear plant: eq 4 suspensions (optionally stiffening), V² actuation, "
+    description = ("FT-G100 nonlinear plant: eq 4 suspensions (optionally stiffening), V² "
+                   "actuation, "
                    "object contact")
     inputs = (Signal("V", "V", "actuation voltage (clipped to [0, V_max])"),)
     outputs = (Signal("x_a", "m", "actuated tip displacement"), Signal("x_b", "m", "sensing tip deflection"),
