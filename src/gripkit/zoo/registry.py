@@ -61,12 +61,16 @@ _ENTRIES: tuple[ZooEntry, ...] = (
              "readout voltage through the object stiffness k0",
              _FTG, "gripkit.systems.ftg100.parameters:coupled_model"),
     ZooEntry("ftg100-plant", "FemtoTools FT-G100 microgripper",
-             "Nonlinear plant: eq 5 comb-drive force as printed (V², 0-200 V), stiffening suspensions, "
-             "unilateral contact with the ball; 29.6 um free at 70 V against the stated 20 um (reported)",
+             "Nonlinear plant: eq 5 comb-drive force as printed (V², 0-200 V), the linear "
+             "suspensions "
+             "of eqs 4 and 8-10 (eq 10 at 70 V grasped), unilateral contact with the ball after "
+             "the "
+             "20 um gap (the stated 20 um at 70 V read as the travel to the ball; reported)",
              _FTG, "gripkit.systems.ftg100.parameters:plant_model"),
     ZooEntry("ftg100-plant-calibrated", "FemtoTools FT-G100 microgripper",
              "Nonlinear plant with the comb-drive force factor fitted to the stated 20 um at 70 V "
-             "(0.559 x eq 5); the departure from eq 5 is reported",
+             "read as the free tip's travel (0.460 x eq 5); its departure from eqs 5 and 10 is "
+             "reported",
              _FTG, "gripkit.systems.ftg100.parameters:calibrated_plant_model"),
     ZooEntry("tsfm-left", "TSFM piezo microgripper", "Left finger, Table II: Bouc-Wen + D(s) actuator, lever, force "
              "sensor (8.52 kHz, ζ = 0.006), eqs 3-13", _TSFM, "gripkit.systems.tsfm.parameters:left_finger"),

@@ -30,14 +30,19 @@ def coupled_model(**values) -> FTG100Coupled:
 
 
 def plant_model(**values) -> FTG100Plant:
-    """Zoo ``ftg100-plant``: the nonlinear plant (stiffening suspensions, V² actuation with eq 5's
-    force as printed, contact with the object): 29.6 µm free at 70 V against the seed's 20 µm."""
+    """Zoo ``ftg100-plant``: the nonlinear plant with eq 5's force as printed and the linear
+    suspensions of eqs 4 and 8-10 (its small-signal model at 70 V grasped is eq 9/10, 0.82 % from
+    eq 10's gain), V² actuation, contact with the ball after the 20 µm gap (100 µm opening − 80 µm
+    ball: the seed's "20 µm at 70 V" read as the travel to the ball; derivation of both readings in
+    :mod:`gripkit.systems.ftg100.model`)."""
     return FTG100Plant(**values)
 
 
 def calibrated_plant_model(**values) -> FTG100Plant:
-    """Zoo ``ftg100-plant-calibrated``: the nonlinear plant with the comb-drive force factor fitted
-    to the seed's 20 µm at 70 V (κ = 0.5592 × eq 5, ``plant_parameters(force_factor='static-70V')``;
-    derivation in :mod:`gripkit.systems.ftg100.model`). ``values`` replace parameters before the fit."""
+    """Zoo ``ftg100-plant-calibrated``: the other reading of the seed's 20 µm at 70 V (the free
+    tip's displacement): the default plant with the comb-drive force factor fitted to it (κ = 0.4601
+    × eq 5 with the linear suspensions, ``plant_parameters(force_factor='static-70V')``), which puts
+    its small-signal gain at 70 V 53.6 % below eq 10 (reported by ``zoo check``). ``values`` replace
+    parameters before the fit."""
     check = values.pop("check", True)
     return FTG100Plant(plant_parameters(force_factor="static-70V", **values), check=check)

@@ -46,6 +46,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import warnings
 from collections import namedtuple
 from collections.abc import Mapping
 
@@ -54,7 +55,7 @@ import numpy as np
 from numba import prange
 
 from ...consistency import Finding, compare
-from ...errors import ModelError, ParameterError
+from ...errors import AccuracyWarning, DataWarning, ModelError, ParameterError
 from ...models.hysteresis import bouc_wen_advance
 from ...models.piezo import actuator_parameters, actuator_state_space, lti_modes, run_bw_lti
 from ...params import Parameter, ParameterSet
@@ -69,7 +70,46 @@ __all__ = ["FINGER_NAMES", "finger_parameter_set", "finger_state_space", "finger
            "finger_coefficients", "finger_transfer_functions", "finger_hybrid",
            "micropart_parameters", "finger_checks", "TSFMFinger", "TSFMFingerContact", "TSFMGripper",
            "gripper_measure", "gripper_advance", "gripper_work", "gripper_model", "GripperModel",
-           "GripperState", "GripperWork"]
+           "GripperState", "GripperWork", "RANGES", "check_ranges"]
+
+_SEED = "001_0b92a7da96e7aa46.txt"
+#: The ranges the seed states for each finger (Table I; §V-A: "a displacement range of 100 µm for
+#: each finger and force sensing range going from 60 nN to 2 mN for each force sensor"). The
+#: simulations check their outputs against them (:func:`check_ranges`): beyond the stroke the model
+#: extrapolates (AccuracyWarning); beyond the sensing range the sensor's reading is clipped
+#: (DataWarning), the true contact force is not.
+RANGES = ParameterSet([
+    Parameter("stroke", 100e-6, "m", "displacement range of each finger (tip C)", (0, None),
+              source=f"{_SEED} Table I, §V-A", display_unit="um"),
+    Parameter("force_range", 2e-3, "N", "sensing range of each integrated force sensor", (0, None),
+              source=f"{_SEED} Table I, §V-A", display_unit="mN"),
+], "tsfm-ranges")
+
+
+def check_ranges(trajectory, positions: tuple[str, ...], forces: tuple[str, ...], subject: str):
+    """Warn where the tip ``positions`` (m) leave the finger's stroke, and clip the sensor
+    readings ``forces`` (N) to the sensing range with a warning (:data:`RANGES`); returns the
+    trajectory (a new one if a reading was clipped)."""
+    stroke, limit = RANGES.value("stroke"), RANGES.value("force_range")
+    for name in positions:
+        peak = float(np.max(np.abs(trajectory[name]))) if trajectory.n else 0.0
+        if peak > stroke:
+            warnings.warn(f"{subject}: {name} reaches {peak * 1e6:.4g} µm, beyond the finger's "
+                          f"{stroke * 1e6:.3g} µm displacement range ({_SEED} Table I): the model "
+                          "extrapolates there (lower the voltage amplitude)", AccuracyWarning,
+                          stacklevel=3)
+    clipped = {}
+    for name in forces:
+        x = trajectory[name]
+        peak = float(np.max(np.abs(x))) if x.size else 0.0
+        if peak > limit:
+            warnings.warn(f"{subject}: {name} reaches {peak * 1e3:.4g} mN, beyond the sensor's "
+                          f"{limit * 1e3:.3g} mN sensing range ({_SEED} Table I): the reading is "
+                          "clipped "
+                          f"to ±{limit * 1e3:.3g} mN", DataWarning, stacklevel=3)
+            clipped[name] = np.clip(x, -limit, limit)
+    return trajectory.with_channels(**clipped) if clipped else trajectory
+
 
 FINGER_NAMES = ("d_p", "s_p", "lam", "beta", "gamma", "a", "b", "m_s", "b_s", "k_s", "L_r", "L_s", "L_a",
                 "sensitivity")
@@ -341,6 +381,11 @@ class TSFMFinger(Model):
         Phi, Gam = zoh_levels(A, B, dt, 0)
         run_bw_lti(bw, Phi[:, 0], Gam[:, 0], C, np.zeros((len(thetas), C.shape[1], 2)), u, x0, y)
 
+    def simulate(self, u, **kwargs):
+        """:meth:`Model.simulate`, then the outputs checked against the stated ranges
+        (:func:`check_ranges`: a warning beyond the 100 µm stroke, F_m clipped at 2 mN)."""
+        return check_ranges(super().simulate(u, **kwargs), ("y_C",), ("F_m",), self.name)
+
     def consistency_checks(self) -> list[Finding]:
         v = self.values()
         out = []
@@ -574,6 +619,10 @@ class TSFMFingerContact(Model):
         v = dict(zip(self.parameters.names, th))
         return finger_hybrid(v, v["k_e"], v["c_e"], v["F_po"], self.realisation)
 
+    def simulate(self, u, **kwargs):
+        """:meth:`Model.simulate`, then the ranges checked (:func:`check_ranges`)."""
+        return check_ranges(super().simulate(u, **kwargs), ("y_C",), ("F_m",), self.name)
+
     def _simulate_batch(self, thetas, u, dt, substeps, x0, y):
         nf = len(FINGER_NAMES)
         rows = [(th[:nf], th[nf + 1], th[nf + 2], th[nf + 3]) for th in thetas]
@@ -774,6 +823,11 @@ class TSFMGripper(Model):
         out = {k: np.ascontiguousarray(v.reshape((P, 2) + v.shape[1:])) for k, v in d.items() if k not in ("target", "ng")}
         out.update(target=d["target"], ng=d["ng"], part=np.array(part), bw=np.array(bw), K=self.levels)
         return out
+
+    def simulate(self, u, **kwargs):
+        """:meth:`Model.simulate`, then the ranges checked (:func:`check_ranges`)."""
+        return check_ranges(super().simulate(u, **kwargs), ("y_C1", "y_C2"), ("F_m1", "F_m2"),
+                            self.name)
 
     def _simulate_batch(self, thetas, u, dt, substeps, x0, y):
         # rows one after another: a gripper is simulated for one or a few parameter sets (a prange
