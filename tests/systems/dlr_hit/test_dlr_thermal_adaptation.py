@@ -12,10 +12,11 @@ import numpy as np
 import pytest
 
 from gripkit.errors import ConsistencyWarning, ModelError
+from gripkit.systems.dlr_hit.finger import ACTUATORS
 from gripkit.systems.dlr_hit.friction_adaptation import (THERMAL_CASES, thermal_adaptation_study,
                                                          tracking_reference)
 from gripkit.systems.dlr_hit.impedance import (POTENTIOMETERS, ImpedanceController, Sensing,
-                                               ThermalObserver)
+                                               ThermalObserver, simulate_impedance)
 from gripkit.systems.dlr_hit.parameters import finger
 
 DEG = math.pi / 180
@@ -116,3 +117,27 @@ def test_bad_settings_are_refused():
         ImpedanceController(sensing=0.1)
     with pytest.raises(ModelError, match="motor temperatures are not integrated"):
         thermal_adaptation_study(_finger(), CTRL, tracking_reference(10.0))
+
+
+def test_observer_in_the_inversion_delivers_the_commanded_torque():
+    """``ThermalObserver(command=True)`` with the start temperature known: the PWM inversion
+    divides by ρ̂, which equals the plant's ρ (same thermal ODE, same PWM and speed), so the
+    motor delivers the commanded actuator torque (to 1e-9 N·m wherever the PWM is not clipped
+    and Appendix E's guard does not zero the torque: a braking command at speed);
+    eq 5.10 as printed delivers ρ(25 °C) = 1 + 0.0136·55 = 1.748 times it at the cold start."""
+    f = _finger(thermal=True)
+    T0 = f.parameters.value("T_amb")
+    ref = tracking_reference(3.0)
+    x0 = f.state(q=ref[0], T=T0)
+    obs = ThermalObserver(initial=(T0, T0), command=True)
+    tr = simulate_impedance(f, ImpedanceController("joint", (8, 8, 8), (0.6, 0.6, 0.6), thermal=obs), ref,
+                            x0=x0)
+    plain = simulate_impedance(f, CTRL, ref, x0=x0)
+    for a in ACTUATORS:
+        ok = (np.abs(tr[f"pwm_{a}"]) < 4096) & (np.abs(tr[f"tau_cmd_{a}"]) > 0.05) & (tr[f"tau_{a}"] != 0)
+        assert ok.sum() > 1000
+        np.testing.assert_allclose(tr[f"tau_{a}"][ok], tr[f"tau_cmd_{a}"][ok], rtol=0, atol=1e-9)
+        ok0 = ((np.abs(plain[f"pwm_{a}"][:50]) < 4096) & (np.abs(plain[f"tau_cmd_{a}"][:50]) > 0.05)
+               & (plain[f"tau_{a}"][:50] != 0))
+        ratio = plain[f"tau_{a}"][:50][ok0] / plain[f"tau_cmd_{a}"][:50][ok0]
+        np.testing.assert_allclose(ratio, 1 + 0.0136 * 55, rtol=2e-3)
