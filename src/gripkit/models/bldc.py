@@ -36,7 +36,8 @@ raise the resistance by about 20 % (α ≈ 0.004 K⁻¹), which would only drop 
 0.82 Ncm at 80 °C. gripkit uses the effective α that reproduces Fig. 5.7 (the winding is hotter
 than the measured 80 °C, and the magnets weaken) and reports the contradiction.
 
-**Thermal model.** A first-order lumped model, C_th dT/dt = R(T) I² − (T − T₀)/R_th, with the
+**Thermal model** (gripkit's addition: the thesis gives eq 5.5 and Fig. 5.7's course, no model
+of the winding temperature). A first-order lumped model, C_th dT/dt = R(T) I² − (T − T₀)/R_th, with the
 current I = τ/k_t. k_t and R₀ follow from an assumed 12 V supply and the physical reading of the
 speed slope (|b(3000)| = k_t²/R(T_ref)): k_t = 7.95 mN·m/A, R₀ = 9.32 Ω; R_th = 7.2 K/W and
 C_th = 5.5 J/K make the Fig. 5.7 experiment (PWM 4000 held at stall) settle near 84 °C with a

@@ -20,8 +20,8 @@ efficiency), h_p the Coriolis/centrifugal and gravity torques, and F_k friction:
   it breaks away when its holding torque exceeds its stiction);
 * ``friction='stribeck'``: eq 6.5 per actuator plus a cubic velocity term (the harmonic-drive
   friction model of [50] quoted in §3.2.2), with the same stiction logic;
-* ``friction='lugre'``: LuGre per actuator (no state machine; moves by a pre-sliding
-  displacement under loads below stiction);
+* ``friction='lugre'``: LuGre per actuator (gripkit's addition, not the thesis's; no state
+  machine; moves by a pre-sliding displacement under loads below stiction);
 * ``friction='none'``: frictionless (energy-conservation studies).
 
 An optional harmonic-drive ripple A·sin(k·p)·sign(ṗ) adds to F (§3.2.2).
@@ -34,7 +34,8 @@ inertia it brakes the finger within tens of milliseconds and lets it bounce back
 
 Motor temperature. By default the winding stays at T_ref, where eq 5.10 holds (the thesis assumes
 the operating temperature, §5.4.3); ``thermal=True`` integrates each motor's first-order thermal
-model (:mod:`gripkit.models.bldc`) from the initial temperature in the state.
+model (:mod:`gripkit.models.bldc`; gripkit's, calibrated on Fig. 5.7) from the initial temperature
+in the state.
 
 Integration. Fixed steps (``substeps`` per sample): semi-implicit Euler (default; one
 force evaluation per step, ≥ 1000× real time at 1 kHz) or RK4 (``integrator='rk4'``) with the

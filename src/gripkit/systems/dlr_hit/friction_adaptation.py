@@ -2,6 +2,10 @@
 §6.3: "an algorithm to adjust the friction model", since friction "differs from finger to finger
 and the parameters may change over time").
 
+Provenance: the recursive estimator is gripkit's addition, not the thesis's content. What the
+thesis does to adjust its friction model is a correcting factor on the lookup tables per drive
+(§6.3, §7: base 2 uses base 1's table times a factor); it gives no online algorithm.
+
 Two uses of the generic estimator (:mod:`gripkit.estimation.friction_adaptation`):
 
 * after the fact, on a log (:func:`adapt_finger_friction`): the finger's motor torques (eq 5.10),

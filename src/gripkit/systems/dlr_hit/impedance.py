@@ -21,7 +21,8 @@ wall — further and sustain a limit cycle). The commanded actuator
 torque becomes a PWM count through the inverse of eq 5.10 at the measured motor speed, clipped to
 ±4096, held over the 1 kHz control period.
 
-Online friction adaptation (§6.3: "an algorithm to adjust the friction model"; abstract). With
+Online friction adaptation (§6.3: "an algorithm to adjust the friction model"; abstract; the
+estimator, the thermal observer and the sensing model are gripkit's additions). With
 ``ImpedanceController(adaptation=AdaptationSettings(...))`` the friction estimator of
 :mod:`gripkit.estimation.friction_adaptation` runs inside the loop: at every control step k, after
 the PWM command u_k is computed,
