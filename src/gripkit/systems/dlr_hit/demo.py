@@ -305,15 +305,16 @@ def _thermal_adaptation(sec, summary):
     st = thermal_adaptation_study(ft, ImpedanceController("joint", (8, 8, 8), (0.6, 0.6, 0.6)),
                                   tracking_reference(120.0))
     rows = [[case] + [st.rms[case, m] / DEG for m in THERMAL_MODES]
-            + [" ".join(f"{x:.2f}" for x in st.scale[case, m]) for m in THERMAL_MODES[1:]]
+            + [" ".join(f"{x:.2f}" for x in st.friction[case, m]) for m in THERMAL_MODES[1:]]
             for case in THERMAL_CASES]
     sec.table(["case", "fixed [°]", "adaptive, eq 5.10 [°]", "adaptive, thermal observer [°]",
-               "ŝ eq 5.10", "ŝ observer"], rows,
+               "F̂/F eq 5.10", "F̂/F observer"], rows,
               caption="RMS joint tracking error (after 5 s of 120 s) with the motors' thermal model on "
                       "(Fig. 5.7: the torque falls as the winding warms) and the controller reading 0.1° "
                       "angles with differentiated velocity. Fed eq 5.10 as printed, the estimator reads the "
-                      "cold motor's extra torque as lower friction (ŝ, mean of the last 10 s per drive "
-                      "base1 base2 distal; truth ≈ 1) and tracking gets worse; with the thermal observer's "
+                      "cold motor's extra torque as lower friction (F̂/F: estimated over the plant's "
+                      "friction at 1 rad/s, last 10 s, per drive base1 base2 distal) and tracking gets "
+                      "worse; with the thermal observer's "
                       "torque factor in its regressor, frozen while the start temperature leaves it "
                       "uncertain by more than 5 %, it beats the fixed compensation under drift "
                       f"({st.rms['cold+drift', 'adaptive-thermal'] / DEG:.4f}° vs "

@@ -29,10 +29,10 @@ from ...estimation.friction_adaptation import AdaptationSettings, FrictionAdapte
 from .finger import ACTUATORS, JOINTS
 from .friction_drift import FrictionDrift, stiction_step, warmup_drift
 from .impedance import (LOOP_ADAPTATION, POTENTIOMETERS, ImpedanceController, Sensing, ThermalObserver,
-                        simulate_impedance)
+                        model_friction_tables, simulate_impedance)
 
 __all__ = ["adapt_finger_friction", "compare_adaptation", "LoopComparison", "tracking_reference",
-           "thermal_adaptation_study", "ThermalStudy", "THERMAL_CASES", "THERMAL_MODES"]
+           "thermal_adaptation_study", "ThermalStudy", "THERMAL_CASES", "THERMAL_MODES", "V_COMPARE"]
 
 
 def adapt_finger_friction(finger, trajectory, *, forgetting: float = 0.999, filter_hz: float = 10.0,
@@ -143,6 +143,8 @@ def compare_adaptation(finger, controller: ImpedanceController, reference, drift
 #: the cases of :func:`thermal_adaptation_study`: the winding starts at room temperature (T_amb)
 #: or at the operating temperature (T_ref), the plant's friction fixed or drifting
 THERMAL_CASES = ("cold", "hot", "cold+drift")
+#: actuator speed (rad/s) at which :class:`ThermalStudy` compares estimated and true friction
+V_COMPARE = 1.0
 #: its compensations: the fixed tables; the estimator on eq 5.10 as printed (it reads a torque
 #: change as a friction change); the estimator with the thermal observer's torque factor and guard
 THERMAL_MODES = ("fixed", "adaptive-eq5.10", "adaptive-thermal")
@@ -153,11 +155,15 @@ class ThermalStudy:
     """Tracking errors of the impedance loop on a finger whose motors heat and cool (thermal
     model on): ``rms[(case, mode)]`` (rad, after ``t_skip``), ``scale[(case, mode)]`` (3,) the
     estimated friction scale ŝ per actuator averaged over the last 10 s (1 for 'fixed'),
-    ``updated[(case, mode)]`` the fraction of samples the estimator updated (all actuators), and
-    ``runs`` the closed-loop Trajectories."""
+    ``friction[(case, mode)]`` (3,) the estimated over the plant's kinetic friction at
+    :data:`V_COMPARE` (ŝ·F_table(v) + ô)/(s·F_table(v) + Δ), both averaged over the last 10 s
+    (ŝ and ô are nearly collinear where the table is flat, so ŝ alone can be off while the
+    friction is right), ``updated[(case, mode)]`` the fraction of samples the estimator updated
+    (all actuators), and ``runs`` the closed-loop Trajectories."""
 
     rms: dict
     scale: dict
+    friction: dict
     updated: dict
     runs: dict
     t_skip: float
@@ -203,7 +209,8 @@ def thermal_adaptation_study(finger, controller: ImpedanceController, reference,
     cases = {"cold": (v("T_amb"), None), "hot": (v("T_ref"), None),
              "cold+drift": (v("T_amb"), warmup_drift(duration).combine(stiction_step(duration / 2)))}
     last = max(ref.shape[0] - int(round(10.0 / dt)), 0)
-    rms, scale, upd, runs = {}, {}, {}, {}
+    f_tab = np.array([float(t(V_COMPARE)) for t in model_friction_tables(finger)])
+    rms, scale, fric, upd, runs = {}, {}, {}, {}, {}
     for case, (T0, drift) in cases.items():
         x0 = finger.state(q=ref[0], T=T0)
         for mode, c in modes.items():
@@ -211,5 +218,17 @@ def thermal_adaptation_study(finger, controller: ImpedanceController, reference,
             runs[case, mode] = tr
             rms[case, mode] = _errors(tr, skip)[0]
             scale[case, mode] = np.array([float(np.mean(tr[f"scale_hat_{a}"][last:])) for a in ACTUATORS])
+            fric[case, mode] = np.array([_friction_ratio(tr, a, f_tab[k], last) for k, a in enumerate(ACTUATORS)])
             upd[case, mode] = float(np.mean([tr[f"adapt_status_{a}"] == 1.0 for a in ACTUATORS]))
-    return ThermalStudy(rms, scale, upd, runs, t_skip)
+    return ThermalStudy(rms, scale, fric, upd, runs, t_skip)
+
+
+def _friction_ratio(tr, a, f_table, last) -> float:
+    """Estimated over true kinetic friction of actuator ``a`` at a speed where the compensation
+    table reads ``f_table`` (N·m), each averaged over the samples from ``last`` on."""
+    est = np.mean(tr[f"scale_hat_{a}"][last:] * f_table + tr[f"offset_hat_{a}"][last:])
+    if f"drift_scale_{a}" in tr:
+        true = np.mean(tr[f"drift_scale_{a}"][last:] * f_table + tr[f"drift_offset_{a}"][last:])
+    else:
+        true = f_table
+    return float(est / true)
