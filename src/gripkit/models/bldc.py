@@ -36,12 +36,12 @@ raise the resistance by about 20 % (α ≈ 0.004 K⁻¹), which would only drop 
 0.82 Ncm at 80 °C. gripkit uses the effective α that reproduces Fig. 5.7 (the winding is hotter
 than the measured 80 °C, and the magnets weaken) and reports the contradiction.
 
-**Thermal model** (gripkit's addition: the thesis gives eq 5.5 and Fig. 5.7's course, no model
-of the winding temperature). A first-order lumped model, C_th dT/dt = R(T) I² − (T − T₀)/R_th, with the
-current I = τ/k_t. k_t and R₀ follow from an assumed 12 V supply and the physical reading of the
-speed slope (|b(3000)| = k_t²/R(T_ref)): k_t = 7.95 mN·m/A, R₀ = 9.32 Ω; R_th = 7.2 K/W and
-C_th = 5.5 J/K make the Fig. 5.7 experiment (PWM 4000 held at stall) settle near 84 °C with a
-40 s time constant, so the torque falls from 1.0 Ncm to 0.57 Ncm within the figure's 120 s.
+**Thermal model** (gripkit's addition: the thesis gives eq 5.5 and Fig. 5.7's course, no model of
+the winding temperature). A first-order lumped model, C_th dT/dt = R(T) I² − (T − T₀)/R_th, with
+the current I = τ/k_t. k_t and R₀ follow from an assumed 12 V supply and the physical reading of
+the speed slope (|b(3000)| = k_t²/R(T_ref)): k_t = 7.95 mN·m/A, R₀ = 9.32 Ω; R_th = 7.2 K/W and
+C_th = 5.5 J/K make the Fig. 5.7 experiment (PWM 4000 held at stall) settle near 84 °C with a 40 s
+time constant, so the torque falls from 1.0 Ncm to 0.57 Ncm within the figure's 120 s.
 """
 
 from __future__ import annotations
@@ -60,8 +60,8 @@ from ..params import Parameter, ParameterSet
 from ..sim.model import Model, Signal
 
 __all__ = ["bldc_torque", "temperature_factor", "motor_parameters", "BLDCMotor",
-           "MotorTestBed", "PowerBalance", "RPM", "SLOPES_5_4_2", "PWM_MAX", "SEED", "SUPPLY_VOLTAGE",
-           "RATED_SPEED_RPM"]
+           "MotorTestBed", "PowerBalance", "RPM", "SLOPES_5_4_2", "PWM_MAX", "SEED",
+           "SUPPLY_VOLTAGE", "RATED_SPEED_RPM"]
 
 SEED = "002_ddea254371185ad3.txt"
 RPM = 2.0 * math.pi / 60.0  # rad/s per rpm
@@ -231,14 +231,16 @@ class BLDCMotor:
         """
         if not (isinstance(supply_voltage, (int, float)) and math.isfinite(supply_voltage)
                 and supply_voltage > 0):
-            raise ModelError(f"supply_voltage: expected a positive voltage in V, found {supply_voltage!r}")
+            raise ModelError(f"supply_voltage: expected a positive voltage in V, "
+                             f"found {supply_voltage!r}")
         b3000 = abs(float(self.slope(3000.0)))
         kt = supply_voltage * b3000 / (PWM_MAX * self._p("c_pwm"))
         R_ref = kt * kt / b3000
         R0 = R_ref / (1.0 + self._p("alpha_R") * (self._p("T_ref") - self._p("T_amb")))
         return kt, R0
 
-    def power_balance(self, pwm, speed_rpm, T=None, *, supply_voltage: float | None = None) -> PowerBalance:
+    def power_balance(self, pwm, speed_rpm, T=None, *,
+                      supply_voltage: float | None = None) -> PowerBalance:
         """Eqs 5.1–5.6 for eq 5.10's torque at ``pwm`` (count) and ``speed_rpm`` (rpm, ≥ 0 in the
         direction of the torque; the quadrant of Fig. 5.6), winding temperature ``T`` (K, default
         T_ref).
@@ -258,7 +260,8 @@ class BLDCMotor:
         less Joule heat: −14.9 % of P_mech at 3500, −29.9 % at 4000 (+14.9 % at 2500, +29.9 % at
         2000, 0 at 3000 by construction). The parameters' rounded k_t = 7.95 mN·m/A and
         R₀ = 9.32 Ω (``supply_voltage=None``) shift these by up to 0.3 points."""
-        u = np.abs(np.clip(np.asarray(pwm, dtype=np.float64), -self._p("pwm_max"), self._p("pwm_max")))
+        pmax = self._p("pwm_max")
+        u = np.abs(np.clip(np.asarray(pwm, dtype=np.float64), -pmax, pmax))
         n = np.asarray(speed_rpm, dtype=np.float64)
         if not (np.isfinite(u).all() and np.isfinite(n).all()) or (n < 0).any():
             raise ModelError("power_balance: expected finite PWM counts and speeds >= 0 rpm "
@@ -313,7 +316,8 @@ class BLDCMotor:
         frac = bal.friction_fraction
         i = int(np.argmin(frac))
         worst = float(frac[i])
-        neg = ", ".join(f"{frac[j]:+.1%} at PWM {pwm[j]:.0f}" for j in range(pwm.size) if frac[j] < -1e-9)
+        neg = ", ".join(f"{frac[j]:+.1%} at PWM {pwm[j]:.0f}" for j in range(pwm.size)
+                        if frac[j] < -1e-9)
         R_ref = R0 * (1.0 + self._p("alpha_R") * (self._p("T_ref") - self._p("T_amb")))
         msg = (f"friction loss P_F = U·I − π·τ·n/30000 − R(T)·I² (eq 5.6) with eq 5.10's torque at "
                f"1000 rpm, {SUPPLY_VOLTAGE:g} V, k_t = {kt * 1e3:.3g} mN·m/A, R(T_ref) = "
@@ -322,9 +326,10 @@ class BLDCMotor:
                f"|b(PWM)|/|b(3000)| − 1 at every speed and supply voltage (eq 5.8's slope shrinks "
                f"with PWM; a DC motor's −k_t²/R does not)")
         return Finding("eq5.6-power-balance", self.name, worst >= 0.0, msg,
-                       used=("gripkit keeps eq 5.10 (the measured torque) for the motor and the thermal "
-                             "model's Joule heat; the balance says eq 5.8's PWM-dependent slope is not "
-                             "a DC motor's at one k_t and R above PWM 3000"),
+                       used=("gripkit keeps eq 5.10 (the measured torque) for the motor and "
+                             "the thermal model's Joule heat; the balance says eq 5.8's "
+                             "PWM-dependent slope is not a DC motor's at one k_t and R above "
+                             "PWM 3000"),
                        computed=worst, stated=0.0, rel_error=abs(min(worst, 0.0)), tolerance=0.0,
                        source=f"{SEED}, eqs 5.1-5.6, 5.8, 5.10 and Fig. 5.6")
 
@@ -340,10 +345,11 @@ class BLDCMotor:
                f"{RATED_SPEED_RPM:.0f} rpm (§2), and eq 5.10 at PWM 4000 would give "
                f"{drop:.3g} Ncm at 2500 rps before Appendix E's guard (Fig. 5.6 shows 0..0.6 "
                f"Ncm); §5.4.2 ('steps of around "
-               f"500 rpm from zero to 2500'), Fig. 5.5 (rpm) and eq 5.8's slopes (Ncm/rpm) read rpm")
+               f"500 rpm from zero to 2500'), Fig. 5.5 (rpm) and eq 5.8's slopes (Ncm/rpm) "
+               f"read rpm")
         return Finding("fig5.6-speed-unit", self.name, False, msg,
-                       used=("gripkit reads rpm: eq 5.8's slopes are per rpm, the experiment of Fig. "
-                             "5.5 ran in rpm, and rps would exceed the rated speed 30×"),
+                       used=("gripkit reads rpm: eq 5.8's slopes are per rpm, the experiment "
+                             "of Fig. 5.5 ran in rpm, and rps would exceed the rated speed 30×"),
                        computed=as_rpm, stated=RATED_SPEED_RPM, rel_error=rel, tolerance=0.0,
                        source=f"{SEED}, §2, §5.4.2, Figs 5.5-5.6, eq 5.8")
 

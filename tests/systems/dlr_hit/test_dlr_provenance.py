@@ -36,9 +36,11 @@ def test_docs_state_the_provenance():
         assert name.replace("\n", " ") in para.replace("\n", " "), name
 
 
-@pytest.mark.parametrize("module", ["gripkit.sysid.friction", "gripkit.estimation.friction_adaptation",
-                                    "gripkit.systems.dlr_hit.friction_adaptation", "gripkit.models.bldc",
-                                    "gripkit.models.friction", "gripkit.systems.dlr_hit.impedance"])
+@pytest.mark.parametrize("module", ["gripkit.sysid.friction",
+                                    "gripkit.estimation.friction_adaptation",
+                                    "gripkit.systems.dlr_hit.friction_adaptation",
+                                    "gripkit.models.bldc", "gripkit.models.friction",
+                                    "gripkit.systems.dlr_hit.impedance"])
 def test_module_docstrings_mark_the_addition(module):
     doc = " ".join(importlib.import_module(module).__doc__.split())
     assert "gripkit's addition" in doc, module

@@ -32,7 +32,8 @@ def _finger(**kw):
 @pytest.fixture(scope="module")
 def exact():
     """120 s (Fig. 5.7's duration), the controller reading the exact state."""
-    return thermal_adaptation_study(_finger(thermal=True), CTRL, tracking_reference(120.0), sensing=None)
+    return thermal_adaptation_study(_finger(thermal=True), CTRL, tracking_reference(120.0),
+                                    sensing=None)
 
 
 @pytest.fixture(scope="module")
@@ -54,9 +55,10 @@ def test_eq510_estimator_reads_the_torque_change_as_friction(exact):
         assert exact.rms[case, "fixed"] / DEG == pytest.approx(fixed[case], abs=6e-4)
         assert exact.rms[case, "adaptive-eq5.10"] / DEG == pytest.approx(naive[case], abs=6e-4)
     for case in ("cold", "hot"):
-        assert (exact.scale[case, "adaptive-eq5.10"] < 0.86).all(), exact.scale[case, "adaptive-eq5.10"]
+        assert (exact.scale[case, "adaptive-eq5.10"] < 0.86).all()
         np.testing.assert_allclose(exact.friction[case, "fixed"], 1.0, rtol=1e-12)
-    assert ((exact.friction["cold+drift", "fixed"] > 0.65) & (exact.friction["cold+drift", "fixed"] < 0.71)).all()
+    drifted = exact.friction["cold+drift", "fixed"]
+    assert ((drifted > 0.65) & (drifted < 0.71)).all()
 
 
 def test_thermal_regressor_estimates_the_friction(exact, noisy):
@@ -109,8 +111,8 @@ def test_known_start_temperature_opens_the_guard(exact):
     T0 = f.parameters.value("T_amb")
     st = thermal_adaptation_study(f, CTRL, tracking_reference(30.0), sensing=None,
                                   observer=ThermalObserver(initial=(T0, T0)))
-    assert st.updated["cold", "adaptive-thermal"] == pytest.approx(st.updated["cold", "adaptive-eq5.10"],
-                                                                    abs=0.02)
+    assert st.updated["cold", "adaptive-thermal"] == pytest.approx(
+        st.updated["cold", "adaptive-eq5.10"], abs=0.02)
     np.testing.assert_allclose(st.scale["cold", "adaptive-thermal"], 1.0, atol=0.04)
 
 
@@ -138,11 +140,12 @@ def test_observer_in_the_inversion_delivers_the_commanded_torque():
     ref = tracking_reference(3.0)
     x0 = f.state(q=ref[0], T=T0)
     obs = ThermalObserver(initial=(T0, T0), command=True)
-    tr = simulate_impedance(f, ImpedanceController("joint", (8, 8, 8), (0.6, 0.6, 0.6), thermal=obs), ref,
-                            x0=x0)
+    ctrl = ImpedanceController("joint", (8, 8, 8), (0.6, 0.6, 0.6), thermal=obs)
+    tr = simulate_impedance(f, ctrl, ref, x0=x0)
     plain = simulate_impedance(f, CTRL, ref, x0=x0)
     for a in ACTUATORS:
-        ok = (np.abs(tr[f"pwm_{a}"]) < 4096) & (np.abs(tr[f"tau_cmd_{a}"]) > 0.05) & (tr[f"tau_{a}"] != 0)
+        ok = ((np.abs(tr[f"pwm_{a}"]) < 4096) & (np.abs(tr[f"tau_cmd_{a}"]) > 0.05)
+              & (tr[f"tau_{a}"] != 0))
         assert ok.sum() > 1000
         np.testing.assert_allclose(tr[f"tau_{a}"][ok], tr[f"tau_cmd_{a}"][ok], rtol=0, atol=1e-9)
         ok0 = ((np.abs(plain[f"pwm_{a}"][:50]) < 4096) & (np.abs(plain[f"tau_cmd_{a}"][:50]) > 0.05)

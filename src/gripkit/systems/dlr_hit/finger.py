@@ -640,18 +640,20 @@ def _adapt_friction(th, fc, cs, x, ctab, est, sensor, y, n):  # pragma: no cover
     sample's status into y[n, 27:36]. While ``sensor[k, 5]`` ≠ 0 (the observer's torque factor
     is too uncertain: a torque loss and a friction change cannot be told apart) the filters run
     but θ, P and σ̂² keep their values (status 0, frozen)."""
-    G, ratio, grav, pwm, hb, theta, P, sig2 = fc.G, fc.ratio, fc.g, cs.pwm, cs.hb, est.theta, est.P, est.sig2
+    G, ratio, grav, pwm, hb = fc.G, fc.ratio, fc.g, cs.pwm, cs.hb
+    theta, P, sig2 = est.theta, est.P, est.sig2
     rnea_pass(4, cs.R, cs.P, fc.jtype, fc.mass, fc.com, fc.inertia, fc.arm_q, cs.qd, cs.zq, grav[0],
               grav[1], grav[2], True, hb, cs.work)
     for k in range(3):
         v = x[3 + k]
-        ts = bldc_torque(pwm[k], ratio[k] * v, th[IX.c_pwm], th[IX.b_pwm], th[IX.b_0], th[IX.pwm_max],
-                         sensor[k, 4])
+        ts = bldc_torque(pwm[k], ratio[k] * v, th[IX.c_pwm], th[IX.b_pwm], th[IX.b_0],
+                         th[IX.pwm_max], sensor[k, 4])
         tm = transmit_torque(ts, v, ratio[k], th[IX.eta])
         h = 0.0
         for j in range(4):
             h += G[j * 3 + k] * hb[j]
-        s0, o0, p00, p01, p11, sg = theta[k, 0], theta[k, 1], P[k, 0, 0], P[k, 0, 1], P[k, 1, 1], sig2[k]
+        s0, o0, sg = theta[k, 0], theta[k, 1], sig2[k]
+        p00, p01, p11 = P[k, 0, 0], P[k, 0, 1], P[k, 1, 1]
         st = friction_rls_step(k, tm, h, v, est.inertia, ctab.velocity, ctab.values, ctab.length,
                                ctab.ipos, est.cfg, theta, P, est.filt, sig2)
         if sensor[k, 5] != 0.0 and st == 1.0:  # guard: undo the update, keep the filters
@@ -698,8 +700,8 @@ def _thermal_observer(th, fc, x, pwm, loop, dt):  # pragma: no cover - compiled
         for j in range(2):
             r = temperature_factor(sen[k, j], Tr, Ta, al)
             ts = bldc_torque(pwm[k], w, th[IX.c_pwm], th[IX.b_pwm], th[IX.b_0], th[IX.pwm_max], r)
-            sen[k, j] = motor_heat_step(sen[k, j], ts, dt, Ta, al, th[IX.R_0], th[IX.k_t], th[IX.R_th],
-                                        th[IX.C_th])
+            sen[k, j] = motor_heat_step(sen[k, j], ts, dt, Ta, al, th[IX.R_0], th[IX.k_t],
+                                        th[IX.R_th], th[IX.C_th])
         r_lo = temperature_factor(sen[k, 1], Tr, Ta, al)
         r_hi = temperature_factor(sen[k, 0], Tr, Ta, al)
         sen[k, 4] = 0.5 * (r_lo + r_hi)
@@ -848,8 +850,8 @@ def _open_loop_records():
                          np.full(3, 2, dtype=np.int64))
     theta = np.zeros((3, 2))
     theta[:, 0] = 1.0
-    return (ImpedanceLoop(0, np.zeros(N_GAINS), tables, np.zeros((1, 3)), np.zeros((1, 3)), np.zeros(9),
-                          np.zeros((3, 6)), np.zeros(NX)),
+    return (ImpedanceLoop(0, np.zeros(N_GAINS), tables, np.zeros((1, 3)), np.zeros((1, 3)),
+                          np.zeros(9), np.zeros((3, 6)), np.zeros(NX)),
             PlantDrift(np.zeros((0, 6)), np.zeros(NTH), np.zeros((3, 1))),
             FrictionEstimator(np.zeros(10), np.ones(3), theta, np.zeros((3, 2, 2)), np.zeros((3, 5)),
                               np.zeros(3)))

@@ -28,11 +28,12 @@ from ...errors import ModelError
 from ...estimation.friction_adaptation import AdaptationSettings, FrictionAdapter
 from .finger import ACTUATORS, JOINTS
 from .friction_drift import FrictionDrift, stiction_step, warmup_drift
-from .impedance import (LOOP_ADAPTATION, POTENTIOMETERS, ImpedanceController, Sensing, ThermalObserver,
-                        model_friction_tables, simulate_impedance)
+from .impedance import (LOOP_ADAPTATION, POTENTIOMETERS, ImpedanceController, Sensing,
+                        ThermalObserver, model_friction_tables, simulate_impedance)
 
 __all__ = ["adapt_finger_friction", "compare_adaptation", "LoopComparison", "tracking_reference",
-           "thermal_adaptation_study", "ThermalStudy", "THERMAL_CASES", "THERMAL_MODES", "V_COMPARE"]
+           "thermal_adaptation_study", "ThermalStudy", "THERMAL_CASES", "THERMAL_MODES",
+           "V_COMPARE"]
 
 
 def adapt_finger_friction(finger, trajectory, *, forgetting: float = 0.999, filter_hz: float = 10.0,
@@ -128,7 +129,8 @@ def compare_adaptation(finger, controller: ImpedanceController, reference, drift
         raise ModelError(f"drift: expected a FrictionDrift, found {type(drift).__name__}")
     skip = int(round(t_skip / dt))
     if not 0 <= skip < np.shape(reference)[0] - 1:
-        raise ModelError(f"t_skip: expected 0 <= t_skip < the reference's duration, found {t_skip!r} s")
+        raise ModelError(f"t_skip: expected 0 <= t_skip < the reference's duration, "
+                         f"found {t_skip!r} s")
     modes = {"fixed": replace(controller, adaptation=None),
              "adaptive": replace(controller, adaptation=settings)}
     runs, rms, mx = {}, {}, {}
@@ -192,22 +194,26 @@ def thermal_adaptation_study(finger, controller: ImpedanceController, reference,
     0.1° potentiometers, velocity differentiated; None: the exact state). ``observer`` defaults
     to ``ThermalObserver()`` (start temperature unknown between T_amb and T_ref)."""
     if not getattr(finger, "thermal", False):
-        raise ModelError("thermal_adaptation_study: the finger's motor temperatures are not integrated",
+        raise ModelError("thermal_adaptation_study: the finger's motor temperatures are not "
+                         "integrated",
                          hint="build it with finger(thermal=True)")
     if controller.kind != "joint":
-        raise ModelError("thermal_adaptation_study: expected a joint impedance controller (errors are joint errors)")
+        raise ModelError("thermal_adaptation_study: expected a joint impedance controller "
+                         "(errors are joint errors)")
     observer = observer if observer is not None else ThermalObserver()
     ref = np.asarray(reference, dtype=np.float64)
     skip = int(round(t_skip / dt))
     if ref.ndim != 2 or not 0 <= skip < ref.shape[0] - 1:
-        raise ModelError(f"t_skip: expected 0 <= t_skip < the reference's duration, found {t_skip!r} s")
+        raise ModelError(f"t_skip: expected 0 <= t_skip < the reference's duration, "
+                         f"found {t_skip!r} s")
     duration = ref.shape[0] * dt
     base = replace(controller, sensing=sensing, adaptation=None, thermal=None)
     modes = {"fixed": base, "adaptive-eq5.10": replace(base, adaptation=settings),
              "adaptive-thermal": replace(base, adaptation=settings, thermal=observer)}
     v = finger.parameters.value
     cases = {"cold": (v("T_amb"), None), "hot": (v("T_ref"), None),
-             "cold+drift": (v("T_amb"), warmup_drift(duration).combine(stiction_step(duration / 2)))}
+             "cold+drift": (v("T_amb"),
+                            warmup_drift(duration).combine(stiction_step(duration / 2)))}
     last = max(ref.shape[0] - int(round(10.0 / dt)), 0)
     f_tab = np.array([float(t(V_COMPARE)) for t in model_friction_tables(finger)])
     rms, scale, fric, upd, runs = {}, {}, {}, {}, {}
@@ -217,8 +223,10 @@ def thermal_adaptation_study(finger, controller: ImpedanceController, reference,
             tr = simulate_impedance(finger, c, ref, dt=dt, x0=x0, friction_drift=drift)
             runs[case, mode] = tr
             rms[case, mode] = _errors(tr, skip)[0]
-            scale[case, mode] = np.array([float(np.mean(tr[f"scale_hat_{a}"][last:])) for a in ACTUATORS])
-            fric[case, mode] = np.array([_friction_ratio(tr, a, f_tab[k], last) for k, a in enumerate(ACTUATORS)])
+            scale[case, mode] = np.array([float(np.mean(tr[f"scale_hat_{a}"][last:]))
+                                          for a in ACTUATORS])
+            fric[case, mode] = np.array([_friction_ratio(tr, a, f_tab[k], last)
+                                         for k, a in enumerate(ACTUATORS)])
             upd[case, mode] = float(np.mean([tr[f"adapt_status_{a}"] == 1.0 for a in ACTUATORS]))
     return ThermalStudy(rms, scale, fric, upd, runs, t_skip)
 

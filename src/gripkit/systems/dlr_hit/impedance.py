@@ -62,8 +62,9 @@ from ...errors import ModelError, SimulationError
 from ...estimation.friction_adaptation import AdaptationSettings
 from ...models.friction import FrictionTable, table_arrays
 from ...signals.trajectory import Trajectory
-from .finger import (ACTUATORS, FRICTION_MODES, G_COMMAND, G_GUARD, G_QUANTUM, G_THERMAL, G_VALPHA, N_GAINS, NX,
-                     DLRFinger, FrictionEstimator, ImpedanceLoop, PlantDrift, finger_run)
+from .finger import (ACTUATORS, FRICTION_MODES, G_COMMAND, G_GUARD, G_QUANTUM, G_THERMAL, G_VALPHA,
+                     N_GAINS, NX, DLRFinger, FrictionEstimator, ImpedanceLoop, PlantDrift,
+                     finger_run)
 from .friction_drift import FrictionDrift
 
 __all__ = ["ImpedanceController", "Wall", "simulate_impedance", "stability_margins",
@@ -86,9 +87,11 @@ class Sensing:
 
     def __post_init__(self):
         if not (math.isfinite(self.resolution) and self.resolution > 0):
-            raise ModelError(f"resolution: expected a positive angle in rad, found {self.resolution!r}")
+            raise ModelError(f"resolution: expected a positive angle in rad, "
+                             f"found {self.resolution!r}")
         if not (math.isfinite(self.filter_hz) and self.filter_hz > 0):
-            raise ModelError(f"filter_hz: expected a positive frequency in Hz, found {self.filter_hz!r}")
+            raise ModelError(f"filter_hz: expected a positive frequency in Hz, "
+                             f"found {self.filter_hz!r}")
 
 
 #: the DLR/HIT potentiometers: 0.1° (§2), velocity differentiated and low-passed at 50 Hz
@@ -120,7 +123,8 @@ class ThermalObserver:
             try:
                 lo, hi = (float(x) for x in self.initial)
             except (TypeError, ValueError):
-                raise ModelError(f"initial: expected (T_lo, T_hi) in K, found {self.initial!r}") from None
+                raise ModelError(f"initial: expected (T_lo, T_hi) in K, "
+                                 f"found {self.initial!r}") from None
             if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi):
                 raise ModelError(f"initial: expected 0 < T_lo <= T_hi in K, found {self.initial!r}")
             object.__setattr__(self, "initial", (lo, hi))
@@ -162,7 +166,8 @@ class ImpedanceController:
 
     def __post_init__(self):
         if self.sensing is not None and not isinstance(self.sensing, Sensing):
-            raise ModelError(f"sensing: expected a Sensing or None, found {type(self.sensing).__name__}")
+            raise ModelError(f"sensing: expected a Sensing or None, "
+                             f"found {type(self.sensing).__name__}")
         if self.thermal is not None and not isinstance(self.thermal, ThermalObserver):
             raise ModelError(f"thermal: expected a ThermalObserver or None, found "
                              f"{type(self.thermal).__name__}")
@@ -281,7 +286,8 @@ def simulate_impedance(finger: DLRFinger, controller: ImpedanceController, refer
     estimator = FrictionEstimator(cfg, J, *settings.initial_state(3))
     y = np.empty((N, 39))
     gains = np.zeros(N_GAINS)
-    gains[:14] = [*controller.stiffness, *controller.damping, float(controller.gravity_compensation),
+    gains[:14] = [*controller.stiffness, *controller.damping,
+                  float(controller.gravity_compensation),
                   float(controller.friction_compensation), controller.velocity_deadband,
                   controller.smoothing, *controller.actuator_damping, float(ad is not None)]
     sensor = _sensor_state(finger, controller, x, gains, dt)
