@@ -121,6 +121,8 @@ def test_bad_settings_are_refused():
         ThermalObserver(initial=(350.0, 300.0))
     with pytest.raises(ModelError, match="guard: expected a positive"):
         ThermalObserver(guard=0.0)
+    with pytest.raises(ModelError, match="alpha_R: expected a positive number or None"):
+        ThermalObserver(alpha_R=-0.004)
     with pytest.raises(ModelError, match="resolution: expected a positive angle"):
         Sensing(resolution=-1.0)
     with pytest.raises(ModelError, match="sensing: expected a Sensing"):
@@ -152,3 +154,27 @@ def test_observer_in_the_inversion_delivers_the_commanded_torque():
                & (plain[f"tau_{a}"][:50] != 0))
         ratio = plain[f"tau_{a}"][:50][ok0] / plain[f"tau_cmd_{a}"][:50][ok0]
         np.testing.assert_allclose(ratio, 1 + 0.0136 * 55, rtol=2e-3)
+
+
+def test_a_wrong_thermal_model_brings_part_of_the_confound_back(noisy):
+    """The observer is only as good as its thermal model. With copper's α = 0.004/K (§5.2's
+    "20 % per 50 K") instead of the 0.0136/K that Fig. 5.7 needs, ρ̂ under-reads the cold motor's
+    extra torque: the estimate falls to 0.76–0.87 of the friction and tracking is 3.8 % (cold) and
+    2.3 % (hot) worse than the fixed compensation — still better than the eq 5.10 estimator
+    (+11 %, +7.8 %); under drift it still helps (0.5373° vs 0.5633°). A thermal time constant
+    30 % too long (R_th 9.36 K/W) keeps the guard closed for the whole 120 s (with the right one it
+    opens after 99–104 s): exactly the fixed compensation."""
+    f = _finger(thermal=True)
+    ref = tracking_reference(120.0)
+    cu = thermal_adaptation_study(f, CTRL, ref, observer=ThermalObserver(alpha_R=0.004))
+    for case, worse in (("cold", 0.038), ("hot", 0.023)):
+        ratio = cu.rms[case, "adaptive-thermal"] / noisy.rms[case, "fixed"]
+        assert ratio == pytest.approx(1 + worse, abs=0.004)
+        assert cu.rms[case, "adaptive-thermal"] < noisy.rms[case, "adaptive-eq5.10"]
+        fr = cu.friction[case, "adaptive-thermal"]
+        assert ((fr > 0.74) & (fr < 0.89)).all()
+    assert cu.rms["cold+drift", "adaptive-thermal"] < 0.97 * noisy.rms["cold+drift", "fixed"]
+    slow = thermal_adaptation_study(f, CTRL, ref, observer=ThermalObserver(R_th=7.2 * 1.3))
+    for case in THERMAL_CASES:
+        assert slow.updated[case, "adaptive-thermal"] == 0.0
+        assert slow.rms[case, "adaptive-thermal"] == slow.rms[case, "fixed"]

@@ -135,7 +135,10 @@ G_QUANTUM = 15
 G_VALPHA = 16
 G_GUARD = 17
 G_COMMAND = 18
-N_GAINS = 19
+G_OBS_ALPHA = 19
+G_OBS_RTH = 20
+G_OBS_CTH = 21
+N_GAINS = 22
 #: the plant's friction drift: schedule (N, 6) = (s_k, Δ_k) or (0, 6), and working copies of the
 #: parameter vector and the table values
 PlantDrift = namedtuple("PlantDrift", "schedule th values")
@@ -692,20 +695,24 @@ def _thermal_observer(th, fc, x, pwm, loop, dt):  # pragma: no cover - compiled
     and the measured speed, each with its own torque factor; then ρ̂ (sensor[k, 4]) = the mean of
     ρ(T̂_lo) and ρ(T̂_hi) for the next step, and the guard (sensor[k, 5]) = 1 while
     (ρ(T̂_lo) − ρ(T̂_hi))/ρ̂ exceeds gains[G_GUARD]. The plant's temperature obeys the same
-    scalar ODE, whose solutions do not cross: a band that holds it at the start holds it always."""
+    scalar ODE, whose solutions do not cross: a band that holds it at the start holds it always
+    (when the observer's α, R_th, C_th = gains[G_OBS_*] are the plant's)."""
     sen, ratio = loop.sensor, fc.ratio
-    Tr, Ta, al = th[IX.T_ref], th[IX.T_amb], th[IX.alpha_R]
+    # the observer's own α, R_th, C_th (the finger's unless told otherwise)
+    gains = loop.gains
+    Tr, Ta, al = th[IX.T_ref], th[IX.T_amb], gains[G_OBS_ALPHA]
+    Rth, Cth = gains[G_OBS_RTH], gains[G_OBS_CTH]
     for k in range(3):
         w = ratio[k] * x[3 + k]
         for j in range(2):
             r = temperature_factor(sen[k, j], Tr, Ta, al)
             ts = bldc_torque(pwm[k], w, th[IX.c_pwm], th[IX.b_pwm], th[IX.b_0], th[IX.pwm_max], r)
-            sen[k, j] = motor_heat_step(sen[k, j], ts, dt, Ta, al, th[IX.R_0], th[IX.k_t],
-                                        th[IX.R_th], th[IX.C_th])
+            sen[k, j] = motor_heat_step(sen[k, j], ts, dt, Ta, al, th[IX.R_0], th[IX.k_t], Rth,
+                                        Cth)
         r_lo = temperature_factor(sen[k, 1], Tr, Ta, al)
         r_hi = temperature_factor(sen[k, 0], Tr, Ta, al)
         sen[k, 4] = 0.5 * (r_lo + r_hi)
-        sen[k, 5] = 1.0 if (r_hi - r_lo) > loop.gains[G_GUARD] * sen[k, 4] else 0.0
+        sen[k, 5] = 1.0 if (r_hi - r_lo) > gains[G_GUARD] * sen[k, 4] else 0.0
 
 
 @hot

@@ -62,9 +62,9 @@ from ...errors import ModelError, SimulationError
 from ...estimation.friction_adaptation import AdaptationSettings
 from ...models.friction import FrictionTable, table_arrays
 from ...signals.trajectory import Trajectory
-from .finger import (ACTUATORS, FRICTION_MODES, G_COMMAND, G_GUARD, G_QUANTUM, G_THERMAL, G_VALPHA,
-                     N_GAINS, NX, DLRFinger, FrictionEstimator, ImpedanceLoop, PlantDrift,
-                     finger_run)
+from .finger import (ACTUATORS, FRICTION_MODES, G_COMMAND, G_GUARD, G_OBS_ALPHA, G_OBS_CTH,
+                     G_OBS_RTH, G_QUANTUM, G_THERMAL, G_VALPHA, N_GAINS, NX, DLRFinger,
+                     FrictionEstimator, ImpedanceLoop, PlantDrift, finger_run)
 from .friction_drift import FrictionDrift
 
 __all__ = ["ImpedanceController", "Wall", "simulate_impedance", "stability_margins",
@@ -112,11 +112,17 @@ class ThermalObserver:
     ρ = R(T_ref)/R(T), and the friction estimator's motor torque is ρ̂ times eq 5.10. The estimator
     is frozen (:data:`gripkit.estimation.friction_adaptation.FROZEN`) while the band is wider than
     ``guard`` relative to ρ̂: then a torque loss and a friction change cannot be told apart (the
-    finger has no torque or current sensor, §3.1)."""
+    finger has no torque or current sensor, §3.1).
+
+    ``alpha_R`` (1/K), ``R_th`` (K/W), ``C_th`` (J/K): the observer's own thermal parameters
+    (default None: the finger's), to study a thermal model that differs from the motor's."""
 
     initial: tuple | None = None
     guard: float = 0.05
     command: bool = False
+    alpha_R: float | None = None
+    R_th: float | None = None
+    C_th: float | None = None
 
     def __post_init__(self):
         if self.initial is not None:
@@ -130,6 +136,11 @@ class ThermalObserver:
             object.__setattr__(self, "initial", (lo, hi))
         if not (math.isfinite(self.guard) and self.guard > 0):
             raise ModelError(f"guard: expected a positive relative width, found {self.guard!r}")
+        for name in ("alpha_R", "R_th", "C_th"):
+            x = getattr(self, name)
+            if x is not None and not (isinstance(x, (int, float)) and math.isfinite(x) and x > 0):
+                raise ModelError(f"{name}: expected a positive number or None (the finger's), "
+                                 f"found {x!r}")
 
 @dataclass(frozen=True)
 class ImpedanceController:
@@ -314,7 +325,8 @@ def _sensor_state(finger, controller, x, gains, dt) -> np.ndarray:
     if ob is not None:
         v = finger.parameters.value
         lo, hi = ob.initial if ob.initial is not None else (v("T_amb"), v("T_ref"))
-        a, T_ref, T_amb = v("alpha_R"), v("T_ref"), v("T_amb")
+        a = v("alpha_R") if ob.alpha_R is None else ob.alpha_R
+        T_ref, T_amb = v("T_ref"), v("T_amb")
         r_lo, r_hi = ((1 + a * (T_ref - T_amb)) / (1 + a * (T - T_amb)) for T in (hi, lo))
         sensor[:, 0], sensor[:, 1] = lo, hi
         sensor[:, 4] = 0.5 * (r_lo + r_hi)
@@ -322,6 +334,9 @@ def _sensor_state(finger, controller, x, gains, dt) -> np.ndarray:
         gains[G_THERMAL] = 1.0
         gains[G_GUARD] = ob.guard
         gains[G_COMMAND] = float(bool(ob.command))
+        gains[G_OBS_ALPHA] = a
+        gains[G_OBS_RTH] = v("R_th") if ob.R_th is None else ob.R_th
+        gains[G_OBS_CTH] = v("C_th") if ob.C_th is None else ob.C_th
     return sensor
 
 
