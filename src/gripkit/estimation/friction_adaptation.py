@@ -2,7 +2,9 @@
 exponential forgetting on a scale and an offset of the friction table.
 
 Friction "differs from finger to finger and the parameters may change over time"
-(``002_ddea254371185ad3.txt``, abstract, §6.3, §8). gripkit adapts, per actuator k, the friction
+(``002_ddea254371185ad3.txt``, abstract, §6.3, §8). The thesis motivates adaptation but gives no
+estimator (its adjustment is a hand-set factor on the lookup tables, §6.3): the recursive least
+squares below is gripkit's addition. gripkit adapts, per actuator k, the friction
 model
 
     F_k(v) = s_k · F_table,k(v) + o_k · sign(v)

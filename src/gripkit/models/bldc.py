@@ -36,16 +36,18 @@ raise the resistance by about 20 % (α ≈ 0.004 K⁻¹), which would only drop 
 0.82 Ncm at 80 °C. gripkit uses the effective α that reproduces Fig. 5.7 (the winding is hotter
 than the measured 80 °C, and the magnets weaken) and reports the contradiction.
 
-**Thermal model.** A first-order lumped model, C_th dT/dt = R(T) I² − (T − T₀)/R_th, with the
-current I = τ/k_t. k_t and R₀ follow from an assumed 12 V supply and the physical reading of the
-speed slope (|b(3000)| = k_t²/R(T_ref)): k_t = 7.95 mN·m/A, R₀ = 9.32 Ω; R_th = 7.2 K/W and
-C_th = 5.5 J/K make the Fig. 5.7 experiment (PWM 4000 held at stall) settle near 84 °C with a
-40 s time constant, so the torque falls from 1.0 Ncm to 0.57 Ncm within the figure's 120 s.
+**Thermal model** (gripkit's addition: the thesis gives eq 5.5 and Fig. 5.7's course, no model of
+the winding temperature). A first-order lumped model, C_th dT/dt = R(T) I² − (T − T₀)/R_th, with
+the current I = τ/k_t. k_t and R₀ follow from an assumed 12 V supply and the physical reading of
+the speed slope (|b(3000)| = k_t²/R(T_ref)): k_t = 7.95 mN·m/A, R₀ = 9.32 Ω; R_th = 7.2 K/W and
+C_th = 5.5 J/K make the Fig. 5.7 experiment (PWM 4000 held at stall) settle near 84 °C with a 40 s
+time constant, so the torque falls from 1.0 Ncm to 0.57 Ncm within the figure's 120 s.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numba
 import numpy as np
@@ -58,7 +60,8 @@ from ..params import Parameter, ParameterSet
 from ..sim.model import Model, Signal
 
 __all__ = ["bldc_torque", "temperature_factor", "motor_parameters", "BLDCMotor",
-           "MotorTestBed", "RPM", "SLOPES_5_4_2", "PWM_MAX", "SEED"]
+           "MotorTestBed", "PowerBalance", "RPM", "SLOPES_5_4_2", "PWM_MAX", "SEED",
+           "SUPPLY_VOLTAGE", "RATED_SPEED_RPM"]
 
 SEED = "002_ddea254371185ad3.txt"
 RPM = 2.0 * math.pi / 60.0  # rad/s per rpm
@@ -66,6 +69,44 @@ NCM = 0.01  # N·m per Ncm
 PWM_MAX = 4096.0
 #: §5.4.2: slopes of torque over speed at constant PWM (Ncm/rpm; printed as magnitudes)
 SLOPES_5_4_2 = {2000: -5.332e-5, 2500: -4.688e-5, 3000: -3.876e-5, 3500: -3.582e-5}
+#: supply voltage assumed for the derivation of k_t and R₀ (V; the seed gives none)
+SUPPLY_VOLTAGE = 12.0
+#: rated speed of the finger motor (§2: "The rated speed and torque of the motor are 6000 rpm and
+#: 3.2 mNm")
+RATED_SPEED_RPM = 6000.0
+#: largest speed on Fig. 5.6's axis (printed "rotationalspeed[rps]", 0..3000)
+FIG_5_6_MAX_SPEED = 3000.0
+
+
+@dataclass(frozen=True)
+class PowerBalance:
+    """The terms of eqs 5.1–5.6 at given PWM counts and speeds (arrays broadcast together), all
+    in W except ``voltage`` (V), ``current`` (A), ``torque`` (N·m) and ``speed`` (rpm):
+    P_el = U·I (5.2), P_mech = π·τ·n/30000 (5.3; τ in mN·m, n in rpm), P_J = R(T)·I² (5.4),
+    and the friction loss the balance leaves, P_F = P_el − P_mech − P_J (5.1, 5.6).
+    ``friction_fraction`` = P_F/P_mech (NaN where P_mech = 0)."""
+
+    pwm: np.ndarray
+    speed: np.ndarray
+    voltage: np.ndarray
+    current: np.ndarray
+    torque: np.ndarray
+    electrical: np.ndarray
+    mechanical: np.ndarray
+    joule: np.ndarray
+    friction: np.ndarray
+
+    units = {"pwm": "1", "speed": "rpm", "voltage": "V", "current": "A", "torque": "N*m",
+             "electrical": "W", "mechanical": "W", "joule": "W", "friction": "W"}
+
+    @property
+    def friction_fraction(self) -> np.ndarray:
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(self.mechanical != 0, self.friction / self.mechanical, np.nan)
+
+    def as_dict(self) -> dict:
+        """Each term with its unit: ``{name: (value, unit)}``."""
+        return {k: (getattr(self, k), u) for k, u in self.units.items()}
 
 
 @hot
@@ -179,10 +220,73 @@ class BLDCMotor:
         (eq 5.4) in the power balance of eq 5.6."""
         return self._p("R_0") * (1.0 + self._p("alpha_R") * (np.asarray(T, dtype=np.float64) - self._p("T_amb")))
 
+    def electrical_constants(self, supply_voltage: float = SUPPLY_VOLTAGE) -> tuple[float, float]:
+        """(k_t in N·m/A, R₀ in Ω) that make a DC motor on ``supply_voltage`` (V) give eq 5.10's
+        stall torque and its speed slope at PWM 3000, at T_ref.
+
+        A DC motor fed the mean voltage U = V·u/4096 gives τ = k_t(U − k_t·ω)/R: the stall term
+        k_t·V/(4096·R) = c (eq 5.7) and the slope −k_t²/R = b(3000) (eq 5.8). Hence
+        k_t = V·|b(3000)|/(4096·c) and R(T_ref) = k_t²/|b(3000)|, R₀ = R(T_ref)/(1 + α(T_ref − T₀)).
+        At 12 V: k_t = 7.955 mN·m/A, R₀ = 9.32 Ω (the parameters ``k_t``, ``R_0``); k_t ∝ V, R ∝ V².
+        """
+        if not (isinstance(supply_voltage, (int, float)) and math.isfinite(supply_voltage)
+                and supply_voltage > 0):
+            raise ModelError(f"supply_voltage: expected a positive voltage in V, "
+                             f"found {supply_voltage!r}")
+        b3000 = abs(float(self.slope(3000.0)))
+        kt = supply_voltage * b3000 / (PWM_MAX * self._p("c_pwm"))
+        R_ref = kt * kt / b3000
+        R0 = R_ref / (1.0 + self._p("alpha_R") * (self._p("T_ref") - self._p("T_amb")))
+        return kt, R0
+
+    def power_balance(self, pwm, speed_rpm, T=None, *,
+                      supply_voltage: float | None = None) -> PowerBalance:
+        """Eqs 5.1–5.6 for eq 5.10's torque at ``pwm`` (count) and ``speed_rpm`` (rpm, ≥ 0 in the
+        direction of the torque; the quadrant of Fig. 5.6), winding temperature ``T`` (K, default
+        T_ref).
+
+        U = V·|u|/4096 (the PWM's mean voltage, §5.2), I = τ/k_t, P_el = U·I (5.2),
+        P_mech = π·τ[mN·m]·n/30000 (5.3, = τ·ω), P_J = R(T)·I² (5.4, R(T) of 5.5) and
+        P_F = P_el − P_mech − P_J (5.6). With ``supply_voltage`` None the parameters' k_t, R₀ and
+        the 12 V they were derived with; with a voltage, k_t and R₀ re-derived for it
+        (:meth:`electrical_constants`).
+
+        *Why P_F < 0 above PWM 3000, at any supply voltage and speed.* With k_t, R from
+        :meth:`electrical_constants`, U·I = τ·u·c/|b(3000)| and R·I² = τ²/|b(3000)| at T_ref, so
+        P_F = τ·[(c·u − τ)/|b(3000)| − ω] = τ·ω·(|b(u)|/|b(3000)| − 1), because eq 5.10 gives
+        c·u − τ = |b(u)|·ω. Hence P_F/P_mech = |b(u)|/|b(3000)| − 1, independent of V and n: eq 5.8
+        makes the slope shrink with PWM, while a DC motor's slope −k_t²/R does not depend on the
+        voltage. Above PWM 3000 eq 5.10 delivers more mechanical power than the electrical input
+        less Joule heat: −14.9 % of P_mech at 3500, −29.9 % at 4000 (+14.9 % at 2500, +29.9 % at
+        2000, 0 at 3000 by construction). The parameters' rounded k_t = 7.95 mN·m/A and
+        R₀ = 9.32 Ω (``supply_voltage=None``) shift these by up to 0.3 points."""
+        pmax = self._p("pwm_max")
+        u = np.abs(np.clip(np.asarray(pwm, dtype=np.float64), -pmax, pmax))
+        n = np.asarray(speed_rpm, dtype=np.float64)
+        if not (np.isfinite(u).all() and np.isfinite(n).all()) or (n < 0).any():
+            raise ModelError("power_balance: expected finite PWM counts and speeds >= 0 rpm "
+                             "(the driving quadrant of Fig. 5.6)")
+        if supply_voltage is None:
+            V, kt, R0 = SUPPLY_VOLTAGE, self._p("k_t"), self._p("R_0")
+        else:
+            V = float(supply_voltage)
+            kt, R0 = self.electrical_constants(V)
+        Tk = self._p("T_ref") if T is None else np.asarray(T, dtype=np.float64)
+        tau = self.torque(u, n * RPM, Tk)
+        I = tau / kt
+        U = V * u / PWM_MAX
+        R = R0 * (1.0 + self._p("alpha_R") * (Tk - self._p("T_amb")))
+        p_el = U * I
+        p_mech = math.pi * (tau * 1e3) * n / 30000.0  # eq 5.3 with τ in mN·m, n in rpm
+        p_j = R * I * I
+        u, n = np.broadcast_arrays(u, n)
+        return PowerBalance(u, n, U, I, tau, p_el, p_mech, p_j, p_el - p_mech - p_j)
+
     def consistency_checks(self) -> list[Finding]:
         """Eq 5.8 against the slopes printed in §5.4.2; the temperature coefficient implied by
-        Fig. 5.7 against the thesis's own statement for copper (§5.2)."""
-        out = []
+        Fig. 5.7 against the thesis's own statement for copper (§5.2); the power balance of eq
+        5.6 with eq 5.10 over Fig. 5.6's PWM range; Fig. 5.6's speed unit."""
+        out = [self._power_balance_finding(), self._speed_unit_finding()]
         for pwm, stated in SLOPES_5_4_2.items():
             out.append(compare(f"eq5.8-slope-pwm{pwm}", self.name,
                                computed=float(self.slope(pwm)) * RPM / NCM, stated=stated, rtol=0.06,
@@ -202,6 +306,52 @@ class BLDCMotor:
                                  f"{drop_copper:.2f} Ncm"),
                            source=f"{SEED}, §5.2 and Fig. 5.7"))
         return out
+
+    def _power_balance_finding(self) -> Finding:
+        """Eq 5.6 with eq 5.10 at PWM 2000..4000 (Fig. 5.6) and 1000 rpm: the smallest
+        P_F/P_mech must be ≥ 0 (friction cannot return power)."""
+        pwm = np.arange(2000.0, 4001.0, 500.0)
+        kt, R0 = self.electrical_constants(SUPPLY_VOLTAGE)
+        bal = self.power_balance(pwm, 1000.0, supply_voltage=SUPPLY_VOLTAGE)
+        frac = bal.friction_fraction
+        i = int(np.argmin(frac))
+        worst = float(frac[i])
+        neg = ", ".join(f"{frac[j]:+.1%} at PWM {pwm[j]:.0f}" for j in range(pwm.size)
+                        if frac[j] < -1e-9)
+        R_ref = R0 * (1.0 + self._p("alpha_R") * (self._p("T_ref") - self._p("T_amb")))
+        msg = (f"friction loss P_F = U·I − π·τ·n/30000 − R(T)·I² (eq 5.6) with eq 5.10's torque at "
+               f"1000 rpm, {SUPPLY_VOLTAGE:g} V, k_t = {kt * 1e3:.3g} mN·m/A, R(T_ref) = "
+               f"{R_ref:.3g} Ω: P_F/P_mech = {worst:+.1%} at PWM "
+               f"{pwm[i]:.0f} (must be >= 0); negative: {neg or 'none'}. P_F/P_mech = "
+               f"|b(PWM)|/|b(3000)| − 1 at every speed and supply voltage (eq 5.8's slope shrinks "
+               f"with PWM; a DC motor's −k_t²/R does not)")
+        return Finding("eq5.6-power-balance", self.name, worst >= 0.0, msg,
+                       used=("gripkit keeps eq 5.10 (the measured torque) for the motor and "
+                             "the thermal model's Joule heat; the balance says eq 5.8's "
+                             "PWM-dependent slope is not a DC motor's at one k_t and R above "
+                             "PWM 3000"),
+                       computed=worst, stated=0.0, rel_error=abs(min(worst, 0.0)), tolerance=0.0,
+                       source=f"{SEED}, eqs 5.1-5.6, 5.8, 5.10 and Fig. 5.6")
+
+    def _speed_unit_finding(self) -> Finding:
+        """Fig. 5.6's axis (and eq 5.8's closing label) say rps; §5.4.2, Fig. 5.5 and eq 5.8's
+        slopes say rpm. Read as rps, Fig. 5.6 would reach 3000·60 rpm, 30× the motor's rated
+        speed."""
+        as_rpm = FIG_5_6_MAX_SPEED * 60.0
+        rel = as_rpm / RATED_SPEED_RPM - 1.0
+        drop = (self._p("c_pwm") * 4000.0 + float(self.slope(4000.0)) * 2500 * 60 * RPM) / NCM
+        msg = (f"Fig. 5.6's speed axis (0..{FIG_5_6_MAX_SPEED:.0f}) and eq 5.8's last label read "
+               f"'rps': {as_rpm:.0f} rpm, {as_rpm / RATED_SPEED_RPM:.0f}× the motor's rated "
+               f"{RATED_SPEED_RPM:.0f} rpm (§2), and eq 5.10 at PWM 4000 would give "
+               f"{drop:.3g} Ncm at 2500 rps before Appendix E's guard (Fig. 5.6 shows 0..0.6 "
+               f"Ncm); §5.4.2 ('steps of around "
+               f"500 rpm from zero to 2500'), Fig. 5.5 (rpm) and eq 5.8's slopes (Ncm/rpm) "
+               f"read rpm")
+        return Finding("fig5.6-speed-unit", self.name, False, msg,
+                       used=("gripkit reads rpm: eq 5.8's slopes are per rpm, the experiment "
+                             "of Fig. 5.5 ran in rpm, and rps would exceed the rated speed 30×"),
+                       computed=as_rpm, stated=RATED_SPEED_RPM, rel_error=rel, tolerance=0.0,
+                       source=f"{SEED}, §2, §5.4.2, Figs 5.5-5.6, eq 5.8")
 
     def __repr__(self) -> str:
         return f"BLDCMotor({self.parameters!r})"

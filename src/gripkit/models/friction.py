@@ -28,7 +28,9 @@ sliding joint sticks when its velocity crosses zero and the holding torque is be
 true stick-slip: no creep under a sub-stiction load (§6.2: "undesired stick-slip effect occurs" at
 PWM 1200–1500).
 
-**LuGre** (Canudas de Wit et al., 1995), an option: an internal bristle state z with
+**LuGre** (Canudas de Wit et al., 1995), an option and gripkit's addition (the DLR/HIT thesis,
+``002_ddea254371185ad3.txt``, uses lookup tables and Stribeck's eq 6.5): an internal bristle
+state z with
 
     ż = v − σ₀|v| z / g(v),  g(v) = F_c + (F_s − F_c) exp(−(v/v_s)²),  F = σ₀ z + σ₁ ż + σ₂ v;
 

@@ -17,7 +17,8 @@ term). Each run gives one (v, F) point; the points form the lookup table of §6.
 with a Stribeck curve plus viscous and cubic terms (:func:`fit_stribeck`) whose covariance gives
 the uncertainty.
 
-IDIM-LS (the standard robot identification method, e.g. Gautier & Khalil; Swevers et al.). For one
+IDIM-LS (the standard robot identification method, e.g. Gautier & Khalil; Swevers et al.; gripkit's
+addition: the DLR/HIT thesis identifies friction from constant-velocity runs only). For one
 axis with position q and effort τ (= K × a logged column):
 
     τ = J q̈ + F_v q̇ + F_c sign(q̇) + τ₀.

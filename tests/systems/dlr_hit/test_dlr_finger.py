@@ -159,7 +159,8 @@ def test_zoo_check_reports_the_thesis_contradictions(capsys):
     assert code == 3 and out["consistent"] is False
     bad = {f["check"] for f in out["findings"] if not f["consistent"]}
     assert {"stiction-base1", "stiction-base2", "table-6.1-mean", "dynamics-influence-flexion",
-            "fig5.7-temperature-coefficient", "appendix-G-distal-lowest-velocity",
+            "fig5.7-temperature-coefficient", "eq5.6-power-balance", "fig5.6-speed-unit",
+            "appendix-G-distal-lowest-velocity",
             "appendix-G-base-point-172.1", "appendix-G-distal-point--253.0"} == bad
     ok = {f["check"] for f in out["findings"] if f["consistent"]}
     assert {"stiction-distal", "appendix-G-distal-max", "appendix-G-base1-min", "belt-ratio",

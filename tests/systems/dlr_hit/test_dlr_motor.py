@@ -174,3 +174,72 @@ def test_bad_motor_data():
     with pytest.raises(DataError, match="three or more"):
         characterize_motor([1000, 2000], [0.1, 0.2], [(2000, np.arange(5.0), np.arange(5.0))])
     assert math.isfinite(MOTOR.torque(10000, 0.0))
+
+
+# --- power balance, eqs 5.1-5.6 (issue 28 item 3) -------------------------------------------------
+
+def test_electrical_constants_reproduce_the_parameters():
+    """k_t = V·|b(3000)|/(4096·c) and R(T_ref) = k_t²/|b(3000)| at the assumed 12 V: 7.955 mN·m/A
+    and R₀ = 9.323 Ω, the parameters k_t = 7.95e-3 and R_0 = 9.32 to their printed digits;
+    k_t ∝ V and R₀ ∝ V²."""
+    kt, R0 = MOTOR.electrical_constants(12.0)
+    b3000 = (1.215e-8 * 3000 - 7.711e-5) * NCM / RPM
+    assert kt == pytest.approx(12.0 * abs(b3000) / (4096 * 1.43e-6), rel=1e-12)
+    assert kt == pytest.approx(7.955e-3, abs=1e-6) and R0 == pytest.approx(9.323, abs=1e-3)
+    assert kt == pytest.approx(MOTOR.parameters.value("k_t"), rel=1e-3)
+    assert R0 == pytest.approx(MOTOR.parameters.value("R_0"), rel=1e-3)
+    kt24, R24 = MOTOR.electrical_constants(24.0)
+    assert kt24 == pytest.approx(2 * kt) and R24 == pytest.approx(4 * R0)
+
+
+def test_power_balance_terms_at_pwm_4000():
+    """Eqs 5.2-5.6 term by term at PWM 4000, 1000 rpm, T_ref, the parameters' k_t and R₀ (12 V):
+    τ = 0.572 − 2.851e-5·1000 = 0.5435 Ncm, P_mech = π·τ[mN·m]·n/30000 = τ·ω = 0.5691 W,
+    U = 12·4000/4096 = 11.72 V, I = τ/k_t = 0.6836 A, P_el = 8.011 W, P_J = R(T_ref)·I² = 7.614 W,
+    P_F = P_el − P_mech − P_J = −0.1717 W (−30.2 % of P_mech)."""
+    b = MOTOR.power_balance(4000.0, 1000.0)
+    tau = (1.43e-4 * 4000 + (1.215e-8 * 4000 - 7.711e-5) * 1000) * NCM
+    assert b.torque == pytest.approx(tau, rel=1e-12)
+    assert tau / NCM == pytest.approx(0.54349, rel=1e-5)
+    assert b.mechanical == pytest.approx(tau * 1000 * 2 * math.pi / 60, rel=1e-12)
+    assert b.voltage == pytest.approx(12 * 4000 / 4096)
+    assert b.current == pytest.approx(tau / 7.95e-3)
+    assert b.electrical == pytest.approx(8.0114, abs=1e-4)
+    R_ref = 9.32 * (1 + 0.0136 * 55)
+    assert b.joule == pytest.approx(R_ref * (tau / 7.95e-3) ** 2, rel=1e-12)
+    assert b.electrical == pytest.approx(b.mechanical + b.joule + b.friction, rel=1e-12)
+    assert b.friction == pytest.approx(-0.1717, abs=1e-4)
+    assert b.friction_fraction == pytest.approx(-0.3016, abs=1e-4)
+    assert b.as_dict()["friction"][1] == "W" and b.as_dict()["speed"][1] == "rpm"
+
+
+@pytest.mark.parametrize("volts", [6.0, 12.0, 24.0])
+def test_friction_loss_is_negative_above_pwm_3000_at_any_voltage(volts):
+    """With k_t and R derived for the supply voltage, P_F/P_mech = |b(u)|/|b(3000)| − 1 at every
+    speed (derivation in BLDCMotor.power_balance): +29.9 %, +14.9 %, 0, −14.9 %, −29.9 % at PWM
+    2000..4000."""
+    pwm = np.array([2000.0, 2500.0, 3000.0, 3500.0, 4000.0])
+    speed = np.array([[300.0], [1000.0], [2500.0]])
+    frac = MOTOR.power_balance(pwm, speed, supply_voltage=volts).friction_fraction
+    b = 1.215e-8 * pwm - 7.711e-5
+    expected = np.abs(b) / abs(1.215e-8 * 3000 - 7.711e-5) - 1
+    np.testing.assert_allclose(frac, np.broadcast_to(expected, frac.shape), atol=1e-12)
+    np.testing.assert_allclose(expected, [0.2988, 0.1494, 0.0, -0.1494, -0.2988], atol=1e-4)
+
+
+def test_zoo_check_reports_the_power_balance_and_the_speed_unit():
+    f = {x.check: x for x in zoo.build("dlr-hit-finger", check=False).consistency_checks()}
+    pb = f["eq5.6-power-balance"]
+    assert not pb.consistent and pb.stated == 0.0
+    assert pb.computed == pytest.approx(-0.2988, abs=1e-4)
+    assert "-14.9% at PWM 3500" in pb.message and "-29.9% at PWM 4000" in pb.message
+    su = f["fig5.6-speed-unit"]
+    assert not su.consistent and su.computed == 180000.0 and su.stated == 6000.0
+    assert "gripkit reads rpm" in su.used and "-3.7 Ncm" in su.message
+
+
+def test_power_balance_bad_input():
+    with pytest.raises(ModelError, match="speeds >= 0 rpm"):
+        MOTOR.power_balance(3000.0, -10.0)
+    with pytest.raises(ModelError, match="supply_voltage: expected a positive voltage"):
+        MOTOR.electrical_constants(0.0)

@@ -20,8 +20,8 @@ efficiency), h_p the Coriolis/centrifugal and gravity torques, and F_k friction:
   it breaks away when its holding torque exceeds its stiction);
 * ``friction='stribeck'``: eq 6.5 per actuator plus a cubic velocity term (the harmonic-drive
   friction model of [50] quoted in §3.2.2), with the same stiction logic;
-* ``friction='lugre'``: LuGre per actuator (no state machine; moves by a pre-sliding
-  displacement under loads below stiction);
+* ``friction='lugre'``: LuGre per actuator (gripkit's addition, not the thesis's; no state
+  machine; moves by a pre-sliding displacement under loads below stiction);
 * ``friction='none'``: frictionless (energy-conservation studies).
 
 An optional harmonic-drive ripple A·sin(k·p)·sign(ṗ) adds to F (§3.2.2).
@@ -34,7 +34,8 @@ inertia it brakes the finger within tens of milliseconds and lets it bounce back
 
 Motor temperature. By default the winding stays at T_ref, where eq 5.10 holds (the thesis assumes
 the operating temperature, §5.4.3); ``thermal=True`` integrates each motor's first-order thermal
-model (:mod:`gripkit.models.bldc`) from the initial temperature in the state.
+model (:mod:`gripkit.models.bldc`; gripkit's, calibrated on Fig. 5.7) from the initial temperature
+in the state.
 
 Integration. Fixed steps (``substeps`` per sample): semi-implicit Euler (default; one
 force evaluation per step, ≥ 1000× real time at 1 kHz) or RK4 (``integrator='rk4'``) with the
@@ -122,9 +123,22 @@ StepWork = namedtuple("StepWork", "chain solve acc tshaft p0 v0 ka ps vs taum2 t
 LoopWork = namedtuple("LoopWork", "q qd R P T J Jp tip tipd tauq gp work zq xs pwm ext taum fric hb "
                                   "ff force")
 #: a closed loop: ``ctrl`` (0 open loop, 1 joint, 2 Cartesian impedance), its gains vector, the
-#: friction tables it compensates with (TableArrays), the reference and its velocity (N, 3) and
-#: the wall (nx, ny, nz, px, py, pz, k, d, on)
-ImpedanceLoop = namedtuple("ImpedanceLoop", "ctrl gains tables ref refd wall")
+#: friction tables it compensates with (TableArrays), the reference and its velocity (N, 3), the
+#: wall (nx, ny, nz, px, py, pz, k, d, on), the controller's sensing and thermal observer state
+#: ``sensor`` (3, 6) per actuator = (T̂_lo, T̂_hi, last quantised angle, filtered velocity, ρ̂,
+#: guard: 1 while the torque factor is too uncertain to adapt) and the measured state ``xm`` (NX)
+ImpedanceLoop = namedtuple("ImpedanceLoop", "ctrl gains tables ref refd wall sensor xm")
+#: indices of the gains vector beyond the impedance gains (see gripkit.systems.dlr_hit.impedance)
+G_ADAPT = 13
+G_THERMAL = 14
+G_QUANTUM = 15
+G_VALPHA = 16
+G_GUARD = 17
+G_COMMAND = 18
+G_OBS_ALPHA = 19
+G_OBS_RTH = 20
+G_OBS_CTH = 21
+N_GAINS = 22
 #: the plant's friction drift: schedule (N, 6) = (s_k, Δ_k) or (0, 6), and working copies of the
 #: parameter vector and the table values
 PlantDrift = namedtuple("PlantDrift", "schedule th values")
@@ -584,7 +598,9 @@ def _impedance(th, fc, cs, x, n, loop, fhat):  # pragma: no cover - compiled
                 ff[k] = fk * math.tanh(abs(tau) / eps)
                 tau += ff[k]
         tauq[k] = tau
-        pwm[k] = _pwm_for(tau, ratio[k] * x[3 + k], ratio[k], th)
+        # with gains[G_COMMAND] the thermal observer's torque factor ρ̂ corrects the inversion
+        rho = loop.sensor[k, 4] if gains[G_COMMAND] != 0.0 else 1.0
+        pwm[k] = _pwm_for(tau / rho, ratio[k] * x[3 + k], ratio[k], th)
 
 
 @hot_inline
@@ -618,27 +634,85 @@ def _wall(th, fc, cs, x, wall):  # pragma: no cover - compiled
 
 
 @hot
-def _adapt_friction(th, fc, cs, x, ctab, est, y, n):  # pragma: no cover - compiled
+def _adapt_friction(th, fc, cs, x, ctab, est, sensor, y, n):  # pragma: no cover - compiled
     """One step of the online friction estimator ``est`` (:data:`FrictionEstimator`) per actuator
     (after :func:`_impedance`, whose chain arrays R, P still hold the current configuration):
-    motor torque from the PWM just commanded and the measured speed through eq 5.10 at T_ref and
-    the transmission, bias torque Γᵀ(C(q, q̇)q̇ + G(q)) by RNEA; writes the estimates and each
-    sample's status into y[n, 27:36]."""
-    G, ratio, grav, pwm, hb, theta = fc.G, fc.ratio, fc.g, cs.pwm, cs.hb, est.theta
+    motor torque from the PWM just commanded and the measured speed through eq 5.10 times the
+    thermal observer's torque factor ρ̂ = ``sensor[k, 4]`` (1: eq 5.10 at T_ref) and the
+    transmission, bias torque Γᵀ(C(q, q̇)q̇ + G(q)) by RNEA; writes the estimates and each
+    sample's status into y[n, 27:36]. While ``sensor[k, 5]`` ≠ 0 (the observer's torque factor
+    is too uncertain: a torque loss and a friction change cannot be told apart) the filters run
+    but θ, P and σ̂² keep their values (status 0, frozen)."""
+    G, ratio, grav, pwm, hb = fc.G, fc.ratio, fc.g, cs.pwm, cs.hb
+    theta, P, sig2 = est.theta, est.P, est.sig2
     rnea_pass(4, cs.R, cs.P, fc.jtype, fc.mass, fc.com, fc.inertia, fc.arm_q, cs.qd, cs.zq, grav[0],
               grav[1], grav[2], True, hb, cs.work)
     for k in range(3):
         v = x[3 + k]
-        ts = bldc_torque(pwm[k], ratio[k] * v, th[IX.c_pwm], th[IX.b_pwm], th[IX.b_0], th[IX.pwm_max], 1.0)
+        ts = bldc_torque(pwm[k], ratio[k] * v, th[IX.c_pwm], th[IX.b_pwm], th[IX.b_0],
+                         th[IX.pwm_max], sensor[k, 4])
         tm = transmit_torque(ts, v, ratio[k], th[IX.eta])
         h = 0.0
         for j in range(4):
             h += G[j * 3 + k] * hb[j]
-        y[n, 33 + k] = friction_rls_step(k, tm, h, v, est.inertia, ctab.velocity, ctab.values,
-                                         ctab.length, ctab.ipos, est.cfg, theta, est.P, est.filt,
-                                         est.sig2)
+        s0, o0, sg = theta[k, 0], theta[k, 1], sig2[k]
+        p00, p01, p11 = P[k, 0, 0], P[k, 0, 1], P[k, 1, 1]
+        st = friction_rls_step(k, tm, h, v, est.inertia, ctab.velocity, ctab.values, ctab.length,
+                               ctab.ipos, est.cfg, theta, P, est.filt, sig2)
+        if sensor[k, 5] != 0.0 and st == 1.0:  # guard: undo the update, keep the filters
+            theta[k, 0], theta[k, 1], sig2[k] = s0, o0, sg
+            P[k, 0, 0], P[k, 0, 1], P[k, 1, 0], P[k, 1, 1] = p00, p01, p01, p11
+            st = 0.0
+        y[n, 33 + k] = st
         y[n, 27 + k] = theta[k, 0]
         y[n, 30 + k] = theta[k, 1]
+
+
+@hot
+def _measure(x, loop, n, dt):  # pragma: no cover - compiled
+    """The controller's view of the state (gains[G_QUANTUM] > 0): actuator angles quantised to
+    the sensor resolution Δ, velocities by backward difference of the quantised angles through a
+    first-order low-pass (α = gains[G_VALPHA]); written into ``loop.xm``. At n = 0 the filter
+    starts at the true velocity (a finger at rest reads 0)."""
+    xm, sen, dq, al = loop.xm, loop.sensor, loop.gains[G_QUANTUM], loop.gains[G_VALPHA]
+    for k in range(NX):
+        xm[k] = x[k]
+    for k in range(3):
+        pq = math.floor(x[k] / dq + 0.5) * dq
+        if n == 0:
+            sen[k, 3] = x[3 + k]
+        else:
+            sen[k, 3] += al * ((pq - sen[k, 2]) / dt - sen[k, 3])
+        sen[k, 2] = pq
+        xm[k] = pq
+        xm[3 + k] = sen[k, 3]
+
+
+@hot
+def _thermal_observer(th, fc, x, pwm, loop, dt):  # pragma: no cover - compiled
+    """The controller's motor-temperature band (gains[G_THERMAL] ≠ 0): T̂_lo and T̂_hi (sensor[k,
+    0:2]) advance by the thermal model of :mod:`gripkit.models.bldc` under the PWM just commanded
+    and the measured speed, each with its own torque factor; then ρ̂ (sensor[k, 4]) = the mean of
+    ρ(T̂_lo) and ρ(T̂_hi) for the next step, and the guard (sensor[k, 5]) = 1 while
+    (ρ(T̂_lo) − ρ(T̂_hi))/ρ̂ exceeds gains[G_GUARD]. The plant's temperature obeys the same
+    scalar ODE, whose solutions do not cross: a band that holds it at the start holds it always
+    (when the observer's α, R_th, C_th = gains[G_OBS_*] are the plant's)."""
+    sen, ratio = loop.sensor, fc.ratio
+    # the observer's own α, R_th, C_th (the finger's unless told otherwise)
+    gains = loop.gains
+    Tr, Ta, al = th[IX.T_ref], th[IX.T_amb], gains[G_OBS_ALPHA]
+    Rth, Cth = gains[G_OBS_RTH], gains[G_OBS_CTH]
+    for k in range(3):
+        w = ratio[k] * x[3 + k]
+        for j in range(2):
+            r = temperature_factor(sen[k, j], Tr, Ta, al)
+            ts = bldc_torque(pwm[k], w, th[IX.c_pwm], th[IX.b_pwm], th[IX.b_0], th[IX.pwm_max], r)
+            sen[k, j] = motor_heat_step(sen[k, j], ts, dt, Ta, al, th[IX.R_0], th[IX.k_t], Rth,
+                                        Cth)
+        r_lo = temperature_factor(sen[k, 1], Tr, Ta, al)
+        r_hi = temperature_factor(sen[k, 0], Tr, Ta, al)
+        sen[k, 4] = 0.5 * (r_lo + r_hi)
+        sen[k, 5] = 1.0 if (r_hi - r_lo) > gains[G_GUARD] * sen[k, 4] else 0.0
 
 
 @hot
@@ -672,7 +746,9 @@ def finger_loop(th, mode, thermal, fc, ws, cs, tab, u, ucol, dt, substeps, x, y,
     joint/Cartesian impedance (:data:`ImpedanceLoop`), closed-loop outputs (39 columns, see
     gripkit.systems.dlr_hit.impedance). ``plant`` (:data:`PlantDrift`): the plant's friction drift
     (:func:`_drift_friction`); ``est`` (:data:`FrictionEstimator`): the online friction
-    estimator, run when gains[13] ≠ 0."""
+    estimator, run when gains[G_ADAPT] ≠ 0; the controller sees the state through
+    :func:`_measure` when gains[G_QUANTUM] > 0 and corrects eq 5.10 by its thermal observer
+    (:func:`_thermal_observer`) when gains[G_THERMAL] ≠ 0."""
     G, q0 = fc.G, fc.q0
     pwm, ext, taum, fric, xs, force = cs.pwm, cs.ext, cs.taum, cs.fric, cs.xs, cs.force
     ctrl, gains = loop.ctrl, loop.gains
@@ -686,14 +762,20 @@ def finger_loop(th, mode, thermal, fc, ws, cs, tab, u, ucol, dt, substeps, x, y,
         if drifting:
             _drift_friction(th, mode, tab, plant, n)
         if ctrl:
-            _impedance(th, fc, cs, x, n, loop, fhat)
-            if gains[13] != 0.0:
-                _adapt_friction(th, fc, cs, x, loop.tables, est, y, n)
+            xc = x
+            if gains[G_QUANTUM] > 0.0:
+                _measure(x, loop, n, dt)
+                xc = loop.xm
+            _impedance(th, fc, cs, xc, n, loop, fhat)
+            if gains[G_ADAPT] != 0.0:
+                _adapt_friction(th, fc, cs, xc, loop.tables, est, loop.sensor, y, n)
             else:
                 for k in range(3):
                     y[n, 27 + k] = fhat[k, 0]
                     y[n, 30 + k] = fhat[k, 1]
                     y[n, 33 + k] = 0.0
+            if gains[G_THERMAL] != 0.0:
+                _thermal_observer(th, fc, xc, pwm, loop, dt)
             for k in range(3):
                 y[n, 36 + k] = cs.ff[k]
         else:
@@ -775,7 +857,8 @@ def _open_loop_records():
                          np.full(3, 2, dtype=np.int64))
     theta = np.zeros((3, 2))
     theta[:, 0] = 1.0
-    return (ImpedanceLoop(0, np.zeros(14), tables, np.zeros((1, 3)), np.zeros((1, 3)), np.zeros(9)),
+    return (ImpedanceLoop(0, np.zeros(N_GAINS), tables, np.zeros((1, 3)), np.zeros((1, 3)),
+                          np.zeros(9), np.zeros((3, 6)), np.zeros(NX)),
             PlantDrift(np.zeros((0, 6)), np.zeros(NTH), np.zeros((3, 1))),
             FrictionEstimator(np.zeros(10), np.ones(3), theta, np.zeros((3, 2, 2)), np.zeros((3, 5)),
                               np.zeros(3)))

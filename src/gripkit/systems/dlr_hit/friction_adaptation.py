@@ -2,6 +2,10 @@
 §6.3: "an algorithm to adjust the friction model", since friction "differs from finger to finger
 and the parameters may change over time").
 
+Provenance: the recursive estimator is gripkit's addition, not the thesis's content. What the
+thesis does to adjust its friction model is a correcting factor on the lookup tables per drive
+(§6.3, §7: base 2 uses base 1's table times a factor); it gives no online algorithm.
+
 Two uses of the generic estimator (:mod:`gripkit.estimation.friction_adaptation`):
 
 * after the fact, on a log (:func:`adapt_finger_friction`): the finger's motor torques (eq 5.10),
@@ -23,10 +27,13 @@ import numpy as np
 from ...errors import ModelError
 from ...estimation.friction_adaptation import AdaptationSettings, FrictionAdapter
 from .finger import ACTUATORS, JOINTS
-from .friction_drift import FrictionDrift
-from .impedance import LOOP_ADAPTATION, ImpedanceController, simulate_impedance
+from .friction_drift import FrictionDrift, stiction_step, warmup_drift
+from .impedance import (LOOP_ADAPTATION, POTENTIOMETERS, ImpedanceController, Sensing,
+                        ThermalObserver, model_friction_tables, simulate_impedance)
 
-__all__ = ["adapt_finger_friction", "compare_adaptation", "LoopComparison", "tracking_reference"]
+__all__ = ["adapt_finger_friction", "compare_adaptation", "LoopComparison", "tracking_reference",
+           "thermal_adaptation_study", "ThermalStudy", "THERMAL_CASES", "THERMAL_MODES",
+           "V_COMPARE"]
 
 
 def adapt_finger_friction(finger, trajectory, *, forgetting: float = 0.999, filter_hz: float = 10.0,
@@ -122,7 +129,8 @@ def compare_adaptation(finger, controller: ImpedanceController, reference, drift
         raise ModelError(f"drift: expected a FrictionDrift, found {type(drift).__name__}")
     skip = int(round(t_skip / dt))
     if not 0 <= skip < np.shape(reference)[0] - 1:
-        raise ModelError(f"t_skip: expected 0 <= t_skip < the reference's duration, found {t_skip!r} s")
+        raise ModelError(f"t_skip: expected 0 <= t_skip < the reference's duration, "
+                         f"found {t_skip!r} s")
     modes = {"fixed": replace(controller, adaptation=None),
              "adaptive": replace(controller, adaptation=settings)}
     runs, rms, mx = {}, {}, {}
@@ -132,3 +140,103 @@ def compare_adaptation(finger, controller: ImpedanceController, reference, drift
             runs[mode, plant] = tr
             rms[mode, plant], mx[mode, plant] = _errors(tr, skip)
     return LoopComparison(runs, rms, mx, t_skip, drift)
+
+
+#: the cases of :func:`thermal_adaptation_study`: the winding starts at room temperature (T_amb)
+#: or at the operating temperature (T_ref), the plant's friction fixed or drifting
+THERMAL_CASES = ("cold", "hot", "cold+drift")
+#: actuator speed (rad/s) at which :class:`ThermalStudy` compares estimated and true friction
+V_COMPARE = 1.0
+#: its compensations: the fixed tables; the estimator on eq 5.10 as printed (it reads a torque
+#: change as a friction change); the estimator with the thermal observer's torque factor and guard
+THERMAL_MODES = ("fixed", "adaptive-eq5.10", "adaptive-thermal")
+
+
+@dataclass(frozen=True)
+class ThermalStudy:
+    """Tracking errors of the impedance loop on a finger whose motors heat and cool (thermal
+    model on): ``rms[(case, mode)]`` (rad, after ``t_skip``), ``scale[(case, mode)]`` (3,) the
+    estimated friction scale ŝ per actuator averaged over the last 10 s (1 for 'fixed'),
+    ``friction[(case, mode)]`` (3,) the estimated over the plant's kinetic friction at
+    :data:`V_COMPARE` (ŝ·F_table(v) + ô)/(s·F_table(v) + Δ), both averaged over the last 10 s
+    (ŝ and ô are nearly collinear where the table is flat, so ŝ alone can be off while the
+    friction is right), ``updated[(case, mode)]`` the fraction of samples the estimator updated
+    (all actuators), and ``runs`` the closed-loop Trajectories."""
+
+    rms: dict
+    scale: dict
+    friction: dict
+    updated: dict
+    runs: dict
+    t_skip: float
+
+
+def thermal_adaptation_study(finger, controller: ImpedanceController, reference, *,
+                             settings=LOOP_ADAPTATION, observer: ThermalObserver | None = None,
+                             sensing: Sensing | None = POTENTIOMETERS, dt: float = 1e-3,
+                             t_skip: float = 5.0) -> ThermalStudy:
+    """Friction adaptation against a motor-torque change (issue 28, item 1).
+
+    Fig. 5.7 (§5.4.3) shows the motor torque at PWM 4000 falling from 1.0 to 0.57 N·cm as the
+    winding warms from room temperature to about 80 °C; the finger has no torque or current
+    sensor (§3.1), so the estimator, fed eq 5.10 as printed (valid at T_ref), sees the motor's
+    torque change as a friction change: cold, the motor delivers ρ > 1 times eq 5.10 and the
+    estimate falls to ≈ 1/ρ. :class:`~gripkit.systems.dlr_hit.impedance.ThermalObserver` removes
+    that confound: its torque factor ρ̂, from the PWM history through the thermal model, enters
+    the estimator's regressor, and its guard freezes the estimator while the band of possible
+    start temperatures leaves ρ uncertain by more than ``guard``.
+
+    ``finger`` must integrate its motor temperatures (``thermal=True``). Runs the loop on
+    ``reference`` for each of :data:`THERMAL_CASES` (cold: winding at T_amb, hot: at T_ref,
+    cold+drift: T_amb with the warm-up friction drift of
+    :func:`~gripkit.systems.dlr_hit.friction_drift.warmup_drift` and a stiction step halfway)
+    and each of :data:`THERMAL_MODES`; the controller measures through ``sensing`` (default the
+    0.1° potentiometers, velocity differentiated; None: the exact state). ``observer`` defaults
+    to ``ThermalObserver()`` (start temperature unknown between T_amb and T_ref)."""
+    if not getattr(finger, "thermal", False):
+        raise ModelError("thermal_adaptation_study: the finger's motor temperatures are not "
+                         "integrated",
+                         hint="build it with finger(thermal=True)")
+    if controller.kind != "joint":
+        raise ModelError("thermal_adaptation_study: expected a joint impedance controller "
+                         "(errors are joint errors)")
+    observer = observer if observer is not None else ThermalObserver()
+    ref = np.asarray(reference, dtype=np.float64)
+    skip = int(round(t_skip / dt))
+    if ref.ndim != 2 or not 0 <= skip < ref.shape[0] - 1:
+        raise ModelError(f"t_skip: expected 0 <= t_skip < the reference's duration, "
+                         f"found {t_skip!r} s")
+    duration = ref.shape[0] * dt
+    base = replace(controller, sensing=sensing, adaptation=None, thermal=None)
+    modes = {"fixed": base, "adaptive-eq5.10": replace(base, adaptation=settings),
+             "adaptive-thermal": replace(base, adaptation=settings, thermal=observer)}
+    v = finger.parameters.value
+    cases = {"cold": (v("T_amb"), None), "hot": (v("T_ref"), None),
+             "cold+drift": (v("T_amb"),
+                            warmup_drift(duration).combine(stiction_step(duration / 2)))}
+    last = max(ref.shape[0] - int(round(10.0 / dt)), 0)
+    f_tab = np.array([float(t(V_COMPARE)) for t in model_friction_tables(finger)])
+    rms, scale, fric, upd, runs = {}, {}, {}, {}, {}
+    for case, (T0, drift) in cases.items():
+        x0 = finger.state(q=ref[0], T=T0)
+        for mode, c in modes.items():
+            tr = simulate_impedance(finger, c, ref, dt=dt, x0=x0, friction_drift=drift)
+            runs[case, mode] = tr
+            rms[case, mode] = _errors(tr, skip)[0]
+            scale[case, mode] = np.array([float(np.mean(tr[f"scale_hat_{a}"][last:]))
+                                          for a in ACTUATORS])
+            fric[case, mode] = np.array([_friction_ratio(tr, a, f_tab[k], last)
+                                         for k, a in enumerate(ACTUATORS)])
+            upd[case, mode] = float(np.mean([tr[f"adapt_status_{a}"] == 1.0 for a in ACTUATORS]))
+    return ThermalStudy(rms, scale, fric, upd, runs, t_skip)
+
+
+def _friction_ratio(tr, a, f_table, last) -> float:
+    """Estimated over true kinetic friction of actuator ``a`` at a speed where the compensation
+    table reads ``f_table`` (N·m), each averaged over the samples from ``last`` on."""
+    est = np.mean(tr[f"scale_hat_{a}"][last:] * f_table + tr[f"offset_hat_{a}"][last:])
+    if f"drift_scale_{a}" in tr:
+        true = np.mean(tr[f"drift_scale_{a}"][last:] * f_table + tr[f"drift_offset_{a}"][last:])
+    else:
+        true = f_table
+    return float(est / true)

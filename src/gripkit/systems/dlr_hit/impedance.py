@@ -21,7 +21,8 @@ wall — further and sustain a limit cycle). The commanded actuator
 torque becomes a PWM count through the inverse of eq 5.10 at the measured motor speed, clipped to
 ±4096, held over the 1 kHz control period.
 
-Online friction adaptation (§6.3: "an algorithm to adjust the friction model"; abstract). With
+Online friction adaptation (§6.3: "an algorithm to adjust the friction model"; abstract; the
+estimator, the thermal observer and the sensing model are gripkit's additions). With
 ``ImpedanceController(adaptation=AdaptationSettings(...))`` the friction estimator of
 :mod:`gripkit.estimation.friction_adaptation` runs inside the loop: at every control step k, after
 the PWM command u_k is computed,
@@ -61,12 +62,85 @@ from ...errors import ModelError, SimulationError
 from ...estimation.friction_adaptation import AdaptationSettings
 from ...models.friction import FrictionTable, table_arrays
 from ...signals.trajectory import Trajectory
-from .finger import (ACTUATORS, FRICTION_MODES, NX, DLRFinger, FrictionEstimator, ImpedanceLoop, PlantDrift,
-                     finger_run)
+from .finger import (ACTUATORS, FRICTION_MODES, G_COMMAND, G_GUARD, G_OBS_ALPHA, G_OBS_CTH,
+                     G_OBS_RTH, G_QUANTUM, G_THERMAL, G_VALPHA, N_GAINS, NX, DLRFinger,
+                     FrictionEstimator, ImpedanceLoop, PlantDrift, finger_run)
 from .friction_drift import FrictionDrift
 
 __all__ = ["ImpedanceController", "Wall", "simulate_impedance", "stability_margins",
-           "impedance_margins", "model_friction_tables", "LOOP_ADAPTATION"]
+           "impedance_margins", "model_friction_tables", "LOOP_ADAPTATION", "Sensing",
+           "ThermalObserver", "POTENTIOMETERS"]
+
+
+@dataclass(frozen=True)
+class Sensing:
+    """How the controller measures the finger: angles quantised to ``resolution`` (rad) and the
+    velocity by backward difference of the quantised angles (1 kHz) through a first-order low-pass
+    at ``filter_hz`` — the DLR/HIT hand has no velocity sensor, "the speed can be calculated by
+    differentiation of the position signal", and its potentiometers resolve 0.1° (§2, the DLR
+    Hand II paragraph of ``002_ddea254371185ad3.txt``). gripkit applies the resolution to the
+    three actuator output angles (the controller's coordinates), an assumption: the seed gives the
+    joints' resolution, not the motors' Hall sensors'."""
+
+    resolution: float = 0.1 * math.pi / 180
+    filter_hz: float = 50.0
+
+    def __post_init__(self):
+        if not (math.isfinite(self.resolution) and self.resolution > 0):
+            raise ModelError(f"resolution: expected a positive angle in rad, "
+                             f"found {self.resolution!r}")
+        if not (math.isfinite(self.filter_hz) and self.filter_hz > 0):
+            raise ModelError(f"filter_hz: expected a positive frequency in Hz, "
+                             f"found {self.filter_hz!r}")
+
+
+#: the DLR/HIT potentiometers: 0.1° (§2), velocity differentiated and low-passed at 50 Hz
+POTENTIOMETERS = Sensing()
+
+
+@dataclass(frozen=True)
+class ThermalObserver:
+    """The controller's estimate of each motor's winding temperature, from the PWM it commanded
+    and the measured speed through gripkit's thermal model (:mod:`gripkit.models.bldc`: eq 5.4's
+    Joule heat, eq 5.5's R(T), the first-order model calibrated on Fig. 5.7). The start
+    temperature is unknown, so two estimates run from the ends of ``initial`` = (T_lo, T_hi) (K;
+    default None: the finger's T_amb and T_ref, room to operating temperature); both see the same
+    PWM history and converge (time constant ≈ R_th·C_th = 39.6 s), and the plant's temperature
+    stays between them (the solutions of the scalar ODE do not cross).
+
+    The PWM inversion divides the commanded torque by ρ̂, the mean of the two torque factors
+    ρ = R(T_ref)/R(T), and the friction estimator's motor torque is ρ̂ times eq 5.10. The estimator
+    is frozen (:data:`gripkit.estimation.friction_adaptation.FROZEN`) while the band is wider than
+    ``guard`` relative to ρ̂: then a torque loss and a friction change cannot be told apart (the
+    finger has no torque or current sensor, §3.1).
+
+    ``alpha_R`` (1/K), ``R_th`` (K/W), ``C_th`` (J/K): the observer's own thermal parameters
+    (default None: the finger's), to study a thermal model that differs from the motor's."""
+
+    initial: tuple | None = None
+    guard: float = 0.05
+    command: bool = False
+    alpha_R: float | None = None
+    R_th: float | None = None
+    C_th: float | None = None
+
+    def __post_init__(self):
+        if self.initial is not None:
+            try:
+                lo, hi = (float(x) for x in self.initial)
+            except (TypeError, ValueError):
+                raise ModelError(f"initial: expected (T_lo, T_hi) in K, "
+                                 f"found {self.initial!r}") from None
+            if not (math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi):
+                raise ModelError(f"initial: expected 0 < T_lo <= T_hi in K, found {self.initial!r}")
+            object.__setattr__(self, "initial", (lo, hi))
+        if not (math.isfinite(self.guard) and self.guard > 0):
+            raise ModelError(f"guard: expected a positive relative width, found {self.guard!r}")
+        for name in ("alpha_R", "R_th", "C_th"):
+            x = getattr(self, name)
+            if x is not None and not (isinstance(x, (int, float)) and math.isfinite(x) and x > 0):
+                raise ModelError(f"{name}: expected a positive number or None (the finger's), "
+                                 f"found {x!r}")
 
 @dataclass(frozen=True)
 class ImpedanceController:
@@ -82,7 +156,10 @@ class ImpedanceController:
     (N·m·s/rad per actuator) adds −D_a·ṗ: a Cartesian stiffness acts weakly along the directions
     J_p maps to small fingertip motion, and this damps them. ``adaptation``: settings of the
     online friction estimator whose (scale, offset) the compensation uses (default None: the
-    tables as given); see :data:`LOOP_ADAPTATION` for the DLR/HIT defaults.
+    tables as given); see :data:`LOOP_ADAPTATION` for the DLR/HIT defaults. ``sensing``: a
+    :class:`Sensing` (quantised angles, differentiated velocity; default None: the exact state).
+    ``thermal``: a :class:`ThermalObserver` that corrects eq 5.10 for the winding temperature
+    and guards the adaptation (default None: eq 5.10 at T_ref as printed).
     """
 
     kind: str = "joint"
@@ -95,8 +172,16 @@ class ImpedanceController:
     smoothing: float = 0.02
     actuator_damping: tuple = (0.0, 0.0, 0.0)
     adaptation: AdaptationSettings | None = None
+    sensing: Sensing | None = None
+    thermal: ThermalObserver | None = None
 
     def __post_init__(self):
+        if self.sensing is not None and not isinstance(self.sensing, Sensing):
+            raise ModelError(f"sensing: expected a Sensing or None, "
+                             f"found {type(self.sensing).__name__}")
+        if self.thermal is not None and not isinstance(self.thermal, ThermalObserver):
+            raise ModelError(f"thermal: expected a ThermalObserver or None, found "
+                             f"{type(self.thermal).__name__}")
         if self.kind not in ("joint", "cartesian"):
             raise ModelError(f"kind: expected 'joint' or 'cartesian', found {self.kind!r}")
         for name in ("stiffness", "damping", "actuator_damping"):
@@ -211,17 +296,48 @@ def simulate_impedance(finger: DLRFinger, controller: ImpedanceController, refer
     cfg = settings.vector(float(dt)) if ad is not None else np.zeros(10)
     estimator = FrictionEstimator(cfg, J, *settings.initial_state(3))
     y = np.empty((N, 39))
-    gains = np.array([*controller.stiffness, *controller.damping, float(controller.gravity_compensation),
-                      float(controller.friction_compensation), controller.velocity_deadband,
-                      controller.smoothing, *controller.actuator_damping, float(ad is not None)])
+    gains = np.zeros(N_GAINS)
+    gains[:14] = [*controller.stiffness, *controller.damping,
+                  float(controller.gravity_compensation),
+                  float(controller.friction_compensation), controller.velocity_deadband,
+                  controller.smoothing, *controller.actuator_damping, float(ad is not None)]
+    sensor = _sensor_state(finger, controller, x, gains, dt)
     loop = ImpedanceLoop(2 if controller.kind == "cartesian" else 1, gains, table_arrays(tables), ref, refd,
-                         _wall_vector(wall))
+                         _wall_vector(wall), sensor, np.zeros(NX))
     fail = finger_run(th, FRICTION_MODES[finger.friction], finger.thermal, finger._tab, np.zeros((1, 3)), 0,
                       float(dt), int(substeps), x, y, 0, loop, plant, estimator)
     if fail or not np.isfinite(y).all():
         raise SimulationError(f"closed loop diverged at sample {max(int(fail) - 1, 0)}",
                               hint="lower the gains or check stability_margins")
     return _loop_trajectory(t, y, ref, drift, finger, controller, dt)
+
+
+def _sensor_state(finger, controller, x, gains, dt) -> np.ndarray:
+    """The controller's sensing and thermal-observer settings (into ``gains``) and initial state
+    (3, 6): T̂_lo, T̂_hi, the last quantised angle, the filtered velocity, ρ̂ and the guard flag
+    (ρ̂ = 1 and no guard without an observer)."""
+    sensor = np.zeros((3, 6))
+    sensor[:, 4] = 1.0
+    if controller.sensing is not None:
+        gains[G_QUANTUM] = controller.sensing.resolution
+        gains[G_VALPHA] = 1.0 - math.exp(-2 * math.pi * controller.sensing.filter_hz * dt)
+    ob = controller.thermal
+    if ob is not None:
+        v = finger.parameters.value
+        lo, hi = ob.initial if ob.initial is not None else (v("T_amb"), v("T_ref"))
+        a = v("alpha_R") if ob.alpha_R is None else ob.alpha_R
+        T_ref, T_amb = v("T_ref"), v("T_amb")
+        r_lo, r_hi = ((1 + a * (T_ref - T_amb)) / (1 + a * (T - T_amb)) for T in (hi, lo))
+        sensor[:, 0], sensor[:, 1] = lo, hi
+        sensor[:, 4] = 0.5 * (r_lo + r_hi)
+        sensor[:, 5] = float(r_hi - r_lo > ob.guard * sensor[0, 4])
+        gains[G_THERMAL] = 1.0
+        gains[G_GUARD] = ob.guard
+        gains[G_COMMAND] = float(bool(ob.command))
+        gains[G_OBS_ALPHA] = a
+        gains[G_OBS_RTH] = v("R_th") if ob.R_th is None else ob.R_th
+        gains[G_OBS_CTH] = v("C_th") if ob.C_th is None else ob.C_th
+    return sensor
 
 
 def _checked_loop_inputs(finger, controller, reference, reference_velocity, dt, x0, substeps):
