@@ -7,6 +7,8 @@ adding commands to the apps defined here. Heavy imports happen inside commands s
 
 from __future__ import annotations
 
+import os
+
 import typer
 
 from .. import progress
@@ -45,5 +47,11 @@ def _print_version(value: bool) -> None:
 def _root(debug: bool = typer.Option(False, "--debug", help="Show tracebacks on errors."),
           quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress output."),
           show_version: bool = typer.Option(False, "--version", is_eager=True, callback=_print_version,
-                                            help="Print gripkit's version and exit.")):
+                                            help="Print gripkit's version and exit."),
+          allow_external_links: bool = typer.Option(
+              False, "--allow-external-links",
+              help="Read HDF5 data kept in other files (external links, external storage, virtual "
+                   "datasets); refused by default, as a file could name any file on the machine.")):
     progress.set_quiet(quiet)
+    if allow_external_links:  # read by gripkit.io.load in this process (and in its workers)
+        os.environ["GRIPKIT_ALLOW_EXTERNAL_LINKS"] = "1"

@@ -78,11 +78,11 @@ def read_mcap(path: Path, columns, stamp: str = "log") -> tuple[dict, dict]:
             for _schema, channel, message, msg in reader.iter_decoded_messages(topics=list(topics)):
                 topic = channel.topic
                 seen.add(topic)
-                if stamp == "header":
+                if stamp == "header":  # integer nanoseconds: a float loses 238 ns at 1.7e9 s
                     st = msg.header.stamp
-                    t = st.sec + 1e-9 * st.nanosec
+                    t = int(st.sec) * 1_000_000_000 + int(st.nanosec)
                 else:
-                    t = 1e-9 * message.log_time
+                    t = int(message.log_time)
                 for (alias, top, fpath), spec in zip(specs, columns):
                     if top == topic:
                         series[alias][0].append(t)
@@ -94,6 +94,9 @@ def read_mcap(path: Path, columns, stamp: str = "log") -> tuple[dict, dict]:
     missing = sorted(topics - seen)
     if missing:
         raise DataError(f"{path.name}: no messages on topics {missing}")
+    # seconds after the earliest stamp, subtracted in integer nanoseconds so that none is lost
+    first = min(min(series[a][0]) for a in series)
+    series = {a: ((np.asarray(ts, dtype=np.int64) - first) * 1e-9, vs) for a, (ts, vs) in series.items()}
     base_alias = specs[0][0]
     tb = np.asarray(series[base_alias][0])
     ob = np.argsort(tb, kind="stable")
