@@ -53,7 +53,8 @@ def test_external_raw_storage_is_refused(tmp_path, secret):
     p = _data_folder(tmp_path) / "run.h5"
     with h5py.File(p, "w") as f:
         f["t"] = np.arange(N) / 100.0
-        f.create_dataset("force", shape=(N,), dtype="<f8", external=[(str(secret), 0, h5py.h5f.UNLIMITED)])
+        f.create_dataset("force", shape=(N,), dtype="<f8",
+                         external=[(str(secret), 0, h5py.h5f.UNLIMITED)])
     msg = _refused(p, "dataset '/force' keeps its values in an external file")
     assert "allow_external_links=True" in msg
     # with the option the values are the file's bytes, read as the dataset says
@@ -126,7 +127,7 @@ def test_environment_variable_allows_external_links(tmp_path, secret, monkeypatc
     _refused(p, "'/force' is an external link")
     monkeypatch.setenv("GRIPKIT_ALLOW_EXTERNAL_LINKS", "1")
     np.testing.assert_array_equal(load(p)["force"], np.arange(5) * 1.0)
-    with pytest.raises(DataError, match="is an external link"):  # the keyword wins over the environment
+    with pytest.raises(DataError, match="is an external link"):  # the keyword wins
         load(p, allow_external_links=False)
 
 
@@ -149,7 +150,8 @@ def test_cli_refuses_external_links_and_follows_them_when_asked(cli, tmp_path, m
         f["t"] = np.arange(300) / 100.0
         f["u"] = u
         f["y"] = h5py.ExternalLink(str(other), "/y")
-    args = ("identify", "arx", p, "--input", "u", "--output", "y", "--na", 1, "--nb", 1, "--nk", 1, "--json")
+    args = ("identify", "arx", p, "--input", "u", "--output", "y", "--na", 1, "--nb", 1, "--nk", 1,
+            "--json")
     assert_user_error(cli(*args), "DataError", "'/y' is an external link")
     res = cli("--allow-external-links", *args)
     monkeypatch.delenv("GRIPKIT_ALLOW_EXTERNAL_LINKS", raising=False)  # the flag sets it in-process
@@ -174,13 +176,14 @@ def test_parquet_metadata_summary_is_refused(tmp_path):
 def test_symlink_to_a_private_file_is_not_echoed(tmp_path, secret):
     """A ``.parquet`` or ``.h5`` name that is a link to a private text file: 'not readable', and
     none of its bytes in the message."""
-    for suffix, phrase in ((".parquet", "not a readable Parquet file"), (".h5", "not a readable HDF5 file")):
+    for suffix, phrase in ((".parquet", "not a readable Parquet file"),
+                           (".h5", "not a readable HDF5 file")):
         link = _data_folder(tmp_path) / f"run{suffix}"
         os.symlink(secret, link)
         _refused(link, phrase)
 
 
-# ---------------------------------------------------------------------------------------------------
+# ------------------------------------------------------------------------------------------------
 # sizes a file only declares (item 11)
 
 def test_declared_huge_hdf5_dataset_is_refused_before_reading(tmp_path, monkeypatch):
@@ -189,13 +192,15 @@ def test_declared_huge_hdf5_dataset_is_refused_before_reading(tmp_path, monkeypa
     monkeypatch.delenv("GRIPKIT_MAX_LOAD_BYTES", raising=False)
     p = tmp_path / "huge.h5"
     with h5py.File(p, "w") as f:
-        ds = f.create_dataset("log", shape=(200_000_000, 3), dtype="f8", chunks=(65536, 3), compression="gzip")
+        ds = f.create_dataset("log", shape=(200_000_000, 3), dtype="f8", chunks=(65536, 3),
+                              compression="gzip")
         ds.attrs["columns"] = ["t", "force", "current"]
     assert p.stat().st_size < 100_000
     msg = _refused(p, "declares 200000000 rows × 3 columns, about 4.8 GB as float64", key="log")
     assert "beyond the load limit of" in msg and "GRIPKIT_MAX_LOAD_BYTES" in msg
     # columns= reads only what it names (and the time column): 2 of 3 columns, 3.2 GB
-    _refused(p, "200000000 rows × 2 columns, about 3.2 GB", key="log", columns=["force"], max_bytes=1e9)
+    _refused(p, "200000000 rows × 2 columns, about 3.2 GB", key="log", columns=["force"],
+             max_bytes=1e9)
 
 
 def test_declared_huge_group_of_datasets_is_refused(tmp_path):
@@ -214,8 +219,8 @@ def test_load_limit_from_keyword_and_environment(tmp_path, monkeypatch):
     for suffix in (".parquet", ".h5"):
         p = tmp_path / f"run{suffix}"
         save(tr, p)
-        _refused(p, "1000 rows × 2 columns, about 1.6e-05 GB as float64, beyond the load limit of 1e-05 GB",
-                 max_bytes=10_000)
+        _refused(p, "1000 rows × 2 columns, about 1.6e-05 GB as float64, beyond the load limit "
+                 "of 1e-05 GB", max_bytes=10_000)
         monkeypatch.setenv("GRIPKIT_MAX_LOAD_BYTES", "10000")
         _refused(p, "beyond the load limit of 1e-05 GB")
         monkeypatch.setenv("GRIPKIT_MAX_LOAD_BYTES", "20000")

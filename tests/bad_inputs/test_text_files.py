@@ -17,8 +17,9 @@ from gripkit.sysid import load_dynamics_model, load_model
 ROWS = "t,force\n0,1.5\n0.1,2.5\n0.2,3.5\n"
 
 
-@pytest.mark.parametrize("encoding, why", [("utf-16", "byte-order mark"), ("utf-16-le", "every other byte is NUL"),
-                                           ("utf-16-be", "every other byte is NUL"), ("utf-32", "byte-order mark")])
+@pytest.mark.parametrize("encoding, why", [
+    ("utf-16", "byte-order mark"), ("utf-16-le", "every other byte is NUL"),
+    ("utf-16-be", "every other byte is NUL"), ("utf-32", "byte-order mark")])
 def test_utf16_csv_is_named(tmp_path, encoding, why):
     """Saved as 'Unicode text' by Excel or Notepad: said so, not 'line 4 has 1 fields'."""
     p = tmp_path / "log.csv"
@@ -31,7 +32,8 @@ def test_utf16_csv_is_named(tmp_path, encoding, why):
 def test_utf16_csv_in_the_cli(cli, tmp_path):
     p = tmp_path / "log.csv"
     p.write_bytes("t,u,y\n0,1,2\n0.1,1,2\n".encode("utf-16"))
-    res = cli("identify", "arx", p, "--input", "u", "--output", "y", "--na", 1, "--nb", 1, "--nk", 1)
+    res = cli("identify", "arx", p, "--input", "u", "--output", "y", "--na", 1, "--nb", 1,
+              "--nk", 1)
     assert_user_error(res, "DataError", "the file is UTF-16 text")
 
 
@@ -57,7 +59,8 @@ def test_semicolon_separator_with_and_without_decimal_commas(tmp_path, text):
 def test_comment_lines_are_skipped(tmp_path):
     """'#' lines before the header and between rows (a logger's notes) are comments."""
     p = tmp_path / "notes.csv"
-    p.write_text("# rig 3, finger 2\n# operator: A\nt,force\n0,1.5\n  # paused here\n0.1,2.5\n0.2,3.5\n")
+    p.write_text("# rig 3, finger 2\n# operator: A\nt,force\n0,1.5\n  # paused here\n"
+                 "0.1,2.5\n0.2,3.5\n")
     tr = load(p)
     np.testing.assert_array_equal(tr.t, [0.0, 0.1, 0.2])
     np.testing.assert_array_equal(tr["force"], [1.5, 2.5, 3.5])
@@ -68,8 +71,8 @@ def test_commented_out_header_is_named(tmp_path):
     column names."""
     p = tmp_path / "np.csv"
     p.write_text("# t,force\n0,1.5\n0.1,2.5\n")
-    with pytest.raises(DataError, match=r"line 2, the first that is not a comment, holds numbers .*header looks "
-                                        r"commented out"):
+    with pytest.raises(DataError, match=r"line 2, the first that is not a comment, holds numbers "
+                                        r".*header looks commented out"):
         load(p)
 
 
@@ -80,14 +83,15 @@ def test_ragged_line_after_comments_is_numbered_in_the_file(tmp_path):
         load(p)
 
 
-# ---------------------------------------------------------------------------------------------------
+# ------------------------------------------------------------------------------------------------
 # model files (JSON) and TOML descriptions
 
 DEEP_JSON = "[" * 100_000 + "]" * 100_000
 BIG_INT = "1" * 100_000
 
 
-@pytest.mark.parametrize("reader, what", [(load_model, "model file"), (load_dynamics_model, "dynamics model file")])
+@pytest.mark.parametrize("reader, what", [(load_model, "model file"),
+                                          (load_dynamics_model, "dynamics model file")])
 @pytest.mark.parametrize("text, phrase", [
     (DEEP_JSON, "nests lists or objects deeper than Python's recursion limit"),
     ('{"schema": "gripkit.linear-model", "schema_version": 1, "x": ' + "[" * 900 + "]" * 900 + "}",
@@ -116,7 +120,8 @@ def test_hostile_model_file_in_the_cli(cli, tmp_path):
 
 
 @pytest.mark.parametrize("text, phrase", [
-    ("a = " + "[" * 100_000 + "]" * 100_000 + "\n", "nests arrays or tables deeper than Python's recursion limit"),
+    ("a = " + "[" * 100_000 + "]" * 100_000 + "\n",
+     "nests arrays or tables deeper than Python's recursion limit"),
     ("a = " + "{b = " * 5_000 + "1" + "}" * 5_000 + "\n", "nests arrays or tables deeper"),
     ("a = " + BIG_INT + "\n", "Exceeds the limit (4300 digits)"),
 ])

@@ -26,7 +26,8 @@ FORCE = np.cos(K / 7.0)
 def _write(path, stamps, name="stamp", extra=None):
     cols = {name: np.asarray(stamps), "force": FORCE, **(extra or {})}
     if path.suffix == ".csv":
-        lines = [",".join(cols)] + [",".join(str(v[k]) for v in cols.values()) for k in range(len(K))]
+        rows = [",".join(str(v[k]) for v in cols.values()) for k in range(len(K))]
+        lines = [",".join(cols)] + rows
         path.write_text("\n".join(lines) + "\n")
     elif path.suffix == ".parquet":
         pq.write_table(pa.table(cols), path)
@@ -72,12 +73,12 @@ def test_microsecond_stamps_need_their_unit(tmp_path, suffix):
     to give the unit; with ``units=`` they are read (1 ms apart)."""
     p = tmp_path / f"us{suffix}"
     _write(p, 1_700_000_000_000_000 + K * 1_000, "stamp")
-    with pytest.raises(DataError, match=r"time column 'stamp' holds values up to 1\.7e\+15, too large for "
-                                        r"seconds.*give the unit.*'stamp \[us\]'"):
+    with pytest.raises(DataError, match=r"time column 'stamp' holds values up to 1\.7e\+15, too "
+                                        r"large for seconds.*give the unit.*'stamp \[us\]'"):
         load(p)
-    t = load(p, units={"stamp": "us"}).t  # below 2**53: exact as float64, read as absolute seconds
+    t = load(p, units={"stamp": "us"}).t  # below 2**53: exact as float64, read as absolute
     assert t[0] == 1.7e9
-    np.testing.assert_allclose(t - t[0], K * 1e-3, rtol=0, atol=2.5e-7)  # float64 spacing at 1.7e9 s
+    np.testing.assert_allclose(t - t[0], K * 1e-3, rtol=0, atol=2.5e-7)  # spacing at 1.7e9 s
 
 
 def test_floating_point_stamps_beyond_seconds_are_refused(tmp_path):
@@ -94,7 +95,8 @@ def test_other_integer_columns_beyond_2_53_are_refused(tmp_path, suffix):
     """A data column of 64-bit counts beyond 2**53: refused, naming it (float64 would round it)."""
     p = tmp_path / f"count{suffix}"
     _write(p, K * 1_000_000, "time_ns", extra={"ticks": 2**60 + K})
-    with pytest.raises(DataError, match=r"column 'ticks' holds integers up to 1152921504606847025, beyond 2\*\*53"):
+    with pytest.raises(DataError, match=r"column 'ticks' holds integers up to "
+                                        r"1152921504606847025, beyond 2\*\*53"):
         load(p)
     tr = load(p, columns=["force"])  # left out, the rest reads
     np.testing.assert_array_equal(tr["force"], FORCE)
@@ -109,7 +111,8 @@ def test_mcap_stamps_keep_nanoseconds(tmp_path):
         w = Writer(f)
         schema = w.register_msgdef("std_msgs/Float64", "float64 data\n")
         for k, s in zip(K, STAMPS):
-            w.write_message("/force", schema, {"data": FORCE[k]}, log_time=int(s), publish_time=int(s))
+            w.write_message("/force", schema, {"data": FORCE[k]}, log_time=int(s),
+                            publish_time=int(s))
         w.finish()
     tr = load(p, columns=["force=/force:data"])
     np.testing.assert_allclose(tr.t, EXPECTED, rtol=1e-15, atol=0)

@@ -156,7 +156,8 @@ def _allow_external(allow) -> bool:
     if allow is None:
         return os.environ.get(_ENV_EXTERNAL, "").strip().lower() in ("1", "true", "yes")
     if not isinstance(allow, (bool, np.bool_)):
-        raise ArgumentError(f"load(): allow_external_links must be True or False, found {allow!r:.40}")
+        raise ArgumentError(f"load(): allow_external_links must be True or False, "
+                            f"found {allow!r:.40}")
     return bool(allow)
 
 
@@ -169,14 +170,16 @@ def _load_limit(max_bytes) -> float:
         try:
             max_bytes = float(max_bytes)
         except ValueError:
-            raise ArgumentError(f"{where} must be a number of bytes, found {max_bytes!r:.40}") from None
+            raise ArgumentError(f"{where} must be a number of bytes, "
+                                f"found {max_bytes!r:.40}") from None
     if max_bytes is None:
         try:
             memory = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
         except (AttributeError, ValueError, OSError):
             memory = 4 * DEFAULT_MAX_BYTES
         return float(min(DEFAULT_MAX_BYTES, memory / 4))
-    ok = isinstance(max_bytes, (int, float, np.integer, np.floating)) and not isinstance(max_bytes, bool)
+    ok = (isinstance(max_bytes, (int, float, np.integer, np.floating))
+          and not isinstance(max_bytes, bool))
     if not ok or not float(max_bytes) > 0:
         raise ArgumentError(f"{where} must be a positive number of bytes, found {max_bytes!r:.40}")
     return float(max_bytes)
@@ -211,14 +214,15 @@ def _check_size(source: str, what: str, rows: int, ncols: int, limit: float) -> 
     if need <= limit:
         return
     raise DataError(
-        f"{source}: {what} declares {rows} rows × {ncols} columns, about {need / 1e9:.3g} GB as float64, "
-        f"beyond the load limit of {limit / 1e9:.3g} GB; nothing was read",
-        hint=f"read fewer columns (columns=, CLI: the command's column options), or raise the limit "
-             f"with max_bytes= or the environment variable {_ENV_LIMIT} (bytes) if the machine has "
-             f"the memory")
+        f"{source}: {what} declares {rows} rows × {ncols} columns, about {need / 1e9:.3g} GB as "
+        f"float64, beyond the load limit of {limit / 1e9:.3g} GB; nothing was read",
+        hint=f"read fewer columns (columns=, CLI: the command's column options), or raise the "
+             f"limit with max_bytes= or the environment variable {_ENV_LIMIT} (bytes) if the "
+             f"machine has the memory")
 
 
-def _read_csv(path: Path, key=None, delimiter=None, *, wanted=None, limit=None, allow_external=False):
+def _read_csv(path: Path, key=None, delimiter=None, *, wanted=None, limit=None,
+              allow_external=False):
     import pyarrow as pa
     from pyarrow import csv as pacsv
 
@@ -227,7 +231,8 @@ def _read_csv(path: Path, key=None, delimiter=None, *, wanted=None, limit=None, 
     data = _strip_comments(path, data)
     decimal = "."
     if delimiter is None:
-        delimiter, decimal = ("\t", ".") if path.suffix.lower() == ".tsv" else _sniff_separator(data)
+        tsv = path.suffix.lower() == ".tsv"
+        delimiter, decimal = ("\t", ".") if tsv else _sniff_separator(data)
     try:
         table = pacsv.read_csv(
             pa.BufferReader(data), parse_options=pacsv.ParseOptions(delimiter=delimiter),
@@ -252,14 +257,16 @@ def _refuse_utf16(path: Path, data: bytes) -> None:
     if found is None and b"\x00" in head:
         if head.count(b"\x00") * 3 < len(head):
             k = head.index(b"\x00")
-            raise DataError(f"{path.name}: not a readable CSV file: byte {k} is a NUL byte, found in "
-                            f"binary files, not in text",
-                            hint="check that the path names the CSV file, or pass format= for another format")
+            raise DataError(f"{path.name}: not a readable CSV file: byte {k} is a NUL byte, found "
+                            f"in binary files, not in text",
+                            hint="check that the path names the CSV file, or pass format= for "
+                                 "another format")
         found, why = "UTF-16", "every other byte is NUL"
     if found is not None:
-        raise DataError(f"{path.name}: not a readable CSV file: the file is {found} text ({why}), and "
-                        f"gripkit reads CSV files as UTF-8",
-                        hint=f"save it as UTF-8 (in Excel: 'CSV UTF-8'; or iconv -f {found} -t UTF-8)")
+        raise DataError(f"{path.name}: not a readable CSV file: the file is {found} text ({why}), "
+                        f"and gripkit reads CSV files as UTF-8",
+                        hint=f"save it as UTF-8 (in Excel: 'CSV UTF-8'; or iconv -f {found} "
+                             f"-t UTF-8)")
 
 
 def _is_comment(line: bytes) -> bool:
@@ -274,7 +281,8 @@ def _strip_comments(path: Path, data: bytes) -> bytes:
     lines = data.splitlines(keepends=True)
     if not any(_is_comment(line) for line in lines):
         return data
-    first = next((k for k, line in enumerate(lines) if line.strip() and not _is_comment(line)), None)
+    first = next((k for k, line in enumerate(lines) if line.strip() and not _is_comment(line)),
+                 None)
     if first is not None and first > 0:
         fields = [f.strip() for f in re.split(rb"[,;\t]", lines[first])]
         if all(_NUMBER.match(f) for f in fields):
@@ -308,7 +316,8 @@ def _refuse_ragged_line(path: Path, delimiter: str) -> None:
     (pyarrow's own message does not say which line); comment lines are skipped."""
     text = path.read_bytes().decode("utf-8", errors="replace")
     lines = text.splitlines()
-    numbered = [(k, line) for k, line in enumerate(lines, start=1) if not line.lstrip().startswith("#")]
+    numbered = [(k, line) for k, line in enumerate(lines, start=1)
+                if not line.lstrip().startswith("#")]
     if not numbered:
         return
     sep = delimiter
@@ -377,8 +386,8 @@ def _integer_column(col, name: str, source: str) -> np.ndarray:
     lo, hi = pc.min_max(col).values()
     big = max(abs(lo.as_py() or 0), abs(hi.as_py() or 0))
     if big > 2**53:
-        raise DataError(f"{source}: column {name!r} holds integers up to {big} (beyond 2**53, which float64 "
-                        f"cannot hold exactly) and {col.null_count} missing values",
+        raise DataError(f"{source}: column {name!r} holds integers up to {big} (beyond 2**53, "
+                        f"which float64 cannot hold exactly) and {col.null_count} missing values",
                         hint="fill the missing values, or leave the column out")
     return _float64_column(col)
 
@@ -401,7 +410,8 @@ def _float64_column(col) -> np.ndarray:
     return np.concatenate(parts) if parts else np.empty(0)
 
 
-def _read_parquet(path: Path, key=None, delimiter=None, *, wanted=None, limit=None, allow_external=False):
+def _read_parquet(path: Path, key=None, delimiter=None, *, wanted=None, limit=None,
+                  allow_external=False):
     """Read the columns ``wanted`` of a Parquet file, from an open file object (a path string
     would be read by pyarrow as a URI or a dataset folder)."""
     import pyarrow as pa
@@ -439,6 +449,10 @@ def _hdf5_text(x) -> str:
     return x.decode() if isinstance(x, bytes) else str(x)
 
 
+_EXTERNAL_HINT = ("pass allow_external_links=True (CLI: gripkit --allow-external-links) if you "
+                  "trust this file, or copy the data into it")
+
+
 def _hdf5_get(group, name: str, source: str, allow_external: bool, depth: int = 0):
     """The object at the path ``name`` below ``group`` (None if absent), following each link
     along the path only while it stays in the file: an external link (to another file) is refused
@@ -458,9 +472,8 @@ def _hdf5_get(group, name: str, source: str, allow_external: bool, depth: int = 
             if not allow_external:
                 raise DataError(
                     f"{source}: {node.name.rstrip('/') + '/' + part!r} is an external link to "
-                    f"{_hdf5_text(link.filename)!r}:{_hdf5_text(link.path)!r}, another file; not followed",
-                    hint="pass allow_external_links=True (CLI: gripkit --allow-external-links) if you "
-                         "trust this file, or copy the data into it")
+                    f"{_hdf5_text(link.filename)!r}:{_hdf5_text(link.path)!r}, another file; "
+                    f"not followed", hint=_EXTERNAL_HINT)
             node = node[part]
         elif isinstance(link, h5py.SoftLink):
             node = _hdf5_get(node, link.path, source, allow_external, depth + 1)
@@ -476,17 +489,17 @@ def _hdf5_check_dataset(ds, source: str, allow_external: bool) -> None:
     HDF5 file names) or a virtual dataset (a map onto datasets of other files)."""
     if allow_external:
         return
-    hint = ("pass allow_external_links=True (CLI: gripkit --allow-external-links) if you trust this "
-            "file, or copy the data into it")
     if ds.is_virtual:
-        raise DataError(f"{source}: dataset {ds.name!r} is a virtual dataset (its values are read from "
-                        f"other datasets or files); not read", hint=hint)
+        raise DataError(f"{source}: dataset {ds.name!r} is a virtual dataset (its values are read "
+                        f"from other datasets or files); not read", hint=_EXTERNAL_HINT)
     if ds.external:
         raise DataError(f"{source}: dataset {ds.name!r} keeps its values in an external file "
-                        f"({_hdf5_text(ds.external[0][0])!r}), not in this file; not read", hint=hint)
+                        f"({_hdf5_text(ds.external[0][0])!r}), not in this file; not read",
+                        hint=_EXTERNAL_HINT)
 
 
-def _read_hdf5(path: Path, key=None, delimiter=None, *, wanted=None, limit=None, allow_external=False):
+def _read_hdf5(path: Path, key=None, delimiter=None, *, wanted=None, limit=None,
+               allow_external=False):
     import h5py
 
     wanted = wanted or _Wanted(None, None)

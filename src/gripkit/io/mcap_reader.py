@@ -96,7 +96,8 @@ def read_mcap(path: Path, columns, stamp: str = "log") -> tuple[dict, dict]:
         raise DataError(f"{path.name}: no messages on topics {missing}")
     # seconds after the earliest stamp, subtracted in integer nanoseconds so that none is lost
     first = min(min(series[a][0]) for a in series)
-    series = {a: ((np.asarray(ts, dtype=np.int64) - first) * 1e-9, vs) for a, (ts, vs) in series.items()}
+    series = {a: ((np.asarray(ts, dtype=np.int64) - first) * 1e-9, vs)
+              for a, (ts, vs) in series.items()}
     base_alias = specs[0][0]
     tb = np.asarray(series[base_alias][0])
     ob = np.argsort(tb, kind="stable")

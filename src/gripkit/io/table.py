@@ -5,9 +5,10 @@ Rules shared by every reader:
 * a column header may carry its unit, ``"force [mN]"`` or ``"force (mN)"``; values are converted
   to SI and the channel is named ``force``. Units may also come from file metadata or ``units=``;
 * the time base is the column named by ``time=``, else a column named ``t``, ``time``,
-  ``timestamp``, ``time_s``, ``stamp`` or ``*_ns`` (see :func:`is_time_name`; its unit converted
-  to seconds), else a uniform one built from ``fs=``. Given both a time column and ``fs``, they must agree (within half a sample at every
-  sample), or a :class:`DataError` says by how much they differ;
+  ``timestamp``, ``time_s``, ``stamp``, ``time_ns`` and the like (:func:`is_time_name`; its
+  unit converted to seconds), else a uniform one built from ``fs=``. Given both a time column
+  and ``fs``, they must agree (within half a sample at every sample), or a
+  :class:`DataError` says by how much they differ;
 * a sample far outside the rest of its channel (a corrupt value) gives a
   :class:`~gripkit.errors.DataWarning` naming its time (:mod:`gripkit.signals.outliers`);
 * integer time stamps (ROS nanoseconds, 1.7e18) are read exactly: beyond 2**53 (where float64
@@ -33,11 +34,12 @@ from ..signals.outliers import corrupt_samples
 from ..signals.trajectory import Trajectory
 from ..units import si_factor
 
-__all__ = ["columns_to_trajectory", "split_header", "check_fill", "check_fs", "is_time_name", "FILL_CHOICES"]
+__all__ = ["columns_to_trajectory", "split_header", "check_fill", "check_fs", "is_time_name",
+           "FILL_CHOICES"]
 
-_TIME_NAMES = ("t", "time", "timestamp", "time_s", "times", "stamp", "t_ns", "time_ns", "timestamp_ns",
-               "stamp_ns", "header_stamp", "header_stamp_ns")
-#: integer time stamps from here up can only be nanoseconds (since 1970: 1e17 µs would be 3000 years)
+_TIME_NAMES = ("t", "time", "timestamp", "time_s", "times", "stamp", "t_ns", "time_ns",
+               "timestamp_ns", "stamp_ns", "header_stamp", "header_stamp_ns")
+#: integer time stamps from here up can only be nanoseconds (1e17 µs since 1970: 3000 years)
 NS_STAMPS_FROM = 10**17
 #: time values from here up are no record's seconds (31 700 years): a stamp in another unit
 STAMPS_FROM = 10**12
@@ -77,8 +79,8 @@ def _numeric(name: str, values, row_offset: int = 0) -> np.ndarray:
         big = max(abs(int(a.min())), abs(int(a.max())))
         if big > 2**53:
             raise DataError(
-                f"column {name!r} holds integers up to {big}, beyond 2**53 (float64 cannot hold them "
-                f"exactly); gripkit reads such integers only as time stamps",
+                f"column {name!r} holds integers up to {big}, beyond 2**53 (float64 cannot hold "
+                f"them exactly); gripkit reads such integers only as time stamps",
                 hint=f"if it is the time column, name it with time={name!r} (CLI: --time {name}); "
                      f"else leave it out with columns=")
     if np.issubdtype(a.dtype, np.number):
@@ -145,7 +147,8 @@ def _check_fs_against_time(source: str, tname: str, t: np.ndarray, fs: float) ->
              "rename the time column")
 
 
-def _time_seconds(source: str, tname: str, values, unit: str | None) -> tuple[np.ndarray, str | None]:
+def _time_seconds(source: str, tname: str, values,
+                  unit: str | None) -> tuple[np.ndarray, str | None]:
     """The time column in seconds, and the subtracted first stamp (``'1700000000000000000 ns'``)
     when integers beyond 2**53 were read relative to it; refuses stamps whose unit is unclear."""
     a = np.asarray(values)
@@ -161,11 +164,12 @@ def _time_seconds(source: str, tname: str, values, unit: str | None) -> tuple[np
         unit = "ns"
     elif unit is None and big >= STAMPS_FROM:
         raise DataError(
-            f"{source}: time column {tname!r} holds values up to {big:.4g}, too large for seconds: they "
-            f"look like time stamps in another unit ({'integers' if integer else 'floating point'}; "
-            f"milliseconds, microseconds or nanoseconds since 1970?)",
-            hint=f"give the unit: in the header ('{tname} [ms]', '{tname} [us]', '{tname} [ns]'), with "
-                 f"units={{'{tname}': 'ns'}}, or name the column {tname}_ns for nanoseconds")
+            f"{source}: time column {tname!r} holds values up to {big:.4g}, too large for "
+            f"seconds: they look like time stamps in another unit "
+            f"({'integers' if integer else 'floating point'}; milliseconds, microseconds or "
+            f"nanoseconds since 1970?)",
+            hint=f"give the unit: in the header ('{tname} [ms]', '{tname} [us]', '{tname} [ns]'), "
+                 f"with units={{'{tname}': 'ns'}}, or name the column {tname}_ns for nanoseconds")
     try:
         scale, offset, si = si_factor(unit or "s")
     except Exception:
@@ -250,8 +254,8 @@ def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
     if tname is None:
         tname = next((c for c in cols if is_time_name(c)), None)
         if tname is None and fs is None:
-            raise DataError(f"{source}: no time column found (looked for {', '.join(_TIME_NAMES[:6])}, "
-                            f"{', '.join(_TIME_NAMES[6:9])}, ...)",
+            looked = ", ".join(_TIME_NAMES[:9])
+            raise DataError(f"{source}: no time column found (looked for {looked}, ...)",
                             hint="name it with time=COL (CLI: --time COL) or give the sampling rate fs (CLI: --fs HZ)")
     if tname is not None and tname not in cols:
         raise DataError(f"{source}: time column {tname!r} not found", hint=f"available columns: {available}")

@@ -36,10 +36,10 @@ def read_toml(path, what: str) -> dict:
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{path.name}: not valid TOML: {exc}") from None
     except RecursionError:
-        raise ConfigError(f"{what} {str(path)!r} cannot be read: its TOML nests arrays or tables deeper "
-                          f"than Python's recursion limit ({sys.getrecursionlimit()})",
+        raise ConfigError(f"{what} {str(path)!r} cannot be read: its TOML nests arrays or tables "
+                          f"deeper than Python's recursion limit ({sys.getrecursionlimit()})",
                           hint="a gripkit TOML file nests a few levels: check the file") from None
     except ValueError as exc:  # an integer beyond Python's limit on digits read from text
-        raise ConfigError(f"{what} {str(path)!r} cannot be read: {str(exc).split(';')[0]} (a number in "
-                          f"the file has more digits than any value gripkit takes)",
+        raise ConfigError(f"{what} {str(path)!r} cannot be read: {str(exc).split(';')[0]} (a "
+                          f"number in the file has more digits than any value gripkit takes)",
                           hint="check the file") from None

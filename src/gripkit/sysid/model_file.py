@@ -91,7 +91,8 @@ def _nesting(doc) -> int:
             deepest = max(deepest, depth + 1)
             if deepest > MAX_NESTING:
                 return deepest
-            stack.extend((v, depth + 1) for v in (node.values() if isinstance(node, dict) else node))
+            children = node.values() if isinstance(node, dict) else node
+            stack.extend((v, depth + 1) for v in children)
     return deepest
 
 
@@ -110,16 +111,17 @@ def read_document(path, schema: str = SCHEMA, newest: int = SCHEMA_VERSION, *, w
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise ModelError(f"{what} {str(path)!r} is not valid JSON ({exc})", hint=hint) from None
     except RecursionError:
-        raise ModelError(f"{what} {str(path)!r} cannot be read: its JSON nests lists or objects deeper "
-                         f"than Python's recursion limit ({sys.getrecursionlimit()}); a model file "
-                         f"nests a few levels", hint=hint) from None
+        raise ModelError(f"{what} {str(path)!r} cannot be read: its JSON nests lists or objects "
+                         f"deeper than Python's recursion limit ({sys.getrecursionlimit()}); a "
+                         f"model file nests a few levels", hint=hint) from None
     except ValueError as exc:  # an integer beyond Python's limit on digits read from text
         raise ModelError(f"{what} {str(path)!r} cannot be read: {str(exc).split(';')[0]} (a number "
-                         f"in the file has more digits than any model parameter)", hint=hint) from None
+                         f"in the file has more digits than any model parameter)",
+                         hint=hint) from None
     where = repr(str(path))
     if _nesting(doc) > MAX_NESTING:
-        raise ModelError(f"{what} {where}: its JSON nests lists or objects more than {MAX_NESTING} deep; "
-                         f"a model file nests a few levels", hint=hint)
+        raise ModelError(f"{what} {where}: its JSON nests lists or objects more than "
+                         f"{MAX_NESTING} deep; a model file nests a few levels", hint=hint)
     if not isinstance(doc, dict) or doc.get("schema") != schema:
         found = doc.get("schema") if isinstance(doc, dict) else type(doc).__name__
         raise ModelError(f"{what} {where}: expected schema {schema!r}, found {found!r}", hint=hint)
