@@ -17,7 +17,7 @@ import pyarrow.parquet as pq
 import pytest
 from corpus import assert_user_error
 
-from gripkit import DataError, Trajectory
+from gripkit import DataError, DataWarning, Trajectory
 from gripkit.io import load, save
 
 SECRET = b"TOPSECRET-ssh-private-key-0123456789abcdef\n" * 8  # 344 bytes = 43 float64 values
@@ -57,8 +57,9 @@ def test_external_raw_storage_is_refused(tmp_path, secret):
                          external=[(str(secret), 0, h5py.h5f.UNLIMITED)])
     msg = _refused(p, "dataset '/force' keeps its values in an external file")
     assert "allow_external_links=True" in msg
-    # with the option the values are the file's bytes, read as the dataset says
-    tr = load(p, allow_external_links=True)
+    # with the option the values are the file's bytes, read as the dataset says (some look corrupt)
+    with pytest.warns(DataWarning, match="look corrupt"):
+        tr = load(p, allow_external_links=True)
     np.testing.assert_array_equal(tr["force"], np.frombuffer(SECRET, dtype="<f8"))
 
 
@@ -240,3 +241,27 @@ def test_bad_load_limits_are_argument_errors(tmp_path, monkeypatch):
         load(p)
     with pytest.raises(ArgumentError, match="allow_external_links must be True or False"):
         load(p, allow_external_links="yes")
+
+
+@pytest.mark.parametrize("chunk_size, limit, phrase", [
+    (2**20, 70_000, r"a chunk of the MCAP file declares [0-9.e-]+ GB uncompressed, beyond the "
+                    r"load limit of 7e-05 GB"),
+    (1024, 20_000, "the MCAP file declares 2000 rows × 2 columns, about 3.2e-05 GB"),
+])
+def test_mcap_declared_sizes(tmp_path, chunk_size, limit, phrase):
+    """An MCAP file's summary declares its chunks' uncompressed sizes and the message count per
+    channel: both are checked before a message is decoded (2000 Float64 messages: one chunk of
+    about 86 kB, or 1 kB chunks and 2000 × 2 values × 8 bytes = 32 kB)."""
+    from mcap_ros2.writer import Writer
+
+    p = tmp_path / "run.mcap"
+    with open(p, "wb") as f:
+        w = Writer(f, chunk_size=chunk_size)
+        schema = w.register_msgdef("std_msgs/Float64", "float64 data\n")
+        for k in range(2000):
+            w.write_message("/force", schema, {"data": float(k)}, log_time=10**18 + k * 10**6,
+                            publish_time=0)
+        w.finish()
+    _refused(p, phrase, columns=["force=/force:data"], max_bytes=limit)
+    tr = load(p, columns=["force=/force:data"], max_bytes=100_000)
+    np.testing.assert_array_equal(tr["force"], np.arange(2000.0))

@@ -31,7 +31,8 @@ import numpy as np
 from ..arguments import check_path, entry_point
 from ..errors import ArgumentError, DataError, DataWarning
 from ..signals.trajectory import Trajectory
-from .table import check_fill, check_fs, columns_to_trajectory, is_time_name, split_header
+from .table import (check_fill, check_fs, check_size, columns_to_trajectory, is_time_name,
+                    split_header)
 
 __all__ = ["load", "save", "FORMATS"]
 
@@ -140,7 +141,7 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
     if fmt == "mcap":
         from .mcap_reader import read_mcap
 
-        raw, meta_units = read_mcap(path, columns, stamp)
+        raw, meta_units = read_mcap(path, columns, stamp, limit)
         return columns_to_trajectory(raw, source=path.name, time="t", fs=fs, units=units,
                                      meta_units=meta_units, fill=fill)
     reader = {"csv": _read_csv, "parquet": _read_parquet, "hdf5": _read_hdf5}[fmt]
@@ -205,20 +206,6 @@ class _Wanted:
                                 hint=f"available columns: {', '.join(names)}")
         return [h for h, n in zip(headers, names) if n in self.columns or n == self.time
                 or is_time_name(n)]
-
-
-def _check_size(source: str, what: str, rows: int, ncols: int, limit: float) -> None:
-    """Refuse to read ``rows`` × ``ncols`` values (as float64) beyond the load limit, before
-    anything is allocated: a small file may declare a huge dataset."""
-    need = float(rows) * float(ncols) * 8.0
-    if need <= limit:
-        return
-    raise DataError(
-        f"{source}: {what} declares {rows} rows × {ncols} columns, about {need / 1e9:.3g} GB as "
-        f"float64, beyond the load limit of {limit / 1e9:.3g} GB; nothing was read",
-        hint=f"read fewer columns (columns=, CLI: the command's column options), or raise the "
-             f"limit with max_bytes= or the environment variable {_ENV_LIMIT} (bytes) if the "
-             f"machine has the memory")
 
 
 def _read_csv(path: Path, key=None, delimiter=None, *, wanted=None, limit=None,
@@ -430,7 +417,7 @@ def _read_parquet(path: Path, key=None, delimiter=None, *, wanted=None, limit=No
                                 hint="give one of the data files of the dataset, not its _metadata")
             schema = pf.schema_arrow
             names = wanted.select(path.name, schema.names)
-            _check_size(path.name, "the file", meta.num_rows, len(names), limit or float("inf"))
+            check_size(path.name, "the file", meta.num_rows, len(names), limit or float("inf"))
             table = pf.read(columns=names)
         except DataError:
             raise
@@ -537,7 +524,7 @@ def _hdf5_table(node, source: str, wanted, limit: float, allow_external: bool):
     _hdf5_check_dataset(node, source, allow_external)
     chosen = set(wanted.select(source, cols))
     keep = [j for j, c in enumerate(cols) if c in chosen]
-    _check_size(source, f"dataset {node.name!r}", node.shape[0], len(keep), limit)
+    check_size(source, f"dataset {node.name!r}", node.shape[0], len(keep), limit)
     arr = node[()] if len(keep) == len(cols) else None
     ulist = node.attrs.get("units")
     raw, units = {}, {}
@@ -564,7 +551,7 @@ def _hdf5_group(node, source: str, wanted, limit: float, allow_external: bool):
         raise DataError(f"{source}: group {node.name!r} holds no 1-D datasets",
                         hint="pass key= to point at the group holding the channels")
     rows = max(ds.shape[0] for ds in datasets.values())
-    _check_size(source, f"group {node.name!r}", rows, len(datasets), limit)
+    check_size(source, f"group {node.name!r}", rows, len(datasets), limit)
     raw, units = {}, {}
     for name, ds in datasets.items():
         raw[name] = ds[()]

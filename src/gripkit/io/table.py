@@ -34,8 +34,8 @@ from ..signals.outliers import corrupt_samples
 from ..signals.trajectory import Trajectory
 from ..units import si_factor
 
-__all__ = ["columns_to_trajectory", "split_header", "check_fill", "check_fs", "is_time_name",
-           "FILL_CHOICES"]
+__all__ = ["columns_to_trajectory", "split_header", "check_fill", "check_fs", "check_size",
+           "is_time_name", "FILL_CHOICES"]
 
 _TIME_NAMES = ("t", "time", "timestamp", "time_s", "times", "stamp", "t_ns", "time_ns",
                "timestamp_ns", "stamp_ns", "header_stamp", "header_stamp_ns")
@@ -43,12 +43,12 @@ _TIME_NAMES = ("t", "time", "timestamp", "time_s", "times", "stamp", "t_ns", "ti
 NS_STAMPS_FROM = 10**17
 #: time values from here up are no record's seconds (31 700 years): a stamp in another unit
 STAMPS_FROM = 10**12
+_HEADER = re.compile(r"^\s*(.*?)\s*[\[(]\s*([^\])]+?)\s*[\])]\s*$")
 
 
 def is_time_name(name: str) -> bool:
     """Whether a column of this name is taken as the time column when ``time=`` is not given."""
     return name.lower() in _TIME_NAMES
-_HEADER = re.compile(r"^\s*(.*?)\s*[\[(]\s*([^\])]+?)\s*[\])]\s*$")
 
 
 def split_header(header: str) -> tuple[str, str | None]:
@@ -108,6 +108,20 @@ def check_fill(fill) -> None:
     if fill is not None and fill not in FILL_CHOICES:
         raise DataError(f"fill: expected None, 'drop' or 'interpolate', found {fill!r}",
                         hint="CLI: --fill drop or --fill interpolate, or leave it out to refuse missing values")
+
+
+def check_size(source: str, what: str, rows: int, ncols: int, limit: float) -> None:
+    """Refuse to read ``rows`` × ``ncols`` values (as float64) beyond the load limit, before
+    anything is allocated: a small file may declare a huge dataset."""
+    need = float(rows) * float(ncols) * 8.0
+    if need <= limit:
+        return
+    raise DataError(
+        f"{source}: {what} declares {rows} rows × {ncols} columns, about {need / 1e9:.3g} GB as "
+        f"float64, beyond the load limit of {limit / 1e9:.3g} GB; nothing was read",
+        hint=f"read fewer columns (columns=, CLI: the command's column options), or raise the "
+             f"limit with max_bytes= or the environment variable GRIPKIT_MAX_LOAD_BYTES (bytes) "
+             f"if the machine has the memory")
 
 
 def check_fs(fs) -> None:
