@@ -265,3 +265,40 @@ def test_mcap_declared_sizes(tmp_path, chunk_size, limit, phrase):
     _refused(p, phrase, columns=["force=/force:data"], max_bytes=limit)
     tr = load(p, columns=["force=/force:data"], max_bytes=100_000)
     np.testing.assert_array_equal(tr["force"], np.arange(2000.0))
+
+
+def test_parquet_text_repeated_from_a_dictionary_is_not_multiplied(tmp_path):
+    """A dictionary-encoded text column: one 1 MB string for 200 rows, 200 MB if every row got its
+    own copy. Read as the one string (Python allocates under 8 MB), then refused as text, the
+    message cut to 40 characters of it."""
+    import tracemalloc
+
+    p = tmp_path / "text.parquet"
+    note = pa.array(["x" * 2**20] * 200).dictionary_encode()
+    pq.write_table(pa.table({"t": np.arange(200) / 1e3, "note": note}), p, compression="zstd")
+    tracemalloc.start()
+    try:
+        msg = _refused(p, "column 'note' mixes numbers and text: row 0 holds 'x{40}';")
+    finally:
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+    assert peak < 8e6, peak
+    assert len(msg) < 300
+
+
+def test_parquet_pages_declaring_more_than_the_limit(tmp_path):
+    """1000 distinct 1 kB strings: 16 kB as float64 rows, but about 1 MB of uncompressed pages."""
+    p = tmp_path / "pages.parquet"
+    words = [f"{k:04d}" * 256 for k in range(1000)]
+    pq.write_table(pa.table({"t": np.arange(1000) / 1e3, "note": words}), p, use_dictionary=False)
+    _refused(p, r"the file's columns declare 0.00\d+ GB uncompressed, beyond the load limit of "
+                r"0.0001 GB", max_bytes=100_000)
+
+
+def test_hdf5_wide_values_count_their_size(tmp_path):
+    """Fixed-length strings of 100 000 bytes: 1000 rows declare 100 MB, not 8 kB as float64."""
+    p = tmp_path / "text.h5"
+    with h5py.File(p, "w") as f:
+        f["t"] = np.arange(1000) / 1e3
+        f.create_dataset("note", shape=(1000,), dtype="S100000", chunks=(10,), compression="gzip")
+    _refused(p, "1000 rows × 2 columns, about 0.2 GB at 100000 bytes a value", max_bytes=50e6)

@@ -199,11 +199,11 @@ class _Wanted:
         headers = [str(h) for h in headers]
         if self.columns is None:
             return headers
-        names = {split_header(h)[0]: h for h in headers}
+        names = [split_header(h)[0] for h in headers]
         for c in self.columns:
             if c not in names:
                 raise DataError(f"{source}: column {c!r} not found",
-                                hint=f"available columns: {', '.join(names)}")
+                                hint=f"available columns: {', '.join(dict.fromkeys(names))}")
         return [h for h, n in zip(headers, names) if n in self.columns or n == self.time
                 or is_time_name(n)]
 
@@ -353,6 +353,8 @@ def _arrow_columns(table, source: str) -> dict[str, object]:
             out[name] = _float64_column(col)
         elif pa.types.is_null(col.type):
             out[name] = np.full(len(col), np.nan)
+        elif pa.types.is_dictionary(col.type):
+            out[name] = _dictionary_column(col)
         else:
             out[name] = np.asarray(col.to_pylist(), dtype=object)
     return out
@@ -377,6 +379,22 @@ def _integer_column(col, name: str, source: str) -> np.ndarray:
                         f"which float64 cannot hold exactly) and {col.null_count} missing values",
                         hint="fill the missing values, or leave the column out")
     return _float64_column(col)
+
+
+def _dictionary_column(col) -> np.ndarray:
+    """A dictionary-encoded Arrow column as an object array whose repeated values are one Python
+    object each (``to_pylist`` would make one per row)."""
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
+    parts = []
+    for chunk in col.chunks:
+        words = chunk.dictionary.to_pylist()
+        values = np.empty(len(words) + 1, dtype=object)  # the last one for nulls
+        values[:-1] = words
+        idx = pc.fill_null(chunk.indices, len(words))
+        parts.append(values[_integer_column(pa.chunked_array([idx]), "", "")])
+    return np.concatenate(parts) if parts else np.empty(0, dtype=object)
 
 
 def _float64_column(col) -> np.ndarray:
@@ -417,7 +435,15 @@ def _read_parquet(path: Path, key=None, delimiter=None, *, wanted=None, limit=No
                                 hint="give one of the data files of the dataset, not its _metadata")
             schema = pf.schema_arrow
             names = wanted.select(path.name, schema.names)
-            check_size(path.name, "the file", meta.num_rows, len(names), limit or float("inf"))
+            limit = limit or float("inf")
+            check_size(path.name, "the file", meta.num_rows, len(names), limit)
+            _check_parquet_stored(path.name, meta, names, limit)
+            # text as dictionaries: one string repeated a million times stays one string
+            text = [f.name for f in schema if f.name in names
+                    and (pa.types.is_string(f.type) or pa.types.is_large_string(f.type)
+                         or pa.types.is_binary(f.type) or pa.types.is_large_binary(f.type))]
+            if text:
+                pf = pq.ParquetFile(fh, read_dictionary=text)
             table = pf.read(columns=names)
         except DataError:
             raise
@@ -430,6 +456,20 @@ def _read_parquet(path: Path, key=None, delimiter=None, *, wanted=None, limit=No
         if b"unit" in md:
             units[f.name] = md[b"unit"].decode()
     return _arrow_columns(table, path.name), units
+
+
+def _check_parquet_stored(source: str, meta, names, limit: float) -> None:
+    """Refuse columns whose pages declare more bytes uncompressed than the load limit (a few kB
+    of compressed pages may declare gigabytes)."""
+    chosen = set(names)
+    stored = sum(meta.row_group(i).column(j).total_uncompressed_size
+                 for i in range(meta.num_row_groups) for j in range(meta.num_columns)
+                 if meta.row_group(i).column(j).path_in_schema.split(".")[0] in chosen)
+    if stored > limit:
+        raise DataError(f"{source}: the file's columns declare {stored / 1e9:.3g} GB uncompressed, "
+                        f"beyond the load limit of {limit / 1e9:.3g} GB; nothing was read",
+                        hint="read fewer columns (columns=), or raise the limit with max_bytes= or "
+                             "the environment variable GRIPKIT_MAX_LOAD_BYTES (bytes)")
 
 
 def _hdf5_text(x) -> str:
@@ -524,7 +564,8 @@ def _hdf5_table(node, source: str, wanted, limit: float, allow_external: bool):
     _hdf5_check_dataset(node, source, allow_external)
     chosen = set(wanted.select(source, cols))
     keep = [j for j, c in enumerate(cols) if c in chosen]
-    check_size(source, f"dataset {node.name!r}", node.shape[0], len(keep), limit)
+    check_size(source, f"dataset {node.name!r}", node.shape[0], len(keep), limit,
+               node.dtype.itemsize)
     arr = node[()] if len(keep) == len(cols) else None
     ulist = node.attrs.get("units")
     raw, units = {}, {}
@@ -551,7 +592,8 @@ def _hdf5_group(node, source: str, wanted, limit: float, allow_external: bool):
         raise DataError(f"{source}: group {node.name!r} holds no 1-D datasets",
                         hint="pass key= to point at the group holding the channels")
     rows = max(ds.shape[0] for ds in datasets.values())
-    check_size(source, f"group {node.name!r}", rows, len(datasets), limit)
+    itemsize = max(ds.dtype.itemsize for ds in datasets.values())
+    check_size(source, f"group {node.name!r}", rows, len(datasets), limit, itemsize)
     raw, units = {}, {}
     for name, ds in datasets.items():
         raw[name] = ds[()]

@@ -94,7 +94,8 @@ def _numeric(name: str, values, row_offset: int = 0) -> np.ndarray:
             out[i] = float(v)
         except (TypeError, ValueError):
             raise DataError(
-                f"column {name!r} mixes numbers and text: row {i + row_offset} holds {str(v)!r}",
+                f"column {name!r} mixes numbers and text: row {i + row_offset} holds "
+                f"{str(v)[:40]!r}",
                 hint="fix or remove that cell, or leave it empty to be treated as missing",
             ) from None
     return out
@@ -110,15 +111,19 @@ def check_fill(fill) -> None:
                         hint="CLI: --fill drop or --fill interpolate, or leave it out to refuse missing values")
 
 
-def check_size(source: str, what: str, rows: int, ncols: int, limit: float) -> None:
-    """Refuse to read ``rows`` × ``ncols`` values (as float64) beyond the load limit, before
-    anything is allocated: a small file may declare a huge dataset."""
-    need = float(rows) * float(ncols) * 8.0
+def check_size(source: str, what: str, rows: int, ncols: int, limit: float,
+               itemsize: int = 8) -> None:
+    """Refuse to read ``rows`` × ``ncols`` values (as float64, or ``itemsize`` bytes each when
+    larger) beyond the load limit, before anything is allocated: a small file may declare a huge
+    dataset."""
+    size = max(8, int(itemsize))
+    need = float(rows) * float(ncols) * size
     if need <= limit:
         return
+    each = "as float64" if size == 8 else f"at {size} bytes a value"
     raise DataError(
-        f"{source}: {what} declares {rows} rows × {ncols} columns, about {need / 1e9:.3g} GB as "
-        f"float64, beyond the load limit of {limit / 1e9:.3g} GB; nothing was read",
+        f"{source}: {what} declares {rows} rows × {ncols} columns, about {need / 1e9:.3g} GB "
+        f"{each}, beyond the load limit of {limit / 1e9:.3g} GB; nothing was read",
         hint=f"read fewer columns (columns=, CLI: the command's column options), or raise the "
              f"limit with max_bytes= or the environment variable GRIPKIT_MAX_LOAD_BYTES (bytes) "
              f"if the machine has the memory")
