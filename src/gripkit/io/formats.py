@@ -109,15 +109,18 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
 
     Warns
     -----
-    CSV files: lines that start with ``#`` are comments and are skipped; a file whose header is
-    separated by ``;`` is read with ``;`` as separator, and with ``,`` as decimal point when its
-    numbers are written so (``0,25``). Integer time stamps in nanoseconds (a column named ``*_ns``
-    or with the unit ``[ns]``, or integers of 1e17 and more) are read exactly, relative to the
-    first stamp (``meta['time_origin']``).
-
     DataWarning
         A CSV whose last line has no line ending (the file looks truncated); a sample far outside
         the rest of its channel (a corrupt value), naming its time.
+
+    Notes
+    -----
+    CSV files: lines that start with ``#`` are comments and are skipped; a file whose header is
+    separated by ``;`` is read with ``;`` as separator, and with ``,`` as decimal point when its
+    numbers are written so (``0,25``). Integer time stamps in nanoseconds (a column named
+    ``stamp``, ``time_ns`` and the like or ``*_ns`` given as ``time=``, with the unit ``[ns]``, or
+    integers of 1e17 and more) are read exactly, relative to the first stamp
+    (``meta['time_origin']``).
     """
     check_path(path, "path", "load()")
     if units is not None and not isinstance(units, Mapping):
@@ -265,6 +268,8 @@ def _strip_comments(path: Path, data: bytes) -> bytes:
     ``#``, before the header or between data rows). Refuses a file whose header is itself
     commented out (``# t,force`` as ``numpy.savetxt`` writes it): its first row would be read as
     column names."""
+    if b"#" not in data:
+        return data
     lines = data.splitlines(keepends=True)
     if not any(_is_comment(line) for line in lines):
         return data
@@ -289,7 +294,9 @@ def _sniff_separator(data: bytes) -> tuple[str, str]:
     """The separator and decimal point of a CSV file read without ``delimiter=``: ``,`` and
     ``.``, unless the header holds ``;`` and no ``,`` (a European spreadsheet's export): then
     ``;``, with ``,`` as decimal point when the data rows write their numbers so (``0,25``)."""
-    lines = data.decode("utf-8", errors="replace").splitlines()
+    lines = data[:65536].decode("utf-8", errors="replace").splitlines()
+    if len(data) > 65536:
+        lines = lines[:-1]  # cut short
     header = next((line for line in lines if line.strip()), "")
     if ";" not in header or "," in header:
         return ",", "."
