@@ -7,6 +7,8 @@ adding commands to the apps defined here. Heavy imports happen inside commands s
 
 from __future__ import annotations
 
+import os
+
 import typer
 
 from .. import progress
@@ -42,8 +44,27 @@ def _print_version(value: bool) -> None:
 
 
 @app.callback()
-def _root(debug: bool = typer.Option(False, "--debug", help="Show tracebacks on errors."),
+def _root(ctx: typer.Context,
+          debug: bool = typer.Option(False, "--debug", help="Show tracebacks on errors."),
           quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress output."),
           show_version: bool = typer.Option(False, "--version", is_eager=True, callback=_print_version,
-                                            help="Print gripkit's version and exit.")):
+                                            help="Print gripkit's version and exit."),
+          allow_external_links: bool = typer.Option(
+              False, "--allow-external-links",
+              help="Read HDF5 data kept in other files (external links, external storage, virtual "
+                   "datasets); refused by default, as a file could name any file on the machine.")):
     progress.set_quiet(quiet)
+    if allow_external_links:  # read by gripkit.io.load, for this command only
+        before = os.environ.get(_EXTERNAL)
+        os.environ[_EXTERNAL] = "1"
+        ctx.call_on_close(lambda: _restore(_EXTERNAL, before))
+
+
+_EXTERNAL = "GRIPKIT_ALLOW_EXTERNAL_LINKS"
+
+
+def _restore(name: str, value: str | None) -> None:
+    if value is None:
+        os.environ.pop(name, None)
+    else:
+        os.environ[name] = value

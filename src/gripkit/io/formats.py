@@ -6,11 +6,22 @@
   with a ``columns`` attribute (and optionally ``units``); ``key=`` names the group/dataset.
 * MCAP (ROS 2 logs, optional extra): columns ``[alias=]/topic:field.path[i]``, see
   :mod:`gripkit.io.mcap_reader`.
+
+A file names only its own data. HDF5 external links, external raw storage and virtual datasets
+(which read other files on the machine) are refused unless ``allow_external_links=True`` (CLI:
+``gripkit --allow-external-links``, or the environment variable ``GRIPKIT_ALLOW_EXTERNAL_LINKS=1``).
+A Parquet file whose column chunks live in other files (a ``_metadata`` summary) is refused.
+
+Sizes a file declares are checked before anything is allocated: when the requested columns would
+take more than the load limit as float64 (rows × columns × 8 bytes), :func:`load` refuses with the
+estimate. The limit is ``max_bytes=``, else ``GRIPKIT_MAX_LOAD_BYTES``, else the smaller of 4 GiB
+and a quarter of the machine's memory.
 """
 
 from __future__ import annotations
 
 import os
+import re
 import warnings
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -21,9 +32,17 @@ from ..arguments import check_path, entry_point
 from ..atomic import atomic_write
 from ..errors import ArgumentError, DataError, DataWarning
 from ..signals.trajectory import Trajectory
-from .table import check_fill, check_fs, columns_to_trajectory
+from .table import (check_fill, check_fs, check_size, columns_to_trajectory, is_time_name,
+                    split_header)
 
 __all__ = ["load", "save", "FORMATS"]
+
+#: the load limit when neither max_bytes= nor GRIPKIT_MAX_LOAD_BYTES sets one: at most 4 GiB of
+#: float64 values, and at most a quarter of the machine's memory (the data are copied a few times on
+#: their way to a Trajectory: conversion to float64, to SI units, missing-value handling)
+DEFAULT_MAX_BYTES = 4 * 2**30
+_ENV_LIMIT = "GRIPKIT_MAX_LOAD_BYTES"
+_ENV_EXTERNAL = "GRIPKIT_ALLOW_EXTERNAL_LINKS"
 
 FORMATS = {".csv": "csv", ".txt": "csv", ".tsv": "csv", ".parquet": "parquet", ".pq": "parquet",
            ".h5": "hdf5", ".hdf5": "hdf5", ".hdf": "hdf5", ".mcap": "mcap"}
@@ -45,7 +64,8 @@ def _format(path: Path, fmt: str | None) -> str:
 def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
          fs: float | None = None, units: Mapping[str, str] | None = None,
          fill: str | None = None, format: str | None = None, key: str | None = None,
-         delimiter: str | None = None, stamp: str = "log") -> Trajectory:
+         delimiter: str | None = None, stamp: str = "log", allow_external_links: bool | None = None,
+         max_bytes: float | None = None) -> Trajectory:
     """Read experiment data into a validated :class:`Trajectory` (SI units).
 
     Parameters
@@ -69,13 +89,21 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
         HDF5 group or dataset path.
     stamp
         MCAP time stamps: 'log' (log time) or 'header' (``header.stamp`` of each message).
+    allow_external_links
+        HDF5: follow external links and read external raw storage and virtual datasets, which take
+        their data from other files. Default: refused (``GRIPKIT_ALLOW_EXTERNAL_LINKS=1`` allows).
+    max_bytes
+        Refuse a file whose requested columns would take more than this many bytes as float64,
+        before reading them (default: ``GRIPKIT_MAX_LOAD_BYTES``, else the smaller of 4 GiB and
+        a quarter of the machine's memory).
 
     Raises
     ------
     DataError
         Missing file or column, truncated or corrupt file (a CSV line with missing fields names
         the line), mixed types, NaN/inf, bad time stamps, ``fs`` contradicting the time column,
-        an invalid ``fill`` or ``fs`` (checked before the file is read).
+        an invalid ``fill`` or ``fs`` (checked before the file is read); an HDF5 dataset that takes
+        its data from another file; declared sizes beyond ``max_bytes``; a CSV file in UTF-16.
     ArgumentError
         An unknown keyword, or an argument of the wrong type (``path`` not a path, ``units`` not a
         mapping, ``fs`` not a number).
@@ -85,6 +113,15 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
     DataWarning
         A CSV whose last line has no line ending (the file looks truncated); a sample far outside
         the rest of its channel (a corrupt value), naming its time.
+
+    Notes
+    -----
+    CSV files: lines that start with ``#`` are comments and are skipped; a file whose header is
+    separated by ``;`` is read with ``;`` as separator, and with ``,`` as decimal point when its
+    numbers are written so (``0,25``). Integer time stamps in nanoseconds (a column named
+    ``stamp``, ``time_ns`` and the like or ``*_ns`` given as ``time=``, with the unit ``[ns]``, or
+    integers of 1e17 and more) are read exactly, relative to the first stamp
+    (``meta['time_origin']``).
     """
     check_path(path, "path", "load()")
     if units is not None and not isinstance(units, Mapping):
@@ -102,29 +139,95 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
         raise DataError(f"data file {str(path)!r} is empty")
     check_fill(fill)
     check_fs(fs)
+    allow_external_links = _allow_external(allow_external_links)
+    limit = _load_limit(max_bytes)
     fmt = _format(path, format)
     if fmt == "mcap":
         from .mcap_reader import read_mcap
 
-        raw, meta_units = read_mcap(path, columns, stamp)
+        raw, meta_units = read_mcap(path, columns, stamp, limit)
         return columns_to_trajectory(raw, source=path.name, time="t", fs=fs, units=units,
                                      meta_units=meta_units, fill=fill)
     reader = {"csv": _read_csv, "parquet": _read_parquet, "hdf5": _read_hdf5}[fmt]
-    raw, meta_units = reader(path, key=key, delimiter=delimiter)
+    wanted = _Wanted(columns, time)
+    raw, meta_units = reader(path, key=key, delimiter=delimiter, wanted=wanted, limit=limit,
+                             allow_external=allow_external_links)
     return columns_to_trajectory(raw, source=path.name, columns=columns, time=time, fs=fs,
                                  units=units, meta_units=meta_units, fill=fill)
 
 
-def _read_csv(path: Path, key=None, delimiter=None):
+def _allow_external(allow) -> bool:
+    """``allow_external_links``, or the environment's ``GRIPKIT_ALLOW_EXTERNAL_LINKS`` when None."""
+    if allow is None:
+        return os.environ.get(_ENV_EXTERNAL, "").strip().lower() in ("1", "true", "yes")
+    if not isinstance(allow, (bool, np.bool_)):
+        raise ArgumentError(f"load(): allow_external_links must be True or False, "
+                            f"found {allow!r:.40}")
+    return bool(allow)
+
+
+def _load_limit(max_bytes) -> float:
+    """The load limit in bytes: ``max_bytes``, else ``GRIPKIT_MAX_LOAD_BYTES``, else the smaller of
+    :data:`DEFAULT_MAX_BYTES` and a quarter of the machine's memory."""
+    where = "load(): max_bytes"
+    if max_bytes is None and os.environ.get(_ENV_LIMIT, "").strip():
+        max_bytes, where = os.environ[_ENV_LIMIT].strip(), f"environment variable {_ENV_LIMIT}"
+        try:
+            max_bytes = float(max_bytes)
+        except ValueError:
+            raise ArgumentError(f"{where} must be a number of bytes, "
+                                f"found {max_bytes!r:.40}") from None
+    if max_bytes is None:
+        try:
+            memory = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE")
+        except (AttributeError, ValueError, OSError):
+            memory = 4 * DEFAULT_MAX_BYTES
+        return float(min(DEFAULT_MAX_BYTES, memory / 4))
+    ok = (isinstance(max_bytes, (int, float, np.integer, np.floating))
+          and not isinstance(max_bytes, bool))
+    if not ok or not float(max_bytes) > 0:
+        raise ArgumentError(f"{where} must be a positive number of bytes, found {max_bytes!r:.40}")
+    return float(max_bytes)
+
+
+class _Wanted:
+    """Which of a file's columns :func:`load` needs: those named by ``columns`` (as headers, less
+    their unit) and every possible time column; all of them when ``columns`` is None."""
+
+    def __init__(self, columns, time):
+        self.columns = None if columns is None else [str(c) for c in columns]
+        self.time = time
+
+    def select(self, source: str, headers) -> list[str]:
+        """The ``headers`` to read; a DataError naming a requested column the file lacks."""
+        headers = [str(h) for h in headers]
+        if self.columns is None:
+            return headers
+        names = [split_header(h)[0] for h in headers]
+        for c in self.columns:
+            if c not in names:
+                raise DataError(f"{source}: column {c!r} not found",
+                                hint=f"available columns: {', '.join(dict.fromkeys(names))}")
+        return [h for h, n in zip(headers, names) if n in self.columns or n == self.time
+                or is_time_name(n)]
+
+
+def _read_csv(path: Path, key=None, delimiter=None, *, wanted=None, limit=None,
+              allow_external=False):
     import pyarrow as pa
     from pyarrow import csv as pacsv
 
+    data = path.read_bytes()
+    _refuse_utf16(path, data)
+    data = _strip_comments(path, data)
+    decimal = "."
     if delimiter is None:
-        delimiter = "\t" if path.suffix.lower() == ".tsv" else ","
+        tsv = path.suffix.lower() == ".tsv"
+        delimiter, decimal = ("\t", ".") if tsv else _sniff_separator(data)
     try:
         table = pacsv.read_csv(
-            path, parse_options=pacsv.ParseOptions(delimiter=delimiter),
-            convert_options=pacsv.ConvertOptions(strings_can_be_null=True,
+            pa.BufferReader(data), parse_options=pacsv.ParseOptions(delimiter=delimiter),
+            convert_options=pacsv.ConvertOptions(strings_can_be_null=True, decimal_point=decimal,
                                                  null_values=["", "NaN", "nan", "NA", "null"]))
     except (pa.ArrowInvalid, pa.ArrowTypeError, UnicodeDecodeError) as exc:
         _refuse_ragged_line(path, delimiter)
@@ -134,16 +237,87 @@ def _read_csv(path: Path, key=None, delimiter=None):
     return _arrow_columns(table, path.name), {}
 
 
+def _refuse_utf16(path: Path, data: bytes) -> None:
+    """A CSV file must be UTF-8 (or ASCII) text: UTF-16 and UTF-32 (a byte-order mark, or NUL
+    bytes between the characters) would otherwise be misread as one garbled column."""
+    boms = ((b"\xff\xfe\x00\x00", "UTF-32"), (b"\x00\x00\xfe\xff", "UTF-32"),
+            (b"\xff\xfe", "UTF-16"), (b"\xfe\xff", "UTF-16"))
+    found = next((name for bom, name in boms if data.startswith(bom)), None)
+    why = f"it starts with a {found} byte-order mark"
+    head = data[:65536]
+    if found is None and b"\x00" in head:
+        if head.count(b"\x00") * 3 < len(head):
+            k = head.index(b"\x00")
+            raise DataError(f"{path.name}: not a readable CSV file: byte {k} is a NUL byte, found "
+                            f"in binary files, not in text",
+                            hint="check that the path names the CSV file, or pass format= for "
+                                 "another format")
+        found, why = "UTF-16", "every other byte is NUL"
+    if found is not None:
+        raise DataError(f"{path.name}: not a readable CSV file: the file is {found} text ({why}), "
+                        f"and gripkit reads CSV files as UTF-8",
+                        hint=f"save it as UTF-8 (in Excel: 'CSV UTF-8'; or iconv -f {found} "
+                             f"-t UTF-8)")
+
+
+def _is_comment(line: bytes) -> bool:
+    return line.lstrip().startswith(b"#")
+
+
+def _strip_comments(path: Path, data: bytes) -> bytes:
+    """``data`` without its comment lines (lines whose first character other than a blank is
+    ``#``, before the header or between data rows). Refuses a file whose header is itself
+    commented out (``# t,force`` as ``numpy.savetxt`` writes it): its first row would be read as
+    column names."""
+    if b"#" not in data:
+        return data
+    lines = data.splitlines(keepends=True)
+    if not any(_is_comment(line) for line in lines):
+        return data
+    first = next((k for k, line in enumerate(lines) if line.strip() and not _is_comment(line)),
+                 None)
+    if first is not None and first > 0:
+        fields = [f.strip() for f in re.split(rb"[,;\t]", lines[first])]
+        if all(_NUMBER.match(f) for f in fields):
+            shown = lines[first].decode("utf-8", errors="replace").strip()[:60]
+            raise DataError(
+                f"{path.name}: line {first + 1}, the first that is not a comment, holds numbers "
+                f"({shown!r}), not column names: the header looks commented out",
+                hint="lines starting with '#' are comments; remove the '#' before the column names")
+    return b"".join(line for line in lines if not _is_comment(line))
+
+
+_NUMBER = re.compile(rb"^[-+]?(\d+([.,]\d*)?|[.,]\d+)([eE][-+]?\d+)?$")
+_DECIMAL_COMMA = re.compile(r"^\s*[-+]?\d*,\d+([eE][-+]?\d+)?\s*$")
+
+
+def _sniff_separator(data: bytes) -> tuple[str, str]:
+    """The separator and decimal point of a CSV file read without ``delimiter=``: ``,`` and
+    ``.``, unless the header holds ``;`` and no ``,`` (a European spreadsheet's export): then
+    ``;``, with ``,`` as decimal point when the data rows write their numbers so (``0,25``)."""
+    lines = data[:65536].decode("utf-8", errors="replace").splitlines()
+    if len(data) > 65536:
+        lines = lines[:-1]  # cut short
+    header = next((line for line in lines if line.strip()), "")
+    if ";" not in header or "," in header:
+        return ",", "."
+    rows = [line for line in lines[1:200] if line.strip()]
+    comma = any(_DECIMAL_COMMA.match(f) for line in rows for f in line.split(";"))
+    return ";", "," if comma else "."
+
+
 def _refuse_ragged_line(path: Path, delimiter: str) -> None:
     """Raise a DataError naming the first line whose number of fields differs from the header's
-    (pyarrow's own message does not say which line)."""
+    (pyarrow's own message does not say which line); comment lines are skipped."""
     text = path.read_bytes().decode("utf-8", errors="replace")
     lines = text.splitlines()
-    if not lines:
+    numbered = [(k, line) for k, line in enumerate(lines, start=1)
+                if not line.lstrip().startswith("#")]
+    if not numbered:
         return
     sep = delimiter
-    expected = lines[0].count(sep) + 1
-    for k, line in enumerate(lines[1:], start=2):
+    expected = numbered[0][1].count(sep) + 1
+    for k, line in numbered[1:]:
         if not line.strip() or '"' in line:
             continue
         got = line.count(sep) + 1
@@ -181,13 +355,54 @@ def _arrow_columns(table, source: str) -> dict[str, object]:
                         f"the header; each column needs its own name", hint="rename the repeated columns")
     out = {}
     for name, col in zip(table.column_names, table.columns):
-        if pa.types.is_integer(col.type) or pa.types.is_floating(col.type) or pa.types.is_boolean(col.type):
+        if pa.types.is_integer(col.type):
+            out[name] = _integer_column(col, name, source)
+        elif pa.types.is_floating(col.type) or pa.types.is_boolean(col.type):
             out[name] = _float64_column(col)
         elif pa.types.is_null(col.type):
             out[name] = np.full(len(col), np.nan)
+        elif pa.types.is_dictionary(col.type):
+            out[name] = _dictionary_column(col)
         else:
             out[name] = np.asarray(col.to_pylist(), dtype=object)
     return out
+
+
+def _integer_column(col, name: str, source: str) -> np.ndarray:
+    """An integer Arrow column as a numpy integer array (exact: time stamps in nanoseconds exceed
+    float64's 2**53), or as float64 with NaN for nulls when every value fits float64 exactly."""
+    import pyarrow.compute as pc
+
+    if col.null_count == 0:
+        parts = []
+        for chunk in col.chunks:
+            dtype = np.dtype(str(chunk.type))
+            parts.append(np.frombuffer(chunk.buffers()[1], dtype=dtype, count=len(chunk),
+                                       offset=chunk.offset * dtype.itemsize).copy())
+        return np.concatenate(parts) if parts else np.empty(0, dtype=np.int64)
+    lo, hi = pc.min_max(col).values()
+    big = max(abs(lo.as_py() or 0), abs(hi.as_py() or 0))
+    if big > 2**53:
+        raise DataError(f"{source}: column {name!r} holds integers up to {big} (beyond 2**53, "
+                        f"which float64 cannot hold exactly) and {col.null_count} missing values",
+                        hint="fill the missing values, or leave the column out")
+    return _float64_column(col)
+
+
+def _dictionary_column(col) -> np.ndarray:
+    """A dictionary-encoded Arrow column as an object array whose repeated values are one Python
+    object each (``to_pylist`` would make one per row)."""
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
+    parts = []
+    for chunk in col.chunks:
+        words = chunk.dictionary.to_pylist()
+        values = np.empty(len(words) + 1, dtype=object)  # the last one for nulls
+        values[:-1] = words
+        idx = pc.fill_null(chunk.indices, len(words))
+        parts.append(values[_integer_column(pa.chunked_array([idx]), "", "")])
+    return np.concatenate(parts) if parts else np.empty(0, dtype=object)
 
 
 def _float64_column(col) -> np.ndarray:
@@ -208,15 +423,41 @@ def _float64_column(col) -> np.ndarray:
     return np.concatenate(parts) if parts else np.empty(0)
 
 
-def _read_parquet(path: Path, key=None, delimiter=None):
+def _read_parquet(path: Path, key=None, delimiter=None, *, wanted=None, limit=None,
+                  allow_external=False):
+    """Read the columns ``wanted`` of a Parquet file, from an open file object (a path string
+    would be read by pyarrow as a URI or a dataset folder)."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    try:
-        table = pq.read_table(path)
-    except (pa.ArrowInvalid, OSError) as exc:
-        raise DataError(f"{path.name}: not a readable Parquet file (truncated or corrupt?): "
-                        f"{str(exc).splitlines()[0]}") from None
+    wanted = wanted or _Wanted(None, None)
+    with open(path, "rb") as fh:
+        try:
+            pf = pq.ParquetFile(fh)
+            meta = pf.metadata
+            elsewhere = {meta.row_group(i).column(j).file_path for i in range(meta.num_row_groups)
+                         for j in range(meta.num_columns)} - {"", None}
+            if elsewhere:
+                raise DataError(f"{path.name}: the Parquet file's data live in other files "
+                                f"({sorted(elsewhere)[0]!r}; a dataset's _metadata summary)",
+                                hint="give one of the data files of the dataset, not its _metadata")
+            schema = pf.schema_arrow
+            names = wanted.select(path.name, schema.names)
+            limit = limit or float("inf")
+            check_size(path.name, "the file", meta.num_rows, len(names), limit)
+            _check_parquet_stored(path.name, meta, names, limit)
+            # text as dictionaries: one string repeated a million times stays one string
+            text = [f.name for f in schema if f.name in names
+                    and (pa.types.is_string(f.type) or pa.types.is_large_string(f.type)
+                         or pa.types.is_binary(f.type) or pa.types.is_large_binary(f.type))]
+            if text:
+                pf = pq.ParquetFile(fh, read_dictionary=text)
+            table = pf.read(columns=names)
+        except DataError:
+            raise
+        except (pa.ArrowException, OSError) as exc:
+            raise DataError(f"{path.name}: not a readable Parquet file (truncated or corrupt?): "
+                            f"{str(exc).splitlines()[0]}") from None
     units = {}
     for f in table.schema:
         md = f.metadata or {}
@@ -225,51 +466,147 @@ def _read_parquet(path: Path, key=None, delimiter=None):
     return _arrow_columns(table, path.name), units
 
 
-def _read_hdf5(path: Path, key=None, delimiter=None):
+def _check_parquet_stored(source: str, meta, names, limit: float) -> None:
+    """Refuse columns whose pages declare more bytes uncompressed than the load limit (a few kB
+    of compressed pages may declare gigabytes)."""
+    chosen = set(names)
+    stored = sum(meta.row_group(i).column(j).total_uncompressed_size
+                 for i in range(meta.num_row_groups) for j in range(meta.num_columns)
+                 if meta.row_group(i).column(j).path_in_schema.split(".")[0] in chosen)
+    if stored > limit:
+        raise DataError(f"{source}: the file's columns declare {stored / 1e9:.3g} GB uncompressed, "
+                        f"beyond the load limit of {limit / 1e9:.3g} GB; nothing was read",
+                        hint="read fewer columns (columns=), or raise the limit with max_bytes= or "
+                             "the environment variable GRIPKIT_MAX_LOAD_BYTES (bytes)")
+
+
+def _hdf5_text(x) -> str:
+    return x.decode() if isinstance(x, bytes) else str(x)
+
+
+_EXTERNAL_HINT = ("pass allow_external_links=True (CLI: gripkit --allow-external-links) if you "
+                  "trust this file, or copy the data into it")
+
+
+def _hdf5_get(group, name: str, source: str, allow_external: bool, depth: int = 0):
+    """The object at the path ``name`` below ``group`` (None if absent), following each link
+    along the path only while it stays in the file: an external link (to another file) is refused
+    unless ``allow_external``; a soft link is followed by its own path (at most 16 deep)."""
     import h5py
 
+    if depth > 16:
+        raise DataError(f"{source}: soft links nest more than 16 deep at {name!r} (a cycle?)")
+    node = group.file["/"] if name.startswith("/") else group
+    for part in [p for p in name.split("/") if p]:
+        if not isinstance(node, h5py.Group):
+            return None
+        link = node.get(part, getlink=True)
+        if link is None:
+            return None
+        if isinstance(link, h5py.ExternalLink):
+            if not allow_external:
+                raise DataError(
+                    f"{source}: {node.name.rstrip('/') + '/' + part!r} is an external link to "
+                    f"{_hdf5_text(link.filename)!r}:{_hdf5_text(link.path)!r}, another file; "
+                    f"not followed", hint=_EXTERNAL_HINT)
+            node = node[part]
+        elif isinstance(link, h5py.SoftLink):
+            node = _hdf5_get(node, link.path, source, allow_external, depth + 1)
+            if node is None:
+                return None
+        else:
+            node = node[part]
+    return node
+
+
+def _hdf5_check_dataset(ds, source: str, allow_external: bool) -> None:
+    """Refuse a dataset whose values come from other files: external raw storage (any file the
+    HDF5 file names) or a virtual dataset (a map onto datasets of other files)."""
+    if allow_external:
+        return
+    if ds.is_virtual:
+        raise DataError(f"{source}: dataset {ds.name!r} is a virtual dataset (its values are read "
+                        f"from other datasets or files); not read", hint=_EXTERNAL_HINT)
+    if ds.external:
+        raise DataError(f"{source}: dataset {ds.name!r} keeps its values in an external file "
+                        f"({_hdf5_text(ds.external[0][0])!r}), not in this file; not read",
+                        hint=_EXTERNAL_HINT)
+
+
+def _read_hdf5(path: Path, key=None, delimiter=None, *, wanted=None, limit=None,
+               allow_external=False):
+    import h5py
+
+    wanted = wanted or _Wanted(None, None)
+    limit = float("inf") if limit is None else limit
     try:
         fh = h5py.File(path, "r")
     except OSError as exc:
         raise DataError(f"{path.name}: not a readable HDF5 file (truncated or corrupt?): {exc}") from None
     with fh:
-        node = fh if key is None else fh.get(key)
+        node = fh if key is None else _hdf5_get(fh, key, path.name, allow_external)
         if node is None:
             raise DataError(f"{path.name}: no group or dataset {key!r}",
                             hint=f"top-level entries: {', '.join(fh.keys())}")
-        raw, units = {}, {}
         try:
             if isinstance(node, h5py.Dataset):
-                arr = node[()]
-                cols = node.attrs.get("columns")
-                if arr.ndim != 2 or cols is None:
-                    raise DataError(f"{path.name}: dataset {node.name!r} must be 2-D with a 'columns' attribute")
-                cols = [c.decode() if isinstance(c, bytes) else str(c) for c in cols]
-                if len(cols) != arr.shape[1]:
-                    raise DataError(f"{path.name}: 'columns' names {len(cols)} columns, data has {arr.shape[1]}")
-                ulist = node.attrs.get("units")
-                for j, c in enumerate(cols):
-                    raw[c] = arr[:, j]
-                    if ulist is not None:
-                        u = ulist[j]
-                        units[c] = u.decode() if isinstance(u, bytes) else str(u)
+                raw, units = _hdf5_table(node, path.name, wanted, limit, allow_external)
             else:
-                order = [c.decode() if isinstance(c, bytes) else str(c) for c in node.attrs.get("columns", [])]
-                items = sorted(node.items(), key=lambda kv: order.index(kv[0]) if kv[0] in order else len(order))
-                for name, ds in items:
-                    if isinstance(ds, h5py.Dataset) and ds.ndim == 1:
-                        raw[name] = ds[()]
-                        if "unit" in ds.attrs:
-                            u = ds.attrs["unit"]
-                            units[name] = u.decode() if isinstance(u, bytes) else str(u)
-                if not raw:
-                    raise DataError(f"{path.name}: group {node.name!r} holds no 1-D datasets",
-                                    hint="pass key= to point at the group holding the channels")
+                raw, units = _hdf5_group(node, path.name, wanted, limit, allow_external)
         except OSError as exc:
             raise DataError(f"{path.name}: HDF5 data cannot be read (truncated or corrupt?): {exc}") from None
     lengths = {k: len(v) for k, v in raw.items()}
     if len(set(lengths.values())) > 1:
         raise DataError(f"{path.name}: datasets have different lengths {lengths}")
+    return raw, units
+
+
+def _hdf5_table(node, source: str, wanted, limit: float, allow_external: bool):
+    """The wanted columns of one 2-D dataset with a ``columns`` attribute."""
+    cols = node.attrs.get("columns")
+    if node.ndim != 2 or cols is None:
+        raise DataError(f"{source}: dataset {node.name!r} must be 2-D with a 'columns' attribute")
+    cols = [_hdf5_text(c) for c in cols]
+    if len(cols) != node.shape[1]:
+        raise DataError(f"{source}: 'columns' names {len(cols)} columns, data has {node.shape[1]}")
+    _hdf5_check_dataset(node, source, allow_external)
+    chosen = set(wanted.select(source, cols))
+    keep = [j for j, c in enumerate(cols) if c in chosen]
+    check_size(source, f"dataset {node.name!r}", node.shape[0], len(keep), limit,
+               node.dtype.itemsize)
+    arr = node[()] if len(keep) == len(cols) else None
+    ulist = node.attrs.get("units")
+    raw, units = {}, {}
+    for j in keep:
+        raw[cols[j]] = arr[:, j] if arr is not None else node[:, j]
+        if ulist is not None:
+            units[cols[j]] = _hdf5_text(ulist[j])
+    return raw, units
+
+
+def _hdf5_group(node, source: str, wanted, limit: float, allow_external: bool):
+    """The wanted 1-D datasets of a group, in the order of its ``columns`` attribute."""
+    import h5py
+
+    order = [_hdf5_text(c) for c in node.attrs.get("columns", [])]
+    names = sorted(node.keys(), key=lambda k: order.index(k) if k in order else len(order))
+    datasets = {}
+    for name in wanted.select(source, names):
+        ds = _hdf5_get(node, name, source, allow_external)
+        if isinstance(ds, h5py.Dataset) and ds.ndim == 1:
+            _hdf5_check_dataset(ds, source, allow_external)
+            datasets[name] = ds
+    if not datasets:
+        raise DataError(f"{source}: group {node.name!r} holds no 1-D datasets",
+                        hint="pass key= to point at the group holding the channels")
+    rows = max(ds.shape[0] for ds in datasets.values())
+    itemsize = max(ds.dtype.itemsize for ds in datasets.values())
+    check_size(source, f"group {node.name!r}", rows, len(datasets), limit, itemsize)
+    raw, units = {}, {}
+    for name, ds in datasets.items():
+        raw[name] = ds[()]
+        if "unit" in ds.attrs:
+            units[name] = _hdf5_text(ds.attrs["unit"])
     return raw, units
 
 

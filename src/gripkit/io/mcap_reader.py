@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataError
+from .table import check_size
 
 __all__ = ["read_mcap", "parse_column"]
 
@@ -55,7 +56,27 @@ def _get(msg, path: list, spec: str) -> float:
                         hint="index into arrays (position[2]) or descend into messages (wrench.force.z)") from None
 
 
-def read_mcap(path: Path, columns, stamp: str = "log") -> tuple[dict, dict]:
+def _check_declared_sizes(path: Path, reader, topics: set, ncols: int, limit: float) -> None:
+    """Refuse, from the file's summary (when it has one), a chunk that declares more than the
+    load limit uncompressed, or more messages on the topics read than the limit allows."""
+    summary = reader.get_summary()
+    if summary is None:
+        return
+    chunk = max((ci.uncompressed_size for ci in summary.chunk_indexes), default=0)
+    if chunk > limit:
+        raise DataError(f"{path.name}: a chunk of the MCAP file declares {chunk / 1e9:.3g} GB "
+                        f"uncompressed, beyond the load limit of {limit / 1e9:.3g} GB; nothing was "
+                        f"read",
+                        hint="raise the limit with max_bytes= or the environment variable "
+                             "GRIPKIT_MAX_LOAD_BYTES (bytes) if the machine has the memory")
+    if summary.statistics is not None:
+        counts = summary.statistics.channel_message_counts
+        rows = sum(counts.get(cid, 0) for cid, ch in summary.channels.items() if ch.topic in topics)
+        check_size(path.name, "the MCAP file", rows, ncols + 1, limit)
+
+
+def read_mcap(path: Path, columns, stamp: str = "log",
+              limit: float = float("inf")) -> tuple[dict, dict]:
     try:
         from mcap.reader import make_reader
         from mcap_ros2.decoder import DecoderFactory
@@ -75,14 +96,15 @@ def read_mcap(path: Path, columns, stamp: str = "log") -> tuple[dict, dict]:
     try:
         with open(path, "rb") as fh:
             reader = make_reader(fh, decoder_factories=[DecoderFactory()])
+            _check_declared_sizes(path, reader, topics, len(specs), limit)
             for _schema, channel, message, msg in reader.iter_decoded_messages(topics=list(topics)):
                 topic = channel.topic
                 seen.add(topic)
-                if stamp == "header":
+                if stamp == "header":  # integer nanoseconds: a float loses 238 ns at 1.7e9 s
                     st = msg.header.stamp
-                    t = st.sec + 1e-9 * st.nanosec
+                    t = int(st.sec) * 1_000_000_000 + int(st.nanosec)
                 else:
-                    t = 1e-9 * message.log_time
+                    t = int(message.log_time)
                 for (alias, top, fpath), spec in zip(specs, columns):
                     if top == topic:
                         series[alias][0].append(t)
@@ -94,6 +116,10 @@ def read_mcap(path: Path, columns, stamp: str = "log") -> tuple[dict, dict]:
     missing = sorted(topics - seen)
     if missing:
         raise DataError(f"{path.name}: no messages on topics {missing}")
+    # seconds after the earliest stamp, subtracted in integer nanoseconds so that none is lost
+    first = min(min(series[a][0]) for a in series)
+    series = {a: ((np.asarray(ts, dtype=np.int64) - first) * 1e-9, vs)
+              for a, (ts, vs) in series.items()}
     base_alias = specs[0][0]
     tb = np.asarray(series[base_alias][0])
     ob = np.argsort(tb, kind="stable")

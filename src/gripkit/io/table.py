@@ -5,11 +5,18 @@ Rules shared by every reader:
 * a column header may carry its unit, ``"force [mN]"`` or ``"force (mN)"``; values are converted
   to SI and the channel is named ``force``. Units may also come from file metadata or ``units=``;
 * the time base is the column named by ``time=``, else a column named ``t``, ``time``,
-  ``timestamp`` or ``time_s`` (its unit converted to seconds), else a uniform one built from
-  ``fs=``. Given both a time column and ``fs``, they must agree (within half a sample at every
-  sample), or a :class:`DataError` says by how much they differ;
+  ``timestamp``, ``time_s``, ``stamp``, ``time_ns`` and the like (:func:`is_time_name`; its
+  unit converted to seconds), else a uniform one built from ``fs=``. Given both a time column
+  and ``fs``, they must agree (within half a sample at every sample), or a
+  :class:`DataError` says by how much they differ;
 * a sample far outside the rest of its channel (a corrupt value) gives a
   :class:`~gripkit.errors.DataWarning` naming its time (:mod:`gripkit.signals.outliers`);
+* integer time stamps (ROS nanoseconds, 1.7e18) are read exactly: beyond 2**53 (where float64
+  loses integers) the first stamp is subtracted in integer arithmetic and the time starts at 0
+  (``meta['time_origin']`` keeps the first stamp). Without a unit, a time column named ``*_ns``
+  or of integers from 1e17 up is in nanoseconds; other stamps from 1e12 up (milliseconds or
+  microseconds since 1970?) are refused until their unit is given. Any other integer column beyond
+  2**53 is refused;
 * ``columns=`` selects channels by name; ``fill='drop'|'interpolate'`` handles missing values.
 """
 
@@ -27,10 +34,21 @@ from ..signals.outliers import corrupt_samples
 from ..signals.trajectory import Trajectory
 from ..units import si_factor
 
-__all__ = ["columns_to_trajectory", "split_header", "check_fill", "check_fs", "FILL_CHOICES"]
+__all__ = ["columns_to_trajectory", "split_header", "check_fill", "check_fs", "check_size",
+           "is_time_name", "FILL_CHOICES"]
 
-_TIME_NAMES = ("t", "time", "timestamp", "time_s", "times")
+_TIME_NAMES = ("t", "time", "timestamp", "time_s", "times", "stamp", "t_ns", "time_ns",
+               "timestamp_ns", "stamp_ns", "header_stamp", "header_stamp_ns")
+#: integer time stamps from here up can only be nanoseconds (1e17 µs since 1970: 3000 years)
+NS_STAMPS_FROM = 10**17
+#: time values from here up are no record's seconds (31 700 years): a stamp in another unit
+STAMPS_FROM = 10**12
 _HEADER = re.compile(r"^\s*(.*?)\s*[\[(]\s*([^\])]+?)\s*[\])]\s*$")
+
+
+def is_time_name(name: str) -> bool:
+    """Whether a column of this name is taken as the time column when ``time=`` is not given."""
+    return name.lower() in _TIME_NAMES
 
 
 def split_header(header: str) -> tuple[str, str | None]:
@@ -57,6 +75,14 @@ def _numeric(name: str, values, row_offset: int = 0) -> np.ndarray:
     a = np.asarray(values)
     if a.dtype == bool:
         return a.astype(np.float64)
+    if np.issubdtype(a.dtype, np.integer) and a.size:
+        big = max(abs(int(a.min())), abs(int(a.max())))
+        if big > 2**53:
+            raise DataError(
+                f"column {name!r} holds integers up to {big}, beyond 2**53 (float64 cannot hold "
+                f"them exactly); gripkit reads such integers only as time stamps",
+                hint=f"if it is the time column, name it with time={name!r} (CLI: --time {name}); "
+                     f"else leave it out with columns=")
     if np.issubdtype(a.dtype, np.number):
         return a.astype(np.float64)
     out = np.empty(a.shape[0], dtype=np.float64)
@@ -68,7 +94,8 @@ def _numeric(name: str, values, row_offset: int = 0) -> np.ndarray:
             out[i] = float(v)
         except (TypeError, ValueError):
             raise DataError(
-                f"column {name!r} mixes numbers and text: row {i + row_offset} holds {str(v)!r}",
+                f"column {name!r} mixes numbers and text: row {i + row_offset} holds "
+                f"{str(v)[:40]!r}",
                 hint="fix or remove that cell, or leave it empty to be treated as missing",
             ) from None
     return out
@@ -82,6 +109,24 @@ def check_fill(fill) -> None:
     if fill is not None and fill not in FILL_CHOICES:
         raise DataError(f"fill: expected None, 'drop' or 'interpolate', found {fill!r}",
                         hint="CLI: --fill drop or --fill interpolate, or leave it out to refuse missing values")
+
+
+def check_size(source: str, what: str, rows: int, ncols: int, limit: float,
+               itemsize: int = 8) -> None:
+    """Refuse to read ``rows`` × ``ncols`` values (as float64, or ``itemsize`` bytes each when
+    larger) beyond the load limit, before anything is allocated: a small file may declare a huge
+    dataset."""
+    size = max(8, int(itemsize))
+    need = float(rows) * float(ncols) * size
+    if need <= limit:
+        return
+    each = "as float64" if size == 8 else f"at {size} bytes a value"
+    raise DataError(
+        f"{source}: {what} declares {rows} rows × {ncols} columns, about {need / 1e9:.3g} GB "
+        f"{each}, beyond the load limit of {limit / 1e9:.3g} GB; nothing was read",
+        hint=f"read fewer columns (columns=, CLI: the command's column options), or raise the "
+             f"limit with max_bytes= or the environment variable GRIPKIT_MAX_LOAD_BYTES (bytes) "
+             f"if the machine has the memory")
 
 
 def check_fs(fs) -> None:
@@ -119,6 +164,46 @@ def _check_fs_against_time(source: str, tname: str, t: np.ndarray, fs: float) ->
         f"apart (tolerance: half a sample)",
         hint="leave out fs (CLI: --fs) to use the file's time stamps; if the stamps are wrong, fix or "
              "rename the time column")
+
+
+def _time_seconds(source: str, tname: str, values,
+                  unit: str | None) -> tuple[np.ndarray, str | None]:
+    """The time column in seconds, and the subtracted first stamp (``'1700000000000000000 ns'``)
+    when integers beyond 2**53 were read relative to it; refuses stamps whose unit is unclear."""
+    a = np.asarray(values)
+    integer = np.issubdtype(a.dtype, np.integer) and a.size > 0
+    if unit is None and tname.lower().endswith("_ns"):
+        unit = "ns"
+    big = 0.0
+    if integer:
+        big = max(abs(int(a.min())), abs(int(a.max())))
+    elif np.issubdtype(a.dtype, np.floating) and a.size and np.isfinite(a).any():
+        big = float(np.nanmax(np.abs(a[np.isfinite(a)])))
+    if unit is None and integer and big >= NS_STAMPS_FROM:
+        unit = "ns"
+    elif unit is None and big >= STAMPS_FROM:
+        raise DataError(
+            f"{source}: time column {tname!r} holds values up to {big:.4g}, too large for "
+            f"seconds: they look like time stamps in another unit "
+            f"({'integers' if integer else 'floating point'}; milliseconds, microseconds or "
+            f"nanoseconds since 1970?)",
+            hint=f"give the unit: in the header ('{tname} [ms]', '{tname} [us]', '{tname} [ns]'), "
+                 f"with units={{'{tname}': 'ns'}}, or name the column {tname}_ns for nanoseconds")
+    try:
+        scale, offset, si = si_factor(unit or "s")
+    except Exception:
+        raise DataError(f"column {tname!r}: unit {unit!r} is not a unit gripkit can read",
+                        hint="write time units like [s], [ms], [us], [ns]") from None
+    if si != "s":
+        raise DataError(f"{source}: time column {tname!r} has unit {unit!r}, which is not a time")
+    if not integer or big <= 2**53:
+        return _numeric(tname, a) * scale + offset, None
+    first = int(a[0])
+    if int(a.max()) - first >= 2**63 or int(a.min()) - first < -(2**63):
+        raise DataError(f"{source}: time column {tname!r} spans more than 2**63 {unit}")
+    wide = a.astype(np.uint64)
+    relative = (wide - wide[0]).view(np.int64)  # exact: the differences fit int64 (checked above)
+    return relative.astype(np.float64) * scale, f"{first} {unit}"
 
 
 def _warn_corrupt(source: str, t: np.ndarray, data: dict[str, np.ndarray], units: dict[str, str]) -> None:
@@ -186,15 +271,16 @@ def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
     check_fs(fs)
     tname = time
     if tname is None:
-        tname = next((c for c in cols if c.lower() in _TIME_NAMES), None)
+        tname = next((c for c in cols if is_time_name(c)), None)
         if tname is None and fs is None:
-            raise DataError(f"{source}: no time column found (looked for {', '.join(_TIME_NAMES)})",
+            looked = ", ".join(_TIME_NAMES[:9])
+            raise DataError(f"{source}: no time column found (looked for {looked}, ...)",
                             hint="name it with time=COL (CLI: --time COL) or give the sampling rate fs (CLI: --fs HZ)")
     if tname is not None and tname not in cols:
         raise DataError(f"{source}: time column {tname!r} not found", hint=f"available columns: {available}")
 
     names = (list(columns) if columns is not None
-             else [c for c in cols if c != tname and c.lower() not in _TIME_NAMES])
+             else [c for c in cols if c != tname and not is_time_name(c)])
     for c in names:
         if c not in cols:
             raise DataError(f"{source}: column {c!r} not found", hint=f"available columns: {available}")
@@ -214,10 +300,10 @@ def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
                         hint="check that the file is complete")
     if tname is not None:
         tvals, tunit = cols[tname]
-        t, tsi = _to_si(tname, _numeric(tname, tvals), tunit or "s")
-        if tsi != "s":
-            raise DataError(f"{source}: time column {tname!r} has unit {tunit!r}, which is not a time")
+        t, origin = _time_seconds(source, tname, tvals, tunit)
         meta = {"source": source, "time_column": tname}
+        if origin is not None:
+            meta["time_origin"] = origin
         if fs is not None:
             _check_fs_against_time(source, tname, t, float(fs))
             meta["dt"] = 1.0 / float(fs)  # the nominal interval: gripkit speaks dt inside

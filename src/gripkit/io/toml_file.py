@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 import tomllib
 from pathlib import Path
 
@@ -34,3 +35,11 @@ def read_toml(path, what: str) -> dict:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError(f"{path.name}: not valid TOML: {exc}") from None
+    except RecursionError:
+        raise ConfigError(f"{what} {str(path)!r} cannot be read: its TOML nests arrays or tables "
+                          f"deeper than Python's recursion limit ({sys.getrecursionlimit()})",
+                          hint="a gripkit TOML file nests a few levels: check the file") from None
+    except ValueError as exc:  # an integer beyond Python's limit on digits read from text
+        raise ConfigError(f"{what} {str(path)!r} cannot be read: {str(exc).split(';')[0]} (a "
+                          f"number in the file has more digits than any value gripkit takes)",
+                          hint="check the file") from None

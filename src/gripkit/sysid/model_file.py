@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import sys
 import warnings
 from pathlib import Path
 
@@ -74,6 +75,25 @@ def write_document(doc: dict, path) -> None:
     write_text(path, json.dumps(doc, indent=1, allow_nan=False) + "\n", what="model file")
 
 
+#: the deepest nesting of lists and objects a model file may hold (gripkit writes at most 4 levels)
+MAX_NESTING = 32
+
+
+def _nesting(doc) -> int:
+    """How deep ``doc`` nests lists and dicts, found without recursion (a hostile file nests
+    deeper than Python's recursion limit allows to hash or walk it)."""
+    deepest, stack = 0, [(doc, 0)]
+    while stack:
+        node, depth = stack.pop()
+        if isinstance(node, (list, dict)):
+            deepest = max(deepest, depth + 1)
+            if deepest > MAX_NESTING:
+                return deepest
+            children = node.values() if isinstance(node, dict) else node
+            stack.extend((v, depth + 1) for v in children)
+    return deepest
+
+
 def read_document(path, schema: str = SCHEMA, newest: int = SCHEMA_VERSION, *, what: str = "model file",
                   hint: str = "give a file written by gripkit identify --out or model.save()") -> dict:
     """The JSON document of the model file ``path``, checked: ``schema`` and a ``schema_version``
@@ -88,7 +108,18 @@ def read_document(path, schema: str = SCHEMA, newest: int = SCHEMA_VERSION, *, w
         raise DataError(f"{what} {str(path)!r} is a folder, expected a JSON file") from None
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
         raise ModelError(f"{what} {str(path)!r} is not valid JSON ({exc})", hint=hint) from None
+    except RecursionError:
+        raise ModelError(f"{what} {str(path)!r} cannot be read: its JSON nests lists or objects "
+                         f"deeper than Python's recursion limit ({sys.getrecursionlimit()}); a "
+                         f"model file nests a few levels", hint=hint) from None
+    except ValueError as exc:  # an integer beyond Python's limit on digits read from text
+        raise ModelError(f"{what} {str(path)!r} cannot be read: {str(exc).split(';')[0]} (a number "
+                         f"in the file has more digits than any model parameter)",
+                         hint=hint) from None
     where = repr(str(path))
+    if _nesting(doc) > MAX_NESTING:
+        raise ModelError(f"{what} {where}: its JSON nests lists or objects more than "
+                         f"{MAX_NESTING} deep; a model file nests a few levels", hint=hint)
     if not isinstance(doc, dict) or doc.get("schema") != schema:
         found = doc.get("schema") if isinstance(doc, dict) else type(doc).__name__
         raise ModelError(f"{what} {where}: expected schema {schema!r}, found {found!r}", hint=hint)
