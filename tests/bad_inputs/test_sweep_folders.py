@@ -180,3 +180,13 @@ def test_chunk_with_other_metrics_than_the_rest_is_recomputed(tmp_path):
         res = _run(out, grid, resume=True)
     _each_job_once(res, grid)
     assert "w" not in res.columns and res.computed_chunks == 1
+
+
+def test_deeply_nested_manifest_is_a_clear_error(tmp_path):
+    """A manifest.json nested beyond Python's recursion limit is a ConfigError naming the folder,
+    not an unexpected RecursionError."""
+    out = tmp_path / "out"
+    _run(out)
+    (out / "manifest.json").write_text("[" * 100_000 + "]" * 100_000)
+    with pytest.raises(ConfigError, match="manifest.json is unreadable"):
+        _run(out, resume=True)

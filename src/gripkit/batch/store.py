@@ -113,7 +113,7 @@ def _bad_schema(table, metrics) -> str:
     meta = table.schema.metadata or {}
     try:
         written = [tuple(x) for x in json.loads(meta.get(_META_COLUMNS, b"null"))]
-    except (ValueError, TypeError):
+    except (ValueError, TypeError, RecursionError):
         written = None
     now = [tuple(x) for x in _schema(table)]
     if written is not None and written != now:
@@ -158,7 +158,7 @@ class ResultStore:
             m = json.loads(path.read_text())
             m["spec"]["sweep"]
             return m
-        except (OSError, ValueError, KeyError, TypeError) as exc:
+        except (OSError, ValueError, KeyError, TypeError, RecursionError) as exc:
             raise ConfigError(f"output folder {str(self.root)!r}: manifest.json is unreadable ({type(exc).__name__})",
                               hint="choose another --out folder, or delete this one and run the sweep again") from None
 
