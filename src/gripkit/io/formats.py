@@ -6,6 +6,8 @@
   with a ``columns`` attribute (and optionally ``units``); ``key=`` names the group/dataset.
 * MCAP (ROS 2 logs, optional extra): columns ``[alias=]/topic:field.path[i]``, see
   :mod:`gripkit.io.mcap_reader`.
+* MATLAB ``.mat`` (versions 4 to 7.3): numeric vectors are columns by variable name, the columns
+  of an N×k matrix are ``name_1`` … ``name_k``; see :mod:`gripkit.io.mat_reader`.
 
 A file names only its own data. HDF5 external links, external raw storage and virtual datasets
 (which read other files on the machine) are refused unless ``allow_external_links=True`` (CLI:
@@ -32,6 +34,8 @@ from ..arguments import check_path, entry_point
 from ..atomic import atomic_write
 from ..errors import ArgumentError, DataError, DataWarning
 from ..signals.trajectory import Trajectory
+from .hdf5_links import check_dataset, hdf5_get, hdf5_text
+from .mat_reader import read_mat
 from .table import (check_fill, check_fs, check_size, columns_to_trajectory, is_time_name,
                     split_header)
 
@@ -45,19 +49,19 @@ _ENV_LIMIT = "GRIPKIT_MAX_LOAD_BYTES"
 _ENV_EXTERNAL = "GRIPKIT_ALLOW_EXTERNAL_LINKS"
 
 FORMATS = {".csv": "csv", ".txt": "csv", ".tsv": "csv", ".parquet": "parquet", ".pq": "parquet",
-           ".h5": "hdf5", ".hdf5": "hdf5", ".hdf": "hdf5", ".mcap": "mcap"}
+           ".h5": "hdf5", ".hdf5": "hdf5", ".hdf": "hdf5", ".mcap": "mcap", ".mat": "mat"}
 
 
 def _format(path: Path, fmt: str | None) -> str:
     if fmt is not None:
         if fmt not in set(FORMATS.values()):
-            raise DataError(f"format: expected one of csv, parquet, hdf5, mcap, found {fmt!r}")
+            raise DataError(f"format: expected one of csv, parquet, hdf5, mcap, mat, found {fmt!r}")
         return fmt
     try:
         return FORMATS[path.suffix.lower()]
     except KeyError:
         raise DataError(f"cannot tell the format of {str(path)!r} from its suffix {path.suffix!r}",
-                        hint="use .csv, .parquet or .h5, or pass format=") from None
+                        hint="use .csv, .parquet, .h5, .mcap or .mat, or pass format=") from None
 
 
 @entry_point
@@ -71,7 +75,7 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
     Parameters
     ----------
     path
-        A ``.csv``, ``.parquet`` or ``.h5`` file.
+        A ``.csv``, ``.parquet``, ``.h5``, ``.mcap`` or ``.mat`` file.
     columns
         Channels to keep (default: all but the time column).
     time
@@ -84,7 +88,7 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
     fill
         Missing values: ``None`` (error), ``'drop'`` rows, or ``'interpolate'`` linearly in time.
     format
-        Force a format ('csv', 'parquet', 'hdf5') instead of the suffix.
+        Force a format ('csv', 'parquet', 'hdf5', 'mcap', 'mat') instead of the suffix.
     key
         HDF5 group or dataset path.
     stamp
@@ -148,7 +152,7 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
         raw, meta_units = read_mcap(path, columns, stamp, limit)
         return columns_to_trajectory(raw, source=path.name, time="t", fs=fs, units=units,
                                      meta_units=meta_units, fill=fill)
-    reader = {"csv": _read_csv, "parquet": _read_parquet, "hdf5": _read_hdf5}[fmt]
+    reader = {"csv": _read_csv, "parquet": _read_parquet, "hdf5": _read_hdf5, "mat": read_mat}[fmt]
     wanted = _Wanted(columns, time)
     raw, meta_units = reader(path, key=key, delimiter=delimiter, wanted=wanted, limit=limit,
                              allow_external=allow_external_links)
@@ -480,59 +484,6 @@ def _check_parquet_stored(source: str, meta, names, limit: float) -> None:
                              "the environment variable GRIPKIT_MAX_LOAD_BYTES (bytes)")
 
 
-def _hdf5_text(x) -> str:
-    return x.decode() if isinstance(x, bytes) else str(x)
-
-
-_EXTERNAL_HINT = ("pass allow_external_links=True (CLI: gripkit --allow-external-links) if you "
-                  "trust this file, or copy the data into it")
-
-
-def _hdf5_get(group, name: str, source: str, allow_external: bool, depth: int = 0):
-    """The object at the path ``name`` below ``group`` (None if absent), following each link
-    along the path only while it stays in the file: an external link (to another file) is refused
-    unless ``allow_external``; a soft link is followed by its own path (at most 16 deep)."""
-    import h5py
-
-    if depth > 16:
-        raise DataError(f"{source}: soft links nest more than 16 deep at {name!r} (a cycle?)")
-    node = group.file["/"] if name.startswith("/") else group
-    for part in [p for p in name.split("/") if p]:
-        if not isinstance(node, h5py.Group):
-            return None
-        link = node.get(part, getlink=True)
-        if link is None:
-            return None
-        if isinstance(link, h5py.ExternalLink):
-            if not allow_external:
-                raise DataError(
-                    f"{source}: {node.name.rstrip('/') + '/' + part!r} is an external link to "
-                    f"{_hdf5_text(link.filename)!r}:{_hdf5_text(link.path)!r}, another file; "
-                    f"not followed", hint=_EXTERNAL_HINT)
-            node = node[part]
-        elif isinstance(link, h5py.SoftLink):
-            node = _hdf5_get(node, link.path, source, allow_external, depth + 1)
-            if node is None:
-                return None
-        else:
-            node = node[part]
-    return node
-
-
-def _hdf5_check_dataset(ds, source: str, allow_external: bool) -> None:
-    """Refuse a dataset whose values come from other files: external raw storage (any file the
-    HDF5 file names) or a virtual dataset (a map onto datasets of other files)."""
-    if allow_external:
-        return
-    if ds.is_virtual:
-        raise DataError(f"{source}: dataset {ds.name!r} is a virtual dataset (its values are read "
-                        f"from other datasets or files); not read", hint=_EXTERNAL_HINT)
-    if ds.external:
-        raise DataError(f"{source}: dataset {ds.name!r} keeps its values in an external file "
-                        f"({_hdf5_text(ds.external[0][0])!r}), not in this file; not read",
-                        hint=_EXTERNAL_HINT)
-
-
 def _read_hdf5(path: Path, key=None, delimiter=None, *, wanted=None, limit=None,
                allow_external=False):
     import h5py
@@ -544,7 +495,7 @@ def _read_hdf5(path: Path, key=None, delimiter=None, *, wanted=None, limit=None,
     except OSError as exc:
         raise DataError(f"{path.name}: not a readable HDF5 file (truncated or corrupt?): {exc}") from None
     with fh:
-        node = fh if key is None else _hdf5_get(fh, key, path.name, allow_external)
+        node = fh if key is None else hdf5_get(fh, key, path.name, allow_external)
         if node is None:
             raise DataError(f"{path.name}: no group or dataset {key!r}",
                             hint=f"top-level entries: {', '.join(fh.keys())}")
@@ -566,10 +517,10 @@ def _hdf5_table(node, source: str, wanted, limit: float, allow_external: bool):
     cols = node.attrs.get("columns")
     if node.ndim != 2 or cols is None:
         raise DataError(f"{source}: dataset {node.name!r} must be 2-D with a 'columns' attribute")
-    cols = [_hdf5_text(c) for c in cols]
+    cols = [hdf5_text(c) for c in cols]
     if len(cols) != node.shape[1]:
         raise DataError(f"{source}: 'columns' names {len(cols)} columns, data has {node.shape[1]}")
-    _hdf5_check_dataset(node, source, allow_external)
+    check_dataset(node, source, allow_external)
     chosen = set(wanted.select(source, cols))
     keep = [j for j, c in enumerate(cols) if c in chosen]
     check_size(source, f"dataset {node.name!r}", node.shape[0], len(keep), limit,
@@ -580,7 +531,7 @@ def _hdf5_table(node, source: str, wanted, limit: float, allow_external: bool):
     for j in keep:
         raw[cols[j]] = arr[:, j] if arr is not None else node[:, j]
         if ulist is not None:
-            units[cols[j]] = _hdf5_text(ulist[j])
+            units[cols[j]] = hdf5_text(ulist[j])
     return raw, units
 
 
@@ -588,13 +539,13 @@ def _hdf5_group(node, source: str, wanted, limit: float, allow_external: bool):
     """The wanted 1-D datasets of a group, in the order of its ``columns`` attribute."""
     import h5py
 
-    order = [_hdf5_text(c) for c in node.attrs.get("columns", [])]
+    order = [hdf5_text(c) for c in node.attrs.get("columns", [])]
     names = sorted(node.keys(), key=lambda k: order.index(k) if k in order else len(order))
     datasets = {}
     for name in wanted.select(source, names):
-        ds = _hdf5_get(node, name, source, allow_external)
+        ds = hdf5_get(node, name, source, allow_external)
         if isinstance(ds, h5py.Dataset) and ds.ndim == 1:
-            _hdf5_check_dataset(ds, source, allow_external)
+            check_dataset(ds, source, allow_external)
             datasets[name] = ds
     if not datasets:
         raise DataError(f"{source}: group {node.name!r} holds no 1-D datasets",
@@ -606,7 +557,7 @@ def _hdf5_group(node, source: str, wanted, limit: float, allow_external: bool):
     for name, ds in datasets.items():
         raw[name] = ds[()]
         if "unit" in ds.attrs:
-            units[name] = _hdf5_text(ds.attrs["unit"])
+            units[name] = hdf5_text(ds.attrs["unit"])
     return raw, units
 
 
