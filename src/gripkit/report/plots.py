@@ -16,7 +16,32 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 __all__ = ["measured_vs_model", "residual_correlation", "pole_zero_map", "bode", "parameter_convergence",
-           "log_ticks"]
+           "log_ticks", "plain", "plain_math_fallback"]
+
+
+def plain(text) -> str:
+    """``text`` (a name from a file: a column, unit, joint) as a matplotlib label shown as it
+    is: each ``$`` escaped, so that no mathtext is parsed from data (``$\\frac{$`` would stop
+    the plot)."""
+    return str(text).replace("$", "\\$")
+
+
+def plain_math_fallback(fig) -> None:
+    """Show as plain text every text of ``fig`` whose mathtext does not parse (the report builder
+    calls this before it saves a figure, so that a label from data cannot stop a report)."""
+    from matplotlib import cbook
+    from matplotlib.mathtext import MathTextParser
+    from matplotlib.text import Text
+
+    parser = MathTextParser("path")
+    for t in fig.findobj(Text):
+        s = t.get_text()
+        if not (t.get_parse_math() and cbook.is_math_text(s)):
+            continue
+        try:
+            parser.parse(s)
+        except Exception:  # noqa: BLE001 - any parse failure: show the text as it is
+            t.set_parse_math(False)
 
 
 def pyplot():
@@ -56,17 +81,18 @@ def log_ticks(*axes) -> None:
 def measured_vs_model(t: np.ndarray, measured: np.ndarray, models: Mapping[str, np.ndarray], *,
                       ylabel: str = "output", title: str = "", measured_label: str = "measured",
                       extra: Mapping[str, np.ndarray] | None = None):
-    """Measured output (solid) and model outputs (dashed) against time ``t`` (s)."""
+    """Measured output (solid) and model outputs (dashed) against time ``t`` (s); labels and title
+    are shown as given (no mathtext: they often hold names from data)."""
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(10, 3.6))
-    ax.plot(t, measured, color="0.55", lw=0.9, label=measured_label)
+    ax.plot(t, measured, color="0.55", lw=0.9, label=plain(measured_label))
     for label, v in (extra or {}).items():
-        ax.plot(t, v, lw=1.2, label=label)
+        ax.plot(t, v, lw=1.2, label=plain(label))
     for label, v in models.items():
-        ax.plot(t, v, "--", lw=1.4, label=label)
+        ax.plot(t, v, "--", lw=1.4, label=plain(label))
     ax.set_xlabel("time [s]")
-    ax.set_ylabel(ylabel)
-    ax.set_title(title)
+    ax.set_ylabel(plain(ylabel))
+    ax.set_title(plain(title))
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.tight_layout()
