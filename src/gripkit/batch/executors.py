@@ -214,7 +214,8 @@ class DaskExecutor(Executor):
 
     name = "dask"
 
-    def __init__(self, address: str | None = None, workers: int | None = None, timeout: float = 10.0):
+    def __init__(self, address: str | None = None, workers: int | None = None,
+                 timeout: float = 10.0):
         check_not_bootstrapping()
         try:
             from distributed import Client, LocalCluster
@@ -229,7 +230,7 @@ class DaskExecutor(Executor):
             probe_scheduler(address, timeout)
             try:
                 self.client = Client(address, timeout=timeout)
-            except (OSError, ValueError, TypeError, MemoryError) as exc:  # unreachable, not an address
+            except (OSError, ValueError, TypeError, MemoryError) as exc:  # unreachable, bad address
                 raise ConfigError(f"cannot reach the Dask scheduler at {address!r}: {exc}",
                                   hint="give its address as tcp://host:8786") from None
         else:
@@ -302,15 +303,16 @@ def probe_scheduler(address: str, timeout: float = 10.0) -> None:
             (n,) = struct.unpack("<Q", head)
             body = _recv_exactly(conn, n) if 16 <= n <= _HANDSHAKE_MAX else _recv_some(conn, 32)
         except TimeoutError:
-            raise ConfigError(f"{address!r} accepts connections but no Dask scheduler answered within "
-                              f"{timeout:g} s (a scheduler greets at once; an HTTP or other server waits)",
-                              hint=_SCHEDULER_HINT) from None
+            raise ConfigError(f"{address!r} accepts connections but no Dask scheduler answered "
+                              f"within {timeout:g} s (a scheduler greets at once; an HTTP or other "
+                              f"server waits)", hint=_SCHEDULER_HINT) from None
         except OSError as exc:  # closed or reset before a whole handshake came
-            raise ConfigError(f"{address!r} is not a Dask scheduler: the connection ended before its "
-                              f"handshake ({exc})", hint=_SCHEDULER_HINT) from None
+            raise ConfigError(f"{address!r} is not a Dask scheduler: the connection ended "
+                              f"before its handshake ({exc})", hint=_SCHEDULER_HINT) from None
     if not _is_handshake(body):
         raise ConfigError(f"{address!r} answered but is not a Dask scheduler: it sent "
-                          f"{(head + body)[:40]!r} instead of a Dask handshake", hint=_SCHEDULER_HINT)
+                          f"{(head + body)[:40]!r} instead of a Dask handshake",
+                          hint=_SCHEDULER_HINT)
 
 
 def _recv_exactly(conn, n: int) -> bytes:
