@@ -27,8 +27,8 @@ matplotlib.use("Agg")
 HOSTILE = '<script>alert(1)</script>"><img src=x onerror=alert(1)></title>&$\\frac{$'
 
 #: what the builder writes itself (html.py's page template)
-BUILDER_TAGS = {"html", "head", "meta", "title", "style", "body", "h1", "h2", "p", "nav", "ul", "li", "a",
-                "div", "table", "tr", "th", "td", "figure", "img", "figcaption"}
+BUILDER_TAGS = {"html", "head", "meta", "title", "style", "body", "h1", "h2", "p", "nav", "ul",
+                "li", "a", "div", "table", "tr", "th", "td", "figure", "img", "figcaption"}
 BUILDER_ATTRS = {"lang", "charset", "name", "content", "href", "id", "class", "alt", "src"}
 
 
@@ -104,16 +104,16 @@ def test_builder_escapes_every_slot(tmp_path):
     sec.table(["head " + HOSTILE, "value"], [["cell " + HOSTILE, 1.5], ["INCONSISTENT", HOSTILE]],
               caption="caption " + HOSTILE)
     t = np.linspace(0, 1, 50)
-    sec.figure(measured_vs_model(t, t, {"model " + HOSTILE: t}, ylabel="y " + HOSTILE, title=HOSTILE),
-               "figure " + HOSTILE, name=HOSTILE)
-    finding = Finding(check="check " + HOSTILE, subject="s", consistent=False, message="msg " + HOSTILE,
-                      used="used " + HOSTILE)
+    fig = measured_vs_model(t, t, {"model " + HOSTILE: t}, ylabel="y " + HOSTILE, title=HOSTILE)
+    sec.figure(fig, "figure " + HOSTILE, name=HOSTILE)
+    finding = Finding(check="check " + HOSTILE, subject="s", consistent=False,
+                      message="msg " + HOSTILE, used="used " + HOSTILE)
     sec.findings(ConsistencyReport([finding], "subject " + HOSTILE))
     html = rep.write(tmp_path).read_text()
     assert_no_markup_from_data(html, _figures(rep), HOSTILE)
-    _slots_hostile(html, ["sub " + HOSTILE, "sec " + HOSTILE, "intro " + HOSTILE, "text " + HOSTILE,
-                          "head " + HOSTILE, "cell " + HOSTILE, "caption " + HOSTILE, "figure " + HOSTILE,
-                          "check " + HOSTILE, "msg " + HOSTILE, "subject " + HOSTILE])
+    _slots_hostile(html, [f"{slot} {HOSTILE}" for slot in (
+        "sub", "sec", "intro", "text", "head", "cell", "caption", "figure", "check", "msg",
+        "subject")])
     assert "&lt;script&gt;alert(1)&lt;/script&gt;" in html and "&lt;/title&gt;" in html
     # the figure's file name is made of [a-z0-9-] only, inside figures/
     assert [p.name for p in (tmp_path / "figures").iterdir()] == [
@@ -138,7 +138,7 @@ def test_label_with_broken_mathtext_does_not_stop_a_figure():
     from gripkit.report.plots import pyplot
 
     fig, ax = pyplot().subplots()
-    ax.set_title("$\\frac{$")  # set outside the report's helpers: the builder's fallback shows it plain
+    ax.set_title("$\\frac{$")  # outside the report's helpers: the builder's fallback shows it
     ax.plot([0, 1], [0, 1], label="$\\frac{$")
     ax.legend()
     sec = Report("t").section("s").figure(fig, "c")
@@ -189,7 +189,8 @@ def test_identify_report_and_gripkit_report(cli, tmp_path):
 # ---------------------------------------------------------------------------------------------
 # identify dynamics --report: the URDF's robot, link and joint names and the log's column names
 
-LINK = '<link name={}><inertial><mass value="0.1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4"/></inertial></link>'
+LINK = ('<link name={}><inertial><mass value="0.1"/><inertia ixx="1e-4" iyy="1e-4" izz="1e-4"/>'
+        '</inertial></link>')
 JOINT = ('<joint name={} type="revolute"><parent link={}/><child link={}/><axis xyz="0 0 1"/>'
          '<limit lower="-1" upper="1" effort="1" velocity="2"/></joint>')
 
@@ -199,7 +200,8 @@ def test_identify_dynamics_report(cli, tmp_path):
     joints = ["j0" + HOSTILE, "j1" + HOSTILE]
     parts = [f"<robot name={quoteattr('arm' + HOSTILE)}>", f"<link name={quoteattr(links[0])}/>"]
     parts += [LINK.format(quoteattr(n)) for n in links[1:]]
-    parts += [JOINT.format(quoteattr(joints[k]), quoteattr(links[k]), quoteattr(links[k + 1])) for k in range(2)]
+    parts += [JOINT.format(quoteattr(joints[k]), quoteattr(links[k]), quoteattr(links[k + 1]))
+              for k in range(2)]
     urdf = tmp_path / "arm.urdf"
     urdf.write_text("".join(parts) + "</robot>")
     n, fs = 4000, 1000.0
@@ -245,8 +247,8 @@ def test_robustness_report_on_a_sweep_table_with_hostile_parameter_names(tmp_pat
     _slots_hostile(html, ["title " + HOSTILE, "intro " + HOSTILE])
 
 
-@pytest.mark.parametrize("bad", ["<script>alert(1)</script>", '"><img src=x onerror=alert(1)>', "</title>", "&",
-                                 "$\\frac{"])
+@pytest.mark.parametrize("bad", ["<script>alert(1)</script>", '"><img src=x onerror=alert(1)>',
+                                 "</title>", "&", "$\\frac{"])
 def test_each_piece_alone_in_a_title(tmp_path, bad):
     from gripkit.report import Report
 

@@ -95,7 +95,8 @@ def test_http_server_times_out_with_the_address(server):
 
 def test_banner_is_not_a_scheduler(server):
     address = server(banner_server)
-    with pytest.raises(ConfigError, match="answered but is not a Dask scheduler: it sent b'SSH-2.0-OpenSSH"):
+    with pytest.raises(ConfigError,
+                       match="answered but is not a Dask scheduler: it sent b'SSH-2.0-OpenSSH"):
         probe_scheduler(address, timeout=5.0)
 
 
@@ -104,7 +105,8 @@ def test_closed_port_cannot_be_reached():
     s.bind(("127.0.0.1", 0))
     port = s.getsockname()[1]
     s.close()  # nothing listens there now
-    with pytest.raises(ConfigError, match=f"cannot reach the Dask scheduler at 'tcp://127.0.0.1:{port}'"):
+    with pytest.raises(ConfigError,
+                       match=f"cannot reach the Dask scheduler at 'tcp://127.0.0.1:{port}'"):
         probe_scheduler(f"tcp://127.0.0.1:{port}", timeout=2.0)
 
 
@@ -145,9 +147,9 @@ def test_executor_and_cli_say_not_a_scheduler(server, cli, tmp_path):
     assert time.perf_counter() - t0 < 4.0
 
     sweep = tmp_path / "sweep.toml"
-    sweep.write_text('[sweep]\nname = "msd"\nscenario = "step-response"\nmodel = "mass-spring-damper"\n'
-                     'samples = 2\nseed = 1\n[parameters]\nk = { grid = [1.0, 4.0] }\n[scenario]\n'
-                     'duration = 10.0\n')
+    sweep.write_text('[sweep]\nname = "msd"\nscenario = "step-response"\n'
+                     'model = "mass-spring-damper"\nsamples = 2\nseed = 1\n[parameters]\n'
+                     'k = { grid = [1.0, 4.0] }\n[scenario]\nduration = 10.0\n')
     banner = server(banner_server)
     res = cli("sweep", sweep, "--scheduler", banner, "--out", tmp_path / "out")
     assert_user_error(res, "ConfigError", f"'{banner}' answered but is not a Dask scheduler")
