@@ -145,6 +145,32 @@ def test_label_with_broken_mathtext_does_not_stop_a_figure():
     assert sec.items[0][1].png.startswith(b"\x89PNG")
 
 
+def test_plot_helpers_draw_names_with_dollars_as_text():
+    """Every figure helper of gripkit.report.plots takes a name with ``$\\frac{$`` (invalid
+    mathtext) and shows it as written: the label's text is escaped, and the figure saves."""
+    from gripkit.report import Report
+    from gripkit.report import plots
+    from gripkit.sysid.validation import residual_tests
+
+    name = "$\\frac{$"
+    rng = np.random.default_rng(2)
+    t = np.linspace(0.0, 1.0, 200)
+    f = np.linspace(0.0, 50.0, 64)
+    rt = residual_tests(rng.standard_normal(200), rng.standard_normal(200))
+    figs = [plots.measured_vs_model(t, t, {name: t}, ylabel=name, title=name, extra={name: t}),
+            plots.residual_correlation({name: rt}, title=name),
+            plots.pole_zero_map({name: ([0.5 + 0.2j, 0.5 - 0.2j], [0.1])}, title=name),
+            plots.bode({name: (f, 1.0 / (1.0 + 1j * f))}, title=name, magnitude_unit=name),
+            plots.parameter_convergence(t, np.ones((200, 1)), np.full((200, 1), 0.1), [name],
+                                        title=name)]
+    sec = Report("t").section("s")
+    for fig in figs:
+        texts = [x.get_text() for x in fig.findobj(matplotlib.text.Text)]
+        assert any("\\$\\frac{\\$" in x for x in texts), texts  # escaped: drawn as written
+        sec.figure(fig, "c")
+    assert all(item.png.startswith(b"\x89PNG") for _, item in sec.items)
+
+
 # ---------------------------------------------------------------------------------------------
 # identify tf/ss --report and gripkit report: CSV column names; the model file's structure, names
 # and units

@@ -7,6 +7,9 @@
 * :func:`bode` — magnitude and phase of discrete-time models against frequency in Hz;
 * :func:`parameter_convergence` — recursive estimates with ±2σ bands and optional true values;
 * :func:`log_ticks` — labelled major ticks at 1, 2, 5 per decade on every log axis of an axes.
+
+Labels, legends and titles are shown as given, never parsed as mathtext (:func:`plain`): they
+often hold names read from files, and ``$`` in a column name must not stop a report.
 """
 
 from __future__ import annotations
@@ -110,9 +113,9 @@ def residual_correlation(tests: Mapping[str, object], *, title: str = ""):
     for k, (label, rt) in enumerate(tests.items()):
         off = (k - (len(tests) - 1) / 2) * width
         a1.bar(rt.lags[1:] + off, rt.autocorr[1:], width=width,
-               label=f"{label} (whiteness p = {rt.whiteness_p:.2g})")
+               label=plain(f"{label} (whiteness p = {rt.whiteness_p:.2g})"))
         a2.bar(rt.lags + off, rt.crosscorr, width=width,
-               label=f"{label} (independence p = {rt.independence_p:.2g})")
+               label=plain(f"{label} (independence p = {rt.independence_p:.2g})"))
         for ax in (a1, a2):
             ax.axhline(rt.bound, color=f"C{k}", ls=":", lw=1)
             ax.axhline(-rt.bound, color=f"C{k}", ls=":", lw=1)
@@ -124,7 +127,7 @@ def residual_correlation(tests: Mapping[str, object], *, title: str = ""):
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)
     if title:
-        fig.suptitle(title)
+        fig.suptitle(plain(title))
     fig.tight_layout()
     return fig
 
@@ -146,9 +149,9 @@ def pole_zero_map(models: Mapping[str, tuple[Sequence[complex], Sequence[complex
         z = np.atleast_1d(np.asarray(z, dtype=complex))
         c, ms = f"C{k}", max(15.0 - 3.0 * k, 5.0)
         ax.plot(p.real, p.imag, pole_marks[k % 4], color=c, ms=ms, mew=2, zorder=3 + k,
-                label=f"{label} poles")
+                label=plain(f"{label} poles"))
         ax.plot(z.real, z.imag, zero_marks[k % 4], color=c, ms=ms, mfc="none", mew=1.6, zorder=3 + k,
-                label=f"{label} zeros")
+                label=plain(f"{label} zeros"))
         allz += list(np.abs(p)) + list(np.abs(z))
     lim = 1.1 * max(allz)
     ax.set_xlim(-lim, lim)
@@ -156,7 +159,7 @@ def pole_zero_map(models: Mapping[str, tuple[Sequence[complex], Sequence[complex
     ax.set_aspect("equal")
     ax.set_xlabel("Re z")
     ax.set_ylabel("Im z")
-    ax.set_title(title)
+    ax.set_title(plain(title))
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, loc="lower left")
     fig.tight_layout()
@@ -182,16 +185,17 @@ def bode(models: Mapping[str, object], *, n: int = 512, title: str = "", magnitu
         else:  # estimates often coincide: cycle the dash pattern as well as the colour
             style = dict(color=f"C{k}", lw=1.4, zorder=2, ls=("-", "--", "-.", ":")[k % 4])
             k += 1
-        am.semilogx(f[sel], 20 * np.log10(np.maximum(np.abs(h[sel]), 1e-300)), label=label, **style)
-        ap.semilogx(f[sel], np.degrees(np.unwrap(np.angle(h[sel]))), label=label, **style)
-    am.set_ylabel(f"magnitude [dB{' ' + magnitude_unit if magnitude_unit else ''}]")
+        shown = plain(label)
+        am.semilogx(f[sel], 20 * np.log10(np.maximum(np.abs(h[sel]), 1e-300)), label=shown, **style)
+        ap.semilogx(f[sel], np.degrees(np.unwrap(np.angle(h[sel]))), label=shown, **style)
+    am.set_ylabel(plain(f"magnitude [dB{' ' + magnitude_unit if magnitude_unit else ''}]"))
     ap.set_ylabel("phase [deg]")
     ap.set_xlabel("frequency [Hz]")
     for ax in (am, ap):
         ax.grid(alpha=0.3, which="both")
     log_ticks(am, ap)
     am.legend(fontsize=8)
-    am.set_title(title)
+    am.set_title(plain(title))
     fig.tight_layout()
     return fig
 
@@ -219,7 +223,7 @@ def parameter_convergence(t: np.ndarray, theta: np.ndarray, std: np.ndarray, nam
                 lo, hi = min(lo, truth[i]), max(hi, truth[i])
             pad = 0.3 * (hi - lo) + 1e-12
             ax.set_ylim(lo - pad, hi + pad)
-        ax.set_ylabel(name)
+        ax.set_ylabel(plain(name))
         ax.grid(alpha=0.3)
     for j in range(p, nrow * ncol):
         axes[j // ncol][j % ncol].set_visible(False)
@@ -227,6 +231,6 @@ def parameter_convergence(t: np.ndarray, theta: np.ndarray, std: np.ndarray, nam
     for ax in axes[-1]:
         ax.set_xlabel("time [s]")
     if title:
-        fig.suptitle(title)
+        fig.suptitle(plain(title))
     fig.tight_layout()
     return fig
