@@ -42,8 +42,6 @@ LAZY_MODULES = {
     ("sysid/linear_model.py", "..lti"): "lti's numba simulation kernel, loaded on the first simulation",
     ("systems/tsfm/grasp_batch.py", ".grasp_gpu"): "numba.cuda: the GPU path only",
     ("io/formats.py", ".mcap_reader"): "the optional mcap extra",
-    ("_fourier_trajectory.py", ".batch.budget"): "the batch package imports its executors "
-                                                  "(cloudpickle): only the memory check loads it",
 }
 
 

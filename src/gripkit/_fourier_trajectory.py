@@ -22,6 +22,7 @@ not only at the samples. The chain is any object with ``regressor``, ``dof``,
 from __future__ import annotations
 
 import math
+import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -240,23 +241,30 @@ def _precheck(chain_name: str, m: int, p: int, H: int, restarts: int, max_iterat
     regressor over one period (samples_per_period·m rows, p + 2m columns, three copies) and the
     base-parameter QR (B·m rows, p columns, B = max(20, 4p/m + 10)); the SVD of each evaluation
     (rows·cols² flops) at :data:`_FAST_FLOPS`."""
-    from .batch.budget import available_memory, format_bytes
-
     B = max(20, 4 * p // max(m, 1) + 10)
     rows, cols = samples_per_period * m, p + 2 * m
     need = 8 * 3 * (rows * cols + B * m * p)
-    room = available_memory() // 2
+    room = _memory_room()
     what = _what(chain_name, m, H, restarts)
     if need > room:
         raise _refuse(what, f"one evaluation of the regressor needs an estimated "
-                            f"{format_bytes(need)} of memory",
-                      f"the limit of {format_bytes(room)} (half the memory available)", memory=True)
+                            f"{need / 1e9:.3g} GB of memory",
+                      f"the limit of {room / 1e9:.3g} GB (half the machine's memory)", memory=True)
     n_eval = _evaluations(m, H, restarts, max_iterations)
     flops = 4.0 * B * m * p ** 2 + n_eval * float(rows) * cols ** 2
     if flops / _FAST_FLOPS > time_limit:
         raise _refuse(what, f"an estimated {flops:.2g} floating-point operations take at least "
                             f"{_duration(flops / _FAST_FLOPS)} even at {_FAST_FLOPS:.0e} flop/s",
                       f"the time limit of {_duration(time_limit)}")
+
+
+def _memory_room() -> int:
+    """Bytes a design may use: half the machine's physical memory (no limit where the system
+    does not say)."""
+    try:
+        return os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE") // 2
+    except (ValueError, OSError, AttributeError):
+        return 2**62
 
 
 def _duration(s: float) -> str:

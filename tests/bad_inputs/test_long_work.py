@@ -69,13 +69,11 @@ def test_a_thousand_joints_are_refused_at_once(cli, tmp_path):
 
 def test_memory_estimate_against_the_limit(tmp_path, monkeypatch):
     """100 joints: the regressor over one period (20 000 rows × 1200 columns) and the base QR
-    (50·100 rows × 1000 columns), three copies of 8 bytes: 0.696 GB, above half of 1 GB."""
-    import gripkit.batch.budget as budget
-
-    monkeypatch.setattr(budget, "available_memory", lambda: 10**9)
+    (50·100 rows × 1000 columns), three copies of 8 bytes: 0.696 GB, above a limit of 0.5 GB."""
+    monkeypatch.setattr(ft, "_memory_room", lambda: 5 * 10**8)
     chain = from_urdf(_urdf(tmp_path / "a.urdf", 100))
-    with pytest.raises(ConfigError, match=r"needs an estimated 696 MB of memory, above the limit "
-                                          r"of 500 MB \(half the memory available\); design a sub"):
+    with pytest.raises(ConfigError, match=r"needs an estimated 0.696 GB of memory, above the limit "
+                                          r"of 0.5 GB \(half the machine's memory\); design a sub"):
         fourier_trajectory(chain)
 
 
