@@ -192,13 +192,14 @@ U, Y = "u" + HOSTILE, "y" + HOSTILE
 
 
 def test_identify_report_and_gripkit_report(cli, tmp_path):
-    data = _record(tmp_path / "d.csv", U, Y)
+    file_name = 'd"><img src=x onerror=alert(1)>&.csv'  # the data file's name is shown too
+    data = _record(tmp_path / file_name, U, Y)
     res = cli("identify", "tf", data, "--input", U, "--output", Y, "--poles", 2, "--zeros", 0,
               "--out", tmp_path / "m.json", "--report", tmp_path / "rep")
     assert res.code == 0, res.err
     html = (tmp_path / "rep" / "index.html").read_text()
     assert_no_markup_from_data(html, 4, "gripkit model report: tfest")
-    _slots_hostile(html, [U, Y])
+    _slots_hostile(html, [U, Y, file_name])
 
     # the model file's structure, names and units (a file someone sent)
     m = json.loads((tmp_path / "m.json").read_text())
@@ -209,7 +210,7 @@ def test_identify_report_and_gripkit_report(cli, tmp_path):
     assert res.code == 0, res.err
     html = (tmp_path / "rep2" / "index.html").read_text()
     assert_no_markup_from_data(html, 4, "gripkit model report: " + HOSTILE)
-    _slots_hostile(html, [U, Y, "unit" + HOSTILE])
+    _slots_hostile(html, [U, Y, "unit" + HOSTILE, file_name])
 
 
 # ---------------------------------------------------------------------------------------------
