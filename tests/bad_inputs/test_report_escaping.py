@@ -121,14 +121,19 @@ def test_builder_escapes_every_slot(tmp_path):
 
 
 def test_builder_ignores_markup_marked_safe(tmp_path):
-    """A caller cannot switch the escaping off: text marked as markup (markupsafe.Markup) is
-    still shown as text."""
+    """A caller cannot switch the escaping off: text marked as markup (markupsafe.Markup, or an
+    object whose str() is one) is still shown as text."""
     from markupsafe import Markup
 
     from gripkit.report import Report
 
+    class Sneaky:
+        def __str__(self):
+            return Markup(HOSTILE)
+
     rep = Report(Markup(HOSTILE))
-    rep.section(Markup(HOSTILE)).text(Markup(HOSTILE)).table([Markup(HOSTILE)], [[Markup(HOSTILE)]])
+    rep.section(Markup(HOSTILE)).text(Sneaky()).table([Sneaky()], [[Markup(HOSTILE), Sneaky()]],
+                                                      caption=Sneaky())
     assert_no_markup_from_data(rep.render(), 0, HOSTILE)
 
 

@@ -106,8 +106,8 @@ def _cell(v) -> tuple[str, str]:
     if isinstance(v, bool):
         return "txt", str(v)
     if isinstance(v, numbers.Real):
-        return "", f"{v:.4g}" if isinstance(v, float) or not float(v).is_integer() else str(v)
-    text = str(v)
+        return "", f"{v:.4g}" if isinstance(v, float) or not float(v).is_integer() else _text(v)
+    text = _text(v)
     return ("txt" if _NUMBER.fullmatch(text.strip()) is None else ""), text
 
 
@@ -153,11 +153,11 @@ class Report:
         """The page. Every string in it that is not the template's own (titles, text, table cells,
         captions: names from files among them) goes through the template's autoescaping, so that
         a name such as ``<script>`` is shown as text, never run as markup."""
-        sections = [{"title": str(sec.title), "items": [_view(k, item) for k, item in sec.items]}
+        sections = [{"title": _text(sec.title), "items": [_view(k, item) for k, item in sec.items]}
                     for sec in self.sections]
         return _page_template().render(
-            title=str(self.title), subtitle=str(self.subtitle), css=Markup(_CSS), sections=sections,
-            when=_dt.datetime.now().strftime("%Y-%m-%d %H:%M"))
+            title=_text(self.title), subtitle=_text(self.subtitle), css=Markup(_CSS),
+            sections=sections, when=_dt.datetime.now().strftime("%Y-%m-%d %H:%M"))
 
     def write(self, out_dir) -> Path:
         """Write ``out_dir/index.html`` (and ``out_dir/figures/*.png``); returns the HTML path.
@@ -174,14 +174,20 @@ class Report:
         return index
 
 
+def _text(v) -> str:
+    """``v`` as a plain ``str``: never markup marked safe (a ``markupsafe.Markup``, or an object
+    whose ``__str__`` returns one), which the template would not escape."""
+    return str(str(v))
+
+
 def _view(kind: str, item) -> dict:
     """What the template needs of one item, as plain strings (escaped there)."""
     if kind == "text":
-        return {"kind": "text", "text": str(item)}
+        return {"kind": "text", "text": _text(item)}
     if kind == "table":
-        return {"kind": "table", "caption": str(item.caption),
-                "headers": [str(h) for h in item.headers], "rows": [_row(r) for r in item.rows]}
-    return {"kind": "figure", "caption": str(item.caption), "slug": _slug(item.slug),
+        return {"kind": "table", "caption": _text(item.caption),
+                "headers": [_text(h) for h in item.headers], "rows": [_row(r) for r in item.rows]}
+    return {"kind": "figure", "caption": _text(item.caption), "slug": _slug(item.slug),
             "b64": base64.b64encode(item.png).decode()}
 
 
