@@ -230,6 +230,20 @@ def _refuse(what: str, estimate: str, limit: str, memory: bool = False) -> Confi
     return ConfigError(f"{what}: {estimate}, above {limit}", hint=hint)
 
 
+def _time_limit(time_limit) -> float:
+    """Seconds > 0 (math.inf: no limit); None: :data:`TIME_LIMIT`."""
+    if time_limit is None:
+        return TIME_LIMIT
+    try:
+        limit = float(time_limit)
+    except (TypeError, ValueError):
+        limit = math.nan
+    if not limit > 0:
+        raise DataError(f"time_limit (CLI --time-limit): expected seconds > 0 (or math.inf), "
+                        f"found {time_limit!r}")
+    return limit
+
+
 def _what(chain_name: str, m: int, H: int, restarts: int) -> str:
     return (f"excitation design of {chain_name} ({m} joints, {2 * m * H} coefficients, "
             f"{1 + restarts:,} start{'s' if restarts else ''})")
@@ -385,9 +399,7 @@ def fourier_trajectory(chain, *, f0: float = 0.1, harmonics: int = 5, dt: float 
     names = tuple(chain.coordinate_names)
     _check_design(f0, dt, harmonics, periods)
     _check_counts(seed, restarts, max_iterations, samples_per_period)
-    limit = TIME_LIMIT if time_limit is None else float(time_limit)
-    if not limit > 0:
-        raise DataError(f"time_limit: expected seconds > 0 (or math.inf), found {time_limit!r}")
+    limit = _time_limit(time_limit)
     H = int(harmonics)
     chain_name = getattr(chain, "name", "the chain")
     _precheck(chain_name, m, len(chain.parameter_names), H, int(restarts), int(max_iterations),

@@ -4,6 +4,7 @@ how to go on; a design estimated above 10 s shows its progress; ``--seed -1`` is
 
 from __future__ import annotations
 
+import math
 import time
 
 import pytest
@@ -85,8 +86,9 @@ def test_measured_estimate_against_a_small_limit(tmp_path):
                                           r"\(measured\) take up to .*, above the time limit "
                                           r"of 50 ms"):
         fourier_trajectory(chain, time_limit=0.05)
-    with pytest.raises(DataError, match="time_limit: expected seconds > 0"):
-        fourier_trajectory(chain, time_limit=0)
+    for bad in (0, -1.0, math.nan, "soon"):
+        with pytest.raises(DataError, match=r"time_limit \(CLI --time-limit\): expected seconds > 0"):
+            fourier_trajectory(chain, time_limit=bad)
 
 
 def test_long_design_shows_progress(tmp_path, monkeypatch, capsys):
