@@ -154,3 +154,19 @@ def test_executor_and_cli_say_not_a_scheduler(server, cli, tmp_path):
     res = cli("sweep", sweep, "--scheduler", banner, "--out", tmp_path / "out")
     assert_user_error(res, "ConfigError", f"'{banner}' answered but is not a Dask scheduler")
     assert not (tmp_path / "out").exists()
+
+
+def trickle_server(conn, stop):
+    """Sends a byte every 0.4 s: no single read waits long, the handshake never completes."""
+    for b in b"\x01\x00\x00\x00\x00\x00\x00\x00" * 100:
+        if stop.wait(0.4):
+            return
+        conn.sendall(bytes([b]))
+
+
+def test_trickling_server_times_out_as_a_whole(server):
+    address = server(trickle_server)
+    t0 = time.perf_counter()
+    with pytest.raises(ConfigError, match="no Dask scheduler answered within 1.5 s"):
+        probe_scheduler(address, timeout=1.5)
+    assert time.perf_counter() - t0 < 4.0

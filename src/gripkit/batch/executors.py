@@ -30,6 +30,7 @@ import struct
 import subprocess
 import sys
 import tempfile
+import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
 
 import cloudpickle
@@ -296,12 +297,15 @@ def probe_scheduler(address: str, timeout: float = 10.0) -> None:
     except OSError as exc:
         raise ConfigError(f"cannot reach the Dask scheduler at {address!r}: {exc}",
                           hint=_SCHEDULER_HINT) from None
+    deadline = time.monotonic() + timeout  # for the whole handshake, however it trickles in
     with conn:
-        conn.settimeout(timeout)
         try:
-            head = _recv_exactly(conn, 8)
+            head = _recv_exactly(conn, 8, deadline)
             (n,) = struct.unpack("<Q", head)
-            body = _recv_exactly(conn, n) if 16 <= n <= _HANDSHAKE_MAX else _recv_some(conn, 32)
+            if 16 <= n <= _HANDSHAKE_MAX:
+                body = _recv_exactly(conn, n, deadline)
+            else:
+                body = _recv_some(conn, 32)
         except TimeoutError:
             raise ConfigError(f"{address!r} accepts connections but no Dask scheduler answered "
                               f"within {timeout:g} s (a scheduler greets at once; an HTTP or other "
@@ -315,9 +319,14 @@ def probe_scheduler(address: str, timeout: float = 10.0) -> None:
                           hint=_SCHEDULER_HINT)
 
 
-def _recv_exactly(conn, n: int) -> bytes:
+def _recv_exactly(conn, n: int, deadline: float) -> bytes:
+    """``n`` bytes, all by ``deadline`` (time.monotonic) or TimeoutError."""
     buf = bytearray()
     while len(buf) < n:
+        left = deadline - time.monotonic()
+        if left <= 0:
+            raise TimeoutError
+        conn.settimeout(left)
         part = conn.recv(n - len(buf))
         if not part:
             raise ConnectionError(f"closed after {len(buf)} of {n} bytes")
