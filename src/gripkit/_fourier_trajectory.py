@@ -22,6 +22,8 @@ not only at the samples. The chain is any object with ``regressor``, ``dof``,
 from __future__ import annotations
 
 import math
+import os
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -29,8 +31,9 @@ import numpy as np
 
 from .arguments import entry_point
 from .atomic import atomic_write
+from .errors import ConfigError, DataError, IdentificationError
+from .progress import status, track
 from .sysid.dynamics import base_structure, friction_columns
-from .errors import DataError, IdentificationError
 
 __all__ = ["FourierTrajectory", "fourier_trajectory", "fourier_states"]
 
@@ -191,20 +194,166 @@ class _Design:
         return np.concatenate([(a * k).ravel(), (b * k).ravel()])
 
 
-def _best_design(design: _Design, restarts: int, max_iterations: int, seed: int):
+#: the design time (s, estimated up front) above which a design is refused unless the caller
+#: raises ``time_limit`` (CLI ``--time-limit``)
+TIME_LIMIT = 1800.0
+#: a floating-point rate no single machine exceeds on these dense SVDs and QRs (flop/s): a design
+#: whose operation count alone gives more than the limit at this rate is refused before any work
+_FAST_FLOPS = 1e11
+#: a design estimated above this many seconds shows its progress on stderr
+_SHOW_PROGRESS_S = 10.0
+#: seconds between two iteration lines of a design that shows its progress
+_PROGRESS_EVERY_S = 10.0
+
+
+def _check_counts(seed, restarts, max_iterations, samples_per_period) -> None:
+    """DataError unless the seed and the counts are non-negative (positive) integers."""
+    for name, v, lo in (("seed", seed, 0), ("restarts", restarts, 0),
+                        ("max_iterations", max_iterations, 1),
+                        ("samples_per_period", samples_per_period, 8)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
+            raise DataError(f"{name}: expected an integer >= {lo}, found {v!r}",
+                            hint="the seed of the random starts is 0, 1, 2, ... (numpy's generator "
+                                 "takes no negative seed)" if name == "seed" else "")
+
+
+def _evaluations(m: int, H: int, restarts: int, max_iterations: int) -> int:
+    """Objective evaluations of the design at most: SLSQP's finite-difference gradient costs
+    2·m·H + 1 evaluations per iteration, its line search about one more."""
+    return (1 + int(restarts)) * (int(max_iterations) * (2 * m * H + 2) + 1)
+
+
+def _refuse(what: str, estimate: str, limit: str, memory: bool = False) -> ConfigError:
+    if memory:
+        hint = ("design a sub-chain (--base-link/--tip-link) or sample the period more coarsely "
+                "(Python: samples_per_period=)")
+    else:
+        hint = ("use fewer joints (a sub-chain: --base-link/--tip-link), fewer --harmonics or "
+                "--restarts, fewer iterations (Python: max_iterations=), or raise the limit with "
+                "--time-limit (Python: time_limit=)")
+    return ConfigError(f"{what}: {estimate}, above {limit}", hint=hint)
+
+
+def _time_limit(time_limit) -> float:
+    """Seconds > 0 (math.inf: no limit); None: :data:`TIME_LIMIT`."""
+    if time_limit is None:
+        return TIME_LIMIT
+    try:
+        limit = float(time_limit)
+    except (TypeError, ValueError):
+        limit = math.nan
+    if not limit > 0:
+        raise DataError(f"time_limit (CLI --time-limit): expected seconds > 0 (or math.inf), "
+                        f"found {time_limit!r}")
+    return limit
+
+
+def _what(chain_name: str, m: int, H: int, restarts: int) -> str:
+    return (f"excitation design of {chain_name} ({m} joints, {2 * m * H} coefficients, "
+            f"{1 + restarts:,} start{'s' if restarts else ''})")
+
+
+def _precheck(chain_name: str, m: int, p: int, H: int, restarts: int, max_iterations: int,
+              samples_per_period: int, time_limit: float) -> None:
+    """Refuse, before any work, a design whose memory or operation count cannot fit: the
+    regressor over one period (samples_per_period·m rows, p + 2m columns, three copies) and the
+    base-parameter QR (B·m rows, p columns, B = max(20, 4p/m + 10)); the SVD of each evaluation
+    (rows·cols² flops) at :data:`_FAST_FLOPS`."""
+    B = max(20, 4 * p // max(m, 1) + 10)
+    rows, cols = samples_per_period * m, p + 2 * m
+    need = 8 * 3 * (rows * cols + B * m * p)
+    room = _memory_room()
+    what = _what(chain_name, m, H, restarts)
+    if need > room:
+        raise _refuse(what, f"one evaluation of the regressor needs an estimated "
+                            f"{need / 1e9:.3g} GB of memory",
+                      f"the limit of {room / 1e9:.3g} GB (half the machine's memory)", memory=True)
+    n_eval = _evaluations(m, H, restarts, max_iterations)
+    flops = 4.0 * B * m * p ** 2 + n_eval * float(rows) * cols ** 2
+    if flops / _FAST_FLOPS > time_limit:
+        raise _refuse(what, f"an estimated {flops:.2g} floating-point operations take at least "
+                            f"{_duration(flops / _FAST_FLOPS)} even at {_FAST_FLOPS:.0e} flop/s",
+                      f"the time limit of {_duration(time_limit)}")
+
+
+def _memory_room() -> int:
+    """Bytes a design may use: half the machine's physical memory (no limit where the system
+    does not say)."""
+    try:
+        return os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE") // 2
+    except (ValueError, OSError, AttributeError):
+        return 2**62
+
+
+def _duration(s: float) -> str:
+    if s < 0.1:
+        return f"{s * 1e3:.3g} ms"
+    if s < 120:
+        return f"{s:.3g} s"
+    if s < 7200:
+        return f"{s / 60:.3g} min"
+    if s < 2 * 86400:
+        return f"{s / 3600:.3g} h"
+    return f"{s / 86400:.3g} days"
+
+
+def _measured_estimate(design: "_Design", seed: int, restarts: int, max_iterations: int,
+                       limit: float) -> tuple[float, float]:
+    """(seconds of one objective evaluation, measured after a warm-up; seconds of the whole
+    design at most). An estimate above ``limit`` is measured twice more and the fastest kept (a
+    busy machine slows single calls). The starting point is drawn from its own generator: the
+    design's draws are unchanged."""
+    x = design.start(np.random.default_rng(seed))
+    design.objective(x)  # compiles the regressor's kernels on first use
+    n_eval = _evaluations(design.m, design.H, restarts, max_iterations)
+    t_eval = math.inf
+    for _ in range(3):
+        t0 = time.perf_counter()
+        design.objective(x)
+        t_eval = min(t_eval, time.perf_counter() - t0)
+        if t_eval * n_eval <= limit:
+            break
+    return t_eval, t_eval * n_eval
+
+
+class _Progress:
+    """SLSQP callback: a status line at most every 10 s (start, iteration, condition number)."""
+
+    def __init__(self, design: "_Design", start: int, starts: int, max_iterations: int):
+        self.design, self.start, self.starts = design, start, starts
+        self.max_iterations = max_iterations
+        self.t0 = self.last = time.perf_counter()
+        self.k = 0
+
+    def __call__(self, x, *args):
+        self.k += 1
+        now = time.perf_counter()
+        if now - self.last >= _PROGRESS_EVERY_S:
+            self.last = now
+            status(f"  excitation design: start {self.start}/{self.starts}, iteration {self.k} "
+                   f"of at most {self.max_iterations}, condition number "
+                   f"{10 ** self.design.objective(x):.4g}, {now - self.t0:.0f} s")
+
+
+def _best_design(design: _Design, restarts: int, max_iterations: int, seed: int,
+                 progress: bool = False):
     """SLSQP from 1 + ``restarts`` random starts, each result kept only if it improves on its
-    start; returns (log10 cond, x) of the best and the condition number of the first start."""
+    start; returns (log10 cond, x) of the best and the condition number of the first start.
+    ``progress``: a line per ~10 % of the starts and an iteration line every 10 s on stderr."""
     from scipy.optimize import minimize
 
     rng = np.random.default_rng(seed)
     best = None
     first_cond = None
-    for _ in range(1 + int(restarts)):
+    starts = 1 + int(restarts)
+    for k in track(range(starts), description="excitation design: starts",
+                   enabled=progress and starts > 1):
         x0 = design.start(rng)
         f_start = design.objective(x0)
         first_cond = 10 ** f_start if first_cond is None else first_cond
+        callback = _Progress(design, k + 1, starts, int(max_iterations)) if progress else None
         sol = minimize(design.objective, x0, method="SLSQP", constraints=[{"type": "ineq", "fun": design.bounds_margin}],
-                       options=dict(maxiter=int(max_iterations), ftol=1e-6))
+                       options=dict(maxiter=int(max_iterations), ftol=1e-6), callback=callback)
         x = design.shrink(sol.x) if np.isfinite(sol.x).all() else x0
         f = design.objective(x)
         if f > f_start:
@@ -218,7 +367,8 @@ def _best_design(design: _Design, restarts: int, max_iterations: int, seed: int)
 def fourier_trajectory(chain, *, f0: float = 0.1, harmonics: int = 5, dt: float = 0.01, periods: int = 1,
                        position_limits=None, velocity_limits=None, acceleration_limits=None,
                        q0=None, friction: bool = True, samples_per_period: int = 200, seed: int = 0,
-                       restarts: int = 0, max_iterations: int = 200) -> FourierTrajectory:
+                       restarts: int = 0, max_iterations: int = 200,
+                       time_limit: float | None = None) -> FourierTrajectory:
     """Design the excitation trajectory of ``chain`` (module doc).
 
     Parameters
@@ -240,11 +390,24 @@ def fourier_trajectory(chain, *, f0: float = 0.1, harmonics: int = 5, dt: float 
         Include the Coulomb and viscous friction columns in the condition number.
     restarts
         Random starting points besides the first; the best design is kept.
+    seed
+        Seed (an integer >= 0) of the random starting points.
+    time_limit
+        Seconds the design may take at most, estimated before it starts (default
+        :data:`TIME_LIMIT`, 30 min): first from the memory and the operation count of the
+        regressor, then from one timed evaluation times the evaluations SLSQP may make. A
+        larger design is refused (ConfigError with the estimate); one above 10 s shows its
+        progress on stderr.
     """
     m = int(chain.dof)
     names = tuple(chain.coordinate_names)
     _check_design(f0, dt, harmonics, periods)
+    _check_counts(seed, restarts, max_iterations, samples_per_period)
+    limit = _time_limit(time_limit)
     H = int(harmonics)
+    chain_name = getattr(chain, "name", "the chain")
+    _precheck(chain_name, m, len(chain.parameter_names), H, int(restarts), int(max_iterations),
+              int(samples_per_period), limit)
     lim = getattr(chain, "limits", None)
     lo, hi = _position_limits(position_limits, lim, m)
     v_c = getattr(lim, "velocity", None)
@@ -255,7 +418,17 @@ def fourier_trajectory(chain, *, f0: float = 0.1, harmonics: int = 5, dt: float 
         raise DataError(f"q0: the centre {q0.tolist()} must lie inside the position limits")
     st = base_structure(chain)
     design = _Design(chain, st, q0, np.minimum(q0 - lo, hi - q0), vmax, amax, f0, H, friction, samples_per_period)
-    f, x, first_cond = _best_design(design, restarts, max_iterations, seed)
+    t_eval, t_max = _measured_estimate(design, int(seed), int(restarts), int(max_iterations), limit)
+    n_eval = _evaluations(m, H, int(restarts), int(max_iterations))
+    if t_max > limit:
+        raise _refuse(_what(chain_name, m, H, int(restarts)),
+                      f"up to {n_eval:,} evaluations of {_duration(t_eval)} each (measured) "
+                      f"take up to {_duration(t_max)}", f"the time limit of {_duration(limit)}")
+    progress = t_max > _SHOW_PROGRESS_S
+    if progress:
+        status(f"excitation design: up to {n_eval:,} evaluations of {_duration(t_eval)} each "
+               f"(at most {_duration(t_max)}; usually far fewer)")
+    f, x, first_cond = _best_design(design, restarts, max_iterations, seed, progress=progress)
     if not math.isfinite(f) or f >= 3:
         raise IdentificationError(f"no excitation found that excites every base parameter of {getattr(chain, 'name', 'the chain')} "
                                   f"within the limits (best condition number {10 ** f:.3g})",

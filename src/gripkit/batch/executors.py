@@ -25,9 +25,12 @@ import multiprocessing
 import os
 import pickle
 import selectors
+import socket
+import struct
 import subprocess
 import sys
 import tempfile
+import time
 from collections.abc import Callable, Iterable, Iterator, Sequence
 
 import cloudpickle
@@ -212,7 +215,8 @@ class DaskExecutor(Executor):
 
     name = "dask"
 
-    def __init__(self, address: str | None = None, workers: int | None = None):
+    def __init__(self, address: str | None = None, workers: int | None = None,
+                 timeout: float = 10.0):
         check_not_bootstrapping()
         try:
             from distributed import Client, LocalCluster
@@ -221,9 +225,13 @@ class DaskExecutor(Executor):
                               hint="pip install 'gripkit[dask]'") from None
         self._cluster = None
         if address:
+            # distributed's own timeout does not cover its handshake: a server that accepts and
+            # stays silent (HTTP) would hang it, and a banner is read as a frame length (an
+            # "out of memory" of exabytes). The probe answers both within ``timeout``.
+            probe_scheduler(address, timeout)
             try:
-                self.client = Client(address, timeout=10)
-            except (OSError, ValueError, TypeError) as exc:  # unreachable, or not an address (ValueError)
+                self.client = Client(address, timeout=timeout)
+            except (OSError, ValueError, TypeError, MemoryError) as exc:  # unreachable, bad address
                 raise ConfigError(f"cannot reach the Dask scheduler at {address!r}: {exc}",
                                   hint="give its address as tcp://host:8786") from None
         else:
@@ -253,6 +261,102 @@ class DaskExecutor(Executor):
         self.client.close()
         if self._cluster is not None:
             self._cluster.close()
+
+
+#: the most bytes a scheduler's first message (its handshake, ~60 bytes) may declare
+_HANDSHAKE_MAX = 1 << 16
+_SCHEDULER_HINT = ("check the host and port: the scheduler's, printed by `dask scheduler` as "
+                   "tcp://host:8786 (8787 is its dashboard, a web page), and that it is running")
+
+
+def _tcp_host_port(address: str) -> tuple[str, int] | None:
+    """(host, port) of a ``tcp://host:port`` (or ``host:port``) address; None for another
+    transport (tls://, ws://, inproc://, ucx://), which the probe leaves to distributed."""
+    scheme, sep, rest = address.partition("://")
+    if not sep:
+        scheme, rest = "tcp", address
+    if scheme != "tcp":
+        return None
+    host, sep, port = rest.rpartition(":")
+    if not sep or not port.isdigit():
+        return None  # distributed says what is wrong with the address
+    return host.strip("[]") or "127.0.0.1", int(port)
+
+
+def probe_scheduler(address: str, timeout: float = 10.0) -> None:
+    """Check that a Dask scheduler answers at the ``tcp://`` ``address`` within ``timeout`` s: a
+    scheduler sends its handshake as soon as a connection opens (a length, a frame count, frame
+    lengths, then a msgpack map with ``compression`` and ``python``). Anything else (no answer,
+    a banner, an HTTP reply) is a :class:`ConfigError` naming the address and the timeout.
+    Addresses of other transports are not probed."""
+    hp = _tcp_host_port(address)
+    if hp is None:
+        return
+    try:
+        conn = socket.create_connection(hp, timeout=timeout)
+    except OSError as exc:
+        raise ConfigError(f"cannot reach the Dask scheduler at {address!r}: {exc}",
+                          hint=_SCHEDULER_HINT) from None
+    deadline = time.monotonic() + timeout  # for the whole handshake, however it trickles in
+    with conn:
+        try:
+            head = _recv_exactly(conn, 8, deadline)
+            (n,) = struct.unpack("<Q", head)
+            if 16 <= n <= _HANDSHAKE_MAX:
+                body = _recv_exactly(conn, n, deadline)
+            else:
+                body = _recv_some(conn, 32)
+        except TimeoutError:
+            raise ConfigError(f"{address!r} accepts connections but no Dask scheduler answered "
+                              f"within {timeout:g} s (a scheduler greets at once; an HTTP or other "
+                              f"server waits)", hint=_SCHEDULER_HINT) from None
+        except OSError as exc:  # closed or reset before a whole handshake came
+            raise ConfigError(f"{address!r} is not a Dask scheduler: the connection ended "
+                              f"before its handshake ({exc})", hint=_SCHEDULER_HINT) from None
+    if not _is_handshake(body):
+        raise ConfigError(f"{address!r} answered but is not a Dask scheduler: it sent "
+                          f"{(head + body)[:40]!r} instead of a Dask handshake",
+                          hint=_SCHEDULER_HINT)
+
+
+def _recv_exactly(conn, n: int, deadline: float) -> bytes:
+    """``n`` bytes, all by ``deadline`` (time.monotonic) or TimeoutError."""
+    buf = bytearray()
+    while len(buf) < n:
+        left = deadline - time.monotonic()
+        if left <= 0:
+            raise TimeoutError
+        conn.settimeout(left)
+        part = conn.recv(n - len(buf))
+        if not part:
+            raise ConnectionError(f"closed after {len(buf)} of {n} bytes")
+        buf += part
+    return bytes(buf)
+
+
+def _recv_some(conn, n: int) -> bytes:
+    """Up to ``n`` more bytes if they come within 0.2 s (to show a banner in the message)."""
+    conn.settimeout(0.2)
+    try:
+        return conn.recv(n)
+    except OSError:
+        return b""
+
+
+def _is_handshake(body: bytes) -> bool:
+    """``body`` framed as distributed frames it (count, lengths, frames) and its last frame a
+    msgpack map with the handshake's keys (``compression``, ``python``)."""
+    if len(body) < 16:
+        return False
+    (count,) = struct.unpack_from("<Q", body)
+    if not 1 <= count <= 16 or len(body) < 8 * (count + 1):
+        return False
+    lengths = struct.unpack_from(f"<{count}Q", body, 8)
+    start = 8 * (count + 1)
+    if start + sum(lengths) != len(body):
+        return False
+    last = body[len(body) - lengths[-1]:]
+    return b"\xabcompression" in last and b"\xa6python" in last  # msgpack str keys
 
 
 def make_executor(backend: str = "process", workers: int | None = None,

@@ -85,7 +85,7 @@ class RobustnessResult:
                name: str = "batch-robustness"):
         """Add a section: the estimates as a table, histograms of the peak force and of the settling
         time, and P(damage), P(lost) against stiffness with their confidence bands."""
-        from ..report.plots import pyplot
+        from ..report.plots import plain, pyplot
 
         plt = pyplot()
         sec = report.section(title, intro)
@@ -132,7 +132,7 @@ class RobustnessResult:
 
         ax[2].xaxis.set_minor_formatter(NullFormatter())
         ax[2].set_ylim(-0.02, 1.02)
-        ax[2].set_xlabel(f"{self.stiffness} (N/m)")
+        ax[2].set_xlabel(plain(f"{self.stiffness} (N/m)"))
         ax[2].set_ylabel("probability")
         ax[2].legend(fontsize=8)
         fig.tight_layout()

@@ -1,11 +1,14 @@
 """``gripkit excitation fourier URDF --out TRAJ.csv [--f0 HZ] [--harmonics H] [--fs HZ]
-[--periods P] [--velocity-limit V] [--acceleration-limit A] [--json]``: design a periodic
+[--periods P] [--velocity-limit V] [--acceleration-limit A] [--restarts R] [--seed S]
+[--time-limit SECONDS] [--json]``: design a periodic
 Fourier-series excitation of every actuated joint of a URDF chain that minimises the condition
 number of the identification regressor within the position (URDF), velocity and acceleration
 limits (:func:`gripkit.excitation.fourier_trajectory`), and write it (columns ``t``,
 ``q_<joint>``, ``qd_<joint>``, ``qdd_<joint>``; SI units) in the format ``--out``'s suffix names:
 ``.csv`` (a plain header of names), ``.parquet`` or ``.h5`` (:func:`gripkit.io.save`, with units);
-another suffix is refused before the design starts. Every format is written atomically."""
+another suffix is refused before the design starts. Every format is written atomically. A design
+estimated to take longer than the time limit is refused before it starts; one above 10 s shows
+its progress."""
 
 from __future__ import annotations
 
@@ -33,8 +36,13 @@ def excitation_fourier(
     acceleration_limit: float = typer.Option(None, "--acceleration-limit", help="|q̈| limit for every joint (default 10)."),
     base_link: str = typer.Option(None, "--base-link", help="Base link of the chain."),
     tip_link: str = typer.Option(None, "--tip-link", help="Tip link of the chain."),
-    restarts: int = typer.Option(0, "--restarts", help="Extra random starting points of the optimisation."),
-    seed: int = typer.Option(0, "--seed", help="Seed of the starting points."),
+    restarts: int = typer.Option(0, "--restarts", min=0,
+                                 help="Extra random starting points of the optimisation."),
+    seed: int = typer.Option(0, "--seed", min=0,
+                             help="Seed of the starting points (0, 1, 2, ...)."),
+    time_limit: float = typer.Option(None, "--time-limit",
+                                     help="Seconds the design may take, estimated before it starts "
+                                          "(default 1800); a longer design is refused."),
     json_out: bool = JsonOpt,
 ):
     """Design an optimal Fourier excitation trajectory for a URDF chain and write it as CSV."""
@@ -48,7 +56,7 @@ def excitation_fourier(
     status(f"optimising {2 * chain.dof * harmonics} Fourier coefficients of {chain.name} ...")
     tr = fourier_trajectory(chain, f0=f0, harmonics=harmonics, dt=1.0 / fs, periods=periods,
                             velocity_limits=velocity_limit, acceleration_limits=acceleration_limit,
-                            restarts=restarts, seed=seed)
+                            restarts=restarts, seed=seed, time_limit=time_limit)
     if out.suffix.lower() == ".csv":
         tr.to_csv(out)
     else:

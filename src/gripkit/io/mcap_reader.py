@@ -87,8 +87,11 @@ def read_mcap(path: Path, columns, stamp: str = "log",
             raise DataError(f"{path.name}: not an MCAP file (it does not start with the MCAP magic bytes)",
                             hint="check the file, or force another format with format='csv'|'parquet'|'hdf5'")
     if not columns:
-        raise DataError(f"{path.name}: name the MCAP columns to read (columns=[...], CLI: repeat --column)",
-                        hint="columns look like force=/fingertip/wrench:wrench.force.z")
+        raise DataError(f"{path.name}: name the MCAP columns to read (gripkit.io.load(path, "
+                        f"columns=[...]))",
+                        hint="columns look like force=/fingertip/wrench:wrench.force.z; the "
+                             "commands take the same names as their column options "
+                             "(--input /cmd:data[0] --output force=/ft:wrench.force.z)")
     specs = [parse_column(c) for c in columns]
     topics = {t for _, t, _ in specs}
     series: dict[str, tuple[list, list]] = {alias: ([], []) for alias, _, _ in specs}

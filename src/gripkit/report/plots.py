@@ -7,6 +7,9 @@
 * :func:`bode` — magnitude and phase of discrete-time models against frequency in Hz;
 * :func:`parameter_convergence` — recursive estimates with ±2σ bands and optional true values;
 * :func:`log_ticks` — labelled major ticks at 1, 2, 5 per decade on every log axis of an axes.
+
+Labels, legends and titles are shown as given, never parsed as mathtext (:func:`plain`): they
+often hold names read from files, and ``$`` in a column name must not stop a report.
 """
 
 from __future__ import annotations
@@ -16,7 +19,32 @@ from collections.abc import Mapping, Sequence
 import numpy as np
 
 __all__ = ["measured_vs_model", "residual_correlation", "pole_zero_map", "bode", "parameter_convergence",
-           "log_ticks"]
+           "log_ticks", "plain", "plain_math_fallback"]
+
+
+def plain(text) -> str:
+    """``text`` (a name from a file: a column, unit, joint) as a matplotlib label shown as it
+    is: each ``$`` escaped, so that no mathtext is parsed from data (``$\\frac{$`` would stop
+    the plot)."""
+    return str(text).replace("$", "\\$")
+
+
+def plain_math_fallback(fig) -> None:
+    """Show as plain text every text of ``fig`` whose mathtext does not parse (the report builder
+    calls this before it saves a figure, so that a label from data cannot stop a report)."""
+    from matplotlib import cbook
+    from matplotlib.mathtext import MathTextParser
+    from matplotlib.text import Text
+
+    parser = MathTextParser("path")
+    for t in fig.findobj(Text):
+        s = t.get_text()
+        if not (t.get_parse_math() and cbook.is_math_text(s)):
+            continue
+        try:
+            parser.parse(s)
+        except Exception:  # noqa: BLE001 - any parse failure: show the text as it is
+            t.set_parse_math(False)
 
 
 def pyplot():
@@ -56,17 +84,18 @@ def log_ticks(*axes) -> None:
 def measured_vs_model(t: np.ndarray, measured: np.ndarray, models: Mapping[str, np.ndarray], *,
                       ylabel: str = "output", title: str = "", measured_label: str = "measured",
                       extra: Mapping[str, np.ndarray] | None = None):
-    """Measured output (solid) and model outputs (dashed) against time ``t`` (s)."""
+    """Measured output (solid) and model outputs (dashed) against time ``t`` (s); labels and title
+    are shown as given (no mathtext: they often hold names from data)."""
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(10, 3.6))
-    ax.plot(t, measured, color="0.55", lw=0.9, label=measured_label)
+    ax.plot(t, measured, color="0.55", lw=0.9, label=plain(measured_label))
     for label, v in (extra or {}).items():
-        ax.plot(t, v, lw=1.2, label=label)
+        ax.plot(t, v, lw=1.2, label=plain(label))
     for label, v in models.items():
-        ax.plot(t, v, "--", lw=1.4, label=label)
+        ax.plot(t, v, "--", lw=1.4, label=plain(label))
     ax.set_xlabel("time [s]")
-    ax.set_ylabel(ylabel)
-    ax.set_title(title)
+    ax.set_ylabel(plain(ylabel))
+    ax.set_title(plain(title))
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     fig.tight_layout()
@@ -84,9 +113,9 @@ def residual_correlation(tests: Mapping[str, object], *, title: str = ""):
     for k, (label, rt) in enumerate(tests.items()):
         off = (k - (len(tests) - 1) / 2) * width
         a1.bar(rt.lags[1:] + off, rt.autocorr[1:], width=width,
-               label=f"{label} (whiteness p = {rt.whiteness_p:.2g})")
+               label=plain(f"{label} (whiteness p = {rt.whiteness_p:.2g})"))
         a2.bar(rt.lags + off, rt.crosscorr, width=width,
-               label=f"{label} (independence p = {rt.independence_p:.2g})")
+               label=plain(f"{label} (independence p = {rt.independence_p:.2g})"))
         for ax in (a1, a2):
             ax.axhline(rt.bound, color=f"C{k}", ls=":", lw=1)
             ax.axhline(-rt.bound, color=f"C{k}", ls=":", lw=1)
@@ -98,7 +127,7 @@ def residual_correlation(tests: Mapping[str, object], *, title: str = ""):
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)
     if title:
-        fig.suptitle(title)
+        fig.suptitle(plain(title))
     fig.tight_layout()
     return fig
 
@@ -120,9 +149,9 @@ def pole_zero_map(models: Mapping[str, tuple[Sequence[complex], Sequence[complex
         z = np.atleast_1d(np.asarray(z, dtype=complex))
         c, ms = f"C{k}", max(15.0 - 3.0 * k, 5.0)
         ax.plot(p.real, p.imag, pole_marks[k % 4], color=c, ms=ms, mew=2, zorder=3 + k,
-                label=f"{label} poles")
+                label=plain(f"{label} poles"))
         ax.plot(z.real, z.imag, zero_marks[k % 4], color=c, ms=ms, mfc="none", mew=1.6, zorder=3 + k,
-                label=f"{label} zeros")
+                label=plain(f"{label} zeros"))
         allz += list(np.abs(p)) + list(np.abs(z))
     lim = 1.1 * max(allz)
     ax.set_xlim(-lim, lim)
@@ -130,7 +159,7 @@ def pole_zero_map(models: Mapping[str, tuple[Sequence[complex], Sequence[complex
     ax.set_aspect("equal")
     ax.set_xlabel("Re z")
     ax.set_ylabel("Im z")
-    ax.set_title(title)
+    ax.set_title(plain(title))
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, loc="lower left")
     fig.tight_layout()
@@ -156,16 +185,17 @@ def bode(models: Mapping[str, object], *, n: int = 512, title: str = "", magnitu
         else:  # estimates often coincide: cycle the dash pattern as well as the colour
             style = dict(color=f"C{k}", lw=1.4, zorder=2, ls=("-", "--", "-.", ":")[k % 4])
             k += 1
-        am.semilogx(f[sel], 20 * np.log10(np.maximum(np.abs(h[sel]), 1e-300)), label=label, **style)
-        ap.semilogx(f[sel], np.degrees(np.unwrap(np.angle(h[sel]))), label=label, **style)
-    am.set_ylabel(f"magnitude [dB{' ' + magnitude_unit if magnitude_unit else ''}]")
+        shown = plain(label)
+        am.semilogx(f[sel], 20 * np.log10(np.maximum(np.abs(h[sel]), 1e-300)), label=shown, **style)
+        ap.semilogx(f[sel], np.degrees(np.unwrap(np.angle(h[sel]))), label=shown, **style)
+    am.set_ylabel(plain(f"magnitude [dB{' ' + magnitude_unit if magnitude_unit else ''}]"))
     ap.set_ylabel("phase [deg]")
     ap.set_xlabel("frequency [Hz]")
     for ax in (am, ap):
         ax.grid(alpha=0.3, which="both")
     log_ticks(am, ap)
     am.legend(fontsize=8)
-    am.set_title(title)
+    am.set_title(plain(title))
     fig.tight_layout()
     return fig
 
@@ -193,7 +223,7 @@ def parameter_convergence(t: np.ndarray, theta: np.ndarray, std: np.ndarray, nam
                 lo, hi = min(lo, truth[i]), max(hi, truth[i])
             pad = 0.3 * (hi - lo) + 1e-12
             ax.set_ylim(lo - pad, hi + pad)
-        ax.set_ylabel(name)
+        ax.set_ylabel(plain(name))
         ax.grid(alpha=0.3)
     for j in range(p, nrow * ncol):
         axes[j // ncol][j % ncol].set_visible(False)
@@ -201,6 +231,6 @@ def parameter_convergence(t: np.ndarray, theta: np.ndarray, std: np.ndarray, nam
     for ax in axes[-1]:
         ax.set_xlabel("time [s]")
     if title:
-        fig.suptitle(title)
+        fig.suptitle(plain(title))
     fig.tight_layout()
     return fig

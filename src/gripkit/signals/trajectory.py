@@ -185,7 +185,8 @@ class Trajectory:
                 f"{why} needs uniform sampling; the interval at t={self.t[i]:.6g} s is {d[i]:.6g} s "
                 f"against a median of {med:.6g} s ({100 * abs(d[i] - med) / med:.3g} % off, "
                 f"tolerance {100 * rtol:.3g} %)",
-                hint="resample the data first (gripkit.signals.resample, or CLI --resample HZ)",
+                hint="resample the data first (gripkit.signals.resample(tr, dt); for the command "
+                     "line, save the result with gripkit.io.save)",
             )
         return self.dt
 

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from ..report.html import Report
-from ..report.plots import measured_vs_model, pyplot
+from ..report.plots import measured_vs_model, plain, pyplot
 
 __all__ = ["dynamics_report", "parameter_unit", "write_dynamics_report"]
 
@@ -38,8 +38,8 @@ def _residual_figure(t, r, joints, rms):
         ax = axes[j, 0]
         ax.plot(t, r[:, j], lw=0.8)
         ax.axhline(0.0, color="k", lw=0.6)
-        ax.set_ylabel(name, fontsize=8)
-        ax.set_title(f"{name}: residual RMS {rms[j]:.3g}", fontsize=8)
+        ax.set_ylabel(plain(name), fontsize=8)
+        ax.set_title(plain(f"{name}: residual RMS {rms[j]:.3g}"), fontsize=8)
         ax.grid(alpha=0.3)
     axes[-1, 0].set_xlabel("time [s]")
     fig.tight_layout()

@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 from ..report.html import Report
-from ..report.plots import measured_vs_model, pyplot
+from ..report.plots import measured_vs_model, plain, pyplot
 from .frf import frf
 from .linear_model import VALIDATION_FIT
 from .pem_ss import predict_errors
@@ -42,11 +42,11 @@ def _residual_figure(e, u, outputs, inputs):
     for i in range(p):
         ax = axes[i, 0]
         ax.bar(lags[1:], _xcorr(e[:, i], e[:, i], lags)[1:], width=0.7)
-        ax.set_title(f"auto-corr. of {outputs[i]} residual", fontsize=8)
+        ax.set_title(plain(f"auto-corr. of {outputs[i]} residual"), fontsize=8)
         for j in range(m):
             ax2 = axes[i, 1 + j]
             ax2.bar(lags, _xcorr(e[:, i], u[:, j], lags), width=0.7, color="C1")
-            ax2.set_title(f"{outputs[i]} residual × past {inputs[j]}", fontsize=8)
+            ax2.set_title(plain(f"{outputs[i]} residual × past {inputs[j]}"), fontsize=8)
         for a in axes[i]:
             a.axhline(bound, color="k", ls=":", lw=0.8)
             a.axhline(-bound, color="k", ls=":", lw=0.8)
@@ -123,7 +123,7 @@ def bode_figure(system, dt, estimate):
                 ref = np.interp(fe[ok], f, ph[:, i, j])
                 php = php + 360 * np.round((ref - php) / 360)
                 ap.plot(fe[ok], php, ".", ms=2, color="0.45")
-            am.set_title(f"{system.inputs[j]} → {system.outputs[i]}", fontsize=9)
+            am.set_title(plain(f"{system.inputs[j]} → {system.outputs[i]}"), fontsize=9)
             am.grid(alpha=0.3, which="both")
             ap.grid(alpha=0.3, which="both")
             am.set_ylabel("|H|")
@@ -155,7 +155,8 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=()) -> R
     dt = data.require_uniform(why="a model report")
     caught_lines = list(warnings_list)
     rep = Report(f"gripkit model report: {model.structure}",
-                 f"{list(model.inputs)} → {list(model.outputs)}, order {ss.n_states}, data {data_name}")
+                 f"{', '.join(model.inputs)} → {', '.join(model.outputs)}, order {ss.n_states}, "
+                 f"data {data_name}")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         u = model._columns(data, model.inputs, model.u_offset, "input")
