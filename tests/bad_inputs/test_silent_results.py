@@ -1,0 +1,109 @@
+"""Silent wrong answers (issue 22, items 6, 7, 10 and the unclear messages): each case asserts the
+error class and a key phrase of the one-line message, or the warning, and a number where the fix
+changes a result.
+
+The ARX system of the RLS cases is y(t) = 1.5 y(t−1) − 0.7 y(t−2) + 1.0 u(t−1) + 0.5 u(t−2) + e(t)
+(poles 0.75 ± 0.37j)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from gripkit import DataError
+from gripkit.sysid import RLS, rls
+from gripkit.sysid.rls import ABSURD_JUMP
+from corpus import assert_user_error, assert_warned  # noqa: F401  (used by later sections)
+
+TRUE = np.array([-1.5, 0.7, 1.0, 0.5])  # a1, a2, b1, b2
+
+
+def arx_data(n: int = 600, noise: float = 0.01, seed: int = 5) -> tuple[np.ndarray, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    u = rng.standard_normal(n)
+    y = np.zeros(n)
+    e = noise * rng.standard_normal(n)
+    for t in range(2, n):
+        y[t] = 1.5 * y[t - 1] - 0.7 * y[t - 2] + 1.0 * u[t - 1] + 0.5 * u[t - 2] + e[t]
+    return u, y
+
+
+# ---------------------------------------------------------------- 6. one absurd sample in RLS
+@pytest.mark.parametrize("bad", [(0.1, 1e300), (1e300, 0.1), (0.1, -1e20)])
+def test_rls_update_refuses_an_absurd_sample_and_keeps_its_state(bad):
+    """The issue's case: y = 1e300 after 300 normal samples made θ ±3e299. Refused as a corrupt
+    sample (not 'scale u and y'), θ and P unchanged, and the estimator goes on exactly as if the
+    sample had never come."""
+    u, y = arx_data()
+    est = RLS(2, 2, 1)
+    for t in range(300):
+        est.update(u[t], y[t])
+    theta, P, n = est.theta, est.P, est.n_updates
+    name = "u" if abs(bad[0]) > 1 else "y"
+    with pytest.raises(DataError, match=rf"RLS.update: sample 300 has {name} = .*times the largest "
+                                        rf"\|{name}\| before it .*a corrupt sample.*the estimator is "
+                                        r"unchanged; drop or repair the sample") as info:
+        est.update(*bad)
+    assert "scale u and y" not in str(info.value)
+    np.testing.assert_array_equal(est.theta, theta)
+    np.testing.assert_array_equal(est.P, P)
+    assert est.n_updates == n
+    ref = RLS(2, 2, 1)
+    for t in range(600):
+        ref.update(u[t], y[t])
+    for t in range(300, 600):
+        est.update(u[t], y[t])
+    np.testing.assert_array_equal(est.theta, ref.theta)
+    np.testing.assert_allclose(est.theta, TRUE, atol=0.01)
+
+
+def test_rls_update_threshold_is_the_documented_jump():
+    """Just below ABSURD_JUMP times the running peak of |y| is accepted, just above refused."""
+    u, y = arx_data()
+    est = RLS(2, 2, 1)
+    for t in range(300):
+        est.update(u[t], y[t])
+    peak = np.max(np.abs(y[:300]))
+    with pytest.raises(DataError, match="a corrupt sample"):
+        est.update(0.0, 1.01 * ABSURD_JUMP * peak)
+    est.update(0.0, 0.99 * ABSURD_JUMP * peak)
+    assert est.n_samples == 301
+
+
+def test_rls_batch_refuses_the_record_naming_the_sample():
+    u, y = arx_data()
+    y[412] = 1e300
+    with pytest.raises(DataError, match=r"RLS \[2 2 1\]: sample 412 has y = 1e\+300, .*a corrupt "
+                                        r"sample.*the record was not processed") as info:
+        rls(u, y, 2, 2, 1)
+    assert "scale u and y" not in str(info.value)
+    y[412] = 1e15  # finite, no overflow anywhere: before the fix θ came back ~1e13 off
+    with pytest.raises(DataError, match="sample 412 has y = 1e\\+15"):
+        rls(u, y, 2, 2, 1)
+
+
+def test_rls_run_continues_the_running_peaks_of_update():
+    """run() and a loop of update() refuse the same sample: the peak carries from one to the other."""
+    u, y = arx_data()
+    est = RLS(2, 2, 1)
+    est.run(u[:300], y[:300])
+    with pytest.raises(DataError, match="sample 300 has y"):
+        est.update(0.0, 1e30)
+    est2 = RLS(2, 2, 1)
+    for t in range(300):
+        est2.update(u[t], y[t])
+    with pytest.raises(DataError, match="sample 300 has y"):
+        est2.run(np.zeros(10), np.full(10, 1e30))
+
+
+def test_rls_signal_growing_over_many_samples_is_not_refused():
+    """A signal that grows by 1e12 over 600 samples (a factor 1.05 per sample) is data, not a
+    corrupt sample."""
+    u, _ = arx_data()
+    g = 1.05 ** np.arange(600)
+    y = 0.5 * g * np.sin(np.arange(600))
+    est = RLS(1, 1, 1)
+    for t in range(600):
+        est.update(u[t], y[t])
+    assert est.n_samples == 600
+    assert rls(u, y, 1, 1, 1).n_samples == 600
