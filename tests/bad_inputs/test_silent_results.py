@@ -107,3 +107,50 @@ def test_rls_signal_growing_over_many_samples_is_not_refused():
         est.update(u[t], y[t])
     assert est.n_samples == 600
     assert rls(u, y, 1, 1, 1).n_samples == 600
+
+
+# ---------------------------------------------------------------- 7. identify ss on an unstable plant
+def unstable_plant(n: int = 400, seed: int = 1) -> tuple[np.ndarray, np.ndarray]:
+    """y(t) = 1.02 y(t−1) + 0.5 u(t−1) + 0.01 e(t): one pole at 1.02."""
+    rng = np.random.default_rng(seed)
+    u = rng.standard_normal(n)
+    y = np.zeros(n)
+    for t in range(1, n):
+        y[t] = 1.02 * y[t - 1] + 0.5 * u[t - 1]
+    return u, y + 0.01 * rng.standard_normal(n)
+
+
+def test_n4sid_warns_when_it_stabilises_an_unstable_plant():
+    """The stable replacement is returned (default stable=True) with a warning that gives the
+    largest |pole| before (the true 1.02) and after, and both fits; stable=False keeps the pole."""
+    from gripkit.errors import StabilityWarning
+    from gripkit.sysid import n4sid
+
+    u, y = unstable_plant()
+    with pytest.warns(StabilityWarning, match=r"n4sid: the data point to an unstable system \(the "
+                                              r"subspace estimate has largest \|pole\| 1\.02, free-run "
+                                              r"fit 100 %\); it was stabilised to largest \|pole\| 0\.\d+"):
+        m = n4sid(u, y, 1, dt=0.01)
+    s = m.info["stabilised"]
+    assert abs(s["largest_pole_before"] - 1.02) < 1e-3
+    assert s["fit_percent_before"][0] > 99.0
+    assert np.max(np.abs(m.system.poles())) < 1.0 and m.fit_percent[0] < 50.0
+    with pytest.warns(StabilityWarning, match=r"the order-1 model is unstable \(largest \|pole\| 1\.02\)"):
+        kept = n4sid(u, y, 1, dt=0.01, stable=False)
+    np.testing.assert_allclose(np.abs(kept.system.poles()), [1.02], atol=1e-3)
+
+
+def test_cli_identify_ss_unstable_plant_warns_on_stderr_and_in_json(cli, tmp_path):
+    """The issue's case: "stable": true with a poor fit and no warning; now the warning names the
+    poles and fits before and after (PEM keeps the model stable)."""
+    u, y = unstable_plant()
+    p = tmp_path / "unstable.csv"
+    np.savetxt(p, np.column_stack([np.arange(u.size) * 0.01, u, y]), delimiter=",",
+               header="t,u [V],y [m]", comments="")
+    res = cli("identify", "ss", p, "--input", "u", "--output", "y", "--order", 1, "--json")
+    assert res.code == 0, res.err
+    assert_warned(res, "StabilityWarning: pem-innovation: the data point to an unstable system "
+                       "(the subspace estimate has largest |pole| 1.02")
+    assert_warned(res, "it was stabilised to largest |pole|")
+    d = res.json()
+    assert d["stable"] is True and d["info"]["stabilised"]["largest_pole_before"] > 1.0

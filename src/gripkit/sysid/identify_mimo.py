@@ -162,6 +162,7 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
         from_factor,
         select_order,
         subspace_factor,
+        warn_if_stabilised,
     )
 
     if method not in SUBSPACE_METHODS:
@@ -214,6 +215,7 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     if refine:
         status(f"PEM refinement ({form} form) of the order-{model.order} model")
         model = pem(model, u=d.u, y=d.y, form=form)
+    warn_if_stabilised(model)
     if vd is not None:
         extras["validation_fit_percent"] = _validation_fit(model, vd)
     return model, extras
