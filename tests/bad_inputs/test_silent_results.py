@@ -7,13 +7,15 @@ The ARX system of the RLS cases is y(t) = 1.5 y(t−1) − 0.7 y(t−2) + 1.0 u(
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 import pytest
 
 from gripkit import DataError
 from gripkit.sysid import RLS, rls
 from gripkit.sysid.rls import ABSURD_JUMP
-from corpus import assert_user_error, assert_warned  # noqa: F401  (used by later sections)
+from corpus import assert_user_error, assert_warned
 
 TRUE = np.array([-1.5, 0.7, 1.0, 0.5])  # a1, a2, b1, b2
 
@@ -154,3 +156,52 @@ def test_cli_identify_ss_unstable_plant_warns_on_stderr_and_in_json(cli, tmp_pat
     assert_warned(res, "it was stabilised to largest |pole|")
     d = res.json()
     assert d["stable"] is True and d["info"]["stabilised"]["largest_pole_before"] > 1.0
+
+
+# ---------------------------------------------------------------- 10. step metrics of a short record
+def test_step_metrics_on_a_record_that_has_not_settled_warn():
+    """The issue's case: ζ = 0.026 (overshoot 92.2 % by the closed form) cut at 1.2 s measured an
+    overshoot of 315 % against the 'final level' of a still-ringing response, without a word."""
+    from gripkit.errors import AccuracyWarning
+    from gripkit.models.second_order import second_order_step
+    from gripkit.sysid.step_response import second_order_metrics, step_metrics
+
+    wn, zeta = 2 * np.pi, 0.026
+    true = second_order_metrics(wn, zeta)["overshoot_percent"]
+    assert true == pytest.approx(100 * np.exp(-np.pi * zeta / np.sqrt(1 - zeta**2)), rel=1e-3)
+    t = np.arange(0.0, 1.2, 1e-3)
+    with pytest.warns(AccuracyWarning, match=r"step_metrics: the response has not settled by the end "
+                                             r"of the record .*the record is too short"):
+        m = step_metrics(t, second_order_step(t, 1.0, wn, zeta))
+    assert m["overshoot_percent"] > 3 * true  # the number the warning is about
+    t = np.arange(0.0, 200.0, 1e-3)  # settled: the closed-form overshoot, no warning
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        m = step_metrics(t, second_order_step(t, 1.0, wn, zeta))
+    assert m["overshoot_percent"] == pytest.approx(true, abs=0.05)
+
+
+def test_step_metrics_noise_on_a_settled_response_is_not_unsettled():
+    from gripkit.models.second_order import second_order_step
+    from gripkit.sysid.step_response import step_metrics
+
+    t = np.arange(0.0, 3.0, 1e-3)
+    y = second_order_step(t, 1.0, 2 * np.pi, 0.7) + 0.05 * np.random.default_rng(0).standard_normal(t.size)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        step_metrics(t, y)
+
+
+# ---------------------------------------------------------------- unclear messages
+def test_cli_identify_step_at_the_last_sample_is_a_data_error(cli, tmp_path):
+    """Was: unexpected IndexError."""
+    n = 200
+    u = np.zeros(n)
+    u[-1] = 1.0
+    y = 1e-3 * np.random.default_rng(0).standard_normal(n)
+    p = tmp_path / "late.csv"
+    np.savetxt(p, np.column_stack([np.arange(n) * 0.01, u, y]), delimiter=",", header="t,u [V],y [m]",
+               comments="")
+    res = cli("identify", "step", p, "--input", "u", "--output", "y")
+    assert_user_error(res, "DataError", "input column 'u' changes only at t = 1.99 s, 1 sample(s) "
+                                        "before the end of the record")
