@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import DataError, GripkitWarning
+from ..errors import AccuracyWarning, DataError, GripkitError, GripkitWarning
 from ..progress import status
 from ..signals.trajectory import Trajectory
 from .arx_mimo import arx_mimo
@@ -216,9 +216,38 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
         status(f"PEM refinement ({form} form) of the order-{model.order} model")
         model = pem(model, u=d.u, y=d.y, form=form)
     warn_if_stabilised(model)
+    if detrend == "mean":
+        _warn_if_detrending_hurt(model, data, d.u.shape[0], input=input, output=output, method=method,
+                                 form=form, refine=refine, horizon=horizon, feedthrough=feedthrough)
     if vd is not None:
         extras["validation_fit_percent"] = _validation_fit(model, vd)
     return model, extras
+
+
+def _warn_if_detrending_hurt(model, data: Trajectory, n: int, **options) -> None:
+    """Mean detrending assumes the record's means are an operating point (an equilibrium). A mode
+    that does not settle within the record (N·|ln|z|| < 5: a near-integrator, a drift) breaks that
+    assumption; then the same order is fitted without detrending, and a warning names
+    ``--detrend none`` when that fits the data better by more than 10 points."""
+    poles = model.system.poles()
+    slowest = float(np.max(np.abs(poles))) if poles.size else 0.0
+    if not (0.0 < slowest < 1.0) or n * -math.log(slowest) >= 5.0:
+        return
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            other, _ = identify_ss(data, order=model.order, detrend="none", **options)
+        except GripkitError:
+            return
+    mean_fit, none_fit = float(np.mean(model.fit_percent)), float(np.mean(other.fit_percent))
+    if none_fit > mean_fit + 10.0:
+        tau = -model.system.dt / math.log(slowest)
+        warnings.warn(
+            f"identify ss: removing the means (detrend 'mean', the default) hurt this fit: the slowest "
+            f"pole (|z| = {slowest:.6g}, time constant {tau:.4g} s) does not settle within the "
+            f"{n * model.system.dt:.4g} s record, so the output drifts and its mean is no operating "
+            f"point; free-run fit {mean_fit:.4g} % with the means removed, {none_fit:.4g} % without; "
+            f"use --detrend none (Python: detrend='none')", AccuracyWarning, stacklevel=3)
 
 
 def identify_frf(data: Trajectory, *, input, output, detrend: str = "mean", **options):
