@@ -310,3 +310,28 @@ def test_cli_identify_ss_mean_detrending_of_a_near_integrator_warns(cli, tmp_pat
     assert res.code == 0 and res.json()["warnings"] == []
     assert res.json()["fit_percent"][0] > 99.0
     assert abs(res.json()["poles"][0][0] - 0.9995) < 1e-4
+
+
+def _fixed_chain_urdf(n_fixed: int) -> str:
+    """One revolute joint carrying a chain of ``n_fixed`` fixed joints, 1 mm apart along z; every
+    link 10 g with its centre of mass 10 mm above its origin."""
+    inertial = ('<inertial><mass value="0.01"/><origin xyz="0 0 0.01"/><inertia ixx="1e-6" '
+                'iyy="1e-6" izz="1e-6" ixy="0" ixz="0" iyz="0"/></inertial>')
+    links = ['<link name="base"/>', f'<link name="l0">{inertial}</link>']
+    joints = ['<joint name="j0" type="revolute"><parent link="base"/><child link="l0"/>'
+              '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>']
+    for i in range(1, n_fixed + 1):
+        links.append(f'<link name="l{i}">{inertial}</link>')
+        joints.append(f'<joint name="f{i}" type="fixed"><parent link="l{i - 1}"/><child link="l{i}"/>'
+                      f'<origin xyz="0 0 0.001"/></joint>')
+    return '<robot name="r">' + "".join(links + joints) + "</robot>"
+
+
+def test_urdf_with_5000_fixed_joints_is_merged_without_recursion():
+    """Was: RecursionError. The 5001 links merge into one body of 50.01 g·1000 whose centre of mass
+    lies at the mean of their offsets: 0.01 + 0.001·2500 = 2.51 m."""
+    from gripkit.multibody.urdf import from_urdf
+
+    chain = from_urdf(_fixed_chain_urdf(5000))
+    np.testing.assert_allclose(chain.mass, [5001 * 0.01], rtol=1e-12)
+    np.testing.assert_allclose(chain.com[0], [0.0, 0.0, 0.01 + 0.001 * 2500], rtol=1e-9, atol=1e-12)
