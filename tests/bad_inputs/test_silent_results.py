@@ -335,3 +335,16 @@ def test_urdf_with_5000_fixed_joints_is_merged_without_recursion():
     chain = from_urdf(_fixed_chain_urdf(5000))
     np.testing.assert_allclose(chain.mass, [5001 * 0.01], rtol=1e-12)
     np.testing.assert_allclose(chain.com[0], [0.0, 0.0, 0.01 + 0.001 * 2500], rtol=1e-9, atol=1e-12)
+
+
+@pytest.mark.parametrize("scale", [1e300, 1e-300])
+@pytest.mark.parametrize("command", [("ss", "--order", 2), ("tf", "--poles", 2, "--zeros", 1), ("frf",)])
+def test_cli_ss_tf_frf_at_extreme_scales_name_the_scale(cli, tmp_path, scale, command):
+    """Was: 'no input power' (frf), 'at most 0 states' (ss) or a singular Jacobian (tf)."""
+    u, y = arx_data(2000)
+    p = tmp_path / "scaled.csv"
+    np.savetxt(p, np.column_stack([np.arange(u.size) * 0.01, u * scale, y * scale]), delimiter=",",
+               header="t,u [V],y [m]", comments="", fmt="%.17g")
+    res = cli("identify", *command[:1], p, "--input", "u", "--output", "y", *command[1:])
+    assert_user_error(res, "DataError", f"input column 'u' has values up to {np.abs(u).max() * scale:.3g}")
+    assert "between 1e-100 and 1e+100" in res.error_lines[0]

@@ -104,10 +104,35 @@ def mimo_data(data: Trajectory, inputs, outputs, detrend: str = "mean", why: str
             raise DataError(f"{what} column {name!r} is constant ({x[0, int(np.argmax(flat))]:.6g} for all "
                             f"{x.shape[0]} samples): it carries no information",
                             hint="drop it from --input/--output or check the data")
+    _check_scale(ins, u, "input", why)
+    _check_scale(outs, y, "output", why)
     u0 = u.mean(axis=0) if detrend == "mean" else np.zeros(len(ins))
     y0 = y.mean(axis=0) if detrend == "mean" else np.zeros(len(outs))
     return MimoData(u - u0, y - y0, dt, ins, outs, tuple(data.unit(n) for n in ins),
                     tuple(data.unit(n) for n in outs), tuple(map(float, u0)), tuple(map(float, y0)))
+
+
+#: Largest and smallest peak magnitude of a column that state-space, frequency-response and
+#: transfer-function estimation accept: they form sums of squares and of products of the signals
+#: (covariances, spectra, Gram matrices), which leave float64 (1e±308) for values beyond about
+#: 1e±150; 1e±100 keeps the margin for record lengths and orders.
+SCALE_LIMITS = (1e-100, 1e100)
+
+
+def _check_scale(names, x: np.ndarray, what: str, why: str) -> None:
+    """Refuse a column whose values are too large or too small for the estimators' sums of squares
+    (the SISO polynomial estimators scale internally; these do not)."""
+    peak = np.max(np.abs(x), axis=0)
+    lo, hi = SCALE_LIMITS
+    bad = (peak > hi) | (peak < lo)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise DataError(
+            f"{what} column {names[i]!r} has values up to {peak[i]:.3g}: {why} forms sums of squares "
+            f"of the signals, which leave float64 beyond about 1e±150, so it accepts peak values "
+            f"between {lo:.0e} and {hi:.0e}",
+            hint="give the column in other units (multiply it by a power of ten); arx, armax and oe "
+                 "(SISO) scale internally")
 
 
 def _validation_data(validate: Trajectory, inputs, outputs, dt: float, detrend: str) -> MimoData:
