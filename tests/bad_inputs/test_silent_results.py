@@ -348,3 +348,79 @@ def test_cli_ss_tf_frf_at_extreme_scales_name_the_scale(cli, tmp_path, scale, co
     res = cli("identify", *command[:1], p, "--input", "u", "--output", "y", *command[1:])
     assert_user_error(res, "DataError", f"input column 'u' has values up to {np.abs(u).max() * scale:.3g}")
     assert "between 1e-100 and 1e+100" in res.error_lines[0]
+
+
+# ---------------------------------------------------------------- 8. physical dimensions
+def _io_csv(path, u, y, u_unit, y_unit):
+    np.savetxt(path, np.column_stack([np.arange(u.size) * 0.01, u, y]), delimiter=",",
+               header=f"t,u [{u_unit}],y [{y_unit}]", comments="", fmt="%.17g")
+    return path
+
+
+def test_cli_compare_and_simulate_check_the_models_units(cli, tmp_path):
+    """The issue's case: a model of u [A] → y [N] compared with data u [V], y [N] reported 99.8 %.
+    Another dimension is refused naming the column; another unit of the same dimension (mA, mN)
+    is converted and gives the fit of the estimation data."""
+    u, y = arx_data(2000)
+    est = _io_csv(tmp_path / "uA.csv", u, y, "A", "N")
+    model = tmp_path / "m.json"
+    assert cli("identify", "arx", est, "--input", "u", "--output", "y", "--na", 2, "--nb", 2, "--nk", 1,
+               "--out", model).code == 0
+    ref = cli("compare", model, est, "--json").json()["fit_percent"][0]
+    volts = _io_csv(tmp_path / "uV.csv", u, y, "V", "N")
+    for cmd in (("compare", model, volts), ("simulate", model, "--data", volts)):
+        assert_user_error(cli(*cmd), "DataError", "input column 'u' is in 'V' (dimension [mass] * [length] "
+                                                  "** 2 / [time] ** 3 / [current]), but the model's input "
+                                                  "'u' is in 'A' (dimension [current])")
+    for name, uu, yy, units in (("mA", u * 1e3, y, ("mA", "N")), ("mN", u, y * 1e3, ("A", "mN"))):
+        res = cli("compare", model, _io_csv(tmp_path / f"{name}.csv", uu, yy, *units), "--json")
+        assert res.code == 0, res.err
+        assert res.json()["fit_percent"][0] == pytest.approx(ref, abs=1e-9)
+
+
+def test_model_in_milliamperes_converts_data_in_amperes():
+    """A model whose input unit is mA (B per mA) simulated on data in A: the data are converted to
+    mA first, so the result equals the model driven by 1000·u."""
+    from gripkit.lti import TransferFunction
+    from gripkit.signals.trajectory import Trajectory
+    from gripkit.sysid.linear_model import LinearModel
+
+    g = TransferFunction([0.0, 1e-3, 0.5e-3], [1.0, -1.5, 0.7], dt=0.01, inputs="u", outputs="y",
+                         input_units="mA", output_units="N")
+    m = LinearModel(g, "arx")
+    u, _ = arx_data(300)
+    tr = Trajectory(np.arange(300) * 0.01, {"u": u}, {"u": "A"}, {"dt": 0.01})
+    np.testing.assert_allclose(m.simulate_data(tr)[:, 0], m.simulate(1e3 * u[:, None], dt=0.01)[:, 0],
+                               rtol=1e-12, atol=1e-12)
+    bad = Trajectory(np.arange(300) * 0.01, {"u": u}, {"u": "V"}, {"dt": 0.01})
+    with pytest.raises(DataError, match="input column 'u' is in 'V'.*the model's input 'u' is in 'mA'"):
+        m.simulate_data(bad)
+
+
+def test_cli_identify_friction_checks_position_and_effort_dimensions(cli, tmp_path):
+    """The issue's case: a position in N and an effort in m were accepted."""
+    t = np.arange(4000) * 1e-3
+    q = 0.5 * np.sin(2 * np.pi * t)
+    tau = 0.2 * np.gradient(np.gradient(q, t), t) + 0.3 * np.sign(np.gradient(q, t))
+    p = tmp_path / "swapped.csv"
+    np.savetxt(p, np.column_stack([t, q, tau]), delimiter=",", header="t,q [N],tau [m]", comments="")
+    res = cli("identify", "friction", p, "--position", "q", "--effort", "tau")
+    assert_user_error(res, "DataError", "position column 'q' is in 'N' (dimension [mass] * [length] / "
+                                        "[time] ** 2), expected a length (like 'm') or an angle")
+    np.savetxt(p, np.column_stack([t, q, tau]), delimiter=",", header="t,q [deg],tau [m]", comments="")
+    res = cli("identify", "friction", p, "--position", "q", "--effort", "tau")
+    assert_user_error(res, "DataError", "effort column 'tau' is in 'm' (dimension [length]), expected a "
+                                        "force (like 'N') or a torque")
+
+
+def test_identify_bouc_wen_refuses_swapped_columns():
+    """The issue's case: input and output swapped fitted 95 % and labelled the result m/V."""
+    from gripkit.signals.trajectory import Trajectory
+    from gripkit.sysid.bouc_wen import identify_bouc_wen
+
+    t = np.arange(2000) * 1e-3
+    U = 50 * (1 - np.cos(2 * np.pi * t))
+    tr = Trajectory(t, {"U": U, "y": 1e-7 * U}, {"U": "V", "y": "m"}, {"dt": 1e-3})
+    with pytest.raises(DataError, match=r"input \(voltage\) column 'y' is in 'm' \(dimension \[length\]\), "
+                                        r"expected a voltage"):
+        identify_bouc_wen(tr, input="y", output="U")

@@ -14,7 +14,12 @@ from ..arguments import sample_interval
 from ..errors import DataError, UnidentifiableError
 
 __all__ = ["as_signal", "as_io_matrix", "check_io", "check_order", "check_dt", "require_samples", "check_excitation",
-           "check_output_varies", "checked_problem", "check_identifiable", "check_persistent_excitation"]
+           "check_output_varies", "checked_problem", "check_identifiable", "check_persistent_excitation",
+           "check_dimension", "LENGTH_OR_ANGLE", "FORCE_OR_TORQUE"]
+
+#: Expected dimensions for :func:`check_dimension`: a description and a reference unit each.
+LENGTH_OR_ANGLE = {"a length": "m", "an angle": "rad"}
+FORCE_OR_TORQUE = {"a force": "N", "a torque": "N*m"}
 
 
 def as_signal(x, name: str) -> np.ndarray:
@@ -143,6 +148,24 @@ def check_persistent_excitation(u: np.ndarray, order: int, what: str, name: str 
             f"{order} parameters of the model cannot all be determined; no estimate returned",
             hint="excite the system more richly (more frequencies than parameters: multisine, PRBS, "
                  "noise: gripkit.excitation) or use fewer poles/zeros")
+
+
+def check_dimension(column: str, unit: str | None, expected: dict[str, str], role: str) -> None:
+    """Refuse a column whose unit measures none of the ``expected`` dimensions (a description
+    mapped to a reference unit, e.g. ``{"a voltage": "V"}``): a position in N, an effort in m, an
+    input and output swapped. A column without a unit (``'1'``, as files without units load) is
+    not checked: nothing says what it measures. Units of the right dimension were converted to SI
+    when the file was read."""
+    if unit in (None, "", "1"):
+        return
+    from ..units import dimension_of, same_dimension
+
+    if any(same_dimension(unit, ref) for ref in expected.values()):
+        return
+    want = " or ".join(f"{d} (like {ref!r})" for d, ref in expected.items())
+    raise DataError(f"{role} column {column!r} is in {unit!r} (dimension {dimension_of(unit)}), expected {want}",
+                    hint=f"check that {column!r} is the {role} column (not swapped with another) and "
+                         f"that its header gives the right unit")
 
 
 def check_output_varies(y: np.ndarray, name: str = "output y") -> None:

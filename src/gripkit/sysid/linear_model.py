@@ -79,6 +79,24 @@ def fit_per_output(y, yhat) -> list[float]:
     return out
 
 
+def _in_unit(data, name: str, unit: str | None, what: str) -> np.ndarray:
+    """Column ``name`` of ``data`` in the model's ``unit``: converted when the data give another
+    unit of the same dimension, a :class:`DataError` when they give another dimension (a model of
+    u [A] compared with u [V]). Either side without a unit ('1' or none) is taken as it is."""
+    x = np.asarray(data[name], dtype=np.float64)
+    have = data.unit(name)
+    if unit in (None, "", "1") or have in (None, "", "1") or have == unit:
+        return x
+    from ..units import convert, dimension_of, same_dimension
+
+    if not same_dimension(have, unit):
+        raise DataError(f"data: {what} column {name!r} is in {have!r} (dimension {dimension_of(have)}), but "
+                        f"the model's {what} {name!r} is in {unit!r} (dimension {dimension_of(unit)}): "
+                        f"a different physical quantity",
+                        hint="check that the record holds the signals the model was identified from")
+    return convert(x, have, unit)
+
+
 @dataclass(frozen=True, eq=False)
 class LinearModel:
     """An identified linear model.
@@ -201,7 +219,8 @@ class LinearModel:
             raise DataError(f"data: the model's {what} column(s) {', '.join(map(repr, missing))} are missing; "
                             f"the data have {', '.join(map(repr, data.names))}",
                             hint="rename the columns or identify the model from matching data")
-        return np.column_stack([np.asarray(data[n], dtype=np.float64) - o for n, o in zip(names, offsets)])
+        units = self.system.input_units if what == "input" else self.system.output_units
+        return np.column_stack([_in_unit(data, n, u, what) - o for n, u, o in zip(names, units, offsets)])
 
     def simulate_data(self, data) -> np.ndarray:
         """Simulated outputs (N, p), offsets added back, for the input columns of a trajectory
