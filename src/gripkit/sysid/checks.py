@@ -12,10 +12,12 @@ import numpy as np
 
 from ..arguments import sample_interval
 from ..errors import DataError, UnidentifiableError
+from ..units import dimension_of, same_dimension
+from .regression import COND_LIMIT, _qr_r, scaled_condition
 
 __all__ = ["as_signal", "as_io_matrix", "check_io", "check_order", "check_dt", "require_samples", "check_excitation",
-           "check_output_varies", "checked_problem", "check_identifiable", "check_persistent_excitation",
-           "check_dimension", "LENGTH_OR_ANGLE", "FORCE_OR_TORQUE"]
+           "check_output_varies", "checked_problem", "check_identifiable",
+           "check_persistent_excitation", "check_dimension", "LENGTH_OR_ANGLE", "FORCE_OR_TORQUE"]
 
 #: Expected dimensions for :func:`check_dimension`: a description and a reference unit each.
 LENGTH_OR_ANGLE = {"a length": "m", "an angle": "rad"}
@@ -121,7 +123,8 @@ def check_excitation(u: np.ndarray, name: str = "input u") -> None:
             hint="record data with a varying input (multisine, PRBS, noise: gripkit.excitation)")
 
 
-def check_persistent_excitation(u: np.ndarray, order: int, what: str, name: str = "input u") -> None:
+def check_persistent_excitation(u: np.ndarray, order: int, what: str,
+                                name: str = "input u") -> None:
     """Refuse an input that is not persistently exciting of ``order`` (Ljung 1999, §13.2): its
     ``order`` delayed copies must be linearly independent, or the data cannot determine ``order``
     parameters of the input-output dynamics (a single sine determines 2, a sum of m sines 2m).
@@ -130,8 +133,6 @@ def check_persistent_excitation(u: np.ndarray, order: int, what: str, name: str 
     half (at least one sample), so that an oversampled but rich input is not mistaken for a poor
     one; the test is the one of least squares (:func:`~gripkit.sysid.regression.triangular_solve`):
     the condition number of the column-scaled matrix above ``COND_LIMIT``."""
-    from .regression import COND_LIMIT, _qr_r, scaled_condition
-
     n = u.size
     x = u - u.mean()
     f = np.fft.rfft(x, 2 * n)
@@ -144,10 +145,10 @@ def check_persistent_excitation(u: np.ndarray, order: int, what: str, name: str 
         raise UnidentifiableError(
             f"{what}: {name} is not persistently exciting of order {order}: {order} copies of it "
             f"delayed by {tau} sample(s) are linearly dependent (condition number {cond:.3g} > "
-            f"{COND_LIMIT:.0e}; a single sine determines only 2 parameters, m sines 2m); the "
-            f"{order} parameters of the model cannot all be determined; no estimate returned",
-            hint="excite the system more richly (more frequencies than parameters: multisine, PRBS, "
-                 "noise: gripkit.excitation) or use fewer poles/zeros")
+            f"{COND_LIMIT:.0e}; a single sine determines only 2 parameters, m sines 2m); "
+            f"the {order} parameters of the model cannot all be determined; no estimate returned",
+            hint="excite the system more richly (more frequencies than parameters: multisine, "
+                 "PRBS, noise: gripkit.excitation) or use fewer poles/zeros")
 
 
 def check_dimension(column: str, unit: str | None, expected: dict[str, str], role: str) -> None:
@@ -158,14 +159,13 @@ def check_dimension(column: str, unit: str | None, expected: dict[str, str], rol
     when the file was read."""
     if unit in (None, "", "1"):
         return
-    from ..units import dimension_of, same_dimension
-
     if any(same_dimension(unit, ref) for ref in expected.values()):
         return
     want = " or ".join(f"{d} (like {ref!r})" for d, ref in expected.items())
-    raise DataError(f"{role} column {column!r} is in {unit!r} (dimension {dimension_of(unit)}), expected {want}",
-                    hint=f"check that {column!r} is the {role} column (not swapped with another) and "
-                         f"that its header gives the right unit")
+    raise DataError(f"{role} column {column!r} is in {unit!r} (dimension {dimension_of(unit)}), "
+                    f"expected {want}",
+                    hint=f"check that {column!r} is the {role} column (not swapped with another) "
+                         f"and that its header gives the right unit")
 
 
 def check_output_varies(y: np.ndarray, name: str = "output y") -> None:

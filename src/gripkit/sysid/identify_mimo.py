@@ -128,11 +128,11 @@ def _check_scale(names, x: np.ndarray, what: str, why: str) -> None:
     if bad.any():
         i = int(np.argmax(bad))
         raise DataError(
-            f"{what} column {names[i]!r} has values up to {peak[i]:.3g}: {why} forms sums of squares "
-            f"of the signals, which leave float64 beyond about 1e±150, so it accepts peak values "
-            f"between {lo:.0e} and {hi:.0e}",
-            hint="give the column in other units (multiply it by a power of ten); arx, armax and oe "
-                 "(SISO) scale internally")
+            f"{what} column {names[i]!r} has values up to {peak[i]:.3g}: {why} forms sums of "
+            f"squares of the signals, which leave float64 beyond about 1e±150, so it accepts peak "
+            f"values between {lo:.0e} and {hi:.0e}",
+            hint="give the column in other units (multiply it by a power of ten); arx, armax and "
+                 "oe (SISO) scale internally")
 
 
 def _validation_data(validate: Trajectory, inputs, outputs, dt: float, detrend: str) -> MimoData:
@@ -242,8 +242,9 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
         model = pem(model, u=d.u, y=d.y, form=form)
     warn_if_stabilised(model)
     if detrend == "mean":
-        _warn_if_detrending_hurt(model, data, d.u.shape[0], input=input, output=output, method=method,
-                                 form=form, refine=refine, horizon=horizon, feedthrough=feedthrough)
+        _warn_if_detrending_hurt(model, data, d.u.shape[0], input=input, output=output,
+                                 method=method, form=form, refine=refine, horizon=horizon,
+                                 feedthrough=feedthrough)
     if vd is not None:
         extras["validation_fit_percent"] = _validation_fit(model, vd)
     return model, extras
@@ -268,11 +269,12 @@ def _warn_if_detrending_hurt(model, data: Trajectory, n: int, **options) -> None
     if none_fit > mean_fit + 10.0:
         tau = -model.system.dt / math.log(slowest)
         warnings.warn(
-            f"identify ss: removing the means (detrend 'mean', the default) hurt this fit: the slowest "
-            f"pole (|z| = {slowest:.6g}, time constant {tau:.4g} s) does not settle within the "
-            f"{n * model.system.dt:.4g} s record, so the output drifts and its mean is no operating "
-            f"point; free-run fit {mean_fit:.4g} % with the means removed, {none_fit:.4g} % without; "
-            f"use --detrend none (Python: detrend='none')", AccuracyWarning, stacklevel=3)
+            f"identify ss: removing the means (detrend 'mean', the default) hurt this fit: the "
+            f"slowest pole (|z| = {slowest:.6g}, time constant {tau:.4g} s) does not settle within "
+            f"the {n * model.system.dt:.4g} s record, so the output drifts and its mean is no "
+            f"operating point; free-run fit {mean_fit:.4g} % with the means removed, "
+            f"{none_fit:.4g} % without; use --detrend none (Python: detrend='none')",
+            AccuracyWarning, stacklevel=3)
 
 
 def identify_frf(data: Trajectory, *, input, output, detrend: str = "mean", **options):

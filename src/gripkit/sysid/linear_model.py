@@ -24,6 +24,7 @@ import numpy as np
 from .. import __version__
 from ..errors import DataError, ModelError
 from ..lti import LinearSystem, StateSpace, TransferFunction
+from ..units import convert, dimension_of, same_dimension
 from .checks import as_io_matrix
 from .model_file import SCHEMA, SCHEMA_VERSION, read_document, write_document
 
@@ -87,13 +88,12 @@ def _in_unit(data, name: str, unit: str | None, what: str) -> np.ndarray:
     have = data.unit(name)
     if unit in (None, "", "1") or have in (None, "", "1") or have == unit:
         return x
-    from ..units import convert, dimension_of, same_dimension
-
     if not same_dimension(have, unit):
-        raise DataError(f"data: {what} column {name!r} is in {have!r} (dimension {dimension_of(have)}), but "
-                        f"the model's {what} {name!r} is in {unit!r} (dimension {dimension_of(unit)}): "
-                        f"a different physical quantity",
-                        hint="check that the record holds the signals the model was identified from")
+        raise DataError(f"data: {what} column {name!r} is in {have!r} (dimension "
+                        f"{dimension_of(have)}), but the model's {what} {name!r} is in {unit!r} "
+                        f"(dimension {dimension_of(unit)}): a different physical quantity",
+                        hint="check that the record holds the signals the model was identified "
+                             "from")
     return convert(x, have, unit)
 
 
@@ -220,7 +220,8 @@ class LinearModel:
                             f"the data have {', '.join(map(repr, data.names))}",
                             hint="rename the columns or identify the model from matching data")
         units = self.system.input_units if what == "input" else self.system.output_units
-        return np.column_stack([_in_unit(data, n, u, what) - o for n, u, o in zip(names, units, offsets)])
+        return np.column_stack([_in_unit(data, n, u, what) - o
+                                for n, u, o in zip(names, units, offsets)])
 
     def simulate_data(self, data) -> np.ndarray:
         """Simulated outputs (N, p), offsets added back, for the input columns of a trajectory

@@ -262,21 +262,23 @@ _MIN_DECAY = 0.05
 
 def _check_decay(zeta: float, z_std: float, sigma_t: float) -> None:
     """Refuse a record whose envelope does not decay (ζ within 2σ of 0, or below): a forced or
-    self-sustained oscillation, whose damped-sine fit returns ζ ≈ 0 with a σ that looks precise; warn
-    when it decays by less than :data:`_MIN_DECAY` over the record. ``sigma_t``: σ·T, the fitted
-    decay rate times the record's duration."""
+    self-sustained oscillation, whose damped-sine fit returns ζ ≈ 0 with a σ that looks precise;
+    warn when it decays by less than :data:`_MIN_DECAY` over the record. ``sigma_t``: σ·T, the
+    fitted decay rate times the record's duration."""
     kept = math.exp(-sigma_t) if sigma_t > -700 else math.inf
     if not zeta > 2 * z_std:
         raise IdentificationError(
-            f"free vibration: the fitted damping ratio ζ = {zeta:.3g} ± {z_std:.2g} does not differ from "
-            f"0 (the envelope ends at {100 * kept:.4g} % of its start): the record does not decay, as a "
-            f"forced or self-sustained oscillation does not; its damping cannot be measured from it",
-            hint="analyse the free response after a release or an impulse, with no excitation during "
-                 "the record (CLI: --start at the release)")
+            f"free vibration: the fitted damping ratio ζ = {zeta:.3g} ± {z_std:.2g} does not "
+            f"differ from 0 (the envelope ends at {100 * kept:.4g} % of its start): the record "
+            f"does not decay, as a forced or self-sustained oscillation does not; its damping "
+            f"cannot be measured from it",
+            hint="analyse the free response after a release or an impulse, with no excitation "
+                 "during the record (CLI: --start at the release)")
     if 1.0 - kept < _MIN_DECAY:
-        warnings.warn(f"free vibration: the envelope decays by only {100 * (1 - kept):.3g} % over the "
-                      f"record (ζ = {zeta:.3g} ± {z_std:.2g}): check that it is a free vibration (no "
-                      f"forcing during the record), or record longer", AccuracyWarning, stacklevel=3)
+        warnings.warn(f"free vibration: the envelope decays by only {100 * (1 - kept):.3g} % over "
+                      f"the record (ζ = {zeta:.3g} ± {z_std:.2g}): check that it is a free "
+                      f"vibration (no forcing during the record), or record longer",
+                      AccuracyWarning, stacklevel=3)
 
 
 def _warn_doubtful(methods: dict, f_fft: float, omega_d: float, fn: float, zeta: float, f_std: float,

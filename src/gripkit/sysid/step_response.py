@@ -223,11 +223,12 @@ def _unsettled(t: np.ndarray, ya: np.ndarray, amp: float, band: float) -> None:
     drift = float(np.ptp(means)) / abs(amp)
     if drift > band:
         warnings.warn(
-            f"step_metrics: the response has not settled by the end of the record (t = {t[-1]:.4g} "
-            f"s): over its last 20 % its level still moves by {100 * drift:.3g} % of the step (more "
-            f"than the {100 * band:g} % band); the final level taken from it, and the overshoot, "
-            f"settling time and error measured against that level, are not reliable: the record is "
-            f"too short; record until the response settles, or pass y_final",
+            f"step_metrics: the response has not settled by the end of the record (t = "
+            f"{t[-1]:.4g} s): over its last 20 % its level still moves by {100 * drift:.3g} % of "
+            f"the step (more than the {100 * band:g} % band); the final level taken from it, and "
+            f"the overshoot, settling time and error measured against that level, are not "
+            f"reliable: the record is too short; record until the response settles, or pass "
+            f"y_final",
             AccuracyWarning, stacklevel=3)
 
 
@@ -237,6 +238,31 @@ _MIN_AFTER_STEP = 10
 
 #: least-squares methods of :func:`identify_step`
 STEP_METHODS = ("lm", "trf")
+
+
+def _step_signals(data: Trajectory, input: str, output: str):
+    """The input and output of :func:`identify_step`, checked: the input steps (with at least
+    :data:`_MIN_AFTER_STEP` samples after its first change) and the output responds. Returns
+    ``(u, y, ptp(u), ptp(y))``."""
+    u = np.asarray(data[input], dtype=np.float64)
+    y = np.asarray(data[output], dtype=np.float64)
+    if np.ptp(u) == 0:
+        raise DataError(f"input column {input!r} is constant ({u[0]:g}): a step response needs a "
+                        f"step in the input",
+                        hint="choose the column that holds the commanded step")
+    first = int(np.argmax(u != u[0]))  # the first sample after the input left its first value
+    if u.size - first < _MIN_AFTER_STEP:
+        raise DataError(
+            f"input column {input!r} changes only at t = {data.t[first]:.6g} s, {u.size - first} "
+            f"sample(s) before the end of the record: the response to the step is not recorded "
+            f"(at least {_MIN_AFTER_STEP} samples after the step are needed)",
+            hint="record longer after the step, or check that the column holds the commanded step")
+    u_scale = np.ptp(u)
+    y_scale = np.ptp(y)
+    if y_scale == 0 or y_scale <= 1e-12 * np.max(np.abs(y)):  # relative: data at any scale
+        raise DataError(f"output column {output!r} does not change: nothing to identify",
+                        hint="check the column, or whether the system was powered")
+    return u, y, u_scale, y_scale
 
 
 @entry_point
@@ -272,23 +298,7 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
     dt = data.require_uniform(why="step-response identification")
     nyquist_w = math.pi / dt  # rad/s
     data.require_samples(20, "step-response identification")
-    u = np.asarray(data[input], dtype=np.float64)
-    y = np.asarray(data[output], dtype=np.float64)
-    if np.ptp(u) == 0:
-        raise DataError(f"input column {input!r} is constant ({u[0]:g}): a step response needs a step in the input",
-                        hint="choose the column that holds the commanded step")
-    first = int(np.argmax(u != u[0]))  # the first sample after the input left its initial value
-    if u.size - first < _MIN_AFTER_STEP:
-        raise DataError(
-            f"input column {input!r} changes only at t = {data.t[first]:.6g} s, {u.size - first} "
-            f"sample(s) before the end of the record: the response to the step is not recorded "
-            f"(at least {_MIN_AFTER_STEP} samples after the step are needed)",
-            hint="record longer after the step, or check that the column holds the commanded step")
-    u_scale = np.ptp(u)
-    y_scale = np.ptp(y)
-    if y_scale == 0 or y_scale <= 1e-12 * np.max(np.abs(y)):  # relative: data at any scale
-        raise DataError(f"output column {output!r} does not change: nothing to identify",
-                        hint="check the column, or whether the system was powered")
+    u, y, u_scale, y_scale = _step_signals(data, input, output)
     # fit in normalised units, u_n = (u − u₀)/Δu and y_n = (y − y₀,ref)/Δy, so that every
     # parameter is of order one whatever the physical units; mapped back below
     u0, y_ref = float(u[0]), float(y[0])

@@ -369,10 +369,11 @@ def warn_if_stabilised(model: LinearModel, stacklevel: int = 3) -> None:
     after = float(np.max(np.abs(model.system.poles())))
     fits = lambda f: ", ".join(f"{v:.3g} %" for v in f)  # noqa: E731
     warnings.warn(
-        f"{model.structure}: the data point to an unstable system (the subspace estimate has largest "
-        f"|pole| {s['largest_pole_before']:.4g}, free-run fit {fits(s['fit_percent_before'])}); it was "
-        f"stabilised to largest |pole| {after:.6g} with free-run fit {fits(model.fit_percent)}: if the "
-        f"plant is unstable this model is not it; identify it from closed-loop data, or keep the "
+        f"{model.structure}: the data point to an unstable system (the subspace estimate has "
+        f"largest |pole| {s['largest_pole_before']:.4g}, free-run fit "
+        f"{fits(s['fit_percent_before'])}); it was stabilised to largest |pole| {after:.6g} with "
+        f"free-run fit {fits(model.fit_percent)}: if the plant is unstable this model is not it; "
+        f"identify it from closed-loop data, or keep the "
         f"unstable estimate with gripkit.sysid.n4sid(u, y, stable=False)", StabilityWarning,
         stacklevel=stacklevel)
 
