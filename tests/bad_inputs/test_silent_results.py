@@ -377,7 +377,8 @@ def test_cli_compare_and_simulate_check_the_models_units(cli, tmp_path):
                "--nk", 1, "--out", model).code == 0
     ref = cli("compare", model, est, "--json").json()["fit_percent"][0]
     volts = _io_csv(tmp_path / "uV.csv", u, y, "V", "N")
-    for cmd in (("compare", model, volts), ("simulate", model, "--data", volts)):
+    for cmd in (("compare", model, volts), ("simulate", model, "--data", volts),
+                ("report", model, volts, "--out", tmp_path / "report")):
         assert_user_error(cli(*cmd), "DataError",
                           "input column 'u' is in 'V' (dimension [mass] * [length] ** 2 / "
                           "[time] ** 3 / [current]), but the model's input 'u' is in 'A' "

@@ -4,7 +4,8 @@ Two front ends share one numba kernel and one state vector:
 
 * :class:`RLS`, a streaming estimator for a control loop: ``e = est.update(u, y)`` per sample
   (a few hundred nanoseconds: one call into a compiled kernel working in place). A NaN/inf sample,
-  a divergence or an overflow raises and leaves θ and P as they were (the kernel keeps a backup);
+  a corrupt one (:data:`ABSURD_JUMP`), a divergence or an overflow raises and leaves θ and P as
+  they were (the kernel keeps a backup);
 * :func:`rls`, the batch form, which returns θ and σ at every step (:class:`RLSResult`).
 
 At each sample t with regressor φ(t) = [−y(t−1) … −y(t−na), u(t−nk) … u(t−nk−nb+1)] (eq 21)::
