@@ -242,39 +242,45 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
         model = pem(model, u=d.u, y=d.y, form=form)
     warn_if_stabilised(model)
     if detrend == "mean":
-        _warn_if_detrending_hurt(model, data, d.u.shape[0], input=input, output=output,
-                                 method=method, form=form, refine=refine, horizon=horizon,
-                                 feedthrough=feedthrough)
+        refit = lambda: identify_ss(  # noqa: E731
+            data, input=input, output=output, order=model.order, method=method, form=form,
+            refine=refine, detrend="none", horizon=horizon, feedthrough=feedthrough)[0]
+        _warn_if_detrending_hurt(model, refit, d.u.shape[0], d.dt, "identify ss")
     if vd is not None:
         extras["validation_fit_percent"] = _validation_fit(model, vd)
     return model, extras
 
 
-def _warn_if_detrending_hurt(model, data: Trajectory, n: int, **options) -> None:
+def _warn_if_detrending_hurt(model, refit, n: int, dt: float, command: str) -> None:
     """Mean detrending assumes the record's means are an operating point (an equilibrium). A mode
-    that does not settle within the record (N·|ln|z|| < 5: a near-integrator, a drift) breaks that
-    assumption; then the same order is fitted without detrending, and a warning names
-    ``--detrend none`` when that fits the data better by more than 10 points."""
+    that does not settle within the record (its envelope falls by less than e⁻⁵ over the N
+    samples: a near-integrator, a drift) breaks that assumption; then ``refit()`` fits the same
+    structure without detrending, and a warning names ``--detrend none`` when that fits the data
+    better by more than 10 points (free run)."""
     poles = model.system.poles()
-    slowest = float(np.max(np.abs(poles))) if poles.size else 0.0
-    if not (0.0 < slowest < 1.0) or n * -math.log(slowest) >= 5.0:
+    if not poles.size:
+        return
+    if model.system.is_discrete:
+        rate = -np.log(np.maximum(np.abs(poles), 1e-300)) / dt  # decay rate per second
+    else:
+        rate = -poles.real
+    slowest = float(np.min(rate))
+    if not 0.0 < slowest * n * dt < 5.0:
         return
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         try:
-            other, _ = identify_ss(data, order=model.order, detrend="none", **options)
+            other = refit()
         except GripkitError:
             return
     mean_fit, none_fit = float(np.mean(model.fit_percent)), float(np.mean(other.fit_percent))
     if none_fit > mean_fit + 10.0:
-        tau = -model.system.dt / math.log(slowest)
         warnings.warn(
-            f"identify ss: removing the means (detrend 'mean', the default) hurt this fit: the "
-            f"slowest pole (|z| = {slowest:.6g}, time constant {tau:.4g} s) does not settle within "
-            f"the {n * model.system.dt:.4g} s record, so the output drifts and its mean is no "
-            f"operating point; free-run fit {mean_fit:.4g} % with the means removed, "
-            f"{none_fit:.4g} % without; use --detrend none (Python: detrend='none')",
-            AccuracyWarning, stacklevel=3)
+            f"{command}: removing the means (detrend 'mean', the default) hurt this fit: the "
+            f"slowest mode (time constant {1 / slowest:.4g} s) does not settle within the "
+            f"{n * dt:.4g} s record, so the output drifts and its mean is no operating point; "
+            f"free-run fit {mean_fit:.4g} % with the means removed, {none_fit:.4g} % without; "
+            f"use --detrend none (Python: detrend='none')", AccuracyWarning, stacklevel=4)
 
 
 def identify_frf(data: Trajectory, *, input, output, detrend: str = "mean", **options):
@@ -288,7 +294,13 @@ def identify_tf(data: Trajectory, *, input, output, poles: int, zeros: int, detr
     from .tfest import tfest
 
     d = mimo_data(data, input, output, detrend, why="transfer-function estimation")
-    return tfest(d.u, d.y, poles, zeros, dt=d.dt, u_offset=d.u_offset, y_offset=d.y_offset, **d.signals)
+    model = tfest(d.u, d.y, poles, zeros, dt=d.dt, u_offset=d.u_offset, y_offset=d.y_offset,
+                  **d.signals)
+    if detrend == "mean":
+        refit = lambda: identify_tf(data, input=input, output=output, poles=poles,  # noqa: E731
+                                    zeros=zeros, detrend="none")
+        _warn_if_detrending_hurt(model, refit, d.u.shape[0], d.dt, "identify tf")
+    return model
 
 
 def several(*names) -> bool:
