@@ -18,7 +18,7 @@ import re
 from .errors import ParameterError
 
 __all__ = ["to_si", "si_factor", "ratio_unit", "si_unit", "convert", "check_unit",
-           "format_quantity", "same_dimension"]
+           "format_quantity", "same_dimension", "dimension_of"]
 
 # Unit strings gripkit uses, spelled for pint; "1" is dimensionless.
 _ALIASES = {
@@ -150,6 +150,12 @@ def convert(value: float, from_unit: str, to_unit: str) -> float:
 def same_dimension(a: str, b: str) -> bool:
     """True when ``a`` and ``b`` measure the same physical dimension."""
     return _parse_unit(a).dimensionality == _parse_unit(b).dimensionality
+
+
+def dimension_of(unit: str) -> str:
+    """The physical dimension of ``unit`` as pint writes it: ``'mA'`` → ``'[current]'``,
+    ``'N'`` → ``'[length] * [mass] / [time] ** 2'``, ``'rad'`` → ``'dimensionless'``."""
+    return str(_parse_unit(unit).dimensionality) or "dimensionless"
 
 
 def format_quantity(value_si: float, unit_si: str, display_unit: str | None = None,

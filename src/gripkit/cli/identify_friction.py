@@ -35,6 +35,7 @@ def identify_friction(
     fill: str = FillOpt,
 ):
     """Identify inertia, viscous and Coulomb friction and an offset of one axis (IDIM-LS)."""
+    from ..sysid.checks import FORCE_OR_TORQUE, LENGTH_OR_ANGLE, check_dimension
     from ..sysid.friction import idim_ls
 
     check_data_options(fs, fill)
@@ -44,6 +45,9 @@ def identify_friction(
     check_number(velocity_threshold, "--velocity-threshold", minimum=0)
     with collected_warnings() as caught:
         tr = load_data(data, [position, effort], fs, time, fill)
+        check_dimension(position, tr.unit(position), LENGTH_OR_ANGLE, "position")
+        if effort_scale == 1.0:  # with --effort-scale the column may be a current, a PWM count ...
+            check_dimension(effort, tr.unit(effort), FORCE_OR_TORQUE, "effort")
         dt = tr.require_uniform(why="IDIM-LS (filtering and differentiation)")
         res = idim_ls(tr[position], tr[effort], dt=dt, effort_scale=effort_scale, cutoff=cutoff,
                       decimation=decimate, velocity_threshold=velocity_threshold)

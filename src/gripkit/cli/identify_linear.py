@@ -67,6 +67,11 @@ def _fit_and_report(method: str, data: Path, input: str, output: str, fs, time, 
     with collected_warnings() as caught:
         io = _io(data, input, output, fs, time, fill, detrend, f"{method.upper()} identification")
         model = fit(io)
+        if detrend == "mean":
+            from ..sysid.identify import warn_if_mean_detrending_hurt
+
+            raw = lambda: _io(data, input, output, fs, time, fill, "none", "refit")  # noqa: E731
+            warn_if_mean_detrending_hurt(model, io, raw, fit)
         if out_file is not None:  # the model file (issue 13), with the data's name and hash
             from ..sysid.linear_model import from_polynomial
             from ..sysid.model_file import file_sha256

@@ -204,15 +204,26 @@ class _Tree:
             link = stack.pop()
             reach.add(link)
             stack.extend(self.joints[j][3] for j in self.children[link])
+        self._moves = None  # see subtree_moves
         lost = [name for name in self.links if name not in reach]
         if lost:
             raise ModelError(f"links {lost[:3]} are not reachable from a root: their joints form a closed loop")
 
     def subtree_moves(self, link) -> bool:
-        for j in self.children[link]:
-            if self.joints[j][1] != "fixed" or self.subtree_moves(self.joints[j][3]):
-                return True
-        return False
+        """Whether a moving joint hangs anywhere below ``link`` (computed for every link at the
+        first call, without recursion: chains of thousands of fixed joints are fine)."""
+        moves = self._moves
+        if moves is None:
+            moves = self._moves = dict.fromkeys(self.links, False)
+            order, stack = [], list(self.roots)
+            while stack:  # pre-order; read backwards, children come before their parents
+                link_ = stack.pop()
+                order.append(link_)
+                stack.extend(self.joints[j][3] for j in self.children[link_])
+            for link_ in reversed(order):
+                moves[link_] = any(self.joints[j][1] != "fixed" or moves[self.joints[j][3]]
+                                   for j in self.children[link_])
+        return moves[link]
 
     def check_type(self, joint):
         jtype = self.joints[joint][1]
@@ -380,16 +391,20 @@ def _moving_joints(tree: _Tree, path: list[str]) -> _MovingJoints:
 def _merge_fixed(tree: _Tree, link: str, T: np.ndarray, k: int, joints: _MovingJoints, on_path: set) -> None:
     """Merge every link fixed (directly or through other fixed links) to ``link``, at ``T`` in
     moving link ``k``'s frame, into that link's inertial data; a moving joint off the path is a
-    branch, which a serial chain cannot hold."""
-    for j in tree.children[link]:
-        el, jtype, _, child = tree.joints[j]
+    branch, which a serial chain cannot hold. Depth first in document order, with a stack (no
+    recursion: chains of thousands of fixed joints are fine)."""
+    stack = [(j, T) for j in reversed(tree.children[link])]
+    while stack:
+        j, T = stack.pop()
+        el, jtype, parent, child = tree.joints[j]
         if jtype == "fixed":
             Tc = T @ _origin(el, f"joint {j!r}")
             data = _inertial(tree.links[child], f"link {child!r}")
             if data is not None:
                 joints.inertials[k] = _combine(joints.inertials[k], _transform_inertial(Tc, data))
-            _merge_fixed(tree, child, Tc, k, joints, on_path)
+            stack.extend((jc, Tc) for jc in reversed(tree.children[child]))
         elif j not in on_path:
+            link = parent
             tree.check_type(j)
             raise ModelError(f"joint {j!r} ({jtype}) branches off the chain at link {link!r}: gripkit "
                              f"models serial chains", hint="choose base_link/tip_link so that the chain does "

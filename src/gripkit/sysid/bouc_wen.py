@@ -28,6 +28,7 @@ from ..models.hysteresis import BoucWen, bouc_wen_parameters, bouc_wen_response
 from ..models.piezo import PiezoActuator, actuator_parameters
 from ..params import ParameterSet
 from ..signals.trajectory import Trajectory
+from .checks import check_dimension
 from .greybox import GreyboxResult, fit
 
 __all__ = ["BoucWenResult", "DynamicsResult", "identify_bouc_wen", "loop_error", "identify_actuator_dynamics",
@@ -119,6 +120,8 @@ def identify_bouc_wen(data: Trajectory, input: str = "U", output: str = "y", *,
         raise DataError(f"data: expected a Trajectory, found {type(data).__name__}")
     U = np.asarray(data[input], dtype=np.float64)
     y = np.asarray(data[output], dtype=np.float64)
+    check_dimension(input, data.unit(input), {"a voltage": "V"}, "input (voltage)")
+    check_dimension(output, data.unit(output), {"a length": "m"}, "output (displacement)")
     if np.ptp(U) <= 0:
         raise DataError(f"column {input!r} (voltage) is constant: a hysteresis needs a voltage sweep")
     if not (np.isfinite(delay) and delay >= 0):

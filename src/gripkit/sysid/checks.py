@@ -12,9 +12,16 @@ import numpy as np
 
 from ..arguments import sample_interval
 from ..errors import DataError, UnidentifiableError
+from ..units import dimension_of, same_dimension
+from .regression import COND_LIMIT, _qr_r, scaled_condition
 
 __all__ = ["as_signal", "as_io_matrix", "check_io", "check_order", "check_dt", "require_samples", "check_excitation",
-           "check_output_varies", "checked_problem", "check_identifiable"]
+           "check_output_varies", "checked_problem", "check_identifiable",
+           "check_persistent_excitation", "check_dimension", "LENGTH_OR_ANGLE", "FORCE_OR_TORQUE"]
+
+#: Expected dimensions for :func:`check_dimension`: a description and a reference unit each.
+LENGTH_OR_ANGLE = {"a length": "m", "an angle": "rad"}
+FORCE_OR_TORQUE = {"a force": "N", "a torque": "N*m"}
 
 
 def as_signal(x, name: str) -> np.ndarray:
@@ -114,6 +121,51 @@ def check_excitation(u: np.ndarray, name: str = "input u") -> None:
             f"{name} is constant ({u[0]:.6g} for all {u.size} samples): a constant input cannot "
             f"identify B, the input-output dynamics; no estimate returned",
             hint="record data with a varying input (multisine, PRBS, noise: gripkit.excitation)")
+
+
+def check_persistent_excitation(u: np.ndarray, order: int, what: str,
+                                name: str = "input u") -> None:
+    """Refuse an input that is not persistently exciting of ``order`` (Ljung 1999, §13.2): its
+    ``order`` delayed copies must be linearly independent, or the data cannot determine ``order``
+    parameters of the input-output dynamics (a single sine determines 2, a sum of m sines 2m).
+
+    The copies are delayed by the lag τ at which the input's autocorrelation first falls below one
+    half (at least one sample), so that an oversampled but rich input is not mistaken for a poor
+    one; the test is the one of least squares (:func:`~gripkit.sysid.regression.triangular_solve`):
+    the condition number of the column-scaled matrix above ``COND_LIMIT``."""
+    n = u.size
+    x = u - u.mean()
+    f = np.fft.rfft(x, 2 * n)
+    r = np.fft.irfft(f * f.conj())[:n]
+    below = np.flatnonzero(r[1:n // (2 * order) + 1] < 0.5 * r[0]) if r[0] > 0 else np.empty(0)
+    tau = int(below[0]) + 1 if below.size else max(1, n // (2 * order))
+    U = np.column_stack([u[(order - 1 - k) * tau:n - k * tau] for k in range(order)])
+    cond = scaled_condition(_qr_r(np.asfortranarray(U), True))[0]
+    if not cond <= COND_LIMIT:
+        raise UnidentifiableError(
+            f"{what}: {name} is not persistently exciting of order {order}: {order} copies of it "
+            f"delayed by {tau} sample(s) are linearly dependent (condition number {cond:.3g} > "
+            f"{COND_LIMIT:.0e}; a single sine determines only 2 parameters, m sines 2m); "
+            f"the {order} parameters of the model cannot all be determined; no estimate returned",
+            hint="excite the system more richly (more frequencies than parameters: multisine, "
+                 "PRBS, noise: gripkit.excitation) or use fewer poles/zeros")
+
+
+def check_dimension(column: str, unit: str | None, expected: dict[str, str], role: str) -> None:
+    """Refuse a column whose unit measures none of the ``expected`` dimensions (a description
+    mapped to a reference unit, e.g. ``{"a voltage": "V"}``): a position in N, an effort in m, an
+    input and output swapped. A column without a unit (``'1'``, as files without units load) is
+    not checked: nothing says what it measures. Units of the right dimension were converted to SI
+    when the file was read."""
+    if unit in (None, "", "1"):
+        return
+    if any(same_dimension(unit, ref) for ref in expected.values()):
+        return
+    want = " or ".join(f"{d} (like {ref!r})" for d, ref in expected.items())
+    raise DataError(f"{role} column {column!r} is in {unit!r} (dimension {dimension_of(unit)}), "
+                    f"expected {want}",
+                    hint=f"check that {column!r} is the {role} column (not swapped with another) "
+                         f"and that its header gives the right unit")
 
 
 def check_output_varies(y: np.ndarray, name: str = "output y") -> None:

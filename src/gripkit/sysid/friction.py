@@ -482,6 +482,14 @@ def idim_ls(position, effort, *, dt: float, effort_scale: float = 1.0, cutoff: f
     if (vel > 0).all() or (vel < 0).all():
         raise UnidentifiableError("the joint moves in one direction only: Coulomb friction and the "
                                   "offset cannot be told apart", hint="excite both directions")
+    hi, lo = float(np.max(e)), float(np.min(e))
+    if hi - lo <= 1e-12 * max(hi, -lo):  # relative: efforts at any scale
+        level = "zero" if hi == lo == 0 else f"constant ({hi / ce:.6g})"
+        raise UnidentifiableError(
+            f"the effort is {level} for all {e.size} samples: it carries no information about "
+            f"inertia or friction (every parameter would come out as "
+            f"{'0 ± 0' if hi == lo == 0 else 'an offset'}); no estimate returned",
+            hint="check that the effort column is the logged torque, force or motor current")
     X = np.column_stack([acc, vel, np.sign(vel), np.ones_like(vel)])
     colscale = np.sqrt(np.mean(X ** 2, axis=0))
     if (colscale == 0).any():

@@ -23,12 +23,14 @@ would otherwise bias every coefficient).
 
 from __future__ import annotations
 
+import math
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..arguments import check_keywords, entry_point, keyword_names
-from ..errors import ArgumentError, DataError
+from ..errors import AccuracyWarning, ArgumentError, DataError, GripkitError
 from ..signals.processing import detrend as detrend_signals
 from ..signals.trajectory import Trajectory
 from . import identify_mimo
@@ -91,6 +93,55 @@ def io_data(data: Trajectory, *, input: str, output: str, detrend: str = "mean",
         u0, y0 = float(u.mean()), float(y.mean())
         u, y = np.array(d[input]), np.array(d[output])
     return IOData(u, y, dt, input, output, data.unit(input), data.unit(output), u0, y0)
+
+
+def _polynomial_fit(method: str, io: IOData, orders: tuple, options: dict):
+    """ARX, ARMAX or OE of ``io`` with ``orders`` = (na, nb, nc, nf, nk)."""
+    na, nb, nc, nf, nk = orders
+    if method == "arx":
+        return arx(io.u, io.y, na, nb, nk, dt=io.dt, **io.meta, **options)
+    if method == "armax":
+        return armax(io.u, io.y, na, nb, nc, nk, dt=io.dt, **io.meta, **options)
+    return oe(io.u, io.y, nb, nf, nk, dt=io.dt, **io.meta, **options)
+
+
+def _free_run_fit(model, u: np.ndarray, y: np.ndarray) -> float:
+    """100 (1 − ‖y − ŷ‖/‖y − ȳ‖) of the model simulated from rest (−inf if its run overflows)."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        yhat = model.simulate(u)
+        if not np.isfinite(yhat).all():
+            return -np.inf
+        return float(100.0 * (1.0 - np.linalg.norm(y - yhat) / np.linalg.norm(y - y.mean())))
+
+
+def warn_if_mean_detrending_hurt(model, io: IOData, raw, refit) -> None:
+    """The SISO form of :func:`gripkit.sysid.identify_mimo._warn_if_detrending_hurt`: when a pole
+    of ``model`` (fitted on the mean-detrended ``io``) does not settle within the record
+    (|z|^N > e⁻⁵), fit the same structure (``refit(raw())``) on the data as they are (``raw()``:
+    their :class:`IOData` without detrending) and warn, naming ``--detrend none``, when its free
+    run from rest fits better by more than 10 points than the detrended model's."""
+    poles = np.abs(model.poles())
+    n = io.u.size
+    if not poles.size or not 0.0 < -n * np.log(max(float(poles.max()), 1e-300)) < 5.0:
+        return
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            rio = raw()
+            other = refit(rio)
+        except GripkitError:
+            return
+    mean_fit = _free_run_fit(model, io.u, io.y)
+    none_fit = _free_run_fit(other, rio.u, rio.y)
+    if none_fit > mean_fit + 10.0:
+        tau = -io.dt / math.log(float(poles.max()))
+        warnings.warn(
+            f"identify {model.structure}: removing the means (detrend 'mean', the default) hurt "
+            f"this fit: the slowest pole (|z| = {poles.max():.6g}, time constant {tau:.4g} s) does "
+            f"not settle within the {n * io.dt:.4g} s record, so the output drifts and its mean is "
+            f"no operating point; free-run fit from rest {mean_fit:.4g} % with the means removed, "
+            f"{none_fit:.4g} % without; use --detrend none (Python: detrend='none')",
+            AccuracyWarning, stacklevel=4)
 
 
 def _method_function(method: str):
@@ -163,12 +214,14 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
     if method == "arx" and identify_mimo.several(input, output):  # matrix-polynomial ARX
         return identify_mimo.identify_arx(data, input=input, output=output, na=na, nb=nb, nk=nk, detrend=detrend)
     io = io_data(data, input=input, output=output, detrend=detrend, why=f"{method.upper()} identification")
-    if method == "arx":
-        return arx(io.u, io.y, na, nb, nk, dt=io.dt, **io.meta, **options)
-    if method == "armax":
-        return armax(io.u, io.y, na, nb, nc, nk, dt=io.dt, **io.meta, **options)
-    if method == "oe":
-        return oe(io.u, io.y, nb, na if nf is None else nf, nk, dt=io.dt, **io.meta, **options)
+    if method in ("arx", "armax", "oe"):
+        orders = (na, nb, nc, na if nf is None else nf, nk)
+        model = _polynomial_fit(method, io, orders, options)
+        if detrend == "mean":
+            raw = lambda: io_data(data, input=input, output=output, detrend="none")  # noqa: E731
+            refit = lambda r: _polynomial_fit(method, r, orders, options)  # noqa: E731
+            warn_if_mean_detrending_hurt(model, io, raw, refit)
+        return model
     if method == "rls":
         from .rls import rls  # numba (0.4 s): loaded only for an RLS fit
 

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import DataError, GripkitWarning
+from ..errors import AccuracyWarning, DataError, GripkitError, GripkitWarning
 from ..progress import status
 from ..signals.trajectory import Trajectory
 from .arx_mimo import arx_mimo
@@ -106,10 +106,35 @@ def mimo_data(data: Trajectory, inputs, outputs, detrend: str = "mean", why: str
             raise DataError(f"{what} column {name!r} is constant ({x[0, int(np.argmax(flat))]:.6g} for all "
                             f"{x.shape[0]} samples): it carries no information",
                             hint="drop it from --input/--output or check the data")
+    _check_scale(ins, u, "input", why)
+    _check_scale(outs, y, "output", why)
     u0 = u.mean(axis=0) if detrend == "mean" else np.zeros(len(ins))
     y0 = y.mean(axis=0) if detrend == "mean" else np.zeros(len(outs))
     return MimoData(u - u0, y - y0, dt, ins, outs, tuple(data.unit(n) for n in ins),
                     tuple(data.unit(n) for n in outs), tuple(map(float, u0)), tuple(map(float, y0)))
+
+
+#: Largest and smallest peak magnitude of a column that state-space, frequency-response and
+#: transfer-function estimation accept: they form sums of squares and of products of the signals
+#: (covariances, spectra, Gram matrices), which leave float64 (1e±308) for values beyond about
+#: 1e±150; 1e±100 keeps the margin for record lengths and orders.
+SCALE_LIMITS = (1e-100, 1e100)
+
+
+def _check_scale(names, x: np.ndarray, what: str, why: str) -> None:
+    """Refuse a column whose values are too large or too small for the estimators' sums of squares
+    (the SISO polynomial estimators scale internally; these do not)."""
+    peak = np.max(np.abs(x), axis=0)
+    lo, hi = SCALE_LIMITS
+    bad = (peak > hi) | (peak < lo)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise DataError(
+            f"{what} column {names[i]!r} has values up to {peak[i]:.3g}: {why} forms sums of "
+            f"squares of the signals, which leave float64 beyond about 1e±150, so it accepts peak "
+            f"values between {lo:.0e} and {hi:.0e}",
+            hint="give the column in other units (multiply it by a power of ten); arx, armax and "
+                 "oe (SISO) scale internally")
 
 
 def _validation_data(validate: Trajectory, d: MimoData) -> MimoData:
@@ -161,6 +186,7 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
         from_factor,
         select_order,
         subspace_factor,
+        warn_if_stabilised,
     )
 
     if method not in SUBSPACE_METHODS:
@@ -214,9 +240,47 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     if refine:
         report(f"PEM refinement ({form} form) of the order-{model.order} model")
         model = pem(model, u=d.u, y=d.y, form=form)
+    warn_if_stabilised(model)
+    if detrend == "mean":
+        refit = lambda: identify_ss(  # noqa: E731
+            data, input=input, output=output, order=model.order, method=method, form=form,
+            refine=refine, detrend="none", horizon=horizon, feedthrough=feedthrough)[0]
+        _warn_if_detrending_hurt(model, refit, d.u.shape[0], d.dt, "identify ss")
     if vd is not None:
         extras["validation_fit_percent"] = _validation_fit(model, vd)
     return model, extras
+
+
+def _warn_if_detrending_hurt(model, refit, n: int, dt: float, command: str) -> None:
+    """Mean detrending assumes the record's means are an operating point (an equilibrium). A mode
+    that does not settle within the record (its envelope falls by less than e⁻⁵ over the N
+    samples: a near-integrator, a drift) breaks that assumption; then ``refit()`` fits the same
+    structure without detrending, and a warning names ``--detrend none`` when that fits the data
+    better by more than 10 points (free run)."""
+    poles = model.system.poles()
+    if not poles.size:
+        return
+    if model.system.is_discrete:
+        rate = -np.log(np.maximum(np.abs(poles), 1e-300)) / dt  # decay rate per second
+    else:
+        rate = -poles.real
+    slowest = float(np.min(rate))
+    if not 0.0 < slowest * n * dt < 5.0:
+        return
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            other = refit()
+        except GripkitError:
+            return
+    mean_fit, none_fit = float(np.mean(model.fit_percent)), float(np.mean(other.fit_percent))
+    if none_fit > mean_fit + 10.0:
+        warnings.warn(
+            f"{command}: removing the means (detrend 'mean', the default) hurt this fit: the "
+            f"slowest mode (time constant {1 / slowest:.4g} s) does not settle within the "
+            f"{n * dt:.4g} s record, so the output drifts and its mean is no operating point; "
+            f"free-run fit {mean_fit:.4g} % with the means removed, {none_fit:.4g} % without; "
+            f"use --detrend none (Python: detrend='none')", AccuracyWarning, stacklevel=4)
 
 
 def identify_frf(data: Trajectory, *, input, output, detrend: str = "mean", **options):
@@ -230,7 +294,13 @@ def identify_tf(data: Trajectory, *, input, output, poles: int, zeros: int, detr
     from .tfest import tfest
 
     d = mimo_data(data, input, output, detrend, why="transfer-function estimation")
-    return tfest(d.u, d.y, poles, zeros, dt=d.dt, u_offset=d.u_offset, y_offset=d.y_offset, **d.signals)
+    model = tfest(d.u, d.y, poles, zeros, dt=d.dt, u_offset=d.u_offset, y_offset=d.y_offset,
+                  **d.signals)
+    if detrend == "mean":
+        refit = lambda: identify_tf(data, input=input, output=output, poles=poles,  # noqa: E731
+                                    zeros=zeros, detrend="none")
+        _warn_if_detrending_hurt(model, refit, d.u.shape[0], d.dt, "identify tf")
+    return model
 
 
 def several(*names) -> bool:

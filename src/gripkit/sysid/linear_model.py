@@ -24,6 +24,7 @@ import numpy as np
 from .. import __version__
 from ..errors import DataError, ModelError
 from ..lti import LinearSystem, StateSpace, TransferFunction
+from ..units import convert, dimension_of, same_dimension
 from .checks import as_io_matrix
 from .model_file import SCHEMA, SCHEMA_VERSION, read_document, write_document
 
@@ -77,6 +78,23 @@ def fit_per_output(y, yhat) -> list[float]:
             raise DataError(f"output {i}: the fit is undefined for a constant output (‖y − ȳ‖ = 0)")
         out.append(100.0 * (1.0 - float(np.linalg.norm(y[:, i] - yhat[:, i])) / den))
     return out
+
+
+def _in_unit(data, name: str, unit: str | None, what: str) -> np.ndarray:
+    """Column ``name`` of ``data`` in the model's ``unit``: converted when the data give another
+    unit of the same dimension, a :class:`DataError` when they give another dimension (a model of
+    u [A] compared with u [V]). Either side without a unit ('1' or none) is taken as it is."""
+    x = np.asarray(data[name], dtype=np.float64)
+    have = data.unit(name)
+    if unit in (None, "", "1") or have in (None, "", "1") or have == unit:
+        return x
+    if not same_dimension(have, unit):
+        raise DataError(f"data: {what} column {name!r} is in {have!r} (dimension "
+                        f"{dimension_of(have)}), but the model's {what} {name!r} is in {unit!r} "
+                        f"(dimension {dimension_of(unit)}): a different physical quantity",
+                        hint="check that the record holds the signals the model was identified "
+                             "from")
+    return convert(x, have, unit)
 
 
 @dataclass(frozen=True, eq=False)
@@ -201,7 +219,9 @@ class LinearModel:
             raise DataError(f"data: the model's {what} column(s) {', '.join(map(repr, missing))} are missing; "
                             f"the data have {', '.join(map(repr, data.names))}",
                             hint="rename the columns or identify the model from matching data")
-        return np.column_stack([np.asarray(data[n], dtype=np.float64) - o for n, o in zip(names, offsets)])
+        units = self.system.input_units if what == "input" else self.system.output_units
+        return np.column_stack([_in_unit(data, n, u, what) - o
+                                for n, u, o in zip(names, units, offsets)])
 
     def simulate_data(self, data) -> np.ndarray:
         """Simulated outputs (N, p), offsets added back, for the input columns of a trajectory

@@ -255,14 +255,37 @@ def _natural_frequency_and_damping(fit: _DampedSine) -> tuple[float, float, floa
     return wn / (2 * math.pi), zeta, f_std, z_std
 
 
+#: The envelope of a free vibration should fall by at least this fraction over the record for ζ to
+#: rest on a visible decay; less gets an AccuracyWarning.
+_MIN_DECAY = 0.05
+
+
+def _check_decay(zeta: float, z_std: float, sigma_t: float) -> None:
+    """Refuse a record whose envelope does not decay (ζ within 2σ of 0, or below): a forced or
+    self-sustained oscillation, whose damped-sine fit returns ζ ≈ 0 with a σ that looks precise;
+    warn when it decays by less than :data:`_MIN_DECAY` over the record. ``sigma_t``: σ·T, the
+    fitted decay rate times the record's duration."""
+    kept = math.exp(-sigma_t) if sigma_t > -700 else math.inf
+    if not zeta > 2 * z_std:
+        raise IdentificationError(
+            f"free vibration: the fitted damping ratio ζ = {zeta:.3g} ± {z_std:.2g} does not "
+            f"differ from 0 (the envelope ends at {100 * kept:.4g} % of its start): the record "
+            f"does not decay, as a forced or self-sustained oscillation does not; its damping "
+            f"cannot be measured from it",
+            hint="analyse the free response after a release or an impulse, with no excitation "
+                 "during the record (CLI: --start at the release)")
+    if 1.0 - kept < _MIN_DECAY:
+        warnings.warn(f"free vibration: the envelope decays by only {100 * (1 - kept):.3g} % over "
+                      f"the record (ζ = {zeta:.3g} ± {z_std:.2g}): check that it is a free "
+                      f"vibration (no forcing during the record), or record longer",
+                      AccuracyWarning, stacklevel=3)
+
+
 def _warn_doubtful(methods: dict, f_fft: float, omega_d: float, fn: float, zeta: float, f_std: float,
                    z_std: float) -> None:
-    """AccuracyWarnings (attributed to the caller of :func:`free_vibration`): a fitted ζ ≤ 0, a
+    """AccuracyWarnings (attributed to the caller of :func:`free_vibration`): a
     method's ζ further from the fit's than its expected scatter, an FFT peak away from the fitted
     damped frequency."""
-    if zeta <= 0:
-        warnings.warn(f"the fitted damping ratio is {zeta:.3g} ≤ 0: the record does not decay", AccuracyWarning,
-                      stacklevel=3)
     for name, v in methods.items():
         if name in ("hilbert", "half_power", "log_decrement") and "damping_ratio" in v:
             if abs(v["damping_ratio"] - zeta) > max(0.3 * zeta, 10 * z_std):
@@ -294,6 +317,8 @@ def free_vibration(y, *, dt: float, start: int | None = None, end: int | None = 
     DataError
         NaN/inf, fewer than 64 samples after the release, no oscillation standing out of the noise,
         or a frequency at DC or at the Nyquist frequency.
+    IdentificationError
+        A record that does not decay (ζ within two standard deviations of 0): a forced response.
     """
     y = _checked_signal(y, dt)
     rate = 1.0 / dt
@@ -321,6 +346,7 @@ def free_vibration(y, *, dt: float, start: int | None = None, end: int | None = 
     zeta0 = methods.get("hilbert", methods.get("log_decrement", methods.get("half_power", {}))).get("damping_ratio", 0.01)
     sine = _fit_damped_sine(x, t, f_fft, per, zeta0)
     fn, zeta, f_std, z_std = _natural_frequency_and_damping(sine)
+    _check_decay(zeta, z_std, sine.sigma * seg.size / rate)
     _warn_doubtful(methods, f_fft, sine.omega_d, fn, zeta, f_std, z_std)
     methods["damped_sine_fit"] = {"natural_frequency_hz": fn, "damping_ratio": zeta,
                                   "natural_frequency_std_hz": f_std, "damping_ratio_std": z_std}

@@ -4,7 +4,8 @@ Two front ends share one numba kernel and one state vector:
 
 * :class:`RLS`, a streaming estimator for a control loop: ``e = est.update(u, y)`` per sample
   (a few hundred nanoseconds: one call into a compiled kernel working in place). A NaN/inf sample,
-  a divergence or an overflow raises and leaves θ and P as they were (the kernel keeps a backup);
+  a corrupt one (:data:`ABSURD_JUMP`), a divergence or an overflow raises and leaves θ and P as
+  they were (the kernel keeps a backup);
 * :func:`rls`, the batch form, which returns θ and σ at every step (:class:`RLSResult`).
 
 At each sample t with regressor φ(t) = [−y(t−1) … −y(t−na), u(t−nk) … u(t−nk−nb+1)] (eq 21)::
@@ -58,10 +59,16 @@ __all__ = ["RLS", "RLSResult", "rls"]
 
 # state vector layout (float64): header, then buffers, θ, P and work vectors
 _COUNT, _LAM, _MODE, _MAXTR, _V, _W1, _W2, _TRACE, _NUPD, _NA, _NB, _NK, _STATUS = range(13)
+_PU, _PY = 13, 14  # running peaks of |u| and |y| (corrupt-sample test)
 _HDR = 16
 _MODES = {"none": 0, "trace": 1, "directional": 2}
 #: Records at least this long run through a batch kernel compiled for their number of parameters.
 SPECIALISE_ABOVE = 100_000
+#: A sample whose magnitude exceeds this many times the largest magnitude of its signal before it
+#: is refused as corrupt (a spike, a logger's sentinel such as 1e30, a parse error): more than the
+#: range of any converter (32 bits: 4.3e9), so no measured change of a signal reaches it, while one
+#: such sample throws θ orders of magnitude off for the rest of the record.
+ABSURD_JUMP = 1e10
 
 
 @njit(cache=True)
@@ -125,10 +132,17 @@ def _rls_step(s, u, y):
 
     A failed update returns NaN and leaves ``s`` as it was (θ and P are restored from a backup
     taken before the update), with the reason in ``s[_STATUS]``: 1 = ``u`` or ``y`` not finite,
-    2 = P or θ no longer finite (divergence), 3 = φᵀPφ overflowed (signals too large for P).
+    2 = P or θ no longer finite (divergence), 3 = φᵀPφ overflowed (signals too large for P),
+    4 = ``|u|`` or ``|y|`` above :data:`ABSURD_JUMP` times its running peak ``s[_PU]``, ``s[_PY]``.
     """
     if not (math.isfinite(u) and math.isfinite(y)):
         s[_STATUS] = 1.0
+        return np.nan
+    au = abs(u)
+    ay = abs(y)
+    if (au > s[_PU] and s[_PU] > 0.0 and au > ABSURD_JUMP * s[_PU]) or (
+            ay > s[_PY] and s[_PY] > 0.0 and ay > ABSURD_JUMP * s[_PY]):
+        s[_STATUS] = 4.0  # a corrupt sample
         return np.nan
     na = int(s[_NA])
     nb = int(s[_NB])
@@ -167,6 +181,10 @@ def _rls_step(s, u, y):
         s[_W1] = lam * s[_W1] + 1.0
         s[_W2] = lam * lam * s[_W2] + 1.0
         s[_NUPD] += 1.0
+    if au > s[_PU]:
+        s[_PU] = au
+    if ay > s[_PY]:
+        s[_PY] = ay
     for i in range(nu - 1, 0, -1):
         s[ou + i] = s[ou + i - 1]
     s[ou] = u
@@ -363,7 +381,8 @@ class RLS:
     def update(self, u: float, y: float) -> float:
         """Process one sample (input u(t), output y(t)); returns the a-priori prediction error.
 
-        Raises :class:`DataError` for a NaN/inf or non-numeric sample and
+        Raises :class:`DataError` for a NaN/inf or non-numeric sample or a corrupt one (a
+        magnitude above :data:`ABSURD_JUMP` times the largest of its signal so far), and
         :class:`IdentificationError` when the update would make P or θ non-finite (divergence, or
         signals too large for P); either way the estimator is left as it was before the call.
         """
@@ -383,6 +402,14 @@ class RLS:
             raise DataError(f"RLS.update: sample {self.n_samples} is not finite (u={u:.6g}, y={y:.6g}); "
                             f"the estimator is unchanged",
                             hint="skip or interpolate missing samples before passing them")
+        if status == 4.0:
+            pu = self._s[_PU]
+            name, v, peak = ("u", u, pu) if 0.0 < pu < abs(u) / ABSURD_JUMP else \
+                ("y", y, self._s[_PY])
+            raise _absurd_sample(f"RLS.update: sample {self.n_samples}", name, v, peak,
+                                 "the estimator is unchanged",
+                                 "drop or repair the sample and go on with update(); if the signal "
+                                 "truly changed scale that much, reset() the estimator")
         if status == 3.0:
             raise IdentificationError(
                 f"RLS [{self.na} {self.nb} {self.nk}]: φᵀPφ overflows at sample {self.n_samples} "
@@ -498,8 +525,25 @@ class RLS:
                     f"10^{log_energy:.0f} is below 1/P, so {names} would stay at their initial values",
                     hint=f"scale u and y to order 1 (other units), or raise p0 above 1/Σ{label[-1]}²")
 
+    def _check_corrupt(self, u: np.ndarray, y: np.ndarray) -> tuple[float, float]:
+        """Refuse a record with a corrupt sample by the rule of :meth:`update` (a magnitude above
+        :data:`ABSURD_JUMP` times every earlier one of its signal, from the estimator's running
+        peaks on), so that ``run`` and a loop of ``update`` refuse the same records; returns the
+        peaks of |u| and |y| at the end of the record."""
+        peaks = []
+        for name, x, slot in (("u", u, _PU), ("y", y, _PY)):
+            i, peak = _first_absurd(x, self._s[slot], ABSURD_JUMP)
+            if i >= 0:
+                where = f"RLS [{self.na} {self.nb} {self.nk}]: sample {self.n_samples + i}"
+                raise _absurd_sample(where, name, float(x[i]), peak, "the record was not processed",
+                                     "drop or repair the sample (gripkit.signals.outliers."
+                                     "corrupt_samples finds such values) and run again")
+            peaks.append(peak)
+        return peaks[0], peaks[1]
+
     def _run(self, u: np.ndarray, y: np.ndarray, store: bool) -> "RLSResult":
         """:meth:`run` on checked float64 arrays."""
+        peaks = self._check_corrupt(u, y)
         self._check_scale(u, y)
         n = u.size
         p = self.n_params
@@ -509,6 +553,7 @@ class RLS:
         yhat = np.empty(n)
         n0 = self.n_updates
         _rls_run(self._s, u, y, theta, std, yhat, (0.0,) * p if n >= SPECIALISE_ABOVE else ())
+        self._s[_PU], self._s[_PY] = peaks
         if not (np.isfinite(self.P).all() and np.isfinite(self.theta).all()):
             raise self._diverged(f"after {self.n_updates} updates")
         e = y - yhat
@@ -523,6 +568,29 @@ class RLS:
                          y_pred=yhat, errors=e, first_update=n - nupd, loss=loss,
                          theta_final=self.theta, theta_std_final=self.theta_std,
                          covariance_final=self.covariance, P_final=self.P, model=self.model())
+
+
+def _absurd_sample(where: str, name: str, value: float, peak: float, state: str,
+                   hint: str) -> DataError:
+    """The error for a corrupt sample ``value`` of signal ``name`` after a running peak ``peak``."""
+    return DataError(
+        f"{where} has {name} = {value:.6g}, {abs(value) / peak:.2g} times the largest |{name}| "
+        f"before it ({peak:.6g}): a corrupt sample (a spike, a logger's sentinel, a parse error), "
+        f"which would throw θ far off for good; {state}", hint=hint)
+
+
+@njit(cache=True)
+def _first_absurd(x, peak, factor):
+    """(index of the first sample of ``x`` above ``factor`` times the largest |x| before it, or −1;
+    the largest |x| up to there), from the running peak ``peak`` on (the test of
+    :func:`_rls_step`)."""
+    for i in range(x.shape[0]):
+        a = abs(x[i])
+        if a > peak:
+            if peak > 0.0 and a > factor * peak:
+                return i, peak
+            peak = a
+    return -1, peak
 
 
 @njit(cache=True)

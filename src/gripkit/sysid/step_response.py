@@ -133,14 +133,14 @@ def _level_start(t: np.ndarray, u: np.ndarray, y: np.ndarray):
     du = np.diff(u)
     k = int(np.argmax(np.abs(du))) + 1
     stop = k + 1 + int(np.argmax(np.abs(du[k:]) > 0)) if np.any(np.abs(du[k:]) > 0) else len(u)
-    stop = max(stop, k + 2)
+    stop = min(max(stop, k + 2), len(u))
     y_before = y[max(0, k - 10):k].mean() if k > 0 else y[0]
     tail = y[k + max(1, (stop - k) * 3 // 4):stop]
     y_after = tail.mean() if tail.size else y[stop - 1]
     K = (y_after - y_before) / du[k - 1]
     seg = (y[k:stop] - y_before) / (y_after - y_before) if y_after != y_before else np.zeros(stop - k)
     i63 = int(np.argmax(seg >= 0.63)) if np.any(seg >= 0.63) else max(1, (stop - k) // 4)
-    t63 = max(t[k + i63] - t[k], t[1] - t[0])
+    t63 = max(t[min(k + i63, len(t) - 1)] - t[k], t[1] - t[0])
     return float(K), 1.5 / t63, 0.7
 
 
@@ -161,7 +161,9 @@ def step_metrics(t, y, *, t_step: float | None = None, y_initial: float | None =
     """Step-response metrics of a measured or simulated response.
 
     ``y_initial`` defaults to the mean before ``t_step`` (or y[0]); ``y_final`` to the mean of the
-    last 10 % of the record (pass the command for tracking metrics). Returns ``overshoot_percent``
+    last 10 % of the record (pass the command for tracking metrics); an :class:`AccuracyWarning`
+    says when that estimate cannot be trusted because the response has not settled by the end of
+    the record (:func:`_unsettled`). Returns ``overshoot_percent``
     (beyond ``y_final``, relative to the step amplitude), ``undershoot_percent`` (the largest
     excursion against the step's direction, as a non-minimum-phase zero causes), ``peak`` and
     ``peak_time``, ``rise_time`` (10 → 90 %), ``settling_time`` (last time outside
@@ -182,11 +184,14 @@ def step_metrics(t, y, *, t_step: float | None = None, y_initial: float | None =
     if y_initial is None:
         before = ~after
         y_initial = float(y[before].mean()) if before.any() else float(y[0])
-    if y_final is None:
+    estimated = y_final is None
+    if estimated:
         y_final = float(y[-max(2, y.size // 10):].mean())
     amp = y_final - y_initial
     if amp == 0 or not math.isfinite(amp):
         raise DataError("step_metrics: the response has no step (final level equals initial level)")
+    if estimated:
+        _unsettled(t, y[after], amp, band)
     ta, ya = t[after], y[after]
     norm = (ya - y_initial) / amp
     ip = int(np.argmax(norm))
@@ -207,8 +212,57 @@ def step_metrics(t, y, *, t_step: float | None = None, y_initial: float | None =
                 y_initial=float(y_initial), y_final=float(y_final))
 
 
+def _unsettled(t: np.ndarray, ya: np.ndarray, amp: float, band: float) -> None:
+    """Warn when the final level (mean of the last 10 %) is not a final level: the means of the
+    four 5 % pieces of the last 20 % of the response differ by more than ``band``·|step| (a drift
+    or an oscillation going on; measurement noise averages out within each piece)."""
+    w = ya.size // 20
+    if w < 2:
+        return
+    means = ya[-4 * w:].reshape(4, w).mean(axis=1)
+    drift = float(np.ptp(means)) / abs(amp)
+    if drift > band:
+        warnings.warn(
+            f"step_metrics: the response has not settled by the end of the record (t = "
+            f"{t[-1]:.4g} s): over its last 20 % its level still moves by {100 * drift:.3g} % of "
+            f"the step (more than the {100 * band:g} % band); the final level taken from it, and "
+            f"the overshoot, settling time and error measured against that level, are not "
+            f"reliable: the record is too short; record until the response settles, or pass "
+            f"y_final",
+            AccuracyWarning, stacklevel=3)
+
+
+#: Fewest samples after the first input change that :func:`identify_step` fits (half its minimum
+#: record): fewer cannot show a response, let alone four parameters of one.
+_MIN_AFTER_STEP = 10
+
 #: least-squares methods of :func:`identify_step`
 STEP_METHODS = ("lm", "trf")
+
+
+def _step_signals(data: Trajectory, input: str, output: str):
+    """The input and output of :func:`identify_step`, checked: the input steps (with at least
+    :data:`_MIN_AFTER_STEP` samples after its first change) and the output responds. Returns
+    ``(u, y, ptp(u), ptp(y))``."""
+    u = np.asarray(data[input], dtype=np.float64)
+    y = np.asarray(data[output], dtype=np.float64)
+    if np.ptp(u) == 0:
+        raise DataError(f"input column {input!r} is constant ({u[0]:g}): a step response needs a "
+                        f"step in the input",
+                        hint="choose the column that holds the commanded step")
+    first = int(np.argmax(u != u[0]))  # the first sample after the input left its first value
+    if u.size - first < _MIN_AFTER_STEP:
+        raise DataError(
+            f"input column {input!r} changes only at t = {data.t[first]:.6g} s, {u.size - first} "
+            f"sample(s) before the end of the record: the response to the step is not recorded "
+            f"(at least {_MIN_AFTER_STEP} samples after the step are needed)",
+            hint="record longer after the step, or check that the column holds the commanded step")
+    u_scale = np.ptp(u)
+    y_scale = np.ptp(y)
+    if y_scale == 0 or y_scale <= 1e-12 * np.max(np.abs(y)):  # relative: data at any scale
+        raise DataError(f"output column {output!r} does not change: nothing to identify",
+                        hint="check the column, or whether the system was powered")
+    return u, y, u_scale, y_scale
 
 
 @entry_point
@@ -244,16 +298,7 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
     dt = data.require_uniform(why="step-response identification")
     nyquist_w = math.pi / dt  # rad/s
     data.require_samples(20, "step-response identification")
-    u = np.asarray(data[input], dtype=np.float64)
-    y = np.asarray(data[output], dtype=np.float64)
-    if np.ptp(u) == 0:
-        raise DataError(f"input column {input!r} is constant ({u[0]:g}): a step response needs a step in the input",
-                        hint="choose the column that holds the commanded step")
-    u_scale = np.ptp(u)
-    y_scale = np.ptp(y)
-    if y_scale == 0 or y_scale <= 1e-12 * np.max(np.abs(y)):  # relative: data at any scale
-        raise DataError(f"output column {output!r} does not change: nothing to identify",
-                        hint="check the column, or whether the system was powered")
+    u, y, u_scale, y_scale = _step_signals(data, input, output)
     # fit in normalised units, u_n = (u − u₀)/Δu and y_n = (y − y₀,ref)/Δy, so that every
     # parameter is of order one whatever the physical units; mapped back below
     u0, y_ref = float(u[0]), float(y[0])

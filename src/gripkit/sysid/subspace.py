@@ -296,6 +296,8 @@ def from_factor(fac: SubspaceFactor, n: int, *, dt: float, feedthrough: bool = F
     rho = float(np.max(np.abs(np.linalg.eigvals(A))))
     if rho >= 1.0:
         if stable:
+            info["stabilised"] = {"largest_pole_before": rho,
+                                  "fit_percent_before": _unstable_fit(fac, A, C, feedthrough)}
             A = np.linalg.lstsq(G, np.vstack([G[p:], np.zeros((p, n))]), rcond=None)[0]
             info["stability"] = (f"shift-invariance estimate unstable (largest |pole| {rho:.4g}); replaced by "
                                  "A = Γ⁺[Γ↓; 0], stable by construction (Chui & Maciejowski 1996)")
@@ -342,6 +344,38 @@ def from_factor(fac: SubspaceFactor, n: int, *, dt: float, feedthrough: bool = F
     fit = fit_per_output(fac.y, yhat)
     return LinearModel(sys, fac.method, K=K, x0=x0s, noise_covariance=Lam, fit_percent=fit,
                        singular_values=fac.s.copy(), n_samples=N, info=info)
+
+
+def _unstable_fit(fac: SubspaceFactor, A, C, feedthrough: bool) -> list[float]:
+    """Free-run fit (% per output) of the unstable shift-invariance estimate, for the warning of
+    :func:`warn_if_stabilised` (−inf where its free run overflows)."""
+    n, m = A.shape[0], fac.m
+    theta = _bdx_least_squares(A, C, fac.us, fac.ys, feedthrough)
+    D = theta[n * m:n * m + fac.p * m].reshape(fac.p, m) if feedthrough else np.zeros((fac.p, m))
+    with np.errstate(over="ignore", invalid="ignore"):
+        yhat = free_run(A, theta[:n * m].reshape(n, m), C, D, fac.us, theta[-n:]) * fac.sy
+        if not np.isfinite(yhat).all():
+            return [-math.inf] * fac.p
+        return [float(f) for f in fit_per_output(fac.y, yhat)]
+
+
+def warn_if_stabilised(model: LinearModel, stacklevel: int = 3) -> None:
+    """A :class:`StabilityWarning` when the subspace step replaced an unstable estimate of A by a
+    stable one: the data may come from an unstable plant, and the stable model then misfits them.
+    Names the largest |pole| and the free-run fit before and after (of ``model`` as returned)."""
+    s = model.info.get("stabilised")
+    if not s:
+        return
+    after = float(np.max(np.abs(model.system.poles())))
+    fits = lambda f: ", ".join(f"{v:.3g} %" for v in f)  # noqa: E731
+    warnings.warn(
+        f"{model.structure}: the data point to an unstable system (the subspace estimate has "
+        f"largest |pole| {s['largest_pole_before']:.4g}, free-run fit "
+        f"{fits(s['fit_percent_before'])}); it was stabilised to largest |pole| {after:.6g} with "
+        f"free-run fit {fits(model.fit_percent)}: if the plant is unstable this model is not it; "
+        f"identify it from closed-loop data, or keep the "
+        f"unstable estimate with gripkit.sysid.n4sid(u, y, stable=False)", StabilityWarning,
+        stacklevel=stacklevel)
 
 
 def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int | None = None,
@@ -406,6 +440,7 @@ def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int
     signals = dict(inputs=inputs, outputs=outputs, input_units=input_units, output_units=output_units)
     model = from_factor(fac, n, dt=step, feedthrough=feedthrough, stable=stable, signals=signals)
     model.info["order_selection"] = "given" if order is not None else "singular values above the noise floor"
+    warn_if_stabilised(model)
     return model.replace(u_offset=u_offset, y_offset=y_offset)
 
 

@@ -29,7 +29,7 @@ from scipy import signal as _signal
 
 from ..errors import DataError, IdentificationError, ModelError
 from ..lti import StateSpace, TransferFunction
-from .checks import check_dt, check_order
+from .checks import check_dt, check_order, check_persistent_excitation
 from .frf import FRF, frf
 from .linear_model import LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run
 
@@ -268,6 +268,7 @@ def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None,
     if N < 10 * k + 64:
         raise DataError(f"tfest: {N} samples are too few for {k} coefficients (need at least {10 * k + 64})",
                         hint="use a longer record or fewer poles/zeros")
+    check_persistent_excitation(u[:, 0], k, f"tfest ({npo} poles, {nz} zeros: {k} coefficients)")
     start = tfest_frf(frf(u, y, dt=step, nperseg=max(64, min(N // 4, 2048))), npo, nz, dt=step)
     th0 = _stabilise(np.concatenate([start.system.denominator()[1:], start.system.numerator()[-(nz + 1):]]), npo)
     uu, yy = u, y[:, 0]
