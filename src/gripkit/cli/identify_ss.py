@@ -60,6 +60,11 @@ def identify_ss_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = 
                     method: str = typer.Option("n4sid", "--method", help="Subspace weighting: n4sid, moesp or cva."),
                     form: str = typer.Option("innovation", "--form", help="PEM refinement: oe or innovation."),
                     no_refine: bool = typer.Option(False, "--no-refine", help="Keep the subspace model (no PEM)."),
+                    focus: str = typer.Option("simulation", "--focus", help="Criterion the returned model never "
+                                              "loses by (subspace start against PEM result): simulation "
+                                              "(free-run fit, default) or prediction (one-step fit)."),
+                    max_iterations: int = typer.Option(50, "--max-iterations", help="PEM iterations at most "
+                                                       "(a warning says when they did not converge)."),
                     validate: Path = typer.Option(None, "--validate", help="Second record: free-run validation "
                                                                            "(and order ranking for a range)."),
                     out: Path = ModelOutOpt, report: Path = ReportOpt,
@@ -71,12 +76,17 @@ def identify_ss_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = 
 
     if form not in ("oe", "innovation"):
         raise DataError(f"--form: expected oe or innovation, found {form!r}")
+    if focus not in ("simulation", "prediction"):
+        raise DataError(f"--focus: expected simulation or prediction, found {focus!r}")
+    if max_iterations < 1:
+        raise DataError(f"--max-iterations: expected a positive integer, found {max_iterations}")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         tr = _load(data, input, output, fs, time, fill)
         vtr = _load(validate, input, output, fs, time, fill) if validate is not None else None
         model, extras = identify_ss(tr, input=input, output=output, order=order, method=method, form=form,
-                                    refine=not no_refine, validate=vtr, detrend=detrend, progress=True)
+                                    refine=not no_refine, validate=vtr, detrend=detrend, progress=True,
+                                    focus=focus, max_iterations=max_iterations)
         model = _with_provenance(model, data)
         _finish(model, data, tr, out, report, None)
     from ..sysid.linear_model import VALIDATION_FIT
@@ -89,6 +99,8 @@ def identify_ss_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = 
     if "search" in extras:
         res["search"] = extras["search"]
         res["search_criterion"] = extras["criterion"]
+    if "focus" in model.info:
+        res["focus"] = model.info["focus"]
     res["warnings"] = report_warnings(caught)
     if json_out:
         emit_json(res)
@@ -102,6 +114,12 @@ def identify_ss_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = 
         typer.echo("singular values: " + " ".join(f"{v:.3g}" for v in sv[:min(sv.size, 12)]))
     for name, f in zip(ss.outputs, model.fit_percent):
         typer.echo(f"  {name}: free-run fit {f:.2f} %")
+    if "focus" in model.info:
+        fo = model.info["focus"]
+        typer.echo(f"focus {fo['criterion']} ({fo['data']} data): subspace {fo['subspace_percent']:.2f} %, "
+                   f"PEM {fo['refined_percent']:.2f} %; kept the {fo['kept']} model")
+    if "search" in extras:
+        _echo_search(extras["search"], extras["criterion"])
     if "validation_fit_percent" in extras and extras["validation_fit_percent"] is not None:
         typer.echo("validation free-run fit: " + ", ".join(f"{n} {f:.2f} %" for n, f in
                                                            zip(ss.outputs, extras["validation_fit_percent"])))
@@ -112,6 +130,18 @@ def identify_ss_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = 
         typer.echo(f"  pole {z.real:.6g}{z.imag:+.6g}j{sd}")
     if out is not None:
         typer.echo(f"model written to {out}")
+
+
+def _echo_search(rows: list[dict], criterion: str) -> None:
+    """The order search as a table, best first (the JSON ``search`` list)."""
+    val = any("validation_fit_percent" in r for r in rows)
+    typer.echo(f"order search, ranked by {criterion} (subspace models; the first is refined):")
+    typer.echo("  order  " + ("validation fit % (per output)  " if val else "") + "fit % (per output)  AIC")
+    for r in rows:
+        vf = r.get("validation_fit_percent")
+        vtxt = ("—" if vf is None else ", ".join(f"{v:.2f}" for v in vf)) if val else ""
+        fit = ", ".join(f"{v:.2f}" for v in r["fit_percent"]) if r.get("fit_percent") else "—"
+        typer.echo(f"  {r['order']:>5}  " + (f"{vtxt:<30}  " if val else "") + f"{fit:<18}  {r['aic']:.6g}")
 
 
 @identify_app.command("frf")

@@ -27,7 +27,7 @@ from ..progress import status
 from ..signals.trajectory import Trajectory
 from .arx_mimo import arx_mimo
 from .frf import frf
-from .linear_model import validation_fit  # the one definition, re-exported for the CLI
+from .linear_model import VALIDATION_FIT, validation_fit  # the one definition, re-exported for the CLI
 
 __all__ = ["MimoData", "mimo_data", "identify_ss", "identify_frf", "identify_tf", "identify_arx", "several",
            "parse_names", "parse_order", "validation_fit"]
@@ -172,12 +172,21 @@ def _aic(model, d: MimoData) -> float:
 
 def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n4sid", form: str = "innovation",
                 refine: bool = True, validate: Trajectory | None = None, detrend: str = "mean",
-                horizon: int | None = None, feedthrough: bool = False, progress: bool = False):
+                horizon: int | None = None, feedthrough: bool = False, progress: bool = False,
+                focus: str = "simulation", max_iterations: int = 50):
     """State-space model of the named columns: subspace (``method``), then PEM in ``form``
     unless ``refine=False``. Returns ``(model, extras)``; ``extras`` holds ``search`` (the ranked
     orders of a range), ``validation_fit_percent`` (per output, with ``validate``) and
     ``criterion``. ``progress=True`` (the command line) reports each stage on stderr; a Python
-    call is silent."""
+    call is silent.
+
+    The returned model never loses to the subspace model it started from by the criterion
+    ``focus`` names (:func:`focus_score`, on ``validate`` when given, else on the estimation
+    record): ``'simulation'`` (default: the free-run fit, the one validation fit of gripkit, which
+    is what a model used for simulation and control design is judged by) or ``'prediction'`` (the
+    one-step-ahead fit, PEM's own criterion, as MATLAB's default ``Focus``). When the refined model
+    scores lower, the subspace model is returned with an :class:`AccuracyWarning` giving both
+    scores. PEM stopping after ``max_iterations`` without converging is warned about too."""
     from .pem_ss import pem
     from .subspace import (
         DEFAULT_MAX_ORDER,
@@ -237,9 +246,13 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
                           f"{rng[0]}:{rng[1]}; the true order may lie outside it, widen the range",
                           GripkitWarning, stacklevel=2)
     model = model.replace(u_offset=d.u_offset, y_offset=d.y_offset)
+    if focus not in FOCUS:
+        raise DataError(f"focus: expected one of {', '.join(FOCUS)}, found {focus!r}")
     if refine:
         report(f"PEM refinement ({form} form) of the order-{model.order} model")
-        model = pem(model, u=d.u, y=d.y, form=form)
+        start = model
+        model = pem(model, u=d.u, y=d.y, form=form, max_iterations=max_iterations)
+        model = _never_lose(start, model, focus, d if vd is None else vd, vd is None, max_iterations)
     warn_if_stabilised(model)
     if detrend == "mean":
         refit = lambda: identify_ss(  # noqa: E731
@@ -249,6 +262,58 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     if vd is not None:
         extras["validation_fit_percent"] = _validation_fit(model, vd)
     return model, extras
+
+
+#: the criteria by which identify_ss keeps the better of the subspace and the refined model
+FOCUS = ("simulation", "prediction")
+
+
+def focus_score(model, focus: str, d: MimoData, estimation: bool = False) -> float:
+    """Mean over outputs of the fit (%) by which ``focus`` judges ``model`` on the deviation data
+    ``d``: ``'simulation'``, the free-run fit with x0 estimated (:data:`VALIDATION_FIT`; −inf for
+    an unstable model); ``'prediction'``, the one-step-ahead fit of the innovation predictor
+    ``x̂⁺ = A x̂ + B u + K (y − C x̂ − D u)`` from the model's x0 on its ``estimation`` record, else
+    from 0 (the predictor forgets it: A − K C is stable, or the score is −inf)."""
+    if focus == "simulation":
+        return float(np.mean(model.compare(d.u, d.y, dt=d.dt)[0])) if model.stable else -math.inf
+    from .pem_ss import predict_errors
+
+    ss = model.system
+    n, p = ss.n_states, ss.n_outputs
+    K = np.zeros((n, p)) if model.K is None else model.K
+    if n and np.max(np.abs(np.linalg.eigvals(ss.A - K @ ss.C))) >= 1.0:
+        return -math.inf
+    x0 = model.x0 if estimation and model.x0 is not None else np.zeros(n)
+    e = np.empty_like(d.y)
+    predict_errors(ss.A, ss.B, ss.C, ss.D, np.ascontiguousarray(K), np.asarray(x0, dtype=np.float64),
+                   np.ascontiguousarray(d.u), np.ascontiguousarray(d.y), e)
+    den = np.linalg.norm(d.y - d.y.mean(axis=0), axis=0)
+    return float(np.mean(100.0 * (1.0 - np.linalg.norm(e, axis=0) / den)))
+
+
+def _never_lose(start, refined, focus: str, d: MimoData, estimation: bool, max_iterations: int):
+    """The refined model, or the subspace model it started from when that scores higher by
+    ``focus`` on ``d``; warns when PEM did not converge and when the refinement is dropped."""
+    pem_info = refined.info.get("pem", {})
+    if not pem_info.get("converged", True):
+        warnings.warn(f"PEM refinement stopped after {pem_info.get('iterations')} iterations without "
+                      f"converging (loss {pem_info.get('loss_start', math.nan):.4g} -> "
+                      f"{pem_info.get('loss', math.nan):.4g} per sample); raise max_iterations "
+                      f"(--max-iterations, now {max_iterations}) or lower the order",
+                      AccuracyWarning, stacklevel=3)
+    where = "estimation" if estimation else "validation"
+    before, after = focus_score(start, focus, d, estimation), focus_score(refined, focus, d, estimation)
+    refined.info["focus"] = {"criterion": focus, "data": where, "subspace_percent": before,
+                             "refined_percent": after, "kept": "refined"}
+    if after >= before:
+        return refined
+    warnings.warn(f"PEM refinement ({refined.structure}) lowered the mean {focus} fit on the {where} "
+                  f"data from {before:.2f} % to {after:.2f} %: the subspace model is returned "
+                  f"(--focus {'prediction' if focus == 'simulation' else 'simulation'} judges by the "
+                  f"other criterion; --no-refine skips PEM)", AccuracyWarning, stacklevel=3)
+    start.info["focus"] = {**refined.info["focus"], "kept": "subspace"}
+    start.info["pem_rejected"] = pem_info
+    return start
 
 
 def _warn_if_detrending_hurt(model, refit, n: int, dt: float, command: str) -> None:
