@@ -1,7 +1,8 @@
 """Every ```python block of the docs runs as pasted (issue 25): the blocks of one page run in page
 order in one namespace (a later block may use what an earlier one made), in a fresh temporary
 folder, so every file a block reads must be created by the page itself. Slow pages (a demo-length
-study) are marked in ``SLOW`` and run with ``-m slow``; the README's blocks are tests/test_readme.py."""
+study) are marked in ``SLOW`` and run with ``-m slow``; the README's blocks are
+tests/test_readme.py."""
 
 import re
 import warnings
