@@ -51,7 +51,7 @@ import numpy as np
 from numba import prange
 
 from ...errors import ModelError, SimulationError
-from ...estimation.friction_adaptation import friction_rls_step
+from ...estimation.friction_adaptation import FrictionEstimator, friction_rls_step
 from ...models.bldc import BLDCMotor, bldc_torque, motor_heat_step, temperature_factor
 from ...models.friction import (FrictionTable, Stribeck, TableArrays, lugre_force, lugre_update,
                                 ripple, stribeck, table_arrays, table_friction)
@@ -108,6 +108,12 @@ ChainWork = namedtuple("ChainWork", "R P work q qd zq Mq tau")
 #: scratch of the actuator-space solve: M_p, h_p, Cholesky factor, applied torques, the free
 #: subsystem (matrix, solution, right side) and the breakaway directions
 SolveWork = namedtuple("SolveWork", "Mp hp L rhs Ms xs rs dirn")
+#: the state one force evaluation reads (views of the state vector, or an RK4 stage): actuator
+#: positions and rates, motor temperatures, LuGre bristles and the stuck flags (3 each)
+FingerState = namedtuple("FingerState", "p pd T z stuck")
+#: a run of the time loop: PWM input u (N, ·) read from column ``ucol`` on, outputs y written
+#: from column ``ycol`` on, the sample time dt and the integration substeps per sample
+FingerRun = namedtuple("FingerRun", "u ucol y ycol dt substeps")
 #: what one force evaluation writes: accelerations, motor torques (output side), shaft torques,
 #: friction torques (all per actuator)
 Forces = namedtuple("Forces", "acc taum tshaft fric")
@@ -128,9 +134,6 @@ ImpedanceLoop = namedtuple("ImpedanceLoop", "ctrl gains tables ref refd wall")
 #: the plant's friction drift: schedule (N, 6) = (s_k, Δ_k) or (0, 6), and working copies of the
 #: parameter vector and the table values
 PlantDrift = namedtuple("PlantDrift", "schedule th values")
-#: the online friction estimator (:func:`gripkit.estimation.friction_adaptation.friction_rls_step`):
-#: settings vector, apparent inertias, θ (3, 2) = (s, o), P (3, 2, 2), filters (3, 5), σ̂² (3)
-FrictionEstimator = namedtuple("FrictionEstimator", "cfg inertia theta P filt sig2")
 
 
 @hot
@@ -304,9 +307,10 @@ def _karnopp(th, n_stuck_iter, mode, tab, p, pd, stuck, out, sw):  # pragma: no 
 
 
 @hot
-def _forces(th, n_stuck_iter, mode, thermal, fc, tab, p, pd, T, z, stuck, pwm, ext, out, cw,
+def _forces(th, n_stuck_iter, mode, thermal, fc, tab, st, pwm, ext, out, cw,
             sw):  # pragma: no cover - compiled
-    """Accelerations ``out.acc`` for the state (p, ṗ, T, z) with the stuck set ``stuck``; fills
+    """Accelerations ``out.acc`` for the state ``st`` (:data:`FingerState`: p, ṗ, T, z) with the
+    stuck set ``st.stuck``; fills
     the motor torques (output side and shaft) and friction of ``out`` (:data:`Forces`). ``fc`` is
     the finger's :data:`FingerChain`, ``tab`` its friction tables, ``cw``/``sw`` scratch
     (:data:`ChainWork`, :data:`SolveWork`). With ``n_stuck_iter > 0`` actuators at rest are
@@ -315,13 +319,13 @@ def _forces(th, n_stuck_iter, mode, thermal, fc, tab, p, pd, T, z, stuck, pwm, e
     frozen (RK4 stages)."""
     m = 3
     G = fc.G
+    p, pd, T, z, stuck = st.p, st.pd, st.T, st.z, st.stuck
     q, qd, zq = cw.q, cw.qd, cw.zq
     Mp, hp, rhs, rs = sw.Mp, sw.hp, sw.rhs, sw.rs
     joints_from_actuators(4, m, G, fc.q0, p, q)
     joints_from_actuators(4, m, G, zq, pd, qd)
     chain_links(4, fc.links, fc.jtype, q, cw.R, cw.P)
-    coupled_mass_bias(4, m, cw.R, cw.P, fc.jtype, fc.mass, fc.com, fc.inertia, fc.arm_q, G, fc.arm_p, qd,
-                      fc.g[0], fc.g[1], fc.g[2], Mp, hp, zq, cw.Mq, cw.tau, cw.work)
+    coupled_mass_bias(4, m, fc, cw, qd, fc.g[0], fc.g[1], fc.g[2], Mp, hp)
     taum, fric = out.taum, out.fric
     _drive_torques(th, thermal, fc.ratio, T, pwm, pd, taum, out.tshaft)
     # applied torque on each actuator (before friction): motor + end stops + external − bias
@@ -401,8 +405,9 @@ def finger_step(th, mode, thermal, fc, tab, x, pwm, ext, h, taum, fric,
     is the finger's :data:`~gripkit.models.friction.TableArrays`. Returns False if the mass
     matrix lost positive definiteness."""
     acc, v0 = ws.acc, ws.v0
-    if not _forces(th, 4, mode, thermal, fc, tab, x[0:3], x[3:6], x[6:9], x[9:12], x[12:15], pwm,
-                   ext, Forces(acc, taum, ws.tshaft, fric), ws.chain, ws.solve):
+    st = FingerState(x[0:3], x[3:6], x[6:9], x[9:12], x[12:15])
+    if not _forces(th, 4, mode, thermal, fc, tab, st, pwm, ext, Forces(acc, taum, ws.tshaft, fric),
+                   ws.chain, ws.solve):
         return False
     for k in range(3):
         v0[k] = x[3 + k]
@@ -424,8 +429,9 @@ def finger_step_rk4(th, mode, thermal, fc, tab, x, pwm, ext, h, taum, fric,
     stuck = x[12:15]
     T = x[6:9]
     z = x[9:12]
-    if not _forces(th, 4, mode, thermal, fc, tab, x[0:3], x[3:6], T, z, stuck, pwm, ext,
-                   Forces(acc, taum, ws.tshaft, fric), ws.chain, ws.solve):
+    st = FingerState(x[0:3], x[3:6], T, z, stuck)
+    if not _forces(th, 4, mode, thermal, fc, tab, st, pwm, ext, Forces(acc, taum, ws.tshaft, fric),
+                   ws.chain, ws.solve):
         return False
     for k in range(3):
         p0[k] = x[k]
@@ -441,7 +447,7 @@ def finger_step_rk4(th, mode, thermal, fc, tab, x, pwm, ext, h, taum, fric,
                 continue
             ps[k] = p0[k] + c * (v0[k] if stage == 0 else vs[k])
             vs[k] = v0[k] + c * ka[3 * stage + k]
-        _forces(th, 0, mode, thermal, fc, tab, ps, vs, T, z, stuck, pwm, ext,
+        _forces(th, 0, mode, thermal, fc, tab, FingerState(ps, vs, T, z, stuck), pwm, ext,
                 Forces(acc, ws.taum2, ws.tshaft2, ws.fric2), ws.chain, ws.solve)
         for k in range(3):
             ka[3 * (stage + 1) + k] = acc[k]
@@ -558,8 +564,7 @@ def _impedance(th, fc, cs, x, n, loop, fhat):  # pragma: no cover - compiled
         tauq[k] -= gains[10 + k] * x[3 + k]
     if gains[6] != 0.0:
         gp = cs.gp
-        rnea_pass(4, R, P, fc.jtype, fc.mass, fc.com, fc.inertia, fc.arm_q, zq, zq, grav[0], grav[1],
-                  grav[2], False, gp, cs.work)
+        rnea_pass(4, fc, R, P, zq, zq, grav[0], grav[1], grav[2], False, gp, cs.work)
         for k in range(3):
             s = 0.0
             for j in range(4):
@@ -625,8 +630,7 @@ def _adapt_friction(th, fc, cs, x, ctab, est, y, n):  # pragma: no cover - compi
     the transmission, bias torque Γᵀ(C(q, q̇)q̇ + G(q)) by RNEA; writes the estimates and each
     sample's status into y[n, 27:36]."""
     G, ratio, grav, pwm, hb, theta = fc.G, fc.ratio, fc.g, cs.pwm, cs.hb, est.theta
-    rnea_pass(4, cs.R, cs.P, fc.jtype, fc.mass, fc.com, fc.inertia, fc.arm_q, cs.qd, cs.zq, grav[0],
-              grav[1], grav[2], True, hb, cs.work)
+    rnea_pass(4, fc, cs.R, cs.P, cs.qd, cs.zq, grav[0], grav[1], grav[2], True, hb, cs.work)
     for k in range(3):
         v = x[3 + k]
         ts = bldc_torque(pwm[k], ratio[k] * v, th[IX.c_pwm], th[IX.b_pwm], th[IX.b_0], th[IX.pwm_max], 1.0)
@@ -634,9 +638,7 @@ def _adapt_friction(th, fc, cs, x, ctab, est, y, n):  # pragma: no cover - compi
         h = 0.0
         for j in range(4):
             h += G[j * 3 + k] * hb[j]
-        y[n, 33 + k] = friction_rls_step(k, tm, h, v, est.inertia, ctab.velocity, ctab.values,
-                                         ctab.length, ctab.ipos, est.cfg, theta, est.P, est.filt,
-                                         est.sig2)
+        y[n, 33 + k] = friction_rls_step(k, tm, h, v, ctab, est)
         y[n, 27 + k] = theta[k, 0]
         y[n, 30 + k] = theta[k, 1]
 
@@ -665,15 +667,17 @@ def _drift_friction(th, mode, tab, plant, n):  # pragma: no cover - compiled
 
 
 @hot
-def finger_loop(th, mode, thermal, fc, ws, cs, tab, u, ucol, dt, substeps, x, y, ycol, loop, plant,
+def finger_loop(th, mode, thermal, fc, ws, cs, tab, run, x, loop, plant,
                 est):  # pragma: no cover - compiled
-    """The time loop (allocation-free, semi-implicit Euler). ``loop.ctrl = 0``: PWM from
-    u[:, ucol:], outputs as DLRFinger.outputs at y[:, ycol:ycol+18]; ``loop.ctrl = 1/2``:
+    """The time loop (allocation-free, semi-implicit Euler) of the run ``run`` (:data:`FingerRun`).
+    ``loop.ctrl = 0``: PWM from u[:, ucol:], outputs as DLRFinger.outputs at
+    y[:, ycol:ycol+18]; ``loop.ctrl = 1/2``:
     joint/Cartesian impedance (:data:`ImpedanceLoop`), closed-loop outputs (39 columns, see
     gripkit.systems.dlr_hit.impedance). ``plant`` (:data:`PlantDrift`): the plant's friction drift
     (:func:`_drift_friction`); ``est`` (:data:`FrictionEstimator`): the online friction
     estimator, run when gains[13] ≠ 0."""
     G, q0 = fc.G, fc.q0
+    u, ucol, y, ycol, dt, substeps = run
     pwm, ext, taum, fric, xs, force = cs.pwm, cs.ext, cs.taum, cs.fric, cs.xs, cs.force
     ctrl, gains = loop.ctrl, loop.gains
     drifting = plant.schedule.shape[0] > 0
@@ -733,9 +737,9 @@ def finger_loop(th, mode, thermal, fc, ws, cs, tab, u, ucol, dt, substeps, x, y,
 
 
 @hot
-def finger_loop_rk4(th, mode, thermal, fc, ws, cs, tab, u, ucol, dt, substeps, x, y,
-                    ycol):  # pragma: no cover - compiled
-    """Open-loop time loop with RK4 steps."""
+def finger_loop_rk4(th, mode, thermal, fc, ws, cs, tab, run, x):  # pragma: no cover - compiled
+    """Open-loop time loop with RK4 steps (``run``: :data:`FingerRun`)."""
+    u, ucol, y, ycol, dt, substeps = run
     pwm, ext, taum, fric, xs = cs.pwm, cs.ext, cs.taum, cs.fric, cs.xs
     h = dt / substeps
     for n in range(u.shape[0]):
@@ -758,14 +762,15 @@ def finger_run(th, mode, thermal, tab, u, ucol, dt, substeps, x, y, ycol, loop, 
     first failed sample + 1, or 0. Scratch arrays are allocated here, in Python, so the only
     compiled function is the time loop itself."""
     fc, ws, cs = _make_context(th)
-    return int(finger_loop(th, mode, thermal, fc, ws, cs, tab, u, ucol, dt, substeps, x, y, ycol,
-                           loop, plant, est))
+    run = FingerRun(u, ucol, y, ycol, dt, substeps)
+    return int(finger_loop(th, mode, thermal, fc, ws, cs, tab, run, x, loop, plant, est))
 
 
 def finger_run_rk4(th, mode, thermal, tab, u, ucol, dt, substeps, x, y, ycol) -> int:
     """Open-loop simulation with RK4 steps (compiled only when asked for)."""
     fc, ws, cs = _make_context(th)
-    return int(finger_loop_rk4(th, mode, thermal, fc, ws, cs, tab, u, ucol, dt, substeps, x, y, ycol))
+    run = FingerRun(u, ucol, y, ycol, dt, substeps)
+    return int(finger_loop_rk4(th, mode, thermal, fc, ws, cs, tab, run, x))
 
 
 def _open_loop_records():
@@ -805,8 +810,9 @@ def _jobs_parallel(thetas, u, ucols, dt, substeps, x0, y, yidx, ycols, tab, mode
         x = x0[j].copy()
         fc, ws, cs = finger_context(thetas[j])
         loop, plant, est = open_loop_records()
-        fail[j] = finger_loop(thetas[j], mode, thermal, fc, ws, cs, TableArrays(tv, tf, tn, tipos), u,
-                              ucols[j], dt, substeps, x, y[yidx[j]], ycols[j], loop, plant, est)
+        fail[j] = finger_loop(thetas[j], mode, thermal, fc, ws, cs, TableArrays(tv, tf, tn, tipos),
+                              FingerRun(u, ucols[j], y[yidx[j]], ycols[j], dt, substeps), x, loop,
+                              plant, est)
     return fail
 
 

@@ -40,6 +40,7 @@ contact, final error, largest voltage, and whether the damage threshold was cros
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 from dataclasses import asdict, dataclass, replace
 
 import numba
@@ -286,12 +287,19 @@ class HybridController:
 # closed loop on the FT-G100 plant
 # ------------------------------------------------------------------------------------------------
 
+#: the settings shared by the grasps of a batch: controller sample time dt, plant substeps per
+#: sample, the settling band (fraction of the command), the number of samples and whether the
+#: trajectories are recorded
+GraspRun = namedtuple("GraspRun", "dt substeps band n_steps rec")
+
+
 @numba.njit(cache=True)
-def _grasp_one(th, cp, fprof, sig_f, sig_x, seed, dt, substeps, band, damage, n_steps, rec,
-               traj, met):  # pragma: no cover - compiled
-    """One closed-loop grasp from rest; writes the trajectory (if ``rec``) and the metrics.
-    ``fprof`` holds the commanded force, one value (constant) or one per sample; the metrics refer
-    to its last value."""
+def _grasp_one(th, cp, fprof, sig_f, sig_x, seed, damage, run, traj,
+               met):  # pragma: no cover - compiled
+    """One closed-loop grasp from rest (``run``: :data:`GraspRun`); writes the trajectory (if
+    ``run.rec``) and the metrics. ``fprof`` holds the commanded force, one value (constant) or one
+    per sample; the metrics refer to its last value."""
+    dt, substeps, band, n_steps, rec = run
     fcmd = fprof[fprof.shape[0] - 1]
     varying = fprof.shape[0] > 1
     s = np.zeros(4)
@@ -361,11 +369,12 @@ def _grasp_one(th, cp, fprof, sig_f, sig_x, seed, dt, substeps, band, damage, n_
 
 
 @numba.njit(cache=True, parallel=True)
-def _grasp_batch(thetas, cps, fprofs, sig_f, sig_x, seeds, dt, substeps, band, damages, n_steps, rec,
-                 traj, met):  # pragma: no cover - compiled
+def _grasp_batch(thetas, cps, fprofs, sig_f, sig_x, seeds, damages, run, traj,
+                 met):  # pragma: no cover - compiled
+    dt, substeps, band, n_steps, rec = run
     for p in numba.prange(thetas.shape[0]):
-        _grasp_one(thetas[p], cps[p], fprofs[p], sig_f[p], sig_x[p], seeds[p], dt, substeps, band,
-                   damages[p], n_steps, rec, traj[p], met[p])
+        _grasp_one(thetas[p], cps[p], fprofs[p], sig_f[p], sig_x[p], seeds[p], damages[p],
+                   GraspRun(dt, substeps, band, n_steps, rec), traj[p], met[p])
 
 
 @dataclass(frozen=True)
@@ -492,10 +501,11 @@ def _run(thetas, cps, fprofs, NF, NX, S, ts, sub, band, dmg, n_steps, record, pr
     met = np.empty((P, len(METRICS)))
     traj = np.empty((P, n_steps if record else 1, 7))
     chunk = 256
+    run = GraspRun(ts, sub, float(band), n_steps, bool(record))
     for a in track(range(0, P, chunk), description="grasp simulations", enabled=progress and P > 2 * chunk):
         b = min(P, a + chunk)
-        _grasp_batch(thetas[a:b], cps[a:b], fprofs[a:b], NF[a:b], NX[a:b], S[a:b], ts, sub, float(band),
-                     dmg[a:b], n_steps, bool(record), traj[a:b], met[a:b])
+        _grasp_batch(thetas[a:b], cps[a:b], fprofs[a:b], NF[a:b], NX[a:b], S[a:b], dmg[a:b], run,
+                     traj[a:b], met[a:b])
     return met, traj
 
 
