@@ -116,6 +116,9 @@ CX = namedtuple("ContactParameterIndex", _CONTACT_NAMES)(*range(len(_CONTACT_NAM
 #: the pad and object constants of one stick-slip substep: pad mass, object mass and drag, and
 #: the Stribeck friction (μ_k, μ_s, v_s)
 PadObject = namedtuple("PadObject", "m M co muk mus vs")
+#: what the drive input of :func:`contact_step` is: the load on a grasped object, or the speed
+#: of a testbed surface (the kernels' ``mode``)
+GRASP, TESTBED = 0, 1
 
 
 def contact_parameters(*, m_pad: float = 2.0e-3, k_t: float = 5.0e3, c_t: float = 1.5, mu_s: float = 0.6,
@@ -251,7 +254,7 @@ def contact_step(th, mode, u, dt, substeps, st, y):  # pragma: no cover - compil
         for _ in range(substeps):
             Fs = mus * Fn
             spring = -k * xp - c * vp
-            if mode == 1:
+            if mode == TESTBED:
                 vp, vo, stuck, F = _testbed_substep(m, Fs, muk, mus, vs, Fn, spring, drive, h, vp, vo, stuck)
             else:
                 vp, vo, stuck, F = _grasp_substep(po, Fs, Fn, spring, drive, h, vp, vo, stuck)
@@ -304,7 +307,7 @@ class StickSlipContact(Model):
               Signal("stuck", "1"), Signal("s", "m", "sliding distance"), Signal("v_film", "V"),
               Signal("d_prev", "m"))
     integrator = "semi-implicit"
-    _mode = 0
+    _mode = GRASP
     internal_rate = 20_000.0
 
     def __init__(self, parameters: ParameterSet | None = None, *, check: bool = True, **kw):
@@ -365,7 +368,7 @@ class SlipTestbed(StickSlipContact):
     name = "slip-testbed"
     description = "PVDF slip sensor on a test rig: surface driven at a prescribed speed (Fig. 12(b))"
     inputs = (Signal("F_n", "N", "normal force"), Signal("v_surface", "m/s", "surface speed"))
-    _mode = 1
+    _mode = TESTBED
 
 
 def pvdf_noise(n: int, *, dt: float, rng=None, white: float = 2e-3, ripple: float = 4e-3,

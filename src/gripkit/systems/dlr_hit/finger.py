@@ -84,8 +84,14 @@ FINGER_PARAMETERS = (
 NTH = len(FINGER_PARAMETERS)
 ACTUATORS = ("base1", "base2", "distal")
 JOINTS = ("abd", "flex", "prox")
-FRICTION_MODES = {"table": 0, "stribeck": 1, "lugre": 2, "none": 3}
-INTEGRATORS = {"semi-implicit": 0, "rk4": 1}
+#: friction model codes of the kernels' ``mode`` (module-level ints: numba folds them)
+TABLE, STRIBECK, LUGRE, NO_FRICTION = 0, 1, 2, 3
+FRICTION_MODES = {"table": TABLE, "stribeck": STRIBECK, "lugre": LUGRE, "none": NO_FRICTION}
+#: integrator codes (``integ``)
+SEMI_IMPLICIT, RK4 = 0, 1
+INTEGRATORS = {"semi-implicit": SEMI_IMPLICIT, "rk4": RK4}
+#: controller codes of :data:`ImpedanceLoop` ``ctrl``
+OPEN_LOOP, JOINT_IMPEDANCE, CARTESIAN_IMPEDANCE = 0, 1, 2
 
 #: the index of each parameter in the vector ``th`` the kernels take, by name: ``th[IX.l1]``,
 #: ``th[IX.fs_base1 + k]`` for actuator k. A module-level namedtuple of ints, generated from
@@ -191,7 +197,7 @@ def finger_setup(th, fc):  # pragma: no cover - compiled
 @hot
 def _kinetic(th, k, v, p, mode, tab):  # pragma: no cover - compiled
     """Kinetic friction of actuator k at velocity v (never 0 for v ≠ 0)."""
-    if mode == 0:
+    if mode == TABLE:
         f = th[IX.scale_base1 + k] * table_friction(v, tab.velocity[k], tab.values[k], tab.length[k],
                                                     tab.ipos[k])
     else:
@@ -332,9 +338,9 @@ def _forces(th, n_stuck_iter, mode, thermal, fc, tab, st, pwm, ext, out, cw,
     for k in range(m):
         rhs[k] = taum[k] + ext[k] - hp[k]
     _add_end_stops(th, q, qd, G, rhs)
-    if mode >= 2:
+    if mode >= LUGRE:  # LuGre or none: no stick-slip constraint
         for k in range(m):
-            if mode == 2:
+            if mode == LUGRE:
                 f = (lugre_force(z[k], pd[k], th[IX.fc_base1 + k], th[IX.fs_base1 + k], th[IX.v_s], th[IX.sigma0],
                                  th[IX.sigma1], th[IX.visc_base1 + k])
                      + ripple(p[k], pd[k], th[IX.ripple_amp], th[IX.ripple_cycles], 0.0))
@@ -378,7 +384,7 @@ def _slow_states(th, mode, thermal, x, v0, tshaft, h):  # pragma: no cover - com
         for k in range(3):
             x[6 + k] = motor_heat_step(x[6 + k], tshaft[k], h, th[IX.T_amb], th[IX.alpha_R], th[IX.R_0],
                                        th[IX.k_t], th[IX.R_th], th[IX.C_th])
-    if mode == 2:
+    if mode == LUGRE:
         for k in range(3):
             x[9 + k] = lugre_update(x[9 + k], v0[k], h, th[IX.fc_base1 + k], th[IX.fs_base1 + k], th[IX.v_s],
                                     th[IX.sigma0])
@@ -388,7 +394,7 @@ def _slow_states(th, mode, thermal, x, v0, tshaft, h):  # pragma: no cover - com
 def _stick(th, mode, x, v0):  # pragma: no cover - compiled
     """Karnopp: a sliding actuator whose velocity crosses zero comes to rest; if its holding torque
     exceeds stiction it breaks away again at the next step."""
-    if mode < 2:
+    if mode < LUGRE:  # table or Stribeck: Karnopp stick-slip
         vst = th[IX.v_stick]
         for k in range(3):
             if x[12 + k] == 0.0 and (x[3 + k] * v0[k] < 0.0 or abs(x[3 + k]) <= vst):
@@ -550,7 +556,7 @@ def _impedance(th, fc, cs, x, n, loop, fhat):  # pragma: no cover - compiled
             s += Jp[r, j] * x[3 + j]
         tipd[r] = s
         tauq[r] = 0.0
-    if ctrl == 2:
+    if ctrl == CARTESIAN_IMPEDANCE:
         for r in range(3):
             f = gains[r] * (ref[n, r] - tip[r]) + gains[3 + r] * (refd[n, r] - tipd[r])
             for j in range(3):
@@ -654,7 +660,7 @@ def _drift_friction(th, mode, tab, plant, n):  # pragma: no cover - compiled
         s = drift[n, k]
         d = drift[n, 3 + k]
         thw[IX.fs_base1 + k] = s * th[IX.fs_base1 + k] + d
-        if mode == 0:
+        if mode == TABLE:
             sc = s * th[IX.scale_base1 + k]
             thw[IX.scale_base1 + k] = 1.0
             for i in range(tn[k]):
@@ -780,7 +786,8 @@ def _open_loop_records():
                          np.full(3, 2, dtype=np.int64))
     theta = np.zeros((3, 2))
     theta[:, 0] = 1.0
-    return (ImpedanceLoop(0, np.zeros(14), tables, np.zeros((1, 3)), np.zeros((1, 3)), np.zeros(9)),
+    return (ImpedanceLoop(OPEN_LOOP, np.zeros(14), tables, np.zeros((1, 3)), np.zeros((1, 3)),
+                          np.zeros(9)),
             PlantDrift(np.zeros((0, 6)), np.zeros(NTH), np.zeros((3, 1))),
             FrictionEstimator(np.zeros(10), np.ones(3), theta, np.zeros((3, 2, 2)), np.zeros((3, 5)),
                               np.zeros(3)))
@@ -792,7 +799,7 @@ _OPEN_LOOP = _open_loop_records()
 
 def run_open_loop(th, mode, integ, thermal, tab, u, dt, substeps, x, y, ucol=0, ycol=0) -> int:
     """One finger, open loop (Python entry used by the models and the hand)."""
-    if integ == 1:
+    if integ == RK4:
         return int(finger_run_rk4(th, mode, thermal, tab, u, ucol, dt, substeps, x, y, ycol))
     return int(finger_run(th, mode, thermal, tab, u, ucol, dt, substeps, x, y, ycol, *_OPEN_LOOP))
 
@@ -821,7 +828,7 @@ def run_jobs(thetas, u, ucols, dt, substeps, x0, y, yidx, ycols, tab, mode, inte
     """Several open-loop finger simulations (a batch of parameter vectors, or the fingers of a
     hand); parallel threads only when asked for (and semi-implicit), else one after another."""
     J = thetas.shape[0]
-    if parallel and integ == 0 and J > 1:
+    if parallel and integ == SEMI_IMPLICIT and J > 1:
         return _jobs_parallel(thetas, u, np.asarray(ucols, dtype=np.int64), dt, substeps, x0, y,
                               np.asarray(yidx, dtype=np.int64), np.asarray(ycols, dtype=np.int64),
                               tab, mode, thermal)

@@ -61,8 +61,8 @@ from ...errors import ModelError, SimulationError
 from ...estimation.friction_adaptation import AdaptationSettings
 from ...models.friction import FrictionTable, table_arrays
 from ...signals.trajectory import Trajectory
-from .finger import (ACTUATORS, FRICTION_MODES, NX, DLRFinger, FrictionEstimator, ImpedanceLoop, PlantDrift,
-                     finger_run)
+from .finger import (ACTUATORS, CARTESIAN_IMPEDANCE, FRICTION_MODES, JOINT_IMPEDANCE, NX, DLRFinger,
+                     FrictionEstimator, ImpedanceLoop, PlantDrift, finger_run)
 from .friction_drift import FrictionDrift
 
 __all__ = ["ImpedanceController", "Wall", "simulate_impedance", "stability_margins",
@@ -214,8 +214,8 @@ def simulate_impedance(finger: DLRFinger, controller: ImpedanceController, refer
     gains = np.array([*controller.stiffness, *controller.damping, float(controller.gravity_compensation),
                       float(controller.friction_compensation), controller.velocity_deadband,
                       controller.smoothing, *controller.actuator_damping, float(ad is not None)])
-    loop = ImpedanceLoop(2 if controller.kind == "cartesian" else 1, gains, table_arrays(tables), ref, refd,
-                         _wall_vector(wall))
+    ctrl = CARTESIAN_IMPEDANCE if controller.kind == "cartesian" else JOINT_IMPEDANCE
+    loop = ImpedanceLoop(ctrl, gains, table_arrays(tables), ref, refd, _wall_vector(wall))
     fail = finger_run(th, FRICTION_MODES[finger.friction], finger.thermal, finger._tab, np.zeros((1, 3)), 0,
                       float(dt), int(substeps), x, y, 0, loop, plant, estimator)
     if fail or not np.isfinite(y).all():

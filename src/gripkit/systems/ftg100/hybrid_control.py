@@ -71,6 +71,8 @@ _NCS = 19
 #: names of the columns of :attr:`GraspBatch.metrics`
 METRICS = ("t_contact", "t_switch", "peak_force", "overshoot_percent", "settling_time", "final_error",
            "max_voltage", "damage", "detected", "sat_fraction")
+#: index of each metric in a row of ``met`` (``met[MX.peak_force]``), generated from METRICS
+MX = namedtuple("MetricIndex", METRICS)(*range(len(METRICS)))
 
 
 @numba.njit(cache=True)
@@ -353,19 +355,19 @@ def _grasp_one(th, cp, fprof, sig_f, sig_x, seed, damage, run, traj,
         if n >= tail:
             err += f - fcmd
             nerr += 1
-    met[0] = t_contact if t_contact >= 0.0 else np.nan
-    met[1] = t_switch if t_switch >= 0.0 else np.nan
-    met[2] = peak
-    met[3] = max(0.0, (peak - fcmd) / fcmd * 100.0)
+    met[MX.t_contact] = t_contact if t_contact >= 0.0 else np.nan
+    met[MX.t_switch] = t_switch if t_switch >= 0.0 else np.nan
+    met[MX.peak_force] = peak
+    met[MX.overshoot_percent] = max(0.0, (peak - fcmd) / fcmd * 100.0)
     if t_contact < 0.0 or last_out == n_steps - 1:
-        met[4] = np.inf
+        met[MX.settling_time] = np.inf
     else:
-        met[4] = max(0.0, (last_out + 1) * dt - t_contact)
-    met[5] = err / nerr / fcmd
-    met[6] = vmax
-    met[7] = 1.0 if peak > damage else 0.0
-    met[8] = 1.0 if t_switch >= 0.0 else 0.0
-    met[9] = nsat / n_steps
+        met[MX.settling_time] = max(0.0, (last_out + 1) * dt - t_contact)
+    met[MX.final_error] = err / nerr / fcmd
+    met[MX.max_voltage] = vmax
+    met[MX.damage] = 1.0 if peak > damage else 0.0
+    met[MX.detected] = 1.0 if t_switch >= 0.0 else 0.0
+    met[MX.sat_fraction] = nsat / n_steps
 
 
 @numba.njit(cache=True, parallel=True)
