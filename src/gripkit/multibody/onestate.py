@@ -21,8 +21,8 @@ import math
 import numba
 import numpy as np
 
-from .kernels import (WORK_PER_LINK, ChainArrays, chain_links, crba, hot_inline, project_mass,
-                      rnea_pass)
+from .kernels import (WORK_PER_LINK, ChainArrays, chain_links, crba, hot_inline, links_of,
+                      project_mass, rnea_pass)
 
 __all__ = ["mass_matrix_one", "pack", "prepare", "rnea_one"]
 
@@ -118,7 +118,7 @@ def rnea_one(buf, q, qd, qdd, out):  # pragma: no cover - compiled
             sdd += gk * qdd[a]
         qqd[k] = sd
         qqdd[k] = sdd
-    rnea_pass(n, ch, R, P, qqd, qqdd, g[0], g[1], g[2], True, tau, work[12 * n:b])
+    rnea_pass(n, links_of(ch), R, P, qqd, qqdd, g[0], g[1], g[2], True, tau, work[12 * n:b])
     for a in range(m):
         s = arm_p[a] * qdd[a]
         for k in range(n):
@@ -138,7 +138,7 @@ def mass_matrix_one(buf, q, out):  # pragma: no cover - compiled
     R, P = _links(n, m, ch, q, work)
     b = 12 * n + WORK_PER_LINK * n
     Mq = work[b + 4 * n:b + 4 * n + n * n].reshape((n, n))
-    crba(n, ch, R, P, Mq, work[12 * n:b])
+    crba(n, links_of(ch), R, P, Mq, work[12 * n:b])
     project_mass(n, m, Mq, ch.G, ch.arm_p, out)
     return True
 

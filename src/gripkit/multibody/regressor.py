@@ -26,7 +26,7 @@ from collections import namedtuple
 
 import numpy as np
 
-from .kernels import REVOLUTE, chain_links, hot, outward_step, rotation
+from .kernels import REVOLUTE, chain_links, hot, hot_inline, outward_step, rotation
 from .rnea import _states
 
 __all__ = ["regressor", "standard_parameters", "parameter_names", "PARAMETERS_PER_LINK",
@@ -100,7 +100,7 @@ def _parameter_wrench(c, wx, wy, wz, ax, ay, az, vx, vy, vz):  # pragma: no cove
     return 0.0, 0.0, 0.0, nx, ny, nz
 
 
-@hot
+@hot_inline
 def regressor_state(n, m, ch, w, qd, qdd, gx, gy, gz, Y, b):  # pragma: no cover - compiled
     """Joint-space regressor Yq = ``w.Yq`` (n × 10n) of one state of the chain ``ch`` (joint types
     and Γ of :data:`~gripkit.multibody.kernels.ChainArrays`; link transforms ``w.R``, ``w.P``

@@ -28,8 +28,8 @@ from numba import prange
 
 from ..errors import ModelError, SimulationError
 from .kernels import (WORK_PER_LINK, ChainArrays, DynamicsWork, chain_links, cholesky_solve,
-                      coupled_mass_bias, frames_into, hot, joints_from_actuators, point_jacobian,
-                      rnea_pass)
+                      coupled_mass_bias, frames_into, hot, joints_from_actuators, links_of,
+                      point_jacobian, rnea_pass)
 
 __all__ = ["rnea", "mass_matrix", "coriolis", "gravity", "bias", "forward_dynamics",
            "kinetic_energy", "potential_energy", "simulate_free"]
@@ -70,7 +70,7 @@ def _accel(n, m, ch, p, pd, tau_p, a, w):  # pragma: no cover - compiled
     joints_from_actuators(n, m, G, ch.q0, p, q)
     joints_from_actuators(n, m, G, zq, pd, qd)
     chain_links(n, ch.links, ch.jtype, q, w.R, w.P)
-    coupled_mass_bias(n, m, ch, w, qd, g[0], g[1], g[2], w.Mp, hp)
+    coupled_mass_bias(n, m, links_of(ch), G, ch.arm_p, w, qd, g[0], g[1], g[2], w.Mp, hp)
     for i in range(m):
         rhs[i] = tau_p[i] - hp[i]
     return cholesky_solve(m, w.Mp, rhs, a, w.L)
@@ -91,7 +91,7 @@ def _range_dyn(op, b0, b1, ch, gscale, pos, vel, acc, vout, mout, w):  # pragma:
         joints_from_actuators(n, m, G, zq, vel[b], qd)
         chain_links(n, ch.links, ch.jtype, q, w.R, w.P)
         if op == OP_MASS_BIAS:
-            coupled_mass_bias(n, m, ch, w, qd, gx, gy, gz, Mp, hp)
+            coupled_mass_bias(n, m, links_of(ch), G, ch.arm_p, w, qd, gx, gy, gz, Mp, hp)
             for i in range(m):
                 vout[b, i] = hp[i]
                 for j in range(m):
@@ -102,7 +102,7 @@ def _range_dyn(op, b0, b1, ch, gscale, pos, vel, acc, vout, mout, w):  # pragma:
         else:
             for k in range(n):
                 qdd[k] = 0.0
-        rnea_pass(n, ch, w.R, w.P, qd, qdd, gx, gy, gz, True, tau, w.work)
+        rnea_pass(n, links_of(ch), w.R, w.P, qd, qdd, gx, gy, gz, True, tau, w.work)
         for i in range(m):
             s = ch.arm_p[i] * acc[b, i] if op == OP_RNEA else 0.0
             for k in range(n):

@@ -59,7 +59,7 @@ from ...models.transmission import transmit_torque
 from ...multibody.coupling import CoupledChain, Coupling, differential_matrix
 from ...multibody.dh import DHChain
 from ...multibody.kernels import (WORK_PER_LINK, chain_links, cholesky_solve, coupled_mass_bias,
-                                  frames_into, hot, hot_inline, joints_from_actuators,
+                                  frames_into, hot, hot_inline, joints_from_actuators, links_of,
                                   point_jacobian, rnea_pass)
 from ...params import ParameterSet
 from ...sim.model import Model, Signal
@@ -331,7 +331,7 @@ def _forces(th, n_stuck_iter, mode, thermal, fc, tab, st, pwm, ext, out, cw,
     joints_from_actuators(4, m, G, fc.q0, p, q)
     joints_from_actuators(4, m, G, zq, pd, qd)
     chain_links(4, fc.links, fc.jtype, q, cw.R, cw.P)
-    coupled_mass_bias(4, m, fc, cw, qd, fc.g[0], fc.g[1], fc.g[2], Mp, hp)
+    coupled_mass_bias(4, m, links_of(fc), G, fc.arm_p, cw, qd, fc.g[0], fc.g[1], fc.g[2], Mp, hp)
     taum, fric = out.taum, out.fric
     _drive_torques(th, thermal, fc.ratio, T, pwm, pd, taum, out.tshaft)
     # applied torque on each actuator (before friction): motor + end stops + external − bias
@@ -570,7 +570,7 @@ def _impedance(th, fc, cs, x, n, loop, fhat):  # pragma: no cover - compiled
         tauq[k] -= gains[10 + k] * x[3 + k]
     if gains[6] != 0.0:
         gp = cs.gp
-        rnea_pass(4, fc, R, P, zq, zq, grav[0], grav[1], grav[2], False, gp, cs.work)
+        rnea_pass(4, links_of(fc), R, P, zq, zq, grav[0], grav[1], grav[2], False, gp, cs.work)
         for k in range(3):
             s = 0.0
             for j in range(4):
@@ -636,7 +636,8 @@ def _adapt_friction(th, fc, cs, x, ctab, est, y, n):  # pragma: no cover - compi
     the transmission, bias torque Γᵀ(C(q, q̇)q̇ + G(q)) by RNEA; writes the estimates and each
     sample's status into y[n, 27:36]."""
     G, ratio, grav, pwm, hb, theta = fc.G, fc.ratio, fc.g, cs.pwm, cs.hb, est.theta
-    rnea_pass(4, fc, cs.R, cs.P, cs.qd, cs.zq, grav[0], grav[1], grav[2], True, hb, cs.work)
+    rnea_pass(4, links_of(fc), cs.R, cs.P, cs.qd, cs.zq, grav[0], grav[1], grav[2], True, hb,
+              cs.work)
     for k in range(3):
         v = x[3 + k]
         ts = bldc_torque(pwm[k], ratio[k] * v, th[IX.c_pwm], th[IX.b_pwm], th[IX.b_0], th[IX.pwm_max], 1.0)
