@@ -155,7 +155,9 @@ class PID:
             raise ConfigError(f"PID tt: expected a time constant >= 0 s (or inf), found {tt!r}")
         if math.isinf(tt):
             tt = 0.0  # 0 disables the back-calculation term in the kernel
-        self._p = np.array([kp, ki, kd, tf, _finite("b", b), _finite("c", c), tt, u_min, u_max, ts])
+        v = dict(kp=kp, ki=ki, kd=kd, tf=tf, b=_finite("b", b), c=_finite("c", c), tt=tt, u_min=u_min,
+                 u_max=u_max, ts=ts)
+        self._p = np.array([v[k] for k in PID_PARAMETERS])
         self._p.flags.writeable = False
         self.state = np.zeros(PID_NSTATE)
 
@@ -165,13 +167,13 @@ class PID:
         """The parameter array for :func:`pid_step` (read-only)."""
         return self._p
 
-    kp = property(lambda self: float(self._p[0]))
-    ki = property(lambda self: float(self._p[1]))
-    kd = property(lambda self: float(self._p[2]))
-    tf = property(lambda self: float(self._p[3]))
-    tt = property(lambda self: float(self._p[6]) if self._p[6] > 0 else math.inf)
-    ts = property(lambda self: float(self._p[9]))
-    limits = property(lambda self: (float(self._p[7]), float(self._p[8])))
+    kp = property(lambda self: float(self._p[PIDX.kp]))
+    ki = property(lambda self: float(self._p[PIDX.ki]))
+    kd = property(lambda self: float(self._p[PIDX.kd]))
+    tf = property(lambda self: float(self._p[PIDX.tf]))
+    tt = property(lambda self: float(self._p[PIDX.tt]) if self._p[PIDX.tt] > 0 else math.inf)
+    ts = property(lambda self: float(self._p[PIDX.ts]))
+    limits = property(lambda self: (float(self._p[PIDX.u_min]), float(self._p[PIDX.u_max])))
 
     def __repr__(self) -> str:
         return (f"PID(kp={self.kp:g}, ki={self.ki:g}, kd={self.kd:g}, ts={self.ts:g}, tf={self.tf:g}, "
