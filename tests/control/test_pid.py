@@ -9,7 +9,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from scipy import signal
 
-from gripkit.control.pid import PID
+from gripkit.control.pid import PID, PID_PARAMETERS, PIDS, PIDX, pid_step
 from gripkit.errors import ConfigError
 
 TS = 1e-3
@@ -82,3 +82,20 @@ def test_configuration_errors():
         PID(1.0, dt=TS).run([0.0, 1.0], [0.0, float("nan")])
     assert PID(2.0, 4.0, dt=TS).tt == pytest.approx(0.5)   # T_t = T_i without derivative
     assert math.isinf(PID(2.0, 4.0, dt=TS, tt=math.inf).tt)
+
+
+def test_parameter_and_state_vectors_are_read_by_name():
+    """The kernel's vectors through their generated index tables: each constructor argument lands
+    at PIDX.<name>; a first step from rest (no derivative history, integral 0) with r = 1, y = 0.2
+    gives u = kp (b r − y) = 2 (0.8 − 0.2) = 1.2, clipped to u_max = 1; then the integral holds
+    ki dt (r − y) + dt/tt (u − v) = 3e-3·0.8 + (1e-3/0.05)(1 − 1.2) = −1.6e-3 and the stored
+    derivative error is c r − y = 0.2 − 0.2 = 0."""
+    given = dict(kp=2.0, ki=3.0, kd=0.5, tf=0.01, b=0.8, c=0.2, tt=0.05, u_min=-1.0, u_max=1.0, dt=1e-3)
+    pid = PID(**given)
+    assert len(pid.params) == len(PID_PARAMETERS)
+    for name, value in given.items():
+        assert pid.params[getattr(PIDX, name)] == value, name
+    s = np.zeros(len(PIDS))
+    assert pid_step(pid.params, s, 1.0, 0.2, 0.0) == 1.0
+    assert s[PIDS.integral] == pytest.approx(3.0 * 1e-3 * 0.8 + 1e-3 / 0.05 * (1.0 - 1.2), rel=1e-12)
+    assert s[PIDS.error_prev] == pytest.approx(0.0, abs=1e-15) and s[PIDS.started] == 1.0

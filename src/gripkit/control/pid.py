@@ -28,6 +28,7 @@ Array layouts (for kernels): parameters ``p`` = [K_p, K_i, K_d, T_f, b, c, T_t, 
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 import numba
 import numpy as np
@@ -36,45 +37,52 @@ from ..errors import ConfigError
 
 __all__ = ["PID", "pid_step", "pid_transfer", "pid_run", "PID_NPARAM", "PID_NSTATE"]
 
-PID_NPARAM = 10
-PID_NSTATE = 4
+#: the parameter vector ``p`` of the kernels, in order, and its index table (``p[PIDX.dt]``, a
+#: module-level namedtuple of ints generated from the names, which numba folds as constants)
+PID_PARAMETERS = ("kp", "ki", "kd", "tf", "b", "c", "tt", "u_min", "u_max", "dt")
+PIDX = namedtuple("PIDParameterIndex", PID_PARAMETERS)(*range(len(PID_PARAMETERS)))
+#: the state vector ``s``: integral, filtered derivative, previous derivative error, started flag
+PID_STATE = ("integral", "derivative", "error_prev", "started")
+PIDS = namedtuple("PIDStateIndex", PID_STATE)(*range(len(PID_STATE)))
+PID_NPARAM = len(PID_PARAMETERS)
+PID_NSTATE = len(PID_STATE)
 
 
 @numba.njit(cache=True)
 def pid_step(p, s, r, y, ff):  # pragma: no cover - compiled
     """One PID sample: returns u_k and updates the state ``s`` in place (module docstring)."""
-    kp = p[0]
-    ki = p[1]
-    kd = p[2]
-    tf = p[3]
-    dt = p[9]
-    ed = p[5] * r - y
-    if s[3] == 0.0:
-        s[1] = 0.0
-        s[2] = ed
-        s[3] = 1.0
-    d = (tf * s[1] + kd * (ed - s[2])) / (tf + dt)
-    v = kp * (p[4] * r - y) + s[0] + d + ff
+    kp = p[PIDX.kp]
+    ki = p[PIDX.ki]
+    kd = p[PIDX.kd]
+    tf = p[PIDX.tf]
+    dt = p[PIDX.dt]
+    ed = p[PIDX.c] * r - y
+    if s[PIDS.started] == 0.0:
+        s[PIDS.derivative] = 0.0
+        s[PIDS.error_prev] = ed
+        s[PIDS.started] = 1.0
+    d = (tf * s[PIDS.derivative] + kd * (ed - s[PIDS.error_prev])) / (tf + dt)
+    v = kp * (p[PIDX.b] * r - y) + s[PIDS.integral] + d + ff
     u = v
-    if u < p[7]:
-        u = p[7]
-    elif u > p[8]:
-        u = p[8]
-    s[0] += ki * dt * (r - y)
-    if p[6] > 0.0:
-        s[0] += dt / p[6] * (u - v)
-    s[1] = d
-    s[2] = ed
+    if u < p[PIDX.u_min]:
+        u = p[PIDX.u_min]
+    elif u > p[PIDX.u_max]:
+        u = p[PIDX.u_max]
+    s[PIDS.integral] += ki * dt * (r - y)
+    if p[PIDX.tt] > 0.0:
+        s[PIDS.integral] += dt / p[PIDX.tt] * (u - v)
+    s[PIDS.derivative] = d
+    s[PIDS.error_prev] = ed
     return u
 
 
 @numba.njit(cache=True)
 def pid_transfer(p, s, r, y, ff, u):  # pragma: no cover - compiled
     """Bumpless transfer: set ``s`` so that ``pid_step(p, s, r, y, ff)`` returns ``u``."""
-    s[1] = 0.0
-    s[2] = p[5] * r - y
-    s[3] = 1.0
-    s[0] = u - p[0] * (p[4] * r - y) - ff
+    s[PIDS.derivative] = 0.0
+    s[PIDS.error_prev] = p[PIDX.c] * r - y
+    s[PIDS.started] = 1.0
+    s[PIDS.integral] = u - p[PIDX.kp] * (p[PIDX.b] * r - y) - ff
 
 
 @numba.njit(cache=True)
@@ -147,7 +155,9 @@ class PID:
             raise ConfigError(f"PID tt: expected a time constant >= 0 s (or inf), found {tt!r}")
         if math.isinf(tt):
             tt = 0.0  # 0 disables the back-calculation term in the kernel
-        self._p = np.array([kp, ki, kd, tf, _finite("b", b), _finite("c", c), tt, u_min, u_max, dt])
+        v = dict(kp=kp, ki=ki, kd=kd, tf=tf, b=_finite("b", b), c=_finite("c", c), tt=tt, u_min=u_min,
+                 u_max=u_max, dt=dt)
+        self._p = np.array([v[k] for k in PID_PARAMETERS])
         self._p.flags.writeable = False
         self.state = np.zeros(PID_NSTATE)
 
@@ -157,13 +167,13 @@ class PID:
         """The parameter array for :func:`pid_step` (read-only)."""
         return self._p
 
-    kp = property(lambda self: float(self._p[0]))
-    ki = property(lambda self: float(self._p[1]))
-    kd = property(lambda self: float(self._p[2]))
-    tf = property(lambda self: float(self._p[3]))
-    tt = property(lambda self: float(self._p[6]) if self._p[6] > 0 else math.inf)
-    dt = property(lambda self: float(self._p[9]))
-    limits = property(lambda self: (float(self._p[7]), float(self._p[8])))
+    kp = property(lambda self: float(self._p[PIDX.kp]))
+    ki = property(lambda self: float(self._p[PIDX.ki]))
+    kd = property(lambda self: float(self._p[PIDX.kd]))
+    tf = property(lambda self: float(self._p[PIDX.tf]))
+    tt = property(lambda self: float(self._p[PIDX.tt]) if self._p[PIDX.tt] > 0 else math.inf)
+    dt = property(lambda self: float(self._p[PIDX.dt]))
+    limits = property(lambda self: (float(self._p[PIDX.u_min]), float(self._p[PIDX.u_max])))
 
     def __repr__(self) -> str:
         return (f"PID(kp={self.kp:g}, ki={self.ki:g}, kd={self.kd:g}, dt={self.dt:g}, tf={self.tf:g}, "

@@ -63,12 +63,13 @@ from __future__ import annotations
 import math
 import numbers
 import warnings
+from collections import namedtuple
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..errors import DataError, DataWarning, ModelError
-from ..models.friction import FrictionTable, table_arrays, table_friction
+from ..models.friction import FrictionTable, TableArrays, table_arrays, table_friction
 from ..multibody.kernels import hot
 
 __all__ = ["FrictionAdapter", "AdaptationResult", "AdaptationSettings", "friction_rls_step",
@@ -177,16 +178,21 @@ class AdaptationSettings:
         return theta, P, np.zeros((m, 5)), np.zeros(m)
 
 
+#: the estimator as the kernels take it: ``cfg`` the settings vector
+#: (:meth:`AdaptationSettings.vector`), ``inertia`` (m,) apparent inertias, and the state, updated
+#: in place: ``theta`` (m, 2) = (s, o), ``P`` (m, 2, 2), ``filt`` (m, 5) = H[τ−h], H[v],
+#: H[F_table], H[sign], signed count of samples sliding in the current direction; ``sig2`` (m,)
+FrictionEstimator = namedtuple("FrictionEstimator", "cfg inertia theta P filt sig2")
+
+
 @hot
-def friction_rls_step(k, tau, bias, v, inertia, tv, tf, tn, tipos, cfg, theta, P, filt,
-                      sig2):  # pragma: no cover - compiled
+def friction_rls_step(k, tau, bias, v, tab, est):  # pragma: no cover - compiled
     """One sample of actuator k (see the module docstring): motor torque ``tau``, bias torque
-    ``bias``, velocity ``v``; ``inertia`` (m,) apparent inertias, ``tv, tf, tn, tipos`` the tables
-    (:func:`~gripkit.models.friction.table_arrays`), ``cfg`` the settings vector
-    (:meth:`AdaptationSettings.vector`). State, updated in place: ``theta`` (m, 2) = (s, o),
-    ``P`` (m, 2, 2), ``filt`` (m, 5) = H[τ−h], H[v], H[F_table], H[sign], signed count of samples
-    sliding in the current direction; ``sig2`` (m,). Returns :data:`UPDATED` (1),
-    :data:`FROZEN` (0: not sliding long enough) or :data:`SKIPPED` (−1: non-finite input)."""
+    ``bias``, velocity ``v``; ``tab`` the tables (:data:`~gripkit.models.friction.TableArrays`),
+    ``est`` the estimator (:data:`FrictionEstimator`, its state updated in place). Returns
+    :data:`UPDATED` (1), :data:`FROZEN` (0: not sliding long enough) or :data:`SKIPPED` (−1:
+    non-finite input)."""
+    cfg, inertia, theta, P, filt, sig2 = est.cfg, est.inertia, est.theta, est.P, est.filt, est.sig2
     if not (math.isfinite(tau) and math.isfinite(bias) and math.isfinite(v)):
         filt[k, 4] = 0.0  # the filters missed a sample: wait three time constants again
         return -1.0
@@ -194,7 +200,8 @@ def friction_rls_step(k, tau, bias, v, inertia, tv, tf, tn, tipos, cfg, theta, P
     dt = cfg[S_DT]
     vmin = cfg[S_VMIN]
     sg = 1.0 if v > 0.0 else (-1.0 if v < 0.0 else 0.0)
-    fr = table_friction(v, tv[k], tf[k], tn[k], tipos[k]) if v != 0.0 else 0.0
+    fr = (table_friction(v, tab.velocity[k], tab.values[k], tab.length[k], tab.ipos[k]) if v != 0.0
+          else 0.0)
     filt[k, 0] += al * (tau - bias - filt[k, 0])
     vf_old = filt[k, 1]
     filt[k, 1] += al * (v - filt[k, 1])
@@ -251,14 +258,13 @@ def friction_rls_step(k, tau, bias, v, inertia, tv, tf, tn, tipos, cfg, theta, P
 
 
 @hot
-def _rls_run(tau, bias, vel, J, tv, tf, tn, tipos, cfg, theta, P, filt, sig2, out_theta, out_std,
-             out_status):  # pragma: no cover - compiled
-    """:func:`friction_rls_step` over N samples of m actuators; the state arrays continue from a
-    previous call."""
+def _rls_run(tau, bias, vel, tab, est, out_theta, out_std, out_status):  # pragma: no cover
+    """:func:`friction_rls_step` over N samples of m actuators; the state of ``est``
+    (:data:`FrictionEstimator`) continues from a previous call."""
+    theta, P, sig2 = est.theta, est.P, est.sig2
     for n in range(tau.shape[0]):
         for k in range(tau.shape[1]):
-            out_status[n, k] = friction_rls_step(k, tau[n, k], bias[n, k], vel[n, k], J, tv, tf, tn,
-                                                 tipos, cfg, theta, P, filt, sig2)
+            out_status[n, k] = friction_rls_step(k, tau[n, k], bias[n, k], vel[n, k], tab, est)
             out_theta[n, k, 0] = theta[k, 0]
             out_theta[n, k, 1] = theta[k, 1]
             s = math.sqrt(max(sig2[k], 0.0))
@@ -378,9 +384,10 @@ class FrictionAdapter:
         th = np.empty((N, m, 2))
         sd = np.empty((N, m, 2))
         status = np.empty((N, m))
-        _rls_run(np.ascontiguousarray(tau), np.ascontiguousarray(h), np.ascontiguousarray(v), self.J,
-                 self._tv, self._tf, self._tn, self._tip, self.cfg, self.theta, self.P, self.filt,
-                 self.sig2, th, sd, status)
+        _rls_run(np.ascontiguousarray(tau), np.ascontiguousarray(h), np.ascontiguousarray(v),
+                 TableArrays(self._tv, self._tf, self._tn, self._tip),
+                 FrictionEstimator(self.cfg, self.J, self.theta, self.P, self.filt, self.sig2),
+                 th, sd, status)
         t = self.t + np.arange(N) * self.dt
         self.t = float(t[-1] + self.dt)
         return AdaptationResult(t, th[:, :, 0], th[:, :, 1], sd, status == UPDATED, self.names,

@@ -21,7 +21,7 @@ import numpy as np
 
 from ..errors import ArgumentError, ModelError
 from . import rnea as _dyn
-from .kernels import ChainArrays, dh_table
+from .kernels import PRISMATIC, REVOLUTE, ChainArrays, dh_table
 from .onestate import mass_matrix_one, rnea_one
 from .onestate import prepare as prepare_one_state
 from .regressor import kernel_parameters, parameter_names, regressor
@@ -296,7 +296,8 @@ class DHChain(Dynamics):
         I = self.inertia  # noqa: E741
         i6 = np.ascontiguousarray(np.stack([I[:, 0, 0], I[:, 1, 1], I[:, 2, 2], I[:, 0, 1],
                                             I[:, 0, 2], I[:, 1, 2]], axis=1))
-        jt = np.array([0 if c == "R" else 1 for c in self.joint_types], dtype=np.int64)
+        jt = np.array([REVOLUTE if c == "R" else PRISMATIC for c in self.joint_types],
+                      dtype=np.int64)
         return dh_table(*self.dh.T), jt, self.mass, self.com, i6, self.armature, self.gravity_vector
 
     def kernel_arrays(self):

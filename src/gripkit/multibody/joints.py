@@ -28,7 +28,7 @@ import numpy as np
 
 from ..errors import ModelError
 from .dh import Dynamics, _as_transform
-from .kernels import PLACEMENT_WIDTH, ChainArrays
+from .kernels import PLACEMENT_WIDTH, PRISMATIC, REVOLUTE, ChainArrays
 from .regressor import kernel_parameters
 from .rnea import OP_JACOBIAN, _states, run_op
 
@@ -227,7 +227,8 @@ class JointChain(Dynamics):
                 I = A[k].T @ self.inertia[k] @ A[k]  # noqa: E741
                 i6[k] = I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2]
                 prev = A[k]
-            jt = np.array([0 if c == "R" else 1 for c in self.joint_types], dtype=np.int64)
+            jt = np.array([REVOLUTE if c == "R" else PRISMATIC for c in self.joint_types],
+                          dtype=np.int64)
             self._arrays = ChainArrays(np.ascontiguousarray(table), jt, self.mass, np.ascontiguousarray(com),
                                        i6, np.zeros(n), np.ascontiguousarray(self.coupling.ravel()),
                                        self.offset, self.armature, self.gravity_vector)

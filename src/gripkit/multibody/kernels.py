@@ -16,7 +16,7 @@ so that, with c/s the cosine/sine,
 Array layout (0-based ``k`` = link k+1): ``R[k, 0:9]`` is ^{k}_{k+1}R row-major, ``P[k, 0:3]``
 is ^{k}P_{k+1}; link inertial data ``mass[k]``, ``com[k, :]`` (centre of mass in frame k+1) and
 ``inertia[k, :] = (Ixx, Iyy, Izz, Ixy, Ixz, Iyz)`` about the centre of mass in frame k+1;
-``jtype[k]`` is 0 (revolute) or 1 (prismatic).
+``jtype[k]`` is REVOLUTE (0) or PRISMATIC (1).
 
 Recursive Newton-Euler (thesis eqs 4.8–4.16 = Craig eqs 6.45–6.53), outward k = 0..n−1 with
 R = (^{k}_{k+1}R)ᵀ and P = ^{k}P_{k+1}::
@@ -57,6 +57,12 @@ import numpy as np
 #: inertias (layout above), joint armatures, the coupling Γ (n×m, row-major), joint offsets q₀,
 #: actuator armatures and gravity (m/s²)
 ChainArrays = namedtuple("ChainArrays", "links jtype mass com inertia arm_q G q0 arm_p g")
+#: the links' part of a chain record, what :func:`rnea_pass`, :func:`crba` and
+#: :func:`coupled_mass_bias` read (:func:`links_of` takes it out of a :data:`ChainArrays`-like
+#: record): joint types, masses, centres of mass, inertias and joint armatures. A record passed to a
+#: compiled call travels as all its arrays' fields; the five it needs keep the call as cheap as
+#: before records (the whole chain record made the DLR/HIT finger's step 13 % slower)
+LinkArrays = namedtuple("LinkArrays", "jtype mass com inertia arm_q")
 #: scratch of the batched dynamics kernels (n links, m coordinates): link rotations and positions,
 #: RNEA/CRBA work, joint positions, rates, accelerations, zeros, joint-space mass matrix and
 #: torques, the coordinates' mass matrix, bias, Cholesky factor, right side and solution
@@ -69,6 +75,10 @@ hot = numba.njit(cache=True, error_model="numpy", _nrt=False)
 #: the same for a small piece of such a kernel, inlined into its caller at numba IR level (where a
 #: compiled call measured slower: docs/performance.md, "Named records in kernels")
 hot_inline = numba.njit(cache=True, error_model="numpy", _nrt=False, inline="always")
+
+#: joint type codes of ``jtype`` (a module-level int: numba folds it as a constant)
+REVOLUTE = 0
+PRISMATIC = 1
 
 # work-array floats per link: RNEA stores F (3), N (3); CRBA a composite inertia (10)
 WORK_PER_LINK = 10
@@ -101,7 +111,7 @@ def placement_links(n, table, jtype, q, R, P):  # pragma: no cover - compiled
     whose z axis is the joint axis, so ^{k}_{k+1}T = F_k · Rz(q_k) (revolute) or F_k · Dz(q_k)
     (prismatic): R = F_R·Rz(q), P = F_P, or R = F_R, P = F_P + q·F_R ẑ."""
     for k in range(n):
-        if jtype[k] == 0:
+        if jtype[k] == REVOLUTE:
             c = math.cos(q[k])
             s = math.sin(q[k])
             for i in range(3):
@@ -133,7 +143,7 @@ def chain_links(n, dh, jtype, q, R, P):  # pragma: no cover - compiled
         placement_links(n, dh, jtype, q, R, P)
         return
     for k in range(n):
-        if jtype[k] == 0:
+        if jtype[k] == REVOLUTE:
             dh_link(dh[k, 4], dh[k, 5], dh[k, 1], dh[k, 2], dh[k, 3] + q[k], R, P, k)
         else:
             dh_link(dh[k, 4], dh[k, 5], dh[k, 1], dh[k, 2] + q[k], dh[k, 3], R, P, k)
@@ -143,6 +153,12 @@ def dh_table(alpha, a, d, offset) -> np.ndarray:
     """The (n, 6) kernel DH table: α, a, d, θ0 and the twist's cosine and sine (computed once)."""
     alpha = np.asarray(alpha, dtype=np.float64)
     return np.ascontiguousarray(np.column_stack([alpha, a, d, offset, np.cos(alpha), np.sin(alpha)]))
+
+
+@hot_inline
+def links_of(ch):  # pragma: no cover - compiled
+    """The :data:`LinkArrays` of a chain record (no copy)."""
+    return LinkArrays(ch.jtype, ch.mass, ch.com, ch.inertia, ch.arm_q)
 
 
 @hot_inline
@@ -175,11 +191,11 @@ def rotate_back(R, k, x, y, z):  # pragma: no cover - compiled
 
 
 @hot_inline
-def outward_step(k, R, P, jtype, qd, qdd, wx, wy, wz, ax, ay, az, vx, vy, vz,
-                 with_velocity):  # pragma: no cover - compiled
+def outward_step(k, R, P, jtype, qd, qdd, s, with_velocity):  # pragma: no cover - compiled
     """One link of the outward Newton-Euler pass (eqs 4.8–4.10): ω, ω̇ and the origin's
-    acceleration v̇ of link k+1 in its own frame from those (w, a, v) of link k.
-    ``with_velocity=False`` skips the velocity products."""
+    acceleration v̇ of link k+1 in its own frame, as the 9-tuple (ω, ω̇, v̇), from those ``s`` of
+    link k. ``with_velocity=False`` skips the velocity products."""
+    wx, wy, wz, ax, ay, az, vx, vy, vz = s
     px = P[k, 0]; py = P[k, 1]; pz = P[k, 2]  # noqa: E702
     # linear acceleration of the new origin, in parent frame: ω̇×P + ω×(ω×P) + v̇
     tx = ay * pz - az * py + vx
@@ -194,7 +210,7 @@ def outward_step(k, R, P, jtype, qd, qdd, wx, wy, wz, ax, ay, az, vx, vy, vz,
     nvx, nvy, nvz = rotate_back(R, k, tx, ty, tz)
     rwx, rwy, rwz = rotate_back(R, k, wx, wy, wz)
     rax, ray, raz = rotate_back(R, k, ax, ay, az)
-    if jtype[k] == 0:
+    if jtype[k] == REVOLUTE:
         return (rwx, rwy, rwz + qd[k], rax + rwy * qd[k], ray - rwx * qd[k], raz + qdd[k], nvx, nvy,
                 nvz)
     # prismatic: + 2 ω × (ḋ ẑ) + d̈ ẑ
@@ -202,16 +218,19 @@ def outward_step(k, R, P, jtype, qd, qdd, wx, wy, wz, ax, ay, az, vx, vy, vz,
 
 
 @hot
-def rnea_pass(n, R, P, jtype, mass, com, inertia, armature, qd, qdd, gx, gy, gz, with_velocity,
-              tau, work):  # pragma: no cover - compiled
-    """Joint forces τ (n) for velocities qd and accelerations qdd, base acceleration −g.
+def rnea_pass(n, lk, R, P, qd, qdd, gx, gy, gz, with_velocity, tau,
+              work):  # pragma: no cover - compiled
+    """Joint forces τ (n) for velocities qd and accelerations qdd, base acceleration −g, of the
+    chain whose links are ``lk`` (:data:`LinkArrays`, :func:`links_of` a chain record) and whose
+    link transforms R, P are filled.
 
     ``with_velocity=False`` skips every velocity product (exact when qd = 0, e.g. gravity).
     ``work`` holds at least ``WORK_PER_LINK * n`` floats."""
-    wx, wy, wz, ax, ay, az, vx, vy, vz = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -gx, -gy, -gz  # base: ω = ω̇ = 0, v̇ = −g
+    jtype, mass, com, inertia, armature = lk.jtype, lk.mass, lk.com, lk.inertia, lk.arm_q
+    s = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -gx, -gy, -gz)  # base: ω = ω̇ = 0, v̇ = −g
     for k in range(n):
-        wx, wy, wz, ax, ay, az, vx, vy, vz = outward_step(k, R, P, jtype, qd, qdd, wx, wy, wz, ax, ay, az,
-                                                          vx, vy, vz, with_velocity)
+        s = outward_step(k, R, P, jtype, qd, qdd, s, with_velocity)
+        wx, wy, wz, ax, ay, az, vx, vy, vz = s
         # centre-of-mass acceleration and link wrench
         cxm = com[k, 0]; cym = com[k, 1]; czm = com[k, 2]  # noqa: E702
         bx = ay * czm - az * cym + vx
@@ -274,15 +293,16 @@ def rnea_pass(n, R, P, jtype, mass, com, inertia, armature, qd, qdd, gx, gy, gz,
         mx = work[o + 3] + rmx + (cym * Fz - czm * Fy)
         my = work[o + 4] + rmy + (czm * Fx - cxm * Fz)
         mz = work[o + 5] + rmz + (cxm * Fy - cym * Fx)
-        if jtype[k] == 0:
+        if jtype[k] == REVOLUTE:
             tau[k] = mz + armature[k] * qdd[k]
         else:
             tau[k] = fz + armature[k] * qdd[k]
 
 
 @hot
-def crba(n, R, P, jtype, mass, com, inertia, armature, M, work):  # pragma: no cover - compiled
-    """Joint-space mass matrix M (n×n) by the composite-rigid-body algorithm in the link frames.
+def crba(n, lk, R, P, M, work):  # pragma: no cover - compiled
+    """Joint-space mass matrix M (n×n) of the chain whose links are ``lk`` (:data:`LinkArrays`) by
+    the composite-rigid-body algorithm in the link frames.
 
     Composite body k (links k..n) in frame k about its origin: mass m, first moment h = Σ m·c,
     rotational inertia I_o. Moving a body's inertia from frame k+1 (origin offset P, rotation R)
@@ -291,9 +311,9 @@ def crba(n, R, P, jtype, mass, com, inertia, armature, M, work):  # pragma: no c
     revolute joint k needs f = ẑ × h, n = I_o ẑ (prismatic: f = m ẑ, n = h × ẑ); M[k, k] is ẑ·n
     (ẑ·f), and M[i, k] for i < k follows by carrying (f, n) down the chain (eqs 4.14–4.16).
     ``work`` holds at least 10·n floats."""
-    _link_inertias(n, mass, com, inertia, work)
+    _link_inertias(n, lk.mass, lk.com, lk.inertia, work)
     _composite_inertias(n, R, P, work)
-    _mass_matrix_columns(n, R, P, jtype, armature, M, work)
+    _mass_matrix_columns(n, R, P, lk.jtype, lk.arm_q, M, work)
 
 
 @hot
@@ -372,7 +392,7 @@ def _mass_matrix_columns(n, R, P, jtype, armature, M, work):  # pragma: no cover
     k, carried down the chain (eqs 4.14–4.16); the armature on the diagonal."""
     for k in range(n):
         o = 10 * k
-        if jtype[k] == 0:
+        if jtype[k] == REVOLUTE:
             fx = -work[o + 2]  # ẑ × h = (−h_y, h_x, 0)
             fy = work[o + 1]
             fz = 0.0
@@ -401,26 +421,28 @@ def _mass_matrix_columns(n, R, P, jtype, armature, M, work):  # pragma: no cover
             mx = nx
             my = ny
             mz = nz
-            v = mz if jtype[i - 1] == 0 else fz
+            v = mz if jtype[i - 1] == REVOLUTE else fz
             M[i - 1, k] = v
             M[k, i - 1] = v
 
 
 @hot
-def coupled_mass_bias(n, m, R, P, jtype, mass, com, inertia, arm_q, G, arm_p, qd, gx, gy, gz,
-                      Mp, hp, zeros_n, Mq, tau, work):  # pragma: no cover - compiled
+def coupled_mass_bias(n, m, lk, G, arm_p, cw, qd, gx, gy, gz, Mp, hp):  # pragma: no cover
     """Actuator-space mass matrix Mp (m×m) = Γᵀ M Γ + diag(arm_p) (M by :func:`crba`) and bias
-    hp (m) = Γᵀ h(q, q̇) (one RNEA pass with q̈ = 0) for joint velocities qd (already Γ ṗ). Link
-    transforms R, P must be filled for the current q; ``Mq`` is n×n scratch, ``work`` at least
-    10·n floats."""
-    rnea_pass(n, R, P, jtype, mass, com, inertia, arm_q, qd, zeros_n, gx, gy, gz, True, tau, work)
+    hp (m) = Γᵀ h(q, q̇) (one RNEA pass with q̈ = 0) for joint velocities qd (already Γ ṗ) of the
+    chain with links ``lk`` (:data:`LinkArrays`) and coupling Γ. ``cw`` is the chain's scratch, a
+    record with the fields ``R``, ``P`` (link transforms, filled for the current q), ``zq`` (n
+    zeros), ``Mq`` (n×n), ``tau`` (n) and ``work`` (at least 10·n floats), as
+    :data:`DynamicsWork`."""
+    tau, work = cw.tau, cw.work
+    rnea_pass(n, lk, cw.R, cw.P, qd, cw.zq, gx, gy, gz, True, tau, work)
     for i in range(m):
         s = 0.0
         for k in range(n):
             s += G[k * m + i] * tau[k]
         hp[i] = s
-    crba(n, R, P, jtype, mass, com, inertia, arm_q, Mq, work)
-    project_mass(n, m, Mq, G, arm_p, Mp)
+    crba(n, lk, cw.R, cw.P, cw.Mq, work)
+    project_mass(n, m, cw.Mq, G, arm_p, Mp)
 
 
 @hot
@@ -507,7 +529,7 @@ def point_jacobian(n, jtype, T, px, py, pz, J):  # pragma: no cover - compiled
         zx = T[k, 2]
         zy = T[k, 6]
         zz = T[k, 10]
-        if jtype[k] == 0:
+        if jtype[k] == REVOLUTE:
             rx = px - T[k, 3]
             ry = py - T[k, 7]
             rz = pz - T[k, 11]

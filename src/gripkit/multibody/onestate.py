@@ -21,7 +21,8 @@ import math
 import numba
 import numpy as np
 
-from .kernels import WORK_PER_LINK, chain_links, crba, hot_inline, project_mass, rnea_pass
+from .kernels import (WORK_PER_LINK, ChainArrays, chain_links, crba, hot_inline, links_of,
+                      project_mass, rnea_pass)
 
 __all__ = ["mass_matrix_one", "pack", "prepare", "rnea_one"]
 
@@ -48,7 +49,8 @@ def pack(arrays) -> np.ndarray:
 
 @hot_inline
 def _model(buf):  # pragma: no cover - compiled
-    """Views of the packed buffer (no allocation): sizes, model arrays and the scratch."""
+    """Views of the packed buffer (no allocation): sizes, the model as a :data:`ChainArrays`
+    record (joint types as floats) and the scratch."""
     n = int(buf[0])
     m = int(buf[1])
     w = int(buf[2])
@@ -64,7 +66,7 @@ def _model(buf):  # pragma: no cover - compiled
     g = buf[int(o[8]):int(o[8]) + 3]
     jtype = buf[int(o[9]):int(o[9]) + n]
     work = buf[int(o[10]):]
-    return n, m, dh, mass, com, inertia, arm_q, G, q0, arm_p, g, jtype, work
+    return n, m, ChainArrays(dh, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g), work
 
 
 @hot_inline
@@ -78,8 +80,9 @@ def _finite(m, q):  # pragma: no cover - compiled
 
 
 @hot_inline
-def _links(n, m, dh, jtype, G, q0, q, work):  # pragma: no cover - compiled
+def _links(n, m, ch, q, work):  # pragma: no cover - compiled
     """Joint positions Γ p + q₀ into the scratch and the link transforms R, P for them."""
+    G, q0 = ch.G, ch.q0
     R = work[0:9 * n].reshape((n, 9))
     P = work[9 * n:12 * n].reshape((n, 3))
     qq = work[12 * n + WORK_PER_LINK * n:13 * n + WORK_PER_LINK * n]
@@ -88,7 +91,7 @@ def _links(n, m, dh, jtype, G, q0, q, work):  # pragma: no cover - compiled
         for a in range(m):
             s += G[k * m + a] * q[a]
         qq[k] = s
-    chain_links(n, dh, jtype, qq, R, P)
+    chain_links(n, ch.links, ch.jtype, qq, R, P)
     return R, P
 
 
@@ -97,10 +100,11 @@ def rnea_one(buf, q, qd, qdd, out):  # pragma: no cover - compiled
     """τ_p = Γᵀ RNEA(Γ p + q₀, Γ ṗ, Γ p̈) + armature_p·p̈ for one state; False when the state has
     NaN or inf or the wrong length, or ``out`` is not of length m (out untouched). Compiled for 1-D float64 arrays only
     (other types raise TypeError at the call)."""
-    n, m, dh, mass, com, inertia, arm_q, G, q0, arm_p, g, jtype, work = _model(buf)
+    n, m, ch, work = _model(buf)
     if out.shape[0] != m or not (_finite(m, q) and _finite(m, qd) and _finite(m, qdd)):
         return False
-    R, P = _links(n, m, dh, jtype, G, q0, q, work)
+    G, g, arm_p = ch.G, ch.g, ch.arm_p
+    R, P = _links(n, m, ch, q, work)
     b = 12 * n + WORK_PER_LINK * n
     qqd = work[b + n:b + 2 * n]
     qqdd = work[b + 2 * n:b + 3 * n]
@@ -114,8 +118,7 @@ def rnea_one(buf, q, qd, qdd, out):  # pragma: no cover - compiled
             sdd += gk * qdd[a]
         qqd[k] = sd
         qqdd[k] = sdd
-    rnea_pass(n, R, P, jtype, mass, com, inertia, arm_q, qqd, qqdd, g[0], g[1], g[2], True, tau,
-              work[12 * n:b])
+    rnea_pass(n, links_of(ch), R, P, qqd, qqdd, g[0], g[1], g[2], True, tau, work[12 * n:b])
     for a in range(m):
         s = arm_p[a] * qdd[a]
         for k in range(n):
@@ -129,14 +132,14 @@ def mass_matrix_one(buf, q, out):  # pragma: no cover - compiled
     """M_p = Γᵀ M(Γ p + q₀) Γ + diag(armature_p) (CRBA, thesis eqs 4.14–4.16) for one state into
     ``out`` (m×m); False when q has NaN or inf or the wrong length, or ``out`` is not m×m (out
     untouched)."""
-    n, m, dh, mass, com, inertia, arm_q, G, q0, arm_p, g, jtype, work = _model(buf)
+    n, m, ch, work = _model(buf)
     if out.shape[0] != m or out.shape[1] != m or not _finite(m, q):
         return False
-    R, P = _links(n, m, dh, jtype, G, q0, q, work)
+    R, P = _links(n, m, ch, q, work)
     b = 12 * n + WORK_PER_LINK * n
     Mq = work[b + 4 * n:b + 4 * n + n * n].reshape((n, n))
-    crba(n, R, P, jtype, mass, com, inertia, arm_q, Mq, work[12 * n:b])
-    project_mass(n, m, Mq, G, arm_p, out)
+    crba(n, links_of(ch), R, P, Mq, work[12 * n:b])
+    project_mass(n, m, Mq, ch.G, ch.arm_p, out)
     return True
 
 

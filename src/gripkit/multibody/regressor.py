@@ -22,9 +22,11 @@ it as an extra column, :func:`gripkit.sysid.identify_dynamics`).
 
 from __future__ import annotations
 
+from collections import namedtuple
+
 import numpy as np
 
-from .kernels import chain_links, hot, outward_step, rotation
+from .kernels import REVOLUTE, chain_links, hot, hot_inline, outward_step, rotation
 from .rnea import _states
 
 __all__ = ["regressor", "standard_parameters", "parameter_names", "PARAMETERS_PER_LINK",
@@ -33,16 +35,20 @@ __all__ = ["regressor", "standard_parameters", "parameter_names", "PARAMETERS_PE
 PARAMETERS_PER_LINK = 10
 #: names of a link's standard parameters, in φ order (hx = m·c_x, ...; I about the link origin)
 LINK_PARAMETERS = ("m", "mx", "my", "mz", "Ixx", "Ixy", "Iyy", "Ixz", "Iyz", "Izz")
+#: scratch of the regressor kernels (n links): link rotations (n, 9) and positions (n, 3), the
+#: outward kinematics (n, 9), one link's parameter wrenches (6, 10), the joint-space regressor
+#: (n, 10n) and the joint positions, rates and accelerations (n each)
+RegressorWork = namedtuple("RegressorWork", "R P kin W Yq q qd qdd")
 
 
 @hot
 def outward_kinematics(n, R, P, jtype, qd, qdd, gx, gy, gz, kin):  # pragma: no cover - compiled
     """ω, ω̇ and the origin's acceleration v̇ (gravity as −g) of every link in its own frame:
     ``kin[k] = (ω, ω̇, v̇)`` (9 floats), eqs 4.8–4.10."""
-    wx, wy, wz, ax, ay, az, vx, vy, vz = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -gx, -gy, -gz  # base: ω = ω̇ = 0, v̇ = −g
+    s = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0, -gx, -gy, -gz)  # base: ω = ω̇ = 0, v̇ = −g
     for k in range(n):
-        wx, wy, wz, ax, ay, az, vx, vy, vz = outward_step(k, R, P, jtype, qd, qdd, wx, wy, wz, ax, ay, az,
-                                                          vx, vy, vz, True)
+        s = outward_step(k, R, P, jtype, qd, qdd, s, True)
+        wx, wy, wz, ax, ay, az, vx, vy, vz = s
         kin[k, 0] = wx
         kin[k, 1] = wy
         kin[k, 2] = wz
@@ -94,16 +100,19 @@ def _parameter_wrench(c, wx, wy, wz, ax, ay, az, vx, vy, vz):  # pragma: no cove
     return 0.0, 0.0, 0.0, nx, ny, nz
 
 
-@hot
-def regressor_state(n, m, R, P, jtype, G, qd, qdd, gx, gy, gz, kin, W, Yq, Y, b):  # pragma: no cover
-    """Joint-space regressor Yq (n × 10n) of one state (link transforms R, P already filled) and
-    its actuator-space projection Y[b] = Γᵀ Yq (m × 10n).
+@hot_inline
+def regressor_state(n, m, ch, w, qd, qdd, gx, gy, gz, Y, b):  # pragma: no cover - compiled
+    """Joint-space regressor Yq = ``w.Yq`` (n × 10n) of one state of the chain ``ch`` (joint types
+    and Γ of :data:`~gripkit.multibody.kernels.ChainArrays`; link transforms ``w.R``, ``w.P``
+    already filled, ``w`` a :data:`RegressorWork`) and its actuator-space projection
+    Y[b] = Γᵀ Yq (m × 10n).
 
     Link j's ten parameter wrenches (f, n) at its origin, in its frame, are kept in ``W`` (6 × 10)
     and projected on each joint i ≤ j: with u the axis of joint i and d the vector from joint i's
     origin to link j's, both in frame j, τ_i = u·n + (u × d)·f (revolute) or u·f (prismatic).
     u and d come from carrying frame j down to frame i (R_{i←j} = R_{i+1}·R_{i+1←j},
     p_i = R_{i+1} p_{i+1} + P_{i+1}): u = R_{i←j}ᵀ ẑ, u × d = R_{i←j}ᵀ (ẑ × p_i)."""
+    R, P, jtype, G, kin, W, Yq = w.R, w.P, ch.jtype, ch.G, w.kin, w.W, w.Yq
     outward_kinematics(n, R, P, jtype, qd, qdd, gx, gy, gz, kin)
     for i in range(n):
         for col in range(10 * n):
@@ -149,7 +158,7 @@ def regressor_state(n, m, R, P, jtype, G, qd, qdd, gx, gy, gz, kin, W, Yq, Y, b)
             uy = a7
             uz = a8
             col = 10 * j
-            if jtype[i] == 0:
+            if jtype[i] == REVOLUTE:
                 ex = -py * a0 + px * a3
                 ey = -py * a1 + px * a4
                 ez = -py * a2 + px * a5
@@ -172,10 +181,12 @@ def regressor_state(n, m, R, P, jtype, G, qd, qdd, gx, gy, gz, kin, W, Yq, Y, b)
 
 
 @hot
-def _regressor_range(b0, b1, dh, jtype, G, q0, g, gscale, pos, vel, acc, Y, R, P, kin, W, Yq, q,
-                     qd, qdd):  # pragma: no cover - compiled
-    n = dh.shape[0]
+def _regressor_range(b0, b1, ch, gscale, pos, vel, acc, Y, w):  # pragma: no cover - compiled
+    """Regressors Y[b] of states b0..b1−1 of the chain ``ch`` (:data:`ChainArrays`), gravity
+    scaled by ``gscale``; scratch ``w`` (:data:`RegressorWork`)."""
+    n = ch.links.shape[0]
     m = pos.shape[1]
+    G, q0, g, q, qd, qdd = ch.G, ch.q0, ch.g, w.q, w.qd, w.qdd
     for b in range(b0, b1):
         for k in range(n):
             s = q0[k]
@@ -189,16 +200,13 @@ def _regressor_range(b0, b1, dh, jtype, G, q0, g, gscale, pos, vel, acc, Y, R, P
             q[k] = s
             qd[k] = sd
             qdd[k] = sdd
-        chain_links(n, dh, jtype, q, R, P)
-        regressor_state(n, m, R, P, jtype, G, qd, qdd, gscale * g[0], gscale * g[1], gscale * g[2],
-                        kin, W, Yq, Y, b)
+        chain_links(n, ch.links, ch.jtype, q, w.R, w.P)
+        regressor_state(n, m, ch, w, qd, qdd, gscale * g[0], gscale * g[1], gscale * g[2], Y, b)
 
 
 @hot
-def _regressor_batch(dh, jtype, G, q0, g, gscale, pos, vel, acc, Y, R, P, kin, W, Yq, q, qd,
-                     qdd):  # pragma: no cover - compiled
-    _regressor_range(0, pos.shape[0], dh, jtype, G, q0, g, gscale, pos, vel, acc, Y, R, P, kin, W,
-                     Yq, q, qd, qdd)
+def _regressor_batch(ch, gscale, pos, vel, acc, Y, w):  # pragma: no cover - compiled
+    _regressor_range(0, pos.shape[0], ch, gscale, pos, vel, acc, Y, w)
 
 
 def regressor(system, q, qd, qdd, *, gravity: bool = True) -> np.ndarray:
@@ -216,14 +224,13 @@ def regressor(system, q, qd, qdd, *, gravity: bool = True) -> np.ndarray:
         :func:`parameter_names` order.
     """
     (q, qd, qdd), single = _states(system, q, qd, qdd, names=("q", "qd", "qdd"))
-    dh, jt, _, _, _, _, G, q0, _, g = system.kernel_arrays()
-    n = dh.shape[0]
+    ch = system.kernel_arrays()
+    n = ch.links.shape[0]
     B, m = q.shape
     Y = np.empty((B, m, PARAMETERS_PER_LINK * n))
-    _regressor_batch(dh, jt, G, q0, g, 1.0 if gravity else 0.0, q, qd, qdd, Y, np.empty((n, 9)),
-                     np.empty((n, 3)), np.empty((n, 9)), np.empty((6, 10)),
-                     np.empty((n, PARAMETERS_PER_LINK * n)),
-                     np.empty(n), np.empty(n), np.empty(n))
+    w = RegressorWork(np.empty((n, 9)), np.empty((n, 3)), np.empty((n, 9)), np.empty((6, 10)),
+                      np.empty((n, PARAMETERS_PER_LINK * n)), np.empty(n), np.empty(n), np.empty(n))
+    _regressor_batch(ch, 1.0 if gravity else 0.0, q, qd, qdd, Y, w)
     L = system.parameter_map()
     if L is not None:
         Y = Y @ L

@@ -28,8 +28,8 @@ from numba import prange
 
 from ..errors import ModelError, SimulationError
 from .kernels import (WORK_PER_LINK, ChainArrays, DynamicsWork, chain_links, cholesky_solve,
-                      coupled_mass_bias, frames_into, hot, joints_from_actuators, point_jacobian,
-                      rnea_pass)
+                      coupled_mass_bias, frames_into, hot, joints_from_actuators, links_of,
+                      point_jacobian, rnea_pass)
 
 __all__ = ["rnea", "mass_matrix", "coriolis", "gravity", "bias", "forward_dynamics",
            "kinetic_energy", "potential_energy", "simulate_free"]
@@ -44,6 +44,14 @@ OP_RNEA, OP_MASS_BIAS, OP_BIAS, OP_FD, OP_POTENTIAL, OP_FRAMES, OP_JACOBIAN = ra
 
 #: scratch of the fixed-step integrator: state, stage state and the four RK4 stage accelerations
 RK4Work = namedtuple("RK4Work", "x v xs vs k1 k2 k3 k4")
+#: what the fixed-step integrator writes: positions and velocities (B, N, m) and, per initial
+#: state, the first sample whose step failed + 1 (0: none)
+Trajectory = namedtuple("Trajectory", "pos vel fail")
+#: scratch of the kinematics kernel (n links): link rotations and positions, joint positions,
+#: base-to-link transforms (n, 16) and a point Jacobian (6, n)
+KinematicsWork = namedtuple("KinematicsWork", "R P q T J")
+#: integration methods of :func:`simulate_free` (the kernels' ``method`` code)
+RK4, SEMI_IMPLICIT = 0, 1
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -62,8 +70,7 @@ def _accel(n, m, ch, p, pd, tau_p, a, w):  # pragma: no cover - compiled
     joints_from_actuators(n, m, G, ch.q0, p, q)
     joints_from_actuators(n, m, G, zq, pd, qd)
     chain_links(n, ch.links, ch.jtype, q, w.R, w.P)
-    coupled_mass_bias(n, m, w.R, w.P, ch.jtype, ch.mass, ch.com, ch.inertia, ch.arm_q, G, ch.arm_p, qd,
-                      g[0], g[1], g[2], w.Mp, hp, zq, w.Mq, w.tau, w.work)
+    coupled_mass_bias(n, m, links_of(ch), G, ch.arm_p, w, qd, g[0], g[1], g[2], w.Mp, hp)
     for i in range(m):
         rhs[i] = tau_p[i] - hp[i]
     return cholesky_solve(m, w.Mp, rhs, a, w.L)
@@ -84,8 +91,7 @@ def _range_dyn(op, b0, b1, ch, gscale, pos, vel, acc, vout, mout, w):  # pragma:
         joints_from_actuators(n, m, G, zq, vel[b], qd)
         chain_links(n, ch.links, ch.jtype, q, w.R, w.P)
         if op == OP_MASS_BIAS:
-            coupled_mass_bias(n, m, w.R, w.P, ch.jtype, ch.mass, ch.com, ch.inertia, ch.arm_q, G,
-                              ch.arm_p, qd, gx, gy, gz, Mp, hp, zq, w.Mq, tau, w.work)
+            coupled_mass_bias(n, m, links_of(ch), G, ch.arm_p, w, qd, gx, gy, gz, Mp, hp)
             for i in range(m):
                 vout[b, i] = hp[i]
                 for j in range(m):
@@ -96,8 +102,7 @@ def _range_dyn(op, b0, b1, ch, gscale, pos, vel, acc, vout, mout, w):  # pragma:
         else:
             for k in range(n):
                 qdd[k] = 0.0
-        rnea_pass(n, w.R, w.P, ch.jtype, ch.mass, ch.com, ch.inertia, ch.arm_q, qd, qdd, gx, gy, gz,
-                  True, tau, w.work)
+        rnea_pass(n, links_of(ch), w.R, w.P, qd, qdd, gx, gy, gz, True, tau, w.work)
         for i in range(m):
             s = ch.arm_p[i] * acc[b, i] if op == OP_RNEA else 0.0
             for k in range(n):
@@ -106,12 +111,14 @@ def _range_dyn(op, b0, b1, ch, gscale, pos, vel, acc, vout, mout, w):  # pragma:
 
 
 @hot
-def _range_kin(op, b0, b1, ch, tool, pos, vout, fout, R, P, q, T, J):  # pragma: no cover - compiled
+def _range_kin(op, b0, b1, ch, tool, pos, vout, fout, kw):  # pragma: no cover - compiled
     """Link frames (OP_FRAMES → fout (B, n, 16)), the tool point's Jacobian (OP_JACOBIAN → fout
-    (B, 6, m)) or the potential energy (OP_POTENTIAL → vout (B, 1))."""
+    (B, 6, m)) or the potential energy (OP_POTENTIAL → vout (B, 1)); scratch ``kw``
+    (:data:`KinematicsWork`)."""
     n = ch.links.shape[0]
     m = pos.shape[1]
     G, g, mass, com = ch.G, ch.g, ch.mass, ch.com
+    R, P, q, T, J = kw.R, kw.P, kw.q, kw.T, kw.J
     for b in range(b0, b1):
         joints_from_actuators(n, m, G, ch.q0, pos[b], q)
         chain_links(n, ch.links, ch.jtype, q, R, P)
@@ -177,8 +184,9 @@ def _dyn_parallel(op, ch, gscale, pos, vel, acc, vout, mout):  # pragma: no cove
 @numba.njit(cache=True, error_model="numpy")
 def _kin_serial(op, ch, tool, pos, vout, fout):  # pragma: no cover - compiled
     n = ch.links.shape[0]
-    _range_kin(op, 0, pos.shape[0], ch, tool, pos, vout, fout, np.empty((n, 9)), np.empty((n, 3)),
-               np.empty(n), np.empty((n, 16)), np.empty((6, n)))
+    _range_kin(op, 0, pos.shape[0], ch, tool, pos, vout, fout,
+               KinematicsWork(np.empty((n, 9)), np.empty((n, 3)), np.empty(n), np.empty((n, 16)),
+                              np.empty((6, n))))
 
 
 @numba.njit(cache=True, error_model="numpy")
@@ -212,11 +220,13 @@ def run_op(system, op: int, pos, vel=None, acc=None, *, gscale: float = 1.0, too
 
 
 @hot
-def _simulate_range(b0, b1, ch, p0, pd0, torque, dt, substeps, method, pos_out, vel_out, fail, w,
+def _simulate_range(b0, b1, ch, p0, pd0, torque, dt, substeps, method, out, w,
                     rk):  # pragma: no cover - compiled
     """Fixed-step integration of τ_p = M_p p̈ + h_p from initial states b0..b1−1, torque held
-    over each sample (N, m). method 0: classical RK4; 1: semi-implicit (symplectic) Euler.
-    Scratch: ``w`` (:data:`DynamicsWork`), ``rk`` (:data:`RK4Work`)."""
+    over each sample (N, m), into ``out`` (:data:`Trajectory`). ``method``: :data:`RK4`
+    (classical Runge-Kutta) or :data:`SEMI_IMPLICIT` (symplectic Euler). Scratch: ``w``
+    (:data:`DynamicsWork`), ``rk`` (:data:`RK4Work`)."""
+    pos_out, vel_out, fail = out.pos, out.vel, out.fail
     n = ch.links.shape[0]
     m = p0.shape[1]
     N = torque.shape[0]
@@ -231,7 +241,7 @@ def _simulate_range(b0, b1, ch, p0, pd0, torque, dt, substeps, method, pos_out, 
                 pos_out[b, s, i] = x[i]
                 vel_out[b, s, i] = v[i]
             for _ in range(substeps):
-                if method == 1:
+                if method == SEMI_IMPLICIT:
                     if not _accel(n, m, ch, x, v, torque[s], k1, w):
                         fail[b] = s + 1
                     for i in range(m):
@@ -282,7 +292,7 @@ def _simulate_parallel(ch, p0, pd0, torque, dt, substeps, method, pos_out, vel_o
     m = p0.shape[1]
     for b in prange(p0.shape[0]):
         _simulate_range(b, b + 1, ChainArrays(links, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g),
-                        p0, pd0, torque, dt, substeps, method, pos_out, vel_out, fail,
+                        p0, pd0, torque, dt, substeps, method, Trajectory(pos_out, vel_out, fail),
                         dynamics_work(n, m), _rk4_work(m))
 
 
@@ -290,8 +300,9 @@ def _simulate_parallel(ch, p0, pd0, torque, dt, substeps, method, pos_out, vel_o
 def _simulate_serial(ch, p0, pd0, torque, dt, substeps, method, pos_out, vel_out,
                      fail):  # pragma: no cover - compiled
     m = p0.shape[1]
-    _simulate_range(0, p0.shape[0], ch, p0, pd0, torque, dt, substeps, method, pos_out, vel_out, fail,
-                    dynamics_work(ch.links.shape[0], m), _rk4_work(m))
+    _simulate_range(0, p0.shape[0], ch, p0, pd0, torque, dt, substeps, method,
+                    Trajectory(pos_out, vel_out, fail), dynamics_work(ch.links.shape[0], m),
+                    _rk4_work(m))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -433,8 +444,8 @@ def simulate_free(system, q0, qd0, torque, dt: float, *, substeps: int = 1,
     vel = np.empty((B, N, m))
     fail = np.zeros(B, dtype=np.int64)
     fn = _simulate_parallel if B >= 8 else _simulate_serial
-    fn(system.kernel_arrays(), q0, qd0, tq, float(dt), int(substeps), 0 if method == "rk4" else 1,
-       pos, vel, fail)
+    fn(system.kernel_arrays(), q0, qd0, tq, float(dt), int(substeps),
+       RK4 if method == "rk4" else SEMI_IMPLICIT, pos, vel, fail)
     if fail.any() or not np.isfinite(pos).all():
         raise SimulationError(f"{system.name}: the simulation diverged or met a singular mass matrix",
                               hint="reduce dt or check the inertial parameters")

@@ -27,6 +27,7 @@ check after every substep — the reference the exact scheme is tested against.
 
 from __future__ import annotations
 
+from collections import namedtuple
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -113,6 +114,17 @@ class HybridResult:
     events: list[tuple[float, str, str]] = field(default_factory=list)
 
 
+#: the switching surfaces as the kernels take them: G (Q, J, n), H (Q, J, m+1), target (Q, J)
+#: and n_guards (Q,) of :class:`DiscreteHybrid`
+PWAGuards = namedtuple("PWAGuards", "G H target n_guards")
+#: the scratch of :func:`pwa_step`: the trial state (n,) and the events' step fractions and
+#: target modes (MAX_EVENTS_PER_STEP each); any record with these fields will do
+#: (``gripkit.systems.tsfm.gripper.GripperWork``)
+EventWork = namedtuple("EventWork", "xt ev_frac ev_to")
+#: what :func:`_hybrid_run` writes: outputs (N, p), states (N, n), modes (N,) and event rows
+HybridOut = namedtuple("HybridOut", "y xs modes ev_rows")
+
+
 @numba.njit(cache=True, inline="always")
 def first_crossed_guard(G, H, n_guards, mode, x, u):  # pragma: no cover - compiled
     """Index of the first guard of ``mode`` with G·x + H·u < 0 (u ends with the constant 1 that
@@ -129,16 +141,18 @@ def first_crossed_guard(G, H, n_guards, mode, x, u):  # pragma: no cover - compi
 
 
 @numba.njit(cache=True, inline="always")
-def pwa_step(x, mode, u, Phi, Gam, G, H, target, n_guards, K, xt, ev_frac, ev_to):  # pragma: no cover
+def pwa_step(x, mode, u, Phi, Gam, G, H, target, n_guards, K, work):  # pragma: no cover
     """Advance ``x`` (n,) in place over one sample step with the held input ``u`` (m+1,, last
-    entry 1). Returns (new mode, number of events); event i happened at fraction ``ev_frac[i]``
-    of the step, into mode ``ev_to[i]`` (arrays of capacity MAX_EVENTS_PER_STEP). See the module
-    docstring for the dyadic event location.
+    entry 1). Returns (new mode, number of events); event i happened at fraction
+    ``work.ev_frac[i]`` of the step, into mode ``work.ev_to[i]`` (arrays of capacity
+    MAX_EVENTS_PER_STEP; ``work`` as :data:`EventWork`). See the module docstring for the dyadic
+    event location.
 
     Speed (measured): the function is inlined into its callers and indexes the matrix stacks in
     place — a call or a slice per step costs reference counting, ~50 ns; the common sizes (4 or 6
     states with 2 inputs + 1) have their matrix-vector product written with constant trip counts,
     which LLVM unrolls (2× faster than runtime-sized loops)."""
+    xt, ev_frac, ev_to = work.xt, work.ev_frac, work.ev_to
     n = x.shape[0]
     m = u.shape[0]
     kind = 1 if (n == 4 and m == 3) else (2 if (n == 6 and m == 3) else 0)
@@ -209,7 +223,11 @@ def pwa_output(C, D, mode, x, u, y):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _hybrid_run(Phi, Gam, C, D, G, H, target, n_guards, K, u, x, mode, y, xs, modes, ev_rows):  # pragma: no cover
+def _hybrid_run(Phi, Gam, C, D, guards, K, u, x, mode, out):  # pragma: no cover - compiled
+    """The dyadic simulation of :meth:`HybridSystem.simulate` (``guards``: :data:`PWAGuards`)
+    into ``out`` (:data:`HybridOut`); returns (event rows, first sample of a Zeno step or −1)."""
+    G, H, target, n_guards = guards
+    y, xs, modes, ev_rows = out
     N = u.shape[0]
     m1 = u.shape[1] + 1
     ua = np.empty(m1)
@@ -217,6 +235,7 @@ def _hybrid_run(Phi, Gam, C, D, G, H, target, n_guards, K, u, x, mode, y, xs, mo
     xt = np.empty(x.shape[0])
     ev_frac = np.empty(MAX_EVENTS_PER_STEP)
     ev_to = np.empty(MAX_EVENTS_PER_STEP, dtype=np.int64)
+    work = EventWork(xt, ev_frac, ev_to)
     nrow = 0
     zeno = -1
     for k in range(N):
@@ -227,7 +246,7 @@ def _hybrid_run(Phi, Gam, C, D, G, H, target, n_guards, K, u, x, mode, y, xs, mo
         pwa_output(C, D, mode, x, ua, y[k])
         modes[k] = mode
         old = mode
-        mode, nev = pwa_step(x, mode, ua, Phi, Gam, G, H, target, n_guards, K, xt, ev_frac, ev_to)
+        mode, nev = pwa_step(x, mode, ua, Phi, Gam, G, H, target, n_guards, K, work)
         if nev >= MAX_EVENTS_PER_STEP and zeno < 0:
             zeno = k
         for e in range(min(nev, MAX_EVENTS_PER_STEP)):
@@ -241,7 +260,10 @@ def _hybrid_run(Phi, Gam, C, D, G, H, target, n_guards, K, u, x, mode, y, xs, mo
 
 
 @numba.njit(cache=True)
-def _hybrid_rk4(A, B, C, D, G, H, target, n_guards, u, h, nsub, x, mode, y, modes):  # pragma: no cover
+def _hybrid_rk4(A, B, C, D, guards, u, h, nsub, x, mode, y, modes):  # pragma: no cover - compiled
+    """The fine-step RK4 reference of :meth:`HybridSystem.simulate_reference` (``guards``:
+    :data:`PWAGuards`)."""
+    G, H, target, n_guards = guards
     N = u.shape[0]
     n = x.shape[0]
     m1 = u.shape[1] + 1
@@ -384,8 +406,8 @@ class HybridSystem:
         xs = np.empty((N, self.n_states))
         modes = np.empty(N, dtype=np.int64)
         rows = np.empty((max_events, 3))
-        nrow, zeno = _hybrid_run(d.Phi, d.Gam, d.C, d.D, d.G, d.H, d.target, d.n_guards, d.levels,
-                                 u2, x, mode, y, xs, modes, rows)
+        nrow, zeno = _hybrid_run(d.Phi, d.Gam, d.C, d.D, PWAGuards(d.G, d.H, d.target, d.n_guards),
+                                 d.levels, u2, x, mode, HybridOut(y, xs, modes, rows))
         if zeno >= 0:
             raise SimulationError(f"{self.name}: more than {MAX_EVENTS_PER_STEP} mode switches inside the "
                                   f"step at t = {zeno * dt:.6g} s (chattering between modes)",
@@ -404,8 +426,9 @@ class HybridSystem:
         N = u2.shape[0]
         y = np.empty((N, self.n_outputs))
         modes = np.empty(N, dtype=np.int64)
-        _hybrid_rk4(self.A, self.B, self.C, self.D, self.G, self.H, self.target, self.n_guards, u2,
-                    dt / substeps, int(substeps), x, mode, y, modes)
+        _hybrid_rk4(self.A, self.B, self.C, self.D,
+                    PWAGuards(self.G, self.H, self.target, self.n_guards), u2, dt / substeps,
+                    int(substeps), x, mode, y, modes)
         ch = np.flatnonzero(np.diff(modes)) + 1
         rows = np.array([[k, modes[k - 1], modes[k]] for k in ch]).reshape(-1, 3)
         return self._result(u2, dt, y, np.full((N, self.n_states), np.nan), modes, rows)

@@ -125,3 +125,19 @@ def test_ftg100_scenario_matches_grasp_batch():
     for m in ("peak_force", "settling_time", "overshoot_percent"):
         np.testing.assert_array_equal(res[m], ref[m])
     assert math.isfinite(res["peak_force"][0])
+
+
+def test_settings_vector_is_read_by_name():
+    """GraspSettings.vector in SETTINGS_VECTOR order: the entries the kernels read as cp[SX.<name>]
+    are the settings given (the gains and dt passed, the commanded force, the loop bandwidths as
+    2π f)."""
+    from gripkit.systems.tsfm.grasp import SETTINGS_VECTOR, SX, GraspSettings
+    gs = GraspSettings(grip_force=150e-6, position_bandwidth_hz=80.0, force_bandwidth_hz=15.0,
+                       threshold=4e-6, release=2e-6, wait_for_other=False)
+    cp = gs.vector((0.7, 0.9), 5e-5)
+    assert cp.shape == (len(SETTINGS_VECTOR),)
+    assert (cp[SX.gain1], cp[SX.gain2], cp[SX.dt]) == (0.7, 0.9, 5e-5)
+    assert (cp[SX.grip_force], cp[SX.threshold], cp[SX.release]) == (150e-6, 4e-6, 2e-6)
+    assert cp[SX.position_gain] == pytest.approx(2 * math.pi * 80.0, rel=1e-15)
+    assert cp[SX.force_gain] == pytest.approx(2 * math.pi * 15.0, rel=1e-15)
+    assert cp[SX.wait_for_other] == 0.0

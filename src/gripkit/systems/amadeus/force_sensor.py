@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections import namedtuple
 from dataclasses import dataclass
 
 import numba
@@ -496,12 +497,27 @@ class ForceDynamics:
         return cls(A, B, C, Q, p.dt, f"identified plant on {'xyz'[axis]} + random-walk disturbance", names)
 
 
+#: the filter's model as :func:`_kf_run` takes it: dynamics A, B, force map C and process noise
+#: Q of :class:`ForceDynamics`, the readings' map HC (6, n), the relative noise variances sn2 (6)
+#: and the noise floor² (V²)
+KalmanArrays = namedtuple("KalmanArrays", "A B C Q HC sn2 floor2")
+#: what :func:`_kf_run` writes per sample: forces (N, 3), their covariances (N, 3, 3), NIS (N,)
+KalmanOut = namedtuple("KalmanOut", "force cov nis")
+#: its scratch: (n, n+1) matrix, two n-vectors
+KalmanWork = namedtuple("KalmanWork", "tmp ph kg")
+
+
 @numba.njit(cache=True)
-def _kf_run(A, B, HC, Q, sn2, floor2, Z, U, x, P, fout, cout, C, nis, tmp, ph, kg):  # pragma: no cover
-    """Kalman filter over N samples; x (n,) and P (n, n) hold the prior at entry, the next prior at exit.
+def _kf_run(model, Z, U, x, P, out, work):  # pragma: no cover - compiled
+    """Kalman filter over N samples of readings Z (N, 6) and inputs U; x (n,) and P (n, n) hold
+    the prior at entry, the next prior at exit. ``model`` is :data:`KalmanArrays`, ``out``
+    :data:`KalmanOut`, ``work`` :data:`KalmanWork`.
 
     Per sample: sequential scalar updates with R_j = sn2_j r̂_j² + floor2 (r̂ from the prior),
     outputs f = C x⁺ and C P⁺ Cᵀ, then the time update with input U[k]."""
+    A, B, C, Q, HC, sn2, floor2 = model
+    fout, cout, nis = out
+    tmp, ph, kg = work
     n = A.shape[0]
     N = Z.shape[0]
     for k in range(N):
@@ -653,8 +669,8 @@ class ForceKalmanFilter:
         c = np.empty((N, 3, 3))
         nis = np.empty(N)
         d = self.dynamics
-        _kf_run(d.A, d.B, self._HC, d.Q, self._sn2, self._floor2, Z, U, self.x, self.P, f, c,
-                d.C, nis, self._tmp, self._ph, self._kg)
+        _kf_run(KalmanArrays(d.A, d.B, d.C, d.Q, self._HC, self._sn2, self._floor2), Z, U, self.x,
+                self.P, KalmanOut(f, c, nis), KalmanWork(self._tmp, self._ph, self._kg))
         return KalmanResult(f, c, np.sqrt(np.einsum("nkk->nk", c)), nis)
 
     def step(self, reading, u=None) -> tuple[np.ndarray, np.ndarray]:

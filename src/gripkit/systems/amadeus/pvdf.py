@@ -43,6 +43,7 @@ phase-I fingertip: pad resonance ≈ 250 Hz, friction μ_s = 0.6, μ_k = 0.45 (w
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 import numba
 import numpy as np
@@ -109,6 +110,15 @@ class PVDFFilm(Model):
 # --------------------------------------------------------------------------- stick-slip contact
 _CONTACT_NAMES = ("m_pad", "k_t", "c_t", "mu_s", "mu_k", "v_stribeck", "m_obj", "c_obj", "k_n",
                   "texture", "wavelength", "shear_coupling", "gain", "tau")
+#: the index of each contact parameter in the vector ``th`` the kernels take (``th[CX.k_t]``),
+#: generated from _CONTACT_NAMES: a module-level namedtuple of ints that numba folds as constants
+CX = namedtuple("ContactParameterIndex", _CONTACT_NAMES)(*range(len(_CONTACT_NAMES)))
+#: the pad and object constants of one stick-slip substep: pad mass, object mass and drag, and
+#: the Stribeck friction (μ_k, μ_s, v_s)
+PadObject = namedtuple("PadObject", "m M co muk mus vs")
+#: what the drive input of :func:`contact_step` is: the load on a grasped object, or the speed
+#: of a testbed surface (the kernels' ``mode``)
+GRASP, TESTBED = 0, 1
 
 
 def contact_parameters(*, m_pad: float = 2.0e-3, k_t: float = 5.0e3, c_t: float = 1.5, mu_s: float = 0.6,
@@ -178,12 +188,14 @@ def _testbed_substep(m, Fs, muk, mus, vs, Fn, spring, v_surface, h, vp, vo, stuc
 
 
 @numba.njit(cache=True)
-def _grasp_substep(m, M, co, Fs, muk, mus, vs, Fn, spring, F_load, h, vp, vo, stuck):  # pragma: no cover - compiled
-    """One substep of the grasp (mode 0): the object (mass M, drag c_o·v) is pulled by ``F_load``
+def _grasp_substep(po, Fs, Fn, spring, F_load, h, vp, vo, stuck):  # pragma: no cover - compiled
+    """One substep of the grasp (mode 0) with the constants ``po`` (:data:`PadObject`): the object
+    (mass M, drag c_o·v) is pulled by ``F_load``
     and held only by friction. Stuck, pad and object accelerate together while the friction that
     takes stays within μ_s F_n (``Fs``); slipping, each moves under its own forces with the
     Stribeck friction, and they stick again at their common (momentum) velocity when the
     relative velocity changes sign. Returns (v_pad, v_obj, stuck, F)."""
+    m, M, co, muk, mus, vs = po
     drag = -co * vo
     if stuck > 0.5:
         a = (F_load + drag + spring) / (m + M)
@@ -220,8 +232,11 @@ def contact_step(th, mode, u, dt, substeps, st, y):  # pragma: no cover - compil
     (testbed, :func:`_testbed_substep`). ``st`` (8,) = [x_pad, v_pad, x_obj, v_obj, stuck, s,
     v_film, d_prev] is updated in place. ``y`` (N, 6) = [film voltage (mean over the sample),
     slip velocity, slipping fraction, pad shear, object position, friction force]."""
-    m, k, c, mus, muk, vs, M, co = th[0], th[1], th[2], th[3], th[4], th[5], th[6], th[7]
-    kn, ta, lam, alpha, g, tau = th[8], th[9], th[10], th[11], th[12], th[13]
+    m, k, c, mus = th[CX.m_pad], th[CX.k_t], th[CX.c_t], th[CX.mu_s]
+    muk, vs = th[CX.mu_k], th[CX.v_stribeck]
+    M, co, kn, ta, lam = th[CX.m_obj], th[CX.c_obj], th[CX.k_n], th[CX.texture], th[CX.wavelength]
+    alpha, g, tau = th[CX.shear_coupling], th[CX.gain], th[CX.tau]
+    po = PadObject(m, M, co, muk, mus, vs)
     h = dt / substeps
     decay = math.exp(-h / tau)
     xp, vp, xo, vo, stuck, s, v, dprev = st[0], st[1], st[2], st[3], st[4], st[5], st[6], st[7]
@@ -239,10 +254,10 @@ def contact_step(th, mode, u, dt, substeps, st, y):  # pragma: no cover - compil
         for _ in range(substeps):
             Fs = mus * Fn
             spring = -k * xp - c * vp
-            if mode == 1:
+            if mode == TESTBED:
                 vp, vo, stuck, F = _testbed_substep(m, Fs, muk, mus, vs, Fn, spring, drive, h, vp, vo, stuck)
             else:
-                vp, vo, stuck, F = _grasp_substep(m, M, co, Fs, muk, mus, vs, Fn, spring, drive, h, vp, vo, stuck)
+                vp, vo, stuck, F = _grasp_substep(po, Fs, Fn, spring, drive, h, vp, vo, stuck)
             xo += vo * h
             xp += vp * h
             vrel_now = vo - vp
@@ -292,7 +307,7 @@ class StickSlipContact(Model):
               Signal("stuck", "1"), Signal("s", "m", "sliding distance"), Signal("v_film", "V"),
               Signal("d_prev", "m"))
     integrator = "semi-implicit"
-    _mode = 0
+    _mode = GRASP
     internal_rate = 20_000.0
 
     def __init__(self, parameters: ParameterSet | None = None, *, check: bool = True, **kw):
@@ -353,7 +368,7 @@ class SlipTestbed(StickSlipContact):
     name = "slip-testbed"
     description = "PVDF slip sensor on a test rig: surface driven at a prescribed speed (Fig. 12(b))"
     inputs = (Signal("F_n", "N", "normal force"), Signal("v_surface", "m/s", "surface speed"))
-    _mode = 1
+    _mode = TESTBED
 
 
 def pvdf_noise(n: int, *, dt: float, rng=None, white: float = 2e-3, ripple: float = 4e-3,

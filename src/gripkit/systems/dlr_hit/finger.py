@@ -52,7 +52,7 @@ import numpy as np
 from numba import prange
 
 from ...errors import ModelError, SimulationError
-from ...estimation.friction_adaptation import friction_rls_step
+from ...estimation.friction_adaptation import FrictionEstimator, friction_rls_step
 from ...models.bldc import BLDCMotor, bldc_torque, motor_heat_step, temperature_factor
 from ...models.friction import (FrictionTable, Stribeck, TableArrays, lugre_force, lugre_update,
                                 ripple, stribeck, table_arrays, table_friction)
@@ -60,7 +60,7 @@ from ...models.transmission import transmit_torque
 from ...multibody.coupling import CoupledChain, Coupling, differential_matrix
 from ...multibody.dh import DHChain
 from ...multibody.kernels import (WORK_PER_LINK, chain_links, cholesky_solve, coupled_mass_bias,
-                                  frames_into, hot, hot_inline, joints_from_actuators,
+                                  frames_into, hot, hot_inline, joints_from_actuators, links_of,
                                   point_jacobian, rnea_pass)
 from ...params import ParameterSet
 from ...sim.model import Model, Signal
@@ -85,8 +85,14 @@ FINGER_PARAMETERS = (
 NTH = len(FINGER_PARAMETERS)
 ACTUATORS = ("base1", "base2", "distal")
 JOINTS = ("abd", "flex", "prox")
-FRICTION_MODES = {"table": 0, "stribeck": 1, "lugre": 2, "none": 3}
-INTEGRATORS = {"semi-implicit": 0, "rk4": 1}
+#: friction model codes of the kernels' ``mode`` (module-level ints: numba folds them)
+TABLE, STRIBECK, LUGRE, NO_FRICTION = 0, 1, 2, 3
+FRICTION_MODES = {"table": TABLE, "stribeck": STRIBECK, "lugre": LUGRE, "none": NO_FRICTION}
+#: integrator codes (``integ``)
+SEMI_IMPLICIT, RK4 = 0, 1
+INTEGRATORS = {"semi-implicit": SEMI_IMPLICIT, "rk4": RK4}
+#: controller codes of :data:`ImpedanceLoop` ``ctrl``
+OPEN_LOOP, JOINT_IMPEDANCE, CARTESIAN_IMPEDANCE = 0, 1, 2
 
 #: the index of each parameter in the vector ``th`` the kernels take, by name: ``th[IX.l1]``,
 #: ``th[IX.fs_base1 + k]`` for actuator k. A module-level namedtuple of ints, generated from
@@ -109,6 +115,12 @@ ChainWork = namedtuple("ChainWork", "R P work q qd zq Mq tau")
 #: scratch of the actuator-space solve: M_p, h_p, Cholesky factor, applied torques, the free
 #: subsystem (matrix, solution, right side) and the breakaway directions
 SolveWork = namedtuple("SolveWork", "Mp hp L rhs Ms xs rs dirn")
+#: the state one force evaluation reads (views of the state vector, or an RK4 stage): actuator
+#: positions and rates, motor temperatures, LuGre bristles and the stuck flags (3 each)
+FingerState = namedtuple("FingerState", "p pd T z stuck")
+#: a run of the time loop: PWM input u (N, ·) read from column ``ucol`` on, outputs y written
+#: from column ``ycol`` on, the sample time dt and the integration substeps per sample
+FingerRun = namedtuple("FingerRun", "u ucol y ycol dt substeps")
 #: what one force evaluation writes: accelerations, motor torques (output side), shaft torques,
 #: friction torques (all per actuator)
 Forces = namedtuple("Forces", "acc taum tshaft fric")
@@ -142,9 +154,6 @@ N_GAINS = 22
 #: the plant's friction drift: schedule (N, 6) = (s_k, Δ_k) or (0, 6), and working copies of the
 #: parameter vector and the table values
 PlantDrift = namedtuple("PlantDrift", "schedule th values")
-#: the online friction estimator (:func:`gripkit.estimation.friction_adaptation.friction_rls_step`):
-#: settings vector, apparent inertias, θ (3, 2) = (s, o), P (3, 2, 2), filters (3, 5), σ̂² (3)
-FrictionEstimator = namedtuple("FrictionEstimator", "cfg inertia theta P filt sig2")
 
 
 @hot
@@ -202,7 +211,7 @@ def finger_setup(th, fc):  # pragma: no cover - compiled
 @hot
 def _kinetic(th, k, v, p, mode, tab):  # pragma: no cover - compiled
     """Kinetic friction of actuator k at velocity v (never 0 for v ≠ 0)."""
-    if mode == 0:
+    if mode == TABLE:
         f = th[IX.scale_base1 + k] * table_friction(v, tab.velocity[k], tab.values[k], tab.length[k],
                                                     tab.ipos[k])
     else:
@@ -318,9 +327,10 @@ def _karnopp(th, n_stuck_iter, mode, tab, p, pd, stuck, out, sw):  # pragma: no 
 
 
 @hot
-def _forces(th, n_stuck_iter, mode, thermal, fc, tab, p, pd, T, z, stuck, pwm, ext, out, cw,
+def _forces(th, n_stuck_iter, mode, thermal, fc, tab, st, pwm, ext, out, cw,
             sw):  # pragma: no cover - compiled
-    """Accelerations ``out.acc`` for the state (p, ṗ, T, z) with the stuck set ``stuck``; fills
+    """Accelerations ``out.acc`` for the state ``st`` (:data:`FingerState`: p, ṗ, T, z) with the
+    stuck set ``st.stuck``; fills
     the motor torques (output side and shaft) and friction of ``out`` (:data:`Forces`). ``fc`` is
     the finger's :data:`FingerChain`, ``tab`` its friction tables, ``cw``/``sw`` scratch
     (:data:`ChainWork`, :data:`SolveWork`). With ``n_stuck_iter > 0`` actuators at rest are
@@ -329,22 +339,22 @@ def _forces(th, n_stuck_iter, mode, thermal, fc, tab, p, pd, T, z, stuck, pwm, e
     frozen (RK4 stages)."""
     m = 3
     G = fc.G
+    p, pd, T, z, stuck = st.p, st.pd, st.T, st.z, st.stuck
     q, qd, zq = cw.q, cw.qd, cw.zq
     Mp, hp, rhs, rs = sw.Mp, sw.hp, sw.rhs, sw.rs
     joints_from_actuators(4, m, G, fc.q0, p, q)
     joints_from_actuators(4, m, G, zq, pd, qd)
     chain_links(4, fc.links, fc.jtype, q, cw.R, cw.P)
-    coupled_mass_bias(4, m, cw.R, cw.P, fc.jtype, fc.mass, fc.com, fc.inertia, fc.arm_q, G, fc.arm_p, qd,
-                      fc.g[0], fc.g[1], fc.g[2], Mp, hp, zq, cw.Mq, cw.tau, cw.work)
+    coupled_mass_bias(4, m, links_of(fc), G, fc.arm_p, cw, qd, fc.g[0], fc.g[1], fc.g[2], Mp, hp)
     taum, fric = out.taum, out.fric
     _drive_torques(th, thermal, fc.ratio, T, pwm, pd, taum, out.tshaft)
     # applied torque on each actuator (before friction): motor + end stops + external − bias
     for k in range(m):
         rhs[k] = taum[k] + ext[k] - hp[k]
     _add_end_stops(th, q, qd, G, rhs)
-    if mode >= 2:
+    if mode >= LUGRE:  # LuGre or none: no stick-slip constraint
         for k in range(m):
-            if mode == 2:
+            if mode == LUGRE:
                 f = (lugre_force(z[k], pd[k], th[IX.fc_base1 + k], th[IX.fs_base1 + k], th[IX.v_s], th[IX.sigma0],
                                  th[IX.sigma1], th[IX.visc_base1 + k])
                      + ripple(p[k], pd[k], th[IX.ripple_amp], th[IX.ripple_cycles], 0.0))
@@ -388,7 +398,7 @@ def _slow_states(th, mode, thermal, x, v0, tshaft, h):  # pragma: no cover - com
         for k in range(3):
             x[6 + k] = motor_heat_step(x[6 + k], tshaft[k], h, th[IX.T_amb], th[IX.alpha_R], th[IX.R_0],
                                        th[IX.k_t], th[IX.R_th], th[IX.C_th])
-    if mode == 2:
+    if mode == LUGRE:
         for k in range(3):
             x[9 + k] = lugre_update(x[9 + k], v0[k], h, th[IX.fc_base1 + k], th[IX.fs_base1 + k], th[IX.v_s],
                                     th[IX.sigma0])
@@ -398,7 +408,7 @@ def _slow_states(th, mode, thermal, x, v0, tshaft, h):  # pragma: no cover - com
 def _stick(th, mode, x, v0):  # pragma: no cover - compiled
     """Karnopp: a sliding actuator whose velocity crosses zero comes to rest; if its holding torque
     exceeds stiction it breaks away again at the next step."""
-    if mode < 2:
+    if mode < LUGRE:  # table or Stribeck: Karnopp stick-slip
         vst = th[IX.v_stick]
         for k in range(3):
             if x[12 + k] == 0.0 and (x[3 + k] * v0[k] < 0.0 or abs(x[3 + k]) <= vst):
@@ -415,8 +425,9 @@ def finger_step(th, mode, thermal, fc, tab, x, pwm, ext, h, taum, fric,
     is the finger's :data:`~gripkit.models.friction.TableArrays`. Returns False if the mass
     matrix lost positive definiteness."""
     acc, v0 = ws.acc, ws.v0
-    if not _forces(th, 4, mode, thermal, fc, tab, x[0:3], x[3:6], x[6:9], x[9:12], x[12:15], pwm,
-                   ext, Forces(acc, taum, ws.tshaft, fric), ws.chain, ws.solve):
+    st = FingerState(x[0:3], x[3:6], x[6:9], x[9:12], x[12:15])
+    if not _forces(th, 4, mode, thermal, fc, tab, st, pwm, ext, Forces(acc, taum, ws.tshaft, fric),
+                   ws.chain, ws.solve):
         return False
     for k in range(3):
         v0[k] = x[3 + k]
@@ -438,8 +449,9 @@ def finger_step_rk4(th, mode, thermal, fc, tab, x, pwm, ext, h, taum, fric,
     stuck = x[12:15]
     T = x[6:9]
     z = x[9:12]
-    if not _forces(th, 4, mode, thermal, fc, tab, x[0:3], x[3:6], T, z, stuck, pwm, ext,
-                   Forces(acc, taum, ws.tshaft, fric), ws.chain, ws.solve):
+    st = FingerState(x[0:3], x[3:6], T, z, stuck)
+    if not _forces(th, 4, mode, thermal, fc, tab, st, pwm, ext, Forces(acc, taum, ws.tshaft, fric),
+                   ws.chain, ws.solve):
         return False
     for k in range(3):
         p0[k] = x[k]
@@ -455,7 +467,7 @@ def finger_step_rk4(th, mode, thermal, fc, tab, x, pwm, ext, h, taum, fric,
                 continue
             ps[k] = p0[k] + c * (v0[k] if stage == 0 else vs[k])
             vs[k] = v0[k] + c * ka[3 * stage + k]
-        _forces(th, 0, mode, thermal, fc, tab, ps, vs, T, z, stuck, pwm, ext,
+        _forces(th, 0, mode, thermal, fc, tab, FingerState(ps, vs, T, z, stuck), pwm, ext,
                 Forces(acc, ws.taum2, ws.tshaft2, ws.fric2), ws.chain, ws.solve)
         for k in range(3):
             ka[3 * (stage + 1) + k] = acc[k]
@@ -558,7 +570,7 @@ def _impedance(th, fc, cs, x, n, loop, fhat):  # pragma: no cover - compiled
             s += Jp[r, j] * x[3 + j]
         tipd[r] = s
         tauq[r] = 0.0
-    if ctrl == 2:
+    if ctrl == CARTESIAN_IMPEDANCE:
         for r in range(3):
             f = gains[r] * (ref[n, r] - tip[r]) + gains[3 + r] * (refd[n, r] - tipd[r])
             for j in range(3):
@@ -572,8 +584,7 @@ def _impedance(th, fc, cs, x, n, loop, fhat):  # pragma: no cover - compiled
         tauq[k] -= gains[10 + k] * x[3 + k]
     if gains[6] != 0.0:
         gp = cs.gp
-        rnea_pass(4, R, P, fc.jtype, fc.mass, fc.com, fc.inertia, fc.arm_q, zq, zq, grav[0], grav[1],
-                  grav[2], False, gp, cs.work)
+        rnea_pass(4, links_of(fc), R, P, zq, zq, grav[0], grav[1], grav[2], False, gp, cs.work)
         for k in range(3):
             s = 0.0
             for j in range(4):
@@ -645,8 +656,8 @@ def _adapt_friction(th, fc, cs, x, ctab, est, sensor, y, n):  # pragma: no cover
     but θ, P and σ̂² keep their values (status 0, frozen)."""
     G, ratio, grav, pwm, hb = fc.G, fc.ratio, fc.g, cs.pwm, cs.hb
     theta, P, sig2 = est.theta, est.P, est.sig2
-    rnea_pass(4, cs.R, cs.P, fc.jtype, fc.mass, fc.com, fc.inertia, fc.arm_q, cs.qd, cs.zq, grav[0],
-              grav[1], grav[2], True, hb, cs.work)
+    rnea_pass(4, links_of(fc), cs.R, cs.P, cs.qd, cs.zq, grav[0], grav[1], grav[2], True, hb,
+              cs.work)
     for k in range(3):
         v = x[3 + k]
         ts = bldc_torque(pwm[k], ratio[k] * v, th[IX.c_pwm], th[IX.b_pwm], th[IX.b_0],
@@ -657,8 +668,7 @@ def _adapt_friction(th, fc, cs, x, ctab, est, sensor, y, n):  # pragma: no cover
             h += G[j * 3 + k] * hb[j]
         s0, o0, sg = theta[k, 0], theta[k, 1], sig2[k]
         p00, p01, p11 = P[k, 0, 0], P[k, 0, 1], P[k, 1, 1]
-        st = friction_rls_step(k, tm, h, v, est.inertia, ctab.velocity, ctab.values, ctab.length,
-                               ctab.ipos, est.cfg, theta, P, est.filt, sig2)
+        st = friction_rls_step(k, tm, h, v, ctab, est)
         if sensor[k, 5] != 0.0 and st == 1.0:  # guard: undo the update, keep the filters
             theta[k, 0], theta[k, 1], sig2[k] = s0, o0, sg
             P[k, 0, 0], P[k, 0, 1], P[k, 1, 0], P[k, 1, 1] = p00, p01, p01, p11
@@ -726,7 +736,7 @@ def _drift_friction(th, mode, tab, plant, n):  # pragma: no cover - compiled
         s = drift[n, k]
         d = drift[n, 3 + k]
         thw[IX.fs_base1 + k] = s * th[IX.fs_base1 + k] + d
-        if mode == 0:
+        if mode == TABLE:
             sc = s * th[IX.scale_base1 + k]
             thw[IX.scale_base1 + k] = 1.0
             for i in range(tn[k]):
@@ -739,10 +749,11 @@ def _drift_friction(th, mode, tab, plant, n):  # pragma: no cover - compiled
 
 
 @hot
-def finger_loop(th, mode, thermal, fc, ws, cs, tab, u, ucol, dt, substeps, x, y, ycol, loop, plant,
+def finger_loop(th, mode, thermal, fc, ws, cs, tab, run, x, loop, plant,
                 est):  # pragma: no cover - compiled
-    """The time loop (allocation-free, semi-implicit Euler). ``loop.ctrl = 0``: PWM from
-    u[:, ucol:], outputs as DLRFinger.outputs at y[:, ycol:ycol+18]; ``loop.ctrl = 1/2``:
+    """The time loop (allocation-free, semi-implicit Euler) of the run ``run`` (:data:`FingerRun`).
+    ``loop.ctrl = 0``: PWM from u[:, ucol:], outputs as DLRFinger.outputs at
+    y[:, ycol:ycol+18]; ``loop.ctrl = 1/2``:
     joint/Cartesian impedance (:data:`ImpedanceLoop`), closed-loop outputs (39 columns, see
     gripkit.systems.dlr_hit.impedance). ``plant`` (:data:`PlantDrift`): the plant's friction drift
     (:func:`_drift_friction`); ``est`` (:data:`FrictionEstimator`): the online friction
@@ -750,6 +761,7 @@ def finger_loop(th, mode, thermal, fc, ws, cs, tab, u, ucol, dt, substeps, x, y,
     :func:`_measure` when gains[G_QUANTUM] > 0 and corrects eq 5.10 by its thermal observer
     (:func:`_thermal_observer`) when gains[G_THERMAL] ≠ 0."""
     G, q0 = fc.G, fc.q0
+    u, ucol, y, ycol, dt, substeps = run
     pwm, ext, taum, fric, xs, force = cs.pwm, cs.ext, cs.taum, cs.fric, cs.xs, cs.force
     ctrl, gains = loop.ctrl, loop.gains
     drifting = plant.schedule.shape[0] > 0
@@ -815,9 +827,9 @@ def finger_loop(th, mode, thermal, fc, ws, cs, tab, u, ucol, dt, substeps, x, y,
 
 
 @hot
-def finger_loop_rk4(th, mode, thermal, fc, ws, cs, tab, u, ucol, dt, substeps, x, y,
-                    ycol):  # pragma: no cover - compiled
-    """Open-loop time loop with RK4 steps."""
+def finger_loop_rk4(th, mode, thermal, fc, ws, cs, tab, run, x):  # pragma: no cover - compiled
+    """Open-loop time loop with RK4 steps (``run``: :data:`FingerRun`)."""
+    u, ucol, y, ycol, dt, substeps = run
     pwm, ext, taum, fric, xs = cs.pwm, cs.ext, cs.taum, cs.fric, cs.xs
     h = dt / substeps
     for n in range(u.shape[0]):
@@ -840,14 +852,15 @@ def finger_run(th, mode, thermal, tab, u, ucol, dt, substeps, x, y, ycol, loop, 
     first failed sample + 1, or 0. Scratch arrays are allocated here, in Python, so the only
     compiled function is the time loop itself."""
     fc, ws, cs = _make_context(th)
-    return int(finger_loop(th, mode, thermal, fc, ws, cs, tab, u, ucol, dt, substeps, x, y, ycol,
-                           loop, plant, est))
+    run = FingerRun(u, ucol, y, ycol, dt, substeps)
+    return int(finger_loop(th, mode, thermal, fc, ws, cs, tab, run, x, loop, plant, est))
 
 
 def finger_run_rk4(th, mode, thermal, tab, u, ucol, dt, substeps, x, y, ycol) -> int:
     """Open-loop simulation with RK4 steps (compiled only when asked for)."""
     fc, ws, cs = _make_context(th)
-    return int(finger_loop_rk4(th, mode, thermal, fc, ws, cs, tab, u, ucol, dt, substeps, x, y, ycol))
+    run = FingerRun(u, ucol, y, ycol, dt, substeps)
+    return int(finger_loop_rk4(th, mode, thermal, fc, ws, cs, tab, run, x))
 
 
 def _open_loop_records():
@@ -857,7 +870,7 @@ def _open_loop_records():
                          np.full(3, 2, dtype=np.int64))
     theta = np.zeros((3, 2))
     theta[:, 0] = 1.0
-    return (ImpedanceLoop(0, np.zeros(N_GAINS), tables, np.zeros((1, 3)), np.zeros((1, 3)),
+    return (ImpedanceLoop(OPEN_LOOP, np.zeros(N_GAINS), tables, np.zeros((1, 3)), np.zeros((1, 3)),
                           np.zeros(9), np.zeros((3, 6)), np.zeros(NX)),
             PlantDrift(np.zeros((0, 6)), np.zeros(NTH), np.zeros((3, 1))),
             FrictionEstimator(np.zeros(10), np.ones(3), theta, np.zeros((3, 2, 2)), np.zeros((3, 5)),
@@ -870,7 +883,7 @@ _OPEN_LOOP = _open_loop_records()
 
 def run_open_loop(th, mode, integ, thermal, tab, u, dt, substeps, x, y, ucol=0, ycol=0) -> int:
     """One finger, open loop (Python entry used by the models and the hand)."""
-    if integ == 1:
+    if integ == RK4:
         return int(finger_run_rk4(th, mode, thermal, tab, u, ucol, dt, substeps, x, y, ycol))
     return int(finger_run(th, mode, thermal, tab, u, ucol, dt, substeps, x, y, ycol, *_OPEN_LOOP))
 
@@ -888,8 +901,9 @@ def _jobs_parallel(thetas, u, ucols, dt, substeps, x0, y, yidx, ycols, tab, mode
         x = x0[j].copy()
         fc, ws, cs = finger_context(thetas[j])
         loop, plant, est = open_loop_records()
-        fail[j] = finger_loop(thetas[j], mode, thermal, fc, ws, cs, TableArrays(tv, tf, tn, tipos), u,
-                              ucols[j], dt, substeps, x, y[yidx[j]], ycols[j], loop, plant, est)
+        fail[j] = finger_loop(thetas[j], mode, thermal, fc, ws, cs, TableArrays(tv, tf, tn, tipos),
+                              FingerRun(u, ucols[j], y[yidx[j]], ycols[j], dt, substeps), x, loop,
+                              plant, est)
     return fail
 
 
@@ -898,7 +912,7 @@ def run_jobs(thetas, u, ucols, dt, substeps, x0, y, yidx, ycols, tab, mode, inte
     """Several open-loop finger simulations (a batch of parameter vectors, or the fingers of a
     hand); parallel threads only when asked for (and semi-implicit), else one after another."""
     J = thetas.shape[0]
-    if parallel and integ == 0 and J > 1:
+    if parallel and integ == SEMI_IMPLICIT and J > 1:
         return _jobs_parallel(thetas, u, np.asarray(ucols, dtype=np.int64), dt, substeps, x0, y,
                               np.asarray(yidx, dtype=np.int64), np.asarray(ycols, dtype=np.int64),
                               tab, mode, thermal)

@@ -62,8 +62,9 @@ from ...errors import ModelError, SimulationError
 from ...estimation.friction_adaptation import AdaptationSettings
 from ...models.friction import FrictionTable, table_arrays
 from ...signals.trajectory import Trajectory
-from .finger import (ACTUATORS, FRICTION_MODES, G_COMMAND, G_GUARD, G_OBS_ALPHA, G_OBS_CTH,
-                     G_OBS_RTH, G_QUANTUM, G_THERMAL, G_VALPHA, N_GAINS, NX, DLRFinger,
+from .finger import (ACTUATORS, CARTESIAN_IMPEDANCE, FRICTION_MODES, G_COMMAND, G_GUARD, G_OBS_ALPHA,
+                     G_OBS_CTH, G_OBS_RTH, G_QUANTUM, G_THERMAL, G_VALPHA, JOINT_IMPEDANCE, N_GAINS, NX,
+                     DLRFinger,
                      FrictionEstimator, ImpedanceLoop, PlantDrift, finger_run)
 from .friction_drift import FrictionDrift
 
@@ -302,8 +303,9 @@ def simulate_impedance(finger: DLRFinger, controller: ImpedanceController, refer
                   float(controller.friction_compensation), controller.velocity_deadband,
                   controller.smoothing, *controller.actuator_damping, float(ad is not None)]
     sensor = _sensor_state(finger, controller, x, gains, dt)
-    loop = ImpedanceLoop(2 if controller.kind == "cartesian" else 1, gains, table_arrays(tables), ref, refd,
-                         _wall_vector(wall), sensor, np.zeros(NX))
+    ctrl = CARTESIAN_IMPEDANCE if controller.kind == "cartesian" else JOINT_IMPEDANCE
+    loop = ImpedanceLoop(ctrl, gains, table_arrays(tables), ref, refd, _wall_vector(wall), sensor,
+                         np.zeros(NX))
     fail = finger_run(th, FRICTION_MODES[finger.friction], finger.thermal, finger._tab, np.zeros((1, 3)), 0,
                       float(dt), int(substeps), x, y, 0, loop, plant, estimator)
     if fail or not np.isfinite(y).all():

@@ -40,6 +40,7 @@ contact, final error, largest voltage, and whether the damage threshold was cros
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 from dataclasses import asdict, dataclass, replace
 
 import numba
@@ -70,6 +71,8 @@ _NCS = 19
 #: names of the columns of :attr:`GraspBatch.metrics`
 METRICS = ("t_contact", "t_switch", "peak_force", "overshoot_percent", "settling_time", "final_error",
            "max_voltage", "damage", "detected", "sat_fraction")
+#: index of each metric in a row of ``met`` (``met[MX.peak_force]``), generated from METRICS
+MX = namedtuple("MetricIndex", METRICS)(*range(len(METRICS)))
 
 
 @numba.njit(cache=True)
@@ -286,12 +289,19 @@ class HybridController:
 # closed loop on the FT-G100 plant
 # ------------------------------------------------------------------------------------------------
 
+#: the settings shared by the grasps of a batch: controller sample time dt, plant substeps per
+#: sample, the settling band (fraction of the command), the number of samples and whether the
+#: trajectories are recorded
+GraspRun = namedtuple("GraspRun", "dt substeps band n_steps rec")
+
+
 @numba.njit(cache=True)
-def _grasp_one(th, cp, fprof, sig_f, sig_x, seed, dt, substeps, band, damage, n_steps, rec,
-               traj, met):  # pragma: no cover - compiled
-    """One closed-loop grasp from rest; writes the trajectory (if ``rec``) and the metrics.
-    ``fprof`` holds the commanded force, one value (constant) or one per sample; the metrics refer
-    to its last value."""
+def _grasp_one(th, cp, fprof, sig_f, sig_x, seed, damage, run, traj,
+               met):  # pragma: no cover - compiled
+    """One closed-loop grasp from rest (``run``: :data:`GraspRun`); writes the trajectory (if
+    ``run.rec``) and the metrics. ``fprof`` holds the commanded force, one value (constant) or one
+    per sample; the metrics refer to its last value."""
+    dt, substeps, band, n_steps, rec = run
     fcmd = fprof[fprof.shape[0] - 1]
     varying = fprof.shape[0] > 1
     s = np.zeros(4)
@@ -345,27 +355,28 @@ def _grasp_one(th, cp, fprof, sig_f, sig_x, seed, dt, substeps, band, damage, n_
         if n >= tail:
             err += f - fcmd
             nerr += 1
-    met[0] = t_contact if t_contact >= 0.0 else np.nan
-    met[1] = t_switch if t_switch >= 0.0 else np.nan
-    met[2] = peak
-    met[3] = max(0.0, (peak - fcmd) / fcmd * 100.0)
+    met[MX.t_contact] = t_contact if t_contact >= 0.0 else np.nan
+    met[MX.t_switch] = t_switch if t_switch >= 0.0 else np.nan
+    met[MX.peak_force] = peak
+    met[MX.overshoot_percent] = max(0.0, (peak - fcmd) / fcmd * 100.0)
     if t_contact < 0.0 or last_out == n_steps - 1:
-        met[4] = np.inf
+        met[MX.settling_time] = np.inf
     else:
-        met[4] = max(0.0, (last_out + 1) * dt - t_contact)
-    met[5] = err / nerr / fcmd
-    met[6] = vmax
-    met[7] = 1.0 if peak > damage else 0.0
-    met[8] = 1.0 if t_switch >= 0.0 else 0.0
-    met[9] = nsat / n_steps
+        met[MX.settling_time] = max(0.0, (last_out + 1) * dt - t_contact)
+    met[MX.final_error] = err / nerr / fcmd
+    met[MX.max_voltage] = vmax
+    met[MX.damage] = 1.0 if peak > damage else 0.0
+    met[MX.detected] = 1.0 if t_switch >= 0.0 else 0.0
+    met[MX.sat_fraction] = nsat / n_steps
 
 
 @numba.njit(cache=True, parallel=True)
-def _grasp_batch(thetas, cps, fprofs, sig_f, sig_x, seeds, dt, substeps, band, damages, n_steps, rec,
-                 traj, met):  # pragma: no cover - compiled
+def _grasp_batch(thetas, cps, fprofs, sig_f, sig_x, seeds, damages, run, traj,
+                 met):  # pragma: no cover - compiled
+    dt, substeps, band, n_steps, rec = run
     for p in numba.prange(thetas.shape[0]):
-        _grasp_one(thetas[p], cps[p], fprofs[p], sig_f[p], sig_x[p], seeds[p], dt, substeps, band,
-                   damages[p], n_steps, rec, traj[p], met[p])
+        _grasp_one(thetas[p], cps[p], fprofs[p], sig_f[p], sig_x[p], seeds[p], damages[p],
+                   GraspRun(dt, substeps, band, n_steps, rec), traj[p], met[p])
 
 
 @dataclass(frozen=True)
@@ -492,10 +503,11 @@ def _run(thetas, cps, fprofs, NF, NX, S, dt, sub, band, dmg, n_steps, record, pr
     met = np.empty((P, len(METRICS)))
     traj = np.empty((P, n_steps if record else 1, 7))
     chunk = 256
+    run = GraspRun(dt, sub, float(band), n_steps, bool(record))
     for a in track(range(0, P, chunk), description="grasp simulations", enabled=progress and P > 2 * chunk):
         b = min(P, a + chunk)
-        _grasp_batch(thetas[a:b], cps[a:b], fprofs[a:b], NF[a:b], NX[a:b], S[a:b], dt, sub, float(band),
-                     dmg[a:b], n_steps, bool(record), traj[a:b], met[a:b])
+        _grasp_batch(thetas[a:b], cps[a:b], fprofs[a:b], NF[a:b], NX[a:b], S[a:b], dmg[a:b], run,
+                     traj[a:b], met[a:b])
     return met, traj
 
 

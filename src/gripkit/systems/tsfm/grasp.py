@@ -49,6 +49,16 @@ __all__ = ["GraspSettings", "TwoFingerGrasp", "TwoFingerGraspResult", "simulate_
 # controller state columns (per finger)
 _PHASE, _REF, _U, _YC, _FC, _FREF, _CONTACT_T = range(7)
 APPROACH, HOLD, SQUEEZE = 0, 1, 2
+#: the entries of the settings vector (:meth:`GraspSettings.vector`): closing speed (m/s), the
+#: position and force loop gains ω (rad/s), the commanded force (N), its ramp time (s), the
+#: voltage range (V), the fingers' static gains, the approach limit (m), the stiffness bounds
+#: (N/m), wait-for-the-other flag, contact threshold and release (N) and the sample time (s)
+SETTINGS_VECTOR = ("approach_speed", "position_gain", "force_gain", "grip_force",
+                   "force_ramp_time", "u_min", "u_max", "gain1", "gain2", "max_closing", "k_min",
+                   "k_max", "wait_for_other", "threshold", "release", "dt")
+#: index of each entry: ``cp[SX.dt]``; a module-level namedtuple of ints generated from
+#: SETTINGS_VECTOR, which numba folds as constants
+SX = namedtuple("GraspSettingIndex", SETTINGS_VECTOR)(*range(len(SETTINGS_VECTOR)))
 
 #: the tip-position estimators of both fingers (:func:`estimator_arrays`, stacked): ``bw`` (2, 4),
 #: ``Phi`` (2, 4, 4), ``Gam`` (2, 4, 2), ``cy`` (2, 4)
@@ -79,10 +89,16 @@ class GraspSettings:
     wait_for_other: bool = True          #: False: the naive grasp (no hold)
 
     def vector(self, gains: tuple[float, float], dt: float) -> np.ndarray:
-        return np.array([self.approach_speed, 2 * math.pi * self.position_bandwidth_hz,
-                         2 * math.pi * self.force_bandwidth_hz, self.grip_force, self.force_ramp_time,
-                         self.u_min, self.u_max, gains[0], gains[1], self.max_closing, self.k_min, self.k_max,
-                         1.0 if self.wait_for_other else 0.0, self.threshold, self.release, dt])
+        """The settings vector the kernels take, in :data:`SETTINGS_VECTOR` order
+        (``cp[SX.dt]``)."""
+        v = dict(approach_speed=self.approach_speed,
+                 position_gain=2 * math.pi * self.position_bandwidth_hz,
+                 force_gain=2 * math.pi * self.force_bandwidth_hz, grip_force=self.grip_force,
+                 force_ramp_time=self.force_ramp_time, u_min=self.u_min, u_max=self.u_max,
+                 gain1=gains[0], gain2=gains[1], max_closing=self.max_closing, k_min=self.k_min,
+                 k_max=self.k_max, wait_for_other=1.0 if self.wait_for_other else 0.0,
+                 threshold=self.threshold, release=self.release, dt=dt)
+        return np.array([v[k] for k in SETTINGS_VECTOR])
 
 
 @numba.njit(cache=True, _nrt=False)
@@ -95,10 +111,10 @@ def grasp_step(F1, F2, loop, e, cp):  # pragma: no cover - compiled
     """
     det, buf, est, cs, out = loop.det, loop.buf, loop.est, loop.cs, loop.out
     cy = e.cy
-    dt = cp[15]
+    dt = cp[SX.dt]
     for i in range(2):
         F = F1 if i == 0 else F2
-        c = detector_step(det[i], buf[i], F, cp[13], cp[14])
+        c = detector_step(det[i], buf[i], F, cp[SX.threshold], cp[SX.release])
         out[i, 2] = det[i, 4]
         out[i, 3] = c
         y = 0.0
@@ -115,13 +131,13 @@ def grasp_step(F1, F2, loop, e, cp):  # pragma: no cover - compiled
             cs[i, _CONTACT_T] = 1.0
             cs[i, _YC] = y
             cs[i, _FC] = Ff
-            if cp[12] > 0.5:
+            if cp[SX.wait_for_other] > 0.5:
                 cs[i, _PHASE] = HOLD
                 cs[i, _REF] = y
         ph = cs[i, _PHASE]
         if ph == APPROACH:
-            if cs[i, _REF] < cp[9]:
-                cs[i, _REF] += cp[0] * dt
+            if cs[i, _REF] < cp[SX.max_closing]:
+                cs[i, _REF] += cp[SX.approach_speed] * dt
         elif ph == HOLD and c < 0.5:                   # lost it before the other touched: close again
             cs[i, _PHASE] = APPROACH
             cs[i, _CONTACT_T] = -1.0
@@ -135,22 +151,23 @@ def grasp_step(F1, F2, loop, e, cp):  # pragma: no cover - compiled
         if cs[i, _PHASE] == SQUEEZE:
             # (conditional expressions, not builtin max/min: numba.cuda cannot compile those in an
             # @njit callee, and gripkit.systems.tsfm.grasp_gpu runs this step on the GPU; same values)
-            step = (cp[3] - cs[i, _FREF]) * dt / (dt if dt > cp[4] else cp[4])
-            if abs(cp[3] - cs[i, _FREF]) <= abs(step):
-                cs[i, _FREF] = cp[3]
+            ramp = cp[SX.force_ramp_time]
+            step = (cp[SX.grip_force] - cs[i, _FREF]) * dt / (dt if dt > ramp else ramp)
+            if abs(cp[SX.grip_force] - cs[i, _FREF]) <= abs(step):
+                cs[i, _FREF] = cp[SX.grip_force]
             else:
                 cs[i, _FREF] += step
             d = y - cs[i, _YC]
-            k = cp[11]
+            k = cp[SX.k_max]
             if d > 50e-9:
                 k = (out[i, 2] - cs[i, _FC]) / d
-                k = cp[10] if cp[10] > k else k
-                k = cp[11] if cp[11] < k else k
-            cs[i, _REF] += dt * cp[2] * (cs[i, _FREF] - out[i, 2]) / k
+                k = cp[SX.k_min] if cp[SX.k_min] > k else k
+                k = cp[SX.k_max] if cp[SX.k_max] < k else k
+            cs[i, _REF] += dt * cp[SX.force_gain] * (cs[i, _FREF] - out[i, 2]) / k
         # inner loop: integral position control on the estimate, voltage clipped
-        U = cs[i, _U] + dt * cp[1] * (cs[i, _REF] - y) / cp[7 + i]
-        U = cp[5] if cp[5] > U else U
-        U = cp[6] if cp[6] < U else U
+        U = cs[i, _U] + dt * cp[SX.position_gain] * (cs[i, _REF] - y) / cp[SX.gain1 + i]
+        U = cp[SX.u_min] if cp[SX.u_min] > U else U
+        U = cp[SX.u_max] if cp[SX.u_max] < U else U
         cs[i, _U] = U
         out[i, 0] = U
         out[i, 4] = cs[i, _PHASE]

@@ -28,7 +28,7 @@ from numba import cuda
 from ...errors import ConfigError
 from ...sim.hybrid import MAX_EVENTS_PER_STEP
 from .grasp import Estimators, GraspLoop
-from .grasp_kernels import _default_gripper, _grasp_core, _setup_jobs, _template
+from .grasp_kernels import SensorNoise, _default_gripper, _grasp_core, _setup_jobs, _template
 from .gripper import GripperModel, GripperState, GripperWork
 
 __all__ = ["cuda_available", "run_cuda", "compile_ptx"]
@@ -62,7 +62,8 @@ def _kernel_py(shared, estimators, jobs, work, met):  # pragma: no cover - runs 
         w = work
         _grasp_core(GripperModel(shared.bw, jobs.Phi[p], jobs.Gam[p], jobs.C[p], jobs.D[p], shared.G, jobs.Hg[p],
                                  shared.target, shared.ng, shared.K, jobs.parts[p]),
-                    jobs.noise[q], jobs.nstd[p], jobs.seeds[p], shared.n_steps, estimators, jobs.cps[p], shared.mset,
+                    SensorNoise(jobs.noise[q], jobs.nstd[p], jobs.seeds[p]), shared.n_steps,
+                    estimators, jobs.cps[p], shared.mset,
                     GraspLoop(w.det[p], w.buf[p], w.est[p], w.cs[p], w.ext[p], w.out[p]),
                     GripperState(w.X[p], w.modes[p], w.hyst[p], w.ps[p]),
                     GripperWork(w.ua[p], w.xt[p], w.ev_frac[p], w.ev_to[p], w.yout[p]), w.rng[p], met[p])

@@ -18,13 +18,18 @@ from ...sim.hybrid import MAX_EVENTS_PER_STEP
 from ...sim.integrators import zoh_levels_into
 from ...sim.noise import normal_draw
 from . import parameters as z
-from .grasp import GraspLoop, _est_stack, _static_gain, _values, grasp_step
+from .grasp import SX, GraspLoop, _est_stack, _static_gain, _values, grasp_step
 from .gripper import (FINGER_NAMES, GripperModel, GripperState, GripperWork, finger_state_space, gripper_advance,
                       gripper_measure)
 
 METRICS = ("t_contact1", "t_contact2", "t_squeeze", "peak_force", "damage", "max_displacement", "grasped",
            "lost", "settling_time", "final_error", "final_force", "width_error", "stiffness_error")
 _NM = len(METRICS)
+#: index of each metric in a row of ``met``: ``met[MX.peak_force]`` (generated from METRICS)
+MX = namedtuple("MetricIndex", METRICS)(*range(len(METRICS)))
+#: the metric settings ``mset`` the kernels take, and their index table ``mset[MSX.band]``
+METRIC_SETTINGS = ("damage_force", "lost_displacement", "band")
+MSX = namedtuple("MetricSettingIndex", METRIC_SETTINGS)(*range(len(METRIC_SETTINGS)))
 _SQUEEZE = 2.0
 _PHASE, _CONTACT_T = 0, 6
 
@@ -37,6 +42,9 @@ JobTemplate = namedtuple("JobTemplate", "A B0 bF iy Phi Gam C D G H target ng K 
 #: scratch of :func:`_job_setup`: the contact mode's continuous ``Ac`` (2, n, n), ``Bc`` (2, n, 3)
 #: and discretised ``PhiC`` (2, K+1, n, n), ``GamC`` (2, K+1, n, 3)
 ContactWork = namedtuple("ContactWork", "Ac Bc PhiC GamC")
+#: the force-sensor noise of one grasp: explicit samples (N, 2) when it has rows, else white noise
+#: of standard deviation ``std`` (N) from a splitmix64 stream seeded with ``seed``
+SensorNoise = namedtuple("SensorNoise", "samples std seed")
 
 
 # ------------------------------------------------------------------------------------------------
@@ -123,16 +131,17 @@ def _stiffness_metrics(met, part, detected, grasped, y_contact, y_sum, f_mean): 
     the tail's mean force and squeeze beyond contact, k the two sides in series (k_side/2); NaN
     unless both contacts were detected."""
     if not detected:
-        met[11] = math.nan
-        met[12] = math.nan
+        met[MX.width_error] = math.nan
+        met[MX.stiffness_error] = math.nan
         return
-    met[11] = part[1] - y_contact - part[0]
+    met[MX.width_error] = part[1] - y_contact - part[0]
     delta = y_sum - y_contact
-    met[12] = f_mean / delta / (0.5 * part[2]) - 1.0 if (grasped and delta > 0.0) else math.nan
+    met[MX.stiffness_error] = (f_mean / delta / (0.5 * part[2]) - 1.0 if (grasped and delta > 0.0)
+                               else math.nan)
 
 
 @numba.njit(cache=True, _nrt=False)
-def _grasp_core(model, noise, nstd, seed, n_steps, e, cp, mset, loop, state, work, rng,
+def _grasp_core(model, sensor, n_steps, e, cp, mset, loop, state, work, rng,
                 met):  # pragma: no cover - compiled
     """One grasp from rest on the gripper ``model`` (:class:`GripperModel`, its part with the
     initial X_p appended), reduced to the metrics ``met`` (len(METRICS)); no allocation (every
@@ -140,8 +149,9 @@ def _grasp_core(model, noise, nstd, seed, n_steps, e, cp, mset, loop, state, wor
     (:class:`GripperState`), ``work`` (:class:`GripperWork`), ``rng`` (1,) uint64; so the function
     also compiles for CUDA, one job per thread).
 
-    ``noise`` (N, 2): the force-sensor noise per sample when it has rows, else white noise of std
-    ``nstd`` from a splitmix64 stream seeded with ``seed``. ``e``: the estimators; ``cp``:
+    ``sensor`` (:data:`SensorNoise`): the force-sensor noise per sample when ``sensor.samples``
+    has rows, else white noise of std ``sensor.std`` from a stream seeded with ``sensor.seed``.
+    ``e``: the estimators; ``cp``:
     :meth:`GraspSettings.vector`; ``mset`` = [damage_force, lost_displacement, band]. The loop is
     the one of :func:`gripkit.systems.tsfm.grasp._grasp_run`. Compiled without numba's reference
     counting (``_nrt=False``, like its callees :func:`grasp_step`, :func:`gripper_advance` and
@@ -149,8 +159,9 @@ def _grasp_core(model, noise, nstd, seed, n_steps, e, cp, mset, loop, state, wor
     incref/decref pair per array per call (docs/performance.md, "Named records in kernels")."""
     out, modes, ps = loop.out, state.modes, state.ps
     part, yout = model.part, work.yout
-    dt = cp[15]
-    fcmd = cp[3]
+    noise, nstd, seed = sensor.samples, sensor.std, sensor.seed
+    dt = cp[SX.dt]
+    fcmd = cp[SX.grip_force]
     _grasp_reset(loop, state, part, rng, seed)
     x0p = part[6]
     explicit = noise.shape[0] > 0
@@ -205,7 +216,7 @@ def _grasp_core(model, noise, nstd, seed, n_steps, e, cp, mset, loop, state, wor
         if t_sq < 0.0 and out[0, 4] == _SQUEEZE:
             t_sq = k * dt
         fbar = 0.5 * (fg1 + fg2)
-        if t_sq >= 0.0 and abs(fbar - fcmd) > mset[2] * fcmd:
+        if t_sq >= 0.0 and abs(fbar - fcmd) > mset[MSX.band] * fcmd:
             last_out = k
         if k >= tail:
             sum_f += fbar
@@ -215,17 +226,17 @@ def _grasp_core(model, noise, nstd, seed, n_steps, e, cp, mset, loop, state, wor
         if k == n_steps - 1:
             grasped = modes[0] == 1 and modes[1] == 1 and out[0, 4] == _SQUEEZE and out[1, 4] == _SQUEEZE
         gripper_advance(out[0, 0], out[1, 0], state, model, work)
-    met[0] = t_c1 if t_c1 >= 0.0 else math.nan
-    met[1] = t_c2 if t_c2 >= 0.0 else math.nan
-    met[2] = t_sq if t_sq >= 0.0 else math.nan
-    met[3] = peak
-    met[4] = 1.0 if peak > mset[0] else 0.0
-    met[5] = maxd
-    met[6] = 1.0 if grasped else 0.0
-    met[7] = 1.0 if (not grasped or maxd > mset[1]) else 0.0
-    met[8] = _settling_time(t_sq, last_out, n_steps, dt)
-    met[9] = (sum_f / n_tail - fcmd) / fcmd
-    met[10] = sum_f / n_tail
+    met[MX.t_contact1] = t_c1 if t_c1 >= 0.0 else math.nan
+    met[MX.t_contact2] = t_c2 if t_c2 >= 0.0 else math.nan
+    met[MX.t_squeeze] = t_sq if t_sq >= 0.0 else math.nan
+    met[MX.peak_force] = peak
+    met[MX.damage] = 1.0 if peak > mset[MSX.damage_force] else 0.0
+    met[MX.max_displacement] = maxd
+    met[MX.grasped] = 1.0 if grasped else 0.0
+    met[MX.lost] = 1.0 if (not grasped or maxd > mset[MSX.lost_displacement]) else 0.0
+    met[MX.settling_time] = _settling_time(t_sq, last_out, n_steps, dt)
+    met[MX.final_error] = (sum_f / n_tail - fcmd) / fcmd
+    met[MX.final_force] = sum_f / n_tail
     _stiffness_metrics(met, part, det1 and det2, grasped, y1c + y2c, sum_s / n_tail, sum_fm / n_tail)
 
 
@@ -255,10 +266,10 @@ def _grasp_jobs(tpl, parts, noise, nstd, seeds, n_steps, window, cps, mset, met)
     rng = np.empty(1, dtype=np.uint64)
     for p in range(parts.shape[0]):
         q = p if noise.shape[0] > 1 else 0
-        _job_setup(tpl, parts[p], cps[p, 15], Phi, Gam, C, D, Hg, cw)
+        _job_setup(tpl, parts[p], cps[p, SX.dt], Phi, Gam, C, D, Hg, cw)
         model = GripperModel(tpl.bw, Phi, Gam, C, D, tpl.G, Hg, tpl.target, tpl.ng, tpl.K, parts[p])
-        _grasp_core(model, noise[q], nstd[p], seeds[p], n_steps, tpl.est, cps[p], mset, loop, state, work, rng,
-                    met[p])
+        _grasp_core(model, SensorNoise(noise[q], nstd[p], seeds[p]), n_steps, tpl.est, cps[p], mset,
+                    loop, state, work, rng, met[p])
 
 
 @numba.njit(cache=True, parallel=True)

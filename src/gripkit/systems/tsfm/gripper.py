@@ -59,8 +59,8 @@ from ...errors import AccuracyWarning, DataWarning, ModelError, ParameterError
 from ...models.hysteresis import bouc_wen_advance
 from ...models.piezo import actuator_parameters, actuator_state_space, lti_modes, run_bw_lti
 from ...params import Parameter, ParameterSet
-from ...sim.hybrid import (DEFAULT_LEVELS, MAX_EVENTS_PER_STEP, Guard, HybridSystem, Mode,
-                           pwa_output, pwa_step)
+from ...sim.hybrid import (DEFAULT_LEVELS, MAX_EVENTS_PER_STEP, EventWork, Guard, HybridSystem,
+                           Mode, PWAGuards, pwa_output, pwa_step)
 from ...sim.integrators import zoh_levels
 from ...sim.linear import StateSpace
 from ...sim.model import Model, Signal
@@ -511,9 +511,11 @@ def _hybrid_arrays(rows, dt, levels, realisation="component"):
 
 
 @numba.njit(cache=True)
-def _bw_pwa_row(bw, Phi, Gam, C, D, G, Hg, target, ng, K, xw, u, x0, y):  # pragma: no cover - compiled
+def _bw_pwa_row(bw, Phi, Gam, C, D, guards, K, xw, u, x0, y):  # pragma: no cover - compiled
     """One parameter row of :func:`_bw_pwa_batch` (a plain function: the prange body of a
-    parallel kernel optimises worse, measured 35 ns/sample slower)."""
+    parallel kernel optimises worse, measured 35 ns/sample slower); ``guards``:
+    :data:`~gripkit.sim.hybrid.PWAGuards`."""
+    G, Hg, target, ng = guards
     N = u.shape[0]
     n = Phi.shape[2]
     p_out = C.shape[1]
@@ -522,6 +524,7 @@ def _bw_pwa_row(bw, Phi, Gam, C, D, G, Hg, target, ng, K, xw, u, x0, y):  # prag
     ua = np.empty(3)
     ev_frac = np.empty(MAX_EVENTS_PER_STEP)
     ev_to = np.empty(MAX_EVENTS_PER_STEP, dtype=np.int64)
+    work = EventWork(xt, ev_frac, ev_to)
     yk = np.empty(p_out)
     for i in range(n):
         x[i] = x0[2 + i]
@@ -560,13 +563,17 @@ def _bw_pwa_row(bw, Phi, Gam, C, D, G, Hg, target, ng, K, xw, u, x0, y):  # prag
             for i in range(p_out):
                 y[k, i] = yk[i]
         y[k, p_out] = mode
-        mode, _nev = pwa_step(x, mode, ua, Phi, Gam, G, Hg, target, ng, K, xt, ev_frac, ev_to)
+        mode, _nev = pwa_step(x, mode, ua, Phi, Gam, G, Hg, target, ng, K, work)
 
 
 @numba.njit(cache=True, parallel=True)
-def _bw_pwa_batch(bw, Phi, Gam, C, D, G, Hg, target, ng, K, xw, u, x0, y):  # pragma: no cover
+def _bw_pwa_batch(bw, Phi, Gam, C, D, guards, K, xw, u, x0, y):  # pragma: no cover
+    """:func:`_bw_pwa_row` for every parameter row (``guards``: PWAGuards with a leading row
+    index on G and H). A prange body takes arrays, not records: each row builds its own."""
+    G, Hg, target, ng = guards
     for p in prange(bw.shape[0]):
-        _bw_pwa_row(bw[p], Phi[p], Gam[p], C[p], D[p], G[p], Hg[p], target, ng, K, xw[p], u, x0[p], y[p])
+        _bw_pwa_row(bw[p], Phi[p], Gam[p], C[p], D[p], PWAGuards(G[p], Hg[p], target, ng), K, xw[p],
+                    u, x0[p], y[p])
 
 
 class TSFMFingerContact(Model):
@@ -630,11 +637,12 @@ class TSFMFingerContact(Model):
         bw = np.ascontiguousarray(thetas[:, [0, 2, 3, 4]])
         xw = np.ascontiguousarray(thetas[:, nf])
         if len(thetas) == 1:  # one row: skip the parallel region (its thread wake-up costs more than it gives)
-            _bw_pwa_row(bw[0], d["Phi"][0], d["Gam"][0], d["C"][0], d["D"][0], d["G"][0], d["H"][0], d["target"],
-                        d["ng"], self.levels, xw[0], u, x0[0], y[0])
+            guards = PWAGuards(d["G"][0], d["H"][0], d["target"], d["ng"])
+            _bw_pwa_row(bw[0], d["Phi"][0], d["Gam"][0], d["C"][0], d["D"][0], guards, self.levels,
+                        xw[0], u, x0[0], y[0])
         else:
-            _bw_pwa_batch(bw, d["Phi"], d["Gam"], d["C"], d["D"], d["G"], d["H"], d["target"], d["ng"],
-                          self.levels, xw, u, x0, y)
+            guards = PWAGuards(d["G"], d["H"], d["target"], d["ng"])
+            _bw_pwa_batch(bw, d["Phi"], d["Gam"], d["C"], d["D"], guards, self.levels, xw, u, x0, y)
 
 
 # ---- two fingers and a part --------------------------------------------------------------------
@@ -702,7 +710,7 @@ def gripper_advance(U1, U2, state, model, work):  # pragma: no cover - compiled
         ua[0] = bw[i, 0] * U - hyst[i]
         ua[1] = _face(i, Xp, part)
         q, _nev = pwa_step(X[i], modes[i], ua, model.Phi[i], model.Gam[i], model.G[i], model.Hg[i], model.target,
-                           model.ng, model.K, work.xt, work.ev_frac, work.ev_to)
+                           model.ng, model.K, work)
         modes[i] = q
     gripper_measure(state, model, work)
     net = yout[0, 2] - yout[1, 2]  # finger 1 pushes towards +X, finger 2 towards −X
