@@ -88,19 +88,43 @@ def test_guard_freezes_while_the_start_temperature_is_unknown(noisy):
 
 
 def test_adaptation_with_the_observer_never_harms_and_helps_under_drift(exact, noisy):
-    """With the thermal motor and the noisy velocity: on the drifting plant the adapted
-    compensation beats the fixed one by at least 3 % (0.5436° vs 0.5633°; exact velocities
-    0.2748° vs 0.2954°); without drift (the fixed tables are then exactly the plant's friction,
-    so adaptation can at best equal them) it stays within 0.5 % of fixed (cold 0.5804° vs
-    0.5797°, hot 0.6930° vs 0.6937°), and in every case it beats the eq 5.10 estimator."""
+    """With the thermal motor, exact or noisy velocities: without drift (the fixed tables are then
+    exactly the plant's friction, so adaptation can at best equal them) the adapted compensation
+    is never worse than the fixed one: the observer's band keeps the table wherever the estimate
+    is not significant (it reads 1.02-1.17 of the friction, inside the ±20 % band) or not settled
+    (the estimator's start-up transient), so the runs equal the fixed ones (cold 0.5797°, hot
+    0.6937° noisy). On the drifting plant it beats the fixed compensation by at least 2 % (noisy
+    0.5474° vs 0.5633°, −2.8 %; exact 0.2790° vs 0.2954°, −5.6 %), and in every case it beats the
+    eq 5.10 estimator."""
     for st in (exact, noisy):
-        assert st.rms["cold+drift", "adaptive-thermal"] < 0.97 * st.rms["cold+drift", "fixed"]
+        assert st.rms["cold+drift", "adaptive-thermal"] < 0.98 * st.rms["cold+drift", "fixed"]
         for case in ("cold", "hot"):
-            assert st.rms[case, "adaptive-thermal"] <= 1.005 * st.rms[case, "fixed"]
+            assert st.rms[case, "adaptive-thermal"] <= 1.0 * st.rms[case, "fixed"]
         for case in THERMAL_CASES:
             assert st.rms[case, "adaptive-thermal"] < st.rms[case, "adaptive-eq5.10"]
     assert noisy.rms["cold", "fixed"] / DEG == pytest.approx(0.5797, abs=6e-4)
-    assert noisy.rms["cold+drift", "adaptive-thermal"] / DEG == pytest.approx(0.5436, abs=6e-4)
+    assert noisy.rms["cold+drift", "adaptive-thermal"] / DEG == pytest.approx(0.5474, abs=6e-4)
+    assert exact.rms["cold+drift", "adaptive-thermal"] / DEG == pytest.approx(0.2790, abs=6e-4)
+
+
+def test_the_band_is_what_keeps_adaptation_from_harming(noisy):
+    """Without the band (band=0: every estimate applied as soon as the guard opens) the noisy
+    cold start is 0.11 % worse than fixed (0.5804° vs 0.5797°): the estimator's start-up
+    transient when the guard opens (ŝ + ô/F_ref up to 3.2-3.5 in the first 10 ms) and its
+    errors-in-variables
+    bias (+2 to +17 %) reach the compensation. With the band the estimate applied is the table's
+    (1, 0) until ln 20/(−ln λ) = 2994 updates have passed (3.0 s of sliding at λ = 0.999) and
+    while the estimated kinetic friction at 1 rad/s is within ±20 % of the table's."""
+    f = _finger(thermal=True)
+    st = thermal_adaptation_study(f, CTRL, tracking_reference(120.0),
+                                  observer=ThermalObserver(band=0.0))
+    ratio = st.rms["cold", "adaptive-thermal"] / st.rms["cold", "fixed"]
+    assert ratio == pytest.approx(1.0011, abs=3e-4)
+    assert noisy.rms["cold", "adaptive-thermal"] == noisy.rms["cold", "fixed"]
+    tr = noisy.runs["cold", "adaptive-thermal"]
+    for a in ACTUATORS:
+        fixed = noisy.runs["cold", "fixed"]
+        np.testing.assert_array_equal(tr[f"fric_ff_{a}"], fixed[f"fric_ff_{a}"])
 
 
 def test_known_start_temperature_opens_the_guard(exact):
@@ -121,6 +145,8 @@ def test_bad_settings_are_refused():
         ThermalObserver(initial=(350.0, 300.0))
     with pytest.raises(ModelError, match="guard: expected a positive"):
         ThermalObserver(guard=0.0)
+    with pytest.raises(ModelError, match="band: expected a relative width >= 0"):
+        ThermalObserver(band=-0.1)
     with pytest.raises(ModelError, match="alpha_R: expected a positive number or None"):
         ThermalObserver(alpha_R=-0.004)
     with pytest.raises(ModelError, match="resolution: expected a positive angle"):
@@ -159,21 +185,23 @@ def test_observer_in_the_inversion_delivers_the_commanded_torque():
 def test_a_wrong_thermal_model_brings_part_of_the_confound_back(noisy):
     """The observer is only as good as its thermal model. With copper's α = 0.004/K (§5.2's
     "20 % per 50 K") instead of the 0.0136/K that Fig. 5.7 needs, ρ̂ under-reads the cold motor's
-    extra torque: the estimate falls to 0.76–0.87 of the friction and tracking is 3.8 % (cold) and
-    2.3 % (hot) worse than the fixed compensation — still better than the eq 5.10 estimator
-    (+11 %, +7.8 %); under drift it still helps (0.5373° vs 0.5633°). A thermal time constant
-    30 % too long (R_th 9.36 K/W) keeps the guard closed for the whole 120 s (with the right one it
-    opens after 99–104 s): exactly the fixed compensation."""
+    extra torque: the estimate falls to 0.75-0.88 of the friction; where it falls more than 20 %
+    below the table (the distal drive, 0.75-0.79) the band lets it through, and tracking is
+    2.9 % (cold) and 0.6 % (hot) worse than the fixed compensation (3.8 % and 2.3 % without the
+    band) — still better than the eq 5.10 estimator (+11 %,
+    +7.8 %); under drift it still helps (0.5562° vs 0.5633°). A thermal time constant 30 % too
+    long (R_th 9.36 K/W) keeps the guard closed for the whole 120 s (with the right one it opens
+    after 99–104 s): exactly the fixed compensation."""
     f = _finger(thermal=True)
     ref = tracking_reference(120.0)
     cu = thermal_adaptation_study(f, CTRL, ref, observer=ThermalObserver(alpha_R=0.004))
-    for case, worse in (("cold", 0.038), ("hot", 0.023)):
+    for case, worse in (("cold", 0.029), ("hot", 0.006)):
         ratio = cu.rms[case, "adaptive-thermal"] / noisy.rms[case, "fixed"]
-        assert ratio == pytest.approx(1 + worse, abs=0.004)
+        assert ratio == pytest.approx(1 + worse, abs=0.003)
         assert cu.rms[case, "adaptive-thermal"] < noisy.rms[case, "adaptive-eq5.10"]
         fr = cu.friction[case, "adaptive-thermal"]
         assert ((fr > 0.74) & (fr < 0.89)).all()
-    assert cu.rms["cold+drift", "adaptive-thermal"] < 0.97 * noisy.rms["cold+drift", "fixed"]
+    assert cu.rms["cold+drift", "adaptive-thermal"] < 0.99 * noisy.rms["cold+drift", "fixed"]
     slow = thermal_adaptation_study(f, CTRL, ref, observer=ThermalObserver(R_th=7.2 * 1.3))
     for case in THERMAL_CASES:
         assert slow.updated[case, "adaptive-thermal"] == 0.0

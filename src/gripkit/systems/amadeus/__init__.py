@@ -5,6 +5,9 @@
 - :mod:`.parameters` — the hand as a zoo system: Table I and Table II in SI units with provenance;
 - :mod:`.bellows_finger`, :mod:`.hand`, :mod:`.valve` — the three-bellows finger (eqs 1–8), the
   three-finger hand (palm, knuckles, force closure), the proportional pressure valves;
+- :mod:`.position_control`, :mod:`.knuckle` — fingertip position control from the tube pressures
+  (no tip sensor, §II-C), and the knuckle's cylinder, linkage, three-position valve and bang-bang
+  angle control (§II-B, §II-D);
 - :mod:`.strain_gauge_sensor`, :mod:`.force_sensor` — the six-bridge fingertip force sensor and its
   calibration, weighted least squares and Kalman filter (eqs 9–19);
 - :mod:`.pvdf`, :mod:`.slip` — the PVDF slip film on a stick-slip contact, and slip detection;

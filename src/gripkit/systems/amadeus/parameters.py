@@ -33,6 +33,7 @@ from ...params import Parameter, ParameterSet
 from .bellows_finger import BellowsFinger
 from .force_dynamics import FORCE_SCALE, PEAK_FORCE, finger_force_model, force_scale_parameter
 from .hand import AmadeusHand
+from .knuckle import KnuckleDrive
 from .pvdf import StickSlipContact
 from .strain_gauge_sensor import StrainGaugeSensor
 from .valve import ProportionalValve
@@ -120,6 +121,7 @@ class AmadeusHandSystem:
         self.valve = ProportionalValve(check=False)
         self.sensor = StrainGaugeSensor()
         self.hand = AmadeusHand(self.finger, check=False)
+        self.knuckle = KnuckleDrive(check=False)
         self.contact = StickSlipContact(check=False)
         self.plant_raw = table2_plant()
         self.plant, self.force_scale = force_plant(force_scale)
@@ -129,11 +131,12 @@ class AmadeusHandSystem:
     @property
     def parameters(self) -> ParameterSet:
         """Every part's parameters, prefixed by part (``finger_``, ``valve_``, ``sensor_``,
-        ``hand_``, ``contact_``, ``force_``)."""
+        ``hand_``, ``contact_``, ``knuckle_``, ``force_``)."""
         params = []
         for prefix, ps in (("finger", self.finger.parameters), ("valve", self.valve.parameters),
                            ("sensor", self.sensor.parameters), ("hand", self.hand.hand_parameters),
-                           ("contact", self.contact.parameters)):
+                           ("contact", self.contact.parameters),
+                           ("knuckle", self.knuckle.parameters)):
             params += [dataclasses.replace(p, name=f"{prefix}_{p.name}") for p in ps.values()]
         A, B = self.plant_raw.A, self.plant_raw.B
         src = self.plant_raw.source
@@ -152,7 +155,7 @@ class AmadeusHandSystem:
 
     def consistency_checks(self) -> list[Finding]:
         out = []
-        for part in (self.finger, self.valve, self.hand):
+        for part in (self.finger, self.valve, self.hand, self.knuckle):
             out += part.consistency_checks()
         out += table1_findings()
         # Fig. 2(c) maximum frequency response vs the identified poles

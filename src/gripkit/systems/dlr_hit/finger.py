@@ -137,8 +137,9 @@ LoopWork = namedtuple("LoopWork", "q qd R P T J Jp tip tipd tauq gp work zq xs p
 #: a closed loop: ``ctrl`` (0 open loop, 1 joint, 2 Cartesian impedance), its gains vector, the
 #: friction tables it compensates with (TableArrays), the reference and its velocity (N, 3), the
 #: wall (nx, ny, nz, px, py, pz, k, d, on), the controller's sensing and thermal observer state
-#: ``sensor`` (3, 6) per actuator = (T̂_lo, T̂_hi, last quantised angle, filtered velocity, ρ̂,
-#: guard: 1 while the torque factor is too uncertain to adapt) and the measured state ``xm`` (NX)
+#: ``sensor`` (3, 7) per actuator = (T̂_lo, T̂_hi, last quantised angle, filtered velocity, ρ̂,
+#: guard: 1 while the torque factor is too uncertain to adapt, the estimator's updates so far)
+#: and the measured state ``xm`` (NX)
 ImpedanceLoop = namedtuple("ImpedanceLoop", "ctrl gains tables ref refd wall sensor xm")
 #: indices of the gains vector beyond the impedance gains (see gripkit.systems.dlr_hit.impedance)
 G_ADAPT = 13
@@ -150,7 +151,13 @@ G_COMMAND = 18
 G_OBS_ALPHA = 19
 G_OBS_RTH = 20
 G_OBS_CTH = 21
-N_GAINS = 22
+#: the thermal observer's significance band on the friction estimate, and the compensation
+#: tables' kinetic friction at the band's reference speed (3 slots, N·m)
+G_BAND = 22
+G_FREF = 23
+#: the number of estimator updates after which an estimate counts as settled (band test)
+G_SETTLE = 26
+N_GAINS = 27
 #: the plant's friction drift: schedule (N, 6) = (s_k, Δ_k) or (0, 6), and working copies of the
 #: parameter vector and the table values
 PlantDrift = namedtuple("PlantDrift", "schedule th values")
@@ -603,9 +610,10 @@ def _impedance(th, fc, cs, x, n, loop, fhat):  # pragma: no cover - compiled
             if v * tau >= 0.0:
                 if abs(v) < vdb:
                     v = vdb if tau > 0.0 else -vdb
-                fk = fhat[k, 0] * table_friction(v, ctab.velocity[k], ctab.values[k], ctab.length[k],
-                                                 ctab.ipos[k])
-                fk += fhat[k, 1] if v > 0.0 else -fhat[k, 1]
+                s_k, o_k = _applied_estimate(fhat, gains, loop.sensor, k)
+                fk = s_k * table_friction(v, ctab.velocity[k], ctab.values[k], ctab.length[k],
+                                          ctab.ipos[k])
+                fk += o_k if v > 0.0 else -o_k
                 ff[k] = fk * math.tanh(abs(tau) / eps)
                 tau += ff[k]
         tauq[k] = tau
@@ -644,6 +652,23 @@ def _wall(th, fc, cs, x, wall):  # pragma: no cover - compiled
         ext[j] = Jp[0, j] * force[0] + Jp[1, j] * force[1] + Jp[2, j] * force[2]
 
 
+@hot_inline
+def _applied_estimate(fhat, gains, sensor, k):  # pragma: no cover - compiled
+    """The (scale, offset) the compensation applies for actuator k: the estimate, unless a
+    band gains[G_BAND] > 0 is set and the estimate is not yet settled (fewer than
+    gains[G_SETTLE] updates, ``sensor[k, 6]``) or not significant (the estimated kinetic friction
+    at the band's reference speed, ŝ·F_ref + ô, within ±band of the table's
+    F_ref = gains[G_FREF + k]): then the table is applied as identified, (1, 0)."""
+    s_k, o_k = fhat[k, 0], fhat[k, 1]
+    band = gains[G_BAND]
+    if band > 0.0:
+        if sensor[k, 6] < gains[G_SETTLE]:
+            return 1.0, 0.0
+        if abs(s_k + o_k / gains[G_FREF + k] - 1.0) <= band:
+            return 1.0, 0.0
+    return s_k, o_k
+
+
 @hot
 def _adapt_friction(th, fc, cs, x, ctab, est, sensor, y, n):  # pragma: no cover - compiled
     """One step of the online friction estimator ``est`` (:data:`FrictionEstimator`) per actuator
@@ -673,6 +698,8 @@ def _adapt_friction(th, fc, cs, x, ctab, est, sensor, y, n):  # pragma: no cover
             theta[k, 0], theta[k, 1], sig2[k] = s0, o0, sg
             P[k, 0, 0], P[k, 0, 1], P[k, 1, 0], P[k, 1, 1] = p00, p01, p01, p11
             st = 0.0
+        if st == 1.0:
+            sensor[k, 6] += 1.0  # updates so far (the band's settling count)
         y[n, 33 + k] = st
         y[n, 27 + k] = theta[k, 0]
         y[n, 30 + k] = theta[k, 1]
@@ -871,7 +898,7 @@ def _open_loop_records():
     theta = np.zeros((3, 2))
     theta[:, 0] = 1.0
     return (ImpedanceLoop(OPEN_LOOP, np.zeros(N_GAINS), tables, np.zeros((1, 3)), np.zeros((1, 3)),
-                          np.zeros(9), np.zeros((3, 6)), np.zeros(NX)),
+                          np.zeros(9), np.zeros((3, 7)), np.zeros(NX)),
             PlantDrift(np.zeros((0, 6)), np.zeros(NTH), np.zeros((3, 1))),
             FrictionEstimator(np.zeros(10), np.ones(3), theta, np.zeros((3, 2, 2)), np.zeros((3, 5)),
                               np.zeros(3)))
