@@ -149,6 +149,19 @@ class PositionResponse:
         return float(self.t[out[-1] + 1])
 
 
+@numba.njit(cache=True)
+def _delay_and_lag(delay: float, tau: float, dt: float):  # pragma: no cover - compiled
+    """A pure delay of ``delay`` s followed by a first-order lag ``tau`` over one sample of a held
+    input: ``delay = (m + f) dt`` splits the sample at f, and the lag's exact factors over the two
+    parts are ``a1 = e^{−f dt/τ}`` and ``a2 = e^{−(1−f) dt/τ}``; returns ``(m, a1, a2)``."""
+    d = delay / dt
+    m = int(math.floor(d + 1e-9))
+    f = d - m
+    if f < 1e-9:
+        f = 0.0
+    return m, math.exp(-f * dt / tau), math.exp(-(1.0 - f) * dt / tau)
+
+
 #: the pressure loops' settings for the kernel: PI gains (kp, ki per sample), valve gain kv
 #: (Pa/A), current limits (A), reading quantum (Pa), dt (s), samples n, and the controller's valve
 #: model (lag tau_c, delay td_c, s)
@@ -171,23 +184,10 @@ def _position_loop(p_ref, i_ff, p0, vpar, loops, rec):  # pragma: no cover - com
     i_hi = vpar[3]
     w = vpar[4]
     h = vpar[5]
-    d = vpar[6] / dt
-    tau = vpar[7]
-    m = int(math.floor(d + 1e-9))
-    f = d - m
-    if f < 1e-9:
-        f = 0.0
-    a1 = math.exp(-f * dt / tau)
-    a2 = math.exp(-(1.0 - f) * dt / tau)
+    m, a1, a2 = _delay_and_lag(vpar[6], vpar[7], dt)
     nb = m + 2
     # the controller's valve model (delay td_c, lag tau_c) predicts the pressure of the step
-    dc = td_c / dt
-    mc = int(math.floor(dc + 1e-9))
-    fc = dc - mc
-    if fc < 1e-9:
-        fc = 0.0
-    c1 = math.exp(-fc * dt / tau_c)
-    c2 = math.exp(-(1.0 - fc) * dt / tau_c)
+    mc, c1, c2 = _delay_and_lag(td_c, tau_c, dt)
     for k in range(3):
         # start at rest at p0: the current of the inverse static curve, the play centred on it
         lo = i_lo - 50.0 * w
