@@ -97,3 +97,22 @@ def row(benchmark: str, task: str, gripkit_s, peer: str, peer_s, *, target: str 
                 peer=peer, peer_s=p_med, peer_min_s=p_min, peer_runs=p_runs, ratio=ratio, target=target,
                 unit=unit, gripkit_accuracy=gripkit_accuracy, peer_accuracy=peer_accuracy,
                 pure_python_peer=pure_python_peer, notes=notes, extra=extra or {})
+
+
+def measure_alternating(fns: list[Callable[[], object]], runs: int = REPEAT) -> list[Timing]:
+    """Time several callables in turn (f0 f1 … f0 f1 …, after one warm-up call each), so that a
+    drift of the machine's speed touches all of them alike; seconds per call, median and min."""
+    for fn in fns:
+        fn()
+    times: list[list[float]] = [[] for _ in fns]
+    gc.collect()
+    gc.disable()
+    try:
+        for _ in range(runs):
+            for k, fn in enumerate(fns):
+                t0 = time.perf_counter()
+                fn()
+                times[k].append(time.perf_counter() - t0)
+    finally:
+        gc.enable()
+    return [Timing(statistics.median(t), min(t), runs) for t in times]
