@@ -64,7 +64,7 @@ _MODES = {"none": 0, "trace": 1, "directional": 2}
 SPECIALISE_ABOVE = 100_000
 
 
-@njit(cache=True)
+@njit(cache=True, inline="always")
 def _core(P, th, phi, q, p, size, lam, mode, maxtr, trace, y):
     """One RLS update of θ (``th``, shape (p,)) and P (``P``, row-major (p·p,)) for regressor
     ``phi`` and output ``y``; ``q`` is a work vector. Returns (a-priori error, r = φᵀPφ, trace).
@@ -79,13 +79,12 @@ def _core(P, th, phi, q, p, size, lam, mode, maxtr, trace, y):
     for i in range(p):
         yhat += phi[i] * th[i]
     e = y - yhat
-    for i in range(p):
-        q[i] = 0.0
-    for j in range(p):
-        pj = phi[j]
-        row = j * p
-        for i in range(p):
-            q[i] += P[row + i] * pj
+    for i in range(p):  # q = Pφ, row i of P (= its column: P is exactly symmetric), j ascending
+        row = i * p
+        acc = 0.0
+        for j in range(p):
+            acc += P[row + j] * phi[j]
+        q[i] = acc
     r = 0.0
     for i in range(p):
         r += phi[i] * q[i]
@@ -192,18 +191,20 @@ def _rls_run(s, u, y, theta_out, std_out, yhat_out, size):
     """Batch RLS: updates ``s`` over the record; writes θ, σ and the a-priori prediction at
     every step when the output arrays have N rows (pass arrays with 0 rows to skip storing).
 
-    ``size``: an empty tuple (generic kernel, p at run time) or a tuple of p zeros, whose length
-    numba knows at compile time: it compiles (and caches) one kernel per number of parameters with
-    unrolled p-loops (measured 1.5–2× faster); :meth:`RLS.run` uses it for records of at least
+    ``size``: four empty tuples (generic kernel, orders read from ``s`` at run time) or tuples of
+    p, na, nb and nk zeros (:func:`_specialised`), whose lengths numba knows at compile time: it
+    compiles (and caches) one kernel per model structure, with unrolled p-loops and constant
+    regressor indices (measured 1.5–2× faster); :meth:`RLS.run` uses it for records of at least
     :data:`SPECIALISE_ABOVE` samples, where the extra compilation (1–2 s, once) pays off. The first
     ``t0`` samples go through :func:`_rls_step` (their regressors need the buffered past); the rest
     take the regressor straight from ``u`` and ``y`` with θ and P in local arrays. Both call
     :func:`_core`, so streaming and batch results are bit-identical.
     """
     n = u.shape[0]
-    na = int(s[_NA])
-    nb = int(s[_NB])
-    nk = int(s[_NK])
+    if len(size[0]) > 0:  # the orders are known to the compiler: constant regressor indices
+        na, nb, nk = len(size[1]), len(size[2]), len(size[3])
+    else:
+        na, nb, nk = int(s[_NA]), int(s[_NB]), int(s[_NK])
     p = na + nb
     nu = nk + nb
     oth = _HDR + na + nu
@@ -244,7 +245,7 @@ def _rls_run(s, u, y, theta_out, std_out, yhat_out, size):
             phi[i] = -y[t - 1 - i]
         for j in range(nb):
             phi[na + j] = u[t - nk - j]
-        e, r, trace = _core(P, th, phi, q, p, size, lam, mode, maxtr, trace, y[t])
+        e, r, trace = _core(P, th, phi, q, p, size[0], lam, mode, maxtr, trace, y[t])
         V = lam * (V + e * e / (lam + r))
         w1 = lam * w1 + 1.0
         w2 = lam * lam * w2 + 1.0
@@ -498,6 +499,14 @@ class RLS:
                     f"10^{log_energy:.0f} is below 1/P, so {names} would stay at their initial values",
                     hint=f"scale u and y to order 1 (other units), or raise p0 above 1/Σ{label[-1]}²")
 
+    def _kernel_size(self, n: int) -> tuple:
+        """The ``size`` argument of :func:`_rls_run`: the orders as tuple lengths (one compiled
+        kernel per structure) for records of at least :data:`SPECIALISE_ABOVE` samples, else
+        empty tuples (the generic kernel)."""
+        if n < SPECIALISE_ABOVE:
+            return (), (), (), ()
+        return (0.0,) * self.n_params, (0.0,) * self.na, (0.0,) * self.nb, (0.0,) * self.nk
+
     def _run(self, u: np.ndarray, y: np.ndarray, store: bool) -> "RLSResult":
         """:meth:`run` on checked float64 arrays."""
         self._check_scale(u, y)
@@ -508,7 +517,7 @@ class RLS:
         std = np.empty((rows, p))
         yhat = np.empty(n)
         n0 = self.n_updates
-        _rls_run(self._s, u, y, theta, std, yhat, (0.0,) * p if n >= SPECIALISE_ABOVE else ())
+        _rls_run(self._s, u, y, theta, std, yhat, self._kernel_size(n))
         if not (np.isfinite(self.P).all() and np.isfinite(self.theta).all()):
             raise self._diverged(f"after {self.n_updates} updates")
         e = y - yhat
@@ -525,8 +534,26 @@ class RLS:
                          covariance_final=self.covariance, P_final=self.P, model=self.model())
 
 
-@njit(cache=True)
+#: peaks within these bounds square and sum without overflow (N·peak² < 1e290 for N < 1e10)
+#: and with the underflow of values below 1e-150 negligible next to peak² ≥ 1e-280
+_PLAIN_NORM_RANGE = (1e-140, 1e140)
+
+
 def _peak_and_norm(x):
+    """(max |x|, ‖x‖₂) without temporaries: max/min and a BLAS dot (fast) when the peak lies in
+    :data:`_PLAIN_NORM_RANGE`, else :func:`_peak_and_norm_scaled` (one pass scaled by the running
+    peak). The dot sums in another order than the scaled pass: the norms agree to a few ulps,
+    which only feed the order-of-magnitude checks of :meth:`RLS._check_scale`."""
+    if x.size == 0:
+        return 0.0, 0.0
+    peak = max(float(x.max()), -float(x.min()))
+    if _PLAIN_NORM_RANGE[0] < peak < _PLAIN_NORM_RANGE[1]:
+        return peak, math.sqrt(float(np.dot(x, x)))
+    return _peak_and_norm_scaled(x)
+
+
+@njit(cache=True)
+def _peak_and_norm_scaled(x):
     """(max |x|, ‖x‖₂) in one pass without temporaries; the norm is scaled by the running peak
     (the LAPACK dnrm2 way), so it neither overflows nor underflows."""
     peak = 0.0
