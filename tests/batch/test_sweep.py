@@ -95,7 +95,7 @@ def test_per_job_cost_leaves_out_the_chunk_fixed_cost(monkeypatch):
     than in-process. With the slope, 8000 jobs (0.4 s) stay in-process."""
     import importlib
 
-    sw = importlib.import_module("gripkit.batch.sweep")  # the module (gripkit.batch.sweep is the function)
+    sw = importlib.import_module("gripkit.batch.sweep")  # the module, not the function of that name
     calls = []
 
     def fake_warm(args):
@@ -107,10 +107,12 @@ def test_per_job_cost_leaves_out_the_chunk_fixed_cost(monkeypatch):
     assert per_job == pytest.approx(5e-5, rel=1e-9)
     assert sorted(calls) == [1, 1, 1, 8, 8]
     assert sw._auto_backend(per_job * 8000, 2, cores=2)[0] == "in-process"
-    assert sw._auto_backend((7e-3 + 8 * 5e-5) / 8 * 8000, 2, cores=2)[0] == "process"  # the old estimate
+    old_estimate = (7e-3 + 8 * 5e-5) / 8
+    assert sw._auto_backend(old_estimate * 8000, 2, cores=2)[0] == "process"
     # slow jobs: one chunk, its fixed cost is small beside them
     calls.clear()
-    monkeypatch.setattr(sw, "_warm_seconds", lambda args: calls.append(len(args[3])) or 0.2 * len(args[3]))
+    monkeypatch.setattr(sw, "_warm_seconds",
+                        lambda args: calls.append(len(args[3])) or 0.2 * len(args[3]))
     assert sw._seconds_per_job(lambda r: (None, None, None, list(r), {}, None, False), 100) == 0.2
     assert calls == [8]
 

@@ -179,7 +179,8 @@ def _busy_cores() -> float:
         return 0.0
 
 
-def _auto_backend(work_s: float, workers: int, busy: float = 0.0, cores: int | None = None) -> tuple[str, str]:
+def _auto_backend(work_s: float, workers: int, busy: float = 0.0,
+                  cores: int | None = None) -> tuple[str, str]:
     """'in-process' when the estimated work cannot win back the pool's start-up
     (``work ≤ startup + work / w``), else 'process'; with the reason for the summary. ``w``, the
     pool's speed-up, is the number of workers, but at most the cores (default ``os.cpu_count()``)
@@ -189,8 +190,9 @@ def _auto_backend(work_s: float, workers: int, busy: float = 0.0, cores: int | N
     w = max(1.0, min(float(workers), cores - busy))
     load = f", {busy:.1f} of {cores} cores busy" if busy > 0 else ""
     if workers <= 1 or work_s <= POOL_STARTUP_S + work_s / w:
-        return "in-process", (f"backend auto: in-process, the estimated work ({work_s:.2g} s) is too small for "
-                              f"a pool of {workers} to win back its start-up (~{POOL_STARTUP_S:g} s{load})")
+        return "in-process", (f"backend auto: in-process, the estimated work ({work_s:.2g} s) is too small "
+                              f"for a pool of {workers} to win back its start-up "
+                              f"(~{POOL_STARTUP_S:g} s{load})")
     return "process", (f"backend auto: process pool of {workers}, the estimated work ({work_s:.2g} s) "
                        f"outweighs its start-up (~{POOL_STARTUP_S:g} s{load})")
 
@@ -255,7 +257,8 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "auto", workers
     # per job without a chunk's fixed cost (model set-up, parallel thread launch)
     per_job = _seconds_per_job(chunk_args, n_jobs) if (chunk_size is None or auto) else None
     if auto:
-        backend, choice = _auto_backend(per_job * n_jobs, int(workers or os.cpu_count() or 1), _busy_cores())
+        backend, choice = _auto_backend(per_job * n_jobs, int(workers or os.cpu_count() or 1),
+                                        _busy_cores())
         in_flight = _in_flight(None, backend, workers, None)
     if chunk_size is None:
         chunk_size = min(max(1, math.ceil(target_task_s / per_job)), max(estimate.largest_chunk(in_flight, limit), 1))
