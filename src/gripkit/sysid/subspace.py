@@ -132,9 +132,11 @@ class SubspaceFactor:
         forming W_p: the sum over its k block columns of the shifted signals times M's blocks."""
         k, m, p, j = self.k, self.m, self.p, self.j
         out = np.zeros((j, M.shape[0]))
+        tmp = np.empty_like(out)  # one product buffer for the 2k terms (not 2k j × n temporaries)
         for i in range(k):
-            out += self.us[i:i + j] @ M[:, i * m:(i + 1) * m].T
-            out += self.ys[i:i + j] @ M[:, k * m + i * p:k * m + (i + 1) * p].T
+            np.add(out, np.matmul(self.us[i:i + j], M[:, i * m:(i + 1) * m].T, out=tmp), out=out)
+            np.add(out, np.matmul(self.ys[i:i + j], M[:, k * m + i * p:k * m + (i + 1) * p].T, out=tmp),
+                   out=out)
         return out
 
 
