@@ -48,14 +48,15 @@ def run(quick: bool) -> list[dict]:
     f, H, std, coh = numpy_h1(u, y)
     Hg = r.H[:, 0, 0]
     acc = (f"max |H − H_numpy|/|H| = {np.max(np.abs(Hg - H) / np.abs(H)):.1e}, "
-           f"max |σ/σ_numpy − 1| = {np.max(np.abs(r.H_std[:, 0, 0] / std - 1)):.1e}, max |coh − coh_numpy| = {np.max(np.abs(r.coherence[:, 0] - coh)):.1e}")
+           f"max |σ/σ_numpy − 1| = {np.max(np.abs(r.H_std[:, 0, 0] / std - 1)):.1e}, "
+           f"max |coh − coh_numpy| = {np.max(np.abs(r.coherence[:, 0] - coh)):.1e}")
 
     def scipy_h1():
         _, pyu = signal.csd(u, y, fs=1000.0, nperseg=L)
         _, puu = signal.welch(u, fs=1000.0, nperseg=L)
         return pyu / puu
-    t_g, t_np, t_sp = measure_alternating([lambda: frf(u, y, dt=0.001, nperseg=L), lambda: numpy_h1(u, y),
-                                           scipy_h1])
+    t_g, t_np, t_sp = measure_alternating(
+        [lambda: frf(u, y, dt=0.001, nperseg=L), lambda: numpy_h1(u, y), scipy_h1])
     lab = "FRF (Welch H1 with σ and coherence), 1e6 samples, 4096-sample Hann segments"
     return [row("frf", lab, t_g, "numpy strided rfft route (H1, σ, coherence)", t_np,
                 target="≤ 1.1× the numpy route", gripkit_accuracy=acc,

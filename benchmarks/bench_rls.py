@@ -4,8 +4,8 @@ the same, fixed size with the same symmetric P update: what an expert would writ
 
 The reference (``_plain_rls``) knows p = 6 at compile time, updates the upper triangle of P and
 mirrors it (as gripkit does, so both keep P exactly symmetric and give the same θ to rounding),
-and tracks the same noise variance (V, w₁, w₂) for σ. Rows: with θ and σ history (``rls()``, the
-full user call: checks, history, errors, result object), without history
+and tracks the same noise variance (V, w₁, w₂) for σ. Rows: with θ and σ history (``rls()``,
+the full user call: checks, history, errors, result object), without history
 (``RLS(...).run(store=False)``), and the streaming ``RLS.update`` from a Python loop beside a
 numba step function on one state array. All runs alternate (``measure_alternating``), BLAS on one
 thread, median and min of 7.
@@ -114,7 +114,7 @@ def _plain_step(s, u, y, lam):  # pragma: no cover - compiled
 
 
 def run(quick: bool) -> list[dict]:
-    """The three rows; ``quick``: N = 1e5 and 2·10⁴ streaming calls instead of 1e6 and 2·10⁵."""
+    """The three rows; ``quick``: N = 1e5 and 2·10⁴ streaming calls (else 1e6 and 2·10⁵)."""
     from gripkit.sysid import RLS, rls
 
     n = 100_000 if quick else 1_000_000
@@ -124,7 +124,8 @@ def run(quick: bool) -> list[dict]:
     hist = (np.empty((n, 6)), np.empty((n, 6)))
     th, _ = _plain_rls(u, y, LAM, P0, *hist)
     acc = (f"max |θ_N − θ_plain| = {np.max(np.abs(res.theta_final - th)):.1e}, "
-           f"max |σ − σ_plain| over the history = {np.nanmax(np.abs(res.theta_std[10:] - hist[1][10:])):.1e}")
+           f"max |σ − σ_plain| over the history = "
+           f"{np.nanmax(np.abs(res.theta_std[10:] - hist[1][10:])):.1e}")
     none = np.empty((0, 6))
     t_g, t_p, t_g0, t_p0 = measure_alternating([
         lambda: rls(u, y, 3, 3, 1, forgetting=LAM, p0=P0, windup="none"),
@@ -132,10 +133,12 @@ def run(quick: bool) -> list[dict]:
         lambda: RLS(3, 3, 1, forgetting=LAM, p0=P0, windup="none").run(u, y, store=False),
         lambda: _plain_rls(u, y, LAM, P0, none, none)])
     target = "≥ 0.9× the plain numba RLS (ratio ≥ 0.9)"
-    rows = [row("rls", lab + ", θ and σ history", t_g, "plain numba RLS, p = 6 fixed, symmetric P, history",
-                t_p, target=target, gripkit_accuracy=acc,
-                notes="rls(): checks, history arrays, a-priori errors, result object; windup='none' as the peer"),
-            row("rls", lab + ", no history", t_g0, "plain numba RLS, p = 6 fixed, symmetric P, no history", t_p0,
+    peer = "plain numba RLS, p = 6 fixed, symmetric P"
+    rows = [row("rls", lab + ", θ and σ history", t_g, peer + ", history", t_p, target=target,
+                gripkit_accuracy=acc,
+                notes="rls(): checks, history arrays, a-priori errors, result object; "
+                      "windup='none' as the peer"),
+            row("rls", lab + ", no history", t_g0, peer + ", final θ and σ only", t_p0,
                 target=target, gripkit_accuracy=acc, notes="RLS(...).run(u, y, store=False)")]
     k = 20_000 if quick else 200_000
     us, ys = u[:k].tolist(), y[:k].tolist()
@@ -154,9 +157,10 @@ def run(quick: bool) -> list[dict]:
             _plain_step(st, a, b, LAM)
     t_s, t_ps = measure_alternating([stream, plain_stream])
     rows.append(row("rls", "streaming RLS.update(u, y), [3 3 1] (per call)", t_s / k,
-                    "plain numba step function (p = 6 fixed, symmetric P) called from Python", t_ps / k,
-                    target=target, notes=f"{k} calls from a Python loop per run; gripkit's update also "
-                                          "refuses non-finite samples and keeps θ, P recoverable"))
+                    "plain numba step (p = 6 fixed, symmetric P) called from Python", t_ps / k,
+                    target=target,
+                    notes=f"{k} calls from a Python loop per run; gripkit's update also refuses "
+                          "non-finite samples and keeps θ, P recoverable"))
     return rows
 
 

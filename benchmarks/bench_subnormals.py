@@ -85,7 +85,8 @@ def run(quick: bool) -> list[dict]:
 
     ok, why = available()
     if not ok:  # pragma: no cover - x86-64 Linux with a C compiler here
-        return [row("subnormals", "FTZ/DAZ set vs cleared", None, "", None, notes=f"not run: {why}")]
+        return [row("subnormals", "FTZ/DAZ set vs cleared", None, "", None,
+                    notes=f"not run: {why}")]
     from gripkit.lti import simulate_ss
     from gripkit.sysid import n4sid
     from gripkit.sysid.pem_ss import _directions, _predict_states, _sensitivity_gram
@@ -102,8 +103,8 @@ def run(quick: bool) -> list[dict]:
 
     def add(task, fn, final, notes):
         t_clear, t_set = measure_alternating(list(_pair(fn)))
-        rows.append(row("subnormals", f"{task}, N=1e5", t_clear, "same kernel with FTZ/DAZ set", t_set,
-                        target=TARGET, notes=f"{notes}; CPU: {cpu}",
+        rows.append(row("subnormals", f"{task}, N=1e5", t_clear, "same kernel with FTZ/DAZ set",
+                        t_set, target=TARGET, notes=f"{notes}; CPU: {cpu}",
                         extra={"subnormal_entries_in_final_state": _subnormals(final), "cpu": cpu}))
 
     cols = n * m + n
@@ -114,7 +115,7 @@ def run(quick: bool) -> list[dict]:
     G2, r2 = np.empty((cols, cols)), np.empty(cols)
     old = lambda: _bdx_unflushed(A, C, u, y, G2, r2)  # noqa: E731
     add("the same B/x0 kernel without flushing (before issue 24)", old, old(),
-        f"reference copy in this file; its sums equal the flushed kernel's: {np.array_equal(G, G2)}")
+        f"reference copy in this file; sums equal to the flushed kernel's: {np.array_equal(G, G2)}")
     for form, K in (("oe", np.zeros((n, p))), ("innovation", model.K / 1.0)):
         Kw = np.ascontiguousarray(K)
         B, D, x0 = s.B, np.zeros((p, m)), np.zeros(n) if model.x0 is None else model.x0
@@ -125,8 +126,8 @@ def run(quick: bool) -> list[dict]:
         H, gv = np.empty((Q, Q)), np.empty(Q)
         Abar = np.ascontiguousarray(A - Kw @ C)
         gram = lambda: _sensitivity_gram(Abar, C, Kw, ent, n, X, u, e, H, gv)  # noqa: E731
-        add(f"PEM sensitivity Gram ({form}, pem_ss._sensitivity_gram), {Q} directions", gram, gram(),
-            "flushes carried entries below 1e-280")
+        add(f"PEM sensitivity Gram ({form}, pem_ss._sensitivity_gram), {Q} directions", gram,
+            gram(), "flushes carried entries below 1e-280")
     x = np.empty(n)
     yo = np.empty((N, p))
     z = np.zeros((N, 1))

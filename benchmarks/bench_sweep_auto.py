@@ -28,10 +28,11 @@ def run(quick: bool) -> list[dict]:
         t_auto, t_in = measure_alternating(
             [auto, lambda: sweep(spec, backend="in-process", progress=False)], runs=5)
         pooled = sum("process pool" in c for c in choices)
-        rows.append(row("batch: sweep auto", f"sweep of {n} short jobs, backend auto, end to end", t_auto,
-                        "in-process", t_in, target="ratio ≥ 1 (never slower than in-process)",
-                        notes=f"load average {load:.1f} on {os.cpu_count()} cores; the pool chosen in "
-                              f"{pooled} of {len(choices)} runs; last choice: {choices[-1]}"))
+        rows.append(row("batch: sweep auto", f"sweep of {n} short jobs, backend auto, end to end",
+                        t_auto, "in-process", t_in,
+                        target="ratio ≥ 1 (never slower than in-process)",
+                        notes=f"load average {load:.1f} on {os.cpu_count()} cores; the pool chosen "
+                              f"in {pooled} of {len(choices)} runs; last choice: {choices[-1]}"))
     return rows
 
 

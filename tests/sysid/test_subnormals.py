@@ -3,18 +3,21 @@ arithmetic takes a microcode assist on Intel CPUs (each multiply ~100 cycles): a
 x ← A x of a stable A sinks into that range and, for a non-normal A, stays there in a rounding
 limit cycle. The kernels flush carried entries below 1e-280 to zero (gripkit.lti.flush_tiny):
 what is left of a decayed response then stays below Σ‖Aᵏ‖·1e-280·√n (normal numbers), and the
-sums the kernels accumulate equal the formed regressor's products at the usual rounding level. CPU-independent: the tests look at the numbers, not at timings."""
+sums the kernels accumulate equal the formed regressor's products at the usual rounding level.
+CPU-independent: the tests look at the numbers, not at timings."""
 
 import numpy as np
 import pytest
 
 from gripkit.lti import flush_tiny, simulate_ss
 from gripkit.sysid.linear_model import observability_regressor
-from gripkit.sysid.pem_ss import _directions, _predict_sensitivity, _predict_states, _sensitivity_gram
+from gripkit.sysid.pem_ss import (_directions, _predict_sensitivity, _predict_states,
+                                  _sensitivity_gram)
 from gripkit.sysid.subspace import _bdx_normal_equations, _bdx_regressor
 
 TINY = np.finfo(np.float64).tiny  # 2.2250738585072014e-308, the smallest normal number
-N_LONG = 30_000  # 0.95**t < 1e-308 from t ≈ 13 800: the free responses spend > half the record there
+#: 0.95**t < 1e-308 from t ≈ 13 800: the free responses spend more than half the record there
+N_LONG = 30_000
 
 
 def _subnormal(a) -> int:

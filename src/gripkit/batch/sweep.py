@@ -190,8 +190,8 @@ def _auto_backend(work_s: float, workers: int, busy: float = 0.0,
     w = max(1.0, min(float(workers), cores - busy))
     load = f", {busy:.1f} of {cores} cores busy" if busy > 0 else ""
     if workers <= 1 or work_s <= POOL_STARTUP_S + work_s / w:
-        return "in-process", (f"backend auto: in-process, the estimated work ({work_s:.2g} s) is too small "
-                              f"for a pool of {workers} to win back its start-up "
+        return "in-process", (f"backend auto: in-process, the estimated work ({work_s:.2g} s) is "
+                              f"too small for a pool of {workers} to win back its start-up "
                               f"(~{POOL_STARTUP_S:g} s{load})")
     return "process", (f"backend auto: process pool of {workers}, the estimated work ({work_s:.2g} s) "
                        f"outweighs its start-up (~{POOL_STARTUP_S:g} s{load})")

@@ -153,7 +153,8 @@ def _h1(u, y, dt, nperseg):
     f = np.fft.rfftfreq(L, dt)
     Suu = _cross_spectra(Ur, Ui, Ur, Ui)
     Syu = _cross_spectra(Yr, Yi, Ur, Ui)
-    Syy = np.stack([_sum_products(Yr[i], Yr[i]) + _sum_products(Yi[i], Yi[i]) for i in range(p)], axis=1)
+    Syy = np.stack([_sum_products(Yr[i], Yr[i]) + _sum_products(Yi[i], Yi[i]) for i in range(p)],
+                   axis=1)
     pu = np.real(np.einsum("fii->fi", Suu))
     bad = np.any(pu <= _NO_POWER * pu.max(axis=0), axis=1)
     good = ~bad

@@ -135,8 +135,8 @@ class SubspaceFactor:
         tmp = np.empty_like(out)  # one product buffer for the 2k terms (not 2k j × n temporaries)
         for i in range(k):
             np.add(out, np.matmul(self.us[i:i + j], M[:, i * m:(i + 1) * m].T, out=tmp), out=out)
-            np.add(out, np.matmul(self.ys[i:i + j], M[:, k * m + i * p:k * m + (i + 1) * p].T, out=tmp),
-                   out=out)
+            My = M[:, k * m + i * p:k * m + (i + 1) * p]
+            np.add(out, np.matmul(self.ys[i:i + j], My.T, out=tmp), out=out)
         return out
 
 
