@@ -65,9 +65,12 @@ SPECIALISE_ABOVE = 100_000
 
 
 @njit(cache=True, inline="always")
-def _core(P, th, phi, q, p, size, lam, mode, maxtr, trace, y):
-    """One RLS update of θ (``th``, shape (p,)) and P (``P``, row-major (p·p,)) for regressor
-    ``phi`` and output ``y``; ``q`` is a work vector. Returns (a-priori error, r = φᵀPφ, trace).
+def _core(Pb, oP, thb, oth, phb, oph, qb, oq, p, size, lam, mode, maxtr, trace, y):
+    """One RLS update of θ (``thb[oth:oth + p]``) and P (``Pb[oP:oP + p·p]``, row-major) for the
+    regressor ``phb[oph:oph + p]`` and output ``y``; ``qb[oq:oq + p]`` is work space. Returns
+    (a-priori error, r = φᵀPφ, trace). The batch kernel passes one local buffer four times with
+    constant offsets (the compiler then sees that the vectors do not overlap), the streaming step
+    views of its state vector at offset 0.
 
     ``size``: an empty tuple (p at run time) or a tuple of p zeros (p known to the compiler, loops
     unrolled). The covariance update is ``P ← (P + coef·q qᵀ)·scale`` with ``q = Pφ`` (see the
@@ -77,17 +80,17 @@ def _core(P, th, phi, q, p, size, lam, mode, maxtr, trace, y):
         p = len(size)
     yhat = 0.0
     for i in range(p):
-        yhat += phi[i] * th[i]
+        yhat += phb[oph + i] * thb[oth + i]
     e = y - yhat
     for i in range(p):  # q = Pφ, row i of P (= its column: P is exactly symmetric), j ascending
-        row = i * p
+        row = oP + i * p
         acc = 0.0
         for j in range(p):
-            acc += P[row + j] * phi[j]
-        q[i] = acc
+            acc += Pb[row + j] * phb[oph + j]
+        qb[oq + i] = acc
     r = 0.0
     for i in range(p):
-        r += phi[i] * q[i]
+        r += phb[oph + i] * qb[oq + i]
     if mode == 2 and r <= 1e-12 * trace:  # directional, no new direction: no forgetting
         inv = 1.0 / (1.0 + r)
         coef, scale = -inv, 1.0
@@ -99,20 +102,20 @@ def _core(P, th, phi, q, p, size, lam, mode, maxtr, trace, y):
         coef, scale = -inv, 1.0 / lam
     g = e * inv
     for i in range(p):
-        th[i] += q[i] * g
+        thb[oth + i] += qb[oq + i] * g
     tr = 0.0
     for i in range(p):  # P stays exactly symmetric: update the upper triangle, mirror it
-        qi = coef * q[i]
-        row = i * p
+        qi = coef * qb[oq + i]
+        row = oP + i * p
         for j in range(i, p):
-            v = (P[row + j] + qi * q[j]) * scale
-            P[row + j] = v
-            P[j * p + i] = v
-        tr += P[row + i]
+            v = (Pb[row + j] + qi * qb[oq + j]) * scale
+            Pb[row + j] = v
+            Pb[oP + j * p + i] = v
+        tr += Pb[row + i]
     if mode == 1 and tr > maxtr:  # bounded trace
         f = maxtr / tr
         for k in range(p * p):
-            P[k] *= f
+            Pb[oP + k] *= f
         tr = maxtr
     return e, r, tr
 
@@ -151,8 +154,8 @@ def _rls_step(s, u, y):
         for i in range(p + p * p):
             s[ob + i] = s[oth + i]
         lam = s[_LAM]
-        e, r, tr = _core(s[op:oph], s[oth:op], s[oph:oq], s[oq:oq + p], p, (), lam, int(s[_MODE]),
-                         s[_MAXTR], s[_TRACE], y)
+        e, r, tr = _core(s[op:oph], 0, s[oth:op], 0, s[oph:oq], 0, s[oq:oq + p], 0, p, (), lam,
+                         int(s[_MODE]), s[_MAXTR], s[_TRACE], y)
         ok = math.isfinite(tr) and math.isfinite(e)
         for i in range(p):
             ok = ok and math.isfinite(s[oth + i])
@@ -224,14 +227,13 @@ def _rls_run(s, u, y, theta_out, std_out, yhat_out, size):
                 std_out[t, i] = math.sqrt(f * s[op + i * p + i])
     if n <= nstart:
         return
-    th = np.empty(p)
-    P = np.empty(p * p)
+    # P, θ, φ and q in one local buffer at constant offsets (for the compiler: no aliasing)
+    bP, bth, bph, bq = 0, p * p, p * p + p, p * p + 2 * p
+    w = np.empty(p * p + 3 * p)
     for i in range(p):  # explicit loops: slice assignment costs seconds of numba compile time
-        th[i] = s[oth + i]
+        w[bth + i] = s[oth + i]
     for i in range(p * p):
-        P[i] = s[op + i]
-    phi = np.empty(p)
-    q = np.empty(p)
+        w[bP + i] = s[op + i]
     lam = s[_LAM]
     mode = int(s[_MODE])
     maxtr = s[_MAXTR]
@@ -242,10 +244,18 @@ def _rls_run(s, u, y, theta_out, std_out, yhat_out, size):
     nupd = s[_NUPD]
     for t in range(nstart, n):
         for i in range(na):
-            phi[i] = -y[t - 1 - i]
+            w[bph + i] = -y[t - 1 - i]
         for j in range(nb):
-            phi[na + j] = u[t - nk - j]
-        e, r, trace = _core(P, th, phi, q, p, size[0], lam, mode, maxtr, trace, y[t])
+            w[bph + na + j] = u[t - nk - j]
+        if mode == 0:  # the mode as a literal: its branches fold away in each copy
+            e, r, trace = _core(w, bP, w, bth, w, bph, w, bq, p, size[0], lam, 0, maxtr, trace,
+                                    y[t])
+        elif mode == 1:
+            e, r, trace = _core(w, bP, w, bth, w, bph, w, bq, p, size[0], lam, 1, maxtr, trace,
+                                    y[t])
+        else:
+            e, r, trace = _core(w, bP, w, bth, w, bph, w, bq, p, size[0], lam, 2, maxtr, trace,
+                                    y[t])
         V = lam * (V + e * e / (lam + r))
         w1 = lam * w1 + 1.0
         w2 = lam * lam * w2 + 1.0
@@ -255,12 +265,12 @@ def _rls_run(s, u, y, theta_out, std_out, yhat_out, size):
         if store:
             f = V / (w1 - p) * (w2 / w1) if (nupd > p and w1 > p) else np.nan
             for i in range(p):
-                theta_out[t, i] = th[i]
-                std_out[t, i] = math.sqrt(f * P[i * p + i])
+                theta_out[t, i] = w[bth + i]
+                std_out[t, i] = math.sqrt(f * w[bP + i * p + i])
     for i in range(p):
-        s[oth + i] = th[i]
+        s[oth + i] = w[bth + i]
     for i in range(p * p):
-        s[op + i] = P[i]
+        s[op + i] = w[bP + i]
     s[_TRACE] = trace
     s[_V] = V
     s[_W1] = w1
