@@ -14,6 +14,7 @@ thread, median and min of 7.
 from __future__ import annotations
 
 import math
+import time
 
 import numpy as np
 from common import measure_alternating, row
@@ -127,19 +128,26 @@ def run(quick: bool) -> list[dict]:
            f"max |σ − σ_plain| over the history = "
            f"{np.nanmax(np.abs(res.theta_std[10:] - hist[1][10:])):.1e}")
     none = np.empty((0, 6))
-    t_g, t_p, t_g0, t_p0 = measure_alternating([
-        lambda: rls(u, y, 3, 3, 1, forgetting=LAM, p0=P0, windup="none"),
-        lambda: _plain_rls(u, y, LAM, P0, np.empty((n, 6)), np.empty((n, 6))),
-        lambda: RLS(3, 3, 1, forgetting=LAM, p0=P0, windup="none").run(u, y, store=False),
-        lambda: _plain_rls(u, y, LAM, P0, none, none)])
+    batch = [lambda: rls(u, y, 3, 3, 1, forgetting=LAM, p0=P0, windup="none"),
+             lambda: _plain_rls(u, y, LAM, P0, np.empty((n, 6)), np.empty((n, 6))),
+             lambda: RLS(3, 3, 1, forgetting=LAM, p0=P0, windup="none").run(u, y, store=False),
+             lambda: _plain_rls(u, y, LAM, P0, none, none)]
+    t_g, t_p, t_g0, t_p0 = measure_alternating(batch)
+    cpu = measure_alternating(batch, clock=time.thread_time)  # steadier under load
+
+    def cpu_note(a, b):
+        return {"cpu_time_s": [cpu[a].median, cpu[a].min],
+                "peer_cpu_time_s": [cpu[b].median, cpu[b].min],
+                "cpu_ratio_of_minima": cpu[b].min / cpu[a].min}
     target = "≥ 0.9× the plain numba RLS (ratio ≥ 0.9)"
     peer = "plain numba RLS, p = 6 fixed, symmetric P"
     rows = [row("rls", lab + ", θ and σ history", t_g, peer + ", history", t_p, target=target,
                 gripkit_accuracy=acc,
                 notes="rls(): checks, history arrays, a-priori errors, result object; "
-                      "windup='none' as the peer"),
+                      "windup='none' as the peer", extra=cpu_note(0, 1)),
             row("rls", lab + ", no history", t_g0, peer + ", final θ and σ only", t_p0,
-                target=target, gripkit_accuracy=acc, notes="RLS(...).run(u, y, store=False)")]
+                target=target, gripkit_accuracy=acc, notes="RLS(...).run(u, y, store=False)",
+                extra=cpu_note(2, 3))]
     k = 20_000 if quick else 200_000
     us, ys = u[:k].tolist(), y[:k].tolist()
     est = RLS(3, 3, 1, forgetting=LAM, p0=P0, windup="none")
@@ -156,11 +164,15 @@ def run(quick: bool) -> list[dict]:
         for a, b in zip(us, ys):
             _plain_step(st, a, b, LAM)
     t_s, t_ps = measure_alternating([stream, plain_stream])
+    c_s, c_ps = measure_alternating([stream, plain_stream], clock=time.thread_time)
     rows.append(row("rls", "streaming RLS.update(u, y), [3 3 1] (per call)", t_s / k,
                     "plain numba step (p = 6 fixed, symmetric P) called from Python", t_ps / k,
                     target=target,
                     notes=f"{k} calls from a Python loop per run; gripkit's update also refuses "
-                          "non-finite samples and keeps θ, P recoverable"))
+                          "non-finite samples and keeps θ, P recoverable",
+                    extra={"cpu_time_s": [c_s.median / k, c_s.min / k],
+                           "peer_cpu_time_s": [c_ps.median / k, c_ps.min / k],
+                           "cpu_ratio_of_minima": c_ps.min / c_s.min}))
     return rows
 
 
