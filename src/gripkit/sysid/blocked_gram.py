@@ -11,7 +11,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ..lti._kernels import flush_tiny
+from ..lti import flush_tiny
 
 __all__ = ["add_rows", "carry", "row_product", "carried_states", "start_sums"]
 
