@@ -11,7 +11,7 @@ from common import measure_alternating, row
 
 
 def run(quick: bool) -> list[dict]:
-    """Rows for 4000 and 8000 jobs (``quick``: 4000 only); 5 alternating runs each."""
+    """Rows for 4000 and 8000 jobs (``quick``: 4000 only); 9 alternating runs each."""
     from gripkit.batch import SweepSpec, sweep
 
     rows = []
@@ -26,7 +26,7 @@ def run(quick: bool) -> list[dict]:
             choices.append(sweep(spec, backend="auto", progress=False).choice)
         load = os.getloadavg()[0]
         t_auto, t_in = measure_alternating(
-            [auto, lambda: sweep(spec, backend="in-process", progress=False)], runs=5)
+            [auto, lambda: sweep(spec, backend="in-process", progress=False)], runs=9)
         pooled = sum("process pool" in c for c in choices)
         rows.append(row("batch: sweep auto", f"sweep of {n} short jobs, backend auto, end to end",
                         t_auto, "in-process", t_in,
