@@ -190,12 +190,13 @@ def _var_factor(s, p):
 
 
 @njit(cache=True)
-def _rls_run(s, u, y, theta_out, std_out, yhat_out, size):
-    """Batch RLS: updates ``s`` over the record; writes θ, σ and the a-priori prediction at
-    every step when the output arrays have N rows (pass arrays with 0 rows to skip storing).
+def _rls_run(s, u, y, theta_out, std_out, yhat_out, err_out, size):
+    """Batch RLS: updates ``s`` over the record; writes θ and σ at every step when their arrays
+    have N rows (pass arrays with 0 rows to skip storing), and the a-priori prediction ŷ and error
+    y − ŷ (``err_out``, computed from the stored ŷ) when ``yhat_out`` has N rows.
 
     ``size``: four empty tuples (generic kernel, orders read from ``s`` at run time) or tuples of
-    p, na, nb and nk zeros (:func:`_specialised`), whose lengths numba knows at compile time: it
+    p, na, nb and nk zeros (:meth:`RLS._kernel_size`), whose lengths numba knows at compile time: it
     compiles (and caches) one kernel per model structure, with unrolled p-loops and constant
     regressor indices (measured 1.5–2× faster); :meth:`RLS.run` uses it for records of at least
     :data:`SPECIALISE_ABOVE` samples, where the extra compilation (1–2 s, once) pays off. The first
@@ -219,7 +220,9 @@ def _rls_run(s, u, y, theta_out, std_out, yhat_out, size):
     for t in range(nstart):
         e = _rls_step(s, u[t], y[t])
         if pred:
-            yhat_out[t] = y[t] - e
+            yh = y[t] - e
+            yhat_out[t] = yh
+            err_out[t] = y[t] - yh  # y − ŷ as stored (bit-identical to the arrays' difference)
         if store:
             f = _var_factor(s, p)
             for i in range(p):
@@ -261,7 +264,9 @@ def _rls_run(s, u, y, theta_out, std_out, yhat_out, size):
         w2 = lam * lam * w2 + 1.0
         nupd += 1.0
         if pred:
-            yhat_out[t] = y[t] - e
+            yh = y[t] - e
+            yhat_out[t] = yh
+            err_out[t] = y[t] - yh  # y − ŷ as stored (bit-identical to the arrays' difference)
         if store:
             f = V / (w1 - p) * (w2 / w1) if (nupd > p and w1 > p) else np.nan
             for i in range(p):
@@ -526,11 +531,11 @@ class RLS:
         theta = np.empty((rows, p))
         std = np.empty((rows, p))
         yhat = np.empty(n)
+        e = np.empty(n)
         n0 = self.n_updates
-        _rls_run(self._s, u, y, theta, std, yhat, self._kernel_size(n))
+        _rls_run(self._s, u, y, theta, std, yhat, e, self._kernel_size(n))
         if not (np.isfinite(self.P).all() and np.isfinite(self.theta).all()):
             raise self._diverged(f"after {self.n_updates} updates")
-        e = y - yhat
         nupd = self.n_updates - n0
         if nupd == 0:
             raise DataError(f"RLS [{self.na} {self.nb} {self.nk}] made no update on {n} samples",
