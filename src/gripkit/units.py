@@ -12,8 +12,10 @@ where values enter or leave: parameter files, column headers, CLI options and re
 from __future__ import annotations
 
 import functools
+import importlib.util
 import math
 import re
+import sys
 
 from .errors import ParameterError
 
@@ -33,9 +35,31 @@ _ALIASES = {
 }
 
 
+def _import_pint():
+    """pint, imported without dask: ``pint.compat`` imports ``dask.base`` (0.1 s) whenever dask is
+    installed, for dask-array quantities gripkit never makes. While pint is first imported (and
+    dask is not yet loaded), ``importlib.util.find_spec`` — which pint.compat binds at import to
+    test ``find_spec("dask")`` — answers None for dask; pint then leaves its dask support out.
+    Everything else, and dask itself when imported later (the sweep backend), is unaffected."""
+    if "pint" in sys.modules or "dask" in sys.modules:
+        import pint
+
+        return pint
+    real = importlib.util.find_spec
+
+    def find_spec(name, package=None):
+        return None if name == "dask" or name.startswith("dask.") else real(name, package)
+    importlib.util.find_spec = find_spec
+    try:
+        import pint
+    finally:
+        importlib.util.find_spec = real
+    return pint
+
+
 @functools.lru_cache(maxsize=1)
 def _registry():
-    import pint
+    pint = _import_pint()
 
     ureg = pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
     ureg.define("PWM = [] = pwm_count")  # motor-driver duty counts (DLR/HIT Hand II: 0..4096)

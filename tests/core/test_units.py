@@ -100,3 +100,18 @@ def test_unit_headers_do_not_import_pint(tmp_path):
     loaded, force, angle = json.loads(out.stdout.strip().splitlines()[-1])
     assert loaded == []
     assert force == 0.5e-3 and angle == pytest.approx(0.1 * 3.141592653589793 / 180, rel=1e-15)
+
+
+def test_pint_fallback_leaves_dask_out():
+    """A unit outside the table (°C) is read by pint, imported without dask (pint.compat would
+    import dask.base, 0.1 s); dask itself still imports afterwards (the sweep backend)."""
+    import json
+    import subprocess
+    import sys
+
+    probe = ("import json, sys\nfrom gripkit.units import si_factor\nf = si_factor('degC')\n"
+             "loaded = [m for m in ('pint', 'dask') if m in sys.modules]\nimport dask\n"
+             "print(json.dumps([loaded, f, dask.__name__]))")
+    out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True, check=True)
+    loaded, factor, name = json.loads(out.stdout.strip().splitlines()[-1])
+    assert loaded == ["pint"] and factor == [1.0, 273.15, "K"] and name == "dask"
