@@ -97,3 +97,25 @@ def row(benchmark: str, task: str, gripkit_s, peer: str, peer_s, *, target: str 
                 peer=peer, peer_s=p_med, peer_min_s=p_min, peer_runs=p_runs, ratio=ratio, target=target,
                 unit=unit, gripkit_accuracy=gripkit_accuracy, peer_accuracy=peer_accuracy,
                 pure_python_peer=pure_python_peer, notes=notes, extra=extra or {})
+
+
+def measure_alternating(fns: list[Callable[[], object]], runs: int = REPEAT,
+                        clock: Callable[[], float] = time.perf_counter) -> list[Timing]:
+    """Time several callables in turn (f0 f1 … f0 f1 …, after one warm-up call each), so that a
+    drift of the machine's speed touches all of them alike; seconds per call, median and min.
+    ``clock=time.thread_time`` counts this thread's CPU time only (steadier on a loaded machine,
+    blind to waiting and to other threads)."""
+    for fn in fns:
+        fn()
+    times: list[list[float]] = [[] for _ in fns]
+    gc.collect()
+    gc.disable()
+    try:
+        for _ in range(runs):
+            for k, fn in enumerate(fns):
+                t0 = clock()
+                fn()
+                times[k].append(clock() - t0)
+    finally:
+        gc.enable()
+    return [Timing(statistics.median(t), min(t), runs) for t in times]

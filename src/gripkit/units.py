@@ -12,8 +12,10 @@ where values enter or leave: parameter files, column headers, CLI options and re
 from __future__ import annotations
 
 import functools
+import importlib.util
 import math
 import re
+import sys
 
 from .errors import ParameterError
 
@@ -33,9 +35,31 @@ _ALIASES = {
 }
 
 
+def _import_pint():
+    """pint, imported without dask: ``pint.compat`` imports ``dask.base`` (0.1 s) whenever dask is
+    installed, for dask-array quantities gripkit never makes. While pint is first imported (and
+    dask is not yet loaded), ``importlib.util.find_spec`` — which pint.compat binds at import to
+    test ``find_spec("dask")`` — answers None for dask; pint then leaves its dask support out.
+    Everything else, and dask itself when imported later (the sweep backend), is unaffected."""
+    if "pint" in sys.modules or "dask" in sys.modules:
+        import pint
+
+        return pint
+    real = importlib.util.find_spec
+
+    def find_spec(name, package=None):
+        return None if name == "dask" or name.startswith("dask.") else real(name, package)
+    importlib.util.find_spec = find_spec
+    try:
+        import pint
+    finally:
+        importlib.util.find_spec = real
+    return pint
+
+
 @functools.lru_cache(maxsize=1)
 def _registry():
-    import pint
+    pint = _import_pint()
 
     ureg = pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
     ureg.define("PWM = [] = pwm_count")  # motor-driver duty counts (DLR/HIT Hand II: 0..4096)
@@ -76,11 +100,113 @@ _PREFERRED = ("m", "s", "kg", "A", "K", "mol", "N", "Pa", "J", "W", "V", "C", "F
 _ANGLE = ("rad", "rad/s", "rad/s**2", "N*m/rad", "N*m*s/rad", "rad/V")
 
 
+# Fast path: the common units, parsed without importing pint (0.3–1 s with its dependencies).
+# Dimensions as exponents of (m, kg, s, A, K, mol); radian and degree are dimensionless, as in
+# pint. Scales are 10^(prefix + unit exponent) for decimal units, so that they round as pint's.
+_DIMS = ("m", "kg", "s", "A", "K", "mol")
+_PREFIX = {"G": 9, "M": 6, "k": 3, "h": 2, "da": 1, "d": -1, "c": -2, "m": -3, "u": -6, "n": -9,
+           "p": -12}
+#: unit: (decimal exponent or None, factor when not decimal, dimension exponents, takes prefixes)
+_FAST_UNITS = {
+    "m": (0, 1.0, (1, 0, 0, 0, 0, 0), True), "g": (-3, 1.0, (0, 1, 0, 0, 0, 0), True),
+    "s": (0, 1.0, (0, 0, 1, 0, 0, 0), True), "A": (0, 1.0, (0, 0, 0, 1, 0, 0), True),
+    "K": (0, 1.0, (0, 0, 0, 0, 1, 0), True), "mol": (0, 1.0, (0, 0, 0, 0, 0, 1), True),
+    "N": (0, 1.0, (1, 1, -2, 0, 0, 0), True), "Pa": (0, 1.0, (-1, 1, -2, 0, 0, 0), True),
+    "bar": (5, 1.0, (-1, 1, -2, 0, 0, 0), True), "J": (0, 1.0, (2, 1, -2, 0, 0, 0), True),
+    "W": (0, 1.0, (2, 1, -3, 0, 0, 0), True), "V": (0, 1.0, (2, 1, -3, -1, 0, 0), True),
+    "C": (0, 1.0, (0, 0, 1, 1, 0, 0), True), "ohm": (0, 1.0, (2, 1, -3, -2, 0, 0), True),
+    "F": (0, 1.0, (-2, -1, 4, 2, 0, 0), True),
+    "Hz": (0, 1.0, (0, 0, -1, 0, 0, 0), True), "rad": (0, 1.0, (0, 0, 0, 0, 0, 0), True),
+    "deg": (None, math.pi / 180.0, (0, 0, 0, 0, 0, 0), False),
+    "min": (None, 60.0, (0, 0, 1, 0, 0, 0), False), "h": (None, 3600.0, (0, 0, 1, 0, 0, 0), False),
+}
+_FAST_TOKEN = re.compile(r"^([A-Za-z]+)(?:\^(-?[1-4]))?$")  # a unit and a power (** written ^)
+
+
+def _fast_token(tok: str):
+    """(decimal exponent or None, factor, dims) of one factor such as ``mm``, ``s^2``, or None."""
+    m = _FAST_TOKEN.match(tok)
+    if not m:
+        return None
+    name, power = m.group(1), int(m.group(2) or 1)
+    if name in _FAST_UNITS:
+        exp, fac, dims, _ = _FAST_UNITS[name]
+        pre = 0
+    else:
+        for p in ("da",) + tuple(_PREFIX):
+            base = name[len(p):]
+            if name.startswith(p) and base in _FAST_UNITS and _FAST_UNITS[base][3]:
+                exp, fac, dims, _ = _FAST_UNITS[base]
+                pre = _PREFIX[p]
+                break
+        else:
+            return None
+    return ((exp + pre) * power if exp is not None else None, fac ** power * 10.0 ** (pre * power),
+            tuple(d * power for d in dims))
+
+
+@functools.lru_cache(maxsize=512)
+def _fast_unit(unit: str):
+    """(scale, dims, angular) of ``unit`` from the table above — products of its units with
+    optional integer powers, over at most one ``/``, at most one of them scaled (a prefix, g,
+    bar, deg, min, h) — or None for anything else (pint then)."""
+    norm = _normalise(unit)
+    if norm == "dimensionless":
+        return 1.0, (0,) * len(_DIMS), False
+    if any(c in norm for c in " ()") or norm.count("/") > 1:
+        return None
+    num, slash, den = norm.partition("/")
+    if not num or (slash and not den):
+        return None
+    dec, fac, dims, scaled = 0, 1.0, [0] * len(_DIMS), 0
+    for sign, part in ((1, num), (-1, den)):
+        if not part or (sign == 1 and part == "1"):
+            continue
+        for tok in part.replace("**", "^").split("*"):
+            got = _fast_token(tok)
+            if got is None:
+                return None
+            e, f, d = got
+            scaled += e != 0
+            if scaled > 1:  # pint multiplies several scales in float: its rounding, not 10^Σ
+                return None
+            if e is None:
+                dec = None
+            elif dec is not None:
+                dec += sign * e
+            fac = fac * f if sign == 1 else fac / f
+            dims = [a + sign * b for a, b in zip(dims, d)]
+    scale = 10.0 ** dec if dec is not None else fac
+    angular = any(a in norm for a in ("rad", "deg"))
+    return scale, tuple(dims), angular
+
+
+def _fast_si_factor(unit: str):
+    """:func:`si_factor` from the fast table, or None (then pint)."""
+    got = _fast_unit(unit)
+    if got is None:
+        return None
+    scale, dims, angular = got
+    for c in (_ANGLE if angular else ()) + _PREFERRED:
+        if _fast_unit(c)[1] == dims:
+            return scale, 0.0, c
+    return (scale, 0.0, "1") if not any(dims) else None
+
+
 @functools.lru_cache(maxsize=512)
 def si_factor(unit: str) -> tuple[float, float, str]:
-    """(scale, offset, si_unit_string) such that value_si = scale*value + offset."""
-    if unit == "s":  # a time column's default: the answer pint gives, without importing pint (0.3 s)
-        return 1.0, 0.0, "s"
+    """(scale, offset, si_unit_string) such that value_si = scale*value + offset.
+
+    Common units (SI prefixes × m, g, s, A, K, mol, N, Pa, bar, J, W, V, C, ohm, F, Hz, rad,
+    and deg, min, h; products, integer powers and one ``/``) are read from a table without
+    importing pint (:func:`_fast_si_factor`, tested equal to pint's answer); the rest through
+    pint (:func:`_pint_si_factor`)."""
+    fast = _fast_si_factor(unit)
+    return fast if fast is not None else _pint_si_factor(unit)
+
+
+def _pint_si_factor(unit: str) -> tuple[float, float, str]:
+    """:func:`si_factor` through pint."""
     ureg = _registry()
     u = _parse_unit(unit)
     q0 = ureg.Quantity(0.0, u).to_base_units()
@@ -148,7 +274,11 @@ def convert(value: float, from_unit: str, to_unit: str) -> float:
 
 
 def same_dimension(a: str, b: str) -> bool:
-    """True when ``a`` and ``b`` measure the same physical dimension."""
+    """True when ``a`` and ``b`` measure the same physical dimension (the fast table when it
+    reads both, else pint)."""
+    fa, fb = _fast_unit(a), _fast_unit(b)
+    if fa is not None and fb is not None:
+        return fa[1] == fb[1]
     return _parse_unit(a).dimensionality == _parse_unit(b).dimensionality
 
 

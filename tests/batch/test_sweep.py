@@ -69,8 +69,62 @@ def test_auto_backend_rule_is_the_break_even_of_the_pool():
 
     assert _auto_backend(2.01 * POOL_STARTUP_S, 2)[0] == "process"
     assert _auto_backend(1.99 * POOL_STARTUP_S, 2)[0] == "in-process"
-    assert _auto_backend(1.51 * POOL_STARTUP_S, 3)[0] == "process"
+    assert _auto_backend(1.51 * POOL_STARTUP_S, 3, cores=3)[0] == "process"
     assert _auto_backend(1e6, 1)[0] == "in-process"
+
+
+def test_auto_backend_counts_only_the_cores_the_load_leaves_free():
+    """The pool's speed-up is min(workers, cores − busy), at least 1: 10 s of work on 2 cores
+    wins back the start-up on an idle machine (1.5 + 5 < 10) but not with both cores busy
+    (speed-up 1); with half a core busy the break-even is startup·w/(w−1) at w = 1.5, 4.5 s."""
+    from gripkit.batch.sweep import POOL_STARTUP_S, _auto_backend
+
+    assert _auto_backend(10.0, 2, busy=0.0, cores=2)[0] == "process"
+    name, why = _auto_backend(10.0, 2, busy=2.0, cores=2)
+    assert name == "in-process" and "2.0 of 2 cores busy" in why
+    assert _auto_backend(10.0, 2, busy=3.5, cores=2)[0] == "in-process"
+    assert _auto_backend(3.01 * POOL_STARTUP_S, 2, busy=0.5, cores=2)[0] == "process"
+    assert _auto_backend(2.99 * POOL_STARTUP_S, 2, busy=0.5, cores=2)[0] == "in-process"
+    assert _auto_backend(10.0, 8, busy=0.0, cores=2)[0] == "process"  # 8 workers, 2 cores: w = 2
+
+
+def test_per_job_cost_leaves_out_the_chunk_fixed_cost(monkeypatch):
+    """Issue 24's case with injected timings: every chunk pays 7 ms once (numba's parallel thread
+    launch under load) and 0.05 ms per job. The slope between a 1-job and an 8-job chunk gives
+    the true 0.05 ms; the old t₈/8 gave 0.92 ms, i.e. 7.4 s for 8000 jobs and a pool 4–20× slower
+    than in-process. With the slope, 8000 jobs (0.4 s) stay in-process."""
+    import importlib
+
+    sw = importlib.import_module("gripkit.batch.sweep")  # the module, not the function of that name
+    calls = []
+
+    def fake_warm(args):
+        calls.append(len(args[3]))
+        return 7e-3 + 5e-5 * len(args[3])
+    monkeypatch.setattr(sw, "run_chunk", lambda *args: None)
+    monkeypatch.setattr(sw, "_warm_seconds", fake_warm)
+    per_job = sw._seconds_per_job(lambda r: (None, None, None, list(r), {}, None, False), 8000)
+    assert per_job == pytest.approx(5e-5, rel=1e-9)
+    assert sorted(calls) == [1, 1, 1, 8, 8]
+    assert sw._auto_backend(per_job * 8000, 2, cores=2)[0] == "in-process"
+    old_estimate = (7e-3 + 8 * 5e-5) / 8
+    assert sw._auto_backend(old_estimate * 8000, 2, cores=2)[0] == "process"
+    # slow jobs: one chunk, its fixed cost is small beside them
+    calls.clear()
+    monkeypatch.setattr(sw, "_warm_seconds",
+                        lambda args: calls.append(len(args[3])) or 0.2 * len(args[3]))
+    assert sw._seconds_per_job(lambda r: (None, None, None, list(r), {}, None, False), 100) == 0.2
+    assert calls == [8]
+
+
+def test_per_job_cost_clamped_against_timing_noise():
+    """A noisy 1-job time above the 8-job one gives no negative slope (1e-7 floor), and the
+    slope never exceeds t_k/k, which already includes the fixed cost."""
+    from gripkit.batch.sweep import _per_job_seconds
+
+    assert _per_job_seconds(9e-3, 8e-3, 8) == 1e-7
+    assert _per_job_seconds(1e-4, 8e-3, 8) == pytest.approx(1e-3)  # slope 1.13e-3 capped at 8e-3/8
+    assert _per_job_seconds(0.0, 2e-3, 1) == 2e-3
 
 
 def test_dask_local_cluster_matches_in_process(reference):

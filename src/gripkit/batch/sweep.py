@@ -131,23 +131,70 @@ class SweepResult:
 POOL_STARTUP_S = 1.5
 
 
-def _seconds_per_job(first: tuple) -> float:
-    """Seconds per job, timed on a warm (compiled) run of the first jobs (``first``:
-    :func:`run_chunk`'s arguments for them)."""
-    run_chunk(*first)  # compile
+#: Jobs slower than this are timed on one chunk: a chunk's fixed cost (a few ms) is then small
+#: beside its jobs' own time.
+_EXACT_PER_JOB_S = 0.01
+
+
+def _warm_seconds(args: tuple) -> float:
+    """Wall time of one (already compiled) :func:`run_chunk` call."""
     t0 = time.perf_counter()
-    run_chunk(*first)
-    return max((time.perf_counter() - t0) / len(first[3]), 1e-7)
+    run_chunk(*args)
+    return time.perf_counter() - t0
 
 
-def _auto_backend(work_s: float, workers: int) -> tuple[str, str]:
+def _per_job_seconds(t_one: float, t_k: float, k: int) -> float:
+    """Seconds per job from the warm times of a 1-job chunk (``t_one``) and a k-job chunk
+    (``t_k``): the slope (t_k − t_one)/(k − 1). It leaves out what every chunk pays once — the
+    model's set-up, the launch of numba's parallel threads (5–7 ms on a loaded machine) — which
+    t_k/k counts k times over (issue 24: 0.9 ms per job estimated, 0.03–0.07 ms true). Clamped to
+    [1e-7, t_k/k]: timing noise may make the slope negative, and t_k/k includes the fixed cost."""
+    if k <= 1:
+        return max(t_k, 1e-7)
+    return min(max((t_k - t_one) / (k - 1), 1e-7), max(t_k / k, 1e-7))
+
+
+def _seconds_per_job(chunk_args, n_jobs: int) -> float:
+    """Seconds per job, without the fixed cost of a chunk: the first ``k = min(8, n_jobs)`` jobs
+    are run once to compile, timed, and — when they take less than :data:`_EXACT_PER_JOB_S` each
+    — timed again beside the first job alone (the best of three), for :func:`_per_job_seconds`.
+    ``chunk_args(range)`` gives :func:`run_chunk`'s arguments."""
+    k = min(8, n_jobs)
+    first = chunk_args(range(k))
+    run_chunk(*first)  # compile
+    t_k = _warm_seconds(first)
+    if k <= 1 or t_k / k >= _EXACT_PER_JOB_S:
+        return max(t_k / k, 1e-7)
+    one = chunk_args(range(1))
+    t_one = min(_warm_seconds(one) for _ in range(3))
+    return _per_job_seconds(t_one, min(t_k, _warm_seconds(first)), k)
+
+
+def _busy_cores() -> float:
+    """Cores kept busy by other processes: the 1-minute load average less this process's own
+    (at most 1), 0 where the load is unknown."""
+    try:
+        return max(os.getloadavg()[0] - 1.0, 0.0)
+    except (AttributeError, OSError):  # not on this platform
+        return 0.0
+
+
+def _auto_backend(work_s: float, workers: int, busy: float = 0.0,
+                  cores: int | None = None) -> tuple[str, str]:
     """'in-process' when the estimated work cannot win back the pool's start-up
-    (``work ≤ startup + work / workers``), else 'process'; with the reason for the summary."""
-    if workers <= 1 or work_s <= POOL_STARTUP_S + work_s / workers:
-        return "in-process", (f"backend auto: in-process, the estimated work ({work_s:.2g} s) is too small for "
-                              f"a pool of {workers} to win back its start-up (~{POOL_STARTUP_S:g} s)")
+    (``work ≤ startup + work / w``), else 'process'; with the reason for the summary. ``w``, the
+    pool's speed-up, is the number of workers, but at most the cores (default ``os.cpu_count()``)
+    that other processes leave free (``busy``: their load, :func:`_busy_cores`), and at least 1:
+    on a loaded machine a pool runs no faster than one process."""
+    cores = int(cores or os.cpu_count() or 1)
+    w = max(1.0, min(float(workers), cores - busy))
+    load = f", {busy:.1f} of {cores} cores busy" if busy > 0 else ""
+    if workers <= 1 or work_s <= POOL_STARTUP_S + work_s / w:
+        return "in-process", (f"backend auto: in-process, the estimated work ({work_s:.2g} s) is "
+                              f"too small for a pool of {workers} to win back its start-up "
+                              f"(~{POOL_STARTUP_S:g} s{load})")
     return "process", (f"backend auto: process pool of {workers}, the estimated work ({work_s:.2g} s) "
-                       f"outweighs its start-up (~{POOL_STARTUP_S:g} s)")
+                       f"outweighs its start-up (~{POOL_STARTUP_S:g} s{load})")
 
 
 def _in_flight(executor: Executor | None, backend: str, workers: int | None, scheduler: str | None) -> int:
@@ -164,8 +211,9 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "auto", workers
           scheduler: str | None = None, out: str | Path | None = None, resume: bool = False,
           progress: bool = True, executor: Executor | None = None, target_task_s: float = 0.1,
           allow_code: bool = False, memory_limit: int | float | str | None = None) -> SweepResult:
-    """Run a sweep. ``backend``: 'auto' (default: 'in-process' when the work, estimated from two
-    timed jobs, is too small to win back a process pool's start-up :data:`POOL_STARTUP_S`, else
+    """Run a sweep. ``backend``: 'auto' (default: 'in-process' when the work, estimated from the
+    first jobs timed without a chunk's fixed cost, is too small to win back a process pool's
+    start-up :data:`POOL_STARTUP_S` with the cores the machine's load leaves free, else
     'process'; the summary says which and why), 'process', 'in-process' or 'dask' (``scheduler``
     address or a LocalCluster); ``out``: folder for checkpointed results (required for ``resume``).
 
@@ -206,10 +254,11 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "auto", workers
 
     choice = ""
     auto = backend == "auto" and executor is None and not scheduler
-    # timed on up to 8 jobs: a chunk's fixed cost (model set-up) spread over 2 would inflate it
-    per_job = _seconds_per_job(chunk_args(range(min(8, n_jobs)))) if (chunk_size is None or auto) else None
+    # per job without a chunk's fixed cost (model set-up, parallel thread launch)
+    per_job = _seconds_per_job(chunk_args, n_jobs) if (chunk_size is None or auto) else None
     if auto:
-        backend, choice = _auto_backend(per_job * n_jobs, int(workers or os.cpu_count() or 1))
+        backend, choice = _auto_backend(per_job * n_jobs, int(workers or os.cpu_count() or 1),
+                                        _busy_cores())
         in_flight = _in_flight(None, backend, workers, None)
     if chunk_size is None:
         chunk_size = min(max(1, math.ceil(target_task_s / per_job)), max(estimate.largest_chunk(in_flight, limit), 1))

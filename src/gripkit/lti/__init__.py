@@ -42,12 +42,14 @@ from ._uncertainty import Uncertainty as Uncertainty
 
 __all__ = ["Bode", "Damping", "LinearSystem", "StateSpace", "TransferFunction", "Uncertainty", "as_system",
            "c2d", "c2d_matrices", "d2c", "d2c_matrices", "feedback", "from_control", "from_scipy", "parallel",
-           "series", "simulate_ss", "affine_row"]
+           "series", "simulate_ss", "affine_row", "flush_tiny"]
 
 if TYPE_CHECKING:
     from ._kernels import affine_row as affine_row
+    from ._kernels import flush_tiny as flush_tiny
     from ._kernels import simulate_ss as simulate_ss
 
 # the numba kernel loads on first use (numba's import is 0.2 s of a fresh process)
 __getattr__, __dir__ = lazy_exports(__name__, {"simulate_ss": ("_kernels", "simulate_ss"),
-                                                  "affine_row": ("_kernels", "affine_row")})
+                                                  "affine_row": ("_kernels", "affine_row"),
+                                                  "flush_tiny": ("_kernels", "flush_tiny")})

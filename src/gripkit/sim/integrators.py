@@ -31,6 +31,7 @@ import numba
 import numpy as np
 
 from ..errors import ModelError
+from ..lti import flush_tiny
 from .steps import check_step
 
 __all__ = ["rk4_lti_step", "rk4_msd_step", "semi_implicit_msd_step", "lti_step", "zoh_levels", "zoh_levels_into",
@@ -54,7 +55,8 @@ def lti_rhs(A, B, x, u, out):  # pragma: no cover - compiled
 
 @numba.njit(cache=True)
 def rk4_lti_step(A, B, x, u, h, k1, k2, k3, k4, tmp):  # pragma: no cover - compiled
-    """One classical RK4 step of ẋ = A x + B u (u held), in place on ``x``; k1..k4, tmp: work (n,)."""
+    """One classical RK4 step of ẋ = A x + B u (u held), in place on ``x``; k1..k4, tmp: work (n,).
+    Entries of x below 1e-280 are carried as zero (:func:`gripkit.lti.flush_tiny`)."""
     n = x.shape[0]
     lti_rhs(A, B, x, u, k1)
     for i in range(n):
@@ -66,8 +68,8 @@ def rk4_lti_step(A, B, x, u, h, k1, k2, k3, k4, tmp):  # pragma: no cover - comp
     for i in range(n):
         tmp[i] = x[i] + h * k3[i]
     lti_rhs(A, B, tmp, u, k4)
-    for i in range(n):
-        x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+    for i in range(n):  # entries below 1e-280 carried as zero (gripkit.lti.flush_tiny)
+        x[i] = flush_tiny(x[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]))
 
 
 @numba.njit(cache=True)
@@ -96,10 +98,12 @@ def semi_implicit_msd_step(x, v, F, m, b, k, h):  # pragma: no cover - compiled
 
 @numba.njit(cache=True, inline="always")
 def lti_step(Phi, Gam, x, u, xt):  # pragma: no cover - compiled
-    """Exact ZOH step x ← Φ x + Γ u (``xt``: work array (n,))."""
+    """Exact ZOH step x ← Φ x + Γ u (``xt``: work array (n,)); entries below 1e-280 are carried as
+    zero (:func:`gripkit.lti.flush_tiny`: an unforced response would otherwise sink into the
+    subnormal range, slow on Intel CPUs; outputs of order one are unchanged)."""
     lti_rhs(Phi, Gam, x, u, xt)
     for i in range(x.shape[0]):
-        x[i] = xt[i]
+        x[i] = flush_tiny(xt[i])
 
 
 @numba.njit(cache=True)

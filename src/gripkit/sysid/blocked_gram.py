@@ -1,15 +1,19 @@
 """Numba steps shared by the kernels that accumulate normal equations without forming their
 regressor (:func:`gripkit.sysid.subspace._bdx_normal_equations`,
 :func:`gripkit.sysid.pem_ss._sensitivity_gram`): the state matrix their responses are carried in,
-a row of a small matrix product over contiguous columns, and a block of collected rows added to
-ΦᵀΦ and Φᵀy by BLAS."""
+a row of a small matrix product over contiguous columns, the copy of the next state into the
+carried one (entries below 1e-280 flushed to zero, :func:`gripkit.lti.flush_tiny`: the free
+responses of the initial-state columns decay into the subnormal range otherwise), and a block of
+collected rows added to ΦᵀΦ and Φᵀy by BLAS."""
 
 from __future__ import annotations
 
 import numba
 import numpy as np
 
-__all__ = ["add_rows", "row_product", "carried_states", "start_sums"]
+from ..lti import flush_tiny
+
+__all__ = ["add_rows", "carry", "row_product", "carried_states", "start_sums"]
 
 
 @numba.njit(cache=True, inline="always")
@@ -22,6 +26,16 @@ def row_product(M, i, S, out):  # pragma: no cover - compiled
         sj = S[j]
         for q in range(out.shape[0]):
             out[q] += a * sj[q]
+
+
+@numba.njit(cache=True, inline="always")
+def carry(Sn, S):  # pragma: no cover - compiled
+    """S = Sn, entries below 1e-280 in magnitude set to zero (:func:`gripkit.lti.flush_tiny`):
+    such an entry adds less than 1e-280·|data| to sums of order one, i.e. nothing, so ΦᵀΦ and Φᵀy
+    stay bit-identical, while the subnormal arithmetic it would lead to is slow on Intel CPUs."""
+    for i in range(S.shape[0]):
+        for q in range(S.shape[1]):
+            S[i, q] = flush_tiny(Sn[i, q])
 
 
 @numba.njit(cache=True, inline="always")

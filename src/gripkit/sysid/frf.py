@@ -29,6 +29,7 @@ import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
+from numpy.lib.stride_tricks import sliding_window_view
 
 from ..errors import AccuracyWarning, DataError
 from .checks import check_dt
@@ -147,13 +148,12 @@ def _h1(u, y, dt, nperseg):
         raise DataError(f"data: {N} samples give {K} segment(s) of {L}; H1 with {m} input(s) needs more than {m}",
                         hint="use a longer record or a shorter --nperseg")
     win = np.hanning(L + 1)[:-1]
-    idx = np.arange(L)[None, :] + step * np.arange(K)[:, None]
-    Uk = np.fft.rfft(u[idx] * win[None, :, None], axis=1)                 # (K, F, m)
-    Yk = np.fft.rfft(y[idx] * win[None, :, None], axis=1)                 # (K, F, p)
+    Uk = _segment_spectra(u, L, step, K, win)                               # (m, K, F)
+    Yk = _segment_spectra(y, L, step, K, win)                               # (p, K, F)
     f = np.fft.rfftfreq(L, dt)
-    Suu = np.einsum("kfi,kfj->fij", Uk, Uk.conj())
-    Syu = np.einsum("kfi,kfj->fij", Yk, Uk.conj())
-    Syy = np.einsum("kfi,kfi->fi", Yk, Yk.conj()).real
+    Suu = _cross_spectra(Uk, Uk)
+    Syu = _cross_spectra(Yk, Uk)
+    Syy = np.stack([_power(Yk[i]) for i in range(p)], axis=1)
     pu = np.real(np.einsum("fii->fi", Suu))
     bad = np.any(pu <= _NO_POWER * pu.max(axis=0), axis=1)
     good = ~bad
@@ -169,6 +169,51 @@ def _h1(u, y, dt, nperseg):
     coh[good] = np.clip(Sfit / np.maximum(Syy[good], 1e-300), 0.0, 1.0)
     _no_power_warning(f, bad, "input")
     return f, H, std, coh, {"segments": K, "nperseg": L, "window": "hann", "overlap": 0.5}
+
+
+def _segment_spectra(x, L: int, step: int, K: int, win):
+    """rfft (c, K, F) of the K Hann-windowed, 50 %-overlapping segments of each column of x (N, c):
+    segments as a strided view (no copy), one windowed temporary per column, the FFT along its
+    last (contiguous) axis into one complex array."""
+    c = x.shape[1]
+    X = np.empty((c, K, L // 2 + 1), dtype=complex)
+    for j in range(c):
+        seg = sliding_window_view(x[:, j], L)[::step][:K]
+        np.fft.rfft(seg * win, axis=-1, out=X[j])
+    return X
+
+
+def _sum_products(a, b):
+    """Σ_k a[k, f]·b[k, f] per column f (a, b: (K, F) real arrays or views)."""
+    return np.einsum("kf,kf->f", a, b)
+
+
+def _real_part_sum(A, B):
+    """Σ_k Re(A[k, f] conj(B[k, f])) = Σ(ar·br) + Σ(ai·bi), from one product over the
+    interleaved (contiguous) real and imaginary parts."""
+    d = _sum_products(A.view(np.float64), B.view(np.float64))
+    return d[0::2] + d[1::2]
+
+
+def _power(A):
+    """Σ_k |A[k, f]|² per line f."""
+    return _real_part_sum(A, A)
+
+
+def _cross_spectra(A, B):
+    """S[f, i, j] = Σ_k A_i[k, f] conj(B_j[k, f]) (A: (a, K, F), B: (b, K, F)) without conjugated
+    copies: Re from :func:`_real_part_sum`, Im = Σ(ai·br) − Σ(ar·bi); a spectrum of a channel with
+    itself (A is B, i = j) is real."""
+    S = np.empty((A.shape[2], A.shape[0], B.shape[0]), dtype=complex)
+    for i in range(A.shape[0]):
+        for j in range(B.shape[0]):
+            S[:, i, j].real = _real_part_sum(A[i], B[j])
+            if A is B and i == j:
+                S[:, i, j].imag = 0.0
+            else:
+                S[:, i, j].imag = (_sum_products(A[i].imag, B[j].real)
+                                   - _sum_products(A[i].real, B[j].imag))
+    return S
 
 
 def _spa(u, y, dt, lag_window, n_lines):

@@ -35,8 +35,8 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..errors import DataError, IdentificationError
-from ..lti import StateSpace, Uncertainty, affine_row
-from .blocked_gram import add_rows, carried_states, row_product, start_sums
+from ..lti import StateSpace, Uncertainty, affine_row, flush_tiny
+from .blocked_gram import add_rows, carried_states, carry, row_product, start_sums
 from .linear_model import LinearModel, as_io_matrix, fit_per_output, free_run
 
 __all__ = ["pem", "PEM_FORMS"]
@@ -95,7 +95,7 @@ def _sensitivities(Abar, C, F, G, S0, Z, J):  # pragma: no cover - compiled
             for r in range(n):
                 sn[r] = affine_row(Abar, r, s, Fq, Z, t)
             for r in range(n):
-                s[r] = sn[r]
+                s[r] = flush_tiny(sn[r])  # x0 directions decay freely: no subnormals carried
 
 
 #: samples per block of :func:`_sensitivity_gram` (its rows of J go to BLAS in one product)
@@ -110,7 +110,10 @@ def _sensitivity_gram(Abar, C, K, entries, n_x0, X, U, E, H, g):  # pragma: no c
     sensitivities of all d + n_x0 directions advance together as the columns of one n × Q state
     matrix S (the inner loops over its contiguous columns), and blocks of
     :data:`_GRAM_BLOCK` samples' rows of J are added to H and g by one BLAS product each.
-    :func:`_predict_sensitivity` forms the same J for any tangents (the tests compare them)."""
+    :func:`_predict_sensitivity` forms the same J for any tangents (the tests compare them).
+    Returns the final S; its entries below 1e-280 are flushed to zero as it is carried
+    (:func:`~gripkit.sysid.blocked_gram.carry`: the x0 directions are free responses of Ā and
+    decay into the subnormal range otherwise; H and g are unchanged by it)."""
     n = Abar.shape[0]
     p = C.shape[0]
     d = entries.shape[0]
@@ -148,9 +151,8 @@ def _sensitivity_gram(Abar, C, K, entries, n_x0, X, U, E, H, g):  # pragma: no c
             elif kind == 3:
                 for i in range(n):
                     Sn[i, q] -= K[i, r] * U[t, c]
-        for i in range(n):
-            for q in range(Q):
-                S[i, q] = Sn[i, q]
+        carry(Sn, S)
+    return S
 
 
 def _gauss_newton_terms(A, B, C, D, K, x0, u, y, entries):

@@ -71,10 +71,13 @@ SPECIALISE_ABOVE = 100_000
 ABSURD_JUMP = 1e10
 
 
-@njit(cache=True)
-def _core(P, th, phi, q, p, size, lam, mode, maxtr, trace, y):
-    """One RLS update of θ (``th``, shape (p,)) and P (``P``, row-major (p·p,)) for regressor
-    ``phi`` and output ``y``; ``q`` is a work vector. Returns (a-priori error, r = φᵀPφ, trace).
+@njit(cache=True, inline="always")
+def _core(Pb, oP, thb, oth, phb, oph, qb, oq, p, size, lam, mode, maxtr, trace, y):
+    """One RLS update of θ (``thb[oth:oth + p]``) and P (``Pb[oP:oP + p·p]``, row-major) for the
+    regressor ``phb[oph:oph + p]`` and output ``y``; ``qb[oq:oq + p]`` is work space. Returns
+    (a-priori error, r = φᵀPφ, trace). The batch kernel passes one local buffer four times with
+    constant offsets (the compiler then sees that the vectors do not overlap), the streaming step
+    views of its state vector at offset 0.
 
     ``size``: an empty tuple (p at run time) or a tuple of p zeros (p known to the compiler, loops
     unrolled). The covariance update is ``P ← (P + coef·q qᵀ)·scale`` with ``q = Pφ`` (see the
@@ -84,18 +87,17 @@ def _core(P, th, phi, q, p, size, lam, mode, maxtr, trace, y):
         p = len(size)
     yhat = 0.0
     for i in range(p):
-        yhat += phi[i] * th[i]
+        yhat += phb[oph + i] * thb[oth + i]
     e = y - yhat
-    for i in range(p):
-        q[i] = 0.0
-    for j in range(p):
-        pj = phi[j]
-        row = j * p
-        for i in range(p):
-            q[i] += P[row + i] * pj
+    for i in range(p):  # q = Pφ, row i of P (= its column: P is exactly symmetric), j ascending
+        row = oP + i * p
+        acc = 0.0
+        for j in range(p):
+            acc += Pb[row + j] * phb[oph + j]
+        qb[oq + i] = acc
     r = 0.0
     for i in range(p):
-        r += phi[i] * q[i]
+        r += phb[oph + i] * qb[oq + i]
     if mode == 2 and r <= 1e-12 * trace:  # directional, no new direction: no forgetting
         inv = 1.0 / (1.0 + r)
         coef, scale = -inv, 1.0
@@ -107,20 +109,20 @@ def _core(P, th, phi, q, p, size, lam, mode, maxtr, trace, y):
         coef, scale = -inv, 1.0 / lam
     g = e * inv
     for i in range(p):
-        th[i] += q[i] * g
+        thb[oth + i] += qb[oq + i] * g
     tr = 0.0
     for i in range(p):  # P stays exactly symmetric: update the upper triangle, mirror it
-        qi = coef * q[i]
-        row = i * p
+        qi = coef * qb[oq + i]
+        row = oP + i * p
         for j in range(i, p):
-            v = (P[row + j] + qi * q[j]) * scale
-            P[row + j] = v
-            P[j * p + i] = v
-        tr += P[row + i]
+            v = (Pb[row + j] + qi * qb[oq + j]) * scale
+            Pb[row + j] = v
+            Pb[oP + j * p + i] = v
+        tr += Pb[row + i]
     if mode == 1 and tr > maxtr:  # bounded trace
         f = maxtr / tr
         for k in range(p * p):
-            P[k] *= f
+            Pb[oP + k] *= f
         tr = maxtr
     return e, r, tr
 
@@ -166,8 +168,8 @@ def _rls_step(s, u, y):
         for i in range(p + p * p):
             s[ob + i] = s[oth + i]
         lam = s[_LAM]
-        e, r, tr = _core(s[op:oph], s[oth:op], s[oph:oq], s[oq:oq + p], p, (), lam, int(s[_MODE]),
-                         s[_MAXTR], s[_TRACE], y)
+        e, r, tr = _core(s[op:oph], 0, s[oth:op], 0, s[oph:oq], 0, s[oq:oq + p], 0, p, (), lam,
+                         int(s[_MODE]), s[_MAXTR], s[_TRACE], y)
         ok = math.isfinite(tr) and math.isfinite(e)
         for i in range(p):
             ok = ok and math.isfinite(s[oth + i])
@@ -206,22 +208,25 @@ def _var_factor(s, p):
 
 
 @njit(cache=True)
-def _rls_run(s, u, y, theta_out, std_out, yhat_out, size):
-    """Batch RLS: updates ``s`` over the record; writes θ, σ and the a-priori prediction at
-    every step when the output arrays have N rows (pass arrays with 0 rows to skip storing).
+def _rls_run(s, u, y, theta_out, std_out, yhat_out, err_out, size):
+    """Batch RLS: updates ``s`` over the record; writes θ and σ at every step when their arrays
+    have N rows (pass arrays with 0 rows to skip storing), and the a-priori prediction ŷ and error
+    y − ŷ (``err_out``, computed from the stored ŷ) when ``yhat_out`` has N rows.
 
-    ``size``: an empty tuple (generic kernel, p at run time) or a tuple of p zeros, whose length
-    numba knows at compile time: it compiles (and caches) one kernel per number of parameters with
-    unrolled p-loops (measured 1.5–2× faster); :meth:`RLS.run` uses it for records of at least
+    ``size``: four empty tuples (generic kernel, orders read from ``s`` at run time) or tuples of
+    p, na, nb and nk zeros (:meth:`RLS._kernel_size`), whose lengths numba knows at compile time: it
+    compiles (and caches) one kernel per model structure, with unrolled p-loops and constant
+    regressor indices (measured 1.5–2× faster); :meth:`RLS.run` uses it for records of at least
     :data:`SPECIALISE_ABOVE` samples, where the extra compilation (1–2 s, once) pays off. The first
     ``t0`` samples go through :func:`_rls_step` (their regressors need the buffered past); the rest
     take the regressor straight from ``u`` and ``y`` with θ and P in local arrays. Both call
     :func:`_core`, so streaming and batch results are bit-identical.
     """
     n = u.shape[0]
-    na = int(s[_NA])
-    nb = int(s[_NB])
-    nk = int(s[_NK])
+    if len(size[0]) > 0:  # the orders are known to the compiler: constant regressor indices
+        na, nb, nk = len(size[1]), len(size[2]), len(size[3])
+    else:
+        na, nb, nk = int(s[_NA]), int(s[_NB]), int(s[_NK])
     p = na + nb
     nu = nk + nb
     oth = _HDR + na + nu
@@ -233,7 +238,9 @@ def _rls_run(s, u, y, theta_out, std_out, yhat_out, size):
     for t in range(nstart):
         e = _rls_step(s, u[t], y[t])
         if pred:
-            yhat_out[t] = y[t] - e
+            yh = y[t] - e
+            yhat_out[t] = yh
+            err_out[t] = y[t] - yh  # y − ŷ as stored (bit-identical to the arrays' difference)
         if store:
             f = _var_factor(s, p)
             for i in range(p):
@@ -241,14 +248,13 @@ def _rls_run(s, u, y, theta_out, std_out, yhat_out, size):
                 std_out[t, i] = math.sqrt(f * s[op + i * p + i])
     if n <= nstart:
         return
-    th = np.empty(p)
-    P = np.empty(p * p)
+    # P, θ, φ and q in one local buffer at constant offsets (for the compiler: no aliasing)
+    bP, bth, bph, bq = 0, p * p, p * p + p, p * p + 2 * p
+    w = np.empty(p * p + 3 * p)
     for i in range(p):  # explicit loops: slice assignment costs seconds of numba compile time
-        th[i] = s[oth + i]
+        w[bth + i] = s[oth + i]
     for i in range(p * p):
-        P[i] = s[op + i]
-    phi = np.empty(p)
-    q = np.empty(p)
+        w[bP + i] = s[op + i]
     lam = s[_LAM]
     mode = int(s[_MODE])
     maxtr = s[_MAXTR]
@@ -259,25 +265,35 @@ def _rls_run(s, u, y, theta_out, std_out, yhat_out, size):
     nupd = s[_NUPD]
     for t in range(nstart, n):
         for i in range(na):
-            phi[i] = -y[t - 1 - i]
+            w[bph + i] = -y[t - 1 - i]
         for j in range(nb):
-            phi[na + j] = u[t - nk - j]
-        e, r, trace = _core(P, th, phi, q, p, size, lam, mode, maxtr, trace, y[t])
+            w[bph + na + j] = u[t - nk - j]
+        if mode == 0:  # the mode as a literal: its branches fold away in each copy
+            e, r, trace = _core(w, bP, w, bth, w, bph, w, bq, p, size[0], lam, 0, maxtr, trace,
+                                    y[t])
+        elif mode == 1:
+            e, r, trace = _core(w, bP, w, bth, w, bph, w, bq, p, size[0], lam, 1, maxtr, trace,
+                                    y[t])
+        else:
+            e, r, trace = _core(w, bP, w, bth, w, bph, w, bq, p, size[0], lam, 2, maxtr, trace,
+                                    y[t])
         V = lam * (V + e * e / (lam + r))
         w1 = lam * w1 + 1.0
         w2 = lam * lam * w2 + 1.0
         nupd += 1.0
         if pred:
-            yhat_out[t] = y[t] - e
+            yh = y[t] - e
+            yhat_out[t] = yh
+            err_out[t] = y[t] - yh  # y − ŷ as stored (bit-identical to the arrays' difference)
         if store:
             f = V / (w1 - p) * (w2 / w1) if (nupd > p and w1 > p) else np.nan
             for i in range(p):
-                theta_out[t, i] = th[i]
-                std_out[t, i] = math.sqrt(f * P[i * p + i])
+                theta_out[t, i] = w[bth + i]
+                std_out[t, i] = math.sqrt(f * w[bP + i * p + i])
     for i in range(p):
-        s[oth + i] = th[i]
+        s[oth + i] = w[bth + i]
     for i in range(p * p):
-        s[op + i] = P[i]
+        s[op + i] = w[bP + i]
     s[_TRACE] = trace
     s[_V] = V
     s[_W1] = w1
@@ -541,6 +557,14 @@ class RLS:
             peaks.append(peak)
         return peaks[0], peaks[1]
 
+    def _kernel_size(self, n: int) -> tuple:
+        """The ``size`` argument of :func:`_rls_run`: the orders as tuple lengths (one compiled
+        kernel per structure) for records of at least :data:`SPECIALISE_ABOVE` samples, else
+        empty tuples (the generic kernel)."""
+        if n < SPECIALISE_ABOVE:
+            return (), (), (), ()
+        return (0.0,) * self.n_params, (0.0,) * self.na, (0.0,) * self.nb, (0.0,) * self.nk
+
     def _run(self, u: np.ndarray, y: np.ndarray, store: bool) -> "RLSResult":
         """:meth:`run` on checked float64 arrays."""
         peaks = self._check_corrupt(u, y)
@@ -551,12 +575,12 @@ class RLS:
         theta = np.empty((rows, p))
         std = np.empty((rows, p))
         yhat = np.empty(n)
+        e = np.empty(n)
         n0 = self.n_updates
-        _rls_run(self._s, u, y, theta, std, yhat, (0.0,) * p if n >= SPECIALISE_ABOVE else ())
+        _rls_run(self._s, u, y, theta, std, yhat, e, self._kernel_size(n))
         self._s[_PU], self._s[_PY] = peaks
         if not (np.isfinite(self.P).all() and np.isfinite(self.theta).all()):
             raise self._diverged(f"after {self.n_updates} updates")
-        e = y - yhat
         nupd = self.n_updates - n0
         if nupd == 0:
             raise DataError(f"RLS [{self.na} {self.nb} {self.nk}] made no update on {n} samples",
@@ -593,8 +617,26 @@ def _first_absurd(x, peak, factor):
     return -1, peak
 
 
-@njit(cache=True)
+#: peaks within these bounds square and sum without overflow (N·peak² < 1e290 for N < 1e10)
+#: and with the underflow of values below 1e-150 negligible next to peak² ≥ 1e-280
+_PLAIN_NORM_RANGE = (1e-140, 1e140)
+
+
 def _peak_and_norm(x):
+    """(max |x|, ‖x‖₂) without temporaries: max/min and a BLAS dot (fast) when the peak lies in
+    :data:`_PLAIN_NORM_RANGE`, else :func:`_peak_and_norm_scaled` (one pass scaled by the running
+    peak). The dot sums in another order than the scaled pass: the norms agree to a few ulps,
+    which only feed the order-of-magnitude checks of :meth:`RLS._check_scale`."""
+    if x.size == 0:
+        return 0.0, 0.0
+    peak = max(float(x.max()), -float(x.min()))
+    if _PLAIN_NORM_RANGE[0] < peak < _PLAIN_NORM_RANGE[1]:
+        return peak, math.sqrt(float(np.dot(x, x)))
+    return _peak_and_norm_scaled(x)
+
+
+@njit(cache=True)
+def _peak_and_norm_scaled(x):
     """(max |x|, ‖x‖₂) in one pass without temporaries; the norm is scaled by the running peak
     (the LAPACK dnrm2 way), so it neither overflows nor underflows."""
     peak = 0.0

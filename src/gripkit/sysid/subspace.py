@@ -42,7 +42,7 @@ import scipy.linalg as sla
 
 from ..errors import DataError, IdentificationError, StabilityWarning
 from ..lti import StateSpace
-from .blocked_gram import add_rows, carried_states, row_product, start_sums
+from .blocked_gram import add_rows, carried_states, carry, row_product, start_sums
 from .checks import check_dt
 from .linear_model import LinearModel, as_io_matrix, fit_per_output, free_run, observability_regressor
 from .regression import _qr_r
@@ -132,9 +132,11 @@ class SubspaceFactor:
         forming W_p: the sum over its k block columns of the shifted signals times M's blocks."""
         k, m, p, j = self.k, self.m, self.p, self.j
         out = np.zeros((j, M.shape[0]))
+        tmp = np.empty_like(out)  # one product buffer for the 2k terms (not 2k j × n temporaries)
         for i in range(k):
-            out += self.us[i:i + j] @ M[:, i * m:(i + 1) * m].T
-            out += self.ys[i:i + j] @ M[:, k * m + i * p:k * m + (i + 1) * p].T
+            np.add(out, np.matmul(self.us[i:i + j], M[:, i * m:(i + 1) * m].T, out=tmp), out=out)
+            My = M[:, k * m + i * p:k * m + (i + 1) * p]
+            np.add(out, np.matmul(self.ys[i:i + j], My.T, out=tmp), out=out)
         return out
 
 
@@ -217,7 +219,10 @@ def _bdx_normal_equations(A, C, u, y, feedthrough, G, r):  # pragma: no cover - 
     one pass that carries the n·m unit-input responses and the n free responses of the state
     together (X[t+1] = A X[t] + [e_i u_j(t)]; the x0 columns start at the identity). Rows of
     :data:`_BDX_BLOCK` samples are collected and added to the sums by one BLAS product each.
-    O(N·n²(m+1)) flops, O(cols²) memory beyond the block."""
+    O(N·n²(m+1)) flops, O(cols²) memory beyond the block. Returns the final carried state X[N]
+    (n × (n·m + n)), whose entries below 1e-280 are flushed to zero as it is carried
+    (:func:`~gripkit.sysid.blocked_gram.carry`: the x0 columns decay into the subnormal range
+    otherwise; G and r are unchanged by it)."""
     N, m = u.shape
     n, p = A.shape[0], C.shape[0]
     nb = n * m
@@ -247,9 +252,8 @@ def _bdx_normal_equations(A, C, u, y, feedthrough, G, r):  # pragma: no cover - 
             row_product(A, i, X, Xn[i])
             for j in range(m):
                 Xn[i, i * m + j] += u[t, j]
-        for i in range(n):
-            for c in range(ns):
-                X[i, c] = Xn[i, c]
+        carry(Xn, X)
+    return X
 
 
 def _bdx_least_squares(A, C, u, y, feedthrough: bool) -> np.ndarray:

@@ -33,7 +33,7 @@ import numpy as np
 from ...control.rst import as_plant
 from ...errors import (AccuracyWarning, DataError, IdentificationError, ModelError,
                        UnidentifiableError)
-from ...lti import affine_row
+from ...lti import affine_row, flush_tiny
 from .strain_gauge_sensor import StrainGaugeSensor, sensitivity_matrix, sensor_parameters
 
 __all__ = [
@@ -570,8 +570,8 @@ def _kf_run(model, Z, U, x, P, out, work):  # pragma: no cover - compiled
         # time update: x = A x + B u ; P = A P A' + Q   (tmp rows 0..n-1 as scratch, n <= tmp rows)
         for i in range(n):
             ph[i] = affine_row(A, i, x, B, U, k)
-        for i in range(n):
-            x[i] = ph[i]
+        for i in range(n):  # entries below 1e-280 carried as zero: never subnormal (flush_tiny)
+            x[i] = flush_tiny(ph[i])
         for i in range(n):
             for l in range(n):
                 acc = 0.0
@@ -583,7 +583,7 @@ def _kf_run(model, Z, U, x, P, out, work):  # pragma: no cover - compiled
                 acc = Q[i, l]
                 for r2 in range(n):
                     acc += tmp[i, r2 + 1] * A[l, r2]
-                P[i, l] = acc
+                P[i, l] = flush_tiny(acc)
 
 
 @dataclass(frozen=True)
