@@ -112,7 +112,7 @@ def test_closed_port_cannot_be_reached():
 
 def test_a_real_scheduler_passes_the_probe():
     """The probe accepts what distributed's scheduler sends (its handshake)."""
-    distributed = pytest.importorskip("distributed", reason="the Dask extra is not installed")
+    import distributed  # a dev dependency (tests/test_dev_dependencies.py): fail, never skip
     ready, done = threading.Event(), threading.Event()
     box = {}
 
@@ -137,7 +137,7 @@ def test_a_real_scheduler_passes_the_probe():
 
 
 def test_executor_and_cli_say_not_a_scheduler(server, cli, tmp_path):
-    pytest.importorskip("distributed", reason="the Dask extra is not installed")
+    import distributed  # noqa: F401  (a dev dependency: fail, never skip)
     from gripkit.batch.executors import DaskExecutor
 
     address = server(http_server)

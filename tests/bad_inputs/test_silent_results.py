@@ -154,9 +154,9 @@ def test_cli_identify_ss_unstable_plant_warns_on_stderr_and_in_json(cli, tmp_pat
                header="t,u [V],y [m]", comments="")
     res = cli("identify", "ss", p, "--input", "u", "--output", "y", "--order", 1, "--json")
     assert res.code == 0, res.err
-    # PEM lowers the free-run fit of the stabilised model here, so the subspace model is kept
-    # (issue 25's default focus) and the warning names it
-    assert_warned(res, "StabilityWarning: n4sid: the data point to an unstable system "
+    # PEM in innovation form lowers the free-run fit of the stabilised model here, so the
+    # output-error refinement is returned (issue 25's default focus) and the warning names it
+    assert_warned(res, "StabilityWarning: pem-oe: the data point to an unstable system "
                        "(the subspace estimate has largest |pole| 1.02")
     assert_warned(res, "AccuracyWarning: PEM refinement (pem-innovation) lowered the mean simulation fit")
     assert_warned(res, "it was stabilised to largest |pole|")

@@ -20,7 +20,6 @@ from test_io import write_mcap  # noqa: E402
 def log(tmp_path_factory):
     """A first-order plant y = 0.5 q⁻¹ u / (1 − 0.8 q⁻¹) logged at 100 Hz on two topics, the
     output with a little noise."""
-    pytest.importorskip("mcap_ros2")
     rng = np.random.default_rng(3)
     n = 1500
     t = np.arange(n) / 100.0

@@ -31,7 +31,7 @@ def test_a_refinement_that_scores_lower_is_not_returned(monkeypatch):
     warning giving both free-run fits."""
     tr = _record(0)
 
-    def bad_pem(model, u=None, y=None, form="innovation", max_iterations=50):
+    def bad_pem(model, u=None, y=None, form="innovation", max_iterations=50):  # both forms
         ss = model.system
         worse = model.replace(system=ss.replace(A=0.9 * ss.A), structure=f"pem-{form}",
                               info={**model.info, "pem": {"converged": True}})
@@ -57,13 +57,13 @@ def test_the_returned_model_never_scores_below_its_start(focus):
         model, _ = identify_ss(tr, input="u", output="y", order=2, focus=focus, validate=val)
         start, _ = identify_ss(tr, input="u", output="y", order=2, refine=False, validate=val)
     vd = identify_mimo._validation_data(val, mimo_data(tr, "u", "y"))
-    assert focus_score(model, focus, vd) >= focus_score(start, focus, vd) - 1e-9
+    assert focus_score(model, focus, vd) >= focus_score(start, focus, vd) - identify_mimo.FOCUS_TIE
     assert model.info["focus"]["data"] == "validation"
     assert np.allclose(sorted(np.abs(model.system.poles())), [np.hypot(0.9, 0.2)] * 2, atol=0.01)
 
 
 def test_pem_that_does_not_converge_says_so():
-    with pytest.warns(AccuracyWarning, match="PEM refinement stopped after 1 iterations without converging"):
+    with pytest.warns(AccuracyWarning, match=r"PEM refinement \(pem-innovation\) stopped after 1 iterations without converging"):
         identify_ss(_record(3), input="u", output="y", order=4, max_iterations=1)
     with pytest.raises(DataError, match="focus: expected one of simulation, prediction"):
         identify_ss(_record(3), input="u", output="y", order=2, focus="both")
@@ -82,3 +82,23 @@ def test_the_search_table_is_in_the_text_output(tmp_path, capsys):
     rows = [ln.split() for ln in out.out.splitlines() if ln.strip()[:1].isdigit() and len(ln.split()) >= 3]
     assert sorted(int(r[0]) for r in rows[:4]) == [1, 2, 3, 4]
     assert "focus simulation (validation data)" in out.out
+
+
+def test_an_innovation_refinement_that_loses_falls_back_to_output_error(monkeypatch):
+    """With focus='simulation', PEM in output-error form (which minimises the free-run error
+    itself) is tried when the innovation form loses; it is returned, with its covariance."""
+    import gripkit.sysid.pem_ss as pem_ss
+
+    real = pem_ss.pem
+
+    def pem(model, u=None, y=None, form="innovation", max_iterations=50):
+        m = real(model, u=u, y=y, form=form, max_iterations=max_iterations)
+        if form == "innovation":  # damaged: scores lower than the subspace start
+            m = m.replace(system=m.system.replace(A=0.9 * m.system.A))
+        return m
+
+    monkeypatch.setattr(pem_ss, "pem", pem)
+    with pytest.warns(AccuracyWarning, match=r"the pem-oe refinement \(.*\) is returned"):
+        model, _ = identify_ss(_record(6), input="u", output="y", order=2)
+    assert model.structure == "pem-oe" and model.info["focus"]["kept"] == "pem-oe"
+    assert model.system.uncertainty is not None

@@ -252,7 +252,11 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
         report(f"PEM refinement ({form} form) of the order-{model.order} model")
         start = model
         model = pem(model, u=d.u, y=d.y, form=form, max_iterations=max_iterations)
-        model = _never_lose(start, model, focus, d if vd is None else vd, vd is None, max_iterations)
+        if form == "innovation" and focus == "simulation":  # PEM in oe form minimises the free-run
+            oe = lambda: pem(start, u=d.u, y=d.y, form="oe", max_iterations=max_iterations)  # noqa: E731
+        else:                                               # error itself: the second candidate
+            oe = None
+        model = _never_lose(start, model, focus, d if vd is None else vd, vd is None, max_iterations, oe)
     warn_if_stabilised(model)
     if detrend == "mean":
         refit = lambda: identify_ss(  # noqa: E731
@@ -291,28 +295,56 @@ def focus_score(model, focus: str, d: MimoData, estimation: bool = False) -> flo
     return float(np.mean(100.0 * (1.0 - np.linalg.norm(e, axis=0) / den)))
 
 
-def _never_lose(start, refined, focus: str, d: MimoData, estimation: bool, max_iterations: int):
-    """The refined model, or the subspace model it started from when that scores higher by
-    ``focus`` on ``d``; warns when PEM did not converge and when the refinement is dropped."""
-    pem_info = refined.info.get("pem", {})
-    if not pem_info.get("converged", True):
-        warnings.warn(f"PEM refinement stopped after {pem_info.get('iterations')} iterations without "
-                      f"converging (loss {pem_info.get('loss_start', math.nan):.4g} -> "
-                      f"{pem_info.get('loss', math.nan):.4g} per sample); raise max_iterations "
+#: fit points (%) within which a refined model counts as scoring as well as its start: the scores
+#: are means of fits computed in floating point, and PEM's σ is worth more than a 1e-5 % tie
+FOCUS_TIE = 0.01
+
+
+def _warn_unconverged(model, max_iterations: int) -> None:
+    info = model.info.get("pem", {})
+    if not info.get("converged", True):
+        warnings.warn(f"PEM refinement ({model.structure}) stopped after {info.get('iterations')} "
+                      f"iterations without converging (loss {info.get('loss_start', math.nan):.4g} -> "
+                      f"{info.get('loss', math.nan):.4g} per sample); raise max_iterations "
                       f"(--max-iterations, now {max_iterations}) or lower the order",
-                      AccuracyWarning, stacklevel=3)
+                      AccuracyWarning, stacklevel=4)
+
+
+def _never_lose(start, refined, focus: str, d: MimoData, estimation: bool, max_iterations: int,
+                second=None):
+    """The refined model, or, when it scores lower than its subspace start by ``focus`` on ``d``
+    (by more than :data:`FOCUS_TIE`), the model of ``second()`` (PEM in output-error form, which
+    minimises the simulation error itself) if that does not, else the subspace start; warns when
+    PEM did not converge and when a refinement is dropped."""
+    _warn_unconverged(refined, max_iterations)
     where = "estimation" if estimation else "validation"
-    before, after = focus_score(start, focus, d, estimation), focus_score(refined, focus, d, estimation)
-    refined.info["focus"] = {"criterion": focus, "data": where, "subspace_percent": before,
-                             "refined_percent": after, "kept": "refined"}
-    if after >= before:
-        return refined
-    warnings.warn(f"PEM refinement ({refined.structure}) lowered the mean {focus} fit on the {where} "
-                  f"data from {before:.2f} % to {after:.2f} %: the subspace model is returned "
-                  f"(--focus {'prediction' if focus == 'simulation' else 'simulation'} judges by the "
-                  f"other criterion; --no-refine skips PEM)", AccuracyWarning, stacklevel=3)
-    start.info["focus"] = {**refined.info["focus"], "kept": "subspace"}
-    start.info["pem_rejected"] = pem_info
+    before = focus_score(start, focus, d, estimation)
+    record = {"criterion": focus, "data": where, "subspace_percent": before}
+    tried = []
+    for candidate in (lambda: refined, second):
+        if candidate is None:
+            continue
+        model = candidate()
+        if model is not refined:
+            _warn_unconverged(model, max_iterations)
+        after = focus_score(model, focus, d, estimation)
+        tried.append(f"{model.structure} {after:.2f} %")
+        if after >= before - FOCUS_TIE:
+            model.info["focus"] = {**record, "refined_percent": after, "kept": model.structure}
+            if model is not refined:
+                warnings.warn(f"PEM refinement ({refined.structure}) lowered the mean {focus} fit on "
+                              f"the {where} data from {before:.2f} % to {tried[0].split()[-2]} %; the "
+                              f"{model.structure} refinement ({after:.2f} %) is returned",
+                              AccuracyWarning, stacklevel=3)
+            return model
+    warnings.warn(f"PEM refinement lowered the mean {focus} fit on the {where} data from "
+                  f"{before:.2f} % to {', '.join(tried)}: the subspace model is returned, without "
+                  f"parameter covariance (--focus {'prediction' if focus == 'simulation' else 'simulation'}"
+                  f" judges by the other criterion; --no-refine skips PEM)", AccuracyWarning,
+                  stacklevel=3)
+    start.info["focus"] = {**record, "refined_percent": focus_score(refined, focus, d, estimation),
+                           "kept": "subspace"}
+    start.info["pem_rejected"] = refined.info.get("pem", {})
     return start
 
 

@@ -17,12 +17,13 @@ least squares (the output is affine in x0: ``y = O x0 + G u``, ``O`` the rows ``
 from __future__ import annotations
 
 import dataclasses
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from .. import __version__
-from ..errors import DataError, ModelError
+from ..errors import DataError, DataWarning, ModelError, ParameterError
 from ..lti import LinearSystem, StateSpace, TransferFunction
 from ..units import convert, dimension_of, same_dimension
 from .checks import as_io_matrix
@@ -88,7 +89,14 @@ def _in_unit(data, name: str, unit: str | None, what: str) -> np.ndarray:
     have = data.unit(name)
     if unit in (None, "", "1") or have in (None, "", "1") or have == unit:
         return x
-    if not same_dimension(have, unit):
+    try:
+        same = same_dimension(have, unit)
+    except ParameterError:  # a unit that is not one (a hand-edited or foreign model file)
+        warnings.warn(f"data: cannot compare the units of the {what} column {name!r}: {have!r} in "
+                      f"the data, {unit!r} in the model, and one is not a unit gripkit can read; "
+                      f"the values are taken as they are", DataWarning, stacklevel=4)
+        return x
+    if not same:
         raise DataError(f"data: {what} column {name!r} is in {have!r} (dimension "
                         f"{dimension_of(have)}), but the model's {what} {name!r} is in {unit!r} "
                         f"(dimension {dimension_of(unit)}): a different physical quantity",
