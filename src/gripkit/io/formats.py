@@ -1,6 +1,8 @@
 """Readers and writers for CSV, Parquet and HDF5 behind :func:`load` and :func:`save`.
 
-* CSV: one header row; units in headers (``force [N]``). Read with pyarrow.
+* CSV: one header row; units in headers (``force [N]``). Read with pyarrow. A file without a
+  header (every field of its first line a number) is read whole, its columns named ``'1'``,
+  ``'2'``, … by position (:mod:`gripkit.io.table`).
 * Parquet: one column per channel; units in the field metadata key ``unit`` (or in headers).
 * HDF5: a group holding one 1-D dataset per channel (attribute ``unit``), or one 2-D dataset
   with a ``columns`` attribute (and optionally ``units``); ``key=`` names the group/dataset.
@@ -36,8 +38,8 @@ from ..errors import ArgumentError, DataError, DataWarning
 from ..signals.trajectory import Trajectory
 from .hdf5_links import check_dataset, hdf5_get, hdf5_text
 from .mat_reader import read_mat
-from .table import (check_fill, check_fs, check_size, columns_to_trajectory, is_time_name,
-                    split_header)
+from .table import (by_position, check_fill, check_fs, check_size, columns_to_trajectory,
+                    is_time_name, split_header)
 
 __all__ = ["load", "save", "FORMATS"]
 
@@ -125,7 +127,9 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
     numbers are written so (``0,25``). Integer time stamps in nanoseconds (a column named
     ``stamp``, ``time_ns`` and the like or ``*_ns`` given as ``time=``, with the unit ``[ns]``, or
     integers of 1e17 and more) are read exactly, relative to the first stamp
-    (``meta['time_origin']``).
+    (``meta['time_origin']``). A file without a header (every field of its first line a
+    number) is read from its first line, its columns named by 1-based position (``'1'``, ``'2'``,
+    …; ``columns=["2", "3"]``, ``time="1"``), and ``meta['header']`` says so.
     """
     check_path(path, "path", "load()")
     if units is not None and not isinstance(units, Mapping):
@@ -157,7 +161,8 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
     raw, meta_units = reader(path, key=key, delimiter=delimiter, wanted=wanted, limit=limit,
                              allow_external=allow_external_links)
     return columns_to_trajectory(raw, source=path.name, columns=columns, time=time, fs=fs,
-                                 units=units, meta_units=meta_units, fill=fill)
+                                 units=units, meta_units=meta_units, fill=fill,
+                                 headerless=fmt == "csv" and by_position(raw))
 
 
 def _allow_external(allow) -> bool:
@@ -228,9 +233,11 @@ def _read_csv(path: Path, key=None, delimiter=None, *, wanted=None, limit=None,
     if delimiter is None:
         tsv = path.suffix.lower() == ".tsv"
         delimiter, decimal = ("\t", ".") if tsv else _sniff_separator(data)
+    names = _headerless_names(data, delimiter)
     try:
         table = pacsv.read_csv(
-            pa.BufferReader(data), parse_options=pacsv.ParseOptions(delimiter=delimiter),
+            pa.BufferReader(data), read_options=pacsv.ReadOptions(column_names=names),
+            parse_options=pacsv.ParseOptions(delimiter=delimiter),
             convert_options=pacsv.ConvertOptions(strings_can_be_null=True, decimal_point=decimal,
                                                  null_values=["", "NaN", "nan", "NA", "null"]))
     except (pa.ArrowInvalid, pa.ArrowTypeError, UnicodeDecodeError) as exc:
@@ -295,17 +302,36 @@ _NUMBER = re.compile(rb"^[-+]?(\d+([.,]\d*)?|[.,]\d+)([eE][-+]?\d+)?$")
 _DECIMAL_COMMA = re.compile(r"^\s*[-+]?\d*,\d+([eE][-+]?\d+)?\s*$")
 
 
+#: cells of a first line that a headerless file's first data row may hold besides numbers
+_MISSING = (b"", b"NaN", b"nan", b"NA", b"null")
+
+
+def _headerless_names(data: bytes, delimiter: str) -> list[str] | None:
+    """Column names ``'1'``, ``'2'``, … when the file has no header (every field of its first
+    line is a number, or a missing value beside at least one number): the first line is then the
+    first data row, and the columns are named by their 1-based index. None for a header."""
+    line = next((x for x in data[:65536].splitlines() if x.strip()), b"")
+    fields = [f.strip().strip(b'"') for f in line.split(delimiter.encode())]
+    if not any(_NUMBER.match(f) for f in fields):
+        return None
+    if not all(_NUMBER.match(f) or f in _MISSING for f in fields):
+        return None
+    return [str(k) for k in range(1, len(fields) + 1)]
+
+
 def _sniff_separator(data: bytes) -> tuple[str, str]:
     """The separator and decimal point of a CSV file read without ``delimiter=``: ``,`` and
-    ``.``, unless the header holds ``;`` and no ``,`` (a European spreadsheet's export): then
+    ``.``, unless the header holds ``;`` and no ``,`` (a European spreadsheet's export), or the
+    file has no header and its first line is numbers separated by ``;`` (``0,25;1,5``): then
     ``;``, with ``,`` as decimal point when the data rows write their numbers so (``0,25``)."""
     lines = data[:65536].decode("utf-8", errors="replace").splitlines()
     if len(data) > 65536:
         lines = lines[:-1]  # cut short
     header = next((line for line in lines if line.strip()), "")
-    if ";" not in header or "," in header:
+    numbers = all(_NUMBER.match(f.strip().encode()) for f in header.split(";"))
+    if ";" not in header or ("," in header and not numbers):
         return ",", "."
-    rows = [line for line in lines[1:200] if line.strip()]
+    rows = [line for line in lines[:200] if line.strip()]  # the header: a data row or no comma
     comma = any(_DECIMAL_COMMA.match(f) for line in rows for f in line.split(";"))
     return ";", "," if comma else "."
 
