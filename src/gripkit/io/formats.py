@@ -588,19 +588,26 @@ def _hdf5_group(node, source: str, wanted, limit: float, allow_external: bool):
 
 
 @entry_point
-def save(tr: Trajectory, path, *, format: str | None = None, key: str = "/") -> None:
-    """Write a trajectory: time as ``t`` (s) then each channel with its SI unit. Written with
+def save(tr: Trajectory, path, *, format: str | None = None, key: str = "/",
+         units: str = "si") -> None:
+    """Write a trajectory: time as ``t`` (s) then each channel with its unit, SI by default;
+    ``units="display"`` writes each channel in the unit its file was written in
+    (:meth:`Trajectory.display_unit`: ``force [mN]`` read, ``force [mN]`` written, values in mN),
+    which :func:`load` reads back to the same SI values. Written with
     :func:`gripkit.atomic.atomic_write`: a save that fails midway leaves the old file as it was and
     raises :class:`PathError`."""
     if not isinstance(tr, Trajectory):
         raise ArgumentError(f"save(): tr must be a gripkit Trajectory, found {type(tr).__name__}")
+    if units not in ("si", "display"):
+        raise ArgumentError(f"save(): units must be 'si' or 'display', found {units!r:.40}",
+                            hint="'display' writes each channel in the unit its file used")
     check_path(path, "path", "save()")
     path = Path(path)
     fmt = _format(path, format)
     if fmt == "mcap":
         raise DataError("gripkit reads MCAP logs but writes CSV, Parquet or HDF5", hint="save as .parquet")
     cols = {"t": tr.t, **{n: tr[n] for n in tr.names}}
-    units = {"t": "s", **tr.units}
+    units = {"t": "s", **(tr.units if units == "si" else _display(tr, cols))}
     if fmt == "csv":
         header = ",".join(f"{n} [{u}]" if u != "1" else n for n, u in units.items())
 
@@ -627,3 +634,20 @@ def save(tr: Trajectory, path, *, format: str | None = None, key: str = "/") -> 
                     ds = g.create_dataset(n, data=v)
                     ds.attrs["unit"] = units[n]
     atomic_write(path, write, what="trajectory file")
+
+
+def _display(tr: Trajectory, cols: dict) -> dict[str, str]:
+    """Each channel's display unit; the values in ``cols`` converted to it (in place)."""
+    from ..units import convert, same_dimension
+
+    out = {}
+    for n in tr.names:
+        si, shown = tr.unit(n), tr.display_unit(n)
+        if shown != si:
+            if not same_dimension(si, shown):
+                raise DataError(f"save(): channel {n!r} is in {si!r}, its display unit {shown!r} "
+                                f"measures another quantity",
+                                hint="correct or remove tr.meta['display_units']")
+            cols[n] = convert(cols[n], si, shown)
+        out[n] = shown
+    return out

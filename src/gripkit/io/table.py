@@ -3,7 +3,10 @@
 Rules shared by every reader:
 
 * a column header may carry its unit, ``"force [mN]"`` or ``"force (mN)"``; values are converted
-  to SI and the channel is named ``force``. Units may also come from file metadata or ``units=``;
+  to SI and the channel is named ``force``. Units may also come from file metadata or ``units=``.
+  The units as written, where they are not SI, are kept in ``meta['display_units']``
+  (``{"force": "mN"}``; :meth:`Trajectory.display_unit`), so that results can be written back
+  in them (``gripkit.io.save(tr, path, units="display")``, ``gripkit simulate MODEL --out``);
 * the time base is the column named by ``time=``, else a column named ``t``, ``time``,
   ``timestamp``, ``time_s``, ``stamp``, ``time_ns`` and the like (:func:`is_time_name`; its
   unit converted to seconds), else a uniform one built from ``fs=``. Given both a time column
@@ -332,6 +335,9 @@ def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
         meta = {"source": source, "dt": 1.0 / float(fs)}
     if headerless:
         meta["header"] = "none: columns named by their 1-based position"
+    shown = {c: cols[c][1] for c in names if cols[c][1] is not None and cols[c][1] != su[c]}
+    if shown:  # the units the file wrote, for outputs in them (Trajectory.display_unit)
+        meta["display_units"] = shown
     t, data = _fill(t, data, fill)
     _warn_corrupt(source, t, data, su)
     if tname is not None:
