@@ -132,3 +132,11 @@ def test_identify_ss_model_file_keeps_the_file_units(record, tmp_path, capsys):
     run(capsys, "identify", "ss", record, "--input", "current", "--output", "force", "--order", 2,
         "--no-refine", "--out", model)
     assert load_model(model).display_units == {"current": "mA", "force": "mN"}
+
+
+def test_python_identify_ss_keeps_the_file_units(record):
+    from gripkit.sysid import identify
+
+    m = identify(load(record), "ss", input="current", output="force", order=2, refine=False)
+    assert m.display_units == {"current": "mA", "force": "mN"}
+    assert (m.display_unit("force"), m.system.output_units) == ("mN", ("N",))

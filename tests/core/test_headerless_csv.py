@@ -104,3 +104,11 @@ def test_cli_without_time_says_how_to_name_it(tmp_path, capsys):
     out, err = capsys.readouterr()
     assert code != 0 and "Traceback" not in err
     assert err.startswith("error: DataError:") and "the file has no header" in err
+
+
+def test_ragged_line_of_a_headerless_file_is_named(tmp_path):
+    p = tmp_path / "cut.csv"
+    p.write_text("0,1,2\n1,2,3\n2,3\n")
+    with pytest.raises(DataError, match=r"line 3 has 2 fields, line 1, the first \(the file has "
+                                        r"no header\), has 3"):
+        load(p, time="1")

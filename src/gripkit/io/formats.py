@@ -36,6 +36,7 @@ from ..arguments import check_path, entry_point
 from ..atomic import atomic_write
 from ..errors import ArgumentError, DataError, DataWarning
 from ..signals.trajectory import Trajectory
+from ..units import convert, same_dimension
 from .hdf5_links import check_dataset, hdf5_get, hdf5_text
 from .mat_reader import read_mat
 from .table import (by_position, check_fill, check_fs, check_size, columns_to_trajectory,
@@ -347,6 +348,8 @@ def _refuse_ragged_line(path: Path, delimiter: str) -> None:
         return
     sep = delimiter
     expected = numbered[0][1].count(sep) + 1
+    first = "the header" if _headerless_names(numbered[0][1].encode(), sep) is None else \
+        f"line {numbered[0][0]}, the first (the file has no header),"
     for k, line in numbered[1:]:
         if not line.strip() or '"' in line:
             continue
@@ -355,7 +358,8 @@ def _refuse_ragged_line(path: Path, delimiter: str) -> None:
             last = k == len(lines)
             cut = " and is the last line, without a line ending" if last and not text.endswith(("\n", "\r")) else ""
             raise DataError(
-                f"{path.name}: line {k} has {got} fields, the header has {expected}{cut}: the file looks "
+                f"{path.name}: line {k} has {got} fields, {first} has {expected}{cut}: "
+                f"the file looks "
                 f"{'truncated' if last else 'truncated or corrupt'}",
                 hint=f"repair or remove line {k}")
 
@@ -638,8 +642,6 @@ def save(tr: Trajectory, path, *, format: str | None = None, key: str = "/",
 
 def _display(tr: Trajectory, cols: dict) -> dict[str, str]:
     """Each channel's display unit; the values in ``cols`` converted to it (in place)."""
-    from ..units import convert, same_dimension
-
     out = {}
     for n in tr.names:
         si, shown = tr.unit(n), tr.display_unit(n)
