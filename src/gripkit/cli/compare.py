@@ -62,12 +62,15 @@ def compare(model: Path = ModelArg,
 
 def simulate_model_file(model: Path, data: Path | None, out: Path | None, fs, time, fill, json_out: bool) -> None:
     """``gripkit simulate MODEL.json --data DATA``: the model's outputs for DATA's input columns
-    (by name, offsets applied, from rest); writes the time column and one column per output."""
+    (by name, offsets applied, from rest); writes the time column and one column per output, each
+    in the output's display unit (the unit the estimation data's file wrote it in, ``force [mN]``)
+    where the model file records one, else in SI."""
     import numpy as np
 
     from ..errors import DataError
     from ..io import save
     from ..signals.trajectory import Trajectory
+    from ..units import convert
 
     if data is None:
         raise DataError(f"simulate {str(model)!r}: a model file needs input data: --data DATA",
@@ -77,12 +80,17 @@ def simulate_model_file(model: Path, data: Path | None, out: Path | None, fs, ti
         m, tr = _model_and_data(model, data, fs, time, fill, outputs=False)
         ys = m.simulate_data(tr)
     units = {n: u for n, u in zip(m.outputs, m.system.output_units) if u}
+    shown = {n: m.display_units[n] for n in m.outputs if n in m.display_units}
     sim = Trajectory(tr.t, {n: ys[:, i] for i, n in enumerate(m.outputs)}, units,
-                     {"model": str(model), "data": str(data)})
+                     {"model": str(model), "data": str(data), "display_units": shown})
     if out is not None:
-        save(sim, out)
+        save(sim, out, units="display")
+    ys = np.column_stack([convert(ys[:, i], units[n], shown[n]) if n in shown else ys[:, i]
+                          for i, n in enumerate(m.outputs)])  # in the units the file shows
+    units.update(shown)
     res = {"model": str(model), "data": str(data), "samples": sim.n, "out": None if out is None else str(out),
-           "outputs": {n: {"unit": sim.unit(n), "min": float(np.min(ys[:, i])), "max": float(np.max(ys[:, i])),
+           "outputs": {n: {"unit": sim.display_unit(n), "si_unit": sim.unit(n),
+                           "min": float(np.min(ys[:, i])), "max": float(np.max(ys[:, i])),
                            "final": float(ys[-1, i])} for i, n in enumerate(m.outputs)},
            "warnings": report_warnings(caught)}
     if json_out:

@@ -55,17 +55,23 @@ def _check_options(fs, fill, detrend: str, validate: Path | None = None, **order
 
 
 def _io(path: Path, input: str, output: str, fs, time, fill, detrend: str, why: str):
+    return _load_io(path, input, output, fs, time, fill, detrend, why)[1]
+
+
+def _load_io(path: Path, input: str, output: str, fs, time, fill, detrend: str, why: str):
+    """The record (a Trajectory) and its input and output as identification data."""
     from ..sysid import io_data
 
     tr = load_data(path, [input, output], fs, time, fill)
-    return io_data(tr, input=input, output=output, detrend=detrend, why=why)
+    return tr, io_data(tr, input=input, output=output, detrend=detrend, why=why)
 
 
 def _fit_and_report(method: str, data: Path, input: str, output: str, fs, time, fill, detrend: str,
                     validate: Path | None, json_out: bool, fit, out_file: Path | None = None):
     """Shared body of arx/armax/oe: load, fit (``fit(io) -> model``), validate, print."""
     with collected_warnings() as caught:
-        io = _io(data, input, output, fs, time, fill, detrend, f"{method.upper()} identification")
+        tr, io = _load_io(data, input, output, fs, time, fill, detrend,
+                          f"{method.upper()} identification")
         model = fit(io)
         if detrend == "mean":
             from ..sysid.identify import warn_if_mean_detrending_hurt
@@ -76,7 +82,9 @@ def _fit_and_report(method: str, data: Path, input: str, output: str, fs, time, 
             from ..sysid.linear_model import from_polynomial
             from ..sysid.model_file import file_sha256
 
-            from_polynomial(model).replace(data_file=Path(data).name, data_hash=file_sha256(data)).save(out_file)
+            lm = from_polynomial(model).replace(data_file=Path(data).name,
+                                                data_hash=file_sha256(data))
+            lm.with_display_units(tr).save(out_file)  # outputs shown in the file's units
         out = model.to_dict()
         out.update(data=str(data), detrend=detrend)
         val = None
@@ -153,6 +161,7 @@ def _mimo_arx(data: Path, input: str, output: str, na: int, nb: int, nk: int, fs
         tr = load_data(data, columns, fs, time, fill)
         model = fit_arx(tr, input=input, output=output, na=na, nb=nb, nk=nk, detrend=detrend)
         model = model.replace(data_file=Path(data).name, data_hash=file_sha256(data))
+        model = model.with_display_units(tr)
         if out_file is not None:
             model.save(out_file)
         res = model.to_dict()

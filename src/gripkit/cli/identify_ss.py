@@ -46,7 +46,7 @@ def _with_provenance(model, data: Path):
 def _finish(model, data, tr, out, report, caught_lines_fn):
     """Save and report (shared tail of the three commands)."""
     if out is not None:
-        model.save(out)
+        model.with_display_units(tr).save(out)  # outputs shown in the units of the data's file
     if report is not None:
         from ..sysid.model_report import write_model_report
 

@@ -1,6 +1,8 @@
 """Readers and writers for CSV, Parquet and HDF5 behind :func:`load` and :func:`save`.
 
-* CSV: one header row; units in headers (``force [N]``). Read with pyarrow.
+* CSV: one header row; units in headers (``force [N]``). Read with pyarrow. A file without a
+  header (every field of its first line a number) is read whole, its columns named ``'1'``,
+  ``'2'``, … by position (:mod:`gripkit.io.table`).
 * Parquet: one column per channel; units in the field metadata key ``unit`` (or in headers).
 * HDF5: a group holding one 1-D dataset per channel (attribute ``unit``), or one 2-D dataset
   with a ``columns`` attribute (and optionally ``units``); ``key=`` names the group/dataset.
@@ -34,10 +36,11 @@ from ..arguments import check_path, entry_point
 from ..atomic import atomic_write
 from ..errors import ArgumentError, DataError, DataWarning
 from ..signals.trajectory import Trajectory
+from ..units import convert, same_dimension
 from .hdf5_links import check_dataset, hdf5_get, hdf5_text
 from .mat_reader import read_mat
-from .table import (check_fill, check_fs, check_size, columns_to_trajectory, is_time_name,
-                    split_header)
+from .table import (by_position, check_fill, check_fs, check_size, columns_to_trajectory,
+                    is_time_name, split_header)
 
 __all__ = ["load", "save", "FORMATS"]
 
@@ -125,7 +128,9 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
     numbers are written so (``0,25``). Integer time stamps in nanoseconds (a column named
     ``stamp``, ``time_ns`` and the like or ``*_ns`` given as ``time=``, with the unit ``[ns]``, or
     integers of 1e17 and more) are read exactly, relative to the first stamp
-    (``meta['time_origin']``).
+    (``meta['time_origin']``). A file without a header (every field of its first line a
+    number) is read from its first line, its columns named by 1-based position (``'1'``, ``'2'``,
+    …; ``columns=["2", "3"]``, ``time="1"``), and ``meta['header']`` says so.
     """
     check_path(path, "path", "load()")
     if units is not None and not isinstance(units, Mapping):
@@ -157,7 +162,8 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
     raw, meta_units = reader(path, key=key, delimiter=delimiter, wanted=wanted, limit=limit,
                              allow_external=allow_external_links)
     return columns_to_trajectory(raw, source=path.name, columns=columns, time=time, fs=fs,
-                                 units=units, meta_units=meta_units, fill=fill)
+                                 units=units, meta_units=meta_units, fill=fill,
+                                 headerless=fmt == "csv" and by_position(raw))
 
 
 def _allow_external(allow) -> bool:
@@ -228,9 +234,11 @@ def _read_csv(path: Path, key=None, delimiter=None, *, wanted=None, limit=None,
     if delimiter is None:
         tsv = path.suffix.lower() == ".tsv"
         delimiter, decimal = ("\t", ".") if tsv else _sniff_separator(data)
+    names = _headerless_names(data, delimiter)
     try:
         table = pacsv.read_csv(
-            pa.BufferReader(data), parse_options=pacsv.ParseOptions(delimiter=delimiter),
+            pa.BufferReader(data), read_options=pacsv.ReadOptions(column_names=names),
+            parse_options=pacsv.ParseOptions(delimiter=delimiter),
             convert_options=pacsv.ConvertOptions(strings_can_be_null=True, decimal_point=decimal,
                                                  null_values=["", "NaN", "nan", "NA", "null"]))
     except (pa.ArrowInvalid, pa.ArrowTypeError, UnicodeDecodeError) as exc:
@@ -295,17 +303,36 @@ _NUMBER = re.compile(rb"^[-+]?(\d+([.,]\d*)?|[.,]\d+)([eE][-+]?\d+)?$")
 _DECIMAL_COMMA = re.compile(r"^\s*[-+]?\d*,\d+([eE][-+]?\d+)?\s*$")
 
 
+#: cells of a first line that a headerless file's first data row may hold besides numbers
+_MISSING = (b"", b"NaN", b"nan", b"NA", b"null")
+
+
+def _headerless_names(data: bytes, delimiter: str) -> list[str] | None:
+    """Column names ``'1'``, ``'2'``, … when the file has no header (every field of its first
+    line is a number, or a missing value beside at least one number): the first line is then the
+    first data row, and the columns are named by their 1-based index. None for a header."""
+    line = next((x for x in data[:65536].splitlines() if x.strip()), b"")
+    fields = [f.strip().strip(b'"') for f in line.split(delimiter.encode())]
+    if not any(_NUMBER.match(f) for f in fields):
+        return None
+    if not all(_NUMBER.match(f) or f in _MISSING for f in fields):
+        return None
+    return [str(k) for k in range(1, len(fields) + 1)]
+
+
 def _sniff_separator(data: bytes) -> tuple[str, str]:
     """The separator and decimal point of a CSV file read without ``delimiter=``: ``,`` and
-    ``.``, unless the header holds ``;`` and no ``,`` (a European spreadsheet's export): then
+    ``.``, unless the header holds ``;`` and no ``,`` (a European spreadsheet's export), or the
+    file has no header and its first line is numbers separated by ``;`` (``0,25;1,5``): then
     ``;``, with ``,`` as decimal point when the data rows write their numbers so (``0,25``)."""
     lines = data[:65536].decode("utf-8", errors="replace").splitlines()
     if len(data) > 65536:
         lines = lines[:-1]  # cut short
     header = next((line for line in lines if line.strip()), "")
-    if ";" not in header or "," in header:
+    numbers = all(_NUMBER.match(f.strip().encode()) for f in header.split(";"))
+    if ";" not in header or ("," in header and not numbers):
         return ",", "."
-    rows = [line for line in lines[1:200] if line.strip()]
+    rows = [line for line in lines[:200] if line.strip()]  # the header: a data row or no comma
     comma = any(_DECIMAL_COMMA.match(f) for line in rows for f in line.split(";"))
     return ";", "," if comma else "."
 
@@ -321,6 +348,8 @@ def _refuse_ragged_line(path: Path, delimiter: str) -> None:
         return
     sep = delimiter
     expected = numbered[0][1].count(sep) + 1
+    first = "the header" if _headerless_names(numbered[0][1].encode(), sep) is None else \
+        f"line {numbered[0][0]}, the first (the file has no header),"
     for k, line in numbered[1:]:
         if not line.strip() or '"' in line:
             continue
@@ -329,7 +358,8 @@ def _refuse_ragged_line(path: Path, delimiter: str) -> None:
             last = k == len(lines)
             cut = " and is the last line, without a line ending" if last and not text.endswith(("\n", "\r")) else ""
             raise DataError(
-                f"{path.name}: line {k} has {got} fields, the header has {expected}{cut}: the file looks "
+                f"{path.name}: line {k} has {got} fields, {first} has {expected}{cut}: "
+                f"the file looks "
                 f"{'truncated' if last else 'truncated or corrupt'}",
                 hint=f"repair or remove line {k}")
 
@@ -562,19 +592,26 @@ def _hdf5_group(node, source: str, wanted, limit: float, allow_external: bool):
 
 
 @entry_point
-def save(tr: Trajectory, path, *, format: str | None = None, key: str = "/") -> None:
-    """Write a trajectory: time as ``t`` (s) then each channel with its SI unit. Written with
+def save(tr: Trajectory, path, *, format: str | None = None, key: str = "/",
+         units: str = "si") -> None:
+    """Write a trajectory: time as ``t`` (s) then each channel with its unit, SI by default;
+    ``units="display"`` writes each channel in the unit its file was written in
+    (:meth:`Trajectory.display_unit`: ``force [mN]`` read, ``force [mN]`` written, values in mN),
+    which :func:`load` reads back to the same SI values. Written with
     :func:`gripkit.atomic.atomic_write`: a save that fails midway leaves the old file as it was and
     raises :class:`PathError`."""
     if not isinstance(tr, Trajectory):
         raise ArgumentError(f"save(): tr must be a gripkit Trajectory, found {type(tr).__name__}")
+    if units not in ("si", "display"):
+        raise ArgumentError(f"save(): units must be 'si' or 'display', found {units!r:.40}",
+                            hint="'display' writes each channel in the unit its file used")
     check_path(path, "path", "save()")
     path = Path(path)
     fmt = _format(path, format)
     if fmt == "mcap":
         raise DataError("gripkit reads MCAP logs but writes CSV, Parquet or HDF5", hint="save as .parquet")
     cols = {"t": tr.t, **{n: tr[n] for n in tr.names}}
-    units = {"t": "s", **tr.units}
+    units = {"t": "s", **(tr.units if units == "si" else _display(tr, cols))}
     if fmt == "csv":
         header = ",".join(f"{n} [{u}]" if u != "1" else n for n, u in units.items())
 
@@ -601,3 +638,18 @@ def save(tr: Trajectory, path, *, format: str | None = None, key: str = "/") -> 
                     ds = g.create_dataset(n, data=v)
                     ds.attrs["unit"] = units[n]
     atomic_write(path, write, what="trajectory file")
+
+
+def _display(tr: Trajectory, cols: dict) -> dict[str, str]:
+    """Each channel's display unit; the values in ``cols`` converted to it (in place)."""
+    out = {}
+    for n in tr.names:
+        si, shown = tr.unit(n), tr.display_unit(n)
+        if shown != si:
+            if not same_dimension(si, shown):
+                raise DataError(f"save(): channel {n!r} is in {si!r}, its display unit {shown!r} "
+                                f"measures another quantity",
+                                hint="correct or remove tr.meta['display_units']")
+            cols[n] = convert(cols[n], si, shown)
+        out[n] = shown
+    return out

@@ -3,7 +3,10 @@
 Rules shared by every reader:
 
 * a column header may carry its unit, ``"force [mN]"`` or ``"force (mN)"``; values are converted
-  to SI and the channel is named ``force``. Units may also come from file metadata or ``units=``;
+  to SI and the channel is named ``force``. Units may also come from file metadata or ``units=``.
+  The units as written, where they are not SI, are kept in ``meta['display_units']``
+  (``{"force": "mN"}``; :meth:`Trajectory.display_unit`), so that results can be written back
+  in them (``gripkit.io.save(tr, path, units="display")``, ``gripkit simulate MODEL --out``);
 * the time base is the column named by ``time=``, else a column named ``t``, ``time``,
   ``timestamp``, ``time_s``, ``stamp``, ``time_ns`` and the like (:func:`is_time_name`; its
   unit converted to seconds), else a uniform one built from ``fs=``. Given both a time column
@@ -17,7 +20,10 @@ Rules shared by every reader:
   or of integers from 1e17 up is in nanoseconds; other stamps from 1e12 up (milliseconds or
   microseconds since 1970?) are refused until their unit is given. Any other integer column beyond
   2**53 is refused;
-* ``columns=`` selects channels by name; ``fill='drop'|'interpolate'`` handles missing values.
+* ``columns=`` selects channels by name; ``fill='drop'|'interpolate'`` handles missing values;
+* a CSV file without a header (every field of its first line a number) has its columns named by
+  their 1-based position, ``'1'``, ``'2'``, …: none is taken as the time column unless named
+  with ``time='1'`` (or ``fs=`` is given), and ``meta['header']`` says so.
 """
 
 from __future__ import annotations
@@ -34,8 +40,8 @@ from ..signals.outliers import corrupt_samples
 from ..signals.trajectory import Trajectory
 from ..units import si_factor
 
-__all__ = ["columns_to_trajectory", "split_header", "check_fill", "check_fs", "check_size",
-           "is_time_name", "FILL_CHOICES"]
+__all__ = ["columns_to_trajectory", "split_header", "by_position", "check_fill", "check_fs",
+           "check_size", "is_time_name", "FILL_CHOICES"]
 
 _TIME_NAMES = ("t", "time", "timestamp", "time_s", "times", "stamp", "t_ns", "time_ns",
                "timestamp_ns", "stamp_ns", "header_stamp", "header_stamp_ns")
@@ -49,6 +55,13 @@ _HEADER = re.compile(r"^\s*(.*?)\s*[\[(]\s*([^\])]+?)\s*[\])]\s*$")
 def is_time_name(name: str) -> bool:
     """Whether a column of this name is taken as the time column when ``time=`` is not given."""
     return name.lower() in _TIME_NAMES
+
+
+def by_position(names) -> bool:
+    """Whether the columns ``names`` are ``'1'``, ``'2'``, … ``'n'``: those of a CSV file without
+    a header, named by their 1-based position."""
+    names = [str(n) for n in names]
+    return bool(names) and names == [str(k) for k in range(1, len(names) + 1)]
 
 
 def split_header(header: str) -> tuple[str, str | None]:
@@ -252,8 +265,9 @@ def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
                           columns: Sequence[str] | None = None, time: str | None = None,
                           fs: float | None = None, units: Mapping[str, str] | None = None,
                           meta_units: Mapping[str, str] | None = None,
-                          fill: str | None = None) -> Trajectory:
-    """Build a Trajectory from raw columns ``{header: values}``."""
+                          fill: str | None = None, headerless: bool = False) -> Trajectory:
+    """Build a Trajectory from raw columns ``{header: values}``; ``headerless``: the columns of a
+    CSV file without a header, named ``'1'``, ``'2'``, … by position (the messages say so)."""
     units = dict(units or {})
     meta_units = dict(meta_units or {})
     cols: dict[str, tuple[object, str | None]] = {}
@@ -265,6 +279,9 @@ def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
     if not cols:
         raise DataError(f"{source}: the file holds no columns")
     available = ", ".join(cols)
+    if headerless:
+        available += (f" (the file has no header, its first line holds numbers: its columns are "
+                      f"named by their position, 1 to {len(cols)})")
 
     # time base: the time column (named, or found by name) and/or the sampling rate fs, which must agree
     check_fill(fill)
@@ -272,6 +289,12 @@ def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
     tname = time
     if tname is None:
         tname = next((c for c in cols if is_time_name(c)), None)
+        if tname is None and fs is None and headerless:
+            raise DataError(f"{source}: no time column: the file has no header (its first line "
+                            f"holds numbers), so its columns are named by their position, 1 to "
+                            f"{len(cols)}, and none is known to be the time",
+                            hint="give the time column by position, time='1' (CLI: --time 1), or "
+                                 "the sampling rate fs (CLI: --fs HZ)")
         if tname is None and fs is None:
             looked = ", ".join(_TIME_NAMES[:9])
             raise DataError(f"{source}: no time column found (looked for {looked}, ...)",
@@ -310,6 +333,11 @@ def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
     else:
         t = np.arange(n) / float(fs)
         meta = {"source": source, "dt": 1.0 / float(fs)}
+    if headerless:
+        meta["header"] = "none: columns named by their 1-based position"
+    shown = {c: cols[c][1] for c in names if cols[c][1] is not None and cols[c][1] != su[c]}
+    if shown:  # the units the file wrote, for outputs in them (Trajectory.display_unit)
+        meta["display_units"] = shown
     t, data = _fill(t, data, fill)
     _warn_corrupt(source, t, data, su)
     if tname is not None:

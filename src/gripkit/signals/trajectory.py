@@ -42,7 +42,8 @@ class Trajectory:
         Mapping name → unit string (SI, e.g. ``'N'``, ``'m'``, ``'V'``, ``'A'``); missing names
         get ``'1'`` (dimensionless).
     meta
-        Free-form provenance (source file, nominal sample interval ``dt`` in s, notes).
+        Free-form provenance (source file, nominal sample interval ``dt`` in s, notes; the units
+        the file wrote its columns in, ``display_units``: :meth:`display_unit`).
     """
 
     __slots__ = ("t", "_ch", "_units", "meta")
@@ -152,6 +153,13 @@ class Trajectory:
         self._require(name)
         return self._units[name]
 
+    def display_unit(self, name: str) -> str:
+        """The unit channel ``name`` was written in by its file (``'mN'`` for a column
+        ``force [mN]``, from ``meta['display_units']``), else its SI unit. The values stay SI;
+        :func:`gripkit.io.save` with ``units="display"`` writes them in these units."""
+        self._require(name)
+        return (self.meta.get("display_units") or {}).get(name, self._units[name])
+
     @property
     def duration(self) -> float:
         return float(self.t[-1] - self.t[0]) if self.n > 1 else 0.0
@@ -231,7 +239,10 @@ class Trajectory:
             self._require(old)
         ch = {mapping.get(k, k): v for k, v in self._ch.items()}
         u = {mapping.get(k, k): v for k, v in self._units.items()}
-        return Trajectory(self.t, ch, u, self.meta)
+        meta = dict(self.meta)
+        if meta.get("display_units"):
+            meta["display_units"] = {mapping.get(k, k): v for k, v in meta["display_units"].items()}
+        return Trajectory(self.t, ch, u, meta)
 
     def window(self, t_start: float | None = None, t_end: float | None = None) -> "Trajectory":
         """Samples with ``t_start <= t < t_end``."""

@@ -210,9 +210,12 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
     if method in ("ss", "frf", "tf"):  # MIMO: input/output may name several columns
         fn = {"ss": identify_mimo.identify_ss, "frf": identify_mimo.identify_frf, "tf": identify_mimo.identify_tf}
         out = fn[method](data, input=input, output=output, detrend=detrend, **options)
-        return out[0] if method == "ss" else out
+        out = out[0] if method == "ss" else out
+        # a model file saved from it shows its columns in the data file's units (force [mN])
+        return out.with_display_units(data) if hasattr(out, "with_display_units") else out
     if method == "arx" and identify_mimo.several(input, output):  # matrix-polynomial ARX
-        return identify_mimo.identify_arx(data, input=input, output=output, na=na, nb=nb, nk=nk, detrend=detrend)
+        return identify_mimo.identify_arx(data, input=input, output=output, na=na, nb=nb, nk=nk,
+                                          detrend=detrend).with_display_units(data)
     io = io_data(data, input=input, output=output, detrend=detrend, why=f"{method.upper()} identification")
     if method in ("arx", "armax", "oe"):
         orders = (na, nb, nc, na if nf is None else nf, nk)

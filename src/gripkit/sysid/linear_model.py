@@ -105,6 +105,30 @@ def _in_unit(data, name: str, unit: str | None, what: str) -> np.ndarray:
     return convert(x, have, unit)
 
 
+def _checked_display_units(model, shown: dict) -> dict:
+    """``shown`` ({name: unit}) checked against the model's inputs and outputs: each a unit of
+    the same dimension as the SI unit it displays (else a :class:`ModelError`)."""
+    if not shown:
+        return shown
+    s = model.system
+    units = dict(zip(s.inputs, s.input_units)) | dict(zip(s.outputs, s.output_units))
+    for name, unit in shown.items():
+        si = units.get(name)
+        if si in (None, "", "1") or not isinstance(unit, str):
+            raise ModelError(f"display unit of {name!r}: the model has no input or output {name!r} "
+                             f"with a physical unit (display units: {shown})",
+                             hint="display units are taken from the estimation data's headers")
+        try:
+            ok = same_dimension(unit, si)
+        except Exception:
+            ok = False
+        if not ok:
+            raise ModelError(f"display unit of {name!r}: {unit!r} is not a unit of the same "
+                             f"quantity as the model's {si!r}",
+                             hint=f"give a unit of {name!r} in {si!r} or its multiples, or none")
+    return shown
+
+
 @dataclass(frozen=True, eq=False)
 class LinearModel:
     """An identified linear model.
@@ -132,6 +156,10 @@ class LinearModel:
         Provenance of the estimation data (file name, sha256 of its bytes).
     info
         Method details (horizon, weighting, iterations, stability notes, ...).
+    display_units
+        ``{name: unit}``: the units the estimation data's file wrote inputs and outputs in, where
+        not SI (``{"force": "mN"}``; :meth:`with_display_units`). The model computes in SI; the
+        model file keeps these as ``display_unit`` and ``gripkit simulate`` writes in them.
     """
 
     system: LinearSystem
@@ -147,6 +175,7 @@ class LinearModel:
     data_file: str | None = None
     data_hash: str | None = None
     info: dict = field(default_factory=dict)
+    display_units: dict = field(default_factory=dict)
 
     def __post_init__(self):
         s = self.system
@@ -163,6 +192,7 @@ class LinearModel:
             if not isinstance(s, StateSpace) or K.shape != (s.n_states, s.n_outputs):
                 raise ModelError(f"K: expected shape (n_states, {s.n_outputs}) on a StateSpace, found {K.shape}")
             set_(self, "K", K)
+        set_(self, "display_units", _checked_display_units(self, dict(self.display_units or {})))
 
     # ------------------------------------------------------------------ views
     @property
@@ -187,6 +217,23 @@ class LinearModel:
 
     def replace(self, **changes) -> LinearModel:
         return dataclasses.replace(self, **changes)
+
+    def with_display_units(self, data) -> LinearModel:
+        """This model with the display units of its inputs and outputs taken from the trajectory
+        ``data`` (:meth:`~gripkit.signals.Trajectory.display_unit`: the units its file wrote
+        them in, ``force [mN]`` → ``'mN'``), where they differ from the model's SI units."""
+        s = self.system
+        pairs = list(zip(s.inputs, s.input_units)) + list(zip(s.outputs, s.output_units))
+        shown = {n: data.display_unit(n) for n, u in pairs
+                 if n in data.names and u not in (None, "", "1") and data.unit(n) == u
+                 and data.display_unit(n) != u}
+        return self.replace(display_units=shown)
+
+    def display_unit(self, name: str) -> str | None:
+        """The unit input or output ``name`` is shown in: its display unit, else its SI unit."""
+        s = self.system
+        units = dict(zip(s.inputs, s.input_units)) | dict(zip(s.outputs, s.output_units))
+        return self.display_units.get(name, units.get(name))
 
     def discrete(self, dt: float) -> StateSpace:
         """The state-space system sampled at ``dt`` (ZOH for a continuous model)."""
@@ -323,7 +370,9 @@ def model_document(model: LinearModel) -> dict:
         {"schema": "gripkit.linear-model", "schema_version": 1, "gripkit_version": "0.1.0",
          "structure": "pem-innovation", "kind": "ss" | "tf", "dt": 0.01 | null,
          "inputs":  [{"name": "current", "unit": "A", "offset": 0.85}, ...],
-         "outputs": [{"name": "force", "unit": "N", "offset": 0.0}, ...],
+         "outputs": [{"name": "force", "unit": "N", "offset": 0.0, "display_unit": "mN"}, ...],
+                              (display_unit: the unit the estimation data wrote the column in,
+                              only where it is not SI; offsets and the system stay SI)
          "system": {…},       the lti system's own description (LinearSystem.to_dict: arrays,
                               names, units, dt, covariance with its tangents)
          "innovation": {"K": … | null, "x0": … | null, "noise_covariance": … | null},
@@ -334,8 +383,9 @@ def model_document(model: LinearModel) -> dict:
     s = model.system
     doc = {"schema": SCHEMA, "schema_version": SCHEMA_VERSION, "gripkit_version": __version__,
            "structure": model.structure, "kind": "ss" if isinstance(s, StateSpace) else "tf", "dt": s.dt,
-           "inputs": [{"name": n, "unit": u, "offset": o} for n, u, o in zip(s.inputs, s.input_units, model.u_offset)],
-           "outputs": [{"name": n, "unit": u, "offset": o}
+           "inputs": [_entry(model, n, u, o)
+                      for n, u, o in zip(s.inputs, s.input_units, model.u_offset)],
+           "outputs": [_entry(model, n, u, o)
                        for n, u, o in zip(s.outputs, s.output_units, model.y_offset)]}
     doc["system"] = s.to_dict()
     doc["innovation"] = {"K": model.K, "x0": model.x0, "noise_covariance": model.noise_covariance}
@@ -343,6 +393,14 @@ def model_document(model: LinearModel) -> dict:
                info=model.info,
                data=None if model.data_file is None else {"file": model.data_file, "sha256": model.data_hash})
     return doc
+
+
+def _entry(model: LinearModel, name: str, unit, offset: float) -> dict:
+    """An input or output of the model document, with its ``display_unit`` when it has one."""
+    entry = {"name": name, "unit": unit, "offset": offset}
+    if name in model.display_units:
+        entry["display_unit"] = model.display_units[name]
+    return entry
 
 
 def save_model(model, path) -> None:
@@ -390,7 +448,13 @@ def load_model(path) -> LinearModel:
                            u_offset=[d["offset"] for d in ins], y_offset=[d["offset"] for d in outs],
                            fit_percent=doc.get("fit_percent"), singular_values=None if sv is None else np.asarray(sv),
                            n_samples=doc.get("n_samples"), data_file=data.get("file"), data_hash=data.get("sha256"),
-                           info=doc.get("info") or {})
-    except (KeyError, TypeError) as exc:
+                           info=doc.get("info") or {},
+                           display_units={d["name"]: d["display_unit"] for d in (*ins, *outs)
+                                          if d.get("display_unit") is not None})
+    except (KeyError, TypeError, AttributeError) as exc:
         raise ModelError(f"model file {where}: a required field is missing or malformed ({exc})",
                          hint="regenerate the file with gripkit identify --out") from None
+    except ModelError as exc:
+        if not exc.message.startswith("display unit"):
+            raise
+        raise ModelError(f"model file {where}: {exc.message}", hint=exc.hint) from None
