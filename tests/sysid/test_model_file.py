@@ -109,3 +109,24 @@ def test_polynomial_model_saves_as_model_file(tmp_path, arx_data):
     p = p[np.abs(p) > 1e-9]                       # the delay's poles at z = 0 are states of B/(A F)
     assert np.allclose(np.sort_complex(p), np.sort_complex(pm.poles()), atol=1e-12)
     assert np.allclose(m.system.uncertainty.std, pm.theta_std, rtol=1e-12)
+
+
+def test_simulate_trajectory_is_what_gripkit_simulate_writes(tmp_path):
+    """Issue 23 ("the library, not the CLI, simulates a model file"): LinearModel.simulate_trajectory
+    gives the SI outputs of simulate_data on the record's time base, with the model's display
+    units in meta, and io.save(units="display") writes them as the estimation file did."""
+    from gripkit import Trajectory
+    from gripkit.io import load, save
+    from gripkit.lti import StateSpace
+    from gripkit.sysid import LinearModel
+
+    ss = StateSpace([[0.5]], [[1.0]], [[2.0]], [[0.0]], dt=0.1, inputs="i", outputs="f",
+                    input_units="A", output_units="N")
+    m = LinearModel(ss, "n4sid", display_units={"f": "mN"})
+    tr = Trajectory.uniform(dt=0.1, i=np.sin(np.arange(50) * 0.3), units={"i": "A"})
+    sim = m.simulate_trajectory(tr)
+    np.testing.assert_array_equal(sim["f"], m.simulate_data(tr)[:, 0])
+    assert sim.unit("f") == "N" and sim.meta["display_units"] == {"f": "mN"}
+    save(sim, tmp_path / "sim.csv", units="display")
+    assert (tmp_path / "sim.csv").read_text().splitlines()[0].endswith("f [mN]")
+    np.testing.assert_allclose(load(tmp_path / "sim.csv")["f"], sim["f"], rtol=1e-9)

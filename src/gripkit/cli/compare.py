@@ -69,7 +69,6 @@ def simulate_model_file(model: Path, data: Path | None, out: Path | None, fs, ti
 
     from ..errors import DataError
     from ..io import save
-    from ..signals.trajectory import Trajectory
     from ..units import convert
 
     if data is None:
@@ -78,11 +77,10 @@ def simulate_model_file(model: Path, data: Path | None, out: Path | None, fs, ti
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         m, tr = _model_and_data(model, data, fs, time, fill, outputs=False)
-        ys = m.simulate_data(tr)
-    units = {n: u for n, u in zip(m.outputs, m.system.output_units) if u}
-    shown = {n: m.display_units[n] for n in m.outputs if n in m.display_units}
-    sim = Trajectory(tr.t, {n: ys[:, i] for i, n in enumerate(m.outputs)}, units,
-                     {"model": str(model), "data": str(data), "display_units": shown})
+        sim = m.simulate_trajectory(tr)
+    sim.meta.update(model=str(model), data=str(data))
+    units, shown = dict(sim.units), sim.meta["display_units"]
+    ys = sim.as_array(*m.outputs)
     if out is not None:
         save(sim, out, units="display")
     ys = np.column_stack([convert(ys[:, i], units[n], shown[n]) if n in shown else ys[:, i]

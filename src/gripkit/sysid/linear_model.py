@@ -25,6 +25,7 @@ import numpy as np
 from .. import __version__
 from ..errors import DataError, DataWarning, ModelError, ParameterError
 from ..lti import LinearSystem, StateSpace, TransferFunction
+from ..signals.trajectory import Trajectory
 from ..units import convert, dimension_of, same_dimension
 from .checks import as_io_matrix
 from .model_file import SCHEMA, SCHEMA_VERSION, read_document, write_document
@@ -284,6 +285,18 @@ class LinearModel:
         dt = data.require_uniform(why="simulation of an identified model")
         u = self._columns(data, self.inputs, self.u_offset, "input")
         return self.simulate(u, dt=dt) + np.asarray(self.y_offset)
+
+    def simulate_trajectory(self, data) -> Trajectory:
+        """The model's outputs for the input columns of the trajectory ``data`` (by name, offsets
+        applied, from rest) as a :class:`~gripkit.signals.Trajectory` on ``data``'s time base:
+        SI values and units, the model's display units in ``meta['display_units']`` (so
+        ``gripkit.io.save(sim, path, units="display")`` writes ``force [mN]`` where the estimation
+        file did). What ``gripkit simulate MODEL.json --data DATA`` writes."""
+        ys = self.simulate_data(data)
+        units = {n: u for n, u in zip(self.outputs, self.system.output_units) if u}
+        shown = {n: self.display_units[n] for n in self.outputs if n in self.display_units}
+        return Trajectory(data.t, {n: ys[:, i] for i, n in enumerate(self.outputs)}, units,
+                          {"model": self.structure, "display_units": shown})
 
     def compare_data(self, data) -> tuple[list[float], np.ndarray]:
         """Free-run fit per output on a trajectory (columns by name, offsets applied, x0
