@@ -29,7 +29,7 @@ import numpy as np
 
 from ..errors import AccuracyWarning
 from ..report.html import Report
-from ..report.plots import log_ticks, measured_vs_model, plain, pyplot
+from ..report.plots import measured_vs_model, plain, pyplot
 from .frf import frf
 from .linear_model import VALIDATION_FIT, fit_per_output
 from .pem_ss import predict_errors
@@ -301,7 +301,6 @@ def bode_figure(system, dt, estimate, keep=None):
             lim = _magnitude_limits(mag[:, i, j], kept)
             if lim is not None:
                 am.set_ylim(*lim)
-                log_ticks(am)
             am.set_title(plain(f"{system.inputs[j]} → {system.outputs[i]}"), fontsize=9)
             am.grid(alpha=0.3, which="both")
             ap.grid(alpha=0.3, which="both")
