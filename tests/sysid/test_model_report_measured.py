@@ -28,8 +28,9 @@ from gripkit.signals import split
 from gripkit.sysid import load_model
 from gripkit.sysid.frf import frf
 from gripkit.sysid.linear_model import LinearModel, fit_per_output
-from gripkit.sysid.model_report import (ESTIMATE_MARGIN_DECADES, MIN_INPUT_POWER, _xcorr, bode_figure,
-                                        meaningful_lines, predictor_x0, residual_analysis)
+from gripkit.sysid.model_report import (ESTIMATE_MARGIN_DECADES, MIN_INPUT_POWER, _xcorr,
+                                        bode_figure, meaningful_lines, predictor_x0,
+                                        residual_analysis)
 from gripkit.sysid.pem_ss import predict_errors
 
 FIXTURE = Path(__file__).resolve().parents[1] / "fixtures" / "dc_motor" / "dc_motor.csv"
@@ -68,21 +69,23 @@ def _check_magnitude_axis(fig, system, dt):
     lo, hi = fig.axes[0].get_ylim()
     assert lo >= g.min() / 10 ** (ESTIMATE_MARGIN_DECADES + 0.21)
     assert hi <= g.max() * 10 ** (ESTIMATE_MARGIN_DECADES + 0.21)
-    assert lo <= g.min() and hi >= g.max()                              # the whole model curve shows
+    assert lo <= g.min() and hi >= g.max()                      # the whole model curve shows
     return lo, hi
 
 
 # --------------------------------------------------------------------------- measured record
 @pytest.fixture(scope="module")
 def measured(tmp_path_factory):
-    """The model: `identify ss --form innovation --order 4` on the first half (SysIdentPy's split)."""
+    """The model: `identify ss --form innovation --order 4` on the first half (SysIdentPy's
+    split)."""
     d = tmp_path_factory.mktemp("dc_motor")
     whole = load(FIXTURE, fs=1.0)
     est, val = split(whole, 2)
     save(est, d / "est.csv")
     save(val, d / "val.csv")
-    code = main([str(a) for a in ("identify", "ss", d / "est.csv", "--input", "voltage", "--output", "output",
-                                  "--fs", "1", "--order", "4", "--form", "innovation", "--out", d / "m.json")])
+    code = main([str(a) for a in ("identify", "ss", d / "est.csv", "--input", "voltage",
+                                  "--output", "output", "--fs", "1", "--order", "4",
+                                  "--form", "innovation", "--out", d / "m.json")])
     assert code == 0
     m = load_model(d / "m.json")
     assert m.structure == "pem-innovation" and m.K is not None
@@ -90,7 +93,8 @@ def measured(tmp_path_factory):
 
 
 def _deviations(m, data):
-    return (m._columns(data, m.inputs, m.u_offset, "input"), m._columns(data, m.outputs, m.y_offset, "output"))
+    return (m._columns(data, m.inputs, m.u_offset, "input"),
+            m._columns(data, m.outputs, m.y_offset, "output"))
 
 
 def test_measured_residuals_from_estimated_x0(measured):
@@ -112,7 +116,8 @@ def test_measured_record_report(capsys, measured):
     every drawn estimate point has input power and σ < |H|; the magnitude axis follows the model."""
     d, m, whole, _ = measured
     save(whole, d / "whole.csv")
-    code, out, err = run(capsys, "report", d / "m.json", d / "whole.csv", "--fs", "1", "--out", d / "rep", "--json")
+    code, out, err = run(capsys, "report", d / "m.json", d / "whole.csv", "--fs", "1",
+                         "--out", d / "rep", "--json")
     assert code == 0, err
     assert not [w for w in json.loads(out)["warnings"] if "residual analysis" in w]
     html = unescape((d / "rep" / "index.html").read_text())
@@ -123,7 +128,7 @@ def test_measured_record_report(capsys, measured):
     assert res.fit_percent[0] >= free[0] - 1.0
     assert f"<td>{free[0]:.4g}</td><td>{res.fit_percent[0]:.4g}</td>" in html.replace(" ", "")
 
-    est = frf(u, y, dt=1.0, nperseg=256)                     # what the report computes for 1000 samples
+    est = frf(u, y, dt=1.0, nperseg=256)              # what the report computes for 1000 samples
     keep = meaningful_lines(est, u)
     assert f"{int(keep.sum())} of the estimate's {keep.size} lines are drawn" in html
     fig = bode_figure(m.system, 1.0, est, keep)
@@ -137,7 +142,7 @@ def test_measured_record_report(capsys, measured):
     assert np.all((mag > lo) & (mag < hi))
 
 
-# --------------------------------------------------------------------------- the issue's failing case
+# ---------------------------------------------------------------------- the issue's failing case
 A = np.array([[1.5, -0.56], [1.0, 0.0]])              # poles 0.8, 0.7
 B, C, D = np.array([[1.0], [0.0]]), np.array([[0.5, 0.3]]), np.zeros((1, 1))
 K = place_poles(A.T, C.T, [-0.99994, 0.3]).gain_matrix.T  # predictor poles −0.99994 and 0.3
@@ -157,14 +162,16 @@ def _innovation_record(n=2000, sigma=0.05, seed=1):
 
 
 def _near_unit_model():
-    return LinearModel(StateSpace(A, B, C, D, dt=0.01, inputs=("u",), outputs=("y",)), "pem-innovation", K=K)
+    system = StateSpace(A, B, C, D, dt=0.01, inputs=("u",), outputs=("y",))
+    return LinearModel(system, "pem-innovation", K=K)
 
 
 def test_predictor_pole_near_minus_one_from_estimated_x0():
     """From x0 = 0 the predictor carries (−0.99994)^t · C x(0) through the record: autocorrelation
     ±1 at every lag and a negative one-step fit (the issue's symptom). From the least-squares x0 it
     recovers x(0) and leaves the white innovations: one-step fit above the free-run fit."""
-    np.testing.assert_allclose(np.sort(np.linalg.eigvals(A - K @ C).real), [-0.99994, 0.3], atol=1e-9)
+    np.testing.assert_allclose(np.sort(np.linalg.eigvals(A - K @ C).real), [-0.99994, 0.3],
+                               atol=1e-9)
     u, y = _innovation_record()
     U, Y = u[:, None], y[:, None]
     e0 = np.empty_like(Y)
@@ -177,7 +184,8 @@ def test_predictor_pole_near_minus_one_from_estimated_x0():
     np.testing.assert_allclose(x0, X0, atol=0.2)
     m = _near_unit_model()
     free = m.compare(U, Y)[0]
-    with pytest.warns(AccuracyWarning, match=r"pole at -0\.99994 .*decays to 1 % only after 7\.675e\+04 samples"):
+    slow = r"pole at -0\.99994 .*decays to 1 % only after 7\.675e\+04 samples"
+    with pytest.warns(AccuracyWarning, match=slow):
         res = residual_analysis(m, U, Y, 0.01, free)
     assert res.fit_percent[0] >= free[0] and res.fit_percent[0] > 95.0
     assert np.max(np.abs(_xcorr(res.e[:, 0], res.e[:, 0], LAGS))) < 4.0 / np.sqrt(y.size)
@@ -188,10 +196,11 @@ def test_near_unit_predictor_is_stated_in_the_report(capsys, tmp_path):
     u, y = _innovation_record()
     _near_unit_model().save(tmp_path / "m.json")
     save(Trajectory.uniform(dt=0.01, u=u, y=y), tmp_path / "d.csv")
-    code, out, err = run(capsys, "report", tmp_path / "m.json", tmp_path / "d.csv", "--out", tmp_path / "rep",
-                         "--json")
+    code, out, err = run(capsys, "report", tmp_path / "m.json", tmp_path / "d.csv",
+                         "--out", tmp_path / "rep", "--json")
     assert code == 0, err
-    warns = [w for w in json.loads(out)["warnings"] if "one-step predictor (A − KC) has a pole at -0.99994" in w]
+    said = "one-step predictor (A − KC) has a pole at -0.99994"
+    warns = [w for w in json.loads(out)["warnings"] if said in w]
     assert warns and warns[0].startswith("AccuracyWarning")
     html = (tmp_path / "rep" / "index.html").read_text()
     assert "has a pole at -0.99994" in html
@@ -221,11 +230,28 @@ def test_lines_without_input_power_are_not_drawn():
     with pytest.warns(AccuracyWarning):
         est = frf(u, y, dt=dt, nperseg=256)
     keep = meaningful_lines(est, u)
-    out_of_band = est.frequency_hz > 2.5 + 2 / (256 * dt)       # beyond the band and its Hann leakage
+    out_of_band = est.frequency_hz > 2.5 + 2 / (256 * dt)   # beyond the band and Hann leakage
     assert np.any(np.isfinite(est.H[out_of_band, 0, 0]))         # what was drawn before
     assert not np.any(keep[out_of_band])
     assert keep[(est.frequency_hz > 0.2) & (est.frequency_hz < 2.4)].all()
     fig = bode_figure(g, dt, est, keep)
     fe, _ = _estimate_points(fig)
     assert fe.max() <= 2.5 + 2 / (256 * dt)
+    _check_magnitude_axis(fig, g, dt)
+
+
+def test_magnitude_axis_ignores_wild_lines_it_is_given():
+    """Even when lines of 1e15 and 1e-300 are drawn (keep=None: every finite line, as before), the
+    magnitude axis stays within ESTIMATE_MARGIN_DECADES of the model's range (the issue's axis ran
+    from 1e-315 to 1e15 and the model was a flat line)."""
+    from gripkit.sysid.frf import FRF
+
+    dt = 0.05
+    g = TransferFunction([2.0, 4.0], [1.0, 0.8, 4.0]).c2d(dt)
+    f = np.linspace(0.0, 10.0, 65)
+    H = g.frequency_response(2 * np.pi * f)
+    H[50, 0, 0], H[60, 0, 0] = 1e15, 1e-300
+    fig = bode_figure(g, dt, FRF(f, H, np.full(H.shape, 1e-3), None, "h1"))
+    fe, mag = _estimate_points(fig)
+    assert mag.max() == 1e15 and mag.min() == 1e-300                    # drawn, but off the axis
     _check_magnitude_axis(fig, g, dt)

@@ -34,8 +34,9 @@ from .frf import frf
 from .linear_model import VALIDATION_FIT, fit_per_output
 from .pem_ss import predict_errors
 
-__all__ = ["write_model_report", "model_report", "residual_analysis", "predictor_x0", "meaningful_lines",
-           "bode_figure", "Residuals", "ESTIMATE_MARGIN_DECADES", "MIN_INPUT_POWER"]
+__all__ = ["write_model_report", "model_report", "residual_analysis", "predictor_x0",
+           "meaningful_lines", "bode_figure", "Residuals", "ESTIMATE_MARGIN_DECADES",
+           "MIN_INPUT_POWER"]
 
 #: an estimate line is drawn only where each input's Welch power is at least this fraction of
 #: that input's largest line (−40 dB): below it H1 divides noise by leakage
@@ -57,13 +58,15 @@ def _xcorr(a, b, lags):
 
 
 def predictor_x0(A, B, C, D, K, u, y) -> tuple[np.ndarray, np.ndarray]:
-    """Least-squares initial state of the predictor ``x̂⁺ = A x̂ + B u + K e``, ``e = y − C x̂ − D u``
-    (K = 0: the free run) over the whole record, and its prediction errors e (N, p).
+    """Least-squares initial state of the predictor ``x̂⁺ = A x̂ + B u + K e``,
+    ``e = y − C x̂ − D u`` (K = 0: the free run) over the whole record, and its prediction
+    errors e (N, p).
 
-    e is affine in x0: ``e(x0) = e(0) − O x0`` with ``O[t] = C (A − KC)^t``, whose column i is the
-    negated error of the same predictor started from the unit state e_i with u = 0 and y = 0; so
-    x0 = argmin ‖e(0) − O x0‖ (the free-run comparison's :func:`~.linear_model.estimate_x0` with
-    A − KC in place of A). Every pass is :func:`~.pem_ss.predict_errors`."""
+    e is affine in x0: ``e(x0) = e(0) − O x0`` with ``O[t] = C (A − KC)^t``, whose column i is
+    the negated error of the same predictor started from the unit state e_i with u = 0 and
+    y = 0; so x0 = argmin ‖e(0) − O x0‖ (the free-run comparison's
+    :func:`~.linear_model.estimate_x0` with A − KC in place of A). Every pass is
+    :func:`~.pem_ss.predict_errors`."""
     A, B, C, D, K = (np.ascontiguousarray(M, dtype=np.float64) for M in (A, B, C, D, K))
     u = np.ascontiguousarray(u, dtype=np.float64)
     y = np.ascontiguousarray(y, dtype=np.float64)
@@ -88,11 +91,12 @@ def predictor_x0(A, B, C, D, K, u, y) -> tuple[np.ndarray, np.ndarray]:
 class Residuals:
     """The residuals the report analyses.
 
-    ``e`` (N, p): one-step prediction errors of the innovation predictor (``kind='one-step'``) or
-    free-run output errors (``kind='output error'``: no K, or an unstable predictor), from ``x0``
-    estimated by least squares; ``fit_percent`` per output (one-step fit for ``'one-step'``);
-    ``predictor_pole``: the slowest pole of A − KC (None without K), ``memory_samples``: samples
-    an initial-state error takes to decay to 1 % through it; ``notes``: what the report states."""
+    ``e`` (N, p): one-step prediction errors of the innovation predictor (``kind='one-step'``)
+    or free-run output errors (``kind='output error'``: no K, or an unstable predictor), from
+    ``x0`` estimated by least squares; ``fit_percent`` per output (the one-step fit for
+    ``'one-step'``); ``predictor_pole``: the slowest pole of A − KC (None without K);
+    ``memory_samples``: samples an initial-state error takes to decay to 1 % through it;
+    ``notes``: what the report states."""
 
     e: np.ndarray
     x0: np.ndarray
@@ -107,58 +111,66 @@ def _fmt_pole(z: complex) -> str:
     return f"{z.real:.6g}" if abs(z.imag) < 1e-12 else f"{z.real:.6g}{z.imag:+.6g}j"
 
 
+def _warn(msg: str, notes: list) -> None:
+    warnings.warn(msg, AccuracyWarning, stacklevel=3)
+    notes.append(msg)
+
+
+def _predictor(model, A, C, notes):
+    """(kind, K, slowest pole, memory in samples) of the predictor the residuals come from."""
+    n, p = A.shape[0], C.shape[0]
+    if model.K is None or n == 0:
+        return "output error", np.zeros((n, p)), None, 0.0
+    K = np.asarray(model.K, dtype=np.float64)
+    poles = np.linalg.eigvals(A - K @ C)
+    pole = complex(poles[np.argmax(np.abs(poles))])
+    rho = abs(pole)
+    if rho >= 1.0:
+        _warn(f"residual analysis: the innovation model's one-step predictor (A − KC) is "
+              f"unstable (pole {_fmt_pole(pole)}, |p| = {rho:.6g}): its prediction errors grow "
+              f"without bound, so the free-run output errors (x0 estimated) are analysed instead",
+              notes)
+        return "output error", np.zeros((n, p)), pole, math.inf
+    memory = 0.0 if rho == 0.0 else math.log(100.0) / -math.log(rho)
+    return "one-step", K, pole, memory
+
+
 def residual_analysis(model, u, y, dt: float, free_run_fit=None) -> Residuals:
     """Residuals of ``model`` on deviation data ``u`` (N, m), ``y`` (N, p), initial state
-    estimated by least squares (:func:`predictor_x0`). Warns (:class:`~gripkit.errors.AccuracyWarning`)
-    when the innovation predictor is unstable (the free-run output errors are analysed instead),
-    when its slowest pole keeps an initial-state error beyond half the record, and when its
-    one-step fit falls more than 10 points below ``free_run_fit`` (the free-run fit per output)."""
+    estimated by least squares (:func:`predictor_x0`). Warns
+    (:class:`~gripkit.errors.AccuracyWarning`) when the innovation predictor is unstable (the
+    free-run output errors are analysed instead), when its slowest pole keeps an initial-state
+    error beyond :data:`SLOW_PREDICTOR_FRACTION` of the record, and when its one-step fit falls
+    more than 10 points below ``free_run_fit`` (the free-run fit per output)."""
     ss = model.discrete(dt)
-    A, B, C, D = ss.A, ss.B, ss.C, ss.D
-    N, n = y.shape[0], ss.n_states
-    notes = []
-    kind, K, pole, memory = "output error", np.zeros((n, ss.n_outputs)), None, 0.0
-    if model.K is not None and n:
-        Kk = np.asarray(model.K, dtype=np.float64)
-        poles = np.linalg.eigvals(A - Kk @ C)
-        pole = complex(poles[np.argmax(np.abs(poles))])
-        rho = abs(pole)
-        memory = math.inf if rho >= 1.0 else (0.0 if rho == 0.0 else math.log(100.0) / -math.log(rho))
-        if rho >= 1.0:
-            msg = (f"residual analysis: the innovation model's one-step predictor (A − KC) is unstable (pole "
-                   f"{_fmt_pole(pole)}, |p| = {rho:.6g}): its prediction errors grow without bound, so the "
-                   f"free-run output errors (x0 estimated) are analysed instead")
-            warnings.warn(msg, AccuracyWarning, stacklevel=2)
-            notes.append(msg)
-        else:
-            kind, K = "one-step", Kk
-    x0, e = predictor_x0(A, B, C, D, K, u, y)
+    N = y.shape[0]
+    notes: list[str] = []
+    kind, K, pole, memory = _predictor(model, ss.A, ss.C, notes)
+    x0, e = predictor_x0(ss.A, ss.B, ss.C, ss.D, K, u, y)
     fit = fit_per_output(y, y - e)
-    if kind == "one-step":
-        notes.append(f"One-step prediction errors of the innovation predictor x̂⁺ = (A − KC) x̂ + (B − KD) u + K y "
-                     f"from the initial state estimated by least squares over the record; its slowest pole "
-                     f"{_fmt_pole(pole)} (|p| = {abs(pole):.6g}) forgets an initial-state error to 1 % in "
-                     f"{memory:.4g} samples.")
-        if memory > SLOW_PREDICTOR_FRACTION * N:
-            msg = (f"residual analysis: the innovation model's one-step predictor (A − KC) has a pole at "
-                   f"{_fmt_pole(pole)} (|p| = {abs(pole):.6g}): an initial-state error decays to 1 % only "
-                   f"after {memory:.4g} samples, more than half of this record ({N}); the residuals and the "
-                   f"one-step fit ({', '.join(f'{f:.2f} %' for f in fit)}) hang on the initial state "
-                   f"estimated by least squares, and the noise model has a zero near the unit circle "
-                   f"(it claims almost no noise near {abs(np.angle(pole)) / (2 * np.pi * dt):.4g} Hz)")
-            warnings.warn(msg, AccuracyWarning, stacklevel=2)
-            notes.append(msg)
-        if free_run_fit is not None:
-            for name, f1, ff in zip(model.outputs, fit, free_run_fit):
-                if f1 < ff - 10.0:
-                    msg = (f"residual analysis: the one-step predictor fits output {name!r} worse than the "
-                           f"free run ({f1:.2f} % against {ff:.2f} %): the innovation gain K does not "
-                           f"describe this record's noise; judge the model by the free-run fit")
-                    warnings.warn(msg, AccuracyWarning, stacklevel=2)
-                    notes.append(msg)
-    else:
-        notes.append("Free-run output errors from the initial state estimated by least squares (as the "
-                     "comparison above).")
+    if kind != "one-step":
+        notes.insert(0, "Free-run output errors from the initial state estimated by least "
+                        "squares (as the comparison above).")
+        return Residuals(e, x0, kind, fit, pole, memory, tuple(notes))
+    notes.append(f"One-step prediction errors of the innovation predictor "
+                 f"x̂⁺ = (A − KC) x̂ + (B − KD) u + K y from the initial state estimated by least "
+                 f"squares over the record; its slowest pole {_fmt_pole(pole)} "
+                 f"(|p| = {abs(pole):.6g}) forgets an initial-state error to 1 % in "
+                 f"{memory:.4g} samples.")
+    if memory > SLOW_PREDICTOR_FRACTION * N:
+        fits = ", ".join(f"{f:.2f} %" for f in fit)
+        f_zero = abs(np.angle(pole)) / (2 * np.pi * dt)
+        _warn(f"residual analysis: the innovation model's one-step predictor (A − KC) has a pole "
+              f"at {_fmt_pole(pole)} (|p| = {abs(pole):.6g}): an initial-state error decays to "
+              f"1 % only after {memory:.4g} samples, more than half of this record ({N}); the "
+              f"residuals and the one-step fit ({fits}) hang on the initial state estimated by "
+              f"least squares, and the noise model has a zero near the unit circle (it claims "
+              f"almost no noise near {f_zero:.4g} Hz)", notes)
+    for name, f1, ff in zip(model.outputs, fit, free_run_fit or ()):
+        if f1 < ff - 10.0:
+            _warn(f"residual analysis: the one-step predictor fits output {name!r} worse than "
+                  f"the free run ({f1:.2f} % against {ff:.2f} %): the innovation gain K does not "
+                  f"describe this record's noise; judge the model by the free-run fit", notes)
     return Residuals(e, x0, kind, fit, pole, memory, tuple(notes))
 
 
@@ -233,11 +245,12 @@ def meaningful_lines(estimate, u) -> np.ndarray:
     from scipy.signal import welch
 
     H, S = estimate.H, estimate.H_std
-    ok = (estimate.frequency_hz > 0)[:, None, None] & np.isfinite(H) & np.isfinite(S) & (S < np.abs(H))
+    ok = np.isfinite(H) & np.isfinite(S) & (S < np.abs(H))
+    ok &= (estimate.frequency_hz > 0)[:, None, None]
     L = estimate.info.get("nperseg")
     if L:
-        _, P = welch(np.asarray(u, dtype=np.float64), nperseg=int(L), noverlap=int(L) // 2, window="hann",
-                     detrend=False, axis=0)
+        _, P = welch(np.asarray(u, dtype=np.float64), nperseg=int(L), noverlap=int(L) // 2,
+                     window="hann", detrend=False, axis=0)
         P = np.asarray(P).reshape(P.shape[0], -1)
         if P.shape[0] == H.shape[0]:
             powered = np.all(P >= MIN_INPUT_POWER * np.maximum(P.max(axis=0), 1e-300), axis=1)
@@ -349,11 +362,12 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=()) -> R
             sec.figure(measured_vs_model(t, y[:, i] + model.y_offset[i], {"model": ys[:, i] + model.y_offset[i]},
                                          ylabel=name, title=f"{name}: fit {fit[i]:.2f} %"), f"{name}", name=f"out-{i}")
         res = residual_analysis(model, u, y, dt, free_run_fit=fit)
-        sec = rep.section("Residual analysis", " ".join(res.notes[:1]) +
-                          " The dotted lines are ±1.96/√N, the 95 % band of white residuals independent of "
-                          "past inputs.")
-        for note in res.notes[1:]:
-            sec.text(note)
+        sec = rep.section("Residual analysis", res.notes[-1 if res.kind == "one-step" else 0]
+                          + " The dotted lines are ±1.96/√N, the 95 % band of white residuals "
+                            "independent of past inputs.")
+        for note in res.notes:
+            if note.startswith("residual analysis:"):
+                sec.text(note)
         if res.kind == "one-step":
             sec.table(["output", "free-run fit %", "one-step fit %"],
                       [[n, ff, f1] for n, ff, f1 in zip(model.outputs, fit, res.fit_percent)])
@@ -370,16 +384,16 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=()) -> R
                     warnings.simplefilter("ignore", AccuracyWarning)
                     est = frf(u, y, dt=dt, nperseg=int(min(4096, max(256, u.shape[0] // 16))))
                 keep = meaningful_lines(est, u)
-                shown = (f" {int(keep.sum())} of the estimate's {keep.size} lines are drawn: those with input "
-                         f"power (at least {MIN_INPUT_POWER:g} of the largest line's) and σ below |H|; the "
-                         f"magnitude axis follows the model, widened for the estimate by at most "
-                         f"{ESTIMATE_MARGIN_DECADES:g} decades.")
+                shown = (f" {int(keep.sum())} of the estimate's {keep.size} lines are drawn: "
+                         f"those with input power (at least {MIN_INPUT_POWER:g} of the largest "
+                         f"line's) and σ below |H|; the magnitude axis follows the model, widened "
+                         f"for the estimate by at most {ESTIMATE_MARGIN_DECADES:g} decades.")
             except Exception as exc:  # the report goes on without the estimate
                 caught_lines.append(f"FRF estimate skipped: {exc}")
-        rep.section("Frequency response", "Model magnitude and phase with ±2σ bands (from the parameter "
-                    "covariance) and the data's Welch H1 estimate with ±2σ where the data allow." + shown
-                    ).figure(bode_figure(model.system, dt, est, keep), "Bode",
-                             name="bode")
+        rep.section("Frequency response", "Model magnitude and phase with ±2σ bands (from the "
+                    "parameter covariance) and the data's Welch H1 estimate with ±2σ where the "
+                    "data allow." + shown).figure(bode_figure(model.system, dt, est, keep), "Bode",
+                                                  name="bode")
         if model.singular_values is not None:
             rep.section("Subspace singular values", "Singular values of the weighted subspace matrix; the order is "
                         "where they drop.").figure(singular_value_figure(np.asarray(model.singular_values), ss.n_states),
