@@ -204,6 +204,7 @@ def test_near_unit_predictor_is_stated_in_the_report(capsys, tmp_path):
     assert warns and warns[0].startswith("AccuracyWarning")
     html = (tmp_path / "rep" / "index.html").read_text()
     assert "has a pole at -0.99994" in html
+    assert "One-step prediction errors of the innovation predictor" in html
 
 
 def test_unstable_predictor_falls_back_to_output_errors():
@@ -214,7 +215,7 @@ def test_unstable_predictor_falls_back_to_output_errors():
     u, y = _innovation_record()
     with pytest.warns(AccuracyWarning, match="is unstable .*free-run output errors"):
         res = residual_analysis(m, u[:, None], y[:, None], 0.01)
-    assert res.kind == "output error"
+    assert res.kind == "output error" and res.notes[0].startswith("Free-run output errors")
     assert res.fit_percent[0] == pytest.approx(m.compare(u[:, None], y[:, None])[0][0], abs=1e-6)
 
 

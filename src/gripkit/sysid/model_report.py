@@ -96,7 +96,7 @@ class Residuals:
     ``x0`` estimated by least squares; ``fit_percent`` per output (the one-step fit for
     ``'one-step'``); ``predictor_pole``: the slowest pole of A − KC (None without K);
     ``memory_samples``: samples an initial-state error takes to decay to 1 % through it;
-    ``notes``: what the report states."""
+    ``notes``: what the report states (first what the residuals are, then the warnings)."""
 
     e: np.ndarray
     x0: np.ndarray
@@ -152,7 +152,7 @@ def residual_analysis(model, u, y, dt: float, free_run_fit=None) -> Residuals:
         notes.insert(0, "Free-run output errors from the initial state estimated by least "
                         "squares (as the comparison above).")
         return Residuals(e, x0, kind, fit, pole, memory, tuple(notes))
-    notes.append(f"One-step prediction errors of the innovation predictor "
+    notes.insert(0, f"One-step prediction errors of the innovation predictor "
                  f"x̂⁺ = (A − KC) x̂ + (B − KD) u + K y from the initial state estimated by least "
                  f"squares over the record; its slowest pole {_fmt_pole(pole)} "
                  f"(|p| = {abs(pole):.6g}) forgets an initial-state error to 1 % in "
@@ -362,12 +362,10 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=()) -> R
             sec.figure(measured_vs_model(t, y[:, i] + model.y_offset[i], {"model": ys[:, i] + model.y_offset[i]},
                                          ylabel=name, title=f"{name}: fit {fit[i]:.2f} %"), f"{name}", name=f"out-{i}")
         res = residual_analysis(model, u, y, dt, free_run_fit=fit)
-        sec = rep.section("Residual analysis", res.notes[-1 if res.kind == "one-step" else 0]
-                          + " The dotted lines are ±1.96/√N, the 95 % band of white residuals "
-                            "independent of past inputs.")
-        for note in res.notes:
-            if note.startswith("residual analysis:"):
-                sec.text(note)
+        sec = rep.section("Residual analysis", res.notes[0] + " The dotted lines are ±1.96/√N, "
+                          "the 95 % band of white residuals independent of past inputs.")
+        for note in res.notes[1:]:  # the warnings, beside the figure they concern
+            sec.text(note)
         if res.kind == "one-step":
             sec.table(["output", "free-run fit %", "one-step fit %"],
                       [[n, ff, f1] for n, ff, f1 in zip(model.outputs, fit, res.fit_percent)])
