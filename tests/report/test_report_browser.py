@@ -117,3 +117,34 @@ def test_demo_section_fits_phone_width(tmp_path, browser):
     code, out, err = _run(page, "--json", "--browser", browser)
     assert code == 0, err
     assert all(r["overflow"] == 0 and r["n_offenders"] == 0 for r in json.loads(out)["sizes"])
+
+
+def test_measured_record_report_fits_desktop_and_phone_width(tmp_path, browser):
+    """The model report of the measured DC-motor record (tests/fixtures/dc_motor: an innovation
+    model from its first half, reported on the whole record, as `gripkit report` writes it) at
+    1400×900 and 390×844: screenshots of those sizes, no horizontal overflow, nothing sticking
+    out."""
+    import warnings
+
+    from gripkit.io import load
+    from gripkit.signals import split
+    from gripkit.sysid.identify_mimo import identify_ss
+    from gripkit.sysid.model_report import write_model_report
+
+    fixture = Path(__file__).resolve().parents[1] / "fixtures" / "dc_motor" / "dc_motor.csv"
+    est, _ = split(load(fixture, fs=1.0), 2)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model, _ = identify_ss(est, input="voltage", output="output", order=4, form="innovation")
+    page = write_model_report(model, load(fixture, fs=1.0), tmp_path / "report",
+                              data_name="dc_motor.csv")
+    html = page.read_text()
+    assert "one-step fit %" in html and "lines are drawn" in html
+    code, out, err = _run(page.parent, "--out", tmp_path / "shots", "--json", "--browser", browser)
+    assert code == 0, err
+    by_width = {r["size"][0]: r for r in json.loads(out)["sizes"]}
+    for w, h in ((1400, 900), (390, 844)):
+        r = by_width[w]
+        assert r["screenshot_size"] == [w, h] and Path(r["screenshot"]).is_file()
+        assert r["viewport"] == w and r["scroll_width"] == w
+        assert r["overflow"] == 0 and r["n_offenders"] == 0

@@ -7,22 +7,47 @@ white, independent residuals (Ljung 2nd ed. §16.6); pole-zero map with the 1σ 
 pole (from the parameter covariance); Bode magnitude and phase with ±2σ bands, and the data's
 Welch H1 estimate (with its ±2σ) beside them when the data allow; the subspace singular values
 with the chosen order; the warnings raised on the way.
+
+Measured records (issue 25): the residuals are those of the model's predictor from the initial
+state estimated by least squares over the record (:func:`residual_analysis`; innovation models:
+``x̂⁺ = (A − KC) x̂ + (B − KD) u + K y``, whose prediction errors are affine in x0), as the free-run
+comparison does, never from x0 = 0 — a predictor pole near the unit circle would carry a wrong
+start through the whole record — and a predictor pole whose memory outlasts half the record is
+warned about. The Bode magnitude axis is set by the model's |G| and the estimate lines that mean
+something (:func:`meaningful_lines`: input power, σ below |H|), at most
+:data:`ESTIMATE_MARGIN_DECADES` beyond the model's range.
 """
 
 from __future__ import annotations
 
+import math
 import warnings
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
+from ..errors import AccuracyWarning
 from ..report.html import Report
 from ..report.plots import measured_vs_model, plain, pyplot
 from .frf import frf
-from .linear_model import VALIDATION_FIT
+from .linear_model import VALIDATION_FIT, fit_per_output
 from .pem_ss import predict_errors
 
-__all__ = ["write_model_report", "model_report"]
+__all__ = ["write_model_report", "model_report", "residual_analysis", "predictor_x0",
+           "meaningful_lines", "bode_figure", "Residuals", "ESTIMATE_MARGIN_DECADES",
+           "MIN_INPUT_POWER"]
+
+#: an estimate line is drawn only where each input's Welch power is at least this fraction of
+#: that input's largest line (−40 dB): below it H1 divides noise by leakage
+MIN_INPUT_POWER = 1e-4
+#: the Bode magnitude axis reaches at most this many decades beyond the model's |G| range to show
+#: estimate lines; the model's own range counts at most MODEL_DECADES below its peak
+ESTIMATE_MARGIN_DECADES = 2.0
+MODEL_DECADES = 8.0
+#: a predictor whose initial-state error needs more than this fraction of the record to decay to
+#: 1 % is warned about (its residuals hang on the estimated x0)
+SLOW_PREDICTOR_FRACTION = 0.5
 
 
 def _xcorr(a, b, lags):
@@ -30,6 +55,123 @@ def _xcorr(a, b, lags):
     b = b - b.mean()
     den = np.sqrt((a @ a) * (b @ b)) or 1.0
     return np.array([(a[k:] @ b[:a.size - k]) / den for k in lags])
+
+
+def predictor_x0(A, B, C, D, K, u, y) -> tuple[np.ndarray, np.ndarray]:
+    """Least-squares initial state of the predictor ``x̂⁺ = A x̂ + B u + K e``,
+    ``e = y − C x̂ − D u`` (K = 0: the free run) over the whole record, and its prediction
+    errors e (N, p).
+
+    e is affine in x0: ``e(x0) = e(0) − O x0`` with ``O[t] = C (A − KC)^t``, whose column i is
+    the negated error of the same predictor started from the unit state e_i with u = 0 and
+    y = 0; so x0 = argmin ‖e(0) − O x0‖ (the free-run comparison's
+    :func:`~.linear_model.estimate_x0` with A − KC in place of A). Every pass is
+    :func:`~.pem_ss.predict_errors`."""
+    A, B, C, D, K = (np.ascontiguousarray(M, dtype=np.float64) for M in (A, B, C, D, K))
+    u = np.ascontiguousarray(u, dtype=np.float64)
+    y = np.ascontiguousarray(y, dtype=np.float64)
+    n, (N, p) = A.shape[0], y.shape
+    e = np.empty((N, p))
+    predict_errors(A, B, C, D, K, np.zeros(n), u, y, e)
+    if n == 0 or N == 0:
+        return np.zeros(n), e
+    O = np.empty((N, p, n))
+    zu, zy, ei = np.zeros_like(u), np.zeros((N, p)), np.empty((N, p))
+    for i in range(n):
+        x = np.zeros(n)
+        x[i] = 1.0
+        predict_errors(A, B, C, D, K, x, zu, zy, ei)
+        O[:, :, i] = -ei
+    x0 = np.linalg.lstsq(O.reshape(-1, n), e.reshape(-1), rcond=None)[0]
+    predict_errors(A, B, C, D, K, x0, u, y, e)
+    return x0, e
+
+
+@dataclass(frozen=True, eq=False)
+class Residuals:
+    """The residuals the report analyses.
+
+    ``e`` (N, p): one-step prediction errors of the innovation predictor (``kind='one-step'``)
+    or free-run output errors (``kind='output error'``: no K, or an unstable predictor), from
+    ``x0`` estimated by least squares; ``fit_percent`` per output (the one-step fit for
+    ``'one-step'``); ``predictor_pole``: the slowest pole of A − KC (None without K);
+    ``memory_samples``: samples an initial-state error takes to decay to 1 % through it;
+    ``notes``: what the report states (first what the residuals are, then the warnings)."""
+
+    e: np.ndarray
+    x0: np.ndarray
+    kind: str
+    fit_percent: list[float]
+    predictor_pole: complex | None
+    memory_samples: float
+    notes: tuple[str, ...]
+
+
+def _fmt_pole(z: complex) -> str:
+    return f"{z.real:.6g}" if abs(z.imag) < 1e-12 else f"{z.real:.6g}{z.imag:+.6g}j"
+
+
+def _warn(msg: str, notes: list) -> None:
+    warnings.warn(msg, AccuracyWarning, stacklevel=3)
+    notes.append(msg)
+
+
+def _predictor(model, A, C, notes):
+    """(kind, K, slowest pole, memory in samples) of the predictor the residuals come from."""
+    n, p = A.shape[0], C.shape[0]
+    if model.K is None or n == 0:
+        return "output error", np.zeros((n, p)), None, 0.0
+    K = np.asarray(model.K, dtype=np.float64)
+    poles = np.linalg.eigvals(A - K @ C)
+    pole = complex(poles[np.argmax(np.abs(poles))])
+    rho = abs(pole)
+    if rho >= 1.0:
+        _warn(f"residual analysis: the innovation model's one-step predictor (A − KC) is "
+              f"unstable (pole {_fmt_pole(pole)}, |p| = {rho:.6g}): its prediction errors grow "
+              f"without bound, so the free-run output errors (x0 estimated) are analysed instead",
+              notes)
+        return "output error", np.zeros((n, p)), pole, math.inf
+    memory = 0.0 if rho == 0.0 else math.log(100.0) / -math.log(rho)
+    return "one-step", K, pole, memory
+
+
+def residual_analysis(model, u, y, dt: float, free_run_fit=None) -> Residuals:
+    """Residuals of ``model`` on deviation data ``u`` (N, m), ``y`` (N, p), initial state
+    estimated by least squares (:func:`predictor_x0`). Warns
+    (:class:`~gripkit.errors.AccuracyWarning`) when the innovation predictor is unstable (the
+    free-run output errors are analysed instead), when its slowest pole keeps an initial-state
+    error beyond :data:`SLOW_PREDICTOR_FRACTION` of the record, and when its one-step fit falls
+    more than 10 points below ``free_run_fit`` (the free-run fit per output)."""
+    ss = model.discrete(dt)
+    N = y.shape[0]
+    notes: list[str] = []
+    kind, K, pole, memory = _predictor(model, ss.A, ss.C, notes)
+    x0, e = predictor_x0(ss.A, ss.B, ss.C, ss.D, K, u, y)
+    fit = fit_per_output(y, y - e)
+    if kind != "one-step":
+        notes.insert(0, "Free-run output errors from the initial state estimated by least "
+                        "squares (as the comparison above).")
+        return Residuals(e, x0, kind, fit, pole, memory, tuple(notes))
+    notes.insert(0, f"One-step prediction errors of the innovation predictor "
+                 f"x̂⁺ = (A − KC) x̂ + (B − KD) u + K y from the initial state estimated by least "
+                 f"squares over the record; its slowest pole {_fmt_pole(pole)} "
+                 f"(|p| = {abs(pole):.6g}) forgets an initial-state error to 1 % in "
+                 f"{memory:.4g} samples.")
+    if memory > SLOW_PREDICTOR_FRACTION * N:
+        fits = ", ".join(f"{f:.2f} %" for f in fit)
+        f_zero = abs(np.angle(pole)) / (2 * np.pi * dt)
+        _warn(f"residual analysis: the innovation model's one-step predictor (A − KC) has a pole "
+              f"at {_fmt_pole(pole)} (|p| = {abs(pole):.6g}): an initial-state error decays to "
+              f"1 % only after {memory:.4g} samples, more than half of this record ({N}); the "
+              f"residuals and the one-step fit ({fits}) hang on the initial state estimated by "
+              f"least squares, and the noise model has a zero near the unit circle (it claims "
+              f"almost no noise near {f_zero:.4g} Hz)", notes)
+    for name, f1, ff in zip(model.outputs, fit, free_run_fit or ()):
+        if f1 < ff - 10.0:
+            _warn(f"residual analysis: the one-step predictor fits output {name!r} worse than "
+                  f"the free run ({f1:.2f} % against {ff:.2f} %): the innovation gain K does not "
+                  f"describe this record's noise; judge the model by the free-run fit", notes)
+    return Residuals(e, x0, kind, fit, pole, memory, tuple(notes))
 
 
 def _residual_figure(e, u, outputs, inputs):
@@ -94,7 +236,51 @@ def _pz_figure(system):
     return fig
 
 
-def bode_figure(system, dt, estimate):
+def meaningful_lines(estimate, u) -> np.ndarray:
+    """Mask (F, p, m) of the H1 estimate lines worth drawing: f > 0, H and σ finite, σ < |H| (the
+    estimate tells the response from zero: for SISO H1 that is coherence γ² > 1/K of K segments,
+    Bendat & Piersol eq 9.90), and every input carrying at least :data:`MIN_INPUT_POWER` of its
+    largest line's Welch power (the estimate's own segments and window) — a line without input
+    power gives H = noise / leakage, anything from 1e-300 to 1e15."""
+    from scipy.signal import welch
+
+    H, S = estimate.H, estimate.H_std
+    ok = np.isfinite(H) & np.isfinite(S) & (S < np.abs(H))
+    ok &= (estimate.frequency_hz > 0)[:, None, None]
+    L = estimate.info.get("nperseg")
+    if L:
+        _, P = welch(np.asarray(u, dtype=np.float64), nperseg=int(L), noverlap=int(L) // 2,
+                     window="hann", detrend=False, axis=0)
+        P = np.asarray(P).reshape(P.shape[0], -1)
+        if P.shape[0] == H.shape[0]:
+            powered = np.all(P >= MIN_INPUT_POWER * np.maximum(P.max(axis=0), 1e-300), axis=1)
+            ok &= powered[:, None, None]
+    return ok
+
+
+def _magnitude_limits(model_mag, est_mag):
+    """(lo, hi) of the magnitude axis: the model's |G| range (at most MODEL_DECADES below its peak),
+    widened to the kept estimates by at most ESTIMATE_MARGIN_DECADES, and a 0.2-decade margin."""
+    g = model_mag[np.isfinite(model_mag) & (model_mag > 0)]
+    if not g.size:
+        g = est_mag[np.isfinite(est_mag) & (est_mag > 0)]
+    if not g.size:
+        return None
+    hi_m = np.log10(g.max())
+    lo_m = max(np.log10(g.min()), hi_m - MODEL_DECADES)
+    lo, hi = lo_m, hi_m
+    e = est_mag[np.isfinite(est_mag) & (est_mag > 0)]
+    if e.size:
+        lo = max(min(lo, np.log10(e.min())), lo_m - ESTIMATE_MARGIN_DECADES)
+        hi = min(max(hi, np.log10(e.max())), hi_m + ESTIMATE_MARGIN_DECADES)
+    return 10 ** (lo - 0.2), 10 ** (hi + 0.2)
+
+
+def bode_figure(system, dt, estimate, keep=None):
+    """Bode magnitude and phase of ``system`` with its ±2σ bands; the estimate's lines where
+    ``keep`` (F, p, m) allows (default: every finite line at f > 0; the report passes
+    :func:`meaningful_lines`). The magnitude axis is set by :func:`_magnitude_limits`; the
+    estimate's points carry the gid ``'frf-estimate'``."""
     plt = pyplot()
     p, m = system.n_outputs, system.n_inputs
     nyq = np.pi / dt
@@ -113,16 +299,21 @@ def bode_figure(system, dt, estimate):
                 am.fill_between(f, np.maximum(mag[:, i, j] - 2 * ms[:, i, j], 1e-300), mag[:, i, j] + 2 * ms[:, i, j],
                                 alpha=0.25, label="±2σ")
                 ap.fill_between(f, ph[:, i, j] - 2 * ps[:, i, j], ph[:, i, j] + 2 * ps[:, i, j], alpha=0.25)
+            kept = np.zeros(0)
             if estimate is not None:
                 fe, He, Se = estimate.frequency_hz, estimate.H[:, i, j], estimate.H_std[:, i, j]
-                ok = np.isfinite(He) & (fe > 0)
-                am.errorbar(fe[ok], np.abs(He[ok]), yerr=2 * Se[ok], fmt=".", ms=2, lw=0.5, color="0.45",
-                            label="H1 estimate ±2σ")
+                ok = np.isfinite(He) & (fe > 0) if keep is None else keep[:, i, j]
+                kept = np.abs(He[ok])
+                am.errorbar(fe[ok], kept, yerr=2 * Se[ok], fmt=".", ms=2, lw=0.5, color="0.45",
+                            label="H1 estimate ±2σ")[0].set_gid("frf-estimate")
                 # phase of the estimate, aligned to the model's branch
                 php = np.degrees(np.angle(He[ok]))
                 ref = np.interp(fe[ok], f, ph[:, i, j])
                 php = php + 360 * np.round((ref - php) / 360)
-                ap.plot(fe[ok], php, ".", ms=2, color="0.45")
+                ap.plot(fe[ok], php, ".", ms=2, color="0.45", gid="frf-estimate-phase")
+            lim = _magnitude_limits(mag[:, i, j], kept)
+            if lim is not None:
+                am.set_ylim(*lim)
             am.set_title(plain(f"{system.inputs[j]} → {system.outputs[i]}"), fontsize=9)
             am.grid(alpha=0.3, which="both")
             ap.grid(alpha=0.3, which="both")
@@ -170,33 +361,43 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=()) -> R
         for i, name in enumerate(model.outputs):
             sec.figure(measured_vs_model(t, y[:, i] + model.y_offset[i], {"model": ys[:, i] + model.y_offset[i]},
                                          ylabel=name, title=f"{name}: fit {fit[i]:.2f} %"), f"{name}", name=f"out-{i}")
-        dss = model.discrete(dt)
-        K = model.K if model.K is not None else np.zeros((dss.n_states, dss.n_outputs))
-        e = np.empty_like(y)
-        x0 = np.zeros(dss.n_states)
-        predict_errors(dss.A, dss.B, dss.C, dss.D, K, x0, u, y, e)
-        rep.section("Residual analysis",
-                    f"{'One-step prediction errors of the innovation form' if model.K is not None else 'Output errors'}"
-                    "; the dotted lines are ±1.96/√N, the 95 % band of white residuals independent of past inputs."
-                    ).figure(_residual_figure(e[min(50, e.shape[0] // 10):], u[min(50, e.shape[0] // 10):],
-                                              model.outputs, model.inputs), "residual correlations", name="residuals")
+        res = residual_analysis(model, u, y, dt, free_run_fit=fit)
+        sec = rep.section("Residual analysis", res.notes[0] + " The dotted lines are ±1.96/√N, "
+                          "the 95 % band of white residuals independent of past inputs.")
+        for note in res.notes[1:]:  # the warnings, beside the figure they concern
+            sec.text(note)
+        if res.kind == "one-step":
+            sec.table(["output", "free-run fit %", "one-step fit %"],
+                      [[n, ff, f1] for n, ff, f1 in zip(model.outputs, fit, res.fit_percent)])
+        sec.figure(_residual_figure(res.e, u, model.outputs, model.inputs), "residual correlations",
+                   name="residuals")
         rep.section("Poles and zeros", "Poles (×), transmission zeros (○) and the 1σ ellipse of each pole, "
                     "by linearisation of the parameter covariance.").figure(_pz_figure(model.system), "pole-zero map",
                                                                             name="pz")
-        est = None
+        est, keep, shown = None, None, ""
         if u.shape[0] >= 256 * (u.shape[1] + 1):
             try:
-                est = frf(u, y, dt=dt, nperseg=int(min(4096, max(256, u.shape[0] // 16))))
+                with warnings.catch_warnings():
+                    # lines without input power are left out below, and the page says how many
+                    warnings.simplefilter("ignore", AccuracyWarning)
+                    est = frf(u, y, dt=dt, nperseg=int(min(4096, max(256, u.shape[0] // 16))))
+                keep = meaningful_lines(est, u)
+                shown = (f" {int(keep.sum())} of the estimate's {keep.size} lines are drawn: "
+                         f"those with input power (at least {MIN_INPUT_POWER:g} of the largest "
+                         f"line's) and σ below |H|; the magnitude axis follows the model, widened "
+                         f"for the estimate by at most {ESTIMATE_MARGIN_DECADES:g} decades.")
             except Exception as exc:  # the report goes on without the estimate
                 caught_lines.append(f"FRF estimate skipped: {exc}")
-        rep.section("Frequency response", "Model magnitude and phase with ±2σ bands (from the parameter "
-                    "covariance) and the data's Welch H1 estimate with ±2σ where the data allow."
-                    ).figure(bode_figure(model.system, dt, est), "Bode",
-                             name="bode")
+        rep.section("Frequency response", "Model magnitude and phase with ±2σ bands (from the "
+                    "parameter covariance) and the data's Welch H1 estimate with ±2σ where the "
+                    "data allow." + shown).figure(bode_figure(model.system, dt, est, keep), "Bode",
+                                                  name="bode")
         if model.singular_values is not None:
             rep.section("Subspace singular values", "Singular values of the weighted subspace matrix; the order is "
                         "where they drop.").figure(singular_value_figure(np.asarray(model.singular_values), ss.n_states),
                                                    "singular values", name="sv")
+    for w in caught:  # the caller sees them too (the CLI prints them and lists them in --json)
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     lines = caught_lines + [f"{w.category.__name__}: {w.message}" for w in caught]
     sec = rep.section("Warnings")
     sec.text("none" if not lines else "")
