@@ -276,21 +276,19 @@ def focus_score(model, focus: str, d: MimoData, estimation: bool = False) -> flo
     """Mean over outputs of the fit (%) by which ``focus`` judges ``model`` on the deviation data
     ``d``: ``'simulation'``, the free-run fit with x0 estimated (:data:`VALIDATION_FIT`; −inf for
     an unstable model); ``'prediction'``, the one-step-ahead fit of the innovation predictor
-    ``x̂⁺ = A x̂ + B u + K (y − C x̂ − D u)`` from the model's x0 on its ``estimation`` record, else
-    from 0 (the predictor forgets it: A − K C is stable, or the score is −inf)."""
+    ``x̂⁺ = A x̂ + B u + K (y − C x̂ − D u)`` from its x0 estimated by least squares
+    (:func:`~.pem_ss.predictor_x0`; −inf when A − K C is unstable). ``estimation`` is kept for
+    the callers' record of which data were used."""
     if focus == "simulation":
         return float(np.mean(model.compare(d.u, d.y, dt=d.dt)[0])) if model.stable else -math.inf
-    from .pem_ss import predict_errors
+    from .pem_ss import predictor_x0
 
     ss = model.system
     n, p = ss.n_states, ss.n_outputs
     K = np.zeros((n, p)) if model.K is None else model.K
     if n and np.max(np.abs(np.linalg.eigvals(ss.A - K @ ss.C))) >= 1.0:
         return -math.inf
-    x0 = model.x0 if estimation and model.x0 is not None else np.zeros(n)
-    e = np.empty_like(d.y)
-    predict_errors(ss.A, ss.B, ss.C, ss.D, np.ascontiguousarray(K), np.asarray(x0, dtype=np.float64),
-                   np.ascontiguousarray(d.u), np.ascontiguousarray(d.y), e)
+    _, e = predictor_x0(ss.A, ss.B, ss.C, ss.D, K, d.u, d.y)
     den = np.linalg.norm(d.y - d.y.mean(axis=0), axis=0)
     return float(np.mean(100.0 * (1.0 - np.linalg.norm(e, axis=0) / den)))
 

@@ -32,7 +32,7 @@ from ..report.html import Report
 from ..report.plots import measured_vs_model, plain, pyplot
 from .frf import frf
 from .linear_model import VALIDATION_FIT, fit_per_output
-from .pem_ss import predict_errors
+from .pem_ss import predictor_x0
 
 __all__ = ["write_model_report", "model_report", "residual_analysis", "predictor_x0",
            "meaningful_lines", "bode_figure", "Residuals", "ESTIMATE_MARGIN_DECADES",
@@ -55,36 +55,6 @@ def _xcorr(a, b, lags):
     b = b - b.mean()
     den = np.sqrt((a @ a) * (b @ b)) or 1.0
     return np.array([(a[k:] @ b[:a.size - k]) / den for k in lags])
-
-
-def predictor_x0(A, B, C, D, K, u, y) -> tuple[np.ndarray, np.ndarray]:
-    """Least-squares initial state of the predictor ``x̂⁺ = A x̂ + B u + K e``,
-    ``e = y − C x̂ − D u`` (K = 0: the free run) over the whole record, and its prediction
-    errors e (N, p).
-
-    e is affine in x0: ``e(x0) = e(0) − O x0`` with ``O[t] = C (A − KC)^t``, whose column i is
-    the negated error of the same predictor started from the unit state e_i with u = 0 and
-    y = 0; so x0 = argmin ‖e(0) − O x0‖ (the free-run comparison's
-    :func:`~.linear_model.estimate_x0` with A − KC in place of A). Every pass is
-    :func:`~.pem_ss.predict_errors`."""
-    A, B, C, D, K = (np.ascontiguousarray(M, dtype=np.float64) for M in (A, B, C, D, K))
-    u = np.ascontiguousarray(u, dtype=np.float64)
-    y = np.ascontiguousarray(y, dtype=np.float64)
-    n, (N, p) = A.shape[0], y.shape
-    e = np.empty((N, p))
-    predict_errors(A, B, C, D, K, np.zeros(n), u, y, e)
-    if n == 0 or N == 0:
-        return np.zeros(n), e
-    O = np.empty((N, p, n))
-    zu, zy, ei = np.zeros_like(u), np.zeros((N, p)), np.empty((N, p))
-    for i in range(n):
-        x = np.zeros(n)
-        x[i] = 1.0
-        predict_errors(A, B, C, D, K, x, zu, zy, ei)
-        O[:, :, i] = -ei
-    x0 = np.linalg.lstsq(O.reshape(-1, n), e.reshape(-1), rcond=None)[0]
-    predict_errors(A, B, C, D, K, x0, u, y, e)
-    return x0, e
 
 
 @dataclass(frozen=True, eq=False)

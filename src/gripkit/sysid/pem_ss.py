@@ -39,7 +39,7 @@ from ..lti import StateSpace, Uncertainty, affine_row, flush_tiny
 from .blocked_gram import add_rows, carried_states, carry, row_product, start_sums
 from .linear_model import LinearModel, as_io_matrix, fit_per_output, free_run
 
-__all__ = ["pem", "PEM_FORMS"]
+__all__ = ["pem", "PEM_FORMS", "predictor_x0"]
 
 PEM_FORMS = ("oe", "innovation")
 _WARM_START_SAMPLES = 20000
@@ -412,3 +412,33 @@ def _pem_covariance(A, B, C, D, K, x0, u, yw, feedthrough: bool, innovation: boo
                                   "model (a non-minimal order or a poorly exciting input)",
                                   hint="lower the order or excite the system more richly") from None
     return 0.5 * (cov_full[:d, :d] + cov_full[:d, :d].T), (dA, dB, dC, dD), e
+
+
+def predictor_x0(A, B, C, D, K, u, y) -> tuple[np.ndarray, np.ndarray]:
+    """Least-squares initial state of the predictor ``x̂⁺ = A x̂ + B u + K e``,
+    ``e = y − C x̂ − D u`` (K = 0: the free run) over the whole record, and its prediction
+    errors e (N, p).
+
+    e is affine in x0: ``e(x0) = e(0) − O x0`` with ``O[t] = C (A − KC)^t``, whose column i is
+    the negated error of the same predictor started from the unit state e_i with u = 0 and
+    y = 0; so x0 = argmin ‖e(0) − O x0‖ (the free-run comparison's
+    :func:`~.linear_model.estimate_x0` with A − KC in place of A). Every pass is
+    :func:`predict_errors`."""
+    A, B, C, D, K = (np.ascontiguousarray(M, dtype=np.float64) for M in (A, B, C, D, K))
+    u = np.ascontiguousarray(u, dtype=np.float64)
+    y = np.ascontiguousarray(y, dtype=np.float64)
+    n, (N, p) = A.shape[0], y.shape
+    e = np.empty((N, p))
+    predict_errors(A, B, C, D, K, np.zeros(n), u, y, e)
+    if n == 0 or N == 0:
+        return np.zeros(n), e
+    O = np.empty((N, p, n))
+    zu, zy, ei = np.zeros_like(u), np.zeros((N, p)), np.empty((N, p))
+    for i in range(n):
+        x = np.zeros(n)
+        x[i] = 1.0
+        predict_errors(A, B, C, D, K, x, zu, zy, ei)
+        O[:, :, i] = -ei
+    x0 = np.linalg.lstsq(O.reshape(-1, n), e.reshape(-1), rcond=None)[0]
+    predict_errors(A, B, C, D, K, x0, u, y, e)
+    return x0, e
