@@ -102,3 +102,22 @@ def test_an_innovation_refinement_that_loses_falls_back_to_output_error(monkeypa
         model, _ = identify_ss(_record(6), input="u", output="y", order=2)
     assert model.structure == "pem-oe" and model.info["focus"]["kept"] == "pem-oe"
     assert model.system.uncertainty is not None
+
+
+def test_pem_on_an_order_the_data_do_not_support_returns_the_subspace_model():
+    """A periodic band-limited record (the CLI tests' multisine) and the default order (9 here,
+    for a second-order plant): JᵀJ at PEM's optimum is so ill-conditioned that its computed
+    inverse is indefinite (an eigenvalue of −2e4), which used to stop identify ss with a
+    ModelError about the covariance. Now PEM reports the undetermined directions and the
+    subspace model comes back with a warning saying why."""
+    from gripkit.excitation import periodic_multisine
+    from gripkit.lti import TransferFunction
+
+    ex = periodic_multisine(0.05, 5.0, 400, 5, dt=0.05, amplitude=1.0)
+    y = TransferFunction([2.0, 4.0], [1.0, 0.8, 4.0]).c2d(0.05).simulate(ex.u)[:, 0]
+    y = y + 0.01 * np.random.default_rng(0).standard_normal(y.size)
+    tr = Trajectory.uniform(dt=0.05, v=ex.u, x=y)
+    with pytest.warns(AccuracyWarning, match="PEM refinement of the order-9 n4sid model failed .*"
+                                             "the data do not determine the model"):
+        model, _ = identify_ss(tr, input="v", output="x")
+    assert model.structure == "n4sid"

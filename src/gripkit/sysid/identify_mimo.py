@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import AccuracyWarning, DataError, GripkitError, GripkitWarning
+from ..errors import AccuracyWarning, DataError, GripkitError, GripkitWarning, IdentificationError
 from ..progress import status
 from ..signals.trajectory import Trajectory
 from .arx_mimo import arx_mimo
@@ -251,11 +251,23 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     if refine:
         report(f"PEM refinement ({form} form) of the order-{model.order} model")
         start = model
-        model = pem(model, u=d.u, y=d.y, form=form, max_iterations=max_iterations)
+        try:
+            model = pem(model, u=d.u, y=d.y, form=form, max_iterations=max_iterations)
+        except IdentificationError as exc:  # an order the data do not support in full
+            warnings.warn(f"PEM refinement of the order-{start.order} {start.structure} model failed "
+                          f"({exc.message}); the subspace model is returned, without parameter "
+                          f"covariance (lower the order, or --no-refine to skip PEM)",
+                          AccuracyWarning, stacklevel=2)
+            refine = False
+            model = start
+    if refine:
+        oe = None
         if form == "innovation" and focus == "simulation":  # PEM in oe form minimises the free-run
-            oe = lambda: pem(start, u=d.u, y=d.y, form="oe", max_iterations=max_iterations)  # noqa: E731
-        else:                                               # error itself: the second candidate
-            oe = None
+            def oe():                                       # error itself: the second candidate
+                try:
+                    return pem(start, u=d.u, y=d.y, form="oe", max_iterations=max_iterations)
+                except IdentificationError:
+                    return None
         model = _never_lose(start, model, focus, d if vd is None else vd, vd is None, max_iterations, oe)
     warn_if_stabilised(model)
     if detrend == "mean":
@@ -323,6 +335,8 @@ def _never_lose(start, refined, focus: str, d: MimoData, estimation: bool, max_i
         if candidate is None:
             continue
         model = candidate()
+        if model is None:  # the output-error refinement failed: nothing to weigh
+            continue
         if model is not refined:
             _warn_unconverged(model, max_iterations)
         after = focus_score(model, focus, d, estimation)

@@ -405,13 +405,21 @@ def _pem_covariance(A, B, C, D, K, x0, u, yw, feedthrough: bool, innovation: boo
         raise DataError(f"pem: {N} samples of {p} output(s) cannot determine {d + n} parameters",
                         hint="use a longer record or a lower order")
     s2 = float(np.sum(e * e)) / dof
+    singular = IdentificationError(
+        "pem: the Jacobian is singular at the optimum: the data do not determine the model (a "
+        "non-minimal order or a poorly exciting input)",
+        hint="lower the order or excite the system more richly")
     try:
         cov_full = s2 * np.linalg.inv(H)
     except np.linalg.LinAlgError:
-        raise IdentificationError("pem: the Jacobian is singular at the optimum: the data do not determine the "
-                                  "model (a non-minimal order or a poorly exciting input)",
-                                  hint="lower the order or excite the system more richly") from None
-    return 0.5 * (cov_full[:d, :d] + cov_full[:d, :d].T), (dA, dB, dC, dD), e
+        raise singular from None
+    cov = 0.5 * (cov_full[:d, :d] + cov_full[:d, :d].T)
+    # JᵀJ is positive semi-definite; an inverse that is not (rounding in an ill-conditioned JᵀJ,
+    # beyond 1/ε) means some directions are not determined, and no σ can be given for them
+    w = np.linalg.eigvalsh(cov) if d else np.zeros(0)
+    if w.size and w.min() < -1e-9 * max(w.max(), 0.0):
+        raise singular
+    return cov, (dA, dB, dC, dD), e
 
 
 def predictor_x0(A, B, C, D, K, u, y) -> tuple[np.ndarray, np.ndarray]:
