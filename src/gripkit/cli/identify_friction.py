@@ -19,6 +19,24 @@ from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, check
                      collected_warnings, emit_json, load_data, report_warnings)
 
 
+def friction_units(position: str, effort: str, scale: float = 1.0) -> dict[str, str]:
+    """Units of IDIM-LS's parameters from the position and effort units: inertia effort·s²/position,
+    viscous effort·s/position, Coulomb and offset in effort units, where the effort is
+    ``scale × effort`` (a factor other than 1 leads the effort unit: ``0.5 A``). A '1' (no unit)
+    drops out of products and quotients: 'N*m*s^2/rad', 's^2' rather than '(1)*s^2/1'."""
+    from ..units import ratio_unit
+
+    def times(a: str, b: str) -> str:
+        a, b = a or "1", b or "1"
+        return b if a == "1" else a if b == "1" else f"{a}*{b}"
+
+    eu = effort or "1"
+    if scale != 1.0:
+        eu = f"{scale:g}" if eu == "1" else f"{scale:g} {eu}"
+    return {"inertia": ratio_unit(times(eu, "s^2"), position or "1"),
+            "viscous": ratio_unit(times(eu, "s"), position or "1"), "coulomb": eu, "offset": eu}
+
+
 @identify_app.command("friction")
 def identify_friction(
     data: Path = typer.Argument(..., help="CSV/Parquet/HDF5 log with position and effort columns."),
@@ -51,9 +69,7 @@ def identify_friction(
         dt = tr.require_uniform(why="IDIM-LS (filtering and differentiation)")
         res = idim_ls(tr[position], tr[effort], dt=dt, effort_scale=effort_scale, cutoff=cutoff,
                       decimation=decimate, velocity_threshold=velocity_threshold)
-    pu = tr.unit(position)
-    eu = tr.unit(effort) if effort_scale == 1.0 else f"{effort_scale:g}*{tr.unit(effort)}"
-    units = {"inertia": f"({eu})*s^2/{pu}", "viscous": f"({eu})*s/{pu}", "coulomb": eu, "offset": eu}
+    units = friction_units(tr.unit(position), tr.unit(effort), effort_scale)
     out = {"params": res.params, "std": res.std, "relative_error_percent": res.relative_error_percent,
            "units": units, "n_samples": res.n_samples, "fs": 1.0 / res.dt, "cutoff_hz": res.cutoff,
            "decimation": res.decimation, "condition_number": res.condition_number,
