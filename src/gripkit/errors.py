@@ -27,6 +27,7 @@ __all__ = [
     "StabilityWarning",
     "AccuracyWarning",
     "DataWarning",
+    "warn",
 ]
 
 
@@ -110,3 +111,20 @@ class AccuracyWarning(GripkitWarning):
 class DataWarning(GripkitWarning):
     """Data that could be read but look damaged: a file whose last line is cut short, a sample far
     outside the rest of its channel (a corrupt value). The data are used as read; check them."""
+
+
+def warn(message: str, category: type[Warning] = GripkitWarning) -> None:
+    """Issue ``category(message)`` attributed to the first stack frame outside gripkit: the user's
+    line that called into gripkit, whatever the depth of the call inside (what Python 3.12's
+    ``warnings.warn(skip_file_prefixes=...)`` does), so the printed location and ``-W`` filters by
+    module point at the user's code, never into gripkit."""
+    import os
+    import sys
+    import warnings
+
+    package = os.path.dirname(os.path.abspath(__file__)) + os.sep
+    frame, level = sys._getframe(1), 2  # stacklevel 2: the caller of warn()
+    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package):
+        frame, level = frame.f_back, level + 1
+    warnings.warn(message, category, stacklevel=level)
+
