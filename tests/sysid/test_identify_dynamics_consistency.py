@@ -204,3 +204,18 @@ def test_consistency_monte_carlo_long(rod_finger):
     stats = np.array([_check_run(res, W, truth, rod_finger) for res, W, truth in rows])
     inside = np.mean(stats[:, 0] ** 2 <= chi2.ppf(0.95, 28))
     assert 0.92 <= inside <= 0.98, inside
+
+
+def test_consistency_fields_survive_the_model_file(rod_finger, tmp_path):
+    """dof, bound, p-value, the solver's status and the constrained values round-trip through
+    ``save`` / ``load_dynamics_model``."""
+    from gripkit.sysid import load_dynamics_model
+
+    (res, _, _), = _monte_carlo(rod_finger, 1, seed=3)
+    res.save(tmp_path / "m.json")
+    c, c2 = res.consistency, load_dynamics_model(tmp_path / "m.json").consistency
+    assert (c2.dof, c2.consistent, c2.inside, c2.converged, c2.iterations, c2.solver) == \
+        (c.dof, c.consistent, c.inside, c.converged, c.iterations, c.solver)
+    assert (c2.distance, c2.bound, c2.p_value) == pytest.approx((c.distance, c.bound, c.p_value), rel=1e-12)
+    np.testing.assert_allclose(c2.theta, c.theta, rtol=1e-12)
+    assert c2.message() == c.message()

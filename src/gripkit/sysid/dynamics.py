@@ -29,22 +29,28 @@ Cov = σ̂² (XᵀWX)⁻¹, σ̂² = rᵀWr/(N_rows − p) (``covariance="ols"``
 covariance of :func:`gripkit.sysid.regression.hac_covariance` for filtered, differentiated or
 decimated logs (``covariance="hac"``).
 
-**Physical consistency.** A base-parameter estimate is physically consistent when some standard
-parameters reproduce it with every link's pseudo-inertia
+**Physical consistency** (:mod:`gripkit.sysid.dynamics_projection`, where it is derived). A
+base-parameter estimate is physically consistent when some standard parameters reproduce it with
+every link's pseudo-inertia
 
-    J = [[½tr(I_o)·1 − I_o, h], [hᵀ, m]]   positive definite
+    J = [[½tr(I_o)·1 − I_o, h], [hᵀ, m]]   positive semidefinite
 
-(positive mass, centre of mass inside the inertia ellipsoid, triangle inequality). gripkit writes
-each J = L Lᵀ (Cholesky factor L, always consistent) and minimises the Mahalanobis distance
-d² = (θ(L) − θ̂)ᵀ Cov⁻¹ (θ(L) − θ̂) over L: d ≈ 0 means consistent. First, though, the standard
-parameters that keep the chain's own values for what the data cannot see are tried: if every link
-is consistent there, so is the estimate, without a search. The failing links are those whose
-pseudo-inertia is indefinite there (or, if none, those pushed onto the boundary by the search).
-"Those standard parameters" are the least change from the chain's own values (each parameter
-relative to its size, so a massless link stays massless) that reproduces the estimate. ``constrained=True``
-returns that nearest consistent estimate (Coulomb and viscous friction ≥ 0) as the result; for a
-linear model this minimum-distance fit equals the constrained weighted least-squares fit on the
-data, without another pass over it.
+(positive mass, centre of mass inside the inertia ellipsoid, triangle inequality), rotor
+inertias and Coulomb and viscous friction ≥ 0. The distance of the estimate θ̂ to that convex
+set is measured where the data put a covariance, in the identified parameters (base parameters
+and friction): d² = min (θ − θ̂)ᵀ Cov⁻¹ (θ − θ̂) over consistent θ, found by a log-det barrier
+method (converged to a duality gap of 1e-8 of ½d², with its status reported). Since the true
+parameters are consistent, d² is at most their own χ²-distributed distance, so "inconsistent"
+is the test d² > χ²_n(0.95) (n identified parameters, offsets excluded), of level at most 5 %.
+First, though, the standard parameters that keep the chain's own values for what the data cannot
+see are tried: if every link is consistent there, so is the estimate (d = 0), without a search.
+The failing links are those whose pseudo-inertia is indefinite there (or, if none, those on the
+boundary at the nearest consistent parameters). "Those standard parameters" are the least change
+from the chain's own values (each parameter relative to its size, so a massless link stays
+massless) that reproduces the estimate. ``constrained=True`` returns the nearest consistent
+parameters as the estimate: for a linear model the weighted least-squares fit on the data
+subject to consistency, without another pass over it, and never further from the truth than the
+unconstrained estimate in the same metric (a projection onto a convex set holding the truth).
 """
 
 from __future__ import annotations
@@ -472,7 +478,8 @@ def identify_dynamics(chain, q, qd, qdd, tau, *, friction: str = "coulomb-viscou
     covariance
         ``'ols'`` (white noise) or ``'hac'`` (filtered or decimated data).
     constrained
-        Return the nearest physically consistent estimate instead of the unconstrained one.
+        Return the nearest physically consistent estimate (in the metric of the covariance) instead
+        of the unconstrained one.
     """
     _check_choices(friction, covariance)
     m = chain.dof
@@ -700,7 +707,12 @@ def load_dynamics_model(path) -> DynamicsResult:
         consistency = None if c is None else Consistency(
             bool(c["consistent"]), float(c["distance_sigma"]), tuple(c["failing_links"]),
             float_array(c["standard_parameters"], "consistency.standard_parameters", where),
-            float_array(c["values"], "consistency.values", where))
+            float_array(c["values"], "consistency.values", where),
+            dof=int(c.get("dof", 0)), bound=float(c.get("bound_sigma", float("nan"))),
+            level=float(c.get("level", 0.95)), p_value=float(c.get("p_value", float("nan"))),
+            inside=bool(c.get("estimate_consistent", c["distance_sigma"] == 0)),
+            solver=str(c.get("solver", "")), converged=bool(c.get("converged", True)),
+            iterations=int(c.get("iterations", 0)))
         data = doc.get("data") or {}
         return DynamicsResult(
             chain, structure, doc["friction_model"], bool(doc["armature"]), names, theta, cov,
