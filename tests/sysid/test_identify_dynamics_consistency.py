@@ -2,7 +2,8 @@
 (``gripkit.sysid.dynamics_projection``), Monte Carlo on the DLR/HIT Hand II finger of the zoo
 (``002_ddea254371185ad3.txt`` Appendix F: thin-rod phalanges, a pseudo-inertia on the boundary of
 the consistent set, so noise puts the estimate outside it in most runs), exported by ``to_urdf``,
-with exact joint states and white torque noise (σ honest, ``tests/sysid/test_identify_dynamics.py``).
+with exact joint states and white torque noise (σ honest:
+``tests/sysid/test_identify_dynamics.py``).
 
 What holds in every run, by the convexity of the consistent set S (module doc of
 ``dynamics_projection``): the true parameters lie in S, so the reported distance d, a minimum over
@@ -38,7 +39,8 @@ def rod_finger(tmp_path_factory):
 
 
 def _truth(res, chain):
-    return np.concatenate([res.structure.base(chain.standard_parameters()), np.ravel(np.column_stack([FC, FV]))])
+    return np.concatenate([res.structure.base(chain.standard_parameters()),
+                           np.ravel(np.column_stack([FC, FV]))])
 
 
 def _mahalanobis(a, b, W):
@@ -52,7 +54,8 @@ def _monte_carlo(chain, runs, seed):
     clean = chain.rnea(q, qd, qdd) + FC * np.sign(qd) + FV * qd
     rows = []
     for _ in range(runs):
-        res = identify_dynamics(chain, q, qd, qdd, clean + rng.normal(size=clean.shape) * NOISE, constrained=True)
+        tau = clean + rng.normal(size=clean.shape) * NOISE
+        res = identify_dynamics(chain, q, qd, qdd, tau, constrained=True)
         W = np.linalg.inv(res.covariance)
         truth = _truth(res, chain)
         rows.append((res, W, truth))
@@ -132,7 +135,8 @@ def _cholesky_search_distance(res, chain, start_phi, start_f):
             J = L @ L.T
             S = J[:3, :3]
             Io = np.trace(S) * np.eye(3) - S
-            phi += [J[3, 3], J[0, 3], J[1, 3], J[2, 3], Io[0, 0], Io[0, 1], Io[1, 1], Io[0, 2], Io[1, 2], Io[2, 2]]
+            phi += [J[3, 3], J[0, 3], J[1, 3], J[2, 3],
+                    Io[0, 0], Io[0, 1], Io[1, 1], Io[0, 2], Io[1, 2], Io[2, 2]]
         return np.concatenate([K @ np.array(phi), z[40:] ** 2])
 
     z0 = []
@@ -150,10 +154,12 @@ def test_distance_against_an_independent_optimiser(rod_finger):
     the truth (a consistent start) or from gripkit's own answer."""
     for res, _, truth in _monte_carlo(rod_finger, 3, seed=5):
         c = res.consistency
-        d_bfgs = _cholesky_search_distance(res, rod_finger, rod_finger.standard_parameters(), truth[22:])
+        d_bfgs = _cholesky_search_distance(res, rod_finger, rod_finger.standard_parameters(),
+                                           truth[22:])
         assert c.distance <= d_bfgs + 1e-3, (c.distance, d_bfgs)
         # and BFGS started at gripkit's answer finds nothing noticeably nearer
-        d_again = _cholesky_search_distance(res, rod_finger, c.standard_parameters, np.maximum(res.theta[22:], 0))
+        d_again = _cholesky_search_distance(res, rod_finger, c.standard_parameters,
+                                            np.maximum(res.theta[22:], 0))
         assert d_again >= c.distance - 1e-3 * max(1.0, c.distance)
 
 
@@ -165,7 +171,8 @@ def test_inconsistent_decision_is_the_chi2_test(rod_finger):
     phi[names.index("Izz_link4")] = -2e-4
     rng = np.random.default_rng(4)
     q, qd, qdd = fourier_states(3_000, 500.0, rng)
-    tau = rod_finger.regressor(q, qd, qdd) @ phi + FC * np.sign(qd) + FV * qd + rng.normal(size=q.shape) * NOISE
+    tau = (rod_finger.regressor(q, qd, qdd) @ phi + FC * np.sign(qd) + FV * qd
+           + rng.normal(size=q.shape) * NOISE)
     r = identify_dynamics(rod_finger, q, qd, qdd, tau)
     c = r.consistency
     assert not c.consistent and c.distance > c.bound and c.p_value < 0.05
@@ -184,12 +191,12 @@ def test_offsets_are_free_and_armature_is_signed(rod_finger):
     off = np.array([0.01, -0.02, 0.005])
     tau = (rod_finger.rnea(q, qd, qdd) + FC * np.sign(qd) + FV * qd + arm * qdd + off
            + rng.normal(size=q.shape) * NOISE)
-    r = identify_dynamics(rod_finger, q, qd, qdd, tau, friction="coulomb-viscous-offset", armature=True,
-                          constrained=True)
+    r = identify_dynamics(rod_finger, q, qd, qdd, tau, friction="coulomb-viscous-offset",
+                          armature=True, constrained=True)
     c = r.consistency
     assert c.dof == r.theta.size - 3
-    truth = np.concatenate([r.structure.base(np.concatenate([rod_finger.standard_parameters(), arm])),
-                            np.ravel(np.column_stack([FC, FV, off]))])
+    phi = np.concatenate([rod_finger.standard_parameters(), arm])
+    truth = np.concatenate([r.structure.base(phi), np.ravel(np.column_stack([FC, FV, off]))])
     W = np.linalg.inv(r.covariance)
     assert c.converged, c.solver
     assert c.distance <= _mahalanobis(r.unconstrained_theta, truth, W) + 1e-6
@@ -216,6 +223,7 @@ def test_consistency_fields_survive_the_model_file(rod_finger, tmp_path):
     c, c2 = res.consistency, load_dynamics_model(tmp_path / "m.json").consistency
     assert (c2.dof, c2.consistent, c2.inside, c2.converged, c2.iterations, c2.solver) == \
         (c.dof, c.consistent, c.inside, c.converged, c.iterations, c.solver)
-    assert (c2.distance, c2.bound, c2.p_value) == pytest.approx((c.distance, c.bound, c.p_value), rel=1e-12)
+    assert (c2.distance, c2.bound, c2.p_value) == pytest.approx((c.distance, c.bound, c.p_value),
+                                                                rel=1e-12)
     np.testing.assert_allclose(c2.theta, c.theta, rtol=1e-12)
     assert c2.message() == c.message()

@@ -198,13 +198,14 @@ class Consistency:
 
     def message(self) -> str:
         if self.inside:
-            return ("physically consistent: standard parameters with positive mass and positive-definite "
-                    "pseudo-inertia reproduce the base parameters")
-        where = (f"the nearest consistent parameters are {self.distance:.3g} σ away (Mahalanobis distance in the "
-                 f"{self.dof} identified parameters; χ²({self.dof}) p = {self.p_value:.2g}, "
-                 f"{100 * self.level:.0f} % bound {self.bound:.3g} σ)")
+            return ("physically consistent: standard parameters with positive mass and "
+                    "positive-definite pseudo-inertia reproduce the base parameters")
+        where = (f"the nearest consistent parameters are {self.distance:.3g} σ away (Mahalanobis "
+                 f"distance in the {self.dof} identified parameters; χ²({self.dof}) p = "
+                 f"{self.p_value:.2g}, {100 * self.level:.0f} % bound {self.bound:.3g} σ)")
         if not self.converged:
-            where += f"; the optimiser did not converge, the distance is an upper bound ({self.solver})"
+            where += (f"; the optimiser did not converge, the distance is an upper bound "
+                      f"({self.solver})")
         if self.consistent:
             return f"physically consistent within the noise: {where}"
         links = ", ".join(self.failing_links) or "(no single part)"
@@ -578,7 +579,8 @@ def _signed_indices(kinds, m: int, n_arm: int, fr0: int):
     return np.concatenate([arm, np.asarray(fr, dtype=np.intp)]).astype(np.intp), arm
 
 
-def _projection_start(phi0, theta, std, signed, n_links: int, nb: int, fr0: int, scale: float) -> np.ndarray:
+def _projection_start(phi0, theta, std, signed, n_links: int, nb: int, fr0: int,
+                      scale: float) -> np.ndarray:
     """A strictly consistent start for the projection: the chain's own links with each
     pseudo-inertia moved inside by 1 % of its scale, rotor inertias at 1 % of ``scale``, the
     estimated friction (Coulomb and viscous at |θ̂| + σ, strictly positive)."""
@@ -587,14 +589,16 @@ def _projection_start(phi0, theta, std, signed, n_links: int, nb: int, fr0: int,
         J = pseudo_inertia(phi0[10 * k:10 * k + 10])
         ev, V = np.linalg.eigh(J)
         eps = 1e-2 * max(ev[-1], 1e-2 * scale)
-        x0[10 * k:10 * k + 10] = _J_TO_PHI @ ((V * np.maximum(ev, 0.0)) @ V.T + eps * np.eye(4)).ravel()
+        J_in = (V * np.maximum(ev, 0.0)) @ V.T + eps * np.eye(4)
+        x0[10 * k:10 * k + 10] = _J_TO_PHI @ J_in.ravel()
     x0[10 * n_links:fr0] = 1e-2 * scale
     fr = signed[signed >= fr0]
     x0[fr] = np.abs(theta[fr - fr0 + nb]) + std[fr - fr0 + nb]
     return x0
 
 
-def _failing_parts(chain, phi_p, x, theta, std, kinds, n_arm: int, nb: int, scale: float) -> list[str]:
+def _failing_parts(chain, phi_p, x, theta, std, kinds, n_arm: int, nb: int,
+                   scale: float) -> list[str]:
     """What has no consistent values: the links whose pseudo-inertia is indefinite in the
     least-change solution (if none, those on the boundary at the projection: smallest eigenvalue
     below 1e-6 of the largest), rotor inertias and Coulomb or viscous coefficients held at 0
@@ -615,12 +619,14 @@ def _failing_parts(chain, phi_p, x, theta, std, kinds, n_arm: int, nb: int, scal
     for j, jn in enumerate(chain.coordinate_names):
         for c, kind in enumerate(kinds):
             k = j * len(kinds) + c
-            if kind in ("coulomb", "viscous") and theta[nb + k] < 0 and x[fr0 + k] <= 1e-3 * std[nb + k]:
+            held = theta[nb + k] < 0 and x[fr0 + k] <= 1e-3 * std[nb + k]
+            if kind in ("coulomb", "viscous") and held:
                 failing.append(f"{kind} friction of {jn!r} (< 0)")
     return failing
 
 
-def _consistency(chain, st: BaseStructure, theta, C, kinds, m, armature, level: float = 0.95) -> Consistency:
+def _consistency(chain, st: BaseStructure, theta, C, kinds, m, armature,
+                 level: float = 0.95) -> Consistency:
     """Physical consistency of the estimate θ̂ with covariance C
     (:mod:`gripkit.sysid.dynamics_projection`): first the least-change standard parameters,
     consistent there means consistent (d = 0, no search); else the projection of θ̂ onto the
@@ -650,9 +656,12 @@ def _consistency(chain, st: BaseStructure, theta, C, kinds, m, armature, level: 
     fr_ok = all(theta[nb + j * len(kinds) + c] >= 0 for j in range(m) for c, kind in enumerate(kinds)
                 if kind in ("coulomb", "viscous"))
     if reproduces and links_ok and fr_ok and (not n_arm or (phi_p[p_std:] >= 0).all()):
-        return Consistency(True, 0.0, (), phi_p, theta.copy(), dof=dof, bound=bound, level=level, p_value=1.0,
-                           inside=True, solver="none needed: the least-change standard parameters are consistent")
-    typical = float(np.mean([np.trace(pseudo_inertia(phi0[10 * k:10 * k + 10])) for k in range(n_links)]))
+        return Consistency(True, 0.0, (), phi_p, theta.copy(), dof=dof, bound=bound, level=level,
+                           p_value=1.0, inside=True,
+                           solver="none needed: the least-change standard parameters are "
+                                  "consistent")
+    typical = float(np.mean([np.trace(pseudo_inertia(phi0[10 * k:10 * k + 10]))
+                             for k in range(n_links)]))
     scale = max(typical, float(np.abs(theta[:nb]).max()), 1e-12)
     A = np.zeros((theta.size, fr0 + theta.size - nb))
     A[:nb, :fr0] = K
@@ -664,9 +673,11 @@ def _consistency(chain, st: BaseStructure, theta, C, kinds, m, armature, level: 
     d = sol.distance
     inside = 0.5 * d * d <= sol.gap
     consistent = bool(d <= bound)
-    failing = () if inside else tuple(_failing_parts(chain, phi_p, sol.x, theta, std, kinds, n_arm, nb, scale))
-    return Consistency(consistent, d, failing, sol.x[:fr0].copy(), sol.theta, dof=dof, bound=bound, level=level,
-                       p_value=float(chi2.sf(d * d, dof)), inside=bool(inside), solver=sol.message,
+    failing = () if inside else tuple(_failing_parts(chain, phi_p, sol.x, theta, std, kinds, n_arm,
+                                                     nb, scale))
+    return Consistency(consistent, d, failing, sol.x[:fr0].copy(), sol.theta, dof=dof, bound=bound,
+                       level=level, p_value=float(chi2.sf(d * d, dof)), inside=bool(inside),
+                       solver=sol.message,
                        converged=sol.converged, iterations=sol.iterations)
 
 

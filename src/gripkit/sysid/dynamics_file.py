@@ -82,9 +82,9 @@ def dynamics_document(result) -> dict:
            "consistency": None if cons is None else {
                "consistent": cons.consistent, "distance_sigma": cons.distance, "failing_links": cons.failing_links,
                "standard_parameters": cons.standard_parameters, "values": cons.theta,
-               "dof": cons.dof, "bound_sigma": cons.bound, "level": cons.level, "p_value": cons.p_value,
-               "estimate_consistent": cons.inside, "solver": cons.solver, "converged": cons.converged,
-               "iterations": cons.iterations},
+               "dof": cons.dof, "bound_sigma": cons.bound, "level": cons.level,
+               "p_value": cons.p_value, "estimate_consistent": cons.inside, "solver": cons.solver,
+               "converged": cons.converged, "iterations": cons.iterations},
            "warnings": list(result.warnings),
            "data": None if result.data_file is None else {"file": result.data_file, "sha256": result.data_hash}}
     doc = plain(doc)

@@ -121,8 +121,8 @@ class _Barrier:
     variables scaled by ``D``: the objective's t-weighted Hessian lives on the first only, so
     the two scales never meet in one matrix."""
 
-    def __init__(self, A, Ci, theta_hat, n_links: int, signed: np.ndarray, bounded: np.ndarray, T: float,
-                 D: np.ndarray):
+    def __init__(self, A, Ci, theta_hat, n_links: int, signed: np.ndarray, bounded: np.ndarray,
+                 T: float, D: np.ndarray):
         self.G = Ci.T @ A                       # residual r = G x − c
         self.c = Ci.T @ theta_hat
         self.n_links = n_links
@@ -143,7 +143,8 @@ class _Barrier:
     def feasible(self, x) -> tuple:
         """(feasible, the Cholesky factors (n_links, 4, 4) of the J_k) at x."""
         P = x[:10 * self.n_links].reshape(self.n_links, 10)
-        if (P @ _TRB >= self.T).any() or (x[self.signed] <= 0).any() or (x[self.bounded] >= self.T).any():
+        if ((P @ _TRB >= self.T).any() or (x[self.signed] <= 0).any()
+                or (x[self.bounded] >= self.T).any()):
             return False, None
         try:
             return True, np.linalg.cholesky(np.einsum("ki,iab->kab", P, _B))
@@ -241,7 +242,8 @@ def _centre(pb: _Barrier, x, t, max_steps: int):
 
 
 def project_consistent(A, Ci, theta_hat, x_start, n_links: int, signed, bounded, scale: float,
-                       *, rel_gap: float = 1e-8, max_newton: int = 600, link_names=None) -> ProjectionResult:
+                       *, rel_gap: float = 1e-8, max_newton: int = 600,
+                       link_names=None) -> ProjectionResult:
     """Solve (1) of the module doc by the barrier method (2).
 
     ``A`` maps x (standard parameters of the ``n_links`` links, then rotor inertias, then
@@ -277,11 +279,13 @@ def project_consistent(A, Ci, theta_hat, x_start, n_links: int, signed, bounded,
     # exceeds 100 gaps (a direction free of data sits at the analytic centre, slack ≈ T/5: 5/t)
     slack = T - x[:10 * n_links].reshape(n_links, 10) @ _TRB
     at_bound = np.flatnonzero(slack < T / (100.0 * pb.nu))
-    msg = (f"log-det barrier (Newton): converged in {steps} steps, duality gap {gap:.2g} on ½d²" if converged
-           else f"log-det barrier (Newton): stopped after {steps} steps with duality gap {gap:.2g} on ½d²; "
-                f"the distance is an upper bound")
+    msg = (f"log-det barrier (Newton): converged in {steps} steps, duality gap {gap:.2g} on ½d²"
+           if converged else
+           f"log-det barrier (Newton): stopped after {steps} steps with duality gap {gap:.2g} on "
+           f"½d²; the distance is an upper bound")
     if at_bound.size:
         names = list(link_names) if link_names is not None else [str(k) for k in range(n_links)]
-        msg += (f"; m + ½tr(I) of link(s) {', '.join(names[k] for k in at_bound)} at the bound {T:.3g}: "
-                f"the nearest consistent parameters are approached only as a link's mass grows on its joint axis")
+        msg += (f"; m + ½tr(I) of link(s) {', '.join(names[k] for k in at_bound)} at the bound "
+                f"{T:.3g}: the nearest consistent parameters are approached only as a link's "
+                f"mass grows on its joint axis")
     return ProjectionResult(x, A @ x, d, converged, float(gap), steps, at_bound, msg)
