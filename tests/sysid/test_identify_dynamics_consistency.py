@@ -227,3 +227,23 @@ def test_consistency_fields_survive_the_model_file(rod_finger, tmp_path):
                                                                 rel=1e-12)
     np.testing.assert_allclose(c2.theta, c.theta, rtol=1e-12)
     assert c2.message() == c.message()
+
+
+def test_unconverged_projection_says_so(rod_finger, monkeypatch):
+    """A projection stopped early (5 Newton steps) reports converged = False, says that its
+    distance is an upper bound, and that bound is not below the converged distance."""
+    import functools
+
+    import gripkit.sysid.dynamics_projection as dp
+
+    rng = np.random.default_rng(12)
+    q, qd, qdd = fourier_states(3_000, 500.0, rng)
+    tau = rod_finger.rnea(q, qd, qdd) + FC * np.sign(qd) + FV * qd + rng.normal(size=q.shape) * NOISE
+    full = identify_dynamics(rod_finger, q, qd, qdd, tau).consistency
+    monkeypatch.setattr(dp, "project_consistent", functools.partial(dp.project_consistent, max_newton=5))
+    short = identify_dynamics(rod_finger, q, qd, qdd, tau).consistency
+    assert full.converged and not short.converged and short.iterations == 5
+    assert short.distance >= full.distance - 1e-9
+    assert "stopped after 5 steps" in short.solver and "upper bound" in short.solver
+    if not short.consistent:
+        assert "did not converge" in short.message()

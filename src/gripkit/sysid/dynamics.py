@@ -671,7 +671,7 @@ def _consistency(chain, st: BaseStructure, theta, C, kinds, m, armature,
     sol = project_consistent(A, Ci, theta, x0, n_links, signed, np.arange(p_std, fr0), scale,
                              link_names=[repr(n) for n in chain.link_names])
     d = sol.distance
-    inside = 0.5 * d * d <= sol.gap
+    inside = sol.converged and 0.5 * d * d <= sol.gap
     consistent = bool(d <= bound)
     failing = () if inside else tuple(_failing_parts(chain, phi_p, sol.x, theta, std, kinds, n_arm,
                                                      nb, scale))

@@ -249,12 +249,13 @@ def project_consistent(A, Ci, theta_hat, x_start, n_links: int, signed, bounded,
     ``A`` maps x (standard parameters of the ``n_links`` links, then rotor inertias, then
     friction) to θ; ``Ci`` is a factor with Ci Ciᵀ = C⁻¹; ``x_start`` a strictly consistent
     point (every J_k ≻ 0, x[signed] > 0); ``signed`` the indices that must stay positive,
-    ``bounded`` those also kept below the bound T = 1000 · ``scale``, which also bounds every
-    link's tr J = m + ½tr(I)."""
+    ``bounded`` those also kept below the bound T = 1000 · ``scale`` (at least 10 times the
+    start's), which also bounds every link's tr J = m + ½tr(I)."""
     signed = np.asarray(signed, dtype=np.intp)
     bounded = np.asarray(bounded, dtype=np.intp)
-    T = 1e3 * scale
     x = np.asarray(x_start, dtype=np.float64).copy()
+    T = max(1e3 * scale, 10.0 * float(np.max(np.concatenate(
+        [x[:10 * n_links].reshape(n_links, 10) @ _TRB, x[bounded], [0.0]]))))
     pb = _Barrier(A, Ci, theta_hat, n_links, signed, bounded, T, np.ones(x.size))
     ok, Ls = pb.feasible(x)
     if not ok:
