@@ -96,10 +96,14 @@ def test_cli_constrained_fit_nearer_the_truth(design, finger_urdf, tmp_path, cap
     np.savetxt(path, cols, delimiter=",", header="t,pos0,pos1,pos2,tau0,tau1,tau2", comments="")
     model = tmp_path / "m.json"
     code = main(["identify", "dynamics", str(finger_urdf), str(path), "--position", "pos0,pos1,pos2",
-                 "--effort", "tau0,tau1,tau2", "--constrained", "--json", "--out", str(model)])
+                 "--effort", "tau0,tau1,tau2", "--constrained", "--json", "--out", str(model),
+                 "--report", str(tmp_path / "rep")])
     cap = capsys.readouterr()
     assert code == 0, cap.err
     c = json.loads(cap.out)["consistency"]
+    # the report states the verdict with its χ² bound and the search's status
+    html = (tmp_path / "rep" / "index.html").read_text()
+    assert "95 % bound 6.43 σ" in html and c["solver"].split(",")[0] in html
     assert c["dof"] == 28 and c["converged"] is True and "duality gap" in c["solver"]
     assert c["bound_sigma"] == pytest.approx(np.sqrt(chi2.ppf(0.95, 28)))
     assert c["consistent"] == (c["distance_sigma"] <= c["bound_sigma"])

@@ -19,9 +19,11 @@ distance of the estimate to it is the Mahalanobis distance in the identified coo
     d² = min_{θ ∈ S} (θ − θ̂)ᵀ C⁻¹ (θ − θ̂),                                            (1)
 
 and its minimiser θ_c is the *constrained estimate*. Since the model is linear in θ, the weighted
-residual of the data at any θ is ‖r(θ̂)‖²_W + (θ − θ̂)ᵀ (XᵀWX) (θ − θ̂), and (XᵀWX)⁻¹ = C/σ̂²: (1)
-is the weighted least-squares fit on the data subject to physical consistency, without another
-pass over the data (Sousa & Cortesão 2014 solve the same problem as an LMI).
+residual of the data at any θ is ‖r(θ̂)‖²_W + (θ − θ̂)ᵀ (XᵀWX) (θ − θ̂), and with the white-noise
+covariance (``covariance='ols'``) (XᵀWX)⁻¹ = C/σ̂²: (1) is then the weighted least-squares fit on
+the data subject to physical consistency, without another pass over the data (Sousa & Cortesão
+2014 solve the same problem as an LMI). With the Newey-West covariance (``'hac'``) (1) weighs the
+parameters by that covariance, the metric in which the test below holds.
 
 **The test.** Let θ* be the true parameters. If the model is right, θ* ∈ S, and d² ≤ (θ* − θ̂)ᵀ
 C⁻¹ (θ* − θ̂) because d² is a minimum over S. With an honest C the right-hand side is χ²
@@ -37,7 +39,7 @@ P(χ²_n > d²), an upper bound of the true one for the same reason. d = 0 means
 itself is consistent.
 
 **The constrained estimate is never further from the truth.** θ_c is the projection of θ̂ onto
-the closed convex set S in the norm ‖v‖ = √(vᵀ C⁻¹ v). A projection onto a convex set containing
+the closed convex set S_T (S bounded, see *The bound T*) in the norm ‖v‖ = √(vᵀ C⁻¹ v). A projection onto a convex set containing
 θ* is non-expansive towards it: ‖θ_c − θ*‖² ≤ ‖θ̂ − θ*‖² − ‖θ̂ − θ_c‖² (the obtuse-angle
 property of projections), for every data set, not only in expectation.
 
@@ -64,10 +66,10 @@ the problem is convex). The DLR/HIT finger takes 120–140 Newton steps, about 0
 DLR/HIT proximal phalanx) acts on no torque, yet a large one relaxes that link's J ⪰ 0, so the
 infimum of (1) can be approached only as that mass grows without limit. gripkit therefore uses
 S_T, S with every link's tr J = m + ½tr(I_o) (kg + kg·m², SI) and every rotor inertia at most
-T = 1000 × max(the chain's mean tr J, the largest |θ̂_b|). S_T is compact and convex and holds the
+T = 1000 × max(the chain's mean tr J, the largest |θ̂_b|). S_T is closed and convex and holds the
 truth of any chain within three orders of magnitude of its model, so the test and the
 non-expansion above hold for it exactly; the distance to S_T exceeds the infimum over S by
-O(1/T) (10⁻⁵ σ on that finger). Where the bound is reached the solver says so.
+O(1/T) (2·10⁻⁵ σ on that finger). Where the bound is reached the solver says so.
 """
 
 from __future__ import annotations
