@@ -29,22 +29,28 @@ Cov = σ̂² (XᵀWX)⁻¹, σ̂² = rᵀWr/(N_rows − p) (``covariance="ols"``
 covariance of :func:`gripkit.sysid.regression.hac_covariance` for filtered, differentiated or
 decimated logs (``covariance="hac"``).
 
-**Physical consistency.** A base-parameter estimate is physically consistent when some standard
-parameters reproduce it with every link's pseudo-inertia
+**Physical consistency** (:mod:`gripkit.sysid.dynamics_projection`, where it is derived). A
+base-parameter estimate is physically consistent when some standard parameters reproduce it with
+every link's pseudo-inertia
 
-    J = [[½tr(I_o)·1 − I_o, h], [hᵀ, m]]   positive definite
+    J = [[½tr(I_o)·1 − I_o, h], [hᵀ, m]]   positive semidefinite
 
-(positive mass, centre of mass inside the inertia ellipsoid, triangle inequality). gripkit writes
-each J = L Lᵀ (Cholesky factor L, always consistent) and minimises the Mahalanobis distance
-d² = (θ(L) − θ̂)ᵀ Cov⁻¹ (θ(L) − θ̂) over L: d ≈ 0 means consistent. First, though, the standard
-parameters that keep the chain's own values for what the data cannot see are tried: if every link
-is consistent there, so is the estimate, without a search. The failing links are those whose
-pseudo-inertia is indefinite there (or, if none, those pushed onto the boundary by the search).
-"Those standard parameters" are the least change from the chain's own values (each parameter
-relative to its size, so a massless link stays massless) that reproduces the estimate. ``constrained=True``
-returns that nearest consistent estimate (Coulomb and viscous friction ≥ 0) as the result; for a
-linear model this minimum-distance fit equals the constrained weighted least-squares fit on the
-data, without another pass over it.
+(positive mass, centre of mass inside the inertia ellipsoid, triangle inequality), rotor
+inertias and Coulomb and viscous friction ≥ 0. The distance of the estimate θ̂ to that convex
+set is measured where the data put a covariance, in the identified parameters (base parameters
+and friction): d² = min (θ − θ̂)ᵀ Cov⁻¹ (θ − θ̂) over consistent θ, found by a log-det barrier
+method (converged to a duality gap of 1e-8 of ½d², with its status reported). Since the true
+parameters are consistent, d² is at most their own χ²-distributed distance, so "inconsistent"
+is the test d² > χ²_n(0.95) (n identified parameters, offsets excluded), of level at most 5 %.
+First, though, the standard parameters that keep the chain's own values for what the data cannot
+see are tried: if every link is consistent there, so is the estimate (d = 0), without a search.
+The failing links are those whose pseudo-inertia is indefinite there (or, if none, those on the
+boundary at the nearest consistent parameters). "Those standard parameters" are the least change
+from the chain's own values (each parameter relative to its size, so a massless link stays
+massless) that reproduces the estimate. ``constrained=True`` returns the nearest consistent
+parameters as the estimate: for a linear model the weighted least-squares fit on the data
+subject to consistency, without another pass over it, and never further from the truth than the
+unconstrained estimate in the same metric (a projection onto a convex set holding the truth).
 """
 
 from __future__ import annotations
@@ -165,27 +171,52 @@ def friction_columns(qd, kinds) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Consistency:
-    """Physical consistency of the estimate (module doc): ``consistent``, the Mahalanobis distance
-    ``distance`` (σ units) to the nearest consistent parameters found (a search of at most 80
-    steps: an upper bound of the true distance), the ``failing_links`` and those
-    ``standard_parameters``."""
+    """Physical consistency of the estimate (:mod:`gripkit.sysid.dynamics_projection`).
+
+    ``distance`` d (σ): the Mahalanobis distance, in the covariance of the identified parameters,
+    from the estimate to the nearest physically consistent parameters ``theta`` (0: the estimate
+    itself is consistent, ``inside``), reproduced by the consistent ``standard_parameters``.
+    ``consistent``: d² ≤ χ²_dof(``level``), the test that some consistent parameters explain the
+    data (``dof`` the number of constrained identified parameters, ``bound`` = √χ²_dof(level),
+    ``p_value`` = P(χ²_dof > d²)). ``failing_links``: the parts held on the boundary (links,
+    rotor inertias, friction coefficients). ``solver``, ``converged``, ``iterations``: how the
+    projection was found."""
 
     consistent: bool
     distance: float
     failing_links: tuple
     standard_parameters: np.ndarray
     theta: np.ndarray
+    dof: int = 0
+    bound: float = float("nan")
+    level: float = 0.95
+    p_value: float = float("nan")
+    inside: bool = False
+    solver: str = ""
+    converged: bool = True
+    iterations: int = 0
 
     def message(self) -> str:
+        if self.inside:
+            return ("physically consistent: standard parameters with positive mass and "
+                    "positive-definite pseudo-inertia reproduce the base parameters")
+        where = (f"the nearest consistent parameters are {self.distance:.3g} σ away (Mahalanobis "
+                 f"distance in the {self.dof} identified parameters; χ²({self.dof}) p = "
+                 f"{self.p_value:.2g}, {100 * self.level:.0f} % bound {self.bound:.3g} σ)")
+        if not self.converged:
+            where += (f"; the optimiser did not converge, the distance is an upper bound "
+                      f"({self.solver})")
         if self.consistent:
-            return "physically consistent: standard parameters with positive mass and positive-definite pseudo-inertia reproduce the base parameters"
-        links = ", ".join(self.failing_links) or "(no single link: the optimiser stopped)"
+            return f"physically consistent within the noise: {where}"
+        links = ", ".join(self.failing_links) or "(no single part)"
         return (f"physically inconsistent: no standard parameters with positive-definite pseudo-inertia reproduce "
-                f"the base parameters (the nearest consistent ones found are {self.distance:.3g} σ away); failing: {links}")
+                f"the base parameters within the noise: {where}; on the boundary: {links}")
 
     def to_dict(self) -> dict:
         return dict(consistent=self.consistent, distance_sigma=self.distance, failing_links=list(self.failing_links),
-                    message=self.message())
+                    dof=self.dof, bound_sigma=self.bound, level=self.level, p_value=self.p_value,
+                    estimate_consistent=self.inside, solver=self.solver, converged=self.converged,
+                    iterations=self.iterations, message=self.message())
 
 
 @dataclass(frozen=True)
@@ -448,7 +479,8 @@ def identify_dynamics(chain, q, qd, qdd, tau, *, friction: str = "coulomb-viscou
     covariance
         ``'ols'`` (white noise) or ``'hac'`` (filtered or decimated data).
     constrained
-        Return the nearest physically consistent estimate instead of the unconstrained one.
+        Return the nearest physically consistent estimate (in the metric of the covariance) instead
+        of the unconstrained one.
     """
     _check_choices(friction, covariance)
     m = chain.dof
@@ -485,18 +517,9 @@ def identify_dynamics(chain, q, qd, qdd, tau, *, friction: str = "coulomb-viscou
 
 # --- physical consistency -------------------------------------------------------------------------
 
-def _phi_from_factor(Lv: np.ndarray) -> np.ndarray:
-    """Standard parameters (10) of J = L Lᵀ, L lower-triangular 4×4 from its 10 entries."""
-    L = np.zeros((4, 4))
-    L[np.tril_indices(4)] = Lv
-    J = L @ L.T
-    Sigma = J[:3, :3]
-    Io = np.trace(Sigma) * np.eye(3) - Sigma
-    return np.array([J[3, 3], J[0, 3], J[1, 3], J[2, 3], Io[0, 0], Io[0, 1], Io[1, 1], Io[0, 2], Io[1, 2], Io[2, 2]])
-
-
 def _j_to_phi() -> np.ndarray:
-    """The linear map vec(J) (16) → φ (10) of :func:`_phi_from_factor`."""
+    """The linear map vec(J) (16) → φ (10) of one link: m = J₃₃, h = J[:3, 3], I = tr(Σ)·1 − Σ
+    with Σ = J[:3, :3] (the inverse of :func:`pseudo_inertia`)."""
     A = np.zeros((10, 16))
     for e in range(16):
         J = np.zeros(16)
@@ -528,61 +551,6 @@ def _psd(J) -> bool:
     return ev[0] >= -1e-9 * max(ev[-1], 1e-300)
 
 
-def _link_factor_jacobian(Lv: np.ndarray) -> np.ndarray:
-    """dφ/dL (10 × 10) of one link: φ is linear in J (the map _J_TO_PHI), J = L Lᵀ."""
-    tri = np.tril_indices(4)
-    L = np.zeros((4, 4))
-    L[tri] = Lv
-    D = np.empty((10, 10))
-    for c, (a, b) in enumerate(zip(*tri)):
-        E = np.zeros((4, 4))
-        E[a, b] = 1.0
-        D[:, c] = _J_TO_PHI @ (E @ L.T + L @ E.T).ravel()
-    return D
-
-
-class _FactorSearch:
-    """The search for the nearest consistent estimate (module doc) over x = [the Cholesky factor L
-    of every link's pseudo-inertia (10 entries each), the rotor inertias (n_arm), the friction
-    parameters (θ past the nb base parameters)]: residual Ci ᵀ(θ(x) − θ̂) (Ci Ciᵀ = Cov⁻¹) and a
-    weak pull (1e-3) of the factors towards the start ``x_start``, with its exact Jacobian."""
-
-    reg = 1e-3
-
-    def __init__(self, K, Ci, theta, x_start, n_links: int, n_arm: int, p_std: int):
-        self.K, self.Ci, self.theta, self.x_start = K, Ci, theta, x_start
-        self.n_links, self.n_arm, self.p_std = n_links, n_arm, p_std
-        self.nb = K.shape[0]
-        self.fr0 = 10 * n_links + n_arm
-
-    def params(self, x):
-        """(θ(x), the standard parameters φ(x) with the rotor inertias)."""
-        n = self.n_links
-        phi = np.concatenate([_phi_from_factor(x[10 * k:10 * k + 10]) for k in range(n)])
-        if self.n_arm:
-            phi = np.concatenate([phi, x[10 * n:self.fr0]])
-        return np.concatenate([self.K @ phi, x[self.fr0:]]), phi
-
-    def resid(self, x):
-        n = self.n_links
-        return np.concatenate([self.Ci.T @ (self.params(x)[0] - self.theta),
-                               self.reg * (x[:10 * n] - self.x_start[:10 * n])])
-
-    def jac(self, x):
-        n, fr0, nb, K = self.n_links, self.fr0, self.nb, self.K
-        Dphi = np.zeros((K.shape[1], fr0))
-        for k in range(n):
-            Dphi[10 * k:10 * k + 10, 10 * k:10 * k + 10] = _link_factor_jacobian(x[10 * k:10 * k + 10])
-        if self.n_arm:
-            Dphi[self.p_std:, 10 * n:fr0] = np.eye(self.n_arm)
-        Dth = np.zeros((self.theta.size, x.size))
-        Dth[:nb, :fr0] = K @ Dphi
-        Dth[nb:, fr0:] = np.eye(self.theta.size - nb)
-        Dreg = np.zeros((10 * n, x.size))
-        Dreg[:, :10 * n] = self.reg * np.eye(10 * n)
-        return np.vstack([self.Ci.T @ Dth, Dreg])
-
-
 def _least_change_parameters(phi_nom, K, theta_b, n_links: int, p_std: int):
     """The standard parameters nearest to the chain's own φ₀ that reproduce the estimate (least
     change, each parameter relative to its own size s, so that a massless link stays massless):
@@ -602,67 +570,71 @@ def _least_change_parameters(phi_nom, K, theta_b, n_links: int, p_std: int):
     return phi_p, reproduces
 
 
-def _search_bounds(n_links: int, n_arm: int, n_friction: int, kinds, m: int):
-    """Bounds (lo, hi) of the search variables: rotor inertias and Coulomb and viscous friction
-    ≥ 0, the rest free."""
-    fr0 = 10 * n_links + n_arm
-    lo = np.full(fr0 + n_friction, -np.inf)
-    hi = np.full(fr0 + n_friction, np.inf)
-    lo[10 * n_links:fr0] = 0.0
-    for j in range(m):
-        for c, kind in enumerate(kinds):
-            if kind in ("coulomb", "viscous"):
-                lo[fr0 + j * len(kinds) + c] = 0.0
-    return lo, hi
+def _signed_indices(kinds, m: int, n_arm: int, fr0: int):
+    """Indices of the projection's variables x = [φ, rotor inertias, friction] that must be ≥ 0
+    (rotor inertias, Coulomb and viscous coefficients), and the rotor inertias alone."""
+    arm = np.arange(fr0 - n_arm, fr0)
+    fr = [fr0 + j * len(kinds) + c for j in range(m) for c, kind in enumerate(kinds)
+          if kind in ("coulomb", "viscous")]
+    return np.concatenate([arm, np.asarray(fr, dtype=np.intp)]).astype(np.intp), arm
 
 
-def _search_start(phi_p, theta_friction, lo, hi, n_links: int, n_arm: int, p_std: int, typical: float):
-    """The search's start: each link's pseudo-inertia in the least-change solution projected onto
-    the consistent set (negative eigenvalues to 0, plus 1e-6 of its scale so that the Cholesky
-    factor exists: at L = 0 the gradient of L Lᵀ vanishes), the rotor inertias of that solution
-    (≥ 1e-15) and the estimated friction, moved just inside its bounds."""
-    x0 = np.concatenate([np.zeros(10 * n_links + n_arm), theta_friction])
-    x0 = np.clip(x0, lo + 1e-15 * (lo > -np.inf), hi)
-    tri = np.tril_indices(4)
+def _projection_start(phi0, theta, std, signed, n_links: int, nb: int, fr0: int,
+                      scale: float) -> np.ndarray:
+    """A strictly consistent start for the projection: the chain's own links with each
+    pseudo-inertia moved inside by 1 % of its scale, rotor inertias at 1 % of ``scale``, the
+    estimated friction (Coulomb and viscous at |θ̂| + σ, strictly positive)."""
+    x0 = np.concatenate([np.zeros(fr0), theta[nb:]])
     for k in range(n_links):
-        ev, V = np.linalg.eigh(pseudo_inertia(phi_p[10 * k:10 * k + 10]))
-        eps = 1e-6 * max(ev[-1], 1e-2 * typical)
-        x0[10 * k:10 * k + 10] = np.linalg.cholesky((V * np.maximum(ev, 0.0)) @ V.T + eps * np.eye(4))[tri]
-    if n_arm:
-        x0[10 * n_links:10 * n_links + n_arm] = np.maximum(phi_p[p_std:], 1e-15)
+        J = pseudo_inertia(phi0[10 * k:10 * k + 10])
+        ev, V = np.linalg.eigh(J)
+        eps = 1e-2 * max(ev[-1], 1e-2 * scale)
+        J_in = (V * np.maximum(ev, 0.0)) @ V.T + eps * np.eye(4)
+        x0[10 * k:10 * k + 10] = _J_TO_PHI @ J_in.ravel()
+    x0[10 * n_links:fr0] = 1e-2 * scale
+    fr = signed[signed >= fr0]
+    x0[fr] = np.abs(theta[fr - fr0 + nb]) + std[fr - fr0 + nb]
     return x0
 
 
-def _failing_parts(chain, search: _FactorSearch, phi_p, phi, x, kinds) -> list[str]:
+def _failing_parts(chain, phi_p, x, theta, std, kinds, n_arm: int, nb: int,
+                   scale: float) -> list[str]:
     """What has no consistent values: the links whose pseudo-inertia is indefinite in the
-    least-change solution (if none, those pushed onto the boundary by the search), rotor inertias
-    and friction coefficients held at 0 while the estimate is negative."""
+    least-change solution (if none, those on the boundary at the projection: smallest eigenvalue
+    below 1e-6 of the largest), rotor inertias and Coulomb or viscous coefficients held at 0
+    while the estimate is negative."""
     failing = []
+    n_links = len(chain.link_names)
     for k, name in enumerate(chain.link_names):
         if not _psd(pseudo_inertia(phi_p[10 * k:10 * k + 10])):
             failing.append(f"link {name!r}")
     if not failing:
         for k, name in enumerate(chain.link_names):
-            ev = np.linalg.eigvalsh(pseudo_inertia(phi[10 * k:10 * k + 10]))
+            ev = np.linalg.eigvalsh(pseudo_inertia(x[10 * k:10 * k + 10]))
             if ev[0] <= 1e-6 * max(ev[-1], 1e-300):
                 failing.append(f"link {name!r}")
-    if search.n_arm:
-        failing += [f"armature of {j!r} (< 0)" for i, j in enumerate(chain.coordinate_names)
-                    if x[10 * search.n_links + i] <= 1e-15]
+    fr0 = 10 * n_links + n_arm
+    failing += [f"armature of {j!r} (< 0)" for i, j in enumerate(chain.coordinate_names[:n_arm])
+                if x[10 * n_links + i] <= 1e-6 * scale]
     for j, jn in enumerate(chain.coordinate_names):
         for c, kind in enumerate(kinds):
-            k = search.fr0 + j * len(kinds) + c
-            if kind in ("coulomb", "viscous") and x[k] <= 0.0 and search.theta[search.nb + j * len(kinds) + c] < 0:
+            k = j * len(kinds) + c
+            held = theta[nb + k] < 0 and x[fr0 + k] <= 1e-3 * std[nb + k]
+            if kind in ("coulomb", "viscous") and held:
                 failing.append(f"{kind} friction of {jn!r} (< 0)")
     return failing
 
 
-def _consistency(chain, st: BaseStructure, theta, C, kinds, m, armature) -> Consistency:
-    """Physical consistency of the estimate θ̂ with covariance C (module doc): first the
-    least-change standard parameters, consistent there means consistent (d = 0, no search);
-    else a search of at most 80 steps over Cholesky factors for the nearest consistent θ in the
-    Mahalanobis distance d, and the parts that fail when d > 0.01 σ."""
-    from scipy.optimize import least_squares
+def _consistency(chain, st: BaseStructure, theta, C, kinds, m, armature,
+                 level: float = 0.95) -> Consistency:
+    """Physical consistency of the estimate θ̂ with covariance C
+    (:mod:`gripkit.sysid.dynamics_projection`): first the least-change standard parameters,
+    consistent there means consistent (d = 0, no search); else the projection of θ̂ onto the
+    consistent set in the metric C⁻¹, its distance d and the χ² test of level 1 − ``level``
+    with n = dim θ − (offsets) degrees of freedom."""
+    from scipy.stats import chi2
+
+    from .dynamics_projection import project_consistent
 
     nb = st.independent.size
     p_std = len(chain.parameter_names)
@@ -670,28 +642,43 @@ def _consistency(chain, st: BaseStructure, theta, C, kinds, m, armature) -> Cons
     K = st.matrix
     phi0 = chain.standard_parameters()
     n_arm = m if armature else 0
+    fr0 = p_std + n_arm
+    dof = int(theta.size - sum(kind == "offset" for kind in kinds) * m)
+    bound = float(np.sqrt(chi2.ppf(level, dof)))
     try:
         Ci = np.linalg.cholesky(np.linalg.inv(C))
     except np.linalg.LinAlgError:
         raise IdentificationError("the covariance of the estimate is not positive definite") from None
+    std = np.sqrt(np.diag(C))
     phi_nom = np.concatenate([phi0, np.zeros(n_arm)]) if n_arm else phi0.copy()
     phi_p, reproduces = _least_change_parameters(phi_nom, K, theta[:nb], n_links, p_std)
     links_ok = all(_psd(pseudo_inertia(phi_p[10 * k:10 * k + 10])) for k in range(n_links))
     fr_ok = all(theta[nb + j * len(kinds) + c] >= 0 for j in range(m) for c, kind in enumerate(kinds)
                 if kind in ("coulomb", "viscous"))
     if reproduces and links_ok and fr_ok and (not n_arm or (phi_p[p_std:] >= 0).all()):
-        return Consistency(True, 0.0, (), phi_p, theta.copy())
-    # search from that solution with each link's pseudo-inertia projected onto the consistent set
-    typical = max(np.mean([np.trace(pseudo_inertia(phi0[10 * k:10 * k + 10])) for k in range(n_links)]), 1e-12)
-    lo, hi = _search_bounds(n_links, n_arm, theta.size - nb, kinds, m)
-    x0 = _search_start(phi_p, theta[nb:], lo, hi, n_links, n_arm, p_std, typical)
-    search = _FactorSearch(K, Ci, theta, x0, n_links, n_arm, p_std)
-    sol = least_squares(search.resid, x0, jac=search.jac, bounds=(lo, hi), x_scale="jac", xtol=1e-10, ftol=1e-10,
-                        gtol=1e-10, max_nfev=80)
-    th, phi = search.params(sol.x)
-    d = float(np.linalg.norm(Ci.T @ (th - theta)))
-    failing = _failing_parts(chain, search, phi_p, phi, sol.x, kinds) if d > 1e-2 else []
-    return Consistency(d <= 1e-2, d, tuple(failing), phi, th)
+        return Consistency(True, 0.0, (), phi_p, theta.copy(), dof=dof, bound=bound, level=level,
+                           p_value=1.0, inside=True,
+                           solver="none needed: the least-change standard parameters are "
+                                  "consistent")
+    typical = float(np.mean([np.trace(pseudo_inertia(phi0[10 * k:10 * k + 10]))
+                             for k in range(n_links)]))
+    scale = max(typical, float(np.abs(theta[:nb]).max()), 1e-12)
+    A = np.zeros((theta.size, fr0 + theta.size - nb))
+    A[:nb, :fr0] = K
+    A[nb:, fr0:] = np.eye(theta.size - nb)
+    signed, _ = _signed_indices(kinds, m, n_arm, fr0)
+    x0 = _projection_start(phi0, theta, std, signed, n_links, nb, fr0, scale)
+    sol = project_consistent(A, Ci, theta, x0, n_links, signed, np.arange(p_std, fr0), scale,
+                             link_names=[repr(n) for n in chain.link_names])
+    d = sol.distance
+    inside = sol.converged and 0.5 * d * d <= sol.gap
+    consistent = bool(d <= bound)
+    failing = () if inside else tuple(_failing_parts(chain, phi_p, sol.x, theta, std, kinds, n_arm,
+                                                     nb, scale))
+    return Consistency(consistent, d, failing, sol.x[:fr0].copy(), sol.theta, dof=dof, bound=bound,
+                       level=level, p_value=float(chi2.sf(d * d, dof)), inside=bool(inside),
+                       solver=sol.message,
+                       converged=sol.converged, iterations=sol.iterations)
 
 
 def load_dynamics_model(path) -> DynamicsResult:
@@ -731,7 +718,12 @@ def load_dynamics_model(path) -> DynamicsResult:
         consistency = None if c is None else Consistency(
             bool(c["consistent"]), float(c["distance_sigma"]), tuple(c["failing_links"]),
             float_array(c["standard_parameters"], "consistency.standard_parameters", where),
-            float_array(c["values"], "consistency.values", where))
+            float_array(c["values"], "consistency.values", where),
+            dof=int(c.get("dof", 0)), bound=float(c.get("bound_sigma", float("nan"))),
+            level=float(c.get("level", 0.95)), p_value=float(c.get("p_value", float("nan"))),
+            inside=bool(c.get("estimate_consistent", c["distance_sigma"] == 0)),
+            solver=str(c.get("solver", "")), converged=bool(c.get("converged", True)),
+            iterations=int(c.get("iterations", 0)))
         data = doc.get("data") or {}
         return DynamicsResult(
             chain, structure, doc["friction_model"], bool(doc["armature"]), names, theta, cov,

@@ -15,7 +15,10 @@ models of :mod:`gripkit.sysid.model_file`)::
      "residual_std": {joint: σ}, "relative_error_percent": …, "condition_number": …, "n_samples": N,
      "constrained": false, "unconstrained_values": […],
      "consistency": {"consistent": …, "distance_sigma": …, "failing_links": […],
-                     "standard_parameters": […], "values": […]} | null,
+                     "standard_parameters": […], "values": […], "dof": n, "bound_sigma": …,
+                     "level": 0.95, "p_value": …, "estimate_consistent": …, "solver": "…",
+                     "converged": …, "iterations": …} | null,   (the fields after "values" are
+                     optional on reading: files written before them read with the defaults)
      "warnings": […], "data": {"file": "log.csv", "sha256": "…"} | null,
      "content_sha256": "…"}
 
@@ -78,7 +81,10 @@ def dynamics_document(result) -> dict:
            "unconstrained_values": result.unconstrained_theta,
            "consistency": None if cons is None else {
                "consistent": cons.consistent, "distance_sigma": cons.distance, "failing_links": cons.failing_links,
-               "standard_parameters": cons.standard_parameters, "values": cons.theta},
+               "standard_parameters": cons.standard_parameters, "values": cons.theta,
+               "dof": cons.dof, "bound_sigma": cons.bound, "level": cons.level,
+               "p_value": cons.p_value, "estimate_consistent": cons.inside, "solver": cons.solver,
+               "converged": cons.converged, "iterations": cons.iterations},
            "warnings": list(result.warnings),
            "data": None if result.data_file is None else {"file": result.data_file, "sha256": result.data_hash}}
     doc = plain(doc)

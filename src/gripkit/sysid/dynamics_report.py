@@ -91,6 +91,7 @@ def dynamics_report(result, t, q, qd, qdd, tau, *, weights=None, data_name: str 
         ["condition number (weighted regressor)", f"{result.condition_number:.4g}"],
         ["relative error %", f"{result.relative_error_percent:.3g}"],
         ["physical consistency", "not checked" if cons is None else cons.message()],
+        ["nearest consistent parameters: search", "not checked" if cons is None else cons.solver],
         ["constrained estimate", "yes" if result.constrained else "no"]])
     lines = list(dict.fromkeys(list(warnings_list) + list(result.warnings)))
     sec = rep.section("Warnings")
