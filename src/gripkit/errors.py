@@ -11,6 +11,10 @@ The CLI prints ``str(error)`` on one line and exits non-zero; ``--debug`` shows 
 
 from __future__ import annotations
 
+import os
+import sys
+import warnings
+
 __all__ = [
     "GripkitError",
     "DataError",
@@ -118,10 +122,6 @@ def warn(message: str, category: type[Warning] = GripkitWarning) -> None:
     line that called into gripkit, whatever the depth of the call inside (what Python 3.12's
     ``warnings.warn(skip_file_prefixes=...)`` does), so the printed location and ``-W`` filters by
     module point at the user's code, never into gripkit."""
-    import os
-    import sys
-    import warnings
-
     package = os.path.dirname(os.path.abspath(__file__)) + os.sep
     frame, level = sys._getframe(1), 2  # stacklevel 2: the caller of warn()
     while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package):

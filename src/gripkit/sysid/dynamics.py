@@ -69,6 +69,7 @@ from ..errors import AccuracyWarning, DataError, IdentificationError, ModelError
 from ..multibody import from_urdf
 from .checks import as_io_matrix
 from .dynamics_file import float_array, read_dynamics_document, save_dynamics_model
+from .dynamics_projection import project_consistent
 from .regression import hac_covariance
 
 __all__ = ["identify_dynamics", "DynamicsResult", "base_structure", "BaseStructure", "load_dynamics_model"]
@@ -633,8 +634,6 @@ def _consistency(chain, st: BaseStructure, theta, C, kinds, m, armature,
     consistent set in the metric C⁻¹, its distance d and the χ² test of level 1 − ``level``
     with n = dim θ − (offsets) degrees of freedom."""
     from scipy.stats import chi2
-
-    from .dynamics_projection import project_consistent
 
     nb = st.independent.size
     p_std = len(chain.parameter_names)

@@ -187,7 +187,6 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     one-step-ahead fit, PEM's own criterion, as MATLAB's default ``Focus``). When the refined model
     scores lower, the subspace model is returned with an :class:`AccuracyWarning` giving both
     scores. PEM stopping after ``max_iterations`` without converging is warned about too."""
-    from .pem_ss import pem
     from .subspace import (
         DEFAULT_MAX_ORDER,
         SUBSPACE_METHODS,
@@ -250,25 +249,7 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
         raise DataError(f"focus: expected one of {', '.join(FOCUS)}, found {focus!r}")
     if refine:
         report(f"PEM refinement ({form} form) of the order-{model.order} model")
-        start = model
-        try:
-            model = pem(model, u=d.u, y=d.y, form=form, max_iterations=max_iterations)
-        except IdentificationError as exc:  # an order the data do not support in full
-            warnings.warn(f"PEM refinement of the order-{start.order} {start.structure} model failed "
-                          f"({exc.message}); the subspace model is returned, without parameter "
-                          f"covariance (lower the order, or --no-refine to skip PEM)",
-                          AccuracyWarning, stacklevel=2)
-            refine = False
-            model = start
-    if refine:
-        oe = None
-        if form == "innovation" and focus == "simulation":  # PEM in oe form minimises the free-run
-            def oe():                                       # error itself: the second candidate
-                try:
-                    return pem(start, u=d.u, y=d.y, form="oe", max_iterations=max_iterations)
-                except IdentificationError:
-                    return None
-        model = _never_lose(start, model, focus, d if vd is None else vd, vd is None, max_iterations, oe)
+        model, refine = _refine(model, d, vd, form, focus, max_iterations)
     warn_if_stabilised(model)
     if detrend == "mean":
         refit = lambda: identify_ss(  # noqa: E731
@@ -303,6 +284,31 @@ def focus_score(model, focus: str, d: MimoData, estimation: bool = False) -> flo
     _, e = predictor_x0(ss.A, ss.B, ss.C, ss.D, K, d.u, d.y)
     den = np.linalg.norm(d.y - d.y.mean(axis=0), axis=0)
     return float(np.mean(100.0 * (1.0 - np.linalg.norm(e, axis=0) / den)))
+
+
+def _refine(start, d: MimoData, vd: MimoData | None, form: str, focus: str, max_iterations: int):
+    """PEM in ``form`` from the subspace model ``start``, kept only when it does not lose by
+    ``focus`` (:func:`_never_lose`; PEM in oe form as the second candidate for the simulation
+    focus); ``(model, refined?)``. A PEM that the data cannot determine returns ``start`` with a
+    warning."""
+    from .pem_ss import pem
+
+    try:
+        model = pem(start, u=d.u, y=d.y, form=form, max_iterations=max_iterations)
+    except IdentificationError as exc:  # an order the data do not support in full
+        warnings.warn(f"PEM refinement of the order-{start.order} {start.structure} model failed "
+                      f"({exc.message}); the subspace model is returned, without parameter "
+                      f"covariance (lower the order, or --no-refine to skip PEM)",
+                      AccuracyWarning, stacklevel=3)
+        return start, False
+    oe = None
+    if form == "innovation" and focus == "simulation":  # PEM in oe form minimises the free-run
+        def oe():                                       # error itself: the second candidate
+            try:
+                return pem(start, u=d.u, y=d.y, form="oe", max_iterations=max_iterations)
+            except IdentificationError:
+                return None
+    return _never_lose(start, model, focus, d if vd is None else vd, vd is None, max_iterations, oe), True
 
 
 #: fit points (%) within which a refined model counts as scoring as well as its start: the scores

@@ -72,9 +72,10 @@ ABSURD_JUMP = 1e10
 
 
 @njit(cache=True, inline="always")
-def _core(Pb, oP, thb, oth, phb, oph, qb, oq, p, size, lam, mode, maxtr, trace, y):
+def _core(Pb, thb, phb, qb, at, p, size, lam, mode, maxtr, trace, y):
     """One RLS update of θ (``thb[oth:oth + p]``) and P (``Pb[oP:oP + p·p]``, row-major) for the
-    regressor ``phb[oph:oph + p]`` and output ``y``; ``qb[oq:oq + p]`` is work space. Returns
+    regressor ``phb[oph:oph + p]`` and output ``y``; ``qb[oq:oq + p]`` is work space; ``at`` holds
+    the offsets ``(oP, oth, oph, oq)`` (a tuple: the kernel is inlined, so it costs nothing). Returns
     (a-priori error, r = φᵀPφ, trace). The batch kernel passes one local buffer four times with
     constant offsets (the compiler then sees that the vectors do not overlap), the streaming step
     views of its state vector at offset 0.
@@ -83,6 +84,7 @@ def _core(Pb, oP, thb, oth, phb, oph, qb, oq, p, size, lam, mode, maxtr, trace, 
     unrolled). The covariance update is ``P ← (P + coef·q qᵀ)·scale`` with ``q = Pφ`` (see the
     module docstring for ``coef``, ``scale`` and the three ``windup`` modes).
     """
+    oP, oth, oph, oq = at
     if len(size) > 0:
         p = len(size)
     yhat = 0.0
@@ -168,8 +170,8 @@ def _rls_step(s, u, y):
         for i in range(p + p * p):
             s[ob + i] = s[oth + i]
         lam = s[_LAM]
-        e, r, tr = _core(s[op:oph], 0, s[oth:op], 0, s[oph:oq], 0, s[oq:oq + p], 0, p, (), lam,
-                         int(s[_MODE]), s[_MAXTR], s[_TRACE], y)
+        e, r, tr = _core(s[op:oph], s[oth:op], s[oph:oq], s[oq:oq + p], (0, 0, 0, 0), p, (),
+                         lam, int(s[_MODE]), s[_MAXTR], s[_TRACE], y)
         ok = math.isfinite(tr) and math.isfinite(e)
         for i in range(p):
             ok = ok and math.isfinite(s[oth + i])
@@ -269,13 +271,13 @@ def _rls_run(s, u, y, theta_out, std_out, yhat_out, err_out, size):
         for j in range(nb):
             w[bph + na + j] = u[t - nk - j]
         if mode == 0:  # the mode as a literal: its branches fold away in each copy
-            e, r, trace = _core(w, bP, w, bth, w, bph, w, bq, p, size[0], lam, 0, maxtr, trace,
+            e, r, trace = _core(w, w, w, w, (bP, bth, bph, bq), p, size[0], lam, 0, maxtr, trace,
                                     y[t])
         elif mode == 1:
-            e, r, trace = _core(w, bP, w, bth, w, bph, w, bq, p, size[0], lam, 1, maxtr, trace,
+            e, r, trace = _core(w, w, w, w, (bP, bth, bph, bq), p, size[0], lam, 1, maxtr, trace,
                                     y[t])
         else:
-            e, r, trace = _core(w, bP, w, bth, w, bph, w, bq, p, size[0], lam, 2, maxtr, trace,
+            e, r, trace = _core(w, w, w, w, (bP, bth, bph, bq), p, size[0], lam, 2, maxtr, trace,
                                     y[t])
         V = lam * (V + e * e / (lam + r))
         w1 = lam * w1 + 1.0
