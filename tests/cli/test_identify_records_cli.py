@@ -104,3 +104,20 @@ def test_short_record_is_one_line_naming_its_file(capsys, files, tmp_path):
     assert code != 0 and len(err.strip().splitlines()) == 1
     assert err.startswith(f"error: DataError: {str(short)!r}: ARX [5 1 1] takes the first 5 "
                           "samples of every record")
+
+
+@pytest.mark.parametrize("method, orders", [("armax", ("--na", 1, "--nb", 1, "--nc", 1, "--nk", 1)),
+                                            ("oe", ("--nb", 1, "--nf", 1, "--nk", 1))])
+def test_armax_and_oe_several_files(capsys, files, method, orders):
+    code, out, err = run(capsys, "identify", method, *files, "--input", "u", "--output", "y",
+                         *orders, "--detrend", "none", "--json")
+    assert code == 0, err
+    res = json.loads(out)
+    m = identify([load(p) for p in files], method, input="u", output="y", na=1, nb=1, nc=1, nf=1,
+                 nk=1, detrend="none")
+    np.testing.assert_allclose(res["theta"], m.theta, rtol=1e-9)
+    assert res["structure"] == method
+    assert [r["data"] for r in res["records"]] == [str(p) for p in files]
+    # the data: y(t) = 0.9 y(t−1) + 0.5 u(t−1) + e, an ARX: as ARMAX, c1 ≈ 0; as OE, f1 ≈ −0.9
+    pole = res["theta"][0] if method == "armax" else res["theta"][1]
+    assert pole == pytest.approx(-0.9, abs=0.02)

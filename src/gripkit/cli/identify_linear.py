@@ -7,6 +7,9 @@ operating point (``--detrend mean`` by default), and prints a summary table, or 
 ``one_step_fit_percent``, ``validation.fit_percent``) are lists per output in ``--output`` order;
 with one input and one output its JSON is the SISO one (``validation.fit_percent`` a number). Warnings (an unstable model in validation, a
 non-converged iteration) go to stderr as ``warning: ...`` lines and into the JSON ``warnings``.
+``identify arx|armax|oe DATA1 DATA2 ...`` fit one model of several records (each with its own
+initial conditions, one operating point): ``data`` is then the list of files and ``records`` each
+file's samples and fit.
 """
 
 from __future__ import annotations
@@ -22,6 +25,9 @@ from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_choice, check_data_
                      collected_warnings, emit_json, load_data, report_warnings)
 
 DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
+DataArgs = typer.Argument(..., help="Data file(s) (.csv, .parquet, .h5); several: one model of all "
+                                    "the records, each with its own initial conditions.",
+                          show_default=False)
 InputOpt = typer.Option(..., "--input", help="Input column (e.g. the valve current).")
 OutputOpt = typer.Option(..., "--output", help="Output column (e.g. the force).")
 DetrendOpt = typer.Option("mean", "--detrend",
@@ -166,7 +172,8 @@ def _mimo_arx(data: list[Path], input: str, output: str, na: int, nb: int, nk: i
             model = fit_arx(tr, input=input, output=output, na=na, nb=nb, nk=nk, detrend=detrend)
             model = model.replace(data_file=Path(data).name, data_hash=file_sha256(data))
         else:
-            model = _fit_records(data, columns, input, output, na, nb, nk, fs, time, fill, detrend)
+            model = _fit_records(data, columns, input, output, fs, time, fill, detrend, "arx",
+                                 na=na, nb=nb, nk=nk)
         if out_file is not None:
             model.save(out_file)
         res = model.to_dict()
@@ -209,9 +216,9 @@ def _mimo_arx(data: list[Path], input: str, output: str, na: int, nb: int, nk: i
         typer.echo(f"model written to {out_file}")
 
 
-def _fit_records(data: list[Path], columns: list[str], input: str, output: str, na: int, nb: int,
-                 nk: int, fs, time, fill, detrend: str):
-    """One ARX model of several data files (:func:`gripkit.sysid.identify.identify_records`): each
+def _fit_records(data: list[Path], columns: list[str], input: str, output: str, fs, time, fill,
+                 detrend: str, method: str, **orders):
+    """One model of several data files (:func:`gripkit.sysid.identify.identify_records`): each
     file a record with its own initial conditions, one operating point for all of them."""
     from ..errors import DataError, GripkitError
     from ..sysid.identify import identify_records
@@ -222,8 +229,8 @@ def _fit_records(data: list[Path], columns: list[str], input: str, output: str, 
                         hint="a line per file would give every record its own operating point")
     trs = [load_data(path, columns, fs, time, fill) for path in data]  # its errors name the file
     try:
-        model = identify_records(trs, "arx", input=input, output=output, na=na, nb=nb, nk=nk,
-                                 detrend=detrend)
+        model = identify_records(trs, method, input=input, output=output, detrend=detrend,
+                                 **orders)
     except GripkitError as exc:  # name the file, not its place in the list
         msg = exc.message
         for i, path in reversed(list(enumerate(data))):  # data[10] before data[1]
@@ -262,14 +269,14 @@ def _echo_records(records: list[dict] | None) -> None:
         typer.echo(line)
 
 
-def _siso_records_arx(data: list[Path], input: str, output: str, na: int, nb: int, nk: int, fs,
-                      time, fill, detrend: str, validate: Path | None, json_out: bool,
-                      out_file: Path | None) -> None:
-    """SISO ARX of several data files: the JSON of one file's fit, with ``data`` the list of files,
-    ``fit_percent`` the one-step fit of all records and ``records`` each file's."""
+def _siso_records(method: str, data: list[Path], input: str, output: str, fs, time, fill,
+                  detrend: str, validate: Path | None, json_out: bool, out_file: Path | None,
+                  **orders) -> None:
+    """ARX, ARMAX or OE of several data files: the JSON of one file's fit, with ``data`` the list
+    of files, ``fit_percent`` the one-step fit of all records and ``records`` each file's."""
     with collected_warnings() as caught:
-        model = _fit_records(data, [input, output], input, output, na, nb, nk, fs, time, fill,
-                             detrend)
+        model = _fit_records(data, [input, output], input, output, fs, time, fill, detrend, method,
+                             **orders)
         if out_file is not None:
             from ..sysid.linear_model import from_polynomial
 
@@ -286,11 +293,6 @@ def _siso_records_arx(data: list[Path], input: str, output: str, na: int, nb: in
         return
     _print_model(model, val, out.get("validation_fit_percent"))
     _echo_records(out["records"])
-
-
-DataArgs = typer.Argument(..., help="Data file(s) (.csv, .parquet, .h5); several: one model of all "
-                                    "the records, each with its own initial conditions.",
-                          show_default=False)
 
 
 @identify_app.command("arx")
@@ -310,8 +312,8 @@ def identify_arx(data: list[Path] = DataArgs, input: str = InputsOpt, output: st
         _mimo_arx(data, input, output, na, nb, nk, fs, time, fill, detrend, validate, json_out, out)
         return
     if len(data) > 1:
-        _siso_records_arx(data, input, output, na, nb, nk, fs, time, fill, detrend, validate,
-                          json_out, out)
+        _siso_records("arx", data, input, output, fs, time, fill, detrend, validate, json_out,
+                      out, na=na, nb=nb, nk=nk)
         return
     data = data[0]
     _fit_and_report("arx", data, input, output, fs, time, fill, detrend, validate, json_out,
@@ -319,32 +321,44 @@ def identify_arx(data: list[Path] = DataArgs, input: str = InputsOpt, output: st
 
 
 @identify_app.command("armax")
-def identify_armax(data: Path = DataArg, input: str = InputOpt, output: str = OutputOpt,
+def identify_armax(data: list[Path] = DataArgs, input: str = InputOpt, output: str = OutputOpt,
                    na: int = NaOpt,
                    nb: int = NbOpt,
                    nc: int = typer.Option(..., "--nc", help="Number of C coefficients."),
                    nk: int = NkOpt,
                    fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                    validate: Path = ValidateOpt, json_out: bool = JsonOpt, out: Path = ModelOutOpt):
-    """ARMAX (orders na, nb, nc, nk) by prediction-error minimisation."""
+    """ARMAX (orders na, nb, nc, nk) by prediction-error minimisation. With several DATA files one
+    model of all the records (each with its own initial conditions)."""
     from ..sysid import armax
 
     _check_options(fs, fill, detrend, validate, na=na, nb=nb, nc=nc, nk=nk)
+    if len(data) > 1:
+        _siso_records("armax", data, input, output, fs, time, fill, detrend, validate, json_out,
+                      out, na=na, nb=nb, nc=nc, nk=nk)
+        return
+    data = data[0]
     _fit_and_report("armax", data, input, output, fs, time, fill, detrend, validate, json_out,
                     lambda io: armax(io.u, io.y, na, nb, nc, nk, dt=io.dt, **io.meta), out)
 
 
 @identify_app.command("oe")
-def identify_oe(data: Path = DataArg, input: str = InputOpt, output: str = OutputOpt,
+def identify_oe(data: list[Path] = DataArgs, input: str = InputOpt, output: str = OutputOpt,
                 nb: int = NbOpt,
                 nf: int = typer.Option(..., "--nf", "--na", help="Number of F (denominator) coefficients."),
                 nk: int = NkOpt,
                 fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                 validate: Path = ValidateOpt, json_out: bool = JsonOpt, out: Path = ModelOutOpt):
-    """Output-error (orders nb, nf, nk) by prediction-error minimisation."""
+    """Output-error (orders nb, nf, nk) by prediction-error minimisation. With several DATA files
+    one model of all the records (each with its own initial outputs, estimated)."""
     from ..sysid import oe
 
     _check_options(fs, fill, detrend, validate, nb=nb, nf=nf, nk=nk)
+    if len(data) > 1:
+        _siso_records("oe", data, input, output, fs, time, fill, detrend, validate, json_out, out,
+                      nb=nb, nf=nf, nk=nk)
+        return
+    data = data[0]
     _fit_and_report("oe", data, input, output, fs, time, fill, detrend, validate, json_out,
                     lambda io: oe(io.u, io.y, nb, nf, nk, dt=io.dt, **io.meta), out)
 

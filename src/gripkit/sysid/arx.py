@@ -186,6 +186,42 @@ def checked_records(records, what: str) -> list:
     return out
 
 
+def check_record_lengths(recs: list, t0: int, label: str) -> None:
+    """Every record longer than its ``t0`` initial samples, or a DataError naming the record."""
+    for i, (_, y) in enumerate(recs):
+        if y.size <= t0:
+            raise DataError(f"records[{i}]: {label} takes the first {t0} samples of every record "
+                            f"as its initial conditions, so a record needs more than {t0} samples, "
+                            f"found {y.size}", hint="drop the short record or lower the orders")
+
+
+def scaled_records(recs: list, skip_within: float = 0.0) -> tuple[list, float, float]:
+    """The records with their input and output scaled to unit size (one power of two for all
+    records, :func:`~gripkit.sysid._scaling.unit_scale`) and the factors ``(scaled, cu, cy)``,
+    after the checks that need all the records: a varying input and a varying output. Peaks
+    within 2^±``skip_within`` stay unscaled."""
+    u_all = np.concatenate([u for u, _ in recs])
+    y_all = np.concatenate([y for _, y in recs])
+    check_excitation(u_all)
+    check_output_varies(y_all)
+    cu, cy = unit_scale(u_all), unit_scale(y_all)
+    if max(abs(np.log2(cu)), abs(np.log2(cy))) <= skip_within:
+        cu = cy = 1.0
+    return [(u * cu, y * cy) if (cu, cy) != (1.0, 1.0) else (u, y) for u, y in recs], cu, cy
+
+
+def records_summary(ys: list, errs: list, t0: int) -> tuple[float, list, list, np.ndarray]:
+    """(fit of all records, per-record dicts, start of each record's errors, all errors read-only)
+    from each record's predicted outputs ``ys`` (samples t0 … N_i − 1) and prediction errors."""
+    yhats = [yi - ei for yi, ei in zip(ys, errs)]
+    per_record = [{"n_samples": int(yi.size + t0), "n_used": int(yi.size),
+                   "fit_percent": fit_percent(yi, hi)} for yi, hi in zip(ys, yhats)]
+    e = np.concatenate(errs)
+    e.flags.writeable = False
+    starts = np.cumsum([0] + [yi.size for yi in ys[:-1]]).tolist()
+    return float(records_fit(ys, yhats)), per_record, starts, e
+
+
 def arx_records(records, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
                 **meta) -> PolynomialModel:
     """Least-squares ARX fitted to several records at once (one model, one θ, one σ).
@@ -227,23 +263,10 @@ def arx_records(records, na: int, nb: int, nk: int = 1, *, dt: float | None = No
     p = na + nb
     t0 = arx_start(na, nb, nk)
     what = f"ARX [{na} {nb} {nk}] ({p} parameters, {t0} initial samples in every record)"
-    for i, (u, y) in enumerate(recs):
-        if y.size <= t0:
-            raise DataError(f"records[{i}]: ARX [{na} {nb} {nk}] takes the first {t0} samples of "
-                            f"every record as its initial conditions, so a record needs more than "
-                            f"{t0} samples, found {y.size}",
-                            hint="drop the short record or lower the orders")
-    ms = [y.size - t0 for _, y in recs]
-    m = sum(ms)
+    check_record_lengths(recs, t0, f"ARX [{na} {nb} {nk}]")
+    m = sum(y.size - t0 for _, y in recs)
     require_samples(m + t0, t0 + p + 1, what)
-    u_all = np.concatenate([u for u, _ in recs])
-    y_all = np.concatenate([y for _, y in recs])
-    check_excitation(u_all)
-    check_output_varies(y_all)
-    cu, cy = unit_scale(u_all), unit_scale(y_all)
-    if max(abs(np.log2(cu)), abs(np.log2(cy))) <= _NO_SCALING_WITHIN:
-        cu = cy = 1.0
-    scaled = [(u * cu, y * cy) if cu != 1.0 else (u, y) for u, y in recs]
+    scaled, cu, cy = scaled_records(recs, skip_within=_NO_SCALING_WITHIN)
     names = tuple(f"a{i}" for i in range(1, na + 1)) + tuple(f"b{nk + j}" for j in range(nb))
     sol = theta = R = None
     if m * (p + 1) > QR_MAX_ELEMENTS:  # the records' Gram matrices summed (O(p²) memory)
@@ -271,15 +294,9 @@ def arx_records(records, na: int, nb: int, nk: int = 1, *, dt: float | None = No
         R[p, p] = np.sqrt(see)
         sol = triangular_solve(R, names, m, True, stacklevel=3)
     sigma2 = see / (m - p)
-    ys = [y[t0:] for _, y in scaled]
-    yhats = [yi - ei for yi, ei in zip(ys, errs)]
-    per_record = [{"n_samples": int(yi.size + t0), "n_used": int(yi.size),
-                   "fit_percent": fit_percent(yi, hi)} for yi, hi in zip(ys, yhats)]
-    e.flags.writeable = False
-    starts = np.cumsum([0] + ms[:-1]).tolist()
+    fit, per_record, starts, e = records_summary([y[t0:] for _, y in scaled], errs, t0)
     model = model.replace(covariance=sigma2 * sol.cov_unscaled, noise_variance=sigma2,
-                          loss=0.5 * see / m, fit_percent=float(records_fit(ys, yhats)),
-                          n_used=m, residuals=e,
+                          loss=0.5 * see / m, fit_percent=fit, n_used=m, residuals=e,
                           info={"method": method, "cond": sol.cond, "n_records": len(recs),
                                 "records": per_record, "record_starts": starts})
     return in_user_units(model, cu, cy)

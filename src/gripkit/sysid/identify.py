@@ -173,8 +173,8 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
     data
         A uniformly sampled :class:`~gripkit.signals.Trajectory` (e.g. from
         :func:`gripkit.io.load`), or a list of them: several records of the same columns fitted
-        by one model, each with its own initial conditions (method ``'arx'``; see
-        :func:`identify_records`).
+        by one model, each with its own initial conditions (methods ``'arx'``, ``'armax'``,
+        ``'oe'``; see :func:`identify_records`).
     method
         ``'arx'`` (least squares), ``'armax'`` (orders na, nb, nc, nk), ``'oe'`` (orders nb, nf,
         nk; ``nf`` defaults to ``na``), ``'rls'`` (recursive least squares; options
@@ -211,7 +211,7 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
                                 if isinstance(data, Trajectory) else None)
     if isinstance(data, (list, tuple)):  # several records, one model
         return identify_records(data, method, input=input, output=output, na=na, nb=nb, nk=nk,
-                                detrend=detrend)
+                                nc=nc, nf=nf, detrend=detrend, **options)
     if method in ("ss", "frf", "tf"):  # MIMO: input/output may name several columns
         fn = {"ss": identify_mimo.identify_ss, "frf": identify_mimo.identify_frf, "tf": identify_mimo.identify_tf}
         out = fn[method](data, input=input, output=output, detrend=detrend, **options)
@@ -235,7 +235,7 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
 
 
 #: the methods that fit one model to several records (``identify([tr1, tr2], ...)``)
-RECORD_METHODS = ("arx",)
+RECORD_METHODS = ("arx", "armax", "oe")
 
 
 def _per_record(i: int, fn, *args, **kw):
@@ -247,12 +247,15 @@ def _per_record(i: int, fn, *args, **kw):
 
 
 def identify_records(data, method: str = "arx", *, input, output, na: int = 2, nb: int = 2,
-                     nk: int = 1, detrend: str = "mean"):
+                     nk: int = 1, nc: int = 1, nf: int | None = None, detrend: str = "mean",
+                     **options):
     """One model from several records (a list of :class:`~gripkit.signals.Trajectory` with the
     same columns, sample interval and units), each with its own initial conditions; σ from all
-    of them (:func:`gripkit.sysid.arx_records`, :func:`gripkit.sysid.arx_mimo.arx_mimo_records`
-    with several columns). This is what ``identify([tr1, tr2], "arx", ...)`` and
-    ``gripkit identify arx DATA1 DATA2 ...`` do.
+    of them: ARX (:func:`gripkit.sysid.arx_records`; with several columns
+    :func:`gripkit.sysid.arx_mimo.arx_mimo_records`), ARMAX
+    (:func:`gripkit.sysid.armax.armax_records`), OE (:func:`gripkit.sysid.oe.oe_records`; ``nf``
+    defaults to ``na``), ``options`` ``maxiter``, ``tol`` for the last two. This is what
+    ``identify([tr1, tr2], method, ...)`` and ``gripkit identify METHOD DATA1 DATA2 ...`` do.
 
     The model has one operating point: ``detrend='mean'`` removes the mean of all the records
     together (each channel's samples pooled), stored as ``u_offset``/``y_offset``;
@@ -263,7 +266,8 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
     if method not in RECORD_METHODS:
         raise ArgumentError(f"identify(): several records (a list of {len(data)} trajectories) are "
                             f"fitted by method {', '.join(map(repr, RECORD_METHODS))} only, found "
-                            f"method {method!r}", hint="pass one trajectory, or use method='arx'")
+                            f"method {method!r}",
+                            hint=f"pass one trajectory, or use method {', '.join(RECORD_METHODS)}")
     if not data:
         raise DataError("data: expected a trajectory or a non-empty list of them, found an empty "
                         "list")
@@ -279,6 +283,10 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
                              "detrend the records before, or use 'mean'")
     why = f"{method.upper()} identification"
     if identify_mimo.several(input, output):
+        if method != "arx":
+            raise ArgumentError(f"identify(): several input or output columns with several records "
+                                f"are fitted by method 'arx' only, found method {method!r}",
+                                hint="name one input and one output, or use method 'arx'")
         from .arx_mimo import arx_mimo_records
 
         ds = [_per_record(i, identify_mimo.mimo_data, d, input, output, "none", why=why)
@@ -291,8 +299,6 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
         return _as_data(arx_mimo_records, [(d.u - u0, d.y - y0) for d in ds], na, nb, nk,
                         dt=ds[0].dt, u_offset=tuple(map(float, u0)),
                         y_offset=tuple(map(float, y0)), **ds[0].signals)
-    from .arx import arx_records
-
     (input,) = identify_mimo.parse_names(input, "input")
     (output,) = identify_mimo.parse_names(output, "output")
     ios = [_per_record(i, io_data, d, input=input, output=output, detrend="none", why=why)
@@ -301,9 +307,19 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
                    (ios[0].input, ios[0].output))
     u0 = float(_pooled_mean([io.u for io in ios])) if detrend == "mean" else 0.0
     y0 = float(_pooled_mean([io.y for io in ios])) if detrend == "mean" else 0.0
-    meta = dict(ios[0].meta, u_offset=u0, y_offset=y0)
-    return _as_data(arx_records, [(io.u - u0, io.y - y0) for io in ios], na, nb, nk,
-                    dt=ios[0].dt, **meta)
+    meta = dict(ios[0].meta, u_offset=u0, y_offset=y0, dt=ios[0].dt, **options)
+    records = [(io.u - u0, io.y - y0) for io in ios]
+    if method == "arx":
+        from .arx import arx_records
+
+        return _as_data(arx_records, records, na, nb, nk, **meta)
+    if method == "armax":
+        from .armax import armax_records
+
+        return _as_data(armax_records, records, na, nb, nc, nk, **meta)
+    from .oe import oe_records
+
+    return _as_data(oe_records, records, nb, na if nf is None else nf, nk, **meta)
 
 
 def _as_data(fit, records, *args, **kw):
