@@ -121,3 +121,23 @@ def test_armax_and_oe_several_files(capsys, files, method, orders):
     # the data: y(t) = 0.9 y(t−1) + 0.5 u(t−1) + e, an ARX: as ARMAX, c1 ≈ 0; as OE, f1 ≈ −0.9
     pole = res["theta"][0] if method == "armax" else res["theta"][1]
     assert pole == pytest.approx(-0.9, abs=0.02)
+
+
+def test_ss_several_files_with_no_refine(capsys, files):
+    code, out, err = run(capsys, "identify", "ss", *files, "--input", "u", "--output", "y",
+                         "--order", 1, "--no-refine", "--validate", files[1], "--json")
+    assert code == 0, err
+    res = json.loads(out)
+    m = identify([load(p) for p in files], "ss", input="u", output="y", order=1, refine=False)
+    np.testing.assert_allclose(res["fit_percent"], m.fit_percent, rtol=1e-9)
+    assert res["data"] == [str(p) for p in files] and len(res["records"]) == 2
+    assert res["A"][0][0] == pytest.approx(0.9, abs=0.01)  # the pole of y(t) = 0.9 y(t−1) + …
+    # free run: the equation noise (σ 0.05 through 1/(1 − 0.9q⁻¹), σ 0.115) against the output's
+    # σ 1.15 caps the fit near 100 (1 − 0.1) = 90 %
+    assert 85.0 < res["validation"]["fit_percent"][0] < 92.0
+
+
+def test_ss_several_files_without_no_refine_is_one_line(capsys, files):
+    code, out, err = run(capsys, "identify", "ss", *files, "--input", "u", "--output", "y")
+    assert code != 0 and len(err.strip().splitlines()) == 1
+    assert err.startswith("error: ArgumentError: identify ss: PEM refinement of several data files")

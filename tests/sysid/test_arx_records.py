@@ -125,7 +125,7 @@ def test_identify_with_a_list_of_trajectories_one_operating_point():
 
 @pytest.mark.parametrize("case, error, phrase", [
     ("linear", DataError, "one operating point"),
-    ("ss", ArgumentError, "fitted by method 'arx', 'armax', 'oe' only"),
+    ("frf", ArgumentError, "fitted by method 'arx', 'armax', 'oe', 'ss' only"),
     ("dt", DataError, "must share the sample interval"),
     ("units", DataError, "must use the same units"),
     ("short", DataError, "data[1]: ARX [2 2 2] takes the first 3 samples of every record"),
@@ -143,7 +143,7 @@ def test_records_refused_with_a_message(case, error, phrase):
         kw["detrend"] = "linear"
     with pytest.raises(error) as exc:
         data = [] if case == "empty" else [tr, other]
-        identify(data, "ss" if case == "ss" else "arx", **kw)
+        identify(data, "frf" if case == "frf" else "arx", **kw)
     assert phrase in str(exc.value)
 
 

@@ -23,6 +23,9 @@ from .app import identify_app
 from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data, report_warnings
 
 DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
+DataArgs = typer.Argument(..., help="Data file(s) (.csv, .parquet, .h5); several (with "
+                                    "--no-refine): one subspace model of all the records, each "
+                                    "with its own initial state.", show_default=False)
 InputsOpt = typer.Option(..., "--input", help="Input column(s), comma-separated (e.g. a,b).")
 OutputsOpt = typer.Option(..., "--output", help="Output column(s), comma-separated (e.g. c,d).")
 DetrendOpt = typer.Option("mean", "--detrend", help="Operating-point removal before fitting: mean or none.")
@@ -54,7 +57,7 @@ def _finish(model, data, tr, out, report, caught_lines_fn):
 
 
 @identify_app.command("ss")
-def identify_ss_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = OutputsOpt,
+def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output: str = OutputsOpt,
                     order: str = typer.Option(None, "--order", help="Order N, or a range LO:HI to search "
                                                                      "(default: from the singular values)."),
                     method: str = typer.Option("n4sid", "--method", help="Subspace weighting: n4sid, moesp or cva."),
@@ -70,7 +73,9 @@ def identify_ss_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = 
                     out: Path = ModelOutOpt, report: Path = ReportOpt,
                     fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                     json_out: bool = JsonOpt):
-    """MIMO state space: subspace (N4SID/MOESP/CVA, order from the singular values), then PEM."""
+    """MIMO state space: subspace (N4SID/MOESP/CVA, order from the singular values), then PEM.
+    Several DATA files (with --no-refine): one subspace model of all the records, one initial state
+    per record (``records``: each file's free-run fit)."""
     from ..errors import DataError
     from ..sysid.identify_mimo import identify_ss
 
@@ -80,19 +85,38 @@ def identify_ss_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = 
         raise DataError(f"--focus: expected simulation or prediction, found {focus!r}")
     if max_iterations < 1:
         raise DataError(f"--max-iterations: expected a positive integer, found {max_iterations}")
+    several = len(data) > 1
+    if several and report is not None:
+        raise DataError("--report: the model report is of one data file; with several data "
+                        "files leave --report out",
+                        hint="run gripkit report MODEL.json DATA for each file")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        tr = _load(data, input, output, fs, time, fill)
-        vtr = _load(validate, input, output, fs, time, fill) if validate is not None else None
-        model, extras = identify_ss(tr, input=input, output=output, order=order, method=method, form=form,
-                                    refine=not no_refine, validate=vtr, detrend=detrend, progress=True,
-                                    focus=focus, max_iterations=max_iterations)
-        model = _with_provenance(model, data)
-        _finish(model, data, tr, out, report, None)
+        if several:
+            model, extras = _ss_of_records(data, input, output, order, method, no_refine, validate,
+                                           detrend, fs, time, fill)
+            if out is not None:
+                model.save(out)
+        else:
+            data = data[0]
+            tr = _load(data, input, output, fs, time, fill)
+            vtr = _load(validate, input, output, fs, time, fill) if validate is not None else None
+            model, extras = identify_ss(tr, input=input, output=output, order=order,
+                                        method=method, form=form, refine=not no_refine,
+                                        validate=vtr, detrend=detrend, progress=True,
+                                        focus=focus, max_iterations=max_iterations)
+            model = _with_provenance(model, data)
+            _finish(model, data, tr, out, report, None)
     from ..sysid.linear_model import VALIDATION_FIT
 
     res = model.to_dict()
-    res.update(data=str(data), method=method, refined=not no_refine, out=None if out is None else str(out))
+    res.update(data=[str(p) for p in data] if several else str(data), method=method,
+               refined=not no_refine, out=None if out is None else str(out))
+    if several:
+        res["records"] = [{"data": str(p), "n_samples": r["n_samples"],
+                           "fit_percent": r["fit_percent"]}
+                          for p, r in zip(data, model.info["records"])]
+        res["info"]["records"] = res["records"]  # without the initial states' arrays
     if "validation_fit_percent" in extras:
         res["validation"] = {"fit_percent": extras["validation_fit_percent"], "data": str(validate),
                              "initial_state": "estimated", "definition": VALIDATION_FIT}
@@ -114,6 +138,9 @@ def identify_ss_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = 
         typer.echo("singular values: " + " ".join(f"{v:.3g}" for v in sv[:min(sv.size, 12)]))
     for name, f in zip(ss.outputs, model.fit_percent):
         typer.echo(f"  {name}: free-run fit {f:.2f} %")
+    for r in res.get("records", []):
+        typer.echo(f"  record {r['data']}: N = {r['n_samples']}, free-run fit "
+                   + ", ".join(f"{v:.2f}" for v in r["fit_percent"]) + " % (its own initial state)")
     if "focus" in model.info:
         fo = model.info["focus"]
         typer.echo(f"focus {fo['criterion']} ({fo['data']} data): subspace {fo['subspace_percent']:.2f} %, "
@@ -130,6 +157,37 @@ def identify_ss_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = 
         typer.echo(f"  pole {z.real:.6g}{z.imag:+.6g}j{sd}")
     if out is not None:
         typer.echo(f"model written to {out}")
+
+
+def _ss_of_records(data: list[Path], input: str, output: str, order, method: str, no_refine: bool,
+                   validate: Path | None, detrend: str, fs, time, fill):
+    """The subspace model of several data files (:func:`gripkit.sysid.identify.identify_records`)
+    and its extras (``validation_fit_percent`` with ``validate``)."""
+    from ..errors import GripkitError
+    from ..sysid.identify import identify_records
+    from ..sysid.linear_model import validation_fit
+
+    if not no_refine:
+        from ..errors import ArgumentError
+
+        raise ArgumentError("identify ss: PEM refinement of several data files is not "
+                            "implemented yet (one record only); add --no-refine for the subspace "
+                            "model of all records")
+    trs = [_load(p, input, output, fs, time, fill) for p in data]
+    try:
+        model = identify_records(trs, "ss", input=input, output=output, detrend=detrend,
+                                 order=order, refine=False, weighting=method)
+    except GripkitError as exc:  # name the file, not its place in the list
+        msg = exc.message
+        for i, path in reversed(list(enumerate(data))):
+            msg = msg.replace(f"data[{i}]", repr(str(path)))
+        raise type(exc)(msg, hint=exc.hint) from None
+    model = model.replace(data_file=", ".join(Path(p).name for p in data), data_hash=None)
+    extras = {}
+    if validate is not None:  # the one validation fit (around the model's stored offsets)
+        vtr = _load(validate, input, output, fs, time, fill)
+        extras["validation_fit_percent"] = validation_fit(model, vtr)
+    return model, extras
 
 
 def _echo_search(rows: list[dict], criterion: str) -> None:

@@ -235,7 +235,10 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
 
 
 #: the methods that fit one model to several records (``identify([tr1, tr2], ...)``)
-RECORD_METHODS = ("arx", "armax", "oe")
+RECORD_METHODS = ("arx", "armax", "oe", "ss")
+#: the options of method 'ss' with several records (the subspace model; PEM takes one record)
+#: (``weighting``: the subspace method, n4sid, moesp or cva; identify()'s own ``method`` is 'ss')
+_SS_RECORD_OPTIONS = ("order", "horizon", "feedthrough", "refine", "weighting")
 
 
 def _per_record(i: int, fn, *args, **kw):
@@ -282,11 +285,11 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
                         hint="detrend 'linear' would give every record its own operating point; "
                              "detrend the records before, or use 'mean'")
     why = f"{method.upper()} identification"
-    if identify_mimo.several(input, output):
-        if method != "arx":
+    if identify_mimo.several(input, output) or method == "ss":
+        if method not in ("arx", "ss"):
             raise ArgumentError(f"identify(): several input or output columns with several records "
-                                f"are fitted by method 'arx' only, found method {method!r}",
-                                hint="name one input and one output, or use method 'arx'")
+                                f"are fitted by method 'arx' or 'ss' only, found method {method!r}",
+                                hint="name one input and one output, or use method 'arx' or 'ss'")
         from .arx_mimo import arx_mimo_records
 
         ds = [_per_record(i, identify_mimo.mimo_data, d, input, output, "none", why=why)
@@ -296,6 +299,8 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
         u0, y0 = _pooled_mean([d.u for d in ds]), _pooled_mean([d.y for d in ds])
         if detrend == "none":
             u0, y0 = np.zeros_like(u0), np.zeros_like(y0)
+        if method == "ss":
+            return _ss_records([(d.u - u0, d.y - y0) for d in ds], ds[0], u0, y0, options)
         return _as_data(arx_mimo_records, [(d.u - u0, d.y - y0) for d in ds], na, nb, nk,
                         dt=ds[0].dt, u_offset=tuple(map(float, u0)),
                         y_offset=tuple(map(float, y0)), **ds[0].signals)
@@ -320,6 +325,31 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
     from .oe import oe_records
 
     return _as_data(oe_records, records, nb, na if nf is None else nf, nk, **meta)
+
+
+def _ss_records(records: list, d, u0, y0, options: dict):
+    """The subspace model of several records (:func:`gripkit.sysid.subspace.n4sid_records`)."""
+    from .subspace import n4sid_records
+
+    other = sorted(set(options) - set(_SS_RECORD_OPTIONS))
+    if other:
+        raise ArgumentError(f"identify(method='ss'): with several records the options are "
+                            f"{', '.join(_SS_RECORD_OPTIONS)}, found {', '.join(other)}",
+                            hint="pass one trajectory for the other options")
+    if options.get("refine", True):
+        raise ArgumentError("identify(method='ss'): PEM refinement of several records is not "
+                            "implemented yet (one record only); pass refine=False for the subspace "
+                            "model of all the records (CLI: --no-refine)",
+                            hint="or refine on one record: identify(tr, 'ss', ...)")
+    rng = identify_mimo.parse_order(options.get("order"))
+    if rng is not None and rng[0] != rng[1]:
+        raise ArgumentError(f"identify(method='ss'): with several records the order is one number "
+                            f"or None, found the range {options['order']!r}",
+                            hint="search the order on one record")
+    return _as_data(n4sid_records, records, None if rng is None else rng[0],
+                    method=options.get("weighting", "n4sid"), horizon=options.get("horizon"),
+                    feedthrough=options.get("feedthrough", False), dt=d.dt,
+                    u_offset=tuple(map(float, u0)), y_offset=tuple(map(float, y0)), **d.signals)
 
 
 def _as_data(fit, records, *args, **kw):
