@@ -137,7 +137,12 @@ def test_ss_several_files_with_no_refine(capsys, files):
     assert 85.0 < res["validation"]["fit_percent"][0] < 92.0
 
 
-def test_ss_several_files_without_no_refine_is_one_line(capsys, files):
-    code, out, err = run(capsys, "identify", "ss", *files, "--input", "u", "--output", "y")
-    assert code != 0 and len(err.strip().splitlines()) == 1
-    assert err.startswith("error: ArgumentError: identify ss: PEM refinement of several data files")
+def test_ss_several_files_refined(capsys, files):
+    code, out, err = run(capsys, "identify", "ss", *files, "--input", "u", "--output", "y",
+                         "--order", 1, "--form", "oe", "--json")
+    assert code == 0, err
+    res = json.loads(out)
+    m = identify([load(p) for p in files], "ss", input="u", output="y", order=1, form="oe")
+    assert res["structure"] == m.structure == "pem-oe"
+    np.testing.assert_allclose(res["fit_percent"], m.fit_percent, rtol=1e-9)
+    assert res["A"][0][0] == pytest.approx(0.9, abs=0.01) and len(res["records"]) == 2

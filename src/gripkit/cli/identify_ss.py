@@ -23,9 +23,9 @@ from .app import identify_app
 from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data, report_warnings
 
 DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
-DataArgs = typer.Argument(..., help="Data file(s) (.csv, .parquet, .h5); several (with "
-                                    "--no-refine): one subspace model of all the records, each "
-                                    "with its own initial state.", show_default=False)
+DataArgs = typer.Argument(..., help="Data file(s) (.csv, .parquet, .h5); several: one model of "
+                                    "all the records, each with its own initial state.",
+                          show_default=False)
 InputsOpt = typer.Option(..., "--input", help="Input column(s), comma-separated (e.g. a,b).")
 OutputsOpt = typer.Option(..., "--output", help="Output column(s), comma-separated (e.g. c,d).")
 DetrendOpt = typer.Option("mean", "--detrend", help="Operating-point removal before fitting: mean or none.")
@@ -74,8 +74,8 @@ def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
                     fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                     json_out: bool = JsonOpt):
     """MIMO state space: subspace (N4SID/MOESP/CVA, order from the singular values), then PEM.
-    Several DATA files (with --no-refine): one subspace model of all the records, one initial state
-    per record (``records``: each file's free-run fit)."""
+    Several DATA files: one model of all the records (subspace, then PEM), one initial state per
+    record (``records``: each file's free-run fit)."""
     from ..errors import DataError
     from ..sysid.identify_mimo import identify_ss
 
@@ -94,7 +94,7 @@ def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
         warnings.simplefilter("always")
         if several:
             model, extras = _ss_of_records(data, input, output, order, method, no_refine, validate,
-                                           detrend, fs, time, fill)
+                                           detrend, fs, time, fill, form, max_iterations)
             if out is not None:
                 model.save(out)
         else:
@@ -160,23 +160,19 @@ def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
 
 
 def _ss_of_records(data: list[Path], input: str, output: str, order, method: str, no_refine: bool,
-                   validate: Path | None, detrend: str, fs, time, fill):
-    """The subspace model of several data files (:func:`gripkit.sysid.identify.identify_records`)
+                   validate: Path | None, detrend: str, fs, time, fill, form: str,
+                   max_iterations: int):
+    """The state-space model of several data files (:func:`gripkit.sysid.identify.identify_records`)
     and its extras (``validation_fit_percent`` with ``validate``)."""
     from ..errors import GripkitError
     from ..sysid.identify import identify_records
     from ..sysid.linear_model import validation_fit
 
-    if not no_refine:
-        from ..errors import ArgumentError
-
-        raise ArgumentError("identify ss: PEM refinement of several data files is not "
-                            "implemented yet (one record only); add --no-refine for the subspace "
-                            "model of all records")
     trs = [_load(p, input, output, fs, time, fill) for p in data]
     try:
         model = identify_records(trs, "ss", input=input, output=output, detrend=detrend,
-                                 order=order, refine=False, weighting=method)
+                                 order=order, refine=not no_refine, weighting=method, form=form,
+                                 max_iterations=max_iterations)
     except GripkitError as exc:  # name the file, not its place in the list
         msg = exc.message
         for i, path in reversed(list(enumerate(data))):

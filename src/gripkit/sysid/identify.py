@@ -236,9 +236,10 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
 
 #: the methods that fit one model to several records (``identify([tr1, tr2], ...)``)
 RECORD_METHODS = ("arx", "armax", "oe", "ss")
-#: the options of method 'ss' with several records (the subspace model; PEM takes one record)
-#: (``weighting``: the subspace method, n4sid, moesp or cva; identify()'s own ``method`` is 'ss')
-_SS_RECORD_OPTIONS = ("order", "horizon", "feedthrough", "refine", "weighting")
+#: the options of method 'ss' with several records (``weighting``: the subspace method, n4sid,
+#: moesp or cva, identify()'s own ``method`` being 'ss')
+_SS_RECORD_OPTIONS = ("order", "horizon", "feedthrough", "refine", "form", "max_iterations",
+                      "weighting")
 
 
 def _per_record(i: int, fn, *args, **kw):
@@ -328,7 +329,12 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
 
 
 def _ss_records(records: list, d, u0, y0, options: dict):
-    """The subspace model of several records (:func:`gripkit.sysid.subspace.n4sid_records`)."""
+    """The state-space model of several records: subspace
+    (:func:`gripkit.sysid.subspace.n4sid_records`), then, unless ``refine=False``, PEM with one
+    initial state per record (:func:`gripkit.sysid.pem_ss.pem_records`); the refined model is
+    returned only when its free-run fit of all records (mean over the outputs) is not below the
+    subspace model's, else the subspace model with an AccuracyWarning giving both."""
+    from .pem_ss import pem_records
     from .subspace import n4sid_records
 
     other = sorted(set(options) - set(_SS_RECORD_OPTIONS))
@@ -336,20 +342,30 @@ def _ss_records(records: list, d, u0, y0, options: dict):
         raise ArgumentError(f"identify(method='ss'): with several records the options are "
                             f"{', '.join(_SS_RECORD_OPTIONS)}, found {', '.join(other)}",
                             hint="pass one trajectory for the other options")
-    if options.get("refine", True):
-        raise ArgumentError("identify(method='ss'): PEM refinement of several records is not "
-                            "implemented yet (one record only); pass refine=False for the subspace "
-                            "model of all the records (CLI: --no-refine)",
-                            hint="or refine on one record: identify(tr, 'ss', ...)")
     rng = identify_mimo.parse_order(options.get("order"))
     if rng is not None and rng[0] != rng[1]:
         raise ArgumentError(f"identify(method='ss'): with several records the order is one number "
                             f"or None, found the range {options['order']!r}",
                             hint="search the order on one record")
-    return _as_data(n4sid_records, records, None if rng is None else rng[0],
-                    method=options.get("weighting", "n4sid"), horizon=options.get("horizon"),
-                    feedthrough=options.get("feedthrough", False), dt=d.dt,
-                    u_offset=tuple(map(float, u0)), y_offset=tuple(map(float, y0)), **d.signals)
+    start = _as_data(n4sid_records, records, None if rng is None else rng[0],
+                     method=options.get("weighting", "n4sid"), horizon=options.get("horizon"),
+                     feedthrough=options.get("feedthrough", False), dt=d.dt,
+                     u_offset=tuple(map(float, u0)), y_offset=tuple(map(float, y0)), **d.signals)
+    if not options.get("refine", True):
+        return start
+    iters = options.get("max_iterations", 50)
+    refined = pem_records(start, records, form=options.get("form", "innovation"),
+                          max_iterations=iters)
+    if not refined.info["pem"]["converged"]:
+        warnings.warn(f"identify ss: PEM over the records stopped after {iters} iterations without "
+                      f"converging; raise max_iterations", AccuracyWarning, stacklevel=4)
+    before, after = float(np.mean(start.fit_percent)), float(np.mean(refined.fit_percent))
+    if after < before:
+        warnings.warn(f"identify ss: PEM over the records lowered the free-run fit of all records "
+                      f"from {before:.4g} % (subspace) to {after:.4g} %; the subspace model is "
+                      f"returned", AccuracyWarning, stacklevel=4)
+        return start
+    return refined
 
 
 def _as_data(fit, records, *args, **kw):
