@@ -159,26 +159,35 @@ def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
         typer.echo(f"model written to {out}")
 
 
-def _ss_of_records(data: list[Path], input: str, output: str, order, method: str, no_refine: bool,
-                   validate: Path | None, detrend: str, fs, time, fill, form: str,
-                   max_iterations: int):
-    """The state-space model of several data files (:func:`gripkit.sysid.identify.identify_records`)
-    and its extras (``validation_fit_percent`` with ``validate``)."""
+def _records_model(data: list[Path], method: str, input: str, output: str, detrend: str, fs, time,
+                   fill, **options):
+    """One ``method`` model of several data files
+    (:func:`gripkit.sysid.identify.identify_records`), its errors naming the files."""
     from ..errors import GripkitError
     from ..sysid.identify import identify_records
-    from ..sysid.linear_model import validation_fit
 
     trs = [_load(p, input, output, fs, time, fill) for p in data]
     try:
-        model = identify_records(trs, "ss", input=input, output=output, detrend=detrend,
-                                 order=order, refine=not no_refine, weighting=method, form=form,
-                                 max_iterations=max_iterations)
+        model = identify_records(trs, method, input=input, output=output, detrend=detrend,
+                                 **options)
     except GripkitError as exc:  # name the file, not its place in the list
         msg = exc.message
         for i, path in reversed(list(enumerate(data))):
             msg = msg.replace(f"data[{i}]", repr(str(path)))
         raise type(exc)(msg, hint=exc.hint) from None
-    model = model.replace(data_file=", ".join(Path(p).name for p in data), data_hash=None)
+    return model.replace(data_file=", ".join(Path(p).name for p in data), data_hash=None)
+
+
+def _ss_of_records(data: list[Path], input: str, output: str, order, method: str, no_refine: bool,
+                   validate: Path | None, detrend: str, fs, time, fill, form: str,
+                   max_iterations: int):
+    """The state-space model of several data files (:func:`_records_model`) and its extras
+    (``validation_fit_percent`` with ``validate``)."""
+    from ..sysid.linear_model import validation_fit
+
+    model = _records_model(data, "ss", input, output, detrend, fs, time, fill, order=order,
+                           refine=not no_refine, weighting=method, form=form,
+                           max_iterations=max_iterations)
     extras = {}
     if validate is not None:  # the one validation fit (around the model's stored offsets)
         vtr = _load(validate, input, output, fs, time, fill)
@@ -230,29 +239,47 @@ def identify_frf_cmd(data: Path = DataArg, input: str = InputsOpt, output: str =
 
 
 @identify_app.command("tf")
-def identify_tf_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = OutputsOpt,
+def identify_tf_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output: str = OutputsOpt,
                     poles: int = typer.Option(..., "--poles", help="Number of poles."),
                     zeros: int = typer.Option(..., "--zeros", help="Number of zeros."),
                     out: Path = ModelOutOpt, report: Path = ReportOpt,
                     fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                     json_out: bool = JsonOpt):
-    """Continuous-time transfer function (zero-order hold between samples) with σ."""
+    """Continuous-time transfer function (zero-order hold between samples) with σ. Several DATA
+    files: one model of all the records, each from its own initial state."""
+    from ..errors import DataError
     from ..sysid.identify_mimo import identify_tf
 
+    several = len(data) > 1
+    if several and report is not None:
+        raise DataError("--report: the model report is of one data file; with several data "
+                        "files leave --report out",
+                        hint="run gripkit report MODEL.json DATA for each file")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        tr = _load(data, input, output, fs, time, fill)
-        model = _with_provenance(identify_tf(tr, input=input, output=output, poles=poles, zeros=zeros,
-                                             detrend=detrend), data)
-        _finish(model, data, tr, out, report, None)
+        if several:
+            model = _records_model(data, "tf", input, output, detrend, fs, time, fill,
+                                   poles=poles, zeros=zeros)
+            if out is not None:
+                model.save(out)
+        else:
+            data = data[0]
+            tr = _load(data, input, output, fs, time, fill)
+            model = _with_provenance(identify_tf(tr, input=input, output=output, poles=poles,
+                                                 zeros=zeros, detrend=detrend), data)
+            _finish(model, data, tr, out, report, None)
     g, info = model.system, model.info
     res = {"num": g.numerator(), "den": g.denominator(), "num_std": info["num_std"][-(zeros + 1):],
            "den_std": info["den_std"], "natural_frequency_hz": info["natural_frequency_hz"],
            "natural_frequency_hz_std": info["natural_frequency_hz_std"], "damping_ratio": info["damping_ratio"],
            "damping_ratio_std": info["damping_ratio_std"], "fit_percent": model.fit_percent,
            "poles": [[float(z.real), float(z.imag)] for z in g.poles()], "inputs": list(g.inputs),
-           "outputs": list(g.outputs), "data": str(data), "out": None if out is None else str(out),
-           "warnings": report_warnings(caught)}
+           "outputs": list(g.outputs), "data": [str(p) for p in data] if several else str(data),
+           "out": None if out is None else str(out), "warnings": report_warnings(caught)}
+    if several:
+        res["records"] = [{"data": str(p), "n_samples": r["n_samples"],
+                           "fit_percent": r["fit_percent"]}
+                          for p, r in zip(data, model.info["records"])]
     if json_out:
         emit_json(res)
         return

@@ -235,7 +235,7 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
 
 
 #: the methods that fit one model to several records (``identify([tr1, tr2], ...)``)
-RECORD_METHODS = ("arx", "armax", "oe", "ss")
+RECORD_METHODS = ("arx", "armax", "oe", "ss", "tf")
 #: the options of method 'ss' with several records (``weighting``: the subspace method, n4sid,
 #: moesp or cva, identify()'s own ``method`` being 'ss')
 _SS_RECORD_OPTIONS = ("order", "horizon", "feedthrough", "refine", "form", "max_iterations",
@@ -258,7 +258,10 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
     of them: ARX (:func:`gripkit.sysid.arx_records`; with several columns
     :func:`gripkit.sysid.arx_mimo.arx_mimo_records`), ARMAX
     (:func:`gripkit.sysid.armax.armax_records`), OE (:func:`gripkit.sysid.oe.oe_records`; ``nf``
-    defaults to ``na``), ``options`` ``maxiter``, ``tol`` for the last two. This is what
+    defaults to ``na``), ``options`` ``maxiter``, ``tol`` for the last two; state space
+    (``options`` of :data:`_SS_RECORD_OPTIONS`: subspace, then PEM, see :func:`_ss_records`) and
+    continuous-time transfer functions (``poles``, ``zeros``:
+    :func:`gripkit.sysid.tfest.tfest_records`). This is what
     ``identify([tr1, tr2], method, ...)`` and ``gripkit identify METHOD DATA1 DATA2 ...`` do.
 
     The model has one operating point: ``detrend='mean'`` removes the mean of all the records
@@ -286,8 +289,8 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
                         hint="detrend 'linear' would give every record its own operating point; "
                              "detrend the records before, or use 'mean'")
     why = f"{method.upper()} identification"
-    if identify_mimo.several(input, output) or method == "ss":
-        if method not in ("arx", "ss"):
+    if identify_mimo.several(input, output) or method in ("ss", "tf"):
+        if method not in ("arx", "ss", "tf"):
             raise ArgumentError(f"identify(): several input or output columns with several records "
                                 f"are fitted by method 'arx' or 'ss' only, found method {method!r}",
                                 hint="name one input and one output, or use method 'arx' or 'ss'")
@@ -302,6 +305,12 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
             u0, y0 = np.zeros_like(u0), np.zeros_like(y0)
         if method == "ss":
             return _ss_records([(d.u - u0, d.y - y0) for d in ds], ds[0], u0, y0, options)
+        if method == "tf":
+            from .tfest import tfest_records
+
+            return _as_data(tfest_records, [(d.u - u0, d.y - y0) for d in ds], options["poles"],
+                            options["zeros"], dt=ds[0].dt, u_offset=tuple(map(float, u0)),
+                            y_offset=tuple(map(float, y0)), **ds[0].signals)
         return _as_data(arx_mimo_records, [(d.u - u0, d.y - y0) for d in ds], na, nb, nk,
                         dt=ds[0].dt, u_offset=tuple(map(float, u0)),
                         y_offset=tuple(map(float, y0)), **ds[0].signals)
