@@ -34,10 +34,11 @@ from ..errors import AccuracyWarning, ArgumentError, DataError, GripkitError
 from ..signals.processing import detrend as detrend_signals
 from ..signals.trajectory import Trajectory
 from . import identify_mimo
-from .armax import armax
-from .arx import arx
+from .armax import armax, armax_records
+from .arx import arx, arx_records
+from .arx_mimo import arx_mimo_records
 from .frf import frf
-from .oe import oe
+from .oe import oe, oe_records
 from .search import structure_search
 
 __all__ = ["IOData", "io_data", "identify", "identify_records", "method_options", "METHODS"]
@@ -236,10 +237,6 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
 
 #: the methods that fit one model to several records (``identify([tr1, tr2], ...)``)
 RECORD_METHODS = ("arx", "armax", "oe", "ss", "tf")
-#: the options of method 'ss' with several records (``weighting``: the subspace method, n4sid,
-#: moesp or cva, identify()'s own ``method`` being 'ss')
-_SS_RECORD_OPTIONS = ("order", "horizon", "feedthrough", "refine", "form", "max_iterations",
-                      "weighting")
 
 
 def _per_record(i: int, fn, *args, **kw):
@@ -259,7 +256,8 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
     :func:`gripkit.sysid.arx_mimo.arx_mimo_records`), ARMAX
     (:func:`gripkit.sysid.armax.armax_records`), OE (:func:`gripkit.sysid.oe.oe_records`; ``nf``
     defaults to ``na``), ``options`` ``maxiter``, ``tol`` for the last two; state space
-    (``options`` of :data:`_SS_RECORD_OPTIONS`: subspace, then PEM, see :func:`_ss_records`) and
+    (``options`` of :data:`gripkit.sysid.identify_mimo.SS_RECORD_OPTIONS`: subspace, then PEM,
+    see :func:`gripkit.sysid.identify_mimo.identify_ss_records`) and
     continuous-time transfer functions (``poles``, ``zeros``:
     :func:`gripkit.sysid.tfest.tfest_records`). This is what
     ``identify([tr1, tr2], method, ...)`` and ``gripkit identify METHOD DATA1 DATA2 ...`` do.
@@ -294,8 +292,6 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
             raise ArgumentError(f"identify(): several input or output columns with several records "
                                 f"are fitted by method 'arx' or 'ss' only, found method {method!r}",
                                 hint="name one input and one output, or use method 'arx' or 'ss'")
-        from .arx_mimo import arx_mimo_records
-
         ds = [_per_record(i, identify_mimo.mimo_data, d, input, output, "none", why=why)
               for i, d in enumerate(data)]
         _same_sampling([(d.dt, d.input_units + d.output_units) for d in ds],
@@ -303,14 +299,12 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
         u0, y0 = _pooled_mean([d.u for d in ds]), _pooled_mean([d.y for d in ds])
         if detrend == "none":
             u0, y0 = np.zeros_like(u0), np.zeros_like(y0)
+        records = [(d.u - u0, d.y - y0) for d in ds]
         if method == "ss":
-            return _ss_records([(d.u - u0, d.y - y0) for d in ds], ds[0], u0, y0, options)
+            return _as_data(identify_mimo.identify_ss_records, records, ds[0], u0, y0, options)
         if method == "tf":
-            from .tfest import tfest_records
-
-            return _as_data(tfest_records, [(d.u - u0, d.y - y0) for d in ds], options["poles"],
-                            options["zeros"], dt=ds[0].dt, u_offset=tuple(map(float, u0)),
-                            y_offset=tuple(map(float, y0)), **ds[0].signals)
+            return _as_data(identify_mimo.identify_tf_records, records, ds[0], u0, y0,
+                            options["poles"], options["zeros"])
         return _as_data(arx_mimo_records, [(d.u - u0, d.y - y0) for d in ds], na, nb, nk,
                         dt=ds[0].dt, u_offset=tuple(map(float, u0)),
                         y_offset=tuple(map(float, y0)), **ds[0].signals)
@@ -325,56 +319,10 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
     meta = dict(ios[0].meta, u_offset=u0, y_offset=y0, dt=ios[0].dt, **options)
     records = [(io.u - u0, io.y - y0) for io in ios]
     if method == "arx":
-        from .arx import arx_records
-
         return _as_data(arx_records, records, na, nb, nk, **meta)
     if method == "armax":
-        from .armax import armax_records
-
         return _as_data(armax_records, records, na, nb, nc, nk, **meta)
-    from .oe import oe_records
-
     return _as_data(oe_records, records, nb, na if nf is None else nf, nk, **meta)
-
-
-def _ss_records(records: list, d, u0, y0, options: dict):
-    """The state-space model of several records: subspace
-    (:func:`gripkit.sysid.subspace.n4sid_records`), then, unless ``refine=False``, PEM with one
-    initial state per record (:func:`gripkit.sysid.pem_ss.pem_records`); the refined model is
-    returned only when its free-run fit of all records (mean over the outputs) is not below the
-    subspace model's, else the subspace model with an AccuracyWarning giving both."""
-    from .pem_ss import pem_records
-    from .subspace import n4sid_records
-
-    other = sorted(set(options) - set(_SS_RECORD_OPTIONS))
-    if other:
-        raise ArgumentError(f"identify(method='ss'): with several records the options are "
-                            f"{', '.join(_SS_RECORD_OPTIONS)}, found {', '.join(other)}",
-                            hint="pass one trajectory for the other options")
-    rng = identify_mimo.parse_order(options.get("order"))
-    if rng is not None and rng[0] != rng[1]:
-        raise ArgumentError(f"identify(method='ss'): with several records the order is one number "
-                            f"or None, found the range {options['order']!r}",
-                            hint="search the order on one record")
-    start = _as_data(n4sid_records, records, None if rng is None else rng[0],
-                     method=options.get("weighting", "n4sid"), horizon=options.get("horizon"),
-                     feedthrough=options.get("feedthrough", False), dt=d.dt,
-                     u_offset=tuple(map(float, u0)), y_offset=tuple(map(float, y0)), **d.signals)
-    if not options.get("refine", True):
-        return start
-    iters = options.get("max_iterations", 50)
-    refined = pem_records(start, records, form=options.get("form", "innovation"),
-                          max_iterations=iters)
-    if not refined.info["pem"]["converged"]:
-        warnings.warn(f"identify ss: PEM over the records stopped after {iters} iterations without "
-                      f"converging; raise max_iterations", AccuracyWarning, stacklevel=4)
-    before, after = float(np.mean(start.fit_percent)), float(np.mean(refined.fit_percent))
-    if after < before:
-        warnings.warn(f"identify ss: PEM over the records lowered the free-run fit of all records "
-                      f"from {before:.4g} % (subspace) to {after:.4g} %; the subspace model is "
-                      f"returned", AccuracyWarning, stacklevel=4)
-        return start
-    return refined
 
 
 def _as_data(fit, records, *args, **kw):

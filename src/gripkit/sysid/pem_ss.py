@@ -38,6 +38,7 @@ from ..errors import DataError, IdentificationError
 from ..lti import StateSpace, Uncertainty, affine_row
 from .blocked_gram import add_rows, carried_states, row_product, start_sums
 from .linear_model import LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run
+from .validation import records_fit
 
 __all__ = ["pem", "pem_records", "PEM_FORMS"]
 
@@ -490,8 +491,6 @@ def pem_records(model: LinearModel, records, *, form: str = "innovation",
     The covariance of the identifiable directions is σ²(JᵀJ)⁻¹ with σ² over Σ N_i·p − d − R·n
     degrees of freedom. ``fit_percent``: the free run of all records (each from its own x0);
     ``info['records']``: each record's free-run fit and x0."""
-    from .validation import records_fit
-
     if form not in PEM_FORMS:
         raise DataError(f"form: expected 'oe' or 'innovation', found {form!r}")
     if not isinstance(model, LinearModel) or not isinstance(model.system, StateSpace) \

@@ -46,6 +46,7 @@ from .blocked_gram import add_rows, carried_states, row_product, start_sums
 from .checks import check_dt
 from .linear_model import LinearModel, as_io_matrix, fit_per_output, free_run, observability_regressor
 from .regression import _qr_r
+from .validation import records_fit
 
 __all__ = ["n4sid", "n4sid_records", "moesp", "SUBSPACE_METHODS", "default_horizon",
            "subspace_factor", "SubspaceFactor", "RecordsFactor"]
@@ -554,8 +555,6 @@ def from_records_factor(fac: RecordsFactor, n: int, *, dt: float, feedthrough: b
     every record. ``fit_percent``: the free run of all records per output, each from its own x0
     (:func:`~gripkit.sysid.validation.records_fit`); ``info['records']``: each record's samples,
     free-run fit and x0 (the model's ``x0`` is the first record's)."""
-    from .validation import records_fit
-
     p, m = fac.p, fac.m
 
     def unstable_fit(A, C):

@@ -32,6 +32,7 @@ from ..lti import StateSpace, TransferFunction
 from .checks import check_dt, check_order, check_persistent_excitation
 from .frf import FRF, frf
 from .linear_model import LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run
+from .validation import records_fit
 
 __all__ = ["tfest", "tfest_records", "tfest_frf", "modal_parameters"]
 
@@ -308,8 +309,6 @@ def tfest_records(records, n_poles: int, n_zeros: int, *, dt: float | None = Non
     FRF fit of the H1 estimate of the longest record. ``fit_percent``: the free run of all
     records (each from its own x0); ``info['records']``: each record's samples, fit and x0 (in
     the coordinates of the model's zero-order-hold state space, ``tf2ss``)."""
-    from .validation import records_fit
-
     npo, nz = _check_orders(n_poles, n_zeros)
     if not isinstance(records, (list, tuple)) or not records:
         raise DataError(f"records: expected a non-empty list of (u, y) pairs, "
