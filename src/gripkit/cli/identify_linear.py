@@ -27,7 +27,7 @@ from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_choice, check_data_
 DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
 DataArgs = typer.Argument(..., help="Data file(s) (.csv, .parquet, .h5); several: one model of all "
                                     "the records, each with its own initial conditions.",
-                          show_default=False)
+                          metavar="DATA", show_default=False)
 InputOpt = typer.Option(..., "--input", help="Input column (e.g. the valve current).")
 OutputOpt = typer.Option(..., "--output", help="Output column (e.g. the force).")
 DetrendOpt = typer.Option("mean", "--detrend",

@@ -25,7 +25,7 @@ from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data, repo
 DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
 DataArgs = typer.Argument(..., help="Data file(s) (.csv, .parquet, .h5); several: one model of "
                                     "all the records, each with its own initial state.",
-                          show_default=False)
+                          metavar="DATA", show_default=False)
 InputsOpt = typer.Option(..., "--input", help="Input column(s), comma-separated (e.g. a,b).")
 OutputsOpt = typer.Option(..., "--output", help="Output column(s), comma-separated (e.g. c,d).")
 DetrendOpt = typer.Option("mean", "--detrend", help="Operating-point removal before fitting: mean or none.")
