@@ -7,6 +7,9 @@ operating point (``--detrend mean`` by default), and prints a summary table, or 
 ``one_step_fit_percent``, ``validation.fit_percent``) are lists per output in ``--output`` order;
 with one input and one output its JSON is the SISO one (``validation.fit_percent`` a number). Warnings (an unstable model in validation, a
 non-converged iteration) go to stderr as ``warning: ...`` lines and into the JSON ``warnings``.
+``identify arx|armax|oe DATA1 DATA2 ...`` fit one model of several records (each with its own
+initial conditions, one operating point): ``data`` is then the list of files and ``records`` each
+file's samples and fit.
 """
 
 from __future__ import annotations
@@ -22,6 +25,9 @@ from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_choice, check_data_
                      collected_warnings, emit_json, load_data, report_warnings)
 
 DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
+DataArgs = typer.Argument(..., help="Data file(s) (.csv, .parquet, .h5); several: one model of all "
+                                    "the records, each with its own initial conditions.",
+                          metavar="DATA", show_default=False)
 InputOpt = typer.Option(..., "--input", help="Input column (e.g. the valve current).")
 OutputOpt = typer.Option(..., "--output", help="Output column (e.g. the force).")
 DetrendOpt = typer.Option("mean", "--detrend",
@@ -87,32 +93,41 @@ def _fit_and_report(method: str, data: Path, input: str, output: str, fs, time, 
             lm.with_display_units(tr).save(out_file)  # outputs shown in the file's units
         out = model.to_dict()
         out.update(data=str(data), detrend=detrend)
-        val = None
-        if validate is not None:
-            # the validation record around the model's operating point (its offsets), as the one
-            # validation fit below and `gripkit compare` take it; a linear trend is the record's own
-            vio = _io(validate, input, output, fs, time, fill, "linear" if detrend == "linear" else "none",
-                      "validation")
-            if detrend != "linear":
-                vio = dataclasses.replace(vio, u=vio.u - model.u_offset, y=vio.y - model.y_offset,
-                                          u_offset=model.u_offset, y_offset=model.y_offset)
-            if abs(vio.dt - io.dt) > 1e-9 * io.dt:
-                from ..errors import DataError
-
-                raise DataError(f"validation data {str(validate)!r} is sampled at {1 / vio.dt:g} Hz, the "
-                                f"estimation data at {1 / io.dt:g} Hz", hint="resample one of them")
-            from ..sysid.linear_model import VALIDATION_FIT, validation_fit
-
-            val = model.validate(vio.u, vio.y)  # one-step fit and residual tests
-            vfit = validation_fit(model, load_data(validate, [input, output], fs, time, fill))
-            out["validation_fit_percent"] = None if vfit is None else vfit[0]
-            out["validation"] = {**val.to_dict(), "fit_percent": out["validation_fit_percent"],
-                                 "initial": "estimated", "definition": VALIDATION_FIT}
+        val = _validate_polynomial(model, io.dt, validate, input, output, fs, time, fill, detrend,
+                                   out)
     out["warnings"] = report_warnings(caught)
     if json_out:
         emit_json(out)
     else:
         _print_model(model, val, out.get("validation_fit_percent"))
+
+
+def _validate_polynomial(model, dt: float, validate: Path | None, input: str, output: str, fs,
+                         time, fill, detrend: str, out: dict):
+    """The validation of a SISO polynomial model on ``--validate`` (None without it): the one-step
+    fit and residual tests returned, the free-run fit written into ``out``."""
+    if validate is None:
+        return None
+    # the validation record around the model's operating point (its offsets), as the one
+    # validation fit below and `gripkit compare` take it; a linear trend is the record's own
+    vio = _io(validate, input, output, fs, time, fill, "linear" if detrend == "linear" else "none",
+              "validation")
+    if detrend != "linear":
+        vio = dataclasses.replace(vio, u=vio.u - model.u_offset, y=vio.y - model.y_offset,
+                                  u_offset=model.u_offset, y_offset=model.y_offset)
+    if abs(vio.dt - dt) > 1e-9 * dt:
+        from ..errors import DataError
+
+        raise DataError(f"validation data {str(validate)!r} is sampled at {1 / vio.dt:g} Hz, the "
+                        f"estimation data at {1 / dt:g} Hz", hint="resample one of them")
+    from ..sysid.linear_model import VALIDATION_FIT, validation_fit
+
+    val = model.validate(vio.u, vio.y)  # one-step fit and residual tests
+    vfit = validation_fit(model, load_data(validate, [input, output], fs, time, fill))
+    out["validation_fit_percent"] = None if vfit is None else vfit[0]
+    out["validation"] = {**val.to_dict(), "fit_percent": out["validation_fit_percent"],
+                         "initial": "estimated", "definition": VALIDATION_FIT}
+    return val
 
 
 def _print_model(model, val, vfit: float | None = None) -> None:
@@ -143,10 +158,11 @@ def _print_model(model, val, vfit: float | None = None) -> None:
                   f"(p = {tt.independence_p:.3g})")
 
 
-def _mimo_arx(data: Path, input: str, output: str, na: int, nb: int, nk: int, fs, time, fill, detrend: str,
-              validate: Path | None, json_out: bool, out_file: Path | None) -> None:
+def _mimo_arx(data: list[Path], input: str, output: str, na: int, nb: int, nk: int, fs, time, fill,
+              detrend: str, validate: Path | None, json_out: bool, out_file: Path | None) -> None:
     """Matrix-polynomial ARX of several columns: every fit figure is a list per output, in
-    ``--output`` order (free run with estimated x0, one-step, and free run on ``--validate``)."""
+    ``--output`` order (free run with estimated x0, one-step, and free run on ``--validate``).
+    Several DATA files: one model of all the records (``records``: each file's fits)."""
     from ..errors import DataError, StabilityWarning
     from ..sysid.identify_mimo import identify_arx as fit_arx
     from ..sysid.identify_mimo import parse_names
@@ -158,18 +174,26 @@ def _mimo_arx(data: Path, input: str, output: str, na: int, nb: int, nk: int, fs
                         "mean or none", hint="use --detrend mean, or detrend the columns before")
     columns = list(parse_names(input, "--input")) + list(parse_names(output, "--output"))
     with collected_warnings() as caught:
-        tr = load_data(data, columns, fs, time, fill)
-        model = fit_arx(tr, input=input, output=output, na=na, nb=nb, nk=nk, detrend=detrend)
-        model = model.replace(data_file=Path(data).name, data_hash=file_sha256(data))
-        model = model.with_display_units(tr)
+        if len(data) == 1:
+            data = data[0]
+            tr = load_data(data, columns, fs, time, fill)
+            model = fit_arx(tr, input=input, output=output, na=na, nb=nb, nk=nk, detrend=detrend)
+            model = model.replace(data_file=Path(data).name, data_hash=file_sha256(data))
+            model = model.with_display_units(tr)
+        else:
+            model = _fit_records(data, columns, input, output, fs, time, fill, detrend, "arx",
+                                 na=na, nb=nb, nk=nk)
         if out_file is not None:
             model.save(out_file)
         res = model.to_dict()
         info = res.pop("info")
-        res.update(na=na, nb=nb, nk=nk, data=str(data), detrend=detrend, n_samples=model.n_samples,
+        res.update(na=na, nb=nb, nk=nk, data=_data_field(data), detrend=detrend,
+                   n_samples=model.n_samples,
                    one_step_fit_percent=info["one_step_fit_percent"],
                    **{k: info[k] for k in ("A_poly", "A_poly_std", "B_poly", "B_poly_std")},
                    out=None if out_file is None else str(out_file))
+        if "records" in info:
+            res["records"] = _records_field(data, info["records"])
         if not model.stable:
             warnings.warn("arx: the identified model is unstable (a pole on or outside the unit circle): "
                           "no free-run fit is reported", StabilityWarning, stacklevel=1)
@@ -196,18 +220,99 @@ def _mimo_arx(data: Path, input: str, output: str, na: int, nb: int, nk: int, fs
         if res.get("validation_fit_percent") is not None:
             line += f", validation free run {res['validation_fit_percent'][i]:.2f} %"
         typer.echo(line)
+    _echo_records(res.get("records"))
     if out_file is not None:
         typer.echo(f"model written to {out_file}")
 
 
+def _fit_records(data: list[Path], columns: list[str], input: str, output: str, fs, time, fill,
+                 detrend: str, method: str, **orders):
+    """One model of several data files (:func:`gripkit.sysid.identify.identify_records`): each
+    file a record with its own initial conditions, one operating point for all of them."""
+    from ..errors import DataError, GripkitError
+    from ..sysid.identify import identify_records
+
+    if detrend == "linear":
+        raise DataError("--detrend: with several data files expected mean (the mean of all "
+                        "records) or none, found 'linear'",
+                        hint="a line per file would give every record its own operating point")
+    trs = [load_data(path, columns, fs, time, fill) for path in data]  # its errors name the file
+    try:
+        model = identify_records(trs, method, input=input, output=output, detrend=detrend,
+                                 **orders)
+    except GripkitError as exc:  # name the file, not its place in the list
+        msg = exc.message
+        for i, path in reversed(list(enumerate(data))):  # data[10] before data[1]
+            msg = msg.replace(f"data[{i}]", repr(str(path)))
+        raise type(exc)(msg, hint=exc.hint) from None
+    names = ", ".join(Path(p).name for p in data)
+    if hasattr(model, "data_file"):  # a LinearModel (several columns) carries its data file
+        model = model.replace(data_file=names, data_hash=None)
+    return model
+
+
+def _data_field(data) -> str | list[str]:
+    """The JSON ``data`` field: the file, or the list of files of a fit of several records."""
+    return [str(p) for p in data] if isinstance(data, list) else str(data)
+
+
+def _records_field(data: list[Path], records: list[dict]) -> list[dict]:
+    """The JSON ``records`` field: each file with its samples and fits (initial states left out)."""
+    return [{"data": str(p), **{k: v for k, v in r.items() if k != "x0"}}
+            for p, r in zip(data, records)]
+
+
+def _echo_records(records: list[dict] | None) -> None:
+    """One line per record of a fit of several files."""
+    if not records:
+        return
+    typer.echo(f"{len(records)} records, each with its own initial conditions:")
+    for r in records:
+        fit = r["fit_percent"]
+        free = "—" if fit is None else (f"{fit:.2f} %" if isinstance(fit, float) else
+                                        "[" + ", ".join(f"{v:.2f}" for v in fit) + "] %")
+        kind = "1-step" if isinstance(fit, float) else "free run"
+        line = f"  {r['data']}: N = {r['n_samples']}, fit ({kind}) {free}"
+        if "one_step_fit_percent" in r:
+            line += ", 1-step [" + ", ".join(f"{v:.2f}" for v in r["one_step_fit_percent"]) + "] %"
+        typer.echo(line)
+
+
+def _siso_records(method: str, data: list[Path], input: str, output: str, fs, time, fill,
+                  detrend: str, validate: Path | None, json_out: bool, out_file: Path | None,
+                  **orders) -> None:
+    """ARX, ARMAX or OE of several data files: the JSON of one file's fit, with ``data`` the list
+    of files, ``fit_percent`` the one-step fit of all records and ``records`` each file's."""
+    with collected_warnings() as caught:
+        model = _fit_records(data, [input, output], input, output, fs, time, fill, detrend, method,
+                             **orders)
+        if out_file is not None:
+            from ..sysid.linear_model import from_polynomial
+
+            names = ", ".join(Path(p).name for p in data)
+            from_polynomial(model).replace(data_file=names, data_hash=None).save(out_file)
+        out = model.to_dict()
+        out.update(data=_data_field(data), detrend=detrend,
+                   records=_records_field(data, model.info["records"]))
+        val = _validate_polynomial(model, model.dt, validate, input, output, fs, time, fill,
+                                   detrend, out)
+    out["warnings"] = report_warnings(caught)
+    if json_out:
+        emit_json(out)
+        return
+    _print_model(model, val, out.get("validation_fit_percent"))
+    _echo_records(out["records"])
+
+
 @identify_app.command("arx")
-def identify_arx(data: Path = DataArg, input: str = InputsOpt, output: str = OutputsOpt,
+def identify_arx(data: list[Path] = DataArgs, input: str = InputsOpt, output: str = OutputsOpt,
                  na: int = NaOpt, nb: int = NbOpt, nk: int = NkOpt,
                  fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                  validate: Path = ValidateOpt, json_out: bool = JsonOpt, out: Path = ModelOutOpt):
     """ARX (orders na, nb, nk) by least squares (QR), with σ, loss (eq 29), fit, AIC, poles and zeros.
     With several columns (``--input a,b --output c,d``) a matrix-polynomial ARX: fit figures are
-    lists per output, in ``--output`` order."""
+    lists per output, in ``--output`` order. With several DATA files one model of all the records
+    (each with its own initial conditions; --detrend mean removes the mean of all of them)."""
     from ..sysid import arx
     from ..sysid.identify_mimo import several
 
@@ -215,37 +320,54 @@ def identify_arx(data: Path = DataArg, input: str = InputsOpt, output: str = Out
     if several(input, output):
         _mimo_arx(data, input, output, na, nb, nk, fs, time, fill, detrend, validate, json_out, out)
         return
+    if len(data) > 1:
+        _siso_records("arx", data, input, output, fs, time, fill, detrend, validate, json_out,
+                      out, na=na, nb=nb, nk=nk)
+        return
+    data = data[0]
     _fit_and_report("arx", data, input, output, fs, time, fill, detrend, validate, json_out,
                     lambda io: arx(io.u, io.y, na, nb, nk, dt=io.dt, **io.meta), out)
 
 
 @identify_app.command("armax")
-def identify_armax(data: Path = DataArg, input: str = InputOpt, output: str = OutputOpt,
+def identify_armax(data: list[Path] = DataArgs, input: str = InputOpt, output: str = OutputOpt,
                    na: int = NaOpt,
                    nb: int = NbOpt,
                    nc: int = typer.Option(..., "--nc", help="Number of C coefficients."),
                    nk: int = NkOpt,
                    fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                    validate: Path = ValidateOpt, json_out: bool = JsonOpt, out: Path = ModelOutOpt):
-    """ARMAX (orders na, nb, nc, nk) by prediction-error minimisation."""
+    """ARMAX (orders na, nb, nc, nk) by prediction-error minimisation. With several DATA files one
+    model of all the records (each with its own initial conditions)."""
     from ..sysid import armax
 
     _check_options(fs, fill, detrend, validate, na=na, nb=nb, nc=nc, nk=nk)
+    if len(data) > 1:
+        _siso_records("armax", data, input, output, fs, time, fill, detrend, validate, json_out,
+                      out, na=na, nb=nb, nc=nc, nk=nk)
+        return
+    data = data[0]
     _fit_and_report("armax", data, input, output, fs, time, fill, detrend, validate, json_out,
                     lambda io: armax(io.u, io.y, na, nb, nc, nk, dt=io.dt, **io.meta), out)
 
 
 @identify_app.command("oe")
-def identify_oe(data: Path = DataArg, input: str = InputOpt, output: str = OutputOpt,
+def identify_oe(data: list[Path] = DataArgs, input: str = InputOpt, output: str = OutputOpt,
                 nb: int = NbOpt,
                 nf: int = typer.Option(..., "--nf", "--na", help="Number of F (denominator) coefficients."),
                 nk: int = NkOpt,
                 fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                 validate: Path = ValidateOpt, json_out: bool = JsonOpt, out: Path = ModelOutOpt):
-    """Output-error (orders nb, nf, nk) by prediction-error minimisation."""
+    """Output-error (orders nb, nf, nk) by prediction-error minimisation. With several DATA files
+    one model of all the records (each with its own initial outputs, estimated)."""
     from ..sysid import oe
 
     _check_options(fs, fill, detrend, validate, nb=nb, nf=nf, nk=nk)
+    if len(data) > 1:
+        _siso_records("oe", data, input, output, fs, time, fill, detrend, validate, json_out, out,
+                      nb=nb, nf=nf, nk=nk)
+        return
+    data = data[0]
     _fit_and_report("oe", data, input, output, fs, time, fill, detrend, validate, json_out,
                     lambda io: oe(io.u, io.y, nb, nf, nk, dt=io.dt, **io.meta), out)
 

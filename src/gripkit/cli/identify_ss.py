@@ -23,6 +23,9 @@ from .app import identify_app
 from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data, report_warnings
 
 DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
+DataArgs = typer.Argument(..., help="Data file(s) (.csv, .parquet, .h5); several: one model of "
+                                    "all the records, each with its own initial state.",
+                          metavar="DATA", show_default=False)
 InputsOpt = typer.Option(..., "--input", help="Input column(s), comma-separated (e.g. a,b).")
 OutputsOpt = typer.Option(..., "--output", help="Output column(s), comma-separated (e.g. c,d).")
 DetrendOpt = typer.Option("mean", "--detrend", help="Operating-point removal before fitting: mean or none.")
@@ -54,7 +57,7 @@ def _finish(model, data, tr, out, report, caught_lines_fn):
 
 
 @identify_app.command("ss")
-def identify_ss_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = OutputsOpt,
+def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output: str = OutputsOpt,
                     order: str = typer.Option(None, "--order", help="Order N, or a range LO:HI to search "
                                                                      "(default: from the singular values)."),
                     method: str = typer.Option("n4sid", "--method", help="Subspace weighting: n4sid, moesp or cva."),
@@ -70,7 +73,9 @@ def identify_ss_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = 
                     out: Path = ModelOutOpt, report: Path = ReportOpt,
                     fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                     json_out: bool = JsonOpt):
-    """MIMO state space: subspace (N4SID/MOESP/CVA, order from the singular values), then PEM."""
+    """MIMO state space: subspace (N4SID/MOESP/CVA, order from the singular values), then PEM.
+    Several DATA files: one model of all the records (subspace, then PEM), one initial state per
+    record (``records``: each file's free-run fit)."""
     from ..errors import DataError
     from ..sysid.identify_mimo import identify_ss
 
@@ -80,19 +85,38 @@ def identify_ss_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = 
         raise DataError(f"--focus: expected simulation or prediction, found {focus!r}")
     if max_iterations < 1:
         raise DataError(f"--max-iterations: expected a positive integer, found {max_iterations}")
+    several = len(data) > 1
+    if several and report is not None:
+        raise DataError("--report: the model report is of one data file; with several data "
+                        "files leave --report out",
+                        hint="run gripkit report MODEL.json DATA for each file")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        tr = _load(data, input, output, fs, time, fill)
-        vtr = _load(validate, input, output, fs, time, fill) if validate is not None else None
-        model, extras = identify_ss(tr, input=input, output=output, order=order, method=method, form=form,
-                                    refine=not no_refine, validate=vtr, detrend=detrend, progress=True,
-                                    focus=focus, max_iterations=max_iterations)
-        model = _with_provenance(model, data)
-        _finish(model, data, tr, out, report, None)
+        if several:
+            model, extras = _ss_of_records(data, input, output, order, method, no_refine, validate,
+                                           detrend, fs, time, fill, form, max_iterations)
+            if out is not None:
+                model.save(out)
+        else:
+            data = data[0]
+            tr = _load(data, input, output, fs, time, fill)
+            vtr = _load(validate, input, output, fs, time, fill) if validate is not None else None
+            model, extras = identify_ss(tr, input=input, output=output, order=order,
+                                        method=method, form=form, refine=not no_refine,
+                                        validate=vtr, detrend=detrend, progress=True,
+                                        focus=focus, max_iterations=max_iterations)
+            model = _with_provenance(model, data)
+            _finish(model, data, tr, out, report, None)
     from ..sysid.linear_model import VALIDATION_FIT
 
     res = model.to_dict()
-    res.update(data=str(data), method=method, refined=not no_refine, out=None if out is None else str(out))
+    res.update(data=[str(p) for p in data] if several else str(data), method=method,
+               refined=not no_refine, out=None if out is None else str(out))
+    if several:
+        res["records"] = [{"data": str(p), "n_samples": r["n_samples"],
+                           "fit_percent": r["fit_percent"]}
+                          for p, r in zip(data, model.info["records"])]
+        res["info"]["records"] = res["records"]  # without the initial states' arrays
     if "validation_fit_percent" in extras:
         res["validation"] = {"fit_percent": extras["validation_fit_percent"], "data": str(validate),
                              "initial_state": "estimated", "definition": VALIDATION_FIT}
@@ -114,6 +138,9 @@ def identify_ss_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = 
         typer.echo("singular values: " + " ".join(f"{v:.3g}" for v in sv[:min(sv.size, 12)]))
     for name, f in zip(ss.outputs, model.fit_percent):
         typer.echo(f"  {name}: free-run fit {f:.2f} %")
+    for r in res.get("records", []):
+        typer.echo(f"  record {r['data']}: N = {r['n_samples']}, free-run fit "
+                   + ", ".join(f"{v:.2f}" for v in r["fit_percent"]) + " % (its own initial state)")
     if "focus" in model.info:
         fo = model.info["focus"]
         typer.echo(f"focus {fo['criterion']} ({fo['data']} data): subspace {fo['subspace_percent']:.2f} %, "
@@ -130,6 +157,42 @@ def identify_ss_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = 
         typer.echo(f"  pole {z.real:.6g}{z.imag:+.6g}j{sd}")
     if out is not None:
         typer.echo(f"model written to {out}")
+
+
+def _records_model(data: list[Path], method: str, input: str, output: str, detrend: str, fs, time,
+                   fill, **options):
+    """One ``method`` model of several data files
+    (:func:`gripkit.sysid.identify.identify_records`), its errors naming the files."""
+    from ..errors import GripkitError
+    from ..sysid.identify import identify_records
+
+    trs = [_load(p, input, output, fs, time, fill) for p in data]
+    try:
+        model = identify_records(trs, method, input=input, output=output, detrend=detrend,
+                                 **options)
+    except GripkitError as exc:  # name the file, not its place in the list
+        msg = exc.message
+        for i, path in reversed(list(enumerate(data))):
+            msg = msg.replace(f"data[{i}]", repr(str(path)))
+        raise type(exc)(msg, hint=exc.hint) from None
+    return model.replace(data_file=", ".join(Path(p).name for p in data), data_hash=None)
+
+
+def _ss_of_records(data: list[Path], input: str, output: str, order, method: str, no_refine: bool,
+                   validate: Path | None, detrend: str, fs, time, fill, form: str,
+                   max_iterations: int):
+    """The state-space model of several data files (:func:`_records_model`) and its extras
+    (``validation_fit_percent`` with ``validate``)."""
+    from ..sysid.linear_model import validation_fit
+
+    model = _records_model(data, "ss", input, output, detrend, fs, time, fill, order=order,
+                           refine=not no_refine, weighting=method, form=form,
+                           max_iterations=max_iterations)
+    extras = {}
+    if validate is not None:  # the one validation fit (around the model's stored offsets)
+        vtr = _load(validate, input, output, fs, time, fill)
+        extras["validation_fit_percent"] = validation_fit(model, vtr)
+    return model, extras
 
 
 def _echo_search(rows: list[dict], criterion: str) -> None:
@@ -176,29 +239,47 @@ def identify_frf_cmd(data: Path = DataArg, input: str = InputsOpt, output: str =
 
 
 @identify_app.command("tf")
-def identify_tf_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = OutputsOpt,
+def identify_tf_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output: str = OutputsOpt,
                     poles: int = typer.Option(..., "--poles", help="Number of poles."),
                     zeros: int = typer.Option(..., "--zeros", help="Number of zeros."),
                     out: Path = ModelOutOpt, report: Path = ReportOpt,
                     fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                     json_out: bool = JsonOpt):
-    """Continuous-time transfer function (zero-order hold between samples) with σ."""
+    """Continuous-time transfer function (zero-order hold between samples) with σ. Several DATA
+    files: one model of all the records, each from its own initial state."""
+    from ..errors import DataError
     from ..sysid.identify_mimo import identify_tf
 
+    several = len(data) > 1
+    if several and report is not None:
+        raise DataError("--report: the model report is of one data file; with several data "
+                        "files leave --report out",
+                        hint="run gripkit report MODEL.json DATA for each file")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        tr = _load(data, input, output, fs, time, fill)
-        model = _with_provenance(identify_tf(tr, input=input, output=output, poles=poles, zeros=zeros,
-                                             detrend=detrend), data)
-        _finish(model, data, tr, out, report, None)
+        if several:
+            model = _records_model(data, "tf", input, output, detrend, fs, time, fill,
+                                   poles=poles, zeros=zeros)
+            if out is not None:
+                model.save(out)
+        else:
+            data = data[0]
+            tr = _load(data, input, output, fs, time, fill)
+            model = _with_provenance(identify_tf(tr, input=input, output=output, poles=poles,
+                                                 zeros=zeros, detrend=detrend), data)
+            _finish(model, data, tr, out, report, None)
     g, info = model.system, model.info
     res = {"num": g.numerator(), "den": g.denominator(), "num_std": info["num_std"][-(zeros + 1):],
            "den_std": info["den_std"], "natural_frequency_hz": info["natural_frequency_hz"],
            "natural_frequency_hz_std": info["natural_frequency_hz_std"], "damping_ratio": info["damping_ratio"],
            "damping_ratio_std": info["damping_ratio_std"], "fit_percent": model.fit_percent,
            "poles": [[float(z.real), float(z.imag)] for z in g.poles()], "inputs": list(g.inputs),
-           "outputs": list(g.outputs), "data": str(data), "out": None if out is None else str(out),
-           "warnings": report_warnings(caught)}
+           "outputs": list(g.outputs), "data": [str(p) for p in data] if several else str(data),
+           "out": None if out is None else str(out), "warnings": report_warnings(caught)}
+    if several:
+        res["records"] = [{"data": str(p), "n_samples": r["n_samples"],
+                           "fit_percent": r["fit_percent"]}
+                          for p, r in zip(data, model.info["records"])]
     if json_out:
         emit_json(res)
         return

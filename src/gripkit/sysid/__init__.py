@@ -24,6 +24,7 @@ from ..exports import lazy_exports
 _LAZY = {
     "armax": ("armax", "armax"),
     "arx": ("arx", "arx"),
+    "arx_records": ("arx", "arx_records"),
     "IOData": ("identify", "IOData"),
     "identify": ("identify", "identify"),
     "io_data": ("identify", "io_data"),
@@ -70,6 +71,7 @@ __all__ = [*_LAZY]
 if TYPE_CHECKING:  # static readers see the same names, imported eagerly
     from .armax import armax as armax
     from .arx import arx as arx
+    from .arx import arx_records as arx_records
     from .identify import IOData as IOData
     from .identify import identify as identify
     from .identify import io_data as io_data

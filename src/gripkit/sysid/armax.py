@@ -13,17 +13,20 @@ unit circle if needed). Then Levenberg–Marquardt (:mod:`gripkit.sysid._pem`) m
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from ._pem import covariance, is_stable_poly, levenberg_marquardt, stabilize
 from ._scaling import in_user_units, unit_scale
-from .arx import _arx, arx
-from .checks import check_identifiable, checked_problem
+from .arx import (_arx, arx, arx_records, check_record_lengths, checked_records, records_summary,
+                  scaled_records)
+from .checks import check_dt, check_identifiable, check_order, checked_problem, require_samples
 from .polynomial import PolynomialModel, check_meta
 from .regression import qr_solve
 from .validation import fit_percent, loss_vn
 
-__all__ = ["armax"]
+__all__ = ["armax", "armax_records"]
 
 
 def _hannan_rissanen(u, y, na, nb, nc, nk) -> np.ndarray:
@@ -108,3 +111,116 @@ def _armax(u, y, na, nb, nc, nk, step, maxiter, tol, meta) -> PolynomialModel:
                            info={"method": "prediction-error minimisation (Levenberg-Marquardt), "
                                            "Hannan-Rissanen start", "iterations": res.iterations,
                                  "converged": res.converged, "cond": cond}, **meta)
+
+
+def armax_records(records, na: int, nb: int, nc: int, nk: int = 1, *, dt: float | None = None,
+                  maxiter: int = 100, tol: float = 1e-10, **meta) -> PolynomialModel:
+    """:func:`armax` fitted to several records at once (one model, one θ, one σ).
+
+    ``records``: a list of ``(u, y)`` pairs around one common operating point. The prediction
+    errors of every record are computed by its own filter, started at its own first predicted
+    sample ``start = max(na, nk + nb − 1)`` from its own first samples (e = 0 before, as for one
+    record), so nothing crosses from one record into the next; the errors and their Jacobians
+    are stacked and Levenberg–Marquardt minimises ``Σ_i Σ_t e_i(t)²``; σ² = Σe²/(Σ M_i − p). The
+    start is Hannan–Rissanen on all the records (:func:`~gripkit.sysid.arx_records` of high order
+    for the innovations, then the stacked regression rows of every record). ``fit_percent``: the
+    one-step fit of all records; ``info['records']``: each record's samples and one-step fit.
+    """
+    check_meta(meta, armax)
+    recs = checked_records(records, "armax_records")
+    step = check_dt(dt)
+    na, nb, nc, nk = (check_order(na, "na"), check_order(nb, "nb", 1), check_order(nc, "nc"),
+                      check_order(nk, "nk"))
+    if nc == 0:
+        return arx_records(recs, na, nb, nk, dt=step, **meta)
+    p = na + nb + nc
+    t0 = max(na, nk + nb - 1)
+    label = f"ARMAX [{na} {nb} {nc} {nk}]"
+    check_record_lengths(recs, t0, label)
+    require_samples(sum(y.size - t0 for _, y in recs) + t0, t0 + 10 * p,
+                    f"{label} ({p} parameters)")
+    scaled, cu, cy = scaled_records(recs)
+    theta0 = _hannan_rissanen_records(scaled, na, nb, nc, nk)
+    theta0[na + nb:] = stabilize(np.concatenate([[1.0], theta0[na + nb:]]))[1:]
+    parts = [_armax_part(u, y, na, nb, nk, t0) for u, y in scaled]
+
+    def fun(theta):
+        es, Js = zip(*(_armax_errors(theta, ya, ub, yt, na, nb, nc) for ya, ub, yt in parts))
+        return np.concatenate(es), np.vstack(Js)
+
+    def admissible(theta):
+        return is_stable_poly(np.concatenate([[1.0], theta[na + nb:]]))
+
+    res = levenberg_marquardt(fun, theta0, admissible, maxiter=maxiter, tol=tol, label=label)
+    names = tuple(f"a{i}" for i in range(1, na + 1)) + tuple(f"b{nk + j}" for j in range(nb)) + \
+        tuple(f"c{k}" for k in range(1, nc + 1))
+    cov, sigma2, cond = covariance(res, names)
+    th = res.theta
+    ys = [yt for _, _, yt in parts]
+    errs = np.split(res.e, np.cumsum([yt.size for yt in ys[:-1]]))
+    fit, per_record, starts, e = records_summary(ys, errs, t0)
+    info = {"method": "prediction-error minimisation over the records (Levenberg-Marquardt), "
+                      "Hannan-Rissanen start", "iterations": res.iterations,
+            "converged": res.converged, "cond": cond, "n_records": len(recs),
+            "records": per_record, "record_starts": starts}
+    model = PolynomialModel(np.concatenate([[1.0], th[:na]]),
+                            np.concatenate([np.zeros(nk), th[na:na + nb]]), nk,
+                            C=np.concatenate([[1.0], th[na + nb:]]), dt=step, structure="armax",
+                            covariance=cov, noise_variance=sigma2, loss=loss_vn(e), fit_percent=fit,
+                            n_samples=int(sum(y.size for _, y in recs)), n_used=int(e.size),
+                            residuals=e, info=info, **meta)
+    return in_user_units(model, cu, cy)
+
+
+def _armax_part(u, y, na, nb, nk, t0):
+    """One record's fixed regressors: past outputs (M, na), past inputs (M, nb), outputs (M,)."""
+    n = y.size
+    ya = (np.column_stack([y[t0 - i:n - i] for i in range(1, na + 1)]) if na
+          else np.zeros((n - t0, 0)))
+    ub = np.column_stack([u[t0 - nk - j:n - nk - j] for j in range(nb)])
+    return ya, ub, y[t0:]
+
+
+def _armax_errors(theta, ya, ub, yt, na, nb, nc):
+    """One record's prediction errors ``C e = A y − B u`` (its filter at rest before its first
+    predicted sample) and their Jacobian (the ``fun`` of :func:`_armax`, record by record)."""
+    from scipy import signal as _sig
+
+    a, b, c = theta[:na], theta[na:na + nb], theta[na + nb:]
+    C = np.concatenate([[1.0], c])
+    e = _sig.lfilter([1.0], C, yt + ya @ a - ub @ b)
+    es = np.zeros((e.size, nc))
+    for k in range(1, nc + 1):
+        es[k:, k - 1] = e[:-k]
+    return e, _sig.lfilter([1.0], C, np.hstack([ya, -ub, -es]), axis=0)
+
+
+def _hannan_rissanen_records(recs, na, nb, nc, nk) -> np.ndarray:
+    """:func:`_hannan_rissanen` on several records: the innovations of each record from one
+    high-order ARX of all of them, then the regression rows of every record stacked."""
+    nmin = min(y.size for _, y in recs)
+    nh = int(min(max(3 * (na + nb + nc), 10), max((nmin - nk) // 10, nc + 1)))
+    th = max(nh, nk + nh - 1)
+    with warnings.catch_warnings():  # an internal fit: the final model's diagnostics speak
+        warnings.simplefilter("ignore")
+        high = arx_records(recs, nh, nh, nk)
+    t0 = max(na, nk + nb - 1, nc) + th
+    p = na + nb + nc
+    rows = []
+    for (u, y), start in zip(recs, high.info["record_starts"]):
+        n = y.size
+        if n <= t0:
+            continue
+        ehat = np.zeros(n)
+        ehat[th:] = high.residuals[start:start + n - th]
+        X = np.empty((n - t0, p + 1))
+        for i in range(na):
+            X[:, i] = -y[t0 - 1 - i:n - 1 - i]
+        for j in range(nb):
+            X[:, na + j] = u[t0 - nk - j:n - nk - j]
+        for k in range(nc):
+            X[:, na + nb + k] = ehat[t0 - 1 - k:n - 1 - k]
+        X[:, p] = y[t0:]
+        rows.append(X)
+    names = tuple(f"p{i}" for i in range(p))
+    return qr_solve(np.asfortranarray(np.vstack(rows)), names, overwrite=True, warn=False).theta

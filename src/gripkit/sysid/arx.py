@@ -17,14 +17,16 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 
+from ..errors import DataError
 from ._scaling import in_user_units, unit_scale
 from .arx_mimo import arx_mimo
-from .checks import check_identifiable, checked_problem
+from .checks import (check_dt, check_excitation, check_identifiable, check_io, check_order,
+                     check_output_varies, checked_problem, require_samples)
 from .polynomial import PolynomialModel, check_meta
 from .regression import arx_regression, arx_start, qr_solve, triangular_solve
-from .validation import fit_percent
+from .validation import fit_percent, records_fit
 
-__all__ = ["arx"]
+__all__ = ["arx", "arx_records"]
 
 #: Regressors up to this many elements (``m·(p+1)``, 2 MiB of float64) are materialised and
 #: solved by QR: a few milliseconds at most, and no numba import or kernel load (0.45 s of a
@@ -157,3 +159,145 @@ def _normal_equations(u, y, na, nb, nk, t0, names, warn, keep_residuals):
     e, see, syy = arx_residuals(u, y, theta, na, nb, nk, t0, keep_residuals)
     R[p, p] = np.sqrt(see)
     return triangular_solve(R, names, y.size - t0, warn, stacklevel=5), e, see, syy
+
+
+def checked_records(records, what: str) -> list:
+    """``records`` as a list of at least one ``(u, y)`` pair, each checked (:func:`check_io`),
+    or a DataError naming the record."""
+    pair = isinstance(records, tuple) and len(records) == 2
+    if pair and not isinstance(records[0], (tuple, list)):
+        records = [records]  # one (u, y) pair
+    try:
+        records = list(records)
+    except TypeError:
+        raise DataError(f"records: expected a list of (u, y) pairs, found "
+                        f"{type(records).__name__}") from None
+    if not records:
+        raise DataError(f"records: {what} needs at least one (u, y) record, found an empty list")
+    out = []
+    for i, r in enumerate(records):
+        if not (isinstance(r, (tuple, list)) and len(r) == 2):
+            raise DataError(f"records[{i}]: expected a (u, y) pair, found {type(r).__name__}",
+                            hint="pass records=[(u1, y1), (u2, y2), ...]")
+        try:
+            out.append(check_io(*r))
+        except DataError as exc:
+            raise DataError(f"records[{i}]: {exc.message}", hint=exc.hint) from None
+    return out
+
+
+def check_record_lengths(recs: list, t0: int, label: str) -> None:
+    """Every record longer than its ``t0`` initial samples, or a DataError naming the record."""
+    for i, (_, y) in enumerate(recs):
+        if y.size <= t0:
+            raise DataError(f"records[{i}]: {label} takes the first {t0} samples of every record "
+                            f"as its initial conditions, so a record needs more than {t0} samples, "
+                            f"found {y.size}", hint="drop the short record or lower the orders")
+
+
+def scaled_records(recs: list, skip_within: float = 0.0) -> tuple[list, float, float]:
+    """The records with their input and output scaled to unit size (one power of two for all
+    records, :func:`~gripkit.sysid._scaling.unit_scale`) and the factors ``(scaled, cu, cy)``,
+    after the checks that need all the records: a varying input and a varying output. Peaks
+    within 2^±``skip_within`` stay unscaled."""
+    u_all = np.concatenate([u for u, _ in recs])
+    y_all = np.concatenate([y for _, y in recs])
+    check_excitation(u_all)
+    check_output_varies(y_all)
+    cu, cy = unit_scale(u_all), unit_scale(y_all)
+    if max(abs(np.log2(cu)), abs(np.log2(cy))) <= skip_within:
+        cu = cy = 1.0
+    return [(u * cu, y * cy) if (cu, cy) != (1.0, 1.0) else (u, y) for u, y in recs], cu, cy
+
+
+def records_summary(ys: list, errs: list, t0: int) -> tuple[float, list, list, np.ndarray]:
+    """(fit of all records, per-record dicts, start of each record's errors, all errors read-only)
+    from each record's predicted outputs ``ys`` (samples t0 … N_i − 1) and prediction errors."""
+    yhats = [yi - ei for yi, ei in zip(ys, errs)]
+    per_record = [{"n_samples": int(yi.size + t0), "n_used": int(yi.size),
+                   "fit_percent": fit_percent(yi, hi)} for yi, hi in zip(ys, yhats)]
+    e = np.concatenate(errs)
+    e.flags.writeable = False
+    starts = np.cumsum([0] + [yi.size for yi in ys[:-1]]).tolist()
+    return float(records_fit(ys, yhats)), per_record, starts, e
+
+
+def arx_records(records, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
+                **meta) -> PolynomialModel:
+    """Least-squares ARX fitted to several records at once (one model, one θ, one σ).
+
+    ``records``: a list of ``(u, y)`` pairs (1-D arrays, each record its own length, in deviation
+    units around one common operating point). Every record supplies its own initial conditions:
+    its first ``start = max(na, nk + nb − 1)`` samples only fill the regressor, so no regressor
+    row reaches across from one record into the next (joining the records into one array would
+    make the rows at each seam mix the end of one record with the start of the next, a false
+    transient that biases θ). The rows of all records are stacked into one least-squares problem:
+
+        θ = argmin Σ_i Σ_{t=start}^{N_i−1} (y_i(t) − φ_i(t)ᵀθ)²,   σ² = Σ e² / (Σ_i M_i − p),
+
+    M_i = N_i − start. The covariance is σ²(ΦᵀΦ)⁻¹ of the stacked Φ. With one record the result
+    is that of :func:`arx` (same rows). ``fit_percent`` is the one-step fit of all the records,
+    each about its own mean (:func:`~gripkit.sysid.validation.records_fit`); ``info['records']``
+    gives each record's samples and one-step fit; ``residuals`` are the records' one-step errors
+    one after another (``info['record_starts']``: where each begins).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from gripkit.sysid import arx_records
+    >>> rng = np.random.default_rng(0)
+    >>> recs = []
+    >>> for n in (800, 1200):
+    ...     u = rng.standard_normal(n); y = np.zeros(n); y[0] = 3.0
+    ...     for t in range(1, n):
+    ...         y[t] = 0.9 * y[t - 1] + 0.5 * u[t - 1] + 0.01 * rng.standard_normal()
+    ...     recs.append((u, y))
+    >>> m = arx_records(recs, 1, 1, 1)
+    >>> np.round(m.theta, 2).tolist(), m.n_used
+    ([-0.9, 0.5], 1998)
+    """
+    check_meta(meta, arx)
+    recs = checked_records(records, "arx_records")
+    step = check_dt(dt)
+    na, nb, nk = check_order(na, "na"), check_order(nb, "nb", 1), check_order(nk, "nk")
+    p = na + nb
+    t0 = arx_start(na, nb, nk)
+    what = f"ARX [{na} {nb} {nk}] ({p} parameters, {t0} initial samples in every record)"
+    check_record_lengths(recs, t0, f"ARX [{na} {nb} {nk}]")
+    m = sum(y.size - t0 for _, y in recs)
+    require_samples(m + t0, t0 + p + 1, what)
+    scaled, cu, cy = scaled_records(recs, skip_within=_NO_SCALING_WITHIN)
+    names = tuple(f"a{i}" for i in range(1, na + 1)) + tuple(f"b{nk + j}" for j in range(nb))
+    sol = theta = R = None
+    if m * (p + 1) > QR_MAX_ELEMENTS:  # the records' Gram matrices summed (O(p²) memory)
+        from .lagged_sums import arx_gram, gram_triangle
+
+        G = sum(arx_gram(u, y, na, nb, nk, t0) for u, y in scaled)
+        r1 = gram_triangle(G)
+        if r1 is not None:
+            R = np.zeros((p + 1, p + 1))
+            R[:p, :p] = r1
+            R[:p, p] = sla.solve_triangular(r1, G[:p, p], trans="T", check_finite=False)
+            theta = sla.solve_triangular(r1, R[:p, p], check_finite=False)
+            method = "least squares over the records (summed normal equations, Cholesky)"
+    if theta is None:
+        X = np.asfortranarray(np.vstack([arx_regression(u, y, na, nb, nk, t0)
+                                         for u, y in scaled]))
+        sol = qr_solve(X, names, overwrite=True)
+        theta = sol.theta
+        method = "least squares over the records (QR of the stacked [Φ | Y])"
+    model = _model(theta, na, nk, step, sum(y.size for _, y in recs), meta)
+    errs = [model.prediction_errors(u, y) for u, y in scaled]
+    e = np.concatenate(errs)
+    see = float(e @ e)
+    if sol is None:  # ρ² from the residuals, as in :func:`_normal_equations`
+        R[p, p] = np.sqrt(see)
+        sol = triangular_solve(R, names, m, True, stacklevel=3)
+    sigma2 = see / (m - p)
+    fit, per_record, starts, e = records_summary([y[t0:] for _, y in scaled], errs, t0)
+    model = model.replace(covariance=sigma2 * sol.cov_unscaled, noise_variance=sigma2,
+                          loss=0.5 * see / m, fit_percent=fit, n_used=m, residuals=e,
+                          info={"method": method, "cond": sol.cond, "n_records": len(recs),
+                                "records": per_record, "record_starts": starts})
+    return in_user_units(model, cu, cy)
+

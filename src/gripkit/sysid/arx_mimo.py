@@ -19,12 +19,14 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import DataError
 from ..lti import StateSpace, Uncertainty
 from .checks import check_dt, check_order
 from .linear_model import LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run
 from .regression import qr_solve
+from .validation import records_fit
 
-__all__ = ["arx_mimo"]
+__all__ = ["arx_mimo", "arx_mimo_records"]
 
 
 def _realisation(theta, p, m, na, nb, nk):
@@ -75,29 +77,86 @@ def arx_mimo(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
     """
     u = as_io_matrix(u, "input u")
     y = as_io_matrix(y, "output y", u.shape[0])
+    meta = dict(inputs=inputs, outputs=outputs, input_units=input_units, output_units=output_units,
+                u_offset=u_offset, y_offset=y_offset)
+    return _arx_mimo([(u, y)], na, nb, nk, dt, meta)
+
+
+def arx_mimo_records(records, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
+                     inputs=None, outputs=None, input_units=None, output_units=None, u_offset=None,
+                     y_offset=None) -> LinearModel:
+    """:func:`arx_mimo` fitted to several records at once: ``records`` a list of ``(u, y)``
+    pairs, ``u`` (N_i, m), ``y`` (N_i, p), around one common operating point. Each record's first
+    ``start = max(na, nk + nb − 1)`` samples are its own initial conditions (no regressor row
+    crosses from one record into the next); the rows of all records form one least-squares
+    problem, ``Λ = EᵀE/(Σ M_i − q)``. ``fit_percent`` is the free-run fit of all records per
+    output (each from its own estimated initial state, about its own mean:
+    :func:`~gripkit.sysid.validation.records_fit`); ``info['records']`` gives each record's
+    samples, free-run and one-step fits and initial state (``x0`` of the model: the first
+    record's).
+    """
+    if not isinstance(records, (list, tuple)) or not records:
+        raise DataError(f"records: expected a non-empty list of (u, y) pairs, "
+                        f"found {records!r:.60}")
+    recs = []
+    for i, r in enumerate(records):
+        if not (isinstance(r, (tuple, list)) and len(r) == 2):
+            raise DataError(f"records[{i}]: expected a (u, y) pair, found {type(r).__name__}")
+        u = as_io_matrix(r[0], f"records[{i}] input u")
+        y = as_io_matrix(r[1], f"records[{i}] output y", u.shape[0])
+        first = (recs[0][0].shape[1], recs[0][1].shape[1]) if recs else None
+        if first and (u.shape[1], y.shape[1]) != first:
+            raise DataError(f"records[{i}]: expected {first[0]} input and {first[1]} output "
+                            f"columns as records[0], found {u.shape[1]} and {y.shape[1]}")
+        recs.append((u, y))
+    meta = dict(inputs=inputs, outputs=outputs, input_units=input_units, output_units=output_units,
+                u_offset=u_offset, y_offset=y_offset)
+    return _arx_mimo(recs, na, nb, nk, dt, meta, several=True)
+
+
+def _arx_mimo(recs, na, nb, nk, dt, meta, several: bool = False) -> LinearModel:
+    """The fit of :func:`arx_mimo` (one record) and :func:`arx_mimo_records`."""
+    inputs, outputs = meta["inputs"], meta["outputs"]
+    input_units, output_units = meta["input_units"], meta["output_units"]
+    u_offset, y_offset = meta["u_offset"], meta["y_offset"]
     step = check_dt(dt)
     na, nb, nk = check_order(na, "na"), check_order(nb, "nb", 1), check_order(nk, "nk")
-    N, m = u.shape
-    p = y.shape[1]
+    m = recs[0][0].shape[1]
+    p = recs[0][1].shape[1]
     t0 = max(na, nk + nb - 1)
     q = p * na + m * nb
-    M = N - t0
+    for i, (u, _) in enumerate(recs):
+        if u.shape[0] <= t0:
+            where = f"records[{i}]: " if several else ""
+            every = " of every record" if several else ""
+            raise DataError(f"{where}ARX [{na} {nb} {nk}] takes the first {t0} samples{every} as "
+                            f"its initial conditions, so it needs more than {t0} samples, found "
+                            f"{u.shape[0]}", hint="use a longer record or lower the orders")
+    N = sum(u.shape[0] for u, _ in recs)
+    M = N - t0 * len(recs)
     X = np.empty((M, q + 1), order="F")
-    for i in range(na):
-        X[:, i * p:(i + 1) * p] = -y[t0 - 1 - i:N - 1 - i]
-    for j in range(nb):
-        lag = nk + j
-        X[:, p * na + j * m:p * na + (j + 1) * m] = u[t0 - lag:N - lag]
+    Y = np.empty((M, p))
+    row = 0
+    for u, y in recs:
+        Ni = u.shape[0]
+        rows = slice(row, row + Ni - t0)
+        for i in range(na):
+            X[rows, i * p:(i + 1) * p] = -y[t0 - 1 - i:Ni - 1 - i]
+        for j in range(nb):
+            lag = nk + j
+            X[rows, p * na + j * m:p * na + (j + 1) * m] = u[t0 - lag:Ni - lag]
+        Y[rows] = y[t0:]
+        row += Ni - t0
     names = [f"A{i + 1}[:,{k}]" for i in range(na) for k in range(p)] + \
             [f"B{nk + j}[:,{k}]" for j in range(nb) for k in range(m)]
     theta = np.empty((p, q))
     cov_unscaled = None
     for r in range(p):
-        X[:, q] = y[t0:, r]
+        X[:, q] = Y[:, r]
         sol = qr_solve(X, tuple(names))
         theta[r] = sol.theta
         cov_unscaled = sol.cov_unscaled
-    E = y[t0:] - X[:, :q] @ theta.T
+    E = Y - X[:, :q] @ theta.T
     Lam = E.T @ E / (M - q)
     cov = np.kron(Lam, cov_unscaled)                     # vec(θ) row-major: output i, then regressor
     A, B, C, D = _realisation(theta, p, m, na, nb, nk)
@@ -117,14 +176,33 @@ def arx_mimo(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
     Kg = np.zeros((n, p))
     if na:
         Kg[:p] = np.eye(p)
-    x0 = estimate_x0(A, B, C, D, u, y)
-    fit = fit_per_output(y, free_run(A, B, C, D, u, x0)) if sys.is_stable() else None
+    stable = sys.is_stable()
+    x0s, runs = [], []
+    for u, y in recs:
+        x0s.append(estimate_x0(A, B, C, D, u, y))
+        runs.append(free_run(A, B, C, D, u, x0s[-1]) if stable else None)
+    x0 = x0s[0]
+    if len(recs) == 1:
+        u, y = recs[0]
+        fit = fit_per_output(y, runs[0]) if stable else None
+    else:
+        fit = records_fit([y for _, y in recs], runs).tolist() if stable else None
     std = np.sqrt(np.diag(cov)).reshape(p, q)
     info = {"orders": {"na": na, "nb": nb, "nk": nk},
             "A_poly": [theta[:, i * p:(i + 1) * p] for i in range(na)],
             "A_poly_std": [std[:, i * p:(i + 1) * p] for i in range(na)],
             "B_poly": [theta[:, p * na + j * m:p * na + (j + 1) * m] for j in range(nb)],
             "B_poly_std": [std[:, p * na + j * m:p * na + (j + 1) * m] for j in range(nb)],
-            "one_step_fit_percent": fit_per_output(y[t0:], y[t0:] - E)}
+            "one_step_fit_percent": fit_per_output(Y, Y - E)}
+    if several:
+        row, info["records"] = 0, []
+        for (u, y), x0i, run in zip(recs, x0s, runs):
+            rows = slice(row, row + u.shape[0] - t0)
+            row = rows.stop
+            info["records"].append({
+                "n_samples": int(u.shape[0]), "n_used": int(u.shape[0] - t0),
+                "fit_percent": None if run is None else fit_per_output(y, run),
+                "one_step_fit_percent": fit_per_output(Y[rows], Y[rows] - E[rows]), "x0": x0i})
+        info["n_records"] = len(recs)
     return LinearModel(sys, "arx", K=Kg, x0=x0, noise_covariance=Lam, fit_percent=fit, u_offset=u_offset,
                        y_offset=y_offset, n_samples=N, info=info)

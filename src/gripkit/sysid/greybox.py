@@ -394,7 +394,7 @@ def _result(params: ParameterSet, free, theta, cov, std, corr, ident: Identifiab
 
 
 @entry_point
-def fit(model, data: Trajectory, *, outputs: Sequence[str] | Mapping[str, str] | None = None,
+def fit(model, data: Trajectory | Sequence[Trajectory], *, outputs: Sequence[str] | Mapping[str, str] | None = None,
         inputs: Mapping[str, str] | None = None, free: Sequence[str] | None = None,
         initial: ParameterSet | Mapping[str, float] | None = None, x0: np.ndarray | None = None,
         output_scale: Sequence[float] | None = None, multistart: int = 0, seed: int = 0,
@@ -434,7 +434,19 @@ def fit(model, data: Trajectory, *, outputs: Sequence[str] | Mapping[str, str] |
         Identifiability diagnosis: a Jacobian direction (in parameters scaled to their starting
         values) is undetermined if its singular value is below ``rcond`` times the largest, or if
         the noise moves the parameters along it by more than ``max_rel_std`` (1.0 = 100 %).
+
+    Several records (``data`` a list of trajectories with the same columns and sample interval):
+    one set of parameters for all of them, every record simulated from its own initial state
+    (``x0`` then a list with one per record, or None for the model's initial state in each), its
+    own ``burn_in`` samples left out, the weights w_j from all records' outputs together; the
+    residuals of all records form one least-squares problem and σ̂² = Σ r²/(Σ N_r − n).
+    ``fit_percent``, ``y_model`` and ``residuals`` are then over the records one after another.
     """
+    if isinstance(data, (list, tuple)):
+        solver = _SolverOptions(method, loss, max_nfev, multistart, seed, progress)
+        return _fit_records(model, data, outputs=outputs, inputs=inputs, free=free, initial=initial,
+                            x0=x0, output_scale=output_scale, burn_in=burn_in, solver=solver,
+                            rcond=rcond, max_rel_std=max_rel_std)
     if not isinstance(data, Trajectory):
         raise DataError(f"data: expected a Trajectory, found {type(data).__name__}")
     dt = data.require_uniform(why="grey-box identification")
@@ -453,3 +465,74 @@ def fit(model, data: Trajectory, *, outputs: Sequence[str] | Mapping[str, str] |
                       AccuracyWarning, stacklevel=2)
     return _result(params, free, theta, cov, std, corr, ident, problem, best, r, tried,
                    source=data.meta.get("source", "data"))
+
+
+class _RecordsOutputError:
+    """:class:`_OutputError` of several records sharing the free parameters: the residuals and
+    Jacobians of the records stacked (each record simulated from its own initial state)."""
+
+    def __init__(self, parts: list[_OutputError]):
+        self.parts = parts
+        first = parts[0]
+        for name in ("lo", "hi", "s", "theta0", "bounds", "logvar", "to_z", "to_theta"):
+            setattr(self, name, getattr(first, name))
+        c = first.cols
+        self.cols = _Columns(None, np.vstack([q.cols.y for q in parts]), c.w, c.out_map, c.out_idx,
+                             c.burn_in)
+
+    @property
+    def nfev(self) -> int:
+        return sum(q.nfev for q in self.parts)
+
+    def residual(self, z):
+        return np.concatenate([q.residual(z) for q in self.parts])
+
+    def jacobian(self, z):
+        return np.vstack([q.jacobian(z) for q in self.parts])
+
+    def jacobian_theta(self, z, theta):
+        return self.jacobian(z) / np.where(self.logvar, theta, self.s)[None, :]
+
+
+def _fit_records(model, data, *, outputs, inputs, free, initial, x0, output_scale, burn_in,
+                 solver: _SolverOptions, rcond: float, max_rel_std: float) -> GreyboxResult:
+    """:func:`fit` of several records (see its docstring)."""
+    if not data:
+        raise DataError("data: expected a trajectory or a non-empty list of them, found an empty "
+                        "list")
+    for i, d in enumerate(data):
+        if not isinstance(d, Trajectory):
+            raise DataError(f"data[{i}]: expected a Trajectory, found {type(d).__name__}")
+    dts = [d.require_uniform(why="grey-box identification") for d in data]
+    for i, dt in enumerate(dts[1:], 1):
+        if abs(dt - dts[0]) > 1e-9 * dts[0]:
+            raise DataError(f"data[{i}] is sampled every {dt:g} s, data[0] every {dts[0]:g} s: the "
+                            "records of one fit must share the sample interval",
+                            hint="resample one of them")
+    if x0 is not None and (not isinstance(x0, (list, tuple)) or len(x0) != len(data)):
+        raise DataError(f"x0: with {len(data)} records expected a list of {len(data)} initial "
+                        f"states (one per record) or None, found {type(x0).__name__}",
+                        hint="x0=[x0_1, x0_2, ...], or None for the model's initial state")
+    params, free = _parameters_to_fit(model, initial, free)
+    cols = [_fit_columns(model, d, inputs=inputs, outputs=outputs, n_free=len(free),
+                         burn_in=burn_in, output_scale=output_scale) for d in data]
+    if output_scale is None:  # one weight per output, from all records
+        w = np.vstack([c.y for c in cols]).std(axis=0)
+        if not np.all(w > 0):
+            raise DataError(f"output scale: a measured output is constant in every record ({w})",
+                            hint="pass output_scale=[...] explicitly")
+        cols = [_Columns(c.u, c.y, w, c.out_map, c.out_idx, c.burn_in) for c in cols]
+    parts = [_OutputError(model, params, free, c, dts[0], None if x0 is None else x0[i],
+                          solver.method) for i, c in enumerate(cols)]
+    problem = _RecordsOutputError(parts)
+    best, tried = _best_of_starts(problem, solver)
+    theta = problem.to_theta(best.x)
+    _check_inside_bounds(theta, problem, free, solver.method)
+    r = problem.residual(best.x)
+    cov, std, corr, ident = _uncertainty(problem.jacobian_theta(best.x, theta), r, problem.s, free,
+                                         rcond, max_rel_std)
+    if not ident.ok:
+        warnings.warn(f"{model.name}: {ident}; their standard deviations are reported as infinite",
+                      AccuracyWarning, stacklevel=3)
+    return _result(params, free, theta, cov, std, corr, ident, problem, best, r, tried,
+                   source=f"{len(data)} records")

@@ -34,13 +34,14 @@ from ..errors import AccuracyWarning, ArgumentError, DataError, GripkitError
 from ..signals.processing import detrend as detrend_signals
 from ..signals.trajectory import Trajectory
 from . import identify_mimo
-from .armax import armax
-from .arx import arx
+from .armax import armax, armax_records
+from .arx import arx, arx_records
+from .arx_mimo import arx_mimo_records
 from .frf import frf
-from .oe import oe
+from .oe import oe, oe_records
 from .search import structure_search
 
-__all__ = ["IOData", "io_data", "identify", "method_options", "METHODS"]
+__all__ = ["IOData", "io_data", "identify", "identify_records", "method_options", "METHODS"]
 
 METHODS = ("arx", "armax", "oe", "rls", "search", "ss", "frf", "tf")
 
@@ -172,7 +173,9 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
     ----------
     data
         A uniformly sampled :class:`~gripkit.signals.Trajectory` (e.g. from
-        :func:`gripkit.io.load`).
+        :func:`gripkit.io.load`), or a list of them: several records of the same columns fitted
+        by one model, each with its own initial conditions (methods ``'arx'``, ``'armax'``,
+        ``'oe'``; see :func:`identify_records`).
     method
         ``'arx'`` (least squares), ``'armax'`` (orders na, nb, nc, nk), ``'oe'`` (orders nb, nf,
         nk; ``nf`` defaults to ``na``), ``'rls'`` (recursive least squares; options
@@ -207,6 +210,9 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
             raise ArgumentError(f"identify(): {name} must be a column name (str), found {type(col).__name__} "
                                 f"{col!r:.40}", hint=f"columns: {', '.join(data.names)}"
                                 if isinstance(data, Trajectory) else None)
+    if isinstance(data, (list, tuple)):  # several records, one model
+        return identify_records(data, method, input=input, output=output, na=na, nb=nb, nk=nk,
+                                nc=nc, nf=nf, detrend=detrend, **options)
     if method in ("ss", "frf", "tf"):  # MIMO: input/output may name several columns
         fn = {"ss": identify_mimo.identify_ss, "frf": identify_mimo.identify_frf, "tf": identify_mimo.identify_tf}
         out = fn[method](data, input=input, output=output, detrend=detrend, **options)
@@ -230,3 +236,124 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
 
         return rls(io.u, io.y, na, nb, nk, dt=io.dt, **options)
     return structure_search(io.u, io.y, na, nb, nk, dt=io.dt, **options)
+
+
+#: the methods that fit one model to several records (``identify([tr1, tr2], ...)``)
+RECORD_METHODS = ("arx", "armax", "oe", "ss", "tf")
+
+
+def _per_record(i: int, fn, *args, **kw):
+    """``fn(*args, **kw)`` for record ``i``, its errors prefixed with ``data[i]: ``."""
+    try:
+        return fn(*args, **kw)
+    except GripkitError as exc:
+        raise type(exc)(f"data[{i}]: {exc.message}", hint=exc.hint) from None
+
+
+def identify_records(data, method: str = "arx", *, input, output, na: int = 2, nb: int = 2,
+                     nk: int = 1, nc: int = 1, nf: int | None = None, detrend: str = "mean",
+                     **options):
+    """One model from several records (a list of :class:`~gripkit.signals.Trajectory` with the
+    same columns, sample interval and units), each with its own initial conditions; σ from all
+    of them: ARX (:func:`gripkit.sysid.arx_records`; with several columns
+    :func:`gripkit.sysid.arx_mimo.arx_mimo_records`), ARMAX
+    (:func:`gripkit.sysid.armax.armax_records`), OE (:func:`gripkit.sysid.oe.oe_records`; ``nf``
+    defaults to ``na``), ``options`` ``maxiter``, ``tol`` for the last two; state space
+    (``options`` of :data:`gripkit.sysid.identify_mimo.SS_RECORD_OPTIONS`: subspace, then PEM,
+    see :func:`gripkit.sysid.identify_mimo.identify_ss_records`) and
+    continuous-time transfer functions (``poles``, ``zeros``:
+    :func:`gripkit.sysid.tfest.tfest_records`). This is what
+    ``identify([tr1, tr2], method, ...)`` and ``gripkit identify METHOD DATA1 DATA2 ...`` do.
+
+    The model has one operating point: ``detrend='mean'`` removes the mean of all the records
+    together (each channel's samples pooled), stored as ``u_offset``/``y_offset``;
+    ``detrend='none'`` keeps the data as they are. ``'linear'`` is refused: each record's own
+    line would give each record its own operating point, which one model cannot have.
+    ``fit_percent`` per record is in ``info['records']``.
+    """
+    if method not in RECORD_METHODS:
+        raise ArgumentError(f"identify(): several records (a list of {len(data)} trajectories) are "
+                            f"fitted by method {', '.join(map(repr, RECORD_METHODS))} only, found "
+                            f"method {method!r}",
+                            hint=f"pass one trajectory, or use method {', '.join(RECORD_METHODS)}")
+    if not data:
+        raise DataError("data: expected a trajectory or a non-empty list of them, found an empty "
+                        "list")
+    for i, d in enumerate(data):
+        if not isinstance(d, Trajectory):
+            raise DataError(f"data[{i}]: expected a gripkit Trajectory, found {type(d).__name__}",
+                            hint="use gripkit.io.load(path) or "
+                                 "Trajectory.uniform(dt=..., u=..., y=...)")
+    if detrend not in ("mean", "none"):
+        raise DataError(f"detrend: with several records expected 'mean' (one operating point: the "
+                        f"mean of all records) or 'none', found {detrend!r}",
+                        hint="detrend 'linear' would give every record its own operating point; "
+                             "detrend the records before, or use 'mean'")
+    why = f"{method.upper()} identification"
+    if identify_mimo.several(input, output) or method in ("ss", "tf"):
+        if method not in ("arx", "ss", "tf"):
+            raise ArgumentError(f"identify(): several input or output columns with several records "
+                                f"are fitted by method 'arx' or 'ss' only, found method {method!r}",
+                                hint="name one input and one output, or use method 'arx' or 'ss'")
+        ds = [_per_record(i, identify_mimo.mimo_data, d, input, output, "none", why=why)
+              for i, d in enumerate(data)]
+        _same_sampling([(d.dt, d.input_units + d.output_units) for d in ds],
+                       ds[0].inputs + ds[0].outputs)
+        u0, y0 = _pooled_mean([d.u for d in ds]), _pooled_mean([d.y for d in ds])
+        if detrend == "none":
+            u0, y0 = np.zeros_like(u0), np.zeros_like(y0)
+        records = [(d.u - u0, d.y - y0) for d in ds]
+        if method == "ss":
+            return _as_data(identify_mimo.identify_ss_records, records, ds[0], u0, y0, options)
+        if method == "tf":
+            return _as_data(identify_mimo.identify_tf_records, records, ds[0], u0, y0,
+                            options["poles"], options["zeros"])
+        return _as_data(arx_mimo_records, [(d.u - u0, d.y - y0) for d in ds], na, nb, nk,
+                        dt=ds[0].dt, u_offset=tuple(map(float, u0)),
+                        y_offset=tuple(map(float, y0)), **ds[0].signals)
+    (input,) = identify_mimo.parse_names(input, "input")
+    (output,) = identify_mimo.parse_names(output, "output")
+    ios = [_per_record(i, io_data, d, input=input, output=output, detrend="none", why=why)
+           for i, d in enumerate(data)]
+    _same_sampling([(io.dt, (io.input_unit, io.output_unit)) for io in ios],
+                   (ios[0].input, ios[0].output))
+    u0 = float(_pooled_mean([io.u for io in ios])) if detrend == "mean" else 0.0
+    y0 = float(_pooled_mean([io.y for io in ios])) if detrend == "mean" else 0.0
+    meta = dict(ios[0].meta, u_offset=u0, y_offset=y0, dt=ios[0].dt, **options)
+    records = [(io.u - u0, io.y - y0) for io in ios]
+    if method == "arx":
+        return _as_data(arx_records, records, na, nb, nk, **meta)
+    if method == "armax":
+        return _as_data(armax_records, records, na, nb, nc, nk, **meta)
+    return _as_data(oe_records, records, nb, na if nf is None else nf, nk, **meta)
+
+
+def _as_data(fit, records, *args, **kw):
+    """``fit(records, ...)``, its errors naming ``data[i]`` (the caller's list), not
+    ``records[i]``."""
+    try:
+        return fit(records, *args, **kw)
+    except GripkitError as exc:
+        if not exc.message.startswith("records["):
+            raise
+        raise type(exc)("data[" + exc.message[len("records["):], hint=exc.hint) from None
+
+
+def _pooled_mean(xs: list) -> np.ndarray:
+    """The mean of every sample of every record (per column)."""
+    return sum(np.sum(x, axis=0) for x in xs) / sum(x.shape[0] for x in xs)
+
+
+def _same_sampling(props: list, columns: tuple) -> None:
+    """Every record sampled at the first one's interval, in its units, or a DataError."""
+    dt0, units0 = props[0]
+    for i, (dt, units) in enumerate(props[1:], 1):
+        if abs(dt - dt0) > 1e-9 * dt0:
+            raise DataError(f"data[{i}] is sampled at {1 / dt:g} Hz, data[0] at {1 / dt0:g} Hz: "
+                            "the records of one fit must share the sample interval",
+                            hint="resample one of them")
+        for col, a, b in zip(columns, units0, units):
+            if a != b:
+                raise DataError(f"data[{i}]: column {col!r} is in {b!r}, in data[0] in {a!r}: the "
+                                "records of one fit must use the same units",
+                                hint="convert one of them")

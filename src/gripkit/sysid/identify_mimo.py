@@ -22,7 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import AccuracyWarning, DataError, GripkitError, GripkitWarning, IdentificationError
+from ..errors import (AccuracyWarning, ArgumentError, DataError, GripkitError, GripkitWarning,
+                      IdentificationError)
 from ..progress import status
 from ..signals.trajectory import Trajectory
 from .arx_mimo import arx_mimo
@@ -427,3 +428,59 @@ def identify_arx(data: Trajectory, *, input, output, na: int, nb: int, nk: int =
     """MIMO ARX of the named columns (:func:`gripkit.sysid.arx_mimo.arx_mimo`)."""
     d = mimo_data(data, input, output, detrend, why="ARX identification")
     return arx_mimo(d.u, d.y, na, nb, nk, dt=d.dt, u_offset=d.u_offset, y_offset=d.y_offset, **d.signals)
+
+
+#: the options of method 'ss' with several records (``weighting``: the subspace method, n4sid,
+#: moesp or cva, identify()'s own ``method`` being 'ss')
+SS_RECORD_OPTIONS = ("order", "horizon", "feedthrough", "refine", "form", "max_iterations",
+                     "weighting")
+
+
+def identify_ss_records(records: list, d: MimoData, u0, y0, options: dict):
+    """The state-space model of several records: subspace
+    (:func:`gripkit.sysid.subspace.n4sid_records`), then, unless ``refine=False``, PEM with one
+    initial state per record (:func:`gripkit.sysid.pem_ss.pem_records`); the refined model is
+    returned only when its free-run fit of all records (mean over the outputs) is not below the
+    subspace model's, else the subspace model with an AccuracyWarning giving both."""
+    from .pem_ss import pem_records
+    from .subspace import n4sid_records
+
+    other = sorted(set(options) - set(SS_RECORD_OPTIONS))
+    if other:
+        raise ArgumentError(f"identify(method='ss'): with several records the options are "
+                            f"{', '.join(SS_RECORD_OPTIONS)}, found {', '.join(other)}",
+                            hint="pass one trajectory for the other options")
+    rng = parse_order(options.get("order"))
+    if rng is not None and rng[0] != rng[1]:
+        raise ArgumentError(f"identify(method='ss'): with several records the order is one number "
+                            f"or None, found the range {options['order']!r}",
+                            hint="search the order on one record")
+    start = n4sid_records(records, None if rng is None else rng[0],
+                          method=options.get("weighting", "n4sid"), horizon=options.get("horizon"),
+                          feedthrough=options.get("feedthrough", False), dt=d.dt,
+                          u_offset=tuple(map(float, u0)), y_offset=tuple(map(float, y0)),
+                          **d.signals)
+    if not options.get("refine", True):
+        return start
+    iters = options.get("max_iterations", 50)
+    refined = pem_records(start, records, form=options.get("form", "innovation"),
+                          max_iterations=iters)
+    if not refined.info["pem"]["converged"]:
+        warnings.warn(f"identify ss: PEM over the records stopped after {iters} iterations without "
+                      f"converging; raise max_iterations", AccuracyWarning, stacklevel=4)
+    before, after = float(np.mean(start.fit_percent)), float(np.mean(refined.fit_percent))
+    if after < before:
+        warnings.warn(f"identify ss: PEM over the records lowered the free-run fit of all records "
+                      f"from {before:.4g} % (subspace) to {after:.4g} %; the subspace model is "
+                      f"returned", AccuracyWarning, stacklevel=4)
+        return start
+    return refined
+
+
+def identify_tf_records(records: list, d: MimoData, u0, y0, poles: int, zeros: int):
+    """The continuous-time transfer function of several records
+    (:func:`gripkit.sysid.tfest.tfest_records`) around the operating point (u0, y0)."""
+    from .tfest import tfest_records
+
+    return tfest_records(records, poles, zeros, dt=d.dt, u_offset=tuple(map(float, u0)),
+                         y_offset=tuple(map(float, y0)), **d.signals)

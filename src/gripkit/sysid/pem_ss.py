@@ -37,9 +37,10 @@ import scipy.linalg as sla
 from ..errors import DataError, IdentificationError
 from ..lti import StateSpace, Uncertainty, affine_row, flush_tiny
 from .blocked_gram import add_rows, carried_states, carry, row_product, start_sums
-from .linear_model import LinearModel, as_io_matrix, fit_per_output, free_run
+from .linear_model import LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run
+from .validation import records_fit
 
-__all__ = ["pem", "PEM_FORMS", "predictor_x0"]
+__all__ = ["pem", "pem_records", "PEM_FORMS", "predictor_x0"]
 
 PEM_FORMS = ("oe", "innovation")
 _WARM_START_SAMPLES = 20000
@@ -450,3 +451,151 @@ def predictor_x0(A, B, C, D, K, u, y) -> tuple[np.ndarray, np.ndarray]:
     x0 = np.linalg.lstsq(O.reshape(-1, n), e.reshape(-1), rcond=None)[0]
     predict_errors(A, B, C, D, K, x0, u, y, e)
     return x0, e
+
+
+def _records_terms(A, B, C, D, K, x0s, us, ys, entries):
+    """:func:`_gauss_newton_terms` of several records: the errors of each, and H, g over the
+    shared directions and one x0 block per record (that record's rows only)."""
+    n = A.shape[0]
+    d = entries.shape[0]
+    R = len(us)
+    H, g = np.zeros((d + R * n, d + R * n)), np.zeros(d + R * n)
+    es = []
+    for r, (x0, u, y) in enumerate(zip(x0s, us, ys)):
+        e, Hr, gr = _gauss_newton_terms(A, B, C, D, K, x0, u, y, entries)
+        own = np.r_[np.arange(d), d + r * n + np.arange(n)]
+        H[np.ix_(own, own)] += Hr
+        g[own] += gr
+        es.append(e)
+    return es, H, g
+
+
+def _records_loss(A, B, C, D, K, x0s, us, ys) -> float:
+    """Σ over the records of the squared (whitened) prediction errors."""
+    total = 0.0
+    for x0, u, y in zip(x0s, us, ys):
+        e = np.empty(y.shape)
+        predict_errors(A, B, C, D, K, x0, u, y, e)
+        total += float(np.sum(e * e))
+    return total
+
+
+def _lm_records(A, B, C, D, K, x0s, us, ys, feedthrough, innovation, max_iterations, tol):
+    """:func:`_levenberg_marquardt` over several records (shared A, B, C, D, K; one x0 each)."""
+    n = A.shape[0]
+    Vc = _records_loss(A, B, C, D, K, x0s, us, ys)
+    lam, it, converged = 1e-3, 0, False
+    for it in range(1, max_iterations + 1):
+        dA, dB, dC, dD, dK, ent = _directions(A, B, C, D, K, feedthrough, innovation)
+        d = dA.shape[0]
+        _, H, g = _records_terms(A, B, C, D, K, x0s, us, ys, ent)
+        hd = np.maximum(np.diag(H), 1e-300)
+        improved, rel, drop = False, 0.0, 0.0
+        for _ in range(30):
+            try:
+                delta = np.linalg.solve(H + lam * np.diag(hd), g)
+            except np.linalg.LinAlgError:
+                lam *= 10
+                continue
+            th = delta[:d]
+            An, Cn = A + np.tensordot(th, dA, 1), C + np.tensordot(th, dC, 1)
+            Kn = K + np.tensordot(th, dK, 1)
+            if _radius(An) >= 1.0 or (innovation and _radius(An - Kn @ Cn) >= 1.0):
+                lam *= 10
+                continue
+            Bn, Dn = B + np.tensordot(th, dB, 1), D + np.tensordot(th, dD, 1)
+            x0n = [x0 + delta[d + r * n:d + (r + 1) * n] for r, x0 in enumerate(x0s)]
+            Vn = _records_loss(An, Bn, Cn, Dn, Kn, x0n, us, ys)
+            if np.isfinite(Vn) and Vn < Vc:
+                improved, rel, drop = True, (Vc - Vn) / max(Vc, 1e-300), Vc - Vn
+                A, B, C, D, K, x0s, Vc = An, Bn, Cn, Dn, Kn, x0n, Vn
+                lam = max(lam / 5, 1e-12)
+                break
+            lam *= 10
+        if not improved or rel < tol or drop < _NEGLIGIBLE_DROP:
+            converged = True
+            break
+    return A, B, C, D, K, x0s, Vc, it, converged
+
+
+def pem_records(model: LinearModel, records, *, form: str = "innovation",
+                feedthrough: bool | None = None, max_iterations: int = 50,
+                tol: float = 1e-7) -> LinearModel:
+    """:func:`pem` on several records: ``records`` a list of ``(u, y)`` pairs in deviation units
+    (the model's operating point removed). A, B, C, D (and K in innovation form) are shared; every
+    record has its own initial state, estimated with them (started from
+    ``model.info['records'][i]['x0']`` where the model has them, as from
+    :func:`gripkit.sysid.subspace.n4sid_records`, else the starting model's least-squares x0 of
+    each record); the prediction errors of all records,
+    each predictor started at its own first sample, are minimised together by Levenberg-Marquardt.
+    The covariance of the identifiable directions is σ²(JᵀJ)⁻¹ with σ² over Σ N_i·p − d − R·n
+    degrees of freedom. ``fit_percent``: the free run of all records (each from its own x0);
+    ``info['records']``: each record's free-run fit and x0."""
+    if form not in PEM_FORMS:
+        raise DataError(f"form: expected 'oe' or 'innovation', found {form!r}")
+    if not isinstance(model, LinearModel) or not isinstance(model.system, StateSpace) \
+            or not model.system.is_discrete:
+        raise DataError("model: expected a discrete state-space LinearModel (e.g. from "
+                        "gripkit.sysid.subspace.n4sid_records)")
+    if not isinstance(records, (list, tuple)) or not records:
+        raise DataError(f"records: expected a non-empty list of (u, y) pairs, "
+                        f"found {records!r:.60}")
+    data = [_pem_data(model, None, u, y) for u, y in records]
+    ss = model.system
+    innovation = form == "innovation"
+    feedthrough = bool(np.any(ss.D != 0)) if feedthrough is None else bool(feedthrough)
+    A, B, C, D, K, _ = _pem_start(model, data[0][0], data[0][1], feedthrough, innovation)
+    given = model.info.get("records")
+    n = ss.n_states
+    if given and len(given) == len(data):
+        x0s = [np.array(r["x0"], dtype=np.float64) for r in given]
+    elif len(data) == 1 and model.x0 is not None:  # as pem() starts
+        x0s = [np.array(model.x0, dtype=np.float64)]
+    else:  # each record's least-squares initial state under the starting model
+        x0s = [estimate_x0(A, B, C, D, u, y) for u, y in data]
+    us = [np.ascontiguousarray(u) for u, _ in data]
+    es = []
+    for x0, u, y in zip(x0s, us, (y for _, y in data)):
+        e = np.empty(y.shape)
+        predict_errors(A, B, C, D, K, x0, u, y, e)
+        es.append(e)
+    E = np.vstack(es)
+    w, V = np.linalg.eigh(E.T @ E / E.shape[0])
+    if w.min() <= 0:
+        raise IdentificationError("pem: the starting model predicts an output exactly (zero "
+                                  "error variance)")
+    W, Winv = (V / np.sqrt(w)) @ V.T, (V * np.sqrt(w)) @ V.T
+    yws = [np.ascontiguousarray(y @ W.T) for _, y in data]
+    C, D, K = W @ C, W @ D, K @ Winv
+    V0 = _records_loss(A, B, C, D, K, x0s, us, yws)
+    A, B, C, D, K, x0s, Vc, it, converged = _lm_records(A, B, C, D, K, x0s, us, yws, feedthrough,
+                                                       innovation, max_iterations, tol)
+    dA, dB, dC, dD, dK, ent = _directions(A, B, C, D, K, feedthrough, innovation)
+    es, H, _ = _records_terms(A, B, C, D, K, x0s, us, yws, ent)
+    N = sum(u.shape[0] for u in us)
+    p, d, R = yws[0].shape[1], dA.shape[0], len(us)
+    dof = N * p - d - R * n
+    if dof <= 0:
+        raise DataError(f"pem: {N} samples of {p} output(s) cannot determine {d + R * n} "
+                        f"parameters", hint="use longer records or a lower order")
+    try:
+        cov = float(sum(np.sum(e * e) for e in es)) / dof * np.linalg.inv(H)[:d, :d]
+    except np.linalg.LinAlgError:
+        raise IdentificationError("pem: the Jacobian is singular at the optimum: the data do not "
+                                  "determine the model", hint="lower the order") from None
+    C, D, K = Winv @ C, Winv @ D, K @ W
+    dC, dD = np.einsum("ij,qjk->qik", Winv, dC), np.einsum("ij,qjk->qik", Winv, dD)
+    E = np.vstack(es) @ Winv.T
+    unc = Uncertainty(tuple(f"theta{i}" for i in range(d)), 0.5 * (cov + cov.T), (dA, dB, dC, dD))
+    sysn = StateSpace(A, B, C, D, **ss._signals(meta={**ss.meta, "refined_by": f"pem-{form}"}),
+                      states=ss.states, state_units=ss.state_units, uncertainty=unc)
+    ys = [y for _, y in data]
+    yhats = [free_run(A, B, C, D, u, x0) for u, x0 in zip(us, x0s)]
+    recs = [{"n_samples": int(y.shape[0]), "fit_percent": fit_per_output(y, yh), "x0": x0}
+            for y, yh, x0 in zip(ys, yhats, x0s)]
+    info = {**model.info, "records": recs, "n_records": R,
+            "pem": {"form": form, "iterations": it, "converged": converged, "loss_start": V0 / N,
+                    "loss": Vc / N, "parameters": d, "feedthrough": feedthrough}}
+    return model.replace(system=sysn, structure=f"pem-{form}", K=K if innovation else None,
+                         x0=x0s[0], noise_covariance=E.T @ E / N, fit_percent=records_fit(ys, yhats).tolist(),
+                         n_samples=N, info=info)

@@ -46,8 +46,10 @@ from .blocked_gram import add_rows, carried_states, carry, row_product, start_su
 from .checks import check_dt
 from .linear_model import LinearModel, as_io_matrix, fit_per_output, free_run, observability_regressor
 from .regression import _qr_r
+from .validation import records_fit
 
-__all__ = ["n4sid", "moesp", "SUBSPACE_METHODS", "default_horizon", "subspace_factor", "SubspaceFactor"]
+__all__ = ["n4sid", "n4sid_records", "moesp", "SUBSPACE_METHODS", "default_horizon",
+           "subspace_factor", "SubspaceFactor", "RecordsFactor"]
 
 SUBSPACE_METHODS = ("n4sid", "moesp", "cva")
 DEFAULT_MAX_ORDER = 10
@@ -105,6 +107,13 @@ class SubspaceFactor:
             Z[:, a + b + i * p:a + b + (i + 1) * p] = ys[k + i:k + i + j]  # Y_f
         L = _lower_factor(Z)
         del Z
+        self._weighted_svd(L)
+        self.j = j
+
+    def _weighted_svd(self, L: np.ndarray) -> None:
+        """From the LQ factor ``L``: L32 L22⁻¹, the method's weighted matrix and its SVD."""
+        k, m, p, method = self.k, self.m, self.p, self.method
+        a, b = k * m, k * (m + p)
         L21, L22 = L[a:a + b, :a], L[a:a + b, a:a + b]
         L32, L33 = L[a + b:, a:a + b], L[a + b:, a + b:]
         self.L32_L22inv = np.linalg.lstsq(L22.T, L32.T, rcond=1e-12)[0].T  # L32 L22⁻¹
@@ -121,7 +130,6 @@ class SubspaceFactor:
             self.W1inv = (V * np.sqrt(w)) @ V.T
             M = W1 @ L32
         self.U, self.s, _ = np.linalg.svd(M, full_matrices=False)
-        self.j = j
 
     def gamma(self, n: int) -> np.ndarray:
         G = self.U[:, :n] * np.sqrt(self.s[:n])
@@ -291,26 +299,9 @@ def _kalman_gain(A, C, Q, S, R):
 def from_factor(fac: SubspaceFactor, n: int, *, dt: float, feedthrough: bool = False, stable: bool = True,
                 signals: dict | None = None, meta: dict | None = None) -> LinearModel:
     """The order-n model from a factored data set (see the module docstring)."""
-    _check_supported(fac, n)
     p, m = fac.p, fac.m
-    G = fac.gamma(n)
-    C = G[:p].copy()
-    A = np.linalg.lstsq(G[:-p], G[p:], rcond=None)[0]
-    info = {"method": fac.method, "horizon": fac.k, "hankel_columns": fac.j}
-    rho = float(np.max(np.abs(np.linalg.eigvals(A))))
-    if rho >= 1.0:
-        if stable:
-            info["stabilised"] = {"largest_pole_before": rho,
-                                  "fit_percent_before": _unstable_fit(fac, A, C, feedthrough)}
-            A = np.linalg.lstsq(G, np.vstack([G[p:], np.zeros((p, n))]), rcond=None)[0]
-            info["stability"] = (f"shift-invariance estimate unstable (largest |pole| {rho:.4g}); replaced by "
-                                 "A = Γ⁺[Γ↓; 0], stable by construction (Chui & Maciejowski 1996)")
-        else:
-            info["stability"] = f"unstable model kept as asked (largest |pole| {rho:.4g})"
-            warnings.warn(f"subspace: the order-{n} model is unstable (largest |pole| {rho:.4g})", StabilityWarning,
-                          stacklevel=3)
-    else:
-        info["stability"] = "stable (shift-invariance estimate)"
+    G, A, C, info = _shift_invariance(fac, n, stable,
+                                      lambda A, C: _unstable_fit(fac, A, C, feedthrough))
     us, ys = fac.us, fac.ys
     N = us.shape[0]
     theta = _bdx_least_squares(A, C, us, ys, feedthrough)
@@ -348,6 +339,34 @@ def from_factor(fac: SubspaceFactor, n: int, *, dt: float, feedthrough: bool = F
     fit = fit_per_output(fac.y, yhat)
     return LinearModel(sys, fac.method, K=K, x0=x0s, noise_covariance=Lam, fit_percent=fit,
                        singular_values=fac.s.copy(), n_samples=N, info=info)
+
+
+def _shift_invariance(fac, n: int, stable: bool, unstable_fit):
+    """(Γ, A, C, info) of the order-n model: C = Γ[0:p], A = Γ_↑⁺ Γ_↓, or, when that A is
+    unstable and ``stable``, the stable A = Γ⁺[Γ_↓; 0] (``unstable_fit(A, C)``: the free-run fit
+    of the unstable estimate, recorded)."""
+    _check_supported(fac, n)
+    p = fac.p
+    G = fac.gamma(n)
+    C = G[:p].copy()
+    A = np.linalg.lstsq(G[:-p], G[p:], rcond=None)[0]
+    info = {"method": fac.method, "horizon": fac.k, "hankel_columns": fac.j}
+    rho = float(np.max(np.abs(np.linalg.eigvals(A))))
+    if rho >= 1.0:
+        if stable:
+            info["stabilised"] = {"largest_pole_before": rho,
+                                  "fit_percent_before": unstable_fit(A, C)}
+            A = np.linalg.lstsq(G, np.vstack([G[p:], np.zeros((p, n))]), rcond=None)[0]
+            info["stability"] = (f"shift-invariance estimate unstable (largest |pole| {rho:.4g}); "
+                                 "replaced by A = Γ⁺[Γ↓; 0], stable by construction (Chui & "
+                                 "Maciejowski 1996)")
+        else:
+            info["stability"] = f"unstable model kept as asked (largest |pole| {rho:.4g})"
+            warnings.warn(f"subspace: the order-{n} model is unstable (largest |pole| {rho:.4g})",
+                          StabilityWarning, stacklevel=4)
+    else:
+        info["stability"] = "stable (shift-invariance estimate)"
+    return G, A, C, info
 
 
 def _unstable_fit(fac: SubspaceFactor, A, C, feedthrough: bool) -> list[float]:
@@ -451,3 +470,182 @@ def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int
 def moesp(u, y, order: int | None = None, **options) -> LinearModel:
     """PO-MOESP: :func:`n4sid` with ``method='moesp'``."""
     return n4sid(u, y, order, method="moesp", **options)
+
+
+class RecordsFactor(SubspaceFactor):
+    """:class:`SubspaceFactor` of several records: the block-Hankel rows (one per time with a
+    full past and future window) of every record stacked, none reaching across from one record
+    into the next; one scaling (the RMS of all records) for all. ``us``, ``ys`` are then lists
+    (one array per record) and ``records`` the records as given."""
+
+    def __init__(self, records, k, method):
+        self.records, self.k, self.method = records, k, method
+        m, p = records[0][0].shape[1], records[0][1].shape[1]
+        self.m, self.p = m, p
+        N = sum(u.shape[0] for u, _ in records)
+        self.su = np.sqrt(sum(np.sum(u * u, axis=0) for u, _ in records) / N)
+        self.sy = np.sqrt(sum(np.sum(y * y, axis=0) for _, y in records) / N)
+        self.us = [u / self.su for u, _ in records]
+        self.ys = [y / self.sy for _, y in records]
+        self.js = [u.shape[0] - 2 * k + 1 for u, _ in records]
+        j = sum(self.js)
+        Z = np.empty((j, 2 * k * (m + p)), order="F")
+        a, b = k * m, k * (m + p)
+        row = 0
+        for us, ys, ji in zip(self.us, self.ys, self.js):
+            r = slice(row, row + ji)
+            for i in range(k):
+                Z[r, i * m:(i + 1) * m] = us[k + i:k + i + ji]
+                Z[r, a + i * m:a + (i + 1) * m] = us[i:i + ji]
+                Z[r, a + k * m + i * p:a + k * m + (i + 1) * p] = ys[i:i + ji]
+                Z[r, a + b + i * p:a + b + (i + 1) * p] = ys[k + i:k + i + ji]
+            row += ji
+        L = _lower_factor(Z)
+        del Z
+        self._weighted_svd(L)
+        self.j = j
+
+    def past_windows_of(self, r: int, M: np.ndarray) -> np.ndarray:
+        """W_p Mᵀ of record ``r`` (rows: its times k … k + j_r − 1)."""
+        k, m, p, j = self.k, self.m, self.p, self.js[r]
+        us, ys = self.us[r], self.ys[r]
+        out = np.zeros((j, M.shape[0]))
+        for i in range(k):
+            out += us[i:i + j] @ M[:, i * m:(i + 1) * m].T
+            out += ys[i:i + j] @ M[:, k * m + i * p:k * m + (i + 1) * p].T
+        return out
+
+
+def _bdx_records(A, C, us, ys, feedthrough: bool) -> tuple[np.ndarray, list[np.ndarray]]:
+    """θ = (vec(B) row-major, vec(D)) shared by all records and one x0 per record, minimising
+    Σ_r ‖y_r − Φ_r θ‖: the normal equations of every record (:func:`_bdx_normal_equations`)
+    assembled, the x0 columns of each record its own block; on column-scaled equations when their
+    condition number stays below 1e8, else ``gelsy`` on the stacked regressors."""
+    n, m, p = A.shape[0], us[0].shape[1], C.shape[0]
+    s = n * m + (p * m if feedthrough else 0)  # shared columns
+    R = len(us)
+    cols = s + R * n
+    G, rhs = np.zeros((cols, cols)), np.zeros(cols)
+    Gi, ri = np.empty((s + n, s + n)), np.empty(s + n)
+    for r, (u, y) in enumerate(zip(us, ys)):
+        _bdx_normal_equations(np.ascontiguousarray(A), np.ascontiguousarray(C), u, y, feedthrough,
+                              Gi, ri)
+        own = np.r_[np.arange(s), s + r * n + np.arange(n)]
+        G[np.ix_(own, own)] += Gi
+        rhs[own] += ri
+    col = np.sqrt(np.diag(G)).copy()
+    col[col == 0] = 1.0
+    Gs = G / np.outer(col, col)
+    w = np.linalg.eigvalsh(Gs)
+    if w[0] > 1e-8 * w[-1]:
+        theta = sla.cho_solve(sla.cho_factor(Gs), rhs / col) / col
+    else:
+        blocks = []
+        for r, (u, y) in enumerate(zip(us, ys)):
+            Phi = _bdx_regressor(A, C, u, feedthrough)
+            full = np.zeros((Phi.shape[0], cols))
+            full[:, :s] = Phi[:, :s]
+            full[:, s + r * n:s + (r + 1) * n] = Phi[:, s:]
+            blocks.append(full)
+        theta = sla.lstsq(np.vstack(blocks), np.concatenate([y.reshape(-1) for y in ys]),
+                          lapack_driver="gelsy", check_finite=False)[0]
+    return theta[:s], [theta[s + r * n:s + (r + 1) * n] for r in range(R)]
+
+
+def from_records_factor(fac: RecordsFactor, n: int, *, dt: float, feedthrough: bool = False,
+                        stable: bool = True, signals: dict | None = None) -> LinearModel:
+    """:func:`from_factor` for several records: A, C from the pooled factor; B, D shared and one
+    x0 per record by least squares over all records; the noise model from the state sequences of
+    every record. ``fit_percent``: the free run of all records per output, each from its own x0
+    (:func:`~gripkit.sysid.validation.records_fit`); ``info['records']``: each record's samples,
+    free-run fit and x0 (the model's ``x0`` is the first record's)."""
+    p, m = fac.p, fac.m
+
+    def unstable_fit(A, C):
+        return [-math.inf] * p  # not simulated: an unstable free run over several records
+
+    G, A, C, info = _shift_invariance(fac, n, stable, unstable_fit)
+    shared, x0s = _bdx_records(A, C, fac.us, fac.ys, feedthrough)
+    Bs = shared[:n * m].reshape(n, m)
+    Ds = shared[n * m:].reshape(p, m) if feedthrough else np.zeros((p, m))
+    Mx = np.linalg.pinv(G) @ fac.L32_L22inv
+    ws, vs = [], []
+    for r, (us, ys) in enumerate(zip(fac.us, fac.ys)):
+        X = fac.past_windows_of(r, Mx)
+        t = np.arange(fac.k, fac.k + X.shape[0] - 1)
+        ws.append(X[1:] - X[:-1] @ A.T - us[t] @ Bs.T)
+        vs.append(ys[t] - X[:-1] @ C.T - us[t] @ Ds.T)
+    w, v = np.vstack(ws), np.vstack(vs)
+    nw = w.shape[0]
+    Ks, Lam = _kalman_gain(A, C, w.T @ w / nw, w.T @ v / nw, v.T @ v / nw)
+    if Ks is None:
+        info["noise_model"] = ("Riccati equation without a stabilising solution: K = 0 "
+                               "(output-error form)")
+        Ks, Lam = np.zeros((n, p)), v.T @ v / nw
+    su, sy = fac.su, fac.sy
+    yhats = [free_run(A, Bs, C, Ds, us, x0) * sy for us, x0 in zip(fac.us, x0s)]
+    ys = [y for _, y in fac.records]
+    info["n_records"] = len(ys)
+    info["records"] = [{"n_samples": int(y.shape[0]), "fit_percent": fit_per_output(y, yh),
+                        "x0": x0} for y, yh, x0 in zip(ys, yhats, x0s)]
+    sys = StateSpace(A, Bs / su, C * sy[:, None], Ds * sy[:, None] / su, dt=dt,
+                     meta={"identified_by": fac.method}, **dict(signals or {}))
+    return LinearModel(sys, fac.method, K=Ks / sy, x0=x0s[0],
+                       noise_covariance=Lam * np.outer(sy, sy),
+                       fit_percent=records_fit(ys, yhats).tolist(), singular_values=fac.s.copy(),
+                       n_samples=int(sum(y.shape[0] for y in ys)), info=info)
+
+
+def n4sid_records(records, order: int | None = None, *, method: str = "n4sid",
+                  horizon: int | None = None, dt: float | None = None, feedthrough: bool = False,
+                  stable: bool = True, max_order: int = DEFAULT_MAX_ORDER, inputs=None,
+                  outputs=None, input_units=None, output_units=None, u_offset=None,
+                  y_offset=None) -> LinearModel:
+    """:func:`n4sid` of several records at once: ``records`` a list of ``(u, y)`` pairs (u (N_i, m),
+    y (N_i, p)) around one common operating point. The block-Hankel data matrices of every record
+    are stacked (:class:`RecordsFactor`: no Hankel column reaches across from one record into the
+    next, each record has its own initial state), A and C come from their one factorisation, B and
+    D from all records with one x0 per record (estimated); see :func:`from_records_factor` for
+    the fits. Each record needs at least 2k samples (k the horizon)."""
+    if method not in SUBSPACE_METHODS:
+        raise DataError(f"method: expected one of {', '.join(SUBSPACE_METHODS)}, found {method!r}")
+    if not isinstance(records, (list, tuple)) or not records:
+        raise DataError(f"records: expected a non-empty list of (u, y) pairs, "
+                        f"found {records!r:.60}")
+    recs = []
+    for i, r in enumerate(records):
+        if not (isinstance(r, (tuple, list)) and len(r) == 2):
+            raise DataError(f"records[{i}]: expected a (u, y) pair, found {type(r).__name__}")
+        u = as_io_matrix(r[0], f"records[{i}] input u")
+        recs.append((u, as_io_matrix(r[1], f"records[{i}] output y", u.shape[0])))
+    m, p = recs[0][0].shape[1], recs[0][1].shape[1]
+    for i, (u, y) in enumerate(recs):
+        if (u.shape[1], y.shape[1]) != (m, p):
+            raise DataError(f"records[{i}]: expected {m} input and {p} output columns as "
+                            f"records[0], found {u.shape[1]} and {y.shape[1]}")
+    step = check_dt(dt)
+    if order is not None:
+        if isinstance(order, bool) or not float(order).is_integer() or int(order) < 1:
+            raise DataError(f"order: expected a positive integer, found {order!r}")
+        order = int(order)
+    n_max = order if order is not None else int(max_order)
+    k = default_horizon(n_max, p) if horizon is None else int(horizon)
+    for i, (u, _) in enumerate(recs):
+        if u.shape[0] < 2 * k:
+            raise DataError(f"records[{i}]: {u.shape[0]} samples, fewer than the 2k = {2 * k} of "
+                            f"one past and future window (horizon k = {k})",
+                            hint="drop the short record or pass a smaller horizon/order")
+    j, q = sum(u.shape[0] - 2 * k + 1 for u, _ in recs), 2 * k * (m + p)
+    if j < 2 * q:
+        raise DataError(f"records: {j} Hankel columns in all with horizon k = {k}, fewer than the "
+                        f"{2 * q} needed (2 × 2k(m + p))",
+                        hint="use longer records or a smaller order")
+    fac = RecordsFactor(recs, k, method)
+    n = order if order is not None else select_order(fac.s, min(n_max, fac.s.size - 1))
+    signals = dict(inputs=inputs, outputs=outputs, input_units=input_units,
+                   output_units=output_units)
+    model = from_records_factor(fac, n, dt=step, feedthrough=feedthrough, stable=stable,
+                                signals=signals)
+    model.info["order_selection"] = ("given" if order is not None
+                                     else "singular values above the noise floor")
+    return model.replace(u_offset=u_offset, y_offset=y_offset)

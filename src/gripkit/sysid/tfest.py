@@ -32,8 +32,9 @@ from ..lti import StateSpace, TransferFunction
 from .checks import check_dt, check_order, check_persistent_excitation
 from .frf import FRF, frf
 from .linear_model import LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run
+from .validation import records_fit
 
-__all__ = ["tfest", "tfest_frf", "modal_parameters"]
+__all__ = ["tfest", "tfest_records", "tfest_frf", "modal_parameters"]
 
 
 def _check_orders(n_poles, n_zeros):
@@ -294,3 +295,81 @@ def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None,
     return _model(theta, 0.5 * (cov + cov.T), npo, nz, fit=fit, structure="tfest",
                   info={"source": "time domain (zero-order hold, output error from rest)", "nfev": int(sol.nfev)},
                   signals=signals, u_offset=u_offset, y_offset=y_offset, n=N)
+
+
+def tfest_records(records, n_poles: int, n_zeros: int, *, dt: float | None = None,
+                  inputs=None, outputs=None, input_units=None, output_units=None, u_offset=None,
+                  y_offset=None) -> LinearModel:
+    """:func:`tfest` of several records at once: ``records`` a list of ``(u, y)`` pairs (one input,
+    one output, deviation units around one common operating point). Every record's output error
+    ``y_i − ŷ_i(θ, x0_i)`` is taken from its own initial state x0_i, the least-squares one for
+    the current θ (variable projection: the output is linear in x0, so each x0_i is solved for
+    inside the residual and the Jacobian of the projected residual gives θ's covariance); the
+    errors of all records are minimised together, σ̂² = RSS/(Σ N_i − dim θ − R·n). Start: the
+    FRF fit of the H1 estimate of the longest record. ``fit_percent``: the free run of all
+    records (each from its own x0); ``info['records']``: each record's samples, fit and x0 (in
+    the coordinates of the model's zero-order-hold state space, ``tf2ss``)."""
+    npo, nz = _check_orders(n_poles, n_zeros)
+    if not isinstance(records, (list, tuple)) or not records:
+        raise DataError(f"records: expected a non-empty list of (u, y) pairs, "
+                        f"found {records!r:.60}")
+    recs = []
+    for i, r in enumerate(records):
+        if not (isinstance(r, (tuple, list)) and len(r) == 2):
+            raise DataError(f"records[{i}]: expected a (u, y) pair, found {type(r).__name__}")
+        u = as_io_matrix(r[0], f"records[{i}] input u")
+        y = as_io_matrix(r[1], f"records[{i}] output y", u.shape[0])
+        if u.shape[1] != 1 or y.shape[1] != 1:
+            raise DataError(f"records[{i}]: expected one input and one output, found {u.shape[1]} "
+                            f"and {y.shape[1]}", hint="estimate one input-output pair at a time")
+        if u.shape[0] <= npo:
+            raise DataError(f"records[{i}]: {u.shape[0]} samples cannot determine its own "
+                            f"{npo}-state initial condition", hint="drop the short record")
+        recs.append((u, y))
+    step = check_dt(dt)
+    N = sum(u.shape[0] for u, _ in recs)
+    k = npo + nz + 1
+    if N < 10 * k + 64 + len(recs) * npo:
+        raise DataError(f"tfest: {N} samples in all are too few for {k} coefficients and "
+                        f"{len(recs)} initial states",
+                        hint="use longer records or fewer poles/zeros")
+    check_persistent_excitation(np.concatenate([u[:, 0] for u, _ in recs]), k,
+                                f"tfest ({npo} poles, {nz} zeros: {k} coefficients)")
+    ul, yl = max(recs, key=lambda r: r[0].shape[0])
+    start = tfest_frf(frf(ul, yl, dt=step, nperseg=max(64, min(ul.shape[0] // 4, 2048))), npo, nz,
+                      dt=step)
+    th0 = _stabilise(np.concatenate([start.system.denominator()[1:],
+                                     start.system.numerator()[-(nz + 1):]]), npo)
+    scale = np.abs(th0) + 1e-8
+    peak = max(float(np.abs(y).max()) for _, y in recs)
+
+    def runs(theta):
+        Ad, Bd, Cd, Dd = _simulate_ct(theta, npo, nz, None, step)
+        x0s = [estimate_x0(Ad, Bd, Cd, Dd, u, y) for u, y in recs]
+        return [free_run(Ad, Bd, Cd, Dd, u, x0)[:, 0] for (u, _), x0 in zip(recs, x0s)], x0s
+
+    def res(z):
+        theta = z * scale
+        if np.any(np.roots(np.concatenate([[1.0], theta[:npo]])).real >= 0):
+            return np.full(N, 1e3 * (peak + 1.0))
+        yh, _ = runs(theta)
+        return np.concatenate([y[:, 0] - h for (_, y), h in zip(recs, yh)])
+
+    sol = optimize.least_squares(res, th0 / scale, method="trf", x_scale="jac", xtol=1e-10,
+                                 ftol=1e-10)
+    theta = sol.x * scale
+    J = sol.jac / scale[None, :]
+    dof = N - k - len(recs) * npo
+    cov = _covariance(J, 2 * sol.cost / dof, "the data", "fewer poles/zeros or a richer input")
+    yh, x0s = runs(theta)
+    ys = [y for _, y in recs]
+    yhats = [h[:, None] for h in yh]
+    info = {"source": "time domain (zero-order hold, output error from each record's least-squares "
+                      "initial state)", "nfev": int(sol.nfev), "n_records": len(recs),
+            "records": [{"n_samples": int(y.shape[0]), "fit_percent": fit_per_output(y, h),
+                         "x0": x0} for y, h, x0 in zip(ys, yhats, x0s)]}
+    signals = dict(inputs=inputs, outputs=outputs, input_units=input_units,
+                   output_units=output_units)
+    return _model(theta, 0.5 * (cov + cov.T), npo, nz, fit=records_fit(ys, yhats).tolist(),
+                  structure="tfest", info=info, signals=signals, u_offset=u_offset,
+                  y_offset=y_offset, n=N)

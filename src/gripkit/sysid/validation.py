@@ -29,8 +29,8 @@ import numpy as np
 from ..errors import DataError, StabilityWarning
 from .checks import check_io
 
-__all__ = ["fit_percent", "loss_vn", "Comparison", "compare", "ResidualTests", "residual_tests",
-           "Validation", "validate"]
+__all__ = ["fit_percent", "records_fit", "loss_vn", "Comparison", "compare", "ResidualTests",
+           "residual_tests", "Validation", "validate"]
 
 
 def loss_vn(e: np.ndarray) -> float:
@@ -47,6 +47,18 @@ def fit_percent(y, yhat) -> float:
     if den == 0.0:
         raise DataError("the fit is undefined for a constant output (‖y − ȳ‖ = 0)")
     return 100.0 * (1.0 - float(np.linalg.norm(y - yhat)) / den)
+
+
+def records_fit(ys: list, yhats: list) -> np.ndarray:
+    """Fit (%) of several records together, per column: ``100 (1 − √(Σ_i ‖y_i − ŷ_i‖²) /
+    √(Σ_i ‖y_i − ȳ_i‖²))``, every record about its own mean ȳ_i (records at different operating
+    levels do not inflate it); with one record it is :func:`fit_percent`."""
+    num = sum(np.sum((np.asarray(y) - np.asarray(h)) ** 2, axis=0) for y, h in zip(ys, yhats))
+    den = sum(np.sum((np.asarray(y) - np.mean(y, axis=0)) ** 2, axis=0) for y in ys)
+    if np.any(den == 0.0):
+        raise DataError("the fit is undefined for an output constant in every record "
+                        "(Σ‖y − ȳ‖² = 0)")
+    return 100.0 * (1.0 - np.sqrt(num) / np.sqrt(den))
 
 
 @dataclass(frozen=True)
