@@ -3,9 +3,10 @@
 Two front ends share one numba kernel and one state vector:
 
 * :class:`RLS`, a streaming estimator for a control loop: ``e = est.update(u, y)`` per sample
-  (a few hundred nanoseconds: one call into a compiled kernel working in place). A NaN/inf sample,
-  a corrupt one (:data:`ABSURD_JUMP`), a divergence or an overflow raises and leaves θ and P as
-  they were (the kernel keeps a backup);
+  (a few hundred nanoseconds: one call into a kernel compiled for the model structure, working in
+  place). A NaN/inf sample, a corrupt one (:data:`ABSURD_JUMP`), a divergence or an overflow
+  raises and leaves θ and P as they were (the kernel updates in place only when a bound shows
+  that no value can overflow, else from a backup);
 * :func:`rls`, the batch form, which returns θ and σ at every step (:class:`RLSResult`).
 
 At each sample t with regressor φ(t) = [−y(t−1) … −y(t−na), u(t−nk) … u(t−nk−nb+1)] (eq 21)::
@@ -445,6 +446,10 @@ class RLS:
     Use ``e = est.update(u_t, y_t)`` once per sample (returns the a-priori prediction error,
     0 during the first ``max(na, nk+nb−1)`` samples), read ``est.theta``, ``est.theta_std``,
     ``est.P``, ``est.model()``. ``est.run(u, y)`` processes a whole record from the current state.
+
+    ``update`` runs a step compiled for the model structure (:func:`_step_entry`): the first
+    update of a structure on a machine compiles it (2–4 s; numba caches it on disk, later
+    processes load it in milliseconds), so call ``update`` once before a timed loop starts.
     """
 
     __slots__ = ("na", "nb", "nk", "forgetting", "windup", "dt", "_s", "_p0", "_theta0", "_maxtr",
