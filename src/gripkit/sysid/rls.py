@@ -310,7 +310,10 @@ def _step_entry(na: int, nb: int, nk: int):
             return _rls_step(s, u, y, size)
         sig = (types.float64[::1], types.float64, types.float64)
         step.compile(sig)
-        fn = _STEPS[key] = getattr(step.overloads.get(sig), "entry_point", step)
+        fn = getattr(step.overloads.get(sig), "entry_point", step)
+        _STEPS[key] = fn, step  # the dispatcher too: it owns the compiled code
+    else:
+        fn = fn[0]
     return fn
 
 
