@@ -39,6 +39,30 @@ def test_streaming_update_equals_batch_kernel_bit_for_bit():
     assert s.n_updates == 2500 - 3 and s.ready
 
 
+def test_streaming_update_with_huge_covariance_equals_batch_kernel():
+    """With P0 = 10³⁰⁰·I the streaming step cannot show beforehand that its update stays finite
+    (its bound (max|P| + |coef|·max|q|²)·p exceeds 1e300), so it backs θ and P up and updates
+    them from there; the result is still the batch kernel's, bit for bit, and a sample that
+    overflows φᵀPφ is refused with the estimator unchanged."""
+    u, y = simulate_arx(400, noise=1.0, seed=26)
+    u, y = 1e-3 * u, 1e-3 * y
+    s = RLS(2, 2, 2, forgetting=0.99, p0=1e300, windup="none")
+    errs = [s.update(float(a), float(b)) for a, b in zip(u, y)]
+    b = RLS(2, 2, 2, forgetting=0.99, p0=1e300, windup="none")
+    res = b.run(u, y)
+    np.testing.assert_array_equal(s.theta, b.theta)
+    np.testing.assert_array_equal(s.P, b.P)
+    np.testing.assert_array_equal(np.asarray(errs), res.errors)
+    fresh = RLS(2, 2, 2, p0=1e300)
+    for _ in range(3):  # fill the regressor: no update yet
+        fresh.update(1e4, 1e4)
+    theta, P = fresh.theta, fresh.P
+    with pytest.raises(IdentificationError, match="φᵀPφ overflows"):
+        fresh.update(1e4, 1e4)  # φᵀPφ = 1e300·4e8: beyond float64
+    np.testing.assert_array_equal(fresh.theta, theta)
+    np.testing.assert_array_equal(fresh.P, P)
+
+
 def _textbook_rls(u, y, lam, p0, windup, max_trace=None):
     """The module docstring's updates written with numpy matrices, one sample at a time: gain
     K = Pφ/(λ + r), exponential forgetting P ← (P − PφφᵀP/(λ + r))/λ (bounded trace for 'trace'),

@@ -3,9 +3,10 @@
 Two front ends share one numba kernel and one state vector:
 
 * :class:`RLS`, a streaming estimator for a control loop: ``e = est.update(u, y)`` per sample
-  (a few hundred nanoseconds: one call into a compiled kernel working in place). A NaN/inf sample,
-  a corrupt one (:data:`ABSURD_JUMP`), a divergence or an overflow raises and leaves θ and P as
-  they were (the kernel keeps a backup);
+  (a few hundred nanoseconds: one call into a kernel compiled for the model structure, working in
+  place). A NaN/inf sample, a corrupt one (:data:`ABSURD_JUMP`), a divergence or an overflow
+  raises and leaves θ and P as they were (the kernel updates in place only when a bound shows
+  that no value can overflow, else from a backup);
 * :func:`rls`, the batch form, which returns θ and σ at every step (:class:`RLSResult`).
 
 At each sample t with regressor φ(t) = [−y(t−1) … −y(t−na), u(t−nk) … u(t−nk−nb+1)] (eq 21)::
@@ -46,7 +47,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
+from numba import njit, types
 from numba.core.errors import TypingError
 
 from ..arguments import entry_point
@@ -71,31 +72,38 @@ SPECIALISE_ABOVE = 100_000
 ABSURD_JUMP = 1e10
 
 
-@njit(cache=True, inline="always")
-def _core(Pb, thb, phb, qb, at, p, size, lam, mode, maxtr, trace, y):
-    """One RLS update of θ (``thb[oth:oth + p]``) and P (``Pb[oP:oP + p·p]``, row-major) for the
-    regressor ``phb[oph:oph + p]`` and output ``y``; ``qb[oq:oq + p]`` is work space; ``at`` holds
-    the offsets ``(oP, oth, oph, oq)`` (a tuple: the kernel is inlined, so it costs nothing). Returns
-    (a-priori error, r = φᵀPφ, trace). The batch kernel passes one local buffer four times with
-    constant offsets (the compiler then sees that the vectors do not overlap), the streaming step
-    views of its state vector at offset 0.
+#: The streaming step updates θ and P in place only when every new value is provably below this
+#: bound (then no entry, nor the trace, can overflow); otherwise it backs them up first.
+_SAFE_BOUND = 1e300
 
-    ``size``: an empty tuple (p at run time) or a tuple of p zeros (p known to the compiler, loops
-    unrolled). The covariance update is ``P ← (P + coef·q qᵀ)·scale`` with ``q = Pφ`` (see the
-    module docstring for ``coef``, ``scale`` and the three ``windup`` modes).
-    """
+
+@njit(cache=True, inline="always")
+def _gain(Pb, thb, phb, qb, at, p, size, lam, mode, trace, y, guard):
+    """The first half of :func:`_core` (``at`` = the offsets ``(oP, oth, oph, oq)``, a tuple: the
+    kernel is inlined): the a-priori error e, q = Pφ (into ``qb[oq:oq + p]``),
+    r = φᵀPφ and the coefficients of the update. With ``guard`` (a literal) also a bound on every
+    value the second half (:func:`_apply`) will write: ``safe`` is True when e and r are finite
+    and all new entries of θ and P stay below :data:`_SAFE_BOUND`/p, so that the update cannot
+    overflow (|P_ij + c q_i q_j|·s <= (max|P| + |c| max|q|²)·s, |θ_i + q_i g| <= max|θ| +
+    max|q|·|g|; r finite implies q finite). Returns (e, r, coef, scale, g, safe)."""
     oP, oth, oph, oq = at
     if len(size) > 0:
         p = len(size)
     yhat = 0.0
+    tm = 0.0
     for i in range(p):
         yhat += phb[oph + i] * thb[oth + i]
+        if guard:
+            tm = max(tm, abs(thb[oth + i]))
     e = y - yhat
+    pm = 0.0
     for i in range(p):  # q = Pφ, row i of P (= its column: P is exactly symmetric), j ascending
         row = oP + i * p
         acc = 0.0
         for j in range(p):
             acc += Pb[row + j] * phb[oph + j]
+            if guard:
+                pm = max(pm, abs(Pb[row + j]))
         qb[oq + i] = acc
     r = 0.0
     for i in range(p):
@@ -110,6 +118,24 @@ def _core(Pb, thb, phb, qb, at, p, size, lam, mode, maxtr, trace, y):
         inv = 1.0 / (lam + r)
         coef, scale = -inv, 1.0 / lam
     g = e * inv
+    safe = False
+    if guard and math.isfinite(e) and math.isfinite(r):
+        qm = 0.0
+        for i in range(p):
+            qm = max(qm, abs(qb[oq + i]))
+        # NaN or inf in a bound compares False: not safe
+        safe = ((pm + abs(coef) * qm * qm) * scale * p < _SAFE_BOUND
+                and tm + qm * abs(g) < _SAFE_BOUND)
+    return e, r, coef, scale, g, safe
+
+
+@njit(cache=True, inline="always")
+def _apply(Pb, thb, qb, at, p, size, mode, maxtr, coef, scale, g):
+    """The second half of :func:`_core`: θ ← θ + q·g and P ← (P + coef·q qᵀ)·scale on the upper
+    triangle, mirrored, then the trace bound; returns trace P."""
+    oP, oth, oph, oq = at
+    if len(size) > 0:
+        p = len(size)
     for i in range(p):
         thb[oth + i] += qb[oq + i] * g
     tr = 0.0
@@ -126,18 +152,75 @@ def _core(Pb, thb, phb, qb, at, p, size, lam, mode, maxtr, trace, y):
         for k in range(p * p):
             Pb[oP + k] *= f
         tr = maxtr
+    return tr
+
+
+@njit(cache=True, inline="always")
+def _core(Pb, thb, phb, qb, at, p, size, lam, mode, maxtr, trace, y):
+    """One RLS update of θ (``thb[oth:oth + p]``) and P (``Pb[oP:oP + p·p]``, row-major) for the
+    regressor ``phb[oph:oph + p]`` and output ``y``; ``qb[oq:oq + p]`` is work space. Returns
+    (a-priori error, r = φᵀPφ, trace). The batch kernel passes one local buffer four times with
+    constant offsets (the compiler then sees that the vectors do not overlap).
+
+    ``size``: an empty tuple (p at run time) or a tuple of p zeros (p known to the compiler, loops
+    unrolled). The covariance update is ``P ← (P + coef·q qᵀ)·scale`` with ``q = Pφ`` (see the
+    module docstring for ``coef``, ``scale`` and the three ``windup`` modes). :func:`_gain`, then
+    :func:`_apply`: the streaming step runs the same two halves with a check between them.
+    """
+    e, r, coef, scale, g, _ = _gain(Pb, thb, phb, qb, at, p, size, lam, mode,
+                                    trace, y, False)
+    tr = _apply(Pb, thb, qb, at, p, size, mode, maxtr, coef, scale, g)
     return e, r, tr
 
 
-@njit(cache=True)
-def _rls_step(s, u, y):
-    """One RLS update in place on the state vector ``s``; returns the a-priori error (0 while
-    the regressor is not yet filled). Same arithmetic as :func:`_rls_run` (both call :func:`_core`).
+@njit(cache=True, inline="always")
+def _step_update(Pb, thb, phb, qb, bb, at, ob, p, size, s, y):
+    """The guarded update of :func:`_rls_step` (θ and P in ``thb``/``Pb``, a backup area at
+    ``bb[ob:ob + p + p·p]``); returns (e, r, trace, status): status 0 = done, 2 = P or θ would
+    no longer be finite, 3 = φᵀPφ overflowed; on 2 and 3 θ and P are as they were."""
+    oP, oth, oph, oq = at
+    if len(size) > 0:
+        p = len(size)
+    lam = s[_LAM]
+    mode = int(s[_MODE])
+    e, r, coef, scale, g, safe = _gain(Pb, thb, phb, qb, at, p, size, lam, mode,
+                                       s[_TRACE], y, True)
+    if safe:  # no value can overflow: update in place, nothing to back up
+        tr = _apply(Pb, thb, qb, at, p, size, mode, s[_MAXTR], coef, scale, g)
+        return e, r, tr, 0
+    for i in range(p):  # rare (huge values or a non-finite e or r): back up, update, check
+        bb[ob + i] = thb[oth + i]
+    for i in range(p * p):
+        bb[ob + p + i] = Pb[oP + i]
+    tr = _apply(Pb, thb, qb, at, p, size, mode, s[_MAXTR], coef, scale, g)
+    ok = math.isfinite(tr) and math.isfinite(e)
+    for i in range(p):
+        ok = ok and math.isfinite(thb[oth + i])
+    if ok and math.isfinite(r):
+        return e, r, tr, 0
+    for i in range(p):
+        thb[oth + i] = bb[ob + i]
+    for i in range(p * p):
+        Pb[oP + i] = bb[ob + p + i]
+    return e, r, tr, 2 if math.isfinite(r) else 3
 
-    A failed update returns NaN and leaves ``s`` as it was (θ and P are restored from a backup
-    taken before the update), with the reason in ``s[_STATUS]``: 1 = ``u`` or ``y`` not finite,
-    2 = P or θ no longer finite (divergence), 3 = φᵀPφ overflowed (signals too large for P),
-    4 = ``|u|`` or ``|y|`` above :data:`ABSURD_JUMP` times its running peak ``s[_PU]``, ``s[_PY]``.
+
+@njit(cache=True)
+def _rls_step(s, u, y, size):
+    """One RLS update in place on the state vector ``s``; returns the a-priori error (0 while
+    the regressor is not yet filled). Same arithmetic as :func:`_rls_run` (both run the halves
+    of :func:`_core`).
+
+    A failed update returns NaN and leaves ``s`` as it was, with the reason in ``s[_STATUS]``:
+    1 = ``u`` or ``y`` not finite, 2 = P or θ no longer finite (divergence), 3 = φᵀPφ overflowed
+    (signals too large for P), 4 = ``|u|`` or ``|y|`` above :data:`ABSURD_JUMP` times its running
+    peak ``s[_PU]``, ``s[_PY]``. θ and P are updated in place when a bound shows that no new
+    value can overflow (:func:`_gain`), else from a backup (``s[ob:]``) that is restored on
+    failure.
+
+    ``size``: as for :func:`_rls_run`. With the orders known to the compiler (tuple lengths) the
+    offsets are constants and θ, P, φ and q are addressed in ``s`` itself (one base pointer,
+    constant offsets: the compiler sees they do not overlap); the generic step passes views.
     """
     if not (math.isfinite(u) and math.isfinite(y)):
         s[_STATUS] = 1.0
@@ -148,9 +231,10 @@ def _rls_step(s, u, y):
             ay > s[_PY] and s[_PY] > 0.0 and ay > ABSURD_JUMP * s[_PY]):
         s[_STATUS] = 4.0  # a corrupt sample
         return np.nan
-    na = int(s[_NA])
-    nb = int(s[_NB])
-    nk = int(s[_NK])
+    if len(size[0]) > 0:
+        na, nb, nk = len(size[1]), len(size[2]), len(size[3])
+    else:
+        na, nb, nk = int(s[_NA]), int(s[_NB]), int(s[_NK])
     p = na + nb
     nu = nk + nb
     oy = _HDR
@@ -167,19 +251,15 @@ def _rls_step(s, u, y):
             s[oph + i] = -s[oy + i]
         for j in range(nb):  # u(t-nk-j): the buffer is shifted only once the update succeeded
             s[oph + na + j] = u if nk + j == 0 else s[ou + nk + j - 1]
-        for i in range(p + p * p):
-            s[ob + i] = s[oth + i]
-        lam = s[_LAM]
-        e, r, tr = _core(s[op:oph], s[oth:op], s[oph:oq], s[oq:oq + p], (0, 0, 0, 0), p, (),
-                         lam, int(s[_MODE]), s[_MAXTR], s[_TRACE], y)
-        ok = math.isfinite(tr) and math.isfinite(e)
-        for i in range(p):
-            ok = ok and math.isfinite(s[oth + i])
-        if not (ok and math.isfinite(r)):
-            for i in range(p + p * p):
-                s[oth + i] = s[ob + i]
-            s[_STATUS] = 2.0 if math.isfinite(r) else 3.0
+        if len(size[0]) > 0:
+            e, r, tr, status = _step_update(s, s, s, s, s, (op, oth, oph, oq), ob, p, size[0], s, y)
+        else:
+            e, r, tr, status = _step_update(s[op:oph], s[oth:op], s[oph:oq], s[oq:ob], s[ob:],
+                                            (0, 0, 0, 0), 0, p, size[0], s, y)
+        if status != 0:
+            s[_STATUS] = float(status)
             return np.nan
+        lam = s[_LAM]
         s[_TRACE] = tr
         s[_V] = lam * (s[_V] + e * e / (lam + r))
         s[_W1] = lam * s[_W1] + 1.0
@@ -198,6 +278,46 @@ def _rls_step(s, u, y):
         s[oy] = y
     s[_COUNT] += 1.0
     return e
+
+
+_GENERIC = ((), (), (), ())
+
+
+@njit(cache=True)
+def _rls_step_any(s, u, y):
+    """:func:`_rls_step` with the orders read from ``s`` (one compiled step for all models)."""
+    return _rls_step(s, u, y, _GENERIC)
+
+
+_STEPS: dict = {}
+
+
+def _step_entry(na: int, nb: int, nk: int):
+    """The step :meth:`RLS.update` calls for an ARX [na nb nk] model: :func:`_rls_step` compiled
+    for this structure (the orders as tuple lengths, like the batch kernel's ``size``: unrolled
+    p-loops and constant offsets, ~50 ns of ~200 ns per call), once per structure and process
+    (numba caches it on disk: seconds the first time on a machine, milliseconds after).
+
+    Returned is the compiled function's ``entry_point`` for (C-contiguous float64 vector, float,
+    float), which unboxes its arguments as those types without numba's dispatcher (its type
+    resolution costs ~80 ns per call); only :meth:`RLS.update` calls it, with the estimator's own
+    state vector and two floats. Where numba has no ``entry_point`` the dispatcher is returned.
+    """
+    key = (na, nb, nk)
+    fn = _STEPS.get(key)
+    if fn is None:
+        size = ((0.0,) * (na + nb), (0.0,) * na, (0.0,) * nb, (0.0,) * nk)
+
+        @njit(cache=True)
+        def step(s, u, y):  # pragma: no cover - compiled
+            return _rls_step(s, u, y, size)
+        sig = (types.float64[::1], types.float64, types.float64)
+        step.compile(sig)
+        fn = getattr(step.overloads.get(sig), "entry_point", step)
+        _STEPS[key] = fn, step  # the dispatcher too: it owns the compiled code
+    else:
+        fn = fn[0]
+    return fn
 
 
 @njit(cache=True)
@@ -238,7 +358,7 @@ def _rls_run(s, u, y, theta_out, std_out, yhat_out, err_out, size):
     t0 = na if na > nk + nb - 1 else nk + nb - 1
     nstart = t0 if t0 < n else n
     for t in range(nstart):
-        e = _rls_step(s, u[t], y[t])
+        e = _rls_step(s, u[t], y[t], size)
         if pred:
             yh = y[t] - e
             yhat_out[t] = yh
@@ -332,9 +452,14 @@ class RLS:
     Use ``e = est.update(u_t, y_t)`` once per sample (returns the a-priori prediction error,
     0 during the first ``max(na, nk+nb−1)`` samples), read ``est.theta``, ``est.theta_std``,
     ``est.P``, ``est.model()``. ``est.run(u, y)`` processes a whole record from the current state.
+
+    ``update`` runs a step compiled for the model structure (:func:`_step_entry`): the first
+    update of a structure on a machine compiles it (2–4 s; numba caches it on disk, later
+    processes load it in milliseconds), so call ``update`` once before a timed loop starts.
     """
 
-    __slots__ = ("na", "nb", "nk", "forgetting", "windup", "dt", "_s", "_p0", "_theta0", "_maxtr")
+    __slots__ = ("na", "nb", "nk", "forgetting", "windup", "dt", "_s", "_p0", "_theta0", "_maxtr",
+                 "_step")
 
     def __init__(self, na: int, nb: int, nk: int = 1, *, forgetting: float = 1.0, p0: float = 1e4,
                  theta0=None, windup: str = "trace", max_trace: float | None = None, dt: float = 1.0):
@@ -367,6 +492,7 @@ class RLS:
         self._maxtr = maxtr
         # header, y and u buffers, θ, P, φ, q, backup of θ and P: see _rls_step
         self._s = np.zeros(_HDR + self.na + self.nk + self.nb + 2 * (p + p * p) + 2 * p)
+        self._step = self._first_step  # the compiled step, fetched at the first update
         self.reset()
 
     def reset(self) -> None:
@@ -404,14 +530,31 @@ class RLS:
         :class:`IdentificationError` when the update would make P or θ non-finite (divergence, or
         signals too large for P); either way the estimator is left as it was before the call.
         """
-        try:
-            e = _rls_step(self._s, u, y)
-        except TypingError:
-            raise DataError(f"RLS.update(u, y): expected two numbers, found {type(u).__name__} "
-                            f"{u!r:.40} and {type(y).__name__} {y!r:.40}") from None
+        if type(u) is float and type(y) is float:  # the common case: straight to the kernel
+            e = self._step(self._s, u, y)
+        else:
+            e = self._update_other(u, y)
         if e != e:  # NaN: the kernel refused the sample and left the state unchanged
             self._refuse(u, y)
         return e
+
+    def _first_step(self, s, u, y):
+        """``self._step`` until the first call: fetches the step compiled for this structure
+        (:func:`_step_entry`)."""
+        self._step = _step_entry(self.na, self.nb, self.nk)
+        return self._step(s, u, y)
+
+    def _update_other(self, u, y):
+        """:meth:`update` for samples that are not both Python floats: float subclasses (numpy
+        float64) go to the compiled step too; other types through numba's dispatcher, which
+        compiles a step for numeric types and refuses the rest."""
+        if isinstance(u, float) and isinstance(y, float):
+            return self._step(self._s, u, y)
+        try:
+            return _rls_step_any(self._s, u, y)
+        except TypingError:
+            raise DataError(f"RLS.update(u, y): expected two numbers, found {type(u).__name__} "
+                            f"{u!r:.40} and {type(y).__name__} {y!r:.40}") from None
 
     def _refuse(self, u, y):
         status = self._s[_STATUS]
