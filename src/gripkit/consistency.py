@@ -11,13 +11,11 @@ which value gripkit uses.
 from __future__ import annotations
 
 import math
-import os
-import sys
 import warnings
 from collections.abc import Iterable, Sequence
 from dataclasses import asdict, dataclass
 
-from .errors import ConsistencyWarning
+from .errors import ConsistencyWarning, emit_warning
 
 __all__ = ["Finding", "ConsistencyReport", "compare", "check", "warn_inconsistent"]
 
@@ -128,19 +126,9 @@ def check(obj) -> ConsistencyReport:
     return ConsistencyReport(findings, getattr(obj, "name", type(obj).__name__))
 
 
-_PACKAGE_DIR = os.path.dirname(os.path.abspath(__file__)) + os.sep
 #: texts already warned, valid while ``warnings.filters`` is the list object they were shown under
 _shown: set[tuple[str, str, str]] = set()
 _shown_under: list = []
-
-
-def _user_stacklevel() -> int:
-    """The ``stacklevel`` (counted from the caller of :func:`warn_inconsistent`) of the first frame
-    outside the gripkit package: the user's line that built the model."""
-    frame, level = sys._getframe(2), 2
-    while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(_PACKAGE_DIR):
-        frame, level = frame.f_back, level + 1
-    return level
 
 
 def warn_inconsistent(findings: Iterable[Finding], stacklevel: int | None = None) -> None:
@@ -155,9 +143,9 @@ def warn_inconsistent(findings: Iterable[Finding], stacklevel: int | None = None
     if warnings.filters is not _shown_under:  # catch_warnings() entered or left: a fresh context
         _shown.clear()
         _shown_under = warnings.filters
-    level = _user_stacklevel() if stacklevel is None else stacklevel
     for f in findings:
         key = (f.subject, f.check, f.message)
         if not f.consistent and key not in _shown:
             _shown.add(key)
-            warnings.warn(str(f), ConsistencyWarning, stacklevel=level)
+            emit_warning(str(f), ConsistencyWarning,
+                         stacklevel=None if stacklevel is None else stacklevel + 1)

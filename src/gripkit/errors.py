@@ -31,7 +31,7 @@ __all__ = [
     "StabilityWarning",
     "AccuracyWarning",
     "DataWarning",
-    "warn",
+    "emit_warning",
 ]
 
 
@@ -117,14 +117,18 @@ class DataWarning(GripkitWarning):
     outside the rest of its channel (a corrupt value). The data are used as read; check them."""
 
 
-def warn(message: str, category: type[Warning] = GripkitWarning) -> None:
+def emit_warning(message: str, category: type[Warning] = GripkitWarning,
+                 stacklevel: int | None = None) -> None:
     """Issue ``category(message)`` attributed to the first stack frame outside gripkit: the user's
     line that called into gripkit, whatever the depth of the call inside (what Python 3.12's
     ``warnings.warn(skip_file_prefixes=...)`` does), so the printed location and ``-W`` filters by
-    module point at the user's code, never into gripkit."""
+    module point at the user's code, never into gripkit. ``stacklevel`` (counted from the caller,
+    as for ``warnings.warn``) overrides the search. Every warning of gripkit goes through here."""
+    if stacklevel is not None:
+        warnings.warn(message, category, stacklevel=stacklevel + 1)
+        return
     package = os.path.dirname(os.path.abspath(__file__)) + os.sep
-    frame, level = sys._getframe(1), 2  # stacklevel 2: the caller of warn()
+    frame, level = sys._getframe(1), 2  # stacklevel 2: the caller of emit_warning()
     while frame is not None and os.path.abspath(frame.f_code.co_filename).startswith(package):
         frame, level = frame.f_back, level + 1
     warnings.warn(message, category, stacklevel=level)
-

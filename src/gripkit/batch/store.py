@@ -31,13 +31,12 @@ import hashlib
 import json
 import os
 import re
-import warnings
 from pathlib import Path
 
 import numpy as np
 
 from ..atomic import TEMP_SUFFIX, atomic_write, write_text
-from ..errors import ConfigError, DataError, GripkitWarning
+from ..errors import ConfigError, DataError, GripkitWarning, emit_warning
 
 __all__ = ["ResultStore", "chunk_range", "collect"]
 
@@ -298,8 +297,8 @@ class ResultStore:
             os.replace(path, path.with_name(path.name + ".bad"))
             r = chunk_range(c, chunk_size, n_jobs)
             again = f"its jobs {r.start}..{r.stop - 1} are computed again" if r else "it is not used"
-            warnings.warn(f"sweep output {str(self.root)!r}: chunk {c} ({path.name}) {problem}; {again} "
-                          f"(the file is kept as {path.name}.bad)", GripkitWarning, stacklevel=2)
+            emit_warning(f"sweep output {str(self.root)!r}: chunk {c} ({path.name}) {problem}; {again} "
+                         f"(the file is kept as {path.name}.bad)", GripkitWarning)
         return good
 
     # --- reading ---------------------------------------------------------------------------

@@ -15,12 +15,12 @@ file's samples and fit.
 from __future__ import annotations
 
 import dataclasses
-import warnings
 from pathlib import Path
 
 import typer
 
 from .app import identify_app
+from ..errors import emit_warning
 from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_choice, check_data_options, check_number,
                      collected_warnings, emit_json, load_data, report_warnings)
 
@@ -195,8 +195,8 @@ def _mimo_arx(data: list[Path], input: str, output: str, na: int, nb: int, nk: i
         if "records" in info:
             res["records"] = _records_field(data, info["records"])
         if not model.stable:
-            warnings.warn("arx: the identified model is unstable (a pole on or outside the unit circle): "
-                          "no free-run fit is reported", StabilityWarning, stacklevel=1)
+            emit_warning("arx: the identified model is unstable (a pole on or outside the unit circle): "
+                         "no free-run fit is reported", StabilityWarning)
         if validate is not None:
             vfit = validation_fit(model, load_data(validate, columns, fs, time, fill))
             res["validation_fit_percent"] = vfit

@@ -62,13 +62,12 @@ from __future__ import annotations
 
 import math
 import numbers
-import warnings
 from collections import namedtuple
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import DataError, DataWarning, ModelError
+from ..errors import DataError, DataWarning, ModelError, emit_warning
 from ..models.friction import FrictionTable, TableArrays, table_arrays, table_friction
 from ..multibody.kernels import hot
 
@@ -379,7 +378,7 @@ class FrictionAdapter:
                 if nonfinite == "raise":
                     raise DataError(what, hint="drop or interpolate them, or pass nonfinite='skip' to "
                                                "leave those samples out (the estimates hold)")
-                warnings.warn(DataWarning(f"{what}: left out, the estimates hold over them"), stacklevel=2)
+                emit_warning(DataWarning(f"{what}: left out, the estimates hold over them"))
         N = tau.shape[0]
         th = np.empty((N, m, 2))
         sd = np.empty((N, m, 2))

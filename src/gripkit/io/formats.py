@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import os
 import re
-import warnings
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -34,7 +33,7 @@ import numpy as np
 
 from ..arguments import check_path, entry_point
 from ..atomic import atomic_write
-from ..errors import ArgumentError, DataError, DataWarning
+from ..errors import ArgumentError, DataError, DataWarning, emit_warning
 from ..signals.trajectory import Trajectory
 from ..units import convert, same_dimension
 from .hdf5_links import check_dataset, hdf5_get, hdf5_text
@@ -374,9 +373,9 @@ def _warn_unterminated(path: Path) -> None:
     data = path.read_bytes()
     k = data.count(b"\n") + 1 if b"\n" in data else data.count(b"\r") + 1
     last = data.splitlines()[-1].decode("utf-8", errors="replace")
-    warnings.warn(f"{path.name}: line {k}, the last, has no line ending: the file looks truncated and "
-                  f"that line's values may be cut short ({last[:60]!r}); check the end of the file, and end "
-                  f"it with a newline if it is complete", DataWarning, stacklevel=4)
+    emit_warning(f"{path.name}: line {k}, the last, has no line ending: the file looks truncated and "
+                 f"that line's values may be cut short ({last[:60]!r}); check the end of the file, and end "
+                 f"it with a newline if it is complete", DataWarning)
 
 
 def _arrow_columns(table, source: str) -> dict[str, object]:

@@ -30,12 +30,11 @@ from __future__ import annotations
 
 import math
 import re
-import warnings
 from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-from ..errors import DataError, DataWarning
+from ..errors import DataError, DataWarning, emit_warning
 from ..signals.outliers import corrupt_samples
 from ..signals.trajectory import Trajectory
 from ..units import si_factor
@@ -231,10 +230,10 @@ def _warn_corrupt(source: str, t: np.ndarray, data: dict[str, np.ndarray], units
         u = "" if u == "1" else f" {u}"
         shown = ", ".join(f"{x[i]:.6g}{u} at t={t[i]:.6g} s" for i in idx[:3])
         more = f" and {idx.size - 3} more" if idx.size > 3 else ""
-        warnings.warn(
-            f"{source}: column {name!r} has {idx.size} sample{'s' if idx.size > 1 else ''} far outside the "
-            f"rest of the channel, which look{'s' if idx.size == 1 else ''} corrupt: {shown}{more}; check "
-            f"the file (drop or repair those rows) unless the spike is real", DataWarning, stacklevel=4)
+        emit_warning(
+           f"{source}: column {name!r} has {idx.size} sample{'s' if idx.size > 1 else ''} far outside the "
+           f"rest of the channel, which look{'s' if idx.size == 1 else ''} corrupt: {shown}{more}; check "
+           f"the file (drop or repair those rows) unless the spike is real", DataWarning)
 
 
 def _fill(t: np.ndarray, data: dict[str, np.ndarray], fill: str | None):

@@ -13,13 +13,12 @@ from __future__ import annotations
 import dataclasses
 import math
 import re
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import linalg
 
-from ..errors import AccuracyWarning, DataError, ModelError
+from ..errors import AccuracyWarning, DataError, ModelError, emit_warning
 from . import _connect, _discretize, _realize
 from ._checks import as_dt, as_input_array, as_matrix, as_names, as_units, require_discrete, same_dt
 from ._frequency import Bode, default_grid
@@ -271,8 +270,8 @@ class LinearSystem:
         bad = cond > 1.0 / np.sqrt(_EPS)
         cov = complex_covariance(J, ss.uncertainty.covariance)
         if np.any(bad):
-            warnings.warn(f"pole_covariance: {int(bad.sum())} pole(s) are (nearly) repeated; their "
-                          "first-order σ is undefined and set to inf", AccuracyWarning, stacklevel=2)
+            emit_warning(f"pole_covariance: {int(bad.sum())} pole(s) are (nearly) repeated; their "
+                         "first-order σ is undefined and set to inf", AccuracyWarning)
             cov[bad] = np.inf
         return lam, cov
 
@@ -890,8 +889,8 @@ class StateSpace(LinearSystem):
         if A.shape == self.A.shape:
             return self
         if self.uncertainty is not None:
-            warnings.warn("to_ss(minimal=True): removing states drops the covariance (the cancelled "
-                          "modes carry part of it)", AccuracyWarning, stacklevel=2)
+            emit_warning("to_ss(minimal=True): removing states drops the covariance (the cancelled "
+                         "modes carry part of it)", AccuracyWarning)
         return StateSpace(A, B, C, D, **self._signals())
 
     def to_tf(self, minimal: bool = True) -> TransferFunction:
@@ -1284,8 +1283,8 @@ class TransferFunction(LinearSystem):
         # a repeated root has D'(r) ≈ 0 (within the rounding of D' at r): its first-order σ is undefined
         bad = np.abs(slope) <= 100 * core.size * _EPS * np.polyval(np.abs(np.polyder(core)), np.abs(r))
         if np.any(bad):
-            warnings.warn(f"pole_covariance: {int(bad.sum())} pole(s) are (nearly) repeated; their "
-                          "first-order σ is undefined and set to inf", AccuracyWarning, stacklevel=2)
+            emit_warning(f"pole_covariance: {int(bad.sum())} pole(s) are (nearly) repeated; their "
+                         "first-order σ is undefined and set to inf", AccuracyWarning)
             cov[bad] = np.inf
         return np.r_[r, np.zeros(t, dtype=complex)], np.concatenate([cov, np.zeros((t, 2, 2))])
 

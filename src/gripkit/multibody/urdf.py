@@ -33,7 +33,6 @@ from __future__ import annotations
 
 import math
 import os
-import warnings
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -42,7 +41,7 @@ import numpy as np
 
 from ..arguments import entry_point
 from ..atomic import atomic_write
-from ..errors import GripkitWarning, ModelError
+from ..errors import GripkitWarning, ModelError, emit_warning
 from .coupling import CoupledChain
 from .dh import DHChain
 from .joints import JointChain, JointLimits
@@ -575,8 +574,8 @@ def to_urdf(chain, path, *, name: str | None = None, base_link: str = "base",
                         f"(q_u = Γ_u p + q₀_u, Γ_u = {np.round(Gu, 6).tolist()}): the URDF's coordinates are "
                         f"these joints")
     if left_out:
-        warnings.warn(f"to_urdf: URDF cannot hold {'; '.join(left_out)}; they are left out of {os.fspath(path)}",
-                      GripkitWarning, stacklevel=2)
+        emit_warning(f"to_urdf: URDF cannot hold {'; '.join(left_out)}; they are left out of {os.fspath(path)}",
+                     GripkitWarning)
     robot = ET.Element("robot", name=name or getattr(chain, "name", "chain"))
     robot.append(ET.Comment(f" written by gripkit.multibody.to_urdf; gravity in {base_link!r}: "
                             f"{_vec(getattr(chain, 'chain', chain).gravity_vector)} m/s^2 "))

@@ -22,10 +22,9 @@ part exactly, :mod:`gripkit.sim.linear`).
 from __future__ import annotations
 
 import math
-import warnings
 from collections.abc import Iterable
 
-from ..errors import AccuracyWarning, SimulationError
+from ..errors import AccuracyWarning, SimulationError, emit_warning
 
 __all__ = ["STABILITY_LIMIT", "check_step", "substeps_for", "step_report"]
 
@@ -72,10 +71,10 @@ def check_step(dt: float, modes: Iterable[tuple[float, float]], method: str = "r
                 f"limit {r['stable_limit']:.3g}",
                 hint=f"use dt <= {r['accurate_limit'] / r['omega_n']:.3g} s or substeps")
         if not r["accurate"]:
-            warnings.warn(
-                f"{what}: step dt = {dt:.6g} s under-resolves the {r['f_n_hz']:.6g} Hz mode "
-                f"(ζ = {r['zeta']:.3g}): ω·dt = {r['omega_h']:.3g} > {r['accurate_limit']:.3g}; "
-                f"use dt <= {r['accurate_limit'] / r['omega_n']:.3g} s", AccuracyWarning, stacklevel=2)
+            emit_warning(
+               f"{what}: step dt = {dt:.6g} s under-resolves the {r['f_n_hz']:.6g} Hz mode "
+               f"(ζ = {r['zeta']:.3g}): ω·dt = {r['omega_h']:.3g} > {r['accurate_limit']:.3g}; "
+               f"use dt <= {r['accurate_limit'] / r['omega_n']:.3g} s", AccuracyWarning)
 
 
 def substeps_for(dt: float, modes: Iterable[tuple[float, float]], method: str = "rk4",

@@ -11,13 +11,12 @@ ill-conditioned Jacobian), ``σ² = Σe²/(M − p)``.
 
 from __future__ import annotations
 
-import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import AccuracyWarning
+from ..errors import AccuracyWarning, emit_warning
 from .regression import qr_solve
 
 __all__ = ["stabilize", "is_stable_poly", "PEMResult", "levenberg_marquardt", "covariance"]
@@ -93,9 +92,8 @@ def levenberg_marquardt(fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray
             message = "converged"
             break
     if not converged:
-        warnings.warn(f"{label}: prediction-error minimisation stopped after {maxiter} iterations "
-                      f"without converging; the estimate may not be the minimum", AccuracyWarning,
-                      stacklevel=3)
+        emit_warning(f"{label}: prediction-error minimisation stopped after {maxiter} iterations "
+                     f"without converging; the estimate may not be the minimum", AccuracyWarning)
     return PEMResult(theta, e, J, it, converged, message)
 
 

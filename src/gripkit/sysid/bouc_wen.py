@@ -17,13 +17,12 @@ sensor) and the whole procedure for one finger are TSFM-specific:
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
 from ..arguments import entry_point
-from ..errors import AccuracyWarning, DataError
+from ..errors import AccuracyWarning, DataError, emit_warning
 from ..models.hysteresis import BoucWen, bouc_wen_parameters, bouc_wen_response
 from ..models.piezo import PiezoActuator, actuator_parameters
 from ..params import ParameterSet
@@ -217,5 +216,4 @@ def identify_actuator_dynamics(data: Trajectory, static: BoucWenResult | dict, i
 
 def _warn_if_poor(res: GreyboxResult, what: str) -> None:
     if res.fit_percent[0] < 90:
-        warnings.warn(f"{what}: the model reproduces only {res.fit_percent[0]:.3g} % of the data", AccuracyWarning,
-                      stacklevel=3)
+        emit_warning(f"{what}: the model reproduces only {res.fit_percent[0]:.3g} % of the data", AccuracyWarning)

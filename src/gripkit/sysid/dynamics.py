@@ -57,7 +57,6 @@ from __future__ import annotations
 
 import hashlib
 import math
-import warnings
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -65,7 +64,8 @@ import numpy as np
 from scipy.linalg import qr
 
 from ..arguments import entry_point
-from ..errors import AccuracyWarning, DataError, IdentificationError, ModelError, UnidentifiableError
+from ..errors import (AccuracyWarning, DataError, IdentificationError, ModelError,
+                      UnidentifiableError, emit_warning)
 from ..multibody import from_urdf
 from .checks import as_io_matrix
 from .dynamics_file import float_array, read_dynamics_document, save_dynamics_model
@@ -695,8 +695,7 @@ def load_dynamics_model(path) -> DynamicsResult:
         urdf = doc["urdf"]
         text = urdf["text"]
         if hashlib.sha256(text.encode()).hexdigest() != urdf.get("sha256"):
-            warnings.warn(f"dynamics model file {where}: the URDF text does not match its sha256", AccuracyWarning,
-                          stacklevel=2)
+            emit_warning(f"dynamics model file {where}: the URDF text does not match its sha256", AccuracyWarning)
         chain = from_urdf(text, base_link=urdf.get("base_link"), tip_link=urdf.get("tip_link"),
                           gravity=float_array(doc["gravity"], "gravity", where, (3,)))
         if list(chain.coordinate_names) != list(doc["joints"]):

@@ -25,13 +25,12 @@ lines (:class:`~gripkit.errors.AccuracyWarning`).
 
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
-from ..errors import AccuracyWarning, DataError
+from ..errors import AccuracyWarning, DataError, emit_warning
 from .checks import check_dt
 from .linear_model import as_io_matrix
 
@@ -88,8 +87,8 @@ class FRF:
 def _no_power_warning(f, bad, what):
     if bad.any():
         lines = ", ".join(f"{x:.4g}" for x in f[bad][:5]) + (" …" if bad.sum() > 5 else "")
-        warnings.warn(f"frf: {int(bad.sum())} line(s) have no {what} power ({lines} Hz): H is undefined there "
-                      f"and its σ is infinite", AccuracyWarning, stacklevel=3)
+        emit_warning(f"frf: {int(bad.sum())} line(s) have no {what} power ({lines} Hz): H is undefined there "
+                     f"and its σ is infinite", AccuracyWarning)
 
 
 def _periodic(u, y, dt, periods, keep_transient):

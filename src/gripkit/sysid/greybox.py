@@ -28,7 +28,6 @@ parameters cannot be told apart.
 from __future__ import annotations
 
 import math
-import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 
@@ -36,7 +35,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from ..arguments import entry_point
-from ..errors import AccuracyWarning, DataError, IdentificationError, ParameterError
+from ..errors import AccuracyWarning, DataError, IdentificationError, ParameterError, emit_warning
 from ..params import ParameterSet
 from ..progress import track
 from ..signals.trajectory import Trajectory
@@ -461,8 +460,8 @@ def fit(model, data: Trajectory | Sequence[Trajectory], *, outputs: Sequence[str
     r = problem.residual(z)
     cov, std, corr, ident = _uncertainty(problem.jacobian_theta(z, theta), r, problem.s, free, rcond, max_rel_std)
     if not ident.ok:
-        warnings.warn(f"{model.name}: {ident}; their standard deviations are reported as infinite",
-                      AccuracyWarning, stacklevel=2)
+        emit_warning(f"{model.name}: {ident}; their standard deviations are reported as infinite",
+                     AccuracyWarning)
     return _result(params, free, theta, cov, std, corr, ident, problem, best, r, tried,
                    source=data.meta.get("source", "data"))
 
@@ -532,7 +531,7 @@ def _fit_records(model, data, *, outputs, inputs, free, initial, x0, output_scal
     cov, std, corr, ident = _uncertainty(problem.jacobian_theta(best.x, theta), r, problem.s, free,
                                          rcond, max_rel_std)
     if not ident.ok:
-        warnings.warn(f"{model.name}: {ident}; their standard deviations are reported as infinite",
-                      AccuracyWarning, stacklevel=3)
+        emit_warning(f"{model.name}: {ident}; their standard deviations are reported as infinite",
+                     AccuracyWarning)
     return _result(params, free, theta, cov, std, corr, ident, problem, best, r, tried,
                    source=f"{len(data)} records")

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..arguments import check_keywords, entry_point, keyword_names
-from ..errors import AccuracyWarning, ArgumentError, DataError, GripkitError
+from ..errors import AccuracyWarning, ArgumentError, DataError, GripkitError, emit_warning
 from ..signals.processing import detrend as detrend_signals
 from ..signals.trajectory import Trajectory
 from . import identify_mimo
@@ -136,13 +136,13 @@ def warn_if_mean_detrending_hurt(model, io: IOData, raw, refit) -> None:
     none_fit = _free_run_fit(other, rio.u, rio.y)
     if none_fit > mean_fit + 10.0:
         tau = -io.dt / math.log(float(poles.max()))
-        warnings.warn(
-            f"identify {model.structure}: removing the means (detrend 'mean', the default) hurt "
-            f"this fit: the slowest pole (|z| = {poles.max():.6g}, time constant {tau:.4g} s) does "
-            f"not settle within the {n * io.dt:.4g} s record, so the output drifts and its mean is "
-            f"no operating point; free-run fit from rest {mean_fit:.4g} % with the means removed, "
-            f"{none_fit:.4g} % without; use --detrend none (Python: detrend='none')",
-            AccuracyWarning, stacklevel=4)
+        emit_warning(
+           f"identify {model.structure}: removing the means (detrend 'mean', the default) hurt "
+           f"this fit: the slowest pole (|z| = {poles.max():.6g}, time constant {tau:.4g} s) does "
+           f"not settle within the {n * io.dt:.4g} s record, so the output drifts and its mean is "
+           f"no operating point; free-run fit from rest {mean_fit:.4g} % with the means removed, "
+           f"{none_fit:.4g} % without; use --detrend none (Python: detrend='none')",
+           AccuracyWarning)
 
 
 def _method_function(method: str):

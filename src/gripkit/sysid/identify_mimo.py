@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import (AccuracyWarning, ArgumentError, DataError, GripkitError, GripkitWarning,
-                      IdentificationError)
+                      IdentificationError, emit_warning)
 from ..progress import status
 from ..signals.trajectory import Trajectory
 from .arx_mimo import arx_mimo
@@ -242,9 +242,9 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
         extras["search"] = [r for r, _ in rows]
         extras["criterion"] = criterion
         if best_row["order"] in rng and rng[1] - rng[0] >= 2:
-            warnings.warn(f"order search: the best order {best_row['order']} lies on the edge of the searched range "
-                          f"{rng[0]}:{rng[1]}; the true order may lie outside it, widen the range",
-                          GripkitWarning, stacklevel=2)
+            emit_warning(f"order search: the best order {best_row['order']} lies on the edge of the searched range "
+                         f"{rng[0]}:{rng[1]}; the true order may lie outside it, widen the range",
+                         GripkitWarning)
     model = model.replace(u_offset=d.u_offset, y_offset=d.y_offset)
     if focus not in FOCUS:
         raise DataError(f"focus: expected one of {', '.join(FOCUS)}, found {focus!r}")
@@ -297,10 +297,10 @@ def _refine(start, d: MimoData, vd: MimoData | None, form: str, focus: str, max_
     try:
         model = pem(start, u=d.u, y=d.y, form=form, max_iterations=max_iterations)
     except IdentificationError as exc:  # an order the data do not support in full
-        warnings.warn(f"PEM refinement of the order-{start.order} {start.structure} model failed "
-                      f"({exc.message}); the subspace model is returned, without parameter "
-                      f"covariance (lower the order, or --no-refine to skip PEM)",
-                      AccuracyWarning, stacklevel=3)
+        emit_warning(f"PEM refinement of the order-{start.order} {start.structure} model failed "
+                     f"({exc.message}); the subspace model is returned, without parameter "
+                     f"covariance (lower the order, or --no-refine to skip PEM)",
+                     AccuracyWarning)
         return start, False
     oe = None
     if form == "innovation" and focus == "simulation":  # PEM in oe form minimises the free-run
@@ -320,11 +320,11 @@ FOCUS_TIE = 0.01
 def _warn_unconverged(model, max_iterations: int) -> None:
     info = model.info.get("pem", {})
     if not info.get("converged", True):
-        warnings.warn(f"PEM refinement ({model.structure}) stopped after {info.get('iterations')} "
-                      f"iterations without converging (loss {info.get('loss_start', math.nan):.4g} -> "
-                      f"{info.get('loss', math.nan):.4g} per sample); raise max_iterations "
-                      f"(--max-iterations, now {max_iterations}) or lower the order",
-                      AccuracyWarning, stacklevel=4)
+        emit_warning(f"PEM refinement ({model.structure}) stopped after {info.get('iterations')} "
+                     f"iterations without converging (loss {info.get('loss_start', math.nan):.4g} -> "
+                     f"{info.get('loss', math.nan):.4g} per sample); raise max_iterations "
+                     f"(--max-iterations, now {max_iterations}) or lower the order",
+                     AccuracyWarning)
 
 
 def _never_lose(start, refined, focus: str, d: MimoData, estimation: bool, max_iterations: int,
@@ -351,16 +351,15 @@ def _never_lose(start, refined, focus: str, d: MimoData, estimation: bool, max_i
         if after >= before - FOCUS_TIE:
             model.info["focus"] = {**record, "refined_percent": after, "kept": model.structure}
             if model is not refined:
-                warnings.warn(f"PEM refinement ({refined.structure}) lowered the mean {focus} fit on "
-                              f"the {where} data from {before:.2f} % to {tried[0].split()[-2]} %; the "
-                              f"{model.structure} refinement ({after:.2f} %) is returned",
-                              AccuracyWarning, stacklevel=3)
+                emit_warning(f"PEM refinement ({refined.structure}) lowered the mean {focus} fit on "
+                             f"the {where} data from {before:.2f} % to {tried[0].split()[-2]} %; the "
+                             f"{model.structure} refinement ({after:.2f} %) is returned",
+                             AccuracyWarning)
             return model
-    warnings.warn(f"PEM refinement lowered the mean {focus} fit on the {where} data from "
-                  f"{before:.2f} % to {', '.join(tried)}: the subspace model is returned, without "
-                  f"parameter covariance (--focus {'prediction' if focus == 'simulation' else 'simulation'}"
-                  f" judges by the other criterion; --no-refine skips PEM)", AccuracyWarning,
-                  stacklevel=3)
+    emit_warning(f"PEM refinement lowered the mean {focus} fit on the {where} data from "
+                 f"{before:.2f} % to {', '.join(tried)}: the subspace model is returned, without "
+                 f"parameter covariance (--focus {'prediction' if focus == 'simulation' else 'simulation'}"
+                 f" judges by the other criterion; --no-refine skips PEM)", AccuracyWarning)
     start.info["focus"] = {**record, "refined_percent": focus_score(refined, focus, d, estimation),
                            "kept": "subspace"}
     start.info["pem_rejected"] = refined.info.get("pem", {})
@@ -391,12 +390,12 @@ def _warn_if_detrending_hurt(model, refit, n: int, dt: float, command: str) -> N
             return
     mean_fit, none_fit = float(np.mean(model.fit_percent)), float(np.mean(other.fit_percent))
     if none_fit > mean_fit + 10.0:
-        warnings.warn(
-            f"{command}: removing the means (detrend 'mean', the default) hurt this fit: the "
-            f"slowest mode (time constant {1 / slowest:.4g} s) does not settle within the "
-            f"{n * dt:.4g} s record, so the output drifts and its mean is no operating point; "
-            f"free-run fit {mean_fit:.4g} % with the means removed, {none_fit:.4g} % without; "
-            f"use --detrend none (Python: detrend='none')", AccuracyWarning, stacklevel=4)
+        emit_warning(
+           f"{command}: removing the means (detrend 'mean', the default) hurt this fit: the "
+           f"slowest mode (time constant {1 / slowest:.4g} s) does not settle within the "
+           f"{n * dt:.4g} s record, so the output drifts and its mean is no operating point; "
+           f"free-run fit {mean_fit:.4g} % with the means removed, {none_fit:.4g} % without; "
+           f"use --detrend none (Python: detrend='none')", AccuracyWarning)
 
 
 def identify_frf(data: Trajectory, *, input, output, detrend: str = "mean", **options):
@@ -466,13 +465,13 @@ def identify_ss_records(records: list, d: MimoData, u0, y0, options: dict):
     refined = pem_records(start, records, form=options.get("form", "innovation"),
                           max_iterations=iters)
     if not refined.info["pem"]["converged"]:
-        warnings.warn(f"identify ss: PEM over the records stopped after {iters} iterations without "
-                      f"converging; raise max_iterations", AccuracyWarning, stacklevel=4)
+        emit_warning(f"identify ss: PEM over the records stopped after {iters} iterations without "
+                     f"converging; raise max_iterations", AccuracyWarning)
     before, after = float(np.mean(start.fit_percent)), float(np.mean(refined.fit_percent))
     if after < before:
-        warnings.warn(f"identify ss: PEM over the records lowered the free-run fit of all records "
-                      f"from {before:.4g} % (subspace) to {after:.4g} %; the subspace model is "
-                      f"returned", AccuracyWarning, stacklevel=4)
+        emit_warning(f"identify ss: PEM over the records lowered the free-run fit of all records "
+                     f"from {before:.4g} % (subspace) to {after:.4g} %; the subspace model is "
+                     f"returned", AccuracyWarning)
         return start
     return refined
 

@@ -17,13 +17,12 @@ least squares (the output is affine in x0: ``y = O x0 + G u``, ``O`` the rows ``
 from __future__ import annotations
 
 import dataclasses
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from .. import __version__
-from ..errors import DataError, DataWarning, ModelError, ParameterError
+from ..errors import DataError, DataWarning, ModelError, ParameterError, emit_warning
 from ..lti import LinearSystem, StateSpace, TransferFunction
 from ..signals.trajectory import Trajectory
 from ..units import convert, dimension_of, same_dimension
@@ -93,9 +92,9 @@ def _in_unit(data, name: str, unit: str | None, what: str) -> np.ndarray:
     try:
         same = same_dimension(have, unit)
     except ParameterError:  # a unit that is not one (a hand-edited or foreign model file)
-        warnings.warn(f"data: cannot compare the units of the {what} column {name!r}: {have!r} in "
-                      f"the data, {unit!r} in the model, and one is not a unit gripkit can read; "
-                      f"the values are taken as they are", DataWarning, stacklevel=4)
+        emit_warning(f"data: cannot compare the units of the {what} column {name!r}: {have!r} in "
+                     f"the data, {unit!r} in the model, and one is not a unit gripkit can read; "
+                     f"the values are taken as they are", DataWarning)
         return x
     if not same:
         raise DataError(f"data: {what} column {name!r} is in {have!r} (dimension "

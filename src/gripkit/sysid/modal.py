@@ -28,7 +28,6 @@ they disagree with the fit by more than their expected scatter.
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
@@ -36,7 +35,7 @@ from scipy.optimize import least_squares
 from scipy.signal import find_peaks, hilbert, resample_poly
 
 from ..arguments import entry_point, sample_interval
-from ..errors import AccuracyWarning, DataError, IdentificationError
+from ..errors import AccuracyWarning, DataError, IdentificationError, emit_warning
 from ._scaling import unit_scale
 
 __all__ = ["ModalResult", "free_vibration"]
@@ -275,10 +274,10 @@ def _check_decay(zeta: float, z_std: float, sigma_t: float) -> None:
             hint="analyse the free response after a release or an impulse, with no excitation "
                  "during the record (CLI: --start at the release)")
     if 1.0 - kept < _MIN_DECAY:
-        warnings.warn(f"free vibration: the envelope decays by only {100 * (1 - kept):.3g} % over "
-                      f"the record (ζ = {zeta:.3g} ± {z_std:.2g}): check that it is a free "
-                      f"vibration (no forcing during the record), or record longer",
-                      AccuracyWarning, stacklevel=3)
+        emit_warning(f"free vibration: the envelope decays by only {100 * (1 - kept):.3g} % over "
+                     f"the record (ζ = {zeta:.3g} ± {z_std:.2g}): check that it is a free "
+                     f"vibration (no forcing during the record), or record longer",
+                     AccuracyWarning)
 
 
 def _warn_doubtful(methods: dict, f_fft: float, omega_d: float, fn: float, zeta: float, f_std: float,
@@ -289,12 +288,11 @@ def _warn_doubtful(methods: dict, f_fft: float, omega_d: float, fn: float, zeta:
     for name, v in methods.items():
         if name in ("hilbert", "half_power", "log_decrement") and "damping_ratio" in v:
             if abs(v["damping_ratio"] - zeta) > max(0.3 * zeta, 10 * z_std):
-                warnings.warn(f"free vibration: the {name.replace('_', ' ')} damping ratio {v['damping_ratio']:.4g} "
-                              f"disagrees with the least-squares fit {zeta:.4g} ± {z_std:.2g}", AccuracyWarning,
-                              stacklevel=3)
+                emit_warning(f"free vibration: the {name.replace('_', ' ')} damping ratio {v['damping_ratio']:.4g} "
+                             f"disagrees with the least-squares fit {zeta:.4g} ± {z_std:.2g}", AccuracyWarning)
     if abs(f_fft - omega_d / (2 * math.pi)) > max(0.01 * fn, 20 * f_std):
-        warnings.warn(f"free vibration: the FFT peak {f_fft:.6g} Hz disagrees with the fitted damped frequency "
-                      f"{omega_d / (2 * math.pi):.6g} Hz", AccuracyWarning, stacklevel=3)
+        emit_warning(f"free vibration: the FFT peak {f_fft:.6g} Hz disagrees with the fitted damped frequency "
+                     f"{omega_d / (2 * math.pi):.6g} Hz", AccuracyWarning)
 
 
 @entry_point

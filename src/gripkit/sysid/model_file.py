@@ -15,13 +15,12 @@ from __future__ import annotations
 import hashlib
 import json
 import sys
-import warnings
 from pathlib import Path
 
 import numpy as np
 
 from ..atomic import write_text
-from ..errors import AccuracyWarning, DataError, ModelError
+from ..errors import AccuracyWarning, DataError, ModelError, emit_warning
 
 __all__ = ["file_sha256", "plain", "write_document", "read_document", "SCHEMA", "SCHEMA_VERSION"]
 
@@ -128,6 +127,6 @@ def read_document(path, schema: str = SCHEMA, newest: int = SCHEMA_VERSION, *, w
         raise ModelError(f"{what} {where}: expected schema_version 1 … {newest}, found {ver!r}",
                          hint="upgrade gripkit to read files written by a newer version")
     if doc.get("content_sha256") != content_hash(doc):
-        warnings.warn(f"{what} {where}: content hash mismatch (the file was edited after it was saved); "
-                      f"using it as it is", AccuracyWarning, stacklevel=3)
+        emit_warning(f"{what} {where}: content hash mismatch (the file was edited after it was saved); "
+                     f"using it as it is", AccuracyWarning)
     return doc

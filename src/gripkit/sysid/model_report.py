@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import AccuracyWarning
+from ..errors import AccuracyWarning, emit_warning
 from ..report.html import Report
 from ..report.plots import measured_vs_model, plain, pyplot
 from .frf import frf
@@ -82,7 +82,7 @@ def _fmt_pole(z: complex) -> str:
 
 
 def _warn(msg: str, notes: list) -> None:
-    warnings.warn(msg, AccuracyWarning, stacklevel=3)
+    emit_warning(msg, AccuracyWarning)
     notes.append(msg)
 
 

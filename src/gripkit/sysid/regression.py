@@ -21,13 +21,12 @@ are never formed (they square the condition number). The parameter covariance is
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.linalg as sla
 
-from ..errors import AccuracyWarning, UnidentifiableError
+from ..errors import AccuracyWarning, UnidentifiableError, emit_warning
 
 __all__ = ["arx_start", "arx_regression", "QRSolution", "qr_solve", "triangular_solve", "scaled_condition",
            "COND_LIMIT", "warn_threshold", "hac_covariance"]
@@ -208,12 +207,12 @@ def triangular_solve(R: np.ndarray, names: tuple[str, ...], m: int, warn: bool =
         with np.errstate(divide="ignore"):
             rel = ", ".join(f"{names[i]} (σ/|{names[i]}| = {std[i] / val[i]:.2g})"
                             for i in _weak_combination(vt, names))
-        warnings.warn(
-            f"the data barely determine the parameters (regressor condition number {cond:.3g} > "
-            f"{limit:.3g}, the limit for this fit's noise and length; refused above {COND_LIMIT:.0e}): "
-            f"poorly determined are {rel}; they move together along a nearly unexcited direction, so "
-            f"their values may be far from the truth; excite the system more richly (more frequencies "
-            f"than parameters) or lower the orders", AccuracyWarning, stacklevel=stacklevel)
+        emit_warning(
+           f"the data barely determine the parameters (regressor condition number {cond:.3g} > "
+           f"{limit:.3g}, the limit for this fit's noise and length; refused above {COND_LIMIT:.0e}): "
+           f"poorly determined are {rel}; they move together along a nearly unexcited direction, so "
+           f"their values may be far from the truth; excite the system more richly (more frequencies "
+           f"than parameters) or lower the orders", AccuracyWarning)
     return QRSolution(theta, rss, r1.copy(), 0.5 * (cov + cov.T), cond, m)
 
 

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..arguments import entry_point
-from ..errors import DataError, GripkitWarning, UnidentifiableError
+from ..errors import DataError, GripkitWarning, UnidentifiableError, emit_warning
 from ..progress import track
 from ._scaling import unit_scale
 from .checks import check_dt, check_identifiable, check_io, check_order
@@ -184,6 +184,5 @@ def _warn_edge(best: Candidate, ranges: dict) -> None:
     edges = [f"{name} = {getattr(best, name)} (searched {min(r)}:{max(r)})" for name, r in ranges.items()
              if len(set(r)) >= 3 and getattr(best, name) in (min(r), max(r))]
     if edges:
-        warnings.warn(f"structure search: the best structure lies on the edge of the searched range: "
-                      f"{', '.join(edges)}; the best may lie outside it, widen the range", GripkitWarning,
-                      stacklevel=3)
+        emit_warning(f"structure search: the best structure lies on the edge of the searched range: "
+                     f"{', '.join(edges)}; the best may lie outside it, widen the range", GripkitWarning)

@@ -34,7 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..arguments import entry_point
-from ..errors import AccuracyWarning, DataError, IdentificationError, SimulationError
+from ..errors import AccuracyWarning, DataError, IdentificationError, SimulationError, emit_warning
 from ..models.second_order import SecondOrderSystem, second_order_step
 from ..signals.trajectory import Trajectory
 from ..units import ratio_unit
@@ -222,14 +222,14 @@ def _unsettled(t: np.ndarray, ya: np.ndarray, amp: float, band: float) -> None:
     means = ya[-4 * w:].reshape(4, w).mean(axis=1)
     drift = float(np.ptp(means)) / abs(amp)
     if drift > band:
-        warnings.warn(
-            f"step_metrics: the response has not settled by the end of the record (t = "
-            f"{t[-1]:.4g} s): over its last 20 % its level still moves by {100 * drift:.3g} % of "
-            f"the step (more than the {100 * band:g} % band); the final level taken from it, and "
-            f"the overshoot, settling time and error measured against that level, are not "
-            f"reliable: the record is too short; record until the response settles, or pass "
-            f"y_final",
-            AccuracyWarning, stacklevel=3)
+        emit_warning(
+           f"step_metrics: the response has not settled by the end of the record (t = "
+           f"{t[-1]:.4g} s): over its last 20 % its level still moves by {100 * drift:.3g} % of "
+           f"the step (more than the {100 * band:g} % band); the final level taken from it, and "
+           f"the overshoot, settling time and error measured against that level, are not "
+           f"reliable: the record is too short; record until the response settles, or pass "
+           f"y_final",
+           AccuracyWarning)
 
 
 #: Fewest samples after the first input change that :func:`identify_step` fits (half its minimum
@@ -331,7 +331,7 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
             f"the fitted natural frequency {wn / (2 * math.pi):.4g} Hz is above the Nyquist frequency "
             f"{0.5 / dt:.4g} Hz of the data", hint="record at a higher sampling rate")
     if not res.identifiability.ok:
-        warnings.warn(f"step-response fit of {output!r}: {res.identifiability}", AccuracyWarning, stacklevel=2)
+        emit_warning(f"step-response fit of {output!r}: {res.identifiability}", AccuracyWarning)
     K = Kn * y_scale / u_scale
     y0 = y_ref + y0n * y_scale
     jd = np.array([y_scale / u_scale, 1.0 / (2 * math.pi), 1.0, y_scale])
@@ -343,9 +343,9 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
     corr = res.covariance / np.outer(d, d)
     m = second_order_metrics(wn, zeta)
     if m["settling_time"] > data.duration:
-        warnings.warn(f"step-response fit of {output!r}: the fitted response settles in "
-                      f"{m['settling_time']:.3g} s, longer than the {data.duration:.3g} s record; the gain "
-                      f"is extrapolated", AccuracyWarning, stacklevel=2)
+        emit_warning(f"step-response fit of {output!r}: the fitted response settles in "
+                     f"{m['settling_time']:.3g} s, longer than the {data.duration:.3g} s record; the gain "
+                     f"is extrapolated", AccuracyWarning)
 
     gunit = ratio_unit(data.unit(output), data.unit(input))
     return StepResponseResult(

@@ -34,13 +34,12 @@ from __future__ import annotations
 
 import contextlib
 import math
-import warnings
 
 import numba
 import numpy as np
 import scipy.linalg as sla
 
-from ..errors import DataError, IdentificationError, StabilityWarning
+from ..errors import DataError, IdentificationError, StabilityWarning, emit_warning
 from ..lti import StateSpace
 from .blocked_gram import add_rows, carried_states, carry, row_product, start_sums
 from .checks import check_dt
@@ -362,8 +361,8 @@ def _shift_invariance(fac, n: int, stable: bool, unstable_fit):
                                  "Maciejowski 1996)")
         else:
             info["stability"] = f"unstable model kept as asked (largest |pole| {rho:.4g})"
-            warnings.warn(f"subspace: the order-{n} model is unstable (largest |pole| {rho:.4g})",
-                          StabilityWarning, stacklevel=4)
+            emit_warning(f"subspace: the order-{n} model is unstable (largest |pole| {rho:.4g})",
+                         StabilityWarning)
     else:
         info["stability"] = "stable (shift-invariance estimate)"
     return G, A, C, info
@@ -391,14 +390,13 @@ def warn_if_stabilised(model: LinearModel, stacklevel: int = 3) -> None:
         return
     after = float(np.max(np.abs(model.system.poles())))
     fits = lambda f: ", ".join(f"{v:.3g} %" for v in f)  # noqa: E731
-    warnings.warn(
-        f"{model.structure}: the data point to an unstable system (the subspace estimate has "
-        f"largest |pole| {s['largest_pole_before']:.4g}, free-run fit "
-        f"{fits(s['fit_percent_before'])}); it was stabilised to largest |pole| {after:.6g} with "
-        f"free-run fit {fits(model.fit_percent)}: if the plant is unstable this model is not it; "
-        f"identify it from closed-loop data, or keep the "
-        f"unstable estimate with gripkit.sysid.n4sid(u, y, stable=False)", StabilityWarning,
-        stacklevel=stacklevel)
+    emit_warning(
+       f"{model.structure}: the data point to an unstable system (the subspace estimate has "
+       f"largest |pole| {s['largest_pole_before']:.4g}, free-run fit "
+       f"{fits(s['fit_percent_before'])}); it was stabilised to largest |pole| {after:.6g} with "
+       f"free-run fit {fits(model.fit_percent)}: if the plant is unstable this model is not it; "
+       f"identify it from closed-loop data, or keep the "
+       f"unstable estimate with gripkit.sysid.n4sid(u, y, stable=False)", StabilityWarning)
 
 
 def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int | None = None,

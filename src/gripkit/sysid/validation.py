@@ -21,12 +21,11 @@
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import DataError, StabilityWarning
+from ..errors import DataError, StabilityWarning, emit_warning
 from .checks import check_io
 
 __all__ = ["fit_percent", "records_fit", "loss_vn", "Comparison", "compare", "ResidualTests",
@@ -107,9 +106,8 @@ def compare(model, u, y, *, initial: str = "estimate") -> Comparison:
     stable = model.stable
     if not stable:
         pmax = float(np.max(np.abs(model.poles())))
-        warnings.warn(f"{model.label} is unstable (largest pole magnitude {pmax:.4g} > 1): its free-run "
-                      f"simulation diverges, so no simulation fit is reported", StabilityWarning,
-                      stacklevel=2)
+        emit_warning(f"{model.label} is unstable (largest pole magnitude {pmax:.4g} > 1): its free-run "
+                     f"simulation diverges, so no simulation fit is reported", StabilityWarning)
     u_past = u[:t0]
     if initial == "past":
         y_past = y[t0 - n_y:t0].copy() if n_y else np.zeros(0)

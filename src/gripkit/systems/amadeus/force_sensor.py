@@ -23,7 +23,6 @@ Kalman filter for use inside a control loop (``000_8f66dcc7ab06470c.txt`` §IV-A
 from __future__ import annotations
 
 import math
-import warnings
 from collections import namedtuple
 from dataclasses import dataclass
 
@@ -32,7 +31,7 @@ import numpy as np
 
 from ...control.rst import as_plant
 from ...errors import (AccuracyWarning, DataError, IdentificationError, ModelError,
-                       UnidentifiableError)
+                       UnidentifiableError, emit_warning)
 from ...lti import affine_row, flush_tiny
 from .strain_gauge_sensor import StrainGaugeSensor, sensitivity_matrix, sensor_parameters
 
@@ -305,8 +304,8 @@ def calibrate(loads, readings, *, beam_length: float, phi: tuple[float, float] |
         off_std = std[6:12] if offsets else np.zeros(6)
     if np.abs(cross).max() > 5.0:
         j, c = np.unravel_index(np.argmax(np.abs(cross)), cross.shape)
-        warnings.warn(f"bridge R{j + 1} responds to f_{'xyz'[c]} (z = {cross[j, c]:.1f}), which eqs 9-14 say it "
-                      "must not: cross-talk or a mislabelled axis", AccuracyWarning, stacklevel=2)
+        emit_warning(f"bridge R{j + 1} responds to f_{'xyz'[c]} (z = {cross[j, c]:.1f}), which eqs 9-14 say it "
+                     "must not: cross-talk or a mislabelled axis", AccuracyWarning)
     floor = np.sqrt(a)
     q1n = (q1 + math.pi) % (2 * math.pi) - math.pi
     q2n = (q2 + math.pi) % (2 * math.pi) - math.pi

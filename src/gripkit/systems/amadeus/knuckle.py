@@ -65,7 +65,6 @@ Each step of the command then costs exactly two switches (on, off) and ends with
 from __future__ import annotations
 
 import math
-import warnings
 from collections import namedtuple
 from dataclasses import dataclass
 
@@ -73,7 +72,7 @@ import numba
 import numpy as np
 
 from ...consistency import Finding, compare, warn_inconsistent
-from ...errors import DataError, ParameterError, StabilityWarning
+from ...errors import DataError, ParameterError, StabilityWarning, emit_warning
 from ...params import Parameter, ParameterSet
 from .hand import hand_parameters
 
@@ -352,10 +351,10 @@ class KnuckleDrive:
         bmin = minimum_dead_band(self.parameters, dt)
         b = 2.0 * bmin if dead_band is None else float(dead_band)
         if target is not None and b <= bmin:
-            warnings.warn(f"dead band {math.degrees(b):.3g}° is not above the coast bound "
-                          f"{math.degrees(bmin):.3g}° (half the angle travelled during a "
-                          "control period and the valve's switching delay, plus the reading's "
-                          "quantum): the valve may chatter", StabilityWarning, stacklevel=2)
+            emit_warning(f"dead band {math.degrees(b):.3g}° is not above the coast bound "
+                         f"{math.degrees(bmin):.3g}° (half the angle travelled during a "
+                         "control period and the valve's switching delay, plus the reading's "
+                         "quantum): the valve may chatter", StabilityWarning)
         v_ext, v_ret = self.speeds(load)
         prm = np.array([self._p("pin_offset"), 0.5 * self.stroke, v_ext, v_ret,
                         self._p("switch_delay"),

@@ -60,14 +60,13 @@ Tolerance derived from the model: with pressure error δP per tube, the tip erro
 from __future__ import annotations
 
 import math
-import warnings
 from collections import namedtuple
 from dataclasses import dataclass
 
 import numba
 import numpy as np
 
-from ...errors import AccuracyWarning, DataError, ModelError, ParameterError
+from ...errors import AccuracyWarning, DataError, ModelError, ParameterError, emit_warning
 from .bellows_finger import BAR, TUBE_PUSH_ANGLES, BellowsFinger
 from .valve import ProportionalValve, valve_static
 
@@ -341,8 +340,8 @@ class FingerPositionController:
                                        "far as the limits allow in the same direction")
         Ps = self._saturated(psi, th, s)
         reached = f.bending(Ps).tip
-        warnings.warn(f"{msg}; saturated to ({reached[0] * 1e3:.4g}, {reached[1] * 1e3:.4g}, "
-                      f"{reached[2] * 1e3:.4g}) mm", AccuracyWarning, stacklevel=2)
+        emit_warning(f"{msg}; saturated to ({reached[0] * 1e3:.4g}, {reached[1] * 1e3:.4g}, "
+                     f"{reached[2] * 1e3:.4g}) mm", AccuracyWarning)
         return Ps, reached
 
     def _saturated(self, psi, th, s):

@@ -46,7 +46,6 @@ from __future__ import annotations
 
 import dataclasses
 import math
-import warnings
 from collections import namedtuple
 from collections.abc import Mapping
 
@@ -55,7 +54,7 @@ import numpy as np
 from numba import prange
 
 from ...consistency import Finding, compare
-from ...errors import AccuracyWarning, DataWarning, ModelError, ParameterError
+from ...errors import AccuracyWarning, DataWarning, ModelError, ParameterError, emit_warning
 from ...models.hysteresis import bouc_wen_advance
 from ...models.piezo import actuator_parameters, actuator_state_space, lti_modes, run_bw_lti
 from ...params import Parameter, ParameterSet
@@ -94,19 +93,18 @@ def check_ranges(trajectory, positions: tuple[str, ...], forces: tuple[str, ...]
     for name in positions:
         peak = float(np.max(np.abs(trajectory[name]))) if trajectory.n else 0.0
         if peak > stroke:
-            warnings.warn(f"{subject}: {name} reaches {peak * 1e6:.4g} µm, beyond the finger's "
-                          f"{stroke * 1e6:.3g} µm displacement range ({_SEED} Table I): the model "
-                          "extrapolates there (lower the voltage amplitude)", AccuracyWarning,
-                          stacklevel=3)
+            emit_warning(f"{subject}: {name} reaches {peak * 1e6:.4g} µm, beyond the finger's "
+                         f"{stroke * 1e6:.3g} µm displacement range ({_SEED} Table I): the model "
+                         "extrapolates there (lower the voltage amplitude)", AccuracyWarning)
     clipped = {}
     for name in forces:
         x = trajectory[name]
         peak = float(np.max(np.abs(x))) if x.size else 0.0
         if peak > limit:
-            warnings.warn(f"{subject}: {name} reaches {peak * 1e3:.4g} mN, beyond the sensor's "
-                          f"{limit * 1e3:.3g} mN sensing range ({_SEED} Table I): the reading is "
-                          "clipped "
-                          f"to ±{limit * 1e3:.3g} mN", DataWarning, stacklevel=3)
+            emit_warning(f"{subject}: {name} reaches {peak * 1e3:.4g} mN, beyond the sensor's "
+                         f"{limit * 1e3:.3g} mN sensing range ({_SEED} Table I): the reading is "
+                         "clipped "
+                         f"to ±{limit * 1e3:.3g} mN", DataWarning)
             clipped[name] = np.clip(x, -limit, limit)
     return trajectory.with_channels(**clipped) if clipped else trajectory
 
