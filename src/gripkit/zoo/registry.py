@@ -79,27 +79,27 @@ _ENTRIES: tuple[ZooEntry, ...] = (
     ZooEntry("ftg100-actuated", "FemtoTools FT-G100 microgripper",
              "Actuated subsystem linearised at 70 V with the 80 um glass ball grasped (eqs 8-10): "
              "voltage (V) to tip displacement (m), M_a, K_fa, k0 identified in §III-B",
-             _FTG, "gripkit.systems.ftg100.parameters:actuated_model"),
+             _FTG, "gripkit.systems.ftg100.model:actuated_model"),
     ZooEntry("ftg100-sensing", "FemtoTools FT-G100 microgripper",
              "Sensing subsystem (eqs 14-17): gripping force (N) to sensing-arm tip deflection (m), "
              "M_b, K_fb identified in §III-D; checks the printed eq 17",
-             _FTG, "gripkit.systems.ftg100.parameters:sensing_model"),
+             _FTG, "gripkit.systems.ftg100.model:sensing_model"),
     ZooEntry("ftg100-coupled", "FemtoTools FT-G100 microgripper",
              "Coupled gripper model (eq 18): voltage (V) to tip displacements, gripping force and "
              "readout voltage through the object stiffness k0",
-             _FTG, "gripkit.systems.ftg100.parameters:coupled_model"),
+             _FTG, "gripkit.systems.ftg100.model:coupled_model"),
     ZooEntry("ftg100-plant", "FemtoTools FT-G100 microgripper",
              "Nonlinear plant: eq 5 comb-drive force as printed (V², 0-200 V), the linear "
              "suspensions "
              "of eqs 4 and 8-10 (eq 10 at 70 V grasped), unilateral contact with the ball after "
              "the "
              "20 um gap (the stated 20 um at 70 V read as the travel to the ball; reported)",
-             _FTG, "gripkit.systems.ftg100.parameters:plant_model"),
+             _FTG, "gripkit.systems.ftg100.model:plant_model"),
     ZooEntry("ftg100-plant-calibrated", "FemtoTools FT-G100 microgripper",
              "Nonlinear plant with the comb-drive force factor fitted to the stated 20 um at 70 V "
              "read as the free tip's travel (0.460 x eq 5); its departure from eqs 5 and 10 is "
              "reported",
-             _FTG, "gripkit.systems.ftg100.parameters:calibrated_plant_model"),
+             _FTG, "gripkit.systems.ftg100.model:calibrated_plant_model"),
     ZooEntry("tsfm-left", "TSFM piezo microgripper", "Left finger, Table II: Bouc-Wen + D(s) actuator, lever, force "
              "sensor (8.52 kHz, ζ = 0.006), eqs 3-13", _TSFM, "gripkit.systems.tsfm.parameters:left_finger"),
     ZooEntry("tsfm-right", "TSFM piezo microgripper", "Right finger, Table II (as tsfm-left)", _TSFM,
