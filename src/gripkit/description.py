@@ -63,15 +63,16 @@ _SIDES = {"tsfm-left": "left", "tsfm-right": "right"}
 def _finger_options(params: Mapping, options: Mapping) -> dict:
     side = _SIDES.get(options.get("zoo", "tsfm-left"))
     if side is None:
-        raise ConfigError(f"[model] zoo = {options.get('zoo')!r}: a TSFM finger type starts from 'tsfm-left' "
-                          f"or 'tsfm-right'")
+        raise ConfigError(f"[model] zoo = {options.get('zoo')!r}: a TSFM finger type starts from "
+                          "'tsfm-left' or 'tsfm-right'")
     return {"side": side}
 
 
 def _contact_options(params: Mapping, options: Mapping) -> dict:
     for key in ("x_w", "k_e"):
         if key not in params:
-            raise ConfigError(f"[parameters]: a tsfm-finger-contact needs {key!r} (x_w: part face, k_e: stiffness)")
+            raise ConfigError(f"[parameters]: a tsfm-finger-contact needs {key!r} "
+                              "(x_w: part face, k_e: stiffness)")
     return _finger_options(params, options)
 
 
@@ -218,7 +219,9 @@ def load_description(path, overrides: Mapping | None = None) -> Description:
                               hint="types (the zoo's models, `gripkit zoo list`): "
                                    f"{', '.join(zoo_names)}")
         if not hasattr(model, "simulate"):
-            raise ConfigError(f"{path.name}: zoo model {mspec.get('zoo')!r} cannot be simulated")
+            raise ConfigError(f"{path.name}: zoo model {mtype or mspec.get('zoo')!r} cannot be "
+                              "simulated", hint="`gripkit zoo list` shows the models; pick one "
+                                                "with inputs and outputs")
         names = set(model.parameters.names)
         bad = sorted(set(params) - names)
         if bad:

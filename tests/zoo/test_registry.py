@@ -104,6 +104,9 @@ def test_unknown_type_lists_the_zoo(tmp_path):
     with pytest.raises(ConfigError, match="type = 'piano' is unknown") as e:
         load_description(p)
     assert "mass-spring-damper" in e.value.hint and "ftg100-plant" in e.value.hint
+    p.write_text("[model]\ntype = \"amadeus-hand\"\n[simulation]\nfs = 10\nduration = 1\n")
+    with pytest.raises(ConfigError, match="zoo model 'amadeus-hand' cannot be simulated"):
+        load_description(p)
 
 
 def test_sweeps_resolve_models_in_the_zoo():

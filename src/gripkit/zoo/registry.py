@@ -57,17 +57,6 @@ _DLR = "002_ddea254371185ad3.txt"
 _FTG = "003_abd62b560633beaf.txt"
 
 _ENTRIES: tuple[ZooEntry, ...] = (
-    ZooEntry("mass-spring-damper", "generic",
-             "m x'' + b x' + k x = F: force (N) to position (m), exact ZOH; m = 1 kg, k = 1 N/m, "
-             "ζ = 0.05 (illustrative values)", "",
-             "gripkit.models.reference:reference_mass_spring_damper"),
-    ZooEntry("bouc-wen", "generic",
-             "Rate-independent Bouc-Wen hysteresis (eq 3): voltage (V) to displacement (m), "
-             "Table II left-finger values", _TSFM, "gripkit.models.reference:reference_bouc_wen"),
-    ZooEntry("piezo-actuator", "generic",
-             "Piezo actuator (eq 4): Bouc-Wen then D(s), voltage and tip loads to tip deflection "
-             "and angle, Table II left-finger values (loads=False: voltage only)",
-             _TSFM, "gripkit.models.reference:reference_piezo_actuator"),
     ZooEntry("amadeus-finger-force", "AMADEUS subsea hand",
              "Finger force dynamics, ARX [2 2 2] LS model of Table II (9 Hz filtered data), valve "
              "current (A) to fingertip force (N) at 200 Hz, two-sample valve delay",
@@ -118,6 +107,17 @@ _ENTRIES: tuple[ZooEntry, ...] = (
     ZooEntry("dlr-hit-hand", "DLR/HIT Hand II",
              "Five identical fingers on a palm, thumb fixed, per-finger friction (§3.1, §6.3)",
              _DLR, "gripkit.systems.dlr_hit.hand:hand"),
+    ZooEntry("mass-spring-damper", "generic",
+             "m x'' + b x' + k x = F: force (N) to position (m), exact ZOH; m = 1 kg, k = 1 N/m, "
+             "ζ = 0.05 (illustrative values)", "",
+             "gripkit.models.reference:reference_mass_spring_damper"),
+    ZooEntry("bouc-wen", "generic",
+             "Rate-independent Bouc-Wen hysteresis (eq 3): voltage (V) to displacement (m), "
+             "Table II left-finger values", _TSFM, "gripkit.models.reference:reference_bouc_wen"),
+    ZooEntry("piezo-actuator", "generic",
+             "Piezo actuator (eq 4): Bouc-Wen then D(s), voltage and tip loads to tip deflection "
+             "and angle, Table II left-finger values (loads=False: voltage only)",
+             _TSFM, "gripkit.models.reference:reference_piezo_actuator"),
 )
 
 

@@ -44,7 +44,8 @@ from .gripper import (RANGES, TSFMFinger, TSFMFingerContact, TSFMGripper, finger
 
 __all__ = ["TABLE_II", "REFERENCE", "ASSUMED_LENGTHS", "TABLE_III", "table_iii_findings", "left_finger",
            "right_finger", "finger_contact", "FIG13_PART", "gripper", "table_ii", "finger",
-           "hysteresis_experiment", "step_experiment", "compliance_experiment", "sensor_calibration_experiment", "free_vibration_experiment",
+           "hysteresis_experiment", "step_experiment", "compliance_experiment",
+           "sensor_calibration_experiment", "free_vibration_experiment",
            "contact_experiment", "contact_voltage", "separation_voltage", "fig13_findings",
            "table_iii_pattern_finding", "stroke_finding"]
 

@@ -8,10 +8,10 @@ confidence interval, and the probabilities against the part's stiffness.
 >>> print(res.p_damage, res.p_lost, res.settling_median)          # doctest: +SKIP
 
 The study is a sweep (:func:`gripkit.batch.sweep`): any backend, checkpointing, resume, per-job
-failure records. Statistics (:mod:`gripkit.batch.montecarlo`, the generic part): Wilson intervals for the
-probabilities, order-statistic intervals for the settling-time quantiles (grasps that never
-settle count as +inf, so they push the quantiles up instead of being dropped), Wilson intervals
-per stiffness bin. Failed jobs (errors) are excluded and counted.
+failure records. Statistics (:mod:`gripkit.batch.montecarlo`, the generic part): Wilson
+intervals for the probabilities, order-statistic intervals for the settling-time quantiles
+(grasps that never settle count as +inf, so they push the quantiles up instead of being
+dropped), Wilson intervals per stiffness bin. Failed jobs (errors) are excluded and counted.
 
 The same numbers come from ``gripkit sweep examples/sweep_tsfm_robustness.toml`` followed by
 :func:`analyse` on the result folder's table.
