@@ -37,7 +37,8 @@ LAZY_MODULES = {
     ("sysid/identify_mimo.py", ".pem_ss"): "numba kernels: only state-space identification loads them",
     ("sysid/identify_mimo.py", ".subspace"): "numba kernels: only state-space identification loads them",
     ("sysid/identify_mimo.py", ".tfest"): "scipy.signal (0.85 s): only transfer-function fits load it",
-    ("batch/robustness.py", "..report.plots"): "matplotlib (0.34 s): only the robustness plot loads it",
+    ("systems/tsfm/robustness.py", "...report.plots"):
+        "matplotlib (0.34 s): only the robustness plot loads it",
     ("lti/_system.py", "._kernels"): "numba simulation kernel: lti loads without numba",
     ("sysid/linear_model.py", "..lti"): "lti's numba simulation kernel, loaded on the first simulation",
     ("systems/tsfm/grasp_batch.py", ".grasp_gpu"): "numba.cuda: the GPU path only",

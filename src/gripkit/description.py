@@ -4,8 +4,8 @@ A description names a model type (or a zoo model), overrides parameters (numbers
 carry their unit), sets the sampling, and gives each model input as a signal::
 
     [model]
-    type = "tsfm-finger-contact"     # see MODEL_TYPES; or `zoo = "tsfm-left"` for a zoo model
-    zoo = "tsfm-left"                # optional for the TSFM types: start from this zoo finger
+    type = "tsfm-finger-contact"     # a zoo model (`gripkit zoo list`); or `zoo = "tsfm-left"`
+    zoo = "tsfm-left"                # optional for the TSFM finger types: start from this finger
 
     [parameters]
     x_w = "62.4 um"                  # the part face (Fig. 13)
@@ -32,7 +32,10 @@ t0 and t1, held outside); ``sine``: amplitude, frequency, offset = 0, phase_deg 
 TOML file), column, optionally time (column name; else the file's own time base) — interpolated
 onto the simulation's time base.
 
-Other developers add model types with :func:`register_model_type`.
+Model names resolve in the zoo (:mod:`gripkit.zoo`), the one registry of buildable models: other
+developers add one with :func:`gripkit.zoo.register`. ``[model]`` options: ``loads`` (bool) for a
+``piezo-actuator``; ``zoo = "tsfm-left" | "tsfm-right"`` (the side) for ``tsfm-finger`` and
+``tsfm-finger-contact``, which needs ``x_w`` and ``k_e`` in ``[parameters]``.
 """
 
 from __future__ import annotations
@@ -49,63 +52,47 @@ from .arguments import check_path
 from .errors import ConfigError, GripkitError
 from .io import load
 from .io.toml_file import read_toml
-from .models.hysteresis import BoucWen
-from .models.mass_spring_damper import MassSpringDamper
-from .models.piezo import PiezoActuator
 from .signals.trajectory import Trajectory
-from .systems.tsfm import parameters as tsfm
 
-__all__ = ["Description", "MODEL_TYPES", "register_model_type", "load_description", "simulate_description",
-           "input_signal"]
+__all__ = ["Description", "load_description", "simulate_description", "input_signal"]
 
 
-def _msd(params, options):
-    return MassSpringDamper(check=False)
+_SIDES = {"tsfm-left": "left", "tsfm-right": "right"}
 
 
-def _bouc_wen(params, options):
-    return BoucWen(check=False)
-
-
-def _piezo(params, options):
-    return PiezoActuator(loads=bool(options.get("loads", True)), check=False)
-
-
-def _finger(params, options):
-    side = {"tsfm-left": "left", "tsfm-right": "right"}.get(options.get("zoo", "tsfm-left"))
+def _finger_options(params: Mapping, options: Mapping) -> dict:
+    side = _SIDES.get(options.get("zoo", "tsfm-left"))
     if side is None:
-        raise ConfigError(f"[model] zoo = {options.get('zoo')!r}: a TSFM finger type starts from 'tsfm-left' "
-                          f"or 'tsfm-right'")
-    return tsfm.finger(side, check=False)
+        raise ConfigError(f"[model] zoo = {options.get('zoo')!r}: a TSFM finger type starts from "
+                          "'tsfm-left' or 'tsfm-right'")
+    return {"side": side}
 
 
-def _finger_contact(params, options):
-    f = _finger(params, options)
+def _contact_options(params: Mapping, options: Mapping) -> dict:
     for key in ("x_w", "k_e"):
         if key not in params:
-            raise ConfigError(f"[parameters]: a tsfm-finger-contact needs {key!r} (x_w: part face, k_e: stiffness)")
-    return f.contact(x_w=0.0, k_e=1.0)
+            raise ConfigError(f"[parameters]: a tsfm-finger-contact needs {key!r} "
+                              "(x_w: part face, k_e: stiffness)")
+    return _finger_options(params, options)
 
 
-def _gripper(params, options):
-    return tsfm.gripper(check=False)
-
-
-#: model type → builder(parameters, model options) returning a gripkit.sim.Model
-MODEL_TYPES: dict[str, Callable] = {
-    "mass-spring-damper": _msd,
-    "bouc-wen": _bouc_wen,
-    "piezo-actuator": _piezo,
-    "tsfm-finger": _finger,
-    "tsfm-finger-contact": _finger_contact,
-    "tsfm-gripper": _gripper,
+#: [model] options of the types that take some → keywords of their zoo factory
+_OPTIONS: dict[str, Callable] = {
+    "piezo-actuator": lambda params, options: {"loads": bool(options.get("loads", True))},
+    "tsfm-finger": _finger_options,
+    "tsfm-finger-contact": _contact_options,
 }
 
 
-def register_model_type(name: str, builder: Callable) -> None:
-    """Make ``type = name`` available in descriptions; ``builder(parameters: dict, options: dict)``
-    returns a :class:`gripkit.sim.Model` (parameters are applied afterwards)."""
-    MODEL_TYPES[name] = builder
+def _build(mtype: str, params: Mapping, options: Mapping):
+    """The zoo model ``mtype`` built with its [model] options, unchecked when its factory allows
+    (the [parameters] are applied afterwards)."""
+    entry = zoo.get(mtype)
+    kwargs = _OPTIONS[mtype](params, options) if mtype in _OPTIONS else {}
+    names = entry.keywords()
+    if names is None or "check" in names:
+        kwargs["check"] = False
+    return entry.build(**kwargs)
 
 
 @dataclass(frozen=True)
@@ -217,19 +204,24 @@ def load_description(path, overrides: Mapping | None = None) -> Description:
     for key in ("type", "zoo"):
         if key in mspec and not isinstance(mspec[key], str):
             raise ConfigError(f"{path.name}: [model] {key} must be a string, found {mspec[key]!r:.60}")
+    zoo_names = [e.name for e in zoo.entries()]
     if "type" not in mspec and "zoo" not in mspec:
-        raise ConfigError(f"{path.name}: [model] needs 'type' (one of {', '.join(MODEL_TYPES)}) or 'zoo'")
+        raise ConfigError(f"{path.name}: [model] needs 'type' or 'zoo' "
+                          f"(a zoo model: {', '.join(zoo_names)})")
     mtype = mspec.get("type")
     try:
         if mtype is None:
             model = zoo.build(mspec["zoo"])
-        elif mtype in MODEL_TYPES:
-            model = MODEL_TYPES[mtype](params, mspec)
+        elif mtype in zoo_names:
+            model = _build(mtype, params, mspec)
         else:
             raise ConfigError(f"{path.name}: [model] type = {mtype!r} is unknown",
-                              hint=f"types: {', '.join(MODEL_TYPES)}")
+                              hint="types (the zoo's models, `gripkit zoo list`): "
+                                   f"{', '.join(zoo_names)}")
         if not hasattr(model, "simulate"):
-            raise ConfigError(f"{path.name}: zoo model {mspec.get('zoo')!r} cannot be simulated")
+            raise ConfigError(f"{path.name}: zoo model {mtype or mspec.get('zoo')!r} cannot be "
+                              "simulated", hint="`gripkit zoo list` shows the models; pick one "
+                                                "with inputs and outputs")
         names = set(model.parameters.names)
         bad = sorted(set(params) - names)
         if bad:

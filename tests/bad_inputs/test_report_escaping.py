@@ -262,7 +262,7 @@ def test_identify_dynamics_report(cli, tmp_path):
 
 
 def test_robustness_report_on_a_sweep_table_with_hostile_parameter_names(tmp_path):
-    from gripkit.batch.robustness import analyse
+    from gripkit.systems.tsfm.robustness import analyse
     from gripkit.report import Report
 
     rng = np.random.default_rng(1)

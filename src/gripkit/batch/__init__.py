@@ -1,5 +1,7 @@
 """Batch runs: parameter sweeps and Monte Carlo studies on in-process, process-pool or Dask
-executors, with results checkpointed per chunk in Parquet."""
+executors, with results checkpointed per chunk in Parquet, and their statistics (confidence
+intervals of probabilities and quantiles). A system's study built on them lives with the system
+(the TSFM grasp robustness: :mod:`gripkit.systems.tsfm.robustness`)."""
 
 from .executors import DaskExecutor as DaskExecutor
 from .executors import InProcessExecutor as InProcessExecutor
@@ -14,9 +16,7 @@ from .montecarlo import quantile as quantile
 from .spec import SweepSpec as SweepSpec
 from .sweep import SweepResult as SweepResult
 from .sweep import sweep as sweep
-from .robustness import RobustnessResult as RobustnessResult
-from .robustness import robustness_study as robustness_study
 
 __all__ = ["binned_probability", "DaskExecutor", "Estimate", "IDENTIFIERS", "identify_many",
            "InProcessExecutor", "make_executor", "probability", "ProcessExecutor", "quantile",
-           "robustness_study", "RobustnessResult", "sweep", "SweepResult", "SweepSpec"]
+           "sweep", "SweepResult", "SweepSpec"]

@@ -31,8 +31,9 @@ from ..sim.model import Model
 from ..sysid.step_response import step_metrics
 from .spec import quantity
 
-__all__ = ["SCENARIOS", "MODELS", "Setting", "Interface", "Prepared", "read_settings", "resolve", "build_model",
-           "prepare", "step_response", "step_metrics_rows", "POSITIVE_TIME", "POSITIVE_RATE", "FRACTION"]
+__all__ = ["SCENARIOS", "Setting", "Interface", "Prepared", "read_settings", "resolve",
+           "build_model", "prepare", "step_response", "step_metrics_rows", "POSITIVE_TIME",
+           "POSITIVE_RATE", "FRACTION"]
 
 SCENARIOS: dict[str, str] = {
     "step-response": "gripkit.batch.scenarios:step_response",
@@ -40,8 +41,6 @@ SCENARIOS: dict[str, str] = {
     "ftg100-grasp": "gripkit.systems.ftg100.scenario:ftg100_grasp",
 }
 
-#: models a sweep may name besides the zoo's (:func:`gripkit.zoo.entries`)
-MODELS: dict[str, str] = {"mass-spring-damper": "gripkit.models:MassSpringDamper"}
 
 
 # --- what a scenario accepts ------------------------------------------------------------------
@@ -165,23 +164,22 @@ _MODELS: dict = {}
 
 
 def build_model(ref: str | None, allow_code: bool = False):
-    """Build (once per process) the model a sweep names: a zoo entry, one of :data:`MODELS`, or
-    (only when ``allow_code``) ``"module:factory"``."""
+    """Build (once per process) the model a sweep names: a zoo entry (:mod:`gripkit.zoo`, the one
+    registry of buildable models), or (only when ``allow_code``) ``"module:factory"``."""
     if ref is None:
         return None
     key = (ref, allow_code)
     if key not in _MODELS:
         zoo_names = [e.name for e in zoo.entries()]
-        if ref in MODELS:
-            factory = _import(MODELS[ref], f"model {ref!r}")
-        elif ref in zoo_names:
+        if ref in zoo_names:
             factory = zoo.get(ref).build
         elif ":" in ref:
             if not allow_code:
-                raise _refuse_code("model", ref, [*MODELS, *zoo_names])
+                raise _refuse_code("model", ref, zoo_names)
             factory = _import(ref, f"model {ref!r}")
         else:
-            raise ConfigError(f"unknown model {ref!r}", hint=f"registered: {', '.join([*MODELS, *zoo_names])}")
+            raise ConfigError(f"unknown model {ref!r}",
+                              hint=f"registered (the zoo): {', '.join(zoo_names)}")
         with warnings.catch_warnings():  # consistency findings are reported by `gripkit zoo check`
             warnings.simplefilter("ignore", ConsistencyWarning)
             try:

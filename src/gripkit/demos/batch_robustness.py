@@ -8,8 +8,8 @@ from __future__ import annotations
 import time
 from dataclasses import asdict
 
-from ..batch.robustness import DEFAULT_POPULATION, DEFAULT_SETTINGS, robustness_study
 from ..systems.tsfm.grasp_batch import FAST_GRASP
+from ..systems.tsfm.robustness import DEFAULT_POPULATION, DEFAULT_SETTINGS, robustness_study
 
 
 def run(report, *, quick: bool = False) -> dict:
@@ -30,7 +30,8 @@ def run(report, *, quick: bool = False) -> dict:
              f"lost: not held by both fingers at the end, or pushed more than 10 µm on the substrate (20 µN "
              f"friction); settling: the grip force within ±5 % of the command, timed from the second contact. "
              f"Probabilities with Wilson intervals, quantiles with order-statistic intervals (grasps that never "
-             f"settle count as +∞). Both studies ran in {seconds:.1f} s in-process (`gripkit.batch.robustness`; "
+             f"settle count as +∞). Both studies ran in {seconds:.1f} s in-process "
+             f"(`gripkit.systems.tsfm.robustness`; "
              f"the same study as a checkpointed sweep: `gripkit sweep examples/sweep_tsfm_robustness.toml`).")
     hold.report(report, "Batch: Monte Carlo grasp robustness (TSFM, hold strategy)", intro)
     sec = naive.report(report, "Batch: the naive grasp on the same population",

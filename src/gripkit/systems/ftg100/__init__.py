@@ -1,8 +1,9 @@
 """The FemtoTools FT-G100 electrostatic MEMS microgripper (``003_abd62b560633beaf.txt``).
 
-- :mod:`.model` — the knowledge-based models: actuated and sensing subsystems, the coupled model,
-  the nonlinear plant, the discrete state space at 20 kHz (eqs 1–18);
-- :mod:`.parameters` — the seed's identified values and the zoo's model factories;
+- :mod:`.parameters` — every number the seed gives, with provenance (the one home of them);
+- :mod:`.model` — the knowledge-based models, which read those numbers: actuated and sensing
+  subsystems, the coupled model, the nonlinear plant, the discrete state space at 20 kHz
+  (eqs 1–18), and the zoo's model factories;
 - :mod:`.identification` — the seed's identification experiments, simulated, and their
   Levenberg-Marquardt identification (§III-B, §III-D);
 - :mod:`.hybrid_control` — hybrid force/position control of the gripper arm (the seed's future

@@ -1,5 +1,7 @@
 """FemtoTools FT-G100 electrostatic MEMS microgripper: knowledge-based models (seed
 ``003_abd62b560633beaf.txt``, Boudaoud, Haddab & Le Gorrec, IROS 2010, §II-III, eqs 1-18).
+Every number of the seed they use, with its provenance, is in
+:mod:`gripkit.systems.ftg100.parameters`; the zoo's factories are at the end of this module.
 
 The extracted text interleaves the paper's two columns and loses Greek letters, minus signs and
 fraction bars. The equations as gripkit reconstructs them (SI units throughout; the seed's own
@@ -132,26 +134,18 @@ from ...models.second_order import second_order_batch
 from ...params import Parameter, ParameterSet
 from ...sim.linear import StateSpace, c2d_zoh, simulate_discrete
 from ...sim.model import Model, Signal
+from .parameters import (DT, R_SENSITIVITY, SEED, SEED_EQ10, SEED_EQ17, STATIC_70V, ftg100_geometry,
+                         ftg100_parameters, plant_table)
 
 __all__ = [
     "SEED", "amplification_ratio", "ftg100_geometry", "ftg100_parameters", "controllable_form",
     "balancing_scale", "seed_state_space", "SEED_EQ10", "SEED_EQ17", "FTG100Actuated",
     "FTG100Sensing", "FTG100Coupled", "FTG100Plant", "plant_parameters", "advance_plant",
-    "R_SENSITIVITY", "STATIC_70V", "static_force_factor", "full_close_voltage",
+    "R_SENSITIVITY", "STATIC_70V", "static_force_factor", "full_close_voltage", "actuated_model",
+    "sensing_model", "coupled_model", "plant_model", "calibrated_plant_model",
 ]
 
-SEED = "003_abd62b560633beaf.txt"
 _S = SEED + ", "
-#: Readout sensitivity r of eq 18 as gripkit reads it: 50 µN/V (the seed prints "50 N/Volts").
-R_SENSITIVITY = 50e-6
-
-# Eq 10 and eq 17 as printed (seed units: V -> µm for eq 10, µN -> µm for eq 17), 20 kHz (dt = 50 µs).
-SEED_EQ10 = dict(A=[[1.6621, -0.9536], [1.0, 0.0]], B=[[0.25], [0.0]], C=[[0.1104, 0.1086]],
-                 dt=5e-05, input="V_in", input_unit="V", output="x_a", output_unit="um",
-                 source=_S + "eq 10")
-SEED_EQ17 = dict(A=[[1.142174, -0.947527], [1.0, 0.0]], B=[[0.5], [0.0]], C=[[0.132080, 0.129656]],
-                 dt=5e-05, input="F_c", input_unit="uN", output="x_b", output_unit="um",
-                 source=_S + "eq 17")
 
 _UNIT = {"um": 1e-6, "uN": 1e-6, "V": 1.0, "m": 1.0, "N": 1.0}
 
@@ -164,61 +158,6 @@ def amplification_ratio(H: float, l: float, arm: float) -> float:
         raise ModelError(f"amplification ratio: expected positive dimensions with H > l/2, found "
                          f"H={H:g}, l={l:g}, arm={arm:g}")
     return (H - l / 2.0) / (arm + l / 2.0)
-
-
-def ftg100_geometry() -> ParameterSet:
-    """The FT-G100 dimensions and materials the seed gives (§III-A, III-C, Fig. 2, Fig. 6)."""
-    um = 1e-6
-    P = Parameter
-    return ParameterSet([
-        P("E", 190e9, "Pa", "Young's modulus of the silicon beams", (0, None), source=_S + "§III-A, after eq 4", display_unit="GPa"),
-        P("h", 50 * um, "m", "structure (beam and finger) thickness", (0, None), source=_S + "§III-A, after eq 4", display_unit="um"),
-        P("w", 8 * um, "m", "suspension beam width", (0, None), source=_S + "§III-A, after eq 4", display_unit="um"),
-        P("L1", 1830 * um, "m", "actuator suspension beam length", (0, None), source=_S + "§III-A, after eq 4", display_unit="um"),
-        P("L2", 870 * um, "m", "sensor suspension beam length", (0, None), source=_S + "§III-C, after eq 15", display_unit="um"),
-        P("H", 5300 * um, "m", "arm length dimension of eqs 3/12", (0, None), source=_S + "§III-A, after eq 3", display_unit="um"),
-        P("l", 300 * um, "m", "hinge dimension of eqs 3/12 (hinge at l/2 from the clamp)", (0, None), source=_S + "§III-A, after eq 3", display_unit="um"),
-        P("a", 950 * um, "m", "actuated-arm lever dimension of eq 3", (0, None), source=_S + "§III-A, after eq 3", display_unit="um"),
-        P("b", 700 * um, "m", "sensing-arm lever dimension of eq 12", (0, None), source=_S + "§III-C, after eq 15", display_unit="um"),
-        P("N_a", 1300.0, "1", "electrode pairs of the lateral comb drive", (1, None), source=_S + "§III-A, after eq 5"),
-        P("eps", 8.85e-12, "F/m", "permittivity of the comb gaps (air)", (0, None), source=_S + "§III-A, after eq 5", display_unit="pF/m"),
-        P("g", 6 * um, "m", "gap between comb fingers", (0, None), source=_S + "§III-A, after eq 5", display_unit="um"),
-        P("V_max", 200.0, "V", "maximum actuation voltage (full close)", (0, None), source=_S + "§II-A"),
-        P("opening", 100 * um, "m", "initial opening between the arm tips", (0, None), source=_S + "§II-A", display_unit="um"),
-        P("resolution", 50e-9, "N", "force sensor resolution", (0, None), source=_S + "§II-A", display_unit="uN"),
-        P("force_range", 140e-6, "N", "largest force of the static sensor characteristic", (0, None), source=_S + "§III-D, Fig. 10", display_unit="uN"),
-        P("k2_measured", 6.48, "N/m", "sensing-arm stiffness measured from Fig. 10", (0, None), source=_S + "§III-D, Fig. 10"),
-        P("x_a70", 20e-6, "m", "static tip displacement at 70 V (free arm)", (0, None), source=_S + "§III-A, after Fig. 4", display_unit="um"),
-    ], "ftg100-geometry")
-
-
-def ftg100_parameters() -> ParameterSet:
-    """Every FT-G100 model parameter at the seed's values (SI), with provenance.
-
-    Stated values are used as printed (D_a = 4.7, K_sa = 25.4 N/m, ...); the consistency checks of
-    the models compare them with what eqs 3, 4, 12, 13, 16 give from the dimensions.
-    """
-    P = Parameter
-    return ParameterSet([
-        P("M_a", 1.37e-6, "kg", "total (effective) mass of the actuated subsystem", (1e-12, 1e-3), source=_S + "§III-B, LM estimate", display_unit="mg"),
-        P("K_fa", 1.3e-3, "N*s/m", "damping factor of the actuated subsystem", (0, 1.0), source=_S + "§III-B, LM estimate (printed unit mNs²/m read as mN·s/m)", display_unit="mN*s/m"),
-        P("k0", 1043.0, "N/m", "stiffness of the grasped object (80 µm glass ball)", (0, 1e7), source=_S + "§III-B, LM estimate"),
-        P("K_sa", 25.4, "N/m", "actuator suspension stiffness (two pairs of clamped-clamped beams)", (0, None), source=_S + "§III-A, eq 4 value stated after Fig. 7"),
-        P("D_a", 4.7, "1", "actuated-arm amplification x_a/x_ea", (0, None), source=_S + "§III-A, eq 3 value stated after Fig. 7"),
-        P("k2", 6.45, "N/m", "sensing-arm tip stiffness K_sb/D_b²", (0, None), source=_S + "§III-C, eq 16"),
-        P("N_a", 1300.0, "1", "electrode pairs of the lateral comb drive", (1, None), source=_S + "§III-A, after eq 5"),
-        P("eps", 8.85e-12, "F/m", "permittivity of the comb gaps (air)", (0, None), source=_S + "§III-A, after eq 5", display_unit="pF/m"),
-        P("h", 50e-6, "m", "comb-finger thickness", (0, None), source=_S + "§III-A, after eq 4", display_unit="um"),
-        P("g", 6e-6, "m", "gap between comb fingers", (0, None), source=_S + "§III-A, after eq 5", display_unit="um"),
-        P("V0", 70.0, "V", "operating voltage V_in0 of the linearisation", (0, 200), source=_S + "§III-A, before eq 8"),
-        P("M_b", 0.5e-6, "kg", "total mass of the sensing subsystem", (1e-12, 1e-3), source=_S + "§III-D, LM estimate", display_unit="mg"),
-        P("K_fb", 0.71e-3, "N*s/m", "damping factor of the sensing subsystem", (0, 1.0), source=_S + "§III-D, LM estimate (printed unit mNs²/m read as mN·s/m)", display_unit="mN*s/m"),
-        P("K_sb", 235.36, "N/m", "sensor suspension stiffness", (0, None), source=_S + "§III-C, eq 13 value stated"),
-        P("D_b", 6.05, "1", "sensing-arm amplification x_b/x_eb", (0, None), source=_S + "§III-C, eq 12 value stated"),
-        P("x_off", 0.0, "m", "output offset (sensor zero) of a displacement record", (-1e-3, 1e-3),
-          source="measurement offset, not in the seed", display_unit="um"),
-        P("r", R_SENSITIVITY, "N/V", "readout sensitivity (force per output volt)", (0, None), source=_S + "eq 18, printed '50 N/Volts', read as 50 µN/V (see module docstring)", display_unit="uN/V"),
-    ], "ftg100")
 
 
 # ------------------------------------------------------------------------------------------------
@@ -363,7 +302,7 @@ class _SecondOrderFTG(Model):
         m, c, k, gain, _, _ = self._coefficients(self.theta()[None, :])[0]
         return np.array([gain]), np.array([m, c, k])
 
-    def discrete(self, dt: float = 5e-05, form: str = "canonical") -> StateSpace:
+    def discrete(self, dt: float = DT, form: str = "canonical") -> StateSpace:
         """ZOH discretisation every ``dt`` s: ``form='canonical'`` is the controllable canonical form
         the seed prints (eqs 10, 17; balancing scale chosen in the seed's units), ``'physical'``
         keeps the states [y, ẏ]."""
@@ -483,7 +422,9 @@ class FTG100Sensing(_SecondOrderFTG):
             compare("D_b-eq12", sub, computed=amplification_ratio(gv("H"), gv("l"), gv("b")), stated=p.value("D_b"),
                     rtol=0.01, what="(H − l/2)/(b + l/2) (eq 12, signs reconstructed)", used="the stated D_b = 6.05",
                     source=_S + "§III-C"),
-            compare("k2-eq16", sub, computed=self.stiffness(), stated=6.45, rtol=0.01, unit="N/m",
+            compare("k2-eq16", sub, computed=self.stiffness(),
+                    stated=ftg100_parameters().value("k2"),
+                    rtol=0.01, unit="N/m",
                     what="K_sb/D_b² (eq 16)", used="k2 = 6.45 N/m where k2 appears", source=_S + "§III-C"),
             compare("k2-measured", sub, computed=self.stiffness(), stated=ftg100_geometry().value("k2_measured"),
                     rtol=0.01, unit="N/m", what="K_sb/D_b² (eq 16) vs the Fig. 10 slope",
@@ -594,7 +535,7 @@ class FTG100Coupled(Model):
         lam = np.linalg.eigvals(A)
         return [(abs(v), -v.real / abs(v)) for v in lam if v.imag >= 0]
 
-    def discrete(self, dt: float = 5e-05, form: str = "canonical") -> StateSpace:
+    def discrete(self, dt: float = DT, form: str = "canonical") -> StateSpace:
         """``form='canonical'``: the seed's eq 18 block form (:meth:`discrete_eq18`); ``'physical'``:
         the exact zero-order hold of the continuous cascade (states [x̃_a, ẋ̃_a, x_b, ẋ_b])."""
         if form == "canonical":
@@ -604,7 +545,7 @@ class FTG100Coupled(Model):
         dt = sample_interval(dt, ModelError)
         return self.state_space().discretize(dt)
 
-    def discrete_eq18(self, dt: float = 5e-05) -> StateSpace:
+    def discrete_eq18(self, dt: float = DT) -> StateSpace:
         """The seed's eq 18: [[A_a, 0], [B_c k_k C_a, A_c]] from the canonical subsystems (eqs 10, 17);
         outputs x_a, x_b, F_c, V_out (SI). The sensing subsystem sees F_c = k_k x_a held over each
         sample (a ZOH approximation of the continuous cascade; the DC gain is exact)."""
@@ -637,12 +578,6 @@ class FTG100Coupled(Model):
 _PLANT_NAMES = ("M_a", "K_fa", "K_sa", "K3_a", "D_a", "c_e", "M_b", "K_fb", "K_sb", "K3_b", "D_b",
                 "k0", "c0", "gap", "V_max")
 
-
-#: The seed's static statement (§III-A, after Fig. 4): 70 V "allows a displacement of 20 µm in
-#: static mode at the tip of the actuated arm". Read as the free tip's displacement it is what
-#: ``force_factor='static-70V'`` calibrates to; read as the 100 − 80 µm gap to the ball it is the
-#: plant's ``gap`` (module docstring).
-STATIC_70V = (70.0, 20e-6)
 
 #: Suspension laws of :func:`plant_parameters` and the provenance of their ``K3_a``.
 _SUSPENSIONS = {
@@ -728,7 +663,7 @@ def plant_parameters(*, force_factor: float | str = 1.0, suspension: str = "line
     if "c_e" in values and (calibrate or kappa != 1.0):
         raise ParameterError(f"c_e and force_factor={force_factor!r} both set the comb-drive coefficient",
                              hint="give one of them: c_e in N/V², or force_factor relative to eq 5")
-    full = ftg100_parameters()
+    full, own = ftg100_parameters(), plant_table()
     P = Parameter
     ce = _eq5_coefficient()
     w = ftg100_geometry().value("w")
@@ -741,15 +676,8 @@ def plant_parameters(*, force_factor: float | str = 1.0, suspension: str = "line
         full["D_a"],
         P("c_e", ce, "N/V**2", "comb-drive force coefficient N_a ε h/(2g)", (0, None), source=_S + "eq 5",
           display_unit="nN/V**2"),
-        full["M_b"], full["K_fb"], full["K_sb"],
-        P("K3_b", 0.0, "N/m**3", "cubic stiffening of the sensor suspension", (0, None),
-          source=_S + "Fig. 10 (linear sensor up to 140 µN)"),
-        full["D_b"], full["k0"],
-        P("c0", 0.0, "N*s/m", "viscous damping of the object contact", (0, None),
-          source="assumed: the seed models the object as a pure spring (§III-E)"),
-        P("gap", 20e-6, "m", "free gap between the actuated tip and the object", (0, None),
-          source=_S + "§II-A opening 100 µm − 80 µm glass ball", display_unit="um"),
-        P("V_max", 200.0, "V", "actuation voltage limit", (0, None), source=_S + "§II-A"),
+        full["M_b"], full["K_fb"], full["K_sb"], own["K3_b"], full["D_b"], full["k0"],
+        own["c0"], own["gap"], own["V_max"],
     ], "ftg100-plant")
     if values:
         ps = ps.replace(**values)
@@ -1156,3 +1084,41 @@ class FTG100Plant(Model):
                        f"K3_a = {p('K3_a'):.4g} N/m³, c_e = {p('c_e') * 1e9:.4g} nN/V²", V,
                        p("V_max"),
                        abs(V - p("V_max")) / p("V_max"), 0.0, _S + "§II-A")
+
+
+# ------------------------------------------------------------------------------------------------
+# the zoo's factories
+# ------------------------------------------------------------------------------------------------
+
+def actuated_model(**values) -> FTG100Actuated:
+    """Zoo ``ftg100-actuated``: eqs 8-10 at the seed's values (M_a, K_fa, k0 free)."""
+    return FTG100Actuated(**values)
+
+
+def sensing_model(**values) -> FTG100Sensing:
+    """Zoo ``ftg100-sensing``: eqs 14-17 at the seed's values (M_b, K_fb free)."""
+    return FTG100Sensing(**values)
+
+
+def coupled_model(**values) -> FTG100Coupled:
+    """Zoo ``ftg100-coupled``: eq 18 (actuated and sensing subsystems through k_k, readout r)."""
+    return FTG100Coupled(**values)
+
+
+def plant_model(**values) -> FTG100Plant:
+    """Zoo ``ftg100-plant``: the nonlinear plant with eq 5's force as printed and the linear
+    suspensions of eqs 4 and 8-10 (its small-signal model at 70 V grasped is eq 9/10, 0.82 % from
+    eq 10's gain), V² actuation, contact with the ball after the 20 µm gap (100 µm opening − 80 µm
+    ball: the seed's "20 µm at 70 V" read as the travel to the ball; derivation of both readings in
+    :mod:`gripkit.systems.ftg100.model`)."""
+    return FTG100Plant(**values)
+
+
+def calibrated_plant_model(**values) -> FTG100Plant:
+    """Zoo ``ftg100-plant-calibrated``: the other reading of the seed's 20 µm at 70 V (the free
+    tip's displacement): the default plant with the comb-drive force factor fitted to it (κ = 0.4601
+    × eq 5 with the linear suspensions, ``plant_parameters(force_factor='static-70V')``), which puts
+    its small-signal gain at 70 V 53.6 % below eq 10 (reported by ``zoo check``). ``values`` replace
+    parameters before the fit."""
+    check = values.pop("check", True)
+    return FTG100Plant(plant_parameters(force_factor="static-70V", **values), check=check)

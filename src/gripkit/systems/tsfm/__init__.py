@@ -11,6 +11,8 @@
   seed's "Estimated" column;
 - :mod:`.grasp` — the two-finger grasp (§I); :mod:`.grasp_batch` (with :mod:`.grasp_kernels`,
   :mod:`.grasp_gpu`) — many grasps at once, the sweep scenario ``tsfm-grasp``;
+- :mod:`.robustness` — the Monte Carlo grasp robustness study on that scenario (its statistics
+  from :mod:`gripkit.batch.montecarlo`);
 - :mod:`.demo` — the demo-report section.
 
 A flat list of explicit re-exports.

@@ -39,12 +39,13 @@ from ...models.piezo import PiezoActuator
 from ...params import ParameterSet
 from ...signals.trajectory import Trajectory
 from .end_effector import sensor_parameters
-from .gripper import (RANGES, TSFMFinger, TSFMGripper, finger_coefficients, finger_parameter_set,
-                      micropart_parameters)
+from .gripper import (RANGES, TSFMFinger, TSFMFingerContact, TSFMGripper, finger_coefficients,
+                      finger_parameter_set, micropart_parameters)
 
 __all__ = ["TABLE_II", "REFERENCE", "ASSUMED_LENGTHS", "TABLE_III", "table_iii_findings", "left_finger",
-           "right_finger", "gripper", "table_ii", "finger", "hysteresis_experiment", "step_experiment",
-           "compliance_experiment", "sensor_calibration_experiment", "free_vibration_experiment",
+           "right_finger", "finger_contact", "FIG13_PART", "gripper", "table_ii", "finger",
+           "hysteresis_experiment", "step_experiment", "compliance_experiment",
+           "sensor_calibration_experiment", "free_vibration_experiment",
            "contact_experiment", "contact_voltage", "separation_voltage", "fig13_findings",
            "table_iii_pattern_finding", "stroke_finding"]
 
@@ -139,6 +140,24 @@ def left_finger(*, as_printed: bool = False, check: bool = True) -> TSFMFinger:
 def right_finger(*, as_printed: bool = False, check: bool = True) -> TSFMFinger:
     """Right finger of Table II (zoo entry ``tsfm-right``); keywords as :func:`finger`."""
     return finger("right", as_printed=as_printed, check=check)
+
+
+#: the part of Fig. 13 (value, source): its face where tip C meets it at 44 V, Table III's part 2
+FIG13_PART = {"x_w": (62.42e-6, f"{SEED} §V-C (Fig. 13): contact at 62.42 µm, 44 V"),
+              "k_e": (72.5, f"{SEED} Table III, micropart 2"),
+              "c_e": (0.0, _PART_ASSUMED["c_e"]), "F_po": (0.0, _PART_ASSUMED["F_po"])}
+
+
+def finger_contact(side: str = "left", *, check: bool = True) -> TSFMFingerContact:
+    """A finger of :func:`finger` pressing on the part of Fig. 13 (:data:`FIG13_PART`; zoo entry
+    ``tsfm-finger-contact``; change x_w, k_e, c_e, F_po with ``with_parameters``)."""
+    f = finger(side, check=check)
+    m = f.contact(**{k: v for k, (v, _) in FIG13_PART.items()})
+    params = ParameterSet([p.with_value(p.value, source=FIG13_PART[p.name][1])
+                           if p.name in FIG13_PART else p for p in m.parameters.values()],
+                          m.parameters.name)
+    return TSFMFingerContact(params, reference=f.reference, printed=f.printed, check=False,
+                             finger_name=f.name)
 
 
 def table_iii_pattern_finding() -> Finding:

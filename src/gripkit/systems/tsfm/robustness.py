@@ -1,16 +1,17 @@
-"""Monte Carlo grasp robustness: for a gripper, a controller and an object population, the
-probability of damaging the object, of losing it, and the distribution of the settling time, each
-with a confidence interval, and the probabilities against the object's stiffness.
+"""Monte Carlo grasp robustness of the TSFM two-finger grasp (``001_0b92a7da96e7aa46.txt`` §I,
+§V): for the gripper, its grasp controller and a micropart population, the probability of
+damaging the part, of losing it, and the distribution of the settling time, each with a
+confidence interval, and the probabilities against the part's stiffness.
 
->>> from gripkit.batch.robustness import robustness_study
+>>> from gripkit.systems.tsfm.robustness import robustness_study
 >>> res = robustness_study(n=400, backend="in-process")            # doctest: +SKIP
 >>> print(res.p_damage, res.p_lost, res.settling_median)          # doctest: +SKIP
 
 The study is a sweep (:func:`gripkit.batch.sweep`): any backend, checkpointing, resume, per-job
-failure records. Statistics (:mod:`gripkit.batch.montecarlo`): Wilson intervals for the
-probabilities, order-statistic intervals for the settling-time quantiles (grasps that never
-settle count as +inf, so they push the quantiles up instead of being dropped), Wilson intervals
-per stiffness bin. Failed jobs (errors) are excluded and counted.
+failure records. Statistics (:mod:`gripkit.batch.montecarlo`, the generic part): Wilson
+intervals for the probabilities, order-statistic intervals for the settling-time quantiles
+(grasps that never settle count as +inf, so they push the quantiles up instead of being
+dropped), Wilson intervals per stiffness bin. Failed jobs (errors) are excluded and counted.
 
 The same numbers come from ``gripkit sweep examples/sweep_tsfm_robustness.toml`` followed by
 :func:`analyse` on the result folder's table.
@@ -24,13 +25,13 @@ from pathlib import Path
 
 import numpy as np
 
-from ..arguments import entry_point
-from ..errors import ConfigError, DataError
-from ..units import to_si
-from .montecarlo import Estimate, binned_probability, probability, quantile
-from .spec import SweepSpec
-from .store import ResultStore
-from .sweep import sweep
+from ...arguments import entry_point
+from ...batch.montecarlo import Estimate, binned_probability, probability, quantile
+from ...batch.spec import SweepSpec
+from ...batch.store import ResultStore
+from ...batch.sweep import sweep
+from ...errors import ConfigError, DataError
+from ...units import to_si
 
 __all__ = ["DEFAULT_POPULATION", "DEFAULT_SETTINGS", "RobustnessResult", "robustness_study", "analyse"]
 
@@ -85,7 +86,7 @@ class RobustnessResult:
                name: str = "batch-robustness"):
         """Add a section: the estimates as a table, histograms of the peak force and of the settling
         time, and P(damage), P(lost) against stiffness with their confidence bands."""
-        from ..report.plots import plain, pyplot
+        from ...report.plots import plain, pyplot
 
         plt = pyplot()
         sec = report.section(title, intro)
