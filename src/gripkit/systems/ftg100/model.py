@@ -119,7 +119,6 @@ from __future__ import annotations
 
 import abc
 import math
-import warnings
 
 import numba
 import numpy as np
@@ -127,7 +126,7 @@ from scipy.optimize import brentq
 
 from ...arguments import sample_interval
 from ...consistency import Finding, compare
-from ...errors import AccuracyWarning, ModelError, ParameterError
+from ...errors import AccuracyWarning, ModelError, ParameterError, emit_warning
 from ...models.beams import STRETCHING_BETA, clamped_clamped_stiffness
 from ...models.comb_drive import comb_drive_coefficient
 from ...models.second_order import second_order_batch
@@ -872,10 +871,10 @@ class FTG100Plant(Model):
         opening = ftg100_geometry().value("opening")
         closing = float(np.max(tr["x_a"] - tr["x_b"])) if tr.n else 0.0
         if closing > opening:
-            warnings.warn(f"{self.name}: the tips close by {closing * 1e6:.4g} µm, more than the "
-                          f"{opening * 1e6:.3g} µm opening ({SEED} §II-A): the arms would touch, "
-                          "which the plant does not model (keep the free arm below 106 V)",
-                          AccuracyWarning, stacklevel=2)
+            emit_warning(f"{self.name}: the tips close by {closing * 1e6:.4g} µm, more than the "
+                         f"{opening * 1e6:.3g} µm opening ({SEED} §II-A): the arms would touch, "
+                         "which the plant does not model (keep the free arm below 106 V)",
+                         AccuracyWarning)
         return tr
 
     # --- statics and linearisation --------------------------------------------------------------
