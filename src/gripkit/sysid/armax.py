@@ -29,6 +29,18 @@ from .validation import fit_percent, loss_vn
 __all__ = ["armax", "armax_records"]
 
 
+
+def _c_stable(theta, start: int) -> bool:
+    """The predictor filter 1/C(q) of the ARMAX parameters ``theta`` (C's coefficients from
+    ``start`` on) is stable: Levenberg-Marquardt's admissible set."""
+    return is_stable_poly(np.concatenate([[1.0], theta[start:]]))
+
+
+def _armax_names(na: int, nb: int, nc: int, nk: int) -> tuple[str, ...]:
+    return (tuple(f"a{i}" for i in range(1, na + 1)) + tuple(f"b{nk + j}" for j in range(nb))
+            + tuple(f"c{k}" for k in range(1, nc + 1)))
+
+
 def _hannan_rissanen(u, y, na, nb, nc, nk) -> np.ndarray:
     n = y.size
     nh = int(min(max(3 * (na + nb + nc), 10), max((n - nk) // 10, nc + 1)))
@@ -93,13 +105,9 @@ def _armax(u, y, na, nb, nc, nk, step, maxiter, tol, meta) -> PolynomialModel:
         J = _sig.lfilter([1.0], C, np.hstack([ya, -ub, -es]), axis=0)
         return e, J
 
-    def admissible(theta):
-        return is_stable_poly(np.concatenate([[1.0], theta[na + nb:]]))
-
-    res = levenberg_marquardt(fun, theta0, admissible, maxiter=maxiter, tol=tol, label=label)
-    names = tuple(f"a{i}" for i in range(1, na + 1)) + tuple(f"b{nk + j}" for j in range(nb)) + \
-        tuple(f"c{k}" for k in range(1, nc + 1))
-    cov, sigma2, cond = covariance(res, names)
+    res = levenberg_marquardt(fun, theta0, lambda theta: _c_stable(theta, na + nb), maxiter=maxiter,
+                              tol=tol, label=label)
+    cov, sigma2, cond = covariance(res, _armax_names(na, nb, nc, nk))
     th = res.theta
     A = np.concatenate([[1.0], th[:na]])
     B = np.concatenate([np.zeros(nk), th[na:na + nb]])
@@ -148,13 +156,9 @@ def armax_records(records, na: int, nb: int, nc: int, nk: int = 1, *, dt: float 
         es, Js = zip(*(_armax_errors(theta, ya, ub, yt, na, nb, nc) for ya, ub, yt in parts))
         return np.concatenate(es), np.vstack(Js)
 
-    def admissible(theta):
-        return is_stable_poly(np.concatenate([[1.0], theta[na + nb:]]))
-
-    res = levenberg_marquardt(fun, theta0, admissible, maxiter=maxiter, tol=tol, label=label)
-    names = tuple(f"a{i}" for i in range(1, na + 1)) + tuple(f"b{nk + j}" for j in range(nb)) + \
-        tuple(f"c{k}" for k in range(1, nc + 1))
-    cov, sigma2, cond = covariance(res, names)
+    res = levenberg_marquardt(fun, theta0, lambda theta: _c_stable(theta, na + nb), maxiter=maxiter,
+                              tol=tol, label=label)
+    cov, sigma2, cond = covariance(res, _armax_names(na, nb, nc, nk))
     th = res.theta
     ys = [yt for _, _, yt in parts]
     errs = np.split(res.e, np.cumsum([yt.size for yt in ys[:-1]]))

@@ -21,7 +21,7 @@ import numpy as np
 
 from ..errors import DataError
 from ..lti import StateSpace, Uncertainty
-from .checks import check_dt, check_order
+from .checks import check_dt, check_order, io_records
 from .linear_model import LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run
 from .regression import qr_solve
 from .validation import records_fit
@@ -95,20 +95,7 @@ def arx_mimo_records(records, na: int, nb: int, nk: int = 1, *, dt: float | None
     samples, free-run and one-step fits and initial state (``x0`` of the model: the first
     record's).
     """
-    if not isinstance(records, (list, tuple)) or not records:
-        raise DataError(f"records: expected a non-empty list of (u, y) pairs, "
-                        f"found {records!r:.60}")
-    recs = []
-    for i, r in enumerate(records):
-        if not (isinstance(r, (tuple, list)) and len(r) == 2):
-            raise DataError(f"records[{i}]: expected a (u, y) pair, found {type(r).__name__}")
-        u = as_io_matrix(r[0], f"records[{i}] input u")
-        y = as_io_matrix(r[1], f"records[{i}] output y", u.shape[0])
-        first = (recs[0][0].shape[1], recs[0][1].shape[1]) if recs else None
-        if first and (u.shape[1], y.shape[1]) != first:
-            raise DataError(f"records[{i}]: expected {first[0]} input and {first[1]} output "
-                            f"columns as records[0], found {u.shape[1]} and {y.shape[1]}")
-        recs.append((u, y))
+    recs = io_records(records)
     meta = dict(inputs=inputs, outputs=outputs, input_units=input_units, output_units=output_units,
                 u_offset=u_offset, y_offset=y_offset)
     return _arx_mimo(recs, na, nb, nk, dt, meta, several=True)

@@ -15,7 +15,7 @@ from ..errors import DataError, UnidentifiableError
 from ..units import dimension_of, same_dimension
 from .regression import COND_LIMIT, _qr_r, scaled_condition
 
-__all__ = ["as_signal", "as_io_matrix", "check_io", "check_order", "check_dt", "require_samples", "check_excitation",
+__all__ = ["as_signal", "as_io_matrix", "io_records", "check_io", "check_order", "check_dt", "require_samples", "check_excitation",
            "check_output_varies", "checked_problem", "check_identifiable",
            "check_persistent_excitation", "check_dimension", "LENGTH_OR_ANGLE", "FORCE_OR_TORQUE"]
 
@@ -68,6 +68,28 @@ def as_io_matrix(x, name: str, n: int | None = None, channels: tuple[str, ...] |
                         f"{channels[c] if channels is not None else c})",
                         hint="drop or interpolate them before identification (CLI: --fill)")
     return np.ascontiguousarray(a)
+
+
+def io_records(records, *, siso: bool = False) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Several records as checked ``(u (N_i, m), y (N_i, p))`` pairs with the same numbers of
+    columns (one input and one output with ``siso``); a DataError names the record."""
+    if not isinstance(records, (list, tuple)) or not records:
+        raise DataError(f"records: expected a non-empty list of (u, y) pairs, found {records!r:.60}")
+    recs = []
+    for i, r in enumerate(records):
+        if not (isinstance(r, (tuple, list)) and len(r) == 2):
+            raise DataError(f"records[{i}]: expected a (u, y) pair, found {type(r).__name__}")
+        u = as_io_matrix(r[0], f"records[{i}] input u")
+        y = as_io_matrix(r[1], f"records[{i}] output y", u.shape[0])
+        if siso and (u.shape[1] != 1 or y.shape[1] != 1):
+            raise DataError(f"records[{i}]: expected one input and one output, found {u.shape[1]} "
+                            f"and {y.shape[1]}", hint="estimate one input-output pair at a time")
+        first = (recs[0][0].shape[1], recs[0][1].shape[1]) if recs else None
+        if first and (u.shape[1], y.shape[1]) != first:
+            raise DataError(f"records[{i}]: expected {first[0]} input and {first[1]} output "
+                            f"columns as records[0], found {u.shape[1]} and {y.shape[1]}")
+        recs.append((u, y))
+    return recs
 
 
 def _all_finite(a: np.ndarray) -> bool:

@@ -37,6 +37,7 @@ import scipy.linalg as sla
 from ..errors import DataError, IdentificationError
 from ..lti import StateSpace, Uncertainty, affine_row, flush_tiny
 from .blocked_gram import add_rows, carried_states, carry, row_product, start_sums
+from .checks import io_records
 from .linear_model import LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run
 from .validation import records_fit
 
@@ -537,10 +538,7 @@ def pem_records(model: LinearModel, records, *, form: str = "innovation",
             or not model.system.is_discrete:
         raise DataError("model: expected a discrete state-space LinearModel (e.g. from "
                         "gripkit.sysid.subspace.n4sid_records)")
-    if not isinstance(records, (list, tuple)) or not records:
-        raise DataError(f"records: expected a non-empty list of (u, y) pairs, "
-                        f"found {records!r:.60}")
-    data = [_pem_data(model, None, u, y) for u, y in records]
+    data = [_pem_data(model, None, u, y) for u, y in io_records(records)]
     ss = model.system
     innovation = form == "innovation"
     feedthrough = bool(np.any(ss.D != 0)) if feedthrough is None else bool(feedthrough)

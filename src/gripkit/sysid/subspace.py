@@ -42,7 +42,7 @@ import scipy.linalg as sla
 from ..errors import DataError, IdentificationError, StabilityWarning, emit_warning
 from ..lti import StateSpace
 from .blocked_gram import add_rows, carried_states, carry, row_product, start_sums
-from .checks import check_dt
+from .checks import check_dt, io_records
 from .linear_model import LinearModel, as_io_matrix, fit_per_output, free_run, observability_regressor
 from .regression import _qr_r
 from .validation import records_fit
@@ -607,20 +607,8 @@ def n4sid_records(records, order: int | None = None, *, method: str = "n4sid",
     the fits. Each record needs at least 2k samples (k the horizon)."""
     if method not in SUBSPACE_METHODS:
         raise DataError(f"method: expected one of {', '.join(SUBSPACE_METHODS)}, found {method!r}")
-    if not isinstance(records, (list, tuple)) or not records:
-        raise DataError(f"records: expected a non-empty list of (u, y) pairs, "
-                        f"found {records!r:.60}")
-    recs = []
-    for i, r in enumerate(records):
-        if not (isinstance(r, (tuple, list)) and len(r) == 2):
-            raise DataError(f"records[{i}]: expected a (u, y) pair, found {type(r).__name__}")
-        u = as_io_matrix(r[0], f"records[{i}] input u")
-        recs.append((u, as_io_matrix(r[1], f"records[{i}] output y", u.shape[0])))
+    recs = io_records(records)
     m, p = recs[0][0].shape[1], recs[0][1].shape[1]
-    for i, (u, y) in enumerate(recs):
-        if (u.shape[1], y.shape[1]) != (m, p):
-            raise DataError(f"records[{i}]: expected {m} input and {p} output columns as "
-                            f"records[0], found {u.shape[1]} and {y.shape[1]}")
     step = check_dt(dt)
     if order is not None:
         if isinstance(order, bool) or not float(order).is_integer() or int(order) < 1:

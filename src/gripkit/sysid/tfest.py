@@ -29,7 +29,7 @@ from scipy import signal as _signal
 
 from ..errors import DataError, IdentificationError, ModelError
 from ..lti import StateSpace, TransferFunction
-from .checks import check_dt, check_order, check_persistent_excitation
+from .checks import check_dt, check_order, check_persistent_excitation, io_records
 from .frf import FRF, frf
 from .linear_model import LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run
 from .validation import records_fit
@@ -310,22 +310,11 @@ def tfest_records(records, n_poles: int, n_zeros: int, *, dt: float | None = Non
     records (each from its own x0); ``info['records']``: each record's samples, fit and x0 (in
     the coordinates of the model's zero-order-hold state space, ``tf2ss``)."""
     npo, nz = _check_orders(n_poles, n_zeros)
-    if not isinstance(records, (list, tuple)) or not records:
-        raise DataError(f"records: expected a non-empty list of (u, y) pairs, "
-                        f"found {records!r:.60}")
-    recs = []
-    for i, r in enumerate(records):
-        if not (isinstance(r, (tuple, list)) and len(r) == 2):
-            raise DataError(f"records[{i}]: expected a (u, y) pair, found {type(r).__name__}")
-        u = as_io_matrix(r[0], f"records[{i}] input u")
-        y = as_io_matrix(r[1], f"records[{i}] output y", u.shape[0])
-        if u.shape[1] != 1 or y.shape[1] != 1:
-            raise DataError(f"records[{i}]: expected one input and one output, found {u.shape[1]} "
-                            f"and {y.shape[1]}", hint="estimate one input-output pair at a time")
+    recs = io_records(records, siso=True)
+    for i, (u, _) in enumerate(recs):
         if u.shape[0] <= npo:
             raise DataError(f"records[{i}]: {u.shape[0]} samples cannot determine its own "
                             f"{npo}-state initial condition", hint="drop the short record")
-        recs.append((u, y))
     step = check_dt(dt)
     N = sum(u.shape[0] for u, _ in recs)
     k = npo + nz + 1
