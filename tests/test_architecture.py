@@ -16,7 +16,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "gripkit"
 #: the generic layers (a package or a top-level module of gripkit)
 GENERIC = ("errors", "atomic", "progress", "arguments", "units", "params", "consistency", "signals",
            "io", "excitation", "report", "lti", "sim", "multibody", "models", "sysid", "estimation",
-           "control", "batch")
+           "control", "batch", "export")
 #: what sits above the systems: the TOML front end, the demo, the CLI
 ABOVE_SYSTEMS = ("description", "demos", "cli")
 SYSTEMS = ("amadeus", "tsfm", "dlr_hit", "ftg100")

@@ -1,0 +1,17 @@
+"""Code for the target: an identified linear model as a C99 step function (issue 27).
+
+:func:`export_c` writes ``NAME.h`` and ``NAME.c`` (no allocation, nothing beyond ``<math.h>``
+and ``<string.h>``); :func:`c_sources` returns their text; :func:`c_harness` is a small program
+that feeds a file of inputs through the step and prints the outputs (tests and users check the
+export with it); :func:`float32_error_bound` is the a-priori bound of the ``--float32`` variant.
+See docs/deploy.md."""
+
+from ..exports import lazy_exports
+
+_LAZY = {"export_c": ("c_code", "export_c"), "c_sources": ("c_code", "c_sources"),
+         "c_harness": ("c_code", "c_harness"),
+         "float32_error_bound": ("c_code", "float32_error_bound"),
+         "check_c_name": ("c_code", "check_c_name"),
+         "float32_bound_on": ("c_code", "float32_bound_on")}
+__all__ = [*_LAZY]
+__getattr__, __dir__ = lazy_exports(__name__, _LAZY)

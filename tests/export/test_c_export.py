@@ -1,0 +1,143 @@
+"""``gripkit export c`` (issue 27): the generated C step, compiled with
+``gcc -std=c99 -O2 -Wall -Wextra -Werror`` and run through the generated harness on a recorded
+input, reproduces ``LinearModel.simulate_data`` (from rest, offsets applied, SI) to 1e-12
+relative in double precision, and stays within :func:`gripkit.export.float32_bound_on` with
+``--float32``. Models: a 2×2 order-4 state space with offsets, and an ARX model identified by the
+CLI from a record written in mA and mN (display units; the C step computes in SI)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+from scipy.signal import lfilter
+
+from gripkit.cli import main
+from gripkit.errors import ArgumentError
+from gripkit.export import c_harness, c_sources, check_c_name, float32_bound_on
+from gripkit.lti import StateSpace
+from gripkit.signals import Trajectory
+from gripkit.sysid import LinearModel, load_model
+
+GCC = shutil.which("gcc")
+needs_gcc = pytest.mark.skipif(GCC is None,
+                               reason="gcc is not on PATH: the generated C cannot be compiled")
+FLAGS = ["-std=c99", "-O2", "-Wall", "-Wextra", "-Werror"]
+
+
+def ss_model() -> LinearModel:
+    """2 inputs, 2 outputs, 4 states: two damped modes (|z| = 0.95, 0.8) coupled through B and C."""
+    r1, w1, r2, w2 = 0.95, 0.3, 0.8, 1.1
+    A = np.zeros((4, 4))
+    A[:2, :2] = r1 * np.array([[np.cos(w1), -np.sin(w1)], [np.sin(w1), np.cos(w1)]])
+    A[2:, 2:] = r2 * np.array([[np.cos(w2), -np.sin(w2)], [np.sin(w2), np.cos(w2)]])
+    A[0, 2] = 0.1
+    B = np.array([[1.0, 0.2], [0.0, 0.5], [0.3, -1.0], [0.7, 0.1]])
+    C = np.array([[0.4, -0.2, 1.0, 0.0], [0.0, 0.9, -0.3, 0.5]])
+    D = np.array([[0.05, 0.0], [0.0, -0.02]])
+    sys = StateSpace(A, B, C, D, dt=0.001, inputs=["current", "voltage"],
+                     outputs=["force", "position"], input_units=["A", "V"], output_units=["N", "m"])
+    return LinearModel(sys, "n4sid", u_offset=(0.85, -2.0), y_offset=(1.5, 0.01))
+
+
+def record(n=600, seed=27) -> Trajectory:
+    rng = np.random.default_rng(seed)
+    t = np.arange(n) * 0.001
+    return Trajectory(t, {"current": 0.85 + 0.3 * rng.standard_normal(n),
+                          "voltage": -2.0 + np.sign(np.sin(40 * t)) + 0.1 * rng.standard_normal(n)},
+                      {"current": "A", "voltage": "V"})
+
+
+def build_and_run(tmp_path, files: dict, name: str, u: np.ndarray) -> np.ndarray:
+    """Compile ``files`` with the harness, feed it ``u`` (N, m), return its outputs (N, p)."""
+    for fname, text in files.items():
+        (tmp_path / fname).write_text(text)
+    (tmp_path / "harness.c").write_text(c_harness(name))
+    exe = tmp_path / "harness"
+    res = subprocess.run([GCC, *FLAGS, "-o", str(exe), str(tmp_path / "harness.c"),
+                          str(tmp_path / f"{name}.c"), "-lm"], capture_output=True, text=True)
+    assert res.returncode == 0, res.stderr
+    inp = tmp_path / "u.txt"
+    np.savetxt(inp, u, fmt="%.17g", delimiter=",")
+    out = subprocess.run([str(exe), str(inp)], capture_output=True, text=True, check=True).stdout
+    return np.loadtxt(out.splitlines(), delimiter=",", ndmin=2)
+
+
+@needs_gcc
+def test_state_space_step_reproduces_simulate_data(tmp_path):
+    m, tr = ss_model(), record()
+    u = np.column_stack([tr["current"], tr["voltage"]])
+    y_c = build_and_run(tmp_path, c_sources(m, "grip"), "grip", u)
+    y_py = m.simulate_data(tr)
+    assert y_c.shape == y_py.shape == (600, 2)
+    np.testing.assert_allclose(y_c, y_py, rtol=1e-12, atol=1e-12 * np.max(np.abs(y_py)))
+    assert np.max(np.abs(y_py[:, 0] - 1.5)) > 0.5  # the run is not near the offset alone
+
+
+@needs_gcc
+def test_float32_step_stays_within_its_bound(tmp_path):
+    m, tr = ss_model(), record()
+    u = np.column_stack([tr["current"], tr["voltage"]])
+    y_c = build_and_run(tmp_path, c_sources(m, "grip32", float32=True), "grip32", u)
+    err = np.max(np.abs(y_c - m.simulate_data(tr)), axis=0)
+    bound = float32_bound_on(m, u)
+    assert np.all(err <= bound)
+    assert np.all(err > 1e-9)  # single precision: the comparison sees its rounding
+    assert np.all(bound < 1e-3)  # and the bound is one a user can use
+
+
+@needs_gcc
+def test_arx_from_the_cli_in_display_units(tmp_path, capsys):
+    """ARX [2 2 1] identified from a record in mA and mN: the C step takes A and gives N."""
+    rng = np.random.default_rng(25)
+    u = 1.0 + 0.2 * rng.standard_normal(400)
+    y = lfilter([0.0, 2.0, 0.5], [1.0, -1.2, 0.4], u) + 1e-3 * rng.standard_normal(400)
+    data = tmp_path / "grasp.csv"
+    data.write_text("t,current [mA],force [mN]\n" + "".join(
+        f"{k / 100:.17g},{1e3 * a:.17g},{1e3 * b:.17g}\n" for k, (a, b) in enumerate(zip(u, y))))
+    model = tmp_path / "arx.json"
+    assert main(["identify", "arx", str(data), "--input", "current", "--output", "force",
+                 "--na", "2", "--nb", "2", "--nk", "1", "--out", str(model)]) == 0
+    capsys.readouterr()
+    out = tmp_path / "c"
+    assert main(["export", "c", str(model), "--out", str(out), "--name", "gk_arx", "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)
+    assert res["units"] == {"inputs": ["A"], "outputs": ["N"]} and res["warnings"] == []
+    m = load_model(model)
+    assert m.display_units == {"current": "mA", "force": "mN"} and m.u_offset[0] != 0.0
+    files = {p.name: p.read_text() for p in out.iterdir()}
+    assert sorted(files) == ["gk_arx.c", "gk_arx.h"]
+    assert "#define GK_ARX_NU 1" in files["gk_arx.h"] and "#define GK_ARX_NX 2" in files["gk_arx.h"]
+    y_c = build_and_run(tmp_path, files, "gk_arx", u[:, None])
+    from gripkit.io import load
+
+    y_py = m.simulate_data(load(data))
+    np.testing.assert_allclose(y_c, y_py, rtol=1e-12, atol=1e-12 * np.max(np.abs(y_py)))
+    np.testing.assert_allclose(y_py[100:, 0], y[100:], rtol=0.02)  # N, not mN (after the start)
+
+
+@pytest.mark.parametrize("name", ["1grip", "grip-model", "int", "a b", "x" * 41, "_grip",
+                                  "gr\u00efp"])
+def test_a_name_that_is_no_c_identifier_is_refused(name):
+    with pytest.raises(ArgumentError, match="expected a C identifier"):
+        check_c_name(name)
+
+
+def test_file_strings_reach_the_c_code_only_as_safe_comments():
+    sys = StateSpace([[0.5]], [[1.0]], [[1.0]], dt=0.1, inputs=["a*/ int evil; /*"],
+                     outputs=["b??/\nx"])
+    text = "".join(c_sources(LinearModel(sys, "n4sid"), "safe").values())
+    assert text.count("*/") == text.count("/*") and "??" not in text and "\\" not in text
+    assert "u[0]: a__ int evil; __ [-]" in text and "y[0]: b____x [-]" in text
+
+
+def test_cli_refuses_a_bad_name_in_one_line(tmp_path, capsys):
+    p = tmp_path / "m.json"
+    ss_model().save(p)
+    assert main(["export", "c", str(p), "--out", str(tmp_path), "--name", "my-model"]) != 0
+    err = capsys.readouterr().err
+    assert err.startswith("error: ArgumentError: --name: expected a C identifier")
+    assert err.count("\n") == 1
