@@ -141,3 +141,37 @@ def test_cli_refuses_a_bad_name_in_one_line(tmp_path, capsys):
     err = capsys.readouterr().err
     assert err.startswith("error: ArgumentError: --name: expected a C identifier")
     assert err.count("\n") == 1
+
+
+@needs_gcc
+def test_a_static_gain_model_has_no_state_and_compiles(tmp_path):
+    """Order 0 (y = D (u − u0) + y0): no A/B arrays, a one-slot state that is never read."""
+    sys = StateSpace(np.zeros((0, 0)), np.zeros((0, 1)), np.zeros((1, 0)), [[2.5]], dt=0.01,
+                     inputs=["u"], outputs=["y"])
+    m = LinearModel(sys, "n4sid", u_offset=(1.0,), y_offset=(-3.0,))
+    u = np.array([[1.0], [2.0], [-0.5]])
+    y_c = build_and_run(tmp_path, c_sources(m, "gain"), "gain", u)
+    assert y_c[:, 0].tolist() == [-3.0, -0.5, -6.75]
+
+
+@pytest.mark.skipif(shutil.which("g++") is None or GCC is None,
+                    reason="g++ or gcc is not on PATH")
+def test_the_header_links_into_cpp(tmp_path):
+    """A C++ caller (a ros2_control controller) includes the header and links the C object."""
+    for fname, text in c_sources(ss_model(), "grip").items():
+        (tmp_path / fname).write_text(text)
+    (tmp_path / "use.cpp").write_text(
+        '#include <cstdio>\n#include "grip.h"\nint main() {\n  grip_state s; grip_init(&s);\n'
+        '  double u[GRIP_NU] = {1.85, -2.0}, y[GRIP_NY];\n'
+        '  grip_step(&s, u, y); grip_step(&s, u, y);\n'
+        '  std::printf("%.17g\\n", y[0]);\n}\n')
+    obj = tmp_path / "grip.o"
+    subprocess.run([GCC, *FLAGS, "-c", "-o", str(obj), str(tmp_path / "grip.c")], check=True)
+    exe = tmp_path / "use"
+    res = subprocess.run([shutil.which("g++"), "-std=c++17", "-Wall", "-Wextra", "-Werror",
+                          "-o", str(exe), str(tmp_path / "use.cpp"), str(obj), "-lm"],
+                         capture_output=True, text=True)
+    assert res.returncode == 0, res.stderr
+    # x1 = B du with du = (1, 0): y[0] = C[0] x1 + D[0] du + 1.5 = 0.4 + 0.3 + 0.05 + 1.5
+    out = subprocess.run([str(exe)], capture_output=True, text=True, check=True).stdout
+    assert float(out) == pytest.approx(2.25, rel=1e-15)
