@@ -17,7 +17,10 @@ from .fusion import normalised_variances as normalised_variances
 from .fusion import proportional_variance as proportional_variance
 from .friction_adaptation import AdaptationSettings as AdaptationSettings
 from .friction_adaptation import FrictionAdapter as FrictionAdapter
+from .kalman import KalmanFilter as KalmanFilter
+from .kalman import KalmanRun as KalmanRun
 
 __all__ = ["AdaptationSettings", "ContactDetector", "FrictionAdapter", "fuse", "fuse_proportional",
-           "fuse_update", "fused_variance", "implied_correlation", "normalised_variances",
+           "fuse_update", "fused_variance", "implied_correlation", "KalmanFilter", "KalmanRun",
+           "normalised_variances",
            "NormalisedVariances", "proportional_variance"]
