@@ -6,6 +6,8 @@ hybrid force/position control, the DLR/HIT impedance control) live in :mod:`grip
 A flat list of explicit re-exports.
 """
 
+from .linear_quadratic import LQR as LQR
+from .linear_quadratic import lqr as lqr
 from .pid import PID as PID
 from .rst import DiscretePlant as DiscretePlant
 from .rst import LoopResult as LoopResult
@@ -14,4 +16,5 @@ from .rst import RSTController as RSTController
 from .rst import design_rst as design_rst
 from .rst import simulate_loop as simulate_loop
 
-__all__ = ["as_plant", "design_rst", "DiscretePlant", "LoopResult", "PID", "RSTController", "simulate_loop"]
+__all__ = ["as_plant", "design_rst", "DiscretePlant", "LoopResult", "LQR", "lqr", "PID",
+           "RSTController", "simulate_loop"]
