@@ -175,3 +175,19 @@ def test_the_header_links_into_cpp(tmp_path):
     # x1 = B du with du = (1, 0): y[0] = C[0] x1 + D[0] du + 1.5 = 0.4 + 0.3 + 0.05 + 1.5
     out = subprocess.run([str(exe)], capture_output=True, text=True, check=True).stdout
     assert float(out) == pytest.approx(2.25, rel=1e-15)
+
+
+@needs_gcc
+def test_a_continuous_model_needs_dt_and_is_sampled_with_a_zero_order_hold(tmp_path):
+    """A mass-spring-damper (ω = 20 rad/s, ζ = 0.3) in continuous time: refused without a
+    sample time; with dt = 0.01 s the step equals simulate_data on a record sampled at 100 Hz."""
+    sys = StateSpace([[0.0, 1.0], [-400.0, -12.0]], [[0.0], [1.0]], [[400.0, 0.0]], [[0.0]],
+                     inputs=["current"], outputs=["force"])
+    m = LinearModel(sys, "tfest", u_offset=(0.2,), y_offset=(0.0,))
+    with pytest.raises(ArgumentError, match="the model is continuous"):
+        c_sources(m, "msd")
+    rng = np.random.default_rng(5)
+    tr = Trajectory(np.arange(300) * 0.01, {"current": 0.2 + rng.standard_normal(300)})
+    y_c = build_and_run(tmp_path, c_sources(m, "msd", dt=0.01), "msd", tr["current"][:, None])
+    y_py = m.simulate_data(tr)
+    np.testing.assert_allclose(y_c, y_py, rtol=1e-12, atol=1e-12 * np.max(np.abs(y_py)))
