@@ -121,3 +121,31 @@ def test_dc_motor_narx_beats_the_best_linear_arx(dc_motor):
     assert cubic.validation_fit_percent > best_arx + 35.0
     assert best_arx < 55.0
     assert "validation free-run fit" in cubic.criterion
+
+
+def _cli(capsys, *args):
+    from gripkit.cli import main
+
+    code = main([str(a) for a in args])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_cli_identify_narx_json_validate_and_model_file(dc_motor, tmp_path, capsys):
+    """The CLI gives the same validation fit as the Python call and writes a loadable model."""
+    ue, ye, uv, yv = dc_motor
+    est, val, model = tmp_path / "est.csv", tmp_path / "val.csv", tmp_path / "narx.json"
+    for path, (u, y) in ((est, (ue, ye)), (val, (uv, yv))):
+        np.savetxt(path, np.column_stack([u, y]), delimiter=",", header="voltage,output", comments="",
+                   fmt="%.10g")
+    code, out, err = _cli(capsys, "identify", "narx", est, "--input", "voltage", "--output", "output",
+                          "--fs", 1, "--degree", 3, "--validate", val, "--out", model, "--json")
+    assert code == 0, err
+    d = json.loads(out)
+    py = narx(ue, ye, degree=3, lags=2, validate=(uv, yv))
+    assert d["validation"]["fit_percent"] == pytest.approx(py.validation_fit_percent, abs=1e-6)
+    assert d["structure"]["terms"] == py.terms and d["warnings"] == []
+    assert load_narx(model).compare(uv, yv) == pytest.approx(py.validation_fit_percent, abs=1e-6)
+    code, out, err = _cli(capsys, "identify", "narx", est, "--input", "voltage", "--output", "output",
+                          "--fs", 1, "--terms", "many")
+    assert code != 0 and err.startswith("error: DataError: --terms: expected 'auto'")
