@@ -85,30 +85,40 @@ def _regressors(bases, rows, u, y, start: int) -> np.ndarray:
 
 def frols(P: np.ndarray, y: np.ndarray, max_terms: int):
     """Forward regression orthogonal least squares: the order in which columns of ``P`` are
-    chosen, their error reduction ratios, and the residual sum of squares after each step."""
+    chosen, their error reduction ratios, and the residual sum of squares after each step.
+
+    Modified Gram-Schmidt on the candidate block ``W`` (Fortran order): after a column is chosen
+    (unit vector ``q``), ``c = qᵀW`` and the rank-one update ``W ← W − q cᵀ`` runs in place
+    (BLAS ``dger``); the squared norms and ``Wᵀy`` are downdated (``‖w‖² − c²``, ``Wᵀy − c qᵀy``)
+    rather than recomputed, so each step is two passes over ``W``."""
+    from scipy.linalg.blas import dger
+
     W = np.array(P, dtype=np.float64, order="F")
-    r = np.array(y, dtype=np.float64)
+    y = np.ascontiguousarray(y, dtype=np.float64)
     yy = float(y @ y)
     active = np.ones(W.shape[1], dtype=bool)
     norms = np.einsum("ij,ij->j", W, W)
-    scale0 = norms.copy()
+    floor = 1e-10 * np.maximum(norms, 1e-300)
+    g = W.T @ y
+    sse_now = yy
     chosen, errs, sse = [], [], []
     for _ in range(min(max_terms, W.shape[1])):
-        g = W.T @ y
-        ok = active & (norms > 1e-10 * np.maximum(scale0, 1e-300))
+        ok = active & (norms > floor)
         if not ok.any():
             break
         err = np.where(ok, g * g / np.where(ok, norms, 1.0), -1.0) / yy
         j = int(np.argmax(err))
         q = W[:, j] / np.sqrt(norms[j])
+        qy = float(q @ y)
         chosen.append(j)
         errs.append(float(err[j]))
         active[j] = False
-        r -= (q @ r) * q
-        sse.append(float(r @ r))
+        sse_now -= qy * qy
+        sse.append(max(sse_now, 0.0))
         c = q @ W
-        W -= np.outer(q, c)
+        W = dger(-1.0, q, c, a=W, overwrite_a=True)
         norms = np.maximum(norms - c * c, 0.0)  # ‖w − q qᵀw‖² = ‖w‖² − (qᵀw)²
+        g = g - c * qy
     return chosen, errs, sse
 
 
