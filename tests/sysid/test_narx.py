@@ -98,6 +98,20 @@ def test_bad_input_is_named():
         narx(u, y, terms=16)
     with pytest.raises(ArgumentError, match="degree must be an integer"):
         narx(u, y, degree=0)
+    with pytest.raises(DataError, match="output is constant"):
+        narx(u, np.full(200, 2.0))
+    with pytest.raises(DataError, match="non-finite"):
+        narx(np.where(np.arange(200) == 5, np.nan, u), y)
+
+
+def test_load_refuses_folder_and_non_json(tmp_path):
+    from gripkit.errors import PathError
+
+    with pytest.raises(PathError, match="cannot be read"):
+        load_narx(tmp_path)
+    (tmp_path / "x.json").write_text("not json")
+    with pytest.raises(ModelError, match="is not JSON"):
+        load_narx(tmp_path / "x.json")
 
 
 @pytest.fixture(scope="module")

@@ -309,6 +309,9 @@ def load_narx(path) -> NARXModel:
     except FileNotFoundError:
         raise PathError(f"narx model file {str(p)!r} does not exist; give the path of a file "
                         "written by NARXModel.save or `gripkit identify narx --out`") from None
+    except OSError as exc:
+        raise PathError(f"narx model file {str(p)!r} cannot be read ({exc.strerror or exc}); give "
+                        "the path of a readable file") from None
     except (json.JSONDecodeError, UnicodeDecodeError) as exc:
         raise ModelError(f"narx model file {str(p)!r} is not JSON ({exc}); expected a file of "
                          f"schema {SCHEMA!r}") from None
@@ -362,6 +365,9 @@ def narx(u, y, *, degree: int = 2, lags: int | None = 2, ylags: int | None = Non
     if len(u) != len(y):
         raise DataError(f"narx: u has {len(u)} samples but y has {len(y)}; pass a pair of equal "
                         "length")
+    if np.ptp(y) == 0.0:
+        raise DataError(f"narx: the output is constant ({y[0]:g} in all {len(y)} samples); there "
+                        "is nothing to identify: check the output column")
     degree = _positive_int(degree, "degree")
     ly = _positive_int(ylags if ylags is not None else lags, "ylags", 0)
     lu = _positive_int(ulags if ulags is not None else lags, "ulags", 0)
