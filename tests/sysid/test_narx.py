@@ -163,3 +163,18 @@ def test_cli_identify_narx_json_validate_and_model_file(dc_motor, tmp_path, caps
     code, out, err = _cli(capsys, "identify", "narx", est, "--input", "voltage", "--output", "output",
                           "--fs", 1, "--terms", "many")
     assert code != 0 and err.startswith("error: DataError: --terms: expected 'auto'")
+
+
+def test_identify_method_narx_on_a_trajectory(dc_motor):
+    """``identify(traj, "narx", ...)`` is the array call on the raw columns (no detrending: the
+    constant term carries the operating point); an unknown option is named."""
+    from gripkit import Trajectory
+    from gripkit.sysid import identify
+
+    ue, ye, uv, yv = dc_motor
+    tr = Trajectory.uniform(dt=1.0, voltage=ue, output=ye)
+    m = identify(tr, "narx", input="voltage", output="output", degree=3, lags=2)
+    ref = narx(ue, ye, degree=3, lags=2)
+    assert m.terms == ref.terms and m.compare(uv, yv) == pytest.approx(ref.compare(uv, yv), abs=1e-9)
+    with pytest.raises(ArgumentError, match="banana"):
+        identify(tr, "narx", input="voltage", output="output", banana=3)
