@@ -75,7 +75,7 @@ def _regressors(bases, rows, u, y, start: int) -> np.ndarray:
     for i, (kind, lag) in enumerate(bases):
         s = y if kind == 0 else u
         cols[i] = s[start - lag:len(s) - lag]
-    P = np.ones((n, len(rows)))
+    P = np.ones((n, len(rows)), order="F")  # column by column
     for j, row in enumerate(rows):
         for b in row:
             if b >= 0:
