@@ -160,6 +160,9 @@ def test_cli_identify_narx_json_validate_and_model_file(dc_motor, tmp_path, caps
     assert d["validation"]["fit_percent"] == pytest.approx(py.validation_fit_percent, abs=1e-6)
     assert d["structure"]["terms"] == py.terms and d["warnings"] == []
     assert load_narx(model).compare(uv, yv) == pytest.approx(py.validation_fit_percent, abs=1e-6)
+    code, out, err = _cli(capsys, "compare", model, val, "--fs", 1, "--json")     # the same number
+    assert code == 0, err
+    assert json.loads(out)["fit_percent"][0] == pytest.approx(d["validation"]["fit_percent"], abs=1e-6)
     code, out, err = _cli(capsys, "identify", "narx", est, "--input", "voltage", "--output", "output",
                           "--fs", 1, "--terms", "many")
     assert code != 0 and err.startswith("error: DataError: --terms: expected 'auto'")

@@ -42,6 +42,10 @@ def compare(model: Path = ModelArg,
             fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, json_out: bool = JsonOpt):
     """Free-run fit (%) of a saved model per output, initial state estimated."""
     from ..sysid.linear_model import VALIDATION_FIT
+    from ..sysid.nonlinear.narx import SCHEMA, file_schema
+
+    if file_schema(model) == SCHEMA:
+        return _compare_narx(model, data, fs, time, fill, json_out)
     from ..sysid.model_file import file_sha256
 
     with warnings.catch_warnings(record=True) as caught:
@@ -58,6 +62,28 @@ def compare(model: Path = ModelArg,
     typer.echo(f"{m.structure} on {data}{' (the estimation data)' if same else ''}: {VALIDATION_FIT}")
     for n, f in zip(m.outputs, fit):
         typer.echo(f"  {n}: {f:.2f} %")
+
+
+def _compare_narx(model: Path, data: Path, fs, time, fill, json_out: bool) -> None:
+    """``gripkit compare`` of a NARX model file: its free-run fit on DATA's columns (the number
+    ``gripkit identify narx --validate`` reports)."""
+    import numpy as np
+
+    from ..sysid.nonlinear.narx import NARX_FIT, load_narx
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        m = load_narx(model)
+        tr = load_data(data, [m.input_name, m.output_name], fs, time, fill)
+        fit = m.compare(np.asarray(tr[m.input_name]), np.asarray(tr[m.output_name]))
+    res = {"model": str(model), "data": str(data), "structure": "narx", "outputs": [m.output_name],
+           "fit_percent": [fit], "initial_state": "measured", "definition": NARX_FIT,
+           "warnings": report_warnings(caught)}
+    if json_out:
+        emit_json(res)
+        return
+    typer.echo(f"narx on {data}: {NARX_FIT}")
+    typer.echo(f"  {m.output_name}: " + ("diverged" if fit is None else f"{fit:.2f} %"))
 
 
 def simulate_model_file(model: Path, data: Path | None, out: Path | None, fs, time, fill, json_out: bool) -> None:

@@ -228,7 +228,9 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
                                           detrend=detrend).with_display_units(data)
     if method == "narx":  # the model's constant term carries the operating point
         io = io_data(data, input=input, output=output, detrend="none", why="NARX identification")
-        return nonlinear.narx(io.u, io.y, dt=io.dt, **options)
+        model = nonlinear.narx(io.u, io.y, dt=io.dt, **options)
+        model.input_name, model.output_name = input, output
+        return model
     io = io_data(data, input=input, output=output, detrend=detrend, why=f"{method.upper()} identification")
     if method in ("arx", "armax", "oe"):
         orders = (na, nb, nc, na if nf is None else nf, nk)

@@ -40,12 +40,16 @@ from ...atomic import write_text
 from ...errors import (ArgumentError, DataError, IdentificationError, ModelError, PathError,
                        StabilityWarning, emit_warning)
 
-__all__ = ["SCHEMA", "NARXModel", "narx", "load_narx", "candidate_terms", "frols"]
+__all__ = ["SCHEMA", "NARX_FIT", "NARXModel", "narx", "load_narx", "file_schema", "candidate_terms",
+           "frols"]
 
 SCHEMA = "gripkit.narx-model"
 VERSION = 1
 #: a free run beyond this many times the data's range (about its mean) counts as diverged
 DIVERGENCE_FACTOR = 1e3
+#: how a NARX model's free-run fit is taken (``gripkit compare`` prints it)
+NARX_FIT = ("free run started from the first max_lag measured outputs, fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) "
+            "over the samples after them")
 #: most terms FROLS selects when ``terms='auto'``
 MAX_AUTO_TERMS = 40
 
@@ -227,6 +231,8 @@ class NARXModel:
     criterion: str = ""
     err: list = field(default_factory=list)
     frols_terms: list = field(default_factory=list)
+    input_name: str = "u"
+    output_name: str = "y"
 
     @property
     def terms(self) -> list[str]:
@@ -294,11 +300,21 @@ class NARXModel:
                     theta=self.theta.tolist(), theta_std=self.theta_std.tolist(),
                     covariance=self.covariance.tolist(), fit_percent=self.fit_percent,
                     prediction_fit_percent=self.prediction_fit_percent,
-                    validation_fit_percent=self.validation_fit_percent, criterion=self.criterion)
+                    validation_fit_percent=self.validation_fit_percent, criterion=self.criterion,
+                    input_name=self.input_name, output_name=self.output_name)
 
     def save(self, path) -> Path:
         """Write the model as JSON (schema ``gripkit.narx-model``), atomically."""
         return write_text(path, json.dumps(self.to_dict(), indent=1) + "\n", what="NARX model")
+
+
+def file_schema(path) -> str | None:
+    """The ``schema`` field of a JSON model file, None when it has none or cannot be read."""
+    try:
+        doc = json.loads(Path(path).read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None
+    return doc.get("schema") if isinstance(doc, dict) else None
 
 
 def load_narx(path) -> NARXModel:
@@ -335,7 +351,9 @@ def load_narx(path) -> NARXModel:
                       fit_percent=doc.get("fit_percent"),
                       prediction_fit_percent=doc.get("prediction_fit_percent"),
                       validation_fit_percent=doc.get("validation_fit_percent"),
-                      criterion=str(doc.get("criterion", "")))
+                      criterion=str(doc.get("criterion", "")),
+                      input_name=str(doc.get("input_name", "u")),
+                      output_name=str(doc.get("output_name", "y")))
     except (KeyError, TypeError, ValueError) as exc:
         raise ModelError(f"{str(p)!r}: a malformed {SCHEMA} ({type(exc).__name__}: {exc}); "
                          "write it again with NARXModel.save") from None
