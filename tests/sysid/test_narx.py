@@ -163,6 +163,10 @@ def test_cli_identify_narx_json_validate_and_model_file(dc_motor, tmp_path, caps
     code, out, err = _cli(capsys, "compare", model, val, "--fs", 1, "--json")     # the same number
     assert code == 0, err
     assert json.loads(out)["fit_percent"][0] == pytest.approx(d["validation"]["fit_percent"], abs=1e-6)
+    code, out, err = _cli(capsys, "simulate", model, "--data", val, "--fs", 1, "--json")
+    assert code == 0, err                                      # from rest: the model's own free run
+    sim = load_narx(model).simulate(uv)
+    assert json.loads(out)["outputs"]["output"]["final"] == pytest.approx(sim[-1], rel=1e-9)
     code, out, err = _cli(capsys, "identify", "narx", est, "--input", "voltage", "--output", "output",
                           "--fs", 1, "--terms", "many")
     assert code != 0 and err.startswith("error: DataError: --terms: expected 'auto'")
