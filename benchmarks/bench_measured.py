@@ -177,8 +177,8 @@ def _narx_row(ue, ye, uv, yv) -> dict:
                gripkit_accuracy=_fit_text(g.compare(uv, yv)) + f" ({len(g.terms)} terms)",
                peer_accuracy=_fit_text(_fit(yv, m.predict(X=uv[:, None], y=yv[:, None])))
                + f" ({m.final_model.shape[0]} terms)",
-               notes="same model class; gripkit: FROLS + BIC + pruning of |θ|/σ < 2, fit over the samples "
-                     "after the first max_lag; sysidentpy: its predict, fit over every sample")
+               notes="same model class; gripkit: FROLS + BIC + pruning of |θ|/σ < 2, fit over the "
+                     "samples after the first max_lag; sysidentpy: its predict, fit over every sample")
 
 
 if __name__ == "__main__":

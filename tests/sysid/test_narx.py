@@ -25,7 +25,8 @@ def _true_system(rng, n=1000, noise=0.05, amplitude=1.0):
     e = rng.normal(0.0, noise, n)
     y = np.zeros(n)
     for t in range(2, n):
-        y[t] = -0.605 * y[t - 1] - 0.163 * y[t - 2] ** 2 + 0.588 * u[t - 1] - 0.240 * u[t - 2] + e[t]
+        y[t] = (-0.605 * y[t - 1] - 0.163 * y[t - 2] ** 2 + 0.588 * u[t - 1] - 0.240 * u[t - 2]
+                + e[t])
     return u, y
 
 
@@ -87,7 +88,8 @@ def test_divergent_free_run_is_reported_not_scored():
     with pytest.warns(StabilityWarning, match="diverges"):
         assert m.compare(uv, yv) is None
     with pytest.warns(StabilityWarning, match="diverges"):
-        assert narx(u, y, degree=2, lags=2, terms=4, validate=(uv, yv)).validation_fit_percent is None
+        m4 = narx(u, y, degree=2, lags=2, terms=4, validate=(uv, yv))
+    assert m4.validation_fit_percent is None
 
 
 def test_bad_input_is_named():
@@ -98,6 +100,10 @@ def test_bad_input_is_named():
         narx(u, y, terms=16)
     with pytest.raises(ArgumentError, match="degree must be an integer"):
         narx(u, y, degree=0)
+    with pytest.raises(ArgumentError, match="terms must be 'auto' or an integer"):
+        narx(u, y, terms="all")
+    with pytest.raises(ArgumentError, match="dt must be a positive"):
+        narx(u, y, dt=0.0)
     with pytest.raises(DataError, match="output is constant"):
         narx(u, np.full(200, 2.0))
     with pytest.raises(DataError, match="non-finite"):
@@ -127,8 +133,8 @@ def test_dc_motor_narx_beats_the_best_linear_arx(dc_motor):
     (measured); asserted with a 4-point margin, and ≥ 35 points above the best ARX."""
     ue, ye, uv, yv = dc_motor
     um, ym = ue.mean(), ye.mean()
-    best_arx = max(from_polynomial(arx(ue - um, ye - ym, n, n, 1, dt=1.0)).compare(uv - um, yv - ym)[0][0]
-                   for n in (1, 2, 3, 4))
+    best_arx = max(from_polynomial(arx(ue - um, ye - ym, n, n, 1, dt=1.0))
+                   .compare(uv - um, yv - ym)[0][0] for n in (1, 2, 3, 4))
     cubic = narx(ue, ye, degree=3, lags=2, validate=(uv, yv))
     quadratic = narx(ue, ye, degree=2, lags=2, validate=(uv, yv))
     assert cubic.validation_fit_percent > 90.0 and quadratic.validation_fit_percent > 88.0
@@ -150,10 +156,11 @@ def test_cli_identify_narx_json_validate_and_model_file(dc_motor, tmp_path, caps
     ue, ye, uv, yv = dc_motor
     est, val, model = tmp_path / "est.csv", tmp_path / "val.csv", tmp_path / "narx.json"
     for path, (u, y) in ((est, (ue, ye)), (val, (uv, yv))):
-        np.savetxt(path, np.column_stack([u, y]), delimiter=",", header="voltage,output", comments="",
-                   fmt="%.10g")
-    code, out, err = _cli(capsys, "identify", "narx", est, "--input", "voltage", "--output", "output",
-                          "--fs", 1, "--degree", 3, "--validate", val, "--out", model, "--json")
+        np.savetxt(path, np.column_stack([u, y]), delimiter=",", header="voltage,output",
+                   comments="", fmt="%.10g")
+    code, out, err = _cli(capsys, "identify", "narx", est, "--input", "voltage",
+                          "--output", "output", "--fs", 1, "--degree", 3, "--validate", val,
+                          "--out", model, "--json")
     assert code == 0, err
     d = json.loads(out)
     py = narx(ue, ye, degree=3, lags=2, validate=(uv, yv))
@@ -162,13 +169,14 @@ def test_cli_identify_narx_json_validate_and_model_file(dc_motor, tmp_path, caps
     assert load_narx(model).compare(uv, yv) == pytest.approx(py.validation_fit_percent, abs=1e-6)
     code, out, err = _cli(capsys, "compare", model, val, "--fs", 1, "--json")     # the same number
     assert code == 0, err
-    assert json.loads(out)["fit_percent"][0] == pytest.approx(d["validation"]["fit_percent"], abs=1e-6)
+    fit = json.loads(out)["fit_percent"][0]
+    assert fit == pytest.approx(d["validation"]["fit_percent"], abs=1e-6)
     code, out, err = _cli(capsys, "simulate", model, "--data", val, "--fs", 1, "--json")
     assert code == 0, err                                      # from rest: the model's own free run
     sim = load_narx(model).simulate(uv)
     assert json.loads(out)["outputs"]["output"]["final"] == pytest.approx(sim[-1], rel=1e-9)
-    code, out, err = _cli(capsys, "identify", "narx", est, "--input", "voltage", "--output", "output",
-                          "--fs", 1, "--terms", "many")
+    code, out, err = _cli(capsys, "identify", "narx", est, "--input", "voltage",
+                          "--output", "output", "--fs", 1, "--terms", "many")
     assert code != 0 and err.startswith("error: DataError: --terms: expected 'auto'")
 
 
@@ -182,6 +190,7 @@ def test_identify_method_narx_on_a_trajectory(dc_motor):
     tr = Trajectory.uniform(dt=1.0, voltage=ue, output=ye)
     m = identify(tr, "narx", input="voltage", output="output", degree=3, lags=2)
     ref = narx(ue, ye, degree=3, lags=2)
-    assert m.terms == ref.terms and m.compare(uv, yv) == pytest.approx(ref.compare(uv, yv), abs=1e-9)
+    assert m.terms == ref.terms
+    assert m.compare(uv, yv) == pytest.approx(ref.compare(uv, yv), abs=1e-9)
     with pytest.raises(ArgumentError, match="banana"):
         identify(tr, "narx", input="voltage", output="output", banana=3)

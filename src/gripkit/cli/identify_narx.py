@@ -33,7 +33,8 @@ def _terms(value: str):
 def _summary(m) -> str:
     lines = [f"NARX degree {m.degree}, ylags {m.ylags}, ulags {m.ulags}: {len(m.terms)} terms "
              f"({m.criterion})"]
-    lines += [f"  {name:<28s} {th: .6g} ± {sd:.3g}" for name, th, sd in zip(m.terms, m.theta, m.theta_std)]
+    lines += [f"  {name:<28s} {th: .6g} ± {sd:.3g}"
+              for name, th, sd in zip(m.terms, m.theta, m.theta_std)]
     fmt = lambda v: "diverged" if v is None else f"{v:.2f} %"  # noqa: E731
     lines.append(f"free-run fit (estimation): {fmt(m.fit_percent)}; one-step prediction fit: "
                  f"{fmt(m.prediction_fit_percent)}")
@@ -43,16 +44,16 @@ def _summary(m) -> str:
 
 
 @identify_app.command("narx")
-def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 file with the record."),
+def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 file, the record."),
                   input_col: str = typer.Option(..., "--input", help="Input column."),
                   output_col: str = typer.Option(..., "--output", help="Output column."),
                   degree: int = typer.Option(2, "--degree", help="Highest degree of a term."),
                   lags: int = typer.Option(2, "--lags", help="Output and input lags."),
-                  ylags: Optional[int] = typer.Option(None, "--ylags", help="Output lags (over --lags)."),
-                  ulags: Optional[int] = typer.Option(None, "--ulags", help="Input lags (over --lags)."),
+                  ylags: Optional[int] = typer.Option(None, "--ylags", help="Output lags."),
+                  ulags: Optional[int] = typer.Option(None, "--ulags", help="Input lags."),
                   terms: str = typer.Option("auto", "--terms",
-                                            help="Number of terms, or auto (BIC; with --validate the "
-                                                 "free-run validation fit)."),
+                                            help="Number of terms, or auto (BIC; with --validate "
+                                                 "the free-run validation fit)."),
                   validate: Optional[Path] = typer.Option(None, "--validate",
                                                           help="Validation record (same columns)."),
                   out: Optional[Path] = typer.Option(None, "--out", help="Write the model (JSON)."),

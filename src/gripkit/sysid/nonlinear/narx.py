@@ -48,8 +48,8 @@ VERSION = 1
 #: a free run beyond this many times the data's range (about its mean) counts as diverged
 DIVERGENCE_FACTOR = 1e3
 #: how a NARX model's free-run fit is taken (``gripkit compare`` prints it)
-NARX_FIT = ("free run started from the first max_lag measured outputs, fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) "
-            "over the samples after them")
+NARX_FIT = ("free run started from the first max_lag measured outputs, "
+            "fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) over the samples after them")
 #: most terms FROLS selects when ``terms='auto'``
 MAX_AUTO_TERMS = 40
 
@@ -263,11 +263,12 @@ class NARXModel:
                                     f"found shape {y0.shape}")
             y[:m] = y0
         lo, hi = self._limits()
-        at = _simulate_kernel(self.bases[:, 0].copy(), self.bases[:, 1].copy(), self.rows, self.theta,
-                              u, y, m, lo, hi)
+        at = _simulate_kernel(self.bases[:, 0].copy(), self.bases[:, 1].copy(), self.rows,
+                              self.theta, u, y, m, lo, hi)
         if at >= 0 and warn:
-            emit_warning(f"narx: the free run diverges at sample {at} (beyond {DIVERGENCE_FACTOR:g}× "
-                         "the estimation output's range); the model is unstable on this input",
+            emit_warning(f"narx: the free run diverges at sample {at} (beyond "
+                         f"{DIVERGENCE_FACTOR:g}× the estimation output's range); the model is "
+                         "unstable on this input",
                          StabilityWarning)
         return y
 
@@ -336,8 +337,8 @@ def load_narx(path) -> NARXModel:
         raise ModelError(f"{str(p)!r} has schema {schema!r}, expected {SCHEMA!r}; load other model "
                          "files with gripkit.sysid.load_model")
     if doc.get("version") != VERSION:
-        raise ModelError(f"{str(p)!r} is a {SCHEMA} of version {doc.get('version')!r}; this gripkit "
-                         f"reads version {VERSION}")
+        raise ModelError(f"{str(p)!r} is a {SCHEMA} of version {doc.get('version')!r}; this "
+                         f"gripkit reads version {VERSION}")
     try:
         bases = np.array(doc["bases"], dtype=np.int64).reshape(-1, 2)
         rows = np.array(doc["rows"], dtype=np.int64).reshape(len(doc["rows"]), int(doc["degree"]))
@@ -376,7 +377,8 @@ def narx(u, y, *, degree: int = 2, lags: int | None = 2, ylags: int | None = Non
 
     ``degree``: highest total degree of a term. ``lags``: output and input lags (``ylags`` /
     ``ulags`` set them apart). ``terms``: ``"auto"`` (BIC, or the validation fit with
-    ``validate=(u2, y2)``) or a number of FROLS terms. ``direct``: include ``u(t)``.
+    ``validate=(u2, y2)``; at most 40 FROLS terms are tried) or a number of FROLS terms.
+    ``direct``: include ``u(t)``. ``dt``: sample interval (s), default 1.
     ``prune``: remove terms with ``|θ|/σ < 2`` and refit.
     """
     u, y = _as_signal(u, "u"), _as_signal(y, "y")
@@ -389,6 +391,9 @@ def narx(u, y, *, degree: int = 2, lags: int | None = 2, ylags: int | None = Non
     degree = _positive_int(degree, "degree")
     ly = _positive_int(ylags if ylags is not None else lags, "ylags", 0)
     lu = _positive_int(ulags if ulags is not None else lags, "ulags", 0)
+    if dt is not None and not (isinstance(dt, (int, float, np.floating)) and np.isfinite(dt)
+                               and dt > 0):
+        raise ArgumentError(f"narx: dt must be a positive sample interval in s, found {dt!r}")
     if ly + lu == 0 and not direct:
         raise ArgumentError("narx: no lagged signal (ylags = ulags = 0); give lags ≥ 1")
     bases, rows = candidate_terms(ly, lu, degree, direct)
@@ -410,10 +415,12 @@ def narx(u, y, *, degree: int = 2, lags: int | None = 2, ylags: int | None = Non
     if terms == "auto":
         kmax = min(len(rows), MAX_AUTO_TERMS)
     else:
+        if isinstance(terms, str):
+            raise ArgumentError(f"narx: terms must be 'auto' or an integer ≥ 1, found {terms!r}")
         kmax = _positive_int(terms, "terms")
         if kmax > len(rows):
-            raise ArgumentError(f"narx: terms = {kmax} but only {len(rows)} candidates; give at most "
-                                f"{len(rows)} or raise degree/lags")
+            raise ArgumentError(f"narx: terms = {kmax} but only {len(rows)} candidates; give at "
+                                f"most {len(rows)} or raise degree/lags")
     order, errs, sse = frols(P, target, kmax)
     if not order:
         raise IdentificationError("narx: no candidate term explains the output (all columns zero)")
@@ -430,7 +437,8 @@ def narx(u, y, *, degree: int = 2, lags: int | None = 2, ylags: int | None = Non
         return NARXModel(ylags=ly, ulags=lu, degree=degree, direct=direct, bases=bases,
                          rows=rows[cols], theta=theta, theta_std=std, covariance=cov,
                          dt=1.0 if dt is None else float(dt), y_range=y_range,
-                         err=list(errs[:k]), frols_terms=[_term_name(rows[c], bases) for c in order[:k]])
+                         err=list(errs[:k]),
+                         frols_terms=[_term_name(rows[c], bases) for c in order[:k]])
 
     if terms != "auto":
         model, how = build(len(order)), f"terms={len(order)}"
