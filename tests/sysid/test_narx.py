@@ -2,7 +2,6 @@
 free-run simulation, save/load, and the measured DC-motor record."""
 
 import json
-import warnings
 from pathlib import Path
 
 import numpy as np
