@@ -19,8 +19,10 @@ Rows (both sides through ``common.measure``: same warm-up call and number of run
 * linear ARX, lags 4: gripkit ``arx(u, y, 4, 4, 1)`` beside sysidentpy ``FROLS`` with a degree-1
   polynomial basis (ylag = xlag = 4, BIC order selection, least squares) — the same model class;
 * sysidentpy's own example on these data (``FROLS``, degree-2 polynomial NARX, ylag = xlag = 5,
-  BIC, recursive least squares) beside gripkit's refined linear model: different model classes
-  (gripkit has no NARX); it shows what a nonlinear model gains on this system.
+  BIC, recursive least squares) beside gripkit's refined linear model: different model classes;
+  it shows what a nonlinear model gains on this system;
+* polynomial NARX, degree 3, lags 2, BIC on both sides: gripkit ``narx`` beside sysidentpy ``FROLS``
+  (least squares).
 """
 
 from __future__ import annotations
@@ -157,8 +159,26 @@ def run(quick: bool) -> list[dict]:
                     gripkit_accuracy=_fit_text(fit_refined) + " (linear, n4sid + PEM)",
                     peer_accuracy=_fit_text(_fit(yv, m.predict(X=uv[:, None], y=yv[:, None]))) + " (nonlinear)",
                     notes="different model classes: the motor speeds up and coasts down with different time "
-                          "constants, which a polynomial NARX captures and a linear model cannot; gripkit has no NARX"))
+                          "constants, which a polynomial NARX captures and a linear model cannot"))
+    rows.append(_narx_row(ue, ye, uv, yv))
     return rows
+
+
+def _narx_row(ue, ye, uv, yv) -> dict:
+    """Polynomial NARX, degree 3, lags 2, BIC on both sides (sysidentpy: least squares)."""
+    from gripkit.sysid import narx as gripkit_narx
+
+    ours = lambda: gripkit_narx(ue, ye, degree=3, lags=2)  # noqa: E731
+    g = ours()
+    peer = _sysidentpy(3, 2, False, ue, ye)
+    m = peer()
+    return row("measured", f"polynomial NARX, degree 3, lags 2, BIC, {DATA}", measure(ours),
+               "sysidentpy FROLS degree 3", measure(peer),
+               gripkit_accuracy=_fit_text(g.compare(uv, yv)) + f" ({len(g.terms)} terms)",
+               peer_accuracy=_fit_text(_fit(yv, m.predict(X=uv[:, None], y=yv[:, None])))
+               + f" ({m.final_model.shape[0]} terms)",
+               notes="same model class; gripkit: FROLS + BIC + pruning of |θ|/σ < 2, fit over the "
+                     "samples after the first max_lag; sysidentpy: its predict, fit over every sample")
 
 
 if __name__ == "__main__":

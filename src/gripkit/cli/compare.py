@@ -42,6 +42,10 @@ def compare(model: Path = ModelArg,
             fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, json_out: bool = JsonOpt):
     """Free-run fit (%) of a saved model per output, initial state estimated."""
     from ..sysid.linear_model import VALIDATION_FIT
+    from ..sysid.nonlinear.narx import SCHEMA, file_schema
+
+    if file_schema(model) == SCHEMA:
+        return _compare_narx(model, data, fs, time, fill, json_out)
     from ..sysid.model_file import file_sha256
 
     with warnings.catch_warnings(record=True) as caught:
@@ -60,6 +64,62 @@ def compare(model: Path = ModelArg,
         typer.echo(f"  {n}: {f:.2f} %")
 
 
+def _compare_narx(model: Path, data: Path, fs, time, fill, json_out: bool) -> None:
+    """``gripkit compare`` of a NARX model file: its free-run fit on DATA's columns (the number
+    ``gripkit identify narx --validate`` reports)."""
+    import numpy as np
+
+    from ..sysid.nonlinear.narx import NARX_FIT, load_narx
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        m = load_narx(model)
+        tr = load_data(data, [m.input_name, m.output_name], fs, time, fill)
+        fit = m.compare(np.asarray(tr[m.input_name]), np.asarray(tr[m.output_name]))
+    res = {"model": str(model), "data": str(data), "structure": "narx", "outputs": [m.output_name],
+           "fit_percent": [fit], "initial_state": "measured", "definition": NARX_FIT,
+           "warnings": report_warnings(caught)}
+    if json_out:
+        emit_json(res)
+        return
+    typer.echo(f"narx on {data}: {NARX_FIT}")
+    typer.echo(f"  {m.output_name}: " + ("diverged" if fit is None else f"{fit:.2f} %"))
+
+
+def _simulate_narx(model: Path, data: Path, out: Path | None, fs, time, fill, json_out: bool) -> None:
+    """``gripkit simulate`` of a NARX model file: its free run on DATA's input column, from rest
+    (the first max_lag outputs zero), written as CSV on stdout or to ``--out``."""
+    import sys
+
+    import numpy as np
+
+    from ..io import save
+    from ..signals.trajectory import Trajectory
+    from ..sysid.nonlinear.narx import load_narx
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        m = load_narx(model)
+        tr = load_data(data, [m.input_name], fs, time, fill)
+        y = m.simulate(np.asarray(tr[m.input_name]))
+    sim = Trajectory(tr.t, {m.output_name: y})
+    if out is not None:
+        save(sim, out)
+    finite = y[np.isfinite(y)]
+    res = {"model": str(model), "data": str(data), "samples": sim.n, "out": None if out is None else str(out),
+           "outputs": {m.output_name: {"min": float(finite.min()) if finite.size else None,
+                                       "max": float(finite.max()) if finite.size else None,
+                                       "final": float(y[-1]) if np.isfinite(y[-1]) else None}},
+           "warnings": report_warnings(caught)}
+    if json_out:
+        emit_json(res)
+    elif out is None:
+        sys.stdout.write(f"t [s],{m.output_name}\n")
+        np.savetxt(sys.stdout, np.column_stack([tr.t, y]), delimiter=",", fmt="%.10g")
+    else:
+        typer.echo(f"narx: {sim.n} samples simulated, written to {out}")
+
+
 def simulate_model_file(model: Path, data: Path | None, out: Path | None, fs, time, fill, json_out: bool) -> None:
     """``gripkit simulate MODEL.json --data DATA``: the model's outputs for DATA's input columns
     (by name, offsets applied, from rest); writes the time column and one column per output, each
@@ -74,6 +134,10 @@ def simulate_model_file(model: Path, data: Path | None, out: Path | None, fs, ti
     if data is None:
         raise DataError(f"simulate {str(model)!r}: a model file needs input data: --data DATA",
                         hint="give a record with the model's input columns")
+    from ..sysid.nonlinear.narx import SCHEMA, file_schema
+
+    if file_schema(model) == SCHEMA:
+        return _simulate_narx(model, data, out, fs, time, fill, json_out)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         m, tr = _model_and_data(model, data, fs, time, fill, outputs=False)

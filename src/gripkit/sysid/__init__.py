@@ -64,6 +64,9 @@ _LAZY = {
     "tfest_frf": ("tfest", "tfest_frf"),
     "load_model": ("linear_model", "load_model"),
     "load_dynamics_model": ("dynamics", "load_dynamics_model"),
+    "narx": ("nonlinear.narx", "narx"),
+    "NARXModel": ("nonlinear.narx", "NARXModel"),
+    "load_narx": ("nonlinear.narx", "load_narx"),
 }
 __getattr__, __dir__ = lazy_exports(__name__, _LAZY)
 __all__ = [*_LAZY]
@@ -111,3 +114,6 @@ if TYPE_CHECKING:  # static readers see the same names, imported eagerly
     from .tfest import tfest_frf as tfest_frf
     from .linear_model import load_model as load_model
     from .dynamics import load_dynamics_model as load_dynamics_model
+    from .nonlinear.narx import NARXModel as NARXModel
+    from .nonlinear.narx import load_narx as load_narx
+    from .nonlinear.narx import narx as narx

@@ -33,7 +33,7 @@ from ..arguments import check_keywords, entry_point, keyword_names
 from ..errors import AccuracyWarning, ArgumentError, DataError, GripkitError, emit_warning
 from ..signals.processing import detrend as detrend_signals
 from ..signals.trajectory import Trajectory
-from . import identify_mimo
+from . import identify_mimo, nonlinear
 from .armax import armax, armax_records
 from .arx import arx, arx_records
 from .arx_mimo import arx_mimo_records
@@ -43,7 +43,7 @@ from .search import structure_search
 
 __all__ = ["IOData", "io_data", "identify", "identify_records", "method_options", "METHODS"]
 
-METHODS = ("arx", "armax", "oe", "rls", "search", "ss", "frf", "tf")
+METHODS = ("arx", "armax", "oe", "rls", "search", "ss", "frf", "tf", "narx")
 
 
 @dataclass(frozen=True)
@@ -150,6 +150,8 @@ def _method_function(method: str):
         from .rls import rls  # numba (0.4 s): loaded only for an RLS fit
 
         return rls
+    if method == "narx":  # numba: nonlinear.narx loads its module on first use
+        return nonlinear.narx
     return {"arx": arx, "armax": armax, "oe": oe, "ss": identify_mimo.identify_ss, "frf": frf,
             "tf": identify_mimo.identify_tf}.get(method, structure_search)
 
@@ -183,8 +185,10 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
         such as ``'1:4'``; option ``criterion``); ``'ss'`` (state space by subspace + PEM,
         options of :func:`gripkit.sysid.identify_mimo.identify_ss`), ``'frf'`` (frequency
         response, options of :func:`gripkit.sysid.frf`), ``'tf'`` (continuous-time transfer
-        function, options ``poles``, ``zeros``). For these three ``input``/``output`` may name
-        several columns (``'a,b'`` or a list).
+        function, options ``poles``, ``zeros``); ``'narx'`` (polynomial NARX on the data as they
+        are, its constant term in place of detrending; options of
+        :func:`gripkit.sysid.narx`: ``degree``, ``lags``, ``terms``, ``validate`` …). For ss,
+        frf and tf ``input``/``output`` may name several columns (``'a,b'`` or a list).
     input, output
         Column names.
     detrend
@@ -196,7 +200,7 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
 
     Returns
     -------
-    PolynomialModel, RLSResult or SearchResult
+    PolynomialModel, RLSResult, SearchResult or NARXModel
     """
     if not isinstance(method, str) or method not in METHODS:
         raise DataError(f"method: expected one of {', '.join(METHODS)}, found {method!r}")
@@ -222,6 +226,11 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
     if method == "arx" and identify_mimo.several(input, output):  # matrix-polynomial ARX
         return identify_mimo.identify_arx(data, input=input, output=output, na=na, nb=nb, nk=nk,
                                           detrend=detrend).with_display_units(data)
+    if method == "narx":  # the model's constant term carries the operating point
+        io = io_data(data, input=input, output=output, detrend="none", why="NARX identification")
+        model = nonlinear.narx(io.u, io.y, dt=io.dt, **options)
+        model.input_name, model.output_name = input, output
+        return model
     io = io_data(data, input=input, output=output, detrend=detrend, why=f"{method.upper()} identification")
     if method in ("arx", "armax", "oe"):
         orders = (na, nb, nc, na if nf is None else nf, nk)

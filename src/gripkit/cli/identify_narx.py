@@ -1,0 +1,92 @@
+"""``gripkit identify narx DATA --input U --output Y [--degree D] [--lags L | --ylags LY --ulags LU]
+[--terms N|auto] [--validate DATA2] [--out MODEL.json] [--json]``: polynomial NARX by forward
+regression with the error reduction ratio (:func:`gripkit.sysid.narx`)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+from .app import identify_app
+from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, collected_warnings,
+                     emit_json, load_data, report_warnings)
+
+
+def _terms(value: str):
+    """``auto`` or a positive integer."""
+    from ..errors import DataError
+
+    if value == "auto":
+        return "auto"
+    try:
+        n = int(value)
+    except ValueError:
+        n = 0
+    if n < 1:
+        raise DataError(f"--terms: expected 'auto' or a positive integer, found {value!r}",
+                        hint="--terms auto chooses the number by BIC (or by --validate's fit)")
+    return n
+
+
+def _summary(m) -> str:
+    lines = [f"NARX degree {m.degree}, ylags {m.ylags}, ulags {m.ulags}: {len(m.terms)} terms "
+             f"({m.criterion})"]
+    lines += [f"  {name:<28s} {th: .6g} ± {sd:.3g}"
+              for name, th, sd in zip(m.terms, m.theta, m.theta_std)]
+    fmt = lambda v: "diverged" if v is None else f"{v:.2f} %"  # noqa: E731
+    lines.append(f"free-run fit (estimation): {fmt(m.fit_percent)}; one-step prediction fit: "
+                 f"{fmt(m.prediction_fit_percent)}")
+    if m.validation_fit_percent is not None or m.criterion.startswith("validation"):
+        lines.append(f"free-run fit (validation): {fmt(m.validation_fit_percent)}")
+    return "\n".join(lines)
+
+
+@identify_app.command("narx")
+def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 file, the record."),
+                  input_col: str = typer.Option(..., "--input", help="Input column."),
+                  output_col: str = typer.Option(..., "--output", help="Output column."),
+                  degree: int = typer.Option(2, "--degree", help="Highest degree of a term."),
+                  lags: int = typer.Option(2, "--lags", help="Output and input lags."),
+                  ylags: Optional[int] = typer.Option(None, "--ylags", help="Output lags."),
+                  ulags: Optional[int] = typer.Option(None, "--ulags", help="Input lags."),
+                  terms: str = typer.Option("auto", "--terms",
+                                            help="Number of terms, or auto (BIC; with --validate "
+                                                 "the free-run validation fit)."),
+                  validate: Optional[Path] = typer.Option(None, "--validate",
+                                                          help="Validation record (same columns)."),
+                  out: Optional[Path] = typer.Option(None, "--out", help="Write the model (JSON)."),
+                  fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
+                  json_out: bool = JsonOpt):
+    """Polynomial NARX: terms by error reduction ratio (FROLS), θ with σ, pruning, free-run fit."""
+    import numpy as np
+
+    from ..sysid.nonlinear.narx import narx
+
+    n_terms = _terms(terms)
+    check_data_options(fs, fill)
+    with collected_warnings() as caught:
+        tr = load_data(data, [input_col, output_col], fs, time, fill)
+        val = None
+        if validate is not None:
+            tv = load_data(validate, [input_col, output_col], fs, time, fill)
+            val = (np.asarray(tv[input_col]), np.asarray(tv[output_col]))
+        m = narx(np.asarray(tr[input_col]), np.asarray(tr[output_col]), degree=degree, lags=lags,
+                 ylags=ylags, ulags=ulags, terms=n_terms, dt=tr.dt, validate=val)
+        m.input_name, m.output_name = input_col, output_col
+        if out is not None:
+            m.save(out)
+    lines = report_warnings(caught)
+    if json_out:
+        emit_json({"data": str(data), "input": input_col, "output": output_col,
+                   "structure": {"degree": m.degree, "ylags": m.ylags, "ulags": m.ulags,
+                                 "terms": m.terms, "criterion": m.criterion},
+                   "parameters": [{"term": t, "value": float(v), "std": float(s)}
+                                  for t, v, s in zip(m.terms, m.theta, m.theta_std)],
+                   "fit_percent": m.fit_percent, "prediction_fit_percent": m.prediction_fit_percent,
+                   "validation": None if validate is None else
+                   {"data": str(validate), "fit_percent": m.validation_fit_percent},
+                   "model": None if out is None else str(out), "warnings": lines})
+    else:
+        typer.echo(_summary(m))
