@@ -266,13 +266,12 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
 FOCUS = ("simulation", "prediction")
 
 
-def focus_score(model, focus: str, d: MimoData, estimation: bool = False) -> float:
+def focus_score(model, focus: str, d: MimoData) -> float:
     """Mean over outputs of the fit (%) by which ``focus`` judges ``model`` on the deviation data
     ``d``: ``'simulation'``, the free-run fit with x0 estimated (:data:`VALIDATION_FIT`; −inf for
     an unstable model); ``'prediction'``, the one-step-ahead fit of the innovation predictor
     ``x̂⁺ = A x̂ + B u + K (y − C x̂ − D u)`` from its x0 estimated by least squares
-    (:func:`~.pem_ss.predictor_x0`; −inf when A − K C is unstable). ``estimation`` is kept for
-    the callers' record of which data were used."""
+    (:func:`~.pem_ss.predictor_x0`; −inf when A − K C is unstable)."""
     if focus == "simulation":
         return float(np.mean(model.compare(d.u, d.y, dt=d.dt)[0])) if model.stable else -math.inf
     from .pem_ss import predictor_x0
@@ -335,33 +334,31 @@ def _never_lose(start, refined, focus: str, d: MimoData, estimation: bool, max_i
     PEM did not converge and when a refinement is dropped."""
     _warn_unconverged(refined, max_iterations)
     where = "estimation" if estimation else "validation"
-    before = focus_score(start, focus, d, estimation)
+    before = focus_score(start, focus, d)
     record = {"criterion": focus, "data": where, "subspace_percent": before}
-    tried = []
+    tried: list[tuple[str, float]] = []
     for candidate in (lambda: refined, second):
-        if candidate is None:
-            continue
-        model = candidate()
-        if model is None:  # the output-error refinement failed: nothing to weigh
+        model = None if candidate is None else candidate()
+        if model is None:  # no second candidate, or the output-error refinement failed
             continue
         if model is not refined:
             _warn_unconverged(model, max_iterations)
-        after = focus_score(model, focus, d, estimation)
-        tried.append(f"{model.structure} {after:.2f} %")
+        after = focus_score(model, focus, d)
+        tried.append((model.structure, after))
         if after >= before - FOCUS_TIE:
             model.info["focus"] = {**record, "refined_percent": after, "kept": model.structure}
             if model is not refined:
                 emit_warning(f"PEM refinement ({refined.structure}) lowered the mean {focus} fit on "
-                             f"the {where} data from {before:.2f} % to {tried[0].split()[-2]} %; the "
+                             f"the {where} data from {before:.2f} % to {tried[0][1]:.2f} %; the "
                              f"{model.structure} refinement ({after:.2f} %) is returned",
                              AccuracyWarning)
             return model
+    other = "prediction" if focus == "simulation" else "simulation"
     emit_warning(f"PEM refinement lowered the mean {focus} fit on the {where} data from "
-                 f"{before:.2f} % to {', '.join(tried)}: the subspace model is returned, without "
-                 f"parameter covariance (--focus {'prediction' if focus == 'simulation' else 'simulation'}"
-                 f" judges by the other criterion; --no-refine skips PEM)", AccuracyWarning)
-    start.info["focus"] = {**record, "refined_percent": focus_score(refined, focus, d, estimation),
-                           "kept": "subspace"}
+                 f"{before:.2f} % to {', '.join(f'{name} {fit:.2f} %' for name, fit in tried)}: the "
+                 f"subspace model is returned, without parameter covariance (--focus {other} judges "
+                 f"by the other criterion; --no-refine skips PEM)", AccuracyWarning)
+    start.info["focus"] = {**record, "refined_percent": tried[0][1], "kept": "subspace"}
     start.info["pem_rejected"] = refined.info.get("pem", {})
     return start
 
