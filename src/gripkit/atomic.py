@@ -22,6 +22,7 @@ job tables and chunks all go through :func:`atomic_write`.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import tempfile
 from collections.abc import Callable
@@ -87,21 +88,18 @@ def atomic_write(path, write: Callable[[str], object], *, what: str = "file",
         write(tmp)
         if sync:
             _sync_file(tmp)
-        if existed:  # keep the target's permission bits, as an in-place write would
-            try:
+        if existed:  # keep the target's permission bits, as an in-place write would; a target
+            # we may replace but not stat (a vanished link) keeps mkstemp's private 0600
+            with contextlib.suppress(OSError):
                 os.chmod(tmp, path.stat().st_mode & 0o7777)
-            except OSError:
-                pass
         else:
             umask = os.umask(0)
             os.umask(umask)
             os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; a plain open() gives 0666 & ~umask
         os.replace(tmp, path)
     except BaseException as exc:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
+        with contextlib.suppress(OSError):  # the temporary file may be gone already; the target is
+            os.unlink(tmp)                  # untouched either way, which the error below says
         if isinstance(exc, OSError) and not isinstance(exc, GripkitError):
             reason = exc.strerror or str(exc) or type(exc).__name__
             raise PathError(f"{what} {str(path)!r} could not be written ({reason}); {kept}",

@@ -58,7 +58,7 @@ def test_fast_table_equals_pint(unit):
     from gripkit.units import _fast_si_factor, _pint_si_factor
 
     fast = _fast_si_factor(unit)
-    assert fast is not None
+    assert fast is not None, f"{unit!r} should be read from the fast table, not by pint"
     assert fast == _pint_si_factor(unit)
 
 

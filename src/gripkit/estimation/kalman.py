@@ -105,6 +105,17 @@ def _cholesky(S):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
+def _plus_product(base, X, Y, out):  # pragma: no cover - compiled
+    """``out = base + X Y`` (row by row, k ascending), without temporaries."""
+    for i in range(out.shape[0]):
+        for j in range(out.shape[1]):
+            acc = base[i, j]
+            for k in range(X.shape[1]):
+                acc += X[i, k] * Y[k, j]
+            out[i, j] = acc
+
+
+@numba.njit(cache=True)
 def _innovation(C, D, xp, du, y, e):  # pragma: no cover - compiled
     for i in range(C.shape[0]):
         acc = y[i]
@@ -148,18 +159,8 @@ def kf_step(m, xp, Pp, du, y, xf, Pf, w):  # pragma: no cover - compiled
             for k in range(n):
                 acc += Pp[i, k] * C[j, k]
             w.PCt[i, j] = acc
-    for i in range(p):  # Σ = C P_p Cᵀ + R
-        for j in range(p):
-            acc = R[i, j]
-            for k in range(n):
-                acc += C[i, k] * w.PCt[k, j]
-            w.Se[i, j] = acc
-    for i in range(n):  # M = A P_p Cᵀ + S
-        for j in range(p):
-            acc = S[i, j]
-            for k in range(n):
-                acc += A[i, k] * w.PCt[k, j]
-            w.M[i, j] = acc
+    _plus_product(R, C, w.PCt, w.Se)  # Σ = C P_p Cᵀ + R
+    _plus_product(S, A, w.PCt, w.M)   # M = A P_p Cᵀ + S
     if not _cholesky(w.Se):
         return False
     _chol_solve_rows(w.Se, w.PCt, w.Kf)

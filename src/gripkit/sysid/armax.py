@@ -47,9 +47,16 @@ def _hannan_rissanen(u, y, na, nb, nc, nk) -> np.ndarray:
     ehat = np.zeros(n)
     ehat[max(nh, nk + nh - 1):] = _arx(u, y, nh, nh, nk, 1.0, warn=False).residuals
     t0 = max(na, nk + nb - 1, nc) + max(nh, nk + nh - 1)
-    m = n - t0
-    p = na + nb + nc
-    X = np.empty((m, p + 1), order="F")
+    X = _hr_rows(u, y, ehat, na, nb, nc, nk, t0)
+    names = tuple(f"p{i}" for i in range(na + nb + nc))
+    return qr_solve(X, names, overwrite=True, warn=False).theta
+
+
+def _hr_rows(u, y, ehat, na, nb, nc, nk, t0) -> np.ndarray:
+    """The Hannan-Rissanen regression ``[−y(t−i), u(t−nk−j), ê(t−k) | y(t)]`` for t = t0 … N−1,
+    with ê the residuals of a long ARX fit (column-major, for the QR)."""
+    n, p = y.size, na + nb + nc
+    X = np.empty((n - t0, p + 1), order="F")
     for i in range(na):
         X[:, i] = -y[t0 - 1 - i:n - 1 - i]
     for j in range(nb):
@@ -57,8 +64,7 @@ def _hannan_rissanen(u, y, na, nb, nc, nk) -> np.ndarray:
     for k in range(nc):
         X[:, na + nb + k] = ehat[t0 - 1 - k:n - 1 - k]
     X[:, p] = y[t0:]
-    names = tuple(f"p{i}" for i in range(p))
-    return qr_solve(X, names, overwrite=True, warn=False).theta
+    return X
 
 
 def armax(u, y, na: int, nb: int, nc: int, nk: int = 1, *, dt: float | None = None,
@@ -217,14 +223,6 @@ def _hannan_rissanen_records(recs, na, nb, nc, nk) -> np.ndarray:
             continue
         ehat = np.zeros(n)
         ehat[th:] = high.residuals[start:start + n - th]
-        X = np.empty((n - t0, p + 1))
-        for i in range(na):
-            X[:, i] = -y[t0 - 1 - i:n - 1 - i]
-        for j in range(nb):
-            X[:, na + j] = u[t0 - nk - j:n - nk - j]
-        for k in range(nc):
-            X[:, na + nb + k] = ehat[t0 - 1 - k:n - 1 - k]
-        X[:, p] = y[t0:]
-        rows.append(X)
+        rows.append(_hr_rows(u, y, ehat, na, nb, nc, nk, t0))
     names = tuple(f"p{i}" for i in range(p))
     return qr_solve(np.asfortranarray(np.vstack(rows)), names, overwrite=True, warn=False).theta

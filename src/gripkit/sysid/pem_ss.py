@@ -232,6 +232,24 @@ def _directions(A, B, C, D, K, feedthrough: bool, innovation: bool):
     return (*out, entries)
 
 
+def _proposal(H, hd, g, lam, directions, system, innovation: bool):
+    """One damped Gauss-Newton proposal of the Levenberg-Marquardt loops (one record and several):
+    δ from ``(H + λ diag H) δ = g``, the system moved by its first d entries along
+    ``directions`` (dA, dB, dC, dD, dK); ``(None, δ)`` when the solve fails or the moved A (or,
+    in innovation form, A − K C) leaves the stable set, else ``((A, B, C, D, K) moved, δ)``."""
+    try:
+        delta = np.linalg.solve(H + lam * np.diag(hd), g)
+    except np.linalg.LinAlgError:
+        return None, None
+    dA, dB, dC, dD, dK = directions
+    A, B, C, D, K = system
+    th = delta[:dA.shape[0]]
+    An, Cn, Kn = A + np.tensordot(th, dA, 1), C + np.tensordot(th, dC, 1), K + np.tensordot(th, dK, 1)
+    if _radius(An) >= 1.0 or (innovation and _radius(An - Kn @ Cn) >= 1.0):
+        return None, delta
+    return (An, B + np.tensordot(th, dB, 1), Cn, D + np.tensordot(th, dD, 1), Kn), delta
+
+
 def _radius(A):
     return float(np.max(np.abs(np.linalg.eigvals(A)))) if A.shape[0] else 0.0
 
@@ -251,17 +269,12 @@ def _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough, innovation, max_
         hd = np.maximum(np.diag(H), 1e-300)
         improved, rel = False, 0.0
         for _ in range(30):
-            try:
-                delta = np.linalg.solve(H + lam * np.diag(hd), g)
-            except np.linalg.LinAlgError:
+            moved, delta = _proposal(H, hd, g, lam, (dA, dB, dC, dD, dK), (A, B, C, D, K), innovation)
+            if moved is None:
                 lam *= 10
                 continue
-            th = delta[:d]
-            An, Cn, Kn = A + np.tensordot(th, dA, 1), C + np.tensordot(th, dC, 1), K + np.tensordot(th, dK, 1)
-            if _radius(An) >= 1.0 or (innovation and _radius(An - Kn @ Cn) >= 1.0):
-                lam *= 10
-                continue
-            Bn, Dn, x0n = B + np.tensordot(th, dB, 1), D + np.tensordot(th, dD, 1), x0 + delta[d:]
+            An, Bn, Cn, Dn, Kn = moved
+            x0n = x0 + delta[d:]
             en = np.empty((N, p))
             predict_errors(An, Bn, Cn, Dn, Kn, x0n, u, yw, en)
             Vn = float(np.sum(en * en))
@@ -493,18 +506,11 @@ def _lm_records(A, B, C, D, K, x0s, us, ys, feedthrough, innovation, max_iterati
         hd = np.maximum(np.diag(H), 1e-300)
         improved, rel, drop = False, 0.0, 0.0
         for _ in range(30):
-            try:
-                delta = np.linalg.solve(H + lam * np.diag(hd), g)
-            except np.linalg.LinAlgError:
+            moved, delta = _proposal(H, hd, g, lam, (dA, dB, dC, dD, dK), (A, B, C, D, K), innovation)
+            if moved is None:
                 lam *= 10
                 continue
-            th = delta[:d]
-            An, Cn = A + np.tensordot(th, dA, 1), C + np.tensordot(th, dC, 1)
-            Kn = K + np.tensordot(th, dK, 1)
-            if _radius(An) >= 1.0 or (innovation and _radius(An - Kn @ Cn) >= 1.0):
-                lam *= 10
-                continue
-            Bn, Dn = B + np.tensordot(th, dB, 1), D + np.tensordot(th, dD, 1)
+            An, Bn, Cn, Dn, Kn = moved
             x0n = [x0 + delta[d + r * n:d + (r + 1) * n] for r, x0 in enumerate(x0s)]
             Vn = _records_loss(An, Bn, Cn, Dn, Kn, x0n, us, ys)
             if np.isfinite(Vn) and Vn < Vc:

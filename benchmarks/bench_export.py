@@ -1,0 +1,118 @@
+"""The exported C step (``gripkit export c``, issue 27) on the target-like path: latency and jitter
+of ``NAME_step`` for a 2×2 state-space model of order 6, compiled with ``gcc -O2``, over 10⁶
+steps timed in blocks of 16 (``clock_gettime``), reported as min, median, p99, p99.9 and max ns
+per step; beside it, the same model's free run per sample in gripkit's numba kernel
+(``lti.simulate_ss``), the route a Python user has. Issue 27's target: ≤ 150 ns median.
+
+Both sides compute the same outputs (checked to 1e-12 relative before timing)."""
+
+from __future__ import annotations
+
+import json
+import shutil
+import subprocess
+import tempfile
+from pathlib import Path
+
+import numpy as np
+from common import measure, row
+
+ORDER, M, P = 6, 2, 2
+STEPS, BLOCK = 1_000_000, 16
+
+_HARNESS = r"""
+#define _POSIX_C_SOURCE 199309L
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+#include "bench.h"
+static double now_ns(void) {
+    struct timespec t; clock_gettime(CLOCK_MONOTONIC, &t);
+    return 1e9 * (double)t.tv_sec + (double)t.tv_nsec;
+}
+static int cmp(const void *a, const void *b) {
+    double x = *(const double *)a, y = *(const double *)b; return (x > y) - (x < y);
+}
+int main(int argc, char **argv) {
+    if (argc < 4) return 2;
+    long steps = atol(argv[1]), block = atol(argv[2]), nb = steps / block;
+    double *per = malloc(sizeof(double) * (size_t)nb), u[BENCH_NU], y[BENCH_NY], sink = 0.0;
+    bench_state s; bench_init(&s);
+    FILE *f = fopen(argv[3], "w");  /* the first 1000 outputs, to check against Python */
+    for (long k = 0; k < 1000; ++k) {
+        for (int i = 0; i < BENCH_NU; ++i) u[i] = (double)((k * (i + 3)) % 17) / 17.0 - 0.5;
+        bench_step(&s, u, y);
+        for (int j = 0; j < BENCH_NY; ++j) fprintf(f, "%.17g%c", y[j], j + 1 < BENCH_NY ? ',' : '\n');
+    }
+    fclose(f);
+    for (long b = 0; b < nb; ++b) {
+        double t0 = now_ns();
+        for (long k = 0; k < block; ++k) {
+            u[0] = (double)(k & 7) * 0.1; u[1] = -u[0];
+            bench_step(&s, u, y);
+            sink += y[0];
+        }
+        per[b] = (now_ns() - t0) / (double)block;
+    }
+    qsort(per, (size_t)nb, sizeof(double), cmp);
+    printf("{\"min\": %.3f, \"median\": %.3f, \"p99\": %.3f, \"p999\": %.3f, \"max\": %.3f, \"sink\": %g}\n",
+           per[0], per[nb / 2], per[(long)(0.99 * nb)], per[(long)(0.999 * nb)], per[nb - 1], sink);
+    return 0;
+}
+"""
+
+
+def _model():
+    """A stable 2×2 model of order 6 (poles of modulus 0.6–0.95) with offsets."""
+    from gripkit.lti import StateSpace
+    from gripkit.sysid import LinearModel
+
+    rng = np.random.default_rng(7)
+    Q, _ = np.linalg.qr(rng.standard_normal((ORDER, ORDER)))
+    A = Q @ np.diag(np.linspace(0.6, 0.95, ORDER)) @ Q.T
+    ss = StateSpace(A, rng.standard_normal((ORDER, M)), rng.standard_normal((P, ORDER)),
+                    np.zeros((P, M)), dt=0.001, inputs=("u1", "u2"), outputs=("y1", "y2"))
+    return LinearModel(ss, "n4sid", u_offset=(0.5, -0.25), y_offset=(1.0, 2.0))
+
+
+def run(quick: bool) -> list[dict]:
+    from gripkit.export import export_c
+
+    gcc = shutil.which("gcc")
+    if gcc is None:
+        return [row("export", "C step, 2x2 order 6", None, "numba simulate_ss", None,
+                    notes="gcc not found: not measured")]
+    model = _model()
+    steps = STEPS // 10 if quick else STEPS
+    with tempfile.TemporaryDirectory() as tmp:
+        d = Path(tmp)
+        export_c(model, d, "bench")
+        (d / "harness.c").write_text(_HARNESS)
+        exe = d / "bench"
+        cc = subprocess.run([gcc, "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-o", str(exe),
+                             str(d / "harness.c"), str(d / "bench.c"), "-lm"], capture_output=True, text=True)
+        if cc.returncode:
+            raise RuntimeError(cc.stderr)
+        res = subprocess.run([str(exe), str(steps), str(BLOCK), str(d / "y.csv")], check=True,
+                             capture_output=True, text=True)
+        stats = json.loads(res.stdout)
+        y_c = np.loadtxt(d / "y.csv", delimiter=",")
+    k = np.arange(1000)
+    u = np.column_stack([((k * (i + 3)) % 17) / 17.0 - 0.5 for i in range(M)])
+    y_py = model.simulate(u - np.asarray(model.u_offset)) + np.asarray(model.y_offset)
+    err = float(np.max(np.abs(y_c - y_py) / np.maximum(np.abs(y_py), 1e-300)))
+    if err > 1e-12:
+        raise AssertionError(f"exported step differs from Python by {err:.3g} relative")
+    uu = np.ascontiguousarray(np.tile(u, (steps // 1000, 1)))
+    numba_run = measure(lambda: model.simulate(uu))
+    per_numba = numba_run.median / uu.shape[0]
+    return [row("export", f"C step of a 2x2 order-{ORDER} model, ns per step (gcc -O2, blocks of "
+                f"{BLOCK}, {steps} steps)", stats["median"] * 1e-9, "numba simulate_ss, per sample "
+                "of a batch free run", per_numba, target="<= 150 ns median (issue 27)",
+                gripkit_accuracy=f"outputs = Python to {err:.1e} relative",
+                extra={k: stats[k] for k in ("min", "median", "p99", "p999", "max")})]
+
+
+if __name__ == "__main__":
+    for r in run(quick=False):
+        print(json.dumps(r))
