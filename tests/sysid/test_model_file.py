@@ -67,8 +67,24 @@ def test_edited_file_warns_hash_mismatch(model, tmp_path):
 def test_wrong_schema_refused(tmp_path):
     p = tmp_path / "x.json"
     p.write_text(json.dumps({"schema": "something-else", "A": [[1]]}))
-    with pytest.raises(ModelError, match="expected schema 'gripkit.linear-model'"):
+    with pytest.raises(ModelError, match="unknown schema 'something-else'; gripkit reads"):
         load_model(p)
+
+
+def test_load_model_gives_back_the_saved_family(tmp_path):
+    """One door (sysid.load_model) for every family: a NARX file comes back as a NARXModel."""
+    from gripkit.sysid import NARXModel, narx
+
+    rng = np.random.default_rng(3)
+    u = rng.standard_normal(400)
+    y = np.zeros(400)
+    for t in range(1, 400):
+        y[t] = 0.5 * y[t - 1] + u[t - 1] + 0.1 * u[t - 1] ** 2
+    m = narx(u, y, degree=2, lags=1)
+    m.save(tmp_path / "n.json")
+    back = load_model(tmp_path / "n.json")
+    assert isinstance(back, NARXModel)
+    np.testing.assert_array_equal(back.theta, m.theta)
 
 
 def test_to_control_keeps_names_and_from_control_goes_back(model):

@@ -62,7 +62,9 @@ _LAZY = {
     "frf": ("frf", "frf"),
     "tfest": ("tfest", "tfest"),
     "tfest_frf": ("tfest", "tfest_frf"),
-    "load_model": ("linear_model", "load_model"),
+    "load_model": ("model_protocol", "load_model"),
+    "ModelFit": ("model_protocol", "ModelFit"),
+    "IdentifiedModel": ("model_protocol", "IdentifiedModel"),
     "load_dynamics_model": ("dynamics", "load_dynamics_model"),
     "narx": ("nonlinear.narx", "narx"),
     "NARXModel": ("nonlinear.narx", "NARXModel"),
@@ -112,7 +114,9 @@ if TYPE_CHECKING:  # static readers see the same names, imported eagerly
     from .frf import frf as frf
     from .tfest import tfest as tfest
     from .tfest import tfest_frf as tfest_frf
-    from .linear_model import load_model as load_model
+    from .model_protocol import IdentifiedModel as IdentifiedModel
+    from .model_protocol import ModelFit as ModelFit
+    from .model_protocol import load_model as load_model
     from .dynamics import load_dynamics_model as load_dynamics_model
     from .nonlinear.narx import NARXModel as NARXModel
     from .nonlinear.narx import load_narx as load_narx

@@ -30,7 +30,7 @@ from .checks import as_io_matrix
 from .model_file import SCHEMA, SCHEMA_VERSION, read_document, write_document
 
 __all__ = ["VALIDATION_FIT", "validation_fit", "LinearModel", "as_io_matrix", "estimate_x0", "free_run", "fit_per_output", "from_polynomial",
-           "model_document", "save_model", "load_model"]
+           "model_document", "save_model", "load_linear_model"]
 
 
 def _sim(A, B, C, D, u, x0):
@@ -312,7 +312,7 @@ class LinearModel:
         return self.system.to_control()
 
     def save(self, path) -> None:
-        """Write the model to a JSON file (:func:`model_document`; reload with :func:`load_model`)."""
+        """Write the model to a JSON file (:func:`model_document`; reload with :func:`load_linear_model`)."""
         write_document(model_document(self), path)
 
     def to_dict(self) -> dict:
@@ -428,7 +428,7 @@ def _arr(x, name, where):
         raise ModelError(f"model file {where}: field {name!r} is not an array of numbers") from None
 
 
-def load_model(path) -> LinearModel:
+def load_linear_model(path) -> LinearModel:
     """Read a model written by ``model.save(path)``.
 
     Raises ModelError for a file that is not a gripkit model (wrong ``schema``), of a newer
@@ -439,7 +439,7 @@ def load_model(path) -> LinearModel:
     --------
     >>> import tempfile, os
     >>> from gripkit.lti import StateSpace
-    >>> from gripkit.sysid import LinearModel, load_model
+    >>> from gripkit.sysid import LinearModel, load_model  # reads any model file
     >>> m = LinearModel(StateSpace([[0.5]], [[1.0]], [[1.0]], dt=0.1, inputs="V", outputs="x"), "n4sid")
     >>> p = os.path.join(tempfile.mkdtemp(), "m.json"); m.save(p)
     >>> load_model(p).system.A.tolist(), load_model(p).inputs
