@@ -41,7 +41,7 @@ def _bare(u, y):
 
 def run(quick: bool) -> list[dict]:
     from gripkit.sysid import arx
-    arx_mod = importlib.import_module("gripkit.sysid.arx")
+    arx_mod = importlib.import_module("gripkit.sysid.linear.arx")
     from gripkit.sysid.regression import arx_regression, qr_solve
 
     u, y = _data(N)

@@ -98,7 +98,7 @@ def _scipy_lm(data):
     from scipy import signal
     from scipy.optimize import least_squares
 
-    from gripkit.sysid.step_response import identify_step
+    from gripkit.sysid.physical.step_response import identify_step
 
     u = data["V_in"] - 70.0
     y = data["x_a"]

@@ -56,14 +56,14 @@ def _fit_text(fit):
 
 def _ss_fit(A, B, C, D, uv, yv):
     from gripkit.lti import StateSpace
-    from gripkit.sysid.linear_model import LinearModel
+    from gripkit.sysid.linear.linear_model import LinearModel
 
     m = LinearModel(StateSpace(A, B, C, D, dt=1.0), "peer")
     return None if not m.stable else float(m.compare(uv - uv.mean(), yv - yv.mean())[0][0])
 
 
 def _fit(y, yhat):
-    from gripkit.sysid.linear_model import fit_per_output
+    from gripkit.sysid.linear.linear_model import fit_per_output
 
     return float(fit_per_output(np.reshape(y, (-1, 1)), np.reshape(yhat, (-1, 1)))[0])
 
@@ -98,7 +98,7 @@ def _sysidentpy(degree: int, lag: int, recursive: bool, ue, ye):
 def run(quick: bool) -> list[dict]:
     """All rows; ``quick`` changes nothing (the record is small)."""
     from gripkit.sysid import arx, n4sid, pem
-    from gripkit.sysid.linear_model import from_polynomial
+    from gripkit.sysid.linear.linear_model import from_polynomial
 
     (ue, ye), (uv, yv) = _halves()
     u0, y0 = ue - ue.mean(), ye - ye.mean()

@@ -18,7 +18,7 @@ import numba
 import numpy as np
 from common import measure_alternating, row
 
-from gripkit.sysid.blocked_gram import add_rows, carried_states, row_product, start_sums
+from gripkit.sysid.linear.blocked_gram import add_rows, carried_states, row_product, start_sums
 
 N = 100_000
 TARGET = "FTZ/DAZ set ≈ cleared (ratio 0.9–1.1)"
@@ -26,7 +26,7 @@ TARGET = "FTZ/DAZ set ≈ cleared (ratio 0.9–1.1)"
 
 @numba.njit(cache=True)
 def _bdx_unflushed(A, C, u, y, G, r):  # pragma: no cover - compiled
-    """The B/x0 normal equations of gripkit.sysid.subspace._bdx_normal_equations (no D) as they
+    """The B/x0 normal equations of gripkit.sysid.linear.subspace._bdx_normal_equations (no D) as they
     were before the flush: the carried state copied as is."""
     N, m = u.shape
     n, p = A.shape[0], C.shape[0]
@@ -89,8 +89,8 @@ def run(quick: bool) -> list[dict]:
                     notes=f"not run: {why}")]
     from gripkit.lti import simulate_ss
     from gripkit.sysid import n4sid
-    from gripkit.sysid.pem_ss import _directions, _predict_states, _sensitivity_gram
-    from gripkit.sysid.subspace import _bdx_normal_equations
+    from gripkit.sysid.linear.pem_ss import _directions, _predict_states, _sensitivity_gram
+    from gripkit.sysid.linear.subspace import _bdx_normal_equations
 
     g = _system()
     u, y = _record(g, N, 1)

@@ -65,7 +65,7 @@ def _record(g, n, seed):
 
 def _val_fit(A, B, C, D, uv, yv):
     from gripkit.lti import StateSpace
-    from gripkit.sysid.linear_model import LinearModel
+    from gripkit.sysid.linear.linear_model import LinearModel
 
     m = LinearModel(StateSpace(A, B, C, D, dt=1.0), "peer")
     if not m.stable:

@@ -7,7 +7,7 @@ and a 5-parameter grey-box fit, each against the scipy code a user would write w
    k_e·max(0, y_C − x_w), U interpolated linearly) on the same 1 s cycle.
 2. A grey-box fit of 5 parameters (d_p, λ, β, a, b; γ held) of Bouc-Wen + D(s) on 20 000 samples
    at 20 kHz (a 2 Hz, 100 V sine then voltage steps; tip B with 20 nm noise): gripkit's
-   :func:`gripkit.sysid.greybox.fit` (target < 1 s) against ``scipy.optimize.least_squares`` on a
+   :func:`gripkit.sysid.physical.greybox.fit` (target < 1 s) against ``scipy.optimize.least_squares`` on a
    ``solve_ivp`` simulation (target ≥ 10×).
 
 Compile time is excluded (warm-up call). Timings: benchmarks/common.py measure (median, min), except
@@ -149,7 +149,7 @@ def _compiled_peer_fit(start, data):
 
 
 def run(quick: bool = False) -> list[dict]:
-    from gripkit.sysid.greybox import fit
+    from gripkit.sysid.physical.greybox import fit
     from gripkit.systems.tsfm import parameters as z
 
     warnings.simplefilter("ignore")

@@ -8,7 +8,7 @@ sign, the filter has finite bandwidth), which no σ from the data can reveal."""
 
 import numpy as np
 
-from gripkit.sysid.friction import idim_ls
+from gripkit.sysid.rigid_body.friction import idim_ls
 
 fs, T = 1000.0, 20.0
 t = np.arange(int(T * fs)) / fs

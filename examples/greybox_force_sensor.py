@@ -9,7 +9,7 @@ import numpy as np
 
 from gripkit import Trajectory
 from gripkit.models import MassSpringDamper
-from gripkit.sysid.greybox import fit
+from gripkit.sysid.physical.greybox import fit
 
 fs = 20000.0
 force = np.where(np.arange(4000) < 2000, 150e-6, 0.0)  # 150 µN preload, released at 0.1 s

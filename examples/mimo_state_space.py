@@ -53,7 +53,7 @@ r = identify(est, "frf", input="a,b", output="c,d", nperseg=500)
 print(f"FRF: {r.frequency_hz.size} lines, median coherence {np.nanmedian(r.coherence):.3f}")
 
 # 3. state space: order from the singular values, subspace then PEM, validated on the second record
-from gripkit.sysid.identify_mimo import identify_ss  # noqa: E402
+from gripkit.sysid.linear.identify_mimo import identify_ss  # noqa: E402
 
 model, extras = identify_ss(est, input="a,b", output="c,d", validate=val)
 p, cov = model.system.pole_covariance()

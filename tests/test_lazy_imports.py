@@ -32,15 +32,15 @@ LAZY_PACKAGES = {
 
 #: gripkit modules imported on first use: (importer, imported) → why
 LAZY_MODULES = {
-    ("sysid/arx.py", ".lagged_sums"): "numba kernels: a small ARX is solved by QR without loading numba (0.45 s)",
-    ("sysid/identify.py", ".rls"): "numba (0.4 s): `gripkit identify arx` does not load it",
-    ("sysid/identify_mimo.py", ".pem_ss"): "numba kernels: only state-space identification loads them",
-    ("sysid/identify_mimo.py", ".subspace"): "numba kernels: only state-space identification loads them",
-    ("sysid/identify_mimo.py", ".tfest"): "scipy.signal (0.85 s): only transfer-function fits load it",
+    ("sysid/linear/arx.py", ".lagged_sums"): "numba kernels: a small ARX is solved by QR without loading numba (0.45 s)",
+    ("sysid/identify.py", ".linear.rls"): "numba (0.4 s): `gripkit identify arx` does not load it",
+    ("sysid/linear/identify_mimo.py", ".pem_ss"): "numba kernels: only state-space identification loads them",
+    ("sysid/linear/identify_mimo.py", ".subspace"): "numba kernels: only state-space identification loads them",
+    ("sysid/linear/identify_mimo.py", ".tfest"): "scipy.signal (0.85 s): only transfer-function fits load it",
     ("systems/tsfm/robustness.py", "...report.plots"):
         "matplotlib (0.34 s): only the robustness plot loads it",
     ("lti/_system.py", "._kernels"): "numba simulation kernel: lti loads without numba",
-    ("sysid/linear_model.py", "..lti"): "lti's numba simulation kernel, loaded on the first simulation",
+    ("sysid/linear/linear_model.py", "...lti"): "lti's numba simulation kernel, loaded on the first simulation",
     ("systems/tsfm/grasp_batch.py", ".grasp_gpu"): "numba.cuda: the GPU path only",
     ("io/formats.py", ".mcap_reader"): "the optional mcap extra",
 }

@@ -28,7 +28,7 @@ from .signals.filters import apply_sos, butter_sos
 from .signals.trajectory import Trajectory
 
 __all__ = ["Excitation", "multisine", "periodic_multisine", "bandlimited_noise", "prbs", "chirp", "steps",
-           "crest_factor", "FourierTrajectory", "fourier_trajectory"]
+           "crest_factor"]
 
 
 @dataclass(frozen=True)
@@ -161,7 +161,7 @@ def periodic_multisine(f_min: float, f_max: float, period_samples: int, periods:
                        amplitude: float | None = None, seed: int = 0, iterations: int = 200,
                        unit: str = "1") -> Excitation:
     """A crest-factor-optimised multisine on chosen DFT lines of one period, repeated an integer
-    number of times: the design that :func:`gripkit.sysid.frf` with ``periods`` expects.
+    number of times: the design that :func:`gripkit.sysid.linear.frf` with ``periods`` expects.
 
     One period has L = ``period_samples`` samples; line k is the frequency k/(L·dt) (Hz), so every
     period is exactly periodic and leakage-free. Lines between ``f_min`` and ``f_max``:
@@ -324,8 +324,3 @@ def steps(levels: Sequence[float], durations: Sequence[float] | float, *, dt: fl
     return Excitation("steps", t, u, float(dt), op, (float(lo), float(hi)), unit,
                       {"levels": levels, "durations_s": durs})
 
-
-# multi-joint excitation for inverse-dynamics identification (a module of its own: it designs
-# for any chain object without importing gripkit.multibody)
-from ._fourier_trajectory import FourierTrajectory as FourierTrajectory  # noqa: E402
-from ._fourier_trajectory import fourier_trajectory as fourier_trajectory  # noqa: E402

@@ -528,7 +528,7 @@ def test_identify_step_method_validated_before_the_data(cli, tmp_path):
 
 
 def test_identify_step_api_method(step_file):
-    from gripkit.sysid.step_response import identify_step
+    from gripkit.sysid.physical.step_response import identify_step
 
     tr = gripkit.io.load(step_file)
     with pytest.raises(DataError, match="method: expected one of lm, trf, found 'dogbox'"):
@@ -539,7 +539,7 @@ def test_identify_step_api_method(step_file):
 
 def test_identify_step_hint_names_the_cli_option(cli, step_file, monkeypatch):
     """When Levenberg-Marquardt leaves the bounds, the hint tells both API and CLI users what to do."""
-    import gripkit.sysid.step_response as sr
+    import gripkit.sysid.physical.step_response as sr
 
     def out_of_bounds(*a, **k):
         raise IdentificationError("Levenberg-Marquardt converged outside the bounds: zeta = -0.1",

@@ -262,8 +262,8 @@ def test_step_and_modal_identification_at_extreme_scales(scale):
     from scipy import signal
 
     from gripkit import Trajectory
-    from gripkit.sysid.modal import free_vibration
-    from gripkit.sysid.step_response import identify_step
+    from gripkit.sysid.physical.modal import free_vibration
+    from gripkit.sysid.physical.step_response import identify_step
 
     fs, wn, zeta = 20000.0, 2 * np.pi * 1000, 0.05
     t = np.arange(4000) / fs
@@ -287,7 +287,7 @@ def test_friction_identification_at_extreme_scales(scale):
     """IDIM-LS of τ = J q̈ + F_v q̇ + F_c sign(q̇) with both signals scaled: J and F_v (ratios of
     effort to motion) unchanged, F_c in the effort's units (before: "ill-conditioned 4e301" and
     "a regressor column is zero")."""
-    from gripkit.sysid.friction import idim_ls
+    from gripkit.sysid.rigid_body.friction import idim_ls
 
     q = np.sin(2 * np.pi * np.arange(20000) / 1000)
     qd = np.gradient(q) * 1000

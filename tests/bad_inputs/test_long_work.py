@@ -10,9 +10,9 @@ import time
 import pytest
 from corpus import assert_user_error
 
-from gripkit import _fourier_trajectory as ft
+from gripkit.sysid.rigid_body import fourier_trajectory as ft
 from gripkit.errors import ConfigError, DataError
-from gripkit.excitation import fourier_trajectory
+from gripkit.sysid import fourier_trajectory
 from gripkit.multibody import from_urdf
 
 LINK = ('<link name="l{}"><inertial><origin xyz="0.05 0 0"/><mass value="0.1"/>'

@@ -155,7 +155,7 @@ def test_plot_helpers_draw_names_with_dollars_as_text():
     mathtext) and shows it as written: the label's text is escaped, and the figure saves."""
     from gripkit.report import Report
     from gripkit.report import plots
-    from gripkit.sysid.validation import residual_tests
+    from gripkit.sysid.linear.validation import residual_tests
 
     name = "$\\frac{$"
     rng = np.random.default_rng(2)

@@ -14,7 +14,7 @@ import pytest
 
 from gripkit import DataError
 from gripkit.sysid import RLS, rls
-from gripkit.sysid.rls import ABSURD_JUMP
+from gripkit.sysid.linear.rls import ABSURD_JUMP
 from corpus import assert_user_error, assert_warned
 
 TRUE = np.array([-1.5, 0.7, 1.0, 0.5])  # a1, a2, b1, b2
@@ -170,7 +170,7 @@ def test_step_metrics_on_a_record_that_has_not_settled_warn():
     overshoot of 315 % against the 'final level' of a still-ringing response, without a word."""
     from gripkit.errors import AccuracyWarning
     from gripkit.models.second_order import second_order_step
-    from gripkit.sysid.step_response import second_order_metrics, step_metrics
+    from gripkit.sysid.physical.step_response import second_order_metrics, step_metrics
 
     wn, zeta = 2 * np.pi, 0.026
     true = second_order_metrics(wn, zeta)["overshoot_percent"]
@@ -189,7 +189,7 @@ def test_step_metrics_on_a_record_that_has_not_settled_warn():
 
 def test_step_metrics_noise_on_a_settled_response_is_not_unsettled():
     from gripkit.models.second_order import second_order_step
-    from gripkit.sysid.step_response import step_metrics
+    from gripkit.sysid.physical.step_response import step_metrics
 
     t = np.arange(0.0, 3.0, 1e-3)
     noise = 0.05 * np.random.default_rng(0).standard_normal(t.size)
@@ -219,7 +219,7 @@ def test_free_vibration_of_a_forced_response_is_refused():
     """A steady 10 Hz forced oscillation plus a decaying 25 Hz transient: the damped-sine fit gave
     ζ ≈ 1e-5 with a σ ten times larger (the issue: 1.2e-5 ± 5e-4) as if it were a result."""
     from gripkit import IdentificationError
-    from gripkit.sysid.modal import free_vibration
+    from gripkit.sysid.physical.modal import free_vibration
 
     rng = np.random.default_rng(0)
     t = np.arange(0.0, 2.0, 1e-3)
@@ -238,7 +238,7 @@ def test_free_vibration_of_a_forced_response_is_refused():
 def test_free_vibration_with_little_decay_warns():
     """ζ = 2e-4 at 10 Hz over 2 s: the envelope falls by 2.5 %; measured, with a warning."""
     from gripkit.errors import AccuracyWarning
-    from gripkit.sysid.modal import free_vibration
+    from gripkit.sysid.physical.modal import free_vibration
 
     t = np.arange(0.0, 2.0, 1e-3)
     y = np.exp(-2e-4 * 2 * np.pi * 10 * t) * np.cos(2 * np.pi * 10 * t)
@@ -403,7 +403,7 @@ def test_model_in_milliamperes_converts_data_in_amperes():
     mA first, so the result equals the model driven by 1000·u."""
     from gripkit.lti import TransferFunction
     from gripkit.signals.trajectory import Trajectory
-    from gripkit.sysid.linear_model import LinearModel
+    from gripkit.sysid.linear.linear_model import LinearModel
 
     g = TransferFunction([0.0, 1e-3, 0.5e-3], [1.0, -1.5, 0.7], dt=0.01, inputs="u", outputs="y",
                          input_units="mA", output_units="N")
@@ -440,7 +440,7 @@ def test_cli_identify_friction_checks_position_and_effort_dimensions(cli, tmp_pa
 def test_identify_bouc_wen_refuses_swapped_columns():
     """The issue's case: input and output swapped fitted 95 % and labelled the result m/V."""
     from gripkit.signals.trajectory import Trajectory
-    from gripkit.sysid.bouc_wen import identify_bouc_wen
+    from gripkit.sysid.physical.bouc_wen import identify_bouc_wen
 
     t = np.arange(2000) * 1e-3
     U = 50 * (1 - np.cos(2 * np.pi * t))

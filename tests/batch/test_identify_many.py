@@ -10,7 +10,7 @@ from gripkit import Trajectory
 from gripkit.batch import identify_many
 from gripkit.io import save
 from gripkit.models import MassSpringDamper
-from gripkit.sysid.greybox import fit
+from gripkit.sysid.physical.greybox import fit
 
 cloudpickle.register_pickle_by_value(sys.modules[__name__])
 

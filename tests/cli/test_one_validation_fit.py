@@ -13,7 +13,7 @@ from scipy import signal
 from gripkit import Trajectory
 from gripkit.cli import main
 from gripkit.io import save
-from gripkit.sysid.linear_model import VALIDATION_FIT
+from gripkit.sysid.linear.linear_model import VALIDATION_FIT
 
 
 @pytest.fixture(scope="module")

@@ -11,7 +11,7 @@ from scipy.signal import lfilter
 from gripkit.control import lqr
 from gripkit.errors import ModelError
 from gripkit.sysid import arx, n4sid
-from gripkit.sysid.linear_model import from_polynomial
+from gripkit.sysid.linear.linear_model import from_polynomial
 
 
 def _identified():

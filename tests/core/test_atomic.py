@@ -174,7 +174,7 @@ def test_failed_rename_leaves_the_old_file(tmp_path, monkeypatch):
 def test_model_file_full_disk(tmp_path, fail_open, monkeypatch):
     from gripkit.lti import StateSpace
     from gripkit.sysid import load_model
-    from gripkit.sysid.linear_model import LinearModel
+    from gripkit.sysid.linear.linear_model import LinearModel
 
     model = LinearModel(StateSpace([[0.5]], [[1.0]], [[1.0]], dt=0.1), "n4sid")
     p = tmp_path / "model.json"

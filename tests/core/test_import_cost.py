@@ -31,14 +31,14 @@ def test_lazy_package_import_does_not_import_heavy_packages(package):
 def test_lazy_names_are_the_defining_modules_objects_and_listed():
     import gripkit.signals
     import gripkit.sysid
-    import gripkit.sysid.arx  # a submodule spelled like a public function: the function stays public
-    import gripkit.sysid.rls
+    import gripkit.sysid.linear.arx  # a submodule spelled like a public function: the function stays public
+    import gripkit.sysid.linear.rls
     from gripkit.signals.filters import lowpass
     from gripkit.sysid import arx, rls
-    from gripkit.sysid.arx import arx as arx_defined
-    from gripkit.sysid.rls import rls as rls_defined
+    from gripkit.sysid.linear.arx import arx as arx_defined
+    from gripkit.sysid.linear.rls import rls as rls_defined
 
-    assert arx is arx_defined and rls is rls_defined and gripkit.sysid.arx is arx_defined
+    assert arx is arx_defined and rls is rls_defined and gripkit.sysid.linear.arx is arx_defined
     assert gripkit.signals.lowpass is lowpass
     for pkg in (gripkit.signals, gripkit.sysid):
         assert set(pkg.__all__) <= set(dir(pkg))

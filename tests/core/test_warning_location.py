@@ -22,7 +22,7 @@ def test_a_warning_deep_in_gripkit_points_at_the_calling_line():
     """The step-metrics warning of a record that has not settled is raised two calls deep in
     gripkit; it names this file and this line."""
     from gripkit.models.second_order import second_order_step
-    from gripkit.sysid.step_response import step_metrics
+    from gripkit.sysid.physical.step_response import step_metrics
 
     t = np.linspace(0.0, 1.2, 600)
     y = second_order_step(t, 1.0, 2 * np.pi, 0.026)

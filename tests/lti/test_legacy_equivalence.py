@@ -18,7 +18,7 @@ from gripkit.errors import ModelError, SimulationError
 from gripkit.sim import StateSpace as SimStateSpace
 from gripkit.sim.linear import c2d_zoh, simulate_discrete
 from gripkit.sysid import PolynomialModel
-from gripkit.sysid.linear_model import from_polynomial
+from gripkit.sysid.linear.linear_model import from_polynomial
 
 # 000_8f66dcc7ab06470c.txt, Table II: ARX [2 2 2], fs = 200 Hz; σ from Table III
 A222 = [1.0, -1.8732, 0.8996]

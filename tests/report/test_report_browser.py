@@ -128,7 +128,7 @@ def test_measured_record_report_fits_desktop_and_phone_width(tmp_path, browser):
 
     from gripkit.io import load
     from gripkit.signals import split
-    from gripkit.sysid.identify_mimo import identify_ss
+    from gripkit.sysid.linear.identify_mimo import identify_ss
     from gripkit.sysid.model_report import write_model_report
 
     fixture = Path(__file__).resolve().parents[1] / "fixtures" / "dc_motor" / "dc_motor.csv"

@@ -9,8 +9,8 @@ from scipy.signal import lfilter
 
 from gripkit import Trajectory
 from gripkit.sysid import armax, identify, oe
-from gripkit.sysid.armax import armax_records
-from gripkit.sysid.oe import oe_records
+from gripkit.sysid.linear.armax import armax_records
+from gripkit.sysid.linear.oe import oe_records
 
 A = np.array([1.0, -1.5, 0.7])
 B = np.array([0.0, 1.0, 0.5])

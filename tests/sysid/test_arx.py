@@ -97,7 +97,7 @@ def test_recovers_from_s2_like_bandlimited_excitation():
 
 
 def test_docstring_examples_run():
-    for name in ("gripkit.sysid.arx", "gripkit.sysid.identify"):
+    for name in ("gripkit.sysid.linear.arx", "gripkit.sysid.identify"):
         res = doctest.testmod(importlib.import_module(name))
         assert res.failed == 0 and res.attempted > 0
 
@@ -114,10 +114,10 @@ def test_lagged_sums_route_equals_qr_of_the_regressor(na, nb, nk, n, monkeypatch
     regressor to rounding (BLOCK·u), and the normal-equations estimate, σ, loss and fit equal the
     QR route's within the derived bound κ²·BLOCK·u (κ: the column-scaled condition number), or
     the QR route is taken when κ exceeds GRAM_COND_LIMIT."""
-    from gripkit.sysid.lagged_sums import BLOCK, GRAM_COND_LIMIT, arx_gram
+    from gripkit.sysid.linear.lagged_sums import BLOCK, GRAM_COND_LIMIT, arx_gram
     from gripkit.sysid.regression import arx_regression, arx_start, qr_solve
 
-    monkeypatch.setattr(importlib.import_module("gripkit.sysid.arx"), "QR_MAX_ELEMENTS", 0)  # the lagged-sums route at every size
+    monkeypatch.setattr(importlib.import_module("gripkit.sysid.linear.arx"), "QR_MAX_ELEMENTS", 0)  # the lagged-sums route at every size
     u, y = simulate_arx(n, noise=0.5, seed=11)
     X = arx_regression(u, y, na, nb, nk)
     G = arx_gram(u, y, na, nb, nk, arx_start(na, nb, nk))
@@ -154,9 +154,9 @@ def test_ill_conditioned_regressor_takes_the_qr_route(monkeypatch):
     """A nearly collinear input (a slow sine plus 1e-4 noise, two adjacent lags) gives κ above
     GRAM_COND_LIMIT: the normal equations would lose κ²·u of accuracy, so QR is used, and the
     estimate still recovers the exact data."""
-    from gripkit.sysid.lagged_sums import GRAM_COND_LIMIT
+    from gripkit.sysid.linear.lagged_sums import GRAM_COND_LIMIT
 
-    monkeypatch.setattr(importlib.import_module("gripkit.sysid.arx"), "QR_MAX_ELEMENTS", 0)  # would be small enough for QR anyway
+    monkeypatch.setattr(importlib.import_module("gripkit.sysid.linear.arx"), "QR_MAX_ELEMENTS", 0)  # would be small enough for QR anyway
     rng = np.random.default_rng(5)
     n = 3000
     u = np.sin(0.001 * np.arange(n)) + 1e-4 * rng.standard_normal(n)
@@ -186,7 +186,7 @@ def test_large_fit_computes_residuals_on_demand_from_its_record():
     """Above QR_MAX_ELEMENTS the fit keeps no N-sample residual array (issue 14: ARX peak memory);
     ``residuals`` is computed on first access from the record and equals the compensated kernel's
     errors e = y − Φθ to rounding, in the user's units also when the data were scaled for the fit."""
-    from gripkit.sysid.lagged_sums import arx_residuals
+    from gripkit.sysid.linear.lagged_sums import arx_residuals
 
     u, y = simulate_arx(100_000, noise=0.5, seed=21)
     for scale in (1.0, 2.0**120):  # the second one is fitted on scaled copies (peak beyond 2^100)

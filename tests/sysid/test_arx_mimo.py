@@ -35,7 +35,7 @@ def test_recovers_matrix_polynomials_within_sigma():
 
 def test_one_step_predictor_of_the_realisation_is_the_arx_predictor():
     """The state-space realisation with K = [I; 0] predicts exactly φ(t)ᵀθ (rounding only)."""
-    from gripkit.sysid.pem_ss import predict_errors
+    from gripkit.sysid.linear.pem_ss import predict_errors
 
     u, y = _data(500, seed=1)
     m = arx(u, y, 1, 2, 1)

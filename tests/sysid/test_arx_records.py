@@ -11,7 +11,7 @@ from arx_cases import A222, B222, THETA222
 from gripkit import Trajectory
 from gripkit.errors import ArgumentError, DataError
 from gripkit.sysid import arx, arx_records, identify
-from gripkit.sysid.arx_mimo import arx_mimo, arx_mimo_records
+from gripkit.sysid.linear.arx_mimo import arx_mimo, arx_mimo_records
 from gripkit.sysid.regression import arx_regression
 
 #: static gain B(1)/A(1) of the [2 2 2] model: an operating point (u0, G·u0) is an equilibrium
@@ -66,7 +66,7 @@ def test_summed_normal_equations_agree_with_qr(monkeypatch):
     recs = [simulate(2000, seed=5, y_init=(30.0, 20.0)),
             simulate(2500, seed=6, y_init=(-30.0, 0.0))]
     qr = arx_records(recs, 2, 2, 2)
-    monkeypatch.setattr(sys.modules["gripkit.sysid.arx"], "QR_MAX_ELEMENTS", 10)
+    monkeypatch.setattr(sys.modules["gripkit.sysid.linear.arx"], "QR_MAX_ELEMENTS", 10)
     ne = arx_records(recs, 2, 2, 2)
     assert "Cholesky" in ne.info["method"] and "QR" in qr.info["method"]
     np.testing.assert_allclose(ne.theta, qr.theta, rtol=1e-9)

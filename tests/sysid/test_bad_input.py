@@ -135,7 +135,7 @@ def test_finiteness_check_without_temporaries_agrees_with_isfinite(values):
 def test_rls_scale_statistics_agree_with_numpy(values):
     """The one-pass (max |x|, ‖x‖₂) of the RLS scale check equals numpy's, scaled so that values
     near the float64 limits neither overflow nor underflow."""
-    from gripkit.sysid.rls import _peak_and_norm
+    from gripkit.sysid.linear.rls import _peak_and_norm
 
     a = np.array(values)
     peak, norm = _peak_and_norm(a)

@@ -98,7 +98,7 @@ def test_other_schema_or_newer_version_refused(saved, change, phrase):
 
 def test_linear_model_file_refused(tmp_path):
     from gripkit.lti import StateSpace
-    from gripkit.sysid.linear_model import LinearModel
+    from gripkit.sysid.linear.linear_model import LinearModel
 
     path = tmp_path / "lin.json"
     LinearModel(StateSpace([[0.5]], [[1.0]], [[1.0]], dt=0.1), "n4sid").save(path)

@@ -7,7 +7,7 @@ import pytest
 from gripkit import Trajectory
 from gripkit.errors import AccuracyWarning, DataError, ParameterError
 from gripkit.models import MassSpringDamper
-from gripkit.sysid.greybox import fit
+from gripkit.sysid.physical.greybox import fit
 
 TRUE = dict(m=1.8e-6, b=7e-4, k=128.0)  # 001_0b92a7da96e7aa46.txt Table II, left force sensor
 FS = 20000.0

@@ -8,7 +8,7 @@ import pytest
 from gripkit import Trajectory
 from gripkit.errors import DataError
 from gripkit.models import MassSpringDamper
-from gripkit.sysid.greybox import fit
+from gripkit.sysid.physical.greybox import fit
 
 TRUE = dict(m=1.8e-6, b=7e-4, k=128.0)
 FS = 20000.0

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from gripkit.cli import main
-from gripkit.excitation import fourier_trajectory
+from gripkit.sysid import fourier_trajectory
 from gripkit.multibody import from_urdf, to_urdf
 
 FC = np.array([0.02, 0.015, 0.01])
@@ -186,5 +186,5 @@ def test_fourier_design_takes_any_chain_object():
     sv = np.linalg.svd(X, compute_uv=False)
     assert sv[0] / sv[-1] == pytest.approx(tr.condition_number, rel=0.05)
     assert tr.condition_number <= tr.initial_condition_number
-    src = open(sys.modules["gripkit._fourier_trajectory"].__file__).read()
+    src = open(sys.modules["gripkit.sysid.rigid_body.fourier_trajectory"].__file__).read()
     assert "multibody" not in src.split('"""', 2)[2]  # no import of gripkit.multibody below the docstring

@@ -1,5 +1,5 @@
 """The physical-consistency distance and the constrained fit of ``identify_dynamics``
-(``gripkit.sysid.dynamics_projection``), Monte Carlo on the DLR/HIT Hand II finger of the zoo
+(``gripkit.sysid.rigid_body.dynamics_projection``), Monte Carlo on the DLR/HIT Hand II finger of the zoo
 (``002_ddea254371185ad3.txt`` Appendix F: thin-rod phalanges, a pseudo-inertia on the boundary of
 the consistent set, so noise puts the estimate outside it in most runs), exported by ``to_urdf``,
 with exact joint states and white torque noise (σ honest:
@@ -22,7 +22,7 @@ from scipy.stats import chi2
 
 from gripkit.multibody import from_urdf, to_urdf
 from gripkit.sysid import identify_dynamics
-from gripkit.sysid.dynamics import pseudo_inertia
+from gripkit.sysid.rigid_body.dynamics import pseudo_inertia
 from test_identify_dynamics import FC, FV, NOISE, fourier_states
 
 
@@ -234,8 +234,8 @@ def test_unconverged_projection_says_so(rod_finger, monkeypatch):
     distance is an upper bound, and that bound is not below the converged distance."""
     import functools
 
-    import gripkit.sysid.dynamics as dynamics
-    import gripkit.sysid.dynamics_projection as dp
+    import gripkit.sysid.rigid_body.dynamics as dynamics
+    import gripkit.sysid.rigid_body.dynamics_projection as dp
 
     rng = np.random.default_rng(12)
     q, qd, qdd = fourier_states(3_000, 500.0, rng)

@@ -11,8 +11,8 @@ import pytest
 from gripkit import Trajectory
 from gripkit.cli import main
 from gripkit.errors import AccuracyWarning, DataError
-from gripkit.sysid import identify_mimo
-from gripkit.sysid.identify_mimo import focus_score, identify_ss, mimo_data
+from gripkit.sysid.linear import identify_mimo
+from gripkit.sysid.linear.identify_mimo import focus_score, identify_ss, mimo_data
 
 
 def _record(seed, n=3000):
@@ -37,7 +37,7 @@ def test_a_refinement_that_scores_lower_is_not_returned(monkeypatch):
                               info={**model.info, "pem": {"converged": True}})
         return worse
 
-    import gripkit.sysid.pem_ss as pem_ss
+    import gripkit.sysid.linear.pem_ss as pem_ss
 
     monkeypatch.setattr(pem_ss, "pem", bad_pem)
     with pytest.warns(AccuracyWarning, match="lowered the mean simulation fit on the estimation data"):
@@ -87,7 +87,7 @@ def test_the_search_table_is_in_the_text_output(tmp_path, capsys):
 def test_an_innovation_refinement_that_loses_falls_back_to_output_error(monkeypatch):
     """With focus='simulation', PEM in output-error form (which minimises the free-run error
     itself) is tried when the innovation form loses; it is returned, with its covariance."""
-    import gripkit.sysid.pem_ss as pem_ss
+    import gripkit.sysid.linear.pem_ss as pem_ss
 
     real = pem_ss.pem
 

@@ -16,8 +16,8 @@ from gripkit.io import load
 from gripkit.lti import StateSpace
 from gripkit.signals import split
 from gripkit.sysid import arx, n4sid, pem
-from gripkit.sysid.identify_mimo import identify_ss
-from gripkit.sysid.linear_model import LinearModel, from_polynomial
+from gripkit.sysid.linear.identify_mimo import identify_ss
+from gripkit.sysid.linear.linear_model import LinearModel, from_polynomial
 
 FIXTURE = Path(__file__).resolve().parents[1] / "fixtures" / "dc_motor"
 

@@ -26,12 +26,12 @@ from gripkit.io import load, save
 from gripkit.lti import StateSpace, TransferFunction
 from gripkit.signals import split
 from gripkit.sysid import load_model
-from gripkit.sysid.frf import frf
-from gripkit.sysid.linear_model import LinearModel, fit_per_output
+from gripkit.sysid.linear.frf import frf
+from gripkit.sysid.linear.linear_model import LinearModel, fit_per_output
 from gripkit.sysid.model_report import (ESTIMATE_MARGIN_DECADES, MIN_INPUT_POWER, _xcorr,
                                         bode_figure, meaningful_lines, predictor_x0,
                                         residual_analysis)
-from gripkit.sysid.pem_ss import predict_errors
+from gripkit.sysid.linear.pem_ss import predict_errors
 
 FIXTURE = Path(__file__).resolve().parents[1] / "fixtures" / "dc_motor" / "dc_motor.csv"
 LAGS = np.arange(1, 26)
@@ -245,7 +245,7 @@ def test_magnitude_axis_ignores_wild_lines_it_is_given():
     """Even when lines of 1e15 and 1e-300 are drawn (keep=None: every finite line, as before), the
     magnitude axis stays within ESTIMATE_MARGIN_DECADES of the model's range (the issue's axis ran
     from 1e-315 to 1e15 and the model was a flat line)."""
-    from gripkit.sysid.frf import FRF
+    from gripkit.sysid.linear.frf import FRF
 
     dt = 0.05
     g = TransferFunction([2.0, 4.0], [1.0, 0.8, 4.0]).c2d(dt)

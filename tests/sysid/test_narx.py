@@ -9,7 +9,7 @@ import pytest
 
 from gripkit.errors import ArgumentError, DataError, ModelError, StabilityWarning
 from gripkit.sysid import arx, narx
-from gripkit.sysid.linear_model import from_polynomial
+from gripkit.sysid.linear.linear_model import from_polynomial
 from gripkit.sysid.nonlinear.narx import NARXModel, candidate_terms, load_narx
 
 FIXTURE = Path(__file__).resolve().parents[1] / "fixtures" / "dc_motor" / "dc_motor.csv"

@@ -6,7 +6,7 @@ from arx_cases import simulate_arx
 
 from gripkit import DataError, Trajectory
 from gripkit.sysid import arx, identify, structure_search
-from gripkit.sysid.search import parse_range
+from gripkit.sysid.linear.search import parse_range
 
 
 def test_search_finds_the_true_structure_by_aic():

@@ -10,7 +10,7 @@ from scipy import signal
 from gripkit import Trajectory
 from gripkit.errors import AccuracyWarning, DataError
 from gripkit.models.second_order import second_order_step
-from gripkit.sysid.step_response import identify_step, second_order_metrics, step_metrics
+from gripkit.sysid.physical.step_response import identify_step, second_order_metrics, step_metrics
 
 FS = 20000.0
 # the FT-G100 actuated arm grasping the ball (eq 9 at the seed's values): 1757 Hz, ζ = 0.043

@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 from gripkit.lti import flush_tiny, simulate_ss
-from gripkit.sysid.linear_model import observability_regressor
-from gripkit.sysid.pem_ss import (_directions, _predict_sensitivity, _predict_states,
+from gripkit.sysid.linear.linear_model import observability_regressor
+from gripkit.sysid.linear.pem_ss import (_directions, _predict_sensitivity, _predict_states,
                                   _sensitivity_gram)
-from gripkit.sysid.subspace import _bdx_normal_equations, _bdx_regressor
+from gripkit.sysid.linear.subspace import _bdx_normal_equations, _bdx_regressor
 
 TINY = np.finfo(np.float64).tiny  # 2.2250738585072014e-308, the smallest normal number
 #: 0.95**t < 1e-308 from t ≈ 13 800: the free responses spend more than half the record there

@@ -142,7 +142,7 @@ def test_bd_x0_normal_equations_equal_least_squares_on_the_regressor():
     equations are singular) the fallback is gelsy's minimum-norm solution on Φ."""
     import scipy.linalg as sla
 
-    from gripkit.sysid.subspace import _bdx_least_squares, _bdx_regressor
+    from gripkit.sysid.linear.subspace import _bdx_least_squares, _bdx_regressor
 
     rng = np.random.default_rng(7)
     A = np.array([[0.9, 0.2], [-0.1, 0.7]])

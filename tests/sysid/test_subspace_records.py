@@ -10,8 +10,8 @@ from gripkit import Trajectory
 from gripkit.errors import ArgumentError, DataError
 from gripkit.lti import StateSpace
 from gripkit.sysid import identify, n4sid, pem
-from gripkit.sysid.pem_ss import pem_records
-from gripkit.sysid.subspace import n4sid_records
+from gripkit.sysid.linear.pem_ss import pem_records
+from gripkit.sysid.linear.subspace import n4sid_records
 
 G = StateSpace([[0.9, 0.2], [0.0, 0.7]], [[0.0], [1.0]], [[1.0, 0.0]], dt=0.01)
 GAIN = 20.0 / 3.0

@@ -9,7 +9,7 @@ import pytest
 from gripkit import Trajectory
 from gripkit.lti import TransferFunction
 from gripkit.sysid import identify, tfest
-from gripkit.sysid.tfest import tfest_records
+from gripkit.sysid.linear.tfest import tfest_records
 
 G = TransferFunction([4.0], [1.0, 0.8, 4.0])
 GD = G.c2d(0.05)

@@ -28,7 +28,7 @@ import numpy as np
 from .. import zoo
 from ..errors import ConfigError, ConsistencyWarning, GripkitError
 from ..sim.model import Model
-from ..sysid.step_response import step_metrics
+from ..sysid.physical.step_response import step_metrics
 from .spec import quantity
 
 __all__ = ["SCENARIOS", "Setting", "Interface", "Prepared", "read_settings", "resolve",
@@ -231,7 +231,7 @@ def prepare(spec, allow_code: bool = False) -> Prepared:
 def step_metrics_rows(t: np.ndarray, y: np.ndarray, band: float = 0.02) -> dict[str, np.ndarray]:
     """Step-response metrics of each row of ``y`` (P, N) from rest: final value (mean of the last
     10 %), peak, overshoot %, 10–90 % rise time and settling time into ±``band``
-    (:func:`gripkit.sysid.step_response.step_metrics` per row)."""
+    (:func:`gripkit.sysid.physical.step_response.step_metrics` per row)."""
     rows = [step_metrics(t, yi, y_initial=0.0, band=band) for yi in np.atleast_2d(y)]
     return {"final": np.array([r["y_final"] for r in rows]), "peak": np.array([r["peak"] for r in rows]),
             **{k: np.array([r[k] for r in rows]) for k in ("overshoot_percent", "rise_time", "settling_time")}}

@@ -41,7 +41,7 @@ def compare(model: Path = ModelArg,
                                         show_default=False),
             fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, json_out: bool = JsonOpt):
     """Free-run fit (%) of a saved model per output, initial state estimated."""
-    from ..sysid.linear_model import VALIDATION_FIT
+    from ..sysid.linear.linear_model import VALIDATION_FIT
     from ..sysid.nonlinear.narx import SCHEMA, file_schema
 
     if file_schema(model) == SCHEMA:

@@ -3,7 +3,7 @@
 [--time-limit SECONDS] [--json]``: design a periodic
 Fourier-series excitation of every actuated joint of a URDF chain that minimises the condition
 number of the identification regressor within the position (URDF), velocity and acceleration
-limits (:func:`gripkit.excitation.fourier_trajectory`), and write it (columns ``t``,
+limits (:func:`gripkit.sysid.fourier_trajectory`), and write it (columns ``t``,
 ``q_<joint>``, ``qd_<joint>``, ``qdd_<joint>``; SI units) in the format ``--out``'s suffix names:
 ``.csv`` (a plain header of names), ``.parquet`` or ``.h5`` (:func:`gripkit.io.save`, with units);
 another suffix is refused before the design starts. Every format is written atomically. A design
@@ -46,7 +46,7 @@ def excitation_fourier(
     json_out: bool = JsonOpt,
 ):
     """Design an optimal Fourier excitation trajectory for a URDF chain and write it as CSV."""
-    from ..excitation import fourier_trajectory
+    from ..sysid import fourier_trajectory
     from ..multibody import from_urdf
     from ..progress import status
     from .paths import output_file

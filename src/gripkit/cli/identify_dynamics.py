@@ -4,15 +4,15 @@ friction of a URDF chain from a log (:func:`gripkit.sysid.identify_dynamics`).
 
 COLS are comma-separated column names, one per actuated joint in the chain's order (``gripkit``
 prints the order in the error when the count is wrong). The signal chain is IDIM-LS's
-(:func:`gripkit.sysid.friction.idim_samples`, the one ``identify friction`` uses for the EMPS and
+(:func:`gripkit.sysid.rigid_body.friction.idim_samples`, the one ``identify friction`` uses for the EMPS and
 DLR/HIT logs): the same zero-phase Butterworth filter on positions (or measured velocities) and
 efforts, central differences, the filter's edges cut, decimation; the rows of a joint within the
 guard band of its velocity reversals or slower than 2 % of its peak speed are left out; σ is the
 Newey-West (HAC) one, since filtering and decimation leave the residuals correlated.
 
-``--out`` writes the model file (:mod:`gripkit.sysid.dynamics_file`: the URDF text, the
+``--out`` writes the model file (:mod:`gripkit.sysid.rigid_body.dynamics_file`: the URDF text, the
 parameters with their covariance, the log's name and SHA-256), ``--report`` an HTML page
-(:mod:`gripkit.sysid.dynamics_report`); both paths are checked before the work starts.
+(:mod:`gripkit.sysid.rigid_body.dynamics_report`); both paths are checked before the work starts.
 """
 
 from __future__ import annotations
@@ -53,10 +53,10 @@ def _vector(option: str, text: str) -> np.ndarray:
 
 
 def _idim_states(tr, pcols, ecols, vcols, effort_scale: float, dt: float, cutoff, decimate):
-    """The IDIM-LS signal chain (:func:`gripkit.sysid.friction.idim_samples`) on the position and
+    """The IDIM-LS signal chain (:func:`gripkit.sysid.rigid_body.friction.idim_samples`) on the position and
     effort columns; with measured velocities, q̇ and q̈ come from them through the same filter and
     decimation. Returns the samples and q, q̇, q̈."""
-    from ..sysid.friction import idim_samples
+    from ..sysid.rigid_body.friction import idim_samples
 
     P = np.column_stack([tr[c] for c in pcols])
     E = np.column_stack([tr[c] for c in ecols]) * effort_scale
@@ -93,7 +93,7 @@ def _write_model_and_report(res, st, states, weights, lines, *, urdf: Path, data
         res.replace(urdf_text=Path(urdf).read_text(), base_link=base_link, tip_link=tip_link,
                     data_file=Path(data).name, data_hash=file_sha256(data)).save(out)
     if report is not None:
-        from ..sysid.dynamics_report import write_dynamics_report
+        from ..sysid.rigid_body.dynamics_report import write_dynamics_report
 
         q, qd, qdd = states
         t = np.arange(q.shape[0]) * st.decimation * st.dt
@@ -153,7 +153,7 @@ def identify_dynamics_cmd(
     """Identify the base inertial parameters and the friction of every joint of a URDF chain."""
     from ..errors import DataError
     from ..multibody import from_urdf
-    from ..sysid.dynamics import identify_dynamics
+    from ..sysid.rigid_body.dynamics import identify_dynamics
     from .paths import output_folder, output_json
 
     output_json(out, "--out")

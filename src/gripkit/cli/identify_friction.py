@@ -3,7 +3,7 @@
 
 Model: effort = K·column = J·q̈ + F_v·q̇ + F_c·sign(q̇) + τ₀, with q̇, q̈ from the zero-phase
 Butterworth-filtered position, the effort filtered alike, decimated (see
-:func:`gripkit.sysid.friction.idim_ls`). The JSON holds ``params`` and ``std`` (``inertia``,
+:func:`gripkit.sysid.rigid_body.friction.idim_ls`). The JSON holds ``params`` and ``std`` (``inertia``,
 ``viscous``, ``coulomb``, ``offset``, in the SI units of the data) and
 ``relative_error_percent`` of the fitted effort.
 """
@@ -54,7 +54,7 @@ def identify_friction(
 ):
     """Identify inertia, viscous and Coulomb friction and an offset of one axis (IDIM-LS)."""
     from ..sysid.checks import FORCE_OR_TORQUE, LENGTH_OR_ANGLE, check_dimension
-    from ..sysid.friction import idim_ls
+    from ..sysid.rigid_body.friction import idim_ls
 
     check_data_options(fs, fill)
     check_number(effort_scale, "--effort-scale", nonzero=True)

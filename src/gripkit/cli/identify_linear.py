@@ -85,7 +85,7 @@ def _fit_and_report(method: str, data: Path, input: str, output: str, fs, time, 
             raw = lambda: _io(data, input, output, fs, time, fill, "none", "refit")  # noqa: E731
             warn_if_mean_detrending_hurt(model, io, raw, fit)
         if out_file is not None:  # the model file (issue 13), with the data's name and hash
-            from ..sysid.linear_model import from_polynomial
+            from ..sysid.linear.linear_model import from_polynomial
             from ..sysid.model_file import file_sha256
 
             lm = from_polynomial(model).replace(data_file=Path(data).name,
@@ -120,7 +120,7 @@ def _validate_polynomial(model, dt: float, validate: Path | None, input: str, ou
 
         raise DataError(f"validation data {str(validate)!r} is sampled at {1 / vio.dt:g} Hz, the "
                         f"estimation data at {1 / dt:g} Hz", hint="resample one of them")
-    from ..sysid.linear_model import VALIDATION_FIT, validation_fit
+    from ..sysid.linear.linear_model import VALIDATION_FIT, validation_fit
 
     val = model.validate(vio.u, vio.y)  # one-step fit and residual tests
     vfit = validation_fit(model, load_data(validate, [input, output], fs, time, fill))
@@ -164,9 +164,9 @@ def _mimo_arx(data: list[Path], input: str, output: str, na: int, nb: int, nk: i
     ``--output`` order (free run with estimated x0, one-step, and free run on ``--validate``).
     Several DATA files: one model of all the records (``records``: each file's fits)."""
     from ..errors import DataError, StabilityWarning
-    from ..sysid.identify_mimo import identify_arx as fit_arx
-    from ..sysid.identify_mimo import parse_names
-    from ..sysid.linear_model import VALIDATION_FIT, validation_fit
+    from ..sysid.linear.identify_mimo import identify_arx as fit_arx
+    from ..sysid.linear.identify_mimo import parse_names
+    from ..sysid.linear.linear_model import VALIDATION_FIT, validation_fit
     from ..sysid.model_file import file_sha256
 
     if detrend == "linear":
@@ -287,7 +287,7 @@ def _siso_records(method: str, data: list[Path], input: str, output: str, fs, ti
         model = _fit_records(data, [input, output], input, output, fs, time, fill, detrend, method,
                              **orders)
         if out_file is not None:
-            from ..sysid.linear_model import from_polynomial
+            from ..sysid.linear.linear_model import from_polynomial
 
             names = ", ".join(Path(p).name for p in data)
             from_polynomial(model).replace(data_file=names, data_hash=None).save(out_file)
@@ -314,7 +314,7 @@ def identify_arx(data: list[Path] = DataArgs, input: str = InputsOpt, output: st
     lists per output, in ``--output`` order. With several DATA files one model of all the records
     (each with its own initial conditions; --detrend mean removes the mean of all of them)."""
     from ..sysid import arx
-    from ..sysid.identify_mimo import several
+    from ..sysid.linear.identify_mimo import several
 
     _check_options(fs, fill, detrend, validate, na=na, nb=nb, nk=nk)
     if several(input, output):
@@ -427,7 +427,7 @@ def identify_search(data: Path = DataArg, input: str = InputOpt, output: str = O
                     validate: Path = ValidateOpt, json_out: bool = JsonOpt):
     """Fit every ARX structure of the ranges and rank them (best first; by free-run fit on --validate)."""
     from ..sysid import structure_search
-    from ..sysid.search import CRITERIA, parse_range
+    from ..sysid.linear.search import CRITERIA, parse_range
 
     _check_options(fs, fill, detrend, validate)
     check_choice(criterion, "--criterion", CRITERIA)

@@ -34,7 +34,7 @@ ReportOpt = typer.Option(None, "--report", help="Write an HTML report of the mod
 
 
 def _load(path: Path, inputs: str, outputs: str, fs, time, fill):
-    from ..sysid.identify_mimo import parse_names
+    from ..sysid.linear.identify_mimo import parse_names
 
     cols = list(parse_names(inputs, "input")) + list(parse_names(outputs, "output"))
     return load_data(path, cols, fs, time, fill)
@@ -77,7 +77,7 @@ def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
     Several DATA files: one model of all the records (subspace, then PEM), one initial state per
     record (``records``: each file's free-run fit)."""
     from ..errors import DataError
-    from ..sysid.identify_mimo import identify_ss
+    from ..sysid.linear.identify_mimo import identify_ss
 
     if form not in ("oe", "innovation"):
         raise DataError(f"--form: expected oe or innovation, found {form!r}")
@@ -107,7 +107,7 @@ def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
                                         focus=focus, max_iterations=max_iterations)
             model = _with_provenance(model, data)
             _finish(model, data, tr, out, report, None)
-    from ..sysid.linear_model import VALIDATION_FIT
+    from ..sysid.linear.linear_model import VALIDATION_FIT
 
     res = model.to_dict()
     res.update(data=[str(p) for p in data] if several else str(data), method=method,
@@ -183,7 +183,7 @@ def _ss_of_records(data: list[Path], input: str, output: str, order, method: str
                    max_iterations: int):
     """The state-space model of several data files (:func:`_records_model`) and its extras
     (``validation_fit_percent`` with ``validate``)."""
-    from ..sysid.linear_model import validation_fit
+    from ..sysid.linear.linear_model import validation_fit
 
     model = _records_model(data, "ss", input, output, detrend, fs, time, fill, order=order,
                            refine=not no_refine, weighting=method, form=form,
@@ -218,7 +218,7 @@ def identify_frf_cmd(data: Path = DataArg, input: str = InputsOpt, output: str =
                      fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                      json_out: bool = JsonOpt):
     """Frequency response with σ on every line (periodic averaging, Welch H1 with coherence, SPA)."""
-    from ..sysid.identify_mimo import identify_frf
+    from ..sysid.linear.identify_mimo import identify_frf
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
@@ -248,7 +248,7 @@ def identify_tf_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
     """Continuous-time transfer function (zero-order hold between samples) with σ. Several DATA
     files: one model of all the records, each from its own initial state."""
     from ..errors import DataError
-    from ..sysid.identify_mimo import identify_tf
+    from ..sysid.linear.identify_mimo import identify_tf
 
     several = len(data) > 1
     if several and report is not None:

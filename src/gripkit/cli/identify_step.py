@@ -23,8 +23,8 @@ def identify_step(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
                   json_out: bool = JsonOpt):
     """Fit K ω_n²/(s² + 2ζω_n s + ω_n²) to a step response (gain, natural frequency, damping, σ)."""
     from ..errors import DataError
-    from ..sysid.step_response import STEP_METHODS
-    from ..sysid.step_response import identify_step as _identify
+    from ..sysid.physical.step_response import STEP_METHODS
+    from ..sysid.physical.step_response import identify_step as _identify
 
     if method not in STEP_METHODS:  # before the data are read
         raise DataError(f"--method: expected one of {', '.join(STEP_METHODS)}, found {method!r}",

@@ -36,7 +36,7 @@ def identify_modal(data: Path = DataArg,
     import math
 
     from ..errors import DataError
-    from ..sysid.modal import free_vibration
+    from ..sysid.physical.modal import free_vibration
 
     check_data_options(fs, fill)
     if start is not None and not math.isfinite(start):
@@ -66,7 +66,7 @@ def identify_bouc_wen_cmd(data: Path = DataArg,
                                                                           "starting mid-loop)."),
                           json_out: bool = JsonOpt):
     """Static Bouc-Wen parameters (eq 3) from a quasi-static voltage/displacement sweep."""
-    from ..sysid.bouc_wen import identify_bouc_wen
+    from ..sysid.physical.bouc_wen import identify_bouc_wen
 
     check_data_options(fs, fill)
     check_number(delay, "--delay", minimum=0)

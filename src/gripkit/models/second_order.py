@@ -3,7 +3,7 @@
     m ÿ + c ẏ + k y = g (u − u₀),    output y₀ + y                     (SI, any units)
 
 covers the standard form  G(s) = K ω_n² / (s² + 2ζω_n s + ω_n²)  (m = 1, c = 2ζω_n, k = ω_n²,
-g = K ω_n²) used by the step-response identification (:mod:`gripkit.sysid.step_response`) and the
+g = K ω_n²) used by the step-response identification (:mod:`gripkit.sysid.physical.step_response`) and the
 FT-G100 subsystems (eqs 9, 15 of ``003_abd62b560633beaf.txt``). The response is linear in g, so
 each parameter vector runs the exact zero-order-hold mass-spring-damper kernel
 (:func:`gripkit.models.mass_spring_damper.msd_zoh`) on the unit-gain input and is scaled afterwards.

@@ -22,50 +22,52 @@ from ..exports import lazy_exports
 
 # public name -> (module of this package, name in that module)
 _LAZY = {
-    "armax": ("armax", "armax"),
-    "arx": ("arx", "arx"),
-    "arx_records": ("arx", "arx_records"),
+    "armax": ("linear.armax", "armax"),
+    "arx": ("linear.arx", "arx"),
+    "arx_records": ("linear.arx", "arx_records"),
     "IOData": ("identify", "IOData"),
     "identify": ("identify", "identify"),
     "io_data": ("identify", "io_data"),
-    "oe": ("oe", "oe"),
-    "PolynomialModel": ("polynomial", "PolynomialModel"),
-    "RLS": ("rls", "RLS"),
-    "RLSResult": ("rls", "RLSResult"),
-    "rls": ("rls", "rls"),
-    "SearchResult": ("search", "SearchResult"),
-    "structure_search": ("search", "structure_search"),
-    "Comparison": ("validation", "Comparison"),
-    "ResidualTests": ("validation", "ResidualTests"),
-    "Validation": ("validation", "Validation"),
-    "compare": ("validation", "compare"),
-    "fit_percent": ("validation", "fit_percent"),
-    "residual_tests": ("validation", "residual_tests"),
-    "validate": ("validation", "validate"),
-    "GreyboxResult": ("greybox", "GreyboxResult"),
-    "fit_greybox": ("greybox", "fit"),
-    "identify_bouc_wen": ("bouc_wen", "identify_bouc_wen"),
-    "free_vibration": ("modal", "free_vibration"),
-    "constant_velocity_friction": ("friction", "constant_velocity_friction"),
-    "detect_breakaway": ("friction", "detect_breakaway"),
-    "fit_stribeck": ("friction", "fit_stribeck"),
-    "idim_ls": ("friction", "idim_ls"),
-    "DynamicsResult": ("dynamics", "DynamicsResult"),
-    "identify_dynamics": ("dynamics", "identify_dynamics"),
-    "characterize_motor": ("motor", "characterize_motor"),
-    "fit_motor": ("motor", "fit_motor"),
-    "LinearModel": ("linear_model", "LinearModel"),
-    "n4sid": ("subspace", "n4sid"),
-    "moesp": ("subspace", "moesp"),
-    "pem": ("pem_ss", "pem"),
-    "FRF": ("frf", "FRF"),
-    "frf": ("frf", "frf"),
-    "tfest": ("tfest", "tfest"),
-    "tfest_frf": ("tfest", "tfest_frf"),
+    "oe": ("linear.oe", "oe"),
+    "PolynomialModel": ("linear.polynomial", "PolynomialModel"),
+    "RLS": ("linear.rls", "RLS"),
+    "RLSResult": ("linear.rls", "RLSResult"),
+    "rls": ("linear.rls", "rls"),
+    "SearchResult": ("linear.search", "SearchResult"),
+    "structure_search": ("linear.search", "structure_search"),
+    "Comparison": ("linear.validation", "Comparison"),
+    "ResidualTests": ("linear.validation", "ResidualTests"),
+    "Validation": ("linear.validation", "Validation"),
+    "compare": ("linear.validation", "compare"),
+    "fit_percent": ("linear.validation", "fit_percent"),
+    "residual_tests": ("linear.validation", "residual_tests"),
+    "validate": ("linear.validation", "validate"),
+    "GreyboxResult": ("physical.greybox", "GreyboxResult"),
+    "fit_greybox": ("physical.greybox", "fit"),
+    "identify_bouc_wen": ("physical.bouc_wen", "identify_bouc_wen"),
+    "free_vibration": ("physical.modal", "free_vibration"),
+    "constant_velocity_friction": ("rigid_body.friction", "constant_velocity_friction"),
+    "detect_breakaway": ("rigid_body.friction", "detect_breakaway"),
+    "fit_stribeck": ("rigid_body.friction", "fit_stribeck"),
+    "idim_ls": ("rigid_body.friction", "idim_ls"),
+    "DynamicsResult": ("rigid_body.dynamics", "DynamicsResult"),
+    "identify_dynamics": ("rigid_body.dynamics", "identify_dynamics"),
+    "characterize_motor": ("rigid_body.motor", "characterize_motor"),
+    "fit_motor": ("rigid_body.motor", "fit_motor"),
+    "LinearModel": ("linear.linear_model", "LinearModel"),
+    "n4sid": ("linear.subspace", "n4sid"),
+    "moesp": ("linear.subspace", "moesp"),
+    "pem": ("linear.pem_ss", "pem"),
+    "FRF": ("linear.frf", "FRF"),
+    "frf": ("linear.frf", "frf"),
+    "tfest": ("linear.tfest", "tfest"),
+    "tfest_frf": ("linear.tfest", "tfest_frf"),
     "load_model": ("model_protocol", "load_model"),
     "ModelFit": ("model_protocol", "ModelFit"),
     "IdentifiedModel": ("model_protocol", "IdentifiedModel"),
-    "load_dynamics_model": ("dynamics", "load_dynamics_model"),
+    "load_dynamics_model": ("rigid_body.dynamics", "load_dynamics_model"),
+    "fourier_trajectory": ("rigid_body.fourier_trajectory", "fourier_trajectory"),
+    "FourierTrajectory": ("rigid_body.fourier_trajectory", "FourierTrajectory"),
     "narx": ("nonlinear.narx", "narx"),
     "NARXModel": ("nonlinear.narx", "NARXModel"),
     "load_narx": ("nonlinear.narx", "load_narx"),
@@ -74,50 +76,52 @@ __getattr__, __dir__ = lazy_exports(__name__, _LAZY)
 __all__ = [*_LAZY]
 
 if TYPE_CHECKING:  # static readers see the same names, imported eagerly
-    from .armax import armax as armax
-    from .arx import arx as arx
-    from .arx import arx_records as arx_records
+    from .linear.armax import armax as armax
+    from .linear.arx import arx as arx
+    from .linear.arx import arx_records as arx_records
     from .identify import IOData as IOData
     from .identify import identify as identify
     from .identify import io_data as io_data
-    from .oe import oe as oe
-    from .polynomial import PolynomialModel as PolynomialModel
-    from .rls import RLS as RLS
-    from .rls import RLSResult as RLSResult
-    from .rls import rls as rls
-    from .search import SearchResult as SearchResult
-    from .search import structure_search as structure_search
-    from .validation import Comparison as Comparison
-    from .validation import ResidualTests as ResidualTests
-    from .validation import Validation as Validation
-    from .validation import compare as compare
-    from .validation import fit_percent as fit_percent
-    from .validation import residual_tests as residual_tests
-    from .validation import validate as validate
-    from .greybox import GreyboxResult as GreyboxResult
-    from .greybox import fit as fit_greybox
-    from .bouc_wen import identify_bouc_wen as identify_bouc_wen
-    from .modal import free_vibration as free_vibration
-    from .friction import constant_velocity_friction as constant_velocity_friction
-    from .friction import detect_breakaway as detect_breakaway
-    from .friction import fit_stribeck as fit_stribeck
-    from .friction import idim_ls as idim_ls
-    from .dynamics import DynamicsResult as DynamicsResult
-    from .dynamics import identify_dynamics as identify_dynamics
-    from .motor import characterize_motor as characterize_motor
-    from .motor import fit_motor as fit_motor
-    from .linear_model import LinearModel as LinearModel
-    from .subspace import n4sid as n4sid
-    from .subspace import moesp as moesp
-    from .pem_ss import pem as pem
-    from .frf import FRF as FRF
-    from .frf import frf as frf
-    from .tfest import tfest as tfest
-    from .tfest import tfest_frf as tfest_frf
+    from .linear.oe import oe as oe
+    from .linear.polynomial import PolynomialModel as PolynomialModel
+    from .linear.rls import RLS as RLS
+    from .linear.rls import RLSResult as RLSResult
+    from .linear.rls import rls as rls
+    from .linear.search import SearchResult as SearchResult
+    from .linear.search import structure_search as structure_search
+    from .linear.validation import Comparison as Comparison
+    from .linear.validation import ResidualTests as ResidualTests
+    from .linear.validation import Validation as Validation
+    from .linear.validation import compare as compare
+    from .linear.validation import fit_percent as fit_percent
+    from .linear.validation import residual_tests as residual_tests
+    from .linear.validation import validate as validate
+    from .physical.greybox import GreyboxResult as GreyboxResult
+    from .physical.greybox import fit as fit_greybox
+    from .physical.bouc_wen import identify_bouc_wen as identify_bouc_wen
+    from .physical.modal import free_vibration as free_vibration
+    from .rigid_body.friction import constant_velocity_friction as constant_velocity_friction
+    from .rigid_body.friction import detect_breakaway as detect_breakaway
+    from .rigid_body.friction import fit_stribeck as fit_stribeck
+    from .rigid_body.friction import idim_ls as idim_ls
+    from .rigid_body.dynamics import DynamicsResult as DynamicsResult
+    from .rigid_body.dynamics import identify_dynamics as identify_dynamics
+    from .rigid_body.motor import characterize_motor as characterize_motor
+    from .rigid_body.motor import fit_motor as fit_motor
+    from .linear.linear_model import LinearModel as LinearModel
+    from .linear.subspace import n4sid as n4sid
+    from .linear.subspace import moesp as moesp
+    from .linear.pem_ss import pem as pem
+    from .linear.frf import FRF as FRF
+    from .linear.frf import frf as frf
+    from .linear.tfest import tfest as tfest
+    from .linear.tfest import tfest_frf as tfest_frf
     from .model_protocol import IdentifiedModel as IdentifiedModel
     from .model_protocol import ModelFit as ModelFit
     from .model_protocol import load_model as load_model
-    from .dynamics import load_dynamics_model as load_dynamics_model
+    from .rigid_body.dynamics import load_dynamics_model as load_dynamics_model
+    from .rigid_body.fourier_trajectory import FourierTrajectory as FourierTrajectory
+    from .rigid_body.fourier_trajectory import fourier_trajectory as fourier_trajectory
     from .nonlinear.narx import NARXModel as NARXModel
     from .nonlinear.narx import load_narx as load_narx
     from .nonlinear.narx import narx as narx

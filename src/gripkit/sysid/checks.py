@@ -13,7 +13,7 @@ import numpy as np
 from ..arguments import sample_interval
 from ..errors import DataError, UnidentifiableError
 from ..units import dimension_of, same_dimension
-from .regression import COND_LIMIT, _qr_r, scaled_condition
+from .regression import COND_LIMIT, qr_r, scaled_condition
 
 __all__ = ["as_signal", "as_io_matrix", "io_records", "check_io", "check_order", "check_dt", "require_samples", "check_excitation",
            "check_output_varies", "checked_problem", "check_identifiable",
@@ -162,7 +162,7 @@ def check_persistent_excitation(u: np.ndarray, order: int, what: str,
     below = np.flatnonzero(r[1:n // (2 * order) + 1] < 0.5 * r[0]) if r[0] > 0 else np.empty(0)
     tau = int(below[0]) + 1 if below.size else max(1, n // (2 * order))
     U = np.column_stack([u[(order - 1 - k) * tau:n - k * tau] for k in range(order)])
-    cond = scaled_condition(_qr_r(np.asfortranarray(U), True))[0]
+    cond = scaled_condition(qr_r(np.asfortranarray(U), True))[0]
     if not cond <= COND_LIMIT:
         raise UnidentifiableError(
             f"{what}: {name} is not persistently exciting of order {order}: {order} copies of it "

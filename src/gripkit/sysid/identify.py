@@ -13,8 +13,8 @@
 >>> m.label, m.dt, m.parameters["b2"].unit
 ('ARX [2 2 2]', 0.005, 'N/A')
 
-The array functions (:func:`~gripkit.sysid.arx`, :func:`~gripkit.sysid.armax`,
-:func:`~gripkit.sysid.oe`, :func:`~gripkit.sysid.rls`, :func:`~gripkit.sysid.structure_search`)
+The array functions (:func:`~gripkit.sysid.linear.arx`, :func:`~gripkit.sysid.linear.armax`,
+:func:`~gripkit.sysid.linear.oe`, :func:`~gripkit.sysid.linear.rls`, :func:`~gripkit.sysid.structure_search`)
 take the signals as they are; :func:`identify` adds what a data file needs: column selection,
 the uniform-sampling check, the sampling rate, units, and removal of the operating point
 (``detrend='mean'`` by default: an ARX model has no constant term, so an input centred on 850 mA
@@ -33,13 +33,14 @@ from ..arguments import check_keywords, entry_point, keyword_names
 from ..errors import AccuracyWarning, ArgumentError, DataError, GripkitError, emit_warning
 from ..signals.processing import detrend as detrend_signals
 from ..signals.trajectory import Trajectory
-from . import identify_mimo, nonlinear
-from .armax import armax, armax_records
-from .arx import arx, arx_records
-from .arx_mimo import arx_mimo_records
-from .frf import frf
-from .oe import oe, oe_records
-from .search import structure_search
+from . import nonlinear
+from .linear import identify_mimo
+from .linear.armax import armax, armax_records
+from .linear.arx import arx, arx_records
+from .linear.arx_mimo import arx_mimo_records
+from .linear.frf import frf
+from .linear.oe import oe, oe_records
+from .linear.search import structure_search
 
 __all__ = ["IOData", "io_data", "identify", "identify_records", "method_options", "METHODS"]
 
@@ -116,7 +117,7 @@ def _free_run_fit(model, u: np.ndarray, y: np.ndarray) -> float:
 
 
 def warn_if_mean_detrending_hurt(model, io: IOData, raw, refit) -> None:
-    """The SISO form of :func:`gripkit.sysid.identify_mimo._warn_if_detrending_hurt`: when a pole
+    """The SISO form of :func:`gripkit.sysid.linear.identify_mimo._warn_if_detrending_hurt`: when a pole
     of ``model`` (fitted on the mean-detrended ``io``) does not settle within the record
     (|z|^N > e⁻⁵), fit the same structure (``refit(raw())``) on the data as they are (``raw()``:
     their :class:`IOData` without detrending) and warn, naming ``--detrend none``, when its free
@@ -147,7 +148,7 @@ def warn_if_mean_detrending_hurt(model, io: IOData, raw, refit) -> None:
 
 def _method_function(method: str):
     if method == "rls":
-        from .rls import rls  # numba (0.4 s): loaded only for an RLS fit
+        from .linear.rls import rls  # numba (0.4 s): loaded only for an RLS fit
 
         return rls
     if method == "narx":  # numba: nonlinear.narx loads its module on first use
@@ -183,8 +184,8 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
         nk; ``nf`` defaults to ``na``), ``'rls'`` (recursive least squares; options
         ``forgetting``, ``p0``, ``windup``), or ``'search'`` (``na``, ``nb``, ``nk`` may be ranges
         such as ``'1:4'``; option ``criterion``); ``'ss'`` (state space by subspace + PEM,
-        options of :func:`gripkit.sysid.identify_mimo.identify_ss`), ``'frf'`` (frequency
-        response, options of :func:`gripkit.sysid.frf`), ``'tf'`` (continuous-time transfer
+        options of :func:`gripkit.sysid.linear.identify_mimo.identify_ss`), ``'frf'`` (frequency
+        response, options of :func:`gripkit.sysid.linear.frf`), ``'tf'`` (continuous-time transfer
         function, options ``poles``, ``zeros``); ``'narx'`` (polynomial NARX on the data as they
         are, its constant term in place of detrending; options of
         :func:`gripkit.sysid.narx`: ``degree``, ``lags``, ``terms``, ``validate`` …). For ss,
@@ -241,7 +242,7 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
             warn_if_mean_detrending_hurt(model, io, raw, refit)
         return model
     if method == "rls":
-        from .rls import rls  # numba (0.4 s): loaded only for an RLS fit
+        from .linear.rls import rls  # numba (0.4 s): loaded only for an RLS fit
 
         return rls(io.u, io.y, na, nb, nk, dt=io.dt, **options)
     return structure_search(io.u, io.y, na, nb, nk, dt=io.dt, **options)
@@ -265,13 +266,13 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
     """One model from several records (a list of :class:`~gripkit.signals.Trajectory` with the
     same columns, sample interval and units), each with its own initial conditions; σ from all
     of them: ARX (:func:`gripkit.sysid.arx_records`; with several columns
-    :func:`gripkit.sysid.arx_mimo.arx_mimo_records`), ARMAX
-    (:func:`gripkit.sysid.armax.armax_records`), OE (:func:`gripkit.sysid.oe.oe_records`; ``nf``
+    :func:`gripkit.sysid.linear.arx_mimo.arx_mimo_records`), ARMAX
+    (:func:`gripkit.sysid.linear.armax.armax_records`), OE (:func:`gripkit.sysid.linear.oe.oe_records`; ``nf``
     defaults to ``na``), ``options`` ``maxiter``, ``tol`` for the last two; state space
-    (``options`` of :data:`gripkit.sysid.identify_mimo.SS_RECORD_OPTIONS`: subspace, then PEM,
-    see :func:`gripkit.sysid.identify_mimo.identify_ss_records`) and
+    (``options`` of :data:`gripkit.sysid.linear.identify_mimo.SS_RECORD_OPTIONS`: subspace, then PEM,
+    see :func:`gripkit.sysid.linear.identify_mimo.identify_ss_records`) and
     continuous-time transfer functions (``poles``, ``zeros``:
-    :func:`gripkit.sysid.tfest.tfest_records`). This is what
+    :func:`gripkit.sysid.linear.tfest.tfest_records`). This is what
     ``identify([tr1, tr2], method, ...)`` and ``gripkit identify METHOD DATA1 DATA2 ...`` do.
 
     The model has one operating point: ``detrend='mean'`` removes the mean of all the records

@@ -3,7 +3,7 @@
 The models themselves (:class:`~gripkit.sysid.LinearModel`: ``model.save(path)`` and
 :func:`~gripkit.sysid.load_model`) build and read the documents; this module knows only the file.
 
-The linear-model document is described at :func:`gripkit.sysid.linear_model.model_document`.
+The linear-model document is described at :func:`gripkit.sysid.linear.linear_model.model_document`.
 
 ``content_sha256`` is the SHA-256 of the canonical JSON (sorted keys, no spaces) of everything
 else; :func:`load_model` warns when it does not match (the file was edited by hand) and refuses a

@@ -30,9 +30,9 @@ import numpy as np
 from ..errors import AccuracyWarning, emit_warning
 from ..report.html import Report
 from ..report.plots import measured_vs_model, plain, pyplot
-from .frf import frf
-from .linear_model import VALIDATION_FIT, fit_per_output
-from .pem_ss import predictor_x0
+from .linear.frf import frf
+from .linear.linear_model import VALIDATION_FIT, fit_per_output
+from .linear.pem_ss import predictor_x0
 
 __all__ = ["write_model_report", "model_report", "residual_analysis", "predictor_x0",
            "meaningful_lines", "bode_figure", "Residuals", "ESTIMATE_MARGIN_DECADES",

@@ -91,7 +91,7 @@ def arx_regression(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int,
     return X
 
 
-def _qr_r(X: np.ndarray, overwrite: bool) -> np.ndarray:
+def qr_r(X: np.ndarray, overwrite: bool) -> np.ndarray:
     """The (q, q) triangular factor R of ``X = QR`` (LAPACK ``geqrf`` called directly: scipy's
     ``qr(mode='r')`` also applies ``triu`` to the whole m×q array, which costs more than the
     factorisation itself for tall matrices)."""
@@ -157,7 +157,7 @@ def qr_solve(X: np.ndarray, names: tuple[str, ...], overwrite: bool = False, war
     if m <= p:
         raise UnidentifiableError(f"{m} equations cannot determine {p} parameters ({', '.join(names)})",
                                   hint="use a longer record or a smaller model")
-    return triangular_solve(_qr_r(X, overwrite), names, m, warn, values, stacklevel=4)
+    return triangular_solve(qr_r(X, overwrite), names, m, warn, values, stacklevel=4)
 
 
 def scaled_condition(r1: np.ndarray) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:

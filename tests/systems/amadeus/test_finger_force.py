@@ -14,7 +14,7 @@ from gripkit.control import DiscretePlant, RSTController, design_rst, simulate_l
 from gripkit import zoo
 from gripkit.errors import ModelError, ParameterError
 from gripkit.sim import StateSpace
-from gripkit.sysid.step_response import step_metrics
+from gripkit.sysid.physical.step_response import step_metrics
 from gripkit.systems.amadeus import GraspScenario, simulate_finger_grasp
 from gripkit.systems.amadeus.parameters import TABLE2_A, TABLE2_B, force_plant
 

@@ -7,7 +7,7 @@ import pytest
 
 from gripkit.errors import DataError, UnidentifiableError
 from gripkit.models.friction import FrictionDrive, FrictionTable, Stribeck
-from gripkit.sysid.friction import fit_stribeck
+from gripkit.sysid.rigid_body.friction import fit_stribeck
 from gripkit.systems.dlr_hit.parameters import dlr_hit_table
 from gripkit.systems.dlr_hit.parameters import thesis_finger_parameters
 

@@ -9,7 +9,7 @@ import pytest
 
 from gripkit.cli import main
 from gripkit.errors import DataError, IdentificationError, UnidentifiableError
-from gripkit.sysid.friction import (constant_velocity_friction, detect_breakaway, fit_stribeck, idim_ls,
+from gripkit.sysid.rigid_body.friction import (constant_velocity_friction, detect_breakaway, fit_stribeck, idim_ls,
                                     table_from_points)
 from gripkit.systems.dlr_hit.impedance import ImpedanceController, simulate_impedance
 from gripkit.systems.dlr_hit.parameters import finger

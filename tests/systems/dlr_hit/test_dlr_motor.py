@@ -9,7 +9,7 @@ from gripkit.errors import DataError, ModelError, UnidentifiableError
 from gripkit import zoo
 from gripkit.models.bldc import NCM, RPM, SLOPES_5_4_2, BLDCMotor, MotorTestBed, motor_parameters
 from gripkit.models.transmission import DLR_BASE, DLR_DISTAL, Transmission, harmonic_drive
-from gripkit.sysid.motor import characterize_motor, fit_motor
+from gripkit.sysid.rigid_body.motor import characterize_motor, fit_motor
 
 MOTOR = BLDCMotor()
 

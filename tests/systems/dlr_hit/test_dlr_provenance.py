@@ -36,7 +36,7 @@ def test_docs_state_the_provenance():
         assert name.replace("\n", " ") in para.replace("\n", " "), name
 
 
-@pytest.mark.parametrize("module", ["gripkit.sysid.friction",
+@pytest.mark.parametrize("module", ["gripkit.sysid.rigid_body.friction",
                                     "gripkit.estimation.friction_adaptation",
                                     "gripkit.systems.dlr_hit.friction_adaptation",
                                     "gripkit.models.bldc", "gripkit.models.friction",

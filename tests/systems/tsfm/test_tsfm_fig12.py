@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from gripkit.errors import AccuracyWarning
-from gripkit.sysid.bouc_wen import loop_error
+from gripkit.sysid.physical.bouc_wen import loop_error
 from gripkit.systems.tsfm import parameters as z
 from gripkit.systems.tsfm.identification import identify_finger
 

@@ -19,7 +19,7 @@ from ...control import design_rst, simulate_loop
 from ...estimation import fused_variance, implied_correlation
 from ...progress import status
 from ...report.plots import log_ticks, subplots
-from ...sysid.step_response import step_metrics
+from ...sysid.physical.step_response import step_metrics
 from .bellows_finger import BAR, PRINCIPAL_DIRECTIONS
 from .force_control import GraspScenario, simulate_finger_grasp
 from .force_dynamics import FORCE_SCALE_NOTE

@@ -43,7 +43,7 @@ from ...params import Parameter, ParameterSet
 from ...signals.filters import apply_sos, butter_sos, butter_zpk
 from ...signals.trajectory import Trajectory
 from ...sysid.checks import as_signal
-from ...sysid.polynomial import PolynomialModel
+from ...sysid.linear.polynomial import PolynomialModel
 
 __all__ = ["ReferenceModel", "TABLE_II", "TABLE_III", "FingerForcePlant", "finger_force_model",
            "seed_checks", "SEED", "DT", "PREFILTER_ORDER", "PREFILTER_CUTOFF", "FORCE_SCALE", "PEAK_FORCE",

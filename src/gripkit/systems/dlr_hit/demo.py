@@ -15,8 +15,8 @@ from ...errors import ConsistencyWarning
 from ...models.bldc import RPM, SLOPES_5_4_2, BLDCMotor, MotorTestBed
 from ...report.plots import subplots
 from ...signals import Trajectory
-from ...sysid.friction import detect_breakaway, fit_stribeck, idim_ls
-from ...sysid.motor import characterize_motor
+from ...sysid.rigid_body.friction import detect_breakaway, fit_stribeck, idim_ls
+from ...sysid.rigid_body.motor import characterize_motor
 from .finger import ACTUATORS, JOINTS
 from .friction_adaptation import (THERMAL_CASES, THERMAL_MODES, adapt_finger_friction,
                                   compare_adaptation, thermal_adaptation_study, tracking_reference)

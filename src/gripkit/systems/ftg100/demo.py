@@ -16,7 +16,7 @@ from ...models.beams import clamped_clamped_stiffness
 from ...models.comb_drive import comb_drive_force, comb_drive_gain
 from ...report.plots import subplots
 from ...signals.trajectory import Trajectory
-from ...sysid.step_response import identify_step
+from ...sysid.physical.step_response import identify_step
 from .hybrid_control import (HybridForcePosition, grasp_batch, impact_speed_limit,
                              simulate_hybrid_grasp)
 from .identification import identify_actuated, identify_sensing, release_experiment, step_experiment

@@ -8,7 +8,7 @@ Levenberg-Marquardt). §III-D: the sensing arm is pushed by a rigid beam (27 µm
 released — a negative force step — and M_b, K_fb are estimated the same way.
 
 :func:`identify_actuated` and :func:`identify_sensing` start from the general second-order step
-fit (:func:`gripkit.sysid.step_response.identify_step`), map its K, ω_n, ζ to the physical
+fit (:func:`gripkit.sysid.physical.step_response.identify_step`), map its K, ω_n, ζ to the physical
 parameters, and refine them by output-error Levenberg-Marquardt on the grey-box engine (positive
 parameters in log space), returning the grey-box result with standard deviations, covariance and
 correlation.
@@ -30,8 +30,8 @@ import numpy as np
 
 from ...errors import ConsistencyWarning, DataError, IdentificationError
 from ...signals.trajectory import Trajectory
-from ...sysid.greybox import GreyboxResult, fit
-from ...sysid.step_response import identify_step
+from ...sysid.physical.greybox import GreyboxResult, fit
+from ...sysid.physical.step_response import identify_step
 from .model import FTG100Actuated, FTG100Sensing
 
 __all__ = ["step_experiment", "release_experiment", "identify_actuated", "identify_sensing"]

@@ -21,7 +21,7 @@ from ...consistency import ConsistencyReport, check
 from ...estimation import ContactDetector
 from ...progress import status
 from ...report.plots import log_ticks, subplots
-from ...sysid.bouc_wen import loop_error
+from ...sysid.physical.bouc_wen import loop_error
 from . import parameters as z
 from .grasp import GraspSettings, simulate_two_finger_grasp
 from .identification import identify_finger

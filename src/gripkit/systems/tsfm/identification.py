@@ -1,12 +1,12 @@
 """The identification procedure of ``001_0b92a7da96e7aa46.txt`` §IV for one TSFM finger.
 
 Steps 1 and 2 (static Bouc-Wen parameters, Fig. 9, and D(s), Fig. 10) are the generic piezo
-procedures of :mod:`gripkit.sysid.bouc_wen`; this module adds the TSFM's own:
+procedures of :mod:`gripkit.sysid.physical.bouc_wen`; this module adds the TSFM's own:
 
 3. **s_p** from a force–displacement test at the tip B (§IV-C3, eq 15, Fig. 11):
    y_B = −(1 + 3L_r/L_a + 3L_r²/L_a²) s_p F_g, a straight line: :func:`identify_compliance`.
 4. **Force sensor m_s, b_s, k_s** (§IV-B) from the free-vibration f_0 and ζ
-   (:func:`gripkit.sysid.modal.free_vibration`) and one of them known:
+   (:func:`gripkit.sysid.physical.modal.free_vibration`) and one of them known:
    :func:`gripkit.systems.tsfm.end_effector.sensor_parameters` (k_s = m_s ω₀², b_s = 2ζ √(k_s m_s)).
 
 and the whole procedure, :func:`identify_finger`.
@@ -30,10 +30,10 @@ import numpy as np
 from ...errors import DataError, IdentificationError
 from ...params import ParameterSet
 from ...signals.trajectory import Trajectory
-from ...sysid.bouc_wen import (BoucWenResult, DynamicsResult, identify_actuator_dynamics,
+from ...sysid.physical.bouc_wen import (BoucWenResult, DynamicsResult, identify_actuator_dynamics,
                                identify_bouc_wen)
-from ...sysid.greybox import fit
-from ...sysid.modal import free_vibration
+from ...sysid.physical.greybox import fit
+from ...sysid.physical.modal import free_vibration
 from .end_effector import lever_coefficients, sensor_parameters
 from .gripper import TSFMFinger, finger_parameter_set
 

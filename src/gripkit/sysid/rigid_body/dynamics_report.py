@@ -14,8 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..report.html import Report
-from ..report.plots import measured_vs_model, plain, pyplot
+from ...report.html import Report
+from ...report.plots import measured_vs_model, plain, pyplot
 
 __all__ = ["dynamics_report", "parameter_unit", "write_dynamics_report"]
 

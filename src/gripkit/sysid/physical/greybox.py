@@ -34,11 +34,11 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.optimize import least_squares
 
-from ..arguments import entry_point
-from ..errors import AccuracyWarning, DataError, IdentificationError, ParameterError, emit_warning
-from ..params import ParameterSet
-from ..progress import track
-from ..signals.trajectory import Trajectory
+from ...arguments import entry_point
+from ...errors import AccuracyWarning, DataError, IdentificationError, ParameterError, emit_warning
+from ...params import ParameterSet
+from ...progress import track
+from ...signals.trajectory import Trajectory
 
 __all__ = ["GreyboxResult", "Identifiability", "fit"]
 

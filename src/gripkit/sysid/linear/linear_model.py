@@ -21,20 +21,20 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .. import __version__
-from ..errors import DataError, DataWarning, ModelError, ParameterError, emit_warning
-from ..lti import LinearSystem, StateSpace, TransferFunction
-from ..signals.trajectory import Trajectory
-from ..units import convert, dimension_of, same_dimension
-from .checks import as_io_matrix
-from .model_file import SCHEMA, SCHEMA_VERSION, read_document, write_document
+from ... import __version__
+from ...errors import DataError, DataWarning, ModelError, ParameterError, emit_warning
+from ...lti import LinearSystem, StateSpace, TransferFunction
+from ...signals.trajectory import Trajectory
+from ...units import convert, dimension_of, same_dimension
+from ..checks import as_io_matrix
+from ..model_file import SCHEMA, SCHEMA_VERSION, read_document, write_document
 
 __all__ = ["VALIDATION_FIT", "validation_fit", "LinearModel", "as_io_matrix", "estimate_x0", "free_run", "fit_per_output", "from_polynomial",
            "model_document", "save_model", "load_linear_model"]
 
 
 def _sim(A, B, C, D, u, x0):
-    from ..lti import simulate_ss  # numba, loaded on first simulation
+    from ...lti import simulate_ss  # numba, loaded on first simulation
 
     y = np.empty((u.shape[0], C.shape[0]))
     simulate_ss(A, B, C, D, u, np.array(x0, dtype=np.float64), np.empty(A.shape[0]), y)

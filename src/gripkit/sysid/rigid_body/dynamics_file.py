@@ -23,7 +23,7 @@ models of :mod:`gripkit.sysid.model_file`)::
      "content_sha256": "…"}
 
 The URDF text makes the file self-contained: the chain is rebuilt from it with the stored links
-and gravity; the base structure (K of φ_b = K φ, :class:`~gripkit.sysid.dynamics.BaseStructure`)
+and gravity; the base structure (K of φ_b = K φ, :class:`~gripkit.sysid.rigid_body.dynamics.BaseStructure`)
 is stored rather than found again, so that the loaded model predicts τ = X(q, q̇, q̈) θ with the very
 columns and parameters it was identified with. ``base_parameters`` and ``friction`` repeat
 ``parameters`` for a reader of the file; the loader uses ``parameters``.
@@ -38,11 +38,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .. import __version__
-from ..atomic import write_text
-from ..errors import DataError, ModelError
-from ..multibody import to_urdf
-from .model_file import content_hash, plain, read_document
+from ... import __version__
+from ...atomic import write_text
+from ...errors import DataError, ModelError
+from ...multibody import to_urdf
+from ..model_file import content_hash, plain, read_document
 
 __all__ = ["SCHEMA", "SCHEMA_VERSION", "dynamics_document", "float_array", "read_dynamics_document",
            "save_dynamics_model"]
@@ -60,7 +60,7 @@ def _urdf_text(result) -> str:
 
 
 def dynamics_document(result) -> dict:
-    """The JSON document of a :class:`~gripkit.sysid.dynamics.DynamicsResult`."""
+    """The JSON document of a :class:`~gripkit.sysid.rigid_body.dynamics.DynamicsResult`."""
     text = _urdf_text(result)
     st = result.structure
     cons = result.consistency
@@ -93,7 +93,7 @@ def dynamics_document(result) -> dict:
 
 
 def save_dynamics_model(result, path) -> None:
-    """Write ``result`` (a :class:`~gripkit.sysid.dynamics.DynamicsResult`) to ``path`` (.json)."""
+    """Write ``result`` (a :class:`~gripkit.sysid.rigid_body.dynamics.DynamicsResult`) to ``path`` (.json)."""
     path = Path(path)
     if path.suffix.lower() != ".json":
         raise DataError(f"dynamics model file: expected a .json path, found {str(path)!r}")

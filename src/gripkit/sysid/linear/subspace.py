@@ -39,12 +39,12 @@ import numba
 import numpy as np
 import scipy.linalg as sla
 
-from ..errors import DataError, IdentificationError, StabilityWarning, emit_warning
-from ..lti import StateSpace
+from ...errors import DataError, IdentificationError, StabilityWarning, emit_warning
+from ...lti import StateSpace
 from .blocked_gram import add_rows, carried_states, carry, row_product, start_sums
-from .checks import check_dt, io_records
+from ..checks import check_dt, io_records
 from .linear_model import LinearModel, as_io_matrix, fit_per_output, free_run, observability_regressor
-from .regression import _qr_r
+from ..regression import qr_r
 from .validation import records_fit
 
 __all__ = ["n4sid", "n4sid_records", "moesp", "SUBSPACE_METHODS", "default_horizon",
@@ -79,7 +79,7 @@ def _lower_factor(Z: np.ndarray) -> np.ndarray:
         L = np.linalg.cholesky(G)
         if np.min(np.abs(np.diag(L))) > 1e-6 * np.sqrt(np.max(np.diag(G))):
             return L
-    return _qr_r(np.asfortranarray(Z), overwrite=True).T / math.sqrt(j)
+    return qr_r(np.asfortranarray(Z), overwrite=True).T / math.sqrt(j)
 
 
 class SubspaceFactor:
@@ -228,7 +228,7 @@ def _bdx_normal_equations(A, C, u, y, feedthrough, G, r):  # pragma: no cover - 
     :data:`_BDX_BLOCK` samples are collected and added to the sums by one BLAS product each.
     O(N·n²(m+1)) flops, O(cols²) memory beyond the block. Returns the final carried state X[N]
     (n × (n·m + n)), whose entries below 1e-280 are flushed to zero as it is carried
-    (:func:`~gripkit.sysid.blocked_gram.carry`: the x0 columns decay into the subnormal range
+    (:func:`~gripkit.sysid.linear.blocked_gram.carry`: the x0 columns decay into the subnormal range
     otherwise; G and r are unchanged by it)."""
     N, m = u.shape
     n, p = A.shape[0], C.shape[0]
@@ -555,7 +555,7 @@ def from_records_factor(fac: RecordsFactor, n: int, *, dt: float, feedthrough: b
     """:func:`from_factor` for several records: A, C from the pooled factor; B, D shared and one
     x0 per record by least squares over all records; the noise model from the state sequences of
     every record. ``fit_percent``: the free run of all records per output, each from its own x0
-    (:func:`~gripkit.sysid.validation.records_fit`); ``info['records']``: each record's samples,
+    (:func:`~gripkit.sysid.linear.validation.records_fit`); ``info['records']``: each record's samples,
     free-run fit and x0 (the model's ``x0`` is the first record's)."""
     p, m = fac.p, fac.m
 

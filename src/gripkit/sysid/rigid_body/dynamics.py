@@ -29,7 +29,7 @@ Cov = σ̂² (XᵀWX)⁻¹, σ̂² = rᵀWr/(N_rows − p) (``covariance="ols"``
 covariance of :func:`gripkit.sysid.regression.hac_covariance` for filtered, differentiated or
 decimated logs (``covariance="hac"``).
 
-**Physical consistency** (:mod:`gripkit.sysid.dynamics_projection`, where it is derived). A
+**Physical consistency** (:mod:`gripkit.sysid.rigid_body.dynamics_projection`, where it is derived). A
 base-parameter estimate is physically consistent when some standard parameters reproduce it with
 every link's pseudo-inertia
 
@@ -63,14 +63,14 @@ from pathlib import Path
 import numpy as np
 from scipy.linalg import qr
 
-from ..arguments import entry_point
-from ..errors import (AccuracyWarning, DataError, IdentificationError, ModelError,
+from ...arguments import entry_point
+from ...errors import (AccuracyWarning, DataError, IdentificationError, ModelError,
                       UnidentifiableError, emit_warning)
-from ..multibody import from_urdf
-from .checks import as_io_matrix
+from ...multibody import from_urdf
+from ..checks import as_io_matrix
 from .dynamics_file import float_array, read_dynamics_document, save_dynamics_model
 from .dynamics_projection import project_consistent
-from .regression import hac_covariance
+from ..regression import hac_covariance
 
 __all__ = ["identify_dynamics", "DynamicsResult", "base_structure", "BaseStructure", "load_dynamics_model"]
 
@@ -172,7 +172,7 @@ def friction_columns(qd, kinds) -> np.ndarray:
 
 @dataclass(frozen=True)
 class Consistency:
-    """Physical consistency of the estimate (:mod:`gripkit.sysid.dynamics_projection`).
+    """Physical consistency of the estimate (:mod:`gripkit.sysid.rigid_body.dynamics_projection`).
 
     ``distance`` d (σ): the Mahalanobis distance, in the covariance of the identified parameters,
     from the estimate to the nearest physically consistent parameters ``theta`` (0: the estimate
@@ -257,7 +257,7 @@ class DynamicsResult:
         return replace(self, **changes)
 
     def save(self, path) -> None:
-        """Write the model as JSON (:mod:`gripkit.sysid.dynamics_file`, schema
+        """Write the model as JSON (:mod:`gripkit.sysid.rigid_body.dynamics_file`, schema
         ``gripkit.dynamics-model``); read it back with :func:`gripkit.sysid.load_dynamics_model`."""
         save_dynamics_model(self, path)
 
@@ -443,7 +443,7 @@ def _solve_joint_weighted(ne: _JointNormalEquations, names, joint_weighting: boo
         top = np.argsort(-np.abs(v / np.max(np.abs(v))))[:3]
         raise UnidentifiableError(f"the data do not excite every base parameter (condition number {cond:.3g}); "
                                   f"the weakest direction mixes {', '.join(names[k] for k in top)}",
-                                  hint="use a richer excitation (gripkit.excitation.fourier_trajectory)")
+                                  hint="use a richer excitation (gripkit.sysid.fourier_trajectory)")
     if joint_weighting and m > 1:
         n_j = (ne.rows_w > 0).sum(axis=0)
         s2_j = ne.rss(theta) / np.maximum(n_j - P / m, 1.0)
@@ -629,7 +629,7 @@ def _failing_parts(chain, phi_p, x, theta, std, kinds, n_arm: int, nb: int,
 def _consistency(chain, st: BaseStructure, theta, C, kinds, m, armature,
                  level: float = 0.95) -> Consistency:
     """Physical consistency of the estimate θ̂ with covariance C
-    (:mod:`gripkit.sysid.dynamics_projection`): first the least-change standard parameters,
+    (:mod:`gripkit.sysid.rigid_body.dynamics_projection`): first the least-change standard parameters,
     consistent there means consistent (d = 0, no search); else the projection of θ̂ onto the
     consistent set in the metric C⁻¹, its distance d and the χ² test of level 1 − ``level``
     with n = dim θ − (offsets) degrees of freedom."""
@@ -681,7 +681,7 @@ def _consistency(chain, st: BaseStructure, theta, C, kinds, m, armature,
 
 
 def load_dynamics_model(path) -> DynamicsResult:
-    """Read a model written by ``result.save(path)`` (:mod:`gripkit.sysid.dynamics_file`): a
+    """Read a model written by ``result.save(path)`` (:mod:`gripkit.sysid.rigid_body.dynamics_file`): a
     :class:`DynamicsResult` with ``predict``, ``base_parameters``, ``base_parameters_std``,
     ``friction``, ``covariance``, ... as identified.
 

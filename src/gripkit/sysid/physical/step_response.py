@@ -16,7 +16,7 @@ Procedure (:func:`identify_step`):
    and ζ = −Re s/|s|, its static gain (b₁ + b₂)/(1 + a₁ + a₂) gives K. When the ARX poles are not
    a stable pair (heavy noise), the step's levels and its 63 % time are used instead.
 2. Output-error least squares on (K, ω_n, ζ, y₀) with the grey-box engine
-   (:func:`gripkit.sysid.greybox.fit`): Levenberg-Marquardt by default (``method='lm'``: ω_n and ζ
+   (:func:`gripkit.sysid.physical.greybox.fit`): Levenberg-Marquardt by default (``method='lm'``: ω_n and ζ
    in log space, so they stay positive), or the bounded trust-region reflective method
    (``method='trf'``, CLI ``--method trf``), which keeps every parameter within its bounds.
 3. Uncertainty: the asymptotic covariance σ̂²(JᵀJ)⁻¹ of the grey-box engine; σ(f_n) = σ(ω_n)/2π.
@@ -33,11 +33,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..arguments import entry_point
-from ..errors import AccuracyWarning, DataError, IdentificationError, SimulationError, emit_warning
-from ..models.second_order import SecondOrderSystem, second_order_step
-from ..signals.trajectory import Trajectory
-from ..units import ratio_unit
+from ...arguments import entry_point
+from ...errors import AccuracyWarning, DataError, IdentificationError, SimulationError, emit_warning
+from ...models.second_order import SecondOrderSystem, second_order_step
+from ...signals.trajectory import Trajectory
+from ...units import ratio_unit
 from .greybox import GreyboxResult, fit
 
 __all__ = ["StepResponseResult", "identify_step", "step_metrics", "second_order_metrics", "STEP_METHODS"]

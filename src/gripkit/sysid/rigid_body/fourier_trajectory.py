@@ -29,11 +29,11 @@ from pathlib import Path
 
 import numpy as np
 
-from .arguments import entry_point
-from .atomic import atomic_write
-from .errors import ConfigError, DataError, IdentificationError
-from .progress import status, track
-from .sysid.dynamics import base_structure, friction_columns
+from ...arguments import entry_point
+from ...atomic import atomic_write
+from ...errors import ConfigError, DataError, IdentificationError
+from ...progress import status, track
+from .dynamics import base_structure, friction_columns
 
 __all__ = ["FourierTrajectory", "fourier_trajectory", "fourier_states"]
 

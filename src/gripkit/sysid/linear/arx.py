@@ -17,13 +17,13 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 
-from ..errors import DataError
-from ._scaling import in_user_units, unit_scale
+from ...errors import DataError
+from ..scaling import in_user_units, unit_scale
 from .arx_mimo import arx_mimo
-from .checks import (check_dt, check_excitation, check_identifiable, check_io, check_order,
+from ..checks import (check_dt, check_excitation, check_identifiable, check_io, check_order,
                      check_output_varies, checked_problem, require_samples)
 from .polynomial import PolynomialModel, check_meta
-from .regression import arx_regression, arx_start, qr_solve, triangular_solve
+from ..regression import arx_regression, arx_start, qr_solve, triangular_solve
 from .validation import fit_percent, records_fit
 
 __all__ = ["arx", "arx_records"]
@@ -53,7 +53,7 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
         ``u_offset``, ``y_offset``.
 
     With several input or output columns (``u`` (N, m), ``y`` (N, p)) the model is a MIMO ARX
-    of matrix polynomials: see :func:`gripkit.sysid.arx_mimo.arx_mimo`.
+    of matrix polynomials: see :func:`gripkit.sysid.linear.arx_mimo.arx_mimo`.
 
     Returns
     -------
@@ -77,7 +77,7 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
         parameters' size, from the noise or from rounding): the message names those parameters
         and their relative σ.
 
-    The signals are scaled to unit size internally (exact powers of two, :mod:`._scaling`), so data
+    The signals are scaled to unit size internally (exact powers of two, :mod:`.scaling`), so data
     at any scale (1e-300 … 1e300) are identified; the model is in the units of ``u`` and ``y``.
     """
     check_meta(meta, arx)
@@ -197,7 +197,7 @@ def check_record_lengths(recs: list, t0: int, label: str) -> None:
 
 def scaled_records(recs: list, skip_within: float = 0.0) -> tuple[list, float, float]:
     """The records with their input and output scaled to unit size (one power of two for all
-    records, :func:`~gripkit.sysid._scaling.unit_scale`) and the factors ``(scaled, cu, cy)``,
+    records, :func:`~gripkit.sysid.scaling.unit_scale`) and the factors ``(scaled, cu, cy)``,
     after the checks that need all the records: a varying input and a varying output. Peaks
     within 2^±``skip_within`` stay unscaled."""
     u_all = np.concatenate([u for u, _ in recs])
@@ -237,7 +237,7 @@ def arx_records(records, na: int, nb: int, nk: int = 1, *, dt: float | None = No
 
     M_i = N_i − start. The covariance is σ²(ΦᵀΦ)⁻¹ of the stacked Φ. With one record the result
     is that of :func:`arx` (same rows). ``fit_percent`` is the one-step fit of all the records,
-    each about its own mean (:func:`~gripkit.sysid.validation.records_fit`); ``info['records']``
+    each about its own mean (:func:`~gripkit.sysid.linear.validation.records_fit`); ``info['records']``
     gives each record's samples and one-step fit; ``residuals`` are the records' one-step errors
     one after another (``info['record_starts']``: where each begins).
 

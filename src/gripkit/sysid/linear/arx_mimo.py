@@ -8,7 +8,7 @@ q = p·na + m·nb), solved by the QR least squares of :mod:`gripkit.sysid.regres
 refuses an ill-conditioned regressor). The covariance of vec(θ) (row i = output i) is
 ``Λ ⊗ (ΦᵀΦ)⁻¹`` with ``Λ = EᵀE/(M − q)``.
 
-The model is returned as a :class:`~gripkit.sysid.linear_model.LinearModel` on a (non-minimal)
+The model is returned as a :class:`~gripkit.sysid.linear.linear_model.LinearModel` on a (non-minimal)
 state-space realisation with state x(t) = [y(t−1); …; y(t−na); u(t−1); …; u(t−L)],
 L = nk + nb − 1, whose innovation gain K = [I_p; 0] makes its one-step predictor the ARX
 predictor. A, B, C, D are affine in θ, so the covariance carries exact tangents; the matrix
@@ -19,11 +19,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import DataError
-from ..lti import StateSpace, Uncertainty
-from .checks import check_dt, check_order, io_records
+from ...errors import DataError
+from ...lti import StateSpace, Uncertainty
+from ..checks import check_dt, check_order, io_records
 from .linear_model import LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run
-from .regression import qr_solve
+from ..regression import qr_solve
 from .validation import records_fit
 
 __all__ = ["arx_mimo", "arx_mimo_records"]
@@ -91,7 +91,7 @@ def arx_mimo_records(records, na: int, nb: int, nk: int = 1, *, dt: float | None
     crosses from one record into the next); the rows of all records form one least-squares
     problem, ``Λ = EᵀE/(Σ M_i − q)``. ``fit_percent`` is the free-run fit of all records per
     output (each from its own estimated initial state, about its own mean:
-    :func:`~gripkit.sysid.validation.records_fit`); ``info['records']`` gives each record's
+    :func:`~gripkit.sysid.linear.validation.records_fit`); ``info['records']`` gives each record's
     samples, free-run and one-step fits and initial state (``x0`` of the model: the first
     record's).
     """

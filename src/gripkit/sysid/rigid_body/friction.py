@@ -41,12 +41,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..arguments import entry_point, sample_interval
-from ..errors import DataError, IdentificationError, UnidentifiableError
-from ..models.friction import FrictionTable
-from ..signals.filters import apply_sos, butter_sos
-from ._scaling import unit_scale
-from .regression import hac_covariance
+from ...arguments import entry_point, sample_interval
+from ...errors import DataError, IdentificationError, UnidentifiableError
+from ...models.friction import FrictionTable
+from ...signals.filters import apply_sos, butter_sos
+from ..scaling import unit_scale
+from ..regression import hac_covariance
 
 __all__ = ["Pulse", "BreakawayResult", "detect_breakaway", "ConstantVelocityPoint",
            "constant_velocity_friction", "table_from_points", "StribeckFit", "fit_stribeck",

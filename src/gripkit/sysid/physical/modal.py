@@ -34,9 +34,9 @@ import numpy as np
 from scipy.optimize import least_squares
 from scipy.signal import find_peaks, hilbert, resample_poly
 
-from ..arguments import entry_point, sample_interval
-from ..errors import AccuracyWarning, DataError, IdentificationError, emit_warning
-from ._scaling import unit_scale
+from ...arguments import entry_point, sample_interval
+from ...errors import AccuracyWarning, DataError, IdentificationError, emit_warning
+from ..scaling import unit_scale
 
 __all__ = ["ModalResult", "free_vibration"]
 

@@ -29,8 +29,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import DataError, UnidentifiableError
-from ..models.bldc import NCM, RPM
+from ...errors import DataError, UnidentifiableError
+from ...models.bldc import NCM, RPM
 
 __all__ = ["MotorFit", "fit_motor", "MotorCharacterization", "characterize_motor"]
 

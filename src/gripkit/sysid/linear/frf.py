@@ -30,8 +30,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
-from ..errors import AccuracyWarning, DataError, emit_warning
-from .checks import check_dt
+from ...errors import AccuracyWarning, DataError, emit_warning
+from ..checks import check_dt
 from .linear_model import as_io_matrix
 
 __all__ = ["FRF", "frf", "FRF_METHODS"]

@@ -11,7 +11,7 @@ the estimate. Gradients::
 Initialisation: an ARX ``[nf nb nk]`` estimate, refined by one instrumental-variable step whose
 instruments are the ARX model's simulated output (Söderström & Stoica, *System Identification*,
 §8), with F reflected into the unit circle if needed; then Levenberg–Marquardt
-(:mod:`gripkit.sysid._pem`) minimises eq (29) of ``000_8f66dcc7ab06470c.txt``.
+(:mod:`gripkit.sysid.linear._pem`) minimises eq (29) of ``000_8f66dcc7ab06470c.txt``.
 """
 
 from __future__ import annotations
@@ -21,10 +21,10 @@ import warnings
 import numpy as np
 
 from ._pem import covariance, is_stable_poly, levenberg_marquardt, stabilize
-from ._scaling import in_user_units, unit_scale
+from ..scaling import in_user_units, unit_scale
 from .arx import (_arx, arx_records, check_record_lengths, checked_records, records_summary,
                   scaled_records)
-from .checks import check_dt, check_identifiable, check_order, checked_problem, require_samples
+from ..checks import check_dt, check_identifiable, check_order, checked_problem, require_samples
 from .polynomial import PolynomialModel, check_meta
 from .validation import fit_percent, loss_vn
 
@@ -59,7 +59,7 @@ def oe(u, y, nb: int, nf: int, nk: int = 1, *, dt: float | None = None,
        maxiter: int = 100, tol: float = 1e-10, **meta) -> PolynomialModel:
     """Output-error model ``y = B/F u + e`` by prediction-error minimisation.
 
-    Parameters as :func:`gripkit.sysid.arx` with ``nf`` (number of F coefficients after the
+    Parameters as :func:`gripkit.sysid.linear.arx` with ``nf`` (number of F coefficients after the
     leading 1) in place of ``na``. Returns a :class:`PolynomialModel` with ``structure='oe'``,
     ``A = [1]``, ``F`` and ``F_std``; its poles are the roots of F.
     """

@@ -17,13 +17,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..arguments import entry_point
-from ..errors import DataError, GripkitWarning, UnidentifiableError, emit_warning
-from ..progress import track
-from ._scaling import unit_scale
-from .checks import check_dt, check_identifiable, check_io, check_order
+from ...arguments import entry_point
+from ...errors import DataError, GripkitWarning, UnidentifiableError, emit_warning
+from ...progress import track
+from ..scaling import unit_scale
+from ..checks import check_dt, check_identifiable, check_io, check_order
 from .polynomial import PolynomialModel
-from .regression import arx_regression, qr_solve
+from ..regression import arx_regression, qr_solve
 from .validation import compare
 
 __all__ = ["Candidate", "SearchResult", "structure_search", "parse_range"]
@@ -139,7 +139,7 @@ def structure_search(u, y, na=range(1, 5), nb=range(1, 5), nk=range(1, 11), *,
     t0 = max(max(nas), max(nks) + max(nbs) - 1)
     pmax = max(nas) + max(nbs)
     check_identifiable(u, y, t0 + pmax + 1, f"structure search up to na={max(nas)}, nb={max(nbs)}, nk={max(nks)}")
-    cu, cy = unit_scale(u), unit_scale(y)  # exact powers of two (see _scaling): any data scale
+    cu, cy = unit_scale(u), unit_scale(y)  # exact powers of two (see scaling): any data scale
     u, y = u * cu, y * cy
     yt = y[t0:]
     sst = float(np.sum((yt - yt.mean()) ** 2))

@@ -50,10 +50,10 @@ import numpy as np
 from numba import njit, types
 from numba.core.errors import TypingError
 
-from ..arguments import entry_point
-from ..errors import DataError, IdentificationError
-from ..signals.trajectory import Trajectory
-from .checks import check_dt, check_excitation, check_io, check_order, require_samples
+from ...arguments import entry_point
+from ...errors import DataError, IdentificationError
+from ...signals.trajectory import Trajectory
+from ..checks import check_dt, check_excitation, check_io, check_order, require_samples
 from .polynomial import PolynomialModel
 
 __all__ = ["RLS", "RLSResult", "rls"]
@@ -434,7 +434,7 @@ class RLS:
     Parameters
     ----------
     na, nb, nk
-        ARX orders in MATLAB's layout (see :func:`gripkit.sysid.arx`).
+        ARX orders in MATLAB's layout (see :func:`gripkit.sysid.linear.arx`).
     forgetting
         λ in (0, 1]; 1 = no forgetting (converges to the least-squares estimate).
     p0

@@ -22,10 +22,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import (AccuracyWarning, ArgumentError, DataError, GripkitError, GripkitWarning,
+from ...errors import (AccuracyWarning, ArgumentError, DataError, GripkitError, GripkitWarning,
                       IdentificationError, emit_warning)
-from ..progress import status
-from ..signals.trajectory import Trajectory
+from ...progress import status
+from ...signals.trajectory import Trajectory
 from .arx_mimo import arx_mimo
 from .frf import frf
 from .linear_model import VALIDATION_FIT, validation_fit  # the one definition, re-exported for the CLI
@@ -141,7 +141,7 @@ def _check_scale(names, x: np.ndarray, what: str, why: str) -> None:
 def _validation_data(validate: Trajectory, d: MimoData) -> MimoData:
     """The validation record's columns as deviations from the *estimation* operating point
     ``d.u_offset``/``d.y_offset`` (the model's offsets): the one validation fit of
-    :data:`gripkit.sysid.linear_model.VALIDATION_FIT`, the number ``gripkit compare`` gives."""
+    :data:`gripkit.sysid.linear.linear_model.VALIDATION_FIT`, the number ``gripkit compare`` gives."""
     vd = mimo_data(validate, d.inputs, d.outputs, "none", why="validation")
     if abs(vd.dt - d.dt) > 1e-9 * d.dt:
         raise DataError(f"validation data are sampled at {1 / vd.dt:g} Hz, the estimation data at "
@@ -396,13 +396,13 @@ def _warn_if_detrending_hurt(model, refit, n: int, dt: float, command: str) -> N
 
 
 def identify_frf(data: Trajectory, *, input, output, detrend: str = "mean", **options):
-    """Frequency response of the named columns (:func:`gripkit.sysid.frf` options)."""
+    """Frequency response of the named columns (:func:`gripkit.sysid.linear.frf` options)."""
     d = mimo_data(data, input, output, detrend, why="frequency-response estimation")
     return frf(d.u, d.y, dt=d.dt, inputs=d.inputs, outputs=d.outputs, **options)
 
 
 def identify_tf(data: Trajectory, *, input, output, poles: int, zeros: int, detrend: str = "mean"):
-    """Continuous-time transfer function of the named columns (:func:`gripkit.sysid.tfest`)."""
+    """Continuous-time transfer function of the named columns (:func:`gripkit.sysid.linear.tfest`)."""
     from .tfest import tfest
 
     d = mimo_data(data, input, output, detrend, why="transfer-function estimation")
@@ -421,7 +421,7 @@ def several(*names) -> bool:
 
 
 def identify_arx(data: Trajectory, *, input, output, na: int, nb: int, nk: int = 1, detrend: str = "mean"):
-    """MIMO ARX of the named columns (:func:`gripkit.sysid.arx_mimo.arx_mimo`)."""
+    """MIMO ARX of the named columns (:func:`gripkit.sysid.linear.arx_mimo.arx_mimo`)."""
     d = mimo_data(data, input, output, detrend, why="ARX identification")
     return arx_mimo(d.u, d.y, na, nb, nk, dt=d.dt, u_offset=d.u_offset, y_offset=d.y_offset, **d.signals)
 
@@ -434,8 +434,8 @@ SS_RECORD_OPTIONS = ("order", "horizon", "feedthrough", "refine", "form", "max_i
 
 def identify_ss_records(records: list, d: MimoData, u0, y0, options: dict):
     """The state-space model of several records: subspace
-    (:func:`gripkit.sysid.subspace.n4sid_records`), then, unless ``refine=False``, PEM with one
-    initial state per record (:func:`gripkit.sysid.pem_ss.pem_records`); the refined model is
+    (:func:`gripkit.sysid.linear.subspace.n4sid_records`), then, unless ``refine=False``, PEM with one
+    initial state per record (:func:`gripkit.sysid.linear.pem_ss.pem_records`); the refined model is
     returned only when its free-run fit of all records (mean over the outputs) is not below the
     subspace model's, else the subspace model with an AccuracyWarning giving both."""
     from .pem_ss import pem_records
@@ -475,7 +475,7 @@ def identify_ss_records(records: list, d: MimoData, u0, y0, options: dict):
 
 def identify_tf_records(records: list, d: MimoData, u0, y0, poles: int, zeros: int):
     """The continuous-time transfer function of several records
-    (:func:`gripkit.sysid.tfest.tfest_records`) around the operating point (u0, y0)."""
+    (:func:`gripkit.sysid.linear.tfest.tfest_records`) around the operating point (u0, y0)."""
     from .tfest import tfest_records
 
     return tfest_records(records, poles, zeros, dt=d.dt, u_offset=tuple(map(float, u0)),

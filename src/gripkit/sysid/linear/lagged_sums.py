@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .regression import scaled_condition
+from ..regression import scaled_condition
 
 __all__ = ["BLOCK", "GRAM_COND_LIMIT", "arx_gram", "arx_residuals", "gram_triangle"]
 
@@ -177,7 +177,7 @@ def arx_residuals(u: np.ndarray, y: np.ndarray, theta: np.ndarray, na: int, nb: 
 #: Largest column-scaled condition number κ of Φ for which the normal equations are used: their
 #: rounding error in θ is about κ²·δ with δ ≤ BLOCK·u the relative error of the compensated Gram
 #: entries; at this κ it is 1e-8, below the statistical error of any noisy record (beyond it,
-#: :func:`gripkit.sysid.arx` factors the regressor by QR instead).
+#: :func:`gripkit.sysid.linear.arx` factors the regressor by QR instead).
 GRAM_COND_LIMIT = float(np.sqrt(1e-8 / (BLOCK * 2.0**-53)))
 
 

@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import AccuracyWarning, emit_warning
-from .regression import qr_solve
+from ...errors import AccuracyWarning, emit_warning
+from ..regression import qr_solve
 
 __all__ = ["stabilize", "is_stable_poly", "PEMResult", "levenberg_marquardt", "covariance"]
 

@@ -25,8 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..errors import DataError, StabilityWarning, emit_warning
-from .checks import check_io
+from ...errors import DataError, StabilityWarning, emit_warning
+from ..checks import check_io
 
 __all__ = ["fit_percent", "records_fit", "loss_vn", "Comparison", "compare", "ResidualTests",
            "residual_tests", "Validation", "validate"]

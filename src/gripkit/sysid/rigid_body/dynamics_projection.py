@@ -3,7 +3,7 @@ its own covariance, and the χ² test built on that distance (:func:`gripkit.sys
 ``check_consistency`` and ``constrained``).
 
 **What is measured, and in which metric.** The data determine only the identified parameters
-θ = [φ_b, f]: the r base parameters φ_b = K φ (:class:`~gripkit.sysid.dynamics.BaseStructure`,
+θ = [φ_b, f]: the r base parameters φ_b = K φ (:class:`~gripkit.sysid.rigid_body.dynamics.BaseStructure`,
 rotor inertias included when identified) and the friction coefficients f. Their estimate θ̂ has
 the covariance C; the standard parameters φ (10 per link) do not have one, since the data say
 nothing about the directions of null(K), so a distance measured in φ is arbitrary. A

@@ -34,10 +34,10 @@ import numba
 import numpy as np
 import scipy.linalg as sla
 
-from ..errors import DataError, IdentificationError
-from ..lti import StateSpace, Uncertainty, affine_row, flush_tiny
+from ...errors import DataError, IdentificationError
+from ...lti import StateSpace, Uncertainty, affine_row, flush_tiny
 from .blocked_gram import add_rows, carried_states, carry, row_product, start_sums
-from .checks import io_records
+from ..checks import io_records
 from .linear_model import LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run
 from .validation import records_fit
 
@@ -114,7 +114,7 @@ def _sensitivity_gram(Abar, C, K, entries, n_x0, X, U, E, H, g):  # pragma: no c
     :data:`_GRAM_BLOCK` samples' rows of J are added to H and g by one BLAS product each.
     :func:`_predict_sensitivity` forms the same J for any tangents (the tests compare them).
     Returns the final S; its entries below 1e-280 are flushed to zero as it is carried
-    (:func:`~gripkit.sysid.blocked_gram.carry`: the x0 directions are free responses of Ā and
+    (:func:`~gripkit.sysid.linear.blocked_gram.carry`: the x0 directions are free responses of Ā and
     decay into the subnormal range otherwise; H and g are unchanged by it)."""
     n = Abar.shape[0]
     p = C.shape[0]
@@ -532,7 +532,7 @@ def pem_records(model: LinearModel, records, *, form: str = "innovation",
     (the model's operating point removed). A, B, C, D (and K in innovation form) are shared; every
     record has its own initial state, estimated with them (started from
     ``model.info['records'][i]['x0']`` where the model has them, as from
-    :func:`gripkit.sysid.subspace.n4sid_records`, else the starting model's least-squares x0 of
+    :func:`gripkit.sysid.linear.subspace.n4sid_records`, else the starting model's least-squares x0 of
     each record); the prediction errors of all records,
     each predictor started at its own first sample, are minimised together by Levenberg-Marquardt.
     The covariance of the identifiable directions is σ²(JᵀJ)⁻¹ with σ² over Σ N_i·p − d − R·n
@@ -543,7 +543,7 @@ def pem_records(model: LinearModel, records, *, form: str = "innovation",
     if not isinstance(model, LinearModel) or not isinstance(model.system, StateSpace) \
             or not model.system.is_discrete:
         raise DataError("model: expected a discrete state-space LinearModel (e.g. from "
-                        "gripkit.sysid.subspace.n4sid_records)")
+                        "gripkit.sysid.linear.subspace.n4sid_records)")
     data = [_pem_data(model, None, u, y) for u, y in io_records(records)]
     ss = model.system
     innovation = form == "innovation"

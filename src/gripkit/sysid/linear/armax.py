@@ -8,7 +8,7 @@ before the first predicted sample. Gradients (Ljung, §10.2)::
 
 Initialisation (Hannan–Rissanen): a high-order ARX model gives estimates ê(t) of the innovations;
 the linear regression of y(t) on −y(t−i), u(t−j), ê(t−k) gives A, B, C (C reflected into the
-unit circle if needed). Then Levenberg–Marquardt (:mod:`gripkit.sysid._pem`) minimises eq (29).
+unit circle if needed). Then Levenberg–Marquardt (:mod:`gripkit.sysid.linear._pem`) minimises eq (29).
 """
 
 from __future__ import annotations
@@ -18,12 +18,12 @@ import warnings
 import numpy as np
 
 from ._pem import covariance, is_stable_poly, levenberg_marquardt, stabilize
-from ._scaling import in_user_units, unit_scale
+from ..scaling import in_user_units, unit_scale
 from .arx import (_arx, arx, arx_records, check_record_lengths, checked_records, records_summary,
                   scaled_records)
-from .checks import check_dt, check_identifiable, check_order, checked_problem, require_samples
+from ..checks import check_dt, check_identifiable, check_order, checked_problem, require_samples
 from .polynomial import PolynomialModel, check_meta
-from .regression import qr_solve
+from ..regression import qr_solve
 from .validation import fit_percent, loss_vn
 
 __all__ = ["armax", "armax_records"]
@@ -72,7 +72,7 @@ def armax(u, y, na: int, nb: int, nc: int, nk: int = 1, *, dt: float | None = No
     """ARMAX model ``A y = B u + C e`` by prediction-error minimisation (MATLAB ``armax``
     orders ``[na nb nc nk]``).
 
-    Parameters as :func:`gripkit.sysid.arx`, plus ``nc`` (number of C coefficients after the
+    Parameters as :func:`gripkit.sysid.linear.arx`, plus ``nc`` (number of C coefficients after the
     leading 1), ``maxiter`` and ``tol`` of the Levenberg–Marquardt iteration. Returns a
     :class:`PolynomialModel` with ``structure='armax'``, ``C`` and ``C_std``. Warns
     :class:`~gripkit.errors.AccuracyWarning` if the iteration does not converge.

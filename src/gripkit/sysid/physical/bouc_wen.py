@@ -3,7 +3,7 @@ D(s), the first two steps of ``001_0b92a7da96e7aa46.txt`` §IV.
 
 1. **Static Bouc-Wen parameters** (§IV-C1, Fig. 9): d_p, λ, β, γ of y = d_p U − H, eq 3, from a
    quasi-static voltage sweep (the seed: 0.1 Hz, 100 V) by nonlinear least squares on the
-   simulation error (:mod:`gripkit.sysid.greybox` on :class:`~gripkit.models.hysteresis.BoucWen`),
+   simulation error (:mod:`gripkit.sysid.physical.greybox` on :class:`~gripkit.models.hysteresis.BoucWen`),
    validated on internal loops by the maximal error relative to the loop's peak-to-peak output
    (Fig. 9b: < 5 % external, < 10 % internal). :func:`identify_bouc_wen`.
 2. **D(s) = 1/(a s² + b s + 1)** (§IV-C2, Fig. 10) from a voltage step, the static part held at
@@ -21,13 +21,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..arguments import entry_point
-from ..errors import AccuracyWarning, DataError, emit_warning
-from ..models.hysteresis import BoucWen, bouc_wen_parameters, bouc_wen_response
-from ..models.piezo import PiezoActuator, actuator_parameters
-from ..params import ParameterSet
-from ..signals.trajectory import Trajectory
-from .checks import check_dimension
+from ...arguments import entry_point
+from ...errors import AccuracyWarning, DataError, emit_warning
+from ...models.hysteresis import BoucWen, bouc_wen_parameters, bouc_wen_response
+from ...models.piezo import PiezoActuator, actuator_parameters
+from ...params import ParameterSet
+from ...signals.trajectory import Trajectory
+from ..checks import check_dimension
 from .greybox import GreyboxResult, fit
 
 __all__ = ["BoucWenResult", "DynamicsResult", "identify_bouc_wen", "loop_error", "identify_actuator_dynamics",

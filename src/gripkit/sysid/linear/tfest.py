@@ -2,7 +2,7 @@
 
     G(s) = (b_0 s^nz + … + b_nz) / (s^np + a_1 s^{np−1} + … + a_np),   θ = [a_1 … a_np, b_0 … b_nz].
 
-* From an FRF (:class:`~gripkit.sysid.frf.FRF` with σ per line): Sanathanan-Koerner iterations
+* From an FRF (:class:`~gripkit.sysid.linear.frf.FRF` with σ per line): Sanathanan-Koerner iterations
   (linear least squares of ``(A(jω)Ĥ − B(jω))/(A_prev(jω) σ)``, frequency scaled to 1 for
   conditioning) give the start; then weighted nonlinear least squares of
   ``(Ĥ_k − G(jω_k))/σ_k`` with the exact Jacobian ``∂G/∂b_i = s^{nz−i}/A``,
@@ -27,9 +27,9 @@ import numpy as np
 from scipy import optimize
 from scipy import signal as _signal
 
-from ..errors import DataError, IdentificationError, ModelError
-from ..lti import StateSpace, TransferFunction
-from .checks import check_dt, check_order, check_persistent_excitation, io_records
+from ...errors import DataError, IdentificationError, ModelError
+from ...lti import StateSpace, TransferFunction
+from ..checks import check_dt, check_order, check_persistent_excitation, io_records
 from .frf import FRF, frf
 from .linear_model import LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run
 from .validation import records_fit

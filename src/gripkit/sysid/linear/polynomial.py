@@ -25,11 +25,11 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..arguments import check_keywords, keyword_names
-from ..errors import DataError, ModelError
-from ..lti import TransferFunction
-from ..params import Parameter, ParameterSet
-from ..units import ratio_unit
+from ...arguments import check_keywords, keyword_names
+from ...errors import DataError, ModelError
+from ...lti import TransferFunction
+from ...params import Parameter, ParameterSet
+from ...units import ratio_unit
 from .linear_model import save_model
 from .validation import validate
 
@@ -74,8 +74,8 @@ def _coeffs(x, name: str, monic: bool) -> np.ndarray:
 class PolynomialModel:
     """A discrete-time SISO polynomial model with its uncertainty and fit diagnostics.
 
-    Build one with :func:`gripkit.sysid.arx`, :func:`~gripkit.sysid.armax`,
-    :func:`~gripkit.sysid.oe`, or from known coefficients with :meth:`from_coefficients`.
+    Build one with :func:`gripkit.sysid.linear.arx`, :func:`~gripkit.sysid.linear.armax`,
+    :func:`~gripkit.sysid.linear.oe`, or from known coefficients with :meth:`from_coefficients`.
 
     Attributes
     ----------
@@ -103,7 +103,7 @@ class PolynomialModel:
     n_samples
         Samples in the estimation record (N); ``n_used`` = M = N − start prediction errors.
     residuals
-        One-step prediction errors e(t), t = start … N−1 (read-only). :func:`gripkit.sysid.arx`
+        One-step prediction errors e(t), t = start … N−1 (read-only). :func:`gripkit.sysid.linear.arx`
         computes them on first access from ``estimation_data``.
     estimation_data
         ``(u, y)``, references to the record the model was fitted on (no copy), or None: the
@@ -504,7 +504,7 @@ class PolynomialModel:
         return self.lti.to_control()
 
     def save(self, path) -> None:
-        """Write the model file (JSON, :func:`gripkit.sysid.linear_model.save_model`); reload it with
+        """Write the model file (JSON, :func:`gripkit.sysid.linear.linear_model.save_model`); reload it with
         :func:`gripkit.sysid.load_model` (as a :class:`gripkit.sysid.LinearModel`)."""
         save_model(self, path)
 
@@ -560,7 +560,7 @@ class PolynomialModel:
         return f"PolynomialModel({self.label}, A={self.A.tolist()}, B={self.B.tolist()}, dt={self.dt:g})"
 
 
-#: the ``**meta`` keywords of :func:`~gripkit.sysid.arx`, :func:`~gripkit.sysid.armax` and :func:`~gripkit.sysid.oe`
+#: the ``**meta`` keywords of :func:`~gripkit.sysid.linear.arx`, :func:`~gripkit.sysid.linear.armax` and :func:`~gripkit.sysid.linear.oe`
 META_KEYS = ("input_name", "output_name", "input_unit", "output_unit", "u_offset", "y_offset")
 
 
