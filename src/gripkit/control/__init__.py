@@ -15,6 +15,9 @@ from .rst import as_plant as as_plant
 from .rst import RSTController as RSTController
 from .rst import design_rst as design_rst
 from .rst import simulate_loop as simulate_loop
+from .state_feedback import StateFeedback as StateFeedback
+from .state_feedback import lqr_controller as lqr_controller
 
 __all__ = ["as_plant", "design_rst", "DiscretePlant", "LoopResult", "LQR", "lqr", "PID",
-           "RSTController", "simulate_loop"]
+           "RSTController", "simulate_loop",
+           "StateFeedback", "lqr_controller"]
