@@ -15,9 +15,16 @@ from .rst import as_plant as as_plant
 from .rst import RSTController as RSTController
 from .rst import design_rst as design_rst
 from .rst import simulate_loop as simulate_loop
+from .robustness import Robustness as Robustness
+from .robustness import loop_margins as loop_margins
+from .robustness import robustness as robustness
 from .state_feedback import StateFeedback as StateFeedback
 from .state_feedback import lqr_controller as lqr_controller
+from .tuning import LowOrderModel as LowOrderModel
+from .tuning import reduce_model as reduce_model
+from .tuning import tune_pid as tune_pid
 
 __all__ = ["as_plant", "design_rst", "DiscretePlant", "LoopResult", "LQR", "lqr", "PID",
            "RSTController", "simulate_loop",
-           "StateFeedback", "lqr_controller"]
+           "StateFeedback", "lqr_controller", "LowOrderModel", "reduce_model", "tune_pid",
+           "Robustness", "loop_margins", "robustness"]
