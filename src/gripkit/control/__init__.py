@@ -6,6 +6,8 @@ hybrid force/position control, the DLR/HIT impedance control) live in :mod:`grip
 A flat list of explicit re-exports.
 """
 
+from .controller_file import load_controller as load_controller
+from .controller_file import save_controller as save_controller
 from .linear_quadratic import LQR as LQR
 from .linear_quadratic import lqr as lqr
 from .pid import PID as PID
@@ -27,4 +29,4 @@ from .tuning import tune_pid as tune_pid
 __all__ = ["as_plant", "design_rst", "DiscretePlant", "LoopResult", "LQR", "lqr", "PID",
            "RSTController", "simulate_loop",
            "StateFeedback", "lqr_controller", "LowOrderModel", "reduce_model", "tune_pid",
-           "Robustness", "loop_margins", "robustness"]
+           "Robustness", "loop_margins", "robustness", "load_controller", "save_controller"]

@@ -210,6 +210,12 @@ class PID:
         pid_run(self._p, self.state, r, y, f, u)
         return u
 
+    def save(self, path):
+        """Write the controller file (:mod:`gripkit.control.controller_file`, kind ``pid``)."""
+        from .controller_file import save_controller
+
+        return save_controller(self, path)
+
     def transfer_function(self) -> tuple[np.ndarray, np.ndarray]:
         """(num, den) of U(z)/E(z) in powers of z (linear region, b = c = 1)."""
         kp, ki, kd, tf, dt = self.kp, self.ki, self.kd, self.tf, self.dt

@@ -50,8 +50,7 @@ def controller_transfer_function(controller) -> tuple[np.ndarray, np.ndarray, fl
         n = max(controller.R.size, controller.S.size)
         num = np.pad(np.asarray(controller.S, float), (0, n - controller.S.size))
         den = np.pad(np.asarray(controller.R, float), (0, n - controller.R.size))
-        dt = controller.plant.dt if controller.plant is not None else None
-        return num, den, dt
+        return num, den, controller.dt
     if isinstance(controller, tuple) and len(controller) in (2, 3):
         num = np.atleast_1d(np.asarray(controller[0], dtype=float))
         den = np.atleast_1d(np.asarray(controller[1], dtype=float))

@@ -188,11 +188,12 @@ class RSTController:
     uses the observer polynomial A_o); ``anti_windup=False`` gives the plain, clamped RST law.
     ``step(r, y)`` returns u for the current sample. Limits ``u_min``/``u_max`` are in the plant's
     input unit (deviation from the operating point). ``reset(u0, y0)`` initialises a bumpless start
-    at the steady state (u0, y0 = r0).
+    at the steady state (u0, y0 = r0). ``dt``: the sample time (default the plant's).
     """
 
     def __init__(self, R, S, T, *, A_aw=None, u_min: float = -math.inf, u_max: float = math.inf,
-                 plant=None, design: dict | None = None, anti_windup: bool = True):
+                 plant=None, design: dict | None = None, anti_windup: bool = True,
+                 dt: float | None = None):
         self.R = _poly(R, "R")
         self.S = _poly(S, "S")
         self.T = _poly(T, "T")
@@ -216,8 +217,17 @@ class RSTController:
         self.u_min = float(u_min)
         self.u_max = float(u_max)
         self.plant = plant
+        #: sample time (s): ``dt``, else the plant's (None without either)
+        self.dt = float(dt) if dt is not None else (
+            float(plant.dt) if getattr(plant, "dt", None) is not None else None)
         self.design = dict(design or {})
         self.reset()
+
+    def save(self, path):
+        """Write the controller file (:mod:`gripkit.control.controller_file`, kind ``rst``)."""
+        from .controller_file import save_controller
+
+        return save_controller(self, path)
 
     def reset(self, u0: float = 0.0, y0: float = 0.0):
         """Bumpless start: histories at the steady state u = v = u0, r = y = y0."""

@@ -125,6 +125,12 @@ class StateFeedback:
     def reset(self) -> None:
         """No memory: nothing to forget (present for the common controller interface)."""
 
+    def save(self, path):
+        """Write the controller file (:mod:`gripkit.control.controller_file`, kind ``lqr``)."""
+        from .controller_file import save_controller
+
+        return save_controller(self, path)
+
     def _vec(self, v, size: int, name: str) -> np.ndarray:
         a = np.ascontiguousarray(np.asarray(v, dtype=np.float64).reshape(-1))
         if a.shape != (size,):
