@@ -20,9 +20,9 @@ app.add_typer(export_app, name="export")
 
 
 @export_app.command("c")
-def export_c(model: Path = typer.Argument(None, help="Model file written by identify --out (.json), "
-                                                "or a controller file with --kind.",
-                                          show_default=False),
+def export_c(model: Path = typer.Argument(None, show_default=False,
+                                          help="Model file written by identify --out (.json), "
+                                               "or a controller file with --kind."),
              out: Path = typer.Option(..., "--out", help="Folder to write NAME.h and NAME.c into.",
                                       show_default=False),
              name: str = typer.Option(None, "--name",

@@ -54,7 +54,8 @@ def controller_transfer_function(controller) -> tuple[np.ndarray, np.ndarray, fl
     if isinstance(controller, tuple) and len(controller) in (2, 3):
         num = np.atleast_1d(np.asarray(controller[0], dtype=float))
         den = np.atleast_1d(np.asarray(controller[1], dtype=float))
-        if num.ndim != 1 or den.ndim != 1 or not (np.isfinite(num).all() and np.isfinite(den).all()):
+        if num.ndim != 1 or den.ndim != 1 or not (np.isfinite(num).all()
+                                                  and np.isfinite(den).all()):
             raise ArgumentError("controller: expected (num, den) of finite coefficients in powers "
                                 "of z")
         return num, den, (float(controller[2]) if len(controller) == 3 else None)

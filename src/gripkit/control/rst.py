@@ -42,8 +42,8 @@ import numpy as np
 from ..errors import DataError, ModelError, SimulationError
 from ..lti import StateSpace, TransferFunction, as_system
 
-__all__ = ["DiscretePlant", "as_plant", "RSTController", "design_rst", "LoopResult", "simulate_loop",
-           "rst_step", "rst_run"]
+__all__ = ["DiscretePlant", "as_plant", "RSTController", "design_rst", "LoopResult",
+           "simulate_loop", "rst_step", "rst_run"]
 
 
 def _poly(x, name: str) -> np.ndarray:

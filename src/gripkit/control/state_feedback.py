@@ -50,7 +50,8 @@ def state_feedback_step(K, Nr, x, r, u_min, u_max, u):  # pragma: no cover - com
 
 @numba.njit(cache=True)
 def state_feedback_run(K, Nr, x, r, u_min, u_max, u):  # pragma: no cover - compiled
-    """:func:`state_feedback_step` for each row of ``x`` (N, n) and ``r`` (N, p) into ``u`` (N, m)."""
+    """:func:`state_feedback_step` for each row of ``x`` (N, n) and ``r`` (N, p) into ``u``
+    (N, m)."""
     for k in range(x.shape[0]):
         state_feedback_step(K, Nr, x[k], r[k], u_min, u_max, u[k])
 
@@ -104,13 +105,14 @@ class StateFeedback:
             raise ConfigError(f"StateFeedback dt: expected a number of seconds, found {dt!r}") \
                 from None
         if not (math.isfinite(dt) and dt > 0):
-            raise ConfigError(f"StateFeedback dt: expected a positive sample interval, found {dt!r}")
+            raise ConfigError(f"StateFeedback dt: expected a positive sample interval, found "
+                              f"{dt!r}")
         self.dt = dt
         self.u_min = _limits(u_min, m, "u_min", -math.inf)
         self.u_max = _limits(u_max, m, "u_max", math.inf)
         if not np.all(self.u_min < self.u_max):
-            raise ConfigError(f"StateFeedback limits: expected u_min < u_max for every input, found "
-                              f"{self.u_min.tolist()} and {self.u_max.tolist()}")
+            raise ConfigError(f"StateFeedback limits: expected u_min < u_max for every input, "
+                              f"found {self.u_min.tolist()} and {self.u_max.tolist()}")
         self._u = np.zeros(m)
         self._r0 = np.zeros(self.Nr.shape[1])
 
@@ -132,6 +134,9 @@ class StateFeedback:
         return save_controller(self, path)
 
     def _vec(self, v, size: int, name: str) -> np.ndarray:
+        if type(v) is np.ndarray and v.dtype == np.float64 and v.shape == (size,) \
+                and v.flags.c_contiguous:
+            return v  # the loop's own buffer: no conversion
         a = np.ascontiguousarray(np.asarray(v, dtype=np.float64).reshape(-1))
         if a.shape != (size,):
             raise ConfigError(f"StateFeedback.step {name}: expected {size} values, found {a.size}")

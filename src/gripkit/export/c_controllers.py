@@ -93,7 +93,8 @@ def _pid(pid, name: str) -> dict:
                "    double started;     /* 0 until the first step */\n"
                f"}} {name}_state;\n\n"
                f"/* no past, integral 0 (PID.reset()) */\nvoid {name}_init({name}_state *s);\n"
-               "/* one sample: the limited output u for setpoint r, measurement y, feedforward ff */\n"
+               "/* one sample: the limited output u for setpoint r, measurement y,\n"
+               " * feedforward ff */\n"
                f"double {name}_step({name}_state *s, double r, double y, double ff);\n"
                "/* bumpless transfer: the next step with (r, y, ff) returns u */\n"
                f"void {name}_transfer({name}_state *s, double u, double r, double y, double ff);\n")

@@ -61,7 +61,8 @@ def rls_c_sources(est, name: str = "rls") -> dict:
          "    double count, n_updates, trace, V, w1, w2, peak_u, peak_y;\n"
          "    int status;              /* why the last update returned NaN (0: it did not) */\n"
          f"}} {name}_state;\n\n"
-         f"/* theta0, P0 = p0 I, empty buffers (RLS.reset()) */\nvoid {name}_init({name}_state *s);\n"
+         "/* theta0, P0 = p0 I, empty buffers (RLS.reset()) */\n"
+         f"void {name}_init({name}_state *s);\n"
          "/* one sample: the a-priori prediction error (0 while the regressor fills), or NaN\n"
          " * with the estimator unchanged (status 1: not finite, 2: diverged, 3: overflow,\n"
          " * 4: corrupt sample) */\n"
@@ -79,7 +80,8 @@ def rls_c_sources(est, name: str = "rls") -> dict:
          f"double {name}_update({name}_state *s, double u, double y)\n{{\n",
          "    double phi[NP], q[NP], bth[NP], bP[NP * NP];\n",
          "    double e = 0.0, au, ay;\n    int i, j;\n",
-         "    if (!isfinite(u) || !isfinite(y)) {\n        s->status = 1;\n        return NAN;\n    }\n",
+         "    if (!isfinite(u) || !isfinite(y)) {\n",
+         "        s->status = 1;\n        return NAN;\n    }\n",
          "    au = fabs(u);\n    ay = fabs(y);\n",
          f"    if ((au > s->peak_u && s->peak_u > 0.0 && au > {_d(ABSURD_JUMP)} * s->peak_u) ||\n"
          f"        (ay > s->peak_y && s->peak_y > 0.0 && ay > {_d(ABSURD_JUMP)} * s->peak_y)) {{\n"
@@ -102,7 +104,8 @@ def rls_c_sources(est, name: str = "rls") -> dict:
         L += ["        if (r <= 1e-12 * s->trace) {\n            inv = 1.0 / (1.0 + r);\n"
               "            coef = -inv;\n            scale = 1.0;\n        } else {\n"
               "            inv = 1.0 / (lam + r);\n"
-              "            coef = (1.0 - lam - r) / r * inv;\n            scale = 1.0;\n        }\n"]
+              "            coef = (1.0 - lam - r) / r * inv;\n"
+              "            scale = 1.0;\n        }\n"]
     else:
         L += ["        inv = 1.0 / (lam + r);\n        coef = -inv;\n        scale = 1.0 / lam;\n"]
     L += ["        g = e * inv;\n",
@@ -121,7 +124,8 @@ def rls_c_sources(est, name: str = "rls") -> dict:
     L += ["        ok = isfinite(tr) && isfinite(e);\n",
           "        for (i = 0; i < NP; ++i) ok = ok && isfinite(s->theta[i]);\n",
           "        if (!(ok && isfinite(r))) {\n",
-          "            memcpy(s->theta, bth, sizeof bth);\n            memcpy(s->P, bP, sizeof bP);\n",
+          "            memcpy(s->theta, bth, sizeof bth);\n",
+          "            memcpy(s->P, bP, sizeof bP);\n",
           "            s->status = isfinite(r) ? 2 : 3;\n            return NAN;\n        }\n",
           "        s->trace = tr;\n",
           "        s->V = lam * (s->V + e * e / (lam + r));\n",
@@ -131,7 +135,8 @@ def rls_c_sources(est, name: str = "rls") -> dict:
           f"    for (i = {nu - 1}; i > 0; --i) s->ub[i] = s->ub[i - 1];\n",
           "    s->ub[0] = u;\n"]
     if na > 0:
-        L += [f"    for (i = {na - 1}; i > 0; --i) s->yb[i] = s->yb[i - 1];\n", "    s->yb[0] = y;\n"]
+        L += [f"    for (i = {na - 1}; i > 0; --i) s->yb[i] = s->yb[i - 1];\n",
+              "    s->yb[0] = y;\n"]
     L += ["    s->count += 1.0;\n    s->status = 0;\n    return e;\n}\n"]
     return {f"{name}.h": h, f"{name}.c": "".join(L)}
 
