@@ -99,3 +99,31 @@ def test_a_model_without_covariance_gives_the_nominal_figures_only():
 def test_loop_without_crossovers_has_infinite_margins():
     res = loop_margins([0.1], [1.0, -0.5], 0.01)
     assert res["gain_margin"] == math.inf and res["phase_margin_deg"] == math.inf
+
+
+def test_the_robustness_section_in_the_model_report(tmp_path):
+    """The model report of a first-order model with a parameter covariance, with the section
+    of a PI loop: the table's nominal gain margin is the result's, P(stable) is printed, and a
+    controller label from outside is escaped, never markup."""
+    from html import unescape
+
+    from gripkit.signals import Trajectory
+    from gripkit.sysid.model_report import write_model_report
+
+    ss = StateSpace([[0.9]], [[0.1]], [[1.0]], dt=0.01, inputs=["u"], outputs=["y"])
+    ss = ss.with_covariance([[1e-4]], ["A[0,0]"])
+    m = LinearModel(ss, "n4sid")
+    rng = np.random.default_rng(0)
+    u = rng.standard_normal(300)
+    y = m.simulate(u[:, None])[:, 0] + 1e-3 * rng.standard_normal(300)
+    data = Trajectory(np.arange(300) * 0.01, {"u": u, "y": y})
+    pid = tune_pid(m, tau_c=0.05)
+    r = robustness(m, pid, n=200, seed=3)
+    assert r.n == 200 and 0.0 <= r.probability_stable <= 1.0
+    index = write_model_report(m, data, tmp_path / "rep",
+                               robustness=(r, "PI <script>alert(1)</script>"))
+    html = index.read_text()
+    assert "Robustness of the loop" in html and "<script>alert" not in html
+    assert "PI <script>alert(1)</script> in the loop" in unescape(html)
+    assert f"Probability that the loop is stable: {r.probability_stable:.4f}" in html
+    assert f"{r.nominal['gain_margin_db']:.4g}" in html

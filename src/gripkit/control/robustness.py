@@ -227,3 +227,56 @@ def robustness(model, controller, n: int = 1000, seed: int | None = None, *,
     return Robustness(nominal=nominal, poles=poles, stable=stable, gain_margin_db=gm,
                       phase_margin_deg=pm, pole_radius=rad, stable_samples=st, n=int(n),
                       seed=seed, dt=float(g.dt), notes=tuple(notes))
+
+
+def _histograms(result: Robustness):
+    from ..report.plots import pyplot
+
+    plt = pyplot()
+    fig, axes = plt.subplots(1, 2, figsize=(8, 3.0))
+    st = result.stable_samples
+    for ax, key, label in ((axes[0], "gain_margin_db", "gain margin (dB)"),
+                           (axes[1], "phase_margin_deg", "phase margin (deg)")):
+        v = getattr(result, key)[st]
+        v = v[np.isfinite(v)]
+        if v.size:
+            ax.hist(v, bins=min(40, max(5, v.size // 10)), color="C0", alpha=0.8)
+        nom = result.nominal[key]
+        if math.isfinite(nom):
+            ax.axvline(nom, color="C3", lw=1.5, label="nominal")
+            ax.legend(fontsize=8)
+        ax.set_xlabel(label)
+        ax.set_ylabel("draws")
+        ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return fig
+
+
+def robustness_section(report, result: Robustness, *, controller: str = "controller"):
+    """Add the section "Robustness of the loop" to a :class:`gripkit.report.html.Report`: the
+    nominal margins and poles, the Monte Carlo statistics and P(stable), and histograms of the
+    margins (all text escaped by the report). Returns the section."""
+    intro = (f"{controller} in the loop with the identified model, broken at the plant input. "
+             "Gain margin: the phase crossover closest to 1 in log scale; phase margin: the "
+             "smallest at a gain crossover (python-control's selection).")
+    if result.n:
+        intro += (f" {result.n} plants drawn from the parameter covariance (seed {result.seed}); "
+                  "margin statistics over the stable draws.")
+    else:
+        intro += " The model carries no parameter covariance: nominal figures only."
+    sec = report.section("Robustness of the loop", intro)
+    rows = []
+    names = {"gain_margin_db": "gain margin (dB)", "phase_margin_deg": "phase margin (deg)",
+             "pole_radius": "largest closed-loop |pole|"}
+    for key, r in result.statistics().items():
+        rows.append([names[key], r["nominal"], r["mean"], r["std"], r["p05"], r["p50"], r["p95"]])
+    sec.table(["quantity", "nominal", "mean", "σ", "5 %", "median", "95 %"], rows)
+    if result.n:
+        sec.text(f"Probability that the loop is stable: {result.probability_stable:.4f} "
+                 f"± {result.probability_stable_se:.4f} (binomial standard error, {result.n} "
+                 f"draws); the nominal loop is {'stable' if result.stable else 'UNSTABLE'}.")
+        sec.figure(_histograms(result), "distribution of the margins over the stable draws",
+                   name="robustness")
+    else:
+        sec.text(f"The nominal loop is {'stable' if result.stable else 'UNSTABLE'}.")
+    return sec
