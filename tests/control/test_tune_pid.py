@@ -90,3 +90,34 @@ def test_models_the_rules_do_not_cover_are_refused():
         tune_pid(LowOrderModel(1.0, 1.0, 0.1, dt=0.01), tau_c=-1.0)
     with pytest.raises(ArgumentError, match="method: expected 'simc'"):
         tune_pid(_foptd(), method="ziegler")
+
+
+def test_half_rule_with_zeros_is_skogestads_example():
+    """Skogestad 2003, §3's example g₀ = (−0.3s + 1)(0.08s + 1)/((2s + 1)(s + 1)(0.4s + 1)
+    (0.2s + 1)(0.05s + 1)³): the inverse-response zero adds 0.3 to θ, the zero 0.08 cancels
+    against 0.2 by rule R3 (leaving a lag 0.12); first order τ₁ = 2.5, θ = 1.47; second order
+    τ₁ = 2, τ₂ = 1.2, θ = 0.77 (the paper's figures), here sampled at h = 0.05 s, + h/2."""
+    num = np.polymul([-0.3, 1.0], [0.08, 1.0])
+    den = np.polymul(np.polymul([2.0, 1.0], [1.0, 1.0]), np.polymul([0.4, 1.0], [0.2, 1.0]))
+    den = np.polymul(den, np.polymul(np.polymul([0.05, 1.0], [0.05, 1.0]), [0.05, 1.0]))
+    g = TransferFunction(num, den).to_ss(minimal=False).c2d(0.05)
+    m1, m2 = reduce_model(g, 1), reduce_model(g, 2)
+    np.testing.assert_allclose([m1.k, m1.tau1, m1.theta], [1.0, 2.5, 1.47 + 0.025], rtol=1e-6)
+    np.testing.assert_allclose([m2.tau1, m2.tau2, m2.theta], [2.0, 1.2, 0.77 + 0.025], rtol=1e-6)
+    assert "zero T0=0.08 s cancelled (rule R3)" in m1.notes
+
+
+def test_an_integrating_model_keeps_its_integrator():
+    """0.5 q⁻²/((1 − q⁻¹)(1 − 0.8 q⁻¹)) at h = 0.01 s: k′ = B(1)/(A′(1) h) = 0.5/(0.2·0.01) =
+    250 /s, the lag τ₂ = −h/ln 0.8, θ = h + h/2; SIMC: K_c = 1/(k′(τ_c + θ)), τ_I = 4(τ_c + θ)."""
+    h = 0.01
+    g = TransferFunction.from_polynomials(np.polymul([1.0, -1.0], [1.0, -0.8]), [0.0, 0.0, 0.5],
+                                          dt=h)
+    m = reduce_model(g, 2)
+    assert m.integrating and m.k == pytest.approx(250.0, rel=1e-9)
+    assert m.tau2 == pytest.approx(-h / math.log(0.8), rel=1e-9)
+    assert m.theta == pytest.approx(1.5 * h, rel=1e-9)
+    pid = tune_pid(g)
+    Kc, ti = 1 / (250.0 * 2 * m.theta), 8 * m.theta
+    assert pid.ki == pytest.approx(Kc / ti, rel=1e-9) and pid.kd == pytest.approx(Kc * m.tau2,
+                                                                                 rel=1e-9)

@@ -36,7 +36,8 @@ time (:meth:`gripkit.lti.LinearSystem.d2c`, exact for a ZOH-sampled system), lea
   on digital implementation).
 
 Oscillatory (complex) or unstable poles, and complex zeros, have no place in these rules: a
-ModelError says so, and :class:`LowOrderModel` can be given directly instead.
+ModelError says so, and :class:`LowOrderModel` can be given directly instead (roots within
+:data:`REAL_TOL` of the real axis count as real: a repeated real root splits so by rounding).
 """
 
 from __future__ import annotations
@@ -48,6 +49,11 @@ from ..errors import ArgumentError, ModelError
 from .pid import PID
 
 __all__ = ["LowOrderModel", "reduce_model", "simc_settings", "tune_pid"]
+
+#: a pole or zero this close to the real axis (relative to max(1, |z|)) counts as real: rounding
+#: splits a repeated real root of multiplicity m by about ε^(1/m) (a triple pole of a sampled
+#: model by ~1e-4), and the rules take the real part
+REAL_TOL = 1e-3
 
 
 class LowOrderModel:
@@ -116,7 +122,7 @@ def reduce_model(model, order: int = 1) -> LowOrderModel:
         raise ModelError("tune_pid: the model has direct feedthrough (nk = 0); a sampled plant "
                          "has at least one sample of delay", hint="check the model's nk")
     zp = np.roots(A) if A.size > 1 else np.zeros(0)
-    if np.any(np.abs(zp.imag) > 1e-9 * np.maximum(1.0, np.abs(zp))):
+    if np.any(np.abs(zp.imag) > REAL_TOL * np.maximum(1.0, np.abs(zp))):
         raise ModelError(f"tune_pid: the model has complex poles {np.round(zp, 6).tolist()} "
                          f"(an oscillatory mode), which the half rule does not reduce",
                          hint="give a LowOrderModel(k, tau1, theta, tau2, dt=...) fitted by hand")
@@ -136,10 +142,10 @@ def reduce_model(model, order: int = 1) -> LowOrderModel:
     else:
         h_int = None
     gd = type(g).from_polynomials(A, np.concatenate([[0.0], B[nk:]]), dt=h)
-    gc = gd.d2c()
+    gc = gd.to_ss(minimal=False).d2c()  # the state-space route keeps high orders accurate
     taus = sorted((-1.0 / p.real for p in gc.poles()), reverse=True)
     zc = gc.zeros()
-    if np.any(np.abs(zc.imag) > 1e-9 * np.maximum(1.0, np.abs(zc))):
+    if np.any(np.abs(zc.imag) > REAL_TOL * np.maximum(1.0, np.abs(zc))):
         raise ModelError(f"tune_pid: the model has complex zeros {np.round(zc, 6).tolist()}, "
                          f"which the half rule does not reduce",
                          hint="identify a model with fewer B coefficients, or give a "
