@@ -46,7 +46,8 @@ def export_c(model: Path = typer.Argument(None, show_default=False,
              windup: str = typer.Option("trace", "--windup",
                                         help="RLS: trace, directional or none."),
              json_out: bool = JsonOpt):
-    """Write the model's step as C99 (NAME_init, NAME_step; SI in and out, offsets applied)."""
+    """Write the model's step as C99 (NAME_init, NAME_step; SI in and out, offsets applied);
+    with --kind a controller's step, with --rls the RLS update (docs/deploy.md)."""
     from ..errors import ArgumentError
 
     if rls or kind is not None:

@@ -1,5 +1,9 @@
 """Control: a discrete SISO plant and RST pole placement with integral action and anti-windup,
-and a discrete PID with setpoint weighting, a filtered derivative and bumpless transfer.
+a discrete PID with setpoint weighting, a filtered derivative and bumpless transfer, LQR and its
+state feedback (:class:`StateFeedback`), each with an allocation-free numba ``.step``; PID tuning
+on an identified model by the SIMC rules (:func:`tune_pid`); margins and closed-loop poles with
+their Monte Carlo distribution over the model's covariance (:func:`robustness`); the controller
+file (:func:`save_controller`, :func:`load_controller`) that ``gripkit export c --kind`` reads.
 
 The reference systems' controllers (the AMADEUS force loop, the TSFM two-finger grasp, the FT-G100
 hybrid force/position control, the DLR/HIT impedance control) live in :mod:`gripkit.systems`.
