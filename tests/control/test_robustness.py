@@ -127,3 +127,28 @@ def test_the_robustness_section_in_the_model_report(tmp_path):
     assert "PI <script>alert(1)</script> in the loop" in unescape(html)
     assert f"Probability that the loop is stable: {r.probability_stable:.4f}" in html
     assert f"{r.nominal['gain_margin_db']:.4g}" in html
+
+
+def test_lqr_state_feedback_margins():
+    """Single-input LQR on a 2-state plant, loop broken at the input, L(z) = K (zI − A)⁻¹ B:
+    the margins equal python-control's on ss(A, B, K, 0), the closed-loop poles are those of
+    A − B K, and the discrete return-difference inequality |1 + L| ≥ ρ = √(R/(R + BᵀSB))
+    (Shaked 1986) guarantees a phase margin of at least 2 asin(ρ/2)."""
+    from gripkit.control import lqr, lqr_controller
+
+    A = np.array([[1.0, 0.01], [-0.5, 0.97]])
+    B = np.array([[0.0], [0.01]])
+    g = StateSpace(A, B, [[1.0, 0.0]], [[0.0]], dt=0.01)
+    g = g.with_covariance(np.diag([1e-4, 1e-4]), ["A[1,0]", "A[1,1]"])
+    Q, R = np.diag([10.0, 1.0]), np.array([[0.01]])
+    sf = lqr_controller(g, Q, R)
+    K, S, E = lqr(g, Q, R)
+    res = robustness(g, sf, n=200, seed=4)
+    np.testing.assert_allclose(np.sort_complex(res.poles), np.sort_complex(E), atol=1e-12)
+    L = control.ss(A, B, K, 0, 0.01)
+    gm, pm = control.stability_margins(L, method="poly")[:2]
+    assert res.nominal["phase_margin_deg"] == pytest.approx(pm, rel=1e-6)
+    assert res.nominal["gain_margin"] == gm == math.inf  # L never crosses the negative real axis
+    rho = math.sqrt(R[0, 0] / (R[0, 0] + float((B.T @ S @ B)[0, 0])))
+    assert res.nominal["phase_margin_deg"] >= math.degrees(2 * math.asin(rho / 2))
+    assert res.probability_stable == 1.0 and np.std(res.phase_margin_deg) > 0

@@ -5,7 +5,8 @@ The loop is broken at the plant input: ``L(z) = C(z) G(z)`` with G the discrete 
 (:func:`gripkit.control.as_plant`) and C the controller's feedback path — a
 :class:`~gripkit.control.PID`'s ``U/E`` (:meth:`PID.transfer_function`, linear region), an
 :class:`~gripkit.control.RSTController`'s ``S/R`` — or a discrete ``(num, den)`` pair in powers of
-z. For L:
+z; for a single-input :class:`~gripkit.control.StateFeedback` ``L(z) = K (zI − A)⁻¹ B`` on the
+model's state space. For L:
 
 * **gain margin** (:func:`loop_margins`): 1/|L| at the phase crossovers (Im L = 0, Re L < 0) on
   0 < ω < π/dt, the one closest to 1 in log scale; **phase margin**: arg L + 180° (wrapped to
@@ -59,9 +60,9 @@ def controller_transfer_function(controller) -> tuple[np.ndarray, np.ndarray, fl
             raise ArgumentError("controller: expected (num, den) of finite coefficients in powers "
                                 "of z")
         return num, den, (float(controller[2]) if len(controller) == 3 else None)
-    raise ArgumentError(f"controller: expected a gripkit.control.PID, RSTController or a (num, den"
-                        f"[, dt]) pair in powers of z, found {type(controller).__name__}",
-                        hint="for state feedback, break the loop yourself and pass (num, den)")
+    raise ArgumentError(f"controller: expected a gripkit.control.PID, RSTController, "
+                        f"StateFeedback or a (num, den[, dt]) pair in powers of z, found "
+                        f"{type(controller).__name__}")
 
 
 def _tf_z(g) -> tuple[np.ndarray, np.ndarray]:
@@ -185,22 +186,56 @@ class Robustness:
                     notes=list(self.notes))
 
 
+def _state_feedback_loop(sf, ss):
+    """(num, den, closed-loop poles) of L(z) = K (zI − A)⁻¹ B for a single-input state feedback
+    on the discrete state space ``ss`` (the loop broken at the plant input)."""
+    from scipy.signal import ss2tf
+
+    A, B = np.asarray(ss.A, float), np.asarray(ss.B, float)
+    num, den = ss2tf(A, B, np.asarray(sf.K, float), np.zeros((1, 1)))
+    return num[0], den, np.linalg.eigvals(A - B @ np.asarray(sf.K, float))
+
+
 def robustness(model, controller, n: int = 1000, seed: int | None = None, *,
                n_grid: int = 4000) -> Robustness:
     """Nominal margins and closed-loop poles of ``controller`` on ``model``, and their
     distributions over ``n`` plants drawn from the model's parameter covariance (module
-    docstring). ``seed`` makes the draw reproducible."""
-    from .rst import as_plant
+    docstring). ``seed`` makes the draw reproducible.
+
+    A single-input :class:`~gripkit.control.StateFeedback` (an LQR gain) is analysed on the
+    model's own discrete state space, broken at the plant input: ``L(z) = K (zI − A)⁻¹ B`` and
+    the closed-loop poles eig(A − B K); the samples are drawn in the same coordinates."""
+    from .state_feedback import StateFeedback
 
     if not isinstance(n, (int, np.integer)) or isinstance(n, bool) or n < 0:
         raise ArgumentError(f"n: expected a number of Monte Carlo samples >= 0, found {n!r}")
-    g = as_plant(model)
-    cnum, cden, cdt = controller_transfer_function(controller)
+    if isinstance(controller, StateFeedback):
+        from .linear_quadratic import _discrete
+
+        g = _discrete(model, controller.dt)
+        if controller.n_inputs != 1 or controller.n_states != g.n_states:
+            raise ArgumentError(
+                f"robustness: a state feedback with {controller.n_inputs} inputs and "
+                f"{controller.n_states} states on a model with {g.n_inputs} inputs and "
+                f"{g.n_states} states: margins need one input and the model's own states",
+                hint="break one loop yourself and pass (num, den) of it")
+        cdt = controller.dt
+
+        def loop(plant):
+            return _state_feedback_loop(controller, plant)
+    else:
+        from .rst import as_plant
+
+        g = as_plant(model)
+        cnum, cden, cdt = controller_transfer_function(controller)
+
+        def loop(plant):
+            return _loop(cnum, cden, plant)
     if cdt is not None and not math.isclose(cdt, g.dt, rel_tol=1e-9):
         raise ModelError(f"robustness: the controller runs at dt = {cdt:g} s but the model's "
                          f"sample time is {g.dt:g} s",
                          hint="design the controller for the model's dt (tune_pid does)")
-    ln, ld, poles = _loop(cnum, cden, g)
+    ln, ld, poles = loop(g)
     nominal = loop_margins(ln, ld, g.dt, n_grid=n_grid)
     stable = bool(np.all(np.abs(poles) < 1.0))
     notes = []
@@ -216,7 +251,7 @@ def robustness(model, controller, n: int = 1000, seed: int | None = None, *,
                 hint="use n=0 for the nominal margins, or a model identified with its "
                      "covariance (arx/armax/oe, or a state-space model that kept one)")
         for i, gi in enumerate(g.sample(int(n), seed=seed)):
-            a, b, p = _loop(cnum, cden, gi)
+            a, b, p = loop(gi)
             r = float(np.max(np.abs(p))) if p.size else 0.0
             rad[i] = r
             st[i] = r < 1.0
@@ -227,7 +262,6 @@ def robustness(model, controller, n: int = 1000, seed: int | None = None, *,
     return Robustness(nominal=nominal, poles=poles, stable=stable, gain_margin_db=gm,
                       phase_margin_deg=pm, pole_radius=rad, stable_samples=st, n=int(n),
                       seed=seed, dt=float(g.dt), notes=tuple(notes))
-
 
 def _histograms(result: Robustness):
     from ..report.plots import pyplot
