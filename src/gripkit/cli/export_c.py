@@ -1,6 +1,8 @@
 """``gripkit export c MODEL.json --out DIR [--name NAME] [--float32] [--dt S] [--json]``: the
 model's step as C99 code, ``NAME.h`` and ``NAME.c`` (:mod:`gripkit.export.c_code`,
-docs/deploy.md)."""
+docs/deploy.md); ``gripkit export c CONTROLLER.json --kind pid|rst|lqr`` and
+``gripkit export c --rls --na NA --nb NB --nk NK`` write a controller's step and the RLS update
+(:mod:`gripkit.export.c_controllers`, :mod:`gripkit.export.c_rls`)."""
 
 from __future__ import annotations
 
@@ -18,8 +20,9 @@ app.add_typer(export_app, name="export")
 
 
 @export_app.command("c")
-def export_c(model: Path = typer.Argument(..., help="Model file written by identify --out (.json).",
-                                          show_default=False),
+def export_c(model: Path = typer.Argument(None, show_default=False,
+                                          help="Model file written by identify --out (.json), "
+                                               "or a controller file with --kind."),
              out: Path = typer.Option(..., "--out", help="Folder to write NAME.h and NAME.c into.",
                                       show_default=False),
              name: str = typer.Option(None, "--name",
@@ -30,9 +33,37 @@ def export_c(model: Path = typer.Argument(..., help="Model file written by ident
                                                "arithmetic."),
              dt: float = typer.Option(None, "--dt",
                                       help="Sample time in s for a continuous (tfest) model."),
+             kind: str = typer.Option(None, "--kind",
+                                      help="pid, rst or lqr: MODEL is a controller file "
+                                           "(PID.save, save_controller)."),
+             rls: bool = typer.Option(False, "--rls", help="The RLS update of an ARX model "
+                                                           "(no MODEL; --na, --nb, --nk)."),
+             na: int = typer.Option(None, "--na", help="RLS: output lags."),
+             nb: int = typer.Option(None, "--nb", help="RLS: input coefficients."),
+             nk: int = typer.Option(1, "--nk", help="RLS: input delay in samples."),
+             lam: float = typer.Option(1.0, "--lam", help="RLS: forgetting factor λ in (0, 1]."),
+             p0: float = typer.Option(1e4, "--p0", help="RLS: initial covariance P0 = p0·I."),
+             windup: str = typer.Option("trace", "--windup",
+                                        help="RLS: trace, directional or none."),
              json_out: bool = JsonOpt):
-    """Write the model's step as C99 (NAME_init, NAME_step; SI in and out, offsets applied)."""
+    """Write the model's step as C99 (NAME_init, NAME_step; SI in and out, offsets applied);
+    with --kind a controller's step, with --rls the RLS update (docs/deploy.md)."""
     from ..errors import ArgumentError
+
+    if rls or kind is not None:
+        from .export_c_controllers import export_command
+
+        if float32 or dt is not None:
+            raise ArgumentError("--float32 and --dt apply to model files, not to --kind or --rls")
+        res = export_command(model, out, name, kind=kind, rls=rls, na=na, nb=nb, nk=nk, lam=lam,
+                             p0=p0, windup=windup)
+        if json_out:
+            emit_json(res)
+        else:
+            typer.echo(f"{res['what']}: wrote {', '.join(res['files'])}")
+        return
+    if model is None:
+        raise ArgumentError("MODEL: give a model file (or --kind with a controller file, or --rls)")
     from ..export.c_code import export_c as write, float32_error_bound
     from ..sysid import load_model
 

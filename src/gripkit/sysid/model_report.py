@@ -310,8 +310,11 @@ def singular_value_figure(sv, order):
     return fig
 
 
-def model_report(model, data, *, data_name: str = "data", warnings_list=()) -> Report:
-    """Build the :class:`~gripkit.report.html.Report` of ``model`` on the trajectory ``data``."""
+def model_report(model, data, *, data_name: str = "data", warnings_list=(),
+                 robustness=None) -> Report:
+    """Build the :class:`~gripkit.report.html.Report` of ``model`` on the trajectory ``data``;
+    ``robustness``: a :func:`gripkit.control.robustness` result (or ``(result, controller
+    label)``) adds the section "Robustness of the loop"."""
     ss = model.system.to_ss(minimal=False)
     dt = data.require_uniform(why="a model report")
     caught_lines = list(warnings_list)
@@ -362,6 +365,12 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=()) -> R
                     "parameter covariance) and the data's Welch H1 estimate with ±2σ where the "
                     "data allow." + shown).figure(bode_figure(model.system, dt, est, keep), "Bode",
                                                   name="bode")
+        if robustness is not None:
+            from ..control.robustness import robustness_section
+
+            res_, label = robustness if isinstance(robustness, tuple) else (robustness,
+                                                                            "The controller")
+            robustness_section(rep, res_, controller=label)
         if model.singular_values is not None:
             rep.section("Subspace singular values", "Singular values of the weighted subspace matrix; the order is "
                         "where they drop.").figure(singular_value_figure(np.asarray(model.singular_values), ss.n_states),
@@ -379,6 +388,8 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=()) -> R
     return rep
 
 
-def write_model_report(model, data, out_dir, *, data_name: str = "data", warnings_list=()) -> Path:
+def write_model_report(model, data, out_dir, *, data_name: str = "data", warnings_list=(),
+                       robustness=None) -> Path:
     """Write ``out_dir/index.html`` (self-contained: figures inline); returns its path."""
-    return model_report(model, data, data_name=data_name, warnings_list=warnings_list).write(Path(out_dir))
+    return model_report(model, data, data_name=data_name, warnings_list=warnings_list,
+                        robustness=robustness).write(Path(out_dir))
