@@ -4,11 +4,11 @@
 ``NAME_update(s, u, y)`` is :meth:`gripkit.sysid.RLS.update` for one sample: the a-priori error
 ``e = y − φᵀθ``, ``q = Pφ``, ``r = φᵀq``, ``θ ← θ + q e/(λ + r)`` and
 ``P ← (P + coef·q qᵀ)·scale`` on the upper triangle, mirrored, then the trace bound (``trace``
-windup) — see :mod:`gripkit.sysid.rls` for coef and scale of each windup mode — and the noise
+windup) — see :mod:`gripkit.sysid.linear.rls` for coef and scale of each windup mode — and the noise
 statistics V, w₁, w₂. The arithmetic and its order are those of the numba step (``_gain``,
 ``_apply``, ``_rls_step``), so θ, P and e equal Python's (bit for bit with gcc -O2 on x86-64; to
 1e-12 relative in any case). Like ``update``, a sample that is not finite (status 1), a corrupt one
-above :data:`~gripkit.sysid.rls.ABSURD_JUMP` times its signal's running peak (status 4), or an
+above :data:`~gripkit.sysid.linear.rls.ABSURD_JUMP` times its signal's running peak (status 4), or an
 update that would make θ or P non-finite (2) or overflow φᵀPφ (3) returns NaN and leaves the
 estimator as it was (``s->status`` says why); Python raises there instead.
 
@@ -35,7 +35,7 @@ def _d(v) -> str:
 def rls_c_sources(est, name: str = "rls") -> dict:
     """``{"NAME.h", "NAME.c"}`` for the estimator ``est`` (a :class:`gripkit.sysid.RLS`, its
     orders, forgetting, windup, p0, trace bound and θ0; its current state is not exported)."""
-    from ..sysid.rls import ABSURD_JUMP, RLS
+    from ..sysid.linear.rls import ABSURD_JUMP, RLS
 
     check_c_name(name)
     if not isinstance(est, RLS):
