@@ -152,19 +152,10 @@ def _flat_solve_rows(a, oL, p, ob, ox, rows):  # pragma: no cover - compiled
             a[ox + r * p + i] = acc / a[oL + i * p + i]
 
 
-@numba.njit(cache=True)
-def kf_step_packed(dims, par, st, u, y):  # pragma: no cover - compiled
-    """One Kalman step (module docstring) on the packed buffers; ``dims`` = (n, m, p, steady).
-    Returns 0 done, 1 Σ not positive definite (``x_p``, ``P_p`` unchanged), 2 ``u`` or 3 ``y``
-    of the wrong length. Every row sum runs over its index ascending, as
-    :mod:`gripkit.export.c_kalman`'s C step does."""
-    n, m, p, steady = dims[0], dims[1], dims[2], dims[3]
-    if u.shape[0] != m:
-        return 2
-    if y.shape[0] != p:
-        return 3
-    oA = 0
-    oB = oA + n * n
+@numba.njit(cache=True, inline="always")
+def _par_offsets(n, m, p):  # pragma: no cover - compiled
+    """Offsets of A, B, C, D, Q, R, S, u0, y0, K_f, K_p, P_f, Σ in the parameter vector."""
+    oB = n * n
     oC = oB + n * m
     oD = oC + p * n
     oQ = oD + p * m
@@ -175,9 +166,14 @@ def kf_step_packed(dims, par, st, u, y):  # pragma: no cover - compiled
     oKf = oy0 + p
     oKp = oKf + n * p
     oPs = oKp + n * p
-    oSs = oPs + n * n
-    sxp = 0
-    sPp = sxp + n
+    return 0, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oPs + n * n
+
+
+@numba.njit(cache=True, inline="always")
+def _st_offsets(n, m, p):  # pragma: no cover - compiled
+    """Offsets of x_p, P_p, x_f, P_f, du, y − y0, e, Σ, P_p Cᵀ, M, K_f, K_p, T, x_next in the
+    state vector."""
+    sPp = n
     sxf = sPp + n * n
     sPf = sxf + n
     sdu = sPf + n * n
@@ -189,10 +185,17 @@ def kf_step_packed(dims, par, st, u, y):  # pragma: no cover - compiled
     sKf = sM + n * p
     sKp = sKf + n * p
     sT = sKp + n * p
-    sxn = sT + n * n
+    return 0, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sT + n * n
+
+
+@numba.njit(cache=True, inline="always")
+def _kf_innovation(n, m, p, par, st, u, y):  # pragma: no cover - compiled
+    """du = u − u0, y − y0, e = y − y0 − C x_p − D du."""
+    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = _par_offsets(n, m, p)
+    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
     for j in range(m):
         st[sdu + j] = u[j] - par[ou0 + j]
-    for i in range(p):  # e = y − y0 − C x_p − D du
+    for i in range(p):
         st[syy + i] = y[i] - par[oy0 + i]
         acc = st[syy + i]
         for j in range(n):
@@ -200,91 +203,131 @@ def kf_step_packed(dims, par, st, u, y):  # pragma: no cover - compiled
         for j in range(m):
             acc -= par[oD + i * m + j] * st[sdu + j]
         st[se + i] = acc
-    if steady:
-        gf, gp = par, par  # fixed gains
-        ogf, ogp = oKf, oKp
-    else:
-        for i in range(n):  # P_p Cᵀ
-            for j in range(p):
-                acc = 0.0
-                for k in range(n):
-                    acc += st[sPp + i * n + k] * par[oC + j * n + k]
-                st[sPC + i * p + j] = acc
-        for i in range(p):  # Σ = R + C (P_p Cᵀ)
-            for j in range(p):
-                acc = par[oR + i * p + j]
-                for k in range(n):
-                    acc += par[oC + i * n + k] * st[sPC + k * p + j]
-                st[sSe + i * p + j] = acc
-        for i in range(n):  # M = S + A (P_p Cᵀ)
-            for j in range(p):
-                acc = par[oS + i * p + j]
-                for k in range(n):
-                    acc += par[oA + i * n + k] * st[sPC + k * p + j]
-                st[sM + i * p + j] = acc
-        if not _flat_cholesky(st, sSe, p):
-            return 1
-        _flat_solve_rows(st, sSe, p, sPC, sKf, n)  # K_f = P_p Cᵀ Σ⁻¹
-        _flat_solve_rows(st, sSe, p, sM, sKp, n)   # K_p = M Σ⁻¹
-        gf, gp = st, st
-        ogf, ogp = sKf, sKp
-    for i in range(n):  # x_f = x_p + K_f e
+
+
+@numba.njit(cache=True, inline="always")
+def _kf_gains(n, m, p, par, st):  # pragma: no cover - compiled
+    """The time-varying gains: P_p Cᵀ, Σ = R + C P_p Cᵀ (factored), M = S + A P_p Cᵀ,
+    K_f = P_p Cᵀ Σ⁻¹, K_p = M Σ⁻¹. False if Σ is not positive definite."""
+    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = _par_offsets(n, m, p)
+    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
+    for i in range(n):  # P_p Cᵀ
+        for j in range(p):
+            acc = 0.0
+            for k in range(n):
+                acc += st[sPp + i * n + k] * par[oC + j * n + k]
+            st[sPC + i * p + j] = acc
+    for i in range(p):  # Σ = R + C (P_p Cᵀ)
+        for j in range(p):
+            acc = par[oR + i * p + j]
+            for k in range(n):
+                acc += par[oC + i * n + k] * st[sPC + k * p + j]
+            st[sSe + i * p + j] = acc
+    for i in range(n):  # M = S + A (P_p Cᵀ)
+        for j in range(p):
+            acc = par[oS + i * p + j]
+            for k in range(n):
+                acc += par[oA + i * n + k] * st[sPC + k * p + j]
+            st[sM + i * p + j] = acc
+    if not _flat_cholesky(st, sSe, p):
+        return False
+    _flat_solve_rows(st, sSe, p, sPC, sKf, n)
+    _flat_solve_rows(st, sSe, p, sM, sKp, n)
+    return True
+
+
+@numba.njit(cache=True, inline="always")
+def _kf_states(n, m, p, par, st, g, ogf, ogp):  # pragma: no cover - compiled
+    """x_f = x_p + K_f e, x_p ← A x_p + B du + K_p e (through x_next); the gains K_f, K_p are
+    the blocks of ``g`` at ``ogf``, ``ogp``."""
+    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = _par_offsets(n, m, p)
+    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
+    for i in range(n):
         acc = st[sxp + i]
         for j in range(p):
-            acc += gf[ogf + i * p + j] * st[se + j]
+            acc += g[ogf + i * p + j] * st[se + j]
         st[sxf + i] = acc
-    for i in range(n):  # x_p ← A x_p + B du + K_p e
+    for i in range(n):
         acc = 0.0
         for j in range(n):
             acc += par[oA + i * n + j] * st[sxp + j]
         for j in range(m):
             acc += par[oB + i * m + j] * st[sdu + j]
         for j in range(p):
-            acc += gp[ogp + i * p + j] * st[se + j]
+            acc += g[ogp + i * p + j] * st[se + j]
         st[sxn + i] = acc
-    if steady:
+    for i in range(n):
+        st[sxp + i] = st[sxn + i]
+
+
+@numba.njit(cache=True, inline="always")
+def _kf_covariances(n, m, p, par, st):  # pragma: no cover - compiled
+    """P_f = P_p − K_f (P_p Cᵀ)ᵀ, P_p ← Q + A P_p Aᵀ − K_p Mᵀ (symmetric parts), and Σ rebuilt
+    from its Cholesky factor."""
+    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = _par_offsets(n, m, p)
+    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
+    for i in range(n):
+        for j in range(n):
+            acc = st[sPp + i * n + j]
+            for k in range(p):
+                acc -= st[sKf + i * p + k] * st[sPC + j * p + k]
+            st[sPf + i * n + j] = acc
+    for i in range(n):  # T = A P_p
+        for j in range(n):
+            acc = 0.0
+            for k in range(n):
+                acc += par[oA + i * n + k] * st[sPp + k * n + j]
+            st[sT + i * n + j] = acc
+    for i in range(n):
+        for j in range(n):
+            acc = par[oQ + i * n + j]
+            for k in range(n):
+                acc += st[sT + i * n + k] * par[oA + j * n + k]
+            for k in range(p):
+                acc -= st[sKp + i * p + k] * st[sM + j * p + k]
+            st[sPp + i * n + j] = acc
+    for i in range(n):
+        for j in range(i + 1, n):
+            a = 0.5 * (st[sPp + i * n + j] + st[sPp + j * n + i])
+            st[sPp + i * n + j] = a
+            st[sPp + j * n + i] = a
+            b = 0.5 * (st[sPf + i * n + j] + st[sPf + j * n + i])
+            st[sPf + i * n + j] = b
+            st[sPf + j * n + i] = b
+    for i in range(p):
+        for j in range(i + 1):
+            acc = 0.0
+            for k in range(j + 1):
+                acc += st[sSe + i * p + k] * st[sSe + j * p + k]
+            st[sSe + i * p + j] = acc
+            st[sSe + j * p + i] = acc
+
+
+@numba.njit(cache=True)
+def kf_step_packed(dims, par, st, u, y):  # pragma: no cover - compiled
+    """One Kalman step (module docstring) on the packed buffers; ``dims`` = (n, m, p, steady).
+    Returns 0 done, 1 Σ not positive definite (``x_p``, ``P_p`` unchanged), 2 ``u`` or 3 ``y``
+    of the wrong length. Every row sum runs over its index ascending, as
+    :mod:`gripkit.export.c_kalman`'s C step does."""
+    n, m, p, steady = dims[0], dims[1], dims[2], dims[3]
+    if u.shape[0] != m:
+        return 2
+    if y.shape[0] != p:
+        return 3
+    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = _par_offsets(n, m, p)
+    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
+    _kf_innovation(n, m, p, par, st, u, y)
+    if steady:  # fixed gains and covariances
+        _kf_states(n, m, p, par, st, par, oKf, oKp)
         for i in range(n * n):
             st[sPf + i] = par[oPs + i]
         for i in range(p * p):
             st[sSe + i] = par[oSs + i]
-    else:
-        for i in range(n):  # P_f = P_p − K_f (P_p Cᵀ)ᵀ
-            for j in range(n):
-                acc = st[sPp + i * n + j]
-                for k in range(p):
-                    acc -= st[sKf + i * p + k] * st[sPC + j * p + k]
-                st[sPf + i * n + j] = acc
-        for i in range(n):  # T = A P_p
-            for j in range(n):
-                acc = 0.0
-                for k in range(n):
-                    acc += par[oA + i * n + k] * st[sPp + k * n + j]
-                st[sT + i * n + j] = acc
-        for i in range(n):  # P_p ← Q + T Aᵀ − K_p Mᵀ
-            for j in range(n):
-                acc = par[oQ + i * n + j]
-                for k in range(n):
-                    acc += st[sT + i * n + k] * par[oA + j * n + k]
-                for k in range(p):
-                    acc -= st[sKp + i * p + k] * st[sM + j * p + k]
-                st[sPp + i * n + j] = acc
-        for i in range(n):  # symmetric parts
-            for j in range(i + 1, n):
-                a = 0.5 * (st[sPp + i * n + j] + st[sPp + j * n + i])
-                st[sPp + i * n + j] = a
-                st[sPp + j * n + i] = a
-                b = 0.5 * (st[sPf + i * n + j] + st[sPf + j * n + i])
-                st[sPf + i * n + j] = b
-                st[sPf + j * n + i] = b
-        for i in range(p):  # Σ back from its factor
-            for j in range(i + 1):
-                acc = 0.0
-                for k in range(j + 1):
-                    acc += st[sSe + i * p + k] * st[sSe + j * p + k]
-                st[sSe + i * p + j] = acc
-                st[sSe + j * p + i] = acc
-    for i in range(n):
-        st[sxp + i] = st[sxn + i]
+        return 0
+    if not _kf_gains(n, m, p, par, st):
+        return 1
+    _kf_covariances(n, m, p, par, st)  # reads P_p before the states step overwrites x only
+    _kf_states(n, m, p, par, st, st, sKf, sKp)
     return 0
 
 
@@ -294,10 +337,7 @@ def kf_run_packed(dims, par, st, U, Y, xs, Ps, es, Ss):  # pragma: no cover - co
     covariances, the innovations and their covariances into xs, Ps, es, Ss. Returns
     (code, k): the first failing sample's code and index, or (0, N)."""
     n, m, p = dims[0], dims[1], dims[2]
-    sxf = n + n * n
-    sPf = sxf + n
-    se = sPf + n * n + m + p
-    sSe = se + p
+    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
     for k in range(U.shape[0]):
         code = kf_step_packed(dims, par, st, U[k], Y[k])
         if code:
