@@ -49,7 +49,7 @@ import numba
 import numpy as np
 
 from ..errors import ArgumentError, DataError, ModelError
-from .kalman import KalmanRun, _cholesky, _chol_solve_rows
+from .kalman import KalmanFilter, KalmanRun, _cholesky, _chol_solve_rows
 
 __all__ = ["ExtendedKalmanFilter", "UnscentedKalmanFilter"]
 
@@ -645,8 +645,6 @@ class UnscentedKalmanFilter(_NonlinearFilter):
             f, h = _linear_model_fh(model, dt)
             self._inputs, self._outputs = list(model.inputs), list(model.outputs)
             if P0 is None:
-                from .kalman import KalmanFilter
-
                 P0 = KalmanFilter(model, Q=Q, R=R, dt=dt).P_steady_pred
         elif not (callable(f) and callable(h)):
             raise ArgumentError("UnscentedKalmanFilter: expected a LinearModel, or callables "
