@@ -7,6 +7,7 @@ A flat list of explicit re-exports.
 """
 
 from .linear_quadratic import LQR as LQR
+from .lqg import LQG as LQG
 from .linear_quadratic import lqr as lqr
 from .pid import PID as PID
 from .rst import DiscretePlant as DiscretePlant
@@ -16,5 +17,5 @@ from .rst import RSTController as RSTController
 from .rst import design_rst as design_rst
 from .rst import simulate_loop as simulate_loop
 
-__all__ = ["as_plant", "design_rst", "DiscretePlant", "LoopResult", "LQR", "lqr", "PID",
+__all__ = ["as_plant", "design_rst", "DiscretePlant", "LoopResult", "LQG", "LQR", "lqr", "PID",
            "RSTController", "simulate_loop"]
