@@ -1,6 +1,7 @@
 """``gripkit export c MODEL.json --out DIR [--name NAME] [--float32] [--dt S] [--json]``: the
 model's step as C99 code, ``NAME.h`` and ``NAME.c`` (:mod:`gripkit.export.c_code`,
-docs/deploy.md)."""
+docs/deploy.md); ``--kind kalman [--noise NOISE.json]``: its steady-state Kalman filter
+(:mod:`gripkit.export.c_kalman`)."""
 
 from __future__ import annotations
 
@@ -30,11 +31,26 @@ def export_c(model: Path = typer.Argument(..., help="Model file written by ident
                                                "arithmetic."),
              dt: float = typer.Option(None, "--dt",
                                       help="Sample time in s for a continuous (tfest) model."),
+             kind: str = typer.Option("model", "--kind",
+                                      help="What to export: model (its step) or kalman (its "
+                                           "steady-state Kalman filter, NAME_kf_step)."),
+             noise: Path = typer.Option(None, "--noise",
+                                        help="--kind kalman: JSON file with the noise "
+                                             "covariances Q, R (and S); default: the model's own "
+                                             "innovation gain K."),
              json_out: bool = JsonOpt):
     """Write the model's step as C99 (NAME_init, NAME_step; SI in and out, offsets applied)."""
     from ..errors import ArgumentError
     from ..export.c_code import export_c as write, float32_error_bound
     from ..sysid import load_model
+    from .common import check_choice
+
+    check_choice(kind, "--kind", ("model", "kalman"))
+    if kind != "kalman" and noise is not None:
+        raise ArgumentError("--noise: only with --kind kalman")
+    if kind == "kalman" and float32:
+        raise ArgumentError("--float32: the Kalman filter is exported in double precision only",
+                            hint="drop --float32")
 
     if name is None:
         name = model.stem
@@ -44,9 +60,13 @@ def export_c(model: Path = typer.Argument(..., help="Model file written by ident
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         m = load_model(model)
-        paths = write(m, out, name, float32=float32, dt=dt)
+        if kind == "kalman":
+            paths = _write_kalman(m, out, name, noise, dt)
+        else:
+            paths = write(m, out, name, float32=float32, dt=dt)
         bound = float32_error_bound(m, dt) if float32 else None
-    res = {"model": str(model), "files": [str(p) for p in paths], "name": name, "float32": float32,
+    res = {"model": str(model), "kind": kind, "files": [str(p) for p in paths], "name": name,
+           "float32": float32,
            "inputs": list(m.inputs), "outputs": list(m.outputs),
            "units": {"inputs": list(m.system.input_units), "outputs": list(m.system.output_units)},
            "float32_error_bound": bound, "warnings": report_warnings(caught)}
@@ -54,3 +74,14 @@ def export_c(model: Path = typer.Argument(..., help="Model file written by ident
         emit_json(res)
         return
     typer.echo(f"{m.structure}: wrote {', '.join(map(str, paths))} (inputs and outputs in SI)")
+
+
+def _write_kalman(m, out, name, noise, dt):
+    """``--kind kalman``: the filter's C files, with the gains of ``--noise`` or the model's K."""
+    from ..export.c_kalman import export_kalman_c, load_noise
+
+    Q = R = S = None
+    if noise is not None and (m.dt or dt):  # a continuous model without --dt: export says so
+        ss = m.discrete(m.dt if dt is None else dt)
+        Q, R, S = load_noise(noise, ss.n_states, ss.n_outputs)
+    return export_kalman_c(m, out, name, Q, R, S, dt=dt)

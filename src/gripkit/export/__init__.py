@@ -3,7 +3,8 @@
 :func:`export_c` writes ``NAME.h`` and ``NAME.c`` (no allocation, nothing beyond ``<math.h>``
 and ``<string.h>``); :func:`c_sources` returns their text; :func:`c_harness` is a small program
 that feeds a file of inputs through the step and prints the outputs (tests and users check the
-export with it); :func:`float32_error_bound` is the a-priori bound of the ``--float32`` variant.
+export with it); :func:`float32_error_bound` is the a-priori bound of the ``--float32`` variant;
+:func:`export_kalman_c` writes the model's steady-state Kalman filter (``NAME_kf_step``).
 See docs/deploy.md."""
 
 from ..exports import lazy_exports
@@ -12,6 +13,10 @@ _LAZY = {"export_c": ("c_code", "export_c"), "c_sources": ("c_code", "c_sources"
          "c_harness": ("c_code", "c_harness"),
          "float32_error_bound": ("c_code", "float32_error_bound"),
          "check_c_name": ("c_code", "check_c_name"),
-         "float32_bound_on": ("c_code", "float32_bound_on")}
+         "float32_bound_on": ("c_code", "float32_bound_on"),
+         "export_kalman_c": ("c_kalman", "export_kalman_c"),
+         "kalman_c_sources": ("c_kalman", "kalman_c_sources"),
+         "kalman_c_harness": ("c_kalman", "kalman_c_harness"),
+         "kalman_filter_of": ("c_kalman", "kalman_filter_of")}
 __all__ = [*_LAZY]
 __getattr__, __dir__ = lazy_exports(__name__, _LAZY)
