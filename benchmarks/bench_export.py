@@ -101,7 +101,8 @@ int main(int argc, char **argv) {
         per[b] = (now_ns() - t0) / (double)block;
     }
     qsort(per, (size_t)nb, sizeof(double), cmp);
-    printf("{\"min\": %.3f, \"median\": %.3f, \"p99\": %.3f, \"p999\": %.3f, \"max\": %.3f, \"sink\": %g}\n",
+    printf("{\"min\": %.3f, \"median\": %.3f, \"p99\": %.3f, \"p999\": %.3f, "
+           "\"max\": %.3f, \"sink\": %g}\n",
            per[0], per[nb / 2], per[(long)(0.99 * nb)], per[(long)(0.999 * nb)], per[nb - 1], sink);
     return 0;
 }
@@ -207,7 +208,8 @@ def run_kalman(quick: bool) -> list[dict]:
         (d / "harness.c").write_text(_KF_HARNESS)
         exe = d / "kf"
         cc = subprocess.run([gcc, "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-o", str(exe),
-                             str(d / "harness.c"), str(d / "kf.c"), "-lm"], capture_output=True, text=True)
+                             str(d / "harness.c"), str(d / "kf.c"), "-lm"],
+                            capture_output=True, text=True)
         if cc.returncode:
             raise RuntimeError(cc.stderr)
         res = subprocess.run([str(exe), str(steps), str(BLOCK), str(d / "x.csv")], check=True,

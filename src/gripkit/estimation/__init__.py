@@ -23,8 +23,8 @@ from .kalman import KalmanRun as KalmanRun
 from .nonlinear_kalman import ExtendedKalmanFilter as ExtendedKalmanFilter
 from .nonlinear_kalman import UnscentedKalmanFilter as UnscentedKalmanFilter
 
-__all__ = ["AdaptationSettings", "ContactDetector", "ExtendedKalmanFilter", "FrictionAdapter", "fuse",
-           "fuse_proportional",
+__all__ = ["AdaptationSettings", "ContactDetector", "ExtendedKalmanFilter", "FrictionAdapter",
+           "fuse", "fuse_proportional",
            "fuse_update", "fused_variance", "implied_correlation", "KalmanFilter", "KalmanRun",
            "normalised_variances",
            "NormalisedVariances", "proportional_variance", "UnscentedKalmanFilter"]

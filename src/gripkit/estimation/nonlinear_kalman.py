@@ -209,7 +209,8 @@ def _ekf_predict(s, w, Q):  # pragma: no cover - compiled
 
 @numba.njit(cache=True)
 def _jac_central(fn, x, u, J, xt):  # pragma: no cover - compiled
-    """J[:, j] = (fn(x + δ_j e_j, u) − fn(x − δ_j e_j, u)) / (2 δ_j), δ_j = ε^(1/3) max(1, |x_j|)."""
+    """J[:, j] = (fn(x + δ_j e_j, u) − fn(x − δ_j e_j, u)) / (2 δ_j),
+    δ_j = ε^(1/3) max(1, |x_j|)."""
     for j in range(x.shape[0]):
         d = _EPS3 * max(1.0, abs(x[j]))
         for k in range(x.shape[0]):

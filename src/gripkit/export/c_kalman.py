@@ -36,7 +36,8 @@ __all__ = ["export_kalman_c", "kalman_c_harness", "kalman_c_sources", "kalman_fi
 
 def load_noise(path, n: int, p: int) -> tuple:
     """``(Q, R, S)`` from a JSON file ``{"Q": …, "R": …, "S": …}`` (``S`` optional): each a
-    matrix (nested lists), or a number q meaning q·I. ``n``, ``p``: the model's order and outputs."""
+    matrix (nested lists), or a number q meaning q·I (S: q everywhere). ``n``, ``p``: the model's
+    order and number of outputs."""
     path = Path(path)
     try:
         obj = json.loads(path.read_text())
