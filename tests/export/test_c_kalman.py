@@ -8,7 +8,6 @@ file reach the C code only as safe comments; bad options are refused in one line
 from __future__ import annotations
 
 import json
-import shutil
 import subprocess
 
 import numpy as np
@@ -18,6 +17,7 @@ from gripkit.cli import main
 from gripkit.errors import DataError, ModelError
 from gripkit.estimation import KalmanFilter
 from gripkit.export import kalman_c_harness, kalman_c_sources
+from gripkit.export.c_kalman import load_noise
 from gripkit.lti import StateSpace
 from gripkit.sysid import LinearModel
 
@@ -113,8 +113,6 @@ def test_bad_models_and_options_are_refused(tmp_path, capsys):
     innovation_model().save(p)
     bad = tmp_path / "noise.json"
     bad.write_text(json.dumps({"Q": [[1.0]], "R": 0.1}))
-    from gripkit.export.c_kalman import load_noise
-
     with pytest.raises(DataError, match="Q in .* must be a finite 4×4 matrix"):
         load_noise(bad, 4, 2)
     for args, phrase in (
