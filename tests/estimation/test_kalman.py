@@ -172,3 +172,11 @@ def test_wrong_sample_lengths_are_refused():
         kf.step([1.0, 0.0], [0.0, 0.0, 1.0])
     with pytest.raises(DataError, match=r"expected u \(N, 2\) and y \(N, 2\)"):
         kf.run_arrays(np.zeros((5, 2)), np.zeros((4, 2)))
+
+
+def test_a_sample_given_as_a_row_or_a_list_is_the_same_sample():
+    a, b = KalmanFilter(model(), Q=Q, R=R), KalmanFilter(model(), Q=Q, R=R)
+    xa, _ = a.step(np.array([[0.5, 1.0]]), np.array([[2.5, 0.0]]))  # (1, m) and (1, p)
+    xb, _ = b.step([0.5, 1], (2.5, 0))                                # a list and ints
+    np.testing.assert_array_equal(xa, xb)
+    assert np.max(np.abs(xa)) > 0.01

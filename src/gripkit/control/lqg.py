@@ -218,7 +218,7 @@ class LQG:
         """``u[t]`` (m,; SI, offsets applied) for the measurement ``y[t]`` (p,) and the reference
         ``r`` (p,; default: the operating point y0). ``copy=False`` returns a read-only view of
         the controller's buffer (nothing allocated; the next step overwrites it)."""
-        if type(y) is not np.ndarray:
+        if type(y) is not np.ndarray or y.ndim != 1:
             y = np.ascontiguousarray(y, dtype=np.float64).reshape(-1)
         if r is None:
             r = self._y0
@@ -227,7 +227,7 @@ class LQG:
                 raise ArgumentError("LQG.step: r needs a square model (as many inputs as "
                                     "outputs) with no zero at z = 1",
                                     hint="regulate without r, or add integral states")
-            if type(r) is not np.ndarray:
+            if type(r) is not np.ndarray or r.ndim != 1:
                 r = np.ascontiguousarray(r, dtype=np.float64).reshape(-1)
         if lqg_step(self._dims, self._par, self._st, y, r):
             p = int(self._dims[2])

@@ -489,12 +489,12 @@ class KalmanFilter:
     def step(self, u, y, *, copy: bool = True):
         """One sample (SI, the model's order, offsets not removed): ``(x[t|t], P[t|t])``.
 
-        ``u`` (m,) and ``y`` (p,) arrays go straight to the kernel (anything else is converted
-        to float64 first). ``copy=False`` returns read-only views of the filter's own buffers
+        ``u`` (m,) and ``y`` (p,) 1-D arrays go straight to the kernel (anything else is
+        converted to float64 first). ``copy=False`` returns read-only views of the filter's own buffers
         instead of copies: nothing is allocated, and the next step overwrites them."""
-        if type(u) is not np.ndarray:
+        if type(u) is not np.ndarray or u.ndim != 1:
             u = np.ascontiguousarray(u, dtype=np.float64).reshape(-1)
-        if type(y) is not np.ndarray:
+        if type(y) is not np.ndarray or y.ndim != 1:
             y = np.ascontiguousarray(y, dtype=np.float64).reshape(-1)
         code = kf_step_packed(self._dims, self._par, self._st, u, y)
         if code:
