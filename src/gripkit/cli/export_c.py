@@ -39,7 +39,8 @@ def export_c(model: Path = typer.Argument(..., help="Model file written by ident
                                              "covariances Q, R (and S); default: the model's own "
                                              "innovation gain K."),
              json_out: bool = JsonOpt):
-    """Write the model's step as C99 (NAME_init, NAME_step; SI in and out, offsets applied)."""
+    """Write the model's step as C99 (NAME_init, NAME_step; SI in and out, offsets applied), or
+    with --kind kalman its steady-state Kalman filter (NAME_kf_init, NAME_kf_step)."""
     from ..errors import ArgumentError
     from ..export.c_code import export_c as write, float32_error_bound
     from ..sysid import load_model
