@@ -1,6 +1,11 @@
 """Measured data: gripkit beside SIPPY (sippy_unipi), nfoursid and sysidentpy on the DC
 motor/generator record published with SysIdentPy (tests/fixtures/dc_motor: source, commit,
-BSD-3 licence), in the same run.
+BSD-3 licence), in the same run, then on the measured corpus of tests/fixtures (:data:`CORPUS`:
+CD player arm 2x2, evaporator 3x3, flexible robot arm, EMPS, cascaded tanks, Silverbox; each
+folder's README and LICENSE give source and terms) and EMPS's IDIM-LS beside its published
+estimates. Corpus rows: same order and horizon on every side, the free-run validation fit of
+every side's model by gripkit's one definition (offsets of the estimation record, x0 by least
+squares); `python benchmarks/run.py --only measured --out DIR`.
 
 Split as SysIdentPy's own example: the first 500 samples estimate, the last 500 validate. Accuracy
 beside every time: the free-run fit on the validation half, 100 (1 − ‖y − ŷ‖/‖y − ȳ‖), in %:
