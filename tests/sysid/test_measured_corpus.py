@@ -167,8 +167,8 @@ def test_identify_validate_compare_report(name, capsys, tmp_path):
 @pytest.mark.parametrize("name", RECORDS)
 def test_python_identify_gives_the_same_validation_fit(name):
     """`identify(est, "ss", …, validate=val)` and `validation_fit(model, val)`: the same floor
-    holds from Python, and ARX [4 4 1] of the single-output records is a stable model whose
-    validation fit is reported (not asserted against a floor: a different model class)."""
+    holds from Python; ARX [4 4 1] of the one-input records at least sysidentpy's linear FROLS
+    (same lags) less MARGIN."""
     rec = RECORDS[name]
     est, val = _parts(rec)
     ins, outs = list(rec.inputs), list(rec.outputs)
@@ -177,10 +177,16 @@ def test_python_identify_gives_the_same_validation_fit(name):
         model = identify(est, "ss", input=ins, output=outs, order=rec.order, validate=val,
                          form="oe")
     _assert_floor(name, validation_fit(model, val), rec.floor)
-    if len(ins) == 1:
-        arx = identify(est, "arx", input=ins[0], output=outs[0], na=4, nb=4, nk=1)
-        fit_arx = validation_fit(arx, val)
-        assert fit_arx is not None and math.isfinite(fit_arx[0])
+    if name in ARX_PEER:
+        with warnings.catch_warnings():  # the tanks' lag-4 regressor is ill-conditioned: warned
+            warnings.simplefilter("ignore")
+            arx = identify(est, "arx", input=ins[0], output=outs[0], na=4, nb=4, nk=1)
+        assert validation_fit(arx, val)[0] >= ARX_PEER[name] - MARGIN
+
+
+#: sysidentpy FROLS with a degree-1 polynomial basis, lags 4 (the same model class as ARX
+#: [4 4 1]), its own predict on the validation part: benchmark run of 2026-11-26
+ARX_PEER = dict(flexible_arm=32.5, emps=99.9, cascaded_tanks=69.2, silverbox=86.3)
 
 
 @pytest.mark.slow
