@@ -40,7 +40,7 @@ from gripkit.errors import StabilityWarning
 from gripkit.io import load, save
 from gripkit.signals import split
 from gripkit.sysid import identify, n4sid
-from gripkit.sysid.linear_model import validation_fit
+from gripkit.sysid.linear.linear_model import validation_fit
 
 FIXTURES = Path(__file__).resolve().parents[1] / "fixtures"
 MARGIN = 2.0  # percentage points the mean fit over the outputs may fall below the reference's
