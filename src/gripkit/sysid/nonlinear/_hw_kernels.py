@@ -77,14 +77,16 @@ def nl_eval(kind, p, c, v, grad):
 
 
 @njit(cache=True)
-def hw_run(u, kin, pin, cin, b, f, nk, kout, pout, cout, y0, want_j, w, x, dw, dx, gin, gout,
-           yhat, jac):
+def hw_run(u, kin, pin, cin, b, f, nk, kout, pout, cout, y0, wpre, want_j, w, x, dw, dx, gin,
+           gout, yhat, jac):
     """Free run of ``w = f(u)``, ``F(q) x = B(q) q^-nk w``, ``ŷ = g(x) + y0`` from the linear
-    block's steady state at the first input sample (``w(t<0) = w(0)``, ``x(t<0) = B(1)/F(1) w(0)``).
+    block's steady state under the constant input ``wpre`` (``w(t<0) = wpre``,
+    ``x(t<0) = B(1)/F(1) wpre``).
 
-    Work arrays: ``w``, ``x`` (N + M), ``dw`` (N + M, ni), ``dx`` (N + M, ni + nb + nf), ``gin``,
-    ``gout`` (≥ 1). With ``want_j`` the rows of ``jac`` (N, P) receive ∂ŷ(t)/∂θ for
-    ``θ = [pin, b, f, pout, y0]``. Returns the first sample where ŷ is not finite, −1 if none."""
+    Work arrays: ``w``, ``x`` (N + M), ``dw`` (N + M, ni + 1), ``dx`` (N + M, ni + nb + nf + 1),
+    ``gin``, ``gout`` (≥ 2). With ``want_j`` the rows of ``jac`` (N, P + 1) receive ∂ŷ(t)/∂θ for
+    ``θ = [pin, b, f, pout, y0, wpre]``. Returns the first sample where ŷ is not finite, −1 if
+    none."""
     n = u.shape[0]
     ni = pin.shape[0]
     nb = b.shape[0]
@@ -92,8 +94,6 @@ def hw_run(u, kin, pin, cin, b, f, nk, kout, pout, cout, y0, want_j, w, x, dw, d
     no = pout.shape[0]
     nl = ni + nb + nf
     m = nk + nb + nf
-    # steady state at the first input sample
-    w0, _ = nl_eval(kin, pin, cin, u[0], gin)
     sb = 0.0
     for i in range(nb):
         sb += b[i]
@@ -102,16 +102,18 @@ def hw_run(u, kin, pin, cin, b, f, nk, kout, pout, cout, y0, want_j, w, x, dw, d
         f1 += f[j]
     s = sb / f1
     for t in range(m):
-        w[t] = w0
-        x[t] = s * w0
+        w[t] = wpre
+        x[t] = s * wpre
         if want_j:
             for k in range(ni):
-                dw[t, k] = gin[k]
-                dx[t, k] = s * gin[k]
+                dw[t, k] = 0.0
+                dx[t, k] = 0.0
+            dw[t, ni] = 1.0
             for i in range(nb):
-                dx[t, ni + i] = w0 / f1
+                dx[t, ni + i] = wpre / f1
             for j in range(nf):
-                dx[t, ni + nb + j] = -s * w0 / f1
+                dx[t, ni + nb + j] = -s * wpre / f1
+            dx[t, nl] = s
     bad = -1
     for t in range(m, n + m):
         wt, _ = nl_eval(kin, pin, cin, u[t - m], gin)
@@ -130,7 +132,8 @@ def hw_run(u, kin, pin, cin, b, f, nk, kout, pout, cout, y0, want_j, w, x, dw, d
         if want_j:
             for k in range(ni):
                 dw[t, k] = gin[k]
-            for k in range(nl):
+            dw[t, ni] = 0.0
+            for k in range(nl + 1):
                 a = 0.0
                 for j in range(nf):
                     a -= f[j] * dx[t - 1 - j, k]
@@ -140,8 +143,11 @@ def hw_run(u, kin, pin, cin, b, f, nk, kout, pout, cout, y0, want_j, w, x, dw, d
                 for i in range(nb):
                     a += b[i] * dw[t - nk - i, k]
                 dx[t, k] += a
+            a = 0.0
             for i in range(nb):
+                a += b[i] * dw[t - nk - i, ni]
                 dx[t, ni + i] += w[t - nk - i]
+            dx[t, nl] += a
             for j in range(nf):
                 dx[t, ni + nb + j] -= x[t - 1 - j]
             r = t - m
@@ -150,4 +156,5 @@ def hw_run(u, kin, pin, cin, b, f, nk, kout, pout, cout, y0, want_j, w, x, dw, d
             for k in range(no):
                 jac[r, nl + k] = gout[k]
             jac[r, nl + no] = 1.0
+            jac[r, nl + no + 1] = gd * dx[t, nl]
     return bad

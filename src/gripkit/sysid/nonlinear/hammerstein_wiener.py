@@ -43,8 +43,12 @@ Marquardt's diagonal scaling; the Jacobian is exact: the forward sensitivities
 free run in one numba kernel. A step that makes ``F`` unstable (a root with ``|z| ≥ 1``) or
 reverses the limits is refused (more damping), so the returned ``F`` is stable.
 
-The free run starts from the linear block's steady state at the first input sample
-(``w(t<0) = w(0)``, ``x(t<0) = B(1)/F(1) w(0)``), on every record.
+The free run starts from a steady state of the linear block under a constant input ``w₋``
+(``w(t<0) = w₋``, ``x(t<0) = B(1)/F(1) w₋``): a record that starts at rest has ``w₋ = 0``, one
+that starts settled at the first input ``w₋ = f(u(0))``. ``w₋`` is estimated with ``θ`` on the
+estimation record (a nuisance parameter: its uncertainty is in every σ), fitted alone by
+Gauss–Newton on a validation record (:meth:`HWModel.compare`), and ``f(u(0))`` in
+:meth:`HWModel.simulate` unless given.
 
 **σ.** ``cov θ = σ² (JᵀJ)⁻¹`` (Gauss–Newton), ``σ² = SSE/(N − P)``, from the eigen-decomposition
 of the column-scaled ``JᵀJ``: a direction with eigenvalue below ``1e-10`` of the largest is not
@@ -84,8 +88,8 @@ __all__ = ["SCHEMA", "HW_FIT", "HWModel", "Nonlinearity", "hammerstein_wiener", 
 SCHEMA = "gripkit.hw-model"
 VERSION = 1
 DIVERGENCE_FACTOR = 1e3
-HW_FIT = ("free run from the linear block's steady state at the first input sample, "
-          "fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) over all samples")
+HW_FIT = ("free run from a steady state of the linear block whose constant input w₋ is fitted "
+          "to the record (least squares), fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) over all samples")
 KINDS = {"none": K.NONE, "saturation": K.SATURATION, "deadzone": K.DEADZONE, "poly": K.POLY,
          "pwl": K.PWL, "sigmoid": K.SIGMOID}
 DEFAULT_N = {"poly": 3, "pwl": 4, "sigmoid": 4}
@@ -210,28 +214,29 @@ class _Problem:
         self.P = self.ni + nb + nf + self.no + 1
         n, m = len(u), nk + nb + nf
         self.w, self.x = np.empty(n + m), np.empty(n + m)
-        self.dw = np.zeros((n + m, max(self.ni, 1)))
-        self.dx = np.zeros((n + m, self.ni + nb + nf))
+        self.dw = np.zeros((n + m, self.ni + 1))
+        self.dx = np.zeros((n + m, self.ni + nb + nf + 1))
         self.gin, self.gout = np.zeros(max(self.ni, 2)), np.zeros(max(self.no, 2))
         self.cin = np.asarray(fin.consts or (0.0,), dtype=np.float64)
         self.cout = np.asarray(fout.consts or (0.0,), dtype=np.float64)
         self.yhat = np.empty(n)
-        self.jac = np.empty((n, self.P))
+        self.jac = np.empty((n, self.P + 1))  # the last column: ∂ŷ/∂w₋
 
     def split(self, th):
         ni, nb, nf, no = self.ni, self.nb, self.nf, self.no
         return (th[:ni], th[ni:ni + nb], th[ni + nb:ni + nb + nf],
                 th[ni + nb + nf:ni + nb + nf + no], th[-1])
 
-    def run(self, th, want_j: bool):
-        pin, b, f, pout, y0 = self.split(np.ascontiguousarray(th, dtype=np.float64))
-        bad = K.hw_run(self.u, self.fin.code, pin, self.cin, b, f, self.nk, self.fout.code, pout,
-                       self.cout, float(y0), want_j, self.w, self.x, self.dw, self.dx, self.gin,
-                       self.gout, self.yhat, self.jac)
-        return bad
+    def run(self, the, want_j: bool):
+        """Free run (and J) for ``the = [θ, w₋]``."""
+        the = np.ascontiguousarray(the, dtype=np.float64)
+        pin, b, f, pout, y0 = self.split(the[:-1])
+        return K.hw_run(self.u, self.fin.code, pin, self.cin, b, f, self.nk, self.fout.code, pout,
+                        self.cout, float(y0), float(the[-1]), want_j, self.w, self.x, self.dw,
+                        self.dx, self.gin, self.gout, self.yhat, self.jac)
 
-    def admissible(self, th) -> bool:
-        pin, _, f, pout, _ = self.split(th)
+    def admissible(self, the) -> bool:
+        pin, _, f, pout, _ = self.split(the[:-1])
         if len(f) and np.max(np.abs(np.roots(np.r_[1.0, f]))) >= 1.0 - 1e-9:
             return False
         for nl, p in ((self.fin, pin), (self.fout, pout)):
@@ -243,7 +248,8 @@ class _Problem:
 
 
 def _lm(prob: _Problem, y, th0, maxiter: int = 200):
-    """Levenberg–Marquardt on the simulation error; returns θ, SSE, J at θ, iterations.
+    """Levenberg–Marquardt on the simulation error over ``[θ, w₋]``; returns them, SSE, J there,
+    iterations.
 
     Stops when a step lowers the SSE by less than ``1e-4 σ̂²`` (``σ̂² = SSE/N``): a move of one
     standard deviation in any parameter changes the SSE by about ``σ²``, so the parameters are
@@ -341,7 +347,8 @@ class HWModel:
     parameters, y0] (names in ``names``), ``theta_std`` (1σ, inf where the data do not determine
     it), ``covariance``; ``fit_percent`` (free run, estimation record), ``validation_fit_percent``
     (free run on ``validate=``, None when diverged or none given), ``criterion`` (how structure
-    and orders were chosen), ``candidates`` (every structure tried with its score)."""
+    and orders were chosen), ``candidates`` (every structure tried with its score),
+    ``initial_input`` (w₋ of the estimation record's initial steady state)."""
 
     input_nl: Nonlinearity
     output_nl: Nonlinearity
@@ -357,6 +364,7 @@ class HWModel:
     validation_fit_percent: float | None = None
     criterion: str = ""
     candidates: list = field(default_factory=list)
+    initial_input: float | None = None
     input_name: str = "u"
     output_name: str = "y"
     structure: str = "hw"
@@ -463,14 +471,18 @@ class HWModel:
                             f"{a.shape}")
         return [_signal(a, "u")]
 
-    def simulate(self, data, *, std: bool = False, warn: bool = True):
+    def simulate(self, data, *, std: bool = False, warn: bool = True, initial_input=None):
         """Free run on ``data``'s input (a Trajectory with the model's input column, or an array
-        (N,)) → (N, 1); with ``std=True`` also its 1σ (N, 1) from the parameter covariance
-        (linearised, module docstring). A diverging run is NaN from where it left the range, after
-        a StabilityWarning."""
+        (N,)) → (N, 1), from the linear block's steady state under the constant input
+        ``initial_input`` (w₋; default ``f(u(0))``, the steady state at the first input sample).
+        With ``std=True`` also its 1σ (N, 1) from the parameter covariance (linearised, module
+        docstring). A diverging run is NaN from where it left the range, after a
+        StabilityWarning."""
         u = self._columns(data, False)[0]
+        if initial_input is None:
+            initial_input = float(self.input_nonlinearity(u[:1])[0])
         prob = self._problem(u)
-        prob.run(self.theta, std)
+        prob.run(np.r_[self.theta, float(initial_input)], std)
         y = prob.yhat.copy()
         lo, hi = self._limits()
         out = np.flatnonzero(~((y >= lo) & (y <= hi)))
@@ -482,17 +494,44 @@ class HWModel:
                              "does not hold on this input", StabilityWarning)
         if not std:
             return y[:, None]
+        J = prob.jac[:, :-1]
         C = np.where(np.isfinite(self.covariance), self.covariance, 0.0)
-        var = np.einsum("ij,jk,ik->i", prob.jac, C, prob.jac)
-        sd = np.sqrt(np.maximum(var, 0.0))
-        if not np.all(np.isfinite(self.theta_std)):
-            loose = ~np.isfinite(self.theta_std)
-            sd = np.where(np.any(np.abs(prob.jac[:, loose]) > 0, axis=1), np.inf, sd)
+        sd = np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", J, C, J), 0.0))
+        loose = ~np.isfinite(self.theta_std)
+        if loose.any():
+            sd = np.where(np.any(np.abs(J[:, loose]) > 0, axis=1), np.inf, sd)
         return y[:, None], sd[:, None]
 
+    def fit_initial_input(self, u, y) -> float:
+        """The constant input w₋ whose steady state best starts the free run on ``(u, y)`` (Gauss–
+        Newton on that one number, from ``f(u(0))``)."""
+        u, y = _signal(u, "u"), _signal(y, "y")
+        prob = self._problem(u)
+        wm = float(self.input_nonlinearity(u[:1])[0])
+        best = None
+        for _ in range(20):
+            if prob.run(np.r_[self.theta, wm], True) >= 0:
+                break
+            r = y - prob.yhat
+            sse = float(r @ r)
+            if best is not None and sse >= best[1]:
+                break
+            best = (wm, sse)
+            j = prob.jac[:, -1]
+            jj = float(j @ j)
+            if jj == 0.0:
+                break
+            step = float(j @ r) / jj
+            wm += step
+            if abs(step) <= 1e-10 * (abs(wm) + 1e-10):
+                break
+        return float(u[0]) if best is None else best[0]
+
     def compare(self, data, y=None, *, warn: bool = True) -> ModelFit:
-        """Free-run fit (%) on a record: a Trajectory with the input and output columns, an array
-        (N, 2) of [u, y], or ``compare(u, y)``. None (with a StabilityWarning) when it diverges."""
+        """Free-run fit (%) on a record (:data:`HW_FIT`): a Trajectory with the input and output
+        columns, an array (N, 2) of [u, y], or ``compare(u, y)``; the initial steady state is
+        fitted to the record (:meth:`fit_initial_input`). None (with a StabilityWarning) when the
+        run diverges."""
         if y is not None:
             u, yv = _signal(data, "u"), _signal(y, "y")
             if len(u) != len(yv):
@@ -500,7 +539,7 @@ class HWModel:
                                 "pair of equal length")
         else:
             u, yv = self._columns(data, True)
-        ys = self.simulate(u, warn=warn)
+        ys = self.simulate(u, warn=warn, initial_input=self.fit_initial_input(u, yv))
         fit = _fit_value(yv, ys[:, 0]) if np.all(np.isfinite(ys)) else None
         return ModelFit(self.outputs, [fit], ys, HW_FIT)
 
@@ -603,21 +642,17 @@ def _order(v, name: str, lo: int) -> int:
 
 
 def _fit_structure(u, y, fin, fout, nb, nf, nk, lin_start=None, maxiter=200):
-    """Fit one structure (orders given) from the linear start; several limit starts, the best
-    kept. Returns (θ, SSE, J, prob)."""
+    """Fit one structure (orders given) from the linear start ``[b, f, y0, w₋]``; several limit
+    starts, the best kept. Returns (``[θ, w₋]``, SSE, J, problem)."""
     if lin_start is None:
         b, f = _arx_start(u - u.mean(), y - y.mean(), nb, nf, nk)
         prob = _Problem(u, Nonlinearity(), Nonlinearity(), nb, nf, nk)
-        th0 = np.r_[b, f, y.mean() - b.sum() / (1 + f.sum()) * u.mean()]
+        th0 = np.r_[b, f, y.mean() - b.sum() / (1 + f.sum()) * u.mean(), u[0]]
         th, sse, J, _ = _lm(prob, y, th0, maxiter)
         if fin.kind == "none" and fout.kind == "none":
             return th, sse, J, prob
         lin_start = th
-    b, f, y0 = lin_start[:nb], lin_start[nb:nb + nf], lin_start[-1]
-    if fin.kind == "none" and fout.kind == "none":
-        prob = _Problem(u, fin, fout, nb, nf, nk)
-        th, sse, J, _ = _lm(prob, y, lin_start, maxiter)
-        return th, sse, J, prob
+    b, f, y0, wpre = lin_start[:nb], lin_start[nb:nb + nf], lin_start[-2], lin_start[-1]
     # the signal entering each block under the linear start
     lin = _Problem(u, Nonlinearity(), Nonlinearity(), nb, nf, nk)
     lin.run(lin_start, False)
@@ -628,10 +663,7 @@ def _fit_structure(u, y, fin, fout, nb, nf, nk, lin_start=None, maxiter=200):
     best = None
     for pin in _limit_starts(fin, u):
         for pout in _limit_starts(fout, xlin):
-            y0s = y0
-            if fout.kind in ("saturation", "deadzone"):  # keep the middle of x where it was
-                y0s = y0
-            th0 = np.r_[pin, b, f, pout, y0s]
+            th0 = np.r_[pin, b, f, pout, y0, wpre]
             if not prob.admissible(th0):
                 continue
             th, sse, J, _ = _lm(prob, y, th0, maxiter)
@@ -652,7 +684,7 @@ def _excitation_check(model: HWModel, u: np.ndarray):
             v = u
         else:
             prob = model._problem(u)
-            prob.run(model.theta, False)
+            prob.run(np.r_[model.theta, model.initial_input], False)
             v = prob.x[model.nk + model.nb + model.nf:]
         lo, hi = model._part("in" if where == "input" else "out")
         below, above = int(np.sum(v < lo)), int(np.sum(v > hi))
@@ -740,9 +772,13 @@ def hammerstein_wiener(u, y, *, input_nonlinearity=None, output_nonlinearity=Non
     y_range = (float(y.min()), float(y.max()))
     dtv = 1.0 if dt is None else float(dt)
 
-    def make(fin, fout, o, th, sse, J):
-        cov, std = _covariance(J, sse)
-        return HWModel(fin, fout, o[0], o[1], o[2], th, std, cov, dt=dtv, y_range=y_range)
+    def make(fin, fout, o, the, sse, J):
+        cov, std = _covariance(J, sse)  # with w₋: its uncertainty is in every other σ
+        P = len(the) - 1
+        m = HWModel(fin, fout, o[0], o[1], o[2], the[:P], std[:P], cov[:P, :P], dt=dtv,
+                    y_range=y_range)
+        m.initial_input = float(the[-1])
+        return m
 
     def score(m: HWModel, sse: float) -> float:
         if uv is None:
