@@ -78,7 +78,8 @@ def identify_hw(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 file
                    "poles": [[float(z.real), float(z.imag)] for z in m.poles],
                    "fit_percent": m.fit_percent, "fit_definition": m.fit_definition,
                    "validation": None if validate is None else
-                   {"data": str(validate), "fit_percent": m.validation_fit_percent},
+                   {"data": str(validate), "fit_percent": m.validation_fit_percent,
+                    "definition": m.fit_definition},
                    "candidates": m.candidates,
                    "model": None if out is None else str(out), "warnings": lines})
     else:

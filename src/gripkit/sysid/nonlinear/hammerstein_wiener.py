@@ -695,21 +695,24 @@ def _excitation_check(model: HWModel, u: np.ndarray):
                 f"hammerstein_wiener: the {where} dead zone [{lo:.6g}, {hi:.6g}] is never left: "
                 f"all {len(v)} samples of {sname} lie inside it, so the output does not depend on "
                 "the input; excite beyond the dead zone or choose another nonlinearity")
-        if nl.kind == "deadzone" and (below == 0 or above == 0 or inside == 0):
-            side = "below the lower" if below == 0 else "above the upper" if above == 0 else \
-                "inside the"
+        few = max(3, math.ceil(0.005 * len(v)))
+        if nl.kind == "deadzone" and min(below, above, inside) < few:
+            where_ = ("below the lower threshold" if below < few else
+                      "above the upper threshold" if above < few else "inside it")
+            k = min(below, above, inside)
             emit_warning(f"hammerstein_wiener: the data never cross the {where} dead zone "
-                         f"[{lo:.6g}, {hi:.6g}]: no sample of {sname} {side} threshold, so "
-                         f"{'the thresholds are' if inside == 0 else 'that threshold is'} not "
-                         "identified (σ = inf or confounded with the offset); excite both sides "
-                         "of the dead zone", AccuracyWarning)
-        if nl.kind == "saturation" and (below == 0 or above == 0):
-            side = "lower" if below == 0 else "upper"
-            emit_warning(f"hammerstein_wiener: the {where} saturation's {side} limit is never "
-                         f"reached by the data (no sample of {sname} "
-                         f"{'below' if below == 0 else 'above'} "
-                         f"{lo if below == 0 else hi:.6g}); it is not identified (σ = inf)",
+                         f"[{lo:.6g}, {hi:.6g}]: only {k} of {len(v)} samples of {sname} lie "
+                         f"{where_}, so its thresholds are not identified (σ = inf, or "
+                         "confounded with the offset y0); excite both sides of the dead zone",
                          AccuracyWarning)
+        if nl.kind == "saturation" and min(below, above) < few:
+            side = "lower" if below < few else "upper"
+            k = min(below, above)
+            emit_warning(f"hammerstein_wiener: the {where} saturation's {side} limit "
+                         f"{lo if below < few else hi:.6g} is never reached by the data (only {k} "
+                         f"of {len(v)} samples of {sname} beyond it), so it is not identified "
+                         "(σ = inf or meaningless); excite beyond the limit or choose another "
+                         "nonlinearity", AccuracyWarning)
 
 
 def hammerstein_wiener(u, y, *, input_nonlinearity=None, output_nonlinearity=None,
