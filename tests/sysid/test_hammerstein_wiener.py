@@ -175,6 +175,11 @@ def test_save_load_round_trip(tmp_path):
     other.write_text(json.dumps({"schema": "gripkit.narx-model", "version": 1}))
     with pytest.raises(ModelError, match="expected 'gripkit.hw-model'"):
         load_hw(other)
+    doc = json.loads(path.read_text())
+    doc["theta"] = doc["theta"][:-1]
+    other.write_text(json.dumps(doc))
+    with pytest.raises(ModelError, match="a malformed gripkit.hw-model"):
+        load_hw(other)
 
 
 def test_deadzone_never_crossed_is_named():
@@ -280,6 +285,8 @@ def test_cli_identify_hw_json_compare_and_simulate(tmp_path, capsys):
     assert code == 0, err
     assert json.loads(out)["outputs"]["force"]["final"] == pytest.approx(
         load_hw(model).simulate(uv)[-1, 0], rel=1e-9)
+    code, out, err = _cli(capsys, "report", model, val, "--fs", 100, "--out", tmp_path / "rep")
+    assert code != 0 and err.startswith("error: ModelError: gripkit report draws linear models")
     code, out, err = _cli(capsys, "identify", "hw", est, "--input", "valve", "--output", "force",
                           "--fs", 100, "--output-nonlinearity", "cubic")
     assert code != 0 and err.startswith("error: ArgumentError: hammerstein_wiener: "

@@ -547,7 +547,7 @@ class HWModel:
     def to_dict(self) -> dict:
         fin = lambda v: float(v) if np.isfinite(v) else None  # noqa: E731
         nl = lambda n: {"kind": n.kind, "n": n.n, "consts": list(n.consts)}  # noqa: E731
-        return dict(schema=SCHEMA, version=VERSION, kind=self.kind, input_nonlinearity=nl(
+        return dict(schema=SCHEMA, schema_version=VERSION, kind=self.kind, input_nonlinearity=nl(
             self.input_nl), output_nonlinearity=nl(self.output_nl), nb=self.nb, nf=self.nf,
             nk=self.nk, dt=self.dt, y_range=[float(v) for v in self.y_range], names=self.names,
             theta=[float(v) for v in self.theta], theta_std=[fin(v) for v in self.theta_std],
@@ -599,9 +599,10 @@ def load_hw(path) -> HWModel:
     if schema != SCHEMA:
         raise ModelError(f"{str(p)!r} has schema {schema!r}, expected {SCHEMA!r}; load other model "
                          "files with gripkit.sysid.load_model")
-    if doc.get("version") != VERSION:
-        raise ModelError(f"{str(p)!r} is a {SCHEMA} of version {doc.get('version')!r}; this "
-                         f"gripkit reads version {VERSION}")
+    if doc.get("schema_version") != VERSION:
+        raise ModelError(f"{str(p)!r} is a {SCHEMA} of schema_version "
+                         f"{doc.get('schema_version')!r}; this gripkit reads version {VERSION}",
+                         hint="write it again with this gripkit's HWModel.save")
     try:
         nls = []
         for key in ("input_nonlinearity", "output_nonlinearity"):
