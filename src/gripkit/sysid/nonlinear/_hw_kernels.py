@@ -158,3 +158,35 @@ def hw_run(u, kin, pin, cin, b, f, nk, kout, pout, cout, y0, wpre, want_j, w, x,
             jac[r, nl + no] = 1.0
             jac[r, nl + no + 1] = gd * dx[t, nl]
     return bad
+
+
+@njit(cache=True)
+def gram(jac, r, H, g):
+    """``H = JᵀJ`` and ``g = Jᵀr`` in one pass, single-threaded: BLAS's threads on these thin
+    (N × P) products cost more than they give on a shared machine."""
+    n, p = jac.shape
+    for a in range(p):
+        g[a] = 0.0
+        for b in range(p):
+            H[a, b] = 0.0
+    for t in range(n):
+        rt = r[t]
+        for a in range(p):
+            ja = jac[t, a]
+            g[a] += ja * rt
+            for b in range(a, p):
+                H[a, b] += ja * jac[t, b]
+    for a in range(p):
+        for b in range(a):
+            H[a, b] = H[b, a]
+
+
+@njit(cache=True)
+def residual(y, yhat, r):
+    """``r = y − ŷ`` and its sum of squares (single-threaded, as :func:`gram`)."""
+    s = 0.0
+    for t in range(y.shape[0]):
+        e = y[t] - yhat[t]
+        r[t] = e
+        s += e * e
+    return s

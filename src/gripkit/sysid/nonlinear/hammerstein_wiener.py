@@ -33,10 +33,13 @@ block (``u`` for the input block; ``x``, the output's unit before ``g``, for the
 
 **Estimation.** (1) Orders: ``(nb, nf)`` in (1, 1), (2, 2), (3, 3) and ``nk`` in 0, 1, 2 unless
 given, each by a linear output-error fit (the best linear approximation: least-squares ARX,
-unstable poles reflected into the unit circle, then the PEM below with both blocks ``none``).
+unstable poles reflected into the unit circle, then the PEM below with both blocks ``none``,
+at most 30 iterations per candidate while screening, the chosen one to convergence).
 (2) Nonlinear fits from that linear model with the nonlinearities at identity (``c = d = a = 0``)
 and, for saturation and dead zone, limits started at quantiles of the signal entering the block
-(a few starts, the best kept). (3) Levenberg–Marquardt on ``V(θ) = ½ Σ (y − ŷ(θ))²`` with
+(a few starts, the best kept); when the orders were searched and the best structure is
+nonlinear, it is fitted again at the other ``(nb, nf)`` (same ``nk``), since a linear
+approximation of a nonlinear system often asks for extra poles. (3) Levenberg–Marquardt on ``V(θ) = ½ Σ (y − ŷ(θ))²`` with
 Marquardt's diagonal scaling; the Jacobian is exact: the forward sensitivities
 ``∂x/∂b_i = q^-(nk+i-1) w − Σ f_j ∂x/∂b_i(t−j)``, ``∂x/∂f_j = −x(t−j) − Σ f_l ∂x/∂f_j(t−l)``,
 ``∂x/∂p_f = B/F ∂f/∂p_f`` and ``∂ŷ/∂θ = g'(x) ∂x/∂θ`` (``∂ŷ/∂p_g = ∂g/∂p_g``) run beside the
@@ -100,6 +103,8 @@ AUTO_STRUCTURES = (("none", "none"), ("saturation", "none"), ("deadzone", "none"
 AUTO_ORDERS = ((1, 1), (2, 2), (3, 3))
 AUTO_NK = (0, 1, 2)
 _EIG_FLOOR = 1e-10
+#: LM iterations of each linear fit while the orders are screened (the chosen one then converges)
+SCREEN_ITERATIONS = 30
 
 
 @dataclass(frozen=True)
@@ -257,15 +262,14 @@ def _lm(prob: _Problem, y, th0, maxiter: int = 200):
     th = np.array(th0, dtype=np.float64)
     if prob.run(th, True) >= 0:
         return th, math.inf, None, 0
-    r = y - prob.yhat
-    sse = float(r @ r)
+    r, rc = np.empty(len(y)), np.empty(len(y))
+    sse = K.residual(y, prob.yhat, r)
     n = len(y)
+    H, g = np.empty((len(th), len(th))), np.empty(len(th))
     lam = 1e-3
     it = 0
     for it in range(1, maxiter + 1):
-        J = prob.jac
-        H = J.T @ J
-        g = J.T @ r
+        K.gram(prob.jac, r, H, g)
         d = np.sqrt(np.maximum(np.diag(H), 0.0))
         d[d == 0] = 1.0
         Hs = H / np.outer(d, d)
@@ -279,8 +283,7 @@ def _lm(prob: _Problem, y, th0, maxiter: int = 200):
                 continue
             cand = th + step
             if prob.admissible(cand) and prob.run(cand, False) < 0:
-                rc = y - prob.yhat
-                sc = float(rc @ rc)
+                sc = K.residual(y, prob.yhat, rc)
                 if sc < sse:
                     improved = True
                     break
@@ -288,21 +291,22 @@ def _lm(prob: _Problem, y, th0, maxiter: int = 200):
         if not improved:
             break
         gain = sse - sc
-        th, sse, r = cand, sc, rc
+        th, sse = cand, sc
+        r, rc = rc, r
         lam = max(lam / 10.0, 1e-12)
         if gain < 1e-4 * sse / n:
             break
         prob.run(th, True)
     prob.run(th, True)
-    r = y - prob.yhat
-    return th, float(r @ r), prob.jac.copy(), it
+    return th, K.residual(y, prob.yhat, r), prob.jac.copy(), it
 
 
 def _covariance(J: np.ndarray, sse: float):
     """Gauss–Newton covariance σ²(JᵀJ)⁻¹ on the directions the data determine; σ = inf for every
     parameter along an undetermined direction."""
     n, P = J.shape
-    H = J.T @ J
+    H, g = np.empty((P, P)), np.empty(P)
+    K.gram(J, np.zeros(n), H, g)
     d = np.sqrt(np.maximum(np.diag(H), 0.0))
     ok = d > 0
     ds = np.where(ok, d, 1.0)
@@ -790,14 +794,18 @@ def hammerstein_wiener(u, y, *, input_nonlinearity=None, output_nonlinearity=Non
         f = m.compare(uv, yv, warn=False).fit_percent[0]
         return -math.inf if f is None else f
 
-    steps = len(orders) + len(structures)
+    searched = nb is None or nf is None
+    dyn = list(dict.fromkeys((nb if nb is not None else b_, nf if nf is not None else f_)
+                             for b_, f_ in AUTO_ORDERS))
+    steps = len(orders) + len(structures) + (len(dyn) - 1 if searched else 0)
     bar = iter(track(range(steps), total=steps, description="hw fit", enabled=progress))
     t0 = time.perf_counter()
     # (1) orders on the linear output-error model
     lin_fits = {}
+    screen = maxiter if len(orders) == 1 else min(maxiter, SCREEN_ITERATIONS)
     for o in orders:
         next(bar, None)
-        th, sse, J, _ = _fit_structure(u, y, Nonlinearity(), Nonlinearity(), *o, maxiter=maxiter)
+        th, sse, J, _ = _fit_structure(u, y, Nonlinearity(), Nonlinearity(), *o, maxiter=screen)
         if J is None:
             continue
         lin_fits[o] = (th, sse, J)
@@ -807,11 +815,13 @@ def hammerstein_wiener(u, y, *, input_nonlinearity=None, output_nonlinearity=Non
     ranked = sorted(lin_fits, key=lambda o: -score(make(Nonlinearity(), Nonlinearity(), o,
                                                         *lin_fits[o]), lin_fits[o][1]))
     o = ranked[0]
+    if screen < maxiter:  # the chosen orders' linear model to convergence
+        th, sse, J, _ = _lm(_Problem(u, Nonlinearity(), Nonlinearity(), *o), y, lin_fits[o][0],
+                            maxiter)
+        lin_fits[o] = (th, sse, J)
     chosen_by = "validation free-run fit" if uv is not None else "BIC"
-    # (2) structures at those orders
-    cands = []
-    for fin, fout in structures:
-        next(bar, None)
+
+    def fit_at(fin, fout, o):
         if fin.kind == "none" and fout.kind == "none":
             th, sse, J = lin_fits[o]
             fin_c, fout_c = fin, fout
@@ -820,10 +830,25 @@ def hammerstein_wiener(u, y, *, input_nonlinearity=None, output_nonlinearity=Non
                                               maxiter=maxiter)
             fin_c, fout_c = prob.fin, prob.fout
         m = make(fin_c, fout_c, o, th, sse, J)
-        cands.append((score(m, sse), m, sse))
+        return score(m, sse), m, (fin, fout)
+
+    # (2) structures at those orders
+    cands = []
+    for fin, fout in structures:
+        next(bar, None)
+        cands.append(fit_at(fin, fout, o))
+    cands.sort(key=lambda c: -c[0])
+    # (3) a nonlinear structure may need fewer poles than the linear approximation: (nb, nf)
+    # chosen again for it, with the delay of step (1)
+    refit = []
+    if searched and cands[0][1].kind != "linear":
+        for b_, f_ in dyn:
+            if (b_, f_, o[2]) != o and (b_, f_, o[2]) in lin_fits:
+                next(bar, None)
+                refit.append(fit_at(*cands[0][2], (b_, f_, o[2])))
     for _ in bar:
         pass
-    cands.sort(key=lambda c: -c[0])
+    cands = sorted(cands + refit, key=lambda c: -c[0])
     best = cands[0][1]
     best.candidates = [{"input": c[1].input_nl.label, "output": c[1].output_nl.label,
                         "nb": c[1].nb, "nf": c[1].nf, "nk": c[1].nk,
@@ -831,11 +856,12 @@ def hammerstein_wiener(u, y, *, input_nonlinearity=None, output_nonlinearity=Non
                         (c[0] if uv is not None else -c[0])} for c in cands]
     what = []
     if nb is None or nf is None or nk is None:
-        what.append(f"orders [nb nf nk] = [{o[0]} {o[1]} {o[2]}] by {chosen_by} of the linear "
-                    "model")
+        what.append(f"orders [nb nf nk] = [{best.nb} {best.nf} {best.nk}] by {chosen_by} (the "
+                    f"delay on the linear model"
+                    f"{'; nb and nf again for the structure' if refit else ''})")
     if auto:
         what.append(f"structure {best.input_nl.label}/{best.output_nl.label} by {chosen_by} "
-                    f"among {len(cands)}")
+                    f"among {len(structures)}")
     best.criterion = "; ".join(what) if what else "structure and orders given"
     _excitation_check(best, u)
     fit = best.compare(u, y)
