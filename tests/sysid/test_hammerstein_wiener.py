@@ -277,6 +277,7 @@ def test_cli_identify_hw_json_compare_and_simulate(tmp_path, capsys):
                             validate=(uv, yv))
     assert d["validation"]["fit_percent"] == pytest.approx(py.validation_fit_percent, abs=1e-6)
     assert d["fit_percent"] > 95.0 and d["warnings"] == []
+    assert "hw fit" in err                                             # the progress bar
     code, out, err = _cli(capsys, "compare", model, val, "--fs", 100, "--json")
     assert code == 0, err
     assert json.loads(out)["fit_percent"][0] == pytest.approx(d["validation"]["fit_percent"],
@@ -306,3 +307,39 @@ def test_cli_warning_lands_in_json(tmp_path, capsys):
                               2, "--nk", 1, "--json")
     assert code == 0, err
     assert any("never cross the input dead zone" in w for w in json.loads(out)["warnings"])
+
+
+def test_dc_motor_record_wiener_beats_the_linear_model():
+    """The measured DC-motor record (tests/fixtures/dc_motor, SysIdentPy's split: first 500
+    samples estimate, last 500 validate). Measured: the output-error model [2 2 1] 43.6 %, the
+    Wiener model with a quartic output block 72.5 % (free run, w₋ fitted); asserted with margins.
+    The input is two-level, so an input block adds nothing; NARX reaches 94 % (test_narx.py)."""
+    from pathlib import Path
+
+    d = np.loadtxt(Path(__file__).resolve().parents[1] / "fixtures" / "dc_motor" / "dc_motor.csv",
+                   delimiter=",", skiprows=1)
+    ue, ye, uv, yv = d[:500, 0], d[:500, 1], d[500:, 0], d[500:, 1]
+    lin = hammerstein_wiener(ue, ye, input_nonlinearity="none", nb=2, nf=2, nk=1)
+    wie = hammerstein_wiener(ue, ye, output_nonlinearity="poly:4", nb=2, nf=2, nk=1,
+                             validate=(uv, yv))
+    lin_fit = lin.compare(uv, yv).fit_percent[0]
+    assert 35.0 < lin_fit < 50.0
+    assert wie.validation_fit_percent > 68.0 and wie.validation_fit_percent > lin_fit + 20.0
+
+
+@pytest.mark.slow
+def test_recovery_monte_carlo_50_runs_and_structure_found():
+    """The larger study: 50 runs of each system, ≥ 90 % of the (run, parameter) pairs within 3σ
+    (measured 99.7–100 %, and 66.6–69.0 % within 1σ: σ honest), and the Hammerstein saturation
+    structure chosen by BIC among the 8 in ≥ 18 of 20 runs (measured 20)."""
+    for system in SYSTEMS:
+        inside = total = 0
+        for i in range(50):
+            u, y, kw, true = system(np.random.default_rng(5000 + i))
+            m = hammerstein_wiener(u, y, nb=2, nf=2, nk=1, **kw)
+            inside += int(np.sum(np.abs(m.theta - true) < 3.0 * m.theta_std))
+            total += len(true)
+        assert inside >= 0.9 * total, (system.__name__, inside, total)
+    found = sum(hammerstein_wiener(*hammerstein_saturation(np.random.default_rng(7000 + i))[:2])
+                .input_nl.kind == "saturation" for i in range(20))
+    assert found >= 18
