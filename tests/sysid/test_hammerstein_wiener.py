@@ -133,15 +133,17 @@ def test_recovery_monte_carlo_parameters_within_3_sigma():
 
 
 @pytest.mark.parametrize("system, found", [(hammerstein_saturation, ("saturation", "none")),
-                                           (wiener_poly, ("none", "poly:3"))])
+                                           (wiener_poly, ("none", "poly:3")),
+                                           (hammerstein_wiener_sat_poly, ("saturation", "poly:3"))])
 def test_structure_and_orders_found_by_bic(system, found):
-    """Without options the structure among the 8 candidates and the orders among 9 (then nb, nf
-    again for the structure) are chosen by BIC: the true ones, with a fit near the noise floor."""
+    """Without options the structure among the 8 candidates and 4 joined ones, and the orders
+    among 9 (then nb, nf again for the structure) are chosen by BIC: the true ones, with a fit
+    near the noise floor."""
     u, y, _, _ = system(np.random.default_rng(11), n=1500)
     m = hammerstein_wiener(u, y)
     assert (m.input_nl.label, m.output_nl.label) == found
     assert (m.nb, m.nf, m.nk) == (2, 2, 1)
-    assert "BIC" in m.criterion and len(m.candidates) == 8 + 2     # + (1, 1), (3, 3) refits
+    assert "BIC" in m.criterion and len(m.candidates) == 8 + 4 + 2   # + 4 joined, 2 refits
     assert m.fit_percent > 90.0
 
 

@@ -60,8 +60,9 @@ saturation limit that the data never reach). ``simulate(data, std=True)`` propag
 the free run linearly: ``σ_ŷ(t)² = J(t) cov θ J(t)ᵀ``.
 
 **Structure.** Without ``input_nonlinearity``/``output_nonlinearity`` the candidates are the
-linear model, the Hammerstein models with saturation, dead zone, poly:3 and pwl:4, and the Wiener
-models with saturation, poly:3 and pwl:4. They (and the orders) are ranked by the free-run fit on
+linear model, the Hammerstein models with saturation, dead zone, poly:3 and pwl:4, the Wiener
+models with saturation, poly:3 and pwl:4, and the Hammerstein–Wiener models that join the two
+best of those input blocks to the two best of those output blocks. They (and the orders) are ranked by the free-run fit on
 ``validate=`` when given, else by ``BIC = N ln(SSE/N) + P ln N`` on the estimation record.
 
 The fit is ``100 (1 − ‖y − ŷ‖/‖y − ȳ‖)`` over all samples of the free run. A run that leaves
@@ -100,6 +101,8 @@ DEFAULT_N = {"poly": 3, "pwl": 4, "sigmoid": 4}
 AUTO_STRUCTURES = (("none", "none"), ("saturation", "none"), ("deadzone", "none"),
                    ("poly:3", "none"), ("pwl:4", "none"), ("none", "saturation"),
                    ("none", "poly:3"), ("none", "pwl:4"))
+#: input and output blocks joined into Hammerstein–Wiener candidates (the best of each side)
+N_JOINED = 2
 AUTO_ORDERS = ((1, 1), (2, 2), (3, 3))
 AUTO_NK = (0, 1, 2)
 _EIG_FLOOR = 1e-10
@@ -797,7 +800,8 @@ def hammerstein_wiener(u, y, *, input_nonlinearity=None, output_nonlinearity=Non
     searched = nb is None or nf is None
     dyn = list(dict.fromkeys((nb if nb is not None else b_, nf if nf is not None else f_)
                              for b_, f_ in AUTO_ORDERS))
-    steps = len(orders) + len(structures) + (len(dyn) - 1 if searched else 0)
+    steps = (len(orders) + len(structures) + (N_JOINED**2 if auto else 0)
+             + (len(dyn) - 1 if searched else 0))
     bar = iter(track(range(steps), total=steps, description="hw fit", enabled=progress))
     t0 = time.perf_counter()
     # (1) orders on the linear output-error model
@@ -837,6 +841,15 @@ def hammerstein_wiener(u, y, *, input_nonlinearity=None, output_nonlinearity=Non
     for fin, fout in structures:
         next(bar, None)
         cands.append(fit_at(fin, fout, o))
+    # Hammerstein–Wiener candidates: the two best input blocks with the two best output blocks
+    ins = sorted((c for c in cands if c[2][0].kind != "none" and c[2][1].kind == "none"),
+                 key=lambda c: -c[0])[:N_JOINED]
+    outs = sorted((c for c in cands if c[2][0].kind == "none" and c[2][1].kind != "none"),
+                  key=lambda c: -c[0])[:N_JOINED]
+    for ci in ins if auto else ():
+        for co in outs:
+            next(bar, None)
+            cands.append(fit_at(ci[2][0], co[2][1], o))
     cands.sort(key=lambda c: -c[0])
     # (3) a nonlinear structure may need fewer poles than the linear approximation: (nb, nf)
     # chosen again for it, with the delay of step (1)
@@ -861,7 +874,8 @@ def hammerstein_wiener(u, y, *, input_nonlinearity=None, output_nonlinearity=Non
                     f"{'; nb and nf again for the structure' if refit else ''})")
     if auto:
         what.append(f"structure {best.input_nl.label}/{best.output_nl.label} by {chosen_by} "
-                    f"among {len(structures)}")
+                    f"among {len(structures)} and {len(cands) - len(structures) - len(refit)} "
+                    "joined")
     best.criterion = "; ".join(what) if what else "structure and orders given"
     _excitation_check(best, u)
     fit = best.compare(u, y)
