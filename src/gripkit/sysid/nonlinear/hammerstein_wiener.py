@@ -63,7 +63,8 @@ the free run linearly: ``σ_ŷ(t)² = J(t) cov θ J(t)ᵀ``.
 linear model, the Hammerstein models with saturation, dead zone, poly:3 and pwl:4, the Wiener
 models with saturation, poly:3 and pwl:4, and the Hammerstein–Wiener models that join the two
 best of those input blocks to the two best of those output blocks. They (and the orders) are ranked by the free-run fit on
-``validate=`` when given, else by ``BIC = N ln(SSE/N) + P ln N`` on the estimation record.
+``validate=`` when given (among those within 0.1 point of the best: one whose parameters the
+data all determine, then the fewest parameters), else by ``BIC = N ln(SSE/N) + P ln N`` on the estimation record.
 
 The fit is ``100 (1 − ‖y − ŷ‖/‖y − ȳ‖)`` over all samples of the free run. A run that leaves
 ``1000×`` the estimation output's range (about its middle) or is not finite counts as diverged:
@@ -101,6 +102,8 @@ DEFAULT_N = {"poly": 3, "pwl": 4, "sigmoid": 4}
 AUTO_STRUCTURES = (("none", "none"), ("saturation", "none"), ("deadzone", "none"),
                    ("poly:3", "none"), ("pwl:4", "none"), ("none", "saturation"),
                    ("none", "poly:3"), ("none", "pwl:4"))
+#: with ``validate=``, the simplest candidate within this many fit points of the best is taken
+PARSIMONY_POINTS = 0.1
 #: input and output blocks joined into Hammerstein–Wiener candidates (the best of each side)
 N_JOINED = 2
 AUTO_ORDERS = ((1, 1), (2, 2), (3, 3))
@@ -863,6 +866,10 @@ def hammerstein_wiener(u, y, *, input_nonlinearity=None, output_nonlinearity=Non
         pass
     cands = sorted(cands + refit, key=lambda c: -c[0])
     best = cands[0][1]
+    if uv is not None:  # parsimony: within 0.1 fit point of the best, every parameter
+        # determined by the data (finite σ) before any is not, then the fewest parameters
+        best = min((c for c in cands if c[0] >= cands[0][0] - PARSIMONY_POINTS),
+                   key=lambda c: (not np.all(np.isfinite(c[1].theta_std)), len(c[1].theta)))[1]
     best.candidates = [{"input": c[1].input_nl.label, "output": c[1].output_nl.label,
                         "nb": c[1].nb, "nf": c[1].nf, "nk": c[1].nk,
                         ("validation_fit_percent" if uv is not None else "bic"):
@@ -878,6 +885,12 @@ def hammerstein_wiener(u, y, *, input_nonlinearity=None, output_nonlinearity=Non
                     "joined")
     best.criterion = "; ".join(what) if what else "structure and orders given"
     _excitation_check(best, u)
+    loose = [n for n, sd in zip(best.names, best.theta_std) if not np.isfinite(sd)]
+    if loose:
+        emit_warning(f"hammerstein_wiener: the data do not determine {', '.join(loose)} of the "
+                     f"{best.input_nl.label}/{best.output_nl.label} model (σ = inf: they trade "
+                     "off against other parameters without changing the output); excite more "
+                     "amplitudes, or choose a simpler block", AccuracyWarning)
     fit = best.compare(u, y)
     best.fit_percent = fit.fit_percent[0]
     if uv is not None:
