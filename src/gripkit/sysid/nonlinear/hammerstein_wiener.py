@@ -31,16 +31,17 @@ between the limits of a saturation and outside the thresholds of a dead zone): t
 whole chain is in ``B``, and thresholds and limits are in the units of the signal entering the
 block (``u`` for the input block; ``x``, the output's unit before ``g``, for the output block).
 
-**Estimation.** (1) Orders: ``(nb, nf)`` in (1, 1), (2, 2), (3, 3) and ``nk`` in 0, 1, 2 unless
-given, each by a linear output-error fit (the best linear approximation: least-squares ARX,
-unstable poles reflected into the unit circle, then the PEM below with both blocks ``none``,
-at most 30 iterations per candidate while screening, the chosen one to convergence).
+**Estimation.** (1) Orders: ``(nb, nf)`` in (1, 1), (2, 2), (3, 3) and ``nk`` in 0, 1, 2
+unless given, each by a linear output-error fit (the best linear approximation: least-squares
+ARX, unstable poles reflected into the unit circle, then the PEM of (3) with both blocks
+``none``; at most 30 iterations per candidate while screening, the chosen one to convergence).
 (2) Nonlinear fits from that linear model with the nonlinearities at identity (``c = d = a = 0``)
 and, for saturation and dead zone, limits started at quantiles of the signal entering the block
-(a few starts, the best kept); when the orders were searched and the best structure is
-nonlinear, it is fitted again at the other ``(nb, nf)`` (same ``nk``), since a linear
-approximation of a nonlinear system often asks for extra poles. (3) Levenberg–Marquardt on ``V(θ) = ½ Σ (y − ŷ(θ))²`` with
-Marquardt's diagonal scaling; the Jacobian is exact: the forward sensitivities
+(a few starts, the best kept). When the orders were searched and the best structure is
+nonlinear, it is fitted again at the other ``(nb, nf)`` with the same ``nk``: a linear
+approximation of a nonlinear system often asks for extra poles. (3) Levenberg–Marquardt on
+``V(θ) = ½ Σ (y − ŷ(θ))²`` with Marquardt's diagonal scaling, until a step lowers the SSE by
+less than ``1e-4 SSE/N``. The Jacobian is exact: the forward sensitivities
 ``∂x/∂b_i = q^-(nk+i-1) w − Σ f_j ∂x/∂b_i(t−j)``, ``∂x/∂f_j = −x(t−j) − Σ f_l ∂x/∂f_j(t−l)``,
 ``∂x/∂p_f = B/F ∂f/∂p_f`` and ``∂ŷ/∂θ = g'(x) ∂x/∂θ`` (``∂ŷ/∂p_g = ∂g/∂p_g``) run beside the
 free run in one numba kernel. A step that makes ``F`` unstable (a root with ``|z| ≥ 1``) or
@@ -56,15 +57,17 @@ Gauss–Newton on a validation record (:meth:`HWModel.compare`), and ``f(u(0))``
 **σ.** ``cov θ = σ² (JᵀJ)⁻¹`` (Gauss–Newton), ``σ² = SSE/(N − P)``, from the eigen-decomposition
 of the column-scaled ``JᵀJ``: a direction with eigenvalue below ``1e-10`` of the largest is not
 determined by the data, and every parameter that moves along it has σ = inf (for example a
-saturation limit that the data never reach). ``simulate(data, std=True)`` propagates ``cov θ`` to
-the free run linearly: ``σ_ŷ(t)² = J(t) cov θ J(t)ᵀ``.
+saturation limit that the data never reach; an AccuracyWarning names them).
+``simulate(data, std=True)`` propagates ``cov θ`` to the free run linearly:
+``σ_ŷ(t)² = J(t) cov θ J(t)ᵀ`` (inf where ŷ(t) depends on an undetermined parameter).
 
 **Structure.** Without ``input_nonlinearity``/``output_nonlinearity`` the candidates are the
 linear model, the Hammerstein models with saturation, dead zone, poly:3 and pwl:4, the Wiener
 models with saturation, poly:3 and pwl:4, and the Hammerstein–Wiener models that join the two
-best of those input blocks to the two best of those output blocks. They (and the orders) are ranked by the free-run fit on
-``validate=`` when given (among those within 0.1 point of the best: one whose parameters the
-data all determine, then the fewest parameters), else by ``BIC = N ln(SSE/N) + P ln N`` on the estimation record.
+best of those input blocks to the two best of those output blocks. They (and the orders) are
+ranked by the free-run fit on ``validate=`` when given (among those within 0.1 point of the
+best: one whose parameters the data all determine, then the fewest parameters), else by
+``BIC = N ln(SSE/N) + P ln N`` on the estimation record.
 
 The fit is ``100 (1 − ‖y − ŷ‖/‖y − ȳ‖)`` over all samples of the free run. A run that leaves
 ``1000×`` the estimation output's range (about its middle) or is not finite counts as diverged:
@@ -75,7 +78,6 @@ from __future__ import annotations
 
 import json
 import math
-import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -806,7 +808,6 @@ def hammerstein_wiener(u, y, *, input_nonlinearity=None, output_nonlinearity=Non
     steps = (len(orders) + len(structures) + (N_JOINED**2 if auto else 0)
              + (len(dyn) - 1 if searched else 0))
     bar = iter(track(range(steps), total=steps, description="hw fit", enabled=progress))
-    t0 = time.perf_counter()
     # (1) orders on the linear output-error model
     lin_fits = {}
     screen = maxiter if len(orders) == 1 else min(maxiter, SCREEN_ITERATIONS)
@@ -895,5 +896,4 @@ def hammerstein_wiener(u, y, *, input_nonlinearity=None, output_nonlinearity=Non
     best.fit_percent = fit.fit_percent[0]
     if uv is not None:
         best.validation_fit_percent = best.compare(uv, yv).fit_percent[0]
-    best.elapsed_s = time.perf_counter() - t0
     return best
