@@ -1,5 +1,6 @@
 """Nonlinear system identification (issue 26): polynomial NARX by forward regression with the
-error reduction ratio (:func:`narx`, :mod:`.narx`).
+error reduction ratio (:func:`narx`, :mod:`.narx`); Hammerstein, Wiener and Hammerstein–Wiener
+models (:func:`hammerstein_wiener`, :mod:`.hammerstein_wiener`).
 
 The public names are loaded on first use (the table ``_LAZY``, :mod:`gripkit.exports`).
 """
@@ -15,11 +16,17 @@ _LAZY = {
     "narx": ("narx", "narx"),
     "NARXModel": ("narx", "NARXModel"),
     "load_narx": ("narx", "load_narx"),
+    "hammerstein_wiener": ("hammerstein_wiener", "hammerstein_wiener"),
+    "HWModel": ("hammerstein_wiener", "HWModel"),
+    "load_hw": ("hammerstein_wiener", "load_hw"),
 }
 __getattr__, __dir__ = lazy_exports(__name__, _LAZY)
 __all__ = [*_LAZY]
 
 if TYPE_CHECKING:  # static readers see the same names, imported eagerly
+    from .hammerstein_wiener import HWModel as HWModel
+    from .hammerstein_wiener import hammerstein_wiener as hammerstein_wiener
+    from .hammerstein_wiener import load_hw as load_hw
     from .narx import NARXModel as NARXModel
     from .narx import load_narx as load_narx
     from .narx import narx as narx
