@@ -69,6 +69,10 @@ _LAZY = {
     "narx": ("nonlinear.narx", "narx"),
     "NARXModel": ("nonlinear.narx", "NARXModel"),
     "load_narx": ("nonlinear.narx", "load_narx"),
+    "hysteresis": ("nonlinear.hysteresis", "hysteresis"),
+    "BoucWenModel": ("nonlinear.hysteresis", "BoucWenModel"),
+    "PrandtlIshlinskiiModel": ("nonlinear.hysteresis", "PrandtlIshlinskiiModel"),
+    "load_hysteresis": ("nonlinear.hysteresis", "load_hysteresis"),
 }
 __getattr__, __dir__ = lazy_exports(__name__, _LAZY)
 __all__ = [*_LAZY]
@@ -121,3 +125,7 @@ if TYPE_CHECKING:  # static readers see the same names, imported eagerly
     from .nonlinear.narx import NARXModel as NARXModel
     from .nonlinear.narx import load_narx as load_narx
     from .nonlinear.narx import narx as narx
+    from .nonlinear.hysteresis import BoucWenModel as BoucWenModel
+    from .nonlinear.hysteresis import PrandtlIshlinskiiModel as PrandtlIshlinskiiModel
+    from .nonlinear.hysteresis import hysteresis as hysteresis
+    from .nonlinear.hysteresis import load_hysteresis as load_hysteresis

@@ -1,5 +1,6 @@
 """Nonlinear system identification (issue 26): polynomial NARX by forward regression with the
-error reduction ratio (:func:`narx`, :mod:`.narx`).
+error reduction ratio (:func:`narx`, :mod:`.narx`); hysteresis, generic Bouc-Wen and
+Prandtl–Ishlinskii with its inverse (:func:`hysteresis`, :mod:`.hysteresis`).
 
 The public names are loaded on first use (the table ``_LAZY``, :mod:`gripkit.exports`).
 """
@@ -15,6 +16,10 @@ _LAZY = {
     "narx": ("narx", "narx"),
     "NARXModel": ("narx", "NARXModel"),
     "load_narx": ("narx", "load_narx"),
+    "hysteresis": ("hysteresis", "hysteresis"),
+    "BoucWenModel": ("hysteresis", "BoucWenModel"),
+    "PrandtlIshlinskiiModel": ("hysteresis", "PrandtlIshlinskiiModel"),
+    "load_hysteresis": ("hysteresis", "load_hysteresis"),
 }
 __getattr__, __dir__ = lazy_exports(__name__, _LAZY)
 __all__ = [*_LAZY]
@@ -23,3 +28,7 @@ if TYPE_CHECKING:  # static readers see the same names, imported eagerly
     from .narx import NARXModel as NARXModel
     from .narx import load_narx as load_narx
     from .narx import narx as narx
+    from .hysteresis import BoucWenModel as BoucWenModel
+    from .hysteresis import PrandtlIshlinskiiModel as PrandtlIshlinskiiModel
+    from .hysteresis import hysteresis as hysteresis
+    from .hysteresis import load_hysteresis as load_hysteresis
