@@ -77,6 +77,25 @@ def _noise_floor(y0, sigma):
     return 100.0 * (1.0 - sigma * np.sqrt(len(y0)) / np.linalg.norm(y0 - y0.mean()))
 
 
+def test_generic_bouc_wen_agrees_with_the_piezo_identification():
+    """On one record of the seed's actuator, the generic family (n = 1, no offset) and the
+    piezo system's identify_bouc_wen (greybox fit of models.hysteresis.BoucWen, eq 3) find the
+    same minimum: λ = α d, β, γ and d_p to 1e-5, and the same σ to 1e-3."""
+    from gripkit.sysid import identify_bouc_wen
+
+    y = BoucWenModel(**SEED).simulate(U_PIEZO)[:, 0] + np.random.default_rng(2).normal(
+        0.0, 0.2e-6, N)
+    tr = Trajectory(T, {"U": U_PIEZO, "y": y}, {"U": "V", "y": "m"})
+    old = identify_bouc_wen(tr, progress=False)
+    new = hysteresis(tr, input="U", output="y", offset=False, progress=False)
+    assert new.free == ("d", "alpha", "beta", "gamma")
+    for k_old, v_new in (("d_p", new.d), ("lambda", new.lam), ("beta", new.beta),
+                         ("gamma", new.gamma)):
+        assert v_new == pytest.approx(old.params[k_old], rel=1e-5)
+    for k_old, k_new in (("d_p", "d"), ("beta", "beta"), ("gamma", "gamma")):
+        assert new.std[k_new] == pytest.approx(old.std[k_old], rel=1e-3)
+
+
 def _n2_case():
     true = dict(d=1.0, alpha=0.4, beta=3.0, gamma=1.0, offset=0.1)
     u = np.sin(2 * np.pi * 4 * T) * (1 - 0.6 * T)
