@@ -1,5 +1,5 @@
 """``gripkit identify hysteresis DATA --input U --output Y [--model bouc-wen|prandtl-ishlinskii]
-[--exponent N|free] [--operators M] [--validate DATA2] [--out MODEL.json] [--json]``: a generic
+[--form actuator|oscillator] [--exponent N|free] [--operators M] [--validate DATA2] [--out MODEL.json] [--json]``: a generic
 Bouc-Wen or Prandtl–Ishlinskii hysteresis from a record (:func:`gripkit.sysid.hysteresis`)."""
 
 from __future__ import annotations
@@ -39,6 +39,9 @@ def identify_hysteresis(data: Path = typer.Argument(..., help="CSV, Parquet or H
                                                        help="Output column (displacement)."),
                         model: str = typer.Option("bouc-wen", "--model",
                                                   help="bouc-wen or prandtl-ishlinskii."),
+                        form: str = typer.Option("actuator", "--form",
+                                                 help="Bouc-Wen form: actuator (y = d u − h) "
+                                                      "or oscillator (force on a mass)."),
                         exponent: str = typer.Option("1", "--exponent",
                                                      help="Bouc-Wen exponent n (1 = eq 3 of the "
                                                           "seed), or free."),
@@ -54,9 +57,10 @@ def identify_hysteresis(data: Path = typer.Argument(..., help="CSV, Parquet or H
                         fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
                         json_out: bool = JsonOpt):
     """Hysteresis (Bouc-Wen or Prandtl-Ishlinskii): parameters with σ, free-run fit."""
-    from ..sysid.nonlinear.hysteresis import MODELS, hysteresis
+    from ..sysid.nonlinear.hysteresis import FORMS, MODELS, hysteresis
 
     check_choice(model, "--model", MODELS)
+    check_choice(form, "--form", FORMS)
     n = _exponent(exponent)
     check_data_options(fs, fill)
     with collected_warnings() as caught:
@@ -64,15 +68,16 @@ def identify_hysteresis(data: Path = typer.Argument(..., help="CSV, Parquet or H
         val = None
         if validate is not None:
             val = load_data(validate, [input_col, output_col], fs, time, fill)
-        m = hysteresis(tr, model, input=input_col, output=output_col, exponent=n,
+        m = hysteresis(tr, model, input=input_col, output=output_col, form=form, exponent=n,
                        operators=operators, burn_in=burn_in, validate=val,
                        progress=not json_out)
         if out is not None:
             m.save(out)
     lines = report_warnings(caught)
     if json_out:
-        structure = ({"model": m.structure, "exponent": m.n, "exponent_estimated": "n" in m.free}
-                     if m.structure == "bouc-wen" else
+        structure = ({"model": model, "form": form, "exponent": m.n,
+                      "exponent_estimated": "n" in m.free}
+                     if model == "bouc-wen" else
                      {"model": m.structure, "operators": len(m.thresholds),
                       "thresholds": [float(r) for r in m.thresholds]})
         structure["criterion"] = m.criterion

@@ -71,6 +71,7 @@ _LAZY = {
     "load_narx": ("nonlinear.narx", "load_narx"),
     "hysteresis": ("nonlinear.hysteresis", "hysteresis"),
     "BoucWenModel": ("nonlinear.hysteresis", "BoucWenModel"),
+    "BoucWenOscillatorModel": ("nonlinear.hysteresis", "BoucWenOscillatorModel"),
     "PrandtlIshlinskiiModel": ("nonlinear.hysteresis", "PrandtlIshlinskiiModel"),
     "load_hysteresis": ("nonlinear.hysteresis", "load_hysteresis"),
 }
@@ -126,6 +127,7 @@ if TYPE_CHECKING:  # static readers see the same names, imported eagerly
     from .nonlinear.narx import load_narx as load_narx
     from .nonlinear.narx import narx as narx
     from .nonlinear.hysteresis import BoucWenModel as BoucWenModel
+    from .nonlinear.hysteresis import BoucWenOscillatorModel as BoucWenOscillatorModel
     from .nonlinear.hysteresis import PrandtlIshlinskiiModel as PrandtlIshlinskiiModel
     from .nonlinear.hysteresis import hysteresis as hysteresis
     from .nonlinear.hysteresis import load_hysteresis as load_hysteresis

@@ -18,6 +18,7 @@ _LAZY = {
     "load_narx": ("narx", "load_narx"),
     "hysteresis": ("hysteresis", "hysteresis"),
     "BoucWenModel": ("hysteresis", "BoucWenModel"),
+    "BoucWenOscillatorModel": ("hysteresis", "BoucWenOscillatorModel"),
     "PrandtlIshlinskiiModel": ("hysteresis", "PrandtlIshlinskiiModel"),
     "load_hysteresis": ("hysteresis", "load_hysteresis"),
 }
@@ -29,6 +30,7 @@ if TYPE_CHECKING:  # static readers see the same names, imported eagerly
     from .narx import load_narx as load_narx
     from .narx import narx as narx
     from .hysteresis import BoucWenModel as BoucWenModel
+    from .hysteresis import BoucWenOscillatorModel as BoucWenOscillatorModel
     from .hysteresis import PrandtlIshlinskiiModel as PrandtlIshlinskiiModel
     from .hysteresis import hysteresis as hysteresis
     from .hysteresis import load_hysteresis as load_hysteresis

@@ -25,8 +25,8 @@ from numba import njit
 
 from ...models.hysteresis import bouc_wen_advance
 
-__all__ = ["RK4_STEP", "bw_advance_rk4", "bw_simulate", "count_reversals", "play_matrix",
-           "pi_simulate"]
+__all__ = ["RK4_STEP", "bw_advance_rk4", "bw_simulate", "bwo_simulate", "count_reversals",
+           "play_matrix", "pi_simulate"]
 
 #: largest (local rate × input sub-step) of the Runge-Kutta integration (local error ~ step⁵/120)
 RK4_STEP = 0.02
@@ -166,3 +166,44 @@ def count_reversals(x, band):  # pragma: no cover - compiled
                 hi = v
                 turns += 1
     return turns
+
+
+@njit(cache=True)
+def _bwo_rates(x, v, z, u, m, c, ke, kh, beta, gamma, n):  # pragma: no cover - compiled
+    """(ẋ, v̇, ż) of the Bouc-Wen oscillator (A = 1)."""
+    a = abs(z) if n == 1.0 else abs(z) ** n
+    zp = a if z >= 0.0 else -a  # z |z|^(n−1)
+    return v, (u - c * v - ke * x - kh * z) / m, v - beta * abs(v) * zp - gamma * v * a
+
+
+@njit(cache=True)
+def bwo_simulate(u, dt, substeps, m, c, ke, kh, beta, gamma, n, offset, y):  # pragma: no cover
+    """Bouc-Wen oscillator from rest (x = ẋ = z = 0 at the first sample), the input held over
+    each sample, ``substeps`` RK4 steps per sample: y[k] = x(t_k) + offset. Returns the first
+    sample where y is not finite, −1 if none (the rest is NaN)."""
+    x = 0.0
+    v = 0.0
+    z = 0.0
+    h = dt / substeps
+    N = u.shape[0]
+    y[0] = offset
+    for k in range(N - 1):
+        uk = u[k]
+        for _ in range(substeps):
+            a1, b1, c1 = _bwo_rates(x, v, z, uk, m, c, ke, kh, beta, gamma, n)
+            a2, b2, c2 = _bwo_rates(x + 0.5 * h * a1, v + 0.5 * h * b1, z + 0.5 * h * c1, uk,
+                                    m, c, ke, kh, beta, gamma, n)
+            a3, b3, c3 = _bwo_rates(x + 0.5 * h * a2, v + 0.5 * h * b2, z + 0.5 * h * c2, uk,
+                                    m, c, ke, kh, beta, gamma, n)
+            a4, b4, c4 = _bwo_rates(x + h * a3, v + h * b3, z + h * c3, uk,
+                                    m, c, ke, kh, beta, gamma, n)
+            x += h * (a1 + 2.0 * a2 + 2.0 * a3 + a4) / 6.0
+            v += h * (b1 + 2.0 * b2 + 2.0 * b3 + b4) / 6.0
+            z += h * (c1 + 2.0 * c2 + 2.0 * c3 + c4) / 6.0
+        val = x + offset
+        y[k + 1] = val
+        if not (math.isfinite(val) and math.isfinite(v) and math.isfinite(z)):
+            for j in range(k + 2, N):
+                y[j] = np.nan
+            return k + 1
+    return -1

@@ -17,6 +17,13 @@ the virgin state, h = 0 at its first input sample. d, α, β, γ (and n with
 ``multistart`` starting points from the data's slope and the gap between its branches);
 cov θ = s² (JᵀJ)⁻¹ with s² = SSE/(N − p) and J the Jacobian of the free run at the optimum.
 
+**Bouc-Wen, oscillator form** (Y.-K. Wen, "Method for random vibration of hysteretic
+systems", *J. Eng. Mech. Div. ASCE* 102(2), 1976; :class:`BoucWenOscillatorModel`): a force u on a
+mass with a hysteretic spring, ``m ẍ + c_v ẋ + k_e x + k_h z = u``,
+``ż = ẋ − β |ẋ| z |z|^(n−1) − γ ẋ |z|^n`` (A = 1 fixes the scale of z), rate dependent,
+simulated from rest with the input held over each sample (RK4 sub-steps) and fitted on the free
+run like the actuator form, from the second-order ARX model nearest the data.
+
 **Prandtl–Ishlinskii**: ``y = c + Σ_i w_i F_{r_i}[u − a]`` with the play operators
 ``F_r[x](k) = max(x(k) − r, min(x(k) + r, F_r[x](k−1)))``, each relaxed at the first sample
 (F = x(0)), thresholds ``r_0 = 0 < r_1 < …`` (by default ``r_i = i R / m``, R half the input's
@@ -52,12 +59,15 @@ from ...params import Parameter, ParameterSet
 from ..model_protocol import ModelFit
 from . import _hysteresis_kernels as K
 
-__all__ = ["SCHEMA", "HYSTERESIS_FIT", "MODELS", "BoucWenModel", "PrandtlIshlinskiiModel",
-           "hysteresis", "load_hysteresis", "pi_inverse"]
+__all__ = ["SCHEMA", "HYSTERESIS_FIT", "MODELS", "FORMS", "BoucWenModel",
+           "BoucWenOscillatorModel", "PrandtlIshlinskiiModel", "hysteresis", "load_hysteresis",
+           "pi_inverse"]
 
 SCHEMA = "gripkit.hysteresis-model"
 VERSION = 1
 MODELS = ("bouc-wen", "prandtl-ishlinskii")
+#: the forms of the Bouc-Wen model
+FORMS = ("actuator", "oscillator")
 #: how a hysteresis model's fit is taken (``gripkit compare`` prints it)
 HYSTERESIS_FIT = ("free run from the relaxed state at the first input sample (Bouc-Wen: h = 0; "
                   "Prandtl-Ishlinskii: every play at the first input), "
@@ -180,6 +190,25 @@ class _HysteresisModel:
         return _record(data, self.input_name, None, f"{self.structure}.simulate",
                        need_output=False)[0]
 
+    def _fd_std(self, u: np.ndarray) -> np.ndarray:
+        """σ of the free run (N,), the parameter covariance propagated through the Jacobian of
+        the run by central differences (step 10⁻³ σ of each free parameter)."""
+        base, sd = self.values(), self.std
+        G = np.zeros((len(u), len(self.free)))
+        for j, k in enumerate(self.free):
+            h = 1e-3 * sd[k] if sd[k] > 0 else 1e-8 * max(abs(base[k]), 1.0)
+            hi, lo = dict(base), dict(base)
+            hi[k] += h
+            lo[k] -= h
+            G[:, j] = (self._run(u, hi)[0] - self._run(u, lo)[0]) / (2 * h)
+        return _output_std(G, self.covariance)
+
+    @property
+    def std(self) -> dict:
+        """1σ of each free parameter (from ``covariance``)."""
+        sd = np.sqrt(np.maximum(np.diag(self.covariance), 0.0)) if len(self.free) else []
+        return {k: float(s) for k, s in zip(self.free, sd)}
+
     def compare(self, data, *, warn: bool = True) -> ModelFit:
         """Free-run fit (%) on a record holding the model's input and output columns (a
         Trajectory, or a pair (u, y)); None (with a StabilityWarning) when the run diverges."""
@@ -231,11 +260,6 @@ class BoucWenModel(_HysteresisModel):
         return {k: float(getattr(self, k)) for k in _BW_NAMES}
 
     @property
-    def std(self) -> dict:
-        sd = np.sqrt(np.maximum(np.diag(self.covariance), 0.0)) if len(self.free) else []
-        return {k: float(s) for k, s in zip(self.free, sd)}
-
-    @property
     def lam(self) -> float:
         """λ = α d of the seed's eq 3 (unit of d)."""
         return self.alpha * self.d
@@ -279,15 +303,7 @@ class BoucWenModel(_HysteresisModel):
                          StabilityWarning)
         if not std:
             return y[:, None]
-        base, sd = self.values(), self.std
-        G = np.zeros((len(u), len(self.free)))
-        for j, k in enumerate(self.free):
-            h = 1e-3 * sd[k] if sd[k] > 0 else 1e-8 * max(abs(base[k]), 1.0)
-            hi, lo = dict(base), dict(base)
-            hi[k] += h
-            lo[k] -= h
-            G[:, j] = (self._run(u, hi)[0] - self._run(u, lo)[0]) / (2 * h)
-        return y[:, None], _output_std(G, self.covariance)[:, None]
+        return y[:, None], self._fd_std(u)[:, None]
 
     def to_dict(self) -> dict:
         return dict(schema=SCHEMA, version=VERSION, model=self.structure, **self.values(),
@@ -399,6 +415,216 @@ def _fit_bouc_wen(u, y, *, exponent, offset, burn_in, multistart, progress):
                      "several amplitudes", AccuracyWarning)
     T = _bw_transform_jacobian(best.x, names, fixed, su, sy)
     phys = _scaled_bw(best.x, names, fixed, su, sy)
+    return phys, tuple(names), T @ cov_s @ T.T
+
+
+# ---------------------------------------------------------------------------------------------
+# Bouc-Wen, oscillator form
+
+
+_BWO_NAMES = ("mass", "damping", "k_e", "k_h", "beta", "gamma", "n", "offset")
+
+
+@dataclass
+class BoucWenOscillatorModel(_HysteresisModel):
+    """Bouc-Wen oscillator (Wen 1976, with A = 1, which fixes the scale of z)::
+
+        mass ẍ + damping ẋ + k_e x + k_h z = u,   ż = ẋ − β |ẋ| z |z|^(n−1) − γ ẋ |z|^n
+
+    output y = x + offset; u a force, x a displacement, z the hysteretic displacement (unit of
+    x), k_e the elastic and k_h the hysteretic stiffness (k_e = a k, k_h = (1 − a) k of Wen's
+    α-form). Rate dependent: simulated from rest with the input held over each sample of ``dt``,
+    ``substeps`` Runge-Kutta steps per sample."""
+
+    mass: float
+    damping: float
+    k_e: float
+    k_h: float
+    beta: float
+    gamma: float
+    n: float = 1.0
+    offset: float = 0.0
+    dt: float = 1.0
+    substeps: int = 4
+    free: tuple = ("mass", "damping", "k_e", "k_h", "beta", "gamma", "offset")
+    covariance: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    input_name: str = "u"
+    output_name: str = "y"
+    input_unit: str = "1"
+    output_unit: str = "1"
+    fit_percent: float | None = None
+    validation_fit_percent: float | None = None
+    burn_in: int = 0
+    criterion: str = ""
+
+    structure = "bouc-wen-oscillator"
+
+    def values(self) -> dict:
+        return {k: float(getattr(self, k)) for k in _BWO_NAMES}
+
+    @property
+    def parameters(self) -> ParameterSet:
+        uu, yu = self.input_unit, self.output_unit
+        k_unit = _ratio(uu, yu)
+        shape = _ratio("1", yu) if self.n == 1.0 else f"1/{yu}^{self.n:g}"
+        sd = self.std
+        docs = {"mass": ("mass: input per unit acceleration", f"{k_unit}*s^2"),
+                "damping": ("viscous damping: input per unit velocity", f"{k_unit}*s"),
+                "k_e": ("elastic stiffness k_e (a k of Wen's form)", k_unit),
+                "k_h": ("hysteretic stiffness k_h ((1 − a) k of Wen's form)", k_unit),
+                "beta": ("β: shape of the hysteresis (A = 1)", shape),
+                "gamma": ("γ: shape of the hysteresis (A = 1)", shape),
+                "n": ("exponent n of |z|", "1"),
+                "offset": ("output offset", yu if not _unitless(yu) else "1")}
+        return ParameterSet([_parameter(k, getattr(self, k), docs[k][1], docs[k][0], sd.get(k),
+                                        fixed=k not in self.free) for k in _BWO_NAMES],
+                            "bouc-wen-oscillator")
+
+    def _input(self, data) -> np.ndarray:
+        from ...signals.trajectory import Trajectory
+
+        if isinstance(data, Trajectory) and data.n > 1 and not math.isclose(
+                data.dt, self.dt, rel_tol=1e-6):
+            raise DataError(f"bouc-wen-oscillator: the data are sampled every {data.dt:g} s but "
+                            f"the model every {self.dt:g} s; a rate-dependent model needs the "
+                            "same sample time", hint="resample the record to the model's dt")
+        return super()._input(data)
+
+    def _run(self, u: np.ndarray, theta: dict | None = None) -> tuple[np.ndarray, int]:
+        p = self.values() if theta is None else theta
+        y = np.empty(len(u))
+        at = K.bwo_simulate(u, float(self.dt), int(self.substeps), p["mass"], p["damping"],
+                            p["k_e"], p["k_h"], p["beta"], p["gamma"], p["n"], p["offset"], y)
+        return y, at
+
+    def simulate(self, data, *, std: bool = False, warn: bool = True):
+        """Free run (N, 1) on the input column of ``data`` (a Trajectory sampled at the model's
+        dt, or an array (N,)), from rest. ``std=True`` also returns σ of ŷ (N, 1), propagated
+        from the parameter covariance (central differences, step 10⁻³ σ)."""
+        u = self._input(data)
+        y, at = self._run(u)
+        if at >= 0 and warn:
+            emit_warning(f"bouc-wen-oscillator: the free run diverges at sample {at}; the model "
+                         "is unstable on this input", StabilityWarning)
+        if not std:
+            return y[:, None]
+        return y[:, None], self._fd_std(u)[:, None]
+
+    def to_dict(self) -> dict:
+        return dict(schema=SCHEMA, version=VERSION, model=self.structure, **self.values(),
+                    substeps=int(self.substeps), free=list(self.free),
+                    covariance=np.asarray(self.covariance).tolist(), std=self.std, dt=self.dt,
+                    input_name=self.input_name, output_name=self.output_name,
+                    input_unit=self.input_unit, output_unit=self.output_unit,
+                    fit_percent=self.fit_percent,
+                    validation_fit_percent=self.validation_fit_percent, burn_in=self.burn_in,
+                    criterion=self.criterion, fit_definition=HYSTERESIS_FIT)
+
+    def summary(self) -> str:
+        sd = self.std
+        rows = [f"Bouc-Wen oscillator (n = {self.n:g}, A = 1): mass x'' + damping x' + k_e x + "
+                f"k_h z = u  ({self.criterion})"]
+        for p in self.parameters.values():
+            s = f" ± {sd[p.name]:.3g}" if p.name in sd else " (fixed)"
+            rows.append(f"  {p.name:<7s} {p.value: .6g}{s} {p.unit}")
+        return "\n".join(rows)
+
+
+def _linear_start(u, y, dt):
+    """(mass, damping, k) of the second-order model nearest the data: a least-squares ARX
+    [2 2 1] with a constant, its poles mapped to s = ln z / dt and its static gain to 1/k."""
+    A = np.column_stack([y[1:-1], y[:-2], u[1:-1], u[:-2], np.ones(len(y) - 2)])
+    a1, a2, b1, b2, _ = np.linalg.lstsq(A, y[2:], rcond=None)[0]
+    roots = np.roots([1.0, -a1, -a2]).astype(complex)
+    gain = (b1 + b2) / (1.0 - a1 - a2) if a1 + a2 != 1.0 else 0.0
+    if np.all(np.abs(roots) < 1) and np.all(np.abs(roots) > 0) and gain > 0:
+        s = np.log(roots) / dt
+        w2 = float(np.real(s[0] * s[1]))
+        two_zw = float(-np.real(s[0] + s[1]))
+        if w2 > 0 and two_zw > 0:
+            k = 1.0 / gain
+            return k / w2, two_zw * k / w2, k
+    k = float(np.ptp(u) / np.ptp(y))  # fallback: a tenth of Nyquist, ζ = 0.2
+    w = 0.1 * math.pi / dt
+    return k / w**2, 0.4 * k / w, k
+
+
+def _fit_bouc_wen_oscillator(u, y, dt, *, exponent, offset, burn_in, multistart, substeps,
+                             progress):
+    from scipy.optimize import least_squares
+
+    from ...progress import track
+
+    su = 0.5 * float(np.ptp(u))
+    sy = 0.5 * float(np.ptp(y))
+    us, ys = u / su, y / sy
+    n_free = exponent == "free"
+    n0 = 1.0 if n_free else float(exponent)
+    names = ["mass", "damping", "k_e", "k_h", "beta", "gamma"] + (["n"] if n_free else []) + (
+        ["offset"] if offset else [])
+    fixed = {"n": n0, "offset": 0.0}
+    lo = {"mass": 0.0, "damping": 0.0, "k_e": -np.inf, "k_h": -np.inf, "beta": 0.0,
+          "gamma": -np.inf, "n": 1.0, "offset": -np.inf}
+    hi = {k: np.inf for k in lo} | {"n": 10.0}
+    m0, c0, k0 = _linear_start(us, ys, dt)
+    y_amp = 0.5 * float(np.ptp(ys))
+    starts = []
+    for frac, q in ((0.5, 0.1), (0.8, 0.1), (0.5, 0.02), (0.8, 0.3), (0.3, 0.05)):
+        bg = (1.0 / (q * y_amp)) ** n0  # z saturates at (1/(β+γ))^(1/n) = q × the amplitude
+        p0 = {"mass": m0, "damping": c0, "k_e": frac * k0, "k_h": (1 - frac) * k0,
+              "beta": bg / 1.3, "gamma": 0.3 * bg / 1.3, "n": n0,
+              "offset": float(ys[0]) if offset else 0.0}
+        starts.append(np.array([p0[k] for k in names]))
+    starts = starts[:max(1, int(multistart))]
+    sl = slice(burn_in, None)
+    target = ys[sl]
+    buf = np.empty(len(us))
+
+    def resid(th):
+        p = dict(fixed)
+        p.update(zip(names, th))
+        K.bwo_simulate(us, dt, substeps, p["mass"], p["damping"], p["k_e"], p["k_h"], p["beta"],
+                       p["gamma"], p["n"], p["offset"], buf)
+        r = buf[sl] - target
+        return np.clip(np.where(np.isfinite(r), r, 1e3), -1e3, 1e3)
+
+    # the starts in order of their initial cost, each to convergence, until one reproduces the
+    # record to a fit of 90 % (a free run of a rate-dependent model is costly)
+    lb = np.array([lo[k] for k in names])
+    ub = np.array([hi[k] for k in names])
+    starts = [np.clip(x0, np.where(np.isfinite(lb), lb + 1e-9, -np.inf),
+                      np.where(np.isfinite(ub), ub - 1e-9, np.inf)) for x0 in starts]
+    starts.sort(key=lambda x0: float(np.sum(resid(x0) ** 2)))
+    good = 0.01 * float(np.sum((target - target.mean()) ** 2))
+    best = None
+    for x0 in track(starts, description="bouc-wen oscillator fit", enabled=progress):
+        res = least_squares(resid, x0, bounds=(lb, ub), x_scale="jac", method="trf",
+                            xtol=1e-10, ftol=1e-10, gtol=1e-10, max_nfev=100 * len(names))
+        if best is None or res.cost < best.cost:
+            best = res
+        if 2.0 * best.cost < good:
+            break
+    dof = max(len(target) - len(names), 1)
+    s2 = 2.0 * best.cost / dof
+    JtJ = best.jac.T @ best.jac
+    if np.linalg.cond(JtJ) > 1e14:
+        emit_warning("bouc-wen-oscillator: the parameters are nearly unidentifiable from this "
+                     "record (JᵀJ singular to working precision); their σ are unreliable: excite "
+                     "loops of several amplitudes", AccuracyWarning)
+    cov_s = s2 * np.linalg.pinv(JtJ)
+    p = dict(fixed)
+    p.update(zip(names, best.x))
+    n = p["n"]
+    g = sy / su  # force-like parameters scale by sy/su, β and γ by sy^−n, offset by sy
+    phys = {"mass": p["mass"] / g, "damping": p["damping"] / g, "k_e": p["k_e"] / g,
+            "k_h": p["k_h"] / g, "beta": p["beta"] * sy ** -n, "gamma": p["gamma"] * sy ** -n,
+            "n": n, "offset": p["offset"] * sy}
+    diag = {"mass": 1 / g, "damping": 1 / g, "k_e": 1 / g, "k_h": 1 / g, "beta": sy ** -n,
+            "gamma": sy ** -n, "n": 1.0, "offset": sy}
+    T = np.diag([diag[k] for k in names])
+    if n_free:
+        for k in ("beta", "gamma"):
+            T[names.index(k), names.index("n")] = -phys[k] * math.log(sy)
     return phys, tuple(names), T @ cov_s @ T.T
 
 
@@ -589,14 +815,17 @@ def _check_int(v, name: str, lo: int) -> int:
 
 
 def hysteresis(data, model: str = "bouc-wen", *, input: str | None = None,
-               output: str | None = None, exponent=1.0, operators: int = 10, thresholds=None,
-               offset: bool = True, burn_in: int = 0, validate=None, multistart: int = 4,
-               dt: float | None = None, progress: bool = True):
+               output: str | None = None, form: str = "actuator", exponent=1.0,
+               operators: int = 10, thresholds=None, offset: bool = True, burn_in: int = 0,
+               validate=None, multistart: int = 4, substeps: int = 4, dt: float | None = None,
+               progress: bool = True):
     """Identify a hysteresis model of ``output`` driven by ``input``.
 
     ``data``: a Trajectory (columns ``input``, ``output``) or a pair of arrays ``(u, y)``.
     ``model``: ``"bouc-wen"`` (actuator form; ``exponent`` n ≥ 1, default 1 = the seed's eq 3, or
-    ``"free"`` to estimate it; ``multistart`` starting points) or ``"prandtl-ishlinskii"``
+    ``"free"`` to estimate it; ``multistart`` starting points; ``form="oscillator"``: the
+    rate-dependent Bouc-Wen oscillator :class:`BoucWenOscillatorModel`, from rest, ``substeps``
+    RK4 steps per sample, its sample time that of the data or ``dt``) or ``"prandtl-ishlinskii"``
     (``operators`` plays with thresholds ``i R / operators``, or ``thresholds`` given, starting
     at 0 and increasing). ``offset``: fit an output offset c. ``burn_in``: samples simulated but
     not scored (a record that starts mid-loop). ``validate``: a second record (Trajectory or
@@ -623,18 +852,34 @@ def hysteresis(data, model: str = "bouc-wen", *, input: str | None = None,
     common = dict(dt=dt, input_name=iname, output_name=oname, input_unit=iunit,
                   output_unit=ounit, burn_in=burn_in)
     if model == "bouc-wen":
+        if form not in FORMS:
+            raise ArgumentError(f"hysteresis: form must be one of {', '.join(FORMS)}, found "
+                                f"{form!r}")
         if not (exponent == "free" or (isinstance(exponent, (int, float, np.floating))
                                        and not isinstance(exponent, bool)
                                        and 1.0 <= exponent <= 10.0)):
             raise ArgumentError(f"hysteresis: exponent must be a number in [1, 10] or 'free', "
                                 f"found {exponent!r}")
         multistart = _check_int(multistart, "multistart", 1)
+        how = (f"free-run least squares, {multistart} start(s), n "
+               + ("estimated" if exponent == "free" else f"= {exponent:g}"))
+    if model == "bouc-wen" and form == "oscillator":
+        substeps = _check_int(substeps, "substeps", 1)
+        if dt is None:
+            raise ArgumentError("hysteresis: the Bouc-Wen oscillator is rate dependent: give the "
+                                "sample time dt= (or a Trajectory, which has one)")
+        phys, names, cov = _fit_bouc_wen_oscillator(u, y, float(dt), exponent=exponent,
+                                                    offset=offset, burn_in=burn_in,
+                                                    multistart=multistart, substeps=substeps,
+                                                    progress=progress)
+        common["dt"] = float(dt)
+        m = BoucWenOscillatorModel(**phys, substeps=substeps, free=names, covariance=cov,
+                                   **common, criterion=how)
+    elif model == "bouc-wen":
         phys, names, cov = _fit_bouc_wen(u, y, exponent=exponent, offset=offset,
                                          burn_in=burn_in, multistart=multistart,
                                          progress=progress)
-        m = BoucWenModel(**phys, free=names, covariance=cov, **common,
-                         criterion=f"free-run least squares, {multistart} start(s), n "
-                                   + ("estimated" if exponent == "free" else f"= {exponent:g}"))
+        m = BoucWenModel(**phys, free=names, covariance=cov, **common, criterion=how)
     else:
         if thresholds is None:
             r = default_thresholds(u, _check_int(operators, "operators", 1))
@@ -670,8 +915,9 @@ def hysteresis(data, model: str = "bouc-wen", *, input: str | None = None,
 
 
 def load_hysteresis(path):
-    """Read a model written by ``save`` of :class:`BoucWenModel` or
-    :class:`PrandtlIshlinskiiModel`; the same type comes back."""
+    """Read a model written by ``save`` of :class:`BoucWenModel`,
+    :class:`BoucWenOscillatorModel` or :class:`PrandtlIshlinskiiModel`; the same type comes
+    back."""
     p = Path(path)
     try:
         doc = json.loads(p.read_text(encoding="utf-8"))
@@ -706,6 +952,17 @@ def load_hysteresis(path):
             cov = np.array(doc["covariance"], dtype=np.float64).reshape(len(free), len(free))
             return BoucWenModel(**{k: float(doc[k]) for k in _BW_NAMES}, free=free,
                                 covariance=cov, **common)
+        if kind == "bouc-wen-oscillator":
+            free = tuple(str(k) for k in doc["free"])
+            if not set(free) <= set(_BWO_NAMES):
+                raise ValueError(f"unknown free parameter in {free}")
+            cov = np.array(doc["covariance"], dtype=np.float64).reshape(len(free), len(free))
+            common["dt"] = float(common["dt"])
+            if not (common["dt"] > 0 and int(doc["substeps"]) >= 1):
+                raise ValueError("dt must be > 0 and substeps ≥ 1")
+            return BoucWenOscillatorModel(**{k: float(doc[k]) for k in _BWO_NAMES},
+                                          substeps=int(doc["substeps"]), free=free,
+                                          covariance=cov, **common)
         if kind == "prandtl-ishlinskii":
             r = np.array(doc["thresholds"], dtype=np.float64)
             w = np.array(doc["weights"], dtype=np.float64)
@@ -721,4 +978,4 @@ def load_hysteresis(path):
         raise ModelError(f"{str(p)!r}: a malformed {SCHEMA} ({type(exc).__name__}: {exc}); "
                          "write it again with model.save") from None
     raise ModelError(f"{str(p)!r}: unknown hysteresis model {kind!r}; expected one of "
-                     f"{', '.join(MODELS)}")
+                     f"{', '.join(MODELS)}, bouc-wen-oscillator")
