@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from gripkit import Trajectory
-from gripkit.errors import ArgumentError, DataError, ModelError, StabilityWarning
+from gripkit.errors import ArgumentError, DataError, ModelError, PathError, StabilityWarning
 from gripkit.models.hysteresis import bouc_wen_advance, bouc_wen_response
 from gripkit.sysid import (BoucWenModel, BoucWenOscillatorModel, PrandtlIshlinskiiModel,
                            hysteresis, identify, load_hysteresis, load_model)
@@ -340,6 +340,26 @@ def test_cli_identify_hysteresis_json_compare_simulate(tmp_path, capsys):
     code, out, err = _cli(capsys, "identify", "hysteresis", mono, "--input", "U", "--output", "x")
     assert code == 1 and err.startswith("error: DataError: hysteresis not excited")
     assert len(err.strip().splitlines()) == 1
+    code, out, err = _cli(capsys, "report", model, val, "--out", tmp_path / "rep")
+    assert code == 1 and err.startswith("error: ModelError: report:")
+    assert "covers linear models only" in err
     code, out, err = _cli(capsys, "identify", "hysteresis", est, "--input", "U", "--output", "x",
                           "--model", "preisach")
     assert code == 1 and "--model: expected one of bouc-wen, prandtl-ishlinskii" in err
+
+
+def test_hostile_model_files_are_named(tmp_path):
+    m = PrandtlIshlinskiiModel(PI_R, PI_W, offset=0.2)
+    doc = m.to_dict()
+    cases = {"not JSON": ("{", "is not a JSON model"),
+             "version": (json.dumps({**doc, "version": 9}), "of version 9"),
+             "kind": (json.dumps({**doc, "model": "preisach"}), "unknown hysteresis model"),
+             "lengths": (json.dumps({**doc, "weights": [1.0]}), "a malformed"),
+             "schema": (json.dumps({**doc, "schema": "gripkit.narx-model"}), "expected 'gripkit.hys")}
+    for name, (text, phrase) in cases.items():
+        p = tmp_path / f"{name}.json"
+        p.write_text(text)
+        with pytest.raises(ModelError, match=phrase):
+            load_hysteresis(p)
+    with pytest.raises(PathError, match="does not exist"):
+        load_hysteresis(tmp_path / "missing.json")

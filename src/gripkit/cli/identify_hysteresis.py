@@ -1,6 +1,7 @@
 """``gripkit identify hysteresis DATA --input U --output Y [--model bouc-wen|prandtl-ishlinskii]
-[--form actuator|oscillator] [--exponent N|free] [--operators M] [--validate DATA2] [--out MODEL.json] [--json]``: a generic
-Bouc-Wen or Prandtl–Ishlinskii hysteresis from a record (:func:`gripkit.sysid.hysteresis`)."""
+[--form actuator|oscillator] [--exponent N|free] [--operators M] [--validate DATA2]
+[--out MODEL.json] [--json]``: a generic Bouc-Wen (actuator or oscillator form) or
+Prandtl–Ishlinskii hysteresis from a record (:func:`gripkit.sysid.hysteresis`)."""
 
 from __future__ import annotations
 

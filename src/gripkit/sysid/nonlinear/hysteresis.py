@@ -316,8 +316,9 @@ class BoucWenModel(_HysteresisModel):
 
     def summary(self) -> str:
         sd = self.std
-        rows = [f"Bouc-Wen (actuator form, n = {self.n:g}{' estimated' if 'n' in self.free else ''})"
-                f": y = d u − h + c  ({self.criterion})"]
+        how = " estimated" if "n" in self.free else ""
+        rows = [f"Bouc-Wen (actuator form, n = {self.n:g}{how}): y = d u − h + c  "
+                f"({self.criterion})"]
         for p in self.parameters.values():
             s = f" ± {sd[p.name]:.3g}" if p.name in sd else " (fixed)"
             rows.append(f"  {p.name:<7s} {p.value: .6g}{s} {p.unit}")
@@ -923,7 +924,8 @@ def load_hysteresis(path):
         doc = json.loads(p.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise PathError(f"hysteresis model file {str(p)!r} does not exist; give the path of a "
-                        "file written by model.save or `gripkit identify hysteresis --out`") from None
+                        "file written by model.save or `gripkit identify hysteresis --out`"
+                        ) from None
     except OSError as exc:
         raise PathError(f"hysteresis model file {str(p)!r} cannot be read "
                         f"({exc.strerror or exc}); give the path of a readable file") from None
