@@ -56,6 +56,8 @@ from ...atomic import write_text
 from ...errors import (AccuracyWarning, ArgumentError, DataError, IdentificationError, ModelError,
                        PathError, StabilityWarning, emit_warning)
 from ...params import Parameter, ParameterSet
+from ...progress import track
+from ...signals.trajectory import Trajectory
 from ..model_protocol import ModelFit
 from . import _hysteresis_kernels as K
 
@@ -116,8 +118,6 @@ def _fit_percent(y: np.ndarray, yhat: np.ndarray) -> float | None:
 def _record(data, input, output, what: str, need_output: bool = True):
     """(u, y or None, dt, input name, output name, input unit, output unit) from a Trajectory or
     a pair (u, y) / an array u."""
-    from ...signals.trajectory import Trajectory
-
     if isinstance(data, Trajectory):
         for role, col in (("input", input), ("output", output)):
             if col is None and (role == "input" or need_output):
@@ -353,8 +353,6 @@ def _bw_transform_jacobian(theta_s, names, fixed, su, sy) -> np.ndarray:
 def _fit_bouc_wen(u, y, *, exponent, offset, burn_in, multistart, progress):
     from scipy.optimize import least_squares
 
-    from ...progress import track
-
     su = 0.5 * float(np.ptp(u))
     sy = 0.5 * float(np.ptp(y))
     us, ys = u / su, y / sy
@@ -482,8 +480,6 @@ class BoucWenOscillatorModel(_HysteresisModel):
                             "bouc-wen-oscillator")
 
     def _input(self, data) -> np.ndarray:
-        from ...signals.trajectory import Trajectory
-
         if isinstance(data, Trajectory) and data.n > 1 and not math.isclose(
                 data.dt, self.dt, rel_tol=1e-6):
             raise DataError(f"bouc-wen-oscillator: the data are sampled every {data.dt:g} s but "
@@ -553,8 +549,6 @@ def _linear_start(u, y, dt):
 def _fit_bouc_wen_oscillator(u, y, dt, *, exponent, offset, burn_in, multistart, substeps,
                              progress):
     from scipy.optimize import least_squares
-
-    from ...progress import track
 
     su = 0.5 * float(np.ptp(u))
     sy = 0.5 * float(np.ptp(y))
