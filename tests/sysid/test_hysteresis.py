@@ -58,9 +58,10 @@ def test_rk4_exponent_2_matches_scipy_ode():
 def test_bouc_wen_recovery_monte_carlo_within_3_sigma():
     """20 noisy records of the seed's actuator (σ = 0.2 µm on a 77 µm stroke): d, α, β, γ and
     the offset within 3σ of the truth in ≥ 90 % of the 100 (run, parameter) pairs, σ from
-    s² (JᵀJ)⁻¹ of the free run."""
+    s² (JᵀJ)⁻¹ of the free run; σ of ŷ (std=True) matches the runs' spread within 40 %."""
     y0 = BoucWenModel(**SEED).simulate(U_PIEZO)[:, 0]
     inside = total = 0
+    runs, sds = [], []
     for i in range(20):
         y = y0 + np.random.default_rng(10 + i).normal(0.0, 0.2e-6, N)
         m = hysteresis((U_PIEZO, y), progress=False)
@@ -68,7 +69,13 @@ def test_bouc_wen_recovery_monte_carlo_within_3_sigma():
         for k, v in SEED.items():
             total += 1
             inside += abs(getattr(m, k) - v) < 3 * m.std[k]
+        yh, sd = m.simulate(U_PIEZO, std=True)
+        runs.append(yh[:, 0])
+        sds.append(sd[:, 0])
     assert total == 100 and inside >= 90
+    # σ of the simulated output (linearised propagation) against the spread of the 20 runs
+    ratio = np.mean(np.array(sds), axis=0) / np.std(np.array(runs), axis=0, ddof=1)
+    assert 0.6 < np.median(ratio) < 1.4
     assert m.fit_percent == pytest.approx(_noise_floor(y0, 0.2e-6), abs=0.1)
 
 
@@ -166,6 +173,30 @@ def test_bouc_wen_oscillator_recovery_and_round_trip(tmp_path):
         m.simulate(Trajectory(OSC_T * 2, {"F": OSC_F}))
     with pytest.raises(ArgumentError, match="give the sample time dt="):
         hysteresis((OSC_F, y0), form="oscillator")
+
+
+def test_cli_bouc_wen_oscillator(tmp_path, capsys):
+    """--form oscillator: the structure says so, and gripkit compare on the validation record
+    gives the --validate number."""
+    truth = BoucWenOscillatorModel(**OSC, dt=OSC_DT)
+    est, val, model = tmp_path / "est.csv", tmp_path / "val.csv", tmp_path / "osc.json"
+    rng = np.random.default_rng(9)
+    for path, f in ((est, OSC_F), (val, 12 * np.sin(2 * np.pi * 3 * OSC_T))):
+        y = truth.simulate(f)[:, 0] + rng.normal(0.0, 1e-4, OSC_N)
+        np.savetxt(path, np.column_stack([OSC_T, f, y]), delimiter=",", header="t,F,x",
+                   comments="", fmt="%.12g")
+    code, out, err = _cli(capsys, "identify", "hysteresis", est, "--input", "F", "--output", "x",
+                          "--form", "oscillator", "--validate", val, "--out", model, "--json")
+    assert code == 0, err
+    d = json.loads(out)
+    assert d["structure"]["form"] == "oscillator" and d["warnings"] == []
+    p = {q["name"]: q for q in d["parameters"]}
+    assert p["k_h"]["value"] == pytest.approx(2000.0, abs=3 * p["k_h"]["std"])
+    code, out, err = _cli(capsys, "compare", model, val, "--json")
+    assert code == 0, err
+    assert json.loads(out)["fit_percent"][0] == pytest.approx(d["validation"]["fit_percent"],
+                                                              abs=1e-9)
+    assert d["validation"]["fit_percent"] > 95.0
 
 
 @pytest.mark.slow
