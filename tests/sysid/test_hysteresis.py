@@ -171,6 +171,8 @@ def test_bouc_wen_oscillator_recovery_and_round_trip(tmp_path):
     assert m.parameters["k_e"].unit == "N/m"
     with pytest.raises(DataError, match="sampled every 0.002 s but the model every 0.001 s"):
         m.simulate(Trajectory(OSC_T * 2, {"F": OSC_F}))
+    with pytest.raises(DataError, match="sampled every 0.002 s"):
+        m.compare(Trajectory(OSC_T * 2, {"F": OSC_F, "x": y0}))
     with pytest.raises(ArgumentError, match="give the sample time dt="):
         hysteresis((OSC_F, y0), form="oscillator")
 

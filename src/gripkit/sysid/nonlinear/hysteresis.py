@@ -156,9 +156,9 @@ def _check_excited(u: np.ndarray, y: np.ndarray, input: str, output: str) -> Non
         raise DataError(f"hysteresis: the output {output!r} is constant ({y[0]:g}); check the "
                         "output column")
     if K.count_reversals(u, REVERSAL_BAND * float(np.ptp(u))) < 1:
-        raise DataError(f"hysteresis not excited: the input {input!r} never reverses (it moves "
-                        f"one way only, by more than {100 * REVERSAL_BAND:g} % of its range); "
-                        "the loop is not closed",
+        raise DataError(f"hysteresis not excited: the input {input!r} never reverses (it "
+                        f"never turns back by more than {100 * REVERSAL_BAND:g} % of its "
+                        "range), so no loop is closed",
                         hint="record at least one rise and one fall of the input (a sine or "
                              "triangle sweep, ideally with loops of several amplitudes)")
 
@@ -215,6 +215,8 @@ class _HysteresisModel:
         """Free-run fit (%) on a record holding the model's input and output columns (a
         Trajectory, or a pair (u, y)); None (with a StabilityWarning) when the run diverges."""
         u, y, *_ = _record(data, self.input_name, self.output_name, f"{self.structure}.compare")
+        if isinstance(data, Trajectory):
+            u = self._input(data)  # the family's checks of a record (the oscillator's dt)
         yhat = self.simulate(u, warn=warn)
         return ModelFit(self.outputs, [_fit_percent(y, yhat[:, 0])], yhat, HYSTERESIS_FIT)
 
