@@ -46,7 +46,7 @@ def compare(model: Path = ModelArg,
 
     if file_schema(model) == SCHEMA:
         return _compare_narx(model, data, fs, time, fill, json_out)
-    if file_schema(model) in _PROTOCOL_ONLY:
+    if _other_family(model):
         return _compare_protocol(model, data, fs, time, fill, json_out)
     from ..sysid.model_file import file_sha256
 
@@ -66,60 +66,60 @@ def compare(model: Path = ModelArg,
         typer.echo(f"  {n}: {f:.2f} %")
 
 
-#: model files read by load_model whose models offer only the protocol of
-#: gripkit.sysid.model_protocol (compare(tr) -> ModelFit, simulate(tr) -> (N, ny))
-_PROTOCOL_ONLY = ("gripkit.hw-model",)
+def _other_family(model: Path) -> bool:
+    """A model file of a family other than the linear and NARX ones (which have their own
+    branches): it is compared and simulated through the model protocol alone."""
+    from ..sysid.model_protocol import MODEL_FILES, file_schema
+
+    return file_schema(model) in set(MODEL_FILES) - {"gripkit.linear-model", "gripkit.narx-model"}
 
 
 def _compare_protocol(model: Path, data: Path, fs, time, fill, json_out: bool) -> None:
-    """``gripkit compare`` of a model that offers the protocol only: ``m.compare(record)``."""
-    from ..sysid import load_model
-
+    """``gripkit compare`` of any model that :func:`~gripkit.sysid.load_model` reads other than
+    the linear and NARX ones: ``m.compare(record)``, the fit by ``m.fit_definition``."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        m = load_model(model)
-        tr = load_data(data, [*m.inputs, *m.outputs], fs, time, fill)
+        m, tr = _model_and_data(model, data, fs, time, fill, outputs=True)
         fit = m.compare(tr)
     res = {"model": str(model), "data": str(data), "structure": m.structure,
-           "outputs": list(fit.outputs), "fit_percent": fit.fit_percent,
+           "outputs": list(m.outputs), "fit_percent": list(fit.fit_percent),
            "definition": fit.definition, "warnings": report_warnings(caught)}
     if json_out:
         emit_json(res)
         return
     typer.echo(f"{m.structure} on {data}: {fit.definition}")
-    for n, f in zip(fit.outputs, fit.fit_percent):
+    for n, f in zip(m.outputs, fit.fit_percent):
         typer.echo(f"  {n}: " + ("diverged" if f is None else f"{f:.2f} %"))
 
 
 def _simulate_protocol(model: Path, data: Path, out: Path | None, fs, time, fill,
                        json_out: bool) -> None:
-    """``gripkit simulate`` of a model that offers the protocol only: ``m.simulate(record)``."""
+    """``gripkit simulate`` of any model that :func:`~gripkit.sysid.load_model` reads other than
+    the linear and NARX ones: ``m.simulate(record)``, written as CSV on stdout or to ``--out``."""
     import sys
 
     import numpy as np
 
     from ..io import save
     from ..signals.trajectory import Trajectory
-    from ..sysid import load_model
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        m = load_model(model)
-        tr = load_data(data, list(m.inputs), fs, time, fill)
-        ys = np.asarray(m.simulate(tr)).reshape(tr.n, -1)
+        m, tr = _model_and_data(model, data, fs, time, fill, outputs=False)
+        ys = np.asarray(m.simulate(tr), dtype=np.float64).reshape(tr.n, len(m.outputs))
     sim = Trajectory(tr.t, {n: ys[:, i] for i, n in enumerate(m.outputs)})
     if out is not None:
         save(sim, out)
 
-    def stats(y):
-        fin = y[np.isfinite(y)]
-        return {"min": float(fin.min()) if fin.size else None,
-                "max": float(fin.max()) if fin.size else None,
-                "final": float(y[-1]) if np.isfinite(y[-1]) else None}
+    def stat(v, f):
+        v = v[np.isfinite(v)]
+        return float(f(v)) if v.size else None
 
     res = {"model": str(model), "data": str(data), "samples": sim.n,
            "out": None if out is None else str(out),
-           "outputs": {n: stats(ys[:, i]) for i, n in enumerate(m.outputs)},
+           "outputs": {n: {"min": stat(ys[:, i], np.min), "max": stat(ys[:, i], np.max),
+                           "final": float(ys[-1, i]) if np.isfinite(ys[-1, i]) else None}
+                       for i, n in enumerate(m.outputs)},
            "warnings": report_warnings(caught)}
     if json_out:
         emit_json(res)
@@ -204,7 +204,7 @@ def simulate_model_file(model: Path, data: Path | None, out: Path | None, fs, ti
 
     if file_schema(model) == SCHEMA:
         return _simulate_narx(model, data, out, fs, time, fill, json_out)
-    if file_schema(model) in _PROTOCOL_ONLY:
+    if _other_family(model):
         return _simulate_protocol(model, data, out, fs, time, fill, json_out)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

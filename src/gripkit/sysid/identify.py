@@ -44,7 +44,7 @@ from .linear.search import structure_search
 
 __all__ = ["IOData", "io_data", "identify", "identify_records", "method_options", "METHODS"]
 
-METHODS = ("arx", "armax", "oe", "rls", "search", "ss", "frf", "tf", "narx", "hw")
+METHODS = ("arx", "armax", "oe", "rls", "search", "ss", "frf", "tf", "narx", "hw", "hysteresis")
 
 
 @dataclass(frozen=True)
@@ -155,6 +155,8 @@ def _method_function(method: str):
         return nonlinear.narx
     if method == "hw":
         return nonlinear.hammerstein_wiener
+    if method == "hysteresis":
+        return nonlinear.hysteresis
     return {"arx": arx, "armax": armax, "oe": oe, "ss": identify_mimo.identify_ss, "frf": frf,
             "tf": identify_mimo.identify_tf}.get(method, structure_search)
 
@@ -194,7 +196,8 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
         (Hammerstein–Wiener on the data as they are, with this function's ``nb``, ``nk`` and
         ``nf`` (default ``nb``); the array function searches the orders; options of
         :func:`gripkit.sysid.hammerstein_wiener`: ``input_nonlinearity``,
-        ``output_nonlinearity``, ``validate`` …). For ss,
+        ``output_nonlinearity``, ``validate`` …); ``'hysteresis'`` (Bouc-Wen or Prandtl–Ishlinskii, options of
+        :func:`gripkit.sysid.hysteresis`: ``model``, ``exponent``, ``operators`` …). For ss,
         frf and tf ``input``/``output`` may name several columns (``'a,b'`` or a list).
     input, output
         Column names.
@@ -207,7 +210,8 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
 
     Returns
     -------
-    PolynomialModel, RLSResult, SearchResult, NARXModel or HWModel
+    PolynomialModel, RLSResult, SearchResult, NARXModel, HWModel, BoucWenModel or
+    PrandtlIshlinskiiModel
     """
     if not isinstance(method, str) or method not in METHODS:
         raise DataError(f"method: expected one of {', '.join(METHODS)}, found {method!r}")
@@ -245,6 +249,8 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
                                              nk=nk, dt=io.dt, **options)
         model.input_name, model.output_name = input, output
         return model
+    if method == "hysteresis":  # rate independent, its offset a parameter: the data as they are
+        return nonlinear.hysteresis(data, input=input, output=output, **options)
     io = io_data(data, input=input, output=output, detrend=detrend, why=f"{method.upper()} identification")
     if method in ("arx", "armax", "oe"):
         orders = (na, nb, nc, na if nf is None else nf, nk)

@@ -1,6 +1,7 @@
 """Nonlinear system identification (issue 26): polynomial NARX by forward regression with the
 error reduction ratio (:func:`narx`, :mod:`.narx`); Hammerstein, Wiener and Hammerstein–Wiener
-models (:func:`hammerstein_wiener`, :mod:`.hammerstein_wiener`).
+models (:func:`hammerstein_wiener`, :mod:`.hammerstein_wiener`); hysteresis, generic Bouc-Wen
+and Prandtl–Ishlinskii with its inverse (:func:`hysteresis`, :mod:`.hysteresis`).
 
 The public names are loaded on first use (the table ``_LAZY``, :mod:`gripkit.exports`).
 """
@@ -19,6 +20,11 @@ _LAZY = {
     "hammerstein_wiener": ("hammerstein_wiener", "hammerstein_wiener"),
     "HWModel": ("hammerstein_wiener", "HWModel"),
     "load_hw": ("hammerstein_wiener", "load_hw"),
+    "hysteresis": ("hysteresis", "hysteresis"),
+    "BoucWenModel": ("hysteresis", "BoucWenModel"),
+    "BoucWenOscillatorModel": ("hysteresis", "BoucWenOscillatorModel"),
+    "PrandtlIshlinskiiModel": ("hysteresis", "PrandtlIshlinskiiModel"),
+    "load_hysteresis": ("hysteresis", "load_hysteresis"),
 }
 __getattr__, __dir__ = lazy_exports(__name__, _LAZY)
 __all__ = [*_LAZY]
@@ -30,3 +36,8 @@ if TYPE_CHECKING:  # static readers see the same names, imported eagerly
     from .narx import NARXModel as NARXModel
     from .narx import load_narx as load_narx
     from .narx import narx as narx
+    from .hysteresis import BoucWenModel as BoucWenModel
+    from .hysteresis import BoucWenOscillatorModel as BoucWenOscillatorModel
+    from .hysteresis import PrandtlIshlinskiiModel as PrandtlIshlinskiiModel
+    from .hysteresis import hysteresis as hysteresis
+    from .hysteresis import load_hysteresis as load_hysteresis
