@@ -375,7 +375,7 @@ def test_cli_identify_hysteresis_json_compare_simulate(tmp_path, capsys):
     assert len(err.strip().splitlines()) == 1
     code, out, err = _cli(capsys, "report", model, val, "--out", tmp_path / "rep")
     assert code == 1 and err.startswith("error: ModelError: report:")
-    assert "covers linear models only" in err
+    assert "draws linear models" in err
     code, out, err = _cli(capsys, "identify", "hysteresis", est, "--input", "U", "--output", "x",
                           "--model", "preisach")
     assert code == 1 and "--model: expected one of bouc-wen, prandtl-ishlinskii" in err

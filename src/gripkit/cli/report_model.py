@@ -27,20 +27,14 @@ def report_model(model: Path = typer.Argument(..., help="Model file written by i
 
     schema = file_schema(model)
     if schema not in (None, "gripkit.linear-model"):  # residual, pole and Bode pages are linear
-        raise ModelError(f"gripkit report draws linear models; {str(model)!r} is a {schema}",
+        raise ModelError(f"report: {str(model)!r} is a {schema}; gripkit report draws linear "
+                         "models",
                          hint="use gripkit compare MODEL DATA (fit) or gripkit simulate MODEL "
                               "--data DATA for it")
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         m, tr = _model_and_data(model, data, fs, time, fill, outputs=True)
-        if not hasattr(m, "system"):  # the page shows poles and Bode plots of a linear model
-            from ..errors import ModelError
-
-            raise ModelError(f"report: {str(model)!r} is a {m.structure} model; the HTML report "
-                             "covers linear models only so far",
-                             hint="use gripkit compare MODEL DATA for its fit and gripkit "
-                                  "simulate MODEL --data DATA for its output")
         index = write_model_report(m, tr, out, data_name=Path(data).name)
     res = {"model": str(model), "data": str(data), "report": str(index), "warnings": report_warnings(caught)}
     if json_out:
