@@ -24,8 +24,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
-from scipy.linalg.lapack import dtrtrs
 
 from ..errors import AccuracyWarning, UnidentifiableError, emit_warning
 
@@ -93,18 +91,21 @@ def arx_regression(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int,
 
 
 def _solve_upper(r1: np.ndarray, b: np.ndarray, trans: int = 0) -> np.ndarray:
-    """``sla.solve_triangular(r1, b, trans=trans, check_finite=False)`` for float64 ``r1``
-    (upper triangular) and ``b``: the same LAPACK ``trtrs`` call with the same arguments, bit for
-    bit, without scipy's argument handling (~8 µs a call, more than a small solve)."""
-    if r1.flags.f_contiguous:
-        x, info = dtrtrs(r1, b, lower=0, trans=trans)
-    else:  # as scipy: the transposed system, since trtrs expects Fortran order
-        x, info = dtrtrs(r1.T, b, lower=1, trans=int(not trans))
-    if info > 0:
-        raise np.linalg.LinAlgError(f"singular matrix: resolution failed at diagonal {info - 1}")
-    if info < 0:  # pragma: no cover - LAPACK argument error
-        raise ValueError(f"illegal value in {-info}-th argument of internal trtrs")
-    return x
+    """``x`` with ``r1 x = b`` (``trans=1``: ``r1ᵀ x = b``) for a nonsingular upper-triangular
+    ``r1`` (float64), by numpy's LAPACK ``gesv``: partial pivoting finds each column's largest
+    entry on the diagonal (the entries below it are zero), so the LU factors are I and ``r1``
+    itself and the solve is the back substitution (for ``r1ᵀ``, the same on the reversed
+    system). numpy, not ``scipy.linalg.solve_triangular``: importing scipy.linalg is ~0.2 s of
+    a CLI start-up (issue 24), and scipy's argument handling ~8 µs a call."""
+    if trans:  # r1ᵀ x = b  ⇔  (J r1ᵀ J)(J x) = J b, J the reversal; J r1ᵀ J is upper triangular
+        return np.linalg.solve(r1.T[::-1, ::-1], b[::-1])[::-1]
+    return np.linalg.solve(r1, b)
+
+
+#: Regressors up to this many elements are factored by numpy's LAPACK (``np.linalg.qr``), which
+#: needs no scipy.linalg import (~0.2 s of a fresh process: a small CLI fit); larger ones by
+#: scipy's ``geqrf`` in place (numpy copies the matrix twice). Both call OpenBLAS's ``dgeqrf``.
+NUMPY_QR_MAX_ELEMENTS = 2**15
 
 
 def _qr_r(X: np.ndarray, overwrite: bool) -> np.ndarray:
@@ -112,6 +113,10 @@ def _qr_r(X: np.ndarray, overwrite: bool) -> np.ndarray:
     ``qr(mode='r')`` also applies ``triu`` to the whole m×q array, which costs more than the
     factorisation itself for tall matrices)."""
     q = X.shape[1]
+    if X.size <= NUMPY_QR_MAX_ELEMENTS:
+        return np.linalg.qr(X, mode="r")[:q, :q]  # numpy's triu is of the top q rows only
+    import scipy.linalg as sla
+
     (geqrf,) = sla.get_lapack_funcs(("geqrf",), (X,))
     # workspace n·nb with a generous block size (a workspace query would copy X first)
     qr, _, _, info = geqrf(X, lwork=64 * q, overwrite_a=overwrite)
