@@ -53,7 +53,7 @@ from numba.core.errors import TypingError
 from ..arguments import entry_point
 from ..errors import DataError, IdentificationError
 from ..signals.trajectory import Trajectory
-from .checks import check_dt, check_excitation, check_io, check_order, require_samples
+from .checks import check_dt, check_excitation, check_io_peaks, check_order, require_samples
 from .polynomial import PolynomialModel
 
 __all__ = ["RLS", "RLSResult", "rls"]
@@ -646,10 +646,10 @@ class RLS:
     def run(self, u, y, *, store: bool = True) -> "RLSResult":
         """Process a whole record from the current state (batch kernel); returns θ and σ at every
         step when ``store`` (else only the final values)."""
-        u, y = check_io(u, y)
-        return self._run(u, y, store)
+        u, y, peaks = check_io_peaks(u, y)
+        return self._run(u, y, store, peaks)
 
-    def _check_scale(self, u: np.ndarray, y: np.ndarray) -> None:
+    def _check_scale(self, u: np.ndarray, y: np.ndarray, peaks: tuple | None = None) -> None:
         """Refuse signals whose scale the recursion cannot represent next to the current P:
 
         * φᵀPφ <= ‖φ‖²·trace P must stay finite: ``p·max(|u|,|y|)²·trace P`` below the float64 limit;
@@ -660,7 +660,8 @@ class RLS:
         p = self.n_params
         P = self.P
         tr = float(np.trace(P))
-        stats = {"input u": _peak_and_norm(u), "output y": _peak_and_norm(y)}
+        pu, py = (None, None) if peaks is None else peaks
+        stats = {"input u": _peak_and_norm(u, pu), "output y": _peak_and_norm(y, py)}
         peak = max(stats["input u"][0], stats["output y"][0])
         if peak > 0 and math.log10(p) + 2 * math.log10(peak) + math.log10(tr) > 307.0:
             raise DataError(
@@ -710,10 +711,12 @@ class RLS:
             return (), (), (), ()
         return (0.0,) * self.n_params, (0.0,) * self.na, (0.0,) * self.nb, (0.0,) * self.nk
 
-    def _run(self, u: np.ndarray, y: np.ndarray, store: bool) -> "RLSResult":
-        """:meth:`run` on checked float64 arrays."""
+    def _run(self, u: np.ndarray, y: np.ndarray, store: bool,
+             minmax: tuple | None = None) -> "RLSResult":
+        """:meth:`run` on checked float64 arrays; ``minmax``: ``((min u, max u), (min y, max y))``
+        from the checks (:func:`~gripkit.sysid.checks.check_io_peaks`), one pass less each."""
         peaks = self._check_corrupt(u, y)
-        self._check_scale(u, y)
+        self._check_scale(u, y, minmax)
         n = u.size
         p = self.n_params
         rows = n if store else 0
@@ -767,14 +770,15 @@ def _first_absurd(x, peak, factor):
 _PLAIN_NORM_RANGE = (1e-140, 1e140)
 
 
-def _peak_and_norm(x):
+def _peak_and_norm(x, minmax: tuple[float, float] | None = None):
     """(max |x|, ‖x‖₂) without temporaries: max/min and a BLAS dot (fast) when the peak lies in
     :data:`_PLAIN_NORM_RANGE`, else :func:`_peak_and_norm_scaled` (one pass scaled by the running
     peak). The dot sums in another order than the scaled pass: the norms agree to a few ulps,
     which only feed the order-of-magnitude checks of :meth:`RLS._check_scale`."""
     if x.size == 0:
         return 0.0, 0.0
-    peak = max(float(x.max()), -float(x.min()))
+    lo, hi = (float(x.min()), float(x.max())) if minmax is None else minmax
+    peak = max(hi, -lo)
     if _PLAIN_NORM_RANGE[0] < peak < _PLAIN_NORM_RANGE[1]:
         return peak, math.sqrt(float(np.dot(x, x)))
     return _peak_and_norm_scaled(x)
@@ -882,11 +886,11 @@ def rls(u, y, na: int, nb: int, nk: int = 1, *, forgetting: float = 1.0, p0: flo
     Parameters as :class:`RLS`; ``u``, ``y`` of shape (N,). Raises :class:`DataError` for bad
     data or too few samples and :class:`~gripkit.errors.UnidentifiableError` for a constant input.
     """
-    u, y = check_io(u, y)
+    u, y, peaks = check_io_peaks(u, y)  # one min and max per signal for all the checks
     est = RLS(na, nb, nk, forgetting=forgetting, p0=p0, theta0=theta0, windup=windup,
               max_trace=max_trace, dt=check_dt(dt))
     t0 = max(est.na, est.nk + est.nb - 1)
     p = est.n_params
     require_samples(u.size, t0 + p + 1, f"RLS ARX [{est.na} {est.nb} {est.nk}] ({p} parameters)")
-    check_excitation(u)
-    return est._run(u, y, store)
+    check_excitation(u, peaks=peaks[0])
+    return est._run(u, y, store, peaks)
