@@ -74,7 +74,8 @@ def test_lti_simulate_ss_loads_on_first_use():
 def test_cli_identify_arx_with_unit_headers_leaves_scipy_linalg_out(tmp_path):
     """`gripkit identify arx` on a small log with the README's unit headers (`force [N]`), in a
     fresh interpreter: the QR route, its triangular solves and the report need no scipy.linalg
-    (~0.2 s of the start-up, issue 24), nor pint/dask for the units, nor numba or pandas."""
+    (~0.2 s of the start-up, issue 24), nor pint/dask for the units, nor numba or pandas; a float64
+    CSV column needs no pyarrow.compute cast, the interval median no numpy.ma."""
     import numpy as np
 
     rng = np.random.default_rng(2)
@@ -91,5 +92,6 @@ def test_cli_identify_arx_with_unit_headers_leaves_scipy_linalg_out(tmp_path):
                                "    try:\n        main()\n    except SystemExit as e:\n"
                                "        assert not e.code, e.code\n"
                                "assert json.loads(out.getvalue())['A'][0] == 1.0\n"))
-    heavy = ("scipy.linalg", "pint", "dask", "numba", "pandas", "scipy.signal", "scipy.stats")
+    heavy = ("scipy.linalg", "pint", "dask", "numba", "pandas", "scipy.signal", "scipy.stats",
+             "pyarrow.compute", "numpy.ma")
     assert [m for m in heavy if m in loaded] == []
