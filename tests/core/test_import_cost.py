@@ -69,3 +69,29 @@ def test_lti_simulate_ss_loads_on_first_use():
     assert "numba" not in loaded
     loaded = set(_loaded_after("from gripkit.lti import simulate_ss"))
     assert "numba" in loaded
+
+
+def test_cli_identify_arx_with_unit_headers_leaves_scipy_linalg_out(tmp_path):
+    """`gripkit identify arx` on a small log with the README's unit headers (`force [N]`), in a
+    fresh interpreter: the QR route, its triangular solves and the report need no scipy.linalg
+    (~0.2 s of the start-up, issue 24), nor pint/dask for the units, nor numba or pandas; a float64
+    CSV column needs no pyarrow.compute cast, the interval median no numpy.ma."""
+    import numpy as np
+
+    rng = np.random.default_rng(2)
+    u = rng.standard_normal(2000)
+    y = np.convolve(u, [0.0, 0.0, 1.0, 0.5])[:2000] + 0.01 * rng.standard_normal(2000)
+    path = tmp_path / "log.csv"
+    np.savetxt(path, np.column_stack([np.arange(2000) * 1e-3, u, y]), delimiter=",",
+               header="time [s],current [A],force [N]", comments="")
+    argv = ["gripkit", "identify", "arx", str(path), "--input", "current", "--output", "force",
+            "--na", "2", "--nb", "2", "--nk", "2", "--json"]
+    loaded = set(_loaded_after(f"import contextlib, io\nsys.argv = {argv!r}\n"
+                               "from gripkit.cli import main\n"
+                               "with contextlib.redirect_stdout(io.StringIO()) as out:\n"
+                               "    try:\n        main()\n    except SystemExit as e:\n"
+                               "        assert not e.code, e.code\n"
+                               "assert json.loads(out.getvalue())['A'][0] == 1.0\n"))
+    heavy = ("scipy.linalg", "pint", "dask", "numba", "pandas", "scipy.signal", "scipy.stats",
+             "pyarrow.compute", "numpy.ma")
+    assert [m for m in heavy if m in loaded] == []

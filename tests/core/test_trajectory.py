@@ -63,3 +63,16 @@ def test_window_take_rename():
     w = tr.window(0.5, 1.0)
     assert w.n == 5 and w["y"][0] == 5.0
     assert "z" in tr.rename(y="z")
+
+
+@pytest.mark.parametrize("d", [[3.0, 1.0, 2.0], [4.0, 1.0, 3.0, 2.0], [0.1, 0.3], [2.5],
+                               [1e-3, np.nan, 1e-3], [0.1 + 0.2, 0.3, 0.1, 1e300, -1e300, 0.7]])
+def test_median_of_intervals_is_numpys(d):
+    """Trajectory's interval median (no numpy.ma import at start-up) is np.median bit for bit:
+    the middle value, the mean of the two middle values, NaN when a NaN is present."""
+    from gripkit.signals.trajectory import _median
+
+    d = np.array(d)
+    ref = float(np.median(d))
+    got = _median(d.copy())
+    assert got == ref or (np.isnan(got) and np.isnan(ref))

@@ -243,3 +243,45 @@ def test_large_fit_allocates_no_record_sized_array():
     tracemalloc.stop()
     assert m.info["method"].startswith("least squares (normal equations")
     assert peak < 0.05 * (u.nbytes + y.nbytes), peak
+
+
+@pytest.mark.parametrize("m, q", [(40, 3), (2000, 5), (6000, 6), (9000, 5)])
+def test_qr_factor_by_numpy_or_scipy_lapack_is_the_same(m, q):
+    """`_qr_r` factors regressors up to NUMPY_QR_MAX_ELEMENTS with numpy's geqrf (no scipy.linalg
+    import at start-up) and larger ones with scipy's in place (sizes on both sides of 2^15 here):
+    R is scipy.linalg.qr's R to rounding, ‖ΔR‖ ≤ 1e-13 ‖R‖ (Householder QR is backward stable,
+    Golub & Van Loan Thm 5.2.1: both are exact for X + E with ‖E‖ ≲ m q u ‖X‖)."""
+    import scipy.linalg as sla
+
+    from gripkit.sysid.regression import NUMPY_QR_MAX_ELEMENTS, _qr_r
+
+    rng = np.random.default_rng(m + q)
+    X = np.asfortranarray(rng.standard_normal((m, q)) * np.logspace(-3, 3, q))
+    ref = sla.qr(X, mode="r")[0][:q]
+    R = _qr_r(X.copy(order="F"), True)
+    assert (X.size <= NUMPY_QR_MAX_ELEMENTS) == (m * q <= 2**15)
+    assert np.allclose(np.abs(R), np.abs(ref), rtol=0, atol=1e-13 * np.abs(ref).max())
+    assert np.array_equal(R, np.triu(R))
+
+
+@pytest.mark.parametrize("trans", [0, 1])
+def test_triangular_solve_without_scipy_matches_solve_triangular(trans):
+    """`solve_upper` (numpy's gesv on an upper-triangular matrix: no pivoting, so a back
+    substitution) against scipy.linalg.solve_triangular, for r1 x = b and r1ᵀ x = b with
+    κ(r1) ≈ 1e6: equal within 8·κ·u relative (the forward error bound of a triangular solve,
+    Higham, Accuracy and Stability, Thm 8.5), and exact on an integer system."""
+    import scipy.linalg as sla
+
+    from gripkit.sysid.regression import solve_upper
+
+    rng = np.random.default_rng(7 + trans)
+    r1 = np.triu(rng.standard_normal((6, 6))) + np.diag(np.logspace(0, 3, 6))
+    b = rng.standard_normal(6)
+    x = solve_upper(r1, b, trans)
+    ref = sla.solve_triangular(r1, b, trans=trans)
+    kappa = np.linalg.cond(r1)
+    assert np.max(np.abs(x - ref)) <= 8 * kappa * 2.0**-53 * np.max(np.abs(ref))
+    A = np.array([[2.0, 1.0, -1.0], [0.0, 4.0, 2.0], [0.0, 0.0, 8.0]])
+    exact = np.array([1.0, -2.0, 0.5])
+    rhs = (A.T if trans else A) @ exact
+    assert np.array_equal(solve_upper(A, rhs, trans), exact)

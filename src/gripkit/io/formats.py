@@ -442,10 +442,13 @@ def _float64_column(col) -> np.ndarray:
     """A numeric or boolean Arrow column as float64 with NaN for nulls, read from its buffers:
     pyarrow's ``to_numpy`` imports pandas (0.3 s of a CLI call) to check for it."""
     import pyarrow as pa
-    import pyarrow.compute as pc
 
+    if not pa.types.is_float64(col.type):  # a float64 column needs no cast: no pyarrow.compute
+        import pyarrow.compute as pc  # import (0.05–0.1 s of a CLI start-up, issue 24)
+
+        col = pc.cast(col, pa.float64())
     parts = []
-    for chunk in pc.cast(col, pa.float64()).chunks:
+    for chunk in col.chunks:
         n = len(chunk)
         validity, values = chunk.buffers()
         x = np.frombuffer(values, dtype=np.float64, count=n, offset=chunk.offset * 8).copy()

@@ -18,7 +18,6 @@ Continuous ẋ = A x + B u, y = C x + D u; discrete x[k+1] = Φ x[k] + Γ u[k], 
 from __future__ import annotations
 
 import numpy as np
-from scipy import linalg
 
 from ..errors import ModelError
 
@@ -52,6 +51,8 @@ def _foh_blocks(A, B, dt):
     M[:n, :n] = A * dt
     M[:n, n:n + m] = B * dt
     M[n:n + m, n + m:] = np.eye(m)
+    from scipy import linalg  # on first use: scipy.linalg is ~0.2 s of a CLI start-up
+
     E = linalg.expm(M)
     return E[:n, :n], E[:n, n:n + m], E[:n, n + m:]
 
@@ -71,6 +72,8 @@ def c2d_matrices(A, B, C, D, dt: float, method: str = "zoh", prewarp=None):
     method = check_method(method, prewarp)
     n, m = B.shape
     if method == "zoh":
+        from scipy import linalg  # on first use: scipy.linalg is ~0.2 s of a CLI start-up
+
         M = np.zeros((n + m, n + m))
         M[:n, :n] = A * dt
         M[:n, n:] = B * dt
@@ -105,6 +108,8 @@ def _real_logm(M, what):
                          "where no continuous-time pole maps to under sampling",
                          hint="use method='tustin', or identify at a sample rate where no pole sits at "
                               "or beyond Nyquist")
+    from scipy import linalg  # on first use (start-up)
+
     L = linalg.logm(M)
     if np.iscomplexobj(L):
         if np.abs(L.imag).max() > 1e-9 * max(np.abs(L).max(), 1.0):

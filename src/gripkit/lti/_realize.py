@@ -4,7 +4,6 @@ transmission zeros. The classes in :mod:`._statespace` and :mod:`._transfer` wra
 from __future__ import annotations
 
 import numpy as np
-from scipy import linalg
 
 __all__ = ["tf2ss", "ss2tf", "balance", "minreal", "ss_zeros", "MINREAL_TOL"]
 
@@ -186,6 +185,8 @@ def minreal(A, B, C, D, tol: float = MINREAL_TOL):
 
 
 def _finite_generalized_eigs(M, N, tol):
+    from scipy import linalg  # on first use: scipy.linalg is ~0.2 s of a CLI start-up
+
     alpha, beta = linalg.eig(M, N, right=False, homogeneous_eigvals=True)
     scale = max(np.linalg.norm(M, 2), 1.0)
     keep = np.abs(beta) * scale > tol * np.abs(alpha)
@@ -223,6 +224,8 @@ def ss_zeros(A, B, C, D, tol: float = MINREAL_TOL):
             M = M @ A
         else:
             return np.zeros(0, dtype=complex)
+        from scipy import linalg  # on first use (start-up)
+
         N = linalg.null_space(np.array(rows))
         Azd = N.T @ (A - B @ (M @ A) / g) @ N
         return np.linalg.eigvals(Azd).astype(complex) if Azd.size else np.zeros(0, dtype=complex)

@@ -16,7 +16,6 @@ import re
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import linalg
 
 from ..errors import AccuracyWarning, DataError, ModelError, emit_warning
 from . import _connect, _discretize, _realize
@@ -261,6 +260,8 @@ class LinearSystem:
         if ss.uncertainty is None:
             raise ModelError("pole_covariance: the system carries no covariance",
                              hint="build it with with_covariance(...) or from an identified model")
+        from scipy import linalg  # on first use: scipy.linalg is ~0.2 s of a CLI start-up
+
         A = ss.A
         lam, vl, vr = linalg.eig(A, left=True, right=True)
         dA = ss.uncertainty.tangents[0]

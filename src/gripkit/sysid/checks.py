@@ -15,8 +15,9 @@ from ..errors import DataError, UnidentifiableError
 from ..units import dimension_of, same_dimension
 from .regression import COND_LIMIT, qr_r, scaled_condition
 
-__all__ = ["as_signal", "as_io_matrix", "io_records", "check_io", "check_order", "check_dt", "require_samples", "check_excitation",
-           "check_output_varies", "checked_problem", "check_identifiable",
+__all__ = ["as_signal", "signal_with_peaks", "as_io_matrix", "io_records", "check_io",
+           "check_io_peaks", "check_order", "check_dt", "require_samples", "check_excitation",
+           "check_output_varies", "checked_problem", "checked_problem_peaks", "check_identifiable",
            "check_persistent_excitation", "check_dimension", "LENGTH_OR_ANGLE", "FORCE_OR_TORQUE"]
 
 #: Expected dimensions for :func:`check_dimension`: a description and a reference unit each.
@@ -26,6 +27,13 @@ FORCE_OR_TORQUE = {"a force": "N", "a torque": "N*m"}
 
 def as_signal(x, name: str) -> np.ndarray:
     """``x`` as a finite 1-D float64 array, or a :class:`DataError` naming ``name``."""
+    return signal_with_peaks(x, name)[0]
+
+
+def signal_with_peaks(x, name: str) -> tuple[np.ndarray, float, float]:
+    """:func:`as_signal` with the signal's minimum and maximum ``(a, lo, hi)``, which the
+    finiteness check computes anyway: the excitation checks and the scaling take them from here
+    instead of two more passes each (``peaks=(lo, hi)``)."""
     try:
         a = np.asarray(x, dtype=np.float64)
     except (TypeError, ValueError):
@@ -35,13 +43,14 @@ def as_signal(x, name: str) -> np.ndarray:
                         hint="pass one channel at a time (single-input single-output models)")
     if a.size == 0:
         raise DataError(f"{name}: the signal holds no samples")
-    if not _all_finite(a):
+    lo, hi = float(a.min()), float(a.max())
+    if not (math.isfinite(lo) and math.isfinite(hi)):  # min and max carry a NaN or an inf through
         for label, mask in (("NaN", np.isnan(a)), ("infinite", np.isinf(a))):
             if mask.any():
                 raise DataError(
                     f"{name} has {int(mask.sum())} {label} values (first at sample {int(np.argmax(mask))})",
                     hint="drop or interpolate them before identification (CLI: --fill)")
-    return a
+    return a, lo, hi
 
 
 def as_io_matrix(x, name: str, n: int | None = None, channels: tuple[str, ...] | None = None,
@@ -100,11 +109,16 @@ def _all_finite(a: np.ndarray) -> bool:
 
 def check_io(u, y) -> tuple[np.ndarray, np.ndarray]:
     """Input and output as finite 1-D float64 arrays of equal length."""
-    u = as_signal(u, "input u")
-    y = as_signal(y, "output y")
+    return check_io_peaks(u, y)[:2]
+
+
+def check_io_peaks(u, y) -> tuple[np.ndarray, np.ndarray, tuple]:
+    """:func:`check_io` with ``((min u, max u), (min y, max y))`` (:func:`signal_with_peaks`)."""
+    u, ulo, uhi = signal_with_peaks(u, "input u")
+    y, ylo, yhi = signal_with_peaks(y, "output y")
     if u.shape != y.shape:
         raise DataError(f"input u and output y must have the same length, found {u.size} and {y.size}")
-    return u, y
+    return u, y, ((ulo, uhi), (ylo, yhi))
 
 
 def check_order(value, name: str, minimum: int = 0) -> int:
@@ -133,9 +147,11 @@ def require_samples(n: int, n_min: int, what: str) -> None:
                         hint="use a longer record or a smaller model")
 
 
-def check_excitation(u: np.ndarray, name: str = "input u") -> None:
-    """Refuse a constant input: it cannot identify the numerator B (the input-output dynamics)."""
-    hi, lo = float(np.max(u)), float(np.min(u))
+def check_excitation(u: np.ndarray, name: str = "input u",
+                     peaks: tuple[float, float] | None = None) -> None:
+    """Refuse a constant input: it cannot identify the numerator B (the input-output dynamics).
+    ``peaks``: ``(min, max)`` of ``u`` when known (:func:`signal_with_peaks`)."""
+    lo, hi = (float(np.min(u)), float(np.max(u))) if peaks is None else peaks
     span = hi - lo
     scale = max(hi, -lo, 1e-300)  # max|u| without an N-sized temporary
     if span <= 1e-12 * scale or span == 0.0:
@@ -190,9 +206,11 @@ def check_dimension(column: str, unit: str | None, expected: dict[str, str], rol
                          f"and that its header gives the right unit")
 
 
-def check_output_varies(y: np.ndarray, name: str = "output y") -> None:
-    """Refuse a constant output: there is nothing to fit (and the fit % is undefined)."""
-    hi, lo = float(np.max(y)), float(np.min(y))
+def check_output_varies(y: np.ndarray, name: str = "output y",
+                        peaks: tuple[float, float] | None = None) -> None:
+    """Refuse a constant output: there is nothing to fit (and the fit % is undefined).
+    ``peaks``: ``(min, max)`` of ``y`` when known (:func:`signal_with_peaks`)."""
+    lo, hi = (float(np.min(y)), float(np.max(y))) if peaks is None else peaks
     if hi - lo <= 1e-12 * max(hi, -lo, 1e-300):
         raise UnidentifiableError(f"{name} is constant ({y[0]:.6g} for all {y.size} samples): "
                                   f"there are no dynamics to identify; no estimate returned",
@@ -203,13 +221,20 @@ def checked_problem(u, y, dt: float | None, **orders):
     """The common start of every estimator: signals checked (:func:`check_io`), orders checked
     (``nb`` >= 1, the others >= 0), sample interval resolved. Returns ``(u, y, dt, *orders)`` with
     the orders as ints in the order given."""
-    u, y = check_io(u, y)
+    return checked_problem_peaks(u, y, dt, **orders)[:-1]
+
+
+def checked_problem_peaks(u, y, dt: float | None, **orders):
+    """:func:`checked_problem` with the signals' ``((min u, max u), (min y, max y))`` last."""
+    u, y, peaks = check_io_peaks(u, y)
     ints = [check_order(v, name, 1 if name == "nb" else 0) for name, v in orders.items()]
-    return (u, y, check_dt(dt), *ints)
+    return (u, y, check_dt(dt), *ints, peaks)
 
 
-def check_identifiable(u: np.ndarray, y: np.ndarray, n_min: int, what: str) -> None:
-    """Enough samples, a varying input and a varying output, or a clear error."""
+def check_identifiable(u: np.ndarray, y: np.ndarray, n_min: int, what: str,
+                       peaks: tuple | None = None) -> None:
+    """Enough samples, a varying input and a varying output, or a clear error; ``peaks``:
+    ``((min u, max u), (min y, max y))`` when known."""
     require_samples(y.size, n_min, what)
-    check_excitation(u)
-    check_output_varies(y)
+    check_excitation(u, peaks=None if peaks is None else peaks[0])
+    check_output_varies(y, peaks=None if peaks is None else peaks[1])

@@ -24,7 +24,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg as sla
 
 from ..errors import AccuracyWarning, UnidentifiableError, emit_warning
 
@@ -91,11 +90,33 @@ def arx_regression(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int,
     return X
 
 
+def solve_upper(r1: np.ndarray, b: np.ndarray, trans: int = 0) -> np.ndarray:
+    """``x`` with ``r1 x = b`` (``trans=1``: ``r1ᵀ x = b``) for a nonsingular upper-triangular
+    ``r1`` (float64), by numpy's LAPACK ``gesv``: partial pivoting finds each column's largest
+    entry on the diagonal (the entries below it are zero), so the LU factors are I and ``r1``
+    itself and the solve is the back substitution (for ``r1ᵀ``, the same on the reversed
+    system). numpy, not ``scipy.linalg.solve_triangular``: importing scipy.linalg is ~0.2 s of
+    a CLI start-up (issue 24), and scipy's argument handling ~8 µs a call."""
+    if trans:  # r1ᵀ x = b  ⇔  (J r1ᵀ J)(J x) = J b, J the reversal; J r1ᵀ J is upper triangular
+        return np.linalg.solve(r1.T[::-1, ::-1], b[::-1])[::-1]
+    return np.linalg.solve(r1, b)
+
+
+#: Regressors up to this many elements are factored by numpy's LAPACK (``np.linalg.qr``), which
+#: needs no scipy.linalg import (~0.2 s of a fresh process: a small CLI fit); larger ones by
+#: scipy's ``geqrf`` in place (numpy copies the matrix twice). Both call OpenBLAS's ``dgeqrf``.
+NUMPY_QR_MAX_ELEMENTS = 2**15
+
+
 def qr_r(X: np.ndarray, overwrite: bool) -> np.ndarray:
     """The (q, q) triangular factor R of ``X = QR`` (LAPACK ``geqrf`` called directly: scipy's
     ``qr(mode='r')`` also applies ``triu`` to the whole m×q array, which costs more than the
     factorisation itself for tall matrices)."""
     q = X.shape[1]
+    if X.size <= NUMPY_QR_MAX_ELEMENTS:
+        return np.linalg.qr(X, mode="r")[:q, :q]  # numpy's triu is of the top q rows only
+    import scipy.linalg as sla
+
     (geqrf,) = sla.get_lapack_funcs(("geqrf",), (X,))
     # workspace n·nb with a generous block size (a workspace query would copy X first)
     qr, _, _, info = geqrf(X, lwork=64 * q, overwrite_a=overwrite)
@@ -166,19 +187,21 @@ def scaled_condition(r1: np.ndarray) -> tuple[float, np.ndarray, np.ndarray, np.
     singular vectors of the scaled factor and the column norms of Φ (inf and empty ``sv``, ``vt``
     when a column is zero)."""
     col = np.sqrt(np.sum(r1 * r1, axis=0))  # column norms of Φ (Q is orthogonal)
-    if np.any(col <= 1e-300):
+    if (col <= 1e-300).any():
         return np.inf, np.empty(0), np.empty((0, r1.shape[1])), col
     sv, vt = np.linalg.svd(r1 / col, compute_uv=True)[1:]
     return (float(sv[0] / sv[-1]) if sv[-1] > 0 else np.inf), sv, vt, col
 
 
 def triangular_solve(R: np.ndarray, names: tuple[str, ...], m: int, warn: bool = True,
-                     values: np.ndarray | None = None, stacklevel: int = 3) -> QRSolution:
+                     values: np.ndarray | None = None, stacklevel: int = 3,
+                     condition: tuple | None = None) -> QRSolution:
     """:func:`qr_solve` from the (q, q) upper-triangular factor ``R`` of ``[Φ | Y]`` (m rows),
-    however it was obtained (QR of the data, or Cholesky of its Gram matrix)."""
+    however it was obtained (QR of the data, or Cholesky of its Gram matrix); ``condition``:
+    :func:`scaled_condition` of ``R[:p, :p]`` when the caller has it already."""
     p = R.shape[0] - 1
     r1 = R[:p, :p]
-    cond, sv, vt, col = scaled_condition(r1)
+    cond, sv, vt, col = scaled_condition(r1) if condition is None else condition
     zero = col <= 1e-300
     if zero.any():
         bad = [names[i] for i in np.flatnonzero(zero)]
@@ -192,14 +215,16 @@ def triangular_solve(R: np.ndarray, names: tuple[str, ...], m: int, warn: bool =
             f"{COND_LIMIT:.0e}); the poorly determined combination involves {', '.join(involved)}",
             hint="excite the system more richly (more frequencies than parameters) or lower the orders")
     r = R[:p, p]
-    theta = sla.solve_triangular(r1, r, check_finite=False)
-    rinv = sla.solve_triangular(r1, np.eye(p), check_finite=False)
+    theta = solve_upper(r1, r)
+    rinv = solve_upper(r1, np.eye(p))
     cov = rinv @ rinv.T
     rss = float(R[p, p] ** 2)
     val = np.abs(theta if values is None else np.asarray(values, dtype=np.float64))
-    size = float(np.linalg.norm(val * col))
+    vc = val * col
+    size = math.sqrt(vc.dot(vc))  # np.linalg.norm of a vector (the same dot), without its dispatch
     sigma_rel = math.sqrt(rss / (m - p)) / (float(sv[0]) * size) if size > 0 else math.inf
-    fitted = float(np.linalg.norm(r))
+    rk = r.ravel(order="K")  # contiguous, as np.linalg.norm makes it
+    fitted = math.sqrt(rk.dot(rk))
     tan_phi = (abs(float(R[p, p])) / fitted if fitted > 0 else math.inf) if values is None else None
     limit = warn_threshold(sigma_rel, tan_phi)
     if warn and cond > limit:

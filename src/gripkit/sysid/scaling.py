@@ -15,17 +15,21 @@ on the B entries and 1 elsewhere.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 __all__ = ["unit_scale", "in_user_units"]
 
 
-def unit_scale(x: np.ndarray) -> float:
-    """The power of two ``c`` that brings ``max|x|`` into [0.5, 1) (1 for an all-zero signal)."""
-    peak = max(float(np.max(x)), -float(np.min(x)))  # max|x| without an N-sized temporary
+def unit_scale(x: np.ndarray, peaks: tuple[float, float] | None = None) -> float:
+    """The power of two ``c`` that brings ``max|x|`` into [0.5, 1) (1 for an all-zero signal);
+    ``peaks``: ``(min, max)`` of ``x`` when already known."""
+    lo, hi = (float(np.min(x)), float(np.max(x))) if peaks is None else peaks
+    peak = max(hi, -lo)  # max|x| without an N-sized temporary
     if peak == 0.0:
         return 1.0
-    return float(np.ldexp(1.0, -int(np.frexp(peak)[1])))
+    return math.ldexp(1.0, -math.frexp(peak)[1])  # exact, as np.ldexp/np.frexp
 
 
 def in_user_units(model, cu: float, cy: float):

@@ -14,16 +14,17 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
-import scipy.linalg as sla
 
 from ...errors import DataError
 from ..scaling import in_user_units, unit_scale
 from .arx_mimo import arx_mimo
 from ..checks import (check_dt, check_excitation, check_identifiable, check_io, check_order,
-                     check_output_varies, checked_problem, require_samples)
+                     check_output_varies, checked_problem_peaks, require_samples)
 from .polynomial import PolynomialModel, check_meta
-from ..regression import arx_regression, arx_start, qr_solve, triangular_solve
+from ..regression import arx_regression, arx_start, qr_solve, solve_upper, triangular_solve
 from .validation import fit_percent, records_fit
 
 __all__ = ["arx", "arx_records"]
@@ -83,11 +84,15 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
     check_meta(meta, arx)
     if any(np.ndim(x) == 2 and np.shape(x)[1] > 1 for x in (u, y)):  # several inputs or outputs
         return arx_mimo(u, y, na, nb, nk, dt=dt, **meta)
-    u, y, step, na, nb, nk = checked_problem(u, y, dt, na=na, nb=nb, nk=nk)
-    cu, cy = unit_scale(u), unit_scale(y)
-    if max(abs(np.log2(cu)), abs(np.log2(cy))) <= _NO_SCALING_WITHIN:
+    # one min and max per signal (the finiteness check's) serve the excitation checks and scaling
+    u, y, step, na, nb, nk, (pu, py) = checked_problem_peaks(u, y, dt, na=na, nb=nb, nk=nk)
+    cu, cy = unit_scale(u, pu), unit_scale(y, py)
+    if max(abs(math.log2(cu)), abs(math.log2(cy))) <= _NO_SCALING_WITHIN:
         cu = cy = 1.0  # scaling by powers of two is exact: skip the two copies where it changes nothing
-    model = _arx(u * cu if cu != 1.0 else u, y * cy if cy != 1.0 else y, na, nb, nk, step, record=(u, y), **meta)
+    # a positive power of two maps min to min and max to max exactly (rounding is monotone)
+    peaks = ((pu[0] * cu, pu[1] * cu), (py[0] * cy, py[1] * cy))
+    model = _arx(u * cu if cu != 1.0 else u, y * cy if cy != 1.0 else y, na, nb, nk, step,
+                 record=(u, y), peaks=peaks, **meta)
     return in_user_units(model, cu, cy)
 
 
@@ -98,15 +103,21 @@ _NO_SCALING_WITHIN = 100
 
 
 def _arx(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int, step: float, *, warn: bool = True,
-         keep_residuals: bool = True, record: tuple | None = None, **meta) -> PolynomialModel:
+         keep_residuals: bool = True, record: tuple | None = None, peaks: tuple | None = None,
+         **meta) -> PolynomialModel:
     """:func:`arx` on checked signals, without scaling; ``warn=False`` for the internal fits of
     other estimators (their own diagnostics speak for the final model). With ``record`` (the
     caller's ``(u, y)`` in its own units) or ``keep_residuals=False`` a large fit keeps no residual
-    array; with ``record`` its model computes them from the record on first access."""
+    array; with ``record`` its model computes them from the record on first access. ``peaks``:
+    ``((min u, max u), (min y, max y))`` when the caller knows them.
+
+    The model object is built once, with every field (a fixed cost that counts in order searches
+    and sliding windows at N ≈ 10⁴, issue 24)."""
     keep_residuals = keep_residuals and record is None
     p = na + nb
     t0 = arx_start(na, nb, nk)
-    check_identifiable(u, y, t0 + p + 1, f"ARX [{na} {nb} {nk}] ({p} parameters, {t0} initial samples)")
+    check_identifiable(u, y, t0 + p + 1,
+                       f"ARX [{na} {nb} {nk}] ({p} parameters, {t0} initial samples)", peaks)
     names = tuple(f"a{i}" for i in range(1, na + 1)) + tuple(f"b{nk + j}" for j in range(nb))
     m = y.size - t0
     small = m * (p + 1) <= QR_MAX_ELEMENTS
@@ -114,25 +125,34 @@ def _arx(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int, step: float, *
     if gram is None:  # small, or ill-conditioned: QR of the materialised [Φ | Y]
         sol = qr_solve(arx_regression(u, y, na, nb, nk), names, overwrite=True, warn=warn)
         method = "least squares (QR of [Φ | Y])"
-        model = _model(sol.theta, na, nk, step, y.size, meta)
-        e = model.prediction_errors(u, y)
+        A, B = _polynomials(sol.theta, na, nk)
+        # PolynomialModel.prediction_errors of an ARX model, on the same arrays
+        e = np.convolve(y, A)[t0:y.size] - np.convolve(u, B)[t0:u.size]
         see, fit = float(e @ e), fit_percent(y[t0:], y[t0:] - e)
     else:
         method = "least squares (normal equations from compensated lagged sums, Cholesky)"
         sol, e, see, syy = gram
-        model = _model(sol.theta, na, nk, step, y.size, meta)
+        A, B = _polynomials(sol.theta, na, nk)
         fit = 100.0 * (1.0 - np.sqrt(see / syy))
     sigma2 = see / (m - p)
     if e is not None:
         e.flags.writeable = False  # handed to the model without a copy
-    return model.replace(covariance=sigma2 * sol.cov_unscaled, noise_variance=sigma2, loss=0.5 * see / m,
-                         fit_percent=fit, n_used=m, residuals=e, estimation_data=record if e is None else None,
-                         info={"method": method, "cond": sol.cond})
+    return PolynomialModel(A, B, nk, dt=step, structure="arx", n_samples=int(y.size),
+                           covariance=sigma2 * sol.cov_unscaled, noise_variance=sigma2,
+                           loss=0.5 * see / m, fit_percent=fit, n_used=m, residuals=e,
+                           estimation_data=record if e is None else None,
+                           info={"method": method, "cond": sol.cond}, **meta)
+
+
+def _polynomials(theta, na, nk) -> tuple[np.ndarray, np.ndarray]:
+    """``A = [1, a…]`` and ``B = [0]*nk + [b…]`` (MATLAB layout) from θ."""
+    A = np.concatenate([[1.0], theta[:na]])
+    B = np.concatenate([np.zeros(nk), theta[na:]])
+    return A, B
 
 
 def _model(theta, na, nk, step, n, meta) -> PolynomialModel:
-    A = np.concatenate([[1.0], theta[:na]])
-    B = np.concatenate([np.zeros(nk), theta[na:]])
+    A, B = _polynomials(theta, na, nk)
     return PolynomialModel(A, B, nk, dt=step, structure="arx", n_samples=int(n), **meta)
 
 
@@ -148,17 +168,18 @@ def _normal_equations(u, y, na, nb, nk, t0, names, warn, keep_residuals):
     )
 
     G = arx_gram(u, y, na, nb, nk, t0)
-    r1 = gram_triangle(G)
+    r1, condition = gram_triangle(G, with_condition=True)
     if r1 is None:
         return None
     p = na + nb
     R = np.zeros((p + 1, p + 1))
     R[:p, :p] = r1
-    R[:p, p] = sla.solve_triangular(r1, G[:p, p], trans="T", check_finite=False)  # R1ᵀ r = ΦᵀY
-    theta = sla.solve_triangular(r1, R[:p, p], check_finite=False)
+    R[:p, p] = solve_upper(r1, G[:p, p], trans=1)  # R1ᵀ r = ΦᵀY
+    theta = solve_upper(r1, R[:p, p])
     e, see, syy = arx_residuals(u, y, theta, na, nb, nk, t0, keep_residuals)
     R[p, p] = np.sqrt(see)
-    return triangular_solve(R, names, y.size - t0, warn, stacklevel=5), e, see, syy
+    return (triangular_solve(R, names, y.size - t0, warn, stacklevel=5, condition=condition),
+            e, see, syy)
 
 
 def checked_records(records, what: str) -> list:
@@ -270,6 +291,8 @@ def arx_records(records, na: int, nb: int, nk: int = 1, *, dt: float | None = No
     names = tuple(f"a{i}" for i in range(1, na + 1)) + tuple(f"b{nk + j}" for j in range(nb))
     sol = theta = R = None
     if m * (p + 1) > QR_MAX_ELEMENTS:  # the records' Gram matrices summed (O(p²) memory)
+        import scipy.linalg as sla
+
         from .lagged_sums import arx_gram, gram_triangle
 
         G = sum(arx_gram(u, y, na, nb, nk, t0) for u, y in scaled)

@@ -19,6 +19,8 @@ compensation, so the rounding error is about ``BLOCK·u`` relative to ``Σ|x z|`
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from numba import njit
 
@@ -30,8 +32,11 @@ __all__ = ["BLOCK", "GRAM_COND_LIMIT", "arx_gram", "arx_residuals", "gram_triang
 BLOCK = 256
 
 
+@functools.lru_cache(maxsize=64)
 def _columns(na: int, nb: int, nk: int):
-    """(signal, lag, sign) of each column of ``[Φ | Y]``: signal 0 = y, 1 = u."""
+    """(signal, lag, sign) of each column of ``[Φ | Y]``: signal 0 = y, 1 = u. Built once per
+    structure (three list-to-array conversions are a visible cost at N ≈ 10⁴); the kernels only
+    read them (left writable: a read-only array is another numba signature to compile)."""
     kind = np.array([0] * na + [1] * nb + [0], dtype=np.int64)
     lag = np.array([1 + i for i in range(na)] + [nk + j for j in range(nb)] + [0], dtype=np.int64)
     sign = np.array([-1.0] * na + [1.0] * nb + [1.0])
@@ -181,13 +186,17 @@ def arx_residuals(u: np.ndarray, y: np.ndarray, theta: np.ndarray, na: int, nb: 
 GRAM_COND_LIMIT = float(np.sqrt(1e-8 / (BLOCK * 2.0**-53)))
 
 
-def gram_triangle(G: np.ndarray) -> np.ndarray | None:
+def gram_triangle(G: np.ndarray, with_condition: bool = False):
     """Upper Cholesky factor ``R1`` of ``ΦᵀΦ = G[:p, :p]`` (``R1ᵀR1 = ΦᵀΦ``), or None when Φ is
     too ill-conditioned for the normal equations (not positive definite, or column-scaled
-    condition number above :data:`GRAM_COND_LIMIT`)."""
+    condition number above :data:`GRAM_COND_LIMIT`). ``with_condition``: ``(R1, scaled_condition
+    of R1)``, or ``(None, None)``, for a caller that needs both."""
     p = G.shape[0] - 1
     try:
         r1 = np.linalg.cholesky(G[:p, :p]).T
     except np.linalg.LinAlgError:
-        return None
-    return r1 if scaled_condition(r1)[0] <= GRAM_COND_LIMIT else None
+        return (None, None) if with_condition else None
+    sc = scaled_condition(r1)
+    if sc[0] > GRAM_COND_LIMIT or sc[0] != sc[0]:  # NaN: refused as before (not <=)
+        return (None, None) if with_condition else None
+    return (r1, sc) if with_condition else r1

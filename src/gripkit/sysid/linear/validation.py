@@ -42,6 +42,13 @@ def fit_percent(y, yhat) -> float:
     """``100 (1 − ‖y − ŷ‖ / ‖y − ȳ‖)`` in percent."""
     y = np.asarray(y, dtype=np.float64)
     yhat = np.asarray(yhat, dtype=np.float64)
+    if y.ndim == 1 and y.shape == yhat.shape:  # np.linalg.norm's arithmetic (√(d·d)), one buffer
+        d = np.subtract(y, y.mean())
+        den = math.sqrt(d.dot(d))
+        if den == 0.0:
+            raise DataError("the fit is undefined for a constant output (‖y − ȳ‖ = 0)")
+        np.subtract(y, yhat, out=d)
+        return 100.0 * (1.0 - math.sqrt(d.dot(d)) / den)
     den = float(np.linalg.norm(y - y.mean()))
     if den == 0.0:
         raise DataError("the fit is undefined for a constant output (‖y − ȳ‖ = 0)")

@@ -1,0 +1,85 @@
+"""Where the time of a one-state mass matrix without ``out=`` goes, beside ``pin.crba`` (issue 24:
+≤ 1.1× ``pin.crba``).
+
+``python benchmarks/ab_crba_alloc.py`` times, per call from a Python loop over 2·10⁴ states of
+the DLR/HIT finger (4 joints, 3 actuators), in thread CPU time (steady on a loaded machine),
+alternating, min and median of 15 runs:
+
+* ``pin.crba(model, data, q)`` (writes into its ``data``, returns a view of it);
+* ``chain.mass_matrix(p)`` (a new 3×3 array per call) and ``chain.mass_matrix(p, out=M)``;
+* the compiled kernel ``mass_matrix_one(buf, p, M)`` alone, into one array and into a new
+  ``np.empty`` per call: the difference of the last two is the price of a fresh result array,
+  the difference to ``chain.mass_matrix`` the Python method's.
+"""
+
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).parents[1] / "src"))
+
+from gripkit.errors import ConsistencyWarning  # noqa: E402
+from gripkit.multibody.onestate import mass_matrix_one  # noqa: E402
+from gripkit.multibody.pinocchio import to_pinocchio  # noqa: E402
+from gripkit.systems.dlr_hit.parameters import finger  # noqa: E402
+
+
+def main(n: int = 20_000, runs: int = 15) -> dict:
+    import pinocchio as pin
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ConsistencyWarning)
+        ch = finger().chain()
+    model, data = to_pinocchio(ch.chain)
+    G = ch.coupling.matrix
+    rng = np.random.default_rng(0)
+    ps = [np.ascontiguousarray(x) for x in rng.normal(size=(n, 3))]
+    qs = [np.ascontiguousarray(G @ x) for x in ps]
+    M = np.empty((3, 3))
+    buf, _, shape = ch._one or ch._one_state()
+
+    def pin_crba():
+        for q in qs:
+            pin.crba(model, data, q)
+
+    def mass_matrix():
+        for p in ps:
+            ch.mass_matrix(p)
+
+    def mass_matrix_out():
+        for p in ps:
+            ch.mass_matrix(p, out=M)
+
+    def kernel_into_one_array():
+        for p in ps:
+            mass_matrix_one(buf, p, M)
+
+    def kernel_into_new_array():
+        for p in ps:
+            mass_matrix_one(buf, p, np.empty(shape))
+
+    fns = {"pin.crba": pin_crba, "mass_matrix(p)": mass_matrix,
+           "mass_matrix(p, out=M)": mass_matrix_out, "kernel, one array": kernel_into_one_array,
+           "kernel, np.empty per call": kernel_into_new_array}
+    for fn in fns.values():
+        fn()
+    times = {k: [] for k in fns}
+    for _ in range(runs):
+        for k, fn in fns.items():
+            t0 = time.thread_time()
+            fn()
+            times[k].append((time.thread_time() - t0) / n)
+    ref = min(times["pin.crba"])
+    out = {}
+    for k, v in times.items():
+        out[k] = (min(v), float(np.median(v)))
+        print(f"{k:26s} min {min(v) * 1e9:6.0f} ns  median {np.median(v) * 1e9:6.0f} ns  "
+              f"min / pin.crba min {min(v) / ref:.2f}")
+    return out
+
+
+if __name__ == "__main__":
+    main()
