@@ -24,7 +24,7 @@ def _build():
     from . import excitation_fourier, identify_dynamics  # noqa: F401
     from . import compare, identify_ss, report_model  # noqa: F401
     from . import export_c  # noqa: F401
-    from . import identify_narx  # noqa: F401
+    from . import identify_narx, identify_nlss  # noqa: F401
     from .app import app
 
     return app

@@ -69,6 +69,9 @@ _LAZY = {
     "narx": ("nonlinear.narx", "narx"),
     "NARXModel": ("nonlinear.narx", "NARXModel"),
     "load_narx": ("nonlinear.narx", "load_narx"),
+    "nlss": ("nonlinear.nlss", "nlss"),
+    "NLSSModel": ("nonlinear.nlss", "NLSSModel"),
+    "load_nlss": ("nonlinear.nlss", "load_nlss"),
 }
 __getattr__, __dir__ = lazy_exports(__name__, _LAZY)
 __all__ = [*_LAZY]
@@ -121,3 +124,6 @@ if TYPE_CHECKING:  # static readers see the same names, imported eagerly
     from .nonlinear.narx import NARXModel as NARXModel
     from .nonlinear.narx import load_narx as load_narx
     from .nonlinear.narx import narx as narx
+    from .nonlinear.nlss import NLSSModel as NLSSModel
+    from .nonlinear.nlss import load_nlss as load_nlss
+    from .nonlinear.nlss import nlss as nlss

@@ -67,6 +67,7 @@ class IdentifiedModel(Protocol):
 MODEL_FILES: dict[str, tuple[str, str]] = {
     "gripkit.linear-model": ("linear_model", "load_linear_model"),
     "gripkit.narx-model": ("nonlinear.narx", "load_narx"),
+    "gripkit.nlss-model": ("nonlinear.nlss", "load_nlss"),
 }
 
 

@@ -1,5 +1,6 @@
 """Nonlinear system identification (issue 26): polynomial NARX by forward regression with the
-error reduction ratio (:func:`narx`, :mod:`.narx`).
+error reduction ratio (:func:`narx`, :mod:`.narx`); polynomial nonlinear state space
+(:func:`nlss`, :mod:`.nlss`).
 
 The public names are loaded on first use (the table ``_LAZY``, :mod:`gripkit.exports`).
 """
@@ -15,6 +16,9 @@ _LAZY = {
     "narx": ("narx", "narx"),
     "NARXModel": ("narx", "NARXModel"),
     "load_narx": ("narx", "load_narx"),
+    "nlss": ("nlss", "nlss"),
+    "NLSSModel": ("nlss", "NLSSModel"),
+    "load_nlss": ("nlss", "load_nlss"),
 }
 __getattr__, __dir__ = lazy_exports(__name__, _LAZY)
 __all__ = [*_LAZY]
@@ -23,3 +27,6 @@ if TYPE_CHECKING:  # static readers see the same names, imported eagerly
     from .narx import NARXModel as NARXModel
     from .narx import load_narx as load_narx
     from .narx import narx as narx
+    from .nlss import NLSSModel as NLSSModel
+    from .nlss import load_nlss as load_nlss
+    from .nlss import nlss as nlss

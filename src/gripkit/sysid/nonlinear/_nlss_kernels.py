@@ -8,12 +8,12 @@ Model (normalised input ũ, states of the model's basis)::
 
 ζ and η are monomials given by exponent tables (M, n + m) over the variables v = [x; ũ]. A
 parameter direction is a row (kind, r, c) of ``dirs``: kind 0 … 5 for the entry (r, c) of A, B,
-C, D, E, F. Its sensitivity s = ∂x/∂θ obeys::
+C, D, E, F, kind 6 for the output offset y₀ᵣ (c = 0). Its sensitivity s = ∂x/∂θ obeys::
 
     s[t+1] = (A + E ∂ζ/∂x) s[t] + f_θ[t],     ∂ŷ[t] = (C + F ∂η/∂x) s[t] + g_θ[t]
 
 with f_θ = e_r x_c, e_r ũ_c, e_r ζ_c for A, B, E and g_θ = e_r x_c, e_r ũ_c, e_r η_c for C, D, F
-(the same form as the linear PEM sensitivities of :mod:`gripkit.sysid.pem_ss`, with the
+(and ∂ŷᵣ/∂y₀ᵣ = 1; the same form as the linear PEM sensitivities of :mod:`gripkit.sysid.pem_ss`, with the
 Jacobian of the state map in place of A). The initial state of each window is n more directions
 (s = I at the window's first sample). The columns of S advance together (rows contiguous,
 :func:`~gripkit.sysid.blocked_gram.row_product`) and blocks of rows of J go to BLAS
@@ -218,6 +218,8 @@ def window_gram(A, B, C, D, E, F, y0, exz, exe, dirs, Z, starts, u, y, w, limit,
                     rows[fill + r, q] += u[t, c]
                 elif kind == 5:
                     rows[fill + r, q] += eta[c]
+                elif kind == 6:
+                    rows[fill + r, q] += 1.0
             for i in range(p):
                 wi = w[i]
                 ri = rows[fill + i]
@@ -302,6 +304,8 @@ def output_variance(A, B, C, D, E, F, y0, exz, exe, dirs, x0, u, L, out):  # pra
                 rows[fill + r, q] += u[t, c]
             elif kind == 5:
                 rows[fill + r, q] += eta[c]
+            elif kind == 6:
+                rows[fill + r, q] += 1.0
         fill += p
         if fill == rows.shape[0] or t == N - 1:
             R = np.dot(rows[:fill], L)

@@ -9,8 +9,9 @@ of nonlinear systems using Polynomial Nonlinear State Space models", Automatica 
 the states only (with ``feedthrough=True`` also of the inputs, and D is estimated; otherwise
 D = 0 and y(t) does not depend on u(t)). Inputs enter normalised, ũ = (u − ū)/s_u (mean and
 standard deviation of the estimation record), and the states are scaled to unit standard
-deviation on the estimation record, so that the monomials are of order one; y₀ is the mean
-output.
+deviation on the estimation record, so that the monomials are of order one; y₀, the output at
+the equilibrium x = 0 of the mean input, is estimated (it differs from the mean output of a
+nonlinear system).
 
 Estimation (:func:`nlss`):
 
@@ -125,7 +126,8 @@ class NLSSModel:
     """A polynomial nonlinear state-space model (module docstring).
 
     Matrices ``A`` (n, n), ``B`` (n, m), ``C`` (p, n), ``D`` (p, m), ``E`` (n, Mζ), ``F`` (p, Mη)
-    on the normalised input ``(u − u_offset)/u_scale`` and the output offset ``y_offset``;
+    on the normalised input ``(u − u_offset)/u_scale`` and the output offset ``y_offset`` (the
+    output at the equilibrium x = 0 of the mean input, estimated);
     ``exz``/``exe``: the exponent tables of ζ and η; ``dirs``: the free entries (kind 0 … 5 for
     A … F, row, column) in the order of ``covariance``; ``x0``: the initial state of the
     estimation record; fits in % per output (None where the free run diverged)."""
@@ -219,6 +221,13 @@ class NLSSModel:
                     params.append(Parameter(self._entry_name(kind, r, c), float(M[r, c]),
                                             unit or "1", what, fixed=key not in std,
                                             std=std.get(key), source="identified (nlss)"))
+        for r in range(len(self.output_names)):
+            key = (6, r, 0)
+            params.append(Parameter(f"y0_{r + 1}", float(self.y_offset[r]),
+                                    self.output_units[r] or "1",
+                                    f"output {r + 1} at the equilibrium x = 0, u = mean input",
+                                    fixed=key not in std, std=std.get(key),
+                                    source="identified (nlss)"))
         return ParameterSet(params, name=f"NLSS order {n} degree {self.degree}")
 
     def _inputs_of(self, data, what: str) -> np.ndarray:
@@ -421,9 +430,11 @@ def load_nlss(path) -> NLSSModel:
     except (KeyError, TypeError, ValueError, AttributeError) as exc:
         raise ModelError(f"{str(p)!r}: a malformed {SCHEMA} ({type(exc).__name__}: {exc}); "
                          "write it again with NLSSModel.save") from None
-    lims = np.array([n, m + 1, p_, m + 1, exz.shape[0], exe.shape[0]])
-    if P and ((dirs[:, 0] < 0).any() or (dirs[:, 0] > 5).any()
-              or (dirs[:, 2] >= lims[np.clip(dirs[:, 0], 0, 5)]).any()
+    lims = np.array([n, m, n, m, exz.shape[0], exe.shape[0], 1])
+    rows_ = np.array([n, n, p_, p_, n, p_, p_])
+    if P and ((dirs[:, 0] < 0).any() or (dirs[:, 0] > 6).any() or (dirs[:, 1:] < 0).any()
+              or (dirs[:, 2] >= lims[np.clip(dirs[:, 0], 0, 6)]).any()
+              or (dirs[:, 1] >= rows_[np.clip(dirs[:, 0], 0, 6)]).any()
               or (exz < 0).any() or (exe < 0).any() or not np.all(model.u_scale > 0)):
         raise ModelError(f"{str(p)!r}: a free entry names a missing matrix entry, or an exponent "
                          "or input scale is out of range; write it again with NLSSModel.save")
@@ -433,10 +444,11 @@ def load_nlss(path) -> NLSSModel:
 # --------------------------------------------------------------------- estimation
 def _apply(model: NLSSModel, dirs, delta) -> NLSSModel:
     mats = [model.A.copy(), model.B.copy(), model.C.copy(), model.D.copy(), model.E.copy(),
-            model.F.copy()]
+            model.F.copy(), model.y_offset.copy()[:, None]]
     for (kind, r, c), d in zip(dirs, delta):
         mats[kind][r, c] += d
-    return replace(model, A=mats[0], B=mats[1], C=mats[2], D=mats[3], E=mats[4], F=mats[5])
+    return replace(model, A=mats[0], B=mats[1], C=mats[2], D=mats[3], E=mats[4], F=mats[5],
+                   y_offset=mats[6][:, 0].copy())
 
 
 def _loss(model, Z, starts, u, y, w) -> float:
@@ -456,22 +468,26 @@ def _gram(model, dirs, Z, starts, u, y, w):
 
 def _schur_step(Htt, gt, Htz, Hzz, gz, lam):
     """The damped Gauss-Newton step (H + λ diag H) δ = g with the initial-state blocks of the
-    windows eliminated (block-arrow H: each window's x0 couples only with θ)."""
+    windows eliminated (block-arrow H: each window's x0 couples only with θ). Solved in the
+    coordinates scaled by diag(H)^½ (the parameters' scales differ by orders of magnitude), where
+    the damping is λ I."""
     n = Hzz.shape[1]
-    dz_diag = np.maximum(np.einsum("wii->wi", Hzz), 1e-300)
-    Hzd = Hzz + lam * dz_diag[:, :, None] * np.eye(n)
-    Hzi_gz = np.linalg.solve(Hzd, gz[:, :, None])[:, :, 0]
-    P = Htt.shape[0]
-    if P:
-        Hzi_Hzt = np.linalg.solve(Hzd, np.transpose(Htz, (0, 2, 1)))          # (W, n, P)
-        R = Htt + lam * np.diag(np.maximum(np.diag(Htt), 1e-300)) \
-            - np.einsum("wpn,wnq->pq", Htz, Hzi_Hzt)
-        r = gt - np.einsum("wpn,wn->p", Htz, Hzi_gz)
-        dth = sla.solve(R, r, assume_a="sym")
+    st = np.sqrt(np.maximum(np.diag(Htt), 1e-300))
+    sz = np.sqrt(np.maximum(np.einsum("wii->wi", Hzz), 1e-300))              # (W, n)
+    Hts = Htt / np.outer(st, st)
+    Htzs = Htz / st[None, :, None] / sz[:, None, :]
+    Hzzs = Hzz / sz[:, :, None] / sz[:, None, :] + lam * np.eye(n)
+    gts, gzs = gt / st, gz / sz
+    Hzi_gz = np.linalg.solve(Hzzs, gzs[:, :, None])[:, :, 0]
+    if st.size:
+        Hzi_Hzt = np.linalg.solve(Hzzs, np.transpose(Htzs, (0, 2, 1)))        # (W, n, P)
+        R = Hts + lam * np.eye(st.size) - np.einsum("wpn,wnq->pq", Htzs, Hzi_Hzt)
+        r = gts - np.einsum("wpn,wn->p", Htzs, Hzi_gz)
+        dth = sla.solve(0.5 * (R + R.T), r, assume_a="sym")
         dz = Hzi_gz - np.einsum("wnp,p->wn", Hzi_Hzt, dth)
     else:
         dth, dz = np.zeros(0), Hzi_gz
-    return dth, dz
+    return dth / st, dz / sz
 
 
 def _lm(model, dirs, Z, starts, u, y, w, max_iterations, bar, tol=1e-7):
@@ -623,7 +639,7 @@ def _positive_int(v, name: str, lo: int = 1) -> int:
 
 def nlss(data, *, input=None, output=None, order: int | None = None, degree: int = 3,
          validate=None, dt: float | None = None, window: int | None = None, max_order: int = 4,
-         feedthrough: bool = False, max_iterations: int = 40, progress: bool = True) -> NLSSModel:
+         feedthrough: bool = False, max_iterations: int = 100, progress: bool = True) -> NLSSModel:
     """Polynomial nonlinear state-space model (PNLSS, module docstring) of a record.
 
     ``data``: a :class:`~gripkit.signals.Trajectory` with ``input``/``output`` naming its
@@ -684,9 +700,17 @@ def nlss(data, *, input=None, output=None, order: int | None = None, degree: int
     def linear(n):
         with warnings.catch_warnings(record=True) as caught:  # the start, not the result
             warnings.simplefilter("always")
-            try:
-                lm = n4sid(ut, y - y_off, n, dt=dt, feedthrough=feedthrough)
-            except np.linalg.LinAlgError:
+            lm = None
+            # n4sid's least squares for B and x0 overflows on a long record when the
+            # shift-invariance A of an over-large order is unstable (LinAlgError): the start is
+            # then taken from the first 2000 samples
+            for cut in (N, 2000):
+                try:
+                    lm = n4sid(ut[:cut], (y - y_off)[:cut], n, dt=dt, feedthrough=feedthrough)
+                    break
+                except np.linalg.LinAlgError:
+                    continue
+            if lm is None:
                 return None
         notes.extend(str(c.message) for c in caught)
         return lm
@@ -784,7 +808,8 @@ def _fit_order(lin, ut, y, u_off, sd_u, y_off, degree, feedthrough, window, max_
                       np.array([(4, r, c) for r in range(n) for c in range(len(exz))],
                                dtype=np.int64).reshape(-1, 3),
                       np.array([(5, r, c) for r in range(p) for c in range(len(exe))],
-                               dtype=np.int64).reshape(-1, 3)])
+                               dtype=np.int64).reshape(-1, 3),
+                      np.array([(6, r, 0) for r in range(p)], dtype=np.int64)])
     # stage 2: truncated simulation windows
     rad = float(np.max(np.abs(np.linalg.eigvals(A)))) if n else 0.0
     tau = -1.0 / math.log(min(max(rad, 1e-6), 1 - 1e-9))
