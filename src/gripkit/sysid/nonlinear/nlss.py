@@ -28,6 +28,10 @@ Estimation (:func:`nlss`):
 3. The whole record: the same criterion with one window (the free-run simulation error from one
    estimated initial state), started from stage 2's parameters.
 
+A record longer than 8000 samples goes through stages 2 and 3 on its first 8000 samples, then
+stage 3 again on all of them (a polish: the optimum moves little, and each pass over the record
+costs N·P² for P parameters).
+
 Both stages are Levenberg-Marquardt on the exact Gauss-Newton sums of the sensitivity equations
 (numba kernels, :mod:`._nlss_kernels`; the initial states are eliminated by a Schur complement,
 one n × n block per window). A step whose free run leaves the state range (1000 × the
@@ -77,6 +81,9 @@ DIVERGENCE_FACTOR = 1e3
 #: noise variances (a move of ≪ 1σ) or by a relative 1e-7
 _NEGLIGIBLE_DROP = 0.01
 _KIND = "ABCDEF"
+#: a longer record is first fitted on its first this many samples (windows, then whole), then
+#: polished on all of them (the same optimum, a fraction of the full-length sensitivity passes)
+_WARM_SAMPLES = 8000
 
 
 def monomial_exponents(n_states: int, n_inputs: int, degree: int, inputs: bool = True,
@@ -771,7 +778,7 @@ def nlss(data, *, input=None, output=None, order: int | None = None, degree: int
 def _fit_order(lin, ut, y, u_off, sd_u, y_off, degree, feedthrough, window, max_iterations,
                progress, dt, ins, outs, iunits, ounits, levels) -> NLSSModel:
     """Stages 1-3 of the module docstring for one order."""
-    from ...progress import status
+    from ...progress import status, track
 
     ss = lin.system
     N, m = ut.shape
@@ -810,44 +817,48 @@ def _fit_order(lin, ut, y, u_off, sd_u, y_off, degree, feedthrough, window, max_
                       np.array([(5, r, c) for r in range(p) for c in range(len(exe))],
                                dtype=np.int64).reshape(-1, 3),
                       np.array([(6, r, 0) for r in range(p)], dtype=np.int64)])
-    # stage 2: truncated simulation windows
+    # stage 2: truncated simulation windows (on the first _WARM_SAMPLES samples of a long record)
+    Ns = min(N, _WARM_SAMPLES)
     rad = float(np.max(np.abs(np.linalg.eigvals(A)))) if n else 0.0
     tau = -1.0 / math.log(min(max(rad, 1e-6), 1 - 1e-9))
-    L = window if window is not None else int(min(max(50, 10 * tau), N))
-    L = max(L, -(-N // 200))
-    L = min(L, N)
-    starts = np.arange(0, N, L, dtype=np.int64)
-    if N - starts[-1] < L // 2 and len(starts) > 1:  # a short tail joins the last window
+    L = window if window is not None else int(min(max(50, 10 * tau), Ns))
+    L = min(max(L, -(-Ns // 200)), Ns)
+    starts = np.arange(0, Ns, L, dtype=np.int64)
+    if Ns - starts[-1] < L // 2 and len(starts) > 1:  # a short tail joins the last window
         starts = starts[:-1]
-    starts = np.append(starts, N)
+    starts = np.append(starts, Ns)
     Z = np.ascontiguousarray(X[starts[:-1]])
-    it_total = [0]
-    total = 2 * max_iterations
+    stages = 2 if Ns == N else 3
+    bar = track(range(stages * max_iterations), description=f"nlss order {n}",
+                enabled=progress)
     t_start = time.perf_counter()
-
-    def tick():
-        it_total[0] += 1
-        if progress and (it_total[0] % 5 == 0):
-            status(f"  nlss order {n}: iteration {it_total[0]} "
-                   f"({time.perf_counter() - t_start:.1f} s)")
-
     if progress:
-        status(f"  nlss order {n} degree {degree}: {dirs.shape[0]} parameters, "
-               f"{len(starts) - 1} windows of {L} samples, then the whole record "
-               f"(at most {total} iterations)")
-    model, Z, V1, it1, conv1 = _lm(base, dirs, Z, starts, ut, y, w, max_iterations, tick)
-    # stage 3: the whole record from one initial state
+        status(f"nlss order {n} degree {degree}: {dirs.shape[0]} parameters; Levenberg-Marquardt "
+               f"on {len(starts) - 1} windows of {L} samples, then the whole "
+               + ("record" if Ns == N else f"first {Ns} samples, then all {N}"))
+    try:
+        tick = lambda: next(bar, None)  # noqa: E731
+        model, Z, V1, it1, conv1 = _lm(base, dirs, Z, starts, ut[:Ns], y[:Ns], w,
+                                       max_iterations, tick)
+        # stage 3: the whole record (first its warm-start part) from one initial state
+        its = [it1]
+        for M_ in ((Ns, N) if Ns < N else (N,)):
+            whole = np.array([0, M_], dtype=np.int64)
+            Z0 = np.ascontiguousarray(Z[:1])
+            if not np.isfinite(_loss(model, Z0, whole, ut, y, w)):
+                # the model runs away over the longer record: restart there from the linear one
+                model, Z0 = base, np.ascontiguousarray(x0[None, :])
+            model, Z, V2, it2, conv2 = _lm(model, dirs, Z0, whole, ut[:M_], y[:M_], w,
+                                           max_iterations, tick)
+            its.append(it2)
+            if not np.isfinite(V2):
+                raise IdentificationError("nlss: the free run of the model diverges on the "
+                                          "estimation record at every step tried; lower the "
+                                          "degree or the order")
+    finally:
+        bar.close()
+    Z0 = Z
     whole = np.array([0, N], dtype=np.int64)
-    Z0 = np.ascontiguousarray(Z[:1])
-    V_start = _loss(model, Z0, whole, ut, y, w)
-    if not np.isfinite(V_start):  # the windowed model runs away over the whole record
-        Z0 = np.ascontiguousarray(x0[None, :])
-        model, Z0, V2, it2, conv2 = _lm(base, dirs, Z0, whole, ut, y, w, max_iterations, tick)
-    else:
-        model, Z0, V2, it2, conv2 = _lm(model, dirs, Z0, whole, ut, y, w, max_iterations, tick)
-    if not np.isfinite(V2):
-        raise IdentificationError("nlss: the free run of the model diverges on the estimation "
-                                  "record at every step tried; lower the degree or the order")
     V, Htt, gt, Htz, Hzz, gz = _gram(model, dirs, Z0, whole, ut, y, w)
     P = dirs.shape[0]
     H = np.zeros((P + n, P + n))
@@ -869,11 +880,11 @@ def _fit_order(lin, ut, y, u_off, sd_u, y_off, degree, feedthrough, window, max_
     model.fit_percent = None if at >= 0 else _fits(y, Yf)
     model.linear_fit_percent = lin_fit
     lin_model = replace(base, dirs=np.zeros((0, 3), dtype=np.int64), covariance=np.zeros((0, 0)))
-    model.info = {"iterations_windows": it1, "iterations_whole": it2,
+    model.info = {"iterations_windows": its[0], "iterations_whole": sum(its[1:]),
                   "converged": bool(conv2), "windows": len(starts) - 1, "window": int(L),
                   "parameters": int(P), "loss_linear": float(np.sum((w * err) ** 2) / N),
                   "loss": float(V / N), "hessian_condition": cond, "_linear": lin_model}
     if progress:
-        status(f"  nlss order {n}: {it1} + {it2} iterations, "
+        status(f"nlss order {n}: {' + '.join(map(str, its))} iterations, "
                f"{time.perf_counter() - t_start:.1f} s")
     return model
