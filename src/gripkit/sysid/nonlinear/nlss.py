@@ -62,8 +62,8 @@ import numpy as np
 import scipy.linalg as sla
 
 from ...atomic import write_text
-from ...errors import (ArgumentError, DataError, IdentificationError, ModelError, PathError,
-                       StabilityWarning, emit_warning)
+from ...errors import (AccuracyWarning, ArgumentError, DataError, IdentificationError,
+                       ModelError, PathError, StabilityWarning, emit_warning)
 from ..model_protocol import ModelFit
 from . import _nlss_kernels as K
 
@@ -84,6 +84,8 @@ _KIND = "ABCDEF"
 #: a longer record is first fitted on its first this many samples (windows, then whole), then
 #: polished on all of them (the same optimum, a fraction of the full-length sensitivity passes)
 _WARM_SAMPLES = 8000
+#: condition number of the scaled Hessian beyond which σ are not trusted (AccuracyWarning)
+_ILL_CONDITIONED = 1e12
 
 
 def monomial_exponents(n_states: int, n_inputs: int, degree: int, inputs: bool = True,
@@ -653,11 +655,12 @@ def nlss(data, *, input=None, output=None, order: int | None = None, degree: int
     columns (``'a,b'`` or a list for several), or a pair ``(u, y)`` of arrays (N,) or (N, k).
     ``order``: states (default: at the largest gap s_n/s_(n+1) among the first ``max_order``
     subspace singular values; with ``validate`` the best free-run validation fit among that
-    order and its two neighbours). ``degree``: highest degree of the monomials (≥ 2). ``validate``: a second
-    record like ``data``. ``window``: samples per truncated simulation window of stage 2
-    (default 10 linear time constants, ≥ 50, ≤ 200 windows). ``feedthrough``: estimate D and
-    the input monomials of the output equation. ``max_iterations``: Levenberg-Marquardt
-    iterations per stage. ``progress``: a progress bar on stderr.
+    order and its two neighbours). ``degree``: highest degree of the monomials (≥ 2).
+    ``validate``: a second record like ``data``. ``window``: samples per truncated simulation
+    window of stage 2 (default 10 linear time constants, ≥ 50, ≤ 200 windows).
+    ``feedthrough``: estimate D and the input monomials of the output equation.
+    ``max_iterations``: Levenberg-Marquardt iterations per stage. ``progress``: a progress bar
+    on stderr.
     """
     u, y, tr_dt, ins, outs, iunits, ounits = _io(data, input, output, "data")
     _check_signals(u, y, "data")
@@ -838,8 +841,8 @@ def _fit_order(lin, ut, y, u_off, sd_u, y_off, degree, feedthrough, window, max_
                + ("record" if Ns == N else f"first {Ns} samples, then all {N}"))
     try:
         tick = lambda: next(bar, None)  # noqa: E731
-        model, Z, V1, it1, conv1 = _lm(base, dirs, Z, starts, ut[:Ns], y[:Ns], w,
-                                       max_iterations, tick)
+        model, Z, _, it1, _ = _lm(base, dirs, Z, starts, ut[:Ns], y[:Ns], w, max_iterations,
+                                  tick)
         # stage 3: the whole record (first its warm-start part) from one initial state
         its = [it1]
         for M_ in ((Ns, N) if Ns < N else (N,)):
@@ -875,6 +878,11 @@ def _fit_order(lin, ut, y, u_off, sd_u, y_off, degree, feedthrough, window, max_
                                   hint="lower the degree or the order, or excite more richly") \
             from None
     cond = float(np.linalg.cond(Hs))
+    if not cond < _ILL_CONDITIONED:
+        emit_warning(f"nlss: the Gauss-Newton Hessian at the optimum is ill-conditioned (condition "
+                     f"number {cond:.2g} after scaling): some combinations of parameters are not "
+                     "determined by the data and their σ are not reliable; lower the degree or the "
+                     "order, or excite the system more richly", AccuracyWarning)
     model = replace(model, dirs=dirs, covariance=0.5 * (cov + cov.T), x0=Z0[0].copy())
     Yf, at = model._run(ut, model.x0)
     model.fit_percent = None if at >= 0 else _fits(y, Yf)
