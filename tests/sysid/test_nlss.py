@@ -330,3 +330,21 @@ def test_monte_carlo_sigma_of_the_output_is_honest():
     print(f"within 1σ: {r1}/{total}, within 3σ: {r3}/{total}")
     assert r3 >= 0.9 * total
     assert 0.45 * total <= r1 <= 0.9 * total
+
+
+@pytest.mark.slow
+def test_forty_thousand_samples_within_a_minute():
+    """Issue 26's speed target: 40 000 samples of the Duffing oscillator (1 % noise), default
+    options (order 2 at the singular-value gap, degree 3, 44 parameters) in under 60 s on the
+    2-core machine; measured 4–7 s with OPENBLAS_NUM_THREADS=1 at load 8–10. The fit is at the
+    noise limit (1 % noise: 99.0 %)."""
+    import time
+
+    rng = np.random.default_rng(1)
+    u = _input(rng, 40000)
+    y0 = duffing(u)
+    y = y0 + rng.normal(0.0, 0.01 * y0.std(), u.size)
+    t = time.perf_counter()
+    m = nlss((u, y), progress=False)
+    assert time.perf_counter() - t < 60.0
+    assert m.order == 2 and m.fit_percent[0] > 98.8

@@ -30,9 +30,9 @@ from ..blocked_gram import add_rows, row_product
 #: rows of J collected before one BLAS product
 _BLOCK = 256
 #: a carried sensitivity below this magnitude is set to zero: the initial-state directions decay
-#: freely, and once below 1e-154 their products in JᵀJ are subnormal numbers, whose arithmetic is
-#: slow on Intel CPUs (a 25× slower Gram sum measured on 8000 samples); such an entry adds less
-#: than 1e-300 to sums of order one, i.e. nothing
+#: freely, and once below 1e-154 their products in JᵀJ would be subnormal numbers, whose
+#: arithmetic is slow on Intel CPUs; such an entry adds less than 1e-300 to sums of order one,
+#: i.e. nothing
 _FLUSH = 1e-150
 
 
