@@ -15,8 +15,9 @@ nonlinear system).
 
 Estimation (:func:`nlss`):
 
-1. The linear start: :func:`gripkit.sysid.n4sid` on the centred data (order at the largest
-   gap of the singular values, at most ``max_order``), E = F = 0 — the model's best linear
+1. The linear start: :func:`gripkit.sysid.n4sid` on the centred data (order n at the largest
+   gap of the singular values, at most ``max_order``, and n + 1; the model of lower BIC is kept,
+   or with a validation record the best validation fit among n − 1, n, n + 1), E = F = 0 — the model's best linear
    approximation, from which Paduart et al. start too.
 2. Truncated simulation windows: the record is cut into windows of ``window`` samples (default
    10 time constants of the slowest linear pole, at least 50 samples and at most 200 windows);
@@ -658,9 +659,11 @@ def nlss(data, *, input=None, output=None, order: int | None = None, degree: int
 
     ``data``: a :class:`~gripkit.signals.Trajectory` with ``input``/``output`` naming its
     columns (``'a,b'`` or a list for several), or a pair ``(u, y)`` of arrays (N,) or (N, k).
-    ``order``: states (default: at the largest gap s_n/s_(n+1) among the first ``max_order``
-    subspace singular values; with ``validate`` the best free-run validation fit among that
-    order and its two neighbours). ``degree``: highest degree of the monomials (≥ 2).
+    ``order``: states (default: n at the largest gap s_n/s_(n+1) among the first ``max_order``
+    subspace singular values and n + 1 are fitted, and the one of lower BIC = N Σᵢ ln σ̂ᵢ² +
+    k ln N is kept (σ̂ᵢ² the mean squared free-run error of output i, k the free parameters and
+    the initial state); with ``validate``, the best free-run validation fit among n and its two
+    neighbours). ``degree``: highest degree of the monomials (≥ 2).
     ``validate``: a second record like ``data``. ``window``: samples per truncated simulation
     window of stage 2 (default 10 linear time constants, ≥ 50, ≤ 200 windows).
     ``feedthrough``: estimate D and the input monomials of the output equation.
@@ -712,6 +715,7 @@ def nlss(data, *, input=None, output=None, order: int | None = None, degree: int
     u_off, y_off = u.mean(axis=0), y.mean(axis=0)
     ut = np.ascontiguousarray((u - u_off) / sd_u)
     yc = np.ascontiguousarray(y)
+
     def linear(n):
         with warnings.catch_warnings(record=True) as caught:  # the start, not the result
             warnings.simplefilter("always")
@@ -725,12 +729,9 @@ def nlss(data, *, input=None, output=None, order: int | None = None, degree: int
                     break
                 except np.linalg.LinAlgError:
                     continue
-            if lm is None:
-                return None
-        notes.extend(str(c.message) for c in caught)
-        return lm
+        notes = list(dict.fromkeys(str(c.message) for c in caught))
+        return None if lm is None else (lm, notes)
 
-    notes: list[str] = []
     if order is None:  # the largest gap among the first max_order singular values
         sv = subspace_factor(ut, y - y_off, horizon=default_horizon(max_order, p),
                              method="n4sid").s
@@ -740,24 +741,35 @@ def nlss(data, *, input=None, output=None, order: int | None = None, degree: int
             n_sv -= 1
     else:
         n_sv = order
-    candidates = [n_sv] if val is None or order is not None else \
-        [k for k in (n_sv, n_sv - 1, n_sv + 1) if 1 <= k <= max_order and N * p >= 4 * n_par(k)]
+    around = (n_sv, n_sv + 1) if val is None else (n_sv, n_sv - 1, n_sv + 1)
+    candidates = [n_sv] if order is not None else \
+        [k for k in around if 1 <= k <= max_order and (k == n_sv or N * p >= 4 * n_par(k))]
     best = None
     for n in candidates:
-        lin_n = linear(n)
-        if lin_n is None:
+        start = linear(n)
+        if start is None:
             continue
+        lin_n, notes = start
         mdl = _fit_order(lin_n, ut, yc, u_off, sd_u, y_off, degree, feedthrough, window,
                          max_iterations, progress, dt, ins, outs, iunits, ounits, levels)
+        if notes:
+            mdl.info["linear_start"] = " | ".join(notes)
         if val is not None:
             fit = mdl.compare(val[0], val[1], warn=False)
             mdl.validation_fit_percent = fit.fit_percent
             lf = mdl.info.pop("_linear")
             mdl.linear_validation_fit_percent = lf.compare(val[0], val[1], warn=False).fit_percent
             score = -np.inf if None in fit.fit_percent else float(np.mean(fit.fit_percent))
-        else:
+        else:  # Bayesian information criterion of the estimation free run
             mdl.info.pop("_linear")
-            score = 0.0
+            k = mdl.dirs.shape[0] + n
+            if mdl.fit_percent is None:
+                score = -np.inf
+            else:
+                e = yc - mdl._run(ut, mdl.x0)[0]
+                score = -(N * float(np.sum(np.log(np.maximum(np.mean(e * e, axis=0), 1e-300))))
+                          + k * math.log(N))
+            mdl.info["bic"] = None if not np.isfinite(score) else -score
         if best is None or score > best[0]:
             best = (score, mdl)
     if best is None:
@@ -766,8 +778,8 @@ def nlss(data, *, input=None, output=None, order: int | None = None, degree: int
                                   "the record")
     model = best[1]
     how = (f"order {model.order} given" if order is not None else
-           f"order {n_sv} at the largest gap of the subspace singular values (at most "
-           f"{max_order})"
+           f"order {model.order} by the information criterion (BIC) among {candidates}, the "
+           f"largest gap of the subspace singular values (at most {max_order}) and the next"
            if val is None else
            f"order {model.order} by the free-run validation fit among {candidates}")
     few = [f"{ins[j]!r} takes {levels[j]} values" for j in range(m) if levels[j] <= degree]
@@ -776,8 +788,6 @@ def nlss(data, *, input=None, output=None, order: int | None = None, degree: int
                 "of it and are left out")
     model.criterion = how
     model.info["seconds"] = round(time.perf_counter() - t0, 3)
-    if notes:
-        model.info["linear_start"] = " | ".join(dict.fromkeys(notes))
     if val is not None and None in (model.validation_fit_percent or []):
         emit_warning("nlss: the free run of the identified model diverges on the validation "
                      "record; no validation fit is reported", StabilityWarning)
