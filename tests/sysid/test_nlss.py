@@ -341,7 +341,7 @@ def test_monte_carlo_sigma_of_the_output_is_honest():
 def test_forty_thousand_samples_within_a_minute():
     """Issue 26's speed target: 40 000 samples of the Duffing oscillator (1 % noise), default
     options (orders 2 and 3 fitted, 2 kept by BIC; degree 3, 44 parameters) in under 60 s on the
-    2-core machine; measured 14.6 s with OPENBLAS_NUM_THREADS=1 at load 8–10. The fit is at the
+    2-core machine; measured 15–27 s at load 7–10. The fit is at the
     noise limit (1 % noise: 99.0 %)."""
     import time
 

@@ -16,8 +16,9 @@ with f_θ = e_r x_c, e_r ũ_c, e_r ζ_c for A, B, E and g_θ = e_r x_c, e_r ũ_c
 and g_θ = e_r for y₀ᵣ: the form of the linear PEM sensitivities of :mod:`gripkit.sysid.pem_ss`,
 with the Jacobian of the state map in place of A. The initial state of each window gives n more
 directions (s = I at the window's first sample). The columns of S advance together (rows contiguous,
-:func:`~gripkit.sysid.blocked_gram.row_product`) and blocks of rows of J go to BLAS
-(:func:`~gripkit.sysid.blocked_gram.add_rows`).
+:func:`~gripkit.sysid.blocked_gram.row_product`), and each row of J is added to the upper
+triangle of JᵀJ in the kernel itself (:func:`_add_row`): no BLAS call, so no BLAS threads,
+which on a loaded 2-core machine made the Gram sums up to 6× slower than one thread.
 """
 
 from __future__ import annotations
@@ -25,10 +26,22 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from ..blocked_gram import add_rows, row_product
+from ..blocked_gram import row_product
 
-#: rows of J collected before one BLAS product
-_BLOCK = 256
+
+
+@numba.njit(cache=True, inline="always")
+def _add_row(r, e, G, g):  # pragma: no cover - compiled
+    """G += r rᵀ (upper triangle only) and g += r e."""
+    Q = r.shape[0]
+    for a in range(Q):
+        ra = r[a]
+        if ra == 0.0:
+            continue
+        g[a] += ra * e
+        Ga = G[a]
+        for b in range(a, Q):
+            Ga[b] += ra * r[b]
 #: a carried sensitivity below this magnitude is set to zero: the initial-state directions decay
 #: freely, and once below 1e-154 their products in JᵀJ would be subnormal numbers, whose
 #: arithmetic is slow on Intel CPUs; such an entry adds less than 1e-300 to sums of order one,
@@ -184,8 +197,8 @@ def window_gram(A, B, C, D, E, F, y0, exz, exe, dirs, Z, starts, u, y, w, limit,
     Sn = np.empty((n, Q))
     G = np.zeros((Q, Q))
     g = np.zeros(Q)
-    rows = np.zeros((_BLOCK * p, Q))
-    eb = np.empty(_BLOCK * p)
+    rows = np.zeros((p, Q))
+    eb = np.empty(p)
     x = np.empty(n)
     xn = np.empty(n)
     zeta = np.empty(exz.shape[0])
@@ -205,8 +218,6 @@ def window_gram(A, B, C, D, E, F, y0, exz, exe, dirs, Z, starts, u, y, w, limit,
             S[r, P + r] = 1.0
         G[:, :] = 0.0
         g[:] = 0.0
-        fill = 0
-        last = starts[j + 1] - 1
         for t in range(starts[j], starts[j + 1]):
             for r in range(n):
                 if not (abs(x[r]) <= limit):
@@ -220,29 +231,26 @@ def window_gram(A, B, C, D, E, F, y0, exz, exe, dirs, Z, starts, u, y, w, limit,
                         acc += F[i, k] * Je[k, c]
                     Gx[i, c] = acc
             for i in range(p):
-                row_product(Gx, i, S, rows[fill + i])
+                row_product(Gx, i, S, rows[i])
                 e = w[i] * (y[t, i] - _output(C, D, F, y0, x, u, t, eta, i))
-                eb[fill + i] = e
+                eb[i] = e
                 V += e * e
             for q in range(P):  # direct terms of the output equation
                 kind, r, c = dirs[q, 0], dirs[q, 1], dirs[q, 2]
                 if kind == 2:
-                    rows[fill + r, q] += x[c]
+                    rows[r, q] += x[c]
                 elif kind == 3:
-                    rows[fill + r, q] += u[t, c]
+                    rows[r, q] += u[t, c]
                 elif kind == 5:
-                    rows[fill + r, q] += eta[c]
+                    rows[r, q] += eta[c]
                 elif kind == 6:
-                    rows[fill + r, q] += 1.0
+                    rows[r, q] += 1.0
             for i in range(p):
                 wi = w[i]
-                ri = rows[fill + i]
+                ri = rows[i]
                 for q in range(Q):
                     ri[q] *= wi
-            fill += p
-            if fill == rows.shape[0] or t == last:
-                add_rows(rows, eb, fill, G, g)
-                fill = 0
+                _add_row(ri, eb[i], G, g)
             _monomials(exz, x, u, t, zeta)
             _monomial_jacobian(exz, x, u, t, Jz)
             for r in range(n):  # Fx = A + E ∂ζ/∂x
@@ -265,16 +273,16 @@ def window_gram(A, B, C, D, E, F, y0, exz, exe, dirs, Z, starts, u, y, w, limit,
             _state_update(A, B, E, x, u, t, zeta, xn)
             for r in range(n):
                 x[r] = xn[r]
-        for a in range(P):
+        for a in range(P):  # G holds its upper triangle
             gt[a] += g[a]
             for b in range(P):
-                Htt[a, b] += G[a, b]
+                Htt[a, b] += G[a, b] if a <= b else G[b, a]
             for c in range(n):
                 Htz[j, a, c] = G[a, P + c]
         for c in range(n):
             gz[j, c] = g[P + c]
             for d in range(n):
-                Hzz[j, c, d] = G[P + c, P + d]
+                Hzz[j, c, d] = G[P + c, P + d] if c <= d else G[P + d, P + c]
     return V
 
 
@@ -287,7 +295,8 @@ def output_variance(A, B, C, D, E, F, y0, exz, exe, dirs, x0, u, L, out):  # pra
     P = dirs.shape[0]
     S = np.zeros((n, P))
     Sn = np.empty((n, P))
-    rows = np.zeros((_BLOCK * p, P))
+    rows = np.zeros((p, P))
+    tmp = np.empty(L.shape[1])
     x = x0.copy()
     xn = np.empty(n)
     zeta = np.empty(exz.shape[0])
@@ -296,8 +305,6 @@ def output_variance(A, B, C, D, E, F, y0, exz, exe, dirs, x0, u, L, out):  # pra
     Je = np.empty((exe.shape[0], n))
     Fx = np.empty((n, n))
     Gx = np.empty((p, n))
-    fill = 0
-    t0 = 0
     N = u.shape[0]
     for t in range(N):
         _monomials(exe, x, u, t, eta)
@@ -309,27 +316,32 @@ def output_variance(A, B, C, D, E, F, y0, exz, exe, dirs, x0, u, L, out):  # pra
                     acc += F[i, k] * Je[k, c]
                 Gx[i, c] = acc
         for i in range(p):
-            row_product(Gx, i, S, rows[fill + i])
+            row_product(Gx, i, S, rows[i])
         for q in range(P):
             kind, r, c = dirs[q, 0], dirs[q, 1], dirs[q, 2]
             if kind == 2:
-                rows[fill + r, q] += x[c]
+                rows[r, q] += x[c]
             elif kind == 3:
-                rows[fill + r, q] += u[t, c]
+                rows[r, q] += u[t, c]
             elif kind == 5:
-                rows[fill + r, q] += eta[c]
+                rows[r, q] += eta[c]
             elif kind == 6:
-                rows[fill + r, q] += 1.0
-        fill += p
-        if fill == rows.shape[0] or t == N - 1:
-            R = np.dot(rows[:fill], L)
-            for a in range(fill):
-                acc = 0.0
-                for b in range(R.shape[1]):
-                    acc += R[a, b] * R[a, b]
-                out[t0 + a // p, a % p] = acc
-            t0 = t + 1
-            fill = 0
+                rows[r, q] += 1.0
+        for i in range(p):  # ‖Lᵀ r‖²
+            ri = rows[i]
+            for b in range(L.shape[1]):
+                tmp[b] = 0.0
+            for a in range(P):
+                ra = ri[a]
+                if ra == 0.0:
+                    continue
+                La = L[a]
+                for b in range(L.shape[1]):
+                    tmp[b] += ra * La[b]
+            acc = 0.0
+            for b in range(L.shape[1]):
+                acc += tmp[b] * tmp[b]
+            out[t, i] = acc
         _monomials(exz, x, u, t, zeta)
         _monomial_jacobian(exz, x, u, t, Jz)
         for r in range(n):
