@@ -16,9 +16,9 @@ with f_θ = e_r x_c, e_r ũ_c, e_r ζ_c for A, B, E and g_θ = e_r x_c, e_r ũ_c
 and g_θ = e_r for y₀ᵣ: the form of the linear PEM sensitivities of :mod:`gripkit.sysid.pem_ss`,
 with the Jacobian of the state map in place of A. The initial state of each window gives n more
 directions (s = I at the window's first sample). The columns of S advance together (rows contiguous,
-:func:`~gripkit.sysid.blocked_gram.row_product`), and each row of J is added to the upper
-triangle of JᵀJ in the kernel itself (:func:`_add_row`): no BLAS call, so no BLAS threads,
-which on a loaded 2-core machine made the Gram sums up to 6× slower than one thread.
+:func:`~gripkit.sysid.blocked_gram.row_product`), and blocks of 16 rows of J are added to the
+upper triangle of JᵀJ in the kernel itself (:func:`_add_rows`): no BLAS call, so no BLAS
+threads, which on a loaded 2-core machine made the Gram sums up to 6× slower than one thread.
 """
 
 from __future__ import annotations
@@ -30,23 +30,39 @@ from ..blocked_gram import row_product
 
 
 
-@numba.njit(cache=True, inline="always")
-def _add_row(r, e, G, g):  # pragma: no cover - compiled
-    """G += r rᵀ (upper triangle only) and g += r e."""
-    Q = r.shape[0]
-    for a in range(Q):
-        ra = r[a]
-        if ra == 0.0:
-            continue
-        g[a] += ra * e
-        Ga = G[a]
-        for b in range(a, Q):
-            Ga[b] += ra * r[b]
 #: a carried sensitivity below this magnitude is set to zero: the initial-state directions decay
 #: freely, and once below 1e-154 their products in JᵀJ would be subnormal numbers, whose
 #: arithmetic is slow on Intel CPUs; such an entry adds less than 1e-300 to sums of order one,
 #: i.e. nothing
 _FLUSH = 1e-150
+#: rows of J gathered before they are added to JᵀJ together
+_ROWS = 16
+
+
+@numba.njit(cache=True, inline="always")
+def _add_rows(R, eb, fill, G, g):  # pragma: no cover - compiled
+    """G += Σ_k r_k r_kᵀ (upper triangle only) and g += Σ_k r_k e_k for the first ``fill`` rows
+    r_k of R (_ROWS, Q): each row of G is loaded once per block and updated by the block's rows
+    in turn (contiguous inner loops)."""
+    Q = R.shape[1]
+    for k in range(fill):
+        rk = R[k]
+        ek = eb[k]
+        for a in range(Q):
+            g[a] += rk[a] * ek
+    k4 = fill - fill % 4
+    for a in range(Q):
+        Ga = G[a]
+        for k in range(0, k4, 4):  # four rows per pass over G's row: fewer loads and stores
+            r0, r1, r2, r3 = R[k], R[k + 1], R[k + 2], R[k + 3]
+            c0, c1, c2, c3 = r0[a], r1[a], r2[a], r3[a]
+            for b in range(a, Q):
+                Ga[b] += c0 * r0[b] + c1 * r1[b] + c2 * r2[b] + c3 * r3[b]
+        for k in range(k4, fill):
+            rk = R[k]
+            rka = rk[a]
+            for b in range(a, Q):
+                Ga[b] += rka * rk[b]
 
 
 @numba.njit(cache=True, inline="always")
@@ -198,7 +214,8 @@ def window_gram(A, B, C, D, E, F, y0, exz, exe, dirs, Z, starts, u, y, w, limit,
     G = np.zeros((Q, Q))
     g = np.zeros(Q)
     rows = np.zeros((p, Q))
-    eb = np.empty(p)
+    RT = np.zeros((_ROWS, Q))
+    eb = np.zeros(_ROWS)
     x = np.empty(n)
     xn = np.empty(n)
     zeta = np.empty(exz.shape[0])
@@ -218,6 +235,7 @@ def window_gram(A, B, C, D, E, F, y0, exz, exe, dirs, Z, starts, u, y, w, limit,
             S[r, P + r] = 1.0
         G[:, :] = 0.0
         g[:] = 0.0
+        fill = 0
         for t in range(starts[j], starts[j + 1]):
             for r in range(n):
                 if not (abs(x[r]) <= limit):
@@ -232,9 +250,6 @@ def window_gram(A, B, C, D, E, F, y0, exz, exe, dirs, Z, starts, u, y, w, limit,
                     Gx[i, c] = acc
             for i in range(p):
                 row_product(Gx, i, S, rows[i])
-                e = w[i] * (y[t, i] - _output(C, D, F, y0, x, u, t, eta, i))
-                eb[i] = e
-                V += e * e
             for q in range(P):  # direct terms of the output equation
                 kind, r, c = dirs[q, 0], dirs[q, 1], dirs[q, 2]
                 if kind == 2:
@@ -247,10 +262,16 @@ def window_gram(A, B, C, D, E, F, y0, exz, exe, dirs, Z, starts, u, y, w, limit,
                     rows[r, q] += 1.0
             for i in range(p):
                 wi = w[i]
+                e = wi * (y[t, i] - _output(C, D, F, y0, x, u, t, eta, i))
+                V += e * e
                 ri = rows[i]
                 for q in range(Q):
-                    ri[q] *= wi
-                _add_row(ri, eb[i], G, g)
+                    RT[fill, q] = wi * ri[q]
+                eb[fill] = e
+                fill += 1
+                if fill == _ROWS:
+                    _add_rows(RT, eb, fill, G, g)
+                    fill = 0
             _monomials(exz, x, u, t, zeta)
             _monomial_jacobian(exz, x, u, t, Jz)
             for r in range(n):  # Fx = A + E ∂ζ/∂x
@@ -273,6 +294,8 @@ def window_gram(A, B, C, D, E, F, y0, exz, exe, dirs, Z, starts, u, y, w, limit,
             _state_update(A, B, E, x, u, t, zeta, xn)
             for r in range(n):
                 x[r] = xn[r]
+        if fill:
+            _add_rows(RT, eb, fill, G, g)
         for a in range(P):  # G holds its upper triangle
             gt[a] += g[a]
             for b in range(P):
