@@ -787,6 +787,12 @@ def nlss(data, *, input=None, output=None, order: int | None = None, degree: int
         how += (f"; {', '.join(few)}: its powers of that degree and above are no new functions "
                 "of it and are left out")
     model.criterion = how
+    cond = model.info["hessian_condition"]
+    if not cond < _ILL_CONDITIONED:  # said of the model returned, not of the candidates
+        emit_warning(f"nlss: the Gauss-Newton Hessian at the optimum is ill-conditioned (condition "
+                     f"number {cond:.2g} after scaling): some combinations of parameters are not "
+                     "determined by the data and their σ are not reliable; lower the degree or the "
+                     "order, or excite the system more richly", AccuracyWarning)
     model.info["seconds"] = round(time.perf_counter() - t0, 3)
     if val is not None and None in (model.validation_fit_percent or []):
         emit_warning("nlss: the free run of the identified model diverges on the validation "
@@ -895,11 +901,6 @@ def _fit_order(lin, ut, y, u_off, sd_u, y_off, degree, feedthrough, window, max_
                                   hint="lower the degree or the order, or excite more richly") \
             from None
     cond = float(np.linalg.cond(Hs))
-    if not cond < _ILL_CONDITIONED:
-        emit_warning(f"nlss: the Gauss-Newton Hessian at the optimum is ill-conditioned (condition "
-                     f"number {cond:.2g} after scaling): some combinations of parameters are not "
-                     "determined by the data and their σ are not reliable; lower the degree or the "
-                     "order, or excite the system more richly", AccuracyWarning)
     model = replace(model, dirs=dirs, covariance=0.5 * (cov + cov.T), x0=Z0[0].copy())
     Yf, at = model._run(ut, model.x0)
     model.fit_percent = None if at >= 0 else _fits(y, Yf)
