@@ -27,6 +27,7 @@ def _build():
     from . import identify_narx  # noqa: F401
     from . import identify_hw  # noqa: F401
     from . import identify_hysteresis  # noqa: F401
+    from . import identify_nlss  # noqa: F401
     from .app import app
 
     return app

@@ -79,6 +79,9 @@ _LAZY = {
     "BoucWenOscillatorModel": ("nonlinear.hysteresis", "BoucWenOscillatorModel"),
     "PrandtlIshlinskiiModel": ("nonlinear.hysteresis", "PrandtlIshlinskiiModel"),
     "load_hysteresis": ("nonlinear.hysteresis", "load_hysteresis"),
+    "nlss": ("nonlinear.nlss", "nlss"),
+    "NLSSModel": ("nonlinear.nlss", "NLSSModel"),
+    "load_nlss": ("nonlinear.nlss", "load_nlss"),
 }
 __getattr__, __dir__ = lazy_exports(__name__, _LAZY)
 __all__ = [*_LAZY]
@@ -141,3 +144,6 @@ if TYPE_CHECKING:  # static readers see the same names, imported eagerly
     from .nonlinear.hysteresis import PrandtlIshlinskiiModel as PrandtlIshlinskiiModel
     from .nonlinear.hysteresis import hysteresis as hysteresis
     from .nonlinear.hysteresis import load_hysteresis as load_hysteresis
+    from .nonlinear.nlss import NLSSModel as NLSSModel
+    from .nonlinear.nlss import load_nlss as load_nlss
+    from .nonlinear.nlss import nlss as nlss

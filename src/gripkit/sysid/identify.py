@@ -44,7 +44,8 @@ from .linear.search import structure_search
 
 __all__ = ["IOData", "io_data", "identify", "identify_records", "method_options", "METHODS"]
 
-METHODS = ("arx", "armax", "oe", "rls", "search", "ss", "frf", "tf", "narx", "hw", "hysteresis")
+METHODS = ("arx", "armax", "oe", "rls", "search", "ss", "frf", "tf", "narx", "hw", "hysteresis",
+           "nlss")
 
 
 @dataclass(frozen=True)
@@ -157,6 +158,8 @@ def _method_function(method: str):
         return nonlinear.hammerstein_wiener
     if method == "hysteresis":
         return nonlinear.hysteresis
+    if method == "nlss":
+        return nonlinear.nlss
     return {"arx": arx, "armax": armax, "oe": oe, "ss": identify_mimo.identify_ss, "frf": frf,
             "tf": identify_mimo.identify_tf}.get(method, structure_search)
 
@@ -197,8 +200,10 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
         ``nf`` (default ``nb``); the array function searches the orders; options of
         :func:`gripkit.sysid.hammerstein_wiener`: ``input_nonlinearity``,
         ``output_nonlinearity``, ``validate`` …); ``'hysteresis'`` (Bouc-Wen or Prandtl–Ishlinskii, options of
-        :func:`gripkit.sysid.hysteresis`: ``model``, ``exponent``, ``operators`` …). For ss,
-        frf and tf ``input``/``output`` may name several columns (``'a,b'`` or a list).
+        :func:`gripkit.sysid.hysteresis`: ``model``, ``exponent``, ``operators`` …); ``'nlss'``
+        (polynomial nonlinear state space, options of :func:`gripkit.sysid.nlss`: ``order``,
+        ``degree``, ``validate`` …). For ss, frf, tf and nlss ``input``/``output`` may name
+        several columns (``'a,b'`` or a list).
     input, output
         Column names.
     detrend
@@ -210,8 +215,8 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
 
     Returns
     -------
-    PolynomialModel, RLSResult, SearchResult, NARXModel, HWModel, BoucWenModel or
-    PrandtlIshlinskiiModel
+    PolynomialModel, RLSResult, SearchResult, NARXModel, HWModel, BoucWenModel,
+    PrandtlIshlinskiiModel or NLSSModel
     """
     if not isinstance(method, str) or method not in METHODS:
         raise DataError(f"method: expected one of {', '.join(METHODS)}, found {method!r}")
@@ -220,7 +225,8 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
                    hint=f"identify accepts {', '.join(keyword_names(identify))} and, for method {method!r}, "
                         + (", ".join(opts) if opts else "no other options"))
     for name, col in (("input", input), ("output", output)):
-        if not (isinstance(col, str) or (method in ("ss", "frf", "tf", "arx") and isinstance(col, (list, tuple))
+        if not (isinstance(col, str) or (method in ("ss", "frf", "tf", "arx", "nlss")
+                                         and isinstance(col, (list, tuple))
                                          and all(isinstance(c, str) for c in col))):
             raise ArgumentError(f"identify(): {name} must be a column name (str), found {type(col).__name__} "
                                 f"{col!r:.40}", hint=f"columns: {', '.join(data.names)}"
@@ -237,6 +243,8 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
     if method == "arx" and identify_mimo.several(input, output):  # matrix-polynomial ARX
         return identify_mimo.identify_arx(data, input=input, output=output, na=na, nb=nb, nk=nk,
                                           detrend=detrend).with_display_units(data)
+    if method == "nlss":  # the model carries the operating point (input and output means)
+        return nonlinear.nlss(data, input=input, output=output, **options)
     if method == "narx":  # the model's constant term carries the operating point
         io = io_data(data, input=input, output=output, detrend="none", why="NARX identification")
         model = nonlinear.narx(io.u, io.y, dt=io.dt, **options)

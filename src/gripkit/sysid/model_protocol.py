@@ -69,6 +69,7 @@ MODEL_FILES: dict[str, tuple[str, str]] = {
     "gripkit.narx-model": ("nonlinear.narx", "load_narx"),
     "gripkit.hw-model": ("nonlinear.hammerstein_wiener", "load_hw"),
     "gripkit.hysteresis-model": ("nonlinear.hysteresis", "load_hysteresis"),
+    "gripkit.nlss-model": ("nonlinear.nlss", "load_nlss"),
 }
 
 

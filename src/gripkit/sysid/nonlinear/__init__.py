@@ -1,7 +1,8 @@
 """Nonlinear system identification (issue 26): polynomial NARX by forward regression with the
 error reduction ratio (:func:`narx`, :mod:`.narx`); Hammerstein, Wiener and Hammerstein–Wiener
 models (:func:`hammerstein_wiener`, :mod:`.hammerstein_wiener`); hysteresis, generic Bouc-Wen
-and Prandtl–Ishlinskii with its inverse (:func:`hysteresis`, :mod:`.hysteresis`).
+and Prandtl–Ishlinskii with its inverse (:func:`hysteresis`, :mod:`.hysteresis`); polynomial
+nonlinear state space (:func:`nlss`, :mod:`.nlss`).
 
 The public names are loaded on first use (the table ``_LAZY``, :mod:`gripkit.exports`).
 """
@@ -25,6 +26,9 @@ _LAZY = {
     "BoucWenOscillatorModel": ("hysteresis", "BoucWenOscillatorModel"),
     "PrandtlIshlinskiiModel": ("hysteresis", "PrandtlIshlinskiiModel"),
     "load_hysteresis": ("hysteresis", "load_hysteresis"),
+    "nlss": ("nlss", "nlss"),
+    "NLSSModel": ("nlss", "NLSSModel"),
+    "load_nlss": ("nlss", "load_nlss"),
 }
 __getattr__, __dir__ = lazy_exports(__name__, _LAZY)
 __all__ = [*_LAZY]
@@ -41,3 +45,6 @@ if TYPE_CHECKING:  # static readers see the same names, imported eagerly
     from .hysteresis import PrandtlIshlinskiiModel as PrandtlIshlinskiiModel
     from .hysteresis import hysteresis as hysteresis
     from .hysteresis import load_hysteresis as load_hysteresis
+    from .nlss import NLSSModel as NLSSModel
+    from .nlss import load_nlss as load_nlss
+    from .nlss import nlss as nlss

@@ -1,0 +1,389 @@
+"""Numba kernels of the polynomial nonlinear state-space model (:mod:`.nlss`): the free run, and
+the Gauss-Newton sums of its simulation error (sensitivity equations), scalar and allocation-free
+in the time loop.
+
+Model (normalised input ũ, states of the model's basis)::
+
+    x[t+1] = A x + B ũ + E ζ(x, ũ),    ŷ[t] = y₀ + C x + D ũ + F η(x, ũ)
+
+ζ and η are monomials given by exponent tables (M, n + m) over the variables v = [x; ũ]. A
+parameter direction is a row (kind, r, c) of ``dirs``: kind 0 … 5 for the entry (r, c) of A, B,
+C, D, E, F, kind 6 for the output offset y₀ᵣ (c = 0). Its sensitivity s = ∂x/∂θ obeys::
+
+    s[t+1] = (A + E ∂ζ/∂x) s[t] + f_θ[t],     ∂ŷ[t] = (C + F ∂η/∂x) s[t] + g_θ[t]
+
+with f_θ = e_r x_c, e_r ũ_c, e_r ζ_c for A, B, E and g_θ = e_r x_c, e_r ũ_c, e_r η_c for C, D, F
+and g_θ = e_r for y₀ᵣ: the form of the linear PEM sensitivities of :mod:`gripkit.sysid.linear.pem_ss`,
+with the Jacobian of the state map in place of A. The initial state of each window gives n more
+directions (s = I at the window's first sample). The columns of S advance together (rows contiguous,
+:func:`~gripkit.sysid.linear.blocked_gram.row_product`), and blocks of 16 rows of J are added to the
+upper triangle of JᵀJ in the kernel itself (:func:`_add_rows`): no BLAS call, so no BLAS
+threads, which on a loaded 2-core machine made the Gram sums up to 6× slower than one thread.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+from ..linear.blocked_gram import row_product
+
+
+
+#: a carried sensitivity below this magnitude is set to zero: the initial-state directions decay
+#: freely, and once below 1e-154 their products in JᵀJ would be subnormal numbers, whose
+#: arithmetic is slow on Intel CPUs; such an entry adds less than 1e-300 to sums of order one,
+#: i.e. nothing
+_FLUSH = 1e-150
+#: rows of J gathered before they are added to JᵀJ together
+_ROWS = 16
+
+
+@numba.njit(cache=True, inline="always")
+def _add_rows(R, eb, fill, G, g):  # pragma: no cover - compiled
+    """G += Σ_k r_k r_kᵀ (upper triangle only) and g += Σ_k r_k e_k for the first ``fill`` rows
+    r_k of R (_ROWS, Q): each row of G is loaded once per block and updated by the block's rows
+    in turn (contiguous inner loops)."""
+    Q = R.shape[1]
+    for k in range(fill):
+        rk = R[k]
+        ek = eb[k]
+        for a in range(Q):
+            g[a] += rk[a] * ek
+    k4 = fill - fill % 4
+    for a in range(Q):
+        Ga = G[a]
+        for k in range(0, k4, 4):  # four rows per pass over G's row: fewer loads and stores
+            r0, r1, r2, r3 = R[k], R[k + 1], R[k + 2], R[k + 3]
+            c0, c1, c2, c3 = r0[a], r1[a], r2[a], r3[a]
+            for b in range(a, Q):
+                Ga[b] += c0 * r0[b] + c1 * r1[b] + c2 * r2[b] + c3 * r3[b]
+        for k in range(k4, fill):
+            rk = R[k]
+            rka = rk[a]
+            for b in range(a, Q):
+                Ga[b] += rka * rk[b]
+
+
+@numba.njit(cache=True, inline="always")
+def _carry(Sn, S):  # pragma: no cover - compiled
+    """S = Sn, entries below :data:`_FLUSH` in magnitude set to zero."""
+    for i in range(S.shape[0]):
+        for q in range(S.shape[1]):
+            v = Sn[i, q]
+            S[i, q] = v if abs(v) >= _FLUSH or v != v else 0.0
+
+
+@numba.njit(cache=True, inline="always")
+def _monomials(ex, x, u, t, out):  # pragma: no cover - compiled
+    """out[k] = Π_i v_i^ex[k, i] with v = [x; u[t]]."""
+    n = x.shape[0]
+    for k in range(ex.shape[0]):
+        v = 1.0
+        for i in range(ex.shape[1]):
+            base = x[i] if i < n else u[t, i - n]
+            for _ in range(ex[k, i]):
+                v *= base
+        out[k] = v
+
+
+@numba.njit(cache=True, inline="always")
+def _monomial_jacobian(ex, x, u, t, out):  # pragma: no cover - compiled
+    """out[k, j] = ∂(Π_i v_i^ex[k, i])/∂x_j for the n states."""
+    n = x.shape[0]
+    for k in range(ex.shape[0]):
+        for j in range(n):
+            a = ex[k, j]
+            if a == 0:
+                out[k, j] = 0.0
+                continue
+            v = float(a)
+            for i in range(ex.shape[1]):
+                base = x[i] if i < n else u[t, i - n]
+                p = ex[k, i] - 1 if i == j else ex[k, i]
+                for _ in range(p):
+                    v *= base
+            out[k, j] = v
+
+
+@numba.njit(cache=True, inline="always")
+def _state_update(A, B, E, x, u, t, zeta, xn):  # pragma: no cover - compiled
+    """xn = A x + B u[t] + E ζ."""
+    for r in range(A.shape[0]):
+        acc = 0.0
+        for j in range(A.shape[1]):
+            acc += A[r, j] * x[j]
+        for j in range(B.shape[1]):
+            acc += B[r, j] * u[t, j]
+        for k in range(E.shape[1]):
+            acc += E[r, k] * zeta[k]
+        xn[r] = acc
+
+
+@numba.njit(cache=True, inline="always")
+def _output(C, D, F, y0, x, u, t, eta, i):  # pragma: no cover - compiled
+    """ŷ_i = y₀_i + (C x + D u[t] + F η)_i."""
+    acc = y0[i]
+    for j in range(C.shape[1]):
+        acc += C[i, j] * x[j]
+    for j in range(D.shape[1]):
+        acc += D[i, j] * u[t, j]
+    for k in range(F.shape[1]):
+        acc += F[i, k] * eta[k]
+    return acc
+
+
+@numba.njit(cache=True)
+def simulate_kernel(A, B, C, D, E, F, y0, exz, exe, x0, u, Y, X, limit):  # pragma: no cover
+    """Free run from x0: outputs into Y (N, p), states into X (N, n) when X has N rows. Returns
+    the first sample whose state leaves [−limit, limit] (or is not finite), −1 if none; the
+    outputs from there on are NaN."""
+    n = A.shape[0]
+    N = u.shape[0]
+    store = X.shape[0] == N
+    x = x0.copy()
+    xn = np.empty(n)
+    zeta = np.empty(exz.shape[0])
+    eta = np.empty(exe.shape[0])
+    for t in range(N):
+        bad = False
+        for r in range(n):
+            if not (abs(x[r]) <= limit):
+                bad = True
+        if bad:
+            for s in range(t, N):
+                for i in range(Y.shape[1]):
+                    Y[s, i] = np.nan
+            return t
+        if store:
+            for r in range(n):
+                X[t, r] = x[r]
+        _monomials(exe, x, u, t, eta)
+        for i in range(Y.shape[1]):
+            Y[t, i] = _output(C, D, F, y0, x, u, t, eta, i)
+        _monomials(exz, x, u, t, zeta)
+        _state_update(A, B, E, x, u, t, zeta, xn)
+        for r in range(n):
+            x[r] = xn[r]
+    return -1
+
+
+@numba.njit(cache=True)
+def window_loss(A, B, C, D, E, F, y0, exz, exe, Z, starts, u, y, w, limit):  # pragma: no cover
+    """Σ over windows (window j: samples starts[j] … starts[j+1] − 1, free run from Z[j]) of the
+    weighted squared simulation errors Σ (w_i e_i)²; inf when a state leaves [−limit, limit]."""
+    n = A.shape[0]
+    p = C.shape[0]
+    x = np.empty(n)
+    xn = np.empty(n)
+    zeta = np.empty(exz.shape[0])
+    eta = np.empty(exe.shape[0])
+    V = 0.0
+    for j in range(starts.shape[0] - 1):
+        for r in range(n):
+            x[r] = Z[j, r]
+        for t in range(starts[j], starts[j + 1]):
+            for r in range(n):
+                if not (abs(x[r]) <= limit):
+                    return np.inf
+            _monomials(exe, x, u, t, eta)
+            for i in range(p):
+                e = w[i] * (y[t, i] - _output(C, D, F, y0, x, u, t, eta, i))
+                V += e * e
+            _monomials(exz, x, u, t, zeta)
+            _state_update(A, B, E, x, u, t, zeta, xn)
+            for r in range(n):
+                x[r] = xn[r]
+    return V
+
+
+@numba.njit(cache=True)
+def window_gram(A, B, C, D, E, F, y0, exz, exe, dirs, Z, starts, u, y, w, limit,
+                Htt, gt, Htz, Hzz, gz):  # pragma: no cover - compiled
+    """Gauss-Newton sums of the windowed simulation error (module docstring): for the P
+    parameter directions ``dirs`` and the n initial-state directions of each window j,
+    Htt = Σ JθᵀJθ (P, P), gt = Σ Jθᵀe, Htz[j] = Σ Jθᵀ Jz_j (P, n), Hzz[j] = Σ Jz_jᵀJz_j, gz[j] =
+    Σ Jz_jᵀ e, rows weighted by w (per output). Returns the loss Σ (w e)², inf when a state
+    leaves [−limit, limit] (the sums are then incomplete)."""
+    n = A.shape[0]
+    p = C.shape[0]
+    P = dirs.shape[0]
+    Q = P + n
+    S = np.zeros((n, Q))
+    Sn = np.empty((n, Q))
+    G = np.zeros((Q, Q))
+    g = np.zeros(Q)
+    rows = np.zeros((p, Q))
+    RT = np.zeros((_ROWS, Q))
+    eb = np.zeros(_ROWS)
+    x = np.empty(n)
+    xn = np.empty(n)
+    zeta = np.empty(exz.shape[0])
+    eta = np.empty(exe.shape[0])
+    Jz = np.empty((exz.shape[0], n))
+    Je = np.empty((exe.shape[0], n))
+    Fx = np.empty((n, n))
+    Gx = np.empty((p, n))
+    Htt[:, :] = 0.0
+    gt[:] = 0.0
+    V = 0.0
+    for j in range(starts.shape[0] - 1):
+        for r in range(n):
+            x[r] = Z[j, r]
+            for q in range(Q):
+                S[r, q] = 0.0
+            S[r, P + r] = 1.0
+        G[:, :] = 0.0
+        g[:] = 0.0
+        fill = 0
+        for t in range(starts[j], starts[j + 1]):
+            for r in range(n):
+                if not (abs(x[r]) <= limit):
+                    return np.inf
+            _monomials(exe, x, u, t, eta)
+            _monomial_jacobian(exe, x, u, t, Je)
+            for i in range(p):  # Gx = C + F ∂η/∂x
+                for c in range(n):
+                    acc = C[i, c]
+                    for k in range(F.shape[1]):
+                        acc += F[i, k] * Je[k, c]
+                    Gx[i, c] = acc
+            for i in range(p):
+                row_product(Gx, i, S, rows[i])
+            for q in range(P):  # direct terms of the output equation
+                kind, r, c = dirs[q, 0], dirs[q, 1], dirs[q, 2]
+                if kind == 2:
+                    rows[r, q] += x[c]
+                elif kind == 3:
+                    rows[r, q] += u[t, c]
+                elif kind == 5:
+                    rows[r, q] += eta[c]
+                elif kind == 6:
+                    rows[r, q] += 1.0
+            for i in range(p):
+                wi = w[i]
+                e = wi * (y[t, i] - _output(C, D, F, y0, x, u, t, eta, i))
+                V += e * e
+                ri = rows[i]
+                for q in range(Q):
+                    RT[fill, q] = wi * ri[q]
+                eb[fill] = e
+                fill += 1
+                if fill == _ROWS:
+                    _add_rows(RT, eb, fill, G, g)
+                    fill = 0
+            _monomials(exz, x, u, t, zeta)
+            _monomial_jacobian(exz, x, u, t, Jz)
+            for r in range(n):  # Fx = A + E ∂ζ/∂x
+                for c in range(n):
+                    acc = A[r, c]
+                    for k in range(E.shape[1]):
+                        acc += E[r, k] * Jz[k, c]
+                    Fx[r, c] = acc
+            for r in range(n):
+                row_product(Fx, r, S, Sn[r])
+            for q in range(P):  # direct terms of the state equation
+                kind, r, c = dirs[q, 0], dirs[q, 1], dirs[q, 2]
+                if kind == 0:
+                    Sn[r, q] += x[c]
+                elif kind == 1:
+                    Sn[r, q] += u[t, c]
+                elif kind == 4:
+                    Sn[r, q] += zeta[c]
+            _carry(Sn, S)
+            _state_update(A, B, E, x, u, t, zeta, xn)
+            for r in range(n):
+                x[r] = xn[r]
+        if fill:
+            _add_rows(RT, eb, fill, G, g)
+        for a in range(P):  # G holds its upper triangle
+            gt[a] += g[a]
+            for b in range(P):
+                Htt[a, b] += G[a, b] if a <= b else G[b, a]
+            for c in range(n):
+                Htz[j, a, c] = G[a, P + c]
+        for c in range(n):
+            gz[j, c] = g[P + c]
+            for d in range(n):
+                Hzz[j, c, d] = G[P + c, P + d] if c <= d else G[P + d, P + c]
+    return V
+
+
+@numba.njit(cache=True)
+def output_variance(A, B, C, D, E, F, y0, exz, exe, dirs, x0, u, L, out):  # pragma: no cover
+    """out[t, i] = ‖Lᵀ ∂ŷ_i[t]/∂θ‖² for the free run from x0 (x0 held): the variance of the
+    simulated output by linearised propagation of cov θ = L Lᵀ (directions ``dirs``)."""
+    n = A.shape[0]
+    p = C.shape[0]
+    P = dirs.shape[0]
+    S = np.zeros((n, P))
+    Sn = np.empty((n, P))
+    rows = np.zeros((p, P))
+    tmp = np.empty(L.shape[1])
+    x = x0.copy()
+    xn = np.empty(n)
+    zeta = np.empty(exz.shape[0])
+    eta = np.empty(exe.shape[0])
+    Jz = np.empty((exz.shape[0], n))
+    Je = np.empty((exe.shape[0], n))
+    Fx = np.empty((n, n))
+    Gx = np.empty((p, n))
+    N = u.shape[0]
+    for t in range(N):
+        _monomials(exe, x, u, t, eta)
+        _monomial_jacobian(exe, x, u, t, Je)
+        for i in range(p):
+            for c in range(n):
+                acc = C[i, c]
+                for k in range(F.shape[1]):
+                    acc += F[i, k] * Je[k, c]
+                Gx[i, c] = acc
+        for i in range(p):
+            row_product(Gx, i, S, rows[i])
+        for q in range(P):
+            kind, r, c = dirs[q, 0], dirs[q, 1], dirs[q, 2]
+            if kind == 2:
+                rows[r, q] += x[c]
+            elif kind == 3:
+                rows[r, q] += u[t, c]
+            elif kind == 5:
+                rows[r, q] += eta[c]
+            elif kind == 6:
+                rows[r, q] += 1.0
+        for i in range(p):  # ‖Lᵀ r‖²
+            ri = rows[i]
+            for b in range(L.shape[1]):
+                tmp[b] = 0.0
+            for a in range(P):
+                ra = ri[a]
+                if ra == 0.0:
+                    continue
+                La = L[a]
+                for b in range(L.shape[1]):
+                    tmp[b] += ra * La[b]
+            acc = 0.0
+            for b in range(L.shape[1]):
+                acc += tmp[b] * tmp[b]
+            out[t, i] = acc
+        _monomials(exz, x, u, t, zeta)
+        _monomial_jacobian(exz, x, u, t, Jz)
+        for r in range(n):
+            for c in range(n):
+                acc = A[r, c]
+                for k in range(E.shape[1]):
+                    acc += E[r, k] * Jz[k, c]
+                Fx[r, c] = acc
+        for r in range(n):
+            row_product(Fx, r, S, Sn[r])
+        for q in range(P):
+            kind, r, c = dirs[q, 0], dirs[q, 1], dirs[q, 2]
+            if kind == 0:
+                Sn[r, q] += x[c]
+            elif kind == 1:
+                Sn[r, q] += u[t, c]
+            elif kind == 4:
+                Sn[r, q] += zeta[c]
+        _carry(Sn, S)
+        _state_update(A, B, E, x, u, t, zeta, xn)
+        for r in range(n):
+            x[r] = xn[r]
