@@ -104,3 +104,16 @@ def test_stick_slip_velocity_reversal():
 def test_friction_drive_refuses_an_unknown_kind():
     with pytest.raises(ModelError, match="kind: expected 'karnopp' or 'lugre'"):
         FrictionDrive(kind="dahl")
+
+
+def test_harmonic_drive_ripple_kernel():
+    """ΔF = A·sin(k·θ + φ)·sign(v) (§3.2.2): odd in v, zero at rest or with A = 0, period 2π/k."""
+    from gripkit.models.friction import ripple
+
+    A, k, phi = 0.03, 200.0, 0.4
+    for th in (0.0, 0.0123, 1.7):
+        assert ripple(th, 0.5, A, k, phi) == pytest.approx(A * math.sin(k * th + phi), rel=1e-14)
+        assert ripple(th, -0.5, A, k, phi) == -ripple(th, 0.5, A, k, phi)
+        assert ripple(th + 2 * math.pi / k, 0.5, A, k, phi) == pytest.approx(
+            ripple(th, 0.5, A, k, phi), abs=1e-12)
+    assert ripple(1.0, 0.0, A, k, phi) == 0.0 and ripple(1.0, 0.5, 0.0, k, phi) == 0.0

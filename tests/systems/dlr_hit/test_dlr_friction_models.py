@@ -1,12 +1,11 @@
-"""Friction models and the recovered Appendix G tables (``002_ddea254371185ad3.txt`` ch. 6)."""
+"""The recovered Appendix G friction tables and the finger's friction (``002_ddea254371185ad3.txt``
+ch. 6); the generic friction models: tests/models/test_friction.py."""
 
 import math
 
 import numpy as np
 import pytest
 
-from gripkit.errors import DataError, UnidentifiableError
-from gripkit.models.friction import Stribeck
 from gripkit.sysid.rigid_body.friction import fit_stribeck
 from gripkit.systems.dlr_hit.parameters import dlr_hit_table
 from gripkit.systems.dlr_hit.parameters import thesis_finger_parameters
@@ -40,23 +39,6 @@ def test_stribeck_defaults_are_the_fits_of_the_tables():
         assert abs(fit.values["cubic"] - p(f"cubic_{name}")) < fit.std["cubic"]
         assert abs(fit.values["sigma"] - p(f"visc_{name}")) < fit.std["sigma"]
         assert fit.rms < 0.06
-
-
-def test_fit_stribeck_recovers_synthetic_parameters_within_3_sigma():
-    truth = dict(fc=0.2, fs=0.36, vs=0.3, delta=2.0, sigma=0.04, cubic=0.002)
-    rng = np.random.default_rng(4)
-    v = np.concatenate([-np.geomspace(0.05, 5, 60), np.geomspace(0.05, 5, 60)])
-    s = Stribeck(truth["fc"], truth["fs"], truth["vs"], truth["delta"], truth["sigma"])
-    f = s(v) + truth["cubic"] * v ** 3 + rng.normal(0, 0.005, v.size)
-    fit = fit_stribeck(v, f, fixed=dict(delta=2.0))
-    for k in ("fc", "fs", "vs", "sigma", "cubic"):
-        assert abs(fit.values[k] - truth[k]) < 3 * fit.std[k], k
-    with pytest.raises(DataError, match="zero velocity"):
-        fit_stribeck(np.r_[v, 0.0], np.r_[f, 0.3])
-    with pytest.raises(UnidentifiableError):
-        # data only far above v_s: the Stribeck part is undetermined
-        vv = np.r_[-np.linspace(3, 5, 20), np.linspace(3, 5, 20)]
-        fit_stribeck(vv, np.sign(vv) * 0.2 + 0.04 * vv, fixed=dict(cubic=0.0))
 
 
 def test_harmonic_drive_ripple_in_the_finger():
