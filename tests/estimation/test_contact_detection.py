@@ -23,7 +23,8 @@ def test_a_force_step_is_detected_within_the_stated_delay(height, window):
     delay = int(np.argmax(c)) - 2 * window  # samples after the first sample of the step
     assert delay == math.floor(thr * window / height)  # k + 1 samples, counted from 0
     assert delay <= window - 1
-    np.testing.assert_allclose(avg[2 * window:3 * window], height * np.arange(1, window + 1) / window)
+    ramp = height * np.arange(1, window + 1) / window
+    np.testing.assert_allclose(avg[2 * window:3 * window], ramp)
 
 
 def test_false_alarm_rate_on_noise_is_the_stated_probability():

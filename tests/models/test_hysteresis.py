@@ -13,7 +13,8 @@ from scipy.integrate import solve_ivp
 from gripkit.models import BoucWen
 from gripkit.models.hysteresis import bouc_wen_advance, bouc_wen_response
 
-BW = dict(d_p=0.77e-6, lam=0.43e-6, beta=0.108, gamma=7.5e-3)  # Table II, left finger (λ in µm/V → m/V)
+#: Table II, left finger (λ read in µm/V, here in m/V)
+BW = dict(d_p=0.77e-6, lam=0.43e-6, beta=0.108, gamma=7.5e-3)
 
 
 def test_bouc_wen_is_exact_against_a_tight_ode_solution():
@@ -37,8 +38,8 @@ def test_bouc_wen_is_rate_independent(levels):
     """Property: H depends on the voltage path only. Visiting the same turning points with 1 or
     with 50 samples per monotone segment gives the same H at the turning points."""
     coarse = np.array(levels)
-    fine = np.concatenate([np.linspace(a, b, 50, endpoint=False) for a, b in zip(levels[:-1], levels[1:])]
-                          + [[levels[-1]]])
+    fine = np.concatenate([np.linspace(a, b, 50, endpoint=False)
+                           for a, b in zip(levels[:-1], levels[1:])] + [[levels[-1]]])
     _, Hc = bouc_wen_response(coarse, **BW)
     _, Hf = bouc_wen_response(fine, **BW)
     np.testing.assert_allclose(Hc, Hf[::50], rtol=1e-9, atol=1e-20)

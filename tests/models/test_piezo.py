@@ -10,7 +10,8 @@ from gripkit.models import PiezoActuator
 from gripkit.models.hysteresis import bouc_wen_response
 from gripkit.models.piezo import actuator_state_space
 
-BW = dict(d_p=0.77e-6, lam=0.43e-6, beta=0.108, gamma=7.5e-3)  # Table II, left finger (λ in µm/V → m/V)
+#: Table II, left finger (λ read in µm/V, here in m/V)
+BW = dict(d_p=0.77e-6, lam=0.43e-6, beta=0.108, gamma=7.5e-3)
 
 
 def test_actuator_compliance_block_is_a_cantilever():
@@ -38,7 +39,8 @@ def test_d_s_step_response_matches_scipy():
     U = np.concatenate([[0.0], np.full(399, 50.0)])
     y = act.simulate(U, dt=5e-5)["y_A"]
     W = 0.77e-6 * 50 - bouc_wen_response(U, **BW)[1][-1]
-    _, ys = signal.dstep(signal.cont2discrete(([1.0], [2.5e-8, 8e-5, 1.0]), 5e-5, method="zoh"), n=399)
+    dsys = signal.cont2discrete(([1.0], [2.5e-8, 8e-5, 1.0]), 5e-5, method="zoh")
+    _, ys = signal.dstep(dsys, n=399)
     np.testing.assert_allclose(y[1:], W * ys[0][:, 0], rtol=1e-9, atol=1e-15)
 
 

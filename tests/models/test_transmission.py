@@ -22,7 +22,8 @@ def test_power_balance_driving_and_back_driven():
     back = tr.output_torque(tau_in, -w_out)  # output moves against the motor torque
     assert tau_in * w_in == pytest.approx(0.7 * back * w_out, rel=1e-12)
     for w in (w_out, -w_out):  # the compiled kernel agrees
-        assert transmit_torque(tau_in, w, 50.0, 0.7) == pytest.approx(float(tr.output_torque(tau_in, w)))
+        expected = float(tr.output_torque(tau_in, w))
+        assert transmit_torque(tau_in, w, 50.0, 0.7) == pytest.approx(expected)
 
 
 def test_stages_in_series_multiply():
