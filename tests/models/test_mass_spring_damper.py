@@ -11,7 +11,6 @@ from scipy import signal
 from scipy.linalg import expm
 
 from gripkit.models import MassSpringDamper
-from gripkit.models.reference import reference_mass_spring_damper
 
 
 def _expm_zoh(m, b, k, h):
@@ -58,13 +57,3 @@ def test_simulation_equals_scipy_dlsim_and_reports_its_mode():
     assert (wn, zeta) == pytest.approx((5.0, 0.02), rel=1e-12)
     assert msd.natural_frequency_hz() == pytest.approx(5.0 / (2 * np.pi), rel=1e-12)
     assert msd.damping_ratio() == pytest.approx(0.02, rel=1e-12)
-
-
-def test_reference_oscillator_is_lightly_damped():
-    """The zoo's generic oscillator: m = 1 kg, k = 1 N/m, b = 0.1 N·s/m, so ζ = 0.05 and
-    f_n = 1/(2π) Hz (models.reference, no seed); static deflection F/k under a held force."""
-    msd = reference_mass_spring_damper()
-    assert msd.damping_ratio() == pytest.approx(0.05, rel=1e-12)
-    assert msd.natural_frequency_hz() == pytest.approx(1 / (2 * np.pi), rel=1e-12)
-    x = msd.simulate(np.full(6000, 0.3), dt=0.05)["x"]  # 300 s, e^{-ζ ω_n t} = 3e-7
-    assert x[-1] == pytest.approx(0.3, rel=1e-5)
