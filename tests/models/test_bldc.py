@@ -49,3 +49,28 @@ def test_inverse_model_round_trip():
 
 def test_current_is_torque_over_k_t():
     assert MOTOR.current(0.01) == pytest.approx(0.01 / P("k_t"), rel=1e-12)
+
+
+def test_test_bed_thermal_model_is_first_order():
+    """With α = 0 (R fixed at R₀, ρ ≡ 1) the stall torque stays c·u and the winding temperature
+    obeys C_th dT/dt = R₀ I² − (T − T_amb)/R_th: it rises by R_th R₀ I² with the time constant
+    R_th C_th (1 − e⁻¹ of the rise at t = R_th C_th, to the explicit step's 1 %)."""
+    from gripkit.models import MotorTestBed
+    from gripkit.models.bldc import motor_parameters
+
+    p = motor_parameters().replace(alpha_R=0.0)
+    tb = MotorTestBed(p, check=False)
+    tau_th = p.value("R_th") * p.value("C_th")
+    dt = tau_th / 100
+    n = 1001  # ten time constants
+    tr = tb.simulate(np.column_stack([np.full(n, 3000.0), np.zeros(n)]), dt=dt)
+    torque = p.value("c_pwm") * 3000.0
+    np.testing.assert_allclose(tr["torque"], torque, rtol=1e-12)
+    np.testing.assert_allclose(tr["current"], torque / p.value("k_t"), rtol=1e-12)
+    rise = p.value("R_th") * p.value("R_0") * (torque / p.value("k_t")) ** 2
+    T = tr["temperature"] - p.value("T_amb")
+    assert T[0] == 0.0
+    assert T[-1] == pytest.approx(rise * (1 - np.exp(-10.0)), rel=1e-3)
+    assert T[100] == pytest.approx(rise * (1 - np.exp(-1.0)), rel=0.01)
+    (rate, _), = tb.modes(tb.theta())
+    assert rate == pytest.approx(1 / tau_th)
