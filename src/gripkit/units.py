@@ -19,8 +19,8 @@ import sys
 
 from .errors import ParameterError
 
-__all__ = ["to_si", "si_factor", "ratio_unit", "si_unit", "convert", "check_unit",
-           "format_quantity", "same_dimension", "dimension_of"]
+__all__ = ["to_si", "si_factor", "ratio_unit", "si_unit", "convert", "format_quantity",
+           "same_dimension", "dimension_of"]
 
 # Unit strings gripkit uses, spelled for pint; "1" is dimensionless.
 _ALIASES = {
@@ -85,12 +85,6 @@ def _parse_unit(unit: str):
             f"unit {unit!r} is not a unit gripkit can read ({type(exc).__name__})",
             hint="use SI spellings such as 'm', 'N/m', 'N*s/m', 'kg', 'V', 'Hz', '1/V', 'bar'",
         ) from None
-
-
-def check_unit(unit: str) -> str:
-    """Return ``unit`` if pint can read it, else raise :class:`ParameterError`."""
-    _parse_unit(unit)
-    return unit
 
 
 # SI spellings preferred over raw base units, tried in order (same dimension wins).

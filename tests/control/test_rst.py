@@ -11,7 +11,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from gripkit.control import as_plant, design_rst, simulate_loop
+from gripkit.control import DiscretePlant, RSTController, as_plant, design_rst, simulate_loop
 from gripkit.errors import ModelError
 from gripkit.lti import StateSpace, TransferFunction
 
@@ -106,3 +106,87 @@ def test_design_rst_refuses_what_it_cannot_do():
         design_rst(TransferFunction.from_polynomials([1.0, -0.5], [1.0, 0.2], dt=0.01))
     with pytest.raises(ModelError, match="discrete"):
         design_rst(TransferFunction([1.0], [1.0, 1.0]))
+
+
+def test_discrete_plant_is_the_q_inverse_view_of_its_transfer_function():
+    """DiscretePlant([1, −1.5, 0.7], [0, 0, 0.5, −0.6]): two samples of delay, a zero at 1.2
+    (non-minimum phase), poles at 0.75 ± 0.37j, DC gain B(1)/A(1) = −0.1/0.2 = −0.5; it simulates
+    as scipy.signal.lfilter(B, A), its state-space realisation and python-control's
+    forced_response; scaled() multiplies B and keeps the poles."""
+    import control  # a dev dependency: the cross-check fails, never skips, without it
+    from scipy.signal import lfilter
+
+    A, B = [1.0, -1.5, 0.7], [0.0, 0.0, 0.5, -0.6]
+    p = DiscretePlant(A, B, 0.02)
+    assert p.nk == 2
+    np.testing.assert_allclose(p.zeros(), [1.2], rtol=1e-12)
+    np.testing.assert_allclose(np.sort_complex(p.poles()), np.sort_complex(np.roots(A)), rtol=1e-12)
+    assert p.dc_gain() == pytest.approx(-0.5, rel=1e-12)
+    assert p.is_stable() and not p.is_minimum_phase()
+    u = np.sin(0.3 * np.arange(150)) + (np.arange(150) > 40)
+    ref = lfilter(B, A, u)
+    np.testing.assert_allclose(p.simulate(u), ref, atol=1e-12)
+    ss = p.to_state_space()
+    np.testing.assert_allclose(ss.simulate(u)[:, 0], ref, atol=1e-10)
+    back = DiscretePlant.from_model(ss)
+    np.testing.assert_allclose(back.A, p.A, atol=1e-12)
+    np.testing.assert_allclose(back.B, p.B, atol=1e-12)
+    _, y = control.forced_response(p.to_control(), U=u)
+    np.testing.assert_allclose(y, ref, atol=1e-10)
+    s = p.scaled(3.0)
+    assert s.dc_gain() == pytest.approx(-1.5, rel=1e-12)
+    np.testing.assert_allclose(s.A, p.A)
+
+
+@pytest.mark.filterwarnings("ignore:stability_margins")
+def test_design_for_a_zoh_second_order_plant_with_a_delay_and_its_margins():
+    """Any discrete plant: a ZOH-discretised K ω_n²/(s² + 2ζω_n s + ω_n²) (ω_n = 30 rad/s,
+    ζ = 0.4, 5 ms) with one more sample of delay gets exactly the designed closed loop; the
+    margins equal python-control's for the loop S/R · B/A."""
+    import control  # a dev dependency: the cross-check fails, never skips, without it
+
+    wn, z = 30.0, 0.4
+    ss = StateSpace([[0, 1], [-wn ** 2, -2 * z * wn]], [[0], [wn ** 2]], [[1, 0]], [[0]]).c2d(0.005)
+    p = DiscretePlant.from_model(ss)
+    p = DiscretePlant(p.A, np.r_[0.0, p.B], p.dt)  # one more sample of delay
+    assert p.nk == 2
+    c = _check_design(p, wn=10.0, zeta=0.8)
+    mg = c.margins()
+    gm, pm, _, _ = control.margin(p.to_control() * control.tf(
+        np.r_[c.S, np.zeros(max(0, c.R.size - c.S.size))], c.R, p.dt))
+    assert 20 * math.log10(gm) == pytest.approx(mg["gain_margin_db"], abs=0.05)
+    assert pm == pytest.approx(mg["phase_margin_deg"], abs=0.2)
+
+
+def test_integral_action_impossible_with_zero_at_one():
+    with pytest.raises(ModelError, match="zero at z = 1"):
+        design_rst(DiscretePlant([1, -0.5], [0, 1, -1], 0.01))
+
+
+def test_anti_windup_recovers_faster_than_the_clamped_law():
+    """A load the limits cannot compensate saturates u for 150 samples; afterwards the anti-windup
+    form (A_aw = A_o) returns to the reference with less than half the integrated error of the
+    same R, S, T clamped only (anti_windup=False, A_aw = R, whose winding-up state is still far
+    from the reference 6 s later), and it settles at r once the load is within reach."""
+    g = _plant([0.9, 0.7], [0.4], nk=1)
+    c = design_rst(g, wn=8.0, zeta=0.8, u_min=-0.3, u_max=0.3)
+    plain = RSTController(c.R, c.S, c.T, anti_windup=False, u_min=-0.3, u_max=0.3, plant=g)
+    np.testing.assert_array_equal(plain.A_aw, c.R)
+    n = 900
+    r = np.full(n, 0.2)
+    d = np.r_[np.zeros(150), np.full(150, 0.6), np.zeros(n - 300)]
+    res = [simulate_loop(k, g, r, d_in=d) for k in (c, plain)]
+    assert all(x.u.min() == -0.3 for x in res)  # both saturate under the load
+    iae = [np.abs(x.y[300:] - 0.2).sum() for x in res]
+    assert iae[0] < 0.5 * iae[1]
+    assert abs(res[0].y[-1] - 0.2) < 1e-6
+
+
+@pytest.mark.parametrize("kw,phrase", [(dict(R=[2.0, 1.0]), "R must be monic"),
+                                       (dict(A_aw=[1.0, -1.5]), "A_aw must be stable"),
+                                       (dict(u_min=1.0, u_max=1.0), "must be below u_max")])
+def test_rst_controller_refuses_bad_polynomials_and_limits(kw, phrase):
+    args = dict(R=[1.0, -1.0], S=[0.5, 0.1], T=[0.6])
+    args.update(kw)
+    with pytest.raises(ModelError, match=phrase):
+        RSTController(args.pop("R"), args.pop("S"), args.pop("T"), **args)

@@ -1,12 +1,11 @@
-"""Friction models and the recovered Appendix G tables (``002_ddea254371185ad3.txt`` ch. 6)."""
+"""The recovered Appendix G friction tables and the finger's friction (``002_ddea254371185ad3.txt``
+ch. 6); the generic friction models: tests/models/test_friction.py."""
 
 import math
 
 import numpy as np
 import pytest
 
-from gripkit.errors import DataError, UnidentifiableError
-from gripkit.models.friction import FrictionDrive, FrictionTable, Stribeck
 from gripkit.sysid.rigid_body.friction import fit_stribeck
 from gripkit.systems.dlr_hit.parameters import dlr_hit_table
 from gripkit.systems.dlr_hit.parameters import thesis_finger_parameters
@@ -30,62 +29,6 @@ def test_appendix_g_tables_recovered():
     assert b(227.0 * DEG) == pytest.approx(0.7558)
 
 
-def test_table_lookup_rules():
-    t = FrictionTable([-2.0, -1.0, 1.0, 2.0, 3.0], [-0.5, -0.2, 0.3, 0.4, 0.6])
-    assert t(0.0) == 0.0
-    assert t(0.5) == pytest.approx(0.3)  # held below the smallest breakpoint
-    assert t(-0.01) == pytest.approx(-0.2)
-    assert t(1.5) == pytest.approx(0.35)  # linear interpolation
-    assert t(4.0) == pytest.approx(0.8)  # last segment extended
-    assert t(-3.0) == pytest.approx(-0.8)
-    assert t.scaled(2.0)(1.5) == pytest.approx(0.7)
-    with pytest.raises(DataError, match="increase strictly"):
-        FrictionTable([-1.0, -2.0, 1.0, 2.0], [0, 0, 0, 0])
-    with pytest.raises(DataError, match="each sign"):
-        FrictionTable([1.0, 2.0, 3.0, 4.0], [0, 0, 0, 0])
-
-
-def test_stribeck_eq_6_5():
-    s = Stribeck(fc=0.2, fs=0.36, vs=0.1, delta=2.0, sigma=0.05)
-    v = np.array([-1.0, -0.1, 0.0, 0.05, 0.1, 1.0])
-    expected = np.sign(v) * (0.2 + 0.16 * np.exp(-np.abs(v / 0.1) ** 2)) + 0.05 * v
-    np.testing.assert_allclose(s(v), expected)
-    assert s(1e-9) == pytest.approx(0.36)  # stiction level at v → 0+
-    rising = Stribeck(fc=0.2, fs=0.36, vs=0.1, delta=-1.0)  # negative shape factor, Fig. 6.2(b)
-    assert rising(0.01) < rising(1.0)
-
-
-def test_karnopp_rests_exactly_below_stiction_and_lugre_does_not():
-    """Karnopp: a constant torque below F_s leaves the inertia exactly at rest for 10 s; above it,
-    it slides. LuGre with the same F_c, F_s moves under the same sub-stiction torque (pre-sliding
-    displacement, then it settles) — why the finger's default model is the state machine."""
-    tau = 0.34  # N·m, below F_s = 0.36
-    u = np.full(10000, tau)
-    kar = FrictionDrive(kind="karnopp").simulate(u, dt=1e-3)
-    assert np.all(kar["position"] == 0.0) and np.all(kar["velocity"] == 0.0)
-    assert np.allclose(kar["friction"], tau)
-    moving = FrictionDrive(kind="karnopp").simulate(np.full(2000, 0.37), dt=1e-3)
-    assert moving["position"][-1] > 0.1
-    lug = FrictionDrive(kind="lugre").simulate(u, dt=1e-3)
-    assert lug["position"][-1] > 1e-3  # rad: it moved although τ < F_s
-    assert abs(lug["velocity"][-1]) < 1e-6  # and settled
-
-
-def test_stick_slip_velocity_reversal():
-    """A sinusoidal torque of amplitude 0.5 N·m > F_s at 1 Hz: the inertia stops at each velocity
-    reversal and stays stuck until |τ| exceeds F_s again (two stick episodes per period), and
-    while stuck the friction equals the applied torque exactly."""
-    t = np.arange(4000) * 1e-3
-    tau = 0.5 * np.sin(2 * np.pi * 1.0 * t)
-    tr = FrictionDrive(kind="karnopp").simulate(tau, dt=1e-3)
-    stuck = tr["velocity"] == 0
-    episodes = np.count_nonzero(stuck[1:] & ~stuck[:-1])
-    assert episodes >= 7
-    held = np.flatnonzero(stuck[:-1] & stuck[1:])  # at rest at t_n and still at t_n+1
-    assert np.all(np.abs(tau[held]) <= 0.36)
-    np.testing.assert_allclose(tr["friction"][held], tau[held])
-
-
 def test_stribeck_defaults_are_the_fits_of_the_tables():
     """The zoo's Stribeck option parameters are fit_stribeck's estimates on Appendix G's tables
     (F_s = 0.36 N·m, v_s = 0.1 rad/s, δ = 2 fixed), within their standard deviations."""
@@ -96,30 +39,6 @@ def test_stribeck_defaults_are_the_fits_of_the_tables():
         assert abs(fit.values["cubic"] - p(f"cubic_{name}")) < fit.std["cubic"]
         assert abs(fit.values["sigma"] - p(f"visc_{name}")) < fit.std["sigma"]
         assert fit.rms < 0.06
-
-
-def test_fit_stribeck_recovers_synthetic_parameters_within_3_sigma():
-    truth = dict(fc=0.2, fs=0.36, vs=0.3, delta=2.0, sigma=0.04, cubic=0.002)
-    rng = np.random.default_rng(4)
-    v = np.concatenate([-np.geomspace(0.05, 5, 60), np.geomspace(0.05, 5, 60)])
-    s = Stribeck(truth["fc"], truth["fs"], truth["vs"], truth["delta"], truth["sigma"])
-    f = s(v) + truth["cubic"] * v ** 3 + rng.normal(0, 0.005, v.size)
-    fit = fit_stribeck(v, f, fixed=dict(delta=2.0))
-    for k in ("fc", "fs", "vs", "sigma", "cubic"):
-        assert abs(fit.values[k] - truth[k]) < 3 * fit.std[k], k
-    with pytest.raises(DataError, match="zero velocity"):
-        fit_stribeck(np.r_[v, 0.0], np.r_[f, 0.3])
-    with pytest.raises(UnidentifiableError):
-        # data only far above v_s: the Stribeck part is undetermined
-        vv = np.r_[-np.linspace(3, 5, 20), np.linspace(3, 5, 20)]
-        fit_stribeck(vv, np.sign(vv) * 0.2 + 0.04 * vv, fixed=dict(cubic=0.0))
-
-
-def test_coulomb_viscous_kernel_is_stribeck_without_stiction_peak():
-    from gripkit.models.friction import coulomb_viscous, stribeck
-
-    for v in (-2.0, -0.01, 0.0, 0.3, 4.0):
-        assert coulomb_viscous(v, 0.2, 0.05) == pytest.approx(stribeck(v, 0.2, 0.2, 0.1, 2.0, 0.05))
 
 
 def test_harmonic_drive_ripple_in_the_finger():

@@ -73,12 +73,6 @@ def test_appendix_e_guard():
     assert MOTOR.torque(-2000, -1.01 * w0) == 0.0
 
 
-def test_inverse_model_round_trip():
-    pwm = np.array([-3500.0, -1200.0, 800.0, 2500.0, 3900.0])
-    w = np.array([-200.0, 50.0, 100.0, 300.0, -150.0])
-    np.testing.assert_allclose(MOTOR.pwm_for_torque(MOTOR.torque(pwm, w), w), pwm, rtol=1e-9)
-
-
 def test_fig_5_7_temperature_drop():
     """Fig. 5.7: PWM 4000 held at stall gives ~1 Ncm at room temperature, falling below 0.6 Ncm
     as the motor reaches ~80 °C within the figure's 120 s."""

@@ -1,15 +1,11 @@
 """FT-G100 physics: comb drive (eq 5), clamped-clamped beams (eqs 4, 13), amplification (eqs 3, 12),
-sensing stiffness (eq 16) — the numbers printed in seed 003_abd62b560633beaf.txt."""
+sensing stiffness (eq 16) — the numbers printed in seed 003_abd62b560633beaf.txt (the generic beam
+and comb-drive formulas: tests/models/)."""
 
-import math
-
-import numpy as np
 import pytest
-from scipy.integrate import quad
 
 from gripkit.errors import ModelError, ParameterError
-from gripkit.models.beams import (STRETCHING_BETA, clamped_clamped_stiffness, cubic_stiffness,
-                                  suspension_force, tangent_stiffness)
+from gripkit.models.beams import clamped_clamped_stiffness
 from gripkit.models.comb_drive import (comb_drive_coefficient, comb_drive_force, comb_drive_gain,
                                        comb_drive_voltage)
 from gripkit.systems.ftg100.model import amplification_ratio, ftg100_geometry
@@ -68,17 +64,3 @@ def test_comb_drive_eq_5():
     assert comb_drive_voltage(-1.0, c, 200.0) == 0.0 and comb_drive_voltage(1.0, c, 200.0) == 200.0
     with pytest.raises(ParameterError):
         comb_drive_coefficient(1300, 8.85e-12, 50e-6, 0.0)
-
-
-def test_stretching_coefficient_galerkin():
-    """β = π⁴/128: axial energy (E h w/2L)(½∫y'²)² of y = x(1 - cos 2πs/L)/2, differentiated twice
-    in x and set against the bending stiffness 16 E h w³/L³ of the same beam (quadrature)."""
-    E, h, w, L = 190e9, 50e-6, 8e-6, 1830e-6
-    stretch = quad(lambda s: (math.pi / L * math.sin(2 * math.pi * s / L)) ** 2, 0, L)[0] / 2  # per x²
-    k3_one_beam = 4 * (E * h * w / (2 * L)) * stretch ** 2  # d/dx of U = (EA/2L) stretch² x⁴
-    assert k3_one_beam / (16 * E * h * w ** 3 / L ** 3) * w ** 2 == pytest.approx(STRETCHING_BETA, rel=1e-9)
-    K = clamped_clamped_stiffness(E, h, w, L)
-    k3 = cubic_stiffness(E, h, w, L)
-    x = np.array([0.0, 2e-6, w])
-    np.testing.assert_allclose(suspension_force(x, K, k3), K * x * (1 + STRETCHING_BETA * (x / w) ** 2))
-    np.testing.assert_allclose(tangent_stiffness(x, K, k3), K * (1 + 3 * STRETCHING_BETA * (x / w) ** 2))

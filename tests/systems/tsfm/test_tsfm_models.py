@@ -1,96 +1,19 @@
-"""TSFM components (001_0b92a7da96e7aa46.txt eqs 3–13): Bouc-Wen, the piezo actuator, the
-end-effector lever, and the whole finger in its three forms."""
-
-import math
+"""TSFM components (001_0b92a7da96e7aa46.txt eqs 3–13): the end-effector lever and the whole finger
+in its three forms (the generic Bouc-Wen and piezo-actuator components: tests/models/)."""
 
 import numpy as np
 import pytest
-from hypothesis import given
-from hypothesis import strategies as st
 from scipy import signal
-from scipy.integrate import solve_ivp
 
 from gripkit.errors import ModelError, ParameterError
-from gripkit.models import BoucWen, PiezoActuator
-from gripkit.models.hysteresis import bouc_wen_advance, bouc_wen_response
+from gripkit.models import BoucWen
+from gripkit.models.hysteresis import bouc_wen_response
 from gripkit.systems.tsfm import parameters as z
 from gripkit.systems.tsfm.end_effector import lever_coefficients
 from gripkit.systems.tsfm.gripper import (finger_coefficients, finger_minimal_state_space,
                                           finger_state_space, finger_transfer_functions)
 
 BW = dict(d_p=0.77e-6, lam=0.43e-6, beta=0.108, gamma=7.5e-3)  # Table II, left finger (λ in µm/V → m/V)
-
-
-def test_bouc_wen_is_exact_against_a_tight_ode_solution():
-    """Eq 3 integrated in time by solve_ivp (rtol 1e-11) under a 100 V, 0.1 Hz sine: the per-sample
-    exact update agrees to 1e-8 of the hysteresis amplitude (the reference's own accuracy)."""
-    t = np.linspace(0, 10, 4001)
-    U = 100 * np.sin(2 * np.pi * 0.1 * t)
-    _, H = bouc_wen_response(U, **BW)
-    w = 2 * np.pi * 0.1
-
-    def rhs(tt, h):
-        du = 100 * w * math.cos(w * tt)
-        return [BW["lam"] * du - BW["beta"] * abs(du) * h[0] - BW["gamma"] * du * abs(h[0])]
-
-    ref = solve_ivp(rhs, (0, 10), [0.0], t_eval=t, rtol=1e-11, atol=1e-18, max_step=1e-3).y[0]
-    assert np.max(np.abs(ref - H)) < 1e-8 * np.max(np.abs(H))
-
-
-@given(st.lists(st.floats(-100, 100), min_size=2, max_size=30))
-def test_bouc_wen_is_rate_independent(levels):
-    """Property: H depends on the voltage path only. Visiting the same turning points with 1 or
-    with 50 samples per monotone segment gives the same H at the turning points."""
-    coarse = np.array(levels)
-    fine = np.concatenate([np.linspace(a, b, 50, endpoint=False) for a, b in zip(levels[:-1], levels[1:])]
-                          + [[levels[-1]]])
-    _, Hc = bouc_wen_response(coarse, **BW)
-    _, Hf = bouc_wen_response(fine, **BW)
-    np.testing.assert_allclose(Hc, Hf[::50], rtol=1e-9, atol=1e-20)
-
-
-def test_bouc_wen_saturates_at_lambda_over_beta_plus_gamma():
-    """A long monotone sweep drives H to λ/(β+γ) = 3.72 µm (Table II)."""
-    bw = BoucWen(**BW)
-    _, H = bouc_wen_response(np.linspace(0, 200, 50), **BW)
-    assert H[-1] == pytest.approx(bw.saturation(), rel=1e-8)
-    assert bw.saturation() == pytest.approx(0.43e-6 / 0.1155)
-    # zero crossing inside one step: from +H_sat down by 20 V lands where the two formulas meet
-    Hs = bw.saturation()
-    h1 = bouc_wen_advance(Hs, -20.0, BW["lam"], BW["beta"], BW["gamma"])
-    h2 = Hs
-    for _ in range(2000):
-        h2 = bouc_wen_advance(h2, -0.01, BW["lam"], BW["beta"], BW["gamma"])
-    assert h1 < 0 and h1 == pytest.approx(h2, rel=1e-10)
-
-
-def test_actuator_compliance_block_is_a_cantilever():
-    """Eq 4 in statics: a tip force F bends by s_p F and turns by (3/2L_a) s_p F; a moment M bends
-    by (3/2L_a) s_p M and turns by (3/L_a²) s_p M (Euler-Bernoulli cantilever, s_p = L³/3EI);
-    free bending turns the tip by 2y/L_a (constant curvature)."""
-    act = PiezoActuator()
-    s_p, L_a = 9.1e-4, 15e-3
-    n = 4000
-    z0 = np.zeros(n)
-    r = act.simulate({"U": z0, "F_A": np.full(n, 1e-4), "M_A": z0}, dt=5e-5)
-    assert r["y_A"][-1] == pytest.approx(-s_p * 1e-4, rel=1e-6)
-    assert r["alpha_A"][-1] == pytest.approx(-1.5 / L_a * s_p * 1e-4, rel=1e-6)
-    r = act.simulate({"U": z0, "F_A": z0, "M_A": np.full(n, 1e-6)}, dt=5e-5)
-    assert r["y_A"][-1] == pytest.approx(-1.5 / L_a * s_p * 1e-6, rel=1e-6)
-    assert r["alpha_A"][-1] == pytest.approx(-3 / L_a**2 * s_p * 1e-6, rel=1e-6)
-    r = act.simulate({"U": np.full(n, 30.0), "F_A": z0, "M_A": z0}, dt=5e-5)
-    assert r["alpha_A"][-1] == pytest.approx(2 / L_a * r["y_A"][-1], rel=1e-9)
-
-
-def test_d_s_step_response_matches_scipy():
-    """D(s) = 1/(a s² + b s + 1) (eq 4, Table II a, b): the actuator's response to a held
-    d_p U − H equals scipy.signal's ZOH step response of D."""
-    act = PiezoActuator(loads=False)
-    U = np.concatenate([[0.0], np.full(399, 50.0)])
-    y = act.simulate(U, dt=5e-5)["y_A"]
-    W = 0.77e-6 * 50 - bouc_wen_response(U, **BW)[1][-1]
-    _, ys = signal.dstep(signal.cont2discrete(([1.0], [2.5e-8, 8e-5, 1.0]), 5e-5, method="zoh"), n=399)
-    np.testing.assert_allclose(y[1:], W * ys[0][:, 0], rtol=1e-9, atol=1e-15)
 
 
 def test_three_forms_of_the_finger_agree(left):

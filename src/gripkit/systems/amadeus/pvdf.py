@@ -103,9 +103,6 @@ class PVDFFilm(Model):
     def _simulate_batch(self, thetas, u, dt, substeps, x0, y):
         _pvdf_batch(thetas, u, dt, x0, y)
 
-    def corner_hz(self) -> float:
-        return 1.0 / (2.0 * math.pi * self.parameters.value("tau"))
-
 
 # --------------------------------------------------------------------------- stick-slip contact
 _CONTACT_NAMES = ("m_pad", "k_t", "c_t", "mu_s", "mu_k", "v_stribeck", "m_obj", "c_obj", "k_n",

@@ -38,8 +38,8 @@ from ...errors import DataError
 from ...params import Parameter, ParameterSet
 from ...sim.linear import StateSpace
 
-__all__ = ["LeverCoefficients", "lever_coefficients", "sensor_state_space", "sensor_transfer_functions",
-           "end_effector_parameters", "sensor_parameters"]
+__all__ = ["LeverCoefficients", "lever_coefficients", "sensor_state_space", "end_effector_parameters",
+           "sensor_parameters"]
 
 
 @dataclass(frozen=True)
@@ -71,12 +71,6 @@ def sensor_state_space(m_s: float, b_s: float, k_s: float) -> StateSpace:
     D = np.array([[0.0, 0.0, 0.0], [k_s, b_s, 0.0], [k_s, 0.0, 0.0]])
     return StateSpace(A, B, C, D, inputs=("y_D", "v_D", "F_g"), outputs=("y_C", "F_A", "F_m"),
                       input_units=("m", "m/s", "N"), output_units=("m", "N", "N"))
-
-
-def sensor_transfer_functions(m_s: float, b_s: float, k_s: float) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Eq 10: ``{'y_D': (num, den), 'F_g': (num, den)}`` (polynomials, highest power first)."""
-    den = np.array([m_s, b_s, k_s])
-    return {"y_D": (np.array([b_s, k_s]), den), "F_g": (np.array([-1.0]), den)}
 
 
 def end_effector_parameters(m_s: float, b_s: float, k_s: float, L_r: float, L_s: float, *,
