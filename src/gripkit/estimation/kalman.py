@@ -255,7 +255,7 @@ class KalmanFilter:
 
     def __init__(self, model, Q=None, R=None, S=None, *, steady_state: bool = False, x0=None,
                  P0=None, dt: float | None = None):
-        ss = model.discrete(model.dt if dt is None else dt) if (model.dt or dt) else None
+        ss = model.to_ss(model.dt if dt is None else dt) if (model.dt or dt) else None
         if ss is None:
             raise ModelError("KalmanFilter: the model is continuous; give the sample time: dt=…")
         self.model, self.steady_state = model, bool(steady_state)
@@ -264,7 +264,7 @@ class KalmanFilter:
         n, p = self.A.shape[0], self.C.shape[0]
         self.innovation_form = Q is None and R is None
         self.Q, self.R, self.S = self._noise(model, Q, R, S, n, p)
-        self._u0, self._y0 = np.asarray(model.u_offset), np.asarray(model.y_offset)
+        self._u0, self._y0 = np.atleast_1d(model.u_offset), np.atleast_1d(model.y_offset)
         self._steady_gains(n, p)
         self.x_pred = np.zeros(n) if x0 is None else np.array(x0, dtype=np.float64).reshape(n)
         self.P_pred = (self.P_steady_pred.copy() if P0 is None
@@ -280,11 +280,11 @@ class KalmanFilter:
     def _noise(model, Q, R, S, n, p):
         """(Q, R, S) as given, or the innovation form's ``K Λ Kᵀ, Λ, K Λ``."""
         if Q is None and R is None:
-            if model.K is None:
+            if getattr(model, "K", None) is None:
                 raise ModelError("KalmanFilter: the model has no innovation gain K (an "
                                  "output-error model); give the noise covariances Q and R",
                                  hint="KalmanFilter(model, Q=Q, R=R)")
-            lam = (np.eye(p) if model.noise_covariance is None
+            lam = (np.eye(p) if getattr(model, "noise_covariance", None) is None
                    else np.asarray(model.noise_covariance, float))
             K = np.asarray(model.K, float)
             return K @ lam @ K.T, lam.copy(), K @ lam

@@ -13,7 +13,7 @@ import pytest
 from gripkit.control import DiscretePlant, RSTController, design_rst, simulate_loop
 from gripkit import zoo
 from gripkit.errors import ModelError, ParameterError
-from gripkit.sim import StateSpace
+from gripkit.lti import StateSpace
 from gripkit.sysid.physical.step_response import step_metrics
 from gripkit.systems.amadeus import GraspScenario, simulate_finger_grasp
 from gripkit.systems.amadeus.parameters import TABLE2_A, TABLE2_B, force_plant
@@ -151,7 +151,7 @@ def test_robust_to_compliant_objects(rst):
 def test_generic_plant_from_state_space():
     """The design works for any discrete plant: a ZOH-discretised second-order system with a delay."""
     wn, z = 30.0, 0.4
-    ss = StateSpace([[0, 1], [-wn ** 2, -2 * z * wn]], [[0], [wn ** 2]], [[1, 0]], [[0]]).discretize(0.005)
+    ss = StateSpace([[0, 1], [-wn ** 2, -2 * z * wn]], [[0], [wn ** 2]], [[1, 0]], [[0]]).c2d(0.005)
     p = DiscretePlant.from_model(ss)
     p = DiscretePlant(p.A, np.r_[0.0, p.B], p.dt)  # one more sample of delay
     c = design_rst(p, wn=10.0, zeta=0.8)
