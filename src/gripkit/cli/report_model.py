@@ -20,12 +20,13 @@ def report_model(model: Path = typer.Argument(..., help="Model file written by i
                  out: Path = typer.Option(..., "--out", help="Folder for index.html."),
                  fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, json_out: bool = JsonOpt):
     """HTML report: measured vs simulated per output, residual correlations, poles with σ, Bode with σ."""
+    from ..sysid.model_report import write_model_report
     from .compare import _model_and_data
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         m, tr = _model_and_data(model, data, fs, time, fill, outputs=True)
-        index = m.report(tr, out, data_name=Path(data).name)
+        index = write_model_report(m, tr, out, data_name=Path(data).name)
     res = {"model": str(model), "data": str(data), "report": str(index), "warnings": report_warnings(caught)}
     if json_out:
         emit_json(res)

@@ -35,6 +35,7 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 
 from ..errors import ModelError, PathError
+from ..signals.trajectory import Trajectory
 
 __all__ = ["IdentifiedModel", "ModelFit", "MODEL_FILES", "file_schema", "load_model",
            "simulated_trajectory"]
@@ -73,7 +74,7 @@ class IdentifiedModel(Protocol):
 
 # schema -> (module of gripkit.sysid, reader function); one line per model family
 MODEL_FILES: dict[str, tuple[str, str]] = {
-    "gripkit.linear-model": ("linear.linear_model", "load_linear_model"),
+    "gripkit.linear-model": ("linear.polynomial", "load_linear_model"),
     "gripkit.narx-model": ("nonlinear.narx", "load_narx"),
 }
 
@@ -115,8 +116,6 @@ def simulated_trajectory(model, data):
     in ``meta['display_units']`` (so ``gripkit.io.save(sim, path, units="display")`` writes
     ``force [mN]`` where the estimation file did). What ``gripkit simulate MODEL.json --data
     DATA`` writes."""
-    from ..signals.trajectory import Trajectory
-
     ys = np.asarray(model.simulate(data), dtype=np.float64).reshape(data.t.size, -1)
     system = getattr(model, "system", None)
     units = {} if system is None else {n: u for n, u in zip(model.outputs, system.output_units)

@@ -311,7 +311,15 @@ def singular_value_figure(sv, order):
 
 
 def model_report(model, data, *, data_name: str = "data", warnings_list=()) -> Report:
-    """Build the :class:`~gripkit.report.html.Report` of ``model`` on the trajectory ``data``."""
+    """Build the :class:`~gripkit.report.html.Report` of ``model`` (any identified linear
+    model: an ARX/ARMAX/OE model is reported through its state-space record,
+    :meth:`~gripkit.sysid.PolynomialModel.linear_record`) on the trajectory ``data``."""
+    if hasattr(model, "linear_record"):
+        model = model.linear_record()
+    if not hasattr(model, "system"):
+        raise ModelError(f"report: the {model.structure} model has no linear system to show "
+                         f"(poles, Bode); the HTML report covers linear models",
+                         hint="judge it with gripkit compare MODEL DATA")
     ss = model.system.to_ss(minimal=False)
     dt = data.require_uniform(why="a model report")
     caught_lines = list(warnings_list)

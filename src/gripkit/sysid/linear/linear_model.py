@@ -11,8 +11,9 @@ Discrete innovation form (the subspace and PEM models)::
 
 The identified linear models form one small hierarchy on the protocol of
 :mod:`gripkit.sysid.model_protocol`: :class:`IdentifiedLinearModel` holds every protocol method
-(``simulate``, ``predict``, ``compare``, ``residuals``, ``report``, ``save``, ``to_ss``, ``to_tf``,
-``to_control``, ``stable``, ``parameters``), written once on the model's ``system``;
+(``simulate``, ``predict``, ``compare``, ``residuals``, ``save``, ``to_ss``, ``to_tf``,
+``to_control``, ``stable``, ``parameters``), written once on the model's ``system``; the HTML
+report of any of them is :func:`gripkit.sysid.model_report.write_model_report`;
 :class:`LinearModel` (state space, transfer function) and
 :class:`~gripkit.sysid.linear.polynomial.PolynomialModel` (ARX, ARMAX, OE, with the polynomial
 views ``A``, ``B``, ``C``, ``F`` and their σ) derive from it. Frequencies are in rad/s everywhere
@@ -42,7 +43,7 @@ from ..model_protocol import ModelFit
 
 __all__ = ["VALIDATION_FIT", "IdentifiedLinearModel", "LinearModel", "as_io_matrix", "estimate_x0",
            "free_run", "fit_per_output", "k_step_prediction", "model_document",
-           "load_linear_model"]
+           "polynomial_document", "read_linear_model"]
 
 
 def _sim(A, B, C, D, u, x0):
@@ -150,22 +151,23 @@ VALIDATION_FIT = ("free run from the model's operating point (its stored offsets
 def k_step_prediction(A, B, C, D, K, u, y, horizon: int) -> np.ndarray:
     """``ŷ(t | t − horizon)`` (N, p) of the innovation model ``x⁺ = A x + B u + K e``,
     ``y = C x + D u + e`` on deviation data ``u`` (N, m), ``y`` (N, p): the one-step predictor
-    ``x̂⁺ = (A − KC) x̂ + (B − KD) u + K y`` from the initial state estimated by least squares
-    (:func:`~gripkit.sysid.linear.pem_ss.predictor_x0`), then ``horizon − 1`` steps of the model
-    with the known inputs and no measurement. Samples ``t < horizon − 1`` are the free run from
-    that initial state. ``K = 0`` gives the free run for every horizon."""
-    from .pem_ss import predictor_x0  # pem_ss imports this module
-
+    ``x̂⁺ = (A − KC) x̂ + (B − KD) u + K y``, ``ŷ = C x̂ + D u`` (a linear system of the inputs
+    ``[u, y]``) from the initial state estimated by least squares (:func:`estimate_x0` on that
+    system, as :func:`~gripkit.sysid.linear.pem_ss.predictor_x0` does), then ``horizon − 1``
+    steps of the model with the known inputs and no measurement. Samples ``t < horizon − 1`` are
+    the free run from that initial state. ``K = 0`` gives the free run for every horizon."""
     A, B, C, D, K = (np.ascontiguousarray(M, dtype=np.float64) for M in (A, B, C, D, K))
-    x0, e = predictor_x0(A, B, C, D, K, u, y)
+    u, y = np.ascontiguousarray(u, dtype=np.float64), np.ascontiguousarray(y, dtype=np.float64)
+    n, N, p = A.shape[0], u.shape[0], C.shape[0]
+    Ap, Bp, Dp = A - K @ C, np.hstack([B - K @ D, K]), np.hstack([D, np.zeros((p, p))])
+    w = np.hstack([u, y])
+    x0 = estimate_x0(Ap, Bp, C, Dp, w, y)
     if horizon == 1:
-        return y - e
-    n, N = A.shape[0], u.shape[0]
+        return free_run(Ap, Bp, C, Dp, w, x0)
     out = free_run(A, B, C, D, u, x0)
     if N < horizon:
         return out
-    Bp = np.hstack([B - K @ D, K])
-    X = free_run(A - K @ C, Bp, np.eye(n), np.zeros((n, Bp.shape[1])), np.hstack([u, y]), x0)
+    X = free_run(Ap, Bp, np.eye(n), np.zeros((n, Bp.shape[1])), w, x0)
     rows = N - horizon + 1
     Z = X[:rows]
     for j in range(horizon - 1):
@@ -344,13 +346,6 @@ class IdentifiedLinearModel:
         u, yy, dt, _ = self._io(data, y, "residuals of an identified model", dt=dt)
         return yy - k_step_prediction(*self._state_space(dt), u, yy, 1)
 
-    def report(self, data, out, **options):
-        """Write the HTML report of the model on the trajectory ``data`` into the folder ``out``
-        (:func:`gripkit.sysid.model_report.write_model_report`); returns the page's path."""
-        from ..model_report import write_model_report
-
-        return write_model_report(self, data, out, **options)
-
     @property
     def parameters(self) -> ParameterSet:
         """The entries of the system's arrays (``A_0_1`` for A[0, 1]; ``num``/``den`` of a
@@ -507,7 +502,7 @@ def model_document(model: IdentifiedLinearModel) -> dict:
     function B/(A F) (:meth:`~gripkit.sysid.PolynomialModel.linear_record`), so that a reader of
     the schema that knows no polynomials still finds the system. Version 1 (no ``polynomial``
     section; an ARX/ARMAX/OE model kept its coefficients in ``info``) is read as well
-    (:func:`load_linear_model`).
+    (:func:`~gripkit.sysid.linear.polynomial.load_linear_model`).
     """
     poly = None
     if not isinstance(model, LinearModel):
@@ -544,11 +539,10 @@ def _arr(x, name, where):
         raise ModelError(f"model file {where}: field {name!r} is not an array of numbers") from None
 
 
-def load_linear_model(path) -> IdentifiedLinearModel:
-    """Read a model written by ``model.save(path)``: a
-    :class:`~gripkit.sysid.PolynomialModel` for a file with a ``polynomial`` section, and for a
-    version-1 ARX/ARMAX/OE file (migrated: its coefficients were in ``info``, its covariance in
-    the system's; loss, AIC and the residuals were not written), else a :class:`LinearModel`.
+def read_linear_model(path) -> tuple[dict, LinearModel, str]:
+    """``(document, system part, where)`` of a model file written by ``model.save(path)``; the
+    reader of the schema, which also builds a :class:`~gripkit.sysid.PolynomialModel` from the
+    ``polynomial`` section, is :func:`gripkit.sysid.linear.polynomial.load_linear_model`.
 
     Raises ModelError for a file that is not a gripkit model (wrong ``schema``), of a newer
     ``schema_version``, or with missing fields; warns (AccuracyWarning) when the content hash does
@@ -564,6 +558,10 @@ def load_linear_model(path) -> IdentifiedLinearModel:
     >>> load_model(p).system.A.tolist(), load_model(p).inputs
     ([[0.5]], ('V',))
     """
+    return _read(path)
+
+
+def _read(path):
     doc = read_document(path)
     where = repr(str(path))
     try:
@@ -582,11 +580,7 @@ def load_linear_model(path) -> IdentifiedLinearModel:
                            info=doc.get("info") or {},
                            display_units={d["name"]: d["display_unit"] for d in (*ins, *outs)
                                           if d.get("display_unit") is not None})
-        if "polynomial" in doc or _v1_polynomial(doc):
-            from .polynomial import PolynomialModel
-
-            return PolynomialModel.from_document(doc, lm, where)
-        return lm
+        return doc, lm, where
     except (KeyError, TypeError, AttributeError) as exc:
         raise ModelError(f"model file {where}: a required field is missing or malformed ({exc})",
                          hint="regenerate the file with gripkit identify --out") from None
@@ -596,7 +590,7 @@ def load_linear_model(path) -> IdentifiedLinearModel:
         raise ModelError(f"model file {where}: {exc.message}", hint=exc.hint) from None
 
 
-def _v1_polynomial(doc: dict) -> bool:
+def polynomial_document(doc: dict) -> bool:
     """A version-1 file of an ARX/ARMAX/OE model (its coefficients in ``info``)."""
     info = doc.get("info") or {}
     return (doc.get("schema_version") == 1 and doc.get("structure") in ("arx", "armax", "oe")

@@ -39,10 +39,10 @@ from ...params import Parameter, ParameterSet
 from ...signals.trajectory import Trajectory
 from ...units import ratio_unit
 from .linear_model import (IdentifiedLinearModel, LinearModel, _checked_display_units, _horizon,
-                           k_step_prediction)
+                           k_step_prediction, polynomial_document, read_linear_model)
 from .validation import validate
 
-__all__ = ["PolynomialModel"]
+__all__ = ["PolynomialModel", "load_linear_model"]
 
 _STRUCTURES = ("arx", "armax", "oe")
 
@@ -560,11 +560,6 @@ class PolynomialModel(IdentifiedLinearModel):
         self._state_space(dt)
         return self.system.to_ss(minimal=False, form=form)
 
-    def report(self, data, out, **options):
-        """The HTML report (:meth:`IdentifiedLinearModel.report`) of the model's
-        :meth:`linear_record`, its output-error residuals included."""
-        return self.linear_record().report(data, out, **options)
-
     # ------------------------------------------------------------------ the model file
     def linear_record(self) -> LinearModel:
         """The model's system part as a :class:`~gripkit.sysid.LinearModel` on B/(A F) (what
@@ -672,6 +667,18 @@ class PolynomialModel(IdentifiedLinearModel):
 
     def __repr__(self) -> str:
         return f"PolynomialModel({self.label}, A={self.A.tolist()}, B={self.B.tolist()}, dt={self.dt:g})"
+
+
+def load_linear_model(path) -> IdentifiedLinearModel:
+    """Read a file of schema ``gripkit.linear-model`` (:func:`gripkit.sysid.load_model`'s reader
+    of it): a :class:`PolynomialModel` for a file with a ``polynomial`` section, and for a
+    version-1 ARX/ARMAX/OE file (migrated: its coefficients were in ``info``, its covariance in
+    the system's; loss, ``n_used`` and the residuals were not written), else the
+    :class:`~gripkit.sysid.LinearModel` (:func:`~.linear_model.read_linear_model`)."""
+    doc, lm, where = read_linear_model(path)
+    if "polynomial" in doc or polynomial_document(doc):
+        return PolynomialModel.from_document(doc, lm, where)
+    return lm
 
 
 #: the ``**meta`` keywords of :func:`~gripkit.sysid.linear.arx`, :func:`~gripkit.sysid.linear.armax` and :func:`~gripkit.sysid.linear.oe`
