@@ -120,7 +120,8 @@ def test_arx_from_the_cli_in_display_units(tmp_path, capsys):
     res = json.loads(capsys.readouterr().out)
     assert res["units"] == {"inputs": ["A"], "outputs": ["N"]} and res["warnings"] == []
     m = load_model(model)
-    assert m.display_units == {"current": "mA", "force": "mN"} and m.u_offset != 0.0  # an ARX model (PolynomialModel): one offset
+    assert m.display_units == {"current": "mA", "force": "mN"}
+    assert m.u_offset != 0.0  # an ARX model (a PolynomialModel): one offset
     files = {p.name: p.read_text() for p in out.iterdir()}
     assert sorted(files) == ["gk_arx.c", "gk_arx.h"]
     assert "#define GK_ARX_NU 1" in files["gk_arx.h"] and "#define GK_ARX_NX 2" in files["gk_arx.h"]

@@ -59,7 +59,8 @@ def compare(model: Path = ModelArg,
     if json_out:
         emit_json(res)
         return
-    typer.echo(f"{m.structure} on {data}{' (the estimation data)' if same else ''}: {fitted.definition}")
+    which = " (the estimation data)" if same else ""
+    typer.echo(f"{m.structure} on {data}{which}: {fitted.definition}")
     for n, f in zip(m.outputs, fit):
         typer.echo(f"  {n}: " + ("diverged" if f is None else f"{f:.2f} %"))
 
@@ -100,8 +101,8 @@ def simulate_model_file(model: Path, data: Path | None, out: Path | None, fs, ti
                 "final": float(y[-1]) if np.isfinite(y[-1]) else None}
 
     res = {"model": str(model), "data": str(data), "samples": sim.n, "out": None if out is None else str(out),
-           "outputs": {n: {"unit": sim.display_unit(n), "si_unit": sim.unit(n), **extremes(ys[:, i])}
-                       for i, n in enumerate(m.outputs)},
+           "outputs": {n: {"unit": sim.display_unit(n), "si_unit": sim.unit(n),
+                           **extremes(ys[:, i])} for i, n in enumerate(m.outputs)},
            "warnings": report_warnings(caught)}
     if json_out:
         emit_json(res)

@@ -2,7 +2,7 @@
 
 The model's discrete state-space realisation (``model.to_ss(dt)``: the system's
 ``to_ss(minimal=False)``, ZOH-sampled at ``dt`` for a continuous model) runs from rest, with the
-model's offsets applied exactly as :meth:`~gripkit.sysid.LinearModel.simulate` applies them to a trajectory::
+model's offsets applied exactly as ``model.simulate(data)`` applies them to a trajectory::
 
     du = u - u_offset;   y = C x + D du + y_offset;   x <- A x + B du
 
@@ -95,10 +95,11 @@ def _describe(model, ss) -> str:
     s = model.system
     lines = [f"model structure: {_comment(model.structure)}, {ss.n_states} states, "
              f"dt = {ss.dt!r} s"]
+    u_off, y_off = np.atleast_1d(model.u_offset), np.atleast_1d(model.y_offset)
     lines += [f"u[{i}]: {_comment(n)} [{_comment(u or '-')}], offset {o!r}"
-              for i, (n, u, o) in enumerate(zip(s.inputs, s.input_units, np.atleast_1d(model.u_offset)))]
+              for i, (n, u, o) in enumerate(zip(s.inputs, s.input_units, u_off))]
     lines += [f"y[{i}]: {_comment(n)} [{_comment(u or '-')}], offset {o!r}"
-              for i, (n, u, o) in enumerate(zip(s.outputs, s.output_units, np.atleast_1d(model.y_offset)))]
+              for i, (n, u, o) in enumerate(zip(s.outputs, s.output_units, y_off))]
     return "".join(f" * {ln}\n" for ln in lines)
 
 

@@ -340,7 +340,8 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=()) -> R
                                                 zip(model.outputs, model.system.output_units, fit)])
         t = data.t - data.t[0]
         for i, name in enumerate(model.outputs):
-            sec.figure(measured_vs_model(t, y[:, i] + y_offset[i], {"model": ys[:, i] + y_offset[i]},
+            yo = y_offset[i]
+            sec.figure(measured_vs_model(t, y[:, i] + yo, {"model": ys[:, i] + yo},
                                          ylabel=name, title=f"{name}: fit {fit[i]:.2f} %"), f"{name}", name=f"out-{i}")
         res = residual_analysis(model, u, y, dt, free_run_fit=fit)
         sec = rep.section("Residual analysis", res.notes[0] + " The dotted lines are ±1.96/√N, "

@@ -273,7 +273,9 @@ def focus_score(model, focus: str, d: MimoData) -> float:
     ``x̂⁺ = A x̂ + B u + K (y − C x̂ − D u)`` from its x0 estimated by least squares
     (:func:`~.pem_ss.predictor_x0`; −inf when A − K C is unstable)."""
     if focus == "simulation":
-        return float(np.mean(model.compare(d.u, d.y, dt=d.dt).fit_percent)) if model.stable else -math.inf
+        if not model.stable:
+            return -math.inf
+        return float(np.mean(model.compare(d.u, d.y, dt=d.dt).fit_percent))
     from .pem_ss import predictor_x0
 
     ss = model.system

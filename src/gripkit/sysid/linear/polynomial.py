@@ -48,9 +48,9 @@ _STRUCTURES = ("arx", "armax", "oe")
 
 
 class _Residuals:
-    """The ``estimation_residuals`` field: the array an estimator passed, or, when it passed its estimation
-    record as ``estimation_data`` instead, the one-step prediction errors computed from that record
-    on first access (issue 14: a large ARX fit keeps no N-sample array a user may never read, so
+    """The ``estimation_residuals`` field: the array an estimator passed, or, when it passed its
+    estimation record as ``estimation_data`` instead, the one-step prediction errors computed from
+    that record on first access (issue 14: a large ARX fit keeps no N-sample array a user may never read, so
     its memory stays O(p²) beyond the data). The computed errors must reproduce the fit's loss:
     a record changed in place after the fit raises instead of giving other residuals."""
 
@@ -118,9 +118,9 @@ class PolynomialModel(IdentifiedLinearModel):
         (``residuals(data)`` computes them on any record.) Not written to the model file.
     estimation_data
         ``(u, y)``, references to the record the model was fitted on (no copy), or None: the
-        source of ``estimation_residuals`` when the estimator did not keep them. Changing those arrays in
-        place after the fit makes ``estimation_residuals`` raise a DataError. Not written to the
-        model file.
+        source of ``estimation_residuals`` when the estimator did not keep them. Changing those
+        arrays in place after the fit makes ``estimation_residuals`` raise a DataError. Not
+        written to the model file.
     input_name, output_name, input_unit, output_unit
         Channel names and SI units of the data.
     u_offset, y_offset
@@ -243,8 +243,8 @@ class PolynomialModel(IdentifiedLinearModel):
 
     @property
     def stored_residuals(self) -> np.ndarray | None:
-        """The residual array the model holds, or None while ``estimation_residuals`` has not been computed
-        from ``estimation_data`` (reading this never computes them)."""
+        """The residual array the model holds, or None while ``estimation_residuals`` has not been
+        computed from ``estimation_data`` (reading this never computes them)."""
         return self.__dict__.get("_residuals")
 
     def _residuals_from_record(self) -> np.ndarray:
@@ -503,7 +503,8 @@ class PolynomialModel(IdentifiedLinearModel):
         if isinstance(data, Trajectory):
             return super().predict(data, horizon=horizon)
         u, y = np.asarray(data, dtype=np.float64), np.asarray(y, dtype=np.float64)
-        return self._prediction(u.reshape(-1, 1), y.reshape(-1, 1), self.dt, _horizon(horizon))[:, 0]
+        h = _horizon(horizon)
+        return self._prediction(u.reshape(-1, 1), y.reshape(-1, 1), self.dt, h)[:, 0]
 
     def _prediction(self, u, y, dt, horizon: int) -> np.ndarray:
         if horizon > 1:
