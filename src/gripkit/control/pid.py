@@ -122,6 +122,8 @@ class PID:
         Anti-windup tracking time constant (s); ``None`` for the default, ``inf`` to disable.
     u_min, u_max
         Output limits (the actuator's range).
+    design
+        Provenance of the gains (kept as ``pid.design``; :func:`gripkit.control.tune_pid`).
 
     >>> pid = PID(2.0, 100.0, dt=1e-3, u_min=-1.0, u_max=1.0)
     >>> round(pid.step(0.1, 0.0), 6)
@@ -130,7 +132,7 @@ class PID:
 
     def __init__(self, kp: float, ki: float = 0.0, kd: float = 0.0, *, dt: float, tf: float | None = None,
                  b: float = 1.0, c: float = 0.0, tt: float | None = None, u_min: float = -math.inf,
-                 u_max: float = math.inf):
+                 u_max: float = math.inf, design: dict | None = None):
         kp, ki, kd = _finite("kp", kp), _finite("ki", ki), _finite("kd", kd)
         dt = _finite("dt", dt, positive=True)
         if tf is None:
@@ -160,6 +162,8 @@ class PID:
         self._p = np.array([v[k] for k in PID_PARAMETERS])
         self._p.flags.writeable = False
         self.state = np.zeros(PID_NSTATE)
+        #: how the gains were obtained (:func:`gripkit.control.tune_pid` fills it), else empty
+        self.design = dict(design or {})
 
     # --- properties ------------------------------------------------------------------------------
     @property
@@ -205,6 +209,7 @@ class PID:
         u = np.empty_like(y)
         pid_run(self._p, self.state, r, y, f, u)
         return u
+
 
     def transfer_function(self) -> tuple[np.ndarray, np.ndarray]:
         """(num, den) of U(z)/E(z) in powers of z (linear region, b = c = 1)."""

@@ -36,12 +36,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from ..errors import DataError, ModelError, SimulationError
 from ..lti import StateSpace, TransferFunction, as_system
 
-__all__ = ["DiscretePlant", "as_plant", "RSTController", "design_rst", "LoopResult", "simulate_loop"]
+__all__ = ["DiscretePlant", "as_plant", "RSTController", "design_rst", "LoopResult",
+           "simulate_loop", "rst_step", "rst_run"]
 
 
 def _poly(x, name: str) -> np.ndarray:
@@ -186,11 +188,12 @@ class RSTController:
     uses the observer polynomial A_o); ``anti_windup=False`` gives the plain, clamped RST law.
     ``step(r, y)`` returns u for the current sample. Limits ``u_min``/``u_max`` are in the plant's
     input unit (deviation from the operating point). ``reset(u0, y0)`` initialises a bumpless start
-    at the steady state (u0, y0 = r0).
+    at the steady state (u0, y0 = r0). ``dt``: the sample time (default the plant's).
     """
 
     def __init__(self, R, S, T, *, A_aw=None, u_min: float = -math.inf, u_max: float = math.inf,
-                 plant=None, design: dict | None = None, anti_windup: bool = True):
+                 plant=None, design: dict | None = None, anti_windup: bool = True,
+                 dt: float | None = None):
         self.R = _poly(R, "R")
         self.S = _poly(S, "S")
         self.T = _poly(T, "T")
@@ -214,33 +217,42 @@ class RSTController:
         self.u_min = float(u_min)
         self.u_max = float(u_max)
         self.plant = plant
+        #: sample time (s): ``dt``, else the plant's (None without either)
+        self.dt = float(dt) if dt is not None else (
+            float(plant.dt) if getattr(plant, "dt", None) is not None else None)
         self.design = dict(design or {})
         self.reset()
+
 
     def reset(self, u0: float = 0.0, y0: float = 0.0):
         """Bumpless start: histories at the steady state u = v = u0, r = y = y0."""
         n = max(self.R.size, self.S.size, self.T.size)
-        self._r = np.full(n, float(y0))
-        self._y = np.full(n, float(y0))
-        self._u = np.full(n, float(u0))
-        self._v = np.full(n, float(u0))
+        # rows r, y, u, v (newest first): one buffer for the kernel, the rows as views
+        self._h = np.empty((4, n))
+        self._h[0:2] = float(y0)
+        self._h[2:4] = float(u0)
+        self._r, self._y, self._u, self._v = self._h
 
     def step(self, r: float, y: float) -> float:
-        """Control for this sample from reference ``r`` and measurement ``y``."""
+        """Control for this sample from reference ``r`` and measurement ``y`` (one call of the
+        allocation-free kernel :func:`rst_step` on the controller's history buffer)."""
         if not (math.isfinite(r) and math.isfinite(y)):
             raise SimulationError(f"controller input is not finite (r={r}, y={y})")
-        for a in (self._r, self._y, self._u, self._v):
-            a[1:] = a[:-1]
-        self._r[0] = r
-        self._y[0] = y
-        t, s, rr, aw = self.T, self.S, self.R, self.A_aw
-        acc = float(t @ self._r[:t.size]) - float(s @ self._y[:s.size])
-        acc += float((aw[1:] - rr[1:]) @ self._u[1:rr.size])
-        acc -= float(aw[1:] @ self._v[1:aw.size])
-        v = acc
-        u = min(max(v, self.u_min), self.u_max)
-        self._v[0] = v
-        self._u[0] = u
+        return rst_step(self.R, self.S, self.T, self.A_aw, self._h, float(r), float(y),
+                        self.u_min, self.u_max)
+
+    def run(self, r, y) -> np.ndarray:
+        """Outputs u (N,) for whole sequences r, y (open loop: y is given; r may be a scalar),
+        continuing from the current state: the same kernel as :meth:`step`, in one call."""
+        y = np.ascontiguousarray(np.asarray(y, dtype=np.float64))
+        if y.ndim != 1:
+            raise DataError(f"RSTController.run: expected a 1-D sequence y, found shape {y.shape}")
+        r = np.ascontiguousarray(np.broadcast_to(np.asarray(r, dtype=np.float64), y.shape))
+        if not (np.isfinite(r).all() and np.isfinite(y).all()):
+            raise DataError("RSTController.run: r or y contains NaN or inf",
+                            hint="interpolate or drop the missing samples first")
+        u = np.empty_like(y)
+        rst_run(self.R, self.S, self.T, self.A_aw, self._h, r, y, self.u_min, self.u_max, u)
         return u
 
     # -- analysis -------------------------------------------------------------------------
@@ -313,6 +325,54 @@ class RSTController:
                     gm, w180 = g, float(w[i])
         return dict(gain_margin_db=gm, phase_margin_deg=pm, w_gain_crossover=wc, w_phase_crossover=w180,
                     sensitivity_peak=ms)
+
+
+# ------------------------------------------------------------------------------- RST kernels
+@numba.njit(cache=True)
+def rst_step(R, S, T, aw, h, r, y, u_min, u_max):  # pragma: no cover - compiled
+    """One sample of the anti-windup RST law (:class:`RSTController`), allocation-free: the
+    history ``h`` (4, n) holds r, y, u, v, newest first, and is shifted in place; returns u.
+
+    v = Σ T_i r_{k−i} − Σ S_i y_{k−i} + Σ_{i≥1} (A_aw,i − R_i) u_{k−i} − Σ_{i≥1} A_aw,i v_{k−i},
+    u = min(max(v, u_min), u_max) (``R``, ``A_aw`` of equal length, monic)."""
+    n = h.shape[1]
+    for i in range(n - 1, 0, -1):
+        h[0, i] = h[0, i - 1]
+        h[1, i] = h[1, i - 1]
+        h[2, i] = h[2, i - 1]
+        h[3, i] = h[3, i - 1]
+    h[0, 0] = r
+    h[1, 0] = y
+    at = 0.0
+    for i in range(T.shape[0]):
+        at += T[i] * h[0, i]
+    bs = 0.0
+    for i in range(S.shape[0]):
+        bs += S[i] * h[1, i]
+    acc = at - bs
+    cu = 0.0
+    for i in range(1, R.shape[0]):
+        cu += (aw[i] - R[i]) * h[2, i]
+    acc += cu
+    cv = 0.0
+    for i in range(1, aw.shape[0]):
+        cv += aw[i] * h[3, i]
+    v = acc - cv
+    u = v
+    if u < u_min:
+        u = u_min
+    elif u > u_max:
+        u = u_max
+    h[3, 0] = v
+    h[2, 0] = u
+    return u
+
+
+@numba.njit(cache=True)
+def rst_run(R, S, T, aw, h, r, y, u_min, u_max, u):  # pragma: no cover - compiled
+    """:func:`rst_step` over sequences r, y (N,), writing u (N,)."""
+    for k in range(y.shape[0]):
+        u[k] = rst_step(R, S, T, aw, h, r[k], y[k], u_min, u_max)
 
 
 def _anti_windup_polynomial(Ao: np.ndarray, deg_r: int) -> np.ndarray:

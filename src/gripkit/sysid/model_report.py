@@ -310,10 +310,14 @@ def singular_value_figure(sv, order):
     return fig
 
 
-def model_report(model, data, *, data_name: str = "data", warnings_list=()) -> Report:
+def model_report(model, data, *, data_name: str = "data", warnings_list=(),
+                 sections=()) -> Report:
     """Build the :class:`~gripkit.report.html.Report` of ``model`` (any identified linear
     model: an ARX/ARMAX/OE model is reported through its state-space record,
-    :meth:`~gripkit.sysid.PolynomialModel.linear_record`) on the trajectory ``data``."""
+    :meth:`~gripkit.sysid.PolynomialModel.linear_record`) on the trajectory ``data``;
+    ``sections``: callables ``f(report)`` that add sections after the frequency response (e.g.
+    ``lambda rep: gripkit.control.robustness_section(rep, result)``, the robustness of a loop
+    closed around the model)."""
     if hasattr(model, "linear_record"):
         model = model.linear_record()
     if not hasattr(model, "system"):
@@ -374,6 +378,8 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=()) -> R
                     "parameter covariance) and the data's Welch H1 estimate with ±2σ where the "
                     "data allow." + shown).figure(bode_figure(model.system, dt, est, keep), "Bode",
                                                   name="bode")
+        for add_section in sections:
+            add_section(rep)
         if getattr(model, "singular_values", None) is not None:
             rep.section("Subspace singular values", "Singular values of the weighted subspace matrix; the order is "
                         "where they drop.").figure(singular_value_figure(np.asarray(model.singular_values), ss.n_states),
@@ -391,6 +397,8 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=()) -> R
     return rep
 
 
-def write_model_report(model, data, out_dir, *, data_name: str = "data", warnings_list=()) -> Path:
+def write_model_report(model, data, out_dir, *, data_name: str = "data", warnings_list=(),
+                       sections=()) -> Path:
     """Write ``out_dir/index.html`` (self-contained: figures inline); returns its path."""
-    return model_report(model, data, data_name=data_name, warnings_list=warnings_list).write(Path(out_dir))
+    return model_report(model, data, data_name=data_name, warnings_list=warnings_list,
+                        sections=sections).write(Path(out_dir))

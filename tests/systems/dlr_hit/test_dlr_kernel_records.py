@@ -93,3 +93,15 @@ def test_parameter_index_names_every_parameter_and_compiles_to_a_constant():
     assert stiction(th, 1) == IX.fs_base1 + 1
     ir = stiction.inspect_llvm(stiction.signatures[0])
     assert f"i64 {8 * IX.fs_base1}" in ir
+
+
+def test_closed_loop_output_columns_follow_the_generated_index_table():
+    """The kernels write block b of the closed-loop outputs from column YL.b on; the column names
+    and units (impedance.LOOP_OUTPUTS) come from the same block table, in the same order."""
+    from gripkit.systems.dlr_hit.finger import LOOP_OUTPUT_BLOCKS, YF, YL
+    from gripkit.systems.dlr_hit.impedance import LOOP_OUTPUTS
+
+    assert tuple(LOOP_OUTPUTS) == LOOP_OUTPUT_BLOCKS
+    assert [getattr(YL, b) for b in LOOP_OUTPUT_BLOCKS] == list(range(0, 39, 3))
+    assert all(len(names) == 3 for names, _ in LOOP_OUTPUTS.values())
+    assert YL.scale_hat == 27 and YL.fric_ff == 36 and YF.temperature == 15

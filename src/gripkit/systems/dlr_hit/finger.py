@@ -102,6 +102,16 @@ IX = namedtuple("FingerParameterIndex", FINGER_PARAMETERS)(*range(len(FINGER_PAR
 # state layout: p(3) pd(3) T(3) z(3) stuck(3)
 NX = 15
 
+#: the first column of each three-column block of the closed-loop outputs (one column per joint,
+#: axis or actuator), by name: ``y[n, YL.scale_hat + k]``; the column names and units are
+#: :data:`gripkit.systems.dlr_hit.impedance.LOOP_OUTPUTS`, generated from the same table
+LOOP_OUTPUT_BLOCKS = ("angle", "velocity", "tip", "tip_velocity", "force", "pwm", "tau_cmd",
+                      "fric", "tau", "scale_hat", "offset_hat", "adapt_status", "fric_ff")
+YL = namedtuple("LoopOutputIndex", LOOP_OUTPUT_BLOCKS)(*range(0, 3 * len(LOOP_OUTPUT_BLOCKS), 3))
+#: the same for the 18 open-loop outputs of one finger (DLRFinger.outputs), from column ycol on
+FINGER_OUTPUT_BLOCKS = ("angle", "velocity", "actuator_velocity", "tau", "fric", "temperature")
+YF = namedtuple("FingerOutputIndex", FINGER_OUTPUT_BLOCKS)(*range(0, 3 * len(FINGER_OUTPUT_BLOCKS), 3))
+
 # Named records of arrays the kernels take (namedtuples: numba resolves each field at compile
 # time, and without NRT taking an array out of one costs nothing; docs/performance.md).
 #: one finger's constant arrays (:func:`finger_setup`): the fields of
@@ -502,13 +512,13 @@ def finger_outputs(G, q0, x, taum, fric, y, yrow, ycol):  # pragma: no cover - c
         for k in range(3):
             s += G[j * 3 + k] * x[k]
             sd += G[j * 3 + k] * x[3 + k]
-        y[yrow, ycol + j] = s
-        y[yrow, ycol + 3 + j] = sd
+        y[yrow, ycol + YF.angle + j] = s
+        y[yrow, ycol + YF.velocity + j] = sd
     for k in range(3):
-        y[yrow, ycol + 6 + k] = x[3 + k]
-        y[yrow, ycol + 9 + k] = taum[k]
-        y[yrow, ycol + 12 + k] = fric[k]
-        y[yrow, ycol + 15 + k] = x[6 + k]
+        y[yrow, ycol + YF.actuator_velocity + k] = x[3 + k]
+        y[yrow, ycol + YF.tau + k] = taum[k]
+        y[yrow, ycol + YF.fric + k] = fric[k]
+        y[yrow, ycol + YF.temperature + k] = x[6 + k]
 
 
 # --- impedance control (used by gripkit.systems.dlr_hit.impedance) ----------------------------------------
@@ -676,7 +686,7 @@ def _adapt_friction(th, fc, cs, x, ctab, est, sensor, y, n):  # pragma: no cover
     motor torque from the PWM just commanded and the measured speed through eq 5.10 times the
     thermal observer's torque factor ρ̂ = ``sensor[k, 4]`` (1: eq 5.10 at T_ref) and the
     transmission, bias torque Γᵀ(C(q, q̇)q̇ + G(q)) by RNEA; writes the estimates and each
-    sample's status into y[n, 27:36]. While ``sensor[k, 5]`` ≠ 0 (the observer's torque factor
+    sample's status into the blocks YL.scale_hat, YL.offset_hat, YL.adapt_status of y[n]. While ``sensor[k, 5]`` ≠ 0 (the observer's torque factor
     is too uncertain: a torque loss and a friction change cannot be told apart) the filters run
     but θ, P and σ̂² keep their values (status 0, frozen)."""
     G, ratio, grav, pwm, hb = fc.G, fc.ratio, fc.g, cs.pwm, cs.hb
@@ -700,9 +710,9 @@ def _adapt_friction(th, fc, cs, x, ctab, est, sensor, y, n):  # pragma: no cover
             st = 0.0
         if st == 1.0:
             sensor[k, 6] += 1.0  # updates so far (the band's settling count)
-        y[n, 33 + k] = st
-        y[n, 27 + k] = theta[k, 0]
-        y[n, 30 + k] = theta[k, 1]
+        y[n, YL.adapt_status + k] = st
+        y[n, YL.scale_hat + k] = theta[k, 0]
+        y[n, YL.offset_hat + k] = theta[k, 1]
 
 
 @hot
@@ -781,8 +791,8 @@ def finger_loop(th, mode, thermal, fc, ws, cs, tab, run, x, loop, plant,
     """The time loop (allocation-free, semi-implicit Euler) of the run ``run`` (:data:`FingerRun`).
     ``loop.ctrl = 0``: PWM from u[:, ucol:], outputs as DLRFinger.outputs at
     y[:, ycol:ycol+18]; ``loop.ctrl = 1/2``:
-    joint/Cartesian impedance (:data:`ImpedanceLoop`), closed-loop outputs (39 columns, see
-    gripkit.systems.dlr_hit.impedance). ``plant`` (:data:`PlantDrift`): the plant's friction drift
+    joint/Cartesian impedance (:data:`ImpedanceLoop`), closed-loop outputs (the blocks of
+    :data:`YL`, named in gripkit.systems.dlr_hit.impedance.LOOP_OUTPUTS). ``plant`` (:data:`PlantDrift`): the plant's friction drift
     (:func:`_drift_friction`); ``est`` (:data:`FrictionEstimator`): the online friction
     estimator, run when gains[G_ADAPT] ≠ 0; the controller sees the state through
     :func:`_measure` when gains[G_QUANTUM] > 0 and corrects eq 5.10 by its thermal observer
@@ -810,13 +820,13 @@ def finger_loop(th, mode, thermal, fc, ws, cs, tab, run, x, loop, plant,
                 _adapt_friction(th, fc, cs, xc, loop.tables, est, loop.sensor, y, n)
             else:
                 for k in range(3):
-                    y[n, 27 + k] = fhat[k, 0]
-                    y[n, 30 + k] = fhat[k, 1]
-                    y[n, 33 + k] = 0.0
+                    y[n, YL.scale_hat + k] = fhat[k, 0]
+                    y[n, YL.offset_hat + k] = fhat[k, 1]
+                    y[n, YL.adapt_status + k] = 0.0
             if gains[G_THERMAL] != 0.0:
                 _thermal_observer(th, fc, xc, pwm, loop, dt)
             for k in range(3):
-                y[n, 36 + k] = cs.ff[k]
+                y[n, YL.fric_ff + k] = cs.ff[k]
         else:
             for k in range(3):
                 pwm[k] = u[n, ucol + k]
@@ -827,7 +837,7 @@ def finger_loop(th, mode, thermal, fc, ws, cs, tab, run, x, loop, plant,
                 _wall(th, fc, cs, x, loop.wall)
                 if s == 0:
                     for k in range(3):
-                        y[n, 12 + k] = force[k]
+                        y[n, YL.force + k] = force[k]
             if not finger_step(thp, mode, thermal, fc, tabp, x, pwm, ext, h, taum, fric, ws):
                 return n + 1
             if s == 0 and not ctrl:
@@ -839,17 +849,17 @@ def finger_loop(th, mode, thermal, fc, ws, cs, tab, run, x, loop, plant,
             joints_from_actuators(4, 3, G, cs.zq, xs[3:6], qd)
             _tip(fc, th, cs.q, cs.R, cs.P, cs.T, cs.J, cs.Jp, cs.tip)
             for k in range(3):
-                y[n, k] = q[k]
-                y[n, 3 + k] = qd[k]
-                y[n, 6 + k] = tip[k]
+                y[n, YL.angle + k] = q[k]
+                y[n, YL.velocity + k] = qd[k]
+                y[n, YL.tip + k] = tip[k]
                 s = 0.0
                 for j in range(3):
                     s += Jp[k, j] * xs[3 + j]
-                y[n, 9 + k] = s
-                y[n, 15 + k] = pwm[k]
-                y[n, 18 + k] = cs.tauq[k]
-                y[n, 21 + k] = fric[k]
-                y[n, 24 + k] = taum[k]
+                y[n, YL.tip_velocity + k] = s
+                y[n, YL.pwm + k] = pwm[k]
+                y[n, YL.tau_cmd + k] = cs.tauq[k]
+                y[n, YL.fric + k] = fric[k]
+                y[n, YL.tau + k] = taum[k]
     return 0
 
 

@@ -64,7 +64,7 @@ from ...models.friction import FrictionTable, table_arrays
 from ...signals.trajectory import Trajectory
 from .finger import (ACTUATORS, CARTESIAN_IMPEDANCE, FRICTION_MODES, G_BAND, G_COMMAND, G_FREF,
                      G_GUARD, G_OBS_ALPHA, G_OBS_CTH, G_OBS_RTH, G_QUANTUM, G_SETTLE, G_THERMAL,
-                     G_VALPHA, JOINT_IMPEDANCE, N_GAINS, NX,
+                     G_VALPHA, JOINT_IMPEDANCE, LOOP_OUTPUT_BLOCKS, N_GAINS, NX, YL,
                      DLRFinger,
                      FrictionEstimator, ImpedanceLoop, PlantDrift, finger_run)
 from .friction_drift import FrictionDrift
@@ -267,13 +267,24 @@ def model_friction_tables(finger: DLRFinger, v_max: float = 8.0, n: int = 200) -
                  for a in ACTUATORS)
 
 
-_OUT = (["abd", "flex", "prox"], ["abd_vel", "flex_vel", "prox_vel"], ["tip_x", "tip_y", "tip_z"],
-        ["tip_vx", "tip_vy", "tip_vz"], ["force_x", "force_y", "force_z"],
-        [f"pwm_{a}" for a in ACTUATORS], [f"tau_cmd_{a}" for a in ACTUATORS],
-        [f"fric_{a}" for a in ACTUATORS], [f"tau_{a}" for a in ACTUATORS],
-        [f"scale_hat_{a}" for a in ACTUATORS], [f"offset_hat_{a}" for a in ACTUATORS],
-        [f"adapt_status_{a}" for a in ACTUATORS], [f"fric_ff_{a}" for a in ACTUATORS])
-_UNITS = ("rad", "rad/s", "m", "m/s", "N", "1", "N*m", "N*m", "N*m", "1", "N*m", "1", "N*m")
+#: the closed loop's output columns: (names, unit) of each block of
+#: :data:`~gripkit.systems.dlr_hit.finger.LOOP_OUTPUT_BLOCKS`, in that order (the kernels write
+#: block b from column ``YL.b`` on)
+LOOP_OUTPUTS = {
+    "angle": (["abd", "flex", "prox"], "rad"),
+    "velocity": (["abd_vel", "flex_vel", "prox_vel"], "rad/s"),
+    "tip": (["tip_x", "tip_y", "tip_z"], "m"),
+    "tip_velocity": (["tip_vx", "tip_vy", "tip_vz"], "m/s"),
+    "force": (["force_x", "force_y", "force_z"], "N"),
+    "pwm": ([f"pwm_{a}" for a in ACTUATORS], "1"),
+    "tau_cmd": ([f"tau_cmd_{a}" for a in ACTUATORS], "N*m"),
+    "fric": ([f"fric_{a}" for a in ACTUATORS], "N*m"),
+    "tau": ([f"tau_{a}" for a in ACTUATORS], "N*m"),
+    "scale_hat": ([f"scale_hat_{a}" for a in ACTUATORS], "1"),
+    "offset_hat": ([f"offset_hat_{a}" for a in ACTUATORS], "N*m"),
+    "adapt_status": ([f"adapt_status_{a}" for a in ACTUATORS], "1"),
+    "fric_ff": ([f"fric_ff_{a}" for a in ACTUATORS], "N*m"),
+}
 
 
 def simulate_impedance(finger: DLRFinger, controller: ImpedanceController, reference,
@@ -318,7 +329,7 @@ def simulate_impedance(finger: DLRFinger, controller: ImpedanceController, refer
     J = np.ascontiguousarray(np.diag(finger.chain().mass_matrix(x[:3])))
     cfg = settings.vector(float(dt)) if ad is not None else np.zeros(10)
     estimator = FrictionEstimator(cfg, J, *settings.initial_state(3))
-    y = np.empty((N, 39))
+    y = np.empty((N, 3 * len(LOOP_OUTPUT_BLOCKS)))
     gains = np.zeros(N_GAINS)
     gains[:14] = [*controller.stiffness, *controller.damping,
                   float(controller.gravity_compensation),
@@ -424,12 +435,10 @@ def _drift_schedule(finger, friction_drift, t) -> np.ndarray:
 def _loop_trajectory(t, y, ref, drift, finger, controller, dt) -> Trajectory:
     """The closed loop's output columns, the references and the plant's drift as a Trajectory."""
     ch, units = {}, {}
-    col = 0
-    for names, unit in zip(_OUT, _UNITS):
-        for nme in names:
-            ch[nme] = y[:, col]
+    for block, (names, unit) in LOOP_OUTPUTS.items():
+        for k, nme in enumerate(names):
+            ch[nme] = y[:, getattr(YL, block) + k]
             units[nme] = unit
-            col += 1
     suffix = ("x", "y", "z") if controller.kind == "cartesian" else ("abd", "flex", "prox")
     for i, sfx in enumerate(suffix):
         ch[f"ref_{sfx}"] = ref[:, i]

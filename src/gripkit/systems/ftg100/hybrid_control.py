@@ -52,7 +52,7 @@ from ...params import ParameterSet
 from ...progress import track
 from ...signals.trajectory import Trajectory
 from ...sim.noise import normal_draw
-from .model import FTG100Plant, advance_plant, plant_outputs, plant_parameters as _pp
+from .model import PO, FTG100Plant, advance_plant, plant_outputs, plant_parameters as _pp
 
 __all__ = ["HybridForcePosition", "HybridController", "hybrid_step", "simulate_hybrid_grasp", "grasp_batch",
            "HybridGraspResult", "GraspBatch", "METRICS", "impact_speed_limit"]
@@ -325,14 +325,14 @@ def _grasp_one(th, cp, fprof, sig_f, sig_x, seed, damage, run, traj,
     tail = n_steps - max(1, n_steps // 10)
     for n in range(n_steps):
         plant_outputs(th, s, mode, o)
-        fm = o[3] + sig_f * normal_draw(rng)
-        xm = o[0] + sig_x * normal_draw(rng)
+        fm = o[PO.F_s] + sig_f * normal_draw(rng)
+        xm = o[PO.x_a] + sig_x * normal_draw(rng)
         V = hybrid_step(cp, cs, xm, fm, fprof[n] if varying else fcmd)
         if rec:
             traj[n, 0] = n * dt
-            traj[n, 1] = o[0]
-            traj[n, 2] = o[1]
-            traj[n, 3] = o[2]
+            traj[n, 1] = o[PO.x_a]
+            traj[n, 2] = o[PO.x_b]
+            traj[n, 3] = o[PO.F_c]
             traj[n, 4] = fm
             traj[n, 5] = V
             traj[n, 6] = cs[_MODE]
@@ -345,7 +345,7 @@ def _grasp_one(th, cp, fprof, sig_f, sig_x, seed, damage, run, traj,
         for j in range(substeps):
             mode = advance_plant(th, s, mode, V, h, 1)
             plant_outputs(th, s, mode, o)
-            f = o[2]
+            f = o[PO.F_c]
             if f > 0.0 and t_contact < 0.0:
                 t_contact = n * dt + (j + 1) * h
             if f > peak:

@@ -118,6 +118,7 @@ secant-stiffness ratio of (200/70)²/(100/20) = 1.63 between 100 µm and 20 µm 
 from __future__ import annotations
 
 import abc
+from collections import namedtuple
 import math
 
 import numba
@@ -577,6 +578,11 @@ class FTG100Coupled(Model):
 
 _PLANT_NAMES = ("M_a", "K_fa", "K_sa", "K3_a", "D_a", "c_e", "M_b", "K_fb", "K_sb", "K3_b", "D_b",
                 "k0", "c0", "gap", "V_max")
+#: the index of each plant parameter in the vector ``th`` the kernels take: ``th[PX.D_a]``
+PX = namedtuple("PlantParameterIndex", _PLANT_NAMES)(*range(len(_PLANT_NAMES)))
+#: the index of each plant output in ``out`` (:func:`plant_outputs`): ``out[PO.F_c]``
+PLANT_OUTPUTS = ("x_a", "x_b", "F_c", "F_s")
+PO = namedtuple("PlantOutputIndex", PLANT_OUTPUTS)(*range(len(PLANT_OUTPUTS)))
 
 
 #: Suspension laws of :func:`plant_parameters` and the provenance of their ``K3_a``.
@@ -698,14 +704,14 @@ def _plant_rhs(th, xa, va, xb, vb, V, contact):  # pragma: no cover - compiled
     """Derivatives of [x_ea, v_ea, x_eb, v_eb] in mode ``contact`` (0 free, 1 touching)."""
     fc = 0.0
     if contact:
-        d = th[4] * xa - th[10] * xb - th[13]
-        dd = th[4] * va - th[10] * vb
-        fc = th[11] * d + th[12] * dd
-        if fc < 0.0 and th[12] > 0.0:  # a Kelvin-Voigt contact cannot pull
+        d = th[PX.D_a] * xa - th[PX.D_b] * xb - th[PX.gap]
+        dd = th[PX.D_a] * va - th[PX.D_b] * vb
+        fc = th[PX.k0] * d + th[PX.c0] * dd
+        if fc < 0.0 and th[PX.c0] > 0.0:  # a Kelvin-Voigt contact cannot pull
             fc = 0.0
-    fx = th[5] * V * V
-    aa = (fx - th[1] * va - th[2] * xa - th[3] * xa * xa * xa - th[4] * fc) / th[0]
-    ab = (th[10] * fc - th[7] * vb - th[8] * xb - th[9] * xb * xb * xb) / th[6]
+    fx = th[PX.c_e] * V * V
+    aa = (fx - th[PX.K_fa] * va - th[PX.K_sa] * xa - th[PX.K3_a] * xa * xa * xa - th[PX.D_a] * fc) / th[PX.M_a]
+    ab = (th[PX.D_b] * fc - th[PX.K_fb] * vb - th[PX.K_sb] * xb - th[PX.K3_b] * xb * xb * xb) / th[PX.M_b]
     return va, aa, vb, ab
 
 
@@ -723,7 +729,7 @@ def _plant_rk4(th, s0, s1, s2, s3, V, mode, h):  # pragma: no cover - compiled
 
 @numba.njit(cache=True)
 def _gap(th, s0, s2):  # pragma: no cover - compiled
-    return th[4] * s0 - th[10] * s2 - th[13]
+    return th[PX.D_a] * s0 - th[PX.D_b] * s2 - th[PX.gap]
 
 
 @numba.njit(cache=True)
@@ -737,12 +743,12 @@ def advance_plant(th, s, mode, V, h, substeps):  # pragma: no cover - compiled
     advanced to the event, the mode switches, and the rest of the step is integrated in the new mode.
     This keeps RK4's order across contact instead of smearing the kink over a step.
     """
-    if th[11] <= 0.0:
+    if th[PX.k0] <= 0.0:
         mode = 0
     if V < 0.0:
         V = 0.0
-    elif V > th[14]:
-        V = th[14]
+    elif V > th[PX.V_max]:
+        V = th[PX.V_max]
     s0 = s[0]
     s1 = s[1]
     s2 = s[2]
@@ -762,7 +768,7 @@ def advance_plant(th, s, mode, V, h, substeps):  # pragma: no cover - compiled
                 fm = _gap(th, n0, n2)
                 if it == 0:
                     crossed = (mode == 0 and fm > 0.0) or (mode == 1 and fm < 0.0)
-                    if th[11] <= 0.0 or not crossed or events >= 4:
+                    if th[PX.k0] <= 0.0 or not crossed or events >= 4:
                         break
                     fhi = fm
                 else:
@@ -799,17 +805,17 @@ def advance_plant(th, s, mode, V, h, substeps):  # pragma: no cover - compiled
 @numba.njit(cache=True)
 def plant_outputs(th, s, mode, out):  # pragma: no cover - compiled
     """out = [x_a, x_b, F_c (true contact force), F_s (sensor force k2 x_b)] for state ``s``."""
-    xa = th[4] * s[0]
-    xb = th[10] * s[2]
+    xa = th[PX.D_a] * s[0]
+    xb = th[PX.D_b] * s[2]
     fc = 0.0
-    if mode == 1 and th[11] > 0.0:
-        fc = th[11] * (xa - xb - th[13]) + th[12] * (th[4] * s[1] - th[10] * s[3])
+    if mode == 1 and th[PX.k0] > 0.0:
+        fc = th[PX.k0] * (xa - xb - th[PX.gap]) + th[PX.c0] * (th[PX.D_a] * s[1] - th[PX.D_b] * s[3])
         if fc < 0.0:
             fc = 0.0
-    out[0] = xa
-    out[1] = xb
-    out[2] = fc
-    out[3] = th[8] / (th[10] * th[10]) * xb
+    out[PO.x_a] = xa
+    out[PO.x_b] = xb
+    out[PO.F_c] = fc
+    out[PO.F_s] = th[PX.K_sb] / (th[PX.D_b] * th[PX.D_b]) * xb
 
 
 @numba.njit(cache=True, parallel=True)
@@ -823,7 +829,7 @@ def _plant_batch(thetas, u, dt, substeps, x0, y):  # pragma: no cover - compiled
         o = np.empty(4)
         for i in range(4):
             s[i] = x0[p, i]
-        mode = 1 if _gap(th, s[0], s[2]) > 0.0 and th[11] > 0.0 else 0
+        mode = 1 if _gap(th, s[0], s[2]) > 0.0 and th[PX.k0] > 0.0 else 0
         for n in range(N):
             plant_outputs(th, s, mode, o)
             for j in range(4):

@@ -1,0 +1,230 @@
+"""PID tuning on an identified model by Skogestad's SIMC rules (issue 27).
+
+Reference: S. Skogestad, "Simple analytic rules for model reduction and PID controller tuning",
+*Journal of Process Control* 13 (2003) 291–309: the half rule (§3, eqs 8–10) reduces a model to
+first or second order plus time delay, and Table 1 gives the settings of the series PID
+``c(s) = K_c (τ_I s + 1)/(τ_I s) · (τ_D s + 1)`` with the closed-loop time constant τ_c as the
+one tuning knob (default τ_c = θ, "tight control": gain margin ≈ 3, phase margin ≈ 47° on a
+first-order process with delay, the paper's §4.3):
+
+    g = k e^{−θs}/(τ₁s + 1)                 K_c = τ₁/(k (τ_c + θ)),  τ_I = min(τ₁, 4(τ_c + θ))
+    g = k e^{−θs}/((τ₁s + 1)(τ₂s + 1))       the same, and τ_D = τ₂
+    g = k′ e^{−θs}/s                        K_c = 1/(k′ (τ_c + θ)),  τ_I = 4(τ_c + θ)
+    g = k′ e^{−θs}/(s (τ₂s + 1))             the same, and τ_D = τ₂
+
+The series settings become :class:`~gripkit.control.PID`'s parallel gains exactly:
+``k_p = K_c (1 + τ_D/τ_I)``, ``k_i = K_c/τ_I``, ``k_d = K_c τ_D``.
+
+Model reduction (:func:`reduce_model`) of a discrete SISO model with sample time h and n_k samples
+of input delay: the ZOH model without its delay beyond the first sample is taken to continuous
+time (:meth:`gripkit.lti.LinearSystem.d2c`, exact for a ZOH-sampled system), leaving
+``k Π_j(T_j s + 1) / Π_i(τ_i s + 1) · e^{−θ₀ s}`` with θ₀ = (n_k − 1) h. Then
+
+* each zero in the right half plane (inverse response, time constant T_inv) adds T_inv to θ
+  (the paper's eq 8, rule for negative numerator time constants);
+* each zero in the left half plane (T₀ > 0) is cancelled against the closest larger denominator
+  time constant τ₀ (the largest when none is larger) by the paper's rules of eq 7 (T1, T1a,
+  T1b, R2, R3), with θ the effective delay before the cancellation: T₀/τ₀ (T₀ ≥ τ₀ ≥ θ),
+  T₀/θ (T₀ ≥ θ ≥ τ₀), 1 (θ ≥ T₀ ≥ τ₀), T₀/τ₀ (τ₀ ≥ T₀ ≥ 5θ), else
+  (τ̃₀/τ₀)/((τ̃₀ − T₀)s + 1) with τ̃₀ = min(τ₀, 5θ);
+* the half rule: with the remaining time constants τ₁₀ ≥ τ₂₀ ≥ …, first order:
+  τ₁ = τ₁₀ + τ₂₀/2, θ = θ₀ + τ₂₀/2 + Σ_{i≥3} τ_i0 + Σ T_inv; second order: τ₁ = τ₁₀,
+  τ₂ = τ₂₀ + τ₃₀/2, θ = θ₀ + τ₃₀/2 + Σ_{i≥4} τ_i0 + Σ T_inv (eqs 9, 10); an integrator (pole at
+  z = 1) is kept as 1/s with k′ = lim s g(s) and the half rule applied to the lags after it
+  (their time constants exact, their zeros those of the lag part sampled alone: approximate);
+* h/2 is added to θ for the sample-and-hold of the digital controller (the paper's §3.1 remark
+  on digital implementation).
+
+Oscillatory (complex) or unstable poles, and complex zeros, have no place in these rules: a
+ModelError says so, and :class:`LowOrderModel` can be given directly instead (roots within
+:data:`REAL_TOL` of the real axis count as real: a repeated real root splits so by rounding).
+"""
+
+from __future__ import annotations
+
+import math
+import numpy as np
+
+from ..errors import ArgumentError, ModelError
+from .pid import PID
+from .rst import as_plant
+
+__all__ = ["LowOrderModel", "reduce_model", "simc_settings", "tune_pid"]
+
+#: a pole or zero this close to the real axis (relative to max(1, |z|)) counts as real: rounding
+#: splits a repeated real root of multiplicity m by about ε^(1/m) (a triple pole of a sampled
+#: model by ~1e-4), and the rules take the real part
+REAL_TOL = 1e-3
+
+
+class LowOrderModel:
+    """``k e^{−θs}/((τ₁s + 1)(τ₂s + 1))`` (τ₂ = 0: first order), or with ``integrating``
+    ``k e^{−θs}/(s (τ₂s + 1))`` (k is then k′, τ₁ unused), and the sample time ``dt`` (s) the
+    PID will run at. ``dt`` is not added to θ here: :func:`reduce_model` adds h/2 itself."""
+
+    __slots__ = ("k", "tau1", "tau2", "theta", "integrating", "dt", "notes")
+
+    def __init__(self, k: float, tau1: float, theta: float, tau2: float = 0.0, *, dt: float,
+                 integrating: bool = False, notes: tuple = ()):
+        vals = dict(k=k, tau1=tau1, theta=theta, tau2=tau2, dt=dt)
+        for name, v in vals.items():
+            if not isinstance(v, (int, float, np.floating, np.integer)) or not math.isfinite(v):
+                raise ArgumentError(f"LowOrderModel {name}: expected a finite number, found {v!r}")
+        if k == 0:
+            raise ArgumentError("LowOrderModel k: the gain is zero: the input does not move the "
+                                "output")
+        if theta < 0 or tau2 < 0 or (tau1 <= 0 and not integrating) or dt <= 0:
+            raise ArgumentError(f"LowOrderModel: expected tau1 > 0, tau2 >= 0, theta >= 0 and "
+                                f"dt > 0 (s), found tau1={tau1!r}, tau2={tau2!r}, "
+                                f"theta={theta!r}, dt={dt!r}")
+        self.k, self.tau1, self.tau2, self.theta = float(k), float(tau1), float(tau2), float(theta)
+        self.dt, self.integrating, self.notes = float(dt), bool(integrating), tuple(notes)
+
+    def __repr__(self) -> str:
+        kind = "integrating, " if self.integrating else ""
+        return (f"LowOrderModel({kind}k={self.k:.6g}, tau1={self.tau1:.6g}, "
+                f"tau2={self.tau2:.6g}, theta={self.theta:.6g}, dt={self.dt:g})")
+
+    def to_dict(self) -> dict:
+        return dict(k=self.k, tau1=self.tau1, tau2=self.tau2, theta=self.theta,
+                    integrating=self.integrating, dt=self.dt, notes=list(self.notes))
+
+
+def _cancel_lhp_zero(T0: float, taus: list, theta: float) -> tuple[float, list, str]:
+    """Skogestad's eq 7 for (T₀s + 1)/(τ₀s + 1): (gain factor, new time constants, rule)."""
+    larger = [t for t in taus if t >= T0]
+    tau0 = min(larger) if larger else max(taus)
+    rest = list(taus)
+    rest.remove(tau0)
+    if T0 >= tau0:
+        if tau0 >= theta:
+            return T0 / tau0, rest, "T1"
+        if T0 >= theta:
+            return T0 / theta, rest, "T1a"
+        return 1.0, rest, "T1b"
+    if T0 >= 5 * theta:
+        return T0 / tau0, rest, "R2"
+    tt = min(tau0, 5 * theta)
+    return tt / tau0, rest + [tt - T0], "R3"
+
+
+def reduce_model(model, order: int = 1) -> LowOrderModel:
+    """First- (``order=1``) or second-order-plus-delay approximation of a discrete SISO model
+    (anything :func:`gripkit.control.as_plant` reads) by the half rule (module docstring)."""
+    if order not in (1, 2):
+        raise ArgumentError(f"order: expected 1 (FOPTD) or 2 (SOPTD), found {order!r}")
+    g = as_plant(model)
+    h = float(g.dt)
+    A, B = g.den_zinv(), g.num_zinv()
+    nk = g.relative_degree()
+    if nk < 1:
+        raise ModelError("tune_pid: the model has direct feedthrough (nk = 0); a sampled plant "
+                         "has at least one sample of delay", hint="check the model's nk")
+    zp = np.roots(A) if A.size > 1 else np.zeros(0)
+    if np.any(np.abs(zp.imag) > REAL_TOL * np.maximum(1.0, np.abs(zp))):
+        raise ModelError(f"tune_pid: the model has complex poles {np.round(zp, 6).tolist()} "
+                         f"(an oscillatory mode), which the half rule does not reduce",
+                         hint="give a LowOrderModel(k, tau1, theta, tau2, dt=...) fitted by hand")
+    zp = zp.real
+    integ = np.abs(zp - 1.0) < 1e-9
+    if int(integ.sum()) > 1:
+        raise ModelError("tune_pid: the model has more than one integrator (a pole at z = 1)")
+    if np.any(zp[~integ] >= 1.0) or np.any(zp[~integ] <= 0.0):
+        raise ModelError(f"tune_pid: the model has poles {np.round(zp, 6).tolist()} outside "
+                         f"(0, 1) (unstable, or with no continuous-time equivalent)",
+                         hint="SIMC needs a stable (or integrating) model with real poles")
+    notes = []
+    theta = (nk - 1) * h
+    if integ.any():  # 1/s kept apart: k' from the rest, the half rule on the remaining lags
+        A = np.real(np.poly(zp[~integ]))
+        h_int = h
+    else:
+        h_int = None
+    gd = type(g).from_polynomials(A, np.concatenate([[0.0], B[nk:]]), dt=h)
+    gc = gd.to_ss(minimal=False).d2c()  # the state-space route keeps high orders accurate
+    taus = sorted((-1.0 / p.real for p in gc.poles()), reverse=True)
+    zc = gc.zeros()
+    if np.any(np.abs(zc.imag) > REAL_TOL * np.maximum(1.0, np.abs(zc))):
+        raise ModelError(f"tune_pid: the model has complex zeros {np.round(zc, 6).tolist()}, "
+                         f"which the half rule does not reduce",
+                         hint="identify a model with fewer B coefficients, or give a "
+                              "LowOrderModel directly")
+    k = float(gc.dc_gain()[0, 0])
+    if h_int is not None:
+        k /= h_int  # ZOH of k'/s is k' h/(z − 1): the lags' DC gain B(1)/A(1) is k' h
+        notes.append("integrator kept as 1/s")
+    t_inv = [1.0 / z.real for z in zc if z.real > 0]
+    t_lhp = sorted((-1.0 / z.real for z in zc if z.real < 0), reverse=True)
+    if t_inv:
+        notes.append(f"{len(t_inv)} inverse-response zero(s) added to the delay")
+    theta_eff = theta + sum(t_inv) + h / 2.0
+    for T0 in t_lhp:
+        if not taus:
+            raise ModelError("tune_pid: the model has more zeros than lags to cancel them")
+        f, taus, rule = _cancel_lhp_zero(T0, taus, theta_eff)
+        k *= f
+        taus = sorted(taus, reverse=True)
+        notes.append(f"zero T0={T0:.4g} s cancelled (rule {rule})")
+    theta += sum(t_inv) + h / 2.0
+    if h_int is not None:  # the integrator plays τ1 = ∞: the lags fill τ2 and θ
+        first, lags = [], taus
+    else:
+        if not taus:
+            raise ModelError("tune_pid: the model has no lag left (a pure delay); SIMC gives "
+                             "an integral controller there", hint="use PID(0, ki) by hand")
+        first, lags = [taus[0]], taus[1:]
+    n_keep = order - 1  # lags kept beyond the first (or beyond the integrator)
+    kept = lags[:n_keep]
+    nxt = lags[n_keep:]
+    if nxt:
+        half = nxt[0] / 2.0
+        theta += half + sum(nxt[1:])
+        if kept:
+            kept[-1] += half
+        elif first:
+            first[0] += half
+    tau1 = first[0] if first else 0.0
+    tau2 = kept[0] if kept else 0.0
+    return LowOrderModel(k, tau1, theta, tau2, dt=h, integrating=h_int is not None,
+                         notes=tuple(notes))
+
+
+def simc_settings(m: LowOrderModel, tau_c: float | None = None) -> dict:
+    """Skogestad's Table 1 for ``m``: series K_c, τ_I, τ_D and the parallel k_p, k_i, k_d."""
+    tc = m.theta if tau_c is None else float(tau_c)
+    if not (math.isfinite(tc) and tc >= 0 and tc + m.theta > 0):
+        raise ArgumentError(f"tau_c: expected a closed-loop time constant >= 0 s (with tau_c + "
+                            f"theta > 0), found {tau_c!r}",
+                            hint="tau_c = theta is SIMC's 'tight control'; larger is slower "
+                                 "and more robust")
+    if m.integrating:
+        Kc = 1.0 / (m.k * (tc + m.theta))
+        ti = 4.0 * (tc + m.theta)
+    else:
+        Kc = m.tau1 / (m.k * (tc + m.theta))
+        ti = min(m.tau1, 4.0 * (tc + m.theta))
+    td = m.tau2
+    return dict(Kc=Kc, tau_I=ti, tau_D=td, tau_c=tc, kp=Kc * (1.0 + td / ti), ki=Kc / ti,
+                kd=Kc * td)
+
+
+def tune_pid(model, method: str = "simc", *, tau_c: float | None = None, order: int | None = None,
+             **pid_options) -> PID:
+    """A :class:`~gripkit.control.PID` for ``model`` by the SIMC rules (module docstring).
+
+    ``model``: an identified discrete SISO model (anything :func:`as_plant` reads) or a
+    :class:`LowOrderModel`. ``order``: 1 (PI on the first-order approximation) or 2 (PID on the
+    second-order one, the default; a PI where the model has one lag only). ``tau_c``:
+    closed-loop time constant in s (default θ). ``pid_options`` go to :class:`PID` (limits, tf,
+    b, c). The PID runs at the model's dt; ``pid.design`` records the reduction and settings.
+    """
+    if method != "simc":
+        raise ArgumentError(f"method: expected 'simc' (Skogestad's rules), found {method!r}")
+    if isinstance(model, LowOrderModel):
+        m = model
+    else:
+        m = reduce_model(model, 2 if order is None else order)
+    s = simc_settings(m, tau_c)
+    design = dict(method="SIMC (Skogestad 2003, Table 1), half-rule reduction",
+                  model=m.to_dict(), **{k: s[k] for k in ("Kc", "tau_I", "tau_D", "tau_c")})
+    return PID(s["kp"], s["ki"], s["kd"], dt=m.dt, design=design, **pid_options)

@@ -1,0 +1,123 @@
+"""PID tuning by Skogestad's SIMC rules (issue 27; S. Skogestad, J. Process Control 13 (2003)
+291–309): Table 1's settings exactly on known first- and second-order models with delay, the half
+rule (eqs 8–10) recovering known time constants and delay from ZOH-sampled models, and the
+loop's margins on a first-order process with delay against the analytic L = e^{−θs}/(2θ s)
+(τ_c = θ, τ_I = τ₁): gain margin π, phase margin 90° − (1/2 rad)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from gripkit.control import LowOrderModel, reduce_model, robustness, tune_pid
+from gripkit.errors import ArgumentError, ModelError
+from gripkit.lti import TransferFunction
+
+
+def test_simc_first_order_settings_are_table_1():
+    """k = 2, τ₁ = 10 s, θ = 1 s: τ_c = θ gives K_c = 10/(2·2) = 2.5, τ_I = min(10, 8) = 8 s;
+    τ_c = 3 s gives K_c = 10/(2·4) = 1.25, τ_I = min(10, 16) = 10 s (a PI: k_d = 0)."""
+    m = LowOrderModel(2.0, 10.0, 1.0, dt=0.1)
+    pid = tune_pid(m)
+    assert (pid.kp, pid.ki, pid.kd, pid.dt) == (2.5, 2.5 / 8.0, 0.0, 0.1)
+    assert pid.design["Kc"] == 2.5 and pid.design["tau_I"] == 8.0
+    pid = tune_pid(m, tau_c=3.0)
+    assert (pid.kp, pid.ki, pid.kd) == (1.25, 1.25 / 10.0, 0.0)
+
+
+def test_simc_second_order_and_integrating_settings_are_table_1():
+    """SOPTD k = 1, τ₁ = 5, τ₂ = 0.5, θ = 0.2, τ_c = 0.2: series K_c = 12.5, τ_I = 1.6,
+    τ_D = 0.5, parallel k_p = K_c(1 + τ_D/τ_I), k_i = K_c/τ_I, k_d = K_c τ_D. Integrating with lag
+    k′ = 0.5, τ₂ = 0.1, θ = 0.3, τ_c = 0.3: K_c = 1/(0.5·0.6), τ_I = 2.4, τ_D = 0.1."""
+    pid = tune_pid(LowOrderModel(1.0, 5.0, 0.2, 0.5, dt=0.01), tau_c=0.2)
+    assert pid.kp == pytest.approx(12.5 * (1 + 0.5 / 1.6), rel=1e-15)
+    assert pid.ki == pytest.approx(12.5 / 1.6, rel=1e-15)
+    assert pid.kd == pytest.approx(6.25, rel=1e-15)
+    pid = tune_pid(LowOrderModel(0.5, 0.0, 0.3, 0.1, dt=0.01, integrating=True))
+    Kc = 1 / (0.5 * 0.6)
+    assert pid.kp == pytest.approx(Kc * (1 + 0.1 / 2.4), rel=1e-15)
+    assert pid.ki == pytest.approx(Kc / 2.4, rel=1e-15)
+    assert pid.kd == pytest.approx(Kc * 0.1, rel=1e-15)
+
+
+def _foptd(k=2.0, tau=0.5, delay=10, h=0.01):
+    """ZOH sample of k e^{−θ₀s}/(τs + 1), θ₀ = delay·h: b q^{−(delay+1)}/(1 − a q⁻¹)."""
+    a = math.exp(-h / tau)
+    return TransferFunction.from_polynomials([1.0, -a], np.r_[np.zeros(delay + 1), k * (1 - a)],
+                                             dt=h)
+
+
+def test_half_rule_recovers_a_sampled_first_order_process_with_delay():
+    m = reduce_model(_foptd(), 1)
+    assert m.k == pytest.approx(2.0, rel=1e-12) and m.tau1 == pytest.approx(0.5, rel=1e-12)
+    assert m.theta == pytest.approx(10 * 0.01 + 0.005, rel=1e-12)  # θ₀ + h/2
+    assert m.tau2 == 0.0 and not m.integrating
+
+
+def test_half_rule_on_three_lags():
+    """1/((s + 1)(0.2 s + 1)(0.05 s + 1)) sampled at h = 0.05 s: first order τ₁ = 1 + 0.1,
+    θ = 0.1 + 0.05 + h/2; second order τ₁ = 1, τ₂ = 0.2 + 0.025, θ = 0.025 + h/2 (eqs 9, 10)."""
+    h = 0.05
+    den = np.polymul(np.polymul([1.0, 1.0], [0.2, 1.0]), [0.05, 1.0])
+    g = TransferFunction([1.0], den).c2d(h)
+    m1, m2 = reduce_model(g, 1), reduce_model(g, 2)
+    np.testing.assert_allclose([m1.k, m1.tau1, m1.theta], [1.0, 1.1, 0.175], rtol=1e-9)
+    np.testing.assert_allclose([m2.tau1, m2.tau2, m2.theta], [1.0, 0.225, 0.05], rtol=1e-9)
+    assert tune_pid(g).kd > 0 and tune_pid(g, order=1).kd == 0.0
+
+
+def test_simc_loop_margins_on_a_first_order_process_with_delay():
+    """τ₁ = 0.5 s ≤ 8θ: τ_I = τ₁ cancels the lag and L(s) = e^{−θs}/(2θ s): gain margin π
+    (phase −180° at ωθ = π/2) and phase margin 90° − 28.65° (gain crossover at ω = 1/(2θ)).
+    The discrete loop (θ = 10.5 samples) is within 1.5 % and 0.5° of that."""
+    g = _foptd()
+    pid = tune_pid(g)
+    assert pid.dt == 0.01 and pid.kd == 0.0
+    r = robustness(g, pid, n=0)
+    assert r.stable
+    assert r.nominal["gain_margin"] == pytest.approx(math.pi, rel=0.015)
+    assert r.nominal["phase_margin_deg"] == pytest.approx(90 - math.degrees(0.5), abs=0.5)
+
+
+def test_models_the_rules_do_not_cover_are_refused():
+    osc = TransferFunction.from_polynomials(np.poly([0.9 + 0.2j, 0.9 - 0.2j]).real, [0, 1.0, 0.5],
+                                            dt=0.01)
+    with pytest.raises(ModelError, match="complex poles"):
+        tune_pid(osc)
+    with pytest.raises(ModelError, match="outside"):
+        tune_pid(TransferFunction.from_polynomials([1.0, -1.2], [0.0, 1.0], dt=0.01))
+    with pytest.raises(ArgumentError, match="tau_c: expected a closed-loop time constant"):
+        tune_pid(LowOrderModel(1.0, 1.0, 0.1, dt=0.01), tau_c=-1.0)
+    with pytest.raises(ArgumentError, match="method: expected 'simc'"):
+        tune_pid(_foptd(), method="ziegler")
+
+
+def test_half_rule_with_zeros_is_skogestads_example():
+    """Skogestad 2003, §3's example g₀ = (−0.3s + 1)(0.08s + 1)/((2s + 1)(s + 1)(0.4s + 1)
+    (0.2s + 1)(0.05s + 1)³): the inverse-response zero adds 0.3 to θ, the zero 0.08 cancels
+    against 0.2 by rule R3 (leaving a lag 0.12); first order τ₁ = 2.5, θ = 1.47; second order
+    τ₁ = 2, τ₂ = 1.2, θ = 0.77 (the paper's figures), here sampled at h = 0.05 s, + h/2."""
+    num = np.polymul([-0.3, 1.0], [0.08, 1.0])
+    den = np.polymul(np.polymul([2.0, 1.0], [1.0, 1.0]), np.polymul([0.4, 1.0], [0.2, 1.0]))
+    den = np.polymul(den, np.polymul(np.polymul([0.05, 1.0], [0.05, 1.0]), [0.05, 1.0]))
+    g = TransferFunction(num, den).to_ss(minimal=False).c2d(0.05)
+    m1, m2 = reduce_model(g, 1), reduce_model(g, 2)
+    np.testing.assert_allclose([m1.k, m1.tau1, m1.theta], [1.0, 2.5, 1.47 + 0.025], rtol=1e-6)
+    np.testing.assert_allclose([m2.tau1, m2.tau2, m2.theta], [2.0, 1.2, 0.77 + 0.025], rtol=1e-6)
+    assert "zero T0=0.08 s cancelled (rule R3)" in m1.notes
+
+
+def test_an_integrating_model_keeps_its_integrator():
+    """0.5 q⁻²/((1 − q⁻¹)(1 − 0.8 q⁻¹)) at h = 0.01 s: k′ = B(1)/(A′(1) h) = 0.5/(0.2·0.01) =
+    250 /s, the lag τ₂ = −h/ln 0.8, θ = h + h/2; SIMC: K_c = 1/(k′(τ_c + θ)), τ_I = 4(τ_c + θ)."""
+    h = 0.01
+    g = TransferFunction.from_polynomials(np.polymul([1.0, -1.0], [1.0, -0.8]), [0.0, 0.0, 0.5],
+                                          dt=h)
+    m = reduce_model(g, 2)
+    assert m.integrating and m.k == pytest.approx(250.0, rel=1e-9)
+    assert m.tau2 == pytest.approx(-h / math.log(0.8), rel=1e-9)
+    assert m.theta == pytest.approx(1.5 * h, rel=1e-9)
+    pid = tune_pid(g)
+    Kc, ti = 1 / (250.0 * 2 * m.theta), 8 * m.theta
+    assert pid.ki == pytest.approx(Kc / ti, rel=1e-9) and pid.kd == pytest.approx(Kc * m.tau2,
+                                                                                 rel=1e-9)
