@@ -211,7 +211,7 @@ def test_emps_closed_loop_reaches_the_published_relative_error():
     model = identify(est, "ss", input="reference", output="position", order=2, validate=val)
 
     def rel(data):
-        _, y_sim = model.compare_data(data)
+        y_sim = model.compare(data).simulated
         y = np.asarray(data["position"])
         return 100 * np.linalg.norm(y - y_sim[:, 0]) / np.linalg.norm(y)
     y, r = np.asarray(val["position"]), np.asarray(val["reference"])
