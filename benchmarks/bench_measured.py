@@ -243,7 +243,7 @@ def _mimo_fit(A, B, C, D, dt, uv, yv, ue, ye):
     """gripkit's one validation fit (``linear_model.VALIDATION_FIT``) of any side's model: free
     run from the estimation record's operating point (its means), x0 by least squares."""
     from gripkit.lti import StateSpace
-    from gripkit.sysid.linear_model import LinearModel
+    from gripkit.sysid.linear.linear_model import LinearModel
 
     m = LinearModel(StateSpace(A, B, C, D, dt=dt), "peer")
     if not m.stable:
@@ -260,8 +260,8 @@ def _corpus_rows(rec) -> list[dict]:
     from nfoursid.nfoursid import NFourSID
 
     from gripkit.sysid import arx, n4sid
-    from gripkit.sysid.identify_mimo import identify_ss
-    from gripkit.sysid.linear_model import from_polynomial
+    from gripkit.sysid.linear.identify_mimo import identify_ss
+    from gripkit.sysid.linear.linear_model import from_polynomial
 
     (est, val), (ue, ye), (uv, yv), dt = corpus_data(rec)
     u0, y0 = ue - ue.mean(0), ye - ye.mean(0)
@@ -336,7 +336,7 @@ def _emps_idim_row() -> dict:
     """gripkit's IDIM-LS (``gripkit identify friction``) on the decimated EMPS record beside the
     description's published estimates (no peer library fits an inverse dynamic model)."""
     from gripkit.io import load
-    from gripkit.sysid.friction import idim_ls
+    from gripkit.sysid.rigid_body.friction import idim_ls
 
     tr = load(FIXTURES / "emps" / "emps_est.csv")
     q, f = np.asarray(tr["position"]), np.asarray(tr["force"])
