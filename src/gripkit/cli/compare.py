@@ -53,9 +53,10 @@ def compare(model: Path = ModelArg,
     data_hash = getattr(m, "data_hash", None)
     same = data_hash is not None and data_hash == file_sha256(data)
     res = {"model": str(model), "data": str(data), "structure": m.structure, "outputs": list(m.outputs),
-           "fit_percent": fit, "initial_state": getattr(m, "initial_state", "estimated"),
-           "definition": fitted.definition, "estimation_data": same,
+           "fit_percent": fit, "definition": fitted.definition, "estimation_data": same,
            "warnings": report_warnings(caught)}
+    if hasattr(m, "initial_state"):  # the linear families and NARX say how the run starts
+        res["initial_state"] = m.initial_state
     if json_out:
         emit_json(res)
         return

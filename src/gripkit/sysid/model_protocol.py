@@ -14,9 +14,11 @@ Hammerstein–Wiener, nonlinear state space, hysteresis) is an object with these
 
 The linear families (:class:`~gripkit.sysid.linear.linear_model.IdentifiedLinearModel`: state
 space, transfer function, ARX/ARMAX/OE) and NARX also give ``m.fit_definition`` (how ``compare``
-scores), ``m.predict(data, horizon=1)``, ``m.residuals(data)``; the linear ones ``m.report(data,
-out)``, ``m.to_ss()``, ``m.to_tf()``, ``m.to_control()``. Optional: ``m.initial_state``, how
-``compare`` starts the free run (``'estimated'`` when absent; ``'measured'`` for NARX), and
+scores), ``m.predict(data, horizon=1)``, ``m.residuals(data)``; the linear ones ``m.to_ss()``,
+``m.to_tf()``, ``m.to_control()`` (and their HTML report is
+:func:`gripkit.sysid.model_report.write_model_report`). Optional: ``m.initial_state``, how
+``compare`` starts the free run (``'estimated'`` for the linear models, ``'measured'`` for NARX;
+``gripkit compare --json`` states it when the model has it), and
 ``m.display_units`` / ``m.system.output_units`` for :func:`simulated_trajectory`.
 
 A model family registers its JSON schema in :data:`MODEL_FILES` (schema → module of this package

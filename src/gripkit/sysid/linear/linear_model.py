@@ -193,8 +193,9 @@ class IdentifiedLinearModel:
     arrays in deviation units (``u`` (N, m) and, where needed, ``y`` (N, p)). Frequencies are in
     rad/s (:meth:`gripkit.lti.LinearSystem.frequency_response`)."""
 
-    #: how :meth:`compare` scores a model
+    #: how :meth:`compare` scores a model, and how it starts the free run
     fit_definition = VALIDATION_FIT
+    initial_state = "estimated"
 
     @property
     def inputs(self) -> tuple[str, ...]:
