@@ -64,7 +64,7 @@ def _ss_fit(A, B, C, D, uv, yv):
     from gripkit.sysid.linear.linear_model import LinearModel
 
     m = LinearModel(StateSpace(A, B, C, D, dt=1.0), "peer")
-    return None if not m.stable else float(m.compare(uv - uv.mean(), yv - yv.mean())[0][0])
+    return None if not m.stable else float(m.compare(uv - uv.mean(), yv - yv.mean()).fit_percent[0])
 
 
 def _fit(y, yhat):
@@ -103,7 +103,6 @@ def _sysidentpy(degree: int, lag: int, recursive: bool, ue, ye):
 def run(quick: bool) -> list[dict]:
     """All rows; ``quick`` changes nothing (the record is small)."""
     from gripkit.sysid import arx, n4sid, pem
-    from gripkit.sysid.linear.linear_model import from_polynomial
 
     (ue, ye), (uv, yv) = _halves()
     u0, y0 = ue - ue.mean(), ye - ye.mean()
@@ -148,7 +147,7 @@ def run(quick: bool) -> list[dict]:
                     gripkit_accuracy=_fit_text(fit_refined), notes="the subspace model refined; free run, x0 estimated"))
 
     ours_arx = lambda: arx(u0, y0, LAGS, LAGS, 1, dt=1.0)  # noqa: E731
-    fit_arx = _ss_fit(*_abcd(from_polynomial(ours_arx())), uv, yv)
+    fit_arx = _ss_fit(*_abcd(ours_arx()), uv, yv)
     linear = _sysidentpy(1, LAGS, False, ue, ye)
     m = linear()
     rows.append(row("measured", f"linear ARX, lags {LAGS}, {DATA}", measure(ours_arx), "sysidentpy FROLS degree 1",
@@ -182,7 +181,8 @@ def _narx_row(ue, ye, uv, yv) -> dict:
     m = peer()
     return row("measured", f"polynomial NARX, degree 3, lags 2, BIC, {DATA}", measure(ours),
                "sysidentpy FROLS degree 3", measure(peer),
-               gripkit_accuracy=_fit_text(g.compare(uv, yv)) + f" ({len(g.terms)} terms)",
+               gripkit_accuracy=(_fit_text(g.compare(uv, yv).fit_percent[0])
+                                 + f" ({len(g.terms)} terms)"),
                peer_accuracy=_fit_text(_fit(yv, m.predict(X=uv[:, None], y=yv[:, None])))
                + f" ({m.final_model.shape[0]} terms)",
                notes="same model class; gripkit: FROLS + BIC + pruning of |θ|/σ < 2, fit over the "

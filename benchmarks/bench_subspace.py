@@ -70,7 +70,7 @@ def _val_fit(A, B, C, D, uv, yv):
     m = LinearModel(StateSpace(A, B, C, D, dt=1.0), "peer")
     if not m.stable:
         return None
-    return float(np.mean(m.compare(uv, yv)[0]))
+    return float(np.mean(m.compare(uv, yv).fit_percent))
 
 
 def _fit_text(fit):

@@ -8,7 +8,7 @@ Fairness notes (also written into each row):
 
 * gripkit ``arx()`` is the full user call: input checks, Gram matrix of the regressor (no Φ),
   Cholesky, covariance, loss and fit from a pass over the one-step errors. The residual array
-  itself is computed on first access to ``model.residuals`` (not in the timed call; the memory
+  itself is computed on first access to ``model.estimation_residuals`` (not in the timed call; the memory
   row times that access separately).
 * bare numpy: build Φ with ``np.column_stack`` of shifted slices and ``np.linalg.lstsq`` (LAPACK
   ``gelsd``) on exactly the same 8-column regression — no checks, no covariance, no residuals.
@@ -147,7 +147,7 @@ if what == "memory":
     cur = status("VmRSS:")
     m = arx(u, y, 4, 4, 2)
     peak = status("VmHWM:")
-    t0 = time.perf_counter(); e = m.residuals; t_res = time.perf_counter() - t0
+    t0 = time.perf_counter(); e = m.estimation_residuals; t_res = time.perf_counter() - t0
     print(json.dumps(dict(input=u.nbytes + y.nbytes, rss_before=cur, peak=peak, residuals=e.nbytes,
                           residuals_s=t_res)))
 else:
@@ -276,7 +276,7 @@ def run(quick: bool = False) -> list[dict]:
                               f"{(mem['peak'] - mem['rss_before']) / 1e6:.1f} MB = {over:.3f}× the inputs "
                               f"(peak/inputs ≤ {1 + over:.3f}×); the residual array "
                               f"({mem['residuals'] / 1e6:.0f} MB) is computed on first access to "
-                              f"model.residuals, after the call: {mem['residuals_s'] * 1e3:.0f} ms; measured in a fresh process "
+                              f"model.estimation_residuals, after the call: {mem['residuals_s'] * 1e3:.0f} ms; measured in a fresh process "
                               f"(/proc/self/status VmHWM after resetting it through /proc/self/clear_refs)",
                         extra=mem))
 

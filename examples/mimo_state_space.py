@@ -65,7 +65,8 @@ for z, c in zip(p, cov):
 # 4. the model is a file: reload, simulate and compare on the validation record
 model.save(work / "gripper.json")
 back = load_model(work / "gripper.json")
-fit, y_sim = back.compare_data(val)
+fitted = back.compare(val)
+fit, y_sim = fitted.fit_percent, fitted.simulated
 print("reloaded model, free-run fit on validation data: " + ", ".join(f"{f:.2f} %" for f in fit))
 
 # 5. the report

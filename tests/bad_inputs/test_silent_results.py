@@ -410,12 +410,12 @@ def test_model_in_milliamperes_converts_data_in_amperes():
     m = LinearModel(g, "arx")
     u, _ = arx_data(300)
     tr = Trajectory(np.arange(300) * 0.01, {"u": u}, {"u": "A"}, {"dt": 0.01})
-    np.testing.assert_allclose(m.simulate_data(tr)[:, 0],
+    np.testing.assert_allclose(m.simulate(tr)[:, 0],
                                m.simulate(1e3 * u[:, None], dt=0.01)[:, 0], rtol=1e-12, atol=1e-12)
     bad = Trajectory(np.arange(300) * 0.01, {"u": u}, {"u": "V"}, {"dt": 0.01})
     pattern = "input column 'u' is in 'V'.*the model's input 'u' is in 'mA'"
     with pytest.raises(DataError, match=pattern):
-        m.simulate_data(bad)
+        m.simulate(bad)
 
 
 def test_cli_identify_friction_checks_position_and_effort_dimensions(cli, tmp_path):

@@ -53,7 +53,7 @@ def test_model_file_keeps_the_file_units_and_simulate_writes_them(record, tmp_pa
     assert [(d["unit"], d["display_unit"]) for d in doc["outputs"]] == [("N", "mN")]
     m = load_model(model)
     assert m.display_units == {"current": "mA", "force": "mN"}
-    si = m.simulate_data(load(record))[:, 0]  # the model computes in SI: newtons
+    si = m.simulate(load(record))[:, 0]  # the model computes in SI: newtons
     sim = tmp_path / "sim.csv"
     run(capsys, "simulate", model, "--data", record, "--out", sim)
     assert sim.read_text().splitlines()[0] == "t [s],force [mN]"
@@ -77,7 +77,7 @@ def test_old_model_file_without_display_units_simulates_in_si(record, tmp_path, 
     sim = tmp_path / "sim.csv"
     run(capsys, "simulate", old, "--data", record, "--out", sim)
     assert sim.read_text().splitlines()[0] == "t [s],force [N]"
-    si = load_model(model).simulate_data(load(record))[:, 0]
+    si = load_model(model).simulate(load(record))[:, 0]
     np.testing.assert_allclose(np.loadtxt(sim, delimiter=",", skiprows=1)[:, 1], si,
                                rtol=1e-14, atol=0)
 

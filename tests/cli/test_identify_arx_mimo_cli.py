@@ -97,7 +97,7 @@ def test_mimo_arx_json_per_output_in_output_order(cli, files):
     # the model file reloads and gives the same validation fit per output
     m = load_model(model_file)
     assert m.outputs == ("d", "c") and m.data_file == "est.csv"
-    fit, _ = m.compare_data(_record(3000, 2))
+    fit = m.compare(_record(3000, 2)).fit_percent
     assert np.allclose(fit, d["validation"]["fit_percent"], atol=0.5)
 
 

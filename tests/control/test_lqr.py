@@ -11,7 +11,6 @@ from scipy.signal import lfilter
 from gripkit.control import lqr
 from gripkit.errors import ModelError
 from gripkit.sysid import arx, n4sid
-from gripkit.sysid.linear.linear_model import from_polynomial
 
 
 def _identified():
@@ -23,7 +22,7 @@ def _identified():
     y = np.column_stack([y1, y2]) + 0.01 * rng.standard_normal((1500, 2))
     ss_model = n4sid(u, y, 4, dt=0.01)
     y_arx = y1 + 0.01 * rng.standard_normal(1500)
-    arx_model = from_polynomial(arx(u[:, 0], y_arx, 2, 2, 1, dt=0.01))
+    arx_model = arx(u[:, 0], y_arx, 2, 2, 1, dt=0.01)
     return ss_model, arx_model
 
 
@@ -39,7 +38,7 @@ def test_lqr_equals_control_dlqr(which):
     import control  # a dev dependency: the cross-check fails, never skips, without it
 
     model = MODELS[which]
-    ss = model.discrete(model.dt)
+    ss = model.to_ss(model.dt)
     n, m = ss.B.shape
     Q, R = np.diag(np.arange(1.0, n + 1)), 0.5 * np.eye(m)
     K, S, E = lqr(model, Q, R)

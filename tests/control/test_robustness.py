@@ -74,7 +74,7 @@ def test_each_draws_margins_are_python_controls():
     r = robustness(m, pid, n=40, seed=1)
     assert r.probability_stable == 1.0
     num, den, _ = controller_transfer_function(pid)
-    for i, gi in enumerate(m.lti.sample(40, seed=1)[:5]):
+    for i, gi in enumerate(m.system.sample(40, seed=1)[:5]):
         L = control.tf(num, den, 0.01) * control.tf(gi.num[0, 0], gi.den[0, 0], 0.01)
         gm, pm = control.stability_margins(L, method="poly")[:2]
         assert r.gain_margin_db[i] == pytest.approx(20 * math.log10(gm), rel=1e-8)

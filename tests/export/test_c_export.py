@@ -1,6 +1,6 @@
 """``gripkit export c`` (issue 27): the generated C step, compiled with
 ``gcc -std=c99 -O2 -Wall -Wextra -Werror`` and run through the generated harness on a recorded
-input, reproduces ``LinearModel.simulate_data`` (from rest, offsets applied, SI) to 1e-12
+input, reproduces ``LinearModel.simulate`` of a trajectory (from rest, offsets applied, SI) to 1e-12
 relative in double precision, and stays within :func:`gripkit.export.float32_bound_on` with
 ``--float32``. Models: a 2×2 order-4 state space with offsets, and an ARX model identified by the
 CLI from a record written in mA and mN (display units; the C step computes in SI)."""
@@ -80,11 +80,11 @@ def build_and_run(tmp_path, files: dict, name: str, u: np.ndarray) -> np.ndarray
 
 
 @needs_gcc
-def test_state_space_step_reproduces_simulate_data(tmp_path):
+def test_state_space_step_reproduces_simulate(tmp_path):
     m, tr = ss_model(), record()
     u = np.column_stack([tr["current"], tr["voltage"]])
     y_c = build_and_run(tmp_path, c_sources(m, "grip"), "grip", u)
-    y_py = m.simulate_data(tr)
+    y_py = m.simulate(tr)
     assert y_c.shape == y_py.shape == (600, 2)
     np.testing.assert_allclose(y_c, y_py, rtol=1e-12, atol=1e-12 * np.max(np.abs(y_py)))
     assert np.max(np.abs(y_py[:, 0] - 1.5)) > 0.5  # the run is not near the offset alone
@@ -95,7 +95,7 @@ def test_float32_step_stays_within_its_bound(tmp_path):
     m, tr = ss_model(), record()
     u = np.column_stack([tr["current"], tr["voltage"]])
     y_c = build_and_run(tmp_path, c_sources(m, "grip32", float32=True), "grip32", u)
-    err = np.max(np.abs(y_c - m.simulate_data(tr)), axis=0)
+    err = np.max(np.abs(y_c - m.simulate(tr)), axis=0)
     bound = float32_bound_on(m, u)
     assert np.all(err <= bound)
     assert np.all(err > 1e-9)  # single precision: the comparison sees its rounding
@@ -120,14 +120,15 @@ def test_arx_from_the_cli_in_display_units(tmp_path, capsys):
     res = json.loads(capsys.readouterr().out)
     assert res["units"] == {"inputs": ["A"], "outputs": ["N"]} and res["warnings"] == []
     m = load_model(model)
-    assert m.display_units == {"current": "mA", "force": "mN"} and m.u_offset[0] != 0.0
+    assert m.display_units == {"current": "mA", "force": "mN"}
+    assert m.u_offset != 0.0  # an ARX model (a PolynomialModel): one offset
     files = {p.name: p.read_text() for p in out.iterdir()}
     assert sorted(files) == ["gk_arx.c", "gk_arx.h"]
     assert "#define GK_ARX_NU 1" in files["gk_arx.h"] and "#define GK_ARX_NX 2" in files["gk_arx.h"]
     y_c = build_and_run(tmp_path, files, "gk_arx", u[:, None])
     from gripkit.io import load
 
-    y_py = m.simulate_data(load(data))
+    y_py = m.simulate(load(data))
     np.testing.assert_allclose(y_c, y_py, rtol=1e-12, atol=1e-12 * np.max(np.abs(y_py)))
     np.testing.assert_allclose(y_py[100:, 0], y[100:], rtol=0.02)  # N, not mN (after the start)
 
@@ -193,7 +194,7 @@ def test_the_header_links_into_cpp(tmp_path):
 @needs_gcc
 def test_a_continuous_model_needs_dt_and_is_sampled_with_a_zero_order_hold(tmp_path):
     """A mass-spring-damper (ω = 20 rad/s, ζ = 0.3) in continuous time: refused without a
-    sample time; with dt = 0.01 s the step equals simulate_data on a record sampled at 100 Hz."""
+    sample time; with dt = 0.01 s the step equals model.simulate on a record sampled at 100 Hz."""
     sys = StateSpace([[0.0, 1.0], [-400.0, -12.0]], [[0.0], [1.0]], [[400.0, 0.0]], [[0.0]],
                      inputs=["current"], outputs=["force"])
     m = LinearModel(sys, "tfest", u_offset=(0.2,), y_offset=(0.0,))
@@ -202,5 +203,5 @@ def test_a_continuous_model_needs_dt_and_is_sampled_with_a_zero_order_hold(tmp_p
     rng = np.random.default_rng(5)
     tr = Trajectory(np.arange(300) * 0.01, {"current": 0.2 + rng.standard_normal(300)})
     y_c = build_and_run(tmp_path, c_sources(m, "msd", dt=0.01), "msd", tr["current"][:, None])
-    y_py = m.simulate_data(tr)
+    y_py = m.simulate(tr)
     np.testing.assert_allclose(y_c, y_py, rtol=1e-12, atol=1e-12 * np.max(np.abs(y_py)))

@@ -1,6 +1,6 @@
-"""The three older linear types are gripkit.lti systems or views of one (issue 12):
-``sim.linear.StateSpace`` is an ``lti.StateSpace``; ``sysid.PolynomialModel.lti`` and
-``control.DiscretePlant.lti`` are ``lti.TransferFunction``s that compute their poles, zeros,
+"""The older linear types are gripkit.lti systems or views of one (issue 12; issue 23 removed
+``sim.linear.StateSpace``: the simulators use ``lti.StateSpace``): ``sysid.PolynomialModel.system``
+and ``control.DiscretePlant.lti`` are ``lti.TransferFunction``s that compute their poles, zeros,
 DC gain, responses and realisations. References come from scipy.signal on the seed models.
 
 Tolerances: scipy and gripkit compute each quantity by backward-stable routes that differ only in
@@ -14,11 +14,9 @@ from scipy import signal
 
 from gripkit import lti
 from gripkit.control import DiscretePlant, as_plant, design_rst
-from gripkit.errors import ModelError, SimulationError
-from gripkit.sim import StateSpace as SimStateSpace
+from gripkit.errors import ModelError
 from gripkit.sim.linear import c2d_zoh, simulate_discrete
 from gripkit.sysid import PolynomialModel
-from gripkit.sysid.linear.linear_model import from_polynomial
 
 # 000_8f66dcc7ab06470c.txt, Table II: ARX [2 2 2], fs = 200 Hz; σ from Table III
 A222 = [1.0, -1.8732, 0.8996]
@@ -39,9 +37,9 @@ def _zpk_zinv(A, B):
     return np.sort_complex(z[z != 0]), np.sort_complex(p[p != 0])
 
 
-# ------------------------------------------------------------------ sim.linear.StateSpace
-def test_sim_statespace_is_an_lti_statespace():
-    old = SimStateSpace(A_SENSOR, B_SENSOR, C_SENSOR, None, None, ("F",), ("y",), ("N",), ("m",))
+# ------------------------------------------------------------------ lti.StateSpace in simulation
+def test_sensor_state_space_matches_scipy():
+    old = lti.StateSpace(A_SENSOR, B_SENSOR, C_SENSOR, None, None, ("F",), ("y",), ("N",), ("m",))
     assert isinstance(old, lti.StateSpace) and lti.as_system(old) is old
     ref = signal.StateSpace(np.array(A_SENSOR), np.array(B_SENSOR), np.array(C_SENSOR), np.zeros((1, 1)))
     np.testing.assert_allclose(np.sort_complex(old.poles()), np.sort_complex(ref.poles), rtol=1e-12)
@@ -49,9 +47,9 @@ def test_sim_statespace_is_an_lti_statespace():
     np.testing.assert_allclose(old.dc_gain(), [[1 / 128]], rtol=1e-12)      # 1/k_s
     f = np.array([10.0, 1e3, 8.5e3])
     _, H = signal.freqresp(ref, 2 * np.pi * f)
-    np.testing.assert_allclose(old.freqresp(f)[:, 0, 0], H, rtol=1e-12)
-    d = old.discretize(5e-5)
-    assert type(d) is SimStateSpace and d.dt == 5e-5 and d.inputs == ("F",) and d.output_units == ("m",)
+    np.testing.assert_allclose(old.frequency_response(2 * np.pi * f)[:, 0, 0], H, rtol=1e-12)
+    d = old.c2d(5e-5)
+    assert type(d) is lti.StateSpace and d.dt == 5e-5 and d.inputs == ("F",) and d.output_units == ("m",)
     Ad, Bd, _, _, _ = signal.cont2discrete((ref.A, ref.B, ref.C, ref.D), 5e-5, method="zoh")
     np.testing.assert_allclose(d.A, Ad, rtol=1e-12, atol=1e-12 * np.abs(Ad).max())
     np.testing.assert_allclose(d.B, Bd, rtol=1e-12)
@@ -80,11 +78,11 @@ def test_sim_array_kernels_delegate_to_lti():
     np.testing.assert_allclose(y1[:, 0], yref[:, 0], rtol=1e-9, atol=1e-9 * np.abs(yref).max())
 
 
-def test_sim_statespace_errors_unchanged():
-    with pytest.raises(SimulationError, match="discrete"):
-        SimStateSpace([[-1.0]], [[1.0]], [[1.0]], None).simulate(np.ones(3))
+def test_state_space_errors():
+    with pytest.raises(ModelError, match="sample time"):
+        lti.StateSpace([[-1.0]], [[1.0]], [[1.0]], None).simulate(np.ones(3))
     with pytest.raises(ModelError, match="already discrete"):
-        SimStateSpace([[0.5]], [[1.0]], [[1.0]], None, 0.1).discretize(0.1)
+        lti.StateSpace([[0.5]], [[1.0]], [[1.0]], None, 0.1).c2d(0.1)
     with pytest.raises(ModelError, match="dt"):
         c2d_zoh(np.eye(1), np.ones((1, 1)), 0.0)
 
@@ -93,12 +91,12 @@ def test_sim_statespace_errors_unchanged():
 def test_polynomial_model_delegates_to_its_transfer_function():
     m = PolynomialModel.from_coefficients(A222, B222, dt=DT, std=STD222, input_name="i", output_name="F",
                                           input_unit="A", output_unit="N")
-    g = m.lti
-    assert isinstance(g, lti.TransferFunction) and m.to_lti() is g and lti.as_system(m) is g
+    g = m.system
+    assert isinstance(g, lti.TransferFunction) and m.to_tf() is g and lti.as_system(m) is g
     assert (g.dt, g.inputs, g.outputs, g.input_units, g.output_units) == (DT, ("i",), ("F",), ("A",), ("N",))
     assert g.uncertainty.names == m.parameter_names == ("a1", "a2", "b2", "b3")
     np.testing.assert_array_equal(g.uncertainty.covariance, m.covariance)
-    assert from_polynomial(m).system is g
+    assert m.linear_record().system is g
     z_ref, p_ref = _zpk_zinv(A222, B222)
     np.testing.assert_allclose(np.sort_complex(m.poles()), p_ref, rtol=1e-12)
     np.testing.assert_allclose(m.zeros(), z_ref, rtol=1e-12)                  # 1.1672, §V-F
@@ -108,9 +106,9 @@ def test_polynomial_model_delegates_to_its_transfer_function():
     np.testing.assert_allclose(m.step(60), signal.lfilter(B222, A222, np.ones(60)), rtol=1e-12, atol=1e-14)
     pulse = np.r_[1.0, np.zeros(59)]
     np.testing.assert_allclose(m.impulse(60), signal.lfilter(B222, A222, pulse), rtol=1e-12, atol=1e-14)
-    f, H = m.frequency_response(n=64)
+    w, H = m.frequency_response(n=64)                                          # rad/s
     f_ref, H_ref = signal.freqz(B222, A222, worN=64, fs=1 / DT)
-    np.testing.assert_allclose(f, f_ref, rtol=1e-15)
+    np.testing.assert_allclose(w, 2 * np.pi * f_ref, rtol=1e-15)
     np.testing.assert_allclose(H, H_ref, rtol=1e-11)
     u = np.cos(np.arange(300) * 0.07)
     np.testing.assert_allclose(m.simulate(u), signal.lfilter(B222, A222, u), rtol=1e-12, atol=1e-14)
@@ -118,7 +116,7 @@ def test_polynomial_model_delegates_to_its_transfer_function():
     zi = signal.lfiltic(B222, A222, yp[::-1], up[::-1])
     np.testing.assert_allclose(m.simulate(u, initial="given", y_past=yp, u_past=up),
                                signal.lfilter(B222, A222, u, zi=zi)[0], rtol=1e-12, atol=1e-14)
-    for X, Y in zip(m.to_statespace(), signal.tf2ss(B222, A222 + [0.0])):
+    for X, Y in zip(m.to_ss(form="controllable")._arrays(), signal.tf2ss(B222, A222 + [0.0])):
         np.testing.assert_array_equal(X, Y)                                    # scipy's realisation
     np.testing.assert_array_equal(m.to_scipy().den, signal.dlti(B222, A222 + [0.0], dt=DT).den)
 
@@ -128,7 +126,7 @@ def test_polynomial_model_layout_roots_and_integrator():
     (ARX [2 1 1]: B/A = b1 z/(z² + a1 z + a2) has a zero at z = 0 in positive powers); an integrator's
     DC gain is ±inf."""
     m = PolynomialModel.from_coefficients([1.0, -1.5, 0.7], [0.0, 2.0], dt=0.1)
-    assert m.zeros().size == 0 and m.lti.zeros().tolist() == [0.0]
+    assert m.zeros().size == 0 and m.system.zeros().tolist() == [0.0]
     np.testing.assert_allclose(np.sort_complex(m.poles()), _zpk_zinv([1.0, -1.5, 0.7], [0.0, 2.0])[1], rtol=1e-12)
     assert m.dc_gain == pytest.approx(2.0 / 0.2, rel=1e-12)
     integ = PolynomialModel.from_coefficients([1.0, -1.0], [0.0, 0.5], dt=0.1)
@@ -139,13 +137,13 @@ def test_polynomial_model_armax_oe_covariances():
     # ARMAX: the covariance over a1 b1 c1 keeps its order; c1 does not move B/A (zero tangent)
     armax = PolynomialModel.from_coefficients([1.0, -0.5], [0.0, 1.0], C=[1.0, 0.3], dt=0.1,
                                               std={"A": [0, 0.01], "B": [0, 0.02], "C": [0, 0.05]})
-    g = armax.lti
+    g = armax.system
     assert g.uncertainty.names == ("a1", "b1", "c1") == armax.parameter_names
     assert np.all(g.uncertainty.tangents[0][2] == 0) and np.all(g.uncertainty.tangents[1][2] == 0)
     # OE: B/F with the f's as the denominator's parameters: ∂p/∂f1 = −1
     oe = PolynomialModel.from_coefficients([1.0], [0.0, 1.0], F=[1.0, -0.7], dt=0.1,
                                            std={"B": [0, 0.02], "F": [0, 0.01]})
-    h = oe.lti
+    h = oe.system
     assert h.uncertainty.names == ("b1", "f1") and h.den_zinv().tolist() == [1.0, -0.7]
     np.testing.assert_allclose(oe.poles(), [0.7], rtol=1e-15)
     np.testing.assert_allclose(h.pole_covariance()[1][0, 0, 0], 0.01 ** 2, rtol=1e-12)
@@ -192,7 +190,7 @@ def test_discrete_plant_from_a_zoh_state_space_matches_scipy():
     """A ZOH-discretised second-order plant read as a q⁻¹ plant: scipy's cont2discrete + ss2tf."""
     wn, z = 30.0, 0.4
     A, B, C = np.array([[0, 1], [-wn ** 2, -2 * z * wn]]), np.array([[0], [wn ** 2]]), np.array([[1.0, 0]])
-    p = DiscretePlant.from_model(SimStateSpace(A, B, C, None).discretize(DT))
+    p = DiscretePlant.from_model(lti.StateSpace(A, B, C, None).c2d(DT))
     Ad, Bd, Cd, Dd, _ = signal.cont2discrete((A, B, C, np.zeros((1, 1))), DT, method="zoh")
     num, den = signal.ss2tf(Ad, Bd, Cd, Dd)
     np.testing.assert_allclose(p.A, den, rtol=1e-12)

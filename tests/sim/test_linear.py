@@ -1,4 +1,5 @@
-"""Linear state space: exact ZOH against scipy, discrete simulation, DC gain."""
+"""Linear state space in simulation (gripkit.lti.StateSpace and the kernels' c2d_zoh): exact ZOH
+against scipy, discrete simulation, DC gain."""
 
 import numpy as np
 import pytest
@@ -6,8 +7,9 @@ from hypothesis import given
 from hypothesis import strategies as st
 from scipy import signal
 
-from gripkit.errors import ModelError, SimulationError
-from gripkit.sim import StateSpace, c2d_zoh
+from gripkit.errors import ModelError
+from gripkit.lti import StateSpace
+from gripkit.sim import c2d_zoh
 
 
 def test_zoh_matches_scipy_cont2discrete():
@@ -24,13 +26,13 @@ def test_discrete_step_settles_at_dc_gain(wn, zeta, dt):
     """Property: the discretised system's DC gain equals the continuous one (ZOH is exact at DC)."""
     A = np.array([[0.0, 1.0], [-wn**2, -2 * zeta * wn]])
     sys = StateSpace(A, [[0.0], [wn**2]], [[1.0, 0.0]], [[0.0]])
-    d = sys.discretize(dt)
+    d = sys.c2d(dt)
     np.testing.assert_allclose(d.dc_gain(), sys.dc_gain(), rtol=1e-8)
     assert d.is_stable() and sys.is_stable()
 
 
 def test_simulate_matches_scipy_dlsim():
-    sys = StateSpace([[0.0, 1.0], [-4.0, -0.4]], [[0.0], [1.0]], [[1.0, 0.0]], [[0.0]]).discretize(0.05)
+    sys = StateSpace([[0.0, 1.0], [-4.0, -0.4]], [[0.0], [1.0]], [[1.0, 0.0]], [[0.0]]).c2d(0.05)
     u = np.sin(np.arange(300) * 0.1)
     _, yref, _ = signal.dlsim(sys.to_scipy(), u)
     # Both run the same recursion in another order; a rounding made at step k reaches y[n] through
@@ -44,11 +46,11 @@ def test_simulate_matches_scipy_dlsim():
     np.testing.assert_allclose(sys.simulate(u)[:, 0], yref[:, 0], rtol=0, atol=tol)
 
 
-def test_freqresp_matches_python_control():
+def test_frequency_response_matches_python_control():
     import control  # a dev dependency: the cross-check fails, never skips, without it
     sys = StateSpace([[0.0, 1.0], [-4.0, -0.4]], [[0.0], [1.0]], [[1.0, 0.0]], [[0.0]])
     f = np.array([0.1, 0.3, 1.0])
-    h = sys.freqresp(f)[:, 0, 0]
+    h = sys.frequency_response(2 * np.pi * f)[:, 0, 0]  # rad/s
     mag, phase, _ = control.frequency_response(sys.to_control(), 2 * np.pi * f)
     np.testing.assert_allclose(np.abs(h), np.squeeze(mag), rtol=1e-10)
 
@@ -56,7 +58,7 @@ def test_freqresp_matches_python_control():
 def test_errors():
     with pytest.raises(ModelError, match="square"):
         StateSpace(np.ones((2, 3)), np.ones((2, 1)), np.ones((1, 2)), None)
-    with pytest.raises(SimulationError, match="discrete"):
+    with pytest.raises(ModelError, match="sample time"):
         StateSpace([[-1.0]], [[1.0]], [[1.0]], [[0.0]]).simulate(np.ones(3))
     with pytest.raises(ModelError, match="infinite"):
         StateSpace([[0.0]], [[1.0]], [[1.0]], [[0.0]]).dc_gain()

@@ -62,7 +62,7 @@ def test_loss_fit_aic_fpe_definitions():
     FPE = V(1 + p/N)/(1 − p/N) with V = Σe²/N (MATLAB's definitions)."""
     u, y = simulate_arx(800, noise=1.0, seed=5)
     m = arx(u, y, 2, 2, 2)
-    e = m.residuals
+    e = m.estimation_residuals
     n = e.size
     assert n == 800 - 3 == m.n_used and m.n_samples == 800
     assert m.loss == pytest.approx(0.5 * np.mean(e ** 2), rel=1e-12)
@@ -194,12 +194,12 @@ def test_large_fit_computes_residuals_on_demand_from_its_record():
         assert m.info["method"].startswith("least squares (normal equations")
         assert m.stored_residuals is None  # nothing stored by the fit itself
         e_ref, see, _ = arx_residuals(u, y * scale, m.theta, 2, 2, 2, 3)
-        e = m.residuals
+        e = m.estimation_residuals
         assert m.stored_residuals is e  # computed once, then kept
         assert not e.flags.writeable and e.size == m.n_used == 100_000 - 3
         np.testing.assert_allclose(e, e_ref, rtol=0, atol=1e-12 * scale)
         assert m.loss == pytest.approx(0.5 * see / e.size, rel=1e-12)
-        assert m.replace(output_name="y2").residuals is not None
+        assert m.replace(output_name="y2").estimation_residuals is not None
 
 
 def test_pickled_model_carries_its_residuals_not_its_record():
@@ -213,13 +213,13 @@ def test_pickled_model_carries_its_residuals_not_its_record():
     assert len(data) < 1.1 * 8 * m.n_used  # the residuals, not u and y (16 × N bytes)
     back = pickle.loads(data)
     assert back.estimation_data is None
-    np.testing.assert_array_equal(back.residuals, m.residuals)
+    np.testing.assert_array_equal(back.estimation_residuals, m.estimation_residuals)
     np.testing.assert_array_equal(back.theta, m.theta)
     assert back.loss == m.loss and back.covariance.tolist() == m.covariance.tolist()
 
 
 def test_residuals_refuse_a_record_changed_after_the_fit():
-    """Changing the estimation record in place before the first access to ``residuals`` would give
+    """Changing the estimation record in place before the first access to ``estimation_residuals`` would give
     another record's errors: a DataError names the cause instead of a silent wrong answer."""
     from gripkit.errors import DataError
 
@@ -227,7 +227,7 @@ def test_residuals_refuse_a_record_changed_after_the_fit():
     m = arx(u, y, 2, 2, 2)
     y[5000:6000] += 3.0
     with pytest.raises(DataError, match="changed in place after the fit"):
-        m.residuals
+        m.estimation_residuals
 
 
 def test_large_fit_allocates_no_record_sized_array():

@@ -58,7 +58,7 @@ def test_equals_least_squares_of_the_stacked_rows_no_row_crosses_a_seam():
     cov = m.noise_variance * np.linalg.inv(X[:, :4].T @ X[:, :4])
     np.testing.assert_allclose(m.covariance, cov, rtol=1e-8)
     assert [r["n_used"] for r in m.info["records"]] == [697, 1297, 37]
-    assert m.info["record_starts"] == [0, 697, 1994] and m.residuals.size == M
+    assert m.info["record_starts"] == [0, 697, 1994] and m.estimation_residuals.size == M
 
 
 def test_summed_normal_equations_agree_with_qr(monkeypatch):

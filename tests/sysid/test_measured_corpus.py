@@ -40,7 +40,6 @@ from gripkit.errors import StabilityWarning
 from gripkit.io import load, save
 from gripkit.signals import split
 from gripkit.sysid import identify, n4sid
-from gripkit.sysid.linear.linear_model import validation_fit
 
 FIXTURES = Path(__file__).resolve().parents[1] / "fixtures"
 MARGIN = 2.0  # percentage points the mean fit over the outputs may fall below the reference's
@@ -166,7 +165,7 @@ def test_identify_validate_compare_report(name, capsys, tmp_path):
 
 @pytest.mark.parametrize("name", RECORDS)
 def test_python_identify_gives_the_same_validation_fit(name):
-    """`identify(est, "ss", …, validate=val)` and `validation_fit(model, val)`: the same floor
+    """`identify(est, "ss", …, validate=val)` and `model.compare(val)`: the same floor
     holds from Python; ARX [4 4 1] of the one-input records at least sysidentpy's linear FROLS
     (same lags) less MARGIN."""
     rec = RECORDS[name]
@@ -176,12 +175,12 @@ def test_python_identify_gives_the_same_validation_fit(name):
         warnings.simplefilter("ignore")
         model = identify(est, "ss", input=ins, output=outs, order=rec.order, validate=val,
                          form="oe")
-    _assert_floor(name, validation_fit(model, val), rec.floor)
+    _assert_floor(name, model.compare(val).fit_percent, rec.floor)
     if name in ARX_PEER:
         with warnings.catch_warnings():  # the tanks' lag-4 regressor is ill-conditioned: warned
             warnings.simplefilter("ignore")
             arx = identify(est, "arx", input=ins[0], output=outs[0], na=4, nb=4, nk=1)
-        assert validation_fit(arx, val)[0] >= ARX_PEER[name] - MARGIN
+        assert arx.compare(val).fit_percent[0] >= ARX_PEER[name] - MARGIN
 
 
 #: sysidentpy FROLS with a degree-1 polynomial basis, lags 4 (the same model class as ARX
@@ -199,7 +198,7 @@ def test_default_form_slow(name):
         warnings.simplefilter("ignore")
         model = identify(est, "ss", input=list(rec.inputs), output=list(rec.outputs),
                          order=rec.order, validate=val)
-    _assert_floor(name, validation_fit(model, val), rec.floor)
+    _assert_floor(name, model.compare(val).fit_percent, rec.floor)
 
 
 def test_emps_closed_loop_reaches_the_published_relative_error():
@@ -212,7 +211,7 @@ def test_emps_closed_loop_reaches_the_published_relative_error():
     model = identify(est, "ss", input="reference", output="position", order=2, validate=val)
 
     def rel(data):
-        _, y_sim = model.compare_data(data)
+        y_sim = model.compare(data).simulated
         y = np.asarray(data["position"])
         return 100 * np.linalg.norm(y - y_sim[:, 0]) / np.linalg.norm(y)
     y, r = np.asarray(val["position"]), np.asarray(val["reference"])

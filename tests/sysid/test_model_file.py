@@ -38,7 +38,7 @@ def test_round_trip_exact(model, tmp_path):
     assert back.u_offset == (1.0, 0.0) and back.y_offset == (3.0, -1.0) and back.dt == 0.01
     assert back.structure == "pem-innovation" and back.data_file == "run.csv" and back.data_hash == "ab" * 32
     doc = json.loads(p.read_text())
-    assert doc["schema"] == "gripkit.linear-model" and doc["schema_version"] == 1 and "gripkit_version" in doc
+    assert doc["schema"] == "gripkit.linear-model" and doc["schema_version"] == 2 and "gripkit_version" in doc
 
 
 def test_tfest_model_round_trip(tmp_path):
@@ -101,17 +101,18 @@ def test_simulate_and_compare_data_by_name(model):
     g = two_by_two()
     u, y = oe_data(g, 1500, 0.0, seed=8)
     tr = Trajectory.uniform(dt=0.01, b=u[:, 1], a=u[:, 0] + 1.0, c=y[:, 0] + 3.0, d=y[:, 1] - 1.0)
-    fit, ys = model.compare_data(tr)
-    assert min(fit) > 99.0
+    assert min(model.compare(tr).fit_percent) > 99.0
     with warnings.catch_warnings():
         warnings.simplefilter("error")
-        sim = model.simulate_data(tr)
+        sim = model.simulate(tr)
     assert np.allclose(sim, model.simulate(u, dt=0.01) + [3.0, -1.0])
 
 
 def test_polynomial_model_saves_as_model_file(tmp_path, arx_data):
-    """An ARX [2 2 2] (Table II of 000_8f66dcc7ab06470c.txt) saves through the same file format: the
-    reloaded transfer function has the same poles, and the σ of its coefficients are the ARX σ."""
+    """An ARX [2 2 2] (Table II of 000_8f66dcc7ab06470c.txt) saves through the same file format and
+    comes back as a PolynomialModel: the reloaded transfer function has the same poles, and the σ of
+    its coefficients are the ARX σ."""
+    from gripkit.sysid import PolynomialModel
     from gripkit.sysid import arx
 
     u, y = arx_data(2000, noise=1.0, seed=0)
@@ -120,7 +121,7 @@ def test_polynomial_model_saves_as_model_file(tmp_path, arx_data):
     pm.save(tmp_path / "arx.json")
     m = load_model(tmp_path / "arx.json")
     assert m.structure == "arx" and m.inputs == ("current",) and m.system.output_units == ("N",)
-    assert m.u_offset == (0.85,) and m.dt == 0.005
+    assert isinstance(m, PolynomialModel) and m.u_offset == 0.85 and m.dt == 0.005
     p = m.system.poles()
     p = p[np.abs(p) > 1e-9]                       # the delay's poles at z = 0 are states of B/(A F)
     assert np.allclose(np.sort_complex(p), np.sort_complex(pm.poles()), atol=1e-12)
@@ -128,20 +129,20 @@ def test_polynomial_model_saves_as_model_file(tmp_path, arx_data):
 
 
 def test_simulate_trajectory_is_what_gripkit_simulate_writes(tmp_path):
-    """Issue 23 ("the library, not the CLI, simulates a model file"): LinearModel.simulate_trajectory
-    gives the SI outputs of simulate_data on the record's time base, with the model's display
+    """Issue 23 ("the library, not the CLI, simulates a model file"): sysid.simulated_trajectory
+    gives the SI outputs of model.simulate(data) on the record's time base, with the model's display
     units in meta, and io.save(units="display") writes them as the estimation file did."""
     from gripkit import Trajectory
     from gripkit.io import load, save
     from gripkit.lti import StateSpace
-    from gripkit.sysid import LinearModel
+    from gripkit.sysid import LinearModel, simulated_trajectory
 
     ss = StateSpace([[0.5]], [[1.0]], [[2.0]], [[0.0]], dt=0.1, inputs="i", outputs="f",
                     input_units="A", output_units="N")
     m = LinearModel(ss, "n4sid", display_units={"f": "mN"})
     tr = Trajectory.uniform(dt=0.1, i=np.sin(np.arange(50) * 0.3), units={"i": "A"})
-    sim = m.simulate_trajectory(tr)
-    np.testing.assert_array_equal(sim["f"], m.simulate_data(tr)[:, 0])
+    sim = simulated_trajectory(m, tr)
+    np.testing.assert_array_equal(sim["f"], m.simulate(tr)[:, 0])
     assert sim.unit("f") == "N" and sim.meta["display_units"] == {"f": "mN"}
     save(sim, tmp_path / "sim.csv", units="display")
     assert (tmp_path / "sim.csv").read_text().splitlines()[0].endswith("f [mN]")

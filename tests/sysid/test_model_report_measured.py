@@ -103,7 +103,7 @@ def test_measured_residuals_from_estimated_x0(measured):
     free-run fit (about half explained, README)."""
     _, m, _, val = measured
     u, y = _deviations(m, val)
-    free = m.compare(u, y, dt=1.0)[0]
+    free = m.compare(u, y, dt=1.0).fit_percent
     res = residual_analysis(m, u, y, 1.0, free)
     assert res.kind == "one-step" and abs(res.predictor_pole) < 0.95
     assert res.fit_percent[0] >= free[0] - 1.0 and free[0] >= 45.0
@@ -123,7 +123,7 @@ def test_measured_record_report(capsys, measured):
     html = unescape((d / "rep" / "index.html").read_text())
     assert "initial state estimated by least squares" in html
     u, y = _deviations(m, whole)
-    free = m.compare(u, y, dt=1.0)[0]
+    free = m.compare(u, y, dt=1.0).fit_percent
     res = residual_analysis(m, u, y, 1.0, free)
     assert res.fit_percent[0] >= free[0] - 1.0
     assert f"<td>{free[0]:.4g}</td><td>{res.fit_percent[0]:.4g}</td>" in html.replace(" ", "")
@@ -183,7 +183,7 @@ def test_predictor_pole_near_minus_one_from_estimated_x0():
     x0, e = predictor_x0(A, B, C, D, K, U, Y)
     np.testing.assert_allclose(x0, X0, atol=0.2)
     m = _near_unit_model()
-    free = m.compare(U, Y)[0]
+    free = m.compare(U, Y).fit_percent
     slow = r"pole at -0\.99994 .*decays to 1 % only after 7\.675e\+04 samples"
     with pytest.warns(AccuracyWarning, match=slow):
         res = residual_analysis(m, U, Y, 0.01, free)
@@ -216,7 +216,7 @@ def test_unstable_predictor_falls_back_to_output_errors():
     with pytest.warns(AccuracyWarning, match="is unstable .*free-run output errors"):
         res = residual_analysis(m, u[:, None], y[:, None], 0.01)
     assert res.kind == "output error" and res.notes[0].startswith("Free-run output errors")
-    assert res.fit_percent[0] == pytest.approx(m.compare(u[:, None], y[:, None])[0][0], abs=1e-6)
+    assert res.fit_percent[0] == pytest.approx(m.compare(u[:, None], y[:, None]).fit_percent[0], abs=1e-6)
 
 
 def test_lines_without_input_power_are_not_drawn():

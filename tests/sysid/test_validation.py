@@ -93,5 +93,5 @@ def test_arx_prediction_equals_regression():
     u, y = simulate_arx(500, noise=1.0, seed=35)
     m = arx(u, y, 2, 2, 2)
     yp = m.predict(u, y)
-    np.testing.assert_allclose(y[3:] - yp[3:], m.residuals, atol=1e-9)
+    np.testing.assert_allclose(y[3:] - yp[3:], m.estimation_residuals, atol=1e-9)
     np.testing.assert_array_equal(yp[:3], y[:3])

@@ -50,7 +50,8 @@ def test_simulate_from_rest_and_with_given_past(plant):
     assert f[0] == f[1] == 0.0  # two-sample delay, at rest before t = 0
     # force = B/A (i − 0.850 A): the same as the model's own simulation and the state space
     np.testing.assert_allclose(f, plant.model.simulate(s1.u - 0.850))
-    Ad, Bd, Cd, Dd = plant.to_statespace()
+    ss = plant.to_ss()
+    Ad, Bd, Cd, Dd = ss.A, ss.B, ss.C, ss.D
     x = np.zeros(Ad.shape[0])
     for k in range(50):
         assert (Cd @ x)[0] + Dd[0, 0] * (s1.u[k] - 0.85) == pytest.approx(f[k], abs=1e-9)

@@ -113,6 +113,6 @@ def _write_kalman(m, out, name, noise, dt):
 
     Q = R = S = None
     if noise is not None and (m.dt or dt):  # a continuous model without --dt: export says so
-        ss = m.discrete(m.dt if dt is None else dt)
+        ss = m.to_ss(m.dt if dt is None else dt)
         Q, R, S = load_noise(noise, ss.n_states, ss.n_outputs)
     return export_kalman_c(m, out, name, Q, R, S, dt=dt)

@@ -85,12 +85,10 @@ def _fit_and_report(method: str, data: Path, input: str, output: str, fs, time, 
             raw = lambda: _io(data, input, output, fs, time, fill, "none", "refit")  # noqa: E731
             warn_if_mean_detrending_hurt(model, io, raw, fit)
         if out_file is not None:  # the model file (issue 13), with the data's name and hash
-            from ..sysid.linear.linear_model import from_polynomial
             from ..sysid.model_file import file_sha256
 
-            lm = from_polynomial(model).replace(data_file=Path(data).name,
-                                                data_hash=file_sha256(data))
-            lm.with_display_units(tr).save(out_file)  # outputs shown in the file's units
+            saved = model.replace(data_file=Path(data).name, data_hash=file_sha256(data))
+            saved.with_display_units(tr).save(out_file)  # outputs shown in the file's units
         out = model.to_dict()
         out.update(data=str(data), detrend=detrend)
         val = _validate_polynomial(model, io.dt, validate, input, output, fs, time, fill, detrend,
@@ -120,11 +118,12 @@ def _validate_polynomial(model, dt: float, validate: Path | None, input: str, ou
 
         raise DataError(f"validation data {str(validate)!r} is sampled at {1 / vio.dt:g} Hz, the "
                         f"estimation data at {1 / dt:g} Hz", hint="resample one of them")
-    from ..sysid.linear.linear_model import VALIDATION_FIT, validation_fit
+    from ..sysid.linear.linear_model import VALIDATION_FIT
 
     val = model.validate(vio.u, vio.y)  # one-step fit and residual tests
-    vfit = validation_fit(model, load_data(validate, [input, output], fs, time, fill))
-    out["validation_fit_percent"] = None if vfit is None else vfit[0]
+    # the one validation fit (None for an unstable model)
+    out["validation_fit_percent"] = model.compare(
+        load_data(validate, [input, output], fs, time, fill)).fit_percent[0]
     out["validation"] = {**val.to_dict(), "fit_percent": out["validation_fit_percent"],
                          "initial": "estimated", "definition": VALIDATION_FIT}
     return val
@@ -166,7 +165,7 @@ def _mimo_arx(data: list[Path], input: str, output: str, na: int, nb: int, nk: i
     from ..errors import DataError, StabilityWarning
     from ..sysid.linear.identify_mimo import identify_arx as fit_arx
     from ..sysid.linear.identify_mimo import parse_names
-    from ..sysid.linear.linear_model import VALIDATION_FIT, validation_fit
+    from ..sysid.linear.linear_model import VALIDATION_FIT
     from ..sysid.model_file import file_sha256
 
     if detrend == "linear":
@@ -198,7 +197,8 @@ def _mimo_arx(data: list[Path], input: str, output: str, na: int, nb: int, nk: i
             emit_warning("arx: the identified model is unstable (a pole on or outside the unit circle): "
                          "no free-run fit is reported", StabilityWarning)
         if validate is not None:
-            vfit = validation_fit(model, load_data(validate, columns, fs, time, fill))
+            vfit = model.compare(load_data(validate, columns, fs, time, fill)).fit_percent
+            vfit = vfit if model.stable else None  # the one validation fit: none when unstable
             res["validation_fit_percent"] = vfit
             res["validation"] = {"fit_percent": vfit, "data": str(validate), "initial_state": "estimated",
                                  "definition": VALIDATION_FIT}
@@ -287,10 +287,8 @@ def _siso_records(method: str, data: list[Path], input: str, output: str, fs, ti
         model = _fit_records(data, [input, output], input, output, fs, time, fill, detrend, method,
                              **orders)
         if out_file is not None:
-            from ..sysid.linear.linear_model import from_polynomial
-
             names = ", ".join(Path(p).name for p in data)
-            from_polynomial(model).replace(data_file=names, data_hash=None).save(out_file)
+            model.replace(data_file=names, data_hash=None).save(out_file)
         out = model.to_dict()
         out.update(data=_data_field(data), detrend=detrend,
                    records=_records_field(data, model.info["records"]))

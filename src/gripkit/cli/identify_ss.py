@@ -183,15 +183,14 @@ def _ss_of_records(data: list[Path], input: str, output: str, order, method: str
                    max_iterations: int):
     """The state-space model of several data files (:func:`_records_model`) and its extras
     (``validation_fit_percent`` with ``validate``)."""
-    from ..sysid.linear.linear_model import validation_fit
-
     model = _records_model(data, "ss", input, output, detrend, fs, time, fill, order=order,
                            refine=not no_refine, weighting=method, form=form,
                            max_iterations=max_iterations)
     extras = {}
     if validate is not None:  # the one validation fit (around the model's stored offsets)
         vtr = _load(validate, input, output, fs, time, fill)
-        extras["validation_fit_percent"] = validation_fit(model, vtr)
+        extras["validation_fit_percent"] = (model.compare(vtr).fit_percent if model.stable
+                                            else None)
     return model, extras
 
 

@@ -1,6 +1,6 @@
 """Discrete linear-quadratic regulator on an identified model (issue 27).
 
-For the model's discrete state-space realisation ``x[t+1] = A x + B u`` (``LinearModel.discrete``,
+For the model's discrete state-space realisation ``x[t+1] = A x + B u`` (``LinearModel.to_ss(dt)``,
 or an :class:`~gripkit.lti.StateSpace`), ``u = −K x`` minimises
 ``Σ_t xᵀ Q x + uᵀ R u + 2 xᵀ N u``; ``K = (Bᵀ S B + R)⁻¹ (Bᵀ S A + Nᵀ)`` with ``S`` the stabilising
 solution of the discrete algebraic Riccati equation (``scipy.linalg.solve_discrete_are``). The
@@ -33,10 +33,10 @@ class LQR(NamedTuple):
 def _discrete(model, dt) -> StateSpace:
     if isinstance(model, StateSpace):
         ss = model
-    elif hasattr(model, "discrete"):
+    elif hasattr(model, "to_ss") and hasattr(model, "u_offset"):  # an identified model
         if model.dt is None and dt is None:
             raise ModelError("lqr: the model is continuous; give the sample time: dt=…")
-        return model.discrete(model.dt if dt is None else dt)
+        return model.to_ss(model.dt if dt is None else dt)
     else:
         raise ModelError(f"lqr: expected a gripkit.sysid.LinearModel or gripkit.lti.StateSpace, "
                          f"found {type(model).__name__}")

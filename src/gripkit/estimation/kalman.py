@@ -392,7 +392,7 @@ class KalmanFilter:
 
     def __init__(self, model, Q=None, R=None, S=None, *, steady_state: bool = False, x0=None,
                  P0=None, dt: float | None = None):
-        ss = model.discrete(model.dt if dt is None else dt) if (model.dt or dt) else None
+        ss = model.to_ss(model.dt if dt is None else dt) if (model.dt or dt) else None
         if ss is None:
             raise ModelError("KalmanFilter: the model is continuous; give the sample time: dt=…")
         self.model, self.steady_state = model, bool(steady_state)
@@ -438,11 +438,11 @@ class KalmanFilter:
     def _noise(model, Q, R, S, n, p):
         """(Q, R, S) as given, or the innovation form's ``K Λ Kᵀ, Λ, K Λ``."""
         if Q is None and R is None:
-            if model.K is None:
+            if getattr(model, "K", None) is None:
                 raise ModelError("KalmanFilter: the model has no innovation gain K (an "
                                  "output-error model); give the noise covariances Q and R",
                                  hint="KalmanFilter(model, Q=Q, R=R)")
-            lam = (np.eye(p) if model.noise_covariance is None
+            lam = (np.eye(p) if getattr(model, "noise_covariance", None) is None
                    else np.asarray(model.noise_covariance, float))
             K = np.asarray(model.K, float)
             return K @ lam @ K.T, lam.copy(), K @ lam

@@ -543,12 +543,12 @@ def _vector(v) -> np.ndarray:
 def _linear_model_fh(model, dt):
     """``f``, ``h`` (Python, numpy) of a LinearModel's discrete realisation with its offsets
     applied (u, y in SI, offsets not removed)."""
-    if not hasattr(model, "discrete"):
+    if not hasattr(model, "to_ss"):
         raise ArgumentError(f"expected a gripkit.sysid.LinearModel or a callable f, found "
                             f"{type(model).__name__}")
     if not (model.dt or dt):
         raise ModelError("the model is continuous; give the sample time: dt=…")
-    ss = model.discrete(model.dt if dt is None else dt)
+    ss = model.to_ss(model.dt if dt is None else dt)
     A, B, C, D = (np.asarray(M, dtype=np.float64) for M in (ss.A, ss.B, ss.C, ss.D))
     u0 = np.asarray(model.u_offset, dtype=np.float64)
     y0 = np.asarray(model.y_offset, dtype=np.float64)

@@ -75,10 +75,10 @@ def from_scipy(sys, **signals) -> LinearSystem:
 def as_system(obj, **signals) -> LinearSystem:
     """Any linear model gripkit meets, as a :class:`LinearSystem`.
 
-    Accepts a LinearSystem (returned as is), an object whose ``lti`` attribute is one (an
-    identified :class:`gripkit.sysid.PolynomialModel`, a :class:`gripkit.control.DiscretePlant`)
-    or whose ``system`` attribute is one (an identified :class:`gripkit.sysid.LinearModel`, also
-    as :func:`gripkit.sysid.load_model` reads it),
+    Accepts a LinearSystem (returned as is), an object whose ``system`` attribute is one (an
+    identified model: :class:`gripkit.sysid.LinearModel`, :class:`gripkit.sysid.PolynomialModel`,
+    also as :func:`gripkit.sysid.load_model` reads them) or whose ``lti`` attribute is one (a
+    :class:`gripkit.control.DiscretePlant`),
     a python-control or scipy.signal system, an object with ``A``, ``B``, ``dt`` coefficient
     arrays in powers of q⁻¹ (``y = B/(A F) u`` when it has ``F``; its ``input_name``/
     ``output_name``/units are kept), or a tuple ``(A, B, dt)`` of q⁻¹ polynomials. ``signals``
@@ -91,7 +91,7 @@ def as_system(obj, **signals) -> LinearSystem:
     >>> type(g).__name__, g.dt, g.den_zinv().tolist()
     ('TransferFunction', 0.01, [1.0, -0.5])
     """
-    for view in ("lti", "system"):  # a polynomial model or plant; an identified LinearModel
+    for view in ("system", "lti"):  # an identified model (LinearModel, PolynomialModel); a plant
         if not isinstance(obj, LinearSystem) and isinstance(getattr(obj, view, None), LinearSystem):
             obj = getattr(obj, view)
     if isinstance(obj, LinearSystem):

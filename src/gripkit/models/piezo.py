@@ -28,7 +28,7 @@ from numba import prange
 
 from ..params import Parameter, ParameterSet
 from ..sim.integrators import lti_rhs, lti_step, modes_of, zoh_levels
-from ..sim.linear import StateSpace
+from ..lti import StateSpace
 from ..sim.model import Model, Signal
 from .hysteresis import bouc_wen_advance, bouc_wen_parameters
 

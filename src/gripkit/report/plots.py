@@ -168,8 +168,9 @@ def pole_zero_map(models: Mapping[str, tuple[Sequence[complex], Sequence[complex
 
 def bode(models: Mapping[str, object], *, n: int = 512, title: str = "", magnitude_unit: str = "",
          reference: str | None = None):
-    """Magnitude (dB) and phase (deg) of models with ``frequency_response(n=...)`` (e.g.
-    :class:`gripkit.sysid.PolynomialModel`), or of ``(f_Hz, H)`` pairs, up to Nyquist.
+    """Magnitude (dB) and phase (deg) of models with ``frequency_response(n=...)`` giving
+    ``(w [rad/s], H)`` (e.g. :class:`gripkit.sysid.PolynomialModel`), or of ``(f_Hz, H)`` pairs,
+    up to Nyquist, drawn against the frequency in Hz.
 
     ``reference`` names the model the others are compared with (e.g. the true plant): it is drawn
     as a wide grey band under the others, so that an estimate lying on it shows as a line inside
@@ -178,7 +179,11 @@ def bode(models: Mapping[str, object], *, n: int = 512, title: str = "", magnitu
     fig, (am, ap) = plt.subplots(2, 1, figsize=(8, 5.6), sharex=True)
     k = 0
     for label, m in models.items():
-        f, h = m if isinstance(m, tuple) else m.frequency_response(n=n)
+        if isinstance(m, tuple):
+            f, h = m
+        else:
+            w, h = m.frequency_response(n=n)
+            f = w / (2.0 * np.pi)
         sel = f > 0
         if label == reference:
             style = dict(color="0.25", lw=6.0, alpha=0.35, zorder=1, solid_capstyle="butt")

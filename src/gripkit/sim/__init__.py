@@ -1,7 +1,7 @@
 """Simulation core: the Model base class, simulate(), step-resolution checks, linear systems,
-fixed-step integrators, hybrid (contact) dynamics, TOML model descriptions."""
+fixed-step integrators, hybrid (contact) dynamics, TOML model descriptions. Linear systems are
+:class:`gripkit.lti.StateSpace`; :mod:`.linear` keeps the kernels' array-level ZOH and recursion."""
 
-from .linear import StateSpace as StateSpace
 from .linear import c2d_zoh as c2d_zoh
 from .model import Model as Model
 from .model import Signal as Signal
@@ -16,4 +16,4 @@ from .integrators import integrate_lti as integrate_lti
 from .integrators import zoh_levels as zoh_levels
 
 __all__ = ["c2d_zoh", "check_step", "Guard", "HybridSystem", "integrate_lti", "Mode", "Model", "Signal",
-           "simulate", "StateSpace", "step_report", "substeps_for", "zoh_levels"]
+           "simulate", "step_report", "substeps_for", "zoh_levels"]

@@ -1,5 +1,6 @@
-"""Linear state space in the simulation layer: :class:`gripkit.lti.StateSpace` under the name the
-simulators use, and the array-level ZOH discretisation and discrete recursion of their kernels.
+"""The array-level ZOH discretisation and discrete recursion of the simulators' kernels (linear
+systems themselves are :class:`gripkit.lti.StateSpace`: ``c2d``, ``simulate``,
+``frequency_response`` in rad/s).
 
 Continuous:  ẋ = A x + B u,  y = C x + D u.   Discrete (step h):  x[k+1] = A_d x[k] + B_d u[k].
 
@@ -22,44 +23,9 @@ import numpy as np
 
 from .. import lti
 from ..lti import simulate_ss
-from ..errors import ModelError, SimulationError
+from ..errors import ModelError
 
-__all__ = ["StateSpace", "c2d_zoh", "simulate_discrete"]
-
-
-class StateSpace(lti.StateSpace):
-    """A :class:`gripkit.lti.StateSpace` (every method, names, units, covariance), with the
-    simulation layer's two older spellings: :meth:`freqresp` in Hz and :meth:`discretize` (ZOH).
-
-    ``StateSpace(A, B, C, D, dt, inputs, outputs, input_units, output_units, meta)``: shapes
-    A (n, n), B (n, m), C (p, n), D (p, m); ``dt=None`` is continuous time, else discrete (s).
-    Discretising keeps the class.
-
-    Examples
-    --------
-    >>> from gripkit.sim import StateSpace
-    >>> s = StateSpace([[-2.0]], [[1.0]], [[2.0]], None)
-    >>> d = s.discretize(0.1)
-    >>> type(d).__name__, round(float(d.dc_gain()[0, 0]), 12), float(abs(s.freqresp([0.0])[0, 0, 0]))
-    ('StateSpace', 1.0, 1.0)
-    """
-
-    def freqresp(self, f_hz) -> np.ndarray:
-        """Frequency response H at ``f_hz`` (Hz), shape (len(f), p, m):
-        ``frequency_response(2π f_hz)``."""
-        return self.frequency_response(2.0 * np.pi * np.atleast_1d(np.asarray(f_hz, dtype=np.float64)))
-
-    def discretize(self, dt: float) -> StateSpace:
-        """Exact zero-order-hold discretisation at step ``dt`` (s): ``c2d(dt)``."""
-        return self.c2d(dt)
-
-    def simulate(self, u, x0=None) -> np.ndarray:
-        """Outputs (N, p) of the discrete system for inputs ``u`` (N, m) or (N,), from ``x0``
-        (default rest); see :meth:`gripkit.lti.StateSpace.simulate`. A continuous system raises
-        SimulationError."""
-        if not self.is_discrete:
-            raise SimulationError("simulate() needs a discrete system: call discretize(dt) first")
-        return super().simulate(u, x0)
+__all__ = ["c2d_zoh", "simulate_discrete"]
 
 
 def c2d_zoh(A: np.ndarray, B: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray]:

@@ -65,6 +65,8 @@ _LAZY = {
     "load_model": ("model_protocol", "load_model"),
     "ModelFit": ("model_protocol", "ModelFit"),
     "IdentifiedModel": ("model_protocol", "IdentifiedModel"),
+    "simulated_trajectory": ("model_protocol", "simulated_trajectory"),
+    "IdentifiedLinearModel": ("linear.linear_model", "IdentifiedLinearModel"),
     "load_dynamics_model": ("rigid_body.dynamics", "load_dynamics_model"),
     "fourier_trajectory": ("rigid_body.fourier_trajectory", "fourier_trajectory"),
     "FourierTrajectory": ("rigid_body.fourier_trajectory", "FourierTrajectory"),
@@ -130,6 +132,8 @@ if TYPE_CHECKING:  # static readers see the same names, imported eagerly
     from .model_protocol import IdentifiedModel as IdentifiedModel
     from .model_protocol import ModelFit as ModelFit
     from .model_protocol import load_model as load_model
+    from .model_protocol import simulated_trajectory as simulated_trajectory
+    from .linear.linear_model import IdentifiedLinearModel as IdentifiedLinearModel
     from .rigid_body.dynamics import load_dynamics_model as load_dynamics_model
     from .rigid_body.fourier_trajectory import FourierTrajectory as FourierTrajectory
     from .rigid_body.fourier_trajectory import fourier_trajectory as fourier_trajectory

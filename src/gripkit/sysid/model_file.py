@@ -25,7 +25,7 @@ from ..errors import AccuracyWarning, DataError, ModelError, emit_warning
 __all__ = ["file_sha256", "plain", "write_document", "read_document", "SCHEMA", "SCHEMA_VERSION"]
 
 SCHEMA = "gripkit.linear-model"
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 
 
 def file_sha256(path) -> str:

@@ -12,6 +12,15 @@ Hammerstein–Wiener, nonlinear state space, hysteresis) is an object with these
     m.compare(data)              # ModelFit: the fit (%) per output by m.fit_definition
     m.save(path)                 # atomic JSON; load_model(path) gives the same type back
 
+The linear families (:class:`~gripkit.sysid.linear.linear_model.IdentifiedLinearModel`: state
+space, transfer function, ARX/ARMAX/OE) and NARX also give ``m.fit_definition`` (how ``compare``
+scores), ``m.predict(data, horizon=1)``, ``m.residuals(data)``; the linear ones ``m.to_ss()``,
+``m.to_tf()``, ``m.to_control()`` (and their HTML report is
+:func:`gripkit.sysid.model_report.write_model_report`). Optional: ``m.initial_state``, how
+``compare`` starts the free run (``'estimated'`` for the linear models, ``'measured'`` for NARX;
+``gripkit compare --json`` states it when the model has it), and
+``m.display_units`` / ``m.system.output_units`` for :func:`simulated_trajectory`.
+
 A model family registers its JSON schema in :data:`MODEL_FILES` (schema → module of this package
 and the name of its reader); `load_model` reads the schema and hands the file to that reader.
 A new family goes into ``sysid/nonlinear/`` (or ``sysid/linear/``) and adds one line here.
@@ -28,8 +37,10 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 
 from ..errors import ModelError, PathError
+from ..signals.trajectory import Trajectory
 
-__all__ = ["IdentifiedModel", "ModelFit", "MODEL_FILES", "file_schema", "load_model"]
+__all__ = ["IdentifiedModel", "ModelFit", "MODEL_FILES", "file_schema", "load_model",
+           "simulated_trajectory"]
 
 
 @dataclass(frozen=True)
@@ -65,7 +76,7 @@ class IdentifiedModel(Protocol):
 
 # schema -> (module of gripkit.sysid, reader function); one line per model family
 MODEL_FILES: dict[str, tuple[str, str]] = {
-    "gripkit.linear-model": ("linear.linear_model", "load_linear_model"),
+    "gripkit.linear-model": ("linear.polynomial", "load_linear_model"),
     "gripkit.narx-model": ("nonlinear.narx", "load_narx"),
     "gripkit.hw-model": ("nonlinear.hammerstein_wiener", "load_hw"),
     "gripkit.hysteresis-model": ("nonlinear.hysteresis", "load_hysteresis"),
@@ -100,3 +111,21 @@ def load_model(path):
                          hint="regenerate the file with gripkit identify --out")
     module, reader = MODEL_FILES[schema]
     return getattr(importlib.import_module(f"{__package__}.{module}"), reader)(p)
+
+
+def simulated_trajectory(model, data):
+    """The free run of any identified model on the input columns of the trajectory ``data``
+    (``model.simulate(data)``: by name, offsets applied, from rest) as a
+    :class:`~gripkit.signals.Trajectory` on ``data``'s time base: one column per output, SI
+    values and units where the model has them (``model.system.output_units``), its display units
+    in ``meta['display_units']`` (so ``gripkit.io.save(sim, path, units="display")`` writes
+    ``force [mN]`` where the estimation file did). What ``gripkit simulate MODEL.json --data
+    DATA`` writes."""
+    ys = np.asarray(model.simulate(data), dtype=np.float64).reshape(data.t.size, -1)
+    system = getattr(model, "system", None)
+    units = {} if system is None else {n: u for n, u in zip(model.outputs, system.output_units)
+                                       if u}
+    display = getattr(model, "display_units", None) or {}
+    shown = {n: display[n] for n in model.outputs if n in display}
+    return Trajectory(data.t, {n: ys[:, i] for i, n in enumerate(model.outputs)}, units,
+                      {"model": model.structure, "display_units": shown})

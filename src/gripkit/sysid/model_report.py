@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import AccuracyWarning, emit_warning
+from ..errors import AccuracyWarning, ModelError, emit_warning
 from ..report.html import Report
 from ..report.plots import measured_vs_model, plain, pyplot
 from .linear.frf import frf
@@ -89,7 +89,7 @@ def _warn(msg: str, notes: list) -> None:
 def _predictor(model, A, C, notes):
     """(kind, K, slowest pole, memory in samples) of the predictor the residuals come from."""
     n, p = A.shape[0], C.shape[0]
-    if model.K is None or n == 0:
+    if getattr(model, "K", None) is None or n == 0:
         return "output error", np.zeros((n, p)), None, 0.0
     K = np.asarray(model.K, dtype=np.float64)
     poles = np.linalg.eigvals(A - K @ C)
@@ -112,7 +112,7 @@ def residual_analysis(model, u, y, dt: float, free_run_fit=None) -> Residuals:
     free-run output errors are analysed instead), when its slowest pole keeps an initial-state
     error beyond :data:`SLOW_PREDICTOR_FRACTION` of the record, and when its one-step fit falls
     more than 10 points below ``free_run_fit`` (the free-run fit per output)."""
-    ss = model.discrete(dt)
+    ss = model.to_ss(dt)
     N = y.shape[0]
     notes: list[str] = []
     kind, K, pole, memory = _predictor(model, ss.A, ss.C, notes)
@@ -312,10 +312,18 @@ def singular_value_figure(sv, order):
 
 def model_report(model, data, *, data_name: str = "data", warnings_list=(),
                  sections=()) -> Report:
-    """Build the :class:`~gripkit.report.html.Report` of ``model`` on the trajectory ``data``;
+    """Build the :class:`~gripkit.report.html.Report` of ``model`` (any identified linear
+    model: an ARX/ARMAX/OE model is reported through its state-space record,
+    :meth:`~gripkit.sysid.PolynomialModel.linear_record`) on the trajectory ``data``;
     ``sections``: callables ``f(report)`` that add sections after the frequency response (e.g.
     ``lambda rep: gripkit.control.robustness_section(rep, result)``, the robustness of a loop
     closed around the model)."""
+    if hasattr(model, "linear_record"):
+        model = model.linear_record()
+    if not hasattr(model, "system"):
+        raise ModelError(f"report: the {model.structure} model has no linear system to show "
+                         f"(poles, Bode); the HTML report covers linear models",
+                         hint="judge it with gripkit compare MODEL DATA")
     ss = model.system.to_ss(minimal=False)
     dt = data.require_uniform(why="a model report")
     caught_lines = list(warnings_list)
@@ -324,16 +332,20 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=(),
                  f"data {data_name}")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        u = model._columns(data, model.inputs, model.u_offset, "input")
-        y = model._columns(data, model.outputs, model.y_offset, "output")
-        fit, ys, _ = model.compare(u, y, dt=dt)
+        u, y, _, y_offset = model._io(data, None, "a model report")
+        fitted = model.compare(data)
+        fit, ys = fitted.fit_percent, fitted.simulated - y_offset
+        if None in fit:
+            raise ModelError("compare: the model is unstable (a pole outside the unit circle): "
+                             "its free run diverges, so no fit is reported")
         sec = rep.section("Measured and simulated outputs",
                           f"Validation fit on the record: {VALIDATION_FIT}.")
         sec.table(["output", "unit", "fit %"], [[n, u_ or "—", f] for n, u_, f in
                                                 zip(model.outputs, model.system.output_units, fit)])
         t = data.t - data.t[0]
         for i, name in enumerate(model.outputs):
-            sec.figure(measured_vs_model(t, y[:, i] + model.y_offset[i], {"model": ys[:, i] + model.y_offset[i]},
+            yo = y_offset[i]
+            sec.figure(measured_vs_model(t, y[:, i] + yo, {"model": ys[:, i] + yo},
                                          ylabel=name, title=f"{name}: fit {fit[i]:.2f} %"), f"{name}", name=f"out-{i}")
         res = residual_analysis(model, u, y, dt, free_run_fit=fit)
         sec = rep.section("Residual analysis", res.notes[0] + " The dotted lines are ±1.96/√N, "
@@ -368,7 +380,7 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=(),
                                                   name="bode")
         for add_section in sections:
             add_section(rep)
-        if model.singular_values is not None:
+        if getattr(model, "singular_values", None) is not None:
             rep.section("Subspace singular values", "Singular values of the weighted subspace matrix; the order is "
                         "where they drop.").figure(singular_value_figure(np.asarray(model.singular_values), ss.n_states),
                                                    "singular values", name="sv")

@@ -47,9 +47,9 @@ def in_user_units(model, cu: float, cy: float):
             changes["noise_variance"] = model.noise_variance / cy / cy
         if model.loss is not None:
             changes["loss"] = model.loss / cy / cy
-    stored = model.stored_residuals  # not model.residuals: those not yet computed stay so
+    stored = model.stored_residuals  # not estimation_residuals: those not yet computed stay so
     if stored is not None:
-        changes["residuals"] = stored / cy
+        changes["estimation_residuals"] = stored / cy
     if "initial_outputs" in model.info:
         changes["info"] = {**model.info,
                            "initial_outputs": [v / cy for v in model.info["initial_outputs"]]}

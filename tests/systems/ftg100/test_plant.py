@@ -93,7 +93,7 @@ def test_equilibrium_and_linearisation():
     n = 600
     u = np.full(n, 70.1)
     ynl = pl.simulate({"V": u}, dt=1 / FS, x0=eq["x"])["x_a"] - eq["x_a"]
-    lin = pl.linearize(70.0).discretize(1 / FS)
+    lin = pl.linearize(70.0).c2d(1 / FS)
     ylin = lin.simulate(np.full(n, 0.1))[:, 0]
     assert np.max(np.abs(ynl - ylin)) < 0.01 * np.max(np.abs(ylin))
     f0, z0 = pl.resonance(0.0)

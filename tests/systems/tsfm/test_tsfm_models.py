@@ -30,7 +30,7 @@ def test_three_forms_of_the_finger_agree(left):
     GuGf = Gu * np.polyval(tf["G_f"][0], s) / np.polyval(tf["G_f"][1], s)
     np.testing.assert_allclose(GuGf, Gf, rtol=1e-12)
     for ss in (finger_state_space(v), finger_minimal_state_space(v)):
-        H = ss.freqresp(f)
+        H = ss.frequency_response(2 * np.pi * f)  # rad/s
         np.testing.assert_allclose(H[:, 0, 0], Gu, rtol=1e-10)
         np.testing.assert_allclose(H[:, 0, 1], -Gf, rtol=1e-10)
     tfp = finger_transfer_functions(v, a2="printed")

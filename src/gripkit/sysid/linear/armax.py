@@ -45,7 +45,7 @@ def _hannan_rissanen(u, y, na, nb, nc, nk) -> np.ndarray:
     n = y.size
     nh = int(min(max(3 * (na + nb + nc), 10), max((n - nk) // 10, nc + 1)))
     ehat = np.zeros(n)
-    ehat[max(nh, nk + nh - 1):] = _arx(u, y, nh, nh, nk, 1.0, warn=False).residuals
+    ehat[max(nh, nk + nh - 1):] = _arx(u, y, nh, nh, nk, 1.0, warn=False).estimation_residuals
     t0 = max(na, nk + nb - 1, nc) + max(nh, nk + nh - 1)
     X = _hr_rows(u, y, ehat, na, nb, nc, nk, t0)
     names = tuple(f"p{i}" for i in range(na + nb + nc))
@@ -121,7 +121,7 @@ def _armax(u, y, na, nb, nc, nk, step, maxiter, tol, meta) -> PolynomialModel:
     e = res.e
     return PolynomialModel(A, B, nk, C=C, dt=step, structure="armax", covariance=cov, noise_variance=sigma2,
                            loss=loss_vn(e), fit_percent=fit_percent(yt, yt - e), n_samples=int(y.size),
-                           n_used=int(e.size), residuals=e,
+                           n_used=int(e.size), estimation_residuals=e,
                            info={"method": "prediction-error minimisation (Levenberg-Marquardt), "
                                            "Hannan-Rissanen start", "iterations": res.iterations,
                                  "converged": res.converged, "cond": cond}, **meta)
@@ -178,7 +178,7 @@ def armax_records(records, na: int, nb: int, nc: int, nk: int = 1, *, dt: float 
                             C=np.concatenate([[1.0], th[na + nb:]]), dt=step, structure="armax",
                             covariance=cov, noise_variance=sigma2, loss=loss_vn(e), fit_percent=fit,
                             n_samples=int(sum(y.size for _, y in recs)), n_used=int(e.size),
-                            residuals=e, info=info, **meta)
+                            estimation_residuals=e, info=info, **meta)
     return in_user_units(model, cu, cy)
 
 
@@ -222,7 +222,7 @@ def _hannan_rissanen_records(recs, na, nb, nc, nk) -> np.ndarray:
         if n <= t0:
             continue
         ehat = np.zeros(n)
-        ehat[th:] = high.residuals[start:start + n - th]
+        ehat[th:] = high.estimation_residuals[start:start + n - th]
         rows.append(_hr_rows(u, y, ehat, na, nb, nc, nk, t0))
     names = tuple(f"p{i}" for i in range(p))
     return qr_solve(np.asfortranarray(np.vstack(rows)), names, overwrite=True, warn=False).theta

@@ -60,7 +60,7 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
     -------
     PolynomialModel
         ``.A``, ``.B``, ``.A_std``, ``.B_std`` (MATLAB layout), ``.covariance``, ``.loss`` (eq 29),
-        ``.fit_percent`` (one-step prediction), ``.aic``, ``.fpe``, ``.residuals``.
+        ``.fit_percent`` (one-step prediction), ``.aic``, ``.fpe``, ``.estimation_residuals``.
 
     Raises
     ------
@@ -139,7 +139,7 @@ def _arx(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int, step: float, *
         e.flags.writeable = False  # handed to the model without a copy
     return PolynomialModel(A, B, nk, dt=step, structure="arx", n_samples=int(y.size),
                            covariance=sigma2 * sol.cov_unscaled, noise_variance=sigma2,
-                           loss=0.5 * see / m, fit_percent=fit, n_used=m, residuals=e,
+                           loss=0.5 * see / m, fit_percent=fit, n_used=m, estimation_residuals=e,
                            estimation_data=record if e is None else None,
                            info={"method": method, "cond": sol.cond}, **meta)
 
@@ -259,7 +259,7 @@ def arx_records(records, na: int, nb: int, nk: int = 1, *, dt: float | None = No
     M_i = N_i − start. The covariance is σ²(ΦᵀΦ)⁻¹ of the stacked Φ. With one record the result
     is that of :func:`arx` (same rows). ``fit_percent`` is the one-step fit of all the records,
     each about its own mean (:func:`~gripkit.sysid.linear.validation.records_fit`); ``info['records']``
-    gives each record's samples and one-step fit; ``residuals`` are the records' one-step errors
+    gives each record's samples and one-step fit; ``estimation_residuals`` are the records' one-step errors
     one after another (``info['record_starts']``: where each begins).
 
     Examples
@@ -319,7 +319,7 @@ def arx_records(records, na: int, nb: int, nk: int = 1, *, dt: float | None = No
     sigma2 = see / (m - p)
     fit, per_record, starts, e = records_summary([y[t0:] for _, y in scaled], errs, t0)
     model = model.replace(covariance=sigma2 * sol.cov_unscaled, noise_variance=sigma2,
-                          loss=0.5 * see / m, fit_percent=fit, n_used=m, residuals=e,
+                          loss=0.5 * see / m, fit_percent=fit, n_used=m, estimation_residuals=e,
                           info={"method": method, "cond": sol.cond, "n_records": len(recs),
                                 "records": per_record, "record_starts": starts})
     return in_user_units(model, cu, cy)

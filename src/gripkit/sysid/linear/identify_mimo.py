@@ -28,10 +28,10 @@ from ...progress import status
 from ...signals.trajectory import Trajectory
 from .arx_mimo import arx_mimo
 from .frf import frf
-from .linear_model import VALIDATION_FIT, validation_fit  # the one definition, re-exported for the CLI
+from .linear_model import VALIDATION_FIT  # the one definition, re-exported for the CLI
 
 __all__ = ["MimoData", "mimo_data", "identify_ss", "identify_frf", "identify_tf", "identify_arx", "several",
-           "parse_names", "parse_order", "validation_fit"]
+           "parse_names", "parse_order"]
 
 
 def parse_names(x, what: str) -> tuple[str, ...]:
@@ -153,7 +153,7 @@ def _validation_data(validate: Trajectory, d: MimoData) -> MimoData:
 def _validation_fit(model, vd: MimoData) -> list[float] | None:
     if not model.stable:
         return None
-    return model.compare(vd.u, vd.y, dt=vd.dt)[0]
+    return model.compare(vd.u, vd.y, dt=vd.dt).fit_percent
 
 
 def _aic(model, d: MimoData) -> float:
@@ -273,7 +273,9 @@ def focus_score(model, focus: str, d: MimoData) -> float:
     ``x̂⁺ = A x̂ + B u + K (y − C x̂ − D u)`` from its x0 estimated by least squares
     (:func:`~.pem_ss.predictor_x0`; −inf when A − K C is unstable)."""
     if focus == "simulation":
-        return float(np.mean(model.compare(d.u, d.y, dt=d.dt)[0])) if model.stable else -math.inf
+        if not model.stable:
+            return -math.inf
+        return float(np.mean(model.compare(d.u, d.y, dt=d.dt).fit_percent))
     from .pem_ss import predictor_x0
 
     ss = model.system

@@ -5,10 +5,19 @@ Discrete innovation form (the subspace and PEM models)::
 
     x[t+1] = A x[t] + B u[t] + K e[t],   y[t] = C x[t] + D u[t] + e[t],   e white, cov Λ.
 
-``K = 0`` is the output-error form. Signals are in deviation units: the model's ``u_offset`` and
-``y_offset`` (one per input and output, the operating point removed before fitting) are applied by
-:meth:`LinearModel.simulate_data` and :meth:`LinearModel.compare_data`, which take a
-:class:`~gripkit.signals.Trajectory` and pick its columns by name.
+``K = 0`` is the output-error form. Arrays are in deviation units; a
+:class:`~gripkit.signals.Trajectory` is read by column name, the model's ``u_offset`` and
+``y_offset`` (one per input and output, the operating point removed before fitting) applied.
+
+The identified linear models form one small hierarchy on the protocol of
+:mod:`gripkit.sysid.model_protocol`: :class:`IdentifiedLinearModel` holds every protocol method
+(``simulate``, ``predict``, ``compare``, ``residuals``, ``save``, ``to_ss``, ``to_tf``,
+``to_control``, ``stable``, ``parameters``), written once on the model's ``system``; the HTML
+report of any of them is :func:`gripkit.sysid.model_report.write_model_report`;
+:class:`LinearModel` (state space, transfer function) and
+:class:`~gripkit.sysid.linear.polynomial.PolynomialModel` (ARX, ARMAX, OE, with the polynomial
+views ``A``, ``B``, ``C``, ``F`` and their σ) derive from it. Frequencies are in rad/s everywhere
+(:meth:`gripkit.lti.LinearSystem.frequency_response`).
 
 Free-run fit per output, ``100 (1 − ‖y_i − ŷ_i‖/‖y_i − ȳ_i‖)``, uses an initial state estimated by
 least squares (the output is affine in x0: ``y = O x0 + G u``, ``O`` the rows ``C A^t``).
@@ -22,15 +31,19 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ... import __version__
-from ...errors import DataError, DataWarning, ModelError, ParameterError, emit_warning
+from ...errors import (ArgumentError, DataError, DataWarning, ModelError, ParameterError,
+                       emit_warning)
 from ...lti import LinearSystem, StateSpace, TransferFunction
+from ...params import Parameter, ParameterSet
 from ...signals.trajectory import Trajectory
 from ...units import convert, dimension_of, same_dimension
 from ..checks import as_io_matrix
 from ..model_file import SCHEMA, SCHEMA_VERSION, read_document, write_document
+from ..model_protocol import ModelFit
 
-__all__ = ["VALIDATION_FIT", "validation_fit", "LinearModel", "as_io_matrix", "estimate_x0", "free_run", "fit_per_output", "from_polynomial",
-           "model_document", "save_model", "load_linear_model"]
+__all__ = ["VALIDATION_FIT", "IdentifiedLinearModel", "LinearModel", "as_io_matrix", "estimate_x0",
+           "free_run", "fit_per_output", "k_step_prediction", "model_document",
+           "polynomial_document", "read_linear_model"]
 
 
 def _sim(A, B, C, D, u, x0):
@@ -129,9 +142,247 @@ def _checked_display_units(model, shown: dict) -> dict:
     return shown
 
 
+#: gripkit's one definition of a validation fit, used by ``identify --validate``, ``compare``,
+#: ``report`` and the demo, and stated in their outputs (:meth:`IdentifiedLinearModel.compare`)
+VALIDATION_FIT = ("free run from the model's operating point (its stored offsets), initial state "
+                  "estimated by least squares, fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) over every sample")
+
+
+def k_step_prediction(A, B, C, D, K, u, y, horizon: int) -> np.ndarray:
+    """``ŷ(t | t − horizon)`` (N, p) of the innovation model ``x⁺ = A x + B u + K e``,
+    ``y = C x + D u + e`` on deviation data ``u`` (N, m), ``y`` (N, p): the one-step predictor
+    ``x̂⁺ = (A − KC) x̂ + (B − KD) u + K y``, ``ŷ = C x̂ + D u`` (a linear system of the inputs
+    ``[u, y]``) from the initial state estimated by least squares (:func:`estimate_x0` on that
+    system, as :func:`~gripkit.sysid.linear.pem_ss.predictor_x0` does), then ``horizon − 1``
+    steps of the model with the known inputs and no measurement. Samples ``t < horizon − 1`` are
+    the free run from that initial state. ``K = 0`` gives the free run for every horizon."""
+    A, B, C, D, K = (np.ascontiguousarray(M, dtype=np.float64) for M in (A, B, C, D, K))
+    u, y = np.ascontiguousarray(u, dtype=np.float64), np.ascontiguousarray(y, dtype=np.float64)
+    n, N, p = A.shape[0], u.shape[0], C.shape[0]
+    Ap, Bp, Dp = A - K @ C, np.hstack([B - K @ D, K]), np.hstack([D, np.zeros((p, p))])
+    w = np.hstack([u, y])
+    x0 = estimate_x0(Ap, Bp, C, Dp, w, y)
+    if horizon == 1:
+        return free_run(Ap, Bp, C, Dp, w, x0)
+    out = free_run(A, B, C, D, u, x0)
+    if N < horizon:
+        return out
+    X = free_run(Ap, Bp, np.eye(n), np.zeros((n, Bp.shape[1])), w, x0)
+    rows = N - horizon + 1
+    Z = X[:rows]
+    for j in range(horizon - 1):
+        Z = Z @ A.T + u[j:j + rows] @ B.T
+    out[horizon - 1:] = Z @ C.T + u[horizon - 1:] @ D.T
+    return out
+
+
+def _horizon(horizon) -> int:
+    if isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer)) or horizon < 1:
+        raise ArgumentError(f"horizon: expected a whole number of samples ≥ 1, found {horizon!r}",
+                            hint="horizon=1 is the one-step-ahead prediction")
+    return int(horizon)
+
+
+class IdentifiedLinearModel:
+    """The protocol of every identified linear model (:mod:`gripkit.sysid.model_protocol`),
+    written once on what a subclass holds: ``system`` (a :mod:`gripkit.lti` system with names,
+    units, dt and parameter covariance), ``structure``, ``dt``, ``u_offset`` and ``y_offset``.
+
+    ``data`` is a :class:`~gripkit.signals.Trajectory` (columns by name, converted to the
+    model's units, the model's offsets removed and added back: results in the data's units) or
+    arrays in deviation units (``u`` (N, m) and, where needed, ``y`` (N, p)). Frequencies are in
+    rad/s (:meth:`gripkit.lti.LinearSystem.frequency_response`)."""
+
+    #: how :meth:`compare` scores a model, and how it starts the free run
+    fit_definition = VALIDATION_FIT
+    initial_state = "estimated"
+
+    @property
+    def inputs(self) -> tuple[str, ...]:
+        return self.system.inputs
+
+    @property
+    def outputs(self) -> tuple[str, ...]:
+        return self.system.outputs
+
+    @property
+    def order(self) -> int:
+        """States of the model's (non-minimal) state-space realisation."""
+        return self.system.to_ss(minimal=False).n_states
+
+    @property
+    def stable(self) -> bool:
+        """All poles strictly inside the unit circle (discrete) or left half-plane (continuous)."""
+        return self.system.is_stable()
+
+    def _offsets(self) -> tuple[np.ndarray, np.ndarray]:
+        return (np.atleast_1d(np.asarray(self.u_offset, dtype=np.float64)),
+                np.atleast_1d(np.asarray(self.y_offset, dtype=np.float64)))
+
+    def with_display_units(self, data) -> IdentifiedLinearModel:
+        """This model with the display units of its inputs and outputs taken from the trajectory
+        ``data`` (:meth:`~gripkit.signals.Trajectory.display_unit`: the units its file wrote
+        them in, ``force [mN]`` → ``'mN'``), where they differ from the model's SI units."""
+        s = self.system
+        pairs = list(zip(s.inputs, s.input_units)) + list(zip(s.outputs, s.output_units))
+        shown = {n: data.display_unit(n) for n, u in pairs
+                 if n in data.names and u not in (None, "", "1") and data.unit(n) == u
+                 and data.display_unit(n) != u}
+        return self.replace(display_units=shown)
+
+    def display_unit(self, name: str) -> str | None:
+        """The unit input or output ``name`` is shown in: its display unit, else its SI unit."""
+        s = self.system
+        units = dict(zip(s.inputs, s.input_units)) | dict(zip(s.outputs, s.output_units))
+        return self.display_units.get(name, units.get(name))
+
+    # ------------------------------------------------------------------ systems and interop
+    def to_ss(self, dt: float | None = None) -> StateSpace:
+        """The model as a :class:`gripkit.lti.StateSpace` (its non-minimal realisation); with
+        ``dt``, sampled at ``dt`` (zero-order hold for a continuous model; a discrete model must
+        have that sample time, else a DataError)."""
+        ss = self.system.to_ss(minimal=False)
+        if dt is None:
+            return ss
+        if ss.is_discrete:
+            if abs(ss.dt - dt) > 1e-9 * dt:
+                raise DataError(f"data: sampled every {dt:g} s, the model every {ss.dt:g} s",
+                                hint="resample the data to the model's rate")
+            return ss
+        return ss.c2d(dt)
+
+    def to_tf(self) -> TransferFunction:
+        """The model as a :class:`gripkit.lti.TransferFunction`."""
+        s = self.system
+        return s if isinstance(s, TransferFunction) else s.to_tf()
+
+    def to_control(self):
+        """``control.StateSpace`` or ``control.TransferFunction`` with the channel names (needs
+        python-control: ``pip install 'gripkit[interop]'``)."""
+        return self.system.to_control()
+
+    # ------------------------------------------------------------------ data in
+    def _columns(self, data, names, offsets, what):
+        missing = [n for n in names if n not in data.names]
+        if missing:
+            raise DataError(f"data: the model's {what} column(s) {', '.join(map(repr, missing))} "
+                            f"are missing; the data have {', '.join(map(repr, data.names))}",
+                            hint="rename the columns or identify the model from matching data")
+        units = self.system.input_units if what == "input" else self.system.output_units
+        return np.column_stack([_in_unit(data, n, u, what) - o
+                                for n, u, o in zip(names, units, offsets)])
+
+    def _io(self, data, y, why: str, outputs: bool = True, dt: float | None = None):
+        """``(u, y, dt, y_offset)``: deviation arrays of a trajectory (y_offset to add back) or
+        of the arrays given (y_offset None)."""
+        uo, yo = self._offsets()
+        if isinstance(data, Trajectory):
+            dt = data.require_uniform(why=why)
+            u = self._columns(data, self.inputs, uo, "input")
+            yy = self._columns(data, self.outputs, yo, "output") if outputs else None
+            return u, yy, dt, yo
+        u = as_io_matrix(data, "u")
+        dt = dt or self.dt
+        if dt is None:
+            raise ArgumentError(f"{why}: the model is continuous and the arrays carry no sample "
+                                f"time", hint="give dt=… (s), or a trajectory")
+        if outputs:
+            if y is None:
+                raise ArgumentError(f"{why}: give a trajectory, or the arrays u and y",
+                                    hint="model.compare(data) or model.compare(u, y)")
+            y = as_io_matrix(y, "y", u.shape[0])
+        return u, y, dt, None
+
+    def _state_space(self, dt):
+        """(A, B, C, D, K) of the model's innovation form at ``dt`` (K = 0: output error)."""
+        ss = self.to_ss(dt)
+        K = getattr(self, "K", None)
+        K = np.zeros((ss.n_states, ss.n_outputs)) if K is None else K
+        return ss.A, ss.B, ss.C, ss.D, K
+
+    # ------------------------------------------------------------------ the protocol
+    def simulate(self, data, x0=None, dt: float | None = None) -> np.ndarray:
+        """Free run (N, p) from ``x0`` (default: rest) on the inputs of ``data``: a trajectory
+        (offsets applied, result in its units) or deviation inputs ``u`` (N, m) sampled every
+        ``dt`` (default the model's)."""
+        u, _, step, yo = self._io(data, None, "simulation of an identified model", False, dt)
+        ss = self.to_ss(step)
+        if u.shape[1] != ss.n_inputs:
+            raise DataError(f"u: expected {ss.n_inputs} input columns, found {u.shape[1]}")
+        ys = free_run(ss.A, ss.B, ss.C, ss.D, u, x0)
+        return ys if yo is None else ys + yo
+
+    def compare(self, data, y=None, dt: float | None = None) -> ModelFit:
+        """The validation fit (:data:`VALIDATION_FIT`) per output on a trajectory, or on
+        deviation arrays ``u``, ``y``: free run from the initial state estimated by least squares.
+        ``fit_percent`` is None per output for an unstable model (its free run, from rest, is
+        ``simulated``)."""
+        u, yy, dt, yo = self._io(data, y, "comparison of an identified model", dt=dt)
+        ss = self.to_ss(dt)
+        if not ss.is_stable():
+            ys = free_run(ss.A, ss.B, ss.C, ss.D, u)
+            fit = [None] * ss.n_outputs
+        else:
+            x0 = estimate_x0(ss.A, ss.B, ss.C, ss.D, u, yy)
+            ys = free_run(ss.A, ss.B, ss.C, ss.D, u, x0)
+            fit = fit_per_output(yy, ys)
+        return ModelFit(tuple(self.outputs), fit, ys if yo is None else ys + yo,
+                        self.fit_definition)
+
+    def predict(self, data, y=None, horizon: int = 1, dt: float | None = None) -> np.ndarray:
+        """``ŷ(t | t − horizon)`` (N, p) on a trajectory or deviation arrays ``u``, ``y``: the
+        model's predictor (innovation gain K; without K the prediction is the free run) from
+        the initial state estimated by least squares (:func:`k_step_prediction`)."""
+        h = _horizon(horizon)
+        u, yy, dt, yo = self._io(data, y, "prediction of an identified model", dt=dt)
+        yh = self._prediction(u, yy, dt, h)
+        return yh if yo is None else yh + yo
+
+    def _prediction(self, u, y, dt, horizon: int) -> np.ndarray:
+        return k_step_prediction(*self._state_space(dt), u, y, horizon)
+
+    def residuals(self, data, y=None, dt: float | None = None) -> np.ndarray:
+        """One-step prediction errors ``y − ŷ(t | t − 1)`` (N, p) on a trajectory or on
+        deviation arrays ``u``, ``y`` (:meth:`predict`)."""
+        u, yy, dt, _ = self._io(data, y, "residuals of an identified model", dt=dt)
+        return yy - k_step_prediction(*self._state_space(dt), u, yy, 1)
+
+    @property
+    def parameters(self) -> ParameterSet:
+        """The entries of the system's arrays (``A_0_1`` for A[0, 1]; ``num``/``den`` of a
+        transfer function) that the identification estimated (a non-zero tangent in the
+        parameter covariance; every entry when the model has none), with their 1σ propagated
+        from that covariance. Units are those of the realisation's coordinates ('1')."""
+        s = self.system
+        named = ([("A", s.A), ("B", s.B), ("C", s.C), ("D", s.D)] if isinstance(s, StateSpace)
+                 else [("num", s.num), ("den", s.den)])
+        unc = s.uncertainty
+        src = f"identified ({self.structure})"
+        params = []
+        for k, (name, arr) in enumerate(named):
+            flat = np.asarray(arr, dtype=np.float64).reshape(-1)
+            std, free = None, np.ones(flat.size, dtype=bool)
+            if unc is not None:
+                T = np.asarray(unc.tangents[k]).reshape(len(unc.names), -1)
+                std = np.sqrt(np.clip(np.einsum("ij,ik,kj->j", T, unc.covariance, T), 0, None))
+                free = np.any(T != 0.0, axis=0)
+            for j in np.flatnonzero(free):
+                idx = np.unravel_index(j, np.shape(arr))
+                params.append(Parameter(f"{name}_{'_'.join(map(str, idx))}", float(flat[j]), "1",
+                                        f"entry {tuple(int(i) for i in idx)} of {name}",
+                                        source=src, std=None if std is None else float(std[j])))
+        return ParameterSet(params, name=self.structure)
+
+    def save(self, path) -> None:
+        """Write the model file (JSON, :func:`model_document`); :func:`gripkit.sysid.load_model`
+        gives the same type back."""
+        write_document(model_document(self), path)
+
+
 @dataclass(frozen=True, eq=False)
-class LinearModel:
-    """An identified linear model.
+class LinearModel(IdentifiedLinearModel):
+    """An identified linear model in state-space or transfer-function form (subspace, PEM,
+    tfest, MIMO ARX); the protocol is :class:`IdentifiedLinearModel`'s.
 
     Attributes
     ----------
@@ -196,124 +447,11 @@ class LinearModel:
 
     # ------------------------------------------------------------------ views
     @property
-    def inputs(self) -> tuple[str, ...]:
-        return self.system.inputs
-
-    @property
-    def outputs(self) -> tuple[str, ...]:
-        return self.system.outputs
-
-    @property
     def dt(self) -> float | None:
         return self.system.dt
 
-    @property
-    def order(self) -> int:
-        return self.system.to_ss(minimal=False).n_states
-
-    @property
-    def stable(self) -> bool:
-        return self.system.is_stable()
-
     def replace(self, **changes) -> LinearModel:
         return dataclasses.replace(self, **changes)
-
-    def with_display_units(self, data) -> LinearModel:
-        """This model with the display units of its inputs and outputs taken from the trajectory
-        ``data`` (:meth:`~gripkit.signals.Trajectory.display_unit`: the units its file wrote
-        them in, ``force [mN]`` → ``'mN'``), where they differ from the model's SI units."""
-        s = self.system
-        pairs = list(zip(s.inputs, s.input_units)) + list(zip(s.outputs, s.output_units))
-        shown = {n: data.display_unit(n) for n, u in pairs
-                 if n in data.names and u not in (None, "", "1") and data.unit(n) == u
-                 and data.display_unit(n) != u}
-        return self.replace(display_units=shown)
-
-    def display_unit(self, name: str) -> str | None:
-        """The unit input or output ``name`` is shown in: its display unit, else its SI unit."""
-        s = self.system
-        units = dict(zip(s.inputs, s.input_units)) | dict(zip(s.outputs, s.output_units))
-        return self.display_units.get(name, units.get(name))
-
-    def discrete(self, dt: float) -> StateSpace:
-        """The state-space system sampled at ``dt`` (ZOH for a continuous model)."""
-        ss = self.system.to_ss(minimal=False)
-        if ss.is_discrete:
-            if abs(ss.dt - dt) > 1e-9 * dt:
-                raise DataError(f"data: sampled every {dt:g} s, the model every {ss.dt:g} s",
-                                hint="resample the data to the model's rate")
-            return ss
-        return ss.c2d(dt)
-
-    # ------------------------------------------------------------------ arrays in
-    def simulate(self, u, x0=None, dt: float | None = None) -> np.ndarray:
-        """Free-run outputs (N, p) in deviation units for deviation inputs ``u`` (N, m)."""
-        ss = self.discrete(dt or self.dt)
-        u = as_io_matrix(u, "u")
-        if u.shape[1] != ss.n_inputs:
-            raise DataError(f"u: expected {ss.n_inputs} input columns, found {u.shape[1]}")
-        return free_run(ss.A, ss.B, ss.C, ss.D, u, x0)
-
-    def compare(self, u, y, dt: float | None = None) -> tuple[list[float], np.ndarray, np.ndarray]:
-        """Free-run fit (%) per output with the initial state estimated by least squares;
-        returns ``(fit_percent, y_sim, x0)``."""
-        ss = self.discrete(dt or self.dt)
-        u = as_io_matrix(u, "u")
-        y = as_io_matrix(y, "y", u.shape[0])
-        if not ss.is_stable():
-            raise ModelError("compare: the model is unstable (a pole outside the unit circle): its free run "
-                             "diverges, so no fit is reported")
-        x0 = estimate_x0(ss.A, ss.B, ss.C, ss.D, u, y)
-        ys = free_run(ss.A, ss.B, ss.C, ss.D, u, x0)
-        return fit_per_output(y, ys), ys, x0
-
-    # ------------------------------------------------------------------ trajectories in
-    def _columns(self, data, names, offsets, what):
-        missing = [n for n in names if n not in data.names]
-        if missing:
-            raise DataError(f"data: the model's {what} column(s) {', '.join(map(repr, missing))} are missing; "
-                            f"the data have {', '.join(map(repr, data.names))}",
-                            hint="rename the columns or identify the model from matching data")
-        units = self.system.input_units if what == "input" else self.system.output_units
-        return np.column_stack([_in_unit(data, n, u, what) - o
-                                for n, u, o in zip(names, units, offsets)])
-
-    def simulate_data(self, data) -> np.ndarray:
-        """Simulated outputs (N, p), offsets added back, for the input columns of a trajectory
-        (picked by name; the model's input offsets removed first), from x0 = 0."""
-        dt = data.require_uniform(why="simulation of an identified model")
-        u = self._columns(data, self.inputs, self.u_offset, "input")
-        return self.simulate(u, dt=dt) + np.asarray(self.y_offset)
-
-    def simulate_trajectory(self, data) -> Trajectory:
-        """The model's outputs for the input columns of the trajectory ``data`` (by name, offsets
-        applied, from rest) as a :class:`~gripkit.signals.Trajectory` on ``data``'s time base:
-        SI values and units, the model's display units in ``meta['display_units']`` (so
-        ``gripkit.io.save(sim, path, units="display")`` writes ``force [mN]`` where the estimation
-        file did). What ``gripkit simulate MODEL.json --data DATA`` writes."""
-        ys = self.simulate_data(data)
-        units = {n: u for n, u in zip(self.outputs, self.system.output_units) if u}
-        shown = {n: self.display_units[n] for n in self.outputs if n in self.display_units}
-        return Trajectory(data.t, {n: ys[:, i] for i, n in enumerate(self.outputs)}, units,
-                          {"model": self.structure, "display_units": shown})
-
-    def compare_data(self, data) -> tuple[list[float], np.ndarray]:
-        """Free-run fit per output on a trajectory (columns by name, offsets applied, x0
-        estimated); returns ``(fit_percent, y_sim with offsets)``."""
-        dt = data.require_uniform(why="comparison of an identified model")
-        u = self._columns(data, self.inputs, self.u_offset, "input")
-        y = self._columns(data, self.outputs, self.y_offset, "output")
-        fit, ys, _ = self.compare(u, y, dt=dt)
-        return fit, ys + np.asarray(self.y_offset)
-
-    # ------------------------------------------------------------------ interop and files
-    def to_control(self):
-        """``control.StateSpace`` or ``control.TransferFunction``, with names."""
-        return self.system.to_control()
-
-    def save(self, path) -> None:
-        """Write the model to a JSON file (:func:`model_document`; reload with :func:`load_linear_model`)."""
-        write_document(model_document(self), path)
 
     def to_dict(self) -> dict:
         """JSON-ready summary (arrays as lists)."""
@@ -342,44 +480,10 @@ class LinearModel:
                 f"outputs={list(self.outputs)}, dt={self.dt})")
 
 
-#: gripkit's one definition of a validation fit, used by ``identify --validate``, ``compare``,
-#: ``report`` and the demo, and stated in their outputs
-VALIDATION_FIT = ("free run from the model's operating point (its stored offsets), initial state "
-                  "estimated by least squares, fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) over every sample")
-
-
-def validation_fit(model, data) -> list[float] | None:
-    """Free-run fit (%) per output of ``model`` on the trajectory ``data``, by
-    :data:`VALIDATION_FIT`: the model's columns by name, its input and output offsets removed (the
-    estimation record's operating point, not the validation record's means), the initial state
-    estimated by least squares (:meth:`LinearModel.compare`). ``model`` is a
-    :class:`LinearModel` or a :class:`~gripkit.sysid.PolynomialModel`; None for an unstable
-    model, whose free run diverges."""
-    lm = model if isinstance(model, LinearModel) else from_polynomial(model)
-    if not lm.stable:
-        return None
-    return lm.compare_data(data)[0]
-
-
-def from_polynomial(pm) -> LinearModel:
-    """A :class:`~gripkit.sysid.PolynomialModel` (ARX/ARMAX/OE) as a :class:`LinearModel` on the
-    discrete transfer function B/(A F) (its :attr:`~gripkit.sysid.PolynomialModel.lti`),
-    with the parameter covariance (the noise polynomial C keeps its place in it, with zero
-    tangents, and is recorded in ``info``), names, units and offsets."""
-    g = pm.lti
-    info = {"label": pm.label, "A": pm.A, "B": pm.B, "C": pm.C, "F": pm.F, "nk": pm.nk,
-            "one_step_fit_percent": pm.fit_percent, "noise_variance": pm.noise_variance,
-            "parameter_names": list(pm.parameter_names), **{k: v for k, v in pm.info.items()
-                                                            if isinstance(v, (str, int, float))}}
-    return LinearModel(g, pm.structure, u_offset=(pm.u_offset,), y_offset=(pm.y_offset,), n_samples=pm.n_samples,
-                       noise_covariance=None if pm.noise_variance is None else np.array([[pm.noise_variance]]),
-                       info=info)
-
-
-def model_document(model: LinearModel) -> dict:
+def model_document(model: IdentifiedLinearModel) -> dict:
     """The JSON document of ``model`` (schema ``gripkit.linear-model``, :mod:`.model_file`)::
 
-        {"schema": "gripkit.linear-model", "schema_version": 1, "gripkit_version": "0.1.0",
+        {"schema": "gripkit.linear-model", "schema_version": 2, "gripkit_version": "0.1.0",
          "structure": "pem-innovation", "kind": "ss" | "tf", "dt": 0.01 | null,
          "inputs":  [{"name": "current", "unit": "A", "offset": 0.85}, ...],
          "outputs": [{"name": "force", "unit": "N", "offset": 0.0, "display_unit": "mN"}, ...],
@@ -390,8 +494,20 @@ def model_document(model: LinearModel) -> dict:
          "innovation": {"K": … | null, "x0": … | null, "noise_covariance": … | null},
          "fit_percent": […], "singular_values": […] | null, "n_samples": N, "info": {…},
          "data": {"file": "run1.csv", "sha256": "…"} | null,
+         "polynomial": {…},   only for an ARX/ARMAX/OE model: its coefficients, covariance and
+                              diagnostics (PolynomialModel.polynomial_section), from which
+                              load_model builds the PolynomialModel again
          "content_sha256": "…"}
+
+    A :class:`~gripkit.sysid.PolynomialModel` writes its system part as the discrete transfer
+    function B/(A F) (:meth:`~gripkit.sysid.PolynomialModel.linear_record`), so that a reader of
+    the schema that knows no polynomials still finds the system. Version 1 (no ``polynomial``
+    section; an ARX/ARMAX/OE model kept its coefficients in ``info``) is read as well
+    (:func:`~gripkit.sysid.linear.polynomial.load_linear_model`).
     """
+    poly = None
+    if not isinstance(model, LinearModel):
+        poly, model = model.polynomial_section(), model.linear_record()
     s = model.system
     doc = {"schema": SCHEMA, "schema_version": SCHEMA_VERSION, "gripkit_version": __version__,
            "structure": model.structure, "kind": "ss" if isinstance(s, StateSpace) else "tf", "dt": s.dt,
@@ -404,6 +520,8 @@ def model_document(model: LinearModel) -> dict:
     doc.update(fit_percent=model.fit_percent, singular_values=model.singular_values, n_samples=model.n_samples,
                info=model.info,
                data=None if model.data_file is None else {"file": model.data_file, "sha256": model.data_hash})
+    if poly is not None:
+        doc["polynomial"] = poly
     return doc
 
 
@@ -415,12 +533,6 @@ def _entry(model: LinearModel, name: str, unit, offset: float) -> dict:
     return entry
 
 
-def save_model(model, path) -> None:
-    """Write ``model`` (a :class:`LinearModel`, or a :class:`~gripkit.sysid.PolynomialModel`,
-    converted by :func:`from_polynomial`) to ``path`` as JSON."""
-    write_document(model_document(model if isinstance(model, LinearModel) else from_polynomial(model)), path)
-
-
 def _arr(x, name, where):
     try:
         return np.asarray(x, dtype=np.float64)
@@ -428,8 +540,10 @@ def _arr(x, name, where):
         raise ModelError(f"model file {where}: field {name!r} is not an array of numbers") from None
 
 
-def load_linear_model(path) -> LinearModel:
-    """Read a model written by ``model.save(path)``.
+def read_linear_model(path) -> tuple[dict, LinearModel, str]:
+    """``(document, system part, where)`` of a model file written by ``model.save(path)``; the
+    reader of the schema, which also builds a :class:`~gripkit.sysid.PolynomialModel` from the
+    ``polynomial`` section, is :func:`gripkit.sysid.linear.polynomial.load_linear_model`.
 
     Raises ModelError for a file that is not a gripkit model (wrong ``schema``), of a newer
     ``schema_version``, or with missing fields; warns (AccuracyWarning) when the content hash does
@@ -445,6 +559,10 @@ def load_linear_model(path) -> LinearModel:
     >>> load_model(p).system.A.tolist(), load_model(p).inputs
     ([[0.5]], ('V',))
     """
+    return _read(path)
+
+
+def _read(path):
     doc = read_document(path)
     where = repr(str(path))
     try:
@@ -456,13 +574,14 @@ def load_linear_model(path) -> LinearModel:
         K, x0, lam = (None if inn.get(k) is None else _arr(inn[k], k, where) for k in ("K", "x0", "noise_covariance"))
         data = doc.get("data") or {}
         sv = doc.get("singular_values")
-        return LinearModel(system, doc["structure"], K=K, x0=x0, noise_covariance=lam,
+        lm = LinearModel(system, doc["structure"], K=K, x0=x0, noise_covariance=lam,
                            u_offset=[d["offset"] for d in ins], y_offset=[d["offset"] for d in outs],
                            fit_percent=doc.get("fit_percent"), singular_values=None if sv is None else np.asarray(sv),
                            n_samples=doc.get("n_samples"), data_file=data.get("file"), data_hash=data.get("sha256"),
                            info=doc.get("info") or {},
                            display_units={d["name"]: d["display_unit"] for d in (*ins, *outs)
                                           if d.get("display_unit") is not None})
+        return doc, lm, where
     except (KeyError, TypeError, AttributeError) as exc:
         raise ModelError(f"model file {where}: a required field is missing or malformed ({exc})",
                          hint="regenerate the file with gripkit identify --out") from None
@@ -470,3 +589,10 @@ def load_linear_model(path) -> LinearModel:
         if not exc.message.startswith("display unit"):
             raise
         raise ModelError(f"model file {where}: {exc.message}", hint=exc.hint) from None
+
+
+def polynomial_document(doc: dict) -> bool:
+    """A version-1 file of an ARX/ARMAX/OE model (its coefficients in ``info``)."""
+    info = doc.get("info") or {}
+    return (doc.get("schema_version") == 1 and doc.get("structure") in ("arx", "armax", "oe")
+            and all(k in info for k in ("A", "B", "C", "F", "nk")))

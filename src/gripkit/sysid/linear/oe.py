@@ -115,7 +115,7 @@ def _oe(u, y, nb, nf, nk, step, maxiter, tol, meta) -> PolynomialModel:
     e = res.e
     return PolynomialModel(np.ones(1), B, nk, F=F, dt=step, structure="oe", covariance=cov,
                            noise_variance=sigma2, loss=loss_vn(e), fit_percent=fit_percent(yt, yt - e),
-                           n_samples=int(n), n_used=int(e.size), residuals=e,
+                           n_samples=int(n), n_used=int(e.size), estimation_residuals=e,
                            info={"method": "prediction-error minimisation (Levenberg-Marquardt), "
                                            "ARX + instrumental-variable start", "iterations": res.iterations,
                                  "converged": res.converged, "cond": cond,
@@ -189,7 +189,7 @@ def oe_records(records, nb: int, nf: int, nk: int = 1, *, dt: float | None = Non
                             F=np.concatenate([[1.0], th[nb:p]]), dt=step, structure="oe",
                             covariance=cov[:p, :p], noise_variance=sigma2, loss=loss_vn(e),
                             fit_percent=fit, n_samples=int(sum(y.size for _, y in recs)),
-                            n_used=int(e.size), residuals=e,
+                            n_used=int(e.size), estimation_residuals=e,
                             info=info, **meta)
     return in_user_units(model, cu, cy)
 

@@ -14,6 +14,13 @@ Arrays hold the coefficients in increasing powers of q⁻¹: ``A = [1, a_1, ...,
 ``idpoly``). ARX: C = F = 1; ARMAX: F = 1; OE: A = C = 1.
 
 Parameter names follow the powers of q⁻¹ (Table III of the seed: ``a1 a2 b2 b3`` for ``[2 2 2]``).
+
+:class:`PolynomialModel` is an :class:`~gripkit.sysid.linear.linear_model.IdentifiedLinearModel`:
+its ``system`` is the discrete transfer function B/(A F); simulation, comparison, prediction,
+the report, the model file and the conversions are the protocol's (one set of names for every
+identified model). Its predictor is that of the noise model: ``ŷ(t|t−1)`` from
+``A y = B/F u + C e`` (:meth:`PolynomialModel.prediction_errors`), ``horizon > 1`` from the
+innovation form of ``[B/(A F), C/A]`` (:meth:`PolynomialModel.innovation_form`).
 """
 
 from __future__ import annotations
@@ -27,21 +34,23 @@ import numpy as np
 
 from ...arguments import check_keywords, keyword_names
 from ...errors import DataError, ModelError
-from ...lti import TransferFunction
+from ...lti import StateSpace, TransferFunction
 from ...params import Parameter, ParameterSet
+from ...signals.trajectory import Trajectory
 from ...units import ratio_unit
-from .linear_model import save_model
+from .linear_model import (IdentifiedLinearModel, LinearModel, _checked_display_units, _horizon,
+                           k_step_prediction, polynomial_document, read_linear_model)
 from .validation import validate
 
-__all__ = ["PolynomialModel"]
+__all__ = ["PolynomialModel", "load_linear_model"]
 
 _STRUCTURES = ("arx", "armax", "oe")
 
 
 class _Residuals:
-    """The ``residuals`` field: the array an estimator passed, or, when it passed its estimation
-    record as ``estimation_data`` instead, the one-step prediction errors computed from that record
-    on first access (issue 14: a large ARX fit keeps no N-sample array a user may never read, so
+    """The ``estimation_residuals`` field: the array an estimator passed, or, when it passed its
+    estimation record as ``estimation_data`` instead, the one-step prediction errors computed from
+    that record on first access (issue 14: a large ARX fit keeps no N-sample array a user may never read, so
     its memory stays O(p²) beyond the data). The computed errors must reproduce the fit's loss:
     a record changed in place after the fit raises instead of giving other residuals."""
 
@@ -72,8 +81,9 @@ def _coeffs(x, name: str, monic: bool) -> np.ndarray:
 
 
 @dataclass(frozen=True, eq=False)
-class PolynomialModel:
-    """A discrete-time SISO polynomial model with its uncertainty and fit diagnostics.
+class PolynomialModel(IdentifiedLinearModel):
+    """A discrete-time SISO polynomial model with its uncertainty and fit diagnostics, on the
+    protocol of :class:`~gripkit.sysid.linear.linear_model.IdentifiedLinearModel`.
 
     Build one with :func:`gripkit.sysid.linear.arx`, :func:`~gripkit.sysid.linear.armax`,
     :func:`~gripkit.sysid.linear.oe`, or from known coefficients with :meth:`from_coefficients`.
@@ -103,13 +113,15 @@ class PolynomialModel:
         One-step-ahead prediction fit on the estimation data, ``100 (1 − ‖y − ŷ‖/‖y − ȳ‖)``.
     n_samples
         Samples in the estimation record (N); ``n_used`` = M = N − start prediction errors.
-    residuals
-        One-step prediction errors e(t), t = start … N−1 (read-only). :func:`gripkit.sysid.linear.arx`
-        computes them on first access from ``estimation_data``.
+    estimation_residuals
+        One-step prediction errors e(t), t = start … N−1, on the estimation record (read-only).
+        :func:`gripkit.sysid.linear.arx` computes them on first access from ``estimation_data``.
+        (``residuals(data)`` computes them on any record.) Not written to the model file.
     estimation_data
         ``(u, y)``, references to the record the model was fitted on (no copy), or None: the
-        source of ``residuals`` when the estimator did not keep them. Changing those arrays in
-        place after the fit makes ``residuals`` raise a DataError.
+        source of ``estimation_residuals`` when the estimator did not keep them. Changing those
+        arrays in place after the fit makes ``estimation_residuals`` raise a DataError. Not
+        written to the model file.
     input_name, output_name, input_unit, output_unit
         Channel names and SI units of the data.
     u_offset, y_offset
@@ -117,6 +129,9 @@ class PolynomialModel:
         the deviations ``u − u_offset`` and ``y − y_offset``.
     info
         Method details: solver, iterations, condition number, source.
+    data_file, data_hash, display_units
+        Provenance of the estimation data and the units its file showed the columns in, as
+        :class:`~gripkit.sysid.LinearModel` has them (:meth:`with_display_units`).
     """
 
     A: np.ndarray
@@ -132,7 +147,7 @@ class PolynomialModel:
     fit_percent: float | None = None
     n_samples: int | None = None
     n_used: int | None = None
-    residuals: np.ndarray | None = _Residuals()
+    estimation_residuals: np.ndarray | None = _Residuals()
     estimation_data: tuple | None = field(default=None, repr=False)
     input_name: str = "u"
     output_name: str = "y"
@@ -141,6 +156,9 @@ class PolynomialModel:
     u_offset: float = 0.0
     y_offset: float = 0.0
     info: dict = field(default_factory=dict)
+    data_file: str | None = None
+    data_hash: str | None = None
+    display_units: dict = field(default_factory=dict)
 
     def __post_init__(self):
         set_ = object.__setattr__
@@ -171,14 +189,15 @@ class PolynomialModel:
                 raise ModelError(f"covariance: expected shape ({p}, {p}), found {cov.shape}")
             cov.flags.writeable = False
             set_(self, "covariance", cov)
-        r = self.stored_residuals  # not self.residuals: that would compute them now
+        r = self.stored_residuals  # not estimation_residuals: that would compute them now
         if r is not None:
             # a read-only float64 array is kept as it is (an estimator's fresh residuals, or a
             # replace()): copying N samples again would double the memory of a large fit
             if not (isinstance(r, np.ndarray) and r.dtype == np.float64 and not r.flags.writeable):
                 r = np.array(r, dtype=np.float64)
                 r.flags.writeable = False
-            set_(self, "residuals", r)
+            set_(self, "estimation_residuals", r)
+        set_(self, "display_units", _checked_display_units(self, dict(self.display_units or {})))
 
     # ------------------------------------------------------------------ construction
     @classmethod
@@ -211,7 +230,7 @@ class PolynomialModel:
 
     def replace(self, **changes) -> "PolynomialModel":
         """A copy with some fields changed (residuals not yet computed stay so)."""
-        changes.setdefault("residuals", self.stored_residuals)
+        changes.setdefault("estimation_residuals", self.stored_residuals)
         return dataclasses.replace(self, **changes)
 
     def __getstate__(self) -> dict:
@@ -219,14 +238,14 @@ class PolynomialModel:
         come from: N numbers rather than the 2N of ``(u, y)``, and no tie to the caller's arrays."""
         state = dict(self.__dict__)
         if state.get("estimation_data") is not None:
-            state["_residuals"] = self.residuals
+            state["_residuals"] = self.estimation_residuals
             state["estimation_data"] = None
         return state
 
     @property
     def stored_residuals(self) -> np.ndarray | None:
-        """The residual array the model holds, or None while ``residuals`` has not been computed
-        from ``estimation_data`` (reading this never computes them)."""
+        """The residual array the model holds, or None while ``estimation_residuals`` has not been
+        computed from ``estimation_data`` (reading this never computes them)."""
         return self.__dict__.get("_residuals")
 
     def _residuals_from_record(self) -> np.ndarray:
@@ -363,7 +382,7 @@ class PolynomialModel:
 
     # ------------------------------------------------------------------ the linear system
     @functools.cached_property
-    def lti(self) -> TransferFunction:
+    def system(self) -> TransferFunction:
         """The input-output part ``y = B(q)/(A(q) F(q)) u`` as a discrete
         :class:`gripkit.lti.TransferFunction`, with the channel names and units, ``dt`` and the
         parameter covariance over ``parameter_names`` (the c's of an ARMAX model with zero
@@ -373,10 +392,6 @@ class PolynomialModel:
             inputs=self.input_name, outputs=self.output_name, input_units=self.input_unit,
             output_units=self.output_unit)
 
-    def to_lti(self) -> TransferFunction:
-        """:attr:`lti` (the same object)."""
-        return self.lti
-
     # ------------------------------------------------------------------ analysis
     @property
     def denominator(self) -> np.ndarray:
@@ -385,58 +400,58 @@ class PolynomialModel:
 
     def poles(self) -> np.ndarray:
         """Roots of A(z)·F(z) (the delay's poles at the origin are not listed): the first
-        ``na + nf`` poles of :attr:`lti` (np.roots lists the origin roots last)."""
-        return self.lti.poles()[:self.denominator.size - 1]
+        ``na + nf`` poles of :attr:`system` (np.roots lists the origin roots last)."""
+        return self.system.poles()[:self.denominator.size - 1]
 
     def zeros(self) -> np.ndarray:
         """Roots of B(z) without its delay: the ``nb − 1`` roots of ``[b_nk, ..., b_last]`` (the
-        first zeros of :attr:`lti`; the origin zeros of the q⁻¹ padding come last)."""
-        return self.lti.zeros()[:np.trim_zeros(self.B).size - 1]
-
-    @property
-    def stable(self) -> bool:
-        """All poles strictly inside the unit circle."""
-        return self.lti.is_stable()
+        first zeros of :attr:`system`; the origin zeros of the q⁻¹ padding come last)."""
+        return self.system.zeros()[:np.trim_zeros(self.B).size - 1]
 
     @property
     def minimum_phase(self) -> bool:
         """All zeros strictly inside the unit circle (the [2 2 2] model of Table II is not: its
         zero lies at z ≈ 1.167, §V-F)."""
-        return self.lti.is_minimum_phase()
+        return self.system.is_minimum_phase()
 
     @property
     def dc_gain(self) -> float:
         """Static gain B(1)/(A(1)F(1)) (±inf with an integrator)."""
         try:
-            return float(self.lti.dc_gain()[0, 0])
+            return float(self.system.dc_gain()[0, 0])
         except ModelError:  # a pole at z = 1
             num = float(np.sum(self.B))
             return math.copysign(math.inf, num) if num != 0 else math.nan
 
     def step(self, n: int) -> np.ndarray:
         """Response to a unit step applied at sample 0, from rest, ``n`` samples."""
-        return self.lti.step(int(n))[:, 0, 0]
+        return self.system.step(int(n))[:, 0, 0]
 
     def impulse(self, n: int) -> np.ndarray:
         """Response to a unit pulse at sample 0, from rest, ``n`` samples."""
-        return self.lti.impulse(int(n))[:, 0, 0]
+        return self.system.impulse(int(n))[:, 0, 0]
 
-    def frequency_response(self, f=None, n: int = 512) -> tuple[np.ndarray, np.ndarray]:
-        """``(f_Hz, H)``: the complex response of B/(A F) at ``f`` (Hz; default ``n`` points from
-        0 up to, not including, the Nyquist frequency), ``H = B(e^{-jωdt}) / (A F)(e^{-jωdt})``."""
-        f = np.linspace(0.0, 0.5 / self.dt, int(n), endpoint=False) if f is None \
-            else np.atleast_1d(np.asarray(f, dtype=np.float64))
-        return f, self.lti.frequency_response(2.0 * np.pi * f)[:, 0, 0]
+    def frequency_response(self, w=None, n: int = 512) -> tuple[np.ndarray, np.ndarray]:
+        """``(w, H)``: the complex response of B/(A F) at the angular frequencies ``w`` (rad/s,
+        as every gripkit frequency response; default ``n`` points from 0 up to, not including,
+        the Nyquist frequency π/dt), ``H = B(e^{-jωdt}) / (A F)(e^{-jωdt})``."""
+        w = np.linspace(0.0, np.pi / self.dt, int(n), endpoint=False) if w is None \
+            else np.atleast_1d(np.asarray(w, dtype=np.float64))
+        return w, self.system.frequency_response(w)[:, 0, 0]
 
     # ------------------------------------------------------------------ simulation and prediction
-    def simulate(self, u, *, initial: str = "rest", y_past=None, u_past=None) -> np.ndarray:
-        """Free-run output ``ŷ = B/(A F) u`` (no noise), shape (N,), in deviation units
+    def simulate(self, data, x0=None, *, initial: str = "rest", y_past=None,
+                 u_past=None) -> np.ndarray:
+        """Free-run output ``ŷ = B/(A F) u`` (no noise): of a trajectory, (N, 1) in its units
+        (:meth:`IdentifiedLinearModel.simulate`); of deviation inputs ``u``, shape (N,)
         (:meth:`gripkit.lti.TransferFunction.simulate`).
 
         Parameters
         ----------
-        u
-            Input samples u(0) … u(N−1), shape (N,).
+        data
+            A trajectory, or the input samples u(0) … u(N−1), shape (N,).
+        x0
+            Initial state of :attr:`system` (default rest); or ``initial='given'``.
         initial
             ``'rest'``: zero past inputs and outputs (say so explicitly: gripkit never assumes
             it silently in validation). ``'given'``: use ``y_past`` and ``u_past``.
@@ -444,13 +459,18 @@ class PolynomialModel:
             The samples before u(0), in time order (most recent last); at least
             ``len(A F) − 1`` outputs and ``len(B) − 1`` inputs are used (missing ones count 0).
         """
+        if isinstance(data, Trajectory):
+            if initial != "rest":
+                raise DataError("initial='given' takes deviation arrays, not a trajectory")
+            return super().simulate(data, x0)
+        u = data
         if initial == "rest":
             if y_past is not None or u_past is not None:
                 raise DataError("initial='rest' takes no y_past/u_past; use initial='given'")
-            return self.lti.simulate(u)[:, 0]
+            return self.system.simulate(u, x0)[:, 0]
         if initial != "given":
             raise DataError(f"initial: expected 'rest' or 'given', found {initial!r}")
-        g = self.lti
+        g = self.system
         x0 = g.initial_state(np.zeros(0) if u_past is None else u_past, np.zeros(0) if y_past is None else y_past)
         return g.simulate(u, x0)[:, 0]
 
@@ -475,13 +495,52 @@ class PolynomialModel:
 
         return _sig.lfilter([1.0], self.C, v)
 
-    def predict(self, u, y) -> np.ndarray:
-        """One-step-ahead prediction ŷ(t | t−1), shape (N,). The first ``start`` samples are the
-        record's own values (they are the initial conditions of the predictor)."""
-        y = np.asarray(y, dtype=np.float64)
+    def predict(self, data, y=None, horizon: int = 1) -> np.ndarray:
+        """``ŷ(t | t − horizon)``: of a trajectory (N, 1) in its units, of deviation arrays
+        ``u``, ``y`` shape (N,). ``horizon = 1``: the exact one-step predictor of the
+        polynomials, the first ``start`` samples being the record's own values (the predictor's
+        initial conditions); ``horizon > 1``: :func:`~.linear_model.k_step_prediction` on
+        :meth:`innovation_form`."""
+        if isinstance(data, Trajectory):
+            return super().predict(data, horizon=horizon)
+        u, y = np.asarray(data, dtype=np.float64), np.asarray(y, dtype=np.float64)
+        h = _horizon(horizon)
+        return self._prediction(u.reshape(-1, 1), y.reshape(-1, 1), self.dt, h)[:, 0]
+
+    def _prediction(self, u, y, dt, horizon: int) -> np.ndarray:
+        if horizon > 1:
+            return k_step_prediction(*self._state_space(dt), u, y, horizon)
         out = y.copy()
-        out[self.start:] = y[self.start:] - self.prediction_errors(u, y)
+        out[self.start:, 0] = y[self.start:, 0] - self.prediction_errors(u[:, 0], y[:, 0])
         return out
+
+    def residuals(self, data, y=None) -> np.ndarray:
+        """One-step prediction errors :meth:`prediction_errors` from sample ``start`` on: of a
+        trajectory (N − start, 1), of deviation arrays ``u``, ``y`` shape (N − start,)."""
+        if isinstance(data, Trajectory):
+            u, yy, _, _ = self._io(data, None, "residuals of an identified model")
+            return self.prediction_errors(u[:, 0], yy[:, 0]).reshape(-1, 1)
+        return self.prediction_errors(data, y)
+
+    def innovation_form(self) -> tuple[np.ndarray, ...]:
+        """``(A, B, C, D, K)`` of ``y = B/(A F) u + C/A e`` in innovation form,
+        ``x⁺ = A x + B u + K e``, ``y = C x + D u + e``: the controllable realisation of the
+        two-input transfer function ``[B, C F]/(A F)`` (both monic denominators), transposed."""
+        from scipy import signal as _sig
+
+        den = np.convolve(self.A, self.F)
+        nums = [self.B, np.convolve(self.C, self.F)]
+        L = max(den.size, *(v.size for v in nums))
+        pad = lambda v: np.concatenate([v, np.zeros(L - v.size)])  # noqa: E731  (q⁻¹ → z layout)
+        A, B, C, D = _sig.tf2ss(np.vstack([pad(v) for v in nums]), pad(den))
+        A, Bt, Ct, Dt = A.T, C.T, B.T, D.T  # the transpose: one output, the inputs u and e
+        return A, Bt[:, :1], Ct, Dt[:, :1], Bt[:, 1:]
+
+    def _state_space(self, dt):
+        if dt is not None and abs(dt - self.dt) > 1e-9 * self.dt:
+            raise DataError(f"data: sampled every {dt:g} s, the model every {self.dt:g} s",
+                            hint="resample the data to the model's rate")
+        return self.innovation_form()
 
     def validate(self, u, y, **kw):
         """Free-run and one-step validation on a separate record; see
@@ -492,22 +551,73 @@ class PolynomialModel:
     def to_scipy(self):
         """``scipy.signal.dlti`` transfer function B/(A F) with ``dt`` (the delay appears as
         poles at the origin): ``lti.to_scipy()``."""
-        return self.lti.to_scipy()
+        return self.system.to_scipy()
 
-    def to_statespace(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Discrete state-space matrices ``(Ad, Bd, Cd, Dd)`` of B/(A F) (controller canonical form,
-        delay included as states, as ``scipy.signal.tf2ss``): ``x⁺ = Ad x + Bd u``, ``y = Cd x + Dd u``."""
-        return self.lti.to_ss(minimal=False, form="controllable")._arrays()
+    def to_ss(self, dt: float | None = None, form: str = "observable") -> StateSpace:
+        """B/(A F) as a :class:`gripkit.lti.StateSpace` (delay included as states);
+        ``form='controllable'`` is scipy's ``tf2ss`` realisation. With ``dt``, the model's own
+        sample time is checked (:meth:`IdentifiedLinearModel.to_ss`)."""
+        if form == "observable":
+            return super().to_ss(dt)
+        self._state_space(dt)
+        return self.system.to_ss(minimal=False, form=form)
 
-    def to_control(self):
-        """``control.TransferFunction`` B/(A F) with ``dt`` and the channel names (needs
-        python-control: ``pip install 'gripkit[interop]'``)."""
-        return self.lti.to_control()
+    # ------------------------------------------------------------------ the model file
+    def linear_record(self) -> LinearModel:
+        """The model's system part as a :class:`~gripkit.sysid.LinearModel` on B/(A F) (what
+        the ``system`` of its model file holds): the parameter covariance (the noise polynomial
+        C keeps its place, with zero tangents), names, units and offsets."""
+        info = {"label": self.label, "A": self.A, "B": self.B, "C": self.C, "F": self.F,
+                "nk": self.nk, "one_step_fit_percent": self.fit_percent,
+                "noise_variance": self.noise_variance,
+                "parameter_names": list(self.parameter_names),
+                **{k: v for k, v in self.info.items() if isinstance(v, (str, int, float))}}
+        return LinearModel(self.system, self.structure, u_offset=(self.u_offset,),
+                           y_offset=(self.y_offset,), n_samples=self.n_samples,
+                           data_file=self.data_file, data_hash=self.data_hash,
+                           display_units=self.display_units,
+                           noise_covariance=None if self.noise_variance is None
+                           else np.array([[self.noise_variance]]), info=info)
 
-    def save(self, path) -> None:
-        """Write the model file (JSON, :func:`gripkit.sysid.linear.linear_model.save_model`); reload it with
-        :func:`gripkit.sysid.load_model` (as a :class:`gripkit.sysid.LinearModel`)."""
-        save_model(self, path)
+    def polynomial_section(self) -> dict:
+        """The ``polynomial`` section of the model file: what :meth:`from_document` needs to
+        build this model again (every field but the record-bound ``estimation_residuals`` and
+        ``estimation_data``)."""
+        return {"A": self.A, "B": self.B, "C": self.C, "F": self.F, "nk": self.nk,
+                "covariance": self.covariance, "noise_variance": self.noise_variance,
+                "loss": self.loss, "fit_percent": self.fit_percent, "n_used": self.n_used,
+                "info": self.info}
+
+    @classmethod
+    def from_document(cls, doc: dict, lm: LinearModel, where: str) -> "PolynomialModel":
+        """The model of a model file's document ``doc`` whose system part was read as ``lm``;
+        a version-1 file (coefficients in ``info``, covariance in the system's) is migrated."""
+        poly = doc.get("polynomial")
+        if poly is None:  # schema_version 1: the coefficients in info, the covariance the system's
+            info = dict(lm.info)
+            unc = lm.system.uncertainty
+            poly = {k: info.pop(k) for k in ("A", "B", "C", "F", "nk")}
+            poly.update(covariance=None if unc is None else unc.covariance,
+                        noise_variance=info.pop("noise_variance", None),
+                        fit_percent=info.pop("one_step_fit_percent", None))
+            for k in ("label", "parameter_names"):
+                info.pop(k, None)
+            poly["info"] = info
+        try:
+            return cls(A=poly["A"], B=poly["B"], nk=int(poly["nk"]), C=poly["C"], F=poly["F"],
+                       dt=lm.dt, structure=lm.structure, covariance=poly.get("covariance"),
+                       noise_variance=poly.get("noise_variance"), loss=poly.get("loss"),
+                       fit_percent=poly.get("fit_percent"), n_samples=lm.n_samples,
+                       n_used=poly.get("n_used"), input_name=lm.inputs[0],
+                       output_name=lm.outputs[0], input_unit=lm.system.input_units[0],
+                       output_unit=lm.system.output_units[0], u_offset=lm.u_offset[0],
+                       y_offset=lm.y_offset[0], info=dict(poly.get("info") or {}),
+                       data_file=lm.data_file, data_hash=lm.data_hash,
+                       display_units=lm.display_units)
+        except (ModelError, ValueError, TypeError) as exc:
+            msg = exc.message if isinstance(exc, ModelError) else str(exc)
+            raise ModelError(f"model file {where}: its polynomial section is malformed ({msg})",
+                             hint="regenerate the file with gripkit identify --out") from None
 
     def to_dict(self) -> dict:
         """JSON-ready summary (complex numbers as ``[re, im]`` pairs)."""
@@ -559,6 +669,18 @@ class PolynomialModel:
 
     def __repr__(self) -> str:
         return f"PolynomialModel({self.label}, A={self.A.tolist()}, B={self.B.tolist()}, dt={self.dt:g})"
+
+
+def load_linear_model(path) -> IdentifiedLinearModel:
+    """Read a file of schema ``gripkit.linear-model`` (:func:`gripkit.sysid.load_model`'s reader
+    of it): a :class:`PolynomialModel` for a file with a ``polynomial`` section, and for a
+    version-1 ARX/ARMAX/OE file (migrated: its coefficients were in ``info``, its covariance in
+    the system's; loss, ``n_used`` and the residuals were not written), else the
+    :class:`~gripkit.sysid.LinearModel` (:func:`~.linear_model.read_linear_model`)."""
+    doc, lm, where = read_linear_model(path)
+    if "polynomial" in doc or polynomial_document(doc):
+        return PolynomialModel.from_document(doc, lm, where)
+    return lm
 
 
 #: the ``**meta`` keywords of :func:`~gripkit.sysid.linear.arx`, :func:`~gripkit.sysid.linear.armax` and :func:`~gripkit.sysid.linear.oe`

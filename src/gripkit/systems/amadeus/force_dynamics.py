@@ -210,7 +210,7 @@ class FingerForcePlant:
         current limits (A, displayed mA).
     model
         The :class:`~gripkit.sysid.PolynomialModel` (SI): ``poles()``, ``zeros()``, ``step()``,
-        ``frequency_response()``, ``to_statespace()``, ``to_control()``, ``to_scipy()``.
+        ``frequency_response()`` (rad/s), ``to_ss()``, ``to_control()``, ``to_scipy()``.
     """
 
     name = "amadeus-finger-force"
@@ -263,9 +263,9 @@ class FingerForcePlant:
 
     # -- properties a controller designer needs (lti, or A, B, dt, make it a plant for design_rst)
     @property
-    def lti(self):
-        """The model as a :class:`gripkit.lti.TransferFunction` (SI, with σ): ``model.lti``."""
-        return self.model.lti
+    def system(self):
+        """The model as a :class:`gripkit.lti.TransferFunction` (SI, with σ): ``model.system``."""
+        return self.model.system
 
     @property
     def force_scale(self) -> float:
@@ -338,10 +338,10 @@ class FingerForcePlant:
         return Trajectory.uniform(dt=DT, units={k: ("A" if k == "current" else "N") for k in ch},
                                   meta={"source": f"simulated {self.name}"}, **ch)
 
-    def to_statespace(self):
-        """``(Ad, Bd, Cd, Dd)`` at 200 Hz for deviations (current − 0.850 A → force), delay states
-        included; see :meth:`gripkit.sysid.PolynomialModel.to_statespace`."""
-        return self.model.to_statespace()
+    def to_ss(self):
+        """The :class:`gripkit.lti.StateSpace` at 200 Hz for deviations (current − 0.850 A →
+        force), delay states included (:meth:`gripkit.sysid.PolynomialModel.to_ss`)."""
+        return self.model.to_ss()
 
     def to_control(self):
         """python-control transfer function (N/A, dt = 5 ms)."""

@@ -132,7 +132,8 @@ from ...models.beams import STRETCHING_BETA, clamped_clamped_stiffness
 from ...models.comb_drive import comb_drive_coefficient
 from ...models.second_order import second_order_batch
 from ...params import Parameter, ParameterSet
-from ...sim.linear import StateSpace, c2d_zoh, simulate_discrete
+from ...lti import StateSpace
+from ...sim.linear import c2d_zoh, simulate_discrete
 from ...sim.model import Model, Signal
 from .parameters import (DT, R_SENSITIVITY, SEED, SEED_EQ10, SEED_EQ17, STATIC_70V, ftg100_geometry,
                          ftg100_parameters, plant_table)
@@ -307,7 +308,7 @@ class _SecondOrderFTG(Model):
         the seed prints (eqs 10, 17; balancing scale chosen in the seed's units), ``'physical'``
         keeps the states [y, ẏ]."""
         dt = sample_interval(dt, ModelError)
-        d = self.state_space().discretize(dt)
+        d = self.state_space().c2d(dt)
         if form == "physical":
             return d
         if form != "canonical":
@@ -543,7 +544,7 @@ class FTG100Coupled(Model):
         if form != "physical":
             raise ModelError(f"form: expected 'canonical' or 'physical', found {form!r}")
         dt = sample_interval(dt, ModelError)
-        return self.state_space().discretize(dt)
+        return self.state_space().c2d(dt)
 
     def discrete_eq18(self, dt: float = DT) -> StateSpace:
         """The seed's eq 18: [[A_a, 0], [B_c k_k C_a, A_c]] from the canonical subsystems (eqs 10, 17);

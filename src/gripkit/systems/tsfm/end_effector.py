@@ -36,7 +36,7 @@ import numpy as np
 
 from ...errors import DataError
 from ...params import Parameter, ParameterSet
-from ...sim.linear import StateSpace
+from ...lti import StateSpace
 
 __all__ = ["LeverCoefficients", "lever_coefficients", "sensor_state_space", "end_effector_parameters",
            "sensor_parameters"]

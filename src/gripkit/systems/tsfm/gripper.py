@@ -61,7 +61,7 @@ from ...params import Parameter, ParameterSet
 from ...sim.hybrid import (DEFAULT_LEVELS, MAX_EVENTS_PER_STEP, EventWork, Guard, HybridSystem,
                            Mode, PWAGuards, pwa_output, pwa_step)
 from ...sim.integrators import zoh_levels
-from ...sim.linear import StateSpace
+from ...lti import StateSpace
 from ...sim.model import Model, Signal
 from .end_effector import end_effector_parameters, lever_coefficients, sensor_parameters, sensor_state_space
 

@@ -1,0 +1,217 @@
+"""Issue 23, item 1: every identified model family on one protocol (gripkit.sysid.model_protocol).
+
+For each family (ARX SISO, MISO and MIMO, ARMAX, OE, N4SID, PEM, tfest, NARX): the model is an
+IdentifiedModel, save → load_model gives back the same type with the same public attributes
+(walked by :func:`assert_same_public`) and bit-identical simulate() and compare(); a model file of
+schema gripkit.linear-model version 1 (written by gripkit 0.1.0 before this change, kept in
+tests/sysid/data/model_v1) loads, migrated; and the one validation fit, prediction and residuals
+agree with their definitions."""
+
+import json
+
+import numpy as np
+import pytest
+
+from gripkit import Trajectory
+from gripkit.errors import ArgumentError
+from gripkit.io import load
+from gripkit.lti import LinearSystem
+from gripkit.params import ParameterSet
+from gripkit.sysid import (IdentifiedLinearModel, IdentifiedModel, LinearModel, ModelFit,
+                           NARXModel, PolynomialModel, armax, arx, load_model, n4sid, narx, oe,
+                           pem, tfest)
+
+from mimo_systems import oe_data, two_by_two
+from pathlib import Path
+
+V1 = Path(__file__).parent / "data" / "model_v1"
+#: record-bound attributes a model file does not hold (documented at PolynomialModel)
+NOT_IN_FILE = {"estimation_residuals", "estimation_data", "stored_residuals"}
+
+
+def _same(a, b, where):
+    if isinstance(a, ParameterSet):
+        a, b = ([(p.name, p.value, p.unit, p.std) for p in x.values()] for x in (a, b))
+    if isinstance(a, LinearSystem):
+        a, b = a.to_dict(), b.to_dict()
+    if isinstance(a, dict):
+        assert isinstance(b, dict) and sorted(a) == sorted(b), where
+        for k in a:
+            _same(a[k], b[k], f"{where}[{k!r}]")
+        return
+    if isinstance(a, np.ndarray) and a.dtype != object:
+        np.testing.assert_array_equal(a, np.asarray(b, dtype=a.dtype), err_msg=where)
+        return
+    if isinstance(a, (np.ndarray, list, tuple)):
+        assert len(a) == len(b), where
+        for i, (va, vb) in enumerate(zip(a, b)):
+            _same(va, vb, f"{where}[{i}]")
+        return
+    if isinstance(a, float) and isinstance(b, float) and np.isnan(a):
+        assert np.isnan(b), where
+        return
+    assert a == b, f"{where}: {a!r} != {b!r}"
+
+
+def assert_same_public(m, back):
+    """Every public non-callable attribute of ``m`` (fields and properties) equals ``back``'s."""
+    names = [n for n in dir(m) if not n.startswith("_") and n not in NOT_IN_FILE]
+    seen = 0
+    for n in names:
+        a = getattr(m, n)
+        if callable(a) and not isinstance(a, (LinearSystem, ParameterSet)):
+            continue
+        _same(a, getattr(back, n), n)
+        seen += 1
+    assert seen >= 10  # the walk did look at the attributes
+
+
+def _siso(n=1500, seed=0):
+    rng = np.random.default_rng(seed)
+    u = rng.standard_normal(n)
+    y = np.zeros(n)
+    for t in range(2, n):
+        y[t] = 1.2 * y[t - 1] - 0.5 * y[t - 2] + 0.8 * u[t - 1] + 0.3 * u[t - 2]
+    return u, y + 0.02 * rng.standard_normal(n)
+
+
+def _families():
+    u, y = _siso()
+    meta = dict(dt=0.01, input_name="current", output_name="force", input_unit="A",
+                output_unit="N", u_offset=0.5, y_offset=1.0)
+    g = two_by_two()
+    U, Y = oe_data(g, 2000, 0.05, seed=1)
+    names = dict(inputs=["a", "b"], outputs=["c", "d"], input_units=["V", "V"],
+                 output_units=["N", "m"])
+    ss = n4sid(U, Y, 4, dt=0.01, u_offset=[1.0, 0.0], y_offset=[3.0, -1.0], **names)
+    return {
+        "arx siso": (arx(u, y, 2, 2, 1, **meta), ["current"], u, y),
+        "arx miso": (arx(U, Y[:, :1], 2, 2, 1, dt=0.01), ["a", "b"], U, Y[:, :1]),
+        "arx mimo": (arx(U, Y, 2, 2, 1, dt=0.01), ["a", "b"], U, Y),
+        "armax": (armax(u, y, 2, 2, 1, 1, **meta), ["current"], u, y),
+        "oe": (oe(u, y, 2, 2, 1, **meta), ["current"], u, y),
+        "n4sid": (ss, ["a", "b"], U, Y),
+        "pem": (pem(ss, u=U, y=Y), ["a", "b"], U, Y),
+        "tfest": (tfest(u, y, 2, 1, dt=0.01, inputs=["current"], outputs=["force"]),
+                  ["current"], u, y),
+        "narx": (narx(u, y, degree=2, lags=2, dt=0.01), ["u"], u, y),
+    }
+
+
+FAMILIES = _families()
+
+
+def _record(m, u, y):
+    """A trajectory with the model's columns (offsets added back where the model has them)."""
+    u, y = np.asarray(u).reshape(len(u), -1), np.asarray(y).reshape(len(y), -1)
+    uo = np.atleast_1d(getattr(m, "u_offset", 0.0)) * np.ones(u.shape[1])
+    yo = np.atleast_1d(getattr(m, "y_offset", 0.0)) * np.ones(y.shape[1])
+    cols = {n: u[:, i] + uo[i] for i, n in enumerate(m.inputs)}
+    cols |= {n: y[:, i] + yo[i] for i, n in enumerate(m.outputs)}
+    return Trajectory.uniform(dt=0.01, **cols)
+
+
+@pytest.mark.parametrize("family", list(FAMILIES))
+def test_round_trip_same_type_attributes_simulation_and_fit(family, tmp_path):
+    m, _, u, y = FAMILIES[family]
+    assert isinstance(m, IdentifiedModel)
+    path = tmp_path / "m.json"
+    m.save(path)
+    back = load_model(path)
+    assert type(back) is type(m)
+    assert_same_public(m, back)
+    tr = _record(m, u, y)
+    np.testing.assert_array_equal(back.simulate(tr), m.simulate(tr))
+    fit, fit_back = m.compare(tr), back.compare(tr)
+    assert isinstance(fit, ModelFit) and fit.definition == m.fit_definition
+    assert fit_back.fit_percent == fit.fit_percent and fit.outputs == tuple(m.outputs)
+    np.testing.assert_array_equal(fit_back.simulated, fit.simulated)
+    assert None not in fit.fit_percent                                # a stable model
+    if family not in ("arx miso", "arx mimo"):  # ARX [2 2 1] is not the order-4 2x2 system
+        assert min(fit.fit_percent) > 90.0
+
+
+@pytest.mark.xfail(strict=True, reason="issue 23 not done: arx of several columns still returns "
+                   "the LinearModel of sysid/linear/arx_mimo.py")
+def test_arx_returns_one_type_whatever_the_number_of_inputs():
+    types = {type(FAMILIES[k][0]) for k in ("arx siso", "arx miso", "arx mimo")}
+    assert types == {PolynomialModel}, types
+
+
+def test_linear_families_share_one_hierarchy_and_one_validation_fit():
+    """The linear models are IdentifiedLinearModels: compare() is VALIDATION_FIT (free run, x0 by
+    least squares) whatever the family, so an ARX model and its state-space record score alike."""
+    from gripkit.sysid.linear.linear_model import VALIDATION_FIT
+
+    for k, (m, *_rest) in FAMILIES.items():
+        if k != "narx":
+            assert isinstance(m, IdentifiedLinearModel) and m.fit_definition == VALIDATION_FIT
+    m, _, u, y = FAMILIES["arx siso"]
+    tr = _record(m, u, y)
+    assert m.compare(tr).fit_percent == m.linear_record().compare(tr).fit_percent
+
+
+def test_narx_states_its_free_run_from_measured_outputs():
+    from gripkit.sysid.nonlinear.narx import NARX_FIT
+
+    m, _, u, y = FAMILIES["narx"]
+    assert m.structure == "narx" and m.fit_definition == NARX_FIT and "measured" in NARX_FIT
+    assert m.initial_state == "measured" and m.inputs == ("u",) and m.outputs == ("y",)
+    assert m.compare(u, y).fit_percent == [m.fit_percent]   # the estimation fit, same definition
+    p = m.parameters
+    assert len(p) == len(m.terms) and [q.std for q in p.values()] == m.theta_std.tolist()
+
+
+def test_v1_files_load_migrated():
+    """Files written before the polynomial section (schema_version 1, gripkit 0.1.0 at commit
+    0622ce5): an ARX/OE file comes back as a PolynomialModel with its coefficients, their σ (the
+    covariance of the file's transfer function) and the one-step fit; its validation fit on the
+    record is the one the version-1 reader gave (71.42703155216157 % and 23.793626275994704 %,
+    computed at 0622ce5 with validation_fit); a state-space file is a LinearModel as before."""
+    tr = load(V1 / "record.csv")
+    for name, fit in (("arx_221", 71.42703155216157), ("oe_221", 23.793626275994704)):
+        doc = json.loads((V1 / f"{name}.json").read_text())
+        assert doc["schema_version"] == 1 and "polynomial" not in doc
+        m = load_model(V1 / f"{name}.json")
+        assert type(m) is PolynomialModel and m.structure == doc["structure"]
+        np.testing.assert_array_equal(m.B, doc["info"]["B"])
+        np.testing.assert_array_equal(m.covariance, doc["system"]["uncertainty"]["covariance"])
+        assert m.fit_percent == doc["info"]["one_step_fit_percent"] and m.loss is None
+        assert (m.u_offset, m.y_offset) == (doc["inputs"][0]["offset"], doc["outputs"][0]["offset"])
+        assert (m.input_name, m.output_unit, m.dt) == ("current", "N", 0.01)
+        assert m.compare(tr).fit_percent == [fit]
+    m = load_model(V1 / "arx_221.json")
+    np.testing.assert_allclose(m.A_std[1:], np.sqrt(np.diag(m.covariance))[:2], rtol=0)
+    s = load_model(V1 / "n4sid_2x2.json")
+    assert type(s) is LinearModel and s.inputs == ("current", "voltage") and s.order == 2
+
+
+def test_arx_prediction_horizons_against_the_difference_equation():
+    """ARX [2 2 1] known coefficients, noise-free data: ŷ(t|t−1) is the measured output (the
+    predictor is exact after na samples), and ŷ(t|t−2) equals the recursion that replaces y(t−1)
+    by its own one-step prediction."""
+    a1, a2, b1, b2 = -1.2, 0.5, 0.8, 0.3
+    m = PolynomialModel.from_coefficients([1.0, a1, a2], [0.0, b1, b2], dt=0.01)
+    rng = np.random.default_rng(4)
+    u = rng.standard_normal(400)
+    y = np.zeros(400)
+    for t in range(2, 400):
+        y[t] = -a1 * y[t - 1] - a2 * y[t - 2] + b1 * u[t - 1] + b2 * u[t - 2]
+    np.testing.assert_allclose(m.predict(u, y)[2:], y[2:], atol=1e-12)
+    y1 = -a1 * y[1:-2] - a2 * y[:-3] + b1 * u[1:-2] + b2 * u[:-3]            # ŷ(t−1|t−2), t ≥ 3
+    ref = -a1 * y1 - a2 * y[1:-2] + b1 * u[2:-1] + b2 * u[1:-2]             # ŷ(t|t−2)
+    np.testing.assert_allclose(m.predict(u, y, horizon=2)[3:], ref, atol=1e-9)
+    assert np.max(np.abs(m.residuals(u, y))) < 1e-12
+    with pytest.raises(ArgumentError, match="horizon: expected a whole number"):
+        m.predict(u, y, horizon=0)
+
+
+def test_state_space_prediction_with_k_zero_is_the_free_run():
+    """An output-error model (K = None) predicts by its free run for every horizon: predict(h)
+    equals compare's simulated output (the same least-squares x0)."""
+    m, _, U, Y = FAMILIES["n4sid"]
+    oe_model = m.replace(K=None)
+    tr = _record(oe_model, U, Y)
+    free = oe_model.compare(tr).simulated
+    for h in (1, 5):
+        np.testing.assert_allclose(oe_model.predict(tr, horizon=h), free, rtol=1e-9, atol=1e-9)
