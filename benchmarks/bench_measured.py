@@ -182,7 +182,8 @@ def _narx_row(ue, ye, uv, yv) -> dict:
     m = peer()
     return row("measured", f"polynomial NARX, degree 3, lags 2, BIC, {DATA}", measure(ours),
                "sysidentpy FROLS degree 3", measure(peer),
-               gripkit_accuracy=_fit_text(g.compare(uv, yv)) + f" ({len(g.terms)} terms)",
+               gripkit_accuracy=(_fit_text(g.compare(uv, yv).fit_percent[0])
+                                 + f" ({len(g.terms)} terms)"),
                peer_accuracy=_fit_text(_fit(yv, m.predict(X=uv[:, None], y=yv[:, None])))
                + f" ({m.final_model.shape[0]} terms)",
                notes="same model class; gripkit: FROLS + BIC + pruning of |θ|/σ < 2, fit over the "

@@ -85,7 +85,7 @@ def test_divergent_free_run_is_reported_not_scored():
     uv = np.full(500, -6.0)
     yv = -3.0 * (1.0 - 0.5 ** np.arange(500.0))            # a step response that settles
     with pytest.warns(StabilityWarning, match="diverges"):
-        assert m.compare(uv, yv) is None
+        assert m.compare(uv, yv).fit_percent == [None]
     with pytest.warns(StabilityWarning, match="diverges"):
         m4 = narx(u, y, degree=2, lags=2, terms=4, validate=(uv, yv))
     assert m4.validation_fit_percent is None
@@ -165,7 +165,8 @@ def test_cli_identify_narx_json_validate_and_model_file(dc_motor, tmp_path, caps
     py = narx(ue, ye, degree=3, lags=2, validate=(uv, yv))
     assert d["validation"]["fit_percent"] == pytest.approx(py.validation_fit_percent, abs=1e-6)
     assert d["structure"]["terms"] == py.terms and d["warnings"] == []
-    assert load_narx(model).compare(uv, yv) == pytest.approx(py.validation_fit_percent, abs=1e-6)
+    assert load_narx(model).compare(uv, yv).fit_percent[0] == pytest.approx(py.validation_fit_percent,
+                                                                          abs=1e-6)
     code, out, err = _cli(capsys, "compare", model, val, "--fs", 1, "--json")     # the same number
     assert code == 0, err
     fit = json.loads(out)["fit_percent"][0]
@@ -190,7 +191,8 @@ def test_identify_method_narx_on_a_trajectory(dc_motor):
     m = identify(tr, "narx", input="voltage", output="output", degree=3, lags=2)
     ref = narx(ue, ye, degree=3, lags=2)
     assert m.terms == ref.terms
-    assert m.compare(uv, yv) == pytest.approx(ref.compare(uv, yv), abs=1e-9)
+    assert m.compare(uv, yv).fit_percent[0] == pytest.approx(ref.compare(uv, yv).fit_percent[0],
+                                                             abs=1e-9)
     with pytest.raises(ArgumentError, match="banana"):
         identify(tr, "narx", input="voltage", output="output", banana=3)
 

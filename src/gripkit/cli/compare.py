@@ -141,7 +141,8 @@ def _compare_narx(model: Path, data: Path, fs, time, fill, json_out: bool) -> No
         warnings.simplefilter("always")
         m = load_narx(model)
         tr = load_data(data, [m.input_name, m.output_name], fs, time, fill)
-        fit = m.compare(np.asarray(tr[m.input_name]), np.asarray(tr[m.output_name]))
+        fit = m.compare(np.asarray(tr[m.input_name]),
+                        np.asarray(tr[m.output_name])).fit_percent[0]
     res = {"model": str(model), "data": str(data), "structure": "narx", "outputs": [m.output_name],
            "fit_percent": [fit], "initial_state": "measured", "definition": NARX_FIT,
            "warnings": report_warnings(caught)}

@@ -39,6 +39,9 @@ from numba import njit
 from ...atomic import write_text
 from ...errors import (ArgumentError, DataError, IdentificationError, ModelError, PathError,
                        StabilityWarning, emit_warning)
+from ...params import Parameter, ParameterSet
+from ...signals.trajectory import Trajectory
+from ..model_protocol import ModelFit
 
 __all__ = ["SCHEMA", "NARX_FIT", "NARXModel", "narx", "load_narx", "file_schema", "candidate_terms",
            "frols"]
@@ -212,7 +215,19 @@ class NARXModel:
     ``prediction_fit_percent`` (one step ahead), ``validation_fit_percent`` (free run on the
     ``validate=`` record; None when the run diverged or no record was given), ``criterion``
     (how the number of terms was chosen), ``err`` (error reduction ratio of each selected term,
-    in FROLS order, before pruning)."""
+    in FROLS order, before pruning).
+
+    The protocol of :mod:`gripkit.sysid.model_protocol`: ``structure`` ('narx'),
+    ``fit_definition`` (:data:`NARX_FIT`: the free run starts from the measured past outputs,
+    ``initial_state = 'measured'``), ``inputs``, ``outputs``, ``parameters``, ``simulate``,
+    ``predict``, ``compare`` → :class:`~gripkit.sysid.ModelFit`, ``residuals``, ``save``. Data
+    are a :class:`~gripkit.signals.Trajectory` (the columns ``input_name``, ``output_name``;
+    results (N, 1)) or the signals ``u``, ``y`` (N,)."""
+
+    structure = "narx"
+    fit_definition = NARX_FIT
+    #: how :meth:`compare` starts the free run: from the first ``max_lag`` measured outputs
+    initial_state = "measured"
 
     ylags: int
     ulags: int
@@ -235,6 +250,42 @@ class NARXModel:
     output_name: str = "y"
 
     @property
+    def inputs(self) -> tuple[str, ...]:
+        return (self.input_name,)
+
+    @property
+    def outputs(self) -> tuple[str, ...]:
+        return (self.output_name,)
+
+    @property
+    def parameters(self) -> ParameterSet:
+        """θ as a :class:`~gripkit.params.ParameterSet` (``theta_0`` … in term order, each
+        documented by its term, with its 1σ); in the units of the record the model was fitted
+        on ('1': a NARX model keeps no units)."""
+        return ParameterSet([Parameter(f"theta_{k}", float(v), "1", f"coefficient of {t}",
+                                       source=f"identified (narx, {self.criterion or 'FROLS'})",
+                                       std=float(s))
+                             for k, (v, s, t) in enumerate(zip(self.theta, self.theta_std,
+                                                               self.terms))], name="narx")
+
+    def _signals(self, data, y, why: str, outputs: bool = True):
+        """``(u, y)`` of a trajectory's columns by name, or of the signals given."""
+        if isinstance(data, Trajectory):
+            cols = [self.input_name] + ([self.output_name] if outputs else [])
+            missing = [c for c in cols if c not in data.names]
+            if missing:
+                raise DataError(f"data: the model's column(s) {', '.join(map(repr, missing))} "
+                                f"are missing; the data have {', '.join(map(repr, data.names))}",
+                                hint="rename the columns or identify the model from matching "
+                                     "data")
+            return (np.asarray(data[self.input_name], dtype=np.float64),
+                    np.asarray(data[self.output_name], dtype=np.float64) if outputs else None)
+        if outputs and y is None:
+            raise ArgumentError(f"narx.{why}: give a trajectory, or the signals u and y",
+                                hint=f"model.{why}(data) or model.{why}(u, y)")
+        return data, y
+
+    @property
     def terms(self) -> list[str]:
         return [_term_name(r, self.bases) for r in self.rows]
 
@@ -248,10 +299,14 @@ class NARXModel:
         mid = 0.5 * (hi + lo)
         return mid - DIVERGENCE_FACTOR * span, mid + DIVERGENCE_FACTOR * span
 
-    def simulate(self, u, y0=None, *, warn: bool = True) -> np.ndarray:
-        """Free run on the input ``u`` (N,): the first ``max_lag`` outputs are ``y0`` (zeros by
-        default), the rest simulated. A diverging run ends in NaN after a StabilityWarning."""
-        u = _as_signal(u, "u")
+    def simulate(self, data, y0=None, *, warn: bool = True) -> np.ndarray:
+        """Free run on the input of ``data`` (a trajectory: (N, 1)) or on the input ``u`` (N,):
+        the first ``max_lag`` outputs are ``y0`` (zeros by default), the rest simulated. A
+        diverging run ends in NaN after a StabilityWarning."""
+        if isinstance(data, Trajectory):
+            u, _ = self._signals(data, None, "simulate", outputs=False)
+            return self.simulate(u, y0, warn=warn).reshape(-1, 1)
+        u = _as_signal(data, "u")
         m = self.max_lag
         if len(u) <= m:
             raise DataError(f"narx.simulate: u has {len(u)} samples, needs more than max_lag = {m}")
@@ -272,10 +327,16 @@ class NARXModel:
                          StabilityWarning)
         return y
 
-    def predict(self, u, y) -> np.ndarray:
-        """One-step-ahead prediction from measured ``u`` and ``y``; the first ``max_lag`` samples
-        are the measured ones."""
-        u, y = _as_signal(u, "u"), _as_signal(y, "y")
+    def predict(self, data, y=None, horizon: int = 1) -> np.ndarray:
+        """One-step-ahead prediction from measured ``u`` and ``y`` (or a trajectory: (N, 1));
+        the first ``max_lag`` samples are the measured ones. ``horizon`` must be 1 (a NARX
+        k-step predictor is a free run of k steps; use :meth:`simulate` with ``y0``)."""
+        if horizon != 1:
+            raise ArgumentError(f"narx.predict: horizon must be 1 for a NARX model, found "
+                                f"{horizon!r}", hint="simulate(u, y0) runs the model freely")
+        if isinstance(data, Trajectory):
+            return self.predict(*self._signals(data, y, "predict")).reshape(-1, 1)
+        u, y = _as_signal(data, "u"), _as_signal(y, "y")
         if len(u) != len(y):
             raise DataError(f"narx.predict: u has {len(u)} samples but y has {len(y)}; pass a pair "
                             "of equal length")
@@ -283,15 +344,29 @@ class NARXModel:
         P = _regressors(self.bases, self.rows, u, y, m)
         return np.concatenate([y[:m], P @ self.theta])
 
-    def compare(self, u, y, *, warn: bool = True) -> float | None:
-        """Free-run fit (%) on ``(u, y)``, the run started from the first ``max_lag`` measured
-        outputs and scored on the samples after them; None (with a warning) if it diverges."""
+    def residuals(self, data, y=None) -> np.ndarray:
+        """One-step prediction errors after the first ``max_lag`` samples: (N − max_lag,) for
+        signals, (N − max_lag, 1) for a trajectory."""
+        u, yy = self._signals(data, y, "residuals")
+        yy = _as_signal(yy, "y")
+        e = (yy - self.predict(u, yy))[self.max_lag:]
+        return e.reshape(-1, 1) if isinstance(data, Trajectory) else e
+
+    def compare(self, data, y=None, *, warn: bool = True) -> ModelFit:
+        """The free-run fit (:data:`NARX_FIT`) on a trajectory or on ``(u, y)``: the run started
+        from the first ``max_lag`` measured outputs and scored on the samples after them;
+        ``fit_percent`` [None] (with a warning) if it diverges; ``simulated`` (N, 1)."""
+        u, yy = self._signals(data, y, "compare")
+        fit, ys = self._free_run_fit(u, yy, warn)
+        return ModelFit(self.outputs, [fit], ys.reshape(-1, 1), self.fit_definition)
+
+    def _free_run_fit(self, u, y, warn: bool = True) -> tuple[float | None, np.ndarray]:
         u, y = _as_signal(u, "u"), _as_signal(y, "y")
         m = self.max_lag
         ys = self.simulate(u, y[:m], warn=warn)
         if not np.all(np.isfinite(ys)):
-            return None
-        return _fit(y[m:], ys[m:])
+            return None, ys
+        return _fit(y[m:], ys[m:]), ys
 
     def to_dict(self) -> dict:
         return dict(schema=SCHEMA, version=VERSION, ylags=self.ylags, ulags=self.ulags,
@@ -302,6 +377,7 @@ class NARXModel:
                     covariance=self.covariance.tolist(), fit_percent=self.fit_percent,
                     prediction_fit_percent=self.prediction_fit_percent,
                     validation_fit_percent=self.validation_fit_percent, criterion=self.criterion,
+                    err=[float(v) for v in self.err], frols_terms=list(self.frols_terms),
                     input_name=self.input_name, output_name=self.output_name)
 
     def save(self, path) -> Path:
@@ -359,6 +435,8 @@ def load_narx(path) -> NARXModel:
                       prediction_fit_percent=doc.get("prediction_fit_percent"),
                       validation_fit_percent=doc.get("validation_fit_percent"),
                       criterion=str(doc.get("criterion", "")),
+                      err=[float(v) for v in doc.get("err", [])],
+                      frols_terms=[str(t) for t in doc.get("frols_terms", [])],
                       input_name=str(doc.get("input_name", "u")),
                       output_name=str(doc.get("output_name", "y")))
     except (KeyError, TypeError, ValueError) as exc:
@@ -456,7 +534,7 @@ def narx(u, y, *, degree: int = 2, lags: int | None = 2, ylags: int | None = Non
         best = None
         for k in range(1, len(order) + 1):
             cand = build(k)
-            f = cand.compare(uv, yv, warn=False)
+            f = cand._free_run_fit(uv, yv, warn=False)[0]
             if f is not None and (best is None or f > best[0] + 1e-9):
                 best = (f, k, cand)
         if best is None:
@@ -467,9 +545,9 @@ def narx(u, y, *, degree: int = 2, lags: int | None = 2, ylags: int | None = Non
     model.criterion = how + (", terms with |θ|/σ < 2 pruned" if prune else "")
     model.prediction_fit_percent = _fit(target, P[:, [_row_index(rows, r) for r in model.rows]]
                                         @ model.theta)
-    model.fit_percent = model.compare(u, y)
+    model.fit_percent = model._free_run_fit(u, y)[0]
     if validate is not None:
-        model.validation_fit_percent = model.compare(uv, yv)
+        model.validation_fit_percent = model._free_run_fit(uv, yv)[0]
     return model
 
 
