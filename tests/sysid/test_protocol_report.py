@@ -186,3 +186,43 @@ def test_diverging_free_run_is_named_not_analysed(tmp_path):
     assert '<td class="txt">diverged</td>' in html
     assert "No residuals for y: the free run diverged." in html
     assert "residual correlations" not in html
+
+
+def test_identify_report_without_validation_uses_the_estimation_record(tmp_path):
+    """Without --validate the page is of the estimation record and shows the estimation fit;
+    a --report path that is a file is one PathError line naming the option, before any fit."""
+    u, y = _hammerstein(np.random.default_rng(4), 600)
+    est = tmp_path / "est.csv"
+    np.savetxt(est, np.column_stack([u, y]), delimiter=",", header=f"{HOSTILE},force",
+               comments="", fmt="%.12g")
+    args = ["identify", "hw", est, "--input", HOSTILE, "--output", "force", "--fs", 100,
+            "--input-nonlinearity", "saturation", "--nb", 2, "--nf", 2, "--nk", 1]
+    code, out, err = _cli(*args, "--report", tmp_path / "rep", "--json")
+    assert code == 0, err
+    d = json.loads(out)
+    html = (tmp_path / "rep" / "index.html").read_text(encoding="utf-8")
+    assert "data est.csv" in html and f"<td>{d['fit_percent']:.2f} %</td>" in html
+    code, out, err = _cli(*args, "--report", est)
+    assert code != 0 and err.startswith("error: PathError: --report") and "is a file" in err
+    assert len(err.strip().splitlines()) == 1
+
+
+def test_model_without_covariance_has_no_band_and_says_why():
+    """A Prandtl–Ishlinskii model built from its weights (no covariance, as an inverse is): the
+    page draws no band and gives the model's reason; its fit on its own noise-free output is
+    100 %, and residuals that are all 0 are named in the residual table, not tested."""
+    from gripkit import Trajectory
+    from gripkit.sysid import PrandtlIshlinskiiModel
+
+    m = PrandtlIshlinskiiModel(np.arange(8) * 0.1,
+                               np.array([0.5, 0.3, 0.2, 0.15, 0.1, 0.08, 0.05, 0.03]), offset=0.2)
+    t = np.linspace(0.0, 1.0, 400)
+    u = 0.4 + 0.4 * np.sin(2 * np.pi * 3 * t)
+    tr = Trajectory(t, {"u": u, "y": m.simulate(u)[:, 0]})
+    rep, fit = protocol_report(m, tr)
+    html = rep.render()
+    assert fit.fit_percent[0] == pytest.approx(100.0, abs=1e-9)
+    assert "No ±2σ band: prandtl-ishlinskii: this model has no parameter covariance" in html
+    assert ('<td>0</td><td class="txt na">not given</td><td class="txt na">not given</td>'
+            '<td class="txt">not tested: residual tests need non-constant residuals and input</td>'
+            in html)

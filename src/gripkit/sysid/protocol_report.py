@@ -118,14 +118,14 @@ def _residuals_section(rep: Report, model, data, fit: ModelFit, y: np.ndarray) -
     e = y[:, keep] - ys[:, keep]
     rows = []
     for k, i in enumerate(keep):
+        rms = float(np.sqrt(np.mean(e[:, k] ** 2)))
         for j, inp in enumerate(model.inputs):
             try:
                 rt = residual_tests(e[:, k], u[:, j], lags=RESIDUAL_LAGS, alpha=RESIDUAL_ALPHA)
             except DataError as exc:  # constant residuals or input: named in the table
-                rows.append([model.outputs[i], inp, str(exc), None, None, None])
+                rows.append([model.outputs[i], inp, rms, None, None, f"not tested: {exc}"])
                 continue
-            rows.append([model.outputs[i], inp, float(np.sqrt(np.mean(e[:, k] ** 2))),
-                         rt.whiteness_p, rt.independence_p,
+            rows.append([model.outputs[i], inp, rms, rt.whiteness_p, rt.independence_p,
                          "yes" if rt.white and rt.independent else "no"])
     sec.table(["output", "input", "RMS residual", "whiteness p", "independence p",
                "passes both at 99 %"], rows)
