@@ -15,13 +15,16 @@ import typer
 from ..sysid.model_file import plain
 
 __all__ = ["emit_json", "is_mcap", "load_data", "collected_warnings", "report_warnings", "check_data_options", "check_choice", "check_number", "complex_pairs",
-           "FsOpt", "TimeOpt", "FillOpt", "JsonOpt"]
+           "FsOpt", "TimeOpt", "FillOpt", "JsonOpt", "ModelReportOpt", "write_model_page"]
 
 FsOpt = typer.Option(None, "--fs", help="Sampling rate in Hz, when the file has no time column "
                                          "(with one, it must agree with the time stamps).")
 TimeOpt = typer.Option(None, "--time", help="Name of the time column (default: t/time/timestamp).")
 FillOpt = typer.Option(None, "--fill", help="Missing values: 'drop' rows or 'interpolate' (default: error).")
 JsonOpt = typer.Option(False, "--json", help="Print one JSON object on stdout.")
+ModelReportOpt = typer.Option(None, "--report", help="Write an HTML report of the model on the "
+                                                     "--validate record (else on the record) "
+                                                     "to this folder.")
 
 
 def is_mcap(path: Path) -> bool:
@@ -111,3 +114,13 @@ def report_warnings(caught) -> list[str]:
     for line in lines:
         print(f"warning: {line}", file=sys.stderr)
     return lines
+
+
+def write_model_page(model, record, folder: Path, data_path: Path) -> str:
+    """``identify narx|hw|hysteresis --report DIR``: the report of ``model`` on ``record`` (the
+    validation record when one is given, else the estimation record) through the model protocol
+    (:mod:`gripkit.sysid.protocol_report`), the page ``gripkit report MODEL DATA --out DIR``
+    writes; returns the page's path."""
+    from ..sysid.protocol_report import write_protocol_report
+
+    return str(write_protocol_report(model, record, folder, data_name=Path(data_path).name)[0])

@@ -11,8 +11,9 @@ from typing import Optional
 import typer
 
 from .app import identify_app
-from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, collected_warnings,
-                     emit_json, load_data, report_warnings)
+from .common import (FillOpt, FsOpt, JsonOpt, ModelReportOpt, TimeOpt, check_data_options,
+                     collected_warnings, emit_json, load_data, report_warnings, write_model_page)
+from .paths import output_folder
 
 
 def _summary(m) -> str:
@@ -42,6 +43,7 @@ def identify_hw(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 file
                 validate: Optional[Path] = typer.Option(None, "--validate",
                                                         help="Validation record (same columns)."),
                 out: Optional[Path] = typer.Option(None, "--out", help="Write the model (JSON)."),
+                report: Optional[Path] = ModelReportOpt,
                 fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
                 json_out: bool = JsonOpt):
     """Hammerstein / Wiener / Hammerstein–Wiener: static nonlinearities around B/F, PEM, σ."""
@@ -53,9 +55,10 @@ def identify_hw(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 file
         if spec is not None:
             parse_nonlinearity(spec, name)
     check_data_options(fs, fill)
+    output_folder(report, "--report")
     with collected_warnings() as caught:
         tr = load_data(data, [input_col, output_col], fs, time, fill)
-        val = None
+        val = tv = None
         if validate is not None:
             tv = load_data(validate, [input_col, output_col], fs, time, fill)
             val = (np.asarray(tv[input_col]), np.asarray(tv[output_col]))
@@ -65,6 +68,8 @@ def identify_hw(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 file
         m.input_name, m.output_name = input_col, output_col
         if out is not None:
             m.save(out)
+        page = None if report is None else write_model_page(
+            m, tr if tv is None else tv, report, data if validate is None else validate)
     lines = report_warnings(caught)
     if json_out:
         emit_json({"data": str(data), "input": input_col, "output": output_col,
@@ -81,6 +86,7 @@ def identify_hw(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 file
                    {"data": str(validate), "fit_percent": m.validation_fit_percent,
                     "definition": m.fit_definition},
                    "candidates": m.candidates,
-                   "model": None if out is None else str(out), "warnings": lines})
+                   "model": None if out is None else str(out), "report": page,
+                   "warnings": lines})
     else:
         typer.echo(_summary(m))

@@ -11,8 +11,10 @@ from typing import Optional
 import typer
 
 from .app import identify_app
-from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_choice, check_data_options,
-                     collected_warnings, emit_json, load_data, report_warnings)
+from .common import (FillOpt, FsOpt, JsonOpt, ModelReportOpt, TimeOpt, check_choice,
+                     check_data_options, collected_warnings, emit_json, load_data, report_warnings,
+                     write_model_page)
+from .paths import output_folder
 
 
 def _exponent(value: str):
@@ -55,6 +57,7 @@ def identify_hysteresis(data: Path = typer.Argument(..., help="CSV, Parquet or H
                                                                      "columns)."),
                         out: Optional[Path] = typer.Option(None, "--out",
                                                            help="Write the model (JSON)."),
+                        report: Optional[Path] = ModelReportOpt,
                         fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
                         json_out: bool = JsonOpt):
     """Hysteresis (Bouc-Wen or Prandtl-Ishlinskii): parameters with σ, free-run fit."""
@@ -64,6 +67,7 @@ def identify_hysteresis(data: Path = typer.Argument(..., help="CSV, Parquet or H
     check_choice(form, "--form", FORMS)
     n = _exponent(exponent)
     check_data_options(fs, fill)
+    output_folder(report, "--report")
     with collected_warnings() as caught:
         tr = load_data(data, [input_col, output_col], fs, time, fill)
         val = None
@@ -74,6 +78,8 @@ def identify_hysteresis(data: Path = typer.Argument(..., help="CSV, Parquet or H
                        progress=not json_out)
         if out is not None:
             m.save(out)
+        page = None if report is None else write_model_page(
+            m, tr if val is None else val, report, data if validate is None else validate)
     lines = report_warnings(caught)
     if json_out:
         structure = ({"model": model, "form": form, "exponent": m.n,
@@ -90,7 +96,8 @@ def identify_hysteresis(data: Path = typer.Argument(..., help="CSV, Parquet or H
                    "fit_percent": m.fit_percent, "definition": m.fit_definition,
                    "validation": None if validate is None else
                    {"data": str(validate), "fit_percent": m.validation_fit_percent},
-                   "model": None if out is None else str(out), "warnings": lines})
+                   "model": None if out is None else str(out), "report": page,
+                   "warnings": lines})
     else:
         typer.echo(m.summary())
         fmt = lambda v: "diverged" if v is None else f"{v:.2f} %"  # noqa: E731

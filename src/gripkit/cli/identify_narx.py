@@ -10,8 +10,9 @@ from typing import Optional
 import typer
 
 from .app import identify_app
-from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, collected_warnings,
-                     emit_json, load_data, report_warnings)
+from .common import (FillOpt, FsOpt, JsonOpt, ModelReportOpt, TimeOpt, check_data_options,
+                     collected_warnings, emit_json, load_data, report_warnings, write_model_page)
+from .paths import output_folder
 
 
 def _terms(value: str):
@@ -57,6 +58,7 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
                   validate: Optional[Path] = typer.Option(None, "--validate",
                                                           help="Validation record (same columns)."),
                   out: Optional[Path] = typer.Option(None, "--out", help="Write the model (JSON)."),
+                  report: Optional[Path] = ModelReportOpt,
                   fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
                   json_out: bool = JsonOpt):
     """Polynomial NARX: terms by error reduction ratio (FROLS), θ with σ, pruning, free-run fit."""
@@ -66,9 +68,10 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
 
     n_terms = _terms(terms)
     check_data_options(fs, fill)
+    output_folder(report, "--report")
     with collected_warnings() as caught:
         tr = load_data(data, [input_col, output_col], fs, time, fill)
-        val = None
+        val = tv = None
         if validate is not None:
             tv = load_data(validate, [input_col, output_col], fs, time, fill)
             val = (np.asarray(tv[input_col]), np.asarray(tv[output_col]))
@@ -77,6 +80,8 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
         m.input_name, m.output_name = input_col, output_col
         if out is not None:
             m.save(out)
+        page = None if report is None else write_model_page(
+            m, tr if tv is None else tv, report, data if validate is None else validate)
     lines = report_warnings(caught)
     if json_out:
         emit_json({"data": str(data), "input": input_col, "output": output_col,
@@ -87,6 +92,7 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
                    "fit_percent": m.fit_percent, "prediction_fit_percent": m.prediction_fit_percent,
                    "validation": None if validate is None else
                    {"data": str(validate), "fit_percent": m.validation_fit_percent},
-                   "model": None if out is None else str(out), "warnings": lines})
+                   "model": None if out is None else str(out), "report": page,
+                   "warnings": lines})
     else:
         typer.echo(_summary(m))

@@ -1,5 +1,6 @@
 """``gripkit report MODEL.json DATA --out DIR``: one self-contained HTML page of a saved model on a
-record (:mod:`gripkit.sysid.model_report`)."""
+record: a linear model by :mod:`gripkit.sysid.model_report` (poles, Bode), every other family
+through the model protocol by :mod:`gripkit.sysid.protocol_report`."""
 
 from __future__ import annotations
 
@@ -19,24 +20,30 @@ def report_model(model: Path = typer.Argument(..., help="Model file written by i
                                              show_default=False),
                  out: Path = typer.Option(..., "--out", help="Folder for index.html."),
                  fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, json_out: bool = JsonOpt):
-    """HTML report: measured vs simulated per output, residual correlations, poles with σ, Bode with σ."""
-    from ..errors import ModelError
+    """HTML report: measured vs simulated per output, residual correlations, parameters with σ;
+    for linear models also poles and Bode with σ."""
     from ..sysid.model_protocol import file_schema
-    from ..sysid.model_report import write_model_report
     from .compare import _model_and_data
 
-    schema = file_schema(model)
-    if schema not in (None, "gripkit.linear-model"):  # residual, pole and Bode pages are linear
-        raise ModelError(f"report: {str(model)!r} is a {schema}; gripkit report draws linear "
-                         "models",
-                         hint="use gripkit compare MODEL DATA (fit) or gripkit simulate MODEL "
-                              "--data DATA for it")
-
+    # a file without a readable schema goes to the linear reader, which names what is wrong
+    linear = file_schema(model) in (None, "gripkit.linear-model")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         m, tr = _model_and_data(model, data, fs, time, fill, outputs=True)
-        index = write_model_report(m, tr, out, data_name=Path(data).name)
-    res = {"model": str(model), "data": str(data), "report": str(index), "warnings": report_warnings(caught)}
+        if linear:  # poles, Bode and innovation residuals (gripkit.sysid.model_report)
+            from ..sysid.model_report import write_model_report
+
+            index = write_model_report(m, tr, out, data_name=Path(data).name)
+            fit = None
+        else:  # any other family, through the model protocol alone
+            from ..sysid.protocol_report import write_protocol_report
+
+            index, fit = write_protocol_report(m, tr, out, data_name=Path(data).name)
+    res = {"model": str(model), "data": str(data), "report": str(index)}
+    if fit is not None:
+        res.update(structure=m.structure, outputs=list(m.outputs),
+                   fit_percent=list(fit.fit_percent), definition=fit.definition)
+    res["warnings"] = report_warnings(caught)
     if json_out:
         emit_json(res)
         return

@@ -144,12 +144,15 @@ def residual_analysis(model, u, y, dt: float, free_run_fit=None) -> Residuals:
     return Residuals(e, x0, kind, fit, pole, memory, tuple(notes))
 
 
-def _residual_figure(e, u, outputs, inputs):
+def _residual_figure(e, u, outputs, inputs, z: float = 1.96):
+    """Auto-correlation of each residual column of ``e`` (N, p) and its cross-correlation with
+    each input column of ``u`` (N, m), lags 0…25, with the band ±z/√N of white residuals
+    independent of past inputs (z = 1.96: 95 %; the protocol report draws 99 %, z = 2.576)."""
     plt = pyplot()
     p, m = e.shape[1], u.shape[1]
     L = min(25, e.shape[0] // 4)
     lags = np.arange(0, L + 1)
-    bound = 1.96 / np.sqrt(e.shape[0])
+    bound = z / np.sqrt(e.shape[0])
     fig, axes = plt.subplots(p, 1 + m, figsize=(3.4 * (1 + m), 2.4 * p), squeeze=False)
     for i in range(p):
         ax = axes[i, 0]

@@ -5,11 +5,25 @@ work array)."""
 
 from __future__ import annotations
 
+from collections import namedtuple
+
 import numpy as np
 from numba import njit
 
 #: kind codes shared with the Python side
 NONE, SATURATION, DEADZONE, POLY, PWL, SIGMOID = 0, 1, 2, 3, 4, 5
+
+# Named records the free-run kernel takes (namedtuples: numba resolves each field at compile time).
+#: a static nonlinearity: its kind code, parameters ``p``, fixed constants ``c`` (breakpoints, or
+#: centres then the width; one unused element where none) and ``grad`` (≥ 2), which receives ∂f/∂p
+HWBlock = namedtuple("HWBlock", "kind p c grad")
+#: the linear block ``B(q)/F(q)``: ``b1…b_nb``, ``f1…f_nf`` and the delay ``nk``
+HWLinear = namedtuple("HWLinear", "b f nk")
+#: scratch of the free run: ``w``, ``x`` (N + M) and their sensitivities ``dw`` (N + M, ni + 1),
+#: ``dx`` (N + M, ni + nb + nf + 1), ``M = nk + nb + nf`` the rows before the record
+HWWork = namedtuple("HWWork", "w x dw dx")
+#: what the free run writes: ``yhat`` (N) and, when asked, ``jac`` (N, P + 1)
+HWOut = namedtuple("HWOut", "yhat jac")
 
 
 @njit(cache=True)
@@ -76,22 +90,24 @@ def nl_eval(kind, p, c, v, grad):
     return v, 1.0
 
 
-@njit(cache=True)
-def hw_run(u, kin, pin, cin, b, f, nk, kout, pout, cout, y0, wpre, want_j, w, x, dw, dx, gin,
-           gout, yhat, jac):
+@njit(cache=True, _nrt=False)
+def hw_run(u, fin, lin, fout, y0, wpre, want_j, work, out):
     """Free run of ``w = f(u)``, ``F(q) x = B(q) q^-nk w``, ``ŷ = g(x) + y0`` from the linear
     block's steady state under the constant input ``wpre`` (``w(t<0) = wpre``,
     ``x(t<0) = B(1)/F(1) wpre``).
 
-    Work arrays: ``w``, ``x`` (N + M), ``dw`` (N + M, ni + 1), ``dx`` (N + M, ni + nb + nf + 1),
-    ``gin``, ``gout`` (≥ 2). With ``want_j`` the rows of ``jac`` (N, P + 1) receive ∂ŷ(t)/∂θ for
-    ``θ = [pin, b, f, pout, y0, wpre]``. Returns the first sample where ŷ is not finite, −1 if
-    none."""
+    ``fin``, ``fout``: the nonlinearities (:data:`HWBlock`), ``lin``: the linear block
+    (:data:`HWLinear`), ``work``: :data:`HWWork`, ``out``: :data:`HWOut`. With ``want_j`` the rows
+    of ``out.jac`` (N, P + 1) receive ∂ŷ(t)/∂θ for ``θ = [fin.p, b, f, fout.p, y0, wpre]``.
+    Returns the first sample where ŷ is not finite, −1 if none."""
+    b, f, nk = lin.b, lin.f, lin.nk
+    w, x, dw, dx = work.w, work.x, work.dw, work.dx
+    gin, gout, yhat, jac = fin.grad, fout.grad, out.yhat, out.jac
     n = u.shape[0]
-    ni = pin.shape[0]
+    ni = fin.p.shape[0]
     nb = b.shape[0]
     nf = f.shape[0]
-    no = pout.shape[0]
+    no = fout.p.shape[0]
     nl = ni + nb + nf
     m = nk + nb + nf
     sb = 0.0
@@ -116,7 +132,7 @@ def hw_run(u, kin, pin, cin, b, f, nk, kout, pout, cout, y0, wpre, want_j, w, x,
             dx[t, nl] = s
     bad = -1
     for t in range(m, n + m):
-        wt, _ = nl_eval(kin, pin, cin, u[t - m], gin)
+        wt, _ = nl_eval(fin.kind, fin.p, fin.c, u[t - m], gin)
         w[t] = wt
         acc = 0.0
         for i in range(nb):
@@ -124,7 +140,7 @@ def hw_run(u, kin, pin, cin, b, f, nk, kout, pout, cout, y0, wpre, want_j, w, x,
         for j in range(nf):
             acc -= f[j] * x[t - 1 - j]
         x[t] = acc
-        g, gd = nl_eval(kout, pout, cout, acc, gout)
+        g, gd = nl_eval(fout.kind, fout.p, fout.c, acc, gout)
         yt = g + y0
         yhat[t - m] = yt
         if bad < 0 and not np.isfinite(yt):

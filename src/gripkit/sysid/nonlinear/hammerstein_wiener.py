@@ -86,6 +86,9 @@ import numpy as np
 from ...atomic import write_text
 from ...errors import (AccuracyWarning, ArgumentError, DataError, IdentificationError, ModelError,
                        PathError, StabilityWarning, emit_warning)
+from ...params import Parameter, ParameterSet
+from ...progress import track
+from ...signals.trajectory import Trajectory
 from ..model_protocol import ModelFit
 from . import _hw_kernels as K
 
@@ -226,14 +229,26 @@ class _Problem:
         self.ni, self.no = fin.n_params, fout.n_params
         self.P = self.ni + nb + nf + self.no + 1
         n, m = len(u), nk + nb + nf
-        self.w, self.x = np.empty(n + m), np.empty(n + m)
-        self.dw = np.zeros((n + m, self.ni + 1))
-        self.dx = np.zeros((n + m, self.ni + nb + nf + 1))
+        self.work = K.HWWork(np.empty(n + m), np.empty(n + m), np.zeros((n + m, self.ni + 1)),
+                             np.zeros((n + m, self.ni + nb + nf + 1)))
         self.gin, self.gout = np.zeros(max(self.ni, 2)), np.zeros(max(self.no, 2))
         self.cin = np.asarray(fin.consts or (0.0,), dtype=np.float64)
         self.cout = np.asarray(fout.consts or (0.0,), dtype=np.float64)
-        self.yhat = np.empty(n)
-        self.jac = np.empty((n, self.P + 1))  # the last column: ∂ŷ/∂w₋
+        self.out = K.HWOut(np.empty(n), np.empty((n, self.P + 1)))  # jac's last column: ∂ŷ/∂w₋
+
+    @property
+    def x(self) -> np.ndarray:
+        """The linear block's output of the last run (its first ``nk + nb + nf`` rows: before the
+        record)."""
+        return self.work.x
+
+    @property
+    def yhat(self) -> np.ndarray:
+        return self.out.yhat
+
+    @property
+    def jac(self) -> np.ndarray:
+        return self.out.jac
 
     def split(self, th):
         ni, nb, nf, no = self.ni, self.nb, self.nf, self.no
@@ -244,9 +259,10 @@ class _Problem:
         """Free run (and J) for ``the = [θ, w₋]``."""
         the = np.ascontiguousarray(the, dtype=np.float64)
         pin, b, f, pout, y0 = self.split(the[:-1])
-        return K.hw_run(self.u, self.fin.code, pin, self.cin, b, f, self.nk, self.fout.code, pout,
-                        self.cout, float(y0), float(the[-1]), want_j, self.w, self.x, self.dw,
-                        self.dx, self.gin, self.gout, self.yhat, self.jac)
+        return K.hw_run(self.u, K.HWBlock(self.fin.code, pin, self.cin, self.gin),
+                        K.HWLinear(b, f, self.nk), K.HWBlock(self.fout.code, pout, self.cout,
+                                                             self.gout),
+                        float(y0), float(the[-1]), want_j, self.work, self.out)
 
     def admissible(self, the) -> bool:
         pin, _, f, pout, _ = self.split(the[:-1])
@@ -435,8 +451,6 @@ class HWModel:
     @property
     def parameters(self):
         """Every parameter with its unit and 1σ (:class:`gripkit.params.ParameterSet`)."""
-        from ...params import Parameter, ParameterSet
-
         docs = {"b": "numerator coefficient of B(q) (carries the chain's gain)",
                 "f": "denominator coefficient of F(q)",
                 "y0": "output offset, in the output's unit"}
@@ -464,8 +478,6 @@ class HWModel:
         return _Problem(u, self.input_nl, self.output_nl, self.nb, self.nf, self.nk)
 
     def _columns(self, data, need_output: bool):
-        from ...signals.trajectory import Trajectory
-
         if isinstance(data, Trajectory):
             cols = [self.input_name] + ([self.output_name] if need_output else [])
             missing = [c for c in cols if c not in data.names]
@@ -728,23 +740,9 @@ def _excitation_check(model: HWModel, u: np.ndarray):
                          "nonlinearity", AccuracyWarning)
 
 
-def hammerstein_wiener(u, y, *, input_nonlinearity=None, output_nonlinearity=None,
-                       nb: int | None = None, nf: int | None = None, nk: int | None = None,
-                       dt: float | None = None, validate=None, maxiter: int = 200,
-                       progress: bool = False) -> HWModel:
-    """Hammerstein, Wiener or Hammerstein–Wiener model of ``y`` driven by ``u`` (see the module
-    docstring).
-
-    ``input_nonlinearity`` / ``output_nonlinearity``: ``'none'``, ``'saturation'``,
-    ``'deadzone'``, ``'poly[:N]'``, ``'pwl[:N]'``, ``'sigmoid[:N]'``; when both are None the
-    structure is chosen among :data:`AUTO_STRUCTURES` (one None with the other given means
-    ``'none'``). ``nb``, ``nf``, ``nk``: orders of B/F; each None is chosen (``(nb, nf)`` in
-    (1,1), (2,2), (3,3); ``nk`` in 0, 1, 2) on the linear model. Choice by free-run fit on
-    ``validate=(u2, y2)`` when given, else by BIC. ``dt``: sample interval (s), default 1.
-    ``progress``: a progress bar on stderr (one step per structure and start).
-    """
-    from ...progress import track
-
+def _check_data(u, y, dt, maxiter):
+    """The estimation record as two finite signals of equal length, neither constant; ``dt`` and
+    ``maxiter`` checked. Returns ``(u, y)``."""
     u, y = _signal(u, "u"), _signal(y, "y")
     if len(u) != len(y):
         raise DataError(f"hammerstein_wiener: u has {len(u)} samples but y has {len(y)}; pass a "
@@ -762,6 +760,212 @@ def hammerstein_wiener(u, y, *, input_nonlinearity=None, output_nonlinearity=Non
     if isinstance(maxiter, bool) or not isinstance(maxiter, (int, np.integer)) or maxiter < 1:
         raise ArgumentError(f"hammerstein_wiener: maxiter must be an integer ≥ 1, found "
                             f"{maxiter!r}")
+    return u, y
+
+
+def _check_validation(validate):
+    """``validate=(u2, y2)`` as two finite signals of equal length (≥ 10 samples), or None."""
+    if validate is None:
+        return None
+    try:
+        uv, yv = validate
+    except (TypeError, ValueError):
+        raise ArgumentError("hammerstein_wiener: validate must be a pair (u, y) of validation "
+                            "data") from None
+    uv, yv = _signal(uv, "validate u"), _signal(yv, "validate y")
+    if len(uv) != len(yv) or len(uv) < 10:
+        raise DataError(f"hammerstein_wiener: validation u has {len(uv)} and y {len(yv)} "
+                        "samples; need a pair of equal length (≥ 10 samples)")
+    return uv, yv
+
+
+def _order_candidates(nb, nf, nk) -> list:
+    """The ``(nb, nf, nk)`` tried in step (1): :data:`AUTO_ORDERS` × :data:`AUTO_NK` with each
+    given order in place of its candidates, without repeats."""
+    orders = [(b_, f_, k_) for b_, f_ in AUTO_ORDERS for k_ in AUTO_NK]
+    orders = [(nb if nb is not None else b_, nf if nf is not None else f_,
+               nk if nk is not None else k_) for b_, f_, k_ in orders]
+    return list(dict.fromkeys(orders))
+
+
+class _Search:
+    """What the steps of :func:`hammerstein_wiener` share: the estimation record, the validation
+    record (or None), the linear fits at each order (``lin_fits``: orders → ``([θ, w₋], SSE, J)``)
+    and the progress bar; builds candidate models and scores them (validation free-run fit, or
+    −BIC)."""
+
+    def __init__(self, u, y, validation, dt, maxiter, bar):
+        self.u, self.y = u, y
+        self.uv, self.yv = validation if validation is not None else (None, None)
+        self.n = len(y)
+        self.dt = 1.0 if dt is None else float(dt)
+        self.maxiter = maxiter
+        self.y_range = (float(y.min()), float(y.max()))
+        self.lin_fits = {}
+        self.bar = bar
+
+    @property
+    def chosen_by(self) -> str:
+        return "validation free-run fit" if self.uv is not None else "BIC"
+
+    def step(self):
+        """One step of the progress bar."""
+        next(self.bar, None)
+
+    def make(self, fin, fout, o, the, sse, J) -> HWModel:
+        """The model of structure ``fin``/``fout`` at orders ``o`` from ``[θ, w₋]``, its SSE and
+        Jacobian (σ with w₋: its uncertainty is in every other σ)."""
+        cov, std = _covariance(J, sse)
+        P = len(the) - 1
+        m = HWModel(fin, fout, o[0], o[1], o[2], the[:P], std[:P], cov[:P, :P], dt=self.dt,
+                    y_range=self.y_range)
+        m.initial_input = float(the[-1])
+        return m
+
+    def score(self, m: HWModel, sse: float) -> float:
+        """Higher is better: the validation free-run fit (−inf when the run diverges), or −BIC."""
+        n = self.n
+        if self.uv is None:
+            return -(n * math.log(max(sse, 1e-300) / n) + len(m.theta) * math.log(n))
+        f = m.compare(self.uv, self.yv, warn=False).fit_percent[0]
+        return -math.inf if f is None else f
+
+    def fit_at(self, fin, fout, o):
+        """Fit structure ``fin``/``fout`` at orders ``o`` from the linear fit there → ``(score,
+        model, (fin, fout))``."""
+        if fin.kind == "none" and fout.kind == "none":
+            th, sse, J = self.lin_fits[o]
+            fin_c, fout_c = fin, fout
+        else:
+            th, sse, J, prob = _fit_structure(self.u, self.y, fin, fout, *o,
+                                              lin_start=self.lin_fits[o][0], maxiter=self.maxiter)
+            fin_c, fout_c = prob.fin, prob.fout
+        m = self.make(fin_c, fout_c, o, th, sse, J)
+        return self.score(m, sse), m, (fin, fout)
+
+
+def _choose_orders(search: _Search, orders: list) -> tuple:
+    """Step (1): the linear output-error model at every candidate order (at most
+    :data:`SCREEN_ITERATIONS` iterations each when there are several), ranked by score; the best
+    one's fit then runs to convergence. Returns its orders ``(nb, nf, nk)``."""
+    lin_fits, maxiter = search.lin_fits, search.maxiter
+    screen = maxiter if len(orders) == 1 else min(maxiter, SCREEN_ITERATIONS)
+    for o in orders:
+        search.step()
+        th, sse, J, _ = _fit_structure(search.u, search.y, Nonlinearity(), Nonlinearity(), *o,
+                                       maxiter=screen)
+        if J is None:
+            continue
+        lin_fits[o] = (th, sse, J)
+    if not lin_fits:
+        raise IdentificationError("hammerstein_wiener: no linear start gave a finite free run; "
+                                  "check the data's scale")
+    ranked = sorted(lin_fits, key=lambda o: -search.score(
+        search.make(Nonlinearity(), Nonlinearity(), o, *lin_fits[o]), lin_fits[o][1]))
+    o = ranked[0]
+    if screen < maxiter:  # the chosen orders' linear model to convergence
+        th, sse, J, _ = _lm(_Problem(search.u, Nonlinearity(), Nonlinearity(), *o), search.y,
+                            lin_fits[o][0], maxiter)
+        lin_fits[o] = (th, sse, J)
+    return o
+
+
+def _fit_candidates(search: _Search, structures: list, o: tuple, auto: bool) -> list:
+    """Step (2): every structure at orders ``o`` and, when the structure is searched, the
+    Hammerstein–Wiener candidates that join the :data:`N_JOINED` best input blocks to the
+    :data:`N_JOINED` best output blocks. Returns ``(score, model, (fin, fout))``, best first."""
+    cands = []
+    for fin, fout in structures:
+        search.step()
+        cands.append(search.fit_at(fin, fout, o))
+    ins = sorted((c for c in cands if c[2][0].kind != "none" and c[2][1].kind == "none"),
+                 key=lambda c: -c[0])[:N_JOINED]
+    outs = sorted((c for c in cands if c[2][0].kind == "none" and c[2][1].kind != "none"),
+                  key=lambda c: -c[0])[:N_JOINED]
+    for ci in ins if auto else ():
+        for co in outs:
+            search.step()
+            cands.append(search.fit_at(ci[2][0], co[2][1], o))
+    cands.sort(key=lambda c: -c[0])
+    return cands
+
+
+def _refit_dynamics(search: _Search, cands: list, o: tuple, dyn: list, searched: bool) -> list:
+    """Step (3): a nonlinear structure may need fewer poles than the linear approximation, so
+    when ``(nb, nf)`` were searched and the best candidate is nonlinear, it is fitted again at
+    the other ``(nb, nf)`` of ``dyn`` with the delay of step (1). Returns those candidates."""
+    refit = []
+    if searched and cands[0][1].kind != "linear":
+        for b_, f_ in dyn:
+            if (b_, f_, o[2]) != o and (b_, f_, o[2]) in search.lin_fits:
+                search.step()
+                refit.append(search.fit_at(*cands[0][2], (b_, f_, o[2])))
+    return refit
+
+
+def _pick(cands: list, validated: bool) -> HWModel:
+    """The best candidate (``cands`` best first), with every candidate's score in
+    ``candidates``. With validation data, parsimony: among those within
+    :data:`PARSIMONY_POINTS` of the best, one whose parameters the data all determine (finite σ)
+    before one that is not, then the fewest parameters."""
+    best = cands[0][1]
+    if validated:
+        best = min((c for c in cands if c[0] >= cands[0][0] - PARSIMONY_POINTS),
+                   key=lambda c: (not np.all(np.isfinite(c[1].theta_std)), len(c[1].theta)))[1]
+    best.candidates = [{"input": c[1].input_nl.label, "output": c[1].output_nl.label,
+                        "nb": c[1].nb, "nf": c[1].nf, "nk": c[1].nk,
+                        ("validation_fit_percent" if validated else "bic"):
+                        (c[0] if validated else -c[0])} for c in cands]
+    return best
+
+
+def _criterion(best: HWModel, orders_chosen: bool, auto: bool, chosen_by: str,
+               n_structures: int, n_joined: int, refit: bool) -> str:
+    """One line on how the orders and the structure of ``best`` were chosen."""
+    what = []
+    if orders_chosen:
+        what.append(f"orders [nb nf nk] = [{best.nb} {best.nf} {best.nk}] by {chosen_by} (the "
+                    f"delay on the linear model"
+                    f"{'; nb and nf again for the structure' if refit else ''})")
+    if auto:
+        what.append(f"structure {best.input_nl.label}/{best.output_nl.label} by {chosen_by} "
+                    f"among {n_structures} and {n_joined} joined")
+    return "; ".join(what) if what else "structure and orders given"
+
+
+def _finish(best: HWModel, search: _Search) -> HWModel:
+    """Name what the data do not excite or determine (:func:`_excitation_check`, an
+    AccuracyWarning for parameters with σ = inf) and set the free-run fits of ``best``."""
+    _excitation_check(best, search.u)
+    loose = [n for n, sd in zip(best.names, best.theta_std) if not np.isfinite(sd)]
+    if loose:
+        emit_warning(f"hammerstein_wiener: the data do not determine {', '.join(loose)} of the "
+                     f"{best.input_nl.label}/{best.output_nl.label} model (σ = inf: they trade "
+                     "off against other parameters without changing the output); excite more "
+                     "amplitudes, or choose a simpler block", AccuracyWarning)
+    fit = best.compare(search.u, search.y)
+    best.fit_percent = fit.fit_percent[0]
+    if search.uv is not None:
+        best.validation_fit_percent = best.compare(search.uv, search.yv).fit_percent[0]
+    return best
+
+
+def hammerstein_wiener(u, y, *, input_nonlinearity=None, output_nonlinearity=None,
+                       nb: int | None = None, nf: int | None = None, nk: int | None = None,
+                       dt: float | None = None, validate=None, maxiter: int = 200,
+                       progress: bool = False) -> HWModel:
+    """Hammerstein, Wiener or Hammerstein–Wiener model of ``y`` driven by ``u`` (see the module
+    docstring).
+
+    ``input_nonlinearity`` / ``output_nonlinearity``: ``'none'``, ``'saturation'``,
+    ``'deadzone'``, ``'poly[:N]'``, ``'pwl[:N]'``, ``'sigmoid[:N]'``; when both are None the
+    structure is chosen among :data:`AUTO_STRUCTURES` (one None with the other given means
+    ``'none'``). ``nb``, ``nf``, ``nk``: orders of B/F; each None is chosen (``(nb, nf)`` in
+    (1,1), (2,2), (3,3); ``nk`` in 0, 1, 2) on the linear model. Choice by free-run fit on
+    ``validate=(u2, y2)`` when given, else by BIC. ``dt``: sample interval (s), default 1.
+    ``progress``: a progress bar on stderr (one step per structure and start).
+    """
+    u, y = _check_data(u, y, dt, maxiter)
     auto = input_nonlinearity is None and output_nonlinearity is None
     structures = ([(parse_nonlinearity(a), parse_nonlinearity(b)) for a, b in AUTO_STRUCTURES]
                   if auto else [(parse_nonlinearity(input_nonlinearity, "input_nonlinearity"),
@@ -769,131 +973,23 @@ def hammerstein_wiener(u, y, *, input_nonlinearity=None, output_nonlinearity=Non
     nb = None if nb is None else _order(nb, "nb", 1)
     nf = None if nf is None else _order(nf, "nf", 0)
     nk = None if nk is None else _order(nk, "nk", 0)
-    uv = yv = None
-    if validate is not None:
-        try:
-            uv, yv = validate
-        except (TypeError, ValueError):
-            raise ArgumentError("hammerstein_wiener: validate must be a pair (u, y) of validation "
-                                "data") from None
-        uv, yv = _signal(uv, "validate u"), _signal(yv, "validate y")
-        if len(uv) != len(yv) or len(uv) < 10:
-            raise DataError(f"hammerstein_wiener: validation u has {len(uv)} and y {len(yv)} "
-                            "samples; need a pair of equal length (≥ 10 samples)")
-    n = len(y)
-    orders = [(b_, f_, k_) for b_, f_ in AUTO_ORDERS for k_ in AUTO_NK]
-    orders = [(nb if nb is not None else b_, nf if nf is not None else f_,
-               nk if nk is not None else k_) for b_, f_, k_ in orders]
-    orders = list(dict.fromkeys(orders))
-    y_range = (float(y.min()), float(y.max()))
-    dtv = 1.0 if dt is None else float(dt)
-
-    def make(fin, fout, o, the, sse, J):
-        cov, std = _covariance(J, sse)  # with w₋: its uncertainty is in every other σ
-        P = len(the) - 1
-        m = HWModel(fin, fout, o[0], o[1], o[2], the[:P], std[:P], cov[:P, :P], dt=dtv,
-                    y_range=y_range)
-        m.initial_input = float(the[-1])
-        return m
-
-    def score(m: HWModel, sse: float) -> float:
-        if uv is None:
-            return -(n * math.log(max(sse, 1e-300) / n) + len(m.theta) * math.log(n))
-        f = m.compare(uv, yv, warn=False).fit_percent[0]
-        return -math.inf if f is None else f
-
+    validation = _check_validation(validate)
+    orders = _order_candidates(nb, nf, nk)
     searched = nb is None or nf is None
     dyn = list(dict.fromkeys((nb if nb is not None else b_, nf if nf is not None else f_)
                              for b_, f_ in AUTO_ORDERS))
     steps = (len(orders) + len(structures) + (N_JOINED**2 if auto else 0)
              + (len(dyn) - 1 if searched else 0))
     bar = iter(track(range(steps), total=steps, description="hw fit", enabled=progress))
-    # (1) orders on the linear output-error model
-    lin_fits = {}
-    screen = maxiter if len(orders) == 1 else min(maxiter, SCREEN_ITERATIONS)
-    for o in orders:
-        next(bar, None)
-        th, sse, J, _ = _fit_structure(u, y, Nonlinearity(), Nonlinearity(), *o, maxiter=screen)
-        if J is None:
-            continue
-        lin_fits[o] = (th, sse, J)
-    if not lin_fits:
-        raise IdentificationError("hammerstein_wiener: no linear start gave a finite free run; "
-                                  "check the data's scale")
-    ranked = sorted(lin_fits, key=lambda o: -score(make(Nonlinearity(), Nonlinearity(), o,
-                                                        *lin_fits[o]), lin_fits[o][1]))
-    o = ranked[0]
-    if screen < maxiter:  # the chosen orders' linear model to convergence
-        th, sse, J, _ = _lm(_Problem(u, Nonlinearity(), Nonlinearity(), *o), y, lin_fits[o][0],
-                            maxiter)
-        lin_fits[o] = (th, sse, J)
-    chosen_by = "validation free-run fit" if uv is not None else "BIC"
-
-    def fit_at(fin, fout, o):
-        if fin.kind == "none" and fout.kind == "none":
-            th, sse, J = lin_fits[o]
-            fin_c, fout_c = fin, fout
-        else:
-            th, sse, J, prob = _fit_structure(u, y, fin, fout, *o, lin_start=lin_fits[o][0],
-                                              maxiter=maxiter)
-            fin_c, fout_c = prob.fin, prob.fout
-        m = make(fin_c, fout_c, o, th, sse, J)
-        return score(m, sse), m, (fin, fout)
-
-    # (2) structures at those orders
-    cands = []
-    for fin, fout in structures:
-        next(bar, None)
-        cands.append(fit_at(fin, fout, o))
-    # Hammerstein–Wiener candidates: the two best input blocks with the two best output blocks
-    ins = sorted((c for c in cands if c[2][0].kind != "none" and c[2][1].kind == "none"),
-                 key=lambda c: -c[0])[:N_JOINED]
-    outs = sorted((c for c in cands if c[2][0].kind == "none" and c[2][1].kind != "none"),
-                  key=lambda c: -c[0])[:N_JOINED]
-    for ci in ins if auto else ():
-        for co in outs:
-            next(bar, None)
-            cands.append(fit_at(ci[2][0], co[2][1], o))
-    cands.sort(key=lambda c: -c[0])
-    # (3) a nonlinear structure may need fewer poles than the linear approximation: (nb, nf)
-    # chosen again for it, with the delay of step (1)
-    refit = []
-    if searched and cands[0][1].kind != "linear":
-        for b_, f_ in dyn:
-            if (b_, f_, o[2]) != o and (b_, f_, o[2]) in lin_fits:
-                next(bar, None)
-                refit.append(fit_at(*cands[0][2], (b_, f_, o[2])))
+    search = _Search(u, y, validation, dt, maxiter, bar)
+    o = _choose_orders(search, orders)
+    cands = _fit_candidates(search, structures, o, auto)
+    refit = _refit_dynamics(search, cands, o, dyn, searched)
     for _ in bar:
         pass
     cands = sorted(cands + refit, key=lambda c: -c[0])
-    best = cands[0][1]
-    if uv is not None:  # parsimony: within 0.1 fit point of the best, every parameter
-        # determined by the data (finite σ) before any is not, then the fewest parameters
-        best = min((c for c in cands if c[0] >= cands[0][0] - PARSIMONY_POINTS),
-                   key=lambda c: (not np.all(np.isfinite(c[1].theta_std)), len(c[1].theta)))[1]
-    best.candidates = [{"input": c[1].input_nl.label, "output": c[1].output_nl.label,
-                        "nb": c[1].nb, "nf": c[1].nf, "nk": c[1].nk,
-                        ("validation_fit_percent" if uv is not None else "bic"):
-                        (c[0] if uv is not None else -c[0])} for c in cands]
-    what = []
-    if nb is None or nf is None or nk is None:
-        what.append(f"orders [nb nf nk] = [{best.nb} {best.nf} {best.nk}] by {chosen_by} (the "
-                    f"delay on the linear model"
-                    f"{'; nb and nf again for the structure' if refit else ''})")
-    if auto:
-        what.append(f"structure {best.input_nl.label}/{best.output_nl.label} by {chosen_by} "
-                    f"among {len(structures)} and {len(cands) - len(structures) - len(refit)} "
-                    "joined")
-    best.criterion = "; ".join(what) if what else "structure and orders given"
-    _excitation_check(best, u)
-    loose = [n for n, sd in zip(best.names, best.theta_std) if not np.isfinite(sd)]
-    if loose:
-        emit_warning(f"hammerstein_wiener: the data do not determine {', '.join(loose)} of the "
-                     f"{best.input_nl.label}/{best.output_nl.label} model (σ = inf: they trade "
-                     "off against other parameters without changing the output); excite more "
-                     "amplitudes, or choose a simpler block", AccuracyWarning)
-    fit = best.compare(u, y)
-    best.fit_percent = fit.fit_percent[0]
-    if uv is not None:
-        best.validation_fit_percent = best.compare(uv, yv).fit_percent[0]
-    return best
+    best = _pick(cands, validation is not None)
+    best.criterion = _criterion(best, nb is None or nf is None or nk is None, auto,
+                                search.chosen_by, len(structures),
+                                len(cands) - len(structures) - len(refit), bool(refit))
+    return _finish(best, search)
