@@ -32,8 +32,8 @@ Rows (both sides through ``common.measure``: same warm-up call and number of run
 NARX rows (:func:`narx_rows`; alone: ``python benchmarks/bench_measured.py narx OUT_DIR``):
 
 * speed: the same 20-term cubic NARX (lags 2, FROLS, least squares) on 41 000 synthetic samples
-  (Billings' example ``y(t) = −0.605 y(t−1) − 0.163 y(t−2)² + 0.588 u(t−1) − 0.240 u(t−2) + e``,
-  σ_e = 0.05), validated on 5000 more: gripkit ``narx(terms=20, prune=False)`` beside sysidentpy
+  (Billings' example ``y(t) = −0.605 y(t−1) − 0.163 y(t−2)² + 0.588 u(t−1) − 0.240 u(t−2)
+  + e``, σ_e = 0.05), validated on 5000 more: gripkit ``narx(terms=20, prune=False)`` beside sysidentpy
   ``FROLS(n_terms=20, order_selection=False)``;
 * the nonlinear benchmarks Silverbox and cascaded tanks (tests/fixtures, their READMEs): gripkit's
   cubic NARX (lags 2, BIC, θ refined on the simulation error) beside sysidentpy's FROLS on the
@@ -208,7 +208,8 @@ def _billings(n: int, seed: int):
     e = rng.normal(0.0, 0.05, n)
     y = np.zeros(n)
     for t in range(2, n):
-        y[t] = -0.605 * y[t - 1] - 0.163 * y[t - 2] ** 2 + 0.588 * u[t - 1] - 0.240 * u[t - 2] + e[t]
+        y[t] = (-0.605 * y[t - 1] - 0.163 * y[t - 2] ** 2 + 0.588 * u[t - 1] - 0.240 * u[t - 2]
+                + e[t])
     return u, y
 
 
@@ -299,7 +300,8 @@ def _nonlinear_rows(name, stem, ci, co, unit, scale) -> list[dict]:
     fp, rp = _free_run_scores(yv, _quiet(lambda: m.predict(X=uv[:, None], y=yv[:, None]))()[:, 0])
     rows = [row("measured", f"polynomial NARX, degree 3, lags 2, BIC, {data}", measure(ours),
                 "sysidentpy FROLS degree 3 (BIC, least squares)", measure(peer),
-                gripkit_accuracy=text(fg, rg, len(g.terms)) + ", θ refined on the simulation error",
+                gripkit_accuracy=text(fg, rg, len(g.terms))
+                + ", θ refined on the simulation error",
                 peer_accuracy=text(fp, rp, m.final_model.shape[0]),
                 notes=f"gripkit without the refinement (one-step least squares): "
                       f"{text(f1, r1, len(one.terms))}; both free runs from the first 2 measured "
@@ -309,7 +311,8 @@ def _nonlinear_rows(name, stem, ci, co, unit, scale) -> list[dict]:
     hw_call = _quiet(lambda: hammerstein_wiener(ue, ye, dt=1.0))
     h = hw_call()
     fh = _quiet(lambda: h.compare(uv, yv))().fit_percent[0]
-    rh = None if fh is None else (1 - fh / 100) * float(np.linalg.norm(yv - yv.mean())) / np.sqrt(len(yv))
+    spread = float(np.linalg.norm(yv - yv.mean())) / np.sqrt(len(yv))
+    rh = None if fh is None else (1 - fh / 100) * spread
     rows.append(row("measured", f"Hammerstein–Wiener, structure and orders by BIC, {data}",
                     measure(hw_call, budget_s=30.0), "", None,
                     gripkit_accuracy="free run diverges" if fh is None else

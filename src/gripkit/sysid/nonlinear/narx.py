@@ -510,10 +510,17 @@ def _positive_int(v, name: str, lo: int = 1) -> int:
     return int(v)
 
 
+def _is_signal(a) -> bool:
+    """``a`` reads as one 1-D numeric signal (not a pair of records)."""
+    try:
+        return np.asarray(a, dtype=np.float64).ndim == 1
+    except (TypeError, ValueError):
+        return False
+
+
 def _pairs(x, what: str) -> list[tuple[np.ndarray, np.ndarray]]:
     """One record ``(u, y)`` or a list of them -> a list of checked pairs of equal length."""
-    if isinstance(x, (list, tuple)) and len(x) == 2 and not isinstance(x[0], (list, tuple)) \
-            and np.ndim(x[0]) == 1:
+    if isinstance(x, (list, tuple)) and len(x) == 2 and _is_signal(x[0]) and _is_signal(x[1]):
         x = [x]
     if not isinstance(x, (list, tuple)) or not x:
         raise ArgumentError(f"narx: {what} must be a pair (u, y) of 1-D arrays or a non-empty list "
@@ -636,7 +643,11 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
     if y is None:
         records = _pairs(u, "records")
     else:
-        records = _pairs((u, y), "(u, y)")
+        u, y = _as_signal(u, "u"), _as_signal(y, "y")
+        if len(u) != len(y):
+            raise DataError(f"narx: u has {len(u)} samples but y has {len(y)}; pass a pair of "
+                            "equal length")
+        records = [(u, y)]
     if refine not in REFINE:
         raise ArgumentError(f"narx: refine must be None or 'simulation', found {refine!r}")
     max_iter = _positive_int(max_iter, "max_iter")
