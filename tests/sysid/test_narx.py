@@ -368,3 +368,15 @@ def test_cli_refine_simulation(tmp_path, capsys):
     code, out, err = _cli(capsys, "identify", "narx", est, "--input", "u", "--output", "y",
                           "--fs", 1, "--refine", "pem")
     assert code != 0 and err.startswith("error: DataError: --refine: expected 'none' or")
+
+
+def test_simulate_std_of_a_diverging_run_is_nan_after_the_divergence():
+    """The σ of a free run that diverges stops where the run does: NaN there and after, with
+    the same StabilityWarning as the plain simulation."""
+    u, y = _true_system(np.random.default_rng(3), noise=0.01)
+    m = narx(u, y, degree=2, lags=2)
+    with pytest.warns(StabilityWarning, match="diverges"):
+        ys, sd = m.simulate(np.full(500, -6.0), std=True)
+    at = int(np.argmax(~np.isfinite(sd)))
+    assert at > 2 and np.all(np.isnan(sd[at:])) and np.all(np.isfinite(sd[:at]))
+    assert np.all(np.isnan(ys[at + 1:]))

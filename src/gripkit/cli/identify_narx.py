@@ -82,7 +82,7 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
             val = (np.asarray(tv[input_col]), np.asarray(tv[output_col]))
         m = narx(np.asarray(tr[input_col]), np.asarray(tr[output_col]), degree=degree, lags=lags,
                  ylags=ylags, ulags=ulags, terms=n_terms, dt=tr.dt, validate=val,
-                 refine=None if refine == "none" else refine)
+                 refine=None if refine == "none" else refine, progress=True)
         m.input_name, m.output_name = input_col, output_col
         if out is not None:
             m.save(out)

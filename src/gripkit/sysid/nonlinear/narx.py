@@ -383,9 +383,12 @@ class NARXModel:
             y[:m] = y0
         lo, hi = self._limits()
         if std:
-            J = self._sensitivities(u, y, self.theta)[1]
-            at = -1 if np.all(np.isfinite(y)) else int(np.argmin(np.isfinite(y)))
+            at, J = self._sensitivities(u, y, self.theta)
+            if at >= 0:  # the kernel stopped there: no sensitivities beyond
+                J[at:] = 0.0
             sy = np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", J, self.covariance, J), 0.0))
+            if at >= 0:
+                sy[at:] = np.nan
         else:
             at = _simulate_kernel(self.bases[:, 0].copy(), self.bases[:, 1].copy(), self.rows,
                                   self.theta, u, y, m, lo, hi)
@@ -624,7 +627,7 @@ def _refine_simulation(model: NARXModel, records, max_iter: int, tol: float = 1e
 def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None = None,
          ulags: int | None = None, terms="auto", dt: float | None = None, validate=None,
          direct: bool = False, prune: bool = True, refine: str | None = None,
-         max_iter: int = 50) -> NARXModel:
+         max_iter: int = 50, progress: bool = False) -> NARXModel:
     """Polynomial NARX model of ``y`` driven by ``u`` (1-D arrays of equal length), or of
     several records: ``narx([(u1, y1), (u2, y2), …])`` (each record's first ``max_lag``
     samples are its own past; one regression over all of them, σ from all).
@@ -639,7 +642,11 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
     chosen, θ refined by Levenberg–Marquardt on the free-run (simulation) error, at most
     ``max_iter`` iterations, σ from its Gauss–Newton Hessian (the estimate to use when the
     noise is measurement noise on the output, which biases the one-step estimate).
+    ``progress``: each stage on stderr, a bar over the validation candidates.
     """
+    from ...progress import status, track
+
+    say = status if progress else (lambda message: None)
     if y is None:
         records = _pairs(u, "records")
     else:
@@ -697,6 +704,7 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
         if kmax > len(rows):
             raise ArgumentError(f"narx: terms = {kmax} but only {len(rows)} candidates; give at "
                                 f"most {len(rows)} or raise degree/lags")
+    say(f"narx: FROLS over {len(rows)} candidate terms, {n} rows")
     reg = _Regression(P, target)
     order, errs, sse = _frols_gram(reg.G, reg.g, reg.yy, kmax)
     if not order:
@@ -729,7 +737,8 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
         (model, sse_k), how = build(k), f"BIC minimum at {k} FROLS terms"
     else:
         best = None
-        for k in range(1, len(order) + 1):
+        for k in track(range(1, len(order) + 1), description="narx: validation free runs",
+                       enabled=progress):
             cand, sse_c = build(k)
             f = _fit_records(cand, val, warn=False)
             if f is not None and (best is None or f > best[0] + 1e-9):
@@ -745,6 +754,7 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
         raise DataError("narx: the fit is undefined for a constant output (‖y − ȳ‖ = 0)")
     model.prediction_fit_percent = 100.0 * (1.0 - np.sqrt(sse_k) / spread)
     if refine == "simulation":
+        say(f"narx: refining {len(model.theta)} parameters on the free-run error")
         iters = _refine_simulation(model, records, max_iter)
         dropped = 0
         while prune and iters is not None and len(model.theta) > 1:
