@@ -9,15 +9,23 @@ Structure selection is the forward regression orthogonal least squares of Billin
 S. A. Billings, *Nonlinear System Identification: NARMAX Methods*, Wiley 2013, §3.2): at each
 step the candidate whose part orthogonal to the terms already chosen explains most of the output
 energy (the largest error reduction ratio ``ERR = (wᵀy)² / (wᵀw · yᵀy)``) is taken, and the
-remaining candidates are orthogonalised against it (modified Gram-Schmidt, one rank-one update
-of the candidate block per step, so ``k`` steps cost ``O(k N M)`` for ``M`` candidates). The
+remaining candidates are orthogonalised against it (Gram-Schmidt carried out on the Gram matrix
+``PᵀP``: one pass over the ``N × M`` candidate block, then ``O(M²)`` per step). The
 number of terms is where the Bayesian information criterion ``BIC = N ln(SSE/N) + k ln N``
 is lowest, or ``terms=N``, or, with ``validate=``, the number whose pruned model has the best
 free-run fit on the validation record.
 
 After selection the parameters are the least-squares solution on the chosen terms, with
-``cov θ = σ² (ΦᵀΦ)⁻¹`` and ``σ² = SSE/(N − k)``; terms with ``|θ|/σ_θ < 2`` are removed one at a
-time (the weakest first) and the model is refitted.
+``cov θ = σ² (ΦᵀΦ)⁻¹`` and ``σ² = SSE/(N − k)`` (Cholesky of the scaled Gram matrix and one step
+of iterative refinement on the residual); terms with ``|θ|/σ_θ < 2`` are removed one at a time
+(the weakest first) and the model is refitted.
+
+With ``refine="simulation"`` θ is then refined by Levenberg–Marquardt on the free-run error, the
+free run and its sensitivities ``∂ŷ/∂θ`` from one numba kernel (:func:`_sensitivity_kernel`),
+``cov θ`` from the Gauss–Newton Hessian, and the pruning done on that σ. The same sensitivities
+give the σ of a simulated output (``simulate(..., std=True)``). Several records
+(``narx([(u1, y1), (u2, y2)])``) share one regression, each with its own first ``max_lag``
+samples as past.
 
 The free run feeds the simulated output back into the lagged terms (numba kernel
 :func:`_simulate_kernel`). The fit is ``100 (1 − ‖y − ŷ‖/‖y − ȳ‖)`` over the samples after the
@@ -41,7 +49,7 @@ from ...errors import (ArgumentError, DataError, IdentificationError, ModelError
                        StabilityWarning, emit_warning)
 
 __all__ = ["SCHEMA", "NARX_FIT", "NARXModel", "narx", "load_narx", "file_schema", "candidate_terms",
-           "frols"]
+           "frols", "REFINE"]
 
 SCHEMA = "gripkit.narx-model"
 VERSION = 1
