@@ -210,3 +210,174 @@ def test_hostile_narx_model_files_are_named(tmp_path):
     big.write_text('{"schema": "gripkit.narx-model", "x": ' + "9" * 5000 + "}")
     with pytest.raises(ModelError, match="big.json' cannot be read"):
         load_narx(big)
+
+
+# ------------------------------------------------- refinement on the simulation error, σ of ŷ
+TRUE_TERMS = set(TRUE)
+
+
+def _output_error_system(rng, n=1000, noise=0.1, amplitude=1.0):
+    """Billings' example with the noise on the measured output, not in the equation:
+    x(t) = −0.605 x(t−1) − 0.163 x(t−2)² + 0.588 u(t−1) − 0.240 u(t−2), y = x + v."""
+    u = rng.uniform(-amplitude, amplitude, n)
+    x = np.zeros(n)
+    for t in range(2, n):
+        x[t] = -0.605 * x[t - 1] - 0.163 * x[t - 2] ** 2 + 0.588 * u[t - 1] - 0.240 * u[t - 2]
+    return u, x, x + rng.normal(0.0, noise, n)
+
+
+def test_sensitivities_match_finite_differences():
+    """∂ŷ/∂θ of the sensitivity kernel (free run and derivative in one pass) against central
+    differences of the free run, and the run itself equal to the plain simulation kernel."""
+    u, _, y = _output_error_system(np.random.default_rng(4), n=300)
+    m = narx(u, y, degree=2, lags=2, terms=6, prune=False)
+    ys = np.zeros(300)
+    ys[:2] = y[:2]
+    at, J = m._sensitivities(u, ys, m.theta)
+    assert at == -1
+    np.testing.assert_allclose(ys, m.simulate(u, y[:2]), rtol=0, atol=1e-14)
+    h = 1e-6
+    for j in range(len(m.theta)):
+        d = np.zeros(len(m.theta))
+        d[j] = h
+        runs = []
+        for sgn in (1.0, -1.0):
+            yy = np.zeros(300)
+            yy[:2] = y[:2]
+            m._sensitivities(u, yy, m.theta + sgn * d)
+            runs.append(yy)
+        np.testing.assert_allclose(J[:, j], (runs[0] - runs[1]) / (2 * h), rtol=1e-5, atol=1e-8)
+
+
+def test_simulation_refinement_beats_one_step_on_output_error_noise():
+    """20 records (N = 1000, measurement noise σ_v = 0.1 on the output): the one-step least
+    squares is biased (the noisy y(t−1) in the regressors), the free-run refinement is not.
+    Measured: the refined model's free-run fit on noise-free validation data is higher in 20 of
+    20 runs (mean 99.0 % against 95.4 %; lowest refined 98.3 %, highest one-step 96.5 %); after
+    refinement and pruning on its σ the structure is exactly the true one in 20 of 20 runs and
+    80 of 80 true parameters lie within 3σ (σ from the Gauss–Newton Hessian of the simulation
+    error); mean |error| of the y(t−1) coefficient 0.207 one-step against 0.0045 refined.
+    Asserted: better in ≥ 18 runs, the exact structure in ≥ 18, ≥ 90 % within 3σ, the one-step
+    error of the y(t−1) coefficient at least 10× the refined one (mean over the runs)."""
+    uv, xv, _ = _output_error_system(np.random.default_rng(999), n=2000, noise=0.0)
+    better = present = inside = total = 0
+    err_ls, err_sim = [], []
+    for i in range(20):
+        u, _, y = _output_error_system(np.random.default_rng(200 + i))
+        one = narx(u, y, degree=2, lags=2)
+        ref = narx(u, y, degree=2, lags=2, refine="simulation")
+        assert "refined on the free-run error" in ref.criterion
+        better += ref.compare(uv, xv) > one.compare(uv, xv)
+        present += TRUE_TERMS == set(ref.terms)
+        for name, th, sd in zip(ref.terms, ref.theta, ref.theta_std):
+            if name in TRUE:
+                total += 1
+                inside += abs(th - TRUE[name]) < 3.0 * sd
+        err_ls.append(abs(one.theta[one.terms.index("y(t-1)")] - TRUE["y(t-1)"]))
+        err_sim.append(abs(ref.theta[ref.terms.index("y(t-1)")] - TRUE["y(t-1)"]))
+    assert better >= 18 and present >= 18
+    assert total >= 4 * 18 and inside >= 0.9 * total
+    assert np.mean(err_ls) > 10.0 * np.mean(err_sim)
+
+
+def test_simulate_std_matches_monte_carlo_spread():
+    """σ of the simulated output (linearised propagation of cov θ through the free run) against
+    the spread of the free runs of independently identified models on one input (from rest).
+    Equation-error noise, least squares (40 runs): measured ratio 0.96. Output-error noise,
+    refined (60 runs, those whose structure is the true one, 48): 1.11. Asserted 0.6–1.6 (RMS
+    over time of the mean predicted σ over the RMS of the empirical σ)."""
+    uv = np.random.default_rng(5).uniform(-1.0, 1.0, 300)
+
+    def ratio(sims, stds):
+        emp = np.std(sims, axis=0, ddof=1)[2:]
+        pred = np.mean(stds, axis=0)[2:]
+        return np.sqrt(np.mean(pred ** 2)) / np.sqrt(np.mean(emp ** 2))
+
+    sims, stds = [], []
+    for i in range(40):
+        u, y = _true_system(np.random.default_rng(300 + i))
+        ys, sd = narx(u, y, degree=2, lags=2).simulate(uv, std=True)
+        assert sd[0] == sd[1] == 0.0 and np.all(sd[2:] > 0)
+        sims.append(ys)
+        stds.append(sd)
+    assert 0.6 < ratio(sims, stds) < 1.6
+    sims, stds = [], []
+    for i in range(60):
+        u, _, y = _output_error_system(np.random.default_rng(300 + i))
+        m = narx(u, y, degree=2, lags=2, refine="simulation")
+        if set(m.terms) == TRUE_TERMS:
+            ys, sd = m.simulate(uv, std=True)
+            np.testing.assert_array_equal(ys, m.simulate(uv))
+            sims.append(ys)
+            stds.append(sd)
+    assert len(sims) >= 20
+    assert 0.6 < ratio(sims, stds) < 1.6
+
+
+def test_refine_argument_is_checked():
+    u, y = _true_system(np.random.default_rng(1), n=200)
+    with pytest.raises(ArgumentError, match="refine must be None or 'simulation'"):
+        narx(u, y, refine="prediction")
+    with pytest.raises(ArgumentError, match="max_iter must be an integer"):
+        narx(u, y, refine="simulation", max_iter=0)
+
+
+# ------------------------------------------------------------------------ several records
+def test_several_records_one_regression_sigma_from_all():
+    """Two records: θ is the least squares on both records' regressors stacked (each record's
+    first max_lag samples its own past, no junction row), computed here with numpy's lstsq; σ
+    about 1/√2 of one record's (twice the data); identify([tr1, tr2], "narx") is the same fit."""
+    from gripkit import Trajectory
+    from gripkit.sysid import identify
+    from gripkit.sysid.nonlinear.narx import _regressors
+
+    u1, y1 = _true_system(np.random.default_rng(11), n=2000)
+    u2, y2 = _true_system(np.random.default_rng(12), n=2000, amplitude=0.8)
+    both = narx([(u1, y1), (u2, y2)], degree=2, lags=2)
+    assert set(both.terms) == TRUE_TERMS
+    bases, rows = candidate_terms(2, 2, 2)
+    cols = [int(np.flatnonzero((rows == r).all(axis=1))[0]) for r in both.rows]
+    P = np.vstack([_regressors(bases, rows, u, y, 2)[:, cols] for u, y in ((u1, y1), (u2, y2))])
+    ref = np.linalg.lstsq(P, np.concatenate([y1[2:], y2[2:]]), rcond=None)[0]
+    np.testing.assert_allclose(both.theta, ref, rtol=1e-10, atol=1e-12)
+    one = narx(u1, y1, degree=2, lags=2)
+    assert set(one.terms) == TRUE_TERMS
+    s1 = dict(zip(one.terms, one.theta_std))
+    for name, sd in zip(both.terms, both.theta_std):
+        assert 0.55 < sd / s1[name] < 0.85
+    tr = [Trajectory.uniform(dt=0.01, voltage=u, output=y) for u, y in ((u1, y1), (u2, y2))]
+    m = identify(tr, "narx", input="voltage", output="output", degree=2, lags=2)
+    np.testing.assert_allclose(m.theta, both.theta, rtol=1e-12)
+    assert m.dt == 0.01 and m.output_name == "output"
+    with pytest.raises(DataError, match=r"records\[1\]: u has 2000 samples but y has 1999"):
+        narx([(u1, y1), (u2, y2[:-1])])
+
+
+def test_cli_refine_simulation(tmp_path, capsys):
+    """``--refine simulation`` gives the Python call's refined model; a bad value is one line."""
+    u, _, y = _output_error_system(np.random.default_rng(200))
+    est = tmp_path / "est.csv"
+    np.savetxt(est, np.column_stack([u, y]), delimiter=",", header="u,y", comments="", fmt="%.17g")
+    code, out, err = _cli(capsys, "identify", "narx", est, "--input", "u", "--output", "y",
+                          "--fs", 1, "--refine", "simulation", "--json")
+    assert code == 0, err
+    d = json.loads(out)
+    py = narx(u, y, degree=2, lags=2, refine="simulation")
+    assert d["structure"]["refine"] == "simulation" and set(d["structure"]["terms"]) == TRUE_TERMS
+    assert [p["value"] for p in d["parameters"]] == pytest.approx(list(py.theta), rel=1e-9)
+    assert [p["std"] for p in d["parameters"]] == pytest.approx(list(py.theta_std), rel=1e-6)
+    code, out, err = _cli(capsys, "identify", "narx", est, "--input", "u", "--output", "y",
+                          "--fs", 1, "--refine", "pem")
+    assert code != 0 and err.startswith("error: DataError: --refine: expected 'none' or")
+
+
+def test_simulate_std_of_a_diverging_run_is_nan_after_the_divergence():
+    """The σ of a free run that diverges stops where the run does: NaN there and after, with
+    the same StabilityWarning as the plain simulation."""
+    u, y = _true_system(np.random.default_rng(3), noise=0.01)
+    m = narx(u, y, degree=2, lags=2)
+    with pytest.warns(StabilityWarning, match="diverges"):
+        ys, sd = m.simulate(np.full(500, -6.0), std=True)
+    at = int(np.argmax(~np.isfinite(sd)))
+    assert at > 2 and np.all(np.isnan(sd[at:])) and np.all(np.isfinite(sd[:at]))
+    assert np.all(np.isnan(ys[at + 1:]))

@@ -1,6 +1,6 @@
 """``gripkit identify narx DATA --input U --output Y [--degree D] [--lags L | --ylags LY --ulags LU]
-[--terms N|auto] [--validate DATA2] [--out MODEL.json] [--json]``: polynomial NARX by forward
-regression with the error reduction ratio (:func:`gripkit.sysid.narx`)."""
+[--terms N|auto] [--refine none|simulation] [--validate DATA2] [--out MODEL.json] [--json]``:
+polynomial NARX by forward regression with the error reduction ratio (:func:`gripkit.sysid.narx`)."""
 
 from __future__ import annotations
 
@@ -55,6 +55,9 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
                   terms: str = typer.Option("auto", "--terms",
                                             help="Number of terms, or auto (BIC; with --validate "
                                                  "the free-run validation fit)."),
+                  refine: str = typer.Option("none", "--refine",
+                                             help="none (one-step least squares) or simulation "
+                                                  "(θ refined on the free-run error)."),
                   validate: Optional[Path] = typer.Option(None, "--validate",
                                                           help="Validation record (same columns)."),
                   out: Optional[Path] = typer.Option(None, "--out", help="Write the model (JSON)."),
@@ -67,6 +70,11 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
     from ..sysid.nonlinear.narx import narx
 
     n_terms = _terms(terms)
+    if refine not in ("none", "simulation"):
+        from ..errors import DataError
+
+        raise DataError(f"--refine: expected 'none' or 'simulation', found {refine!r}",
+                        hint="--refine simulation fits θ to the free run (output-error noise)")
     check_data_options(fs, fill)
     output_folder(report, "--report")
     with collected_warnings() as caught:
@@ -76,7 +84,8 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
             tv = load_data(validate, [input_col, output_col], fs, time, fill)
             val = (np.asarray(tv[input_col]), np.asarray(tv[output_col]))
         m = narx(np.asarray(tr[input_col]), np.asarray(tr[output_col]), degree=degree, lags=lags,
-                 ylags=ylags, ulags=ulags, terms=n_terms, dt=tr.dt, validate=val)
+                 ylags=ylags, ulags=ulags, terms=n_terms, dt=tr.dt, validate=val,
+                 refine=None if refine == "none" else refine, progress=True)
         m.input_name, m.output_name = input_col, output_col
         if out is not None:
             m.save(out)
@@ -86,7 +95,8 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
     if json_out:
         emit_json({"data": str(data), "input": input_col, "output": output_col,
                    "structure": {"degree": m.degree, "ylags": m.ylags, "ulags": m.ulags,
-                                 "terms": m.terms, "criterion": m.criterion},
+                                 "terms": m.terms, "criterion": m.criterion,
+                                 "refine": refine},
                    "parameters": [{"term": t, "value": float(v), "std": float(s)}
                                   for t, v, s in zip(m.terms, m.theta, m.theta_std)],
                    "fit_percent": m.fit_percent, "prediction_fit_percent": m.prediction_fit_percent,

@@ -276,7 +276,7 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
 
 
 #: the methods that fit one model to several records (``identify([tr1, tr2], ...)``)
-RECORD_METHODS = ("arx", "armax", "oe", "ss", "tf")
+RECORD_METHODS = ("arx", "armax", "oe", "ss", "tf", "narx")
 
 
 def _per_record(i: int, fn, *args, **kw):
@@ -297,9 +297,11 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
     (:func:`gripkit.sysid.linear.armax.armax_records`), OE (:func:`gripkit.sysid.linear.oe.oe_records`; ``nf``
     defaults to ``na``), ``options`` ``maxiter``, ``tol`` for the last two; state space
     (``options`` of :data:`gripkit.sysid.linear.identify_mimo.SS_RECORD_OPTIONS`: subspace, then PEM,
-    see :func:`gripkit.sysid.linear.identify_mimo.identify_ss_records`) and
+    see :func:`gripkit.sysid.linear.identify_mimo.identify_ss_records`),
     continuous-time transfer functions (``poles``, ``zeros``:
-    :func:`gripkit.sysid.linear.tfest.tfest_records`). This is what
+    :func:`gripkit.sysid.linear.tfest.tfest_records`) and polynomial NARX
+    (:func:`gripkit.sysid.narx` on the records as they are, its constant term in place of
+    ``detrend``; ``options`` of that function). This is what
     ``identify([tr1, tr2], method, ...)`` and ``gripkit identify METHOD DATA1 DATA2 ...`` do.
 
     The model has one operating point: ``detrend='mean'`` removes the mean of all the records
@@ -354,6 +356,10 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
            for i, d in enumerate(data)]
     _same_sampling([(io.dt, (io.input_unit, io.output_unit)) for io in ios],
                    (ios[0].input, ios[0].output))
+    if method == "narx":  # the data as they are: the model's constant carries the operating point
+        model = _as_data(nonlinear.narx, [(io.u, io.y) for io in ios], dt=ios[0].dt, **options)
+        model.input_name, model.output_name = input, output
+        return model
     u0 = float(_pooled_mean([io.u for io in ios])) if detrend == "mean" else 0.0
     y0 = float(_pooled_mean([io.y for io in ios])) if detrend == "mean" else 0.0
     meta = dict(ios[0].meta, u_offset=u0, y_offset=y0, dt=ios[0].dt, **options)

@@ -9,15 +9,23 @@ Structure selection is the forward regression orthogonal least squares of Billin
 S. A. Billings, *Nonlinear System Identification: NARMAX Methods*, Wiley 2013, §3.2): at each
 step the candidate whose part orthogonal to the terms already chosen explains most of the output
 energy (the largest error reduction ratio ``ERR = (wᵀy)² / (wᵀw · yᵀy)``) is taken, and the
-remaining candidates are orthogonalised against it (modified Gram-Schmidt, one rank-one update
-of the candidate block per step, so ``k`` steps cost ``O(k N M)`` for ``M`` candidates). The
+remaining candidates are orthogonalised against it (Gram-Schmidt carried out on the Gram matrix
+``PᵀP``: one pass over the ``N × M`` candidate block, then ``O(M²)`` per step). The
 number of terms is where the Bayesian information criterion ``BIC = N ln(SSE/N) + k ln N``
 is lowest, or ``terms=N``, or, with ``validate=``, the number whose pruned model has the best
 free-run fit on the validation record.
 
 After selection the parameters are the least-squares solution on the chosen terms, with
-``cov θ = σ² (ΦᵀΦ)⁻¹`` and ``σ² = SSE/(N − k)``; terms with ``|θ|/σ_θ < 2`` are removed one at a
-time (the weakest first) and the model is refitted.
+``cov θ = σ² (ΦᵀΦ)⁻¹`` and ``σ² = SSE/(N − k)`` (Cholesky of the scaled Gram matrix and one step
+of iterative refinement on the residual); terms with ``|θ|/σ_θ < 2`` are removed one at a time
+(the weakest first) and the model is refitted.
+
+With ``refine="simulation"`` θ is then refined by Levenberg–Marquardt on the free-run error, the
+free run and its sensitivities ``∂ŷ/∂θ`` from one numba kernel (:func:`_sensitivity_kernel`),
+``cov θ`` from the Gauss–Newton Hessian, and the pruning done on that σ. The same sensitivities
+give the σ of a simulated output (``simulate(..., std=True)``). Several records
+(``narx([(u1, y1), (u2, y2)])``) share one regression, each with its own first ``max_lag``
+samples as past.
 
 The free run feeds the simulated output back into the lagged terms (numba kernel
 :func:`_simulate_kernel`). The fit is ``100 (1 − ‖y − ŷ‖/‖y − ȳ‖)`` over the samples after the
@@ -44,7 +52,7 @@ from ...signals.trajectory import Trajectory
 from ..model_protocol import ModelFit
 
 __all__ = ["SCHEMA", "NARX_FIT", "NARXModel", "narx", "load_narx", "file_schema", "candidate_terms",
-           "frols"]
+           "frols", "REFINE"]
 
 SCHEMA = "gripkit.narx-model"
 VERSION = 1
@@ -75,58 +83,117 @@ def _term_name(row, bases) -> str:
     return "*".join(parts) if parts else "1"
 
 
-def _regressors(bases, rows, u, y, start: int) -> np.ndarray:
-    """The candidate matrix (N − start, M): every monomial evaluated on the measured data."""
+def _regressors(bases, rows, u, y, start: int, out=None) -> np.ndarray:
+    """The candidate matrix (N − start, M): every monomial evaluated on the measured data
+    (written into ``out``, a Fortran-order block of that shape, when given)."""
     n = len(y) - start
     cols = np.empty((len(bases), n))
     for i, (kind, lag) in enumerate(bases):
         s = y if kind == 0 else u
         cols[i] = s[start - lag:len(s) - lag]
-    P = np.ones((n, len(rows)), order="F")  # column by column
+    P = np.empty((n, len(rows)), order="F") if out is None else out
     for j, row in enumerate(rows):
-        for b in row:
-            if b >= 0:
+        used = [b for b in row if b >= 0]
+        if not used:
+            P[:, j] = 1.0
+        elif len(used) == 1:
+            P[:, j] = cols[used[0]]
+        else:
+            np.multiply(cols[used[0]], cols[used[1]], out=P[:, j])
+            for b in used[2:]:
                 P[:, j] *= cols[b]
     return P
+
+
+def _gram(P: np.ndarray, y: np.ndarray):
+    """``PᵀP`` (numpy hands ``Aᵀ A`` to BLAS ``syrk``: one pass over ``P``), ``Pᵀy``, ``yᵀy``."""
+    return P.T @ P, P.T @ y, float(y @ y)
 
 
 def frols(P: np.ndarray, y: np.ndarray, max_terms: int):
     """Forward regression orthogonal least squares: the order in which columns of ``P`` are
     chosen, their error reduction ratios, and the residual sum of squares after each step.
 
-    Modified Gram-Schmidt on the candidate block ``W`` (Fortran order): after a column is chosen
-    (unit vector ``q``), ``c = qᵀW`` and the rank-one update ``W ← W − q cᵀ`` runs in place
-    (BLAS ``dger``); the squared norms and ``Wᵀy`` are downdated (``‖w‖² − c²``, ``Wᵀy − c qᵀy``)
-    rather than recomputed, so each step is two passes over ``W``."""
-    from scipy.linalg.blas import dger
+    Modified Gram-Schmidt carried out on the Gram matrix: with ``C = WᵀW`` and ``g = Wᵀy`` of the
+    candidates orthogonalised so far, choosing column ``j`` (``q = w_j/‖w_j‖``, ``c = qᵀW =
+    C[j]/√C_jj``) turns ``W`` into ``W − q cᵀ``, whose Gram matrix is ``C − c cᵀ`` and whose
+    ``Wᵀy`` is ``g − c qᵀy``. One pass over the data (``PᵀP``, ``Pᵀy``), then ``O(M²)`` per step:
+    the same choices and ERRs as the Gram-Schmidt on the columns, in exact arithmetic."""
+    P = np.asarray(P, dtype=np.float64)
+    if not P.flags.f_contiguous:
+        P = np.asfortranarray(P)
+    G, g, yy = _gram(P, np.ascontiguousarray(y, dtype=np.float64))
+    return _frols_gram(G, g, yy, max_terms)
 
-    W = np.array(P, dtype=np.float64, order="F")
-    y = np.ascontiguousarray(y, dtype=np.float64)
-    yy = float(y @ y)
-    active = np.ones(W.shape[1], dtype=bool)
-    norms = np.einsum("ij,ij->j", W, W)
+
+def _frols_gram(G: np.ndarray, g: np.ndarray, yy: float, max_terms: int):
+    """:func:`frols` from ``G = PᵀP``, ``g = Pᵀy`` and ``yy = yᵀy``."""
+    C = np.array(G, dtype=np.float64)
+    g = np.array(g, dtype=np.float64)
+    norms = np.diag(C).copy()
+    active = np.ones(len(g), dtype=bool)
     floor = 1e-10 * np.maximum(norms, 1e-300)
-    g = W.T @ y
     sse_now = yy
     chosen, errs, sse = [], [], []
-    for _ in range(min(max_terms, W.shape[1])):
+    for _ in range(min(max_terms, len(g))):
         ok = active & (norms > floor)
         if not ok.any():
             break
         err = np.where(ok, g * g / np.where(ok, norms, 1.0), -1.0) / yy
         j = int(np.argmax(err))
-        q = W[:, j] / np.sqrt(norms[j])
-        qy = float(q @ y)
+        r = np.sqrt(norms[j])
+        c = C[j] / r
+        qy = g[j] / r
         chosen.append(j)
         errs.append(float(err[j]))
         active[j] = False
         sse_now -= qy * qy
         sse.append(max(sse_now, 0.0))
-        c = q @ W
-        W = dger(-1.0, q, c, a=W, overwrite_a=True)
+        C -= np.outer(c, c)
         norms = np.maximum(norms - c * c, 0.0)  # ‖w − q qᵀw‖² = ‖w‖² − (qᵀw)²
         g = g - c * qy
     return chosen, errs, sse
+
+
+class _Regression:
+    """The stacked candidate matrix ``P`` (every record's rows after its first ``max_lag``
+    samples), the target, and their Gram matrix, from which every least-squares fit on a subset
+    of the columns is taken (:meth:`fit`)."""
+
+    def __init__(self, P, target):
+        self.P, self.target = P, target
+        self.G, self.g, self.yy = _gram(P, target)
+
+    def fit(self, cols):
+        """θ, cov θ = σ² (ΦᵀΦ)⁻¹ and SSE of the least squares on ``cols``: Cholesky of the
+        column-scaled Gram matrix (the semi-normal equations) and one step of iterative
+        refinement on the actual residual, which brings θ to the accuracy of a QR solution for
+        any ``cond(Φ)`` below about 1e7; beyond that (or a failed Cholesky) a QR of ``Φ``."""
+        cols = list(cols)
+        G = self.G[np.ix_(cols, cols)]
+        d = np.sqrt(np.diag(G))
+        d[d == 0] = 1.0
+        Gs = G / np.outer(d, d)
+        try:
+            L = np.linalg.cholesky(Gs)
+            ok = np.min(np.diag(L)) ** 2 > 1e-14 * len(cols)
+        except np.linalg.LinAlgError:
+            ok = False
+        if not ok:
+            return _lstsq_cov(self.P[:, cols], self.target)
+        from scipy.linalg import cho_solve
+
+        Phi = self.P[:, cols]
+        z = cho_solve((L, True), self.g[cols] / d)
+        e = self.target - Phi @ (z / d)
+        z += cho_solve((L, True), (Phi.T @ e) / d)  # one refinement step on the residual
+        theta = z / d
+        e = self.target - Phi @ theta
+        sse = float(e @ e)
+        n, k = Phi.shape
+        Linv = np.linalg.solve(L, np.eye(k))
+        cov = sse / max(n - k, 1) * (Linv.T @ Linv) / np.outer(d, d)
+        return theta, cov, sse
 
 
 def _lstsq_cov(Phi: np.ndarray, y: np.ndarray):
@@ -145,11 +212,11 @@ def _lstsq_cov(Phi: np.ndarray, y: np.ndarray):
     return theta, cov, sse
 
 
-def _fit_pruned(P, y, cols: list[int], threshold: float = 2.0):
+def _fit_pruned(reg: _Regression, cols: list[int], threshold: float = 2.0):
     """Least squares on ``cols``, removing the weakest term while ``|θ|/σ < threshold``."""
     cols = list(cols)
     while True:
-        theta, cov, sse = _lstsq_cov(P[:, cols], y)
+        theta, cov, sse = reg.fit(cols)
         std = np.sqrt(np.maximum(np.diag(cov), 0.0))
         t = np.abs(theta) / np.where(std > 0, std, np.inf)
         weakest = int(np.argmin(np.where(std > 0, t, np.inf)))
@@ -179,6 +246,62 @@ def _simulate_kernel(kinds, lags, rows, theta, u, y, start, limit_lo, limit_hi):
                     v *= u[t - lags[b]]
             acc += v
         y[t] = acc
+        if not (acc >= limit_lo and acc <= limit_hi):
+            for s in range(t + 1, n):
+                y[s] = np.nan
+            return t
+    return -1
+
+
+@njit(cache=True)
+def _sensitivity_kernel(kinds, lags, rows, theta, u, y, start, limit_lo, limit_hi, J, dfdy):
+    """Free run in place (as :func:`_simulate_kernel`) and, in the same pass, its derivative
+    ``J[t, j] = ∂ŷ(t)/∂θ_j``: ``J[t] = m(t) + Σ_b ∂f/∂y(t−lag_b) · J[t − lag_b]`` over the
+    output bases ``b``, with ``J[t] = 0`` for the ``start`` given outputs. ``dfdy`` is scratch of
+    one entry per base. Returns the first sample where the run left the limits, −1 if none."""
+    n = y.shape[0]
+    nt = rows.shape[0]
+    deg = rows.shape[1]
+    nb = kinds.shape[0]
+    for t in range(start):
+        for j in range(nt):
+            J[t, j] = 0.0
+    for t in range(start, n):
+        for b in range(nb):
+            dfdy[b] = 0.0
+        acc = 0.0
+        for k in range(nt):
+            m = 1.0
+            v = theta[k]  # the same order of products as _simulate_kernel: the same run
+            for d in range(deg):
+                b = rows[k, d]
+                if b < 0:
+                    break
+                f = y[t - lags[b]] if kinds[b] == 0 else u[t - lags[b]]
+                m *= f
+                v *= f
+            J[t, k] = m
+            acc += v
+            for d in range(deg):  # ∂(θ_k m_k)/∂y(t − lag_b): the product of the other factors
+                b = rows[k, d]
+                if b < 0:
+                    break
+                if kinds[b] != 0:
+                    continue
+                p = theta[k]
+                for e in range(deg):
+                    c = rows[k, e]
+                    if c < 0:
+                        break
+                    if e != d:
+                        p *= y[t - lags[c]] if kinds[c] == 0 else u[t - lags[c]]
+                dfdy[b] += p
+        y[t] = acc
+        for b in range(nb):
+            if kinds[b] == 0 and dfdy[b] != 0.0:
+                s = t - lags[b]
+                for j in range(nt):
+                    J[t, j] += dfdy[b] * J[s, j]
         if not (acc >= limit_lo and acc <= limit_hi):
             for s in range(t + 1, n):
                 y[s] = np.nan
@@ -299,13 +422,20 @@ class NARXModel:
         mid = 0.5 * (hi + lo)
         return mid - DIVERGENCE_FACTOR * span, mid + DIVERGENCE_FACTOR * span
 
-    def simulate(self, data, y0=None, *, warn: bool = True) -> np.ndarray:
+    def simulate(self, data, y0=None, *, warn: bool = True, std: bool = False):
         """Free run on the input of ``data`` (a trajectory: (N, 1)) or on the input ``u`` (N,):
         the first ``max_lag`` outputs are ``y0`` (zeros by default), the rest simulated. A
-        diverging run ends in NaN after a StabilityWarning."""
+        diverging run ends in NaN after a StabilityWarning.
+
+        ``std=True``: also the 1σ of the simulated output from the parameter covariance,
+        ``σ_ŷ(t)² = J(t) cov θ J(t)ᵀ`` with ``J(t) = ∂ŷ(t)/∂θ`` propagated through the free run
+        (linearised; 0 for the given first outputs); returns ``(y, σ_y)``."""
         if isinstance(data, Trajectory):
             u, _ = self._signals(data, None, "simulate", outputs=False)
-            return self.simulate(u, y0, warn=warn).reshape(-1, 1)
+            out = self.simulate(u, y0, warn=warn, std=std)
+            if std:
+                return out[0].reshape(-1, 1), out[1].reshape(-1, 1)
+            return out.reshape(-1, 1)
         u = _as_signal(data, "u")
         m = self.max_lag
         if len(u) <= m:
@@ -318,14 +448,32 @@ class NARXModel:
                                     f"found shape {y0.shape}")
             y[:m] = y0
         lo, hi = self._limits()
-        at = _simulate_kernel(self.bases[:, 0].copy(), self.bases[:, 1].copy(), self.rows,
-                              self.theta, u, y, m, lo, hi)
+        if std:
+            at, J = self._sensitivities(u, y, self.theta)
+            if at >= 0:  # the kernel stopped there: no sensitivities beyond
+                J[at:] = 0.0
+            sy = np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", J, self.covariance, J), 0.0))
+            if at >= 0:
+                sy[at:] = np.nan
+        else:
+            at = _simulate_kernel(self.bases[:, 0].copy(), self.bases[:, 1].copy(), self.rows,
+                                  self.theta, u, y, m, lo, hi)
         if at >= 0 and warn:
             emit_warning(f"narx: the free run diverges at sample {at} (beyond "
                          f"{DIVERGENCE_FACTOR:g}× the estimation output's range); the model is "
                          "unstable on this input",
                          StabilityWarning)
-        return y
+        return (y, sy) if std else y
+
+    def _sensitivities(self, u, y, theta):
+        """Free run into ``y`` (its first ``max_lag`` entries given) with parameters ``theta``,
+        and ``J = ∂ŷ/∂θ`` (N, k); returns (diverged sample or −1, J)."""
+        lo, hi = self._limits()
+        J = np.empty((len(u), len(theta)))
+        at = _sensitivity_kernel(self.bases[:, 0].copy(), self.bases[:, 1].copy(), self.rows,
+                                 np.ascontiguousarray(theta, dtype=np.float64), u, y,
+                                 self.max_lag, lo, hi, J, np.empty(len(self.bases)))
+        return at, J
 
     def predict(self, data, y=None, horizon: int = 1) -> np.ndarray:
         """One-step-ahead prediction from measured ``u`` and ``y`` (or a trajectory: (N, 1));
@@ -454,24 +602,155 @@ def _positive_int(v, name: str, lo: int = 1) -> int:
     return int(v)
 
 
-def narx(u, y, *, degree: int = 2, lags: int | None = 2, ylags: int | None = None,
+def _is_signal(a) -> bool:
+    """``a`` reads as one 1-D numeric signal (not a pair of records)."""
+    try:
+        return np.asarray(a, dtype=np.float64).ndim == 1
+    except (TypeError, ValueError):
+        return False
+
+
+def _pairs(x, what: str) -> list[tuple[np.ndarray, np.ndarray]]:
+    """One record ``(u, y)`` or a list of them -> a list of checked pairs of equal length."""
+    if isinstance(x, (list, tuple)) and len(x) == 2 and _is_signal(x[0]) and _is_signal(x[1]):
+        x = [x]
+    if not isinstance(x, (list, tuple)) or not x:
+        raise ArgumentError(f"narx: {what} must be a pair (u, y) of 1-D arrays or a non-empty list "
+                            f"of such pairs, found {type(x).__name__}")
+    out = []
+    for i, pair in enumerate(x):
+        name = what if len(x) == 1 else f"{what}[{i}]"
+        try:
+            u, y = pair
+        except (TypeError, ValueError):
+            raise ArgumentError(f"narx: {name} must be a pair (u, y) of 1-D arrays, found "
+                                f"{type(pair).__name__}") from None
+        u, y = _as_signal(u, f"{name} u"), _as_signal(y, f"{name} y")
+        if len(u) != len(y):
+            raise DataError(f"narx: {name}: u has {len(u)} samples but y has {len(y)}; pass a pair "
+                            "of equal length")
+        out.append((u, y))
+    return out
+
+
+def _fit_records(model: NARXModel, records, warn: bool = True) -> float | None:
+    """Free-run fit (%) over several records, each run from its own first ``max_lag`` measured
+    outputs; the fit over all the samples after them together (None if a run diverges)."""
+    if len(records) == 1:
+        return model._free_run_fit(*records[0], warn=warn)[0]
+    m = model.max_lag
+    ys, yh = [], []
+    for u, y in records:
+        s = model.simulate(u, y[:m], warn=warn)
+        if not np.all(np.isfinite(s)):
+            return None
+        ys.append(y[m:])
+        yh.append(s[m:])
+    return _fit(np.concatenate(ys), np.concatenate(yh))
+
+
+#: choices of ``refine``
+REFINE = (None, "simulation")
+
+
+def _refine_simulation(model: NARXModel, records, max_iter: int, tol: float = 1e-9):
+    """Levenberg–Marquardt on the free-run error ``Σ_records ‖y − ŷ(θ)‖²`` (the samples after
+    each record's first ``max_lag``), started from the least-squares θ; the Jacobian from
+    :func:`_sensitivity_kernel` (the free run and ``∂ŷ/∂θ`` in one pass). ``cov θ = σ² (JᵀJ)⁻¹``
+    at the optimum (the Gauss–Newton Hessian), ``σ² = SSE/(N − k)``. Returns the number of
+    iterations, or None when the least-squares start itself diverges."""
+    m = model.max_lag
+
+    def run(theta):
+        es, Js = [], []
+        for u, y in records:
+            ys = np.empty(len(u))
+            ys[:m] = y[:m]
+            at, J = model._sensitivities(u, ys, theta)
+            if at >= 0:
+                return None
+            es.append(y[m:] - ys[m:])
+            Js.append(J[m:])
+        return np.concatenate(es), np.concatenate(Js)
+
+    theta = model.theta.copy()
+    cur = run(theta)
+    if cur is None:
+        return None
+    e, J = cur
+    cost = float(e @ e)
+    lam, it = 1e-3, 0
+    for it in range(1, max_iter + 1):
+        A = J.T @ J
+        g = J.T @ e
+        d = np.sqrt(np.maximum(np.diag(A), 1e-300))
+        As, gs = A / np.outer(d, d), g / d
+        improved = False
+        while lam < 1e12:
+            try:
+                step = np.linalg.solve(As + lam * np.eye(len(d)), gs) / d
+            except np.linalg.LinAlgError:
+                lam *= 10.0
+                continue
+            new = run(theta + step)
+            if new is not None and float(new[0] @ new[0]) < cost:
+                improved = True
+                theta = theta + step
+                e, J = new
+                old, cost = cost, float(e @ e)
+                lam = max(lam / 3.0, 1e-12)
+                break
+            lam *= 4.0
+        if not improved or old - cost <= tol * old:
+            break
+    n, k = J.shape
+    A = J.T @ J
+    d = np.sqrt(np.maximum(np.diag(A), 1e-300))
+    cov = cost / max(n - k, 1) * np.linalg.pinv(A / np.outer(d, d)) / np.outer(d, d)
+    model.theta = theta
+    model.covariance = cov
+    model.theta_std = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    return it
+
+
+def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None = None,
          ulags: int | None = None, terms="auto", dt: float | None = None, validate=None,
-         direct: bool = False, prune: bool = True) -> NARXModel:
-    """Polynomial NARX model of ``y`` driven by ``u`` (1-D arrays of equal length).
+         direct: bool = False, prune: bool = True, refine: str | None = None,
+         max_iter: int = 50, progress: bool = False) -> NARXModel:
+    """Polynomial NARX model of ``y`` driven by ``u`` (1-D arrays of equal length), or of
+    several records: ``narx([(u1, y1), (u2, y2), …])`` (each record's first ``max_lag``
+    samples are its own past; one regression over all of them, σ from all).
 
     ``degree``: highest total degree of a term. ``lags``: output and input lags (``ylags`` /
     ``ulags`` set them apart). ``terms``: ``"auto"`` (BIC, or the validation fit with
-    ``validate=(u2, y2)``; at most 40 FROLS terms are tried) or a number of FROLS terms.
-    ``direct``: include ``u(t)``. ``dt``: sample interval (s), default 1.
+    ``validate=(u2, y2)`` or a list of such pairs; at most 40 FROLS terms are tried) or a number
+    of FROLS terms. ``direct``: include ``u(t)``. ``dt``: sample interval (s), default 1.
     ``prune``: remove terms with ``|θ|/σ < 2`` and refit.
+    ``refine``: None (default: θ and σ of the one-step least squares, the maximum-likelihood
+    estimate when the noise enters the equation) or ``"simulation"``: after the structure is
+    chosen, θ refined by Levenberg–Marquardt on the free-run (simulation) error, at most
+    ``max_iter`` iterations, σ from its Gauss–Newton Hessian (the estimate to use when the
+    noise is measurement noise on the output, which biases the one-step estimate).
+    ``progress``: each stage on stderr, a bar over the validation candidates.
     """
-    u, y = _as_signal(u, "u"), _as_signal(y, "y")
-    if len(u) != len(y):
-        raise DataError(f"narx: u has {len(u)} samples but y has {len(y)}; pass a pair of equal "
-                        "length")
-    if np.ptp(y) == 0.0:
-        raise DataError(f"narx: the output is constant ({y[0]:g} in all {len(y)} samples); there "
-                        "is nothing to identify: check the output column")
+    from ...progress import status, track
+
+    say = status if progress else (lambda message: None)
+    if y is None:
+        records = _pairs(u, "records")
+    else:
+        u, y = _as_signal(u, "u"), _as_signal(y, "y")
+        if len(u) != len(y):
+            raise DataError(f"narx: u has {len(u)} samples but y has {len(y)}; pass a pair of "
+                            "equal length")
+        records = [(u, y)]
+    if refine not in REFINE:
+        raise ArgumentError(f"narx: refine must be None or 'simulation', found {refine!r}")
+    max_iter = _positive_int(max_iter, "max_iter")
+    yall = np.concatenate([r[1] for r in records])
+    if np.ptp(yall) == 0.0:
+        raise DataError(f"narx: the output is constant ({yall[0]:g} in all {len(yall)} samples); "
+                        "there is nothing to identify: check the output column")
     degree = _positive_int(degree, "degree")
     ly = _positive_int(ylags if ylags is not None else lags, "ylags", 0)
     lu = _positive_int(ulags if ulags is not None else lags, "ulags", 0)
@@ -482,20 +761,29 @@ def narx(u, y, *, degree: int = 2, lags: int | None = 2, ylags: int | None = Non
         raise ArgumentError("narx: no lagged signal (ylags = ulags = 0); give lags ≥ 1")
     bases, rows = candidate_terms(ly, lu, degree, direct)
     start = max(ly, lu, 1)
-    if len(y) - start < 2 * len(rows):
-        raise DataError(f"narx: {len(y)} samples for {len(rows)} candidate terms; need at least "
-                        f"{2 * len(rows) + start}: lower degree or lags, or give more data")
-    P = _regressors(bases, rows, u, y, start)
-    target = y[start:]
+    for i, (_, yr) in enumerate(records):
+        if len(yr) <= start + 1:
+            raise DataError(f"narx: record {i} has {len(yr)} samples; each record needs more than "
+                            f"max_lag + 1 = {start + 1}")
+    n = sum(len(yr) - start for _, yr in records)
+    if n < 2 * len(rows):
+        raise DataError(f"narx: {n + start * len(records)} samples for {len(rows)} candidate "
+                        f"terms; need at least {2 * len(rows) + start * len(records)}: lower "
+                        "degree or lags, or give more data")
+    P = np.empty((n, len(rows)), order="F")
+    at = 0
+    for ur, yr in records:
+        k = len(yr) - start
+        _regressors(bases, rows, ur, yr, start, out=P[at:at + k])
+        at += k
+    target = np.concatenate([yr[start:] for _, yr in records])
+    val = None
     if validate is not None:
-        try:
-            uv, yv = validate
-        except (TypeError, ValueError):
-            raise ArgumentError("narx: validate must be a pair (u, y) of validation data") from None
-        uv, yv = _as_signal(uv, "validate u"), _as_signal(yv, "validate y")
-        if len(uv) != len(yv) or len(uv) <= start + 2:
-            raise DataError(f"narx: validation u has {len(uv)} and y {len(yv)} samples; need equal "
-                            f"lengths beyond max_lag = {start}")
+        val = _pairs(validate, "validate")
+        for uv, yv in val:
+            if len(uv) <= start + 2:
+                raise DataError(f"narx: a validation record has {len(uv)} samples; need more "
+                                f"than max_lag + 2 = {start + 2}")
     if terms == "auto":
         kmax = min(len(rows), MAX_AUTO_TERMS)
     else:
@@ -505,49 +793,82 @@ def narx(u, y, *, degree: int = 2, lags: int | None = 2, ylags: int | None = Non
         if kmax > len(rows):
             raise ArgumentError(f"narx: terms = {kmax} but only {len(rows)} candidates; give at "
                                 f"most {len(rows)} or raise degree/lags")
-    order, errs, sse = frols(P, target, kmax)
+    say(f"narx: FROLS over {len(rows)} candidate terms, {n} rows")
+    reg = _Regression(P, target)
+    order, errs, sse = _frols_gram(reg.G, reg.g, reg.yy, kmax)
     if not order:
         raise IdentificationError("narx: no candidate term explains the output (all columns zero)")
-    n = len(target)
-    y_range = (float(y.min()), float(y.max()))
+    y_range = (float(yall.min()), float(yall.max()))
+
+    # with refine, terms are pruned by the σ of the simulation-error criterion, after refinement
+    # (the one-step σ of a biased estimate would remove true terms)
+    prune_ls = prune and refine is None
 
     def build(k):
         cols = order[:k]
-        if prune:
-            cols, theta, std, cov, _ = _fit_pruned(P, target, cols)
+        if prune_ls:
+            cols, theta, std, cov, sse_k = _fit_pruned(reg, cols)
         else:
-            theta, cov, _ = _lstsq_cov(P[:, cols], target)
+            theta, cov, sse_k = reg.fit(cols)
             std = np.sqrt(np.maximum(np.diag(cov), 0.0))
-        return NARXModel(ylags=ly, ulags=lu, degree=degree, direct=direct, bases=bases,
-                         rows=rows[cols], theta=theta, theta_std=std, covariance=cov,
-                         dt=1.0 if dt is None else float(dt), y_range=y_range,
-                         err=list(errs[:k]),
-                         frols_terms=[_term_name(rows[c], bases) for c in order[:k]])
+        mod = NARXModel(ylags=ly, ulags=lu, degree=degree, direct=direct, bases=bases,
+                        rows=rows[cols], theta=theta, theta_std=std, covariance=cov,
+                        dt=1.0 if dt is None else float(dt), y_range=y_range,
+                        err=list(errs[:k]),
+                        frols_terms=[_term_name(rows[c], bases) for c in order[:k]])
+        return mod, sse_k
 
     if terms != "auto":
-        model, how = build(len(order)), f"terms={len(order)}"
-    elif validate is None:
+        (model, sse_k), how = build(len(order)), f"terms={len(order)}"
+    elif val is None:
         bic = [n * np.log(max(s, 1e-300) / n) + (k + 1) * np.log(n) for k, s in enumerate(sse)]
         k = int(np.argmin(bic)) + 1
-        model, how = build(k), f"BIC minimum at {k} FROLS terms"
+        (model, sse_k), how = build(k), f"BIC minimum at {k} FROLS terms"
     else:
         best = None
-        for k in range(1, len(order) + 1):
-            cand = build(k)
-            f = cand._free_run_fit(uv, yv, warn=False)[0]
+        for k in track(range(1, len(order) + 1), description="narx: validation free runs",
+                       enabled=progress):
+            cand, sse_c = build(k)
+            f = _fit_records(cand, val, warn=False)
             if f is not None and (best is None or f > best[0] + 1e-9):
-                best = (f, k, cand)
+                best = (f, k, cand, sse_c)
         if best is None:
-            model = build(len(order))
-            how = "validation fit (every candidate diverged)"
+            (model, sse_k), how = build(len(order)), "validation fit (every candidate diverged)"
         else:
-            model, how = best[2], f"validation free-run fit best at {best[1]} FROLS terms"
-    model.criterion = how + (", terms with |θ|/σ < 2 pruned" if prune else "")
-    model.prediction_fit_percent = _fit(target, P[:, [_row_index(rows, r) for r in model.rows]]
-                                        @ model.theta)
-    model.fit_percent = model._free_run_fit(u, y)[0]
-    if validate is not None:
-        model.validation_fit_percent = model._free_run_fit(uv, yv)[0]
+            model, sse_k = best[2], best[3]
+            how = f"validation free-run fit best at {best[1]} FROLS terms"
+    model.criterion = how + (", terms with |θ|/σ < 2 pruned" if prune_ls else "")
+    spread = float(np.linalg.norm(target - target.mean()))
+    if spread == 0.0:
+        raise DataError("narx: the fit is undefined for a constant output (‖y − ȳ‖ = 0)")
+    model.prediction_fit_percent = 100.0 * (1.0 - np.sqrt(sse_k) / spread)
+    if refine == "simulation":
+        say(f"narx: refining {len(model.theta)} parameters on the free-run error")
+        iters = _refine_simulation(model, records, max_iter)
+        dropped = 0
+        while prune and iters is not None and len(model.theta) > 1:
+            t = np.abs(model.theta) / np.where(model.theta_std > 0, model.theta_std, np.inf)
+            weakest = int(np.argmin(t))
+            if not t[weakest] < 2.0:
+                break
+            keep = np.arange(len(model.theta)) != weakest
+            model.rows, model.theta = model.rows[keep], model.theta[keep]
+            dropped += 1
+            more = _refine_simulation(model, records, max_iter)
+            iters = None if more is None else iters + more
+        model.criterion += ("; θ refined on the free-run error (Levenberg–Marquardt, "
+                            f"{iters} iterations, σ from its Gauss–Newton Hessian"
+                            + (f", then {dropped} term(s) with |θ|/σ < 2 pruned one by one)"
+                               if dropped else ")")
+                            if iters is not None else
+                            "; not refined: the least-squares model's free run diverges")
+        if iters is not None:  # the one-step fit of the refined θ
+            cols = [_row_index(rows, r) for r in model.rows]
+            e = target - P[:, cols] @ model.theta
+            model.prediction_fit_percent = _fit(target, target - e)
+    model.fit_percent = _fit_records(model, records)
+    if val is not None:
+        model.validation_fit_percent = _fit_records(model, val)
     return model
 
 
