@@ -23,7 +23,7 @@ What the state is, family by family:
   the voltage then applied), outputs ``[d_p U − H, H]``. Another ``Model`` subclass takes part by
   defining ``state_functions(dt) -> (f, h, x0)``; without it a :class:`ModelError` says so.
 * **Hammerstein–Wiener** (:class:`~gripkit.sysid.nonlinear.HWModel`): the states of the linear
-  block ``B(q)/F(q)`` in the controllable canonical realisation (``scipy.signal.tf2ss``), fed
+  block ``B(q)/F(q)`` in the controllable canonical realisation (as ``scipy.signal.tf2ss``), fed
   with ``w = f_in(u)``; ``h`` applies the output nonlinearity and ``y0`` to the block's output.
   ``x0`` = 0: the block at rest (``HWModel.simulate(..., initial_input=0)``). numba.
 * **Bouc-Wen** (:class:`~gripkit.sysid.nonlinear.BoucWenModel`): state ``[h, u_prev]`` (the
@@ -49,6 +49,8 @@ filter's covariance stays positive definite.
 
 from __future__ import annotations
 
+import dataclasses
+import weakref
 from typing import NamedTuple
 
 import numba
@@ -76,16 +78,51 @@ _FAMILIES = ("a gripkit.sysid.LinearModel, a grey-box gripkit Model (MassSpringD
 def state_functions(model, dt: float | None = None) -> StateFunctions:
     """The discrete state functions of ``model`` (module docstring); ``dt`` the sample time
     (needed for a continuous linear model and a grey-box Model; a rate-dependent identified
-    model uses its own). Raises :class:`ModelError` naming what the model lacks."""
-    return StateFunctions(*_build(model, dt)[:4])
+    model uses its own). Raises :class:`ModelError` naming what the model lacks.
+
+    The same model with the same values and ``dt`` gives the same ``f``, ``h`` objects (a cache
+    keyed on the model's identity and its values), so that filters made again on one model reuse
+    the numba kernels compiled for the first."""
+    f, h, x0, nx, _ = _build(model, dt)
+    return StateFunctions(f, h, x0.copy(), nx)
 
 
 def state_labels(model, dt: float | None = None) -> list[str]:
     """The names of the nx states of ``model`` in :func:`state_functions`'s order."""
-    return _build(model, dt)[4]
+    return list(_build(model, dt)[4])
+
+
+#: id(model) -> (weak reference, (dt, values), built functions)
+_CACHE: dict = {}
+
+
+def _values(model):
+    """The numbers that fix a model's state functions (for the cache): a grey-box Model's
+    parameter vector, an identified model's fields."""
+    if hasattr(model, "theta") and callable(model.theta):
+        return type(model), model.theta().tobytes()
+    if dataclasses.is_dataclass(model):
+        return type(model), tuple(
+            np.asarray(v).tobytes() if isinstance(v, (np.ndarray, float, int)) else repr(v)
+            for v in (getattr(model, fl.name) for fl in dataclasses.fields(model)))
+    return None
 
 
 def _build(model, dt):
+    key = (dt, _values(model))
+    hit = _CACHE.get(id(model))
+    if key[1] is not None and hit is not None and hit[0]() is model and hit[1] == key:
+        return hit[2]
+    built = _build_new(model, dt)
+    if key[1] is not None:
+        try:
+            _CACHE[id(model)] = (weakref.ref(model), key, built)
+        except TypeError:  # no weak references to this kind of object: not cached
+            pass
+    return built
+
+
+def _build_new(model, dt):
     from ..sim.model import Model
     from ..sysid.nonlinear.hammerstein_wiener import HWModel
     from ..sysid.nonlinear.hysteresis import BoucWenModel, BoucWenOscillatorModel
@@ -189,8 +226,6 @@ def _greybox(model, dt):
 
 
 def _hw(model):
-    from scipy.signal import tf2ss
-
     from ..sysid.nonlinear._hw_kernels import nl_eval
 
     num, den = np.asarray(model.B, dtype=np.float64), np.asarray(model.F, dtype=np.float64)
@@ -199,10 +234,18 @@ def _hw(model):
         raise ModelError(f"state_functions: the Hammerstein-Wiener model's linear block "
                          f"(nb={model.nb}, nf={model.nf}, nk={model.nk}) is static and has no "
                          "state to filter")
-    A, Bm, C, D = tf2ss(np.r_[num, np.zeros(L - len(num))], np.r_[den, np.zeros(L - len(den))])
-    A, Bv, Cv = (np.ascontiguousarray(M, dtype=np.float64) for M in (A, Bm[:, 0], C[0]))
-    d = float(D[0, 0])
-    n = A.shape[0]
+    # controllable canonical form of (n0 z^n + … + n_n)/(z^n + a1 z^(n−1) + … + a_n), n = L − 1
+    # (scipy.signal.tf2ss's convention): A's first row −a, ones below the diagonal, B = e1,
+    # C_j = n_j − n0 a_j, D = n0
+    nz, a = np.r_[num, np.zeros(L - len(num))], np.r_[den, np.zeros(L - len(den))]
+    n = L - 1
+    A = np.zeros((n, n))
+    A[0] = -a[1:]
+    A[np.arange(1, n), np.arange(n - 1)] = 1.0
+    Bv = np.zeros(n)
+    Bv[0] = 1.0
+    Cv = np.ascontiguousarray(nz[1:] - nz[0] * a[1:])
+    d = float(nz[0])
     kin, kout = model.input_nl.code, model.output_nl.code
     pin = np.ascontiguousarray(model._part("in"), dtype=np.float64)
     pout = np.ascontiguousarray(model._part("out"), dtype=np.float64)
