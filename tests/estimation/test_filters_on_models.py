@@ -23,7 +23,7 @@ from gripkit.errors import ArgumentError, ModelError
 from gripkit.estimation import ExtendedKalmanFilter, KalmanFilter, UnscentedKalmanFilter
 from gripkit.estimation.state_functions import state_functions, state_labels
 from gripkit.lti import StateSpace
-from gripkit.models import BoucWen, MassSpringDamper
+from gripkit.models import BoucWen, MassSpringDamper, PiezoActuator
 from gripkit.sim.model import Model, Signal
 from gripkit.sysid import LinearModel
 from gripkit.sysid.nonlinear.hammerstein_wiener import HWModel, Nonlinearity
@@ -96,6 +96,20 @@ def test_state_functions_reproduce_each_models_simulation():
     run = _free_run(f, h, x0, U)
     np.testing.assert_allclose(run[:, 0], ref["y"], rtol=0, atol=1e-18)
     np.testing.assert_allclose(run[:, 1], ref["H"], rtol=0, atol=1e-18)
+
+    for loads in (False, True):
+        g = PiezoActuator(loads=loads)
+        dtp = 2e-5  # D(s): ω_n = 6.3 krad/s, ζ = 0.25
+        t = np.arange(300) * dtp
+        U = np.column_stack([60.0 * np.sin(2 * np.pi * 300 * t), 0.01 * np.cos(2e3 * t),
+                             1e-4 * np.sin(3e3 * t)])[:, :len(g.inputs)]
+        f, h, x0, nx = state_functions(g, dt=dtp)
+        assert nx == 6
+        ref = g.simulate(U, dt=dtp)
+        run = _free_run(f, h, x0, U)
+        for i, name in enumerate(("y_A", "alpha_A")):
+            scale = np.abs(ref[name]).max()
+            np.testing.assert_allclose(run[:, i], ref[name], rtol=0, atol=1e-12 * scale)
 
     m = hw()
     f, h, x0, nx = state_functions(m)

@@ -22,6 +22,10 @@ What the state is, family by family:
   :func:`~gripkit.models.bouc_wen_advance`, state ``[H, U]`` (H after the previous sample and
   the voltage then applied), outputs ``[d_p U − H, H]``. Another ``Model`` subclass takes part by
   defining ``state_functions(dt) -> (f, h, x0)``; without it a :class:`ModelError` says so.
+  :class:`~gripkit.models.PiezoActuator` (``'zoh'``): the Bouc-Wen step, then ``D(s)``
+  discretised exactly by the same ``zoh_levels`` matrices as its simulate; state ``[H, U, y_A,
+  v_A, α_A, w_A]``; ``dt`` required. A model fitted by ``gripkit.sysid.fit_greybox`` is the
+  model class with the fitted parameters: ``type(model)(result.parameters)``.
 * **Hammerstein–Wiener** (:class:`~gripkit.sysid.nonlinear.HWModel`): the states of the linear
   block ``B(q)/F(q)`` in the controllable canonical realisation (as ``scipy.signal.tf2ss``), fed
   with ``w = f_in(u)``; ``h`` applies the output nonlinearity and ``y0`` to the block's output.
@@ -71,7 +75,7 @@ class StateFunctions(NamedTuple):
 
 
 _FAMILIES = ("a gripkit.sysid.LinearModel, a grey-box gripkit Model (MassSpringDamper, "
-             "BoucWen, or one defining state_functions(dt)), HWModel, BoucWenModel, "
+             "BoucWen, PiezoActuator, or one defining state_functions(dt)), HWModel, BoucWenModel, "
              "BoucWenOscillatorModel or NARXModel")
 
 
@@ -171,6 +175,7 @@ def _linear(model, dt):
 def _greybox(model, dt):
     from ..models.hysteresis import BoucWen, bouc_wen_advance
     from ..models.mass_spring_damper import MassSpringDamper, msd_zoh
+    from ..models.piezo import PiezoActuator
 
     own = getattr(model, "state_functions", None)
     theta = model.theta()
@@ -217,9 +222,64 @@ def _greybox(model, dt):
             return out
 
         return f, h, model.initial_state(theta).astype(np.float64), 2, labels
+    if isinstance(model, PiezoActuator):
+        return _piezo(model, theta, _need_dt(dt, model.name), labels)
     raise ModelError(f"state_functions: the grey-box model {model.name!r} "
                      f"({type(model).__name__}) has no per-sample state transition (it only "
                      "simulates in batch); define state_functions(dt) -> (f, h, x0) on it")
+
+
+def _piezo(model, theta, dt, labels):
+    """PiezoActuator: Bouc-Wen, then D(s) discretised exactly (its own ``zoh_levels`` step)."""
+    from ..models.hysteresis import bouc_wen_advance
+    from ..sim.integrators import zoh_levels
+
+    A, B, C, D, bw = model.matrices(theta[None, :])
+    Phi, Gam = zoh_levels(A, B, dt, 0)
+    Phi, Gam = np.ascontiguousarray(Phi[0, 0]), np.ascontiguousarray(Gam[0, 0])
+    C, D = np.ascontiguousarray(C[0]), np.ascontiguousarray(D[0])
+    d_p, lam, beta, gamma = (float(v) for v in bw[0])
+    n, m, p = Phi.shape[0], Gam.shape[1], C.shape[0]
+
+    @numba.njit
+    def drive(x, u):  # pragma: no cover - compiled
+        """(H⁺, w): the hysteresis after this sample and the LTI input [d_p U − H⁺, loads]."""
+        H = bouc_wen_advance(x[0], u[0] - x[1], lam, beta, gamma)
+        w = np.empty(m)
+        w[0] = d_p * u[0] - H
+        for j in range(1, m):
+            w[j] = u[j]
+        return H, w
+
+    @numba.njit
+    def f(x, u):  # pragma: no cover - compiled
+        H, w = drive(x, u)
+        out = np.empty(2 + n)
+        out[0] = H
+        out[1] = u[0]
+        for i in range(n):
+            acc = 0.0
+            for j in range(n):
+                acc += Phi[i, j] * x[2 + j]
+            for j in range(m):
+                acc += Gam[i, j] * w[j]
+            out[2 + i] = acc
+        return out
+
+    @numba.njit
+    def h(x, u):  # pragma: no cover - compiled
+        _, w = drive(x, u)
+        out = np.empty(p)
+        for i in range(p):
+            acc = 0.0
+            for j in range(n):
+                acc += C[i, j] * x[2 + j]
+            for j in range(m):
+                acc += D[i, j] * w[j]
+            out[i] = acc
+        return out
+
+    return f, h, model.initial_state(theta).astype(np.float64), 2 + n, labels
 
 
 # ------------------------------------------------------------------------------ identified
