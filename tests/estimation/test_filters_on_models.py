@@ -11,7 +11,9 @@ lies inside the two-sided 99 % χ²(M·d)/M band (Bar-Shalom, Li, Kirubarajan, *
 Applications to Tracking*, §5.4) on at least 90 % of the samples.
 (3) On a linear grey-box model (MassSpringDamper), the UKF is the Kalman filter of the same
 discrete model to 1e-8 at every sample.
-(4) A model without what the filters need raises ModelError naming it."""
+(4) A model without what the filters need raises ModelError naming it.
+(5) A grey-box model's own ``state_functions(dt)`` is used; the functions are cached per model
+and built again when a value changes."""
 
 from __future__ import annotations
 
@@ -24,6 +26,8 @@ from gripkit.estimation import ExtendedKalmanFilter, KalmanFilter, UnscentedKalm
 from gripkit.estimation.state_functions import state_functions, state_labels
 from gripkit.lti import StateSpace
 from gripkit.models import BoucWen, MassSpringDamper, PiezoActuator
+from gripkit.params import Parameter, ParameterSet
+from gripkit.signals import Trajectory
 from gripkit.sim.model import Model, Signal
 from gripkit.sysid import LinearModel
 from gripkit.sysid.nonlinear.hammerstein_wiener import HWModel, Nonlinearity
@@ -209,8 +213,6 @@ def test_filter_on_model_tracks_hidden_state_consistently(family, Filter):
 
 def test_filter_from_model_runs_on_the_models_columns():
     """run(data) takes the model's input and output names; the model's x0 is the default."""
-    from gripkit.signals import Trajectory
-
     m = msd()
     u = _input(100)
     y = m.simulate(u, dt=DT)["x"]
@@ -258,8 +260,6 @@ class _BatchOnly(Model):
 
 
 def test_models_without_what_the_filters_need_raise_model_error():
-    from gripkit.params import Parameter, ParameterSet
-
     batch_only = _BatchOnly(ParameterSet([Parameter("a", 1.0, "1", "gain")], "p"))
     with pytest.raises(ModelError, match="has no per-sample state transition") as err:
         UnscentedKalmanFilter(batch_only, Q=[[1.0]], R=[[1.0]], dt=0.1)
@@ -276,3 +276,30 @@ def test_models_without_what_the_filters_need_raise_model_error():
         state_functions(static)
     with pytest.raises(ArgumentError, match="give both f"):
         ExtendedKalmanFilter(lambda x, u: x, Q=[[1.0]], R=[[1.0]])
+
+
+class _WithTransition(_BatchOnly):
+    """A grey-box model that gives its own transition: x⁺ = a x + u, y = x."""
+
+    name = "with-transition"
+
+    def state_functions(self, dt):
+        a = self.parameters.value("a")
+        return (lambda x, u: a * x + u), (lambda x, u: x), np.zeros(1)
+
+
+def test_state_functions_hook_and_cache():
+    g = _WithTransition(ParameterSet([Parameter("a", 0.5, "1", "pole")], "p"))
+    ukf = UnscentedKalmanFilter(g, Q=[[0.1]], R=[[1.0]], P0=[[1.0]])
+    assert not ukf._jit  # Python functions: called from Python between the kernels
+    x, P = ukf.step([0.0], [2.0])
+    # scalar Kalman filter: K = 1/(1 + 1), x = 0 + K·2, P = 1 − K
+    np.testing.assert_allclose([x[0], P[0, 0]], [1.0, 0.5], rtol=1e-12)
+    data = Trajectory(np.arange(3.0), {"u": np.zeros(3), "y": np.ones(3)})
+    assert ukf.run(data).x.shape == (3, 1)  # the model's own column names
+
+    m = bw()
+    first = state_functions(m)
+    assert state_functions(m).f is first.f  # same model, same values: the same numba functions
+    m.beta = 1.0
+    assert state_functions(m).f is not first.f  # a value changed: built again
