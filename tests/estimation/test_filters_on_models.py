@@ -266,6 +266,8 @@ def test_models_without_what_the_filters_need_raise_model_error():
     assert "\n" not in str(err.value) and "state_functions(dt)" in str(err.value)
     with pytest.raises(ModelError, match="no sample time; give dt="):
         ExtendedKalmanFilter(msd(), Q=np.eye(2), R=[[1.0]])
+    with pytest.raises(ModelError, match="dt must be a positive number of seconds, found '1'"):
+        state_functions(msd(), dt="1")
     with pytest.raises(ModelError, match="dict has no state-space form"):
         UnscentedKalmanFilter({"A": 1}, Q=[[1.0]], R=[[1.0]])
     with pytest.raises(ModelError, match="keeps its own sample time"):

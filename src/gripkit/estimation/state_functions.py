@@ -33,8 +33,8 @@ What the state is, family by family:
 * **Bouc-Wen** (:class:`~gripkit.sysid.nonlinear.BoucWenModel`): state ``[h, u_prev]`` (the
   hysteresis variable after the previous sample and the input then), ``h(x, u) = d u −
   h⁺ + offset`` with ``h⁺`` the step of the model's own kernel (exact for n = 1, RK4 in the input
-  otherwise) and ``f(x, u) = [h⁺, u]``; ``x0 = [0, u(0)]`` is its simulate's start, so give
-  ``x0=[0, u0]`` to the filter. numba.
+  otherwise) and ``f(x, u) = [h⁺, u]``; ``x0`` = [0, 0] (virgin state at zero input); its
+  simulate starts at ``[0, u(0)]``, which is ``x0=[0, u[0]]`` given to the filter. numba.
 * **Bouc-Wen oscillator** (:class:`~gripkit.sysid.nonlinear.BoucWenOscillatorModel`): state
   ``[x, ẋ, z]``, ``f`` the model's ``substeps`` RK4 steps over its ``dt`` with the input held,
   ``h = x + offset``; ``x0`` = rest. numba.
@@ -103,8 +103,9 @@ _CACHE: dict = {}
 def _values(model):
     """The numbers that fix a model's state functions (for the cache): a grey-box Model's
     parameter vector, an identified model's fields."""
-    if hasattr(model, "theta") and callable(model.theta):
-        return type(model), model.theta().tobytes()
+    if hasattr(model, "theta") and callable(model.theta):  # a gripkit Model: θ and its options
+        return type(model), model.theta().tobytes(), tuple(sorted(
+            (k, repr(v)) for k, v in vars(model).items() if k != "parameters"))
     if dataclasses.is_dataclass(model):
         return type(model), tuple(
             np.asarray(v).tobytes() if isinstance(v, (np.ndarray, float, int)) else repr(v)
@@ -120,7 +121,8 @@ def _build(model, dt):
     built = _build_new(model, dt)
     if key[1] is not None:
         try:
-            _CACHE[id(model)] = (weakref.ref(model), key, built)
+            ref = weakref.ref(model, lambda _, k=id(model): _CACHE.pop(k, None))
+            _CACHE[id(model)] = (ref, key, built)
         except TypeError:  # no weak references to this kind of object: not cached
             pass
     return built
@@ -152,7 +154,8 @@ def _need_dt(dt, what):
     if dt is None:
         raise ModelError(f"state_functions: {what} is continuous and has no sample time; give "
                          "dt= (seconds)")
-    if isinstance(dt, bool) or not (np.isfinite(dt) and dt > 0):
+    if (isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating))
+            or not (np.isfinite(dt) and dt > 0)):
         raise ModelError(f"state_functions: dt must be a positive number of seconds, found "
                          f"{dt!r}")
     return float(dt)
