@@ -22,9 +22,13 @@ from .kalman import KalmanFilter as KalmanFilter
 from .kalman import KalmanRun as KalmanRun
 from .nonlinear_kalman import ExtendedKalmanFilter as ExtendedKalmanFilter
 from .nonlinear_kalman import UnscentedKalmanFilter as UnscentedKalmanFilter
+from .state_functions import StateFunctions as StateFunctions
+from .state_functions import state_functions as state_functions
+from .state_functions import state_labels as state_labels
 
 __all__ = ["AdaptationSettings", "ContactDetector", "ExtendedKalmanFilter", "FrictionAdapter",
            "fuse", "fuse_proportional",
            "fuse_update", "fused_variance", "implied_correlation", "KalmanFilter", "KalmanRun",
            "normalised_variances",
-           "NormalisedVariances", "proportional_variance", "UnscentedKalmanFilter"]
+           "NormalisedVariances", "proportional_variance", "StateFunctions", "state_functions",
+           "state_labels", "UnscentedKalmanFilter"]

@@ -562,6 +562,31 @@ def _linear_model_fh(model, dt):
     return f, h
 
 
+def _is_linear(model) -> bool:
+    return hasattr(model, "discrete") and hasattr(model, "u_offset")
+
+
+def _names(model, kind: str) -> list:
+    """The model's input or output names (a gripkit Model's are Signals)."""
+    names = getattr(model, kind, None)
+    if names is None:  # NARXModel: one input, one output
+        names = (getattr(model, "input_name" if kind == "inputs" else "output_name"),)
+    return [getattr(s, "name", s) for s in names]
+
+
+def _model_functions(filt, model, x0, dt):
+    """``f``, ``h`` and the initial state of ``model`` (:mod:`.state_functions`); the filter
+    keeps the model and its signal names for ``run``."""
+    from .state_functions import state_functions
+
+    if callable(model) and not _is_linear(model):
+        raise ArgumentError(f"{filt._name}: give both f(x, u) and h(x, u), or a model alone")
+    f, h, x0_model, _ = state_functions(model, dt)
+    filt.model = model
+    filt._inputs, filt._outputs = _names(model, "inputs"), _names(model, "outputs")
+    return f, h, x0_model if x0 is None else x0
+
+
 class _NonlinearFilter:
     """What the EKF and UKF share: the state record, the checks, the ``step``/``run`` plumbing.
     ``x_pred``, ``P_pred``, ``x``, ``P`` are the arrays of the state record."""
@@ -671,7 +696,11 @@ class ExtendedKalmanFilter(_NonlinearFilter):
     Parameters
     ----------
     f, h
-        ``f(x, u) -> (n,)``, ``h(x, u) -> (p,)``: Python callables or ``numba.njit`` functions.
+        ``f(x, u) -> (n,)``, ``h(x, u) -> (p,)``: Python callables or ``numba.njit`` functions;
+        or a model alone in place of ``f`` (``h`` left out): a linear, grey-box or identified
+        nonlinear model, whose state functions are those of
+        :func:`~gripkit.estimation.state_functions.state_functions` (``x0`` default the model's
+        initial state; ``run(data)`` takes the model's input and output columns by default).
     Q, R
         Process (n×n) and measurement (p×p) noise covariances; they fix n and p.
     F, H
@@ -681,6 +710,8 @@ class ExtendedKalmanFilter(_NonlinearFilter):
         accept complex ``x``; evaluated from Python).
     x0, P0
         Initial prediction (default 0) and its covariance (default Q).
+    dt
+        Sample time of a continuous linear model or of a grey-box model (given as a model).
 
     Examples
     --------
@@ -692,8 +723,12 @@ class ExtendedKalmanFilter(_NonlinearFilter):
 
     _name = "ExtendedKalmanFilter"
 
-    def __init__(self, f, h, Q, R, *, F=None, H=None, jacobian: str = "central", x0=None,
-                 P0=None):
+    def __init__(self, f, h=None, Q=None, R=None, *, F=None, H=None, jacobian: str = "central",
+                 x0=None, P0=None, dt: float | None = None):
+        if Q is None or R is None:
+            raise ArgumentError("ExtendedKalmanFilter: give the noise covariances Q= and R=")
+        if h is None:
+            f, h, x0 = _model_functions(self, f, x0, dt)
         if not (callable(f) and callable(h)):
             raise ArgumentError("ExtendedKalmanFilter: f and h must be callables f(x, u) and "
                                 "h(x, u)")
@@ -762,7 +797,11 @@ class UnscentedKalmanFilter(_NonlinearFilter):
     ``UnscentedKalmanFilter(model, Q=, R=)`` with a :class:`~gripkit.sysid.LinearModel`: its
     discrete realisation with offsets (u, y in SI, offsets not removed, as
     :class:`~gripkit.estimation.KalmanFilter`), ``x0`` default rest and ``P0`` default the
-    steady-state prediction covariance. ``UnscentedKalmanFilter(f, h, Q=, R=)``: ``f(x, u)``,
+    steady-state prediction covariance. With a grey-box gripkit ``Model``, an ``HWModel``,
+    ``BoucWenModel``, ``BoucWenOscillatorModel`` or ``NARXModel``: the state functions of
+    :func:`~gripkit.estimation.state_functions.state_functions` (``dt`` for a grey-box model),
+    ``x0`` default the model's initial state, ``P0`` default Q; ``run(data)`` takes the model's
+    input and output columns by default. ``UnscentedKalmanFilter(f, h, Q=, R=)``: ``f(x, u)``,
     ``h(x, u)`` Python or numba callables, ``x0`` default 0, ``P0`` default Q.
     ``alpha``, ``beta``, ``kappa``: the sigma-point scaling (module docstring).
 
@@ -786,9 +825,8 @@ class UnscentedKalmanFilter(_NonlinearFilter):
             raise ArgumentError("UnscentedKalmanFilter: give the noise covariances Q= and R=")
         if h is None:
             model = f
-            f, h = _linear_model_fh(model, dt)
-            self._inputs, self._outputs = list(model.inputs), list(model.outputs)
-            if P0 is None:
+            f, h, x0 = _model_functions(self, model, x0, dt)
+            if P0 is None and _is_linear(model):
                 P0 = KalmanFilter(model, Q=Q, R=R, dt=dt).P_steady_pred
         elif not (callable(f) and callable(h)):
             raise ArgumentError("UnscentedKalmanFilter: expected a LinearModel, or callables "

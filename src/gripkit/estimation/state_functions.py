@@ -1,0 +1,465 @@
+"""The discrete state functions of a model, for the extended and unscented Kalman filters.
+
+``state_functions(model, dt=None) -> (f, h, x0, nx)`` gives ``x[t+1] = f(x[t], u[t])`` and
+``y[t] = h(x[t], u[t])`` (``x`` (nx,), ``u`` (m,), ``y`` (p,), in the model's units, offsets
+applied) and the state ``x0`` (nx,) the model's own simulation starts from. Simulating ``f``,
+``h`` from ``x0`` reproduces the model's noise-free simulation; the filters add the process
+noise ``w ~ N(0, Q)`` to ``f`` and the measurement noise ``v ~ N(0, R)`` to ``h``.
+``state_labels(model)`` names the nx states.
+
+What the state is, family by family:
+
+* **Linear model** (:class:`~gripkit.sysid.LinearModel`): its discrete realisation at ``dt``
+  (the model's own by default) with the input and output offsets, as
+  :class:`~gripkit.estimation.KalmanFilter` uses it; ``x0`` = 0. Python functions.
+* **Grey-box model** (a :class:`gripkit.sim.Model`): a ``Model`` simulates by its numba kernel
+  ``_simulate_batch`` with the integrator it names in ``Model.integrator``, and exposes no
+  per-sample transition; ``f``, ``h`` are the same discretisation, one sample at a time.
+  :class:`~gripkit.models.MassSpringDamper` (``integrator = 'zoh'``): the exact zero-order-hold
+  step of ``m ẍ + b ẋ + k x = F`` (:func:`~gripkit.models.msd_zoh`), state ``[x, v]``, output
+  ``x`` at the sample (as its simulate writes it before stepping); ``dt`` required.
+  :class:`~gripkit.models.BoucWen` (``'zoh'``, rate independent): the exact step
+  :func:`~gripkit.models.bouc_wen_advance`, state ``[H, U]`` (H after the previous sample and
+  the voltage then applied), outputs ``[d_p U − H, H]``. Another ``Model`` subclass takes part by
+  defining ``state_functions(dt) -> (f, h, x0)``; without it a :class:`ModelError` says so.
+  :class:`~gripkit.models.PiezoActuator` (``'zoh'``): the Bouc-Wen step, then ``D(s)``
+  discretised exactly by the same ``zoh_levels`` matrices as its simulate; state ``[H, U, y_A,
+  v_A, α_A, w_A]``; ``dt`` required. A model fitted by ``gripkit.sysid.fit_greybox`` is the
+  model class with the fitted parameters: ``type(model)(result.parameters)``.
+* **Hammerstein–Wiener** (:class:`~gripkit.sysid.nonlinear.HWModel`): the states of the linear
+  block ``B(q)/F(q)`` in the controllable canonical realisation (as ``scipy.signal.tf2ss``), fed
+  with ``w = f_in(u)``; ``h`` applies the output nonlinearity and ``y0`` to the block's output.
+  ``x0`` = 0: the block at rest (``HWModel.simulate(..., initial_input=0)``). numba.
+* **Bouc-Wen** (:class:`~gripkit.sysid.nonlinear.BoucWenModel`): state ``[h, u_prev]`` (the
+  hysteresis variable after the previous sample and the input then), ``h(x, u) = d u −
+  h⁺ + offset`` with ``h⁺`` the step of the model's own kernel (exact for n = 1, RK4 in the input
+  otherwise) and ``f(x, u) = [h⁺, u]``; ``x0`` = [0, 0] (virgin state at zero input); its
+  simulate starts at ``[0, u(0)]``, which is ``x0=[0, u[0]]`` given to the filter. numba.
+* **Bouc-Wen oscillator** (:class:`~gripkit.sysid.nonlinear.BoucWenOscillatorModel`): state
+  ``[x, ẋ, z]``, ``f`` the model's ``substeps`` RK4 steps over its ``dt`` with the input held,
+  ``h = x + offset``; ``x0`` = rest. numba.
+* **NARX** (:class:`~gripkit.sysid.nonlinear.NARXModel`): state ``[s(t−1) … s(t−ly), u(t−1) …
+  u(t−lu)]``, the window of past noise-free outputs ``s`` (and of past inputs, which the
+  polynomial needs); ``h(x, u) = s(t) = Σ θ_k m_k`` evaluated on that window and ``u(t)``,
+  ``f`` shifts ``s(t)`` and ``u(t)`` in. This is the *output-error* reading of the NARX model:
+  the measured output is ``y = s + v`` (noise enters through the measurement, R), and the
+  equation error of the fit enters as process noise on ``s(t−1)`` (Q[0, 0]); the model's own
+  one-step predictor instead feeds the noisy measured outputs back. ``x0`` = 0. numba.
+
+The past-input components (Bouc-Wen ``u_prev``, NARX ``u(t−k)``) are known exactly: give them a
+small positive process noise (for example 1e-12 of the input's variance) so that the unscented
+filter's covariance stays positive definite.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import weakref
+from typing import NamedTuple
+
+import numba
+import numpy as np
+
+from ..errors import ModelError
+
+__all__ = ["StateFunctions", "state_functions", "state_labels"]
+
+
+class StateFunctions(NamedTuple):
+    """``f(x, u) -> (nx,)``, ``h(x, u) -> (p,)``, the initial state ``x0`` (nx,) and ``nx``."""
+
+    f: object
+    h: object
+    x0: np.ndarray
+    nx: int
+
+
+_FAMILIES = ("a gripkit.sysid.LinearModel, a grey-box gripkit Model (MassSpringDamper, "
+             "BoucWen, PiezoActuator, or one defining state_functions(dt)), HWModel, BoucWenModel, "
+             "BoucWenOscillatorModel or NARXModel")
+
+
+def state_functions(model, dt: float | None = None) -> StateFunctions:
+    """The discrete state functions of ``model`` (module docstring); ``dt`` the sample time
+    (needed for a continuous linear model and a grey-box Model; a rate-dependent identified
+    model uses its own). Raises :class:`ModelError` naming what the model lacks.
+
+    The same model with the same values and ``dt`` gives the same ``f``, ``h`` objects (a cache
+    keyed on the model's identity and its values), so that filters made again on one model reuse
+    the numba kernels compiled for the first."""
+    f, h, x0, nx, _ = _build(model, dt)
+    return StateFunctions(f, h, x0.copy(), nx)
+
+
+def state_labels(model, dt: float | None = None) -> list[str]:
+    """The names of the nx states of ``model`` in :func:`state_functions`'s order."""
+    return list(_build(model, dt)[4])
+
+
+#: id(model) -> (weak reference, (dt, values), built functions)
+_CACHE: dict = {}
+
+
+def _values(model):
+    """The numbers that fix a model's state functions (for the cache): a grey-box Model's
+    parameter vector, an identified model's fields."""
+    if hasattr(model, "theta") and callable(model.theta):  # a gripkit Model: θ and its options
+        return type(model), model.theta().tobytes(), tuple(sorted(
+            (k, repr(v)) for k, v in vars(model).items() if k != "parameters"))
+    if dataclasses.is_dataclass(model):
+        return type(model), tuple(
+            np.asarray(v).tobytes() if isinstance(v, (np.ndarray, float, int)) else repr(v)
+            for v in (getattr(model, fl.name) for fl in dataclasses.fields(model)))
+    return None
+
+
+def _build(model, dt):
+    key = (dt, _values(model))
+    hit = _CACHE.get(id(model))
+    if key[1] is not None and hit is not None and hit[0]() is model and hit[1] == key:
+        return hit[2]
+    built = _build_new(model, dt)
+    if key[1] is not None:
+        try:
+            ref = weakref.ref(model, lambda _, k=id(model): _CACHE.pop(k, None))
+            _CACHE[id(model)] = (ref, key, built)
+        except TypeError:  # no weak references to this kind of object: not cached
+            pass
+    return built
+
+
+def _build_new(model, dt):
+    from ..sim.model import Model
+    from ..sysid.nonlinear.hammerstein_wiener import HWModel
+    from ..sysid.nonlinear.hysteresis import BoucWenModel, BoucWenOscillatorModel
+    from ..sysid.nonlinear.narx import NARXModel
+
+    if isinstance(model, Model):
+        return _greybox(model, dt)
+    if isinstance(model, HWModel):
+        return _hw(model)
+    if isinstance(model, BoucWenOscillatorModel):
+        return _bwo(model, dt)
+    if isinstance(model, BoucWenModel):
+        return _bw(model)
+    if isinstance(model, NARXModel):
+        return _narx(model)
+    if hasattr(model, "discrete") and hasattr(model, "u_offset"):
+        return _linear(model, dt)
+    raise ModelError(f"state_functions: {type(model).__name__} has no state-space form gripkit "
+                     f"knows; expected {_FAMILIES}")
+
+
+def _need_dt(dt, what):
+    if dt is None:
+        raise ModelError(f"state_functions: {what} is continuous and has no sample time; give "
+                         "dt= (seconds)")
+    if (isinstance(dt, bool) or not isinstance(dt, (int, float, np.integer, np.floating))
+            or not (np.isfinite(dt) and dt > 0)):
+        raise ModelError(f"state_functions: dt must be a positive number of seconds, found "
+                         f"{dt!r}")
+    return float(dt)
+
+
+# ------------------------------------------------------------------------------ linear
+
+
+def _linear(model, dt):
+    from .nonlinear_kalman import _linear_model_fh
+
+    f, h = _linear_model_fh(model, dt)
+    n = int(np.asarray(model.discrete(model.dt if dt is None else dt).A).shape[0])
+    return f, h, np.zeros(n), n, [f"x{i + 1}" for i in range(n)]
+
+
+# ------------------------------------------------------------------------------ grey box
+
+
+def _greybox(model, dt):
+    from ..models.hysteresis import BoucWen, bouc_wen_advance
+    from ..models.mass_spring_damper import MassSpringDamper, msd_zoh
+    from ..models.piezo import PiezoActuator
+
+    own = getattr(model, "state_functions", None)
+    theta = model.theta()
+    labels = [s.name for s in model.states]
+    if callable(own):
+        f, h, x0 = own(dt)
+        x0 = np.asarray(x0, dtype=np.float64).ravel()
+        return f, h, x0, x0.size, labels
+    if isinstance(model, MassSpringDamper):
+        mat = np.empty(6)
+        msd_zoh(theta[0], theta[1], theta[2], _need_dt(dt, model.name), mat)
+        a11, a12, a21, a22, b1, b2 = (float(v) for v in mat)
+
+        @numba.njit
+        def f(x, u):  # pragma: no cover - compiled
+            out = np.empty(2)
+            out[0] = a11 * x[0] + a12 * x[1] + b1 * u[0]
+            out[1] = a21 * x[0] + a22 * x[1] + b2 * u[0]
+            return out
+
+        @numba.njit
+        def h(x, u):  # pragma: no cover - compiled
+            out = np.empty(1)
+            out[0] = x[0]
+            return out
+
+        return f, h, model.initial_state(theta).astype(np.float64), 2, labels
+    if isinstance(model, BoucWen):
+        d_p, lam, beta, gamma = (float(v) for v in theta[:4])
+
+        @numba.njit
+        def f(x, u):  # pragma: no cover - compiled
+            out = np.empty(2)
+            out[0] = bouc_wen_advance(x[0], u[0] - x[1], lam, beta, gamma)
+            out[1] = u[0]
+            return out
+
+        @numba.njit
+        def h(x, u):  # pragma: no cover - compiled
+            out = np.empty(2)
+            H = bouc_wen_advance(x[0], u[0] - x[1], lam, beta, gamma)
+            out[0] = d_p * u[0] - H
+            out[1] = H
+            return out
+
+        return f, h, model.initial_state(theta).astype(np.float64), 2, labels
+    if isinstance(model, PiezoActuator):
+        return _piezo(model, theta, _need_dt(dt, model.name), labels)
+    raise ModelError(f"state_functions: the grey-box model {model.name!r} "
+                     f"({type(model).__name__}) has no per-sample state transition (it only "
+                     "simulates in batch); define state_functions(dt) -> (f, h, x0) on it")
+
+
+def _piezo(model, theta, dt, labels):
+    """PiezoActuator: Bouc-Wen, then D(s) discretised exactly (its own ``zoh_levels`` step)."""
+    from ..models.hysteresis import bouc_wen_advance
+    from ..sim.integrators import zoh_levels
+
+    A, B, C, D, bw = model.matrices(theta[None, :])
+    Phi, Gam = zoh_levels(A, B, dt, 0)
+    Phi, Gam = np.ascontiguousarray(Phi[0, 0]), np.ascontiguousarray(Gam[0, 0])
+    C, D = np.ascontiguousarray(C[0]), np.ascontiguousarray(D[0])
+    d_p, lam, beta, gamma = (float(v) for v in bw[0])
+    n, m, p = Phi.shape[0], Gam.shape[1], C.shape[0]
+
+    @numba.njit
+    def drive(x, u):  # pragma: no cover - compiled
+        """(H⁺, w): the hysteresis after this sample and the LTI input [d_p U − H⁺, loads]."""
+        H = bouc_wen_advance(x[0], u[0] - x[1], lam, beta, gamma)
+        w = np.empty(m)
+        w[0] = d_p * u[0] - H
+        for j in range(1, m):
+            w[j] = u[j]
+        return H, w
+
+    @numba.njit
+    def f(x, u):  # pragma: no cover - compiled
+        H, w = drive(x, u)
+        out = np.empty(2 + n)
+        out[0] = H
+        out[1] = u[0]
+        for i in range(n):
+            acc = 0.0
+            for j in range(n):
+                acc += Phi[i, j] * x[2 + j]
+            for j in range(m):
+                acc += Gam[i, j] * w[j]
+            out[2 + i] = acc
+        return out
+
+    @numba.njit
+    def h(x, u):  # pragma: no cover - compiled
+        _, w = drive(x, u)
+        out = np.empty(p)
+        for i in range(p):
+            acc = 0.0
+            for j in range(n):
+                acc += C[i, j] * x[2 + j]
+            for j in range(m):
+                acc += D[i, j] * w[j]
+            out[i] = acc
+        return out
+
+    return f, h, model.initial_state(theta).astype(np.float64), 2 + n, labels
+
+
+# ------------------------------------------------------------------------------ identified
+
+
+def _hw(model):
+    from ..sysid.nonlinear._hw_kernels import nl_eval
+
+    num, den = np.asarray(model.B, dtype=np.float64), np.asarray(model.F, dtype=np.float64)
+    L = max(len(num), len(den))
+    if L < 2:
+        raise ModelError(f"state_functions: the Hammerstein-Wiener model's linear block "
+                         f"(nb={model.nb}, nf={model.nf}, nk={model.nk}) is static and has no "
+                         "state to filter")
+    # controllable canonical form of (n0 z^n + … + n_n)/(z^n + a1 z^(n−1) + … + a_n), n = L − 1
+    # (scipy.signal.tf2ss's convention): A's first row −a, ones below the diagonal, B = e1,
+    # C_j = n_j − n0 a_j, D = n0
+    nz, a = np.r_[num, np.zeros(L - len(num))], np.r_[den, np.zeros(L - len(den))]
+    n = L - 1
+    A = np.zeros((n, n))
+    A[0] = -a[1:]
+    A[np.arange(1, n), np.arange(n - 1)] = 1.0
+    Bv = np.zeros(n)
+    Bv[0] = 1.0
+    Cv = np.ascontiguousarray(nz[1:] - nz[0] * a[1:])
+    d = float(nz[0])
+    kin, kout = model.input_nl.code, model.output_nl.code
+    pin = np.ascontiguousarray(model._part("in"), dtype=np.float64)
+    pout = np.ascontiguousarray(model._part("out"), dtype=np.float64)
+    cin = np.asarray(model.input_nl.consts or (0.0,), dtype=np.float64)
+    cout = np.asarray(model.output_nl.consts or (0.0,), dtype=np.float64)
+    y0 = float(model.theta[-1])
+    gi, go = max(pin.size, 2), max(pout.size, 2)
+
+    @numba.njit
+    def f(x, u):  # pragma: no cover - compiled
+        w, _ = nl_eval(kin, pin, cin, u[0], np.empty(gi))
+        out = np.empty(n)
+        for i in range(n):
+            acc = Bv[i] * w
+            for j in range(n):
+                acc += A[i, j] * x[j]
+            out[i] = acc
+        return out
+
+    @numba.njit
+    def h(x, u):  # pragma: no cover - compiled
+        w, _ = nl_eval(kin, pin, cin, u[0], np.empty(gi))
+        v = d * w
+        for j in range(n):
+            v += Cv[j] * x[j]
+        g, _ = nl_eval(kout, pout, cout, v, np.empty(go))
+        out = np.empty(1)
+        out[0] = g + y0
+        return out
+
+    return f, h, np.zeros(n), n, [f"x{i + 1}" for i in range(n)]
+
+
+def _bw(model):
+    from ..models.hysteresis import bouc_wen_advance
+    from ..sysid.nonlinear._hysteresis_kernels import bw_advance_rk4
+
+    d, lam, beta, gamma = float(model.d), float(model.lam), float(model.beta), float(model.gamma)
+    nexp, offset, exact = float(model.n), float(model.offset), float(model.n) == 1.0
+
+    @numba.njit
+    def advance(x, u):  # pragma: no cover - compiled
+        if exact:
+            return bouc_wen_advance(x[0], u[0] - x[1], lam, beta, gamma)
+        return bw_advance_rk4(x[0], u[0] - x[1], lam, beta, gamma, nexp)
+
+    @numba.njit
+    def f(x, u):  # pragma: no cover - compiled
+        out = np.empty(2)
+        out[0] = advance(x, u)
+        out[1] = u[0]
+        return out
+
+    @numba.njit
+    def h(x, u):  # pragma: no cover - compiled
+        out = np.empty(1)
+        out[0] = d * u[0] - advance(x, u) + offset
+        return out
+
+    return f, h, np.zeros(2), 2, ["h", "u_prev"]
+
+
+def _bwo(model, dt):
+    from ..sysid.nonlinear._hysteresis_kernels import _bwo_rates
+
+    if dt is not None and not np.isclose(dt, model.dt, rtol=1e-6):
+        raise ModelError(f"state_functions: the Bouc-Wen oscillator is sampled every "
+                         f"{model.dt:g} s, found dt={dt!r}; a rate-dependent model keeps its own "
+                         "sample time (leave dt out)")
+    m, c, ke, kh = float(model.mass), float(model.damping), float(model.k_e), float(model.k_h)
+    beta, gamma, nexp, offset = (float(model.beta), float(model.gamma), float(model.n),
+                                 float(model.offset))
+    sub = int(model.substeps)
+    hs = float(model.dt) / sub
+
+    @numba.njit
+    def f(s, u):  # pragma: no cover - compiled
+        x, v, z, uk = s[0], s[1], s[2], u[0]
+        for _ in range(sub):
+            a1, b1, c1 = _bwo_rates(x, v, z, uk, m, c, ke, kh, beta, gamma, nexp)
+            a2, b2, c2 = _bwo_rates(x + 0.5 * hs * a1, v + 0.5 * hs * b1, z + 0.5 * hs * c1, uk,
+                                    m, c, ke, kh, beta, gamma, nexp)
+            a3, b3, c3 = _bwo_rates(x + 0.5 * hs * a2, v + 0.5 * hs * b2, z + 0.5 * hs * c2, uk,
+                                    m, c, ke, kh, beta, gamma, nexp)
+            a4, b4, c4 = _bwo_rates(x + hs * a3, v + hs * b3, z + hs * c3, uk,
+                                    m, c, ke, kh, beta, gamma, nexp)
+            x += hs * (a1 + 2.0 * a2 + 2.0 * a3 + a4) / 6.0
+            v += hs * (b1 + 2.0 * b2 + 2.0 * b3 + b4) / 6.0
+            z += hs * (c1 + 2.0 * c2 + 2.0 * c3 + c4) / 6.0
+        out = np.empty(3)
+        out[0] = x
+        out[1] = v
+        out[2] = z
+        return out
+
+    @numba.njit
+    def h(s, u):  # pragma: no cover - compiled
+        out = np.empty(1)
+        out[0] = s[0] + offset
+        return out
+
+    return f, h, np.zeros(3), 3, ["x", "v", "z"]
+
+
+def _narx(model):
+    ly, lu = int(model.ylags), int(model.ulags)
+    if ly < 1:
+        raise ModelError(f"state_functions: the NARX model has no output lags (ylags={ly}), so "
+                         "no state to filter; use its one-step prediction instead")
+    kinds = np.ascontiguousarray(model.bases[:, 0], dtype=np.int64)
+    lags = np.ascontiguousarray(model.bases[:, 1], dtype=np.int64)
+    rows = np.ascontiguousarray(model.rows, dtype=np.int64)
+    theta = np.ascontiguousarray(model.theta, dtype=np.float64)
+    nt, deg, n = rows.shape[0], rows.shape[1], ly + lu
+
+    @numba.njit
+    def output(x, u):  # pragma: no cover - compiled
+        acc = 0.0
+        for k in range(nt):
+            v = theta[k]
+            for j in range(deg):
+                b = rows[k, j]
+                if b < 0:
+                    break
+                lag = lags[b]
+                if kinds[b] == 0:
+                    v *= x[lag - 1]
+                elif lag == 0:
+                    v *= u[0]
+                else:
+                    v *= x[ly + lag - 1]
+            acc += v
+        return acc
+
+    @numba.njit
+    def f(x, u):  # pragma: no cover - compiled
+        out = np.empty(n)
+        out[0] = output(x, u)
+        for i in range(1, ly):
+            out[i] = x[i - 1]
+        if lu > 0:
+            out[ly] = u[0]
+            for i in range(1, lu):
+                out[ly + i] = x[ly + i - 1]
+        return out
+
+    @numba.njit
+    def h(x, u):  # pragma: no cover - compiled
+        out = np.empty(1)
+        out[0] = output(x, u)
+        return out
+
+    labels = [f"s(t-{k})" for k in range(1, ly + 1)] + [f"u(t-{k})" for k in range(1, lu + 1)]
+    return f, h, np.zeros(n), n, labels
