@@ -50,6 +50,7 @@ import numpy as np
 
 from ..errors import ArgumentError, DataError, ModelError
 from .kalman import KalmanFilter, KalmanRun, _cholesky, _chol_solve_rows
+from .state_functions import state_functions
 
 __all__ = ["ExtendedKalmanFilter", "UnscentedKalmanFilter"]
 
@@ -540,30 +541,8 @@ def _vector(v) -> np.ndarray:
     return np.ascontiguousarray(np.atleast_1d(np.asarray(v, dtype=np.float64)).ravel())
 
 
-def _linear_model_fh(model, dt):
-    """``f``, ``h`` (Python, numpy) of a LinearModel's discrete realisation with its offsets
-    applied (u, y in SI, offsets not removed)."""
-    if not hasattr(model, "to_ss"):
-        raise ArgumentError(f"expected a gripkit.sysid.LinearModel or a callable f, found "
-                            f"{type(model).__name__}")
-    if not (model.dt or dt):
-        raise ModelError("the model is continuous; give the sample time: dt=…")
-    ss = model.to_ss(model.dt if dt is None else dt)
-    A, B, C, D = (np.asarray(M, dtype=np.float64) for M in (ss.A, ss.B, ss.C, ss.D))
-    u0 = np.asarray(model.u_offset, dtype=np.float64)
-    y0 = np.asarray(model.y_offset, dtype=np.float64)
-
-    def f(x, u):
-        return A @ x + B @ (u - u0)
-
-    def h(x, u):
-        return C @ x + D @ (u - u0) + y0
-
-    return f, h
-
-
 def _is_linear(model) -> bool:
-    return hasattr(model, "discrete") and hasattr(model, "u_offset")
+    return hasattr(model, "to_ss") and hasattr(model, "u_offset")
 
 
 def _names(model, kind: str) -> list:
@@ -577,8 +556,6 @@ def _names(model, kind: str) -> list:
 def _model_functions(filt, model, x0, dt):
     """``f``, ``h`` and the initial state of ``model`` (:mod:`.state_functions`); the filter
     keeps the model and its signal names for ``run``."""
-    from .state_functions import state_functions
-
     if callable(model) and not _is_linear(model):
         raise ArgumentError(f"{filt._name}: give both f(x, u) and h(x, u), or a model alone")
     f, h, x0_model, _ = state_functions(model, dt)

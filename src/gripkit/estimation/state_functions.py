@@ -144,7 +144,7 @@ def _build_new(model, dt):
         return _bw(model)
     if isinstance(model, NARXModel):
         return _narx(model)
-    if hasattr(model, "discrete") and hasattr(model, "u_offset"):
+    if hasattr(model, "to_ss") and hasattr(model, "u_offset"):
         return _linear(model, dt)
     raise ModelError(f"state_functions: {type(model).__name__} has no state-space form gripkit "
                      f"knows; expected {_FAMILIES}")
@@ -164,11 +164,32 @@ def _need_dt(dt, what):
 # ------------------------------------------------------------------------------ linear
 
 
-def _linear(model, dt):
-    from .nonlinear_kalman import _linear_model_fh
+def _linear_model_fh(model, dt):
+    """``f``, ``h`` (Python, numpy) of a LinearModel's discrete realisation with its offsets
+    applied (u, y in SI, offsets not removed)."""
+    if not hasattr(model, "to_ss"):
+        raise ModelError(f"expected a gripkit.sysid.LinearModel or a callable f, found "
+                            f"{type(model).__name__}")
+    if not (model.dt or dt):
+        raise ModelError("the model is continuous; give the sample time: dt=…")
+    ss = model.to_ss(model.dt if dt is None else dt)
+    A, B, C, D = (np.asarray(M, dtype=np.float64) for M in (ss.A, ss.B, ss.C, ss.D))
+    u0 = np.asarray(model.u_offset, dtype=np.float64)
+    y0 = np.asarray(model.y_offset, dtype=np.float64)
 
+    def f(x, u):
+        return A @ x + B @ (u - u0)
+
+    def h(x, u):
+        return C @ x + D @ (u - u0) + y0
+
+    return f, h
+
+
+
+def _linear(model, dt):
     f, h = _linear_model_fh(model, dt)
-    n = int(np.asarray(model.discrete(model.dt if dt is None else dt).A).shape[0])
+    n = int(np.asarray(model.to_ss(model.dt if dt is None else dt).A).shape[0])
     return f, h, np.zeros(n), n, [f"x{i + 1}" for i in range(n)]
 
 
