@@ -43,6 +43,8 @@ LAZY_MODULES = {
     ("sysid/linear/linear_model.py", "...lti"): "lti's numba simulation kernel, loaded on the first simulation",
     ("systems/tsfm/grasp_batch.py", ".grasp_gpu"): "numba.cuda: the GPU path only",
     ("io/formats.py", ".mcap_reader"): "the optional mcap extra",
+    ("sysid/model_file.py", "..io.formats"):
+        "the readers (pyarrow, h5py, scipy.io): every CLI command imports model_file for JSON output",
 }
 
 

@@ -56,7 +56,7 @@ def test_the_returned_model_never_scores_below_its_start(focus):
         warnings.simplefilter("ignore", AccuracyWarning)
         model, _ = identify_ss(tr, input="u", output="y", order=2, focus=focus, validate=val)
         start, _ = identify_ss(tr, input="u", output="y", order=2, refine=False, validate=val)
-    vd = identify_mimo._validation_data(val, mimo_data(tr, "u", "y"))
+    vd = identify_mimo.validation_data(val, mimo_data(tr, "u", "y"))
     assert focus_score(model, focus, vd) >= focus_score(start, focus, vd) - identify_mimo.FOCUS_TIE
     assert model.info["focus"]["data"] == "validation"
     assert np.allclose(sorted(np.abs(model.system.poles())), [np.hypot(0.9, 0.2)] * 2, atol=0.01)

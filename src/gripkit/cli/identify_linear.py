@@ -114,7 +114,7 @@ def _validate_polynomial(model, dt: float, validate: Path | None, input: str, ou
               "validation")
     if detrend != "linear":
         vio = dataclasses.replace(vio, u=vio.u - model.u_offset, y=vio.y - model.y_offset,
-                                  u_offset=model.u_offset, y_offset=model.y_offset)
+                                  u_offset=(model.u_offset,), y_offset=(model.y_offset,))
     if abs(vio.dt - dt) > 1e-9 * dt:
         from ..errors import DataError
 
@@ -122,7 +122,7 @@ def _validate_polynomial(model, dt: float, validate: Path | None, input: str, ou
                         f"estimation data at {1 / dt:g} Hz", hint="resample one of them")
     from ..sysid.linear.linear_model import VALIDATION_FIT, validation_fit
 
-    val = model.validate(vio.u, vio.y)  # one-step fit and residual tests
+    val = model.validate(vio.u1, vio.y1)  # one-step fit and residual tests
     vfit = validation_fit(model, load_data(validate, [input, output], fs, time, fill))
     out["validation_fit_percent"] = None if vfit is None else vfit[0]
     out["validation"] = {**val.to_dict(), "fit_percent": out["validation_fit_percent"],
@@ -326,7 +326,7 @@ def identify_arx(data: list[Path] = DataArgs, input: str = InputsOpt, output: st
         return
     data = data[0]
     _fit_and_report("arx", data, input, output, fs, time, fill, detrend, validate, json_out,
-                    lambda io: arx(io.u, io.y, na, nb, nk, dt=io.dt, **io.meta), out)
+                    lambda io: arx(io.u1, io.y1, na, nb, nk, dt=io.dt, **io.keywords), out)
 
 
 @identify_app.command("armax")
@@ -348,7 +348,7 @@ def identify_armax(data: list[Path] = DataArgs, input: str = InputOpt, output: s
         return
     data = data[0]
     _fit_and_report("armax", data, input, output, fs, time, fill, detrend, validate, json_out,
-                    lambda io: armax(io.u, io.y, na, nb, nc, nk, dt=io.dt, **io.meta), out)
+                    lambda io: armax(io.u1, io.y1, na, nb, nc, nk, dt=io.dt, **io.keywords), out)
 
 
 @identify_app.command("oe")
@@ -369,7 +369,7 @@ def identify_oe(data: list[Path] = DataArgs, input: str = InputOpt, output: str 
         return
     data = data[0]
     _fit_and_report("oe", data, input, output, fs, time, fill, detrend, validate, json_out,
-                    lambda io: oe(io.u, io.y, nb, nf, nk, dt=io.dt, **io.meta), out)
+                    lambda io: oe(io.u1, io.y1, nb, nf, nk, dt=io.dt, **io.keywords), out)
 
 
 @identify_app.command("rls")
@@ -392,7 +392,7 @@ def identify_rls(data: Path = DataArg, input: str = InputOpt, output: str = Outp
     output_file(trajectory, "--trajectory")
     with collected_warnings() as caught:
         io = _io(data, input, output, fs, time, fill, detrend, "RLS identification")
-        res = rls(io.u, io.y, na, nb, nk, forgetting=forgetting, p0=p0, windup=windup, dt=io.dt)
+        res = rls(io.u1, io.y1, na, nb, nk, forgetting=forgetting, p0=p0, windup=windup, dt=io.dt)
         if trajectory is not None:
             save(res.to_trajectory(), trajectory)
     out = res.to_dict()
@@ -437,8 +437,8 @@ def identify_search(data: Path = DataArg, input: str = InputOpt, output: str = O
     with collected_warnings() as caught:
         io = _io(data, input, output, fs, time, fill, detrend, "ARX structure search")
         vio = None if validate is None else _io(validate, input, output, fs, time, fill, detrend, "validation")
-        res = structure_search(io.u, io.y, na, nb, nk, criterion=criterion, dt=io.dt,
-                               validate=None if vio is None else (vio.u, vio.y))
+        res = structure_search(io.u1, io.y1, na, nb, nk, criterion=criterion, dt=io.dt,
+                               validate=None if vio is None else (vio.u1, vio.y1))
     report_warnings(caught)
     criterion = res.criterion
     if json_out:

@@ -25,15 +25,14 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass
 
 import numpy as np
 
 from ..arguments import check_keywords, entry_point, keyword_names
 from ..errors import AccuracyWarning, ArgumentError, DataError, GripkitError, emit_warning
-from ..signals.processing import detrend as detrend_signals
 from ..signals.trajectory import Trajectory
 from . import nonlinear
+from .io_data import IOData, io_data, records_provenance
 from .linear import identify_mimo
 from .linear.armax import armax, armax_records
 from .linear.arx import arx, arx_records
@@ -42,69 +41,20 @@ from .linear.frf import frf
 from .linear.oe import oe, oe_records
 from .linear.search import structure_search
 
-__all__ = ["IOData", "io_data", "identify", "identify_records", "method_options", "METHODS"]
+__all__ = ["IOData", "io_data", "identify", "identify_records", "method_options", "METHODS",
+           "with_provenance"]
 
 METHODS = ("arx", "armax", "oe", "rls", "search", "ss", "frf", "tf", "narx")
-
-
-@dataclass(frozen=True)
-class IOData:
-    """Input/output arrays taken from a trajectory, ready for identification."""
-
-    u: np.ndarray
-    y: np.ndarray
-    dt: float
-    input: str
-    output: str
-    input_unit: str
-    output_unit: str
-    u_offset: float
-    y_offset: float
-
-    @property
-    def meta(self) -> dict:
-        """Model metadata keywords for the identification functions."""
-        return dict(input_name=self.input, output_name=self.output, input_unit=self.input_unit,
-                    output_unit=self.output_unit, u_offset=self.u_offset, y_offset=self.y_offset)
-
-
-def io_data(data: Trajectory, *, input: str, output: str, detrend: str = "mean",
-            why: str = "discrete-time identification") -> IOData:
-    """Select the input and output channels of a uniformly sampled trajectory.
-
-    ``detrend``: ``'mean'`` removes each channel's mean (recorded as ``u_offset``/``y_offset``),
-    ``'linear'`` a least-squares line, ``'none'`` keeps the data as they are.
-    """
-    if not isinstance(data, Trajectory):
-        raise DataError(f"data: expected a gripkit Trajectory, found {type(data).__name__}",
-                        hint="use gripkit.io.load(path) or Trajectory.uniform(dt=..., u=..., y=...)")
-    if detrend not in ("mean", "linear", "none"):
-        raise DataError(f"detrend: expected 'mean', 'linear' or 'none', found {detrend!r}")
-    if input == output:
-        raise DataError(f"input and output must be different columns, both are {input!r}")
-    u = np.array(data[input], dtype=np.float64)
-    y = np.array(data[output], dtype=np.float64)
-    dt = float(f"{data.require_uniform(why=why):.9g}")  # time stamps in files carry rounding noise
-    u0 = y0 = 0.0
-    if detrend == "mean":
-        u0, y0 = float(u.mean()), float(y.mean())
-        u -= u0
-        y -= y0
-    elif detrend == "linear":
-        d = detrend_signals(data.select(input, output), kind="linear")
-        u0, y0 = float(u.mean()), float(y.mean())
-        u, y = np.array(d[input]), np.array(d[output])
-    return IOData(u, y, dt, input, output, data.unit(input), data.unit(output), u0, y0)
 
 
 def _polynomial_fit(method: str, io: IOData, orders: tuple, options: dict):
     """ARX, ARMAX or OE of ``io`` with ``orders`` = (na, nb, nc, nf, nk)."""
     na, nb, nc, nf, nk = orders
     if method == "arx":
-        return arx(io.u, io.y, na, nb, nk, dt=io.dt, **io.meta, **options)
+        return arx(io.u1, io.y1, na, nb, nk, dt=io.dt, **io.keywords, **options)
     if method == "armax":
-        return armax(io.u, io.y, na, nb, nc, nk, dt=io.dt, **io.meta, **options)
-    return oe(io.u, io.y, nb, nf, nk, dt=io.dt, **io.meta, **options)
+        return armax(io.u1, io.y1, na, nb, nc, nk, dt=io.dt, **io.keywords, **options)
+    return oe(io.u1, io.y1, nb, nf, nk, dt=io.dt, **io.keywords, **options)
 
 
 def _free_run_fit(model, u: np.ndarray, y: np.ndarray) -> float:
@@ -123,7 +73,7 @@ def warn_if_mean_detrending_hurt(model, io: IOData, raw, refit) -> None:
     their :class:`IOData` without detrending) and warn, naming ``--detrend none``, when its free
     run from rest fits better by more than 10 points than the detrended model's."""
     poles = np.abs(model.poles())
-    n = io.u.size
+    n = io.n_samples
     if not poles.size or not 0.0 < -n * np.log(max(float(poles.max()), 1e-300)) < 5.0:
         return
     with warnings.catch_warnings():
@@ -133,8 +83,8 @@ def warn_if_mean_detrending_hurt(model, io: IOData, raw, refit) -> None:
             other = refit(rio)
         except GripkitError:
             return
-    mean_fit = _free_run_fit(model, io.u, io.y)
-    none_fit = _free_run_fit(other, rio.u, rio.y)
+    mean_fit = _free_run_fit(model, io.u1, io.y1)
+    none_fit = _free_run_fit(other, rio.u1, rio.y1)
     if none_fit > mean_fit + 10.0:
         tau = -io.dt / math.log(float(poles.max()))
         emit_warning(
@@ -158,8 +108,8 @@ def _method_function(method: str):
 
 
 #: what identify() itself passes to the method's function (not accepted as an option)
-_SUPPLIED = ("u", "y", "na", "nb", "nc", "nf", "nk", "dt", *IOData.__dataclass_fields__, "input_name",
-             "output_name", "input_unit", "output_unit")
+_SUPPLIED = ("u", "y", "na", "nb", "nc", "nf", "nk", "dt", *IOData.__dataclass_fields__, "input",
+             "output", "input_name", "output_name", "input_unit", "output_unit")
 
 
 def method_options(method: str) -> list[str]:
@@ -201,7 +151,11 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
 
     Returns
     -------
-    PolynomialModel, RLSResult, SearchResult or NARXModel
+    PolynomialModel, LinearModel, RLSResult, SearchResult, FRF or NARXModel. A model records
+    where its data came from (:func:`~gripkit.sysid.io_data.records_provenance`): the file's
+    name and SHA-256 that :func:`gripkit.io.load` put in the trajectory's meta (``data_file``,
+    ``data_hash`` of a LinearModel; ``info['data_file']``, ``info['data_hash']`` of a
+    PolynomialModel); of several records the names joined, no hash.
     """
     if not isinstance(method, str) or method not in METHODS:
         raise DataError(f"method: expected one of {', '.join(METHODS)}, found {method!r}")
@@ -215,6 +169,26 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
             raise ArgumentError(f"identify(): {name} must be a column name (str), found {type(col).__name__} "
                                 f"{col!r:.40}", hint=f"columns: {', '.join(data.names)}"
                                 if isinstance(data, Trajectory) else None)
+    model = _dispatch(data, method, input=input, output=output, na=na, nb=nb, nk=nk, nc=nc, nf=nf,
+                      detrend=detrend, **options)
+    return with_provenance(model, records_provenance(data))
+
+
+def with_provenance(model, provenance: dict):
+    """``model`` with ``data_file``/``data_hash`` set from ``provenance`` (a LinearModel's fields,
+    a PolynomialModel's ``info``); other results, and data built in memory, as they are."""
+    if provenance.get("data_file") is None:
+        return model
+    if hasattr(model, "data_file"):
+        return model.replace(**provenance)
+    if isinstance(getattr(model, "info", None), dict) and hasattr(model, "replace"):
+        return model.replace(info={**model.info, **provenance})
+    return model
+
+
+def _dispatch(data, method: str, *, input, output, na: int, nb: int, nk: int, nc: int,
+              nf: int | None, detrend: str, **options):
+    """The fit of :func:`identify`, its arguments checked."""
     if isinstance(data, (list, tuple)):  # several records, one model
         return identify_records(data, method, input=input, output=output, na=na, nb=nb, nk=nk,
                                 nc=nc, nf=nf, detrend=detrend, **options)
@@ -229,7 +203,7 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
                                           detrend=detrend).with_display_units(data)
     if method == "narx":  # the model's constant term carries the operating point
         io = io_data(data, input=input, output=output, detrend="none", why="NARX identification")
-        model = nonlinear.narx(io.u, io.y, dt=io.dt, **options)
+        model = nonlinear.narx(io.u1, io.y1, dt=io.dt, **options)
         model.input_name, model.output_name = input, output
         return model
     io = io_data(data, input=input, output=output, detrend=detrend, why=f"{method.upper()} identification")
@@ -244,8 +218,8 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
     if method == "rls":
         from .linear.rls import rls  # numba (0.4 s): loaded only for an RLS fit
 
-        return rls(io.u, io.y, na, nb, nk, dt=io.dt, **options)
-    return structure_search(io.u, io.y, na, nb, nk, dt=io.dt, **options)
+        return rls(io.u1, io.y1, na, nb, nk, dt=io.dt, **options)
+    return structure_search(io.u1, io.y1, na, nb, nk, dt=io.dt, **options)
 
 
 #: the methods that fit one model to several records (``identify([tr1, tr2], ...)``)
@@ -327,10 +301,10 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
            for i, d in enumerate(data)]
     _same_sampling([(io.dt, (io.input_unit, io.output_unit)) for io in ios],
                    (ios[0].input, ios[0].output))
-    u0 = float(_pooled_mean([io.u for io in ios])) if detrend == "mean" else 0.0
-    y0 = float(_pooled_mean([io.y for io in ios])) if detrend == "mean" else 0.0
-    meta = dict(ios[0].meta, u_offset=u0, y_offset=y0, dt=ios[0].dt, **options)
-    records = [(io.u - u0, io.y - y0) for io in ios]
+    u0 = float(_pooled_mean([io.u1 for io in ios])) if detrend == "mean" else 0.0
+    y0 = float(_pooled_mean([io.y1 for io in ios])) if detrend == "mean" else 0.0
+    meta = dict(ios[0].keywords, u_offset=u0, y_offset=y0, dt=ios[0].dt, **options)
+    records = [(io.u1 - u0, io.y1 - y0) for io in ios]
     if method == "arx":
         return _as_data(arx_records, records, na, nb, nk, **meta)
     if method == "armax":

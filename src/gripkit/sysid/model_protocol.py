@@ -65,7 +65,7 @@ class IdentifiedModel(Protocol):
 
 # schema -> (module of gripkit.sysid, reader function); one line per model family
 MODEL_FILES: dict[str, tuple[str, str]] = {
-    "gripkit.linear-model": ("linear_model", "load_linear_model"),
+    "gripkit.linear-model": ("linear.linear_model", "load_linear_model"),
     "gripkit.narx-model": ("nonlinear.narx", "load_narx"),
 }
 

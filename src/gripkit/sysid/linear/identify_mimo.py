@@ -15,10 +15,8 @@ edge of a range of three or more orders is warned about: the true order may lie 
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import warnings
-from dataclasses import dataclass
 
 import numpy as np
 
@@ -28,21 +26,11 @@ from ...progress import status
 from ...signals.trajectory import Trajectory
 from .arx_mimo import arx_mimo
 from .frf import frf
+from ..io_data import SCALE_LIMITS, IOData, parse_names, validation_data  # noqa: F401 (re-exported)
 from .linear_model import VALIDATION_FIT, validation_fit  # the one definition, re-exported for the CLI
 
-__all__ = ["MimoData", "mimo_data", "identify_ss", "identify_frf", "identify_tf", "identify_arx", "several",
+__all__ = ["mimo_data", "identify_ss", "identify_frf", "identify_tf", "identify_arx", "several",
            "parse_names", "parse_order", "validation_fit"]
-
-
-def parse_names(x, what: str) -> tuple[str, ...]:
-    """Column names from ``'a,b'`` or a sequence."""
-    names = [s.strip() for s in x.split(",")] if isinstance(x, str) else [str(s).strip() for s in x]
-    if not names or any(not n for n in names):
-        raise DataError(f"{what}: expected one or more column names separated by commas, found {x!r}")
-    dup = sorted({n for n in names if names.count(n) > 1})
-    if dup:
-        raise DataError(f"{what}: column(s) {', '.join(map(repr, dup))} listed twice")
-    return tuple(names)
 
 
 def parse_order(order) -> tuple[int, int] | None:
@@ -62,101 +50,23 @@ def parse_order(order) -> tuple[int, int] | None:
     return lo, hi
 
 
-@dataclass(frozen=True)
-class MimoData:
-    """Inputs (N, m) and outputs (N, p) in deviation units, with names, units and offsets."""
-
-    u: np.ndarray
-    y: np.ndarray
-    dt: float
-    inputs: tuple[str, ...]
-    outputs: tuple[str, ...]
-    input_units: tuple[str, ...]
-    output_units: tuple[str, ...]
-    u_offset: tuple[float, ...]
-    y_offset: tuple[float, ...]
-
-    @property
-    def signals(self) -> dict:
-        return dict(inputs=self.inputs, outputs=self.outputs, input_units=self.input_units,
-                    output_units=self.output_units)
-
-
-def mimo_data(data: Trajectory, inputs, outputs, detrend: str = "mean", why: str = "identification") -> MimoData:
-    """Select and detrend the input and output columns of a uniformly sampled trajectory."""
-    if not isinstance(data, Trajectory):
-        raise DataError(f"data: expected a gripkit Trajectory, found {type(data).__name__}",
-                        hint="use gripkit.io.load(path) or Trajectory.uniform(dt=..., u=..., y=...)")
-    ins, outs = parse_names(inputs, "input"), parse_names(outputs, "output")
-    both = sorted(set(ins) & set(outs))
-    if both:
-        raise DataError(f"input and output must be different columns, {', '.join(map(repr, both))} is both")
-    missing = [n for n in ins + outs if n not in data.names]
-    if missing:
-        raise DataError(f"data: column(s) {', '.join(map(repr, missing))} not found; the data have "
-                        f"{', '.join(map(repr, data.names))}")
+def mimo_data(data: Trajectory, inputs, outputs, detrend: str = "mean",
+              why: str = "identification") -> IOData:
+    """The named columns as :class:`~gripkit.sysid.io_data.IOData` with the constant and scale
+    checks (these estimators form unscaled sums of squares); ``detrend`` 'mean' or 'none' (a line
+    per column would leave the model no operating point)."""
     if detrend not in ("mean", "none"):
         raise DataError(f"detrend: expected 'mean' or 'none', found {detrend!r}")
-    dt = float(f"{data.require_uniform(why=why):.9g}")  # time stamps in files carry rounding noise
-    u = np.column_stack([np.asarray(data[n], dtype=np.float64) for n in ins])
-    y = np.column_stack([np.asarray(data[n], dtype=np.float64) for n in outs])
-    for names, x, what in ((ins, u, "input"), (outs, y, "output")):
-        flat = np.ptp(x, axis=0) <= 1e-12 * np.maximum(np.max(np.abs(x), axis=0), 1e-300)
-        if flat.any():
-            name = names[int(np.argmax(flat))]
-            raise DataError(f"{what} column {name!r} is constant ({x[0, int(np.argmax(flat))]:.6g} for all "
-                            f"{x.shape[0]} samples): it carries no information",
-                            hint="drop it from --input/--output or check the data")
-    _check_scale(ins, u, "input", why)
-    _check_scale(outs, y, "output", why)
-    u0 = u.mean(axis=0) if detrend == "mean" else np.zeros(len(ins))
-    y0 = y.mean(axis=0) if detrend == "mean" else np.zeros(len(outs))
-    return MimoData(u - u0, y - y0, dt, ins, outs, tuple(data.unit(n) for n in ins),
-                    tuple(data.unit(n) for n in outs), tuple(map(float, u0)), tuple(map(float, y0)))
+    return IOData.from_trajectory(data, inputs, outputs, detrend=detrend, why=why, checks=True)
 
 
-#: Largest and smallest peak magnitude of a column that state-space, frequency-response and
-#: transfer-function estimation accept: they form sums of squares and of products of the signals
-#: (covariances, spectra, Gram matrices), which leave float64 (1e±308) for values beyond about
-#: 1e±150; 1e±100 keeps the margin for record lengths and orders.
-SCALE_LIMITS = (1e-100, 1e100)
-
-
-def _check_scale(names, x: np.ndarray, what: str, why: str) -> None:
-    """Refuse a column whose values are too large or too small for the estimators' sums of squares
-    (the SISO polynomial estimators scale internally; these do not)."""
-    peak = np.max(np.abs(x), axis=0)
-    lo, hi = SCALE_LIMITS
-    bad = (peak > hi) | (peak < lo)
-    if bad.any():
-        i = int(np.argmax(bad))
-        raise DataError(
-            f"{what} column {names[i]!r} has values up to {peak[i]:.3g}: {why} forms sums of "
-            f"squares of the signals, which leave float64 beyond about 1e±150, so it accepts peak "
-            f"values between {lo:.0e} and {hi:.0e}",
-            hint="give the column in other units (multiply it by a power of ten); arx, armax and "
-                 "oe (SISO) scale internally")
-
-
-def _validation_data(validate: Trajectory, d: MimoData) -> MimoData:
-    """The validation record's columns as deviations from the *estimation* operating point
-    ``d.u_offset``/``d.y_offset`` (the model's offsets): the one validation fit of
-    :data:`gripkit.sysid.linear.linear_model.VALIDATION_FIT`, the number ``gripkit compare`` gives."""
-    vd = mimo_data(validate, d.inputs, d.outputs, "none", why="validation")
-    if abs(vd.dt - d.dt) > 1e-9 * d.dt:
-        raise DataError(f"validation data are sampled at {1 / vd.dt:g} Hz, the estimation data at "
-                        f"{1 / d.dt:g} Hz", hint="resample one of them")
-    return dataclasses.replace(vd, u=vd.u - np.asarray(d.u_offset), y=vd.y - np.asarray(d.y_offset),
-                               u_offset=d.u_offset, y_offset=d.y_offset)
-
-
-def _validation_fit(model, vd: MimoData) -> list[float] | None:
+def _validation_fit(model, vd: IOData) -> list[float] | None:
     if not model.stable:
         return None
     return model.compare(vd.u, vd.y, dt=vd.dt)[0]
 
 
-def _aic(model, d: MimoData) -> float:
+def _aic(model, d: IOData) -> float:
     from .pem_ss import predict_errors
 
     ss = model.system
@@ -201,7 +111,7 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     if method not in SUBSPACE_METHODS:
         raise DataError(f"method: expected one of {', '.join(SUBSPACE_METHODS)}, found {method!r}")
     d = mimo_data(data, input, output, detrend, why="state-space identification")
-    vd = None if validate is None else _validation_data(validate, d)
+    vd = None if validate is None else validation_data(validate, d)
     rng = parse_order(order)
     n_hi = rng[1] if rng else DEFAULT_MAX_ORDER
     k = default_horizon(n_hi, d.y.shape[1]) if horizon is None else int(horizon)
@@ -266,7 +176,7 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
 FOCUS = ("simulation", "prediction")
 
 
-def focus_score(model, focus: str, d: MimoData) -> float:
+def focus_score(model, focus: str, d: IOData) -> float:
     """Mean over outputs of the fit (%) by which ``focus`` judges ``model`` on the deviation data
     ``d``: ``'simulation'``, the free-run fit with x0 estimated (:data:`VALIDATION_FIT`; −inf for
     an unstable model); ``'prediction'``, the one-step-ahead fit of the innovation predictor
@@ -286,7 +196,7 @@ def focus_score(model, focus: str, d: MimoData) -> float:
     return float(np.mean(100.0 * (1.0 - np.linalg.norm(e, axis=0) / den)))
 
 
-def _refine(start, d: MimoData, vd: MimoData | None, form: str, focus: str, max_iterations: int):
+def _refine(start, d: IOData, vd: IOData | None, form: str, focus: str, max_iterations: int):
     """PEM in ``form`` from the subspace model ``start``, kept only when it does not lose by
     ``focus`` (:func:`_never_lose`; PEM in oe form as the second candidate for the simulation
     focus); ``(model, refined?)``. A PEM that the data cannot determine returns ``start`` with a
@@ -326,7 +236,7 @@ def _warn_unconverged(model, max_iterations: int) -> None:
                      AccuracyWarning)
 
 
-def _never_lose(start, refined, focus: str, d: MimoData, estimation: bool, max_iterations: int,
+def _never_lose(start, refined, focus: str, d: IOData, estimation: bool, max_iterations: int,
                 second=None):
     """The refined model, or, when it scores lower than its subspace start by ``focus`` on ``d``
     (by more than :data:`FOCUS_TIE`), the model of ``second()`` (PEM in output-error form, which
@@ -432,7 +342,7 @@ SS_RECORD_OPTIONS = ("order", "horizon", "feedthrough", "refine", "form", "max_i
                      "weighting")
 
 
-def identify_ss_records(records: list, d: MimoData, u0, y0, options: dict):
+def identify_ss_records(records: list, d: IOData, u0, y0, options: dict):
     """The state-space model of several records: subspace
     (:func:`gripkit.sysid.linear.subspace.n4sid_records`), then, unless ``refine=False``, PEM with one
     initial state per record (:func:`gripkit.sysid.linear.pem_ss.pem_records`); the refined model is
@@ -473,7 +383,7 @@ def identify_ss_records(records: list, d: MimoData, u0, y0, options: dict):
     return refined
 
 
-def identify_tf_records(records: list, d: MimoData, u0, y0, poles: int, zeros: int):
+def identify_tf_records(records: list, d: IOData, u0, y0, poles: int, zeros: int):
     """The continuous-time transfer function of several records
     (:func:`gripkit.sysid.linear.tfest.tfest_records`) around the operating point (u0, y0)."""
     from .tfest import tfest_records
