@@ -70,12 +70,16 @@ def test_identify_ss_order_range_ranked_by_validation(capsys, files):
     assert [row["order"] for row in r["search"]][0] == 4
 
 
-def test_order_search_warns_on_edge(capsys, files):
+def test_order_search_widens_past_the_edge(capsys, files):
+    """The system has order 4: the range 1:3 has its best on the edge, so the search goes on
+    past it (issue 25) and finds 4, without the edge warning."""
     code, out, err = run(capsys, "identify", "ss", files["est"], "--input", "a,b", "--output", "c,d",
                          "--order", "1:3", "--no-refine", "--json")
     assert code == 0, err
     r = json.loads(out)
-    assert r["order"] == 3 and any("edge of the searched range" in w for w in r["warnings"])
+    assert r["order"] == 4 and 4 in [row["order"] for row in r["search"]]
+    assert "(1:3 widened)" in r["info"]["order_selection"]
+    assert not any("edge of the searched range" in w for w in r["warnings"])
 
 
 def test_compare_simulate_report(capsys, files):

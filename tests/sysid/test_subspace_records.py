@@ -9,6 +9,7 @@ import pytest
 from gripkit import Trajectory
 from gripkit.errors import ArgumentError, DataError
 from gripkit.lti import StateSpace
+from gripkit.sysid.linear import identify_mimo
 from gripkit.sysid import identify, n4sid, pem
 from gripkit.sysid.linear.pem_ss import pem_records
 from gripkit.sysid.linear.subspace import n4sid_records
@@ -72,8 +73,35 @@ def test_identify_list_ss_keeps_one_operating_point():
     u0 = np.concatenate([r[0] for r in recs]).mean()
     assert m.u_offset[0] == pytest.approx(u0, rel=1e-12)
     assert m.info["n_records"] == 2 and m.n_samples == 2700
-    with pytest.raises(ArgumentError, match="the order is one number or None"):
-        identify(trs, "ss", input="u", output="y", order="1:3", refine=False)
+    # the order search over the records (issue 25), as for one record: AIC of the innovation
+    # predictor over all of them finds the true order 2 (poles 0.7 and 0.9)
+    s = identify(trs, "ss", input="u", output="y", order="1:3", refine=False)
+    assert s.order == 2 and sorted(r["order"] for r in s.info["search"]) == [1, 2, 3]
+    assert s.info["search_criterion"] == "aic"
+    np.testing.assert_allclose(np.sort(s.system.poles().real), [0.7, 0.9], atol=0.01)
+
+
+def test_identify_list_ss_search_ranks_refined_models():
+    """The best REFINE_TOP orders are refined by PEM over the records and ranked by Akaike's
+    criterion of the errors the focus judges (free run for 'simulation', the innovation
+    predictor for 'prediction'); the first row is the returned model."""
+    recs = [record(1200, 8, x0=(5.0, 1.0)), record(1500, 9, x0=(-5.0, 0.0))]
+    trs = [Trajectory.uniform(dt=0.01, u=u, y=y) for u, y in recs]
+    dev = None
+    for focus in ("simulation", "prediction"):
+        m = identify(trs, "ss", input="u", output="y", order="1:3", focus=focus)
+        rows = m.info["search"]
+        refined = [r for r in rows if "refined_aic" in r]
+        assert len(refined) == identify_mimo.REFINE_TOP and rows[:3] == refined
+        assert rows[0]["order"] == m.order and m.info["focus"]["criterion"] == focus
+        assert rows[0]["refined_aic"] == min(r["refined_aic"] for r in refined)
+        dev = [(u - m.u_offset[0], y - m.y_offset[0]) for u, y in recs]
+        assert rows[0]["refined_percent"] == pytest.approx(
+            identify_mimo.records_score(m, dev, focus), rel=1e-12)
+        # the true poles are among the model's (order 3 adds a pole at 1 that carries each
+        # record's own level, the records' means differing from their pooled mean)
+        poles = np.abs(m.system.poles())
+        assert all(np.min(np.abs(poles - z)) < 0.01 for z in (0.7, 0.9))
 
 
 def test_short_record_refused():

@@ -26,7 +26,7 @@ import typer
 
 from .app import identify_app
 from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data, report_warnings
-from .identify_ss import ModelOutOpt, ReportOpt
+from .identify_common import ModelOutOpt, ReportOpt
 
 
 def _columns(option: str, text: str | None, joints) -> list[str] | None:

@@ -154,24 +154,28 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
     check_fs(fs)
     allow_external_links = _allow_external(allow_external_links)
     limit = _load_limit(max_bytes)
-    fmt = _format(path, format)
+    tr = _read(path, _format(path, format), columns=columns, time=time, fs=fs, units=units,
+               fill=fill, key=key, delimiter=delimiter, stamp=stamp,
+               allow_external=allow_external_links, limit=limit)
+    tr.meta["sha256"] = file_sha256(path)
+    return tr
+
+
+def _read(path: Path, fmt: str, *, columns, time, fs, units, fill, key, delimiter, stamp,
+          allow_external: bool, limit: float) -> Trajectory:
+    """The file read by its format's reader, as a validated trajectory (:func:`load`)."""
     if fmt == "mcap":
         from .mcap_reader import read_mcap
 
         raw, meta_units = read_mcap(path, columns, stamp, limit)
-        tr = columns_to_trajectory(raw, source=path.name, time="t", fs=fs, units=units,
-                                   meta_units=meta_units, fill=fill)
-    else:
-        reader = {"csv": _read_csv, "parquet": _read_parquet, "hdf5": _read_hdf5,
-                  "mat": read_mat}[fmt]
-        wanted = _Wanted(columns, time)
-        raw, meta_units = reader(path, key=key, delimiter=delimiter, wanted=wanted, limit=limit,
-                                 allow_external=allow_external_links)
-        tr = columns_to_trajectory(raw, source=path.name, columns=columns, time=time, fs=fs,
-                                   units=units, meta_units=meta_units, fill=fill,
-                                   headerless=fmt == "csv" and by_position(raw))
-    tr.meta["sha256"] = file_sha256(path)
-    return tr
+        return columns_to_trajectory(raw, source=path.name, time="t", fs=fs, units=units,
+                                     meta_units=meta_units, fill=fill)
+    reader = {"csv": _read_csv, "parquet": _read_parquet, "hdf5": _read_hdf5, "mat": read_mat}[fmt]
+    raw, meta_units = reader(path, key=key, delimiter=delimiter, wanted=_Wanted(columns, time),
+                             limit=limit, allow_external=allow_external)
+    return columns_to_trajectory(raw, source=path.name, columns=columns, time=time, fs=fs,
+                                 units=units, meta_units=meta_units, fill=fill,
+                                 headerless=fmt == "csv" and by_position(raw))
 
 
 def file_sha256(path) -> str:

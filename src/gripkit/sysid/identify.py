@@ -32,7 +32,7 @@ from ..arguments import check_keywords, entry_point, keyword_names
 from ..errors import AccuracyWarning, ArgumentError, DataError, GripkitError, emit_warning
 from ..signals.trajectory import Trajectory
 from . import nonlinear
-from .io_data import IOData, io_data, records_provenance
+from .io_data import IOData, io_data, records_provenance, validation_data
 from .linear import identify_mimo
 from .linear.armax import armax, armax_records
 from .linear.arx import arx, arx_records
@@ -113,8 +113,13 @@ _SUPPLIED = ("u", "y", "na", "nb", "nc", "nf", "nk", "dt", *IOData.__dataclass_f
 
 
 def method_options(method: str) -> list[str]:
-    """The ``**options`` that :func:`identify` accepts for ``method``."""
-    return keyword_names(_method_function(method), exclude=_SUPPLIED)
+    """The ``**options`` that :func:`identify` accepts for ``method``. For 'ss' the subspace
+    weighting (n4sid, moesp or cva) is the option ``weighting``, for one record and several
+    (identify's own ``method`` being 'ss')."""
+    names = keyword_names(_method_function(method), exclude=_SUPPLIED)
+    if method == "ss":
+        names = [n for n in names if n not in ("data", "method")] + ["weighting"]
+    return names
 
 
 @entry_point
@@ -194,8 +199,12 @@ def _dispatch(data, method: str, *, input, output, na: int, nb: int, nk: int, nc
                                 nc=nc, nf=nf, detrend=detrend, **options)
     if method in ("ss", "frf", "tf"):  # MIMO: input/output may name several columns
         fn = {"ss": identify_mimo.identify_ss, "frf": identify_mimo.identify_frf, "tf": identify_mimo.identify_tf}
+        if method == "ss" and "weighting" in options:  # identify_ss names it ``method``
+            options = dict(options)
+            options["method"] = options.pop("weighting")
         out = fn[method](data, input=input, output=output, detrend=detrend, **options)
-        out = out[0] if method == "ss" else out
+        if method == "ss":  # the order search and the validation fit go into the model's info
+            out = _with_extras(*out)
         # a model file saved from it shows its columns in the data file's units (force [mN])
         return out.with_display_units(data) if hasattr(out, "with_display_units") else out
     if method == "arx" and identify_mimo.several(input, output):  # matrix-polynomial ARX
@@ -203,6 +212,9 @@ def _dispatch(data, method: str, *, input, output, na: int, nb: int, nk: int, nc
                                           detrend=detrend).with_display_units(data)
     if method == "narx":  # the model's constant term carries the operating point
         io = io_data(data, input=input, output=output, detrend="none", why="NARX identification")
+        if isinstance(options.get("validate"), Trajectory):  # the record as it is, as estimation
+            vd = validation_data(options["validate"], io)
+            options = {**options, "validate": (vd.u1, vd.y1)}
         model = nonlinear.narx(io.u1, io.y1, dt=io.dt, **options)
         model.input_name, model.output_name = input, output
         return model
@@ -219,7 +231,22 @@ def _dispatch(data, method: str, *, input, output, na: int, nb: int, nk: int, nc
         from .linear.rls import rls  # numba (0.4 s): loaded only for an RLS fit
 
         return rls(io.u1, io.y1, na, nb, nk, dt=io.dt, **options)
+    if isinstance(options.get("validate"), Trajectory):  # around the estimation operating point
+        vd = validation_data(options["validate"], io, detrend=detrend)
+        options = {**options, "validate": (vd.u1, vd.y1)}
     return structure_search(io.u1, io.y1, na, nb, nk, dt=io.dt, **options)
+
+
+def _with_extras(model, extras: dict):
+    """The state-space model with :func:`~.linear.identify_mimo.identify_ss`'s extras in its
+    ``info``: ``search`` (the ranked orders) and ``search_criterion`` of an order range,
+    ``validation_fit_percent`` with ``validate``."""
+    info = dict(model.info)
+    if "search" in extras:
+        info.update(search=extras["search"], search_criterion=extras["criterion"])
+    if "validation_fit_percent" in extras:
+        info["validation_fit_percent"] = extras["validation_fit_percent"]
+    return model.replace(info=info)
 
 
 #: the methods that fit one model to several records (``identify([tr1, tr2], ...)``)

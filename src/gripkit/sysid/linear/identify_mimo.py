@@ -9,8 +9,10 @@ Order search (``order='2:8'``): every order of the range is fitted from one fact
 ranked by the free-run fit on ``validate`` data (mean over outputs, x0 estimated) when given,
 the lowest order within 0.05 fit points of the best winning (higher orders that fit the noise tie),
 otherwise by Akaike's criterion of the innovation predictor,
-``AIC = N log det Λ̂ + 2 d``, d = n(m + 2p) (+ pm with D) free parameters. A best order on the
-edge of a range of three or more orders is warned about: the true order may lie outside it.
+``AIC = N log det Λ̂ + 2 d``, d = n(m + 2p) (+ pm with D) free parameters. When the best order
+of a range of three or more orders sits on its edge, the search goes on past that edge, one
+order at a time, up to :data:`WIDEN_STEPS` orders (and the largest order the factorisation
+holds); a best order still on an edge is warned about: the true order may lie outside it.
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ import numpy as np
 
 from ...errors import (AccuracyWarning, ArgumentError, DataError, GripkitError, GripkitWarning,
                       IdentificationError, emit_warning)
-from ...progress import status
+from ...progress import status, track
 from ...signals.trajectory import Trajectory
 from .arx_mimo import arx_mimo
 from .frf import frf
@@ -127,40 +129,26 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     elif rng[0] == rng[1]:
         model = build(rng[0])
         model.info["order_selection"] = "given"
-    else:
-        rows = []
-        criterion = "validation_fit" if vd is not None else "aic"
-        for n in range(rng[0], rng[1] + 1):
-            cand = build(n)
-            row = {"order": n, "fit_percent": cand.fit_percent, "aic": _aic(cand, d)}
-            if vd is not None:
-                vf = _validation_fit(cand, vd)
-                row["validation_fit_percent"] = vf
-                row["score"] = -math.inf if vf is None else float(np.mean(vf))
-            else:
-                row["score"] = -row["aic"]
-            rows.append((row, cand))
-        rows.sort(key=lambda rc: -rc[0]["score"])
-        if vd is not None:  # parsimony: the lowest order within 0.05 fit points of the best
-            top = rows[0][0]["score"]
-            close = [rc for rc in rows if rc[0]["score"] >= top - 0.05]
-            pick = min(close, key=lambda rc: rc[0]["order"])
-            rows.remove(pick)
-            rows.insert(0, pick)
-        best_row, model = rows[0]
-        model.info["order_selection"] = f"best of {rng[0]}:{rng[1]} by {criterion}"
-        extras["search"] = [r for r, _ in rows]
-        extras["criterion"] = criterion
-        if best_row["order"] in rng and rng[1] - rng[0] >= 2:
-            emit_warning(f"order search: the best order {best_row['order']} lies on the edge of the searched range "
-                         f"{rng[0]}:{rng[1]}; the true order may lie outside it, widen the range",
-                         GripkitWarning)
-    model = model.replace(u_offset=d.u_offset, y_offset=d.y_offset)
     if focus not in FOCUS:
         raise DataError(f"focus: expected one of {', '.join(FOCUS)}, found {focus!r}")
-    if refine:
+    ranked = None
+    if rng is not None and rng[0] != rng[1]:
+        ranked, extras["criterion"] = _order_search(
+            lambda n: _order_row(build, n, d, vd), "aic" if vd is None else "validation_fit",
+            rng, min(fac.s.size - 1, (k - 1) * d.y.shape[1]), progress)
+        model = ranked[0][1]
+    model = model.replace(u_offset=d.u_offset, y_offset=d.y_offset)
+    if refine and ranked is not None:  # the search ranks the refined models it returns
+        ranked = [(r, c.replace(u_offset=d.u_offset, y_offset=d.y_offset)) for r, c in ranked]
+        model, ranked = _refine_top(
+            ranked, lambda c: _refine(c, d, vd, form, focus, max_iterations, progress)[0],
+            lambda m: focus_score(m, focus, d if vd is None else vd),
+            None if vd is not None else lambda m: _aic(m, d), progress)
+    elif refine:
         report(f"PEM refinement ({form} form) of the order-{model.order} model")
-        model, refine = _refine(model, d, vd, form, focus, max_iterations)
+        model, refine = _refine(model, d, vd, form, focus, max_iterations, progress)
+    if ranked is not None:
+        extras["search"] = [r for r, _ in ranked]
     warn_if_stabilised(model)
     if detrend == "mean":
         refit = lambda: identify_ss(  # noqa: E731
@@ -170,6 +158,111 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     if vd is not None:
         extras["validation_fit_percent"] = _validation_fit(model, vd)
     return model, extras
+
+
+#: orders an order search adds past an edge of its range where the best order sits
+WIDEN_STEPS = 3
+
+
+def _order_row(build, n: int, d: IOData, vd: IOData | None):
+    """(row of the search table, subspace model) of order ``n``; score: the mean validation
+    fit with ``vd``, else −AIC."""
+    cand = build(n)
+    row = {"order": n, "fit_percent": cand.fit_percent, "aic": _aic(cand, d)}
+    if vd is not None:
+        vf = _validation_fit(cand, vd)
+        row["validation_fit_percent"] = vf
+        row["score"] = -math.inf if vf is None else float(np.mean(vf))
+    else:
+        row["score"] = -row["aic"]
+    return row, cand
+
+
+def _ranked(found: dict, parsimony: bool) -> list:
+    """The (row, model) pairs best first; ``parsimony`` (validation fits): the lowest order
+    within 0.05 fit points of the best first (higher orders that fit the noise tie)."""
+    rows = sorted(found.values(), key=lambda rc: -rc[0]["score"])
+    if parsimony:
+        top = rows[0][0]["score"]
+        pick = min((rc for rc in rows if rc[0]["score"] >= top - 0.05),
+                   key=lambda rc: rc[0]["order"])
+        rows.remove(pick)
+        rows.insert(0, pick)
+    return rows
+
+
+def _order_search(row_of, criterion: str, rng: tuple, n_cap: int, progress: bool):
+    """Every order of ``rng`` ranked (module doc; ``row_of(n)`` -> (row, model), by ``criterion``,
+    'validation_fit' or 'aic'); while the best sits on an edge of the orders tried, up to
+    :data:`WIDEN_STEPS` orders past it (at most ``n_cap``, at least 1) are added. A best order
+    still on an edge is warned about. Returns (the (row, model) pairs best first, criterion)."""
+    parsimony = criterion == "validation_fit"
+    found = {n: row_of(n) for n in track(range(rng[0], rng[1] + 1), description="order search",
+                                         enabled=progress)}
+    rows = _ranked(found, parsimony)
+    for _ in range(WIDEN_STEPS):
+        best, lo, hi = rows[0][0]["order"], min(found), max(found)
+        nxt = hi + 1 if best == hi and hi < n_cap else lo - 1 if best == lo and lo > 1 else None
+        if nxt is None or hi - lo < 2:
+            break
+        try:
+            found[nxt] = row_of(nxt)
+        except GripkitError:  # the factorisation does not support that order
+            break
+        rows = _ranked(found, parsimony)
+    best_row, model = rows[0]
+    lo, hi = min(found), max(found)
+    tried = f"{lo}:{hi}" if (lo, hi) == rng else f"{lo}:{hi} ({rng[0]}:{rng[1]} widened)"
+    model.info["order_selection"] = f"best of {tried} by {criterion}"
+    best = best_row["order"]
+    if (best == hi or best == lo > 1) and hi - lo >= 2:  # below order 1 there is nothing
+        emit_warning(f"order search: the best order {best} lies on the edge of the "
+                     f"searched range {tried}; the true order may lie outside it, widen the range",
+                     GripkitWarning)
+    return rows, criterion
+
+
+#: the best orders of a search that PEM refines; the refined models are ranked by the focus
+REFINE_TOP = 3
+
+
+def _refine_top(ranked: list, refine_one, fit_of, aic_of, progress: bool):
+    """``refine_one(model)`` (PEM that never loses by the focus) of the :data:`REFINE_TOP` best
+    orders of a search, ranked again: by ``fit_of(model)`` (the focus fit on validation data;
+    the lowest order within :data:`FOCUS_TIE` of the best first) when ``aic_of`` is None, else
+    by ``aic_of(model)`` (on the estimation data a higher order always fits better: Akaike's
+    criterion weighs the fit against the parameters). Each row gets ``refined_percent`` (the
+    focus fit), ``kept`` (the structure returned for that order) and ``refined_aic`` when ranked
+    by it. Only the returned model's warnings are emitted. Returns (best model, the ranking:
+    refined orders first, then the others as the search ranked them)."""
+    top = []
+    for row, cand in ranked[:REFINE_TOP]:
+        if progress:
+            status(f"PEM refinement of the order-{cand.order} model")
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            model = refine_one(cand)
+        row = {**row, "refined_percent": fit_of(model), "kept": model.structure}
+        if aic_of is not None:
+            row["refined_aic"] = aic_of(model)
+        top.append((row, model, caught))
+    if aic_of is None:
+        best = max(r["refined_percent"] for r, _, _ in top)
+        top.sort(key=lambda rmc: (-rmc[0]["refined_percent"], rmc[0]["order"]))
+        pick = min((rmc for rmc in top if rmc[0]["refined_percent"] >= best - FOCUS_TIE),
+                   key=lambda rmc: rmc[0]["order"])
+        top.remove(pick)
+        top.insert(0, pick)
+    else:
+        top.sort(key=lambda rmc: (rmc[0]["refined_aic"], rmc[0]["order"]))
+    pick = top[0]
+    for w in pick[2]:
+        emit_warning(str(w.message), w.category)
+    model = pick[1]
+    by = "Akaike's criterion" if aic_of is not None else "the validation fit"
+    model.info["order_selection"] = (f"{ranked[0][1].info['order_selection']}; the best "
+                                     f"{len(top)} refined by PEM and ranked by {by}")
+    return model, [(r, m) for r, m, _ in top] + list(ranked[REFINE_TOP:])
 
 
 #: the criteria by which identify_ss keeps the better of the subspace and the refined model
@@ -196,7 +289,8 @@ def focus_score(model, focus: str, d: IOData) -> float:
     return float(np.mean(100.0 * (1.0 - np.linalg.norm(e, axis=0) / den)))
 
 
-def _refine(start, d: IOData, vd: IOData | None, form: str, focus: str, max_iterations: int):
+def _refine(start, d: IOData, vd: IOData | None, form: str, focus: str, max_iterations: int,
+            progress: bool = False):
     """PEM in ``form`` from the subspace model ``start``, kept only when it does not lose by
     ``focus`` (:func:`_never_lose`; PEM in oe form as the second candidate for the simulation
     focus); ``(model, refined?)``. A PEM that the data cannot determine returns ``start`` with a
@@ -204,7 +298,8 @@ def _refine(start, d: IOData, vd: IOData | None, form: str, focus: str, max_iter
     from .pem_ss import pem
 
     try:
-        model = pem(start, u=d.u, y=d.y, form=form, max_iterations=max_iterations)
+        model = pem(start, u=d.u, y=d.y, form=form, max_iterations=max_iterations,
+                    progress=progress)
     except IdentificationError as exc:  # an order the data do not support in full
         emit_warning(f"PEM refinement of the order-{start.order} {start.structure} model failed "
                      f"({exc.message}); the subspace model is returned, without parameter "
@@ -215,7 +310,8 @@ def _refine(start, d: IOData, vd: IOData | None, form: str, focus: str, max_iter
     if form == "innovation" and focus == "simulation":  # PEM in oe form minimises the free-run
         def oe():                                       # error itself: the second candidate
             try:
-                return pem(start, u=d.u, y=d.y, form="oe", max_iterations=max_iterations)
+                return pem(start, u=d.u, y=d.y, form="oe", max_iterations=max_iterations,
+                           progress=progress)
             except IdentificationError:
                 return None
     return _never_lose(start, model, focus, d if vd is None else vd, vd is None, max_iterations, oe), True
@@ -339,16 +435,18 @@ def identify_arx(data: Trajectory, *, input, output, na: int, nb: int, nk: int =
 #: the options of method 'ss' with several records (``weighting``: the subspace method, n4sid,
 #: moesp or cva, identify()'s own ``method`` being 'ss')
 SS_RECORD_OPTIONS = ("order", "horizon", "feedthrough", "refine", "form", "max_iterations",
-                     "weighting")
+                     "weighting", "focus", "progress")
 
 
 def identify_ss_records(records: list, d: IOData, u0, y0, options: dict):
     """The state-space model of several records: subspace
-    (:func:`gripkit.sysid.linear.subspace.n4sid_records`), then, unless ``refine=False``, PEM with one
-    initial state per record (:func:`gripkit.sysid.linear.pem_ss.pem_records`); the refined model is
-    returned only when its free-run fit of all records (mean over the outputs) is not below the
-    subspace model's, else the subspace model with an AccuracyWarning giving both."""
-    from .pem_ss import pem_records
+    (:func:`gripkit.sysid.linear.subspace.n4sid_records`), then, unless ``refine=False``, PEM with
+    one initial state per record (:func:`gripkit.sysid.linear.pem_ss.pem_records`), kept only when
+    it does not lose to its start by ``focus`` (:func:`records_score` over all records; else the
+    subspace model with an AccuracyWarning giving both). ``order='LO:HI'`` searches the order as
+    for one record: ranked by Akaike's criterion of the free run over all records,
+    widened past an edge, the best :data:`REFINE_TOP` refined and ranked by ``focus``
+    (``info['search']``)."""
     from .subspace import n4sid_records
 
     other = sorted(set(options) - set(SS_RECORD_OPTIONS))
@@ -356,31 +454,106 @@ def identify_ss_records(records: list, d: IOData, u0, y0, options: dict):
         raise ArgumentError(f"identify(method='ss'): with several records the options are "
                             f"{', '.join(SS_RECORD_OPTIONS)}, found {', '.join(other)}",
                             hint="pass one trajectory for the other options")
+    focus, progress = options.get("focus", "simulation"), options.get("progress", False)
+    if focus not in FOCUS:
+        raise DataError(f"focus: expected one of {', '.join(FOCUS)}, found {focus!r}")
     rng = parse_order(options.get("order"))
-    if rng is not None and rng[0] != rng[1]:
-        raise ArgumentError(f"identify(method='ss'): with several records the order is one number "
-                            f"or None, found the range {options['order']!r}",
-                            hint="search the order on one record")
-    start = n4sid_records(records, None if rng is None else rng[0],
-                          method=options.get("weighting", "n4sid"), horizon=options.get("horizon"),
-                          feedthrough=options.get("feedthrough", False), dt=d.dt,
-                          u_offset=tuple(map(float, u0)), y_offset=tuple(map(float, y0)),
-                          **d.signals)
-    if not options.get("refine", True):
-        return start
+
+    def fit(n):
+        return n4sid_records(records, n, method=options.get("weighting", "n4sid"),
+                             horizon=options.get("horizon"),
+                             feedthrough=options.get("feedthrough", False), dt=d.dt,
+                             u_offset=tuple(map(float, u0)), y_offset=tuple(map(float, y0)),
+                             **d.signals)
+
+    refine = lambda m: _refine_records(m, records, options, focus)  # noqa: E731
+    score = lambda m: records_score(m, records, focus)  # noqa: E731
+    if rng is None or rng[0] == rng[1]:
+        start = fit(None if rng is None else rng[0])
+        return refine(start) if options.get("refine", True) else start
+    # the subspace models are ranked by their free run: the innovation gain a subspace fit of
+    # several records gives is too rough to rank orders by; PEM's gains rank the refined ones
+    row_of = lambda n: _records_row(fit(n), records, "simulation")  # noqa: E731
+    ranked, criterion = _order_search(row_of, "aic", rng, rng[1] + WIDEN_STEPS, progress)
+    if options.get("refine", True):
+        model, ranked = _refine_top(ranked, refine, score,
+                                    lambda m: _records_row(m, records, focus)[0]["aic"],
+                                    progress)
+    else:
+        model = ranked[0][1]
+    return model.replace(info={**model.info, "search": [r for r, _ in ranked],
+                               "search_criterion": criterion})
+
+
+def records_score(model, records: list, focus: str) -> float:
+    """Mean over outputs of the fit (%) of all records together by ``focus``
+    (:func:`focus_score` for several records): each record's errors from its own initial state
+    estimated by least squares (:func:`~.pem_ss.predictor_x0`; K = 0 for 'simulation', the
+    free run), ``100 (1 − √Σ_i‖e_i‖² / √Σ_i‖y_i − ȳ_i‖²)``; −inf for an unstable run."""
+    from .pem_ss import predictor_x0
+
+    ss = model.system
+    n, p = ss.n_states, ss.n_outputs
+    K = np.zeros((n, p)) if focus == "simulation" or model.K is None else model.K
+    if n and np.max(np.abs(np.linalg.eigvals(ss.A - K @ ss.C))) >= 1.0:
+        return -math.inf
+    num = den = 0.0
+    for u, y in records:
+        u, y = _columns(u), _columns(y)
+        _, e = predictor_x0(ss.A, ss.B, ss.C, ss.D, K, u, y)
+        num = num + np.sum(e * e, axis=0)
+        den = den + np.sum((y - np.mean(y, axis=0)) ** 2, axis=0)
+    return float(np.mean(100.0 * (1.0 - np.sqrt(num) / np.sqrt(den))))
+
+
+def _columns(x) -> np.ndarray:
+    """A record's signal as float64 columns (N, k) (a 1-D array is one column)."""
+    x = np.asarray(x, dtype=np.float64)
+    return np.ascontiguousarray(x.reshape(x.shape[0], -1))
+
+
+def _records_row(model, records: list, focus: str):
+    """(row, model) of a records order search: ``AIC = ΣN log det Λ̂ + 2 d`` over all records,
+    each from its least-squares initial state, of the errors ``focus`` judges: the free run
+    ('simulation'; d = n (m + p + R) for R records) or the innovation predictor ('prediction';
+    d = n (m + 2p + R)), + pm with D."""
+    from .pem_ss import predictor_x0
+
+    ss = model.system
+    n, p, m = ss.n_states, ss.n_outputs, ss.n_inputs
+    innovation = focus == "prediction" and model.K is not None
+    K = model.K if innovation else np.zeros((n, p))
+    es = [predictor_x0(ss.A, ss.B, ss.C, ss.D, K, _columns(u), _columns(y))[1]
+          for u, y in records]
+    e = np.vstack(es)
+    N = e.shape[0]
+    sign, logdet = np.linalg.slogdet(e.T @ e / N)
+    k = n * (m + p + (p if innovation else 0) + len(records)) + (p * m if np.any(ss.D) else 0)
+    aic = float(N * logdet + 2 * k) if sign > 0 and np.isfinite(logdet) else math.inf
+    return {"order": n, "fit_percent": model.fit_percent, "aic": aic, "score": -aic}, model
+
+
+def _refine_records(start, records: list, options: dict, focus: str):
+    """PEM over the records (:func:`~.pem_ss.pem_records`) from ``start``, returned only when it
+    does not lose to ``start`` by ``focus`` (:func:`records_score`, within :data:`FOCUS_TIE`)."""
+    from .pem_ss import pem_records
+
     iters = options.get("max_iterations", 50)
     refined = pem_records(start, records, form=options.get("form", "innovation"),
-                          max_iterations=iters)
+                          max_iterations=iters, progress=options.get("progress", False))
     if not refined.info["pem"]["converged"]:
         emit_warning(f"identify ss: PEM over the records stopped after {iters} iterations without "
                      f"converging; raise max_iterations", AccuracyWarning)
-    before, after = float(np.mean(start.fit_percent)), float(np.mean(refined.fit_percent))
-    if after < before:
-        emit_warning(f"identify ss: PEM over the records lowered the free-run fit of all records "
-                     f"from {before:.4g} % (subspace) to {after:.4g} %; the subspace model is "
-                     f"returned", AccuracyWarning)
-        return start
-    return refined
+    before = records_score(start, records, focus)
+    after = records_score(refined, records, focus)
+    record = {"criterion": focus, "data": "estimation", "subspace_percent": before,
+              "refined_percent": after}
+    if after < before - FOCUS_TIE:
+        emit_warning(f"identify ss: PEM over the records lowered the mean {focus} fit of all "
+                     f"records from {before:.4g} % (subspace) to {after:.4g} %; the subspace "
+                     f"model is returned", AccuracyWarning)
+        return start.replace(info={**start.info, "focus": {**record, "kept": "subspace"}})
+    return refined.replace(info={**refined.info, "focus": {**record, "kept": refined.structure}})
 
 
 def identify_tf_records(records: list, d: IOData, u0, y0, poles: int, zeros: int):
