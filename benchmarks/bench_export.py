@@ -69,6 +69,53 @@ int main(int argc, char **argv) {
 """
 
 
+_KF_HARNESS = r"""
+#define _POSIX_C_SOURCE 199309L
+#include <stdio.h>
+#include <stdlib.h>
+#include <time.h>
+#include "kf.h"
+static double now_ns(void) {
+    struct timespec t; clock_gettime(CLOCK_MONOTONIC, &t);
+    return 1e9 * (double)t.tv_sec + (double)t.tv_nsec;
+}
+static int cmp(const void *a, const void *b) {
+    double x = *(const double *)a, y = *(const double *)b; return (x > y) - (x < y);
+}
+static void input(long k, double u[KF_NU], double y[KF_NY]) {
+    for (int i = 0; i < KF_NU; ++i) u[i] = (double)((k * (i + 3)) % 17) / 17.0 - 0.5;
+    for (int i = 0; i < KF_NY; ++i) y[i] = (double)((k * (i + 5)) % 13) / 13.0 + 1.0;
+}
+int main(int argc, char **argv) {
+    if (argc < 4) return 2;
+    long steps = atol(argv[1]), block = atol(argv[2]), nb = steps / block;
+    double *per = malloc(sizeof(double) * (size_t)nb), u[KF_NU], y[KF_NY], x[KF_NX], sink = 0.0;
+    kf_kf_state s; kf_kf_init(&s);
+    FILE *f = fopen(argv[3], "w");  /* the first 1000 estimates, to check against Python */
+    for (long k = 0; k < 1000; ++k) {
+        input(k, u, y);
+        kf_kf_step(&s, u, y, x);
+        for (int j = 0; j < KF_NX; ++j) fprintf(f, "%.17g%c", x[j], j + 1 < KF_NX ? ',' : '\n');
+    }
+    fclose(f);
+    for (long b = 0; b < nb; ++b) {
+        double t0 = now_ns();
+        for (long k = 0; k < block; ++k) {
+            u[0] = (double)(k & 7) * 0.1; u[1] = -u[0]; y[0] = 1.0 + u[0]; y[1] = 2.0 - u[0];
+            kf_kf_step(&s, u, y, x);
+            sink += x[0];
+        }
+        per[b] = (now_ns() - t0) / (double)block;
+    }
+    qsort(per, (size_t)nb, sizeof(double), cmp);
+    printf("{\"min\": %.3f, \"median\": %.3f, \"p99\": %.3f, \"p999\": %.3f, "
+           "\"max\": %.3f, \"sink\": %g}\n",
+           per[0], per[nb / 2], per[(long)(0.99 * nb)], per[(long)(0.999 * nb)], per[nb - 1], sink);
+    return 0;
+}
+"""
+
+
 def _model():
     """A stable 2×2 model of order 6 (poles of modulus 0.6–0.95) with offsets."""
     from gripkit.lti import StateSpace
@@ -83,7 +130,9 @@ def _model():
 
 
 def run(quick: bool) -> list[dict]:
-    return model_rows(quick) + controller_rows(quick)
+    """The model's C step, the controllers' and RLS update's (:func:`controller_rows`) and the
+    Kalman filter's (:func:`run_kalman`)."""
+    return model_rows(quick) + controller_rows(quick) + run_kalman(quick)
 
 
 def model_rows(quick: bool) -> list[dict]:
@@ -273,4 +322,70 @@ if __name__ == "__main__":
 
     quick = "--quick" in sys.argv
     for r in run(quick=quick):
+        print(json.dumps(r))
+
+
+def _python_kf_steps(kf, u, y, steps: int) -> dict:
+    """``kf.step(u_k, y_k, copy=False)`` from Python, timed in blocks of BLOCK calls."""
+    import time
+
+    nb = steps // BLOCK
+    per = np.empty(nb)
+    clock = time.perf_counter_ns
+    for k in range(1000):  # warm: compiled, caches filled
+        kf.step(u[k % BLOCK], y[k % BLOCK], copy=False)
+    for b in range(nb):
+        t0 = clock()
+        for k in range(BLOCK):
+            kf.step(u[k], y[k], copy=False)
+        per[b] = (clock() - t0) / BLOCK
+    return _percentiles(per)
+
+
+def run_kalman(quick: bool) -> list[dict]:
+    """The steady-state Kalman filter's C step and its numba step from Python."""
+    from gripkit.estimation import KalmanFilter
+    from gripkit.export import export_kalman_c
+
+    gcc = shutil.which("gcc")
+    if gcc is None:
+        return [row("export", "C Kalman step, 2x2 order 6", None, "numba KalmanFilter.step", None,
+                    notes="gcc not found: not measured")]
+    model = _model()
+    Qn, Rn = 1e-3 * np.eye(ORDER), 1e-2 * np.eye(P)
+    steps = STEPS // 10 if quick else STEPS
+    with tempfile.TemporaryDirectory() as tmp:
+        d = Path(tmp)
+        export_kalman_c(model, d, "kf", Qn, Rn)
+        (d / "harness.c").write_text(_KF_HARNESS)
+        exe = d / "kf"
+        cc = subprocess.run([gcc, "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-o", str(exe),
+                             str(d / "harness.c"), str(d / "kf.c"), "-lm"],
+                            capture_output=True, text=True)
+        if cc.returncode:
+            raise RuntimeError(cc.stderr)
+        res = subprocess.run([str(exe), str(steps), str(BLOCK), str(d / "x.csv")], check=True,
+                             capture_output=True, text=True)
+        stats = json.loads(res.stdout)
+        x_c = np.loadtxt(d / "x.csv", delimiter=",")
+    k = np.arange(1000)
+    u = np.column_stack([((k * (i + 3)) % 17) / 17.0 - 0.5 for i in range(M)])
+    y = np.column_stack([((k * (i + 5)) % 13) / 13.0 + 1.0 for i in range(P)])
+    x_py = KalmanFilter(model, Qn, Rn, steady_state=True).run_arrays(u, y).x
+    err = float(np.max(np.abs(x_c - x_py)) / np.max(np.abs(x_py)))
+    if err > 1e-12:
+        raise AssertionError(f"exported Kalman step differs from Python by {err:.3g} relative")
+    kf = KalmanFilter(model, Qn, Rn, steady_state=True)
+    py = _python_kf_steps(kf, np.ascontiguousarray(u), np.ascontiguousarray(y), steps)
+    return [row("export", f"C steady-state Kalman step of a 2x2 order-{ORDER} model, ns per step "
+                f"(gcc -O2, blocks of {BLOCK}, {steps} steps)", stats["median"] * 1e-9,
+                f"numba KalmanFilter.step(copy=False) called from Python ({steps} steps)",
+                py["median"] * 1e-9, target="<= 400 ns median (issue 27)",
+                gripkit_accuracy=f"x_hat = Python to {err:.1e} relative",
+                extra={"c": {k: stats[k] for k in ("min", "median", "p99", "p999", "max")},
+                       "python_step": py})]
+
+
+if __name__ == "__main__":
+    for r in run(quick=False):
         print(json.dumps(r))

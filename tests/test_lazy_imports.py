@@ -45,6 +45,8 @@ LAZY_MODULES = {
     ("io/formats.py", ".mcap_reader"): "the optional mcap extra",
     ("sysid/model_file.py", "..io.formats"):
         "the readers (pyarrow, h5py, scipy.io): every CLI command imports model_file for JSON output",
+    ("control/robustness.py", "..report.plots"): "matplotlib (0.34 s): only the histograms load it",
+    ("export/c_rls.py", "..sysid.linear.rls"): "numba (0.4 s): the RLS kernels, for --rls only",
 }
 
 

@@ -56,7 +56,7 @@ def test_frf_line_without_excitation(cli, files):
 def test_model_file_with_wrong_schema(cli, files, tmp_path):
     p = tmp_path / "wrong.json"
     p.write_text(json.dumps({"schema": "other", "A": [[1.0]]}))
-    assert_user_error(cli("compare", p, files / "clean.csv"), "ModelError", "expected schema")
+    assert_user_error(cli("compare", p, files / "clean.csv"), "ModelError", "unknown schema 'other'")
 
 
 def test_model_file_hash_mismatch_warns(cli, files, tmp_path):

@@ -5,17 +5,17 @@ is stable equals the analytic one for a first-order plant whose pole is uncertai
 
 import math
 
+import control
 import numpy as np
 import pytest
 from scipy.stats import norm
 
 from gripkit.control import PID, design_rst, loop_margins, robustness, tune_pid
-from gripkit.control.robustness import controller_transfer_function
+from gripkit.control.robustness import controller_transfer_function, robustness_section
 from gripkit.errors import ModelError
 from gripkit.lti import StateSpace, TransferFunction
 from gripkit.sysid import LinearModel, PolynomialModel
 
-control = pytest.importorskip("control")
 
 
 def _plant():
@@ -120,8 +120,9 @@ def test_the_robustness_section_in_the_model_report(tmp_path):
     pid = tune_pid(m, tau_c=0.05)
     r = robustness(m, pid, n=200, seed=3)
     assert r.n == 200 and 0.0 <= r.probability_stable <= 1.0
+    label = "PI <script>alert(1)</script>"
     index = write_model_report(m, data, tmp_path / "rep",
-                               robustness=(r, "PI <script>alert(1)</script>"))
+                               sections=[lambda rep: robustness_section(rep, r, controller=label)])
     html = index.read_text()
     assert "Robustness of the loop" in html and "<script>alert" not in html
     assert "PI <script>alert(1)</script> in the loop" in unescape(html)

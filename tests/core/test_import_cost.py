@@ -38,7 +38,7 @@ def test_lazy_names_are_the_defining_modules_objects_and_listed():
     from gripkit.sysid.linear.arx import arx as arx_defined
     from gripkit.sysid.linear.rls import rls as rls_defined
 
-    assert arx is arx_defined and rls is rls_defined and gripkit.sysid.linear.arx is arx_defined
+    assert arx is arx_defined and rls is rls_defined and gripkit.sysid.arx is arx_defined
     assert gripkit.signals.lowpass is lowpass
     for pkg in (gripkit.signals, gripkit.sysid):
         assert set(pkg.__all__) <= set(dir(pkg))

@@ -11,7 +11,7 @@ import pytest
 from scipy.linalg import solve_discrete_are
 from scipy.stats import chi2
 
-from gripkit.errors import ModelError
+from gripkit.errors import DataError, ModelError
 from gripkit.estimation import KalmanFilter
 from gripkit.lti import StateSpace
 from gripkit.signals import Trajectory
@@ -140,3 +140,43 @@ def test_bad_noise_is_refused():
         KalmanFilter(model(), Q=Q, R=np.zeros((2, 2)))
     with pytest.raises(ModelError, match="Q must be a finite 3×3 matrix"):
         KalmanFilter(model(), Q=np.eye(2), R=R)
+
+
+@pytest.mark.parametrize("steady", [False, True])
+def test_run_is_the_step_kernel_over_the_record_and_views_are_read_only(steady):
+    """``run_arrays`` (one numba call over the record) gives the states, covariances and
+    innovations of ``step`` called sample by sample, bit for bit; ``copy=False`` returns
+    read-only views of the filter's buffers, which the next step overwrites."""
+    rng = np.random.default_rng(4)
+    _, us, ys = synthetic(50, rng)
+    run = KalmanFilter(model(), Q=Q, R=R, P0=np.eye(3), steady_state=steady).run_arrays(us, ys)
+    kf = KalmanFilter(model(), Q=Q, R=R, P0=np.eye(3), steady_state=steady)
+    for k in range(50):
+        x, P = kf.step(us[k], ys[k], copy=False)
+        np.testing.assert_array_equal(x, run.x[k])
+        np.testing.assert_array_equal(P, run.P[k])
+        np.testing.assert_array_equal(kf.innovation, run.e[k])
+    assert not x.flags.writeable and not P.flags.writeable
+    kept = x.copy()
+    kf.step(us[0], ys[0], copy=False)
+    assert not np.array_equal(x, kept)  # the view follows the filter
+    with pytest.raises(ValueError, match="read-only"):
+        x[0] = 1.0
+
+
+def test_wrong_sample_lengths_are_refused():
+    kf = KalmanFilter(model(), Q=Q, R=R)
+    with pytest.raises(DataError, match="u must hold 2 value"):
+        kf.step([1.0], [0.0, 0.0])
+    with pytest.raises(DataError, match="y must hold 2 value"):
+        kf.step([1.0, 0.0], [0.0, 0.0, 1.0])
+    with pytest.raises(DataError, match=r"expected u \(N, 2\) and y \(N, 2\)"):
+        kf.run_arrays(np.zeros((5, 2)), np.zeros((4, 2)))
+
+
+def test_a_sample_given_as_a_row_or_a_list_is_the_same_sample():
+    a, b = KalmanFilter(model(), Q=Q, R=R), KalmanFilter(model(), Q=Q, R=R)
+    xa, _ = a.step(np.array([[0.5, 1.0]]), np.array([[2.5, 0.0]]))  # (1, m) and (1, p)
+    xb, _ = b.step([0.5, 1], (2.5, 0))                                # a list and ints
+    np.testing.assert_array_equal(xa, xb)
+    assert np.max(np.abs(xa)) > 0.01

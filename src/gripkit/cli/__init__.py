@@ -25,6 +25,8 @@ def _build():
     from . import compare, identify_ss, report_model  # noqa: F401
     from . import export_c  # noqa: F401
     from . import identify_narx  # noqa: F401
+    from . import identify_hw  # noqa: F401
+    from . import identify_hysteresis  # noqa: F401
     from .app import app
 
     return app

@@ -46,6 +46,8 @@ def compare(model: Path = ModelArg,
 
     if file_schema(model) == SCHEMA:
         return _compare_narx(model, data, fs, time, fill, json_out)
+    if _other_family(model):
+        return _compare_protocol(model, data, fs, time, fill, json_out)
     from ..sysid.model_file import file_sha256
 
     with warnings.catch_warnings(record=True) as caught:
@@ -62,6 +64,70 @@ def compare(model: Path = ModelArg,
     typer.echo(f"{m.structure} on {data}{' (the estimation data)' if same else ''}: {VALIDATION_FIT}")
     for n, f in zip(m.outputs, fit):
         typer.echo(f"  {n}: {f:.2f} %")
+
+
+def _other_family(model: Path) -> bool:
+    """A model file of a family other than the linear and NARX ones (which have their own
+    branches): it is compared and simulated through the model protocol alone."""
+    from ..sysid.model_protocol import MODEL_FILES, file_schema
+
+    return file_schema(model) in set(MODEL_FILES) - {"gripkit.linear-model", "gripkit.narx-model"}
+
+
+def _compare_protocol(model: Path, data: Path, fs, time, fill, json_out: bool) -> None:
+    """``gripkit compare`` of any model that :func:`~gripkit.sysid.load_model` reads other than
+    the linear and NARX ones: ``m.compare(record)``, the fit by ``m.fit_definition``."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        m, tr = _model_and_data(model, data, fs, time, fill, outputs=True)
+        fit = m.compare(tr)
+    res = {"model": str(model), "data": str(data), "structure": m.structure,
+           "outputs": list(m.outputs), "fit_percent": list(fit.fit_percent),
+           "definition": fit.definition, "warnings": report_warnings(caught)}
+    if json_out:
+        emit_json(res)
+        return
+    typer.echo(f"{m.structure} on {data}: {fit.definition}")
+    for n, f in zip(m.outputs, fit.fit_percent):
+        typer.echo(f"  {n}: " + ("diverged" if f is None else f"{f:.2f} %"))
+
+
+def _simulate_protocol(model: Path, data: Path, out: Path | None, fs, time, fill,
+                       json_out: bool) -> None:
+    """``gripkit simulate`` of any model that :func:`~gripkit.sysid.load_model` reads other than
+    the linear and NARX ones: ``m.simulate(record)``, written as CSV on stdout or to ``--out``."""
+    import sys
+
+    import numpy as np
+
+    from ..io import save
+    from ..signals.trajectory import Trajectory
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        m, tr = _model_and_data(model, data, fs, time, fill, outputs=False)
+        ys = np.asarray(m.simulate(tr), dtype=np.float64).reshape(tr.n, len(m.outputs))
+    sim = Trajectory(tr.t, {n: ys[:, i] for i, n in enumerate(m.outputs)})
+    if out is not None:
+        save(sim, out)
+
+    def stat(v, f):
+        v = v[np.isfinite(v)]
+        return float(f(v)) if v.size else None
+
+    res = {"model": str(model), "data": str(data), "samples": sim.n,
+           "out": None if out is None else str(out),
+           "outputs": {n: {"min": stat(ys[:, i], np.min), "max": stat(ys[:, i], np.max),
+                           "final": float(ys[-1, i]) if np.isfinite(ys[-1, i]) else None}
+                       for i, n in enumerate(m.outputs)},
+           "warnings": report_warnings(caught)}
+    if json_out:
+        emit_json(res)
+    elif out is None:
+        sys.stdout.write(",".join(["t [s]", *m.outputs]) + "\n")
+        np.savetxt(sys.stdout, np.column_stack([tr.t, ys]), delimiter=",", fmt="%.10g")
+    else:
+        typer.echo(f"{m.structure}: {sim.n} samples simulated, written to {out}")
 
 
 def _compare_narx(model: Path, data: Path, fs, time, fill, json_out: bool) -> None:
@@ -138,6 +204,8 @@ def simulate_model_file(model: Path, data: Path | None, out: Path | None, fs, ti
 
     if file_schema(model) == SCHEMA:
         return _simulate_narx(model, data, out, fs, time, fill, json_out)
+    if _other_family(model):
+        return _simulate_protocol(model, data, out, fs, time, fill, json_out)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         m, tr = _model_and_data(model, data, fs, time, fill, outputs=False)

@@ -19,7 +19,7 @@ def export_command(path, out, name, *, kind, rls, na, nb, nk, lam, p0, windup) -
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         if rls:
-            from ..sysid.rls import RLS
+            from ..sysid.linear.rls import RLS
             from ..export.c_rls import export_rls_c
 
             if path is not None or kind is not None:

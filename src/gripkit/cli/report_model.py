@@ -20,8 +20,17 @@ def report_model(model: Path = typer.Argument(..., help="Model file written by i
                  out: Path = typer.Option(..., "--out", help="Folder for index.html."),
                  fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, json_out: bool = JsonOpt):
     """HTML report: measured vs simulated per output, residual correlations, poles with σ, Bode with σ."""
+    from ..errors import ModelError
+    from ..sysid.model_protocol import file_schema
     from ..sysid.model_report import write_model_report
     from .compare import _model_and_data
+
+    schema = file_schema(model)
+    if schema not in (None, "gripkit.linear-model"):  # residual, pole and Bode pages are linear
+        raise ModelError(f"report: {str(model)!r} is a {schema}; gripkit report draws linear "
+                         "models",
+                         hint="use gripkit compare MODEL DATA (fit) or gripkit simulate MODEL "
+                              "--data DATA for it")
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")

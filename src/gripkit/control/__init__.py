@@ -13,7 +13,9 @@ A flat list of explicit re-exports.
 from .controller_file import load_controller as load_controller
 from .controller_file import save_controller as save_controller
 from .linear_quadratic import LQR as LQR
+
 from .linear_quadratic import lqr as lqr
+from .lqg import LQG as LQG
 from .pid import PID as PID
 from .rst import DiscretePlant as DiscretePlant
 from .rst import LoopResult as LoopResult
@@ -30,7 +32,7 @@ from .tuning import LowOrderModel as LowOrderModel
 from .tuning import reduce_model as reduce_model
 from .tuning import tune_pid as tune_pid
 
-__all__ = ["as_plant", "design_rst", "DiscretePlant", "LoopResult", "LQR", "lqr", "PID",
+__all__ = ["as_plant", "design_rst", "DiscretePlant", "LoopResult", "LQG", "LQR", "lqr", "PID",
            "RSTController", "simulate_loop",
            "StateFeedback", "lqr_controller", "LowOrderModel", "reduce_model", "tune_pid",
            "Robustness", "loop_margins", "robustness", "load_controller", "save_controller"]

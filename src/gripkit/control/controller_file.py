@@ -28,7 +28,10 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import write_text
-from ..errors import ConfigError, PathError
+from ..errors import ConfigError, GripkitError, PathError
+from .pid import PID
+from .rst import RSTController
+from .state_feedback import StateFeedback
 
 __all__ = ["FORMAT", "VERSION", "KINDS", "controller_to_dict", "controller_from_dict",
            "save_controller", "load_controller"]
@@ -67,9 +70,6 @@ _DROP = object()
 
 def controller_to_dict(controller) -> dict:
     """The controller file's content for a PID, RSTController or StateFeedback."""
-    from .pid import PID
-    from .rst import RSTController
-    from .state_feedback import StateFeedback
 
     if isinstance(controller, PID):
         tt = controller.tt
@@ -139,13 +139,10 @@ def _arr(d: dict, key: str, where: str, ndim: int, *, allow_none: bool = False):
 
 def controller_from_dict(d, where: str = "controller file"):
     """A PID, RSTController or StateFeedback from the controller file's content."""
-    from .pid import PID
-    from .rst import RSTController
-    from .state_feedback import StateFeedback
 
     if not isinstance(d, dict) or d.get("format") != FORMAT:
         raise ConfigError(f"{where}: not a controller file (expected \"format\": \"{FORMAT}\")",
-                          hint="write one with PID.save(path) or save_controller(c, path)")
+                          hint="write one with gripkit.control.save_controller(controller, path)")
     if d.get("version") != VERSION:
         raise ConfigError(f"{where}: version {d.get('version')!r} is not supported (expected "
                           f"{VERSION})", hint="upgrade gripkit")
@@ -190,8 +187,6 @@ def controller_from_dict(d, where: str = "controller file"):
     except ConfigError:
         raise
     except Exception as e:  # the classes' own checks (ModelError from RST, ...)
-        from ..errors import GripkitError
-
         if isinstance(e, GripkitError):
             raise ConfigError(f"{where}: {e.message}") from None
         raise

@@ -210,11 +210,6 @@ class PID:
         pid_run(self._p, self.state, r, y, f, u)
         return u
 
-    def save(self, path):
-        """Write the controller file (:mod:`gripkit.control.controller_file`, kind ``pid``)."""
-        from .controller_file import save_controller
-
-        return save_controller(self, path)
 
     def transfer_function(self) -> tuple[np.ndarray, np.ndarray]:
         """(num, den) of U(z)/E(z) in powers of z (linear region, b = c = 1)."""

@@ -35,14 +35,16 @@ import numpy as np
 from scipy.optimize import brentq
 
 from ..errors import ArgumentError, ModelError
+from .linear_quadratic import _discrete
+from .pid import PID
+from .rst import RSTController, as_plant
+from .state_feedback import StateFeedback
 
 __all__ = ["Robustness", "controller_transfer_function", "loop_margins", "robustness"]
 
 
 def controller_transfer_function(controller) -> tuple[np.ndarray, np.ndarray, float | None]:
     """(num, den, dt) of the controller's feedback path C(z) in descending powers of z."""
-    from .pid import PID
-    from .rst import RSTController
 
     if isinstance(controller, PID):
         num, den = controller.transfer_function()
@@ -205,13 +207,9 @@ def robustness(model, controller, n: int = 1000, seed: int | None = None, *,
     A single-input :class:`~gripkit.control.StateFeedback` (an LQR gain) is analysed on the
     model's own discrete state space, broken at the plant input: ``L(z) = K (zI − A)⁻¹ B`` and
     the closed-loop poles eig(A − B K); the samples are drawn in the same coordinates."""
-    from .state_feedback import StateFeedback
-
     if not isinstance(n, (int, np.integer)) or isinstance(n, bool) or n < 0:
         raise ArgumentError(f"n: expected a number of Monte Carlo samples >= 0, found {n!r}")
     if isinstance(controller, StateFeedback):
-        from .linear_quadratic import _discrete
-
         g = _discrete(model, controller.dt)
         if controller.n_inputs != 1 or controller.n_states != g.n_states:
             raise ArgumentError(
@@ -224,8 +222,6 @@ def robustness(model, controller, n: int = 1000, seed: int | None = None, *,
         def loop(plant):
             return _state_feedback_loop(controller, plant)
     else:
-        from .rst import as_plant
-
         g = as_plant(model)
         cnum, cden, cdt = controller_transfer_function(controller)
 

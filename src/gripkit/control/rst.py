@@ -223,11 +223,6 @@ class RSTController:
         self.design = dict(design or {})
         self.reset()
 
-    def save(self, path):
-        """Write the controller file (:mod:`gripkit.control.controller_file`, kind ``rst``)."""
-        from .controller_file import save_controller
-
-        return save_controller(self, path)
 
     def reset(self, u0: float = 0.0, y0: float = 0.0):
         """Bumpless start: histories at the steady state u = v = u0, r = y = y0."""

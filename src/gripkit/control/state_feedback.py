@@ -24,6 +24,7 @@ import numba
 import numpy as np
 
 from ..errors import ConfigError, ModelError
+from .linear_quadratic import _discrete, lqr
 
 __all__ = ["StateFeedback", "state_feedback_step", "state_feedback_run", "lqr_controller",
            "reference_gain"]
@@ -127,11 +128,6 @@ class StateFeedback:
     def reset(self) -> None:
         """No memory: nothing to forget (present for the common controller interface)."""
 
-    def save(self, path):
-        """Write the controller file (:mod:`gripkit.control.controller_file`, kind ``lqr``)."""
-        from .controller_file import save_controller
-
-        return save_controller(self, path)
 
     def _vec(self, v, size: int, name: str) -> np.ndarray:
         if type(v) is np.ndarray and v.dtype == np.float64 and v.shape == (size,) \
@@ -187,8 +183,6 @@ def lqr_controller(model, Q, R, N=None, *, dt: float | None = None, reference: b
     """The LQR gain of :func:`gripkit.control.lqr` as a :class:`StateFeedback` on ``model``'s
     discrete realisation, with the reference prefilter ``N_r`` when ``reference`` (square
     models) or the regulator u = −K x without."""
-    from .linear_quadratic import _discrete, lqr
-
     ss = _discrete(model, dt)
     K = lqr(ss, Q, R, N).K
     Nr = reference_gain(ss.A, ss.B, ss.C, ss.D, K) if reference else None

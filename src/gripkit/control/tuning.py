@@ -47,6 +47,7 @@ import numpy as np
 
 from ..errors import ArgumentError, ModelError
 from .pid import PID
+from .rst import as_plant
 
 __all__ = ["LowOrderModel", "reduce_model", "simc_settings", "tune_pid"]
 
@@ -110,8 +111,6 @@ def _cancel_lhp_zero(T0: float, taus: list, theta: float) -> tuple[float, list, 
 def reduce_model(model, order: int = 1) -> LowOrderModel:
     """First- (``order=1``) or second-order-plus-delay approximation of a discrete SISO model
     (anything :func:`gripkit.control.as_plant` reads) by the half rule (module docstring)."""
-    from .rst import as_plant
-
     if order not in (1, 2):
         raise ArgumentError(f"order: expected 1 (FOPTD) or 2 (SOPTD), found {order!r}")
     g = as_plant(model)

@@ -1,4 +1,5 @@
-"""Estimation: fusion of independent estimates, contact detection, online friction adaptation.
+"""Estimation: fusion of independent estimates, contact detection, online friction adaptation,
+Kalman filters (linear, extended, unscented).
 
 The reference systems' estimators (AMADEUS fingertip force and slip, TSFM tip position and
 micropart) live in :mod:`gripkit.systems`.
@@ -19,8 +20,11 @@ from .friction_adaptation import AdaptationSettings as AdaptationSettings
 from .friction_adaptation import FrictionAdapter as FrictionAdapter
 from .kalman import KalmanFilter as KalmanFilter
 from .kalman import KalmanRun as KalmanRun
+from .nonlinear_kalman import ExtendedKalmanFilter as ExtendedKalmanFilter
+from .nonlinear_kalman import UnscentedKalmanFilter as UnscentedKalmanFilter
 
-__all__ = ["AdaptationSettings", "ContactDetector", "FrictionAdapter", "fuse", "fuse_proportional",
+__all__ = ["AdaptationSettings", "ContactDetector", "ExtendedKalmanFilter", "FrictionAdapter",
+           "fuse", "fuse_proportional",
            "fuse_update", "fused_variance", "implied_correlation", "KalmanFilter", "KalmanRun",
            "normalised_variances",
-           "NormalisedVariances", "proportional_variance"]
+           "NormalisedVariances", "proportional_variance", "UnscentedKalmanFilter"]

@@ -19,8 +19,9 @@ gains). With ``Q`` and ``R`` not given, an innovation-form model (``K``, ``Λ`` 
 PEM identification) is its own filter: ``Q = K Λ Kᵀ``, ``R = Λ``, ``S = K Λ``, whose Riccati
 solution is ``P_p = 0`` and predictor gain ``K``: the model's own steady-state predictor.
 
-The step is a numba kernel in scalar loops that allocates nothing (the work arrays are made once,
-with the filter)."""
+The step is one call of a numba kernel (:func:`kf_step_packed`) in scalar loops that allocates
+nothing: the filter's matrices and its state and work arrays are two flat float64 buffers made
+once, with the filter. ``run`` filters a whole record in one kernel call (:func:`kf_run_packed`)."""
 
 from __future__ import annotations
 
@@ -43,29 +44,6 @@ class KalmanRun(NamedTuple):
     P: np.ndarray
     e: np.ndarray
     S: np.ndarray
-
-
-class _Noisy(NamedTuple):
-    """The model's matrices and its noise covariances, as the step kernel takes them."""
-
-    A: np.ndarray
-    B: np.ndarray
-    C: np.ndarray
-    D: np.ndarray
-    Q: np.ndarray
-    R: np.ndarray
-    S: np.ndarray
-
-
-class _Work(NamedTuple):
-    e: np.ndarray
-    PCt: np.ndarray
-    Se: np.ndarray
-    M: np.ndarray
-    Kf: np.ndarray
-    Kp: np.ndarray
-    T: np.ndarray
-    xn: np.ndarray
 
 
 @numba.njit(cache=True)
@@ -104,120 +82,275 @@ def _cholesky(S):  # pragma: no cover - compiled
     return True
 
 
-@numba.njit(cache=True)
-def _plus_product(base, X, Y, out):  # pragma: no cover - compiled
-    """``out = base + X Y`` (row by row, k ascending), without temporaries."""
-    for i in range(out.shape[0]):
-        for j in range(out.shape[1]):
-            acc = base[i, j]
-            for k in range(X.shape[1]):
-                acc += X[i, k] * Y[k, j]
-            out[i, j] = acc
+# --- packed buffers: one parameter vector and one state vector per filter, in flat row-major
+# indexing with offsets (no views: making array views inside a kernel costs more than a small
+# filter's arithmetic), so that a step is one numba call with five array arguments.
+#
+# par: A (n×n), B (n×m), C (p×n), D (p×m), Q (n×n), R (p×p), S (n×p), u0 (m), y0 (p),
+#      K_f (n×p), K_p (n×p), P_f steady (n×n), Σ steady (p×p)
+# st:  x_p (n), P_p (n×n), x_f (n), P_f (n×n), du (m), y − y0 (p), e (p), Σ (p×p),
+#      work: P_p Cᵀ (n×p), M (n×p), K_f (n×p), K_p (n×p), A P_p (n×n), x_next (n)
+
+def _par_layout(n, m, p):
+    """Offsets of the parameter vector's blocks (names as in the comment above), and its size."""
+    sizes = (("A", n * n), ("B", n * m), ("C", p * n), ("D", p * m), ("Q", n * n), ("R", p * p),
+             ("S", n * p), ("u0", m), ("y0", p), ("Kf", n * p), ("Kp", n * p), ("Pf", n * n),
+             ("Sig", p * p))
+    out, o = {}, 0
+    for name, size in sizes:
+        out[name] = o
+        o += size
+    return out, o
 
 
-@numba.njit(cache=True)
-def _innovation(C, D, xp, du, y, e):  # pragma: no cover - compiled
-    for i in range(C.shape[0]):
-        acc = y[i]
-        for j in range(C.shape[1]):
-            acc -= C[i, j] * xp[j]
-        for j in range(D.shape[1]):
-            acc -= D[i, j] * du[j]
-        e[i] = acc
+def _st_layout(n, m, p):
+    """Offsets of the state vector's blocks, and its size."""
+    sizes = (("xp", n), ("Pp", n * n), ("xf", n), ("Pf", n * n), ("du", m), ("yy", p), ("e", p),
+             ("Sig", p * p), ("PCt", n * p), ("M", n * p), ("Kf", n * p), ("Kp", n * p),
+             ("T", n * n), ("xn", n))
+    out, o = {}, 0
+    for name, size in sizes:
+        out[name] = o
+        o += size
+    return out, o
 
 
-@numba.njit(cache=True)
-def _advance(A, B, Kp, xp, du, e, xn):  # pragma: no cover - compiled
-    """x_p ← A x_p + B du + K_p e (through ``xn``)."""
-    n = A.shape[0]
-    for i in range(n):
-        acc = 0.0
+@numba.njit(cache=True, inline="always")
+def _flat_cholesky(a, o, p):  # pragma: no cover - compiled
+    """In place on the p×p block of ``a`` at ``o``: its lower triangle becomes L (Σ = L Lᵀ);
+    False if Σ is not positive definite."""
+    for j in range(p):
+        d = a[o + j * p + j]
+        for k in range(j):
+            d -= a[o + j * p + k] * a[o + j * p + k]
+        if not d > 0.0:
+            return False
+        d = np.sqrt(d)
+        a[o + j * p + j] = d
+        for i in range(j + 1, p):
+            acc = a[o + i * p + j]
+            for k in range(j):
+                acc -= a[o + i * p + k] * a[o + j * p + k]
+            a[o + i * p + j] = acc / d
+    return True
+
+
+@numba.njit(cache=True, inline="always")
+def _flat_solve_rows(a, oL, p, ob, ox, rows):  # pragma: no cover - compiled
+    """Rows of X = B Σ⁻¹ (X, B: rows×p blocks of ``a`` at ``ox``, ``ob``; Σ = L Lᵀ, L at
+    ``oL``): forward then back substitution, row by row."""
+    for r in range(rows):
+        for i in range(p):
+            acc = a[ob + r * p + i]
+            for k in range(i):
+                acc -= a[oL + i * p + k] * a[ox + r * p + k]
+            a[ox + r * p + i] = acc / a[oL + i * p + i]
+        for i in range(p - 1, -1, -1):
+            acc = a[ox + r * p + i]
+            for k in range(i + 1, p):
+                acc -= a[oL + k * p + i] * a[ox + r * p + k]
+            a[ox + r * p + i] = acc / a[oL + i * p + i]
+
+
+@numba.njit(cache=True, inline="always")
+def _par_offsets(n, m, p):  # pragma: no cover - compiled
+    """Offsets of A, B, C, D, Q, R, S, u0, y0, K_f, K_p, P_f, Σ in the parameter vector."""
+    oB = n * n
+    oC = oB + n * m
+    oD = oC + p * n
+    oQ = oD + p * m
+    oR = oQ + n * n
+    oS = oR + p * p
+    ou0 = oS + n * p
+    oy0 = ou0 + m
+    oKf = oy0 + p
+    oKp = oKf + n * p
+    oPs = oKp + n * p
+    return 0, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oPs + n * n
+
+
+@numba.njit(cache=True, inline="always")
+def _st_offsets(n, m, p):  # pragma: no cover - compiled
+    """Offsets of x_p, P_p, x_f, P_f, du, y − y0, e, Σ, P_p Cᵀ, M, K_f, K_p, T, x_next in the
+    state vector."""
+    sPp = n
+    sxf = sPp + n * n
+    sPf = sxf + n
+    sdu = sPf + n * n
+    syy = sdu + m
+    se = syy + p
+    sSe = se + p
+    sPC = sSe + p * p
+    sM = sPC + n * p
+    sKf = sM + n * p
+    sKp = sKf + n * p
+    sT = sKp + n * p
+    return 0, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sT + n * n
+
+
+@numba.njit(cache=True, inline="always")
+def _kf_innovation(n, m, p, par, st, u, y):  # pragma: no cover - compiled
+    """du = u − u0, y − y0, e = y − y0 − C x_p − D du."""
+    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = _par_offsets(n, m, p)
+    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
+    for j in range(m):
+        st[sdu + j] = u[j] - par[ou0 + j]
+    for i in range(p):
+        st[syy + i] = y[i] - par[oy0 + i]
+        acc = st[syy + i]
         for j in range(n):
-            acc += A[i, j] * xp[j]
-        for j in range(B.shape[1]):
-            acc += B[i, j] * du[j]
-        for j in range(Kp.shape[1]):
-            acc += Kp[i, j] * e[j]
-        xn[i] = acc
-    for i in range(n):
-        xp[i] = xn[i]
+            acc -= par[oC + i * n + j] * st[sxp + j]
+        for j in range(m):
+            acc -= par[oD + i * m + j] * st[sdu + j]
+        st[se + i] = acc
 
 
-@numba.njit(cache=True)
-def kf_step(m, xp, Pp, du, y, xf, Pf, w):  # pragma: no cover - compiled
-    """One time-varying Kalman step (module docstring), in place: ``xp``, ``Pp`` advance to
-    the next prediction, ``xf``, ``Pf`` receive the filtered estimate, ``w`` (:class:`_Work`)
-    the innovation ``w.e`` and its covariance ``w.Se`` (its lower triangle overwritten by the
-    Cholesky factor: the full matrix is rebuilt before return). False if Σ is not positive
-    definite (the state is then left as it was). ``m`` holds A, B, C, D, Q, R, S."""
-    A, B, C, D, Q, R, S = m.A, m.B, m.C, m.D, m.Q, m.R, m.S
-    n, p = A.shape[0], C.shape[0]
-    _innovation(C, D, xp, du, y, w.e)
+@numba.njit(cache=True, inline="always")
+def _kf_gains(n, m, p, par, st):  # pragma: no cover - compiled
+    """The time-varying gains: P_p Cᵀ, Σ = R + C P_p Cᵀ (factored), M = S + A P_p Cᵀ,
+    K_f = P_p Cᵀ Σ⁻¹, K_p = M Σ⁻¹. False if Σ is not positive definite."""
+    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = _par_offsets(n, m, p)
+    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
     for i in range(n):  # P_p Cᵀ
         for j in range(p):
             acc = 0.0
             for k in range(n):
-                acc += Pp[i, k] * C[j, k]
-            w.PCt[i, j] = acc
-    _plus_product(R, C, w.PCt, w.Se)  # Σ = C P_p Cᵀ + R
-    _plus_product(S, A, w.PCt, w.M)   # M = A P_p Cᵀ + S
-    if not _cholesky(w.Se):
-        return False
-    _chol_solve_rows(w.Se, w.PCt, w.Kf)
-    _chol_solve_rows(w.Se, w.M, w.Kp)
-    for i in range(n):  # x_f, P_f = P_p − K_f (P_p Cᵀ)ᵀ
-        acc = xp[i]
+                acc += st[sPp + i * n + k] * par[oC + j * n + k]
+            st[sPC + i * p + j] = acc
+    for i in range(p):  # Σ = R + C (P_p Cᵀ)
         for j in range(p):
-            acc += w.Kf[i, j] * w.e[j]
-        xf[i] = acc
+            acc = par[oR + i * p + j]
+            for k in range(n):
+                acc += par[oC + i * n + k] * st[sPC + k * p + j]
+            st[sSe + i * p + j] = acc
+    for i in range(n):  # M = S + A (P_p Cᵀ)
+        for j in range(p):
+            acc = par[oS + i * p + j]
+            for k in range(n):
+                acc += par[oA + i * n + k] * st[sPC + k * p + j]
+            st[sM + i * p + j] = acc
+    if not _flat_cholesky(st, sSe, p):
+        return False
+    _flat_solve_rows(st, sSe, p, sPC, sKf, n)
+    _flat_solve_rows(st, sSe, p, sM, sKp, n)
+    return True
+
+
+@numba.njit(cache=True, inline="always")
+def _kf_states(n, m, p, par, st, g, ogf, ogp):  # pragma: no cover - compiled
+    """x_f = x_p + K_f e, x_p ← A x_p + B du + K_p e (through x_next); the gains K_f, K_p are
+    the blocks of ``g`` at ``ogf``, ``ogp``."""
+    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = _par_offsets(n, m, p)
+    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
+    for i in range(n):
+        acc = st[sxp + i]
+        for j in range(p):
+            acc += g[ogf + i * p + j] * st[se + j]
+        st[sxf + i] = acc
+    for i in range(n):
+        acc = 0.0
         for j in range(n):
-            acc = Pp[i, j]
+            acc += par[oA + i * n + j] * st[sxp + j]
+        for j in range(m):
+            acc += par[oB + i * m + j] * st[sdu + j]
+        for j in range(p):
+            acc += g[ogp + i * p + j] * st[se + j]
+        st[sxn + i] = acc
+    for i in range(n):
+        st[sxp + i] = st[sxn + i]
+
+
+@numba.njit(cache=True, inline="always")
+def _kf_covariances(n, m, p, par, st):  # pragma: no cover - compiled
+    """P_f = P_p − K_f (P_p Cᵀ)ᵀ, P_p ← Q + A P_p Aᵀ − K_p Mᵀ (symmetric parts), and Σ rebuilt
+    from its Cholesky factor."""
+    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = _par_offsets(n, m, p)
+    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
+    for i in range(n):
+        for j in range(n):
+            acc = st[sPp + i * n + j]
             for k in range(p):
-                acc -= w.Kf[i, k] * w.PCt[j, k]
-            Pf[i, j] = acc
+                acc -= st[sKf + i * p + k] * st[sPC + j * p + k]
+            st[sPf + i * n + j] = acc
     for i in range(n):  # T = A P_p
         for j in range(n):
             acc = 0.0
             for k in range(n):
-                acc += A[i, k] * Pp[k, j]
-            w.T[i, j] = acc
-    for i in range(n):  # P_p ← T Aᵀ + Q − K_p Mᵀ
+                acc += par[oA + i * n + k] * st[sPp + k * n + j]
+            st[sT + i * n + j] = acc
+    for i in range(n):
         for j in range(n):
-            acc = Q[i, j]
+            acc = par[oQ + i * n + j]
             for k in range(n):
-                acc += w.T[i, k] * A[j, k]
+                acc += st[sT + i * n + k] * par[oA + j * n + k]
             for k in range(p):
-                acc -= w.Kp[i, k] * w.M[j, k]
-            Pp[i, j] = acc
-    for i in range(n):  # symmetric parts
+                acc -= st[sKp + i * p + k] * st[sM + j * p + k]
+            st[sPp + i * n + j] = acc
+    for i in range(n):
         for j in range(i + 1, n):
-            a = 0.5 * (Pp[i, j] + Pp[j, i])
-            Pp[i, j] = a
-            Pp[j, i] = a
-            b = 0.5 * (Pf[i, j] + Pf[j, i])
-            Pf[i, j] = b
-            Pf[j, i] = b
-    _advance(A, B, w.Kp, xp, du, w.e, w.xn)
-    for i in range(p):  # Σ back from its factor
+            a = 0.5 * (st[sPp + i * n + j] + st[sPp + j * n + i])
+            st[sPp + i * n + j] = a
+            st[sPp + j * n + i] = a
+            b = 0.5 * (st[sPf + i * n + j] + st[sPf + j * n + i])
+            st[sPf + i * n + j] = b
+            st[sPf + j * n + i] = b
+    for i in range(p):
         for j in range(i + 1):
             acc = 0.0
             for k in range(j + 1):
-                acc += w.Se[i, k] * w.Se[j, k]
-            w.Se[i, j] = acc
-            w.Se[j, i] = acc
-    return True
+                acc += st[sSe + i * p + k] * st[sSe + j * p + k]
+            st[sSe + i * p + j] = acc
+            st[sSe + j * p + i] = acc
 
 
 @numba.njit(cache=True)
-def kf_step_steady(A, B, C, D, Kf, Kp, xp, du, y, xf, e, xn):  # pragma: no cover - compiled
-    """One steady-state step with fixed gains: x_f = x_p + K_f e, x_p ← A x_p + B du + K_p e."""
-    _innovation(C, D, xp, du, y, e)
-    for i in range(A.shape[0]):
-        acc = xp[i]
-        for j in range(e.shape[0]):
-            acc += Kf[i, j] * e[j]
-        xf[i] = acc
-    _advance(A, B, Kp, xp, du, e, xn)
+def kf_step_packed(dims, par, st, u, y):  # pragma: no cover - compiled
+    """One Kalman step (module docstring) on the packed buffers; ``dims`` = (n, m, p, steady).
+    Returns 0 done, 1 Σ not positive definite (``x_p``, ``P_p`` unchanged), 2 ``u`` or 3 ``y``
+    of the wrong length. Every row sum runs over its index ascending, as
+    :mod:`gripkit.export.c_kalman`'s C step does."""
+    n, m, p, steady = dims[0], dims[1], dims[2], dims[3]
+    if u.shape[0] != m:
+        return 2
+    if y.shape[0] != p:
+        return 3
+    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = _par_offsets(n, m, p)
+    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
+    _kf_innovation(n, m, p, par, st, u, y)
+    if steady:  # fixed gains and covariances
+        _kf_states(n, m, p, par, st, par, oKf, oKp)
+        for i in range(n * n):
+            st[sPf + i] = par[oPs + i]
+        for i in range(p * p):
+            st[sSe + i] = par[oSs + i]
+        return 0
+    if not _kf_gains(n, m, p, par, st):
+        return 1
+    _kf_covariances(n, m, p, par, st)  # reads P_p before the states step overwrites x only
+    _kf_states(n, m, p, par, st, st, sKf, sKp)
+    return 0
+
+
+@numba.njit(cache=True)
+def kf_run_packed(dims, par, st, U, Y, xs, Ps, es, Ss):  # pragma: no cover - compiled
+    """:func:`kf_step_packed` over the rows of U (N, m), Y (N, p); the filtered states, their
+    covariances, the innovations and their covariances into xs, Ps, es, Ss. Returns
+    (code, k): the first failing sample's code and index, or (0, N)."""
+    n, m, p = dims[0], dims[1], dims[2]
+    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
+    for k in range(U.shape[0]):
+        code = kf_step_packed(dims, par, st, U[k], Y[k])
+        if code:
+            return code, k
+        for i in range(n):
+            xs[k, i] = st[sxf + i]
+            for j in range(n):
+                Ps[k, i, j] = st[sPf + i * n + j]
+        for i in range(p):
+            es[k, i] = st[se + i]
+            for j in range(p):
+                Ss[k, i, j] = st[sSe + i * p + j]
+    return 0, U.shape[0]
 
 
 class KalmanFilter:
@@ -240,6 +373,10 @@ class KalmanFilter:
     dt
         Sample time for a continuous model.
 
+    The filter's numbers live in two flat float64 buffers (parameters and state); ``x_pred``,
+    ``P_pred``, ``x``, ``P`` are views into the state buffer. :meth:`step` is one call of the
+    numba kernel :func:`kf_step_packed`, :meth:`run_arrays` one call of :func:`kf_run_packed`.
+
     Examples
     --------
     >>> from gripkit.lti import StateSpace
@@ -259,22 +396,43 @@ class KalmanFilter:
         if ss is None:
             raise ModelError("KalmanFilter: the model is continuous; give the sample time: dt=…")
         self.model, self.steady_state = model, bool(steady_state)
-        self.A, self.B, self.C, self.D = (np.ascontiguousarray(M, dtype=np.float64)
-                                          for M in (ss.A, ss.B, ss.C, ss.D))
-        n, p = self.A.shape[0], self.C.shape[0]
+        A, B, C, D = (np.ascontiguousarray(M, dtype=np.float64) for M in (ss.A, ss.B, ss.C, ss.D))
+        n, m, p = A.shape[0], B.shape[1], C.shape[0]
         self.innovation_form = Q is None and R is None
-        self.Q, self.R, self.S = self._noise(model, Q, R, S, n, p)
-        self._u0, self._y0 = np.asarray(model.u_offset), np.asarray(model.y_offset)
-        self._steady_gains(n, p)
-        self.x_pred = np.zeros(n) if x0 is None else np.array(x0, dtype=np.float64).reshape(n)
-        self.P_pred = (self.P_steady_pred.copy() if P0 is None
-                       else np.array(P0, dtype=np.float64).reshape(n, n))
-        self.x, self.P = np.zeros(n), np.zeros((n, n))
-        self._w = _Work(np.zeros(p), np.zeros((n, p)), np.zeros((p, p)), np.zeros((n, p)),
-                        np.zeros((n, p)), np.zeros((n, p)), np.zeros((n, n)), np.zeros(n))
-        self._m = _Noisy(self.A, self.B, self.C, self.D, self.Q, self.R, self.S)
-        self._du = np.zeros(self.B.shape[1])
-        self._y = np.zeros(p)
+        Q, R, S = self._noise(model, Q, R, S, n, p)
+        Kf, Kp, Pp, Pf = self._steady_gains(A, C, Q, R, S, n, p)
+        Sss = C @ Pp @ C.T + R
+        u0 = np.asarray(model.u_offset, dtype=np.float64).reshape(m)
+        y0 = np.asarray(model.y_offset, dtype=np.float64).reshape(p)
+        self._dims = np.array([n, m, p, int(self.steady_state)], dtype=np.int64)
+        lp, _ = _par_layout(n, m, p)
+        self._par = np.concatenate([M.ravel() for M in (A, B, C, D, Q, R, S, u0, y0, Kf, Kp, Pf,
+                                                        Sss)])
+        ls, size = _st_layout(n, m, p)
+        self._st = np.zeros(size)
+
+        def block(buf, lay, key, *shape):
+            return buf[lay[key]:lay[key] + int(np.prod(shape))].reshape(shape)
+
+        (self.A, self.B, self.C, self.D, self.Q, self.R, self.S, self.filter_gain,
+         self.predictor_gain, self.P_steady, self.innovation_cov_steady) = (
+            block(self._par, lp, k, *sh) for k, sh in (
+                ("A", (n, n)), ("B", (n, m)), ("C", (p, n)), ("D", (p, m)), ("Q", (n, n)),
+                ("R", (p, p)), ("S", (n, p)), ("Kf", (n, p)), ("Kp", (n, p)), ("Pf", (n, n)),
+                ("Sig", (p, p))))
+        for M in (self.A, self.B, self.C, self.D, self.Q, self.R, self.S, self.filter_gain,
+                  self.predictor_gain, self.P_steady, self.innovation_cov_steady):
+            M.flags.writeable = False
+        self.P_steady_pred = Pp
+        self._u0, self._y0 = u0, y0
+        self.x_pred, self.P_pred = block(self._st, ls, "xp", n), block(self._st, ls, "Pp", n, n)
+        self.x, self.P = block(self._st, ls, "xf", n), block(self._st, ls, "Pf", n, n)
+        self._e = block(self._st, ls, "e", p)
+        self.x_pred[:] = 0.0 if x0 is None else np.asarray(x0, dtype=np.float64).reshape(n)
+        self.P_pred[:] = Pp if P0 is None else np.asarray(P0, dtype=np.float64).reshape(n, n)
+        self._x_out, self._P_out = self.x.view(), self.P.view()
+        self._x_out.flags.writeable = False
+        self._P_out.flags.writeable = False
 
     @staticmethod
     def _noise(model, Q, R, S, n, p):
@@ -302,9 +460,8 @@ class KalmanFilter:
                              "with some noise)")
         return Q, R, S
 
-    def _steady_gains(self, n, p):
-        """P_steady (filtered), the predictor's Riccati solution and the fixed gains."""
-        A, C, Q, R, S = self.A, self.C, self.Q, self.R, self.S
+    def _steady_gains(self, A, C, Q, R, S, n, p):
+        """Fixed gains K_f, K_p, the predictor's Riccati solution and its filtered form."""
         if self.innovation_form:
             Pp = np.zeros((n, n))  # the innovation form: the model's own predictor
         else:
@@ -316,25 +473,40 @@ class KalmanFilter:
                                  hint="check that (A, C) is detectable and Q, R are covariances"
                                  ) from None
         Se = C @ Pp @ C.T + R
-        self.filter_gain = np.linalg.solve(Se, C @ Pp).T
-        self.predictor_gain = np.linalg.solve(Se, (A @ Pp @ C.T + S).T).T
-        self.P_steady_pred = Pp
-        self.P_steady = Pp - self.filter_gain @ C @ Pp
+        Kf = np.linalg.solve(Se, C @ Pp).T
+        Kp = np.linalg.solve(Se, (A @ Pp @ C.T + S).T).T
+        return Kf, Kp, Pp, Pp - Kf @ C @ Pp
 
-    def step(self, u, y):
-        """One sample (SI, the model's order, offsets not removed): ``(x[t|t], P[t|t])``
-        (copies)."""
-        np.subtract(np.asarray(u, dtype=np.float64), self._u0, out=self._du)
-        np.subtract(np.asarray(y, dtype=np.float64), self._y0, out=self._y)
-        if self.steady_state:
-            kf_step_steady(self.A, self.B, self.C, self.D, self.filter_gain, self.predictor_gain,
-                           self.x_pred, self._du, self._y, self.x, self._w.e, self._w.xn)
-            return self.x.copy(), self.P_steady.copy()
-        if not kf_step(self._m, self.x_pred, self.P_pred, self._du, self._y, self.x, self.P,
-                       self._w):
-            raise ModelError("KalmanFilter.step: the innovation covariance C P Cᵀ + R is not "
+    def _fail(self, code, what):
+        if code == 1:
+            raise ModelError(f"KalmanFilter.{what}: the innovation covariance C P Cᵀ + R is not "
                              "positive definite", hint="check R and the filter's covariance P")
-        return self.x.copy(), self.P.copy()
+        n_u, n_y = int(self._dims[1]), int(self._dims[2])
+        arg, want = ("u", n_u) if code == 2 else ("y", n_y)
+        raise DataError(f"KalmanFilter.{what}: {arg} must hold {want} value(s) per sample (the "
+                        f"model's {'inputs' if code == 2 else 'outputs'} in order)")
+
+    def step(self, u, y, *, copy: bool = True):
+        """One sample (SI, the model's order, offsets not removed): ``(x[t|t], P[t|t])``.
+
+        ``u`` (m,) and ``y`` (p,) 1-D arrays go straight to the kernel (anything else is
+        converted to float64 first). ``copy=False`` returns read-only views of the filter's own buffers
+        instead of copies: nothing is allocated, and the next step overwrites them."""
+        if type(u) is not np.ndarray or u.ndim != 1:
+            u = np.ascontiguousarray(u, dtype=np.float64).reshape(-1)
+        if type(y) is not np.ndarray or y.ndim != 1:
+            y = np.ascontiguousarray(y, dtype=np.float64).reshape(-1)
+        code = kf_step_packed(self._dims, self._par, self._st, u, y)
+        if code:
+            self._fail(code, "step")
+        if copy:
+            return self.x.copy(), self.P.copy()
+        return self._x_out, self._P_out
+
+    @property
+    def innovation(self) -> np.ndarray:
+        """The last step's innovation ``e`` (p,) (a copy)."""
+        return self._e.copy()
 
     def run(self, data) -> KalmanRun:
         """Filter a whole record: a :class:`~gripkit.signals.Trajectory` with the model's input
@@ -348,14 +520,21 @@ class KalmanFilter:
         return self.run_arrays(u, y)
 
     def run_arrays(self, u, y) -> KalmanRun:
-        """Filter inputs ``u`` (N, m) and outputs ``y`` (N, p), SI, offsets not removed."""
-        u, y = np.atleast_2d(np.asarray(u, float)), np.atleast_2d(np.asarray(y, float))
-        N, n, p = u.shape[0], self.A.shape[0], self.C.shape[0]
+        """Filter inputs ``u`` (N, m) and outputs ``y`` (N, p), SI, offsets not removed: one
+        call of the numba kernel :func:`kf_run_packed`."""
+        n, m, p = (int(v) for v in self._dims[:3])
+        u = np.ascontiguousarray(np.asarray(u, dtype=np.float64).reshape(-1, m) if m == 1 else
+                                 np.atleast_2d(np.asarray(u, dtype=np.float64)))
+        y = np.ascontiguousarray(np.asarray(y, dtype=np.float64).reshape(-1, p) if p == 1 else
+                                 np.atleast_2d(np.asarray(y, dtype=np.float64)))
+        if u.ndim != 2 or u.shape[1] != m or y.ndim != 2 or y.shape[1] != p \
+                or u.shape[0] != y.shape[0]:
+            raise DataError(f"KalmanFilter.run_arrays: expected u (N, {m}) and y (N, {p}) with "
+                            f"the same N, found {u.shape} and {y.shape}")
+        N = u.shape[0]
         xs, Ps = np.empty((N, n)), np.empty((N, n, n))
         es, Ss = np.empty((N, p)), np.empty((N, p, p))
-        for k in range(N):
-            xs[k], Ps[k] = self.step(u[k], y[k])
-            es[k] = self._w.e
-            Ss[k] = (self.C @ self.P_steady_pred @ self.C.T + self.R if self.steady_state
-                     else self._w.Se)
+        code, k = kf_run_packed(self._dims, self._par, self._st, u, y, xs, Ps, es, Ss)
+        if code:
+            self._fail(code, f"run (sample {k})")
         return KalmanRun(xs, Ps, es, Ss)

@@ -5,7 +5,8 @@ and ``<string.h>``); :func:`c_sources` returns their text; :func:`c_harness` is 
 that feeds a file of inputs through the step and prints the outputs (tests and users check the
 export with it); :func:`float32_error_bound` is the a-priori bound of the ``--float32`` variant.
 :func:`controller_c_sources` (PID, RST, LQR state feedback) and :func:`rls_c_sources` (the RLS
-update) do the same for controllers, with :func:`controller_harness` and :func:`rls_harness`.
+update) do the same for controllers, with :func:`controller_harness` and :func:`rls_harness`;
+:func:`export_kalman_c` writes the model's steady-state Kalman filter (``NAME_kf_step``).
 See docs/deploy.md."""
 
 from ..exports import lazy_exports
@@ -20,6 +21,10 @@ _LAZY = {"export_c": ("c_code", "export_c"), "c_sources": ("c_code", "c_sources"
          "export_controller_c": ("c_controllers", "export_controller_c"),
          "rls_c_sources": ("c_rls", "rls_c_sources"),
          "rls_harness": ("c_rls", "rls_harness"),
-         "export_rls_c": ("c_rls", "export_rls_c")}
+         "export_rls_c": ("c_rls", "export_rls_c"),
+         "export_kalman_c": ("c_kalman", "export_kalman_c"),
+         "kalman_c_sources": ("c_kalman", "kalman_c_sources"),
+         "kalman_c_harness": ("c_kalman", "kalman_c_harness"),
+         "kalman_filter_of": ("c_kalman", "kalman_filter_of")}
 __all__ = [*_LAZY]
 __getattr__, __dir__ = lazy_exports(__name__, _LAZY)

@@ -131,7 +131,7 @@ def _header(name: str, model, ss, float32: bool) -> str:
 
 def _source(name: str, ss, A, B, C, D, model, float32: bool) -> str:
     N = name.upper()
-    nx, nu, ny = ss.n_states, ss.n_inputs, ss.n_outputs
+    nx = ss.n_states
     t = "float" if float32 else "double"
     flush = FLUSH_FLOAT if float32 else FLUSH_DOUBLE
     fabs = "fabsf" if float32 else "fabs"

@@ -30,6 +30,10 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import write_text
+from ..control.controller_file import controller_to_dict
+from ..control.pid import PID, PIDX
+from ..control.rst import RSTController
+from ..control.state_feedback import StateFeedback
 from ..errors import ArgumentError
 from .c_code import check_c_name
 
@@ -78,8 +82,6 @@ def _clamp(var: str, lo: float, hi: float, indent: str = "    ", lo_expr=None, h
 
 # ------------------------------------------------------------------------------------ PID
 def _pid(pid, name: str) -> dict:
-    from ..control.pid import PIDX
-
     p = pid.params
     kp, ki, kd, tf = (float(p[i]) for i in (PIDX.kp, PIDX.ki, PIDX.kd, PIDX.tf))
     b, c, tt, dt = (float(p[i]) for i in (PIDX.b, PIDX.c, PIDX.tt, PIDX.dt))
@@ -204,9 +206,6 @@ def _lqr(sf, name: str) -> dict:
 
 def controller_c_sources(controller, name: str = "controller") -> dict:
     """``{"NAME.h": text, "NAME.c": text}`` of a PID, RSTController or StateFeedback."""
-    from ..control.pid import PID
-    from ..control.rst import RSTController
-    from ..control.state_feedback import StateFeedback
 
     check_c_name(name)
     if isinstance(controller, PID):
@@ -221,8 +220,6 @@ def controller_c_sources(controller, name: str = "controller") -> dict:
 
 def kind_of(controller) -> str:
     """'pid', 'rst' or 'lqr'."""
-    from ..control.controller_file import controller_to_dict
-
     return controller_to_dict(controller)["kind"]
 
 

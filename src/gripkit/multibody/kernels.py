@@ -69,8 +69,8 @@ LinkArrays = namedtuple("LinkArrays", "jtype mass com inertia arm_q")
 DynamicsWork = namedtuple("DynamicsWork", "R P work q qd qdd zq Mq tau Mp hp L rhs a")
 
 #: decorator of the allocation-free scalar kernels: compiled without numba's reference-counting
-#: runtime (NRT), so passing arrays between them costs nothing. Measured on the finger step
-#: (45 array arguments): 1.1 µs with NRT, 0.45 µs without. Such kernels may not allocate.
+#: runtime (NRT), so passing arrays between them costs nothing (the finger step's figures:
+#: docs/performance.md). Such kernels may not allocate.
 hot = numba.njit(cache=True, error_model="numpy", _nrt=False)
 #: the same for a small piece of such a kernel, inlined into its caller at numba IR level (where a
 #: compiled call measured slower: docs/performance.md, "Named records in kernels")

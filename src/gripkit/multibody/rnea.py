@@ -36,8 +36,8 @@ __all__ = ["rnea", "mass_matrix", "coriolis", "gravity", "bias", "forward_dynami
 
 _CHUNK = 128
 #: batches at least this large run in parallel (prange) unless told otherwise; smaller ones on one
-#: thread (0.1–0.5 µs per state), so that a script that evaluates a few thousand states never
-#: pays the parallel kernel's compile time (~10 s)
+#: thread, so that a script that evaluates a few thousand states never pays the parallel
+#: kernel's compile time (docs/performance.md)
 PARALLEL_MIN = 100_000
 
 OP_RNEA, OP_MASS_BIAS, OP_BIAS, OP_FD, OP_POTENTIAL, OP_FRAMES, OP_JACOBIAN = range(7)

@@ -148,10 +148,10 @@ def pwa_step(x, mode, u, Phi, Gam, G, H, target, n_guards, K, work):  # pragma: 
     MAX_EVENTS_PER_STEP; ``work`` as :data:`EventWork`). See the module docstring for the dyadic
     event location.
 
-    Speed (measured): the function is inlined into its callers and indexes the matrix stacks in
-    place — a call or a slice per step costs reference counting, ~50 ns; the common sizes (4 or 6
-    states with 2 inputs + 1) have their matrix-vector product written with constant trip counts,
-    which LLVM unrolls (2× faster than runtime-sized loops)."""
+    Speed: the function is inlined into its callers and indexes the matrix stacks in place (a
+    call or a slice per step costs reference counting); the common sizes (4 or 6 states with 2
+    inputs + 1) have their matrix-vector product written with constant trip counts, which LLVM
+    unrolls (the measurements: docs/performance.md)."""
     xt, ev_frac, ev_to = work.xt, work.ev_frac, work.ev_to
     n = x.shape[0]
     m = u.shape[0]

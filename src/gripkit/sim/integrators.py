@@ -157,8 +157,7 @@ def expm_small(M, out):  # pragma: no cover - compiled
     """e^M for a small square matrix: diagonal balancing (:func:`_balance`), then scaling and
     squaring around a degree-16 Taylor polynomial (‖M/2^s‖₁ ≤ 1/2, truncation < 0.5^17/17! ≈
     2e-20 relative). No BLAS: scipy's expm calls BLAS for every product, which on small matrices
-    costs more than the arithmetic (measured 3-8 ms per 9×9 matrix with threaded OpenBLAS on a
-    busy machine, against ~20 µs here); agrees with scipy to ~1e-14 (tested)."""
+    costs more than the arithmetic (docs/performance.md); agrees with scipy to ~1e-14 (tested)."""
     n = M.shape[0]
     Mb = M.copy()
     d = np.empty(n)

@@ -71,6 +71,14 @@ _LAZY = {
     "narx": ("nonlinear.narx", "narx"),
     "NARXModel": ("nonlinear.narx", "NARXModel"),
     "load_narx": ("nonlinear.narx", "load_narx"),
+    "hammerstein_wiener": ("nonlinear.hammerstein_wiener", "hammerstein_wiener"),
+    "HWModel": ("nonlinear.hammerstein_wiener", "HWModel"),
+    "load_hw": ("nonlinear.hammerstein_wiener", "load_hw"),
+    "hysteresis": ("nonlinear.hysteresis", "hysteresis"),
+    "BoucWenModel": ("nonlinear.hysteresis", "BoucWenModel"),
+    "BoucWenOscillatorModel": ("nonlinear.hysteresis", "BoucWenOscillatorModel"),
+    "PrandtlIshlinskiiModel": ("nonlinear.hysteresis", "PrandtlIshlinskiiModel"),
+    "load_hysteresis": ("nonlinear.hysteresis", "load_hysteresis"),
 }
 __getattr__, __dir__ = lazy_exports(__name__, _LAZY)
 __all__ = [*_LAZY]
@@ -122,6 +130,14 @@ if TYPE_CHECKING:  # static readers see the same names, imported eagerly
     from .rigid_body.dynamics import load_dynamics_model as load_dynamics_model
     from .rigid_body.fourier_trajectory import FourierTrajectory as FourierTrajectory
     from .rigid_body.fourier_trajectory import fourier_trajectory as fourier_trajectory
+    from .nonlinear.hammerstein_wiener import HWModel as HWModel
+    from .nonlinear.hammerstein_wiener import hammerstein_wiener as hammerstein_wiener
+    from .nonlinear.hammerstein_wiener import load_hw as load_hw
     from .nonlinear.narx import NARXModel as NARXModel
     from .nonlinear.narx import load_narx as load_narx
     from .nonlinear.narx import narx as narx
+    from .nonlinear.hysteresis import BoucWenModel as BoucWenModel
+    from .nonlinear.hysteresis import BoucWenOscillatorModel as BoucWenOscillatorModel
+    from .nonlinear.hysteresis import PrandtlIshlinskiiModel as PrandtlIshlinskiiModel
+    from .nonlinear.hysteresis import hysteresis as hysteresis
+    from .nonlinear.hysteresis import load_hysteresis as load_hysteresis

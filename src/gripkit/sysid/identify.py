@@ -44,7 +44,7 @@ from .linear.search import structure_search
 __all__ = ["IOData", "io_data", "identify", "identify_records", "method_options", "METHODS",
            "with_provenance"]
 
-METHODS = ("arx", "armax", "oe", "rls", "search", "ss", "frf", "tf", "narx")
+METHODS = ("arx", "armax", "oe", "rls", "search", "ss", "frf", "tf", "narx", "hw", "hysteresis")
 
 
 def _polynomial_fit(method: str, io: IOData, orders: tuple, options: dict):
@@ -103,6 +103,10 @@ def _method_function(method: str):
         return rls
     if method == "narx":  # numba: nonlinear.narx loads its module on first use
         return nonlinear.narx
+    if method == "hw":
+        return nonlinear.hammerstein_wiener
+    if method == "hysteresis":
+        return nonlinear.hysteresis
     return {"arx": arx, "armax": armax, "oe": oe, "ss": identify_mimo.identify_ss, "frf": frf,
             "tf": identify_mimo.identify_tf}.get(method, structure_search)
 
@@ -143,7 +147,12 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
         response, options of :func:`gripkit.sysid.linear.frf`), ``'tf'`` (continuous-time transfer
         function, options ``poles``, ``zeros``); ``'narx'`` (polynomial NARX on the data as they
         are, its constant term in place of detrending; options of
-        :func:`gripkit.sysid.narx`: ``degree``, ``lags``, ``terms``, ``validate`` …). For ss,
+        :func:`gripkit.sysid.narx`: ``degree``, ``lags``, ``terms``, ``validate`` …); ``'hw'``
+        (Hammerstein–Wiener on the data as they are, with this function's ``nb``, ``nk`` and
+        ``nf`` (default ``nb``); the array function searches the orders; options of
+        :func:`gripkit.sysid.hammerstein_wiener`: ``input_nonlinearity``,
+        ``output_nonlinearity``, ``validate`` …); ``'hysteresis'`` (Bouc-Wen or Prandtl–Ishlinskii, options of
+        :func:`gripkit.sysid.hysteresis`: ``model``, ``exponent``, ``operators`` …). For ss,
         frf and tf ``input``/``output`` may name several columns (``'a,b'`` or a list).
     input, output
         Column names.
@@ -156,11 +165,12 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
 
     Returns
     -------
-    PolynomialModel, LinearModel, RLSResult, SearchResult, FRF or NARXModel. A model records
-    where its data came from (:func:`~gripkit.sysid.io_data.records_provenance`): the file's
-    name and SHA-256 that :func:`gripkit.io.load` put in the trajectory's meta (``data_file``,
-    ``data_hash`` of a LinearModel; ``info['data_file']``, ``info['data_hash']`` of a
-    PolynomialModel); of several records the names joined, no hash.
+    PolynomialModel, LinearModel, RLSResult, SearchResult, FRF, NARXModel, HWModel,
+    BoucWenModel or PrandtlIshlinskiiModel. A model records where its data came from
+    (:func:`~gripkit.sysid.io_data.records_provenance`): the file's name and SHA-256 that
+    :func:`gripkit.io.load` put in the trajectory's meta (``data_file``, ``data_hash`` of a
+    LinearModel; ``info['data_file']``, ``info['data_hash']`` of a PolynomialModel); of several
+    records the names joined, no hash.
     """
     if not isinstance(method, str) or method not in METHODS:
         raise DataError(f"method: expected one of {', '.join(METHODS)}, found {method!r}")
@@ -218,6 +228,15 @@ def _dispatch(data, method: str, *, input, output, na: int, nb: int, nk: int, nc
         model = nonlinear.narx(io.u1, io.y1, dt=io.dt, **options)
         model.input_name, model.output_name = input, output
         return model
+    if method == "hw":  # the offset y0 carries the operating point; orders as given here
+        io = io_data(data, input=input, output=output, detrend="none",
+                     why="Hammerstein-Wiener identification")
+        model = nonlinear.hammerstein_wiener(io.u1, io.y1, nb=nb, nf=nb if nf is None else nf,
+                                             nk=nk, dt=io.dt, **options)
+        model.input_name, model.output_name = input, output
+        return model
+    if method == "hysteresis":  # rate independent, its offset a parameter: the data as they are
+        return nonlinear.hysteresis(data, input=input, output=output, **options)
     io = io_data(data, input=input, output=output, detrend=detrend, why=f"{method.upper()} identification")
     if method in ("arx", "armax", "oe"):
         orders = (na, nb, nc, na if nf is None else nf, nk)

@@ -67,6 +67,8 @@ class IdentifiedModel(Protocol):
 MODEL_FILES: dict[str, tuple[str, str]] = {
     "gripkit.linear-model": ("linear.linear_model", "load_linear_model"),
     "gripkit.narx-model": ("nonlinear.narx", "load_narx"),
+    "gripkit.hw-model": ("nonlinear.hammerstein_wiener", "load_hw"),
+    "gripkit.hysteresis-model": ("nonlinear.hysteresis", "load_hysteresis"),
 }
 
 

@@ -311,10 +311,11 @@ def singular_value_figure(sv, order):
 
 
 def model_report(model, data, *, data_name: str = "data", warnings_list=(),
-                 robustness=None) -> Report:
+                 sections=()) -> Report:
     """Build the :class:`~gripkit.report.html.Report` of ``model`` on the trajectory ``data``;
-    ``robustness``: a :func:`gripkit.control.robustness` result (or ``(result, controller
-    label)``) adds the section "Robustness of the loop"."""
+    ``sections``: callables ``f(report)`` that add sections after the frequency response (e.g.
+    ``lambda rep: gripkit.control.robustness_section(rep, result)``, the robustness of a loop
+    closed around the model)."""
     ss = model.system.to_ss(minimal=False)
     dt = data.require_uniform(why="a model report")
     caught_lines = list(warnings_list)
@@ -365,12 +366,8 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=(),
                     "parameter covariance) and the data's Welch H1 estimate with ±2σ where the "
                     "data allow." + shown).figure(bode_figure(model.system, dt, est, keep), "Bode",
                                                   name="bode")
-        if robustness is not None:
-            from ..control.robustness import robustness_section
-
-            res_, label = robustness if isinstance(robustness, tuple) else (robustness,
-                                                                            "The controller")
-            robustness_section(rep, res_, controller=label)
+        for add_section in sections:
+            add_section(rep)
         if model.singular_values is not None:
             rep.section("Subspace singular values", "Singular values of the weighted subspace matrix; the order is "
                         "where they drop.").figure(singular_value_figure(np.asarray(model.singular_values), ss.n_states),
@@ -389,7 +386,7 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=(),
 
 
 def write_model_report(model, data, out_dir, *, data_name: str = "data", warnings_list=(),
-                       robustness=None) -> Path:
+                       sections=()) -> Path:
     """Write ``out_dir/index.html`` (self-contained: figures inline); returns its path."""
     return model_report(model, data, data_name=data_name, warnings_list=warnings_list,
-                        robustness=robustness).write(Path(out_dir))
+                        sections=sections).write(Path(out_dir))

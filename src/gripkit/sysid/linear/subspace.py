@@ -372,7 +372,11 @@ def _unstable_fit(fac: SubspaceFactor, A, C, feedthrough: bool) -> list[float]:
     """Free-run fit (% per output) of the unstable shift-invariance estimate, for the warning of
     :func:`warn_if_stabilised` (−inf where its free run overflows)."""
     n, m = A.shape[0], fac.m
-    theta = _bdx_least_squares(A, C, fac.us, fac.ys, feedthrough)
+    try:
+        with np.errstate(over="ignore", invalid="ignore"):
+            theta = _bdx_least_squares(A, C, fac.us, fac.ys, feedthrough)
+    except (np.linalg.LinAlgError, ValueError):  # the unstable regressor overflowed first
+        return [-math.inf] * fac.p
     D = theta[n * m:n * m + fac.p * m].reshape(fac.p, m) if feedthrough else np.zeros((fac.p, m))
     with np.errstate(over="ignore", invalid="ignore"):
         yhat = free_run(A, theta[:n * m].reshape(n, m), C, D, fac.us, theta[-n:]) * fac.sy

@@ -15,7 +15,7 @@ code as the single grasp (:func:`~gripkit.systems.tsfm.grasp.grasp_step` and
 Per-job setup. Only the contact mode of each finger depends on the part (k_side = 2 k_e,
 c_side = 2 c_e per side, pull-off F_po/k_side, see :class:`~gripkit.systems.tsfm.gripper.TSFMGripper`):
 its ZOH matrices (13 dyadic levels) are recomputed per job in numba (:func:`_job_setup`: two
-9×9 matrix exponentials per finger, ≈ 40 µs: 2 % of a 0.1 s grasp, measured); the free mode, the estimators and
+9×9 matrix exponentials per finger, a small part of a grasp's cost: docs/performance.md); the free mode, the estimators and
 the fingers' hysteresis come from one template per gripper. The contact mode is built exactly as
 :func:`~gripkit.systems.tsfm.gripper.finger_hybrid` builds it (A + b_F kᵀ, [B_W, −k b_F]), so a job
 reproduces the single-grasp simulation bit for bit (tested).

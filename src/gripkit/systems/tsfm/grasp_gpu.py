@@ -7,7 +7,7 @@ detector and estimator steps), so there is one source for both targets. The core
 nothing: every work array (controller, detector, estimator and finger states, the part's contact-
 mode matrices) is a slice, per thread, of arrays allocated on the device before the launch. The
 per-job contact-mode ZOH matrices (matrix exponentials, which allocate) are computed on the CPU
-by the numba kernel :func:`~gripkit.systems.tsfm.grasp_kernels._setup_jobs` (≈ 40 µs per job and core) and
+by the numba kernel :func:`~gripkit.systems.tsfm.grasp_kernels._setup_jobs` and
 copied to the device with the jobs, in launches of at most ``batch`` jobs.
 
 Use: ``tsfm_grasp_batch(..., backend="cuda")`` or ``backend = "cuda"`` in a sweep's

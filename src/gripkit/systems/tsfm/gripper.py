@@ -511,7 +511,7 @@ def _hybrid_arrays(rows, dt, levels, realisation="component"):
 @numba.njit(cache=True)
 def _bw_pwa_row(bw, Phi, Gam, C, D, guards, K, xw, u, x0, y):  # pragma: no cover - compiled
     """One parameter row of :func:`_bw_pwa_batch` (a plain function: the prange body of a
-    parallel kernel optimises worse, measured 35 ns/sample slower); ``guards``:
+    parallel kernel optimises worse, docs/performance.md); ``guards``:
     :data:`~gripkit.sim.hybrid.PWAGuards`."""
     G, Hg, target, ng = guards
     N = u.shape[0]

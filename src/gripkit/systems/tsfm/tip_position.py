@@ -8,7 +8,7 @@ the integrated sensor measures, is the estimator. :class:`TipPositionEstimator` 
 at a time — exact Bouc-Wen update, then the minimal 4-state realisation of eq 11
 (:func:`gripkit.systems.tsfm.gripper.finger_minimal_state_space`) discretised exactly (ZOH) at the loop's
 sample time — in a numba step (:func:`estimator_step`) that a control loop can call at 20 kHz
-(≈ 1 µs per call from Python, ≈ 20 ns inside a numba loop).
+(its cost per call, from Python and inside a numba loop: docs/performance.md).
 
 Timing convention (the same as the simulators'): ``update(U, F)`` returns the estimate at the
 current sample, computed from the inputs up to the previous one, then takes the voltage U applied

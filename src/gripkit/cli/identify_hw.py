@@ -1,0 +1,86 @@
+"""``gripkit identify hw DATA --input U --output Y [--input-nonlinearity KIND[:N]]
+[--output-nonlinearity KIND[:N]] [--nb NB --nf NF --nk NK] [--validate DATA2] [--out MODEL.json]
+[--json]``: Hammerstein, Wiener and Hammerstein–Wiener models
+(:func:`gripkit.sysid.hammerstein_wiener`)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+from .app import identify_app
+from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, collected_warnings,
+                     emit_json, load_data, report_warnings)
+
+
+def _summary(m) -> str:
+    fmt = lambda v: "diverged" if v is None else f"{v:.2f} %"  # noqa: E731
+    lines = [f"{m.kind} model: input {m.input_nl.label}, output {m.output_nl.label}, "
+             f"[nb nf nk] = [{m.nb} {m.nf} {m.nk}] ({m.criterion})"]
+    lines += [f"  {n:<10s} {v: .6g} ± {s:.3g}" for n, v, s in zip(m.names, m.theta, m.theta_std)]
+    lines.append(f"free-run fit (estimation): {fmt(m.fit_percent)}")
+    if m.validation_fit_percent is not None or "validation" in m.criterion:
+        lines.append(f"free-run fit (validation): {fmt(m.validation_fit_percent)}")
+    return "\n".join(lines)
+
+
+@identify_app.command("hw")
+def identify_hw(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 file, the record."),
+                input_col: str = typer.Option(..., "--input", help="Input column."),
+                output_col: str = typer.Option(..., "--output", help="Output column."),
+                input_nl: Optional[str] = typer.Option(
+                    None, "--input-nonlinearity",
+                    help="pwl, deadzone, saturation, poly, sigmoid or none, with :N for pwl, "
+                         "poly, sigmoid (default: chosen with the output one)."),
+                output_nl: Optional[str] = typer.Option(
+                    None, "--output-nonlinearity", help="As --input-nonlinearity, after B/F."),
+                nb: Optional[int] = typer.Option(None, "--nb", help="B coefficients (searched)."),
+                nf: Optional[int] = typer.Option(None, "--nf", help="F coefficients (searched)."),
+                nk: Optional[int] = typer.Option(None, "--nk", help="Input delay (searched)."),
+                validate: Optional[Path] = typer.Option(None, "--validate",
+                                                        help="Validation record (same columns)."),
+                out: Optional[Path] = typer.Option(None, "--out", help="Write the model (JSON)."),
+                fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
+                json_out: bool = JsonOpt):
+    """Hammerstein / Wiener / Hammerstein–Wiener: static nonlinearities around B/F, PEM, σ."""
+    import numpy as np
+
+    from ..sysid.nonlinear.hammerstein_wiener import hammerstein_wiener, parse_nonlinearity
+
+    for spec, name in ((input_nl, "--input-nonlinearity"), (output_nl, "--output-nonlinearity")):
+        if spec is not None:
+            parse_nonlinearity(spec, name)
+    check_data_options(fs, fill)
+    with collected_warnings() as caught:
+        tr = load_data(data, [input_col, output_col], fs, time, fill)
+        val = None
+        if validate is not None:
+            tv = load_data(validate, [input_col, output_col], fs, time, fill)
+            val = (np.asarray(tv[input_col]), np.asarray(tv[output_col]))
+        m = hammerstein_wiener(np.asarray(tr[input_col]), np.asarray(tr[output_col]),
+                               input_nonlinearity=input_nl, output_nonlinearity=output_nl,
+                               nb=nb, nf=nf, nk=nk, dt=tr.dt, validate=val, progress=True)
+        m.input_name, m.output_name = input_col, output_col
+        if out is not None:
+            m.save(out)
+    lines = report_warnings(caught)
+    if json_out:
+        emit_json({"data": str(data), "input": input_col, "output": output_col,
+                   "structure": {"kind": m.kind, "input_nonlinearity": m.input_nl.label,
+                                 "output_nonlinearity": m.output_nl.label, "nb": m.nb,
+                                 "nf": m.nf, "nk": m.nk, "criterion": m.criterion,
+                                 "gain_normalisation": "unit slope of every nonlinearity in its "
+                                                       "linear part; the gain is in B"},
+                   "parameters": [{"name": n, "value": float(v), "std": float(s)}
+                                  for n, v, s in zip(m.names, m.theta, m.theta_std)],
+                   "poles": [[float(z.real), float(z.imag)] for z in m.poles],
+                   "fit_percent": m.fit_percent, "fit_definition": m.fit_definition,
+                   "validation": None if validate is None else
+                   {"data": str(validate), "fit_percent": m.validation_fit_percent,
+                    "definition": m.fit_definition},
+                   "candidates": m.candidates,
+                   "model": None if out is None else str(out), "warnings": lines})
+    else:
+        typer.echo(_summary(m))

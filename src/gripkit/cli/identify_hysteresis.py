@@ -1,0 +1,99 @@
+"""``gripkit identify hysteresis DATA --input U --output Y [--model bouc-wen|prandtl-ishlinskii]
+[--form actuator|oscillator] [--exponent N|free] [--operators M] [--validate DATA2]
+[--out MODEL.json] [--json]``: a generic Bouc-Wen (actuator or oscillator form) or
+Prandtl–Ishlinskii hysteresis from a record (:func:`gripkit.sysid.hysteresis`)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+from .app import identify_app
+from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_choice, check_data_options,
+                     collected_warnings, emit_json, load_data, report_warnings)
+
+
+def _exponent(value: str):
+    """``free`` or a number in [1, 10]."""
+    from ..errors import DataError
+
+    if value == "free":
+        return "free"
+    try:
+        n = float(value)
+    except ValueError:
+        n = float("nan")
+    if not 1.0 <= n <= 10.0:
+        raise DataError(f"--exponent: expected 'free' or a number in [1, 10], found {value!r}",
+                        hint="--exponent 1 is the seed's Bouc-Wen (eq 3); free estimates it")
+    return n
+
+
+@identify_app.command("hysteresis")
+def identify_hysteresis(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 file, the "
+                                                              "record."),
+                        input_col: str = typer.Option(..., "--input", help="Input column "
+                                                                           "(voltage, force)."),
+                        output_col: str = typer.Option(..., "--output",
+                                                       help="Output column (displacement)."),
+                        model: str = typer.Option("bouc-wen", "--model",
+                                                  help="bouc-wen or prandtl-ishlinskii."),
+                        form: str = typer.Option("actuator", "--form",
+                                                 help="Bouc-Wen form: actuator (y = d u − h) "
+                                                      "or oscillator (force on a mass)."),
+                        exponent: str = typer.Option("1", "--exponent",
+                                                     help="Bouc-Wen exponent n (1 = eq 3 of the "
+                                                          "seed), or free."),
+                        operators: int = typer.Option(10, "--operators",
+                                                      help="Prandtl-Ishlinskii: number of plays."),
+                        burn_in: int = typer.Option(0, "--burn-in",
+                                                    help="Samples simulated but not scored."),
+                        validate: Optional[Path] = typer.Option(None, "--validate",
+                                                                help="Validation record (same "
+                                                                     "columns)."),
+                        out: Optional[Path] = typer.Option(None, "--out",
+                                                           help="Write the model (JSON)."),
+                        fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
+                        json_out: bool = JsonOpt):
+    """Hysteresis (Bouc-Wen or Prandtl-Ishlinskii): parameters with σ, free-run fit."""
+    from ..sysid.nonlinear.hysteresis import FORMS, MODELS, hysteresis
+
+    check_choice(model, "--model", MODELS)
+    check_choice(form, "--form", FORMS)
+    n = _exponent(exponent)
+    check_data_options(fs, fill)
+    with collected_warnings() as caught:
+        tr = load_data(data, [input_col, output_col], fs, time, fill)
+        val = None
+        if validate is not None:
+            val = load_data(validate, [input_col, output_col], fs, time, fill)
+        m = hysteresis(tr, model, input=input_col, output=output_col, form=form, exponent=n,
+                       operators=operators, burn_in=burn_in, validate=val,
+                       progress=not json_out)
+        if out is not None:
+            m.save(out)
+    lines = report_warnings(caught)
+    if json_out:
+        structure = ({"model": model, "form": form, "exponent": m.n,
+                      "exponent_estimated": "n" in m.free}
+                     if model == "bouc-wen" else
+                     {"model": m.structure, "operators": len(m.thresholds),
+                      "thresholds": [float(r) for r in m.thresholds]})
+        structure["criterion"] = m.criterion
+        emit_json({"data": str(data), "input": input_col, "output": output_col,
+                   "structure": structure,
+                   "parameters": [{"name": p.name, "value": p.value, "std": p.std,
+                                   "unit": p.unit, "fixed": p.fixed}
+                                  for p in m.parameters.values()],
+                   "fit_percent": m.fit_percent, "definition": m.fit_definition,
+                   "validation": None if validate is None else
+                   {"data": str(validate), "fit_percent": m.validation_fit_percent},
+                   "model": None if out is None else str(out), "warnings": lines})
+    else:
+        typer.echo(m.summary())
+        fmt = lambda v: "diverged" if v is None else f"{v:.2f} %"  # noqa: E731
+        typer.echo(f"free-run fit (estimation): {fmt(m.fit_percent)}")
+        if validate is not None:
+            typer.echo(f"free-run fit (validation): {fmt(m.validation_fit_percent)}")

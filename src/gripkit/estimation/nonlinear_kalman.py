@@ -1,0 +1,834 @@
+"""Extended and unscented Kalman filters for grey-box and nonlinear models (issue 27).
+
+The model, with ``x`` (n,), ``u`` (m,), ``y`` (p,) in SI::
+
+    x[t+1] = f(x[t], u[t]) + w[t],   y[t] = h(x[t], u[t]) + v[t],   w ~ N(0, Q),  v ~ N(0, R)
+
+``f(x, u) -> (n,)`` and ``h(x, u) -> (p,)`` are Python callables or ``numba.njit`` functions.
+As :class:`~gripkit.estimation.KalmanFilter`, each filter carries the one-step prediction
+``x[t|t−1]``, ``P[t|t−1]`` (``x0``, ``P0`` at the start), and ``step(u, y)`` returns the
+filtered ``x[t|t]``, ``P[t|t]`` and then predicts the next sample.
+
+Extended (Jazwinski 1970; Simon, *Optimal State Estimation*, §13.2), with ``H = ∂h/∂x`` at
+``x_p`` and ``F = ∂f/∂x`` at ``x_f``::
+
+    e = y − h(x_p, u),   Σ = H P_p Hᵀ + R,   K = P_p Hᵀ Σ⁻¹,
+    x_f = x_p + K e,     P_f = P_p − K (P_p Hᵀ)ᵀ,
+    x_p ← f(x_f, u),     P_p ← F P_f Fᵀ + Q
+
+The Jacobians are the functions ``F(x, u) -> (n, n)``, ``H(x, u) -> (p, n)`` when given, else
+central differences (step ``ε^(1/3) max(1, |x_j|)``) or, with ``jacobian="complex"``, the complex
+step ``Im f(x + i δ e_j) / δ`` (δ = 1e-30; exact to rounding, for an ``f`` that accepts complex
+states).
+
+Unscented (Julier & Uhlmann 2004; the scaled sigma points of Wan & van der Merwe 2000), for
+``(x, P)`` with ``P = L Lᵀ`` (Cholesky), ``c = α² (n + κ)``, ``λ = c − n``::
+
+    X_0 = x,  X_j = x + √c L[:, j],  X_{n+j} = x − √c L[:, j]                (j = 1 … n)
+    W^m_0 = λ/c,  W^c_0 = λ/c + 1 − α² + β,  W^m_j = W^c_j = 1/(2c)
+
+update from the sigma points of ``(x_p, P_p)`` through ``h``, ``ŷ = Σ W^m_i h(X_i)``,
+``Σ = Σ W^c_i (h(X_i) − ŷ)(·)ᵀ + R``, ``P_xy = Σ W^c_i (X_i − x_p)(h(X_i) − ŷ)ᵀ``,
+``K = P_xy Σ⁻¹``, ``x_f = x_p + K (y − ŷ)``, ``P_f = P_p − K Σ Kᵀ``; prediction from the sigma
+points of ``(x_f, P_f)`` through ``f``: ``x_p = Σ W^m_i f(X_i)``,
+``P_p = Σ W^c_i (f(X_i) − x_p)(·)ᵀ + Q``. Defaults α = 1, β = 2, κ = 0 (all weights but
+``W^c_0`` positive). On a linear model both filters are the Kalman filter.
+
+The filters' own arithmetic is numba kernels in scalar loops on work arrays made once with the
+filter. When ``f`` and ``h`` (and ``F``, ``H`` if given) are ``numba.njit`` functions, ``step``
+and ``run`` call them from inside one kernel (``run``: the whole record in one call); Python
+callables are called from Python between the kernels. What ``f`` and ``h`` allocate (their
+returned arrays) is theirs.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numba
+import numpy as np
+
+from ..errors import ArgumentError, DataError, ModelError
+from .kalman import KalmanFilter, KalmanRun, _cholesky, _chol_solve_rows
+
+__all__ = ["ExtendedKalmanFilter", "UnscentedKalmanFilter"]
+
+_EPS3 = np.finfo(float).eps ** (1.0 / 3.0)
+
+
+def _is_jit(fn) -> bool:
+    return isinstance(fn, numba.core.registry.CPUDispatcher)
+
+
+# ---------------------------------------------------------------- records
+
+
+class FilterState(NamedTuple):
+    """A filter's state and last results: prediction ``xp`` (n,), ``Pp`` (n, n); filtered
+    ``xf``, ``Pf``; innovation ``e`` (p,) and its covariance ``Se`` (p, p)."""
+
+    xp: np.ndarray
+    Pp: np.ndarray
+    xf: np.ndarray
+    Pf: np.ndarray
+    e: np.ndarray
+    Se: np.ndarray
+
+
+class Noise(NamedTuple):
+    """Process (n, n) and measurement (p, p) noise covariances."""
+
+    Q: np.ndarray
+    R: np.ndarray
+
+
+class EKFWork(NamedTuple):
+    """EKF work arrays: P Hᵀ and the gain (n, p), the Jacobians F (n, n) and H (p, n), F P (n,
+    n), a perturbed state (n,)."""
+
+    PHt: np.ndarray
+    K: np.ndarray
+    F: np.ndarray
+    H: np.ndarray
+    T: np.ndarray
+    xt: np.ndarray
+
+
+class UKFWork(NamedTuple):
+    """UKF weights (2n+1,) and work arrays: P_xy, K (n, p), ŷ (p,), the Cholesky factor (n, n),
+    the sigma points (2n+1, n) and their images through h (2n+1, p) and f (2n+1, n)."""
+
+    Wm: np.ndarray
+    Wc: np.ndarray
+    Pxy: np.ndarray
+    K: np.ndarray
+    yhat: np.ndarray
+    L: np.ndarray
+    X: np.ndarray
+    Yp: np.ndarray
+    Xn: np.ndarray
+
+
+# ---------------------------------------------------------------- shared kernels
+
+
+@numba.njit(cache=True)
+def _gain_update(s, yhat, Pxy, K, y):  # pragma: no cover - compiled
+    """``e = y − ŷ``; ``K = P_xy Σ⁻¹`` (``s.Se`` = Σ factored in place, rebuilt before return);
+    ``x_f = x_p + K e``; ``P_f = P_p − K P_xyᵀ`` (= P_p − K Σ Kᵀ; P_xy = P_p Hᵀ for the EKF).
+    False if Σ is not positive definite."""
+    n, p = s.xp.shape[0], y.shape[0]
+    for i in range(p):
+        s.e[i] = y[i] - yhat[i]
+    if not _cholesky(s.Se):
+        return False
+    _chol_solve_rows(s.Se, Pxy, K)
+    for i in range(n):
+        acc = s.xp[i]
+        for j in range(p):
+            acc += K[i, j] * s.e[j]
+        s.xf[i] = acc
+        for j in range(n):
+            acc = s.Pp[i, j]
+            for k in range(p):
+                acc -= K[i, k] * Pxy[j, k]
+            s.Pf[i, j] = acc
+    _symmetrise(s.Pf)
+    for i in range(p):
+        for j in range(i + 1):
+            acc = 0.0
+            for k in range(j + 1):
+                acc += s.Se[i, k] * s.Se[j, k]
+            s.Se[i, j] = acc
+            s.Se[j, i] = acc
+    return True
+
+
+@numba.njit(cache=True, inline="always")
+def _symmetrise(P):  # pragma: no cover - compiled
+    for i in range(P.shape[0]):
+        for j in range(i + 1, P.shape[0]):
+            a = 0.5 * (P[i, j] + P[j, i])
+            P[i, j] = a
+            P[j, i] = a
+
+
+@numba.njit(cache=True)
+def _store(k, s, out):  # pragma: no cover - compiled
+    """Row k of ``out`` (a KalmanRun of arrays) from the state's filtered results."""
+    for i in range(s.xf.shape[0]):
+        out.x[k, i] = s.xf[i]
+        for j in range(s.xf.shape[0]):
+            out.P[k, i, j] = s.Pf[i, j]
+    for i in range(s.e.shape[0]):
+        out.e[k, i] = s.e[i]
+        for j in range(s.e.shape[0]):
+            out.S[k, i, j] = s.Se[i, j]
+
+
+# ---------------------------------------------------------------- extended
+
+
+@numba.njit(cache=True)
+def _ekf_update(s, w, hx, R, y):  # pragma: no cover - compiled
+    """The EKF measurement update (module docstring) with ``hx = h(x_p, u)``, ``w.H`` at x_p."""
+    n, p = s.xp.shape[0], R.shape[0]
+    for i in range(n):
+        for j in range(p):
+            acc = 0.0
+            for k in range(n):
+                acc += s.Pp[i, k] * w.H[j, k]
+            w.PHt[i, j] = acc
+    for i in range(p):
+        for j in range(p):
+            acc = R[i, j]
+            for k in range(n):
+                acc += w.H[i, k] * w.PHt[k, j]
+            s.Se[i, j] = acc
+    return _gain_update(s, hx, w.PHt, w.K, y)
+
+
+@numba.njit(cache=True)
+def _ekf_predict(s, w, Q):  # pragma: no cover - compiled
+    """``P_p = F P_f Fᵀ + Q`` (symmetric part)."""
+    n = Q.shape[0]
+    for i in range(n):
+        for j in range(n):
+            acc = 0.0
+            for k in range(n):
+                acc += w.F[i, k] * s.Pf[k, j]
+            w.T[i, j] = acc
+    for i in range(n):
+        for j in range(n):
+            acc = Q[i, j]
+            for k in range(n):
+                acc += w.T[i, k] * w.F[j, k]
+            s.Pp[i, j] = acc
+    _symmetrise(s.Pp)
+
+
+@numba.njit(cache=True)
+def _jac_central(fn, x, u, J, xt):  # pragma: no cover - compiled
+    """J[:, j] = (fn(x + δ_j e_j, u) − fn(x − δ_j e_j, u)) / (2 δ_j),
+    δ_j = ε^(1/3) max(1, |x_j|)."""
+    for j in range(x.shape[0]):
+        d = _EPS3 * max(1.0, abs(x[j]))
+        for k in range(x.shape[0]):
+            xt[k] = x[k]
+        xt[j] = x[j] + d
+        hi = fn(xt, u)
+        for i in range(J.shape[0]):  # kept before fn runs again (fn may return its argument)
+            J[i, j] = hi[i]
+        xt[j] = x[j] - d
+        lo = fn(xt, u)
+        for i in range(J.shape[0]):
+            J[i, j] = (J[i, j] - lo[i]) / (2.0 * d)
+
+
+@numba.njit(cache=True)
+def _jac_given(Jf, x, u, J):  # pragma: no cover - compiled
+    """J = Jf(x, u); False if it has the wrong shape."""
+    M = Jf(x, u)
+    if M.shape[0] != J.shape[0] or M.shape[1] != J.shape[1]:
+        return False
+    for i in range(J.shape[0]):
+        for j in range(J.shape[1]):
+            J[i, j] = M[i, j]
+    return True
+
+
+@numba.njit(cache=True)
+def _ekf_step_jit(f, h, Fj, Hj, noise, u, y, s, w):  # pragma: no cover - compiled
+    """One EKF step calling numba ``f``, ``h`` and ``Fj``, ``Hj`` (None: central differences;
+    numba prunes the other branch). 0 done, 1 Σ not positive definite (the prediction is then
+    left as it was), 4 ``f`` or 5 ``h`` returned the wrong length, 6 a Jacobian the wrong
+    shape."""
+    hx = h(s.xp, u)
+    if hx.shape[0] != noise.R.shape[0]:
+        return 5
+    if Hj is None:
+        _jac_central(h, s.xp, u, w.H, w.xt)
+    elif not _jac_given(Hj, s.xp, u, w.H):
+        return 6
+    if not _ekf_update(s, w, hx, noise.R, y):
+        return 1
+    fx = f(s.xf, u)
+    if fx.shape[0] != s.xp.shape[0]:
+        return 4
+    if Fj is None:
+        _jac_central(f, s.xf, u, w.F, w.xt)
+    elif not _jac_given(Fj, s.xf, u, w.F):
+        return 6
+    for i in range(s.xp.shape[0]):
+        s.xp[i] = fx[i]
+    _ekf_predict(s, w, noise.Q)
+    return 0
+
+
+@numba.njit(cache=True)
+def _ekf_run_jit(f, h, Fj, Hj, noise, U, Y, s, w, out):  # pragma: no cover - compiled
+    """:func:`_ekf_step_jit` over the rows of U, Y into ``out``: (code, k) of the first failure
+    or (0, N)."""
+    for k in range(U.shape[0]):
+        code = _ekf_step_jit(f, h, Fj, Hj, noise, U[k], Y[k], s, w)
+        if code:
+            return code, k
+        _store(k, s, out)
+    return 0, U.shape[0]
+
+
+# ---------------------------------------------------------------- unscented
+
+
+@numba.njit(cache=True)
+def _sigma_points(x, P, c, L, X):  # pragma: no cover - compiled
+    """X (2n+1, n): x, x ± √c L[:, j] with P = L Lᵀ (lower triangle of ``L``). False if P is
+    not positive definite."""
+    n = x.shape[0]
+    for i in range(n):
+        for j in range(n):
+            L[i, j] = P[i, j]
+    if not _cholesky(L):
+        return False
+    r = np.sqrt(c)
+    for i in range(n):
+        X[0, i] = x[i]
+    for j in range(n):
+        for i in range(n):
+            d = r * L[i, j] if i >= j else 0.0
+            X[1 + j, i] = x[i] + d
+            X[1 + n + j, i] = x[i] - d
+    return True
+
+
+@numba.njit(cache=True)
+def _ukf_update(s, w, R, y):  # pragma: no cover - compiled
+    """The UKF measurement update (module docstring) from the sigma points ``w.X`` and their
+    images ``w.Yp[i] = h(X[i], u)``."""
+    n, p, ns = s.xp.shape[0], R.shape[0], w.X.shape[0]
+    for j in range(p):
+        acc = 0.0
+        for i in range(ns):
+            acc += w.Wm[i] * w.Yp[i, j]
+        w.yhat[j] = acc
+    for a in range(p):
+        for b in range(p):
+            acc = R[a, b]
+            for i in range(ns):
+                acc += w.Wc[i] * (w.Yp[i, a] - w.yhat[a]) * (w.Yp[i, b] - w.yhat[b])
+            s.Se[a, b] = acc
+    for a in range(n):
+        for b in range(p):
+            acc = 0.0
+            for i in range(ns):
+                acc += w.Wc[i] * (w.X[i, a] - s.xp[a]) * (w.Yp[i, b] - w.yhat[b])
+            w.Pxy[a, b] = acc
+    return _gain_update(s, w.yhat, w.Pxy, w.K, y)
+
+
+@numba.njit(cache=True)
+def _ukf_predict(s, w, Q):  # pragma: no cover - compiled
+    """x_p = Σ W^m_i Xn_i, P_p = Σ W^c_i (Xn_i − x_p)(·)ᵀ + Q."""
+    n, ns = s.xp.shape[0], w.Xn.shape[0]
+    for j in range(n):
+        acc = 0.0
+        for i in range(ns):
+            acc += w.Wm[i] * w.Xn[i, j]
+        s.xp[j] = acc
+    for a in range(n):
+        for b in range(a, n):
+            acc = Q[a, b]
+            for i in range(ns):
+                acc += w.Wc[i] * (w.Xn[i, a] - s.xp[a]) * (w.Xn[i, b] - s.xp[b])
+            s.Pp[a, b] = acc
+            s.Pp[b, a] = acc
+
+
+@numba.njit(cache=True)
+def _ukf_step_jit(f, h, c, noise, u, y, s, w):  # pragma: no cover - compiled
+    """One UKF step with numba ``f``, ``h``: 0 done, 1 P_p or 2 Σ or 3 P_f not positive
+    definite (the prediction is then left as it was), 4 ``f`` or 5 ``h`` returned the wrong
+    length."""
+    if not _sigma_points(s.xp, s.Pp, c, w.L, w.X):
+        return 1
+    for i in range(w.X.shape[0]):
+        yi = h(w.X[i], u)
+        if yi.shape[0] != w.Yp.shape[1]:
+            return 5
+        for j in range(w.Yp.shape[1]):
+            w.Yp[i, j] = yi[j]
+    if not _ukf_update(s, w, noise.R, y):
+        return 2
+    if not _sigma_points(s.xf, s.Pf, c, w.L, w.X):
+        return 3
+    for i in range(w.X.shape[0]):
+        xi = f(w.X[i], u)
+        if xi.shape[0] != w.Xn.shape[1]:
+            return 4
+        for j in range(w.Xn.shape[1]):
+            w.Xn[i, j] = xi[j]
+    _ukf_predict(s, w, noise.Q)
+    return 0
+
+
+@numba.njit(cache=True)
+def _ukf_run_jit(f, h, c, noise, U, Y, s, w, out):  # pragma: no cover - compiled
+    """:func:`_ukf_step_jit` over the rows of U, Y into ``out``: (code, k) of the first failure
+    or (0, N)."""
+    for k in range(U.shape[0]):
+        code = _ukf_step_jit(f, h, c, noise, U[k], Y[k], s, w)
+        if code:
+            return code, k
+        _store(k, s, out)
+    return 0, U.shape[0]
+
+
+# ---------------------------------------------------------------- one buffer per filter
+#
+# A filter's numbers live in one flat float64 buffer; the records above are views of it, made
+# in Python for the kernels called from Python, and inside the kernel for the numba path (a
+# call with three arrays instead of fourteen: unboxing a record of arrays costs ~0.5 µs per
+# array, making views inside the kernel a few ns).
+
+
+def _layout(n: int, p: int, kind: str) -> list:
+    """(name, shape) of the buffer's blocks, in order; the numba builders below follow it."""
+    ns = 2 * n + 1
+    blocks = [("xp", (n,)), ("Pp", (n, n)), ("xf", (n,)), ("Pf", (n, n)), ("e", (p,)),
+              ("Se", (p, p)), ("Q", (n, n)), ("R", (p, p))]
+    if kind == "ekf":
+        return blocks + [("PHt", (n, p)), ("K", (n, p)), ("F", (n, n)), ("H", (p, n)),
+                         ("T", (n, n)), ("xt", (n,))]
+    return blocks + [("Wm", (ns,)), ("Wc", (ns,)), ("Pxy", (n, p)), ("K", (n, p)), ("yhat", (p,)),
+                     ("L", (n, n)), ("X", (ns, n)), ("Yp", (ns, p)), ("Xn", (ns, n)), ("c", (1,))]
+
+
+def _allocate(n: int, p: int, kind: str):
+    """The buffer (zeros) and a dict of its blocks as numpy views."""
+    blocks = _layout(n, p, kind)
+    buf = np.zeros(sum(int(np.prod(shape)) for _, shape in blocks))
+    views, o = {}, 0
+    for name, shape in blocks:
+        k = int(np.prod(shape))
+        views[name] = buf[o:o + k].reshape(shape)
+        o += k
+    return buf, views
+
+
+@numba.njit(cache=True)
+def _common_records(buf, n, p):  # pragma: no cover - compiled
+    """FilterState and Noise as views of ``buf`` (the first blocks of :func:`_layout`), and the
+    offset after them."""
+    xp = buf[0:n]
+    o = n
+    Pp = buf[o:o + n * n].reshape((n, n))
+    o += n * n
+    xf = buf[o:o + n]
+    o += n
+    Pf = buf[o:o + n * n].reshape((n, n))
+    o += n * n
+    e = buf[o:o + p]
+    o += p
+    Se = buf[o:o + p * p].reshape((p, p))
+    o += p * p
+    Q = buf[o:o + n * n].reshape((n, n))
+    o += n * n
+    R = buf[o:o + p * p].reshape((p, p))
+    return FilterState(xp, Pp, xf, Pf, e, Se), Noise(Q, R), o + p * p
+
+
+@numba.njit(cache=True)
+def _ekf_records(buf, n, p):  # pragma: no cover - compiled
+    """(FilterState, Noise, EKFWork) as views of an EKF's buffer."""
+    s, noise, o = _common_records(buf, n, p)
+    PHt = buf[o:o + n * p].reshape((n, p))
+    o += n * p
+    K = buf[o:o + n * p].reshape((n, p))
+    o += n * p
+    F = buf[o:o + n * n].reshape((n, n))
+    o += n * n
+    H = buf[o:o + p * n].reshape((p, n))
+    o += p * n
+    T = buf[o:o + n * n].reshape((n, n))
+    o += n * n
+    return s, noise, EKFWork(PHt, K, F, H, T, buf[o:o + n])
+
+
+@numba.njit(cache=True)
+def _ukf_records(buf, n, p):  # pragma: no cover - compiled
+    """(FilterState, Noise, UKFWork, c) as views of a UKF's buffer."""
+    s, noise, o = _common_records(buf, n, p)
+    ns = 2 * n + 1
+    Wm = buf[o:o + ns]
+    o += ns
+    Wc = buf[o:o + ns]
+    o += ns
+    Pxy = buf[o:o + n * p].reshape((n, p))
+    o += n * p
+    K = buf[o:o + n * p].reshape((n, p))
+    o += n * p
+    yhat = buf[o:o + p]
+    o += p
+    L = buf[o:o + n * n].reshape((n, n))
+    o += n * n
+    X = buf[o:o + ns * n].reshape((ns, n))
+    o += ns * n
+    Yp = buf[o:o + ns * p].reshape((ns, p))
+    o += ns * p
+    Xn = buf[o:o + ns * n].reshape((ns, n))
+    o += ns * n
+    return s, noise, UKFWork(Wm, Wc, Pxy, K, yhat, L, X, Yp, Xn), buf[o]
+
+
+#: the step and run kernels specialised to one set of numba model functions, made once per set
+_SPECIALISED: dict = {}
+
+
+def _ekf_kernels(f, h, Fj, Hj):
+    """``(step(dims, buf, u, y), run(dims, buf, U, Y, out))`` calling ``f``, ``h``, ``Fj``,
+    ``Hj`` as compile-time constants (a numba function passed as an argument costs ~15 µs per
+    call to type)."""
+    key = ("ekf", f, h, Fj, Hj)
+    if key not in _SPECIALISED:
+        @numba.njit
+        def step(dims, buf, u, y):  # pragma: no cover - compiled
+            s, noise, w = _ekf_records(buf, dims[0], dims[1])
+            return _ekf_step_jit(f, h, Fj, Hj, noise, u, y, s, w)
+
+        @numba.njit
+        def run(dims, buf, U, Y, out):  # pragma: no cover - compiled
+            s, noise, w = _ekf_records(buf, dims[0], dims[1])
+            return _ekf_run_jit(f, h, Fj, Hj, noise, U, Y, s, w, out)
+
+        _SPECIALISED[key] = (step, run)
+    return _SPECIALISED[key]
+
+
+def _ukf_kernels(f, h):
+    """As :func:`_ekf_kernels`, for the UKF."""
+    key = ("ukf", f, h)
+    if key not in _SPECIALISED:
+        @numba.njit
+        def step(dims, buf, u, y):  # pragma: no cover - compiled
+            s, noise, w, c = _ukf_records(buf, dims[0], dims[1])
+            return _ukf_step_jit(f, h, c, noise, u, y, s, w)
+
+        @numba.njit
+        def run(dims, buf, U, Y, out):  # pragma: no cover - compiled
+            s, noise, w, c = _ukf_records(buf, dims[0], dims[1])
+            return _ukf_run_jit(f, h, c, noise, U, Y, s, w, out)
+
+        _SPECIALISED[key] = (step, run)
+    return _SPECIALISED[key]
+
+
+# ---------------------------------------------------------------- the classes
+
+
+def _covariance(M, name, size, cls) -> np.ndarray:
+    M = np.atleast_2d(np.asarray(M, dtype=np.float64))
+    if M.shape != (size, size) or not np.all(np.isfinite(M)):
+        raise ModelError(f"{cls}: {name} must be a finite {size}×{size} matrix, found shape "
+                         f"{M.shape}")
+    if np.min(np.linalg.eigvalsh(0.5 * (M + M.T))) < (1e-300 if name in ("R", "P0") else 0.0):
+        what = "positive definite" if name in ("R", "P0") else "positive semidefinite"
+        raise ModelError(f"{cls}: {name} must be {what} (a covariance)")
+    return np.ascontiguousarray(0.5 * (M + M.T))
+
+
+def _vector(v) -> np.ndarray:
+    return np.ascontiguousarray(np.atleast_1d(np.asarray(v, dtype=np.float64)).ravel())
+
+
+def _linear_model_fh(model, dt):
+    """``f``, ``h`` (Python, numpy) of a LinearModel's discrete realisation with its offsets
+    applied (u, y in SI, offsets not removed)."""
+    if not hasattr(model, "discrete"):
+        raise ArgumentError(f"expected a gripkit.sysid.LinearModel or a callable f, found "
+                            f"{type(model).__name__}")
+    if not (model.dt or dt):
+        raise ModelError("the model is continuous; give the sample time: dt=…")
+    ss = model.discrete(model.dt if dt is None else dt)
+    A, B, C, D = (np.asarray(M, dtype=np.float64) for M in (ss.A, ss.B, ss.C, ss.D))
+    u0 = np.asarray(model.u_offset, dtype=np.float64)
+    y0 = np.asarray(model.y_offset, dtype=np.float64)
+
+    def f(x, u):
+        return A @ x + B @ (u - u0)
+
+    def h(x, u):
+        return C @ x + D @ (u - u0) + y0
+
+    return f, h
+
+
+class _NonlinearFilter:
+    """What the EKF and UKF share: the state record, the checks, the ``step``/``run`` plumbing.
+    ``x_pred``, ``P_pred``, ``x``, ``P`` are the arrays of the state record."""
+
+    _name = "filter"
+    _FAIL = {1: "the innovation covariance is not positive definite",
+             4: "f(x, u) returned the wrong number of values (expected n, Q's size)",
+             5: "h(x, u) returned the wrong number of values (expected p, R's size)",
+             6: "a Jacobian returned the wrong shape (expected F: n×n, H: p×n)"}
+
+    def _setup(self, Q, R, x0, P0, kind):
+        """Checks, the buffer (:func:`_allocate`) and its records; returns the dict of views."""
+        Q = _covariance(Q, "Q", np.atleast_2d(np.asarray(Q)).shape[0], self._name)
+        R = _covariance(R, "R", np.atleast_2d(np.asarray(R)).shape[0], self._name)
+        n, p = Q.shape[0], R.shape[0]
+        xp = np.zeros(n) if x0 is None else _vector(x0)
+        if xp.shape != (n,):
+            raise ModelError(f"{self._name}: x0 must hold {n} values (Q is {n}×{n}), found "
+                             f"{xp.size}")
+        Pp = Q.copy() if P0 is None else _covariance(P0, "P0", n, self._name)
+        self._buf, v = _allocate(n, p, kind)
+        self._dims = np.array([n, p], dtype=np.int64)
+        v["Q"][:], v["R"][:], v["xp"][:], v["Pp"][:] = Q, R, xp, Pp
+        self.noise, self.n, self.p = Noise(v["Q"], v["R"]), n, p
+        self._s = FilterState(v["xp"], v["Pp"], v["xf"], v["Pf"], v["e"], v["Se"])
+        self.x_pred, self.P_pred, self.x, self.P = self._s[:4]
+        return v
+
+    @property
+    def Q(self) -> np.ndarray:
+        return self.noise.Q
+
+    @property
+    def R(self) -> np.ndarray:
+        return self.noise.R
+
+    def _raise(self, code, where):
+        raise ModelError(f"{self._name}.{where}: {self._FAIL[code]}",
+                         hint="check f, h, Q, R, P0 and the model's scaling")
+
+    def _sample(self, u, y):
+        """``u``, ``y`` as 1-D float64 arrays (float64 arrays pass as they are); y's length
+        checked (the kernels trust it)."""
+        if type(u) is not np.ndarray or u.dtype != np.float64 or u.ndim != 1:
+            u = np.ascontiguousarray(np.atleast_1d(np.asarray(u, dtype=np.float64)))
+        if type(y) is not np.ndarray or y.dtype != np.float64 or y.ndim != 1:
+            y = np.ascontiguousarray(np.atleast_1d(np.asarray(y, dtype=np.float64)))
+        if y.shape[0] != self.p:
+            raise DataError(f"{self._name}.step: y must hold {self.p} value(s) per sample (R is "
+                            f"{self.p}×{self.p}), found {y.size}")
+        return u, y
+
+    @property
+    def innovation(self) -> np.ndarray:
+        """The last step's innovation ``e`` (p,) (a copy)."""
+        return self._s.e.copy()
+
+    def _out(self, code, copy):
+        if code:
+            self._raise(code, "step")
+        if copy:
+            return self.x.copy(), self.P.copy()
+        return self.x, self.P
+
+    def run(self, data, inputs=None, outputs=None) -> KalmanRun:
+        """Filter a record: a :class:`~gripkit.signals.Trajectory` and the names of its input
+        and output columns (a linear model's own names by default), from the current state."""
+        inputs = list(getattr(self, "_inputs", ()) if inputs is None else inputs)
+        outputs = list(getattr(self, "_outputs", ()) if outputs is None else outputs)
+        if not outputs:
+            raise ArgumentError(f"{self._name}.run: name the output columns: outputs=[...]")
+        missing = [c for c in (*inputs, *outputs) if c not in data.names]
+        if missing:
+            raise DataError(f"data: the column(s) {', '.join(map(repr, missing))} are missing; "
+                            f"the data have {', '.join(map(repr, data.names))}")
+        N = len(data)
+        u = (np.column_stack([data[c] for c in inputs]) if inputs else np.zeros((N, 0)))
+        y = np.column_stack([data[c] for c in outputs])
+        return self.run_arrays(u, y)
+
+    def run_arrays(self, u, y) -> KalmanRun:
+        """Filter inputs ``u`` (N, m) and outputs ``y`` (N, p): one numba call over the record
+        when the model's functions are numba functions, else :meth:`step` per row."""
+        y = np.ascontiguousarray(np.asarray(y, dtype=np.float64).reshape(len(y), -1))
+        u = np.ascontiguousarray(np.asarray(u, dtype=np.float64).reshape(len(u), -1))
+        if y.shape[1] != self.p or u.shape[0] != y.shape[0]:
+            raise DataError(f"{self._name}.run_arrays: expected u (N, m) and y (N, {self.p}) "
+                            f"with the same N, found {u.shape} and {y.shape}")
+        N = y.shape[0]
+        out = KalmanRun(np.empty((N, self.n)), np.empty((N, self.n, self.n)),
+                        np.empty((N, self.p)), np.empty((N, self.p, self.p)))
+        if self._jit:
+            code, k = self._kernels[1](self._dims, self._buf, u, y, out)
+            if code:
+                self._raise(code, f"run (sample {k})")
+            return out
+        for k in range(N):
+            out.x[k], out.P[k] = self.step(u[k], y[k], copy=False)
+            out.e[k], out.S[k] = self._s.e, self._s.Se
+        return out
+
+
+class ExtendedKalmanFilter(_NonlinearFilter):
+    """Extended Kalman filter of ``x[t+1] = f(x, u) + w``, ``y = h(x, u) + v`` (module
+    docstring).
+
+    Parameters
+    ----------
+    f, h
+        ``f(x, u) -> (n,)``, ``h(x, u) -> (p,)``: Python callables or ``numba.njit`` functions.
+    Q, R
+        Process (n×n) and measurement (p×p) noise covariances; they fix n and p.
+    F, H
+        Jacobians ``F(x, u) -> (n, n)``, ``H(x, u) -> (p, n)``; not given: by ``jacobian``.
+    jacobian
+        ``"central"`` (central differences) or ``"complex"`` (complex step; ``f`` and ``h`` must
+        accept complex ``x``; evaluated from Python).
+    x0, P0
+        Initial prediction (default 0) and its covariance (default Q).
+
+    Examples
+    --------
+    >>> ekf = ExtendedKalmanFilter(lambda x, u: 0.9 * x + u, lambda x, u: x, Q=[[0.1]],
+    ...                            R=[[1.0]], P0=[[1.0]])
+    >>> x, P = ekf.step([0.0], [2.0]); x.round(6).tolist(), P.round(6).tolist()
+    ([1.0], [[0.5]])
+    """
+
+    _name = "ExtendedKalmanFilter"
+
+    def __init__(self, f, h, Q, R, *, F=None, H=None, jacobian: str = "central", x0=None,
+                 P0=None):
+        if not (callable(f) and callable(h)):
+            raise ArgumentError("ExtendedKalmanFilter: f and h must be callables f(x, u) and "
+                                "h(x, u)")
+        if jacobian not in ("central", "complex"):
+            raise ArgumentError(f"ExtendedKalmanFilter: jacobian must be 'central' or 'complex', "
+                                f"found {jacobian!r}")
+        if (F is None) != (H is None):
+            raise ArgumentError("ExtendedKalmanFilter: give both Jacobians F and H, or neither")
+        self.f, self.h, self.Fj, self.Hj, self.jacobian = f, h, F, H, jacobian
+        v = self._setup(Q, R, x0, P0, "ekf")
+        self._w = EKFWork(*(v[k] for k in EKFWork._fields))
+        self._jit = (_is_jit(f) and _is_jit(h) and jacobian == "central"
+                     and (F is None or (_is_jit(F) and _is_jit(H))))
+        self._kernels = _ekf_kernels(f, h, F, H) if self._jit else None
+
+    def _jacobian(self, fn, J, x, u, given):
+        if given is not None:
+            M = np.asarray(given(x, u), dtype=np.float64)
+            if M.shape != J.shape:
+                self._raise(6, "step")
+            J[:] = M
+        elif self.jacobian == "complex":
+            d = 1e-30
+            xc = x.astype(complex)
+            for j in range(x.size):
+                xc[j] += 1j * d
+                J[:, j] = np.imag(np.asarray(fn(xc, u))) / d
+                xc[j] = x[j]
+        else:
+            for j in range(x.size):
+                dj = _EPS3 * max(1.0, abs(x[j]))
+                xt = x.copy()
+                xt[j] = x[j] + dj
+                hi = np.array(fn(xt, u), dtype=np.float64)  # a copy: fn may return xt
+                xt[j] = x[j] - dj
+                J[:, j] = (hi - np.asarray(fn(xt, u), dtype=np.float64)) / (2 * dj)
+
+    def _fn(self, fn, x, u, size, code):
+        v = np.asarray(fn(x, u), dtype=np.float64).reshape(-1)
+        if v.shape != (size,):
+            self._raise(code, "step")
+        return v
+
+    def step(self, u, y, *, copy: bool = True):
+        """One sample: ``(x[t|t], P[t|t])`` (copies; ``copy=False``: the filter's own arrays,
+        overwritten by the next step)."""
+        u, y = self._sample(u, y)
+        s, w = self._s, self._w
+        if self._jit:
+            return self._out(self._kernels[0](self._dims, self._buf, u, y), copy)
+        hx = self._fn(self.h, s.xp, u, self.p, 5)
+        self._jacobian(self.h, w.H, s.xp, u, self.Hj)
+        if not _ekf_update(s, w, hx, self.noise.R, y):
+            return self._out(1, copy)
+        fx = self._fn(self.f, s.xf, u, self.n, 4)
+        self._jacobian(self.f, w.F, s.xf, u, self.Fj)
+        s.xp[:] = fx
+        _ekf_predict(s, w, self.noise.Q)
+        return self._out(0, copy)
+
+
+
+class UnscentedKalmanFilter(_NonlinearFilter):
+    """Unscented Kalman filter (module docstring) of a linear model or of ``f``, ``h``.
+
+    ``UnscentedKalmanFilter(model, Q=, R=)`` with a :class:`~gripkit.sysid.LinearModel`: its
+    discrete realisation with offsets (u, y in SI, offsets not removed, as
+    :class:`~gripkit.estimation.KalmanFilter`), ``x0`` default rest and ``P0`` default the
+    steady-state prediction covariance. ``UnscentedKalmanFilter(f, h, Q=, R=)``: ``f(x, u)``,
+    ``h(x, u)`` Python or numba callables, ``x0`` default 0, ``P0`` default Q.
+    ``alpha``, ``beta``, ``kappa``: the sigma-point scaling (module docstring).
+
+    Examples
+    --------
+    >>> ukf = UnscentedKalmanFilter(lambda x, u: 0.9 * x + u, lambda x, u: x, Q=[[0.1]],
+    ...                             R=[[1.0]], P0=[[1.0]])
+    >>> x, P = ukf.step([0.0], [2.0]); x.round(6).tolist(), P.round(6).tolist()
+    ([1.0], [[0.5]])
+    """
+
+    _name = "UnscentedKalmanFilter"
+    _FAIL = {**_NonlinearFilter._FAIL,
+             1: "the predicted covariance P is not positive definite",
+             2: "the innovation covariance is not positive definite",
+             3: "the filtered covariance P is not positive definite"}
+
+    def __init__(self, f, h=None, Q=None, R=None, *, x0=None, P0=None, alpha: float = 1.0,
+                 beta: float = 2.0, kappa: float = 0.0, dt: float | None = None):
+        if Q is None or R is None:
+            raise ArgumentError("UnscentedKalmanFilter: give the noise covariances Q= and R=")
+        if h is None:
+            model = f
+            f, h = _linear_model_fh(model, dt)
+            self._inputs, self._outputs = list(model.inputs), list(model.outputs)
+            if P0 is None:
+                P0 = KalmanFilter(model, Q=Q, R=R, dt=dt).P_steady_pred
+        elif not (callable(f) and callable(h)):
+            raise ArgumentError("UnscentedKalmanFilter: expected a LinearModel, or callables "
+                                "f(x, u) and h(x, u)")
+        self.f, self.h = f, h
+        v = self._setup(Q, R, x0, P0, "ukf")
+        n = self.n
+        if not (alpha > 0 and np.isfinite(alpha) and n + kappa > 0):
+            raise ArgumentError(f"UnscentedKalmanFilter: need alpha > 0 and n + kappa > 0, found "
+                                f"alpha={alpha!r}, kappa={kappa!r} (n = {n})")
+        self.c = float(alpha ** 2 * (n + kappa))
+        v["c"][0] = self.c
+        v["Wm"][:] = v["Wc"][:] = 0.5 / self.c
+        v["Wm"][0] = (self.c - n) / self.c
+        v["Wc"][0] = (self.c - n) / self.c + 1.0 - alpha ** 2 + beta
+        self._w = UKFWork(*(v[k] for k in UKFWork._fields))
+        self._jit = _is_jit(f) and _is_jit(h)
+        self._kernels = _ukf_kernels(f, h) if self._jit else None
+
+    def _through(self, fn, X, u, out, code):
+        for i in range(X.shape[0]):
+            v = np.asarray(fn(X[i], u), dtype=np.float64).reshape(-1)
+            if v.shape != (out.shape[1],):
+                self._raise(code, "step")
+            out[i] = v
+
+    def step(self, u, y, *, copy: bool = True):
+        """One sample: ``(x[t|t], P[t|t])`` (copies; ``copy=False``: the filter's own arrays,
+        overwritten by the next step)."""
+        u, y = self._sample(u, y)
+        s, w = self._s, self._w
+        if self._jit:
+            return self._out(self._kernels[0](self._dims, self._buf, u, y), copy)
+        if not _sigma_points(s.xp, s.Pp, self.c, w.L, w.X):
+            return self._out(1, copy)
+        self._through(self.h, w.X, u, w.Yp, 5)
+        if not _ukf_update(s, w, self.noise.R, y):
+            return self._out(2, copy)
+        if not _sigma_points(s.xf, s.Pf, self.c, w.L, w.X):
+            return self._out(3, copy)
+        self._through(self.f, w.X, u, w.Xn, 4)
+        _ukf_predict(s, w, self.noise.Q)
+        return self._out(0, copy)

@@ -1,0 +1,192 @@
+"""Numba kernels of the Hammerstein–Wiener family (:mod:`.hammerstein_wiener`): the static
+nonlinearities with their derivatives, and the free run of ``y = g(B/F f(u)) + y0`` with the
+forward sensitivities of ŷ to every parameter (scalar, allocation-free loops; the caller owns every
+work array)."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+#: kind codes shared with the Python side
+NONE, SATURATION, DEADZONE, POLY, PWL, SIGMOID = 0, 1, 2, 3, 4, 5
+
+
+@njit(cache=True)
+def nl_eval(kind, p, c, v, grad):
+    """``(f(v), f'(v))`` of the nonlinearity ``kind`` with parameters ``p`` and constants ``c``;
+    ``grad[:len(p)]`` receives ∂f/∂p. Every kind has unit slope in its linear part (the gain
+    normalisation, see the module docstring of :mod:`.hammerstein_wiener`)."""
+    if kind == SATURATION:
+        lo, hi = p[0], p[1]
+        grad[0] = 0.0
+        grad[1] = 0.0
+        if v < lo:
+            grad[0] = 1.0
+            return lo, 0.0
+        if v > hi:
+            grad[1] = 1.0
+            return hi, 0.0
+        return v, 1.0
+    if kind == DEADZONE:
+        lo, hi = p[0], p[1]
+        grad[0] = 0.0
+        grad[1] = 0.0
+        if v < lo:
+            grad[0] = -1.0
+            return v - lo, 1.0
+        if v > hi:
+            grad[1] = -1.0
+            return v - hi, 1.0
+        return 0.0, 0.0
+    if kind == POLY:  # v + c2 v² + … + cN v^N
+        f = v
+        d = 1.0
+        vk = v  # v^(k-1)
+        for k in range(p.shape[0]):
+            deg = k + 2
+            d += deg * p[k] * vk
+            vk *= v
+            grad[k] = vk
+            f += p[k] * vk
+        return f, d
+    if kind == PWL:  # v + Σ_{k<N/2} d_k min(0, v − β_k) + Σ_{k≥N/2} d_k max(0, v − β_k)
+        f = v
+        d = 1.0
+        half = p.shape[0] // 2
+        for k in range(p.shape[0]):
+            r = v - c[k]
+            if (k >= half and r > 0.0) or (k < half and r < 0.0):
+                grad[k] = r
+                f += p[k] * r
+                d += p[k]
+            else:
+                grad[k] = 0.0
+        return f, d
+    if kind == SIGMOID:  # v + Σ a_k tanh((v − c_k)/h), h = c[-1]
+        h = c[c.shape[0] - 1]
+        f = v
+        d = 1.0
+        for k in range(p.shape[0]):
+            th = np.tanh((v - c[k]) / h)
+            grad[k] = th
+            f += p[k] * th
+            d += p[k] * (1.0 - th * th) / h
+        return f, d
+    return v, 1.0
+
+
+@njit(cache=True)
+def hw_run(u, kin, pin, cin, b, f, nk, kout, pout, cout, y0, wpre, want_j, w, x, dw, dx, gin,
+           gout, yhat, jac):
+    """Free run of ``w = f(u)``, ``F(q) x = B(q) q^-nk w``, ``ŷ = g(x) + y0`` from the linear
+    block's steady state under the constant input ``wpre`` (``w(t<0) = wpre``,
+    ``x(t<0) = B(1)/F(1) wpre``).
+
+    Work arrays: ``w``, ``x`` (N + M), ``dw`` (N + M, ni + 1), ``dx`` (N + M, ni + nb + nf + 1),
+    ``gin``, ``gout`` (≥ 2). With ``want_j`` the rows of ``jac`` (N, P + 1) receive ∂ŷ(t)/∂θ for
+    ``θ = [pin, b, f, pout, y0, wpre]``. Returns the first sample where ŷ is not finite, −1 if
+    none."""
+    n = u.shape[0]
+    ni = pin.shape[0]
+    nb = b.shape[0]
+    nf = f.shape[0]
+    no = pout.shape[0]
+    nl = ni + nb + nf
+    m = nk + nb + nf
+    sb = 0.0
+    for i in range(nb):
+        sb += b[i]
+    f1 = 1.0
+    for j in range(nf):
+        f1 += f[j]
+    s = sb / f1
+    for t in range(m):
+        w[t] = wpre
+        x[t] = s * wpre
+        if want_j:
+            for k in range(ni):
+                dw[t, k] = 0.0
+                dx[t, k] = 0.0
+            dw[t, ni] = 1.0
+            for i in range(nb):
+                dx[t, ni + i] = wpre / f1
+            for j in range(nf):
+                dx[t, ni + nb + j] = -s * wpre / f1
+            dx[t, nl] = s
+    bad = -1
+    for t in range(m, n + m):
+        wt, _ = nl_eval(kin, pin, cin, u[t - m], gin)
+        w[t] = wt
+        acc = 0.0
+        for i in range(nb):
+            acc += b[i] * w[t - nk - i]
+        for j in range(nf):
+            acc -= f[j] * x[t - 1 - j]
+        x[t] = acc
+        g, gd = nl_eval(kout, pout, cout, acc, gout)
+        yt = g + y0
+        yhat[t - m] = yt
+        if bad < 0 and not np.isfinite(yt):
+            bad = t - m
+        if want_j:
+            for k in range(ni):
+                dw[t, k] = gin[k]
+            dw[t, ni] = 0.0
+            for k in range(nl + 1):
+                a = 0.0
+                for j in range(nf):
+                    a -= f[j] * dx[t - 1 - j, k]
+                dx[t, k] = a
+            for k in range(ni):
+                a = 0.0
+                for i in range(nb):
+                    a += b[i] * dw[t - nk - i, k]
+                dx[t, k] += a
+            a = 0.0
+            for i in range(nb):
+                a += b[i] * dw[t - nk - i, ni]
+                dx[t, ni + i] += w[t - nk - i]
+            dx[t, nl] += a
+            for j in range(nf):
+                dx[t, ni + nb + j] -= x[t - 1 - j]
+            r = t - m
+            for k in range(nl):
+                jac[r, k] = gd * dx[t, k]
+            for k in range(no):
+                jac[r, nl + k] = gout[k]
+            jac[r, nl + no] = 1.0
+            jac[r, nl + no + 1] = gd * dx[t, nl]
+    return bad
+
+
+@njit(cache=True)
+def gram(jac, r, H, g):
+    """``H = JᵀJ`` and ``g = Jᵀr`` in one pass, single-threaded: BLAS's threads on these thin
+    (N × P) products cost more than they give on a shared machine."""
+    n, p = jac.shape
+    for a in range(p):
+        g[a] = 0.0
+        for b in range(p):
+            H[a, b] = 0.0
+    for t in range(n):
+        rt = r[t]
+        for a in range(p):
+            ja = jac[t, a]
+            g[a] += ja * rt
+            for b in range(a, p):
+                H[a, b] += ja * jac[t, b]
+    for a in range(p):
+        for b in range(a):
+            H[a, b] = H[b, a]
+
+
+@njit(cache=True)
+def residual(y, yhat, r):
+    """``r = y − ŷ`` and its sum of squares (single-threaded, as :func:`gram`)."""
+    s = 0.0
+    for t in range(y.shape[0]):
+        e = y[t] - yhat[t]
+        r[t] = e
+        s += e * e
+    return s

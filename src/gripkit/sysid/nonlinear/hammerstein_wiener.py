@@ -1,0 +1,899 @@
+"""Hammerstein, Wiener and Hammerstein–Wiener models (issue 26, family 2): static nonlinearities
+around an output-error linear block, refined by prediction-error minimisation of the simulation
+error, with σ of every parameter.
+
+The model (one input ``u``, one output ``y``)::
+
+    w(t) = f(u(t))                                   input nonlinearity (static)
+    x(t) = B(q)/F(q) w(t)                            linear block, output-error form
+    ŷ(t) = g(x(t)) + y0                              output nonlinearity (static) and offset
+    B(q) = b1 q^-nk + … + b_nb q^-(nk+nb-1),   F(q) = 1 + f1 q^-1 + … + f_nf q^-nf
+
+``f = none`` gives a Wiener model, ``g = none`` a Hammerstein model, both ``none`` the linear
+output-error model with an offset. The nonlinearities (``KIND[:N]``):
+
+* ``none``: ``v``
+* ``saturation``: ``min(max(v, lo), hi)`` (parameters ``lo < hi``)
+* ``deadzone``: ``v − hi`` for ``v > hi``, ``v − lo`` for ``v < lo``, 0 between (``lo ≤ hi``)
+* ``poly:N``: ``v + c2 v² + … + cN v^N`` (default N = 3)
+* ``pwl:N``: ``v + Σ_{k ≤ N/2} d_k min(0, v − β_k) + Σ_{k > N/2} d_k max(0, v − β_k)``, the N
+  breakpoints ``β_1 < … < β_N`` fixed at the ``k/(N+1)`` quantiles of the signal entering the
+  block (the measured ``u``, or ``x`` of the initial linear model); the slope changes ``d_k``
+  away from the middle segment (between ``β_⌊N/2⌋`` and the next, slope 1) are estimated
+  (default N = 4)
+* ``sigmoid:N``: ``v + Σ_k a_k tanh((v − c_k)/h)``, the N centres ``c_k`` fixed at the same
+  quantiles and ``h`` at their spacing; the weights ``a_k`` are estimated (default N = 4)
+
+**Gain normalisation.** ``c·f``, ``B/c`` and ``g(c·)``, ``B·c`` give the same output for every
+``c ≠ 0``. gripkit fixes the ambiguity by giving every nonlinearity **unit slope in its linear
+part** (the coefficient of ``v`` is 1 for poly and sigmoid; slope 1 on the middle segment of pwl,
+between the limits of a saturation and outside the thresholds of a dead zone): the gain of the
+whole chain is in ``B``, and thresholds and limits are in the units of the signal entering the
+block (``u`` for the input block; ``x``, the output's unit before ``g``, for the output block).
+
+**Estimation.** (1) Orders: ``(nb, nf)`` in (1, 1), (2, 2), (3, 3) and ``nk`` in 0, 1, 2
+unless given, each by a linear output-error fit (the best linear approximation: least-squares
+ARX, unstable poles reflected into the unit circle, then the PEM of (3) with both blocks
+``none``; at most 30 iterations per candidate while screening, the chosen one to convergence).
+(2) Nonlinear fits from that linear model with the nonlinearities at identity (``c = d = a = 0``)
+and, for saturation and dead zone, limits started at quantiles of the signal entering the block
+(a few starts, the best kept). When the orders were searched and the best structure is
+nonlinear, it is fitted again at the other ``(nb, nf)`` with the same ``nk``: a linear
+approximation of a nonlinear system often asks for extra poles. (3) Levenberg–Marquardt on
+``V(θ) = ½ Σ (y − ŷ(θ))²`` with Marquardt's diagonal scaling, until a step lowers the SSE by
+less than ``1e-4 SSE/N``. The Jacobian is exact: the forward sensitivities
+``∂x/∂b_i = q^-(nk+i-1) w − Σ f_j ∂x/∂b_i(t−j)``, ``∂x/∂f_j = −x(t−j) − Σ f_l ∂x/∂f_j(t−l)``,
+``∂x/∂p_f = B/F ∂f/∂p_f`` and ``∂ŷ/∂θ = g'(x) ∂x/∂θ`` (``∂ŷ/∂p_g = ∂g/∂p_g``) run beside the
+free run in one numba kernel. A step that makes ``F`` unstable (a root with ``|z| ≥ 1``) or
+reverses the limits is refused (more damping), so the returned ``F`` is stable.
+
+The free run starts from a steady state of the linear block under a constant input ``w₋``
+(``w(t<0) = w₋``, ``x(t<0) = B(1)/F(1) w₋``): a record that starts at rest has ``w₋ = 0``, one
+that starts settled at the first input ``w₋ = f(u(0))``. ``w₋`` is estimated with ``θ`` on the
+estimation record (a nuisance parameter: its uncertainty is in every σ), fitted alone by
+Gauss–Newton on a validation record (:meth:`HWModel.compare`), and ``f(u(0))`` in
+:meth:`HWModel.simulate` unless given.
+
+**σ.** ``cov θ = σ² (JᵀJ)⁻¹`` (Gauss–Newton), ``σ² = SSE/(N − P)``, from the eigen-decomposition
+of the column-scaled ``JᵀJ``: a direction with eigenvalue below ``1e-10`` of the largest is not
+determined by the data, and every parameter that moves along it has σ = inf (for example a
+saturation limit that the data never reach; an AccuracyWarning names them).
+``simulate(data, std=True)`` propagates ``cov θ`` to the free run linearly:
+``σ_ŷ(t)² = J(t) cov θ J(t)ᵀ`` (inf where ŷ(t) depends on an undetermined parameter).
+
+**Structure.** Without ``input_nonlinearity``/``output_nonlinearity`` the candidates are the
+linear model, the Hammerstein models with saturation, dead zone, poly:3 and pwl:4, the Wiener
+models with saturation, poly:3 and pwl:4, and the Hammerstein–Wiener models that join the two
+best of those input blocks to the two best of those output blocks. They (and the orders) are
+ranked by the free-run fit on ``validate=`` when given (among those within 0.1 point of the
+best: one whose parameters the data all determine, then the fewest parameters), else by
+``BIC = N ln(SSE/N) + P ln N`` on the estimation record.
+
+The fit is ``100 (1 − ‖y − ŷ‖/‖y − ȳ‖)`` over all samples of the free run. A run that leaves
+``1000×`` the estimation output's range (about its middle) or is not finite counts as diverged:
+fit None with a :class:`StabilityWarning`.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ...atomic import write_text
+from ...errors import (AccuracyWarning, ArgumentError, DataError, IdentificationError, ModelError,
+                       PathError, StabilityWarning, emit_warning)
+from ..model_protocol import ModelFit
+from . import _hw_kernels as K
+
+__all__ = ["SCHEMA", "HW_FIT", "HWModel", "Nonlinearity", "hammerstein_wiener", "load_hw",
+           "parse_nonlinearity"]
+
+SCHEMA = "gripkit.hw-model"
+VERSION = 1
+DIVERGENCE_FACTOR = 1e3
+HW_FIT = ("free run from a steady state of the linear block whose constant input w₋ is fitted "
+          "to the record (least squares), fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) over all samples")
+KINDS = {"none": K.NONE, "saturation": K.SATURATION, "deadzone": K.DEADZONE, "poly": K.POLY,
+         "pwl": K.PWL, "sigmoid": K.SIGMOID}
+DEFAULT_N = {"poly": 3, "pwl": 4, "sigmoid": 4}
+#: the structures tried when no nonlinearity is given: (input, output)
+AUTO_STRUCTURES = (("none", "none"), ("saturation", "none"), ("deadzone", "none"),
+                   ("poly:3", "none"), ("pwl:4", "none"), ("none", "saturation"),
+                   ("none", "poly:3"), ("none", "pwl:4"))
+#: with ``validate=``, the simplest candidate within this many fit points of the best is taken
+PARSIMONY_POINTS = 0.1
+#: input and output blocks joined into Hammerstein–Wiener candidates (the best of each side)
+N_JOINED = 2
+AUTO_ORDERS = ((1, 1), (2, 2), (3, 3))
+AUTO_NK = (0, 1, 2)
+_EIG_FLOOR = 1e-10
+#: LM iterations of each linear fit while the orders are screened (the chosen one then converges)
+SCREEN_ITERATIONS = 30
+
+
+@dataclass(frozen=True)
+class Nonlinearity:
+    """A static nonlinearity: ``kind`` (``none``, ``saturation``, ``deadzone``, ``poly``,
+    ``pwl``, ``sigmoid``), ``n`` (degree or number of breakpoints/units; 0 where none) and the
+    fixed ``consts`` (breakpoints, or centres followed by the width ``h``)."""
+
+    kind: str = "none"
+    n: int = 0
+    consts: tuple = ()
+
+    @property
+    def code(self) -> int:
+        return KINDS[self.kind]
+
+    @property
+    def n_params(self) -> int:
+        return {"none": 0, "saturation": 2, "deadzone": 2, "poly": max(self.n - 1, 0)}.get(
+            self.kind, self.n)
+
+    @property
+    def label(self) -> str:
+        return self.kind + (f":{self.n}" if self.kind in DEFAULT_N else "")
+
+    def param_names(self, prefix: str) -> list[str]:
+        if self.kind in ("saturation", "deadzone"):
+            return [f"{prefix}_lo", f"{prefix}_hi"]
+        letter = {"poly": "c", "pwl": "d", "sigmoid": "a"}.get(self.kind)
+        if letter is None:
+            return []
+        first = 2 if self.kind == "poly" else 1
+        return [f"{prefix}_{letter}{k}" for k in range(first, first + self.n_params)]
+
+    def evaluate(self, v, p) -> np.ndarray:
+        """``f(v)`` for an array ``v`` with parameters ``p``."""
+        v = np.asarray(v, dtype=np.float64)
+        p = np.asarray(p, dtype=np.float64)
+        c = np.asarray(self.consts, dtype=np.float64) if self.consts else np.zeros(1)
+        g = np.zeros(max(len(p), 1))
+        return np.array([K.nl_eval(self.code, p, c, float(x), g)[0] for x in v.ravel()]
+                        ).reshape(v.shape)
+
+
+def parse_nonlinearity(spec, where: str = "nonlinearity") -> Nonlinearity:
+    """``'KIND[:N]'`` (or None / ``'none'``) → a :class:`Nonlinearity` without its constants."""
+    if spec is None:
+        return Nonlinearity()
+    if isinstance(spec, Nonlinearity):
+        return spec
+    if not isinstance(spec, str):
+        raise ArgumentError(f"hammerstein_wiener: {where} must be a string KIND[:N], found "
+                            f"{type(spec).__name__} {spec!r:.40}")
+    kind, _, num = spec.strip().lower().partition(":")
+    if kind not in KINDS:
+        raise ArgumentError(f"hammerstein_wiener: {where} {spec!r}: unknown kind {kind!r}; "
+                            f"expected one of {', '.join(KINDS)} (with :N for poly, pwl, sigmoid)")
+    if num and kind not in DEFAULT_N:
+        raise ArgumentError(f"hammerstein_wiener: {where} {spec!r}: {kind} takes no :N (only "
+                            "poly, pwl and sigmoid do)")
+    if not num:
+        return Nonlinearity(kind, DEFAULT_N.get(kind, 0))
+    try:
+        n = int(num)
+    except ValueError:
+        n = -1
+    lo = 2 if kind == "poly" else 1
+    if not lo <= n <= 20:
+        raise ArgumentError(f"hammerstein_wiener: {where} {spec!r}: N must be an integer from {lo} "
+                            f"to 20 (the {'degree' if kind == 'poly' else 'number of units'}), "
+                            f"found {num!r}")
+    return Nonlinearity(kind, n)
+
+
+def _with_consts(nl: Nonlinearity, v: np.ndarray) -> Nonlinearity:
+    """Fix the breakpoints/centres of pwl and sigmoid at the quantiles of ``v``."""
+    if nl.kind not in ("pwl", "sigmoid"):
+        return nl
+    q = np.quantile(v, np.arange(1, nl.n + 1) / (nl.n + 1))
+    if nl.kind == "pwl":
+        return Nonlinearity(nl.kind, nl.n, tuple(float(a) for a in q))
+    span = float(np.quantile(v, 0.95) - np.quantile(v, 0.05))
+    h = max(span / (nl.n + 1), 1e-12 * max(abs(float(np.mean(v))), 1.0), 1e-300)
+    return Nonlinearity(nl.kind, nl.n, tuple(float(a) for a in q) + (h,))
+
+
+def _limit_starts(nl: Nonlinearity, v: np.ndarray) -> list[np.ndarray]:
+    """Start values of the nonlinearity's parameters: identity for poly/pwl/sigmoid; limits at a
+    few quantile pairs of ``v`` for saturation and dead zone."""
+    if nl.kind == "saturation":
+        return [np.quantile(v, [q, 1.0 - q]) for q in (0.03, 0.1, 0.25)]
+    if nl.kind == "deadzone":
+        return [np.quantile(v, [0.5 - m / 2, 0.5 + m / 2]) for m in (0.1, 0.3, 0.5)]
+    return [np.zeros(nl.n_params)]
+
+
+def _fit_value(y, yhat) -> float:
+    den = float(np.linalg.norm(y - y.mean()))
+    if den == 0.0:
+        raise DataError("hammerstein_wiener: the fit is undefined for a constant output "
+                        "(‖y − ȳ‖ = 0)")
+    return 100.0 * (1.0 - float(np.linalg.norm(y - yhat)) / den)
+
+
+class _Problem:
+    """One structure on one record: work arrays for the kernel, ŷ and J."""
+
+    def __init__(self, u, fin: Nonlinearity, fout: Nonlinearity, nb, nf, nk):
+        self.u, self.fin, self.fout = u, fin, fout
+        self.nb, self.nf, self.nk = nb, nf, nk
+        self.ni, self.no = fin.n_params, fout.n_params
+        self.P = self.ni + nb + nf + self.no + 1
+        n, m = len(u), nk + nb + nf
+        self.w, self.x = np.empty(n + m), np.empty(n + m)
+        self.dw = np.zeros((n + m, self.ni + 1))
+        self.dx = np.zeros((n + m, self.ni + nb + nf + 1))
+        self.gin, self.gout = np.zeros(max(self.ni, 2)), np.zeros(max(self.no, 2))
+        self.cin = np.asarray(fin.consts or (0.0,), dtype=np.float64)
+        self.cout = np.asarray(fout.consts or (0.0,), dtype=np.float64)
+        self.yhat = np.empty(n)
+        self.jac = np.empty((n, self.P + 1))  # the last column: ∂ŷ/∂w₋
+
+    def split(self, th):
+        ni, nb, nf, no = self.ni, self.nb, self.nf, self.no
+        return (th[:ni], th[ni:ni + nb], th[ni + nb:ni + nb + nf],
+                th[ni + nb + nf:ni + nb + nf + no], th[-1])
+
+    def run(self, the, want_j: bool):
+        """Free run (and J) for ``the = [θ, w₋]``."""
+        the = np.ascontiguousarray(the, dtype=np.float64)
+        pin, b, f, pout, y0 = self.split(the[:-1])
+        return K.hw_run(self.u, self.fin.code, pin, self.cin, b, f, self.nk, self.fout.code, pout,
+                        self.cout, float(y0), float(the[-1]), want_j, self.w, self.x, self.dw,
+                        self.dx, self.gin, self.gout, self.yhat, self.jac)
+
+    def admissible(self, the) -> bool:
+        pin, _, f, pout, _ = self.split(the[:-1])
+        if len(f) and np.max(np.abs(np.roots(np.r_[1.0, f]))) >= 1.0 - 1e-9:
+            return False
+        for nl, p in ((self.fin, pin), (self.fout, pout)):
+            if nl.kind == "saturation" and not p[0] < p[1]:
+                return False
+            if nl.kind == "deadzone" and not p[0] <= p[1]:
+                return False
+        return True
+
+
+def _lm(prob: _Problem, y, th0, maxiter: int = 200):
+    """Levenberg–Marquardt on the simulation error over ``[θ, w₋]``; returns them, SSE, J there,
+    iterations.
+
+    Stops when a step lowers the SSE by less than ``1e-4 σ̂²`` (``σ̂² = SSE/N``): a move of one
+    standard deviation in any parameter changes the SSE by about ``σ²``, so the parameters are
+    then within about 0.01σ of the minimum."""
+    th = np.array(th0, dtype=np.float64)
+    if prob.run(th, True) >= 0:
+        return th, math.inf, None, 0
+    r, rc = np.empty(len(y)), np.empty(len(y))
+    sse = K.residual(y, prob.yhat, r)
+    n = len(y)
+    H, g = np.empty((len(th), len(th))), np.empty(len(th))
+    lam = 1e-3
+    it = 0
+    for it in range(1, maxiter + 1):
+        K.gram(prob.jac, r, H, g)
+        d = np.sqrt(np.maximum(np.diag(H), 0.0))
+        d[d == 0] = 1.0
+        Hs = H / np.outer(d, d)
+        gs = g / d
+        improved = False
+        while lam <= 1e16:
+            try:
+                step = np.linalg.solve(Hs + lam * np.eye(len(th)), gs) / d
+            except np.linalg.LinAlgError:
+                lam *= 10.0
+                continue
+            cand = th + step
+            if prob.admissible(cand) and prob.run(cand, False) < 0:
+                sc = K.residual(y, prob.yhat, rc)
+                if sc < sse:
+                    improved = True
+                    break
+            lam *= 10.0
+        if not improved:
+            break
+        gain = sse - sc
+        th, sse = cand, sc
+        r, rc = rc, r
+        lam = max(lam / 10.0, 1e-12)
+        if gain < 1e-4 * sse / n:
+            break
+        prob.run(th, True)
+    prob.run(th, True)
+    return th, K.residual(y, prob.yhat, r), prob.jac.copy(), it
+
+
+def _covariance(J: np.ndarray, sse: float):
+    """Gauss–Newton covariance σ²(JᵀJ)⁻¹ on the directions the data determine; σ = inf for every
+    parameter along an undetermined direction."""
+    n, P = J.shape
+    H, g = np.empty((P, P)), np.empty(P)
+    K.gram(J, np.zeros(n), H, g)
+    d = np.sqrt(np.maximum(np.diag(H), 0.0))
+    ok = d > 0
+    ds = np.where(ok, d, 1.0)
+    lam, V = np.linalg.eigh(H / np.outer(ds, ds))
+    keep = lam > _EIG_FLOOR * max(lam.max(), 1e-300)
+    inv = (V[:, keep] / lam[keep]) @ V[:, keep].T
+    sigma2 = sse / max(n - P, 1)
+    cov = sigma2 * inv / np.outer(ds, ds)
+    loose = ~ok | (np.abs(V[:, ~keep]) > 1e-3).any(axis=1) if (~keep).any() else ~ok
+    cov[loose, :] = np.nan
+    cov[:, loose] = np.nan
+    std = np.sqrt(np.maximum(np.diag(cov), 0.0))
+    std[loose] = np.inf
+    return cov, std
+
+
+def _arx_start(u, y, nb, nf, nk):
+    """Least-squares ARX ``F y = B q^-nk u + c`` on demeaned signals, F stabilised; θ = [b, f]."""
+    m = nk + nb + nf
+    n = len(y)
+    if n - m < 4 * (nb + nf + 1):
+        raise DataError(f"hammerstein_wiener: {n} samples for orders nb={nb}, nf={nf}, nk={nk}; "
+                        f"need at least {m + 4 * (nb + nf + 1)}: lower the orders or give more "
+                        "data")
+    cols = [-y[m - j:n - j] for j in range(1, nf + 1)]
+    cols += [u[m - nk - i:n - nk - i] for i in range(nb)]
+    Phi = np.column_stack(cols + [np.ones(n - m)])
+    th = np.linalg.lstsq(Phi, y[m:], rcond=None)[0]
+    f, b = th[:nf], th[nf:nf + nb]
+    if nf:
+        z = np.roots(np.r_[1.0, f])
+        z = np.where(np.abs(z) >= 0.98, 0.98 * z / np.maximum(np.abs(z), 1e-300), z)
+        f = np.real(np.poly(z))[1:]
+    return b, f
+
+
+@dataclass
+class HWModel:
+    """A Hammerstein–Wiener model ``ŷ = g(B/F f(u)) + y0`` (see the module docstring).
+
+    ``theta`` = [input-nonlinearity parameters, b1…b_nb, f1…f_nf, output-nonlinearity
+    parameters, y0] (names in ``names``), ``theta_std`` (1σ, inf where the data do not determine
+    it), ``covariance``; ``fit_percent`` (free run, estimation record), ``validation_fit_percent``
+    (free run on ``validate=``, None when diverged or none given), ``criterion`` (how structure
+    and orders were chosen), ``candidates`` (every structure tried with its score),
+    ``initial_input`` (w₋ of the estimation record's initial steady state)."""
+
+    input_nl: Nonlinearity
+    output_nl: Nonlinearity
+    nb: int
+    nf: int
+    nk: int
+    theta: np.ndarray
+    theta_std: np.ndarray
+    covariance: np.ndarray
+    dt: float = 1.0
+    y_range: tuple = (-np.inf, np.inf)
+    fit_percent: float | None = None
+    validation_fit_percent: float | None = None
+    criterion: str = ""
+    candidates: list = field(default_factory=list)
+    initial_input: float | None = None
+    input_name: str = "u"
+    output_name: str = "y"
+    structure: str = "hw"
+    fit_definition: str = HW_FIT
+
+    # -- names and blocks -------------------------------------------------------------------
+    @property
+    def inputs(self) -> tuple[str, ...]:
+        return (self.input_name,)
+
+    @property
+    def outputs(self) -> tuple[str, ...]:
+        return (self.output_name,)
+
+    @property
+    def kind(self) -> str:
+        """``'linear'``, ``'hammerstein'``, ``'wiener'`` or ``'hammerstein-wiener'``."""
+        i, o = self.input_nl.kind != "none", self.output_nl.kind != "none"
+        return {(0, 0): "linear", (1, 0): "hammerstein", (0, 1): "wiener"}.get(
+            (i, o), "hammerstein-wiener")
+
+    @property
+    def names(self) -> list[str]:
+        return (self.input_nl.param_names("in") + [f"b{i}" for i in range(1, self.nb + 1)]
+                + [f"f{j}" for j in range(1, self.nf + 1)] + self.output_nl.param_names("out")
+                + ["y0"])
+
+    def _part(self, which: str) -> np.ndarray:
+        ni, no = self.input_nl.n_params, self.output_nl.n_params
+        s = {"in": slice(0, ni), "b": slice(ni, ni + self.nb),
+             "f": slice(ni + self.nb, ni + self.nb + self.nf),
+             "out": slice(ni + self.nb + self.nf, ni + self.nb + self.nf + no)}[which]
+        return self.theta[s]
+
+    @property
+    def B(self) -> np.ndarray:
+        """B(q) coefficients from q⁰ (``nk`` leading zeros), as in gripkit's polynomial models."""
+        return np.r_[np.zeros(self.nk), self._part("b")]
+
+    @property
+    def F(self) -> np.ndarray:
+        return np.r_[1.0, self._part("f")]
+
+    @property
+    def poles(self) -> np.ndarray:
+        return np.roots(self.F) if self.nf else np.zeros(0)
+
+    def input_nonlinearity(self, u) -> np.ndarray:
+        """``f(u)`` of the identified input block."""
+        return self.input_nl.evaluate(u, self._part("in"))
+
+    def output_nonlinearity(self, x) -> np.ndarray:
+        """``g(x)`` of the identified output block (without ``y0``)."""
+        return self.output_nl.evaluate(x, self._part("out"))
+
+    @property
+    def parameters(self):
+        """Every parameter with its unit and 1σ (:class:`gripkit.params.ParameterSet`)."""
+        from ...params import Parameter, ParameterSet
+
+        docs = {"b": "numerator coefficient of B(q) (carries the chain's gain)",
+                "f": "denominator coefficient of F(q)",
+                "y0": "output offset, in the output's unit"}
+        ps = []
+        for name, v, s in zip(self.names, self.theta, self.theta_std):
+            if name.startswith(("in_", "out_")):
+                blk, sub = name.split("_", 1)
+                sig = "u, in the input's unit" if blk == "in" else "x, in the output's unit"
+                doc = f"{'input' if blk == 'in' else 'output'} nonlinearity parameter {sub} " \
+                      f"(signal {sig})"
+            else:
+                doc = docs["y0" if name == "y0" else name[0]]
+            ps.append(Parameter(name, float(v), "1", doc, std=float(s),
+                                source="identified (hammerstein_wiener)"))
+        return ParameterSet(ps, name=f"hw {self.input_nl.label}/{self.output_nl.label}")
+
+    # -- simulation -------------------------------------------------------------------------
+    def _limits(self):
+        lo, hi = self.y_range
+        span = max(hi - lo, 1e-12)
+        mid = 0.5 * (hi + lo)
+        return mid - DIVERGENCE_FACTOR * span, mid + DIVERGENCE_FACTOR * span
+
+    def _problem(self, u) -> _Problem:
+        return _Problem(u, self.input_nl, self.output_nl, self.nb, self.nf, self.nk)
+
+    def _columns(self, data, need_output: bool):
+        from ...signals.trajectory import Trajectory
+
+        if isinstance(data, Trajectory):
+            cols = [self.input_name] + ([self.output_name] if need_output else [])
+            missing = [c for c in cols if c not in data.names]
+            if missing:
+                raise DataError(f"hw: the data have no column {missing[0]!r} (the model's "
+                                f"{'input' if missing[0] == self.input_name else 'output'}); "
+                                f"they have {', '.join(map(repr, data.names))}")
+            return [_signal(data[c], c) for c in cols]
+        a = np.asarray(data, dtype=np.float64)
+        if a.ndim == 2 and a.shape[1] == (2 if need_output else 1) and a.shape[0] > 2:
+            return [_signal(a[:, i], n) for i, n in enumerate(("u", "y")[:a.shape[1]])]
+        if need_output:
+            raise DataError(f"hw.compare: expected a Trajectory with columns {self.input_name!r}, "
+                            f"{self.output_name!r} or an array (N, 2) of [u, y], found shape "
+                            f"{a.shape}")
+        return [_signal(a, "u")]
+
+    def simulate(self, data, *, std: bool = False, warn: bool = True, initial_input=None):
+        """Free run on ``data``'s input (a Trajectory with the model's input column, or an array
+        (N,)) → (N, 1), from the linear block's steady state under the constant input
+        ``initial_input`` (w₋; default ``f(u(0))``, the steady state at the first input sample).
+        With ``std=True`` also its 1σ (N, 1) from the parameter covariance (linearised, module
+        docstring). A diverging run is NaN from where it left the range, after a
+        StabilityWarning."""
+        u = self._columns(data, False)[0]
+        if initial_input is None:
+            initial_input = float(self.input_nonlinearity(u[:1])[0])
+        prob = self._problem(u)
+        prob.run(np.r_[self.theta, float(initial_input)], std)
+        y = prob.yhat.copy()
+        lo, hi = self._limits()
+        out = np.flatnonzero(~((y >= lo) & (y <= hi)))
+        if out.size:
+            y[out[0]:] = np.nan
+            if warn:
+                emit_warning(f"hw: the free run diverges at sample {int(out[0])} (beyond "
+                             f"{DIVERGENCE_FACTOR:g}× the estimation output's range); the model "
+                             "does not hold on this input", StabilityWarning)
+        if not std:
+            return y[:, None]
+        J = prob.jac[:, :-1]
+        C = np.where(np.isfinite(self.covariance), self.covariance, 0.0)
+        sd = np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", J, C, J), 0.0))
+        loose = ~np.isfinite(self.theta_std)
+        if loose.any():
+            sd = np.where(np.any(np.abs(J[:, loose]) > 0, axis=1), np.inf, sd)
+        return y[:, None], sd[:, None]
+
+    def fit_initial_input(self, u, y) -> float:
+        """The constant input w₋ whose steady state best starts the free run on ``(u, y)`` (Gauss–
+        Newton on that one number, from ``f(u(0))``)."""
+        u, y = _signal(u, "u"), _signal(y, "y")
+        prob = self._problem(u)
+        wm = float(self.input_nonlinearity(u[:1])[0])
+        best = None
+        for _ in range(20):
+            if prob.run(np.r_[self.theta, wm], True) >= 0:
+                break
+            r = y - prob.yhat
+            sse = float(r @ r)
+            if best is not None and sse >= best[1]:
+                break
+            best = (wm, sse)
+            j = prob.jac[:, -1]
+            jj = float(j @ j)
+            if jj == 0.0:
+                break
+            step = float(j @ r) / jj
+            wm += step
+            if abs(step) <= 1e-10 * (abs(wm) + 1e-10):
+                break
+        return float(u[0]) if best is None else best[0]
+
+    def compare(self, data, y=None, *, warn: bool = True) -> ModelFit:
+        """Free-run fit (%) on a record (:data:`HW_FIT`): a Trajectory with the input and output
+        columns, an array (N, 2) of [u, y], or ``compare(u, y)``; the initial steady state is
+        fitted to the record (:meth:`fit_initial_input`). None (with a StabilityWarning) when the
+        run diverges."""
+        if y is not None:
+            u, yv = _signal(data, "u"), _signal(y, "y")
+            if len(u) != len(yv):
+                raise DataError(f"hw.compare: u has {len(u)} samples but y has {len(yv)}; pass a "
+                                "pair of equal length")
+        else:
+            u, yv = self._columns(data, True)
+        ys = self.simulate(u, warn=warn, initial_input=self.fit_initial_input(u, yv))
+        fit = _fit_value(yv, ys[:, 0]) if np.all(np.isfinite(ys)) else None
+        return ModelFit(self.outputs, [fit], ys, HW_FIT)
+
+    # -- files ------------------------------------------------------------------------------
+    def to_dict(self) -> dict:
+        fin = lambda v: float(v) if np.isfinite(v) else None  # noqa: E731
+        nl = lambda n: {"kind": n.kind, "n": n.n, "consts": list(n.consts)}  # noqa: E731
+        return dict(schema=SCHEMA, schema_version=VERSION, kind=self.kind, input_nonlinearity=nl(
+            self.input_nl), output_nonlinearity=nl(self.output_nl), nb=self.nb, nf=self.nf,
+            nk=self.nk, dt=self.dt, y_range=[float(v) for v in self.y_range], names=self.names,
+            theta=[float(v) for v in self.theta], theta_std=[fin(v) for v in self.theta_std],
+            covariance=[[fin(v) for v in row] for row in self.covariance],
+            fit_percent=self.fit_percent, validation_fit_percent=self.validation_fit_percent,
+            criterion=self.criterion, input_name=self.input_name, output_name=self.output_name,
+            fit_definition=HW_FIT)
+
+    def save(self, path) -> Path:
+        """Write the model as JSON (schema ``gripkit.hw-model``), atomically."""
+        return write_text(path, json.dumps(self.to_dict(), indent=1, allow_nan=False) + "\n",
+                          what="Hammerstein-Wiener model")
+
+
+def _signal(x, name: str) -> np.ndarray:
+    a = np.asarray(x, dtype=np.float64)
+    if a.ndim == 2 and 1 in a.shape:
+        a = a.ravel()
+    if a.ndim != 1:
+        raise DataError(f"hw: {name} must be one signal (shape (N,)), found shape {a.shape}; "
+                        "pass one column")
+    if not np.all(np.isfinite(a)):
+        raise DataError(f"hw: {name} has {int(np.sum(~np.isfinite(a)))} non-finite samples; "
+                        "remove or interpolate them first")
+    return np.ascontiguousarray(a)
+
+
+def load_hw(path) -> HWModel:
+    """Read a model written by :meth:`HWModel.save`; any other schema is refused."""
+    p = Path(path)
+    try:
+        doc = json.loads(p.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise PathError(f"hw model file {str(p)!r} does not exist; give the path of a file "
+                        "written by HWModel.save or `gripkit identify hw --out`") from None
+    except OSError as exc:
+        raise PathError(f"hw model file {str(p)!r} cannot be read ({exc.strerror or exc}); give "
+                        "the path of a readable file") from None
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise ModelError(f"hw model file {str(p)!r} is not JSON ({exc}); expected a file of schema "
+                         f"{SCHEMA!r}") from None
+    except RecursionError:
+        raise ModelError(f"hw model file {str(p)!r} cannot be read: its JSON nests lists or "
+                         "objects deeper than Python's recursion limit") from None
+    except ValueError as exc:
+        raise ModelError(f"hw model file {str(p)!r} cannot be read: "
+                         f"{str(exc).split(';')[0]}") from None
+    schema = doc.get("schema") if isinstance(doc, dict) else None
+    if schema != SCHEMA:
+        raise ModelError(f"{str(p)!r} has schema {schema!r}, expected {SCHEMA!r}; load other model "
+                         "files with gripkit.sysid.load_model")
+    if doc.get("schema_version") != VERSION:
+        raise ModelError(f"{str(p)!r} is a {SCHEMA} of schema_version "
+                         f"{doc.get('schema_version')!r}; this gripkit reads version {VERSION}",
+                         hint="write it again with this gripkit's HWModel.save")
+    try:
+        nls = []
+        for key in ("input_nonlinearity", "output_nonlinearity"):
+            d = doc[key]
+            base = parse_nonlinearity(d["kind"] + (f":{int(d['n'])}" if d["kind"] in DEFAULT_N
+                                                   else ""), key)
+            nls.append(Nonlinearity(base.kind, base.n, tuple(float(c) for c in d["consts"])))
+        theta = np.array(doc["theta"], dtype=np.float64)
+        P = len(theta)
+        nan = lambda v: np.nan if v is None else v  # noqa: E731
+        std = np.array([np.inf if v is None else v for v in doc["theta_std"]], dtype=np.float64)
+        cov = np.array([[nan(v) for v in row] for row in doc["covariance"]], dtype=np.float64)
+        m = HWModel(nls[0], nls[1], int(doc["nb"]), int(doc["nf"]), int(doc["nk"]), theta, std,
+                    cov.reshape(P, P), dt=float(doc["dt"]), y_range=tuple(doc["y_range"]),
+                    fit_percent=doc.get("fit_percent"),
+                    validation_fit_percent=doc.get("validation_fit_percent"),
+                    criterion=str(doc.get("criterion", "")),
+                    input_name=str(doc.get("input_name", "u")),
+                    output_name=str(doc.get("output_name", "y")))
+    except (KeyError, TypeError, ValueError, ArgumentError) as exc:
+        raise ModelError(f"{str(p)!r}: a malformed {SCHEMA} ({type(exc).__name__}: {exc}); write "
+                         "it again with HWModel.save") from None
+    if len(m.names) != P or len(std) != P or min(m.nb, m.nf + 1, m.nk + 1) < 1:
+        raise ModelError(f"{str(p)!r}: {P} parameters but the structure needs {len(m.names)}; "
+                         "write it again with HWModel.save")
+    if (m.input_nl.kind in ("pwl", "sigmoid") and len(m.input_nl.consts) < m.input_nl.n) or (
+            m.output_nl.kind in ("pwl", "sigmoid") and len(m.output_nl.consts) < m.output_nl.n):
+        raise ModelError(f"{str(p)!r}: a pwl/sigmoid block without its breakpoints; write it "
+                         "again with HWModel.save")
+    return m
+
+
+def _order(v, name: str, lo: int) -> int:
+    if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not lo <= v <= 20:
+        raise ArgumentError(f"hammerstein_wiener: {name} must be an integer from {lo} to 20, "
+                            f"found {v!r}")
+    return int(v)
+
+
+def _fit_structure(u, y, fin, fout, nb, nf, nk, lin_start=None, maxiter=200):
+    """Fit one structure (orders given) from the linear start ``[b, f, y0, w₋]``; several limit
+    starts, the best kept. Returns (``[θ, w₋]``, SSE, J, problem)."""
+    if lin_start is None:
+        b, f = _arx_start(u - u.mean(), y - y.mean(), nb, nf, nk)
+        prob = _Problem(u, Nonlinearity(), Nonlinearity(), nb, nf, nk)
+        th0 = np.r_[b, f, y.mean() - b.sum() / (1 + f.sum()) * u.mean(), u[0]]
+        th, sse, J, _ = _lm(prob, y, th0, maxiter)
+        if fin.kind == "none" and fout.kind == "none":
+            return th, sse, J, prob
+        lin_start = th
+    b, f, y0, wpre = lin_start[:nb], lin_start[nb:nb + nf], lin_start[-2], lin_start[-1]
+    # the signal entering each block under the linear start
+    lin = _Problem(u, Nonlinearity(), Nonlinearity(), nb, nf, nk)
+    lin.run(lin_start, False)
+    xlin = lin.x[nk + nb + nf:].copy()
+    fin = _with_consts(fin, u)
+    fout = _with_consts(fout, xlin)
+    prob = _Problem(u, fin, fout, nb, nf, nk)
+    best = None
+    for pin in _limit_starts(fin, u):
+        for pout in _limit_starts(fout, xlin):
+            th0 = np.r_[pin, b, f, pout, y0, wpre]
+            if not prob.admissible(th0):
+                continue
+            th, sse, J, _ = _lm(prob, y, th0, maxiter)
+            if J is not None and (best is None or sse < best[1]):
+                best = (th, sse, J)
+    if best is None:
+        raise IdentificationError(f"hammerstein_wiener: no start of the {fin.label}/{fout.label} "
+                                  "structure gave a finite free run; check the data's scale")
+    return best[0], best[1], best[2], prob
+
+
+def _excitation_check(model: HWModel, u: np.ndarray):
+    """Name a saturation limit or dead-zone threshold that the data never cross."""
+    for where, nl, sig in (("input", model.input_nl, None), ("output", model.output_nl, None)):
+        if nl.kind not in ("saturation", "deadzone"):
+            continue
+        if where == "input":
+            v = u
+        else:
+            prob = model._problem(u)
+            prob.run(np.r_[model.theta, model.initial_input], False)
+            v = prob.x[model.nk + model.nb + model.nf:]
+        lo, hi = model._part("in" if where == "input" else "out")
+        below, above = int(np.sum(v < lo)), int(np.sum(v > hi))
+        inside = len(v) - below - above
+        sname = "u" if where == "input" else "x (the linear block's output)"
+        if nl.kind == "deadzone" and below + above == 0:
+            raise IdentificationError(
+                f"hammerstein_wiener: the {where} dead zone [{lo:.6g}, {hi:.6g}] is never left: "
+                f"all {len(v)} samples of {sname} lie inside it, so the output does not depend on "
+                "the input; excite beyond the dead zone or choose another nonlinearity")
+        few = max(3, math.ceil(0.005 * len(v)))
+        if nl.kind == "deadzone" and min(below, above, inside) < few:
+            where_ = ("below the lower threshold" if below < few else
+                      "above the upper threshold" if above < few else "inside it")
+            k = min(below, above, inside)
+            emit_warning(f"hammerstein_wiener: the data never cross the {where} dead zone "
+                         f"[{lo:.6g}, {hi:.6g}]: only {k} of {len(v)} samples of {sname} lie "
+                         f"{where_}, so its thresholds are not identified (σ = inf, or "
+                         "confounded with the offset y0); excite both sides of the dead zone",
+                         AccuracyWarning)
+        if nl.kind == "saturation" and min(below, above) < few:
+            side = "lower" if below < few else "upper"
+            k = min(below, above)
+            emit_warning(f"hammerstein_wiener: the {where} saturation's {side} limit "
+                         f"{lo if below < few else hi:.6g} is never reached by the data (only {k} "
+                         f"of {len(v)} samples of {sname} beyond it), so it is not identified "
+                         "(σ = inf or meaningless); excite beyond the limit or choose another "
+                         "nonlinearity", AccuracyWarning)
+
+
+def hammerstein_wiener(u, y, *, input_nonlinearity=None, output_nonlinearity=None,
+                       nb: int | None = None, nf: int | None = None, nk: int | None = None,
+                       dt: float | None = None, validate=None, maxiter: int = 200,
+                       progress: bool = False) -> HWModel:
+    """Hammerstein, Wiener or Hammerstein–Wiener model of ``y`` driven by ``u`` (see the module
+    docstring).
+
+    ``input_nonlinearity`` / ``output_nonlinearity``: ``'none'``, ``'saturation'``,
+    ``'deadzone'``, ``'poly[:N]'``, ``'pwl[:N]'``, ``'sigmoid[:N]'``; when both are None the
+    structure is chosen among :data:`AUTO_STRUCTURES` (one None with the other given means
+    ``'none'``). ``nb``, ``nf``, ``nk``: orders of B/F; each None is chosen (``(nb, nf)`` in
+    (1,1), (2,2), (3,3); ``nk`` in 0, 1, 2) on the linear model. Choice by free-run fit on
+    ``validate=(u2, y2)`` when given, else by BIC. ``dt``: sample interval (s), default 1.
+    ``progress``: a progress bar on stderr (one step per structure and start).
+    """
+    from ...progress import track
+
+    u, y = _signal(u, "u"), _signal(y, "y")
+    if len(u) != len(y):
+        raise DataError(f"hammerstein_wiener: u has {len(u)} samples but y has {len(y)}; pass a "
+                        "pair of equal length")
+    if np.ptp(y) == 0.0:
+        raise DataError(f"hammerstein_wiener: the output is constant ({y[0]:g} in all {len(y)} "
+                        "samples); there is nothing to identify: check the output column")
+    if np.ptp(u) == 0.0:
+        raise DataError(f"hammerstein_wiener: the input is constant ({u[0]:g} in all {len(u)} "
+                        "samples); it excites nothing: check the input column")
+    if dt is not None and not (isinstance(dt, (int, float, np.floating)) and np.isfinite(dt)
+                               and dt > 0):
+        raise ArgumentError(f"hammerstein_wiener: dt must be a positive sample interval in s, "
+                            f"found {dt!r}")
+    if isinstance(maxiter, bool) or not isinstance(maxiter, (int, np.integer)) or maxiter < 1:
+        raise ArgumentError(f"hammerstein_wiener: maxiter must be an integer ≥ 1, found "
+                            f"{maxiter!r}")
+    auto = input_nonlinearity is None and output_nonlinearity is None
+    structures = ([(parse_nonlinearity(a), parse_nonlinearity(b)) for a, b in AUTO_STRUCTURES]
+                  if auto else [(parse_nonlinearity(input_nonlinearity, "input_nonlinearity"),
+                                 parse_nonlinearity(output_nonlinearity, "output_nonlinearity"))])
+    nb = None if nb is None else _order(nb, "nb", 1)
+    nf = None if nf is None else _order(nf, "nf", 0)
+    nk = None if nk is None else _order(nk, "nk", 0)
+    uv = yv = None
+    if validate is not None:
+        try:
+            uv, yv = validate
+        except (TypeError, ValueError):
+            raise ArgumentError("hammerstein_wiener: validate must be a pair (u, y) of validation "
+                                "data") from None
+        uv, yv = _signal(uv, "validate u"), _signal(yv, "validate y")
+        if len(uv) != len(yv) or len(uv) < 10:
+            raise DataError(f"hammerstein_wiener: validation u has {len(uv)} and y {len(yv)} "
+                            "samples; need a pair of equal length (≥ 10 samples)")
+    n = len(y)
+    orders = [(b_, f_, k_) for b_, f_ in AUTO_ORDERS for k_ in AUTO_NK]
+    orders = [(nb if nb is not None else b_, nf if nf is not None else f_,
+               nk if nk is not None else k_) for b_, f_, k_ in orders]
+    orders = list(dict.fromkeys(orders))
+    y_range = (float(y.min()), float(y.max()))
+    dtv = 1.0 if dt is None else float(dt)
+
+    def make(fin, fout, o, the, sse, J):
+        cov, std = _covariance(J, sse)  # with w₋: its uncertainty is in every other σ
+        P = len(the) - 1
+        m = HWModel(fin, fout, o[0], o[1], o[2], the[:P], std[:P], cov[:P, :P], dt=dtv,
+                    y_range=y_range)
+        m.initial_input = float(the[-1])
+        return m
+
+    def score(m: HWModel, sse: float) -> float:
+        if uv is None:
+            return -(n * math.log(max(sse, 1e-300) / n) + len(m.theta) * math.log(n))
+        f = m.compare(uv, yv, warn=False).fit_percent[0]
+        return -math.inf if f is None else f
+
+    searched = nb is None or nf is None
+    dyn = list(dict.fromkeys((nb if nb is not None else b_, nf if nf is not None else f_)
+                             for b_, f_ in AUTO_ORDERS))
+    steps = (len(orders) + len(structures) + (N_JOINED**2 if auto else 0)
+             + (len(dyn) - 1 if searched else 0))
+    bar = iter(track(range(steps), total=steps, description="hw fit", enabled=progress))
+    # (1) orders on the linear output-error model
+    lin_fits = {}
+    screen = maxiter if len(orders) == 1 else min(maxiter, SCREEN_ITERATIONS)
+    for o in orders:
+        next(bar, None)
+        th, sse, J, _ = _fit_structure(u, y, Nonlinearity(), Nonlinearity(), *o, maxiter=screen)
+        if J is None:
+            continue
+        lin_fits[o] = (th, sse, J)
+    if not lin_fits:
+        raise IdentificationError("hammerstein_wiener: no linear start gave a finite free run; "
+                                  "check the data's scale")
+    ranked = sorted(lin_fits, key=lambda o: -score(make(Nonlinearity(), Nonlinearity(), o,
+                                                        *lin_fits[o]), lin_fits[o][1]))
+    o = ranked[0]
+    if screen < maxiter:  # the chosen orders' linear model to convergence
+        th, sse, J, _ = _lm(_Problem(u, Nonlinearity(), Nonlinearity(), *o), y, lin_fits[o][0],
+                            maxiter)
+        lin_fits[o] = (th, sse, J)
+    chosen_by = "validation free-run fit" if uv is not None else "BIC"
+
+    def fit_at(fin, fout, o):
+        if fin.kind == "none" and fout.kind == "none":
+            th, sse, J = lin_fits[o]
+            fin_c, fout_c = fin, fout
+        else:
+            th, sse, J, prob = _fit_structure(u, y, fin, fout, *o, lin_start=lin_fits[o][0],
+                                              maxiter=maxiter)
+            fin_c, fout_c = prob.fin, prob.fout
+        m = make(fin_c, fout_c, o, th, sse, J)
+        return score(m, sse), m, (fin, fout)
+
+    # (2) structures at those orders
+    cands = []
+    for fin, fout in structures:
+        next(bar, None)
+        cands.append(fit_at(fin, fout, o))
+    # Hammerstein–Wiener candidates: the two best input blocks with the two best output blocks
+    ins = sorted((c for c in cands if c[2][0].kind != "none" and c[2][1].kind == "none"),
+                 key=lambda c: -c[0])[:N_JOINED]
+    outs = sorted((c for c in cands if c[2][0].kind == "none" and c[2][1].kind != "none"),
+                  key=lambda c: -c[0])[:N_JOINED]
+    for ci in ins if auto else ():
+        for co in outs:
+            next(bar, None)
+            cands.append(fit_at(ci[2][0], co[2][1], o))
+    cands.sort(key=lambda c: -c[0])
+    # (3) a nonlinear structure may need fewer poles than the linear approximation: (nb, nf)
+    # chosen again for it, with the delay of step (1)
+    refit = []
+    if searched and cands[0][1].kind != "linear":
+        for b_, f_ in dyn:
+            if (b_, f_, o[2]) != o and (b_, f_, o[2]) in lin_fits:
+                next(bar, None)
+                refit.append(fit_at(*cands[0][2], (b_, f_, o[2])))
+    for _ in bar:
+        pass
+    cands = sorted(cands + refit, key=lambda c: -c[0])
+    best = cands[0][1]
+    if uv is not None:  # parsimony: within 0.1 fit point of the best, every parameter
+        # determined by the data (finite σ) before any is not, then the fewest parameters
+        best = min((c for c in cands if c[0] >= cands[0][0] - PARSIMONY_POINTS),
+                   key=lambda c: (not np.all(np.isfinite(c[1].theta_std)), len(c[1].theta)))[1]
+    best.candidates = [{"input": c[1].input_nl.label, "output": c[1].output_nl.label,
+                        "nb": c[1].nb, "nf": c[1].nf, "nk": c[1].nk,
+                        ("validation_fit_percent" if uv is not None else "bic"):
+                        (c[0] if uv is not None else -c[0])} for c in cands]
+    what = []
+    if nb is None or nf is None or nk is None:
+        what.append(f"orders [nb nf nk] = [{best.nb} {best.nf} {best.nk}] by {chosen_by} (the "
+                    f"delay on the linear model"
+                    f"{'; nb and nf again for the structure' if refit else ''})")
+    if auto:
+        what.append(f"structure {best.input_nl.label}/{best.output_nl.label} by {chosen_by} "
+                    f"among {len(structures)} and {len(cands) - len(structures) - len(refit)} "
+                    "joined")
+    best.criterion = "; ".join(what) if what else "structure and orders given"
+    _excitation_check(best, u)
+    loose = [n for n, sd in zip(best.names, best.theta_std) if not np.isfinite(sd)]
+    if loose:
+        emit_warning(f"hammerstein_wiener: the data do not determine {', '.join(loose)} of the "
+                     f"{best.input_nl.label}/{best.output_nl.label} model (σ = inf: they trade "
+                     "off against other parameters without changing the output); excite more "
+                     "amplitudes, or choose a simpler block", AccuracyWarning)
+    fit = best.compare(u, y)
+    best.fit_percent = fit.fit_percent[0]
+    if uv is not None:
+        best.validation_fit_percent = best.compare(uv, yv).fit_percent[0]
+    return best

@@ -1,0 +1,989 @@
+"""Hysteresis identified from the user's data (issue 26, family 4): generic Bouc-Wen (actuator
+form) and Prandtl–Ishlinskii with its analytic inverse, parameters with σ.
+
+**Bouc-Wen, actuator form** (``001_0b92a7da96e7aa46.txt`` eq 3, generalised by the exponent n)::
+
+    y = d u − h + c,     dh/dt = α d du/dt − β |du/dt| h |h|^(n−1) − γ du/dt |h|^n
+
+u the input (a voltage, a force), y the output (a displacement), h the hysteresis term (unit of
+y), c the output offset. With n = 1 and λ = α d this is eq 3 of the seed, the model of the
+piezo reference system (:class:`gripkit.models.hysteresis.BoucWen`), and the free run uses its
+exact per-sample step (:func:`gripkit.models.hysteresis.bouc_wen_advance`); for n ≠ 1 it is
+integrated in the input by Runge-Kutta (:mod:`._hysteresis_kernels`). The model is rate
+independent: only the path of u matters, the sample time does not. The record is simulated from
+the virgin state, h = 0 at its first input sample. d, α, β, γ (and n with
+``exponent='free'``, c with ``offset=True``) minimise ‖y − ŷ‖² of that free run
+(``scipy.optimize.least_squares``, trust-region reflective, on signals scaled to unit half-range,
+``multistart`` starting points from the data's slope and the gap between its branches);
+cov θ = s² (JᵀJ)⁻¹ with s² = SSE/(N − p) and J the Jacobian of the free run at the optimum.
+
+**Bouc-Wen, oscillator form** (Y.-K. Wen, "Method for random vibration of hysteretic
+systems", *J. Eng. Mech. Div. ASCE* 102(2), 1976; :class:`BoucWenOscillatorModel`): a force u on a
+mass with a hysteretic spring, ``m ẍ + c_v ẋ + k_e x + k_h z = u``,
+``ż = ẋ − β |ẋ| z |z|^(n−1) − γ ẋ |z|^n`` (A = 1 fixes the scale of z), rate dependent,
+simulated from rest with the input held over each sample (RK4 sub-steps) and fitted on the free
+run like the actuator form, from the second-order ARX model nearest the data (the starting
+points tried on the first :data:`WARM_SAMPLES` samples, the best then refined on the whole
+record).
+
+**Prandtl–Ishlinskii**: ``y = c + Σ_i w_i F_{r_i}[u − a]`` with the play operators
+``F_r[x](k) = max(x(k) − r, min(x(k) + r, F_r[x](k−1)))``, each relaxed at the first sample
+(F = x(0)), thresholds ``r_0 = 0 < r_1 < …`` (by default ``r_i = i R / m``, R half the input's
+range, m = ``operators``) and input offset a (0 for an identified model). The weights are the
+least-squares solution with ``w_i ≥ 0`` (bounded-variable least squares, ``scipy.optimize
+.lsq_linear``), cov = s² (AᵀA)⁻¹ over the play matrix A (the unconstrained covariance, honest
+for the weights not on their bound). :meth:`PrandtlIshlinskiiModel.invert` gives the inverse
+operator, again a PI model (Kuhnen, *Eur. J. Control* 9(4), 2003, eq 18)::
+
+    r̂_i = Σ_{j≤i} w_j (r_i − r_j),   ŵ_0 = 1/w_0,   ŵ_i = −w_i / (W_i W_{i−1}),  W_i = Σ_{j≤i} w_j
+
+with input offset c and output offset a, so that ``inverse(model(u)) = u`` sample by sample
+(the inverse's plays relaxed at its first sample are the image of the model's relaxed state);
+it needs w_0 > 0, and is the feed-forward compensator: voltage = inverse(desired displacement).
+
+Both are scored by :data:`HYSTERESIS_FIT`. An input that never turns back does not excite the
+hysteresis and is refused with a DataError that says so.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from ...atomic import write_text
+from ...errors import (AccuracyWarning, ArgumentError, DataError, IdentificationError, ModelError,
+                       PathError, StabilityWarning, emit_warning)
+from ...params import Parameter, ParameterSet
+from ...progress import track
+from ...signals.trajectory import Trajectory
+from ..model_protocol import ModelFit
+from . import _hysteresis_kernels as K
+
+__all__ = ["SCHEMA", "HYSTERESIS_FIT", "MODELS", "FORMS", "BoucWenModel",
+           "BoucWenOscillatorModel", "PrandtlIshlinskiiModel", "hysteresis", "load_hysteresis",
+           "pi_inverse"]
+
+SCHEMA = "gripkit.hysteresis-model"
+VERSION = 1
+MODELS = ("bouc-wen", "prandtl-ishlinskii")
+#: the forms of the Bouc-Wen model
+FORMS = ("actuator", "oscillator")
+#: how a hysteresis model's fit is taken (``gripkit compare`` prints it)
+HYSTERESIS_FIT = ("free run from the relaxed state at the first input sample (Bouc-Wen: h = 0; "
+                  "Prandtl-Ishlinskii: every play at the first input), "
+                  "fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) over the record (at identification: the "
+                  "samples after burn_in)")
+#: an input turning back by less than this fraction of its range is no reversal (noise)
+REVERSAL_BAND = 0.01
+
+
+# ---------------------------------------------------------------------------------------------
+# helpers
+
+
+def _unitless(u: str) -> bool:
+    return u in ("", "1")
+
+
+def _ratio(num: str, den: str) -> str:
+    if _unitless(den):
+        return num if not _unitless(num) else "1"
+    return f"1/{den}" if _unitless(num) else f"{num}/{den}"
+
+
+def _as_signal(x, name: str) -> np.ndarray:
+    a = np.asarray(x, dtype=np.float64)
+    if a.ndim == 2 and 1 in a.shape:
+        a = a.ravel()
+    if a.ndim != 1:
+        raise DataError(f"hysteresis: {name} must be one signal (shape (N,)), found shape "
+                        f"{a.shape}; pass one column")
+    if not np.all(np.isfinite(a)):
+        raise DataError(f"hysteresis: {name} has {int(np.sum(~np.isfinite(a)))} non-finite "
+                        "samples; remove or interpolate them first")
+    return a
+
+
+def _fit_percent(y: np.ndarray, yhat: np.ndarray) -> float | None:
+    if not np.all(np.isfinite(yhat)):
+        return None
+    den = float(np.linalg.norm(y - y.mean()))
+    if den == 0.0:
+        raise DataError("hysteresis: the fit is undefined for a constant output (‖y − ȳ‖ = 0)")
+    return 100.0 * (1.0 - float(np.linalg.norm(y - yhat)) / den)
+
+
+def _record(data, input, output, what: str, need_output: bool = True):
+    """(u, y or None, dt, input name, output name, input unit, output unit) from a Trajectory or
+    a pair (u, y) / an array u."""
+    if isinstance(data, Trajectory):
+        for role, col in (("input", input), ("output", output)):
+            if col is None and (role == "input" or need_output):
+                raise ArgumentError(f"{what}: give {role}= (a column of the data: "
+                                    f"{', '.join(map(repr, data.names))})")
+            if col is not None and col not in data.names and (role == "input" or need_output):
+                raise DataError(f"{what}: no column {col!r} in the data; it has "
+                                f"{', '.join(map(repr, data.names))}")
+        u = _as_signal(data[input], f"column {input!r}")
+        y = (_as_signal(data[output], f"column {output!r}")
+             if need_output or (output is not None and output in data.names) else None)
+        dt = data.dt if data.n > 1 else None
+        return (u, y, dt, input, output, data.unit(input),
+                data.unit(output) if output in data.names else "1")
+    if isinstance(data, (tuple, list)) and len(data) == 2:
+        u, y = _as_signal(data[0], "u"), _as_signal(data[1], "y")
+        if len(u) != len(y):
+            raise DataError(f"{what}: u has {len(u)} samples but y has {len(y)}; pass a pair of "
+                            "equal length")
+        return u, y, None, input or "u", output or "y", "1", "1"
+    if need_output:
+        raise ArgumentError(f"{what}: data must be a Trajectory or a pair (u, y), found "
+                            f"{type(data).__name__}")
+    return _as_signal(data, "u"), None, None, input or "u", output or "y", "1", "1"
+
+
+def _check_excited(u: np.ndarray, y: np.ndarray, input: str, output: str) -> None:
+    if len(u) < 10:
+        raise DataError(f"hysteresis: {len(u)} samples; a loop needs at least 10")
+    if np.ptp(u) == 0.0:
+        raise DataError(f"hysteresis: the input {input!r} is constant ({u[0]:g}); a hysteresis "
+                        "needs an input sweep")
+    if np.ptp(y) == 0.0:
+        raise DataError(f"hysteresis: the output {output!r} is constant ({y[0]:g}); check the "
+                        "output column")
+    if K.count_reversals(u, REVERSAL_BAND * float(np.ptp(u))) < 1:
+        raise DataError(f"hysteresis not excited: the input {input!r} never reverses (it "
+                        f"never turns back by more than {100 * REVERSAL_BAND:g} % of its "
+                        "range), so no loop is closed",
+                        hint="record at least one rise and one fall of the input (a sine or "
+                             "triangle sweep, ideally with loops of several amplitudes)")
+
+
+def _parameter(name, value, unit, doc, std=None, fixed=False, bounds=(None, None)):
+    return Parameter(name, float(value), unit, doc, bounds=bounds, fixed=fixed,
+                     source="identified (gripkit.sysid.hysteresis)" if not fixed else "fixed",
+                     std=None if std is None or not math.isfinite(std) else float(std))
+
+
+def _output_std(G: np.ndarray, cov: np.ndarray) -> np.ndarray:
+    """sqrt(diag(G cov Gᵀ)) row by row."""
+    return np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", G, cov, G), 0.0))
+
+
+class _HysteresisModel:
+    """What both hysteresis families share: the protocol's names, compare, save."""
+
+    structure = ""
+    fit_definition = HYSTERESIS_FIT
+
+    @property
+    def inputs(self) -> tuple[str, ...]:
+        return (self.input_name,)
+
+    @property
+    def outputs(self) -> tuple[str, ...]:
+        return (self.output_name,)
+
+    def _input(self, data) -> np.ndarray:
+        return _record(data, self.input_name, None, f"{self.structure}.simulate",
+                       need_output=False)[0]
+
+    def _fd_std(self, u: np.ndarray) -> np.ndarray:
+        """σ of the free run (N,), the parameter covariance propagated through the Jacobian of
+        the run by central differences (step 10⁻³ σ of each free parameter)."""
+        base, sd = self.values(), self.std
+        G = np.zeros((len(u), len(self.free)))
+        for j, k in enumerate(self.free):
+            h = 1e-3 * sd[k] if sd[k] > 0 else 1e-8 * max(abs(base[k]), 1.0)
+            hi, lo = dict(base), dict(base)
+            hi[k] += h
+            lo[k] -= h
+            G[:, j] = (self._run(u, hi)[0] - self._run(u, lo)[0]) / (2 * h)
+        return _output_std(G, self.covariance)
+
+    @property
+    def std(self) -> dict:
+        """1σ of each free parameter (from ``covariance``)."""
+        sd = np.sqrt(np.maximum(np.diag(self.covariance), 0.0)) if len(self.free) else []
+        return {k: float(s) for k, s in zip(self.free, sd)}
+
+    def compare(self, data, *, warn: bool = True) -> ModelFit:
+        """Free-run fit (%) on a record holding the model's input and output columns (a
+        Trajectory, or a pair (u, y)); None (with a StabilityWarning) when the run diverges."""
+        u, y, *_ = _record(data, self.input_name, self.output_name, f"{self.structure}.compare")
+        if isinstance(data, Trajectory):
+            u = self._input(data)  # the family's checks of a record (the oscillator's dt)
+        yhat = self.simulate(u, warn=warn)
+        return ModelFit(self.outputs, [_fit_percent(y, yhat[:, 0])], yhat, HYSTERESIS_FIT)
+
+    def save(self, path) -> Path:
+        """Write the model as JSON (schema ``gripkit.hysteresis-model``), atomically."""
+        return write_text(path, json.dumps(self.to_dict(), indent=1) + "\n",
+                          what="hysteresis model")
+
+
+# ---------------------------------------------------------------------------------------------
+# Bouc-Wen
+
+
+_BW_NAMES = ("d", "alpha", "beta", "gamma", "n", "offset")
+
+
+@dataclass
+class BoucWenModel(_HysteresisModel):
+    """Generic Bouc-Wen hysteresis, actuator form (module docstring): y = d u − h + offset.
+
+    ``free``: the names estimated, in the order of ``covariance``; the others are held (n = 1 by
+    default, offset 0 with ``offset=False``)."""
+
+    d: float
+    alpha: float
+    beta: float
+    gamma: float
+    n: float = 1.0
+    offset: float = 0.0
+    free: tuple = ("d", "alpha", "beta", "gamma", "offset")
+    covariance: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    dt: float | None = None
+    input_name: str = "u"
+    output_name: str = "y"
+    input_unit: str = "1"
+    output_unit: str = "1"
+    fit_percent: float | None = None
+    validation_fit_percent: float | None = None
+    burn_in: int = 0
+    criterion: str = ""
+
+    structure = "bouc-wen"
+
+    def values(self) -> dict:
+        return {k: float(getattr(self, k)) for k in _BW_NAMES}
+
+    @property
+    def lam(self) -> float:
+        """λ = α d of the seed's eq 3 (unit of d)."""
+        return self.alpha * self.d
+
+    def saturation(self) -> float:
+        """|h| a long monotone sweep tends to, (α d / (β + γ))^(1/n); inf when β + γ ≤ 0."""
+        c = self.beta + self.gamma
+        return (abs(self.lam) / c) ** (1.0 / self.n) if c > 0 else math.inf
+
+    @property
+    def parameters(self) -> ParameterSet:
+        uu, yu = self.input_unit, self.output_unit
+        shape = _ratio("1", uu) if self.n == 1.0 else f"1/({uu}*{yu}^{self.n - 1:g})"
+        sd = self.std
+        docs = {"d": ("gain: output per unit input without hysteresis", _ratio(yu, uu)),
+                "alpha": ("α: amplitude of the hysteresis (λ = α d in eq 3)", "1"),
+                "beta": ("β: shape of the hysteresis (eq 3)", shape),
+                "gamma": ("γ: shape of the hysteresis (eq 3)", shape),
+                "n": ("exponent n of |h| (n = 1: eq 3)", "1"),
+                "offset": ("output offset c", yu if not _unitless(yu) else "1")}
+        return ParameterSet([_parameter(k, getattr(self, k), docs[k][1], docs[k][0], sd.get(k),
+                                        fixed=k not in self.free) for k in _BW_NAMES],
+                            "bouc-wen")
+
+    def _run(self, u: np.ndarray, theta: dict | None = None) -> tuple[np.ndarray, int]:
+        p = self.values() if theta is None else theta
+        y = np.empty(len(u))
+        at = K.bw_simulate(u, p["d"], p["alpha"], p["beta"], p["gamma"], p["n"], p["offset"],
+                           0.0, float(u[0]), y)
+        return y, at
+
+    def simulate(self, data, *, std: bool = False, warn: bool = True):
+        """Free run (N, 1) on the input column of ``data`` (a Trajectory, or an array (N,)), from
+        h = 0 at the first sample. ``std=True`` also returns σ of ŷ (N, 1), propagated from the
+        parameter covariance through the Jacobian of the run (central differences, step 10⁻³ σ)."""
+        u = self._input(data)
+        y, at = self._run(u)
+        if at >= 0 and warn:
+            emit_warning(f"bouc-wen: the free run diverges at sample {at} (β + γ = "
+                         f"{self.beta + self.gamma:.4g} ≤ 0 lets h grow without bound?)",
+                         StabilityWarning)
+        if not std:
+            return y[:, None]
+        return y[:, None], self._fd_std(u)[:, None]
+
+    def to_dict(self) -> dict:
+        return dict(schema=SCHEMA, version=VERSION, model=self.structure, **self.values(),
+                    free=list(self.free), covariance=np.asarray(self.covariance).tolist(),
+                    std=self.std, dt=self.dt, input_name=self.input_name,
+                    output_name=self.output_name, input_unit=self.input_unit,
+                    output_unit=self.output_unit, fit_percent=self.fit_percent,
+                    validation_fit_percent=self.validation_fit_percent, burn_in=self.burn_in,
+                    criterion=self.criterion, fit_definition=HYSTERESIS_FIT)
+
+    def summary(self) -> str:
+        sd = self.std
+        how = " estimated" if "n" in self.free else ""
+        rows = [f"Bouc-Wen (actuator form, n = {self.n:g}{how}): y = d u − h + c  "
+                f"({self.criterion})"]
+        for p in self.parameters.values():
+            s = f" ± {sd[p.name]:.3g}" if p.name in sd else " (fixed)"
+            rows.append(f"  {p.name:<7s} {p.value: .6g}{s} {p.unit}")
+        return "\n".join(rows)
+
+
+def _scaled_bw(theta_s, names, fixed, su, sy):
+    """Physical Bouc-Wen parameters from the scaled ones (u/su, y/sy)."""
+    p = dict(fixed)
+    p.update(zip(names, theta_s))
+    n = p["n"]
+    k = 1.0 / (su * sy ** (n - 1.0))
+    return {"d": p["d"] * sy / su, "alpha": p["alpha"], "beta": p["beta"] * k,
+            "gamma": p["gamma"] * k, "n": n, "offset": p["offset"] * sy}
+
+
+def _bw_transform_jacobian(theta_s, names, fixed, su, sy) -> np.ndarray:
+    """∂(physical)/∂(scaled) over ``names`` (analytic: diagonal but for ∂β/∂n, ∂γ/∂n)."""
+    phys = _scaled_bw(theta_s, names, fixed, su, sy)
+    n = phys["n"]
+    k = 1.0 / (su * sy ** (n - 1.0))
+    diag = {"d": sy / su, "alpha": 1.0, "beta": k, "gamma": k, "n": 1.0, "offset": sy}
+    T = np.diag([diag[x] for x in names])
+    if "n" in names:
+        j = names.index("n")
+        for g in ("beta", "gamma"):
+            if g in names:
+                T[names.index(g), j] = -phys[g] * math.log(sy)
+    return T
+
+
+def _fit_bouc_wen(u, y, *, exponent, offset, burn_in, multistart, progress):
+    from scipy.optimize import least_squares
+
+    su = 0.5 * float(np.ptp(u))
+    sy = 0.5 * float(np.ptp(y))
+    us, ys = u / su, y / sy
+    n_free = exponent == "free"
+    n0 = 1.0 if n_free else float(exponent)
+    names = ["d", "alpha", "beta", "gamma"] + (["n"] if n_free else []) + (
+        ["offset"] if offset else [])
+    fixed = {"n": n0, "offset": 0.0}
+    lo = {"d": -np.inf, "alpha": 0.0, "beta": 0.0, "gamma": -np.inf, "n": 1.0, "offset": -np.inf}
+    hi = {"d": np.inf, "alpha": np.inf, "beta": np.inf, "gamma": np.inf, "n": 10.0,
+          "offset": np.inf}
+    # starting values: the straight line through the loop, and its half width as |h| reached
+    A = np.column_stack([us, np.ones_like(us)])
+    slope, icpt = np.linalg.lstsq(A, ys, rcond=None)[0]
+    e = ys - A @ np.array([slope, icpt])
+    hs = max(0.25 * float(np.ptp(e)), 1e-3)
+    d0 = slope if abs(slope) > 1e-6 else 1.0
+    starts = []
+    for c0 in (2.0, 8.0, 0.5, 30.0):
+        for ratio in (0.3, -0.3):
+            beta0 = c0 / (1.0 + ratio)
+            gamma0 = ratio * beta0
+            alpha0 = hs ** n0 * c0 / abs(d0)
+            p0 = {"d": d0, "alpha": alpha0, "beta": beta0, "gamma": gamma0, "n": n0,
+                  "offset": float(ys[0] - d0 * us[0]) if offset else 0.0}
+            starts.append(np.array([p0[k] for k in names]))
+    starts = starts[:max(1, int(multistart))]
+    sl = slice(burn_in, None)
+    target = ys[sl]
+    buf = np.empty(len(us))
+
+    def resid(th):
+        p = dict(fixed)
+        p.update(zip(names, th))
+        K.bw_simulate(us, p["d"], p["alpha"], p["beta"], p["gamma"], p["n"], p["offset"], 0.0,
+                      float(us[0]), buf)
+        r = buf[sl] - target
+        return np.where(np.isfinite(r), r, 1e3)
+
+    best = None
+    for x0 in track(starts, description="bouc-wen fit", enabled=progress):
+        x0 = np.clip(x0, [lo[k] + 1e-9 if np.isfinite(lo[k]) else -np.inf for k in names],
+                     [hi[k] - 1e-9 if np.isfinite(hi[k]) else np.inf for k in names])
+        res = least_squares(resid, x0, bounds=([lo[k] for k in names], [hi[k] for k in names]),
+                            x_scale="jac", method="trf", xtol=1e-12, ftol=1e-12, gtol=1e-12,
+                            max_nfev=400 * len(names))
+        if best is None or res.cost < best.cost:
+            best = res
+    if best is None or not np.isfinite(best.cost):
+        raise IdentificationError("bouc-wen: no starting point gave a finite free run; check that "
+                                  "the output follows the input")
+    dof = max(len(target) - len(names), 1)
+    s2 = 2.0 * best.cost / dof
+    J = best.jac
+    cov_s = s2 * np.linalg.pinv(J.T @ J)
+    if np.linalg.cond(J.T @ J) > 1e14:
+        emit_warning("bouc-wen: the parameters are nearly unidentifiable from this record (JᵀJ "
+                     "singular to working precision); their σ are unreliable: excite loops of "
+                     "several amplitudes", AccuracyWarning)
+    T = _bw_transform_jacobian(best.x, names, fixed, su, sy)
+    phys = _scaled_bw(best.x, names, fixed, su, sy)
+    return phys, tuple(names), T @ cov_s @ T.T
+
+
+# ---------------------------------------------------------------------------------------------
+# Bouc-Wen, oscillator form
+
+
+_BWO_NAMES = ("mass", "damping", "k_e", "k_h", "beta", "gamma", "n", "offset")
+#: the oscillator's starting points are fitted on this many samples first (then the whole record)
+WARM_SAMPLES = 5000
+
+
+@dataclass
+class BoucWenOscillatorModel(_HysteresisModel):
+    """Bouc-Wen oscillator (Wen 1976, with A = 1, which fixes the scale of z)::
+
+        mass ẍ + damping ẋ + k_e x + k_h z = u,   ż = ẋ − β |ẋ| z |z|^(n−1) − γ ẋ |z|^n
+
+    output y = x + offset; u a force, x a displacement, z the hysteretic displacement (unit of
+    x), k_e the elastic and k_h the hysteretic stiffness (k_e = a k, k_h = (1 − a) k of Wen's
+    α-form). Rate dependent: simulated from rest with the input held over each sample of ``dt``,
+    ``substeps`` Runge-Kutta steps per sample."""
+
+    mass: float
+    damping: float
+    k_e: float
+    k_h: float
+    beta: float
+    gamma: float
+    n: float = 1.0
+    offset: float = 0.0
+    dt: float = 1.0
+    substeps: int = 4
+    free: tuple = ("mass", "damping", "k_e", "k_h", "beta", "gamma", "offset")
+    covariance: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    input_name: str = "u"
+    output_name: str = "y"
+    input_unit: str = "1"
+    output_unit: str = "1"
+    fit_percent: float | None = None
+    validation_fit_percent: float | None = None
+    burn_in: int = 0
+    criterion: str = ""
+
+    structure = "bouc-wen-oscillator"
+
+    def values(self) -> dict:
+        return {k: float(getattr(self, k)) for k in _BWO_NAMES}
+
+    @property
+    def parameters(self) -> ParameterSet:
+        uu, yu = self.input_unit, self.output_unit
+        k_unit = _ratio(uu, yu)
+        shape = _ratio("1", yu) if self.n == 1.0 else f"1/{yu}^{self.n:g}"
+        sd = self.std
+        docs = {"mass": ("mass: input per unit acceleration", f"{k_unit}*s^2"),
+                "damping": ("viscous damping: input per unit velocity", f"{k_unit}*s"),
+                "k_e": ("elastic stiffness k_e (a k of Wen's form)", k_unit),
+                "k_h": ("hysteretic stiffness k_h ((1 − a) k of Wen's form)", k_unit),
+                "beta": ("β: shape of the hysteresis (A = 1)", shape),
+                "gamma": ("γ: shape of the hysteresis (A = 1)", shape),
+                "n": ("exponent n of |z|", "1"),
+                "offset": ("output offset", yu if not _unitless(yu) else "1")}
+        return ParameterSet([_parameter(k, getattr(self, k), docs[k][1], docs[k][0], sd.get(k),
+                                        fixed=k not in self.free) for k in _BWO_NAMES],
+                            "bouc-wen-oscillator")
+
+    def _input(self, data) -> np.ndarray:
+        if isinstance(data, Trajectory) and data.n > 1 and not math.isclose(
+                data.dt, self.dt, rel_tol=1e-6):
+            raise DataError(f"bouc-wen-oscillator: the data are sampled every {data.dt:g} s but "
+                            f"the model every {self.dt:g} s; a rate-dependent model needs the "
+                            "same sample time", hint="resample the record to the model's dt")
+        return super()._input(data)
+
+    def _run(self, u: np.ndarray, theta: dict | None = None) -> tuple[np.ndarray, int]:
+        p = self.values() if theta is None else theta
+        y = np.empty(len(u))
+        at = K.bwo_simulate(u, float(self.dt), int(self.substeps), p["mass"], p["damping"],
+                            p["k_e"], p["k_h"], p["beta"], p["gamma"], p["n"], p["offset"], y)
+        return y, at
+
+    def simulate(self, data, *, std: bool = False, warn: bool = True):
+        """Free run (N, 1) on the input column of ``data`` (a Trajectory sampled at the model's
+        dt, or an array (N,)), from rest. ``std=True`` also returns σ of ŷ (N, 1), propagated
+        from the parameter covariance (central differences, step 10⁻³ σ)."""
+        u = self._input(data)
+        y, at = self._run(u)
+        if at >= 0 and warn:
+            emit_warning(f"bouc-wen-oscillator: the free run diverges at sample {at}; the model "
+                         "is unstable on this input", StabilityWarning)
+        if not std:
+            return y[:, None]
+        return y[:, None], self._fd_std(u)[:, None]
+
+    def to_dict(self) -> dict:
+        return dict(schema=SCHEMA, version=VERSION, model=self.structure, **self.values(),
+                    substeps=int(self.substeps), free=list(self.free),
+                    covariance=np.asarray(self.covariance).tolist(), std=self.std, dt=self.dt,
+                    input_name=self.input_name, output_name=self.output_name,
+                    input_unit=self.input_unit, output_unit=self.output_unit,
+                    fit_percent=self.fit_percent,
+                    validation_fit_percent=self.validation_fit_percent, burn_in=self.burn_in,
+                    criterion=self.criterion, fit_definition=HYSTERESIS_FIT)
+
+    def summary(self) -> str:
+        sd = self.std
+        rows = [f"Bouc-Wen oscillator (n = {self.n:g}, A = 1): mass x'' + damping x' + k_e x + "
+                f"k_h z = u  ({self.criterion})"]
+        for p in self.parameters.values():
+            s = f" ± {sd[p.name]:.3g}" if p.name in sd else " (fixed)"
+            rows.append(f"  {p.name:<7s} {p.value: .6g}{s} {p.unit}")
+        return "\n".join(rows)
+
+
+def _linear_start(u, y, dt):
+    """(mass, damping, k) of the second-order model nearest the data: a least-squares ARX
+    [2 2 1] with a constant, its poles mapped to s = ln z / dt and its static gain to 1/k."""
+    A = np.column_stack([y[1:-1], y[:-2], u[1:-1], u[:-2], np.ones(len(y) - 2)])
+    a1, a2, b1, b2, _ = np.linalg.lstsq(A, y[2:], rcond=None)[0]
+    roots = np.roots([1.0, -a1, -a2]).astype(complex)
+    gain = (b1 + b2) / (1.0 - a1 - a2) if a1 + a2 != 1.0 else 0.0
+    if np.all(np.abs(roots) < 1) and np.all(np.abs(roots) > 0) and gain > 0:
+        s = np.log(roots) / dt
+        w2 = float(np.real(s[0] * s[1]))
+        two_zw = float(-np.real(s[0] + s[1]))
+        if w2 > 0 and two_zw > 0:
+            k = 1.0 / gain
+            return k / w2, two_zw * k / w2, k
+    k = float(np.ptp(u) / np.ptp(y))  # fallback: a tenth of Nyquist, ζ = 0.2
+    w = 0.1 * math.pi / dt
+    return k / w**2, 0.4 * k / w, k
+
+
+def _fit_bouc_wen_oscillator(u, y, dt, *, exponent, offset, burn_in, multistart, substeps,
+                             progress):
+    from scipy.optimize import least_squares
+
+    su = 0.5 * float(np.ptp(u))
+    sy = 0.5 * float(np.ptp(y))
+    us, ys = u / su, y / sy
+    n_free = exponent == "free"
+    n0 = 1.0 if n_free else float(exponent)
+    names = ["mass", "damping", "k_e", "k_h", "beta", "gamma"] + (["n"] if n_free else []) + (
+        ["offset"] if offset else [])
+    fixed = {"n": n0, "offset": 0.0}
+    lo = {"mass": 0.0, "damping": 0.0, "k_e": -np.inf, "k_h": -np.inf, "beta": 0.0,
+          "gamma": -np.inf, "n": 1.0, "offset": -np.inf}
+    hi = {k: np.inf for k in lo} | {"n": 10.0}
+    m0, c0, k0 = _linear_start(us, ys, dt)
+    y_amp = 0.5 * float(np.ptp(ys))
+    starts = []
+    for frac, q in ((0.5, 0.1), (0.8, 0.1), (0.5, 0.02), (0.8, 0.3), (0.3, 0.05)):
+        bg = (1.0 / (q * y_amp)) ** n0  # z saturates at (1/(β+γ))^(1/n) = q × the amplitude
+        p0 = {"mass": m0, "damping": c0, "k_e": frac * k0, "k_h": (1 - frac) * k0,
+              "beta": bg / 1.3, "gamma": 0.3 * bg / 1.3, "n": n0,
+              "offset": float(ys[0]) if offset else 0.0}
+        starts.append(np.array([p0[k] for k in names]))
+    starts = starts[:max(1, int(multistart))]
+    target = ys[burn_in:]
+    buf = np.empty(len(us))
+
+    def resid(th, end=len(us)):
+        p = dict(fixed)
+        p.update(zip(names, th))
+        K.bwo_simulate(us[:end], dt, substeps, p["mass"], p["damping"], p["k_e"], p["k_h"],
+                       p["beta"], p["gamma"], p["n"], p["offset"], buf[:end])
+        r = buf[burn_in:end] - ys[burn_in:end]
+        return np.clip(np.where(np.isfinite(r), r, 1e3), -1e3, 1e3)
+
+    # the starts in order of their initial cost, each to convergence on the first
+    # WARM_SAMPLES samples, until one reproduces them to a fit of 90 % (a free run of a
+    # rate-dependent model is costly, and a long record makes a poor start crawl); then the
+    # best one refined on the whole record
+    lb = np.array([lo[k] for k in names])
+    ub = np.array([hi[k] for k in names])
+    starts = [np.clip(x0, np.where(np.isfinite(lb), lb + 1e-9, -np.inf),
+                      np.where(np.isfinite(ub), ub - 1e-9, np.inf)) for x0 in starts]
+    end = min(len(us), burn_in + WARM_SAMPLES)
+    starts.sort(key=lambda x0: float(np.sum(resid(x0, end) ** 2)))
+    short = ys[burn_in:end]
+    good = 0.01 * float(np.sum((short - short.mean()) ** 2))
+    opts = dict(bounds=(lb, ub), x_scale="jac", method="trf", xtol=1e-10, ftol=1e-10,
+                gtol=1e-10, max_nfev=100 * len(names))
+    best = None
+    for x0 in track(starts, description="bouc-wen oscillator fit", enabled=progress):
+        res = least_squares(resid, x0, args=(end,), **opts)
+        if best is None or res.cost < best.cost:
+            best = res
+        if 2.0 * best.cost < good:
+            break
+    if end < len(us):
+        best = least_squares(resid, best.x, **opts)
+    dof = max(len(target) - len(names), 1)
+    s2 = 2.0 * best.cost / dof
+    JtJ = best.jac.T @ best.jac
+    if np.linalg.cond(JtJ) > 1e14:
+        emit_warning("bouc-wen-oscillator: the parameters are nearly unidentifiable from this "
+                     "record (JᵀJ singular to working precision); their σ are unreliable: excite "
+                     "loops of several amplitudes", AccuracyWarning)
+    cov_s = s2 * np.linalg.pinv(JtJ)
+    p = dict(fixed)
+    p.update(zip(names, best.x))
+    n = p["n"]
+    g = sy / su  # force-like parameters scale by sy/su, β and γ by sy^−n, offset by sy
+    phys = {"mass": p["mass"] / g, "damping": p["damping"] / g, "k_e": p["k_e"] / g,
+            "k_h": p["k_h"] / g, "beta": p["beta"] * sy ** -n, "gamma": p["gamma"] * sy ** -n,
+            "n": n, "offset": p["offset"] * sy}
+    diag = {"mass": 1 / g, "damping": 1 / g, "k_e": 1 / g, "k_h": 1 / g, "beta": sy ** -n,
+            "gamma": sy ** -n, "n": 1.0, "offset": sy}
+    T = np.diag([diag[k] for k in names])
+    if n_free:
+        for k in ("beta", "gamma"):
+            T[names.index(k), names.index("n")] = -phys[k] * math.log(sy)
+    return phys, tuple(names), T @ cov_s @ T.T
+
+
+# ---------------------------------------------------------------------------------------------
+# Prandtl–Ishlinskii
+
+
+def pi_inverse(thresholds, weights) -> tuple[np.ndarray, np.ndarray]:
+    """Thresholds and weights of the inverse PI operator (Kuhnen 2003, eq 18; module docstring).
+    Needs r_0 = 0 < r_1 < … and every partial sum W_i = Σ_{j≤i} w_j > 0."""
+    r = np.asarray(thresholds, dtype=np.float64)
+    w = np.asarray(weights, dtype=np.float64)
+    if r.ndim != 1 or r.shape != w.shape or len(r) == 0:
+        raise ModelError(f"pi_inverse: thresholds {r.shape} and weights {w.shape} must be two "
+                         "1-D arrays of equal length")
+    if r[0] != 0.0 or np.any(np.diff(r) <= 0):
+        raise ModelError("prandtl-ishlinskii invert: the thresholds must start at 0 and increase "
+                         f"strictly, found {r.tolist()}")
+    W = np.cumsum(w)
+    if not (w[0] > 0 and np.all(W > 0)):
+        bad = int(np.argmax(~(W > 0))) if w[0] > 0 else 0
+        raise ModelError(f"prandtl-ishlinskii invert: the model is not invertible: the weight sum "
+                         f"W_{bad} = Σ_(j≤{bad}) w_j = {W[bad]:.4g} must be > 0 (w_0 = {w[0]:.4g} "
+                         "is the slope of the loop's branches at a reversal)",
+                         hint="refit with more data near the reversals, or with fewer operators")
+    rh = np.array([float(np.sum(w[:i + 1] * (r[i] - r[:i + 1]))) for i in range(len(r))])
+    wh = np.empty_like(w)
+    wh[0] = 1.0 / w[0]
+    wh[1:] = -w[1:] / (W[1:] * W[:-1])
+    return rh, wh
+
+
+@dataclass
+class PrandtlIshlinskiiModel(_HysteresisModel):
+    """``y = offset + Σ_i weights[i] · play(thresholds[i])[u − input_offset]`` (module docstring).
+    ``covariance`` is over the weights then the offset (when ``fit_offset``)."""
+
+    thresholds: np.ndarray
+    weights: np.ndarray
+    offset: float = 0.0
+    input_offset: float = 0.0
+    covariance: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    fit_offset: bool = True
+    dt: float | None = None
+    input_name: str = "u"
+    output_name: str = "y"
+    input_unit: str = "1"
+    output_unit: str = "1"
+    fit_percent: float | None = None
+    validation_fit_percent: float | None = None
+    burn_in: int = 0
+    criterion: str = ""
+
+    structure = "prandtl-ishlinskii"
+
+    @property
+    def weights_std(self) -> np.ndarray:
+        m = len(self.weights)
+        if self.covariance.shape[0] < m:
+            return np.full(m, np.nan)
+        return np.sqrt(np.maximum(np.diag(self.covariance)[:m], 0.0))
+
+    @property
+    def parameters(self) -> ParameterSet:
+        uu, yu = self.input_unit, self.output_unit
+        sd = self.weights_std
+        ps = [_parameter(f"w_{i}", w, _ratio(yu, uu), f"weight of the play of threshold r_{i}",
+                         sd[i] if self.covariance.size else None, fixed=not self.covariance.size)
+              for i, w in enumerate(self.weights)]
+        ps += [_parameter(f"r_{i}", r, uu, f"threshold of play operator {i} (chosen, not fitted)",
+                          fixed=True) for i, r in enumerate(self.thresholds)]
+        osd = (math.sqrt(max(self.covariance[-1, -1], 0.0))
+               if self.fit_offset and self.covariance.size else None)
+        ps.append(_parameter("offset", self.offset, yu, "output offset c", osd,
+                             fixed=osd is None))
+        ps.append(_parameter("input_offset", self.input_offset, uu, "input offset a", fixed=True))
+        return ParameterSet(ps, "prandtl-ishlinskii")
+
+    def _play_matrix(self, u: np.ndarray) -> np.ndarray:
+        P = np.empty((len(u), len(self.thresholds)))
+        K.play_matrix(u - self.input_offset, np.asarray(self.thresholds, dtype=np.float64), P)
+        return P
+
+    def simulate(self, data, *, std: bool = False, warn: bool = True):
+        """Output (N, 1) for the input column of ``data`` (a Trajectory or an array (N,)), every
+        play relaxed at the first sample. ``std=True`` also returns σ of ŷ (N, 1) from the
+        covariance of the weights (and offset): the model is linear in them, so it is exact."""
+        u = self._input(data)
+        y = np.empty(len(u))
+        K.pi_simulate(u - self.input_offset, np.asarray(self.thresholds, dtype=np.float64),
+                      np.asarray(self.weights, dtype=np.float64), float(self.offset), y)
+        if not std:
+            return y[:, None]
+        G = self._play_matrix(u)
+        if self.fit_offset:
+            G = np.column_stack([G, np.ones(len(u))])
+        if self.covariance.shape != (G.shape[1], G.shape[1]):
+            raise ModelError("prandtl-ishlinskii: this model has no parameter covariance (an "
+                             "inverse, or read from a file without one); std=True needs one")
+        return y[:, None], _output_std(G, self.covariance)[:, None]
+
+    def invert(self) -> "PrandtlIshlinskiiModel":
+        """The inverse operator, a PI model from the model's output column to its input column:
+        ``inverse.simulate(model.simulate(u)) == u`` (to rounding) for every input record. It has
+        no covariance (its parameters are exact functions of the model's)."""
+        rh, wh = pi_inverse(self.thresholds, self.weights)
+        return PrandtlIshlinskiiModel(rh, wh, offset=float(self.input_offset),
+                                      input_offset=float(self.offset), fit_offset=False,
+                                      dt=self.dt, input_name=self.output_name,
+                                      output_name=self.input_name, input_unit=self.output_unit,
+                                      output_unit=self.input_unit,
+                                      criterion=f"inverse (Kuhnen 2003) of: {self.criterion}")
+
+    def to_dict(self) -> dict:
+        return dict(schema=SCHEMA, version=VERSION, model=self.structure,
+                    thresholds=np.asarray(self.thresholds).tolist(),
+                    weights=np.asarray(self.weights).tolist(),
+                    weights_std=[None if not np.isfinite(s) else float(s)
+                                 for s in self.weights_std],
+                    offset=float(self.offset), input_offset=float(self.input_offset),
+                    fit_offset=bool(self.fit_offset),
+                    covariance=np.asarray(self.covariance).tolist(), dt=self.dt,
+                    input_name=self.input_name, output_name=self.output_name,
+                    input_unit=self.input_unit, output_unit=self.output_unit,
+                    fit_percent=self.fit_percent,
+                    validation_fit_percent=self.validation_fit_percent, burn_in=self.burn_in,
+                    criterion=self.criterion, fit_definition=HYSTERESIS_FIT)
+
+    def summary(self) -> str:
+        rows = [f"Prandtl-Ishlinskii, {len(self.weights)} play operators ({self.criterion})"]
+        sd = self.weights_std
+        for i, (r, w) in enumerate(zip(self.thresholds, self.weights)):
+            s = f" ± {sd[i]:.3g}" if np.isfinite(sd[i]) else ""
+            rows.append(f"  r_{i:<3d} {r: .6g} {self.input_unit:<6s} w_{i:<3d} {w: .6g}{s}")
+        rows.append(f"  offset {self.offset: .6g} {self.output_unit}")
+        return "\n".join(rows)
+
+
+def default_thresholds(u: np.ndarray, operators: int) -> np.ndarray:
+    """r_i = i R / m, i = 0 … m−1, R half the input's range: every play turns on the largest
+    loop."""
+    return np.arange(operators) * (0.5 * float(np.ptp(u)) / operators)
+
+
+def _fit_pi(u, y, thresholds, *, offset, burn_in):
+    from scipy.optimize import lsq_linear
+
+    r = np.asarray(thresholds, dtype=np.float64)
+    m = len(r)
+    P = np.empty((len(u), m))
+    K.play_matrix(u, r, P)
+    A = P[burn_in:]
+    if offset:
+        A = np.column_stack([A, np.ones(len(A))])
+    b = y[burn_in:]
+    if len(b) < 2 * A.shape[1]:
+        raise DataError(f"prandtl-ishlinskii: {len(b)} samples for {A.shape[1]} parameters; "
+                        f"give at least {2 * A.shape[1]} or fewer operators")
+    s = np.linalg.norm(A, axis=0)
+    s[s == 0] = 1.0
+    lb = np.r_[np.zeros(m), [-np.inf] if offset else []]
+    res = lsq_linear(A / s, b, bounds=(lb, np.full(A.shape[1], np.inf)), method="bvls",
+                     tol=1e-12)
+    theta = res.x / s
+    e = b - A @ theta
+    s2 = float(e @ e) / max(len(b) - A.shape[1], 1)
+    As = A / s
+    G = As.T @ As
+    if np.linalg.cond(G) > 1e14:
+        emit_warning("prandtl-ishlinskii: the play operators are nearly collinear on this record; "
+                     "the σ of the weights are unreliable: use fewer operators or loops of several "
+                     "amplitudes", AccuracyWarning)
+    cov = s2 * np.linalg.pinv(G) / np.outer(s, s)
+    at_bound = int(np.sum(theta[:m] <= 0.0))
+    w = theta[:m].copy()
+    c = float(theta[m]) if offset else 0.0
+    return w, c, cov, at_bound
+
+
+# ---------------------------------------------------------------------------------------------
+# entry point
+
+
+def _check_int(v, name: str, lo: int) -> int:
+    if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
+        raise ArgumentError(f"hysteresis: {name} must be an integer ≥ {lo}, found {v!r}")
+    return int(v)
+
+
+def hysteresis(data, model: str = "bouc-wen", *, input: str | None = None,
+               output: str | None = None, form: str = "actuator", exponent=1.0,
+               operators: int = 10, thresholds=None, offset: bool = True, burn_in: int = 0,
+               validate=None, multistart: int = 4, substeps: int = 4, dt: float | None = None,
+               progress: bool = True):
+    """Identify a hysteresis model of ``output`` driven by ``input``.
+
+    ``data``: a Trajectory (columns ``input``, ``output``) or a pair of arrays ``(u, y)``.
+    ``model``: ``"bouc-wen"`` (actuator form; ``exponent`` n ≥ 1, default 1 = the seed's eq 3, or
+    ``"free"`` to estimate it; ``multistart`` starting points; ``form="oscillator"``: the
+    rate-dependent Bouc-Wen oscillator :class:`BoucWenOscillatorModel`, from rest, ``substeps``
+    RK4 steps per sample, its sample time that of the data or ``dt``) or ``"prandtl-ishlinskii"``
+    (``operators`` plays with thresholds ``i R / operators``, or ``thresholds`` given, starting
+    at 0 and increasing). ``offset``: fit an output offset c. ``burn_in``: samples simulated but
+    not scored (a record that starts mid-loop). ``validate``: a second record (Trajectory or
+    pair) scored by the free run, ``validation_fit_percent``. The model's ``fit_percent`` is on
+    the estimation record (:data:`HYSTERESIS_FIT`).
+
+    Raises DataError when the input never reverses (the hysteresis is not excited).
+    """
+    if model not in MODELS:
+        raise ArgumentError(f"hysteresis: model must be one of {', '.join(MODELS)}, found "
+                            f"{model!r}")
+    u, y, dt0, iname, oname, iunit, ounit = _record(data, input, output, "hysteresis")
+    dt = dt0 if dt is None else dt
+    if dt is not None and not (isinstance(dt, (int, float, np.floating)) and math.isfinite(dt)
+                               and dt > 0):
+        raise ArgumentError(f"hysteresis: dt must be a positive sample interval in s, found {dt!r}")
+    burn_in = _check_int(burn_in, "burn_in", 0)
+    if burn_in > len(u) - 10:
+        raise ArgumentError(f"hysteresis: burn_in = {burn_in} leaves fewer than 10 of the "
+                            f"{len(u)} samples to fit; lower it")
+    _check_excited(u, y, iname, oname)
+    if validate is not None:
+        uv, yv, *_ = _record(validate, iname, oname, "hysteresis validate")
+    common = dict(dt=dt, input_name=iname, output_name=oname, input_unit=iunit,
+                  output_unit=ounit, burn_in=burn_in)
+    if model == "bouc-wen":
+        if form not in FORMS:
+            raise ArgumentError(f"hysteresis: form must be one of {', '.join(FORMS)}, found "
+                                f"{form!r}")
+        if not (exponent == "free" or (isinstance(exponent, (int, float, np.floating))
+                                       and not isinstance(exponent, bool)
+                                       and 1.0 <= exponent <= 10.0)):
+            raise ArgumentError(f"hysteresis: exponent must be a number in [1, 10] or 'free', "
+                                f"found {exponent!r}")
+        multistart = _check_int(multistart, "multistart", 1)
+        how = (f"free-run least squares, {multistart} start(s), n "
+               + ("estimated" if exponent == "free" else f"= {exponent:g}"))
+    if model == "bouc-wen" and form == "oscillator":
+        substeps = _check_int(substeps, "substeps", 1)
+        if dt is None:
+            raise ArgumentError("hysteresis: the Bouc-Wen oscillator is rate dependent: give the "
+                                "sample time dt= (or a Trajectory, which has one)")
+        phys, names, cov = _fit_bouc_wen_oscillator(u, y, float(dt), exponent=exponent,
+                                                    offset=offset, burn_in=burn_in,
+                                                    multistart=multistart, substeps=substeps,
+                                                    progress=progress)
+        common["dt"] = float(dt)
+        m = BoucWenOscillatorModel(**phys, substeps=substeps, free=names, covariance=cov,
+                                   **common, criterion=how)
+    elif model == "bouc-wen":
+        phys, names, cov = _fit_bouc_wen(u, y, exponent=exponent, offset=offset,
+                                         burn_in=burn_in, multistart=multistart,
+                                         progress=progress)
+        m = BoucWenModel(**phys, free=names, covariance=cov, **common, criterion=how)
+    else:
+        if thresholds is None:
+            r = default_thresholds(u, _check_int(operators, "operators", 1))
+        else:
+            r = np.atleast_1d(np.asarray(thresholds, dtype=np.float64))
+            if r.ndim != 1 or r[0] != 0.0 or np.any(np.diff(r) <= 0) or not np.all(np.isfinite(r)):
+                raise ArgumentError("hysteresis: thresholds must start at 0 and increase strictly, "
+                                    f"found {r.tolist()}")
+        half = 0.5 * float(np.ptp(u))
+        if r[-1] >= half:
+            raise DataError(f"hysteresis: the play of threshold {r[-1]:g} is not excited: the "
+                            f"input {iname!r} spans only ±{half:g} about its middle, so plays of "
+                            f"thresholds ≥ {half:g} never move on a loop",
+                            hint="give thresholds below half the input's range, or record a "
+                                 "wider sweep")
+        w, c, cov, at_bound = _fit_pi(u, y, r, offset=offset, burn_in=burn_in)
+        m = PrandtlIshlinskiiModel(r, w, offset=c, covariance=cov, fit_offset=bool(offset),
+                                   **common,
+                                   criterion=f"{len(r)} plays, weights ≥ 0 by bounded least "
+                                             f"squares ({at_bound} on the bound 0)")
+        if w[0] <= 0:
+            emit_warning("prandtl-ishlinskii: w_0 (the play of threshold 0) came out 0, so the "
+                         "model has no inverse (invert() will refuse it)", AccuracyWarning)
+    yhat = m.simulate(u)[:, 0]
+    m.fit_percent = _fit_percent(y[burn_in:], yhat[burn_in:])
+    if validate is not None:
+        m.validation_fit_percent = m.compare((uv, yv)).fit_percent[0]
+    return m
+
+
+# ---------------------------------------------------------------------------------------------
+# reading a model file
+
+
+def load_hysteresis(path):
+    """Read a model written by ``save`` of :class:`BoucWenModel`,
+    :class:`BoucWenOscillatorModel` or :class:`PrandtlIshlinskiiModel`; the same type comes
+    back."""
+    p = Path(path)
+    try:
+        doc = json.loads(p.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise PathError(f"hysteresis model file {str(p)!r} does not exist; give the path of a "
+                        "file written by model.save or `gripkit identify hysteresis --out`"
+                        ) from None
+    except OSError as exc:
+        raise PathError(f"hysteresis model file {str(p)!r} cannot be read "
+                        f"({exc.strerror or exc}); give the path of a readable file") from None
+    except (ValueError, RecursionError) as exc:
+        raise ModelError(f"hysteresis model file {str(p)!r} is not a JSON model "
+                         f"({type(exc).__name__}); expected a file of schema {SCHEMA!r}") from None
+    schema = doc.get("schema") if isinstance(doc, dict) else None
+    if schema != SCHEMA:
+        raise ModelError(f"{str(p)!r} has schema {schema!r}, expected {SCHEMA!r}; load other "
+                         "model files with gripkit.sysid.load_model")
+    if doc.get("version") != VERSION:
+        raise ModelError(f"{str(p)!r} is a {SCHEMA} of version {doc.get('version')!r}; this "
+                         f"gripkit reads version {VERSION}")
+    kind = doc.get("model")
+    common = {k: doc.get(k) for k in ("dt", "fit_percent", "validation_fit_percent",
+                                      "criterion")}
+    try:
+        common.update(input_name=str(doc["input_name"]), output_name=str(doc["output_name"]),
+                      input_unit=str(doc["input_unit"]), output_unit=str(doc["output_unit"]),
+                      burn_in=int(doc.get("burn_in", 0)))
+        common["criterion"] = str(common["criterion"] or "")
+        if kind == "bouc-wen":
+            free = tuple(str(k) for k in doc["free"])
+            if not set(free) <= set(_BW_NAMES):
+                raise ValueError(f"unknown free parameter in {free}")
+            cov = np.array(doc["covariance"], dtype=np.float64).reshape(len(free), len(free))
+            return BoucWenModel(**{k: float(doc[k]) for k in _BW_NAMES}, free=free,
+                                covariance=cov, **common)
+        if kind == "bouc-wen-oscillator":
+            free = tuple(str(k) for k in doc["free"])
+            if not set(free) <= set(_BWO_NAMES):
+                raise ValueError(f"unknown free parameter in {free}")
+            cov = np.array(doc["covariance"], dtype=np.float64).reshape(len(free), len(free))
+            common["dt"] = float(common["dt"])
+            if not (common["dt"] > 0 and int(doc["substeps"]) >= 1):
+                raise ValueError("dt must be > 0 and substeps ≥ 1")
+            return BoucWenOscillatorModel(**{k: float(doc[k]) for k in _BWO_NAMES},
+                                          substeps=int(doc["substeps"]), free=free,
+                                          covariance=cov, **common)
+        if kind == "prandtl-ishlinskii":
+            r = np.array(doc["thresholds"], dtype=np.float64)
+            w = np.array(doc["weights"], dtype=np.float64)
+            if r.ndim != 1 or r.shape != w.shape:
+                raise ValueError("thresholds and weights differ in length")
+            cov = np.array(doc["covariance"], dtype=np.float64)
+            k = int(cov.size ** 0.5)
+            return PrandtlIshlinskiiModel(r, w, offset=float(doc["offset"]),
+                                          input_offset=float(doc["input_offset"]),
+                                          covariance=cov.reshape(k, k),
+                                          fit_offset=bool(doc["fit_offset"]), **common)
+    except (KeyError, TypeError, ValueError) as exc:
+        raise ModelError(f"{str(p)!r}: a malformed {SCHEMA} ({type(exc).__name__}: {exc}); "
+                         "write it again with model.save") from None
+    raise ModelError(f"{str(p)!r}: unknown hysteresis model {kind!r}; expected one of "
+                     f"{', '.join(MODELS)}, bouc-wen-oscillator")
