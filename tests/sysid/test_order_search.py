@@ -91,3 +91,43 @@ def test_progress_api_without_a_terminal(capsys):
     assert len(lines) == 10 and lines[0].strip().startswith("work: 2/20 (10 %")
     assert list(track(range(5), description="quiet", enabled=False)) == list(range(5))
     assert capsys.readouterr().err == ""
+
+
+def test_armax_and_oe_pem_progress_when_asked(capsys):
+    """The polynomial PEM (ARMAX, OE) shows its iterations on stderr with progress=True, and the
+    result is the same as without."""
+    from gripkit.sysid import armax, oe
+
+    rng = np.random.default_rng(6)
+    u = rng.standard_normal(2000)
+    e = 0.1 * rng.standard_normal(2000)
+    y = signal.lfilter([0, 0.4], [1, -0.7], u) + signal.lfilter([1, 0.5], [1, -0.7], e)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # 5 iterations may stop short of convergence
+        quiet = armax(u, y, 1, 1, 1, 1, maxiter=5)
+        assert capsys.readouterr().err == ""
+        loud = armax(u, y, 1, 1, 1, 1, maxiter=5, progress=True)
+        oe(u, y, 1, 1, 1, maxiter=5, progress=True)
+    err = capsys.readouterr().err
+    assert "PEM ARMAX [1 1 1 1]: 1/5 (20 %" in err and "PEM OE [1 1 1]: 1/5 (20 %" in err
+    np.testing.assert_array_equal(quiet.theta, loud.theta)
+    # the model: a1 = −0.7, b1 = 0.4, c1 = 0.5 within 4σ
+    assert np.all(np.abs(loud.theta - [-0.7, 0.4, 0.5]) < 4 * loud.theta_std)
+
+
+def test_arx_structure_search_widens_past_the_edge():
+    """identify 'search' over na 1:3 for an ARX system with na = 4 (the 4th-order A above, nb = 2,
+    nk = 1): the best na sits on the edge 3, the range grows to 4 and 5, and the search returns
+    [4 2 1] without an edge warning."""
+    rng = np.random.default_rng(7)
+    u = rng.standard_normal(4000)
+    y = signal.lfilter([0, 0.5, 0.3], DEN, u) + signal.lfilter([1.0], DEN,
+                                                                0.05 * rng.standard_normal(4000))
+    tr = Trajectory.uniform(dt=0.01, u=u, y=y)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", GripkitWarning)
+        res = identify(tr, "search", input="u", output="y", na="1:3", nb="1:3", nk="1:2",
+                       progress=False)
+    best = res.best
+    assert (best.na, best.nb, best.nk) == (4, 2, 1)
+    assert sorted({c.na for c in res.candidates}) == [1, 2, 3, 4, 5]

@@ -76,6 +76,8 @@ def _siso(method: str, data: list[Path], input: str, output: str, fs, time, fill
     and ``records`` each file's): one call of gripkit.sysid.identify, one validation, print."""
     check_outputs(out_file, report)
     _several_files_detrend(data, detrend)
+    if method in ("armax", "oe") and len(data) == 1:  # PEM: its iterations on stderr
+        orders["progress"] = True
     with collected_warnings() as caught:
         model, tr, vtr = run_identify(data, method, input, output, fs=fs, time=time, fill=fill,
                                       validate=validate, detrend=detrend, **orders)

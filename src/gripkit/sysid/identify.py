@@ -243,7 +243,8 @@ def _dispatch(data, method: str, *, input, output, na: int, nb: int, nk: int, nc
         model = _polynomial_fit(method, io, orders, options)
         if detrend == "mean":
             raw = lambda: io_data(data, input=input, output=output, detrend="none")  # noqa: E731
-            refit = lambda r: _polynomial_fit(method, r, orders, options)  # noqa: E731
+            quiet = {k: v for k, v in options.items() if k != "progress"}  # one bar: the fit's
+            refit = lambda r: _polynomial_fit(method, r, orders, quiet)  # noqa: E731
             warn_if_mean_detrending_hurt(model, io, raw, refit)
         return model
     if method == "rls":
@@ -253,7 +254,53 @@ def _dispatch(data, method: str, *, input, output, na: int, nb: int, nk: int, nc
     if isinstance(options.get("validate"), Trajectory):  # around the estimation operating point
         vd = validation_data(options["validate"], io, detrend=detrend)
         options = {**options, "validate": (vd.u1, vd.y1)}
-    return structure_search(io.u1, io.y1, na, nb, nk, dt=io.dt, **options)
+    return search_widened(io, na, nb, nk, options)
+
+
+#: structures a search adds past each edge of its ranges where the best structure sits
+SEARCH_WIDEN_STEPS = 3
+#: the smallest value of each order in a search
+_LOWEST = {"na": 1, "nb": 1, "nk": 0}
+
+
+def search_widened(io: IOData, na, nb, nk, options: dict):
+    """:func:`~gripkit.sysid.structure_search` of ``io`` that goes past the edge of its ranges:
+    while the best structure sits on the edge of a range of three or more values (what
+    structure_search warns about), that range gains the next value past the edge (at most
+    :data:`SEARCH_WIDEN_STEPS` times; never for ``criterion='loss'``, which always prefers the
+    largest structure) and the search runs again. Only the last search's warnings are emitted
+    (its edge warning, when the best still sits on an edge, names the ranges searched)."""
+    from .linear.search import parse_range
+
+    ranges = {"na": parse_range(na, "na"), "nb": parse_range(nb, "nb"), "nk": parse_range(nk, "nk")}
+    for step in range(SEARCH_WIDEN_STEPS + 1):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            res = structure_search(io.u1, io.y1, ranges["na"], ranges["nb"], ranges["nk"],
+                                   dt=io.dt, **options)
+        grown = _grow_ranges(res.best, ranges) if options.get("criterion") != "loss" else False
+        if not grown or step == SEARCH_WIDEN_STEPS:
+            break
+    for w in caught:
+        emit_warning(str(w.message), w.category)
+    return res
+
+
+def _grow_ranges(best, ranges: dict) -> bool:
+    """Add the value past each edge of ``ranges`` (three values or more) where ``best`` sits;
+    whether any grew."""
+    grown = False
+    for name, r in ranges.items():
+        v = getattr(best, name)
+        if len(set(r)) < 3:
+            continue
+        if v == max(r):
+            r.append(v + 1)
+            grown = True
+        elif v == min(r) and v - 1 >= _LOWEST[name]:
+            r.insert(0, v - 1)
+            grown = True
+    return grown
 
 
 def _with_extras(model, extras: dict):
