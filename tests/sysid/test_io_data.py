@@ -68,7 +68,8 @@ def test_none_keeps_the_data_and_zero_offsets():
 
 def test_checks_of_state_space_data():
     tr = _record().with_channels(b=np.full(400, 4.5))
-    with pytest.raises(DataError, match=r"input column 'b' is constant \(4.5 for all 400 samples\)"):
+    with pytest.raises(DataError,
+                       match=r"input column 'b' is constant \(4.5 for all 400 samples\)"):
         IOData.from_trajectory(tr, "a,b", "c")
     big = _record().with_channels(a=_record()["a"] * 1e120)
     with pytest.raises(DataError, match=r"input column 'a' has values up to .*accepts peak values "

@@ -28,7 +28,7 @@ from ...progress import status, track
 from ...signals.trajectory import Trajectory
 from .arx_mimo import arx_mimo
 from .frf import frf
-from ..io_data import SCALE_LIMITS, IOData, parse_names, validation_data  # noqa: F401 (re-exported)
+from ..io_data import IOData, parse_names, validation_data
 from .linear_model import VALIDATION_FIT, validation_fit  # the one definition, re-exported for the CLI
 
 __all__ = ["mimo_data", "identify_ss", "identify_frf", "identify_tf", "identify_arx", "several",

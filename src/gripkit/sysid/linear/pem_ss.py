@@ -352,7 +352,8 @@ def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovatio
     if N > _WARM_START_SAMPLES:  # converge on the first samples, then polish on all of them
         A, B, C, D, K, x0, _, it_warm, _, _ = _levenberg_marquardt(
             A, B, C, D, K, x0, u[:_WARM_START_SAMPLES], yw[:_WARM_START_SAMPLES], feedthrough, innovation,
-            max_iterations, tol, f"{label}, first {_WARM_START_SAMPLES} samples" if progress else None)
+            max_iterations, tol,
+            f"{label}, first {_WARM_START_SAMPLES} samples" if progress else None)
     A, B, C, D, K, x0, Vc, it, converged, at_final = _levenberg_marquardt(
         A, B, C, D, K, x0, u, yw, feedthrough, innovation, max_iterations, tol,
         label if progress else None)
