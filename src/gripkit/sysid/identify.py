@@ -39,7 +39,7 @@ from .linear.arx import arx, arx_records
 from .linear.arx_mimo import arx_mimo_records
 from .linear.frf import frf
 from .linear.oe import oe, oe_records
-from .linear.search import structure_search
+from .linear.search import parse_range, structure_search
 
 __all__ = ["IOData", "io_data", "identify", "identify_records", "method_options", "METHODS",
            "with_provenance"]
@@ -270,8 +270,6 @@ def search_widened(io: IOData, na, nb, nk, options: dict):
     :data:`SEARCH_WIDEN_STEPS` times; never for ``criterion='loss'``, which always prefers the
     largest structure) and the search runs again. Only the last search's warnings are emitted
     (its edge warning, when the best still sits on an edge, names the ranges searched)."""
-    from .linear.search import parse_range
-
     ranges = {"na": parse_range(na, "na"), "nb": parse_range(nb, "nb"), "nk": parse_range(nk, "nk")}
     for step in range(SEARCH_WIDEN_STEPS + 1):
         with warnings.catch_warnings(record=True) as caught:
