@@ -143,7 +143,8 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
         model, ranked = _refine_top(
             ranked, lambda c: _refine(c, d, vd, form, focus, max_iterations, progress)[0],
             lambda m: focus_score(m, focus, d if vd is None else vd),
-            None if vd is not None else lambda m: _aic(m, d), progress)
+            None if vd is not None else lambda m: _aic(m, d), progress,
+            REFINE_TOP if vd is not None else 1)
     elif refine:
         report(f"PEM refinement ({form} form) of the order-{model.order} model")
         model, refine = _refine(model, d, vd, form, focus, max_iterations, progress)
@@ -184,8 +185,10 @@ def _ranked(found: dict, parsimony: bool) -> list:
     rows = sorted(found.values(), key=lambda rc: -rc[0]["score"])
     if parsimony:
         top = rows[0][0]["score"]
-        pick = min((rc for rc in rows if rc[0]["score"] >= top - 0.05),
-                   key=lambda rc: rc[0]["order"])
+        band = [rc for rc in rows if rc[0]["score"] >= top - 0.05]
+        pick = min(band, key=lambda rc: rc[0]["order"])
+        for row, _ in rows:  # the higher orders that tie with the pick: not worth a PEM
+            row["tie"] = any(row is r for r, _ in band) and row is not pick[0]
         rows.remove(pick)
         rows.insert(0, pick)
     return rows
@@ -222,21 +225,27 @@ def _order_search(row_of, criterion: str, rng: tuple, n_cap: int, progress: bool
     return rows, criterion
 
 
-#: the best orders of a search that PEM refines; the refined models are ranked by the focus
+#: the best orders of a search with a validation record that PEM refines, ranked again by their
+#: focus fit on it; without one only the best order is refined (on the estimation data the
+#: refined models could only be ranked by Akaike's criterion again, and the PEM of the
+#: overparametrised runners-up costs many times that of the best)
 REFINE_TOP = 3
 
 
-def _refine_top(ranked: list, refine_one, fit_of, aic_of, progress: bool):
-    """``refine_one(model)`` (PEM that never loses by the focus) of the :data:`REFINE_TOP` best
-    orders of a search, ranked again: by ``fit_of(model)`` (the focus fit on validation data;
+def _refine_top(ranked: list, refine_one, fit_of, aic_of, progress: bool, n_top: int):
+    """``refine_one(model)`` (PEM that never loses by the focus) of the ``n_top`` best orders of
+    a search (the higher orders that tie with the best on the validation fit, ``tie``
+    in their rows, left out: they fit the noise, and their PEM costs most), ranked again: by ``fit_of(model)`` (the focus fit on validation data;
     the lowest order within :data:`FOCUS_TIE` of the best first) when ``aic_of`` is None, else
     by ``aic_of(model)`` (on the estimation data a higher order always fits better: Akaike's
     criterion weighs the fit against the parameters). Each row gets ``refined_percent`` (the
     focus fit), ``kept`` (the structure returned for that order) and ``refined_aic`` when ranked
     by it. Only the returned model's warnings are emitted. Returns (best model, the ranking:
     refined orders first, then the others as the search ranked them)."""
+    chosen = [rc for rc in ranked if not rc[0].get("tie")][:n_top]
+    rest = [rc for rc in ranked if not any(rc is c for c in chosen)]
     top = []
-    for row, cand in ranked[:REFINE_TOP]:
+    for row, cand in chosen:
         if progress:
             status(f"PEM refinement of the order-{cand.order} model")
         with warnings.catch_warnings(record=True) as caught:
@@ -262,7 +271,7 @@ def _refine_top(ranked: list, refine_one, fit_of, aic_of, progress: bool):
     by = "Akaike's criterion" if aic_of is not None else "the validation fit"
     model.info["order_selection"] = (f"{ranked[0][1].info['order_selection']}; the best "
                                      f"{len(top)} refined by PEM and ranked by {by}")
-    return model, [(r, m) for r, m, _ in top] + list(ranked[REFINE_TOP:])
+    return model, [(r, m) for r, m, _ in top] + rest
 
 
 #: the criteria by which identify_ss keeps the better of the subspace and the refined model
@@ -445,8 +454,7 @@ def identify_ss_records(records: list, d: IOData, u0, y0, options: dict):
     it does not lose to its start by ``focus`` (:func:`records_score` over all records; else the
     subspace model with an AccuracyWarning giving both). ``order='LO:HI'`` searches the order as
     for one record: ranked by Akaike's criterion of the free run over all records,
-    widened past an edge, the best :data:`REFINE_TOP` refined and ranked by ``focus``
-    (``info['search']``)."""
+    widened past an edge, the best order refined (``info['search']``)."""
     from .subspace import n4sid_records
 
     other = sorted(set(options) - set(SS_RECORD_OPTIONS))
@@ -478,7 +486,7 @@ def identify_ss_records(records: list, d: IOData, u0, y0, options: dict):
     if options.get("refine", True):
         model, ranked = _refine_top(ranked, refine, score,
                                     lambda m: _records_row(m, records, focus)[0]["aic"],
-                                    progress)
+                                    progress, 1)
     else:
         model = ranked[0][1]
     return model.replace(info={**model.info, "search": [r for r, _ in ranked],
