@@ -43,6 +43,8 @@ LAZY_MODULES = {
     ("sysid/linear/linear_model.py", "...lti"): "lti's numba simulation kernel, loaded on the first simulation",
     ("systems/tsfm/grasp_batch.py", ".grasp_gpu"): "numba.cuda: the GPU path only",
     ("io/formats.py", ".mcap_reader"): "the optional mcap extra",
+    ("sysid/model_file.py", "..io.formats"):
+        "the readers (pyarrow, h5py, scipy.io): every CLI command imports model_file for its JSON",
     ("control/robustness.py", "..report.plots"): "matplotlib (0.34 s): only the histograms load it",
     ("export/c_rls.py", "..sysid.linear.rls"): "numba (0.4 s): the RLS kernels, for --rls only",
 }

@@ -61,14 +61,14 @@ def track(iterable: Iterable[T], total: int | None = None, description: str = "w
                 bar.update(task, advance=1, rate=f"{i / dt:.3g}/s" if dt > 0 else "")
         return
     t0 = time.perf_counter()
-    next_mark = 0.1
+    tenth = 1  # the next line at tenth/10 of the total, counted in integers (no drift)
     for i, item in enumerate(iterable, 1):
         yield item
         if total:
             frac = i / total
-            if frac >= next_mark or i == total:
+            if 10 * i >= tenth * total or i == total:
                 dt = time.perf_counter() - t0
                 eta = dt / frac - dt
                 status(f"  {description}: {i}/{total} ({100 * frac:.0f} %, {dt:.1f} s, ETA {eta:.1f} s)")
-                while next_mark <= frac:
-                    next_mark += 0.1
+                while tenth * total <= 10 * i:
+                    tenth += 1

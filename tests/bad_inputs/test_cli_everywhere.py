@@ -22,6 +22,7 @@ import numpy as np
 import pytest
 
 import gripkit
+import gripkit.io  # the fixtures save and load with it
 from gripkit.errors import (ArgumentError, ConfigError, DataError, IdentificationError, ModelError,
                             ParameterError, PathError)
 from corpus import assert_user_error
@@ -200,7 +201,7 @@ def test_description_output_file_checked_before_simulating(cli, tmp_path, files)
 
 
 def test_rls_trajectory_path_checked_before_the_data(cli, files, monkeypatch):
-    import gripkit.cli.identify_linear as cmd
+    import gripkit.cli.identify_common as cmd  # the identify commands read their data there
 
     monkeypatch.setattr(cmd, "load_data", lambda *a, **k: pytest.fail("work started"))
     base = ("identify", "rls", files / "io.csv", "--input", "u", "--output", "y", "--na", 2, "--nb", 2, "--nk", 1)
@@ -240,7 +241,7 @@ def test_os_errors_become_path_errors(cli, files, monkeypatch, exc, phrase):
 
 
 def test_undecodable_text_anywhere_is_a_data_error(cli, files, monkeypatch):
-    import gripkit.cli.identify_linear as cmd
+    import gripkit.cli.identify_common as cmd  # the identify commands read their data there
 
     def fail(*a, **k):
         b"\x93quoted\x94".decode("utf-8")
@@ -251,7 +252,7 @@ def test_undecodable_text_anywhere_is_a_data_error(cli, files, monkeypatch):
 
 def test_a_bug_is_still_reported_as_unexpected(cli, files, monkeypatch):
     """The catch-all stays for bugs: one line, 'unexpected', the exception's class, a pointer to --debug."""
-    import gripkit.cli.identify_linear as cmd
+    import gripkit.cli.identify_common as cmd  # the identify commands read their data there
 
     monkeypatch.setattr(cmd, "load_data", lambda *a, **k: 1 / 0)
     res = cli(*arx_args(files / "io.csv"))

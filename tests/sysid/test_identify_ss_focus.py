@@ -31,7 +31,8 @@ def test_a_refinement_that_scores_lower_is_not_returned(monkeypatch):
     warning giving both free-run fits."""
     tr = _record(0)
 
-    def bad_pem(model, u=None, y=None, form="innovation", max_iterations=50):  # both forms
+    def bad_pem(model, u=None, y=None, form="innovation", max_iterations=50,  # both forms
+                progress=False):
         ss = model.system
         worse = model.replace(system=ss.replace(A=0.9 * ss.A), structure=f"pem-{form}",
                               info={**model.info, "pem": {"converged": True}})
@@ -56,7 +57,7 @@ def test_the_returned_model_never_scores_below_its_start(focus):
         warnings.simplefilter("ignore", AccuracyWarning)
         model, _ = identify_ss(tr, input="u", output="y", order=2, focus=focus, validate=val)
         start, _ = identify_ss(tr, input="u", output="y", order=2, refine=False, validate=val)
-    vd = identify_mimo._validation_data(val, mimo_data(tr, "u", "y"))
+    vd = identify_mimo.validation_data(val, mimo_data(tr, "u", "y"))
     assert focus_score(model, focus, vd) >= focus_score(start, focus, vd) - identify_mimo.FOCUS_TIE
     assert model.info["focus"]["data"] == "validation"
     assert np.allclose(sorted(np.abs(model.system.poles())), [np.hypot(0.9, 0.2)] * 2, atol=0.01)
@@ -78,7 +79,8 @@ def test_the_search_table_is_in_the_text_output(tmp_path, capsys):
                  "--order", "1:4", "--validate", str(tmp_path / "val.csv")])
     out = capsys.readouterr()
     assert code == 0, out.err
-    assert "order search, ranked by validation_fit" in out.out
+    assert "order search, subspace models ranked by validation_fit; the best refined by PEM " \
+        "and ranked first by their simulation fit (refined %)" in out.out
     rows = [ln.split() for ln in out.out.splitlines() if ln.strip()[:1].isdigit() and len(ln.split()) >= 3]
     assert sorted(int(r[0]) for r in rows[:4]) == [1, 2, 3, 4]
     assert "focus simulation (validation data)" in out.out
@@ -91,7 +93,7 @@ def test_an_innovation_refinement_that_loses_falls_back_to_output_error(monkeypa
 
     real = pem_ss.pem
 
-    def pem(model, u=None, y=None, form="innovation", max_iterations=50):
+    def pem(model, u=None, y=None, form="innovation", max_iterations=50, progress=False):
         m = real(model, u=u, y=y, form=form, max_iterations=max_iterations)
         if form == "innovation":  # damaged: scores lower than the subspace start
             m = m.replace(system=m.system.replace(A=0.9 * m.system.A))

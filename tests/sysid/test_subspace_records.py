@@ -9,6 +9,7 @@ import pytest
 from gripkit import Trajectory
 from gripkit.errors import ArgumentError, DataError
 from gripkit.lti import StateSpace
+from gripkit.sysid.linear import identify_mimo
 from gripkit.sysid import identify, n4sid, pem
 from gripkit.sysid.linear.pem_ss import pem_records
 from gripkit.sysid.linear.subspace import n4sid_records
@@ -72,8 +73,31 @@ def test_identify_list_ss_keeps_one_operating_point():
     u0 = np.concatenate([r[0] for r in recs]).mean()
     assert m.u_offset[0] == pytest.approx(u0, rel=1e-12)
     assert m.info["n_records"] == 2 and m.n_samples == 2700
-    with pytest.raises(ArgumentError, match="the order is one number or None"):
-        identify(trs, "ss", input="u", output="y", order="1:3", refine=False)
+    # the order search over the records (issue 25), as for one record: AIC of the innovation
+    # predictor over all of them finds the true order 2 (poles 0.7 and 0.9)
+    s = identify(trs, "ss", input="u", output="y", order="1:3", refine=False)
+    assert s.order == 2 and sorted(r["order"] for r in s.info["search"]) == [1, 2, 3]
+    assert s.info["search_criterion"] == "aic"
+    np.testing.assert_allclose(np.sort(s.system.poles().real), [0.7, 0.9], atol=0.01)
+
+
+def test_identify_list_ss_search_refines_the_best_by_focus():
+    """The search over records refines its best order by PEM over the records, kept when it does
+    not lose by the focus (free run for 'simulation', the innovation predictor for
+    'prediction'); the first row is the returned model, with its focus fit."""
+    recs = [record(1200, 8, x0=(5.0, 1.0)), record(1500, 9, x0=(-5.0, 0.0))]
+    trs = [Trajectory.uniform(dt=0.01, u=u, y=y) for u, y in recs]
+    for focus in ("simulation", "prediction"):
+        m = identify(trs, "ss", input="u", output="y", order="1:3", focus=focus)
+        rows = m.info["search"]
+        assert rows[0]["order"] == m.order == 2 and "refined_percent" in rows[0]
+        assert not any("refined_percent" in r for r in rows[1:])
+        assert m.info["focus"]["criterion"] == focus and m.structure == "pem-innovation"
+        dev = [(u - m.u_offset[0], y - m.y_offset[0]) for u, y in recs]
+        assert rows[0]["refined_percent"] == pytest.approx(
+            identify_mimo.records_score(m, dev, focus), rel=1e-12)
+        assert m.info["focus"]["refined_percent"] >= m.info["focus"]["subspace_percent"] - 0.01
+        np.testing.assert_allclose(np.sort(m.system.poles().real), [0.7, 0.9], atol=0.01)
 
 
 def test_short_record_refused():

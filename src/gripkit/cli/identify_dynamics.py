@@ -7,7 +7,8 @@ prints the order in the error when the count is wrong). The signal chain is IDIM
 (:func:`gripkit.sysid.rigid_body.friction.idim_samples`, the one ``identify friction`` uses for the EMPS and
 DLR/HIT logs): the same zero-phase Butterworth filter on positions (or measured velocities) and
 efforts, central differences, the filter's edges cut, decimation; the rows of a joint within the
-guard band of its velocity reversals or slower than 2 % of its peak speed are left out; σ is the
+guard band of its velocity reversals or slower than 2 % of its peak speed are left out
+(:func:`gripkit.sysid.rigid_body.dynamics_data.dynamics_data`, the library does it); σ is the
 Newey-West (HAC) one, since filtering and decimation leave the residuals correlated.
 
 ``--out`` writes the model file (:mod:`gripkit.sysid.rigid_body.dynamics_file`: the URDF text, the
@@ -25,7 +26,7 @@ import typer
 
 from .app import identify_app
 from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data, report_warnings
-from .identify_ss import ModelOutOpt, ReportOpt
+from .identify_common import ModelOutOpt, ReportOpt
 
 
 def _columns(option: str, text: str | None, joints) -> list[str] | None:
@@ -52,53 +53,21 @@ def _vector(option: str, text: str) -> np.ndarray:
     return v
 
 
-def _idim_states(tr, pcols, ecols, vcols, effort_scale: float, dt: float, cutoff, decimate):
-    """The IDIM-LS signal chain (:func:`gripkit.sysid.rigid_body.friction.idim_samples`) on the position and
-    effort columns; with measured velocities, q̇ and q̈ come from them through the same filter and
-    decimation. Returns the samples and q, q̇, q̈."""
-    from ..sysid.rigid_body.friction import idim_samples
-
-    P = np.column_stack([tr[c] for c in pcols])
-    E = np.column_stack([tr[c] for c in ecols]) * effort_scale
-    st = idim_samples(P, E, dt=dt, cutoff=cutoff, decimation=decimate)
-    q, qd, qdd = st.position, st.velocity, st.acceleration
-    if vcols is not None:
-        sv = idim_samples(np.column_stack([tr[c] for c in vcols]), E, dt=dt, cutoff=st.cutoff,
-                          decimation=st.decimation)
-        qd, qdd = sv.position, sv.velocity
-    return st, q, qd, qdd
-
-
-def _moving_rows(qd, st, joints, data: Path) -> np.ndarray:
-    """Row weights 1/0: a joint's rows count where it moves faster than 2 % of its peak speed,
-    outside the guard band of its velocity reversals; a joint that never moves is an error."""
-    from ..errors import UnidentifiableError
-
-    vmax = np.max(np.abs(qd), axis=0)
-    still = [j for j, v in zip(joints, vmax) if v == 0]
-    if still:
-        raise UnidentifiableError(f"joint(s) {', '.join(still)} never move in {data.name}",
-                                  hint="excite every joint (gripkit excitation fourier)")
-    return ((np.abs(qd) > 0.02 * vmax) & ~st.near_reversal).astype(np.float64)
-
-
-def _write_model_and_report(res, st, states, weights, lines, *, urdf: Path, data: Path, base_link, tip_link,
-                            out: Path | None, report: Path | None) -> None:
-    """``--out``: the model file with the URDF text and the log's name and SHA-256; ``--report``:
-    the HTML page of the identification on ``states`` (q, q̇, q̈)."""
+def _write_model_and_report(res, dd, lines, *, urdf: Path, data: Path, provenance: dict,
+                            base_link, tip_link, out: Path | None, report: Path | None) -> None:
+    """``--out``: the model file with the URDF text and the log's name and SHA-256 (recorded by
+    gripkit.io.load); ``--report``: the HTML page of the identification on ``dd``
+    (:class:`~gripkit.sysid.rigid_body.dynamics_data.DynamicsData`)."""
     if out is not None:
-        from ..sysid.model_file import file_sha256
-
         out.parent.mkdir(parents=True, exist_ok=True)
         res.replace(urdf_text=Path(urdf).read_text(), base_link=base_link, tip_link=tip_link,
-                    data_file=Path(data).name, data_hash=file_sha256(data)).save(out)
+                    **provenance).save(out)
     if report is not None:
         from ..sysid.rigid_body.dynamics_report import write_dynamics_report
 
-        q, qd, qdd = states
-        t = np.arange(q.shape[0]) * st.decimation * st.dt
-        write_dynamics_report(res, t, q, qd, qdd, st.effort, report, weights=weights,
-                              data_name=Path(data).name, warnings_list=list(st.notes) + lines)
+        write_dynamics_report(res, dd.t, dd.q, dd.qd, dd.qdd, dd.effort, report,
+                              weights=dd.weights, data_name=Path(data).name,
+                              warnings_list=list(dd.samples.notes) + lines)
 
 
 def _print_tables(res, chain, data: Path, notes) -> None:
@@ -153,7 +122,9 @@ def identify_dynamics_cmd(
     """Identify the base inertial parameters and the friction of every joint of a URDF chain."""
     from ..errors import DataError
     from ..multibody import from_urdf
+    from ..sysid.io_data import records_provenance
     from ..sysid.rigid_body.dynamics import identify_dynamics
+    from ..sysid.rigid_body.dynamics_data import dynamics_data
     from .paths import output_folder, output_json
 
     output_json(out, "--out")
@@ -166,20 +137,22 @@ def identify_dynamics_cmd(
     ecols = _columns("--effort", effort, joints)
     vcols = _columns("--velocity", velocity, joints)
     tr = load_data(data, list(dict.fromkeys(pcols + ecols + (vcols or []))), fs, time, fill)
-    dt = tr.require_uniform(why="inverse-dynamics identification (filtering and differentiation)")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        st, q, qd, qdd = _idim_states(tr, pcols, ecols, vcols, effort_scale, dt, cutoff, decimate)
-        weights = _moving_rows(qd, st, joints, data)
-        res = identify_dynamics(chain, q, qd, qdd, st.effort, friction=friction, weights=weights,
-                                armature=armature, covariance="hac", constrained=constrained)
+        dd = dynamics_data(tr, joints, pcols, ecols, vcols, effort_scale=effort_scale,
+                           cutoff=cutoff, decimate=decimate)
+        res = identify_dynamics(chain, dd.q, dd.qd, dd.qdd, dd.effort, friction=friction,
+                                weights=dd.weights, armature=armature, covariance="hac",
+                                constrained=constrained)
     lines = report_warnings(caught)
+    st = dd.samples
     notes = list(st.notes) + list(res.warnings)
-    _write_model_and_report(res, st, (q, qd, qdd), weights, lines, urdf=urdf, data=data, base_link=base_link,
+    _write_model_and_report(res, dd, lines, urdf=urdf, data=data,
+                            provenance=records_provenance(tr), base_link=base_link,
                             tip_link=tip_link, out=out, report=report)
     summary = dict(urdf=str(urdf), data=str(data), chain=chain.name,
-                   columns=dict(position=pcols, effort=ecols, velocity=vcols), fs=1.0 / dt, cutoff_hz=st.cutoff,
-                   decimation=st.decimation, **res.to_dict())
+                   columns=dict(position=pcols, effort=ecols, velocity=vcols), fs=1.0 / st.dt,
+                   cutoff_hz=st.cutoff, decimation=st.decimation, **res.to_dict())
     summary["notes"] = notes
     summary["warnings"] = lines
     if json_out:

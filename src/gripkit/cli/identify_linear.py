@@ -14,7 +14,6 @@ file's samples and fit.
 
 from __future__ import annotations
 
-import dataclasses
 from pathlib import Path
 
 import typer
@@ -22,7 +21,9 @@ import typer
 from .app import identify_app
 from ..errors import emit_warning
 from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_choice, check_data_options, check_number,
-                     collected_warnings, emit_json, load_data, report_warnings)
+                     collected_warnings, emit_json, report_warnings)
+from .identify_common import (ModelOutOpt, ReportOpt, ValidateOpt, check_outputs, data_field,
+                              records_field, run_identify, save_and_report, validation)
 
 DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
 DataArgs = typer.Argument(..., help="Data file(s) (.csv, .parquet, .h5); several: one model of all "
@@ -32,8 +33,6 @@ InputOpt = typer.Option(..., "--input", help="Input column (e.g. the valve curre
 OutputOpt = typer.Option(..., "--output", help="Output column (e.g. the force).")
 DetrendOpt = typer.Option("mean", "--detrend",
                           help="Operating-point removal before fitting: mean, linear or none.")
-ValidateOpt = typer.Option(None, "--validate", help="Second record for free-run validation (same columns).")
-ModelOutOpt = typer.Option(None, "--out", help="Write the identified model to this JSON file.")
 NaOpt = typer.Option(..., "--na", help="Number of A coefficients (after the leading 1).")
 NbOpt = typer.Option(..., "--nb", help="Number of B coefficients.")
 NkOpt = typer.Option(..., "--nk", help="Input delay in samples (B's leading zeros).")
@@ -60,73 +59,51 @@ def _check_options(fs, fill, detrend: str, validate: Path | None = None, **order
         raise DataError(f"--validate: data file {str(validate)!r} not found")
 
 
-def _io(path: Path, input: str, output: str, fs, time, fill, detrend: str, why: str):
-    return _load_io(path, input, output, fs, time, fill, detrend, why)[1]
+def _several_files_detrend(data: list[Path], detrend: str) -> None:
+    from ..errors import DataError
+
+    if len(data) > 1 and detrend == "linear":
+        raise DataError("--detrend: with several data files expected mean (the mean of all "
+                        "records) or none, found 'linear'",
+                        hint="a line per file would give every record its own operating point")
 
 
-def _load_io(path: Path, input: str, output: str, fs, time, fill, detrend: str, why: str):
-    """The record (a Trajectory) and its input and output as identification data."""
-    from ..sysid import io_data
-
-    tr = load_data(path, [input, output], fs, time, fill)
-    return tr, io_data(tr, input=input, output=output, detrend=detrend, why=why)
-
-
-def _fit_and_report(method: str, data: Path, input: str, output: str, fs, time, fill, detrend: str,
-                    validate: Path | None, json_out: bool, fit, out_file: Path | None = None):
-    """Shared body of arx/armax/oe: load, fit (``fit(io) -> model``), validate, print."""
+def _siso(method: str, data: list[Path], input: str, output: str, fs, time, fill, detrend: str,
+          validate: Path | None, json_out: bool, out_file: Path | None, report: Path | None,
+          **orders) -> None:
+    """ARX, ARMAX or OE of one input and one output, of one file or of several (one model of
+    all the records: ``data`` the list of files, ``fit_percent`` the one-step fit of all records
+    and ``records`` each file's): one call of gripkit.sysid.identify, one validation, print."""
+    check_outputs(out_file, report)
+    _several_files_detrend(data, detrend)
+    if method in ("armax", "oe") and len(data) == 1:  # PEM: its iterations on stderr
+        orders["progress"] = True
     with collected_warnings() as caught:
-        tr, io = _load_io(data, input, output, fs, time, fill, detrend,
-                          f"{method.upper()} identification")
-        model = fit(io)
-        if detrend == "mean":
-            from ..sysid.identify import warn_if_mean_detrending_hurt
-
-            raw = lambda: _io(data, input, output, fs, time, fill, "none", "refit")  # noqa: E731
-            warn_if_mean_detrending_hurt(model, io, raw, fit)
-        if out_file is not None:  # the model file (issue 13), with the data's name and hash
-            from ..sysid.model_file import file_sha256
-
-            saved = model.replace(data_file=Path(data).name, data_hash=file_sha256(data))
-            saved.with_display_units(tr).save(out_file)  # outputs shown in the file's units
+        model, tr, vtr = run_identify(data, method, input, output, fs=fs, time=time, fill=fill,
+                                      validate=validate, detrend=detrend, **orders)
+        save_and_report(model, tr, data, out_file, report)
         out = model.to_dict()
-        out.update(data=str(data), detrend=detrend)
-        val = _validate_polynomial(model, io.dt, validate, input, output, fs, time, fill, detrend,
-                                   out)
+        out.update(data=data_field(data), detrend=detrend)
+        if len(data) > 1:
+            out["records"] = records_field(data, model.info["records"])
+        val = validation(model, vtr, validate, detrend)
+        if val is not None:
+            out["validation_fit_percent"] = val.fit_percent
+            out["validation"] = val.to_dict()
     out["warnings"] = report_warnings(caught)
     if json_out:
         emit_json(out)
-    else:
-        _print_model(model, val, out.get("validation_fit_percent"))
+        return
+    _print_model(model, None if val is None else val.one_step, out.get("validation_fit_percent"))
+    _echo_records(out.get("records"))
+    _echo_written(out_file, report)
 
 
-def _validate_polynomial(model, dt: float, validate: Path | None, input: str, output: str, fs,
-                         time, fill, detrend: str, out: dict):
-    """The validation of a SISO polynomial model on ``--validate`` (None without it): the one-step
-    fit and residual tests returned, the free-run fit written into ``out``."""
-    if validate is None:
-        return None
-    # the validation record around the model's operating point (its offsets), as the one
-    # validation fit below and `gripkit compare` take it; a linear trend is the record's own
-    vio = _io(validate, input, output, fs, time, fill, "linear" if detrend == "linear" else "none",
-              "validation")
-    if detrend != "linear":
-        vio = dataclasses.replace(vio, u=vio.u - model.u_offset, y=vio.y - model.y_offset,
-                                  u_offset=model.u_offset, y_offset=model.y_offset)
-    if abs(vio.dt - dt) > 1e-9 * dt:
-        from ..errors import DataError
-
-        raise DataError(f"validation data {str(validate)!r} is sampled at {1 / vio.dt:g} Hz, the "
-                        f"estimation data at {1 / dt:g} Hz", hint="resample one of them")
-    from ..sysid.linear.linear_model import VALIDATION_FIT
-
-    val = model.validate(vio.u, vio.y)  # one-step fit and residual tests
-    # the one validation fit (None for an unstable model)
-    out["validation_fit_percent"] = model.compare(
-        load_data(validate, [input, output], fs, time, fill)).fit_percent[0]
-    out["validation"] = {**val.to_dict(), "fit_percent": out["validation_fit_percent"],
-                         "initial": "estimated", "definition": VALIDATION_FIT}
-    return val
+def _echo_written(out_file: Path | None, report: Path | None) -> None:
+    if out_file is not None:
+        typer.echo(f"model written to {out_file}")
+    if report is not None:
+        typer.echo(f"report written to {report}")
 
 
 def _print_model(model, val, vfit: float | None = None) -> None:
@@ -158,50 +135,37 @@ def _print_model(model, val, vfit: float | None = None) -> None:
 
 
 def _mimo_arx(data: list[Path], input: str, output: str, na: int, nb: int, nk: int, fs, time, fill,
-              detrend: str, validate: Path | None, json_out: bool, out_file: Path | None) -> None:
+              detrend: str, validate: Path | None, json_out: bool, out_file: Path | None,
+              report: Path | None) -> None:
     """Matrix-polynomial ARX of several columns: every fit figure is a list per output, in
     ``--output`` order (free run with estimated x0, one-step, and free run on ``--validate``).
     Several DATA files: one model of all the records (``records``: each file's fits)."""
     from ..errors import DataError, StabilityWarning
-    from ..sysid.linear.identify_mimo import identify_arx as fit_arx
-    from ..sysid.linear.identify_mimo import parse_names
-    from ..sysid.linear.linear_model import VALIDATION_FIT
-    from ..sysid.model_file import file_sha256
 
     if detrend == "linear":
         raise DataError("--detrend: 'linear' is for one input and one output; with several columns expected "
                         "mean or none", hint="use --detrend mean, or detrend the columns before")
-    columns = list(parse_names(input, "--input")) + list(parse_names(output, "--output"))
+    check_outputs(out_file, report)
     with collected_warnings() as caught:
-        if len(data) == 1:
-            data = data[0]
-            tr = load_data(data, columns, fs, time, fill)
-            model = fit_arx(tr, input=input, output=output, na=na, nb=nb, nk=nk, detrend=detrend)
-            model = model.replace(data_file=Path(data).name, data_hash=file_sha256(data))
-            model = model.with_display_units(tr)
-        else:
-            model = _fit_records(data, columns, input, output, fs, time, fill, detrend, "arx",
-                                 na=na, nb=nb, nk=nk)
-        if out_file is not None:
-            model.save(out_file)
+        model, tr, vtr = run_identify(data, "arx", input, output, fs=fs, time=time, fill=fill,
+                                      validate=validate, detrend=detrend, na=na, nb=nb, nk=nk)
+        save_and_report(model, tr, data, out_file, report)
         res = model.to_dict()
         info = res.pop("info")
-        res.update(na=na, nb=nb, nk=nk, data=_data_field(data), detrend=detrend,
+        res.update(na=na, nb=nb, nk=nk, data=data_field(data), detrend=detrend,
                    n_samples=model.n_samples,
                    one_step_fit_percent=info["one_step_fit_percent"],
                    **{k: info[k] for k in ("A_poly", "A_poly_std", "B_poly", "B_poly_std")},
                    out=None if out_file is None else str(out_file))
         if "records" in info:
-            res["records"] = _records_field(data, info["records"])
+            res["records"] = records_field(data, info["records"])
         if not model.stable:
             emit_warning("arx: the identified model is unstable (a pole on or outside the unit circle): "
                          "no free-run fit is reported", StabilityWarning)
-        if validate is not None:
-            vfit = model.compare(load_data(validate, columns, fs, time, fill)).fit_percent
-            vfit = vfit if model.stable else None  # the one validation fit: none when unstable
-            res["validation_fit_percent"] = vfit
-            res["validation"] = {"fit_percent": vfit, "data": str(validate), "initial_state": "estimated",
-                                 "definition": VALIDATION_FIT}
+        val = validation(model, vtr, validate)
+        if val is not None:
+            res["validation_fit_percent"] = val.fit_percent
+            res["validation"] = val.to_dict()
     res["warnings"] = report_warnings(caught)
     if json_out:
         emit_json(res)
@@ -221,45 +185,7 @@ def _mimo_arx(data: list[Path], input: str, output: str, na: int, nb: int, nk: i
             line += f", validation free run {res['validation_fit_percent'][i]:.2f} %"
         typer.echo(line)
     _echo_records(res.get("records"))
-    if out_file is not None:
-        typer.echo(f"model written to {out_file}")
-
-
-def _fit_records(data: list[Path], columns: list[str], input: str, output: str, fs, time, fill,
-                 detrend: str, method: str, **orders):
-    """One model of several data files (:func:`gripkit.sysid.identify.identify_records`): each
-    file a record with its own initial conditions, one operating point for all of them."""
-    from ..errors import DataError, GripkitError
-    from ..sysid.identify import identify_records
-
-    if detrend == "linear":
-        raise DataError("--detrend: with several data files expected mean (the mean of all "
-                        "records) or none, found 'linear'",
-                        hint="a line per file would give every record its own operating point")
-    trs = [load_data(path, columns, fs, time, fill) for path in data]  # its errors name the file
-    try:
-        model = identify_records(trs, method, input=input, output=output, detrend=detrend,
-                                 **orders)
-    except GripkitError as exc:  # name the file, not its place in the list
-        msg = exc.message
-        for i, path in reversed(list(enumerate(data))):  # data[10] before data[1]
-            msg = msg.replace(f"data[{i}]", repr(str(path)))
-        raise type(exc)(msg, hint=exc.hint) from None
-    names = ", ".join(Path(p).name for p in data)
-    if hasattr(model, "data_file"):  # a LinearModel (several columns) carries its data file
-        model = model.replace(data_file=names, data_hash=None)
-    return model
-
-
-def _data_field(data) -> str | list[str]:
-    """The JSON ``data`` field: the file, or the list of files of a fit of several records."""
-    return [str(p) for p in data] if isinstance(data, list) else str(data)
-
-
-def _records_field(data: list[Path], records: list[dict]) -> list[dict]:
-    """The JSON ``records`` field: each file with its samples and fits (initial states left out)."""
-    return [{"data": str(p), **{k: v for k, v in r.items() if k != "x0"}}
-            for p, r in zip(data, records)]
+    _echo_written(out_file, report)
 
 
 def _echo_records(records: list[dict] | None) -> None:
@@ -278,53 +204,25 @@ def _echo_records(records: list[dict] | None) -> None:
         typer.echo(line)
 
 
-def _siso_records(method: str, data: list[Path], input: str, output: str, fs, time, fill,
-                  detrend: str, validate: Path | None, json_out: bool, out_file: Path | None,
-                  **orders) -> None:
-    """ARX, ARMAX or OE of several data files: the JSON of one file's fit, with ``data`` the list
-    of files, ``fit_percent`` the one-step fit of all records and ``records`` each file's."""
-    with collected_warnings() as caught:
-        model = _fit_records(data, [input, output], input, output, fs, time, fill, detrend, method,
-                             **orders)
-        if out_file is not None:
-            names = ", ".join(Path(p).name for p in data)
-            model.replace(data_file=names, data_hash=None).save(out_file)
-        out = model.to_dict()
-        out.update(data=_data_field(data), detrend=detrend,
-                   records=_records_field(data, model.info["records"]))
-        val = _validate_polynomial(model, model.dt, validate, input, output, fs, time, fill,
-                                   detrend, out)
-    out["warnings"] = report_warnings(caught)
-    if json_out:
-        emit_json(out)
-        return
-    _print_model(model, val, out.get("validation_fit_percent"))
-    _echo_records(out["records"])
-
-
 @identify_app.command("arx")
 def identify_arx(data: list[Path] = DataArgs, input: str = InputsOpt, output: str = OutputsOpt,
                  na: int = NaOpt, nb: int = NbOpt, nk: int = NkOpt,
                  fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
-                 validate: Path = ValidateOpt, json_out: bool = JsonOpt, out: Path = ModelOutOpt):
+                 validate: Path = ValidateOpt, json_out: bool = JsonOpt, out: Path = ModelOutOpt,
+                 report: Path = ReportOpt):
     """ARX (orders na, nb, nk) by least squares (QR), with σ, loss (eq 29), fit, AIC, poles and zeros.
     With several columns (``--input a,b --output c,d``) a matrix-polynomial ARX: fit figures are
     lists per output, in ``--output`` order. With several DATA files one model of all the records
     (each with its own initial conditions; --detrend mean removes the mean of all of them)."""
-    from ..sysid import arx
     from ..sysid.linear.identify_mimo import several
 
     _check_options(fs, fill, detrend, validate, na=na, nb=nb, nk=nk)
     if several(input, output):
-        _mimo_arx(data, input, output, na, nb, nk, fs, time, fill, detrend, validate, json_out, out)
+        _mimo_arx(data, input, output, na, nb, nk, fs, time, fill, detrend, validate, json_out, out,
+                  report)
         return
-    if len(data) > 1:
-        _siso_records("arx", data, input, output, fs, time, fill, detrend, validate, json_out,
-                      out, na=na, nb=nb, nk=nk)
-        return
-    data = data[0]
-    _fit_and_report("arx", data, input, output, fs, time, fill, detrend, validate, json_out,
-                    lambda io: arx(io.u, io.y, na, nb, nk, dt=io.dt, **io.meta), out)
+    _siso("arx", data, input, output, fs, time, fill, detrend, validate, json_out, out, report,
+          na=na, nb=nb, nk=nk)
 
 
 @identify_app.command("armax")
@@ -334,19 +232,13 @@ def identify_armax(data: list[Path] = DataArgs, input: str = InputOpt, output: s
                    nc: int = typer.Option(..., "--nc", help="Number of C coefficients."),
                    nk: int = NkOpt,
                    fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
-                   validate: Path = ValidateOpt, json_out: bool = JsonOpt, out: Path = ModelOutOpt):
+                   validate: Path = ValidateOpt, json_out: bool = JsonOpt, out: Path = ModelOutOpt,
+                   report: Path = ReportOpt):
     """ARMAX (orders na, nb, nc, nk) by prediction-error minimisation. With several DATA files one
     model of all the records (each with its own initial conditions)."""
-    from ..sysid import armax
-
     _check_options(fs, fill, detrend, validate, na=na, nb=nb, nc=nc, nk=nk)
-    if len(data) > 1:
-        _siso_records("armax", data, input, output, fs, time, fill, detrend, validate, json_out,
-                      out, na=na, nb=nb, nc=nc, nk=nk)
-        return
-    data = data[0]
-    _fit_and_report("armax", data, input, output, fs, time, fill, detrend, validate, json_out,
-                    lambda io: armax(io.u, io.y, na, nb, nc, nk, dt=io.dt, **io.meta), out)
+    _siso("armax", data, input, output, fs, time, fill, detrend, validate, json_out, out, report,
+          na=na, nb=nb, nc=nc, nk=nk)
 
 
 @identify_app.command("oe")
@@ -355,19 +247,13 @@ def identify_oe(data: list[Path] = DataArgs, input: str = InputOpt, output: str 
                 nf: int = typer.Option(..., "--nf", "--na", help="Number of F (denominator) coefficients."),
                 nk: int = NkOpt,
                 fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
-                validate: Path = ValidateOpt, json_out: bool = JsonOpt, out: Path = ModelOutOpt):
+                validate: Path = ValidateOpt, json_out: bool = JsonOpt, out: Path = ModelOutOpt,
+                report: Path = ReportOpt):
     """Output-error (orders nb, nf, nk) by prediction-error minimisation. With several DATA files
     one model of all the records (each with its own initial outputs, estimated)."""
-    from ..sysid import oe
-
     _check_options(fs, fill, detrend, validate, nb=nb, nf=nf, nk=nk)
-    if len(data) > 1:
-        _siso_records("oe", data, input, output, fs, time, fill, detrend, validate, json_out, out,
-                      nb=nb, nf=nf, nk=nk)
-        return
-    data = data[0]
-    _fit_and_report("oe", data, input, output, fs, time, fill, detrend, validate, json_out,
-                    lambda io: oe(io.u, io.y, nb, nf, nk, dt=io.dt, **io.meta), out)
+    _siso("oe", data, input, output, fs, time, fill, detrend, validate, json_out, out, report,
+          nb=nb, nf=nf, nk=nk)
 
 
 @identify_app.command("rls")
@@ -380,17 +266,21 @@ def identify_rls(data: Path = DataArg, input: str = InputOpt, output: str = Outp
                                                  help="Write θ(t), σ(t), prediction and error to this file."),
                  fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                  json_out: bool = JsonOpt):
-    """Recursive least squares ARX (orders na, nb, nk) with forgetting; θ and σ at every sample."""
+    """Recursive least squares ARX (orders na, nb, nk) with forgetting; θ and σ at every sample.
+    No --out, --report or --validate: the result is a parameter trajectory θ(t), not one model
+    (with forgetting, θ at the end describes the end of the record only); write θ(t) with
+    --trajectory, or fit one model of the record with identify arx."""
     from ..io import save
-    from ..sysid import RLS, rls
+    from ..sysid import RLS
     from .paths import output_file
 
     _check_options(fs, fill, detrend)
     RLS(na, nb, nk, forgetting=forgetting, p0=p0, windup=windup)  # checks the orders and the options
     output_file(trajectory, "--trajectory")
     with collected_warnings() as caught:
-        io = _io(data, input, output, fs, time, fill, detrend, "RLS identification")
-        res = rls(io.u, io.y, na, nb, nk, forgetting=forgetting, p0=p0, windup=windup, dt=io.dt)
+        res = run_identify([data], "rls", input, output, fs=fs, time=time, fill=fill,
+                           detrend=detrend, na=na, nb=nb, nk=nk, forgetting=forgetting, p0=p0,
+                           windup=windup)[0]
         if trajectory is not None:
             save(res.to_trajectory(), trajectory)
     out = res.to_dict()
@@ -422,9 +312,11 @@ def identify_search(data: Path = DataArg, input: str = InputOpt, output: str = O
                     criterion: str = typer.Option("aic", "--criterion", help="Ranking: aic, fpe or loss."),
                     top: int = typer.Option(10, "--top", help="Rows shown in the table (JSON lists all)."),
                     fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
-                    validate: Path = ValidateOpt, json_out: bool = JsonOpt):
-    """Fit every ARX structure of the ranges and rank them (best first; by free-run fit on --validate)."""
-    from ..sysid import structure_search
+                    validate: Path = ValidateOpt, json_out: bool = JsonOpt, out: Path = ModelOutOpt,
+                    report: Path = ReportOpt):
+    """Fit every ARX structure of the ranges and rank them (best first; by free-run fit on
+    --validate). --out and --report: the best structure, fitted by identify arx on the whole
+    record (the ranking fits every structure on the samples they have in common)."""
     from ..sysid.linear.search import CRITERIA, parse_range
 
     _check_options(fs, fill, detrend, validate)
@@ -432,11 +324,18 @@ def identify_search(data: Path = DataArg, input: str = InputOpt, output: str = O
     check_number(top, "--top", minimum=1, integer=True)
     for name, text in (("--na", na), ("--nb", nb), ("--nk", nk)):
         parse_range(text, name)
+    check_outputs(out, report)
     with collected_warnings() as caught:
-        io = _io(data, input, output, fs, time, fill, detrend, "ARX structure search")
-        vio = None if validate is None else _io(validate, input, output, fs, time, fill, detrend, "validation")
-        res = structure_search(io.u, io.y, na, nb, nk, criterion=criterion, dt=io.dt,
-                               validate=None if vio is None else (vio.u, vio.y))
+        res, tr, vtr = run_identify([data], "search", input, output, fs=fs, time=time, fill=fill,
+                                    validate=validate, fit_validate=True, detrend=detrend,
+                                    na=na, nb=nb, nk=nk, criterion=criterion)
+        if out is not None or report is not None:
+            from ..sysid import identify
+
+            b = res.best
+            best = identify(tr, "arx", input=input, output=output, na=b.na, nb=b.nb, nk=b.nk,
+                            detrend=detrend)
+            save_and_report(best, tr, [data], out, report)
     report_warnings(caught)
     criterion = res.criterion
     if json_out:

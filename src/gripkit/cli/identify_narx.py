@@ -11,8 +11,8 @@ import typer
 
 from .app import identify_app
 from .common import (FillOpt, FsOpt, JsonOpt, ModelReportOpt, TimeOpt, check_data_options,
-                     collected_warnings, emit_json, load_data, report_warnings, write_model_page)
-from .paths import output_folder
+                     collected_warnings, emit_json, report_warnings, write_model_page)
+from .identify_common import check_outputs, run_identify, validation
 
 
 def _terms(value: str):
@@ -64,11 +64,9 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
                   report: Optional[Path] = ModelReportOpt,
                   fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
                   json_out: bool = JsonOpt):
-    """Polynomial NARX: terms by error reduction ratio (FROLS), θ with σ, pruning, free-run fit."""
-    import numpy as np
-
-    from ..sysid.nonlinear.narx import narx
-
+    """Polynomial NARX: terms by error reduction ratio (FROLS), θ with σ, pruning, free-run fit.
+    No --report: the model report draws the frequency response, poles and residuals of a linear
+    model, which a NARX model has not; gripkit compare MODEL.json DATA gives its free-run fit."""
     n_terms = _terms(terms)
     if refine not in ("none", "simulation"):
         from ..errors import DataError
@@ -76,21 +74,17 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
         raise DataError(f"--refine: expected 'none' or 'simulation', found {refine!r}",
                         hint="--refine simulation fits θ to the free run (output-error noise)")
     check_data_options(fs, fill)
-    output_folder(report, "--report")
+    check_outputs(out, report)
     with collected_warnings() as caught:
-        tr = load_data(data, [input_col, output_col], fs, time, fill)
-        val = tv = None
-        if validate is not None:
-            tv = load_data(validate, [input_col, output_col], fs, time, fill)
-            val = (np.asarray(tv[input_col]), np.asarray(tv[output_col]))
-        m = narx(np.asarray(tr[input_col]), np.asarray(tr[output_col]), degree=degree, lags=lags,
-                 ylags=ylags, ulags=ulags, terms=n_terms, dt=tr.dt, validate=val,
-                 refine=None if refine == "none" else refine, progress=True)
-        m.input_name, m.output_name = input_col, output_col
+        m, tr, vtr = run_identify([data], "narx", input_col, output_col, fs=fs, time=time,
+                                  fill=fill, validate=validate, fit_validate=True, degree=degree,
+                                  lags=lags, ylags=ylags, ulags=ulags, terms=n_terms,
+                                  refine=None if refine == "none" else refine, progress=True)
         if out is not None:
             m.save(out)
+        val = validation(m, vtr, validate)
         page = None if report is None else write_model_page(
-            m, tr if tv is None else tv, report, data if validate is None else validate)
+            m, tr if vtr is None else vtr, report, data if validate is None else validate)
     lines = report_warnings(caught)
     if json_out:
         emit_json({"data": str(data), "input": input_col, "output": output_col,
@@ -100,8 +94,7 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
                    "parameters": [{"term": t, "value": float(v), "std": float(s)}
                                   for t, v, s in zip(m.terms, m.theta, m.theta_std)],
                    "fit_percent": m.fit_percent, "prediction_fit_percent": m.prediction_fit_percent,
-                   "validation": None if validate is None else
-                   {"data": str(validate), "fit_percent": m.validation_fit_percent},
+                   "validation": None if val is None else val.to_dict(),
                    "model": None if out is None else str(out), "report": page,
                    "warnings": lines})
     else:

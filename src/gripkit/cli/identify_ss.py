@@ -21,6 +21,8 @@ import typer
 
 from .app import identify_app
 from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data, report_warnings
+from .identify_common import (ModelOutOpt, ReportOpt, ValidateOpt, check_outputs, data_field,
+                              run_identify, save_and_report, validation)
 
 DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
 DataArgs = typer.Argument(..., help="Data file(s) (.csv, .parquet, .h5); several: one model of "
@@ -29,31 +31,12 @@ DataArgs = typer.Argument(..., help="Data file(s) (.csv, .parquet, .h5); several
 InputsOpt = typer.Option(..., "--input", help="Input column(s), comma-separated (e.g. a,b).")
 OutputsOpt = typer.Option(..., "--output", help="Output column(s), comma-separated (e.g. c,d).")
 DetrendOpt = typer.Option("mean", "--detrend", help="Operating-point removal before fitting: mean or none.")
-ModelOutOpt = typer.Option(None, "--out", help="Write the identified model to this JSON file.")
-ReportOpt = typer.Option(None, "--report", help="Write an HTML report of the model on the data to this folder.")
 
 
 def _load(path: Path, inputs: str, outputs: str, fs, time, fill):
-    from ..sysid.linear.identify_mimo import parse_names
+    from .identify_common import columns
 
-    cols = list(parse_names(inputs, "input")) + list(parse_names(outputs, "output"))
-    return load_data(path, cols, fs, time, fill)
-
-
-def _with_provenance(model, data: Path):
-    from ..sysid.model_file import file_sha256
-
-    return model.replace(data_file=Path(data).name, data_hash=file_sha256(data))
-
-
-def _finish(model, data, tr, out, report, caught_lines_fn):
-    """Save and report (shared tail of the three commands)."""
-    if out is not None:
-        model.with_display_units(tr).save(out)  # outputs shown in the units of the data's file
-    if report is not None:
-        from ..sysid.model_report import write_model_report
-
-        write_model_report(model, tr, report, data_name=Path(data).name)
+    return load_data(path, columns(inputs, outputs), fs, time, fill)
 
 
 @identify_app.command("ss")
@@ -75,9 +58,10 @@ def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
                     json_out: bool = JsonOpt):
     """MIMO state space: subspace (N4SID/MOESP/CVA, order from the singular values), then PEM.
     Several DATA files: one model of all the records (subspace, then PEM), one initial state per
-    record (``records``: each file's free-run fit)."""
+    record (``records``: each file's free-run fit), with the order search, --focus and --report
+    (one page per file) as for one file; --validate then checks the model, the search ranks by
+    Akaike's criterion over the records."""
     from ..errors import DataError
-    from ..sysid.linear.identify_mimo import identify_ss
 
     if form not in ("oe", "innovation"):
         raise DataError(f"--form: expected oe or innovation, found {form!r}")
@@ -86,43 +70,32 @@ def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
     if max_iterations < 1:
         raise DataError(f"--max-iterations: expected a positive integer, found {max_iterations}")
     several = len(data) > 1
-    if several and report is not None:
-        raise DataError("--report: the model report is of one data file; with several data "
-                        "files leave --report out",
-                        hint="run gripkit report MODEL.json DATA for each file")
+    check_outputs(out, report)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        if several:
-            model, extras = _ss_of_records(data, input, output, order, method, no_refine, validate,
-                                           detrend, fs, time, fill, form, max_iterations)
-            if out is not None:
-                model.save(out)
-        else:
-            data = data[0]
-            tr = _load(data, input, output, fs, time, fill)
-            vtr = _load(validate, input, output, fs, time, fill) if validate is not None else None
-            model, extras = identify_ss(tr, input=input, output=output, order=order,
-                                        method=method, form=form, refine=not no_refine,
-                                        validate=vtr, detrend=detrend, progress=True,
-                                        focus=focus, max_iterations=max_iterations)
-            model = _with_provenance(model, data)
-            _finish(model, data, tr, out, report, None)
-    from ..sysid.linear.linear_model import VALIDATION_FIT
-
+        options = dict(order=order, refine=not no_refine, form=form, max_iterations=max_iterations,
+                       weighting=method, progress=True, focus=focus)
+        model, tr, vtr = run_identify(data, "ss", input, output, fs=fs, time=time, fill=fill,
+                                      validate=validate, fit_validate=not several,
+                                      detrend=detrend, **options)
+        save_and_report(model, tr, data, out, report)
+        val = validation(model, vtr, validate)
     res = model.to_dict()
-    res.update(data=[str(p) for p in data] if several else str(data), method=method,
-               refined=not no_refine, out=None if out is None else str(out))
+    res["info"] = {k: v for k, v in res["info"].items()  # the search is given at the top level
+                   if k not in ("search", "search_criterion", "validation_fit_percent")}
+    res.update(data=data_field(data), method=method, refined=not no_refine,
+               out=None if out is None else str(out))
     if several:
         res["records"] = [{"data": str(p), "n_samples": r["n_samples"],
                            "fit_percent": r["fit_percent"]}
                           for p, r in zip(data, model.info["records"])]
         res["info"]["records"] = res["records"]  # without the initial states' arrays
-    if "validation_fit_percent" in extras:
-        res["validation"] = {"fit_percent": extras["validation_fit_percent"], "data": str(validate),
-                             "initial_state": "estimated", "definition": VALIDATION_FIT}
-    if "search" in extras:
-        res["search"] = extras["search"]
-        res["search_criterion"] = extras["criterion"]
+    if val is not None:
+        res["validation"] = val.to_dict()
+    search = model.info.get("search")
+    if search is not None:
+        res["search"] = search
+        res["search_criterion"] = model.info["search_criterion"]
     if "focus" in model.info:
         res["focus"] = model.info["focus"]
     res["warnings"] = report_warnings(caught)
@@ -145,12 +118,12 @@ def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
         fo = model.info["focus"]
         typer.echo(f"focus {fo['criterion']} ({fo['data']} data): subspace {fo['subspace_percent']:.2f} %, "
                    f"PEM {fo['refined_percent']:.2f} %; kept the {fo['kept']} model")
-    if "search" in extras:
-        _echo_search(extras["search"], extras["criterion"])
-    if "validation_fit_percent" in extras and extras["validation_fit_percent"] is not None:
+    if search is not None:
+        _echo_search(search, res["search_criterion"], focus)
+    if val is not None and val.fit_percent is not None:
         typer.echo("validation free-run fit: " + ", ".join(f"{n} {f:.2f} %" for n, f in
-                                                           zip(ss.outputs, extras["validation_fit_percent"])))
-        typer.echo(f"  ({VALIDATION_FIT})")
+                                                           zip(ss.outputs, val.fit_percent)))
+        typer.echo(f"  ({val.definition})")
     p, cov = (ss.pole_covariance() if ss.uncertainty is not None else (ss.poles(), None))
     for i, z in enumerate(p):
         sd = "" if cov is None else f" ± ({np.sqrt(cov[i, 0, 0]):.2g}, {np.sqrt(cov[i, 1, 1]):.2g})"
@@ -159,51 +132,23 @@ def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
         typer.echo(f"model written to {out}")
 
 
-def _records_model(data: list[Path], method: str, input: str, output: str, detrend: str, fs, time,
-                   fill, **options):
-    """One ``method`` model of several data files
-    (:func:`gripkit.sysid.identify.identify_records`), its errors naming the files."""
-    from ..errors import GripkitError
-    from ..sysid.identify import identify_records
-
-    trs = [_load(p, input, output, fs, time, fill) for p in data]
-    try:
-        model = identify_records(trs, method, input=input, output=output, detrend=detrend,
-                                 **options)
-    except GripkitError as exc:  # name the file, not its place in the list
-        msg = exc.message
-        for i, path in reversed(list(enumerate(data))):
-            msg = msg.replace(f"data[{i}]", repr(str(path)))
-        raise type(exc)(msg, hint=exc.hint) from None
-    return model.replace(data_file=", ".join(Path(p).name for p in data), data_hash=None)
-
-
-def _ss_of_records(data: list[Path], input: str, output: str, order, method: str, no_refine: bool,
-                   validate: Path | None, detrend: str, fs, time, fill, form: str,
-                   max_iterations: int):
-    """The state-space model of several data files (:func:`_records_model`) and its extras
-    (``validation_fit_percent`` with ``validate``)."""
-    model = _records_model(data, "ss", input, output, detrend, fs, time, fill, order=order,
-                           refine=not no_refine, weighting=method, form=form,
-                           max_iterations=max_iterations)
-    extras = {}
-    if validate is not None:  # the one validation fit (around the model's stored offsets)
-        vtr = _load(validate, input, output, fs, time, fill)
-        extras["validation_fit_percent"] = (model.compare(vtr).fit_percent if model.stable
-                                            else None)
-    return model, extras
-
-
-def _echo_search(rows: list[dict], criterion: str) -> None:
-    """The order search as a table, best first (the JSON ``search`` list)."""
+def _echo_search(rows: list[dict], criterion: str, focus: str) -> None:
+    """The order search as a table, best first (the JSON ``search`` list): the refined orders
+    first, ranked by their ``focus`` fit, then the other subspace models by ``criterion``."""
     val = any("validation_fit_percent" in r for r in rows)
-    typer.echo(f"order search, ranked by {criterion} (subspace models; the first is refined):")
-    typer.echo("  order  " + ("validation fit % (per output)  " if val else "") + "fit % (per output)  AIC")
+    ref = any("refined_percent" in r for r in rows)
+    typer.echo(f"order search, subspace models ranked by {criterion}"
+               + (f"; the best refined by PEM and ranked first by their {focus} fit "
+                  "(refined %)" if ref else "") + ":")
+    typer.echo("  order  " + ("refined %  " if ref else "")
+               + ("validation fit % (per output)  " if val else "") + "fit % (per output)  AIC")
     for r in rows:
         vf = r.get("validation_fit_percent")
         vtxt = ("—" if vf is None else ", ".join(f"{v:.2f}" for v in vf)) if val else ""
         fit = ", ".join(f"{v:.2f}" for v in r["fit_percent"]) if r.get("fit_percent") else "—"
-        typer.echo(f"  {r['order']:>5}  " + (f"{vtxt:<30}  " if val else "") + f"{fit:<18}  {r['aic']:.6g}")
+        rtxt = ("—" if "refined_percent" not in r else f"{r['refined_percent']:.2f}") if ref else ""
+        typer.echo(f"  {r['order']:>5}  " + (f"{rtxt:<9}  " if ref else "")
+                   + (f"{vtxt:<30}  " if val else "") + f"{fit:<18}  {r['aic']:.6g}")
 
 
 @identify_app.command("frf")
@@ -242,39 +187,30 @@ def identify_tf_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
                     poles: int = typer.Option(..., "--poles", help="Number of poles."),
                     zeros: int = typer.Option(..., "--zeros", help="Number of zeros."),
                     out: Path = ModelOutOpt, report: Path = ReportOpt,
+                    validate: Path = ValidateOpt,
                     fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                     json_out: bool = JsonOpt):
     """Continuous-time transfer function (zero-order hold between samples) with σ. Several DATA
     files: one model of all the records, each from its own initial state."""
-    from ..errors import DataError
-    from ..sysid.linear.identify_mimo import identify_tf
-
     several = len(data) > 1
-    if several and report is not None:
-        raise DataError("--report: the model report is of one data file; with several data "
-                        "files leave --report out",
-                        hint="run gripkit report MODEL.json DATA for each file")
+    check_outputs(out, report)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        if several:
-            model = _records_model(data, "tf", input, output, detrend, fs, time, fill,
-                                   poles=poles, zeros=zeros)
-            if out is not None:
-                model.save(out)
-        else:
-            data = data[0]
-            tr = _load(data, input, output, fs, time, fill)
-            model = _with_provenance(identify_tf(tr, input=input, output=output, poles=poles,
-                                                 zeros=zeros, detrend=detrend), data)
-            _finish(model, data, tr, out, report, None)
+        model, tr, vtr = run_identify(data, "tf", input, output, fs=fs, time=time, fill=fill,
+                                      validate=validate, detrend=detrend, poles=poles,
+                                      zeros=zeros)
+        save_and_report(model, tr, data, out, report)
+        val = validation(model, vtr, validate)
     g, info = model.system, model.info
     res = {"num": g.numerator(), "den": g.denominator(), "num_std": info["num_std"][-(zeros + 1):],
            "den_std": info["den_std"], "natural_frequency_hz": info["natural_frequency_hz"],
            "natural_frequency_hz_std": info["natural_frequency_hz_std"], "damping_ratio": info["damping_ratio"],
            "damping_ratio_std": info["damping_ratio_std"], "fit_percent": model.fit_percent,
            "poles": [[float(z.real), float(z.imag)] for z in g.poles()], "inputs": list(g.inputs),
-           "outputs": list(g.outputs), "data": [str(p) for p in data] if several else str(data),
+           "outputs": list(g.outputs), "data": data_field(data),
            "out": None if out is None else str(out), "warnings": report_warnings(caught)}
+    if val is not None:
+        res["validation"] = val.to_dict()
     if several:
         res["records"] = [{"data": str(p), "n_samples": r["n_samples"],
                            "fit_percent": r["fit_percent"]}
@@ -289,3 +225,8 @@ def identify_tf_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
     for f, sf, z, sz in zip(res["natural_frequency_hz"], res["natural_frequency_hz_std"], res["damping_ratio"],
                             res["damping_ratio_std"]):
         typer.echo(f"  mode: f_n = {f:.6g} ± {sf:.2g} Hz, ζ = {z:.4g} ± {sz:.2g}")
+    if val is not None:
+        fit = "—" if val.fit_percent is None else ", ".join(f"{v:.2f}" for v in val.fit_percent)
+        typer.echo(f"validation free-run fit: {fit} % ({val.definition})")
+    if out is not None:
+        typer.echo(f"model written to {out}")

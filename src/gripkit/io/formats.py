@@ -24,6 +24,7 @@ and a quarter of the machine's memory.
 
 from __future__ import annotations
 
+import hashlib
 import os
 import re
 from collections.abc import Mapping, Sequence
@@ -41,7 +42,7 @@ from .mat_reader import read_mat
 from .table import (by_position, check_fill, check_fs, check_size, columns_to_trajectory,
                     is_time_name, split_header)
 
-__all__ = ["load", "save", "FORMATS"]
+__all__ = ["load", "save", "file_sha256", "FORMATS"]
 
 #: the load limit when neither max_bytes= nor GRIPKIT_MAX_LOAD_BYTES sets one: at most 4 GiB of
 #: float64 values, and at most a quarter of the machine's memory (the data are copied a few times on
@@ -103,6 +104,10 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
         before reading them (default: ``GRIPKIT_MAX_LOAD_BYTES``, else the smaller of 4 GiB and
         a quarter of the machine's memory).
 
+    Provenance: ``meta['source']`` is the file's name and ``meta['sha256']`` the SHA-256 of its
+    bytes (hex), which :func:`gripkit.sysid.identify` stores in the model it returns
+    (``data_file``, ``data_hash``) and ``gripkit compare`` checks.
+
     Raises
     ------
     DataError
@@ -149,7 +154,16 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
     check_fs(fs)
     allow_external_links = _allow_external(allow_external_links)
     limit = _load_limit(max_bytes)
-    fmt = _format(path, format)
+    tr = _read(path, _format(path, format), columns=columns, time=time, fs=fs, units=units,
+               fill=fill, key=key, delimiter=delimiter, stamp=stamp,
+               allow_external=allow_external_links, limit=limit)
+    tr.meta["sha256"] = file_sha256(path)
+    return tr
+
+
+def _read(path: Path, fmt: str, *, columns, time, fs, units, fill, key, delimiter, stamp,
+          allow_external: bool, limit: float) -> Trajectory:
+    """The file read by its format's reader, as a validated trajectory (:func:`load`)."""
     if fmt == "mcap":
         from .mcap_reader import read_mcap
 
@@ -157,12 +171,20 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
         return columns_to_trajectory(raw, source=path.name, time="t", fs=fs, units=units,
                                      meta_units=meta_units, fill=fill)
     reader = {"csv": _read_csv, "parquet": _read_parquet, "hdf5": _read_hdf5, "mat": read_mat}[fmt]
-    wanted = _Wanted(columns, time)
-    raw, meta_units = reader(path, key=key, delimiter=delimiter, wanted=wanted, limit=limit,
-                             allow_external=allow_external_links)
+    raw, meta_units = reader(path, key=key, delimiter=delimiter, wanted=_Wanted(columns, time),
+                             limit=limit, allow_external=allow_external)
     return columns_to_trajectory(raw, source=path.name, columns=columns, time=time, fs=fs,
                                  units=units, meta_units=meta_units, fill=fill,
                                  headerless=fmt == "csv" and by_position(raw))
+
+
+def file_sha256(path) -> str:
+    """SHA-256 of a file's bytes (hex), read in 1 MiB blocks."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        for chunk in iter(lambda: fh.read(1 << 20), b""):
+            h.update(chunk)
+    return h.hexdigest()
 
 
 def _allow_external(allow) -> bool:

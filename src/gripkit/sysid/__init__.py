@@ -25,9 +25,9 @@ _LAZY = {
     "armax": ("linear.armax", "armax"),
     "arx": ("linear.arx", "arx"),
     "arx_records": ("linear.arx", "arx_records"),
-    "IOData": ("identify", "IOData"),
+    "IOData": ("io_data", "IOData"),
     "identify": ("identify", "identify"),
-    "io_data": ("identify", "io_data"),
+    "io_data": ("io_data", "io_data"),
     "oe": ("linear.oe", "oe"),
     "PolynomialModel": ("linear.polynomial", "PolynomialModel"),
     "RLS": ("linear.rls", "RLS"),
@@ -92,9 +92,9 @@ if TYPE_CHECKING:  # static readers see the same names, imported eagerly
     from .linear.armax import armax as armax
     from .linear.arx import arx as arx
     from .linear.arx import arx_records as arx_records
-    from .identify import IOData as IOData
+    from .io_data import IOData as IOData
     from .identify import identify as identify
-    from .identify import io_data as io_data
+    from .io_data import io_data as io_data
     from .linear.oe import oe as oe
     from .linear.polynomial import PolynomialModel as PolynomialModel
     from .linear.rls import RLS as RLS

@@ -25,87 +25,37 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass
 
 import numpy as np
 
 from ..arguments import check_keywords, entry_point, keyword_names
 from ..errors import AccuracyWarning, ArgumentError, DataError, GripkitError, emit_warning
-from ..signals.processing import detrend as detrend_signals
 from ..signals.trajectory import Trajectory
 from . import nonlinear
+from .io_data import IOData, io_data, records_provenance, validation_data
 from .linear import identify_mimo
 from .linear.armax import armax, armax_records
 from .linear.arx import arx, arx_records
 from .linear.arx_mimo import arx_mimo_records
 from .linear.frf import frf
 from .linear.oe import oe, oe_records
-from .linear.search import structure_search
+from .linear.search import parse_range, structure_search
 
-__all__ = ["IOData", "io_data", "identify", "identify_records", "method_options", "METHODS"]
+__all__ = ["IOData", "io_data", "identify", "identify_records", "method_options", "METHODS",
+           "with_provenance"]
 
 METHODS = ("arx", "armax", "oe", "rls", "search", "ss", "frf", "tf", "narx", "hw", "hysteresis",
            "nlss")
-
-
-@dataclass(frozen=True)
-class IOData:
-    """Input/output arrays taken from a trajectory, ready for identification."""
-
-    u: np.ndarray
-    y: np.ndarray
-    dt: float
-    input: str
-    output: str
-    input_unit: str
-    output_unit: str
-    u_offset: float
-    y_offset: float
-
-    @property
-    def meta(self) -> dict:
-        """Model metadata keywords for the identification functions."""
-        return dict(input_name=self.input, output_name=self.output, input_unit=self.input_unit,
-                    output_unit=self.output_unit, u_offset=self.u_offset, y_offset=self.y_offset)
-
-
-def io_data(data: Trajectory, *, input: str, output: str, detrend: str = "mean",
-            why: str = "discrete-time identification") -> IOData:
-    """Select the input and output channels of a uniformly sampled trajectory.
-
-    ``detrend``: ``'mean'`` removes each channel's mean (recorded as ``u_offset``/``y_offset``),
-    ``'linear'`` a least-squares line, ``'none'`` keeps the data as they are.
-    """
-    if not isinstance(data, Trajectory):
-        raise DataError(f"data: expected a gripkit Trajectory, found {type(data).__name__}",
-                        hint="use gripkit.io.load(path) or Trajectory.uniform(dt=..., u=..., y=...)")
-    if detrend not in ("mean", "linear", "none"):
-        raise DataError(f"detrend: expected 'mean', 'linear' or 'none', found {detrend!r}")
-    if input == output:
-        raise DataError(f"input and output must be different columns, both are {input!r}")
-    u = np.array(data[input], dtype=np.float64)
-    y = np.array(data[output], dtype=np.float64)
-    dt = float(f"{data.require_uniform(why=why):.9g}")  # time stamps in files carry rounding noise
-    u0 = y0 = 0.0
-    if detrend == "mean":
-        u0, y0 = float(u.mean()), float(y.mean())
-        u -= u0
-        y -= y0
-    elif detrend == "linear":
-        d = detrend_signals(data.select(input, output), kind="linear")
-        u0, y0 = float(u.mean()), float(y.mean())
-        u, y = np.array(d[input]), np.array(d[output])
-    return IOData(u, y, dt, input, output, data.unit(input), data.unit(output), u0, y0)
 
 
 def _polynomial_fit(method: str, io: IOData, orders: tuple, options: dict):
     """ARX, ARMAX or OE of ``io`` with ``orders`` = (na, nb, nc, nf, nk)."""
     na, nb, nc, nf, nk = orders
     if method == "arx":
-        return arx(io.u, io.y, na, nb, nk, dt=io.dt, **io.meta, **options)
+        return arx(io.u1, io.y1, na, nb, nk, dt=io.dt, **io.keywords, **options)
     if method == "armax":
-        return armax(io.u, io.y, na, nb, nc, nk, dt=io.dt, **io.meta, **options)
-    return oe(io.u, io.y, nb, nf, nk, dt=io.dt, **io.meta, **options)
+        return armax(io.u1, io.y1, na, nb, nc, nk, dt=io.dt, **io.keywords, **options)
+    return oe(io.u1, io.y1, nb, nf, nk, dt=io.dt, **io.keywords, **options)
 
 
 def _free_run_fit(model, u: np.ndarray, y: np.ndarray) -> float:
@@ -124,7 +74,7 @@ def warn_if_mean_detrending_hurt(model, io: IOData, raw, refit) -> None:
     their :class:`IOData` without detrending) and warn, naming ``--detrend none``, when its free
     run from rest fits better by more than 10 points than the detrended model's."""
     poles = np.abs(model.poles())
-    n = io.u.size
+    n = io.n_samples
     if not poles.size or not 0.0 < -n * np.log(max(float(poles.max()), 1e-300)) < 5.0:
         return
     with warnings.catch_warnings():
@@ -134,8 +84,8 @@ def warn_if_mean_detrending_hurt(model, io: IOData, raw, refit) -> None:
             other = refit(rio)
         except GripkitError:
             return
-    mean_fit = _free_run_fit(model, io.u, io.y)
-    none_fit = _free_run_fit(other, rio.u, rio.y)
+    mean_fit = _free_run_fit(model, io.u1, io.y1)
+    none_fit = _free_run_fit(other, rio.u1, rio.y1)
     if none_fit > mean_fit + 10.0:
         tau = -io.dt / math.log(float(poles.max()))
         emit_warning(
@@ -165,13 +115,18 @@ def _method_function(method: str):
 
 
 #: what identify() itself passes to the method's function (not accepted as an option)
-_SUPPLIED = ("u", "y", "na", "nb", "nc", "nf", "nk", "dt", *IOData.__dataclass_fields__, "input_name",
-             "output_name", "input_unit", "output_unit")
+_SUPPLIED = ("u", "y", "na", "nb", "nc", "nf", "nk", "dt", *IOData.__dataclass_fields__, "input",
+             "output", "input_name", "output_name", "input_unit", "output_unit")
 
 
 def method_options(method: str) -> list[str]:
-    """The ``**options`` that :func:`identify` accepts for ``method``."""
-    return keyword_names(_method_function(method), exclude=_SUPPLIED)
+    """The ``**options`` that :func:`identify` accepts for ``method``. For 'ss' the subspace
+    weighting (n4sid, moesp or cva) is the option ``weighting``, for one record and several
+    (identify's own ``method`` being 'ss')."""
+    names = keyword_names(_method_function(method), exclude=_SUPPLIED)
+    if method == "ss":
+        names = [n for n in names if n not in ("data", "method")] + ["weighting"]
+    return names
 
 
 @entry_point
@@ -215,8 +170,11 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
 
     Returns
     -------
-    PolynomialModel, RLSResult, SearchResult, NARXModel, HWModel, BoucWenModel,
-    PrandtlIshlinskiiModel or NLSSModel
+    PolynomialModel, LinearModel, RLSResult, SearchResult, FRF, NARXModel, HWModel,
+    BoucWenModel, PrandtlIshlinskiiModel or NLSSModel. A model records where its data came from
+    (:func:`~gripkit.sysid.io_data.records_provenance`): the file's name and SHA-256 that
+    :func:`gripkit.io.load` put in the trajectory's meta (its ``data_file``, ``data_hash``); of
+    several records the names joined, no hash.
     """
     if not isinstance(method, str) or method not in METHODS:
         raise DataError(f"method: expected one of {', '.join(METHODS)}, found {method!r}")
@@ -231,13 +189,37 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
             raise ArgumentError(f"identify(): {name} must be a column name (str), found {type(col).__name__} "
                                 f"{col!r:.40}", hint=f"columns: {', '.join(data.names)}"
                                 if isinstance(data, Trajectory) else None)
+    model = _dispatch(data, method, input=input, output=output, na=na, nb=nb, nk=nk, nc=nc, nf=nf,
+                      detrend=detrend, **options)
+    return with_provenance(model, records_provenance(data))
+
+
+def with_provenance(model, provenance: dict):
+    """``model`` with ``data_file``/``data_hash`` set from ``provenance`` (a LinearModel's fields,
+    a PolynomialModel's ``info``); other results, and data built in memory, as they are."""
+    if provenance.get("data_file") is None:
+        return model
+    if hasattr(model, "data_file"):
+        return model.replace(**provenance)
+    if isinstance(getattr(model, "info", None), dict) and hasattr(model, "replace"):
+        return model.replace(info={**model.info, **provenance})
+    return model
+
+
+def _dispatch(data, method: str, *, input, output, na: int, nb: int, nk: int, nc: int,
+              nf: int | None, detrend: str, **options):
+    """The fit of :func:`identify`, its arguments checked."""
     if isinstance(data, (list, tuple)):  # several records, one model
         return identify_records(data, method, input=input, output=output, na=na, nb=nb, nk=nk,
                                 nc=nc, nf=nf, detrend=detrend, **options)
     if method in ("ss", "frf", "tf"):  # MIMO: input/output may name several columns
         fn = {"ss": identify_mimo.identify_ss, "frf": identify_mimo.identify_frf, "tf": identify_mimo.identify_tf}
+        if method == "ss" and "weighting" in options:  # identify_ss names it ``method``
+            options = dict(options)
+            options["method"] = options.pop("weighting")
         out = fn[method](data, input=input, output=output, detrend=detrend, **options)
-        out = out[0] if method == "ss" else out
+        if method == "ss":  # the order search and the validation fit go into the model's info
+            out = _with_extras(*out)
         # a model file saved from it shows its columns in the data file's units (force [mN])
         return out.with_display_units(data) if hasattr(out, "with_display_units") else out
     if method == "arx" and identify_mimo.several(input, output):  # matrix-polynomial ARX
@@ -247,13 +229,16 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
         return nonlinear.nlss(data, input=input, output=output, **options)
     if method == "narx":  # the model's constant term carries the operating point
         io = io_data(data, input=input, output=output, detrend="none", why="NARX identification")
-        model = nonlinear.narx(io.u, io.y, dt=io.dt, **options)
+        if isinstance(options.get("validate"), Trajectory):  # the record as it is, as estimation
+            vd = validation_data(options["validate"], io)
+            options = {**options, "validate": (vd.u1, vd.y1)}
+        model = nonlinear.narx(io.u1, io.y1, dt=io.dt, **options)
         model.input_name, model.output_name = input, output
         return model
     if method == "hw":  # the offset y0 carries the operating point; orders as given here
         io = io_data(data, input=input, output=output, detrend="none",
                      why="Hammerstein-Wiener identification")
-        model = nonlinear.hammerstein_wiener(io.u, io.y, nb=nb, nf=nb if nf is None else nf,
+        model = nonlinear.hammerstein_wiener(io.u1, io.y1, nb=nb, nf=nb if nf is None else nf,
                                              nk=nk, dt=io.dt, **options)
         model.input_name, model.output_name = input, output
         return model
@@ -265,14 +250,74 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
         model = _polynomial_fit(method, io, orders, options)
         if detrend == "mean":
             raw = lambda: io_data(data, input=input, output=output, detrend="none")  # noqa: E731
-            refit = lambda r: _polynomial_fit(method, r, orders, options)  # noqa: E731
+            quiet = {k: v for k, v in options.items() if k != "progress"}  # one bar: the fit's
+            refit = lambda r: _polynomial_fit(method, r, orders, quiet)  # noqa: E731
             warn_if_mean_detrending_hurt(model, io, raw, refit)
         return model
     if method == "rls":
         from .linear.rls import rls  # numba (0.4 s): loaded only for an RLS fit
 
-        return rls(io.u, io.y, na, nb, nk, dt=io.dt, **options)
-    return structure_search(io.u, io.y, na, nb, nk, dt=io.dt, **options)
+        return rls(io.u1, io.y1, na, nb, nk, dt=io.dt, **options)
+    if isinstance(options.get("validate"), Trajectory):  # around the estimation operating point
+        vd = validation_data(options["validate"], io, detrend=detrend)
+        options = {**options, "validate": (vd.u1, vd.y1)}
+    return search_widened(io, na, nb, nk, options)
+
+
+#: structures a search adds past each edge of its ranges where the best structure sits
+SEARCH_WIDEN_STEPS = 3
+#: the smallest value of each order in a search
+_LOWEST = {"na": 1, "nb": 1, "nk": 0}
+
+
+def search_widened(io: IOData, na, nb, nk, options: dict):
+    """:func:`~gripkit.sysid.structure_search` of ``io`` that goes past the edge of its ranges:
+    while the best structure sits on the edge of a range of three or more values (what
+    structure_search warns about), that range gains the next value past the edge (at most
+    :data:`SEARCH_WIDEN_STEPS` times; never for ``criterion='loss'``, which always prefers the
+    largest structure) and the search runs again. Only the last search's warnings are emitted
+    (its edge warning, when the best still sits on an edge, names the ranges searched)."""
+    ranges = {"na": parse_range(na, "na"), "nb": parse_range(nb, "nb"), "nk": parse_range(nk, "nk")}
+    for step in range(SEARCH_WIDEN_STEPS + 1):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            res = structure_search(io.u1, io.y1, ranges["na"], ranges["nb"], ranges["nk"],
+                                   dt=io.dt, **options)
+        grown = _grow_ranges(res.best, ranges) if options.get("criterion") != "loss" else False
+        if not grown or step == SEARCH_WIDEN_STEPS:
+            break
+    for w in caught:
+        emit_warning(str(w.message), w.category)
+    return res
+
+
+def _grow_ranges(best, ranges: dict) -> bool:
+    """Add the value past each edge of ``ranges`` (three values or more) where ``best`` sits;
+    whether any grew."""
+    grown = False
+    for name, r in ranges.items():
+        v = getattr(best, name)
+        if len(set(r)) < 3:
+            continue
+        if v == max(r):
+            r.append(v + 1)
+            grown = True
+        elif v == min(r) and v - 1 >= _LOWEST[name]:
+            r.insert(0, v - 1)
+            grown = True
+    return grown
+
+
+def _with_extras(model, extras: dict):
+    """The state-space model with :func:`~.linear.identify_mimo.identify_ss`'s extras in its
+    ``info``: ``search`` (the ranked orders) and ``search_criterion`` of an order range,
+    ``validation_fit_percent`` with ``validate``."""
+    info = dict(model.info)
+    if "search" in extras:
+        info.update(search=extras["search"], search_criterion=extras["criterion"])
+    if "validation_fit_percent" in extras:
+        info["validation_fit_percent"] = extras["validation_fit_percent"]
+    return model.replace(info=info)
 
 
 #: the methods that fit one model to several records (``identify([tr1, tr2], ...)``)
@@ -357,13 +402,13 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
     _same_sampling([(io.dt, (io.input_unit, io.output_unit)) for io in ios],
                    (ios[0].input, ios[0].output))
     if method == "narx":  # the data as they are: the model's constant carries the operating point
-        model = _as_data(nonlinear.narx, [(io.u, io.y) for io in ios], dt=ios[0].dt, **options)
+        model = _as_data(nonlinear.narx, [(io.u1, io.y1) for io in ios], dt=ios[0].dt, **options)
         model.input_name, model.output_name = input, output
         return model
-    u0 = float(_pooled_mean([io.u for io in ios])) if detrend == "mean" else 0.0
-    y0 = float(_pooled_mean([io.y for io in ios])) if detrend == "mean" else 0.0
-    meta = dict(ios[0].meta, u_offset=u0, y_offset=y0, dt=ios[0].dt, **options)
-    records = [(io.u - u0, io.y - y0) for io in ios]
+    u0 = float(_pooled_mean([io.u1 for io in ios])) if detrend == "mean" else 0.0
+    y0 = float(_pooled_mean([io.y1 for io in ios])) if detrend == "mean" else 0.0
+    meta = dict(ios[0].keywords, u_offset=u0, y_offset=y0, dt=ios[0].dt, **options)
+    records = [(io.u1 - u0, io.y1 - y0) for io in ios]
     if method == "arx":
         return _as_data(arx_records, records, na, nb, nk, **meta)
     if method == "armax":

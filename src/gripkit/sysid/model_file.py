@@ -29,12 +29,11 @@ SCHEMA_VERSION = 2
 
 
 def file_sha256(path) -> str:
-    """SHA-256 of a file's bytes (hex)."""
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for chunk in iter(lambda: fh.read(1 << 20), b""):
-            h.update(chunk)
-    return h.hexdigest()
+    """SHA-256 of a file's bytes (hex): :func:`gripkit.io.file_sha256`, the hash
+    :func:`gripkit.io.load` records in a trajectory's ``meta['sha256']``."""
+    from ..io.formats import file_sha256 as sha256
+
+    return sha256(path)
 
 
 def plain(x):

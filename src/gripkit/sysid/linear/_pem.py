@@ -17,6 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import AccuracyWarning, emit_warning
+from ...progress import track
 from ..regression import qr_solve
 
 __all__ = ["stabilize", "is_stable_poly", "PEMResult", "levenberg_marquardt", "covariance"]
@@ -53,8 +54,10 @@ class PEMResult:
 
 def levenberg_marquardt(fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]],
                         theta0: np.ndarray, admissible: Callable[[np.ndarray], bool], *,
-                        maxiter: int = 100, tol: float = 1e-10, label: str = "model") -> PEMResult:
-    """Minimise ``‖e(θ)‖²`` where ``fun(θ) -> (e, J = ∂e/∂θ)``; ``admissible(θ)`` must stay True."""
+                        maxiter: int = 100, tol: float = 1e-10, label: str = "model",
+                        progress: bool = False) -> PEMResult:
+    """Minimise ``‖e(θ)‖²`` where ``fun(θ) -> (e, J = ∂e/∂θ)``; ``admissible(θ)`` must stay True.
+    ``progress``: a progress bar of the iterations on stderr (:func:`gripkit.progress.track`)."""
     theta = np.asarray(theta0, dtype=np.float64).copy()
     e, J = fun(theta)
     cost = float(e @ e)
@@ -63,7 +66,8 @@ def levenberg_marquardt(fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray
     converged = False
     message = f"no convergence in {maxiter} iterations"
     it = 0
-    for it in range(1, maxiter + 1):
+    for it in track(range(1, maxiter + 1), total=maxiter, description=f"PEM {label}",
+                    enabled=progress):
         d = np.sqrt(np.sum(J * J, axis=0))
         d[d == 0] = 1.0
         while True:

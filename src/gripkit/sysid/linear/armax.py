@@ -68,12 +68,14 @@ def _hr_rows(u, y, ehat, na, nb, nc, nk, t0) -> np.ndarray:
 
 
 def armax(u, y, na: int, nb: int, nc: int, nk: int = 1, *, dt: float | None = None,
-          maxiter: int = 100, tol: float = 1e-10, **meta) -> PolynomialModel:
+          maxiter: int = 100, tol: float = 1e-10, progress: bool = False,
+          **meta) -> PolynomialModel:
     """ARMAX model ``A y = B u + C e`` by prediction-error minimisation (MATLAB ``armax``
     orders ``[na nb nc nk]``).
 
     Parameters as :func:`gripkit.sysid.linear.arx`, plus ``nc`` (number of C coefficients after the
-    leading 1), ``maxiter`` and ``tol`` of the Levenberg–Marquardt iteration. Returns a
+    leading 1), ``maxiter`` and ``tol`` of the Levenberg–Marquardt iteration (``progress``: a
+    progress bar of its iterations on stderr, as the command line shows it). Returns a
     :class:`PolynomialModel` with ``structure='armax'``, ``C`` and ``C_std``. Warns
     :class:`~gripkit.errors.AccuracyWarning` if the iteration does not converge.
     """
@@ -82,10 +84,11 @@ def armax(u, y, na: int, nb: int, nc: int, nk: int = 1, *, dt: float | None = No
     if nc == 0:
         return arx(u, y, na, nb, nk, dt=step, **meta)
     cu, cy = unit_scale(u), unit_scale(y)
-    return in_user_units(_armax(u * cu, y * cy, na, nb, nc, nk, step, maxiter, tol, meta), cu, cy)
+    return in_user_units(_armax(u * cu, y * cy, na, nb, nc, nk, step, maxiter, tol, meta,
+                                progress), cu, cy)
 
 
-def _armax(u, y, na, nb, nc, nk, step, maxiter, tol, meta) -> PolynomialModel:
+def _armax(u, y, na, nb, nc, nk, step, maxiter, tol, meta, progress=False) -> PolynomialModel:
     """:func:`armax` (nc >= 1) on checked signals scaled to unit size."""
     from scipy import signal as _sig
 
@@ -112,7 +115,7 @@ def _armax(u, y, na, nb, nc, nk, step, maxiter, tol, meta) -> PolynomialModel:
         return e, J
 
     res = levenberg_marquardt(fun, theta0, lambda theta: _c_stable(theta, na + nb), maxiter=maxiter,
-                              tol=tol, label=label)
+                              tol=tol, label=label, progress=progress)
     cov, sigma2, cond = covariance(res, _armax_names(na, nb, nc, nk))
     th = res.theta
     A = np.concatenate([[1.0], th[:na]])

@@ -9,40 +9,29 @@ Order search (``order='2:8'``): every order of the range is fitted from one fact
 ranked by the free-run fit on ``validate`` data (mean over outputs, x0 estimated) when given,
 the lowest order within 0.05 fit points of the best winning (higher orders that fit the noise tie),
 otherwise by Akaike's criterion of the innovation predictor,
-``AIC = N log det Λ̂ + 2 d``, d = n(m + 2p) (+ pm with D) free parameters. A best order on the
-edge of a range of three or more orders is warned about: the true order may lie outside it.
+``AIC = N log det Λ̂ + 2 d``, d = n(m + 2p) (+ pm with D) free parameters. When the best order
+of a range of three or more orders sits on its edge, the search goes on past that edge, one
+order at a time, up to :data:`WIDEN_STEPS` orders (and the largest order the factorisation
+holds); a best order still on an edge is warned about: the true order may lie outside it.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import warnings
-from dataclasses import dataclass
 
 import numpy as np
 
 from ...errors import (AccuracyWarning, ArgumentError, DataError, GripkitError, GripkitWarning,
                       IdentificationError, emit_warning)
-from ...progress import status
+from ...progress import status, track
 from ...signals.trajectory import Trajectory
 from .arx_mimo import arx_mimo
 from .frf import frf
-from .linear_model import VALIDATION_FIT  # the one definition, re-exported for the CLI
+from ..io_data import IOData, parse_names, validation_data
 
-__all__ = ["MimoData", "mimo_data", "identify_ss", "identify_frf", "identify_tf", "identify_arx", "several",
+__all__ = ["mimo_data", "identify_ss", "identify_frf", "identify_tf", "identify_arx", "several",
            "parse_names", "parse_order"]
-
-
-def parse_names(x, what: str) -> tuple[str, ...]:
-    """Column names from ``'a,b'`` or a sequence."""
-    names = [s.strip() for s in x.split(",")] if isinstance(x, str) else [str(s).strip() for s in x]
-    if not names or any(not n for n in names):
-        raise DataError(f"{what}: expected one or more column names separated by commas, found {x!r}")
-    dup = sorted({n for n in names if names.count(n) > 1})
-    if dup:
-        raise DataError(f"{what}: column(s) {', '.join(map(repr, dup))} listed twice")
-    return tuple(names)
 
 
 def parse_order(order) -> tuple[int, int] | None:
@@ -62,101 +51,23 @@ def parse_order(order) -> tuple[int, int] | None:
     return lo, hi
 
 
-@dataclass(frozen=True)
-class MimoData:
-    """Inputs (N, m) and outputs (N, p) in deviation units, with names, units and offsets."""
-
-    u: np.ndarray
-    y: np.ndarray
-    dt: float
-    inputs: tuple[str, ...]
-    outputs: tuple[str, ...]
-    input_units: tuple[str, ...]
-    output_units: tuple[str, ...]
-    u_offset: tuple[float, ...]
-    y_offset: tuple[float, ...]
-
-    @property
-    def signals(self) -> dict:
-        return dict(inputs=self.inputs, outputs=self.outputs, input_units=self.input_units,
-                    output_units=self.output_units)
-
-
-def mimo_data(data: Trajectory, inputs, outputs, detrend: str = "mean", why: str = "identification") -> MimoData:
-    """Select and detrend the input and output columns of a uniformly sampled trajectory."""
-    if not isinstance(data, Trajectory):
-        raise DataError(f"data: expected a gripkit Trajectory, found {type(data).__name__}",
-                        hint="use gripkit.io.load(path) or Trajectory.uniform(dt=..., u=..., y=...)")
-    ins, outs = parse_names(inputs, "input"), parse_names(outputs, "output")
-    both = sorted(set(ins) & set(outs))
-    if both:
-        raise DataError(f"input and output must be different columns, {', '.join(map(repr, both))} is both")
-    missing = [n for n in ins + outs if n not in data.names]
-    if missing:
-        raise DataError(f"data: column(s) {', '.join(map(repr, missing))} not found; the data have "
-                        f"{', '.join(map(repr, data.names))}")
+def mimo_data(data: Trajectory, inputs, outputs, detrend: str = "mean",
+              why: str = "identification") -> IOData:
+    """The named columns as :class:`~gripkit.sysid.io_data.IOData` with the constant and scale
+    checks (these estimators form unscaled sums of squares); ``detrend`` 'mean' or 'none' (a line
+    per column would leave the model no operating point)."""
     if detrend not in ("mean", "none"):
         raise DataError(f"detrend: expected 'mean' or 'none', found {detrend!r}")
-    dt = float(f"{data.require_uniform(why=why):.9g}")  # time stamps in files carry rounding noise
-    u = np.column_stack([np.asarray(data[n], dtype=np.float64) for n in ins])
-    y = np.column_stack([np.asarray(data[n], dtype=np.float64) for n in outs])
-    for names, x, what in ((ins, u, "input"), (outs, y, "output")):
-        flat = np.ptp(x, axis=0) <= 1e-12 * np.maximum(np.max(np.abs(x), axis=0), 1e-300)
-        if flat.any():
-            name = names[int(np.argmax(flat))]
-            raise DataError(f"{what} column {name!r} is constant ({x[0, int(np.argmax(flat))]:.6g} for all "
-                            f"{x.shape[0]} samples): it carries no information",
-                            hint="drop it from --input/--output or check the data")
-    _check_scale(ins, u, "input", why)
-    _check_scale(outs, y, "output", why)
-    u0 = u.mean(axis=0) if detrend == "mean" else np.zeros(len(ins))
-    y0 = y.mean(axis=0) if detrend == "mean" else np.zeros(len(outs))
-    return MimoData(u - u0, y - y0, dt, ins, outs, tuple(data.unit(n) for n in ins),
-                    tuple(data.unit(n) for n in outs), tuple(map(float, u0)), tuple(map(float, y0)))
+    return IOData.from_trajectory(data, inputs, outputs, detrend=detrend, why=why, checks=True)
 
 
-#: Largest and smallest peak magnitude of a column that state-space, frequency-response and
-#: transfer-function estimation accept: they form sums of squares and of products of the signals
-#: (covariances, spectra, Gram matrices), which leave float64 (1e±308) for values beyond about
-#: 1e±150; 1e±100 keeps the margin for record lengths and orders.
-SCALE_LIMITS = (1e-100, 1e100)
-
-
-def _check_scale(names, x: np.ndarray, what: str, why: str) -> None:
-    """Refuse a column whose values are too large or too small for the estimators' sums of squares
-    (the SISO polynomial estimators scale internally; these do not)."""
-    peak = np.max(np.abs(x), axis=0)
-    lo, hi = SCALE_LIMITS
-    bad = (peak > hi) | (peak < lo)
-    if bad.any():
-        i = int(np.argmax(bad))
-        raise DataError(
-            f"{what} column {names[i]!r} has values up to {peak[i]:.3g}: {why} forms sums of "
-            f"squares of the signals, which leave float64 beyond about 1e±150, so it accepts peak "
-            f"values between {lo:.0e} and {hi:.0e}",
-            hint="give the column in other units (multiply it by a power of ten); arx, armax and "
-                 "oe (SISO) scale internally")
-
-
-def _validation_data(validate: Trajectory, d: MimoData) -> MimoData:
-    """The validation record's columns as deviations from the *estimation* operating point
-    ``d.u_offset``/``d.y_offset`` (the model's offsets): the one validation fit of
-    :data:`gripkit.sysid.linear.linear_model.VALIDATION_FIT`, the number ``gripkit compare`` gives."""
-    vd = mimo_data(validate, d.inputs, d.outputs, "none", why="validation")
-    if abs(vd.dt - d.dt) > 1e-9 * d.dt:
-        raise DataError(f"validation data are sampled at {1 / vd.dt:g} Hz, the estimation data at "
-                        f"{1 / d.dt:g} Hz", hint="resample one of them")
-    return dataclasses.replace(vd, u=vd.u - np.asarray(d.u_offset), y=vd.y - np.asarray(d.y_offset),
-                               u_offset=d.u_offset, y_offset=d.y_offset)
-
-
-def _validation_fit(model, vd: MimoData) -> list[float] | None:
+def _validation_fit(model, vd: IOData) -> list[float] | None:
     if not model.stable:
         return None
     return model.compare(vd.u, vd.y, dt=vd.dt).fit_percent
 
 
-def _aic(model, d: MimoData) -> float:
+def _aic(model, d: IOData) -> float:
     from .pem_ss import predict_errors
 
     ss = model.system
@@ -201,7 +112,7 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     if method not in SUBSPACE_METHODS:
         raise DataError(f"method: expected one of {', '.join(SUBSPACE_METHODS)}, found {method!r}")
     d = mimo_data(data, input, output, detrend, why="state-space identification")
-    vd = None if validate is None else _validation_data(validate, d)
+    vd = None if validate is None else validation_data(validate, d)
     rng = parse_order(order)
     n_hi = rng[1] if rng else DEFAULT_MAX_ORDER
     k = default_horizon(n_hi, d.y.shape[1]) if horizon is None else int(horizon)
@@ -217,40 +128,27 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     elif rng[0] == rng[1]:
         model = build(rng[0])
         model.info["order_selection"] = "given"
-    else:
-        rows = []
-        criterion = "validation_fit" if vd is not None else "aic"
-        for n in range(rng[0], rng[1] + 1):
-            cand = build(n)
-            row = {"order": n, "fit_percent": cand.fit_percent, "aic": _aic(cand, d)}
-            if vd is not None:
-                vf = _validation_fit(cand, vd)
-                row["validation_fit_percent"] = vf
-                row["score"] = -math.inf if vf is None else float(np.mean(vf))
-            else:
-                row["score"] = -row["aic"]
-            rows.append((row, cand))
-        rows.sort(key=lambda rc: -rc[0]["score"])
-        if vd is not None:  # parsimony: the lowest order within 0.05 fit points of the best
-            top = rows[0][0]["score"]
-            close = [rc for rc in rows if rc[0]["score"] >= top - 0.05]
-            pick = min(close, key=lambda rc: rc[0]["order"])
-            rows.remove(pick)
-            rows.insert(0, pick)
-        best_row, model = rows[0]
-        model.info["order_selection"] = f"best of {rng[0]}:{rng[1]} by {criterion}"
-        extras["search"] = [r for r, _ in rows]
-        extras["criterion"] = criterion
-        if best_row["order"] in rng and rng[1] - rng[0] >= 2:
-            emit_warning(f"order search: the best order {best_row['order']} lies on the edge of the searched range "
-                         f"{rng[0]}:{rng[1]}; the true order may lie outside it, widen the range",
-                         GripkitWarning)
-    model = model.replace(u_offset=d.u_offset, y_offset=d.y_offset)
     if focus not in FOCUS:
         raise DataError(f"focus: expected one of {', '.join(FOCUS)}, found {focus!r}")
-    if refine:
+    ranked = None
+    if rng is not None and rng[0] != rng[1]:
+        ranked, extras["criterion"] = _order_search(
+            lambda n: _order_row(build, n, d, vd), "aic" if vd is None else "validation_fit",
+            rng, min(fac.s.size - 1, (k - 1) * d.y.shape[1]), progress)
+        model = ranked[0][1]
+    model = model.replace(u_offset=d.u_offset, y_offset=d.y_offset)
+    if refine and ranked is not None:  # the search ranks the refined models it returns
+        ranked = [(r, c.replace(u_offset=d.u_offset, y_offset=d.y_offset)) for r, c in ranked]
+        model, ranked = _refine_top(
+            ranked, lambda c: _refine(c, d, vd, form, focus, max_iterations, progress)[0],
+            lambda m: focus_score(m, focus, d if vd is None else vd),
+            None if vd is not None else lambda m: _aic(m, d), progress,
+            REFINE_TOP if vd is not None else 1)
+    elif refine:
         report(f"PEM refinement ({form} form) of the order-{model.order} model")
-        model, refine = _refine(model, d, vd, form, focus, max_iterations)
+        model, refine = _refine(model, d, vd, form, focus, max_iterations, progress)
+    if ranked is not None:
+        extras["search"] = [r for r, _ in ranked]
     warn_if_stabilised(model)
     if detrend == "mean":
         refit = lambda: identify_ss(  # noqa: E731
@@ -262,11 +160,124 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     return model, extras
 
 
+#: orders an order search adds past an edge of its range where the best order sits
+WIDEN_STEPS = 3
+
+
+def _order_row(build, n: int, d: IOData, vd: IOData | None):
+    """(row of the search table, subspace model) of order ``n``; score: the mean validation
+    fit with ``vd``, else −AIC."""
+    cand = build(n)
+    row = {"order": n, "fit_percent": cand.fit_percent, "aic": _aic(cand, d)}
+    if vd is not None:
+        vf = _validation_fit(cand, vd)
+        row["validation_fit_percent"] = vf
+        row["score"] = -math.inf if vf is None else float(np.mean(vf))
+    else:
+        row["score"] = -row["aic"]
+    return row, cand
+
+
+def _ranked(found: dict, parsimony: bool) -> list:
+    """The (row, model) pairs best first; ``parsimony`` (validation fits): the lowest order
+    within 0.05 fit points of the best first (higher orders that fit the noise tie)."""
+    rows = sorted(found.values(), key=lambda rc: -rc[0]["score"])
+    if parsimony:
+        top = rows[0][0]["score"]
+        band = [rc for rc in rows if rc[0]["score"] >= top - 0.05]
+        pick = min(band, key=lambda rc: rc[0]["order"])
+        for row, _ in rows:  # the higher orders that tie with the pick: not worth a PEM
+            row["tie"] = any(row is r for r, _ in band) and row is not pick[0]
+        rows.remove(pick)
+        rows.insert(0, pick)
+    return rows
+
+
+def _order_search(row_of, criterion: str, rng: tuple, n_cap: int, progress: bool):
+    """Every order of ``rng`` ranked (module doc; ``row_of(n)`` -> (row, model), by ``criterion``,
+    'validation_fit' or 'aic'); while the best sits on an edge of the orders tried, up to
+    :data:`WIDEN_STEPS` orders past it (at most ``n_cap``, at least 1) are added. A best order
+    still on an edge is warned about. Returns (the (row, model) pairs best first, criterion)."""
+    parsimony = criterion == "validation_fit"
+    found = {n: row_of(n) for n in track(range(rng[0], rng[1] + 1), description="order search",
+                                         enabled=progress)}
+    rows = _ranked(found, parsimony)
+    for _ in range(WIDEN_STEPS):
+        best, lo, hi = rows[0][0]["order"], min(found), max(found)
+        nxt = hi + 1 if best == hi and hi < n_cap else lo - 1 if best == lo and lo > 1 else None
+        if nxt is None or hi - lo < 2:
+            break
+        try:
+            found[nxt] = row_of(nxt)
+        except GripkitError:  # the factorisation does not support that order
+            break
+        rows = _ranked(found, parsimony)
+    best_row, model = rows[0]
+    lo, hi = min(found), max(found)
+    tried = f"{lo}:{hi}" if (lo, hi) == rng else f"{lo}:{hi} ({rng[0]}:{rng[1]} widened)"
+    model.info["order_selection"] = f"best of {tried} by {criterion}"
+    best = best_row["order"]
+    if (best == hi or best == lo > 1) and hi - lo >= 2:  # below order 1 there is nothing
+        emit_warning(f"order search: the best order {best} lies on the edge of the "
+                     f"searched range {tried}; the true order may lie outside it, widen the range",
+                     GripkitWarning)
+    return rows, criterion
+
+
+#: the best orders of a search with a validation record that PEM refines, ranked again by their
+#: focus fit on it; without one only the best order is refined (on the estimation data the
+#: refined models could only be ranked by Akaike's criterion again, and the PEM of the
+#: overparametrised runners-up costs many times that of the best)
+REFINE_TOP = 3
+
+
+def _refine_top(ranked: list, refine_one, fit_of, aic_of, progress: bool, n_top: int):
+    """``refine_one(model)`` (PEM that never loses by the focus) of the ``n_top`` best orders of
+    a search (the higher orders that tie with the best on the validation fit, ``tie``
+    in their rows, left out: they fit the noise, and their PEM costs most), ranked again: by ``fit_of(model)`` (the focus fit on validation data;
+    the lowest order within :data:`FOCUS_TIE` of the best first) when ``aic_of`` is None, else
+    by ``aic_of(model)`` (on the estimation data a higher order always fits better: Akaike's
+    criterion weighs the fit against the parameters). Each row gets ``refined_percent`` (the
+    focus fit), ``kept`` (the structure returned for that order) and ``refined_aic`` when ranked
+    by it. Only the returned model's warnings are emitted. Returns (best model, the ranking:
+    refined orders first, then the others as the search ranked them)."""
+    chosen = [rc for rc in ranked if not rc[0].get("tie")][:n_top]
+    rest = [rc for rc in ranked if not any(rc is c for c in chosen)]
+    top = []
+    for row, cand in chosen:
+        if progress:
+            status(f"PEM refinement of the order-{cand.order} model")
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            model = refine_one(cand)
+        row = {**row, "refined_percent": fit_of(model), "kept": model.structure}
+        if aic_of is not None:
+            row["refined_aic"] = aic_of(model)
+        top.append((row, model, caught))
+    if aic_of is None:
+        best = max(r["refined_percent"] for r, _, _ in top)
+        top.sort(key=lambda rmc: (-rmc[0]["refined_percent"], rmc[0]["order"]))
+        pick = min((rmc for rmc in top if rmc[0]["refined_percent"] >= best - FOCUS_TIE),
+                   key=lambda rmc: rmc[0]["order"])
+        top.remove(pick)
+        top.insert(0, pick)
+    else:
+        top.sort(key=lambda rmc: (rmc[0]["refined_aic"], rmc[0]["order"]))
+    pick = top[0]
+    for w in pick[2]:
+        emit_warning(str(w.message), w.category)
+    model = pick[1]
+    by = "Akaike's criterion" if aic_of is not None else "the validation fit"
+    model.info["order_selection"] = (f"{ranked[0][1].info['order_selection']}; the best "
+                                     f"{len(top)} refined by PEM and ranked by {by}")
+    return model, [(r, m) for r, m, _ in top] + rest
+
+
 #: the criteria by which identify_ss keeps the better of the subspace and the refined model
 FOCUS = ("simulation", "prediction")
 
 
-def focus_score(model, focus: str, d: MimoData) -> float:
+def focus_score(model, focus: str, d: IOData) -> float:
     """Mean over outputs of the fit (%) by which ``focus`` judges ``model`` on the deviation data
     ``d``: ``'simulation'``, the free-run fit with x0 estimated (:data:`VALIDATION_FIT`; −inf for
     an unstable model); ``'prediction'``, the one-step-ahead fit of the innovation predictor
@@ -288,7 +299,8 @@ def focus_score(model, focus: str, d: MimoData) -> float:
     return float(np.mean(100.0 * (1.0 - np.linalg.norm(e, axis=0) / den)))
 
 
-def _refine(start, d: MimoData, vd: MimoData | None, form: str, focus: str, max_iterations: int):
+def _refine(start, d: IOData, vd: IOData | None, form: str, focus: str, max_iterations: int,
+            progress: bool = False):
     """PEM in ``form`` from the subspace model ``start``, kept only when it does not lose by
     ``focus`` (:func:`_never_lose`; PEM in oe form as the second candidate for the simulation
     focus); ``(model, refined?)``. A PEM that the data cannot determine returns ``start`` with a
@@ -296,7 +308,8 @@ def _refine(start, d: MimoData, vd: MimoData | None, form: str, focus: str, max_
     from .pem_ss import pem
 
     try:
-        model = pem(start, u=d.u, y=d.y, form=form, max_iterations=max_iterations)
+        model = pem(start, u=d.u, y=d.y, form=form, max_iterations=max_iterations,
+                    progress=progress)
     except IdentificationError as exc:  # an order the data do not support in full
         emit_warning(f"PEM refinement of the order-{start.order} {start.structure} model failed "
                      f"({exc.message}); the subspace model is returned, without parameter "
@@ -307,7 +320,8 @@ def _refine(start, d: MimoData, vd: MimoData | None, form: str, focus: str, max_
     if form == "innovation" and focus == "simulation":  # PEM in oe form minimises the free-run
         def oe():                                       # error itself: the second candidate
             try:
-                return pem(start, u=d.u, y=d.y, form="oe", max_iterations=max_iterations)
+                return pem(start, u=d.u, y=d.y, form="oe", max_iterations=max_iterations,
+                           progress=progress)
             except IdentificationError:
                 return None
     return _never_lose(start, model, focus, d if vd is None else vd, vd is None, max_iterations, oe), True
@@ -328,7 +342,7 @@ def _warn_unconverged(model, max_iterations: int) -> None:
                      AccuracyWarning)
 
 
-def _never_lose(start, refined, focus: str, d: MimoData, estimation: bool, max_iterations: int,
+def _never_lose(start, refined, focus: str, d: IOData, estimation: bool, max_iterations: int,
                 second=None):
     """The refined model, or, when it scores lower than its subspace start by ``focus`` on ``d``
     (by more than :data:`FOCUS_TIE`), the model of ``second()`` (PEM in output-error form, which
@@ -431,16 +445,17 @@ def identify_arx(data: Trajectory, *, input, output, na: int, nb: int, nk: int =
 #: the options of method 'ss' with several records (``weighting``: the subspace method, n4sid,
 #: moesp or cva, identify()'s own ``method`` being 'ss')
 SS_RECORD_OPTIONS = ("order", "horizon", "feedthrough", "refine", "form", "max_iterations",
-                     "weighting")
+                     "weighting", "focus", "progress")
 
 
-def identify_ss_records(records: list, d: MimoData, u0, y0, options: dict):
+def identify_ss_records(records: list, d: IOData, u0, y0, options: dict):
     """The state-space model of several records: subspace
-    (:func:`gripkit.sysid.linear.subspace.n4sid_records`), then, unless ``refine=False``, PEM with one
-    initial state per record (:func:`gripkit.sysid.linear.pem_ss.pem_records`); the refined model is
-    returned only when its free-run fit of all records (mean over the outputs) is not below the
-    subspace model's, else the subspace model with an AccuracyWarning giving both."""
-    from .pem_ss import pem_records
+    (:func:`gripkit.sysid.linear.subspace.n4sid_records`), then, unless ``refine=False``, PEM with
+    one initial state per record (:func:`gripkit.sysid.linear.pem_ss.pem_records`), kept only when
+    it does not lose to its start by ``focus`` (:func:`records_score` over all records; else the
+    subspace model with an AccuracyWarning giving both). ``order='LO:HI'`` searches the order as
+    for one record: ranked by Akaike's criterion of the free run over all records,
+    widened past an edge, the best order refined (``info['search']``)."""
     from .subspace import n4sid_records
 
     other = sorted(set(options) - set(SS_RECORD_OPTIONS))
@@ -448,34 +463,109 @@ def identify_ss_records(records: list, d: MimoData, u0, y0, options: dict):
         raise ArgumentError(f"identify(method='ss'): with several records the options are "
                             f"{', '.join(SS_RECORD_OPTIONS)}, found {', '.join(other)}",
                             hint="pass one trajectory for the other options")
+    focus, progress = options.get("focus", "simulation"), options.get("progress", False)
+    if focus not in FOCUS:
+        raise DataError(f"focus: expected one of {', '.join(FOCUS)}, found {focus!r}")
     rng = parse_order(options.get("order"))
-    if rng is not None and rng[0] != rng[1]:
-        raise ArgumentError(f"identify(method='ss'): with several records the order is one number "
-                            f"or None, found the range {options['order']!r}",
-                            hint="search the order on one record")
-    start = n4sid_records(records, None if rng is None else rng[0],
-                          method=options.get("weighting", "n4sid"), horizon=options.get("horizon"),
-                          feedthrough=options.get("feedthrough", False), dt=d.dt,
-                          u_offset=tuple(map(float, u0)), y_offset=tuple(map(float, y0)),
-                          **d.signals)
-    if not options.get("refine", True):
-        return start
+
+    def fit(n):
+        return n4sid_records(records, n, method=options.get("weighting", "n4sid"),
+                             horizon=options.get("horizon"),
+                             feedthrough=options.get("feedthrough", False), dt=d.dt,
+                             u_offset=tuple(map(float, u0)), y_offset=tuple(map(float, y0)),
+                             **d.signals)
+
+    refine = lambda m: _refine_records(m, records, options, focus)  # noqa: E731
+    score = lambda m: records_score(m, records, focus)  # noqa: E731
+    if rng is None or rng[0] == rng[1]:
+        start = fit(None if rng is None else rng[0])
+        return refine(start) if options.get("refine", True) else start
+    # the subspace models are ranked by their free run: the innovation gain a subspace fit of
+    # several records gives is too rough to rank orders by; PEM's gains rank the refined ones
+    row_of = lambda n: _records_row(fit(n), records, "simulation")  # noqa: E731
+    ranked, criterion = _order_search(row_of, "aic", rng, rng[1] + WIDEN_STEPS, progress)
+    if options.get("refine", True):
+        model, ranked = _refine_top(ranked, refine, score,
+                                    lambda m: _records_row(m, records, focus)[0]["aic"],
+                                    progress, 1)
+    else:
+        model = ranked[0][1]
+    return model.replace(info={**model.info, "search": [r for r, _ in ranked],
+                               "search_criterion": criterion})
+
+
+def records_score(model, records: list, focus: str) -> float:
+    """Mean over outputs of the fit (%) of all records together by ``focus``
+    (:func:`focus_score` for several records): each record's errors from its own initial state
+    estimated by least squares (:func:`~.pem_ss.predictor_x0`; K = 0 for 'simulation', the
+    free run), ``100 (1 − √Σ_i‖e_i‖² / √Σ_i‖y_i − ȳ_i‖²)``; −inf for an unstable run."""
+    from .pem_ss import predictor_x0
+
+    ss = model.system
+    n, p = ss.n_states, ss.n_outputs
+    K = np.zeros((n, p)) if focus == "simulation" or model.K is None else model.K
+    if n and np.max(np.abs(np.linalg.eigvals(ss.A - K @ ss.C))) >= 1.0:
+        return -math.inf
+    num = den = 0.0
+    for u, y in records:
+        u, y = _columns(u), _columns(y)
+        _, e = predictor_x0(ss.A, ss.B, ss.C, ss.D, K, u, y)
+        num = num + np.sum(e * e, axis=0)
+        den = den + np.sum((y - np.mean(y, axis=0)) ** 2, axis=0)
+    return float(np.mean(100.0 * (1.0 - np.sqrt(num) / np.sqrt(den))))
+
+
+def _columns(x) -> np.ndarray:
+    """A record's signal as float64 columns (N, k) (a 1-D array is one column)."""
+    x = np.asarray(x, dtype=np.float64)
+    return np.ascontiguousarray(x.reshape(x.shape[0], -1))
+
+
+def _records_row(model, records: list, focus: str):
+    """(row, model) of a records order search: ``AIC = ΣN log det Λ̂ + 2 d`` over all records,
+    each from its least-squares initial state, of the errors ``focus`` judges: the free run
+    ('simulation'; d = n (m + p + R) for R records) or the innovation predictor ('prediction';
+    d = n (m + 2p + R)), + pm with D."""
+    from .pem_ss import predictor_x0
+
+    ss = model.system
+    n, p, m = ss.n_states, ss.n_outputs, ss.n_inputs
+    innovation = focus == "prediction" and model.K is not None
+    K = model.K if innovation else np.zeros((n, p))
+    es = [predictor_x0(ss.A, ss.B, ss.C, ss.D, K, _columns(u), _columns(y))[1]
+          for u, y in records]
+    e = np.vstack(es)
+    N = e.shape[0]
+    sign, logdet = np.linalg.slogdet(e.T @ e / N)
+    k = n * (m + p + (p if innovation else 0) + len(records)) + (p * m if np.any(ss.D) else 0)
+    aic = float(N * logdet + 2 * k) if sign > 0 and np.isfinite(logdet) else math.inf
+    return {"order": n, "fit_percent": model.fit_percent, "aic": aic, "score": -aic}, model
+
+
+def _refine_records(start, records: list, options: dict, focus: str):
+    """PEM over the records (:func:`~.pem_ss.pem_records`) from ``start``, returned only when it
+    does not lose to ``start`` by ``focus`` (:func:`records_score`, within :data:`FOCUS_TIE`)."""
+    from .pem_ss import pem_records
+
     iters = options.get("max_iterations", 50)
     refined = pem_records(start, records, form=options.get("form", "innovation"),
-                          max_iterations=iters)
+                          max_iterations=iters, progress=options.get("progress", False))
     if not refined.info["pem"]["converged"]:
         emit_warning(f"identify ss: PEM over the records stopped after {iters} iterations without "
                      f"converging; raise max_iterations", AccuracyWarning)
-    before, after = float(np.mean(start.fit_percent)), float(np.mean(refined.fit_percent))
-    if after < before:
-        emit_warning(f"identify ss: PEM over the records lowered the free-run fit of all records "
-                     f"from {before:.4g} % (subspace) to {after:.4g} %; the subspace model is "
-                     f"returned", AccuracyWarning)
-        return start
-    return refined
+    before = records_score(start, records, focus)
+    after = records_score(refined, records, focus)
+    record = {"criterion": focus, "data": "estimation", "subspace_percent": before,
+              "refined_percent": after}
+    if after < before - FOCUS_TIE:
+        emit_warning(f"identify ss: PEM over the records lowered the mean {focus} fit of all "
+                     f"records from {before:.4g} % (subspace) to {after:.4g} %; the subspace "
+                     f"model is returned", AccuracyWarning)
+        return start.replace(info={**start.info, "focus": {**record, "kept": "subspace"}})
+    return refined.replace(info={**refined.info, "focus": {**record, "kept": refined.structure}})
 
 
-def identify_tf_records(records: list, d: MimoData, u0, y0, poles: int, zeros: int):
+def identify_tf_records(records: list, d: IOData, u0, y0, poles: int, zeros: int):
     """The continuous-time transfer function of several records
     (:func:`gripkit.sysid.linear.tfest.tfest_records`) around the operating point (u0, y0)."""
     from .tfest import tfest_records

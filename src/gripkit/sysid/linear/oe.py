@@ -56,20 +56,23 @@ def _iv_start(u, y, nb, nf, nk, t0) -> np.ndarray:
 
 
 def oe(u, y, nb: int, nf: int, nk: int = 1, *, dt: float | None = None,
-       maxiter: int = 100, tol: float = 1e-10, **meta) -> PolynomialModel:
+       maxiter: int = 100, tol: float = 1e-10, progress: bool = False,
+       **meta) -> PolynomialModel:
     """Output-error model ``y = B/F u + e`` by prediction-error minimisation.
 
     Parameters as :func:`gripkit.sysid.linear.arx` with ``nf`` (number of F coefficients after the
     leading 1) in place of ``na``. Returns a :class:`PolynomialModel` with ``structure='oe'``,
-    ``A = [1]``, ``F`` and ``F_std``; its poles are the roots of F.
+    ``A = [1]``, ``F`` and ``F_std``; its poles are the roots of F. ``progress``: a progress
+    bar of the Levenberg–Marquardt iterations on stderr.
     """
     check_meta(meta, oe)
     u, y, step, nb, nf, nk = checked_problem(u, y, dt, nb=nb, nf=nf, nk=nk)
     cu, cy = unit_scale(u), unit_scale(y)
-    return in_user_units(_oe(u * cu, y * cy, nb, nf, nk, step, maxiter, tol, meta), cu, cy)
+    return in_user_units(_oe(u * cu, y * cy, nb, nf, nk, step, maxiter, tol, meta, progress),
+                         cu, cy)
 
 
-def _oe(u, y, nb, nf, nk, step, maxiter, tol, meta) -> PolynomialModel:
+def _oe(u, y, nb, nf, nk, step, maxiter, tol, meta, progress=False) -> PolynomialModel:
     """:func:`oe` on checked signals scaled to unit size."""
     from scipy import signal as _sig
 
@@ -104,7 +107,8 @@ def _oe(u, y, nb, nf, nk, step, maxiter, tol, meta) -> PolynomialModel:
     def admissible(theta):
         return is_stable_poly(np.concatenate([[1.0], theta[nb:p]]))
 
-    res = levenberg_marquardt(fun, theta0, admissible, maxiter=maxiter, tol=tol, label=label)
+    res = levenberg_marquardt(fun, theta0, admissible, maxiter=maxiter, tol=tol, label=label,
+                              progress=progress)
     names = tuple(f"b{nk + j}" for j in range(nb)) + tuple(f"f{k}" for k in range(1, nf + 1)) + \
         tuple(f"w(t0-{k})" for k in range(1, nf + 1))
     cov, sigma2, cond = covariance(res, names)

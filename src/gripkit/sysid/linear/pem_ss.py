@@ -35,6 +35,7 @@ import numpy as np
 import scipy.linalg as sla
 
 from ...errors import DataError, IdentificationError
+from ...progress import status, track
 from ...lti import StateSpace, Uncertainty, affine_row, flush_tiny
 from .blocked_gram import add_rows, carried_states, carry, row_product, start_sums
 from ..checks import io_records
@@ -254,15 +255,19 @@ def _radius(A):
     return float(np.max(np.abs(np.linalg.eigvals(A)))) if A.shape[0] else 0.0
 
 
-def _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough, innovation, max_iterations, tol):
+def _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough, innovation, max_iterations, tol,
+                         progress: str | None = None):
     """Levenberg-Marquardt on the whitened prediction errors, re-centring the local coordinates
-    after every accepted step and rejecting steps that leave the stable set."""
+    after every accepted step and rejecting steps that leave the stable set; ``progress``: the
+    description of a progress bar of the iterations on stderr (:func:`gripkit.progress.track`),
+    None for none."""
     N, p = yw.shape
     e = np.empty((N, p))
     predict_errors(A, B, C, D, K, x0, u, yw, e)
     Vc = float(np.sum(e * e))
     lam, it, converged = 1e-3, 0, False
-    for it in range(1, max_iterations + 1):
+    for it in track(range(1, max_iterations + 1), total=max_iterations,
+                    description=progress or "", enabled=progress is not None):
         dA, dB, dC, dD, dK, ent = _directions(A, B, C, D, K, feedthrough, innovation)
         d = dA.shape[0]
         e, H, g = _gauss_newton_terms(A, B, C, D, K, x0, u, yw, ent)
@@ -295,7 +300,7 @@ def _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough, innovation, max_
 
 
 def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovation", feedthrough: bool | None = None,
-        max_iterations: int = 50, tol: float = 1e-7) -> LinearModel:
+        max_iterations: int = 50, tol: float = 1e-7, progress: bool = False) -> LinearModel:
     """Refine a discrete state-space model by prediction-error minimisation.
 
     Parameters
@@ -314,6 +319,10 @@ def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovatio
         stop when a step lowers the whitened V by less than 0.01, a move of less than 0.1σ). Records
         longer than 20 000 samples are first fitted on their first 20 000 samples, then polished
         on the whole record (the same optimum, a fraction of the full-length Jacobians).
+    progress
+        A progress bar of the iterations on stderr (:func:`gripkit.progress.track`: rich in a
+        terminal, a line per 10 % of ``max_iterations`` otherwise) and a closing line saying
+        whether PEM converged; a Python call is silent by default.
 
     Returns
     -------
@@ -339,12 +348,18 @@ def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovatio
     predict_errors(A, B, C, D, K, x0, u, yw, e)
     V0 = float(np.sum(e * e))
     it_warm = 0
+    label = f"PEM ({form} form)"
     if N > _WARM_START_SAMPLES:  # converge on the first samples, then polish on all of them
         A, B, C, D, K, x0, _, it_warm, _, _ = _levenberg_marquardt(
             A, B, C, D, K, x0, u[:_WARM_START_SAMPLES], yw[:_WARM_START_SAMPLES], feedthrough, innovation,
-            max_iterations, tol)
-    A, B, C, D, K, x0, Vc, it, converged, at_final = _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough,
-                                                                          innovation, max_iterations, tol)
+            max_iterations, tol,
+            f"{label}, first {_WARM_START_SAMPLES} samples" if progress else None)
+    A, B, C, D, K, x0, Vc, it, converged, at_final = _levenberg_marquardt(
+        A, B, C, D, K, x0, u, yw, feedthrough, innovation, max_iterations, tol,
+        label if progress else None)
+    if progress:
+        status(f"{label}: {'converged' if converged else 'NOT converged'} after {it} iteration(s) "
+               f"of at most {max_iterations}, loss {V0 / N:.4g} -> {Vc / N:.4g} per sample")
     cov, (dA, dB, dC, dD), e = _pem_covariance(A, B, C, D, K, x0, u, yw, feedthrough, innovation, at_final)
     # back to physical output units
     C, D, K = Winv @ C, Winv @ D, K @ W
@@ -494,12 +509,14 @@ def _records_loss(A, B, C, D, K, x0s, us, ys) -> float:
     return total
 
 
-def _lm_records(A, B, C, D, K, x0s, us, ys, feedthrough, innovation, max_iterations, tol):
+def _lm_records(A, B, C, D, K, x0s, us, ys, feedthrough, innovation, max_iterations, tol,
+                progress: str | None = None):
     """:func:`_levenberg_marquardt` over several records (shared A, B, C, D, K; one x0 each)."""
     n = A.shape[0]
     Vc = _records_loss(A, B, C, D, K, x0s, us, ys)
     lam, it, converged = 1e-3, 0, False
-    for it in range(1, max_iterations + 1):
+    for it in track(range(1, max_iterations + 1), total=max_iterations,
+                    description=progress or "", enabled=progress is not None):
         dA, dB, dC, dD, dK, ent = _directions(A, B, C, D, K, feedthrough, innovation)
         d = dA.shape[0]
         _, H, g = _records_terms(A, B, C, D, K, x0s, us, ys, ent)
@@ -527,8 +544,9 @@ def _lm_records(A, B, C, D, K, x0s, us, ys, feedthrough, innovation, max_iterati
 
 def pem_records(model: LinearModel, records, *, form: str = "innovation",
                 feedthrough: bool | None = None, max_iterations: int = 50,
-                tol: float = 1e-7) -> LinearModel:
-    """:func:`pem` on several records: ``records`` a list of ``(u, y)`` pairs in deviation units
+                tol: float = 1e-7, progress: bool = False) -> LinearModel:
+    """:func:`pem` on several records (``progress``: a progress bar of the iterations on stderr,
+    as :func:`pem`): ``records`` a list of ``(u, y)`` pairs in deviation units
     (the model's operating point removed). A, B, C, D (and K in innovation form) are shared; every
     record has its own initial state, estimated with them (started from
     ``model.info['records'][i]['x0']`` where the model has them, as from
@@ -572,8 +590,13 @@ def pem_records(model: LinearModel, records, *, form: str = "innovation",
     yws = [np.ascontiguousarray(y @ W.T) for _, y in data]
     C, D, K = W @ C, W @ D, K @ Winv
     V0 = _records_loss(A, B, C, D, K, x0s, us, yws)
+    label = f"PEM over {len(us)} records ({form} form)"
     A, B, C, D, K, x0s, Vc, it, converged = _lm_records(A, B, C, D, K, x0s, us, yws, feedthrough,
-                                                       innovation, max_iterations, tol)
+                                                       innovation, max_iterations, tol,
+                                                       label if progress else None)
+    if progress:
+        status(f"{label}: {'converged' if converged else 'NOT converged'} after {it} "
+               f"iteration(s) of at most {max_iterations}")
     dA, dB, dC, dD, dK, ent = _directions(A, B, C, D, K, feedthrough, innovation)
     es, H, _ = _records_terms(A, B, C, D, K, x0s, us, yws, ent)
     N = sum(u.shape[0] for u in us)

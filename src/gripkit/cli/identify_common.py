@@ -1,0 +1,110 @@
+"""The shell of every ``gripkit identify`` command that yields a model: read the data files into
+trajectories, one call of :func:`gripkit.sysid.identify`, one call of
+:func:`gripkit.sysid.identify_results.validate_model` for ``--validate``, then ``--out`` (the model
+file: every model saves itself) and ``--report`` (the HTML model
+report). The commands only parse options and print."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from .common import load_data
+
+ValidateOpt = typer.Option(None, "--validate", help="Second record (same columns): the one "
+                                                    "validation fit, as gripkit compare gives it.")
+ModelOutOpt = typer.Option(None, "--out", help="Write the identified model to this JSON file.")
+ReportOpt = typer.Option(None, "--report", help="Write an HTML report of the model on the data "
+                                                "to this folder.")
+
+
+def columns(inputs, outputs) -> list[str]:
+    """The columns to read: every input and output name (``'a,b'`` lists several)."""
+    from ..sysid.io_data import parse_names
+
+    return list(parse_names(inputs, "--input")) + list(parse_names(outputs, "--output"))
+
+
+def check_outputs(out: Path | None, report: Path | None) -> None:
+    """``--out`` and ``--report`` checked before any work."""
+    from .paths import output_folder, output_json
+
+    output_json(out, "--out")
+    output_folder(report, "--report")
+
+
+def run_identify(data: list[Path], method: str, input, output, *, fs, time, fill,
+                 validate: Path | None = None, fit_validate: bool = False, **options):
+    """Load ``data`` (one file: a trajectory; several: one model of all the records) and
+    ``validate``, and call :func:`gripkit.sysid.identify` once (``fit_validate``: with the
+    validation record as its ``validate`` option, for the methods that rank or select by it:
+    ss, search, narx); errors about ``data[i]`` name the file. Returns ``(model, trajectory or
+    list of them, validation trajectory or None)``."""
+    from ..errors import GripkitError
+    from ..sysid import identify
+
+    cols = columns(input, output)
+    trs = [load_data(p, cols, fs, time, fill) for p in data]  # its errors name the file
+    vtr = None if validate is None else load_data(validate, cols, fs, time, fill)
+    tr = trs[0] if len(trs) == 1 else trs
+    if fit_validate and vtr is not None:
+        options["validate"] = vtr
+    try:
+        model = identify(tr, method, input=input, output=output, **options)
+    except GripkitError as exc:
+        if len(trs) == 1:
+            raise
+        msg = exc.message
+        for i, path in reversed(list(enumerate(data))):  # data[10] before data[1]
+            msg = msg.replace(f"data[{i}]", repr(str(path)))
+        raise type(exc)(msg, hint=exc.hint) from None
+    return model, tr, vtr
+
+
+def validation(model, vtr, validate: Path | None, detrend: str = "mean"):
+    """The :class:`~gripkit.sysid.identify_results.ValidationResult` of ``model`` on the
+    ``--validate`` record (None without one), its ``data`` the path as given."""
+    if vtr is None:
+        return None
+    import dataclasses
+
+    from ..sysid.identify_results import validate_model
+
+    return dataclasses.replace(validate_model(model, vtr, detrend=detrend), data_file=str(validate))
+
+
+def save_and_report(model, tr, data: list[Path], out: Path | None, report: Path | None) -> None:
+    """``--out``: the model file (outputs shown in the units of the data's file when there is one
+    file); ``--report``: the HTML report of the model on that file, or with several files one
+    report per file (each record with its own initial state) in ``report/<file stem>/``."""
+    if out is None and report is None:
+        return
+    fm = model
+    if len(data) == 1 and hasattr(fm, "with_display_units"):
+        fm = fm.with_display_units(tr)
+    if out is not None:
+        fm.save(out)
+    if report is None:
+        return
+    from ..sysid.model_report import write_model_report
+
+    if len(data) == 1:
+        write_model_report(fm, tr, report, data_name=Path(data[0]).name)
+        return
+    stems = [Path(p).stem for p in data]
+    for i, (path, record) in enumerate(zip(data, tr)):
+        folder = stems[i] if stems.count(stems[i]) == 1 else f"{i + 1}-{stems[i]}"
+        write_model_report(fm, record, Path(report) / folder, data_name=Path(path).name)
+
+
+def data_field(data: list[Path]) -> str | list[str]:
+    """The JSON ``data`` field: the file, or the list of files of a fit of several records."""
+    return str(data[0]) if len(data) == 1 else [str(p) for p in data]
+
+
+def records_field(data: list[Path], records: list[dict]) -> list[dict]:
+    """The JSON ``records`` field: each file with its samples and fits (initial states left
+    out)."""
+    return [{"data": str(p), **{k: v for k, v in r.items() if k != "x0"}}
+            for p, r in zip(data, records)]
