@@ -1,4 +1,4 @@
-"""Discrete linear-quadratic regulator on an identified model (issue 27).
+"""Discrete linear-quadratic regulator on an identified model.
 
 For the model's discrete state-space realisation ``x[t+1] = A x + B u`` (``LinearModel.to_ss(dt)``,
 or an :class:`~gripkit.lti.StateSpace`), ``u = −K x`` minimises

@@ -1,4 +1,4 @@
-"""LQG: the LQR state feedback on the Kalman filter's estimate, as one controller (issue 27).
+"""LQG: the LQR state feedback on the Kalman filter's estimate, as one controller.
 
 For an identified model's discrete realisation (``LinearModel.discrete``; strictly proper,
 ``D = 0``) with offsets ``u0``, ``y0``, the controller takes the measurement ``y[t]`` (and a

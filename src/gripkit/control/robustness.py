@@ -1,5 +1,5 @@
-"""Stability margins and closed-loop poles of a controller on an identified model, **with σ**
-(issue 27): a Monte Carlo over the model's parameter covariance.
+"""Stability margins and closed-loop poles of a controller on an identified model, **with σ**:
+a Monte Carlo over the model's parameter covariance.
 
 The loop is broken at the plant input: ``L(z) = C(z) G(z)`` with G the discrete SISO plant
 (:func:`gripkit.control.as_plant`) and C the controller's feedback path — a

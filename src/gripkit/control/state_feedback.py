@@ -1,5 +1,5 @@
-"""State feedback ``u = N_r r − K x`` with output limits: the controller an LQR gain becomes
-(issue 27), with an allocation-free numba step.
+"""State feedback ``u = N_r r − K x`` with output limits: the controller an LQR gain becomes,
+with an allocation-free numba step.
 
 ``K`` (m, n) is the gain of :func:`gripkit.control.lqr` (u = −K x on the model's own state, in
 deviation from its input offsets); ``N_r`` (m, p) is the reference prefilter that makes the

@@ -1,4 +1,4 @@
-"""PID tuning on an identified model by Skogestad's SIMC rules (issue 27).
+"""PID tuning on an identified model by Skogestad's SIMC rules.
 
 Reference: S. Skogestad, "Simple analytic rules for model reduction and PID controller tuning",
 *Journal of Process Control* 13 (2003) 291–309: the half rule (§3, eqs 8–10) reduces a model to

@@ -1,4 +1,4 @@
-"""A discrete Kalman filter for an identified linear model (issue 27).
+"""A discrete Kalman filter for an identified linear model.
 
 The model (a :class:`~gripkit.sysid.LinearModel`, its discrete state-space realisation)::
 

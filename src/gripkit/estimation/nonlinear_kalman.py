@@ -1,4 +1,4 @@
-"""Extended and unscented Kalman filters for grey-box and nonlinear models (issue 27).
+"""Extended and unscented Kalman filters for grey-box and nonlinear models.
 
 The model, with ``x`` (n,), ``u`` (m,), ``y`` (p,) in SI::
 

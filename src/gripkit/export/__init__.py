@@ -1,4 +1,4 @@
-"""Code for the target: an identified linear model as a C99 step function (issue 27).
+"""Code for the target: an identified linear model as a C99 step function.
 
 :func:`export_c` writes ``NAME.h`` and ``NAME.c`` (no allocation, nothing beyond ``<math.h>``
 and ``<string.h>``); :func:`c_sources` returns their text; :func:`c_harness` is a small program

@@ -1,4 +1,4 @@
-"""C99 code of an identified linear model's step (``gripkit export c``, issue 27).
+"""C99 code of an identified linear model's step (``gripkit export c``).
 
 The model's discrete state-space realisation (``model.to_ss(dt)``: the system's
 ``to_ss(minimal=False)``, ZOH-sampled at ``dt`` for a continuous model) runs from rest, with the

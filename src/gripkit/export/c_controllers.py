@@ -1,5 +1,5 @@
-"""C99 code of a controller's step (``gripkit export c CONTROLLER.json --kind pid|rst|lqr``,
-issue 27): the same arithmetic, in the same order, as the numba kernels behind ``.step``
+"""C99 code of a controller's step (``gripkit export c CONTROLLER.json --kind pid|rst|lqr``):
+the same arithmetic, in the same order, as the numba kernels behind ``.step``
 (:func:`gripkit.control.pid.pid_step`, :func:`gripkit.control.rst.rst_step`,
 :func:`gripkit.control.state_feedback.state_feedback_step`), so the C outputs equal the Python
 ones (bit for bit with gcc -O2 on x86-64, where neither side contracts a*b + c into an FMA; to

@@ -1,5 +1,5 @@
 """C99 code of an identified model's steady-state Kalman filter (``gripkit export c --kind
-kalman``, issue 27).
+kalman``).
 
 The filter is :class:`~gripkit.estimation.KalmanFilter` with ``steady_state=True``: fixed gains
 ``K_f``, ``K_p`` (the model's own innovation gain K by default, or those of the noise

@@ -1,5 +1,5 @@
 """C99 code of the recursive least-squares update of an ARX ``[na nb nk]`` model
-(``gripkit export c --rls --na NA --nb NB --nk NK [--lam L] [--p0 P0] [--windup W]``, issue 27).
+(``gripkit export c --rls --na NA --nb NB --nk NK [--lam L] [--p0 P0] [--windup W]``).
 
 ``NAME_update(s, u, y)`` is :meth:`gripkit.sysid.RLS.update` for one sample: the a-priori error
 ``e = y − φᵀθ``, ``q = Pφ``, ``r = φᵀq``, ``θ ← θ + q e/(λ + r)`` and

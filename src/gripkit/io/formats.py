@@ -466,7 +466,7 @@ def _float64_column(col) -> np.ndarray:
     import pyarrow as pa
 
     if not pa.types.is_float64(col.type):  # a float64 column needs no cast: no pyarrow.compute
-        import pyarrow.compute as pc  # import (0.05–0.1 s of a CLI start-up, issue 24)
+        import pyarrow.compute as pc  # import (a part of a CLI start-up worth saving)
 
         col = pc.cast(col, pa.float64())
     parts = []

@@ -26,7 +26,7 @@ __all__ = ["Trajectory"]
 def _median(d: np.ndarray) -> float:
     """``np.median`` of a 1-D float64 array, the same arithmetic (partition, the mean of the one
     or two middle values, NaN when there is one), without its NaN check's import of numpy.ma
-    (~10 ms of a CLI start-up, issue 24)."""
+    (a part of a CLI start-up worth saving)."""
     h = d.size // 2
     if d.size % 2:
         part = np.partition(d, [h, -1])  # the last: NaN sorts there

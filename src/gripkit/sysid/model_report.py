@@ -8,7 +8,7 @@ pole (from the parameter covariance); Bode magnitude and phase with ±2σ bands,
 Welch H1 estimate (with its ±2σ) beside them when the data allow; the subspace singular values
 with the chosen order; the warnings raised on the way.
 
-Measured records (issue 25): the residuals are those of the model's predictor from the initial
+Measured records: the residuals are those of the model's predictor from the initial
 state estimated by least squares over the record (:func:`residual_analysis`; innovation models:
 ``x̂⁺ = (A − KC) x̂ + (B − KD) u + K y``, whose prediction errors are affine in x0), as the free-run
 comparison does, never from x0 = 0 — a predictor pole near the unit circle would carry a wrong

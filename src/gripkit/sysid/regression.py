@@ -95,8 +95,8 @@ def solve_upper(r1: np.ndarray, b: np.ndarray, trans: int = 0) -> np.ndarray:
     ``r1`` (float64), by numpy's LAPACK ``gesv``: partial pivoting finds each column's largest
     entry on the diagonal (the entries below it are zero), so the LU factors are I and ``r1``
     itself and the solve is the back substitution (for ``r1ᵀ``, the same on the reversed
-    system). numpy, not ``scipy.linalg.solve_triangular``: importing scipy.linalg is ~0.2 s of
-    a CLI start-up (issue 24), and scipy's argument handling ~8 µs a call."""
+    system). numpy, not ``scipy.linalg.solve_triangular``: importing scipy.linalg is a
+    noticeable part of a CLI start-up, and scipy's argument handling costs more than a small solve."""
     if trans:  # r1ᵀ x = b  ⇔  (J r1ᵀ J)(J x) = J b, J the reversal; J r1ᵀ J is upper triangular
         return np.linalg.solve(r1.T[::-1, ::-1], b[::-1])[::-1]
     return np.linalg.solve(r1, b)

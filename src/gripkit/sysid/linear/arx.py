@@ -112,7 +112,7 @@ def _arx(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int, step: float, *
     ``((min u, max u), (min y, max y))`` when the caller knows them.
 
     The model object is built once, with every field (a fixed cost that counts in order searches
-    and sliding windows at N ≈ 10⁴, issue 24)."""
+    and sliding windows at N ≈ 10⁴)."""
     keep_residuals = keep_residuals and record is None
     p = na + nb
     t0 = arx_start(na, nb, nk)

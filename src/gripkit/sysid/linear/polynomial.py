@@ -50,7 +50,7 @@ _STRUCTURES = ("arx", "armax", "oe")
 class _Residuals:
     """The ``estimation_residuals`` field: the array an estimator passed, or, when it passed its
     estimation record as ``estimation_data`` instead, the one-step prediction errors computed from
-    that record on first access (issue 14: a large ARX fit keeps no N-sample array a user may never read, so
+    that record on first access (a large ARX fit keeps no N-sample array a user may never read, so
     its memory stays O(p²) beyond the data). The computed errors must reproduce the fit's loss:
     a record changed in place after the fit raises instead of giving other residuals."""
 

@@ -1,4 +1,4 @@
-"""Nonlinear system identification (issue 26): polynomial NARX by forward regression with the
+"""Nonlinear system identification: polynomial NARX by forward regression with the
 error reduction ratio (:func:`narx`, :mod:`.narx`); Hammerstein, Wiener and Hammerstein–Wiener
 models (:func:`hammerstein_wiener`, :mod:`.hammerstein_wiener`); hysteresis, generic Bouc-Wen
 and Prandtl–Ishlinskii with its inverse (:func:`hysteresis`, :mod:`.hysteresis`); polynomial

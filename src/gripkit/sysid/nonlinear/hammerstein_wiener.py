@@ -1,4 +1,4 @@
-"""Hammerstein, Wiener and Hammerstein–Wiener models (issue 26, family 2): static nonlinearities
+"""Hammerstein, Wiener and Hammerstein–Wiener models: static nonlinearities
 around an output-error linear block, refined by prediction-error minimisation of the simulation
 error, with σ of every parameter.
 

@@ -1,4 +1,4 @@
-"""Hysteresis identified from the user's data (issue 26, family 4): generic Bouc-Wen (actuator
+"""Hysteresis identified from the user's data: generic Bouc-Wen (actuator
 form) and Prandtl–Ishlinskii with its analytic inverse, parameters with σ.
 
 **Bouc-Wen, actuator form** (``001_0b92a7da96e7aa46.txt`` eq 3, generalised by the exponent n)::

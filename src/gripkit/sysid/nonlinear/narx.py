@@ -1,4 +1,4 @@
-"""Polynomial NARX models (issue 26, family 1): structure by forward regression with the error
+"""Polynomial NARX models: structure by forward regression with the error
 reduction ratio, parameters by least squares with σ, free-run simulation.
 
 The model is ``y(t) = Σ_k θ_k m_k(t) + e(t)`` where every term ``m_k`` is a constant or a product

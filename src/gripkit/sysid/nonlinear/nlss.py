@@ -1,4 +1,4 @@
-"""Polynomial nonlinear state-space models (issue 26, family 3), in the PNLSS form of Paduart et
+"""Polynomial nonlinear state-space models, in the PNLSS form of Paduart et
 al. (J. Paduart, L. Lauwers, J. Swevers, K. Smolders, J. Schoukens, R. Pintelon, "Identification
 of nonlinear systems using Polynomial Nonlinear State Space models", Automatica 46(4), 647–656,
 2010)::

@@ -175,7 +175,7 @@ def thermal_adaptation_study(finger, controller: ImpedanceController, reference,
                              settings=LOOP_ADAPTATION, observer: ThermalObserver | None = None,
                              sensing: Sensing | None = POTENTIOMETERS, dt: float = 1e-3,
                              t_skip: float = 5.0) -> ThermalStudy:
-    """Friction adaptation against a motor-torque change (issue 28, item 1).
+    """Friction adaptation against a motor-torque change.
 
     Fig. 5.7 (§5.4.3) shows the motor torque at PWM 4000 falling from 1.0 to 0.57 N·cm as the
     winding warms from room temperature to about 80 °C; the finger has no torque or current
