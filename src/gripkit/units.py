@@ -36,7 +36,7 @@ _ALIASES = {
 
 
 def _import_pint():
-    """pint, imported without dask: ``pint.compat`` imports ``dask.base`` (0.1 s) whenever dask is
+    """pint, imported without dask: ``pint.compat`` imports ``dask.base`` whenever dask is
     installed, for dask-array quantities gripkit never makes. While pint is first imported (and
     dask is not yet loaded), ``importlib.util.find_spec`` — which pint.compat binds at import to
     test ``find_spec("dask")`` — answers None for dask; pint then leaves its dask support out.

@@ -1,12 +1,12 @@
 """One-state inverse dynamics and mass matrix with the least call overhead.
 
 A controller or an estimator calls ``chain.rnea(q, qd, qdd)`` on one state at a time; there the
-cost is the call, not the arithmetic (a 4-link RNEA is ~0.1 µs). The batched path validates and
-stacks its inputs and passes 17 arrays to the kernel (~11 µs per call, measured on the DLR/HIT
-finger). This path packs the model and its scratch memory once into one float64 array
+cost is the call, not the arithmetic. The batched path validates and stacks its inputs and
+passes 17 arrays to the kernel (the figures: docs/performance.md, "One-state RNEA and CRBA").
+This path packs the model and its scratch memory once into one float64 array
 (:func:`pack`) kept with the chain, so a call is one ``np.empty`` and one call of a kernel compiled
 for float64 arrays only, with three (mass matrix) or five (RNEA) arguments: unboxing an argument
-is most of the cost of a call (~0.1 µs each). Other argument types raise TypeError
+is most of the cost of a call. Other argument types raise TypeError
 at the call, and the kernel reports a state of the wrong length or with NaN/inf: the caller then
 takes the validating path, which raises the error. The scratch is shared by the calls on one
 chain, which is safe because the kernel holds the GIL. The mass matrix (:func:`mass_matrix_one`,
@@ -145,6 +145,6 @@ def mass_matrix_one(buf, q, out):  # pragma: no cover - compiled
 
 def prepare(system):
     """(packed buffer, m, (m, m)) of ``system`` for ``Dynamics.rnea`` and ``Dynamics.mass_matrix``
-    (the shape tuple made once: building it per call is 60 ns of a 1 µs call)."""
+    (the shape tuple made once: building it per call is a measurable part of a call)."""
     m = system.dof
     return pack(system.kernel_arrays()), m, (m, m)

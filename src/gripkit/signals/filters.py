@@ -21,7 +21,8 @@ from .trajectory import Trajectory
 
 
 def _signal():
-    """``scipy.signal``, imported on first use: it costs ~0.7 s, more than the rest of ``import gripkit``."""
+    """``scipy.signal``, imported on first use: it costs more than the rest of ``import
+    gripkit`` (docs/performance.md, "Start-up")."""
     from scipy import signal
 
     return signal

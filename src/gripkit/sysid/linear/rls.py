@@ -169,10 +169,8 @@ def _core(Pb, thb, phb, qb, at, p, size, lam, mode, maxtr, trace, y, std_out, tp
 
     Between the halves, when ``tprev >= 0``, σ of the previous step goes into row ``tprev`` of
     ``std_out``: ``√(fprev·P_ii)`` from P before this update, i.e. after the previous one, the
-    numbers the end of that step would write. There the square roots overlap with this update:
-    the batch kernel with history took 44.1 instead of 45.4 ms per 10⁶ samples (AMD EPYC, thread
-    CPU time, arrays preallocated). They still cost ~8 ms per 10⁶ samples, against ~1.7 ms in a
-    plain RLS of fixed size; why was not found (the instructions of that store are the same).
+    numbers the end of that step would write. There the square roots overlap with this update
+    (the measurements: docs/performance.md, "Issue 24 follow-up").
     """
     e, r, coef, scale, g, _ = _gain(Pb, thb, phb, qb, at, p, size, lam, mode,
                                     trace, y, False)
@@ -308,12 +306,11 @@ _STEPS: dict = {}
 def _step_entry(na: int, nb: int, nk: int):
     """The step :meth:`RLS.update` calls for an ARX [na nb nk] model: :func:`_rls_step` compiled
     for this structure (the orders as tuple lengths, like the batch kernel's ``size``: unrolled
-    p-loops and constant offsets, ~50 ns of ~200 ns per call), once per structure and process
-    (numba caches it on disk: seconds the first time on a machine, milliseconds after).
+    p-loops and constant offsets), once per structure and process (numba caches it on disk).
 
     Returned is the compiled function's ``entry_point`` for (C-contiguous float64 vector, float,
-    float), which unboxes its arguments as those types without numba's dispatcher (its type
-    resolution costs ~80 ns per call); only :meth:`RLS.update` calls it, with the estimator's own
+    float), which unboxes its arguments as those types without numba's dispatcher (and its type
+    resolution per call); only :meth:`RLS.update` calls it, with the estimator's own
     state vector and two floats. Where numba has no ``entry_point`` the dispatcher is returned.
     """
     key = (na, nb, nk)
@@ -351,8 +348,8 @@ def _rls_run(s, u, y, theta_out, std_out, yhat_out, err_out, size):
     ``size``: four empty tuples (generic kernel, orders read from ``s`` at run time) or tuples of
     p, na, nb and nk zeros (:meth:`RLS._kernel_size`), whose lengths numba knows at compile time: it
     compiles (and caches) one kernel per model structure, with unrolled p-loops and constant
-    regressor indices (measured 1.5–2× faster); :meth:`RLS.run` uses it for records of at least
-    :data:`SPECIALISE_ABOVE` samples, where the extra compilation (1–2 s, once) pays off. The first
+    regressor indices (faster: docs/performance.md, "RLS"); :meth:`RLS.run` uses it for records of
+    at least :data:`SPECIALISE_ABOVE` samples, where the extra compilation (once) pays off. The first
     ``t0`` samples go through :func:`_rls_step` (their regressors need the buffered past); the rest
     take the regressor straight from ``u`` and ``y`` with θ and P in local arrays. Both call
     :func:`_core`, so streaming and batch results are bit-identical.
