@@ -293,7 +293,8 @@ def test_cli_identify_hw_json_compare_and_simulate(tmp_path, capsys):
     assert json.loads(out)["outputs"]["force"]["final"] == pytest.approx(
         load_hw(model).simulate(uv)[-1, 0], rel=1e-9)
     code, out, err = _cli(capsys, "report", model, val, "--fs", 100, "--out", tmp_path / "rep")
-    assert code != 0 and err.startswith("error: ModelError: report:") and "draws linear models" in err
+    assert (code != 0 and err.startswith("error: ModelError: report:")
+            and "draws linear models" in err)
     code, out, err = _cli(capsys, "identify", "hw", est, "--input", "valve", "--output", "force",
                           "--fs", 100, "--output-nonlinearity", "cubic")
     assert code != 0 and err.startswith("error: ArgumentError: hammerstein_wiener: "

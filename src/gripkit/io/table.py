@@ -274,7 +274,8 @@ def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
         name, unit = split_header(str(header))
         if name in cols:
             raise DataError(f"{source}: column {name!r} appears twice")
-        cols[name] = (values, units.get(name) or unit or meta_units.get(header) or meta_units.get(name))
+        cols[name] = (values,
+                      units.get(name) or unit or meta_units.get(header) or meta_units.get(name))
     if not cols:
         raise DataError(f"{source}: the file holds no columns")
     available = ", ".join(cols)

@@ -40,7 +40,8 @@ class StateSpace(lti.StateSpace):
     >>> from gripkit.sim import StateSpace
     >>> s = StateSpace([[-2.0]], [[1.0]], [[2.0]], None)
     >>> d = s.discretize(0.1)
-    >>> type(d).__name__, round(float(d.dc_gain()[0, 0]), 12), float(abs(s.freqresp([0.0])[0, 0, 0]))
+    >>> (type(d).__name__, round(float(d.dc_gain()[0, 0]), 12),
+    ...  float(abs(s.freqresp([0.0])[0, 0, 0])))
     ('StateSpace', 1.0, 1.0)
     """
 

@@ -76,7 +76,8 @@ def test_stretching_coefficient_galerkin():
     E, h, w, L = 190e9, 50e-6, 8e-6, 1830e-6
     stretch = quad(lambda s: (math.pi / L * math.sin(2 * math.pi * s / L)) ** 2, 0, L)[0] / 2  # per x²
     k3_one_beam = 4 * (E * h * w / (2 * L)) * stretch ** 2  # d/dx of U = (EA/2L) stretch² x⁴
-    assert k3_one_beam / (16 * E * h * w ** 3 / L ** 3) * w ** 2 == pytest.approx(STRETCHING_BETA, rel=1e-9)
+    assert k3_one_beam / (16 * E * h * w ** 3 / L ** 3) * w ** 2 == pytest.approx(STRETCHING_BETA,
+                                                                                  rel=1e-9)
     K = clamped_clamped_stiffness(E, h, w, L)
     k3 = cubic_stiffness(E, h, w, L)
     x = np.array([0.0, 2e-6, w])
