@@ -136,9 +136,9 @@ def check_size(source: str, what: str, rows: int, ncols: int, limit: float,
     raise DataError(
         f"{source}: {what} declares {rows} rows × {ncols} columns, about {need / 1e9:.3g} GB "
         f"{each}, beyond the load limit of {limit / 1e9:.3g} GB; nothing was read",
-        hint=f"read fewer columns (columns=, CLI: the command's column options), or raise the "
-             f"limit with max_bytes= or the environment variable GRIPKIT_MAX_LOAD_BYTES (bytes) "
-             f"if the machine has the memory")
+        hint="read fewer columns (columns=, CLI: the command's column options), or raise the "
+             "limit with max_bytes= or the environment variable GRIPKIT_MAX_LOAD_BYTES (bytes) "
+             "if the machine has the memory")
 
 
 def check_fs(fs) -> None:

@@ -28,7 +28,7 @@ from ...progress import status
 from ...signals.trajectory import Trajectory
 from .arx_mimo import arx_mimo
 from .frf import frf
-from .linear_model import VALIDATION_FIT, validation_fit  # the one definition, re-exported for the CLI
+from .linear_model import validation_fit  # the one definition (with VALIDATION_FIT, its text)
 
 __all__ = ["MimoData", "mimo_data", "identify_ss", "identify_frf", "identify_tf", "identify_arx", "several",
            "parse_names", "parse_order", "validation_fit"]
@@ -209,7 +209,8 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     report(f"{method}: {d.u.shape[0]} samples, {len(d.inputs)} input(s), {len(d.outputs)} output(s), horizon {k}")
     fac = subspace_factor(d.u, d.y, horizon=k, method=method)
     extras: dict = {}
-    build = lambda n: from_factor(fac, n, dt=d.dt, feedthrough=feedthrough, signals=d.signals)  # noqa: E731
+    build = lambda n: from_factor(  # noqa: E731
+        fac, n, dt=d.dt, feedthrough=feedthrough, signals=d.signals)
     if rng is None:
         n = select_order(fac.s, min(n_hi, fac.s.size - 1))
         model = build(n)
