@@ -13,7 +13,8 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(sys.argv[1] if len(sys.argv) > 1 else Path(__file__).parents[1]) / "src"))
+sys.path.insert(0, str(Path(sys.argv[1] if len(sys.argv) > 1 else Path(__file__).parents[1])
+                       / "src"))
 
 from gripkit.errors import ConsistencyWarning  # noqa: E402
 from gripkit.systems.dlr_hit.friction_adaptation import tracking_reference  # noqa: E402

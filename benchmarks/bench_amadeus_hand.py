@@ -93,7 +93,8 @@ def run(quick: bool = False) -> list[dict]:
     assert np.allclose(got, ref, rtol=1e-7, atol=1e-9)
     tg = measure(kf)
     tp = measure(lambda: _kf_numpy(s.H, s.sigma_n2, s.noise_floor ** 2, Z[:Nk], 5.0, 0.005)) * N / Nk
-    rows.append(row("amadeus_hand", f"Kalman filter, 6 bridges, {N} samples", tg, "numpy joint update, per sample in Python", tp, pure_python_peer=True,
+    rows.append(row("amadeus_hand", f"Kalman filter, 6 bridges, {N} samples", tg,
+                    "numpy joint update, per sample in Python", tp, pure_python_peer=True,
                     notes=f"peer timed on {Nk} samples and scaled"))
 
     def wls_loop(R):
@@ -108,7 +109,8 @@ def run(quick: bool = False) -> list[dict]:
     np.testing.assert_allclose(estimate_force(Z[:Nw], s, iterations=1).force, wls_loop(Z[:Nw]), rtol=1e-9, atol=1e-12)
     tg = measure(lambda: estimate_force(Z, s, iterations=1))
     tp = measure(lambda: wls_loop(Z[:Nw])) * N / Nw
-    rows.append(row("amadeus_hand", f"per-sample WLS force, {N} samples", tg, "numpy lstsq, once per sample in Python", tp, pure_python_peer=True,
+    rows.append(row("amadeus_hand", f"per-sample WLS force, {N} samples", tg,
+                    "numpy lstsq, once per sample in Python", tp, pure_python_peer=True,
                     notes=f"peer timed on {Nw} samples and scaled"))
 
     import control

@@ -49,7 +49,8 @@ int main(int argc, char **argv) {
     for (long k = 0; k < 1000; ++k) {
         for (int i = 0; i < BENCH_NU; ++i) u[i] = (double)((k * (i + 3)) % 17) / 17.0 - 0.5;
         bench_step(&s, u, y);
-        for (int j = 0; j < BENCH_NY; ++j) fprintf(f, "%.17g%c", y[j], j + 1 < BENCH_NY ? ',' : '\n');
+        for (int j = 0; j < BENCH_NY; ++j)
+            fprintf(f, "%.17g%c", y[j], j + 1 < BENCH_NY ? ',' : '\n');
     }
     fclose(f);
     for (long b = 0; b < nb; ++b) {
@@ -62,7 +63,8 @@ int main(int argc, char **argv) {
         per[b] = (now_ns() - t0) / (double)block;
     }
     qsort(per, (size_t)nb, sizeof(double), cmp);
-    printf("{\"min\": %.3f, \"median\": %.3f, \"p99\": %.3f, \"p999\": %.3f, \"max\": %.3f, \"sink\": %g}\n",
+    printf("{\"min\": %.3f, \"median\": %.3f, \"p99\": %.3f, \"p999\": %.3f, "
+           "\"max\": %.3f, \"sink\": %g}\n",
            per[0], per[nb / 2], per[(long)(0.99 * nb)], per[(long)(0.999 * nb)], per[nb - 1], sink);
     return 0;
 }

@@ -103,8 +103,9 @@ def _sysidentpy(degree: int, lag: int, recursive: bool, ue, ye):
     from sysidentpy.parameter_estimation import LeastSquares, RecursiveLeastSquares
 
     def call():
-        model = FROLS(order_selection=True, n_info_values=100 if degree > 1 else 2 * lag + 1, ylag=lag, xlag=lag,
-                      info_criteria="bic", estimator=RecursiveLeastSquares() if recursive else LeastSquares(),
+        model = FROLS(order_selection=True, n_info_values=100 if degree > 1 else 2 * lag + 1,
+                      ylag=lag, xlag=lag, info_criteria="bic",
+                      estimator=RecursiveLeastSquares() if recursive else LeastSquares(),
                       basis_function=Polynomial(degree=degree), err_tol=None)
         model.fit(X=ue[:, None], y=ye[:, None])
         return model

@@ -108,7 +108,8 @@ def run(quick: bool = False) -> list[dict]:
 
     rows.append(row("multibody", "RNEA, one state per public call (a controller step)", measure(gk_one) / n_one,
                     "pin.rnea, one call per state", measure(pin_one) / n_one, target="ratio ≥ 0.67 (≤ 1.5×)",
-                    gripkit_accuracy=f"max |τ − (Γᵀ τ_pin + arm·p̈)| = {rnea_err:.1e} N·m",
+                    gripkit_accuracy=f"max |τ − (Γᵀ τ_pin + arm·p̈)| = "
+                                     f"{rnea_err:.1e} N·m",
                     notes="both called from a Python loop; gripkit checks its inputs on every call and includes Γ"))
 
     def gk_one_m():
@@ -134,10 +135,13 @@ def run(quick: bool = False) -> list[dict]:
         for i in range(n_one):
             ch.mass_matrix(p1[i], out=M_ws)
 
-    rows.append(row("multibody", "RNEA, one state per public call, out= workspace", measure(gk_one_out) / n_one,
+    rows.append(row("multibody", "RNEA, one state per public call, out= workspace",
+                    measure(gk_one_out) / n_one,
                     "pin.rnea, one call per state (into its data)", measure(pin_one) / n_one,
-                    target="ratio ≥ 0.67 (≤ 1.5×)", gripkit_accuracy=f"max |τ − (Γᵀ τ_pin + arm·p̈)| = {rnea_err:.1e} N·m",
-                    notes="rnea(..., out=τ): no allocation per call; same checks of the state as without out"))
+                    target="ratio ≥ 0.67 (≤ 1.5×)",
+                    gripkit_accuracy=f"max |τ − (Γᵀ τ_pin + arm·p̈)| = {rnea_err:.1e} N·m",
+                    notes="rnea(..., out=τ): no allocation per call; same checks of the state "
+                          "as without out"))
     rows.append(row("multibody", "mass matrix (CRBA), one state per public call, out= workspace",
                     measure(gk_one_m_out) / n_one, "pin.crba, one call per state (into its data)",
                     measure(pin_one_m) / n_one, target="ratio ≥ 0.67 (≤ 1.5×)",

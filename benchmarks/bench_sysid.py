@@ -152,7 +152,8 @@ if what == "memory":
                           residuals_s=t_res)))
 else:
     out = {{}}
-    for name, f in (("gripkit", lambda: arx(u, y, 4, 4, 2)), ("numpy", lambda: _normal_equations(u, y))):
+    for name, f in (("gripkit", lambda: arx(u, y, 4, 4, 2)),
+                    ("numpy", lambda: _normal_equations(u, y))):
         ts = []
         for _ in range(7):
             t0 = time.perf_counter(); f(); ts.append(time.perf_counter() - t0)
@@ -263,7 +264,8 @@ def run(quick: bool = False) -> list[dict]:
         p_ = [s["numpy"] for s in spread]
         rows.append(row("sysid", f"ARX [4 4 2], N = {n:.0e}: spread of the median between 3 processes", None,
                         "numpy normal equations", None, target="≤ 2×",
-                        notes=f"gripkit medians {', '.join(f'{x * 1e3:.3g}' for x in g)} ms (max/min "
+                        notes=f"gripkit medians "
+                              f"{', '.join(f'{x * 1e3:.3g}' for x in g)} ms (max/min "
                               f"{max(g) / min(g):.2f}); numpy {', '.join(f'{x * 1e3:.3g}' for x in p_)} ms "
                               f"(max/min {max(p_) / min(p_):.2f})",
                         extra={"gripkit_spread": max(g) / min(g), "numpy_spread": max(p_) / min(p_)}))
@@ -285,7 +287,8 @@ def run(quick: bool = False) -> list[dict]:
     assert np.allclose(_sysidentpy_theta(sm), arx(u[:20000], y[:20000], 4, 4, 2).theta, atol=1e-4)
     ns, t_s = _timed_per_sample(lambda k: _sysidentpy_arx(u[:k], y[:k]), [n // 10, n], budget_s=30)
     rows.append(row("sysid", label, t_gk, "sysidentpy FROLS+LeastSquares", t_s * n / ns, pure_python_peer=True,
-                    gripkit_accuracy=gk_acc, peer_accuracy=acc(_sysidentpy_theta(sm)) + " (at N = 2e4)",
+                    gripkit_accuracy=gk_acc,
+                    peer_accuracy=acc(_sysidentpy_theta(sm)) + " (at N = 2e4)",
                     notes=(f"timed at N = {ns:.0e}" + ("" if ns == n else f", scaled ×{n // ns} (per sample)")
                            + "; sysidentpy adds a constant column (9 regressors)")))
     sp = _sippy_arx(u[:20000], y[:20000])

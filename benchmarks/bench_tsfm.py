@@ -174,7 +174,8 @@ def run(quick: bool = False) -> list[dict]:
                         notes=f"{tg / U.shape[0] * 1e9:.1f} ns/sample through Model.simulate_batch (discretisation, "
                               f"input/output checks included, output buffer reused), {tk / U.shape[0] * 1e9:.1f} ns/sample in the "
                               f"kernel alone ({dur / tk:.0f}× real time); "
-                              f"{'eq 11 (minimal)' if states == 4 else 'component-wise (with y_B)'} realisation; "
+                              f"{'eq 11 (minimal)' if states == 4 else 'component-wise (with y_B)'}"
+                              " realisation; "
                               f"{int(np.sum(np.diff(y[0, :, 4]) != 0))} contact events"))
         if states == 4:
             ts_pub = measure(lambda: m.simulate(U, dt=1 / fs))

@@ -84,7 +84,8 @@ def to_markdown(results: dict) -> str:
         ratio = f"{r['ratio']:.3g}×" if r.get("ratio") else "—"
         accuracy = " / ".join(a for a in (r.get("gripkit_accuracy", ""), r.get("peer_accuracy", "")) if a)
         lines.append(f"| {r['benchmark']} | {r['task']} | {t(r['gripkit_s'], r.get('gripkit_min_s'), r.get('gripkit_runs'))} "
-                     f"| {r['peer']} | {t(r['peer_s'], r.get('peer_min_s'), r.get('peer_runs'))} | {ratio} | "
+                     f"| {r['peer']} | {t(r['peer_s'], r.get('peer_min_s'), r.get('peer_runs'))} "
+                     f"| {ratio} | "
                      f"{r.get('target', '')} | {accuracy} | {r.get('notes', '')} |")
     if results.get("errors"):
         lines += ["", "## Benchmarks that failed", ""]

@@ -16,7 +16,7 @@ from gripkit import Trajectory
 from gripkit.io import save
 from gripkit.excitation import periodic_multisine
 from gripkit.lti import StateSpace
-from gripkit.sysid import frf, identify, load_model
+from gripkit.sysid import identify, load_model
 
 rng = np.random.default_rng(3)
 A = np.array([[0.9, 0.2, 0, 0], [-0.2, 0.9, 0, 0], [0, 0, 0.7, 0], [0, 0, 0, -0.4]])

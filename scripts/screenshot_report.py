@@ -59,10 +59,12 @@ document.getElementById('page').addEventListener('load', function () {
   var all = doc.body.getElementsByTagName('*');
   for (var i = 0; i < all.length; i++) {
     var el = all[i], r = el.getBoundingClientRect(), right = r.right;
-    if (win.getComputedStyle(el).overflowX === 'visible')  // content (a long word) spilling out of its box
+    // content (a long word) spilling out of its box
+    if (win.getComputedStyle(el).overflowX === 'visible')
       right = Math.max(right, r.left + el.scrollWidth);
     if (r.width > 0 && right > vw + 1 && !scrollsX(el)) {
-      out.push({tag: el.tagName.toLowerCase(), cls: String(el.className || ''), right: Math.round(right),
+      out.push({tag: el.tagName.toLowerCase(), cls: String(el.className || ''),
+                right: Math.round(right),
                 text: (el.textContent || '').trim().slice(0, 60)});
     }
   }

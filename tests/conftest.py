@@ -35,7 +35,8 @@ def record_of(result: np.ndarray) -> dict:
 def _check_record(name, result, record):
     """The result has the recorded shape and agrees with the recorded rows to RECORD_RTOL."""
     result = np.asarray(result, dtype=np.float64)
-    assert list(result.shape) == record["shape"], f"{name}: shape {result.shape}, recorded {record['shape']}"
+    assert list(result.shape) == record["shape"], \
+        f"{name}: shape {result.shape}, recorded {record['shape']}"
     ref = np.array([[float.fromhex(v) for v in row] for row in record["values"]])
     got = result[record["rows"]]
     finite = np.where(np.isfinite(ref), ref, 0.0)

@@ -52,7 +52,8 @@ def _imports():
                 if plain:
                     out.append((mod, target, tuple(plain), node.lineno))
             elif isinstance(node, ast.Import):
-                out.extend((mod, a.name, (), node.lineno) for a in node.names if a.name.startswith("gripkit"))
+                out.extend((mod, a.name, (), node.lineno) for a in node.names
+                           if a.name.startswith("gripkit"))
     return modules, out
 
 
@@ -115,13 +116,17 @@ def test_layering(rule):
     bad = []
     for a, b, names, line in IMPORTS:
         la, lb = _layer(a), _layer(b)
-        if rule == "generic layers name no system" and la in GENERIC and lb in ("systems", *ABOVE_SYSTEMS):
+        if (rule == "generic layers name no system" and la in GENERIC
+                and lb in ("systems", *ABOVE_SYSTEMS)):
             bad.append((a, b, line))
-        elif rule == "systems stay apart" and _system(a) and _system(b) and _system(a) != _system(b):
+        elif (rule == "systems stay apart" and _system(a) and _system(b)
+              and _system(a) != _system(b)):
             bad.append((a, b, line))
-        elif rule == "systems sit below description, demos and cli" and la == "systems" and lb in ABOVE_SYSTEMS:
+        elif (rule == "systems sit below description, demos and cli" and la == "systems"
+              and lb in ABOVE_SYSTEMS):
             bad.append((a, b, line))
-        elif rule == "the zoo names its factories by string" and la == "zoo" and lb not in ("zoo", *GENERIC):
+        elif (rule == "the zoo names its factories by string" and la == "zoo"
+              and lb not in ("zoo", *GENERIC)):
             bad.append((a, b, line))
         elif rule == "signals never imports io" and la == "signals" and lb == "io":
             bad.append((a, b, line))

@@ -32,4 +32,5 @@ def test_modules_with_examples_are_found():
 def test_module_examples_run(name):
     module = importlib.import_module(name)
     result = doctest.testmod(module, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE, verbose=False)
-    assert result.failed == 0, f"{result.failed} of {result.attempted} examples in {name} failed (output above)"
+    assert result.failed == 0, \
+        f"{result.failed} of {result.attempted} examples in {name} failed (output above)"

@@ -44,7 +44,8 @@ def test_every_package_declares_what_it_exports(pkg):
     assert declared is not None, f"{_package(pkg)} has no __all__"
     assert len(declared) == len(set(declared)), f"{_package(pkg)}: a name twice in __all__"
     missing = exported - set(declared)
-    assert not missing, f"{_package(pkg)} re-exports {sorted(missing)} without listing them in __all__"
+    assert not missing, \
+        f"{_package(pkg)} re-exports {sorted(missing)} without listing them in __all__"
     module = importlib.import_module(_package(pkg))
     unresolved = [n for n in declared if not hasattr(module, n)  # or a subpackage (gripkit.systems)
                   and importlib.util.find_spec(f"{module.__name__}.{n}") is None]

@@ -112,9 +112,11 @@ def test_allow_list_entries_are_still_needed():
                                   f"{LENGTHS[(rel, name)][0]} lines, within the limit")
              for rel, name in sorted(NUMBA_KERNELS)
              if (rel, name) not in LENGTHS or LENGTHS[(rel, name)][0] <= LIMIT]
-    assert not stale, "remove from the allow-list of tests/test_function_length.py: " + "; ".join(stale)
+    assert not stale, \
+        "remove from the allow-list of tests/test_function_length.py: " + "; ".join(stale)
     for (rel, name), reason in NUMBA_KERNELS.items():
-        assert LENGTHS[(rel, name)][2], f"{rel} {name} is in NUMBA_KERNELS but is not a numba kernel"
+        assert LENGTHS[(rel, name)][2], \
+            f"{rel} {name} is in NUMBA_KERNELS but is not a numba kernel"
         assert reason.strip(), f"{rel} {name}: give the measured slowdown of a split"
 
 

@@ -81,7 +81,8 @@ def _allowed(rel: str, module: str) -> bool:
 def test_imports_inside_functions_have_a_reason():
     found = [f"{rel}:{line} imports {module}" for rel, line, module in _in_function_imports()
              if not _allowed(rel, module)]
-    assert found == [], "move to the top of the module (or give the reason here):\n" + "\n".join(found)
+    assert found == [], \
+        "move to the top of the module (or give the reason here):\n" + "\n".join(found)
 
 
 def test_every_exception_is_still_used():

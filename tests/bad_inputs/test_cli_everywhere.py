@@ -127,7 +127,8 @@ def test_unknown_option_names_the_command_help(cli, files):
 def test_group_without_a_command_prints_its_help(cli):
     for args in ((), ("identify",), ("zoo",)):
         res = cli(*args)
-        assert res.code == 0 and res.error_lines == [] and "Usage: gripkit" in res.out + res.err, args
+        assert (res.code == 0 and res.error_lines == []
+                and "Usage: gripkit" in res.out + res.err), args
 
 
 # junk, folders and unreadable TOML files (sweep files and model descriptions, via read_toml)
@@ -379,10 +380,12 @@ def test_save_refuses_wrong_types(traj, tmp_path):
 def test_identify_unknown_keyword(traj, method, options, phrase):
     from gripkit.sysid import identify
 
-    with pytest.raises(ArgumentError, match=r"identify\(method='" + method + r"'\): unknown keyword") as info:
+    with pytest.raises(ArgumentError,
+                       match=r"identify\(method='" + method + r"'\): unknown keyword") as info:
         identify(traj, method, input="u", output="y", **options)
     msg = str(info.value)
-    assert phrase in msg and "identify accepts data, method, input, output, na, nb, nk, nc, nf, detrend" in msg
+    assert (phrase in msg
+            and "identify accepts data, method, input, output, na, nb, nk, nc, nf, detrend" in msg)
 
 
 def test_identify_wrong_types_and_missing_arguments(traj):

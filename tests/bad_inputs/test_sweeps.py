@@ -149,7 +149,8 @@ def test_failed_jobs_give_a_non_zero_exit_and_are_counted(sweep_cli, write, own_
     res = sweep_cli(write(OWN.replace("5.0", "3.0")), "--allow-code")
     assert res.code == 3 and "Traceback" not in res.err
     assert "4 jobs, 1 of them FAILED" in res.out
-    assert len(res.error_lines) == 1 and "1 of 4 jobs failed (first: job 3: ValueError: x = 3" in res.error_lines[0]
+    assert (len(res.error_lines) == 1
+            and "1 of 4 jobs failed (first: job 3: ValueError: x = 3" in res.error_lines[0])
 
 
 def test_failed_jobs_in_json(sweep_cli, write, own_module):
@@ -283,7 +284,8 @@ def test_controller_settings_checked_before_the_run(sweep_cli, write):
     """ftg100-grasp builds its controller once up front: its own checks refuse the sweep."""
     base = '[sweep]\nscenario = "ftg100-grasp"\n[parameters]\nk0 = { grid = [520.0] }\n[scenario]\n'
     assert_user_error(sweep_cli(write(base + 'v_min = 250.0\n')), "ConfigError", "expected 0 <= v_min < v_max")
-    assert_user_error(sweep_cli(write(base + 'band = 1.0\n')), "ConfigError", "[scenario] band: expected a value < 1")
+    assert_user_error(sweep_cli(write(base + 'band = 1.0\n')), "ConfigError",
+                      "[scenario] band: expected a value < 1")
 
 
 def test_api_spec_built_directly_is_checked_too():
@@ -298,7 +300,8 @@ def test_values_outside_the_parameter_bounds(sweep_cli, write):
     the count, instead of failing those jobs one by one."""
     res = sweep_cli(write(MSD + 'samples = 200\n[parameters]\nk = { normal = [1.0, 1.0] }' + SCENARIO))
     assert_user_error(res, "ConfigError", "[parameters] k: ")
-    assert "of 200 jobs have values outside its bounds [0, inf] N/m" in res.err and "clip" in res.err
+    assert ("of 200 jobs have values outside its bounds [0, inf] N/m" in res.err
+            and "clip" in res.err)
     ok = sweep_cli(write(MSD + 'samples = 20\n[parameters]\nk = { normal = [1.0, 1.0], clip = [0.1, 10] }' + SCENARIO))
     assert ok.code == 0, ok.err
 

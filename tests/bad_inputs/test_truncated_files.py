@@ -66,8 +66,8 @@ def check_cut(folder, original: Trajectory, data: bytes, suffix: str, offset: in
 
 
 @pytest.mark.parametrize("suffix", [".csv", ".parquet", ".h5"])
-@settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture],
-          derandomize=True)
+@settings(max_examples=200, deadline=None,
+          suppress_health_check=[HealthCheck.function_scoped_fixture], derandomize=True)
 @given(data=st.data())
 def test_a_cut_file_never_loads_as_different_data_in_silence(originals, suffix, data):
     folder, files = originals

@@ -153,7 +153,8 @@ def test_damaged_output_is_refused_when_read(scen_dir, tmp_path):
 
 def test_collect_asserts_each_job_exactly_once():
     jobs = {"job_id": np.arange(6), "x": np.arange(6.0)}
-    part = lambda ids: {"job_id": np.array(ids), "y": np.array(ids, float), "error": np.full(len(ids), None)}  # noqa: E731
+    part = lambda ids: {  # noqa: E731
+        "job_id": np.array(ids), "y": np.array(ids, float), "error": np.full(len(ids), None)}
     ok = collect(jobs, [part([0, 1, 2]), part([3, 4, 5])])
     np.testing.assert_array_equal(ok["y"], np.arange(6.0))
     with pytest.raises(DataError, match=r"1 jobs missing \(first \[5\]\) and 1 held more than once \(first \[0\]\)"):

@@ -25,7 +25,8 @@ def test_flags_only_rows_slower_against_their_peer(tmp_path, capsys):
                                        ("new", "np", 1.0, 1.0)])
     rows = {r["task"]: r for r in compare_runs.compare(compare_runs._rows(old)[1], compare_runs._rows(new)[1], 0.05)}
     assert set(rows) == {"load", "regressed", "faster"}
-    assert rows["load"]["raw"] == 1.5 and rows["load"]["relative"] == 1.0 and not rows["load"]["slower"]
+    assert (rows["load"]["raw"] == 1.5 and rows["load"]["relative"] == 1.0
+            and not rows["load"]["slower"])
     assert rows["regressed"]["slower"] and abs(rows["regressed"]["relative"] - 1.2) < 1e-12
     assert not rows["faster"]["slower"]
     assert compare_runs.main([old, new]) == 1

@@ -103,7 +103,8 @@ def test_mimo_arx_json_per_output_in_output_order(cli, files):
 
 def test_miso_arx_has_lists_too(cli, files):
     d = cli(*arx_args(files["est"], "a,b", "c", "--json")).json()
-    assert d["outputs"] == ["c"] and len(d["fit_percent"]) == 1 and np.shape(d["B_poly"][0]) == (1, 2)
+    assert (d["outputs"] == ["c"] and len(d["fit_percent"]) == 1
+            and np.shape(d["B_poly"][0]) == (1, 2))
     assert np.allclose(d["B_poly"][0][0], B_TRUE[0], atol=4 * np.max(d["B_poly_std"][0]))
 
 
@@ -117,7 +118,8 @@ def test_mimo_arx_human_readable(cli, files):
     r = cli(*arx_args(files["est"], "a,b", "c,d", "--validate", files["val"]))
     assert r.code == 0, r.err
     assert "ARX [1 1 1]: 2 input(s)" in r.out and "A1 = [" in r.out and "B1 = [" in r.out
-    assert "  c: fit free run" in r.out and "  d: fit free run" in r.out and "validation free run" in r.out
+    assert ("  c: fit free run" in r.out and "  d: fit free run" in r.out
+            and "validation free run" in r.out)
 
 
 def test_mimo_arx_unstable_model_warns_and_reports_no_fit(cli, files):

@@ -68,7 +68,8 @@ def test_arx_json_has_the_issue_fields(capsys, data):
 def test_arx_human_readable_table(capsys, data):
     code, out, err = run(capsys, *arx_args(data["est"], "--validate", data["val"]))
     assert code == 0
-    assert "ARX [2 2 2]" in out and "b3" in out and "NON-minimum phase" in out and "free-run fit" in out
+    assert ("ARX [2 2 2]" in out and "b3" in out and "NON-minimum phase" in out
+            and "free-run fit" in out)
 
 
 def test_rls_json_and_trajectory(capsys, data, tmp_path):
@@ -77,7 +78,8 @@ def test_rls_json_and_trajectory(capsys, data, tmp_path):
                          "--na", 2, "--nb", 2, "--nk", 2, "--forgetting", 0.995, "--trajectory", traj, "--json")
     assert code == 0, err
     d = json.loads(out)
-    assert d["forgetting"] == 0.995 and len(d["theta_final"]) == 4 and len(d["theta_std_final"]) == 4
+    assert (d["forgetting"] == 0.995 and len(d["theta_final"]) == 4
+            and len(d["theta_std_final"]) == 4)
     # order a1..a_na then the nb B coefficients; close to the plant (A = [1, −1.8732, 0.8996])
     assert d["theta_final"][0] == pytest.approx(-1.8732, abs=0.05)
     assert d["theta_final"][2] == pytest.approx(195.0 * 0.02502, rel=0.2)  # N/A, Table II × force_scale
@@ -207,4 +209,5 @@ def test_subprocess_entry_point(data):
     bad = subprocess.run(cmd + ["identify", "arx", str(data["est"]), "--input", "nope", "--output", "force",
                                 "--na", "2", "--nb", "2", "--nk", "2"], capture_output=True, text=True, env=env,
                          timeout=120)
-    assert bad.returncode == 1 and bad.stderr.count("\n") == 1 and "column 'nope' not found" in bad.stderr
+    assert (bad.returncode == 1 and bad.stderr.count("\n") == 1
+            and "column 'nope' not found" in bad.stderr)

@@ -125,7 +125,8 @@ def test_identify_tf_json(capsys, files):
     assert "Poles and zeros" in (rep / "index.html").read_text()
     assert code == 0, err
     r = json.loads(out)
-    assert len(r["num"]) == 2 and len(r["den"]) == 3 and len(r["num_std"]) == 2 and len(r["den_std"]) == 3
+    assert (len(r["num"]) == 2 and len(r["den"]) == 3 and len(r["num_std"]) == 2
+            and len(r["den_std"]) == 3)
     assert abs(r["den"][2] - 4.0) <= 4 * r["den_std"][2]
     assert r["natural_frequency_hz"][0] == pytest.approx(1 / np.pi, rel=0.02)
     assert r["damping_ratio"][0] == pytest.approx(0.2, abs=0.02) and r["fit_percent"][0] > 95

@@ -6,7 +6,6 @@ import warnings
 from pathlib import Path
 
 import numpy as np
-import pytest
 
 from gripkit.errors import AccuracyWarning, GripkitWarning, emit_warning
 

@@ -121,7 +121,8 @@ def test_nonfinite_torque_is_one_line_error_or_skipped_with_a_warning():
         a.update(tau, h, v)
     msg = str(err.value)
     assert "\n" not in msg
-    assert "tau_motor: 2 non-finite value(s), the first at sample 1500 (t = 1.5 s) of actuator distal" in msg
+    assert ("tau_motor: 2 non-finite value(s), the first at sample 1500 (t = 1.5 s) "
+            "of actuator distal") in msg
     assert "nonfinite='skip'" in msg
     np.testing.assert_array_equal(a.theta, [[1.0, 0.0]])  # nothing was consumed
     with pytest.warns(DataWarning, match="left out"):

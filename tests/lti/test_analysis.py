@@ -56,7 +56,8 @@ def test_discrete_frequency_response_matches_freqz():
     _, href = signal.freqz(b, a, worN=w * 0.005)
     H = g.frequency_response(w)[:, 0, 0]
     den_min = np.abs(np.polyval(a, np.exp(1j * w * 0.005))).min()
-    assert np.abs(H - href).max() <= 10 * len(a) * EPS * np.abs(a).sum() / den_min * np.abs(href).max()
+    assert (np.abs(H - href).max()
+            <= 10 * len(a) * EPS * np.abs(a).sum() / den_min * np.abs(href).max())
 
 
 def test_siso_zeros_match_python_control():

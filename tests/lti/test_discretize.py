@@ -60,7 +60,8 @@ def test_tustin_prewarp_matches_python_control_and_is_exact_at_the_prewarp_frequ
     # ~10 n ε κ ≈ 1e-13; 1e-10 leaves room for the different realisations python-control builds
     np.testing.assert_allclose(gd.frequency_response(w)[:, 0, 0], ref(np.exp(1j * w * dt)), rtol=1e-10)
     # prewarp makes the response exact at ω_p (the bilinear map sends jω_p to e^{jω_p dt})
-    assert gd.frequency_response([wp])[0, 0, 0] == pytest.approx(g.frequency_response([wp])[0, 0, 0], rel=1e-10)
+    assert gd.frequency_response([wp])[0, 0, 0] == pytest.approx(
+        g.frequency_response([wp])[0, 0, 0], rel=1e-10)
     with pytest.raises(ModelError, match="prewarp applies to the Tustin method only"):
         g.c2d(dt, "zoh", prewarp=wp)
     with pytest.raises(ModelError, match=r"prewarp: expected a frequency in \(0, π/dt"):

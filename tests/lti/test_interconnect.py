@@ -15,7 +15,8 @@ W = np.logspace(-1, 1.5, 11)
 
 
 def _resp(sys):
-    return np.moveaxis(sys(1j * W), -1, 0) if sys.ninputs * sys.noutputs > 1 else sys(1j * W).reshape(-1, 1, 1)
+    return (np.moveaxis(sys(1j * W), -1, 0) if sys.ninputs * sys.noutputs > 1
+            else sys(1j * W).reshape(-1, 1, 1))
 
 
 def _close(ours, ref_ctrl):

@@ -14,7 +14,8 @@ def test_state_space_names_survive_control_round_trip():
                    inputs=("V", "F"), outputs=("x", "v"), states=("pos", "vel"), input_units=("V", "N"),
                    output_units=("m", "m/s"))
     c = s.to_control()
-    assert c.input_labels == ["V", "F"] and c.output_labels == ["x", "v"] and c.state_labels == ["pos", "vel"]
+    assert (c.input_labels == ["V", "F"] and c.output_labels == ["x", "v"]
+            and c.state_labels == ["pos", "vel"])
     assert c.dt == 0.01
     back = from_control(c, input_units=("V", "N"), output_units=("m", "m/s"))
     assert isinstance(back, StateSpace)
@@ -62,7 +63,8 @@ def test_as_system_reads_tuples_and_polynomial_like_objects():
         covariance = None
 
     g = as_system(Poly())
-    assert g.inputs == ("i",) and g.outputs == ("F",) and g.input_units == ("A",) and g.output_units == ("N",)
+    assert (g.inputs == ("i",) and g.outputs == ("F",) and g.input_units == ("A",)
+            and g.output_units == ("N",))
     assert g.dc_gain()[0, 0] == pytest.approx(4.0)
     assert as_system(g) is g
     with pytest.raises(ModelError, match="cannot read a linear system from int"):

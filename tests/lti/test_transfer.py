@@ -104,7 +104,8 @@ def test_from_polynomials_table_ii():
     np.testing.assert_allclose(g.simulate(u)[:, 0], signal.lfilter(B222, A222, u), rtol=1e-12, atol=1e-14)
     # non-monic A (DiscretePlant layout) is normalised; trailing zeros are padding
     g2 = TransferFunction.from_polynomials(np.r_[2 * np.array(A222), 0.0], np.r_[2 * np.array(B222), 0.0], dt=0.005)
-    assert g2.den_zinv().tolist() == pytest.approx(A222) and g2.num_zinv().tolist() == pytest.approx(B222)
+    assert (g2.den_zinv().tolist() == pytest.approx(A222)
+            and g2.num_zinv().tolist() == pytest.approx(B222))
     with pytest.raises(ModelError, match="B is all zeros"):
         TransferFunction.from_polynomials(A222, [0.0, 0.0], dt=0.005)
     with pytest.raises(ModelError, match="positive sample time"):

@@ -87,8 +87,9 @@ def test_covariance_goes_through_c2d_and_to_ss(g, draws):
     mc = np.exp(np.array([_upper(np.roots([1.0, t[1], t[2]])) for t in draws]) * dt)
     _check_cov(cov[k], np.c_[mc.real, mc.imag])
     w = np.array([1.0, 10.0])
-    np.testing.assert_allclose(gd.to_ss().frequency_response_covariance(w), gd.frequency_response_covariance(w),
-                               rtol=1e-6, atol=1e-12 * np.abs(gd.frequency_response_covariance(w)).max())
+    np.testing.assert_allclose(gd.to_ss().frequency_response_covariance(w),
+                               gd.frequency_response_covariance(w), rtol=1e-6,
+                               atol=1e-12 * np.abs(gd.frequency_response_covariance(w)).max())
 
 
 def test_state_space_entry_covariance_matches_monte_carlo():

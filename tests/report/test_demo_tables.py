@@ -18,7 +18,8 @@ def _run(module):
 
 
 def _tables(rep):
-    return [(sec.title, item) for sec in rep.sections for kind, item in sec.items if kind == "table"]
+    return [(sec.title, item) for sec in rep.sections
+            for kind, item in sec.items if kind == "table"]
 
 
 def _assert_no_nan_cells(rep):

@@ -55,7 +55,8 @@ def _wide_report(tmp_path) -> Path:
     """A report with what a phone squeezes: a 12-column table, 120-character unbroken words in
     prose and in a caption, a 13-inch figure."""
     rep = Report("layout check")
-    sec = rep.section("wide things", "a name longer than a phone line: " + "plant_parameters_force_factor_" * 4)
+    sec = rep.section("wide things",
+                      "a name longer than a phone line: " + "plant_parameters_force_factor_" * 4)
     sec.table([f"column {i}" for i in range(12)], [[f"{i * j / 7:.5g} µm" for i in range(12)] for j in range(5)],
               caption="twelve columns, " + "a_caption_without_a_break_" * 4)
     fig, ax = plt.subplots(figsize=(13, 3.6))

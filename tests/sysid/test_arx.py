@@ -124,7 +124,8 @@ def test_lagged_sums_route_equals_qr_of_the_regressor(na, nb, nk, n, monkeypatch
     assert np.all(np.abs(G - X.T @ X) <= 4 * BLOCK * 2**-53 * (np.abs(X).T @ np.abs(X)))
     m = arx(u, y, na, nb, nk)
     # an over-parameterised [4 4 2] on this second-order system is near-collinear: QR then
-    assert m.info["method"].startswith("least squares (normal equations") == (m.info["cond"] <= GRAM_COND_LIMIT)
+    assert (m.info["method"].startswith("least squares (normal equations")
+            == (m.info["cond"] <= GRAM_COND_LIMIT))
     names = tuple(f"p{i}" for i in range(na + nb))
     ref = qr_solve(X, names)
     tol = max(m.info["cond"] ** 2 * BLOCK * 2**-53, 1e-12)
@@ -133,7 +134,8 @@ def test_lagged_sums_route_equals_qr_of_the_regressor(na, nb, nk, n, monkeypatch
     assert m.loss == pytest.approx(0.5 * (e @ e) / e.size, rel=1e-9)
     assert m.fit_percent == pytest.approx(100 * (1 - np.linalg.norm(e) / np.linalg.norm(X[:, -1] - X[:, -1].mean())),
                                           rel=1e-9)
-    np.testing.assert_allclose(m.theta_std, np.sqrt(np.diag(ref.cov_unscaled) * (e @ e) / (e.size - na - nb)),
+    np.testing.assert_allclose(m.theta_std,
+                               np.sqrt(np.diag(ref.cov_unscaled) * (e @ e) / (e.size - na - nb)),
                                rtol=1e-8)
 
 

@@ -63,7 +63,8 @@ def test_round_trip_predicts_the_same_torques(fit, saved):
     assert doc["gravity"] == list(fit.chain.gravity_vector)
     # saving the loaded model writes the same content
     m.save(saved.with_name("again.json"))
-    assert json.loads(saved.with_name("again.json").read_text())["content_sha256"] == doc["content_sha256"]
+    assert (json.loads(saved.with_name("again.json").read_text())["content_sha256"]
+            == doc["content_sha256"])
 
 
 def test_result_without_urdf_text_writes_its_chain(fit, tmp_path):

@@ -94,7 +94,8 @@ def test_line_without_excitation_has_infinite_sigma():
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         r = frf(u, y, dt=0.01, nperseg=64)
-    assert any(issubclass(w.category, AccuracyWarning) and "no input power" in str(w.message) for w in caught)
+    assert any(issubclass(w.category, AccuracyWarning) and "no input power" in str(w.message)
+               for w in caught)
     excited = np.isfinite(r.H_std[:, 0, 0])
     assert np.flatnonzero(excited).tolist() == [7, 8, 9, 19, 20, 21]
     assert np.all(np.isinf(r.H_std[~excited])) and np.all(np.isnan(r.H[~excited]))

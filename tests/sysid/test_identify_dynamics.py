@@ -151,7 +151,8 @@ def test_inconsistent_link_is_named_and_constrained_fit(finger):
     np.testing.assert_allclose(rc.structure.base(rc.consistency.standard_parameters), rc.theta[:rc.n_base], atol=1e-12)
     from gripkit.sysid.rigid_body.dynamics import pseudo_inertia
     for k in range(4):
-        assert np.linalg.eigvalsh(pseudo_inertia(rc.consistency.standard_parameters[10 * k:10 * k + 10]))[0] > -1e-12
+        assert np.linalg.eigvalsh(
+            pseudo_inertia(rc.consistency.standard_parameters[10 * k:10 * k + 10]))[0] > -1e-12
 
 
 def test_offset_friction_and_armature(finger):

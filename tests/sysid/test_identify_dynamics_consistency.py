@@ -239,7 +239,8 @@ def test_unconverged_projection_says_so(rod_finger, monkeypatch):
 
     rng = np.random.default_rng(12)
     q, qd, qdd = fourier_states(3_000, 500.0, rng)
-    tau = rod_finger.rnea(q, qd, qdd) + FC * np.sign(qd) + FV * qd + rng.normal(size=q.shape) * NOISE
+    tau = (rod_finger.rnea(q, qd, qdd) + FC * np.sign(qd) + FV * qd
+           + rng.normal(size=q.shape) * NOISE)
     full = identify_dynamics(rod_finger, q, qd, qdd, tau).consistency
     monkeypatch.setattr(dynamics, "project_consistent",
                         functools.partial(dp.project_consistent, max_newton=5))

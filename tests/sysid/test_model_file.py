@@ -36,7 +36,8 @@ def test_round_trip_exact(model, tmp_path):
     assert np.array_equal(p1, p2) and np.array_equal(c1, c2)
     assert (b.inputs, b.outputs, b.input_units, b.output_units) == (("a", "b"), ("c", "d"), ("V", "V"), ("N", "m"))
     assert back.u_offset == (1.0, 0.0) and back.y_offset == (3.0, -1.0) and back.dt == 0.01
-    assert back.structure == "pem-innovation" and back.data_file == "run.csv" and back.data_hash == "ab" * 32
+    assert (back.structure == "pem-innovation" and back.data_file == "run.csv"
+            and back.data_hash == "ab" * 32)
     doc = json.loads(p.read_text())
     assert doc["schema"] == "gripkit.linear-model" and doc["schema_version"] == 2 and "gripkit_version" in doc
 

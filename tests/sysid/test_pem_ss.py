@@ -6,7 +6,8 @@ import pytest
 
 from gripkit.lti import StateSpace
 from gripkit.sysid import n4sid, pem
-from gripkit.sysid.linear.pem_ss import _directions, _gauss_newton_terms, _predict_sensitivity, predict_errors
+from gripkit.sysid.linear.pem_ss import (_directions, _gauss_newton_terms, _predict_sensitivity,
+                                         predict_errors)
 
 from mimo_systems import TRUE_POLES, match_poles, oe_data, two_by_two
 

@@ -20,7 +20,8 @@ def test_search_finds_the_true_structure_by_aic():
     assert r.n_used == 4000 - 13
     c = r.best
     m = arx(u[13 - 3:], y[13 - 3:], 2, 2, 2)  # same equations as the search's
-    assert c.loss == pytest.approx(m.loss, rel=1e-10) and c.fit_percent == pytest.approx(m.fit_percent)
+    assert (c.loss == pytest.approx(m.loss, rel=1e-10)
+            and c.fit_percent == pytest.approx(m.fit_percent))
 
 
 def test_search_by_loss_prefers_the_largest_model():

@@ -211,14 +211,17 @@ def prepare(spec, allow_code: bool = False) -> Prepared:
     fn = resolve(spec.scenario, allow_code)
     model = build_model(spec.model, allow_code)
     declare = getattr(fn, "interface", None)
-    iface = declare(model, dict(spec.settings)) if declare else Interface(settings=dict(spec.settings))
+    iface = (declare(model, dict(spec.settings)) if declare
+             else Interface(settings=dict(spec.settings)))
     scen = spec.scenario if isinstance(spec.scenario, str) else getattr(spec.scenario, "__name__", "scenario")
     if iface.parameters is not None:
         unknown = [n for n in spec.parameters if n not in iface.parameters]
         if unknown:
             on = f" on model {spec.model!r}" if spec.model else ""
-            raise ConfigError(f"[parameters]: {unknown} are not parameters of scenario {scen!r}{on}",
-                              hint=f"its parameters: {', '.join(f'{n} [{u}]' for n, u in iface.parameters.items())}")
+            raise ConfigError(
+                f"[parameters]: {unknown} are not parameters of scenario {scen!r}{on}",
+                hint="its parameters: "
+                     f"{', '.join(f'{n} [{u}]' for n, u in iface.parameters.items())}")
     spec._axes(dict(iface.parameters or {}))  # every value read with its parameter's unit
     if spec.metrics is not None and iface.metrics is not None:
         missing = [m for m in spec.metrics if m not in iface.metrics]

@@ -3,8 +3,8 @@
 ```toml
 [sweep]
 name = "msd-robustness"
-scenario = "step-response"         # a registered scenario ("package.module:function": allow_code only)
-model = "mass-spring-damper"       # a registered model, left out ("package.module:factory": allow_code only)
+scenario = "step-response"         # a registered scenario ("pkg.module:function": allow_code only)
+model = "mass-spring-damper"       # optional registered model ("pkg.module:factory": allow_code)
 samples = 200                      # random draws per grid point (default 1)
 seed = 1
 chunk_size = 50                    # jobs per task (default: chosen from a timing run, >= 0.1 s)
@@ -178,7 +178,8 @@ class SweepSpec:
 
     def to_dict(self) -> dict:
         scen = self.scenario if isinstance(self.scenario, str) else \
-            f"{getattr(self.scenario, '__module__', '?')}:{getattr(self.scenario, '__qualname__', '?')}"
+            (f"{getattr(self.scenario, '__module__', '?')}:"
+             f"{getattr(self.scenario, '__qualname__', '?')}")
         return {"sweep": {"name": self.name, "scenario": scen, "model": self.model,
                           "samples": self.samples, "seed": self.seed, "chunk_size": self.chunk_size},
                 "parameters": self.parameters, "scenario": self.settings,

@@ -1,7 +1,8 @@
 """Parameter sweeps: chunked, checkpointed, resumable, on any executor.
 
 >>> from gripkit.batch import SweepSpec, sweep
->>> spec = SweepSpec.from_dict({"sweep": {"scenario": "step-response", "model": "mass-spring-damper"},
+>>> spec = SweepSpec.from_dict({"sweep": {"scenario": "step-response",
+...                                        "model": "mass-spring-damper"},
 ...                             "parameters": {"k": {"grid": [1.0, 4.0]}}})
 >>> res = sweep(spec, backend="in-process", progress=False)
 >>> res["overshoot_percent"].round(2).tolist()

@@ -51,8 +51,9 @@ def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
                                               "(free-run fit, default) or prediction (one-step fit)."),
                     max_iterations: int = typer.Option(50, "--max-iterations", help="PEM iterations at most "
                                                        "(a warning says when they did not converge)."),
-                    validate: Path = typer.Option(None, "--validate", help="Second record: free-run validation "
-                                                                           "(and order ranking for a range)."),
+                    validate: Path = typer.Option(None, "--validate",
+                                                  help="Second record: free-run validation "
+                                                       "(and order ranking for a range)."),
                     out: Path = ModelOutOpt, report: Path = ReportOpt,
                     fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
                     json_out: bool = JsonOpt):
@@ -153,8 +154,9 @@ def _echo_search(rows: list[dict], criterion: str, focus: str) -> None:
 
 @identify_app.command("frf")
 def identify_frf_cmd(data: Path = DataArg, input: str = InputsOpt, output: str = OutputsOpt,
-                     periods: int = typer.Option(None, "--periods", help="Number of periods of a periodic input "
-                                                                         "(averaging; the first is dropped)."),
+                     periods: int = typer.Option(None, "--periods",
+                                                 help="Number of periods of a periodic input "
+                                                      "(averaging; the first is dropped)."),
                      keep_transient: bool = typer.Option(False, "--keep-transient",
                                                          help="Keep the first period with --periods."),
                      method: str = typer.Option("auto", "--method", help="auto, periodic, h1 or spa."),

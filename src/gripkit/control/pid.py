@@ -203,7 +203,8 @@ class PID:
         y = np.ascontiguousarray(np.asarray(y, dtype=np.float64))
         if y.ndim != 1:
             raise ConfigError(f"PID.run: expected 1-D sequences, found shape {y.shape}")
-        f = np.zeros_like(y) if ff is None else np.ascontiguousarray(np.broadcast_to(np.asarray(ff, float), y.shape))
+        f = (np.zeros_like(y) if ff is None
+             else np.ascontiguousarray(np.broadcast_to(np.asarray(ff, float), y.shape)))
         if not (np.isfinite(r).all() and np.isfinite(y).all() and np.isfinite(f).all()):
             raise ConfigError("PID.run: r, y or ff contains NaN or inf")
         u = np.empty_like(y)

@@ -15,7 +15,8 @@ of the multibody model. The actuator's equation J v̇ = τ_m − h − F(v) is l
 H(s) = a/(s + a) on both sides, which removes the need for an acceleration signal
 (H[s·v] = a(v − H[v])):
 
-    y = H[τ_m − h] − J·a·(v − H[v]) = s·H[F_table(v)] + o·H[sign(v)] = φᵀθ,   φ = (H[F_table], H[sign]).
+    y = H[τ_m − h] − J·a·(v − H[v]) = s·H[F_table(v)] + o·H[sign(v)] = φᵀθ,
+    φ = (H[F_table], H[sign]).
 
 H is discretised exactly for a held input: H[x]ₙ = H[x]ₙ₋₁ + α(xₙ − H[x]ₙ₋₁), α = 1 − e^(−a·T_s);
 H[v̇] is the difference of the filtered velocity over one sample.
@@ -347,7 +348,8 @@ class FrictionAdapter:
 
     def reset(self, scale: float = 1.0, offset: float = 0.0) -> None:
         """Start again from ``scale``, ``offset`` with covariance p0·I."""
-        self.theta, self.P, self.filt, self.sig2 = self.settings.initial_state(self.m, scale, offset)
+        self.theta, self.P, self.filt, self.sig2 = self.settings.initial_state(
+            self.m, scale, offset)
         self.t = 0.0
 
     def convergence_time(self, tol: float = 0.05) -> float:

@@ -101,7 +101,7 @@ def fuse(estimates, variances):
 
     Examples
     --------
-    >>> print(f"{fuse([1.0, 1.2], [0.01309, 0.00459])[1]:.7f}")  # Table I: theoretical variance of ε_N12
+    >>> print(f"{fuse([1.0, 1.2], [0.01309, 0.00459])[1]:.7f}")  # Table I: theoretical var(ε_N12)
     0.0033984
     """
     x = _stack(estimates, "estimates")

@@ -70,7 +70,8 @@ def _plan(source: str, variables: dict, wanted, limit: float) -> dict[str, list[
     keep = wanted.select(source, list(columns)) if wanted is not None else list(columns)
     if not keep:
         raise DataError(f"{source}: no numeric vector or matrix variables to read "
-                        f"(found {', '.join(f'{v} ({lay})' for v, lay in layouts.items()) or 'none'})",
+                        "(found "
+                        f"{', '.join(f'{v} ({lay})' for v, lay in layouts.items()) or 'none'})",
                         hint="save the signals as numeric variables, one per channel")
     plan: dict[str, list[str]] = {}
     for c in keep:

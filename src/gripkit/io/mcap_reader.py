@@ -19,7 +19,8 @@ from .table import check_size
 
 __all__ = ["read_mcap", "parse_column"]
 
-_COL = re.compile(r"^(?:(?P<alias>[A-Za-z_][\w]*)=)?(?P<topic>/[^:]*):(?P<field>[A-Za-z_][\w.\[\]]*)$")
+_COL = re.compile(r"^(?:(?P<alias>[A-Za-z_][\w]*)=)?"
+                  r"(?P<topic>/[^:]*):(?P<field>[A-Za-z_][\w.\[\]]*)$")
 _PART = re.compile(r"^([A-Za-z_]\w*)((?:\[\d+\])*)$")
 _MAGIC = b"\x89MCAP0\r\n"  # the MCAP specification's leading magic bytes
 
@@ -48,7 +49,9 @@ def _get(msg, path: list, spec: str) -> float:
             v = v[p] if isinstance(p, int) else getattr(v, p)
         except (AttributeError, IndexError, TypeError):
             raise DataError(f"MCAP column {spec!r}: the message has no field {p!r} "
-                            f"(fields: {', '.join(getattr(v, '__slots__', []) or dir(v)[:10])})") from None
+                            "(fields: "
+                            f"{', '.join(getattr(v, '__slots__', []) or dir(v)[:10])})"
+                            ) from None
     try:
         return float(v)
     except (TypeError, ValueError):

@@ -136,9 +136,9 @@ def check_size(source: str, what: str, rows: int, ncols: int, limit: float,
     raise DataError(
         f"{source}: {what} declares {rows} rows × {ncols} columns, about {need / 1e9:.3g} GB "
         f"{each}, beyond the load limit of {limit / 1e9:.3g} GB; nothing was read",
-        hint=f"read fewer columns (columns=, CLI: the command's column options), or raise the "
-             f"limit with max_bytes= or the environment variable GRIPKIT_MAX_LOAD_BYTES (bytes) "
-             f"if the machine has the memory")
+        hint="read fewer columns (columns=, CLI: the command's column options), or raise the "
+             "limit with max_bytes= or the environment variable GRIPKIT_MAX_LOAD_BYTES (bytes) "
+             "if the machine has the memory")
 
 
 def check_fs(fs) -> None:
@@ -274,7 +274,8 @@ def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
         name, unit = split_header(str(header))
         if name in cols:
             raise DataError(f"{source}: column {name!r} appears twice")
-        cols[name] = (values, units.get(name) or unit or meta_units.get(header) or meta_units.get(name))
+        cols[name] = (values,
+                      units.get(name) or unit or meta_units.get(header) or meta_units.get(name))
     if not cols:
         raise DataError(f"{source}: the file holds no columns")
     available = ", ".join(cols)

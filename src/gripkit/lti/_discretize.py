@@ -65,7 +65,8 @@ def c2d_matrices(A, B, C, D, dt: float, method: str = "zoh", prewarp=None):
     Examples
     --------
     >>> import numpy as np
-    >>> Phi, Gam, _, _ = c2d_matrices(np.array([[-1.0]]), np.array([[1.0]]), np.eye(1), np.zeros((1, 1)), 0.1)
+    >>> Phi, Gam, _, _ = c2d_matrices(np.array([[-1.0]]), np.array([[1.0]]), np.eye(1),
+    ...                               np.zeros((1, 1)), 0.1)
     >>> round(float(Phi[0, 0]), 6), round(float(Gam[0, 0]), 6)      # e^{-0.1}, 1 − e^{-0.1}
     (0.904837, 0.095163)
     """

@@ -46,7 +46,8 @@ def affine_row(M, i, x, N, u, k):  # pragma: no cover - compiled
     Examples
     --------
     >>> import numpy as np
-    >>> affine_row(np.array([[1.0, 2.0]]), 0, np.array([3.0, 4.0]), np.array([[10.0]]), np.array([[0.5]]), 0)
+    >>> affine_row(np.array([[1.0, 2.0]]), 0, np.array([3.0, 4.0]), np.array([[10.0]]),
+    ...            np.array([[0.5]]), 0)
     16.0
     """
     acc = 0.0

@@ -193,7 +193,8 @@ class LinearSystem:
         Examples
         --------
         >>> from gripkit.lti import TransferFunction
-        >>> g = TransferFunction.from_polynomials([1, -1.8732, 0.8996], [0, 0, 0.1950, -0.2276], dt=0.005)
+        >>> g = TransferFunction.from_polynomials([1, -1.8732, 0.8996], [0, 0, 0.1950, -0.2276],
+        ...                                       dt=0.005)
         >>> g.is_minimum_phase()     # zero at z = 1.167 (000_8f66dcc7ab06470c.txt §V-F)
         False
         """
@@ -474,7 +475,8 @@ class LinearSystem:
         Examples
         --------
         >>> from gripkit.lti import TransferFunction
-        >>> TransferFunction([1.0], [1.0, 1.0]).series(TransferFunction([3.0], [1.0, 3.0])).dc_gain().tolist()
+        >>> TransferFunction([1.0], [1.0, 1.0]).series(
+        ...     TransferFunction([3.0], [1.0, 3.0])).dc_gain().tolist()
         [[1.0]]
         """
         return series(self, other)
@@ -485,7 +487,8 @@ class LinearSystem:
         Examples
         --------
         >>> from gripkit.lti import TransferFunction
-        >>> TransferFunction([1.0], [1.0, 1.0]).parallel(TransferFunction([3.0], [1.0, 3.0])).dc_gain().tolist()
+        >>> TransferFunction([1.0], [1.0, 1.0]).parallel(
+        ...     TransferFunction([3.0], [1.0, 3.0])).dc_gain().tolist()
         [[2.0]]
         """
         return parallel(self, other)
@@ -566,7 +569,8 @@ class LinearSystem:
         Examples
         --------
         >>> from gripkit.lti import LinearSystem
-        >>> LinearSystem.from_dict({"type": "StateSpace", "A": [[-1.0]], "B": [[1.0]], "C": [[2.0]]}).dc_gain().tolist()
+        >>> LinearSystem.from_dict({"type": "StateSpace", "A": [[-1.0]], "B": [[1.0]],
+        ...                         "C": [[2.0]]}).dc_gain().tolist()
         [[2.0]]
         """
         if not isinstance(d, dict) or d.get("type") not in ("StateSpace", "TransferFunction"):
@@ -779,7 +783,8 @@ class StateSpace(LinearSystem):
         Examples
         --------
         >>> from gripkit.lti import StateSpace
-        >>> StateSpace([[-1.0, 0.0], [0.0, -3.0]], [[1.0], [1.0]], [[1.0, 1.0]]).poles().real.tolist()
+        >>> StateSpace([[-1.0, 0.0], [0.0, -3.0]], [[1.0], [1.0]],
+        ...            [[1.0, 1.0]]).poles().real.tolist()
         [-1.0, -3.0]
         """
         return np.linalg.eigvals(self.A).astype(complex) if self.n_states else np.zeros(0, dtype=complex)
@@ -917,7 +922,8 @@ class StateSpace(LinearSystem):
         Examples
         --------
         >>> from gripkit.lti import StateSpace
-        >>> StateSpace([[-1.0]], [[1.0]], [[1.0]], inputs="V", outputs="x").to_control().input_labels
+        >>> StateSpace([[-1.0]], [[1.0]], [[1.0]], inputs="V",
+        ...            outputs="x").to_control().input_labels
         ['V']
         """
         ct = control_module()
@@ -1076,7 +1082,8 @@ class TransferFunction(LinearSystem):
         Examples
         --------
         >>> from gripkit.lti import TransferFunction
-        >>> g = TransferFunction.from_polynomials([1, -1.8732, 0.8996], [0, 0, 0.1950, -0.2276], dt=0.005)
+        >>> g = TransferFunction.from_polynomials([1, -1.8732, 0.8996], [0, 0, 0.1950, -0.2276],
+        ...                                       dt=0.005)
         >>> g.relative_degree(), round(float(g.dc_gain()[0, 0]), 4)
         (2, -1.2348)
         """
@@ -1260,7 +1267,8 @@ class TransferFunction(LinearSystem):
         Examples
         --------
         >>> from gripkit.lti import TransferFunction
-        >>> g = TransferFunction.from_polynomials([1, -0.5], [0, 0, 0, 1.0], dt=1.0, covariance=[[1e-4, 0], [0, 0]])
+        >>> g = TransferFunction.from_polynomials([1, -0.5], [0, 0, 0, 1.0], dt=1.0,
+        ...                                       covariance=[[1e-4, 0], [0, 0]])
         >>> p, cov = g.pole_covariance()
         >>> p.real.tolist(), cov[:, 0, 0].round(12).tolist()
         ([0.5, 0.0, 0.0], [0.0001, 0.0, 0.0])
@@ -1368,7 +1376,8 @@ class TransferFunction(LinearSystem):
         Examples
         --------
         >>> from gripkit.lti import TransferFunction
-        >>> TransferFunction([0.1950, -0.2276], [1.0, -1.8732, 0.8996], dt=0.005).dc_gain().round(4).tolist()
+        >>> TransferFunction([0.1950, -0.2276], [1.0, -1.8732, 0.8996],
+        ...                  dt=0.005).dc_gain().round(4).tolist()
         [[-1.2348]]
         """
         s0 = np.array([1.0 if self.is_discrete else 0.0])
@@ -1426,7 +1435,8 @@ class TransferFunction(LinearSystem):
         Examples
         --------
         >>> from gripkit.lti import TransferFunction
-        >>> TransferFunction.from_polynomials([1, -0.5], [0, 1.0], dt=1.0).simulate([1.0, 0, 0])[:, 0].tolist()
+        >>> TransferFunction.from_polynomials([1, -0.5], [0, 1.0],
+        ...                                   dt=1.0).simulate([1.0, 0, 0])[:, 0].tolist()
         [0.0, 1.0, 0.5]
         """
         if not self.is_discrete:

@@ -5,8 +5,9 @@ The DLR/HIT Hand II motor (maxon EC 20 flat) was characterised on a test bed in
 0 (no voltage) to 4096 (continuous voltage)"; the sign selects the direction) and the shaft speed
 n in rpm, the thesis's model (eq 5.10 = eqs 5.7 + 5.8) is
 
-    τ(u, n) = c·u + b(|u|)·n,        c = 1.43·10⁻⁴ Ncm per PWM count              (5.7)
-                                     b(|u|) = 1.215·10⁻⁸ Ncm/(rpm·PWM)·|u| − 7.711·10⁻⁵ Ncm/rpm  (5.8)
+    τ(u, n) = c·u + b(|u|)·n,                                                     (5.7)
+    c = 1.43·10⁻⁴ Ncm per PWM count,
+    b(|u|) = 1.215·10⁻⁸ Ncm/(rpm·PWM)·|u| − 7.711·10⁻⁵ Ncm/rpm                    (5.8)
 
 with Appendix E's guard: if |c·u| < |b(|u|)·n| the torque is zero (the speed term may never
 overturn the PWM term). The slopes b printed in §5.4.2 for PWM 2000/2500/3000/3500 are the

@@ -157,7 +157,8 @@ class JointChain(Dynamics):
         for k in range(n):
             check_inertia(float(mass[k]), inertia[k], f"link {link_names[k]!r}")
         G = np.eye(n) if coupling is None else np.asarray(coupling, dtype=np.float64)
-        if G.ndim != 2 or G.shape[0] != n or G.shape[1] > n or np.linalg.matrix_rank(G) < G.shape[1]:
+        if (G.ndim != 2 or G.shape[0] != n or G.shape[1] > n
+                or np.linalg.matrix_rank(G) < G.shape[1]):
             raise ModelError(f"coupling: expected a full-column-rank ({n}, m) matrix, found shape {G.shape}")
         m = G.shape[1]
         q0 = np.zeros(n) if offset is None else np.asarray(offset, dtype=np.float64).reshape(n)

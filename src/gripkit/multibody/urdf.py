@@ -546,7 +546,8 @@ def to_urdf(chain, path, *, name: str | None = None, base_link: str = "base",
     inertia, or a coupling that mixes actuators (the file's coordinates are then its independent
     joints q_u = Γ_u p + q₀_u, and τ_p = Γ_uᵀ τ_u).
     """
-    X, axes, types, mass, com, inertia, G, q0, names, link_names, tool, arm, limits = _describe(chain)
+    (X, axes, types, mass, com, inertia, G, q0, names, link_names, tool, arm,
+     limits) = _describe(chain)
     n, m = G.shape
     left_out = []
     if np.any(np.asarray(arm) != 0):

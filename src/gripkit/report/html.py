@@ -121,16 +121,20 @@ def _row(cells) -> dict:
 
 
 _CSS = """
-body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;max-width:1100px;margin:2em auto;
+body{font-family:system-ui,-apple-system,Segoe UI,Roboto,sans-serif;max-width:1100px;
+margin:2em auto;
 padding:0 1em;color:#222;line-height:1.45;overflow-wrap:break-word}
-h1{border-bottom:2px solid #345;padding-bottom:.2em}h2{color:#234;margin-top:2em;border-bottom:1px solid #ccd}
+h1{border-bottom:2px solid #345;padding-bottom:.2em}
+h2{color:#234;margin-top:2em;border-bottom:1px solid #ccd}
 .tbl{overflow-x:auto}table{border-collapse:collapse;margin:1em 0;font-size:.92em}
-th,td{border:1px solid #ccd;padding:.25em .6em;text-align:right;vertical-align:top}th{background:#eef2f7}
+th,td{border:1px solid #ccd;padding:.25em .6em;text-align:right;vertical-align:top}
+th{background:#eef2f7}
 td.txt,th:first-child,td:first-child{text-align:left}td.na{color:#888;font-style:italic}
 tr.bad td{background:#fde8e6}tr.bad td:first-child{font-weight:600;color:#a31515}
 figure{margin:1.2em 0}figure img{max-width:100%;height:auto;border:1px solid #dde}
 figcaption,.cap{font-size:.9em;color:#555}nav ul{columns:2}.meta{color:#666;font-size:.9em}
-@media (max-width:700px){body{margin:1em auto;font-size:.95em}nav ul{columns:1}table{font-size:.85em}
+@media (max-width:700px){body{margin:1em auto;font-size:.95em}nav ul{columns:1}
+table{font-size:.85em}
 td.txt{min-width:8em}}
 """
 

@@ -110,7 +110,7 @@ if TYPE_CHECKING:  # static readers see the same names, imported eagerly
     from .linear.validation import residual_tests as residual_tests
     from .linear.validation import validate as validate
     from .physical.greybox import GreyboxResult as GreyboxResult
-    from .physical.greybox import fit as fit_greybox
+    from .physical.greybox import fit as fit_greybox  # noqa: F401  (a lazy export: _LAZY)
     from .physical.bouc_wen import identify_bouc_wen as identify_bouc_wen
     from .physical.modal import free_vibration as free_vibration
     from .rigid_body.friction import constant_velocity_friction as constant_velocity_friction

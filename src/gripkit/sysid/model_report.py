@@ -384,9 +384,11 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=(),
         for add_section in sections:
             add_section(rep)
         if getattr(model, "singular_values", None) is not None:
-            rep.section("Subspace singular values", "Singular values of the weighted subspace matrix; the order is "
-                        "where they drop.").figure(singular_value_figure(np.asarray(model.singular_values), ss.n_states),
-                                                   "singular values", name="sv")
+            rep.section("Subspace singular values",
+                        "Singular values of the weighted subspace matrix; the order is "
+                        "where they drop.").figure(
+                singular_value_figure(np.asarray(model.singular_values), ss.n_states),
+                "singular values", name="sv")
     for w in caught:  # the caller sees them too (the CLI prints them and lists them in --json)
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     lines = caught_lines + [f"{w.category.__name__}: {w.message}" for w in caught]

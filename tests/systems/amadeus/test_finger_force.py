@@ -67,8 +67,8 @@ def test_closed_loop_poles_as_designed_and_zero_kept(rst):
     assert np.min(np.abs(zeros - 1.1672)) < 1e-3
     assert np.min(np.abs(rst.closed_loop_poles() - 1.1672)) > 0.2  # no pole cancels it
     G = PLANT.to_control()
-    Cfb = control.tf(np.r_[rst.S, np.zeros(rst.R.size - rst.S.size)] if rst.S.size < rst.R.size else rst.S,
-                     rst.R, PLANT.dt)
+    Cfb = control.tf(np.r_[rst.S, np.zeros(rst.R.size - rst.S.size)] if rst.S.size < rst.R.size
+                     else rst.S, rst.R, PLANT.dt)
     cl = control.feedback(G * Cfb, 1)
     p_ref = np.sort_complex(np.asarray(control.poles(cl)))
     p_ref = p_ref[np.abs(p_ref) > 1e-9]
@@ -196,7 +196,8 @@ def test_force_scale_default_is_derived_from_fig2c_peak_over_the_valve_span():
 def test_force_scale_is_user_settable_and_scales_b_only():
     ref = zoo.build("amadeus-finger-force")
     m = zoo.build("amadeus-finger-force", force_scale=0.04)
-    assert m.force_scale == 0.04 and m.parameters["force_scale"].source.startswith("set by the user")
+    assert (m.force_scale == 0.04
+            and m.parameters["force_scale"].source.startswith("set by the user"))
     np.testing.assert_allclose(m.model.B, ref.model.B * 0.04 / ref.force_scale, rtol=1e-12)
     np.testing.assert_array_equal(m.model.A, ref.model.A)
     hand = zoo.build("amadeus-hand", force_scale=0.04)

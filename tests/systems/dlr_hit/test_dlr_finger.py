@@ -11,7 +11,8 @@ from gripkit.errors import ModelError, SimulationError
 from gripkit.params import ParameterSet
 from gripkit.systems.dlr_hit.finger import ACTUATORS, DLRFinger
 from gripkit.systems.dlr_hit.hand import hand
-from gripkit.systems.dlr_hit.parameters import FINGERS, finger, thesis_finger_parameters, finger_tables
+from gripkit.systems.dlr_hit.parameters import (FINGERS, finger, thesis_finger_parameters,
+                                                finger_tables)
 
 DEG = math.pi / 180
 # start configurations at one end of the travel of each actuator (joint angles abd, flex, prox)
@@ -63,7 +64,8 @@ def test_velocity_plateaus_of_figs_7_3_to_7_5(fng, actuator):
     plateaus = []
     for pwm in (2000, 3000, 4000):
         vs = fng.steady_velocity(actuator, pwm) / DEG
-        assert (run(f0, actuator, pwm)[f"{actuator}_vel"] / DEG).max() == pytest.approx(vs, rel=0.005)
+        assert (run(f0, actuator, pwm)[f"{actuator}_vel"] / DEG).max() == pytest.approx(
+            vs, rel=0.005)
         plateaus.append((run(fng, actuator, pwm)[f"{actuator}_vel"] / DEG).max())
     assert plateaus[0] < plateaus[1] < plateaus[2]
     assert 80 < plateaus[0] and plateaus[2] < (350 if actuator == "distal" else 250)

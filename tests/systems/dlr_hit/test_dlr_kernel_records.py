@@ -17,7 +17,8 @@ from gripkit.errors import ConsistencyWarning
 from gripkit.systems.dlr_hit.friction_adaptation import tracking_reference
 from gripkit.systems.dlr_hit.friction_drift import stiction_step, warmup_drift
 from gripkit.systems.dlr_hit.hand import hand
-from gripkit.systems.dlr_hit.impedance import LOOP_ADAPTATION, ImpedanceController, Wall, simulate_impedance
+from gripkit.systems.dlr_hit.impedance import (LOOP_ADAPTATION, ImpedanceController, Wall,
+                                               simulate_impedance)
 from gripkit.systems.dlr_hit.parameters import finger
 
 DEG = math.pi / 180
@@ -83,7 +84,8 @@ def test_parameter_index_names_every_parameter_and_compiles_to_a_constant():
 
     from gripkit.systems.dlr_hit.finger import FINGER_PARAMETERS, IX
 
-    assert list(IX._fields) == list(FINGER_PARAMETERS) and list(IX) == list(range(len(FINGER_PARAMETERS)))
+    assert (list(IX._fields) == list(FINGER_PARAMETERS)
+            and list(IX) == list(range(len(FINGER_PARAMETERS))))
 
     @numba.njit
     def stiction(th, k):

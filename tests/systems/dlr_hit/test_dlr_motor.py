@@ -29,7 +29,8 @@ def test_slopes_of_section_5_4_2():
         assert MOTOR.slope(pwm) * RPM / NCM == pytest.approx(stated, rel=0.05)
         # the torque actually falls with that slope
         w = 1500 * RPM
-        assert (MOTOR.torque(pwm, w) - MOTOR.torque(pwm, 0.0)) / 1500 / NCM == pytest.approx(MOTOR.slope(pwm) * RPM / NCM)
+        assert (MOTOR.torque(pwm, w) - MOTOR.torque(pwm, 0.0)) / 1500 / NCM == pytest.approx(
+            MOTOR.slope(pwm) * RPM / NCM)
 
 
 #: eq 5.8 against the four slopes printed under Fig. 5.6 (§5.4.2, Ncm/rpm): (eq 5.8 value, relative
@@ -48,7 +49,8 @@ def test_fig_5_6_slopes_against_eq_5_8_and_the_consistency_finding(pwm):
     b = float(MOTOR.slope(pwm)) * RPM / NCM
     assert b == pytest.approx(1.215e-8 * pwm - 7.711e-5, rel=1e-12) == pytest.approx(eq58, rel=1e-12)
     assert abs(b - stated) / abs(stated) == pytest.approx(rel, abs=5e-5)
-    f = {x.check: x for x in zoo.build("dlr-hit-finger").consistency_checks()}[f"eq5.8-slope-pwm{pwm}"]
+    f = {x.check: x
+         for x in zoo.build("dlr-hit-finger").consistency_checks()}[f"eq5.8-slope-pwm{pwm}"]
     assert f.consistent and f.tolerance == 0.06
     assert f.computed == pytest.approx(b, rel=1e-12) and f.stated == stated
     assert f.rel_error == pytest.approx(rel, abs=5e-5)

@@ -134,4 +134,5 @@ def test_eq18_coupled():
     y = cpl.simulate({"V_in": u}, dt=1 / FS)
     assert y["V_out"][-1] == pytest.approx(dc[3], rel=1e-3)
     f = check(cpl).find("readout-sensitivity-unit")
-    assert not f.consistent and f.stated == pytest.approx(2.8) and f.computed == pytest.approx(2.8e-6)
+    assert (not f.consistent and f.stated == pytest.approx(2.8)
+            and f.computed == pytest.approx(2.8e-6))

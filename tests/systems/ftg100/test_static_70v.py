@@ -215,7 +215,8 @@ def test_zoo_check_lists_the_70V_findings(capsys):
     out, _ = capsys.readouterr()
     assert code == 3
     f = {x["check"]: x for x in json.loads(out)["findings"]}
-    assert not f["static-70V-eq5"]["consistent"] and f["static-70V-eq5"]["computed"] == pytest.approx(43.46e-6, rel=1e-3)
+    assert (not f["static-70V-eq5"]["consistent"]
+            and f["static-70V-eq5"]["computed"] == pytest.approx(43.46e-6, rel=1e-3))
     assert not f["static-70V"]["consistent"]
     assert f["static-70V"]["computed"] == pytest.approx(43.46e-6, rel=1e-3)
     assert f["static-70V"]["stated"] == 20e-6

@@ -23,7 +23,8 @@ SCRIPT = textwrap.dedent(f"""
     from gripkit.systems.tsfm.grasp_gpu import cuda_available
     assert cuda_available()            # the simulator stands in for a device
     res = tsfm_grasp_batch(backend="cuda", duration={DUR}, **{JOBS!r})
-    print(json.dumps({{k: [None if v != v else v for v in map(float, res[k])] for k in {list(METRICS)!r}}}))
+    print(json.dumps({{k: [None if v != v else v for v in map(float, res[k])]
+                      for k in {list(METRICS)!r}}}))
 """)
 
 

@@ -11,7 +11,8 @@ from gripkit import Trajectory
 from gripkit.cli import main
 from gripkit.errors import DataError
 from gripkit.io import save
-from gripkit.sysid.physical.bouc_wen import identify_actuator_dynamics, identify_bouc_wen, loop_error
+from gripkit.sysid.physical.bouc_wen import (identify_actuator_dynamics, identify_bouc_wen,
+                                             loop_error)
 from gripkit.sysid.physical.modal import free_vibration
 from gripkit.systems.tsfm import parameters as z
 from gripkit.systems.tsfm.end_effector import sensor_parameters

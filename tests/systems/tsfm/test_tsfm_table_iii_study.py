@@ -11,7 +11,8 @@ import pytest
 from gripkit.errors import DataError
 from gripkit.systems.tsfm import parameters as z
 from gripkit.systems.tsfm.end_effector import lever_coefficients
-from gripkit.systems.tsfm.stiffness_study import BLOCK, INSTRUMENT_LAG, MEASUREMENT_NOISE, table_iii_study
+from gripkit.systems.tsfm.stiffness_study import (BLOCK, INSTRUMENT_LAG, MEASUREMENT_NOISE,
+                                                  table_iii_study)
 
 GRIP = 200e-6  # N, the study's default squeeze force
 

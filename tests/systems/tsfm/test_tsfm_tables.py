@@ -85,7 +85,8 @@ def test_every_table_ii_value_of_both_fingers():
             assert z.TABLE_II[side][name] == pytest.approx(value, rel=1e-12), (side, name)
             assert printed.value(name) == pytest.approx(value, rel=1e-12), (side, name)
             src = printed[name].source
-            assert "001_0b92a7da96e7aa46.txt" in src and "Table II" in src and f"{side} finger" in src, (side, name, src)
+            assert ("001_0b92a7da96e7aa46.txt" in src and "Table II" in src
+                    and f"{side} finger" in src), (side, name, src)
 
 
 def test_right_finger_values_cited_row_by_row():
@@ -103,7 +104,8 @@ def test_right_finger_values_cited_row_by_row():
             assert f"{value:g}" in right.parameters[name].source
         else:
             assert right.parameters.value(name) == pytest.approx(value, rel=1e-12), name
-            assert "Table II" in right.parameters[name].source and "right finger" in right.parameters[name].source
+            assert ("Table II" in right.parameters[name].source
+                    and "right finger" in right.parameters[name].source)
 
 
 def test_right_finger_in_zoo_show(capsys):
@@ -112,7 +114,8 @@ def test_right_finger_in_zoo_show(capsys):
     params = {p["name"]: p for p in json.loads(capsys.readouterr().out)["parameters"]}
     for name in ("d_p", "s_p", "lam", "beta", "gamma", "a", "b", "k_s"):
         assert params[name]["value"] == pytest.approx(RIGHT_FINGER[name], rel=1e-12), name
-        assert "Table II" in params[name]["source"] and "right finger" in params[name]["source"], name
+        assert ("Table II" in params[name]["source"]
+                and "right finger" in params[name]["source"]), name
 
 
 def test_table_iii_as_printed():

@@ -6,7 +6,8 @@
 >>> u = rng.standard_normal(2000)
 >>> y = np.zeros(2000)
 >>> for t in range(3, 2000):  # Table II, [2 2 2], S1, filtered data
-...     y[t] = 1.8732*y[t-1] - 0.8996*y[t-2] + 0.1950*u[t-2] - 0.2276*u[t-3] + 0.001*rng.standard_normal()
+...     y[t] = (1.8732*y[t-1] - 0.8996*y[t-2] + 0.1950*u[t-2] - 0.2276*u[t-3]
+...             + 0.001*rng.standard_normal())
 >>> m = arx(u, y, 2, 2, 2)
 >>> np.round(m.A, 3).tolist(), np.round(m.B, 3).tolist()
 ([1.0, -1.873, 0.9], [0.0, 0.0, 0.195, -0.228])

@@ -120,7 +120,8 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     report(f"{method}: {d.u.shape[0]} samples, {len(d.inputs)} input(s), {len(d.outputs)} output(s), horizon {k}")
     fac = subspace_factor(d.u, d.y, horizon=k, method=method)
     extras: dict = {}
-    build = lambda n: from_factor(fac, n, dt=d.dt, feedthrough=feedthrough, signals=d.signals)  # noqa: E731
+    build = lambda n: from_factor(  # noqa: E731
+        fac, n, dt=d.dt, feedthrough=feedthrough, signals=d.signals)
     if rng is None:
         n = select_order(fac.s, min(n_hi, fac.s.size - 1))
         model = build(n)

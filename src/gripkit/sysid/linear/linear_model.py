@@ -554,7 +554,8 @@ def read_linear_model(path) -> tuple[dict, LinearModel, str]:
     >>> import tempfile, os
     >>> from gripkit.lti import StateSpace
     >>> from gripkit.sysid import LinearModel, load_model  # reads any model file
-    >>> m = LinearModel(StateSpace([[0.5]], [[1.0]], [[1.0]], dt=0.1, inputs="V", outputs="x"), "n4sid")
+    >>> m = LinearModel(StateSpace([[0.5]], [[1.0]], [[1.0]], dt=0.1, inputs="V", outputs="x"),
+    ...                 "n4sid")
     >>> p = os.path.join(tempfile.mkdtemp(), "m.json"); m.save(p)
     >>> load_model(p).system.A.tolist(), load_model(p).inputs
     ([[0.5]], ('V',))

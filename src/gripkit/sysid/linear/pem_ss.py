@@ -19,7 +19,8 @@ directions), for each direction θ_q with matrix tangents (dA, dB, dC, dD, dK)::
 
     ∂ŷ[t] = C s[t] + dC x[t] + dD u[t],
     s[t+1] = A s[t] + dA x[t] + dB u[t] + dK e[t] − K ∂ŷ[t]
-           = (A − KC) s[t] + (dA − K dC) x[t] + (dB − K dD) u[t] + dK e[t],   s[0] = 0 (e_i for x0_i).
+           = (A − KC) s[t] + (dA − K dC) x[t] + (dB − K dD) u[t] + dK e[t],
+    s[0] = 0 (e_i for x0_i).
 
 Levenberg-Marquardt steps re-centre the coordinates after every accepted step and reject any step
 that makes A (or the predictor A − KC) unstable, so stability is kept. The covariance of the
@@ -333,7 +334,8 @@ def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovatio
     """
     if form not in PEM_FORMS:
         raise DataError(f"form: expected 'oe' or 'innovation', found {form!r}")
-    if not isinstance(model, LinearModel) or not isinstance(model.system, StateSpace) or not model.system.is_discrete:
+    if (not isinstance(model, LinearModel) or not isinstance(model.system, StateSpace)
+            or not model.system.is_discrete):
         raise DataError("model: expected a discrete state-space LinearModel (e.g. from gripkit.sysid.n4sid)")
     ss = model.system
     u, y = _pem_data(model, data, u, y)

@@ -43,7 +43,8 @@ from ...errors import DataError, IdentificationError, StabilityWarning, emit_war
 from ...lti import StateSpace
 from .blocked_gram import add_rows, carried_states, carry, row_product, start_sums
 from ..checks import check_dt, io_records
-from .linear_model import LinearModel, as_io_matrix, fit_per_output, free_run, observability_regressor
+from .linear_model import (LinearModel, as_io_matrix, fit_per_output, free_run,
+                           observability_regressor)
 from ..regression import qr_r
 from .validation import records_fit
 

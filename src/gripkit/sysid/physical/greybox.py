@@ -105,7 +105,8 @@ class GreyboxResult:
     def summary(self) -> str:
         lines = [f"grey-box fit: {self.n_samples} samples, {len(self.free)} free parameters, "
                  f"{self.nfev} simulations, cost {self.cost:.6g}, "
-                 f"fit {', '.join(f'{o} {f:.2f} %' for o, f in zip(self.outputs, self.fit_percent))}"]
+                 "fit "
+                 f"{', '.join(f'{o} {f:.2f} %' for o, f in zip(self.outputs, self.fit_percent))}"]
         for name in self.free:
             lines.append("  " + self.parameters[name].display())
         lines.append("  identifiability: " + str(self.identifiability))
@@ -224,7 +225,8 @@ def _fit_columns(model, data: Trajectory, *, inputs, outputs, n_free: int, burn_
     if burn_in < 0:
         raise DataError(f"burn_in: expected a number of samples >= 0, found {burn_in}")
     data.require_samples(burn_in + 2 * n_free + 1, f"fitting {n_free} parameters after {burn_in} burn-in samples")
-    w = np.asarray(output_scale, dtype=np.float64) if output_scale is not None else y[burn_in:].std(axis=0)
+    w = (np.asarray(output_scale, dtype=np.float64) if output_scale is not None
+         else y[burn_in:].std(axis=0))
     if w.shape != (y.shape[1],) or not np.all(w > 0):
         raise DataError(f"output scale: expected {y.shape[1]} positive weights (a measured output may be "
                         f"constant), found {w}", hint="pass output_scale=[...] explicitly")
@@ -332,7 +334,8 @@ def _weak_directions(sv, Vt, sigma2: float, rcond: float, max_rel_std: float, fr
     parameters loading a weak direction (> 0.1 of its largest component), and their name groups."""
     with np.errstate(divide="ignore"):
         rel_std_dir = np.sqrt(sigma2) / sv
-    weak = (sv <= rcond * sv[0]) | (rel_std_dir > max_rel_std) if sv[0] > 0 else np.ones_like(sv, dtype=bool)
+    weak = ((sv <= rcond * sv[0]) | (rel_std_dir > max_rel_std) if sv[0] > 0
+            else np.ones_like(sv, dtype=bool))
     groups = []
     bad_params = np.zeros(len(free), dtype=bool)
     for k in np.flatnonzero(weak):

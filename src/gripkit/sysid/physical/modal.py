@@ -341,7 +341,9 @@ def free_vibration(y, *, dt: float, start: int | None = None, end: int | None = 
         if estimate is not None:
             methods[name] = estimate
     # damped-sine least squares, started from the best of the above
-    zeta0 = methods.get("hilbert", methods.get("log_decrement", methods.get("half_power", {}))).get("damping_ratio", 0.01)
+    zeta0 = methods.get("hilbert",
+                        methods.get("log_decrement", methods.get("half_power", {}))
+                        ).get("damping_ratio", 0.01)
     sine = _fit_damped_sine(x, t, f_fft, per, zeta0)
     fn, zeta, f_std, z_std = _natural_frequency_and_damping(sine)
     _check_decay(zeta, z_std, sine.sigma * seg.size / rate)

@@ -138,7 +138,8 @@ def _level_start(t: np.ndarray, u: np.ndarray, y: np.ndarray):
     tail = y[k + max(1, (stop - k) * 3 // 4):stop]
     y_after = tail.mean() if tail.size else y[stop - 1]
     K = (y_after - y_before) / du[k - 1]
-    seg = (y[k:stop] - y_before) / (y_after - y_before) if y_after != y_before else np.zeros(stop - k)
+    seg = ((y[k:stop] - y_before) / (y_after - y_before) if y_after != y_before
+           else np.zeros(stop - k))
     i63 = int(np.argmax(seg >= 0.63)) if np.any(seg >= 0.63) else max(1, (stop - k) // 4)
     t63 = max(t[min(k + i63, len(t) - 1)] - t[k], t[1] - t[0])
     return float(K), 1.5 / t63, 0.7
@@ -318,8 +319,9 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
                       multistart=multistart, progress=progress, output_scale=[1.0])
         except IdentificationError as exc:
             if method == "lm" and "method='trf'" in str(exc):
-                raise IdentificationError(exc.message, hint="use method='trf' (CLI: --method trf) to keep the "
-                                                            "parameters within their bounds") from None
+                raise IdentificationError(exc.message,
+                                          hint="use method='trf' (CLI: --method trf) to keep the "
+                                               "parameters within their bounds") from None
             raise
         except SimulationError:
             raise IdentificationError(

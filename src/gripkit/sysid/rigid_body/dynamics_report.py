@@ -71,13 +71,15 @@ def dynamics_report(result, t, q, qd, qdd, tau, *, weights=None, data_name: str 
     sec = rep.section("Residuals", "τ − τ̂ per joint; the RMS is over the rows the fit kept (away from velocity "
                       "reversals and standstill), the residual std over those rows weighted as in the fit.")
     sec.table(["joint", "residual RMS", "residual std"],
-              [[name, f"{rms[j]:.4g}", f"{result.residual_std[name]:.4g}"] for j, name in enumerate(joints)])
+              [[name, f"{rms[j]:.4g}", f"{result.residual_std[name]:.4g}"]
+               for j, name in enumerate(joints)])
     sec.figure(_residual_figure(t, r, joints, rms), "residuals", name="residuals")
     std = result.base_parameters_std
     rep.section("Base parameters", "Each base parameter is the combination of standard parameters it is named "
                 "after (SI units of its leading term).").table(
         ["base parameter", "value", "σ", "unit"],
-        [[n, f"{v:.6g}", f"{std[n]:.3g}", parameter_unit(n)] for n, v in result.base_parameters.items()])
+        [[n, f"{v:.6g}", f"{std[n]:.3g}", parameter_unit(n)]
+         for n, v in result.base_parameters.items()])
     sec = rep.section("Friction")
     if result.friction:
         kinds = [k for k in next(iter(result.friction.values())) if not k.endswith("_std")]

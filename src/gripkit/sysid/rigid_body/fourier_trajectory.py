@@ -2,7 +2,8 @@
 Tükel, De Schutter & Van Brussel, "Optimal robot excitation and identification", IEEE T-RA 13(5),
 1997): every joint follows a finite Fourier series of base frequency f₀,
 
-    q_j(t) = q0_j + Σ_{l=1..H} [ a_jl/(ω_f l)·sin(ω_f l t) − b_jl/(ω_f l)·cos(ω_f l t) ],   ω_f = 2π f₀,
+    q_j(t) = q0_j + Σ_{l=1..H} [ a_jl/(ω_f l)·sin(ω_f l t) − b_jl/(ω_f l)·cos(ω_f l t) ],
+    ω_f = 2π f₀,
     q̇_j(t) = Σ_l [ a_jl cos(ω_f l t) + b_jl sin(ω_f l t) ],
     q̈_j(t) = Σ_l ω_f l [ −a_jl sin(ω_f l t) + b_jl cos(ω_f l t) ],
 

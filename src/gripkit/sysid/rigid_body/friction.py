@@ -222,7 +222,8 @@ def constant_velocity_friction(pwm, velocity, *, motor_torque: Callable[[float, 
         tau = float(motor_torque(u[a], vm))
         dv = max(abs(vm) * 1e-6, 1e-9)
         slope = (float(motor_torque(u[a], vm + dv)) - float(motor_torque(u[a], vm - dv))) / (2 * dv)
-        ld = 0.0 if load is None else float(np.mean([load(i) for i in range(a, b)][::max(1, (b - a) // 20)]))
+        ld = (0.0 if load is None
+              else float(np.mean([load(i) for i in range(a, b)][::max(1, (b - a) // 20)])))
         if inertia is not None:
             if dt is None:
                 raise DataError("constant_velocity_friction: give dt (the sample interval in s) with inertia")

@@ -335,7 +335,8 @@ def _control(report, z, det, rng, summary, quick):
         g = simulate_finger_grasp(c, p, sc, valve=z.valve, sensor=z.sensor, contact=z.contact, detector=det)
         slip_t = g.t[g.slipping > 0]
         rows.append(["rigid" if math.isinf(k_obj) else f"{k_obj:.0f}", g.contact_time, g.max_force,
-                     sc.force_limit, len([a for a in g.alarms if a > (g.contact_time or 0) + sc.slip_blanking]),
+                     sc.force_limit,
+                     len([a for a in g.alarms if a > (g.contact_time or 0) + sc.slip_blanking]),
                      f"{slip_t[0]:.3f}-{slip_t[-1]:.3f}" if slip_t.size else "none",
                      1e3 * float(g.x_obj[-1] - g.x_obj[int(2.0 / p.dt)])])
         if k_obj == 2000.0:

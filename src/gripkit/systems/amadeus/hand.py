@@ -200,9 +200,11 @@ class AmadeusHand:
         lim = self._hp("knuckle_range")
         if (np.abs(th) > lim + math.radians(1.0)).any():
             bad = float(v.flat[int(np.argmax(np.abs(th)))])
-            raise DataError(f"potentiometer reads {bad:.4g} V = {math.degrees((bad - self._hp('pot_offset')) / self._hp('pot_gain')):.3g}°, "
-                            f"beyond the ±{math.degrees(lim):.3g}° knuckle range",
-                            hint="check the potentiometer wiring, offset and gain")
+            raise DataError(
+                f"potentiometer reads {bad:.4g} V = "
+                f"{math.degrees((bad - self._hp('pot_offset')) / self._hp('pot_gain')):.3g}°, "
+                f"beyond the ±{math.degrees(lim):.3g}° knuckle range",
+                hint="check the potentiometer wiring, offset and gain")
         return th
 
     def potentiometer_voltage(self, angle) -> np.ndarray:

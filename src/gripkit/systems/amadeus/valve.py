@@ -187,7 +187,8 @@ class ProportionalValve(Model):
         missing = [n for n in _NAMES if n not in params]
         if missing or tuple(params.names) != _NAMES:
             raise DataError(f"valve parameters must be {_NAMES} in this order, found {params.names}")
-        if params.value("i_hi") <= params.value("i_lo") or params.value("p_supply") <= params.value("p_min"):
+        if (params.value("i_hi") <= params.value("i_lo")
+                or params.value("p_supply") <= params.value("p_min")):
             raise DataError("valve: need i_hi > i_lo and p_supply > p_min")
         super().__init__(params, check=check)
 

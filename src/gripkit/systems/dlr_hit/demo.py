@@ -285,12 +285,13 @@ def _loop_adaptation(sec, f, summary):
             for mode in ("fixed", "adaptive") for plant in ("nominal", "drift")]
     rows.append(["ratio fixed/adaptive, drifting plant", cmp.rms_ratio, cmp.max_ratio])
     sec.table(["compensation, plant", "RMS joint error [°]", "max joint error [°]"], rows,
-              caption=f"Joint tracking errors after the first {cmp.t_skip:g} s of the {T:g} s run. On the "
-                      f"drifting plant adaptation lowers the RMS error {cmp.rms_ratio:.2f}× and the largest "
-                      f"error {cmp.max_ratio:.2f}× (to {cmp.rms['adaptive', 'drift'] / DEG:.2f}°, against "
-                      f"{cmp.rms['fixed', 'nominal'] / DEG:.2f}° for the fixed compensation on the nominal "
-                      "plant); on the nominal plant it changes the RMS error by "
-                      f"{100 * (cmp.rms['adaptive', 'nominal'] / cmp.rms['fixed', 'nominal'] - 1):+.1f} %.")
+              caption=(
+        f"Joint tracking errors after the first {cmp.t_skip:g} s of the {T:g} s run. On the "
+        f"drifting plant adaptation lowers the RMS error {cmp.rms_ratio:.2f}× and the largest "
+        f"error {cmp.max_ratio:.2f}× (to {cmp.rms['adaptive', 'drift'] / DEG:.2f}°, against "
+        f"{cmp.rms['fixed', 'nominal'] / DEG:.2f}° for the fixed compensation on the nominal "
+        "plant); on the nominal plant it changes the RMS error by "
+        f"{100 * (cmp.rms['adaptive', 'nominal'] / cmp.rms['fixed', 'nominal'] - 1):+.1f} %."))
     summary["loop_adaptation_rms_deg"] = {f"{m}/{p}": cmp.rms[m, p] / DEG for m, p in cmp.rms}
     summary["loop_adaptation_max_deg"] = {f"{m}/{p}": cmp.max[m, p] / DEG for m, p in cmp.max}
     summary["loop_adaptation_ratio"] = {"rms": cmp.rms_ratio, "max": cmp.max_ratio}

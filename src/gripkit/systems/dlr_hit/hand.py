@@ -9,7 +9,8 @@ import numpy as np
 from ...errors import ModelError, SimulationError
 from ...params import Parameter, ParameterSet
 from ...sim.model import Model, Signal
-from .finger import ACTUATORS, FINGER_PARAMETERS, FRICTION_MODES, INTEGRATORS, NTH, NX, DLRFinger, run_jobs
+from .finger import (ACTUATORS, FINGER_PARAMETERS, FRICTION_MODES, INTEGRATORS, NTH, NX, DLRFinger,
+                     run_jobs)
 from .parameters import (FINGERS, SEED, DLRHITFinger, finger_consistency_checks, finger_tables,
                          thesis_finger_parameters)
 

@@ -260,7 +260,8 @@ def model_friction_tables(finger: DLRFinger, v_max: float = 8.0, n: int = 200) -
     tables with their scale factors, or its Stribeck/LuGre/no-friction curve tabulated on
     ±[v_max/n·…, v_max] rad/s — the default model of the controller's friction compensation."""
     if finger.friction == "table":
-        return tuple(t.scaled(finger.parameters.value(f"scale_{a}")) for t, a in zip(finger.tables, ACTUATORS))
+        return tuple(t.scaled(finger.parameters.value(f"scale_{a}"))
+                     for t, a in zip(finger.tables, ACTUATORS))
     v = np.geomspace(v_max / n, v_max, n)
     v = np.r_[-v[::-1], v]
     return tuple(FrictionTable(v, finger.kinetic_friction(a, v), name=f"{finger.friction} friction, {a}")
@@ -288,8 +289,9 @@ LOOP_OUTPUTS = {
 
 
 def simulate_impedance(finger: DLRFinger, controller: ImpedanceController, reference,
-                       reference_velocity=None, *, dt: float = 1e-3, x0=None, wall: Wall | None = None,
-                       substeps: int = 1, friction_drift: FrictionDrift | None = None) -> Trajectory:
+                       reference_velocity=None, *, dt: float = 1e-3, x0=None,
+                       wall: Wall | None = None, substeps: int = 1,
+                       friction_drift: FrictionDrift | None = None) -> Trajectory:
     """Closed-loop simulation of ``finger`` under ``controller``.
 
     Parameters

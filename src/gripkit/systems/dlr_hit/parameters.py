@@ -82,7 +82,8 @@ def thesis_finger_parameters(**overrides) -> ParameterSet:
         ps.append(Parameter(f"m{k + 1}", masses[k], "kg", f"mass of phalanx {k + 1}", bounds=(0, None), source=F, display_unit="g"))
     for k in range(3):
         for j, ax in enumerate("xyz"):
-            ps.append(Parameter(f"pc{k + 1}_{ax}", _pc(k + 1)[j], "m", f"centre of mass of phalanx {k + 1}, {ax} (link frame)",
+            ps.append(Parameter(f"pc{k + 1}_{ax}", _pc(k + 1)[j], "m",
+                                f"centre of mass of phalanx {k + 1}, {ax} (link frame)",
                                 source=F, display_unit="mm"))
     for k in range(3):
         lc2 = float(np.sum(np.square(_pc(k + 1))))

@@ -772,7 +772,8 @@ def advance_plant(th, s, mode, V, h, substeps):  # pragma: no cover - compiled
                         break
                     fhi = fm
                 else:
-                    if fm == 0.0 or (hi - lo) * rem < 1e-15 or abs(fm) <= 1e-13 * (abs(flo) + abs(fhi)):
+                    if (fm == 0.0 or (hi - lo) * rem < 1e-15
+                            or abs(fm) <= 1e-13 * (abs(flo) + abs(fhi))):
                         break
                     if (fm > 0.0) == (fhi > 0.0):
                         hi, fhi = theta, fm

@@ -39,7 +39,8 @@ from ...errors import DataError, IdentificationError, SimulationError
 from ...estimation.contact_detection import detector_step
 from ...signals.trajectory import Trajectory
 from .end_effector import lever_coefficients
-from .gripper import TSFMGripper, GripperState, gripper_advance, gripper_measure, gripper_model, gripper_work
+from .gripper import (TSFMGripper, GripperState, gripper_advance, gripper_measure, gripper_model,
+                      gripper_work)
 from .micropart import MicropartEstimate, estimate_micropart
 from .tip_position import estimator_arrays, estimator_step
 

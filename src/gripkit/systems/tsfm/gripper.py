@@ -63,7 +63,8 @@ from ...sim.hybrid import (DEFAULT_LEVELS, MAX_EVENTS_PER_STEP, EventWork, Guard
 from ...sim.integrators import zoh_levels
 from ...lti import StateSpace
 from ...sim.model import Model, Signal
-from .end_effector import end_effector_parameters, lever_coefficients, sensor_parameters, sensor_state_space
+from .end_effector import (end_effector_parameters, lever_coefficients, sensor_parameters,
+                           sensor_state_space)
 
 __all__ = ["FINGER_NAMES", "finger_parameter_set", "finger_state_space", "finger_minimal_state_space",
            "finger_coefficients", "finger_transfer_functions", "finger_hybrid",
