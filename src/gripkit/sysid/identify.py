@@ -276,7 +276,7 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
 
 
 #: the methods that fit one model to several records (``identify([tr1, tr2], ...)``)
-RECORD_METHODS = ("arx", "armax", "oe", "ss", "tf", "narx")
+RECORD_METHODS = ("arx", "armax", "oe", "ss", "tf", "narx", "hw")
 
 
 def _per_record(i: int, fn, *args, **kw):
@@ -358,6 +358,11 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
                    (ios[0].input, ios[0].output))
     if method == "narx":  # the data as they are: the model's constant carries the operating point
         model = _as_data(nonlinear.narx, [(io.u, io.y) for io in ios], dt=ios[0].dt, **options)
+        model.input_name, model.output_name = input, output
+        return model
+    if method == "hw":  # each record from its own steady state, the offset y0 shared
+        model = _as_data(nonlinear.hammerstein_wiener, [(io.u, io.y) for io in ios], nb=nb,
+                         nf=nb if nf is None else nf, nk=nk, dt=ios[0].dt, **options)
         model.input_name, model.output_name = input, output
         return model
     u0 = float(_pooled_mean([io.u for io in ios])) if detrend == "mean" else 0.0
