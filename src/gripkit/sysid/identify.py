@@ -276,7 +276,7 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
 
 
 #: the methods that fit one model to several records (``identify([tr1, tr2], ...)``)
-RECORD_METHODS = ("arx", "armax", "oe", "ss", "tf", "narx", "hw")
+RECORD_METHODS = ("arx", "armax", "oe", "ss", "tf", "narx", "hw", "hysteresis")
 
 
 def _per_record(i: int, fn, *args, **kw):
@@ -365,6 +365,8 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
                          nf=nb if nf is None else nf, nk=nk, dt=ios[0].dt, **options)
         model.input_name, model.output_name = input, output
         return model
+    if method == "hysteresis":  # each record from its own relaxed state, the data as they are
+        return nonlinear.hysteresis(list(data), input=input, output=output, **options)
     u0 = float(_pooled_mean([io.u for io in ios])) if detrend == "mean" else 0.0
     y0 = float(_pooled_mean([io.y for io in ios])) if detrend == "mean" else 0.0
     meta = dict(ios[0].meta, u_offset=u0, y_offset=y0, dt=ios[0].dt, **options)
