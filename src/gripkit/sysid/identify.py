@@ -276,7 +276,7 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
 
 
 #: the methods that fit one model to several records (``identify([tr1, tr2], ...)``)
-RECORD_METHODS = ("arx", "armax", "oe", "ss", "tf", "narx", "hw", "hysteresis")
+RECORD_METHODS = ("arx", "armax", "oe", "ss", "tf", "narx", "hw", "hysteresis", "nlss")
 
 
 def _per_record(i: int, fn, *args, **kw):
@@ -329,6 +329,10 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
                         hint="detrend 'linear' would give every record its own operating point; "
                              "detrend the records before, or use 'mean'")
     why = f"{method.upper()} identification"
+    if method == "nlss":  # the model carries the operating point; input/output may be several
+        for i, d in enumerate(data):
+            _per_record(i, identify_mimo.mimo_data, d, input, output, "none", why=why)
+        return nonlinear.nlss(list(data), input=input, output=output, **options)
     if identify_mimo.several(input, output) or method in ("ss", "tf"):
         if method not in ("arx", "ss", "tf"):
             raise ArgumentError(f"identify(): several input or output columns with several records "
