@@ -107,3 +107,42 @@ def test_a_mismatched_record_is_named(records):
         hammerstein_wiener([(u1, y1), (u2, y2[:-1])], **KW)
     with pytest.raises(ArgumentError, match="non-empty list of records"):
         hammerstein_wiener([], **KW)
+
+
+def _cli(capsys, *args):
+    from gripkit.cli import main
+
+    code = main([str(a) for a in args])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_cli_identify_hw_of_two_files(records, fit, tmp_path, capsys):
+    import json
+
+    paths = [tmp_path / "grasp1.csv", tmp_path / "grasp2.csv"]
+    for path, (u, y) in zip(paths, records):
+        np.savetxt(path, np.column_stack([u, y]), delimiter=",", header="valve,force",
+                   comments="", fmt="%.17g")
+    code, out, err = _cli(capsys, "identify", "hw", *paths, "--input", "valve", "--output",
+                          "force", "--fs", 100, "--output-nonlinearity", "poly:3", "--nb", 2,
+                          "--nf", 2, "--nk", 1, "--json")
+    assert code == 0, err
+    d = json.loads(out)
+    assert d["data"] == [str(p) for p in paths]
+    assert [r["data"] for r in d["records"]] == [str(p) for p in paths]
+    np.testing.assert_allclose([r["fit_percent"] for r in d["records"]],
+                               [r["fit_percent"] for r in fit.records], atol=1e-6)
+    np.testing.assert_allclose([p["value"] for p in d["parameters"]], fit.theta, atol=1e-8)
+    assert d["fit_percent"] == pytest.approx(fit.fit_percent, abs=1e-6)
+    code, out, err = _cli(capsys, "identify", "hw", *paths, "--input", "valve", "--output",
+                          "force", "--fs", 100, "--output-nonlinearity", "poly:3", "--nb", 2,
+                          "--nf", 2, "--nk", 1)
+    assert code == 0, err
+    assert "2 records, each with its own initial conditions" in out and "free run" in out
+    bad = tmp_path / "other.csv"
+    np.savetxt(bad, np.column_stack(records[1]), delimiter=",", header="valve,grip",
+               comments="")
+    code, out, err = _cli(capsys, "identify", "hw", paths[0], bad, "--input", "valve",
+                          "--output", "force", "--fs", 100)
+    assert code != 0 and err.startswith("error: ") and "other.csv" in err and "force" in err

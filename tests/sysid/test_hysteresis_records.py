@@ -129,3 +129,27 @@ def test_a_mismatched_record_is_named(bw_records):
         hysteresis([(u1, y1), (np.linspace(0, 1, N), y2)], progress=False)
     with pytest.raises(ArgumentError, match="oscillator is fitted to one record"):
         hysteresis([tr1, tr1], input="volt", output="disp", form="oscillator")
+
+
+def test_cli_identify_hysteresis_of_two_files(bw_records, tmp_path, capsys):
+    import json
+
+    from gripkit.cli import main
+
+    paths = [tmp_path / "sweep1.csv", tmp_path / "sweep2.csv"]
+    for path, (u, y) in zip(paths, bw_records):
+        np.savetxt(path, np.column_stack([u, y]), delimiter=",", header="volt,disp",
+                   comments="", fmt="%.17g")
+    code = main([*map(str, ["identify", "hysteresis", *paths, "--input", "volt", "--output",
+                            "disp", "--fs", 1000, "--json"])])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    d = json.loads(out)
+    ref = hysteresis(bw_records, progress=False)
+    assert d["data"] == [str(p) for p in paths] and len(d["records"]) == 2
+    assert [r["data"] for r in d["records"]] == [str(p) for p in paths]
+    for r, q in zip(d["records"], ref.records):
+        assert r["fit_percent"] == pytest.approx(q["fit_percent"], abs=1e-6)
+    values = {p["name"]: p["value"] for p in d["parameters"]}
+    assert values["beta"] == pytest.approx(ref.beta, rel=1e-6)
+    assert d["fit_percent"] == pytest.approx(ref.fit_percent, abs=1e-6)

@@ -125,3 +125,25 @@ def test_identify_and_a_mismatched_record_is_named(records, fit):
     with pytest.raises(DataError, match=r"data\[1\].*'x'"):
         identify([trs[0], Trajectory.uniform(dt=0.1, f=u2, z=y2)], "nlss", input="f",
                  output="x", order=2)
+
+
+def test_cli_identify_nlss_of_two_files(records, fit, tmp_path, capsys):
+    import json
+
+    from gripkit.cli import main
+
+    paths = [tmp_path / "run1.csv", tmp_path / "run2.csv"]
+    for path, (u, y) in zip(paths, records):
+        np.savetxt(path, np.column_stack([u, y]), delimiter=",", header="f,x", comments="",
+                   fmt="%.17g")
+    code = main([*map(str, ["identify", "nlss", *paths, "--input", "f", "--output", "x", "--fs",
+                            10, "--order", 2, "--degree", 3, "--json"])])
+    out, err = capsys.readouterr()
+    assert code == 0, err
+    d = json.loads(out)
+    assert d["data"] == [str(p) for p in paths]
+    assert [r["data"] for r in d["records"]] == [str(p) for p in paths]
+    assert "x0" not in d["records"][0] and d["records"][0]["n_samples"] == N
+    assert d["fit_percent"][0] == pytest.approx(fit.fit_percent[0], abs=1e-6)
+    np.testing.assert_allclose([r["fit_percent"][0] for r in d["records"]],
+                               [r["fit_percent"][0] for r in fit.info["records"]], atol=1e-6)
