@@ -63,6 +63,12 @@ def test_two_records_equal_the_fit_with_each_records_own_initial_state(records, 
     assert all(r["fit_percent"] > 85 for r in fit.records) and fit.fit_percent > 85
 
 
+def test_structure_and_orders_found_on_two_records(records):
+    """Nothing given: the Wiener structure poly:3 and the orders [2 2 1] chosen by BIC."""
+    m = hammerstein_wiener(records)
+    assert (m.kind, m.output_nl.label, m.nb, m.nf, m.nk) == ("wiener", "poly:3", 2, 2, 1)
+
+
 def test_joined_record_is_different_and_worse_at_the_seam(records, fit):
     (u1, y1), (u2, y2) = records
     joined = hammerstein_wiener(np.r_[u1, u2], np.r_[y1, y2], **KW)

@@ -184,8 +184,8 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
     data
         A uniformly sampled :class:`~gripkit.signals.Trajectory` (e.g. from
         :func:`gripkit.io.load`), or a list of them: several records of the same columns fitted
-        by one model, each with its own initial conditions (methods ``'arx'``, ``'armax'``,
-        ``'oe'``; see :func:`identify_records`).
+        by one model, each with its own initial conditions (methods of
+        :data:`RECORD_METHODS`; see :func:`identify_records`).
     method
         ``'arx'`` (least squares), ``'armax'`` (orders na, nb, nc, nk), ``'oe'`` (orders nb, nf,
         nk; ``nf`` defaults to ``na``), ``'rls'`` (recursive least squares; options
@@ -301,7 +301,12 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
     continuous-time transfer functions (``poles``, ``zeros``:
     :func:`gripkit.sysid.linear.tfest.tfest_records`) and polynomial NARX
     (:func:`gripkit.sysid.narx` on the records as they are, its constant term in place of
-    ``detrend``; ``options`` of that function). This is what
+    ``detrend``; ``options`` of that function), Hammerstein–Wiener (each record from its own
+    steady state: :func:`gripkit.sysid.hammerstein_wiener` on the records as they are, with
+    this function's ``nb``, ``nf`` (default ``nb``), ``nk``), hysteresis (each record from its
+    own relaxed state: :func:`gripkit.sysid.hysteresis`) and nonlinear state space (each record
+    its own initial state: :func:`gripkit.sysid.nlss`; ``input``/``output`` may name several
+    columns); these three ignore ``detrend`` (their models carry the operating point). This is what
     ``identify([tr1, tr2], method, ...)`` and ``gripkit identify METHOD DATA1 DATA2 ...`` do.
 
     The model has one operating point: ``detrend='mean'`` removes the mean of all the records
