@@ -125,7 +125,8 @@ def test_identify_with_a_list_of_trajectories_one_operating_point():
 
 @pytest.mark.parametrize("case, error, phrase", [
     ("linear", DataError, "one operating point"),
-    ("frf", ArgumentError, "fitted by method 'arx', 'armax', 'oe', 'ss', 'tf', 'narx' only"),
+    ("frf", ArgumentError, "fitted by method 'arx', 'armax', 'oe', 'ss', 'tf', 'narx', 'hw', "
+                           "'hysteresis', 'nlss' only"),
     ("dt", DataError, "must share the sample interval"),
     ("units", DataError, "must use the same units"),
     ("short", DataError, "data[1]: ARX [2 2 2] takes the first 3 samples of every record"),

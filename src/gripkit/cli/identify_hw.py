@@ -11,6 +11,8 @@ from typing import Optional
 import typer
 
 from .app import identify_app
+from .identify_linear import (DataArgs, _data_field, _echo_records, _fit_records,
+                              _records_field)
 from .common import (FillOpt, FsOpt, JsonOpt, ModelReportOpt, TimeOpt, check_data_options,
                      collected_warnings, emit_json, load_data, report_warnings, write_model_page)
 from .paths import output_folder
@@ -28,7 +30,7 @@ def _summary(m) -> str:
 
 
 @identify_app.command("hw")
-def identify_hw(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 file, the record."),
+def identify_hw(data: list[Path] = DataArgs,
                 input_col: str = typer.Option(..., "--input", help="Input column."),
                 output_col: str = typer.Option(..., "--output", help="Output column."),
                 input_nl: Optional[str] = typer.Option(
@@ -46,7 +48,9 @@ def identify_hw(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 file
                 report: Optional[Path] = ModelReportOpt,
                 fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
                 json_out: bool = JsonOpt):
-    """Hammerstein / Wiener / Hammerstein–Wiener: static nonlinearities around B/F, PEM, σ."""
+    """Hammerstein / Wiener / Hammerstein–Wiener: static nonlinearities around B/F, PEM, σ.
+    Several DATA files: one model of all the records, each from its own steady state
+    (``records``: each file's fit and w₋)."""
     import numpy as np
 
     from ..sysid.nonlinear.hammerstein_wiener import hammerstein_wiener, parse_nonlinearity
@@ -57,22 +61,28 @@ def identify_hw(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 file
     check_data_options(fs, fill)
     output_folder(report, "--report")
     with collected_warnings() as caught:
-        tr = load_data(data, [input_col, output_col], fs, time, fill)
+        tr = load_data(data[0], [input_col, output_col], fs, time, fill)
         val = tv = None
         if validate is not None:
             tv = load_data(validate, [input_col, output_col], fs, time, fill)
             val = (np.asarray(tv[input_col]), np.asarray(tv[output_col]))
-        m = hammerstein_wiener(np.asarray(tr[input_col]), np.asarray(tr[output_col]),
-                               input_nonlinearity=input_nl, output_nonlinearity=output_nl,
-                               nb=nb, nf=nf, nk=nk, dt=tr.dt, validate=val, progress=True)
+        if len(data) > 1:  # one model of every file's record, each from its own steady state
+            m = _fit_records(data, [input_col, output_col], input_col, output_col, fs, time, fill,
+                             "none", "hw", nb=nb, nf=nf, nk=nk, input_nonlinearity=input_nl,
+                             output_nonlinearity=output_nl, validate=val, progress=True)
+        else:
+            m = hammerstein_wiener(np.asarray(tr[input_col]), np.asarray(tr[output_col]),
+                                   input_nonlinearity=input_nl, output_nonlinearity=output_nl,
+                                   nb=nb, nf=nf, nk=nk, dt=tr.dt, validate=val, progress=True)
         m.input_name, m.output_name = input_col, output_col
         if out is not None:
             m.save(out)
         page = None if report is None else write_model_page(
-            m, tr if tv is None else tv, report, data if validate is None else validate)
+            m, tr if tv is None else tv, report, data[0] if validate is None else validate)
     lines = report_warnings(caught)
     if json_out:
-        emit_json({"data": str(data), "input": input_col, "output": output_col,
+        emit_json({"data": _data_field(data if len(data) > 1 else data[0]),
+                   "input": input_col, "output": output_col,
                    "structure": {"kind": m.kind, "input_nonlinearity": m.input_nl.label,
                                  "output_nonlinearity": m.output_nl.label, "nb": m.nb,
                                  "nf": m.nf, "nk": m.nk, "criterion": m.criterion,
@@ -86,7 +96,10 @@ def identify_hw(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 file
                    {"data": str(validate), "fit_percent": m.validation_fit_percent,
                     "definition": m.fit_definition},
                    "candidates": m.candidates,
+                   **({"records": _records_field(data, m.records)} if len(data) > 1 else {}),
                    "model": None if out is None else str(out), "report": page,
                    "warnings": lines})
     else:
         typer.echo(_summary(m))
+        if len(data) > 1:
+            _echo_records(_records_field(data, m.records), free_run=True)

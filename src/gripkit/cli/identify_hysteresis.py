@@ -14,6 +14,8 @@ from .app import identify_app
 from .common import (FillOpt, FsOpt, JsonOpt, ModelReportOpt, TimeOpt, check_choice,
                      check_data_options, collected_warnings, emit_json, load_data, report_warnings,
                      write_model_page)
+from .identify_linear import (DataArgs, _data_field, _echo_records, _fit_records,
+                              _records_field)
 from .paths import output_folder
 
 
@@ -34,8 +36,7 @@ def _exponent(value: str):
 
 
 @identify_app.command("hysteresis")
-def identify_hysteresis(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 file, the "
-                                                              "record."),
+def identify_hysteresis(data: list[Path] = DataArgs,
                         input_col: str = typer.Option(..., "--input", help="Input column "
                                                                            "(voltage, force)."),
                         output_col: str = typer.Option(..., "--output",
@@ -60,7 +61,9 @@ def identify_hysteresis(data: Path = typer.Argument(..., help="CSV, Parquet or H
                         report: Optional[Path] = ModelReportOpt,
                         fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
                         json_out: bool = JsonOpt):
-    """Hysteresis (Bouc-Wen or Prandtl-Ishlinskii): parameters with σ, free-run fit."""
+    """Hysteresis (Bouc-Wen or Prandtl-Ishlinskii): parameters with σ, free-run fit. Several
+    DATA files: one model of all the records, each from its own relaxed state (``records``:
+    each file's fit)."""
     from ..sysid.nonlinear.hysteresis import FORMS, MODELS, hysteresis
 
     check_choice(model, "--model", MODELS)
@@ -69,17 +72,21 @@ def identify_hysteresis(data: Path = typer.Argument(..., help="CSV, Parquet or H
     check_data_options(fs, fill)
     output_folder(report, "--report")
     with collected_warnings() as caught:
-        tr = load_data(data, [input_col, output_col], fs, time, fill)
+        tr = load_data(data[0], [input_col, output_col], fs, time, fill)
         val = None
         if validate is not None:
             val = load_data(validate, [input_col, output_col], fs, time, fill)
-        m = hysteresis(tr, model, input=input_col, output=output_col, form=form, exponent=n,
-                       operators=operators, burn_in=burn_in, validate=val,
-                       progress=not json_out)
+        opts = dict(form=form, exponent=n, operators=operators, burn_in=burn_in, validate=val,
+                    progress=not json_out)
+        if len(data) > 1:  # one model of every file's record, each from its own relaxed state
+            m = _fit_records(data, [input_col, output_col], input_col, output_col, fs, time, fill,
+                             "none", "hysteresis", model=model, **opts)
+        else:
+            m = hysteresis(tr, model, input=input_col, output=output_col, **opts)
         if out is not None:
             m.save(out)
         page = None if report is None else write_model_page(
-            m, tr if val is None else val, report, data if validate is None else validate)
+            m, tr if val is None else val, report, data[0] if validate is None else validate)
     lines = report_warnings(caught)
     if json_out:
         structure = ({"model": model, "form": form, "exponent": m.n,
@@ -88,7 +95,8 @@ def identify_hysteresis(data: Path = typer.Argument(..., help="CSV, Parquet or H
                      {"model": m.structure, "operators": len(m.thresholds),
                       "thresholds": [float(r) for r in m.thresholds]})
         structure["criterion"] = m.criterion
-        emit_json({"data": str(data), "input": input_col, "output": output_col,
+        emit_json({"data": _data_field(data if len(data) > 1 else data[0]),
+                   "input": input_col, "output": output_col,
                    "structure": structure,
                    "parameters": [{"name": p.name, "value": p.value, "std": p.std,
                                    "unit": p.unit, "fixed": p.fixed}
@@ -96,6 +104,7 @@ def identify_hysteresis(data: Path = typer.Argument(..., help="CSV, Parquet or H
                    "fit_percent": m.fit_percent, "definition": m.fit_definition,
                    "validation": None if validate is None else
                    {"data": str(validate), "fit_percent": m.validation_fit_percent},
+                   **({"records": _records_field(data, m.records)} if len(data) > 1 else {}),
                    "model": None if out is None else str(out), "report": page,
                    "warnings": lines})
     else:
@@ -104,3 +113,5 @@ def identify_hysteresis(data: Path = typer.Argument(..., help="CSV, Parquet or H
         typer.echo(f"free-run fit (estimation): {fmt(m.fit_percent)}")
         if validate is not None:
             typer.echo(f"free-run fit (validation): {fmt(m.validation_fit_percent)}")
+        if len(data) > 1:
+            _echo_records(_records_field(data, m.records), free_run=True)

@@ -188,16 +188,18 @@ def _mimo_arx(data: list[Path], input: str, output: str, na: int, nb: int, nk: i
     _echo_written(out_file, report)
 
 
-def _echo_records(records: list[dict] | None) -> None:
-    """One line per record of a fit of several files."""
+def _echo_records(records: list[dict] | None, free_run: bool = False) -> None:
+    """One line per record of a fit of several files (``free_run``: a single fit per record is
+    the free run, as for the nonlinear families, not the one-step fit of ARX/ARMAX/OE)."""
     if not records:
         return
     typer.echo(f"{len(records)} records, each with its own initial conditions:")
     for r in records:
         fit = r["fit_percent"]
         free = "—" if fit is None else (f"{fit:.2f} %" if isinstance(fit, float) else
-                                        "[" + ", ".join(f"{v:.2f}" for v in fit) + "] %")
-        kind = "1-step" if isinstance(fit, float) else "free run"
+                                        "[" + ", ".join("—" if v is None else f"{v:.2f}"
+                                                        for v in fit) + "] %")
+        kind = "1-step" if isinstance(fit, float) and not free_run else "free run"
         line = f"  {r['data']}: N = {r['n_samples']}, fit ({kind}) {free}"
         if "one_step_fit_percent" in r:
             line += ", 1-step [" + ", ".join(f"{v:.2f}" for v in r["one_step_fit_percent"]) + "] %"

@@ -12,6 +12,8 @@ import typer
 from .app import identify_app
 from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, collected_warnings,
                      emit_json, load_data, report_warnings)
+from .identify_linear import (DataArgs, _data_field, _echo_records, _fit_records,
+                              _records_field)
 
 
 def _names(value: str, option: str) -> list[str]:
@@ -49,7 +51,7 @@ def _summary(m) -> str:
 
 
 @identify_app.command("nlss")
-def identify_nlss(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 file, the record."),
+def identify_nlss(data: list[Path] = DataArgs,
                   input_cols: str = typer.Option(..., "--input", help="Input column(s), U or "
                                                  "U1,U2."),
                   output_cols: str = typer.Option(..., "--output", help="Output column(s), Y or "
@@ -68,23 +70,29 @@ def identify_nlss(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
                   out: Optional[Path] = typer.Option(None, "--out", help="Write the model (JSON)."),
                   fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
                   json_out: bool = JsonOpt):
-    """Polynomial nonlinear state space (PNLSS) from the subspace start, simulation error, σ."""
+    """Polynomial nonlinear state space (PNLSS) from the subspace start, simulation error, σ.
+    Several DATA files: one model of all the records, each with its own initial state
+    (``records``: each file's fit)."""
     from ..sysid.nonlinear.nlss import nlss
 
     ins, outs = _names(input_cols, "--input"), _names(output_cols, "--output")
     check_data_options(fs, fill)
     with collected_warnings() as caught:
-        tr = load_data(data, ins + outs, fs, time, fill)
         tv = None if validate is None else load_data(validate, ins + outs, fs, time, fill)
-        m = nlss(tr, input=ins, output=outs, order=order, degree=degree, max_order=max_order,
-                 window=window, validate=tv)
+        opts = dict(order=order, degree=degree, max_order=max_order, window=window, validate=tv)
+        if len(data) > 1:  # one model of every file's record, each with its own initial state
+            m = _fit_records(data, ins + outs, ins, outs, fs, time, fill, "none", "nlss", **opts)
+        else:
+            tr = load_data(data[0], ins + outs, fs, time, fill)
+            m = nlss(tr, input=ins, output=outs, **opts)
         if out is not None:
             m.save(out)
     lines = report_warnings(caught)
     if json_out:
         params = [{"name": p.name, "value": p.value, "std": p.std, "unit": p.unit,
                    "fixed": p.fixed, "meaning": p.doc} for p in m.parameters.values()]
-        emit_json({"data": str(data), "inputs": ins, "outputs": outs,
+        emit_json({"data": _data_field(data if len(data) > 1 else data[0]),
+                   "inputs": ins, "outputs": outs,
                    "structure": {"model": "nlss", "order": m.order, "degree": m.degree,
                                  "zeta_terms": m.zeta_terms, "eta_terms": m.eta_terms,
                                  "criterion": m.criterion},
@@ -94,7 +102,12 @@ def identify_nlss(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
                    "validation": None if validate is None else
                    {"data": str(validate), "fit_percent": m.validation_fit_percent,
                     "linear_fit_percent": m.linear_validation_fit_percent},
-                   "info": {k: v for k, v in m.info.items() if k != "linear_start"},
+                   "info": {k: v for k, v in m.info.items()
+                            if k not in ("linear_start", "records")},
+                   **({"records": _records_field(data, m.info["records"])}
+                      if len(data) > 1 else {}),
                    "model": None if out is None else str(out), "warnings": lines})
     else:
         typer.echo(_summary(m))
+        if len(data) > 1:
+            _echo_records(_records_field(data, m.info["records"]), free_run=True)

@@ -139,8 +139,8 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
     data
         A uniformly sampled :class:`~gripkit.signals.Trajectory` (e.g. from
         :func:`gripkit.io.load`), or a list of them: several records of the same columns fitted
-        by one model, each with its own initial conditions (methods ``'arx'``, ``'armax'``,
-        ``'oe'``; see :func:`identify_records`).
+        by one model, each with its own initial conditions (methods of
+        :data:`RECORD_METHODS`; see :func:`identify_records`).
     method
         ``'arx'`` (least squares), ``'armax'`` (orders na, nb, nc, nk), ``'oe'`` (orders nb, nf,
         nk; ``nf`` defaults to ``na``), ``'rls'`` (recursive least squares; options
@@ -321,7 +321,7 @@ def _with_extras(model, extras: dict):
 
 
 #: the methods that fit one model to several records (``identify([tr1, tr2], ...)``)
-RECORD_METHODS = ("arx", "armax", "oe", "ss", "tf", "narx")
+RECORD_METHODS = ("arx", "armax", "oe", "ss", "tf", "narx", "hw", "hysteresis", "nlss")
 
 
 def _per_record(i: int, fn, *args, **kw):
@@ -346,7 +346,12 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
     continuous-time transfer functions (``poles``, ``zeros``:
     :func:`gripkit.sysid.linear.tfest.tfest_records`) and polynomial NARX
     (:func:`gripkit.sysid.narx` on the records as they are, its constant term in place of
-    ``detrend``; ``options`` of that function). This is what
+    ``detrend``; ``options`` of that function), Hammerstein–Wiener (each record from its own
+    steady state: :func:`gripkit.sysid.hammerstein_wiener` on the records as they are, with
+    this function's ``nb``, ``nf`` (default ``nb``), ``nk``), hysteresis (each record from its
+    own relaxed state: :func:`gripkit.sysid.hysteresis`) and nonlinear state space (each record
+    its own initial state: :func:`gripkit.sysid.nlss`; ``input``/``output`` may name several
+    columns); these three ignore ``detrend`` (their models carry the operating point). This is what
     ``identify([tr1, tr2], method, ...)`` and ``gripkit identify METHOD DATA1 DATA2 ...`` do.
 
     The model has one operating point: ``detrend='mean'`` removes the mean of all the records
@@ -374,6 +379,10 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
                         hint="detrend 'linear' would give every record its own operating point; "
                              "detrend the records before, or use 'mean'")
     why = f"{method.upper()} identification"
+    if method == "nlss":  # the model carries the operating point; input/output may be several
+        for i, d in enumerate(data):
+            _per_record(i, identify_mimo.mimo_data, d, input, output, "none", why=why)
+        return nonlinear.nlss(list(data), input=input, output=output, **options)
     if identify_mimo.several(input, output) or method in ("ss", "tf"):
         if method not in ("arx", "ss", "tf"):
             raise ArgumentError(f"identify(): several input or output columns with several records "
@@ -405,6 +414,13 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
         model = _as_data(nonlinear.narx, [(io.u1, io.y1) for io in ios], dt=ios[0].dt, **options)
         model.input_name, model.output_name = input, output
         return model
+    if method == "hw":  # each record from its own steady state, the offset y0 shared
+        model = _as_data(nonlinear.hammerstein_wiener, [(io.u1, io.y1) for io in ios], nb=nb,
+                         nf=nb if nf is None else nf, nk=nk, dt=ios[0].dt, **options)
+        model.input_name, model.output_name = input, output
+        return model
+    if method == "hysteresis":  # each record from its own relaxed state, the data as they are
+        return nonlinear.hysteresis(list(data), input=input, output=output, **options)
     u0 = float(_pooled_mean([io.u1 for io in ios])) if detrend == "mean" else 0.0
     y0 = float(_pooled_mean([io.y1 for io in ios])) if detrend == "mean" else 0.0
     meta = dict(ios[0].keywords, u_offset=u0, y_offset=y0, dt=ios[0].dt, **options)

@@ -243,6 +243,11 @@ class _Problem:
         return self.work.x
 
     @property
+    def inner(self) -> np.ndarray:
+        """The linear block's output of the last run on the record's samples."""
+        return self.work.x[self.nk + self.nb + self.nf:]
+
+    @property
     def yhat(self) -> np.ndarray:
         return self.out.yhat
 
@@ -265,7 +270,7 @@ class _Problem:
                         float(y0), float(the[-1]), want_j, self.work, self.out)
 
     def admissible(self, the) -> bool:
-        pin, _, f, pout, _ = self.split(the[:-1])
+        pin, _, f, pout, _ = self.split(the[:self.P])
         if len(f) and np.max(np.abs(np.roots(np.r_[1.0, f]))) >= 1.0 - 1e-9:
             return False
         for nl, p in ((self.fin, pin), (self.fout, pout)):
@@ -274,6 +279,62 @@ class _Problem:
             if nl.kind == "deadzone" and not p[0] <= p[1]:
                 return False
         return True
+
+
+class _Records:
+    """One structure on several records (the interface of :class:`_Problem`): each record runs
+    from its own steady state, ``the = [θ, w₋ of record 1, …, w₋ of record R]``; ŷ and J are the
+    records' stacked (a record's rows are zero in the other records' w₋ columns)."""
+
+    def __init__(self, us, fin: Nonlinearity, fout: Nonlinearity, nb, nf, nk):
+        self.parts = [_Problem(u, fin, fout, nb, nf, nk) for u in us]
+        p = self.parts[0]
+        self.fin, self.fout, self.nb, self.nf, self.nk = fin, fout, nb, nf, nk
+        self.ni, self.no, self.P, self.R = p.ni, p.no, p.P, len(us)
+        self.bounds = np.cumsum([0] + [len(u) for u in us])
+        n = int(self.bounds[-1])
+        self.out = K.HWOut(np.empty(n), np.zeros((n, self.P + self.R)))
+        self._inner = np.empty(n)
+
+    @property
+    def inner(self) -> np.ndarray:
+        return self._inner
+
+    @property
+    def yhat(self) -> np.ndarray:
+        return self.out.yhat
+
+    @property
+    def jac(self) -> np.ndarray:
+        return self.out.jac
+
+    def split(self, th):
+        return self.parts[0].split(th)
+
+    def run(self, the, want_j: bool):
+        """Every record's free run (and J) for ``the = [θ, w₋ …]``; the first code ≥ 0 of a
+        record that diverged (offset to the stacked rows), else −1."""
+        P = self.P
+        for r, prob in enumerate(self.parts):
+            a, b = self.bounds[r], self.bounds[r + 1]
+            code = prob.run(np.r_[the[:P], the[P + r]], want_j)
+            if code >= 0:
+                return int(a + code)
+            self.out.yhat[a:b] = prob.yhat
+            self._inner[a:b] = prob.inner
+            if want_j:
+                self.out.jac[a:b, :P] = prob.jac[:, :P]
+                self.out.jac[a:b, P + r] = prob.jac[:, P]
+        return -1
+
+    def admissible(self, the) -> bool:
+        return self.parts[0].admissible(the)
+
+
+def _problem(us, fin: Nonlinearity, fout: Nonlinearity, nb, nf, nk):
+    """:class:`_Problem` for one record, :class:`_Records` for several (``us``: their inputs)."""
+    return _Problem(us[0], fin, fout, nb, nf, nk) if len(us) == 1 else _Records(
+        us, fin, fout, nb, nf, nk)
 
 
 def _lm(prob: _Problem, y, th0, maxiter: int = 200):
@@ -347,18 +408,22 @@ def _covariance(J: np.ndarray, sse: float):
     return cov, std
 
 
-def _arx_start(u, y, nb, nf, nk):
-    """Least-squares ARX ``F y = B q^-nk u + c`` on demeaned signals, F stabilised; θ = [b, f]."""
+def _arx_start(recs, nb, nf, nk):
+    """Least-squares ARX ``F y = B q^-nk u + c`` on demeaned signals (``recs``: the records
+    ``(u, y)``, each one's regressors from its own samples only), F stabilised; θ = [b, f]."""
     m = nk + nb + nf
-    n = len(y)
-    if n - m < 4 * (nb + nf + 1):
-        raise DataError(f"hammerstein_wiener: {n} samples for orders nb={nb}, nf={nf}, nk={nk}; "
-                        f"need at least {m + 4 * (nb + nf + 1)}: lower the orders or give more "
-                        "data")
-    cols = [-y[m - j:n - j] for j in range(1, nf + 1)]
-    cols += [u[m - nk - i:n - nk - i] for i in range(nb)]
-    Phi = np.column_stack(cols + [np.ones(n - m)])
-    th = np.linalg.lstsq(Phi, y[m:], rcond=None)[0]
+    rows, target = [], []
+    for u, y in recs:
+        n = len(y)
+        if n - m < 4 * (nb + nf + 1):
+            raise DataError(f"hammerstein_wiener: {n} samples{' in a record' * (len(recs) > 1)} "
+                            f"for orders nb={nb}, nf={nf}, nk={nk}; need at least "
+                            f"{m + 4 * (nb + nf + 1)}: lower the orders or give more data")
+        cols = [-y[m - j:n - j] for j in range(1, nf + 1)]
+        cols += [u[m - nk - i:n - nk - i] for i in range(nb)]
+        rows.append(np.column_stack(cols + [np.ones(n - m)]))
+        target.append(y[m:])
+    th = np.linalg.lstsq(np.vstack(rows), np.concatenate(target), rcond=None)[0]
     f, b = th[:nf], th[nf:nf + nb]
     if nf:
         z = np.roots(np.r_[1.0, f])
@@ -376,7 +441,9 @@ class HWModel:
     it), ``covariance``; ``fit_percent`` (free run, estimation record), ``validation_fit_percent``
     (free run on ``validate=``, None when diverged or none given), ``criterion`` (how structure
     and orders were chosen), ``candidates`` (every structure tried with its score),
-    ``initial_input`` (w₋ of the estimation record's initial steady state)."""
+    ``initial_input`` (w₋ of the estimation record's initial steady state; of the first record
+    when fitted on several), ``records`` (with several records: each one's ``n_samples``, its own
+    ``initial_input`` w₋ and free-run ``fit_percent``; empty for one record)."""
 
     input_nl: Nonlinearity
     output_nl: Nonlinearity
@@ -393,6 +460,7 @@ class HWModel:
     criterion: str = ""
     candidates: list = field(default_factory=list)
     initial_input: float | None = None
+    records: list = field(default_factory=list)
     input_name: str = "u"
     output_name: str = "y"
     structure: str = "hw"
@@ -578,7 +646,7 @@ class HWModel:
             covariance=[[fin(v) for v in row] for row in self.covariance],
             fit_percent=self.fit_percent, validation_fit_percent=self.validation_fit_percent,
             criterion=self.criterion, input_name=self.input_name, output_name=self.output_name,
-            fit_definition=HW_FIT)
+            fit_definition=HW_FIT, **({"records": self.records} if self.records else {}))
 
     def save(self, path) -> Path:
         """Write the model as JSON (schema ``gripkit.hw-model``), atomically."""
@@ -666,25 +734,29 @@ def _order(v, name: str, lo: int) -> int:
     return int(v)
 
 
-def _fit_structure(u, y, fin, fout, nb, nf, nk, lin_start=None, maxiter=200):
-    """Fit one structure (orders given) from the linear start ``[b, f, y0, w₋]``; several limit
-    starts, the best kept. Returns (``[θ, w₋]``, SSE, J, problem)."""
+def _fit_structure(recs, fin, fout, nb, nf, nk, lin_start=None, maxiter=200):
+    """Fit one structure (orders given) to the records ``recs`` (a list of ``(u, y)``) from the
+    linear start ``[b, f, y0, w₋ of each record]``; several limit starts, the best kept. Returns
+    (``[θ, w₋ …]``, SSE, J, problem)."""
+    us = [r[0] for r in recs]
+    u, y = np.concatenate(us), np.concatenate([r[1] for r in recs])
     if lin_start is None:
-        b, f = _arx_start(u - u.mean(), y - y.mean(), nb, nf, nk)
-        prob = _Problem(u, Nonlinearity(), Nonlinearity(), nb, nf, nk)
-        th0 = np.r_[b, f, y.mean() - b.sum() / (1 + f.sum()) * u.mean(), u[0]]
+        b, f = _arx_start([(ur - u.mean(), yr - y.mean()) for ur, yr in recs], nb, nf, nk)
+        prob = _problem(us, Nonlinearity(), Nonlinearity(), nb, nf, nk)
+        th0 = np.r_[b, f, y.mean() - b.sum() / (1 + f.sum()) * u.mean(), [ur[0] for ur in us]]
         th, sse, J, _ = _lm(prob, y, th0, maxiter)
         if fin.kind == "none" and fout.kind == "none":
             return th, sse, J, prob
         lin_start = th
-    b, f, y0, wpre = lin_start[:nb], lin_start[nb:nb + nf], lin_start[-2], lin_start[-1]
+    b, f, y0, wpre = (lin_start[:nb], lin_start[nb:nb + nf], lin_start[nb + nf],
+                      lin_start[nb + nf + 1:])
     # the signal entering each block under the linear start
-    lin = _Problem(u, Nonlinearity(), Nonlinearity(), nb, nf, nk)
+    lin = _problem(us, Nonlinearity(), Nonlinearity(), nb, nf, nk)
     lin.run(lin_start, False)
-    xlin = lin.x[nk + nb + nf:].copy()
+    xlin = lin.inner.copy()
     fin = _with_consts(fin, u)
     fout = _with_consts(fout, xlin)
-    prob = _Problem(u, fin, fout, nb, nf, nk)
+    prob = _problem(us, fin, fout, nb, nf, nk)
     best = None
     for pin in _limit_starts(fin, u):
         for pout in _limit_starts(fout, xlin):
@@ -700,17 +772,20 @@ def _fit_structure(u, y, fin, fout, nb, nf, nk, lin_start=None, maxiter=200):
     return best[0], best[1], best[2], prob
 
 
-def _excitation_check(model: HWModel, u: np.ndarray):
-    """Name a saturation limit or dead-zone threshold that the data never cross."""
+def _excitation_check(model: HWModel, us: list):
+    """Name a saturation limit or dead-zone threshold that the data (the records' inputs ``us``)
+    never cross."""
     for where, nl, sig in (("input", model.input_nl, None), ("output", model.output_nl, None)):
         if nl.kind not in ("saturation", "deadzone"):
             continue
         if where == "input":
-            v = u
+            v = np.concatenate(us)
         else:
-            prob = model._problem(u)
-            prob.run(np.r_[model.theta, model.initial_input], False)
-            v = prob.x[model.nk + model.nb + model.nf:]
+            prob = _problem(us, model.input_nl, model.output_nl, model.nb, model.nf, model.nk)
+            w0 = ([r["initial_input"] for r in model.records] if model.records
+                  else [model.initial_input])
+            prob.run(np.r_[model.theta, w0], False)
+            v = prob.inner.copy()
         lo, hi = model._part("in" if where == "input" else "out")
         below, above = int(np.sum(v < lo)), int(np.sum(v > hi))
         inside = len(v) - below - above
@@ -794,10 +869,14 @@ class _Search:
     and the progress bar; builds candidate models and scores them (validation free-run fit, or
     −BIC)."""
 
-    def __init__(self, u, y, validation, dt, maxiter, bar):
-        self.u, self.y = u, y
+    def __init__(self, recs, validation, dt, maxiter, bar):
+        self.recs = recs
+        self.us = [r[0] for r in recs]
+        self.u, self.y = np.concatenate(self.us), np.concatenate([r[1] for r in recs])
+        y = self.y
         self.uv, self.yv = validation if validation is not None else (None, None)
         self.n = len(y)
+        self.R = len(recs)
         self.dt = 1.0 if dt is None else float(dt)
         self.maxiter = maxiter
         self.y_range = (float(y.min()), float(y.max()))
@@ -816,10 +895,13 @@ class _Search:
         """The model of structure ``fin``/``fout`` at orders ``o`` from ``[θ, w₋]``, its SSE and
         Jacobian (σ with w₋: its uncertainty is in every other σ)."""
         cov, std = _covariance(J, sse)
-        P = len(the) - 1
+        P = len(the) - self.R
         m = HWModel(fin, fout, o[0], o[1], o[2], the[:P], std[:P], cov[:P, :P], dt=self.dt,
                     y_range=self.y_range)
-        m.initial_input = float(the[-1])
+        m.initial_input = float(the[P])
+        if self.R > 1:
+            m.records = [{"n_samples": len(ur), "initial_input": float(w)}
+                         for ur, w in zip(self.us, the[P:])]
         return m
 
     def score(self, m: HWModel, sse: float) -> float:
@@ -837,7 +919,7 @@ class _Search:
             th, sse, J = self.lin_fits[o]
             fin_c, fout_c = fin, fout
         else:
-            th, sse, J, prob = _fit_structure(self.u, self.y, fin, fout, *o,
+            th, sse, J, prob = _fit_structure(self.recs, fin, fout, *o,
                                               lin_start=self.lin_fits[o][0], maxiter=self.maxiter)
             fin_c, fout_c = prob.fin, prob.fout
         m = self.make(fin_c, fout_c, o, th, sse, J)
@@ -852,7 +934,7 @@ def _choose_orders(search: _Search, orders: list) -> tuple:
     screen = maxiter if len(orders) == 1 else min(maxiter, SCREEN_ITERATIONS)
     for o in orders:
         search.step()
-        th, sse, J, _ = _fit_structure(search.u, search.y, Nonlinearity(), Nonlinearity(), *o,
+        th, sse, J, _ = _fit_structure(search.recs, Nonlinearity(), Nonlinearity(), *o,
                                        maxiter=screen)
         if J is None:
             continue
@@ -864,7 +946,7 @@ def _choose_orders(search: _Search, orders: list) -> tuple:
         search.make(Nonlinearity(), Nonlinearity(), o, *lin_fits[o]), lin_fits[o][1]))
     o = ranked[0]
     if screen < maxiter:  # the chosen orders' linear model to convergence
-        th, sse, J, _ = _lm(_Problem(search.u, Nonlinearity(), Nonlinearity(), *o), search.y,
+        th, sse, J, _ = _lm(_problem(search.us, Nonlinearity(), Nonlinearity(), *o), search.y,
                             lin_fits[o][0], maxiter)
         lin_fits[o] = (th, sse, J)
     return o
@@ -936,26 +1018,56 @@ def _criterion(best: HWModel, orders_chosen: bool, auto: bool, chosen_by: str,
 def _finish(best: HWModel, search: _Search) -> HWModel:
     """Name what the data do not excite or determine (:func:`_excitation_check`, an
     AccuracyWarning for parameters with σ = inf) and set the free-run fits of ``best``."""
-    _excitation_check(best, search.u)
+    _excitation_check(best, search.us)
     loose = [n for n, sd in zip(best.names, best.theta_std) if not np.isfinite(sd)]
     if loose:
         emit_warning(f"hammerstein_wiener: the data do not determine {', '.join(loose)} of the "
                      f"{best.input_nl.label}/{best.output_nl.label} model (σ = inf: they trade "
                      "off against other parameters without changing the output); excite more "
                      "amplitudes, or choose a simpler block", AccuracyWarning)
-    fit = best.compare(search.u, search.y)
-    best.fit_percent = fit.fit_percent[0]
+    if search.R == 1:
+        best.fit_percent = best.compare(search.u, search.y).fit_percent[0]
+    else:  # each record from its own steady state; the fit over all their samples together
+        fits = [best.compare(ur, yr) for ur, yr in search.recs]
+        for rec, f in zip(best.records, fits):
+            rec["fit_percent"] = f.fit_percent[0]
+        ys = np.concatenate([f.simulated[:, 0] for f in fits])
+        best.fit_percent = _fit_value(search.y, ys) if np.all(np.isfinite(ys)) else None
     if search.uv is not None:
         best.validation_fit_percent = best.compare(search.uv, search.yv).fit_percent[0]
     return best
 
 
-def hammerstein_wiener(u, y, *, input_nonlinearity=None, output_nonlinearity=None,
+def _records(u, y) -> list:
+    """``(u, y)``, or ``u`` a list of records ``(u_i, y_i)`` when ``y`` is None → a list of
+    checked pairs (names ``records[i]``)."""
+    if y is not None:
+        return [(u, y)]
+    if not isinstance(u, (list, tuple)) or not u:
+        raise ArgumentError(f"hammerstein_wiener: without y, the data must be a non-empty list of "
+                            f"records (u, y), found {type(u).__name__}",
+                            hint="call hammerstein_wiener(u, y) or "
+                                 "hammerstein_wiener([(u1, y1), (u2, y2)])")
+    out = []
+    for i, pair in enumerate(u):
+        try:
+            ui, yi = pair
+        except (TypeError, ValueError):
+            raise ArgumentError(f"hammerstein_wiener: records[{i}] must be a pair (u, y) of 1-D "
+                                f"arrays, found {type(pair).__name__}") from None
+        out.append((ui, yi))
+    return out
+
+
+def hammerstein_wiener(u, y=None, *, input_nonlinearity=None, output_nonlinearity=None,
                        nb: int | None = None, nf: int | None = None, nk: int | None = None,
                        dt: float | None = None, validate=None, maxiter: int = 200,
                        progress: bool = False) -> HWModel:
     """Hammerstein, Wiener or Hammerstein–Wiener model of ``y`` driven by ``u`` (see the module
-    docstring).
+    docstring), or of several records: ``hammerstein_wiener([(u1, y1), (u2, y2), …])`` (each
+    record's free run from its own steady state, its own ``w₋`` estimated with θ; one SSE over
+    all of them, σ from all; ``fit_percent`` over all samples together and each record's in
+    ``records``).
 
     ``input_nonlinearity`` / ``output_nonlinearity``: ``'none'``, ``'saturation'``,
     ``'deadzone'``, ``'poly[:N]'``, ``'pwl[:N]'``, ``'sigmoid[:N]'``; when both are None the
@@ -965,7 +1077,15 @@ def hammerstein_wiener(u, y, *, input_nonlinearity=None, output_nonlinearity=Non
     ``validate=(u2, y2)`` when given, else by BIC. ``dt``: sample interval (s), default 1.
     ``progress``: a progress bar on stderr (one step per structure and start).
     """
-    u, y = _check_data(u, y, dt, maxiter)
+    recs = _records(u, y)
+    for i, (ui, yi) in enumerate(recs):
+        try:
+            recs[i] = _check_data(ui, yi, dt, maxiter)
+        except (DataError, ArgumentError) as exc:
+            if len(recs) == 1:
+                raise
+            raise type(exc)(exc.message.replace("hammerstein_wiener: ", f"records[{i}]: ", 1)
+                            .replace("hw: ", f"records[{i}]: ", 1), hint=exc.hint) from None
     auto = input_nonlinearity is None and output_nonlinearity is None
     structures = ([(parse_nonlinearity(a), parse_nonlinearity(b)) for a, b in AUTO_STRUCTURES]
                   if auto else [(parse_nonlinearity(input_nonlinearity, "input_nonlinearity"),
@@ -981,7 +1101,7 @@ def hammerstein_wiener(u, y, *, input_nonlinearity=None, output_nonlinearity=Non
     steps = (len(orders) + len(structures) + (N_JOINED**2 if auto else 0)
              + (len(dyn) - 1 if searched else 0))
     bar = iter(track(range(steps), total=steps, description="hw fit", enabled=progress))
-    search = _Search(u, y, validation, dt, maxiter, bar)
+    search = _Search(recs, validation, dt, maxiter, bar)
     o = _choose_orders(search, orders)
     cands = _fit_candidates(search, structures, o, auto)
     refit = _refit_dynamics(search, cands, o, dyn, searched)

@@ -179,6 +179,8 @@ class _HysteresisModel:
 
     structure = ""
     fit_definition = HYSTERESIS_FIT
+    #: with several estimation records: each one's ``n_samples`` and free-run ``fit_percent``
+    records = ()
 
     @property
     def inputs(self) -> tuple[str, ...]:
@@ -316,7 +318,8 @@ class BoucWenModel(_HysteresisModel):
                     output_name=self.output_name, input_unit=self.input_unit,
                     output_unit=self.output_unit, fit_percent=self.fit_percent,
                     validation_fit_percent=self.validation_fit_percent, burn_in=self.burn_in,
-                    criterion=self.criterion, fit_definition=HYSTERESIS_FIT)
+                    criterion=self.criterion, fit_definition=HYSTERESIS_FIT,
+                    **({"records": list(self.records)} if self.records else {}))
 
     def summary(self) -> str:
         sd = self.std
@@ -354,12 +357,18 @@ def _bw_transform_jacobian(theta_s, names, fixed, su, sy) -> np.ndarray:
     return T
 
 
-def _fit_bouc_wen(u, y, *, exponent, offset, burn_in, multistart, progress):
+def _fit_bouc_wen(recs, *, exponent, offset, burn_in, multistart, progress):
+    """Bouc-Wen (actuator form) on the records ``recs`` (a list of ``(u, y)``), each run from
+    h = 0 at its own first sample, its first ``burn_in`` samples not scored; one least squares
+    over all of them."""
     from scipy.optimize import least_squares
 
+    u = np.concatenate([r[0] for r in recs])
+    y = np.concatenate([r[1] for r in recs])
     su = 0.5 * float(np.ptp(u))
     sy = 0.5 * float(np.ptp(y))
     us, ys = u / su, y / sy
+    bounds = np.cumsum([0] + [len(r[0]) for r in recs])
     n_free = exponent == "free"
     n0 = 1.0 if n_free else float(exponent)
     names = ["d", "alpha", "beta", "gamma"] + (["n"] if n_free else []) + (
@@ -384,16 +393,17 @@ def _fit_bouc_wen(u, y, *, exponent, offset, burn_in, multistart, progress):
                   "offset": float(ys[0] - d0 * us[0]) if offset else 0.0}
             starts.append(np.array([p0[k] for k in names]))
     starts = starts[:max(1, int(multistart))]
-    sl = slice(burn_in, None)
-    target = ys[sl]
+    scored = np.concatenate([np.arange(a + burn_in, b) for a, b in zip(bounds, bounds[1:])])
+    target = ys[scored]
     buf = np.empty(len(us))
 
     def resid(th):
         p = dict(fixed)
         p.update(zip(names, th))
-        K.bw_simulate(us, p["d"], p["alpha"], p["beta"], p["gamma"], p["n"], p["offset"], 0.0,
-                      float(us[0]), buf)
-        r = buf[sl] - target
+        for a, b in zip(bounds, bounds[1:]):  # every record from h = 0 at its first sample
+            K.bw_simulate(us[a:b], p["d"], p["alpha"], p["beta"], p["gamma"], p["n"],
+                          p["offset"], 0.0, float(us[a]), buf[a:b])
+        r = buf[scored] - target
         return np.where(np.isfinite(r), r, 1e3)
 
     best = None
@@ -521,7 +531,8 @@ class BoucWenOscillatorModel(_HysteresisModel):
                     input_unit=self.input_unit, output_unit=self.output_unit,
                     fit_percent=self.fit_percent,
                     validation_fit_percent=self.validation_fit_percent, burn_in=self.burn_in,
-                    criterion=self.criterion, fit_definition=HYSTERESIS_FIT)
+                    criterion=self.criterion, fit_definition=HYSTERESIS_FIT,
+                    **({"records": list(self.records)} if self.records else {}))
 
     def summary(self) -> str:
         sd = self.std
@@ -758,7 +769,8 @@ class PrandtlIshlinskiiModel(_HysteresisModel):
                     input_unit=self.input_unit, output_unit=self.output_unit,
                     fit_percent=self.fit_percent,
                     validation_fit_percent=self.validation_fit_percent, burn_in=self.burn_in,
-                    criterion=self.criterion, fit_definition=HYSTERESIS_FIT)
+                    criterion=self.criterion, fit_definition=HYSTERESIS_FIT,
+                    **({"records": list(self.records)} if self.records else {}))
 
     def summary(self) -> str:
         rows = [f"Prandtl-Ishlinskii, {len(self.weights)} play operators ({self.criterion})"]
@@ -776,17 +788,23 @@ def default_thresholds(u: np.ndarray, operators: int) -> np.ndarray:
     return np.arange(operators) * (0.5 * float(np.ptp(u)) / operators)
 
 
-def _fit_pi(u, y, thresholds, *, offset, burn_in):
+def _fit_pi(recs, thresholds, *, offset, burn_in):
+    """Prandtl–Ishlinskii weights on the records ``recs`` (a list of ``(u, y)``), every play
+    relaxed at each record's own first sample; one least squares over their rows after
+    ``burn_in``."""
     from scipy.optimize import lsq_linear
 
     r = np.asarray(thresholds, dtype=np.float64)
     m = len(r)
-    P = np.empty((len(u), m))
-    K.play_matrix(u, r, P)
-    A = P[burn_in:]
+    rows = []
+    for u, _ in recs:
+        P = np.empty((len(u), m))
+        K.play_matrix(u, r, P)
+        rows.append(P[burn_in:])
+    A = np.vstack(rows)
     if offset:
         A = np.column_stack([A, np.ones(len(A))])
-    b = y[burn_in:]
+    b = np.concatenate([y[burn_in:] for _, y in recs])
     if len(b) < 2 * A.shape[1]:
         raise DataError(f"prandtl-ishlinskii: {len(b)} samples for {A.shape[1]} parameters; "
                         f"give at least {2 * A.shape[1]} or fewer operators")
@@ -821,6 +839,50 @@ def _check_int(v, name: str, lo: int) -> int:
     return int(v)
 
 
+def _is_records(data) -> bool:
+    """``data`` is a list of records (Trajectories or pairs ``(u, y)``), not one pair."""
+    if not isinstance(data, (list, tuple)):
+        return False
+    if any(isinstance(d, Trajectory) for d in data):
+        return True
+    return bool(data) and all(isinstance(d, (list, tuple)) and len(d) == 2 for d in data)
+
+
+def _records(data, input, output):
+    """Several records → ``(recs, dt, iname, oname, iunit, ounit)``, each record checked as one
+    is, its errors naming ``data[i]``; every record sampled alike and in the same units."""
+    if not data:
+        raise DataError("hysteresis: data must be a Trajectory, a pair (u, y) or a non-empty list "
+                        "of them, found an empty list")
+    recs, first = [], None
+    for i, d in enumerate(data):
+        what = f"hysteresis data[{i}]"
+        if not isinstance(d, Trajectory) and not (isinstance(d, (list, tuple)) and len(d) == 2):
+            raise DataError(f"{what}: expected a Trajectory or a pair (u, y), found "
+                            f"{type(d).__name__}")
+        u, y, dt, iname, oname, iunit, ounit = _record(d, input, output, what)
+        if first is None:
+            first = (dt, iname, oname, iunit, ounit)
+        else:
+            dt0, _, _, iu0, ou0 = first
+            if (dt is None) != (dt0 is None) or (dt is not None and abs(dt - dt0) > 1e-9 * dt0):
+                rate = lambda h: "an unknown rate" if h is None else f"{1 / h:g} Hz"  # noqa: E731
+                raise DataError(f"{what} is sampled at {rate(dt)}, data[0] at {rate(dt0)}: the "
+                                "records of one fit must share the sample interval",
+                                hint="resample one of them")
+            for col, a, b in ((iname, iu0, iunit), (oname, ou0, ounit)):
+                if a != b:
+                    raise DataError(f"{what}: column {col!r} is in {b!r}, in data[0] in {a!r}: "
+                                    "the records of one fit must use the same units",
+                                    hint="convert one of them")
+        try:
+            _check_excited(u, y, iname, oname)
+        except DataError as exc:
+            raise DataError(exc.message.replace("hysteresis", what, 1), hint=exc.hint) from None
+        recs.append((u, y))
+    return (recs, *first)
+
+
 def hysteresis(data, model: str = "bouc-wen", *, input: str | None = None,
                output: str | None = None, form: str = "actuator", exponent=1.0,
                operators: int = 10, thresholds=None, offset: bool = True, burn_in: int = 0,
@@ -828,7 +890,12 @@ def hysteresis(data, model: str = "bouc-wen", *, input: str | None = None,
                progress: bool = True):
     """Identify a hysteresis model of ``output`` driven by ``input``.
 
-    ``data``: a Trajectory (columns ``input``, ``output``) or a pair of arrays ``(u, y)``.
+    ``data``: a Trajectory (columns ``input``, ``output``) or a pair of arrays ``(u, y)``, or a
+    list of them: several records fitted by one model (Bouc-Wen actuator form and
+    Prandtl–Ishlinskii), each run from its own relaxed state (h = 0, every play at its first
+    input) with its own first ``burn_in`` samples unscored, one least squares over all of them
+    (σ from all); ``fit_percent`` over all scored samples together, each record's in
+    ``records``.
     ``model``: ``"bouc-wen"`` (actuator form; ``exponent`` n ≥ 1, default 1 = the seed's eq 3, or
     ``"free"`` to estimate it; ``multistart`` starting points; ``form="oscillator"``: the
     rate-dependent Bouc-Wen oscillator :class:`BoucWenOscillatorModel`, from rest, ``substeps``
@@ -844,16 +911,24 @@ def hysteresis(data, model: str = "bouc-wen", *, input: str | None = None,
     if model not in MODELS:
         raise ArgumentError(f"hysteresis: model must be one of {', '.join(MODELS)}, found "
                             f"{model!r}")
-    u, y, dt0, iname, oname, iunit, ounit = _record(data, input, output, "hysteresis")
+    if _is_records(data):
+        recs, dt0, iname, oname, iunit, ounit = _records(data, input, output)
+    else:
+        u, y, dt0, iname, oname, iunit, ounit = _record(data, input, output, "hysteresis")
+        recs = [(u, y)]
+    u = np.concatenate([r[0] for r in recs])
     dt = dt0 if dt is None else dt
     if dt is not None and not (isinstance(dt, (int, float, np.floating)) and math.isfinite(dt)
                                and dt > 0):
         raise ArgumentError(f"hysteresis: dt must be a positive sample interval in s, found {dt!r}")
     burn_in = _check_int(burn_in, "burn_in", 0)
-    if burn_in > len(u) - 10:
-        raise ArgumentError(f"hysteresis: burn_in = {burn_in} leaves fewer than 10 of the "
-                            f"{len(u)} samples to fit; lower it")
-    _check_excited(u, y, iname, oname)
+    for i, (ur, _) in enumerate(recs):
+        if burn_in > len(ur) - 10:
+            raise ArgumentError(f"hysteresis: burn_in = {burn_in} leaves fewer than 10 of the "
+                                f"{len(ur)} samples{f' of data[{i}]' * (len(recs) > 1)} to fit; "
+                                "lower it")
+    if len(recs) == 1:
+        _check_excited(*recs[0], iname, oname)
     if validate is not None:
         uv, yv, *_ = _record(validate, iname, oname, "hysteresis validate")
     common = dict(dt=dt, input_name=iname, output_name=oname, input_unit=iunit,
@@ -871,6 +946,12 @@ def hysteresis(data, model: str = "bouc-wen", *, input: str | None = None,
         how = (f"free-run least squares, {multistart} start(s), n "
                + ("estimated" if exponent == "free" else f"= {exponent:g}"))
     if model == "bouc-wen" and form == "oscillator":
+        if len(recs) > 1:
+            raise ArgumentError(f"hysteresis: the Bouc-Wen oscillator is fitted to one record, "
+                                f"found {len(recs)}",
+                                hint="fit the actuator form or Prandtl-Ishlinskii to several "
+                                     "records, or pass one record")
+        u, y = recs[0]
         substeps = _check_int(substeps, "substeps", 1)
         if dt is None:
             raise ArgumentError("hysteresis: the Bouc-Wen oscillator is rate dependent: give the "
@@ -883,7 +964,7 @@ def hysteresis(data, model: str = "bouc-wen", *, input: str | None = None,
         m = BoucWenOscillatorModel(**phys, substeps=substeps, free=names, covariance=cov,
                                    **common, criterion=how)
     elif model == "bouc-wen":
-        phys, names, cov = _fit_bouc_wen(u, y, exponent=exponent, offset=offset,
+        phys, names, cov = _fit_bouc_wen(recs, exponent=exponent, offset=offset,
                                          burn_in=burn_in, multistart=multistart,
                                          progress=progress)
         m = BoucWenModel(**phys, free=names, covariance=cov, **common, criterion=how)
@@ -902,7 +983,7 @@ def hysteresis(data, model: str = "bouc-wen", *, input: str | None = None,
                             f"thresholds ≥ {half:g} never move on a loop",
                             hint="give thresholds below half the input's range, or record a "
                                  "wider sweep")
-        w, c, cov, at_bound = _fit_pi(u, y, r, offset=offset, burn_in=burn_in)
+        w, c, cov, at_bound = _fit_pi(recs, r, offset=offset, burn_in=burn_in)
         m = PrandtlIshlinskiiModel(r, w, offset=c, covariance=cov, fit_offset=bool(offset),
                                    **common,
                                    criterion=f"{len(r)} plays, weights ≥ 0 by bounded least "
@@ -910,8 +991,16 @@ def hysteresis(data, model: str = "bouc-wen", *, input: str | None = None,
         if w[0] <= 0:
             emit_warning("prandtl-ishlinskii: w_0 (the play of threshold 0) came out 0, so the "
                          "model has no inverse (invert() will refuse it)", AccuracyWarning)
-    yhat = m.simulate(u)[:, 0]
-    m.fit_percent = _fit_percent(y[burn_in:], yhat[burn_in:])
+    if len(recs) == 1:
+        u, y = recs[0]
+        yhat = m.simulate(u)[:, 0]
+        m.fit_percent = _fit_percent(y[burn_in:], yhat[burn_in:])
+    else:  # every record from its own relaxed state; the fit over all scored samples together
+        runs = [m.simulate(ur)[burn_in:, 0] for ur, _ in recs]
+        m.records = [{"n_samples": len(ur), "fit_percent": _fit_percent(yr[burn_in:], s)}
+                     for (ur, yr), s in zip(recs, runs)]
+        m.fit_percent = _fit_percent(np.concatenate([yr[burn_in:] for _, yr in recs]),
+                                     np.concatenate(runs))
     if validate is not None:
         m.validation_fit_percent = m.compare((uv, yv)).fit_percent[0]
     return m

@@ -652,13 +652,59 @@ def _positive_int(v, name: str, lo: int = 1) -> int:
     return int(v)
 
 
+def _is_records(data) -> bool:
+    """``data`` is a list of records (Trajectories or pairs ``(u, y)``), not one pair."""
+    from ...signals.trajectory import Trajectory
+
+    if not isinstance(data, (list, tuple)) or not data:
+        return False
+    if any(isinstance(d, Trajectory) for d in data):
+        return True
+    return all(isinstance(d, (list, tuple)) and len(d) == 2 for d in data)
+
+
+def _io_records(data, input, output):
+    """Several records → (list of (u, y), dt, names and units of data[0]); each record read and
+    checked as one is, named ``data[i]``; all with the same columns, sampling and units."""
+    recs, first = [], None
+    for i, d in enumerate(data):
+        u, y, dt, ins, outs, iu, ou = _io(d, input, output, f"data[{i}]")
+        _check_signals(u, y, f"data[{i}]")
+        if first is None:
+            first = (dt, ins, outs, iu, ou)
+        else:
+            dt0, ins0, outs0, iu0, ou0 = first
+            if u.shape[1] != len(ins0) or y.shape[1] != len(outs0):
+                raise DataError(f"nlss: data[{i}] has {u.shape[1]} input(s) and {y.shape[1]} "
+                                f"output(s), data[0] {len(ins0)} and {len(outs0)}: the records "
+                                "of one fit must have the same columns")
+            if (dt is None) != (dt0 is None) or (dt is not None and abs(dt - dt0) > 1e-9 * dt0):
+                rate = lambda h: "an unknown rate" if h is None else f"{1 / h:g} Hz"  # noqa: E731
+                raise DataError(f"nlss: data[{i}] is sampled at {rate(dt)}, data[0] at "
+                                f"{rate(dt0)}: the records of one fit must share the sample "
+                                "interval", hint="resample one of them")
+            for col, a, b in zip(ins0 + outs0, iu0 + ou0, iu + ou):
+                if a != b:
+                    raise DataError(f"nlss: data[{i}]: column {col!r} is in {b!r}, in data[0] in "
+                                    f"{a!r}: the records of one fit must use the same units",
+                                    hint="convert one of them")
+        recs.append((u, y))
+    return (recs, *first)
+
+
 def nlss(data, *, input=None, output=None, order: int | None = None, degree: int = 3,
          validate=None, dt: float | None = None, window: int | None = None, max_order: int = 4,
          feedthrough: bool = False, max_iterations: int = 100, progress: bool = True) -> NLSSModel:
     """Polynomial nonlinear state-space model (PNLSS, module docstring) of a record.
 
     ``data``: a :class:`~gripkit.signals.Trajectory` with ``input``/``output`` naming its
-    columns (``'a,b'`` or a list for several), or a pair ``(u, y)`` of arrays (N,) or (N, k).
+    columns (``'a,b'`` or a list for several), or a pair ``(u, y)`` of arrays (N,) or (N, k);
+    or a list of them: several records of one system fitted by one model, each record with its
+    own initial state (estimated), one operating point (the means of all records), the linear
+    start from :func:`gripkit.sysid.linear.subspace.n4sid_records`, the windows of stage 2 inside
+    the records (never across a seam), stage 3 with one window per record, σ from all of them
+    (the first-8000-samples warm start of one long record is not used);
+    ``fit_percent`` over all records, each one's in ``info['records']``.
     ``order``: states (default: n at the largest gap s_n/s_(n+1) among the first ``max_order``
     subspace singular values and n + 1 are fitted, and the one of lower BIC = N Σᵢ ln σ̂ᵢ² +
     k ln N is kept (σ̂ᵢ² the mean squared free-run error of output i, k the free parameters and
@@ -670,8 +716,15 @@ def nlss(data, *, input=None, output=None, order: int | None = None, degree: int
     ``max_iterations``: Levenberg-Marquardt iterations per stage. ``progress``: a progress bar
     on stderr.
     """
-    u, y, tr_dt, ins, outs, iunits, ounits = _io(data, input, output, "data")
-    _check_signals(u, y, "data")
+    if _is_records(data):
+        recs, tr_dt, ins, outs, iunits, ounits = _io_records(data, input, output)
+        u, y = np.vstack([r[0] for r in recs]), np.vstack([r[1] for r in recs])
+    else:
+        u, y, tr_dt, ins, outs, iunits, ounits = _io(data, input, output, "data")
+        _check_signals(u, y, "data")
+        recs = [(u, y)]
+    bounds = np.cumsum([0] + [len(r[0]) for r in recs]).astype(np.int64)
+    several = len(recs) > 1
     N, m = u.shape
     p = y.shape[1]
     degree = _positive_int(degree, "degree", 2)
@@ -732,9 +785,29 @@ def nlss(data, *, input=None, output=None, order: int | None = None, degree: int
         notes = list(dict.fromkeys(str(c.message) for c in caught))
         return None if lm is None else (lm, notes)
 
+    def linear_records(n):  # one subspace model of all records, one x0 each
+        from ..linear.subspace import n4sid_records
+
+        with warnings.catch_warnings(record=True) as caught:  # the start, not the result
+            warnings.simplefilter("always")
+            try:
+                lm = n4sid_records([(ut[a:b], (y - y_off)[a:b]) for a, b in
+                                    zip(bounds[:-1], bounds[1:])], n, dt=dt,
+                                   feedthrough=feedthrough)
+            except np.linalg.LinAlgError:
+                return None
+        notes = list(dict.fromkeys(str(c.message) for c in caught))
+        return lm, notes
+
+    if order is None and several:  # the same gap, of the records' stacked Hankel matrices
+        from ..linear.subspace import RecordsFactor
+
+        sv = RecordsFactor([(ut[a:b], (y - y_off)[a:b]) for a, b in zip(bounds[:-1], bounds[1:])],
+                           default_horizon(max_order, p), "n4sid").s
     if order is None:  # the largest gap among the first max_order singular values
-        sv = subspace_factor(ut, y - y_off, horizon=default_horizon(max_order, p),
-                             method="n4sid").s
+        sv = sv if several else subspace_factor(ut, y - y_off,
+                                                horizon=default_horizon(max_order, p),
+                                                method="n4sid").s
         k = min(max_order, sv.size - 1)
         n_sv = int(np.argmax(sv[:k] / np.maximum(sv[1:k + 1], 1e-300 * sv[0]))) + 1
         while n_sv > 1 and N * p < 4 * n_par(n_sv):  # no more parameters than data allow
@@ -746,12 +819,15 @@ def nlss(data, *, input=None, output=None, order: int | None = None, degree: int
         [k for k in around if 1 <= k <= max_order and (k == n_sv or N * p >= 4 * n_par(k))]
     best = None
     for n in candidates:
-        start = linear(n)
+        start = linear_records(n) if several else linear(n)
         if start is None:
             continue
         lin_n, notes = start
+        x0s = [r["x0"] for r in lin_n.info["records"]] if several else None
         mdl = _fit_order(lin_n, ut, yc, u_off, sd_u, y_off, degree, feedthrough, window,
-                         max_iterations, progress, dt, ins, outs, iunits, ounits, levels)
+                         max_iterations, progress, dt, ins, outs, iunits, ounits, levels,
+                         bounds, x0s)
+        x0s = mdl.info.pop("_x0s", [mdl.x0])
         if notes:
             mdl.info["linear_start"] = " | ".join(notes)
         if val is not None:
@@ -766,7 +842,7 @@ def nlss(data, *, input=None, output=None, order: int | None = None, degree: int
             if mdl.fit_percent is None:
                 score = -np.inf
             else:
-                e = yc - mdl._run(ut, mdl.x0)[0]
+                e = yc - _run_records(mdl, ut, bounds, x0s)[0]
                 score = -(N * float(np.sum(np.log(np.maximum(np.mean(e * e, axis=0), 1e-300))))
                           + k * math.log(N))
             mdl.info["bic"] = None if not np.isfinite(score) else -score
@@ -800,9 +876,37 @@ def nlss(data, *, input=None, output=None, order: int | None = None, degree: int
     return model
 
 
+def _run_records(model: NLSSModel, ut, bounds, x0s):
+    """The free run of every record (rows ``bounds[r]:bounds[r+1]`` of ``ut``) from its own
+    initial state → (Y stacked, the first diverging sample or −1)."""
+    Ys = []
+    for r, x0 in enumerate(x0s):
+        a, b = int(bounds[r]), int(bounds[r + 1])
+        Y, at = model._run(np.ascontiguousarray(ut[a:b]), x0)
+        if at >= 0:
+            return None, a + at
+        Ys.append(Y)
+    return np.vstack(Ys), -1
+
+
+def _record_windows(bounds, L: int) -> np.ndarray:
+    """Window starts of ``L`` samples inside each record (a short tail joins the record's last
+    window; no window crosses from one record into the next), and the end."""
+    starts = []
+    for a, b in zip(bounds[:-1], bounds[1:]):
+        st = np.arange(a, b, L, dtype=np.int64)
+        if b - st[-1] < L // 2 and len(st) > 1:
+            st = st[:-1]
+        starts.append(st)
+    return np.append(np.concatenate(starts), bounds[-1]).astype(np.int64)
+
+
 def _fit_order(lin, ut, y, u_off, sd_u, y_off, degree, feedthrough, window, max_iterations,
-               progress, dt, ins, outs, iunits, ounits, levels) -> NLSSModel:
-    """Stages 1-3 of the module docstring for one order."""
+               progress, dt, ins, outs, iunits, ounits, levels, bounds=None,
+               x0s=None) -> NLSSModel:
+    """Stages 1-3 of the module docstring for one order. Several records: ``bounds`` their
+    first rows in ``ut``, ``y`` and the end, ``x0s`` their initial states of the linear start;
+    each record runs from its own initial state and no window crosses a seam."""
     from ...progress import status, track
 
     ss = lin.system
@@ -812,6 +916,11 @@ def _fit_order(lin, ut, y, u_off, sd_u, y_off, degree, feedthrough, window, max_
     A, B, C = (np.array(M, dtype=np.float64) for M in (ss.A, ss.B, ss.C))
     D = np.array(ss.D, dtype=np.float64) if feedthrough else np.zeros((p, m))
     x0 = np.zeros(n) if lin.x0 is None else np.array(lin.x0, dtype=np.float64).ravel()
+    if bounds is not None and len(bounds) > 2:
+        return _fit_order_records(ss, A, B, C, D, ut, y, u_off, sd_u, y_off, degree,
+                                  feedthrough, window, max_iterations, progress, dt, ins, outs,
+                                  iunits, ounits, levels, np.asarray(bounds, dtype=np.int64),
+                                  [np.asarray(z, dtype=np.float64).ravel() for z in x0s])
     exz = monomial_exponents(n, m, degree, inputs=True, input_levels=levels)
     exe = monomial_exponents(n, m, degree, inputs=feedthrough, input_levels=levels)
     base = NLSSModel(A=A, B=B, C=C, D=D, E=np.zeros((n, len(exz))), F=np.zeros((p, len(exe))),
@@ -912,5 +1021,116 @@ def _fit_order(lin, ut, y, u_off, sd_u, y_off, degree, feedthrough, window, max_
                   "loss": float(V / N), "hessian_condition": cond, "_linear": lin_model}
     if progress:
         status(f"nlss order {n}: {' + '.join(map(str, its))} iterations, "
+               f"{time.perf_counter() - t_start:.1f} s")
+    return model
+
+
+def _fit_order_records(ss, A, B, C, D, ut, y, u_off, sd_u, y_off, degree, feedthrough, window,
+                       max_iterations, progress, dt, ins, outs, iunits, ounits, levels, bounds,
+                       x0s) -> NLSSModel:
+    """:func:`_fit_order` for several records (rows ``bounds[r]:bounds[r+1]``): the linear
+    start's states scaled over all records; stage 2 on windows inside each record; stage 3 with
+    one window per record (each record's free run from its own estimated initial state); σ from
+    the Gauss-Newton Hessian with every record's initial state a parameter."""
+    from ...progress import status, track
+
+    N, m = ut.shape
+    p = y.shape[1]
+    n = A.shape[0]
+    R = len(bounds) - 1
+    exz = monomial_exponents(n, m, degree, inputs=True, input_levels=levels)
+    exe = monomial_exponents(n, m, degree, inputs=feedthrough, input_levels=levels)
+    base = NLSSModel(A=A, B=B, C=C, D=D, E=np.zeros((n, len(exz))), F=np.zeros((p, len(exe))),
+                     exz=exz, exe=exe, u_offset=u_off, u_scale=sd_u, y_offset=y_off,
+                     dirs=np.zeros((0, 3), dtype=np.int64), covariance=np.zeros((0, 0)),
+                     x0=x0s[0], state_limit=np.inf, dt=float(dt), degree=degree,
+                     feedthrough=feedthrough, input_names=ins, output_names=outs,
+                     input_units=iunits, output_units=ounits)
+    X, Y = np.empty((N, n)), np.empty((N, p))
+    for r, x0 in enumerate(x0s):
+        a, b = bounds[r], bounds[r + 1]
+        K.simulate_kernel(A, B, C, D, base.E, base.F, y_off, exz, exe, x0,
+                          np.ascontiguousarray(ut[a:b]), Y[a:b], X[a:b], np.inf)
+    if not np.all(np.isfinite(X)):
+        raise IdentificationError("nlss: the linear start (n4sid) does not give a finite free "
+                                  "run on the records; check them")
+    s = X.std(axis=0)
+    s[s <= 1e-12 * max(float(s.max()), 1e-300)] = 1.0
+    T, Ti = np.diag(1.0 / s), np.diag(s)
+    A, B, C, X = T @ A @ Ti, T @ B, C @ Ti, X / s
+    x0s = [x0 / s for x0 in x0s]
+    limit = DIVERGENCE_FACTOR * max(1.0, float(np.abs(X).max()))
+    base = replace(base, A=A, B=B, C=C, x0=x0s[0], state_limit=limit)
+    lin_fit = _fits(y, Y)
+    err = y - Y
+    w = 1.0 / np.maximum(np.sqrt(np.mean(err * err, axis=0)), 1e-12 * y.std(axis=0))
+    dirs = np.vstack([_free_linear_entries(A, B, C, D, feedthrough),
+                      np.array([(4, r, c) for r in range(n) for c in range(len(exz))],
+                               dtype=np.int64).reshape(-1, 3),
+                      np.array([(5, r, c) for r in range(p) for c in range(len(exe))],
+                               dtype=np.int64).reshape(-1, 3),
+                      np.array([(6, r, 0) for r in range(p)], dtype=np.int64)])
+    shortest = int(np.min(np.diff(bounds)))
+    rad = float(np.max(np.abs(np.linalg.eigvals(A)))) if n else 0.0
+    tau = -1.0 / math.log(min(max(rad, 1e-6), 1 - 1e-9))
+    L = window if window is not None else int(min(max(50, 10 * tau), shortest))
+    L = min(max(L, -(-N // 200)), shortest)
+    starts = _record_windows(bounds, L)
+    Z = np.ascontiguousarray(X[starts[:-1]])
+    first = np.searchsorted(starts, bounds[:-1])  # the window that opens each record
+    bar = track(range(2 * max_iterations), description=f"nlss order {n}", enabled=progress)
+    t_start = time.perf_counter()
+    if progress:
+        status(f"nlss order {n} degree {degree}: {dirs.shape[0]} parameters; Levenberg-Marquardt "
+               f"on {len(starts) - 1} windows of {L} samples inside {R} records, then each "
+               "whole record")
+    try:
+        tick = lambda: next(bar, None)  # noqa: E731
+        model, Z, _, it1, _ = _lm(base, dirs, Z, starts, ut, y, w, max_iterations, tick)
+        Z0 = np.ascontiguousarray(Z[first])
+        if not np.isfinite(_loss(model, Z0, bounds, ut, y, w)):
+            model, Z0 = base, np.ascontiguousarray(np.array(x0s))
+        model, Z0, V, it2, conv2 = _lm(model, dirs, Z0, bounds, ut, y, w, max_iterations, tick)
+        if not np.isfinite(V):
+            raise IdentificationError("nlss: the free run of the model diverges on the "
+                                      "estimation records at every step tried; lower the "
+                                      "degree or the order")
+    finally:
+        bar.close()
+    V, Htt, gt, Htz, Hzz, gz = _gram(model, dirs, Z0, bounds, ut, y, w)
+    P = dirs.shape[0]
+    H = np.zeros((P + R * n, P + R * n))
+    H[:P, :P] = Htt
+    for r in range(R):
+        sl = slice(P + r * n, P + (r + 1) * n)
+        H[:P, sl], H[sl, :P], H[sl, sl] = Htz[r], Htz[r].T, Hzz[r]
+    dof = N * p - P - R * n
+    s2 = V / max(dof, 1)
+    sc = np.sqrt(np.maximum(np.diag(H), 1e-300))
+    Hs = H / np.outer(sc, sc)
+    try:
+        cov = s2 * np.linalg.inv(Hs)[:P, :P] / np.outer(sc[:P], sc[:P])
+    except np.linalg.LinAlgError:
+        raise IdentificationError("nlss: the Jacobian is singular at the optimum: the data do "
+                                  "not determine every monomial (a poorly exciting input)",
+                                  hint="lower the degree or the order, or excite more richly") \
+            from None
+    model = replace(model, dirs=dirs, covariance=0.5 * (cov + cov.T), x0=Z0[0].copy())
+    Yf, at = _run_records(model, ut, bounds, list(Z0))
+    model.fit_percent = None if at >= 0 else _fits(y, Yf)
+    model.linear_fit_percent = lin_fit
+    lin_model = replace(base, dirs=np.zeros((0, 3), dtype=np.int64), covariance=np.zeros((0, 0)))
+    records = []
+    for r in range(R):
+        a, b = bounds[r], bounds[r + 1]
+        records.append({"n_samples": int(b - a), "x0": [float(v) for v in Z0[r]],
+                        "fit_percent": None if at >= 0 else _fits(y[a:b], Yf[a:b])})
+    model.info = {"iterations_windows": it1, "iterations_whole": it2, "converged": bool(conv2),
+                  "windows": len(starts) - 1, "window": int(L), "parameters": int(P),
+                  "loss_linear": float(np.sum((w * err) ** 2) / N), "loss": float(V / N),
+                  "hessian_condition": float(np.linalg.cond(Hs)), "records": records,
+                  "_linear": lin_model, "_x0s": [z.copy() for z in Z0]}
+    if progress:
+        status(f"nlss order {n}: {it1} + {it2} iterations, "
                f"{time.perf_counter() - t_start:.1f} s")
     return model
