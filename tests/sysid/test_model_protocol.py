@@ -131,8 +131,6 @@ def test_round_trip_same_type_attributes_simulation_and_fit(family, tmp_path):
         assert min(fit.fit_percent) > 90.0
 
 
-@pytest.mark.xfail(strict=True, reason="issue 23 not done: arx of several columns still returns "
-                   "the LinearModel of sysid/linear/arx_mimo.py")
 def test_arx_returns_one_type_whatever_the_number_of_inputs():
     types = {type(FAMILIES[k][0]) for k in ("arx siso", "arx miso", "arx mimo")}
     assert types == {PolynomialModel}, types
