@@ -63,5 +63,6 @@ def test_identify_dispatches_several_columns_to_mimo_arx():
     u, y = _data(2000, seed=3)
     tr = Trajectory.uniform(dt=0.01, u0=u[:, 0], u1=u[:, 1], u2=u[:, 2] + 5.0, y0=y[:, 0], y1=y[:, 1])
     m = identify(tr, "arx", input="u0,u1,u2", output=["y0", "y1"], na=1, nb=2, nk=1)
+    assert type(m) is type(arx(u[:, 0], y[:, 0], 1, 2, 1))  # one type: PolynomialModel
     assert m.inputs == ("u0", "u1", "u2") and m.u_offset[2] == pytest.approx(5.0, abs=0.1)
     assert np.all(np.abs(m.A[1] - A1) <= 4 * m.A_std[1])
