@@ -15,6 +15,16 @@ Arrays hold the coefficients in increasing powers of q⁻¹: ``A = [1, a_1, ...,
 
 Parameter names follow the powers of q⁻¹ (Table III of the seed: ``a1 a2 b2 b3`` for ``[2 2 2]``).
 
+Several inputs or outputs (ARX only, ``arx`` returns this one type whatever the number of
+channels): ``A`` (na+1, p, p) with ``A[0] = I`` and ``B`` (nk+nb, p, m) with ``nk`` leading zero
+matrices are matrix polynomials, ``A(q) y(t) = B(q) u(t) + e(t)``; ``A_std``, ``B_std`` have
+their shapes, ``covariance`` is over θ row by row (output 0 first: ``a1_0_0 … b_nk_0_0 …``,
+:mod:`.matrix_polynomial`), ``noise_variance`` is Λ (p, p), ``fit_percent`` the one-step fit per
+output, names, units and offsets one per channel. The ``system`` is then the state-space
+realisation of :mod:`.matrix_polynomial` (the one the former MIMO ``LinearModel`` had), the
+one-step predictor the exact matrix difference equation, ``horizon > 1`` the realisation's
+innovation form (K = [I; 0]). With one input and one output every array stays 1-D, as below.
+
 :class:`PolynomialModel` is an :class:`~gripkit.sysid.linear.linear_model.IdentifiedLinearModel`:
 its ``system`` is the discrete transfer function B/(A F); simulation, comparison, prediction,
 the report, the model file and the conversions are the protocol's (one set of names for every
@@ -83,8 +93,9 @@ def _coeffs(x, name: str, monic: bool) -> np.ndarray:
 
 @dataclass(frozen=True, eq=False)
 class PolynomialModel(IdentifiedLinearModel):
-    """A discrete-time SISO polynomial model with its uncertainty and fit diagnostics, on the
-    protocol of :class:`~gripkit.sysid.linear.linear_model.IdentifiedLinearModel`.
+    """A discrete-time polynomial model with its uncertainty and fit diagnostics, on the
+    protocol of :class:`~gripkit.sysid.linear.linear_model.IdentifiedLinearModel`: SISO ARX,
+    ARMAX, OE, or a MIMO ARX of matrix polynomials (see the module docstring).
 
     Build one with :func:`gripkit.sysid.linear.arx`, :func:`~gripkit.sysid.linear.armax`,
     :func:`~gripkit.sysid.linear.oe`, or from known coefficients with :meth:`from_coefficients`.
@@ -266,10 +277,13 @@ class PolynomialModel(IdentifiedLinearModel):
         """
         B = np.asarray(B, dtype=np.float64)
         if nk is None:
-            nz = np.flatnonzero(B)
+            nz = np.flatnonzero(B.reshape(len(B), -1).any(axis=1) if B.ndim == 3 else B)
             if nz.size == 0:
                 raise ModelError("B is all zeros: the model has no input path")
             nk = int(nz[0])
+        if B.ndim == 3 and std is not None:
+            raise ModelError("std: give a MIMO model's uncertainty as covariance=… (over θ, "
+                             "output 0's row first)")
         if structure is None:
             structure = "oe" if np.size(F) > 1 else ("armax" if np.size(C) > 1 else "arx")
         m = cls(A=A, B=B, nk=nk, C=C, F=F, dt=dt, structure=structure, **kw)
@@ -714,7 +728,12 @@ class PolynomialModel(IdentifiedLinearModel):
 
     def validate(self, u, y, **kw):
         """Free-run and one-step validation on a separate record; see
-        :func:`gripkit.sysid.validate`."""
+        :func:`gripkit.sysid.validate` (one input and one output; a MIMO model: :meth:`compare`
+        and :meth:`residuals`)."""
+        if self.multivariable:
+            raise ModelError(f"validate: {self.label} has {self.n_inputs} inputs and "
+                             f"{self.n_outputs} outputs; validate takes one of each",
+                             hint="use model.compare(data) and model.residuals(data)")
         return validate(self, u, y, **kw)
 
     # ------------------------------------------------------------------ exports
