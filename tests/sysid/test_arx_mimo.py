@@ -23,13 +23,12 @@ def _data(N=4000, seed=0, noise=0.1):
 def test_recovers_matrix_polynomials_within_sigma():
     u, y = _data()
     m = arx(u, y, 1, 2, 1, dt=0.01)
-    info = m.info
-    for est, sd, true in ((info["A_poly"][0], info["A_poly_std"][0], A1),
-                          (info["B_poly"][0], info["B_poly_std"][0], B1),
-                          (info["B_poly"][1], info["B_poly_std"][1], B2)):
+    for est, sd, true in ((m.A[1], m.A_std[1], A1),
+                          (m.B[1], m.B_std[1], B1),
+                          (m.B[2], m.B_std[2], B2)):
         assert np.all(np.abs(np.asarray(est) - true) <= 4 * np.asarray(sd))
     assert m.noise_covariance == pytest.approx(0.01 * np.eye(2), abs=0.002)
-    assert m.stable and min(m.info["one_step_fit_percent"]) > 90
+    assert m.stable and min(m.fit_percent) > 90
     assert np.allclose(np.sort(np.abs(m.system.poles()))[-2:], np.sort(np.abs(np.linalg.eigvals(-A1))), atol=0.02)
 
 
@@ -42,8 +41,8 @@ def test_one_step_predictor_of_the_realisation_is_the_arx_predictor():
     s = m.system
     e = np.empty_like(y[2:])
     x0 = np.concatenate([y[1], u[1], u[0]])            # state at t = 2: y(1), u(1), u(0)
-    predict_errors(s.A, s.B, s.C, s.D, m.K, x0, u[2:], y[2:], e)
-    A, B1e, B2e = -np.asarray(m.info["A_poly"][0]), np.asarray(m.info["B_poly"][0]), np.asarray(m.info["B_poly"][1])
+    predict_errors(s.A, s.B, s.C, s.D, m.innovation_form()[4], x0, u[2:], y[2:], e)
+    A, B1e, B2e = -m.A[1], m.B[1], m.B[2]
     direct = y[2:] - (y[1:-1] @ A.T + u[1:-1] @ B1e.T + u[:-2] @ B2e.T)
     assert np.allclose(e, direct, atol=1e-12)
 
@@ -53,7 +52,7 @@ def test_sigma_honest_monte_carlo_small():
     for k in range(20):
         u, y = _data(800, seed=100 + k)
         m = arx(u, y, 1, 2, 1)
-        hits.append(np.mean(np.abs(np.asarray(m.info["A_poly"][0]) - A1) <= 3 * np.asarray(m.info["A_poly_std"][0])))
+        hits.append(np.mean(np.abs(m.A[1] - A1) <= 3 * m.A_std[1]))
     assert np.mean(hits) >= 0.9
 
 
@@ -64,5 +63,6 @@ def test_identify_dispatches_several_columns_to_mimo_arx():
     u, y = _data(2000, seed=3)
     tr = Trajectory.uniform(dt=0.01, u0=u[:, 0], u1=u[:, 1], u2=u[:, 2] + 5.0, y0=y[:, 0], y1=y[:, 1])
     m = identify(tr, "arx", input="u0,u1,u2", output=["y0", "y1"], na=1, nb=2, nk=1)
+    assert type(m) is type(arx(u[:, 0], y[:, 0], 1, 2, 1))  # one type: PolynomialModel
     assert m.inputs == ("u0", "u1", "u2") and m.u_offset[2] == pytest.approx(5.0, abs=0.1)
-    assert np.all(np.abs(np.asarray(m.info["A_poly"][0]) - A1) <= 4 * np.asarray(m.info["A_poly_std"][0]))
+    assert np.all(np.abs(m.A[1] - A1) <= 4 * m.A_std[1])

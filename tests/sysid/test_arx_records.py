@@ -168,13 +168,13 @@ def test_mimo_one_record_is_arx_mimo_and_two_records_pool():
     r2 = simulate_mimo(1500, seed=15, y_init=(-9.0, 7.0))
     one = arx_mimo(*r1, 1, 1, 1)
     rec = arx_mimo_records([r1], 1, 1, 1)
-    np.testing.assert_array_equal(one.info["A_poly"][0], rec.info["A_poly"][0])
+    np.testing.assert_array_equal(one.A[1], rec.A[1])
     np.testing.assert_array_equal(one.noise_covariance, rec.noise_covariance)
     assert one.fit_percent == rec.fit_percent
     m = arx_mimo_records([r1, r2], 1, 1, 1)
-    A, S = -m.info["A_poly"][0], m.info["A_poly_std"][0]
+    A, S = -m.A[1], m.A_std[1]
     assert np.all(np.abs(A - A1) < 3 * S), (A, S)
-    s1 = one.info["A_poly_std"][0]
+    s1 = one.A_std[1]
     np.testing.assert_allclose(S / s1, 1 / np.sqrt(2), rtol=0.15)
     np.testing.assert_allclose(m.noise_covariance, 0.0025 * np.eye(2), atol=3e-4)
     # every record from its own estimated initial state: x0 = the record's y(0)-driven state
@@ -185,7 +185,7 @@ def test_mimo_one_record_is_arx_mimo_and_two_records_pool():
     X = np.vstack([np.hstack([-y[:-1], u[:-1]]) for u, y in (r1, r2)])
     Y = np.vstack([y[1:] for _, y in (r1, r2)])
     theta = np.linalg.lstsq(X, Y, rcond=None)[0].T
-    np.testing.assert_allclose(-m.info["A_poly"][0], -theta[:, :2], rtol=1e-9)
+    np.testing.assert_allclose(-m.A[1], -theta[:, :2], rtol=1e-9)
 
 
 def test_identify_mimo_records_pooled_offsets():

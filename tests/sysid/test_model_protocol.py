@@ -131,8 +131,6 @@ def test_round_trip_same_type_attributes_simulation_and_fit(family, tmp_path):
         assert min(fit.fit_percent) > 90.0
 
 
-@pytest.mark.xfail(strict=True, reason="issue 23 not done: arx of several columns still returns "
-                   "the LinearModel of sysid/linear/arx_mimo.py")
 def test_arx_returns_one_type_whatever_the_number_of_inputs():
     types = {type(FAMILIES[k][0]) for k in ("arx siso", "arx miso", "arx mimo")}
     assert types == {PolynomialModel}, types
@@ -215,3 +213,94 @@ def test_state_space_prediction_with_k_zero_is_the_free_run():
     free = oe_model.compare(tr).simulated
     for h in (1, 5):
         np.testing.assert_allclose(oe_model.predict(tr, horizon=h), free, rtol=1e-9, atol=1e-9)
+
+
+V2 = Path(__file__).parent / "data" / "model_v2"
+
+
+def test_v2_mimo_arx_file_written_as_a_linear_model_loads_as_the_polynomial_model():
+    """A MIMO ARX file written before arx returned one type (schema_version 2, gripkit at commit
+    ebed4b9, `identify(record, "arx", input=["a", "b"], output=["c", "d"], na=2, nb=1, nk=1)`):
+    a state-space LinearModel with the matrix polynomials in ``info``. It loads as the
+    PolynomialModel: A, B and their σ are the file's A_poly, B_poly and their σ, the covariance of
+    θ the system's, and its validation fit on the record is the one ebed4b9 computed
+    ([6.293701151614794, 69.16946622509013] %, free run, x0 by least squares)."""
+    doc = json.loads((V2 / "arx_mimo_212.json").read_text())
+    assert doc["schema_version"] == 2 and "polynomial" not in doc and doc["kind"] == "ss"
+    m = load_model(V2 / "arx_mimo_212.json")
+    assert type(m) is PolynomialModel and m.structure == "arx" and m.orders == (2, 1, 1)
+    assert m.inputs == ("a", "b") and m.outputs == ("c", "d") and m.dt == 0.01
+    np.testing.assert_array_equal(m.A[0], np.eye(2))
+    np.testing.assert_array_equal(m.A[1:], doc["info"]["A_poly"])
+    np.testing.assert_array_equal(m.B[0], np.zeros((2, 2)))
+    np.testing.assert_array_equal(m.B[1:], doc["info"]["B_poly"])
+    np.testing.assert_allclose(m.A_std[1:], doc["info"]["A_poly_std"], rtol=1e-12, atol=0)
+    np.testing.assert_allclose(m.B_std[1:], doc["info"]["B_poly_std"], rtol=1e-12, atol=0)
+    np.testing.assert_array_equal(m.covariance, doc["system"]["uncertainty"]["covariance"])
+    np.testing.assert_array_equal(m.noise_covariance, doc["innovation"]["noise_covariance"])
+    assert m.fit_percent == doc["info"]["one_step_fit_percent"]
+    assert m.info["free_run_fit_percent"] == doc["fit_percent"]
+    assert m.u_offset == tuple(d["offset"] for d in doc["inputs"])
+    tr = load(V2 / "record.csv")
+    assert m.compare(tr).fit_percent == [6.293701151614794, 69.16946622509013]
+
+
+def _mimo_arx_record(n=300, seed=5):
+    """Noise-free data of a known 2-output, 2-input ARX [2 2 1]: y(t) = −A1 y(t−1) − A2 y(t−2)
+    + B1 u(t−1) + B2 u(t−2)."""
+    A1 = np.array([[-0.9, 0.2], [0.1, -0.5]])
+    A2 = np.array([[0.2, 0.0], [-0.05, 0.1]])
+    B1 = np.array([[1.0, 0.3], [0.0, -0.7]])
+    B2 = np.array([[0.4, 0.0], [0.2, 0.1]])
+    rng = np.random.default_rng(seed)
+    u = rng.standard_normal((n, 2))
+    y = np.zeros((n, 2))
+    for t in range(2, n):
+        y[t] = -A1 @ y[t - 1] - A2 @ y[t - 2] + B1 @ u[t - 1] + B2 @ u[t - 2]
+    A = np.stack([np.eye(2), A1, A2])
+    B = np.stack([np.zeros((2, 2)), B1, B2])
+    return A, B, u, y
+
+
+def test_mimo_arx_one_step_prediction_is_exact():
+    """Known matrix polynomials on noise-free data: ŷ(t|t−1) is the measured output from sample
+    start = 2 on (the exact ARX predictor, rounding only), the residuals vanish, the model fitted
+    to the same data recovers A and B, and ŷ(t|t−2) is the recursion that replaces y(t−1) by its
+    one-step prediction."""
+    A, B, u, y = _mimo_arx_record()
+    m = PolynomialModel(A, B, 1, dt=0.01)
+    assert m.multivariable and (m.n_inputs, m.n_outputs, m.start) == (2, 2, 2)
+    yh = m.predict(u, y)
+    np.testing.assert_array_equal(yh[:2], y[:2])
+    np.testing.assert_allclose(yh[2:], y[2:], rtol=0, atol=1e-12)
+    assert np.max(np.abs(m.residuals(u, y))) < 1e-12 and m.residuals(u, y).shape == (298, 2)
+    fit = arx(u, y, 2, 2, 1, dt=0.01)
+    np.testing.assert_allclose(fit.A, A, atol=1e-10)
+    np.testing.assert_allclose(fit.B, B, atol=1e-10)
+    y1 = -y[1:-2] @ A[1].T - y[:-3] @ A[2].T + u[1:-2] @ B[1].T + u[:-3] @ B[2].T  # ŷ(t−1|t−2)
+    ref = -y1 @ A[1].T - y[1:-2] @ A[2].T + u[2:-1] @ B[1].T + u[1:-2] @ B[2].T     # ŷ(t|t−2)
+    np.testing.assert_allclose(m.predict(u, y, horizon=2)[3:], ref, atol=1e-9)
+
+
+def test_mimo_arx_aic_and_names():
+    """AIC of a MIMO ARX is M ln det(2π Λ̂) + M p + 2 d with Λ̂ = EᵀE/M of its residuals (the
+    Gaussian likelihood; MATLAB's aic); arx keeps the channel names, units and offsets given in
+    either spelling (input_name=… or inputs=…), refuses both at once, and a SISO arx takes
+    inputs=["a"] as input_name="a"."""
+    g = two_by_two()
+    U, Y = oe_data(g, 1000, 0.05, seed=2)
+    m = arx(U, Y, 2, 2, 1, dt=0.01, inputs=["a", "b"], output_name=("c", "d"),
+            input_units=["V", "V"], output_units=["N", "m"], y_offset=(1.0, 2.0))
+    E = m.estimation_residuals
+    M, d = E.shape[0], m.n_params
+    assert (M, d) == (998, 16) and m.n_used == M
+    ref = M * np.log(np.linalg.det(2 * np.pi * E.T @ E / M)) + M * 2 + 2 * d
+    assert m.aic == pytest.approx(ref, rel=1e-12)
+    assert (m.inputs, m.outputs, m.y_offset) == (("a", "b"), ("c", "d"), (1.0, 2.0))
+    assert m.parameters["b1_1_0"].unit == "m/V" and m.parameters["a2_0_1"].unit == "1"
+    with pytest.raises(ArgumentError, match="inputs= and input_name= name the same channels"):
+        arx(U, Y, 1, 1, 1, inputs=["a", "b"], input_name=("a", "b"))
+    u, y = _siso(300)
+    s = arx(u, y, 2, 2, 1, inputs=["current"], outputs=["force"], input_units=["A"])
+    assert (s.input_name, s.output_name, s.input_unit) == ("current", "force", "A")
+    np.testing.assert_array_equal(s.A, arx(u, y, 2, 2, 1).A)

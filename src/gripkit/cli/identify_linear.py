@@ -137,8 +137,9 @@ def _print_model(model, val, vfit: float | None = None) -> None:
 def _mimo_arx(data: list[Path], input: str, output: str, na: int, nb: int, nk: int, fs, time, fill,
               detrend: str, validate: Path | None, json_out: bool, out_file: Path | None,
               report: Path | None) -> None:
-    """Matrix-polynomial ARX of several columns: every fit figure is a list per output, in
-    ``--output`` order (free run with estimated x0, one-step, and free run on ``--validate``).
+    """Matrix-polynomial ARX of several columns (a PolynomialModel of matrix polynomials): every
+    fit figure is a list per output, in ``--output`` order (``fit_percent`` the free run with
+    estimated x0, ``one_step_fit_percent``, and the free run on ``--validate``).
     Several DATA files: one model of all the records (``records``: each file's fits)."""
     from ..errors import DataError, StabilityWarning
 
@@ -151,12 +152,12 @@ def _mimo_arx(data: list[Path], input: str, output: str, na: int, nb: int, nk: i
                                       validate=validate, detrend=detrend, na=na, nb=nb, nk=nk)
         save_and_report(model, tr, data, out_file, report)
         res = model.to_dict()
-        info = res.pop("info")
+        info = model.info
         res.update(na=na, nb=nb, nk=nk, data=data_field(data), detrend=detrend,
-                   n_samples=model.n_samples,
-                   one_step_fit_percent=info["one_step_fit_percent"],
-                   **{k: info[k] for k in ("A_poly", "A_poly_std", "B_poly", "B_poly_std")},
-                   out=None if out_file is None else str(out_file))
+                   n_samples=model.n_samples, fit_percent=info["free_run_fit_percent"],
+                   one_step_fit_percent=model.fit_percent,
+                   A_poly=res["A"][1:], A_poly_std=res["A_std"][1:], B_poly=res["B"][nk:],
+                   B_poly_std=res["B_std"][nk:], out=None if out_file is None else str(out_file))
         if "records" in info:
             res["records"] = records_field(data, info["records"])
         if not model.stable:
@@ -179,7 +180,7 @@ def _mimo_arx(data: list[Path], input: str, output: str, na: int, nb: int, nk: i
             rows = "; ".join(" ".join(f"{v:.4g}±{s:.2g}" for v, s in zip(r, rs)) for r, rs in zip(c, sd))
             typer.echo(f"  {what}{first + i} = [{rows}]")
     for i, name in enumerate(model.outputs):
-        free = "—" if model.fit_percent is None else f"{model.fit_percent[i]:.2f} %"
+        free = "—" if res["fit_percent"] is None else f"{res['fit_percent'][i]:.2f} %"
         line = f"  {name}: fit free run {free}, 1-step {res['one_step_fit_percent'][i]:.2f} %"
         if res.get("validation_fit_percent") is not None:
             line += f", validation free run {res['validation_fit_percent'][i]:.2f} %"

@@ -24,7 +24,7 @@ from ..scaling import in_user_units, unit_scale
 from .arx_mimo import arx_mimo
 from ..checks import (check_dt, check_excitation, check_identifiable, check_io, check_order,
                      check_output_varies, checked_problem_peaks, require_samples)
-from .polynomial import PolynomialModel, check_meta
+from .polynomial import PolynomialModel, channel_meta
 from ..regression import arx_regression, arx_start, qr_solve, solve_upper, triangular_solve
 from .validation import fit_percent, records_fit
 
@@ -52,10 +52,12 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
         Sample interval (s); default 1 (time in samples).
     **meta
         Model metadata: ``input_name``, ``output_name``, ``input_unit``, ``output_unit``,
-        ``u_offset``, ``y_offset``.
+        ``u_offset``, ``y_offset`` (or, in the lti spelling, ``inputs``, ``outputs``,
+        ``input_units``, ``output_units``); one per channel with several columns.
 
-    With several input or output columns (``u`` (N, m), ``y`` (N, p)) the model is a MIMO ARX
-    of matrix polynomials: see :func:`gripkit.sysid.linear.arx_mimo.arx_mimo`.
+    With several input or output columns (``u`` (N, m), ``y`` (N, p)) the model is the same
+    :class:`PolynomialModel` holding matrix polynomials ``A`` (na+1, p, p) and ``B``
+    (nk+nb, p, m): see :func:`gripkit.sysid.linear.arx_mimo.arx_mimo`.
 
     Returns
     -------
@@ -82,8 +84,9 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
     The signals are scaled to unit size internally (exact powers of two, :mod:`.scaling`), so data
     at any scale (1e-300 … 1e300) are identified; the model is in the units of ``u`` and ``y``.
     """
-    check_meta(meta, arx)
-    if any(np.ndim(x) == 2 and np.shape(x)[1] > 1 for x in (u, y)):  # several inputs or outputs
+    several = any(np.ndim(x) == 2 and np.shape(x)[1] > 1 for x in (u, y))
+    meta = channel_meta(meta, arx, not several)
+    if several:  # several inputs or outputs: matrix polynomials
         return arx_mimo(u, y, na, nb, nk, dt=dt, **meta)
     # one min and max per signal (the finiteness check's) serve the excitation checks and scaling
     u, y, step, na, nb, nk, (pu, py) = checked_problem_peaks(u, y, dt, na=na, nb=nb, nk=nk)
@@ -278,7 +281,7 @@ def arx_records(records, na: int, nb: int, nk: int = 1, *, dt: float | None = No
     >>> np.round(m.theta, 2).tolist(), m.n_used
     ([-0.9, 0.5], 1998)
     """
-    check_meta(meta, arx)
+    meta = channel_meta(meta, arx, True)
     recs = checked_records(records, "arx_records")
     step = check_dt(dt)
     na, nb, nk = check_order(na, "na"), check_order(nb, "nb", 1), check_order(nk, "nk")

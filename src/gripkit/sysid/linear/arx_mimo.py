@@ -8,11 +8,13 @@ q = p·na + m·nb), solved by the QR least squares of :mod:`gripkit.sysid.regres
 refuses an ill-conditioned regressor). The covariance of vec(θ) (row i = output i) is
 ``Λ ⊗ (ΦᵀΦ)⁻¹`` with ``Λ = EᵀE/(M − q)``.
 
-The model is returned as a :class:`~gripkit.sysid.linear.linear_model.LinearModel` on a (non-minimal)
-state-space realisation with state x(t) = [y(t−1); …; y(t−na); u(t−1); …; u(t−L)],
-L = nk + nb − 1, whose innovation gain K = [I_p; 0] makes its one-step predictor the ARX
-predictor. A, B, C, D are affine in θ, so the covariance carries exact tangents; the matrix
-polynomials and their σ are in ``info`` (``A_poly``, ``B_poly``, ``A_poly_std``, ``B_poly_std``).
+The model is a :class:`~gripkit.sysid.linear.polynomial.PolynomialModel` holding the matrix
+polynomials ``A`` (na+1, p, p), ``B`` (nk+nb, p, m) and their σ, as :func:`gripkit.sysid.arx`
+returns for one input and one output; its ``system`` is the state-space realisation of
+:mod:`.matrix_polynomial` (state x(t) = [y(t−1); …; y(t−na); u(t−1); …; u(t−L)],
+L = nk + nb − 1, innovation gain K = [I_p; 0]), affine in θ, so the covariance carries exact
+tangents. ``fit_percent`` is the one-step fit per output (as for one output);
+``info['free_run_fit_percent']`` the free run from the initial state estimated by least squares.
 """
 
 from __future__ import annotations
@@ -20,46 +22,18 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import DataError
-from ...lti import StateSpace, Uncertainty
 from ..checks import check_dt, check_order, io_records
-from .linear_model import LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run
+from . import matrix_polynomial as mp
+from .linear_model import as_io_matrix, estimate_x0, fit_per_output, free_run
+from .polynomial import PolynomialModel, channel_meta
 from ..regression import qr_solve
 from .validation import records_fit
 
 __all__ = ["arx_mimo", "arx_mimo_records"]
 
 
-def _realisation(theta, p, m, na, nb, nk):
-    """(A, B, C, D) of the ARX with coefficient rows ``theta`` (p, q)."""
-    L = nk + nb - 1
-    n = p * na + m * L
-    Ay = theta[:, :p * na]                   # multiplies −y(t−1) … −y(t−na)
-    Bu = theta[:, p * na:]                   # multiplies u(t−nk) … u(t−nk−nb+1)
-    C = np.zeros((p, n))
-    D = np.zeros((p, m))
-    C[:, :p * na] = -Ay
-    for j in range(nb):
-        lag = nk + j
-        blk = Bu[:, j * m:(j + 1) * m]
-        if lag == 0:
-            D += blk
-        else:
-            C[:, p * na + (lag - 1) * m:p * na + lag * m] += blk
-    A = np.zeros((n, n))
-    B = np.zeros((n, m))
-    if na:
-        A[:p] = C
-        B[:p] = D
-        A[p:p * na, :p * (na - 1)] = np.eye(p * (na - 1))
-    if L:
-        B[p * na:p * na + m] = np.eye(m)
-        A[p * na + m:, p * na:p * na + m * (L - 1)] = np.eye(m * (L - 1))
-    return A, B, C, D
-
-
 def arx_mimo(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
-             inputs=None, outputs=None, input_units=None, output_units=None, u_offset=None, y_offset=None,
-             **_meta) -> LinearModel:
+             **meta) -> PolynomialModel:
     """Least-squares MIMO ARX (see the module docstring); ``u`` (N, m), ``y`` (N, p).
 
     Examples
@@ -72,40 +46,32 @@ def arx_mimo(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
     >>> for t in range(1, 3000):
     ...     y[t] = [[0.5, 0.1], [0.0, 0.7]] @ y[t - 1] + u[t - 1] + 0.01 * rng.standard_normal(2)
     >>> m = arx(u, y, 1, 1, 1)
-    >>> (np.round(-np.asarray(m.info["A_poly"][0]), 2) + 0.0).tolist()
+    >>> (np.round(-m.A[1], 2) + 0.0).tolist()
     [[0.5, 0.1], [0.0, 0.7]]
     """
     u = as_io_matrix(u, "input u")
     y = as_io_matrix(y, "output y", u.shape[0])
-    meta = dict(inputs=inputs, outputs=outputs, input_units=input_units, output_units=output_units,
-                u_offset=u_offset, y_offset=y_offset)
-    return _arx_mimo([(u, y)], na, nb, nk, dt, meta)
+    return _arx_mimo([(u, y)], na, nb, nk, dt, channel_meta(meta, arx_mimo, False))
 
 
 def arx_mimo_records(records, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
-                     inputs=None, outputs=None, input_units=None, output_units=None, u_offset=None,
-                     y_offset=None) -> LinearModel:
+                     **meta) -> PolynomialModel:
     """:func:`arx_mimo` fitted to several records at once: ``records`` a list of ``(u, y)``
     pairs, ``u`` (N_i, m), ``y`` (N_i, p), around one common operating point. Each record's first
     ``start = max(na, nk + nb − 1)`` samples are its own initial conditions (no regressor row
     crosses from one record into the next); the rows of all records form one least-squares
-    problem, ``Λ = EᵀE/(Σ M_i − q)``. ``fit_percent`` is the free-run fit of all records per
-    output (each from its own estimated initial state, about its own mean:
+    problem, ``Λ = EᵀE/(Σ M_i − q)``. ``info['free_run_fit_percent']`` is the free-run fit of
+    all records per output (each from its own estimated initial state, about its own mean:
     :func:`~gripkit.sysid.linear.validation.records_fit`); ``info['records']`` gives each record's
-    samples, free-run and one-step fits and initial state (``x0`` of the model: the first
-    record's).
+    samples, free-run and one-step fits and initial state.
     """
     recs = io_records(records)
-    meta = dict(inputs=inputs, outputs=outputs, input_units=input_units, output_units=output_units,
-                u_offset=u_offset, y_offset=y_offset)
-    return _arx_mimo(recs, na, nb, nk, dt, meta, several=True)
+    return _arx_mimo(recs, na, nb, nk, dt, channel_meta(meta, arx_mimo, False), several=True)
 
 
-def _arx_mimo(recs, na, nb, nk, dt, meta, several: bool = False) -> LinearModel:
-    """The fit of :func:`arx_mimo` (one record) and :func:`arx_mimo_records`."""
-    inputs, outputs = meta["inputs"], meta["outputs"]
-    input_units, output_units = meta["input_units"], meta["output_units"]
-    u_offset, y_offset = meta["u_offset"], meta["y_offset"]
+def _arx_mimo(recs, na, nb, nk, dt, meta, several: bool = False) -> PolynomialModel:
+    """The fit of :func:`arx_mimo` (one record) and :func:`arx_mimo_records`; ``meta`` the
+    model's channel fields (:func:`~.polynomial.channel_meta`)."""
     step = check_dt(dt)
     na, nb, nk = check_order(na, "na"), check_order(nb, "nb", 1), check_order(nk, "nk")
     m = recs[0][0].shape[1]
@@ -146,41 +112,26 @@ def _arx_mimo(recs, na, nb, nk, dt, meta, several: bool = False) -> LinearModel:
     E = Y - X[:, :q] @ theta.T
     Lam = E.T @ E / (M - q)
     cov = np.kron(Lam, cov_unscaled)                     # vec(θ) row-major: output i, then regressor
-    A, B, C, D = _realisation(theta, p, m, na, nb, nk)
-    k = p * q
-    tangents = [np.empty((k,) + X_.shape) for X_ in (A, B, C, D)]
-    zero = _realisation(np.zeros((p, q)), p, m, na, nb, nk)
-    for i in range(k):
-        e = np.zeros(k)
-        e[i] = 1.0
-        for t, a, z in zip(tangents, _realisation(e.reshape(p, q), p, m, na, nb, nk), zero):
-            t[i] = a - z
-    pnames = tuple(f"y{i}:{nm}" for i in range(p) for nm in [f"θ{j}" for j in range(q)])
-    unc = Uncertainty(pnames, 0.5 * (cov + cov.T), tuple(tangents))
-    sys = StateSpace(A, B, C, D, dt=step, inputs=inputs, outputs=outputs, input_units=input_units,
-                     output_units=output_units, uncertainty=unc, meta={"identified_by": "arx (least squares)"})
-    n = A.shape[0]
-    Kg = np.zeros((n, p))
-    if na:
-        Kg[:p] = np.eye(p)
-    stable = sys.is_stable()
+    A = np.concatenate([np.eye(p)[None], theta[:, :p * na].reshape(p, na, p).transpose(1, 0, 2)])
+    B = np.concatenate([np.zeros((nk, p, m)),
+                        theta[:, p * na:].reshape(p, nb, m).transpose(1, 0, 2)])
+    E.flags.writeable = False
+    model = PolynomialModel(A, B, nk, dt=step, structure="arx", covariance=0.5 * (cov + cov.T),
+                            noise_variance=Lam, loss=0.5 * float(np.sum(E * E)) / M,
+                            fit_percent=fit_per_output(Y, Y - E), n_samples=N, n_used=M,
+                            estimation_residuals=E,
+                            info={"method": "least squares (QR of [Φ | Y] per output)"}, **meta)
+    s = model.system
+    stable = model.stable
     x0s, runs = [], []
     for u, y in recs:
-        x0s.append(estimate_x0(A, B, C, D, u, y))
-        runs.append(free_run(A, B, C, D, u, x0s[-1]) if stable else None)
-    x0 = x0s[0]
+        x0s.append(estimate_x0(s.A, s.B, s.C, s.D, u, y))
+        runs.append(free_run(s.A, s.B, s.C, s.D, u, x0s[-1]) if stable else None)
     if len(recs) == 1:
-        u, y = recs[0]
-        fit = fit_per_output(y, runs[0]) if stable else None
+        free = fit_per_output(recs[0][1], runs[0]) if stable else None
     else:
-        fit = records_fit([y for _, y in recs], runs).tolist() if stable else None
-    std = np.sqrt(np.diag(cov)).reshape(p, q)
-    info = {"orders": {"na": na, "nb": nb, "nk": nk},
-            "A_poly": [theta[:, i * p:(i + 1) * p] for i in range(na)],
-            "A_poly_std": [std[:, i * p:(i + 1) * p] for i in range(na)],
-            "B_poly": [theta[:, p * na + j * m:p * na + (j + 1) * m] for j in range(nb)],
-            "B_poly_std": [std[:, p * na + j * m:p * na + (j + 1) * m] for j in range(nb)],
-            "one_step_fit_percent": fit_per_output(Y, Y - E)}
+        free = records_fit([y for _, y in recs], runs).tolist() if stable else None
+    info = dict(model.info, free_run_fit_percent=free)
     if several:
         row, info["records"] = 0, []
         for (u, y), x0i, run in zip(recs, x0s, runs):
@@ -191,5 +142,4 @@ def _arx_mimo(recs, na, nb, nk, dt, meta, several: bool = False) -> LinearModel:
                 "fit_percent": None if run is None else fit_per_output(y, run),
                 "one_step_fit_percent": fit_per_output(Y[rows], Y[rows] - E[rows]), "x0": x0i})
         info["n_records"] = len(recs)
-    return LinearModel(sys, "arx", K=Kg, x0=x0, noise_covariance=Lam, fit_percent=fit, u_offset=u_offset,
-                       y_offset=y_offset, n_samples=N, info=info)
+    return model.replace(info=info)

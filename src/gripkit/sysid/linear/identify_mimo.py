@@ -438,7 +438,8 @@ def several(*names) -> bool:
 
 
 def identify_arx(data: Trajectory, *, input, output, na: int, nb: int, nk: int = 1, detrend: str = "mean"):
-    """MIMO ARX of the named columns (:func:`gripkit.sysid.linear.arx_mimo.arx_mimo`)."""
+    """MIMO ARX of the named columns (:func:`gripkit.sysid.linear.arx_mimo.arx_mimo`): a
+    :class:`~gripkit.sysid.PolynomialModel` of matrix polynomials."""
     d = mimo_data(data, input, output, detrend, why="ARX identification")
     return arx_mimo(d.u, d.y, na, nb, nk, dt=d.dt, u_offset=d.u_offset, y_offset=d.y_offset, **d.signals)
 

@@ -382,7 +382,7 @@ class IdentifiedLinearModel:
 @dataclass(frozen=True, eq=False)
 class LinearModel(IdentifiedLinearModel):
     """An identified linear model in state-space or transfer-function form (subspace, PEM,
-    tfest, MIMO ARX); the protocol is :class:`IdentifiedLinearModel`'s.
+    tfest); the protocol is :class:`IdentifiedLinearModel`'s.
 
     Attributes
     ----------

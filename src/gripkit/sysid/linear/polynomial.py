@@ -15,6 +15,16 @@ Arrays hold the coefficients in increasing powers of q⁻¹: ``A = [1, a_1, ...,
 
 Parameter names follow the powers of q⁻¹ (Table III of the seed: ``a1 a2 b2 b3`` for ``[2 2 2]``).
 
+Several inputs or outputs (ARX only, ``arx`` returns this one type whatever the number of
+channels): ``A`` (na+1, p, p) with ``A[0] = I`` and ``B`` (nk+nb, p, m) with ``nk`` leading zero
+matrices are matrix polynomials, ``A(q) y(t) = B(q) u(t) + e(t)``; ``A_std``, ``B_std`` have
+their shapes, ``covariance`` is over θ row by row (output 0 first: ``a1_0_0 … b_nk_0_0 …``,
+:mod:`.matrix_polynomial`), ``noise_variance`` is Λ (p, p), ``fit_percent`` the one-step fit per
+output, names, units and offsets one per channel. The ``system`` is then the state-space
+realisation of :mod:`.matrix_polynomial` (the one the former MIMO ``LinearModel`` had), the
+one-step predictor the exact matrix difference equation, ``horizon > 1`` the realisation's
+innovation form (K = [I; 0]). With one input and one output every array stays 1-D, as below.
+
 :class:`PolynomialModel` is an :class:`~gripkit.sysid.linear.linear_model.IdentifiedLinearModel`:
 its ``system`` is the discrete transfer function B/(A F); simulation, comparison, prediction,
 the report, the model file and the conversions are the protocol's (one set of names for every
@@ -33,13 +43,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...arguments import check_keywords, keyword_names
-from ...errors import DataError, ModelError
+from ...errors import ArgumentError, DataError, ModelError
 from ...lti import StateSpace, TransferFunction
 from ...params import Parameter, ParameterSet
 from ...signals.trajectory import Trajectory
 from ...units import ratio_unit
+from . import matrix_polynomial as mp
 from .linear_model import (IdentifiedLinearModel, LinearModel, _checked_display_units, _horizon,
-                           k_step_prediction, polynomial_document, read_linear_model)
+                           as_io_matrix, k_step_prediction, polynomial_document, read_linear_model)
 from .validation import validate
 
 __all__ = ["PolynomialModel", "load_linear_model"]
@@ -82,8 +93,9 @@ def _coeffs(x, name: str, monic: bool) -> np.ndarray:
 
 @dataclass(frozen=True, eq=False)
 class PolynomialModel(IdentifiedLinearModel):
-    """A discrete-time SISO polynomial model with its uncertainty and fit diagnostics, on the
-    protocol of :class:`~gripkit.sysid.linear.linear_model.IdentifiedLinearModel`.
+    """A discrete-time polynomial model with its uncertainty and fit diagnostics, on the
+    protocol of :class:`~gripkit.sysid.linear.linear_model.IdentifiedLinearModel`: SISO ARX,
+    ARMAX, OE, or a MIMO ARX of matrix polynomials (see the module docstring).
 
     Build one with :func:`gripkit.sysid.linear.arx`, :func:`~gripkit.sysid.linear.armax`,
     :func:`~gripkit.sysid.linear.oe`, or from known coefficients with :meth:`from_coefficients`.
@@ -161,6 +173,9 @@ class PolynomialModel(IdentifiedLinearModel):
     display_units: dict = field(default_factory=dict)
 
     def __post_init__(self):
+        if np.ndim(self.A) == 3 or np.ndim(self.B) == 3:
+            self._post_init_matrix()
+            return
         set_ = object.__setattr__
         set_(self, "A", _coeffs(self.A, "A", True))
         set_(self, "B", _coeffs(self.B, "B", False))
@@ -199,6 +214,57 @@ class PolynomialModel(IdentifiedLinearModel):
             set_(self, "estimation_residuals", r)
         set_(self, "display_units", _checked_display_units(self, dict(self.display_units or {})))
 
+    def _post_init_matrix(self):
+        """The checks of a MIMO ARX model: ``A`` (na+1, p, p) with ``A[0] = I``, ``B``
+        (nk+nb, p, m) with ``B[:nk] = 0``, one name, unit and offset per channel."""
+        set_ = object.__setattr__
+        A, B = (np.array(x, dtype=np.float64) for x in (self.A, self.B))
+        if A.ndim != 3 or B.ndim != 3 or A.shape[1:] != (A.shape[1],) * 2 or A.shape[0] < 1 \
+                or B.shape[0] < 1 or B.shape[1] != A.shape[1]:
+            raise ModelError(f"A, B: expected matrix polynomials of shapes (na+1, p, p) and "
+                             f"(nk+nb, p, m), found {A.shape} and {B.shape}")
+        if not (np.isfinite(A).all() and np.isfinite(B).all()):
+            raise ModelError("A, B: the matrix polynomials have non-finite coefficients")
+        p, m = A.shape[1], B.shape[2]
+        if not np.array_equal(A[0], np.eye(p)):
+            raise ModelError(f"A[0] must be the identity (monic matrix polynomial), found "
+                             f"{A[0].tolist()}")
+        if self.structure != "arx" or np.size(self.C) > 1 or np.size(self.F) > 1:
+            raise ModelError(f"a model with several inputs or outputs is an ARX model "
+                             f"(C = F = 1), found structure {self.structure!r}")
+        nk = int(self.nk)
+        if nk < 0 or nk >= B.shape[0]:
+            raise ModelError(f"nk={self.nk} must lie in [0, len(B)-1 = {B.shape[0] - 1}]")
+        if B[:nk].any():
+            raise ModelError(f"B must start with nk={nk} zero matrices (MATLAB layout)")
+        if not (math.isfinite(self.dt) and self.dt > 0):
+            raise ModelError(f"dt: expected a positive sample interval in s, found {self.dt!r}")
+        for x in (A, B):
+            x.flags.writeable = False
+        set_(self, "A", A)
+        set_(self, "B", B)
+        set_(self, "nk", nk)
+        for k in ("C", "F"):
+            set_(self, k, _coeffs(getattr(self, k), k, True))
+        for name, default, n in (("input_name", "u", m), ("output_name", "y", p),
+                                 ("input_unit", "1", m), ("output_unit", "1", p),
+                                 ("u_offset", 0.0, m), ("y_offset", 0.0, p)):
+            set_(self, name, _per_channel(getattr(self, name), name, default, n))
+        for name, x, shape in (("covariance", self.covariance, (self.n_params,) * 2),
+                               ("noise_variance", self.noise_variance, (p, p))):
+            if x is not None:
+                x = np.array(x, dtype=np.float64)
+                if x.shape != shape:
+                    raise ModelError(f"{name}: expected shape {shape}, found {x.shape}")
+                x.flags.writeable = False
+                set_(self, name, x)
+        r = self.stored_residuals
+        if r is not None and not (isinstance(r, np.ndarray) and not r.flags.writeable):
+            r = np.array(r, dtype=np.float64)
+            r.flags.writeable = False
+            set_(self, "estimation_residuals", r)
+        set_(self, "display_units", _checked_display_units(self, dict(self.display_units or {})))
+
     # ------------------------------------------------------------------ construction
     @classmethod
     def from_coefficients(cls, A, B, *, nk: int | None = None, C=(1.0,), F=(1.0,), dt: float = 1.0,
@@ -211,10 +277,13 @@ class PolynomialModel(IdentifiedLinearModel):
         """
         B = np.asarray(B, dtype=np.float64)
         if nk is None:
-            nz = np.flatnonzero(B)
+            nz = np.flatnonzero(B.reshape(len(B), -1).any(axis=1) if B.ndim == 3 else B)
             if nz.size == 0:
                 raise ModelError("B is all zeros: the model has no input path")
             nk = int(nz[0])
+        if B.ndim == 3 and std is not None:
+            raise ModelError("std: give a MIMO model's uncertainty as covariance=… (over θ, "
+                             "output 0's row first)")
         if structure is None:
             structure = "oe" if np.size(F) > 1 else ("armax" if np.size(C) > 1 else "arx")
         m = cls(A=A, B=B, nk=nk, C=C, F=F, dt=dt, structure=structure, **kw)
@@ -264,11 +333,31 @@ class PolynomialModel(IdentifiedLinearModel):
     # ------------------------------------------------------------------ orders and parameters
     @property
     def na(self) -> int:
-        return self.A.size - 1
+        return len(self.A) - 1
 
     @property
     def nb(self) -> int:
-        return self.B.size - self.nk
+        return len(self.B) - self.nk
+
+    @property
+    def multivariable(self) -> bool:
+        """Several inputs or outputs: ``A``, ``B`` and their σ are matrix polynomials."""
+        return self.A.ndim == 3
+
+    @property
+    def n_inputs(self) -> int:
+        return self.B.shape[2] if self.multivariable else 1
+
+    @property
+    def n_outputs(self) -> int:
+        return self.A.shape[1] if self.multivariable else 1
+
+    @property
+    def noise_covariance(self) -> np.ndarray | None:
+        """Λ, the covariance of e(t), (p, p) (``[[noise_variance]]`` with one output)."""
+        if self.noise_variance is None:
+            return None
+        return np.array(self.noise_variance, dtype=np.float64).reshape(self.n_outputs, -1)
 
     @property
     def nc(self) -> int:
@@ -296,6 +385,13 @@ class PolynomialModel(IdentifiedLinearModel):
 
     @property
     def parameter_names(self) -> tuple[str, ...]:
+        """``a1 … b_nk …`` (one output); with several, ``a1_i_j`` the entry (i, j) of A_1,
+        output 0's row first (:mod:`.matrix_polynomial`)."""
+        if self.multivariable:
+            p, m = self.n_outputs, self.n_inputs
+            return tuple(n for i in range(p) for n in
+                         [f"a{k}_{i}_{j}" for k in range(1, self.na + 1) for j in range(p)]
+                         + [f"b{self.nk + k}_{i}_{j}" for k in range(self.nb) for j in range(m)])
         names = [f"a{i}" for i in range(1, self.na + 1)]
         names += [f"b{self.nk + j}" for j in range(self.nb)]
         names += [f"c{i}" for i in range(1, self.nc + 1)]
@@ -304,11 +400,15 @@ class PolynomialModel(IdentifiedLinearModel):
 
     @property
     def n_params(self) -> int:
+        if self.multivariable:
+            return self.n_outputs * (self.n_outputs * self.na + self.n_inputs * self.nb)
         return self.na + self.nb + self.nc + self.nf
 
     @property
     def theta(self) -> np.ndarray:
         """Free parameters in ``parameter_names`` order (eq 21 / eq 27)."""
+        if self.multivariable:
+            return mp.theta_rows(self.A, self.B, self.nk).ravel()
         return np.concatenate([arr[sl] for _, arr, sl in self._blocks()])
 
     @property
@@ -321,6 +421,17 @@ class PolynomialModel(IdentifiedLinearModel):
         s = self.theta_std
         if s is None:
             return None
+        if self.multivariable:
+            if which not in ("A", "B"):  # C = F = 1: fixed
+                return np.zeros(1)
+            p, m = self.n_outputs, self.n_inputs
+            rows = s.reshape(p, -1)
+            out = np.zeros(self.A.shape if which == "A" else self.B.shape)
+            if which == "A":
+                out[1:] = rows[:, :p * self.na].reshape(p, self.na, p).transpose(1, 0, 2)
+            else:
+                out[self.nk:] = rows[:, p * self.na:].reshape(p, self.nb, m).transpose(1, 0, 2)
+            return out
         i = 0
         for name, arr, sl in self._blocks():
             n = arr[sl].size
@@ -344,9 +455,11 @@ class PolynomialModel(IdentifiedLinearModel):
     def parameters(self):
         """The free coefficients as a :class:`~gripkit.params.ParameterSet` (SI units: ``b``
         in output unit per input unit, the others dimensionless), with their std."""
-        bunit = ratio_unit(self.output_unit, self.input_unit)
         std = self.theta_std
         src = self.info.get("source", f"identified ({self.label})")
+        if self.multivariable:
+            return self._matrix_parameters(std, src)
+        bunit = ratio_unit(self.output_unit, self.input_unit)
         params = []
         for i, (n, v) in enumerate(zip(self.parameter_names, self.theta)):
             doc = {"a": f"coefficient of q^-{n[1:]} in A(q)", "b": f"coefficient of q^-{n[1:]} in B(q)",
@@ -355,11 +468,23 @@ class PolynomialModel(IdentifiedLinearModel):
                                     std=None if std is None else float(std[i])))
         return ParameterSet(params, name=self.label)
 
+    def _matrix_parameters(self, std, src) -> ParameterSet:
+        """:attr:`parameters` of a MIMO model: ``a1_i_j`` dimensionless, ``b2_i_j`` in
+        output i's unit per input j's."""
+        params = []
+        for k, (n, v) in enumerate(zip(self.parameter_names, self.theta)):
+            power, i, j = (int(x) for x in n[1:].split("_"))
+            unit = "1" if n[0] == "a" else ratio_unit(self.output_unit[i], self.input_unit[j])
+            doc = f"entry ({i}, {j}) of the coefficient of q^-{power} in {n[0].upper()}(q)"
+            params.append(Parameter(n, float(v), unit, doc, source=src,
+                                    std=None if std is None else float(std[k])))
+        return ParameterSet(params, name=self.label)
+
     # ------------------------------------------------------------------ criteria
     @property
     def start(self) -> int:
         """First sample index whose one-step prediction uses only measured past data."""
-        return max(self.na, self.nf, self.B.size - 1)
+        return max(self.na, self.nf, len(self.B) - 1)
 
     @property
     def aic(self) -> float | None:
@@ -367,10 +492,20 @@ class PolynomialModel(IdentifiedLinearModel):
         ``V = Σe²/M`` (MATLAB's ``aic``, same constant)."""
         if self.loss is None or not self.n_used:
             return None
+        if self.multivariable:  # M ln det(2π Λ̂) + M p + 2 d, Λ̂ = EᵀE/M
+            sign, logdet = np.linalg.slogdet(2 * math.pi * self._ml_noise_covariance())
+            if sign <= 0:
+                return -math.inf
+            return self.n_used * (logdet + self.n_outputs) + 2 * self.n_params
         v = 2.0 * self.loss
         if v <= 0:
             return -math.inf
         return self.n_used * math.log(2 * math.pi * v) + self.n_used + 2 * self.n_params
+
+    def _ml_noise_covariance(self) -> np.ndarray:
+        """``EᵀE/M`` from the unbiased Λ = EᵀE/(M − q) (q regressors per output)."""
+        q = self.n_params // self.n_outputs
+        return self.noise_covariance * (self.n_used - q) / self.n_used
 
     @property
     def fpe(self) -> float | None:
@@ -378,6 +513,8 @@ class PolynomialModel(IdentifiedLinearModel):
         if self.loss is None or not self.n_used or self.n_used <= self.n_params:
             return None
         r = self.n_params / self.n_used
+        if self.multivariable:  # MATLAB's: det Λ̂ (1 + d/M)/(1 − d/M)
+            return float(np.linalg.det(self._ml_noise_covariance())) * (1 + r) / (1 - r)
         return 2.0 * self.loss * (1 + r) / (1 - r)
 
     # ------------------------------------------------------------------ the linear system
@@ -386,7 +523,13 @@ class PolynomialModel(IdentifiedLinearModel):
         """The input-output part ``y = B(q)/(A(q) F(q)) u`` as a discrete
         :class:`gripkit.lti.TransferFunction`, with the channel names and units, ``dt`` and the
         parameter covariance over ``parameter_names`` (the c's of an ARMAX model with zero
-        tangents). Poles, zeros, DC gain, responses and exports below are computed by it."""
+        tangents). Poles, zeros, DC gain, responses and exports below are computed by it.
+        With several inputs or outputs: the :class:`gripkit.lti.StateSpace` realisation of
+        :mod:`.matrix_polynomial` (state: past outputs and inputs) with exact tangents."""
+        if self.multivariable:
+            return mp.state_space(self.A, self.B, self.nk, self.dt, self.covariance,
+                                  inputs=self.input_name, outputs=self.output_name,
+                                  input_units=self.input_unit, output_units=self.output_unit)
         return TransferFunction.from_polynomials(
             self.A, self.B, C=self.C if self.nc else None, F=self.F, dt=self.dt, covariance=self.covariance,
             inputs=self.input_name, outputs=self.output_name, input_units=self.input_unit,
@@ -395,17 +538,28 @@ class PolynomialModel(IdentifiedLinearModel):
     # ------------------------------------------------------------------ analysis
     @property
     def denominator(self) -> np.ndarray:
-        """A(q)·F(q): the denominator of the input-output transfer function B/(A F)."""
+        """A(q)·F(q): the denominator of the input-output transfer function B/(A F); with
+        several outputs det A(q) = Π (1 − λ_i q⁻¹) over the :meth:`poles`."""
+        if self.multivariable:
+            return np.real(np.poly(self.poles()))
         return np.convolve(self.A, self.F)
 
     def poles(self) -> np.ndarray:
         """Roots of A(z)·F(z) (the delay's poles at the origin are not listed): the first
-        ``na + nf`` poles of :attr:`system` (np.roots lists the origin roots last)."""
+        ``na + nf`` poles of :attr:`system` (np.roots lists the origin roots last). With
+        several outputs: the p·na roots of det A(z), the eigenvalues of the past-output block of
+        the realisation (the input-delay states add only poles at the origin)."""
+        if self.multivariable:
+            k = self.n_outputs * self.na
+            return np.linalg.eigvals(self.system.A[:k, :k])
         return self.system.poles()[:self.denominator.size - 1]
 
     def zeros(self) -> np.ndarray:
         """Roots of B(z) without its delay: the ``nb − 1`` roots of ``[b_nk, ..., b_last]`` (the
-        first zeros of :attr:`system`; the origin zeros of the q⁻¹ padding come last)."""
+        first zeros of :attr:`system`; the origin zeros of the q⁻¹ padding come last). With
+        several inputs or outputs: the transmission zeros of :attr:`system`."""
+        if self.multivariable:
+            return self.system.zeros()
         return self.system.zeros()[:np.trim_zeros(self.B).size - 1]
 
     @property
@@ -415,8 +569,11 @@ class PolynomialModel(IdentifiedLinearModel):
         return self.system.is_minimum_phase()
 
     @property
-    def dc_gain(self) -> float:
-        """Static gain B(1)/(A(1)F(1)) (±inf with an integrator)."""
+    def dc_gain(self) -> float | np.ndarray:
+        """Static gain B(1)/(A(1)F(1)) (±inf with an integrator); with several inputs or
+        outputs the (p, m) matrix A(1)⁻¹ B(1)."""
+        if self.multivariable:
+            return self.system.dc_gain()
         try:
             return float(self.system.dc_gain()[0, 0])
         except ModelError:  # a pole at z = 1
@@ -424,12 +581,16 @@ class PolynomialModel(IdentifiedLinearModel):
             return math.copysign(math.inf, num) if num != 0 else math.nan
 
     def step(self, n: int) -> np.ndarray:
-        """Response to a unit step applied at sample 0, from rest, ``n`` samples."""
-        return self.system.step(int(n))[:, 0, 0]
+        """Response to a unit step applied at sample 0, from rest, ``n`` samples ((n, p, m)
+        with several inputs or outputs)."""
+        r = self.system.step(int(n))
+        return r if self.multivariable else r[:, 0, 0]
 
     def impulse(self, n: int) -> np.ndarray:
-        """Response to a unit pulse at sample 0, from rest, ``n`` samples."""
-        return self.system.impulse(int(n))[:, 0, 0]
+        """Response to a unit pulse at sample 0, from rest, ``n`` samples ((n, p, m) with
+        several inputs or outputs)."""
+        r = self.system.impulse(int(n))
+        return r if self.multivariable else r[:, 0, 0]
 
     def frequency_response(self, w=None, n: int = 512) -> tuple[np.ndarray, np.ndarray]:
         """``(w, H)``: the complex response of B/(A F) at the angular frequencies ``w`` (rad/s,
@@ -437,7 +598,8 @@ class PolynomialModel(IdentifiedLinearModel):
         the Nyquist frequency π/dt), ``H = B(e^{-jωdt}) / (A F)(e^{-jωdt})``."""
         w = np.linspace(0.0, np.pi / self.dt, int(n), endpoint=False) if w is None \
             else np.atleast_1d(np.asarray(w, dtype=np.float64))
-        return w, self.system.frequency_response(w)[:, 0, 0]
+        H = self.system.frequency_response(w)
+        return w, H if self.multivariable else H[:, 0, 0]
 
     # ------------------------------------------------------------------ simulation and prediction
     def simulate(self, data, x0=None, *, initial: str = "rest", y_past=None,
@@ -459,9 +621,10 @@ class PolynomialModel(IdentifiedLinearModel):
             The samples before u(0), in time order (most recent last); at least
             ``len(A F) − 1`` outputs and ``len(B) − 1`` inputs are used (missing ones count 0).
         """
-        if isinstance(data, Trajectory):
+        if isinstance(data, Trajectory) or self.multivariable:
             if initial != "rest":
-                raise DataError("initial='given' takes deviation arrays, not a trajectory")
+                raise DataError("initial='given' takes deviation arrays of one input and one "
+                                "output, not a trajectory or several columns")
             return super().simulate(data, x0)
         u = data
         if initial == "rest":
@@ -483,6 +646,16 @@ class PolynomialModel(IdentifiedLinearModel):
         u = np.asarray(u, dtype=np.float64)
         y = np.asarray(y, dtype=np.float64)
         t0 = self.start
+        if self.multivariable:
+            u = as_io_matrix(u, "u")
+            y = as_io_matrix(y, "y", u.shape[0])
+            if (u.shape[1], y.shape[1]) != (self.n_inputs, self.n_outputs):
+                raise DataError(f"u, y: expected {self.n_inputs} input and {self.n_outputs} "
+                                f"output columns, found {u.shape[1]} and {y.shape[1]}")
+            if y.shape[0] <= t0:
+                raise DataError(f"one-step prediction with {self.label} needs more than {t0} "
+                                f"samples, found {y.shape[0]}")
+            return mp.prediction_errors(self.A, self.B, u, y, t0)
         if y.size <= t0:
             raise DataError(f"one-step prediction with {self.label} needs more than {t0} samples, found {y.size}")
         if self.structure == "oe":
@@ -501,8 +674,8 @@ class PolynomialModel(IdentifiedLinearModel):
         polynomials, the first ``start`` samples being the record's own values (the predictor's
         initial conditions); ``horizon > 1``: :func:`~.linear_model.k_step_prediction` on
         :meth:`innovation_form`."""
-        if isinstance(data, Trajectory):
-            return super().predict(data, horizon=horizon)
+        if isinstance(data, Trajectory) or self.multivariable:
+            return super().predict(data, y, horizon=horizon)
         u, y = np.asarray(data, dtype=np.float64), np.asarray(y, dtype=np.float64)
         h = _horizon(horizon)
         return self._prediction(u.reshape(-1, 1), y.reshape(-1, 1), self.dt, h)[:, 0]
@@ -511,6 +684,10 @@ class PolynomialModel(IdentifiedLinearModel):
         if horizon > 1:
             return k_step_prediction(*self._state_space(dt), u, y, horizon)
         out = y.copy()
+        if self.multivariable:
+            self._state_space(dt)  # the sample time checked
+            out[self.start:] = y[self.start:] - self.prediction_errors(u, y)
+            return out
         out[self.start:, 0] = y[self.start:, 0] - self.prediction_errors(u[:, 0], y[:, 0])
         return out
 
@@ -519,13 +696,20 @@ class PolynomialModel(IdentifiedLinearModel):
         trajectory (N − start, 1), of deviation arrays ``u``, ``y`` shape (N − start,)."""
         if isinstance(data, Trajectory):
             u, yy, _, _ = self._io(data, None, "residuals of an identified model")
+            if self.multivariable:
+                return self.prediction_errors(u, yy)
             return self.prediction_errors(u[:, 0], yy[:, 0]).reshape(-1, 1)
         return self.prediction_errors(data, y)
 
     def innovation_form(self) -> tuple[np.ndarray, ...]:
         """``(A, B, C, D, K)`` of ``y = B/(A F) u + C/A e`` in innovation form,
         ``x⁺ = A x + B u + K e``, ``y = C x + D u + e``: the controllable realisation of the
-        two-input transfer function ``[B, C F]/(A F)`` (both monic denominators), transposed."""
+        two-input transfer function ``[B, C F]/(A F)`` (both monic denominators), transposed.
+        With several inputs or outputs: the realisation of :mod:`.matrix_polynomial` with
+        K = [I; 0]."""
+        if self.multivariable:
+            s = self.system
+            return s.A, s.B, s.C, s.D, mp.innovation_gain(self.n_outputs, s.n_states, self.na)
         from scipy import signal as _sig
 
         den = np.convolve(self.A, self.F)
@@ -544,7 +728,12 @@ class PolynomialModel(IdentifiedLinearModel):
 
     def validate(self, u, y, **kw):
         """Free-run and one-step validation on a separate record; see
-        :func:`gripkit.sysid.validate`."""
+        :func:`gripkit.sysid.validate` (one input and one output; a MIMO model: :meth:`compare`
+        and :meth:`residuals`)."""
+        if self.multivariable:
+            raise ModelError(f"validate: {self.label} has {self.n_inputs} inputs and "
+                             f"{self.n_outputs} outputs; validate takes one of each",
+                             hint="use model.compare(data) and model.residuals(data)")
         return validate(self, u, y, **kw)
 
     # ------------------------------------------------------------------ exports
@@ -566,7 +755,17 @@ class PolynomialModel(IdentifiedLinearModel):
     def linear_record(self) -> LinearModel:
         """The model's system part as a :class:`~gripkit.sysid.LinearModel` on B/(A F) (what
         the ``system`` of its model file holds): the parameter covariance (the noise polynomial
-        C keeps its place, with zero tangents), names, units and offsets."""
+        C keeps its place, with zero tangents), names, units and offsets. With several inputs
+        or outputs: the state-space realisation with its innovation gain K = [I; 0] and Λ."""
+        if self.multivariable:
+            s = self.system
+            return LinearModel(s, "arx", K=mp.innovation_gain(self.n_outputs, s.n_states, self.na),
+                               noise_covariance=self.noise_variance, u_offset=self.u_offset,
+                               y_offset=self.y_offset, n_samples=self.n_samples,
+                               data_file=self.data_file, data_hash=self.data_hash,
+                               display_units=self.display_units,
+                               info={"label": self.label, "nk": self.nk,
+                                     "parameter_names": list(self.parameter_names)})
         info = {"label": self.label, "A": self.A, "B": self.B, "C": self.C, "F": self.F,
                 "nk": self.nk, "one_step_fit_percent": self.fit_percent,
                 "noise_variance": self.noise_variance,
@@ -593,6 +792,8 @@ class PolynomialModel(IdentifiedLinearModel):
         """The model of a model file's document ``doc`` whose system part was read as ``lm``;
         a version-1 file (coefficients in ``info``, covariance in the system's) is migrated."""
         poly = doc.get("polynomial")
+        if len(lm.inputs) > 1 or len(lm.outputs) > 1:
+            return cls._from_matrix_document(poly, lm, where)
         if poly is None:  # schema_version 1: the coefficients in info, the covariance the system's
             info = dict(lm.info)
             unc = lm.system.uncertainty
@@ -619,8 +820,34 @@ class PolynomialModel(IdentifiedLinearModel):
             raise ModelError(f"model file {where}: its polynomial section is malformed ({msg})",
                              hint="regenerate the file with gripkit identify --out") from None
 
+    @classmethod
+    def _from_matrix_document(cls, poly: dict, lm: LinearModel, where: str) -> "PolynomialModel":
+        """:meth:`from_document` of a MIMO ARX model: the ``polynomial`` section, or a file
+        without one (gripkit before the matrix polynomials moved here wrote a MIMO ARX model as
+        a state-space ``LinearModel`` with ``A_poly``, ``B_poly`` in ``info`` and the
+        covariance of θ in its system's: :func:`_matrix_section` migrates it)."""
+        if poly is None:
+            poly = _matrix_section(lm)
+        s = lm.system
+        try:
+            return cls(A=poly["A"], B=poly["B"], nk=int(poly["nk"]), dt=lm.dt, structure="arx",
+                       covariance=poly.get("covariance"),
+                       noise_variance=poly.get("noise_variance"), loss=poly.get("loss"),
+                       fit_percent=poly.get("fit_percent"), n_samples=lm.n_samples,
+                       n_used=poly.get("n_used"), input_name=s.inputs, output_name=s.outputs,
+                       input_unit=s.input_units, output_unit=s.output_units,
+                       u_offset=lm.u_offset, y_offset=lm.y_offset,
+                       info=dict(poly.get("info") or {}), data_file=lm.data_file,
+                       data_hash=lm.data_hash, display_units=lm.display_units)
+        except (ModelError, ValueError, TypeError, KeyError) as exc:
+            msg = exc.message if isinstance(exc, ModelError) else str(exc)
+            raise ModelError(f"model file {where}: its polynomial section is malformed ({msg})",
+                             hint="regenerate the file with gripkit identify --out") from None
+
     def to_dict(self) -> dict:
         """JSON-ready summary (complex numbers as ``[re, im]`` pairs)."""
+        if self.multivariable:
+            return self._matrix_dict()
         def pairs(z):
             return [[float(np.real(v)), float(np.imag(v))] for v in z]
 
@@ -647,8 +874,29 @@ class PolynomialModel(IdentifiedLinearModel):
                  output_unit=self.output_unit, u_offset=self.u_offset, y_offset=self.y_offset)
         return d
 
+    def _matrix_dict(self) -> dict:
+        """:meth:`to_dict` of a MIMO model: ``A``, ``B``, ``A_std``, ``B_std`` nested lists
+        (na+1, p, p) and (nk+nb, p, m), ``fit_percent`` and Λ per output."""
+        def lst(a):
+            return None if a is None else np.asarray(a, dtype=np.float64).tolist()
+
+        poles = self.poles()
+        return {"structure": "arx", "na": self.na, "nb": self.nb, "nk": self.nk,
+                "A": lst(self.A), "B": lst(self.B), "A_std": lst(self.A_std),
+                "B_std": lst(self.B_std), "parameter_names": list(self.parameter_names),
+                "theta": lst(self.theta), "theta_std": lst(self.theta_std), "loss": self.loss,
+                "fit_percent": self.fit_percent, "aic": self.aic, "fpe": self.fpe,
+                "noise_covariance": lst(self.noise_covariance),
+                "poles": [[float(z.real), float(z.imag)] for z in poles], "stable": self.stable,
+                "n_samples": self.n_samples, "dt": self.dt, "inputs": list(self.inputs),
+                "outputs": list(self.outputs), "input_units": list(self.input_unit),
+                "output_units": list(self.output_unit), "u_offset": list(self.u_offset),
+                "y_offset": list(self.y_offset)}
+
     def summary(self) -> str:
         """Several lines: structure, coefficients ± σ, loss, fit, poles and zeros."""
+        if self.multivariable:
+            return self._matrix_summary()
         lines = [f"{self.label}  dt = {self.dt:g} s"]
         for name, arr, _ in self._blocks():
             if arr.size == 1 and name in ("C", "F"):
@@ -667,8 +915,71 @@ class PolynomialModel(IdentifiedLinearModel):
         lines.append(f"  zeros: {fmt(self.zeros())} ({'minimum' if self.minimum_phase else 'NON-minimum'} phase)")
         return "\n".join(lines)
 
+    def _matrix_summary(self) -> str:
+        lines = [f"{self.label}  {self.n_inputs} input(s) {list(self.inputs)} → "
+                 f"{self.n_outputs} output(s) {list(self.outputs)}, dt = {self.dt:g} s"]
+        for what, arr, std, first in (("A", self.A, self.A_std, 1), ("B", self.B, self.B_std,
+                                                                      self.nk)):
+            sd = np.zeros(arr.shape) if std is None else std
+            for k in range(first, len(arr)):
+                rows = "; ".join(" ".join(f"{v:.4g}±{e:.2g}" for v, e in zip(r, rs))
+                                 for r, rs in zip(arr[k], sd[k]))
+                lines.append(f"  {what}{k} = [{rows}]")
+        if self.fit_percent is not None:
+            fits = ", ".join(f"{n} {f:.2f} %" for n, f in zip(self.outputs, self.fit_percent))
+            lines.append(f"  one-step fit: {fits}; N = {self.n_samples}")
+        fmt = lambda z: ", ".join(f"{v.real:.4g}{v.imag:+.4g}j" for v in z) or "none"  # noqa: E731
+        lines.append(f"  poles: {fmt(self.poles())}")
+        return "\n".join(lines)
+
     def __repr__(self) -> str:
+        if self.multivariable:
+            return (f"PolynomialModel({self.label}, inputs={list(self.inputs)}, "
+                    f"outputs={list(self.outputs)}, dt={self.dt:g})")
         return f"PolynomialModel({self.label}, A={self.A.tolist()}, B={self.B.tolist()}, dt={self.dt:g})"
+
+
+def _per_channel(value, name: str, default, n: int) -> tuple:
+    """One name, unit or offset per channel of a MIMO model: a sequence of ``n``, or the
+    scalar default (names ``u0``, ``u1``, …; units '1'; offsets 0)."""
+    if not isinstance(value, (list, tuple, np.ndarray)):
+        if value == default or value is None:
+            if name.endswith("_name"):
+                return tuple(f"{default}{i}" for i in range(n))
+            return (default,) * n
+        value = (value,)
+    if len(value) != n:
+        raise ModelError(f"{name}: expected {n} values (one per channel), found {len(value)}")
+    if name.endswith("offset"):
+        return tuple(float(v) for v in value)
+    if name.endswith("unit"):
+        return tuple("1" if v in (None, "") else str(v) for v in value)
+    return tuple(str(v) for v in value)
+
+
+def _matrix_section(lm: LinearModel) -> dict:
+    """The ``polynomial`` section of a MIMO ARX file written without one: ``A``, ``B`` from
+    ``info['A_poly']``, ``info['B_poly']`` (A_i, B_{nk+j}), the covariance of θ the system's
+    (the same order: output 0's row first), Λ, the one-step fit; the free-run fit and the
+    estimated initial state that file held move to ``info``."""
+    info = dict(lm.info)
+    orders = info.pop("orders")
+    na, nb, nk = int(orders["na"]), int(orders["nb"]), int(orders["nk"])
+    p, m = len(lm.outputs), len(lm.inputs)
+    A = np.concatenate([np.eye(p)[None]] + [np.asarray(a, dtype=np.float64).reshape(1, p, p)
+                                            for a in info.pop("A_poly")])
+    B = np.concatenate([np.zeros((nk, p, m))] + [np.asarray(b, dtype=np.float64).reshape(1, p, m)
+                                                 for b in info.pop("B_poly")])
+    if A.shape[0] != na + 1 or B.shape[0] != nk + nb:
+        raise ModelError(f"A_poly, B_poly: expected {na} and {nb} matrices (orders {orders}), "
+                         f"found {A.shape[0] - 1} and {B.shape[0] - nk}")
+    for k in ("A_poly_std", "B_poly_std"):
+        info.pop(k, None)
+    info["free_run_fit_percent"] = lm.fit_percent
+    unc = lm.system.uncertainty
+    return {"A": A, "B": B, "nk": nk, "covariance": None if unc is None else unc.covariance,
+            "noise_variance": lm.noise_covariance,
+            "fit_percent": info.pop("one_step_fit_percent", None), "info": info}
 
 
 def load_linear_model(path) -> IdentifiedLinearModel:
@@ -678,9 +989,16 @@ def load_linear_model(path) -> IdentifiedLinearModel:
     the system's; loss, ``n_used`` and the residuals were not written), else the
     :class:`~gripkit.sysid.LinearModel` (:func:`~.linear_model.read_linear_model`)."""
     doc, lm, where = read_linear_model(path)
-    if "polynomial" in doc or polynomial_document(doc):
+    if "polynomial" in doc or polynomial_document(doc) or _matrix_document(doc):
         return PolynomialModel.from_document(doc, lm, where)
     return lm
+
+
+def _matrix_document(doc: dict) -> bool:
+    """A MIMO ARX file written as a state-space model (``A_poly`` in ``info``, no
+    ``polynomial`` section)."""
+    info = doc.get("info") or {}
+    return doc.get("structure") == "arx" and "A_poly" in info and "B_poly" in info
 
 
 #: the ``**meta`` keywords of :func:`~gripkit.sysid.linear.arx`, :func:`~gripkit.sysid.linear.armax` and :func:`~gripkit.sysid.linear.oe`
@@ -695,3 +1013,30 @@ def check_meta(meta: dict, fn) -> None:
     name = fn.__name__
     check_keywords(meta, META_KEYS, f"{name}()", hint=f"{name} accepts {', '.join(keyword_names(fn))} and the "
                                                       f"metadata {', '.join(META_KEYS)}")
+
+
+#: the lti spelling of the channel keywords (``inputs=[...]``, as :class:`gripkit.lti.StateSpace`
+#: and :func:`gripkit.sysid.n4sid` take them) and the model's field each one sets
+CHANNEL_KEYS = {"inputs": "input_name", "outputs": "output_name", "input_units": "input_unit",
+                "output_units": "output_unit"}
+
+
+def channel_meta(meta: dict, fn, siso: bool) -> dict:
+    """``meta`` with ``inputs``, ``outputs``, ``input_units``, ``output_units`` turned into the
+    model's fields (:data:`CHANNEL_KEYS`; a list of one taken as its entry for a SISO model),
+    then checked (:func:`check_meta`); an ArgumentError when both spellings are given."""
+    out = dict(meta)
+    for lti_key, field_ in CHANNEL_KEYS.items():
+        if lti_key not in out:
+            continue
+        value = out.pop(lti_key)
+        if field_ in out:
+            raise ArgumentError(f"{fn.__name__}(): {lti_key}= and {field_}= name the same "
+                                f"channels; give one of them", hint=f"use {field_}=…")
+        if value is None:
+            continue
+        if siso and isinstance(value, (list, tuple)) and len(value) == 1:
+            value = value[0]
+        out[field_] = value
+    check_meta(out, fn)
+    return out
