@@ -280,6 +280,17 @@ def test_filter_from_model_runs_on_the_models_columns():
     out = ukf.run(data)
     assert np.sqrt(np.mean((out.x[:, 0] - y) ** 2)) < 1e-3
 
+    m = nlss()  # two inputs, two outputs: the columns by name, in the model's order
+    U = _nlss_input(100)
+    Y = m.simulate(U)
+    data = Trajectory(np.arange(100) * DT, {"y2": Y[:, 1], "u2": U[:, 1], "y1": Y[:, 0],
+                                            "u1": U[:, 0]})
+    Q, R = np.diag([1e-4, 1e-4]), np.diag([1e-2, 1e-2])
+    by_name = UnscentedKalmanFilter(m, Q=Q, R=R).run(data)
+    by_array = UnscentedKalmanFilter(m, Q=Q, R=R).run_arrays(U, Y)
+    np.testing.assert_array_equal(by_name.x, by_array.x)
+    assert np.abs(by_name.x).max() > 0.5  # the states move with the input
+
 
 # ---------------------------------------------------------------- (3) the Kalman filter
 

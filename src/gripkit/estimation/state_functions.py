@@ -56,20 +56,22 @@ What the state is, family by family:
   m play outputs ``z_i = F_{r_i}[u − a]`` after the previous sample; ``f`` applies each play to
   the new input, ``z_i⁺ = min(u − a + r_i, max(u − a − r_i, z_i))``, and ``h = c + Σ w_i z_i⁺``.
   ``x0`` = 0: every play relaxed at the input offset ``a``; its simulate relaxes them at the
-  first input, which is ``x0 = u[0] − a`` (every entry) given to the filter. numba. Process
-  noise Q on the plays is a random walk of each play's memory *while the input stays inside its
-  band* ``|u − a − z_i| < r_i`` (the play holds its output, so the noise accumulates: a drifting
-  loop interior, as creep or unmodelled minor loops give); a play that the input drives is
-  reset to ``u − a ∓ r_i`` and keeps only the last step's noise, so the accumulated error is
-  forgotten at every reversal the input carries through the band. The ``r_0 = 0`` play is
-  always driven (``z_0⁺ = u − a``): its state never reaches the output with its noise and carries
-  only that step's Q, and the output error is ``Σ w_i`` of the held plays' walks. The filter
-  then estimates the drifted play memories from the output; with EKF, a driven play's Jacobian
-  is 0 and its variance falls back to Q.
+  first input, which is ``x0 = u[0] − a`` (every entry) given to the filter. numba.
+  *The noise model this implies*: Q on the plays (``z⁺ = play(z, u) + w``) is a random walk of
+  each play's memory *while the input stays inside its band* ``|u − a − z_i| < r_i`` (the play
+  holds its output, so the noise accumulates: a drifting loop interior, as creep or unmodelled
+  minor loops give); once the input drives a play (reaches the band's edge) the play is reset
+  to ``u − a ∓ r_i`` and keeps only the last step's noise: the accumulated error is forgotten.
+  The ``r_0 = 0`` play is always driven (``z_0⁺ = u − a``), its state is the input and its
+  noise never reaches the output (give it a small Q); the output's model error is ``Σ w_i`` of
+  the held plays' walks. The play is not differentiable at the band's edge: the extended
+  filter's Jacobian is 1 (held), 0 (driven, its variance falls back to Q), and between them
+  within the difference step of the edge; near reversals it is more confident than its error
+  (average NEES 3.3 for 3 plays in the tests, 3.1 for the unscented filter).
 
-The past-input components (Bouc-Wen ``u_prev``, NARX ``u(t−k)``) are known exactly: give them a
-small positive process noise (for example 1e-12 of the input's variance) so that the unscented
-filter's covariance stays positive definite.
+The past-input components (Bouc-Wen ``u_prev``, NARX ``u(t−k)``) and the PI play of threshold 0
+are known exactly: give them a small positive process noise (for example 1e-12 of the input's
+variance) so that the unscented filter's covariance stays positive definite.
 """
 
 from __future__ import annotations
