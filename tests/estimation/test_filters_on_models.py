@@ -17,6 +17,8 @@ and built again when a value changes."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from scipy.stats import chi2
@@ -31,8 +33,10 @@ from gripkit.signals import Trajectory
 from gripkit.sim.model import Model, Signal
 from gripkit.sysid import LinearModel
 from gripkit.sysid.nonlinear.hammerstein_wiener import HWModel, Nonlinearity
-from gripkit.sysid.nonlinear.hysteresis import BoucWenModel, BoucWenOscillatorModel
+from gripkit.sysid.nonlinear.hysteresis import (BoucWenModel, BoucWenOscillatorModel,
+                                               PrandtlIshlinskiiModel)
 from gripkit.sysid.nonlinear.narx import NARXModel
+from gripkit.sysid.nonlinear.nlss import NLSSModel, monomial_exponents
 
 M_RUNS, N = 20, 300
 DT = 0.05
@@ -72,6 +76,34 @@ def narx():
     theta = np.array([1.2, -0.5, 0.5, -0.05, 0.05])
     return NARXModel(2, 1, 3, False, bases, rows, theta, np.zeros(5), np.zeros((5, 5)), dt=DT,
                      y_range=(-10.0, 10.0))
+
+
+def nlss():
+    # 2 states, 2 inputs, 2 outputs, degree 3 with feedthrough: ζ and η over [x; ũ] (30 terms
+    # each), small seeded coefficients; ũ = (u − [0.2, −0.1]) / [0.7, 1.3]
+    exz = monomial_exponents(2, 2, 3)
+    exe = monomial_exponents(2, 2, 3, inputs=True)
+    rng = np.random.default_rng(26)
+    return NLSSModel(A=np.array([[0.8, 0.2], [-0.2, 0.7]]), B=np.array([[0.5, 0.1], [0.0, 0.3]]),
+                     C=np.array([[1.0, 0.3], [0.2, -0.5]]), D=np.array([[0.1, 0.0], [0.05, 0.2]]),
+                     E=0.02 * rng.standard_normal((2, len(exz))),
+                     F=0.02 * rng.standard_normal((2, len(exe))), exz=exz, exe=exe,
+                     u_offset=np.array([0.2, -0.1]), u_scale=np.array([0.7, 1.3]),
+                     y_offset=np.array([0.3, -1.0]), dirs=np.zeros((0, 3), dtype=np.int64),
+                     covariance=np.zeros((0, 0)), x0=np.zeros(2), state_limit=1e3, dt=DT,
+                     degree=3, feedthrough=True, input_names=("u1", "u2"),
+                     output_names=("y1", "y2"))
+
+
+def _nlss_input(n, seed=0):
+    return np.column_stack([_input(n, seed)[:, 0], 0.8 * _input(n, seed + 1)[:, 0]])
+
+
+def pi():
+    # four plays (r = 0 … 0.6, all driven by the ±1.5 input), input offset a = 0.05
+    return PrandtlIshlinskiiModel(thresholds=np.array([0.0, 0.2, 0.4, 0.6]),
+                                  weights=np.array([0.5, 0.3, 0.2, 0.1]), offset=0.1,
+                                  input_offset=0.05, dt=DT)
 
 
 def _piezo():
@@ -149,6 +181,22 @@ def test_state_functions_reproduce_each_models_simulation():
     x = np.array([ref[1], ref[0], u[1, 0]])
     np.testing.assert_allclose(_free_run(f, h, x, u[2:])[:, 0], ref[2:], rtol=0, atol=1e-12)
 
+    m = nlss()
+    U = _nlss_input(200)
+    f, h, x0, nx = state_functions(m)
+    assert nx == 2 and state_labels(m) == ["x1", "x2"]
+    ref = m.simulate(U)  # from x = 0, the equilibrium of the mean input
+    assert np.ptp(ref, axis=0).min() > 1.0  # a real excursion, not a run at rest
+    np.testing.assert_allclose(_free_run(f, h, x0, U), ref, rtol=0, atol=1e-12)
+
+    m = pi()
+    f, h, x0, nx = state_functions(m)
+    assert nx == 4 and state_labels(m) == ["play_0", "play_1", "play_2", "play_3"]
+    np.testing.assert_array_equal(x0, np.zeros(4))  # every play relaxed at u = a
+    ref = m.simulate(u[:, 0])[:, 0]
+    x0[:] = u[0, 0] - m.input_offset  # simulate relaxes every play at the first input
+    np.testing.assert_allclose(_free_run(f, h, x0, u)[:, 0], ref, rtol=0, atol=1e-12)
+
 
 # ---------------------------------------------------------------- (2) filters on noisy models
 
@@ -161,6 +209,12 @@ CASES = {
                             np.diag([1e-4, 1e-3, 1e-3]), [0, 1, 2]),
     "narx": (narx, None, np.diag([1e-4, 1e-12, 1e-12]), 1e-2, np.diag([1e-2, 1e-2, 1e-12]),
              [0, 1]),
+    "nlss": (nlss, None, np.diag([1e-4, 1e-4]), np.diag([1e-2, 1e-2]), np.diag([1e-2, 1e-2]),
+             [0, 1]),
+    # Q: a random walk of the held plays' memories (state_functions docstring); play_0 (r = 0)
+    # is always driven, its state is u − a and carries only the last step's Q: not in the NEES
+    "prandtl-ishlinskii": (pi, None, np.diag([1e-12, 1e-6, 1e-6, 1e-6]), 1e-4,
+                           np.diag([1e-12, 1e-4, 1e-4, 1e-4]), [1, 2, 3]),
     # state [H, U, y_A, v_A, α_A, w_A] (m, V, m, m/s, rad, rad/s); outputs y_A, α_A
     "piezo-actuator": (_piezo, 2e-5, np.diag([1e-16, 1e-12, 1e-18, 1e-10, 1e-14, 1e-6]),
                        np.diag([1e-16, 1e-12]), np.diag([1e-14, 1e-12, 1e-16, 1e-8, 1e-12, 1e-4]),
@@ -189,8 +243,12 @@ def test_filter_on_model_tracks_hidden_state_consistently(family, Filter):
     R = np.atleast_2d(R)
     rng = np.random.default_rng(27)
     u = _piezo_input(N) if family == "piezo-actuator" else _input(N, seed=1)
+    if family == "nlss":
+        u = _nlss_input(N, seed=1)
     if family in ("bouc-wen", "piezo-actuator"):
         x0[1] = u[0, 0]  # the input last applied
+    if family == "prandtl-ishlinskii":
+        x0[:] = u[0, 0] - model.input_offset  # every play relaxed at the first input
     d = len(hidden)
     nees = np.zeros((M_RUNS, N))
     ratios = []
@@ -221,6 +279,17 @@ def test_filter_from_model_runs_on_the_models_columns():
     np.testing.assert_array_equal(ukf.x_pred, [0.0, 0.0])
     out = ukf.run(data)
     assert np.sqrt(np.mean((out.x[:, 0] - y) ** 2)) < 1e-3
+
+    m = nlss()  # two inputs, two outputs: the columns by name, in the model's order
+    U = _nlss_input(100)
+    Y = m.simulate(U)
+    data = Trajectory(np.arange(100) * DT, {"y2": Y[:, 1], "u2": U[:, 1], "y1": Y[:, 0],
+                                            "u1": U[:, 0]})
+    Q, R = np.diag([1e-4, 1e-4]), np.diag([1e-2, 1e-2])
+    by_name = UnscentedKalmanFilter(m, Q=Q, R=R).run(data)
+    by_array = UnscentedKalmanFilter(m, Q=Q, R=R).run_arrays(U, Y)
+    np.testing.assert_array_equal(by_name.x, by_array.x)
+    assert np.abs(by_name.x).max() > 0.5  # the states move with the input
 
 
 # ---------------------------------------------------------------- (3) the Kalman filter
@@ -276,6 +345,12 @@ def test_models_without_what_the_filters_need_raise_model_error():
                        np.array([1.0, 0.5]), np.zeros(2), np.zeros((2, 2)))
     with pytest.raises(ModelError, match="no output lags"):
         state_functions(static)
+    with pytest.raises(ModelError, match="NLSS model has order 0"):
+        state_functions(dataclasses.replace(nlss(), A=np.zeros((0, 0))))
+    bad_pi = pi()
+    bad_pi.weights = np.array([0.5, 0.3])
+    with pytest.raises(ModelError, match="one weight per play operator, found 4 thresholds"):
+        state_functions(bad_pi)
     with pytest.raises(ArgumentError, match="give both f"):
         ExtendedKalmanFilter(lambda x, u: x, Q=[[1.0]], R=[[1.0]])
 

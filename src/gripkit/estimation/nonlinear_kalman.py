@@ -775,7 +775,8 @@ class UnscentedKalmanFilter(_NonlinearFilter):
     discrete realisation with offsets (u, y in SI, offsets not removed, as
     :class:`~gripkit.estimation.KalmanFilter`), ``x0`` default rest and ``P0`` default the
     steady-state prediction covariance. With a grey-box gripkit ``Model``, an ``HWModel``,
-    ``BoucWenModel``, ``BoucWenOscillatorModel`` or ``NARXModel``: the state functions of
+    ``BoucWenModel``, ``BoucWenOscillatorModel``, ``NARXModel``, ``NLSSModel`` or
+    ``PrandtlIshlinskiiModel``: the state functions of
     :func:`~gripkit.estimation.state_functions.state_functions` (``dt`` for a grey-box model),
     ``x0`` default the model's initial state, ``P0`` default Q; ``run(data)`` takes the model's
     input and output columns by default. ``UnscentedKalmanFilter(f, h, Q=, R=)``: ``f(x, u)``,

@@ -45,10 +45,33 @@ What the state is, family by family:
   the measured output is ``y = s + v`` (noise enters through the measurement, R), and the
   equation error of the fit enters as process noise on ``s(t−1)`` (Q[0, 0]); the model's own
   one-step predictor instead feeds the noisy measured outputs back. ``x0`` = 0. numba.
+* **Nonlinear state space** (:class:`~gripkit.sysid.nonlinear.NLSSModel`): its own states (the
+  model's basis, scaled to unit standard deviation on the estimation record), ``f(x, u) = A x +
+  B ũ + E ζ(x, ũ)`` and ``h(x, u) = y₀ + C x + D ũ + F η(x, ũ)`` with the model's normalised
+  input ``ũ = (u − u_offset)/u_scale`` (u in the model's units, as its ``simulate`` takes it),
+  by the monomial kernels of its own free run. ``x0`` = 0, the equilibrium of the mean input
+  (``NLSSModel.simulate``'s default start). ``f`` does not stop at the model's state limit (the
+  free run's divergence check). numba.
+* **Prandtl–Ishlinskii** (:class:`~gripkit.sysid.nonlinear.PrandtlIshlinskiiModel`): state the
+  m play outputs ``z_i = F_{r_i}[u − a]`` after the previous sample; ``f`` applies each play to
+  the new input, ``z_i⁺ = min(u − a + r_i, max(u − a − r_i, z_i))``, and ``h = c + Σ w_i z_i⁺``.
+  ``x0`` = 0: every play relaxed at the input offset ``a``; its simulate relaxes them at the
+  first input, which is ``x0 = u[0] − a`` (every entry) given to the filter. numba.
+  *The noise model this implies*: Q on the plays (``z⁺ = play(z, u) + w``) is a random walk of
+  each play's memory *while the input stays inside its band* ``|u − a − z_i| < r_i`` (the play
+  holds its output, so the noise accumulates: a drifting loop interior, as creep or unmodelled
+  minor loops give); once the input drives a play (reaches the band's edge) the play is reset
+  to ``u − a ∓ r_i`` and keeps only the last step's noise: the accumulated error is forgotten.
+  The ``r_0 = 0`` play is always driven (``z_0⁺ = u − a``), its state is the input and its
+  noise never reaches the output (give it a small Q); the output's model error is ``Σ w_i`` of
+  the held plays' walks. The play is not differentiable at the band's edge: the extended
+  filter's Jacobian is 1 (held), 0 (driven, its variance falls back to Q), and between them
+  within the difference step of the edge; near reversals it is more confident than its error
+  (average NEES 3.3 for 3 plays in the tests, 3.1 for the unscented filter).
 
-The past-input components (Bouc-Wen ``u_prev``, NARX ``u(t−k)``) are known exactly: give them a
-small positive process noise (for example 1e-12 of the input's variance) so that the unscented
-filter's covariance stays positive definite.
+The past-input components (Bouc-Wen ``u_prev``, NARX ``u(t−k)``) and the PI play of threshold 0
+are known exactly: give them a small positive process noise (for example 1e-12 of the input's
+variance) so that the unscented filter's covariance stays positive definite.
 """
 
 from __future__ import annotations
@@ -76,7 +99,7 @@ class StateFunctions(NamedTuple):
 
 _FAMILIES = ("a gripkit.sysid.LinearModel, a grey-box gripkit Model (MassSpringDamper, "
              "BoucWen, PiezoActuator, or one defining state_functions(dt)), HWModel, BoucWenModel, "
-             "BoucWenOscillatorModel or NARXModel")
+             "BoucWenOscillatorModel, NARXModel, NLSSModel or PrandtlIshlinskiiModel")
 
 
 def state_functions(model, dt: float | None = None) -> StateFunctions:
@@ -131,8 +154,10 @@ def _build(model, dt):
 def _build_new(model, dt):
     from ..sim.model import Model
     from ..sysid.nonlinear.hammerstein_wiener import HWModel
-    from ..sysid.nonlinear.hysteresis import BoucWenModel, BoucWenOscillatorModel
+    from ..sysid.nonlinear.hysteresis import (BoucWenModel, BoucWenOscillatorModel,
+                                              PrandtlIshlinskiiModel)
     from ..sysid.nonlinear.narx import NARXModel
+    from ..sysid.nonlinear.nlss import NLSSModel
 
     if isinstance(model, Model):
         return _greybox(model, dt)
@@ -144,6 +169,10 @@ def _build_new(model, dt):
         return _bw(model)
     if isinstance(model, NARXModel):
         return _narx(model)
+    if isinstance(model, NLSSModel):
+        return _nlss(model)
+    if isinstance(model, PrandtlIshlinskiiModel):
+        return _pi(model)
     if hasattr(model, "to_ss") and hasattr(model, "u_offset"):
         return _linear(model, dt)
     raise ModelError(f"state_functions: {type(model).__name__} has no state-space form gripkit "
@@ -484,3 +513,79 @@ def _narx(model):
 
     labels = [f"s(t-{k})" for k in range(1, ly + 1)] + [f"u(t-{k})" for k in range(1, lu + 1)]
     return f, h, np.zeros(n), n, labels
+
+
+def _nlss(model):
+    from ..sysid.nonlinear._nlss_kernels import _monomials, _output, _state_update
+
+    f64 = lambda M: np.ascontiguousarray(M, dtype=np.float64)  # noqa: E731
+    A, B, C, D, E, F = (f64(M) for M in (model.A, model.B, model.C, model.D, model.E, model.F))
+    y0, u0, su = f64(model.y_offset), f64(model.u_offset), f64(model.u_scale)
+    exz = np.ascontiguousarray(model.exz, dtype=np.int64)
+    exe = np.ascontiguousarray(model.exe, dtype=np.int64)
+    n, m, p = A.shape[0], B.shape[1], C.shape[0]
+    if n < 1:
+        raise ModelError("state_functions: the NLSS model has order 0, so no state to filter")
+
+    @numba.njit
+    def normalised(u):  # pragma: no cover - compiled
+        """ũ as the one row (1, m) the model's kernels index by sample."""
+        ut = np.empty((1, m))
+        for j in range(m):
+            ut[0, j] = (u[j] - u0[j]) / su[j]
+        return ut
+
+    @numba.njit
+    def f(x, u):  # pragma: no cover - compiled
+        ut = normalised(u)
+        zeta = np.empty(exz.shape[0])
+        _monomials(exz, x, ut, 0, zeta)
+        out = np.empty(n)
+        _state_update(A, B, E, x, ut, 0, zeta, out)
+        return out
+
+    @numba.njit
+    def h(x, u):  # pragma: no cover - compiled
+        ut = normalised(u)
+        eta = np.empty(exe.shape[0])
+        _monomials(exe, x, ut, 0, eta)
+        out = np.empty(p)
+        for i in range(p):
+            out[i] = _output(C, D, F, y0, x, ut, 0, eta, i)
+        return out
+
+    return f, h, np.zeros(n), n, [f"x{i + 1}" for i in range(n)]
+
+
+def _pi(model):
+    r = np.ascontiguousarray(model.thresholds, dtype=np.float64)
+    w = np.ascontiguousarray(model.weights, dtype=np.float64)
+    a, c, n = float(model.input_offset), float(model.offset), r.shape[0]
+    if n < 1 or w.shape != (n,):
+        raise ModelError(f"state_functions: the Prandtl-Ishlinskii model needs one weight per "
+                         f"play operator, found {n} thresholds and {w.shape[0]} weights")
+
+    @numba.njit
+    def f(x, u):  # pragma: no cover - compiled
+        out = np.empty(n)
+        v = u[0] - a
+        for i in range(n):  # the play of pi_simulate: z = min(v + r, max(v − r, z))
+            z = x[i]
+            if z < v - r[i]:
+                z = v - r[i]
+            elif z > v + r[i]:
+                z = v + r[i]
+            out[i] = z
+        return out
+
+    @numba.njit
+    def h(x, u):  # pragma: no cover - compiled
+        z = f(x, u)
+        acc = c
+        for i in range(n):
+            acc += w[i] * z[i]
+        out = np.empty(1)
+        out[0] = acc
+        return out
+
+    return f, h, np.zeros(n), n, [f"play_{i}" for i in range(n)]
