@@ -404,7 +404,6 @@ def _corpus_rows(rec) -> list[dict]:
 
     from gripkit.sysid import arx, n4sid
     from gripkit.sysid.linear.identify_mimo import identify_ss
-    from gripkit.sysid.linear.linear_model import from_polynomial
 
     (est, val), (ue, ye), (uv, yv), dt = corpus_data(rec)
     u0, y0 = ue - ue.mean(0), ye - ye.mean(0)
@@ -457,7 +456,7 @@ def _corpus_rows(rec) -> list[dict]:
 
     if u0.shape[1] == 1 and y0.shape[1] == 1:
         ours_arx = lambda: arx(u0[:, 0], y0[:, 0], LAGS, LAGS, 1, dt=dt)  # noqa: E731
-        fit_arx = _mimo_fit(*_abcd(from_polynomial(ours_arx())), dt, uv, yv, ue, ye)
+        fit_arx = _mimo_fit(*_abcd(ours_arx().linear_record()), dt, uv, yv, ue, ye)
         linear = _sysidentpy(1, LAGS, False, ue[:, 0], ye[:, 0])
         mp = linear()
         rows.append(row("measured", f"linear ARX, lags {LAGS}, {data}", measure(ours_arx),

@@ -24,7 +24,7 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "gripkit"
 LAZY_PACKAGES = {
     "scipy.signal": "0.85 s", "scipy.stats": "0.70 s", "scipy.optimize": "0.30 s", "scipy.spatial": "0.21 s",
     "scipy.linalg.blas": "0.13 s", "matplotlib": "0.34 s", "pint": "0.23 s", "pyarrow": "0.08 s",
-    "h5py": "0.07 s", "scipy.io": "0.13-0.41 s (the .mat reader only)", "rich": "0.04 s per module", "jinja2": "the HTML report only", "numba": "numba.cuda, the GPU path only",
+    "h5py": "0.07 s", "scipy.linalg": "0.2 s: a small ARX fit (`gripkit identify arx`) needs none", "scipy.io": "0.13-0.41 s (the .mat reader only)", "rich": "0.04 s per module", "jinja2": "the HTML report only", "numba": "numba.cuda, the GPU path only",
     # optional extras of pyproject.toml: absent unless installed
     "control": "extra 'interop'", "pinocchio": "extra 'pinocchio'", "distributed": "extra 'dask'",
     "mcap": "extra 'mcap'", "mcap_ros2": "extra 'mcap'",
@@ -47,6 +47,18 @@ LAZY_MODULES = {
         "the readers (pyarrow, h5py, scipy.io): every CLI command imports model_file for its JSON",
     ("control/robustness.py", "..report.plots"): "matplotlib (0.34 s): only the histograms load it",
     ("export/c_rls.py", "..sysid.linear.rls"): "numba (0.4 s): the RLS kernels, for --rls only",
+    ("estimation/state_functions.py", "..sim.model"): "a filter on a model reads its family "
+                                                     "on first use",
+    ("estimation/state_functions.py", "..sysid.nonlinear.hammerstein_wiener"):
+        "numba kernels of the nonlinear families: `import gripkit.estimation` loads none",
+    ("estimation/state_functions.py", "..sysid.nonlinear.hysteresis"): "as the line above",
+    ("estimation/state_functions.py", "..sysid.nonlinear.narx"): "as the line above",
+    ("estimation/state_functions.py", "..sysid.nonlinear.nlss"): "as the line above",
+    ("estimation/state_functions.py", "..models.hysteresis"): "numba kernels of the grey-box "
+                                                               "models, for their filters only",
+    ("estimation/state_functions.py", "..models.mass_spring_damper"): "as the line above",
+    ("estimation/state_functions.py", "..models.piezo"): "as the line above",
+    ("estimation/state_functions.py", "..sim.integrators"): "as the line above",
 }
 
 

@@ -249,18 +249,18 @@ def test_large_fit_allocates_no_record_sized_array():
 
 @pytest.mark.parametrize("m, q", [(40, 3), (2000, 5), (6000, 6), (9000, 5)])
 def test_qr_factor_by_numpy_or_scipy_lapack_is_the_same(m, q):
-    """`_qr_r` factors regressors up to NUMPY_QR_MAX_ELEMENTS with numpy's geqrf (no scipy.linalg
+    """`qr_r` factors regressors up to NUMPY_QR_MAX_ELEMENTS with numpy's geqrf (no scipy.linalg
     import at start-up) and larger ones with scipy's in place (sizes on both sides of 2^15 here):
     R is scipy.linalg.qr's R to rounding, ‖ΔR‖ ≤ 1e-13 ‖R‖ (Householder QR is backward stable,
     Golub & Van Loan Thm 5.2.1: both are exact for X + E with ‖E‖ ≲ m q u ‖X‖)."""
     import scipy.linalg as sla
 
-    from gripkit.sysid.regression import NUMPY_QR_MAX_ELEMENTS, _qr_r
+    from gripkit.sysid.regression import NUMPY_QR_MAX_ELEMENTS, qr_r
 
     rng = np.random.default_rng(m + q)
     X = np.asfortranarray(rng.standard_normal((m, q)) * np.logspace(-3, 3, q))
     ref = sla.qr(X, mode="r")[0][:q]
-    R = _qr_r(X.copy(order="F"), True)
+    R = qr_r(X.copy(order="F"), True)
     assert (X.size <= NUMPY_QR_MAX_ELEMENTS) == (m * q <= 2**15)
     assert np.allclose(np.abs(R), np.abs(ref), rtol=0, atol=1e-13 * np.abs(ref).max())
     assert np.array_equal(R, np.triu(R))

@@ -11,8 +11,8 @@ from typing import Optional
 import typer
 
 from .app import identify_app
-from .identify_linear import (DataArgs, _data_field, _echo_records, _fit_records,
-                              _records_field)
+from .identify_common import data_field, records_field, run_identify
+from .identify_linear import DataArgs, _echo_records
 from .common import (FillOpt, FsOpt, JsonOpt, ModelReportOpt, TimeOpt, check_data_options,
                      collected_warnings, emit_json, load_data, report_warnings, write_model_page)
 from .paths import output_folder
@@ -67,9 +67,9 @@ def identify_hw(data: list[Path] = DataArgs,
             tv = load_data(validate, [input_col, output_col], fs, time, fill)
             val = (np.asarray(tv[input_col]), np.asarray(tv[output_col]))
         if len(data) > 1:  # one model of every file's record, each from its own steady state
-            m = _fit_records(data, [input_col, output_col], input_col, output_col, fs, time, fill,
-                             "none", "hw", nb=nb, nf=nf, nk=nk, input_nonlinearity=input_nl,
-                             output_nonlinearity=output_nl, validate=val, progress=True)
+            m = run_identify(data, "hw", input_col, output_col, fs=fs, time=time, fill=fill,
+                             detrend="none", nb=nb, nf=nf, nk=nk, input_nonlinearity=input_nl,
+                             output_nonlinearity=output_nl, validate=val, progress=True)[0]
         else:
             m = hammerstein_wiener(np.asarray(tr[input_col]), np.asarray(tr[output_col]),
                                    input_nonlinearity=input_nl, output_nonlinearity=output_nl,
@@ -81,7 +81,7 @@ def identify_hw(data: list[Path] = DataArgs,
             m, tr if tv is None else tv, report, data[0] if validate is None else validate)
     lines = report_warnings(caught)
     if json_out:
-        emit_json({"data": _data_field(data if len(data) > 1 else data[0]),
+        emit_json({"data": data_field(data),
                    "input": input_col, "output": output_col,
                    "structure": {"kind": m.kind, "input_nonlinearity": m.input_nl.label,
                                  "output_nonlinearity": m.output_nl.label, "nb": m.nb,
@@ -96,10 +96,10 @@ def identify_hw(data: list[Path] = DataArgs,
                    {"data": str(validate), "fit_percent": m.validation_fit_percent,
                     "definition": m.fit_definition},
                    "candidates": m.candidates,
-                   **({"records": _records_field(data, m.records)} if len(data) > 1 else {}),
+                   **({"records": records_field(data, m.records)} if len(data) > 1 else {}),
                    "model": None if out is None else str(out), "report": page,
                    "warnings": lines})
     else:
         typer.echo(_summary(m))
         if len(data) > 1:
-            _echo_records(_records_field(data, m.records), free_run=True)
+            _echo_records(records_field(data, m.records), free_run=True)

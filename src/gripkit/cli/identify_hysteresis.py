@@ -14,8 +14,8 @@ from .app import identify_app
 from .common import (FillOpt, FsOpt, JsonOpt, ModelReportOpt, TimeOpt, check_choice,
                      check_data_options, collected_warnings, emit_json, load_data, report_warnings,
                      write_model_page)
-from .identify_linear import (DataArgs, _data_field, _echo_records, _fit_records,
-                              _records_field)
+from .identify_common import data_field, records_field, run_identify
+from .identify_linear import DataArgs, _echo_records
 from .paths import output_folder
 
 
@@ -79,8 +79,8 @@ def identify_hysteresis(data: list[Path] = DataArgs,
         opts = dict(form=form, exponent=n, operators=operators, burn_in=burn_in, validate=val,
                     progress=not json_out)
         if len(data) > 1:  # one model of every file's record, each from its own relaxed state
-            m = _fit_records(data, [input_col, output_col], input_col, output_col, fs, time, fill,
-                             "none", "hysteresis", model=model, **opts)
+            m = run_identify(data, "hysteresis", input_col, output_col, fs=fs, time=time,
+                             fill=fill, detrend="none", model=model, **opts)[0]
         else:
             m = hysteresis(tr, model, input=input_col, output=output_col, **opts)
         if out is not None:
@@ -95,7 +95,7 @@ def identify_hysteresis(data: list[Path] = DataArgs,
                      {"model": m.structure, "operators": len(m.thresholds),
                       "thresholds": [float(r) for r in m.thresholds]})
         structure["criterion"] = m.criterion
-        emit_json({"data": _data_field(data if len(data) > 1 else data[0]),
+        emit_json({"data": data_field(data),
                    "input": input_col, "output": output_col,
                    "structure": structure,
                    "parameters": [{"name": p.name, "value": p.value, "std": p.std,
@@ -104,7 +104,7 @@ def identify_hysteresis(data: list[Path] = DataArgs,
                    "fit_percent": m.fit_percent, "definition": m.fit_definition,
                    "validation": None if validate is None else
                    {"data": str(validate), "fit_percent": m.validation_fit_percent},
-                   **({"records": _records_field(data, m.records)} if len(data) > 1 else {}),
+                   **({"records": records_field(data, m.records)} if len(data) > 1 else {}),
                    "model": None if out is None else str(out), "report": page,
                    "warnings": lines})
     else:
@@ -114,4 +114,4 @@ def identify_hysteresis(data: list[Path] = DataArgs,
         if validate is not None:
             typer.echo(f"free-run fit (validation): {fmt(m.validation_fit_percent)}")
         if len(data) > 1:
-            _echo_records(_records_field(data, m.records), free_run=True)
+            _echo_records(records_field(data, m.records), free_run=True)

@@ -12,8 +12,8 @@ import typer
 from .app import identify_app
 from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, collected_warnings,
                      emit_json, load_data, report_warnings)
-from .identify_linear import (DataArgs, _data_field, _echo_records, _fit_records,
-                              _records_field)
+from .identify_common import data_field, records_field, run_identify
+from .identify_linear import DataArgs, _echo_records
 
 
 def _names(value: str, option: str) -> list[str]:
@@ -81,7 +81,8 @@ def identify_nlss(data: list[Path] = DataArgs,
         tv = None if validate is None else load_data(validate, ins + outs, fs, time, fill)
         opts = dict(order=order, degree=degree, max_order=max_order, window=window, validate=tv)
         if len(data) > 1:  # one model of every file's record, each with its own initial state
-            m = _fit_records(data, ins + outs, ins, outs, fs, time, fill, "none", "nlss", **opts)
+            m = run_identify(data, "nlss", ins, outs, fs=fs, time=time, fill=fill, detrend="none",
+                             **opts)[0]
         else:
             tr = load_data(data[0], ins + outs, fs, time, fill)
             m = nlss(tr, input=ins, output=outs, **opts)
@@ -91,7 +92,7 @@ def identify_nlss(data: list[Path] = DataArgs,
     if json_out:
         params = [{"name": p.name, "value": p.value, "std": p.std, "unit": p.unit,
                    "fixed": p.fixed, "meaning": p.doc} for p in m.parameters.values()]
-        emit_json({"data": _data_field(data if len(data) > 1 else data[0]),
+        emit_json({"data": data_field(data),
                    "inputs": ins, "outputs": outs,
                    "structure": {"model": "nlss", "order": m.order, "degree": m.degree,
                                  "zeta_terms": m.zeta_terms, "eta_terms": m.eta_terms,
@@ -104,10 +105,10 @@ def identify_nlss(data: list[Path] = DataArgs,
                     "linear_fit_percent": m.linear_validation_fit_percent},
                    "info": {k: v for k, v in m.info.items()
                             if k not in ("linear_start", "records")},
-                   **({"records": _records_field(data, m.info["records"])}
+                   **({"records": records_field(data, m.info["records"])}
                       if len(data) > 1 else {}),
                    "model": None if out is None else str(out), "warnings": lines})
     else:
         typer.echo(_summary(m))
         if len(data) > 1:
-            _echo_records(_records_field(data, m.info["records"]), free_run=True)
+            _echo_records(records_field(data, m.info["records"]), free_run=True)

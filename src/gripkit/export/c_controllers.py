@@ -151,7 +151,7 @@ def _rst(c, name: str) -> dict:
               f"void {name}_init({name}_state *s)\n{{\n    {name}_reset(s, 0.0, 0.0);\n}}\n\n",
               f"double {name}_step({name}_state *s, double r, double y)\n{{\n",
               "    double at = 0.0, bs = 0.0, acc, cu = 0.0, cv = 0.0, v, u;\n    int i;\n",
-              f"    for (i = {n - 1}; i > 0; --i) {{\n"
+              f"    for (i = {n - 1}; i > 0; i--) {{\n"
               "        s->r[i] = s->r[i - 1];\n        s->y[i] = s->y[i - 1];\n"
               "        s->u[i] = s->u[i - 1];\n        s->v[i] = s->v[i - 1];\n    }\n",
               "    s->r[0] = r;\n    s->y[0] = y;\n",

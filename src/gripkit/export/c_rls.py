@@ -138,10 +138,10 @@ def rls_c_sources(est, name: str = "rls") -> dict:
           "        s->w1 = lam * s->w1 + 1.0;\n        s->w2 = lam * lam * s->w2 + 1.0;\n",
           "        s->n_updates += 1.0;\n    }\n",
           "    if (au > s->peak_u) s->peak_u = au;\n    if (ay > s->peak_y) s->peak_y = ay;\n",
-          f"    for (i = {nu - 1}; i > 0; --i) s->ub[i] = s->ub[i - 1];\n",
+          f"    for (i = {nu - 1}; i > 0; i--) s->ub[i] = s->ub[i - 1];\n",
           "    s->ub[0] = u;\n"]
     if na > 0:
-        L += [f"    for (i = {na - 1}; i > 0; --i) s->yb[i] = s->yb[i - 1];\n",
+        L += [f"    for (i = {na - 1}; i > 0; i--) s->yb[i] = s->yb[i - 1];\n",
               "    s->yb[0] = y;\n"]
     L += ["    s->count += 1.0;\n    s->status = 0;\n    return e;\n}\n"]
     return {f"{name}.h": h, f"{name}.c": "".join(L)}
