@@ -297,8 +297,7 @@ class NLSSModel:
     def _run(self, ut, x0):
         N = ut.shape[0]
         Y = np.empty((N, len(self.output_names)))
-        at = K.simulate_kernel(self.A, self.B, self.C, self.D, self.E, self.F, self.y_offset,
-                               self.exz, self.exe, np.asarray(x0, dtype=np.float64), ut, Y,
+        at = K.simulate_kernel(_arrays(self), np.asarray(x0, dtype=np.float64), ut, Y,
                                np.empty((0, self.order)), self.state_limit)
         return Y, at
 
@@ -325,8 +324,7 @@ class NLSSModel:
         if at < 0 and self.dirs.shape[0]:
             w, V = np.linalg.eigh(0.5 * (self.covariance + self.covariance.T))
             L = np.ascontiguousarray(V * np.sqrt(np.maximum(w, 0.0)))
-            K.output_variance(self.A, self.B, self.C, self.D, self.E, self.F, self.y_offset,
-                              self.exz, self.exe, self.dirs, x0, ut, L, var)
+            K.output_variance(_arrays(self), self.dirs, x0, ut, L, var)
         return Y, np.sqrt(var)
 
     def estimate_x0(self, data, y=None, *, max_iterations: int = 30) -> np.ndarray:
@@ -466,18 +464,22 @@ def _apply(model: NLSSModel, dirs, delta) -> NLSSModel:
                    y_offset=mats[6][:, 0].copy())
 
 
+def _arrays(model) -> K.NLSSArrays:
+    """The model's arrays as the kernels take them (a :data:`._nlss_kernels.NLSSArrays`)."""
+    return K.NLSSArrays(model.A, model.B, model.C, model.D, model.E, model.F, model.y_offset,
+                        model.exz, model.exe)
+
+
 def _loss(model, Z, starts, u, y, w) -> float:
-    return K.window_loss(model.A, model.B, model.C, model.D, model.E, model.F, model.y_offset,
-                         model.exz, model.exe, Z, starts, u, y, w, model.state_limit)
+    return K.window_loss(_arrays(model), K.NLSSWindows(Z, starts, u, y, w), model.state_limit)
 
 
 def _gram(model, dirs, Z, starts, u, y, w):
     P, n, W = dirs.shape[0], model.order, starts.shape[0] - 1
     Htt, gt = np.empty((P, P)), np.empty(P)
     Htz, Hzz, gz = np.empty((W, P, n)), np.empty((W, n, n)), np.empty((W, n))
-    V = K.window_gram(model.A, model.B, model.C, model.D, model.E, model.F, model.y_offset,
-                      model.exz, model.exe, dirs, Z, starts, u, y, w, model.state_limit,
-                      Htt, gt, Htz, Hzz, gz)
+    V = K.window_gram(_arrays(model), dirs, K.NLSSWindows(Z, starts, u, y, w),
+                      model.state_limit, K.NLSSGram(Htt, gt, Htz, Hzz, gz))
     return V, Htt, gt, Htz, Hzz, gz
 
 
@@ -931,7 +933,8 @@ def _fit_order(lin, ut, y, u_off, sd_u, y_off, degree, feedthrough, window, max_
                      input_units=iunits, output_units=ounits)
     X = np.empty((N, n))
     Y = np.empty((N, p))
-    K.simulate_kernel(A, B, C, D, base.E, base.F, y_off, exz, exe, x0, ut, Y, X, np.inf)
+    K.simulate_kernel(K.NLSSArrays(A, B, C, D, base.E, base.F, y_off, exz, exe), x0, ut, Y, X,
+                      np.inf)
     if not np.all(np.isfinite(X)):
         raise IdentificationError("nlss: the linear start (n4sid) does not give a finite free "
                                   "run on the data; check the record")
@@ -1049,7 +1052,7 @@ def _fit_order_records(ss, A, B, C, D, ut, y, u_off, sd_u, y_off, degree, feedth
     X, Y = np.empty((N, n)), np.empty((N, p))
     for r, x0 in enumerate(x0s):
         a, b = bounds[r], bounds[r + 1]
-        K.simulate_kernel(A, B, C, D, base.E, base.F, y_off, exz, exe, x0,
+        K.simulate_kernel(K.NLSSArrays(A, B, C, D, base.E, base.F, y_off, exz, exe), x0,
                           np.ascontiguousarray(ut[a:b]), Y[a:b], X[a:b], np.inf)
     if not np.all(np.isfinite(X)):
         raise IdentificationError("nlss: the linear start (n4sid) does not give a finite free "
