@@ -84,9 +84,10 @@ def test_sensitivity_gram_matches_finite_differences():
     P = len(dirs)
     Htt, gt = np.empty((P, P)), np.empty(P)
     Htz, Hzz, gz = np.empty((3, P, 2)), np.empty((3, 2, 2)), np.empty((3, 2))
-    args = (m.A, m.B, m.C, m.D, m.E, m.F, m.y_offset, m.exz, m.exe)
-    V = K.window_gram(*args, dirs, Z, starts, u, y, w, 1e6, Htt, gt, Htz, Hzz, gz)
-    assert V == pytest.approx(K.window_loss(*args, Z, starts, u, y, w, 1e6), rel=1e-12)
+    arrays = K.NLSSArrays(m.A, m.B, m.C, m.D, m.E, m.F, m.y_offset, m.exz, m.exe)
+    win = K.NLSSWindows(Z, starts, u, y, w)
+    V = K.window_gram(arrays, dirs, win, 1e6, K.NLSSGram(Htt, gt, Htz, Hzz, gz))
+    assert V == pytest.approx(K.window_loss(arrays, win, 1e6), rel=1e-12)
     h = 1e-6
     from gripkit.sysid.nonlinear.nlss import _apply, _loss
 

@@ -156,11 +156,11 @@ def _apply(Pb, thb, qb, at, p, size, mode, maxtr, coef, scale, g):
 
 
 @njit(cache=True, inline="always")
-def _core(Pb, thb, phb, qb, at, p, size, lam, mode, maxtr, trace, y, std_out, tprev, fprev):
-    """One RLS update of θ (``thb[oth:oth + p]``) and P (``Pb[oP:oP + p·p]``, row-major) for the
-    regressor ``phb[oph:oph + p]`` and output ``y``; ``qb[oq:oq + p]`` is work space. Returns
-    (a-priori error, r = φᵀPφ, trace). The batch kernel passes one local buffer four times with
-    constant offsets (the compiler then sees that the vectors do not overlap).
+def _core(wb, at, p, size, lam, mode, maxtr, trace, y, std_out, tprev, fprev):
+    """One RLS update of θ (``wb[oth:oth + p]``) and P (``wb[oP:oP + p·p]``, row-major) for the
+    regressor ``wb[oph:oph + p]`` and output ``y``; ``wb[oq:oq + p]`` is work space. Returns
+    (a-priori error, r = φᵀPφ, trace). The batch kernel passes its one local buffer with constant
+    offsets (the compiler then sees that the vectors do not overlap).
 
     ``size``: an empty tuple (p at run time) or a tuple of p zeros (p known to the compiler, loops
     unrolled). The covariance update is ``P ← (P + coef·q qᵀ)·scale`` with ``q = Pφ`` (see the
@@ -172,15 +172,15 @@ def _core(Pb, thb, phb, qb, at, p, size, lam, mode, maxtr, trace, y, std_out, tp
     numbers the end of that step would write. There the square roots overlap with this update
     (the measurements: docs/performance.md, "Issue 24 follow-up").
     """
-    e, r, coef, scale, g, _ = _gain(Pb, thb, phb, qb, at, p, size, lam, mode,
+    e, r, coef, scale, g, _ = _gain(wb, wb, wb, wb, at, p, size, lam, mode,
                                     trace, y, False)
     if tprev >= 0:
         oP = at[0]
         if len(size) > 0:
             p = len(size)
         for i in range(p):
-            std_out[tprev, i] = math.sqrt(fprev * Pb[oP + i * p + i])
-    tr = _apply(Pb, thb, qb, at, p, size, mode, maxtr, coef, scale, g)
+            std_out[tprev, i] = math.sqrt(fprev * wb[oP + i * p + i])
+    tr = _apply(wb, wb, wb, at, p, size, mode, maxtr, coef, scale, g)
     return e, r, tr
 
 
@@ -403,14 +403,14 @@ def _rls_run(s, u, y, theta_out, std_out, yhat_out, err_out, size):
             w[bph + na + j] = u[t - nk - j]
         tprev = t - 1 if (store and t > nstart) else -1  # σ of step t − 1 (:func:`_core`)
         if mode == 0:  # the mode as a literal: its branches fold away in each copy
-            e, r, trace = _core(w, w, w, w, (bP, bth, bph, bq), p, size[0], lam, 0, maxtr,
-                                    trace, y[t], std_out, tprev, f)
+            e, r, trace = _core(w, (bP, bth, bph, bq), p, size[0], lam, 0, maxtr, trace, y[t],
+                                std_out, tprev, f)
         elif mode == 1:
-            e, r, trace = _core(w, w, w, w, (bP, bth, bph, bq), p, size[0], lam, 1, maxtr,
-                                    trace, y[t], std_out, tprev, f)
+            e, r, trace = _core(w, (bP, bth, bph, bq), p, size[0], lam, 1, maxtr, trace, y[t],
+                                std_out, tprev, f)
         else:
-            e, r, trace = _core(w, w, w, w, (bP, bth, bph, bq), p, size[0], lam, 2, maxtr,
-                                    trace, y[t], std_out, tprev, f)
+            e, r, trace = _core(w, (bP, bth, bph, bq), p, size[0], lam, 2, maxtr, trace, y[t],
+                                std_out, tprev, f)
         V = lam * (V + e * e / (lam + r))
         w1 = lam * w1 + 1.0
         w2 = lam * lam * w2 + 1.0

@@ -23,12 +23,23 @@ threads, which on a loaded 2-core machine made the Gram sums up to 6× slower th
 
 from __future__ import annotations
 
+from collections import namedtuple
+
 import numba
 import numpy as np
 
 from ..linear.blocked_gram import row_product
 
-
+# Named records the kernels take (namedtuples: numba resolves each field at compile time).
+#: the model's arrays: A (n, n), B (n, m), C (p, n), D (p, m), E (n, Mζ), F (p, Mη), the output
+#: offset y0 (p,) and the exponent tables exz (Mζ, n + m), exe (Mη, n + m)
+NLSSArrays = namedtuple("NLSSArrays", "A B C D E F y0 exz exe")
+#: the estimation windows: initial states Z (W, n), first samples ``starts`` (W + 1,), the
+#: normalised input u (N, m), the output y (N, p) and the per-output weights w (p,)
+NLSSWindows = namedtuple("NLSSWindows", "Z starts u y w")
+#: the Gauss-Newton sums :func:`window_gram` writes: Htt (P, P), gt (P,), Htz (W, P, n),
+#: Hzz (W, n, n), gz (W, n)
+NLSSGram = namedtuple("NLSSGram", "Htt gt Htz Hzz gz")
 
 #: a carried sensitivity below this magnitude is set to zero: the initial-state directions decay
 #: freely, and once below 1e-154 their products in JᵀJ would be subnormal numbers, whose
@@ -133,11 +144,85 @@ def _output(C, D, F, y0, x, u, t, eta, i):  # pragma: no cover - compiled
     return acc
 
 
+@numba.njit(cache=True, inline="always")
+def _output_rows(m, dirs, x, u, t, S, eta, Je, Gx, rows):  # pragma: no cover - compiled
+    """η and its Jacobian at sample t, and the rows ∂ŷ_i/∂θ of the output sensitivity:
+    rows = (C + F ∂η/∂x) S plus the direct terms of C, D, F and y₀ (directions ``dirs``)."""
+    C, F = m.C, m.F
+    n = x.shape[0]
+    p = C.shape[0]
+    _monomials(m.exe, x, u, t, eta)
+    _monomial_jacobian(m.exe, x, u, t, Je)
+    for i in range(p):  # Gx = C + F ∂η/∂x
+        for c in range(n):
+            acc = C[i, c]
+            for k in range(F.shape[1]):
+                acc += F[i, k] * Je[k, c]
+            Gx[i, c] = acc
+    for i in range(p):
+        row_product(Gx, i, S, rows[i])
+    for q in range(dirs.shape[0]):  # direct terms of the output equation
+        kind, r, c = dirs[q, 0], dirs[q, 1], dirs[q, 2]
+        if kind == 2:
+            rows[r, q] += x[c]
+        elif kind == 3:
+            rows[r, q] += u[t, c]
+        elif kind == 5:
+            rows[r, q] += eta[c]
+        elif kind == 6:
+            rows[r, q] += 1.0
+
+
+@numba.njit(cache=True, inline="always")
+def _state_rows(m, dirs, x, u, t, S, zeta, Jz, Fx, Sn):  # pragma: no cover - compiled
+    """ζ and its Jacobian at sample t, and the next sensitivity Sn = (A + E ∂ζ/∂x) S plus the
+    direct terms of A, B and E (directions ``dirs``)."""
+    A, E = m.A, m.E
+    n = x.shape[0]
+    _monomials(m.exz, x, u, t, zeta)
+    _monomial_jacobian(m.exz, x, u, t, Jz)
+    for r in range(n):  # Fx = A + E ∂ζ/∂x
+        for c in range(n):
+            acc = A[r, c]
+            for k in range(E.shape[1]):
+                acc += E[r, k] * Jz[k, c]
+            Fx[r, c] = acc
+    for r in range(n):
+        row_product(Fx, r, S, Sn[r])
+    for q in range(dirs.shape[0]):  # direct terms of the state equation
+        kind, r, c = dirs[q, 0], dirs[q, 1], dirs[q, 2]
+        if kind == 0:
+            Sn[r, q] += x[c]
+        elif kind == 1:
+            Sn[r, q] += u[t, c]
+        elif kind == 4:
+            Sn[r, q] += zeta[c]
+
+
+@numba.njit(cache=True, inline="always")
+def _window_sums(G, g, P, j, out):  # pragma: no cover - compiled
+    """Adds window j's sums (G: the upper triangle of JᵀJ over [θ; z_j], g = Jᵀe) to
+    ``out.Htt``, ``out.gt`` and writes its blocks ``out.Htz[j]``, ``out.Hzz[j]``, ``out.gz[j]``."""
+    Htt, Htz, Hzz = out.Htt, out.Htz, out.Hzz
+    n = G.shape[0] - P
+    for a in range(P):  # G holds its upper triangle
+        out.gt[a] += g[a]
+        for b in range(P):
+            Htt[a, b] += G[a, b] if a <= b else G[b, a]
+        for c in range(n):
+            Htz[j, a, c] = G[a, P + c]
+    for c in range(n):
+        out.gz[j, c] = g[P + c]
+        for d in range(n):
+            Hzz[j, c, d] = G[P + c, P + d] if c <= d else G[P + d, P + c]
+
+
 @numba.njit(cache=True)
-def simulate_kernel(A, B, C, D, E, F, y0, exz, exe, x0, u, Y, X, limit):  # pragma: no cover
-    """Free run from x0: outputs into Y (N, p), states into X (N, n) when X has N rows. Returns
-    the first sample whose state leaves [−limit, limit] (or is not finite), −1 if none; the
-    outputs from there on are NaN."""
+def simulate_kernel(m, x0, u, Y, X, limit):  # pragma: no cover - compiled
+    """Free run of the model ``m`` (:data:`NLSSArrays`) from x0: outputs into Y (N, p), states
+    into X (N, n) when X has N rows. Returns the first sample whose state leaves [−limit, limit]
+    (or is not finite), −1 if none; the outputs from there on are NaN."""
+    A, B, C, D, E, F, y0, exz, exe = m
     n = A.shape[0]
     N = u.shape[0]
     store = X.shape[0] == N
@@ -169,9 +254,12 @@ def simulate_kernel(A, B, C, D, E, F, y0, exz, exe, x0, u, Y, X, limit):  # prag
 
 
 @numba.njit(cache=True)
-def window_loss(A, B, C, D, E, F, y0, exz, exe, Z, starts, u, y, w, limit):  # pragma: no cover
-    """Σ over windows (window j: samples starts[j] … starts[j+1] − 1, free run from Z[j]) of the
-    weighted squared simulation errors Σ (w_i e_i)²; inf when a state leaves [−limit, limit]."""
+def window_loss(m, win, limit):  # pragma: no cover - compiled
+    """Σ over the windows ``win`` (:data:`NLSSWindows`; window j: samples starts[j] …
+    starts[j+1] − 1, free run of ``m`` from Z[j]) of the weighted squared simulation errors
+    Σ (w_i e_i)²; inf when a state leaves [−limit, limit]."""
+    A, B, C, D, E, F, y0, exz, exe = m
+    Z, starts, u, y, w = win
     n = A.shape[0]
     p = C.shape[0]
     x = np.empty(n)
@@ -198,13 +286,15 @@ def window_loss(A, B, C, D, E, F, y0, exz, exe, Z, starts, u, y, w, limit):  # p
 
 
 @numba.njit(cache=True)
-def window_gram(A, B, C, D, E, F, y0, exz, exe, dirs, Z, starts, u, y, w, limit,
-                Htt, gt, Htz, Hzz, gz):  # pragma: no cover - compiled
-    """Gauss-Newton sums of the windowed simulation error (module docstring): for the P
-    parameter directions ``dirs`` and the n initial-state directions of each window j,
-    Htt = Σ JθᵀJθ (P, P), gt = Σ Jθᵀe, Htz[j] = Σ Jθᵀ Jz_j (P, n), Hzz[j] = Σ Jz_jᵀJz_j, gz[j] =
-    Σ Jz_jᵀ e, rows weighted by w (per output). Returns the loss Σ (w e)², inf when a state
-    leaves [−limit, limit] (the sums are then incomplete)."""
+def window_gram(m, dirs, win, limit, out):  # pragma: no cover - compiled
+    """Gauss-Newton sums of the windowed simulation error (module docstring) of the model ``m``
+    (:data:`NLSSArrays`) over the windows ``win`` (:data:`NLSSWindows`): for the P parameter
+    directions ``dirs`` and the n initial-state directions of each window j, into ``out``
+    (:data:`NLSSGram`): Htt = Σ JθᵀJθ (P, P), gt = Σ Jθᵀe, Htz[j] = Σ Jθᵀ Jz_j (P, n), Hzz[j] =
+    Σ Jz_jᵀJz_j, gz[j] = Σ Jz_jᵀ e, rows weighted by w (per output). Returns the loss Σ (w e)²,
+    inf when a state leaves [−limit, limit] (the sums are then incomplete)."""
+    A, B, C, D, E, F, y0, exz, exe = m
+    Z, starts, u, y, w = win
     n = A.shape[0]
     p = C.shape[0]
     P = dirs.shape[0]
@@ -224,8 +314,8 @@ def window_gram(A, B, C, D, E, F, y0, exz, exe, dirs, Z, starts, u, y, w, limit,
     Je = np.empty((exe.shape[0], n))
     Fx = np.empty((n, n))
     Gx = np.empty((p, n))
-    Htt[:, :] = 0.0
-    gt[:] = 0.0
+    out.Htt[:, :] = 0.0
+    out.gt[:] = 0.0
     V = 0.0
     for j in range(starts.shape[0] - 1):
         for r in range(n):
@@ -240,26 +330,7 @@ def window_gram(A, B, C, D, E, F, y0, exz, exe, dirs, Z, starts, u, y, w, limit,
             for r in range(n):
                 if not (abs(x[r]) <= limit):
                     return np.inf
-            _monomials(exe, x, u, t, eta)
-            _monomial_jacobian(exe, x, u, t, Je)
-            for i in range(p):  # Gx = C + F ∂η/∂x
-                for c in range(n):
-                    acc = C[i, c]
-                    for k in range(F.shape[1]):
-                        acc += F[i, k] * Je[k, c]
-                    Gx[i, c] = acc
-            for i in range(p):
-                row_product(Gx, i, S, rows[i])
-            for q in range(P):  # direct terms of the output equation
-                kind, r, c = dirs[q, 0], dirs[q, 1], dirs[q, 2]
-                if kind == 2:
-                    rows[r, q] += x[c]
-                elif kind == 3:
-                    rows[r, q] += u[t, c]
-                elif kind == 5:
-                    rows[r, q] += eta[c]
-                elif kind == 6:
-                    rows[r, q] += 1.0
+            _output_rows(m, dirs, x, u, t, S, eta, Je, Gx, rows)
             for i in range(p):
                 wi = w[i]
                 e = wi * (y[t, i] - _output(C, D, F, y0, x, u, t, eta, i))
@@ -272,47 +343,23 @@ def window_gram(A, B, C, D, E, F, y0, exz, exe, dirs, Z, starts, u, y, w, limit,
                 if fill == _ROWS:
                     _add_rows(RT, eb, fill, G, g)
                     fill = 0
-            _monomials(exz, x, u, t, zeta)
-            _monomial_jacobian(exz, x, u, t, Jz)
-            for r in range(n):  # Fx = A + E ∂ζ/∂x
-                for c in range(n):
-                    acc = A[r, c]
-                    for k in range(E.shape[1]):
-                        acc += E[r, k] * Jz[k, c]
-                    Fx[r, c] = acc
-            for r in range(n):
-                row_product(Fx, r, S, Sn[r])
-            for q in range(P):  # direct terms of the state equation
-                kind, r, c = dirs[q, 0], dirs[q, 1], dirs[q, 2]
-                if kind == 0:
-                    Sn[r, q] += x[c]
-                elif kind == 1:
-                    Sn[r, q] += u[t, c]
-                elif kind == 4:
-                    Sn[r, q] += zeta[c]
+            _state_rows(m, dirs, x, u, t, S, zeta, Jz, Fx, Sn)
             _carry(Sn, S)
             _state_update(A, B, E, x, u, t, zeta, xn)
             for r in range(n):
                 x[r] = xn[r]
         if fill:
             _add_rows(RT, eb, fill, G, g)
-        for a in range(P):  # G holds its upper triangle
-            gt[a] += g[a]
-            for b in range(P):
-                Htt[a, b] += G[a, b] if a <= b else G[b, a]
-            for c in range(n):
-                Htz[j, a, c] = G[a, P + c]
-        for c in range(n):
-            gz[j, c] = g[P + c]
-            for d in range(n):
-                Hzz[j, c, d] = G[P + c, P + d] if c <= d else G[P + d, P + c]
+        _window_sums(G, g, P, j, out)
     return V
 
 
 @numba.njit(cache=True)
-def output_variance(A, B, C, D, E, F, y0, exz, exe, dirs, x0, u, L, out):  # pragma: no cover
-    """out[t, i] = ‖Lᵀ ∂ŷ_i[t]/∂θ‖² for the free run from x0 (x0 held): the variance of the
-    simulated output by linearised propagation of cov θ = L Lᵀ (directions ``dirs``)."""
+def output_variance(m, dirs, x0, u, L, out):  # pragma: no cover - compiled
+    """out[t, i] = ‖Lᵀ ∂ŷ_i[t]/∂θ‖² for the free run of ``m`` (:data:`NLSSArrays`) from x0 (x0
+    held): the variance of the simulated output by linearised propagation of cov θ = L Lᵀ
+    (directions ``dirs``)."""
+    A, B, C, D, E, F, y0, exz, exe = m
     n = A.shape[0]
     p = C.shape[0]
     P = dirs.shape[0]
@@ -330,26 +377,7 @@ def output_variance(A, B, C, D, E, F, y0, exz, exe, dirs, x0, u, L, out):  # pra
     Gx = np.empty((p, n))
     N = u.shape[0]
     for t in range(N):
-        _monomials(exe, x, u, t, eta)
-        _monomial_jacobian(exe, x, u, t, Je)
-        for i in range(p):
-            for c in range(n):
-                acc = C[i, c]
-                for k in range(F.shape[1]):
-                    acc += F[i, k] * Je[k, c]
-                Gx[i, c] = acc
-        for i in range(p):
-            row_product(Gx, i, S, rows[i])
-        for q in range(P):
-            kind, r, c = dirs[q, 0], dirs[q, 1], dirs[q, 2]
-            if kind == 2:
-                rows[r, q] += x[c]
-            elif kind == 3:
-                rows[r, q] += u[t, c]
-            elif kind == 5:
-                rows[r, q] += eta[c]
-            elif kind == 6:
-                rows[r, q] += 1.0
+        _output_rows(m, dirs, x, u, t, S, eta, Je, Gx, rows)
         for i in range(p):  # ‖Lᵀ r‖²
             ri = rows[i]
             for b in range(L.shape[1]):
@@ -365,24 +393,7 @@ def output_variance(A, B, C, D, E, F, y0, exz, exe, dirs, x0, u, L, out):  # pra
             for b in range(L.shape[1]):
                 acc += tmp[b] * tmp[b]
             out[t, i] = acc
-        _monomials(exz, x, u, t, zeta)
-        _monomial_jacobian(exz, x, u, t, Jz)
-        for r in range(n):
-            for c in range(n):
-                acc = A[r, c]
-                for k in range(E.shape[1]):
-                    acc += E[r, k] * Jz[k, c]
-                Fx[r, c] = acc
-        for r in range(n):
-            row_product(Fx, r, S, Sn[r])
-        for q in range(P):
-            kind, r, c = dirs[q, 0], dirs[q, 1], dirs[q, 2]
-            if kind == 0:
-                Sn[r, q] += x[c]
-            elif kind == 1:
-                Sn[r, q] += u[t, c]
-            elif kind == 4:
-                Sn[r, q] += zeta[c]
+        _state_rows(m, dirs, x, u, t, S, zeta, Jz, Fx, Sn)
         _carry(Sn, S)
         _state_update(A, B, E, x, u, t, zeta, xn)
         for r in range(n):

@@ -883,6 +883,100 @@ def _records(data, input, output):
     return (recs, *first)
 
 
+def _check_burn_in(burn_in, recs) -> int:
+    """``burn_in`` as an int ≥ 0 that leaves at least 10 samples of every record to fit."""
+    burn_in = _check_int(burn_in, "burn_in", 0)
+    for i, (ur, _) in enumerate(recs):
+        if burn_in > len(ur) - 10:
+            raise ArgumentError(f"hysteresis: burn_in = {burn_in} leaves fewer than 10 of the "
+                                f"{len(ur)} samples{f' of data[{i}]' * (len(recs) > 1)} to fit; "
+                                "lower it")
+    return burn_in
+
+
+def _bouc_wen_settings(form, exponent, multistart):
+    """The Bouc-Wen arguments checked → (multistart, how the model is fitted)."""
+    if form not in FORMS:
+        raise ArgumentError(f"hysteresis: form must be one of {', '.join(FORMS)}, found "
+                            f"{form!r}")
+    if not (exponent == "free" or (isinstance(exponent, (int, float, np.floating))
+                                   and not isinstance(exponent, bool)
+                                   and 1.0 <= exponent <= 10.0)):
+        raise ArgumentError(f"hysteresis: exponent must be a number in [1, 10] or 'free', "
+                            f"found {exponent!r}")
+    multistart = _check_int(multistart, "multistart", 1)
+    how = (f"free-run least squares, {multistart} start(s), n "
+           + ("estimated" if exponent == "free" else f"= {exponent:g}"))
+    return multistart, how
+
+
+def _oscillator(recs, dt, exponent, offset, burn_in, multistart, substeps, progress, common,
+                how) -> BoucWenOscillatorModel:
+    """The Bouc-Wen oscillator fitted to one record (``common``: the model's other fields)."""
+    if len(recs) > 1:
+        raise ArgumentError(f"hysteresis: the Bouc-Wen oscillator is fitted to one record, "
+                            f"found {len(recs)}",
+                            hint="fit the actuator form or Prandtl-Ishlinskii to several "
+                                 "records, or pass one record")
+    u, y = recs[0]
+    substeps = _check_int(substeps, "substeps", 1)
+    if dt is None:
+        raise ArgumentError("hysteresis: the Bouc-Wen oscillator is rate dependent: give the "
+                            "sample time dt= (or a Trajectory, which has one)")
+    phys, names, cov = _fit_bouc_wen_oscillator(u, y, float(dt), exponent=exponent,
+                                                offset=offset, burn_in=burn_in,
+                                                multistart=multistart, substeps=substeps,
+                                                progress=progress)
+    common["dt"] = float(dt)
+    return BoucWenOscillatorModel(**phys, substeps=substeps, free=names, covariance=cov,
+                                  **common, criterion=how)
+
+
+def _prandtl_ishlinskii(recs, u, operators, thresholds, offset, burn_in, iname,
+                        common) -> PrandtlIshlinskiiModel:
+    """The Prandtl–Ishlinskii model of the records (``u`` all their inputs): ``thresholds``, or
+    ``operators`` default ones, each below half the input's range; weights ≥ 0."""
+    if thresholds is None:
+        r = default_thresholds(u, _check_int(operators, "operators", 1))
+    else:
+        r = np.atleast_1d(np.asarray(thresholds, dtype=np.float64))
+        if r.ndim != 1 or r[0] != 0.0 or np.any(np.diff(r) <= 0) or not np.all(np.isfinite(r)):
+            raise ArgumentError("hysteresis: thresholds must start at 0 and increase strictly, "
+                                f"found {r.tolist()}")
+    half = 0.5 * float(np.ptp(u))
+    if r[-1] >= half:
+        raise DataError(f"hysteresis: the play of threshold {r[-1]:g} is not excited: the "
+                        f"input {iname!r} spans only ±{half:g} about its middle, so plays of "
+                        f"thresholds ≥ {half:g} never move on a loop",
+                        hint="give thresholds below half the input's range, or record a "
+                             "wider sweep")
+    w, c, cov, at_bound = _fit_pi(recs, r, offset=offset, burn_in=burn_in)
+    m = PrandtlIshlinskiiModel(r, w, offset=c, covariance=cov, fit_offset=bool(offset),
+                               **common,
+                               criterion=f"{len(r)} plays, weights ≥ 0 by bounded least "
+                                         f"squares ({at_bound} on the bound 0)")
+    if w[0] <= 0:
+        emit_warning("prandtl-ishlinskii: w_0 (the play of threshold 0) came out 0, so the "
+                     "model has no inverse (invert() will refuse it)", AccuracyWarning)
+    return m
+
+
+def _score_records(m, recs, burn_in: int) -> None:
+    """``m.fit_percent`` of the free run over the scored samples; with several records each
+    record from its own relaxed state, the fit over all of them together and each one's in
+    ``m.records``."""
+    if len(recs) == 1:
+        u, y = recs[0]
+        yhat = m.simulate(u)[:, 0]
+        m.fit_percent = _fit_percent(y[burn_in:], yhat[burn_in:])
+        return
+    runs = [m.simulate(ur)[burn_in:, 0] for ur, _ in recs]
+    m.records = [{"n_samples": len(ur), "fit_percent": _fit_percent(yr[burn_in:], s)}
+                 for (ur, yr), s in zip(recs, runs)]
+    m.fit_percent = _fit_percent(np.concatenate([yr[burn_in:] for _, yr in recs]),
+                                 np.concatenate(runs))
+
+
 def hysteresis(data, model: str = "bouc-wen", *, input: str | None = None,
                output: str | None = None, form: str = "actuator", exponent=1.0,
                operators: int = 10, thresholds=None, offset: bool = True, burn_in: int = 0,
@@ -921,12 +1015,7 @@ def hysteresis(data, model: str = "bouc-wen", *, input: str | None = None,
     if dt is not None and not (isinstance(dt, (int, float, np.floating)) and math.isfinite(dt)
                                and dt > 0):
         raise ArgumentError(f"hysteresis: dt must be a positive sample interval in s, found {dt!r}")
-    burn_in = _check_int(burn_in, "burn_in", 0)
-    for i, (ur, _) in enumerate(recs):
-        if burn_in > len(ur) - 10:
-            raise ArgumentError(f"hysteresis: burn_in = {burn_in} leaves fewer than 10 of the "
-                                f"{len(ur)} samples{f' of data[{i}]' * (len(recs) > 1)} to fit; "
-                                "lower it")
+    burn_in = _check_burn_in(burn_in, recs)
     if len(recs) == 1:
         _check_excited(*recs[0], iname, oname)
     if validate is not None:
@@ -934,73 +1023,18 @@ def hysteresis(data, model: str = "bouc-wen", *, input: str | None = None,
     common = dict(dt=dt, input_name=iname, output_name=oname, input_unit=iunit,
                   output_unit=ounit, burn_in=burn_in)
     if model == "bouc-wen":
-        if form not in FORMS:
-            raise ArgumentError(f"hysteresis: form must be one of {', '.join(FORMS)}, found "
-                                f"{form!r}")
-        if not (exponent == "free" or (isinstance(exponent, (int, float, np.floating))
-                                       and not isinstance(exponent, bool)
-                                       and 1.0 <= exponent <= 10.0)):
-            raise ArgumentError(f"hysteresis: exponent must be a number in [1, 10] or 'free', "
-                                f"found {exponent!r}")
-        multistart = _check_int(multistart, "multistart", 1)
-        how = (f"free-run least squares, {multistart} start(s), n "
-               + ("estimated" if exponent == "free" else f"= {exponent:g}"))
+        multistart, how = _bouc_wen_settings(form, exponent, multistart)
     if model == "bouc-wen" and form == "oscillator":
-        if len(recs) > 1:
-            raise ArgumentError(f"hysteresis: the Bouc-Wen oscillator is fitted to one record, "
-                                f"found {len(recs)}",
-                                hint="fit the actuator form or Prandtl-Ishlinskii to several "
-                                     "records, or pass one record")
-        u, y = recs[0]
-        substeps = _check_int(substeps, "substeps", 1)
-        if dt is None:
-            raise ArgumentError("hysteresis: the Bouc-Wen oscillator is rate dependent: give the "
-                                "sample time dt= (or a Trajectory, which has one)")
-        phys, names, cov = _fit_bouc_wen_oscillator(u, y, float(dt), exponent=exponent,
-                                                    offset=offset, burn_in=burn_in,
-                                                    multistart=multistart, substeps=substeps,
-                                                    progress=progress)
-        common["dt"] = float(dt)
-        m = BoucWenOscillatorModel(**phys, substeps=substeps, free=names, covariance=cov,
-                                   **common, criterion=how)
+        m = _oscillator(recs, dt, exponent, offset, burn_in, multistart, substeps, progress,
+                        common, how)
     elif model == "bouc-wen":
         phys, names, cov = _fit_bouc_wen(recs, exponent=exponent, offset=offset,
                                          burn_in=burn_in, multistart=multistart,
                                          progress=progress)
         m = BoucWenModel(**phys, free=names, covariance=cov, **common, criterion=how)
     else:
-        if thresholds is None:
-            r = default_thresholds(u, _check_int(operators, "operators", 1))
-        else:
-            r = np.atleast_1d(np.asarray(thresholds, dtype=np.float64))
-            if r.ndim != 1 or r[0] != 0.0 or np.any(np.diff(r) <= 0) or not np.all(np.isfinite(r)):
-                raise ArgumentError("hysteresis: thresholds must start at 0 and increase strictly, "
-                                    f"found {r.tolist()}")
-        half = 0.5 * float(np.ptp(u))
-        if r[-1] >= half:
-            raise DataError(f"hysteresis: the play of threshold {r[-1]:g} is not excited: the "
-                            f"input {iname!r} spans only ±{half:g} about its middle, so plays of "
-                            f"thresholds ≥ {half:g} never move on a loop",
-                            hint="give thresholds below half the input's range, or record a "
-                                 "wider sweep")
-        w, c, cov, at_bound = _fit_pi(recs, r, offset=offset, burn_in=burn_in)
-        m = PrandtlIshlinskiiModel(r, w, offset=c, covariance=cov, fit_offset=bool(offset),
-                                   **common,
-                                   criterion=f"{len(r)} plays, weights ≥ 0 by bounded least "
-                                             f"squares ({at_bound} on the bound 0)")
-        if w[0] <= 0:
-            emit_warning("prandtl-ishlinskii: w_0 (the play of threshold 0) came out 0, so the "
-                         "model has no inverse (invert() will refuse it)", AccuracyWarning)
-    if len(recs) == 1:
-        u, y = recs[0]
-        yhat = m.simulate(u)[:, 0]
-        m.fit_percent = _fit_percent(y[burn_in:], yhat[burn_in:])
-    else:  # every record from its own relaxed state; the fit over all scored samples together
-        runs = [m.simulate(ur)[burn_in:, 0] for ur, _ in recs]
-        m.records = [{"n_samples": len(ur), "fit_percent": _fit_percent(yr[burn_in:], s)}
-                     for (ur, yr), s in zip(recs, runs)]
-        m.fit_percent = _fit_percent(np.concatenate([yr[burn_in:] for _, yr in recs]),
-                                     np.concatenate(runs))
+        m = _prandtl_ishlinskii(recs, u, operators, thresholds, offset, burn_in, iname, common)
+    _score_records(m, recs, burn_in)
     if validate is not None:
         m.validation_fit_percent = m.compare((uv, yv)).fit_percent[0]
     return m

@@ -713,6 +713,115 @@ def _refine_simulation(model: NARXModel, records, max_iter: int, tol: float = 1e
     return it
 
 
+def _narx_records(u, y) -> list:
+    """The estimation records [(u, y)]: ``u`` a list of pairs when ``y`` is None."""
+    if y is None:
+        return _pairs(u, "records")
+    u, y = _as_signal(u, "u"), _as_signal(y, "y")
+    if len(u) != len(y):
+        raise DataError(f"narx: u has {len(u)} samples but y has {len(y)}; pass a pair of "
+                        "equal length")
+    return [(u, y)]
+
+
+def _regression_matrix(bases, rows, records, start: int):
+    """The candidate regressors of every record's samples from ``start`` on, stacked in one
+    Fortran-ordered matrix, and the targets → (P, target); raises for records too short."""
+    for i, (_, yr) in enumerate(records):
+        if len(yr) <= start + 1:
+            raise DataError(f"narx: record {i} has {len(yr)} samples; each record needs more than "
+                            f"max_lag + 1 = {start + 1}")
+    n = sum(len(yr) - start for _, yr in records)
+    if n < 2 * len(rows):
+        raise DataError(f"narx: {n + start * len(records)} samples for {len(rows)} candidate "
+                        f"terms; need at least {2 * len(rows) + start * len(records)}: lower "
+                        "degree or lags, or give more data")
+    P = np.empty((n, len(rows)), order="F")
+    at = 0
+    for ur, yr in records:
+        k = len(yr) - start
+        _regressors(bases, rows, ur, yr, start, out=P[at:at + k])
+        at += k
+    return P, np.concatenate([yr[start:] for _, yr in records])
+
+
+def _validation_records(validate, start: int):
+    """The validation records [(u, y)], or None; each must be longer than max_lag + 2."""
+    if validate is None:
+        return None
+    val = _pairs(validate, "validate")
+    for uv, yv in val:
+        if len(uv) <= start + 2:
+            raise DataError(f"narx: a validation record has {len(uv)} samples; need more "
+                            f"than max_lag + 2 = {start + 2}")
+    return val
+
+
+def _max_terms(terms, n_candidates: int) -> int:
+    """The most FROLS terms to select: ``terms``, or up to :data:`MAX_AUTO_TERMS` for 'auto'."""
+    if terms == "auto":
+        return min(n_candidates, MAX_AUTO_TERMS)
+    if isinstance(terms, str):
+        raise ArgumentError(f"narx: terms must be 'auto' or an integer ≥ 1, found {terms!r}")
+    kmax = _positive_int(terms, "terms")
+    if kmax > n_candidates:
+        raise ArgumentError(f"narx: terms = {kmax} but only {n_candidates} candidates; give at "
+                            f"most {n_candidates} or raise degree/lags")
+    return kmax
+
+
+def _choose_terms(build, terms, n_selected: int, sse, n: int, val, progress: bool):
+    """The model of the number of FROLS terms chosen: all ``n_selected`` for a given ``terms``,
+    else the BIC minimum, or with ``val`` the best validation free-run fit; ``build(k)`` makes
+    the model of the first k terms → (model, its SSE, how the number was chosen)."""
+    from ...progress import track
+
+    if terms != "auto":
+        return (*build(n_selected), f"terms={n_selected}")
+    if val is None:
+        bic = [n * np.log(max(s, 1e-300) / n) + (k + 1) * np.log(n) for k, s in enumerate(sse)]
+        k = int(np.argmin(bic)) + 1
+        return (*build(k), f"BIC minimum at {k} FROLS terms")
+    best = None
+    for k in track(range(1, n_selected + 1), description="narx: validation free runs",
+                   enabled=progress):
+        cand, sse_c = build(k)
+        f = _fit_records(cand, val, warn=False)
+        if f is not None and (best is None or f > best[0] + 1e-9):
+            best = (f, k, cand, sse_c)
+    if best is None:
+        return (*build(n_selected), "validation fit (every candidate diverged)")
+    return best[2], best[3], f"validation free-run fit best at {best[1]} FROLS terms"
+
+
+def _refine_and_prune(model, records, rows, P, target, prune: bool, max_iter: int) -> None:
+    """θ refined on the free-run error (:func:`_refine_simulation`), then with ``prune`` the
+    weakest term with |θ|/σ < 2 dropped and θ refined again, one at a time; the criterion and
+    the one-step fit of the refined θ updated."""
+    iters = _refine_simulation(model, records, max_iter)
+    dropped = 0
+    while prune and iters is not None and len(model.theta) > 1:
+        t = np.abs(model.theta) / np.where(model.theta_std > 0, model.theta_std, np.inf)
+        weakest = int(np.argmin(t))
+        if not t[weakest] < 2.0:
+            break
+        keep = np.arange(len(model.theta)) != weakest
+        model.rows, model.theta = model.rows[keep], model.theta[keep]
+        dropped += 1
+        more = _refine_simulation(model, records, max_iter)
+        iters = None if more is None else iters + more
+    model.criterion += ("; θ refined on the free-run error (Levenberg–Marquardt, "
+                        f"{iters} iterations, σ from its Gauss–Newton Hessian"
+                        + (f", then {dropped} term(s) with |θ|/σ < 2 pruned one by one)"
+                           if dropped else ")")
+                        if iters is not None else
+                        "; not refined: the least-squares model's free run diverges")
+    if iters is not None:  # the one-step fit of the refined θ
+        cols = [_row_index(rows, r) for r in model.rows]
+        e = target - P[:, cols] @ model.theta
+        model.prediction_fit_percent = _fit(target, target - e)
+
+
 def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None = None,
          ulags: int | None = None, terms="auto", dt: float | None = None, validate=None,
          direct: bool = False, prune: bool = True, refine: str | None = None,
@@ -733,17 +842,10 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
     noise is measurement noise on the output, which biases the one-step estimate).
     ``progress``: each stage on stderr, a bar over the validation candidates.
     """
-    from ...progress import status, track
+    from ...progress import status
 
     say = status if progress else (lambda message: None)
-    if y is None:
-        records = _pairs(u, "records")
-    else:
-        u, y = _as_signal(u, "u"), _as_signal(y, "y")
-        if len(u) != len(y):
-            raise DataError(f"narx: u has {len(u)} samples but y has {len(y)}; pass a pair of "
-                            "equal length")
-        records = [(u, y)]
+    records = _narx_records(u, y)
     if refine not in REFINE:
         raise ArgumentError(f"narx: refine must be None or 'simulation', found {refine!r}")
     max_iter = _positive_int(max_iter, "max_iter")
@@ -761,38 +863,10 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
         raise ArgumentError("narx: no lagged signal (ylags = ulags = 0); give lags ≥ 1")
     bases, rows = candidate_terms(ly, lu, degree, direct)
     start = max(ly, lu, 1)
-    for i, (_, yr) in enumerate(records):
-        if len(yr) <= start + 1:
-            raise DataError(f"narx: record {i} has {len(yr)} samples; each record needs more than "
-                            f"max_lag + 1 = {start + 1}")
-    n = sum(len(yr) - start for _, yr in records)
-    if n < 2 * len(rows):
-        raise DataError(f"narx: {n + start * len(records)} samples for {len(rows)} candidate "
-                        f"terms; need at least {2 * len(rows) + start * len(records)}: lower "
-                        "degree or lags, or give more data")
-    P = np.empty((n, len(rows)), order="F")
-    at = 0
-    for ur, yr in records:
-        k = len(yr) - start
-        _regressors(bases, rows, ur, yr, start, out=P[at:at + k])
-        at += k
-    target = np.concatenate([yr[start:] for _, yr in records])
-    val = None
-    if validate is not None:
-        val = _pairs(validate, "validate")
-        for uv, yv in val:
-            if len(uv) <= start + 2:
-                raise DataError(f"narx: a validation record has {len(uv)} samples; need more "
-                                f"than max_lag + 2 = {start + 2}")
-    if terms == "auto":
-        kmax = min(len(rows), MAX_AUTO_TERMS)
-    else:
-        if isinstance(terms, str):
-            raise ArgumentError(f"narx: terms must be 'auto' or an integer ≥ 1, found {terms!r}")
-        kmax = _positive_int(terms, "terms")
-        if kmax > len(rows):
-            raise ArgumentError(f"narx: terms = {kmax} but only {len(rows)} candidates; give at "
-                                f"most {len(rows)} or raise degree/lags")
+    P, target = _regression_matrix(bases, rows, records, start)
+    n = P.shape[0]
+    val = _validation_records(validate, start)
+    kmax = _max_terms(terms, len(rows))
     say(f"narx: FROLS over {len(rows)} candidate terms, {n} rows")
     reg = _Regression(P, target)
     order, errs, sse = _frols_gram(reg.G, reg.g, reg.yy, kmax)
@@ -818,25 +892,7 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
                         frols_terms=[_term_name(rows[c], bases) for c in order[:k]])
         return mod, sse_k
 
-    if terms != "auto":
-        (model, sse_k), how = build(len(order)), f"terms={len(order)}"
-    elif val is None:
-        bic = [n * np.log(max(s, 1e-300) / n) + (k + 1) * np.log(n) for k, s in enumerate(sse)]
-        k = int(np.argmin(bic)) + 1
-        (model, sse_k), how = build(k), f"BIC minimum at {k} FROLS terms"
-    else:
-        best = None
-        for k in track(range(1, len(order) + 1), description="narx: validation free runs",
-                       enabled=progress):
-            cand, sse_c = build(k)
-            f = _fit_records(cand, val, warn=False)
-            if f is not None and (best is None or f > best[0] + 1e-9):
-                best = (f, k, cand, sse_c)
-        if best is None:
-            (model, sse_k), how = build(len(order)), "validation fit (every candidate diverged)"
-        else:
-            model, sse_k = best[2], best[3]
-            how = f"validation free-run fit best at {best[1]} FROLS terms"
+    model, sse_k, how = _choose_terms(build, terms, len(order), sse, n, val, progress)
     model.criterion = how + (", terms with |θ|/σ < 2 pruned" if prune_ls else "")
     spread = float(np.linalg.norm(target - target.mean()))
     if spread == 0.0:
@@ -844,28 +900,7 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
     model.prediction_fit_percent = 100.0 * (1.0 - np.sqrt(sse_k) / spread)
     if refine == "simulation":
         say(f"narx: refining {len(model.theta)} parameters on the free-run error")
-        iters = _refine_simulation(model, records, max_iter)
-        dropped = 0
-        while prune and iters is not None and len(model.theta) > 1:
-            t = np.abs(model.theta) / np.where(model.theta_std > 0, model.theta_std, np.inf)
-            weakest = int(np.argmin(t))
-            if not t[weakest] < 2.0:
-                break
-            keep = np.arange(len(model.theta)) != weakest
-            model.rows, model.theta = model.rows[keep], model.theta[keep]
-            dropped += 1
-            more = _refine_simulation(model, records, max_iter)
-            iters = None if more is None else iters + more
-        model.criterion += ("; θ refined on the free-run error (Levenberg–Marquardt, "
-                            f"{iters} iterations, σ from its Gauss–Newton Hessian"
-                            + (f", then {dropped} term(s) with |θ|/σ < 2 pruned one by one)"
-                               if dropped else ")")
-                            if iters is not None else
-                            "; not refined: the least-squares model's free run diverges")
-        if iters is not None:  # the one-step fit of the refined θ
-            cols = [_row_index(rows, r) for r in model.rows]
-            e = target - P[:, cols] @ model.theta
-            model.prediction_fit_percent = _fit(target, target - e)
+        _refine_and_prune(model, records, rows, P, target, prune, max_iter)
     model.fit_percent = _fit_records(model, records)
     if val is not None:
         model.validation_fit_percent = _fit_records(model, val)

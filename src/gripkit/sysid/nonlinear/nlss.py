@@ -297,8 +297,7 @@ class NLSSModel:
     def _run(self, ut, x0):
         N = ut.shape[0]
         Y = np.empty((N, len(self.output_names)))
-        at = K.simulate_kernel(self.A, self.B, self.C, self.D, self.E, self.F, self.y_offset,
-                               self.exz, self.exe, np.asarray(x0, dtype=np.float64), ut, Y,
+        at = K.simulate_kernel(_arrays(self), np.asarray(x0, dtype=np.float64), ut, Y,
                                np.empty((0, self.order)), self.state_limit)
         return Y, at
 
@@ -325,8 +324,7 @@ class NLSSModel:
         if at < 0 and self.dirs.shape[0]:
             w, V = np.linalg.eigh(0.5 * (self.covariance + self.covariance.T))
             L = np.ascontiguousarray(V * np.sqrt(np.maximum(w, 0.0)))
-            K.output_variance(self.A, self.B, self.C, self.D, self.E, self.F, self.y_offset,
-                              self.exz, self.exe, self.dirs, x0, ut, L, var)
+            K.output_variance(_arrays(self), self.dirs, x0, ut, L, var)
         return Y, np.sqrt(var)
 
     def estimate_x0(self, data, y=None, *, max_iterations: int = 30) -> np.ndarray:
@@ -466,18 +464,22 @@ def _apply(model: NLSSModel, dirs, delta) -> NLSSModel:
                    y_offset=mats[6][:, 0].copy())
 
 
+def _arrays(model) -> K.NLSSArrays:
+    """The model's arrays as the kernels take them (a :data:`._nlss_kernels.NLSSArrays`)."""
+    return K.NLSSArrays(model.A, model.B, model.C, model.D, model.E, model.F, model.y_offset,
+                        model.exz, model.exe)
+
+
 def _loss(model, Z, starts, u, y, w) -> float:
-    return K.window_loss(model.A, model.B, model.C, model.D, model.E, model.F, model.y_offset,
-                         model.exz, model.exe, Z, starts, u, y, w, model.state_limit)
+    return K.window_loss(_arrays(model), K.NLSSWindows(Z, starts, u, y, w), model.state_limit)
 
 
 def _gram(model, dirs, Z, starts, u, y, w):
     P, n, W = dirs.shape[0], model.order, starts.shape[0] - 1
     Htt, gt = np.empty((P, P)), np.empty(P)
     Htz, Hzz, gz = np.empty((W, P, n)), np.empty((W, n, n)), np.empty((W, n))
-    V = K.window_gram(model.A, model.B, model.C, model.D, model.E, model.F, model.y_offset,
-                      model.exz, model.exe, dirs, Z, starts, u, y, w, model.state_limit,
-                      Htt, gt, Htz, Hzz, gz)
+    V = K.window_gram(_arrays(model), dirs, K.NLSSWindows(Z, starts, u, y, w),
+                      model.state_limit, K.NLSSGram(Htt, gt, Htz, Hzz, gz))
     return V, Htt, gt, Htz, Hzz, gz
 
 
@@ -692,6 +694,164 @@ def _io_records(data, input, output):
     return (recs, *first)
 
 
+def _read_data(data, input, output):
+    """The estimation records → (records [(u, y)], u and y stacked, dt of the data or None,
+    names (inputs, outputs, input units, output units), the records' first rows and the end)."""
+    if _is_records(data):
+        recs, tr_dt, ins, outs, iunits, ounits = _io_records(data, input, output)
+        u, y = np.vstack([r[0] for r in recs]), np.vstack([r[1] for r in recs])
+    else:
+        u, y, tr_dt, ins, outs, iunits, ounits = _io(data, input, output, "data")
+        _check_signals(u, y, "data")
+        recs = [(u, y)]
+    bounds = np.cumsum([0] + [len(r[0]) for r in recs]).astype(np.int64)
+    return recs, u, y, tr_dt, (ins, outs, iunits, ounits), bounds
+
+
+def _sample_interval(dt, tr_dt) -> float:
+    """``dt`` as given, else the data's, else 1; a given one must be positive and finite."""
+    if dt is None:
+        return 1.0 if tr_dt is None else tr_dt
+    if not (isinstance(dt, (int, float, np.floating)) and not isinstance(dt, bool)
+            and math.isfinite(dt) and dt > 0):
+        raise ArgumentError(f"nlss: dt must be a positive sample interval in s, found {dt!r}")
+    return dt
+
+
+def _check_excited(u, y, ins, outs) -> np.ndarray:
+    """σ of each input; raises for a constant input or output."""
+    sd_u = u.std(axis=0)
+    if np.any(sd_u == 0):
+        raise DataError(f"nlss: input {ins[int(np.argmin(sd_u))]!r} is constant; it excites "
+                        "nothing: check the input column")
+    const = [outs[i] for i in range(y.shape[1]) if np.ptp(y[:, i]) == 0]
+    if const:
+        raise DataError(f"nlss: output {const[0]!r} is constant ({y[0, outs.index(const[0])]:g} "
+                        "throughout); there is nothing to identify: check the output column")
+    return sd_u
+
+
+def _read_validation(validate, input, output, m: int, p: int):
+    """The validation record (u, y), or None."""
+    if validate is None:
+        return None
+    uv, yv, *_ = _io(validate, input, output, "validate")
+    _check_signals(uv, yv, "validate")
+    if uv.shape[1] != m or yv.shape[1] != p:
+        raise DataError(f"nlss: validate has {uv.shape[1]} input(s) and {yv.shape[1]} "
+                        f"output(s), the data {m} and {p}")
+    return uv, yv
+
+
+def _linear_start(ut, yr, n, dt, feedthrough):
+    """The subspace model of order n of one record (normalised input, output less its mean),
+    and the distinct warnings it raised → (model, notes), or None."""
+    from ..linear.subspace import n4sid
+
+    N = ut.shape[0]
+    with warnings.catch_warnings(record=True) as caught:  # the start, not the result
+        warnings.simplefilter("always")
+        lm = None
+        # n4sid's least squares for B and x0 overflows on a long record when the
+        # shift-invariance A of an over-large order is unstable (LinAlgError): the start is
+        # then taken from a shorter head of the record
+        for cut in (N, *(c for c in (4000, 2000, 1000, 500, 250) if c < N)):
+            try:
+                lm = n4sid(ut[:cut], yr[:cut], n, dt=dt, feedthrough=feedthrough)
+                break
+            except np.linalg.LinAlgError:
+                continue
+    notes = list(dict.fromkeys(str(c.message) for c in caught))
+    return None if lm is None else (lm, notes)
+
+
+def _linear_start_records(ut, yr, bounds, n, dt, feedthrough):
+    """One subspace model of order n of all records, one x0 each → (model, notes), or None."""
+    from ..linear.subspace import n4sid_records
+
+    with warnings.catch_warnings(record=True) as caught:  # the start, not the result
+        warnings.simplefilter("always")
+        try:
+            lm = n4sid_records([(ut[a:b], yr[a:b]) for a, b in
+                                zip(bounds[:-1], bounds[1:])], n, dt=dt,
+                               feedthrough=feedthrough)
+        except np.linalg.LinAlgError:
+            return None
+    notes = list(dict.fromkeys(str(c.message) for c in caught))
+    return lm, notes
+
+
+def _gap_order(ut, yr, bounds, max_order: int, n_par) -> int:
+    """The order at the largest gap s_n/s_(n+1) among the first ``max_order`` subspace singular
+    values (of the records' stacked Hankel matrices for several), lowered until the data hold
+    4 samples per parameter (``n_par(n)`` parameters at order n)."""
+    from ..linear.subspace import RecordsFactor, default_horizon, subspace_factor
+
+    N, p = yr.shape
+    if len(bounds) > 2:
+        sv = RecordsFactor([(ut[a:b], yr[a:b]) for a, b in zip(bounds[:-1], bounds[1:])],
+                           default_horizon(max_order, p), "n4sid").s
+    else:
+        sv = subspace_factor(ut, yr, horizon=default_horizon(max_order, p), method="n4sid").s
+    k = min(max_order, sv.size - 1)
+    n_sv = int(np.argmax(sv[:k] / np.maximum(sv[1:k + 1], 1e-300 * sv[0]))) + 1
+    while n_sv > 1 and N * p < 4 * n_par(n_sv):  # no more parameters than data allow
+        n_sv -= 1
+    return n_sv
+
+
+def _score(mdl, val, yc, ut, bounds, x0s) -> float:
+    """How well the candidate ``mdl`` does (higher is better): its mean free-run validation fit
+    with ``val``, else −BIC of the estimation free run (kept in ``info['bic']``)."""
+    if val is not None:
+        fit = mdl.compare(val[0], val[1], warn=False)
+        mdl.validation_fit_percent = fit.fit_percent
+        lf = mdl.info.pop("_linear")
+        mdl.linear_validation_fit_percent = lf.compare(val[0], val[1], warn=False).fit_percent
+        return -np.inf if None in fit.fit_percent else float(np.mean(fit.fit_percent))
+    # Bayesian information criterion of the estimation free run
+    mdl.info.pop("_linear")
+    N = yc.shape[0]
+    k = mdl.dirs.shape[0] + mdl.order
+    if mdl.fit_percent is None:
+        score = -np.inf
+    else:
+        e = yc - _run_records(mdl, ut, bounds, x0s)[0]
+        score = -(N * float(np.sum(np.log(np.maximum(np.mean(e * e, axis=0), 1e-300))))
+                  + k * math.log(N))
+    mdl.info["bic"] = None if not np.isfinite(score) else -score
+    return score
+
+
+def _criterion(model, order, candidates, max_order, val, ins, levels, degree) -> str:
+    """How the order was chosen, and the inputs whose high powers were left out."""
+    how = (f"order {model.order} given" if order is not None else
+           f"order {model.order} by the information criterion (BIC) among {candidates}, the "
+           f"largest gap of the subspace singular values (at most {max_order}) and the next"
+           if val is None else
+           f"order {model.order} by the free-run validation fit among {candidates}")
+    few = [f"{ins[j]!r} takes {levels[j]} values" for j in range(len(levels))
+           if levels[j] <= degree]
+    if few:
+        how += (f"; {', '.join(few)}: its powers of that degree and above are no new functions "
+                "of it and are left out")
+    return how
+
+
+def _warn_of_result(model, val) -> None:
+    """Warnings about the model returned: an ill-conditioned Hessian, a diverging validation
+    run."""
+    cond = model.info["hessian_condition"]
+    if not cond < _ILL_CONDITIONED:  # said of the model returned, not of the candidates
+        emit_warning(f"nlss: the Gauss-Newton Hessian at the optimum is ill-conditioned (condition "
+                     f"number {cond:.2g} after scaling): some combinations of parameters are not "
+                     "determined by the data and their σ are not reliable; lower the degree or the "
+                     "order, or excite the system more richly", AccuracyWarning)
+    if val is not None and None in (model.validation_fit_percent or []):
+        emit_warning("nlss: the free run of the identified model diverges on the validation "
+                     "record; no validation fit is reported", StabilityWarning)
+
+
 def nlss(data, *, input=None, output=None, order: int | None = None, degree: int = 3,
          validate=None, dt: float | None = None, window: int | None = None, max_order: int = 4,
          feedthrough: bool = False, max_iterations: int = 100, progress: bool = True) -> NLSSModel:
@@ -716,14 +876,8 @@ def nlss(data, *, input=None, output=None, order: int | None = None, degree: int
     ``max_iterations``: Levenberg-Marquardt iterations per stage. ``progress``: a progress bar
     on stderr.
     """
-    if _is_records(data):
-        recs, tr_dt, ins, outs, iunits, ounits = _io_records(data, input, output)
-        u, y = np.vstack([r[0] for r in recs]), np.vstack([r[1] for r in recs])
-    else:
-        u, y, tr_dt, ins, outs, iunits, ounits = _io(data, input, output, "data")
-        _check_signals(u, y, "data")
-        recs = [(u, y)]
-    bounds = np.cumsum([0] + [len(r[0]) for r in recs]).astype(np.int64)
+    recs, u, y, tr_dt, names, bounds = _read_data(data, input, output)
+    ins, outs, iunits, ounits = names
     several = len(recs) > 1
     N, m = u.shape
     p = y.shape[1]
@@ -734,27 +888,9 @@ def nlss(data, *, input=None, output=None, order: int | None = None, degree: int
         order = _positive_int(order, "order")
     if window is not None:
         window = _positive_int(window, "window", 10)
-    if dt is None:
-        dt = 1.0 if tr_dt is None else tr_dt
-    elif not (isinstance(dt, (int, float, np.floating)) and not isinstance(dt, bool)
-              and math.isfinite(dt) and dt > 0):
-        raise ArgumentError(f"nlss: dt must be a positive sample interval in s, found {dt!r}")
-    sd_u = u.std(axis=0)
-    if np.any(sd_u == 0):
-        raise DataError(f"nlss: input {ins[int(np.argmin(sd_u))]!r} is constant; it excites "
-                        "nothing: check the input column")
-    const = [outs[i] for i in range(p) if np.ptp(y[:, i]) == 0]
-    if const:
-        raise DataError(f"nlss: output {const[0]!r} is constant ({y[0, outs.index(const[0])]:g} "
-                        "throughout); there is nothing to identify: check the output column")
-    val = None
-    if validate is not None:
-        uv, yv, *_ = _io(validate, input, output, "validate")
-        _check_signals(uv, yv, "validate")
-        if uv.shape[1] != m or yv.shape[1] != p:
-            raise DataError(f"nlss: validate has {uv.shape[1]} input(s) and {yv.shape[1]} "
-                            f"output(s), the data {m} and {p}")
-        val = (uv, yv)
+    dt = _sample_interval(dt, tr_dt)
+    sd_u = _check_excited(u, y, ins, outs)
+    val = _read_validation(validate, input, output, m, p)
     levels = [min(len(np.unique(u[:, j])), degree + 1) for j in range(m)]
     n_par = lambda n: (n + p) * (n + m + len(monomial_exponents(  # noqa: E731
         n, m, degree, input_levels=levels)))
@@ -763,63 +899,18 @@ def nlss(data, *, input=None, output=None, order: int | None = None, degree: int
                         f"degree {degree}); need at least {4 * n_par(order) // p}: lower the "
                         "order or degree, or give more data")
     t0 = time.perf_counter()
-    from ..linear.subspace import default_horizon, n4sid, subspace_factor
-
     u_off, y_off = u.mean(axis=0), y.mean(axis=0)
     ut = np.ascontiguousarray((u - u_off) / sd_u)
     yc = np.ascontiguousarray(y)
-
-    def linear(n):
-        with warnings.catch_warnings(record=True) as caught:  # the start, not the result
-            warnings.simplefilter("always")
-            lm = None
-            # n4sid's least squares for B and x0 overflows on a long record when the
-            # shift-invariance A of an over-large order is unstable (LinAlgError): the start is
-            # then taken from a shorter head of the record
-            for cut in (N, *(c for c in (4000, 2000, 1000, 500, 250) if c < N)):
-                try:
-                    lm = n4sid(ut[:cut], (y - y_off)[:cut], n, dt=dt, feedthrough=feedthrough)
-                    break
-                except np.linalg.LinAlgError:
-                    continue
-        notes = list(dict.fromkeys(str(c.message) for c in caught))
-        return None if lm is None else (lm, notes)
-
-    def linear_records(n):  # one subspace model of all records, one x0 each
-        from ..linear.subspace import n4sid_records
-
-        with warnings.catch_warnings(record=True) as caught:  # the start, not the result
-            warnings.simplefilter("always")
-            try:
-                lm = n4sid_records([(ut[a:b], (y - y_off)[a:b]) for a, b in
-                                    zip(bounds[:-1], bounds[1:])], n, dt=dt,
-                                   feedthrough=feedthrough)
-            except np.linalg.LinAlgError:
-                return None
-        notes = list(dict.fromkeys(str(c.message) for c in caught))
-        return lm, notes
-
-    if order is None and several:  # the same gap, of the records' stacked Hankel matrices
-        from ..linear.subspace import RecordsFactor
-
-        sv = RecordsFactor([(ut[a:b], (y - y_off)[a:b]) for a, b in zip(bounds[:-1], bounds[1:])],
-                           default_horizon(max_order, p), "n4sid").s
-    if order is None:  # the largest gap among the first max_order singular values
-        sv = sv if several else subspace_factor(ut, y - y_off,
-                                                horizon=default_horizon(max_order, p),
-                                                method="n4sid").s
-        k = min(max_order, sv.size - 1)
-        n_sv = int(np.argmax(sv[:k] / np.maximum(sv[1:k + 1], 1e-300 * sv[0]))) + 1
-        while n_sv > 1 and N * p < 4 * n_par(n_sv):  # no more parameters than data allow
-            n_sv -= 1
-    else:
-        n_sv = order
+    yr = y - y_off
+    n_sv = order if order is not None else _gap_order(ut, yr, bounds, max_order, n_par)
     around = (n_sv, n_sv + 1) if val is None else (n_sv, n_sv - 1, n_sv + 1)
     candidates = [n_sv] if order is not None else \
         [k for k in around if 1 <= k <= max_order and (k == n_sv or N * p >= 4 * n_par(k))]
     best = None
     for n in candidates:
-        start = linear_records(n) if several else linear(n)
+        start = (_linear_start_records(ut, yr, bounds, n, dt, feedthrough) if several
+                 else _linear_start(ut, yr, n, dt, feedthrough))
         if start is None:
             continue
         lin_n, notes = start
@@ -830,22 +921,7 @@ def nlss(data, *, input=None, output=None, order: int | None = None, degree: int
         x0s = mdl.info.pop("_x0s", [mdl.x0])
         if notes:
             mdl.info["linear_start"] = " | ".join(notes)
-        if val is not None:
-            fit = mdl.compare(val[0], val[1], warn=False)
-            mdl.validation_fit_percent = fit.fit_percent
-            lf = mdl.info.pop("_linear")
-            mdl.linear_validation_fit_percent = lf.compare(val[0], val[1], warn=False).fit_percent
-            score = -np.inf if None in fit.fit_percent else float(np.mean(fit.fit_percent))
-        else:  # Bayesian information criterion of the estimation free run
-            mdl.info.pop("_linear")
-            k = mdl.dirs.shape[0] + n
-            if mdl.fit_percent is None:
-                score = -np.inf
-            else:
-                e = yc - _run_records(mdl, ut, bounds, x0s)[0]
-                score = -(N * float(np.sum(np.log(np.maximum(np.mean(e * e, axis=0), 1e-300))))
-                          + k * math.log(N))
-            mdl.info["bic"] = None if not np.isfinite(score) else -score
+        score = _score(mdl, val, yc, ut, bounds, x0s)
         if best is None or score > best[0]:
             best = (score, mdl)
     if best is None:
@@ -853,26 +929,9 @@ def nlss(data, *, input=None, output=None, order: int | None = None, degree: int
                                   f"tried ({candidates})", hint="give another order= or check "
                                   "the record")
     model = best[1]
-    how = (f"order {model.order} given" if order is not None else
-           f"order {model.order} by the information criterion (BIC) among {candidates}, the "
-           f"largest gap of the subspace singular values (at most {max_order}) and the next"
-           if val is None else
-           f"order {model.order} by the free-run validation fit among {candidates}")
-    few = [f"{ins[j]!r} takes {levels[j]} values" for j in range(m) if levels[j] <= degree]
-    if few:
-        how += (f"; {', '.join(few)}: its powers of that degree and above are no new functions "
-                "of it and are left out")
-    model.criterion = how
-    cond = model.info["hessian_condition"]
-    if not cond < _ILL_CONDITIONED:  # said of the model returned, not of the candidates
-        emit_warning(f"nlss: the Gauss-Newton Hessian at the optimum is ill-conditioned (condition "
-                     f"number {cond:.2g} after scaling): some combinations of parameters are not "
-                     "determined by the data and their σ are not reliable; lower the degree or the "
-                     "order, or excite the system more richly", AccuracyWarning)
+    model.criterion = _criterion(model, order, candidates, max_order, val, ins, levels, degree)
+    _warn_of_result(model, val)
     model.info["seconds"] = round(time.perf_counter() - t0, 3)
-    if val is not None and None in (model.validation_fit_percent or []):
-        emit_warning("nlss: the free run of the identified model diverges on the validation "
-                     "record; no validation fit is reported", StabilityWarning)
     return model
 
 
@@ -901,6 +960,94 @@ def _record_windows(bounds, L: int) -> np.ndarray:
     return np.append(np.concatenate(starts), bounds[-1]).astype(np.int64)
 
 
+def _start_model(A, B, C, D, x0, u_off, sd_u, y_off, degree, feedthrough, levels, dt, names):
+    """The linear start as an NLSSModel (E = F = 0, no free directions, no state limit) with the
+    exponent tables of ζ and η; ``names``: (inputs, outputs, input units, output units)."""
+    n, m, p = A.shape[0], B.shape[1], C.shape[0]
+    ins, outs, iunits, ounits = names
+    exz = monomial_exponents(n, m, degree, inputs=True, input_levels=levels)
+    exe = monomial_exponents(n, m, degree, inputs=feedthrough, input_levels=levels)
+    return NLSSModel(A=A, B=B, C=C, D=D, E=np.zeros((n, len(exz))), F=np.zeros((p, len(exe))),
+                     exz=exz, exe=exe, u_offset=u_off, u_scale=sd_u, y_offset=y_off,
+                     dirs=np.zeros((0, 3), dtype=np.int64), covariance=np.zeros((0, 0)),
+                     x0=x0, state_limit=np.inf, dt=float(dt), degree=degree,
+                     feedthrough=feedthrough, input_names=ins, output_names=outs,
+                     input_units=iunits, output_units=ounits)
+
+
+def _state_scales(X) -> np.ndarray:
+    """σ of each state of the linear start's free run X (1 for a state that does not move)."""
+    s = X.std(axis=0)
+    s[s <= 1e-12 * max(float(s.max()), 1e-300)] = 1.0
+    return s
+
+
+def _output_weights(y, Y):
+    """The linear start's fits, its error y − Y and the output weights 1/RMS of that error."""
+    err = y - Y
+    w = 1.0 / np.maximum(np.sqrt(np.mean(err * err, axis=0)), 1e-12 * y.std(axis=0))
+    return _fits(y, Y), err, w
+
+
+def _directions(base: NLSSModel) -> np.ndarray:
+    """The free parameters (kind, r, c): the free linear entries, every entry of E and F, y₀."""
+    n, p = base.order, base.C.shape[0]
+    return np.vstack([_free_linear_entries(base.A, base.B, base.C, base.D, base.feedthrough),
+                      np.array([(4, r, c) for r in range(n) for c in range(len(base.exz))],
+                               dtype=np.int64).reshape(-1, 3),
+                      np.array([(5, r, c) for r in range(p) for c in range(len(base.exe))],
+                               dtype=np.int64).reshape(-1, 3),
+                      np.array([(6, r, 0) for r in range(p)], dtype=np.int64)])
+
+
+def _window_length(A, window, cap: int, total: int) -> int:
+    """Samples per window of stage 2: ``window`` or 10 linear time constants (≥ 50), at most
+    ``cap`` and at least total/200 (no more than 200 windows)."""
+    n = A.shape[0]
+    rad = float(np.max(np.abs(np.linalg.eigvals(A)))) if n else 0.0
+    tau = -1.0 / math.log(min(max(rad, 1e-6), 1 - 1e-9))
+    L = window if window is not None else int(min(max(50, 10 * tau), cap))
+    return min(max(L, -(-total // 200)), cap)
+
+
+def _parameter_covariance(H, V, dof: int, P: int):
+    """cov θ = s² (H⁻¹)_θθ with s² = V/dof, H inverted in the coordinates scaled by diag(H)^½
+    → (cov, the scaled H)."""
+    s2 = V / max(dof, 1)
+    sc = np.sqrt(np.maximum(np.diag(H), 1e-300))
+    Hs = H / np.outer(sc, sc)
+    try:
+        cov = s2 * np.linalg.inv(Hs)[:P, :P] / np.outer(sc[:P], sc[:P])
+    except np.linalg.LinAlgError:
+        raise IdentificationError("nlss: the Jacobian is singular at the optimum: the data do "
+                                  "not determine every monomial (a poorly exciting input)",
+                                  hint="lower the degree or the order, or excite more richly") \
+            from None
+    return cov, Hs
+
+
+def _whole_record(model, base, dirs, Z, x0, ut, y, w, Ns, max_iterations, tick):
+    """Stage 3 of one record: Levenberg-Marquardt on the whole record from one initial state,
+    first on its warm-start part (``Ns`` samples) when shorter; a model that runs away over the
+    longer record restarts there from the linear one → (model, Z, iterations, converged)."""
+    N = ut.shape[0]
+    its = []
+    for M_ in ((Ns, N) if Ns < N else (N,)):
+        whole = np.array([0, M_], dtype=np.int64)
+        Z0 = np.ascontiguousarray(Z[:1])
+        if not np.isfinite(_loss(model, Z0, whole, ut, y, w)):
+            # the model runs away over the longer record: restart there from the linear one
+            model, Z0 = base, np.ascontiguousarray(x0[None, :])
+        cap = max_iterations if M_ == Ns else min(max_iterations, _POLISH_ITERATIONS)
+        model, Z, V2, it2, conv2 = _lm(model, dirs, Z0, whole, ut[:M_], y[:M_], w, cap, tick)
+        its.append(it2)
+        if not np.isfinite(V2):
+            raise IdentificationError("nlss: the free run of the model diverges on the "
+                                      "estimation record at every step tried; lower the "
+                                      "degree or the order")
+    return model, Z, its, conv2
+
+
 def _fit_order(lin, ut, y, u_off, sd_u, y_off, degree, feedthrough, window, max_iterations,
                progress, dt, ins, outs, iunits, ounits, levels, bounds=None,
                x0s=None) -> NLSSModel:
@@ -921,42 +1068,24 @@ def _fit_order(lin, ut, y, u_off, sd_u, y_off, degree, feedthrough, window, max_
                                   feedthrough, window, max_iterations, progress, dt, ins, outs,
                                   iunits, ounits, levels, np.asarray(bounds, dtype=np.int64),
                                   [np.asarray(z, dtype=np.float64).ravel() for z in x0s])
-    exz = monomial_exponents(n, m, degree, inputs=True, input_levels=levels)
-    exe = monomial_exponents(n, m, degree, inputs=feedthrough, input_levels=levels)
-    base = NLSSModel(A=A, B=B, C=C, D=D, E=np.zeros((n, len(exz))), F=np.zeros((p, len(exe))),
-                     exz=exz, exe=exe, u_offset=u_off, u_scale=sd_u, y_offset=y_off,
-                     dirs=np.zeros((0, 3), dtype=np.int64), covariance=np.zeros((0, 0)),
-                     x0=x0, state_limit=np.inf, dt=float(dt), degree=degree,
-                     feedthrough=feedthrough, input_names=ins, output_names=outs,
-                     input_units=iunits, output_units=ounits)
+    base = _start_model(A, B, C, D, x0, u_off, sd_u, y_off, degree, feedthrough, levels, dt,
+                        (ins, outs, iunits, ounits))
     X = np.empty((N, n))
     Y = np.empty((N, p))
-    K.simulate_kernel(A, B, C, D, base.E, base.F, y_off, exz, exe, x0, ut, Y, X, np.inf)
+    K.simulate_kernel(_arrays(base), x0, ut, Y, X, np.inf)
     if not np.all(np.isfinite(X)):
         raise IdentificationError("nlss: the linear start (n4sid) does not give a finite free "
                                   "run on the data; check the record")
-    s = X.std(axis=0)
-    s[s <= 1e-12 * max(float(s.max()), 1e-300)] = 1.0
+    s = _state_scales(X)
     T, Ti = np.diag(1.0 / s), np.diag(s)
     A, B, C, x0, X = T @ A @ Ti, T @ B, C @ Ti, x0 / s, X / s
     limit = DIVERGENCE_FACTOR * max(1.0, float(np.abs(X).max()))
     base = replace(base, A=A, B=B, C=C, x0=x0, state_limit=limit)
-    lin_fit = _fits(y, Y)
-    err = y - Y
-    w = 1.0 / np.maximum(np.sqrt(np.mean(err * err, axis=0)), 1e-12 * y.std(axis=0))
-    lin_entries = _free_linear_entries(A, B, C, D, feedthrough)
-    dirs = np.vstack([lin_entries,
-                      np.array([(4, r, c) for r in range(n) for c in range(len(exz))],
-                               dtype=np.int64).reshape(-1, 3),
-                      np.array([(5, r, c) for r in range(p) for c in range(len(exe))],
-                               dtype=np.int64).reshape(-1, 3),
-                      np.array([(6, r, 0) for r in range(p)], dtype=np.int64)])
+    lin_fit, err, w = _output_weights(y, Y)
+    dirs = _directions(base)
     # stage 2: truncated simulation windows (on the first _WARM_SAMPLES samples of a long record)
     Ns = min(N, _WARM_SAMPLES)
-    rad = float(np.max(np.abs(np.linalg.eigvals(A)))) if n else 0.0
-    tau = -1.0 / math.log(min(max(rad, 1e-6), 1 - 1e-9))
-    L = window if window is not None else int(min(max(50, 10 * tau), Ns))
-    L = min(max(L, -(-Ns // 200)), Ns)
+    L = _window_length(A, window, Ns, Ns)
     starts = np.arange(0, Ns, L, dtype=np.int64)
     if Ns - starts[-1] < L // 2 and len(starts) > 1:  # a short tail joins the last window
         starts = starts[:-1]
@@ -975,21 +1104,9 @@ def _fit_order(lin, ut, y, u_off, sd_u, y_off, degree, feedthrough, window, max_
         model, Z, _, it1, _ = _lm(base, dirs, Z, starts, ut[:Ns], y[:Ns], w, max_iterations,
                                   tick)
         # stage 3: the whole record (first its warm-start part) from one initial state
-        its = [it1]
-        for M_ in ((Ns, N) if Ns < N else (N,)):
-            whole = np.array([0, M_], dtype=np.int64)
-            Z0 = np.ascontiguousarray(Z[:1])
-            if not np.isfinite(_loss(model, Z0, whole, ut, y, w)):
-                # the model runs away over the longer record: restart there from the linear one
-                model, Z0 = base, np.ascontiguousarray(x0[None, :])
-            cap = max_iterations if M_ == Ns else min(max_iterations, _POLISH_ITERATIONS)
-            model, Z, V2, it2, conv2 = _lm(model, dirs, Z0, whole, ut[:M_], y[:M_], w, cap,
-                                           tick)
-            its.append(it2)
-            if not np.isfinite(V2):
-                raise IdentificationError("nlss: the free run of the model diverges on the "
-                                          "estimation record at every step tried; lower the "
-                                          "degree or the order")
+        model, Z, its, conv2 = _whole_record(model, base, dirs, Z, x0, ut, y, w, Ns,
+                                             max_iterations, tick)
+        its = [it1, *its]
     finally:
         bar.close()
     Z0 = Z
@@ -998,17 +1115,7 @@ def _fit_order(lin, ut, y, u_off, sd_u, y_off, degree, feedthrough, window, max_
     P = dirs.shape[0]
     H = np.zeros((P + n, P + n))
     H[:P, :P], H[:P, P:], H[P:, :P], H[P:, P:] = Htt, Htz[0], Htz[0].T, Hzz[0]
-    dof = N * p - P - n
-    s2 = V / max(dof, 1)
-    sc = np.sqrt(np.maximum(np.diag(H), 1e-300))
-    Hs = H / np.outer(sc, sc)
-    try:
-        cov = s2 * np.linalg.inv(Hs)[:P, :P] / np.outer(sc[:P], sc[:P])
-    except np.linalg.LinAlgError:
-        raise IdentificationError("nlss: the Jacobian is singular at the optimum: the data do "
-                                  "not determine every monomial (a poorly exciting input)",
-                                  hint="lower the degree or the order, or excite more richly") \
-            from None
+    cov, Hs = _parameter_covariance(H, V, N * p - P - n, P)
     cond = float(np.linalg.cond(Hs))
     model = replace(model, dirs=dirs, covariance=0.5 * (cov + cov.T), x0=Z0[0].copy())
     Yf, at = model._run(ut, model.x0)
@@ -1025,6 +1132,18 @@ def _fit_order(lin, ut, y, u_off, sd_u, y_off, degree, feedthrough, window, max_
     return model
 
 
+def _records_hessian(Htt, Htz, Hzz):
+    """The Gauss-Newton Hessian over [θ; z₁ … z_R] (every record's initial state a parameter)
+    from the blocks of :func:`_gram` with one window per record."""
+    P, R, n = Htt.shape[0], Htz.shape[0], Hzz.shape[1]
+    H = np.zeros((P + R * n, P + R * n))
+    H[:P, :P] = Htt
+    for r in range(R):
+        sl = slice(P + r * n, P + (r + 1) * n)
+        H[:P, sl], H[sl, :P], H[sl, sl] = Htz[r], Htz[r].T, Hzz[r]
+    return H
+
+
 def _fit_order_records(ss, A, B, C, D, ut, y, u_off, sd_u, y_off, degree, feedthrough, window,
                        max_iterations, progress, dt, ins, outs, iunits, ounits, levels, bounds,
                        x0s) -> NLSSModel:
@@ -1038,43 +1157,25 @@ def _fit_order_records(ss, A, B, C, D, ut, y, u_off, sd_u, y_off, degree, feedth
     p = y.shape[1]
     n = A.shape[0]
     R = len(bounds) - 1
-    exz = monomial_exponents(n, m, degree, inputs=True, input_levels=levels)
-    exe = monomial_exponents(n, m, degree, inputs=feedthrough, input_levels=levels)
-    base = NLSSModel(A=A, B=B, C=C, D=D, E=np.zeros((n, len(exz))), F=np.zeros((p, len(exe))),
-                     exz=exz, exe=exe, u_offset=u_off, u_scale=sd_u, y_offset=y_off,
-                     dirs=np.zeros((0, 3), dtype=np.int64), covariance=np.zeros((0, 0)),
-                     x0=x0s[0], state_limit=np.inf, dt=float(dt), degree=degree,
-                     feedthrough=feedthrough, input_names=ins, output_names=outs,
-                     input_units=iunits, output_units=ounits)
+    base = _start_model(A, B, C, D, x0s[0], u_off, sd_u, y_off, degree, feedthrough, levels,
+                        dt, (ins, outs, iunits, ounits))
     X, Y = np.empty((N, n)), np.empty((N, p))
     for r, x0 in enumerate(x0s):
         a, b = bounds[r], bounds[r + 1]
-        K.simulate_kernel(A, B, C, D, base.E, base.F, y_off, exz, exe, x0,
-                          np.ascontiguousarray(ut[a:b]), Y[a:b], X[a:b], np.inf)
+        K.simulate_kernel(_arrays(base), x0, np.ascontiguousarray(ut[a:b]), Y[a:b], X[a:b],
+                          np.inf)
     if not np.all(np.isfinite(X)):
         raise IdentificationError("nlss: the linear start (n4sid) does not give a finite free "
                                   "run on the records; check them")
-    s = X.std(axis=0)
-    s[s <= 1e-12 * max(float(s.max()), 1e-300)] = 1.0
+    s = _state_scales(X)
     T, Ti = np.diag(1.0 / s), np.diag(s)
     A, B, C, X = T @ A @ Ti, T @ B, C @ Ti, X / s
     x0s = [x0 / s for x0 in x0s]
     limit = DIVERGENCE_FACTOR * max(1.0, float(np.abs(X).max()))
     base = replace(base, A=A, B=B, C=C, x0=x0s[0], state_limit=limit)
-    lin_fit = _fits(y, Y)
-    err = y - Y
-    w = 1.0 / np.maximum(np.sqrt(np.mean(err * err, axis=0)), 1e-12 * y.std(axis=0))
-    dirs = np.vstack([_free_linear_entries(A, B, C, D, feedthrough),
-                      np.array([(4, r, c) for r in range(n) for c in range(len(exz))],
-                               dtype=np.int64).reshape(-1, 3),
-                      np.array([(5, r, c) for r in range(p) for c in range(len(exe))],
-                               dtype=np.int64).reshape(-1, 3),
-                      np.array([(6, r, 0) for r in range(p)], dtype=np.int64)])
-    shortest = int(np.min(np.diff(bounds)))
-    rad = float(np.max(np.abs(np.linalg.eigvals(A)))) if n else 0.0
-    tau = -1.0 / math.log(min(max(rad, 1e-6), 1 - 1e-9))
-    L = window if window is not None else int(min(max(50, 10 * tau), shortest))
-    L = min(max(L, -(-N // 200)), shortest)
+    lin_fit, err, w = _output_weights(y, Y)
+    dirs = _directions(base)
+    L = _window_length(A, window, int(np.min(np.diff(bounds))), N)
     starts = _record_windows(bounds, L)
     Z = np.ascontiguousarray(X[starts[:-1]])
     first = np.searchsorted(starts, bounds[:-1])  # the window that opens each record
@@ -1099,22 +1200,7 @@ def _fit_order_records(ss, A, B, C, D, ut, y, u_off, sd_u, y_off, degree, feedth
         bar.close()
     V, Htt, gt, Htz, Hzz, gz = _gram(model, dirs, Z0, bounds, ut, y, w)
     P = dirs.shape[0]
-    H = np.zeros((P + R * n, P + R * n))
-    H[:P, :P] = Htt
-    for r in range(R):
-        sl = slice(P + r * n, P + (r + 1) * n)
-        H[:P, sl], H[sl, :P], H[sl, sl] = Htz[r], Htz[r].T, Hzz[r]
-    dof = N * p - P - R * n
-    s2 = V / max(dof, 1)
-    sc = np.sqrt(np.maximum(np.diag(H), 1e-300))
-    Hs = H / np.outer(sc, sc)
-    try:
-        cov = s2 * np.linalg.inv(Hs)[:P, :P] / np.outer(sc[:P], sc[:P])
-    except np.linalg.LinAlgError:
-        raise IdentificationError("nlss: the Jacobian is singular at the optimum: the data do "
-                                  "not determine every monomial (a poorly exciting input)",
-                                  hint="lower the degree or the order, or excite more richly") \
-            from None
+    cov, Hs = _parameter_covariance(_records_hessian(Htt, Htz, Hzz), V, N * p - P - R * n, P)
     model = replace(model, dirs=dirs, covariance=0.5 * (cov + cov.T), x0=Z0[0].copy())
     Yf, at = _run_records(model, ut, bounds, list(Z0))
     model.fit_percent = None if at >= 0 else _fits(y, Yf)
