@@ -50,6 +50,7 @@ from ...errors import (ArgumentError, DataError, IdentificationError, ModelError
 from ...params import Parameter, ParameterSet
 from ...signals.trajectory import Trajectory
 from ..model_protocol import ModelFit
+from ...progress import status, track
 
 __all__ = ["SCHEMA", "NARX_FIT", "NARXModel", "narx", "load_narx", "file_schema", "candidate_terms",
            "frols", "REFINE"]
@@ -774,8 +775,6 @@ def _choose_terms(build, terms, n_selected: int, sse, n: int, val, progress: boo
     """The model of the number of FROLS terms chosen: all ``n_selected`` for a given ``terms``,
     else the BIC minimum, or with ``val`` the best validation free-run fit; ``build(k)`` makes
     the model of the first k terms → (model, its SSE, how the number was chosen)."""
-    from ...progress import track
-
     if terms != "auto":
         return (*build(n_selected), f"terms={n_selected}")
     if val is None:
@@ -842,8 +841,6 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
     noise is measurement noise on the output, which biases the one-step estimate).
     ``progress``: each stage on stderr, a bar over the validation candidates.
     """
-    from ...progress import status
-
     say = status if progress else (lambda message: None)
     records = _narx_records(u, y)
     if refine not in REFINE:

@@ -70,6 +70,10 @@ from ...errors import (AccuracyWarning, ArgumentError, DataError, Identification
                        ModelError, PathError, StabilityWarning, emit_warning)
 from ..model_protocol import ModelFit
 from . import _nlss_kernels as K
+from ...params import Parameter, ParameterSet
+from ...progress import status, track
+from ...signals.trajectory import Trajectory
+from ..linear.subspace import RecordsFactor, default_horizon, n4sid, n4sid_records, subspace_factor
 
 __all__ = ["SCHEMA", "NLSS_FIT", "NLSSModel", "nlss", "load_nlss", "monomial_exponents"]
 
@@ -213,8 +217,6 @@ class NLSSModel:
         ones with their σ (in the model's state basis, see the module docstring), the n² entries
         that fix the basis marked ``fixed``. Units: the output's unit for C, D, F (per normalised
         state/input), 1 for A, B, E."""
-        from ...params import Parameter, ParameterSet
-
         std = dict(zip(map(tuple, self.dirs.tolist()), self.theta_std.tolist()))
         n = self.order
         params = []
@@ -247,8 +249,6 @@ class NLSSModel:
 
     def _inputs_of(self, data, what: str) -> np.ndarray:
         """Normalised input (N, m) from a Trajectory (columns by name) or an array."""
-        from ...signals.trajectory import Trajectory
-
         m = len(self.input_names)
         if isinstance(data, Trajectory):
             missing = [c for c in self.input_names if c not in data.names]
@@ -270,7 +270,6 @@ class NLSSModel:
         return np.ascontiguousarray((u - self.u_offset) / self.u_scale)
 
     def _outputs_of(self, data, y, n: int, what: str) -> np.ndarray:
-        from ...signals.trajectory import Trajectory
 
         p = len(self.output_names)
         if y is None:
@@ -594,8 +593,6 @@ def _columns(spec, what: str) -> list[str]:
 
 def _io(data, input, output, what: str):
     """(u (N, m), y (N, p), dt, input names, output names, input units, output units)."""
-    from ...signals.trajectory import Trajectory
-
     if isinstance(data, Trajectory):
         if input is None or output is None:
             raise ArgumentError(f"nlss: {what} is a Trajectory: name its columns with input= and "
@@ -656,8 +653,6 @@ def _positive_int(v, name: str, lo: int = 1) -> int:
 
 def _is_records(data) -> bool:
     """``data`` is a list of records (Trajectories or pairs ``(u, y)``), not one pair."""
-    from ...signals.trajectory import Trajectory
-
     if not isinstance(data, (list, tuple)) or not data:
         return False
     if any(isinstance(d, Trajectory) for d in data):
@@ -746,8 +741,6 @@ def _read_validation(validate, input, output, m: int, p: int):
 def _linear_start(ut, yr, n, dt, feedthrough):
     """The subspace model of order n of one record (normalised input, output less its mean),
     and the distinct warnings it raised → (model, notes), or None."""
-    from ..linear.subspace import n4sid
-
     N = ut.shape[0]
     with warnings.catch_warnings(record=True) as caught:  # the start, not the result
         warnings.simplefilter("always")
@@ -767,8 +760,6 @@ def _linear_start(ut, yr, n, dt, feedthrough):
 
 def _linear_start_records(ut, yr, bounds, n, dt, feedthrough):
     """One subspace model of order n of all records, one x0 each → (model, notes), or None."""
-    from ..linear.subspace import n4sid_records
-
     with warnings.catch_warnings(record=True) as caught:  # the start, not the result
         warnings.simplefilter("always")
         try:
@@ -785,8 +776,6 @@ def _gap_order(ut, yr, bounds, max_order: int, n_par) -> int:
     """The order at the largest gap s_n/s_(n+1) among the first ``max_order`` subspace singular
     values (of the records' stacked Hankel matrices for several), lowered until the data hold
     4 samples per parameter (``n_par(n)`` parameters at order n)."""
-    from ..linear.subspace import RecordsFactor, default_horizon, subspace_factor
-
     N, p = yr.shape
     if len(bounds) > 2:
         sv = RecordsFactor([(ut[a:b], yr[a:b]) for a, b in zip(bounds[:-1], bounds[1:])],
@@ -1054,8 +1043,6 @@ def _fit_order(lin, ut, y, u_off, sd_u, y_off, degree, feedthrough, window, max_
     """Stages 1-3 of the module docstring for one order. Several records: ``bounds`` their
     first rows in ``ut``, ``y`` and the end, ``x0s`` their initial states of the linear start;
     each record runs from its own initial state and no window crosses a seam."""
-    from ...progress import status, track
-
     ss = lin.system
     N, m = ut.shape
     p = y.shape[1]
@@ -1151,8 +1138,6 @@ def _fit_order_records(ss, A, B, C, D, ut, y, u_off, sd_u, y_off, degree, feedth
     start's states scaled over all records; stage 2 on windows inside each record; stage 3 with
     one window per record (each record's free run from its own estimated initial state); σ from
     the Gauss-Newton Hessian with every record's initial state a parameter."""
-    from ...progress import status, track
-
     N, m = ut.shape
     p = y.shape[1]
     n = A.shape[0]
