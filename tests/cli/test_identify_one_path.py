@@ -88,8 +88,8 @@ def test_search_out_writes_the_best_structure(files, capsys):
     py = identify(load(files["est"]), "arx", input="u", output="y", na=best["na"], nb=best["nb"],
                   nk=best["nk"])
     m = load_model(model_file)
-    assert m.info["label"] == py.label and best["nk"] == 1  # the true delay of one sample
-    np.testing.assert_array_equal(m.info["A"], py.A)
+    assert m.label == py.label and best["nk"] == 1  # the true delay of one sample
+    np.testing.assert_array_equal(m.A, py.A)
 
 
 def test_narx_validation_is_the_library_one(files, capsys):

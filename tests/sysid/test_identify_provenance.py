@@ -43,7 +43,7 @@ def test_identify_sets_the_model_provenance(files, tmp_path):
     ss = identify(tr, "ss", input="u", output="y", order=2)
     assert (ss.data_file, ss.data_hash) == ("run1.csv", digest)
     arx = identify(tr, "arx", input="u", output="y", na=2, nb=1, nk=1)
-    assert (arx.info["data_file"], arx.info["data_hash"]) == ("run1.csv", digest)
+    assert (arx.data_file, arx.data_hash) == ("run1.csv", digest)
     ss.save(tmp_path / "m.json")
     back = load_model(tmp_path / "m.json")
     assert (back.data_file, back.data_hash) == ("run1.csv", digest)

@@ -73,7 +73,7 @@ def validate_model(model, data: Trajectory, *, detrend: str = "mean") -> Validat
         fit = model.compare(np.asarray(data[model.input_name]),
                             np.asarray(data[model.output_name])).fit_percent[0]
         return ValidationResult(fit, NARX_VALIDATION_FIT, name, initial_state="measured")
-    if isinstance(model, LinearModel):
+    if isinstance(model, LinearModel) or getattr(model, "multivariable", False):
         return ValidationResult(_free_run_fit(model, data), VALIDATION_FIT, name)
     if not isinstance(model, PolynomialModel):
         raise ArgumentError(f"validate_model(): expected a LinearModel, PolynomialModel or "
