@@ -167,44 +167,37 @@ def _store(k, s, out):  # pragma: no cover - compiled
             out.S[k, i, j] = s.Se[i, j]
 
 
+@numba.njit(cache=True, inline="always")
+def _mul_add(A, B, C, out):  # pragma: no cover - compiled
+    """``out = C + A B`` (``C`` None: ``out = A B``), each sum from ``C[i, j]`` (or 0) over k in
+    order; ``B`` may be a transposed view (``H.T``) for ``A Hᵀ``."""
+    for i in range(out.shape[0]):
+        for j in range(out.shape[1]):
+            if C is None:
+                acc = 0.0
+            else:
+                acc = C[i, j]
+            for k in range(A.shape[1]):
+                acc += A[i, k] * B[k, j]
+            out[i, j] = acc
+
+
 # ---------------------------------------------------------------- extended
 
 
 @numba.njit(cache=True)
 def _ekf_update(s, w, hx, R, y):  # pragma: no cover - compiled
     """The EKF measurement update (module docstring) with ``hx = h(x_p, u)``, ``w.H`` at x_p."""
-    n, p = s.xp.shape[0], R.shape[0]
-    for i in range(n):
-        for j in range(p):
-            acc = 0.0
-            for k in range(n):
-                acc += s.Pp[i, k] * w.H[j, k]
-            w.PHt[i, j] = acc
-    for i in range(p):
-        for j in range(p):
-            acc = R[i, j]
-            for k in range(n):
-                acc += w.H[i, k] * w.PHt[k, j]
-            s.Se[i, j] = acc
+    _mul_add(s.Pp, w.H.T, None, w.PHt)
+    _mul_add(w.H, w.PHt, R, s.Se)
     return _gain_update(s, hx, w.PHt, w.K, y)
 
 
 @numba.njit(cache=True)
 def _ekf_predict(s, w, Q):  # pragma: no cover - compiled
     """``P_p = F P_f Fᵀ + Q`` (symmetric part)."""
-    n = Q.shape[0]
-    for i in range(n):
-        for j in range(n):
-            acc = 0.0
-            for k in range(n):
-                acc += w.F[i, k] * s.Pf[k, j]
-            w.T[i, j] = acc
-    for i in range(n):
-        for j in range(n):
-            acc = Q[i, j]
-            for k in range(n):
-                acc += w.T[i, k] * w.F[j, k]
-            s.Pp[i, j] = acc
+    _mul_add(w.F, s.Pf, None, w.T)
+    _mul_add(w.T, w.F.T, Q, s.Pp)
     _symmetrise(s.Pp)
 
 
@@ -346,28 +339,33 @@ def _ukf_predict(s, w, Q):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
+def _through_jit(fn, X, u, out):  # pragma: no cover - compiled
+    """``out[i] = fn(X[i], u)`` for each sigma point; False if ``fn`` returns other than
+    ``out.shape[1]`` values."""
+    for i in range(X.shape[0]):
+        v = fn(X[i], u)
+        if v.shape[0] != out.shape[1]:
+            return False
+        for j in range(out.shape[1]):
+            out[i, j] = v[j]
+    return True
+
+
+@numba.njit(cache=True)
 def _ukf_step_jit(f, h, c, noise, u, y, s, w):  # pragma: no cover - compiled
     """One UKF step with numba ``f``, ``h``: 0 done, 1 P_p or 2 Σ or 3 P_f not positive
     definite (the prediction is then left as it was), 4 ``f`` or 5 ``h`` returned the wrong
     length."""
     if not _sigma_points(s.xp, s.Pp, c, w.L, w.X):
         return 1
-    for i in range(w.X.shape[0]):
-        yi = h(w.X[i], u)
-        if yi.shape[0] != w.Yp.shape[1]:
-            return 5
-        for j in range(w.Yp.shape[1]):
-            w.Yp[i, j] = yi[j]
+    if not _through_jit(h, w.X, u, w.Yp):
+        return 5
     if not _ukf_update(s, w, noise.R, y):
         return 2
     if not _sigma_points(s.xf, s.Pf, c, w.L, w.X):
         return 3
-    for i in range(w.X.shape[0]):
-        xi = f(w.X[i], u)
-        if xi.shape[0] != w.Xn.shape[1]:
-            return 4
-        for j in range(w.Xn.shape[1]):
-            w.Xn[i, j] = xi[j]
+    if not _through_jit(f, w.X, u, w.Xn):
+        return 4
     _ukf_predict(s, w, noise.Q)
     return 0
 

@@ -528,27 +528,26 @@ def _nlss(model):
         raise ModelError("state_functions: the NLSS model has order 0, so no state to filter")
 
     @numba.njit
-    def normalised(u):  # pragma: no cover - compiled
-        """ũ as the one row (1, m) the model's kernels index by sample."""
+    def monomials(ex, x, u):  # pragma: no cover - compiled
+        """ũ as the one row (1, m) the model's kernels index by sample, and the monomials of
+        the exponent rows ``ex`` at (x, ũ)."""
         ut = np.empty((1, m))
         for j in range(m):
             ut[0, j] = (u[j] - u0[j]) / su[j]
-        return ut
+        values = np.empty(ex.shape[0])
+        _monomials(ex, x, ut, 0, values)
+        return ut, values
 
     @numba.njit
     def f(x, u):  # pragma: no cover - compiled
-        ut = normalised(u)
-        zeta = np.empty(exz.shape[0])
-        _monomials(exz, x, ut, 0, zeta)
+        ut, zeta = monomials(exz, x, u)
         out = np.empty(n)
         _state_update(A, B, E, x, ut, 0, zeta, out)
         return out
 
     @numba.njit
     def h(x, u):  # pragma: no cover - compiled
-        ut = normalised(u)
-        eta = np.empty(exe.shape[0])
-        _monomials(exe, x, ut, 0, eta)
+        ut, eta = monomials(exe, x, u)
         out = np.empty(p)
         for i in range(p):
             out[i] = _output(C, D, F, y0, x, ut, 0, eta, i)
