@@ -414,42 +414,36 @@ def _allocate(n: int, p: int, kind: str):
     return buf, views
 
 
+@numba.njit(cache=True, inline="always")
+def _block(buf, o, rows, cols):  # pragma: no cover - compiled
+    """The (rows, cols) view of ``buf`` at offset ``o``, and the offset after it."""
+    return buf[o:o + rows * cols].reshape((rows, cols)), o + rows * cols
+
+
 @numba.njit(cache=True)
 def _common_records(buf, n, p):  # pragma: no cover - compiled
     """FilterState and Noise as views of ``buf`` (the first blocks of :func:`_layout`), and the
     offset after them."""
-    xp = buf[0:n]
-    o = n
-    Pp = buf[o:o + n * n].reshape((n, n))
-    o += n * n
-    xf = buf[o:o + n]
-    o += n
-    Pf = buf[o:o + n * n].reshape((n, n))
-    o += n * n
-    e = buf[o:o + p]
-    o += p
-    Se = buf[o:o + p * p].reshape((p, p))
-    o += p * p
-    Q = buf[o:o + n * n].reshape((n, n))
-    o += n * n
-    R = buf[o:o + p * p].reshape((p, p))
-    return FilterState(xp, Pp, xf, Pf, e, Se), Noise(Q, R), o + p * p
+    xp, o = buf[0:n], n
+    Pp, o = _block(buf, o, n, n)
+    xf, o = buf[o:o + n], o + n
+    Pf, o = _block(buf, o, n, n)
+    e, o = buf[o:o + p], o + p
+    Se, o = _block(buf, o, p, p)
+    Q, o = _block(buf, o, n, n)
+    R, o = _block(buf, o, p, p)
+    return FilterState(xp, Pp, xf, Pf, e, Se), Noise(Q, R), o
 
 
 @numba.njit(cache=True)
 def _ekf_records(buf, n, p):  # pragma: no cover - compiled
     """(FilterState, Noise, EKFWork) as views of an EKF's buffer."""
     s, noise, o = _common_records(buf, n, p)
-    PHt = buf[o:o + n * p].reshape((n, p))
-    o += n * p
-    K = buf[o:o + n * p].reshape((n, p))
-    o += n * p
-    F = buf[o:o + n * n].reshape((n, n))
-    o += n * n
-    H = buf[o:o + p * n].reshape((p, n))
-    o += p * n
-    T = buf[o:o + n * n].reshape((n, n))
-    o += n * n
+    PHt, o = _block(buf, o, n, p)
+    K, o = _block(buf, o, n, p)
+    F, o = _block(buf, o, n, n)
+    H, o = _block(buf, o, p, n)
+    T, o = _block(buf, o, n, n)
     return s, noise, EKFWork(PHt, K, F, H, T, buf[o:o + n])
 
 
@@ -458,24 +452,15 @@ def _ukf_records(buf, n, p):  # pragma: no cover - compiled
     """(FilterState, Noise, UKFWork, c) as views of a UKF's buffer."""
     s, noise, o = _common_records(buf, n, p)
     ns = 2 * n + 1
-    Wm = buf[o:o + ns]
-    o += ns
-    Wc = buf[o:o + ns]
-    o += ns
-    Pxy = buf[o:o + n * p].reshape((n, p))
-    o += n * p
-    K = buf[o:o + n * p].reshape((n, p))
-    o += n * p
-    yhat = buf[o:o + p]
-    o += p
-    L = buf[o:o + n * n].reshape((n, n))
-    o += n * n
-    X = buf[o:o + ns * n].reshape((ns, n))
-    o += ns * n
-    Yp = buf[o:o + ns * p].reshape((ns, p))
-    o += ns * p
-    Xn = buf[o:o + ns * n].reshape((ns, n))
-    o += ns * n
+    Wm, o = buf[o:o + ns], o + ns
+    Wc, o = buf[o:o + ns], o + ns
+    Pxy, o = _block(buf, o, n, p)
+    K, o = _block(buf, o, n, p)
+    yhat, o = buf[o:o + p], o + p
+    L, o = _block(buf, o, n, n)
+    X, o = _block(buf, o, ns, n)
+    Yp, o = _block(buf, o, ns, p)
+    Xn, o = _block(buf, o, ns, n)
     return s, noise, UKFWork(Wm, Wc, Pxy, K, yhat, L, X, Yp, Xn), buf[o]
 
 
