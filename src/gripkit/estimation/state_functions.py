@@ -305,18 +305,23 @@ def _piezo(model, theta, dt, labels):
         return H, w
 
     @numba.njit
+    def linear_row(M, N, x, w, i):  # pragma: no cover - compiled
+        """Row i of ``M x[2:] + N w`` (the linear part's state after the hysteresis states)."""
+        acc = 0.0
+        for j in range(n):
+            acc += M[i, j] * x[2 + j]
+        for j in range(m):
+            acc += N[i, j] * w[j]
+        return acc
+
+    @numba.njit
     def f(x, u):  # pragma: no cover - compiled
         H, w = drive(x, u)
         out = np.empty(2 + n)
         out[0] = H
         out[1] = u[0]
         for i in range(n):
-            acc = 0.0
-            for j in range(n):
-                acc += Phi[i, j] * x[2 + j]
-            for j in range(m):
-                acc += Gam[i, j] * w[j]
-            out[2 + i] = acc
+            out[2 + i] = linear_row(Phi, Gam, x, w, i)
         return out
 
     @numba.njit
@@ -324,12 +329,7 @@ def _piezo(model, theta, dt, labels):
         _, w = drive(x, u)
         out = np.empty(p)
         for i in range(p):
-            acc = 0.0
-            for j in range(n):
-                acc += C[i, j] * x[2 + j]
-            for j in range(m):
-                acc += D[i, j] * w[j]
-            out[i] = acc
+            out[i] = linear_row(C, D, x, w, i)
         return out
 
     return f, h, model.initial_state(theta).astype(np.float64), 2 + n, labels
