@@ -82,6 +82,23 @@ def check_number(value, option: str, *, minimum: float | None = None, above: flo
         raise DataError(f"{option}: expected {want}, found {value!r}")
 
 
+def keyword_or_number(value: str, option: str, keyword: str, kind, low: float, high: float,
+                      expected: str, hint: str):
+    """``keyword`` itself, or ``value`` as ``kind`` (int or float) in ``[low, high]``; else a
+    :class:`~gripkit.errors.DataError` "OPTION: expected EXPECTED, found VALUE" with ``hint``."""
+    from ..errors import DataError
+
+    if value == keyword:
+        return keyword
+    try:
+        n = kind(value)
+    except ValueError:
+        n = None
+    if n is None or not low <= n <= high:
+        raise DataError(f"{option}: expected {expected}, found {value!r}", hint=hint)
+    return n
+
+
 def emit_json(obj) -> None:
     """Write ``obj`` as one JSON object on stdout (NaN/inf become null)."""
     sys.stdout.write(json.dumps(plain(obj), allow_nan=False) + "\n")

@@ -10,13 +10,16 @@ from pathlib import Path
 
 import typer
 
-from .common import load_data
+from .common import load_data, write_model_page
 
 ValidateOpt = typer.Option(None, "--validate", help="Second record (same columns): the one "
                                                     "validation fit, as gripkit compare gives it.")
 ModelOutOpt = typer.Option(None, "--out", help="Write the identified model to this JSON file.")
 ReportOpt = typer.Option(None, "--report", help="Write an HTML report of the model on the data "
                                                 "to this folder.")
+#: ``--validate`` and ``--out`` of the nonlinear commands (hw, hysteresis, narx, nlss)
+RecordValidateOpt = typer.Option(None, "--validate", help="Validation record (same columns).")
+ModelJsonOpt = typer.Option(None, "--out", help="Write the model (JSON).")
 
 
 def columns(inputs, outputs) -> list[str]:
@@ -96,6 +99,19 @@ def save_and_report(model, tr, data: list[Path], out: Path | None, report: Path 
     for i, (path, record) in enumerate(zip(data, tr)):
         folder = stems[i] if stems.count(stems[i]) == 1 else f"{i + 1}-{stems[i]}"
         write_model_report(fm, record, Path(report) / folder, data_name=Path(path).name)
+
+
+def save_and_page(model, out: Path | None, report: Path | None, record, vrecord,
+                  data_path: Path, validate: Path | None):
+    """``--out``: ``model.save(out)``; ``--report``: the model page (:func:`write_model_page`)
+    on the validation record ``vrecord`` (file ``validate``) when given, else on ``record``
+    (file ``data_path``). Returns the page, None without ``--report``."""
+    if out is not None:
+        model.save(out)
+    if report is None:
+        return None
+    return write_model_page(model, record if vrecord is None else vrecord, report,
+                            data_path if validate is None else validate)
 
 
 def data_field(data: list[Path]) -> str | list[str]:

@@ -11,10 +11,11 @@ from typing import Optional
 import typer
 
 from .app import identify_app
-from .identify_common import data_field, records_field, run_identify
+from .identify_common import (ModelJsonOpt, RecordValidateOpt, data_field, records_field,
+                              run_identify, save_and_page)
 from .identify_linear import DataArgs, _echo_records
 from .common import (FillOpt, FsOpt, JsonOpt, ModelReportOpt, TimeOpt, check_data_options,
-                     collected_warnings, emit_json, load_data, report_warnings, write_model_page)
+                     collected_warnings, emit_json, load_data, report_warnings)
 from .paths import output_folder
 
 
@@ -42,9 +43,8 @@ def identify_hw(data: list[Path] = DataArgs,
                 nb: Optional[int] = typer.Option(None, "--nb", help="B coefficients (searched)."),
                 nf: Optional[int] = typer.Option(None, "--nf", help="F coefficients (searched)."),
                 nk: Optional[int] = typer.Option(None, "--nk", help="Input delay (searched)."),
-                validate: Optional[Path] = typer.Option(None, "--validate",
-                                                        help="Validation record (same columns)."),
-                out: Optional[Path] = typer.Option(None, "--out", help="Write the model (JSON)."),
+                validate: Optional[Path] = RecordValidateOpt,
+                out: Optional[Path] = ModelJsonOpt,
                 report: Optional[Path] = ModelReportOpt,
                 fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
                 json_out: bool = JsonOpt):
@@ -75,10 +75,7 @@ def identify_hw(data: list[Path] = DataArgs,
                                    input_nonlinearity=input_nl, output_nonlinearity=output_nl,
                                    nb=nb, nf=nf, nk=nk, dt=tr.dt, validate=val, progress=True)
         m.input_name, m.output_name = input_col, output_col
-        if out is not None:
-            m.save(out)
-        page = None if report is None else write_model_page(
-            m, tr if tv is None else tv, report, data[0] if validate is None else validate)
+        page = save_and_page(m, out, report, tr, tv, data[0], validate)
     lines = report_warnings(caught)
     if json_out:
         emit_json({"data": data_field(data),

@@ -12,27 +12,19 @@ import typer
 
 from .app import identify_app
 from .common import (FillOpt, FsOpt, JsonOpt, ModelReportOpt, TimeOpt, check_choice,
-                     check_data_options, collected_warnings, emit_json, load_data, report_warnings,
-                     write_model_page)
-from .identify_common import data_field, records_field, run_identify
+                     check_data_options, collected_warnings, emit_json, keyword_or_number,
+                     load_data, report_warnings)
+from .identify_common import (ModelJsonOpt, RecordValidateOpt, data_field, records_field,
+                              run_identify, save_and_page)
 from .identify_linear import DataArgs, _echo_records
 from .paths import output_folder
 
 
 def _exponent(value: str):
     """``free`` or a number in [1, 10]."""
-    from ..errors import DataError
-
-    if value == "free":
-        return "free"
-    try:
-        n = float(value)
-    except ValueError:
-        n = float("nan")
-    if not 1.0 <= n <= 10.0:
-        raise DataError(f"--exponent: expected 'free' or a number in [1, 10], found {value!r}",
-                        hint="--exponent 1 is the seed's Bouc-Wen (eq 3); free estimates it")
-    return n
+    return keyword_or_number(value, "--exponent", "free", float, 1.0, 10.0,
+                             "'free' or a number in [1, 10]",
+                             "--exponent 1 is the seed's Bouc-Wen (eq 3); free estimates it")
 
 
 @identify_app.command("hysteresis")
@@ -53,11 +45,8 @@ def identify_hysteresis(data: list[Path] = DataArgs,
                                                       help="Prandtl-Ishlinskii: number of plays."),
                         burn_in: int = typer.Option(0, "--burn-in",
                                                     help="Samples simulated but not scored."),
-                        validate: Optional[Path] = typer.Option(None, "--validate",
-                                                                help="Validation record (same "
-                                                                     "columns)."),
-                        out: Optional[Path] = typer.Option(None, "--out",
-                                                           help="Write the model (JSON)."),
+                        validate: Optional[Path] = RecordValidateOpt,
+                        out: Optional[Path] = ModelJsonOpt,
                         report: Optional[Path] = ModelReportOpt,
                         fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
                         json_out: bool = JsonOpt):
@@ -83,10 +72,7 @@ def identify_hysteresis(data: list[Path] = DataArgs,
                              fill=fill, detrend="none", model=model, **opts)[0]
         else:
             m = hysteresis(tr, model, input=input_col, output=output_col, **opts)
-        if out is not None:
-            m.save(out)
-        page = None if report is None else write_model_page(
-            m, tr if val is None else val, report, data[0] if validate is None else validate)
+        page = save_and_page(m, out, report, tr, val, data[0], validate)
     lines = report_warnings(caught)
     if json_out:
         structure = ({"model": model, "form": form, "exponent": m.n,

@@ -4,6 +4,7 @@ polynomial NARX by forward regression with the error reduction ratio (:func:`gri
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 from typing import Optional
 
@@ -11,24 +12,17 @@ import typer
 
 from .app import identify_app
 from .common import (FillOpt, FsOpt, JsonOpt, ModelReportOpt, TimeOpt, check_data_options,
-                     collected_warnings, emit_json, report_warnings, write_model_page)
-from .identify_common import check_outputs, run_identify, validation
+                     collected_warnings, emit_json, keyword_or_number, report_warnings,
+                     write_model_page)
+from .identify_common import (ModelJsonOpt, RecordValidateOpt, check_outputs, run_identify,
+                              validation)
 
 
 def _terms(value: str):
     """``auto`` or a positive integer."""
-    from ..errors import DataError
-
-    if value == "auto":
-        return "auto"
-    try:
-        n = int(value)
-    except ValueError:
-        n = 0
-    if n < 1:
-        raise DataError(f"--terms: expected 'auto' or a positive integer, found {value!r}",
-                        hint="--terms auto chooses the number by BIC (or by --validate's fit)")
-    return n
+    return keyword_or_number(value, "--terms", "auto", int, 1, math.inf,
+                             "'auto' or a positive integer",
+                             "--terms auto chooses the number by BIC (or by --validate's fit)")
 
 
 def _summary(m) -> str:
@@ -58,9 +52,8 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
                   refine: str = typer.Option("none", "--refine",
                                              help="none (one-step least squares) or simulation "
                                                   "(θ refined on the free-run error)."),
-                  validate: Optional[Path] = typer.Option(None, "--validate",
-                                                          help="Validation record (same columns)."),
-                  out: Optional[Path] = typer.Option(None, "--out", help="Write the model (JSON)."),
+                  validate: Optional[Path] = RecordValidateOpt,
+                  out: Optional[Path] = ModelJsonOpt,
                   report: Optional[Path] = ModelReportOpt,
                   fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
                   json_out: bool = JsonOpt):

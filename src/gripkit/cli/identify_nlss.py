@@ -12,7 +12,8 @@ import typer
 from .app import identify_app
 from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, collected_warnings,
                      emit_json, load_data, report_warnings)
-from .identify_common import data_field, records_field, run_identify
+from .identify_common import (ModelJsonOpt, RecordValidateOpt, data_field, records_field,
+                              run_identify)
 from .identify_linear import DataArgs, _echo_records
 
 
@@ -65,9 +66,8 @@ def identify_nlss(data: list[Path] = DataArgs,
                   window: Optional[int] = typer.Option(None, "--window",
                                                        help="Samples per truncated simulation "
                                                             "window (default 10 time constants)."),
-                  validate: Optional[Path] = typer.Option(None, "--validate",
-                                                          help="Validation record (same columns)."),
-                  out: Optional[Path] = typer.Option(None, "--out", help="Write the model (JSON)."),
+                  validate: Optional[Path] = RecordValidateOpt,
+                  out: Optional[Path] = ModelJsonOpt,
                   fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
                   json_out: bool = JsonOpt):
     """Polynomial nonlinear state space (PNLSS) from the subspace start, simulation error, σ.

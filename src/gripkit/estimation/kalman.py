@@ -206,6 +206,19 @@ def _kf_innovation(n, m, p, par, st, u, y):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, inline="always")
+def _flat_mul_add(c, oc, a, oa, b, ob, out, oo, rows, cols, inner):  # pragma: no cover
+    """``out = C + A B`` on row-major blocks of flat vectors: C and out (rows, cols) at ``oc``,
+    ``oo``, A (rows, inner) at ``oa``, B (inner, cols) at ``ob``; each sum from C[i, j] over k
+    in order."""
+    for i in range(rows):
+        for j in range(cols):
+            acc = c[oc + i * cols + j]
+            for k in range(inner):
+                acc += a[oa + i * inner + k] * b[ob + k * cols + j]
+            out[oo + i * cols + j] = acc
+
+
+@numba.njit(cache=True, inline="always")
 def _kf_gains(n, m, p, par, st):  # pragma: no cover - compiled
     """The time-varying gains: P_p Cᵀ, Σ = R + C P_p Cᵀ (factored), M = S + A P_p Cᵀ,
     K_f = P_p Cᵀ Σ⁻¹, K_p = M Σ⁻¹. False if Σ is not positive definite."""
@@ -217,18 +230,8 @@ def _kf_gains(n, m, p, par, st):  # pragma: no cover - compiled
             for k in range(n):
                 acc += st[sPp + i * n + k] * par[oC + j * n + k]
             st[sPC + i * p + j] = acc
-    for i in range(p):  # Σ = R + C (P_p Cᵀ)
-        for j in range(p):
-            acc = par[oR + i * p + j]
-            for k in range(n):
-                acc += par[oC + i * n + k] * st[sPC + k * p + j]
-            st[sSe + i * p + j] = acc
-    for i in range(n):  # M = S + A (P_p Cᵀ)
-        for j in range(p):
-            acc = par[oS + i * p + j]
-            for k in range(n):
-                acc += par[oA + i * n + k] * st[sPC + k * p + j]
-            st[sM + i * p + j] = acc
+    _flat_mul_add(par, oR, par, oC, st, sPC, st, sSe, p, p, n)  # Σ = R + C (P_p Cᵀ)
+    _flat_mul_add(par, oS, par, oA, st, sPC, st, sM, n, p, n)  # M = S + A (P_p Cᵀ)
     if not _flat_cholesky(st, sSe, p):
         return False
     _flat_solve_rows(st, sSe, p, sPC, sKf, n)

@@ -167,44 +167,37 @@ def _store(k, s, out):  # pragma: no cover - compiled
             out.S[k, i, j] = s.Se[i, j]
 
 
+@numba.njit(cache=True, inline="always")
+def _mul_add(A, B, C, out):  # pragma: no cover - compiled
+    """``out = C + A B`` (``C`` None: ``out = A B``), each sum from ``C[i, j]`` (or 0) over k in
+    order; ``B`` may be a transposed view (``H.T``) for ``A Hᵀ``."""
+    for i in range(out.shape[0]):
+        for j in range(out.shape[1]):
+            if C is None:
+                acc = 0.0
+            else:
+                acc = C[i, j]
+            for k in range(A.shape[1]):
+                acc += A[i, k] * B[k, j]
+            out[i, j] = acc
+
+
 # ---------------------------------------------------------------- extended
 
 
 @numba.njit(cache=True)
 def _ekf_update(s, w, hx, R, y):  # pragma: no cover - compiled
     """The EKF measurement update (module docstring) with ``hx = h(x_p, u)``, ``w.H`` at x_p."""
-    n, p = s.xp.shape[0], R.shape[0]
-    for i in range(n):
-        for j in range(p):
-            acc = 0.0
-            for k in range(n):
-                acc += s.Pp[i, k] * w.H[j, k]
-            w.PHt[i, j] = acc
-    for i in range(p):
-        for j in range(p):
-            acc = R[i, j]
-            for k in range(n):
-                acc += w.H[i, k] * w.PHt[k, j]
-            s.Se[i, j] = acc
+    _mul_add(s.Pp, w.H.T, None, w.PHt)
+    _mul_add(w.H, w.PHt, R, s.Se)
     return _gain_update(s, hx, w.PHt, w.K, y)
 
 
 @numba.njit(cache=True)
 def _ekf_predict(s, w, Q):  # pragma: no cover - compiled
     """``P_p = F P_f Fᵀ + Q`` (symmetric part)."""
-    n = Q.shape[0]
-    for i in range(n):
-        for j in range(n):
-            acc = 0.0
-            for k in range(n):
-                acc += w.F[i, k] * s.Pf[k, j]
-            w.T[i, j] = acc
-    for i in range(n):
-        for j in range(n):
-            acc = Q[i, j]
-            for k in range(n):
-                acc += w.T[i, k] * w.F[j, k]
-            s.Pp[i, j] = acc
+    _mul_add(w.F, s.Pf, None, w.T)
+    _mul_add(w.T, w.F.T, Q, s.Pp)
     _symmetrise(s.Pp)
 
 
@@ -346,28 +339,33 @@ def _ukf_predict(s, w, Q):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
+def _through_jit(fn, X, u, out):  # pragma: no cover - compiled
+    """``out[i] = fn(X[i], u)`` for each sigma point; False if ``fn`` returns other than
+    ``out.shape[1]`` values."""
+    for i in range(X.shape[0]):
+        v = fn(X[i], u)
+        if v.shape[0] != out.shape[1]:
+            return False
+        for j in range(out.shape[1]):
+            out[i, j] = v[j]
+    return True
+
+
+@numba.njit(cache=True)
 def _ukf_step_jit(f, h, c, noise, u, y, s, w):  # pragma: no cover - compiled
     """One UKF step with numba ``f``, ``h``: 0 done, 1 P_p or 2 Σ or 3 P_f not positive
     definite (the prediction is then left as it was), 4 ``f`` or 5 ``h`` returned the wrong
     length."""
     if not _sigma_points(s.xp, s.Pp, c, w.L, w.X):
         return 1
-    for i in range(w.X.shape[0]):
-        yi = h(w.X[i], u)
-        if yi.shape[0] != w.Yp.shape[1]:
-            return 5
-        for j in range(w.Yp.shape[1]):
-            w.Yp[i, j] = yi[j]
+    if not _through_jit(h, w.X, u, w.Yp):
+        return 5
     if not _ukf_update(s, w, noise.R, y):
         return 2
     if not _sigma_points(s.xf, s.Pf, c, w.L, w.X):
         return 3
-    for i in range(w.X.shape[0]):
-        xi = f(w.X[i], u)
-        if xi.shape[0] != w.Xn.shape[1]:
-            return 4
-        for j in range(w.Xn.shape[1]):
-            w.Xn[i, j] = xi[j]
+    if not _through_jit(f, w.X, u, w.Xn):
+        return 4
     _ukf_predict(s, w, noise.Q)
     return 0
 
@@ -416,42 +414,36 @@ def _allocate(n: int, p: int, kind: str):
     return buf, views
 
 
+@numba.njit(cache=True, inline="always")
+def _block(buf, o, rows, cols):  # pragma: no cover - compiled
+    """The (rows, cols) view of ``buf`` at offset ``o``, and the offset after it."""
+    return buf[o:o + rows * cols].reshape((rows, cols)), o + rows * cols
+
+
 @numba.njit(cache=True)
 def _common_records(buf, n, p):  # pragma: no cover - compiled
     """FilterState and Noise as views of ``buf`` (the first blocks of :func:`_layout`), and the
     offset after them."""
-    xp = buf[0:n]
-    o = n
-    Pp = buf[o:o + n * n].reshape((n, n))
-    o += n * n
-    xf = buf[o:o + n]
-    o += n
-    Pf = buf[o:o + n * n].reshape((n, n))
-    o += n * n
-    e = buf[o:o + p]
-    o += p
-    Se = buf[o:o + p * p].reshape((p, p))
-    o += p * p
-    Q = buf[o:o + n * n].reshape((n, n))
-    o += n * n
-    R = buf[o:o + p * p].reshape((p, p))
-    return FilterState(xp, Pp, xf, Pf, e, Se), Noise(Q, R), o + p * p
+    xp, o = buf[0:n], n
+    Pp, o = _block(buf, o, n, n)
+    xf, o = buf[o:o + n], o + n
+    Pf, o = _block(buf, o, n, n)
+    e, o = buf[o:o + p], o + p
+    Se, o = _block(buf, o, p, p)
+    Q, o = _block(buf, o, n, n)
+    R, o = _block(buf, o, p, p)
+    return FilterState(xp, Pp, xf, Pf, e, Se), Noise(Q, R), o
 
 
 @numba.njit(cache=True)
 def _ekf_records(buf, n, p):  # pragma: no cover - compiled
     """(FilterState, Noise, EKFWork) as views of an EKF's buffer."""
     s, noise, o = _common_records(buf, n, p)
-    PHt = buf[o:o + n * p].reshape((n, p))
-    o += n * p
-    K = buf[o:o + n * p].reshape((n, p))
-    o += n * p
-    F = buf[o:o + n * n].reshape((n, n))
-    o += n * n
-    H = buf[o:o + p * n].reshape((p, n))
-    o += p * n
-    T = buf[o:o + n * n].reshape((n, n))
-    o += n * n
+    PHt, o = _block(buf, o, n, p)
+    K, o = _block(buf, o, n, p)
+    F, o = _block(buf, o, n, n)
+    H, o = _block(buf, o, p, n)
+    T, o = _block(buf, o, n, n)
     return s, noise, EKFWork(PHt, K, F, H, T, buf[o:o + n])
 
 
@@ -460,24 +452,15 @@ def _ukf_records(buf, n, p):  # pragma: no cover - compiled
     """(FilterState, Noise, UKFWork, c) as views of a UKF's buffer."""
     s, noise, o = _common_records(buf, n, p)
     ns = 2 * n + 1
-    Wm = buf[o:o + ns]
-    o += ns
-    Wc = buf[o:o + ns]
-    o += ns
-    Pxy = buf[o:o + n * p].reshape((n, p))
-    o += n * p
-    K = buf[o:o + n * p].reshape((n, p))
-    o += n * p
-    yhat = buf[o:o + p]
-    o += p
-    L = buf[o:o + n * n].reshape((n, n))
-    o += n * n
-    X = buf[o:o + ns * n].reshape((ns, n))
-    o += ns * n
-    Yp = buf[o:o + ns * p].reshape((ns, p))
-    o += ns * p
-    Xn = buf[o:o + ns * n].reshape((ns, n))
-    o += ns * n
+    Wm, o = buf[o:o + ns], o + ns
+    Wc, o = buf[o:o + ns], o + ns
+    Pxy, o = _block(buf, o, n, p)
+    K, o = _block(buf, o, n, p)
+    yhat, o = buf[o:o + p], o + p
+    L, o = _block(buf, o, n, n)
+    X, o = _block(buf, o, ns, n)
+    Yp, o = _block(buf, o, ns, p)
+    Xn, o = _block(buf, o, ns, n)
     return s, noise, UKFWork(Wm, Wc, Pxy, K, yhat, L, X, Yp, Xn), buf[o]
 
 

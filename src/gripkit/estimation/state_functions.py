@@ -305,18 +305,23 @@ def _piezo(model, theta, dt, labels):
         return H, w
 
     @numba.njit
+    def linear_row(M, N, x, w, i):  # pragma: no cover - compiled
+        """Row i of ``M x[2:] + N w`` (the linear part's state after the hysteresis states)."""
+        acc = 0.0
+        for j in range(n):
+            acc += M[i, j] * x[2 + j]
+        for j in range(m):
+            acc += N[i, j] * w[j]
+        return acc
+
+    @numba.njit
     def f(x, u):  # pragma: no cover - compiled
         H, w = drive(x, u)
         out = np.empty(2 + n)
         out[0] = H
         out[1] = u[0]
         for i in range(n):
-            acc = 0.0
-            for j in range(n):
-                acc += Phi[i, j] * x[2 + j]
-            for j in range(m):
-                acc += Gam[i, j] * w[j]
-            out[2 + i] = acc
+            out[2 + i] = linear_row(Phi, Gam, x, w, i)
         return out
 
     @numba.njit
@@ -324,12 +329,7 @@ def _piezo(model, theta, dt, labels):
         _, w = drive(x, u)
         out = np.empty(p)
         for i in range(p):
-            acc = 0.0
-            for j in range(n):
-                acc += C[i, j] * x[2 + j]
-            for j in range(m):
-                acc += D[i, j] * w[j]
-            out[i] = acc
+            out[i] = linear_row(C, D, x, w, i)
         return out
 
     return f, h, model.initial_state(theta).astype(np.float64), 2 + n, labels
@@ -528,27 +528,26 @@ def _nlss(model):
         raise ModelError("state_functions: the NLSS model has order 0, so no state to filter")
 
     @numba.njit
-    def normalised(u):  # pragma: no cover - compiled
-        """ũ as the one row (1, m) the model's kernels index by sample."""
+    def monomials(ex, x, u):  # pragma: no cover - compiled
+        """ũ as the one row (1, m) the model's kernels index by sample, and the monomials of
+        the exponent rows ``ex`` at (x, ũ)."""
         ut = np.empty((1, m))
         for j in range(m):
             ut[0, j] = (u[j] - u0[j]) / su[j]
-        return ut
+        values = np.empty(ex.shape[0])
+        _monomials(ex, x, ut, 0, values)
+        return ut, values
 
     @numba.njit
     def f(x, u):  # pragma: no cover - compiled
-        ut = normalised(u)
-        zeta = np.empty(exz.shape[0])
-        _monomials(exz, x, ut, 0, zeta)
+        ut, zeta = monomials(exz, x, u)
         out = np.empty(n)
         _state_update(A, B, E, x, ut, 0, zeta, out)
         return out
 
     @numba.njit
     def h(x, u):  # pragma: no cover - compiled
-        ut = normalised(u)
-        eta = np.empty(exe.shape[0])
-        _monomials(exe, x, ut, 0, eta)
+        ut, eta = monomials(exe, x, u)
         out = np.empty(p)
         for i in range(p):
             out[i] = _output(C, D, F, y0, x, ut, 0, eta, i)

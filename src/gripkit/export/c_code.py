@@ -183,11 +183,9 @@ def c_sources(model, name: str = "model", *, float32: bool = False,
             f"{name}.c": _source(name, ss, A, B, C, D, model, float32)}
 
 
-def export_c(model, out_dir, name: str = "model", *, float32: bool = False,
-             dt: float | None = None) -> list:
-    """Write ``NAME.h`` and ``NAME.c`` of ``model`` into ``out_dir`` (created if missing);
-    returns the two paths. See the module docstring for what the step computes."""
-    files = c_sources(model, name, float32=float32, dt=dt)
+def _write_sources(files: dict, out_dir) -> list:
+    """Write each ``{file name: text}`` of ``files`` into ``out_dir`` (created if missing),
+    atomically; returns the paths in the dict's order."""
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     paths = []
@@ -195,6 +193,14 @@ def export_c(model, out_dir, name: str = "model", *, float32: bool = False,
         write_text(out_dir / fname, text)
         paths.append(out_dir / fname)
     return paths
+
+
+def export_c(model, out_dir, name: str = "model", *, float32: bool = False,
+             dt: float | None = None) -> list:
+    """Write ``NAME.h`` and ``NAME.c`` of ``model`` into ``out_dir`` (created if missing);
+    returns the two paths. See the module docstring for what the step computes."""
+    files = c_sources(model, name, float32=float32, dt=dt)
+    return _write_sources(files, out_dir)
 
 
 def c_harness(name: str) -> str:

@@ -25,10 +25,9 @@ from pathlib import Path
 
 import numpy as np
 
-from ..atomic import write_text
 from ..errors import DataError, ModelError, PathError
 from ..estimation import KalmanFilter
-from .c_code import _array, _describe, _realisation, check_c_name
+from .c_code import _array, _describe, _realisation, _write_sources, check_c_name
 
 __all__ = ["export_kalman_c", "kalman_c_harness", "kalman_c_sources", "kalman_filter_of",
            "load_noise"]
@@ -161,13 +160,7 @@ def export_kalman_c(model, out_dir, name: str = "model", Q=None, R=None, S=None,
     """Write :func:`kalman_c_sources` into ``out_dir`` (created if missing); returns the two
     paths."""
     files = kalman_c_sources(model, name, Q, R, S, dt=dt)
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    paths = []
-    for fname, text in files.items():
-        write_text(out_dir / fname, text)
-        paths.append(out_dir / fname)
-    return paths
+    return _write_sources(files, out_dir)
 
 
 def kalman_c_harness(name: str) -> str:

@@ -256,37 +256,35 @@ def _radius(A):
     return float(np.max(np.abs(np.linalg.eigvals(A)))) if A.shape[0] else 0.0
 
 
-def _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough, innovation, max_iterations, tol,
-                         progress: str | None = None):
-    """Levenberg-Marquardt on the whitened prediction errors, re-centring the local coordinates
-    after every accepted step and rejecting steps that leave the stable set; ``progress``: the
-    description of a progress bar of the iterations on stderr (:func:`gripkit.progress.track`),
-    None for none."""
-    N, p = yw.shape
-    e = np.empty((N, p))
-    predict_errors(A, B, C, D, K, x0, u, yw, e)
-    Vc = float(np.sum(e * e))
+def _lm_loop(system, x0, terms, loss, shifted, feedthrough, innovation, max_iterations, tol,
+             progress):
+    """The Levenberg-Marquardt loop of one record and of several: ``system`` (A, B, C, D, K)
+    and the initial state(s) ``x0``; ``terms(system, x0, entries) -> (errors, H, g)``,
+    ``loss(system, x0) -> V``, ``shifted(x0, δ_x0)`` the initial state(s) moved by the entries
+    of δ after the system's d. Re-centres the local coordinates after every accepted step and
+    rejects steps that leave the stable set. Returns ``(A, B, C, D, K, x0, V, iterations,
+    converged, at_final)``."""
+    A, B, C, D, K = system
+    Vc = loss(system, x0)
     lam, it, converged = 1e-3, 0, False
     for it in track(range(1, max_iterations + 1), total=max_iterations,
                     description=progress or "", enabled=progress is not None):
         dA, dB, dC, dD, dK, ent = _directions(A, B, C, D, K, feedthrough, innovation)
         d = dA.shape[0]
-        e, H, g = _gauss_newton_terms(A, B, C, D, K, x0, u, yw, ent)
+        e, H, g = terms((A, B, C, D, K), x0, ent)
         hd = np.maximum(np.diag(H), 1e-300)
-        improved, rel = False, 0.0
+        improved, rel, drop = False, 0.0, 0.0
         for _ in range(30):
-            moved, delta = _proposal(H, hd, g, lam, (dA, dB, dC, dD, dK), (A, B, C, D, K), innovation)
+            moved, delta = _proposal(H, hd, g, lam, (dA, dB, dC, dD, dK), (A, B, C, D, K),
+                                     innovation)
             if moved is None:
                 lam *= 10
                 continue
-            An, Bn, Cn, Dn, Kn = moved
-            x0n = x0 + delta[d:]
-            en = np.empty((N, p))
-            predict_errors(An, Bn, Cn, Dn, Kn, x0n, u, yw, en)
-            Vn = float(np.sum(en * en))
+            x0n = shifted(x0, delta[d:])
+            Vn = loss(moved, x0n)
             if np.isfinite(Vn) and Vn < Vc:
                 improved, rel, drop = True, (Vc - Vn) / max(Vc, 1e-300), Vc - Vn
-                A, B, C, D, K, x0, Vc = An, Bn, Cn, Dn, Kn, x0n, Vn
+                (A, B, C, D, K), x0, Vc = moved, x0n, Vn
                 lam = max(lam / 5, 1e-12)
                 break
             lam *= 10
@@ -298,6 +296,22 @@ def _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough, innovation, max_
             break
     at_final = (H, (dA, dB, dC, dD, dK), e) if not improved else None   # H at (or ≪ 1σ from) the end
     return A, B, C, D, K, x0, Vc, it, converged, at_final
+
+
+def _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough, innovation, max_iterations, tol,
+                         progress: str | None = None):
+    """:func:`_lm_loop` on the whitened prediction errors of one record; ``progress``: the
+    description of a progress bar of the iterations on stderr (:func:`gripkit.progress.track`),
+    None for none."""
+
+    def loss(system, x):
+        e = np.empty(yw.shape)
+        predict_errors(*system, x, u, yw, e)
+        return float(np.sum(e * e))
+
+    return _lm_loop((A, B, C, D, K), x0,
+                    lambda system, x, ent: _gauss_newton_terms(*system, x, u, yw, ent), loss,
+                    lambda x, dx: x + dx, feedthrough, innovation, max_iterations, tol, progress)
 
 
 def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovation", feedthrough: bool | None = None,
@@ -513,35 +527,13 @@ def _records_loss(A, B, C, D, K, x0s, us, ys) -> float:
 
 def _lm_records(A, B, C, D, K, x0s, us, ys, feedthrough, innovation, max_iterations, tol,
                 progress: str | None = None):
-    """:func:`_levenberg_marquardt` over several records (shared A, B, C, D, K; one x0 each)."""
+    """:func:`_lm_loop` over several records (shared A, B, C, D, K; one x0 each)."""
     n = A.shape[0]
-    Vc = _records_loss(A, B, C, D, K, x0s, us, ys)
-    lam, it, converged = 1e-3, 0, False
-    for it in track(range(1, max_iterations + 1), total=max_iterations,
-                    description=progress or "", enabled=progress is not None):
-        dA, dB, dC, dD, dK, ent = _directions(A, B, C, D, K, feedthrough, innovation)
-        d = dA.shape[0]
-        _, H, g = _records_terms(A, B, C, D, K, x0s, us, ys, ent)
-        hd = np.maximum(np.diag(H), 1e-300)
-        improved, rel, drop = False, 0.0, 0.0
-        for _ in range(30):
-            moved, delta = _proposal(H, hd, g, lam, (dA, dB, dC, dD, dK), (A, B, C, D, K), innovation)
-            if moved is None:
-                lam *= 10
-                continue
-            An, Bn, Cn, Dn, Kn = moved
-            x0n = [x0 + delta[d + r * n:d + (r + 1) * n] for r, x0 in enumerate(x0s)]
-            Vn = _records_loss(An, Bn, Cn, Dn, Kn, x0n, us, ys)
-            if np.isfinite(Vn) and Vn < Vc:
-                improved, rel, drop = True, (Vc - Vn) / max(Vc, 1e-300), Vc - Vn
-                A, B, C, D, K, x0s, Vc = An, Bn, Cn, Dn, Kn, x0n, Vn
-                lam = max(lam / 5, 1e-12)
-                break
-            lam *= 10
-        if not improved or rel < tol or drop < _NEGLIGIBLE_DROP:
-            converged = True
-            break
-    return A, B, C, D, K, x0s, Vc, it, converged
+    return _lm_loop((A, B, C, D, K), x0s,
+                    lambda system, xs, ent: _records_terms(*system, xs, us, ys, ent),
+                    lambda system, xs: _records_loss(*system, xs, us, ys),
+                    lambda xs, dx: [x0 + dx[r * n:(r + 1) * n] for r, x0 in enumerate(xs)],
+                    feedthrough, innovation, max_iterations, tol, progress)[:9]
 
 
 def pem_records(model: LinearModel, records, *, form: str = "innovation",

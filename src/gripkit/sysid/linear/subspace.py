@@ -404,6 +404,16 @@ def warn_if_stabilised(model: LinearModel, stacklevel: int = 3) -> None:
        f"unstable estimate with gripkit.sysid.n4sid(u, y, stable=False)", StabilityWarning)
 
 
+def _orders(order, max_order) -> tuple:
+    """``(order, n_max)``: ``order`` None or checked a positive integer (as int), and the
+    largest order to consider (``order`` when given, else ``max_order``)."""
+    if order is not None:
+        if isinstance(order, bool) or not float(order).is_integer() or int(order) < 1:
+            raise DataError(f"order: expected a positive integer, found {order!r}")
+        order = int(order)
+    return order, order if order is not None else int(max_order)
+
+
 def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int | None = None,
           dt: float | None = None, feedthrough: bool = False, stable: bool = True,
           max_order: int = DEFAULT_MAX_ORDER, inputs=None, outputs=None, input_units=None, output_units=None,
@@ -454,11 +464,7 @@ def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int
     u = as_io_matrix(u, "input u")
     y = as_io_matrix(y, "output y", u.shape[0])
     step = check_dt(dt)
-    if order is not None:
-        if isinstance(order, bool) or not float(order).is_integer() or int(order) < 1:
-            raise DataError(f"order: expected a positive integer, found {order!r}")
-        order = int(order)
-    n_max = order if order is not None else int(max_order)
+    order, n_max = _orders(order, max_order)
     p = y.shape[1]
     k = default_horizon(n_max, p) if horizon is None else int(horizon)
     fac = subspace_factor(u, y, horizon=k, method=method)
@@ -615,11 +621,7 @@ def n4sid_records(records, order: int | None = None, *, method: str = "n4sid",
     recs = io_records(records)
     m, p = recs[0][0].shape[1], recs[0][1].shape[1]
     step = check_dt(dt)
-    if order is not None:
-        if isinstance(order, bool) or not float(order).is_integer() or int(order) < 1:
-            raise DataError(f"order: expected a positive integer, found {order!r}")
-        order = int(order)
-    n_max = order if order is not None else int(max_order)
+    order, n_max = _orders(order, max_order)
     k = default_horizon(n_max, p) if horizon is None else int(horizon)
     for i, (u, _) in enumerate(recs):
         if u.shape[0] < 2 * k:

@@ -220,7 +220,19 @@ def _fit_value(y, yhat) -> float:
     return 100.0 * (1.0 - float(np.linalg.norm(y - yhat)) / den)
 
 
-class _Problem:
+class _RunOutput:
+    """``yhat`` and ``jac``: the last run's ŷ and J, views of ``self.out`` (a ``K.HWOut``)."""
+
+    @property
+    def yhat(self) -> np.ndarray:
+        return self.out.yhat
+
+    @property
+    def jac(self) -> np.ndarray:
+        return self.out.jac
+
+
+class _Problem(_RunOutput):
     """One structure on one record: work arrays for the kernel, ŷ and J."""
 
     def __init__(self, u, fin: Nonlinearity, fout: Nonlinearity, nb, nf, nk):
@@ -246,14 +258,6 @@ class _Problem:
     def inner(self) -> np.ndarray:
         """The linear block's output of the last run on the record's samples."""
         return self.work.x[self.nk + self.nb + self.nf:]
-
-    @property
-    def yhat(self) -> np.ndarray:
-        return self.out.yhat
-
-    @property
-    def jac(self) -> np.ndarray:
-        return self.out.jac
 
     def split(self, th):
         ni, nb, nf, no = self.ni, self.nb, self.nf, self.no
@@ -281,7 +285,7 @@ class _Problem:
         return True
 
 
-class _Records:
+class _Records(_RunOutput):
     """One structure on several records (the interface of :class:`_Problem`): each record runs
     from its own steady state, ``the = [θ, w₋ of record 1, …, w₋ of record R]``; ŷ and J are the
     records' stacked (a record's rows are zero in the other records' w₋ columns)."""
@@ -299,14 +303,6 @@ class _Records:
     @property
     def inner(self) -> np.ndarray:
         return self._inner
-
-    @property
-    def yhat(self) -> np.ndarray:
-        return self.out.yhat
-
-    @property
-    def jac(self) -> np.ndarray:
-        return self.out.jac
 
     def split(self, th):
         return self.parts[0].split(th)
