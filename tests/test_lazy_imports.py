@@ -59,6 +59,10 @@ LAZY_MODULES = {
     ("estimation/state_functions.py", "..models.mass_spring_damper"): "as the line above",
     ("estimation/state_functions.py", "..models.piezo"): "as the line above",
     ("estimation/state_functions.py", "..sim.integrators"): "as the line above",
+    ("estimation/state_functions.py", "..sysid.nonlinear.hw_kernels"): "numba kernels of the "
+                                                                         "nonlinear families",
+    ("estimation/state_functions.py", "..sysid.nonlinear.hysteresis_kernels"): "as the line above",
+    ("estimation/state_functions.py", "..sysid.nonlinear.nlss_kernels"): "as the line above",
 }
 
 

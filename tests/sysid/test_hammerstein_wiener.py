@@ -15,7 +15,7 @@ from gripkit.errors import (AccuracyWarning, ArgumentError, DataError, ModelErro
 from gripkit.sysid import HWModel, hammerstein_wiener, load_hw, load_model
 
 HW = importlib.import_module("gripkit.sysid.nonlinear.hammerstein_wiener")
-K = importlib.import_module("gripkit.sysid.nonlinear._hw_kernels")
+K = importlib.import_module("gripkit.sysid.nonlinear.hw_kernels")
 
 #: linear blocks of the synthetic systems: poles 0.6 ± 0.37j and 0.45 ± 0.32j
 B1, F1 = [0.0, 0.5, 0.3], [1.0, -1.2, 0.5]

@@ -12,7 +12,7 @@ from gripkit.errors import ArgumentError, DataError, ModelError, PathError, Stab
 from gripkit.models.hysteresis import bouc_wen_advance, bouc_wen_response
 from gripkit.sysid import (BoucWenModel, BoucWenOscillatorModel, PrandtlIshlinskiiModel,
                            hysteresis, identify, load_hysteresis, load_model)
-from gripkit.sysid.nonlinear._hysteresis_kernels import bw_advance_rk4
+from gripkit.sysid.nonlinear.hysteresis_kernels import bw_advance_rk4
 from gripkit.sysid.nonlinear.hysteresis import pi_inverse
 
 N = 1500

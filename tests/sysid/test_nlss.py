@@ -13,7 +13,7 @@ from scipy.signal import lfilter
 from gripkit.errors import (AccuracyWarning, ArgumentError, DataError, ModelError,
                             StabilityWarning)
 from gripkit.sysid import load_model, nlss
-from gripkit.sysid.nonlinear import _nlss_kernels as K
+from gripkit.sysid.nonlinear import nlss_kernels as K
 from gripkit.sysid.nonlinear.nlss import NLSSModel, load_nlss, monomial_exponents
 
 FIXTURE = Path(__file__).resolve().parents[1] / "fixtures" / "dc_motor" / "dc_motor.csv"

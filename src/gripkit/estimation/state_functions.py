@@ -339,7 +339,7 @@ def _piezo(model, theta, dt, labels):
 
 
 def _hw(model):
-    from ..sysid.nonlinear._hw_kernels import nl_eval
+    from ..sysid.nonlinear.hw_kernels import nl_eval
 
     num, den = np.asarray(model.B, dtype=np.float64), np.asarray(model.F, dtype=np.float64)
     L = max(len(num), len(den))
@@ -394,7 +394,7 @@ def _hw(model):
 
 def _bw(model):
     from ..models.hysteresis import bouc_wen_advance
-    from ..sysid.nonlinear._hysteresis_kernels import bw_advance_rk4
+    from ..sysid.nonlinear.hysteresis_kernels import bw_advance_rk4
 
     d, lam, beta, gamma = float(model.d), float(model.lam), float(model.beta), float(model.gamma)
     nexp, offset, exact = float(model.n), float(model.offset), float(model.n) == 1.0
@@ -422,7 +422,7 @@ def _bw(model):
 
 
 def _bwo(model, dt):
-    from ..sysid.nonlinear._hysteresis_kernels import _bwo_rates
+    from ..sysid.nonlinear.hysteresis_kernels import bwo_rates
 
     if dt is not None and not np.isclose(dt, model.dt, rtol=1e-6):
         raise ModelError(f"state_functions: the Bouc-Wen oscillator is sampled every "
@@ -438,12 +438,12 @@ def _bwo(model, dt):
     def f(s, u):  # pragma: no cover - compiled
         x, v, z, uk = s[0], s[1], s[2], u[0]
         for _ in range(sub):
-            a1, b1, c1 = _bwo_rates(x, v, z, uk, m, c, ke, kh, beta, gamma, nexp)
-            a2, b2, c2 = _bwo_rates(x + 0.5 * hs * a1, v + 0.5 * hs * b1, z + 0.5 * hs * c1, uk,
+            a1, b1, c1 = bwo_rates(x, v, z, uk, m, c, ke, kh, beta, gamma, nexp)
+            a2, b2, c2 = bwo_rates(x + 0.5 * hs * a1, v + 0.5 * hs * b1, z + 0.5 * hs * c1, uk,
                                     m, c, ke, kh, beta, gamma, nexp)
-            a3, b3, c3 = _bwo_rates(x + 0.5 * hs * a2, v + 0.5 * hs * b2, z + 0.5 * hs * c2, uk,
+            a3, b3, c3 = bwo_rates(x + 0.5 * hs * a2, v + 0.5 * hs * b2, z + 0.5 * hs * c2, uk,
                                     m, c, ke, kh, beta, gamma, nexp)
-            a4, b4, c4 = _bwo_rates(x + hs * a3, v + hs * b3, z + hs * c3, uk,
+            a4, b4, c4 = bwo_rates(x + hs * a3, v + hs * b3, z + hs * c3, uk,
                                     m, c, ke, kh, beta, gamma, nexp)
             x += hs * (a1 + 2.0 * a2 + 2.0 * a3 + a4) / 6.0
             v += hs * (b1 + 2.0 * b2 + 2.0 * b3 + b4) / 6.0
@@ -516,7 +516,8 @@ def _narx(model):
 
 
 def _nlss(model):
-    from ..sysid.nonlinear._nlss_kernels import _monomials, _output, _state_update
+    from ..sysid.nonlinear.nlss_kernels import monomials as nlss_monomials
+    from ..sysid.nonlinear.nlss_kernels import output_row, state_update
 
     f64 = lambda M: np.ascontiguousarray(M, dtype=np.float64)  # noqa: E731
     A, B, C, D, E, F = (f64(M) for M in (model.A, model.B, model.C, model.D, model.E, model.F))
@@ -535,14 +536,14 @@ def _nlss(model):
         for j in range(m):
             ut[0, j] = (u[j] - u0[j]) / su[j]
         values = np.empty(ex.shape[0])
-        _monomials(ex, x, ut, 0, values)
+        nlss_monomials(ex, x, ut, 0, values)
         return ut, values
 
     @numba.njit
     def f(x, u):  # pragma: no cover - compiled
         ut, zeta = monomials(exz, x, u)
         out = np.empty(n)
-        _state_update(A, B, E, x, ut, 0, zeta, out)
+        state_update(A, B, E, x, ut, 0, zeta, out)
         return out
 
     @numba.njit
@@ -550,7 +551,7 @@ def _nlss(model):
         ut, eta = monomials(exe, x, u)
         out = np.empty(p)
         for i in range(p):
-            out[i] = _output(C, D, F, y0, x, ut, 0, eta, i)
+            out[i] = output_row(C, D, F, y0, x, ut, 0, eta, i)
         return out
 
     return f, h, np.zeros(n), n, [f"x{i + 1}" for i in range(n)]

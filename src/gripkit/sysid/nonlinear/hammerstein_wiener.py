@@ -90,7 +90,7 @@ from ...params import Parameter, ParameterSet
 from ...progress import track
 from ...signals.trajectory import Trajectory
 from ..model_protocol import ModelFit
-from . import _hw_kernels as K
+from . import hw_kernels as K
 
 __all__ = ["SCHEMA", "HW_FIT", "HWModel", "Nonlinearity", "hammerstein_wiener", "load_hw",
            "parse_nonlinearity"]

@@ -9,7 +9,7 @@ u the input (a voltage, a force), y the output (a displacement), h the hysteresi
 y), c the output offset. With n = 1 and λ = α d this is eq 3 of the seed, the model of the
 piezo reference system (:class:`gripkit.models.hysteresis.BoucWen`), and the free run uses its
 exact per-sample step (:func:`gripkit.models.hysteresis.bouc_wen_advance`); for n ≠ 1 it is
-integrated in the input by Runge-Kutta (:mod:`._hysteresis_kernels`). The model is rate
+integrated in the input by Runge-Kutta (:mod:`.hysteresis_kernels`). The model is rate
 independent: only the path of u matters, the sample time does not. The record is simulated from
 the virgin state, h = 0 at its first input sample. d, α, β, γ (and n with
 ``exponent='free'``, c with ``offset=True``) minimise ‖y − ŷ‖² of that free run
@@ -61,7 +61,7 @@ from ...params import Parameter, ParameterSet
 from ...progress import track
 from ...signals.trajectory import Trajectory
 from ..model_protocol import ModelFit
-from . import _hysteresis_kernels as K
+from . import hysteresis_kernels as K
 
 __all__ = ["SCHEMA", "HYSTERESIS_FIT", "MODELS", "FORMS", "BoucWenModel",
            "BoucWenOscillatorModel", "PrandtlIshlinskiiModel", "hysteresis", "load_hysteresis",

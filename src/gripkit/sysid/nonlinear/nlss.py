@@ -34,7 +34,7 @@ stage 3 again on all of them, at most 10 iterations (a polish: the optimum moves
 pass over the record costs N·P² for P parameters).
 
 Both stages are Levenberg-Marquardt on the exact Gauss-Newton sums of the sensitivity equations
-(numba kernels, :mod:`._nlss_kernels`; the initial states are eliminated by a Schur complement,
+(numba kernels, :mod:`.nlss_kernels`; the initial states are eliminated by a Schur complement,
 one n × n block per window). A step whose free run leaves the state range (1000 × the
 estimation states' largest magnitude) is rejected like a step that raises the criterion.
 
@@ -69,7 +69,7 @@ from ...atomic import write_text
 from ...errors import (AccuracyWarning, ArgumentError, DataError, IdentificationError,
                        ModelError, PathError, StabilityWarning, emit_warning)
 from ..model_protocol import ModelFit
-from . import _nlss_kernels as K
+from . import nlss_kernels as K
 from ...params import Parameter, ParameterSet
 from ...progress import status, track
 from ...signals.trajectory import Trajectory
@@ -464,7 +464,7 @@ def _apply(model: NLSSModel, dirs, delta) -> NLSSModel:
 
 
 def _arrays(model) -> K.NLSSArrays:
-    """The model's arrays as the kernels take them (a :data:`._nlss_kernels.NLSSArrays`)."""
+    """The model's arrays as the kernels take them (a :data:`.nlss_kernels.NLSSArrays`)."""
     return K.NLSSArrays(model.A, model.B, model.C, model.D, model.E, model.F, model.y_offset,
                         model.exz, model.exe)
 

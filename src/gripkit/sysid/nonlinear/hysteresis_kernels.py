@@ -169,7 +169,7 @@ def count_reversals(x, band):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _bwo_rates(x, v, z, u, m, c, ke, kh, beta, gamma, n):  # pragma: no cover - compiled
+def bwo_rates(x, v, z, u, m, c, ke, kh, beta, gamma, n):  # pragma: no cover - compiled
     """(ẋ, v̇, ż) of the Bouc-Wen oscillator (A = 1)."""
     a = abs(z) if n == 1.0 else abs(z) ** n
     zp = a if z >= 0.0 else -a  # z |z|^(n−1)
@@ -190,12 +190,12 @@ def bwo_simulate(u, dt, substeps, m, c, ke, kh, beta, gamma, n, offset, y):  # p
     for k in range(N - 1):
         uk = u[k]
         for _ in range(substeps):
-            a1, b1, c1 = _bwo_rates(x, v, z, uk, m, c, ke, kh, beta, gamma, n)
-            a2, b2, c2 = _bwo_rates(x + 0.5 * h * a1, v + 0.5 * h * b1, z + 0.5 * h * c1, uk,
+            a1, b1, c1 = bwo_rates(x, v, z, uk, m, c, ke, kh, beta, gamma, n)
+            a2, b2, c2 = bwo_rates(x + 0.5 * h * a1, v + 0.5 * h * b1, z + 0.5 * h * c1, uk,
                                     m, c, ke, kh, beta, gamma, n)
-            a3, b3, c3 = _bwo_rates(x + 0.5 * h * a2, v + 0.5 * h * b2, z + 0.5 * h * c2, uk,
+            a3, b3, c3 = bwo_rates(x + 0.5 * h * a2, v + 0.5 * h * b2, z + 0.5 * h * c2, uk,
                                     m, c, ke, kh, beta, gamma, n)
-            a4, b4, c4 = _bwo_rates(x + h * a3, v + h * b3, z + h * c3, uk,
+            a4, b4, c4 = bwo_rates(x + h * a3, v + h * b3, z + h * c3, uk,
                                     m, c, ke, kh, beta, gamma, n)
             x += h * (a1 + 2.0 * a2 + 2.0 * a3 + a4) / 6.0
             v += h * (b1 + 2.0 * b2 + 2.0 * b3 + b4) / 6.0

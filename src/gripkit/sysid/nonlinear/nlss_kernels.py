@@ -86,7 +86,7 @@ def _carry(Sn, S):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, inline="always")
-def _monomials(ex, x, u, t, out):  # pragma: no cover - compiled
+def monomials(ex, x, u, t, out):  # pragma: no cover - compiled
     """out[k] = Π_i v_i^ex[k, i] with v = [x; u[t]]."""
     n = x.shape[0]
     for k in range(ex.shape[0]):
@@ -118,7 +118,7 @@ def _monomial_jacobian(ex, x, u, t, out):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, inline="always")
-def _state_update(A, B, E, x, u, t, zeta, xn):  # pragma: no cover - compiled
+def state_update(A, B, E, x, u, t, zeta, xn):  # pragma: no cover - compiled
     """xn = A x + B u[t] + E ζ."""
     for r in range(A.shape[0]):
         acc = 0.0
@@ -132,7 +132,7 @@ def _state_update(A, B, E, x, u, t, zeta, xn):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, inline="always")
-def _output(C, D, F, y0, x, u, t, eta, i):  # pragma: no cover - compiled
+def output_row(C, D, F, y0, x, u, t, eta, i):  # pragma: no cover - compiled
     """ŷ_i = y₀_i + (C x + D u[t] + F η)_i."""
     acc = y0[i]
     for j in range(C.shape[1]):
@@ -151,7 +151,7 @@ def _output_rows(m, dirs, x, u, t, S, eta, Je, Gx, rows):  # pragma: no cover - 
     C, F = m.C, m.F
     n = x.shape[0]
     p = C.shape[0]
-    _monomials(m.exe, x, u, t, eta)
+    monomials(m.exe, x, u, t, eta)
     _monomial_jacobian(m.exe, x, u, t, Je)
     for i in range(p):  # Gx = C + F ∂η/∂x
         for c in range(n):
@@ -179,7 +179,7 @@ def _state_rows(m, dirs, x, u, t, S, zeta, Jz, Fx, Sn):  # pragma: no cover - co
     direct terms of A, B and E (directions ``dirs``)."""
     A, E = m.A, m.E
     n = x.shape[0]
-    _monomials(m.exz, x, u, t, zeta)
+    monomials(m.exz, x, u, t, zeta)
     _monomial_jacobian(m.exz, x, u, t, Jz)
     for r in range(n):  # Fx = A + E ∂ζ/∂x
         for c in range(n):
@@ -243,11 +243,11 @@ def simulate_kernel(m, x0, u, Y, X, limit):  # pragma: no cover - compiled
         if store:
             for r in range(n):
                 X[t, r] = x[r]
-        _monomials(exe, x, u, t, eta)
+        monomials(exe, x, u, t, eta)
         for i in range(Y.shape[1]):
-            Y[t, i] = _output(C, D, F, y0, x, u, t, eta, i)
-        _monomials(exz, x, u, t, zeta)
-        _state_update(A, B, E, x, u, t, zeta, xn)
+            Y[t, i] = output_row(C, D, F, y0, x, u, t, eta, i)
+        monomials(exz, x, u, t, zeta)
+        state_update(A, B, E, x, u, t, zeta, xn)
         for r in range(n):
             x[r] = xn[r]
     return -1
@@ -274,12 +274,12 @@ def window_loss(m, win, limit):  # pragma: no cover - compiled
             for r in range(n):
                 if not (abs(x[r]) <= limit):
                     return np.inf
-            _monomials(exe, x, u, t, eta)
+            monomials(exe, x, u, t, eta)
             for i in range(p):
-                e = w[i] * (y[t, i] - _output(C, D, F, y0, x, u, t, eta, i))
+                e = w[i] * (y[t, i] - output_row(C, D, F, y0, x, u, t, eta, i))
                 V += e * e
-            _monomials(exz, x, u, t, zeta)
-            _state_update(A, B, E, x, u, t, zeta, xn)
+            monomials(exz, x, u, t, zeta)
+            state_update(A, B, E, x, u, t, zeta, xn)
             for r in range(n):
                 x[r] = xn[r]
     return V
@@ -333,7 +333,7 @@ def window_gram(m, dirs, win, limit, out):  # pragma: no cover - compiled
             _output_rows(m, dirs, x, u, t, S, eta, Je, Gx, rows)
             for i in range(p):
                 wi = w[i]
-                e = wi * (y[t, i] - _output(C, D, F, y0, x, u, t, eta, i))
+                e = wi * (y[t, i] - output_row(C, D, F, y0, x, u, t, eta, i))
                 V += e * e
                 ri = rows[i]
                 for q in range(Q):
@@ -345,7 +345,7 @@ def window_gram(m, dirs, win, limit, out):  # pragma: no cover - compiled
                     fill = 0
             _state_rows(m, dirs, x, u, t, S, zeta, Jz, Fx, Sn)
             _carry(Sn, S)
-            _state_update(A, B, E, x, u, t, zeta, xn)
+            state_update(A, B, E, x, u, t, zeta, xn)
             for r in range(n):
                 x[r] = xn[r]
         if fill:
@@ -395,6 +395,6 @@ def output_variance(m, dirs, x0, u, L, out):  # pragma: no cover - compiled
             out[t, i] = acc
         _state_rows(m, dirs, x, u, t, S, zeta, Jz, Fx, Sn)
         _carry(Sn, S)
-        _state_update(A, B, E, x, u, t, zeta, xn)
+        state_update(A, B, E, x, u, t, zeta, xn)
         for r in range(n):
             x[r] = xn[r]
