@@ -35,7 +35,8 @@ def main():
     warnings.simplefilter("ignore", ConsistencyWarning)
     f = finger(check=False)
     t = np.arange(10_000) * 1e-3
-    u = np.column_stack([2500 * np.sin(2 * math.pi * 3 * t), -3000 * np.sin(2 * math.pi * 2 * t + 0.4),
+    u = np.column_stack([2500 * np.sin(2 * math.pi * 3 * t),
+                         -3000 * np.sin(2 * math.pi * 2 * t + 0.4),
                          2000 * np.sin(2 * math.pi * t)])
     x0 = f.state(q=(10 * math.pi / 180, 20 * math.pi / 180, 80 * math.pi / 180))
     f.simulate(u[:100], dt=1e-3, x0=x0)

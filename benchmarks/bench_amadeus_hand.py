@@ -63,9 +63,11 @@ def run(quick: bool = False) -> list[dict]:
     c = StickSlipContact(check=False)
     T = 60.0 if quick else 600.0
     u = nonslip_grasp_inputs(T, dt=1 / fs, rng=rng)
-    u[int(0.5 * u.shape[0]):, 1] += np.linspace(0, 2.0, u.shape[0] - int(0.5 * u.shape[0]))  # ends in slip
+    # ends in slip
+    u[int(0.5 * u.shape[0]):, 1] += np.linspace(0, 2.0, u.shape[0] - int(0.5 * u.shape[0]))
     t_sim = measure(lambda: c.simulate(u, dt=1 / fs, x0=c.equilibrium_state(u[0, 1])))
-    x = c.simulate(u, dt=1 / fs, x0=c.equilibrium_state(u[0, 1]))["v_pvdf"] + pvdf_noise(u.shape[0], dt=1 / fs, rng=rng)
+    x = (c.simulate(u, dt=1 / fs, x0=c.equilibrium_state(u[0, 1]))["v_pvdf"]
+         + pvdf_noise(u.shape[0], dt=1 / fs, rng=rng))
     det = SlipDetector(dt=1 / fs).calibrate(x[: int(20 * fs)])
     onsets_g = [int(round(e.alarm * fs)) for e in det.detect(x).events]
     onsets_p = list(_slip_scipy(x, det))
@@ -75,7 +77,8 @@ def run(quick: bool = False) -> list[dict]:
     rows.append(row("amadeus_hand", f"slip detection, {T:.0f} s PVDF record at 2 kHz", tg,
                     "scipy.signal sosfilt+lfilter+numpy runs", tp,
                     notes="same first alarm; the peer has no release hysteresis or event features"))
-    rows.append(row("amadeus_hand", f"stick-slip contact + PVDF film, {T:.0f} s (20 kHz internal)", t_sim,
+    rows.append(row("amadeus_hand", f"stick-slip contact + PVDF film, {T:.0f} s "
+                                    "(20 kHz internal)", t_sim,
                     "none (solve_ivp cannot switch stick/slip at this rate)", None))
 
     s = StrainGaugeSensor()
@@ -92,7 +95,8 @@ def run(quick: bool = False) -> list[dict]:
     got = ForceKalmanFilter(s, dyn, x0=np.zeros(3), P0=np.eye(3) * 0.01).run(Z[:Nk]).force
     assert np.allclose(got, ref, rtol=1e-7, atol=1e-9)
     tg = measure(kf)
-    tp = measure(lambda: _kf_numpy(s.H, s.sigma_n2, s.noise_floor ** 2, Z[:Nk], 5.0, 0.005)) * N / Nk
+    tp = (measure(lambda: _kf_numpy(s.H, s.sigma_n2, s.noise_floor ** 2, Z[:Nk], 5.0,
+                                    0.005)) * N / Nk)
     rows.append(row("amadeus_hand", f"Kalman filter, 6 bridges, {N} samples", tg,
                     "numpy joint update, per sample in Python", tp, pure_python_peer=True,
                     notes=f"peer timed on {Nk} samples and scaled"))
@@ -106,7 +110,8 @@ def run(quick: bool = False) -> list[dict]:
         return out
 
     Nw = min(N, 10_000)
-    np.testing.assert_allclose(estimate_force(Z[:Nw], s, iterations=1).force, wls_loop(Z[:Nw]), rtol=1e-9, atol=1e-12)
+    np.testing.assert_allclose(estimate_force(Z[:Nw], s, iterations=1).force, wls_loop(Z[:Nw]),
+                               rtol=1e-9, atol=1e-12)
     tg = measure(lambda: estimate_force(Z, s, iterations=1))
     tp = measure(lambda: wls_loop(Z[:Nw])) * N / Nw
     rows.append(row("amadeus_hand", f"per-sample WLS force, {N} samples", tg,

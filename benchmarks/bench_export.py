@@ -152,7 +152,8 @@ def model_rows(quick: bool) -> list[dict]:
         (d / "harness.c").write_text(_HARNESS)
         exe = d / "bench"
         cc = subprocess.run([gcc, "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-o", str(exe),
-                             str(d / "harness.c"), str(d / "bench.c"), "-lm"], capture_output=True, text=True)
+                             str(d / "harness.c"), str(d / "bench.c"), "-lm"], capture_output=True,
+                             text=True)
         if cc.returncode:
             raise RuntimeError(cc.stderr)
         res = subprocess.run([str(exe), str(steps), str(BLOCK), str(d / "y.csv")], check=True,

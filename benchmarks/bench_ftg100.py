@@ -32,7 +32,8 @@ def _scipy_grasp(duration: float, gap: float, noise: bool = True, seed: int = 0)
     def rhs(t, s, V, contact):
         xa, va, xb, vb = s
         fc = p["k0"] * (p["D_a"] * xa - p["D_b"] * xb - p["gap"]) if contact else 0.0
-        return [va, (p["c_e"] * V * V - p["K_fa"] * va - p["K_sa"] * xa - p["K3_a"] * xa ** 3 - p["D_a"] * fc) / p["M_a"],
+        return [va, (p["c_e"] * V * V - p["K_fa"] * va - p["K_sa"] * xa - p["K3_a"] * xa ** 3
+                     - p["D_a"] * fc) / p["M_a"],
                 vb, (p["D_b"] * fc - p["K_fb"] * vb - p["K_sb"] * xb) / p["M_b"]]
 
     def event(contact):
@@ -44,7 +45,8 @@ def _scipy_grasp(duration: float, gap: float, noise: bool = True, seed: int = 0)
     s, F = np.zeros(4), []
     for k in range(int(round(duration / ts))):
         xa, xb = p["D_a"] * s[0], p["D_b"] * s[2]
-        V = ctl.step(xa + sx * rng.standard_normal(), p["K_sb"] / p["D_b"] ** 2 * xb + sf * rng.standard_normal(), 20e-6)
+        V = (ctl.step(xa + sx * rng.standard_normal(),
+                      p["K_sb"] / p["D_b"] ** 2 * xb + sf * rng.standard_normal(), 20e-6))
         V = min(max(V, 0.0), p["V_max"])
         t, t1 = k * ts, (k + 1) * ts
         while t < t1:
@@ -52,7 +54,8 @@ def _scipy_grasp(duration: float, gap: float, noise: bool = True, seed: int = 0)
             # event located on the wrong side of the surface would otherwise be missed)
             d = p["D_a"] * s[0] - p["D_b"] * s[2] - p["gap"]
             contact = d > 1e-15 or (abs(d) <= 1e-15 and p["D_a"] * s[1] - p["D_b"] * s[3] > 0.0)
-            sol = solve_ivp(rhs, (t, t1), s, args=(V, contact), events=event(contact), rtol=1e-9, atol=1e-18,
+            sol = solve_ivp(rhs, (t, t1), s, args=(V, contact), events=event(contact), rtol=1e-9,
+                            atol=1e-18,
                             max_step=ts / 20)
             s, t = sol.y[:, -1], sol.t[-1]
         F.append(p["k0"] * max(p["D_a"] * s[0] - p["D_b"] * s[2] - p["gap"], 0.0))
@@ -72,12 +75,16 @@ def run(quick: bool) -> list[dict]:
     p = measure(lambda: _scipy_grasp(dur, 5e-6))
     # without noise both must give the same contact force (gripkit records F_c at the start of a
     # sample, the scipy loop after it: shift by one)
-    a = simulate_hybrid_grasp(gap=5e-6, duration=dur, noise_force=0.0, noise_position=0.0).trajectory["F_c"][1:]
+    a = (simulate_hybrid_grasp(gap=5e-6, duration=dur, noise_force=0.0,
+                               noise_position=0.0).trajectory["F_c"][1:])
     b = _scipy_grasp(dur, 5e-6, noise=False)[:-1]
     err = float(np.max(np.abs(a - b)) / 20e-6)
-    rows.append(row("ftg100", f"closed-loop grasp, {dur * 1e3:.0f} ms at 20 kHz (plant with contact events + hybrid controller)",
-                    g, "scipy solve_ivp RK45 + events, once per sample in a Python loop", p, pure_python_peer=True,
-                    notes=f"same controller, no noise: contact force agrees within {100 * err:.2g} % of the command at every sample"))
+    rows.append(row("ftg100", f"closed-loop grasp, {dur * 1e3:.0f} ms at 20 kHz (plant with "
+                              "contact events + hybrid controller)",
+                    g, "scipy solve_ivp RK45 + events, once per sample "
+                       "in a Python loop", p, pure_python_peer=True,
+                    notes=f"same controller, no noise: contact force agrees within {100 * err:.2g} "
+                          "% of the command at every sample"))
     # 2. LM identification of M_a, K_fa, k0 (+ sensor zero)
     data = step_experiment(duration=1.0 if quick else 2.0, period=0.05, seed=1)
     identify_actuated(data)
@@ -88,7 +95,8 @@ def run(quick: bool) -> list[dict]:
     rel = max(abs(ours.value(n) / theirs[i] - 1) for i, n in enumerate(("M_a", "K_fa", "k0")))
     rows.append(row("ftg100", f"LM identification of M_a, K_fa, k0 ({data.n} samples, §III-B)", g,
                     "scipy least_squares(lm) + signal.dlsim", p, pure_python_peer=True,
-                    notes=f"same start (step fit), estimates agree to {rel:.1e}; gripkit adds σ/covariance"))
+                    notes=f"same start (step fit), estimates agree to {rel:.1e}; gripkit "
+                          "adds σ/covariance"))
     return rows
 
 

@@ -33,7 +33,8 @@ NARX rows (:func:`narx_rows`; alone: ``python benchmarks/bench_measured.py narx 
 
 * speed: the same 20-term cubic NARX (lags 2, FROLS, least squares) on 41 000 synthetic samples
   (Billings' example ``y(t) = −0.605 y(t−1) − 0.163 y(t−2)² + 0.588 u(t−1) − 0.240 u(t−2)
-  + e``, σ_e = 0.05), validated on 5000 more: gripkit ``narx(terms=20, prune=False)`` beside sysidentpy
+  + e``, σ_e = 0.05), validated on 5000 more: gripkit ``narx(terms=20, prune=False)`` beside
+  sysidentpy
   ``FROLS(n_terms=20, order_selection=False)``;
 * the nonlinear benchmarks Silverbox and cascaded tanks (tests/fixtures, their READMEs): gripkit's
   cubic NARX (lags 2, BIC, θ refined on the simulation error) beside sysidentpy's FROLS on the
@@ -134,7 +135,8 @@ def run(quick: bool) -> list[dict]:
         return tuple(np.asarray(a) for a in (sm.A, sm.B, sm.C, sm.D))
     sippy_call = _quiet(sippy_call)
     rows.append(row("measured", task, t_ours, "sippy_unipi N4SID", measure(sippy_call),
-                    gripkit_accuracy=_fit_text(fit_ours), peer_accuracy=_fit_text(_ss_fit(*sippy_call(), uv, yv)),
+                    gripkit_accuracy=_fit_text(fit_ours),
+                    peer_accuracy=_fit_text(_ss_fit(*sippy_call(), uv, yv)),
                     notes="same order and horizon; free run, x0 estimated"))
 
     import pandas as pd
@@ -148,33 +150,42 @@ def run(quick: bool) -> list[dict]:
         ss, _ = nf.system_identification(rank=ORDER)
         return ss.a, ss.b, ss.c, ss.d
     rows.append(row("measured", task, t_ours, "nfoursid", measure(nfoursid_call),
-                    gripkit_accuracy=_fit_text(fit_ours), peer_accuracy=_fit_text(_ss_fit(*nfoursid_call(), uv, yv)),
+                    gripkit_accuracy=_fit_text(fit_ours),
+                    peer_accuracy=_fit_text(_ss_fit(*nfoursid_call(), uv, yv)),
                     notes="same order and block rows; free run, x0 estimated"))
 
     refined = lambda: pem(ours(), u=u0, y=y0, form="oe")  # noqa: E731
     t_refined = measure(refined)
     s = refined().system
     fit_refined = _ss_fit(s.A, s.B, s.C, s.D, uv, yv)
-    rows.append(row("measured", f"n4sid + PEM (output error), order {ORDER}, {DATA}", t_refined, "", None,
-                    gripkit_accuracy=_fit_text(fit_refined), notes="the subspace model refined; free run, x0 estimated"))
+    rows.append(row("measured", "n4sid + PEM (output error), order "
+                                f"{ORDER}, {DATA}", t_refined, "", None,
+                    gripkit_accuracy=_fit_text(fit_refined), notes="the subspace model refined; "
+                                                                   "free run, x0 estimated"))
 
     ours_arx = lambda: arx(u0, y0, LAGS, LAGS, 1, dt=1.0)  # noqa: E731
     fit_arx = _ss_fit(*_abcd(ours_arx()), uv, yv)
     linear = _sysidentpy(1, LAGS, False, ue, ye)
     m = linear()
-    rows.append(row("measured", f"linear ARX, lags {LAGS}, {DATA}", measure(ours_arx), "sysidentpy FROLS degree 1",
+    rows.append(row("measured", f"linear ARX, lags {LAGS}, {DATA}", measure(ours_arx),
+                    "sysidentpy FROLS degree 1",
                     measure(linear), gripkit_accuracy=_fit_text(fit_arx),
                     peer_accuracy=_fit_text(_fit(yv, m.predict(X=uv[:, None], y=yv[:, None]))),
-                    notes=f"same model class; sysidentpy keeps {m.final_model.shape[0]} of its {2 * LAGS} terms (BIC); "
-                          "gripkit: x0 estimated, sysidentpy: its predict from the first measured lags"))
+                    notes=f"same model class; sysidentpy keeps {m.final_model.shape[0]} of its "
+                          f"{2 * LAGS} terms (BIC); "
+                          "gripkit: x0 estimated, sysidentpy: its predict from the "
+                          "first measured lags"))
 
     narx = _sysidentpy(2, 5, True, ue, ye)
     m = narx()
     rows.append(row("measured", f"best model of each tool, {DATA}", t_refined,
                     "sysidentpy FROLS degree-2 NARX (its own example)", measure(narx),
                     gripkit_accuracy=_fit_text(fit_refined) + " (linear, n4sid + PEM)",
-                    peer_accuracy=_fit_text(_fit(yv, m.predict(X=uv[:, None], y=yv[:, None]))) + " (nonlinear)",
-                    notes="different model classes: the motor speeds up and coasts down with different time "
+                    peer_accuracy=_fit_text(_fit(yv,
+                                                 m.predict(X=uv[:, None],
+                                                               y=yv[:, None]))) + " (nonlinear)",
+                    notes="different model classes: the motor speeds up and coasts down with "
+                          "different time "
                           "constants, which a polynomial NARX captures and a linear model cannot"))
     rows.append(_narx_row(ue, ye, uv, yv))
     rows.extend(narx_rows())
@@ -199,7 +210,8 @@ def _narx_row(ue, ye, uv, yv) -> dict:
                peer_accuracy=_fit_text(_fit(yv, m.predict(X=uv[:, None], y=yv[:, None])))
                + f" ({m.final_model.shape[0]} terms)",
                notes="same model class; gripkit: FROLS + BIC + pruning of |θ|/σ < 2, fit over the "
-                     "samples after the first max_lag; sysidentpy: its predict, fit over every sample")
+                     "samples after the first max_lag; sysidentpy: its predict, fit "
+                     "over every sample")
 
 
 # ------------------------------------------------------------------------------ NARX rows

@@ -43,8 +43,10 @@ def _python_finger_step(pin, model, data, f, ch, x, pwm, h):
     M = G.T @ pin.crba(model, data, q) @ G
     M = np.triu(M) + np.triu(M, 1).T + np.diag(arm)
     h_p = G.T @ pin.nonLinearEffects(model, data, q, qd)
-    tau = np.array([float(f.motor_torque(a, pwm[k], pd[k])) for k, a in enumerate(("base1", "base2", "distal"))])
-    fr = np.array([float(f.kinetic_friction(a, pd[k])) for k, a in enumerate(("base1", "base2", "distal"))])
+    tau = (np.array([float(f.motor_torque(a, pwm[k], pd[k]))
+                     for k, a in enumerate(("base1", "base2", "distal"))]))
+    fr = (np.array([float(f.kinetic_friction(a, pd[k])) for k, a in enumerate(("base1", "base2",
+                                                                               "distal"))]))
     acc = np.linalg.solve(M, tau - h_p - fr)
     x[3:6] = pd + h * acc
     x[:3] = p + h * x[3:6]
@@ -72,13 +74,17 @@ def run(quick: bool = False) -> list[dict]:
 
     t_pin = measure(pin_loop) / n_pin
     np.testing.assert_allclose(ch.rnea(p[:5], pd[:5], pdd[:5]),
-                               [G.T @ pin.rnea(model, data, q[i], qd[i], qdd[i]) + arm * pdd[i] for i in range(5)],
+                               [G.T @ pin.rnea(model, data, q[i], qd[i],
+                                               qdd[i]) + arm * pdd[i] for i in range(5)],
                                atol=1e-10)
-    rows.append(row("multibody", "RNEA, coupled 3-actuator finger, per state (batch, 1 thread)", t_gk,
+    rows.append(row("multibody", "RNEA, coupled 3-actuator finger, per state "
+                                 "(batch, 1 thread)", t_gk,
                     "pin.rnea, one call per state in a Python loop", t_pin, target="ratio >= 1",
-                    notes=f"batch of {B}; gripkit includes the coupling Γ, Pinocchio's time does not"))
+                    notes=f"batch of {B}; gripkit includes the coupling Γ, "
+                          "Pinocchio's time does not"))
     rows.append(row("multibody", "RNEA, coupled finger, per state (batch, all cores)", t_gk_par,
-                    "pin.rnea in a Python loop", t_pin, target="ratio >= 1", notes=f"batch of {B}, prange"))
+                    "pin.rnea in a Python loop", t_pin, target="ratio >= 1",
+                    notes=f"batch of {B}, prange"))
 
     t_gk_m = measure(lambda: ch.mass_matrix(p)) / B
 
@@ -88,14 +94,16 @@ def run(quick: bool = False) -> list[dict]:
 
     t_pin_m = measure(pin_crba) / n_pin
     rows.append(row("multibody", "mass matrix (CRBA), coupled finger, per state", t_gk_m,
-                    "pin.crba in a Python loop", t_pin_m, target="ratio >= 1", notes=f"batch of {B}"))
+                    "pin.crba in a Python loop", t_pin_m, target="ratio >= 1",
+                    notes=f"batch of {B}"))
 
     # one state per public call, as a controller calls it each step, against single pin calls
     n_one = 2_000
     p1, pd1, pdd1 = ([np.ascontiguousarray(a[i]) for i in range(n_one)] for a in (p, pd, pdd))
     q1, qd1, qdd1 = ([np.ascontiguousarray(a[i]) for i in range(n_one)] for a in (q, qd, qdd))
     rnea_err = max(float(np.max(np.abs(ch.rnea(p1[i], pd1[i], pdd1[i])
-                                       - (G.T @ pin.rnea(model, data, q1[i], qd1[i], qdd1[i]) + arm * pdd1[i]))))
+                                       - (G.T @ pin.rnea(model, data, q1[i], qd1[i],
+                                                         qdd1[i]) + arm * pdd1[i]))))
                    for i in range(20))
 
     def gk_one():
@@ -106,11 +114,14 @@ def run(quick: bool = False) -> list[dict]:
         for i in range(n_one):
             pin.rnea(model, data, q1[i], qd1[i], qdd1[i])
 
-    rows.append(row("multibody", "RNEA, one state per public call (a controller step)", measure(gk_one) / n_one,
-                    "pin.rnea, one call per state", measure(pin_one) / n_one, target="ratio ≥ 0.67 (≤ 1.5×)",
+    rows.append(row("multibody", "RNEA, one state per public call (a "
+                                 "controller step)", measure(gk_one) / n_one,
+                    "pin.rnea, one call per state", measure(pin_one) / n_one,
+                    target="ratio ≥ 0.67 (≤ 1.5×)",
                     gripkit_accuracy=f"max |τ − (Γᵀ τ_pin + arm·p̈)| = "
                                      f"{rnea_err:.1e} N·m",
-                    notes="both called from a Python loop; gripkit checks its inputs on every call and includes Γ"))
+                    notes="both called from a Python loop; gripkit checks its inputs on every "
+                          "call and includes Γ"))
 
     def gk_one_m():
         for i in range(n_one):
@@ -120,9 +131,12 @@ def run(quick: bool = False) -> list[dict]:
         for i in range(n_one):
             pin.crba(model, data, q1[i])
 
-    rows.append(row("multibody", "mass matrix (CRBA), one state per public call", measure(gk_one_m) / n_one,
-                    "pin.crba, one call per state", measure(pin_one_m) / n_one, target="ratio ≥ 0.67 (≤ 1.5×)",
-                    notes="both called from a Python loop; gripkit projects through Γ (3×3), Pinocchio returns 4×4"))
+    rows.append(row("multibody", "mass matrix (CRBA), one state "
+                                 "per public call", measure(gk_one_m) / n_one,
+                    "pin.crba, one call per state", measure(pin_one_m) / n_one,
+                    target="ratio ≥ 0.67 (≤ 1.5×)",
+                    notes="both called from a Python loop; gripkit projects through Γ (3×3), "
+                          "Pinocchio returns 4×4"))
 
     # the same with the caller's workspace, as Pinocchio writes into its preallocated `data`
     tau_ws, M_ws = np.empty(3), np.empty((3, 3))
@@ -145,12 +159,14 @@ def run(quick: bool = False) -> list[dict]:
     rows.append(row("multibody", "mass matrix (CRBA), one state per public call, out= workspace",
                     measure(gk_one_m_out) / n_one, "pin.crba, one call per state (into its data)",
                     measure(pin_one_m) / n_one, target="ratio ≥ 0.67 (≤ 1.5×)",
-                    notes="mass_matrix(q, out=M): no allocation per call; gripkit projects through Γ (3×3)"))
+                    notes="mass_matrix(q, out=M): no allocation per call; gripkit projects "
+                          "through Γ (3×3)"))
 
     T = 2.0 if quick else 10.0
     N = int(T * 1000)
     t = np.arange(N) * 1e-3
-    u = np.column_stack([2500 * np.sign(np.sin(2 * np.pi * 0.3 * t)), -2500 * np.sign(np.sin(2 * np.pi * 0.35 * t)),
+    u = np.column_stack([2500 * np.sign(np.sin(2 * np.pi * 0.3 * t)),
+                         -2500 * np.sign(np.sin(2 * np.pi * 0.35 * t)),
                          3000 * np.sign(np.sin(2 * np.pi * 0.5 * t))])
     x0 = f.state(q=(0.0, 20 * math.pi / 180, 20 * math.pi / 180))
     th = f.theta()[None]
@@ -167,9 +183,12 @@ def run(quick: bool = False) -> list[dict]:
 
     t_py = measure(py_sim) * (1000 / n_py)
     rows.append(row("multibody", "complete finger at 1 kHz, per simulated second (kernel)", t_sim,
-                    "Python loop around pin.aba-equivalent step", t_py, target="≥ 1000× real time (≤ 1 ms)",
+                    "Python loop around "
+                    "pin.aba-equivalent step", t_py, target="≥ 1000× real time (≤ 1 ms)",
                     pure_python_peer=True,
-                    notes=f"{1.0 / t_sim:.0f}× real time; with the simulate() wrapper (Trajectory, checks): "
+                    notes=f"{1.0 / t_sim:.0f}× real time; with the simulate() wrapper "
+                          "(Trajectory, checks): "
                           f"{1.0 / t_wrap:.0f}×",
-                    extra=dict(real_time_factor=1.0 / t_sim, real_time_factor_wrapper=1.0 / t_wrap)))
+                    extra=dict(real_time_factor=1.0 / t_sim,
+                               real_time_factor_wrapper=1.0 / t_wrap)))
     return rows

@@ -26,7 +26,8 @@ TARGET = "FTZ/DAZ set ≈ cleared (ratio 0.9–1.1)"
 
 @numba.njit(cache=True)
 def _bdx_unflushed(A, C, u, y, G, r):  # pragma: no cover - compiled
-    """The B/x0 normal equations of gripkit.sysid.linear.subspace._bdx_normal_equations (no D) as they
+    """The B/x0 normal equations of gripkit.sysid.linear.subspace._bdx_normal_equations (no D) as
+    they
     were before the flush: the carried state copied as is."""
     N, m = u.shape
     n, p = A.shape[0], C.shape[0]

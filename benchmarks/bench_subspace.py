@@ -15,7 +15,8 @@ Fairness notes (also in each row):
   ``subspace_identification()``, ``system_identification(rank=8)`` (its documented use; a pandas
   DataFrame is its input format, built outside the timing). Its ``system_identification`` takes a
   full SVD (``np.linalg.svd``, ``full_matrices=True``) of a p·k × (N − k + 1) matrix, whose
-  right factor alone is (N − k + 1)² float64: 74.5 GiB at N = 10⁵. It is called at N = 10⁵ only when that fits in
+  right factor alone is (N − k + 1)² float64: 74.5 GiB at N = 10⁵. It is called at N = 10⁵ only
+  when that fits in
   half the available memory (else the row says so, with the figures); a second pair of rows
   compares gripkit and nfoursid at N = 10⁴ (0.75 GiB), where nfoursid runs.
 * Both sides of every row go through ``common.measure`` (same warm-up call and number of runs,
@@ -48,12 +49,14 @@ def _system():
     from gripkit.lti import StateSpace
 
     rng = np.random.default_rng(2)
-    poles = [0.95 * np.exp(1j * 0.1), 0.9 * np.exp(1j * 0.4), 0.8 * np.exp(1j * 0.9), 0.7 * np.exp(1j * 1.8)]
+    poles = ([0.95 * np.exp(1j * 0.1), 0.9 * np.exp(1j * 0.4), 0.8 * np.exp(1j * 0.9),
+              0.7 * np.exp(1j * 1.8)])
     A = np.zeros((8, 8))
     for i, z in enumerate(poles):
         A[2 * i:2 * i + 2, 2 * i:2 * i + 2] = [[z.real, z.imag], [-z.imag, z.real]]
     T = rng.standard_normal((8, 8))
-    return StateSpace(T @ A @ np.linalg.inv(T), rng.standard_normal((8, 2)), rng.standard_normal((2, 8)), dt=1.0)
+    return (StateSpace(T @ A @ np.linalg.inv(T), rng.standard_normal((8, 2)),
+                       rng.standard_normal((2, 8)), dt=1.0))
 
 
 def _record(g, n, seed):
@@ -94,7 +97,8 @@ def _nfoursid(u, y):
     df = pd.DataFrame(np.hstack([u, y]), columns=["u0", "u1", "y0", "y1"])
 
     def call():
-        nf = NFourSID(df, output_columns=["y0", "y1"], input_columns=["u0", "u1"], num_block_rows=HORIZON)
+        nf = (NFourSID(df, output_columns=["y0", "y1"], input_columns=["u0", "u1"],
+                       num_block_rows=HORIZON))
         nf.subspace_identification()
         ss, _ = nf.system_identification(rank=ORDER)
         return ss.a, ss.b, ss.c, ss.d
@@ -127,20 +131,28 @@ def _nfoursid_rows(g, uv, yv, u, y, ours, model) -> list[dict]:
     if need <= 0.5 * avail:  # pragma: no cover - needs ~150 GiB of free memory
         t = measure(_nfoursid(u, y))
         fit = _val_fit(*_nfoursid(u, y)(), uv, yv)
-        rows.append(row("subspace", task, ours, "nfoursid", t, target=TARGET, gripkit_accuracy=_fit_text(g_fit),
-                        peer_accuracy=_fit_text(fit), notes="same order and horizon; free run, x0 estimated"))
+        rows.append(row("subspace", task, ours, "nfoursid", t, target=TARGET,
+                        gripkit_accuracy=_fit_text(g_fit),
+                        peer_accuracy=_fit_text(fit), notes="same order and horizon; free "
+                                                            "run, x0 estimated"))
     else:
-        rows.append(row("subspace", task, ours, "nfoursid", None, target=TARGET, gripkit_accuracy=_fit_text(g_fit),
-                        notes=f"nfoursid not run at N=1e5: its system_identification takes a full SVD "
-                              f"(np.linalg.svd, full_matrices=True) whose right factor needs {need / 2**30:.1f} GiB; "
-                              f"{avail / 2**30:.1f} GiB available (MemoryError). See the N=1e4 row."))
+        rows.append(row("subspace", task, ours, "nfoursid", None, target=TARGET,
+                        gripkit_accuracy=_fit_text(g_fit),
+                        notes="nfoursid not run at N=1e5: its system_identification "
+                              "takes a full SVD "
+                              "(np.linalg.svd, full_matrices=True) whose right factor needs "
+                              f"{need / 2**30:.1f} GiB; "
+                              f"{avail / 2**30:.1f} GiB available (MemoryError). "
+                              "See the N=1e4 row."))
     us, ys = _record(g, N_SMALL, 1)
     t_g = measure(_gripkit_n4sid(us, ys))
     t_p = measure(_nfoursid(us, ys))
-    rows.append(row("subspace", "n4sid 2×2, N=1e4, order 8 (median)", t_g, "nfoursid", t_p, target=TARGET,
+    rows.append(row("subspace", "n4sid 2×2, N=1e4, "
+                                "order 8 (median)", t_g, "nfoursid", t_p, target=TARGET,
                     gripkit_accuracy=_fit_text(_val_fit(*_abcd(_gripkit_n4sid(us, ys)()), uv, yv)),
                     peer_accuracy=_fit_text(_val_fit(*_nfoursid(us, ys)(), uv, yv)),
-                    notes="same order and horizon; free run on the N=2e4 validation record, x0 estimated; "
+                    notes="same order and horizon; free run on the N=2e4 validation "
+                          "record, x0 estimated; "
                           "nfoursid's time is mostly its N×N SVD factor (0.75 GiB)"))
     return rows
 
@@ -166,17 +178,20 @@ def run(quick: bool) -> list[dict]:
         g_fit = _val_fit(*_abcd(model), uv, yv)
         task = f"{method} 2×2, N=1e5, order 8 (median)"
         if sippy is None:  # pragma: no cover
-            rows.append(row("subspace", task, t, f"sippy_unipi {sip}", None, notes="sippy_unipi not installed"))
+            rows.append(row("subspace", task, t, f"sippy_unipi {sip}", None,
+                            notes="sippy_unipi not installed"))
             continue
 
         def call():
             with contextlib.redirect_stdout(io.StringIO()), warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                sm = sippy.system_identification(y.T, u.T, sip, SS_fixed_order=ORDER, SS_f=HORIZON, SS_p=HORIZON)
+                sm = (sippy.system_identification(y.T, u.T, sip, SS_fixed_order=ORDER, SS_f=HORIZON,
+                                                  SS_p=HORIZON))
             return np.asarray(sm.A), np.asarray(sm.B), np.asarray(sm.C), np.asarray(sm.D)
         t_p = measure(call)
         rows.append(row("subspace", task, t, f"sippy_unipi {sip}", t_p, target=TARGET,
-                        gripkit_accuracy=_fit_text(g_fit), peer_accuracy=_fit_text(_val_fit(*call(), uv, yv)),
+                        gripkit_accuracy=_fit_text(g_fit),
+                        peer_accuracy=_fit_text(_val_fit(*call(), uv, yv)),
                         notes="same order and horizon; validation = free run, x0 estimated"))
     rows += _nfoursid_rows(g, uv, yv, u, y, *ours["n4sid"])
     start = ours["n4sid"][1]
@@ -184,7 +199,8 @@ def run(quick: bool) -> list[dict]:
         call = lambda: pem(start, u=u, y=y, form=form)  # noqa: E731
         t = measure(call)
         r = call()
-        rows.append(row("subspace", f"PEM refinement ({form}) of the order-8 model, N=1e5", t, "", None,
+        rows.append(row("subspace", f"PEM refinement ({form}) of the "
+                                    "order-8 model, N=1e5", t, "", None,
                         target="< 2 s", gripkit_accuracy=_fit_text(_val_fit(*_abcd(r), uv, yv)),
                         notes="from the N4SID model; exact sensitivity Jacobians",
                         extra={"iterations": r.info["pem"]["iterations"]}))
@@ -200,8 +216,10 @@ def run(quick: bool) -> list[dict]:
         f, pyu = signal.csd(uf, yf, fs=1000.0, nperseg=4096)
         _, puu = signal.welch(uf, fs=1000.0, nperseg=4096)
         return pyu / puu
-    rows.append(row("subspace", "FRF (Welch H1 with σ and coherence) of 1e6 samples", t, "scipy.signal csd/welch",
-                    measure(scipy_h1), target="< 0.5 s", notes="scipy gives H1 only (no σ, no coherence)"))
+    rows.append(row("subspace", "FRF (Welch H1 with σ and "
+                                "coherence) of 1e6 samples", t, "scipy.signal csd/welch",
+                    measure(scipy_h1), target="< 0.5 s", notes="scipy gives H1 only (no "
+                                                               "σ, no coherence)"))
     return rows
 
 

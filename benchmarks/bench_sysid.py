@@ -8,7 +8,8 @@ Fairness notes (also written into each row):
 
 * gripkit ``arx()`` is the full user call: input checks, Gram matrix of the regressor (no Φ),
   Cholesky, covariance, loss and fit from a pass over the one-step errors. The residual array
-  itself is computed on first access to ``model.estimation_residuals`` (not in the timed call; the memory
+  itself is computed on first access to ``model.estimation_residuals`` (not in the timed call; the
+  memory
   row times that access separately).
 * bare numpy: build Φ with ``np.column_stack`` of shifted slices and ``np.linalg.lstsq`` (LAPACK
   ``gelsd``) on exactly the same 8-column regression — no checks, no covariance, no residuals.
@@ -51,7 +52,8 @@ def _data(n: int, seed: int = 0):
 def _numpy_lstsq(u, y):
     n = y.size
     t0 = 5
-    phi = np.column_stack([-y[t0 - i:n - i] for i in range(1, 5)] + [u[t0 - 2 - j:n - 2 - j] for j in range(4)])
+    phi = (np.column_stack([-y[t0 - i:n - i] for i in range(1, 5)]
+                           + [u[t0 - 2 - j:n - 2 - j] for j in range(4)]))
     return np.linalg.lstsq(phi, y[t0:], rcond=None)[0]
 
 
@@ -67,7 +69,8 @@ def _sysidentpy_arx(u, y):
 
 
 def _sysidentpy_theta(m) -> np.ndarray:
-    """sysidentpy's coefficients in gripkit's order [a1..a4, b2..b5] (its y terms carry a + sign)."""
+    """sysidentpy's coefficients in gripkit's order [a1..a4, b2..b5] (its y terms carry a +
+    sign)."""
     codes = m.final_model.ravel()
     th = m.theta.ravel()
     out = np.zeros(8)
@@ -110,7 +113,8 @@ def _normal_equations(u, y):
     """The expert's numpy route: Φ from shifted slices, ΦᵀΦ θ = ΦᵀY (Cholesky-free solve)."""
     n = y.size
     t0 = 5
-    phi = np.column_stack([-y[t0 - i:n - i] for i in range(1, 5)] + [u[t0 - 2 - j:n - 2 - j] for j in range(4)])
+    phi = (np.column_stack([-y[t0 - i:n - i] for i in range(1, 5)]
+                           + [u[t0 - 2 - j:n - 2 - j] for j in range(4)]))
     return np.linalg.solve(phi.T @ phi, phi.T @ y[t0:])
 
 
@@ -119,7 +123,8 @@ def _scipy_lstsq(u, y, driver):
 
     n = y.size
     t0 = 5
-    phi = np.column_stack([-y[t0 - i:n - i] for i in range(1, 5)] + [u[t0 - 2 - j:n - 2 - j] for j in range(4)])
+    phi = (np.column_stack([-y[t0 - i:n - i] for i in range(1, 5)]
+                           + [u[t0 - 2 - j:n - 2 - j] for j in range(4)]))
     return lstsq(phi, y[t0:], lapack_driver=driver, check_finite=False, overwrite_a=True)[0]
 
 
@@ -178,14 +183,16 @@ def _child(what: str, n: int) -> dict:
             path = os.path.join(tmp, "uy.npy")
             np.save(path, np.stack(_data(n)))
             args.append(path)
-        out = subprocess.run([sys.executable, "-c", _CHILD.format(here=here), *args], env=os.environ.copy(),
+        out = subprocess.run([sys.executable, "-c", _CHILD.format(here=here), *args],
+                             env=os.environ.copy(),
                              capture_output=True, text=True, check=True)
     return json.loads(out.stdout.strip().splitlines()[-1])
 
 
 @njit(cache=True)
 def _rls_update(th, P, phi, q, lam, y):
-    """The expert's textbook RLS update with exponential forgetting, scalar loops (no allocation)."""
+    """The expert's textbook RLS update with exponential forgetting, scalar loops (no
+    allocation)."""
     p = th.shape[0]
     r = 0.0
     e = y
@@ -206,7 +213,8 @@ def _rls_update(th, P, phi, q, lam, y):
 
 @njit(cache=True)
 def _numba_rls(u, y, lam, p0, theta_hist, std_hist):
-    """The expert's batch RLS [3 3 1]; stores θ and σ per step when the history arrays have N rows."""
+    """The expert's batch RLS [3 3 1]; stores θ and σ per step when the history arrays have N
+    rows."""
     n = u.shape[0]
     p = 6
     th = np.zeros(p)
@@ -250,52 +258,67 @@ def run(quick: bool = False) -> list[dict]:
     t_gk = measure(lambda: arx(u, y, 4, 4, 2))
     label = f"ARX [4 4 2] LS, N = {n:.0e}"
     gk_acc = acc(m.theta) + f"; cond {m.info['cond']:.3g}"
-    for peer, fn, target in (("numpy normal equations (same regression)", _normal_equations, "ratio ≥ 0.8 (≤ 1.25×)"),
+    for peer, fn, target in (("numpy normal equations "
+                              "(same regression)", _normal_equations, "ratio ≥ 0.8 (≤ 1.25×)"),
                              ("scipy lstsq gelsy", lambda a, b: _scipy_lstsq(a, b, "gelsy"), ""),
                              ("scipy lstsq gelsd", lambda a, b: _scipy_lstsq(a, b, "gelsd"), "")):
         t_p = measure(lambda: fn(u, y))
         rows.append(row("sysid", label, t_gk, peer, t_p, target=target, gripkit_accuracy=gk_acc,
                         peer_accuracy=acc(fn(u, y)),
-                        notes="gripkit: checks + Gram from compensated lagged sums (no Φ) + Cholesky + "
-                              "covariance + loss + fit (the residual array on demand); peer: Φ + solve only"))
+                        notes="gripkit: checks + Gram from compensated lagged sums (no "
+                              "Φ) + Cholesky + "
+                              "covariance + loss + fit (the residual array on demand); "
+                              "peer: Φ + solve only"))
     if not quick:
         spread = [_child("spread", n) for _ in range(3)]
         g = [s["gripkit"] for s in spread]
         p_ = [s["numpy"] for s in spread]
-        rows.append(row("sysid", f"ARX [4 4 2], N = {n:.0e}: spread of the median between 3 processes", None,
+        rows.append(row("sysid", f"ARX [4 4 2], N = {n:.0e}: spread of the median "
+                                 "between 3 processes", None,
                         "numpy normal equations", None, target="≤ 2×",
                         notes=f"gripkit medians "
                               f"{', '.join(f'{x * 1e3:.3g}' for x in g)} ms (max/min "
-                              f"{max(g) / min(g):.2f}); numpy {', '.join(f'{x * 1e3:.3g}' for x in p_)} ms "
+                              f"{max(g) / min(g):.2f}); numpy "
+                              f"{', '.join(f'{x * 1e3:.3g}' for x in p_)} ms "
                               f"(max/min {max(p_) / min(p_):.2f})",
-                        extra={"gripkit_spread": max(g) / min(g), "numpy_spread": max(p_) / min(p_)}))
+                        extra={"gripkit_spread": max(g) / min(g),
+                               "numpy_spread": max(p_) / min(p_)}))
         mem = _child("memory", 10_000_000)
         over = (mem["peak"] - mem["rss_before"]) / mem["input"]
         rows.append(row("sysid", "ARX [4 4 2], N = 1e7: peak RSS during the call", None, "—", None,
                         target="≤ 1.3× the input arrays",
-                        notes=f"inputs u, y {mem['input'] / 1e6:.0f} MB; peak RSS = {mem['peak'] / 1e6:.0f} MB; "
+                        notes=f"inputs u, y {mem['input'] / 1e6:.0f} MB; peak RSS = "
+                              f"{mem['peak'] / 1e6:.0f} MB; "
                               f"peak RSS − RSS before the call = "
-                              f"{(mem['peak'] - mem['rss_before']) / 1e6:.1f} MB = {over:.3f}× the inputs "
+                              f"{(mem['peak'] - mem['rss_before']) / 1e6:.1f} MB = "
+                              f"{over:.3f}× the inputs "
                               f"(peak/inputs ≤ {1 + over:.3f}×); the residual array "
                               f"({mem['residuals'] / 1e6:.0f} MB) is computed on first access to "
-                              f"model.estimation_residuals, after the call: {mem['residuals_s'] * 1e3:.0f} ms; measured in a fresh process "
-                              f"(/proc/self/status VmHWM after resetting it through /proc/self/clear_refs)",
+                              "model.estimation_residuals, after the call: "
+                              f"{mem['residuals_s'] * 1e3:.0f} ms; measured in a fresh process "
+                              "(/proc/self/status VmHWM after resetting it through "
+                              "/proc/self/clear_refs)",
                         extra=mem))
 
     # sysidentpy, sippy_unipi: pure-Python per-row work, timed at a smaller N when too slow
     sm = _sysidentpy_arx(u[:20000], y[:20000])
     assert np.allclose(_sysidentpy_theta(sm), arx(u[:20000], y[:20000], 4, 4, 2).theta, atol=1e-4)
     ns, t_s = _timed_per_sample(lambda k: _sysidentpy_arx(u[:k], y[:k]), [n // 10, n], budget_s=30)
-    rows.append(row("sysid", label, t_gk, "sysidentpy FROLS+LeastSquares", t_s * n / ns, pure_python_peer=True,
+    rows.append(row("sysid", label, t_gk, "sysidentpy FROLS+LeastSquares", t_s * n / ns,
+                    pure_python_peer=True,
                     gripkit_accuracy=gk_acc,
                     peer_accuracy=acc(_sysidentpy_theta(sm)) + " (at N = 2e4)",
-                    notes=(f"timed at N = {ns:.0e}" + ("" if ns == n else f", scaled ×{n // ns} (per sample)")
+                    notes=(f"timed at N = {ns:.0e}"
+                           + ("" if ns == n else f", scaled ×{n // ns} (per sample)")
                            + "; sysidentpy adds a constant column (9 regressors)")))
     sp = _sippy_arx(u[:20000], y[:20000])
     assert np.allclose(_sippy_theta(sp), arx(u[:20000], y[:20000], 4, 4, 2).theta, atol=1e-4)
-    ns, t_p = _timed_per_sample(lambda k: _sippy_arx(u[:k], y[:k]), [n // 100, n // 10, n], budget_s=30)
-    rows.append(row("sysid", label, t_gk, "sippy_unipi ARX (LLS)", t_p * n / ns, pure_python_peer=True,
-                    notes=f"timed at N = {ns:.0e}" + ("" if ns == n else f", scaled ×{n // ns} (per sample)")
+    ns, t_p = (_timed_per_sample(lambda k: _sippy_arx(u[:k], y[:k]), [n // 100, n // 10, n],
+                                 budget_s=30))
+    rows.append(row("sysid", label, t_gk, "sippy_unipi ARX (LLS)", t_p * n / ns,
+                    pure_python_peer=True,
+                    notes=f"timed at N = {ns:.0e}"
+                    + ("" if ns == n else f", scaled ×{n // ns} (per sample)")
                     + "; Python row loop + pinv"))
 
     # batch RLS, 6 parameters: the expert's numba RLS, with and without history
@@ -306,19 +329,25 @@ def run(quick: bool = False) -> list[dict]:
     th_nb = _numba_rls(ur, yr, 0.999, 1e4, *hist)
     rls_acc = f"max |θ_N − θ_numba| = {np.max(np.abs(res.theta_final - th_nb)):.1e}"
     t_rls = measure(lambda: rls(ur, yr, 3, 3, 1, forgetting=0.999, windup="none"))
-    t_rls_nostore = measure(lambda: RLS(3, 3, 1, forgetting=0.999, windup="none").run(ur, yr, store=False))
+    t_rls_nostore = (measure(lambda: RLS(3, 3, 1, forgetting=0.999,
+                                         windup="none").run(ur, yr, store=False)))
     t_nb = measure(lambda: _numba_rls(ur, yr, 0.999, 1e4, np.empty((nr, 6)), np.empty((nr, 6))))
     none = np.empty((0, 6))
     t_nb0 = measure(lambda: _numba_rls(ur, yr, 0.999, 1e4, none, none))
     rate, rate0 = nr / t_rls.median, nr / t_rls_nostore.median
     lab = f"batch RLS, 6 parameters, N = {nr:.0e}"
-    rows.append(row("sysid", lab + ", θ and σ history", t_rls, "numba RLS, 20 lines, history arrays allocated",
+    rows.append(row("sysid", lab + ", θ and σ history", t_rls, "numba RLS, 20 lines, history "
+                                                               "arrays allocated",
                     t_nb, target="≥ 1e7 samples/s", gripkit_accuracy=rls_acc,
-                    notes=f"gripkit {rate:.3g} samples/s (rls(): checks, history, errors, result object; windup='none' like the peer); peer {nr / t_nb.median:.3g}/s (exponential forgetting only)",
+                    notes=f"gripkit {rate:.3g} samples/s (rls(): checks, history, errors, result "
+                          f"object; windup='none' like the peer); peer {nr / t_nb.median:.3g}/s "
+                          "(exponential forgetting only)",
                     extra={"gripkit_samples_per_s": rate}))
-    rows.append(row("sysid", lab + ", no history", t_rls_nostore, "numba RLS, 20 lines, no history", t_nb0,
+    rows.append(row("sysid", lab + ", no history", t_rls_nostore, "numba RLS, 20 lines, no history",
+                    t_nb0,
                     target="≥ 1e7 samples/s", gripkit_accuracy=rls_acc,
-                    notes=f"gripkit {rate0:.3g} samples/s (RLS.run(store=False)); peer {nr / t_nb0.median:.3g}/s",
+                    notes=f"gripkit {rate0:.3g} samples/s (RLS.run(store=False)); peer "
+                          f"{nr / t_nb0.median:.3g}/s",
                     extra={"gripkit_samples_per_s": rate0}))
 
     def sysidentpy_rls(k):
@@ -332,7 +361,8 @@ def run(quick: bool = False) -> list[dict]:
     ns, t_srls = _timed_per_sample(sysidentpy_rls, [nr // 100, nr // 10, nr], budget_s=20)
     rows.append(row("sysid", lab + ", θ and σ history", t_rls, "sysidentpy RecursiveLeastSquares",
                     t_srls * nr / ns, pure_python_peer=True,
-                    notes=f"peer timed at N = {ns:.0e}" + ("" if ns == nr else f", scaled ×{nr // ns} (per sample)")))
+                    notes=f"peer timed at N = {ns:.0e}"
+                    + ("" if ns == nr else f", scaled ×{nr // ns} (per sample)")))
 
     # streaming update: against a numba step function called from Python (the expert's route)
     k = 20_000 if quick else 200_000
@@ -357,14 +387,16 @@ def run(quick: bool = False) -> list[dict]:
     t_nb_stream = measure(numba_stream) / k
     rows.append(row("sysid", "streaming RLS update(u, y), 6 parameters (per call)", t_stream,
                     "numba step function on a state array, called from Python", t_nb_stream,
-                    target="≤ 0.5 µs per call", notes="called from a Python loop, one sample per call; "
+                    target="≤ 0.5 µs per call", notes="called from a Python loop, one "
+                                                      "sample per call; "
                     "gripkit's update also checks its input and keeps θ, P recoverable"))
     return rows
 
 
 @njit(cache=True)
 def _numba_rls_step(s, u, y, lam):
-    """The expert's streaming RLS [3 3 1] step on one state array [θ(6), P(36), y(3), u(3), φ(6), q(6)]."""
+    """The expert's streaming RLS [3 3 1] step on one state array [θ(6), P(36), y(3), u(3), φ(6),
+    q(6)]."""
     th = s[0:6]
     P = s[6:42].reshape((6, 6))
     yb = s[42:45]

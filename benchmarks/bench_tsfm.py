@@ -7,7 +7,8 @@ and a 5-parameter grey-box fit, each against the scipy code a user would write w
    k_e·max(0, y_C − x_w), U interpolated linearly) on the same 1 s cycle.
 2. A grey-box fit of 5 parameters (d_p, λ, β, a, b; γ held) of Bouc-Wen + D(s) on 20 000 samples
    at 20 kHz (a 2 Hz, 100 V sine then voltage steps; tip B with 20 nm noise): gripkit's
-   :func:`gripkit.sysid.physical.greybox.fit` (target < 1 s) against ``scipy.optimize.least_squares`` on a
+   :func:`gripkit.sysid.physical.greybox.fit` (target < 1 s) against
+   ``scipy.optimize.least_squares`` on a
    ``solve_ivp`` simulation (target ≥ 10×).
 
 Compile time is excluded (warm-up call). Timings: benchmarks/common.py measure (median, min), except
@@ -59,9 +60,11 @@ def _fit_data(seed=0):
     U = np.where(t < 0.5, 100.0 * np.sin(2 * np.pi * 2.0 * t), 0.0)
     for i, level in enumerate([0, 40, -30, 70, 10, -60, 90, -90, 20, 0]):
         U[(t >= 0.5 + 0.05 * i) & (t < 0.55 + 0.05 * i)] = level
-    true = PiezoActuator(loads=False, d_p=1.49e-6, lam=0.83e-6, beta=0.108, gamma=7.5e-3, a=2.5e-8, b=8e-5,
+    true = PiezoActuator(loads=False, d_p=1.49e-6, lam=0.83e-6, beta=0.108, gamma=7.5e-3, a=2.5e-8,
+                         b=8e-5,
                          check=False)
-    y = true.simulate(U, dt=1 / fs)["y_A"] + 20e-9 * np.random.default_rng(seed).standard_normal(U.size)
+    y = (true.simulate(U, dt=1 / fs)["y_A"] + 20e-9
+         * np.random.default_rng(seed).standard_normal(U.size))
     return Trajectory.uniform(dt=1 / fs, U=U, y_A=y, units={"U": "V", "y_A": "m"}), true
 
 
@@ -70,13 +73,16 @@ def _kernel_time(m, th, U, fs):
     from gripkit.systems.tsfm import gripper as T
 
     nf = len(T.FINGER_NAMES)
-    d = T._hybrid_arrays([(th[0, :nf], th[0, nf + 1], th[0, nf + 2], th[0, nf + 3])], 1 / fs, m.levels,
+    d = T._hybrid_arrays([(th[0, :nf], th[0, nf + 1], th[0, nf + 2], th[0, nf + 3])], 1 / fs,
+                         m.levels,
                          m.realisation)
     bw = np.ascontiguousarray(th[0, [0, 2, 3, 4]])
     y = np.empty((U.shape[0], len(m.outputs)))
     x0 = np.zeros(len(m.states))
-    return measure(lambda: T._bw_pwa_row(bw, d["Phi"][0], d["Gam"][0], d["C"][0], d["D"][0], d["G"][0], d["H"][0],
-                                           d["target"], d["ng"], m.levels, th[0, nf], U, x0.copy(), y))
+    return measure(lambda: T._bw_pwa_row(bw, d["Phi"][0], d["Gam"][0], d["C"][0], d["D"][0],
+                                         d["G"][0], d["H"][0],
+                                           d["target"], d["ng"], m.levels, th[0, nf], U, x0.copy(),
+                                           y))
 
 
 FREE = ("d_p", "lam", "beta", "a", "b")
@@ -103,9 +109,11 @@ def _peer_fit(data, true, max_nfev=None):
             du = slope[k]
             u = U[k] + du * (tt - t[k])
             H, q, v = x
-            return [lam * du - beta * abs(du) * H - gamma * du * abs(H), v, (d_p * u - H - q - b * v) / a]
+            return ([lam * du - beta * abs(du) * H - gamma * du * abs(H), v,
+                     (d_p * u - H - q - b * v) / a])
 
-        return solve_ivp(rhs, (0.0, t[-1]), [0.0, 0.0, 0.0], t_eval=t, method="RK45", rtol=1e-6, atol=1e-12).y[1]
+        return (solve_ivp(rhs, (0.0, t[-1]), [0.0, 0.0, 0.0], t_eval=t, method="RK45", rtol=1e-6,
+                          atol=1e-12).y[1])
 
     nsim = [0]
 
@@ -116,7 +124,8 @@ def _peer_fit(data, true, max_nfev=None):
     t0 = time.perf_counter()
     # diff_step: the default (≈1.5e-8) is below solve_ivp's rtol = 1e-6 noise and the fit stalls
     # (measured: 15 % off after 59 simulations); a user who got it working sets a larger step
-    sol = least_squares(resid, np.ones(5), x_scale="jac", bounds=(0.0, np.inf), max_nfev=max_nfev, diff_step=1e-3)
+    sol = (least_squares(resid, np.ones(5), x_scale="jac", bounds=(0.0, np.inf), max_nfev=max_nfev,
+                         diff_step=1e-3))
     return time.perf_counter() - t0, sol.x * p0, nsim[0], simulate
 
 
@@ -168,11 +177,14 @@ def run(quick: bool = False) -> list[dict]:
         buf = np.empty_like(y)  # a loop simulating many times reuses its output buffer
         tg = measure(lambda: m.simulate_batch(th, U, 1 / fs, out=buf))
         tk = _kernel_time(m, th, U, fs)
-        rows.append(row("tsfm", f"finger: Bouc-Wen + {states}-state linear + contact, {dur:g} s at 20 kHz "
+        rows.append(row("tsfm", f"finger: Bouc-Wen + {states}-state linear + contact, "
+                                f"{dur:g} s at 20 kHz "
                                 f"(one Fig. 13 cycle)", tg, "real time", dur,
                         target="≥ 1000× faster than real time" if states == 4 else "",
-                        notes=f"{tg / U.shape[0] * 1e9:.1f} ns/sample through Model.simulate_batch (discretisation, "
-                              f"input/output checks included, output buffer reused), {tk / U.shape[0] * 1e9:.1f} ns/sample in the "
+                        notes=f"{tg / U.shape[0] * 1e9:.1f} ns/sample through Model.simulate_batch "
+                              "(discretisation, "
+                              "input/output checks included, output buffer reused), "
+                              f"{tk / U.shape[0] * 1e9:.1f} ns/sample in the "
                               f"kernel alone ({dur / tk:.0f}× real time); "
                               f"{'eq 11 (minimal)' if states == 4 else 'component-wise (with y_B)'}"
                               " realisation; "
@@ -180,11 +192,14 @@ def run(quick: bool = False) -> list[dict]:
         if states == 4:
             ts_pub = measure(lambda: m.simulate(U, dt=1 / fs))
             tb_new = measure(lambda: m.simulate_batch(th, U, 1 / fs))
-            rows.append(row("tsfm", f"finger (4-state + contact), {dur:g} s at 20 kHz through the public "
+            rows.append(row("tsfm", f"finger (4-state + contact), {dur:g} s at 20 kHz "
+                                    "through the public "
                                     f"Model.simulate (returns a Trajectory)", ts_pub,
                             "Model.simulate_batch, new output array each call", tb_new,
-                            target="ratio ≥ 0.83 (simulate ≤ 1.2× simulate_batch); ≥ 1000× real time",
-                            notes=f"{dur / ts_pub:.0f}× real time through Model.simulate; simulate/simulate_batch = "
+                            target="ratio ≥ 0.83 (simulate ≤ 1.2× simulate_batch); ≥ "
+                                   "1000× real time",
+                            notes=f"{dur / ts_pub:.0f}× real time through Model.simulate; "
+                                  "simulate/simulate_batch = "
                                   f"{ts_pub / tb_new:.2f}",
                             extra={"real_time_factor_simulate": dur / ts_pub}))
     # 1b. one 1 Hz cycle against solve_ivp
@@ -197,16 +212,19 @@ def run(quick: bool = False) -> list[dict]:
     t0 = time.perf_counter()
     yp = _contact_peer(f, x_w, 72.5, U1, fs)
     tp = time.perf_counter() - t0
-    rows.append(row("tsfm", "finger with contact, one 1 Hz cycle (20 000 samples)", tg, "scipy solve_ivp RK45, "
+    rows.append(row("tsfm", "finger with contact, one 1 Hz cycle "
+                            "(20 000 samples)", tg, "scipy solve_ivp RK45, "
                     "Python right-hand side, timed once", tp, pure_python_peer=True,
-                    notes=f"max |Δy_C| = {np.max(np.abs(yp - yg)) * 1e9:.1f} nm (peer: linear input "
+                    notes=f"max |Δy_C| = {np.max(np.abs(yp - yg)) * 1e9:.1f} nm "
+                          "(peer: linear input "
                           f"interpolation, smooth contact, rtol 1e-6)"))
     # 2. grey-box fit
     data, true = _fit_data()
     from gripkit.models.piezo import PiezoActuator
 
     start = PiezoActuator(loads=False, check=False, d_p=1.49e-6 * START[0], lam=0.83e-6 * START[1],
-                          beta=0.108 * START[2], gamma=7.5e-3, a=2.5e-8 * START[3], b=8e-5 * START[4])
+                          beta=0.108 * START[2], gamma=7.5e-3, a=2.5e-8 * START[3],
+                          b=8e-5 * START[4])
     res = fit(start, data, outputs=["y_A"], free=list(FREE), progress=False)
     tg = measure(lambda: fit(start, data, outputs=["y_A"], free=list(FREE), progress=False))
     err = max(abs(res.value(n) / true.parameters.value(n) - 1) for n in FREE)
@@ -216,22 +234,30 @@ def run(quick: bool = False) -> list[dict]:
         t0 = time.perf_counter()
         simulate(p)
         tp = (time.perf_counter() - t0) * res.nfev
-        note = f"peer estimated as one solve_ivp simulation × {res.nfev} (gripkit's count); run without --quick to time it"
+        note = (f"peer estimated as one solve_ivp simulation × {res.nfev} (gripkit's count); run "
+                "without --quick to time it")
     else:
         tp, p_peer, nsim, _ = _peer_fit(data, true)
         perr = max(abs(p_peer[i] / true.parameters.value(n) - 1) for i, n in enumerate(FREE))
-        note = (f"peer: {nsim} simulations, max parameter error {100 * perr:.3g} % (its linear input interpolation "
-                f"cannot represent the held voltage steps of the data: a half-sample lag that biases a, b)")
+        note = (f"peer: {nsim} simulations, max parameter error {100 * perr:.3g} % (its linear "
+                "input interpolation "
+                "cannot represent the held voltage steps of the data: a half-sample lag "
+                "that biases a, b)")
     label = "grey-box fit, 5 parameters (d_p, λ, β, a, b), 20 000 samples"
     gk_acc = f"max parameter error {100 * err:.3g} %"
     p_c, nsim_c = _compiled_peer_fit(start, data)
     cerr = max(abs(p_c[i] / true.parameters.value(n) - 1) for i, n in enumerate(FREE))
     tc = measure(lambda: _compiled_peer_fit(start, data))
-    rows.append(row("tsfm", label, tg, "scipy least_squares driving gripkit's compiled simulate_batch", tc,
-                    target="< 1 s", gripkit_accuracy=gk_acc, peer_accuracy=f"max parameter error {100 * cerr:.3g} %",
-                    notes=f"gripkit: {res.nfev} simulated rows, with σ and covariance; peer: {nsim_c} simulations "
-                          f"(2-point finite differences), no σ; same simulator, so the ratio is what the fit adds"))
-    rows.append(row("tsfm", label, tg, "scipy least_squares + solve_ivp (Python right-hand side)", tp,
+    rows.append(row("tsfm", label, tg, "scipy least_squares driving gripkit's "
+                                       "compiled simulate_batch", tc,
+                    target="< 1 s", gripkit_accuracy=gk_acc, peer_accuracy="max parameter error "
+                                                                           f"{100 * cerr:.3g} %",
+                    notes=f"gripkit: {res.nfev} simulated rows, with σ and covariance; peer: "
+                          f"{nsim_c} simulations "
+                          "(2-point finite differences), no σ; same simulator, so the ratio is "
+                          "what the fit adds"))
+    rows.append(row("tsfm", label, tg, "scipy least_squares + solve_ivp (Python "
+                                       "right-hand side)", tp,
                     pure_python_peer=True, gripkit_accuracy=gk_acc,
                     notes=f"peer timed once (one fit takes minutes); {note}"))
     return rows

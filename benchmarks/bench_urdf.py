@@ -70,9 +70,11 @@ def run(quick: bool = False) -> list[dict]:
     gk1 = timed(lambda: chain.rnea(q, qd, qdd), R, n1)
     pn1 = timed(lambda: pin.rnea(model, data, q, qd, qdd), R, n1)
     err = float(np.max(np.abs(chain.rnea(q, qd, qdd) - pin.rnea(model, data, q, qd, qdd))))
-    rows.append(row("urdf", "RNEA, one state, URDF finger (3 joints + mimic)", gk1[0], "one pin.rnea call", pn1[0],
+    rows.append(row("urdf", "RNEA, one state, URDF finger (3 "
+                            "joints + mimic)", gk1[0], "one pin.rnea call", pn1[0],
                     target="ratio >= 0.67 (gripkit <= 1.5x pin)",
-                    notes=f"per call, {n1} calls per run; min gripkit {gk1[1] * 1e6:.3f} µs, pin {pn1[1] * 1e6:.3f} µs; "
+                    notes=f"per call, {n1} calls per run; min gripkit {gk1[1] * 1e6:.3f} µs, pin "
+                          f"{pn1[1] * 1e6:.3f} µs; "
                           f"max |Δτ| {err:.1e} N·m",
                     extra=dict(gripkit_min_s=gk1[1], peer_min_s=pn1[1], max_abs_diff=err)))
 
@@ -92,7 +94,8 @@ def run(quick: bool = False) -> list[dict]:
     rows.append(row("urdf", f"RNEA, batch of {B} states (1 thread), per state", gkb[0] / B,
                     "pin.rnea in a Python loop", pnb[0] / B, target="ratio >= 2",
                     notes=f"min {gkb[1] / B * 1e9:.0f} vs {pnb[1] / B * 1e9:.0f} ns/state; "
-                          f"max |Δτ| {err:.1e} N·m", extra=dict(gripkit_min_s=gkb[1] / B, peer_min_s=pnb[1] / B,
+                          f"max |Δτ| {err:.1e} N·m",
+                          extra=dict(gripkit_min_s=gkb[1] / B, peer_min_s=pnb[1] / B,
                                                               max_abs_diff=err)))
 
     # regressor
@@ -102,16 +105,19 @@ def run(quick: bool = False) -> list[dict]:
     def pin_regressor():
         out = np.empty((Br, 3, G.shape[0] * 10))
         for i in range(Br):
-            out[i] = G.T @ pin.computeJointTorqueRegressor(full, fdata, G @ Q[i], G @ QD[i], G @ QDD[i])
+            out[i] = (G.T @ pin.computeJointTorqueRegressor(full, fdata, G @ Q[i], G @ QD[i],
+                                                            G @ QDD[i]))
         return out
 
     gkr = timed(lambda: chain.regressor(Q[:Br], QD[:Br], QDD[:Br]), R)
     pnr = timed(pin_regressor, R)
     err = float(np.max(np.abs(chain.regressor(Q[:Br], QD[:Br], QDD[:Br]) - pin_regressor())))
     rows.append(row("urdf", f"inertial-parameter regressor, batch of {Br}, per state", gkr[0] / Br,
-                    "pin.computeJointTorqueRegressor in a loop (+ Γᵀ)", pnr[0] / Br, target="ratio >= 1",
+                    "pin.computeJointTorqueRegressor "
+                    "in a loop (+ Γᵀ)", pnr[0] / Br, target="ratio >= 1",
                     notes=f"min {gkr[1] / Br * 1e6:.2f} vs {pnr[1] / Br * 1e6:.2f} µs/state; "
-                          f"max |ΔY| {err:.1e}", extra=dict(gripkit_min_s=gkr[1] / Br, peer_min_s=pnr[1] / Br,
+                          f"max |ΔY| {err:.1e}",
+                          extra=dict(gripkit_min_s=gkr[1] / Br, peer_min_s=pnr[1] / Br,
                                                          max_abs_diff=err)))
 
     # identification from 1e5 samples
@@ -136,7 +142,8 @@ def run(quick: bool = False) -> list[dict]:
     def pin_identify():
         Y = np.empty((N, 3, G.shape[0] * 10))
         for i in range(N):
-            Y[i] = G.T @ pin.computeJointTorqueRegressor(full, fdata, G @ qs[i], G @ qds[i], G @ qdds[i])
+            Y[i] = (G.T @ pin.computeJointTorqueRegressor(full, fdata, G @ qs[i], G @ qds[i],
+                                                          G @ qdds[i]))
         F = np.zeros((N, 3, 6))
         for j in range(3):
             F[:, j, 2 * j] = np.sign(qds[:, j])
@@ -149,11 +156,14 @@ def run(quick: bool = False) -> list[dict]:
     pni = timed(pin_identify, max(2, Rid - 2))
     th_pin = pin_identify()
     fr_err = float(np.max(np.abs(res.theta[-6:] - np.ravel(np.column_stack([fc, fv])))))
-    rows.append(row("urdf", f"identify_dynamics, 3-joint finger, {N} samples (no consistency check)", gki[0],
+    rows.append(row("urdf", f"identify_dynamics, 3-joint finger, {N} samples (no "
+                            "consistency check)", gki[0],
                     "pin regressor loop + numpy lstsq", pni[0], target="< 1 s",
                     notes=f"min {gki[1]:.3f} s vs {pni[1]:.3f} s; with the consistency check "
-                          f"{gkc[0]:.3f} s; max |friction error| {fr_err:.1e} (σ {np.max(res.std[-6:]):.1e}); "
-                          f"max |Δθ| vs Pinocchio+lstsq (OLS, unweighted) {np.max(np.abs(res.theta - th_pin)):.1e}",
+                          f"{gkc[0]:.3f} s; max |friction error| {fr_err:.1e} (σ "
+                          f"{np.max(res.std[-6:]):.1e}); "
+                          "max |Δθ| vs Pinocchio+lstsq (OLS, unweighted) "
+                          f"{np.max(np.abs(res.theta - th_pin)):.1e}",
                     extra=dict(gripkit_min_s=gki[1], peer_min_s=pni[1], with_consistency_s=gkc[0],
                                friction_max_abs_error=fr_err)))
     return rows

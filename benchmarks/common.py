@@ -58,7 +58,8 @@ def measure(fn: Callable[[], object], number: int = 1, budget_s: float = BUDGET_
         t0 = time.perf_counter()
         fn()
         t_warm = time.perf_counter() - t0
-    runs = REPEAT if t_warm * number * REPEAT <= budget_s else max(1, int(budget_s / max(t_warm * number, 1e-12)))
+    runs = (REPEAT if t_warm * number * REPEAT <= budget_s
+            else max(1, int(budget_s / max(t_warm * number, 1e-12))))
     times = []
     gc.collect()
     gc.disable()
@@ -81,8 +82,10 @@ def _split(t) -> tuple[float | None, float | None, int | None]:
     return float(t), None, None  # a reference figure (real time), not a measurement
 
 
-def row(benchmark: str, task: str, gripkit_s, peer: str, peer_s, *, target: str = "", unit: str = "s",
-        notes: str = "", gripkit_accuracy: str = "", peer_accuracy: str = "", pure_python_peer: bool = False,
+def row(benchmark: str, task: str, gripkit_s, peer: str, peer_s, *, target: str = "",
+        unit: str = "s",
+        notes: str = "", gripkit_accuracy: str = "", peer_accuracy: str = "",
+        pure_python_peer: bool = False,
         extra: dict | None = None) -> dict:
     """One comparison. ``gripkit_s``/``peer_s``: :class:`Timing` from :func:`measure` (or a plain
     number for a reference such as real time). ``ratio`` = peer median / gripkit median (> 1:
@@ -93,8 +96,10 @@ def row(benchmark: str, task: str, gripkit_s, peer: str, peer_s, *, target: str 
     ratio = (p_med / g_med) if (g_med and p_med) else None
     if pure_python_peer:
         peer = f"{peer} [pure-Python peer]"
-    return dict(benchmark=benchmark, task=task, gripkit_s=g_med, gripkit_min_s=g_min, gripkit_runs=g_runs,
-                peer=peer, peer_s=p_med, peer_min_s=p_min, peer_runs=p_runs, ratio=ratio, target=target,
+    return dict(benchmark=benchmark, task=task, gripkit_s=g_med, gripkit_min_s=g_min,
+                gripkit_runs=g_runs,
+                peer=peer, peer_s=p_med, peer_min_s=p_min, peer_runs=p_runs, ratio=ratio,
+                target=target,
                 unit=unit, gripkit_accuracy=gripkit_accuracy, peer_accuracy=peer_accuracy,
                 pure_python_peer=pure_python_peer, notes=notes, extra=extra or {})
 

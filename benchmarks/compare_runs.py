@@ -42,7 +42,8 @@ def compare(old: dict, new: dict, tolerance: float) -> list[dict]:
         if a.get("peer_s") and b.get("peer_s"):
             rel = raw / (b["peer_s"] / a["peer_s"])
         slower = raw > 1 + tolerance and (rel is None or rel > 1 + tolerance)
-        out.append(dict(benchmark=key[0], task=key[1], peer=key[2], old_s=a["gripkit_s"], new_s=b["gripkit_s"],
+        out.append(dict(benchmark=key[0], task=key[1], peer=key[2], old_s=a["gripkit_s"],
+                        new_s=b["gripkit_s"],
                         raw=raw, relative=rel, slower=slower))
     return sorted(out, key=lambda r: (r["benchmark"], r["task"], r["peer"]))
 
@@ -54,8 +55,10 @@ def _table(rows: list[dict], only_old: list, only_new: list, machines: tuple[dic
              "|---|---|---|---|---|---|---|---|"]
     for r in rows:
         rel = "—" if r["relative"] is None else f"{r['relative']:.2f}"
-        lines.append(f"| {r['benchmark']} | {r['task']} | {r['peer'] or '—'} | {r['old_s']:.3g} s | "
-                     f"{r['new_s']:.3g} s | {r['raw']:.2f} | {rel} | {'**yes**' if r['slower'] else ''} |")
+        lines.append(f"| {r['benchmark']} | {r['task']} | {r['peer'] or '—'} | "
+                     f"{r['old_s']:.3g} s | "
+                     f"{r['new_s']:.3g} s | {r['raw']:.2f} | {rel} | "
+                     f"{'**yes**' if r['slower'] else ''} |")
     for what, keys in (("only in the old run", only_old), ("only in the new run", only_new)):
         if keys:
             lines += ["", f"{what}: " + "; ".join(f"{k[0]}: {k[1]}" for k in sorted(keys))]
@@ -66,12 +69,14 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("old")
     ap.add_argument("new")
-    ap.add_argument("--tolerance", type=float, default=0.05, help="allowed slow-down (default 0.05: 5 %%)")
+    ap.add_argument("--tolerance", type=float, default=0.05, help="allowed slow-down "
+                                                                  "(default 0.05: 5 %%)")
     args = ap.parse_args(argv)
     m_old, old = _rows(args.old)
     m_new, new = _rows(args.new)
     rows = compare(old, new, args.tolerance)
-    print(_table(rows, list(old.keys() - new.keys()), list(new.keys() - old.keys()), (m_old, m_new)))
+    print(_table(rows, list(old.keys() - new.keys()), list(new.keys() - old.keys()),
+                 (m_old, m_new)))
     flagged = [r for r in rows if r["slower"]]
     print(f"\n{len(rows)} rows compared, {len(flagged)} slower by more than {args.tolerance:.0%} "
           f"both raw and against their peer")

@@ -44,7 +44,8 @@ def machine() -> dict:
         blas = f"{deps.get('name')} {deps.get('version', '')}".strip()
     env = {k: os.environ[k] for k in ("OPENBLAS_CORETYPE", "OPENBLAS_L2_SIZE") if k in os.environ}
     return dict(cpu=cpu, cores=os.cpu_count(), python=platform.python_version(),
-                numpy=numpy.__version__, scipy=scipy.__version__, numba=numba.__version__, blas=blas,
+                numpy=numpy.__version__, scipy=scipy.__version__, numba=numba.__version__,
+                blas=blas,
                 blas_threads=BLAS_THREADS, blas_env=env, load_average=os.getloadavg(),
                 platform=platform.platform(), date=dt.datetime.now().isoformat(timespec="seconds"))
 
@@ -64,14 +65,21 @@ def to_markdown(results: dict) -> str:
              f"Machine: {m['cpu']}, {m['cores']} cores; Python {m['python']}, numpy {m['numpy']}, "
              f"scipy {m['scipy']}, numba {m['numba']}; BLAS {m.get('blas', '?')} with "
              f"{m.get('blas_threads', '?')} thread(s) on both sides"
-             + (f" ({', '.join(f'{k}={v}' for k, v in m['blas_env'].items())})" if m.get("blas_env") else "")
-             + f"; load average at start {', '.join(f'{x:.2f}' for x in m.get('load_average', ()))}; {m['date']}.", "",
-             "Both sides of every row are timed by one harness (benchmarks/common.py `measure`): the same "
-             "warm-up call (numba compile time excluded on both sides) and the same number of timed runs; "
-             "times are per call, median (min). ratio = peer median / gripkit median (> 1 means gripkit "
-             "is faster). Peers marked [pure-Python peer] run interpreted Python per sample or per row; "
+             + (f" ({', '.join(f'{k}={v}' for k, v in m['blas_env'].items())})"
+                if m.get("blas_env") else "")
+             + "; load average at start "
+               f"{', '.join(f'{x:.2f}' for x in m.get('load_average', ()))}; {m['date']}.", "",
+             "Both sides of every row are timed by one harness (benchmarks/common.py "
+             "`measure`): the same "
+             "warm-up call (numba compile time excluded on both sides) and the same number "
+             "of timed runs; "
+             "times are per call, median (min). ratio = peer median / gripkit median (> "
+             "1 means gripkit "
+             "is faster). Peers marked [pure-Python peer] run interpreted Python per "
+             "sample or per row; "
              "their ratios measure that, not an expert's compiled route.", "",
-             "| benchmark | task | gripkit median (min) | peer | peer median (min) | ratio | target | "
+             "| benchmark | task | gripkit median (min) | peer | peer median (min) | "
+             "ratio | target | "
              "accuracy: gripkit / peer | notes |",
              "|---|---|---|---|---|---|---|---|---|"]
 
@@ -82,8 +90,10 @@ def to_markdown(results: dict) -> str:
 
     for r in results["rows"]:
         ratio = f"{r['ratio']:.3g}×" if r.get("ratio") else "—"
-        accuracy = " / ".join(a for a in (r.get("gripkit_accuracy", ""), r.get("peer_accuracy", "")) if a)
-        lines.append(f"| {r['benchmark']} | {r['task']} | {t(r['gripkit_s'], r.get('gripkit_min_s'), r.get('gripkit_runs'))} "
+        accuracy = (" / ".join(a for a in (r.get("gripkit_accuracy", ""),
+                                           r.get("peer_accuracy", "")) if a))
+        lines.append(f"| {r['benchmark']} | {r['task']} | "
+                     f"{t(r['gripkit_s'], r.get('gripkit_min_s'), r.get('gripkit_runs'))} "
                      f"| {r['peer']} | {t(r['peer_s'], r.get('peer_min_s'), r.get('peer_runs'))} "
                      f"| {ratio} | "
                      f"{r.get('target', '')} | {accuracy} | {r.get('notes', '')} |")
@@ -114,8 +124,10 @@ def main(argv=None) -> int:
             rows = mod.run(quick=args.quick)
             results["rows"].extend(rows)
             for r in rows:
-                print(f"  {r['task']}: gripkit {_fmt_t(r['gripkit_s'])}, {r['peer']} {_fmt_t(r['peer_s'])}"
-                      + (f", ratio {r['ratio']:.3g}" if r.get('ratio') else ""), file=sys.stderr, flush=True)
+                print(f"  {r['task']}: gripkit {_fmt_t(r['gripkit_s'])}, {r['peer']} "
+                      f"{_fmt_t(r['peer_s'])}"
+                      + (f", ratio {r['ratio']:.3g}" if r.get('ratio') else ""), file=sys.stderr,
+                      flush=True)
         except Exception as exc:  # record and continue: one broken peer must not hide the rest
             results["errors"][name] = f"{type(exc).__name__}: {exc}"
             traceback.print_exc()

@@ -9,7 +9,8 @@ from gripkit.excitation import bandlimited_noise, multisine
 from gripkit.systems.amadeus.force_dynamics import finger_force_model
 
 plant = finger_force_model()  # Table II [2 2 2] at 200 Hz, valve current (A) -> force (N)
-s2 = bandlimited_noise(0.3, 10.0, 20.0, dt=0.005, operating_point=0.850, limits=(0.600, 1.100), unit="A", seed=7)
+s2 = (bandlimited_noise(0.3, 10.0, 20.0, dt=0.005, operating_point=0.850, limits=(0.600, 1.100),
+                        unit="A", seed=7))
 s1 = multisine(range(1, 11), 2.0, dt=0.005, operating_point=0.850, limits=(0.600, 1.100), unit="A")
 est = plant.simulate(s2.u, noise_std=0.02, seed=1)
 val = plant.simulate(np.tile(s1.u, 2), noise_std=0.02, seed=2)

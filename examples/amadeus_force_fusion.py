@@ -12,4 +12,5 @@ rng = np.random.default_rng(0)
 e = force * (1.0 + np.sqrt(var_n)[:, None] * rng.standard_normal((3, 20000)))  # eq 19 noise
 est, var = fuse(e, (e ** 2) * var_n[:, None])              # per sample, eq 19 variances
 print("single estimates, normalised variance:", np.round((e / force).var(axis=1), 5))
-print(f"fused: normalised variance {np.var(est / force):.5f} (theory, eq 18: {1 / np.sum(1 / var_n):.5f})")
+print(f"fused: normalised variance {np.var(est / force):.5f} (theory, eq 18: "
+      f"{1 / np.sum(1 / var_n):.5f})")

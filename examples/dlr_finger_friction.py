@@ -23,7 +23,8 @@ for k in range(t.size):
         x += h * v
 q = np.round(q / 1e-4) * 1e-4                         # 0.1 mrad encoder
 res = idim_ls(q, tau, dt=1 / fs)
-for name, true in (("inertia", J), ("viscous", b), ("coulomb", fc)):  # σ covers the noise, not the filter's bias
+# σ covers the noise, not the filter's bias
+for name, true in (("inertia", J), ("viscous", b), ("coulomb", fc)):
     print(f"{name}: {res.params[name]:.4g} ± {res.std[name]:.2g} (true {true:.4g}, "
           f"{100 * (res.params[name] / true - 1):+.2f} %)")
 print(f"relative error of the fitted effort: {res.relative_error_percent:.2f} %")

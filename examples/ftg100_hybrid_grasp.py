@@ -13,4 +13,5 @@ ctrl = HybridForcePosition.for_plant(plant.parameters)
 k0 = np.linspace(520.0, 1560.0, 5)
 res = grasp_batch(ctrl, plant, force=20e-6, k0=k0, gap=20e-6, seed=np.arange(k0.size))
 for k, ov, ts, peak in zip(k0, res["overshoot_percent"], res["settling_time"], res["peak_force"]):
-    print(f"k0 = {k:6.0f} N/m: overshoot {ov:4.1f} %, settling {ts * 1e3:4.2f} ms, peak {peak * 1e6:5.2f} µN")
+    print(f"k0 = {k:6.0f} N/m: overshoot {ov:4.1f} %, settling {ts * 1e3:4.2f} ms, peak "
+          f"{peak * 1e6:5.2f} µN")

@@ -12,4 +12,5 @@ result = sweep(spec, backend="process", workers=2, progress=False)
 print(result.summary())
 for k in (1.0, 4.0, 16.0):
     m = result["k"] == k
-    print(f"k = {k:5.1f} N/m: overshoot {np.mean(result['overshoot_percent'][m]):5.1f} % on average")
+    print(f"k = {k:5.1f} N/m: overshoot "
+          f"{np.mean(result['overshoot_percent'][m]):5.1f} % on average")

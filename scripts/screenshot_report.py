@@ -1,5 +1,6 @@
 #!/usr/bin/env python3
-"""Check that an HTML report (``make demo`` -> ``report/index.html``) reads at desktop and phone width.
+"""Check that an HTML report (``make demo`` -> ``report/index.html``) reads at desktop and phone
+width.
 
 For each window size (default 1400×900 and 390×844, an iPhone-sized portrait) headless Chromium
 
@@ -82,16 +83,20 @@ class BrowserError(RuntimeError):
 
 
 def find_browser(explicit: str | None = None) -> str:
-    """The browser to run: ``explicit``, ``$GRIPKIT_BROWSER``, or the first of :data:`BROWSERS` on the PATH."""
+    """The browser to run: ``explicit``, ``$GRIPKIT_BROWSER``, or the first of :data:`BROWSERS` on
+    the PATH."""
     for name in (explicit, os.environ.get("GRIPKIT_BROWSER"), *BROWSERS):
         if name and shutil.which(name):
             return shutil.which(name)
     raise BrowserError(f"no headless browser found (tried {', '.join(BROWSERS)}); install one "
-                       "(Debian: apt-get install chromium) or pass --browser PATH / set GRIPKIT_BROWSER")
+                       "(Debian: apt-get install chromium) or pass --browser PATH / set "
+                       "GRIPKIT_BROWSER")
 
 
-def _run(browser: str, profile: str, size: tuple[int, int], url: str, *args: str, timeout: float = 120.0) -> str:
-    cmd = [browser, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars", "--no-first-run",
+def _run(browser: str, profile: str, size: tuple[int, int], url: str, *args: str,
+         timeout: float = 120.0) -> str:
+    cmd = [browser, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
+           "--no-first-run",
            f"--user-data-dir={profile}", f"--window-size={size[0]},{size[1]}",
            "--run-all-compositor-stages-before-draw", "--virtual-time-budget=5000", *args, url]
     try:
@@ -120,7 +125,8 @@ def parse_probe(dom: str) -> dict:
     return json.loads(html.unescape(m.group(1)))
 
 
-def check_report(page: Path, out: Path, sizes=DEFAULT_SIZES, browser: str | None = None) -> list[dict]:
+def check_report(page: Path, out: Path, sizes=DEFAULT_SIZES,
+                 browser: str | None = None) -> list[dict]:
     """Screenshot ``page`` at each size into ``out`` and measure its layout; one dict per size:
     ``size``, ``screenshot``, ``screenshot_size``, ``viewport``, ``scroll_width``, ``overflow``
     (px the page is wider than the viewport), ``offenders``, ``n_offenders``."""
@@ -140,7 +146,8 @@ def check_report(page: Path, out: Path, sizes=DEFAULT_SIZES, browser: str | None
             probed.write_text(_PROBE % dict(w=w, h=h, mark=_MARK), encoding="utf-8")
             probe = parse_probe(_run(exe, profile, (w + 40, h + 40), probed.as_uri(), "--dump-dom",
                                      "--allow-file-access-from-files"))
-            results.append(dict(size=[w, h], screenshot=str(shot), screenshot_size=list(png_size(shot)), **probe,
+            results.append(dict(size=[w, h], screenshot=str(shot),
+                                screenshot_size=list(png_size(shot)), **probe,
                                 overflow=max(0, probe["scroll_width"] - probe["viewport"])))
     return results
 
@@ -148,22 +155,27 @@ def check_report(page: Path, out: Path, sizes=DEFAULT_SIZES, browser: str | None
 def _parse_size(text: str) -> tuple[int, int]:
     m = re.fullmatch(r"\s*(\d+)\s*[xX×]\s*(\d+)\s*", text)
     if m is None or int(m.group(1)) < 200 or int(m.group(2)) < 200:
-        raise argparse.ArgumentTypeError(f"expected WIDTHxHEIGHT in pixels (each ≥ 200), e.g. 390x844, found {text!r}")
+        raise argparse.ArgumentTypeError("expected WIDTHxHEIGHT in pixels (each ≥ 200), e.g. "
+                                         f"390x844, found {text!r}")
     return int(m.group(1)), int(m.group(2))
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("report", type=Path, help="report folder (with index.html) or an HTML file")
-    ap.add_argument("--out", type=Path, help="folder for the screenshots (default: REPORT/screenshots)")
-    ap.add_argument("--size", type=_parse_size, action="append", help="window WIDTHxHEIGHT (repeatable; "
+    ap.add_argument("--out", type=Path, help="folder for the screenshots (default: "
+                                             "REPORT/screenshots)")
+    ap.add_argument("--size", type=_parse_size, action="append",
+                    help="window WIDTHxHEIGHT (repeatable; "
                     "default 1400x900 and 390x844)")
-    ap.add_argument("--browser", help="browser executable (default: $GRIPKIT_BROWSER or chromium on the PATH)")
+    ap.add_argument("--browser", help="browser executable (default: $GRIPKIT_BROWSER or "
+                                      "chromium on the PATH)")
     ap.add_argument("--json", action="store_true", help="print the measurements as one JSON object")
     a = ap.parse_args(argv)
     page = a.report / "index.html" if a.report.is_dir() else a.report
     if not page.is_file():
-        print(f"error: report: expected a report folder with index.html or an HTML file, found {a.report}",
+        print("error: report: expected a report folder with index.html or an HTML file, "
+              f"found {a.report}",
               file=sys.stderr)
         return 2
     out = a.out or page.parent / "screenshots"
@@ -178,11 +190,13 @@ def main(argv: list[str] | None = None) -> int:
     for r in results:
         w, h = r["size"]
         line = (f"{w}x{h}: page {r['scroll_width']} px wide in a {r['viewport']} px viewport"
-                f"{' (overflows by %d px)' % r['overflow'] if r['overflow'] else ''}; screenshot {r['screenshot']}")
+                f"{' (overflows by %d px)' % r['overflow'] if r['overflow'] else ''}; screenshot "
+                f"{r['screenshot']}")
         print(line, file=sys.stderr if r["overflow"] else sys.stdout) if not a.json else None
         if r["overflow"]:
             for o in r["offenders"]:
-                print(f"  {w}x{h}: <{o['tag']} class='{o['cls']}'> reaches {o['right']} px: {o['text']!r}",
+                print(f"  {w}x{h}: <{o['tag']} class='{o['cls']}'> reaches {o['right']} "
+                      f"px: {o['text']!r}",
                       file=sys.stderr)
     return 1 if bad else 0
 

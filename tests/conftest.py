@@ -20,7 +20,8 @@ RECORD_RTOL = 1e-9
 
 
 def recorded_rows(n: int) -> np.ndarray:
-    """The rows of an n-row result that a recording keeps: about a dozen, evenly spread, and the last."""
+    """The rows of an n-row result that a recording keeps: about a dozen, evenly spread, and the
+    last."""
     return np.unique(np.r_[np.arange(0, n, max(1, n // 12)), n - 1])
 
 
@@ -47,7 +48,8 @@ def _check_record(name, result, record):
     if bad.any():
         r, c = np.argwhere(bad)[0]
         raise AssertionError(f"{name}: row {record['rows'][r]}, column {c}: {got[r, c]!r}, "
-                             f"recorded {ref[r, c]!r} ({int(bad.sum())} entries beyond rtol {RECORD_RTOL})")
+                             f"recorded {ref[r, c]!r} ({int(bad.sum())} entries beyond "
+                             f"rtol {RECORD_RTOL})")
 
 
 @pytest.fixture(scope="session")

@@ -1,4 +1,5 @@
-"""The import rules of docs/ARCHITECTURE.md, read from the source with ``ast`` (nothing is imported):
+"""The import rules of docs/ARCHITECTURE.md, read from the source with ``ast`` (nothing is
+imported):
 no circles between modules, generic layers never import a reference system (nor the TOML front
 end, the demo or the CLI), a system never imports another one, the zoo imports no system,
 ``signals`` never imports ``io``, ``atomic`` imports only ``errors``, no module imports another
@@ -110,7 +111,8 @@ def test_the_import_graph_has_no_circles():
 
 @pytest.mark.parametrize("rule", ["generic layers name no system", "systems stay apart",
                                   "systems sit below description, demos and cli",
-                                  "the zoo names its factories by string", "signals never imports io",
+                                  "the zoo names its "
+                                  "factories by string", "signals never imports io",
                                   "atomic writes import only errors"])
 def test_layering(rule):
     bad = []
@@ -150,6 +152,7 @@ def test_no_module_imports_another_packages_private_names():
 def test_the_rules_catch_what_they_forbid():
     """The checks above are not vacuous: the graph holds the imports they judge."""
     layers = {(_layer(a), _layer(b)) for a, b, _, _ in IMPORTS}
-    assert ("systems", "sim") in layers and ("systems", "batch") in layers and ("batch", "zoo") in layers
+    assert ("systems", "sim") in layers and ("systems",
+                                             "batch") in layers and ("batch", "zoo") in layers
     assert ("cli", "description") in layers and ("demos", "systems") in layers
     assert ("atomic", "errors") in layers and ("report", "atomic") in layers

@@ -13,7 +13,8 @@ from gripkit.errors import ConfigError
 from gripkit.io import load
 from gripkit.models import MassSpringDamper
 
-MSD = (Path(__file__).resolve().parents[1] / "examples" / "mass_spring_damper_step.toml").read_text()
+MSD = (Path(__file__).resolve().parents[1] / "examples"
+       / "mass_spring_damper_step.toml").read_text()
 
 
 def test_description_simulates_like_the_python_api(tmp_path):
@@ -28,9 +29,11 @@ def test_description_simulates_like_the_python_api(tmp_path):
 
 def test_input_kinds():
     t = np.arange(10) / 10.0
-    np.testing.assert_allclose(input_signal({"kind": "ramp", "start": 0, "end": 1, "t0": 0.2, "t1": 0.6}, t, "x"),
+    np.testing.assert_allclose(input_signal({"kind": "ramp", "start": 0, "end": 1, "t0": 0.2,
+                                             "t1": 0.6}, t, "x"),
                                np.clip((t - 0.2) / 0.4, 0, 1))
-    np.testing.assert_allclose(input_signal({"kind": "sine", "amplitude": 2, "frequency": 1, "offset": 1}, t, "x"),
+    np.testing.assert_allclose(input_signal({"kind": "sine", "amplitude": 2, "frequency": 1,
+                                             "offset": 1}, t, "x"),
                                1 + 2 * np.sin(2 * np.pi * t))
     s = input_signal({"kind": "steps", "levels": [1, 2, 3], "durations": [0.3, 0.3, 0.3]}, t, "x")
     np.testing.assert_array_equal(s, [1, 1, 1, 2, 2, 2, 3, 3, 3, 3])
@@ -83,7 +86,8 @@ phase_deg = -90.0
     assert code == 0
     res = json.loads(capsys.readouterr().out)
     assert res["samples"] == 200000 and res["out"] == str(out)
-    assert any("sensor-natural-frequency" in w for w in res["warnings"])  # the seed's contradiction, reported
+    # the seed's contradiction, reported
+    assert any("sensor-natural-frequency" in w for w in res["warnings"])
     tr = load(out)
     on = np.flatnonzero(tr["contact"] > 0.5)
     assert abs(tr["U"][on[0]] - 44.0) < 0.1   # Fig. 13: contact at U = 44 V

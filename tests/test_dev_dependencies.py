@@ -31,5 +31,6 @@ def test_reference_implementation_is_installed(name):
     try:
         importlib.import_module(name)
     except ImportError as exc:
-        pytest.fail(f"{name} is a dev/bench dependency pinned in requirements.lock, needed by the cross-check "
+        pytest.fail(f"{name} is a dev/bench dependency pinned in requirements.lock, needed by "
+                    "the cross-check "
                     f"tests; found: {exc}. Run `make install`.", pytrace=False)

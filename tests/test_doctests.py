@@ -12,7 +12,8 @@ import gripkit
 
 
 def _modules_with_examples():
-    names = [gripkit.__name__] + [m.name for m in pkgutil.walk_packages(gripkit.__path__, "gripkit.")]
+    names = ([gripkit.__name__] + [m.name for m in pkgutil.walk_packages(gripkit.__path__,
+                                                                         "gripkit.")])
     found = []
     for name in names:
         module = importlib.import_module(name)
@@ -31,6 +32,7 @@ def test_modules_with_examples_are_found():
 @pytest.mark.parametrize("name", MODULES)
 def test_module_examples_run(name):
     module = importlib.import_module(name)
-    result = doctest.testmod(module, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE, verbose=False)
+    result = (doctest.testmod(module, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE,
+                              verbose=False))
     assert result.failed == 0, \
         f"{result.failed} of {result.attempted} examples in {name} failed (output above)"

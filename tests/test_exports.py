@@ -23,8 +23,10 @@ def declared_and_exported(init: Path) -> tuple[list | None, set]:
     tree = ast.parse(init.read_text())
     declared, exported = None, set()
     for node in tree.body:
-        if isinstance(node, ast.Assign) and any(getattr(t, "id", None) == "__all__" for t in node.targets):
-            declared = [ast.literal_eval(e) for e in node.value.elts if not isinstance(e, ast.Starred)]
+        if isinstance(node, ast.Assign) and any(getattr(t, "id",
+                                                        None) == "__all__" for t in node.targets):
+            declared = ([ast.literal_eval(e) for e in node.value.elts
+                         if not isinstance(e, ast.Starred)])
             if any(isinstance(e, ast.Starred) for e in node.value.elts):  # __all__ = [*_LAZY, ...]
                 lazy = next(n for n in tree.body if isinstance(n, ast.Assign)
                             and any(getattr(t, "id", None) == "_LAZY" for t in n.targets))
@@ -33,7 +35,8 @@ def declared_and_exported(init: Path) -> tuple[list | None, set]:
             exported |= {a.asname for a in node.names if a.asname and not a.asname.startswith("_")}
         elif isinstance(node, (ast.FunctionDef, ast.ClassDef)) and not node.name.startswith("_"):
             exported.add(node.name)
-        elif isinstance(node, ast.Assign) and any(getattr(t, "id", None) == "_LAZY" for t in node.targets):
+        elif isinstance(node, ast.Assign) and any(getattr(t, "id",
+                                                          None) == "_LAZY" for t in node.targets):
             exported |= {ast.literal_eval(k) for k in node.value.keys}
     return declared, exported
 

@@ -52,7 +52,8 @@ def function_lengths(source: str) -> dict[str, tuple[int, int, ast.AST]]:
 
 def _numba_decorators(tree: ast.Module) -> set[str]:
     """Names bound at module level to a numba decorator (``hot = numba.njit(...)``)."""
-    return {t.id for node in tree.body if isinstance(node, ast.Assign) and "jit" in ast.unparse(node.value)
+    return {t.id for node in tree.body if isinstance(node, ast.Assign)
+            and "jit" in ast.unparse(node.value)
             for t in node.targets if isinstance(t, ast.Name)}
 
 
@@ -92,13 +93,15 @@ def test_no_function_is_longer_than_100_lines():
     assert not too_long, (
         f"{len(too_long)} function(s) longer than {LIMIT} lines: "
         + "; ".join(f"{where} ({length} lines)" for length, where in too_long[::-1])
-        + ". Split each into named steps with docstrings (docs/DEVELOPING.md); a scalar numba kernel whose "
+        + ". Split each into named steps with docstrings (docs/DEVELOPING.md); a scalar "
+          "numba kernel whose "
           "split measurably costs speed goes into NUMBA_KERNELS with that measurement.")
 
 
 def test_no_compiled_kernel_takes_more_than_12_arguments():
     crowded = sorted((n, f"src/gripkit/{rel}:{line} {name}")
-                     for (rel, name), (_, line, kernel, n) in LENGTHS.items() if kernel and n > KERNEL_ARGUMENTS)
+                     for (rel, name), (_, line, kernel, n) in LENGTHS.items() if kernel
+                     and n > KERNEL_ARGUMENTS)
     assert not crowded, (
         f"{len(crowded)} compiled kernel(s) with more than {KERNEL_ARGUMENTS} arguments: "
         + "; ".join(f"{where} ({n})" for n, where in crowded[::-1])

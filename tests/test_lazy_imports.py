@@ -22,9 +22,13 @@ SRC = Path(__file__).resolve().parents[1] / "src" / "gripkit"
 #: pyarrow 0.08 s, h5py 0.07 s, numba.cuda 0.06 s, rich.console/table/progress 0.03–0.04 s each,
 #: jinja2 0.02 s (the HTML report only)
 LAZY_PACKAGES = {
-    "scipy.signal": "0.85 s", "scipy.stats": "0.70 s", "scipy.optimize": "0.30 s", "scipy.spatial": "0.21 s",
+    "scipy.signal": "0.85 s", "scipy.stats": "0.70 s", "scipy.optimize": "0.30 s",
+    "scipy.spatial": "0.21 s",
     "scipy.linalg.blas": "0.13 s", "matplotlib": "0.34 s", "pint": "0.23 s", "pyarrow": "0.08 s",
-    "h5py": "0.07 s", "scipy.linalg": "0.2 s: a small ARX fit (`gripkit identify arx`) needs none", "scipy.io": "0.13-0.41 s (the .mat reader only)", "rich": "0.04 s per module", "jinja2": "the HTML report only", "numba": "numba.cuda, the GPU path only",
+    "h5py": "0.07 s", "scipy.io": "0.13-0.41 s (the .mat reader only)",
+    "scipy.linalg": "0.2 s: a small ARX fit (`gripkit identify arx`) needs none",
+    "rich": "0.04 s per module", "jinja2": "the HTML report only",
+    "numba": "numba.cuda, the GPU path only",
     # optional extras of pyproject.toml: absent unless installed
     "control": "extra 'interop'", "pinocchio": "extra 'pinocchio'", "distributed": "extra 'dask'",
     "mcap": "extra 'mcap'", "mcap_ros2": "extra 'mcap'",
@@ -32,15 +36,20 @@ LAZY_PACKAGES = {
 
 #: gripkit modules imported on first use: (importer, imported) → why
 LAZY_MODULES = {
-    ("sysid/linear/arx.py", ".lagged_sums"): "numba kernels: a small ARX is solved by QR without loading numba (0.45 s)",
+    ("sysid/linear/arx.py", ".lagged_sums"): "numba kernels: a small ARX is solved by QR without "
+                                             "loading numba (0.45 s)",
     ("sysid/identify.py", ".linear.rls"): "numba (0.4 s): `gripkit identify arx` does not load it",
-    ("sysid/linear/identify_mimo.py", ".pem_ss"): "numba kernels: only state-space identification loads them",
-    ("sysid/linear/identify_mimo.py", ".subspace"): "numba kernels: only state-space identification loads them",
-    ("sysid/linear/identify_mimo.py", ".tfest"): "scipy.signal (0.85 s): only transfer-function fits load it",
+    ("sysid/linear/identify_mimo.py", ".pem_ss"): "numba kernels: only state-space "
+                                                  "identification loads them",
+    ("sysid/linear/identify_mimo.py", ".subspace"): "numba kernels: only state-space "
+                                                    "identification loads them",
+    ("sysid/linear/identify_mimo.py", ".tfest"): "scipy.signal (0.85 s): only "
+                                                 "transfer-function fits load it",
     ("systems/tsfm/robustness.py", "...report.plots"):
         "matplotlib (0.34 s): only the robustness plot loads it",
     ("lti/_system.py", "._kernels"): "numba simulation kernel: lti loads without numba",
-    ("sysid/linear/linear_model.py", "...lti"): "lti's numba simulation kernel, loaded on the first simulation",
+    ("sysid/linear/linear_model.py", "...lti"): "lti's numba simulation kernel, loaded on the "
+                                                "first simulation",
     ("systems/tsfm/grasp_batch.py", ".grasp_gpu"): "numba.cuda: the GPU path only",
     ("io/formats.py", ".mcap_reader"): "the optional mcap extra",
     ("sysid/model_file.py", "..io.formats"):

@@ -31,7 +31,8 @@ def _named_fs():
             params = [p.arg for p in a.posonlyargs + a.args + a.kwonlyargs]
             if "fs" in params:
                 yield f"{rel}:{node.lineno} {node.name}() takes a parameter fs"
-            if node.name == "fs" and any(getattr(d, "id", None) == "property" for d in node.decorator_list):
+            if node.name == "fs" and any(getattr(d, "id",
+                                                 None) == "property" for d in node.decorator_list):
                 yield f"{rel}:{node.lineno} property fs"
 
 
@@ -47,7 +48,8 @@ def _named_ts():
                 for item in node.body:
                     if isinstance(item, ast.AnnAssign) and getattr(item.target, "id", None) == "ts":
                         yield f"{rel}:{item.lineno} {node.name}.ts field"
-                    if isinstance(item, ast.Assign) and any(getattr(t, "id", None) == "ts" for t in item.targets):
+                    if isinstance(item, ast.Assign) and any(getattr(t, "id", None) == "ts"
+                                                            for t in item.targets):
                         yield f"{rel}:{item.lineno} {node.name}.ts attribute"
 
 
@@ -61,15 +63,18 @@ def test_no_parameter_field_or_property_is_named_ts():
 
 def test_the_ts_check_finds_what_it_forbids(tmp_path, monkeypatch):
     (tmp_path / "control").mkdir()
-    (tmp_path / "control" / "c.py").write_text("class P:\n    ts: float = 1.0\n    ts = property(lambda s: 1)\n\n\n"
+    (tmp_path / "control" / "c.py").write_text("class P:\n    ts: float = 1.0\n    ts = "
+                                               "property(lambda s: 1)\n\n\n"
                                                 "def f(u, *, ts):\n    pass\n")
     monkeypatch.setattr(__import__(__name__), "SRC", tmp_path)
-    assert [x.split(" ", 1)[1] for x in _named_ts()] == ["P.ts field", "P.ts attribute", "f() takes a parameter ts"]
+    assert [x.split(" ", 1)[1] for x in _named_ts()] == ["P.ts field", "P.ts attribute",
+                                                         "f() takes a parameter ts"]
 
 
 def test_the_check_finds_what_it_forbids(tmp_path, monkeypatch):
     (tmp_path / "sysid").mkdir()
-    (tmp_path / "sysid" / "m.py").write_text("def f(u, fs):\n    pass\n\n\nclass C:\n    @property\n"
+    (tmp_path / "sysid" / "m.py").write_text("def f(u, fs):\n    pass\n\n\nclass "
+                                             "C:\n    @property\n"
                                              "    def fs(self):\n        return 1.0\n")
     (tmp_path / "io").mkdir()
     (tmp_path / "io" / "r.py").write_text("def load(path, fs=None):\n    pass\n")

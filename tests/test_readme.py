@@ -20,4 +20,5 @@ def test_readme_block_runs(index, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")       # the seeds' ConsistencyWarnings are expected here
-        exec(compile(BLOCKS[index], f"README.md block {index + 1}", "exec"), {"__name__": "__readme__"})
+        exec(compile(BLOCKS[index], f"README.md block {index + 1}", "exec"),
+             {"__name__": "__readme__"})

@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 
-def test_a_result_agrees_with_its_own_record_and_its_rows_are_spread(assert_matches_record, record_tools):
+def test_a_result_agrees_with_its_own_record_and_its_rows_are_spread(assert_matches_record,
+                                                                     record_tools):
     record_of, RECORD_RTOL = record_tools.record_of, record_tools.rtol
     result = np.column_stack([np.linspace(0.0, 1.0, 300), np.full(300, np.inf), np.zeros(300)])
     record = record_of(result)

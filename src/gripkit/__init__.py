@@ -28,7 +28,10 @@ from .signals.trajectory import Trajectory as Trajectory
 
 __version__ = "0.1.0"
 
-__all__ = ["ArgumentError", "check_consistency", "ConfigError", "ConsistencyReport", "ConsistencyWarning",
-           "DataError", "DataWarning", "Finding", "GripkitError", "GripkitWarning", "IdentificationError",
-           "ModelError", "Parameter", "ParameterError", "ParameterSet", "PathError", "SimulationError",
+__all__ = ["ArgumentError", "check_consistency", "ConfigError", "ConsistencyReport",
+           "ConsistencyWarning",
+           "DataError", "DataWarning", "Finding", "GripkitError", "GripkitWarning",
+           "IdentificationError",
+           "ModelError", "Parameter", "ParameterError", "ParameterSet", "PathError",
+           "SimulationError",
            "Trajectory", "UnidentifiableError", "__version__"]

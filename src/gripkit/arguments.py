@@ -34,7 +34,8 @@ def sample_interval(dt, error: type = DataError) -> float:
     >>> sample_interval(5e-5)
     5e-05
     """
-    if isinstance(dt, bool) or not isinstance(dt, numbers.Real) or not (math.isfinite(dt) and dt > 0):
+    if isinstance(dt, bool) or not isinstance(dt,
+                                              numbers.Real) or not (math.isfinite(dt) and dt > 0):
         raise error(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
     return float(dt)
 
@@ -42,7 +43,8 @@ def sample_interval(dt, error: type = DataError) -> float:
 def keyword_names(fn: Callable, exclude: Iterable[str] = ()) -> list[str]:
     """The named parameters of ``fn`` (its ``*args``/``**kwargs`` left out), minus ``exclude``."""
     skip = set(exclude)
-    return [n for n, p in inspect.signature(fn).parameters.items() if p.kind not in _VARIADIC and n not in skip]
+    return ([n for n, p in inspect.signature(fn).parameters.items() if p.kind not in _VARIADIC
+             and n not in skip])
 
 
 def check_keywords(given: Mapping | Iterable[str], accepted: Iterable[str], where: str,
@@ -81,15 +83,18 @@ def entry_point(fn: Callable) -> Callable:
             try:
                 sig.bind(*args, **kwargs)
             except TypeError as refused:  # the call itself did not fit: nothing of fn has run
-                accepted = ", ".join(n if p.kind not in _VARIADIC else f"*{n}" if p.kind is p.VAR_POSITIONAL
+                accepted = ", ".join(n if p.kind not in _VARIADIC else f"*{n}"
+                                     if p.kind is p.VAR_POSITIONAL
                                      else f"**{n}" for n, p in sig.parameters.items())
                 unknown = [k for k in kwargs if k not in sig.parameters]
-                if unknown and not any(p.kind is inspect.Parameter.VAR_KEYWORD for p in sig.parameters.values()):
+                if unknown and not any(p.kind is inspect.Parameter.VAR_KEYWORD
+                                       for p in sig.parameters.values()):
                     s = "s" if len(unknown) > 1 else ""
                     what = f"unknown keyword{s} {', '.join(map(repr, unknown))}"
                 else:
                     what = str(refused)
-                raise ArgumentError(f"{name}(): {what}", hint=f"{name} accepts {accepted}") from None
+                raise ArgumentError(f"{name}(): {what}",
+                                    hint=f"{name} accepts {accepted}") from None
             raise
 
     return wrapper

@@ -103,7 +103,8 @@ def atomic_write(path, write: Callable[[str], object], *, what: str = "file",
         if isinstance(exc, OSError) and not isinstance(exc, GripkitError):
             reason = exc.strerror or str(exc) or type(exc).__name__
             raise PathError(f"{what} {str(path)!r} could not be written ({reason}); {kept}",
-                            hint="free disk space or choose another path, then write it again") from exc
+                            hint="free disk space or choose another path, "
+                                 "then write it again") from exc
         raise
     if sync:
         _sync_folder(path.parent)

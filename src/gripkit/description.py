@@ -136,13 +136,16 @@ def _table(raw: Mapping, key: str, where: str) -> dict:
     return dict(v)
 
 
-_KINDS = {"constant": {"value"}, "step": {"initial", "final", "time"}, "ramp": {"start", "end", "t0", "t1"},
-          "sine": {"amplitude", "frequency", "offset", "phase_deg"}, "steps": {"levels", "durations"},
+_KINDS = {"constant": {"value"}, "step": {"initial", "final", "time"},
+          "ramp": {"start", "end", "t0", "t1"},
+          "sine": {"amplitude", "frequency", "offset", "phase_deg"},
+          "steps": {"levels", "durations"},
           "file": {"path", "column", "time"}}
 
 
 def input_signal(spec: Mapping, t: np.ndarray, where: str, base: Path | None = None) -> np.ndarray:
-    """The samples of one input described by ``spec`` at the times ``t`` (see the module docstring)."""
+    """The samples of one input described by ``spec`` at the times ``t`` (see the module
+    docstring)."""
     kind = spec.get("kind")
     if kind not in _KINDS:
         raise ConfigError(f"{where}: kind = {kind!r}; expected one of {', '.join(_KINDS)}")
@@ -153,7 +156,8 @@ def input_signal(spec: Mapping, t: np.ndarray, where: str, base: Path | None = N
     if kind == "constant":
         return np.full(t.size, _num(spec, "value", where))
     if kind == "step":
-        return np.where(t < _num(spec, "time", where), _num(spec, "initial", where, 0.0), _num(spec, "final", where))
+        return (np.where(t < _num(spec, "time", where), _num(spec, "initial", where, 0.0),
+                         _num(spec, "final", where)))
     if kind == "ramp":
         t0, t1 = _num(spec, "t0", where, 0.0), _num(spec, "t1", where)
         if t1 <= t0:
@@ -167,7 +171,8 @@ def input_signal(spec: Mapping, t: np.ndarray, where: str, base: Path | None = N
     if kind == "steps":
         lv, du = _numbers(spec, "levels", where), _numbers(spec, "durations", where)
         if len(du) != len(lv):
-            raise ConfigError(f"{where}: steps needs lists 'levels' and 'durations' of the same length, "
+            raise ConfigError(f"{where}: steps needs lists 'levels' and 'durations' of "
+                              "the same length, "
                               f"found {len(lv)} and {len(du)}")
         if min(du) <= 0:
             raise ConfigError(f"{where}: durations must be positive (s), found {min(du):g}")
@@ -203,7 +208,8 @@ def load_description(path, overrides: Mapping | None = None) -> Description:
     params.update(overrides or {})
     for key in ("type", "zoo"):
         if key in mspec and not isinstance(mspec[key], str):
-            raise ConfigError(f"{path.name}: [model] {key} must be a string, found {mspec[key]!r:.60}")
+            raise ConfigError(f"{path.name}: [model] {key} must be a string, found "
+                              f"{mspec[key]!r:.60}")
     zoo_names = [e.name for e in zoo.entries()]
     if "type" not in mspec and "zoo" not in mspec:
         raise ConfigError(f"{path.name}: [model] needs 'type' or 'zoo' "
@@ -236,36 +242,43 @@ def load_description(path, overrides: Mapping | None = None) -> Description:
     sim = _table(raw, "simulation", path.name)
     bad = set(sim) - {"fs", "dt", "duration"}
     if bad:
-        raise ConfigError(f"{path.name}: [simulation] unknown keys {sorted(bad)}", hint="keys: fs or dt, duration")
+        raise ConfigError(f"{path.name}: [simulation] unknown "
+                          f"keys {sorted(bad)}", hint="keys: fs or dt, duration")
     if ("fs" in sim) == ("dt" in sim):
         raise ConfigError(f"{path.name}: [simulation] needs exactly one of fs (Hz) or dt (s)")
     step = _num(sim, "fs" if "fs" in sim else "dt", "[simulation]")  # the file's fs (Hz) or dt (s)
     duration = _num(sim, "duration", "[simulation]")
     if step <= 0 or duration <= 0:
-        raise ConfigError(f"{path.name}: [simulation] {'fs' if 'fs' in sim else 'dt'} and duration must be positive")
+        raise ConfigError(f"{path.name}: [simulation] {'fs' if 'fs' in sim else 'dt'} and duration "
+                          "must be positive")
     dt = 1.0 / step if "fs" in sim else step
     n = duration / dt
     if not 1 <= round(n) <= 50_000_000:
-        raise ConfigError(f"{path.name}: [simulation] duration / dt = {n:.4g} samples; expected 1 to 50 million")
+        raise ConfigError(f"{path.name}: [simulation] duration / dt = {n:.4g} samples; expected "
+                          "1 to 50 million")
     n = int(round(n))
     t = np.arange(n) * dt
     ispec = _table(raw, "inputs", path.name)
     names = [s.name for s in model.inputs]
     missing = [nm for nm in names if nm not in ispec]
     if missing:
-        raise ConfigError(f"{path.name}: [inputs] misses {missing}", hint=f"{model.name} has inputs {names}")
+        raise ConfigError(f"{path.name}: [inputs] "
+                          f"misses {missing}", hint=f"{model.name} has inputs {names}")
     extra = sorted(set(ispec) - set(names))
     if extra:
-        raise ConfigError(f"{path.name}: [inputs] {extra} are not inputs of {model.name}", hint=f"inputs: {names}")
+        raise ConfigError(f"{path.name}: [inputs] {extra} are not inputs "
+                          f"of {model.name}", hint=f"inputs: {names}")
     for nm in names:
         if not isinstance(ispec[nm], Mapping):
-            raise ConfigError(f"{path.name}: inputs.{nm} must be a table ([inputs.{nm}]), found {ispec[nm]!r:.60}")
+            raise ConfigError(f"{path.name}: inputs.{nm} must be a table ([inputs.{nm}]), found "
+                              f"{ispec[nm]!r:.60}")
     ch = {nm: input_signal(ispec[nm], t, f"{path.name} [inputs.{nm}]", path.parent) for nm in names}
     units = {s.name: s.unit for s in model.inputs}
     inputs = Trajectory(t, ch, units, {"dt": dt, "source": path.name})
     out = _table(raw, "output", path.name).get("file")
     if out is not None and not isinstance(out, str):
-        raise ConfigError(f"{path.name}: [output] file must be a string (a path), found {out!r:.60}")
+        raise ConfigError(f"{path.name}: [output] file must be a string (a path), "
+                          f"found {out!r:.60}")
     return Description(model, inputs, (path.parent / out) if out else None, raw)
 
 

@@ -92,7 +92,8 @@ class ArgumentError(GripkitError, TypeError):
 
 class PathError(GripkitError, OSError):
     """A file or folder that cannot be used as asked: missing, a folder where a file is expected
-    (or the reverse), not readable or not writable. An ``OSError``, as Python raises for such paths."""
+    (or the reverse), not readable or not writable. An ``OSError``, as Python raises for such
+    paths."""
 
 
 class GripkitWarning(UserWarning):

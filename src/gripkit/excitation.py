@@ -27,7 +27,8 @@ from .errors import DataError
 from .signals.filters import apply_sos, butter_sos
 from .signals.trajectory import Trajectory
 
-__all__ = ["Excitation", "multisine", "periodic_multisine", "bandlimited_noise", "prbs", "chirp", "steps",
+__all__ = ["Excitation", "multisine", "periodic_multisine", "bandlimited_noise", "prbs", "chirp",
+           "steps",
            "crest_factor"]
 
 
@@ -89,12 +90,14 @@ def _check_common(duration: float, dt: float, operating_point: float,
         raise DataError(f"duration: expected a positive number of seconds, found {duration!r}")
     n = int(round(duration * rate))
     if n < 2:
-        raise DataError(f"duration {duration} s at dt = {dt:g} s gives {n} samples; need at least 2")
+        raise DataError(f"duration {duration} s at dt = {dt:g} s gives {n} samples; "
+                        "need at least 2")
     lo, hi = (float(limits[0]), float(limits[1]))
     if not lo < hi:
         raise DataError(f"limits: expected (lower, upper) with lower < upper, found {limits!r}")
     if not lo <= operating_point <= hi:
-        raise DataError(f"operating point {operating_point:g} lies outside the limits [{lo:g}, {hi:g}]")
+        raise DataError(f"operating point {operating_point:g} lies outside the limits "
+                        f"[{lo:g}, {hi:g}]")
     return n, lo, hi, rate
 
 
@@ -113,13 +116,15 @@ def _place(dev: np.ndarray, operating_point: float, lo: float, hi: float,
         scale = float(amplitude) / peak
         if scale > room * (1 + 1e-12):
             raise DataError(
-                f"amplitude {amplitude:g} around {operating_point:g} leaves the limits [{lo:g}, {hi:g}]",
+                f"amplitude {amplitude:g} around {operating_point:g} leaves the limits "
+                f"[{lo:g}, {hi:g}]",
                 hint=f"the largest amplitude that fits is {room * peak:.6g}",
             )
     return np.clip(operating_point + scale * dev, lo, hi)
 
 
-def multisine(frequencies: Sequence[float], duration: float, *, dt: float, operating_point: float = 0.0,
+def multisine(frequencies: Sequence[float], duration: float, *, dt: float,
+              operating_point: float = 0.0,
               limits: tuple[float, float] = (-1.0, 1.0), amplitude: float | None = None,
               phases: str = "min-crest", seed: int = 0, iterations: int = 200,
               unit: str = "1") -> Excitation:
@@ -134,7 +139,8 @@ def multisine(frequencies: Sequence[float], duration: float, *, dt: float, opera
     if f.size == 0:
         raise DataError("multisine needs at least one frequency")
     if (f <= 0).any() or (f >= rate / 2).any():
-        raise DataError(f"multisine frequencies must lie in (0, 1/(2 dt) = {rate / 2:g}) Hz, found {f.tolist()}")
+        raise DataError(f"multisine frequencies must lie in (0, 1/(2 dt) = {rate / 2:g}) Hz, "
+                        f"found {f.tolist()}")
     t = np.arange(n) / rate
     k = np.arange(1, f.size + 1)
     if phases == "zero":
@@ -144,7 +150,8 @@ def multisine(frequencies: Sequence[float], duration: float, *, dt: float, opera
     elif phases in ("schroeder", "min-crest"):
         phi = -np.pi * k * (k - 1) / f.size
     else:
-        raise DataError(f"phases: expected 'min-crest', 'schroeder', 'random' or 'zero', found {phases!r}")
+        raise DataError("phases: expected 'min-crest', 'schroeder', 'random' or 'zero', "
+                        f"found {phases!r}")
     bins = f * n / rate
     on_grid = np.allclose(bins, np.round(bins), atol=1e-6)
     if phases == "min-crest" and on_grid:
@@ -157,7 +164,8 @@ def multisine(frequencies: Sequence[float], duration: float, *, dt: float, opera
 
 
 def periodic_multisine(f_min: float, f_max: float, period_samples: int, periods: int, *, dt: float,
-                       lines: str = "all", operating_point: float = 0.0, limits: tuple[float, float] = (-1.0, 1.0),
+                       lines: str = "all", operating_point: float = 0.0,
+                       limits: tuple[float, float] = (-1.0, 1.0),
                        amplitude: float | None = None, seed: int = 0, iterations: int = 200,
                        unit: str = "1") -> Excitation:
     """A crest-factor-optimised multisine on chosen DFT lines of one period, repeated an integer
@@ -197,13 +205,16 @@ def periodic_multisine(f_min: float, f_max: float, period_samples: int, periods:
     elif lines != "all":
         raise DataError(f"lines: expected 'all', 'odd' or 'random-odd', found {lines!r}")
     if k.size == 0:
-        raise DataError(f"no DFT line of a {L}-sample period at dt = {dt:g} s (resolution {rate / L:g} Hz) lies in "
+        raise DataError(f"no DFT line of a {L}-sample period at dt = {dt:g} s (resolution "
+                        f"{rate / L:g} Hz) lies in "
                         f"[{f_min:g}, {f_max:g}] Hz", hint="lengthen the period or widen the band")
-    one = multisine(k * rate / L, L / rate, dt=dt, operating_point=operating_point, limits=limits, amplitude=amplitude,
+    one = multisine(k * rate / L, L / rate, dt=dt, operating_point=operating_point, limits=limits,
+                    amplitude=amplitude,
                     phases="min-crest", seed=seed, iterations=iterations, unit=unit)
     u = np.tile(one.u, P)
     t = np.arange(u.size) / rate
-    info = {**one.info, "lines": k.tolist(), "line_selection": lines, "period_samples": L, "periods": P}
+    info = ({**one.info, "lines": k.tolist(), "line_selection": lines, "period_samples": L,
+             "periods": P})
     return Excitation("multisine", t, u, float(dt), float(operating_point), one.limits, unit, info)
 
 
@@ -235,11 +246,13 @@ def bandlimited_noise(f_low: float, f_high: float, duration: float, *, dt: float
     (``f_low = 0`` gives a low-pass), scaled so its extreme just fits the limits."""
     n, lo, hi, rate = _check_common(duration, dt, operating_point, limits)
     if not 0 <= f_low < f_high < rate / 2:
-        raise DataError(f"band: expected 0 <= f_low < f_high < 1/(2 dt) = {rate / 2:g} Hz, found ({f_low}, {f_high})")
+        raise DataError(f"band: expected 0 <= f_low < f_high < 1/(2 dt) = {rate / 2:g} Hz, found "
+                        f"({f_low}, {f_high})")
     rng = np.random.default_rng(seed)
     pad = int(3 * rate / max(f_low, f_high / 10, 1e-3))
     w = rng.standard_normal(n + 2 * pad)
-    sos = butter_sos(order, f_high, dt=dt) if f_low == 0 else butter_sos(order, (f_low, f_high), dt=dt, btype="bandpass")
+    sos = (butter_sos(order, f_high, dt=dt) if f_low == 0 else butter_sos(order, (f_low, f_high),
+                                                                          dt=dt, btype="bandpass"))
     dev = apply_sos(sos, w, zero_phase=True)[pad:pad + n]
     dev -= dev.mean()
     t = np.arange(n) / rate
@@ -292,7 +305,8 @@ def chirp(f0: float, f1: float, duration: float, *, dt: float, method: str = "lo
 
     n, lo, hi, rate = _check_common(duration, dt, operating_point, limits)
     if not (0 < f0 < rate / 2 and 0 < f1 < rate / 2):
-        raise DataError(f"chirp frequencies must lie in (0, 1/(2 dt) = {rate / 2:g}) Hz, found {f0}, {f1}")
+        raise DataError(f"chirp frequencies must lie in (0, 1/(2 dt) = {rate / 2:g}) Hz, "
+                        f"found {f0}, {f1}")
     if method not in ("linear", "logarithmic"):
         raise DataError(f"method: expected 'linear' or 'logarithmic', found {method!r}")
     t = np.arange(n) / rate
@@ -310,10 +324,12 @@ def steps(levels: Sequence[float], durations: Sequence[float] | float, *, dt: fl
     levels = [float(v) for v in levels]
     if not levels:
         raise DataError("steps needs at least one level")
-    durs = [float(durations)] * len(levels) if np.isscalar(durations) else [float(d) for d in durations]
+    durs = ([float(durations)] * len(levels) if np.isscalar(durations)
+            else [float(d) for d in durations])
     if len(durs) != len(levels):
         raise DataError(f"steps: {len(levels)} levels but {len(durs)} durations")
-    lo, hi = limits if limits is not None else (min(levels), max(levels) if max(levels) > min(levels) else min(levels) + 1)
+    lo, hi = (limits if limits is not None else (min(levels), max(levels)
+                                                 if max(levels) > min(levels) else min(levels) + 1))
     op = levels[0] if operating_point is None else float(operating_point)
     rate = _check_common(sum(durs), dt, op, (lo, hi))[3]
     for v in levels:

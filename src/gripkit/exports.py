@@ -7,7 +7,8 @@ installs the module-level ``__getattr__`` and ``__dir__`` made here::
     _LAZY = {"arx": ("arx", "arx"), ...}
     __getattr__, __dir__ = lazy_exports(__name__, _LAZY)
 
-A name of the table that is also a submodule's name (``gripkit.sysid.linear.arx``, the function, in the
+A name of the table that is also a submodule's name (``gripkit.sysid.linear.arx``, the function, in
+the
 module ``gripkit/sysid/arx.py``) stays the public object: the import system's binding of the
 submodule to the package, on its first import, is not kept.
 """
@@ -25,12 +26,14 @@ class _LazyPackage(types.ModuleType):
     def __setattr__(self, name: str, value) -> None:
         if (isinstance(value, types.ModuleType) and name in self._lazy_table
                 and value.__name__ == f"{self.__name__}.{name}"):
-            return  # the import system binding a submodule over the public name of the same spelling
+            # the import system binding a submodule over the public name of the same spelling
+            return
         super().__setattr__(name, value)
 
 
 def lazy_exports(package: str, table: dict[str, tuple[str, str]]):
-    """The ``__getattr__`` and ``__dir__`` of ``package`` that load each name of ``table`` on first use."""
+    """The ``__getattr__`` and ``__dir__`` of ``package`` that load each name of ``table`` on first
+    use."""
     module = sys.modules[package]
 
     def __getattr__(name: str):

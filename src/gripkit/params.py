@@ -86,7 +86,8 @@ class Parameter:
         lo = -math.inf if lo is None else float(lo)
         hi = math.inf if hi is None else float(hi)
         if lo > hi:
-            raise ParameterError(f"parameter {self.name!r}: lower bound {lo:g} > upper bound {hi:g}")
+            raise ParameterError(f"parameter {self.name!r}: lower bound {lo:g} > "
+                                 f"upper bound {hi:g}")
         object.__setattr__(self, "bounds", (lo, hi))
         if not lo <= v <= hi:
             raise ParameterError(
@@ -100,7 +101,8 @@ class Parameter:
                 raise ParameterError(f"parameter {self.name!r}: std must be >= 0, found {s}")
             object.__setattr__(self, "std", s)
 
-    def with_value(self, value: float, std: float | None = None, source: str | None = None) -> "Parameter":
+    def with_value(self, value: float, std: float | None = None,
+                   source: str | None = None) -> "Parameter":
         """A copy holding ``value`` (SI), optionally with its uncertainty and provenance."""
         return dataclasses.replace(
             self, value=value, std=std, source=self.source if source is None else source
@@ -131,7 +133,8 @@ class ParameterSet(Mapping[str, Parameter]):
         d: dict[str, Parameter] = {}
         for p in params:
             if not isinstance(p, Parameter):
-                raise ParameterError(f"ParameterSet takes Parameter objects, found {type(p).__name__}")
+                raise ParameterError("ParameterSet takes Parameter objects, found "
+                                     f"{type(p).__name__}")
             if p.name in d:
                 raise ParameterError(f"parameter {p.name!r} appears twice in set {name!r}")
             d[p.name] = p
@@ -204,7 +207,8 @@ class ParameterSet(Mapping[str, Parameter]):
                     )
                 v = si
             elif isinstance(v, bool) or not isinstance(v, (int, float, np.integer, np.floating)):
-                raise ParameterError(f"parameter {name!r}: expected a number (in {p.unit!r}) or a string with "
+                raise ParameterError(f"parameter {name!r}: expected a number (in {p.unit!r}) "
+                                     "or a string with "
                                      f"its unit, found {type(v).__name__} {v!r:.40}")
             new[name] = p.with_value(float(v))
         return ParameterSet(new.values(), self.name)
@@ -215,7 +219,8 @@ class ParameterSet(Mapping[str, Parameter]):
         names = self.free_names if names is None else tuple(names)
         vec = np.asarray(vec, dtype=np.float64)
         if vec.shape != (len(names),):
-            raise ParameterError(f"expected a vector of {len(names)} values for {names}, found shape {vec.shape}")
+            raise ParameterError(f"expected a vector of {len(names)} values for {names}, found "
+                                 f"shape {vec.shape}")
         new = dict(self._params)
         for i, n in enumerate(names):
             s = None if std is None else float(std[i])
@@ -270,7 +275,8 @@ class ParameterSet(Mapping[str, Parameter]):
             val = convert(p.value, p.unit, u) if p.display_unit else p.value
             std = None
             if p.std is not None:
-                std = abs(convert(p.std, p.unit, u) - convert(0.0, p.unit, u)) if p.display_unit else p.std
+                std = (abs(convert(p.std, p.unit,
+                                   u) - convert(0.0, p.unit, u)) if p.display_unit else p.std)
             rows.append(dict(name=p.name, value=val, std=std, unit=u, fixed=p.fixed,
                              doc=p.doc, source=p.source))
         return rows

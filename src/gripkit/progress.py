@@ -69,6 +69,7 @@ def track(iterable: Iterable[T], total: int | None = None, description: str = "w
             if 10 * i >= tenth * total or i == total:
                 dt = time.perf_counter() - t0
                 eta = dt / frac - dt
-                status(f"  {description}: {i}/{total} ({100 * frac:.0f} %, {dt:.1f} s, ETA {eta:.1f} s)")
+                status(f"  {description}: {i}/{total} ({100 * frac:.0f} %, {dt:.1f} s, "
+                       f"ETA {eta:.1f} s)")
                 while tenth * total <= 10 * i:
                     tenth += 1

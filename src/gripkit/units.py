@@ -260,7 +260,8 @@ def convert(value: float, from_unit: str, to_unit: str) -> float:
     if not same_dimension(from_unit, to_unit):
         raise ParameterError(
             f"cannot convert from {from_unit!r} to {to_unit!r}: different dimensions",
-            hint=f"{from_unit!r} is {si_unit(from_unit)!r} in SI, {to_unit!r} is {si_unit(to_unit)!r}",
+            hint=f"{from_unit!r} is {si_unit(from_unit)!r} in SI, {to_unit!r} is "
+                 f"{si_unit(to_unit)!r}",
         )
     s1, o1, _ = si_factor(from_unit)
     s2, o2, _ = si_factor(to_unit)
@@ -284,7 +285,8 @@ def dimension_of(unit: str) -> str:
 
 def format_quantity(value_si: float, unit_si: str, display_unit: str | None = None,
                     digits: int = 4, std: float | None = None) -> str:
-    """Format an SI value for people, e.g. ``format_quantity(1.37e-6, 'kg', 'mg')`` → ``'1.37 mg'``."""
+    """Format an SI value for people, e.g. ``format_quantity(1.37e-6, 'kg', 'mg')`` → ``'1.37
+    mg'``."""
     unit = display_unit or unit_si
     v = convert(value_si, unit_si, unit) if display_unit else value_si
     text = _fmt(v, digits)

@@ -28,7 +28,8 @@ from gripkit.errors import (ArgumentError, ConfigError, DataError, Identificatio
 from corpus import assert_user_error
 
 
-MSD = (pathlib.Path(__file__).resolve().parents[2] / "examples" / "mass_spring_damper_step.toml").read_text()
+MSD = (pathlib.Path(__file__).resolve().parents[2] / "examples"
+       / "mass_spring_damper_step.toml").read_text()
 
 SWEEP = """
 [sweep]
@@ -80,7 +81,8 @@ def desc(tmp_path, old: str, new: str) -> pathlib.Path:
 
 
 def arx_args(path, *extra):
-    return ("identify", "arx", path, "--input", "u", "--output", "y", "--na", 2, "--nb", 2, "--nk", 1, *extra)
+    return ("identify", "arx", path, "--input", "u", "--output", "y", "--na", 2, "--nb", 2, "--nk",
+            1, *extra)
 
 
 # ---------------------------------------------------------------------------------------------- 12
@@ -95,15 +97,19 @@ def arx_args(path, *extra):
     (("zoo", "check", "ftg100-sensing", "--json", "--nope"), "no such option: --nope"),
     (("demo", "--quick", "--bogus"), "see 'gripkit demo --help'"),
     (("simulate", "msd.toml", "--out"), "option '--out' requires an argument"),
-    (("identify", "modal", "io.csv", "--signal", "y", "--start", "soon"), "invalid value for '--start'"),
-    (("identify", "bouc-wen", "io.csv", "--input", "u", "--output", "y", "--burn-in", "1.5"), "'--burn-in'"),
+    (("identify", "modal", "io.csv", "--signal", "y", "--start", "soon"),
+     "invalid value for '--start'"),
+    (("identify", "bouc-wen", "io.csv", "--input", "u", "--output", "y", "--burn-in", "1.5"),
+     "'--burn-in'"),
     (("identify", "friction", "io.csv", "--position", "y"), "missing option '--effort'"),
     (("identify", "rls", "io.csv", "--input", "u", "--output", "y", "--na", 2, "--nb", 2, "--nk", 1,
       "--forgetting", "high"), "invalid value for '--forgetting'"),
     (("identify", "search", "io.csv", "--input", "u", "--output", "y", "--top", "ten"), "'--top'"),
-    (("identify", "armax", "io.csv", "--input", "u", "--output", "y", "--na", 2, "--nb", 2, "--nk", 1),
+    (("identify", "armax", "io.csv", "--input", "u", "--output", "y", "--na", 2, "--nb", 2, "--nk",
+      1),
      "missing option '--nc'"),
-    (("identify", "oe", "io.csv", "--input", "u", "--output", "y", "--nb", 2, "--nf", "x", "--nk", 1), "'--nf'"),
+    (("identify", "oe", "io.csv", "--input", "u", "--output", "y", "--nb", 2, "--nf", "x", "--nk",
+      1), "'--nf'"),
     (("identify", "step", "io.csv", "--input", "u", "--output", "y", "--fs", "fast"), "'--fs'"),
     (("sweep", "sweep.toml", "--workers", "abc"), "invalid value for '--workers'"),
 ])
@@ -116,11 +122,13 @@ def test_usage_mistakes_are_one_line_usage_errors(cli, files, monkeypatch, args,
 
 def test_unknown_option_names_the_command_help(cli, files):
     res = cli(*arx_args(files / "io.csv", "--bogus"))
-    assert_user_error(res, "UsageError", "no such option: --bogus")  # click may add its guesses here
+    # click may add its guesses here
+    assert_user_error(res, "UsageError", "no such option: --bogus")
     assert res.error_lines[0].endswith("see 'gripkit identify arx --help'")
     res = cli(*arx_args(files / "io.csv")[:-2])  # no --nk
     assert_user_error(res, "UsageError", "missing option '--nk'")
-    res = cli("identify", "arx", files / "io.csv", "--input", "u", "--output", "y", "--na", "two", "--nb", 2, "--nk", 1)
+    res = (cli("identify", "arx", files / "io.csv", "--input", "u", "--output", "y", "--na", "two",
+               "--nb", 2, "--nk", 1))
     assert_user_error(res, "UsageError", "invalid value for '--na'")
 
 
@@ -141,7 +149,8 @@ def test_binary_toml_is_a_config_error(cli, files, command):
 
 @pytest.mark.parametrize("command", ["simulate", "sweep"])
 def test_folder_given_as_toml_is_a_config_error(cli, files, command):
-    assert_user_error(cli(command, files / "folder"), "ConfigError", "is a folder, expected a .toml file")
+    assert_user_error(cli(command, files / "folder"), "ConfigError",
+                      "is a folder, expected a .toml file")
     assert_user_error(cli(command, ""), "ConfigError", "'.' is a folder")
 
 
@@ -150,8 +159,10 @@ def test_unreadable_toml_is_a_config_error(cli, files, monkeypatch):
         raise PermissionError(errno.EACCES, "Permission denied", str(self))
 
     monkeypatch.setattr(pathlib.Path, "read_bytes", denied)
-    assert_user_error(cli("simulate", files / "msd.toml"), "ConfigError", "cannot be read: permission denied")
-    assert_user_error(cli("sweep", files / "sweep.toml"), "ConfigError", "cannot be read: permission denied")
+    assert_user_error(cli("simulate", files / "msd.toml"), "ConfigError",
+                      "cannot be read: permission denied")
+    assert_user_error(cli("sweep", files / "sweep.toml"), "ConfigError",
+                      "cannot be read: permission denied")
 
 
 def test_toml_errors_in_the_python_api(files):
@@ -179,7 +190,8 @@ def test_toml_with_a_byte_order_mark_is_read(tmp_path):
 def test_simulate_out_folder_refused_before_the_model_is_loaded(cli, files, monkeypatch):
     import gripkit.description as description
 
-    monkeypatch.setattr(description, "load_description", lambda *a, **k: pytest.fail("work started"))
+    monkeypatch.setattr(description, "load_description", lambda *a,
+                        **k: pytest.fail("work started"))
     res = cli("simulate", files / "msd.toml", "--out", files / "folder")
     assert_user_error(res, "PathError", "--out")
     assert "is a folder, expected a file" in res.err and not any((files / "folder").iterdir())
@@ -197,7 +209,8 @@ def test_simulate_bad_out_paths(cli, files, monkeypatch, out, phrase):
 
 
 def test_description_output_file_checked_before_simulating(cli, tmp_path, files):
-    p = desc(tmp_path, "duration = 0.5", f'duration = 0.5\n[output]\nfile = "{files / "plain" / "x.parquet"}"')
+    p = desc(tmp_path, "duration = 0.5", 'duration = 0.5\n[output]\nfile = '
+                                         f'"{files / "plain" / "x.parquet"}"')
     assert_user_error(cli("simulate", p), "PathError", "[output] file of bad.toml")
 
 
@@ -205,28 +218,37 @@ def test_rls_trajectory_path_checked_before_the_data(cli, files, monkeypatch):
     import gripkit.cli.identify_common as cmd  # the identify commands read their data there
 
     monkeypatch.setattr(cmd, "load_data", lambda *a, **k: pytest.fail("work started"))
-    base = ("identify", "rls", files / "io.csv", "--input", "u", "--output", "y", "--na", 2, "--nb", 2, "--nk", 1)
-    assert_user_error(cli(*base, "--trajectory", files / "plain" / "t.parquet"), "PathError", "is not a folder")
+    base = ("identify", "rls", files / "io.csv", "--input", "u", "--output", "y", "--na", 2, "--nb",
+            2, "--nk", 1)
+    assert_user_error(cli(*base, "--trajectory", files / "plain" / "t.parquet"), "PathError",
+                      "is not a folder")
     assert_user_error(cli(*base, "--trajectory", files / "folder"), "PathError", "--trajectory")
     assert_user_error(cli(*base, "--trajectory", files / "t.txt.gz"), "PathError", "suffix '.gz'")
 
 
-@pytest.mark.parametrize("command", [("sweep", "sweep.toml"), ("demo", "--quick", "--section", "tsfm")])
+@pytest.mark.parametrize("command", [("sweep", "sweep.toml"),
+                                     ("demo", "--quick", "--section", "tsfm")])
 def test_output_folder_options(cli, files, monkeypatch, command):
     monkeypatch.chdir(files)
-    assert_user_error(cli(*command, "--out", "plain"), "PathError", "--out 'plain' is a file, expected a folder")
+    assert_user_error(cli(*command, "--out", "plain"), "PathError", "--out 'plain' is a file, "
+                                                                    "expected a folder")
     assert_user_error(cli(*command, "--out", "plain/sub"), "PathError", "'plain' is not a folder")
 
 
 # operating-system errors that reach main(): translated generically as a last resort
 
 @pytest.mark.parametrize("exc, phrase", [
-    (FileNotFoundError(errno.ENOENT, "No such file or directory", "gone.csv"), "'gone.csv' not found"),
-    (IsADirectoryError(errno.EISDIR, "Is a directory", "out"), "'out' is a folder, expected a file"),
-    (NotADirectoryError(errno.ENOTDIR, "Not a directory", "plain/x"), "part of this path is a file"),
-    (PermissionError(errno.EACCES, "Permission denied", "r.parquet"), "permission denied on 'r.parquet'"),
+    (FileNotFoundError(errno.ENOENT, "No such file or directory", "gone.csv"),
+     "'gone.csv' not found"),
+    (IsADirectoryError(errno.EISDIR, "Is a directory", "out"), "'out' is a folder, "
+                                                               "expected a file"),
+    (NotADirectoryError(errno.ENOTDIR, "Not a directory", "plain/x"),
+     "part of this path is a file"),
+    (PermissionError(errno.EACCES, "Permission denied", "r.parquet"),
+     "permission denied on 'r.parquet'"),
     (FileExistsError(errno.EEXIST, "File exists", "plain"), "'plain' already exists"),
-    (OSError(errno.ENOSPC, "No space left on device", "big.h5"), "no space left on device ('big.h5'); free disk"),
+    (OSError(errno.ENOSPC, "No space left on device", "big.h5"), "no space left on device "
+                                                                 "('big.h5'); free disk"),
 ])
 def test_os_errors_become_path_errors(cli, files, monkeypatch, exc, phrase):
     """`simulate` whose save fails with each OS error (the checks before the work passed)."""
@@ -248,11 +270,13 @@ def test_undecodable_text_anywhere_is_a_data_error(cli, files, monkeypatch):
         b"\x93quoted\x94".decode("utf-8")
 
     monkeypatch.setattr(cmd, "load_data", fail)
-    assert_user_error(cli(*arx_args(files / "io.csv")), "DataError", "not UTF-8 text (byte 0x93 at offset 0")
+    assert_user_error(cli(*arx_args(files / "io.csv")), "DataError", "not UTF-8 text (byte "
+                                                                     "0x93 at offset 0")
 
 
 def test_a_bug_is_still_reported_as_unexpected(cli, files, monkeypatch):
-    """The catch-all stays for bugs: one line, 'unexpected', the exception's class, a pointer to --debug."""
+    """The catch-all stays for bugs: one line, 'unexpected', the exception's class, a pointer to
+    --debug."""
     import gripkit.cli.identify_common as cmd  # the identify commands read their data there
 
     monkeypatch.setattr(cmd, "load_data", lambda *a, **k: 1 / 0)
@@ -279,8 +303,10 @@ def test_a_bug_is_still_reported_as_unexpected(cli, files, monkeypatch):
 ])
 def test_identify_commands_refuse_folders_and_junk(cli, files, command):
     name, *opts = command
-    assert_user_error(cli("identify", name, files / "folder", *opts), "DataError", "is a folder, expected a data file")
-    assert_user_error(cli("identify", name, files / "junk.csv", *opts), "DataError", "not a readable CSV file")
+    assert_user_error(cli("identify", name, files / "folder", *opts), "DataError",
+                      "is a folder, expected a data file")
+    assert_user_error(cli("identify", name, files / "junk.csv", *opts), "DataError",
+                      "not a readable CSV file")
 
 
 def test_validation_record_that_is_a_folder(cli, files):
@@ -292,12 +318,14 @@ def test_validation_record_that_is_a_folder(cli, files):
 
 @pytest.mark.parametrize("old, new, phrase", [
     ('kind = "step"\ninitial = 0.0\nfinal = 0.1\ntime = 0.1',
-     'kind = "steps"\nlevels = ["a", 1]\ndurations = [0.1, 0.1]', "levels[0] must be a number, found 'a'"),
+     'kind = "steps"\nlevels = ["a", '
+     '1]\ndurations = [0.1, 0.1]', "levels[0] must be a number, found 'a'"),
     ('kind = "step"\ninitial = 0.0\nfinal = 0.1\ntime = 0.1',
      'kind = "steps"\nlevels = [0, 1]\ndurations = [-0.1, 0.1]', "durations must be positive"),
     ('kind = "step"\ninitial = 0.0\nfinal = 0.1\ntime = 0.1',
      'kind = "file"\npath = 3\ncolumn = "u"', "'path' must be a string, found 3"),
-    ('k = "20 N/m"', "k = [1, 2]", "parameter 'k': expected a number (in 'N/m') or a string with its unit"),
+    ('k = "20 N/m"', "k = [1, 2]", "parameter 'k': expected a number (in 'N/m') or a "
+                                   "string with its unit"),
     ('k = "20 N/m"', "k = true", "found bool true"),
     ('type = "mass-spring-damper"', 'type = ["a"]', "[model] type must be a string"),
     ("duration = 0.5", 'duration = 0.5\n[output]\nfile = 5', "[output] file must be a string"),
@@ -319,17 +347,22 @@ def test_description_section_that_is_not_a_table(cli, tmp_path):
 
 def test_modal_start_must_be_finite(cli, files):
     res = cli("identify", "modal", files / "io.csv", "--signal", "y", "--start", "nan")
-    assert_user_error(res, "DataError", "--start: expected the release time in s (a finite number), found nan")
+    assert_user_error(res, "DataError", "--start: expected the release time in s (a finite "
+                                        "number), found nan")
 
 
 def test_zoo_commands_name_the_models(cli):
-    for args in (("zoo", "show", "nope"), ("zoo", "check", "nope"), ("zoo", "discretize", "nope", "--fs", 1000)):
-        assert_user_error(cli(*args), "ModelError", "no zoo model 'nope'; available: amadeus-finger-force")
-    assert_user_error(cli("zoo", "discretize", "tsfm-left", "--fs", 1000), "ModelError", "discretize works on: ftg100")
+    for args in (("zoo", "show", "nope"), ("zoo", "check", "nope"),
+                 ("zoo", "discretize", "nope", "--fs", 1000)):
+        assert_user_error(cli(*args), "ModelError", "no zoo model 'nope'; available: "
+                                                    "amadeus-finger-force")
+    assert_user_error(cli("zoo", "discretize", "tsfm-left", "--fs", 1000), "ModelError",
+                      "discretize works on: ftg100")
 
 
 def test_sweep_scheduler_that_is_not_an_address(cli, files, tmp_path):
-    res = cli("sweep", files / "sweep.toml", "--backend", "dask", "--scheduler", "garbage", "--out", tmp_path / "s")
+    res = (cli("sweep", files / "sweep.toml", "--backend", "dask", "--scheduler", "garbage",
+               "--out", tmp_path / "s"))
     assert_user_error(res, "ConfigError", "dask")
 
 
@@ -348,14 +381,16 @@ def traj(files):
 
 
 def test_load_refuses_a_non_path():
-    with pytest.raises(ArgumentError, match=r"load\(\): path must be a file path \(str or pathlib.Path\), found int 12345"):
+    with pytest.raises(ArgumentError, match=r"load\(\): path must be a file path \(str or "
+                                            r"pathlib.Path\), found int 12345"):
         gripkit.io.load(12345)
     with pytest.raises(TypeError):  # an ArgumentError is a TypeError, as Python's own
         gripkit.io.load(None)
 
 
 def test_load_unknown_keyword_and_wrong_types(files):
-    with pytest.raises(ArgumentError, match=r"unknown keyword 'colums'; load accepts path, columns, time, fs"):
+    with pytest.raises(ArgumentError, match=r"unknown keyword 'colums'; load accepts path, "
+                                            r"columns, time, fs"):
         gripkit.io.load(files / "io.csv", colums=["u"])
     with pytest.raises(ArgumentError, match="units must be a mapping"):
         gripkit.io.load(files / "io.csv", units=["mN"])
@@ -391,9 +426,11 @@ def test_identify_unknown_keyword(traj, method, options, phrase):
 def test_identify_wrong_types_and_missing_arguments(traj):
     from gripkit.sysid import identify
 
-    with pytest.raises(ArgumentError, match="input must be a column name .str., found int 3; columns: u, y"):
+    with pytest.raises(ArgumentError, match="input must be a column name .str., found int "
+                                            "3; columns: u, y"):
         identify(traj, "arx", input=3, output="y")
-    with pytest.raises(ArgumentError, match="missing a required argument: 'output'; identify accepts data, method"):
+    with pytest.raises(ArgumentError, match="missing a required argument: 'output'; identify "
+                                            "accepts data, method"):
         identify(traj, "arx", input="u")
     with pytest.raises(DataError, match="method: expected one of arx, armax, oe, rls, search"):
         identify(traj, ["arx"], input="u", output="y")
@@ -410,11 +447,13 @@ def test_identify_known_options_still_work(traj):
     np.testing.assert_allclose(m.A, [1.0, -1.5, 0.7], atol=0.01)
 
 
-@pytest.mark.parametrize("fn, args", [("arx", (2, 2, 1)), ("armax", (2, 2, 1, 1)), ("oe", (2, 2, 1))])
+@pytest.mark.parametrize("fn, args", [("arx", (2, 2, 1)), ("armax", (2, 2, 1, 1)),
+                                      ("oe", (2, 2, 1))])
 def test_polynomial_fits_refuse_unknown_metadata_before_fitting(traj, fn, args):
     import gripkit.sysid as sysid
 
-    with pytest.raises(ArgumentError, match=rf"{fn}\(\): unknown keyword 'banana'; {fn} accepts u, y") as info:
+    with pytest.raises(ArgumentError, match=rf"{fn}\(\): unknown keyword 'banana'; "
+                                            rf"{fn} accepts u, y") as info:
         getattr(sysid, fn)(traj["u"], traj["y"], *args, banana=3)
     assert "the metadata input_name, output_name" in str(info.value)
 
@@ -422,7 +461,8 @@ def test_polynomial_fits_refuse_unknown_metadata_before_fitting(traj, fn, args):
 def test_rls_and_search_unknown_keyword(traj):
     from gripkit.sysid import rls, structure_search
 
-    with pytest.raises(ArgumentError, match=r"rls\(\): unknown keyword 'lam'; rls accepts u, y, na, nb, nk, forgetting"):
+    with pytest.raises(ArgumentError, match=r"rls\(\): unknown keyword 'lam'; rls accepts u, y, "
+                                            r"na, nb, nk, forgetting"):
         rls(traj["u"], traj["y"], 2, 2, 1, lam=0.99)
     with pytest.raises(ArgumentError, match="criterion"):
         structure_search(traj["u"], traj["y"], critrion="aic")
@@ -434,18 +474,23 @@ def test_simulate_entry_point():
 
     m = MassSpringDamper(m=1.0, b=1.0, k=1.0)
     u = np.ones(10)
-    with pytest.raises(ArgumentError, match=r"unknown keyword 'banana'; accepted: dt, x0, params, substeps"):
+    with pytest.raises(ArgumentError, match=r"unknown keyword 'banana'; accepted: dt, x0, "
+                                            r"params, substeps"):
         simulate(m, u, dt=0.1, banana=3)
-    with pytest.raises(ArgumentError, match="model must be a gripkit model .gripkit.sim.Model., found str 'nope'"):
+    with pytest.raises(ArgumentError, match="model must be a gripkit model .gripkit.sim.Model., "
+                                            "found str 'nope'"):
         simulate("nope", u, dt=0.1)
     with pytest.raises(ArgumentError, match="u: expected numbers"):
         simulate(m, "abc", dt=0.1)
-    with pytest.raises(ArgumentError, match="dt: expected a sample time in seconds .a number., found str"):
+    with pytest.raises(ArgumentError, match="dt: expected a sample time in seconds .a "
+                                            "number., found str"):
         simulate(m, u, dt="0.1")
-    with pytest.raises(ArgumentError, match="missing a required argument: 'u'; simulate accepts model, u, \\*\\*kwargs"):
+    with pytest.raises(ArgumentError, match="missing a required argument: 'u'; simulate accepts "
+                                            "model, u, \\*\\*kwargs"):
         simulate(m)
     # a right call still gives the right numbers: the exact (zero-order hold) unit-step response of
-    # m = b = k = 1 (ζ = 0.5, ω_n = 1 rad/s), x = 1 − e^{−ζt}(cos ω_d t + ζ/ω_d sin ω_d t), to rounding
+    # m = b = k = 1 (ζ = 0.5, ω_n = 1 rad/s), x = 1 − e^{−ζt}(cos ω_d t + ζ/ω_d sin ω_d t), to
+    # rounding
     tr = simulate(m, np.ones(20000), dt=1e-3)
     wd = np.sqrt(0.75)
     ref = 1 - np.exp(-0.5 * tr.t) * (np.cos(wd * tr.t) + 0.5 / wd * np.sin(wd * tr.t))
@@ -455,20 +500,25 @@ def test_simulate_entry_point():
 def test_zoo_build_and_get():
     from gripkit import zoo
 
-    with pytest.raises(ModelError, match="no zoo model 'nope'; available: amadeus-finger-force, amadeus-hand"):
+    with pytest.raises(ModelError, match="no zoo model 'nope'; available: "
+                                         "amadeus-finger-force, amadeus-hand"):
         zoo.build("nope")
-    with pytest.raises(ArgumentError, match="zoo model name: expected a str, found int 3; available: "):
+    with pytest.raises(ArgumentError, match="zoo model name: expected a str, found "
+                                            "int 3; available: "):
         zoo.build(3)
-    with pytest.raises(ArgumentError, match=r"zoo.build\('tsfm-left'\): unknown keyword 'banana'; accepted: as_printed, check"):
+    with pytest.raises(ArgumentError, match=r"zoo.build\('tsfm-left'\): unknown keyword 'banana'; "
+                                            r"accepted: as_printed, check"):
         zoo.build("tsfm-left", banana=3)
-    with pytest.raises(ArgumentError, match=r"zoo.build\(.amadeus-finger-force.\): unknown keyword .gain.; accepted: force_scale"):
+    with pytest.raises(ArgumentError, match=r"zoo.build\(.amadeus-finger-force.\): unknown keyword "
+                                            r".gain.; accepted: force_scale"):
         zoo.build("amadeus-finger-force", gain=2)
 
 
 def test_batch_sweep_unknown_keyword(files):
     from gripkit.batch import sweep
 
-    with pytest.raises(ArgumentError, match=r"sweep\(\): unknown keyword 'worker'; sweep accepts spec, backend, workers"):
+    with pytest.raises(ArgumentError, match=r"sweep\(\): unknown keyword 'worker'; sweep accepts "
+                                            r"spec, backend, workers"):
         sweep(files / "sweep.toml", worker=2)
 
 
@@ -476,7 +526,8 @@ def test_parameter_value_of_the_wrong_type():
     from gripkit.models import MassSpringDamper
 
     ps = MassSpringDamper().parameters
-    with pytest.raises(ParameterError, match="parameter 'k': expected a number .in 'N/m'. or a string with its unit, found list"):
+    with pytest.raises(ParameterError, match="parameter 'k': expected a number .in 'N/m'. or a "
+                                             "string with its unit, found list"):
         ps.replace(k=[1, 2])
     assert ps.replace(k="2 kN/m").value("k") == 2000.0
 
@@ -515,7 +566,8 @@ def test_identify_step_method_trf(cli, step_file):
     agrees with the default Levenberg-Marquardt to a small fraction of σ (the same minimum)."""
     fits = {}
     for method in ("trf", "lm"):
-        res = cli("identify", "step", step_file, "--input", "V_in", "--output", "x_a", "--method", method, "--json")
+        res = (cli("identify", "step", step_file, "--input", "V_in", "--output", "x_a", "--method",
+                   method, "--json"))
         assert res.code == 0, res.err
         fits[method] = d = res.json()
         assert d["method"] == method
@@ -527,7 +579,8 @@ def test_identify_step_method_trf(cli, step_file):
 
 
 def test_identify_step_method_validated_before_the_data(cli, tmp_path):
-    res = cli("identify", "step", tmp_path / "missing.csv", "--input", "u", "--output", "y", "--method", "newton")
+    res = (cli("identify", "step", tmp_path / "missing.csv", "--input", "u", "--output", "y",
+               "--method", "newton"))
     assert_user_error(res, "DataError", "--method: expected one of lm, trf, found 'newton'")
 
 
@@ -542,7 +595,8 @@ def test_identify_step_api_method(step_file):
 
 
 def test_identify_step_hint_names_the_cli_option(cli, step_file, monkeypatch):
-    """When Levenberg-Marquardt leaves the bounds, the hint tells both API and CLI users what to do."""
+    """When Levenberg-Marquardt leaves the bounds, the hint tells both API and CLI users what to
+    do."""
     import gripkit.sysid.physical.step_response as sr
 
     def out_of_bounds(*a, **k):

@@ -68,7 +68,8 @@ def test_cli_csv_cut_in_its_last_value_warns_naming_the_line(cli, tmp_path):
 def test_api_unterminated_last_line_warns_and_keeps_the_other_rows(tmp_path):
     p = tmp_path / "d.csv"
     p.write_text("t,u,y\n0,1,2\n0.01,2,1.529\n0.02,3,4\n0.03,1,1")
-    with pytest.warns(DataWarning, match=r"line 5, the last, has no line ending: the file looks truncated"):
+    with pytest.warns(DataWarning, match=r"line 5, the last, has no line ending: the file "
+                                         r"looks truncated"):
         tr = load(p)
     np.testing.assert_array_equal(tr["y"][:3], [2, 1.529, 4])
 
@@ -76,7 +77,8 @@ def test_api_unterminated_last_line_warns_and_keeps_the_other_rows(tmp_path):
 def test_api_line_with_missing_fields_is_refused_naming_it(tmp_path):
     p = tmp_path / "d.csv"
     p.write_text("t,u,y\n0,1,2\n0.01,2\n0.02,3,4\n")
-    with pytest.raises(DataError, match=r"d.csv: line 3 has 2 fields, the header has 3: the file looks truncated"):
+    with pytest.raises(DataError, match=r"d.csv: line 3 has 2 fields, the header has 3: the file "
+                                        r"looks truncated"):
         load(p)
 
 
@@ -84,7 +86,8 @@ def test_cli_last_line_with_missing_fields_is_refused_as_truncated(cli, clean_cs
     text = clean_csv.read_text().rstrip("\n")
     clean_csv.write_text(text[: text.rindex(",")])  # the last line loses its last field
     assert_user_error(cli(*ARX, clean_csv, *ORDERS), "DataError",
-                      "line 1001 has 2 fields, the header has 3 and is the last line, without a line ending: "
+                      "line 1001 has 2 fields, the header has 3 and is the last line, without "
+                      "a line ending: "
                       "the file looks truncated")
 
 
@@ -98,7 +101,8 @@ def test_a_complete_file_gives_no_warning(tmp_path, clean_csv):
 # ---------------------------------------------------------------- 7. --fs against a time column
 def test_cli_fs_disagreeing_with_the_time_column_is_refused(cli, clean_csv):
     res = cli(*ARX, clean_csv, *ORDERS, "--fs", 1000)
-    assert_user_error(res, "DataError", "fs=1000 Hz disagrees with the time column 't' (its stamps give 200 Hz)")
+    assert_user_error(res, "DataError", "fs=1000 Hz disagrees with the time column 't' (its "
+                                        "stamps give 200 Hz)")
 
 
 def test_cli_fs_agreeing_with_rounded_stamps_passes(cli, tmp_path):
@@ -135,40 +139,52 @@ def test_cli_fill_banana_on_clean_data_is_refused(cli, clean_csv):
 
 
 @pytest.mark.parametrize("args,phrase", [
-    (("arx", "--input", "u", "--output", "y", "--na", 2, "--nb", 2, "--nk", 1, "--detrend", "banana"),
+    (("arx", "--input", "u", "--output", "y", "--na", 2, "--nb", 2, "--nk", 1, "--detrend",
+      "banana"),
      "--detrend: expected one of mean, linear, none"),
-    (("arx", "--input", "u", "--output", "y", "--na", 2, "--nb", 0, "--nk", 1), "--nb: expected an integer >= 1"),
+    (("arx", "--input", "u", "--output", "y", "--na", 2, "--nb", 0, "--nk", 1),
+     "--nb: expected an integer >= 1"),
     (("armax", "--input", "u", "--output", "y", "--na", 2, "--nb", 2, "--nc", -1, "--nk", 1),
      "--nc: expected an integer >= 0"),
     (("oe", "--input", "u", "--output", "y", "--nb", 2, "--nf", 2, "--nk", 1, "--fill", "zero"),
      "fill: expected None, 'drop' or 'interpolate'"),
-    (("rls", "--input", "u", "--output", "y", "--na", 2, "--nb", 2, "--nk", 1, "--windup", "banana"),
+    (("rls", "--input", "u", "--output", "y", "--na", 2, "--nb", 2, "--nk", 1, "--windup",
+      "banana"),
      "windup: expected one of none, trace, directional"),
     (("rls", "--input", "u", "--output", "y", "--na", 2, "--nb", 2, "--nk", 1, "--forgetting", 1.5),
      "forgetting factor: expected 0 < λ <= 1"),
-    (("search", "--input", "u", "--output", "y", "--criterion", "bic"), "--criterion: expected one of aic, fpe, loss"),
-    (("search", "--input", "u", "--output", "y", "--na", "1:x"), "--na: expected a range like '1:4'"),
+    (("search", "--input", "u", "--output", "y", "--criterion", "bic"), "--criterion: expected one "
+                                                                        "of aic, fpe, loss"),
+    (("search", "--input", "u", "--output", "y", "--na", "1:x"), "--na: expected a "
+                                                                 "range like '1:4'"),
     (("search", "--input", "u", "--output", "y", "--top", 0), "--top: expected an integer >= 1"),
     (("step", "--input", "u", "--output", "y", "--fs", 0), "fs: expected a positive sampling rate"),
     (("modal", "--signal", "y", "--fill", "banana"), "fill: expected None"),
-    (("bouc-wen", "--input", "u", "--output", "y", "--burn-in", -3), "--burn-in: expected an integer >= 0"),
-    (("friction", "--position", "u", "--effort", "y", "--cutoff", -5), "--cutoff: expected a finite number > 0"),
-    (("friction", "--position", "u", "--effort", "y", "--effort-scale", 0), "--effort-scale: expected a finite number, not zero"),
+    (("bouc-wen", "--input", "u", "--output", "y", "--burn-in", -3), "--burn-in: expected "
+                                                                     "an integer >= 0"),
+    (("friction", "--position", "u", "--effort", "y", "--cutoff", -5), "--cutoff: expected a "
+                                                                       "finite number > 0"),
+    (("friction", "--position", "u", "--effort", "y", "--effort-scale", 0),
+     "--effort-scale: expected a finite number, not zero"),
 ])
 def test_cli_every_identify_option_is_checked_before_the_data(cli, tmp_path, args, phrase):
     """The data file does not exist: the option error must come first (it would otherwise be
     reported only after a possibly long load, or never on clean data)."""
     command, rest = args[0], args[1:]
-    assert_user_error(cli("identify", command, tmp_path / "missing.csv", *rest), "DataError", phrase)
+    assert_user_error(cli("identify", command, tmp_path / "missing.csv", *rest), "DataError",
+                      phrase)
 
 
 def test_cli_missing_validation_file_is_reported_before_the_fit(cli, clean_csv, tmp_path):
-    assert_user_error(cli(*ARX, clean_csv, *ORDERS, "--validate", tmp_path / "nope.csv"), "DataError",
+    assert_user_error(cli(*ARX, clean_csv, *ORDERS, "--validate", tmp_path / "nope.csv"),
+                      "DataError",
                       "--validate: data file")
 
 
-@pytest.mark.parametrize("kw,phrase", [({"fill": "banana"}, "fill: expected None, 'drop' or 'interpolate'"),
-                                       ({"fs": -5.0}, "fs: expected a positive sampling rate in Hz")])
+@pytest.mark.parametrize("kw,phrase", [({"fill": "banana"}, "fill: expected None, 'drop' "
+                                                            "or 'interpolate'"),
+                                       ({"fs": -5.0}, "fs: expected a positive "
+                                                      "sampling rate in Hz")])
 def test_api_load_checks_options_before_reading(tmp_path, kw, phrase):
     """An unreadable file: the option error comes first, so it was checked before any reading."""
     p = tmp_path / "broken.parquet"
@@ -177,7 +193,8 @@ def test_api_load_checks_options_before_reading(tmp_path, kw, phrase):
         load(p, **kw)
 
 
-# ---------------------------------------------------------------- 9. corrupt samples and extreme scales
+# ---------------------------------------------------------------- 9. corrupt samples and extreme
+# scales
 def test_cli_corrupt_sample_warns_naming_its_time(cli, tmp_path):
     """One force value of 1e29 at t = 2 s: the warning names the column, the value and the time,
     also when the fit then refuses or warns about the data."""
@@ -185,7 +202,8 @@ def test_cli_corrupt_sample_warns_naming_its_time(cli, tmp_path):
     y[400] = 1e29
     p = write_csv(tmp_path / "spike.csv", u, y)
     res = cli(*ARX, p, *ORDERS, "--json")
-    assert_warned(res, "column 'force' has 1 sample far outside the rest of the channel, which looks "
+    assert_warned(res, "column 'force' has 1 sample far outside the rest of the "
+                       "channel, which looks "
                        "corrupt: 1e+29 N at t=2 s")
 
 
@@ -209,7 +227,8 @@ def test_outlier_check_is_silent_on_gaussian_data(n):
 
 def test_outlier_check_is_silent_on_structured_signals():
     """Steps, PRBS, a fast-decaying vibration, a decaying σ(t) trajectory and a train of 50
-    one-sample trigger pulses (more than the 2m = 10 samples a corruption may touch) are not corrupt."""
+    one-sample trigger pulses (more than the 2m = 10 samples a corruption may touch) are not
+    corrupt."""
     t = np.arange(5000) / 1000
     rng = np.random.default_rng(0)
     signals = {
@@ -224,7 +243,8 @@ def test_outlier_check_is_silent_on_structured_signals():
 
 
 @pytest.mark.parametrize("scale", [1e300, 1e-300])
-@pytest.mark.parametrize("fit", [lambda u, y: arx(u, y, 2, 2, 1), lambda u, y: armax(u, y, 2, 2, 1, 1),
+@pytest.mark.parametrize("fit", [lambda u, y: arx(u, y, 2, 2, 1), lambda u,
+                                 y: armax(u, y, 2, 2, 1, 1),
                                  lambda u, y: oe(u, y, 2, 2, 1)], ids=["arx", "armax", "oe"])
 def test_extreme_but_valid_scales_are_identified_in_the_users_units(scale, fit):
     """Both signals scaled by 1e±300: the same A (and C, F) and B as at unit scale (the internal
@@ -271,7 +291,8 @@ def test_step_and_modal_identification_at_extreme_scales(scale):
     y = signal.lsim(([0.2 * wn**2], [1, 2 * zeta * wn, wn**2]), u, t)[1]
     y = y + 1e-4 * np.random.default_rng(0).standard_normal(t.size)
     ref = identify_step(Trajectory(t, {"u": u, "y": y}), input="u", output="y").to_dict()
-    res = identify_step(Trajectory(t, {"u": u * scale, "y": y * scale}), input="u", output="y").to_dict()
+    res = (identify_step(Trajectory(t, {"u": u * scale, "y": y * scale}), input="u",
+                         output="y").to_dict())
     for key in ("gain", "natural_frequency_hz", "damping_ratio"):
         assert res[key] == pytest.approx(ref[key], rel=1e-6), key
     x = np.exp(-zeta * wn * t) * np.cos(wn * np.sqrt(1 - zeta**2) * t)
@@ -308,13 +329,15 @@ def test_cli_identifies_a_file_at_1e_minus_300(cli, tmp_path):
 
 def test_rls_at_1e300_is_refused_as_overflow_not_as_windup():
     u, y = simulate()
-    with pytest.raises(DataError, match=r"values up to [\d.]+e\+30\d in u and y make φᵀPφ overflow float64"):
+    with pytest.raises(DataError, match=r"values up to [\d.]+e\+30\d in u and y make φᵀPφ "
+                                        r"overflow float64"):
         rls(u * 1e300, y * 1e300, 2, 2, 1)
 
 
 def test_rls_at_1e_minus_300_is_refused_as_outweighed_by_the_prior():
     u, y = simulate()
-    with pytest.raises(IdentificationError, match=r"carries almost no information next to the prior"):
+    with pytest.raises(IdentificationError, match=r"carries almost no information "
+                                                  r"next to the prior"):
         rls(u * 1e-300, y * 1e-300, 2, 2, 1)
 
 
@@ -332,14 +355,17 @@ def collinear(eps: float, n: int = 2000, seed: int = 3):
 def test_ill_conditioned_fit_warns_naming_the_poor_parameters():
     """κ = 1.3e5 < 1e10 (no error), the B estimate is tens of units off the truth [1, 0.5, 0.2]."""
     u, y = collinear(1e-5)
-    with pytest.warns(AccuracyWarning, match=r"the data barely determine the parameters \(regressor condition "
-                                             r"number 1.26e\+05 > .*poorly determined are b\d .*b\d .*b\d "):
+    with pytest.warns(AccuracyWarning, match=r"the data barely determine the parameters "
+                                             r"\(regressor condition "
+                                             r"number 1.26e\+05 > .*poorly determined are "
+                                             r"b\d .*b\d .*b\d "):
         m = arx(u, y, 0, 3, 1)
     assert 1e5 < m.info["cond"] < 1e10 and np.max(np.abs(m.B[1:] - [1.0, 0.5, 0.2])) > 5
 
 
 def test_the_issue_case_near_the_hard_limit_warns():
-    """κ ≈ 9e9, just below the 1e10 hard limit, where the issue found B = [-18100, 36131, -18101]."""
+    """κ ≈ 9e9, just below the 1e10 hard limit, where the issue found B = [-18100, 36131,
+    -18101]."""
     u, y = collinear(1.4e-10)
     with pytest.warns(AccuracyWarning, match="barely determine"):
         m = arx(u, y, 0, 3, 1)
@@ -357,7 +383,8 @@ def test_well_conditioned_fit_does_not_warn():
 def test_cli_ill_conditioned_fit_warns_on_stderr_and_in_json(cli, tmp_path):
     u, y = collinear(1e-5)
     p = write_csv(tmp_path / "c.csv", u, y)
-    res = cli("identify", "arx", p, "--input", "current", "--output", "force", "--na", 0, "--nb", 3, "--nk", 1,
+    res = cli("identify", "arx", p, "--input", "current", "--output", "force", "--na", 0, "--nb", 3,
+              "--nk", 1,
               "--detrend", "none", "--json")
     assert res.code == 0, res.err
     assert_warned(res, "AccuracyWarning: the data barely determine the parameters")
@@ -371,7 +398,8 @@ def test_rls_update_refuses_non_finite_samples_and_keeps_its_state(bad):
     for t in range(200):
         est.update(u[t], y[t])
     theta, P, n = est.theta, est.P, est.n_updates
-    with pytest.raises(DataError, match="RLS.update: sample 200 is not finite.*the estimator is unchanged"):
+    with pytest.raises(DataError, match="RLS.update: sample 200 is not finite.*the "
+                                        "estimator is unchanged"):
         est.update(*bad)
     np.testing.assert_array_equal(est.theta, theta)
     np.testing.assert_array_equal(est.P, P)
@@ -401,33 +429,38 @@ def test_rls_update_detects_windup_divergence_like_run():
     assert 6000 < est.n_updates < 7000
     assert np.isfinite(est.P).all() and np.isfinite(est.theta).all()
     with pytest.raises(IdentificationError, match=r"diverged after \d+ updates"):
-        y = 1e-3 * np.random.default_rng(0).standard_normal(10_000)  # excites a1, a2; u excites b only once
+        # excites a1, a2; u excites b only once
+        y = 1e-3 * np.random.default_rng(0).standard_normal(10_000)
         RLS(2, 2, 1, forgetting=0.9, windup="none").run(np.r_[1.0, np.zeros(9999)], y)
 
 
 def test_one_row_csv_names_the_file(cli, tmp_path):
     p = tmp_path / "one.csv"
     p.write_text("t,u,y\n0,1,2\n")
-    res = cli("identify", "arx", p, "--input", "u", "--output", "y", "--na", 1, "--nb", 1, "--nk", 1)
+    res = (cli("identify", "arx", p, "--input", "u", "--output", "y", "--na", 1, "--nb", 1, "--nk",
+               1))
     assert_user_error(res, "DataError", "one.csv: 1 sample(s) have no sample interval")
 
 
 def test_junk_mcap_is_not_read_as_mcap(cli, tmp_path):
     p = tmp_path / "log.mcap"
     p.write_text("junk\n")
-    res = cli("identify", "arx", p, "--input", "u", "--output", "y", "--na", 1, "--nb", 1, "--nk", 1)
+    res = (cli("identify", "arx", p, "--input", "u", "--output", "y", "--na", 1, "--nb", 1, "--nk",
+               1))
     assert_user_error(res, "DataError", "log.mcap: not an MCAP file")
 
 
 def test_repeated_column_name_is_refused(cli, tmp_path):
     p = tmp_path / "dup.csv"
     p.write_text("t,u,u\n" + "".join(f"{k / 100},{np.sin(k)},{np.cos(k)}\n" for k in range(50)))
-    res = cli("identify", "arx", p, "--input", "u", "--output", "u", "--na", 1, "--nb", 1, "--nk", 1)
+    res = (cli("identify", "arx", p, "--input", "u", "--output", "u", "--na", 1, "--nb", 1, "--nk",
+               1))
     assert_user_error(res, "DataError", "column name 'u' appears 2 times")
 
 
 def test_header_without_rows_names_the_file(cli, tmp_path):
     p = tmp_path / "hdr.csv"
     p.write_text("t,u,y\n")
-    res = cli("identify", "arx", p, "--input", "u", "--output", "y", "--na", 1, "--nb", 1, "--nk", 1)
+    res = (cli("identify", "arx", p, "--input", "u", "--output", "y", "--na", 1, "--nb", 1, "--nk",
+               1))
     assert_user_error(res, "DataError", "hdr.csv: the file has column names but no data rows")

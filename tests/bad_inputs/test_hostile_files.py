@@ -277,7 +277,8 @@ def test_parquet_text_repeated_from_a_dictionary_is_not_multiplied(tmp_path):
     note = pa.array(["x" * 2**20] * 200).dictionary_encode()
     pq.write_table(pa.table({"t": np.arange(200) / 1e3, "note": note}), p, compression="zstd")
     small = tmp_path / "small.parquet"  # the reader's first use imports modules: not this test's
-    pq.write_table(pa.table({"t": np.arange(3) / 1e3, "note": pa.array(["x"] * 3).dictionary_encode()}),
+    pq.write_table(pa.table({"t": np.arange(3) / 1e3,
+                             "note": pa.array(["x"] * 3).dictionary_encode()}),
                    small)
     _refused(small, "column 'note' mixes numbers and text")
     tracemalloc.start()

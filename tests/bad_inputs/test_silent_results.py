@@ -158,7 +158,8 @@ def test_cli_identify_ss_unstable_plant_warns_on_stderr_and_in_json(cli, tmp_pat
     # output-error refinement is returned (issue 25's default focus) and the warning names it
     assert_warned(res, "StabilityWarning: pem-oe: the data point to an unstable system "
                        "(the subspace estimate has largest |pole| 1.02")
-    assert_warned(res, "AccuracyWarning: PEM refinement (pem-innovation) lowered the mean simulation fit")
+    assert_warned(res, "AccuracyWarning: PEM refinement (pem-innovation) lowered the "
+                       "mean simulation fit")
     assert_warned(res, "it was stabilised to largest |pole|")
     d = res.json()
     assert d["stable"] is True and d["info"]["stabilised"]["largest_pole_before"] > 1.0

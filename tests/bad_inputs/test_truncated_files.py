@@ -1,4 +1,5 @@
-"""Property (issue 11, §3): a valid CSV, Parquet or HDF5 file cut at any byte offset loads as the same
+"""Property (issue 11, §3): a valid CSV, Parquet or HDF5 file cut at any byte offset loads as the
+same
 data, or with a warning, or fails with a gripkit error — never as different data in silence and
 never with a raw pyarrow/h5py exception.
 
@@ -83,6 +84,8 @@ def test_every_outcome_occurs_for_csv(originals):
     original, raw = files[".csv"]
     line_end = raw.index(b"\n", len(raw) // 2) + 1
     assert check_cut(folder, original, raw, ".csv", line_end) == "prefix"
-    assert check_cut(folder, original, raw, ".csv", line_end - 3) == "warning"  # last value cut short
-    assert check_cut(folder, original, raw, ".csv", raw.index(b",", line_end) + 1) == "error"  # fields missing
+    # last value cut short
+    assert check_cut(folder, original, raw, ".csv", line_end - 3) == "warning"
+    # fields missing
+    assert check_cut(folder, original, raw, ".csv", raw.index(b",", line_end) + 1) == "error"
     assert check_cut(folder, original, raw, ".csv", 0) == "error"  # empty file

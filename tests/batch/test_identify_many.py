@@ -31,7 +31,8 @@ def folder(tmp_path_factory):
     for i, k in enumerate(K_TRUE):
         y = MassSpringDamper(m=1.8e-6, b=7e-4, k=k).simulate(u, dt=5e-5)["x"]
         y = y + 0.01 * y.std() * rng.standard_normal(y.size)
-        save(Trajectory.uniform(dt=5e-05, F=u, x=y, units={"F": "N", "x": "m"}), d / f"finger{i}.parquet")
+        save(Trajectory.uniform(dt=5e-05, F=u, x=y, units={"F": "N", "x": "m"}),
+             d / f"finger{i}.parquet")
     bad = np.array(y)
     bad[10] = np.nan
     save_bad = d / "finger_broken.csv"

@@ -54,7 +54,8 @@ def test_binned_probability_recovers_a_known_dose_response():
     assert len(rows) == 6
     inside = 0
     for r in rows:
-        u = np.linspace(np.log(r["low"]), np.log(r["high"]), 2001)   # k log-uniform: uniform in ln k
+        # k log-uniform: uniform in ln k
+        u = np.linspace(np.log(r["low"]), np.log(r["high"]), 2001)
         truth = stats.logistic.cdf((u - np.log(300)) / 0.3).mean()
         inside += r["p_low"] <= truth <= r["p_high"]
     assert inside >= 5   # each interval misses with probability 5 %

@@ -8,7 +8,8 @@ from gripkit.errors import ConfigError
 
 
 def spec(params, samples=1, seed=0):
-    return SweepSpec.from_dict({"sweep": {"scenario": "step-response", "samples": samples, "seed": seed},
+    return SweepSpec.from_dict({"sweep": {"scenario": "step-response", "samples": samples,
+                                          "seed": seed},
                                 "parameters": params})
 
 
@@ -78,10 +79,13 @@ def test_job_order_is_the_nested_loop(tmp_path):
 
     (tmp_path / "rows.csv").write_text("r\n10\n20\n30\n")
     s = SweepSpec.from_dict({"sweep": {"scenario": "step-response", "samples": 2},
-                             "parameters": {"a": {"grid": [1.0, 2.0]}, "t": {"table": "rows.csv", "column": "r"},
-                                            "b": {"linspace": [0.0, 1.0, 3]}}}, base_dir=str(tmp_path))
+                             "parameters": {"a": {"grid": [1.0, 2.0]},
+                                            "t": {"table": "rows.csv", "column": "r"},
+                                            "b": {"linspace": [0.0, 1.0, 3]}}},
+                                            base_dir=str(tmp_path))
     jobs = s.jobs()
-    loops = [(a, b, t) for a, b in itertools.product([1.0, 2.0], [0.0, 0.5, 1.0]) for t in (10.0, 20.0, 30.0)
+    loops = [(a, b, t) for a, b in itertools.product([1.0, 2.0],
+                                                     [0.0, 0.5, 1.0]) for t in (10.0, 20.0, 30.0)
              for _ in range(2)]
     assert s.n_jobs() == len(loops) == 36
     assert list(zip(jobs["a"], jobs["b"], jobs["t"])) == loops

@@ -40,7 +40,8 @@ def reference():
 
 def test_in_process_metrics_are_right(reference):
     """Overshoot of m x'' + b x' + k x = F against the analytic 100 exp(-πζ/√(1-ζ²))."""
-    for k, b, ov, fin in zip(reference["k"], reference["b"], reference["overshoot_percent"], reference["final"]):
+    for k, b, ov, fin in zip(reference["k"], reference["b"], reference["overshoot_percent"],
+                             reference["final"]):
         assert ov == pytest.approx(analytic_overshoot(1.0, b, k), abs=0.5)
         assert fin == pytest.approx(2.0 / k, rel=0.02)
     assert not reference.failed.any() and reference.n_jobs == 12
@@ -147,7 +148,8 @@ def flaky_scenario(model, params, settings):
 
 
 def flaky_spec(tmp_path, kill):
-    return SweepSpec.from_dict({"sweep": {"scenario": flaky_scenario, "chunk_size": 2, "samples": 2},
+    return SweepSpec.from_dict({"sweep": {"scenario": flaky_scenario, "chunk_size": 2,
+                                          "samples": 2},
                                 "parameters": {"k": {"grid": [1.0, 2.0, 4.0, 8.0, 16.0]}},
                                 "scenario": {"marker": str(tmp_path / "marker"), "kill": kill}})
 
@@ -163,7 +165,8 @@ def test_failing_jobs_are_recorded_and_the_sweep_finishes(tmp_path):
 
 def test_killed_worker_leaves_every_result_exactly_once(tmp_path):
     out = tmp_path / "run"
-    res = sweep(flaky_spec(tmp_path, kill=True), backend="process", workers=2, out=out, progress=False)
+    res = (sweep(flaky_spec(tmp_path, kill=True), backend="process", workers=2, out=out,
+                 progress=False))
     assert (tmp_path / "marker").exists()  # a worker really was killed mid-sweep
     ids = res["job_id"]
     assert sorted(ids.tolist()) == list(range(10))  # every job exactly once
@@ -171,7 +174,8 @@ def test_killed_worker_leaves_every_result_exactly_once(tmp_path):
     np.testing.assert_array_equal(res["twice_k"][ok], 2 * res["k"][ok])
     import pyarrow.parquet as pq
 
-    on_disk = np.concatenate([pq.read_table(p)["job_id"].to_numpy() for p in (out / "chunks").glob("*.parquet")])
+    on_disk = (np.concatenate([pq.read_table(p)["job_id"].to_numpy()
+                               for p in (out / "chunks").glob("*.parquet")]))
     assert sorted(on_disk.tolist()) == list(range(10))
 
 
@@ -220,7 +224,8 @@ def test_many_tiny_tasks_never_stall_the_pool():
 
     def work():
         with ProcessExecutor(2) as ex:
-            out["res"] = sorted(v for _, ok, v in ex.map_unordered((i, square, (i,)) for i in range(400)))
+            out["res"] = (sorted(v for _, ok, v in ex.map_unordered((i, square,
+                                                                     (i,)) for i in range(400))))
 
     th = threading.Thread(target=work, daemon=True)
     th.start()

@@ -63,14 +63,16 @@ def scen_dir(tmp_path, monkeypatch):
 def spec_file(tmp_path, name="faults", **settings) -> Path:
     p = tmp_path / f"{name}.toml"
     table = "\n".join(f"{k} = {v!r}".replace("'", '"') for k, v in settings.items())
-    p.write_text(f'[sweep]\nname = "faults"\nscenario = "faultscen:scenario"\nchunk_size = {CHUNK}\n'
+    p.write_text('[sweep]\nname = "faults"\nscenario = '
+                 f'"faultscen:scenario"\nchunk_size = {CHUNK}\n'
                  f'[parameters]\nx = {{ linspace = [0.0, 2.0, {N_JOBS}] }}\n'
                  f'[scenario]\nmarker = "{tmp_path / "marker"}"\n{table}\n')
     return p
 
 
 def assert_same_as_uninterrupted(res, tmp_path):
-    ref = sweep(SweepSpec.from_toml(spec_file(tmp_path, "reference")), backend="in-process", progress=False,
+    ref = sweep(SweepSpec.from_toml(spec_file(tmp_path, "reference")), backend="in-process",
+                progress=False,
                 allow_code=True)
     np.testing.assert_array_equal(res["job_id"], np.arange(N_JOBS))
     for col in ("x", "square", "cube"):
@@ -92,7 +94,8 @@ def test_worker_killed_mid_task_from_outside(scen_dir, tmp_path):
 
     def killer():
         deadline = time.monotonic() + 60
-        while time.monotonic() < deadline and not (marker.exists() and marker.read_text().isdigit()):
+        while time.monotonic() < deadline and not (marker.exists()
+                                                   and marker.read_text().isdigit()):
             time.sleep(0.01)
         pid = int(marker.read_text())
         os.kill(pid, signal.SIGKILL)
@@ -116,18 +119,23 @@ def test_parent_killed_then_resumed_over_damaged_chunks(scen_dir, tmp_path):
     the table equals an uninterrupted run."""
     path = spec_file(tmp_path, kill_at=22)
     out = tmp_path / "run"
-    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(scen_dir), str(Path(__file__).parents[2] / "src")])}
-    proc = subprocess.run([sys.executable, "-c", "import sys; from gripkit.cli import main; sys.exit(main())",
-                           "sweep", str(path), "--out", str(out), "--backend", "in-process", "--allow-code"],
+    env = ({**os.environ, "PYTHONPATH": os.pathsep.join([str(scen_dir),
+                                                         str(Path(__file__).parents[2] / "src")])})
+    proc = subprocess.run([sys.executable, "-c", "import sys; from gripkit.cli import main; "
+                                                 "sys.exit(main())",
+                           "sweep", str(path), "--out", str(out), "--backend", "in-process",
+                           "--allow-code"],
                           env=env, capture_output=True, text=True, timeout=120)
     assert proc.returncode == -signal.SIGKILL, proc.stderr
     on_disk = sorted(int(p.name[6:12]) for p in (out / "chunks").glob("chunk-*.parquet"))
-    assert on_disk == [0, 1, 2, 3, 4]  # chunks 0-4 written, chunk 5 (jobs 20-23) died with the process
+    # chunks 0-4 written, chunk 5 (jobs 20-23) died with the process
+    assert on_disk == [0, 1, 2, 3, 4]
     c1, c2 = out / "chunks" / "chunk-000001.parquet", out / "chunks" / "chunk-000002.parquet"
     c1.write_bytes(c1.read_bytes()[: c1.stat().st_size // 2])  # truncated
     shutil.copyfile(out / "chunks" / "chunk-000000.parquet", c2)  # jobs 0-3 where 8-11 belong
     with pytest.warns(GripkitWarning) as caught:
-        res = sweep(SweepSpec.from_toml(path), backend="in-process", out=out, resume=True, progress=False,
+        res = sweep(SweepSpec.from_toml(path), backend="in-process", out=out, resume=True,
+                    progress=False,
                     allow_code=True)
     text = " | ".join(str(w.message) for w in caught)
     assert "chunk 1" in text and "unreadable" in text, text
@@ -146,7 +154,8 @@ def test_damaged_output_is_refused_when_read(scen_dir, tmp_path):
     out = tmp_path / "run"
     sweep(SweepSpec.from_toml(path), backend="in-process", out=out, progress=False, allow_code=True)
     assert ResultStore(out).read()["square"].shape == (N_JOBS,)
-    shutil.copyfile(out / "chunks" / "chunk-000003.parquet", out / "chunks" / "chunk-000007.parquet")
+    shutil.copyfile(out / "chunks" / "chunk-000003.parquet",
+                    out / "chunks" / "chunk-000007.parquet")
     with pytest.raises(DataError, match="chunk 7 holds job ids 12..15, expected 28..31"):
         ResultStore(out).read()
 
@@ -157,7 +166,8 @@ def test_collect_asserts_each_job_exactly_once():
         "job_id": np.array(ids), "y": np.array(ids, float), "error": np.full(len(ids), None)}
     ok = collect(jobs, [part([0, 1, 2]), part([3, 4, 5])])
     np.testing.assert_array_equal(ok["y"], np.arange(6.0))
-    with pytest.raises(DataError, match=r"1 jobs missing \(first \[5\]\) and 1 held more than once \(first \[0\]\)"):
+    with pytest.raises(DataError, match=r"1 jobs missing \(first \[5\]\) and 1 held more than once "
+                                        r"\(first \[0\]\)"):
         collect(jobs, [part([0, 1, 2]), part([3, 4, 0])])
     with pytest.raises(DataError, match="outside 0..5"):
         collect(jobs, [part([0, 1, 2, 3, 4, 6])])

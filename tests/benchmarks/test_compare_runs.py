@@ -23,7 +23,8 @@ def test_flags_only_rows_slower_against_their_peer(tmp_path, capsys):
     new = _run(tmp_path / "new.json", [("load", "np", 1.5, 3.0),  # both 1.5× slower: the machine
                                        ("regressed", "np", 1.2, 2.0), ("faster", "np", 0.5, 2.0),
                                        ("new", "np", 1.0, 1.0)])
-    rows = {r["task"]: r for r in compare_runs.compare(compare_runs._rows(old)[1], compare_runs._rows(new)[1], 0.05)}
+    rows = ({r["task"]: r for r in compare_runs.compare(compare_runs._rows(old)[1],
+                                                        compare_runs._rows(new)[1], 0.05)})
     assert set(rows) == {"load", "regressed", "faster"}
     assert (rows["load"]["raw"] == 1.5 and rows["load"]["relative"] == 1.0
             and not rows["load"]["slower"])

@@ -8,7 +8,8 @@ from gripkit.units import same_dimension
 
 def test_units_of_a_joint_in_rad_with_a_torque():
     u = friction_units("rad", "N*m")
-    assert u == {"inertia": "(N*m*s^2)/rad", "viscous": "(N*m*s)/rad", "coulomb": "N*m", "offset": "N*m"}
+    assert u == {"inertia": "(N*m*s^2)/rad", "viscous": "(N*m*s)/rad", "coulomb": "N*m",
+                 "offset": "N*m"}
     assert same_dimension(u["inertia"], "kg*m^2")   # rad is dimensionless: J in kg·m²
 
 

@@ -16,7 +16,8 @@ from gripkit.sysid import load_model
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "bad_inputs"))
 from corpus import CliResult, assert_user_error, assert_warned  # noqa: E402
 
-# y(t) = A y(t−1) + B u(t−1) + e(t), i.e. ARX [1 1 1] with A1 = −A, B1 = B (outputs c, d; inputs a, b)
+# y(t) = A y(t−1) + B u(t−1) + e(t), i.e. ARX [1 1 1] with A1 = −A, B1 = B (outputs c, d; inputs a,
+# b)
 A_TRUE = np.array([[0.5, 0.1], [-0.2, 0.7]])
 B_TRUE = np.array([[1.0, 0.3], [0.0, 0.8]])
 NOISE = 0.05
@@ -68,16 +69,19 @@ def cli(capsys):
 
 
 def arx_args(path, inputs, outputs, *extra):
-    return ["identify", "arx", path, "--input", inputs, "--output", outputs, "--na", 1, "--nb", 1, "--nk", 1,
+    return ["identify", "arx", path, "--input", inputs, "--output", outputs, "--na", 1, "--nb", 1,
+            "--nk", 1,
             *extra]
 
 
 def test_mimo_arx_json_per_output_in_output_order(cli, files):
     model_file = files["dir"] / "arx.json"
-    r = cli(*arx_args(files["est"], "a,b", "d,c", "--validate", files["val"], "--out", model_file, "--json"))
+    r = (cli(*arx_args(files["est"], "a,b", "d,c", "--validate", files["val"], "--out", model_file,
+                       "--json")))
     assert r.code == 0, r.err
     d = r.json()
-    assert d["outputs"] == ["d", "c"] and d["inputs"] == ["a", "b"] and (d["na"], d["nb"], d["nk"]) == (1, 1, 1)
+    assert d["outputs"] == ["d", "c"] and d["inputs"] == ["a", "b"] and (d["na"], d["nb"],
+                                                                         d["nk"]) == (1, 1, 1)
     # rows in --output order: d first, then c; A1 = −A, B1 = B (both permuted the same way)
     perm = [1, 0]
     A1, A1_std = np.array(d["A_poly"][0]), np.array(d["A_poly_std"][0])
@@ -87,7 +91,8 @@ def test_mimo_arx_json_per_output_in_output_order(cli, files):
     assert np.all(A1_std < 0.01) and np.all(B1_std < 0.01)
     for key in ("fit_percent", "one_step_fit_percent"):
         assert isinstance(d[key], list) and len(d[key]) == 2
-    assert isinstance(d["validation"]["fit_percent"], list) and len(d["validation"]["fit_percent"]) == 2
+    assert isinstance(d["validation"]["fit_percent"],
+                      list) and len(d["validation"]["fit_percent"]) == 2
     assert d["validation_fit_percent"] == d["validation"]["fit_percent"]
     # free run on fresh data: as good as the true system's own free run (the equation noise passes
     # through A(q)⁻¹ and no model can predict it), within half a fit point, on each output

@@ -25,7 +25,8 @@ SRC = str(Path(__file__).resolve().parents[2] / "src")
 def data(tmp_path_factory):
     d = tmp_path_factory.mktemp("cli")
     plant = finger_force_model()
-    s2 = bandlimited_noise(0.3, 10.0, 20.0, dt=0.005, operating_point=0.85, limits=(0.6, 1.1), unit="A")
+    s2 = (bandlimited_noise(0.3, 10.0, 20.0, dt=0.005, operating_point=0.85, limits=(0.6, 1.1),
+                            unit="A"))
     s1 = multisine(range(1, 11), 2.0, dt=0.005, operating_point=0.85, limits=(0.6, 1.1), unit="A")
     est = plant.simulate(s2.u, noise_std=0.0125, seed=1).select("current", "force")
     val = plant.simulate(np.tile(s1.u, 2), noise_std=0.0125, seed=2).select("current", "force")
@@ -42,7 +43,8 @@ def run(capsys, *args):
 
 
 def arx_args(path, *extra):
-    return ["identify", "arx", path, "--input", "current", "--output", "force", "--na", 2, "--nb", 2,
+    return ["identify", "arx", path, "--input", "current", "--output", "force", "--na", 2, "--nb",
+            2,
             "--nk", 2, *extra]
 
 
@@ -50,7 +52,8 @@ def test_arx_json_has_the_issue_fields(capsys, data):
     code, out, err = run(capsys, *arx_args(data["est"], "--validate", data["val"], "--json"))
     assert code == 0, err
     d = json.loads(out)
-    for k in ("structure", "na", "nb", "nk", "A", "B", "A_std", "B_std", "loss", "fit_percent", "poles",
+    for k in ("structure", "na", "nb", "nk", "A", "B", "A_std", "B_std", "loss", "fit_percent",
+              "poles",
               "zeros", "minimum_phase", "n_samples", "validation_fit_percent"):
         assert k in d, k
     assert (d["structure"], d["na"], d["nb"], d["nk"]) == ("arx", 2, 2, 2)
@@ -74,22 +77,26 @@ def test_arx_human_readable_table(capsys, data):
 
 def test_rls_json_and_trajectory(capsys, data, tmp_path):
     traj = tmp_path / "theta.parquet"
-    code, out, err = run(capsys, "identify", "rls", data["est"], "--input", "current", "--output", "force",
-                         "--na", 2, "--nb", 2, "--nk", 2, "--forgetting", 0.995, "--trajectory", traj, "--json")
+    code, out, err = run(capsys, "identify", "rls", data["est"], "--input", "current", "--output",
+                         "force",
+                         "--na", 2, "--nb", 2, "--nk", 2, "--forgetting", 0.995, "--trajectory",
+                         traj, "--json")
     assert code == 0, err
     d = json.loads(out)
     assert (d["forgetting"] == 0.995 and len(d["theta_final"]) == 4
             and len(d["theta_std_final"]) == 4)
     # order a1..a_na then the nb B coefficients; close to the plant (A = [1, −1.8732, 0.8996])
     assert d["theta_final"][0] == pytest.approx(-1.8732, abs=0.05)
-    assert d["theta_final"][2] == pytest.approx(195.0 * 0.02502, rel=0.2)  # N/A, Table II × force_scale
+    # N/A, Table II × force_scale
+    assert d["theta_final"][2] == pytest.approx(195.0 * 0.02502, rel=0.2)
     tr = load(traj)
     assert {"a1", "a2", "b2", "b3", "a1_std"} <= set(tr.names) and tr.dt == pytest.approx(0.005)
     assert tr["b3"][-1] == pytest.approx(d["theta_final"][3])
 
 
 def test_search_json_list_ranked(capsys, data):
-    code, out, err = run(capsys, "identify", "search", data["est"], "--input", "current", "--output", "force",
+    code, out, err = run(capsys, "identify", "search", data["est"], "--input", "current",
+                         "--output", "force",
                          "--na", "1:4", "--nb", "1:4", "--nk", "1:10", "--json")
     assert code == 0, err
     rows = json.loads(out)
@@ -100,15 +107,18 @@ def test_search_json_list_ranked(capsys, data):
     assert "the best structure lies on the edge of the searched range: na = 7 (searched 1:7)" in err
     assert all({"na", "nb", "nk", "loss", "aic", "fit_percent"} <= set(r) for r in rows)
     assert [r["aic"] for r in rows] == sorted(r["aic"] for r in rows)
-    code, out, _ = run(capsys, "identify", "search", data["est"], "--input", "current", "--output", "force",
+    code, out, _ = run(capsys, "identify", "search", data["est"], "--input", "current", "--output",
+                       "force",
                        "--na", "1:2", "--nb", "1:2", "--nk", "1:3", "--top", 3)
     assert code == 0 and "ranked by AIC" in out
 
 
-@pytest.mark.parametrize("cmd,orders,structure", [("armax", ["--na", 2, "--nb", 2, "--nc", 1, "--nk", 2], "armax"),
+@pytest.mark.parametrize("cmd,orders,structure",
+                         [("armax", ["--na", 2, "--nb", 2, "--nc", 1, "--nk", 2], "armax"),
                                                   ("oe", ["--nb", 2, "--nf", 2, "--nk", 2], "oe")])
 def test_armax_and_oe_json(capsys, data, cmd, orders, structure):
-    code, out, err = run(capsys, "identify", cmd, data["est"], "--input", "current", "--output", "force",
+    code, out, err = run(capsys, "identify", cmd, data["est"], "--input", "current", "--output",
+                         "force",
                          *orders, "--json")
     assert code == 0, err
     d = json.loads(out)
@@ -128,14 +138,17 @@ def _one_line_error(code, err, pattern):
 
 
 def test_missing_column_is_one_line(capsys, data):
-    code, out, err = run(capsys, "identify", "arx", data["est"], "--input", "curent", "--output", "force",
+    code, out, err = run(capsys, "identify", "arx", data["est"], "--input", "curent", "--output",
+                         "force",
                          "--na", 2, "--nb", 2, "--nk", 2)
-    _one_line_error(code, err, r"DataError: .*column 'curent' not found; available columns: t, current, force")
+    _one_line_error(code, err, r"DataError: .*column 'curent' not found; available columns: "
+                               r"t, current, force")
     assert out == ""
 
 
 def _csv(path, t, u, y):
-    np.savetxt(path, np.column_stack([t, u, y]), delimiter=",", header="t,current,force", comments="")
+    np.savetxt(path, np.column_stack([t, u, y]), delimiter=",", header="t,current,force",
+               comments="")
     return path
 
 
@@ -179,7 +192,8 @@ def test_unstable_model_in_validation_warns_and_reports_null(capsys, tmp_path):
         y[k] = 1.04 * y[k - 1] + u[k - 1] + 0.01 * rng.standard_normal()
     t = np.arange(300) * 0.005
     p = _csv(tmp_path / "unstable.csv", t, u, y)
-    code, out, err = run(capsys, "identify", "arx", p, "--input", "current", "--output", "force", "--na", 1,
+    code, out, err = run(capsys, "identify", "arx", p, "--input", "current", "--output", "force",
+                         "--na", 1,
                          "--nb", 1, "--nk", 1, "--detrend", "none", "--validate", p, "--json")
     assert code == 0
     d = json.loads(out)
@@ -189,10 +203,12 @@ def test_unstable_model_in_validation_warns_and_reports_null(capsys, tmp_path):
 
 
 def test_bad_range_and_options_are_one_line(capsys, data):
-    code, _, err = run(capsys, "identify", "search", data["est"], "--input", "current", "--output", "force",
+    code, _, err = run(capsys, "identify", "search", data["est"], "--input", "current", "--output",
+                       "force",
                        "--nk", "10:1")
     _one_line_error(code, err, r"nk: expected a range like '1:4'")
-    code, _, err = run(capsys, "identify", "rls", data["est"], "--input", "current", "--output", "force",
+    code, _, err = run(capsys, "identify", "rls", data["est"], "--input", "current", "--output",
+                       "force",
                        "--na", 2, "--nb", 2, "--nk", 2, "--forgetting", 1.2)
     _one_line_error(code, err, r"forgetting factor: expected 0 < λ <= 1, found 1.2")
 
@@ -202,12 +218,15 @@ def test_subprocess_entry_point(data):
     one line on stderr."""
     env = {**os.environ, "PYTHONPATH": SRC + os.pathsep + os.environ.get("PYTHONPATH", "")}
     cmd = [sys.executable, "-c", "import sys; from gripkit.cli import main; sys.exit(main())"]
-    ok = subprocess.run(cmd + [str(a) for a in arx_args(data["est"], "--json")], capture_output=True,
+    ok = subprocess.run(cmd + [str(a) for a in arx_args(data["est"], "--json")],
+                        capture_output=True,
                         text=True, env=env, timeout=120)
     assert ok.returncode == 0, ok.stderr
     assert json.loads(ok.stdout)["structure"] == "arx"
-    bad = subprocess.run(cmd + ["identify", "arx", str(data["est"]), "--input", "nope", "--output", "force",
-                                "--na", "2", "--nb", "2", "--nk", "2"], capture_output=True, text=True, env=env,
+    bad = subprocess.run(cmd + ["identify", "arx", str(data["est"]), "--input", "nope", "--output",
+                                "force",
+                                "--na", "2", "--nb", "2", "--nk", "2"], capture_output=True,
+                                text=True, env=env,
                          timeout=120)
     assert (bad.returncode == 1 and bad.stderr.count("\n") == 1
             and "column 'nope' not found" in bad.stderr)

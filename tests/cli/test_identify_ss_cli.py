@@ -46,8 +46,10 @@ def run(capsys, *args):
 
 def test_identify_ss_json_fields(capsys, files):
     model = files["dir"] / "m.json"
-    code, out, err = run(capsys, "identify", "ss", files["est"], "--input", "a,b", "--output", "d,c",
-                         "--validate", files["val"], "--out", model, "--report", files["dir"] / "ssrep", "--json")
+    code, out, err = run(capsys, "identify", "ss", files["est"], "--input", "a,b", "--output",
+                         "d,c",
+                         "--validate", files["val"], "--out", model, "--report",
+                         files["dir"] / "ssrep", "--json")
     assert "Subspace singular values" in (files["dir"] / "ssrep" / "index.html").read_text()
     assert code == 0, err
     r = json.loads(out)
@@ -62,7 +64,8 @@ def test_identify_ss_json_fields(capsys, files):
 
 
 def test_identify_ss_order_range_ranked_by_validation(capsys, files):
-    code, out, err = run(capsys, "identify", "ss", files["est"], "--input", "a,b", "--output", "c,d",
+    code, out, err = run(capsys, "identify", "ss", files["est"], "--input", "a,b", "--output",
+                         "c,d",
                          "--order", "2:7", "--validate", files["val"], "--no-refine", "--json")
     assert code == 0, err
     r = json.loads(out)
@@ -73,7 +76,8 @@ def test_identify_ss_order_range_ranked_by_validation(capsys, files):
 def test_order_search_widens_past_the_edge(capsys, files):
     """The system has order 4: the range 1:3 has its best on the edge, so the search goes on
     past it (issue 25) and finds 4, without the edge warning."""
-    code, out, err = run(capsys, "identify", "ss", files["est"], "--input", "a,b", "--output", "c,d",
+    code, out, err = run(capsys, "identify", "ss", files["est"], "--input", "a,b", "--output",
+                         "c,d",
                          "--order", "1:3", "--no-refine", "--json")
     assert code == 0, err
     r = json.loads(out)
@@ -84,7 +88,8 @@ def test_order_search_widens_past_the_edge(capsys, files):
 
 def test_compare_simulate_report(capsys, files):
     model = files["dir"] / "m2.json"
-    assert run(capsys, "identify", "ss", files["est"], "--input", "a,b", "--output", "c,d", "--out", model)[0] == 0
+    assert run(capsys, "identify", "ss", files["est"], "--input", "a,b", "--output", "c,d", "--out",
+               model)[0] == 0
     code, out, err = run(capsys, "compare", model, files["val"], "--json")
     assert code == 0, err
     r = json.loads(out)
@@ -100,13 +105,15 @@ def test_compare_simulate_report(capsys, files):
     code, out, err = run(capsys, "report", model, files["val"], "--out", files["dir"] / "rep")
     assert code == 0, err
     html = (files["dir"] / "rep" / "index.html").read_text()
-    for section in ("Measured and simulated outputs", "Residual analysis", "Poles and zeros", "Frequency response",
+    for section in ("Measured and simulated outputs", "Residual analysis", "Poles and zeros",
+                    "Frequency response",
                     "Subspace singular values", "Warnings"):
         assert section in html
 
 
 def test_identify_frf_json(capsys, files):
-    code, out, err = run(capsys, "identify", "frf", files["siso"], "--input", "v", "--output", "x", "--periods", "5",
+    code, out, err = run(capsys, "identify", "frf", files["siso"], "--input", "v", "--output", "x",
+                         "--periods", "5",
                          "--json")
     assert code == 0, err
     r = json.loads(out)
@@ -114,14 +121,17 @@ def test_identify_frf_json(capsys, files):
     true = TransferFunction([2.0, 4.0], [1.0, 0.8, 4.0]).c2d(0.05).frequency_response(
         2 * np.pi * np.array(r["frequency_hz"]))[:, 0, 0]
     assert np.mean(np.abs(H - true) <= 3 * np.array(r["H_std"])) >= 0.9
-    code, out, err = run(capsys, "identify", "frf", files["siso"], "--input", "v", "--output", "x", "--json")
+    code, out, err = (run(capsys, "identify", "frf", files["siso"], "--input", "v", "--output", "x",
+                          "--json"))
     assert "coherence" in json.loads(out)
 
 
 def test_identify_tf_json(capsys, files):
     rep = files["dir"] / "tfrep"
-    code, out, err = run(capsys, "identify", "tf", files["siso"], "--input", "v", "--output", "x", "--poles", "2",
-                         "--zeros", "1", "--out", files["dir"] / "tf.json", "--report", rep, "--json")
+    code, out, err = run(capsys, "identify", "tf", files["siso"], "--input", "v", "--output", "x",
+                         "--poles", "2",
+                         "--zeros", "1", "--out", files["dir"] / "tf.json", "--report", rep,
+                         "--json")
     assert "Poles and zeros" in (rep / "index.html").read_text()
     assert code == 0, err
     r = json.loads(out)
@@ -145,8 +155,10 @@ def test_identify_arx_out_then_compare(capsys, files):
     validation fit (two code paths, the same number within 0.1 point: they differ only in how the
     initial condition is estimated)."""
     model = files["dir"] / "arx.json"
-    code, out, err = run(capsys, "identify", "arx", files["siso"], "--input", "v", "--output", "x", "--na", "2",
-                         "--nb", "2", "--nk", "1", "--validate", files["siso"], "--out", model, "--json")
+    code, out, err = run(capsys, "identify", "arx", files["siso"], "--input", "v", "--output", "x",
+                         "--na", "2",
+                         "--nb", "2", "--nk", "1", "--validate", files["siso"], "--out", model,
+                         "--json")
     assert code == 0, err
     own = json.loads(out)["validation_fit_percent"]
     code, out, err = run(capsys, "compare", model, files["siso"], "--json")
@@ -157,7 +169,8 @@ def test_identify_arx_out_then_compare(capsys, files):
 
 def test_simulate_without_out_prints_csv(capsys, files):
     model = files["dir"] / "m3.json"
-    assert run(capsys, "identify", "ss", files["est"], "--input", "a,b", "--output", "c,d", "--order", "4",
+    assert run(capsys, "identify", "ss", files["est"], "--input", "a,b", "--output", "c,d",
+               "--order", "4",
                "--no-refine", "--out", model)[0] == 0
     code, out, err = run(capsys, "simulate", model, "--data", files["val"])
     assert code == 0, err
@@ -167,7 +180,8 @@ def test_simulate_without_out_prints_csv(capsys, files):
 
 
 def test_identify_search_ranked_by_validation(capsys, files):
-    code, out, err = run(capsys, "identify", "search", files["siso"], "--input", "v", "--output", "x", "--na", "1:3",
+    code, out, err = run(capsys, "identify", "search", files["siso"], "--input", "v", "--output",
+                         "x", "--na", "1:3",
                          "--nb", "1:3", "--nk", "0:2", "--validate", files["siso"], "--json")
     assert code == 0, err
     rows = json.loads(out)

@@ -38,8 +38,10 @@ def _run(capsys, *args):
 
 def test_identify_and_compare_an_mcap_log_by_topic_field(log, capsys, tmp_path):
     model = tmp_path / "m.json"
-    code, out, err = _run(capsys, "identify", "arx", str(log), "--input", "/cmd:data[0]", "--output",
-                          "/force:data[0]", "--na", "1", "--nb", "1", "--nk", "1", "--out", str(model), "--json")
+    code, out, err = _run(capsys, "identify", "arx", str(log), "--input", "/cmd:data[0]",
+                          "--output",
+                          "/force:data[0]", "--na", "1", "--nb", "1", "--nk", "1", "--out",
+                          str(model), "--json")
     assert code == 0, err
     res = json.loads(out)
     assert res["A"][1] == pytest.approx(-0.8, abs=0.01)   # the plant's pole, recovered
@@ -53,7 +55,8 @@ def test_identify_and_compare_an_mcap_log_by_topic_field(log, capsys, tmp_path):
 
 
 def test_aliases_name_the_channels_on_the_command_line_too(log, capsys):
-    code, out, err = _run(capsys, "identify", "arx", str(log), "--input", "u=/cmd:data[0]", "--output",
+    code, out, err = _run(capsys, "identify", "arx", str(log), "--input", "u=/cmd:data[0]",
+                          "--output",
                           "force=/force:data[0]", "--na", "1", "--nb", "1", "--nk", "1", "--json")
     assert code == 0, err
     assert json.loads(out)["input"] == "u=/cmd:data[0]"

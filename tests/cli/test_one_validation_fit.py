@@ -55,7 +55,8 @@ def _json(capsys, *args):
 ])
 def test_validate_reports_what_compare_reports(records, capsys, command):
     model = records["dir"] / f"{command[0]}-{len(command)}.json"
-    res = _json(capsys, "identify", command[0], records["est"], *command[1:], "--validate", records["val"],
+    res = _json(capsys, "identify", command[0], records["est"], *command[1:], "--validate",
+                records["val"],
                 "--out", model)
     cmp = _json(capsys, "compare", model, records["val"])
     vfit = res["validation"]["fit_percent"]

@@ -22,10 +22,12 @@ def test_sweep_runs_and_resumes(tmp_path, capsys):
     spec = tmp_path / "s.toml"
     spec.write_text(SPEC)
     out = tmp_path / "out"
-    assert main(["--quiet", "sweep", str(spec), "--backend", "in-process", "--out", str(out), "--json"]) == 0
+    assert main(["--quiet", "sweep", str(spec), "--backend", "in-process", "--out", str(out),
+                 "--json"]) == 0
     res = json.loads(capsys.readouterr().out)
     assert res["n_jobs"] == 3 and res["n_failed"] == 0 and res["chunk_size"] == 2
-    assert main(["--quiet", "sweep", str(spec), "--backend", "in-process", "--out", str(out), "--resume", "--json"]) == 0
+    assert main(["--quiet", "sweep", str(spec), "--backend", "in-process", "--out", str(out),
+                 "--resume", "--json"]) == 0
     assert json.loads(capsys.readouterr().out)["n_jobs"] == 3
 
 

@@ -1,4 +1,5 @@
-"""Discrete PID: linear behaviour against its z-transfer function (scipy.signal.lfilter), anti-windup,
+"""Discrete PID: linear behaviour against its z-transfer function (scipy.signal.lfilter),
+anti-windup,
 bumpless transfer (hypothesis), derivative on the measurement, configuration errors."""
 
 import math
@@ -16,7 +17,8 @@ TS = 1e-3
 
 
 def test_linear_region_equals_transfer_function():
-    """b = c = 1, no saturation, e[0] = 0: u = C(z) e with C(z) = kp + ki T/(z-1) + kd(z-1)/((Tf+T)z - Tf)."""
+    """b = c = 1, no saturation, e[0] = 0: u = C(z) e with C(z) = kp + ki T/(z-1) +
+    kd(z-1)/((Tf+T)z - Tf)."""
     pid = PID(2.0, 150.0, 0.01, dt=TS, tf=0.004, c=1.0)
     e = np.r_[0.0, np.random.default_rng(0).standard_normal(500)]
     u = pid.run(e, np.zeros_like(e))
@@ -24,7 +26,8 @@ def test_linear_region_equals_transfer_function():
     # The integrator's pole at z = 1 keeps every rounding: after N samples each recursion is off by
     # at most about N·ε·Σ|num|·Σ|den|·max|e| (a first-order bound, each step adding one rounding
     # of each product), which is 100× the difference actually seen.
-    tol = e.size * np.finfo(np.float64).eps * np.abs(num).sum() * np.abs(den).sum() * np.abs(e).max()
+    tol = (e.size * np.finfo(np.float64).eps * np.abs(num).sum() * np.abs(den).sum()
+           * np.abs(e).max())
     np.testing.assert_allclose(u, signal.lfilter(num, den, e), rtol=0, atol=tol)
 
 
@@ -35,7 +38,8 @@ def test_first_output_and_integrator():
 
 
 def _windup_recovery(tt):
-    """Plant y' = (u - y)/10 ms with u in [-1, 1]; the setpoint 5 is unreachable for 2 s, then 0.5."""
+    """Plant y' = (u - y)/10 ms with u in [-1, 1]; the setpoint 5 is unreachable for 2 s, then
+    0.5."""
     pid = PID(0.5, 50.0, dt=TS, u_min=-1.0, u_max=1.0, tt=tt)
     y, out = 0.0, []
     for rk in np.r_[np.full(2000, 5.0), np.full(3000, 0.5)]:
@@ -53,7 +57,8 @@ def test_back_calculation_prevents_windup():
     assert with_aw < 0.1
 
 
-@given(kp=st.floats(0, 10), ki=st.floats(0, 1e3), kd=st.floats(0, 0.1), r=st.floats(-5, 5), y=st.floats(-5, 5),
+@given(kp=st.floats(0, 10), ki=st.floats(0, 1e3), kd=st.floats(0, 0.1), r=st.floats(-5, 5),
+       y=st.floats(-5, 5),
        ff=st.floats(-1, 1), u=st.floats(-9, 9), b=st.floats(0, 1), c=st.floats(0, 1))
 def test_bumpless_transfer_returns_the_given_output(kp, ki, kd, r, y, ff, u, b, c):
     pid = PID(kp, ki, kd, dt=TS, b=b, c=c, u_min=-10, u_max=10)
@@ -90,12 +95,14 @@ def test_parameter_and_state_vectors_are_read_by_name():
     gives u = kp (b r − y) = 2 (0.8 − 0.2) = 1.2, clipped to u_max = 1; then the integral holds
     ki dt (r − y) + dt/tt (u − v) = 3e-3·0.8 + (1e-3/0.05)(1 − 1.2) = −1.6e-3 and the stored
     derivative error is c r − y = 0.2 − 0.2 = 0."""
-    given = dict(kp=2.0, ki=3.0, kd=0.5, tf=0.01, b=0.8, c=0.2, tt=0.05, u_min=-1.0, u_max=1.0, dt=1e-3)
+    given = (dict(kp=2.0, ki=3.0, kd=0.5, tf=0.01, b=0.8, c=0.2, tt=0.05, u_min=-1.0, u_max=1.0,
+                  dt=1e-3))
     pid = PID(**given)
     assert len(pid.params) == len(PID_PARAMETERS)
     for name, value in given.items():
         assert pid.params[getattr(PIDX, name)] == value, name
     s = np.zeros(len(PIDS))
     assert pid_step(pid.params, s, 1.0, 0.2, 0.0) == 1.0
-    assert s[PIDS.integral] == pytest.approx(3.0 * 1e-3 * 0.8 + 1e-3 / 0.05 * (1.0 - 1.2), rel=1e-12)
+    assert s[PIDS.integral] == pytest.approx(3.0 * 1e-3 * 0.8 + 1e-3 / 0.05 * (1.0 - 1.2),
+                                             rel=1e-12)
     assert s[PIDS.error_prev] == pytest.approx(0.0, abs=1e-15) and s[PIDS.started] == 1.0

@@ -101,7 +101,8 @@ def test_saturated_loop_recovers_for_a_third_order_plant():
 
 def test_design_rst_refuses_what_it_cannot_do():
     with pytest.raises(ModelError, match="zero at z = 1"):
-        design_rst(_plant([0.5, 0.3], [], nk=1).replace() * TransferFunction([1.0, -1.0], [1.0, 0.0], dt=0.01))
+        design_rst(_plant([0.5, 0.3], [], nk=1).replace() * TransferFunction([1.0, -1.0],
+                                                                             [1.0, 0.0], dt=0.01))
     with pytest.raises(ModelError, match="feedthrough"):
         design_rst(TransferFunction.from_polynomials([1.0, -0.5], [1.0, 0.2], dt=0.01))
     with pytest.raises(ModelError, match="discrete"):

@@ -10,7 +10,8 @@ from gripkit.excitation import bandlimited_noise, chirp, crest_factor, multisine
 def test_s1_multisine_matches_seed_design():
     """S1 of 000_8f66dcc7ab06470c.txt §V-E: 400 samples at 200 Hz, 1..10 Hz at 1 Hz steps,
     600..1100 mA around 850 mA."""
-    ex = multisine(range(1, 11), 2.0, dt=0.005, operating_point=0.850, limits=(0.600, 1.100), unit="A")
+    ex = (multisine(range(1, 11), 2.0, dt=0.005, operating_point=0.850, limits=(0.600, 1.100),
+                    unit="A"))
     assert ex.u.size == 400
     assert ex.u.min() >= 0.600 - 1e-12 and ex.u.max() <= 1.100 + 1e-12
     assert max(ex.u.max() - 0.85, 0.85 - ex.u.min()) == pytest.approx(0.25)
@@ -32,7 +33,8 @@ def test_min_crest_beats_schroeder_and_zero_phase():
 
 
 def test_s2_noise_band_and_limits():
-    ex = bandlimited_noise(0.3, 10.0, 20.0, dt=0.005, operating_point=0.85, limits=(0.6, 1.1), seed=3)
+    ex = (bandlimited_noise(0.3, 10.0, 20.0, dt=0.005, operating_point=0.85, limits=(0.6, 1.1),
+                            seed=3))
     assert ex.u.size == 4000 and ex.u.min() >= 0.6 and ex.u.max() <= 1.1
     p = np.abs(np.fft.rfft(ex.u - ex.u.mean())) ** 2
     f = np.fft.rfftfreq(4000, 1 / 200)

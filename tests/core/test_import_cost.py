@@ -1,5 +1,6 @@
 """Start-up structure (issue 14): ``import gripkit`` leaves the heavy third-party packages unloaded,
-and the lazy re-exports of the packages (:mod:`gripkit.exports`) give the same objects as eager imports.
+and the lazy re-exports of the packages (:mod:`gripkit.exports`) give the same objects as eager
+imports.
 Structural checks in a fresh interpreter, not timings."""
 
 import json
@@ -8,7 +9,8 @@ import sys
 
 import pytest
 
-HEAVY = ("scipy.signal", "scipy.stats", "scipy.optimize", "matplotlib", "pyarrow", "pint", "h5py", "numba")
+HEAVY = ("scipy.signal", "scipy.stats", "scipy.optimize", "matplotlib", "pyarrow", "pint", "h5py",
+         "numba")
 
 
 def _loaded_after(code: str) -> list[str]:
@@ -31,7 +33,8 @@ def test_lazy_package_import_does_not_import_heavy_packages(package):
 def test_lazy_names_are_the_defining_modules_objects_and_listed():
     import gripkit.signals
     import gripkit.sysid
-    import gripkit.sysid.linear.arx  # a submodule spelled like a public function: the function stays public
+    # a submodule spelled like a public function: the function stays public
+    import gripkit.sysid.linear.arx
     import gripkit.sysid.linear.rls
     from gripkit.signals.filters import lowpass
     from gripkit.sysid import arx, rls
@@ -58,9 +61,11 @@ def test_small_arx_from_a_csv_file_stays_light(tmp_path):
     u = rng.standard_normal(500)
     y = np.convolve(u, [0.0, 0.5, 0.25])[:500]
     path = tmp_path / "log.csv"
-    np.savetxt(path, np.column_stack([np.arange(500) * 1e-3, u, y]), delimiter=",", header="time,u,y", comments="")
+    np.savetxt(path, np.column_stack([np.arange(500) * 1e-3, u, y]), delimiter=",",
+               header="time,u,y", comments="")
     loaded = set(_loaded_after(f"from gripkit.io import load\nfrom gripkit.sysid import arx\n"
-                               f"d = load({str(path)!r})\nm = arx(d['u'], d['y'], 1, 2, 1, dt=d.dt)"))
+                               f"d = load({str(path)!r})\nm = arx(d['u'], d['y'], "
+                               "1, 2, 1, dt=d.dt)"))
     assert [m for m in ("pandas", "numba", "scipy.signal", "scipy.stats") if m in loaded] == []
 
 

@@ -45,7 +45,8 @@ def test_fs_instead_of_time(tmp_path):
 def test_missing_column_lists_available(tmp_path, traj):
     p = tmp_path / "d.parquet"
     save(traj, p)
-    with pytest.raises(DataError, match="column 'pressure' not found; available columns: t, u, force"):
+    with pytest.raises(DataError, match="column 'pressure' not found; available "
+                                        "columns: t, u, force"):
         load(p, columns=["pressure"])
 
 
@@ -59,7 +60,8 @@ def test_mixed_types(tmp_path):
 def test_truncated_csv(tmp_path):
     p = tmp_path / "d.csv"
     p.write_text("t,u,y\n0,1,2\n1,2\n")
-    with pytest.raises(DataError, match="line 3 has 2 fields, the header has 3: the file looks truncated"):
+    with pytest.raises(DataError, match="line 3 has 2 fields, the header has 3: the file "
+                                        "looks truncated"):
         load(p)
 
 
@@ -103,8 +105,10 @@ def test_hdf5_2d_dataset(tmp_path):
     assert tr["force"][0] == pytest.approx(1e-3) and tr.unit("force") == "N"
 
 
-FLOAT64_ARRAY = ("std_msgs/MultiArrayLayout layout\nfloat64[] data\n" + "=" * 80 + "\nMSG: std_msgs/MultiArrayLayout\n"
-                 "MultiArrayDimension[] dim\nuint32 data_offset\n" + "=" * 80 + "\nMSG: std_msgs/MultiArrayDimension\n"
+FLOAT64_ARRAY = ("std_msgs/MultiArrayLayout "
+                 "layout\nfloat64[] data\n" + "=" * 80 + "\nMSG: std_msgs/MultiArrayLayout\n"
+                 "MultiArrayDimension[] "
+                 "dim\nuint32 data_offset\n" + "=" * 80 + "\nMSG: std_msgs/MultiArrayDimension\n"
                  "string label\nuint32 size\nuint32 stride\n")
 
 
@@ -116,7 +120,8 @@ def write_mcap(path, topics):
         schema = w.register_msgdef("std_msgs/Float64MultiArray", FLOAT64_ARRAY)
         for topic, times, values in topics:
             for t, v in zip(times, values):
-                w.write_message(topic, schema, {"layout": {"dim": [], "data_offset": 0}, "data": list(v)},
+                w.write_message(topic, schema,
+                                {"layout": {"dim": [], "data_offset": 0}, "data": list(v)},
                                 log_time=int(round(t * 1e9)), publish_time=int(round(t * 1e9)))
         w.finish()
 
@@ -133,7 +138,8 @@ def test_mcap_topics_aligned_on_first_column(tmp_path):
               units={"p": "bar"})
     np.testing.assert_allclose(tr.t, tf - tf[0], atol=1e-9)
     np.testing.assert_allclose(tr["force"], 2 * tf, atol=1e-12)
-    np.testing.assert_allclose(tr["p"], 3.0 * tf * 1e5, rtol=1e-9)  # linear, so interpolation is exact
+    # linear, so interpolation is exact
+    np.testing.assert_allclose(tr["p"], 3.0 * tf * 1e5, rtol=1e-9)
     with pytest.raises(DataError, match="no field 'wrench'"):
         load(p, columns=["/finger/force:wrench.force.z"])
     with pytest.raises(DataError, match="no messages on topics"):

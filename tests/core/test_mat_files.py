@@ -37,18 +37,21 @@ def write_v73(path, variables: dict, external: str | None = None):
             if x.shape[0] == 1:
                 x = x.T  # MATLAB column vector N×1
             if external and name == "y":
-                ds = f.create_dataset(name, shape=x.T.shape, dtype="f8", external=[(external, 0, 8 * x.size)])
+                ds = (f.create_dataset(name, shape=x.T.shape, dtype="f8",
+                                       external=[(external, 0, 8 * x.size)]))
             else:
                 ds = f.create_dataset(name, data=x.T)
             ds.attrs["MATLAB_class"] = np.bytes_("double")
     with open(path, "r+b") as fh:
-        fh.write(b"MATLAB 7.3 MAT-file, Platform: GLNXA64, Created on: Thu Nov 26 12:00:00 2026 HDF5 schema 1.00 .")
+        fh.write(b"MATLAB 7.3 MAT-file, Platform: GLNXA64, Created on: Thu Nov 26 12:00:00 2026 "
+                 b"HDF5 schema 1.00 .")
 
 
 def test_version_5_vectors_and_matrix_columns(tmp_path):
     u, y = _record()
     p = tmp_path / "run.mat"
-    sio.savemat(p, {"t": T, "u": u, "y": y[:, None], "Y2": np.column_stack([y, 2 * y]).T, "Ts": 0.01,
+    sio.savemat(p, {"t": T, "u": u, "y": y[:, None], "Y2": np.column_stack([y, 2 * y]).T,
+                    "Ts": 0.01,
                     "note": "grasp 3"})
     tr = load(p)
     assert tr.names == ("u", "y", "Y2_1", "Y2_2")
@@ -102,9 +105,11 @@ def test_identify_from_a_mat_file_on_the_command_line(tmp_path, capsys):
     u, y = _record(2)
     p = tmp_path / "log.mat"
     sio.savemat(p, {"u": u, "y": y})
-    code = main(["identify", "arx", str(p), "--input", "u", "--output", "y", "--na", "1", "--nb", "1",
+    code = main(["identify", "arx", str(p), "--input", "u", "--output", "y", "--na", "1", "--nb",
+                 "1",
                  "--nk", "1", "--fs", "100", "--json"])
     out = capsys.readouterr()
     assert code == 0, out.err
     res = json.loads(out.out)
-    assert res["A"][1] == pytest.approx(-0.8, abs=0.01) and res["B"][1] == pytest.approx(0.5, abs=0.01)
+    assert res["A"][1] == pytest.approx(-0.8,
+                                        abs=0.01) and res["B"][1] == pytest.approx(0.5, abs=0.01)

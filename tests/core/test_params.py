@@ -36,7 +36,8 @@ def test_non_finite_rejected():
 
 
 def test_replace_parses_units_and_checks_dimension():
-    ps = ParameterSet([k_s(), Parameter("m_s", 1.8e-6, "kg", "sensor mass", display_unit="mg")], "sensor")
+    ps = (ParameterSet([k_s(), Parameter("m_s", 1.8e-6, "kg", "sensor mass", display_unit="mg")],
+                       "sensor"))
     ps2 = ps.replace(m_s="1.79 mg", k_s=130.8)
     assert ps2["m_s"].value == pytest.approx(1.79e-6)
     assert ps2["k_s"].value == 130.8

@@ -20,7 +20,8 @@ def test_lowpass_dc_gain_and_cutoff():
     fs = 200.0
     t = np.arange(4000) / fs
     dc = lowpass(np.full(t.size, 3.0), 9.0, dt=1 / fs)
-    assert dc[-1] == pytest.approx(3.0, rel=1e-9) and dc[0] == pytest.approx(3.0)  # no start transient
+    # no start transient
+    assert dc[-1] == pytest.approx(3.0, rel=1e-9) and dc[0] == pytest.approx(3.0)
     x = np.sin(2 * np.pi * 9.0 * t)
     y = lowpass(x, 9.0, dt=1 / fs, zero_phase=True)  # forward-backward: |H|^2 = 1/2 at the cutoff
     assert np.std(y[1000:-1000]) / np.std(x[1000:-1000]) == pytest.approx(0.5, rel=0.02)

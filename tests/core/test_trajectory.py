@@ -17,7 +17,8 @@ def test_uniform_construction():
 def test_nan_reports_count_and_first_time():
     y = np.ones(10)
     y[[3, 5, 6]] = np.nan
-    with pytest.raises(DataError, match=r"column 'force' has 3 NaN values \(first at t=0.015 s\).*fill"):
+    with pytest.raises(DataError, match=r"column 'force' has 3 NaN values \(first at "
+                                        r"t=0.015 s\).*fill"):
         Trajectory.uniform(dt=0.005, force=y)
 
 

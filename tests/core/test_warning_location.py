@@ -1,5 +1,6 @@
 """Warnings point at the user's line (issue 25, "rough edges": they pointed into gripkit):
-gripkit.errors.emit_warning attributes a warning to the first frame outside the package, however deep
+gripkit.errors.emit_warning attributes a warning to the first frame outside the package, however
+deep
 the call inside it."""
 
 import warnings

@@ -19,7 +19,8 @@ from gripkit.models.friction import FrictionTable
 DT = 1e-3
 J = 0.02
 V = np.r_[-np.geomspace(4.0, 0.05, 30), np.geomspace(0.05, 4.0, 30)]
-TABLE = FrictionTable(V, np.sign(V) * (0.3 + 0.1 * np.exp(-(V / 0.2) ** 2)) + 0.05 * V, name="synthetic")
+TABLE = (FrictionTable(V, np.sign(V) * (0.3 + 0.1 * np.exp(-(V / 0.2) ** 2)) + 0.05 * V,
+                       name="synthetic"))
 
 
 def drive(v, scale=1.0, offset=0.0, noise=0.0, seed=0):

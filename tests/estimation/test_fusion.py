@@ -8,7 +8,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from gripkit.errors import DataError
-from gripkit.estimation import (fuse, fuse_proportional, fuse_update, fused_variance, implied_correlation,
+from gripkit.estimation import (fuse, fuse_proportional, fuse_update, fused_variance,
+                                implied_correlation,
                                 normalised_variances, proportional_variance)
 from gripkit.systems.amadeus.parameters import TABLE_I, table1_findings
 

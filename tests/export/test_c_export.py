@@ -169,7 +169,8 @@ def test_a_static_gain_model_has_no_state_and_compiles(tmp_path):
 
 
 @pytest.mark.skipif((shutil.which("g++") is None or GCC is None) and not REQUIRED,
-                    reason="g++ or gcc is not on PATH (set GRIPKIT_C_TESTS=1 to make this a failure)")
+                    reason="g++ or gcc is not on PATH (set GRIPKIT_C_TESTS=1 to make "
+                           "this a failure)")
 def test_the_header_links_into_cpp(tmp_path):
     """A C++ caller (a ros2_control controller) includes the header and links the C object."""
     for fname, text in c_sources(ss_model(), "grip").items():

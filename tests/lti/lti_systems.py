@@ -36,7 +36,8 @@ def random_ss(rng, n, m, p, *, dt=None, pole_radius=(0.3, 3.0), max_angle=None, 
             blocks.append(np.array([[re, im], [-im, re]]))
             k += 2
         else:
-            blocks.append(np.array([[-rng.uniform(*pole_radius) if dt is None else rng.uniform(0.1, 0.9)]]))
+            blocks.append(np.array([[-rng.uniform(*pole_radius) if dt is None
+                                     else rng.uniform(0.1, 0.9)]]))
             k += 1
     Lam = np.zeros((n, n))
     o = 0
@@ -48,4 +49,5 @@ def random_ss(rng, n, m, p, *, dt=None, pole_radius=(0.3, 3.0), max_angle=None, 
     Q = np.linalg.qr(rng.standard_normal((n, n)))[0]
     V = Q @ np.diag(np.linspace(1.0, cond, n))
     A = V @ Lam @ np.linalg.inv(V)
-    return A, rng.standard_normal((n, m)), rng.standard_normal((p, n)), rng.standard_normal((p, m)), V
+    return (A, rng.standard_normal((n, m)), rng.standard_normal((p, n)),
+            rng.standard_normal((p, m)), V)

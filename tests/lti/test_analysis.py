@@ -81,9 +81,11 @@ def test_mimo_transmission_zeros_known():
     """G(s) = [[1/(s+1), 1/(s+2)], [1/(s+3), 1/(s+4)]]: det G = ((s+2)(s+3) − (s+1)(s+4)) / Π =
     2 / Π(s+i), so no finite transmission zero; and G₂ = [[(s+5)/(s+1), 0], [0, 1/(s+2)]] has
     the zero −5 (analytic)."""
-    g = TransferFunction([[[1.0], [1.0]], [[1.0], [1.0]]], [[[1, 1.0], [1, 2.0]], [[1, 3.0], [1, 4.0]]])
+    g = (TransferFunction([[[1.0], [1.0]], [[1.0], [1.0]]],
+                          [[[1, 1.0], [1, 2.0]], [[1, 3.0], [1, 4.0]]]))
     assert g.zeros().size == 0
-    g2 = TransferFunction([[[1.0, 5.0], [0.0]], [[0.0], [1.0]]], [[[1, 1.0], [1.0]], [[1.0], [1, 2.0]]])
+    g2 = (TransferFunction([[[1.0, 5.0], [0.0]], [[0.0], [1.0]]],
+                           [[[1, 1.0], [1.0]], [[1.0], [1, 2.0]]]))
     z = g2.zeros()
     # rank decisions are taken at √ε relative: a zero is located to ~√ε |z| at worst
     tol = np.sqrt(EPS) * 5.0
@@ -180,8 +182,10 @@ def test_validation_errors():
 
 def test_names_and_units_survive_conversions():
     s = second_order(10.0, 0.3).replace(states=("x", "v"), state_units=("m", "m/s"))
-    for t in (s.c2d(0.01), s.c2d(0.01).d2c(), s.to_tf(), s.to_tf().to_ss(), s.c2d(0.01, "tustin"), 2.0 * s, -s):
-        assert (t.inputs, t.outputs, t.input_units, t.output_units) == (("F",), ("x",), ("N",), ("m",))
+    for t in (s.c2d(0.01), s.c2d(0.01).d2c(), s.to_tf(), s.to_tf().to_ss(), s.c2d(0.01, "tustin"),
+              2.0 * s, -s):
+        assert (t.inputs, t.outputs, t.input_units,
+                t.output_units) == (("F",), ("x",), ("N",), ("m",))
     d = s.c2d(0.01)
     assert d.states == ("x", "v") and d.state_units == ("m", "m/s") and d.dt == 0.01
 

@@ -53,12 +53,14 @@ def test_tustin_prewarp_matches_python_control_and_is_exact_at_the_prewarp_frequ
     g = TransferFunction([wn**2], [1.0, 2 * zeta * wn, wn**2])
     wp = 30.0
     gd = g.c2d(dt, "tustin", prewarp=wp)
-    ref = control.sample_system(control.tf([wn**2], [1.0, 2 * zeta * wn, wn**2]), dt, method="tustin",
+    ref = control.sample_system(control.tf([wn**2], [1.0, 2 * zeta * wn, wn**2]), dt,
+                                method="tustin",
                                 prewarp_frequency=wp)
     w = np.array([1.0, 10.0, wp])
     # the bilinear map solves with E = I − (T/2)A, κ(E) ≈ 1 + ‖A‖T/2 ≈ 25: both sides agree to
     # ~10 n ε κ ≈ 1e-13; 1e-10 leaves room for the different realisations python-control builds
-    np.testing.assert_allclose(gd.frequency_response(w)[:, 0, 0], ref(np.exp(1j * w * dt)), rtol=1e-10)
+    np.testing.assert_allclose(gd.frequency_response(w)[:, 0, 0], ref(np.exp(1j * w * dt)),
+                               rtol=1e-10)
     # prewarp makes the response exact at ω_p (the bilinear map sends jω_p to e^{jω_p dt})
     assert gd.frequency_response([wp])[0, 0, 0] == pytest.approx(
         g.frequency_response([wp])[0, 0, 0], rel=1e-10)
@@ -116,5 +118,6 @@ def test_zoh_keeps_the_dc_gain_and_maps_poles_to_exp():
     """ZOH maps each pole p to e^{p dt} and keeps the DC gain (analytic)."""
     g = TransferFunction([4.0], [1.0, 0.8, 4.0])
     gd = g.c2d(0.05)
-    np.testing.assert_allclose(np.sort_complex(gd.poles()), np.sort_complex(np.exp(g.poles() * 0.05)), rtol=1e-13)
+    np.testing.assert_allclose(np.sort_complex(gd.poles()),
+                               np.sort_complex(np.exp(g.poles() * 0.05)), rtol=1e-13)
     assert gd.dc_gain()[0, 0] == pytest.approx(1.0, rel=1e-12)

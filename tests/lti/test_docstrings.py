@@ -24,7 +24,9 @@ def _public_callables():
         yield name, obj
         if inspect.isclass(obj):
             for attr, member in vars(obj).items():
-                if not attr.startswith("_") and (inspect.isfunction(member) or isinstance(member, (classmethod, staticmethod))):
+                if not attr.startswith("_") and (inspect.isfunction(member)
+                                                 or isinstance(member,
+                                                               (classmethod, staticmethod))):
                     yield f"{name}.{attr}", member
 
 

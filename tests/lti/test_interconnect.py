@@ -26,7 +26,8 @@ def _close(ours, ref_ctrl):
     H, R = ours.frequency_response(W), _resp(ref_ctrl)
     s = ours.to_ss(minimal=False)
     n = max(s.n_states, 1)
-    kappa = max([np.linalg.cond(1j * w * np.eye(s.n_states) - s.A) for w in W] if s.n_states else [1.0])
+    kappa = (max([np.linalg.cond(1j * w * np.eye(s.n_states) - s.A) for w in W] if s.n_states
+                 else [1.0]))
     assert np.abs(H - R).max() <= 1e3 * n * EPS * kappa * max(np.abs(R).max(), 1.0)
 
 

@@ -10,8 +10,10 @@ from gripkit.lti import StateSpace, TransferFunction, as_system, from_control, f
 
 
 def test_state_space_names_survive_control_round_trip():
-    s = StateSpace([[0.0, 1.0], [-4.0, -0.4]], [[0.0, 0.0], [1.0, 0.5]], [[1.0, 0.0], [0.0, 1.0]], dt=0.01,
-                   inputs=("V", "F"), outputs=("x", "v"), states=("pos", "vel"), input_units=("V", "N"),
+    s = StateSpace([[0.0, 1.0], [-4.0, -0.4]], [[0.0, 0.0], [1.0, 0.5]], [[1.0, 0.0], [0.0, 1.0]],
+                   dt=0.01,
+                   inputs=("V", "F"), outputs=("x", "v"), states=("pos", "vel"),
+                   input_units=("V", "N"),
                    output_units=("m", "m/s"))
     c = s.to_control()
     assert (c.input_labels == ["V", "F"] and c.output_labels == ["x", "v"]
@@ -19,14 +21,16 @@ def test_state_space_names_survive_control_round_trip():
     assert c.dt == 0.01
     back = from_control(c, input_units=("V", "N"), output_units=("m", "m/s"))
     assert isinstance(back, StateSpace)
-    assert (back.inputs, back.outputs, back.states, back.dt) == (s.inputs, s.outputs, s.states, s.dt)
+    assert (back.inputs, back.outputs, back.states,
+            back.dt) == (s.inputs, s.outputs, s.states, s.dt)
     assert back.output_units == ("m", "m/s")
     for X, Y in zip(back._arrays(), s._arrays()):
         np.testing.assert_array_equal(X, Y)
 
 
 def test_transfer_function_names_survive_control_round_trip_mimo():
-    g = TransferFunction([[[1.0], [2.0, 1.0]]], [[[1.0, 1.0], [1.0, 3.0, 2.0]]], inputs=("a", "b"), outputs="y")
+    g = (TransferFunction([[[1.0], [2.0, 1.0]]], [[[1.0, 1.0], [1.0, 3.0, 2.0]]], inputs=("a", "b"),
+                          outputs="y"))
     c = g.to_control()
     assert c.input_labels == ["a", "b"] and c.output_labels == ["y"] and c.dt == 0
     back = from_control(c)
@@ -76,8 +80,10 @@ def test_dict_round_trip_through_json_is_exact():
     floats by their shortest repr, which round-trips exactly)."""
     import json
 
-    s = StateSpace([[0.0, 1.0], [-4.0, -0.4]], [[0.0], [1.0 / 3.0]], [[1.0, 0.0]], dt=0.01, inputs="V",
-                   outputs="x", states=("p", "v"), input_units="V", output_units="m", meta={"source": "test"})
+    s = StateSpace([[0.0, 1.0], [-4.0, -0.4]], [[0.0], [1.0 / 3.0]], [[1.0, 0.0]], dt=0.01,
+                   inputs="V",
+                   outputs="x", states=("p", "v"), input_units="V", output_units="m",
+                   meta={"source": "test"})
     s = s.with_covariance(np.diag([1e-4, 2e-4]), ["A[1,0]", "A[1,1]"])
     g = TransferFunction.from_polynomials([1.0, -1.8732, 0.8996], [0, 0, 0.1950, -0.2276], dt=0.005,
                                           covariance=np.diag([1e-6, 1e-6, 4e-6, 4e-6]), outputs="F")
@@ -86,7 +92,8 @@ def test_dict_round_trip_through_json_is_exact():
         assert type(back) is type(sys)
         for X, Y in zip(back._arrays(), sys._arrays()):
             np.testing.assert_array_equal(X, Y)
-        assert (back.dt, back.inputs, back.outputs, back.input_units, back.output_units, back.meta) == \
+        assert (back.dt, back.inputs, back.outputs, back.input_units, back.output_units,
+                back.meta) == \
             (sys.dt, sys.inputs, sys.outputs, sys.input_units, sys.output_units, sys.meta)
         np.testing.assert_array_equal(back.uncertainty.covariance, sys.uncertainty.covariance)
         assert back.uncertainty.names == sys.uncertainty.names

@@ -41,7 +41,8 @@ def _zpk_zinv(A, B):
 def test_sensor_state_space_matches_scipy():
     old = lti.StateSpace(A_SENSOR, B_SENSOR, C_SENSOR, None, None, ("F",), ("y",), ("N",), ("m",))
     assert isinstance(old, lti.StateSpace) and lti.as_system(old) is old
-    ref = signal.StateSpace(np.array(A_SENSOR), np.array(B_SENSOR), np.array(C_SENSOR), np.zeros((1, 1)))
+    ref = (signal.StateSpace(np.array(A_SENSOR), np.array(B_SENSOR), np.array(C_SENSOR),
+                             np.zeros((1, 1))))
     np.testing.assert_allclose(np.sort_complex(old.poles()), np.sort_complex(ref.poles), rtol=1e-12)
     assert old.zeros().size == 0 == ref.zeros.size
     np.testing.assert_allclose(old.dc_gain(), [[1 / 128]], rtol=1e-12)      # 1/k_s
@@ -49,17 +50,20 @@ def test_sensor_state_space_matches_scipy():
     _, H = signal.freqresp(ref, 2 * np.pi * f)
     np.testing.assert_allclose(old.frequency_response(2 * np.pi * f)[:, 0, 0], H, rtol=1e-12)
     d = old.c2d(5e-5)
-    assert type(d) is lti.StateSpace and d.dt == 5e-5 and d.inputs == ("F",) and d.output_units == ("m",)
+    assert type(d) is lti.StateSpace and d.dt == 5e-5
+    assert d.inputs == ("F",) and d.output_units == ("m",)
     Ad, Bd, _, _, _ = signal.cont2discrete((ref.A, ref.B, ref.C, ref.D), 5e-5, method="zoh")
     np.testing.assert_allclose(d.A, Ad, rtol=1e-12, atol=1e-12 * np.abs(Ad).max())
     np.testing.assert_allclose(d.B, Bd, rtol=1e-12)
     _, (ys,) = signal.dstep((Ad, Bd, ref.C, ref.D, 5e-5), n=400)
-    np.testing.assert_allclose(d.step(400)[:, 0, 0], ys[:, 0], rtol=1e-9, atol=1e-12 * np.abs(ys).max())
+    np.testing.assert_allclose(d.step(400)[:, 0, 0], ys[:, 0], rtol=1e-9,
+                               atol=1e-12 * np.abs(ys).max())
     assert d.is_stable() and old.is_stable()
 
 
 def test_sim_array_kernels_delegate_to_lti():
-    """c2d_zoh ≡ lti.c2d_matrices (bit for bit, C-contiguous) and simulate_discrete ≡ lti.simulate_ss."""
+    """c2d_zoh ≡ lti.c2d_matrices (bit for bit, C-contiguous) and simulate_discrete ≡
+    lti.simulate_ss."""
     A, B = np.array(A_SENSOR), np.array(B_SENSOR)
     Ad, Bd = c2d_zoh(A, B, 5e-5)
     ref = lti.c2d_matrices(A, B, np.zeros((0, 2)), np.zeros((0, 1)), 5e-5)
@@ -89,11 +93,13 @@ def test_state_space_errors():
 
 # ------------------------------------------------------------------ sysid.PolynomialModel
 def test_polynomial_model_delegates_to_its_transfer_function():
-    m = PolynomialModel.from_coefficients(A222, B222, dt=DT, std=STD222, input_name="i", output_name="F",
+    m = PolynomialModel.from_coefficients(A222, B222, dt=DT, std=STD222, input_name="i",
+                                          output_name="F",
                                           input_unit="A", output_unit="N")
     g = m.system
     assert isinstance(g, lti.TransferFunction) and m.to_tf() is g and lti.as_system(m) is g
-    assert (g.dt, g.inputs, g.outputs, g.input_units, g.output_units) == (DT, ("i",), ("F",), ("A",), ("N",))
+    assert (g.dt, g.inputs, g.outputs, g.input_units,
+            g.output_units) == (DT, ("i",), ("F",), ("A",), ("N",))
     assert g.uncertainty.names == m.parameter_names == ("a1", "a2", "b2", "b3")
     np.testing.assert_array_equal(g.uncertainty.covariance, m.covariance)
     assert m.linear_record().system is g
@@ -103,9 +109,11 @@ def test_polynomial_model_delegates_to_its_transfer_function():
     assert m.zeros()[0].real == pytest.approx(0.2276 / 0.1950, rel=1e-12)
     assert m.stable and not m.minimum_phase
     assert m.dc_gain == pytest.approx((0.1950 - 0.2276) / (1 - 1.8732 + 0.8996), rel=1e-12)
-    np.testing.assert_allclose(m.step(60), signal.lfilter(B222, A222, np.ones(60)), rtol=1e-12, atol=1e-14)
+    np.testing.assert_allclose(m.step(60), signal.lfilter(B222, A222, np.ones(60)), rtol=1e-12,
+                               atol=1e-14)
     pulse = np.r_[1.0, np.zeros(59)]
-    np.testing.assert_allclose(m.impulse(60), signal.lfilter(B222, A222, pulse), rtol=1e-12, atol=1e-14)
+    np.testing.assert_allclose(m.impulse(60), signal.lfilter(B222, A222, pulse), rtol=1e-12,
+                               atol=1e-14)
     w, H = m.frequency_response(n=64)                                          # rad/s
     f_ref, H_ref = signal.freqz(B222, A222, worN=64, fs=1 / DT)
     np.testing.assert_allclose(w, 2 * np.pi * f_ref, rtol=1e-15)
@@ -123,11 +131,13 @@ def test_polynomial_model_delegates_to_its_transfer_function():
 
 def test_polynomial_model_layout_roots_and_integrator():
     """Poles and zeros in the q⁻¹ layout leave out the origin roots of the delay and of the padding
-    (ARX [2 1 1]: B/A = b1 z/(z² + a1 z + a2) has a zero at z = 0 in positive powers); an integrator's
+    (ARX [2 1 1]: B/A = b1 z/(z² + a1 z + a2) has a zero at z = 0 in positive powers); an
+    integrator's
     DC gain is ±inf."""
     m = PolynomialModel.from_coefficients([1.0, -1.5, 0.7], [0.0, 2.0], dt=0.1)
     assert m.zeros().size == 0 and m.system.zeros().tolist() == [0.0]
-    np.testing.assert_allclose(np.sort_complex(m.poles()), _zpk_zinv([1.0, -1.5, 0.7], [0.0, 2.0])[1], rtol=1e-12)
+    np.testing.assert_allclose(np.sort_complex(m.poles()),
+                               _zpk_zinv([1.0, -1.5, 0.7], [0.0, 2.0])[1], rtol=1e-12)
     assert m.dc_gain == pytest.approx(2.0 / 0.2, rel=1e-12)
     integ = PolynomialModel.from_coefficients([1.0, -1.0], [0.0, 0.5], dt=0.1)
     assert integ.dc_gain == np.inf and not integ.stable
@@ -152,7 +162,8 @@ def test_polynomial_model_armax_oe_covariances():
 # ------------------------------------------------------------------ control.DiscretePlant
 def test_discrete_plant_is_a_view_of_its_transfer_function():
     # a non-monic A with trailing padding: normalised as before (both divided by A[0] = 2)
-    p = DiscretePlant([2 * a for a in A222] + [0.0], [2 * b for b in B222] + [0.0], DT, input_name="i",
+    p = DiscretePlant([2 * a for a in A222] + [0.0], [2 * b for b in B222] + [0.0], DT,
+                      input_name="i",
                       input_unit="A", output_name="F", output_unit="N")
     np.testing.assert_allclose(p.A, A222, rtol=1e-15)
     np.testing.assert_allclose(p.B, B222, rtol=1e-15)
@@ -166,7 +177,8 @@ def test_discrete_plant_is_a_view_of_its_transfer_function():
     assert p.dc_gain() == pytest.approx((0.1950 - 0.2276) / (1 - 1.8732 + 0.8996), rel=1e-12)
     assert p.is_stable() and not p.is_minimum_phase()
     u = np.ones(200)
-    np.testing.assert_allclose(p.simulate(u, y_offset=2.0), signal.lfilter(B222, A222, u) + 2.0, rtol=1e-12)
+    np.testing.assert_allclose(p.simulate(u, y_offset=2.0), signal.lfilter(B222, A222, u) + 2.0,
+                               rtol=1e-12)
     np.testing.assert_allclose(p.scaled(3.0).B, 3.0 * np.array(B222), rtol=1e-15)
     ss = p.to_state_space()
     assert isinstance(ss, lti.StateSpace) and ss.inputs == ("i",) and ss.output_units == ("N",)
@@ -189,7 +201,8 @@ def test_discrete_plant_is_a_view_of_its_transfer_function():
 def test_discrete_plant_from_a_zoh_state_space_matches_scipy():
     """A ZOH-discretised second-order plant read as a q⁻¹ plant: scipy's cont2discrete + ss2tf."""
     wn, z = 30.0, 0.4
-    A, B, C = np.array([[0, 1], [-wn ** 2, -2 * z * wn]]), np.array([[0], [wn ** 2]]), np.array([[1.0, 0]])
+    A, B, C = (np.array([[0, 1], [-wn ** 2, -2 * z * wn]]), np.array([[0], [wn ** 2]]),
+               np.array([[1.0, 0]]))
     p = DiscretePlant.from_model(lti.StateSpace(A, B, C, None).c2d(DT))
     Ad, Bd, Cd, Dd, _ = signal.cont2discrete((A, B, C, np.zeros((1, 1))), DT, method="zoh")
     num, den = signal.ss2tf(Ad, Bd, Cd, Dd)
@@ -203,16 +216,22 @@ def test_design_rst_accepts_lti_transfer_functions_and_what_it_accepted():
     one controller, whose closed loop A R + B S = P has the designed poles."""
     g = lti.TransferFunction.from_polynomials(A222, B222, dt=DT)
     designs = [design_rst(x, wn=15.0, zeta=0.9) for x in
-               (g, DiscretePlant(A222, B222, DT), (A222, B222, DT), PolynomialModel.from_coefficients(A222, B222, dt=DT))]
+               (g, DiscretePlant(A222, B222, DT), (A222, B222, DT),
+                PolynomialModel.from_coefficients(A222, B222, dt=DT))]
     for c in designs[1:]:
         for k in "RST":
             np.testing.assert_array_equal(getattr(c, k), getattr(designs[0], k))
     c = designs[0]
     assert isinstance(c.plant, lti.TransferFunction)
-    np.testing.assert_allclose(c.characteristic(), np.pad(c.design["P"], (0, c.characteristic().size - c.design["P"].size)),
+    np.testing.assert_allclose(c.characteristic(),
+                               np.pad(c.design["P"],
+                                                          (0,
+                                                                          c.characteristic().size
+                                                                          - c.design["P"].size)),
                                atol=1e-12)
     # the loop's frequency response is that of K·G in scipy: B S/(A R) at z = e^{jωh}; near the
-    # integrator's pole at z = 1 both evaluations lose digits as 1/|z − 1| = 1/(ωh) (400 at 0.5 rad/s)
+    # integrator's pole at z = 1 both evaluations lose digits as 1/|z − 1| = 1/(ωh) (400 at 0.5
+    # rad/s)
     w = np.array([0.5, 4.0, 40.0])
     _, hg = signal.freqz(B222, A222, worN=w * DT)
     _, hk = signal.freqz(c.S, c.R, worN=w * DT)

@@ -52,14 +52,17 @@ def test_ss_to_tf_matches_python_control_ss2tf():
     B, C, D = np.array([[1.0], [0.0], [2.0]]), np.array([[0.0, 1.0, 1.0]]), np.array([[0.5]])
     g = StateSpace(A, B, C, D).to_tf()
     ref = control.ss2tf(control.ss(A, B, C, D))
-    np.testing.assert_allclose(g.numerator(), np.squeeze(ref.num_array[0, 0]), rtol=1e-12, atol=1e-12)
-    np.testing.assert_allclose(g.denominator(), np.squeeze(ref.den_array[0, 0]), rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(g.numerator(), np.squeeze(ref.num_array[0, 0]), rtol=1e-12,
+                               atol=1e-12)
+    np.testing.assert_allclose(g.denominator(), np.squeeze(ref.den_array[0, 0]), rtol=1e-12,
+                               atol=1e-12)
 
 
 def test_mimo_tf_to_ss_is_minimal_and_keeps_the_response():
     """G = [[1/(s+1), 1/(s+1)], [2/(s+1), 2/(s+1)]] is rank one with a single pole: its minimal
     realisation has one state (McMillan degree 1); the frequency response is kept."""
-    g = TransferFunction([[[1.0], [1.0]], [[2.0], [2.0]]], [[[1, 1.0], [1, 1.0]], [[1, 1.0], [1, 1.0]]],
+    g = TransferFunction([[[1.0], [1.0]], [[2.0], [2.0]]],
+                         [[[1, 1.0], [1, 1.0]], [[1, 1.0], [1, 1.0]]],
                          inputs=("a", "b"), outputs=("x", "y"))
     s = g.to_ss()
     assert s.n_states == 1 and s.inputs == ("a", "b") and s.outputs == ("x", "y")
@@ -101,9 +104,11 @@ def test_from_polynomials_table_ii():
     assert g.dc_gain()[0, 0] == pytest.approx(sum(B222) / sum(A222), rel=1e-12)
     # simulation equals scipy.signal.lfilter on the q⁻¹ arrays
     u = np.sin(np.arange(400) * 0.05)
-    np.testing.assert_allclose(g.simulate(u)[:, 0], signal.lfilter(B222, A222, u), rtol=1e-12, atol=1e-14)
+    np.testing.assert_allclose(g.simulate(u)[:, 0], signal.lfilter(B222, A222, u), rtol=1e-12,
+                               atol=1e-14)
     # non-monic A (DiscretePlant layout) is normalised; trailing zeros are padding
-    g2 = TransferFunction.from_polynomials(np.r_[2 * np.array(A222), 0.0], np.r_[2 * np.array(B222), 0.0], dt=0.005)
+    g2 = (TransferFunction.from_polynomials(np.r_[2 * np.array(A222), 0.0],
+                                            np.r_[2 * np.array(B222), 0.0], dt=0.005))
     assert (g2.den_zinv().tolist() == pytest.approx(A222)
             and g2.num_zinv().tolist() == pytest.approx(B222))
     with pytest.raises(ModelError, match="B is all zeros"):
@@ -130,7 +135,8 @@ def test_initial_state_continues_like_lfiltic():
     u_past, y_past, u = rng.standard_normal(5), rng.standard_normal(5), rng.standard_normal(50)
     zi = signal.lfiltic(B222, A222, y_past[::-1], u_past[::-1])
     ref = signal.lfilter(B222, A222, u, zi=zi)[0]
-    np.testing.assert_allclose(g.simulate(u, g.initial_state(u_past, y_past))[:, 0], ref, rtol=1e-12, atol=1e-13)
+    np.testing.assert_allclose(g.simulate(u, g.initial_state(u_past, y_past))[:, 0], ref,
+                               rtol=1e-12, atol=1e-13)
 
 
 def test_controllable_form_is_scipys_tf2ss_bit_for_bit():

@@ -70,13 +70,16 @@ def test_frequency_response_covariance_matches_monte_carlo(g, draws):
     for f in range(w.size):
         _check_cov(cov[f, 0, 0], np.c_[H[:, f].real, H[:, f].imag])
     b = g.bode(w)
-    np.testing.assert_allclose(np.std(np.abs(H), axis=0, ddof=1), b.magnitude_std[:, 0, 0], rtol=REL)
-    np.testing.assert_allclose(np.std(np.unwrap(np.angle(H), axis=1), axis=0, ddof=1), b.phase_std[:, 0, 0],
+    np.testing.assert_allclose(np.std(np.abs(H), axis=0, ddof=1), b.magnitude_std[:, 0, 0],
+                               rtol=REL)
+    np.testing.assert_allclose(np.std(np.unwrap(np.angle(H), axis=1), axis=0, ddof=1),
+                               b.phase_std[:, 0, 0],
                                rtol=REL)
 
 
 def test_covariance_goes_through_c2d_and_to_ss(g, draws):
-    """Discrete poles of c2d(G, zoh) against Monte Carlo of e^{p dt} (ZOH's pole map); the state-space
+    """Discrete poles of c2d(G, zoh) against Monte Carlo of e^{p dt} (ZOH's pole map); the
+    state-space
     view gives the same frequency-response covariance as the transfer function (central
     differences with h = ε^{1/3}: relative error ~ε^{2/3} ≈ 4e-11, checked at 1e-6)."""
     dt = 0.02
@@ -115,7 +118,8 @@ def test_series_of_uncertain_systems_matches_monte_carlo():
     g2 = TransferFunction([0.0, 5.0], [1.0, 5.0]).with_covariance([[1e-6]], ["den[1]"])
     gs = series(g1, g2)
     assert gs.uncertainty.names == ("num[1]", "den[1]")
-    assert series(g1, g1).uncertainty.names == ("1.num[1]", "2.num[1]")  # colliding names get prefixes
+    # colliding names get prefixes
+    assert series(g1, g1).uncertainty.names == ("1.num[1]", "2.num[1]")
     w = np.array([3.0])
     cov = gs.frequency_response_covariance(w)[0, 0, 0]
     rng = np.random.default_rng(8)
@@ -143,7 +147,8 @@ def test_arx_covariance_reaches_the_frequency_response():
     th = rng.multivariate_normal(m.theta, m.covariance, size=N_MC)
     z = np.exp(1j * w * 0.005)
     for f in range(w.size):
-        H = (th[:, 2] * z[f] ** -2 + th[:, 3] * z[f] ** -3) / (1 + th[:, 0] / z[f] + th[:, 1] / z[f] ** 2)
+        H = (th[:, 2] * z[f] ** -2 + th[:, 3]
+             * z[f] ** -3) / (1 + th[:, 0] / z[f] + th[:, 1] / z[f] ** 2)
         _check_cov(cov[f, 0, 0], np.c_[H.real, H.imag])
 
 
@@ -181,14 +186,16 @@ def test_delay_poles_have_zero_sigma_and_agree_with_the_realisation():
     """ARX [2 2 3]: two poles at z = 0 from the delay are exact (σ = 0), and the root-sensitivity
     σ of the others equals the eigenvector formula on the state-space realisation."""
     cov = np.diag([1e-3, 1e-3, 2e-3, 2e-3]) ** 2
-    g = TransferFunction.from_polynomials([1.0, -1.8732, 0.8996], [0, 0, 0, 0.1950, -0.2276], dt=0.005,
+    g = TransferFunction.from_polynomials([1.0, -1.8732, 0.8996], [0, 0, 0, 0.1950, -0.2276],
+                                          dt=0.005,
                                           covariance=cov)
     p, c = g.pole_covariance()
     assert np.count_nonzero(p == 0) == 2 and np.all(c[p == 0] == 0)
     d = g.damping()
     assert np.all(np.isinf(d.wn[p == 0])) and np.all(d.zeta[p == 0] == 1.0)
     # the same σ from the eigenvalues of a realisation without the delay states
-    g2 = TransferFunction.from_polynomials([1.0, -1.8732, 0.8996], [0.1950, -0.2276], dt=0.005, covariance=cov)
+    g2 = (TransferFunction.from_polynomials([1.0, -1.8732, 0.8996], [0.1950, -0.2276], dt=0.005,
+                                            covariance=cov))
     p2, c2 = g2.to_ss(minimal=False).pole_covariance()
     order = [int(np.argmin(np.abs(p2 - x))) for x in p[p != 0]]
     np.testing.assert_allclose(c[p != 0], c2[order], rtol=1e-6)

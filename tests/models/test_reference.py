@@ -16,7 +16,8 @@ def test_bouc_wen_has_table_ii_values_and_its_saturation():
     each parameter citing Table II."""
     bw = reference_bouc_wen()
     p = bw.parameters
-    assert [p.value(k) for k in ("d_p", "lam", "beta", "gamma")] == [0.77e-6, 0.43e-6, 0.108, 7.5e-3]
+    assert [p.value(k) for k in ("d_p", "lam", "beta", "gamma")] == [0.77e-6, 0.43e-6, 0.108,
+                                                                     7.5e-3]
     assert bw.saturation() == pytest.approx(0.43e-6 / 0.1155, rel=1e-12)
     assert round(bw.saturation() * 1e6, 2) == 3.72
     assert all("Table II" in p[k].source for k in p.names)

@@ -38,7 +38,8 @@ def pinocchio_model(alpha, a, d, off, types, mass, com, inertia, armature, gravi
         p = np.array([a[k], 0.0, 0.0]) + _rx(alpha[k]) @ np.array([0.0, 0.0, d[k]])
         joint = pin.JointModelPZ() if types[k] == "P" else pin.JointModelRZ()
         parent = model.addJoint(parent, joint, pin.SE3(R, p), f"j{k}")
-        model.appendBodyToJoint(parent, pin.Inertia(mass[k], np.asarray(com[k]), np.asarray(inertia[k])),
+        model.appendBodyToJoint(parent, pin.Inertia(mass[k], np.asarray(com[k]),
+                                                    np.asarray(inertia[k])),
                                 pin.SE3.Identity())
     model.armature = np.asarray(armature, dtype=float)
     model.gravity.linear = np.asarray(gravity, dtype=float)
@@ -54,12 +55,15 @@ def random_inertia(rng, scale):
 
 def random_chain(rng, types):
     n = len(types)
-    kw = dict(alpha=rng.uniform(-math.pi, math.pi, n), a=rng.uniform(0, 0.3, n), d=rng.uniform(-0.2, 0.2, n),
+    kw = dict(alpha=rng.uniform(-math.pi, math.pi, n), a=rng.uniform(0, 0.3, n),
+              d=rng.uniform(-0.2, 0.2, n),
               theta_offset=rng.uniform(-1, 1, n), joint_types=types, mass=rng.uniform(0.1, 2.0, n),
-              com=rng.normal(size=(n, 3)) * 0.1, inertia=np.array([random_inertia(rng, 1e-3) for _ in range(n)]),
+              com=rng.normal(size=(n, 3)) * 0.1,
+              inertia=np.array([random_inertia(rng, 1e-3) for _ in range(n)]),
               armature=rng.uniform(0, 0.05, n), gravity=rng.normal(size=3) * 5)
     chain = DHChain(**kw)
-    model, data = pinocchio_model(kw["alpha"], kw["a"], kw["d"], kw["theta_offset"], types, kw["mass"],
+    model, data = pinocchio_model(kw["alpha"], kw["a"], kw["d"], kw["theta_offset"], types,
+                                  kw["mass"],
                                   kw["com"], kw["inertia"], kw["armature"], kw["gravity"])
     return chain, model, data
 
@@ -80,11 +84,13 @@ def test_dh_chain_dynamics_match_pinocchio(types):
     C = chain.coriolis(q, qd)
     G = chain.gravity(q)
     for b in range(B):
-        np.testing.assert_allclose(tau[b], pin.rnea(model, data, q[b], qd[b], qdd[b]), atol=TOL, rtol=0)
+        np.testing.assert_allclose(tau[b], pin.rnea(model, data, q[b], qd[b], qdd[b]), atol=TOL,
+                                   rtol=0)
         np.testing.assert_allclose(M[b], full_crba(model, data, q[b]), atol=TOL, rtol=0)
         g = pin.computeGeneralizedGravity(model, data, q[b])
         np.testing.assert_allclose(G[b], g, atol=TOL, rtol=0)
-        np.testing.assert_allclose(C[b], pin.nonLinearEffects(model, data, q[b], qd[b]) - g, atol=TOL, rtol=0)
+        np.testing.assert_allclose(C[b], pin.nonLinearEffects(model, data, q[b], qd[b]) - g,
+                                   atol=TOL, rtol=0)
         np.testing.assert_allclose(chain.forward_dynamics(q[b], qd[b], tau[b]),
                                    pin.aba(model, data, q[b], qd[b], tau[b]), atol=1e-9, rtol=0)
 
@@ -104,7 +110,8 @@ def test_kinematics_match_pinocchio(types):
         for k in range(chain.n):
             np.testing.assert_allclose(frames[k], data.oMi[k + 1].homogeneous, atol=TOL)
         # Jacobian of the tool point, world-aligned: Pinocchio's frame Jacobian at the tool frame
-        fid = model.addFrame(pin.Frame("tool", chain.n, 0, pin.SE3(tool[:3, :3], tool[:3, 3]), pin.OP_FRAME)) \
+        fid = model.addFrame(pin.Frame("tool", chain.n, 0, pin.SE3(tool[:3, :3], tool[:3, 3]),
+                                       pin.OP_FRAME)) \
             if not model.existFrame("tool") else model.getFrameId("tool")
         data = model.createData()
         J = pin.computeFrameJacobian(model, data, q, fid, pin.LOCAL_WORLD_ALIGNED)
@@ -119,7 +126,8 @@ def test_coupled_finger_matches_pinocchio_reduced_model():
     ch = f.chain()
     c = ch.chain
     I = c.inertia  # noqa: E741
-    model, data = pinocchio_model(c.dh[:, 0], c.dh[:, 1], c.dh[:, 2], c.dh[:, 3], "RRRR", c.mass, c.com, I,
+    model, data = pinocchio_model(c.dh[:, 0], c.dh[:, 1], c.dh[:, 2], c.dh[:, 3], "RRRR", c.mass,
+                                  c.com, I,
                                   np.zeros(4), c.gravity_vector)
     Gm = ch.coupling.matrix
     arm = ch.coupling.armature
@@ -141,8 +149,10 @@ def test_coupled_finger_matches_pinocchio_reduced_model():
         g = pin.computeGeneralizedGravity(model, data, q)
         np.testing.assert_allclose(M[b], Gm.T @ Mq @ Gm + np.diag(arm), atol=TOL, rtol=0)
         np.testing.assert_allclose(G[b], Gm.T @ g, atol=TOL, rtol=0)
-        np.testing.assert_allclose(C[b], Gm.T @ (pin.nonLinearEffects(model, data, q, qd) - g), atol=TOL, rtol=0)
-        np.testing.assert_allclose(tau[b], Gm.T @ pin.rnea(model, data, q, qd, qdd) + arm * pdd[b], atol=TOL, rtol=0)
+        np.testing.assert_allclose(C[b], Gm.T @ (pin.nonLinearEffects(model, data, q, qd) - g),
+                                   atol=TOL, rtol=0)
+        np.testing.assert_allclose(tau[b], Gm.T @ pin.rnea(model, data, q, qd, qdd) + arm * pdd[b],
+                                   atol=TOL, rtol=0)
 
 
 def test_exporter_matches_independent_model():
@@ -159,7 +169,8 @@ def test_large_batches_run_in_parallel_with_the_same_result():
     rng = np.random.default_rng(9)
     chain, _, _ = random_chain(rng, "RRRR")
     q, qd, qdd = (rng.normal(size=(600, 4)) for _ in range(3))
-    np.testing.assert_allclose(chain.rnea(q, qd, qdd, parallel=True), chain.rnea(q, qd, qdd, parallel=False),
+    np.testing.assert_allclose(chain.rnea(q, qd, qdd, parallel=True),
+                               chain.rnea(q, qd, qdd, parallel=False),
                                atol=1e-13, rtol=0)
 
 

@@ -21,9 +21,12 @@ def chain_from(seed, n, prismatic=False):
         Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
         inertia.append(Q @ np.diag(rng.uniform(0.5, 1.0, 3) * 1e-3) @ Q.T)
     types = "".join("P" if (prismatic and k % 2) else "R" for k in range(n))
-    return DHChain(alpha=rng.uniform(-3, 3, n), a=rng.uniform(0, 0.3, n), d=rng.uniform(-0.1, 0.1, n),
-                   theta_offset=rng.uniform(-1, 1, n), joint_types=types, mass=rng.uniform(0.05, 1.0, n),
-                   com=rng.normal(size=(n, 3)) * 0.05, inertia=np.array(inertia), gravity=(0, 0, -9.81))
+    return DHChain(alpha=rng.uniform(-3, 3, n), a=rng.uniform(0, 0.3, n),
+                   d=rng.uniform(-0.1, 0.1, n),
+                   theta_offset=rng.uniform(-1, 1, n), joint_types=types,
+                   mass=rng.uniform(0.05, 1.0, n),
+                   com=rng.normal(size=(n, 3)) * 0.05, inertia=np.array(inertia),
+                   gravity=(0, 0, -9.81))
 
 
 @given(seed=st.integers(0, 10_000), n=st.integers(1, 7), prismatic=st.booleans(),
@@ -43,7 +46,8 @@ def test_finger_mass_matrix_spd(q):
     assert np.linalg.eigvalsh(M).min() > 0.02  # the reflected rotor inertia alone is ≥ 0.0221 kg·m²
 
 
-@given(seed=st.integers(0, 10_000), n=st.integers(1, 6), prismatic=st.booleans(), coupled=st.booleans())
+@given(seed=st.integers(0, 10_000), n=st.integers(1, 6), prismatic=st.booleans(),
+       coupled=st.booleans())
 def test_one_state_path_equals_the_batched_kernels(seed, n, prismatic, coupled):
     """``rnea`` and ``mass_matrix`` on one float64 state (the low-overhead path of
     gripkit.multibody.onestate) give the batched kernels' values bit for bit on DH chains, with
@@ -69,9 +73,11 @@ def test_one_state_path_hands_bad_states_to_the_checks():
     with pytest.raises(ModelError, match="NaN"):
         ch.mass_matrix(np.array([np.nan, 0.0, 0.0]))
     np.testing.assert_allclose(ch.mass_matrix(q.tolist()), ch.mass_matrix(q), rtol=1e-15)
-    np.testing.assert_allclose(ch.mass_matrix(q.astype(np.float32)), ch.mass_matrix(q.astype(np.float32).astype(float)),
+    np.testing.assert_allclose(ch.mass_matrix(q.astype(np.float32)),
+                               ch.mass_matrix(q.astype(np.float32).astype(float)),
                                rtol=1e-15)
-    strided = np.column_stack([q, -q])[:, 0]  # a non-contiguous view: the kernel refuses it, the checks copy it
+    # a non-contiguous view: the kernel refuses it, the checks copy it
+    strided = np.column_stack([q, -q])[:, 0]
     np.testing.assert_array_equal(ch.mass_matrix(strided), ch.mass_matrix(q))
 
 
@@ -93,7 +99,8 @@ def test_one_state_out_workspace():
     np.testing.assert_array_equal(ch.rnea(q, qd, qdd, gravity=False, out=tau),
                                   ch.rnea(q, qd, qdd, gravity=False))
     for bad in (np.empty((2, 2)), np.empty((3, 3), dtype=np.float32), np.empty(9), [[0.0] * 3] * 3):
-        with pytest.raises(ArgumentError, match=r"out: expected a writable float64 array of shape \(3, 3\)"):
+        with pytest.raises(ArgumentError, match=r"out: expected a writable float64 array "
+                                                r"of shape \(3, 3\)"):
             ch.mass_matrix(q, out=bad)
     ro = np.empty(3)
     ro.flags.writeable = False
@@ -106,7 +113,8 @@ def test_one_state_out_workspace():
 
 
 def test_power_balance_qd_C_equals_half_qd_Mdot_qd():
-    """q̇ᵀ(Ṁ/2 − C_mat)q̇ = 0, i.e. q̇ᵀ c(q, q̇) = ½ q̇ᵀ Ṁ q̇ for the Coriolis vector c (Ṁ by central
+    """q̇ᵀ(Ṁ/2 − C_mat)q̇ = 0, i.e. q̇ᵀ c(q, q̇) = ½ q̇ᵀ Ṁ q̇ for the Coriolis vector c (Ṁ by
+    central
     differences along q̇)."""
     ch = chain_from(4, 5)
     rng = np.random.default_rng(0)

@@ -34,7 +34,8 @@ def link_xml(name, inertial):
     i = inertial
     ixx, iyy, izz = (float(x) for x in i["I"])
     return (f'<link name="{name}"><inertial><origin xyz="{_v(i["xyz"])}" rpy="{_v(i["rpy"])}"/>'
-            f'<mass value="{float(i["mass"])!r}"/><inertia ixx="{ixx!r}" ixy="0" ixz="0" iyy="{iyy!r}" iyz="0" '
+            f'<mass value="{float(i["mass"])!r}"/><inertia ixx="{ixx!r}" ixy="0" ixz="0" '
+            f'iyy="{iyy!r}" iyz="0" '
             f'izz="{izz!r}"/></inertial></link>')
 
 
@@ -72,11 +73,14 @@ def random_urdf(rng, spec):
 
 SPECS = {
     "revolute-z": [("revolute", (0, 0, 1), None)] * 3,
-    "mixed-axes": [("revolute", (1, 0, 0), None), ("revolute", (0, -1, 0), None), ("prismatic", (0.3, -0.5, 0.8), None),
+    "mixed-axes": [("revolute", (1, 0, 0), None), ("revolute", (0, -1, 0), None),
+                   ("prismatic", (0.3, -0.5, 0.8), None),
                    ("revolute", (0, 0, -1), None)],
-    "mimic": [("revolute", (0, 0, 1), None), ("revolute", (0, 1, 0), None), ("revolute", (1, 0, 0), None),
+    "mimic": [("revolute", (0, 0, 1), None), ("revolute", (0, 1, 0), None),
+              ("revolute", (1, 0, 0), None),
               ("revolute", (0.6, 0, 0.8), ("j2", 0.7, 0.2))],
-    "fixed-links": [("revolute", (0, 0, 1), None), ("fixed", None, None), ("revolute", (0, 1, 0), None),
+    "fixed-links": [("revolute", (0, 0, 1), None), ("fixed", None, None),
+                    ("revolute", (0, 1, 0), None),
                     ("prismatic", (0, 0, 1), ("j0", -0.5, 0.0))],
 }
 
@@ -117,12 +121,14 @@ def test_rnea_mass_gravity_fd(pair):
     for b in range(B):
         ref = pin.rnea(model, data, q[b], qd[b], qdd[b])
         np.testing.assert_allclose(tau[b], ref, atol=TOL, rtol=0)
-        np.testing.assert_allclose(chain.rnea(q[b], qd[b], qdd[b]), ref, atol=TOL, rtol=0)  # one-state path
+        # one-state path
+        np.testing.assert_allclose(chain.rnea(q[b], qd[b], qdd[b]), ref, atol=TOL, rtol=0)
         Mp = pin.crba(model, data, q[b])
         Mp = np.triu(Mp) + np.triu(Mp, 1).T
         np.testing.assert_allclose(M[b], Mp, atol=TOL, rtol=0)
         np.testing.assert_allclose(chain.mass_matrix(q[b]), Mp, atol=TOL, rtol=0)  # one-state path
-        np.testing.assert_allclose(G[b], pin.computeGeneralizedGravity(model, data, q[b]), atol=TOL, rtol=0)
+        np.testing.assert_allclose(G[b], pin.computeGeneralizedGravity(model, data, q[b]), atol=TOL,
+                                   rtol=0)
     qdd_fd = chain.forward_dynamics(q, qd, tau)
     np.testing.assert_allclose(qdd_fd, qdd, atol=1e-8, rtol=0)
 
@@ -133,7 +139,8 @@ def test_regressor_matches_pinocchio(pair):
     q, qd, qdd = (rng.uniform(-1.5, 1.5, size=(8, m)) for _ in range(3))
     Y = chain.regressor(q, qd, qdd)
     phi = chain.standard_parameters()
-    np.testing.assert_allclose(np.einsum("bij,j->bi", Y, phi), chain.rnea(q, qd, qdd), atol=TOL, rtol=0)
+    np.testing.assert_allclose(np.einsum("bij,j->bi", Y, phi), chain.rnea(q, qd, qdd), atol=TOL,
+                               rtol=0)
     # Pinocchio's regressor does not take mimic joints: use the full model (every joint free) and
     # project, Y = Γᵀ Y_full(Γ q + q₀, Γ q̇, Γ q̈)
     full = pin.buildModelFromXML(chain.urdf_text, mimic=False)
@@ -143,7 +150,8 @@ def test_regressor_matches_pinocchio(pair):
     moving = list(range(1, full.njoints))
     assert Y.shape[2] == 10 * len(moving)
     for b in range(len(q)):
-        Yp = Gm.T @ pin.computeJointTorqueRegressor(full, fdata, chain.joints(q[b]), Gm @ qd[b], Gm @ qdd[b])
+        Yp = (Gm.T @ pin.computeJointTorqueRegressor(full, fdata, chain.joints(q[b]), Gm @ qd[b],
+                                                     Gm @ qdd[b]))
         np.testing.assert_allclose(Y[b], Yp, atol=TOL, rtol=0)
     ref = np.concatenate([full.inertias[i].toDynamicParameters() for i in moving])
     np.testing.assert_allclose(phi, ref, atol=1e-14, rtol=0)
@@ -173,28 +181,38 @@ def _xml(body):
     return f'<robot name="r">{body}</robot>'
 
 
-L = '<link name="{}"><inertial><mass value="1"/><inertia ixx="1" iyy="1" izz="1"/></inertial></link>'
+L = ('<link name="{}"><inertial><mass value="1"/><inertia ixx="1" iyy="1" '
+     'izz="1"/></inertial></link>')
 J = ('<joint name="{}" type="{}"><parent link="{}"/><child link="{}"/><axis xyz="0 0 1"/>'
      '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>')
 
 
 @pytest.mark.parametrize("body, match", [
     (L.format("a") + L.format("b") + L.format("c") + J.format("j1", "revolute", "a", "b")
-     + J.format("j2", "revolute", "c", "b"), "link 'b' is the child of joints 'j1' and 'j2'.*closed loop"),
-    (L.format("a") + L.format("b") + L.format("c") + L.format("d") + J.format("j1", "revolute", "a", "b")
+     + J.format("j2", "revolute", "c", "b"), "link 'b' is the child of joints 'j1' and "
+                                             "'j2'.*closed loop"),
+    (L.format("a") + L.format("b") + L.format("c") + L.format("d") + J.format("j1", "revolute", "a",
+                                                                              "b")
      + J.format("j2", "revolute", "c", "d"), "several trees.*'a', 'c'"),
-    (L.format("a") + '<link name="b"/>' + J.format("j1", "revolute", "a", "b"), "link 'b', moved by joint 'j1', has no <inertial>"),
-    (L.format("a") + L.format("b") + J.format("j1", "floating", "a", "b"), "joint 'j1' has type 'floating'"),
-    (L.format("a") + L.format("b") + J.format("j1", "planar", "a", "b"), "joint 'j1' has type 'planar'"),
+    (L.format("a") + '<link name="b"/>' + J.format("j1", "revolute", "a", "b"),
+     "link 'b', moved by joint 'j1', has no <inertial>"),
+    (L.format("a") + L.format("b") + J.format("j1", "floating", "a", "b"),
+     "joint 'j1' has type 'floating'"),
+    (L.format("a") + L.format("b") + J.format("j1", "planar", "a", "b"),
+     "joint 'j1' has type 'planar'"),
     (L.format("a") + L.format("b") + J.format("j1", "revolute", "a", "b").replace("0 0 1", "0 x 1"),
      r"joint 'j1' <axis xyz>: expected 3 numbers, found '0 x 1'"),
-    (L.format("a") + L.format("b").replace('value="1"', 'value="heavy"') + J.format("j1", "revolute", "a", "b"),
+    (L.format("a") + L.format("b").replace('value="1"',
+                                           'value="heavy"') + J.format("j1", "revolute", "a", "b"),
      r"link 'b' <mass>: value='heavy' is not a number"),
     (L.format("a") + L.format("b") + L.format("c") + J.format("j1", "revolute", "a", "b")
      + J.format("j2", "revolute", "a", "c"), "link 'a' carries several chains"),
-    (L.format("a") + L.format("b") + J.format("j1", "revolute", "a", "b").replace("</joint>", '<mimic joint="zz"/></joint>'),
+    (L.format("a") + L.format("b") + J.format("j1", "revolute", "a",
+                                              "b").replace("</joint>",
+                                                           '<mimic joint="zz"/></joint>'),
      "joint 'j1' mimics 'zz', which is not a moving joint"),
-    (L.format("a") + L.format("b") + J.format("j1", "revolute", "a", "x"), "joint 'j1': child link 'x' is not defined"),
+    (L.format("a") + L.format("b") + J.format("j1", "revolute", "a", "x"), "joint 'j1': child link "
+                                                                           "'x' is not defined"),
 ])
 def test_clear_errors(body, match):
     with pytest.raises(ModelError, match=match):
@@ -202,11 +220,13 @@ def test_clear_errors(body, match):
 
 
 def test_branch_needs_tip_link_and_tip_link_selects():
-    body = (L.format("a") + L.format("b") + L.format("c") + L.format("d") + J.format("j1", "revolute", "a", "b")
+    body = (L.format("a") + L.format("b") + L.format("c") + L.format("d")
+            + J.format("j1", "revolute", "a", "b")
             + J.format("j2", "revolute", "b", "c") + J.format("j3", "revolute", "b", "d"))
     with pytest.raises(ModelError, match="the chain branches at link 'b'"):
         from_urdf(_xml(body))
-    with pytest.raises(ModelError, match="joint 'j3' \\(revolute\\) branches off the chain at link 'b'"):
+    with pytest.raises(ModelError, match="joint 'j3' \\(revolute\\) branches off the "
+                                         "chain at link 'b'"):
         from_urdf(_xml(body), tip_link="c")
 
 

@@ -37,7 +37,8 @@ def _joint_space(ch):
     """The finger's links with only the distal coupling θ₄ = θ₃ (what URDF can hold)."""
     G = np.zeros((4, 3))
     G[0, 0] = G[1, 1] = G[2, 2] = G[3, 2] = 1.0
-    return CoupledChain(ch.chain.replace(armature=np.zeros(4)), Coupling(G, np.zeros(4), np.zeros(3), ch.chain.names[:3]))
+    return (CoupledChain(ch.chain.replace(armature=np.zeros(4)),
+                         Coupling(G, np.zeros(4), np.zeros(3), ch.chain.names[:3])))
 
 
 def _states(rng, m, B=25):
@@ -61,7 +62,8 @@ def test_finger_round_trip_dynamics(finger_urdf, finger_chain):
     np.testing.assert_allclose(u.mass_matrix(q), ref.mass_matrix(q), atol=TOL, rtol=0)
     np.testing.assert_allclose(u.gravity(q), ref.gravity(q), atol=TOL, rtol=0)
     np.testing.assert_allclose(u.regressor(q, qd, qdd), ref.regressor(q, qd, qdd), atol=TOL, rtol=0)
-    np.testing.assert_allclose(u.standard_parameters(), ref.standard_parameters(), atol=1e-15, rtol=0)
+    np.testing.assert_allclose(u.standard_parameters(), ref.standard_parameters(), atol=1e-15,
+                               rtol=0)
     np.testing.assert_allclose(u.fk(q), ref.fk(q), atol=TOL, rtol=0)
     np.testing.assert_allclose(u.jacobian(q), ref.jacobian(q), atol=TOL, rtol=0)
 
@@ -85,10 +87,12 @@ def test_finger_urdf_in_pinocchio(finger_urdf, finger_chain):
     ref = _joint_space(finger_chain)
     q, qd, qdd = _states(np.random.default_rng(3), 3, B=10)
     for b in range(10):
-        np.testing.assert_allclose(pin.rnea(model, data, q[b], qd[b], qdd[b]), ref.rnea(q[b], qd[b], qdd[b]),
+        np.testing.assert_allclose(pin.rnea(model, data, q[b], qd[b], qdd[b]),
+                                   ref.rnea(q[b], qd[b], qdd[b]),
                                    atol=TOL, rtol=0)
         M = pin.crba(model, data, q[b])
-        np.testing.assert_allclose(np.triu(M) + np.triu(M, 1).T, ref.mass_matrix(q[b]), atol=TOL, rtol=0)
+        np.testing.assert_allclose(np.triu(M) + np.triu(M, 1).T, ref.mass_matrix(q[b]), atol=TOL,
+                                   rtol=0)
 
 
 def test_regressor_with_rotor_inertia(finger_chain):
@@ -106,9 +110,12 @@ def _random_dh(rng, types, base=None):
     inertia = np.array([q @ np.diag(rng.uniform(0.5, 1.0, 3) * 1e-3) @ q.T for q in Q])
     tool = np.eye(4)
     tool[:3, 3] = rng.normal(size=3) * 0.05
-    return DHChain(alpha=rng.uniform(-math.pi, math.pi, n), a=rng.uniform(0, 0.3, n), d=rng.uniform(-0.2, 0.2, n),
-                   theta_offset=rng.uniform(-1, 1, n), joint_types=types, mass=rng.uniform(0.1, 2.0, n),
-                   com=rng.normal(size=(n, 3)) * 0.1, inertia=inertia, gravity=rng.normal(size=3) * 5,
+    return DHChain(alpha=rng.uniform(-math.pi, math.pi, n), a=rng.uniform(0, 0.3, n),
+                   d=rng.uniform(-0.2, 0.2, n),
+                   theta_offset=rng.uniform(-1, 1, n), joint_types=types,
+                   mass=rng.uniform(0.1, 2.0, n),
+                   com=rng.normal(size=(n, 3)) * 0.1, inertia=inertia,
+                   gravity=rng.normal(size=3) * 5,
                    tool=tool, base=base)
 
 
@@ -135,5 +142,6 @@ def test_dh_round_trip(types, tmp_path):
 
 
 def test_to_urdf_refuses_unknown_objects(tmp_path):
-    with pytest.raises(ModelError, match="expected a DHChain, CoupledChain or JointChain, found str"):
+    with pytest.raises(ModelError, match="expected a DHChain, CoupledChain or "
+                                         "JointChain, found str"):
         to_urdf("arm", tmp_path / "x.urdf")

@@ -16,7 +16,8 @@ from pathlib import Path
 import numba
 
 TESTS = Path(__file__).resolve().parents[1]
-for folder in (TESTS / "systems" / "dlr_hit", TESTS / "systems" / "tsfm", TESTS):  # tests/conftest.py first
+# tests/conftest.py first
+for folder in (TESTS / "systems" / "dlr_hit", TESTS / "systems" / "tsfm", TESTS):
     sys.path.insert(0, str(folder))
 
 from conftest import RECORD_RTOL, record_of  # noqa: E402
@@ -42,7 +43,8 @@ def main():
         tsfm = _results()
     records = {"source": f"recorded by tests/reference/record_kernels.py at commit {commit}, "
                          f"{platform.machine()} ({_cpu()}), numba {numba.__version__}; "
-                         f"each result's shape and a dozen of its rows (float.hex); the tests ask for "
+                         "each result's shape and a dozen of its rows (float.hex); "
+                         "the tests ask for "
                          f"agreement to {RECORD_RTOL} relative",
                "dlr_hit": {k: record_of(v) for k, v in dlr.items()},
                "tsfm": {k: record_of(v) for k, v in tsfm.items()}}

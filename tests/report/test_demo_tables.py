@@ -27,7 +27,8 @@ def _assert_no_nan_cells(rep):
         for row in t.rows:
             for c in row:
                 assert not (isinstance(c, float) and math.isnan(c)), (title, t.caption[:60], row)
-                assert not (isinstance(c, str) and c.strip().lower() == "nan"), (title, t.caption[:60], row)
+                assert not (isinstance(c, str)
+                            and c.strip().lower() == "nan"), (title, t.caption[:60], row)
 
 
 def test_amadeus_demo_marks_forces_resting_on_the_force_scale():

@@ -10,7 +10,8 @@ from gripkit.sysid import PolynomialModel
 def _visible_labels(ax, axis):
     ax.figure.canvas.draw()
     lo, hi = sorted(axis.get_view_interval())
-    return [t for t, v in zip(axis.get_ticklabels(), axis.get_majorticklocs()) if t.get_text() and lo <= v <= hi]
+    return ([t for t, v in zip(axis.get_ticklabels(),
+                               axis.get_majorticklocs()) if t.get_text() and lo <= v <= hi])
 
 
 @pytest.mark.parametrize("span", [(3.0, 20.0), (0.2, 100.0), (1e-3, 1e5)])
@@ -23,7 +24,8 @@ def test_log_ticks_label_at_least_three_ticks(span):
 
 
 def _model(a1, a2, b2):
-    return PolynomialModel.from_coefficients([1.0, a1, a2], [0.0, 0.0, b2, -0.8 * b2], nk=2, dt=0.005)
+    return (PolynomialModel.from_coefficients([1.0, a1, a2], [0.0, 0.0, b2, -0.8 * b2], nk=2,
+                                              dt=0.005))
 
 
 def test_bode_draws_the_reference_under_the_estimates_and_labels_log_ticks():
@@ -42,7 +44,8 @@ def test_pole_zero_map_gives_each_model_its_own_marker_and_size():
     p, z = [0.9 + 0.1j, 0.9 - 0.1j], [1.17]
     fig = pole_zero_map({"a": (p, z), "b": (p, z), "c": (p, z)})
     ax = fig.axes[0]
-    shown = [ln for ln in ax.get_lines() if not ln.get_label().startswith("_")]  # not the unit circle
+    # not the unit circle
+    shown = [ln for ln in ax.get_lines() if not ln.get_label().startswith("_")]
     marks = [(ln.get_marker(), ln.get_markersize()) for ln in shown]
     assert len(marks) == 6 and len(set(marks)) == 6
     poles = [m for ln, m in zip(shown, marks) if ln.get_label().endswith("poles")]

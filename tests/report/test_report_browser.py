@@ -1,5 +1,6 @@
 """The report in a real browser (issue 16): headless Chromium screenshots at 1400 px and at phone
-width (390 px), and no horizontal overflow of the page there, through ``scripts/screenshot_report.py``.
+width (390 px), and no horizontal overflow of the page there, through
+``scripts/screenshot_report.py``.
 
 Chromium is a system package, not a Python dependency: without it these tests skip, unless
 ``GRIPKIT_BROWSER_TESTS=1`` is set, which makes a missing browser a failure (docs/DEVELOPING.md).
@@ -41,12 +42,14 @@ def browser():
     except shot.BrowserError as exc:
         if os.environ.get("GRIPKIT_BROWSER_TESTS") == "1":
             pytest.fail(f"GRIPKIT_BROWSER_TESTS=1 but {exc}")
-        pytest.skip(f"the report's layout check needs a headless browser, a system package that pip does not "
+        pytest.skip("the report's layout check needs a headless browser, a system package "
+                    "that pip does not "
                     f"install: {exc}; set GRIPKIT_BROWSER_TESTS=1 to make its absence a failure")
 
 
 def _run(*args):
-    done = subprocess.run([sys.executable, str(SCRIPT), *map(str, args)], capture_output=True, text=True,
+    done = subprocess.run([sys.executable, str(SCRIPT), *map(str, args)], capture_output=True,
+                          text=True,
                           timeout=300)
     return done.returncode, done.stdout, done.stderr
 
@@ -57,7 +60,8 @@ def _wide_report(tmp_path) -> Path:
     rep = Report("layout check")
     sec = rep.section("wide things",
                       "a name longer than a phone line: " + "plant_parameters_force_factor_" * 4)
-    sec.table([f"column {i}" for i in range(12)], [[f"{i * j / 7:.5g} µm" for i in range(12)] for j in range(5)],
+    sec.table([f"column {i}" for i in range(12)],
+              [[f"{i * j / 7:.5g} µm" for i in range(12)] for j in range(5)],
               caption="twelve columns, " + "a_caption_without_a_break_" * 4)
     fig, ax = plt.subplots(figsize=(13, 3.6))
     ax.plot([0, 1], [0, 1])
@@ -97,11 +101,14 @@ def test_report_fits_desktop_and_phone_width(tmp_path, browser):
 
 
 def test_overflow_is_found_and_named(tmp_path, browser):
-    """A 900 px block outside a scrolling box makes a 390 px page 908 px wide (8 px body margin): the
+    """A 900 px block outside a scrolling box makes a 390 px page 908 px wide (8 px body margin):
+    the
     check fails and names the element; a wider table inside an overflow-x box is not blamed."""
     (tmp_path / "index.html").write_text(
-        "<!DOCTYPE html><html><head><meta name='viewport' content='width=device-width, initial-scale=1'></head>"
-        "<body><div class='wide' style='width:900px'>wide block</div><div style='overflow-x:auto'><table><tr>"
+        "<!DOCTYPE html><html><head><meta name='viewport' content='width=device-width, "
+        "initial-scale=1'></head>"
+        "<body><div class='wide' style='width:900px'>wide block</div><div "
+        "style='overflow-x:auto'><table><tr>"
         "<td style='min-width:1200px'>scrolls inside</td></tr></table></div></body></html>")
     code, out, err = _run(tmp_path, "--size", "390x844", "--browser", browser)
     assert code == 1

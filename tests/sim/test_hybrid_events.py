@@ -17,10 +17,12 @@ def bouncing(k_wall=K_WALL, c_wall=0.0):
     """A unit mass on a unit spring that hits a wall (stiffness k_wall) at x = 1; output x and
     the wall force."""
     free = Mode("free", A=[[0, 1], [-1, 0]], B=[[0], [1]], C=[[1, 0], [0, 0]])
-    wall = Mode("contact", A=[[0, 1], [-(1 + k_wall), -c_wall]], B=[[0], [1]], C=[[1, 0], [k_wall, c_wall]],
+    wall = Mode("contact", A=[[0, 1], [-(1 + k_wall), -c_wall]], B=[[0], [1]],
+                C=[[1, 0], [k_wall, c_wall]],
                 e=[0, k_wall], f=[0, -k_wall])
     return HybridSystem([free, wall], [Guard("free", "contact", G=[-1, 0], c=1.0),
-                                       Guard("contact", "free", G=[1, 0], c=-1.0)], outputs=("x", "F"))
+                                       Guard("contact", "free", G=[1, 0], c=-1.0)],
+                                       outputs=("x", "F"))
 
 
 def test_contact_instant_and_energy_against_analytic():
@@ -61,7 +63,8 @@ def test_chattering_is_reported():
     """Guards that leave a mode straight back into it switch endlessly: SimulationError."""
     a = Mode("a", A=[[0.0]], B=[[1.0]], C=[[1.0]])
     b = Mode("b", A=[[0.0]], B=[[1.0]], C=[[1.0]])
-    sysm = HybridSystem([a, b], [Guard("a", "b", G=[1.0], c=-0.5), Guard("b", "a", G=[1.0], c=-0.5)])
+    sysm = (HybridSystem([a, b], [Guard("a", "b", G=[1.0], c=-0.5),
+                                  Guard("b", "a", G=[1.0], c=-0.5)]))
     with pytest.raises(SimulationError, match="chattering"):
         sysm.simulate(np.ones(10), 0.1, x0=[0.0])
 

@@ -112,4 +112,5 @@ def test_rk4_paths_check_the_step():
         integrate_lti(A, B, C, [[0.0]], np.ones(10), 1e-4, method="rk4")
     with pytest.warns(AccuracyWarning, match="under-resolves"):
         integrate_lti(A, B, C, [[0.0]], np.ones(10), 5e-5, method="rk4")
-    integrate_lti(A, B, C, [[0.0]], np.ones(10), 5e-5, method="rk4", substeps=20)  # resolved: silent
+    # resolved: silent
+    integrate_lti(A, B, C, [[0.0]], np.ones(10), 5e-5, method="rk4", substeps=20)

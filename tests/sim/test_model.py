@@ -13,7 +13,8 @@ def analytic_step(t, m, b, k, F):
     wn = math.sqrt(k / m)
     z = b / (2 * math.sqrt(k * m))
     wd = wn * math.sqrt(1 - z**2)
-    return F / k * (1 - np.exp(-z * wn * t) * (np.cos(wd * t) + z / math.sqrt(1 - z**2) * np.sin(wd * t)))
+    return (F / k * (1 - np.exp(-z * wn * t)
+                     * (np.cos(wd * t) + z / math.sqrt(1 - z**2) * np.sin(wd * t))))
 
 
 def test_step_response_is_exact_for_tsfm_sensor():
@@ -22,7 +23,8 @@ def test_step_response_is_exact_for_tsfm_sensor():
     m, b, k = 1.8e-6, 7e-4, 128.0
     model = MassSpringDamper(m=m, b=b, k=k)
     tr = model.simulate(np.full(400, 1e-4), dt=1 / 20000)
-    np.testing.assert_allclose(tr["x"], analytic_step(tr.t, m, b, k, 1e-4), rtol=0, atol=1e-12 * 1e-4 / k * 1e6)
+    np.testing.assert_allclose(tr["x"], analytic_step(tr.t, m, b, k, 1e-4), rtol=0,
+                               atol=1e-12 * 1e-4 / k * 1e6)
 
 
 def test_batch_equals_single_runs():
@@ -76,6 +78,7 @@ def test_simulated_trajectory_owns_read_only_contiguous_channels():
             a[0] = 1.0
     u[0] = 99.0
     assert tr["F"][0] == 0.0
-    np.testing.assert_array_equal(tr["x"], model.simulate_batch(model.theta()[None], np.sin(np.arange(200) * 0.05),
+    np.testing.assert_array_equal(tr["x"], model.simulate_batch(model.theta()[None],
+                                                                np.sin(np.arange(200) * 0.05),
                                                                 dt=0.01)[0, :, 0])
 

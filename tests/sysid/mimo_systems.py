@@ -16,7 +16,8 @@ def two_by_two(order4_seed: int = 3) -> StateSpace:
     A = T @ A @ np.linalg.inv(T)
     B = rng.standard_normal((4, 2))
     C = rng.standard_normal((2, 4))
-    return StateSpace(A, B, C, dt=0.01, inputs=["a", "b"], outputs=["c", "d"], input_units=["V", "V"],
+    return StateSpace(A, B, C, dt=0.01, inputs=["a", "b"], outputs=["c", "d"],
+                      input_units=["V", "V"],
                       output_units=["N", "m"])
 
 

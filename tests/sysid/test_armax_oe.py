@@ -44,8 +44,10 @@ def test_oe_recovers_known_parameters_within_3_sigma():
     truth = np.r_[B222[2:], A222[1:]]
     assert m.structure == "oe" and m.parameter_names == ("b2", "b3", "f1", "f2")
     assert np.all(np.abs(m.theta - truth) < 3 * m.theta_std), (m.theta, m.theta_std)
-    np.testing.assert_allclose(np.sort_complex(m.poles()), np.sort_complex(np.roots(m.F)))  # roots of F
-    np.testing.assert_allclose(np.sort_complex(m.poles()), np.sort_complex(np.roots(A222)), atol=1e-3)
+    # roots of F
+    np.testing.assert_allclose(np.sort_complex(m.poles()), np.sort_complex(np.roots(m.F)))
+    np.testing.assert_allclose(np.sort_complex(m.poles()), np.sort_complex(np.roots(A222)),
+                               atol=1e-3)
     assert m.A.tolist() == [1.0] and m.F_std[0] == 0
     assert m.noise_variance == pytest.approx(4.0, rel=0.1)
 
@@ -70,4 +72,5 @@ def test_oe_validation_on_fresh_record_is_near_noise_floor():
     from gripkit.sysid import PolynomialModel, compare
 
     true = PolynomialModel.from_coefficients([1.0], B222, F=A222)
-    assert compare(m, u2, y2).fit_percent == pytest.approx(compare(true, u2, y2).fit_percent, abs=0.5)
+    assert compare(m, u2, y2).fit_percent == pytest.approx(compare(true, u2, y2).fit_percent,
+                                                           abs=0.5)

@@ -67,7 +67,9 @@ def test_loss_fit_aic_fpe_definitions():
     assert n == 800 - 3 == m.n_used and m.n_samples == 800
     assert m.loss == pytest.approx(0.5 * np.mean(e ** 2), rel=1e-12)
     yt = y[3:]
-    assert m.fit_percent == pytest.approx(100 * (1 - np.linalg.norm(e) / np.linalg.norm(yt - yt.mean())))
+    assert m.fit_percent == pytest.approx(100
+                                          * (1 - np.linalg.norm(e)
+                                                 / np.linalg.norm(yt - yt.mean())))
     v = np.mean(e ** 2)
     assert m.aic == pytest.approx(n * math.log(2 * math.pi * v) + n + 8)
     assert m.fpe == pytest.approx(v * (1 + 4 / n) / (1 - 4 / n))
@@ -75,7 +77,8 @@ def test_loss_fit_aic_fpe_definitions():
 
 @pytest.mark.parametrize("na,nb,nk", [(0, 3, 1), (2, 1, 0), (1, 2, 5)])
 def test_other_structures_recover_exact_data(na, nb, nk):
-    """Noise-free data from a known model are fitted exactly (FIR na = 0, direct feedthrough nk = 0)."""
+    """Noise-free data from a known model are fitted exactly (FIR na = 0, direct feedthrough nk =
+    0)."""
     A = np.r_[1.0, [-0.5, 0.2][:na]] if na else np.ones(1)
     B = np.r_[np.zeros(nk), [0.4, -0.3, 0.1][:nb]]
     u, y = simulate_arx(300, noise=0.0, seed=6, A=A, B=B)
@@ -107,7 +110,8 @@ def test_simulated_truth_matches_seed_coefficients():
     assert A222.tolist() == [1.0, -1.8732, 0.8996] and B222.tolist() == [0, 0, 0.1950, -0.2276]
 
 
-@pytest.mark.parametrize("na, nb, nk, n", [(2, 2, 2, 4000), (4, 4, 2, 20000), (2, 3, 1, 20000), (1, 3, 7, 60), (3, 2, 0, 500),
+@pytest.mark.parametrize("na, nb, nk, n", [(2, 2, 2, 4000), (4, 4, 2, 20000), (2, 3, 1, 20000),
+                                           (1, 3, 7, 60), (3, 2, 0, 500),
                                            (0, 2, 3, 30)])
 def test_lagged_sums_route_equals_qr_of_the_regressor(na, nb, nk, n, monkeypatch):
     """The Gram matrix from compensated lagged sums equals [Φ|Y]ᵀ[Φ|Y] of the materialised
@@ -117,7 +121,8 @@ def test_lagged_sums_route_equals_qr_of_the_regressor(na, nb, nk, n, monkeypatch
     from gripkit.sysid.linear.lagged_sums import BLOCK, GRAM_COND_LIMIT, arx_gram
     from gripkit.sysid.regression import arx_regression, arx_start, qr_solve
 
-    monkeypatch.setattr(importlib.import_module("gripkit.sysid.linear.arx"), "QR_MAX_ELEMENTS", 0)  # the lagged-sums route at every size
+    # the lagged-sums route at every size
+    monkeypatch.setattr(importlib.import_module("gripkit.sysid.linear.arx"), "QR_MAX_ELEMENTS", 0)
     u, y = simulate_arx(n, noise=0.5, seed=11)
     X = arx_regression(u, y, na, nb, nk)
     G = arx_gram(u, y, na, nb, nk, arx_start(na, nb, nk))
@@ -132,7 +137,9 @@ def test_lagged_sums_route_equals_qr_of_the_regressor(na, nb, nk, n, monkeypatch
     np.testing.assert_allclose(m.theta, ref.theta, rtol=0, atol=tol * np.max(np.abs(ref.theta)))
     e = X[:, -1] - X[:, :-1] @ ref.theta
     assert m.loss == pytest.approx(0.5 * (e @ e) / e.size, rel=1e-9)
-    assert m.fit_percent == pytest.approx(100 * (1 - np.linalg.norm(e) / np.linalg.norm(X[:, -1] - X[:, -1].mean())),
+    assert m.fit_percent == pytest.approx(100
+                                          * (1 - np.linalg.norm(e)
+                                                 / np.linalg.norm(X[:, -1] - X[:, -1].mean())),
                                           rel=1e-9)
     np.testing.assert_allclose(m.theta_std,
                                np.sqrt(np.diag(ref.cov_unscaled) * (e @ e) / (e.size - na - nb)),
@@ -145,10 +152,12 @@ def test_small_problem_takes_the_qr_route_without_numba():
     import subprocess
     import sys
 
-    code = ("import sys, numpy as np; from gripkit.sysid import arx; rng = np.random.default_rng(0); "
+    code = ("import sys, numpy as np; from gripkit.sysid import arx; rng = "
+            "np.random.default_rng(0); "
             "u = rng.standard_normal(2000); y = np.convolve(u, [0, 0, 0.195, -0.2276])[:2000]; "
             "m = arx(u, y, 2, 2, 2); print(m.info['method'], 'numba' in sys.modules)")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    out = (subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          check=True).stdout)
     assert out.split()[-1] == "False" and "QR of" in out
 
 
@@ -158,7 +167,8 @@ def test_ill_conditioned_regressor_takes_the_qr_route(monkeypatch):
     estimate still recovers the exact data."""
     from gripkit.sysid.linear.lagged_sums import GRAM_COND_LIMIT
 
-    monkeypatch.setattr(importlib.import_module("gripkit.sysid.linear.arx"), "QR_MAX_ELEMENTS", 0)  # would be small enough for QR anyway
+    # would be small enough for QR anyway
+    monkeypatch.setattr(importlib.import_module("gripkit.sysid.linear.arx"), "QR_MAX_ELEMENTS", 0)
     rng = np.random.default_rng(5)
     n = 3000
     u = np.sin(0.001 * np.arange(n)) + 1e-4 * rng.standard_normal(n)
@@ -187,7 +197,8 @@ def test_read_only_signals_in_any_mix(u_writable, y_writable):
 def test_large_fit_computes_residuals_on_demand_from_its_record():
     """Above QR_MAX_ELEMENTS the fit keeps no N-sample residual array (issue 14: ARX peak memory);
     ``residuals`` is computed on first access from the record and equals the compensated kernel's
-    errors e = y − Φθ to rounding, in the user's units also when the data were scaled for the fit."""
+    errors e = y − Φθ to rounding, in the user's units also when the data were scaled for the
+    fit."""
     from gripkit.sysid.linear.lagged_sums import arx_residuals
 
     u, y = simulate_arx(100_000, noise=0.5, seed=21)
@@ -221,7 +232,8 @@ def test_pickled_model_carries_its_residuals_not_its_record():
 
 
 def test_residuals_refuse_a_record_changed_after_the_fit():
-    """Changing the estimation record in place before the first access to ``estimation_residuals`` would give
+    """Changing the estimation record in place before the first access to ``estimation_residuals``
+    would give
     another record's errors: a DataError names the cause instead of a silent wrong answer."""
     from gripkit.errors import DataError
 
@@ -233,8 +245,10 @@ def test_residuals_refuse_a_record_changed_after_the_fit():
 
 
 def test_large_fit_allocates_no_record_sized_array():
-    """ARX [2 2 2] on N = 4e5 samples allocates (numpy, traced) under 5 % of its input arrays: the Gram
-    pass is O(p²) and the residual sums reuse one block of scratch (before: +50 %, the residuals)."""
+    """ARX [2 2 2] on N = 4e5 samples allocates (numpy, traced) under 5 % of its input arrays: the
+    Gram
+    pass is O(p²) and the residual sums reuse one block of scratch (before: +50 %, the
+    residuals)."""
     import tracemalloc
 
     u, y = simulate_arx(400_000, noise=0.5, seed=23)

@@ -29,7 +29,8 @@ def test_recovers_matrix_polynomials_within_sigma():
         assert np.all(np.abs(np.asarray(est) - true) <= 4 * np.asarray(sd))
     assert m.noise_covariance == pytest.approx(0.01 * np.eye(2), abs=0.002)
     assert m.stable and min(m.fit_percent) > 90
-    assert np.allclose(np.sort(np.abs(m.system.poles()))[-2:], np.sort(np.abs(np.linalg.eigvals(-A1))), atol=0.02)
+    assert np.allclose(np.sort(np.abs(m.system.poles()))[-2:],
+                       np.sort(np.abs(np.linalg.eigvals(-A1))), atol=0.02)
 
 
 def test_one_step_predictor_of_the_realisation_is_the_arx_predictor():
@@ -61,7 +62,8 @@ def test_identify_dispatches_several_columns_to_mimo_arx():
     from gripkit.sysid import identify
 
     u, y = _data(2000, seed=3)
-    tr = Trajectory.uniform(dt=0.01, u0=u[:, 0], u1=u[:, 1], u2=u[:, 2] + 5.0, y0=y[:, 0], y1=y[:, 1])
+    tr = (Trajectory.uniform(dt=0.01, u0=u[:, 0], u1=u[:, 1], u2=u[:, 2] + 5.0, y0=y[:, 0],
+                             y1=y[:, 1]))
     m = identify(tr, "arx", input="u0,u1,u2", output=["y0", "y1"], na=1, nb=2, nk=1)
     assert type(m) is type(arx(u[:, 0], y[:, 0], 1, 2, 1))  # one type: PolynomialModel
     assert m.inputs == ("u0", "u1", "u2") and m.u_offset[2] == pytest.approx(5.0, abs=0.1)

@@ -1,4 +1,5 @@
-"""Bad input: every case gives one clear error (or warning) naming what is wrong — issue 2's list."""
+"""Bad input: every case gives one clear error (or warning) naming what is wrong — issue 2's
+list."""
 
 import numpy as np
 import pytest
@@ -16,7 +17,8 @@ U, Y = simulate_arx(400, noise=1.0, seed=40)
 
 @pytest.mark.parametrize("bad,label", [(np.nan, "NaN"), (np.inf, "infinite")])
 @pytest.mark.parametrize("fn", [lambda u, y: arx(u, y, 2, 2, 2), lambda u, y: oe(u, y, 2, 2, 2),
-                                lambda u, y: armax(u, y, 2, 2, 1, 2), lambda u, y: rls(u, y, 2, 2, 2)],
+                                lambda u, y: armax(u, y, 2, 2, 1, 2), lambda u,
+                                y: rls(u, y, 2, 2, 2)],
                          ids=["arx", "oe", "armax", "rls"])
 def test_nan_and_inf(fn, bad, label):
     y = Y.copy()
@@ -51,7 +53,8 @@ def test_non_uniform_sampling_is_refused():
 
 
 def test_too_few_samples():
-    with pytest.raises(DataError, match=r"ARX \[4 4 2\] \(8 parameters, 5 initial samples\) needs at "
+    with pytest.raises(DataError, match=r"ARX \[4 4 2\] \(8 parameters, 5 initial "
+                                        r"samples\) needs at "
                                         r"least 14 samples, found 10"):
         arx(U[:10], Y[:10], 4, 4, 2)
     with pytest.raises(DataError, match="OE \\[2 2 2\\] .* needs at least 43 samples"):
@@ -60,10 +63,12 @@ def test_too_few_samples():
 
 def test_constant_input_is_unidentifiable_and_returns_nothing():
     """A constant input cannot identify B: say so, return no numbers."""
-    with pytest.raises(UnidentifiableError, match=r"input u is constant \(0.85 for all 400 samples\): "
+    with pytest.raises(UnidentifiableError, match=r"input u is constant \(0.85 for all "
+                                                  r"400 samples\): "
                                                   r"a constant input cannot identify B"):
         arx(np.full(400, 0.85), Y, 2, 2, 2)
-    for fn in (lambda: oe(np.full(400, 0.85), Y, 2, 2, 2), lambda: rls(np.full(400, 0.85), Y, 2, 2, 2),
+    for fn in (lambda: oe(np.full(400, 0.85), Y, 2, 2, 2),
+               lambda: rls(np.full(400, 0.85), Y, 2, 2, 2),
                lambda: structure_search(np.full(400, 0.85), Y, "1:2", "1:2", "1:2")):
         with pytest.raises(UnidentifiableError, match="constant input cannot identify B"):
             fn()
@@ -79,7 +84,8 @@ def test_poorly_exciting_input_names_the_undetermined_parameters():
 
 def test_missing_column():
     tr = Trajectory.uniform(dt=0.005, current=U, force=Y)
-    with pytest.raises(DataError, match="column 'forse' not found; available columns: current, force"):
+    with pytest.raises(DataError, match="column 'forse' not found; available "
+                                        "columns: current, force"):
         identify(tr, "arx", input="current", output="forse", na=2, nb=2, nk=2)
 
 
@@ -88,7 +94,8 @@ def test_unstable_fitted_model_in_free_run_validation():
     and no fit number (never −10⁴⁰ %)."""
     rng = np.random.default_rng(42)
     u = rng.standard_normal(300)
-    y = simulate_arx(300, noise=0.01, seed=42, A=np.array([1.0, -1.05]), B=np.array([0.0, 1.0]), u=u)[1]
+    y = (simulate_arx(300, noise=0.01, seed=42, A=np.array([1.0, -1.05]), B=np.array([0.0, 1.0]),
+                      u=u)[1])
     m = arx(u, y, 1, 1, 1)
     assert not m.stable
     with pytest.warns(StabilityWarning, match="largest pole magnitude 1.05"):
@@ -121,7 +128,8 @@ def test_model_built_from_bad_validation_data():
         m.validate(U, y)
 
 
-@given(values=st.lists(st.floats(allow_nan=True, allow_infinity=True, width=64), min_size=1, max_size=50))
+@given(values=st.lists(st.floats(allow_nan=True, allow_infinity=True, width=64), min_size=1,
+                       max_size=50))
 def test_finiteness_check_without_temporaries_agrees_with_isfinite(values):
     """The min/max finiteness test of the signal checks (no N-element boolean temporary) says
     exactly what ``np.isfinite(a).all()`` says, for any mix of NaN, ±inf and finite values."""
@@ -131,7 +139,8 @@ def test_finiteness_check_without_temporaries_agrees_with_isfinite(values):
     assert _all_finite(a) == bool(np.isfinite(a).all())
 
 
-@given(values=st.lists(st.floats(allow_nan=False, allow_infinity=False, width=64), min_size=1, max_size=50))
+@given(values=st.lists(st.floats(allow_nan=False, allow_infinity=False, width=64), min_size=1,
+                       max_size=50))
 def test_rls_scale_statistics_agree_with_numpy(values):
     """The one-pass (max |x|, ‖x‖₂) of the RLS scale check equals numpy's, scaled so that values
     near the float64 limits neither overflow nor underflow."""

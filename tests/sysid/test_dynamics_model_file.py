@@ -24,7 +24,8 @@ def finger_urdf(tmp_path_factory):
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return to_urdf(zoo.build("dlr-hit-finger").chain(), tmp_path_factory.mktemp("dyn") / "finger.urdf")
+        return (to_urdf(zoo.build("dlr-hit-finger").chain(),
+                        tmp_path_factory.mktemp("dyn") / "finger.urdf"))
 
 
 @pytest.fixture(scope="module")
@@ -122,12 +123,14 @@ def test_cli_out_and_report(finger_urdf, tmp_path, capsys):
     assert code == 0, cap.err
     printed = json.loads(cap.out)
     doc = json.loads(out.read_text())
-    assert doc["data"] == {"file": "log.csv", "sha256": hashlib.sha256(log.read_bytes()).hexdigest()}
+    assert doc["data"] == {"file": "log.csv",
+                           "sha256": hashlib.sha256(log.read_bytes()).hexdigest()}
     assert doc["urdf"]["text"] == finger_urdf.read_text()
     m = load_dynamics_model(out)
     assert m.base_parameters == pytest.approx(printed["base_parameters"], rel=1e-12)
     html = (rep / "index.html").read_text()
-    for header in ("<th>base parameter</th><th>value</th><th>σ</th><th>unit</th>", "<th>joint</th><th>coulomb</th>",
+    for header in ("<th>base parameter</th><th>value</th><th>σ</th><th>unit</th>",
+                   "<th>joint</th><th>coulomb</th>",
                    "<th>residual RMS</th>", "condition number"):
         assert header in html, header
     verdict = m.consistency.message()

@@ -388,7 +388,8 @@ def test_hostile_model_files_are_named(tmp_path):
              "version": (json.dumps({**doc, "version": 9}), "of version 9"),
              "kind": (json.dumps({**doc, "model": "preisach"}), "unknown hysteresis model"),
              "lengths": (json.dumps({**doc, "weights": [1.0]}), "a malformed"),
-             "schema": (json.dumps({**doc, "schema": "gripkit.narx-model"}), "expected 'gripkit.hys")}
+             "schema": (json.dumps({**doc, "schema": "gripkit.narx-model"}),
+                        "expected 'gripkit.hys")}
     for name, (text, phrase) in cases.items():
         p = tmp_path / f"{name}.json"
         p.write_text(text)

@@ -30,8 +30,10 @@ def finger(tmp_path_factory):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ch = zoo.build("dlr-hit-finger").chain()
-        # the zoo's thin-rod tensors (Appendix F) put each phalanx's mass on a line: a pseudo-inertia
-        # on the boundary of the consistent set. A solid body (I_xx = 0.2·m·lc², I_yy = I_zz = m·lc²)
+        # the zoo's thin-rod tensors (Appendix F) put each phalanx's mass on a line: a
+        # pseudo-inertia
+        # on the boundary of the consistent set. A solid body (I_xx = 0.2·m·lc², I_yy = I_zz =
+        # m·lc²)
         # keeps the truth strictly inside, so "consistent" is decidable at any noise level.
         I = ch.chain.inertia.copy()  # noqa: E741
         for k in range(1, 4):
@@ -77,7 +79,8 @@ def test_base_structure_rank(finger, fit):
     q, qd, qdd = fourier_states(50, 100.0, rng)
     Yf = finger.regressor(q, qd, qdd)
     phi = finger.standard_parameters()
-    np.testing.assert_allclose(Yf[:, :, fit.structure.independent] @ fit.structure.base(phi), Yf @ phi, atol=1e-13)
+    np.testing.assert_allclose(Yf[:, :, fit.structure.independent] @ fit.structure.base(phi),
+                               Yf @ phi, atol=1e-13)
 
 
 def test_recovers_base_parameters_and_friction(finger, fit):
@@ -129,18 +132,21 @@ def test_sigma_is_honest_monte_carlo(finger):
 def test_consistency_true_parameters(finger):
     rng = np.random.default_rng(3)
     q, qd, qdd = fourier_states(4_000, 500.0, rng)
-    r = identify_dynamics(finger, q, qd, qdd, torques(finger, q, qd, qdd) + rng.normal(size=(4000, 3)) * 1e-7)
+    r = (identify_dynamics(finger, q, qd, qdd,
+                           torques(finger, q, qd, qdd) + rng.normal(size=(4000, 3)) * 1e-7))
     assert r.consistency.consistent, r.consistency.message()
 
 
 def test_inconsistent_link_is_named_and_constrained_fit(finger):
-    """A negative Izz of the distal link (a base parameter on its own) has no rigid body behind it."""
+    """A negative Izz of the distal link (a base parameter on its own) has no rigid body behind
+    it."""
     names = finger.parameter_names
     phi = finger.standard_parameters().copy()
     phi[names.index("Izz_link4")] = -2e-4
     rng = np.random.default_rng(4)
     q, qd, qdd = fourier_states(6_000, 500.0, rng)
-    tau = finger.regressor(q, qd, qdd) @ phi + FC * np.sign(qd) + FV * qd + rng.normal(size=(6000, 3)) * 1e-6
+    tau = (finger.regressor(q, qd, qdd) @ phi + FC * np.sign(qd) + FV * qd
+           + rng.normal(size=(6000, 3)) * 1e-6)
     r = identify_dynamics(finger, q, qd, qdd, tau)
     assert not r.consistency.consistent
     assert r.consistency.failing_links == ("link 'link4'",)
@@ -148,7 +154,8 @@ def test_inconsistent_link_is_named_and_constrained_fit(finger):
     rc = identify_dynamics(finger, q, qd, qdd, tau, constrained=True)
     assert rc.base_parameters["Izz_link4"] >= -1e-9
     # the consistent standard parameters reproduce the constrained base parameters
-    np.testing.assert_allclose(rc.structure.base(rc.consistency.standard_parameters), rc.theta[:rc.n_base], atol=1e-12)
+    np.testing.assert_allclose(rc.structure.base(rc.consistency.standard_parameters),
+                               rc.theta[:rc.n_base], atol=1e-12)
     from gripkit.sysid.rigid_body.dynamics import pseudo_inertia
     for k in range(4):
         assert np.linalg.eigvalsh(
@@ -175,11 +182,13 @@ def test_offset_friction_and_armature(finger):
 
 def test_bad_input(finger):
     q = np.zeros((100, 3))
-    with pytest.raises(DataError, match=r"qd: expected shape \(N, 3\) for the joints theta1, theta2, theta3, found \(100, 2\)"):
+    with pytest.raises(DataError, match=r"qd: expected shape \(N, 3\) for the joints theta1, "
+                                        r"theta2, theta3, found \(100, 2\)"):
         identify_dynamics(finger, q, q[:, :2], q, q)
     bad = q.copy()
     bad[5, 1] = np.nan
-    with pytest.raises(DataError, match="tau: 1 NaN or inf values \\(first at sample 5, joint theta2\\)"):
+    with pytest.raises(DataError, match="tau: 1 NaN or inf values \\(first at sample 5, "
+                                        "joint theta2\\)"):
         identify_dynamics(finger, q, q, q, bad)
     with pytest.raises(DataError, match="friction: expected one of"):
         identify_dynamics(finger, q, q, q, q, friction="stribeck")

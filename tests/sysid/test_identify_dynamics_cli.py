@@ -33,8 +33,10 @@ def finger_urdf(tmp_path_factory):
 @pytest.fixture(scope="module")
 def design(finger_urdf):
     chain = from_urdf(finger_urdf)
-    return chain, fourier_trajectory(chain, f0=0.2, harmonics=3, dt=0.001, periods=6, samples_per_period=100,
-                                     velocity_limits=2.0, acceleration_limits=10.0, max_iterations=60)
+    return chain, fourier_trajectory(chain, f0=0.2, harmonics=3, dt=0.001, periods=6,
+                                     samples_per_period=100,
+                                     velocity_limits=2.0, acceleration_limits=10.0,
+                                     max_iterations=60)
 
 
 def test_fourier_design_within_limits_and_better_conditioned(design):
@@ -61,8 +63,10 @@ def test_cli_identify_dynamics_from_log(design, finger_urdf, tmp_path, capsys):
     for j, name in enumerate(chain.joint_names):
         cols[f"pos{j}"] = tr.q[:, j]
         cols[f"tau{j}"] = tau[:, j]
-    np.savetxt(path, np.column_stack(list(cols.values())), delimiter=",", header=",".join(cols), comments="")
-    code = main(["identify", "dynamics", str(finger_urdf), str(path), "--position", "pos0,pos1,pos2",
+    np.savetxt(path, np.column_stack(list(cols.values())), delimiter=",", header=",".join(cols),
+               comments="")
+    code = main(["identify", "dynamics", str(finger_urdf), str(path), "--position",
+                 "pos0,pos1,pos2",
                  "--effort", "tau0,tau1,tau2", "--json"])
     cap = capsys.readouterr()
     assert code == 0, cap.err
@@ -95,7 +99,8 @@ def test_cli_constrained_fit_nearer_the_truth(design, finger_urdf, tmp_path, cap
     cols = np.column_stack([tr.t, tr.q, tau])
     np.savetxt(path, cols, delimiter=",", header="t,pos0,pos1,pos2,tau0,tau1,tau2", comments="")
     model = tmp_path / "m.json"
-    code = main(["identify", "dynamics", str(finger_urdf), str(path), "--position", "pos0,pos1,pos2",
+    code = main(["identify", "dynamics", str(finger_urdf), str(path), "--position",
+                 "pos0,pos1,pos2",
                  "--effort", "tau0,tau1,tau2", "--constrained", "--json", "--out", str(model),
                  "--report", str(tmp_path / "rep")])
     cap = capsys.readouterr()
@@ -122,12 +127,14 @@ def test_cli_constrained_fit_nearer_the_truth(design, finger_urdf, tmp_path, cap
 
 def test_cli_excitation_writes_csv(finger_urdf, tmp_path, capsys):
     out = tmp_path / "traj.csv"
-    code = main(["excitation", "fourier", str(finger_urdf), "--out", str(out), "--harmonics", "2", "--f0", "0.25",
+    code = main(["excitation", "fourier", str(finger_urdf), "--out", str(out), "--harmonics", "2",
+                 "--f0", "0.25",
                  "--fs", "50", "--velocity-limit", "1.5", "--json"])
     d = json.loads(capsys.readouterr().out)
     assert code == 0
     data = np.genfromtxt(out, delimiter=",", names=True)
-    assert data.dtype.names == ("t", "q_theta1", "q_theta2", "q_theta3", "qd_theta1", "qd_theta2", "qd_theta3",
+    assert data.dtype.names == ("t", "q_theta1", "q_theta2", "q_theta3", "qd_theta1", "qd_theta2",
+                                "qd_theta3",
                                 "qdd_theta1", "qdd_theta2", "qdd_theta3")
     assert data.size == 200 and d["n_samples"] == 200
     assert np.max(np.abs([data[f"qd_theta{k}"] for k in (1, 2, 3)])) <= 1.5 + 1e-9
@@ -135,7 +142,8 @@ def test_cli_excitation_writes_csv(finger_urdf, tmp_path, capsys):
 
 @pytest.mark.parametrize("args, match", [
     (["--position", "pos0,pos1", "--effort", "tau0,tau1,tau2"],
-     "error: ConfigError: --position: 2 column(s) ['pos0', 'pos1'] for the 3 actuated joints theta1, theta2, theta3"),
+     "error: ConfigError: --position: 2 column(s) ['pos0', 'pos1'] for the 3 actuated joints "
+     "theta1, theta2, theta3"),
     (["--position", "pos0,pos1,nope", "--effort", "tau0,tau1,tau2"], "error: DataError:"),
     (["--position", "pos0,pos1,pos2", "--effort", "tau0,tau1,tau2", "--friction", "stribeck"],
      "error: DataError: friction: expected one of"),
@@ -153,12 +161,15 @@ def test_cli_bad_input_one_line(finger_urdf, tmp_path, capsys, args, match):
 
 def test_cli_bad_urdf_one_line(tmp_path, capsys):
     bad = tmp_path / "bad.urdf"
-    bad.write_text('<robot name="r"><link name="a"/><link name="b"/><joint name="j" type="floating">'
+    bad.write_text('<robot name="r"><link name="a"/><link name="b"/><joint name="j" '
+                   'type="floating">'
                    '<parent link="a"/><child link="b"/></joint></robot>')
     code = main(["excitation", "fourier", str(bad), "--out", str(tmp_path / "x.csv")])
     err = capsys.readouterr().err.strip().splitlines()
-    assert code == 1 and err == ["error: ModelError: joint 'j' has type 'floating', which gripkit does not support"
-                                 "; gripkit builds serial chains of revolute, continuous, prismatic and fixed joints"]
+    assert code == 1 and err == ["error: ModelError: joint 'j' has type 'floating', which gripkit "
+                                 "does not support"
+                                 "; gripkit builds serial chains of revolute, continuous, "
+                                 "prismatic and fixed joints"]
 
 
 class Pendulum:
@@ -176,8 +187,10 @@ class Pendulum:
 def test_fourier_design_takes_any_chain_object():
     import sys
 
-    tr = fourier_trajectory(Pendulum(), f0=0.5, harmonics=2, dt=0.01, friction=False, samples_per_period=100,
-                            position_limits=(-0.5, 0.5), velocity_limits=1.0, acceleration_limits=3.0)
+    tr = fourier_trajectory(Pendulum(), f0=0.5, harmonics=2, dt=0.01, friction=False,
+                            samples_per_period=100,
+                            position_limits=(-0.5, 0.5), velocity_limits=1.0,
+                            acceleration_limits=3.0)
     assert np.all(np.abs(tr.q) <= 0.5 + 1e-9) and np.all(np.abs(tr.qd) <= 1.0 + 1e-9)
     assert np.all(np.abs(tr.qdd) <= 3.0 + 1e-9)
     # the design's condition number is the scaled regressor's over one period
@@ -187,4 +200,5 @@ def test_fourier_design_takes_any_chain_object():
     assert sv[0] / sv[-1] == pytest.approx(tr.condition_number, rel=0.05)
     assert tr.condition_number <= tr.initial_condition_number
     src = open(sys.modules["gripkit.sysid.rigid_body.fourier_trajectory"].__file__).read()
-    assert "multibody" not in src.split('"""', 2)[2]  # no import of gripkit.multibody below the docstring
+    # no import of gripkit.multibody below the docstring
+    assert "multibody" not in src.split('"""', 2)[2]

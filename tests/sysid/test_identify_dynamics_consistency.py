@@ -1,5 +1,6 @@
 """The physical-consistency distance and the constrained fit of ``identify_dynamics``
-(``gripkit.sysid.rigid_body.dynamics_projection``), Monte Carlo on the DLR/HIT Hand II finger of the zoo
+(``gripkit.sysid.rigid_body.dynamics_projection``), Monte Carlo on the DLR/HIT Hand II finger of
+the zoo
 (``002_ddea254371185ad3.txt`` Appendix F: thin-rod phalanges, a pseudo-inertia on the boundary of
 the consistent set, so noise puts the estimate outside it in most runs), exported by ``to_urdf``,
 with exact joint states and white torque noise (σ honest:

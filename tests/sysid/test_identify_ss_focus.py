@@ -41,7 +41,8 @@ def test_a_refinement_that_scores_lower_is_not_returned(monkeypatch):
     import gripkit.sysid.linear.pem_ss as pem_ss
 
     monkeypatch.setattr(pem_ss, "pem", bad_pem)
-    with pytest.warns(AccuracyWarning, match="lowered the mean simulation fit on the estimation data"):
+    with pytest.warns(AccuracyWarning, match="lowered the mean simulation fit on the "
+                                             "estimation data"):
         model, _ = identify_ss(tr, input="u", output="y", order=2)
     assert model.structure == "n4sid"
     fo = model.info["focus"]
@@ -64,7 +65,8 @@ def test_the_returned_model_never_scores_below_its_start(focus):
 
 
 def test_pem_that_does_not_converge_says_so():
-    with pytest.warns(AccuracyWarning, match=r"PEM refinement \(pem-innovation\) stopped after 1 iterations without converging"):
+    with pytest.warns(AccuracyWarning, match=r"PEM refinement \(pem-innovation\) stopped after 1 "
+                                             r"iterations without converging"):
         identify_ss(_record(3), input="u", output="y", order=4, max_iterations=1)
     with pytest.raises(DataError, match="focus: expected one of simulation, prediction"):
         identify_ss(_record(3), input="u", output="y", order=2, focus="both")
@@ -81,7 +83,8 @@ def test_the_search_table_is_in_the_text_output(tmp_path, capsys):
     assert code == 0, out.err
     assert "order search, subspace models ranked by validation_fit; the best refined by PEM " \
         "and ranked first by their simulation fit (refined %)" in out.out
-    rows = [ln.split() for ln in out.out.splitlines() if ln.strip()[:1].isdigit() and len(ln.split()) >= 3]
+    rows = ([ln.split() for ln in out.out.splitlines() if ln.strip()[:1].isdigit()
+             and len(ln.split()) >= 3])
     assert sorted(int(r[0]) for r in rows[:4]) == [1, 2, 3, 4]
     assert "focus simulation (validation data)" in out.out
 

@@ -45,7 +45,8 @@ def test_fixture_is_the_published_decimated_record_with_its_licence(record):
     assert (FIXTURE / "LICENSE").read_text().startswith("BSD 3-Clause License")
     readme = (FIXTURE / "README.md").read_text()
     assert "c10cf593a4dc6a03c56ade9e6838d61b6a061268" in readme
-    assert (tr["voltage"][0], tr["output"][0]) == (0.0, -143.8)              # y_cc.csv's first value
+    # y_cc.csv's first value
+    assert (tr["voltage"][0], tr["output"][0]) == (0.0, -143.8)
     assert hashlib.sha256((FIXTURE / "dc_motor.csv").read_bytes()).hexdigest() in readme
 
 
@@ -64,7 +65,8 @@ def test_pem_refinement_keeps_the_validation_fit(record):
 
 
 def test_arx_validation_fit_on_held_out_half(record):
-    """ARX [4 4 1]: the free-run fit on the held-out half beats the first-order ARX by > 5 points."""
+    """ARX [4 4 1]: the free-run fit on the held-out half beats the first-order ARX by > 5
+    points."""
     ue, ye = record[3]["est"]
     fits = [_validation_fit(arx(ue, ye, n, n, 1, dt=1.0), record[3]) for n in (1, 4)]
     assert fits[1] >= 47.0 and fits[1] > fits[0] + 5.0
@@ -73,7 +75,8 @@ def test_arx_validation_fit_on_held_out_half(record):
 def test_identify_ss_on_the_files_columns_with_validation_record(record):
     """The user's route: columns by name, the validation record's own operating point removed."""
     _, est, val, _ = record
-    model, extras = identify_ss(est, input="voltage", output="output", order=3, validate=val, refine=False)
+    model, extras = (identify_ss(est, input="voltage", output="output", order=3, validate=val,
+                                 refine=False))
     assert model.outputs == ("output",) and extras["validation_fit_percent"][0] >= 50.0
 
 
@@ -81,10 +84,12 @@ def test_as_good_as_nfoursid_on_the_same_split(record):
     import nfoursid.nfoursid as nfoursid
     import pandas as pd
     ue, ye = record[3]["est"]
-    nf = nfoursid.NFourSID(pd.DataFrame({"u": ue, "y": ye}), output_columns=["y"], input_columns=["u"],
+    nf = nfoursid.NFourSID(pd.DataFrame({"u": ue, "y": ye}), output_columns=["y"],
+                           input_columns=["u"],
                            num_block_rows=8)
     nf.subspace_identification()
     ss, _ = nf.system_identification(rank=3)
-    peer = _validation_fit(LinearModel(StateSpace(ss.a, ss.b, ss.c, ss.d, dt=1.0), "nfoursid"), record[3])
+    peer = (_validation_fit(LinearModel(StateSpace(ss.a, ss.b, ss.c, ss.d, dt=1.0), "nfoursid"),
+                            record[3]))
     ours = _validation_fit(n4sid(ue, ye, 3, horizon=8, dt=1.0), record[3])
     assert ours >= peer - 0.5

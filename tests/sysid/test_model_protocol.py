@@ -18,7 +18,7 @@ from gripkit.io import load
 from gripkit.lti import LinearSystem
 from gripkit.params import ParameterSet
 from gripkit.sysid import (IdentifiedLinearModel, IdentifiedModel, LinearModel, ModelFit,
-                           NARXModel, PolynomialModel, armax, arx, load_model, n4sid, narx, oe,
+                           PolynomialModel, armax, arx, load_model, n4sid, narx, oe,
                            pem, tfest)
 
 from mimo_systems import oe_data, two_by_two

@@ -216,7 +216,8 @@ def test_unstable_predictor_falls_back_to_output_errors():
     with pytest.warns(AccuracyWarning, match="is unstable .*free-run output errors"):
         res = residual_analysis(m, u[:, None], y[:, None], 0.01)
     assert res.kind == "output error" and res.notes[0].startswith("Free-run output errors")
-    assert res.fit_percent[0] == pytest.approx(m.compare(u[:, None], y[:, None]).fit_percent[0], abs=1e-6)
+    assert res.fit_percent[0] == pytest.approx(m.compare(u[:, None], y[:, None]).fit_percent[0],
+                                               abs=1e-6)
 
 
 def test_lines_without_input_power_are_not_drawn():

@@ -164,8 +164,8 @@ def test_cli_identify_narx_json_validate_and_model_file(dc_motor, tmp_path, caps
     py = narx(ue, ye, degree=3, lags=2, validate=(uv, yv))
     assert d["validation"]["fit_percent"] == pytest.approx(py.validation_fit_percent, abs=1e-6)
     assert d["structure"]["terms"] == py.terms and d["warnings"] == []
-    assert load_narx(model).compare(uv, yv).fit_percent[0] == pytest.approx(py.validation_fit_percent,
-                                                                          abs=1e-6)
+    fit = load_narx(model).compare(uv, yv).fit_percent[0]
+    assert fit == pytest.approx(py.validation_fit_percent, abs=1e-6)
     code, out, err = _cli(capsys, "compare", model, val, "--fs", 1, "--json")     # the same number
     assert code == 0, err
     fit = json.loads(out)["fit_percent"][0]

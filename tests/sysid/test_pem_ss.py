@@ -32,7 +32,8 @@ def test_sensitivity_jacobian_matches_finite_differences(feedthrough, innovation
     e2, H, g = _gauss_newton_terms(A, B, C, D, K, x0, u, y, entries)
     np.testing.assert_array_equal(e2, e)
     np.testing.assert_allclose(H, J.T @ J, rtol=0, atol=1e-12 * np.abs(J.T @ J).max())
-    np.testing.assert_allclose(g, J.T @ e.reshape(-1), rtol=0, atol=1e-12 * np.abs(J).max() * np.abs(e).sum())
+    np.testing.assert_allclose(g, J.T @ e.reshape(-1), rtol=0,
+                               atol=1e-12 * np.abs(J).max() * np.abs(e).sum())
     h = 1e-6
     for q in range(d + n):
         th, dx = np.zeros(d), np.zeros(n)
@@ -42,8 +43,10 @@ def test_sensitivity_jacobian_matches_finite_differences(feedthrough, innovation
             dx[q - d] = h
         def errs(s):  # noqa: E306
             out = np.empty((N, p))
-            predict_errors(A + s * np.tensordot(th, dA, 1), B + s * np.tensordot(th, dB, 1), C + s * np.tensordot(th, dC, 1),
-                     D + s * np.tensordot(th, dD, 1), K + s * np.tensordot(th, dK, 1), x0 + s * dx, u, y, out)
+            predict_errors(A + s * np.tensordot(th, dA, 1), B + s * np.tensordot(th, dB, 1),
+                           C + s * np.tensordot(th, dC, 1),
+                     D + s * np.tensordot(th, dD, 1), K + s * np.tensordot(th, dK, 1), x0 + s * dx,
+                     u, y, out)
             return out
         fd = -(errs(1) - errs(-1)).reshape(-1) / (2 * h)
         assert np.max(np.abs(fd - J[:, q])) <= 1e-6 * np.max(np.abs(fd))
@@ -92,7 +95,8 @@ def _mc_pem(runs, N, seed):
         p, cov = r.system.pole_covariance()
         k = int(np.argmin(np.abs(p - true)))
         d = p[k] - true
-        hits += abs(d.real) <= 3 * np.sqrt(cov[k, 0, 0]) and abs(d.imag) <= 3 * np.sqrt(cov[k, 1, 1])
+        hits += (abs(d.real) <= 3 * np.sqrt(cov[k, 0,
+                                                0]) and abs(d.imag) <= 3 * np.sqrt(cov[k, 1, 1]))
     return hits / runs
 
 
@@ -116,7 +120,8 @@ def test_sigma_honest_mimo_monte_carlo_small():
         p, cov = r.system.pole_covariance()
         i = match_poles(p, TRUE_POLES)
         d = p[i] - TRUE_POLES
-        hits += list((np.abs(d.real) <= 3 * np.sqrt(cov[i, 0, 0])) & (np.abs(d.imag) <= 3 * np.sqrt(cov[i, 1, 1])
+        hits += list((np.abs(d.real) <= 3 * np.sqrt(cov[i, 0, 0])) & (np.abs(d.imag) <= 3
+                                                                      * np.sqrt(cov[i, 1, 1])
                                                                       + 1e-12))
     assert np.mean(hits) >= 0.9
 

@@ -23,7 +23,8 @@ def test_poles_zeros_dcgain_match_python_control(m):
     pc = np.sort_complex(control.poles(g))
     ours = np.sort_complex(np.r_[m.poles(), np.zeros(g.den[0][0].size - 1 - m.na)])
     np.testing.assert_allclose(pc, ours, atol=1e-6)
-    np.testing.assert_allclose(np.sort_complex(control.zeros(g)), np.sort_complex(m.zeros()), atol=1e-6)
+    np.testing.assert_allclose(np.sort_complex(control.zeros(g)), np.sort_complex(m.zeros()),
+                               atol=1e-6)
     assert float(np.real(control.dcgain(g))) == pytest.approx(m.dc_gain, rel=1e-9)
     assert g.dt == pytest.approx(0.005)
 
@@ -88,7 +89,8 @@ def test_bad_coefficients_are_refused():
 
 
 def test_parameters_carry_units_and_std():
-    m = PolynomialModel.from_coefficients([1.0, -0.5], [0.0, 2.0], dt=0.01, input_unit="A", output_unit="N",
+    m = PolynomialModel.from_coefficients([1.0, -0.5], [0.0, 2.0], dt=0.01, input_unit="A",
+                                          output_unit="N",
                                           std={"A": [0, 0.01], "B": [0, 0.2]})
     ps = m.parameters
     assert ps["a1"].unit == "1" and ps["b1"].unit == "N/A"

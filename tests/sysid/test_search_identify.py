@@ -45,7 +45,8 @@ def test_identify_trajectory_removes_operating_point():
     """With the input centred on 850 mA and detrend='mean' (default) the Trajectory entry point
     gives the same model as arx() on the centred arrays, with units and dt from the data."""
     u, y = simulate_arx(2000, noise=1.0, seed=52)
-    tr = Trajectory.uniform(dt=0.005, current=0.850 + 1e-3 * u, force=12.0 + y, units={"current": "A", "force": "N"})
+    tr = (Trajectory.uniform(dt=0.005, current=0.850 + 1e-3 * u, force=12.0 + y,
+                             units={"current": "A", "force": "N"}))
     m = identify(tr, "arx", input="current", output="force", na=2, nb=2, nk=2)
     ref = arx(1e-3 * u - np.mean(1e-3 * u), y - y.mean(), 2, 2, 2)
     np.testing.assert_allclose(m.theta, ref.theta, rtol=1e-9)
@@ -60,8 +61,10 @@ def test_identify_dispatches_every_method():
     tr = Trajectory.uniform(dt=0.005, u=u, y=y)
     assert identify(tr, "oe", input="u", output="y", nb=2, na=2, nk=2).structure == "oe"
     assert identify(tr, "armax", input="u", output="y", na=2, nb=2, nc=1, nk=2).structure == "armax"
-    assert identify(tr, "rls", input="u", output="y", na=2, nb=2, nk=2, forgetting=0.99).forgetting == 0.99
-    assert identify(tr, "search", input="u", output="y", na="1:2", nb="1:2", nk="2", progress=False).best
+    assert identify(tr, "rls", input="u", output="y", na=2, nb=2, nk=2,
+                    forgetting=0.99).forgetting == 0.99
+    assert identify(tr, "search", input="u", output="y", na="1:2", nb="1:2", nk="2",
+                    progress=False).best
     with pytest.raises(DataError, match="method: expected one of"):
         identify(tr, "bj", input="u", output="y")
     with pytest.raises(DataError, match="input and output must be different"):

@@ -19,12 +19,14 @@ def test_ranked_by_validation_fit(arx_data):
     assert res.criterion == "validation"
     v = [c.validation_fit_percent for c in res.candidates]
     n_ok = sum(x is not None for x in v)
-    assert all(x is None for x in v[n_ok:])             # unstable candidates (no free-run fit) rank last
+    # unstable candidates (no free-run fit) rank last
+    assert all(x is None for x in v[n_ok:])
     v = v[:n_ok]
     assert all(a >= b for a, b in zip(v, v[1:]))
     assert (res.best.na, res.best.nk) == (2, 2)        # the true denominator order and delay
     one_step = [c.fit_percent for c in res.candidates]
-    assert max(one_step) - min(one_step[:5]) < max(v) - min(v)   # validation separates, one-step does not
+    # validation separates, one-step does not
+    assert max(one_step) - min(one_step[:5]) < max(v) - min(v)
 
 
 def test_edge_of_range_warned(arx_data):

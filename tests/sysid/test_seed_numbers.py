@@ -78,7 +78,8 @@ def test_plant_consistency_checks_pass():
 def test_seed_statement_contradiction_is_reported():
     """§V-F says the filter 'reduces the variability of parameters by a factor of 4'. Table III
     [2,2,2]: σ(a) ratio (0.0480/0.0117 + 0.0454/0.0117)/2 = 3.99, σ(b) ratio 24.7 — gripkit
-    reports the B contradiction and the consistent A and loss (16200/27.62 = 587 ≈ 10³) statements."""
+    reports the B contradiction and the consistent A and loss (16200/27.62 = 587 ≈ 10³)
+    statements."""
     f = {x.check: x for x in seed_checks()}
     assert f["filter-sigma-factor-A"].consistent
     assert f["filter-sigma-factor-A"].computed == pytest.approx(3.99, abs=0.01)

@@ -38,7 +38,9 @@ def test_metrics_match_textbook_formulas():
     """Overshoot exp(-πζ/√(1-ζ²)), peak time π/ω_d, 2 % settling ≈ 4/(ζ ω_n) (within one period)."""
     wn, z = 2 * math.pi * 100, 0.2
     m = second_order_metrics(wn, z)
-    assert m["overshoot_percent"] == pytest.approx(100 * math.exp(-math.pi * z / math.sqrt(1 - z * z)), rel=1e-3)
+    assert m["overshoot_percent"] == pytest.approx(100
+                                                   * math.exp(-math.pi * z
+                                                                  / math.sqrt(1 - z * z)), rel=1e-3)
     assert m["peak_time"] == pytest.approx(math.pi / (wn * math.sqrt(1 - z * z)), rel=1e-3)
     assert abs(m["settling_time"] - 4 / (z * wn)) < 2 * math.pi / wn
 
@@ -46,7 +48,8 @@ def test_metrics_match_textbook_formulas():
 def test_recovers_gain_frequency_damping_within_3_sigma():
     """1 % noise on the FT-G100-like response: all three within 3σ and within 0.5 %."""
     r = identify_step(record(1), input="V", output="x")
-    for est, sd, true in ((r.gain, r.gain_std, K), (r.natural_frequency_hz, r.natural_frequency_hz_std, F_N),
+    for est, sd, true in ((r.gain, r.gain_std, K),
+                          (r.natural_frequency_hz, r.natural_frequency_hz_std, F_N),
                           (r.damping_ratio, r.damping_ratio_std, ZETA)):
         assert abs(est - true) < 3 * sd
         assert abs(est - true) / true < 0.005
@@ -57,7 +60,8 @@ def test_recovers_gain_frequency_damping_within_3_sigma():
 
 
 def test_sigma_agrees_with_monte_carlo():
-    """Reported σ vs the spread of 30 noisy repetitions (within 35 %: 30 draws give the sample std to
+    """Reported σ vs the spread of 30 noisy repetitions (within 35 %: 30 draws give the sample std
+    to
     about ±13 %)."""
     est, sds = [], []
     for seed in range(30):
@@ -79,13 +83,16 @@ def test_step_metrics_on_data():
     t = np.linspace(0, 0.05, 5001)
     y = second_order_step(t, 1.0, 2 * math.pi * 200, 0.3)
     m = step_metrics(t, y, y_final=1.0, y_initial=0.0)
-    assert m["overshoot_percent"] == pytest.approx(100 * math.exp(-math.pi * 0.3 / math.sqrt(1 - 0.09)), rel=1e-3)
+    assert m["overshoot_percent"] == pytest.approx(100
+                                                   * math.exp(-math.pi * 0.3
+                                                                  / math.sqrt(1 - 0.09)), rel=1e-3)
     assert math.isinf(step_metrics(t[:300], y[:300], y_final=1.0, y_initial=0.0)["settling_time"])
 
 
 def test_bad_data():
     t = np.arange(200) / FS
-    const = Trajectory(t, {"V": np.full(200, 70.0), "x": np.random.default_rng(0).standard_normal(200)})
+    const = (Trajectory(t, {"V": np.full(200, 70.0),
+                            "x": np.random.default_rng(0).standard_normal(200)}))
     with pytest.raises(DataError, match="input column 'V' is constant"):
         identify_step(const, input="V", output="x")
     flat = Trajectory(t, {"V": np.where(t > 0.001, 1.0, 0.0), "x": np.zeros(200)})
@@ -94,10 +101,12 @@ def test_bad_data():
     with pytest.raises(DataError, match="not found"):
         identify_step(const, input="V", output="y")
     with pytest.raises(DataError, match="at least 20 samples"):
-        identify_step(Trajectory(t[:10], {"V": np.arange(10.0), "x": np.arange(10.0)}), input="V", output="x")
+        identify_step(Trajectory(t[:10], {"V": np.arange(10.0), "x": np.arange(10.0)}), input="V",
+                      output="x")
     with pytest.raises(DataError, match="uniform sampling"):
         tt = np.cumsum(np.r_[0, np.full(99, 1e-3), 5e-3, np.full(99, 1e-3)])
-        identify_step(Trajectory(tt, {"V": (tt > 0.05) * 1.0, "x": np.sin(tt)}), input="V", output="x")
+        identify_step(Trajectory(tt, {"V": (tt > 0.05) * 1.0, "x": np.sin(tt)}), input="V",
+                      output="x")
 
 
 def test_record_too_short_warns():

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from gripkit import Trajectory
-from gripkit.errors import ArgumentError, DataError
+from gripkit.errors import DataError
 from gripkit.lti import StateSpace
 from gripkit.sysid.linear import identify_mimo
 from gripkit.sysid import identify, n4sid, pem

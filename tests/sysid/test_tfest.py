@@ -24,7 +24,8 @@ def test_time_domain_recovery_within_sigma():
     info = m.info
     assert np.all(np.abs(m.system.denominator()[1:] - [0.8, 4.0]) <= 4 * info["den_std"][1:])
     assert np.all(np.abs(m.system.numerator() - [2.0, 4.0]) <= 4 * info["num_std"])
-    assert abs(info["natural_frequency_hz"][0] - 2 / (2 * np.pi)) <= 4 * info["natural_frequency_hz_std"][0]
+    assert abs(info["natural_frequency_hz"][0] - 2
+               / (2 * np.pi)) <= 4 * info["natural_frequency_hz_std"][0]
     assert abs(info["damping_ratio"][0] - 0.2) <= 4 * info["damping_ratio_std"][0]
     assert m.system.dt is None and m.fit_percent[0] > 85
 
@@ -41,7 +42,8 @@ def test_from_periodic_frf_within_sigma():
     assert np.all(np.abs(num - [2.0, 4.0]) <= 4 * m.info["num_std"])
     # without the hold the continuous fit is biased by more than 4σ
     biased = tfest_frf(r, 2, 1)
-    assert np.max(np.abs(biased.system.denominator()[1:] - [0.8, 4.0]) / biased.info["den_std"][1:]) > 4
+    assert np.max(np.abs(biased.system.denominator()[1:] - [0.8,
+                                                            4.0]) / biased.info["den_std"][1:]) > 4
 
 
 NOISE_FREE = [TransferFunction([4.0], [1.0, 0.8, 4.0]),      # ω_n = 2 rad/s, ζ = 0.2, no zero

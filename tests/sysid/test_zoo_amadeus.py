@@ -28,7 +28,8 @@ def test_registry_builds_the_plant(plant):
 
 def test_coefficients_units_and_provenance(plant):
     """SI: B in N/A = 1000 × force_scale × the printed units-per-mA values, force_scale =
-    15.45 N / (1.235 units/mA × 500 mA) = 0.02502 N/unit (Fig. 2(c) peak force over the valve span)."""
+    15.45 N / (1.235 units/mA × 500 mA) = 0.02502 N/unit (Fig. 2(c) peak force over the valve
+    span)."""
     from gripkit.systems.amadeus.force_dynamics import FORCE_SCALE
 
     assert FORCE_SCALE == pytest.approx(15.45 / (0.0326 / 0.0264 * 500), rel=1e-9)
@@ -43,7 +44,8 @@ def test_coefficients_units_and_provenance(plant):
 
 
 def test_simulate_from_rest_and_with_given_past(plant):
-    s1 = multisine(range(1, 11), 2.0, dt=0.005, operating_point=0.850, limits=(0.600, 1.100), unit="A")
+    s1 = (multisine(range(1, 11), 2.0, dt=0.005, operating_point=0.850, limits=(0.600, 1.100),
+                    unit="A"))
     tr = plant.simulate(s1.u)
     f = tr["force"]
     assert tr.unit("force") == "N" and tr.unit("current") == "A" and tr.dt == 0.005
@@ -64,9 +66,11 @@ def test_simulated_plant_is_identified_back(plant):
     """Noisy simulation with the S1 input, identified with the Trajectory entry point: the
     estimates contain the plant's coefficients within 3σ (equation-error noise is not what we add,
     so use a small noise: the ARX bias stays well below σ)."""
-    s1 = multisine(range(1, 11), 2.0, dt=0.005, operating_point=0.850, limits=(0.600, 1.100), unit="A")
+    s1 = (multisine(range(1, 11), 2.0, dt=0.005, operating_point=0.850, limits=(0.600, 1.100),
+                    unit="A"))
     tr = plant.simulate(np.tile(s1.u, 3), noise_std=0.00125, seed=1)
-    dev = tr.with_channels(current=tr["current"] - plant.operating_point)  # the plant's input variable
+    # the plant's input variable
+    dev = tr.with_channels(current=tr["current"] - plant.operating_point)
     m = identify(dev, "arx", input="current", output="force", na=2, nb=2, nk=2, detrend="none")
     assert np.all(np.abs(m.theta - plant.model.theta) < 3 * m.theta_std)
     assert np.std(tr["force"] - tr["force_true"]) == pytest.approx(0.00125, rel=0.1)
@@ -76,7 +80,8 @@ def test_prefilter_and_exports(plant):
     tr = plant.simulate(np.full(400, 0.95), noise_std=0.125, seed=2, prefilter=True)
     # the filtered force keeps the step's steady state (unit DC gain) and removes most noise
     ff, f = tr["force_filtered"], tr["force"]
-    assert np.std(ff[300:] - tr["force_true"][300:]) < 0.5 * np.std(f[300:] - tr["force_true"][300:])
+    assert np.std(ff[300:] - tr["force_true"][300:]) < 0.5 * np.std(f[300:]
+                                                                    - tr["force_true"][300:])
     assert tr["force_true"][-1] == pytest.approx(plant.model.dc_gain * 0.1, rel=1e-3)
     g = plant.to_control()
     assert isinstance(g, control.TransferFunction) and g.dt == 0.005

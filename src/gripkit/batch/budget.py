@@ -72,7 +72,8 @@ def parse_bytes(value, where: str = "memory_limit") -> int:
     else:
         m = re.fullmatch(r"\s*([0-9]*\.?[0-9]+(?:[eE][-+]?[0-9]+)?)\s*([A-Za-z]*)\s*", str(value))
         if not m or m.group(2).lower() not in _UNITS:
-            raise ConfigError(f"{where}: expected a size such as '8 GB' or '512 MiB', found {value!r}",
+            raise ConfigError(f"{where}: expected a size such as '8 GB' or '512 MiB', "
+                              f"found {value!r}",
                               hint="units: B, kB, MB, GB, TB, KiB, MiB, GiB, TiB")
         n = float(m.group(1)) * _UNITS[m.group(2).lower()]
     if not n > 0 or n == float("inf"):
@@ -97,7 +98,8 @@ def memory_limit(override=None) -> tuple[int, str]:
         n = parse_bytes(override)
         return n, f"the limit of {format_bytes(n)} given"
     avail = available_memory()
-    return avail // 2, f"the limit of {format_bytes(avail // 2)} (half the {format_bytes(avail)} available)"
+    return (avail // 2, f"the limit of {format_bytes(avail // 2)} (half the "
+                        f"{format_bytes(avail)} available)")
 
 
 @dataclass(frozen=True)
@@ -120,7 +122,8 @@ class MemoryEstimate:
     def total(self, chunk_size: int, in_flight: int) -> int:
         return self.table_bytes + in_flight * self.task_bytes(chunk_size)
 
-    def check(self, chunk_size: int, in_flight: int, limit: int, limit_text: str, what: str) -> None:
+    def check(self, chunk_size: int, in_flight: int, limit: int, limit_text: str,
+              what: str) -> None:
         """Raise :class:`ConfigError` with the estimate and the limit when it does not fit."""
         total = self.total(chunk_size, in_flight)
         if total <= limit:
@@ -128,10 +131,13 @@ class MemoryEstimate:
         tasks = (f"; {_count(in_flight, 'task')} of {_count(chunk_size, 'job')} in flight, "
                  f"{format_bytes(self.task_bytes(chunk_size))} each" if in_flight else "")
         raise ConfigError(
-            f"{what}: {_count(self.n_jobs, 'job')} need{'s' if self.n_jobs == 1 else ''} an estimated {format_bytes(total)} of memory (job table "
-            f"and results {format_bytes(self.table_bytes)} for {_count(self.n_parameters, 'parameter')} and "
+            f"{what}: {_count(self.n_jobs, 'job')} need{'s' if self.n_jobs == 1 else ''} an "
+            f"estimated {format_bytes(total)} of memory (job table "
+            f"and results {format_bytes(self.table_bytes)} for "
+            f"{_count(self.n_parameters, 'parameter')} and "
             f"{_count(self.n_metrics, 'metric')}{tasks}), above {limit_text}",
-            hint="use fewer grid points, samples or time samples, split the sweep, lower chunk_size, "
+            hint="use fewer grid points, samples or time samples, split the sweep, "
+                 "lower chunk_size, "
                  "or raise the limit with --memory-limit (Python: memory_limit=)")
 
     def largest_chunk(self, in_flight: int, limit: int) -> int:

@@ -51,7 +51,8 @@ def check_not_bootstrapping() -> None:
             getattr(sys.modules.get("__main__"), "__name__", "") == "__mp_main__":
         raise ConfigError(
             "a gripkit sweep was started while a worker process was importing your script",
-            hint="put the code that starts the sweep under `if __name__ == \"__main__\":`, or use the "
+            hint="put the code that starts the sweep under `if __name__ == "
+                 "\"__main__\":`, or use the "
                  "default process backend, which needs no guard")
 
 
@@ -95,7 +96,8 @@ class _Worker:
         env = dict(os.environ)
         env.update(PIN_ENV)
         # unbuffered pipes: a frame must never hide in a Python buffer while select() waits
-        self.proc = subprocess.Popen([sys.executable, "-m", "gripkit.batch.worker"], stdin=subprocess.PIPE,
+        self.proc = subprocess.Popen([sys.executable, "-m", "gripkit.batch.worker"],
+                                     stdin=subprocess.PIPE,
                                      stdout=subprocess.PIPE, stderr=log, env=env, bufsize=0)
         self.tasks: collections.deque = collections.deque()  # sent, not yet answered (oldest first)
 
@@ -181,7 +183,8 @@ class ProcessExecutor(Executor):
                             attempts[culprit[0]] += 1
                             if attempts[culprit[0]] >= self.max_attempts:
                                 yield culprit[0], False, (
-                                    f"WorkerDied: a worker exited with code {code} while running this task "
+                                    f"WorkerDied: a worker exited with code {code} while "
+                                    "running this task "
                                     f"({attempts[culprit[0]]} attempts)")
                             else:
                                 pending.appendleft(culprit)
@@ -197,7 +200,8 @@ class ProcessExecutor(Executor):
             sel.close()
 
     def _retire(self, w: _Worker, sel) -> None:
-        with contextlib.suppress(KeyError, ValueError):  # not registered, or its pipe already closed
+        # not registered, or its pipe already closed
+        with contextlib.suppress(KeyError, ValueError):
             sel.unregister(w.proc.stdout)
         if w in self._pool:
             self._pool.remove(w)

@@ -39,7 +39,8 @@ def _resolve(identifier) -> Callable:
     target = IDENTIFIERS.get(identifier, identifier)
     if ":" not in str(target):
         raise ConfigError(f"unknown identifier {identifier!r}",
-                          hint=f"registered: {', '.join(IDENTIFIERS) or 'none'}; or 'package.module:function'")
+                          hint=f"registered: {', '.join(IDENTIFIERS) or 'none'}; or "
+                               "'package.module:function'")
     module, func = target.split(":", 1)
     try:
         return getattr(importlib.import_module(module), func)
@@ -73,7 +74,8 @@ def _files(paths) -> list[str]:
 
 @entry_point
 def identify_many(paths: str | Path | Iterable, identifier, options: dict | None = None, *,
-                  load_options: dict | None = None, backend: str = "process", workers: int | None = None,
+                  load_options: dict | None = None, backend: str = "process",
+                  workers: int | None = None,
                   scheduler: str | None = None, executor: Executor | None = None,
                   progress: bool = True) -> dict[str, np.ndarray]:
     """Identify every file; returns columns ``file``, each parameter, ``<param>_std``, any scalar
@@ -82,13 +84,15 @@ def identify_many(paths: str | Path | Iterable, identifier, options: dict | None
     options = dict(options or {})
     load_options = dict(load_options or {})
     _resolve(identifier)  # fail early on an unknown identifier
-    tasks = [(i, identify_file, (f, identifier, options, load_options)) for i, f in enumerate(files)]
+    tasks = ([(i, identify_file, (f, identifier, options,
+                                  load_options)) for i, f in enumerate(files)])
     own = executor is None
     ex = executor or make_executor(backend, workers, scheduler)
     results: dict[int, tuple[bool, object]] = {}
     try:
         for key, ok, value in track(ex.map_unordered(tasks), total=len(tasks),
-                                    description=f"identifying {len(files)} files", enabled=progress):
+                                    description=f"identifying {len(files)} files",
+                                    enabled=progress):
             results[key] = (ok, value)
     finally:
         if own:

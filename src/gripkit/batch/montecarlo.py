@@ -34,7 +34,8 @@ class Estimate:
     confidence: float
 
     def __str__(self) -> str:
-        return f"{self.value:.4g} [{self.low:.4g}, {self.high:.4g}] ({100 * self.confidence:.0f} % CI, n={self.n})"
+        return (f"{self.value:.4g} [{self.low:.4g}, {self.high:.4g}] ({100 * self.confidence:.0f} "
+                f"% CI, n={self.n})")
 
 
 def probability(flags, confidence: float = 0.95) -> Estimate:
@@ -83,5 +84,6 @@ def binned_probability(x, flags, bins, confidence: float = 0.95) -> list[dict]:
         if m.sum() == 0:
             continue
         e = probability(flags[m], confidence)
-        rows.append(dict(low=a, high=b, centre=0.5 * (a + b), p=e.value, p_low=e.low, p_high=e.high, n=e.n))
+        rows.append(dict(low=a, high=b, centre=0.5 * (a + b), p=e.value, p_low=e.low, p_high=e.high,
+                         n=e.n))
     return rows

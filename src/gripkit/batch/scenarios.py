@@ -63,8 +63,10 @@ class Setting:
             return value
         if self.kind == "str":
             if not isinstance(value, str) or (self.choices and value not in self.choices):
-                raise ConfigError(f"{where}: expected one of {', '.join(map(repr, self.choices))}, found {value!r}"
-                                  if self.choices else f"{where}: expected a string, found {value!r}")
+                raise ConfigError(f"{where}: expected one of {', '.join(map(repr, self.choices))}, "
+                                  f"found {value!r}"
+                                  if self.choices else f"{where}: expected a string, "
+                                                       f"found {value!r}")
             return value
         if self.kind == "int":
             if isinstance(value, bool) or not isinstance(value, numbers.Integral):
@@ -74,10 +76,12 @@ class Setting:
             v = quantity(value, where, self.kind)
         unit = "" if self.kind in ("int", "1") else f" {self.kind}"
         if self.low is not None and (v <= self.low if self.strict else v < self.low):
-            raise ConfigError(f"{where}: expected a value {'>' if self.strict else '>='} {self.low:g}{unit}, "
+            raise ConfigError(f"{where}: expected a value {'>' if self.strict else '>='} "
+                              f"{self.low:g}{unit}, "
                               f"found {value!r}")
         if self.high is not None and (v >= self.high if self.strict else v > self.high):
-            raise ConfigError(f"{where}: expected a value {'<' if self.strict else '<='} {self.high:g}{unit}, "
+            raise ConfigError(f"{where}: expected a value {'<' if self.strict else '<='} "
+                              f"{self.high:g}{unit}, "
                               f"found {value!r}")
         return v
 
@@ -92,7 +96,8 @@ def read_settings(table: Mapping, schema: Mapping[str, Setting], scenario: str) 
     raise :class:`ConfigError`; quantities come back in SI."""
     unknown = sorted(set(table) - set(schema))
     if unknown:
-        raise ConfigError(f"[scenario] ({scenario}): unknown keys {unknown}", hint=f"allowed: {', '.join(schema)}")
+        raise ConfigError(f"[scenario] ({scenario}): "
+                          f"unknown keys {unknown}", hint=f"allowed: {', '.join(schema)}")
     return {k: schema[k].read(v, f"[scenario] {k}") for k, v in table.items()}
 
 
@@ -121,8 +126,10 @@ class Interface:
                 i = int(np.argmax(bad))
                 unit = (self.parameters or {}).get(name, "")
                 raise ConfigError(
-                    f"[parameters] {name}: {int(bad.sum()):,} of {len(v):,} jobs have values outside its bounds "
-                    f"[{-np.inf if lo is None else lo:g}, {np.inf if hi is None else hi:g}] {unit} (job {i}: {v[i]:g})",
+                    f"[parameters] {name}: {int(bad.sum()):,} of {len(v):,} jobs have values "
+                    "outside its bounds "
+                    f"[{-np.inf if lo is None else lo:g}, {np.inf if hi is None else hi:g}] {unit} "
+                    f"(job {i}: {v[i]:g})",
                     hint="narrow the grid or range, or give a random draw clip = [low, high]")
 
 
@@ -187,7 +194,8 @@ def build_model(ref: str | None, allow_code: bool = False):
             except GripkitError:
                 raise
             except Exception as exc:
-                raise ConfigError(f"model {ref!r}: building it failed ({type(exc).__name__}: {exc})") from None
+                raise ConfigError(f"model {ref!r}: building it failed "
+                                  f"({type(exc).__name__}: {exc})") from None
     return _MODELS[key]
 
 
@@ -213,7 +221,8 @@ def prepare(spec, allow_code: bool = False) -> Prepared:
     declare = getattr(fn, "interface", None)
     iface = (declare(model, dict(spec.settings)) if declare
              else Interface(settings=dict(spec.settings)))
-    scen = spec.scenario if isinstance(spec.scenario, str) else getattr(spec.scenario, "__name__", "scenario")
+    scen = (spec.scenario if isinstance(spec.scenario,
+                                        str) else getattr(spec.scenario, "__name__", "scenario"))
     if iface.parameters is not None:
         unknown = [n for n in spec.parameters if n not in iface.parameters]
         if unknown:
@@ -236,8 +245,10 @@ def step_metrics_rows(t: np.ndarray, y: np.ndarray, band: float = 0.02) -> dict[
     10 %), peak, overshoot %, 10–90 % rise time and settling time into ±``band``
     (:func:`gripkit.sysid.physical.step_response.step_metrics` per row)."""
     rows = [step_metrics(t, yi, y_initial=0.0, band=band) for yi in np.atleast_2d(y)]
-    return {"final": np.array([r["y_final"] for r in rows]), "peak": np.array([r["peak"] for r in rows]),
-            **{k: np.array([r[k] for r in rows]) for k in ("overshoot_percent", "rise_time", "settling_time")}}
+    return {"final": np.array([r["y_final"] for r in rows]),
+            "peak": np.array([r["peak"] for r in rows]),
+            **{k: np.array([r[k] for r in rows]) for k in ("overshoot_percent", "rise_time",
+                                                           "settling_time")}}
 
 
 _STEP_DEFAULTS = {"fs": 20000.0, "duration": 0.05, "amplitude": 1.0, "band": 0.02}
@@ -248,30 +259,36 @@ def _step_interface(model, settings: dict) -> Interface:
     """step-response: the model's parameters; fs (Hz) and duration (s) > 0 giving >= 2 samples,
     amplitude in the input's unit, input/output among the model's, band in (0, 1]."""
     if not isinstance(model, Model):
-        raise ConfigError("scenario 'step-response' needs a simulation model ([sweep] model = ...), found "
+        raise ConfigError("scenario 'step-response' needs a simulation model ([sweep] "
+                          "model = ...), found "
                           f"{type(model).__name__ if model is not None else 'none'}",
                           hint="for instance model = \"mass-spring-damper\"")
     ins, outs = {s.name: s.unit for s in model.inputs}, [s.name for s in model.outputs]
     inp = settings.get("input", next(iter(ins)))
-    schema = {"fs": POSITIVE_RATE, "duration": POSITIVE_TIME, "amplitude": Setting(ins.get(inp, "1")),
-              "input": Setting("str", choices=tuple(ins)), "output": Setting("str", choices=tuple(outs)),
+    schema = {"fs": POSITIVE_RATE, "duration": POSITIVE_TIME,
+              "amplitude": Setting(ins.get(inp, "1")),
+              "input": Setting("str", choices=tuple(ins)),
+              "output": Setting("str", choices=tuple(outs)),
               "band": FRACTION}
     s = {**_STEP_DEFAULTS, **read_settings(settings, schema, "step-response")}
     n = round(s["duration"] * s["fs"])
     if n < 2:
-        raise ConfigError(f"[scenario] duration × fs: {s['duration']:g} s × {s['fs']:g} Hz gives {n} samples, "
+        raise ConfigError(f"[scenario] duration × fs: {s['duration']:g} s × {s['fs']:g} Hz "
+                          f"gives {n} samples, "
                           "expected at least 2", hint="lengthen duration or raise fs")
     p = model.parameters
     # per job its output record and room for two more; per task the input, the time axis and the
     # step-metric temporaries of one row. Measured: 193 MB peak for a task of 10 jobs of 10⁶
     # samples (mass-spring-damper), estimated 264 MB.
-    return Interface(parameters={name: p[name].unit for name in p.names}, settings=s, metrics=_STEP_METRICS,
+    return Interface(parameters={name: p[name].unit for name in p.names}, settings=s,
+                     metrics=_STEP_METRICS,
                      bytes_per_job=8 * n * (len(outs) + 2), bytes_per_task=8 * n * (len(ins) + 2),
                      bounds={name: p[name].bounds for name in p.names})
 
 
 def step_response(model, params: dict[str, np.ndarray], settings: dict) -> dict[str, np.ndarray]:
-    """Step of ``amplitude`` on input ``input`` (default: the first) for ``duration`` s at ``fs`` Hz;
+    """Step of ``amplitude`` on input ``input`` (default: the first) for ``duration`` s at ``fs``
+    Hz;
     metrics of output ``output`` (default: the first), see :func:`step_metrics_rows`. ``settings``:
     as read by :func:`_step_interface`."""
     s = _step_interface(model, settings).settings

@@ -65,7 +65,8 @@ def quantity(v, where: str, unit: str | None = None) -> float:
     dimension (``"3 furlong"`` for a stiffness) is refused. Non-finite values are refused."""
     expected = f" in {unit}" if unit else ""
     if isinstance(v, bool) or not isinstance(v, (numbers.Real, str)):
-        raise ConfigError(f"{where}: expected a number{expected} or a quantity like '3 mg', found {v!r}")
+        raise ConfigError(f"{where}: expected a number{expected} or a quantity like '3 "
+                          f"mg', found {v!r}")
     if isinstance(v, str):
         try:
             value = float(v)  # a bare number in a string: SI
@@ -74,10 +75,13 @@ def quantity(v, where: str, unit: str | None = None) -> float:
                 value, si = to_si(v)
             except GripkitError as exc:
                 raise ConfigError(f"{where}: cannot read {v!r} as a quantity ({exc.message})",
-                                  hint="write a number followed by a unit, like '3 mg' or '25 N/m'") from None
+                                  hint="write a number followed by a unit, like '3 "
+                                       "mg' or '25 N/m'") from None
             if unit is not None and not same_dimension(si, unit):
-                raise ConfigError(f"{where}: {v!r} is a quantity in {si}, expected one in {si_unit(unit)}",
-                                  hint=f"give it in {unit} (or a unit of the same dimension), or as a "
+                raise ConfigError(f"{where}: {v!r} is a quantity in {si}, expected one in "
+                                  f"{si_unit(unit)}",
+                                  hint=f"give it in {unit} (or a unit of the same "
+                                       "dimension), or as a "
                                        f"plain number in {si_unit(unit)}")
     else:
         value = float(v)
@@ -134,17 +138,22 @@ class SweepSpec:
         if unknown:
             hint = f"allowed: {', '.join(_SWEEP_KEYS)}"
             if any("allow" in k or "code" in k for k in unknown):
-                hint += ("; importing code cannot be allowed from inside a sweep file: pass --allow-code "
+                hint += ("; importing code cannot be allowed from inside a sweep file: "
+                         "pass --allow-code "
                          "on the command line (Python: sweep(..., allow_code=True))")
             raise ConfigError(f"[sweep]: unknown keys {unknown}", hint=hint)
-        params, settings, metrics = d.get("parameters", {}), d.get("scenario", {}), d.get("metrics", {})
+        params, settings, metrics = (d.get("parameters", {}), d.get("scenario", {}),
+                                     d.get("metrics", {}))
         if not isinstance(metrics, dict):
             raise ConfigError(f"[metrics]: expected a table, found {metrics!r}")
         if set(metrics) - {"record"}:
-            raise ConfigError(f"[metrics]: unknown keys {sorted(set(metrics) - {'record'})}", hint="allowed: record")
+            raise ConfigError("[metrics]: unknown keys "
+                              f"{sorted(set(metrics) - {'record'})}", hint="allowed: record")
         record = metrics.get("record")
-        return cls(scenario=sw["scenario"], parameters=params, model=sw.get("model"), name=sw.get("name", "sweep"),
-                   settings=settings, metrics=record, samples=sw.get("samples", 1), seed=sw.get("seed", 0),
+        return cls(scenario=sw["scenario"], parameters=params, model=sw.get("model"),
+                   name=sw.get("name", "sweep"),
+                   settings=settings, metrics=record, samples=sw.get("samples", 1),
+                   seed=sw.get("seed", 0),
                    chunk_size=sw.get("chunk_size"), base_dir=base_dir)
 
     def __post_init__(self):
@@ -154,16 +163,20 @@ class SweepSpec:
             if not isinstance(value, dict):
                 raise ConfigError(f"[{table}]: expected a table, found {value!r}")
         record = self.metrics
-        if record is not None and (isinstance(record, str) or not isinstance(record, (list, tuple)) or not record
+        if record is not None and (isinstance(record, str) or not isinstance(record, (list, tuple))
+                                   or not record
                                    or not all(isinstance(m, str) for m in record)):
-            raise ConfigError(f"[metrics] record: expected a non-empty list of metric names, found {record!r}")
+            raise ConfigError("[metrics] record: expected a non-empty list of metric names, "
+                              f"found {record!r}")
         if not (callable(self.scenario) or isinstance(self.scenario, str)):
-            raise ConfigError(f"[sweep] scenario: expected a scenario name, found {self.scenario!r}")
+            raise ConfigError("[sweep] scenario: expected a scenario name, found "
+                              f"{self.scenario!r}")
         if self.model is not None and not isinstance(self.model, str):
             raise ConfigError(f"[sweep] model: expected a model name, found {self.model!r}")
         name = self.name
         if not isinstance(name, str) or not name or any(c in name for c in "/\\\0"):
-            raise ConfigError(f"[sweep] name: expected a short name without slashes, found {name!r}")
+            raise ConfigError("[sweep] name: expected a short name without "
+                              f"slashes, found {name!r}")
         cs = self.chunk_size
         fix = object.__setattr__  # frozen: normalise once, here
         fix(self, "parameters", dict(self.parameters))
@@ -173,7 +186,8 @@ class SweepSpec:
         fix(self, "seed", _integer(self.seed, "[sweep] seed", 0))
         fix(self, "chunk_size", None if cs is None else _integer(cs, "[sweep] chunk_size", 1))
         if self.n_jobs() == 0:
-            raise ConfigError("sweep specification: the parameter table has no rows, so there are no jobs",
+            raise ConfigError("sweep specification: the parameter table has no rows, so "
+                              "there are no jobs",
                               hint="check the table files named in [parameters]")
 
     def to_dict(self) -> dict:
@@ -181,7 +195,8 @@ class SweepSpec:
             (f"{getattr(self.scenario, '__module__', '?')}:"
              f"{getattr(self.scenario, '__qualname__', '?')}")
         return {"sweep": {"name": self.name, "scenario": scen, "model": self.model,
-                          "samples": self.samples, "seed": self.seed, "chunk_size": self.chunk_size},
+                          "samples": self.samples, "seed": self.seed,
+                          "chunk_size": self.chunk_size},
                 "parameters": self.parameters, "scenario": self.settings,
                 "metrics": {"record": list(self.metrics) if self.metrics else None}}
 
@@ -197,18 +212,22 @@ class SweepSpec:
             where = f"[parameters] {name}"
             unit = (units or {}).get(name)
             if not isinstance(desc, dict) or not desc:
-                raise ConfigError(f"{where}: expected {{ grid = [...] }}, {{ uniform = [lo, hi] }}, ...")
+                raise ConfigError(f"{where}: expected {{ grid = [...] }}, "
+                                  f"{{ uniform = [lo, hi] }}, ...")
             kinds = [k for k in desc if k in _KINDS]
             if len(kinds) != 1:
-                raise ConfigError(f"{where}: give exactly one of {', '.join(_KINDS)}, found {sorted(desc)}")
+                raise ConfigError(f"{where}: give exactly one of {', '.join(_KINDS)}, "
+                                  f"found {sorted(desc)}")
             kind = kinds[0]
             extra = sorted(k for k in desc if k != kind and kind not in _OPTIONS.get(k, ()))
             if extra:
                 raise ConfigError(f"{where}: unknown keys {extra} for a {kind}",
-                                  hint="'clip' goes with uniform/normal/loguniform, 'column' with table")
+                                  hint="'clip' goes with uniform/normal/loguniform, "
+                                       "'column' with table")
             arg = desc[kind]
             if kind in ("grid", "values"):
-                vals = np.array([quantity(v, where, unit) for v in (arg if isinstance(arg, list) else [arg])])
+                vals = (np.array([quantity(v, where, unit)
+                                  for v in (arg if isinstance(arg, list) else [arg])]))
                 if vals.size == 0:
                     raise ConfigError(f"{where}: empty grid")
                 grids[name] = vals
@@ -222,7 +241,8 @@ class SweepSpec:
                 spaces[name] = (kind, a, b, n)
             elif kind == "table":
                 if not isinstance(arg, str) or not isinstance(desc.get("column", name), str):
-                    raise ConfigError(f"{where}: table = \"file.csv\" (and column = \"name\"), found {arg!r}")
+                    raise ConfigError(f"{where}: table = \"file.csv\" (and column = "
+                                      f"\"name\"), found {arg!r}")
                 tables.setdefault(arg, []).append(name)
             else:
                 if not (isinstance(arg, list) and len(arg) == 2):
@@ -304,7 +324,8 @@ class SweepSpec:
         grids, spaces, randoms, tables = self._axes(units)
         for name, (kind, a, b, n) in spaces.items():
             grids[name] = np.linspace(a, b, n) if kind == "linspace" else np.geomspace(a, b, n)
-        grids = {n: grids[n] for n in self.parameters if n in grids}  # file order: first varies slowest
+        # file order: first varies slowest
+        grids = {n: grids[n] for n in self.parameters if n in grids}
         read = self._read_tables(tables)
         n_rows = math.prod(len(columns[0]) for _, columns in read)
         n_points = math.prod(g.size for g in grids.values())

@@ -56,14 +56,18 @@ def collect(jobs: dict[str, np.ndarray], parts) -> dict[str, np.ndarray]:
     each job exactly once."""
     parts = list(parts)
     n = len(jobs["job_id"])
-    ids = np.concatenate([np.asarray(p["job_id"], dtype=np.int64) for p in parts]) if parts else np.zeros(0, np.int64)
+    ids = (np.concatenate([np.asarray(p["job_id"], dtype=np.int64) for p in parts]) if parts
+           else np.zeros(0, np.int64))
     if ids.size and (ids.min() < 0 or ids.max() >= n):
-        raise DataError(f"sweep results: job ids outside 0..{n - 1} (found {ids.min()}..{ids.max()})")
+        raise DataError(f"sweep results: job ids outside 0..{n - 1} (found "
+                        f"{ids.min()}..{ids.max()})")
     count = np.bincount(ids, minlength=n)
     if (count != 1).any():
         missing, twice = np.flatnonzero(count == 0), np.flatnonzero(count > 1)
-        raise DataError(f"sweep results: {len(missing)} jobs missing (first {missing[:5].tolist()}) and "
-                        f"{len(twice)} held more than once (first {twice[:5].tolist()}); each job must appear "
+        raise DataError(f"sweep results: {len(missing)} jobs missing (first "
+                        f"{missing[:5].tolist()}) and "
+                        f"{len(twice)} held more than once (first {twice[:5].tolist()}); each "
+                        "job must appear "
                         "exactly once", hint="resume the sweep to recompute the missing chunks")
     out = dict(jobs)
     for p in parts:
@@ -158,8 +162,10 @@ class ResultStore:
             m["spec"]["sweep"]
             return m
         except (OSError, ValueError, KeyError, TypeError, RecursionError) as exc:
-            raise ConfigError(f"output folder {str(self.root)!r}: manifest.json is unreadable ({type(exc).__name__})",
-                              hint="choose another --out folder, or delete this one and run the sweep again") from None
+            raise ConfigError(f"output folder {str(self.root)!r}: manifest.json is unreadable "
+                              f"({type(exc).__name__})",
+                              hint="choose another --out folder, or delete this one and run "
+                                   "the sweep again") from None
 
     def initialise(self, spec: dict, jobs: dict[str, np.ndarray], resume: bool) -> None:
         """Create the folder, or check that an existing one belongs to the same sweep."""
@@ -167,7 +173,8 @@ class ResultStore:
 
         fp = fingerprint(spec)
         if self.root.exists() and not self.root.is_dir():
-            raise ConfigError(f"output folder {str(self.root)!r} is a file", hint="choose another --out folder")
+            raise ConfigError(f"output folder {str(self.root)!r} is a file",
+                              hint="choose another --out folder")
         old = self.manifest()
         if old is None:
             self._refuse_foreign()
@@ -175,10 +182,13 @@ class ResultStore:
             if old.get("fingerprint") != fp:
                 raise ConfigError(
                     f"output folder {str(self.root)!r} holds a different sweep (fingerprint "
-                    f"{old.get('fingerprint')} vs {fp})", hint="choose another --out folder or delete it")
+                    f"{old.get('fingerprint')} vs {fp})", hint="choose another --out "
+                                                               "folder or delete it")
             if not resume:
-                raise ConfigError(f"output folder {str(self.root)!r} already holds results of this sweep",
-                                  hint="pass --resume (resume=True) to continue it, or choose another folder")
+                raise ConfigError(f"output folder {str(self.root)!r} already holds "
+                                  "results of this sweep",
+                                  hint="pass --resume (resume=True) to continue it, or "
+                                       "choose another folder")
         self.chunks_dir.mkdir(parents=True, exist_ok=True)
         self.fingerprint = fp
         manifest = json.dumps({"fingerprint": fp, "spec": spec}, indent=2, default=str)
@@ -247,14 +257,16 @@ class ResultStore:
         try:
             table = pq.read_table(self.chunk_path(chunk))
         except Exception as exc:  # pyarrow raises several types for damaged files
-            return None, f"is unreadable ({type(exc).__name__}: {str(exc).splitlines()[0][:120] if str(exc) else ''})"
+            return (None, f"is unreadable ({type(exc).__name__}: "
+                          f"{str(exc).splitlines()[0][:120] if str(exc) else ''})")
         problem = _foreign(table, fp) or _bad_schema(table, metrics)
         if problem:
             return None, problem
         ids = table["job_id"].to_numpy()
         if not np.array_equal(ids, np.arange(expected.start, expected.stop)):
             found = f"{ids.min()}..{ids.max()}" if len(ids) else "none"
-            found += "" if not len(ids) or len(ids) == ids.max() - ids.min() + 1 else f" ({len(ids)} jobs)"
+            found += ("" if not len(ids) or len(ids) == ids.max() - ids.min() + 1
+                      else f" ({len(ids)} jobs)")
             return None, f"holds job ids {found}, expected {expected.start}..{expected.stop - 1}"
         values = [k for k in table.column_names if k not in ("job_id", "error")]
         cols = {"job_id": ids, "error": np.array(table["error"].to_pylist(), dtype=object)}
@@ -296,8 +308,10 @@ class ResultStore:
             path = self.chunk_path(c)
             os.replace(path, path.with_name(path.name + ".bad"))
             r = chunk_range(c, chunk_size, n_jobs)
-            again = f"its jobs {r.start}..{r.stop - 1} are computed again" if r else "it is not used"
-            emit_warning(f"sweep output {str(self.root)!r}: chunk {c} ({path.name}) {problem}; {again} "
+            again = (f"its jobs {r.start}..{r.stop - 1} are computed again" if r
+                     else "it is not used")
+            emit_warning(f"sweep output {str(self.root)!r}: chunk {c} ({path.name}) "
+                         f"{problem}; {again} "
                          f"(the file is kept as {path.name}.bad)", GripkitWarning)
         return good
 
@@ -321,7 +335,8 @@ class ResultStore:
         jobs_path = self.root / "jobs.parquet"
         manifest = self.manifest()
         if manifest is None or not jobs_path.exists():
-            raise DataError(f"{str(self.root)!r} holds no sweep (manifest.json or jobs.parquet missing)")
+            raise DataError(f"{str(self.root)!r} holds no sweep (manifest.json or "
+                            "jobs.parquet missing)")
         try:
             table = pq.read_table(jobs_path)
             jobs = {k: table[k].to_numpy() for k in table.column_names}

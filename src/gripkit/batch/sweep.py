@@ -53,13 +53,16 @@ def run_chunk(scenario, model_ref: str | None, settings: dict, job_ids: np.ndarr
     errors = np.full(n, None, dtype=object)
     try:
         # a scenario that draws random numbers per job (noise) seeds them by job id, so results do
-        # not depend on the chunking: it declares ``fn.uses_job_id = True`` and gets params["job_id"]
-        res = fn(model, {**params, "job_id": np.asarray(job_ids)} if getattr(fn, "uses_job_id", False) else params,
+        # not depend on the chunking: it declares ``fn.uses_job_id = True`` and gets
+        # params["job_id"]
+        res = fn(model, {**params, "job_id": np.asarray(job_ids)} if getattr(fn, "uses_job_id",
+                                                                             False) else params,
                  settings)
         res = {k: np.asarray(v, dtype=np.float64) for k, v in res.items()}
         for k, v in res.items():
             if v.shape != (n,):
-                raise ConfigError(f"scenario {scenario!r} returned {v.shape} values for metric {k!r}, expected ({n},)")
+                raise ConfigError(f"scenario {scenario!r} returned {v.shape} values for metric "
+                                  f"{k!r}, expected ({n},)")
     except Exception as exc:
         if n == 1:
             res, errors[0] = {}, f"{type(exc).__name__}: {exc}"
@@ -106,7 +109,8 @@ class SweepResult:
     @property
     def failed(self) -> np.ndarray:
         err = self.columns.get("error")
-        return np.zeros(self.n_jobs, bool) if err is None else np.array([e is not None for e in err], dtype=bool)
+        return (np.zeros(self.n_jobs, bool) if err is None
+                else np.array([e is not None for e in err], dtype=bool))
 
     @property
     def n_failed(self) -> int:
@@ -116,13 +120,17 @@ class SweepResult:
     def failures(self) -> list[tuple[int, str]]:
         if "error" not in self.columns:
             return []
-        return [(int(j), e) for j, e in zip(self.columns["job_id"], self.columns["error"]) if e is not None]
+        return ([(int(j), e) for j, e in zip(self.columns["job_id"],
+                                             self.columns["error"]) if e is not None])
 
     def summary(self) -> str:
-        failed = f"{self.n_failed} of them FAILED (see the error column)" if self.n_failed else "none failed"
-        return (f"{self.n_jobs} job{'s' if self.n_jobs != 1 else ''}, {failed}, in {self.seconds:.2f} s on "
+        failed = (f"{self.n_failed} of them FAILED (see the error column)" if self.n_failed
+                  else "none failed")
+        return (f"{self.n_jobs} job{'s' if self.n_jobs != 1 else ''}, {failed}, in "
+                f"{self.seconds:.2f} s on "
                 f"{self.backend}, chunks of {self.chunk_size}, {self.computed_chunks} computed"
-                + (f"; results in {self.path}" if self.path else "") + (f" ({self.choice})" if self.choice else ""))
+                + (f"; results in {self.path}" if self.path else "")
+                + (f" ({self.choice})" if self.choice else ""))
 
 
 #: Seconds a process pool needs before its first result: starting the workers, importing gripkit
@@ -194,11 +202,13 @@ def _auto_backend(work_s: float, workers: int, busy: float = 0.0,
         return "in-process", (f"backend auto: in-process, the estimated work ({work_s:.2g} s) is "
                               f"too small for a pool of {workers} to win back its start-up "
                               f"(~{POOL_STARTUP_S:g} s{load})")
-    return "process", (f"backend auto: process pool of {workers}, the estimated work ({work_s:.2g} s) "
+    return "process", (f"backend auto: process pool of {workers}, the estimated work "
+                       f"({work_s:.2g} s) "
                        f"outweighs its start-up (~{POOL_STARTUP_S:g} s{load})")
 
 
-def _in_flight(executor: Executor | None, backend: str, workers: int | None, scheduler: str | None) -> int:
+def _in_flight(executor: Executor | None, backend: str, workers: int | None,
+               scheduler: str | None) -> int:
     """Tasks that run at once on this machine (a remote scheduler's workers use their own)."""
     if executor is not None:
         return 0 if executor.name == "dask" and scheduler else max(int(executor.workers), 1)
@@ -227,30 +237,36 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "auto", workers
         spec = SweepSpec.from_dict(spec) if isinstance(spec, dict) else SweepSpec.from_toml(spec)
     if resume and out is None:
         raise ConfigError("resume needs the output folder of the interrupted sweep (out=...)")
-    if executor is None and not scheduler and backend not in ("auto", "in-process", "process", "dask"):
-        raise ConfigError(f"backend: expected 'auto', 'in-process', 'process' or 'dask', found {backend!r}")
-    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, int) or workers < 1):
+    if executor is None and not scheduler and backend not in ("auto", "in-process", "process",
+                                                              "dask"):
+        raise ConfigError("backend: expected 'auto', 'in-process', 'process' or 'dask', "
+                          f"found {backend!r}")
+    if workers is not None and (isinstance(workers,
+                                           bool) or not isinstance(workers, int) or workers < 1):
         raise ConfigError(f"workers: expected a positive number, found {workers!r}")
     prep = prepare(spec, allow_code)
     n_jobs = spec.n_jobs()
     limit, limit_text = _memory_limit(memory_limit)
     iface = prep.interface
     n_metrics = len(spec.metrics or iface.metrics or ()) or UNDECLARED_METRICS
-    estimate = MemoryEstimate(n_jobs, len(spec.parameters), n_metrics, iface.bytes_per_job, iface.bytes_per_task)
+    estimate = (MemoryEstimate(n_jobs, len(spec.parameters), n_metrics, iface.bytes_per_job,
+                               iface.bytes_per_task))
     in_flight = _in_flight(executor, backend, workers, scheduler)
     store = ResultStore(out) if out is not None else None
     chunk_size = spec.chunk_size
     if chunk_size is None and resume and store is not None and (m := store.manifest()) is not None:
         chunk_size = m["spec"]["sweep"].get("chunk_size")
     # the table, the results and a first small task must fit before anything is built
-    estimate.check(min(chunk_size or 2, n_jobs), max(in_flight, 1), limit, limit_text, f"sweep {spec.name!r}")
+    estimate.check(min(chunk_size or 2, n_jobs), max(in_flight, 1), limit, limit_text,
+                   f"sweep {spec.name!r}")
     jobs = spec.jobs(dict(iface.parameters or {}), memory_limit=limit)
     iface.check_values(jobs)
     names = [k for k in jobs if k != "job_id"]
 
     def chunk_args(r: range) -> tuple:
         sl = slice(r.start, r.stop)
-        return (spec.scenario, spec.model, prep.settings, jobs["job_id"][sl], {n: jobs[n][sl] for n in names},
+        return (spec.scenario, spec.model, prep.settings, jobs["job_id"][sl],
+                {n: jobs[n][sl] for n in names},
                 spec.metrics, allow_code)
 
     choice = ""
@@ -262,7 +278,8 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "auto", workers
                                         _busy_cores())
         in_flight = _in_flight(None, backend, workers, None)
     if chunk_size is None:
-        chunk_size = min(max(1, math.ceil(target_task_s / per_job)), max(estimate.largest_chunk(in_flight, limit), 1))
+        chunk_size = (min(max(1, math.ceil(target_task_s / per_job)),
+                          max(estimate.largest_chunk(in_flight, limit), 1)))
     chunk_size = int(min(chunk_size, n_jobs))
     estimate.check(chunk_size, in_flight, limit, limit_text, f"sweep {spec.name!r}")
     record = spec.to_dict()
@@ -295,7 +312,8 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "auto", workers
                                   enabled=progress):
             if not ok:
                 r = chunk_range(c, chunk_size, n_jobs)
-                value = {"job_id": jobs["job_id"][r.start:r.stop], "error": np.full(len(r), value, dtype=object)}
+                value = ({"job_id": jobs["job_id"][r.start:r.stop],
+                          "error": np.full(len(r), value, dtype=object)})
             if store is not None:
                 store.write_chunk(c, value)
             else:
@@ -304,6 +322,8 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "auto", workers
         if own:
             ex.close()
     seconds = time.perf_counter() - t0
-    parts = store.read_parts(chunk_size, n_jobs, spec.metrics) if store is not None else mem.values()
+    parts = (store.read_parts(chunk_size, n_jobs,
+                              spec.metrics) if store is not None else mem.values())
     cols = collect(jobs, parts)  # raises unless each job is there exactly once
-    return SweepResult(cols, None if out is None else Path(out), ex.name, chunk_size, seconds, len(tasks), choice)
+    return (SweepResult(cols, None if out is None else Path(out), ex.name, chunk_size, seconds,
+                        len(tasks), choice))

@@ -54,7 +54,8 @@ def _one_line(text: str) -> str:
 
 
 def user_error(exc: BaseException):
-    """The gripkit error a user should see for ``exc`` (an error of the environment, not of gripkit),
+    """The gripkit error a user should see for ``exc`` (an error of the environment, not of
+    gripkit),
     or ``None`` when ``exc`` is a bug. OS errors on a path become :class:`~gripkit.errors.PathError`
     saying what is wrong with the path; undecodable text a :class:`~gripkit.errors.DataError`."""
     from ..errors import DataError, GripkitError, PathError
@@ -73,15 +74,19 @@ def user_error(exc: BaseException):
                              hint="choose a path whose parent folders are folders")
         if isinstance(exc, FileExistsError):
             kind = "a folder" if name is not None and os.path.isdir(name) else "a file"
-            return PathError(f"{where} already exists as {kind}", hint="choose another path, or remove it")
+            return (PathError(f"{where} already exists as {kind}",
+                              hint="choose another path, or remove it"))
         if isinstance(exc, PermissionError):
             return PathError(f"permission denied on {where}",
                              hint="choose a path you may read or write, or change its permissions")
         reason = exc.strerror or _one_line(exc) or type(exc).__name__
-        return PathError(f"{reason} ({where})" if name is not None else f"operating-system error: {reason}",
-                         hint="free disk space, or choose another path" if exc.errno == errno.ENOSPC else None)
+        return PathError(f"{reason} ({where})" if name is not None else "operating-system "
+                                                                        f"error: {reason}",
+                         hint="free disk space, or "
+                              "choose another path" if exc.errno == errno.ENOSPC else None)
     if isinstance(exc, UnicodeDecodeError):
-        return DataError(f"a file is not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at offset {exc.start} "
+        return DataError(f"a file is not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at "
+                         f"offset {exc.start} "
                          f"cannot be decoded)", hint="check that each path names the right file")
     return None
 
@@ -107,7 +112,8 @@ def main(argv: list[str] | None = None) -> int:
     except _click_classes("NoArgsIsHelpError") as exc:  # `gripkit identify`: the help is the answer
         exc.show()
         return 0
-    except _click_classes("ClickException") as exc:  # unknown option, a value of the wrong type, ...
+    # unknown option, a value of the wrong type, ...
+    except _click_classes("ClickException") as exc:
         print(_usage_error(exc), file=sys.stderr)
         return exc.exit_code
     except _click_classes("Abort"):
@@ -123,11 +129,13 @@ def main(argv: list[str] | None = None) -> int:
             traceback.print_exc()
         err = user_error(exc)
         if isinstance(exc, MemoryError):
-            print("error: MemoryError: not enough memory for this run; make the problem smaller (fewer or "
+            print("error: MemoryError: not enough memory for this run; make the problem "
+                  "smaller (fewer or "
                   "shorter records, fewer jobs)", file=sys.stderr)
         elif err is not None:
             print(f"error: {type(err).__name__}: {_one_line(err)}", file=sys.stderr)
         else:  # a bug in gripkit: still one line unless --debug
             print(f"error: unexpected {type(exc).__name__}: {_one_line(exc)[:500]} "
-                  f"(a bug in gripkit: run with --debug for the traceback and report it)", file=sys.stderr)
+                  "(a bug in gripkit: run with --debug for the "
+                  "traceback and report it)", file=sys.stderr)
         return 1

@@ -15,9 +15,11 @@ from .. import progress
 
 app = typer.Typer(name="gripkit", no_args_is_help=True, add_completion=False,
                   pretty_exceptions_enable=False,
-                  help="Model, simulate, identify, estimate and control robotic grippers and fingers.")
+                  help="Model, simulate, identify, estimate and control robotic "
+                       "grippers and fingers.")
 identify_app = typer.Typer(no_args_is_help=True, pretty_exceptions_enable=False,
-                           help="Identify models from logged data (prints a summary, or JSON with --json).")
+                           help="Identify models from logged data (prints a summary, or "
+                                "JSON with --json).")
 zoo_app = typer.Typer(no_args_is_help=True, pretty_exceptions_enable=False,
                       help="The reference systems of the seeds, with parameters and provenance.")
 app.add_typer(identify_app, name="identify")
@@ -47,7 +49,8 @@ def _print_version(value: bool) -> None:
 def _root(ctx: typer.Context,
           debug: bool = typer.Option(False, "--debug", help="Show tracebacks on errors."),
           quiet: bool = typer.Option(False, "--quiet", "-q", help="No progress output."),
-          show_version: bool = typer.Option(False, "--version", is_eager=True, callback=_print_version,
+          show_version: bool = typer.Option(False, "--version", is_eager=True,
+                                            callback=_print_version,
                                             help="Print gripkit's version and exit."),
           allow_external_links: bool = typer.Option(
               False, "--allow-external-links",

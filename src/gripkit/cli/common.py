@@ -14,13 +14,15 @@ import typer
 
 from ..sysid.model_file import plain
 
-__all__ = ["emit_json", "is_mcap", "load_data", "collected_warnings", "report_warnings", "check_data_options", "check_choice", "check_number", "complex_pairs",
+__all__ = ["emit_json", "is_mcap", "load_data", "collected_warnings", "report_warnings",
+           "check_data_options", "check_choice", "check_number", "complex_pairs",
            "FsOpt", "TimeOpt", "FillOpt", "JsonOpt", "ModelReportOpt", "write_model_page"]
 
 FsOpt = typer.Option(None, "--fs", help="Sampling rate in Hz, when the file has no time column "
                                          "(with one, it must agree with the time stamps).")
 TimeOpt = typer.Option(None, "--time", help="Name of the time column (default: t/time/timestamp).")
-FillOpt = typer.Option(None, "--fill", help="Missing values: 'drop' rows or 'interpolate' (default: error).")
+FillOpt = typer.Option(None, "--fill", help="Missing values: 'drop' rows or 'interpolate' "
+                                            "(default: error).")
 JsonOpt = typer.Option(False, "--json", help="Print one JSON object on stdout.")
 ModelReportOpt = typer.Option(None, "--report", help="Write an HTML report of the model on the "
                                                      "--validate record (else on the record) "
@@ -74,9 +76,11 @@ def check_number(value, option: str, *, minimum: float | None = None, above: flo
     if value is None:
         return
     want = ("an integer" if integer else "a finite number") + (
-        f" >= {minimum:g}" if minimum is not None else f" > {above:g}" if above is not None else "") + (
+        f" >= {minimum:g}" if minimum is not None else f" > {above:g}" if above is not None
+        else "") + (
         ", not zero" if nonzero else "")
-    ok = (math.isfinite(value) and (minimum is None or value >= minimum) and (above is None or value > above)
+    ok = (math.isfinite(value) and (minimum is None or value >= minimum)
+          and (above is None or value > above)
           and (not integer or float(value).is_integer()) and not (nonzero and value == 0))
     if not ok:
         raise DataError(f"{option}: expected {want}, found {value!r}")

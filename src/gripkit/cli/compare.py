@@ -14,7 +14,8 @@ import typer
 from .app import app
 from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, is_mcap, load_data, report_warnings
 
-ModelArg = typer.Argument(..., help="Model file written by identify --out (.json).", show_default=False)
+ModelArg = typer.Argument(..., help="Model file written by "
+                                    "identify --out (.json).", show_default=False)
 
 
 def _model_and_data(model_path: Path, data: Path, fs, time, fill, outputs: bool):
@@ -25,13 +26,15 @@ def _model_and_data(model_path: Path, data: Path, fs, time, fill, outputs: bool)
     from ..io import load
 
     # an MCAP log is read by the model's channel names (the /topic:field specs it was fitted on)
-    tr = load_data(data, cols, fs, time, fill) if is_mcap(data) else load(data, fs=fs, time=time, fill=fill)
+    tr = (load_data(data, cols, fs, time, fill) if is_mcap(data) else load(data, fs=fs, time=time,
+                                                                           fill=fill))
     missing = [c for c in cols if c not in tr.names]
     if missing:
         from ..errors import DataError
 
         kind = "input" if any(c in model.inputs for c in missing) else "output"
-        raise DataError(f"data {str(data)!r}: the model's {kind} column(s) {', '.join(map(repr, missing))} are "
+        raise DataError(f"data {str(data)!r}: the model's {kind} column(s) "
+                        f"{', '.join(map(repr, missing))} are "
                         f"missing; the file has {', '.join(map(repr, tr.names))}",
                         hint="rename the columns to the model's names or pick another record")
     return model, tr.select(*cols)
@@ -39,7 +42,8 @@ def _model_and_data(model_path: Path, data: Path, fs, time, fill, outputs: bool)
 
 @app.command()
 def compare(model: Path = ModelArg,
-            data: Path = typer.Argument(..., help="Data file with the model's input and output columns.",
+            data: Path = typer.Argument(..., help="Data file with the model's input and "
+                                                  "output columns.",
                                         show_default=False),
             fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, json_out: bool = JsonOpt):
     """Free-run fit (%) of a saved model per output, by the model's fit definition."""
@@ -52,7 +56,8 @@ def compare(model: Path = ModelArg,
     fit = fitted.fit_percent
     data_hash = getattr(m, "data_hash", None)
     same = data_hash is not None and data_hash == file_sha256(data)
-    res = {"model": str(model), "data": str(data), "structure": m.structure, "outputs": list(m.outputs),
+    res = {"model": str(model), "data": str(data), "structure": m.structure,
+           "outputs": list(m.outputs),
            "fit_percent": fit, "definition": fitted.definition, "estimation_data": same,
            "warnings": report_warnings(caught)}
     if hasattr(m, "initial_state"):  # the linear families and NARX say how the run starts
@@ -66,7 +71,8 @@ def compare(model: Path = ModelArg,
         typer.echo(f"  {n}: " + ("diverged" if f is None else f"{f:.2f} %"))
 
 
-def simulate_model_file(model: Path, data: Path | None, out: Path | None, fs, time, fill, json_out: bool) -> None:
+def simulate_model_file(model: Path, data: Path | None, out: Path | None, fs, time, fill,
+                        json_out: bool) -> None:
     """``gripkit simulate MODEL.json --data DATA``: the model's outputs for DATA's input columns
     (:func:`gripkit.sysid.simulated_trajectory`: by name, offsets applied, from rest); writes
     the time column and one column per output, each in the output's display unit (the unit the
@@ -101,7 +107,8 @@ def simulate_model_file(model: Path, data: Path | None, out: Path | None, fs, ti
                 "max": float(finite.max()) if finite.size else None,
                 "final": float(y[-1]) if np.isfinite(y[-1]) else None}
 
-    res = {"model": str(model), "data": str(data), "samples": sim.n, "out": None if out is None else str(out),
+    res = {"model": str(model), "data": str(data), "samples": sim.n,
+           "out": None if out is None else str(out),
            "outputs": {n: {"unit": sim.display_unit(n), "si_unit": sim.unit(n),
                            **extremes(ys[:, i])} for i, n in enumerate(m.outputs)},
            "warnings": report_warnings(caught)}

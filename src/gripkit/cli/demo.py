@@ -11,9 +11,12 @@ from .common import emit_json
 
 
 @app.command()
-def demo(out: Path = typer.Option(Path("report"), "--out", help="Folder for index.html and figures."),
-         section: list[str] = typer.Option(None, "--section", help="Run only these sections (repeatable)."),
-         quick: bool = typer.Option(False, "--quick", help="Shorter records and fewer repetitions."),
+def demo(out: Path = typer.Option(Path("report"), "--out",
+                                  help="Folder for index.html and figures."),
+         section: list[str] = typer.Option(None, "--section",
+                                           help="Run only these sections (repeatable)."),
+         quick: bool = typer.Option(False, "--quick", help="Shorter records and "
+                                                           "fewer repetitions."),
          json_out: bool = typer.Option(False, "--json", help="Print the summary as JSON.")):
     """Run the demo study and write OUT/index.html."""
     from ..demos import run_demo

@@ -33,8 +33,10 @@ def excitation_fourier(
     fs: float = typer.Option(100.0, "--fs", help="Sampling rate of the written trajectory, Hz."),
     periods: int = typer.Option(1, "--periods", help="Number of periods written."),
     velocity_limit: float = typer.Option(None, "--velocity-limit",
-                                         help="|q̇| limit for every joint (default: URDF, else 2)."),
-    acceleration_limit: float = typer.Option(None, "--acceleration-limit", help="|q̈| limit for every joint (default 10)."),
+                                         help="|q̇| limit for every joint "
+                                              "(default: URDF, else 2)."),
+    acceleration_limit: float = typer.Option(None, "--acceleration-limit",
+                                             help="|q̈| limit for every joint (default 10)."),
     base_link: str = typer.Option(None, "--base-link", help="Base link of the chain."),
     tip_link: str = typer.Option(None, "--tip-link", help="Tip link of the chain."),
     restarts: int = typer.Option(0, "--restarts", min=0,
@@ -67,8 +69,10 @@ def excitation_fourier(
     if json_out:
         emit_json(d)
         return
-    typer.echo(f"wrote {out}: {tr.t.size} samples at {fs:g} Hz of joints {', '.join(tr.joint_names)}; "
-               f"regressor condition number {tr.condition_number:.3g} (start {tr.initial_condition_number:.3g})")
+    typer.echo(f"wrote {out}: {tr.t.size} samples at {fs:g} Hz of joints "
+               f"{', '.join(tr.joint_names)}; "
+               f"regressor condition number {tr.condition_number:.3g} (start "
+               f"{tr.initial_condition_number:.3g})")
 
 
 def _save_with_units(tr, chain, out: Path) -> None:

@@ -65,7 +65,8 @@ def export_c(model: Path = typer.Argument(None, show_default=False,
 
         if float32 or dt is not None:
             raise ArgumentError("--float32 and --dt apply to model files, not to --kind or --rls")
-        res = export_command(model, out, name, kind=None if kind == "model" else kind, rls=rls, na=na, nb=nb, nk=nk, lam=lam,
+        res = export_command(model, out, name, kind=None if kind == "model" else kind, rls=rls,
+                             na=na, nb=nb, nk=nk, lam=lam,
                              p0=p0, windup=windup)
         if json_out:
             emit_json(res)

@@ -4,7 +4,8 @@ friction of a URDF chain from a log (:func:`gripkit.sysid.identify_dynamics`).
 
 COLS are comma-separated column names, one per actuated joint in the chain's order (``gripkit``
 prints the order in the error when the count is wrong). The signal chain is IDIM-LS's
-(:func:`gripkit.sysid.rigid_body.friction.idim_samples`, the one ``identify friction`` uses for the EMPS and
+(:func:`gripkit.sysid.rigid_body.friction.idim_samples`, the one ``identify friction`` uses for the
+EMPS and
 DLR/HIT logs): the same zero-phase Butterworth filter on positions (or measured velocities) and
 efforts, central differences, the filter's edges cut, decimation; the rows of a joint within the
 guard band of its velocity reversals or slower than 2 % of its peak speed are left out
@@ -36,8 +37,10 @@ def _columns(option: str, text: str | None, joints) -> list[str] | None:
         return None
     cols = [c.strip() for c in text.split(",") if c.strip()]
     if len(cols) != len(joints):
-        raise ConfigError(f"{option}: {len(cols)} column(s) {cols} for the {len(joints)} actuated joints "
-                          f"{', '.join(joints)}", hint="give one column per joint, comma-separated, in that order")
+        raise ConfigError(f"{option}: {len(cols)} column(s) {cols} for the {len(joints)} "
+                          "actuated joints "
+                          f"{', '.join(joints)}", hint="give one column per joint, "
+                                                       "comma-separated, in that order")
     return cols
 
 
@@ -78,16 +81,20 @@ def _print_tables(res, chain, data: Path, notes) -> None:
 
     con = Console()
     t = Table("base parameter (combination of standard parameters)", "value", "std",
-              title=f"{chain.name} from {data.name}: {res.n_samples} samples, {res.n_base} base parameters "
-                    f"(of {len(res.structure.standard_names)}), relative error {res.relative_error_percent:.2f} %")
+              title=f"{chain.name} from {data.name}: {res.n_samples} samples, {res.n_base} "
+                    "base parameters "
+                    f"(of {len(res.structure.standard_names)}), relative error "
+                    f"{res.relative_error_percent:.2f} %")
     for name, v in res.base_parameters.items():
         t.add_row(name, f"{v:.6g}", f"{res.base_parameters_std[name]:.2g}")
     con.print(t)
     if res.friction:
         kinds = [k for k in next(iter(res.friction.values())) if not k.endswith("_std")]
-        ft = Table("joint", *kinds, "residual std", title="friction (N·m, N·m·s/rad; N, N·s/m for prismatic joints)")
+        ft = Table("joint", *kinds, "residual std", title="friction (N·m, N·m·s/rad; N, N·s/m for "
+                                                          "prismatic joints)")
         for j, f in res.friction.items():
-            ft.add_row(j, *(f"{f[k]:.4g} ± {f[k + '_std']:.2g}" for k in kinds), f"{res.residual_std[j]:.3g}")
+            ft.add_row(j, *(f"{f[k]:.4g} ± {f[k + '_std']:.2g}" for k in kinds),
+                       f"{res.residual_std[j]:.3g}")
         con.print(ft)
     if res.consistency is not None and res.consistency.consistent:
         typer.echo(res.consistency.message(), err=True)
@@ -99,21 +106,32 @@ def _print_tables(res, chain, data: Path, notes) -> None:
 def identify_dynamics_cmd(
     urdf: Path = typer.Argument(..., help="URDF file of the chain."),
     data: Path = typer.Argument(..., help="CSV/Parquet/HDF5 log with joint positions and efforts."),
-    position: str = typer.Option(..., "--position", help="Position columns, one per actuated joint (comma-separated)."),
-    effort: str = typer.Option(..., "--effort", help="Effort columns (N·m or N), one per actuated joint."),
-    velocity: str = typer.Option(None, "--velocity", help="Measured velocity columns (default: differentiate the positions)."),
+    position: str = typer.Option(..., "--position", help="Position columns, one per actuated joint "
+                                                         "(comma-separated)."),
+    effort: str = typer.Option(..., "--effort", help="Effort columns (N·m or N), one per "
+                                                     "actuated joint."),
+    velocity: str = typer.Option(None, "--velocity", help="Measured velocity columns (default: "
+                                                          "differentiate the positions)."),
     fs: float = FsOpt,
     json_out: bool = JsonOpt,
     friction: str = typer.Option("coulomb-viscous", "--friction",
                                  help="coulomb-viscous, coulomb-viscous-offset or none."),
-    armature: bool = typer.Option(False, "--armature", help="Also identify a rotor inertia per joint."),
-    constrained: bool = typer.Option(False, "--constrained", help="Report the nearest physically consistent estimate."),
-    base_link: str = typer.Option(None, "--base-link", help="Base link of the chain (default: the URDF's root)."),
-    tip_link: str = typer.Option(None, "--tip-link", help="Tip link of the chain (default: its end)."),
-    gravity: str = typer.Option("0,0,-9.81", "--gravity", help="Gravity in the base link frame, m/s² (gx,gy,gz)."),
-    effort_scale: float = typer.Option(1.0, "--effort-scale", help="K: effort = K × column (e.g. k_t·N for a current)."),
-    cutoff: float = typer.Option(None, "--cutoff", help="Low-pass cutoff in Hz (default fs/50; 5-10x the motion bandwidth)."),
-    decimate: int = typer.Option(None, "--decimate", help="Keep every q-th filtered sample (default from the cutoff)."),
+    armature: bool = typer.Option(False, "--armature", help="Also identify a rotor "
+                                                            "inertia per joint."),
+    constrained: bool = typer.Option(False, "--constrained", help="Report the nearest physically "
+                                                                  "consistent estimate."),
+    base_link: str = typer.Option(None, "--base-link", help="Base link of the chain (default: "
+                                                            "the URDF's root)."),
+    tip_link: str = typer.Option(None, "--tip-link", help="Tip link of the chain "
+                                                          "(default: its end)."),
+    gravity: str = typer.Option("0,0,-9.81", "--gravity", help="Gravity in the base link frame, "
+                                                               "m/s² (gx,gy,gz)."),
+    effort_scale: float = typer.Option(1.0, "--effort-scale", help="K: effort = K × column (e.g. "
+                                                                   "k_t·N for a current)."),
+    cutoff: float = typer.Option(None, "--cutoff", help="Low-pass cutoff in Hz (default fs/50; "
+                                                        "5-10x the motion bandwidth)."),
+    decimate: int = typer.Option(None, "--decimate", help="Keep every q-th filtered sample "
+                                                          "(default from the cutoff)."),
     time: str = TimeOpt,
     fill: str = FillOpt,
     out: Path = ModelOutOpt,
@@ -130,8 +148,10 @@ def identify_dynamics_cmd(
     output_json(out, "--out")
     output_folder(report, "--report")
     if not (np.isfinite(effort_scale) and effort_scale != 0):
-        raise DataError(f"--effort-scale: expected a finite non-zero factor, found {effort_scale!r}")
-    chain = from_urdf(urdf, base_link=base_link, tip_link=tip_link, gravity=_vector("--gravity", gravity))
+        raise DataError("--effort-scale: expected a finite non-zero factor, found "
+                        f"{effort_scale!r}")
+    chain = (from_urdf(urdf, base_link=base_link, tip_link=tip_link,
+                       gravity=_vector("--gravity", gravity)))
     joints = chain.joint_names
     pcols = _columns("--position", position, joints)
     ecols = _columns("--effort", effort, joints)

@@ -3,7 +3,8 @@
 
 Model: effort = K·column = J·q̈ + F_v·q̇ + F_c·sign(q̇) + τ₀, with q̇, q̈ from the zero-phase
 Butterworth-filtered position, the effort filtered alike, decimated (see
-:func:`gripkit.sysid.rigid_body.friction.idim_ls`). The JSON holds ``params`` and ``std`` (``inertia``,
+:func:`gripkit.sysid.rigid_body.friction.idim_ls`). The JSON holds ``params`` and ``std``
+(``inertia``,
 ``viscous``, ``coulomb``, ``offset``, in the SI units of the data) and
 ``relative_error_percent`` of the fitted effort.
 """
@@ -40,15 +41,21 @@ def friction_units(position: str, effort: str, scale: float = 1.0) -> dict[str, 
 @identify_app.command("friction")
 def identify_friction(
     data: Path = typer.Argument(..., help="CSV/Parquet/HDF5 log with position and effort columns."),
-    position: str = typer.Option(..., "--position", help="Position column (rad or m after unit conversion)."),
-    effort: str = typer.Option(..., "--effort", help="Effort column (torque, force, current, PWM ...)."),
-    effort_scale: float = typer.Option(1.0, "--effort-scale", help="K: effort = K × column (e.g. k_t·N for a current)."),
+    position: str = typer.Option(..., "--position", help="Position column (rad or m after "
+                                                         "unit conversion)."),
+    effort: str = typer.Option(..., "--effort", help="Effort column (torque, force, "
+                                                     "current, PWM ...)."),
+    effort_scale: float = typer.Option(1.0, "--effort-scale", help="K: effort = K × column (e.g. "
+                                                                   "k_t·N for a current)."),
     fs: float = FsOpt,
     json_out: bool = JsonOpt,
-    cutoff: float = typer.Option(None, "--cutoff", help="Low-pass cutoff in Hz (default fs/50; 5-10x the motion bandwidth)."),
-    decimate: int = typer.Option(None, "--decimate", help="Keep every q-th filtered sample (default from the cutoff)."),
+    cutoff: float = typer.Option(None, "--cutoff", help="Low-pass cutoff in Hz (default fs/50; "
+                                                        "5-10x the motion bandwidth)."),
+    decimate: int = typer.Option(None, "--decimate", help="Keep every q-th filtered sample "
+                                                          "(default from the cutoff)."),
     velocity_threshold: float = typer.Option(None, "--velocity-threshold",
-                                             help="Drop samples slower than this (default 2 % of the peak speed)."),
+                                             help="Drop samples slower than this (default 2 % of "
+                                                  "the peak speed)."),
     time: str = TimeOpt,
     fill: str = FillOpt,
 ):
@@ -70,7 +77,8 @@ def identify_friction(
         res = idim_ls(tr[position], tr[effort], dt=dt, effort_scale=effort_scale, cutoff=cutoff,
                       decimation=decimate, velocity_threshold=velocity_threshold)
     units = friction_units(tr.unit(position), tr.unit(effort), effort_scale)
-    out = {"params": res.params, "std": res.std, "relative_error_percent": res.relative_error_percent,
+    out = {"params": res.params, "std": res.std,
+           "relative_error_percent": res.relative_error_percent,
            "units": units, "n_samples": res.n_samples, "fs": 1.0 / res.dt, "cutoff_hz": res.cutoff,
            "decimation": res.decimation, "condition_number": res.condition_number,
            "notes": res.notes, "warnings": report_warnings(caught)}

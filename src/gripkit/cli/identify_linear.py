@@ -5,7 +5,8 @@ operating point (``--detrend mean`` by default), and prints a summary table, or 
 (a list for ``search``) with ``--json``. ``identify arx`` also takes several columns
 (``--input a,b --output c,d``): a matrix-polynomial ARX whose fit figures (``fit_percent``,
 ``one_step_fit_percent``, ``validation.fit_percent``) are lists per output in ``--output`` order;
-with one input and one output its JSON is the SISO one (``validation.fit_percent`` a number). Warnings (an unstable model in validation, a
+with one input and one output its JSON is the SISO one (``validation.fit_percent`` a number).
+Warnings (an unstable model in validation, a
 non-converged iteration) go to stderr as ``warning: ...`` lines and into the JSON ``warnings``.
 ``identify arx|armax|oe DATA1 DATA2 ...`` fit one model of several records (each with its own
 initial conditions, one operating point): ``data`` is then the list of files and ``records`` each
@@ -20,7 +21,8 @@ import typer
 
 from .app import identify_app
 from ..errors import emit_warning
-from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_choice, check_data_options, check_number,
+from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_choice, check_data_options,
+                     check_number,
                      collected_warnings, emit_json, report_warnings)
 from .identify_common import (ModelOutOpt, ReportOpt, ValidateOpt, check_outputs, data_field,
                               records_field, run_identify, save_and_report, validation)
@@ -36,8 +38,10 @@ DetrendOpt = typer.Option("mean", "--detrend",
 NaOpt = typer.Option(..., "--na", help="Number of A coefficients (after the leading 1).")
 NbOpt = typer.Option(..., "--nb", help="Number of B coefficients.")
 NkOpt = typer.Option(..., "--nk", help="Input delay in samples (B's leading zeros).")
-InputsOpt = typer.Option(..., "--input", help="Input column, or several comma-separated (a,b: MIMO ARX).")
-OutputsOpt = typer.Option(..., "--output", help="Output column, or several comma-separated (c,d: MIMO ARX).")
+InputsOpt = typer.Option(..., "--input", help="Input column, or several comma-separated "
+                                              "(a,b: MIMO ARX).")
+OutputsOpt = typer.Option(..., "--output", help="Output column, or several comma-separated "
+                                                "(c,d: MIMO ARX).")
 
 
 DETREND_CHOICES = ("mean", "linear", "none")
@@ -111,8 +115,10 @@ def _print_model(model, val, vfit: float | None = None) -> None:
     from rich.table import Table
 
     con = Console()
-    t = Table("parameter", "value", "σ", title=f"{model.label}  ({model.input_name} → {model.output_name}, "
-                                               f"fs = {1.0 / model.dt:g} Hz, N = {model.n_samples})")
+    t = Table("parameter", "value", "σ", title=f"{model.label}  ({model.input_name} → "
+                                               f"{model.output_name}, "
+                                               f"fs = {1.0 / model.dt:g} Hz, N = "
+                                               f"{model.n_samples})")
     std = model.theta_std
     for i, (n, v) in enumerate(zip(model.parameter_names, model.theta)):
         t.add_row(n, f"{v:.6g}", "—" if std is None else f"{std[i]:.3g}")
@@ -121,12 +127,14 @@ def _print_model(model, val, vfit: float | None = None) -> None:
               f"AIC = {model.aic:.6g}   FPE = {model.fpe:.6g}")
     fmt = lambda z: ", ".join(f"{v.real:.4g}{v.imag:+.4g}j" for v in z) or "none"  # noqa: E731
     con.print(f"poles: {fmt(model.poles())}   ({'stable' if model.stable else 'UNSTABLE'})")
-    con.print(f"zeros: {fmt(model.zeros())}   ({'minimum' if model.minimum_phase else 'NON-minimum'} phase)")
+    con.print(f"zeros: {fmt(model.zeros())}   "
+              f"({'minimum' if model.minimum_phase else 'NON-minimum'} phase)")
     if val is not None:
         fit = "— (unstable model)" if vfit is None else f"{vfit:.2f} %"
         tt = val.tests
         if tt is None:
-            con.print(f"validation: free-run fit {fit}; the one-step predictor diverges (unstable model)")
+            con.print(f"validation: free-run fit {fit}; the one-step predictor diverges "
+                      "(unstable model)")
             return
         con.print(f"validation: free-run fit {fit}, 1-step fit {val.prediction_fit_percent:.2f} %, "
                   f"residuals {'white' if tt.white else 'NOT white'} (p = {tt.whiteness_p:.3g}), "
@@ -144,7 +152,8 @@ def _mimo_arx(data: list[Path], input: str, output: str, na: int, nb: int, nk: i
     from ..errors import DataError, StabilityWarning
 
     if detrend == "linear":
-        raise DataError("--detrend: 'linear' is for one input and one output; with several columns expected "
+        raise DataError("--detrend: 'linear' is for one input and one output; with several "
+                        "columns expected "
                         "mean or none", hint="use --detrend mean, or detrend the columns before")
     check_outputs(out_file, report)
     with collected_warnings() as caught:
@@ -161,7 +170,8 @@ def _mimo_arx(data: list[Path], input: str, output: str, na: int, nb: int, nk: i
         if "records" in info:
             res["records"] = records_field(data, info["records"])
         if not model.stable:
-            emit_warning("arx: the identified model is unstable (a pole on or outside the unit circle): "
+            emit_warning("arx: the identified model is unstable (a pole on or outside "
+                         "the unit circle): "
                          "no free-run fit is reported", StabilityWarning)
         val = validation(model, vtr, validate)
         if val is not None:
@@ -171,13 +181,16 @@ def _mimo_arx(data: list[Path], input: str, output: str, na: int, nb: int, nk: i
     if json_out:
         emit_json(res)
         return
-    typer.echo(f"ARX [{na} {nb} {nk}]: {len(model.inputs)} input(s) {list(model.inputs)} → {len(model.outputs)} "
+    typer.echo(f"ARX [{na} {nb} {nk}]: {len(model.inputs)} input(s) {list(model.inputs)} → "
+               f"{len(model.outputs)} "
                f"output(s) {list(model.outputs)}, dt = {model.dt:g} s, N = {model.n_samples}, "
                f"{'stable' if model.stable else 'UNSTABLE'}")
-    for what, polys, stds in (("A", res["A_poly"], res["A_poly_std"]), ("B", res["B_poly"], res["B_poly_std"])):
+    for what, polys, stds in (("A", res["A_poly"], res["A_poly_std"]),
+                              ("B", res["B_poly"], res["B_poly_std"])):
         first = 1 if what == "A" else nk
         for i, (c, sd) in enumerate(zip(polys, stds)):
-            rows = "; ".join(" ".join(f"{v:.4g}±{s:.2g}" for v, s in zip(r, rs)) for r, rs in zip(c, sd))
+            rows = ("; ".join(" ".join(f"{v:.4g}±{s:.2g}" for v, s in zip(r, rs))
+                              for r, rs in zip(c, sd)))
             typer.echo(f"  {what}{first + i} = [{rows}]")
     for i, name in enumerate(model.outputs):
         free = "—" if res["fit_percent"] is None else f"{res['fit_percent'][i]:.2f} %"
@@ -210,10 +223,12 @@ def _echo_records(records: list[dict] | None, free_run: bool = False) -> None:
 @identify_app.command("arx")
 def identify_arx(data: list[Path] = DataArgs, input: str = InputsOpt, output: str = OutputsOpt,
                  na: int = NaOpt, nb: int = NbOpt, nk: int = NkOpt,
-                 fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
+                 fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
+                 detrend: str = DetrendOpt,
                  validate: Path = ValidateOpt, json_out: bool = JsonOpt, out: Path = ModelOutOpt,
                  report: Path = ReportOpt):
-    """ARX (orders na, nb, nk) by least squares (QR), with σ, loss (eq 29), fit, AIC, poles and zeros.
+    """ARX (orders na, nb, nk) by least squares (QR), with σ, loss (eq 29), fit, AIC, poles and
+    zeros.
     With several columns (``--input a,b --output c,d``) a matrix-polynomial ARX: fit figures are
     lists per output, in ``--output`` order. With several DATA files one model of all the records
     (each with its own initial conditions; --detrend mean removes the mean of all of them)."""
@@ -234,7 +249,8 @@ def identify_armax(data: list[Path] = DataArgs, input: str = InputOpt, output: s
                    nb: int = NbOpt,
                    nc: int = typer.Option(..., "--nc", help="Number of C coefficients."),
                    nk: int = NkOpt,
-                   fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
+                   fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
+                   detrend: str = DetrendOpt,
                    validate: Path = ValidateOpt, json_out: bool = JsonOpt, out: Path = ModelOutOpt,
                    report: Path = ReportOpt):
     """ARMAX (orders na, nb, nc, nk) by prediction-error minimisation. With several DATA files one
@@ -247,9 +263,11 @@ def identify_armax(data: list[Path] = DataArgs, input: str = InputOpt, output: s
 @identify_app.command("oe")
 def identify_oe(data: list[Path] = DataArgs, input: str = InputOpt, output: str = OutputOpt,
                 nb: int = NbOpt,
-                nf: int = typer.Option(..., "--nf", "--na", help="Number of F (denominator) coefficients."),
+                nf: int = typer.Option(..., "--nf", "--na",
+                                       help="Number of F (denominator) coefficients."),
                 nk: int = NkOpt,
-                fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
+                fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
+                detrend: str = DetrendOpt,
                 validate: Path = ValidateOpt, json_out: bool = JsonOpt, out: Path = ModelOutOpt,
                 report: Path = ReportOpt):
     """Output-error (orders nb, nf, nk) by prediction-error minimisation. With several DATA files
@@ -262,12 +280,16 @@ def identify_oe(data: list[Path] = DataArgs, input: str = InputOpt, output: str 
 @identify_app.command("rls")
 def identify_rls(data: Path = DataArg, input: str = InputOpt, output: str = OutputOpt,
                  na: int = NaOpt, nb: int = NbOpt, nk: int = NkOpt,
-                 forgetting: float = typer.Option(1.0, "--forgetting", help="Forgetting factor λ in (0, 1]."),
+                 forgetting: float = typer.Option(1.0, "--forgetting",
+                                                  help="Forgetting factor λ in (0, 1]."),
                  p0: float = typer.Option(1e4, "--p0", help="Initial covariance P0 = p0·I."),
-                 windup: str = typer.Option("trace", "--windup", help="Anti-windup: trace, directional or none."),
+                 windup: str = typer.Option("trace", "--windup", help="Anti-windup: trace, "
+                                                                      "directional or none."),
                  trajectory: Path = typer.Option(None, "--trajectory",
-                                                 help="Write θ(t), σ(t), prediction and error to this file."),
-                 fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
+                                                 help="Write θ(t), σ(t), prediction and "
+                                                      "error to this file."),
+                 fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
+                 detrend: str = DetrendOpt,
                  json_out: bool = JsonOpt):
     """Recursive least squares ARX (orders na, nb, nk) with forgetting; θ and σ at every sample.
     No --out, --report or --validate: the result is a parameter trajectory θ(t), not one model
@@ -278,7 +300,8 @@ def identify_rls(data: Path = DataArg, input: str = InputOpt, output: str = Outp
     from .paths import output_file
 
     _check_options(fs, fill, detrend)
-    RLS(na, nb, nk, forgetting=forgetting, p0=p0, windup=windup)  # checks the orders and the options
+    # checks the orders and the options
+    RLS(na, nb, nk, forgetting=forgetting, p0=p0, windup=windup)
     output_file(trajectory, "--trajectory")
     with collected_warnings() as caught:
         res = run_identify([data], "rls", input, output, fs=fs, time=time, fill=fill,
@@ -288,14 +311,16 @@ def identify_rls(data: Path = DataArg, input: str = InputOpt, output: str = Outp
             save(res.to_trajectory(), trajectory)
     out = res.to_dict()
     out.update(data=str(data), detrend=detrend, input=input, output=output,
-               trajectory=None if trajectory is None else str(trajectory), warnings=report_warnings(caught))
+               trajectory=None if trajectory is None else str(trajectory),
+               warnings=report_warnings(caught))
     if json_out:
         emit_json(out)
         return
     from rich.console import Console
     from rich.table import Table
 
-    t = Table("parameter", "final value", "σ", title=f"RLS ARX [{na} {nb} {nk}], λ = {forgetting:g}, "
+    t = Table("parameter", "final value", "σ", title=f"RLS ARX [{na} {nb} {nk}], λ = "
+                                                     f"{forgetting:g}, "
                                                       f"N = {res.n_samples}")
     std = res.theta_std_final
     for i, n in enumerate(res.names):
@@ -312,9 +337,12 @@ def identify_search(data: Path = DataArg, input: str = InputOpt, output: str = O
                     na: str = typer.Option("1:4", "--na", help="Range of na, e.g. 1:4."),
                     nb: str = typer.Option("1:4", "--nb", help="Range of nb, e.g. 1:4."),
                     nk: str = typer.Option("1:10", "--nk", help="Range of nk, e.g. 1:10."),
-                    criterion: str = typer.Option("aic", "--criterion", help="Ranking: aic, fpe or loss."),
-                    top: int = typer.Option(10, "--top", help="Rows shown in the table (JSON lists all)."),
-                    fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
+                    criterion: str = typer.Option("aic", "--criterion",
+                                                  help="Ranking: aic, fpe or loss."),
+                    top: int = typer.Option(10, "--top", help="Rows shown in the table "
+                                                              "(JSON lists all)."),
+                    fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
+                    detrend: str = DetrendOpt,
                     validate: Path = ValidateOpt, json_out: bool = JsonOpt, out: Path = ModelOutOpt,
                     report: Path = ReportOpt):
     """Fit every ARX structure of the ranges and rank them (best first; by free-run fit on
@@ -347,12 +375,15 @@ def identify_search(data: Path = DataArg, input: str = InputOpt, output: str = O
     from rich.console import Console
     from rich.table import Table
 
-    t = Table("rank", "na", "nb", "nk", "loss V_N", "AIC", "FPE", "1-step fit %", "validation fit %",
+    t = Table("rank", "na", "nb", "nk", "loss V_N", "AIC", "FPE", "1-step fit %",
+              "validation fit %",
               title=f"ARX structures ranked by {criterion.upper()} ({res.n_used} common samples)")
     for i, c in enumerate(res.candidates[:top], 1):
         v = c.validation_fit_percent
-        t.add_row(str(i), str(c.na), str(c.nb), str(c.nk), f"{c.loss:.5g}", f"{c.aic:.6g}", f"{c.fpe:.5g}",
+        t.add_row(str(i), str(c.na), str(c.nb), str(c.nk), f"{c.loss:.5g}", f"{c.aic:.6g}",
+                  f"{c.fpe:.5g}",
                   f"{c.fit_percent:.2f}", "—" if v is None else f"{v:.2f}")
     Console().print(t)
     if res.skipped:
-        typer.echo(f"{len(res.skipped)} structure(s) skipped (not identifiable from these data)", err=True)
+        typer.echo(f"{len(res.skipped)} structure(s) skipped (not identifiable "
+                   "from these data)", err=True)

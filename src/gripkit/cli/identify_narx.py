@@ -1,6 +1,7 @@
 """``gripkit identify narx DATA --input U --output Y [--degree D] [--lags L | --ylags LY --ulags LU]
 [--terms N|auto] [--refine none|simulation] [--validate DATA2] [--out MODEL.json] [--json]``:
-polynomial NARX by forward regression with the error reduction ratio (:func:`gripkit.sysid.narx`)."""
+polynomial NARX by forward regression with the error reduction ratio
+(:func:`gripkit.sysid.narx`)."""
 
 from __future__ import annotations
 

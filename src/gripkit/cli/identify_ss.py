@@ -30,7 +30,8 @@ DataArgs = typer.Argument(..., help="Data file(s) (.csv, .parquet, .h5); several
                           metavar="DATA", show_default=False)
 InputsOpt = typer.Option(..., "--input", help="Input column(s), comma-separated (e.g. a,b).")
 OutputsOpt = typer.Option(..., "--output", help="Output column(s), comma-separated (e.g. c,d).")
-DetrendOpt = typer.Option("mean", "--detrend", help="Operating-point removal before fitting: mean or none.")
+DetrendOpt = typer.Option("mean", "--detrend", help="Operating-point removal before "
+                                                    "fitting: mean or none.")
 
 
 def _load(path: Path, inputs: str, outputs: str, fs, time, fill):
@@ -41,21 +42,32 @@ def _load(path: Path, inputs: str, outputs: str, fs, time, fill):
 
 @identify_app.command("ss")
 def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output: str = OutputsOpt,
-                    order: str = typer.Option(None, "--order", help="Order N, or a range LO:HI to search "
-                                                                     "(default: from the singular values)."),
-                    method: str = typer.Option("n4sid", "--method", help="Subspace weighting: n4sid, moesp or cva."),
-                    form: str = typer.Option("innovation", "--form", help="PEM refinement: oe or innovation."),
-                    no_refine: bool = typer.Option(False, "--no-refine", help="Keep the subspace model (no PEM)."),
-                    focus: str = typer.Option("simulation", "--focus", help="Criterion the returned model never "
-                                              "loses by (subspace start against PEM result): simulation "
-                                              "(free-run fit, default) or prediction (one-step fit)."),
-                    max_iterations: int = typer.Option(50, "--max-iterations", help="PEM iterations at most "
-                                                       "(a warning says when they did not converge)."),
+                    order: str = typer.Option(None, "--order", help="Order N, or a range "
+                                                                    "LO:HI to search "
+                                                                     "(default: from the "
+                                                                     "singular values)."),
+                    method: str = typer.Option("n4sid", "--method", help="Subspace weighting: "
+                                                                         "n4sid, moesp or cva."),
+                    form: str = typer.Option("innovation", "--form",
+                                             help="PEM refinement: oe or innovation."),
+                    no_refine: bool = typer.Option(False, "--no-refine", help="Keep the subspace "
+                                                                              "model (no PEM)."),
+                    focus: str = typer.Option("simulation", "--focus",
+                                              help="Criterion the returned model never "
+                                              "loses by (subspace start against PEM "
+                                              "result): simulation "
+                                              "(free-run fit, default) or prediction "
+                                              "(one-step fit)."),
+                    max_iterations: int = typer.Option(50, "--max-iterations",
+                                                       help="PEM iterations at most "
+                                                       "(a warning says when they "
+                                                       "did not converge)."),
                     validate: Path = typer.Option(None, "--validate",
                                                   help="Second record: free-run validation "
                                                        "(and order ranking for a range)."),
                     out: Path = ModelOutOpt, report: Path = ReportOpt,
-                    fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
+                    fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
+                    detrend: str = DetrendOpt,
                     json_out: bool = JsonOpt):
     """MIMO state space: subspace (N4SID/MOESP/CVA, order from the singular values), then PEM.
     Several DATA files: one model of all the records (subspace, then PEM), one initial state per
@@ -104,7 +116,8 @@ def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
         emit_json(res)
         return
     ss = model.system
-    typer.echo(f"{model.structure}: order {ss.n_states}, {ss.n_inputs} input(s) {list(ss.inputs)} → "
+    typer.echo(f"{model.structure}: order {ss.n_states}, {ss.n_inputs} input(s) "
+               f"{list(ss.inputs)} → "
                f"{ss.n_outputs} output(s) {list(ss.outputs)}, dt = {ss.dt:g} s, "
                f"{'stable' if model.stable else 'UNSTABLE'}")
     sv = model.singular_values
@@ -117,7 +130,8 @@ def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
                    + ", ".join(f"{v:.2f}" for v in r["fit_percent"]) + " % (its own initial state)")
     if "focus" in model.info:
         fo = model.info["focus"]
-        typer.echo(f"focus {fo['criterion']} ({fo['data']} data): subspace {fo['subspace_percent']:.2f} %, "
+        typer.echo(f"focus {fo['criterion']} ({fo['data']} data): subspace "
+                   f"{fo['subspace_percent']:.2f} %, "
                    f"PEM {fo['refined_percent']:.2f} %; kept the {fo['kept']} model")
     if search is not None:
         _echo_search(search, res["search_criterion"], focus)
@@ -158,25 +172,32 @@ def identify_frf_cmd(data: Path = DataArg, input: str = InputsOpt, output: str =
                                                  help="Number of periods of a periodic input "
                                                       "(averaging; the first is dropped)."),
                      keep_transient: bool = typer.Option(False, "--keep-transient",
-                                                         help="Keep the first period with --periods."),
-                     method: str = typer.Option("auto", "--method", help="auto, periodic, h1 or spa."),
-                     nperseg: int = typer.Option(None, "--nperseg", help="Samples per Welch segment (h1)."),
-                     fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
+                                                         help="Keep the first period "
+                                                              "with --periods."),
+                     method: str = typer.Option("auto", "--method",
+                                                help="auto, periodic, h1 or spa."),
+                     nperseg: int = typer.Option(None, "--nperseg",
+                                                 help="Samples per Welch segment (h1)."),
+                     fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
+                     detrend: str = DetrendOpt,
                      json_out: bool = JsonOpt):
-    """Frequency response with σ on every line (periodic averaging, Welch H1 with coherence, SPA)."""
+    """Frequency response with σ on every line (periodic averaging, Welch H1 with coherence,
+    SPA)."""
     from ..sysid.linear.identify_mimo import identify_frf
 
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         tr = _load(data, input, output, fs, time, fill)
-        r = identify_frf(tr, input=input, output=output, detrend=detrend, method=method, periods=periods,
+        r = identify_frf(tr, input=input, output=output, detrend=detrend, method=method,
+                         periods=periods,
                          keep_transient=keep_transient, nperseg=nperseg)
     res = r.to_dict()
     res.update(data=str(data), warnings=report_warnings(caught))
     if json_out:
         emit_json(res)
         return
-    typer.echo(f"FRF ({r.method}): {r.frequency_hz.size} lines, {list(r.inputs)} → {list(r.outputs)}")
+    typer.echo(f"FRF ({r.method}): {r.frequency_hz.size} lines, {list(r.inputs)} → "
+               f"{list(r.outputs)}")
     step = max(1, r.frequency_hz.size // 20)
     for k in range(0, r.frequency_hz.size, step):
         h, s = r.H[k, 0, 0], r.H_std[k, 0, 0]
@@ -190,7 +211,8 @@ def identify_tf_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
                     zeros: int = typer.Option(..., "--zeros", help="Number of zeros."),
                     out: Path = ModelOutOpt, report: Path = ReportOpt,
                     validate: Path = ValidateOpt,
-                    fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, detrend: str = DetrendOpt,
+                    fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
+                    detrend: str = DetrendOpt,
                     json_out: bool = JsonOpt):
     """Continuous-time transfer function (zero-order hold between samples) with σ. Several DATA
     files: one model of all the records, each from its own initial state."""
@@ -206,7 +228,8 @@ def identify_tf_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
     g, info = model.system, model.info
     res = {"num": g.numerator(), "den": g.denominator(), "num_std": info["num_std"][-(zeros + 1):],
            "den_std": info["den_std"], "natural_frequency_hz": info["natural_frequency_hz"],
-           "natural_frequency_hz_std": info["natural_frequency_hz_std"], "damping_ratio": info["damping_ratio"],
+           "natural_frequency_hz_std": info["natural_frequency_hz_std"],
+           "damping_ratio": info["damping_ratio"],
            "damping_ratio_std": info["damping_ratio_std"], "fit_percent": model.fit_percent,
            "poles": [[float(z.real), float(z.imag)] for z in g.poles()], "inputs": list(g.inputs),
            "outputs": list(g.outputs), "data": data_field(data),
@@ -221,10 +244,12 @@ def identify_tf_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
         emit_json(res)
         return
     fmt = lambda v, s: " ".join(f"{a:.6g}±{b:.2g}" for a, b in zip(v, s))  # noqa: E731
-    typer.echo(f"G(s) = num/den, {poles} pole(s), {zeros} zero(s); free-run fit {model.fit_percent[0]:.2f} %")
+    typer.echo(f"G(s) = num/den, {poles} pole(s), {zeros} zero(s); free-run fit "
+               f"{model.fit_percent[0]:.2f} %")
     typer.echo(f"  num: {fmt(res['num'], res['num_std'])}")
     typer.echo(f"  den: {fmt(res['den'], res['den_std'])}")
-    for f, sf, z, sz in zip(res["natural_frequency_hz"], res["natural_frequency_hz_std"], res["damping_ratio"],
+    for f, sf, z, sz in zip(res["natural_frequency_hz"], res["natural_frequency_hz_std"],
+                            res["damping_ratio"],
                             res["damping_ratio_std"]):
         typer.echo(f"  mode: f_n = {f:.6g} ± {sf:.2g} Hz, ζ = {z:.4g} ± {sz:.2g}")
     if val is not None:

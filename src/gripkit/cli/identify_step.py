@@ -13,13 +13,18 @@ from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, colle
 
 
 @identify_app.command("step")
-def identify_step(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 file with the step record."),
-                  input_col: str = typer.Option(..., "--input", help="Input column (the commanded step)."),
-                  output_col: str = typer.Option(..., "--output", help="Output column (the response)."),
+def identify_step(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 file with "
+                                                        "the step record."),
+                  input_col: str = typer.Option(..., "--input", help="Input column (the "
+                                                                     "commanded step)."),
+                  output_col: str = typer.Option(..., "--output",
+                                                 help="Output column (the response)."),
                   fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
                   method: str = typer.Option("lm", "--method",
-                                             help="Least squares: lm (Levenberg-Marquardt) or trf (trust-region "
-                                                  "reflective, keeps the parameters within their bounds)."),
+                                             help="Least squares: lm (Levenberg-Marquardt) or "
+                                                  "trf (trust-region "
+                                                  "reflective, keeps the parameters "
+                                                  "within their bounds)."),
                   json_out: bool = JsonOpt):
     """Fit K ω_n²/(s² + 2ζω_n s + ω_n²) to a step response (gain, natural frequency, damping, σ)."""
     from ..errors import DataError

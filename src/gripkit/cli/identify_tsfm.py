@@ -27,9 +27,11 @@ DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_defa
 
 @identify_app.command("modal")
 def identify_modal(data: Path = DataArg,
-                   signal: str = typer.Option(..., "--signal", help="Column holding the free vibration."),
+                   signal: str = typer.Option(..., "--signal", help="Column holding the "
+                                                                    "free vibration."),
                    fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
-                   start: float = typer.Option(None, "--start", help="Time (s) of the release (default: found)."),
+                   start: float = typer.Option(None, "--start", help="Time (s) of the release "
+                                                                     "(default: found)."),
                    json_out: bool = JsonOpt):
     """Natural frequency and damping ratio from a free vibration (FFT peak, half-power, log
     decrement, Hilbert envelope, damped-sine least squares)."""
@@ -47,7 +49,8 @@ def identify_modal(data: Path = DataArg,
         i0 = None if start is None else int(round((start - tr.t[0]) / dt))
         res = free_vibration(tr[signal], dt=dt, start=i0)
     out = res.to_dict()
-    out.update(data=str(data), signal=signal, unit=tr.unit(signal), warnings=report_warnings(caught))
+    out.update(data=str(data), signal=signal, unit=tr.unit(signal),
+               warnings=report_warnings(caught))
     if json_out:
         emit_json(out)
         return
@@ -57,12 +60,16 @@ def identify_modal(data: Path = DataArg,
 @identify_app.command("bouc-wen")
 def identify_bouc_wen_cmd(data: Path = DataArg,
                           input: str = typer.Option(..., "--input", help="Voltage column (V)."),
-                          output: str = typer.Option(..., "--output", help="Displacement column (m)."),
+                          output: str = typer.Option(..., "--output",
+                                                     help="Displacement column (m)."),
                           fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
                           delay: float = typer.Option(0.0, "--delay",
-                                                      help="Lag (s) of the displacement behind the static "
-                                                           "hysteresis: b of D(s) plus half a DAC sample."),
-                          burn_in: int = typer.Option(0, "--burn-in", help="Samples left out of the fit (a record "
+                                                      help="Lag (s) of the displacement "
+                                                           "behind the static "
+                                                           "hysteresis: b of D(s) plus "
+                                                           "half a DAC sample."),
+                          burn_in: int = typer.Option(0, "--burn-in", help="Samples left out of "
+                                                                           "the fit (a record "
                                                                           "starting mid-loop)."),
                           json_out: bool = JsonOpt):
     """Static Bouc-Wen parameters (eq 3) from a quasi-static voltage/displacement sweep."""
@@ -73,11 +80,14 @@ def identify_bouc_wen_cmd(data: Path = DataArg,
     check_number(burn_in, "--burn-in", minimum=0, integer=True)
     with collected_warnings() as caught:
         tr = load_data(data, [input, output], fs, time, fill)
-        res = identify_bouc_wen(tr, input=input, output=output, delay=delay, burn_in=burn_in, progress=not json_out)
+        res = (identify_bouc_wen(tr, input=input, output=output, delay=delay, burn_in=burn_in,
+                                 progress=not json_out))
     out = res.to_dict()
-    out.update(data=str(data), input=input, output=output, delay=delay, warnings=report_warnings(caught))
+    out.update(data=str(data), input=input, output=output, delay=delay,
+               warnings=report_warnings(caught))
     if json_out:
         emit_json(out)
         return
     typer.echo(res.summary())
-    typer.echo(f"  fit {res.fit.fit_percent[0]:.4g} % over {res.fit.n_samples} samples; {res.fit.identifiability}")
+    typer.echo(f"  fit {res.fit.fit_percent[0]:.4g} % over {res.fit.n_samples} samples; "
+               f"{res.fit.identifiability}")

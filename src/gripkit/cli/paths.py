@@ -15,14 +15,16 @@ _WRITABLE_FORMATS = ("csv", "parquet", "hdf5")
 
 def output_file(path: Path | None, option: str) -> Path | None:
     """``path`` if a data file can be written there (its folders may not exist yet) in a format
-    :func:`gripkit.io.save` writes (.csv, .parquet, .h5), else :class:`PathError` naming ``option``."""
+    :func:`gripkit.io.save` writes (.csv, .parquet, .h5), else :class:`PathError` naming
+    ``option``."""
     if path is None:
         return None
     path = _writable_file(Path(path), option, "result.parquet")
     from ..io import FORMATS
 
     if FORMATS.get(path.suffix.lower()) not in _WRITABLE_FORMATS:
-        raise PathError(f"{option} {str(path)!r}: cannot tell the format from the suffix {path.suffix!r}",
+        raise PathError(f"{option} {str(path)!r}: cannot tell the format from the suffix "
+                        f"{path.suffix!r}",
                         hint="use .csv, .parquet or .h5")
     return path
 
@@ -34,7 +36,8 @@ def output_json(path: Path | None, option: str) -> Path | None:
         return None
     path = _writable_file(Path(path), option, "model.json")
     if path.suffix.lower() != ".json":
-        raise PathError(f"{option} {str(path)!r}: expected a .json file, found the suffix {path.suffix!r}",
+        raise PathError(f"{option} {str(path)!r}: expected a .json file, found the suffix "
+                        f"{path.suffix!r}",
                         hint=f"use {str(path.with_suffix('.json'))!r}")
     return path
 
@@ -50,7 +53,8 @@ def output_folder(path: Path | None, option: str) -> Path | None:
                         hint="choose a folder (it is created if missing)")
     if path.is_dir():
         if not os.access(path, os.W_OK | os.X_OK):
-            raise PathError(f"{option} {str(path)!r}: permission denied (cannot write in this folder)",
+            raise PathError(f"{option} {str(path)!r}: permission denied (cannot write "
+                            "in this folder)",
                             hint="choose another folder")
         return path
     _check_folders(path, option)
@@ -79,6 +83,7 @@ def _check_folders(path: Path, option: str) -> None:
             raise PathError(f"{option} {str(path)!r}: {str(parent)!r} is not a folder",
                             hint="choose a path whose parent folders are folders")
         if not os.access(parent, os.W_OK | os.X_OK):
-            raise PathError(f"{option} {str(path)!r}: permission denied (cannot write in {str(parent)!r})",
+            raise PathError(f"{option} {str(path)!r}: permission denied (cannot write in "
+                            f"{str(parent)!r})",
                             hint="choose a path in a folder you may write to")
         return

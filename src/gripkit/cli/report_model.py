@@ -14,12 +14,15 @@ from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, report_warnings
 
 
 @app.command("report")
-def report_model(model: Path = typer.Argument(..., help="Model file written by identify --out (.json).",
+def report_model(model: Path = typer.Argument(..., help="Model file written by "
+                                                        "identify --out (.json).",
                                               show_default=False),
-                 data: Path = typer.Argument(..., help="Data file with the model's input and output columns.",
+                 data: Path = typer.Argument(..., help="Data file with the model's input and "
+                                                       "output columns.",
                                              show_default=False),
                  out: Path = typer.Option(..., "--out", help="Folder for index.html."),
-                 fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt, json_out: bool = JsonOpt):
+                 fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
+                 json_out: bool = JsonOpt):
     """HTML report: measured vs simulated per output, residual correlations, parameters with σ;
     for linear models also poles and Bode with σ."""
     from ..sysid.model_protocol import file_schema

@@ -14,11 +14,15 @@ from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, report_warnings
 
 
 @app.command()
-def simulate(model: Path = typer.Argument(..., help="Model description (.toml) or identified model (.json).",
+def simulate(model: Path = typer.Argument(..., help="Model description (.toml) or "
+                                                    "identified model (.json).",
                                           show_default=False),
-             out: Path = typer.Option(None, "--out", help="Write the trajectory here (.parquet, .csv, .h5); "
-                                                          "default: [output] file of the description."),
-             data: Path = typer.Option(None, "--data", help="Input data for a .json model (columns by name)."),
+             out: Path = typer.Option(None, "--out", help="Write the trajectory here "
+                                                          "(.parquet, .csv, .h5); "
+                                                          "default: [output] file of "
+                                                          "the description."),
+             data: Path = typer.Option(None, "--data", help="Input data for a .json model "
+                                                            "(columns by name)."),
              fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
              json_out: bool = JsonOpt):
     """Simulate a model described in a TOML file, or an identified model file on DATA's inputs."""
@@ -51,11 +55,14 @@ def simulate(model: Path = typer.Argument(..., help="Model description (.toml) o
     summary = {n: {"unit": tr.unit(n), "min": float(np.min(tr[n])), "max": float(np.max(tr[n])),
                    "final": float(tr[n][-1])} for n in tr.names}
     res = {"model": d.model.name, "description": str(model), "samples": tr.n, "fs": 1.0 / tr.dt,
-           "duration_s": tr.duration, "out": None if target is None else str(target), "channels": summary,
+           "duration_s": tr.duration, "out": None if target is None else str(target),
+           "channels": summary,
            "warnings": lines}
     if json_out:
         emit_json(res)
         return
-    typer.echo(f"{d.model.name}: {tr.n} samples at {1.0 / tr.dt:g} Hz" + (f", written to {target}" if target else ""))
+    typer.echo(f"{d.model.name}: {tr.n} samples at "
+               f"{1.0 / tr.dt:g} Hz" + (f", written to {target}" if target else ""))
     for n, s in summary.items():
-        typer.echo(f"  {n} [{s['unit']}]: min {s['min']:.6g}, max {s['max']:.6g}, final {s['final']:.6g}")
+        typer.echo(f"  {n} [{s['unit']}]: min {s['min']:.6g}, max {s['max']:.6g}, final "
+                   f"{s['final']:.6g}")

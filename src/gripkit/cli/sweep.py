@@ -19,17 +19,25 @@ EXIT_JOBS_FAILED = 3
 
 @app.command()
 def sweep(spec: Path = typer.Argument(..., help="Sweep specification (TOML)."),
-          scheduler: str = typer.Option(None, "--scheduler", help="Dask scheduler address (tcp://host:8786)."),
-          workers: int = typer.Option(None, "--workers", help="Local worker processes (default: one per core)."),
-          backend: str = typer.Option("auto", "--backend", help="auto | process | in-process | dask (auto: in-process when the work is below the pool start-up)"),
-          out: Path = typer.Option(None, "--out", help="Folder for checkpointed results (default: sweep-<name>)."),
-          resume: bool = typer.Option(False, "--resume", help="Continue an interrupted sweep in --out."),
+          scheduler: str = typer.Option(None, "--scheduler", help="Dask scheduler address "
+                                                                  "(tcp://host:8786)."),
+          workers: int = typer.Option(None, "--workers", help="Local worker processes "
+                                                              "(default: one per core)."),
+          backend: str = typer.Option("auto", "--backend", help="auto | process | in-process | "
+                                                                "dask (auto: in-process when the "
+                                                                "work is below the pool start-up)"),
+          out: Path = typer.Option(None, "--out", help="Folder for checkpointed results "
+                                                       "(default: sweep-<name>)."),
+          resume: bool = typer.Option(False, "--resume", help="Continue an interrupted "
+                                                              "sweep in --out."),
           allow_code: bool = typer.Option(
               False, "--allow-code",
-              help="Let the file name Python code to import (scenario/model = 'module:function'): the sweep "
+              help="Let the file name Python code to import (scenario/model = "
+                   "'module:function'): the sweep "
                    "file is then code; use only with files you trust."),
           memory_limit: str = typer.Option(
-              None, "--memory-limit", help="Memory the sweep may use, e.g. '8 GB' (default: half the available)."),
+              None, "--memory-limit", help="Memory the sweep may use, e.g. '8 GB' (default: half "
+                                           "the available)."),
           json_out: bool = JsonOpt):
     """Run the sweep SPEC (jobs chunked, results streamed to OUT/chunks/*.parquet)."""
     import warnings
@@ -48,7 +56,8 @@ def sweep(spec: Path = typer.Argument(..., help="Sweep specification (TOML)."),
     lines = report_warnings(caught)
     if json_out:
         emit_json({"name": s.name, "n_jobs": res.n_jobs, "n_failed": res.n_failed,
-                   "seconds": res.seconds, "backend": res.backend, "backend_choice": res.choice, "chunk_size": res.chunk_size,
+                   "seconds": res.seconds, "backend": res.backend, "backend_choice": res.choice,
+                   "chunk_size": res.chunk_size,
                    "out": str(out), "failures": res.failures[:20], "warnings": lines})
     else:
         typer.echo(res.summary())

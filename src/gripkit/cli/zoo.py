@@ -24,7 +24,8 @@ def zoo_list(json_out: bool = JsonOpt):
     """List the zoo models."""
     from .. import zoo
 
-    rows = [dict(name=e.name, system=e.system, description=e.description, seed=e.seed) for e in zoo.entries()]
+    rows = ([dict(name=e.name, system=e.system, description=e.description,
+                  seed=e.seed) for e in zoo.entries()])
     if json_out:
         emit_json({"models": rows})
         return
@@ -56,7 +57,8 @@ def zoo_show(name: str, json_out: bool = JsonOpt):
         return
     from rich.table import Table
 
-    t = Table("parameter", "value", "unit", "meaning", "source", title=f"{entry.name}: {entry.description}")
+    t = (Table("parameter", "value", "unit", "meaning", "source",
+               title=f"{entry.name}: {entry.description}"))
     for row in params.table():
         val = f"{row['value']:.6g}" + (f" ± {row['std']:.2g}" if row["std"] is not None else "")
         t.add_row(row["name"], val, row["unit"], row["doc"], row["source"])

@@ -15,12 +15,15 @@ from .common import JsonOpt, complex_pairs, emit_json
 
 @zoo_app.command("discretize")
 def zoo_discretize(name: str = typer.Argument(..., help="Zoo model name (gripkit zoo list)."),
-                   fs: float = typer.Option(..., "--fs", help="Sampling rate in Hz (the seed uses 20000)."),
+                   fs: float = typer.Option(..., "--fs", help="Sampling rate in Hz (the "
+                                                              "seed uses 20000)."),
                    form: str = typer.Option("canonical", "--form",
-                                            help="'canonical' (the seed's controllable form) or 'physical' "
+                                            help="'canonical' (the seed's controllable "
+                                                 "form) or 'physical' "
                                                  "(exact ZOH of the physical states)."),
                    json_out: bool = JsonOpt):
-    """Discretise a linear zoo model with a zero-order hold; prints A, B, C, D, poles and DC gain."""
+    """Discretise a linear zoo model with a zero-order hold; prints A, B, C, D, poles and DC
+    gain."""
     from ..errors import ModelError
     from .zoo import _build
 
@@ -30,7 +33,8 @@ def zoo_discretize(name: str = typer.Argument(..., help="Zoo model name (gripkit
     if not hasattr(model, "discrete"):
         from .. import zoo
 
-        ok = [e.name for e in zoo.entries() if e.name.startswith("ftg100") and hasattr(_build(e.name), "discrete")]
+        ok = ([e.name for e in zoo.entries() if e.name.startswith("ftg100")
+               and hasattr(_build(e.name), "discrete")])
         raise ModelError(f"zoo model {name!r} has no linear continuous-time form to discretise",
                          hint=f"discretize works on: {', '.join(ok)}")
     sys = model.discrete(dt=1.0 / fs, form=form)
@@ -49,7 +53,8 @@ def zoo_discretize(name: str = typer.Argument(..., help="Zoo model name (gripkit
         return
     np.set_printoptions(precision=6, suppress=False)
     typer.echo(f"{name}: zero-order hold at {fs:g} Hz ({out['form']}); inputs {out['inputs']} "
-               f"[{', '.join(out['input_units'])}], outputs {out['outputs']} [{', '.join(out['output_units'])}]")
+               f"[{', '.join(out['input_units'])}], outputs {out['outputs']} "
+               f"[{', '.join(out['output_units'])}]")
     for k in ("A", "B", "C", "D"):
         typer.echo(f"{k} =\n{np.array(out[k])}")
     typer.echo("poles = " + ", ".join(f"{re:.6f}{im:+.6f}j" for re, im in out["poles"]))

@@ -130,7 +130,8 @@ class PID:
     0.2
     """
 
-    def __init__(self, kp: float, ki: float = 0.0, kd: float = 0.0, *, dt: float, tf: float | None = None,
+    def __init__(self, kp: float, ki: float = 0.0, kd: float = 0.0, *, dt: float,
+                 tf: float | None = None,
                  b: float = 1.0, c: float = 0.0, tt: float | None = None, u_min: float = -math.inf,
                  u_max: float = math.inf, design: dict | None = None):
         kp, ki, kd = _finite("kp", kp), _finite("ki", ki), _finite("kd", kd)
@@ -141,7 +142,8 @@ class PID:
         tf = _finite("tf", tf)
         if tf < 0:
             raise ConfigError(f"PID tf: expected a time constant >= 0 s, found {tf!r}")
-        u_min, u_max = _finite("u_min", u_min, allow_inf=True), _finite("u_max", u_max, allow_inf=True)
+        u_min, u_max = (_finite("u_min", u_min, allow_inf=True),
+                        _finite("u_max", u_max, allow_inf=True))
         if not u_min < u_max:
             raise ConfigError(f"PID limits: expected u_min < u_max, found [{u_min:g}, {u_max:g}]")
         if tt is None:
@@ -157,7 +159,8 @@ class PID:
             raise ConfigError(f"PID tt: expected a time constant >= 0 s (or inf), found {tt!r}")
         if math.isinf(tt):
             tt = 0.0  # 0 disables the back-calculation term in the kernel
-        v = dict(kp=kp, ki=ki, kd=kd, tf=tf, b=_finite("b", b), c=_finite("c", c), tt=tt, u_min=u_min,
+        v = dict(kp=kp, ki=ki, kd=kd, tf=tf, b=_finite("b", b), c=_finite("c", c), tt=tt,
+                 u_min=u_min,
                  u_max=u_max, dt=dt)
         self._p = np.array([v[k] for k in PID_PARAMETERS])
         self._p.flags.writeable = False
@@ -180,7 +183,8 @@ class PID:
     limits = property(lambda self: (float(self._p[PIDX.u_min]), float(self._p[PIDX.u_max])))
 
     def __repr__(self) -> str:
-        return (f"PID(kp={self.kp:g}, ki={self.ki:g}, kd={self.kd:g}, dt={self.dt:g}, tf={self.tf:g}, "
+        return (f"PID(kp={self.kp:g}, ki={self.ki:g}, kd={self.kd:g}, dt={self.dt:g}, "
+                f"tf={self.tf:g}, "
                 f"tt={self.tt:g}, limits={self.limits})")
 
     # --- operation -------------------------------------------------------------------------------
@@ -190,7 +194,8 @@ class PID:
         self.state[0] = float(integral)
 
     def step(self, r: float, y: float, ff: float = 0.0) -> float:
-        """One sample: the limited output u_k for setpoint ``r``, measurement ``y``, feedforward ``ff``."""
+        """One sample: the limited output u_k for setpoint ``r``, measurement ``y``, feedforward
+        ``ff``."""
         return float(pid_step(self._p, self.state, float(r), float(y), float(ff)))
 
     def transfer(self, u: float, r: float, y: float, ff: float = 0.0) -> None:
@@ -217,6 +222,7 @@ class PID:
         kp, ki, kd, tf, dt = self.kp, self.ki, self.kd, self.tf, self.dt
         a = np.array([tf + dt, -tf])      # (T_f + Δt) z − T_f
         zm1 = np.array([1.0, -1.0])       # z − 1
-        num = kp * np.polymul(zm1, a) + ki * dt * np.concatenate([[0.0], a]) + kd * np.polymul(zm1, zm1)
+        num = (kp * np.polymul(zm1, a) + ki * dt * np.concatenate([[0.0],
+                                                                   a]) + kd * np.polymul(zm1, zm1))
         den = np.polymul(zm1, a)
         return num / den[0], den / den[0]

@@ -80,12 +80,15 @@ def as_plant(model) -> TransferFunction:
         g = as_system(model)
     except ModelError as e:
         raise ModelError(f"cannot build a discrete plant from {type(model).__name__}: {e.message}",
-                         hint=e.hint or "give a gripkit.lti transfer function or state space, a gripkit.sysid "
-                                        "polynomial model, a DiscretePlant, or a tuple (A, B, dt)") from None
+                         hint=e.hint or "give a gripkit.lti transfer function or state space, "
+                                        "a gripkit.sysid "
+                                        "polynomial model, a DiscretePlant, or a "
+                                        "tuple (A, B, dt)") from None
     if not g.is_discrete:
         raise ModelError("the plant must be discrete: discretise it with c2d(dt) first")
     if not g.is_siso:
-        raise ModelError(f"the plant must be SISO, found {g.n_outputs} outputs and {g.n_inputs} inputs")
+        raise ModelError(f"the plant must be SISO, found {g.n_outputs} outputs and "
+                         f"{g.n_inputs} inputs")
     return g if isinstance(g, TransferFunction) else g.to_tf()
 
 
@@ -113,7 +116,8 @@ class DiscretePlant:
     def __post_init__(self):
         # trailing zeros are padding in the q⁻¹ layout (not factors): drop them
         A, B = (np.trim_zeros(_poly(x, k), "b") for x, k in ((self.A, "A"), (self.B, "B")))
-        g = TransferFunction.from_polynomials(A if A.size else np.zeros(1), B if B.size else np.zeros(1),
+        g = TransferFunction.from_polynomials(A if A.size else np.zeros(1),
+                                              B if B.size else np.zeros(1),
                                               dt=self.dt, inputs=self.input_name,
                                               outputs=self.output_name, input_units=self.input_unit,
                                               output_units=self.output_unit)
@@ -124,11 +128,13 @@ class DiscretePlant:
 
     @classmethod
     def from_model(cls, model, **kw) -> "DiscretePlant":
-        """The q⁻¹ view of :func:`as_plant` ``(model)``; ``kw`` overrides names, units and source."""
+        """The q⁻¹ view of :func:`as_plant` ``(model)``; ``kw`` overrides names, units and
+        source."""
         if isinstance(model, DiscretePlant):
             return model
         g = as_plant(model)
-        d = dict(input_name=g.inputs[0], input_unit=g.input_units[0] or "1", output_name=g.outputs[0],
+        d = dict(input_name=g.inputs[0], input_unit=g.input_units[0] or "1",
+                 output_name=g.outputs[0],
                  output_unit=g.output_units[0] or "1", source=type(model).__name__)
         d.update(kw)
         return cls(g.den_zinv(), g.num_zinv(), g.dt, **d)
@@ -159,7 +165,8 @@ class DiscretePlant:
 
     def scaled(self, gain: float, **kw) -> "DiscretePlant":
         """The plant with B multiplied by ``gain`` (unit changes, contact compliance)."""
-        d = dict(input_name=self.input_name, input_unit=self.input_unit, output_name=self.output_name,
+        d = dict(input_name=self.input_name, input_unit=self.input_unit,
+                 output_name=self.output_name,
                  output_unit=self.output_unit, source=self.source)
         d.update(kw)
         return DiscretePlant(self.A, (float(gain) * self.lti).num_zinv(), self.dt, **d)
@@ -323,7 +330,8 @@ class RSTController:
                 g = -20.0 * math.log10(mag[i])
                 if 0 < g < gm:
                     gm, w180 = g, float(w[i])
-        return dict(gain_margin_db=gm, phase_margin_deg=pm, w_gain_crossover=wc, w_phase_crossover=w180,
+        return dict(gain_margin_db=gm, phase_margin_deg=pm, w_gain_crossover=wc,
+                    w_phase_crossover=w180,
                     sensitivity_peak=ms)
 
 
@@ -388,7 +396,8 @@ def _anti_windup_polynomial(Ao: np.ndarray, deg_r: int) -> np.ndarray:
     return np.real(np.poly(np.full(deg_r, rho)))
 
 
-def design_rst(plant, *, wn: float = 15.0, zeta: float = 0.9, observer: float = 2.0, observer_poles=None,
+def design_rst(plant, *, wn: float = 15.0, zeta: float = 0.9, observer: float = 2.0,
+               observer_poles=None,
                u_min: float = -math.inf, u_max: float = math.inf) -> RSTController:
     """RST pole placement with integral action that keeps B (delay and NMP zeros) in the loop.
 
@@ -447,8 +456,10 @@ def design_rst(plant, *, wn: float = 15.0, zeta: float = 0.9, observer: float = 
     for j in range(dA1):
         M[j:j + B.size, dB + j] = B
     if np.linalg.cond(M) > 1e12:
-        raise ModelError("A(q)(1 − q⁻¹) and B(q) have a common factor: the plant has a zero at z = 1 or a "
-                         "pole/zero pair cancels", hint="integral action is impossible with a zero at z = 1")
+        raise ModelError("A(q)(1 − q⁻¹) and B(q) have a common factor: the plant has a "
+                         "zero at z = 1 or a "
+                         "pole/zero pair cancels", hint="integral action is impossible with "
+                                                        "a zero at z = 1")
     x = np.linalg.solve(M, np.pad(P, (0, n - P.size)))
     Rp, S = x[:dB], x[dB:]
     R = np.convolve(Rp, [1.0, -1.0])

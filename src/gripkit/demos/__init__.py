@@ -26,7 +26,8 @@ SECTIONS: dict[str, str] = {
 }
 
 
-def run_demo(out_dir="report", sections: list[str] | None = None, quick: bool = False) -> tuple[Path, dict]:
+def run_demo(out_dir="report", sections: list[str] | None = None,
+             quick: bool = False) -> tuple[Path, dict]:
     """Run the selected sections (default: all) and write ``out_dir/index.html``."""
     names = list(SECTIONS) if not sections else sections
     for n in names:

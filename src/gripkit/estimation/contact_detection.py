@@ -63,7 +63,8 @@ class ContactDetector:
 
     >>> det = ContactDetector(5e-6)
     >>> [det.update(f) for f in [0.0] * 8 + [8e-6] * 8]
-    [False, False, False, False, False, False, False, False, False, False, False, False, False, True, True, True]
+    [False, False, False, False, False, False, False, False, False, False, False, False, False,
+    True, True, True]
     """
 
     def __init__(self, threshold: float = 5e-6, release: float | None = None, window: int = 8):
@@ -71,7 +72,8 @@ class ContactDetector:
             raise DataError(f"threshold: expected a positive force in N, found {threshold!r}")
         release = threshold / 2.0 if release is None else float(release)
         if not 0 <= release < threshold:
-            raise DataError(f"release: expected 0 <= release < threshold ({threshold:g} N), found {release!r}")
+            raise DataError(f"release: expected 0 <= release < threshold ({threshold:g} N), "
+                            f"found {release!r}")
         if int(window) < 1:
             raise DataError(f"window: expected >= 1 sample, found {window!r}")
         self.threshold, self.release, self.window = float(threshold), release, int(window)
@@ -92,7 +94,8 @@ class ContactDetector:
         return float(self.state[4])
 
     def update(self, F: float) -> bool:
-        return bool(detector_step(self.state, self.buffer, float(F), self.threshold, self.release) > 0.5)
+        return (bool(detector_step(self.state, self.buffer, float(F), self.threshold,
+                                   self.release) > 0.5))
 
     def run(self, F) -> tuple[np.ndarray, np.ndarray]:
         """(in_contact (bool, N), moving average (N)) for a whole record."""

@@ -27,7 +27,8 @@ RLS with forgetting factor λ (per sample of period T_s):
 
 with Π the projection onto the bounds of s and o in the metric of P⁻¹ (a coordinate clipped to
 its bound moves the other by P₀₁/P_cc times the clipping: the most probable value given the
-clipped one; plain clipping makes the nearly collinear pair bang between its bounds), and σ̂² ← λσ̂² + (1 − λ)e²/(1 + φᵀg/λ)
+clipped one; plain clipping makes the nearly collinear pair bang between its bounds), and σ̂² ←
+λσ̂² + (1 − λ)e²/(1 + φᵀg/λ)
 the exponentially weighted variance of the a-priori residuals; the standard deviations are
 σ̂·sqrt(diag P).
 
@@ -133,7 +134,8 @@ class AdaptationSettings:
             raise ModelError(f"forgetting factor must lie in (0, 1], found {self.forgetting!r}",
                              hint="0.999 remembers about 1000 samples")
         if not (self.filter_hz > 0 and self.v_min >= 0 and self.p0 > 0):
-            raise ModelError(f"filter_hz and p0 must be > 0 and v_min >= 0, found filter_hz={self.filter_hz!r}, "
+            raise ModelError("filter_hz and p0 must be > 0 and v_min >= 0, found "
+                             f"filter_hz={self.filter_hz!r}, "
                              f"p0={self.p0!r}, v_min={self.v_min!r}")
         for name in ("scale_bounds", "offset_bounds"):
             b = getattr(self, name)
@@ -146,10 +148,13 @@ class AdaptationSettings:
             object.__setattr__(self, name, (lo, hi))
         lo, hi = self.scale_bounds
         if not lo <= 1.0 <= hi:
-            raise ModelError(f"scale_bounds: must contain the nominal scale 1, found {self.scale_bounds!r}")
+            raise ModelError("scale_bounds: must contain the nominal scale 1, found "
+                             f"{self.scale_bounds!r}")
         if not self.offset_bounds[0] <= 0.0 <= self.offset_bounds[1]:
-            raise ModelError(f"offset_bounds: must contain the nominal offset 0, found {self.offset_bounds!r}")
-        if self.trace_max is not None and not (math.isfinite(self.trace_max) and self.trace_max > 0):
+            raise ModelError("offset_bounds: must contain the nominal offset 0, found "
+                             f"{self.offset_bounds!r}")
+        if self.trace_max is not None and not (math.isfinite(self.trace_max)
+                                               and self.trace_max > 0):
             raise ModelError(f"trace_max: expected a positive number, found {self.trace_max!r}")
 
     def vector(self, dt: float) -> np.ndarray:
@@ -157,7 +162,8 @@ class AdaptationSettings:
         if not (isinstance(dt, numbers.Real) and math.isfinite(dt) and dt > 0):
             raise ModelError(f"dt: expected a sample period > 0 s, found {dt!r}")
         if self.filter_hz >= 0.5 / dt:
-            raise ModelError(f"filter_hz = {self.filter_hz:g} Hz must lie below the Nyquist frequency "
+            raise ModelError(f"filter_hz = {self.filter_hz:g} Hz must lie below the "
+                             "Nyquist frequency "
                              f"{0.5 / dt:g} Hz")
         a = 2 * math.pi * self.filter_hz
         c = np.empty(N_SETTINGS)
@@ -332,7 +338,8 @@ class FrictionAdapter:
         self.settings = settings if settings is not None else AdaptationSettings(
             forgetting=forgetting, filter_hz=filter_hz, v_min=v_min, p0=p0)
         if not isinstance(self.settings, AdaptationSettings):
-            raise ModelError(f"settings: expected AdaptationSettings, found {type(settings).__name__}")
+            raise ModelError("settings: expected AdaptationSettings, found "
+                             f"{type(settings).__name__}")
         self.cfg = self.settings.vector(dt)
         self.J = J
         self.dt = float(dt)
@@ -362,7 +369,8 @@ class FrictionAdapter:
     def update(self, tau_motor, bias, velocity, *, nonfinite: str = "raise") -> AdaptationResult:
         """Feed samples (N, m) (or one sample (m,)) of motor torque, bias torque and velocity;
         the adapter keeps its state between calls. ``nonfinite='raise'`` (default) refuses NaN/inf
-        with a DataError; ``'skip'`` leaves those samples out (estimates held) with a DataWarning."""
+        with a DataError; ``'skip'`` leaves those samples out (estimates held) with a
+        DataWarning."""
         if nonfinite not in ("raise", "skip"):
             raise ModelError(f"nonfinite: expected 'raise' or 'skip', found {nonfinite!r}")
         tau = np.atleast_2d(np.asarray(tau_motor, dtype=np.float64))
@@ -378,7 +386,8 @@ class FrictionAdapter:
                 what = (f"{name}: {int(bad.sum())} non-finite value(s), the first at sample {n0} "
                         f"(t = {self.t + n0 * self.dt:.6g} s) of actuator {self.names[k0]}")
                 if nonfinite == "raise":
-                    raise DataError(what, hint="drop or interpolate them, or pass nonfinite='skip' to "
+                    raise DataError(what, hint="drop or interpolate them, or pass "
+                                               "nonfinite='skip' to "
                                                "leave those samples out (the estimates hold)")
                 emit_warning(DataWarning(f"{what}: left out, the estimates hold over them"))
         N = tau.shape[0]

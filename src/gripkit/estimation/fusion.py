@@ -71,13 +71,15 @@ def _stack(items, what: str) -> np.ndarray:
         b = np.broadcast_arrays(*[np.asarray(a, dtype=np.float64) for a in arrs])
     except ValueError:
         shapes = [np.shape(a) for a in arrs]
-        raise DataError(f"{what}: the estimates do not broadcast together, shapes {shapes}") from None
+        raise DataError(f"{what}: the estimates do not broadcast together, "
+                        f"shapes {shapes}") from None
     return np.stack(b, axis=0)
 
 
 def _first_bad(mask: np.ndarray) -> str:
     idx = np.argwhere(mask)[0]
-    return f"estimate {int(idx[0])}" + (f" at index {tuple(int(i) for i in idx[1:])}" if idx.size > 1 else "")
+    return (f"estimate {int(idx[0])}" + (f" at index {tuple(int(i) for i in idx[1:])}"
+                                         if idx.size > 1 else ""))
 
 
 def fuse(estimates, variances):
@@ -112,7 +114,8 @@ def fuse(estimates, variances):
     try:
         x, v = np.broadcast_arrays(x, v)
     except ValueError:
-        raise DataError(f"fuse: estimates of shape {x.shape[1:]} and variances of shape {v.shape[1:]} "
+        raise DataError(f"fuse: estimates of shape {x.shape[1:]} and variances of "
+                        f"shape {v.shape[1:]} "
                         "do not broadcast together") from None
     if not np.isfinite(x).all():
         raise DataError(f"fuse: non-finite estimate ({_first_bad(~np.isfinite(x))})",
@@ -128,7 +131,8 @@ def fuse(estimates, variances):
     none = (wsum == 0.0) & (n_exact == 0)
     if none.any():
         idx = np.argwhere(none)[0] if none.ndim else ()
-        raise DataError(f"fuse: every estimate has infinite variance at index {tuple(int(i) for i in idx)}",
+        raise DataError("fuse: every estimate has infinite variance at index "
+                        f"{tuple(int(i) for i in idx)}",
                         hint="at least one estimate must carry information")
     with np.errstate(invalid="ignore", divide="ignore"):
         est = (w * x).sum(axis=0) / wsum
@@ -139,7 +143,8 @@ def fuse(estimates, variances):
         spread = np.where(exact, np.abs(x - mean_exact), 0.0).max(axis=0)
         tol = 1e-9 * np.maximum(1.0, np.abs(mean_exact))
         if (spread > tol).any():
-            raise DataError("fuse: estimates with zero variance disagree (they cannot all be exact)",
+            raise DataError("fuse: estimates with zero variance disagree (they "
+                            "cannot all be exact)",
                             hint="give them their real (positive) variances")
         est = np.where(n_exact > 0, mean_exact, est)
         var = np.where(n_exact > 0, 0.0, var)
@@ -162,9 +167,11 @@ def fuse_update(estimate, variance, new, new_variance):
     v2 = np.asarray(new_variance, dtype=np.float64)
     for name, a in (("variance", v1), ("new_variance", v2)):
         if np.isnan(a).any() or (a < 0).any():
-            raise DataError(f"fuse_update: {name} must be >= 0, found {a[np.isnan(a) | (a < 0)].ravel()[0]!r}")
+            raise DataError(f"fuse_update: {name} must be >= 0, found "
+                            f"{a[np.isnan(a) | (a < 0)].ravel()[0]!r}")
     if ((v1 + v2) == 0).any():
-        raise DataError("fuse_update: both variances are zero", hint="use fuse() for exact estimates")
+        raise DataError("fuse_update: both "
+                        "variances are zero", hint="use fuse() for exact estimates")
     with np.errstate(invalid="ignore"):
         k = np.where(np.isinf(v1), 1.0, v1 / np.where(np.isinf(v1), 1.0, v1 + v2))
         k = np.where(np.isinf(v2) & ~np.isinf(v1), 0.0, k)
@@ -200,7 +207,8 @@ def fuse_proportional(estimates, normalised_variances, floor=0.0):
     x = _stack(estimates, "estimates")
     sn = np.asarray(normalised_variances, dtype=np.float64).reshape(-1)
     if sn.size != x.shape[0]:
-        raise DataError(f"fuse_proportional: {x.shape[0]} estimates but {sn.size} normalised variances")
+        raise DataError(f"fuse_proportional: {x.shape[0]} estimates but {sn.size} "
+                        "normalised variances")
     fl = np.broadcast_to(np.asarray(floor, dtype=np.float64), (x.shape[0],))
     shape = (-1,) + (1,) * (x.ndim - 1)
     var = proportional_variance(x, sn.reshape(shape), 0.0) + (fl * fl).reshape(shape)
@@ -225,7 +233,8 @@ def fused_variance(variances, correlation=None):
         C = np.full((v.size, v.size), float(C))
         np.fill_diagonal(C, 1.0)
     if C.shape != (v.size, v.size):
-        raise DataError(f"correlation: expected a scalar or a {v.size}x{v.size} matrix, found shape {C.shape}")
+        raise DataError(f"correlation: expected a scalar or a {v.size}x{v.size} matrix, found "
+                        f"shape {C.shape}")
     d = np.sqrt(v)
     return float(w @ (d[:, None] * C * d[None, :]) @ w)
 
@@ -296,14 +305,17 @@ def normalised_variances(estimates, known) -> NormalisedVariances:
     e = e[:, None] if e.ndim == 1 else e
     k = np.asarray(known, dtype=np.float64).reshape(-1)
     if e.ndim != 2 or e.shape[0] != k.size:
-        raise DataError(f"normalised_variances: estimates of shape {np.shape(estimates)} do not match "
+        raise DataError("normalised_variances: estimates of shape "
+                        f"{np.shape(estimates)} do not match "
                         f"{k.size} known values")
     if k.size < 3:
-        raise DataError(f"normalised_variances needs at least 3 calibration samples, found {k.size}")
+        raise DataError("normalised_variances needs at least 3 calibration "
+                        f"samples, found {k.size}")
     if not (np.isfinite(e).all() and np.isfinite(k).all()):
         raise DataError("normalised_variances: calibration data contain NaN or inf")
     if (k == 0).any():
-        raise DataError(f"normalised_variances: known force is zero in {int((k == 0).sum())} samples",
+        raise DataError("normalised_variances: known force is zero in "
+                        f"{int((k == 0).sum())} samples",
                         hint="normalisation divides by the known force; drop the unloaded samples")
     r = e / k[:, None]
     levels, inv = np.unique(k, return_inverse=True)
@@ -329,5 +341,6 @@ def normalised_variances(estimates, known) -> NormalisedVariances:
     if len(big) >= 2:
         for c in range(e.shape[1]):
             pvals[c] = stats.bartlett(*[g[:, c] for g in big]).pvalue
-    return NormalisedVariances(mean=r.mean(axis=0), variance=var, variance_std=var * np.sqrt(2.0 / dof),
+    return NormalisedVariances(mean=r.mean(axis=0), variance=var,
+                               variance_std=var * np.sqrt(2.0 / dof),
                                n=int(k.size), levels=levels, level_variance=lv, homogeneity_p=pvals)

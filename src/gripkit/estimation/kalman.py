@@ -493,7 +493,8 @@ class KalmanFilter:
         """One sample (SI, the model's order, offsets not removed): ``(x[t|t], P[t|t])``.
 
         ``u`` (m,) and ``y`` (p,) 1-D arrays go straight to the kernel (anything else is
-        converted to float64 first). ``copy=False`` returns read-only views of the filter's own buffers
+        converted to float64 first). ``copy=False`` returns read-only views of the filter's own
+        buffers
         instead of copies: nothing is allocated, and the next step overwrites them."""
         if type(u) is not np.ndarray or u.ndim != 1:
             u = np.ascontiguousarray(u, dtype=np.float64).reshape(-1)

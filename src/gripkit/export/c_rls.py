@@ -8,7 +8,8 @@ windup) — see :mod:`gripkit.sysid.linear.rls` for coef and scale of each windu
 statistics V, w₁, w₂. The arithmetic and its order are those of the numba step (``_gain``,
 ``_apply``, ``_rls_step``), so θ, P and e equal Python's (bit for bit with gcc -O2 on x86-64; to
 1e-12 relative in any case). Like ``update``, a sample that is not finite (status 1), a corrupt one
-above :data:`~gripkit.sysid.linear.rls.ABSURD_JUMP` times its signal's running peak (status 4), or an
+above :data:`~gripkit.sysid.linear.rls.ABSURD_JUMP` times its signal's running peak (status 4), or
+an
 update that would make θ or P non-finite (2) or overflow φᵀPφ (3) returns NaN and leaves the
 estimator as it was (``s->status`` says why); Python raises there instead.
 

@@ -138,10 +138,14 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
     """
     check_path(path, "path", "load()")
     if units is not None and not isinstance(units, Mapping):
-        raise ArgumentError(f"load(): units must be a mapping {{column: unit}}, found {type(units).__name__}",
+        raise ArgumentError(f"load(): units must be a mapping {{column: unit}}, found "
+                            f"{type(units).__name__}",
                             hint='e.g. units={"force": "mN"}')
-    if fs is not None and (isinstance(fs, bool) or not isinstance(fs, (int, float, np.integer, np.floating))):
-        raise ArgumentError(f"load(): fs must be a sampling rate in Hz (a number), found {type(fs).__name__} "
+    if fs is not None and (isinstance(fs, bool) or not isinstance(fs,
+                                                                  (int, float, np.integer,
+                                                                       np.floating))):
+        raise ArgumentError("load(): fs must be a sampling rate in Hz (a number), found "
+                            f"{type(fs).__name__} "
                             f"{fs!r:.40}")
     path = Path(path)
     if not path.exists():
@@ -377,7 +381,8 @@ def _refuse_ragged_line(path: Path, delimiter: str) -> None:
         got = line.count(sep) + 1
         if got != expected:
             last = k == len(lines)
-            cut = " and is the last line, without a line ending" if last and not text.endswith(("\n", "\r")) else ""
+            cut = (" and is the last line, without a line ending" if last
+                   and not text.endswith(("\n", "\r")) else "")
             raise DataError(
                 f"{path.name}: line {k} has {got} fields, {first} has {expected}{cut}: "
                 f"the file looks "
@@ -395,8 +400,10 @@ def _warn_unterminated(path: Path) -> None:
     data = path.read_bytes()
     k = data.count(b"\n") + 1 if b"\n" in data else data.count(b"\r") + 1
     last = data.splitlines()[-1].decode("utf-8", errors="replace")
-    emit_warning(f"{path.name}: line {k}, the last, has no line ending: the file looks truncated and "
-                 f"that line's values may be cut short ({last[:60]!r}); check the end of the file, and end "
+    emit_warning(f"{path.name}: line {k}, the last, has no line ending: the file "
+                 "looks truncated and "
+                 f"that line's values may be cut short ({last[:60]!r}); check the end of "
+                 "the file, and end "
                  f"it with a newline if it is complete", DataWarning)
 
 
@@ -406,8 +413,10 @@ def _arrow_columns(table, source: str) -> dict[str, object]:
     names = table.column_names
     repeated = sorted({n for n in names if names.count(n) > 1})
     if repeated:
-        raise DataError(f"{source}: column name {repeated[0]!r} appears {names.count(repeated[0])} times in "
-                        f"the header; each column needs its own name", hint="rename the repeated columns")
+        raise DataError(f"{source}: column name {repeated[0]!r} appears "
+                        f"{names.count(repeated[0])} times in "
+                        "the header; each column "
+                        "needs its own name", hint="rename the repeated columns")
     out = {}
     for name, col in zip(table.column_names, table.columns):
         if pa.types.is_integer(col.type):
@@ -547,7 +556,8 @@ def _read_hdf5(path: Path, key=None, delimiter=None, *, wanted=None, limit=None,
     try:
         fh = h5py.File(path, "r")
     except OSError as exc:
-        raise DataError(f"{path.name}: not a readable HDF5 file (truncated or corrupt?): {exc}") from None
+        raise DataError(f"{path.name}: not a readable HDF5 file (truncated or "
+                        f"corrupt?): {exc}") from None
     with fh:
         node = fh if key is None else hdf5_get(fh, key, path.name, allow_external)
         if node is None:
@@ -559,7 +569,8 @@ def _read_hdf5(path: Path, key=None, delimiter=None, *, wanted=None, limit=None,
             else:
                 raw, units = _hdf5_group(node, path.name, wanted, limit, allow_external)
         except OSError as exc:
-            raise DataError(f"{path.name}: HDF5 data cannot be read (truncated or corrupt?): {exc}") from None
+            raise DataError(f"{path.name}: HDF5 data cannot be read (truncated or "
+                            f"corrupt?): {exc}") from None
     lengths = {k: len(v) for k, v in raw.items()}
     if len(set(lengths.values())) > 1:
         raise DataError(f"{path.name}: datasets have different lengths {lengths}")
@@ -633,7 +644,8 @@ def save(tr: Trajectory, path, *, format: str | None = None, key: str = "/",
     path = Path(path)
     fmt = _format(path, format)
     if fmt == "mcap":
-        raise DataError("gripkit reads MCAP logs but writes CSV, Parquet or HDF5", hint="save as .parquet")
+        raise DataError("gripkit reads MCAP logs but writes CSV, "
+                        "Parquet or HDF5", hint="save as .parquet")
     cols = {"t": tr.t, **{n: tr[n] for n in tr.names}}
     units = {"t": "s", **(tr.units if units == "si" else _display(tr, cols))}
     if fmt == "csv":

@@ -119,7 +119,8 @@ def _read_v73(path: Path, wanted, limit: float, allow_external: bool):
     try:
         fh = h5py.File(path, "r")
     except OSError as exc:
-        raise DataError(f"{path.name}: not a readable MAT-file 7.3 (truncated or corrupt?): {exc}") from None
+        raise DataError(f"{path.name}: not a readable MAT-file 7.3 (truncated or "
+                        f"corrupt?): {exc}") from None
     with fh:
         variables = {}
         for name in fh.keys():
@@ -140,12 +141,14 @@ def _read_v73(path: Path, wanted, limit: float, allow_external: bool):
             try:
                 raw.update(_columns(v, np.asarray(ds[()]).T, names))
             except OSError as exc:
-                raise DataError(f"{path.name}: MAT-file data cannot be read (truncated or corrupt?): "
+                raise DataError(f"{path.name}: MAT-file data cannot be read "
+                                "(truncated or corrupt?): "
                                 f"{exc}") from None
     return raw
 
 
-def read_mat(path: Path, key=None, delimiter=None, *, wanted=None, limit=None, allow_external=False):
+def read_mat(path: Path, key=None, delimiter=None, *, wanted=None, limit=None,
+             allow_external=False):
     """``(columns, units)`` of a MAT-file (module docstring); no units are stored in the format."""
     limit = float("inf") if limit is None else limit
     with open(path, "rb") as fh:

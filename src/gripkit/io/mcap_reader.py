@@ -1,7 +1,8 @@
 """ROS 2 logs in MCAP files (optional extra ``gripkit[mcap]``).
 
 Columns are named ``[alias=]TOPIC:FIELD``, where FIELD is a dotted path into the message with
-optional indices, e.g. ``force=/fingertip/wrench:wrench.force.z`` or ``q3=/joint_states:position[2]``.
+optional indices, e.g. ``force=/fingertip/wrench:wrench.force.z`` or
+``q3=/joint_states:position[2]``.
 Each topic has its own time stamps (the log time, or ``header.stamp`` with ``stamp='header'``);
 the first column's topic sets the time base and the other columns are interpolated linearly onto
 it, over the interval where every topic has data.
@@ -30,7 +31,8 @@ def parse_column(spec: str) -> tuple[str, str, list]:
     m = _COL.match(spec)
     if not m:
         raise DataError(f"MCAP column {spec!r}: expected [alias=]/topic:field.path[index]",
-                        hint="for example force=/fingertip/wrench:wrench.force.z or /joint_states:position[2]")
+                        hint="for example force=/fingertip/wrench:wrench.force.z or "
+                             "/joint_states:position[2]")
     path: list = []
     for part in m.group("field").split("."):
         pm = _PART.match(part)
@@ -38,7 +40,8 @@ def parse_column(spec: str) -> tuple[str, str, list]:
             raise DataError(f"MCAP column {spec!r}: cannot read field part {part!r}")
         path.append(pm.group(1))
         path += [int(i) for i in re.findall(r"\[(\d+)\]", pm.group(2))]
-    alias = m.group("alias") or re.sub(r"\W+", "_", f"{m.group('topic')}_{m.group('field')}").strip("_")
+    alias = (m.group("alias") or re.sub(r"\W+", "_",
+                                        f"{m.group('topic')}_{m.group('field')}").strip("_"))
     return alias, m.group("topic"), path
 
 
@@ -56,7 +59,8 @@ def _get(msg, path: list, spec: str) -> float:
         return float(v)
     except (TypeError, ValueError):
         raise DataError(f"MCAP column {spec!r}: field is not a number ({type(v).__name__})",
-                        hint="index into arrays (position[2]) or descend into messages (wrench.force.z)") from None
+                        hint="index into arrays (position[2]) or descend into messages "
+                             "(wrench.force.z)") from None
 
 
 def _check_declared_sizes(path: Path, reader, topics: set, ncols: int, limit: float) -> None:
@@ -84,11 +88,14 @@ def read_mcap(path: Path, columns, stamp: str = "log",
         from mcap.reader import make_reader
         from mcap_ros2.decoder import DecoderFactory
     except ImportError:
-        raise DataError("reading MCAP files needs the optional extra", hint="pip install 'gripkit[mcap]'") from None
+        raise DataError("reading MCAP files needs "
+                        "the optional extra", hint="pip install 'gripkit[mcap]'") from None
     with open(path, "rb") as fh:
         if fh.read(len(_MAGIC)) != _MAGIC:
-            raise DataError(f"{path.name}: not an MCAP file (it does not start with the MCAP magic bytes)",
-                            hint="check the file, or force another format with format='csv'|'parquet'|'hdf5'")
+            raise DataError(f"{path.name}: not an MCAP file (it does not start with the "
+                            "MCAP magic bytes)",
+                            hint="check the file, or force another format with "
+                                 "format='csv'|'parquet'|'hdf5'")
     if not columns:
         raise DataError(f"{path.name}: name the MCAP columns to read (gripkit.io.load(path, "
                         f"columns=[...]))",
@@ -118,7 +125,8 @@ def read_mcap(path: Path, columns, stamp: str = "log",
     except DataError:
         raise
     except Exception as exc:
-        raise DataError(f"{path.name}: not a readable MCAP file (truncated or corrupt?): {exc}") from None
+        raise DataError(f"{path.name}: not a readable MCAP file (truncated or "
+                        f"corrupt?): {exc}") from None
     missing = sorted(topics - seen)
     if missing:
         raise DataError(f"{path.name}: no messages on topics {missing}")

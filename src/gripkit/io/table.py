@@ -120,7 +120,8 @@ def check_fill(fill) -> None:
     """``fill`` must be None, 'drop' or 'interpolate' (checked before any data are read)."""
     if fill is not None and fill not in FILL_CHOICES:
         raise DataError(f"fill: expected None, 'drop' or 'interpolate', found {fill!r}",
-                        hint="CLI: --fill drop or --fill interpolate, or leave it out to refuse missing values")
+                        hint="CLI: --fill drop or --fill interpolate, or leave it out to "
+                             "refuse missing values")
 
 
 def check_size(source: str, what: str, rows: int, ncols: int, limit: float,
@@ -159,7 +160,8 @@ def _check_fs_against_time(source: str, tname: str, t: np.ndarray, fs: float) ->
     The two time bases agree when the stamps stay within half a sample interval of the uniform grid
     ``t[0] + k/fs`` at every sample k: each stamp is then nearest to its own grid point, so both
     label the same samples with the same times. Rounding of the stamps (a few digits written to the
-    file) and clock jitter far below a sample pass; a different rate drifts by more than half a sample
+    file) and clock jitter far below a sample pass; a different rate drifts by more than half a
+    sample
     over a record of N samples as soon as the rates differ by more than 1/(2N), relative.
     """
     k = np.flatnonzero(np.isfinite(t))
@@ -172,9 +174,11 @@ def _check_fs_against_time(source: str, tname: str, t: np.ndarray, fs: float) ->
     rate = (k[-1] - k[0]) / (t[k[-1]] - t[k[0]]) if t[k[-1]] != t[k[0]] else float("inf")
     raise DataError(
         f"{source}: fs={fs:g} Hz disagrees with the time column {tname!r} (its stamps give "
-        f"{rate:.6g} Hz): at t={t[k[i]]:.6g} s the two time bases are {abs(drift[i]) * fs:.3g} samples "
+        f"{rate:.6g} Hz): at t={t[k[i]]:.6g} s the two time bases are "
+        f"{abs(drift[i]) * fs:.3g} samples "
         f"apart (tolerance: half a sample)",
-        hint="leave out fs (CLI: --fs) to use the file's time stamps; if the stamps are wrong, fix or "
+        hint="leave out fs (CLI: --fs) to use the file's time stamps; if the stamps "
+             "are wrong, fix or "
              "rename the time column")
 
 
@@ -218,8 +222,10 @@ def _time_seconds(source: str, tname: str, values,
     return relative.astype(np.float64) * scale, f"{first} {unit}"
 
 
-def _warn_corrupt(source: str, t: np.ndarray, data: dict[str, np.ndarray], units: dict[str, str]) -> None:
-    """One :class:`~gripkit.errors.DataWarning` per channel holding corrupt samples, naming their times."""
+def _warn_corrupt(source: str, t: np.ndarray, data: dict[str, np.ndarray],
+                  units: dict[str, str]) -> None:
+    """One :class:`~gripkit.errors.DataWarning` per channel holding corrupt samples, naming their
+    times."""
     for name, x in data.items():
         if not np.isfinite(x).all():
             continue  # missing values are refused (or filled) elsewhere
@@ -231,8 +237,10 @@ def _warn_corrupt(source: str, t: np.ndarray, data: dict[str, np.ndarray], units
         shown = ", ".join(f"{x[i]:.6g}{u} at t={t[i]:.6g} s" for i in idx[:3])
         more = f" and {idx.size - 3} more" if idx.size > 3 else ""
         emit_warning(
-           f"{source}: column {name!r} has {idx.size} sample{'s' if idx.size > 1 else ''} far outside the "
-           f"rest of the channel, which look{'s' if idx.size == 1 else ''} corrupt: {shown}{more}; check "
+           f"{source}: column {name!r} has {idx.size} sample{'s' if idx.size > 1 else ''} "
+           "far outside the "
+           f"rest of the channel, which look{'s' if idx.size == 1 else ''} corrupt: "
+           f"{shown}{more}; check "
            f"the file (drop or repair those rows) unless the spike is real", DataWarning)
 
 
@@ -283,7 +291,8 @@ def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
         available += (f" (the file has no header, its first line holds numbers: its columns are "
                       f"named by their position, 1 to {len(cols)})")
 
-    # time base: the time column (named, or found by name) and/or the sampling rate fs, which must agree
+    # time base: the time column (named, or found by name) and/or the sampling rate fs, which must
+    # agree
     check_fill(fill)
     check_fs(fs)
     tname = time
@@ -298,15 +307,18 @@ def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
         if tname is None and fs is None:
             looked = ", ".join(_TIME_NAMES[:9])
             raise DataError(f"{source}: no time column found (looked for {looked}, ...)",
-                            hint="name it with time=COL (CLI: --time COL) or give the sampling rate fs (CLI: --fs HZ)")
+                            hint="name it with time=COL (CLI: --time COL) or give the sampling "
+                                 "rate fs (CLI: --fs HZ)")
     if tname is not None and tname not in cols:
-        raise DataError(f"{source}: time column {tname!r} not found", hint=f"available columns: {available}")
+        raise DataError(f"{source}: time column "
+                        f"{tname!r} not found", hint=f"available columns: {available}")
 
     names = (list(columns) if columns is not None
              else [c for c in cols if c != tname and not is_time_name(c)])
     for c in names:
         if c not in cols:
-            raise DataError(f"{source}: column {c!r} not found", hint=f"available columns: {available}")
+            raise DataError(f"{source}: column "
+                            f"{c!r} not found", hint=f"available columns: {available}")
     if not names:
         raise DataError(f"{source}: no data columns besides the time column")
 
@@ -344,6 +356,7 @@ def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
         bad = ~np.isfinite(t)
         if bad.any():
             i = int(np.argmax(bad))
-            raise DataError(f"{source}: time column {tname!r} has {int(bad.sum())} missing or non-finite "
+            raise DataError(f"{source}: time column {tname!r} has {int(bad.sum())} "
+                            "missing or non-finite "
                             f"values (first at row {i})", hint="drop those rows (fill='drop')")
     return Trajectory(t, data, su, meta)

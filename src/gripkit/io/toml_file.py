@@ -23,12 +23,15 @@ def read_toml(path, what: str) -> dict:
     try:
         text = path.read_bytes().decode("utf-8-sig")  # a leading BOM (Windows editors) is fine
     except UnicodeDecodeError as exc:
-        raise ConfigError(f"{what} {str(path)!r} is not UTF-8 text (byte 0x{exc.object[exc.start]:02x} at offset "
-                          f"{exc.start} cannot be decoded)", hint="a TOML file is UTF-8 text: check that the "
+        raise ConfigError(f"{what} {str(path)!r} is not UTF-8 text (byte "
+                          f"0x{exc.object[exc.start]:02x} at offset "
+                          f"{exc.start} cannot be decoded)", hint="a TOML file is UTF-8 text: "
+                                                                  "check that the "
                           "path names the .toml file, and save it as UTF-8") from None
     except PermissionError:
         raise ConfigError(f"{what} {str(path)!r} cannot be read: permission denied",
-                          hint="make it readable (chmod u+r) or copy it somewhere you can read") from None
+                          hint="make it readable (chmod u+r) or copy it "
+                               "somewhere you can read") from None
     except OSError as exc:
         raise ConfigError(f"{what} {str(path)!r} cannot be read: {exc.strerror or exc}") from None
     try:

@@ -40,8 +40,10 @@ from ._system import parallel as parallel
 from ._system import series as series
 from ._uncertainty import Uncertainty as Uncertainty
 
-__all__ = ["Bode", "Damping", "LinearSystem", "StateSpace", "TransferFunction", "Uncertainty", "as_system",
-           "c2d", "c2d_matrices", "d2c", "d2c_matrices", "feedback", "from_control", "from_scipy", "parallel",
+__all__ = ["Bode", "Damping", "LinearSystem", "StateSpace", "TransferFunction", "Uncertainty",
+           "as_system",
+           "c2d", "c2d_matrices", "d2c", "d2c_matrices", "feedback", "from_control", "from_scipy",
+           "parallel",
            "series", "simulate_ss", "affine_row", "flush_tiny"]
 
 if TYPE_CHECKING:

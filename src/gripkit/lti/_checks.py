@@ -27,7 +27,8 @@ def as_matrix(x, name: str, shape: tuple[int | None, int | None] | None = None) 
             raise ModelError(f"{name}: expected shape {want}, found {a.shape}")
     if not np.isfinite(a).all():
         bad = np.argwhere(~np.isfinite(a))[0]
-        raise ModelError(f"{name} has non-finite entries (first at [{bad[0]}, {bad[1]}] = {a[tuple(bad)]})",
+        raise ModelError(f"{name} has non-finite entries (first at [{bad[0]}, {bad[1]}] = "
+                         f"{a[tuple(bad)]})",
                          hint="a linear system needs finite matrices")
     a.flags.writeable = False
     return a
@@ -35,10 +36,14 @@ def as_matrix(x, name: str, shape: tuple[int | None, int | None] | None = None) 
 
 def as_dt(dt) -> float | None:
     """``None`` or 0 → continuous (None); a finite positive number → discrete sample time (s)."""
-    if dt is None or (not isinstance(dt, bool) and isinstance(dt, (int, float, np.number)) and dt == 0):
+    if dt is None or (not isinstance(dt, bool) and isinstance(dt,
+                                                              (int, float, np.number)) and dt == 0):
         return None
-    if isinstance(dt, bool) or not isinstance(dt, (int, float, np.number)) or not math.isfinite(dt) or dt < 0:
-        raise ModelError(f"dt: expected None or 0 (continuous) or a positive sample time in s, found {dt!r}")
+    if isinstance(dt, bool) or not isinstance(dt,
+                                              (int, float,
+                                                   np.number)) or not math.isfinite(dt) or dt < 0:
+        raise ModelError("dt: expected None or 0 (continuous) or a positive sample time in "
+                         f"s, found {dt!r}")
     return float(dt)
 
 
@@ -56,10 +61,12 @@ def _labels(values, n: int, what: str, kind: str):
         return None
     values = (values,) if isinstance(values, str) else tuple(values)
     if len(values) != n:
-        raise ModelError(f"{what}: expected {n} {kind}, found {len(values)} ({', '.join(map(str, values))})")
+        raise ModelError(f"{what}: expected {n} {kind}, found {len(values)} "
+                         f"({', '.join(map(str, values))})")
     for s in values:
         if not isinstance(s, str) or (kind == "names" and not s):
-            raise ModelError(f"{what}: {kind} must be {'non-empty ' if kind == 'names' else ''}strings, "
+            raise ModelError(f"{what}: {kind} must be "
+                             f"{'non-empty ' if kind == 'names' else ''}strings, "
                              f"found {s!r}")
     return values
 
@@ -88,7 +95,8 @@ def same_dt(a, b, what: str) -> float | None:
         return None
     if a is None or b is None or not math.isclose(a, b, rel_tol=1e-12):
         fmt = lambda d: "continuous" if d is None else f"dt = {d:g} s"  # noqa: E731
-        raise ModelError(f"{what}: both systems must share one time base, found {fmt(a)} and {fmt(b)}",
+        raise ModelError(f"{what}: both systems must share one time base, found "
+                         f"{fmt(a)} and {fmt(b)}",
                          hint="discretise the continuous one with c2d(dt) first")
     return a
 
@@ -102,5 +110,6 @@ def as_input_array(u, m: int, what: str = "u") -> np.ndarray:
         raise DataError(f"{what}: expected shape (N, {m}) (one column per input), found {a.shape}")
     if not np.isfinite(a).all():
         k = int(np.argwhere(~np.isfinite(a))[0, 0])
-        raise DataError(f"{what} has non-finite values (first at sample {k})", hint="drop or interpolate them")
+        raise DataError(f"{what} has non-finite values "
+                        f"(first at sample {k})", hint="drop or interpolate them")
     return np.ascontiguousarray(a)

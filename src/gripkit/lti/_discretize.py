@@ -1,6 +1,7 @@
 """Array-level c2d/d2c: zero-order hold, first-order hold and Tustin (with optional prewarp).
 
-Continuous ẋ = A x + B u, y = C x + D u; discrete x[k+1] = Φ x[k] + Γ u[k], y[k] = C_d x[k] + D_d u[k].
+Continuous ẋ = A x + B u, y = C x + D u; discrete x[k+1] = Φ x[k] + Γ u[k], y[k] = C_d x[k] + D_d
+u[k].
 
 * ZOH (u held over each step; Van Loan):  ``expm([[A, B], [0, 0]]·dt) = [[Φ, Γ], [0, I]]``,
   C_d = C, D_d = D. Inverse: ``logm`` of the same block matrix, which exists (real) when no pole
@@ -41,7 +42,8 @@ def tustin_step(dt: float, prewarp) -> float:
         return dt
     w = float(prewarp)
     if not (np.isfinite(w) and 0 < w < np.pi / dt):
-        raise ModelError(f"prewarp: expected a frequency in (0, π/dt = {np.pi / dt:.6g}) rad/s, found {prewarp!r}")
+        raise ModelError(f"prewarp: expected a frequency in (0, π/dt = {np.pi / dt:.6g}) rad/s, "
+                         f"found {prewarp!r}")
     return 2.0 * np.tan(w * dt / 2.0) / w
 
 
@@ -105,9 +107,11 @@ def _real_logm(M, what):
     ev = np.linalg.eigvals(M)
     bad = ev[(np.abs(ev.imag) <= 1e-12 * np.maximum(np.abs(ev), 1.0)) & (ev.real <= 0)]
     if bad.size:
-        raise ModelError(f"{what}: a pole at z = {bad[0].real:.6g} lies on the closed negative real axis, "
+        raise ModelError(f"{what}: a pole at z = {bad[0].real:.6g} lies on the closed "
+                         "negative real axis, "
                          "where no continuous-time pole maps to under sampling",
-                         hint="use method='tustin', or identify at a sample rate where no pole sits at "
+                         hint="use method='tustin', or identify at a sample rate where "
+                              "no pole sits at "
                               "or beyond Nyquist")
     from scipy import linalg  # on first use (start-up)
 

@@ -34,13 +34,16 @@ def from_control(sys, *, input_units=None, output_units=None) -> LinearSystem:
     kw = dict(inputs=tuple(sys.input_labels), outputs=tuple(sys.output_labels),
               input_units=input_units, output_units=output_units)
     if isinstance(sys, ct.StateSpace):
-        return StateSpace(np.asarray(sys.A), np.asarray(sys.B), np.asarray(sys.C), np.asarray(sys.D),
+        return StateSpace(np.asarray(sys.A), np.asarray(sys.B), np.asarray(sys.C),
+                          np.asarray(sys.D),
                           dt=_control_dt(sys.dt), states=tuple(sys.state_labels), **kw)
     if isinstance(sys, ct.TransferFunction):
         p, m = sys.noutputs, sys.ninputs
-        num = [[np.asarray(sys.num_array[i, j] if hasattr(sys, "num_array") else sys.num[i][j], dtype=float)
+        num = [[np.asarray(sys.num_array[i, j] if hasattr(sys, "num_array") else sys.num[i][j],
+                           dtype=float)
                 for j in range(m)] for i in range(p)]
-        den = [[np.asarray(sys.den_array[i, j] if hasattr(sys, "den_array") else sys.den[i][j], dtype=float)
+        den = [[np.asarray(sys.den_array[i, j] if hasattr(sys, "den_array") else sys.den[i][j],
+                           dtype=float)
                 for j in range(m)] for i in range(p)]
         return TransferFunction(num, den, dt=_control_dt(sys.dt), **kw)
     raise ModelError(f"from_control: expected a control.StateSpace or control.TransferFunction, "
@@ -61,7 +64,8 @@ def from_scipy(sys, **signals) -> LinearSystem:
     from scipy import signal
 
     if not isinstance(sys, (signal.lti, signal.dlti)):
-        raise ModelError(f"from_scipy: expected a scipy.signal lti/dlti, found {type(sys).__name__}")
+        raise ModelError("from_scipy: expected a scipy.signal lti/dlti, found "
+                         f"{type(sys).__name__}")
     dt = getattr(sys, "dt", None)
     if isinstance(sys, (signal.StateSpace,)):
         return StateSpace(sys.A, sys.B, sys.C, sys.D, dt=dt, **signals)
@@ -106,12 +110,15 @@ def as_system(obj, **signals) -> LinearSystem:
         return from_scipy(obj, **signals)
     if all(hasattr(obj, k) for k in ("A", "B", "dt")):
         kw = {}
-        for src, dst in (("input_name", "inputs"), ("output_name", "outputs"), ("input_unit", "input_units"),
+        for src, dst in (("input_name", "inputs"), ("output_name", "outputs"),
+                         ("input_unit", "input_units"),
                          ("output_unit", "output_units")):
             if getattr(obj, src, None):
                 kw[dst] = getattr(obj, src)
         kw.update(signals)
-        return TransferFunction.from_polynomials(obj.A, obj.B, F=getattr(obj, "F", None), dt=float(obj.dt), **kw)
+        return (TransferFunction.from_polynomials(obj.A, obj.B, F=getattr(obj, "F", None),
+                                                  dt=float(obj.dt), **kw))
     raise ModelError(f"as_system: cannot read a linear system from {type(obj).__name__}",
-                     hint="give a gripkit.lti system, a python-control or scipy.signal system, a polynomial "
+                     hint="give a gripkit.lti system, a python-control or scipy.signal "
+                          "system, a polynomial "
                           "model (A, B, dt), or a tuple (A, B, dt)")

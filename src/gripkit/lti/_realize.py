@@ -111,7 +111,8 @@ def ss2tf(A, B, C, D, minimal: bool = True, tol: float = MINREAL_TOL):
             # leading coefficients that are zero in exact arithmetic (relative degree) come out as
             # rounding noise of the subtraction: bounded by n ε times the coefficients of
             # Π(s + |λ_i|) and Π(s + |μ_i|); 100× that is taken as zero
-            noise = 100 * a.shape[0] * _EPS * (np.poly(-np.abs(lam)).real + np.poly(-np.abs(mu)).real
+            noise = 100 * a.shape[0] * _EPS * (np.poly(-np.abs(lam)).real
+                                               + np.poly(-np.abs(mu)).real
                                                 * max(1.0, abs(D[i, j] - 1.0)))
             k = 0
             while k < num.size - 1 and abs(num[k]) <= noise[k]:
@@ -132,7 +133,8 @@ def _reachable_basis(A, B, tol):
     """Orthonormal basis of the reachable subspace span[B, AB, A²B, …] (block Krylov with
     re-orthogonalisation; a direction counts when its singular value exceeds tol·‖[A B]‖)."""
     n = A.shape[0]
-    scale = max(np.linalg.norm(A, 2) if n else 0.0, np.linalg.norm(B, 2) if B.size else 0.0, np.finfo(float).tiny)
+    scale = (max(np.linalg.norm(A, 2) if n else 0.0, np.linalg.norm(B, 2) if B.size else 0.0,
+                 np.finfo(float).tiny))
     Q = np.zeros((n, 0))
     blk = B
     while Q.shape[1] < n:
@@ -208,7 +210,8 @@ def ss_zeros(A, B, C, D, tol: float = MINREAL_TOL):
     p, m = D.shape
     if n == 0:
         return np.zeros(0, dtype=complex)
-    scale = max(np.linalg.norm(A, 2), np.linalg.norm(B, 2), np.linalg.norm(C, 2), np.linalg.norm(D, 2))
+    scale = (max(np.linalg.norm(A, 2), np.linalg.norm(B, 2), np.linalg.norm(C, 2),
+                 np.linalg.norm(D, 2)))
     if p == m:
         sD = np.linalg.svd(D, compute_uv=False)
         if sD.size and sD.min() > tol * scale:

@@ -24,7 +24,8 @@ from ._frequency import Bode, default_grid
 from ._pycontrol import control_module
 from ._uncertainty import Uncertainty, complex_covariance, push
 
-__all__ = ["Damping", "LinearSystem", "StateSpace", "TransferFunction", "c2d", "d2c", "series", "parallel", "feedback"]
+__all__ = (["Damping", "LinearSystem", "StateSpace", "TransferFunction", "c2d", "d2c", "series",
+            "parallel", "feedback"])
 
 _EPS = np.finfo(float).eps
 
@@ -86,8 +87,10 @@ def _ss_frequency(A, B, C, D, s):
     sv = np.linalg.svd(M, compute_uv=False)
     bad = sv[:, -1] <= n * _EPS * np.maximum(sv[:, 0], 1.0)
     if np.any(bad):
-        raise ModelError(f"frequency response: s = {s[bad][0]:.6g} is a pole of the system (sI − A is singular)",
-                         hint="evaluate away from the poles on the imaginary axis (or the unit circle)")
+        raise ModelError(f"frequency response: s = {s[bad][0]:.6g} is a pole of the system (sI "
+                         "− A is singular)",
+                         hint="evaluate away from the poles on the imaginary axis (or "
+                              "the unit circle)")
     X = np.linalg.solve(M, np.broadcast_to(B.astype(complex), (s.size,) + B.shape))
     Ct = np.broadcast_to(C.T.astype(complex), (s.size,) + C.T.shape)
     Y = np.swapaxes(np.linalg.solve(np.swapaxes(M, 1, 2), Ct), 1, 2)
@@ -231,7 +234,8 @@ class LinearSystem:
             s, c = p.astype(complex), np.ones(p.size, dtype=complex)
         wn = np.abs(s)
         with np.errstate(invalid="ignore"):
-            zeta = np.where(np.isinf(wn), 1.0, np.where(wn > 0, -s.real / np.where(wn > 0, wn, 1.0), -1.0))
+            zeta = (np.where(np.isinf(wn), 1.0,
+                             np.where(wn > 0, -s.real / np.where(wn > 0, wn, 1.0), -1.0)))
         if cov is None:
             return Damping(p, wn, zeta, None, None)
         # ∂(Re s, Im s)/∂(Re p, Im p): multiplication by the complex number c = ds/dp
@@ -242,7 +246,8 @@ class LinearSystem:
         gw = np.stack([x / w, y / w], -1)
         gz = np.stack([-y ** 2 / w ** 3, x * y / w ** 3], -1)
         var = lambda g: np.einsum("ka,kab,kb->k", g, cs, g)  # noqa: E731
-        return Damping(p, wn, zeta, np.sqrt(np.clip(var(gw), 0, None)), np.sqrt(np.clip(var(gz), 0, None)))
+        return (Damping(p, wn, zeta, np.sqrt(np.clip(var(gw), 0, None)),
+                        np.sqrt(np.clip(var(gz), 0, None))))
 
     def pole_covariance(self) -> tuple[np.ndarray, np.ndarray]:
         """Poles and the covariance of (Re p, Im p) of each, shape (n, 2, 2), to first order:
@@ -305,7 +310,8 @@ class LinearSystem:
         [0.0, -3.01]
         """
         if w is None:
-            w = default_grid(self.dt, self.poles(), self.zeros() if self.is_siso else np.zeros(0), int(n))
+            w = (default_grid(self.dt, self.poles(), self.zeros() if self.is_siso else np.zeros(0),
+                              int(n)))
         w = np.atleast_1d(np.asarray(w, dtype=np.float64))
         H = self.frequency_response(w)
         cov = None if self.uncertainty is None else self.frequency_response_covariance(w)
@@ -325,7 +331,8 @@ class LinearSystem:
             return t.size, self.dt
         t = np.asarray(t, dtype=np.float64)
         if t.ndim != 1 or t.size < 2:
-            raise DataError("t: a continuous system needs times in s (uniform, from 0, at least 2 samples)")
+            raise DataError("t: a continuous system needs times in s (uniform, from 0, at "
+                            "least 2 samples)")
         h = float(t[1] - t[0])
         if not (h > 0 and abs(t[0]) <= 1e-12 * h and np.allclose(np.diff(t), h, rtol=1e-9, atol=0)):
             raise DataError("t: expected uniform, increasing times starting at 0")
@@ -363,7 +370,8 @@ class LinearSystem:
         A, B, C, D = self._sampled(h)
         out = np.empty((N, C.shape[0], B.shape[1]))
         for j in range(B.shape[1]):
-            out[:, :, j] = _simulate_arrays(A, B[:, j:j + 1], C, D[:, j:j + 1], np.ones((N, 1)), None)
+            out[:, :, j] = (_simulate_arrays(A, B[:, j:j + 1], C, D[:, j:j + 1], np.ones((N, 1)),
+                                             None))
         return out
 
     def impulse(self, t) -> np.ndarray:
@@ -395,7 +403,8 @@ class LinearSystem:
                 u[0] = 1.0
                 out[:, :, j] = _simulate_arrays(A, B[:, j:j + 1], C, D[:, j:j + 1], u, None)
             else:
-                out[:, :, j] = _simulate_arrays(A, np.zeros((A.shape[0], 1)), C, np.zeros((C.shape[0], 1)),
+                out[:, :, j] = _simulate_arrays(A, np.zeros((A.shape[0], 1)), C,
+                                                np.zeros((C.shape[0], 1)),
                                                 np.zeros((N, 1)), self.to_ss(minimal=False).B[:, j])
         return out
 
@@ -433,7 +442,8 @@ class LinearSystem:
                              hint="use d2c() first to resample, or keep it as it is")
         dt = require_discrete(dt, "c2d")
         m = _discretize.check_method(method, prewarp)
-        return self._map_ss(lambda A, B, C, D: _discretize.c2d_matrices(A, B, C, D, dt, m, prewarp), dt=dt,
+        return self._map_ss(lambda A, B, C, D: _discretize.c2d_matrices(A, B, C, D, dt, m, prewarp),
+                            dt=dt,
                             meta={**self.meta, "c2d": m})
 
     def d2c(self, method: str = "zoh", prewarp: float | None = None):
@@ -465,7 +475,8 @@ class LinearSystem:
             raise ModelError("d2c: the system is already continuous")
         dt = self.dt
         m = _discretize.check_method(method, prewarp)
-        return self._map_ss(lambda A, B, C, D: _discretize.d2c_matrices(A, B, C, D, dt, m, prewarp), dt=None,
+        return self._map_ss(lambda A, B, C, D: _discretize.d2c_matrices(A, B, C, D, dt, m, prewarp),
+                            dt=None,
                             meta={**self.meta, "d2c": m})
 
     # ------------------------------------------------------------------ interconnection
@@ -554,11 +565,13 @@ class LinearSystem:
         d = {"type": type(self).__name__}
         d.update({k: a.tolist() for k, a in zip(keys, self._arrays())})
         d.update(dt=self.dt, inputs=list(self.inputs), outputs=list(self.outputs),
-                 input_units=list(self.input_units), output_units=list(self.output_units), meta=dict(self.meta))
+                 input_units=list(self.input_units), output_units=list(self.output_units),
+                 meta=dict(self.meta))
         if isinstance(self, StateSpace):
             d.update(states=list(self.states), state_units=list(self.state_units))
         u = self.uncertainty
-        d["uncertainty"] = None if u is None else {"names": list(u.names), "covariance": u.covariance.tolist(),
+        d["uncertainty"] = None if u is None else {"names": list(u.names),
+                                                   "covariance": u.covariance.tolist(),
                                                    "tangents": [t.tolist() for t in u.tangents]}
         return d
 
@@ -575,20 +588,26 @@ class LinearSystem:
         """
         if not isinstance(d, dict) or d.get("type") not in ("StateSpace", "TransferFunction"):
             found = d.get("type") if isinstance(d, dict) else type(d).__name__
-            raise ModelError(f"from_dict: expected a dict with type 'StateSpace' or 'TransferFunction', found {found!r}")
-        kw = {k: d[k] for k in ("dt", "inputs", "outputs", "input_units", "output_units", "meta") if d.get(k) is not None}
+            raise ModelError("from_dict: expected a dict with type 'StateSpace' or "
+                             f"'TransferFunction', found {found!r}")
+        kw = ({k: d[k] for k in ("dt", "inputs", "outputs", "input_units", "output_units",
+                                 "meta") if d.get(k) is not None})
         u = d.get("uncertainty")
         if u is not None:
             try:
                 kw["uncertainty"] = Uncertainty(tuple(u["names"]), u["covariance"],
-                                                tuple(np.asarray(t, dtype=np.float64) for t in u["tangents"]))
+                                                tuple(np.asarray(t, dtype=np.float64)
+                                                      for t in u["tangents"]))
             except (KeyError, TypeError) as e:
-                raise ModelError(f"from_dict: uncertainty needs names, covariance and tangents ({e})") from None
+                raise ModelError("from_dict: uncertainty needs names, covariance "
+                                 f"and tangents ({e})") from None
         try:
             if d["type"] == "StateSpace":
                 kw.update({k: d[k] for k in ("states", "state_units") if d.get(k) is not None})
-                return StateSpace(np.asarray(d["A"], dtype=np.float64), d["B"], d["C"], d.get("D"), **kw)
-            return TransferFunction(np.asarray(d["num"], dtype=np.float64), np.asarray(d["den"], dtype=np.float64), **kw)
+                return (StateSpace(np.asarray(d["A"], dtype=np.float64), d["B"], d["C"], d.get("D"),
+                                   **kw))
+            return (TransferFunction(np.asarray(d["num"], dtype=np.float64),
+                                     np.asarray(d["den"], dtype=np.float64), **kw))
         except KeyError as e:
             raise ModelError(f"from_dict: the {d['type']} description lacks {e}") from None
 
@@ -609,7 +628,8 @@ class LinearSystem:
         arrays = self._arrays()
         out = []
         for d in self.uncertainty.draws(n, rng):
-            arrs = tuple(a + np.tensordot(d, t, axes=1) for a, t in zip(arrays, self.uncertainty.tangents))
+            arrs = (tuple(a + np.tensordot(d, t, axes=1)
+                          for a, t in zip(arrays, self.uncertainty.tangents)))
             out.append(self._rebuild(arrs, None))
         return out
 
@@ -719,7 +739,8 @@ class StateSpace(LinearSystem):
         set_(self, "meta", dict(self.meta or {}))
         if self.uncertainty is not None:
             if not isinstance(self.uncertainty, Uncertainty):
-                raise ModelError(f"uncertainty: expected an Uncertainty, found {type(self.uncertainty).__name__}")
+                raise ModelError("uncertainty: expected an Uncertainty, found "
+                                 f"{type(self.uncertainty).__name__}")
             self.uncertainty._check_shapes(self._arrays())
 
     # ------------------------------------------------------------------ plumbing
@@ -772,7 +793,8 @@ class StateSpace(LinearSystem):
                 raise ModelError(f"parameters: expected names like 'A[0,1]', found {name!r}")
             k, i, j = mt.group(1), int(mt.group(2)), int(mt.group(3))
             if i >= arrays[k].shape[0] or j >= arrays[k].shape[1]:
-                raise ModelError(f"parameters: {name!r} lies outside {k}, whose shape is {arrays[k].shape}")
+                raise ModelError(f"parameters: {name!r} lies outside {k}, whose shape is "
+                                 f"{arrays[k].shape}")
             tangents["ABCD".index(k)][q, i, j] = 1.0
         return self.replace(uncertainty=Uncertainty(tuple(parameters), covariance, tuple(tangents)))
 
@@ -787,7 +809,8 @@ class StateSpace(LinearSystem):
         ...            [[1.0, 1.0]]).poles().real.tolist()
         [-1.0, -3.0]
         """
-        return np.linalg.eigvals(self.A).astype(complex) if self.n_states else np.zeros(0, dtype=complex)
+        return (np.linalg.eigvals(self.A).astype(complex) if self.n_states
+                else np.zeros(0, dtype=complex))
 
     def zeros(self) -> np.ndarray:
         """Transmission zeros: where the system matrix [[A − zI, B], [C, D]] of a minimal
@@ -817,7 +840,8 @@ class StateSpace(LinearSystem):
         if n:
             s = np.linalg.svd(M, compute_uv=False)
             if s[-1] <= n * _EPS * max(s[0], np.abs(self.A).max(), 1.0):
-                raise ModelError("dc_gain: the system has a pole at " + ("z = 1" if self.is_discrete else "s = 0")
+                raise ModelError("dc_gain: the system has a pole at "
+                                 + ("z = 1" if self.is_discrete else "s = 0")
                                  + ": its DC gain is infinite")
             return self.C @ np.linalg.solve(M, self.B) + self.D
         return self.D.copy()
@@ -875,7 +899,8 @@ class StateSpace(LinearSystem):
         if not self.is_discrete:
             raise ModelError("simulate: the system is continuous; it needs a sample time",
                              hint="discretise it first: sys.c2d(dt)")
-        return _simulate_arrays(self.A, self.B, self.C, self.D, as_input_array(u, self.n_inputs), x0)
+        return (_simulate_arrays(self.A, self.B, self.C, self.D, as_input_array(u, self.n_inputs),
+                                 x0))
 
     # ------------------------------------------------------------------ conversions
     def to_ss(self, minimal: bool = False) -> StateSpace:
@@ -913,7 +938,8 @@ class StateSpace(LinearSystem):
         ([3.0], [1.0, 2.0])
         """
         minimal = minimal and self.uncertainty is None
-        arrs, unc = push(lambda A, B, C, D: _realize.ss2tf(A, B, C, D, minimal), [self._arrays()], [self.uncertainty])
+        arrs, unc = (push(lambda A, B, C, D: _realize.ss2tf(A, B, C, D, minimal), [self._arrays()],
+                          [self.uncertainty]))
         return TransferFunction(arrs[0], arrs[1], **self._signals(), uncertainty=unc)
 
     def to_control(self):
@@ -931,7 +957,8 @@ class StateSpace(LinearSystem):
                      inputs=list(self.inputs), outputs=list(self.outputs), states=list(self.states))
 
     def __repr__(self) -> str:
-        return (f"StateSpace(n={self.n_states}, inputs={list(self.inputs)}, outputs={list(self.outputs)}, "
+        return (f"StateSpace(n={self.n_states}, inputs={list(self.inputs)}, "
+                f"outputs={list(self.outputs)}, "
                 f"{_fmt_dt(self.dt)}{', with covariance' if self.uncertainty is not None else ''})")
 
 
@@ -950,13 +977,15 @@ def _parse_polys(x, name):
 
     if isinstance(x, np.ndarray) and x.ndim == 3:
         return [[poly(x[i, j], f"[{i},{j}]") for j in range(x.shape[1])] for i in range(x.shape[0])]
-    nested = isinstance(x, (list, tuple)) and len(x) > 0 and all(isinstance(r, (list, tuple)) for r in x) \
+    nested = isinstance(x, (list, tuple)) and len(x) > 0 and all(isinstance(r, (list, tuple))
+                                                                 for r in x) \
         and all(isinstance(c, (list, tuple, np.ndarray)) for r in x for c in r)
     if not nested:
         return [[poly(x, "")]]
     rows = [[poly(c, f"[{i},{j}]") for j, c in enumerate(r)] for i, r in enumerate(x)]
     if any(len(r) != len(rows[0]) for r in rows) or not rows[0]:
-        raise ModelError(f"{name}: expected a rectangular p × m list of lists of polynomials, found rows of "
+        raise ModelError(f"{name}: expected a rectangular p × m list of lists of "
+                         "polynomials, found rows of "
                          f"lengths {[len(r) for r in rows]}")
     return rows
 
@@ -1006,7 +1035,8 @@ class TransferFunction(LinearSystem):
         nums, dens = _parse_polys(self.num, "num"), _parse_polys(self.den, "den")
         p, m = len(nums), len(nums[0])
         if (len(dens), len(dens[0])) != (p, m):
-            raise ModelError(f"den: expected {p} × {m} denominators (as num), found {len(dens)} × {len(dens[0])}")
+            raise ModelError(f"den: expected {p} × {m} denominators (as num), found {len(dens)} "
+                             f"× {len(dens[0])}")
         stored = self.uncertainty is not None
         L = max(max(c.size for r in nums for c in r), max(c.size for r in dens for c in r))
         num = np.zeros((p, m, L))
@@ -1024,12 +1054,15 @@ class TransferFunction(LinearSystem):
                 nz = np.flatnonzero(nu)
                 deg_num = nu.size - 1 - nz[0] if nz.size else 0
                 if deg_num > deg_den:
-                    raise ModelError(f"num{where}: an improper transfer function (numerator degree {deg_num} > "
-                                     f"denominator degree {deg_den}) has no state-space realisation",
+                    raise ModelError(f"num{where}: an improper transfer function (numerator "
+                                     f"degree {deg_num} > "
+                                     f"denominator degree {deg_den}) has no "
+                                     "state-space realisation",
                                      hint="add poles (a filter) to make it proper")
                 lead = de[k]
                 if stored and lead != 1.0:
-                    raise ModelError("den: with an uncertainty, denominators must be given monic (stored form)",
+                    raise ModelError("den: with an uncertainty, denominators must be given "
+                                     "monic (stored form)",
                                      hint="build the system first, then call with_covariance(...)")
                 num[i, j, L - nu.size:] = nu / lead
                 den[i, j, L - de.size:] = de / lead
@@ -1048,12 +1081,14 @@ class TransferFunction(LinearSystem):
         set_(self, "meta", dict(self.meta or {}))
         if stored:
             if not isinstance(self.uncertainty, Uncertainty):
-                raise ModelError(f"uncertainty: expected an Uncertainty, found {type(self.uncertainty).__name__}")
+                raise ModelError("uncertainty: expected an Uncertainty, found "
+                                 f"{type(self.uncertainty).__name__}")
             self.uncertainty._check_shapes(self._arrays())
 
     # ------------------------------------------------------------------ construction
     @classmethod
-    def from_polynomials(cls, A, B, *, C=None, F=None, dt: float, covariance=None, **signals) -> TransferFunction:
+    def from_polynomials(cls, A, B, *, C=None, F=None, dt: float, covariance=None,
+                         **signals) -> TransferFunction:
         """The discrete SISO system ``y = B(q)/(A(q) F(q)) u``, coefficients in increasing powers
         of q⁻¹ (MATLAB ``idpoly`` layout, as in :class:`gripkit.sysid.PolynomialModel`)::
 
@@ -1094,7 +1129,8 @@ class TransferFunction(LinearSystem):
         c = np.ones(1) if C is None else np.atleast_1d(np.asarray(C, dtype=np.float64))
         for name, v in (("A", a), ("B", b), ("C", c), ("F", f)):
             if v.ndim != 1 or not np.isfinite(v).all() or v.size == 0:
-                raise ModelError(f"{name}: expected finite coefficients in powers of q⁻¹, found {v.tolist()}")
+                raise ModelError(f"{name}: expected finite coefficients in powers of q⁻¹, "
+                                 f"found {v.tolist()}")
         if a[0] == 0 or f[0] == 0:
             raise ModelError("A and F must start with a nonzero coefficient (q⁰ term)")
         if not np.any(b):
@@ -1105,7 +1141,8 @@ class TransferFunction(LinearSystem):
         if covariance is None:
             return cls(num_s, den_s, dt=dt, **signals)
         if a[0] != 1.0 or f[0] != 1.0 or (C is not None and c[0] != 1.0):
-            raise ModelError("from_polynomials with covariance: A, C and F must be monic (start with 1)")
+            raise ModelError("from_polynomials with covariance: A, C and F must be "
+                             "monic (start with 1)")
         nk = int(np.flatnonzero(b)[0])
         names = ([f"a{i}" for i in range(1, a.size)] + [f"b{j}" for j in range(nk, b.size)]
                  + [f"c{i}" for i in range(1, c.size)] + [f"f{i}" for i in range(1, f.size)])
@@ -1128,7 +1165,8 @@ class TransferFunction(LinearSystem):
             dden[q, 0, 0, :den.size] = np.convolve(a, e)
             q += 1
         unc = Uncertainty(tuple(names), covariance, (dnum, dden))
-        return cls(num_s.reshape(1, 1, L), den_s.reshape(1, 1, L), dt=dt, uncertainty=unc, **signals)
+        return (cls(num_s.reshape(1, 1, L), den_s.reshape(1, 1, L), dt=dt, uncertainty=unc,
+                    **signals))
 
     def with_covariance(self, covariance, parameters=None) -> TransferFunction:
         """A copy carrying the covariance of some coefficients.
@@ -1151,7 +1189,8 @@ class TransferFunction(LinearSystem):
         tag = (lambda i, j: "") if (p, m) == (1, 1) else (lambda i, j: f"[{i},{j}]")
         if parameters is None:
             parameters = [f"{w}{tag(i, j)}[{k}]" for i in range(p) for j in range(m)
-                          for w, ks in (("num", range(deg[i][j] + 1)), ("den", range(1, deg[i][j] + 1))) for k in ks]
+                          for w, ks in (("num", range(deg[i][j] + 1)),
+                                        ("den", range(1, deg[i][j] + 1))) for k in ks]
         parameters = list(parameters)
         tangents = (np.zeros((len(parameters), p, m, L)), np.zeros((len(parameters), p, m, L)))
         pat = r"\s*(num|den)\[\s*(\d+)\s*\]\s*" if (p, m) == (1, 1) else \
@@ -1159,13 +1198,16 @@ class TransferFunction(LinearSystem):
         for q, name in enumerate(parameters):
             mt = re.fullmatch(pat, str(name))
             if not mt:
-                raise ModelError(f"parameters: expected names like {'num[0]' if (p, m) == (1, 1) else 'num[0,1][2]'}, "
+                raise ModelError("parameters: expected names like "
+                                 f"{'num[0]' if (p, m) == (1, 1) else 'num[0,1][2]'}, "
                                  f"found {name!r}")
             g = mt.groups()
-            w, i, j, k = (g[0], 0, 0, int(g[1])) if len(g) == 2 else (g[0], int(g[1]), int(g[2]), int(g[3]))
+            w, i, j, k = (g[0], 0, 0, int(g[1])) if len(g) == 2 else (g[0], int(g[1]), int(g[2]),
+                                                                      int(g[3]))
             if i >= p or j >= m or k > deg[i][j] or (w == "den" and k == 0):
                 raise ModelError(f"parameters: {name!r} is not a free coefficient (entry degree "
-                                 f"{deg[i][j] if i < p and j < m else '?'}; den[0] is the fixed leading 1)")
+                                 f"{deg[i][j] if i < p and j < m else '?'}; den[0] is the "
+                                 "fixed leading 1)")
             tangents[0 if w == "num" else 1][q, i, j, L - 1 - deg[i][j] + k] = 1.0
         return self.replace(uncertainty=Uncertainty(tuple(parameters), covariance, tangents))
 
@@ -1174,7 +1216,8 @@ class TransferFunction(LinearSystem):
         return (self.num, self.den)
 
     def _rebuild(self, arrays, uncertainty, **signals):
-        return TransferFunction(arrays[0], arrays[1], **self._signals(**signals), uncertainty=uncertainty)
+        return (TransferFunction(arrays[0], arrays[1], **self._signals(**signals),
+                                 uncertainty=uncertainty))
 
     @staticmethod
     def _scale_arrays(arrs, k):
@@ -1182,7 +1225,8 @@ class TransferFunction(LinearSystem):
 
     def _entry(self, i, j):
         if not (0 <= i < self.n_outputs and 0 <= j < self.n_inputs):
-            raise ModelError(f"entry ({i}, {j}) lies outside the {self.n_outputs} × {self.n_inputs} system")
+            raise ModelError(f"entry ({i}, {j}) lies outside the {self.n_outputs} × "
+                             f"{self.n_inputs} system")
         d = self.den[i, j]
         k = np.flatnonzero(d)[0]
         return self.num[i, j, k:], d[k:]
@@ -1225,7 +1269,8 @@ class TransferFunction(LinearSystem):
 
     def _zinv_check(self):
         if not self.is_discrete:
-            raise ModelError("num_zinv/den_zinv: powers of z⁻¹ need a discrete system", hint="use numerator()")
+            raise ModelError("num_zinv/den_zinv: powers of z⁻¹ need a "
+                             "discrete system", hint="use numerator()")
 
     def num_zinv(self, i: int = 0, j: int = 0) -> np.ndarray:
         """Entry ij's numerator in increasing powers of z⁻¹ (delay as leading zeros, trailing
@@ -1289,8 +1334,10 @@ class TransferFunction(LinearSystem):
         slope = np.polyval(np.polyder(core), r) if r.size else r
         J = -np.array([np.polyval(row, r) for row in dcore]).reshape(-1, r.size) / slope
         cov = complex_covariance(J, self.uncertainty.covariance)
-        # a repeated root has D'(r) ≈ 0 (within the rounding of D' at r): its first-order σ is undefined
-        bad = np.abs(slope) <= 100 * core.size * _EPS * np.polyval(np.abs(np.polyder(core)), np.abs(r))
+        # a repeated root has D'(r) ≈ 0 (within the rounding of D' at r): its first-order σ is
+        # undefined
+        bad = (np.abs(slope) <= 100 * core.size * _EPS * np.polyval(np.abs(np.polyder(core)),
+                                                                    np.abs(r)))
         if np.any(bad):
             emit_warning(f"pole_covariance: {int(bad.sum())} pole(s) are (nearly) repeated; their "
                          "first-order σ is undefined and set to inf", AccuracyWarning)
@@ -1358,7 +1405,8 @@ class TransferFunction(LinearSystem):
             f = np.argwhere(bad)[0, 0]
             var = "z" if self.is_discrete else "s"
             raise ModelError(f"frequency response: {var} = {s[f]:.6g} is a pole of the system",
-                             hint="evaluate away from the poles on the imaginary axis (or the unit circle)")
+                             hint="evaluate away from the poles on the imaginary axis (or "
+                                  "the unit circle)")
         return nu / de
 
     def _frequency_jacobian(self, s):
@@ -1383,7 +1431,8 @@ class TransferFunction(LinearSystem):
         s0 = np.array([1.0 if self.is_discrete else 0.0])
         nu, de, bound = self._eval(s0)
         if np.any(np.abs(de) <= bound):
-            raise ModelError("dc_gain: the system has a pole at " + ("z = 1" if self.is_discrete else "s = 0")
+            raise ModelError("dc_gain: the system has a pole at "
+                             + ("z = 1" if self.is_discrete else "s = 0")
                              + ": its DC gain is infinite")
         return (nu / de)[0].real
 
@@ -1450,7 +1499,8 @@ class TransferFunction(LinearSystem):
                 return nu[0] * u
             from scipy import signal  # imported on first use (0.6 s)
 
-            return signal.lfilter(nu, de, u[:, 0], zi=_initial_state(x0, de.size - 1))[0].reshape(-1, 1)
+            return (signal.lfilter(nu, de, u[:, 0],
+                                   zi=_initial_state(x0, de.size - 1))[0].reshape(-1, 1))
         A, B, C, D = _realize.tf2ss(self.num, self.den)
         return _simulate_arrays(A, B, C, D, u, x0)
 
@@ -1487,7 +1537,8 @@ class TransferFunction(LinearSystem):
         """
         if form not in _realize.FORMS:
             raise ModelError(f"form: expected one of {', '.join(_realize.FORMS)}, found {form!r}")
-        arrs, unc = push(lambda n, d: _realize.tf2ss(n, d, form), [self._arrays()], [self.uncertainty])
+        arrs, unc = (push(lambda n, d: _realize.tf2ss(n, d, form), [self._arrays()],
+                          [self.uncertainty]))
         if minimal and self.uncertainty is None:
             reduced = _realize.minreal(*arrs)
             if reduced[0].shape[0] < arrs[0].shape[0]:
@@ -1507,19 +1558,22 @@ class TransferFunction(LinearSystem):
         p, m = self.n_outputs, self.n_inputs
         num = [[self.numerator(i, j) for j in range(m)] for i in range(p)]
         den = [[self.denominator(i, j) for j in range(m)] for i in range(p)]
-        return ct.tf(num, den, 0 if self.dt is None else self.dt, inputs=list(self.inputs), outputs=list(self.outputs))
+        return (ct.tf(num, den, 0 if self.dt is None else self.dt, inputs=list(self.inputs),
+                      outputs=list(self.outputs)))
 
     def __repr__(self) -> str:
         if self.is_siso:
             body = f"num={self.numerator().tolist()}, den={self.denominator().tolist()}"
         else:
             body = f"{self.n_outputs}×{self.n_inputs}"
-        return (f"TransferFunction({body}, inputs={list(self.inputs)}, outputs={list(self.outputs)}, "
+        return (f"TransferFunction({body}, inputs={list(self.inputs)}, "
+                f"outputs={list(self.outputs)}, "
                 f"{_fmt_dt(self.dt)}{', with covariance' if self.uncertainty is not None else ''})")
 
 
 # ====================================================================== operations
-def c2d(sys: LinearSystem, dt: float, method: str = "zoh", prewarp: float | None = None) -> LinearSystem:
+def c2d(sys: LinearSystem, dt: float, method: str = "zoh",
+        prewarp: float | None = None) -> LinearSystem:
     """Discretise ``sys`` at ``dt`` (s); see :meth:`LinearSystem.c2d`.
 
     Examples
@@ -1552,7 +1606,8 @@ def _check_units(a, b, what):
 
 
 def _both_siso_tf(g1, g2):
-    return isinstance(g1, TransferFunction) and isinstance(g2, TransferFunction) and g1.is_siso and g2.is_siso
+    return (isinstance(g1, TransferFunction) and isinstance(g2, TransferFunction) and g1.is_siso
+            and g2.is_siso)
 
 
 def _as_system(x, like: LinearSystem, n_in: int, n_out: int):
@@ -1561,12 +1616,14 @@ def _as_system(x, like: LinearSystem, n_in: int, n_out: int):
     try:
         K = np.asarray(x, dtype=np.float64)
     except (TypeError, ValueError):
-        raise ModelError(f"expected a LinearSystem or a static gain, found {type(x).__name__}") from None
+        raise ModelError("expected a LinearSystem or a static gain, found "
+                         f"{type(x).__name__}") from None
     if K.ndim == 0:
         K = K * np.eye(n_out) if n_out == n_in else np.full((n_out, n_in), float(K))
     if K.shape == (1, 1) and like.is_siso and isinstance(like, TransferFunction):
         return TransferFunction([K[0, 0]], [1.0], dt=like.dt)
-    return StateSpace(np.zeros((0, 0)), np.zeros((0, K.shape[1])), np.zeros((K.shape[0], 0)), K, dt=like.dt)
+    return (StateSpace(np.zeros((0, 0)), np.zeros((0, K.shape[1])), np.zeros((K.shape[0], 0)), K,
+                       dt=like.dt))
 
 
 def series(*systems: LinearSystem) -> LinearSystem:
@@ -1606,14 +1663,16 @@ def series(*systems: LinearSystem) -> LinearSystem:
 def _series2(g1, g2):
     dt = same_dt(g1.dt, g2.dt, "series")
     if g1.n_outputs != g2.n_inputs:
-        raise ModelError(f"series: the first system has {g1.n_outputs} outputs but the second {g2.n_inputs} inputs")
+        raise ModelError(f"series: the first system has {g1.n_outputs} outputs but the second "
+                         f"{g2.n_inputs} inputs")
     _check_units(g1.output_units, g2.input_units, "series")
     sig = dict(dt=dt, inputs=g1.inputs, outputs=g2.outputs, input_units=g1.input_units,
                output_units=g2.output_units, meta={})
     if _both_siso_tf(g1, g2):
         return _siso_tf_op(_connect.tf_series, g1, g2, sig)
     s1, s2 = g1.to_ss(minimal=False), g2.to_ss(minimal=False)
-    arrs, unc = push(_connect.ss_series, [s1._arrays(), s2._arrays()], [s1.uncertainty, s2.uncertainty])
+    arrs, unc = (push(_connect.ss_series, [s1._arrays(), s2._arrays()],
+                      [s1.uncertainty, s2.uncertainty]))
     return StateSpace(*arrs, **sig, states=_joined(s1.states, s2.states), uncertainty=unc)
 
 
@@ -1661,7 +1720,8 @@ def parallel(g1: LinearSystem, g2: LinearSystem) -> LinearSystem:
     g2 = _as_system(g2, g1, g1.n_inputs, g1.n_outputs)
     dt = same_dt(g1.dt, g2.dt, "parallel")
     if (g1.n_outputs, g1.n_inputs) != (g2.n_outputs, g2.n_inputs):
-        raise ModelError(f"parallel: shapes differ, {g1.n_outputs}×{g1.n_inputs} and {g2.n_outputs}×{g2.n_inputs}")
+        raise ModelError(f"parallel: shapes differ, {g1.n_outputs}×{g1.n_inputs} and "
+                         f"{g2.n_outputs}×{g2.n_inputs}")
     _check_units(g1.input_units, g2.input_units, "parallel inputs")
     _check_units(g2.output_units, g1.output_units, "parallel outputs")
     sig = dict(dt=dt, inputs=g1.inputs, outputs=g1.outputs, input_units=g1.input_units,
@@ -1669,7 +1729,8 @@ def parallel(g1: LinearSystem, g2: LinearSystem) -> LinearSystem:
     if _both_siso_tf(g1, g2):
         return _siso_tf_op(_connect.tf_parallel, g1, g2, sig)
     s1, s2 = g1.to_ss(minimal=False), g2.to_ss(minimal=False)
-    arrs, unc = push(_connect.ss_parallel, [s1._arrays(), s2._arrays()], [s1.uncertainty, s2.uncertainty])
+    arrs, unc = (push(_connect.ss_parallel, [s1._arrays(), s2._arrays()],
+                      [s1.uncertainty, s2.uncertainty]))
     return StateSpace(*arrs, **sig, states=_joined(s1.states, s2.states), uncertainty=unc)
 
 
@@ -1713,7 +1774,8 @@ def feedback(plant: LinearSystem, controller=1.0, sign: float = -1.0) -> LinearS
     sig = dict(dt=dt, inputs=plant.inputs, outputs=plant.outputs, input_units=plant.input_units,
                output_units=plant.output_units, meta={})
     if _both_siso_tf(plant, K):
-        return _siso_tf_op(lambda n, d, nk, dk: _connect.tf_feedback(n, d, nk, dk, sign), plant, K, sig)
+        return (_siso_tf_op(lambda n, d, nk, dk: _connect.tf_feedback(n, d, nk, dk, sign), plant, K,
+                            sig))
     s1, s2 = plant.to_ss(minimal=False), K.to_ss(minimal=False)
     arrs, unc = push(lambda *a: _connect.ss_feedback(*a, sign=sign), [s1._arrays(), s2._arrays()],
                      [s1.uncertainty, s2.uncertainty])

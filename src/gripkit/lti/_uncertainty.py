@@ -59,7 +59,8 @@ class Uncertainty:
                              + ", ".join(sorted({n for n in names if names.count(n) > 1})))
         cov = np.array(self.covariance, dtype=np.float64)
         if cov.shape != (k, k):
-            raise ModelError(f"covariance: expected shape ({k}, {k}) (one row per parameter), found {cov.shape}")
+            raise ModelError(f"covariance: expected shape ({k}, {k}) (one row per parameter), "
+                             f"found {cov.shape}")
         if not np.isfinite(cov).all():
             raise ModelError("covariance has non-finite entries")
         scale = max(float(np.abs(cov).max()) if k else 0.0, np.finfo(float).tiny)
@@ -74,7 +75,8 @@ class Uncertainty:
         for t in self.tangents:
             t = np.array(t, dtype=np.float64)
             if t.shape[:1] != (k,):
-                raise ModelError(f"tangents: expected a leading axis of {k} (one per parameter), found shape {t.shape}")
+                raise ModelError(f"tangents: expected a leading axis of {k} (one per parameter), "
+                                 f"found shape {t.shape}")
             if not np.isfinite(t).all():
                 raise ModelError("tangents have non-finite entries")
             t.flags.writeable = False
@@ -95,10 +97,12 @@ class Uncertainty:
 
     def _check_shapes(self, arrays) -> None:
         if len(arrays) != len(self.tangents):
-            raise ModelError(f"uncertainty: expected {len(arrays)} tangent arrays, found {len(self.tangents)}")
+            raise ModelError(f"uncertainty: expected {len(arrays)} tangent arrays, found "
+                             f"{len(self.tangents)}")
         for a, t in zip(arrays, self.tangents):
             if t.shape[1:] != a.shape:
-                raise ModelError(f"uncertainty: tangent shape {t.shape[1:]} does not match its array {a.shape}")
+                raise ModelError(f"uncertainty: tangent shape {t.shape[1:]} does not match its "
+                                 f"array {a.shape}")
 
     def draws(self, n: int, rng) -> np.ndarray:
         """``n`` parameter deviations δθ ~ N(0, Σ), shape (n, k) (Σ may be singular).

@@ -24,8 +24,10 @@ from .transmission import Transmission as Transmission
 from .transmission import harmonic_drive as harmonic_drive
 from .transmission import timing_belt as timing_belt
 
-__all__ = ["BLDCMotor", "BoucWen", "FrictionDrive", "FrictionTable", "MassSpringDamper", "MotorTestBed",
-           "PiezoActuator", "SecondOrderSystem", "Stribeck", "Transmission", "clamped_clamped_stiffness",
+__all__ = ["BLDCMotor", "BoucWen", "FrictionDrive", "FrictionTable", "MassSpringDamper",
+           "MotorTestBed",
+           "PiezoActuator", "SecondOrderSystem", "Stribeck", "Transmission",
+           "clamped_clamped_stiffness",
            "comb_drive_force", "comb_drive_voltage", "cubic_stiffness", "harmonic_drive",
            "reference_bouc_wen", "reference_mass_spring_damper", "reference_piezo_actuator",
            "suspension_force", "timing_belt"]

@@ -47,7 +47,8 @@ def _pos(name: str, v: float) -> float:
 
 
 def clamped_clamped_stiffness(E: float, thickness: float, width: float, length: float) -> float:
-    """Two pairs of clamped-clamped beams under a mid-span load: K = 32 E h w³ / L³ [N/m] (eqs 4, 13).
+    """Two pairs of clamped-clamped beams under a mid-span load: K = 32 E h w³ / L³ [N/m] (eqs 4,
+    13).
 
     ``E`` in Pa, ``thickness`` h, ``width`` w and ``length`` L in m.
     """

@@ -143,7 +143,8 @@ def motor_parameters(*, name: str = "bldc") -> ParameterSet:
         Parameter("b_pwm", 1.215e-8 * NCM / RPM, "N*m*s/rad",
                   "PWM-proportional part of the torque-speed slope (per count)",
                   source=f"{src58} (1.215e-8 Ncm/(rpm·PWM))"),
-        Parameter("b_0", -7.711e-5 * NCM / RPM, "N*m*s/rad", "constant part of the torque-speed slope",
+        Parameter("b_0", -7.711e-5 * NCM / RPM, "N*m*s/rad", "constant part of the "
+                                                             "torque-speed slope",
                   source=f"{src58} (-7.711e-5 Ncm/rpm)"),
         Parameter("pwm_max", PWM_MAX, "1", "largest PWM count (continuous voltage)",
                   bounds=(1.0, None), fixed=True, source=f"{SEED}, §5.2"),
@@ -152,11 +153,14 @@ def motor_parameters(*, name: str = "bldc") -> ParameterSet:
                   source="derived: Fig. 5.7 (<0.6 Ncm near 80 °C) with eq 5.7 (0.572 Ncm)"),
         Parameter("T_amb", 298.15, "K", "ambient (room) temperature T0 of eq 5.5",
                   bounds=(200.0, 400.0), display_unit="degC", source="assumed: 25 °C room"),
-        Parameter("alpha_R", 0.0136, "1/K", "effective temperature coefficient of the winding resistance",
+        Parameter("alpha_R", 0.0136, "1/K", "effective temperature coefficient of the "
+                                            "winding resistance",
                   bounds=(0.0, 0.1),
-                  source="derived: Fig. 5.7, ~1.0 Ncm at 25 °C -> 0.572 Ncm at 80 °C (see module doc)"),
+                  source="derived: Fig. 5.7, ~1.0 Ncm at 25 °C -> 0.572 Ncm at 80 °C "
+                         "(see module doc)"),
         Parameter("k_t", 7.95e-3, "N*m/A", "torque constant",
-                  bounds=(1e-6, None), source="derived: 12 V supply (assumed) and |b(3000)| = k_t²/R(T_ref)"),
+                  bounds=(1e-6, None), source="derived: 12 V supply (assumed) and |b(3000)| "
+                                              "= k_t²/R(T_ref)"),
         Parameter("R_0", 9.32, "ohm", "winding resistance at T_amb",
                   bounds=(1e-6, None), source="derived: 12 V supply (assumed) and eq 5.7 at 25 °C"),
         Parameter("R_th", 7.2, "K/W", "thermal resistance winding to ambient",
@@ -174,7 +178,8 @@ class BLDCMotor:
     """
 
     name = "dlr-hit-bldc"
-    description = "maxon EC 20 flat BLDC motor of the DLR/HIT Hand II, torque vs PWM/speed/temperature"
+    description = ("maxon EC 20 flat BLDC motor of the DLR/HIT Hand II, torque vs "
+                   "PWM/speed/temperature")
 
     def __init__(self, parameters: ParameterSet | None = None):
         self.parameters = parameters if parameters is not None else motor_parameters()
@@ -188,7 +193,8 @@ class BLDCMotor:
             return 1.0
         T = np.asarray(T, dtype=np.float64)
         a = self._p("alpha_R")
-        return (1.0 + a * (self._p("T_ref") - self._p("T_amb"))) / (1.0 + a * (T - self._p("T_amb")))
+        return (1.0 + a * (self._p("T_ref") - self._p("T_amb"))) / (1.0 + a
+                                                                    * (T - self._p("T_amb")))
 
     def slope(self, pwm) -> np.ndarray:
         """b(|u|) of eq 5.8 in N·m·s/rad (multiply by RPM/NCM for Ncm/rpm)."""
@@ -213,13 +219,15 @@ class BLDCMotor:
         return np.clip(u, -self._p("pwm_max"), self._p("pwm_max"))
 
     def current(self, torque, T=None) -> np.ndarray:
-        """Winding current I = τ/k_t (A): the current of eqs 5.2 and 5.4 (P_el = U·I, P_J = R(T)·I²)."""
+        """Winding current I = τ/k_t (A): the current of eqs 5.2 and 5.4 (P_el = U·I, P_J =
+        R(T)·I²)."""
         return np.asarray(torque, dtype=np.float64) / self._p("k_t")
 
     def resistance(self, T) -> np.ndarray:
         """R(T) = R₀(1 + α(T − T_amb)) (Ω), eq 5.5: the resistance of the Joule loss P_J = R(T)·I²
         (eq 5.4) in the power balance of eq 5.6."""
-        return self._p("R_0") * (1.0 + self._p("alpha_R") * (np.asarray(T, dtype=np.float64) - self._p("T_amb")))
+        return (self._p("R_0") * (1.0 + self._p("alpha_R")
+                                  * (np.asarray(T, dtype=np.float64) - self._p("T_amb"))))
 
     def electrical_constants(self, supply_voltage: float = SUPPLY_VOLTAGE) -> tuple[float, float]:
         """(k_t in N·m/A, R₀ in Ω) that make a DC motor on ``supply_voltage`` (V) give eq 5.10's
@@ -290,9 +298,11 @@ class BLDCMotor:
         out = [self._power_balance_finding(), self._speed_unit_finding()]
         for pwm, stated in SLOPES_5_4_2.items():
             out.append(compare(f"eq5.8-slope-pwm{pwm}", self.name,
-                               computed=float(self.slope(pwm)) * RPM / NCM, stated=stated, rtol=0.06,
+                               computed=float(self.slope(pwm)) * RPM / NCM, stated=stated,
+                               rtol=0.06,
                                what=f"eq 5.8 slope at PWM {pwm}", unit="Ncm/rpm",
-                               used="gripkit uses eq 5.8 (the least-squares line through the four slopes)",
+                               used="gripkit uses eq 5.8 (the least-squares line through "
+                                    "the four slopes)",
                                source=f"{SEED}, §5.4.2"))
         a_eff = self._p("alpha_R")
         dT = 55.0
@@ -300,9 +310,11 @@ class BLDCMotor:
         drop_eff = 1.0 / (1.0 + a_eff * dT)
         out.append(compare("fig5.7-temperature-coefficient", self.name,
                            computed=a_eff, stated=0.2 / 50.0, rtol=0.25,
-                           what="α implied by Fig. 5.7 with eq 5.7 (vs §5.2: '50 K raise R by about 20 %')",
+                           what="α implied by Fig. 5.7 with eq 5.7 (vs §5.2: '50 K raise R "
+                                "by about 20 %')",
                            unit="1/K",
-                           used=(f"gripkit uses α = {a_eff:.4g}/K, which reproduces Fig. 5.7 (1.0 -> "
+                           used=(f"gripkit uses α = {a_eff:.4g}/K, which reproduces "
+                                 "Fig. 5.7 (1.0 -> "
                                  f"{drop_eff:.2f} Ncm from 25 to 80 °C); §5.2's α would give only "
                                  f"{drop_copper:.2f} Ncm"),
                            source=f"{SEED}, §5.2 and Fig. 5.7"))
@@ -402,7 +414,8 @@ class MotorTestBed(Model):
     name = "dlr-hit-motor-test-bed"
     description = "BLDC motor on the torque test bed of §5.3 (eq 5.10 with temperature, Fig. 5.7)"
     inputs = (Signal("pwm", "1", "PWM duty count"), Signal("speed", "rad/s", "imposed shaft speed"))
-    outputs = (Signal("torque", "N*m", "shaft torque"), Signal("temperature", "K", "winding temperature"),
+    outputs = (Signal("torque", "N*m", "shaft torque"),
+               Signal("temperature", "K", "winding temperature"),
                Signal("current", "A", "winding current"))
     states = (Signal("temperature", "K", "winding temperature"),)
     integrator = "semi-implicit"
@@ -410,7 +423,8 @@ class MotorTestBed(Model):
     def __init__(self, parameters: ParameterSet | None = None, *, check: bool = True):
         parameters = parameters if parameters is not None else motor_parameters()
         if parameters.names != motor_parameters().names:
-            raise ModelError("MotorTestBed: expected the parameters of motor_parameters(), in order",
+            raise ModelError("MotorTestBed: expected the parameters of "
+                             "motor_parameters(), in order",
                              hint=f"found {', '.join(parameters.names)}")
         super().__init__(parameters, check=check)
 

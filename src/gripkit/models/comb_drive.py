@@ -51,6 +51,7 @@ def comb_drive_gain(v0: float, n_pairs: float, eps: float, thickness: float, gap
 
 def comb_drive_voltage(force, coefficient: float, v_max: float = np.inf):
     """Voltage that produces ``force`` (N): V = √(F/c), clipped to [0, v_max] (square-law inversion
-    used by force-commanding controllers; a negative force request gives 0 V: comb drives only pull)."""
+    used by force-commanding controllers; a negative force request gives 0 V: comb drives only
+    pull)."""
     c = _pos("coefficient", coefficient)
     return np.clip(np.sqrt(np.clip(np.asarray(force, dtype=np.float64), 0.0, None) / c), 0.0, v_max)

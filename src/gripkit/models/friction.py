@@ -35,7 +35,8 @@ state z with
     ż = v − σ₀|v| z / g(v),  g(v) = F_c + (F_s − F_c) exp(−(v/v_s)²),  F = σ₀ z + σ₁ ż + σ₂ v;
 
 it reproduces pre-sliding displacement and frictional lag, but unlike Karnopp it moves under a
-constant sub-stiction load (a pre-sliding displacement of many times F_s/σ₀ before it settles). gripkit integrates z exactly for the velocity held over a step
+constant sub-stiction load (a pre-sliding displacement of many times F_s/σ₀ before it settles).
+gripkit integrates z exactly for the velocity held over a step
 (z relaxes exponentially towards sign(v)·g(v)/σ₀ at rate σ₀|v|/g(v)), stable for any step.
 """
 
@@ -178,7 +179,8 @@ class FrictionTable:
         if (d <= 0).any():
             i = int(np.argmax(d <= 0)) + 1
             raise DataError(f"{name}: breakpoints must increase strictly; breakpoint {i} "
-                            f"({v[i]:.6g}) follows {v[i - 1]:.6g}", hint="sort the table by velocity")
+                            f"({v[i]:.6g}) follows {v[i - 1]:.6g}",
+                            hint="sort the table by velocity")
         if not ((v < 0).sum() >= 2 and (v > 0).sum() >= 2):
             raise DataError(f"{name}: needs at least two breakpoints of each sign (found "
                             f"{(v < 0).sum()} negative, {(v > 0).sum()} positive)")
@@ -227,7 +229,8 @@ class FrictionTable:
         """A copy without the :meth:`outliers` (measurement points the thesis meant to delete)."""
         bad = {i for i, _ in self.outliers(rtol)}
         keep = np.array([i not in bad for i in range(self.velocity.size)])
-        return FrictionTable(self.velocity[keep], self.friction[keep], name=f"{self.name} (outliers removed)",
+        return FrictionTable(self.velocity[keep], self.friction[keep],
+                             name=f"{self.name} (outliers removed)",
                              source=self.source, scale=self.scale)
 
     @classmethod
@@ -256,7 +259,8 @@ class FrictionTable:
 
     def __repr__(self) -> str:
         return (f"FrictionTable({self.name!r}, {self.velocity.size} breakpoints "
-                f"{self.velocity[0] / DEG:.4g}..{self.velocity[-1] / DEG:.4g} deg/s, scale {self.scale:g})")
+                f"{self.velocity[0] / DEG:.4g}..{self.velocity[-1] / DEG:.4g} deg/s, scale "
+                f"{self.scale:g})")
 
 
 #: FrictionTables padded into kernel arrays: breakpoints (m, K), scaled values (m, K), lengths (m,)
@@ -314,13 +318,18 @@ def friction_drive_parameters(J: float = 0.0221, fc: float = 0.19, fs: float = 0
     table; v_s, δ, σ and the LuGre stiffness/damping are assumed."""
     seed = "002_ddea254371185ad3.txt"
     return ParameterSet([
-        Parameter("J", J, "kg*m^2", "inertia at the joint (rotor inertia reflected)", bounds=(1e-12, None),
+        Parameter("J", J, "kg*m^2", "inertia at the joint (rotor "
+                                    "inertia reflected)", bounds=(1e-12, None),
                   source=f"{seed}, Appendix A (Im = 5.1e-7 kg·m²) × 208.3²"),
-        Parameter("fc", fc, "N*m", "Coulomb friction", bounds=(0, None), source=f"{seed}, Appendix G (low speed)"),
-        Parameter("fs", fs, "N*m", "stiction (breakaway torque)", bounds=(0, None), source=f"{seed}, Appendix F"),
+        Parameter("fc", fc, "N*m", "Coulomb friction", bounds=(0, None),
+                  source=f"{seed}, Appendix G (low speed)"),
+        Parameter("fs", fs, "N*m", "stiction (breakaway torque)", bounds=(0, None),
+                  source=f"{seed}, Appendix F"),
         Parameter("vs", vs, "rad/s", "Stribeck velocity", bounds=(1e-9, None), source="assumed"),
-        Parameter("delta", delta, "1", "Stribeck shape factor", bounds=(0.1, 10.0), source="assumed"),
-        Parameter("sigma", sigma, "N*m*s/rad", "viscous friction", bounds=(0, None), source="assumed"),
+        Parameter("delta", delta, "1", "Stribeck shape factor", bounds=(0.1, 10.0),
+                  source="assumed"),
+        Parameter("sigma", sigma, "N*m*s/rad", "viscous friction", bounds=(0, None),
+                  source="assumed"),
         Parameter("sigma0", sigma0, "N*m/rad", "LuGre bristle stiffness", bounds=(1e-9, None),
                   source="assumed: pre-sliding displacement fs/σ0 = 1 mrad"),
         Parameter("sigma1", sigma1, "N*m*s/rad", "LuGre bristle damping", bounds=(0, None),
@@ -386,7 +395,8 @@ class FrictionDrive(Model):
     inputs = (Signal("tau", "N*m", "applied torque"),)
     outputs = (Signal("position", "rad", "position"), Signal("velocity", "rad/s", "velocity"),
                Signal("friction", "N*m", "friction torque (opposing)"))
-    states = (Signal("position", "rad"), Signal("velocity", "rad/s"), Signal("z", "rad", "LuGre bristle"),
+    states = (Signal("position", "rad"), Signal("velocity", "rad/s"),
+              Signal("z", "rad", "LuGre bristle"),
               Signal("stuck", "1", "1 when at rest in stiction"))
     integrator = "semi-implicit"
 
@@ -396,7 +406,8 @@ class FrictionDrive(Model):
             raise ModelError(f"kind: expected 'karnopp' or 'lugre', found {kind!r}")
         ps = parameters if parameters is not None else friction_drive_parameters(**values)
         if ps.names != friction_drive_parameters().names:
-            raise ModelError("FrictionDrive: expected the parameters of friction_drive_parameters()")
+            raise ModelError("FrictionDrive: expected the parameters of "
+                             "friction_drive_parameters()")
         self.kind = kind
         super().__init__(ps, check=check)
 

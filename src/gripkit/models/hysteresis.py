@@ -1,4 +1,5 @@
-"""Rate-independent Bouc-Wen hysteresis of a piezoelectric actuator (``001_0b92a7da96e7aa46.txt`` eq 3).
+"""Rate-independent Bouc-Wen hysteresis of a piezoelectric actuator (``001_0b92a7da96e7aa46.txt``
+eq 3).
 
     y = d_p U − H,        dH/dt = λ dU/dt − β |dU/dt| H − γ dU/dt |H|          (eq 3)
 
@@ -89,7 +90,8 @@ def _bouc_wen_row(theta, u, x0, y):  # pragma: no cover - compiled
 
 @numba.njit(cache=True, parallel=True)
 def _bouc_wen_batch(thetas, u, dt, substeps, x0, y):  # pragma: no cover - compiled
-    for p in prange(thetas.shape[0]):  # rows in parallel; the row body is a plain function (faster code)
+    # rows in parallel; the row body is a plain function (faster code)
+    for p in prange(thetas.shape[0]):
         _bouc_wen_row(thetas[p], u, x0[p], y[p])
 
 
@@ -128,7 +130,8 @@ class BoucWen(Model):
     integrator = "zoh"  # exact per sample (rate independent)
 
     def __init__(self, parameters: ParameterSet | None = None, *, d_p: float = 0.77e-6,
-                 lam: float = 0.43e-6, beta: float = 0.108, gamma: float = 7.5e-3, check: bool = True):
+                 lam: float = 0.43e-6, beta: float = 0.108, gamma: float = 7.5e-3,
+                 check: bool = True):
         super().__init__(parameters if parameters is not None
                          else bouc_wen_parameters(d_p, lam, beta, gamma), check=check)
 

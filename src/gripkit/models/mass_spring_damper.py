@@ -89,7 +89,8 @@ def _msd_batch(thetas, u, dt, substeps, x0, y):  # pragma: no cover - compiled
             x = xn
 
 
-def msd_parameters(m: float, b: float, k: float, *, source: str = "", name: str = "msd") -> ParameterSet:
+def msd_parameters(m: float, b: float, k: float, *, source: str = "",
+                   name: str = "msd") -> ParameterSet:
     """A ParameterSet (m [kg], b [N·s/m], k [N/m]) with positivity bounds."""
     return ParameterSet([
         Parameter("m", m, "kg", "moving mass", bounds=(1e-15, None), source=source),
@@ -110,7 +111,8 @@ class MassSpringDamper(Model):
 
     def __init__(self, parameters: ParameterSet | None = None, *, m: float = 1.0, b: float = 0.1,
                  k: float = 1.0, check: bool = True):
-        super().__init__(parameters if parameters is not None else msd_parameters(m, b, k), check=check)
+        super().__init__(parameters if parameters is not None else msd_parameters(m, b, k),
+                         check=check)
 
     def _simulate_batch(self, thetas, u, dt, substeps, x0, y):
         _msd_batch(thetas, u, dt, substeps, x0, y)

@@ -1,4 +1,5 @@
-"""Piezoelectric bending actuator with voltage, force and moment inputs (``001_0b92a7da96e7aa46.txt``
+"""Piezoelectric bending actuator with voltage, force and moment inputs
+(``001_0b92a7da96e7aa46.txt``
 eqs 2–4).
 
     y_A = [ d_p U − H_s(U) − s_p F_A − (3/(2 L_a)) s_p M_A ] · D(s)
@@ -55,24 +56,30 @@ def actuator_state_space(s_p: float, a: float, b: float, L_a: float) -> StateSpa
     B /= a
     C = np.zeros((2, 4))
     C[0, 0] = C[1, 2] = 1.0
-    return StateSpace(A, B, C, np.zeros((2, 3)), inputs=("W", "F_A", "M_A"), outputs=("y_A", "alpha_A"),
+    return StateSpace(A, B, C, np.zeros((2, 3)), inputs=("W", "F_A", "M_A"),
+                      outputs=("y_A", "alpha_A"),
                       input_units=("m", "N", "N*m"), output_units=("m", "rad"))
 
 
 def actuator_parameters(d_p: float, s_p: float, lam: float, beta: float, gamma: float, a: float,
-                        b: float, L_a: float, *, source: str = "", name: str = "piezo-actuator") -> ParameterSet:
+                        b: float, L_a: float, *, source: str = "",
+                        name: str = "piezo-actuator") -> ParameterSet:
     """ParameterSet of eq 4 (SI units)."""
     bw = bouc_wen_parameters(d_p, lam, beta, gamma, source=source)
     return ParameterSet([
         bw["d_p"],
-        Parameter("s_p", s_p, "m/N", "elastic compliance at the actuator tip A (eq 4)", bounds=(0.0, None),
+        Parameter("s_p", s_p, "m/N", "elastic compliance at the "
+                                     "actuator tip A (eq 4)", bounds=(0.0, None),
                   source=source, display_unit="um/N"),
         bw["lam"], bw["beta"], bw["gamma"],
-        Parameter("a", a, "s^2", "D(s) = 1/(a s² + b s + 1): s² coefficient (eq 4)", bounds=(1e-16, None),
+        Parameter("a", a, "s^2", "D(s) = 1/(a s² + b s + 1): s² "
+                                 "coefficient (eq 4)", bounds=(1e-16, None),
                   source=source),
-        Parameter("b", b, "s", "D(s) = 1/(a s² + b s + 1): s coefficient (eq 4)", bounds=(0.0, None),
+        Parameter("b", b, "s", "D(s) = 1/(a s² + b s + 1): s "
+                               "coefficient (eq 4)", bounds=(0.0, None),
                   source=source),
-        Parameter("L_a", L_a, "m", "actuator length (eq 4)", bounds=(1e-6, None), fixed=True, source=source,
+        Parameter("L_a", L_a, "m", "actuator length (eq 4)", bounds=(1e-6, None), fixed=True,
+                  source=source,
                   display_unit="mm"),
     ], name)
 
@@ -84,7 +91,8 @@ def lti_modes(A: np.ndarray) -> list[tuple[float, float]]:
 
 @numba.njit(cache=True)
 def bw_lti_row(bw, Phi, Gam, C, D, u, x0, y):  # pragma: no cover - compiled
-    """One parameter row of :func:`bw_lti_batch` (bw (4,), Phi (n, n), … , x0 (2 + n,), y (N, p))."""
+    """One parameter row of :func:`bw_lti_batch` (bw (4,), Phi (n, n), … , x0 (2 + n,), y (N,
+    p))."""
     N = u.shape[0]
     n = Phi.shape[0]
     m = Gam.shape[1]
@@ -152,10 +160,12 @@ class PiezoActuator(Model):
               Signal("w_A", "rad/s", ""))
     integrator = "zoh"
 
-    def __init__(self, parameters: ParameterSet | None = None, *, loads: bool = True, check: bool = True,
+    def __init__(self, parameters: ParameterSet | None = None, *, loads: bool = True,
+                 check: bool = True,
                  **values):
         if parameters is None:
-            defaults = dict(d_p=0.77e-6, s_p=9.1e-4, lam=0.43e-6, beta=0.108, gamma=7.5e-3, a=2.5e-8,
+            defaults = dict(d_p=0.77e-6, s_p=9.1e-4, lam=0.43e-6, beta=0.108, gamma=7.5e-3,
+                            a=2.5e-8,
                             b=8e-5, L_a=15e-3)
             defaults.update(values)
             parameters = actuator_parameters(**defaults)

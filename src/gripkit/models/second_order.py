@@ -3,7 +3,8 @@
     m ÿ + c ẏ + k y = g (u − u₀),    output y₀ + y                     (SI, any units)
 
 covers the standard form  G(s) = K ω_n² / (s² + 2ζω_n s + ω_n²)  (m = 1, c = 2ζω_n, k = ω_n²,
-g = K ω_n²) used by the step-response identification (:mod:`gripkit.sysid.physical.step_response`) and the
+g = K ω_n²) used by the step-response identification (:mod:`gripkit.sysid.physical.step_response`)
+and the
 FT-G100 subsystems (eqs 9, 15 of ``003_abd62b560633beaf.txt``). The response is linear in g, so
 each parameter vector runs the exact zero-order-hold mass-spring-damper kernel
 (:func:`gripkit.models.mass_spring_damper.msd_zoh`) on the unit-gain input and is scaled afterwards.
@@ -23,7 +24,8 @@ from .mass_spring_damper import _msd_batch
 __all__ = ["second_order_batch", "SecondOrderSystem", "second_order_step"]
 
 
-def second_order_batch(coef: np.ndarray, u: np.ndarray, dt: float, x0: np.ndarray, y: np.ndarray) -> None:
+def second_order_batch(coef: np.ndarray, u: np.ndarray, dt: float, x0: np.ndarray,
+                       y: np.ndarray) -> None:
     """Simulate P systems: ``coef`` (P, 6) rows [m, c, k, g, u₀, y₀]; ``u`` (N, ≥1) (first column
     used); ``x0`` (P, 2) initial [y, ẏ] (without y₀); writes ``y`` (P, N, 1)."""
     gains = coef[:, 3]
@@ -67,9 +69,11 @@ class SecondOrderSystem(Model):
     integrator = "zoh"
     states = (Signal("y", "1", "output deviation"), Signal("ydot", "1/s", "its rate"))
 
-    def __init__(self, parameters: ParameterSet | None = None, *, gain: float = 1.0, wn: float = 1.0,
+    def __init__(self, parameters: ParameterSet | None = None, *, gain: float = 1.0,
+                 wn: float = 1.0,
                  zeta: float = 0.5, y0: float = 0.0, u0: float = 0.0, input_unit: str = "1",
-                 output_unit: str = "1", input_name: str = "u", output_name: str = "y", check: bool = True):
+                 output_unit: str = "1", input_name: str = "u", output_name: str = "y",
+                 check: bool = True):
         gunit = ratio_unit(output_unit, input_unit)
         if parameters is None:
             parameters = ParameterSet([

@@ -44,9 +44,11 @@ class Transmission:
 
     def __post_init__(self):
         if not (np.isfinite(self.ratio) and self.ratio != 0):
-            raise ModelError(f"{self.name}: ratio must be finite and non-zero, found {self.ratio!r}")
+            raise ModelError(f"{self.name}: ratio must be finite and non-zero, "
+                             f"found {self.ratio!r}")
         if not (0 < self.efficiency <= 1):
-            raise ModelError(f"{self.name}: efficiency must lie in (0, 1], found {self.efficiency!r}")
+            raise ModelError(f"{self.name}: efficiency must lie in (0, 1], found "
+                             f"{self.efficiency!r}")
 
     def then(self, other: "Transmission") -> "Transmission":
         """This stage followed by ``other`` (ratios and efficiencies multiply)."""
@@ -63,7 +65,8 @@ class Transmission:
         """τ_out for motor torque ``tau_in``; ``omega_out`` (sign) decides driving/back-driving."""
         tau_in = np.asarray(tau_in, dtype=np.float64)
         driving = tau_in * np.asarray(omega_out, dtype=np.float64) >= 0
-        return np.where(driving, self.ratio * self.efficiency * tau_in, self.ratio * tau_in / self.efficiency)
+        return (np.where(driving, self.ratio * self.efficiency * tau_in,
+                         self.ratio * tau_in / self.efficiency))
 
     def reflected_inertia(self, rotor_inertia: float) -> float:
         """Rotor inertia seen at the output, I_m·N² (thesis Appendix A)."""

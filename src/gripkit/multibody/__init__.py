@@ -24,6 +24,8 @@ from .urdf import from_urdf as from_urdf
 from .urdf import to_urdf as to_urdf
 
 __all__ = ["bias", "coriolis", "CoupledChain", "Coupling", "DHChain", "differential_matrix",
-           "finger_coupling", "forward_dynamics", "from_urdf", "gravity", "JointChain", "JointLimits",
-           "kinetic_energy", "mass_matrix", "potential_energy", "regressor", "rnea", "simulate_free",
+           "finger_coupling", "forward_dynamics", "from_urdf", "gravity", "JointChain",
+           "JointLimits",
+           "kinetic_energy", "mass_matrix", "potential_energy", "regressor", "rnea",
+           "simulate_free",
            "to_urdf"]

@@ -78,7 +78,8 @@ class Coupling:
                              f"found {off.shape} and {arm.shape}")
         if (arm < 0).any():
             raise ModelError(f"coupling armature must be >= 0, found {arm.tolist()}")
-        names = tuple(self.names) if self.names is not None else tuple(f"p{j + 1}" for j in range(m))
+        names = (tuple(self.names) if self.names is not None
+                 else tuple(f"p{j + 1}" for j in range(m)))
         if len(names) != m:
             raise ModelError(f"coupling: expected {m} actuator names, found {len(names)}")
         object.__setattr__(self, "matrix", G)
@@ -169,7 +170,8 @@ class CoupledChain(Dynamics):
         if self._arrays is None:
             dh, jt, mass, com, i6, arm, g = self._chain.link_arrays()
             c = self.coupling
-            self._arrays = ChainArrays(dh, jt, mass, com, i6, arm, np.ascontiguousarray(c.matrix.ravel()),
+            self._arrays = ChainArrays(dh, jt, mass, com, i6, arm,
+                                       np.ascontiguousarray(c.matrix.ravel()),
                                        c.offset, c.armature, g)
         return self._arrays
 

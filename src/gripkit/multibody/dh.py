@@ -33,7 +33,8 @@ def _as_transform(T, what: str) -> np.ndarray:
         return np.eye(4)
     T = np.asarray(T, dtype=np.float64)
     if T.shape != (4, 4) or not np.isfinite(T).all():
-        raise ModelError(f"{what}: expected a finite 4×4 homogeneous transform, found shape {T.shape}")
+        raise ModelError(f"{what}: expected a finite 4×4 homogeneous transform, found "
+                         f"shape {T.shape}")
     R = T[:3, :3]
     if not np.allclose(R @ R.T, np.eye(3), atol=1e-9) or abs(np.linalg.det(R) - 1) > 1e-9 \
             or not np.allclose(T[3], [0, 0, 0, 1]):
@@ -47,9 +48,11 @@ def _into(out, value: np.ndarray) -> np.ndarray:
         return value
     if not (isinstance(out, np.ndarray) and out.dtype == np.float64 and out.shape == value.shape
             and out.flags.writeable):
-        found = (f"{out.dtype} array of shape {out.shape}{'' if out.flags.writeable else ', read-only'}"
+        found = (f"{out.dtype} array of shape "
+                 f"{out.shape}{'' if out.flags.writeable else ', read-only'}"
                  if isinstance(out, np.ndarray) else type(out).__name__)
-        raise ArgumentError(f"out: expected a writable float64 array of shape {value.shape}, found {found}")
+        raise ArgumentError("out: expected a writable float64 array of shape "
+                            f"{value.shape}, found {found}")
     out[...] = value
     return out
 
@@ -91,7 +94,8 @@ class Dynamics:
 
     @property
     def parameter_names(self) -> tuple[str, ...]:
-        """``'<parameter>_<link>'`` per regressor column (m, mx, my, mz, Ixx, Ixy, Iyy, Ixz, Iyz, Izz)."""
+        """``'<parameter>_<link>'`` per regressor column (m, mx, my, mz, Ixx, Ixy, Iyy, Ixz, Iyz,
+        Izz)."""
         return parameter_names(self)
 
     def standard_parameters(self) -> np.ndarray:
@@ -114,12 +118,14 @@ class Dynamics:
     def mass_matrix(self, q, *, out: np.ndarray | None = None) -> np.ndarray:
         """M(q), including reflected rotor inertia (CRBA, eqs 4.14–4.16); one float64 state takes
         the low-overhead path of :mod:`gripkit.multibody.onestate`. ``out``: a float64 array of
-        M's shape to write into (a controller loop's workspace, as Pinocchio's ``data``); returned."""
+        M's shape to write into (a controller loop's workspace, as Pinocchio's ``data``);
+        returned."""
         buf, _, shape = self._one or self._one_state()
         res = np.empty(shape) if out is None else out
         try:
             done = mass_matrix_one(buf, q, res)
-        except TypeError:  # not a 1-D float64 state or a C-contiguous float64 out: the validating way
+        # not a 1-D float64 state or a C-contiguous float64 out: the validating way
+        except TypeError:
             done = False
         return res if done else _into(out, _dyn.mass_matrix(self, q))
 
@@ -221,7 +227,8 @@ class DHChain(Dynamics):
         alpha = np.atleast_1d(np.asarray(alpha, dtype=np.float64))
         n = alpha.shape[0]
         if alpha.ndim != 1 or n < 1:
-            raise ModelError(f"alpha: expected a 1-D array of link twists, found shape {alpha.shape}")
+            raise ModelError("alpha: expected a 1-D array of link twists, found "
+                             f"shape {alpha.shape}")
 
         def vec(x, what, default=0.0, shape=(n,)):
             if x is None:
@@ -238,7 +245,8 @@ class DHChain(Dynamics):
         off = vec(theta_offset, "theta_offset")
         jt = "R" * n if joint_types is None else str(joint_types).upper()
         if len(jt) != n or set(jt) - {"R", "P"}:
-            raise ModelError(f"joint_types: expected {n} letters R (revolute) or P (prismatic), found {joint_types!r}")
+            raise ModelError(f"joint_types: expected {n} letters R (revolute) or P (prismatic), "
+                             f"found {joint_types!r}")
         mass = vec(mass, "mass")
         if (mass < 0).any():
             raise ModelError(f"mass: link masses must be >= 0 kg, found {mass.tolist()}")
@@ -251,10 +259,12 @@ class DHChain(Dynamics):
             ev = np.linalg.eigvalsh(Ik)
             tol = 1e-12 * max(1.0, ev.max(initial=0.0))
             if ev.min() < -tol:
-                raise ModelError(f"inertia of link {k + 1} has a negative principal moment ({ev.min():.3g} kg·m²)")
+                raise ModelError(f"inertia of link {k + 1} has a negative principal moment "
+                                 f"({ev.min():.3g} kg·m²)")
             if ev[0] + ev[1] < ev[2] - tol:
                 raise ModelError(f"inertia of link {k + 1} violates the triangle inequality "
-                                 f"(principal moments {ev[0]:.3g} + {ev[1]:.3g} < {ev[2]:.3g} kg·m²): "
+                                 f"(principal moments {ev[0]:.3g} + {ev[1]:.3g} < "
+                                 f"{ev[2]:.3g} kg·m²): "
                                  f"no rigid body has it")
         armature = vec(armature, "armature")
         if (armature < 0).any():
@@ -312,7 +322,8 @@ class DHChain(Dynamics):
         """A copy with some constructor arguments changed (``gravity=``, ``base=``, ...)."""
         kw = dict(alpha=self.dh[:, 0], a=self.dh[:, 1], d=self.dh[:, 2], theta_offset=self.dh[:, 3],
                   joint_types=self.joint_types, mass=self.mass, com=self.com, inertia=self.inertia,
-                  armature=self.armature, gravity=self.gravity_vector, tool=self.tool, base=self.base,
+                  armature=self.armature, gravity=self.gravity_vector, tool=self.tool,
+                  base=self.base,
                   names=self.names, name=self.name)
         unknown = set(changes) - set(kw)
         if unknown:
@@ -321,4 +332,5 @@ class DHChain(Dynamics):
         return DHChain(**kw)
 
     def __repr__(self) -> str:
-        return f"DHChain({self.name!r}, {self.n} joints {self.joint_types}, mass {self.mass.sum():.4g} kg)"
+        return (f"DHChain({self.name!r}, {self.n} joints {self.joint_types}, mass "
+                f"{self.mass.sum():.4g} kg)")

@@ -60,7 +60,8 @@ def axis_frame(axis) -> np.ndarray:
             e[k] = sgn
             if np.array_equal(a, e):
                 # a permutation (with signs) mapping z to e, det +1
-                cols = {0: ([0, 0, 1], [0, 1, 0]), 1: ([0, 0, 1], [1, 0, 0]), 2: ([1, 0, 0], [0, 1, 0])}[k]
+                cols = ({0: ([0, 0, 1], [0, 1, 0]), 1: ([0, 0, 1], [1, 0, 0]),
+                         2: ([1, 0, 0], [0, 1, 0])}[k])
                 x = np.array(cols[0], dtype=np.float64)
                 y = np.cross(e, x)
                 return np.column_stack([x, y, e])
@@ -80,7 +81,8 @@ def _parameter_map(A: np.ndarray) -> np.ndarray:
         e[c] = 1.0
         I = np.array([[e[4], e[5], e[7]], [e[5], e[6], e[8]], [e[7], e[8], e[9]]])  # noqa: E741
         IK = A.T @ I @ A
-        L[:, c] = [e[0], *(A.T @ e[1:4]), IK[0, 0], IK[0, 1], IK[1, 1], IK[0, 2], IK[1, 2], IK[2, 2]]
+        L[:, c] = ([e[0], *(A.T @ e[1:4]), IK[0, 0], IK[0, 1], IK[1, 1], IK[0, 2], IK[1, 2],
+                    IK[2, 2]])
     return L
 
 
@@ -89,12 +91,14 @@ def check_inertia(mass: float, inertia: np.ndarray, what: str) -> None:
     semidefinite and satisfies the triangle inequality (a rigid body can have it)."""
     if not (math.isfinite(mass) and mass >= 0):
         raise ModelError(f"{what}: mass must be a finite number >= 0 kg, found {mass!r}")
-    if not np.isfinite(inertia).all() or not np.allclose(inertia, inertia.T, atol=1e-15 + 1e-9 * np.abs(inertia).max()):
+    if not np.isfinite(inertia).all() or not np.allclose(inertia, inertia.T,
+                                                         atol=1e-15 + 1e-9 * np.abs(inertia).max()):
         raise ModelError(f"{what}: the inertia tensor is not a finite symmetric matrix")
     ev = np.linalg.eigvalsh(inertia)
     tol = 1e-12 * max(1e-30, ev.max(initial=0.0)) + 1e-300
     if ev.min() < -tol:
-        raise ModelError(f"{what}: the inertia tensor has a negative principal moment ({ev.min():.3g} kg·m²)")
+        raise ModelError(f"{what}: the inertia tensor has a negative principal moment "
+                         f"({ev.min():.3g} kg·m²)")
     if ev[0] + ev[1] < ev[2] - 1e-9 * max(ev[2], 0.0) - tol:
         raise ModelError(f"{what}: principal moments {ev[0]:.3g} + {ev[1]:.3g} < {ev[2]:.3g} kg·m² "
                          f"violate the triangle inequality: no rigid body has them")
@@ -131,7 +135,8 @@ class JointChain(Dynamics):
     """
 
     def __init__(self, placements, axes, joint_types, mass, com, inertia, *, coupling=None,
-                 offset=None, names, actuated=None, link_names=None, limits: JointLimits | None = None,
+                 offset=None, names, actuated=None, link_names=None,
+                 limits: JointLimits | None = None,
                  gravity=(0.0, 0.0, -9.81), tool=None, armature=None, name: str = "chain"):
         X = np.asarray(placements, dtype=np.float64)
         n = X.shape[0]
@@ -151,20 +156,24 @@ class JointChain(Dynamics):
         com = np.asarray(com, dtype=np.float64).reshape(n, 3)
         inertia = np.asarray(inertia, dtype=np.float64).reshape(n, 3, 3)
         names = tuple(names)
-        link_names = tuple(link_names) if link_names is not None else tuple(f"link{k + 1}" for k in range(n))
+        link_names = (tuple(link_names) if link_names is not None
+                      else tuple(f"link{k + 1}" for k in range(n)))
         if len(names) != n or len(link_names) != n:
-            raise ModelError(f"names and link_names: expected {n} each, found {len(names)} and {len(link_names)}")
+            raise ModelError(f"names and link_names: expected {n} each, found {len(names)} and "
+                             f"{len(link_names)}")
         for k in range(n):
             check_inertia(float(mass[k]), inertia[k], f"link {link_names[k]!r}")
         G = np.eye(n) if coupling is None else np.asarray(coupling, dtype=np.float64)
         if (G.ndim != 2 or G.shape[0] != n or G.shape[1] > n
                 or np.linalg.matrix_rank(G) < G.shape[1]):
-            raise ModelError(f"coupling: expected a full-column-rank ({n}, m) matrix, found shape {G.shape}")
+            raise ModelError(f"coupling: expected a full-column-rank ({n}, m) matrix, found "
+                             f"shape {G.shape}")
         m = G.shape[1]
         q0 = np.zeros(n) if offset is None else np.asarray(offset, dtype=np.float64).reshape(n)
         actuated = tuple(range(n)) if actuated is None else tuple(int(a) for a in actuated)
         if len(actuated) != m:
-            raise ModelError(f"actuated: expected {m} joint indices (columns of the coupling), found {len(actuated)}")
+            raise ModelError(f"actuated: expected {m} joint indices (columns of the coupling), "
+                             f"found {len(actuated)}")
         arm = np.zeros(m) if armature is None else np.asarray(armature, dtype=np.float64).reshape(m)
         self.placements = X.copy()
         self.axes = axes
@@ -230,7 +239,8 @@ class JointChain(Dynamics):
                 prev = A[k]
             jt = np.array([REVOLUTE if c == "R" else PRISMATIC for c in self.joint_types],
                           dtype=np.int64)
-            self._arrays = ChainArrays(np.ascontiguousarray(table), jt, self.mass, np.ascontiguousarray(com),
+            self._arrays = ChainArrays(np.ascontiguousarray(table), jt, self.mass,
+                                       np.ascontiguousarray(com),
                                        i6, np.zeros(n), np.ascontiguousarray(self.coupling.ravel()),
                                        self.offset, self.armature, self.gravity_vector)
             self._kernel_tool = self.tool.copy()
@@ -287,6 +297,7 @@ class JointChain(Dynamics):
         return JointChain(**kw)
 
     def __repr__(self) -> str:
-        return (f"JointChain({self.name!r}, {self.n} joints {self.joint_types}, {self.dof} actuated, "
+        return (f"JointChain({self.name!r}, {self.n} joints {self.joint_types}, "
+                f"{self.dof} actuated, "
                 f"mass {self.mass.sum():.4g} kg)")
 

@@ -152,7 +152,8 @@ def chain_links(n, dh, jtype, q, R, P):  # pragma: no cover - compiled
 def dh_table(alpha, a, d, offset) -> np.ndarray:
     """The (n, 6) kernel DH table: α, a, d, θ0 and the twist's cosine and sine (computed once)."""
     alpha = np.asarray(alpha, dtype=np.float64)
-    return np.ascontiguousarray(np.column_stack([alpha, a, d, offset, np.cos(alpha), np.sin(alpha)]))
+    return (np.ascontiguousarray(np.column_stack([alpha, a, d, offset, np.cos(alpha),
+                                                  np.sin(alpha)])))
 
 
 @hot_inline
@@ -214,7 +215,8 @@ def outward_step(k, R, P, jtype, qd, qdd, s, with_velocity):  # pragma: no cover
         return (rwx, rwy, rwz + qd[k], rax + rwy * qd[k], ray - rwx * qd[k], raz + qdd[k], nvx, nvy,
                 nvz)
     # prismatic: + 2 ω × (ḋ ẑ) + d̈ ẑ
-    return rwx, rwy, rwz, rax, ray, raz, nvx + 2.0 * rwy * qd[k], nvy - 2.0 * rwx * qd[k], nvz + qdd[k]
+    return (rwx, rwy, rwz, rax, ray, raz, nvx + 2.0 * rwy * qd[k], nvy - 2.0 * rwx * qd[k],
+            nvz + qdd[k])
 
 
 @hot

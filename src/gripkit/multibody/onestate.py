@@ -95,10 +95,12 @@ def _links(n, m, ch, q, work):  # pragma: no cover - compiled
     return R, P
 
 
-@numba.njit("b1(f8[::1], f8[::1], f8[::1], f8[::1], f8[::1])", cache=True, error_model="numpy", _nrt=False)
+@numba.njit("b1(f8[::1], f8[::1], f8[::1], "
+            "f8[::1], f8[::1])", cache=True, error_model="numpy", _nrt=False)
 def rnea_one(buf, q, qd, qdd, out):  # pragma: no cover - compiled
     """τ_p = Γᵀ RNEA(Γ p + q₀, Γ ṗ, Γ p̈) + armature_p·p̈ for one state; False when the state has
-    NaN or inf or the wrong length, or ``out`` is not of length m (out untouched). Compiled for 1-D float64 arrays only
+    NaN or inf or the wrong length, or ``out`` is not of length m (out untouched). Compiled for 1-D
+    float64 arrays only
     (other types raise TypeError at the call)."""
     n, m, ch, work = _model(buf)
     if out.shape[0] != m or not (_finite(m, q) and _finite(m, qd) and _finite(m, qdd)):

@@ -21,7 +21,8 @@ def to_pinocchio(chain):
     try:
         import pinocchio as pin
     except ImportError:  # pragma: no cover - optional dependency
-        raise ConfigError("Pinocchio is not installed", hint="pip install 'gripkit[pinocchio]'") from None
+        raise ConfigError("Pinocchio is not installed",
+                          hint="pip install 'gripkit[pinocchio]'") from None
     model = pin.Model()
     parent = 0
     for k in range(chain.n):

@@ -57,7 +57,8 @@ RK4, SEMI_IMPLICIT = 0, 1
 @numba.njit(cache=True, error_model="numpy")
 def dynamics_work(n, m):  # pragma: no cover - compiled
     """Scratch of the dynamics kernels for n links and m coordinates (:data:`DynamicsWork`)."""
-    return DynamicsWork(np.empty((n, 9)), np.empty((n, 3)), np.empty(WORK_PER_LINK * n), np.empty(n),
+    return DynamicsWork(np.empty((n, 9)), np.empty((n, 3)), np.empty(WORK_PER_LINK * n),
+                        np.empty(n),
                         np.empty(n), np.empty(n), np.zeros(n), np.empty((n, n)), np.empty(n),
                         np.empty((m, m)), np.empty(m), np.empty((m, m)), np.empty(m), np.empty(m))
 
@@ -177,7 +178,8 @@ def _dyn_parallel(op, ch, gscale, pos, vel, acc, vout, mout):  # pragma: no cove
     B = pos.shape[0]
     for c in prange((B + _CHUNK - 1) // _CHUNK):
         _range_dyn(op, c * _CHUNK, min(B, (c + 1) * _CHUNK),
-                   ChainArrays(links, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g), gscale, pos,
+                   ChainArrays(links, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g), gscale,
+                   pos,
                    vel, acc, vout, mout, dynamics_work(n, m))
 
 
@@ -291,7 +293,8 @@ def _simulate_parallel(ch, p0, pd0, torque, dt, substeps, method, pos_out, vel_o
     n = links.shape[0]
     m = p0.shape[1]
     for b in prange(p0.shape[0]):
-        _simulate_range(b, b + 1, ChainArrays(links, jtype, mass, com, inertia, arm_q, G, q0, arm_p, g),
+        _simulate_range(b, b + 1, ChainArrays(links, jtype, mass, com, inertia, arm_q, G, q0, arm_p,
+                                              g),
                         p0, pd0, torque, dt, substeps, method, Trajectory(pos_out, vel_out, fail),
                         dynamics_work(n, m), _rk4_work(m))
 
@@ -447,6 +450,7 @@ def simulate_free(system, q0, qd0, torque, dt: float, *, substeps: int = 1,
     fn(system.kernel_arrays(), q0, qd0, tq, float(dt), int(substeps),
        RK4 if method == "rk4" else SEMI_IMPLICIT, pos, vel, fail)
     if fail.any() or not np.isfinite(pos).all():
-        raise SimulationError(f"{system.name}: the simulation diverged or met a singular mass matrix",
+        raise SimulationError(f"{system.name}: the simulation diverged or met a "
+                              "singular mass matrix",
                               hint="reduce dt or check the inertial parameters")
     return (pos[0], vel[0]) if single else (pos, vel)

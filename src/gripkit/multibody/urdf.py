@@ -87,7 +87,8 @@ def _number(el, attr: str, where: str, default: float | None = None) -> float:
 def rpy_matrix(rpy) -> np.ndarray:
     """R = Rz(yaw)·Ry(pitch)·Rx(roll) (URDF's fixed-axis roll-pitch-yaw)."""
     r, p, y = rpy
-    cr, sr, cp, sp, cy, sy = math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y), math.sin(y)
+    cr, sr, cp, sp, cy, sy = (math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(y),
+                              math.sin(y))
     return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
                      [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
                      [-sp, cp * sr, cp * cr]])
@@ -97,7 +98,8 @@ def matrix_rpy(R) -> tuple[float, float, float]:
     """Roll, pitch, yaw of a rotation (inverse of :func:`rpy_matrix`)."""
     sp = -R[2, 0]
     if abs(sp) < 1.0 - 1e-12:
-        return (math.atan2(R[2, 1], R[2, 2]), math.asin(max(-1.0, min(1.0, sp))), math.atan2(R[1, 0], R[0, 0]))
+        return (math.atan2(R[2, 1], R[2, 2]), math.asin(max(-1.0, min(1.0, sp))),
+                math.atan2(R[1, 0], R[0, 0]))
     # gimbal lock: roll and yaw share one axis; put it all in yaw
     pitch = math.copysign(math.pi / 2, sp)
     return (0.0, pitch, math.atan2(-R[0, 1], R[1, 1]))
@@ -116,7 +118,8 @@ def _origin(el, where: str) -> np.ndarray:
     o = el.find("origin") if el is not None else None
     if o is not None:
         T[:3, 3] = _numbers(o.get("xyz"), 3, f"{where} <origin xyz>", default=(0, 0, 0))
-        T[:3, :3] = rpy_matrix(_numbers(o.get("rpy"), 3, f"{where} <origin rpy>", default=(0, 0, 0)))
+        T[:3, :3] = (rpy_matrix(_numbers(o.get("rpy"), 3, f"{where} <origin rpy>",
+                                         default=(0, 0, 0))))
     return T
 
 
@@ -127,8 +130,10 @@ def _inertial(link, where: str):
         return None
     mass = _number(_child(el, "mass", f"{where} <inertial>"), "value", f"{where} <mass>")
     i_el = _child(el, "inertia", f"{where} <inertial>")
-    v = {a: _number(i_el, a, f"{where} <inertia>", default=0.0) for a in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")}
-    Ic = np.array([[v["ixx"], v["ixy"], v["ixz"]], [v["ixy"], v["iyy"], v["iyz"]], [v["ixz"], v["iyz"], v["izz"]]])
+    v = ({a: _number(i_el, a, f"{where} <inertia>",
+                     default=0.0) for a in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")})
+    Ic = (np.array([[v["ixx"], v["ixy"], v["ixz"]], [v["ixy"], v["iyy"], v["iyz"]],
+                    [v["ixz"], v["iyz"], v["izz"]]]))
     T = _origin(el, f"{where} <inertial>")
     R = T[:3, :3]
     return mass, T[:3, 3].copy(), R @ Ic @ R.T
@@ -188,9 +193,11 @@ class _Tree:
                 if link not in self.links:
                     raise ModelError(f"joint {name!r}: {role} link {link!r} is not defined")
             if child in self.parent:
-                raise ModelError(f"link {child!r} is the child of joints {self.parent[child]!r} and {name!r}: "
+                raise ModelError(f"link {child!r} is the child of joints "
+                                 f"{self.parent[child]!r} and {name!r}: "
                                  f"the URDF has a closed loop; gripkit needs a tree",
-                                 hint="cut the loop (keep one parent joint) and model it as a mimic or a constraint")
+                                 hint="cut the loop (keep one parent joint) and model it as a "
+                                      "mimic or a constraint")
             self.joints[name] = (el, jtype, parent, child)
             self.parent[child] = name
             self.children[parent].append(name)
@@ -206,7 +213,8 @@ class _Tree:
         self._moves = None  # see subtree_moves
         lost = [name for name in self.links if name not in reach]
         if lost:
-            raise ModelError(f"links {lost[:3]} are not reachable from a root: their joints form a closed loop")
+            raise ModelError(f"links {lost[:3]} are not reachable from a root: their joints "
+                             "form a closed loop")
 
     def subtree_moves(self, link) -> bool:
         """Whether a moving joint hangs anywhere below ``link`` (computed for every link at the
@@ -228,7 +236,8 @@ class _Tree:
         jtype = self.joints[joint][1]
         if jtype not in _SUPPORTED:
             raise ModelError(f"joint {joint!r} has type {jtype!r}, which gripkit does not support",
-                             hint="gripkit builds serial chains of revolute, continuous, prismatic and fixed joints")
+                             hint="gripkit builds serial chains of revolute, continuous, prismatic "
+                                  "and fixed joints")
 
 
 def _read_root(source):
@@ -251,7 +260,8 @@ def _base_link(tree: _Tree, base_link: str | None) -> str:
     """``base_link``, checked, or the tree's only root."""
     if base_link is None:
         if len(tree.roots) > 1:
-            raise ModelError(f"the URDF holds several trees (roots {', '.join(map(repr, tree.roots[:5]))})",
+            raise ModelError("the URDF holds several trees (roots "
+                             f"{', '.join(map(repr, tree.roots[:5]))})",
                              hint="choose one with base_link=")
         return tree.roots[0]
     if base_link not in tree.links:
@@ -266,12 +276,15 @@ def _path_to_end(tree: _Tree, base_link: str) -> tuple[list[str], str]:
     path = []
     link = base_link
     while True:
-        moving = [j for j in tree.children[link] if tree.subtree_moves(tree.joints[j][3]) or tree.joints[j][1] != "fixed"]
+        moving = ([j for j in tree.children[link] if tree.subtree_moves(tree.joints[j][3])
+                   or tree.joints[j][1] != "fixed"])
         if len(moving) > 1:
             if path and any(tree.joints[j][1] != "fixed" for j in path):
-                raise ModelError(f"the chain branches at link {link!r} into joints {', '.join(map(repr, moving))}",
+                raise ModelError(f"the chain branches at link {link!r} into joints "
+                                 f"{', '.join(map(repr, moving))}",
                                  hint="choose the chain's end with tip_link=")
-            raise ModelError(f"link {link!r} carries several chains (joints {', '.join(map(repr, moving))})",
+            raise ModelError(f"link {link!r} carries several chains (joints "
+                             f"{', '.join(map(repr, moving))})",
                              hint="choose the chain's end with tip_link= (and base_link=)")
         if moving:
             path.append(moving[0])
@@ -323,7 +336,8 @@ class _MovingJoints:
 def _axis(el, j: str) -> np.ndarray:
     """The unit ``<axis xyz>`` of joint ``j`` (default (1, 0, 0))."""
     ax_el = el.find("axis")
-    axis = _numbers(ax_el.get("xyz") if ax_el is not None else None, 3, f"joint {j!r} <axis xyz>", default=(1, 0, 0))
+    axis = (_numbers(ax_el.get("xyz") if ax_el is not None else None, 3, f"joint {j!r} <axis xyz>",
+                     default=(1, 0, 0)))
     if np.linalg.norm(axis) < 1e-12:
         raise ModelError(f"joint {j!r}: <axis xyz> is the zero vector")
     return axis / np.linalg.norm(axis)
@@ -387,7 +401,8 @@ def _moving_joints(tree: _Tree, path: list[str]) -> _MovingJoints:
     return out
 
 
-def _merge_fixed(tree: _Tree, link: str, T: np.ndarray, k: int, joints: _MovingJoints, on_path: set) -> None:
+def _merge_fixed(tree: _Tree, link: str, T: np.ndarray, k: int, joints: _MovingJoints,
+                 on_path: set) -> None:
     """Merge every link fixed (directly or through other fixed links) to ``link``, at ``T`` in
     moving link ``k``'s frame, into that link's inertial data; a moving joint off the path is a
     branch, which a serial chain cannot hold. Depth first in document order, with a stack (no
@@ -405,8 +420,10 @@ def _merge_fixed(tree: _Tree, link: str, T: np.ndarray, k: int, joints: _MovingJ
         elif j not in on_path:
             link = parent
             tree.check_type(j)
-            raise ModelError(f"joint {j!r} ({jtype}) branches off the chain at link {link!r}: gripkit "
-                             f"models serial chains", hint="choose base_link/tip_link so that the chain does "
+            raise ModelError(f"joint {j!r} ({jtype}) branches off the chain at link "
+                             f"{link!r}: gripkit "
+                             f"models serial chains", hint="choose base_link/tip_link so that "
+                                                           "the chain does "
                              "not carry the branch, or make the joint fixed")
 
 
@@ -426,7 +443,8 @@ def _mimic_coupling(joints: _MovingJoints, base_link: str, tip_link: str):
         while cur in mimic:
             leader, a, b = mimic[cur]
             if leader not in index:
-                raise ModelError(f"joint {cur!r} mimics {leader!r}, which is not a moving joint of the chain "
+                raise ModelError(f"joint {cur!r} mimics {leader!r}, which is not a moving "
+                                 "joint of the chain "
                                  f"{base_link!r} → {tip_link!r}")
             if leader in seen:
                 raise ModelError(f"mimic joints {sorted(seen)} follow each other in a circle")
@@ -480,9 +498,12 @@ def from_urdf(source, *, base_link: str | None = None, tip_link: str | None = No
     limits = JointLimits(lim[:, 0].copy(), lim[:, 1].copy(), lim[:, 2].copy(), lim[:, 3].copy())
     inertials = joints.inertials
     return JointChain(np.array(joints.placements), np.array(joints.axes), "".join(joints.types),
-                      [d[0] for d in inertials], [d[1] for d in inertials], [d[2] for d in inertials],
-                      coupling=G, offset=q0, names=joints.names, actuated=actuated, link_names=joints.links,
-                      limits=limits, gravity=gravity, tool=joints.tool, name=robot.get("name") or "urdf")
+                      [d[0] for d in inertials], [d[1] for d in inertials],
+                      [d[2] for d in inertials],
+                      coupling=G, offset=q0, names=joints.names, actuated=actuated,
+                      link_names=joints.links,
+                      limits=limits, gravity=gravity, tool=joints.tool,
+                      name=robot.get("name") or "urdf")
 
 
 # --- writing --------------------------------------------------------------------------------------
@@ -503,8 +524,10 @@ def _describe(chain):
     """(placements, axes, types, mass, com, inertia, Γ, q₀, names, link names, tool, armature,
     limits or None) of a DH, coupled or joint chain, in joint coordinates."""
     if isinstance(chain, JointChain):
-        return (chain.placements, chain.axes, chain.joint_types, chain.mass, chain.com, chain.inertia,
-                chain.coupling, chain.offset, chain.names, chain.link_names, chain.tool, chain.armature,
+        return (chain.placements, chain.axes, chain.joint_types, chain.mass, chain.com,
+                chain.inertia,
+                chain.coupling, chain.offset, chain.names, chain.link_names, chain.tool,
+                chain.armature,
                 chain.limits)
     if isinstance(chain, CoupledChain):
         dh, c = chain.chain, chain.coupling
@@ -513,7 +536,8 @@ def _describe(chain):
         dh = chain
         G, q0, arm = np.eye(dh.n), np.zeros(dh.n), np.zeros(dh.n)
     else:
-        raise ModelError(f"chain: expected a DHChain, CoupledChain or JointChain, found {type(chain).__name__}")
+        raise ModelError("chain: expected a DHChain, CoupledChain or JointChain, found "
+                         f"{type(chain).__name__}")
     X = np.zeros((dh.n, 4, 4))
     for k in range(dh.n):
         alpha, a, d, off = dh.dh[k]
@@ -526,7 +550,8 @@ def _describe(chain):
     X[0] = dh.base @ X[0]
     arm_q = dh.armature
     arm_total = np.concatenate([arm, arm_q])
-    return (X, np.tile([0.0, 0.0, 1.0], (dh.n, 1)), dh.joint_types, dh.mass, dh.com, dh.inertia, G, q0,
+    return (X, np.tile([0.0, 0.0, 1.0], (dh.n, 1)), dh.joint_types, dh.mass, dh.com, dh.inertia, G,
+            q0,
             dh.names, tuple(f"link{k + 1}" for k in range(dh.n)), dh.tool, arm_total, None)
 
 
@@ -551,14 +576,16 @@ def to_urdf(chain, path, *, name: str | None = None, base_link: str = "base",
     n, m = G.shape
     left_out = []
     if np.any(np.asarray(arm) != 0):
-        left_out.append("rotor inertia (armature) " + ", ".join(f"{a:.4g}" for a in np.asarray(arm) if a != 0))
+        left_out.append("rotor inertia (armature) "
+                        + ", ".join(f"{a:.4g}" for a in np.asarray(arm) if a != 0))
     # independent joints and mimic joints: row k = c·row j (j earlier, independent)
     leader, mult, mimic_off = {}, {}, {}
     independent = []
     for k in range(n):
         row = G[k]
         if not row.any():
-            raise ModelError(f"joint {names[k]!r} is moved by no actuator: URDF has no joint for it",
+            raise ModelError(f"joint {names[k]!r} is moved by no actuator: URDF has "
+                             "no joint for it",
                              hint="fold it into a fixed transform first")
         for j in independent:
             rj = G[j]
@@ -571,11 +598,14 @@ def to_urdf(chain, path, *, name: str | None = None, base_link: str = "base",
             independent.append(k)
     Gu = G[independent]
     if not np.array_equal(Gu, np.eye(m)) or np.any(q0[independent] != 0):
-        left_out.append(f"the transmission from the actuators to the joints {[names[k] for k in independent]} "
-                        f"(q_u = Γ_u p + q₀_u, Γ_u = {np.round(Gu, 6).tolist()}): the URDF's coordinates are "
+        left_out.append("the transmission from the actuators to the joints "
+                        f"{[names[k] for k in independent]} "
+                        f"(q_u = Γ_u p + q₀_u, Γ_u = {np.round(Gu, 6).tolist()}): the URDF's "
+                        "coordinates are "
                         f"these joints")
     if left_out:
-        emit_warning(f"to_urdf: URDF cannot hold {'; '.join(left_out)}; they are left out of {os.fspath(path)}",
+        emit_warning(f"to_urdf: URDF cannot hold {'; '.join(left_out)}; they are left out of "
+                     f"{os.fspath(path)}",
                      GripkitWarning)
     robot = ET.Element("robot", name=name or getattr(chain, "name", "chain"))
     robot.append(ET.Comment(f" written by gripkit.multibody.to_urdf; gravity in {base_link!r}: "
@@ -591,7 +621,8 @@ def to_urdf(chain, path, *, name: str | None = None, base_link: str = "base",
         I = inertia[k]  # noqa: E741
         ET.SubElement(inert, "inertia", ixx=_fmt(I[0, 0]), ixy=_fmt(I[0, 1]), ixz=_fmt(I[0, 2]),
                       iyy=_fmt(I[1, 1]), iyz=_fmt(I[1, 2]), izz=_fmt(I[2, 2]))
-        joint = ET.SubElement(robot, "joint", name=names[k], type="revolute" if types[k] == "R" else "prismatic")
+        joint = (ET.SubElement(robot, "joint", name=names[k],
+                               type="revolute" if types[k] == "R" else "prismatic"))
         _origin_el(joint, X[k])
         ET.SubElement(joint, "parent", link=parent)
         ET.SubElement(joint, "child", link=link_names[k])
@@ -606,9 +637,11 @@ def to_urdf(chain, path, *, name: str | None = None, base_link: str = "base",
             hi = vals[1] if np.isfinite(vals[1]) else hi
             vel = vals[2] if np.isfinite(vals[2]) else 0.0
             eff = vals[3] if np.isfinite(vals[3]) else 0.0
-        ET.SubElement(joint, "limit", lower=_fmt(lo), upper=_fmt(hi), effort=_fmt(eff), velocity=_fmt(vel))
+        ET.SubElement(joint, "limit", lower=_fmt(lo), upper=_fmt(hi), effort=_fmt(eff),
+                      velocity=_fmt(vel))
         if k in leader:
-            ET.SubElement(joint, "mimic", joint=names[leader[k]], multiplier=_fmt(mult[k]), offset=_fmt(mimic_off[k]))
+            ET.SubElement(joint, "mimic", joint=names[leader[k]], multiplier=_fmt(mult[k]),
+                          offset=_fmt(mimic_off[k]))
         parent = link_names[k]
     ET.SubElement(robot, "link", name=tip_link)
     tj = ET.SubElement(robot, "joint", name=f"{tip_link}_joint", type="fixed")

@@ -73,7 +73,8 @@ class Section:
         return self
 
     def table(self, headers, rows, caption: str = "") -> "Section":
-        self.items.append(("table", _Table([str(h) for h in headers], [list(r) for r in rows], caption)))
+        self.items.append(("table", _Table([str(h) for h in headers], [list(r) for r in rows],
+                                           caption)))
         return self
 
     def figure(self, fig, caption: str = "", name: str | None = None, dpi: int = 110) -> "Section":
@@ -90,7 +91,8 @@ class Section:
 
     def findings(self, report) -> "Section":
         """Add a consistency report (see :mod:`gripkit.consistency`) as a table."""
-        rows = [["ok" if f.consistent else "INCONSISTENT", f.check, f.message, f.used] for f in report]
+        rows = ([["ok" if f.consistent else "INCONSISTENT", f.check, f.message,
+                  f.used] for f in report])
         return self.table(["status", "check", "finding", "gripkit uses"], rows,
                           caption=f"Consistency checks: {report.subject}")
 

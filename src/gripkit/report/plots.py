@@ -1,4 +1,5 @@
-"""Reusable matplotlib figures for reports (Agg backend; add them with ``section.figure(fig, ...)``).
+"""Reusable matplotlib figures for reports (Agg backend; add them with ``section.figure(fig,
+...)``).
 
 * :func:`measured_vs_model` — measured output against model outputs (seed Figs. 19–22 style);
 * :func:`residual_correlation` — residual autocorrelation and input–residual cross-correlation with
@@ -18,7 +19,8 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
-__all__ = ["measured_vs_model", "residual_correlation", "pole_zero_map", "bode", "parameter_convergence",
+__all__ = ["measured_vs_model", "residual_correlation", "pole_zero_map", "bode",
+           "parameter_convergence",
            "log_ticks", "plain", "plain_math_fallback"]
 
 
@@ -64,7 +66,8 @@ def subplots(*args, **kw):
 
 def log_ticks(*axes) -> None:
     """Give every log-scaled axis of ``axes`` labelled ticks at 1, 2 and 5 × 10ⁿ (unlabelled minor
-    ticks at the other integers), so that even a span under one decade shows at least three labels."""
+    ticks at the other integers), so that even a span under one decade shows at least three
+    labels."""
     from matplotlib.ticker import LogFormatterSciNotation, LogLocator, NullFormatter
 
     for ax in axes:
@@ -75,7 +78,8 @@ def log_ticks(*axes) -> None:
             decades = np.log10(hi / lo) if lo > 0 else np.inf
             subs = (1.0, 2.0, 5.0) if decades <= 4 else (1.0,)
             axis.set_major_locator(LogLocator(base=10.0, subs=subs, numticks=30))
-            axis.set_major_formatter(LogFormatterSciNotation(labelOnlyBase=False, minor_thresholds=(np.inf, np.inf))
+            axis.set_major_formatter(LogFormatterSciNotation(labelOnlyBase=False,
+                                                             minor_thresholds=(np.inf, np.inf))
                                      if decades <= 4 else LogFormatterSciNotation())
             axis.set_minor_locator(LogLocator(base=10.0, subs=np.arange(2, 10), numticks=30))
             axis.set_minor_formatter(NullFormatter())
@@ -132,7 +136,8 @@ def residual_correlation(tests: Mapping[str, object], *, title: str = ""):
     return fig
 
 
-def pole_zero_map(models: Mapping[str, tuple[Sequence[complex], Sequence[complex]]], *, title: str = ""):
+def pole_zero_map(models: Mapping[str, tuple[Sequence[complex], Sequence[complex]]], *,
+                  title: str = ""):
     """z-plane map: ``models`` maps a label to ``(poles, zeros)``."""
     plt = pyplot()
     fig, ax = plt.subplots(figsize=(5.6, 5.2))
@@ -150,7 +155,8 @@ def pole_zero_map(models: Mapping[str, tuple[Sequence[complex], Sequence[complex
         c, ms = f"C{k}", max(15.0 - 3.0 * k, 5.0)
         ax.plot(p.real, p.imag, pole_marks[k % 4], color=c, ms=ms, mew=2, zorder=3 + k,
                 label=plain(f"{label} poles"))
-        ax.plot(z.real, z.imag, zero_marks[k % 4], color=c, ms=ms, mfc="none", mew=1.6, zorder=3 + k,
+        ax.plot(z.real, z.imag, zero_marks[k % 4], color=c, ms=ms, mfc="none", mew=1.6,
+                zorder=3 + k,
                 label=plain(f"{label} zeros"))
         allz += list(np.abs(p)) + list(np.abs(z))
     lim = 1.1 * max(allz)
@@ -205,7 +211,8 @@ def bode(models: Mapping[str, object], *, n: int = 512, title: str = "", magnitu
     return fig
 
 
-def parameter_convergence(t: np.ndarray, theta: np.ndarray, std: np.ndarray, names: Sequence[str], *,
+def parameter_convergence(t: np.ndarray, theta: np.ndarray, std: np.ndarray, names: Sequence[str],
+                          *,
                           truth: Sequence[float] | None = None, title: str = ""):
     """One panel per parameter: estimate θ_i(t) with a ±2σ band and the true value (dashed)."""
     plt = pyplot()
@@ -217,7 +224,8 @@ def parameter_convergence(t: np.ndarray, theta: np.ndarray, std: np.ndarray, nam
         ax = axes[i // ncol][i % ncol]
         ax.plot(t, theta[:, i], color="C0", lw=1.2, label="estimate")
         ok = np.isfinite(std[:, i])
-        ax.fill_between(t[ok], theta[ok, i] - 2 * std[ok, i], theta[ok, i] + 2 * std[ok, i], color="C0",
+        ax.fill_between(t[ok], theta[ok, i] - 2 * std[ok, i], theta[ok, i] + 2 * std[ok, i],
+                        color="C0",
                         alpha=0.25, label="±2σ")
         if truth is not None:
             ax.axhline(truth[i], color="C3", ls="--", lw=1, label="true")

@@ -56,19 +56,22 @@ def butter_sos(order: int, cutoff, *, dt: float, btype: str = "lowpass") -> np.n
     sampling rate 1/``dt``.
     """
     wn, rate = _check_design(order, cutoff, dt, btype)
-    return _signal().butter(int(order), wn if wn.size > 1 else wn[0], btype=btype, fs=rate, output="sos")
+    return (_signal().butter(int(order), wn if wn.size > 1 else wn[0], btype=btype, fs=rate,
+                             output="sos"))
 
 
 def butter_zpk(order: int, cutoff, *, dt: float, btype: str = "lowpass"):
     """Zeros, poles and gain of the digital Butterworth filter (z-plane)."""
     wn, rate = _check_design(order, cutoff, dt, btype)
-    return _signal().butter(int(order), wn if wn.size > 1 else wn[0], btype=btype, fs=rate, output="zpk")
+    return (_signal().butter(int(order), wn if wn.size > 1 else wn[0], btype=btype, fs=rate,
+                             output="zpk"))
 
 
 def butter_ba(order: int, cutoff, *, dt: float, btype: str = "lowpass"):
     """Transfer-function coefficients (b, a) in powers of z^-1 (for analysis; filter with SOS)."""
     wn, rate = _check_design(order, cutoff, dt, btype)
-    return _signal().butter(int(order), wn if wn.size > 1 else wn[0], btype=btype, fs=rate, output="ba")
+    return (_signal().butter(int(order), wn if wn.size > 1 else wn[0], btype=btype, fs=rate,
+                             output="ba"))
 
 
 def apply_sos(sos: np.ndarray, x: np.ndarray, zero_phase: bool = False) -> np.ndarray:
@@ -84,7 +87,8 @@ def apply_sos(sos: np.ndarray, x: np.ndarray, zero_phase: bool = False) -> np.nd
     if zero_phase:
         padlen = 3 * (2 * sos.shape[0] + 1)
         if x.shape[0] <= padlen:
-            raise DataError(f"zero-phase filtering needs more than {padlen} samples, found {x.shape[0]}")
+            raise DataError(f"zero-phase filtering needs more than {padlen} samples, "
+                            f"found {x.shape[0]}")
         return _signal().sosfiltfilt(sos, x, axis=0)
     zi = _signal().sosfilt_zi(sos)
     zi = zi * x[0] if x.ndim == 1 else zi[:, :, None] * x[0][None, None, :]

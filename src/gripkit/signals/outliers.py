@@ -1,4 +1,5 @@
-"""Corrupt samples: isolated values far outside the rest of a channel (a bit flip, a sentinel such as
+"""Corrupt samples: isolated values far outside the rest of a channel (a bit flip, a sentinel such
+as
 -9999 or 1e30 written by a logger, a transmission error).
 
 A sample is flagged when both hold:
@@ -70,6 +71,7 @@ def corrupt_samples(x: np.ndarray) -> np.ndarray:
         if b < n and not abs(x[b - 1] - x[b]) > bound:
             continue
         keep.extend(range(a, b))
-    if len(keep) > 2 * m:  # more than the scale estimate sets aside: pulses of the signal, not corruption
+    # more than the scale estimate sets aside: pulses of the signal, not corruption
+    if len(keep) > 2 * m:
         return np.empty(0, dtype=np.intp)
     return np.asarray(keep, dtype=np.intp)

@@ -31,14 +31,16 @@ def remove_mean(tr: Trajectory, channels: Sequence[str] | None = None) -> Trajec
     return tr.with_channels(**{n: tr[n] - tr[n].mean() for n in names})
 
 
-def ac_couple(tr: Trajectory, channels: Sequence[str], reference: Trajectory | None = None) -> Trajectory:
+def ac_couple(tr: Trajectory, channels: Sequence[str],
+              reference: Trajectory | None = None) -> Trajectory:
     """Subtract the average level of ``reference`` (a record at a fixed operating point), or of
     the record itself when no reference is given (§V-F of the AMADEUS seed)."""
     ref = tr if reference is None else reference
     return tr.with_channels(**{n: tr[n] - float(np.mean(ref[n])) for n in channels})
 
 
-def detrend(tr: Trajectory, channels: Sequence[str] | None = None, kind: str = "linear") -> Trajectory:
+def detrend(tr: Trajectory, channels: Sequence[str] | None = None,
+            kind: str = "linear") -> Trajectory:
     """Remove a least-squares line (``kind='linear'``) or the mean (``'constant'``) against time."""
     if kind not in ("linear", "constant"):
         raise DataError(f"detrend kind: expected 'linear' or 'constant', found {kind!r}")
@@ -69,7 +71,8 @@ def decimate(tr: Trajectory, q: int, order: int = 8, zero_phase: bool = True) ->
 
 
 def to_uniform(tr: Trajectory, dt: float) -> Trajectory:
-    """Linear interpolation of a (possibly non-uniform) record onto a uniform grid every ``dt`` s."""
+    """Linear interpolation of a (possibly non-uniform) record onto a uniform grid every ``dt``
+    s."""
     dt = sample_interval(dt)
     n = int(np.floor(tr.duration / dt + 1e-9)) + 1
     t = tr.t[0] + np.arange(n) * dt
@@ -104,4 +107,5 @@ def split(tr: Trajectory, n_segments: int) -> list[Trajectory]:
 def segment_by(tr: Trajectory, boundaries: Sequence[float]) -> list[Trajectory]:
     """Cut at the given times (s): ``[t0, b0), [b0, b1), ..., [b_last, end]``."""
     edges = [tr.t[0], *sorted(boundaries), np.nextafter(tr.t[-1], np.inf)]
-    return [tr.window(a, b) for a, b in zip(edges[:-1], edges[1:]) if ((tr.t >= a) & (tr.t < b)).any()]
+    return ([tr.window(a, b) for a, b in zip(edges[:-1],
+                                             edges[1:]) if ((tr.t >= a) & (tr.t < b)).any()])

@@ -70,13 +70,16 @@ class Trajectory:
         if not np.issubdtype(t.dtype, np.number):
             raise DataError(f"time stamps: expected numbers, found dtype {t.dtype}")
         if t.size == 0:
-            raise DataError("the data holds no samples", hint="check the file and the selected rows")
+            raise DataError("the data holds no samples", hint="check the file and "
+                                                              "the selected rows")
         t = _readonly(t)
         bad = ~np.isfinite(t)
         if bad.any():
             i = int(np.argmax(bad))
-            raise DataError(f"time stamps have {int(bad.sum())} non-finite values (first at row {i})",
-                            hint="drop those rows or rebuild the time base from the sampling rate (--fs)")
+            raise DataError(f"time stamps have {int(bad.sum())} non-finite values "
+                            f"(first at row {i})",
+                            hint="drop those rows or rebuild the time base from the "
+                                 "sampling rate (--fs)")
         if t.size >= 2:
             d = np.diff(t)
             if (d <= 0).any():
@@ -106,13 +109,16 @@ class Trajectory:
                     if mask.any():
                         i = int(np.argmax(mask))
                         raise DataError(
-                            f"column {name!r} has {int(mask.sum())} {label} values (first at t={t[i]:.6g} s)",
-                            hint="drop or interpolate them with fill='drop'|'interpolate' (CLI: --fill)",
+                            f"column {name!r} has {int(mask.sum())} {label} values (first at "
+                            f"t={t[i]:.6g} s)",
+                            hint="drop or interpolate them with "
+                                 "fill='drop'|'interpolate' (CLI: --fill)",
                         )
             ch[name] = a
         unknown = set(units) - set(ch)
         if unknown:
-            raise DataError(f"units given for unknown channels {sorted(unknown)}; channels: {list(ch)}")
+            raise DataError(f"units given for unknown channels {sorted(unknown)}; "
+                            f"channels: {list(ch)}")
         self.t = t
         self._ch = ch
         self._units = {n: units.get(n, "1") for n in ch}
@@ -120,7 +126,8 @@ class Trajectory:
 
     # construction helpers
     @classmethod
-    def _from_checked(cls, t: np.ndarray, channels: Mapping[str, np.ndarray], units: Mapping[str, str],
+    def _from_checked(cls, t: np.ndarray, channels: Mapping[str, np.ndarray],
+                      units: Mapping[str, str],
                       meta: Mapping) -> "Trajectory":
         """A Trajectory around arrays gripkit has just made and checked (strictly increasing
         ``t``, finite float64 channels that nothing else references): no copies, no second check.
@@ -186,8 +193,10 @@ class Trajectory:
             return float(self.meta["dt"])
         if self.n < 2:
             source = self.meta.get("source")
-            raise DataError(f"{source + ': ' if source else ''}{self.n} sample(s) have no sample interval",
-                            hint="a record needs at least 2 samples; check that the file is complete")
+            raise DataError(f"{source + ': ' if source else ''}{self.n} sample(s) have no "
+                            "sample interval",
+                            hint="a record needs at least 2 samples; check that the "
+                                 "file is complete")
         return _median(np.diff(self.t))
 
     def is_uniform(self, rtol: float = 1e-3) -> bool:
@@ -197,14 +206,17 @@ class Trajectory:
         med = _median(d)
         return bool(np.max(np.abs(d - med)) <= rtol * med)
 
-    def require_uniform(self, rtol: float = 1e-3, why: str = "discrete-time identification") -> float:
-        """Return the sample interval ``dt`` (s), or raise :class:`DataError` if sampling is not uniform."""
+    def require_uniform(self, rtol: float = 1e-3,
+                        why: str = "discrete-time identification") -> float:
+        """Return the sample interval ``dt`` (s), or raise :class:`DataError` if sampling is not
+        uniform."""
         if not self.is_uniform(rtol):
             d = np.diff(self.t)
             med = _median(d)
             i = int(np.argmax(np.abs(d - med)))
             raise DataError(
-                f"{why} needs uniform sampling; the interval at t={self.t[i]:.6g} s is {d[i]:.6g} s "
+                f"{why} needs uniform sampling; the interval at t={self.t[i]:.6g} s "
+                f"is {d[i]:.6g} s "
                 f"against a median of {med:.6g} s ({100 * abs(d[i] - med) / med:.3g} % off, "
                 f"tolerance {100 * rtol:.3g} %)",
                 hint="resample the data first (gripkit.signals.resample(tr, dt); for the command "
@@ -220,7 +232,8 @@ class Trajectory:
     # channel access
     def _require(self, name: str) -> None:
         if name not in self._ch:
-            raise DataError(f"column {name!r} not found", hint=f"available columns: {', '.join(self._ch)}")
+            raise DataError(f"column {name!r} not found", hint="available columns: "
+                                                               f"{', '.join(self._ch)}")
 
     def __getitem__(self, name: str) -> np.ndarray:
         self._require(name)
@@ -270,7 +283,8 @@ class Trajectory:
 
     def take(self, index) -> "Trajectory":
         idx = np.asarray(index)
-        return Trajectory(self.t[idx], {k: v[idx] for k, v in self._ch.items()}, self._units, self.meta)
+        return (Trajectory(self.t[idx], {k: v[idx] for k, v in self._ch.items()}, self._units,
+                           self.meta))
 
     def as_array(self, *names: str) -> np.ndarray:
         """Columns stacked as an (N, len(names)) float64 array."""

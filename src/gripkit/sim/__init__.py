@@ -15,5 +15,6 @@ from .hybrid import Mode as Mode
 from .integrators import integrate_lti as integrate_lti
 from .integrators import zoh_levels as zoh_levels
 
-__all__ = ["c2d_zoh", "check_step", "Guard", "HybridSystem", "integrate_lti", "Mode", "Model", "Signal",
+__all__ = ["c2d_zoh", "check_step", "Guard", "HybridSystem", "integrate_lti", "Mode", "Model",
+           "Signal",
            "simulate", "step_report", "substeps_for", "zoh_levels"]

@@ -39,7 +39,8 @@ from ..signals.trajectory import Trajectory
 from .integrators import modes_of, rk4_lti_step, zoh_levels
 from .steps import check_step
 
-__all__ = ["Mode", "Guard", "HybridSystem", "DiscreteHybrid", "HybridResult", "pwa_step", "pwa_output",
+__all__ = ["Mode", "Guard", "HybridSystem", "DiscreteHybrid", "HybridResult", "pwa_step",
+           "pwa_output",
            "DEFAULT_LEVELS", "MAX_EVENTS_PER_STEP"]
 
 #: dyadic levels: events are located within dt / 2**DEFAULT_LEVELS
@@ -59,7 +60,8 @@ def _arr(x, shape, name):
 
 @dataclass(frozen=True)
 class Mode:
-    """One mode: ẋ = A x + B u + e, y = C x + D u + f (shapes (n,n), (n,m), (n,), (p,n), (p,m), (p,))."""
+    """One mode: ẋ = A x + B u + e, y = C x + D u + f (shapes (n,n), (n,m), (n,), (p,n), (p,m),
+    (p,))."""
 
     name: str
     A: np.ndarray
@@ -171,13 +173,15 @@ def pwa_step(x, mode, u, Phi, Gam, G, H, target, n_guards, K, work):  # pragma: 
         while True:
             if kind == 1:
                 for i in range(4):
-                    acc = Gam[mode, j, i, 0] * u[0] + Gam[mode, j, i, 1] * u[1] + Gam[mode, j, i, 2] * u[2]
+                    acc = (Gam[mode, j, i, 0] * u[0] + Gam[mode, j, i,
+                                                           1] * u[1] + Gam[mode, j, i, 2] * u[2])
                     for k in range(4):
                         acc += Phi[mode, j, i, k] * x[k]
                     xt[i] = acc
             elif kind == 2:
                 for i in range(6):
-                    acc = Gam[mode, j, i, 0] * u[0] + Gam[mode, j, i, 1] * u[1] + Gam[mode, j, i, 2] * u[2]
+                    acc = (Gam[mode, j, i, 0] * u[0] + Gam[mode, j, i,
+                                                           1] * u[1] + Gam[mode, j, i, 2] * u[2])
                     for k in range(6):
                         acc += Phi[mode, j, i, k] * x[k]
                     xt[i] = acc
@@ -189,7 +193,8 @@ def pwa_step(x, mode, u, Phi, Gam, G, H, target, n_guards, K, work):  # pragma: 
                     for k in range(m):
                         acc += Gam[mode, j, i, k] * u[k]
                     xt[i] = acc
-            hit = first_crossed_guard(G, H, n_guards, mode, xt, u) if nev < MAX_EVENTS_PER_STEP else -1
+            hit = (first_crossed_guard(G, H, n_guards, mode, xt,
+                                       u) if nev < MAX_EVENTS_PER_STEP else -1)
             if hit < 0:
                 for i in range(n):
                     x[i] = xt[i]
@@ -307,7 +312,8 @@ class HybridSystem:
     """
 
     def __init__(self, modes: Sequence[Mode], guards: Sequence[Guard] = (), *,
-                 inputs: Sequence[str] = (), outputs: Sequence[str] = (), states: Sequence[str] = (),
+                 inputs: Sequence[str] = (), outputs: Sequence[str] = (),
+                 states: Sequence[str] = (),
                  units: Mapping[str, str] | None = None, name: str = "hybrid"):
         if not modes:
             raise ModelError("a hybrid system needs at least one mode")
@@ -328,10 +334,12 @@ class HybridSystem:
         for q, md in enumerate(modes):
             self.A[q] = _arr(md.A, (n, n), f"mode {md.name!r}: A")
             Bq = np.asarray(md.B, dtype=np.float64)
-            self.B[q, :, :m] = _arr(Bq.reshape(n, m) if Bq.size == n * m else Bq, (n, m), f"mode {md.name!r}: B")
+            self.B[q, :, :m] = (_arr(Bq.reshape(n, m) if Bq.size == n * m else Bq, (n, m),
+                                     f"mode {md.name!r}: B"))
             self.B[q, :, m] = 0.0 if md.e is None else _arr(md.e, (n,), f"mode {md.name!r}: e")
             self.C[q] = _arr(np.atleast_2d(md.C), (p, n), f"mode {md.name!r}: C")
-            self.D[q, :, :m] = 0.0 if md.D is None else _arr(np.atleast_2d(md.D), (p, m), f"mode {md.name!r}: D")
+            self.D[q, :, :m] = (0.0 if md.D is None else _arr(np.atleast_2d(md.D), (p, m),
+                                                              f"mode {md.name!r}: D"))
             self.D[q, :, m] = 0.0 if md.f is None else _arr(md.f, (p,), f"mode {md.name!r}: f")
         J = max([sum(1 for g in guards if g.source == nm) for nm in self.names] + [1])
         self.G = np.zeros((Q, J, n))
@@ -341,12 +349,14 @@ class HybridSystem:
         for g in guards:
             for which in (g.source, g.target):
                 if which not in self.names:
-                    raise ModelError(f"guard {g.name or (g.source + '->' + g.target)!r}: no mode {which!r}",
+                    raise ModelError(f"guard {g.name or (g.source + '->' + g.target)!r}: "
+                                     f"no mode {which!r}",
                                      hint=f"modes: {', '.join(self.names)}")
             q = self.names.index(g.source)
             k = self.n_guards[q]
             self.G[q, k] = _arr(g.G, (n,), f"guard {g.source}->{g.target}: G")
-            self.H[q, k, :m] = 0.0 if g.H is None else _arr(g.H, (m,), f"guard {g.source}->{g.target}: H")
+            self.H[q, k, :m] = (0.0 if g.H is None else _arr(g.H, (m,),
+                                                             f"guard {g.source}->{g.target}: H"))
             self.H[q, k, m] = float(g.c)
             self.target[q, k] = self.names.index(g.target)
             self.n_guards[q] += 1
@@ -374,7 +384,8 @@ class HybridSystem:
             u = u.as_array(*self.inputs)
         u2 = np.ascontiguousarray(np.asarray(u, dtype=np.float64).reshape(len(u), -1))
         if u2.shape[1] != self.n_inputs:
-            raise SimulationError(f"{self.name}: expected inputs of shape (N, {self.n_inputs}), found {u2.shape}")
+            raise SimulationError(f"{self.name}: expected inputs of shape (N, {self.n_inputs}), "
+                                  f"found {u2.shape}")
         if not np.isfinite(u2).all():
             raise SimulationError(f"{self.name}: inputs contain NaN or inf")
         if dt is None or not (np.isfinite(dt) and dt > 0):
@@ -392,7 +403,8 @@ class HybridSystem:
         ch = {n: u2[:, i] for i, n in enumerate(self.inputs)}
         ch.update({n: y[:, i] for i, n in enumerate(self.outputs)})
         ch["mode"] = modes.astype(np.float64)
-        tr = Trajectory(t, ch, {k: v for k, v in self.units.items() if k in ch}, {"dt": dt, "model": self.name})
+        tr = (Trajectory(t, ch, {k: v for k, v in self.units.items() if k in ch},
+                         {"dt": dt, "model": self.name}))
         ev = [(float(r[0]) * dt, self.names[int(r[1])], self.names[int(r[2])]) for r in rows]
         return HybridResult(tr, xs, modes, ev)
 
@@ -409,9 +421,11 @@ class HybridSystem:
         nrow, zeno = _hybrid_run(d.Phi, d.Gam, d.C, d.D, PWAGuards(d.G, d.H, d.target, d.n_guards),
                                  d.levels, u2, x, mode, HybridOut(y, xs, modes, rows))
         if zeno >= 0:
-            raise SimulationError(f"{self.name}: more than {MAX_EVENTS_PER_STEP} mode switches inside the "
+            raise SimulationError(f"{self.name}: more than {MAX_EVENTS_PER_STEP} mode "
+                                  "switches inside the "
                                   f"step at t = {zeno * dt:.6g} s (chattering between modes)",
-                                  hint="check the guards: leaving a mode must not immediately re-enter it")
+                                  hint="check the guards: leaving a mode must not "
+                                       "immediately re-enter it")
         if not np.isfinite(y).all():
             raise SimulationError(f"{self.name}: the simulation diverged (non-finite outputs)")
         return self._result(u2, dt, y, xs, modes, rows[:min(nrow, max_events)])

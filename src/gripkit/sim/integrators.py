@@ -34,7 +34,8 @@ from ..errors import ModelError
 from ..lti import flush_tiny
 from .steps import check_step
 
-__all__ = ["rk4_lti_step", "rk4_msd_step", "semi_implicit_msd_step", "lti_step", "zoh_levels", "zoh_levels_into",
+__all__ = ["rk4_lti_step", "rk4_msd_step", "semi_implicit_msd_step", "lti_step", "zoh_levels",
+           "zoh_levels_into",
            "expm_small", "integrate_lti", "modes_of"]
 
 
@@ -198,7 +199,8 @@ def zoh_levels_into(A, B, dt, levels, Phi, Gam):  # pragma: no cover - compiled
     """Kernel of :func:`zoh_levels`, writing into preallocated arrays (callable from other kernels):
     stacks A (P, n, n), B (P, n, m) → Phi (P, L+1, n, n), Gam (P, L+1, n, m). The full step
     (level L, used at every sample) is one expm of the augmented matrix; the finer levels (used
-    only to locate events inside a step) come from the finest one by squaring, e^{2Mh} = (e^{Mh})²."""
+    only to locate events inside a step) come from the finest one by squaring, e^{2Mh} =
+    (e^{Mh})²."""
     P, n, m = B.shape[0], B.shape[1], B.shape[2]
     M = np.zeros((n + m, n + m))
     E = np.empty((n + m, n + m))
@@ -226,7 +228,8 @@ def zoh_levels_into(A, B, dt, levels, Phi, Gam):  # pragma: no cover - compiled
                         Gam[p, lev, i, j] = E[i, n + j]
 
 
-def zoh_levels(A: np.ndarray, B: np.ndarray, dt: float, levels: int = 0) -> tuple[np.ndarray, np.ndarray]:
+def zoh_levels(A: np.ndarray, B: np.ndarray, dt: float,
+               levels: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """Exact ZOH matrices for the steps dt·2^(j−levels), j = 0..levels.
 
     ``A`` (..., n, n) and ``B`` (..., n, m) may be stacks (one system per leading index).
@@ -237,7 +240,8 @@ def zoh_levels(A: np.ndarray, B: np.ndarray, dt: float, levels: int = 0) -> tupl
     A = np.asarray(A, dtype=np.float64)
     B = np.asarray(B, dtype=np.float64)
     if A.shape[-1] != A.shape[-2] or B.shape[-2] != A.shape[-1] or A.shape[:-2] != B.shape[:-2]:
-        raise ModelError(f"zoh_levels: A must be (..., n, n) and B (..., n, m) with the same leading "
+        raise ModelError("zoh_levels: A must be (..., n, n) and B (..., n, m) with "
+                         "the same leading "
                          f"shape, found {A.shape} and {B.shape}")
     if not (np.isfinite(dt) and dt > 0):
         raise ModelError(f"dt: expected a positive sample time, found {dt!r}")
@@ -256,7 +260,8 @@ def zoh_levels(A: np.ndarray, B: np.ndarray, dt: float, levels: int = 0) -> tupl
 
 
 @numba.njit(cache=True)
-def _integrate_lti(A, B, Phi, Gam, u, h, substeps, method, x, y, C, D):  # pragma: no cover - compiled
+def _integrate_lti(A, B, Phi, Gam, u, h, substeps, method, x, y, C,
+                   D):  # pragma: no cover - compiled
     n = A.shape[0]
     m = B.shape[1]
     p = C.shape[0]
@@ -281,7 +286,8 @@ def _integrate_lti(A, B, Phi, Gam, u, h, substeps, method, x, y, C, D):  # pragm
 
 
 def modes_of(A: np.ndarray) -> list[tuple[float, float]]:
-    """(ω_n rad/s, ζ) of each eigenvalue of A (one entry per complex pair; zero eigenvalues skipped)."""
+    """(ω_n rad/s, ζ) of each eigenvalue of A (one entry per complex pair; zero eigenvalues
+    skipped)."""
     out = []
     for lam in np.linalg.eigvals(np.asarray(A, dtype=np.float64)):
         if lam.imag < 0 or abs(lam) == 0:
@@ -290,7 +296,8 @@ def modes_of(A: np.ndarray) -> list[tuple[float, float]]:
     return out
 
 
-def integrate_lti(A, B, C, D, u, dt: float, x0=None, *, method: str = "zoh", substeps: int = 1) -> np.ndarray:
+def integrate_lti(A, B, C, D, u, dt: float, x0=None, *, method: str = "zoh",
+                  substeps: int = 1) -> np.ndarray:
     """Outputs (N, p) of ẋ = A x + B u, y = C x + D u for inputs ``u`` (N, m) held over each
     sample ``dt``: ``method='zoh'`` (exact) or ``'rk4'`` with ``substeps`` RK4 steps per sample."""
     A, B, C, D = (np.atleast_2d(np.asarray(v, dtype=np.float64)) for v in (A, B, C, D))
@@ -298,7 +305,8 @@ def integrate_lti(A, B, C, D, u, dt: float, x0=None, *, method: str = "zoh", sub
     x = np.zeros(A.shape[0]) if x0 is None else np.array(x0, dtype=np.float64)
     if method not in ("zoh", "rk4"):
         raise ModelError(f"method: expected 'zoh' or 'rk4', found {method!r}")
-    if method == "rk4":  # refuse an unstable step, warn on an under-resolved mode (gripkit.sim.steps)
+    # refuse an unstable step, warn on an under-resolved mode (gripkit.sim.steps)
+    if method == "rk4":
         check_step(dt / substeps, modes_of(A), "rk4", what="integrate_lti")
     Phi, Gam = zoh_levels(A, B, dt, 0) if method == "zoh" else (np.eye(A.shape[0])[None], B[None])
     y = np.empty((u2.shape[0], C.shape[0]))

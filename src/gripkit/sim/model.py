@@ -61,7 +61,8 @@ class Model(abc.ABC):
 
     def __init__(self, parameters: ParameterSet, *, check: bool = True):
         if not isinstance(parameters, ParameterSet):
-            raise ParameterError(f"{type(self).__name__}: expected a ParameterSet, found {type(parameters).__name__}")
+            raise ParameterError(f"{type(self).__name__}: expected a ParameterSet, found "
+                                 f"{type(parameters).__name__}")
         self.parameters = parameters
         if check:
             warn_inconsistent(self.consistency_checks())
@@ -71,7 +72,8 @@ class Model(abc.ABC):
     def _simulate_batch(self, thetas: np.ndarray, u: np.ndarray, dt: float, substeps: int,
                         x0: np.ndarray, y: np.ndarray) -> None:
         """Simulate every row of ``thetas`` (P, n_params) against ``u`` (N, n_inputs) from
-        ``x0`` (P, n_states), ``substeps`` internal steps per sample, writing ``y`` (P, N, n_outputs)."""
+        ``x0`` (P, n_states), ``substeps`` internal steps per sample, writing ``y`` (P, N,
+        n_outputs)."""
 
     def modes(self, theta: np.ndarray) -> list[tuple[float, float]]:
         """Natural frequencies (rad/s) and damping ratios of the model's modes at ``theta``."""
@@ -106,7 +108,8 @@ class Model(abc.ABC):
         n = len(self.parameters)
         if thetas.ndim != 2 or thetas.shape[1] != n:
             raise ParameterError(f"{self.name}: expected parameter vectors of length {n} "
-                                 f"({', '.join(self.parameters.names)}), found shape {thetas.shape}")
+                                 f"({', '.join(self.parameters.names)}), found "
+                                 f"shape {thetas.shape}")
         if not np.isfinite(thetas).all():
             raise ParameterError(f"{self.name}: parameter vectors contain NaN or inf")
         lo, hi = self.parameters.bounds_arrays()
@@ -114,7 +117,8 @@ class Model(abc.ABC):
         if bad.any():
             i, j = map(int, np.argwhere(bad)[0])
             p = self.parameters[self.parameters.names[j]]
-            raise ParameterError(f"{self.name}: {p.name} = {thetas[i, j]:g} {p.unit} is outside its "
+            raise ParameterError(f"{self.name}: {p.name} = {thetas[i, j]:g} {p.unit} "
+                                 "is outside its "
                                  f"bounds [{lo[j]:g}, {hi[j]:g}] (parameter vector {i})")
         return thetas
 
@@ -126,18 +130,21 @@ class Model(abc.ABC):
             arr = u.as_array(*names)
             t0 = float(u.t[0])
             if dt is not None and abs(dt / dt_u - 1.0) > 1e-6:
-                raise SimulationError(f"dt={dt} s given, but the input trajectory is sampled every {dt_u:g} s")
+                raise SimulationError(f"dt={dt} s given, but the input trajectory is sampled "
+                                      f"every {dt_u:g} s")
             dt = dt_u
         elif isinstance(u, Mapping):
             missing = [n for n in names if n not in u]
             if missing:
-                raise SimulationError(f"{self.name}: inputs {missing} missing", hint=f"inputs are {names}")
+                raise SimulationError(f"{self.name}: inputs "
+                                      f"{missing} missing", hint=f"inputs are {names}")
             arr = np.column_stack([_float_array(u[n], f"input {n!r}") for n in names])
         else:
             arr = _float_array(u, "u")
             arr = arr.reshape(-1, 1) if arr.ndim == 1 else arr
             if arr.ndim != 2 or arr.shape[1] != len(names):
-                raise SimulationError(f"{self.name}: expected inputs of shape (N, {len(names)}) for {names}, "
+                raise SimulationError(f"{self.name}: expected inputs of shape (N, "
+                                      f"{len(names)}) for {names}, "
                                       f"found {np.shape(u)}")
         if dt is None:
             raise SimulationError(f"{self.name}: give the sample time dt (or a Trajectory input)")
@@ -168,7 +175,8 @@ class Model(abc.ABC):
         arr, dt, _ = self._inputs_array(u, dt)
         return self._simulate_checked(thetas, arr, dt, x0, substeps, out)
 
-    def _simulate_checked(self, thetas: np.ndarray, arr: np.ndarray, dt: float, x0, substeps, out) -> np.ndarray:
+    def _simulate_checked(self, thetas: np.ndarray, arr: np.ndarray, dt: float, x0, substeps,
+                          out) -> np.ndarray:
         """:meth:`simulate_batch` on parameter vectors and inputs already checked."""
         if substeps is None:
             substeps = self.substeps(dt, thetas)
@@ -179,13 +187,16 @@ class Model(abc.ABC):
                 check_step(dt / substeps, self.modes(th), self.integrator, what=self.name)
         P = thetas.shape[0]
         if x0 is None:
-            x0 = np.stack([self.initial_state(th) for th in thetas]) if len(self.states) else np.zeros((P, 0))
-        x0 = np.ascontiguousarray(np.broadcast_to(np.asarray(x0, dtype=np.float64), (P, len(self.states))))
+            x0 = (np.stack([self.initial_state(th) for th in thetas]) if len(self.states)
+                  else np.zeros((P, 0)))
+        x0 = (np.ascontiguousarray(np.broadcast_to(np.asarray(x0, dtype=np.float64),
+                                                   (P, len(self.states)))))
         shape = (P, arr.shape[0], len(self.outputs))
         if out is None:
             y = np.empty(shape)
         elif out.shape != shape or out.dtype != np.float64 or not out.flags.c_contiguous:
-            raise SimulationError(f"out: expected a C-contiguous float64 array of shape {shape}, found "
+            raise SimulationError("out: expected a C-contiguous float64 array of shape "
+                                  f"{shape}, found "
                                   f"{out.dtype} {out.shape}")
         else:
             y = out
@@ -202,7 +213,8 @@ class Model(abc.ABC):
         """Simulate one parameter set; returns a Trajectory of the inputs and outputs."""
         arr, dt, t0 = self._inputs_array(u, dt)
         y = self._simulate_checked(self._check_thetas(self.theta(params)[None, :]), arr, dt,
-                                   None if x0 is None else np.asarray(x0)[None, :], substeps, None)[0]
+                                   None if x0 is None else np.asarray(x0)[None, :], substeps,
+                                   None)[0]
         t = np.arange(arr.shape[0], dtype=np.float64)
         t *= dt
         t += t0
@@ -223,7 +235,8 @@ def _float_array(values, name: str) -> np.ndarray:
     try:
         return np.asarray(values, dtype=np.float64)
     except (TypeError, ValueError):
-        raise ArgumentError(f"{name}: expected numbers (an array of float), found {type(values).__name__} "
+        raise ArgumentError(f"{name}: expected numbers (an array of float), found "
+                            f"{type(values).__name__} "
                             f"{values!r:.40}") from None
 
 
@@ -237,9 +250,11 @@ def simulate(model: Model, u, **kwargs) -> Trajectory:
     if not callable(getattr(model, "simulate", None)):
         raise ArgumentError(f"simulate(): model must be a gripkit model (gripkit.sim.Model), found "
                             f"{type(model).__name__} {model!r:.40}",
-                            hint="build one, e.g. gripkit.zoo.build('tsfm-left') or gripkit.models.MassSpringDamper()")
+                            hint="build one, e.g. gripkit.zoo.build('tsfm-left') or "
+                                 "gripkit.models.MassSpringDamper()")
     method = model.simulate
-    if not any(p.kind is inspect.Parameter.VAR_KEYWORD for p in inspect.signature(method).parameters.values()):
+    if not any(p.kind is inspect.Parameter.VAR_KEYWORD
+               for p in inspect.signature(method).parameters.values()):
         check_keywords(kwargs, keyword_names(method, exclude=("u",)), f"simulate({model.name})"
                        if hasattr(model, "name") else "simulate()")
     return method(u, **kwargs)

@@ -44,7 +44,8 @@ def step_report(dt: float, modes: Iterable[tuple[float, float]], method: str = "
                 points_per_period: int = 20) -> list[dict]:
     """For each mode (ω_n rad/s, ζ): ω h, the stable and accurate limits, and verdicts."""
     if method not in STABILITY_LIMIT:
-        raise SimulationError(f"method: expected one of {sorted(STABILITY_LIMIT)}, found {method!r}")
+        raise SimulationError(f"method: expected one of {sorted(STABILITY_LIMIT)}, "
+                              f"found {method!r}")
     rows = []
     for wn, zeta in modes:
         wh = wn * dt
@@ -67,7 +68,8 @@ def check_step(dt: float, modes: Iterable[tuple[float, float]], method: str = "r
         if not r["stable"]:
             raise SimulationError(
                 f"{what}: step dt = {dt:.6g} s cannot integrate the {r['f_n_hz']:.6g} Hz mode "
-                f"(ζ = {r['zeta']:.3g}) with {method}: ω·dt = {r['omega_h']:.3g} exceeds the stability "
+                f"(ζ = {r['zeta']:.3g}) with {method}: ω·dt = {r['omega_h']:.3g} "
+                "exceeds the stability "
                 f"limit {r['stable_limit']:.3g}",
                 hint=f"use dt <= {r['accurate_limit'] / r['omega_n']:.3g} s or substeps")
         if not r["accurate"]:

@@ -37,7 +37,8 @@ def signal_with_peaks(x, name: str) -> tuple[np.ndarray, float, float]:
     try:
         a = np.asarray(x, dtype=np.float64)
     except (TypeError, ValueError):
-        raise DataError(f"{name}: expected a 1-D array of numbers, found {type(x).__name__}") from None
+        raise DataError(f"{name}: expected a 1-D array of numbers, found "
+                        f"{type(x).__name__}") from None
     if a.ndim != 1:
         raise DataError(f"{name}: expected a 1-D array of samples, found shape {a.shape}",
                         hint="pass one channel at a time (single-input single-output models)")
@@ -48,7 +49,8 @@ def signal_with_peaks(x, name: str) -> tuple[np.ndarray, float, float]:
         for label, mask in (("NaN", np.isnan(a)), ("infinite", np.isinf(a))):
             if mask.any():
                 raise DataError(
-                    f"{name} has {int(mask.sum())} {label} values (first at sample {int(np.argmax(mask))})",
+                    f"{name} has {int(mask.sum())} {label} values (first at sample "
+                    f"{int(np.argmax(mask))})",
                     hint="drop or interpolate them before identification (CLI: --fill)")
     return a, lo, hi
 
@@ -64,12 +66,14 @@ def as_io_matrix(x, name: str, n: int | None = None, channels: tuple[str, ...] |
     if a.ndim == 1:
         a = a[:, None]
     if channels is not None and (a.ndim != 2 or a.shape[1] != len(channels)):
-        raise DataError(f"{name}: expected shape (N, {len(channels)}) for the {kind}s {', '.join(channels)}, "
+        raise DataError(f"{name}: expected shape (N, {len(channels)}) for the {kind}s "
+                        f"{', '.join(channels)}, "
                         f"found {a.shape}")
     if a.ndim != 2 or a.shape[0] == 0 or a.shape[1] == 0:
         raise DataError(f"{name}: expected shape (N,) or (N, {kind}s), found {a.shape}")
     if n is not None and a.shape[0] != n:
-        raise DataError(f"{name}: expected {n} samples (as many as the other signal), found {a.shape[0]}")
+        raise DataError(f"{name}: expected {n} samples (as many as the other signal), "
+                        f"found {a.shape[0]}")
     if not _all_finite(a):
         bad = ~np.isfinite(a)
         r, c = np.argwhere(bad)[0]
@@ -83,7 +87,8 @@ def io_records(records, *, siso: bool = False) -> list[tuple[np.ndarray, np.ndar
     """Several records as checked ``(u (N_i, m), y (N_i, p))`` pairs with the same numbers of
     columns (one input and one output with ``siso``); a DataError names the record."""
     if not isinstance(records, (list, tuple)) or not records:
-        raise DataError(f"records: expected a non-empty list of (u, y) pairs, found {records!r:.60}")
+        raise DataError("records: expected a non-empty list of (u, y) pairs, found "
+                        f"{records!r:.60}")
     recs = []
     for i, r in enumerate(records):
         if not (isinstance(r, (tuple, list)) and len(r) == 2):
@@ -117,7 +122,8 @@ def check_io_peaks(u, y) -> tuple[np.ndarray, np.ndarray, tuple]:
     u, ulo, uhi = signal_with_peaks(u, "input u")
     y, ylo, yhi = signal_with_peaks(y, "output y")
     if u.shape != y.shape:
-        raise DataError(f"input u and output y must have the same length, found {u.size} and {y.size}")
+        raise DataError("input u and output y must have the same length, found "
+                        f"{u.size} and {y.size}")
     return u, y, ((ulo, uhi), (ylo, yhi))
 
 

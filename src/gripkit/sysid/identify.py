@@ -14,7 +14,8 @@
 ('ARX [2 2 2]', 0.005, 'N/A')
 
 The array functions (:func:`~gripkit.sysid.linear.arx`, :func:`~gripkit.sysid.linear.armax`,
-:func:`~gripkit.sysid.linear.oe`, :func:`~gripkit.sysid.linear.rls`, :func:`~gripkit.sysid.structure_search`)
+:func:`~gripkit.sysid.linear.oe`, :func:`~gripkit.sysid.linear.rls`,
+:func:`~gripkit.sysid.structure_search`)
 take the signals as they are; :func:`identify` adds what a data file needs: column selection,
 the uniform-sampling check, the sampling rate, units, and removal of the operating point
 (``detrend='mean'`` by default: an ARX model has no constant term, so an input centred on 850 mA
@@ -68,7 +69,8 @@ def _free_run_fit(model, u: np.ndarray, y: np.ndarray) -> float:
 
 
 def warn_if_mean_detrending_hurt(model, io: IOData, raw, refit) -> None:
-    """The SISO form of :func:`gripkit.sysid.linear.identify_mimo._warn_if_detrending_hurt`: when a pole
+    """The SISO form of :func:`gripkit.sysid.linear.identify_mimo._warn_if_detrending_hurt`: when a
+    pole
     of ``model`` (fitted on the mean-detrended ``io``) does not settle within the record
     (|z|^N > e⁻⁵), fit the same structure (``refit(raw())``) on the data as they are (``raw()``:
     their :class:`IOData` without detrending) and warn, naming ``--detrend none``, when its free
@@ -130,7 +132,8 @@ def method_options(method: str) -> list[str]:
 
 
 @entry_point
-def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, na: int = 2, nb: int = 2,
+def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, na: int = 2,
+             nb: int = 2,
              nk: int = 1, nc: int = 1, nf: int | None = None, detrend: str = "mean", **options):
     """Identify a linear model of ``output`` driven by ``input`` from a trajectory.
 
@@ -154,7 +157,8 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
         (Hammerstein–Wiener on the data as they are, with this function's ``nb``, ``nk`` and
         ``nf`` (default ``nb``); the array function searches the orders; options of
         :func:`gripkit.sysid.hammerstein_wiener`: ``input_nonlinearity``,
-        ``output_nonlinearity``, ``validate`` …); ``'hysteresis'`` (Bouc-Wen or Prandtl–Ishlinskii, options of
+        ``output_nonlinearity``, ``validate`` …); ``'hysteresis'`` (Bouc-Wen or Prandtl–Ishlinskii,
+        options of
         :func:`gripkit.sysid.hysteresis`: ``model``, ``exponent``, ``operators`` …); ``'nlss'``
         (polynomial nonlinear state space, options of :func:`gripkit.sysid.nlss`: ``order``,
         ``degree``, ``validate`` …). For ss, frf, tf and nlss ``input``/``output`` may name
@@ -180,13 +184,15 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
         raise DataError(f"method: expected one of {', '.join(METHODS)}, found {method!r}")
     opts = method_options(method)
     check_keywords(options, opts, f"identify(method={method!r})",
-                   hint=f"identify accepts {', '.join(keyword_names(identify))} and, for method {method!r}, "
+                   hint=f"identify accepts {', '.join(keyword_names(identify))} and, for "
+                        f"method {method!r}, "
                         + (", ".join(opts) if opts else "no other options"))
     for name, col in (("input", input), ("output", output)):
         if not (isinstance(col, str) or (method in ("ss", "frf", "tf", "arx", "nlss")
                                          and isinstance(col, (list, tuple))
                                          and all(isinstance(c, str) for c in col))):
-            raise ArgumentError(f"identify(): {name} must be a column name (str), found {type(col).__name__} "
+            raise ArgumentError(f"identify(): {name} must be a column name (str), found "
+                                f"{type(col).__name__} "
                                 f"{col!r:.40}", hint=f"columns: {', '.join(data.names)}"
                                 if isinstance(data, Trajectory) else None)
     model = _dispatch(data, method, input=input, output=output, na=na, nb=nb, nk=nk, nc=nc, nf=nf,
@@ -213,7 +219,8 @@ def _dispatch(data, method: str, *, input, output, na: int, nb: int, nk: int, nc
         return identify_records(data, method, input=input, output=output, na=na, nb=nb, nk=nk,
                                 nc=nc, nf=nf, detrend=detrend, **options)
     if method in ("ss", "frf", "tf"):  # MIMO: input/output may name several columns
-        fn = {"ss": identify_mimo.identify_ss, "frf": identify_mimo.identify_frf, "tf": identify_mimo.identify_tf}
+        fn = ({"ss": identify_mimo.identify_ss, "frf": identify_mimo.identify_frf,
+               "tf": identify_mimo.identify_tf})
         if method == "ss" and "weighting" in options:  # identify_ss names it ``method``
             options = dict(options)
             options["method"] = options.pop("weighting")
@@ -244,7 +251,8 @@ def _dispatch(data, method: str, *, input, output, na: int, nb: int, nk: int, nc
         return model
     if method == "hysteresis":  # rate independent, its offset a parameter: the data as they are
         return nonlinear.hysteresis(data, input=input, output=output, **options)
-    io = io_data(data, input=input, output=output, detrend=detrend, why=f"{method.upper()} identification")
+    io = (io_data(data, input=input, output=output, detrend=detrend,
+                  why=f"{method.upper()} identification"))
     if method in ("arx", "armax", "oe"):
         orders = (na, nb, nc, na if nf is None else nf, nk)
         model = _polynomial_fit(method, io, orders, options)
@@ -339,9 +347,11 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
     same columns, sample interval and units), each with its own initial conditions; σ from all
     of them: ARX (:func:`gripkit.sysid.arx_records`; with several columns
     :func:`gripkit.sysid.linear.arx_mimo.arx_mimo_records`), ARMAX
-    (:func:`gripkit.sysid.linear.armax.armax_records`), OE (:func:`gripkit.sysid.linear.oe.oe_records`; ``nf``
+    (:func:`gripkit.sysid.linear.armax.armax_records`), OE
+    (:func:`gripkit.sysid.linear.oe.oe_records`; ``nf``
     defaults to ``na``), ``options`` ``maxiter``, ``tol`` for the last two; state space
-    (``options`` of :data:`gripkit.sysid.linear.identify_mimo.SS_RECORD_OPTIONS`: subspace, then PEM,
+    (``options`` of :data:`gripkit.sysid.linear.identify_mimo.SS_RECORD_OPTIONS`: subspace, then
+    PEM,
     see :func:`gripkit.sysid.linear.identify_mimo.identify_ss_records`),
     continuous-time transfer functions (``poles``, ``zeros``:
     :func:`gripkit.sysid.linear.tfest.tfest_records`) and polynomial NARX

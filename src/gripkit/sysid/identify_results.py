@@ -1,5 +1,6 @@
 """What follows an identification: the one validation of a model on a second record
-(:func:`validate_model` → :class:`ValidationResult`). The ``gripkit identify`` commands call these after
+(:func:`validate_model` → :class:`ValidationResult`). The ``gripkit identify`` commands call these
+after
 :func:`gripkit.sysid.identify`; a Python session calls the same.
 
 The validation fit is the one of :data:`gripkit.sysid.linear.linear_model.VALIDATION_FIT` (free

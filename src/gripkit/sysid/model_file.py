@@ -60,7 +60,8 @@ def plain(x):
 def content_hash(doc: dict) -> str:
     """SHA-256 of the canonical JSON (sorted keys, no spaces) of ``doc`` less ``content_sha256``."""
     body = {k: v for k, v in doc.items() if k != "content_sha256"}
-    return hashlib.sha256(json.dumps(body, sort_keys=True, separators=(",", ":")).encode()).hexdigest()
+    return (hashlib.sha256(json.dumps(body, sort_keys=True,
+                                      separators=(",", ":")).encode()).hexdigest())
 
 
 def write_document(doc: dict, path) -> None:
@@ -92,8 +93,10 @@ def _nesting(doc) -> int:
     return deepest
 
 
-def read_document(path, schema: str = SCHEMA, newest: int = SCHEMA_VERSION, *, what: str = "model file",
-                  hint: str = "give a file written by gripkit identify --out or model.save()") -> dict:
+def read_document(path, schema: str = SCHEMA, newest: int = SCHEMA_VERSION, *,
+                  what: str = "model file",
+                  hint: str = "give a file written by gripkit identify --out "
+                              "or model.save()") -> dict:
     """The JSON document of the model file ``path``, checked: ``schema`` and a ``schema_version``
     from 1 to ``newest`` (ModelError otherwise), and its content hash (AccuracyWarning when the
     file was edited after it was saved)."""
@@ -126,6 +129,7 @@ def read_document(path, schema: str = SCHEMA, newest: int = SCHEMA_VERSION, *, w
         raise ModelError(f"{what} {where}: expected schema_version 1 … {newest}, found {ver!r}",
                          hint="upgrade gripkit to read files written by a newer version")
     if doc.get("content_sha256") != content_hash(doc):
-        emit_warning(f"{what} {where}: content hash mismatch (the file was edited after it was saved); "
+        emit_warning(f"{what} {where}: content hash mismatch (the file was edited after "
+                     "it was saved); "
                      f"using it as it is", AccuracyWarning)
     return doc

@@ -269,9 +269,11 @@ def bode_figure(system, dt, estimate, keep=None):
             am.loglog(f, mag[:, i, j], label="model")
             ap.semilogx(f, ph[:, i, j])
             if ms is not None:
-                am.fill_between(f, np.maximum(mag[:, i, j] - 2 * ms[:, i, j], 1e-300), mag[:, i, j] + 2 * ms[:, i, j],
+                am.fill_between(f, np.maximum(mag[:, i, j] - 2 * ms[:, i, j], 1e-300),
+                                mag[:, i, j] + 2 * ms[:, i, j],
                                 alpha=0.25, label="±2σ")
-                ap.fill_between(f, ph[:, i, j] - 2 * ps[:, i, j], ph[:, i, j] + 2 * ps[:, i, j], alpha=0.25)
+                ap.fill_between(f, ph[:, i, j] - 2 * ps[:, i, j], ph[:, i, j] + 2 * ps[:, i, j],
+                                alpha=0.25)
             kept = np.zeros(0)
             if estimate is not None:
                 fe, He, Se = estimate.frequency_hz, estimate.H[:, i, j], estimate.H_std[:, i, j]
@@ -304,7 +306,8 @@ def singular_value_figure(sv, order):
     fig, ax = plt.subplots(figsize=(6, 3.2))
     k = np.arange(1, sv.size + 1)
     ax.semilogy(k, sv, "o-", ms=4)
-    ax.semilogy([order], [sv[order - 1]], "o", ms=10, mfc="none", color="C3", label=f"order {order}")
+    ax.semilogy([order], [sv[order - 1]], "o", ms=10, mfc="none", color="C3",
+                label=f"order {order}")
     ax.set_xlabel("index")
     ax.set_ylabel("singular value")
     ax.grid(alpha=0.3, which="both")
@@ -349,7 +352,8 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=(),
         for i, name in enumerate(model.outputs):
             yo = y_offset[i]
             sec.figure(measured_vs_model(t, y[:, i] + yo, {"model": ys[:, i] + yo},
-                                         ylabel=name, title=f"{name}: fit {fit[i]:.2f} %"), f"{name}", name=f"out-{i}")
+                                         ylabel=name, title=f"{name}: fit {fit[i]:.2f} %"),
+                                         f"{name}", name=f"out-{i}")
         res = residual_analysis(model, u, y, dt, free_run_fit=fit)
         sec = rep.section("Residual analysis", res.notes[0] + " The dotted lines are ±1.96/√N, "
                           "the 95 % band of white residuals independent of past inputs.")
@@ -360,8 +364,10 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=(),
                       [[n, ff, f1] for n, ff, f1 in zip(model.outputs, fit, res.fit_percent)])
         sec.figure(_residual_figure(res.e, u, model.outputs, model.inputs), "residual correlations",
                    name="residuals")
-        rep.section("Poles and zeros", "Poles (×), transmission zeros (○) and the 1σ ellipse of each pole, "
-                    "by linearisation of the parameter covariance.").figure(_pz_figure(model.system), "pole-zero map",
+        rep.section("Poles and zeros", "Poles (×), transmission zeros (○) and the 1σ "
+                                       "ellipse of each pole, "
+                    "by linearisation of the "
+                    "parameter covariance.").figure(_pz_figure(model.system), "pole-zero map",
                                                                             name="pz")
         est, keep, shown = None, None, ""
         if u.shape[0] >= 256 * (u.shape[1] + 1):
@@ -398,7 +404,8 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=(),
         sec.table(["warning"], [[ln] for ln in dict.fromkeys(lines)])
     info = {k: v for k, v in model.info.items() if isinstance(v, (str, int, float))}
     if info:
-        rep.section("Identification details").table(["item", "value"], [[k, v] for k, v in info.items()])
+        rep.section("Identification details").table(["item", "value"],
+                                                    [[k, v] for k, v in info.items()])
     return rep
 
 

@@ -27,7 +27,8 @@ import numpy as np
 
 from ..errors import AccuracyWarning, UnidentifiableError, emit_warning
 
-__all__ = ["arx_start", "arx_regression", "QRSolution", "qr_solve", "triangular_solve", "scaled_condition",
+__all__ = ["arx_start", "arx_regression", "QRSolution", "qr_solve", "triangular_solve",
+           "scaled_condition",
            "COND_LIMIT", "warn_threshold", "hac_covariance"]
 
 #: Largest acceptable condition number of the column-scaled regressor. Beyond it the data do
@@ -96,7 +97,8 @@ def solve_upper(r1: np.ndarray, b: np.ndarray, trans: int = 0) -> np.ndarray:
     entry on the diagonal (the entries below it are zero), so the LU factors are I and ``r1``
     itself and the solve is the back substitution (for ``r1ᵀ``, the same on the reversed
     system). numpy, not ``scipy.linalg.solve_triangular``: importing scipy.linalg is a
-    noticeable part of a CLI start-up, and scipy's argument handling costs more than a small solve."""
+    noticeable part of a CLI start-up, and scipy's argument handling costs more than a small
+    solve."""
     if trans:  # r1ᵀ x = b  ⇔  (J r1ᵀ J)(J x) = J b, J the reversal; J r1ᵀ J is upper triangular
         return np.linalg.solve(r1.T[::-1, ::-1], b[::-1])[::-1]
     return np.linalg.solve(r1, b)
@@ -176,7 +178,8 @@ def qr_solve(X: np.ndarray, names: tuple[str, ...], overwrite: bool = False, war
     m, q = X.shape
     p = q - 1
     if m <= p:
-        raise UnidentifiableError(f"{m} equations cannot determine {p} parameters ({', '.join(names)})",
+        raise UnidentifiableError(f"{m} equations cannot determine {p} parameters "
+                                  f"({', '.join(names)})",
                                   hint="use a longer record or a smaller model")
     return triangular_solve(qr_r(X, overwrite), names, m, warn, values, stacklevel=4)
 
@@ -213,7 +216,8 @@ def triangular_solve(R: np.ndarray, names: tuple[str, ...], m: int, warn: bool =
         raise UnidentifiableError(
             f"the data do not determine the parameters (regressor condition number {cond:.3g} > "
             f"{COND_LIMIT:.0e}); the poorly determined combination involves {', '.join(involved)}",
-            hint="excite the system more richly (more frequencies than parameters) or lower the orders")
+            hint="excite the system more richly (more frequencies than parameters) or "
+                 "lower the orders")
     r = R[:p, p]
     theta = solve_upper(r1, r)
     rinv = solve_upper(r1, np.eye(p))
@@ -234,9 +238,12 @@ def triangular_solve(R: np.ndarray, names: tuple[str, ...], m: int, warn: bool =
                             for i in _weak_combination(vt, names))
         emit_warning(
            f"the data barely determine the parameters (regressor condition number {cond:.3g} > "
-           f"{limit:.3g}, the limit for this fit's noise and length; refused above {COND_LIMIT:.0e}): "
-           f"poorly determined are {rel}; they move together along a nearly unexcited direction, so "
-           f"their values may be far from the truth; excite the system more richly (more frequencies "
+           f"{limit:.3g}, the limit for this fit's noise and length; refused above "
+           f"{COND_LIMIT:.0e}): "
+           f"poorly determined are {rel}; they move together along a nearly "
+           "unexcited direction, so "
+           "their values may be far from the truth; excite the system more richly "
+           "(more frequencies "
            f"than parameters) or lower the orders", AccuracyWarning)
     return QRSolution(theta, rss, r1.copy(), 0.5 * (cov + cov.T), cond, m)
 

@@ -7,9 +7,11 @@ Each signal is multiplied by a power of two ``c = 2^-e`` with ``max|x| = m·2^e`
 the scaled signal has ``0.5 <= max|x'| < 1``, and the multiplication is exact (only the exponent
 changes), so data already of order 1 give bit-for-bit the same fit as without scaling.
 
-With ``u' = c_u u`` and ``y' = c_y y``, ``A y = B u + C e`` becomes ``A y' = (c_y/c_u) B u' + C c_y e``:
+With ``u' = c_u u`` and ``y' = c_y y``, ``A y = B u + C e`` becomes ``A y' = (c_y/c_u) B u' + C c_y
+e``:
 A, C and F are unchanged, ``B = B' c_u/c_y``, the errors are ``e = e'/c_y``, the noise variance and
-the loss (squares of e) are divided by ``c_y²``, and the covariance of θ is ``D Cov' D`` with D = c_u/c_y
+the loss (squares of e) are divided by ``c_y²``, and the covariance of θ is ``D Cov' D`` with D =
+c_u/c_y
 on the B entries and 1 elsewhere.
 """
 
@@ -39,7 +41,8 @@ def in_user_units(model, cu: float, cy: float):
     g = cu / cy
     changes = {"B": model.B * g}
     with np.errstate(over="ignore", under="ignore", invalid="ignore"):
-        if model.covariance is not None:  # variances of B beyond ~1e308 overflow to inf: not representable
+        # variances of B beyond ~1e308 overflow to inf: not representable
+        if model.covariance is not None:
             d = np.ones(model.n_params)
             d[model.na:model.na + model.nb] = g
             changes["covariance"] = model.covariance * d[:, None] * d[None, :]

@@ -62,7 +62,8 @@ _ENTRIES: tuple[ZooEntry, ...] = (
              "current (A) to fingertip force (N) at 200 Hz, two-sample valve delay",
              _AMADEUS, "gripkit.systems.amadeus.force_dynamics:finger_force_model"),
     ZooEntry("amadeus-hand", "AMADEUS subsea hand",
-             "Three-bellows finger (eqs 1-8), proportional valves, six-bridge force sensor with fusion "
+             "Three-bellows finger (eqs 1-8), proportional valves, six-bridge force "
+             "sensor with fusion "
              "(eqs 9-19, Table I), PVDF slip sensor, Table II force dynamics in SI units",
              _AMADEUS, "gripkit.systems.amadeus.parameters:amadeus_hand"),
     ZooEntry("ftg100-actuated", "FemtoTools FT-G100 microgripper",
@@ -89,16 +90,20 @@ _ENTRIES: tuple[ZooEntry, ...] = (
              "read as the free tip's travel (0.460 x eq 5); its departure from eqs 5 and 10 is "
              "reported",
              _FTG, "gripkit.systems.ftg100.model:calibrated_plant_model"),
-    ZooEntry("tsfm-left", "TSFM piezo microgripper", "Left finger, Table II: Bouc-Wen + D(s) actuator, lever, force "
-             "sensor (8.52 kHz, ζ = 0.006), eqs 3-13", _TSFM, "gripkit.systems.tsfm.parameters:left_finger"),
-    ZooEntry("tsfm-right", "TSFM piezo microgripper", "Right finger, Table II (as tsfm-left)", _TSFM,
+    ZooEntry("tsfm-left", "TSFM piezo microgripper", "Left finger, Table II: Bouc-Wen + D(s) "
+                                                     "actuator, lever, force "
+             "sensor (8.52 kHz, ζ = "
+             "0.006), eqs 3-13", _TSFM, "gripkit.systems.tsfm.parameters:left_finger"),
+    ZooEntry("tsfm-right", "TSFM piezo microgripper", "Right finger, Table "
+                                                      "II (as tsfm-left)", _TSFM,
              "gripkit.systems.tsfm.parameters:right_finger"),
     ZooEntry("tsfm-finger", "TSFM piezo microgripper", "One finger of Table II, side='left' "
              "(default) or 'right'", _TSFM, "gripkit.systems.tsfm.parameters:finger"),
     ZooEntry("tsfm-finger-contact", "TSFM piezo microgripper",
              "One finger pressing on a part (Fig. 13): face at 62.42 µm (§V-C), Table III's "
              "72.5 N/m; hybrid contact", _TSFM, "gripkit.systems.tsfm.parameters:finger_contact"),
-    ZooEntry("tsfm-gripper", "TSFM piezo microgripper", "Both fingers, 400 µm gap, a 300 µm micropart of Table III "
+    ZooEntry("tsfm-gripper", "TSFM piezo microgripper", "Both fingers, 400 µm gap, a 300 µm "
+                                                        "micropart of Table III "
              "stiffness; hybrid contacts", _TSFM, "gripkit.systems.tsfm.parameters:gripper"),
     ZooEntry("dlr-hit-finger", "DLR/HIT Hand II",
              "Modular finger of ch. 7: PWM → BLDC motor (eq 5.10) → belts and harmonic drive → "
@@ -144,12 +149,14 @@ def register(entry: ZooEntry) -> None:
 
 def get(name: str) -> ZooEntry:
     if not isinstance(name, str):
-        raise ArgumentError(f"zoo model name: expected a str, found {type(name).__name__} {name!r:.40}",
+        raise ArgumentError("zoo model name: expected a str, found "
+                            f"{type(name).__name__} {name!r:.40}",
                             hint=f"available: {', '.join(e.name for e in _ENTRIES)}")
     for e in _ENTRIES:
         if e.name == name:
             return e
-    raise ModelError(f"no zoo model {name!r}", hint=f"available: {', '.join(e.name for e in _ENTRIES)}")
+    raise ModelError(f"no zoo model {name!r}",
+                     hint=f"available: {', '.join(e.name for e in _ENTRIES)}")
 
 
 def build(name: str, **kwargs):

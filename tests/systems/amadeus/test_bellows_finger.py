@@ -1,4 +1,5 @@
-"""Three-bellows finger: eqs 1-8 (000_8f66dcc7ab06470c.txt §III), deflection and the inverse of §III-C."""
+"""Three-bellows finger: eqs 1-8 (000_8f66dcc7ab06470c.txt §III), deflection and the inverse of
+§III-C."""
 
 import math
 
@@ -81,7 +82,8 @@ def test_lowest_and_highest_total_pressure_variants():
         lo = F.pressures_for(psi, 0.012, "min")
         hi = F.pressures_for(psi, 0.012, "max")
         assert lo.sum() < hi.sum()
-        # same differences up to the length change (higher mean pressure -> longer finger, less moment)
+        # same differences up to the length change (higher mean pressure -> longer finger, less
+        # moment)
         assert np.ptp(hi) < np.ptp(lo)
 
 
@@ -93,7 +95,8 @@ def test_reach_is_a_hexagon_with_20mm_in_principal_directions():
     assert reach.max() == pytest.approx(0.020, rel=1e-9)
     np.testing.assert_allclose(reach[1::2], 0.020, rtol=1e-9)
     assert np.all(reach[0::2] > 0.0195) and np.all(reach[0::2] < 0.020)
-    assert F.max_moment(math.radians(30)) == pytest.approx(math.cos(math.radians(30)) * F.max_moment(0), rel=1e-12)
+    assert F.max_moment(math.radians(30)) == pytest.approx(math.cos(math.radians(30))
+                                                           * F.max_moment(0), rel=1e-12)
     assert F.max_deflection(math.radians(30)) < 0.019
     with pytest.raises(ModelError, match="out of reach"):
         F.pressures_for(math.radians(30), 0.0195)

@@ -58,7 +58,8 @@ def rst():
 
 def test_closed_loop_poles_as_designed_and_zero_kept(rst):
     """The characteristic polynomial A R + B S equals the designed A_m A_o (no pole/zero
-    cancellation: the NMP zero and the delay remain in B T, the reference transfer); python-control's
+    cancellation: the NMP zero and the delay remain in B T, the reference transfer);
+    python-control's
     feedback loop has the same poles."""
     import control  # a dev dependency: the cross-check fails, never skips, without it
     np.testing.assert_allclose(rst.characteristic()[:6], rst.design["P"], atol=1e-10)
@@ -124,7 +125,8 @@ def test_anti_windup_limits_overshoot_under_saturation(rst):
     """A load on the valve current that the limits cannot compensate drives u into saturation for
     1 s; when it goes away, the anti-windup form recovers in a fraction of the time and error of the
     same RST law with windup (clamped only)."""
-    naive = RSTController(rst.R, rst.S, rst.T, anti_windup=False, u_min=-0.1, u_max=0.1, plant=PLANT)
+    naive = (RSTController(rst.R, rst.S, rst.T, anti_windup=False, u_min=-0.1, u_max=0.1,
+                           plant=PLANT))
     aw = RSTController(rst.R, rst.S, rst.T, A_aw=rst.A_aw, u_min=-0.1, u_max=0.1, plant=PLANT)
     n = 800
     r = np.full(n, 2.0)  # needs u = -0.065 A
@@ -142,7 +144,8 @@ def test_anti_windup_limits_overshoot_under_saturation(rst):
 
 
 def test_robust_to_compliant_objects(rst):
-    """Softer contacts lower the plant gain: the loop stays stable from 5 % to 200 % of the rigid gain."""
+    """Softer contacts lower the plant gain: the loop stays stable from 5 % to 200 % of the rigid
+    gain."""
     for g in (0.05, 0.2, 0.5, 1.0, 1.5, 2.0):
         assert rst.is_stable(PLANT.scaled(g))
 
@@ -155,14 +158,16 @@ def detector():
     rng = np.random.default_rng(8)
     c = StickSlipContact()
     u = nonslip_grasp_inputs(20.0, dt=0.0005, rng=rng)
-    x = c.simulate(u, dt=1 / 2000.0, x0=c.equilibrium_state(u[0, 1]))["v_pvdf"] + pvdf_noise(u.shape[0], dt=0.0005, rng=rng)
+    x = (c.simulate(u, dt=1 / 2000.0, x0=c.equilibrium_state(u[0, 1]))["v_pvdf"]
+         + pvdf_noise(u.shape[0], dt=0.0005, rng=rng))
     return SlipDetector(dt=0.0005).calibrate(x)
 
 
 @pytest.mark.parametrize("k_object, hold_tol", [(300.0, 0.25), (2000.0, 0.1), (math.inf, 0.1)])
 def test_grasp_respects_the_force_limit_and_arrests_slip(rst, detector, k_object, hold_tol):
     """Guarded approach, force control to 2 N, a load increase beyond μ_s F_n: the slip is detected
-    within 20 ms of its onset, the reflex raises the grip until the slip stops, and the contact force
+    within 20 ms of its onset, the reflex raises the grip until the slip stops, and the contact
+    force
     never exceeds the 4 N limit (compliant and rigid objects). The fixed controller, designed on the
     rigid-plate model, is slower on a very soft object (300 N/m: 28 % of the loop gain), hence the
     looser hold tolerance there."""
@@ -180,7 +185,8 @@ def test_grasp_respects_the_force_limit_and_arrests_slip(rst, detector, k_object
     assert g.force[-1] > sc.force_target + 0.5
 
 
-# -- the force scale (N per sensor unit) is an assumed, user-settable calibration ---------------------
+# -- the force scale (N per sensor unit) is an assumed, user-settable calibration
+# ---------------------
 
 def test_force_scale_default_is_derived_from_fig2c_peak_over_the_valve_span():
     from gripkit.systems.amadeus.force_dynamics import FORCE_SCALE, TABLE_II
@@ -215,7 +221,8 @@ def test_design_rst_accepts_the_zoo_model_directly():
     m = zoo.build("amadeus-finger-force")
     c = design_rst(m, wn=15.0, zeta=0.9, u_min=-0.25, u_max=0.25)
     ref = design_rst(m.model, wn=15.0, zeta=0.9, u_min=-0.25, u_max=0.25)
-    np.testing.assert_allclose(np.sort_complex(c.closed_loop_poles()), np.sort_complex(ref.closed_loop_poles()),
+    np.testing.assert_allclose(np.sort_complex(c.closed_loop_poles()),
+                               np.sort_complex(ref.closed_loop_poles()),
                                atol=1e-12)
     assert np.abs(c.closed_loop_poles()).max() < 1
     assert DiscretePlant.from_model(m).output_unit == "N"

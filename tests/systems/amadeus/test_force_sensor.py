@@ -22,7 +22,8 @@ def test_readings_follow_eqs_9_to_14():
     R = S.readings(np.array([fx, fy, fz]))
     c1, c2, s1, s2 = math.cos(p1), math.cos(p2), math.sin(p1), math.sin(p2)
     expect = [K[0] * l * fz, K[1] * l * (1 + math.cos(p2 - p1)) * fz, K[2] * l * (1 + c1 + c2) * fz,
-              K[3] * l * (c2 * fy - s2 * fx), K[4] * l * ((c1 + c2) * fy - s1 * fx), K[5] * l * (1 + c1 + c2) * fy]
+              K[3] * l * (c2 * fy - s2 * fx), K[4] * l * ((c1 + c2) * fy - s1 * fx),
+              K[5] * l * (1 + c1 + c2) * fy]
     np.testing.assert_allclose(R, expect, rtol=1e-14)
 
 
@@ -97,7 +98,8 @@ def test_fused_force_variance_below_singles_and_near_theory(static_record):
 
 
 def test_wls_is_fusion_for_one_component(static_record):
-    """With given variances, the WLS f_z equals fuse() of the three single-bridge estimates (eq 16-18
+    """With given variances, the WLS f_z equals fuse() of the three single-bridge estimates (eq
+    16-18
     for K = 3) — the z bridges see nothing else."""
     f0, R = static_record
     V = np.tile(np.array([1e-4, 2e-4, 3e-4, 1e-4, 1e-4, 1e-4]), (200, 1))
@@ -141,7 +143,8 @@ def _joint_kf(sensor, dyn, Z, U, x, P):
 
 
 def test_kalman_sequential_update_equals_joint_update():
-    """Independent measurement noise: the kernel's scalar sequential updates equal the joint update."""
+    """Independent measurement noise: the kernel's scalar sequential updates equal the joint
+    update."""
     rng = np.random.default_rng(1)
     plant, _ = force_plant()
     dyn = ForceDynamics.from_plant(plant, axis=2, q_disturbance=5.0, q_other=2.0)
@@ -164,7 +167,8 @@ def test_kalman_filter_is_honest_and_beats_per_sample_wls():
     q = np.array([2.0, 2.0, 5.0])
     f = np.cumsum(rng.standard_normal((N, 3)) * np.sqrt(q * dt), axis=0) + [0.5, 1.0, 2.0]
     Z = S.simulate(f, rng)
-    kf = ForceKalmanFilter(S, ForceDynamics.random_walk(q, dt), x0=[0.5, 1.0, 2.0], P0=np.eye(3) * 0.01)
+    kf = (ForceKalmanFilter(S, ForceDynamics.random_walk(q, dt), x0=[0.5, 1.0, 2.0],
+                            P0=np.eye(3) * 0.01))
     r = kf.run(Z)
     e = r.force - f
     nees = np.einsum("ni,nij,nj->n", e, np.linalg.inv(r.covariance), e)
@@ -172,13 +176,15 @@ def test_kalman_filter_is_honest_and_beats_per_sample_wls():
     assert r.nis[100:].mean() == pytest.approx(6.0, rel=0.1)
     wls = estimate_force(Z, S)
     assert np.all(np.sqrt((e ** 2).mean(0)) < 0.7 * np.sqrt(((wls.force - f) ** 2).mean(0)))
-    kf2 = ForceKalmanFilter(S, ForceDynamics.random_walk(q, dt), x0=[0.5, 1.0, 2.0], P0=np.eye(3) * 0.01)
+    kf2 = (ForceKalmanFilter(S, ForceDynamics.random_walk(q, dt), x0=[0.5, 1.0, 2.0],
+                             P0=np.eye(3) * 0.01))
     steps = np.array([kf2.step(Z[k])[0] for k in range(100)])
     np.testing.assert_array_equal(steps, r.force[:100])
 
 
 def test_plant_model_kalman_filter_uses_the_valve_command():
-    """In a control loop the identified force model (driven by the valve command) predicts the force:
+    """In a control loop the identified force model (driven by the valve command) predicts the
+    force:
     lower error than a random walk of the same disturbance intensity."""
     rng = np.random.default_rng(7)
     plant, _ = force_plant()

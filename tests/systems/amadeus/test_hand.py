@@ -1,4 +1,5 @@
-"""AMADEUS hand: palm, knuckles, fingertip kinematics and force closure (000_8f66dcc7ab06470c.txt §II-B, §II-C)."""
+"""AMADEUS hand: palm, knuckles, fingertip kinematics and force closure (000_8f66dcc7ab06470c.txt
+§II-B, §II-C)."""
 
 import math
 
@@ -20,7 +21,8 @@ def _rot(a):
     return np.array([[c, -s, 0], [s, c, 0], [0, 0, 1]])
 
 
-@given(st.floats(-math.radians(20), math.radians(20)), st.floats(0, 2 * math.pi), st.floats(0, 0.012))
+@given(st.floats(-math.radians(20), math.radians(20)), st.floats(0, 2 * math.pi),
+       st.floats(0, 0.012))
 def test_symmetric_triangle(angle, psi, d):
     """§II-B: three fingers in a symmetric triangle — the same knuckle angle and bending put the
     tips 120° apart about the hand axis."""
@@ -31,13 +33,15 @@ def test_symmetric_triangle(angle, psi, d):
 
 
 def test_straight_finger_tip_position():
-    """Straight fingers: tip radius R_p + L sin θ and height L cos θ (L = knuckle offset + length)."""
+    """Straight fingers: tip radius R_p + L sin θ and height L cos θ (L = knuckle offset +
+    length)."""
     P = np.full(3, 21 * BAR)
     L = HAND.reach(21 * BAR)
     for th in np.radians([-20, -7, 0, 13, 20]):
         tips = HAND.fingertip_positions(th, P)
         rho = np.hypot(tips[:, 0], tips[:, 1])
-        np.testing.assert_allclose(rho, HAND.hand_parameters.value("palm_radius") + L * math.sin(th), rtol=1e-12)
+        np.testing.assert_allclose(rho, HAND.hand_parameters.value("palm_radius") + L
+                                   * math.sin(th), rtol=1e-12)
         np.testing.assert_allclose(tips[:, 2], L * math.cos(th), rtol=1e-12)
 
 
@@ -47,13 +51,15 @@ def test_bending_toward_the_palm_axis_closes_the_hand():
     P = HAND.finger.pressures_for(0.0, 0.010, "max")
     bent = HAND.fingertip_positions(0.0, P)
     lat = float(HAND.finger.bending(P).tip_deflection)
-    np.testing.assert_allclose(np.hypot(bent[:, 0], bent[:, 1]), HAND.hand_parameters.value("palm_radius") - lat,
+    np.testing.assert_allclose(np.hypot(bent[:, 0], bent[:, 1]),
+                               HAND.hand_parameters.value("palm_radius") - lat,
                                rtol=1e-12)
     assert np.all(np.hypot(bent[:, 0], bent[:, 1]) < np.hypot(straight[:, 0], straight[:, 1]))
 
 
 def test_knuckle_potentiometer_and_object_sizes():
-    """§II-C potentiometer (assumed ±2 V over ±20°) and §II-B object range ∅10-150 mm within ±20°."""
+    """§II-C potentiometer (assumed ±2 V over ±20°) and §II-B object range ∅10-150 mm within
+    ±20°."""
     for th in np.radians([-20, 0, 11.5]):
         assert HAND.knuckle_angle(HAND.potentiometer_voltage(th)) == pytest.approx(th)
     with pytest.raises(DataError, match="beyond the ±20° knuckle range"):

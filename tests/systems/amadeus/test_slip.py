@@ -38,7 +38,8 @@ def test_slip_starts_at_the_static_friction_limit():
 def detector():
     rng = np.random.default_rng(1)
     u = nonslip_grasp_inputs(30.0, dt=1 / FS, rng=rng)
-    x = C.simulate(u, dt=1 / FS, x0=C.equilibrium_state(u[0, 1]))["v_pvdf"] + pvdf_noise(u.shape[0], dt=1 / FS, rng=rng)
+    x = (C.simulate(u, dt=1 / FS, x0=C.equilibrium_state(u[0, 1]))["v_pvdf"]
+         + pvdf_noise(u.shape[0], dt=1 / FS, rng=rng))
     return SlipDetector(dt=1 / FS).calibrate(x)
 
 
@@ -57,7 +58,8 @@ def test_ten_minute_nonslip_record_and_onsets(detector):
     assert fa["rate"] < 0.01
     for trial in range(12):
         fn = rng.uniform(1.0, 3.0)
-        uu = slip_onset_inputs(1.0, dt=1 / FS, normal_force=fn, load0=0.3 * fn, start=0.2, rate=rng.uniform(0.5, 8.0))
+        uu = (slip_onset_inputs(1.0, dt=1 / FS, normal_force=fn, load0=0.3 * fn, start=0.2,
+                                rate=rng.uniform(0.5, 8.0)))
         t = C.simulate(uu, dt=1 / FS, x0=C.equilibrium_state(uu[0, 1]))
         onset = np.argmax(t["slipping"] > 0) / FS
         dd = detector.detect(t["v_pvdf"] + pvdf_noise(uu.shape[0], dt=1 / FS, rng=rng))
@@ -69,7 +71,8 @@ def test_ten_minute_nonslip_record_and_onsets(detector):
 def test_stream_equals_batch(detector):
     rng = np.random.default_rng(3)
     u = slip_onset_inputs(1.0, dt=1 / FS, start=0.3)
-    x = C.simulate(u, dt=1 / FS, x0=C.equilibrium_state(u[0, 1]))["v_pvdf"] + pvdf_noise(u.shape[0], dt=1 / FS, rng=rng)
+    x = (C.simulate(u, dt=1 / FS, x0=C.equilibrium_state(u[0, 1]))["v_pvdf"]
+         + pvdf_noise(u.shape[0], dt=1 / FS, rng=rng))
     batch = detector.detect(x)
     s = detector.stream()
     alarms = []
@@ -80,7 +83,8 @@ def test_stream_equals_batch(detector):
 
 
 def test_slip_speed_indication():
-    """Fig. 12(b): the film signal depends on slip speed. Calibrated on the test rig at 4-20 mm/s and
+    """Fig. 12(b): the film signal depends on slip speed. Calibrated on the test rig at 4-20 mm/s
+    and
     two normal forces, the stick-slip rate × F_n indicates held-out speeds within 20 %, and the
     indication increases with the true speed."""
     rng = np.random.default_rng(4)

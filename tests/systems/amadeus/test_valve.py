@@ -1,4 +1,5 @@
-"""Proportional valve: static curve with hysteresis (Fig. 5), leakage floor and supply (§II-D), delay
+"""Proportional valve: static curve with hysteresis (Fig. 5), leakage floor and supply (§II-D),
+delay
 (Fig. 15, §V-C) and first-order pressure dynamics (000_8f66dcc7ab06470c.txt)."""
 
 
@@ -65,7 +66,8 @@ def test_step_response_exact_with_delay(fs):
     y = v.simulate(i, dt=1 / fs)["p"]
     t = np.arange(n) / fs
     p0, p1 = v.static_pressure(0.7), v.static_pressure(0.9)
-    np.testing.assert_allclose(y, _analytic(t, k0 / fs, 0.01, v.parameters.value("tau"), p0, p1), rtol=1e-12)
+    np.testing.assert_allclose(y, _analytic(t, k0 / fs, 0.01, v.parameters.value("tau"), p0, p1),
+                               rtol=1e-12)
     if fs == 200.0:
         assert np.all(y[: k0 + 3] == p0) and y[k0 + 3] > p0
 

@@ -27,7 +27,8 @@ def test_parameters_have_units_and_sources(system):
 
 def test_consistency_report(system):
     """Seed contradictions are reported, the rest checks out: Table I actual vs eq 18 and the ε23
-    rounding flagged; 5.5 Hz (Fig. 2(c)) within 10 % of the Table II poles' 5.32 Hz; the bending model's
+    rounding flagged; 5.5 Hz (Fig. 2(c)) within 10 % of the Table II poles' 5.32 Hz; the bending
+    model's
     20 mm maximum; the NMP zero noted."""
     rep = check(system)
     bad = {f.check for f in rep.inconsistent}

@@ -28,9 +28,11 @@ def drifting_log():
     c = ImpedanceController("joint", (8, 8, 8), (0.6, 0.6, 0.6))
     f1, f2 = finger(check=False), finger(check=False, **DRIFT)
     a = simulate_impedance(f1, c, ref[:n])
-    x1 = f2.state(q=[a[j][-1] for j in ("abd", "flex", "prox")], qd=[a[f"{j}_vel"][-1] for j in ("abd", "flex", "prox")])
+    x1 = (f2.state(q=[a[j][-1] for j in ("abd", "flex", "prox")],
+                   qd=[a[f"{j}_vel"][-1] for j in ("abd", "flex", "prox")]))
     b = simulate_impedance(f2, c, ref[n:], x0=x1)
-    names = ("abd", "flex", "prox", "abd_vel", "flex_vel", "prox_vel", "pwm_base1", "pwm_base2", "pwm_distal")
+    names = ("abd", "flex", "prox", "abd_vel", "flex_vel", "prox_vel", "pwm_base1", "pwm_base2",
+             "pwm_distal")
     return f1, Trajectory.uniform(dt=0.001, **{k: np.concatenate([a[k], b[k]]) for k in names})
 
 

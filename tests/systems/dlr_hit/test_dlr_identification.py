@@ -9,7 +9,8 @@ import pytest
 
 from gripkit.cli import main
 from gripkit.errors import DataError, IdentificationError, UnidentifiableError
-from gripkit.sysid.rigid_body.friction import (constant_velocity_friction, detect_breakaway, fit_stribeck, idim_ls,
+from gripkit.sysid.rigid_body.friction import (constant_velocity_friction, detect_breakaway,
+                                               fit_stribeck, idim_ls,
                                     table_from_points)
 from gripkit.systems.dlr_hit.impedance import ImpedanceController, simulate_impedance
 from gripkit.systems.dlr_hit.parameters import finger
@@ -27,7 +28,8 @@ def excitation_log():
     reference), friction F = 0.19 sign(v) + 0.05 v N·m (Stribeck option with F_s = F_c); the
     potentiometer is quantised to 0.1° (§2.8) with 0.02° noise, the effort (a motor-current log,
     A) has 0.6 mA noise."""
-    f = finger(check=False, friction="stribeck", fs_distal=TRUE["coulomb"], fc_distal=TRUE["coulomb"],
+    f = finger(check=False, friction="stribeck", fs_distal=TRUE["coulomb"],
+               fc_distal=TRUE["coulomb"],
                visc_distal=TRUE["viscous"], cubic_distal=0.0, **AXES_VERTICAL)
     N = 30_000
     t = np.arange(N) / FS
@@ -35,13 +37,15 @@ def excitation_log():
     ref[:, 1] = 30 * DEG
     ref[:, 2] = (45 + 25 * np.sin(2 * np.pi * 0.7 * t) + 10 * np.sin(2 * np.pi * 1.9 * t + 1)
                  + 5 * np.sin(2 * np.pi * 3.1 * t + 2)) * DEG
-    tr = simulate_impedance(f, ImpedanceController("joint", (10, 10, 10), (0.8, 0.8, 0.8)), ref, dt=1 / FS)
+    tr = (simulate_impedance(f, ImpedanceController("joint", (10, 10, 10), (0.8, 0.8, 0.8)), ref,
+                             dt=1 / FS))
     rng = np.random.default_rng(0)
     pos = np.round((tr["prox"] + rng.normal(0, 0.02 * DEG, N)) / (0.1 * DEG)) * (0.1 * DEG)
     k = f.parameters.value("k_t") * 208.3  # N·m at the joint per A
     current = tr["tau_distal"] / k + rng.normal(0, 6e-4, N)
     ch = f.chain()
-    p = np.linalg.solve(ch.coupling.matrix[:3], np.column_stack([tr["abd"], tr["flex"], tr["prox"]]).T).T
+    p = (np.linalg.solve(ch.coupling.matrix[:3],
+                         np.column_stack([tr["abd"], tr["flex"], tr["prox"]]).T).T)
     J = float(np.mean(ch.mass_matrix(p)[:, 2, 2]))
     return dict(t=t, pos=pos, current=current, k=k, J=J)
 
@@ -53,7 +57,8 @@ def test_idim_ls_recovers_inertia_and_friction_within_2_percent(excitation_log):
     assert res.params["viscous"] == pytest.approx(TRUE["viscous"], rel=0.02)
     assert res.params["coulomb"] == pytest.approx(TRUE["coulomb"], rel=0.02)
     assert abs(res.params["offset"]) < 0.01 * TRUE["coulomb"] + 3 * res.std["offset"]
-    assert all(0 < res.std[k] < 0.02 * abs(res.params[k]) for k in ("inertia", "viscous", "coulomb"))
+    assert all(0 < res.std[k] < 0.02 * abs(res.params[k]) for k in ("inertia", "viscous",
+                                                                    "coulomb"))
     assert res.relative_error_percent < 5
     assert res.cutoff == pytest.approx(20.0) and res.decimation == 10
 
@@ -72,12 +77,14 @@ def test_cli_identify_friction_json(tmp_path, capsys, excitation_log):
     assert out["params"]["coulomb"] == pytest.approx(TRUE["coulomb"], rel=0.02)
     assert 0 < out["relative_error_percent"] < 5
     # --fs instead of a time column gives the same answer
-    np.savetxt(path, np.column_stack([d["pos"], d["current"]]), delimiter=",", header="position,current",
+    np.savetxt(path, np.column_stack([d["pos"], d["current"]]), delimiter=",",
+               header="position,current",
                comments="")
     code = main(["identify", "friction", str(path), "--position", "position", "--effort", "current",
                  "--effort-scale", str(d["k"]), "--fs", "1000", "--json"])
     out2 = json.loads(capsys.readouterr().out)
-    assert code == 0 and out2["params"]["inertia"] == pytest.approx(out["params"]["inertia"], rel=1e-9)
+    assert code == 0 and out2["params"]["inertia"] == pytest.approx(out["params"]["inertia"],
+                                                                    rel=1e-9)
 
 
 def test_cli_reports_bad_input_in_one_line(tmp_path, capsys):
@@ -159,7 +166,8 @@ def test_constant_velocity_runs_rebuild_the_friction_table():
             vel.append(tr["distal_vel"])
     J = f.chain().mass_matrix(np.zeros(3))[2, 2]
     pts = constant_velocity_friction(np.concatenate(pwm), np.concatenate(vel),
-                                     motor_torque=lambda u, v: float(f.motor_torque("distal", u, v)),
+                                     motor_torque=lambda u,
+                                     v: float(f.motor_torque("distal", u, v)),
                                      inertia=J, dt=1 / FS, plateau=0.01)
     assert len(pts) == 22
     table = f.tables[2]

@@ -53,7 +53,8 @@ def test_joint_impedance_gravity_compensation():
     ref = np.tile([0.0, 30 * DEG, 30 * DEG], (3000, 1))
     K = np.array([4.0, 4.0, 4.0])
     on = simulate_impedance(f, ImpedanceController("joint", K, (0.5, 0.5, 0.5)), ref)
-    off = simulate_impedance(f, ImpedanceController("joint", K, (0.5, 0.5, 0.5), gravity_compensation=False), ref)
+    off = (simulate_impedance(f, ImpedanceController("joint", K, (0.5, 0.5, 0.5),
+                                                     gravity_compensation=False), ref))
     q_on = np.array([on[j][-1] for j in ("abd", "flex", "prox")])
     q_off = np.array([off[j][-1] for j in ("abd", "flex", "prox")])
     np.testing.assert_allclose(q_on, ref[0], atol=1e-6)
@@ -92,7 +93,8 @@ def test_friction_compensation_improves_tracking_and_contact_force():
 
 def test_stability_margins_match_python_control():
     import control  # a dev dependency: the cross-check fails, never skips, without it
-    for J, K, D, visc, ke in ((0.0221, 5.0, 0.5, 0.0, 0.0), (0.028, 50.0, 0.2, 0.05, 20.0), (0.0221, 400.0, 1.0, 0.0, 0.0)):
+    for J, K, D, visc, ke in ((0.0221, 5.0, 0.5, 0.0, 0.0), (0.028, 50.0, 0.2, 0.05, 20.0),
+                              (0.0221, 400.0, 1.0, 0.0, 0.0)):
         dt = 1e-3
         m = stability_margins(J, K, D, dt, viscous=visc, k_env=ke)
         P = control.sample_system(control.tf([1.0], [J, visc, ke]), dt, method="zoh")
@@ -126,4 +128,5 @@ def test_bad_controller_input():
     with pytest.raises(SimulationError, match="reference"):
         simulate_impedance(f, ImpedanceController(), np.zeros((10, 2)))
     with pytest.raises(SimulationError, match="semi-implicit"):
-        simulate_impedance(finger(check=False, integrator="rk4"), ImpedanceController(), np.zeros((10, 3)))
+        simulate_impedance(finger(check=False, integrator="rk4"), ImpedanceController(),
+                           np.zeros((10, 3)))

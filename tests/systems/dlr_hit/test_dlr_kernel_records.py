@@ -22,12 +22,14 @@ from gripkit.systems.dlr_hit.impedance import (LOOP_ADAPTATION, ImpedanceControl
 from gripkit.systems.dlr_hit.parameters import finger
 
 DEG = math.pi / 180
-REFERENCE = json.loads((Path(__file__).parents[2] / "reference" / "kernel_records.json").read_text())["dlr_hit"]
+REFERENCE = (json.loads((Path(__file__).parents[2] / "reference"
+                         / "kernel_records.json").read_text())["dlr_hit"])
 
 
 def _pwm(n):
     t = np.arange(n) * 1e-3
-    return np.column_stack([2500 * np.sin(2 * math.pi * 3 * t), -3000 * np.sin(2 * math.pi * 2 * t + 0.4),
+    return np.column_stack([2500 * np.sin(2 * math.pi * 3 * t),
+                            -3000 * np.sin(2 * math.pi * 2 * t + 0.4),
                             np.where(t < 0.15, 3900.0, -1500.0)])
 
 
@@ -53,13 +55,18 @@ def _trajectories():
     joint = ImpedanceController("joint", (8, 8, 8), (0.6, 0.6, 0.6))
     adaptive = ImpedanceController("joint", (8, 8, 8), (0.6, 0.6, 0.6), adaptation=LOOP_ADAPTATION)
     out["joint_adapt_drift"] = simulate_impedance(f, adaptive, ref, friction_drift=drift).as_array()
-    out["joint_stribeck_drift"] = simulate_impedance(finger(check=False, friction="stribeck"), joint, ref,
+    out["joint_stribeck_drift"] = simulate_impedance(finger(check=False, friction="stribeck"),
+                                                     joint, ref,
                                                      friction_drift=drift).as_array()
-    cart = ImpedanceController("cartesian", (400, 400, 400), (4, 4, 4), actuator_damping=(0.02, 0.02, 0.02))
+    cart = (ImpedanceController("cartesian", (400, 400, 400), (4, 4, 4),
+                                actuator_damping=(0.02, 0.02, 0.02)))
     x0 = f.state(q=(0.0, 30 * DEG, 30 * DEG))
     tip0 = f.chain().tip_position(x0[:3])
-    wall = Wall(normal=(0.0, 0.0, 1.0), point=tuple(tip0 - np.array([0.0, 0.0, 0.005])), stiffness=2e3, damping=5.0)
-    out["cartesian_wall"] = simulate_impedance(f, cart, np.tile(tip0 + np.array([0.0, 0.0, -0.01]), (300, 1)),
+    wall = (Wall(normal=(0.0, 0.0, 1.0), point=tuple(tip0 - np.array([0.0, 0.0, 0.005])),
+                 stiffness=2e3, damping=5.0))
+    out["cartesian_wall"] = simulate_impedance(f, cart,
+                                               np.tile(tip0 + np.array([0.0, 0.0, -0.01]),
+                                                                (300, 1)),
                                                x0=x0, wall=wall, substeps=2).as_array()
     return out
 

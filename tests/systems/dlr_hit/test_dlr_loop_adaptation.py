@@ -53,9 +53,11 @@ def test_in_loop_estimator_is_the_offline_adapter_run_each_step(study):
     p = np.linalg.solve(G, np.column_stack([tr[j] for j in JOINTS]).T).T
     pd = np.linalg.solve(G, np.column_stack([tr[f"{j}_vel"] for j in JOINTS]).T).T
     pd[np.abs(pd) < 1e-12] = 0.0
-    tau = np.column_stack([f.motor_torque(a, tr[f"pwm_{a}"], pd[:, k]) for k, a in enumerate(ACTUATORS)])
+    tau = (np.column_stack([f.motor_torque(a, tr[f"pwm_{a}"],
+                                           pd[:, k]) for k, a in enumerate(ACTUATORS)]))
     J = np.diag(ch.mass_matrix(p[0]))
-    ad = FrictionAdapter(model_friction_tables(f), J, 1e-3, settings=LOOP_ADAPTATION, names=ACTUATORS)
+    ad = (FrictionAdapter(model_friction_tables(f), J, 1e-3, settings=LOOP_ADAPTATION,
+                          names=ACTUATORS))
     off = ad.update(tau, ch.bias(p, pd), pd)
     for k, a in enumerate(ACTUATORS):
         np.testing.assert_allclose(tr[f"scale_hat_{a}"], off.scale[:, k], rtol=0, atol=1e-9)
@@ -68,7 +70,8 @@ def test_adaptation_reduces_the_tracking_error_under_drift(study):
     nominal plant: the test is meaningful); adaptation removes at least half of that added error
     (margin derived from the run) and lowers the largest error."""
     _, cmp = study
-    fixed, nominal, adaptive = cmp.rms["fixed", "drift"], cmp.rms["fixed", "nominal"], cmp.rms["adaptive", "drift"]
+    fixed, nominal, adaptive = (cmp.rms["fixed", "drift"], cmp.rms["fixed", "nominal"],
+                                cmp.rms["adaptive", "drift"])
     assert fixed > 1.2 * nominal, (fixed, nominal)
     assert adaptive <= nominal + 0.5 * (fixed - nominal), (adaptive, nominal, fixed)
     assert cmp.recovered >= 0.5
@@ -115,7 +118,8 @@ def test_plant_drift_is_a_rescaled_friction():
     stiction step Δ on a Stribeck finger is F_c and F_s raised by Δ: the closed-loop runs agree."""
     ref = tracking_reference(3.0)
     f = _finger(check=False)
-    ctrl = ImpedanceController("joint", (8, 8, 8), (0.6, 0.6, 0.6), friction_tables=model_friction_tables(f))
+    ctrl = (ImpedanceController("joint", (8, 8, 8), (0.6, 0.6, 0.6),
+                                friction_tables=model_friction_tables(f)))
     v = f.parameters.value
     scaled = _finger(check=False, **{f"scale_{a}": 1.3 * v(f"scale_{a}") for a in ACTUATORS},
                      **{f"fs_{a}": 1.3 * v(f"fs_{a}") for a in ACTUATORS})
@@ -126,9 +130,11 @@ def test_plant_drift_is_a_rescaled_friction():
     fs = _finger(check=False, friction="stribeck")
     vs = fs.parameters.value
     d = 0.05
-    raised = _finger(check=False, friction="stribeck", **{f"fc_{x}": vs(f"fc_{x}") + d for x in ACTUATORS},
+    raised = _finger(check=False, friction="stribeck",
+                     **{f"fc_{x}": vs(f"fc_{x}") + d for x in ACTUATORS},
                      **{f"fs_{x}": vs(f"fs_{x}") + d for x in ACTUATORS})
-    ctrl = ImpedanceController("joint", (8, 8, 8), (0.6, 0.6, 0.6), friction_tables=model_friction_tables(fs))
+    ctrl = (ImpedanceController("joint", (8, 8, 8), (0.6, 0.6, 0.6),
+                                friction_tables=model_friction_tables(fs)))
     a = simulate_impedance(fs, ctrl, ref, friction_drift=stiction_step(0.0, d))
     b = simulate_impedance(raised, ctrl, ref)
     for ch in ("abd", "flex", "prox", "fric_distal"):
@@ -142,12 +148,14 @@ def test_drift_schedules():
     assert w.at(0.0)[0] == pytest.approx(1.5)
     assert w.at(39.6)[0] == pytest.approx(1 + 0.5 / math.e, rel=1e-4)
     s = stiction_step(60.0, actuators=("distal",))
-    np.testing.assert_array_equal(s.at([59.999, 60.0]), [[1, 1, 1, 0, 0, 0], [1, 1, 1, 0, 0, STICTION_STEP]])
+    np.testing.assert_array_equal(s.at([59.999, 60.0]),
+                                  [[1, 1, 1, 0, 0, 0], [1, 1, 1, 0, 0, STICTION_STEP]])
     assert STICTION_STEP == pytest.approx(0.09)
     c = w.combine(s)
     t = np.array([10.0, 59.9, 60.0, 100.0])
     expect = w.at(t) * [1, 1, 1, 0, 0, 0] + s.at(t) * [0, 0, 0, 1, 1, 1]
-    np.testing.assert_allclose(c.at(t), expect, rtol=2e-5)  # w is piecewise linear between 200 points
+    # w is piecewise linear between 200 points
+    np.testing.assert_allclose(c.at(t), expect, rtol=2e-5)
     assert c.at(120.0)[0] == pytest.approx(1 + 0.5 * math.exp(-120 / 39.6))
 
 
@@ -159,7 +167,8 @@ def test_drift_schedules():
     (lambda: warmup_drift(-1.0), "duration"),
     (lambda: stiction_step(1.0, actuators=("thumb",)), "actuators"),
     (lambda: ImpedanceController(adaptation="fast"), "adaptation"),
-    (lambda: ImpedanceController(adaptation=LOOP_ADAPTATION, friction_compensation=False), "friction_compensation"),
+    (lambda: ImpedanceController(adaptation=LOOP_ADAPTATION, friction_compensation=False),
+     "friction_compensation"),
 ])
 def test_bad_drift_and_adaptation_settings_are_refused(build, match):
     with pytest.raises(ModelError, match=match):

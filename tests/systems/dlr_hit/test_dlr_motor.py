@@ -43,11 +43,13 @@ FIG_5_6_SLOPES = {2000: (-5.281e-5, 0.00956), 2500: (-4.6735e-5, 0.00309),
 @pytest.mark.parametrize("pwm", sorted(FIG_5_6_SLOPES))
 def test_fig_5_6_slopes_against_eq_5_8_and_the_consistency_finding(pwm):
     """Each Fig. 5.6 slope printed in §5.4.2 against eq 5.8, with the deviation ``zoo check``
-    reports: PWM 2000 0.96 %, 2500 0.31 %, 3000 4.9 %, 3500 3.45 % (all within the 6 % tolerance)."""
+    reports: PWM 2000 0.96 %, 2500 0.31 %, 3000 4.9 %, 3500 3.45 % (all within the 6 %
+    tolerance)."""
     eq58, rel = FIG_5_6_SLOPES[pwm]
     stated = SLOPES_5_4_2[pwm]
     b = float(MOTOR.slope(pwm)) * RPM / NCM
-    assert b == pytest.approx(1.215e-8 * pwm - 7.711e-5, rel=1e-12) == pytest.approx(eq58, rel=1e-12)
+    assert b == pytest.approx(1.215e-8 * pwm - 7.711e-5,
+                              rel=1e-12) == pytest.approx(eq58, rel=1e-12)
     assert abs(b - stated) / abs(stated) == pytest.approx(rel, abs=5e-5)
     f = {x.check: x
          for x in zoo.build("dlr-hit-finger").consistency_checks()}[f"eq5.8-slope-pwm{pwm}"]
@@ -68,7 +70,8 @@ def test_eq_5_8_is_the_least_squares_line_through_the_fig_5_6_slopes():
 
 def test_appendix_e_guard():
     """Appendix E: if |speed term| exceeds |PWM term| the torque is zero; PWM 0 gives no torque."""
-    w0 = 1.43e-4 * 2000 / -(1.215e-8 * 2000 - 7.711e-5) * RPM  # speed where the terms cancel (rad/s)
+    # speed where the terms cancel (rad/s)
+    w0 = 1.43e-4 * 2000 / -(1.215e-8 * 2000 - 7.711e-5) * RPM
     assert MOTOR.torque(2000, 0.99 * w0) > 0
     assert MOTOR.torque(2000, 1.01 * w0) == 0.0
     assert MOTOR.torque(0, 100.0) == 0.0

@@ -26,7 +26,8 @@ def thesis_chain(alpha1):
                  com=[[0, 0, 0], [LC[0], 0, 0], [LC[1], 0, 0], [LC[2], 0, 0]],
                  inertia=np.array([np.zeros((3, 3)), *rod]), gravity=(0, 0, 0))
     G = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [0, 0, 1.0]])  # θ4 = θ3, τ3 += τ4 (§4.5)
-    return CoupledChain(ch, Coupling(G, np.zeros(4), np.array([IM * N1 ** 2, 0, 0]), ("t1", "t2", "t3")))
+    return (CoupledChain(ch, Coupling(G, np.zeros(4), np.array([IM * N1 ** 2, 0, 0]),
+                                      ("t1", "t2", "t3"))))
 
 
 def appendix_f_M1(t2, t3):
@@ -34,10 +35,13 @@ def appendix_f_M1(t2, t3):
     l1c, l2c, l3c = LC
     return (IM * N1 ** 2 + (l2 ** 2 * m3) / 2 + l2c ** 2 * m2 + l3c ** 2 * m3
             + (l2 ** 2 * m3 * cos(2 * t2 + 2 * t3)) / 2 + l2c ** 2 * m2 * cos(2 * t2 + 2 * t3)
-            + l3c ** 2 * m3 * cos(2 * t2 + 4 * t3) + l1 ** 2 * m2 * cos(t2) ** 2 + l1 ** 2 * m3 * cos(t2) ** 2
+            + l3c ** 2 * m3 * cos(2 * t2 + 4 * t3) + l1 ** 2 * m2 * cos(t2) ** 2 + l1 ** 2 * m3
+            * cos(t2) ** 2
             + 2 * l1c ** 2 * m1 * cos(t2) ** 2 + l1 * l3c * m3 * cos(2 * t2 + 2 * t3)
-            + l2 * l3c * m3 * cos(2 * t2 + 3 * t3) + l1 * l2 * m3 * cos(t3) + l1 * l2c * m2 * cos(t3)
-            + l2 * l3c * m3 * cos(t3) + l1 * l2 * m3 * cos(2 * t2 + t3) + l1 * l2c * m2 * cos(2 * t2 + t3)
+            + l2 * l3c * m3 * cos(2 * t2 + 3 * t3) + l1 * l2 * m3 * cos(t3) + l1 * l2c * m2
+            * cos(t3)
+            + l2 * l3c * m3 * cos(t3) + l1 * l2 * m3 * cos(2 * t2 + t3) + l1 * l2c * m2
+            * cos(2 * t2 + t3)
             + l1 * l3c * m3 * cos(2 * t3))
 
 
@@ -45,22 +49,29 @@ def appendix_b_C(t2, t3, td1, td2, td3):
     l1, l2, m1, m2, m3 = L1, L2, M1_, M2_, M3_
     l1c, l2c, l3c = LC
     C2 = ((l1 ** 2 * m2 * td1 ** 2 * sin(2 * t2)) / 2 + (l1 ** 2 * m3 * td1 ** 2 * sin(2 * t2)) / 2
-          + l1c ** 2 * m1 * td1 ** 2 * sin(2 * t2) + (l2 ** 2 * m3 * td1 ** 2 * sin(2 * t2 + 2 * t3)) / 2
-          + l2c ** 2 * m2 * td1 ** 2 * sin(2 * t2 + 2 * t3) + l3c ** 2 * m3 * td1 ** 2 * sin(2 * t2 + 4 * t3)
+          + l1c ** 2 * m1 * td1 ** 2 * sin(2 * t2)
+          + (l2 ** 2 * m3 * td1 ** 2 * sin(2 * t2 + 2 * t3)) / 2
+          + l2c ** 2 * m2 * td1 ** 2 * sin(2 * t2 + 2 * t3) + l3c ** 2 * m3 * td1 ** 2
+          * sin(2 * t2 + 4 * t3)
           - l1 * l2 * m3 * td3 ** 2 * sin(t3) - l1 * l2c * m2 * td3 ** 2 * sin(t3)
           - 3 * l2 * l3c * m3 * td3 ** 2 * sin(t3) + l1 * l2 * m3 * td1 ** 2 * sin(2 * t2 + t3)
           + l1 * l2c * m2 * td1 ** 2 * sin(2 * t2 + t3) - 4 * l1 * l3c * m3 * td3 ** 2 * sin(2 * t3)
-          + l1 * l3c * m3 * td1 ** 2 * sin(2 * t2 + 2 * t3) + l2 * l3c * m3 * td1 ** 2 * sin(2 * t2 + 3 * t3)
+          + l1 * l3c * m3 * td1 ** 2 * sin(2 * t2 + 2 * t3) + l2 * l3c * m3 * td1 ** 2
+          * sin(2 * t2 + 3 * t3)
           - 2 * l1 * l2 * m3 * td2 * td3 * sin(t3) - 2 * l1 * l2c * m2 * td2 * td3 * sin(t3)
           - 2 * l2 * l3c * m3 * td2 * td3 * sin(t3) - 4 * l1 * l3c * m3 * td2 * td3 * sin(2 * t3))
-    C3 = ((l2 ** 2 * m3 * td1 ** 2 * sin(2 * t2 + 2 * t3)) / 2 + l2c ** 2 * m2 * td1 ** 2 * sin(2 * t2 + 2 * t3)
-          + 2 * l3c ** 2 * m3 * td1 ** 2 * sin(2 * t2 + 4 * t3) + (l1 * l2 * m3 * td1 ** 2 * sin(t3)) / 2
+    C3 = ((l2 ** 2 * m3 * td1 ** 2 * sin(2 * t2 + 2 * t3)) / 2 + l2c ** 2 * m2 * td1 ** 2
+          * sin(2 * t2 + 2 * t3)
+          + 2 * l3c ** 2 * m3 * td1 ** 2 * sin(2 * t2 + 4 * t3)
+          + (l1 * l2 * m3 * td1 ** 2 * sin(t3)) / 2
           + l1 * l2 * m3 * td2 ** 2 * sin(t3) + (l1 * l2c * m2 * td1 ** 2 * sin(t3)) / 2
           + l1 * l2c * m2 * td2 ** 2 * sin(t3) + (l2 * l3c * m3 * td1 ** 2 * sin(t3)) / 2
           + l2 * l3c * m3 * td2 ** 2 * sin(t3) - 2 * l2 * l3c * m3 * td3 ** 2 * sin(t3)
-          + (l1 * l2 * m3 * td1 ** 2 * sin(2 * t2 + t3)) / 2 + (l1 * l2c * m2 * td1 ** 2 * sin(2 * t2 + t3)) / 2
+          + (l1 * l2 * m3 * td1 ** 2 * sin(2 * t2 + t3)) / 2
+          + (l1 * l2c * m2 * td1 ** 2 * sin(2 * t2 + t3)) / 2
           + l1 * l3c * m3 * td1 ** 2 * sin(2 * t3) + 2 * l1 * l3c * m3 * td2 ** 2 * sin(2 * t3)
-          + l1 * l3c * m3 * td1 ** 2 * sin(2 * t2 + 2 * t3) + (3 * l2 * l3c * m3 * td1 ** 2 * sin(2 * t2 + 3 * t3)) / 2)
+          + l1 * l3c * m3 * td1 ** 2 * sin(2 * t2 + 2 * t3)
+          + (3 * l2 * l3c * m3 * td1 ** 2 * sin(2 * t2 + 3 * t3)) / 2)
     return C2, C3
 
 

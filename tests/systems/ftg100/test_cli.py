@@ -33,13 +33,15 @@ def test_zoo_discretize_actuated_json(capsys):
     assert d["dc_gain"] == pytest.approx(0.1878e-6, rel=0.015)
     assert len(d["poles"]) == 2 and all(len(p) == 2 for p in d["poles"])
     z = np.array([complex(*p) for p in d["poles"]])
-    np.testing.assert_allclose(np.sort_complex(z), np.sort_complex(np.linalg.eigvals(d["A"])), rtol=1e-12)
+    np.testing.assert_allclose(np.sort_complex(z), np.sort_complex(np.linalg.eigvals(d["A"])),
+                               rtol=1e-12)
 
 
 def test_zoo_discretize_text_and_other_models(capsys):
     code, out, _ = run(capsys, "zoo", "discretize", "ftg100-coupled", "--fs", "20000")
     assert code == 0 and "eq 18 block form" in out and "DC gain" in out
-    code, out, _ = run(capsys, "zoo", "discretize", "ftg100-sensing", "--fs", "20000", "--form", "physical", "--json")
+    code, out, _ = (run(capsys, "zoo", "discretize", "ftg100-sensing", "--fs", "20000", "--form",
+                        "physical", "--json"))
     assert code == 0 and json.loads(out)["dc_gain"] == pytest.approx(6.05 ** 2 / 235.36, rel=1e-9)
 
 
@@ -60,7 +62,8 @@ def test_identify_step_json(capsys, tmp_path):
     f_n = 1757 Hz and ζ = 0.043 of eq 9 at the seed's values, within 3σ."""
     path = tmp_path / "step.csv"
     save(step_experiment(duration=0.05, seed=4), path)
-    code, out, err = run(capsys, "identify", "step", str(path), "--input", "V_in", "--output", "x_a", "--json")
+    code, out, err = (run(capsys, "identify", "step", str(path), "--input", "V_in", "--output",
+                          "x_a", "--json"))
     assert code == 0
     d = json.loads(out)
     for key in ("gain", "natural_frequency_hz", "damping_ratio"):
@@ -74,8 +77,10 @@ def test_identify_step_json(capsys, tmp_path):
 def test_identify_step_fs_option_and_text(capsys, tmp_path):
     d = step_experiment(duration=0.02, seed=1)
     path = tmp_path / "notime.csv"
-    np.savetxt(path, np.column_stack([d["V_in"], d["x_a"]]), delimiter=",", header="u [V],y [um]", comments="")
-    code, out, _ = run(capsys, "identify", "step", str(path), "--input", "u", "--output", "y", "--fs", "20000")
+    np.savetxt(path, np.column_stack([d["V_in"], d["x_a"]]), delimiter=",", header="u [V],y [um]",
+               comments="")
+    code, out, _ = (run(capsys, "identify", "step", str(path), "--input", "u", "--output", "y",
+                        "--fs", "20000"))
     assert code == 0 and "natural frequency" in out and "Hz" in out
 
 

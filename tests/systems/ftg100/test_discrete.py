@@ -52,7 +52,8 @@ def test_dc_gain_0_1878_um_per_volt(act):
 
 
 def test_canonical_form_matches_scipy_and_control(act):
-    """The canonical form's transfer function equals scipy's ZOH of G_a(s) (eq 9), and python-control's
+    """The canonical form's transfer function equals scipy's ZOH of G_a(s) (eq 9), and
+    python-control's
     c2d gives the same poles."""
     num, den = act.transfer_function()
     nd, dd, _ = signal.cont2discrete((num, den), 1 / FS, method="zoh")
@@ -68,7 +69,8 @@ def test_canonical_form_matches_scipy_and_control(act):
     np.testing.assert_allclose(n2[0], np.ravel(nd), rtol=num_rtol, atol=0)
     import control  # a dev dependency: the cross-check fails, never skips, without it
     sysd = control.c2d(control.tf(num, den), 1 / FS, "zoh")
-    np.testing.assert_allclose(np.sort_complex(control.poles(sysd)), np.sort_complex(d.poles()), rtol=1e-10)
+    np.testing.assert_allclose(np.sort_complex(control.poles(sysd)), np.sort_complex(d.poles()),
+                               rtol=1e-10)
     # physical-coordinate ZOH is similar: same poles and DC gain
     p = act.discrete(1 / FS, form="physical")
     np.testing.assert_allclose(np.sort_complex(p.poles()), np.sort_complex(d.poles()), rtol=1e-12)
@@ -127,7 +129,8 @@ def test_eq18_coupled():
     np.testing.assert_allclose(dc, [xa, xb, kk * xa, p.value("k2") / 50e-6 * xb], rtol=1e-7)
     exact = cpl.discrete(1 / FS, form="physical")
     np.testing.assert_allclose(exact.dc_gain()[:, 0], dc, rtol=1e-7)
-    np.testing.assert_allclose(np.sort_complex(exact.poles()), np.sort_complex(d.poles()), rtol=1e-9)
+    np.testing.assert_allclose(np.sort_complex(exact.poles()), np.sort_complex(d.poles()),
+                               rtol=1e-9)
     np.testing.assert_allclose(d.A[:2, :2], act.discrete(1 / FS).A)
     # simulate: the exact cascade settles at the DC gains
     u = np.full(4000, p.value("V0") + 1.0)

@@ -15,7 +15,8 @@ F_CMD = 20e-6
 @pytest.fixture(scope="module")
 def sweep():
     """k0 ∈ {520, 780, 1043, 1300, 1560} N/m × gap ∈ {5, 20, 40} µm × 2 noise seeds."""
-    K, G, S = np.meshgrid([520.0, 780.0, 1043.0, 1300.0, 1560.0], [5e-6, 20e-6, 40e-6], [0, 1], indexing="ij")
+    K, G, S = (np.meshgrid([520.0, 780.0, 1043.0, 1300.0, 1560.0], [5e-6, 20e-6, 40e-6], [0, 1],
+                           indexing="ij"))
     return grasp_batch(force=F_CMD, k0=K, gap=G, seed=S, duration=0.095, progress=False)
 
 
@@ -55,7 +56,8 @@ def test_bumpless_switch():
     plant = FTG100Plant(check=False, K_sa=25.4 * 1.15)
     res = {}
     for bumpless in (True, False):
-        r = simulate_hybrid_grasp(HybridForcePosition.for_plant(bumpless=bumpless), plant, duration=0.06)
+        r = (simulate_hybrid_grasp(HybridForcePosition.for_plant(bumpless=bumpless), plant,
+                                   duration=0.06))
         tr = r.trajectory
         k = int(np.flatnonzero(np.diff(tr["mode"]) > 0)[0]) + 1
         res[bumpless] = (abs(tr["V"][k] - tr["V"][k - 1]), r.metrics["overshoot_percent"])
@@ -70,7 +72,8 @@ def test_anti_windup_at_200_V():
     prof = np.where(np.arange(n) < int(0.07 / 5e-5), 400e-6, 50e-6)
     t_settle = {}
     for aw in (True, False):
-        r = simulate_hybrid_grasp(HybridForcePosition.for_plant(anti_windup=aw), force_profile=prof, duration=0.12)
+        r = (simulate_hybrid_grasp(HybridForcePosition.for_plant(anti_windup=aw),
+                                   force_profile=prof, duration=0.12))
         tr = r.trajectory
         assert r.metrics["max_voltage"] == pytest.approx(200.0)
         after = tr.t >= 0.07

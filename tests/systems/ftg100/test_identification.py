@@ -33,7 +33,8 @@ def test_recovers_Ma_Kfa_k0_within_2_percent(long_fit):
 
 
 def test_short_step_reports_k0_as_poorly_determined():
-    """A paper-like 20 ms record (1 ms before the step): M_a and K_fa are determined to < 1 %, but k0
+    """A paper-like 20 ms record (1 ms before the step): M_a and K_fa are determined to < 1 %, but
+    k0
     in series with k2 = 6.45 N/m moves the response by only 0.5 % per 100 %: σ(k0)/k0 > 20 %."""
     res = identify_actuated(step_experiment(duration=0.02, seed=5))
     assert res.stdev("M_a") / res.value("M_a") < 0.01

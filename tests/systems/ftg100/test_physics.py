@@ -40,7 +40,8 @@ def test_amplification_ratios_eqs_3_12():
 
 
 def test_sensing_stiffness_eq_16():
-    """§III-C: k2 = K_sb / D_b^2 = 6.45 N/m (from eq 13's K_sb and D_b = 6.05); Fig. 10 measures 6.48."""
+    """§III-C: k2 = K_sb / D_b^2 = 6.45 N/m (from eq 13's K_sb and D_b = 6.05); Fig. 10 measures
+    6.48."""
     Ksb = clamped_clamped_stiffness(g("E"), g("h"), g("w"), g("L2"))
     assert Ksb / 6.05 ** 2 == pytest.approx(6.45, rel=2e-3)
     assert 235.36 / 6.05 ** 2 == pytest.approx(6.45, rel=5e-3)

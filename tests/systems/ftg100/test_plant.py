@@ -27,7 +27,8 @@ def reference():
     def rhs(t, s, contact):
         xa, va, xb, vb = s
         fc = p["k0"] * (p["D_a"] * xa - p["D_b"] * xb - p["gap"]) if contact else 0.0
-        return [va, (p["c_e"] * V * V - p["K_fa"] * va - p["K_sa"] * xa - p["K3_a"] * xa ** 3 - p["D_a"] * fc) / p["M_a"],
+        return [va, (p["c_e"] * V * V - p["K_fa"] * va - p["K_sa"] * xa - p["K3_a"] * xa ** 3
+                     - p["D_a"] * fc) / p["M_a"],
                 vb, (p["D_b"] * fc - p["K_fb"] * vb - p["K_sb"] * xb) / p["M_b"]]
 
     def event(contact):
@@ -38,7 +39,8 @@ def reference():
 
     T, s, t, contact, events = 5e-4, np.zeros(4), 0.0, False, []
     while t < T:
-        sol = solve_ivp(rhs, (t, T), s, args=(contact,), events=event(contact), rtol=1e-12, atol=1e-22,
+        sol = solve_ivp(rhs, (t, T), s, args=(contact,), events=event(contact), rtol=1e-12,
+                        atol=1e-22,
                         method="DOP853")
         s, t = sol.y[:, -1], sol.t[-1]
         if sol.status == 1:
@@ -76,7 +78,8 @@ def test_rk4_keeps_fourth_order_across_contact(reference):
 
 
 def test_equilibrium_and_linearisation():
-    """Static equilibrium = end of a long simulation; the small-signal model predicts the response to
+    """Static equilibrium = end of a long simulation; the small-signal model predicts the response
+    to
     a 0.1 V step (free arm, 70 V) within 1 % of its amplitude; f_n(0 V) = √(K_sa/M_a)/2π."""
     pl = FTG100Plant(check=False, k0=0.0)
     eq = pl.equilibrium(70.0)
@@ -87,7 +90,8 @@ def test_equilibrium_and_linearisation():
     e2 = pg.equilibrium(80.0)
     p = dict(zip(pg.parameters.names, pg.theta()))
     assert e2["contact"] and e2["F_c"] > 0
-    assert p["c_e"] * 80 ** 2 == pytest.approx(p["K_sa"] * e2["x_ea"] + p["K3_a"] * e2["x_ea"] ** 3 + p["D_a"] * e2["F_c"], rel=1e-9)
+    assert p["c_e"] * 80 ** 2 == pytest.approx(p["K_sa"] * e2["x_ea"] + p["K3_a"] * e2["x_ea"] ** 3
+                                               + p["D_a"] * e2["F_c"], rel=1e-9)
     assert p["D_b"] * e2["F_c"] == pytest.approx(p["K_sb"] * e2["x_eb"], rel=1e-9)
     # linear response to a small step vs the nonlinear one
     n = 600

@@ -161,7 +161,8 @@ def test_calibrated_force_factor_puts_the_tip_at_20_um():
     fs = 20000.0
     x = plant.simulate({"V": np.full(int(0.04 * fs), 70.0)}, dt=1 / fs)["x_a"]
     assert x[-1] == pytest.approx(20e-6, rel=1e-6)     # 40 ms = 19 decay times 2 M_a/K_fa
-    assert x.max() > 20e-6                              # it rang there (ζ ≈ 0.04), not a static solve
+    # it rang there (ζ ≈ 0.04), not a static solve
+    assert x.max() > 20e-6
     # a number is also accepted, relative to eq 5
     assert plant_parameters(force_factor=0.5).value("c_e") == pytest.approx(0.5 * C_EQ5, rel=1e-12)
 
@@ -187,7 +188,8 @@ def test_static_force_factor_solves_the_static_balance(V, x, k3_scale):
 
 
 @pytest.mark.parametrize("kwargs, pattern", [
-    (dict(force_factor=-1.0), "force_factor: expected a positive number or 'static-70V', found -1.0"),
+    (dict(force_factor=-1.0), "force_factor: expected a positive number or "
+                              "'static-70V', found -1.0"),
     (dict(force_factor="static-80V"), "found 'static-80V'"),
     (dict(force_factor=None), "found None"),
     (dict(force_factor=float("nan")), "found nan"),
@@ -201,7 +203,8 @@ def test_bad_force_factor(kwargs, pattern):
 
 
 def test_bad_static_target():
-    with pytest.raises(ParameterError, match="tip_displacement: expected a positive displacement in m"):
+    with pytest.raises(ParameterError, match="tip_displacement: expected a positive "
+                                             "displacement in m"):
         static_force_factor(tip_displacement=-20e-6)
     with pytest.raises(ParameterError, match="voltage: expected a positive voltage"):
         static_force_factor(voltage=0.0)
@@ -235,9 +238,12 @@ def test_zoo_check_lists_the_70V_findings(capsys):
 
 
 def test_zoo_discretize_refuses_the_nonlinear_plant(capsys):
-    """The plant has no linear form to discretise: one error line that lists the linear models only."""
+    """The plant has no linear form to discretise: one error line that lists the linear models
+    only."""
     code = main(["zoo", "discretize", "ftg100-plant", "--fs", "20000"])
     out, err = capsys.readouterr()
     assert code == 1 and out == "" and len(err.strip().splitlines()) == 1
-    assert err.startswith("error: ModelError: zoo model 'ftg100-plant' has no linear continuous-time form")
-    assert err.rstrip().endswith("discretize works on: ftg100-actuated, ftg100-sensing, ftg100-coupled")
+    assert err.startswith("error: ModelError: zoo model 'ftg100-plant' has no linear "
+                          "continuous-time form")
+    assert err.rstrip().endswith("discretize works on: ftg100-actuated, "
+                                 "ftg100-sensing, ftg100-coupled")

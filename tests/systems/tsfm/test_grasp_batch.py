@@ -17,7 +17,8 @@ from gripkit.systems.tsfm import parameters as z
 from gripkit.systems.tsfm.grasp_batch import FAST_GRASP, METRICS, record_metrics, tsfm_grasp_batch
 
 FS, DUR = 20000.0, 0.06
-EXACT = [m for m in METRICS if m not in ("final_error", "final_force", "stiffness_error")]  # sums: order-dependent
+# sums: order-dependent
+EXACT = [m for m in METRICS if m not in ("final_error", "final_force", "stiffness_error")]
 
 
 @pytest.fixture(scope="module")
@@ -32,26 +33,31 @@ def test_batch_kernel_reproduces_the_single_grasp(gripper):
     speeds): the batch kernel, fed the same sensor noise, gives the metrics computed with numpy
     from the full record of simulate_two_finger_grasp — bit for bit for the sample-wise metrics,
     to 1e-12 for the averaged ones (summation order)."""
-    jobs = [(72.5, 370e-6, 200e-6, 1e-3), (469.0, 360e-6, 206e-6, 1.5e-3), (12.1, 380e-6, 196e-6, 0.8e-3)]
+    jobs = ([(72.5, 370e-6, 200e-6, 1e-3), (469.0, 360e-6, 206e-6, 1.5e-3),
+             (12.1, 380e-6, 196e-6, 0.8e-3)])
     N = int(DUR * FS)
     refs, noises = [], []
     for j, (k, w, xp, v) in enumerate(jobs):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             g = z.gripper(stiffness=k, width=w, centre=xp, check=False)
-        r = simulate_two_finger_grasp(g, settings=replace(FAST_GRASP, approach_speed=v), duration=DUR, dt=1 / FS,
+        r = simulate_two_finger_grasp(g, settings=replace(FAST_GRASP, approach_speed=v),
+                                      duration=DUR, dt=1 / FS,
                                       noise_std=2e-6, seed=j)
         refs.append(record_metrics(r, gap=400e-6, width=w, stiffness=k))
         noises.append(np.random.default_rng(j).standard_normal((N, 2)) * 2e-6)  # the noise it drew
-    res = tsfm_grasp_batch(gripper, k_e=[j[0] for j in jobs], w=[j[1] for j in jobs], X_p=[j[2] for j in jobs],
-                           approach_speed=[j[3] for j in jobs], noise=np.array(noises), duration=DUR, dt=1 / FS)
+    res = tsfm_grasp_batch(gripper, k_e=[j[0] for j in jobs], w=[j[1] for j in jobs],
+                           X_p=[j[2] for j in jobs],
+                           approach_speed=[j[3] for j in jobs], noise=np.array(noises),
+                           duration=DUR, dt=1 / FS)
     for m in METRICS:
         ref = np.array([r[m] for r in refs])
         if m in EXACT:
             np.testing.assert_array_equal(res[m], ref, err_msg=m)
         else:
             np.testing.assert_allclose(res[m], ref, rtol=1e-12, err_msg=m)
-    assert np.isfinite(res["width_error"]).all() and (np.abs(res["width_error"]) < 2e-6).all()  # §V-C: < 2 µm
+    # §V-C: < 2 µm
+    assert np.isfinite(res["width_error"]).all() and (np.abs(res["width_error"]) < 2e-6).all()
     assert (res["grasped"] == 1).all()
 
 
@@ -59,7 +65,8 @@ def test_stiffer_parts_give_higher_peaks_and_damage(gripper):
     """Fixed controller, centred 370 µm part, no noise: the impact and the force loop's overshoot
     grow with the part's stiffness; 1000 N/m crosses a 250 µN damage force, 10 N/m does not."""
     k = np.array([10.0, 100.0, 1000.0])
-    res = tsfm_grasp_batch(gripper, k_e=k, w=370e-6, noise_std=0.0, duration=0.1, damage_force=250e-6)
+    res = (tsfm_grasp_batch(gripper, k_e=k, w=370e-6, noise_std=0.0, duration=0.1,
+                            damage_force=250e-6))
     assert np.all(np.diff(res["peak_force"]) > 0)
     assert res["damage"].tolist() == [0.0, 0.0, 1.0]
     assert res["peak_force"][0] == pytest.approx(200e-6, rel=0.03)  # a soft part: no overshoot
@@ -67,7 +74,8 @@ def test_stiffer_parts_give_higher_peaks_and_damage(gripper):
 
 def test_the_hold_strategy_keeps_centred_parts_the_naive_grasp_loses_off_centre_ones(gripper):
     """§I: the finger that touches first waits. Centred parts over 10-1000 N/m and widths of
-    320-380 µm are never lost (grasped, displaced < 5 µm, median < 1 µm); parts 20 µm off-centre on 20 µN
+    320-380 µm are never lost (grasped, displaced < 5 µm, median < 1 µm); parts 20 µm off-centre on
+    20 µN
     friction are pushed away by the naive grasp (wait_for_other=False)."""
     rng = np.random.default_rng(5)
     n = 16
@@ -76,7 +84,8 @@ def test_the_hold_strategy_keeps_centred_parts_the_naive_grasp_loses_off_centre_
     ok = tsfm_grasp_batch(gripper, k_e=k, w=w, offset=0.0, approach_speed=1.5e-3, duration=0.12)
     assert (ok["lost"] == 0).all() and (ok["grasped"] == 1).all()
     assert ok["max_displacement"].max() < 5e-6 and np.median(ok["max_displacement"]) < 1e-6
-    naive = tsfm_grasp_batch(gripper, k_e=k, w=np.minimum(w, 340e-6), offset=20e-6, approach_speed=1.5e-3,
+    naive = tsfm_grasp_batch(gripper, k_e=k, w=np.minimum(w, 340e-6), offset=20e-6,
+                             approach_speed=1.5e-3,
                              duration=0.12, settings=replace(FAST_GRASP, wait_for_other=False))
     assert naive["lost"].mean() > 0.5
     assert np.nanmin(naive["max_displacement"]) > 10e-6
@@ -91,8 +100,10 @@ def test_bad_parts_are_refused_with_a_clear_error(gripper):
 
 def _spec(chunk, **extra):
     return SweepSpec.from_dict({
-        "sweep": {"scenario": "tsfm-grasp", "model": "tsfm-gripper", "samples": 8, "seed": 2, "chunk_size": chunk},
-        "parameters": {"k_e": {"loguniform": ["10 N/m", "1000 N/m"]}, "w": {"uniform": ["340 um", "380 um"]},
+        "sweep": {"scenario": "tsfm-grasp", "model": "tsfm-gripper", "samples": 8, "seed": 2,
+                  "chunk_size": chunk},
+        "parameters": {"k_e": {"loguniform": ["10 N/m", "1000 N/m"]},
+                       "w": {"uniform": ["340 um", "380 um"]},
                        "noise_std": {"uniform": ["1 uN", "3 uN"]}, **extra},
         "scenario": {"duration": "40 ms", "grip_force": "150 uN"}})
 
@@ -120,7 +131,8 @@ def test_ftg100_scenario_matches_grasp_batch():
     res = sweep(spec, backend="in-process", progress=False)
     from gripkit.systems.ftg100.hybrid_control import HybridForcePosition
 
-    ref = grasp_batch(HybridForcePosition.for_plant(approach_speed=4e-4), k0=np.array([520.0, 1560.0]),
+    ref = grasp_batch(HybridForcePosition.for_plant(approach_speed=4e-4),
+                      k0=np.array([520.0, 1560.0]),
                       seed=np.arange(2), duration=0.03, progress=False)
     for m in ("peak_force", "settling_time", "overshoot_percent"):
         np.testing.assert_array_equal(res[m], ref[m])

@@ -12,7 +12,8 @@ import pytest
 
 from gripkit.systems.tsfm.grasp_batch import METRICS, tsfm_grasp_batch
 
-JOBS = dict(k_e=[72.5, 800.0], w=[396e-6, 394e-6], offset=[0.0, 1e-6], approach_speed=[1e-3, 1.5e-3],
+JOBS = dict(k_e=[72.5, 800.0], w=[396e-6, 394e-6], offset=[0.0, 1e-6],
+            approach_speed=[1e-3, 1.5e-3],
             noise_std=[2e-6, 1e-6])
 DUR = 0.006   # 120 samples: contact after ~40, detection, hold, the start of the squeeze
 
@@ -32,11 +33,13 @@ def test_cuda_kernel_in_the_simulator_matches_the_cpu_kernel():
     """Two jobs (one soft, one stiff part): the kernel launched through numba.cuda (simulated: one
     Python thread per GPU thread, njit callees as Python) gives the CPU kernel's metrics."""
     env = dict(os.environ, NUMBA_ENABLE_CUDASIM="1", NUMBA_DISABLE_JIT="1")
-    proc = subprocess.run([sys.executable, "-c", SCRIPT], capture_output=True, text=True, env=env, timeout=300)
+    proc = (subprocess.run([sys.executable, "-c", SCRIPT], capture_output=True, text=True, env=env,
+                           timeout=300))
     assert proc.returncode == 0, proc.stderr[-3000:]
     sim = json.loads(proc.stdout.strip().splitlines()[-1])
     cpu = tsfm_grasp_batch(duration=DUR, **JOBS)
-    assert np.isfinite(cpu["t_contact1"]).all() and np.isfinite(cpu["t_squeeze"]).all()  # the case has contacts
+    # the case has contacts
+    assert np.isfinite(cpu["t_contact1"]).all() and np.isfinite(cpu["t_squeeze"]).all()
     for m in METRICS:
         got = np.array([np.nan if v is None else v for v in sim[m]])
         np.testing.assert_allclose(got, cpu[m], rtol=1e-9, atol=1e-15, err_msg=m)
@@ -51,7 +54,8 @@ def _nvvm():
         return False
 
 
-@pytest.mark.skipif(not _nvvm(), reason="compiling to PTX needs the CUDA toolkit's NVVM library, absent here; "
+@pytest.mark.skipif(not _nvvm(), reason="compiling to PTX needs the CUDA toolkit's NVVM "
+                                        "library, absent here; "
                     "the simulator test above still checks the kernel's values")
 def test_the_grasp_kernel_compiles_to_ptx():
     """Every function the GPU kernel calls (grasp step, gripper step, hybrid contact step,

@@ -16,7 +16,8 @@ from gripkit.systems.tsfm import parameters as z
 from gripkit.systems.tsfm import simulate_two_finger_grasp
 from gripkit.systems.tsfm.grasp_batch import FAST_GRASP, METRICS, tsfm_grasp_batch
 
-REFERENCE = json.loads((Path(__file__).parents[2] / "reference" / "kernel_records.json").read_text())["tsfm"]
+REFERENCE = (json.loads((Path(__file__).parents[2] / "reference"
+                         / "kernel_records.json").read_text())["tsfm"])
 
 
 def _results():
@@ -28,11 +29,13 @@ def _results():
         warnings.simplefilter("ignore")
         g = z.gripper(stiffness=469.0, width=360e-6, centre=206e-6, check=False)
         out = {}
-        r = simulate_two_finger_grasp(g, settings=replace(FAST_GRASP, approach_speed=1.5e-3), duration=0.03,
+        r = simulate_two_finger_grasp(g, settings=replace(FAST_GRASP, approach_speed=1.5e-3),
+                                      duration=0.03,
                                       dt=5e-05, noise_std=2e-6, seed=3)
         out["single_grasp"] = r.trajectory.as_array()
         res = tsfm_grasp_batch(k_e=[72.5, 800.0, 12.1, 300.0], w=[396e-6, 394e-6, 380e-6, 370e-6],
-                               offset=[0.0, 1e-6, -3e-6, 2e-6], approach_speed=[1e-3, 1.5e-3, 0.8e-3, 1.2e-3],
+                               offset=[0.0, 1e-6, -3e-6, 2e-6],
+                               approach_speed=[1e-3, 1.5e-3, 0.8e-3, 1.2e-3],
                                noise_std=[2e-6, 1e-6, 0.0, 3e-6], duration=0.02, serial=True)
         out["batch_serial"] = np.column_stack([res[m] for m in METRICS])
         u = np.column_stack([np.linspace(0, 60, 400), np.linspace(0, 55, 400)])

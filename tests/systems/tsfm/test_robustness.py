@@ -24,7 +24,8 @@ def test_analyse_a_synthetic_table():
     err[n:] = "ValueError: part slipped"
     tab = {"job_id": np.arange(n + 3), "k_e": np.exp(rng.uniform(np.log(10), np.log(1000), n + 3)),
            "damage": np.r_[exact(0.3), [np.nan] * 3], "lost": np.r_[exact(0.1), [np.nan] * 3],
-           "peak_force": np.r_[rng.uniform(1e-4, 3e-4, n), [np.nan] * 3], "settling_time": np.r_[st, [np.nan] * 3],
+           "peak_force": np.r_[rng.uniform(1e-4, 3e-4, n), [np.nan] * 3],
+           "settling_time": np.r_[st, [np.nan] * 3],
            "error": err}
     r = analyse(tab)
     assert r.n == n and r.n_failed == 3

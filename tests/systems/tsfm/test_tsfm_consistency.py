@@ -42,9 +42,11 @@ def test_other_contradictions_found_in_the_seed():
     the right sensor (5.1e-3 V/µN) and both actuator stiffnesses (Table I, 1100 N/m) agree."""
     left, right = _findings("left"), _findings("right")
     bad = {f.check for f in left.inconsistent}
-    assert {"sensor-natural-frequency", "sensor-damping-ratio", "eq13-a2", "sensor-sensitivity"} <= bad
+    assert {"sensor-natural-frequency", "sensor-damping-ratio", "eq13-a2",
+            "sensor-sensitivity"} <= bad
     assert "sensor-sensitivity" not in {f.check for f in right.inconsistent}
-    assert all(f.consistent for f in [*left, *right] if f.check in ("actuator-stiffness", "sensor-stiffness",
+    assert all(f.consistent for f in [*left, *right] if f.check in ("actuator-stiffness",
+                                                                    "sensor-stiffness",
                                                                     "actuation-bandwidth"))
 
 

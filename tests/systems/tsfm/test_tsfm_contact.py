@@ -17,7 +17,8 @@ def fig13(left):
 
 
 def test_contact_starts_at_44_V_and_no_force_before(fig13):
-    """Fig. 13: the contact starts at U = 44 V (part face placed there); no force at all while free."""
+    """Fig. 13: the contact starts at U = 44 V (part face placed there); no force at all while
+    free."""
     c = fig13["contact"] > 0.5
     on = int(np.argmax(c))
     assert fig13["U"][on] == pytest.approx(44.0, abs=0.05)

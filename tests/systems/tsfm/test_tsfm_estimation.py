@@ -77,7 +77,8 @@ def grasps():
         out = {}
         for k in (12.1, 72.5, 469.0):
             g = z.gripper(stiffness=k, centre=170e-6)
-            out[k] = simulate_two_finger_grasp(g, duration=3.0, settings=GraspSettings(approach_speed=60e-6),
+            out[k] = simulate_two_finger_grasp(g, duration=3.0,
+                                               settings=GraspSettings(approach_speed=60e-6),
                                                seed=int(k))
         return out
 
@@ -91,7 +92,8 @@ def test_width_within_2_um_and_stiffness_within_5_percent(grasps, k):
     assert e.width == pytest.approx(300e-6, abs=2e-6)
     assert e.width_threshold == pytest.approx(300e-6, abs=2e-6)
     assert e.stiffness == pytest.approx(k, rel=0.05)
-    assert e.faces[0] == pytest.approx(170e-6 - 150e-6, abs=2e-6)  # the part's location from finger 1
+    # the part's location from finger 1
+    assert e.faces[0] == pytest.approx(170e-6 - 150e-6, abs=2e-6)
     assert grasps[k].final_forces == pytest.approx((200e-6, 200e-6), rel=0.05)
 
 
@@ -103,7 +105,8 @@ def test_the_first_finger_holds_and_the_part_stays(grasps):
         warnings.simplefilter("ignore")
         g = z.gripper(stiffness=72.5, centre=170e-6)
     naive = simulate_two_finger_grasp(g, duration=3.0, seed=1,
-                                      settings=GraspSettings(approach_speed=60e-6, wait_for_other=False))
+                                      settings=GraspSettings(approach_speed=60e-6,
+                                                             wait_for_other=False))
     assert naive.part_displacement > 10e-6
     assert abs(naive.estimate.width_threshold - 300e-6) > 10e-6
     assert naive.estimate.width == pytest.approx(300e-6, abs=2e-6)  # the loading line is immune

@@ -37,7 +37,8 @@ def point_b(left):
 @pytest.fixture(scope="module")
 def dynamics(left, loops):
     bw0 = identify_bouc_wen(loops, "U", "y_B", progress=False)
-    return identify_actuator_dynamics(z.step_experiment(left, seed=6), bw0, "U", "y_B", progress=False)
+    return (identify_actuator_dynamics(z.step_experiment(left, seed=6), bw0, "U", "y_B",
+                                       progress=False))
 
 
 def test_bouc_wen_recovered_within_2_percent_from_three_loops(loops, dynamics, point_b):
@@ -56,7 +57,8 @@ def test_internal_loops_validate_as_in_fig_9b(loops, dynamics):
     ext = loops.take(np.flatnonzero(loops["loop"] == 0))
     res = identify_bouc_wen(ext, "U", "y_B", delay=dynamics.b + 0.5 / 20000, progress=False)
     pred = res.predict(loops["U"])
-    errs = [loop_error(loops["y_B"][loops["loop"] == k], pred[loops["loop"] == k]) for k in range(3)]
+    errs = ([loop_error(loops["y_B"][loops["loop"] == k],
+                        pred[loops["loop"] == k]) for k in range(3)])
     assert errs[0] < 0.05 and errs[1] < 0.10 and errs[2] < 0.10
     assert max(errs) < 0.005  # same model, only noise: far inside the seed's bounds
 
@@ -67,7 +69,8 @@ def test_d_s_from_a_step(dynamics):
     b within 0.2 %."""
     assert dynamics.a == pytest.approx(2.5e-8, rel=0.005)
     assert dynamics.b == pytest.approx(8e-5, rel=0.002)
-    assert dynamics.natural_frequency_hz == pytest.approx(1 / (2 * math.pi * math.sqrt(2.5e-8)), rel=0.005)
+    assert dynamics.natural_frequency_hz == pytest.approx(1 / (2 * math.pi * math.sqrt(2.5e-8)),
+                                                          rel=0.005)
 
 
 def test_compliance_from_eq_15(left):
@@ -104,7 +107,8 @@ def test_modal_std_agrees_with_the_spread(ringing):
     rs = [free_vibration(tr["F"], dt=tr.dt) for tr in ringing]
     f = np.array([r.natural_frequency_hz for r in rs])
     zt = np.array([r.damping_ratio for r in rs])
-    for est, sd in ((f, [r.natural_frequency_std_hz for r in rs]), (zt, [r.damping_ratio_std for r in rs])):
+    for est, sd in ((f, [r.natural_frequency_std_hz for r in rs]),
+                    (zt, [r.damping_ratio_std for r in rs])):
         ratio = np.std(est, ddof=1) / np.mean(sd)
         assert 1 / 1.6 < ratio < 1.6
 
@@ -132,7 +136,8 @@ def test_to_tip_a_divides_by_the_lever_gains():
 
 def test_bad_data():
     with pytest.raises(DataError, match="never reverses"):
-        identify_bouc_wen(Trajectory.uniform(dt=0.01, U=np.linspace(0, 1, 50), y=np.linspace(0, 1, 50)),
+        identify_bouc_wen(Trajectory.uniform(dt=0.01, U=np.linspace(0, 1, 50),
+                                             y=np.linspace(0, 1, 50)),
                           progress=False)
     with pytest.raises(DataError, match="constant"):
         free_vibration(np.ones(200), dt=0.001)
@@ -151,12 +156,14 @@ def test_cli_identify(tmp_path, capsys, left, loops, ringing):
     assert r["damping_ratio"] == pytest.approx(0.006, rel=0.1)
     assert r["natural_frequency_std_hz"] > 0 and r["damping_ratio_std"] > 0
     save(loops, tmp_path / "loops.parquet")
-    assert main(["identify", "bouc-wen", str(tmp_path / "loops.parquet"), "--input", "U", "--output", "y_B",
+    assert main(["identify", "bouc-wen", str(tmp_path / "loops.parquet"), "--input", "U",
+                 "--output", "y_B",
                  "--json"]) == 0
     r = json.loads(capsys.readouterr().out)
     assert set(r["params"]) == set(r["std"]) == {"d_p", "lambda", "beta", "gamma"}
     assert r["params"]["d_p"] == pytest.approx(0.77e-6 * (1 + 14 / 15), rel=0.01)
-    assert main(["identify", "bouc-wen", str(tmp_path / "loops.parquet"), "--input", "U", "--output", "nope"]) == 1
+    assert main(["identify", "bouc-wen", str(tmp_path / "loops.parquet"), "--input", "U",
+                 "--output", "nope"]) == 1
     assert "column 'nope' not found" in capsys.readouterr().err
 
 
@@ -164,7 +171,8 @@ def test_record_starting_mid_loop_with_burn_in(loops, dynamics, point_b):
     """A record that starts mid-loop (hysteresis state unknown): simulated from H = 0, the first
     half period left out of the cost (greybox burn_in) — parameters still within 2 %."""
     mid = loops.take(np.arange(5000, loops.n))
-    res = identify_bouc_wen(mid, "U", "y_B", burn_in=10000, delay=dynamics.b + 0.5 / 20000, progress=False)
+    res = (identify_bouc_wen(mid, "U", "y_B", burn_in=10000, delay=dynamics.b + 0.5 / 20000,
+                             progress=False))
     for k, true in point_b.items():
         assert abs(res.params[k] / true - 1) < 0.02, (k, res.params[k], true)
     assert res.fit.n_samples == mid.n - 10000

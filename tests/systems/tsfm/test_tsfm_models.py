@@ -13,7 +13,8 @@ from gripkit.systems.tsfm.end_effector import lever_coefficients
 from gripkit.systems.tsfm.gripper import (finger_coefficients, finger_minimal_state_space,
                                           finger_state_space, finger_transfer_functions)
 
-BW = dict(d_p=0.77e-6, lam=0.43e-6, beta=0.108, gamma=7.5e-3)  # Table II, left finger (λ in µm/V → m/V)
+# Table II, left finger (λ in µm/V → m/V)
+BW = dict(d_p=0.77e-6, lam=0.43e-6, beta=0.108, gamma=7.5e-3)
 
 
 def test_three_forms_of_the_finger_agree(left):
@@ -45,9 +46,12 @@ def test_static_gains_from_eq_13(left):
     c = finger_coefficients(v)
     L = v["L_r"] + v["L_s"]
     assert c["b0"] / c["a0"] == pytest.approx(1 + 2 * L / v["L_a"])
-    assert c["c0"] / c["a0"] == pytest.approx(1 / v["k_s"] + (1 + 3 * L / v["L_a"] + 3 * L**2 / v["L_a"] ** 2) * v["s_p"])
+    assert c["c0"] / c["a0"] == pytest.approx(1 / v["k_s"]
+                                              + (1 + 3 * L / v["L_a"] + 3 * L**2
+                                                              / v["L_a"] ** 2) * v["s_p"])
     lc = lever_coefficients(L, v["L_a"])
-    assert (lc.alpha_u, lc.alpha_f, lc.alpha_m) == pytest.approx((c["alpha_u"], c["alpha_f"], c["alpha_m"]))
+    assert (lc.alpha_u, lc.alpha_f, lc.alpha_m) == pytest.approx((c["alpha_u"], c["alpha_f"],
+                                                                  c["alpha_m"]))
 
 
 def test_component_wise_simulation_equals_eq_11_simulated_by_scipy(left):
@@ -90,7 +94,8 @@ def test_finger_errors():
 def test_parallel_batch_equals_single_runs(left, kind):
     """simulate_batch over several parameter sets (prange over rows) equals one run per set."""
     if kind == "finger":
-        m, names, u = left, ("d_p", "k_s"), {"U": 40 * np.sin(np.arange(3000) / 300), "F_g": np.zeros(3000)}
+        m, names, u = (left, ("d_p", "k_s"), {"U": 40 * np.sin(np.arange(3000) / 300),
+                                              "F_g": np.zeros(3000)})
     elif kind == "contact":
         m, names = left.contact(x_w=20e-6, k_e=72.5), ("k_e", "x_w")
         u = {"U": 40 * np.sin(np.arange(3000) / 300)}

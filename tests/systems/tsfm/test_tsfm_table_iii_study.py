@@ -65,7 +65,8 @@ def test_sigma_is_what_the_stated_noise_implies(study):
     study could not tell the seed's errors from noise."""
     for r in study.rows:
         expected = _noise_sigma(r.true, r.estimate_detail.n_blocks - INSTRUMENT_LAG)
-        assert 0.5 < (r.std_noise / r.true) / expected < 2.0, (r.true, r.std_noise / r.true, expected)
+        assert 0.5 < (r.std_noise / r.true) / expected < 2.0, (r.true, r.std_noise / r.true,
+                                                               expected)
         assert r.std / r.true < 0.01
 
 
@@ -93,7 +94,8 @@ def test_the_seed_errors_are_beyond_its_stated_noise(study):
 
 
 def test_study_carries_the_table_iii_findings_and_the_identified_fingers(study):
-    assert [f.check for f in study.findings] == ["table-iii-error-1", "table-iii-error-2", "table-iii-error-3"]
+    assert [f.check for f in study.findings] == ["table-iii-error-1", "table-iii-error-2",
+                                                 "table-iii-error-3"]
     assert all(f.consistent for f in study.findings)
     for side in ("left", "right"):
         p = study.identified[side].finger.parameters

@@ -19,8 +19,10 @@ SEED_NAME = "001_0b92a7da96e7aa46.txt"
 
 # Table II row label (as extracted) -> gripkit name, SI factor (tests/reference/tsfm_tables.md)
 ROWS = {r"$d_p$ ( $\mu\text{m}/\text{V}$ )": ("d_p", 1e-6), "$s_p$ (m/N)": ("s_p", 1.0),
-        r"$\lambda$": ("lam", 1e-6), r"$\beta$": ("beta", 1.0), r"$\gamma$": ("gamma", 1.0), "$a$": ("a", 1.0),
-        "$b$": ("b", 1.0), "$m_s$ (Kg)": ("m_s", 1.0), "$b_s$ (N·s/m)": ("b_s", 1.0), "$k_s$ (N/m)": ("k_s", 1.0),
+        r"$\lambda$": ("lam", 1e-6), r"$\beta$": ("beta", 1.0), r"$\gamma$": ("gamma", 1.0),
+        "$a$": ("a", 1.0),
+        "$b$": ("b", 1.0), "$m_s$ (Kg)": ("m_s", 1.0), "$b_s$ (N·s/m)": ("b_s", 1.0),
+        "$k_s$ (N/m)": ("k_s", 1.0),
         r"Sensitivity (V/ $\mu\text{N}$ )": ("sensitivity", 1e6)}
 
 # Table II, right finger, each value as printed (seed p. 7, "Right Finger" column), SI
@@ -76,7 +78,8 @@ def _seed_file() -> Path | None:
 
 def test_every_table_ii_value_of_both_fingers():
     """Table II (p. 7), all eleven rows of both columns, against TABLE_II and the printed
-    parameter set of each finger (``table_ii(side)``), each with a Table II source naming the finger."""
+    parameter set of each finger (``table_ii(side)``), each with a Table II source naming the
+    finger."""
     parsed = _table_ii()
     assert len(parsed["left"]) == len(parsed["right"]) == 11
     for side in ("left", "right"):
@@ -109,7 +112,8 @@ def test_right_finger_values_cited_row_by_row():
 
 
 def test_right_finger_in_zoo_show(capsys):
-    """`gripkit zoo show tsfm-right --json` lists the right finger's Table II values (SI) with their source."""
+    """`gripkit zoo show tsfm-right --json` lists the right finger's Table II values (SI) with
+    their source."""
     assert main(["zoo", "show", "tsfm-right", "--json"]) == 0
     params = {p["name"]: p for p in json.loads(capsys.readouterr().out)["parameters"]}
     for name in ("d_p", "s_p", "lam", "beta", "gamma", "a", "b", "k_s"):
@@ -162,12 +166,15 @@ def test_zoo_check_lists_table_iii(capsys):
 
 
 def test_reference_extraction_matches_the_seed():
-    """Each line of the verbatim blocks occurs in the seed file (skipped when the seeds are not on disk)."""
+    """Each line of the verbatim blocks occurs in the seed file (skipped when the seeds are not on
+    disk)."""
     seed = _seed_file()
     if seed is None:
-        pytest.skip("the seed document 001_0b92a7da96e7aa46.txt is not shipped with gripkit (it is the "
+        pytest.skip("the seed document 001_0b92a7da96e7aa46.txt is not shipped with "
+                    "gripkit (it is the "
                     "specification, kept outside the repository); the Table II/III copy in "
-                    "tests/reference/tsfm_tables.md is still checked by the other tests; set GRIPKIT_SEEDS "
+                    "tests/reference/tsfm_tables.md is still checked by the other tests; "
+                    "set GRIPKIT_SEEDS "
                     "to the seeds' folder to compare the copy with the seed itself")
     lines = set(seed.read_text(encoding="utf-8").splitlines())
     for tag in ("table-ii", "table-iii"):

@@ -29,7 +29,8 @@ def is_stable_poly(c: np.ndarray) -> bool:
 
 
 def stabilize(c: np.ndarray) -> np.ndarray:
-    """Reflect roots outside the unit circle to ``1/conj(z)`` (same spectrum shape), keep it monic."""
+    """Reflect roots outside the unit circle to ``1/conj(z)`` (same spectrum shape), keep it
+    monic."""
     c = np.asarray(c, dtype=np.float64)
     if c.size <= 1:
         return c
@@ -88,7 +89,8 @@ def levenberg_marquardt(fun: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray
             message = "converged (no further decrease)"
             break
         decrease = (cost - cost_new) / max(cost, 1e-300)
-        small_step = float(np.linalg.norm(step)) <= np.sqrt(tol) * (float(np.linalg.norm(theta)) + np.sqrt(tol))
+        small_step = (float(np.linalg.norm(step)) <= np.sqrt(tol)
+                      * (float(np.linalg.norm(theta)) + np.sqrt(tol)))
         theta, e, J, cost = cand, e_new, J_new, cost_new
         mu = max(mu / 10.0, 1e-15)
         if decrease < tol or small_step:

@@ -1,4 +1,5 @@
-"""ARMAX identification by prediction-error minimisation, eqs (24)–(27) of ``000_8f66dcc7ab06470c.txt``.
+"""ARMAX identification by prediction-error minimisation, eqs (24)–(27) of
+``000_8f66dcc7ab06470c.txt``.
 
 Model: ``A(q) y(t) = B(q) u(t) + C(q) e(t)``; θ = [a_1..a_na, b_nk..b_{nk+nb-1}, c_1..c_nc] (eq 27).
 Predictor: ``C(q) e(t) = A(q) y(t) − B(q) u(t)``, so ``ŷ(t|t−1) = y(t) − e(t)``, with e(t) = 0
@@ -8,7 +9,8 @@ before the first predicted sample. Gradients (Ljung, §10.2)::
 
 Initialisation (Hannan–Rissanen): a high-order ARX model gives estimates ê(t) of the innovations;
 the linear regression of y(t) on −y(t−i), u(t−j), ê(t−k) gives A, B, C (C reflected into the
-unit circle if needed). Then Levenberg–Marquardt (:mod:`gripkit.sysid.linear._pem`) minimises eq (29).
+unit circle if needed). Then Levenberg–Marquardt (:mod:`gripkit.sysid.linear._pem`) minimises eq
+(29).
 """
 
 from __future__ import annotations
@@ -99,7 +101,8 @@ def _armax(u, y, na, nb, nc, nk, step, maxiter, tol, meta, progress=False) -> Po
     theta0 = _hannan_rissanen(u, y, na, nb, nc, nk)
     theta0[na + nb:] = stabilize(np.concatenate([[1.0], theta0[na + nb:]]))[1:]
 
-    ya = np.column_stack([y[t0 - i:y.size - i] for i in range(1, na + 1)]) if na else np.zeros((y.size - t0, 0))
+    ya = (np.column_stack([y[t0 - i:y.size - i] for i in range(1, na + 1)]) if na
+          else np.zeros((y.size - t0, 0)))
     ub = np.column_stack([u[t0 - nk - j:u.size - nk - j] for j in range(nb)])
     yt = y[t0:]
 
@@ -122,8 +125,10 @@ def _armax(u, y, na, nb, nc, nk, step, maxiter, tol, meta, progress=False) -> Po
     B = np.concatenate([np.zeros(nk), th[na:na + nb]])
     C = np.concatenate([[1.0], th[na + nb:]])
     e = res.e
-    return PolynomialModel(A, B, nk, C=C, dt=step, structure="armax", covariance=cov, noise_variance=sigma2,
-                           loss=loss_vn(e), fit_percent=fit_percent(yt, yt - e), n_samples=int(y.size),
+    return PolynomialModel(A, B, nk, C=C, dt=step, structure="armax", covariance=cov,
+                           noise_variance=sigma2,
+                           loss=loss_vn(e), fit_percent=fit_percent(yt, yt - e),
+                           n_samples=int(y.size),
                            n_used=int(e.size), estimation_residuals=e,
                            info={"method": "prediction-error minimisation (Levenberg-Marquardt), "
                                            "Hannan-Rissanen start", "iterations": res.iterations,

@@ -92,7 +92,8 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
     u, y, step, na, nb, nk, (pu, py) = checked_problem_peaks(u, y, dt, na=na, nb=nb, nk=nk)
     cu, cy = unit_scale(u, pu), unit_scale(y, py)
     if max(abs(math.log2(cu)), abs(math.log2(cy))) <= _NO_SCALING_WITHIN:
-        cu = cy = 1.0  # scaling by powers of two is exact: skip the two copies where it changes nothing
+        # scaling by powers of two is exact: skip the two copies where it changes nothing
+        cu = cy = 1.0
     # a positive power of two maps min to min and max to max exactly (rounding is monotone)
     peaks = ((pu[0] * cu, pu[1] * cu), (py[0] * cy, py[1] * cy))
     model = _arx(u * cu if cu != 1.0 else u, y * cy if cy != 1.0 else y, na, nb, nk, step,
@@ -262,8 +263,10 @@ def arx_records(records, na: int, nb: int, nk: int = 1, *, dt: float | None = No
 
     M_i = N_i − start. The covariance is σ²(ΦᵀΦ)⁻¹ of the stacked Φ. With one record the result
     is that of :func:`arx` (same rows). ``fit_percent`` is the one-step fit of all the records,
-    each about its own mean (:func:`~gripkit.sysid.linear.validation.records_fit`); ``info['records']``
-    gives each record's samples and one-step fit; ``estimation_residuals`` are the records' one-step errors
+    each about its own mean (:func:`~gripkit.sysid.linear.validation.records_fit`);
+    ``info['records']``
+    gives each record's samples and one-step fit; ``estimation_residuals`` are the records'
+    one-step errors
     one after another (``info['record_starts']``: where each begins).
 
     Examples

@@ -23,7 +23,6 @@ import numpy as np
 
 from ...errors import DataError
 from ..checks import check_dt, check_order, io_records
-from . import matrix_polynomial as mp
 from .linear_model import as_io_matrix, estimate_x0, fit_per_output, free_run
 from .polynomial import PolynomialModel, channel_meta
 from ..regression import qr_solve
@@ -111,7 +110,8 @@ def _arx_mimo(recs, na, nb, nk, dt, meta, several: bool = False) -> PolynomialMo
         cov_unscaled = sol.cov_unscaled
     E = Y - X[:, :q] @ theta.T
     Lam = E.T @ E / (M - q)
-    cov = np.kron(Lam, cov_unscaled)                     # vec(θ) row-major: output i, then regressor
+    # vec(θ) row-major: output i, then regressor
+    cov = np.kron(Lam, cov_unscaled)
     A = np.concatenate([np.eye(p)[None], theta[:, :p * na].reshape(p, na, p).transpose(1, 0, 2)])
     B = np.concatenate([np.zeros((nk, p, m)),
                         theta[:, p * na:].reshape(p, nb, m).transpose(1, 0, 2)])

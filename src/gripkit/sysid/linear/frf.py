@@ -76,7 +76,8 @@ class FRF:
         siso = self.H.shape[1:] == (1, 1)
         sq = (lambda a: a[:, 0, 0]) if siso else (lambda a: a)
         out = {"method": self.method, "inputs": list(self.inputs), "outputs": list(self.outputs),
-               "frequency_hz": self.frequency_hz, "H_real": sq(self.H.real), "H_imag": sq(self.H.imag),
+               "frequency_hz": self.frequency_hz, "H_real": sq(self.H.real),
+               "H_imag": sq(self.H.imag),
                "H_std": sq(self.H_std)}
         if self.coherence is not None:
             out["coherence"] = self.coherence[:, 0] if siso else self.coherence
@@ -87,7 +88,8 @@ class FRF:
 def _no_power_warning(f, bad, what):
     if bad.any():
         lines = ", ".join(f"{x:.4g}" for x in f[bad][:5]) + (" …" if bad.sum() > 5 else "")
-        emit_warning(f"frf: {int(bad.sum())} line(s) have no {what} power ({lines} Hz): H is undefined there "
+        emit_warning(f"frf: {int(bad.sum())} line(s) have no {what} power ({lines} Hz): H is "
+                     "undefined there "
                      f"and its σ is infinite", AccuracyWarning)
 
 
@@ -98,23 +100,28 @@ def _periodic(u, y, dt, periods, keep_transient):
     if P < 2 or N % P:
         raise DataError(f"periods: {N} samples do not split into {P} whole periods" if P >= 2 else
                         f"periods: expected an integer >= 2, found {periods!r}",
-                        hint="give the number of periods the record holds (N must be a multiple of it)")
+                        hint="give the number of periods the record holds (N must be a "
+                             "multiple of it)")
     L = N // P
     U = u.reshape(P, L, m)
     span = float(np.max(np.abs(u - u.mean(axis=0)))) or 1.0
     dev = np.max(np.abs(U - U[-1:]), axis=(1, 2)) / span
     if np.max(dev) > 1e-3:
         i = int(np.argmax(dev))
-        raise DataError(f"periods: the input is not periodic with {P} periods of {L} samples (period {i + 1} differs "
+        raise DataError(f"periods: the input is not periodic with {P} periods of {L} samples "
+                        f"(period {i + 1} differs "
                         f"from the last by {100 * dev[i]:.3g} % of the input range)",
                         hint="check --periods, or use a method for arbitrary excitation (h1, spa)")
     if m != 1:
-        raise DataError(f"periods: periodic FRF estimation takes one input per experiment, found {m}",
+        raise DataError("periods: periodic FRF estimation takes one input per "
+                        f"experiment, found {m}",
                         hint="use the h1 method for several simultaneous inputs")
     first = 0 if keep_transient else 1
     if P - first < 2:
-        raise DataError(f"periods: {P} period(s) leave {P - first} after dropping the transient; the "
-                        f"noise estimate needs at least 2", hint="record more periods or pass --keep-transient")
+        raise DataError(f"periods: {P} period(s) leave {P - first} after dropping the "
+                        "transient; the "
+                        f"noise estimate needs at least 2", hint="record more periods or pass "
+                                                                 "--keep-transient")
     Uk = np.fft.rfft(U[first:, :, 0], axis=1)[:, 1:]                       # (P', F)
     Yk = np.fft.rfft(y.reshape(P, L, p)[first:], axis=1)[:, 1:]            # (P', F, p)
     f = np.fft.rfftfreq(L, dt)[1:]
@@ -127,11 +134,14 @@ def _periodic(u, y, dt, periods, keep_transient):
     vU = np.sum(np.abs(dU) ** 2, axis=0) / (Pk * (Pk - 1))
     vY = np.sum(np.abs(dY) ** 2, axis=0) / (Pk * (Pk - 1))
     cYU = np.sum(dY * dU.conj()[:, :, None], axis=0) / (Pk * (Pk - 1))
-    f, Ub, Yb, vU, vY, cYU = f[excited], Ub[excited], Yb[excited], vU[excited], vY[excited], cYU[excited]
+    f, Ub, Yb, vU, vY, cYU = (f[excited], Ub[excited], Yb[excited], vU[excited], vY[excited],
+                              cYU[excited])
     H = Yb / Ub[:, None]
-    var = (vY + np.abs(H) ** 2 * vU[:, None] - 2 * np.real(H.conj() * cYU / Ub[:, None])) / np.abs(Ub[:, None]) ** 2
+    var = ((vY + np.abs(H) ** 2 * vU[:, None] - 2 * np.real(H.conj() * cYU / Ub[:, None]))
+           / np.abs(Ub[:, None]) ** 2)
     std = np.sqrt(np.maximum(var, 0.0))
-    return f, H[:, :, None], std[:, :, None], None, {"periods": P, "periods_used": Pk, "period_samples": L,
+    return f, H[:, :, None], std[:, :, None], None, {"periods": P, "periods_used": Pk,
+                                                     "period_samples": L,
                                                      "transient_dropped": not keep_transient}
 
 
@@ -144,7 +154,8 @@ def _h1(u, y, dt, nperseg):
     step = L // 2
     K = 1 + (N - L) // step
     if K <= m:
-        raise DataError(f"data: {N} samples give {K} segment(s) of {L}; H1 with {m} input(s) needs more than {m}",
+        raise DataError(f"data: {N} samples give {K} segment(s) of {L}; H1 with {m} input(s) "
+                        f"needs more than {m}",
                         hint="use a longer record or a shorter --nperseg")
     win = np.hanning(L + 1)[:-1]
     Uk = _segment_spectra(u, L, step, K, win)                               # (m, K, F)
@@ -163,7 +174,8 @@ def _h1(u, y, dt, nperseg):
     Hg = Syu[good] @ Sinv
     Sfit = np.einsum("fij,fjk,fik->fi", Hg, Suu[good], Hg.conj()).real
     Svv = np.maximum(Syy[good] - Sfit, 0.0)
-    var = _HANN_OVERLAP_INFLATION * Svv[:, :, None] * np.real(np.einsum("fjj->fj", Sinv))[:, None, :] / (K - m)
+    var = (_HANN_OVERLAP_INFLATION * Svv[:, :, None]
+           * np.real(np.einsum("fjj->fj", Sinv))[:, None, :] / (K - m))
     H[good], std[good] = Hg, np.sqrt(var)
     coh[good] = np.clip(Sfit / np.maximum(Syy[good], 1e-300), 0.0, 1.0)
     _no_power_warning(f, bad, "input")
@@ -244,7 +256,8 @@ def _spa(u, y, dt, lag_window, n_lines):
     coh = np.where(bad, np.nan, np.clip(np.abs(Pyu) ** 2 / np.maximum(Pu * Py, 1e-300), 0, 1))
     f = w / (2 * np.pi * dt)
     _no_power_warning(f, bad, "input")
-    return f, G[:, None, None], np.sqrt(var)[:, None, None], coh[:, None], {"lag_window": M, "window": "hann"}
+    return (f, G[:, None, None], np.sqrt(var)[:, None, None], coh[:, None],
+            {"lag_window": M, "window": "hann"})
 
 
 def frf(u, y, *, dt: float | None = None, method: str = "auto", periods: int | None = None,
@@ -274,7 +287,8 @@ def frf(u, y, *, dt: float | None = None, method: str = "auto", periods: int | N
         raise DataError(f"method: expected one of auto, {', '.join(FRF_METHODS)}, found {method!r}")
     if method == "periodic":
         if periods is None:
-            raise DataError("periods: the periodic method needs the number of periods in the record")
+            raise DataError("periods: the periodic method needs the number of "
+                            "periods in the record")
         f, H, std, coh, info = _periodic(u, y, step, periods, keep_transient)
     elif method == "h1":
         f, H, std, coh, info = _h1(u, y, step, nperseg)

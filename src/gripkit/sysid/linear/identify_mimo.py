@@ -45,7 +45,8 @@ def parse_order(order) -> tuple[int, int] | None:
         try:
             lo, hi = (int(v) for v in txt.split(":")) if ":" in txt else (int(txt),) * 2
         except ValueError:
-            raise DataError(f"order: expected N or LO:HI (positive integers), found {order!r}") from None
+            raise DataError("order: expected N or LO:HI (positive integers), "
+                            f"found {order!r}") from None
     if lo < 1 or hi < lo:
         raise DataError(f"order: expected 1 <= LO <= HI, found {order!r}")
     return lo, hi
@@ -82,7 +83,8 @@ def _aic(model, d: IOData) -> float:
     return float(N * logdet + 2 * k) if sign > 0 else -math.inf
 
 
-def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n4sid", form: str = "innovation",
+def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n4sid",
+                form: str = "innovation",
                 refine: bool = True, validate: Trajectory | None = None, detrend: str = "mean",
                 horizon: int | None = None, feedthrough: bool = False, progress: bool = False,
                 focus: str = "simulation", max_iterations: int = 50):
@@ -117,7 +119,8 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     n_hi = rng[1] if rng else DEFAULT_MAX_ORDER
     k = default_horizon(n_hi, d.y.shape[1]) if horizon is None else int(horizon)
     report = status if progress else (lambda line: None)
-    report(f"{method}: {d.u.shape[0]} samples, {len(d.inputs)} input(s), {len(d.outputs)} output(s), horizon {k}")
+    report(f"{method}: {d.u.shape[0]} samples, {len(d.inputs)} input(s), {len(d.outputs)} "
+           f"output(s), horizon {k}")
     fac = subspace_factor(d.u, d.y, horizon=k, method=method)
     extras: dict = {}
     build = lambda n: from_factor(  # noqa: E731
@@ -235,7 +238,8 @@ REFINE_TOP = 3
 def _refine_top(ranked: list, refine_one, fit_of, aic_of, progress: bool, n_top: int):
     """``refine_one(model)`` (PEM that never loses by the focus) of the ``n_top`` best orders of
     a search (the higher orders that tie with the best on the validation fit, ``tie``
-    in their rows, left out: they fit the noise, and their PEM costs most), ranked again: by ``fit_of(model)`` (the focus fit on validation data;
+    in their rows, left out: they fit the noise, and their PEM costs most), ranked again: by
+    ``fit_of(model)`` (the focus fit on validation data;
     the lowest order within :data:`FOCUS_TIE` of the best first) when ``aic_of`` is None, else
     by ``aic_of(model)`` (on the estimation data a higher order always fits better: Akaike's
     criterion weighs the fit against the parameters). Each row gets ``refined_percent`` (the
@@ -325,7 +329,8 @@ def _refine(start, d: IOData, vd: IOData | None, form: str, focus: str, max_iter
                            progress=progress)
             except IdentificationError:
                 return None
-    return _never_lose(start, model, focus, d if vd is None else vd, vd is None, max_iterations, oe), True
+    return (_never_lose(start, model, focus, d if vd is None else vd, vd is None, max_iterations,
+                        oe), True)
 
 
 #: fit points (%) within which a refined model counts as scoring as well as its start: the scores
@@ -337,7 +342,8 @@ def _warn_unconverged(model, max_iterations: int) -> None:
     info = model.info.get("pem", {})
     if not info.get("converged", True):
         emit_warning(f"PEM refinement ({model.structure}) stopped after {info.get('iterations')} "
-                     f"iterations without converging (loss {info.get('loss_start', math.nan):.4g} -> "
+                     "iterations without converging (loss "
+                     f"{info.get('loss_start', math.nan):.4g} -> "
                      f"{info.get('loss', math.nan):.4g} per sample); raise max_iterations "
                      f"(--max-iterations, now {max_iterations}) or lower the order",
                      AccuracyWarning)
@@ -365,15 +371,18 @@ def _never_lose(start, refined, focus: str, d: IOData, estimation: bool, max_ite
         if after >= before - FOCUS_TIE:
             model.info["focus"] = {**record, "refined_percent": after, "kept": model.structure}
             if model is not refined:
-                emit_warning(f"PEM refinement ({refined.structure}) lowered the mean {focus} fit on "
+                emit_warning(f"PEM refinement ({refined.structure}) lowered the mean "
+                             f"{focus} fit on "
                              f"the {where} data from {before:.2f} % to {tried[0][1]:.2f} %; the "
                              f"{model.structure} refinement ({after:.2f} %) is returned",
                              AccuracyWarning)
             return model
     other = "prediction" if focus == "simulation" else "simulation"
     emit_warning(f"PEM refinement lowered the mean {focus} fit on the {where} data from "
-                 f"{before:.2f} % to {', '.join(f'{name} {fit:.2f} %' for name, fit in tried)}: the "
-                 f"subspace model is returned, without parameter covariance (--focus {other} judges "
+                 f"{before:.2f} % to "
+                 f"{', '.join(f'{name} {fit:.2f} %' for name, fit in tried)}: the "
+                 "subspace model is returned, without parameter covariance (--focus "
+                 f"{other} judges "
                  f"by the other criterion; --no-refine skips PEM)", AccuracyWarning)
     start.info["focus"] = {**record, "refined_percent": tried[0][1], "kept": "subspace"}
     start.info["pem_rejected"] = refined.info.get("pem", {})
@@ -419,7 +428,8 @@ def identify_frf(data: Trajectory, *, input, output, detrend: str = "mean", **op
 
 
 def identify_tf(data: Trajectory, *, input, output, poles: int, zeros: int, detrend: str = "mean"):
-    """Continuous-time transfer function of the named columns (:func:`gripkit.sysid.linear.tfest`)."""
+    """Continuous-time transfer function of the named columns
+    (:func:`gripkit.sysid.linear.tfest`)."""
     from .tfest import tfest
 
     d = mimo_data(data, input, output, detrend, why="transfer-function estimation")
@@ -437,11 +447,13 @@ def several(*names) -> bool:
     return any(len(parse_names(n, "column")) > 1 for n in names)
 
 
-def identify_arx(data: Trajectory, *, input, output, na: int, nb: int, nk: int = 1, detrend: str = "mean"):
+def identify_arx(data: Trajectory, *, input, output, na: int, nb: int, nk: int = 1,
+                 detrend: str = "mean"):
     """MIMO ARX of the named columns (:func:`gripkit.sysid.linear.arx_mimo.arx_mimo`): a
     :class:`~gripkit.sysid.PolynomialModel` of matrix polynomials."""
     d = mimo_data(data, input, output, detrend, why="ARX identification")
-    return arx_mimo(d.u, d.y, na, nb, nk, dt=d.dt, u_offset=d.u_offset, y_offset=d.y_offset, **d.signals)
+    return (arx_mimo(d.u, d.y, na, nb, nk, dt=d.dt, u_offset=d.u_offset, y_offset=d.y_offset,
+                     **d.signals))
 
 
 #: the options of method 'ss' with several records (``weighting``: the subspace method, n4sid,

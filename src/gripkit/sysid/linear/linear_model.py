@@ -57,7 +57,8 @@ def _sim(A, B, C, D, u, x0):
 def free_run(A, B, C, D, u, x0=None) -> np.ndarray:
     """Outputs (N, p) of ``x[t+1] = A x + B u, y = C x + D u`` from ``x0`` (numba kernel)."""
     A, B, C, D = (np.ascontiguousarray(M, dtype=np.float64) for M in (A, B, C, D))
-    return _sim(A, B, C, D, np.ascontiguousarray(u, dtype=np.float64), np.zeros(A.shape[0]) if x0 is None else x0)
+    return (_sim(A, B, C, D, np.ascontiguousarray(u, dtype=np.float64),
+                 np.zeros(A.shape[0]) if x0 is None else x0))
 
 
 def observability_regressor(A, C, N: int) -> np.ndarray:
@@ -436,12 +437,14 @@ class LinearModel(IdentifiedLinearModel):
         set_(self, "u_offset", tuple(float(v) for v in (self.u_offset or (0.0,) * s.n_inputs)))
         set_(self, "y_offset", tuple(float(v) for v in (self.y_offset or (0.0,) * s.n_outputs)))
         if len(self.u_offset) != s.n_inputs or len(self.y_offset) != s.n_outputs:
-            raise ModelError(f"offsets: expected {s.n_inputs} input and {s.n_outputs} output offsets, found "
+            raise ModelError(f"offsets: expected {s.n_inputs} input and {s.n_outputs} output "
+                             "offsets, found "
                              f"{len(self.u_offset)} and {len(self.y_offset)}")
         if self.K is not None:
             K = np.array(self.K, dtype=np.float64).reshape(-1, s.n_outputs)
             if not isinstance(s, StateSpace) or K.shape != (s.n_states, s.n_outputs):
-                raise ModelError(f"K: expected shape (n_states, {s.n_outputs}) on a StateSpace, found {K.shape}")
+                raise ModelError(f"K: expected shape (n_states, {s.n_outputs}) on a StateSpace, "
+                                 f"found {K.shape}")
             set_(self, "K", K)
         set_(self, "display_units", _checked_display_units(self, dict(self.display_units or {})))
 
@@ -456,7 +459,8 @@ class LinearModel(IdentifiedLinearModel):
     def to_dict(self) -> dict:
         """JSON-ready summary (arrays as lists)."""
         ss = self.system.to_ss(minimal=False)
-        out = {"structure": self.structure, "inputs": list(self.inputs), "outputs": list(self.outputs),
+        out = {"structure": self.structure, "inputs": list(self.inputs),
+               "outputs": list(self.outputs),
                "dt": self.dt, "order": ss.n_states, "stable": self.stable,
                "fit_percent": self.fit_percent}
         if isinstance(self.system, StateSpace):
@@ -510,16 +514,19 @@ def model_document(model: IdentifiedLinearModel) -> dict:
         poly, model = model.polynomial_section(), model.linear_record()
     s = model.system
     doc = {"schema": SCHEMA, "schema_version": SCHEMA_VERSION, "gripkit_version": __version__,
-           "structure": model.structure, "kind": "ss" if isinstance(s, StateSpace) else "tf", "dt": s.dt,
+           "structure": model.structure, "kind": "ss" if isinstance(s, StateSpace) else "tf",
+           "dt": s.dt,
            "inputs": [_entry(model, n, u, o)
                       for n, u, o in zip(s.inputs, s.input_units, model.u_offset)],
            "outputs": [_entry(model, n, u, o)
                        for n, u, o in zip(s.outputs, s.output_units, model.y_offset)]}
     doc["system"] = s.to_dict()
     doc["innovation"] = {"K": model.K, "x0": model.x0, "noise_covariance": model.noise_covariance}
-    doc.update(fit_percent=model.fit_percent, singular_values=model.singular_values, n_samples=model.n_samples,
+    doc.update(fit_percent=model.fit_percent, singular_values=model.singular_values,
+               n_samples=model.n_samples,
                info=model.info,
-               data=None if model.data_file is None else {"file": model.data_file, "sha256": model.data_hash})
+               data=None if model.data_file is None else {"file": model.data_file,
+                                                          "sha256": model.data_hash})
     if poly is not None:
         doc["polynomial"] = poly
     return doc
@@ -569,16 +576,23 @@ def _read(path):
     try:
         ins, outs = doc["inputs"], doc["outputs"]
         system = LinearSystem.from_dict(doc["system"])
-        if list(system.inputs) != [d["name"] for d in ins] or list(system.outputs) != [d["name"] for d in outs]:
-            raise ModelError(f"model file {where}: the inputs/outputs lists disagree with the system's names")
+        if list(system.inputs) != [d["name"]
+                                   for d in ins] or list(system.outputs) != [d["name"]
+                                                                             for d in outs]:
+            raise ModelError(f"model file {where}: the inputs/outputs lists disagree with "
+                             "the system's names")
         inn = doc.get("innovation") or {}
-        K, x0, lam = (None if inn.get(k) is None else _arr(inn[k], k, where) for k in ("K", "x0", "noise_covariance"))
+        K, x0, lam = (None if inn.get(k) is None else _arr(inn[k], k, where)
+                      for k in ("K", "x0", "noise_covariance"))
         data = doc.get("data") or {}
         sv = doc.get("singular_values")
         lm = LinearModel(system, doc["structure"], K=K, x0=x0, noise_covariance=lam,
-                           u_offset=[d["offset"] for d in ins], y_offset=[d["offset"] for d in outs],
-                           fit_percent=doc.get("fit_percent"), singular_values=None if sv is None else np.asarray(sv),
-                           n_samples=doc.get("n_samples"), data_file=data.get("file"), data_hash=data.get("sha256"),
+                           u_offset=[d["offset"] for d in ins],
+                           y_offset=[d["offset"] for d in outs],
+                           fit_percent=doc.get("fit_percent"),
+                           singular_values=None if sv is None else np.asarray(sv),
+                           n_samples=doc.get("n_samples"), data_file=data.get("file"),
+                           data_hash=data.get("sha256"),
                            info=doc.get("info") or {},
                            display_units={d["name"]: d["display_unit"] for d in (*ins, *outs)
                                           if d.get("display_unit") is not None})

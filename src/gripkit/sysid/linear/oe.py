@@ -101,7 +101,8 @@ def _oe(u, y, nb, nf, nk, step, maxiter, tol, meta, progress=False) -> Polynomia
         for k in range(nf):  # ∂e/∂z_k = −(free response of the k-th past output)
             ek = np.zeros(nf)
             ek[k] = 1.0
-            free[:, k] = -_sig.lfilter(B, F, zero_u, zi=_sig.lfiltic(B, F, ek, np.zeros(B.size - 1)))[0]
+            free[:, k] = (-_sig.lfilter(B, F, zero_u,
+                                        zi=_sig.lfiltic(B, F, ek, np.zeros(B.size - 1)))[0])
         return e, np.hstack([J, free])
 
     def admissible(theta):
@@ -118,10 +119,12 @@ def _oe(u, y, nb, nf, nk, step, maxiter, tol, meta, progress=False) -> Polynomia
     F = np.concatenate([[1.0], th[nb:p]])
     e = res.e
     return PolynomialModel(np.ones(1), B, nk, F=F, dt=step, structure="oe", covariance=cov,
-                           noise_variance=sigma2, loss=loss_vn(e), fit_percent=fit_percent(yt, yt - e),
+                           noise_variance=sigma2, loss=loss_vn(e),
+                           fit_percent=fit_percent(yt, yt - e),
                            n_samples=int(n), n_used=int(e.size), estimation_residuals=e,
                            info={"method": "prediction-error minimisation (Levenberg-Marquardt), "
-                                           "ARX + instrumental-variable start", "iterations": res.iterations,
+                                           "ARX + instrumental-variable start",
+                                           "iterations": res.iterations,
                                  "converged": res.converged, "cond": cond,
                                  "initial_outputs": th[p:][::-1].tolist()}, **meta)
 

@@ -60,7 +60,8 @@ def predict_errors(A, B, C, D, K, x0, u, y, e):  # pragma: no cover - compiled
 
 @numba.njit(cache=True)
 def _predict_states(A, B, C, D, K, x0, u, y, e, X):  # pragma: no cover - compiled
-    """Prediction errors e (N, p) and, when X has N rows, predictor states X (N, n) (X[t] = x[t])."""
+    """Prediction errors e (N, p) and, when X has N rows, predictor states X (N, n) (X[t] =
+    x[t])."""
     n, p = A.shape[0], C.shape[0]
     store = X.shape[0] == u.shape[0]
     x = x0.copy()
@@ -169,7 +170,8 @@ def _gauss_newton_terms(A, B, C, D, K, x0, u, y, entries):
     _predict_states(A, B, C, D, K, x0, u, y, e, X)
     Q = entries.shape[0] + n
     H, g = np.empty((Q, Q)), np.empty(Q)
-    _sensitivity_gram(np.ascontiguousarray(A - K @ C), np.ascontiguousarray(C), np.ascontiguousarray(K),
+    _sensitivity_gram(np.ascontiguousarray(A - K @ C), np.ascontiguousarray(C),
+                      np.ascontiguousarray(K),
                       entries, n, X, np.ascontiguousarray(u), e, H, g)
     return e, H, g
 
@@ -193,7 +195,8 @@ def _predict_sensitivity(A, B, C, D, K, dA, dB, dC, dD, dK, x0, u, y):
     S0 = np.zeros((d + n, n))
     S0[d:] = np.eye(n)
     J = np.empty((N * p, d + n), order="F")
-    _sensitivities(np.ascontiguousarray(A - K @ C), np.ascontiguousarray(C), F, G, S0, np.hstack([X, u, e]), J)
+    _sensitivities(np.ascontiguousarray(A - K @ C), np.ascontiguousarray(C), F, G, S0,
+                   np.hstack([X, u, e]), J)
     return e, J
 
 
@@ -246,7 +249,8 @@ def _proposal(H, hd, g, lam, directions, system, innovation: bool):
     dA, dB, dC, dD, dK = directions
     A, B, C, D, K = system
     th = delta[:dA.shape[0]]
-    An, Cn, Kn = A + np.tensordot(th, dA, 1), C + np.tensordot(th, dC, 1), K + np.tensordot(th, dK, 1)
+    An, Cn, Kn = (A + np.tensordot(th, dA, 1), C + np.tensordot(th, dC, 1),
+                  K + np.tensordot(th, dK, 1))
     if _radius(An) >= 1.0 or (innovation and _radius(An - Kn @ Cn) >= 1.0):
         return None, delta
     return (An, B + np.tensordot(th, dB, 1), Cn, D + np.tensordot(th, dD, 1), Kn), delta
@@ -294,7 +298,8 @@ def _lm_loop(system, x0, terms, loss, shifted, feedthrough, innovation, max_iter
         if drop < _NEGLIGIBLE_DROP:  # the step moved θ by ≪ 1σ: J before it serves at the optimum
             converged, improved = True, False
             break
-    at_final = (H, (dA, dB, dC, dD, dK), e) if not improved else None   # H at (or ≪ 1σ from) the end
+    # H at (or ≪ 1σ from) the end
+    at_final = (H, (dA, dB, dC, dD, dK), e) if not improved else None
     return A, B, C, D, K, x0, Vc, it, converged, at_final
 
 
@@ -314,14 +319,16 @@ def _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough, innovation, max_
                     lambda x, dx: x + dx, feedthrough, innovation, max_iterations, tol, progress)
 
 
-def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovation", feedthrough: bool | None = None,
+def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovation",
+        feedthrough: bool | None = None,
         max_iterations: int = 50, tol: float = 1e-7, progress: bool = False) -> LinearModel:
     """Refine a discrete state-space model by prediction-error minimisation.
 
     Parameters
     ----------
     model
-        A :class:`LinearModel` with a discrete ``StateSpace`` (e.g. from :func:`gripkit.sysid.n4sid`).
+        A :class:`LinearModel` with a discrete ``StateSpace`` (e.g. from
+        :func:`gripkit.sysid.n4sid`).
     data
         A :class:`~gripkit.signals.Trajectory` with the model's input and output columns (offsets
         removed as recorded in the model), or give ``u`` (N, m) and ``y`` (N, p) in deviation units.
@@ -350,7 +357,8 @@ def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovatio
         raise DataError(f"form: expected 'oe' or 'innovation', found {form!r}")
     if (not isinstance(model, LinearModel) or not isinstance(model.system, StateSpace)
             or not model.system.is_discrete):
-        raise DataError("model: expected a discrete state-space LinearModel (e.g. from gripkit.sysid.n4sid)")
+        raise DataError("model: expected a discrete state-space LinearModel (e.g. from "
+                        "gripkit.sysid.n4sid)")
     ss = model.system
     u, y = _pem_data(model, data, u, y)
     innovation = form == "innovation"
@@ -367,7 +375,8 @@ def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovatio
     label = f"PEM ({form} form)"
     if N > _WARM_START_SAMPLES:  # converge on the first samples, then polish on all of them
         A, B, C, D, K, x0, _, it_warm, _, _ = _levenberg_marquardt(
-            A, B, C, D, K, x0, u[:_WARM_START_SAMPLES], yw[:_WARM_START_SAMPLES], feedthrough, innovation,
+            A, B, C, D, K, x0, u[:_WARM_START_SAMPLES], yw[:_WARM_START_SAMPLES], feedthrough,
+            innovation,
             max_iterations, tol,
             f"{label}, first {_WARM_START_SAMPLES} samples" if progress else None)
     A, B, C, D, K, x0, Vc, it, converged, at_final = _levenberg_marquardt(
@@ -376,19 +385,24 @@ def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovatio
     if progress:
         status(f"{label}: {'converged' if converged else 'NOT converged'} after {it} iteration(s) "
                f"of at most {max_iterations}, loss {V0 / N:.4g} -> {Vc / N:.4g} per sample")
-    cov, (dA, dB, dC, dD), e = _pem_covariance(A, B, C, D, K, x0, u, yw, feedthrough, innovation, at_final)
+    cov, (dA, dB, dC, dD), e = _pem_covariance(A, B, C, D, K, x0, u, yw, feedthrough, innovation,
+                                               at_final)
     # back to physical output units
     C, D, K = Winv @ C, Winv @ D, K @ W
     dC, dD = np.einsum("ij,qjk->qik", Winv, dC), np.einsum("ij,qjk->qik", Winv, dD)
     e = e @ Winv.T
     unc = Uncertainty(tuple(f"theta{i}" for i in range(dA.shape[0])), cov, (dA, dB, dC, dD))
-    sysn = StateSpace(A, B, C, D, **ss._signals(meta={**ss.meta, "refined_by": f"pem-{form}"}), states=ss.states,
+    sysn = StateSpace(A, B, C, D, **ss._signals(meta={**ss.meta, "refined_by": f"pem-{form}"}),
+                      states=ss.states,
                       state_units=ss.state_units, uncertainty=unc)
-    info = {**model.info, "pem": {"form": form, "iterations": it_warm + it, "iterations_warm_start": it_warm,
+    info = {**model.info, "pem": {"form": form, "iterations": it_warm + it,
+                                  "iterations_warm_start": it_warm,
                                   "converged": converged, "loss_start": V0 / N,
-                                  "loss": Vc / N, "parameters": dA.shape[0], "feedthrough": feedthrough}}
+                                  "loss": Vc / N, "parameters": dA.shape[0],
+                                  "feedthrough": feedthrough}}
     return model.replace(system=sysn, structure=f"pem-{form}", K=K if innovation else None, x0=x0,
-                         noise_covariance=e.T @ e / N, fit_percent=fit_per_output(y, free_run(A, B, C, D, u, x0)),
+                         noise_covariance=e.T @ e / N,
+                         fit_percent=fit_per_output(y, free_run(A, B, C, D, u, x0)),
                          n_samples=N, info=info)
 
 
@@ -406,7 +420,8 @@ def _pem_data(model: LinearModel, data, u, y) -> tuple[np.ndarray, np.ndarray]:
     y = as_io_matrix(y, "output y", u.shape[0])
     m, p = ss.n_inputs, ss.n_outputs
     if u.shape[1] != m or y.shape[1] != p:
-        raise DataError(f"data: the model has {m} input(s) and {p} output(s), the data {u.shape[1]} and {y.shape[1]}")
+        raise DataError(f"data: the model has {m} input(s) and {p} output(s), the data "
+                        f"{u.shape[1]} and {y.shape[1]}")
     return u, y
 
 
@@ -417,7 +432,8 @@ def _pem_start(model: LinearModel, u, y, feedthrough: bool, innovation: bool):
     n, m, p = ss.n_states, ss.n_inputs, ss.n_outputs
     A, B, C = ss.A.copy(), ss.B.copy(), ss.C.copy()
     D = ss.D.copy() if feedthrough else np.zeros((p, m))
-    K = (model.K.copy() if model.K is not None else np.zeros((n, p))) if innovation else np.zeros((n, p))
+    K = (model.K.copy() if model.K is not None
+         else np.zeros((n, p))) if innovation else np.zeros((n, p))
     if innovation and _radius(A - K @ C) >= 1.0:
         K = np.zeros((n, p))
     x0 = np.zeros(n) if model.x0 is None else np.array(model.x0, dtype=np.float64)
@@ -431,7 +447,8 @@ def _output_whitening(A, B, C, D, K, x0, u, y) -> tuple[np.ndarray, np.ndarray]:
     predict_errors(A, B, C, D, K, x0, u, y, e)
     w, V = np.linalg.eigh(e.T @ e / u.shape[0])
     if w.min() <= 0:
-        raise IdentificationError("pem: the starting model predicts an output exactly (zero error variance)")
+        raise IdentificationError("pem: the starting model predicts an output exactly (zero "
+                                  "error variance)")
     return (V / np.sqrt(w)) @ V.T, (V * np.sqrt(w)) @ V.T
 
 
@@ -544,7 +561,8 @@ def pem_records(model: LinearModel, records, *, form: str = "innovation",
     (the model's operating point removed). A, B, C, D (and K in innovation form) are shared; every
     record has its own initial state, estimated with them (started from
     ``model.info['records'][i]['x0']`` where the model has them, as from
-    :func:`gripkit.sysid.linear.subspace.n4sid_records`, else the starting model's least-squares x0 of
+    :func:`gripkit.sysid.linear.subspace.n4sid_records`, else the starting model's least-squares x0
+    of
     each record); the prediction errors of all records,
     each predictor started at its own first sample, are minimised together by Levenberg-Marquardt.
     The covariance of the identifiable directions is σ²(JᵀJ)⁻¹ with σ² over Σ N_i·p − d − R·n
@@ -618,5 +636,6 @@ def pem_records(model: LinearModel, records, *, form: str = "innovation",
             "pem": {"form": form, "iterations": it, "converged": converged, "loss_start": V0 / N,
                     "loss": Vc / N, "parameters": d, "feedthrough": feedthrough}}
     return model.replace(system=sysn, structure=f"pem-{form}", K=K if innovation else None,
-                         x0=x0s[0], noise_covariance=E.T @ E / N, fit_percent=records_fit(ys, yhats).tolist(),
+                         x0=x0s[0], noise_covariance=E.T @ E / N,
+                         fit_percent=records_fit(ys, yhats).tolist(),
                          n_samples=N, info=info)

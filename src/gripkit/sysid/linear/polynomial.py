@@ -182,12 +182,14 @@ class PolynomialModel(IdentifiedLinearModel):
         set_(self, "C", _coeffs(self.C, "C", True))
         set_(self, "F", _coeffs(self.F, "F", True))
         if self.structure not in _STRUCTURES:
-            raise ModelError(f"structure: expected one of {', '.join(_STRUCTURES)}, found {self.structure!r}")
+            raise ModelError(f"structure: expected one of {', '.join(_STRUCTURES)}, found "
+                             f"{self.structure!r}")
         nk = int(self.nk)
         if nk < 0 or nk >= self.B.size:
             raise ModelError(f"nk={self.nk} must lie in [0, len(B)-1 = {self.B.size - 1}]")
         if any(self.B[:nk].tolist()):  # a nonzero leading entry (NaN was refused above)
-            raise ModelError(f"B must start with nk={nk} zeros (MATLAB layout), found {self.B[:nk].tolist()}")
+            raise ModelError(f"B must start with nk={nk} zeros (MATLAB layout), found "
+                             f"{self.B[:nk].tolist()}")
         set_(self, "nk", nk)
         if not (math.isfinite(self.dt) and self.dt > 0):
             raise ModelError(f"dt: expected a positive sample interval in s, found {self.dt!r}")
@@ -268,7 +270,8 @@ class PolynomialModel(IdentifiedLinearModel):
     # ------------------------------------------------------------------ construction
     @classmethod
     def from_coefficients(cls, A, B, *, nk: int | None = None, C=(1.0,), F=(1.0,), dt: float = 1.0,
-                          structure: str | None = None, std: dict | None = None, **kw) -> "PolynomialModel":
+                          structure: str | None = None, std: dict | None = None,
+                          **kw) -> "PolynomialModel":
         """A model with known coefficients (no estimation diagnostics).
 
         ``nk`` defaults to the number of leading zeros of ``B``. ``std`` may give one-sigma
@@ -293,7 +296,8 @@ class PolynomialModel(IdentifiedLinearModel):
         for k, arr, sl in m._blocks():
             s = np.asarray(std.get(k, np.zeros(arr.size)), dtype=np.float64)
             if s.shape != arr.shape:
-                raise ModelError(f"std[{k!r}]: expected {arr.size} values (the layout of {k}), found {s.size}")
+                raise ModelError(f"std[{k!r}]: expected {arr.size} values (the layout of "
+                                 f"{k}), found {s.size}")
             var.append(s[sl] ** 2)
         return m.replace(covariance=np.diag(np.concatenate(var)))
 
@@ -324,8 +328,10 @@ class PolynomialModel(IdentifiedLinearModel):
             loss = 0.5 * float(e @ e) / e.size
             floor = 1e-24 * float(np.mean(np.square(y[self.start:])))  # rounding of noise-free fits
             if abs(loss - self.loss) > 1e-8 * self.loss + floor:
-                raise DataError(f"residuals: the estimation record (u, y) was changed in place after the fit "
-                                f"(its one-step loss is now {loss:.6g}, the fit's was {self.loss:.6g}); compute "
+                raise DataError("residuals: the estimation record (u, y) was changed in "
+                                "place after the fit "
+                                f"(its one-step loss is now {loss:.6g}, the fit's was "
+                                f"{self.loss:.6g}); compute "
                                 f"errors on the data you hold with model.prediction_errors(u, y)")
         e.flags.writeable = False
         return e
@@ -443,13 +449,17 @@ class PolynomialModel(IdentifiedLinearModel):
         raise KeyError(which)
 
     A_std = property(lambda self: self._std_layout("A"),
-                     doc="One-sigma uncertainty of each entry of ``A`` (0 for the fixed leading 1).")
+                     doc="One-sigma uncertainty of each entry of ``A`` (0 for the "
+                         "fixed leading 1).")
     B_std = property(lambda self: self._std_layout("B"),
-                     doc="One-sigma uncertainty of each entry of ``B`` (0 for the ``nk`` fixed leading zeros).")
+                     doc="One-sigma uncertainty of each entry of ``B`` (0 for the ``nk`` fixed "
+                         "leading zeros).")
     C_std = property(lambda self: self._std_layout("C"),
-                     doc="One-sigma uncertainty of each entry of ``C`` (0 for the fixed leading 1).")
+                     doc="One-sigma uncertainty of each entry of ``C`` (0 for the "
+                         "fixed leading 1).")
     F_std = property(lambda self: self._std_layout("F"),
-                     doc="One-sigma uncertainty of each entry of ``F`` (0 for the fixed leading 1).")
+                     doc="One-sigma uncertainty of each entry of ``F`` (0 for the "
+                         "fixed leading 1).")
 
     @property
     def parameters(self):
@@ -462,8 +472,10 @@ class PolynomialModel(IdentifiedLinearModel):
         bunit = ratio_unit(self.output_unit, self.input_unit)
         params = []
         for i, (n, v) in enumerate(zip(self.parameter_names, self.theta)):
-            doc = {"a": f"coefficient of q^-{n[1:]} in A(q)", "b": f"coefficient of q^-{n[1:]} in B(q)",
-                   "c": f"coefficient of q^-{n[1:]} in C(q)", "f": f"coefficient of q^-{n[1:]} in F(q)"}[n[0]]
+            doc = {"a": f"coefficient of q^-{n[1:]} in A(q)",
+                   "b": f"coefficient of q^-{n[1:]} in B(q)",
+                   "c": f"coefficient of q^-{n[1:]} in C(q)",
+                   "f": f"coefficient of q^-{n[1:]} in F(q)"}[n[0]]
             params.append(Parameter(n, float(v), bunit if n[0] == "b" else "1", doc, source=src,
                                     std=None if std is None else float(std[i])))
         return ParameterSet(params, name=self.label)
@@ -531,7 +543,8 @@ class PolynomialModel(IdentifiedLinearModel):
                                   inputs=self.input_name, outputs=self.output_name,
                                   input_units=self.input_unit, output_units=self.output_unit)
         return TransferFunction.from_polynomials(
-            self.A, self.B, C=self.C if self.nc else None, F=self.F, dt=self.dt, covariance=self.covariance,
+            self.A, self.B, C=self.C if self.nc else None, F=self.F, dt=self.dt,
+            covariance=self.covariance,
             inputs=self.input_name, outputs=self.output_name, input_units=self.input_unit,
             output_units=self.output_unit)
 
@@ -634,7 +647,8 @@ class PolynomialModel(IdentifiedLinearModel):
         if initial != "given":
             raise DataError(f"initial: expected 'rest' or 'given', found {initial!r}")
         g = self.system
-        x0 = g.initial_state(np.zeros(0) if u_past is None else u_past, np.zeros(0) if y_past is None else y_past)
+        x0 = (g.initial_state(np.zeros(0) if u_past is None else u_past,
+                              np.zeros(0) if y_past is None else y_past))
         return g.simulate(u, x0)[:, 0]
 
     def prediction_errors(self, u, y) -> np.ndarray:
@@ -657,7 +671,8 @@ class PolynomialModel(IdentifiedLinearModel):
                                 f"samples, found {y.shape[0]}")
             return mp.prediction_errors(self.A, self.B, u, y, t0)
         if y.size <= t0:
-            raise DataError(f"one-step prediction with {self.label} needs more than {t0} samples, found {y.size}")
+            raise DataError(f"one-step prediction with {self.label} needs more than {t0} "
+                            f"samples, found {y.size}")
         if self.structure == "oe":
             return y[t0:] - self.simulate(u[t0:], initial="given", y_past=y[:t0], u_past=u[:t0])
         # the FIR parts by np.convolve: scipy.signal's import is 0.9 s of a fresh ARX process
@@ -912,7 +927,8 @@ class PolynomialModel(IdentifiedLinearModel):
                          f"AIC = {self.aic:.5g}, N = {self.n_samples}")
         fmt = lambda z: ", ".join(f"{v.real:.4g}{v.imag:+.4g}j" for v in z) or "none"  # noqa: E731
         lines.append(f"  poles: {fmt(self.poles())}")
-        lines.append(f"  zeros: {fmt(self.zeros())} ({'minimum' if self.minimum_phase else 'NON-minimum'} phase)")
+        lines.append(f"  zeros: {fmt(self.zeros())} "
+                     f"({'minimum' if self.minimum_phase else 'NON-minimum'} phase)")
         return "\n".join(lines)
 
     def _matrix_summary(self) -> str:
@@ -936,7 +952,8 @@ class PolynomialModel(IdentifiedLinearModel):
         if self.multivariable:
             return (f"PolynomialModel({self.label}, inputs={list(self.inputs)}, "
                     f"outputs={list(self.outputs)}, dt={self.dt:g})")
-        return f"PolynomialModel({self.label}, A={self.A.tolist()}, B={self.B.tolist()}, dt={self.dt:g})"
+        return (f"PolynomialModel({self.label}, A={self.A.tolist()}, B={self.B.tolist()}, "
+                f"dt={self.dt:g})")
 
 
 def _per_channel(value, name: str, default, n: int) -> tuple:
@@ -1001,7 +1018,8 @@ def _matrix_document(doc: dict) -> bool:
     return doc.get("structure") == "arx" and "A_poly" in info and "B_poly" in info
 
 
-#: the ``**meta`` keywords of :func:`~gripkit.sysid.linear.arx`, :func:`~gripkit.sysid.linear.armax` and :func:`~gripkit.sysid.linear.oe`
+# : the ``**meta`` keywords of :func:`~gripkit.sysid.linear.arx`,
+# :func:`~gripkit.sysid.linear.armax` and :func:`~gripkit.sysid.linear.oe`
 META_KEYS = ("input_name", "output_name", "input_unit", "output_unit", "u_offset", "y_offset")
 
 
@@ -1011,7 +1029,8 @@ def check_meta(meta: dict, fn) -> None:
     if all(k in META_KEYS for k in meta):  # the usual case: no signature to read (~30 µs)
         return
     name = fn.__name__
-    check_keywords(meta, META_KEYS, f"{name}()", hint=f"{name} accepts {', '.join(keyword_names(fn))} and the "
+    check_keywords(meta, META_KEYS, f"{name}()",
+                   hint=f"{name} accepts {', '.join(keyword_names(fn))} and the "
                                                       f"metadata {', '.join(META_KEYS)}")
 
 

@@ -36,7 +36,8 @@ gains φφᵀ), and the trace limit bounds it above.
 
 Uncertainty: the noise variance is tracked as σ̂² = V/(w₁ − p) with the weighted residual sum
 ``V ← λV + λe²/(λ + r)`` and effective sample count ``w₁ ← λw₁ + 1``; the parameter covariance
-is ``σ̂² P · w₂/w₁`` with ``w₂ ← λ²w₂ + 1`` (asymptotically exact for stationary regressors: weighted least
+is ``σ̂² P · w₂/w₁`` with ``w₂ ← λ²w₂ + 1`` (asymptotically exact for stationary regressors:
+weighted least
 squares with weights λᵏ has covariance σ² R⁻¹(Σλ²ᵏφφᵀ)R⁻¹; for λ = 1 it is σ̂²P, the least-squares
 covariance). With λ = 1 and a large P0 the RLS estimate equals the least-squares one.
 """
@@ -349,7 +350,8 @@ def _rls_run(s, u, y, theta_out, std_out, yhat_out, err_out, size):
     p, na, nb and nk zeros (:meth:`RLS._kernel_size`), whose lengths numba knows at compile time: it
     compiles (and caches) one kernel per model structure, with unrolled p-loops and constant
     regressor indices (faster: docs/performance.md, "RLS"); :meth:`RLS.run` uses it for records of
-    at least :data:`SPECIALISE_ABOVE` samples, where the extra compilation (once) pays off. The first
+    at least :data:`SPECIALISE_ABOVE` samples, where the extra compilation (once) pays off. The
+    first
     ``t0`` samples go through :func:`_rls_step` (their regressors need the buffered past); the rest
     take the regressor straight from ``u`` and ``y`` with θ and P in local arrays. Both call
     :func:`_core`, so streaming and batch results are bit-identical.
@@ -476,7 +478,8 @@ class RLS:
                  "_step")
 
     def __init__(self, na: int, nb: int, nk: int = 1, *, forgetting: float = 1.0, p0: float = 1e4,
-                 theta0=None, windup: str = "trace", max_trace: float | None = None, dt: float = 1.0):
+                 theta0=None, windup: str = "trace", max_trace: float | None = None,
+                 dt: float = 1.0):
         self.na = check_order(na, "na", 0)
         self.nb = check_order(nb, "nb", 1)
         self.nk = check_order(nk, "nk", 0)
@@ -534,7 +537,8 @@ class RLS:
 
     @property
     def names(self) -> tuple[str, ...]:
-        return tuple(f"a{i}" for i in range(1, self.na + 1)) + tuple(f"b{self.nk + j}" for j in range(self.nb))
+        return (tuple(f"a{i}" for i in range(1, self.na + 1))
+                + tuple(f"b{self.nk + j}" for j in range(self.nb)))
 
     def update(self, u: float, y: float) -> float:
         """Process one sample (input u(t), output y(t)); returns the a-priori prediction error.
@@ -574,7 +578,8 @@ class RLS:
         status = self._s[_STATUS]
         self._s[_STATUS] = 0.0
         if status == 1.0:
-            raise DataError(f"RLS.update: sample {self.n_samples} is not finite (u={u:.6g}, y={y:.6g}); "
+            raise DataError(f"RLS.update: sample {self.n_samples} is not finite "
+                            f"(u={u:.6g}, y={y:.6g}); "
                             f"the estimator is unchanged",
                             hint="skip or interpolate missing samples before passing them")
         if status == 4.0:
@@ -588,16 +593,19 @@ class RLS:
         if status == 3.0:
             raise IdentificationError(
                 f"RLS [{self.na} {self.nb} {self.nk}]: φᵀPφ overflows at sample {self.n_samples} "
-                f"(u={u:.6g}, y={y:.6g}, trace P = {self._s[_TRACE]:.3g}): the regressor's values are too "
+                f"(u={u:.6g}, y={y:.6g}, trace P = {self._s[_TRACE]:.3g}): the regressor's "
+                "values are too "
                 f"large for float64 with this P; the estimator is unchanged",
                 hint="scale u and y to order 1 (other units) and reset() the estimator")
-        raise self._diverged(f"at update {self.n_updates + 1}; the estimator is left at its last finite "
+        raise self._diverged(f"at update {self.n_updates + 1}; the estimator is left at "
+                             "its last finite "
                              f"state (reset() it)")
 
     def _diverged(self, when: str) -> IdentificationError:
         return IdentificationError(
             f"RLS [{self.na} {self.nb} {self.nk}] diverged {when}: P or θ is no longer finite "
-            f"(forgetting λ = {self.forgetting:g}, windup={self.windup!r}); the covariance wound up on "
+            f"(forgetting λ = {self.forgetting:g}, windup={self.windup!r}); the "
+            "covariance wound up on "
             f"data that do not excite every direction",
             hint="use windup='trace' or 'directional', or a forgetting factor closer to 1")
 
@@ -636,7 +644,8 @@ class RLS:
 
     @property
     def covariance(self) -> np.ndarray | None:
-        """Parameter covariance σ̂² P w₂/w₁ (see the module docstring), or None before p+1 updates."""
+        """Parameter covariance σ̂² P w₂/w₁ (see the module docstring), or None before p+1
+        updates."""
         s2 = self.noise_variance
         if s2 is None:
             return None
@@ -652,7 +661,8 @@ class RLS:
         th = self.theta
         A = np.concatenate([[1.0], th[:self.na]])
         B = np.concatenate([np.zeros(self.nk), th[self.na:]])
-        return PolynomialModel(A, B, self.nk, dt=self.dt, structure="arx", covariance=self.covariance,
+        return PolynomialModel(A, B, self.nk, dt=self.dt, structure="arx",
+                               covariance=self.covariance,
                                noise_variance=self.noise_variance,
                                info={"method": f"recursive least squares (λ={self.forgetting:g}, "
                                                f"windup={self.windup})"}, **meta)
@@ -666,7 +676,8 @@ class RLS:
     def _check_scale(self, u: np.ndarray, y: np.ndarray, peaks: tuple | None = None) -> None:
         """Refuse signals whose scale the recursion cannot represent next to the current P:
 
-        * φᵀPφ <= ‖φ‖²·trace P must stay finite: ``p·max(|u|,|y|)²·trace P`` below the float64 limit;
+        * φᵀPφ <= ‖φ‖²·trace P must stay finite: ``p·max(|u|,|y|)²·trace P`` below the float64
+        limit;
         * the data must outweigh the prior: the RLS estimate minimises
           ``Σe² + (θ − θ0)ᵀP0⁻¹(θ − θ0)``, so a parameter whose regressor energy ``Σφ_j²`` is below
           ``1/P_jj`` stays (more than half-way) at its prior value: θ0 returned as if estimated.
@@ -679,9 +690,11 @@ class RLS:
         peak = max(stats["input u"][0], stats["output y"][0])
         if peak > 0 and math.log10(p) + 2 * math.log10(peak) + math.log10(tr) > 307.0:
             raise DataError(
-                f"RLS [{self.na} {self.nb} {self.nk}]: values up to {peak:.3g} in u and y make φᵀPφ "
+                f"RLS [{self.na} {self.nb} {self.nk}]: values up to {peak:.3g} in u "
+                "and y make φᵀPφ "
                 f"overflow float64 (trace P = {tr:.3g}), so the recursion cannot run on them",
-                hint="scale u and y to order 1 (other units); arx(), armax() and oe() scale internally")
+                hint="scale u and y to order 1 (other units); arx(), armax() and oe() "
+                     "scale internally")
         for label, x, idx in (("output y", y, range(self.na)), ("input u", u, range(self.na, p))):
             if not len(idx):
                 continue
@@ -696,10 +709,13 @@ class RLS:
             if log_energy + math.log10(prior) < 0.0:
                 names = ", ".join(self.names[i] for i in idx)
                 raise IdentificationError(
-                    f"RLS [{self.na} {self.nb} {self.nk}]: the {label} (values up to {mx:.3g}) carries "
+                    f"RLS [{self.na} {self.nb} {self.nk}]: the {label} (values up to "
+                    f"{mx:.3g}) carries "
                     f"almost no information next to the prior P = {prior:.3g}·I: Σ{label[-1]}² = "
-                    f"10^{log_energy:.0f} is below 1/P, so {names} would stay at their initial values",
-                    hint=f"scale u and y to order 1 (other units), or raise p0 above 1/Σ{label[-1]}²")
+                    f"10^{log_energy:.0f} is below 1/P, so {names} would stay at "
+                    "their initial values",
+                    hint="scale u and y to order 1 (other units), or raise p0 above "
+                         f"1/Σ{label[-1]}²")
 
     def _check_corrupt(self, u: np.ndarray, y: np.ndarray) -> tuple[float, float]:
         """Refuse a record with a corrupt sample by the rule of :meth:`update` (a magnitude above
@@ -860,10 +876,12 @@ class RLSResult:
 
     def to_dict(self) -> dict:
         m = self.model
-        return dict(structure="arx-rls", na=self.na, nb=self.nb, nk=self.nk, forgetting=self.forgetting,
+        return dict(structure="arx-rls", na=self.na, nb=self.nb, nk=self.nk,
+                    forgetting=self.forgetting,
                     windup=self.windup, parameter_names=list(self.names),
                     theta_final=self.theta_final.tolist(),
-                    theta_std_final=None if self.theta_std_final is None else self.theta_std_final.tolist(),
+                    theta_std_final=None if self.theta_std_final is None
+                    else self.theta_std_final.tolist(),
                     A=m.A.tolist(), B=m.B.tolist(),
                     A_std=None if m.A_std is None else m.A_std.tolist(),
                     B_std=None if m.B_std is None else m.B_std.tolist(), loss=self.loss,
@@ -892,7 +910,8 @@ class RLSResult:
 
 
 @entry_point
-def rls(u, y, na: int, nb: int, nk: int = 1, *, forgetting: float = 1.0, p0: float = 1e4, theta0=None,
+def rls(u, y, na: int, nb: int, nk: int = 1, *, forgetting: float = 1.0, p0: float = 1e4,
+        theta0=None,
         windup: str = "trace", max_trace: float | None = None, dt: float | None = None,
         store: bool = True) -> RLSResult:
     """Recursive least squares over a record (numba batch kernel): θ and σ at every step.

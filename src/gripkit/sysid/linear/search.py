@@ -77,7 +77,8 @@ class SearchResult:
 
 
 def parse_range(text: str | int | Iterable[int], name: str) -> list[int]:
-    """``'1:4'`` → [1, 2, 3, 4] (inclusive, MATLAB style), ``'2'`` → [2], ``'1,3,5'`` → [1, 3, 5]."""
+    """``'1:4'`` → [1, 2, 3, 4] (inclusive, MATLAB style), ``'2'`` → [2], ``'1,3,5'`` → [1, 3,
+    5]."""
     if isinstance(text, (int, np.integer)):
         return [int(text)]
     if not isinstance(text, str):
@@ -100,7 +101,8 @@ def parse_range(text: str | int | Iterable[int], name: str) -> list[int]:
             return list(range(lo, hi + 1, step))
         return [int(x) for x in t.split(",")]
     except ValueError:
-        raise DataError(f"{name}: expected a range like '1:4', '1:2:9' or '1,3,5', found {text!r}") from None
+        raise DataError(f"{name}: expected a range like '1:4', '1:2:9' or "
+                        f"'1,3,5', found {text!r}") from None
 
 
 @entry_point
@@ -130,7 +132,8 @@ def structure_search(u, y, na=range(1, 5), nb=range(1, 5), nk=range(1, 11), *,
         uv, yv = check_io(*validate)
         criterion = "validation"
     elif criterion == "validation":
-        raise DataError("criterion 'validation' needs a validation record (validate=(u2, y2); CLI: --validate)")
+        raise DataError("criterion 'validation' needs a validation record (validate=(u2, y2); "
+                        "CLI: --validate)")
     if criterion not in CRITERIA:
         raise DataError(f"criterion: expected one of {', '.join(CRITERIA)}, found {criterion!r}")
     nas = [check_order(v, "na", 0) for v in parse_range(na, "na")]
@@ -138,7 +141,8 @@ def structure_search(u, y, na=range(1, 5), nb=range(1, 5), nk=range(1, 11), *,
     nks = [check_order(v, "nk", 0) for v in parse_range(nk, "nk")]
     t0 = max(max(nas), max(nks) + max(nbs) - 1)
     pmax = max(nas) + max(nbs)
-    check_identifiable(u, y, t0 + pmax + 1, f"structure search up to na={max(nas)}, nb={max(nbs)}, nk={max(nks)}")
+    check_identifiable(u, y, t0 + pmax + 1, f"structure search up to na={max(nas)}, "
+                                            f"nb={max(nbs)}, nk={max(nks)}")
     cu, cy = unit_scale(u), unit_scale(y)  # exact powers of two (see scaling): any data scale
     u, y = u * cu, y * cy
     yt = y[t0:]
@@ -146,7 +150,8 @@ def structure_search(u, y, na=range(1, 5), nb=range(1, 5), nk=range(1, 11), *,
     m = y.size - t0
     grid = [(a, b, k) for a in nas for b in nbs for k in nks]
     found, skipped = [], []
-    for a, b, k in track(grid, description="ARX structure search", enabled=progress and len(grid) * y.size > 2e6):
+    for a, b, k in track(grid, description="ARX structure search",
+                         enabled=progress and len(grid) * y.size > 2e6):
         names = tuple(f"a{i}" for i in range(1, a + 1)) + tuple(f"b{k + j}" for j in range(b))
         try:
             sol = qr_solve(arx_regression(u, y, a, b, k, t0=t0), names, overwrite=True, warn=False)
@@ -158,7 +163,8 @@ def structure_search(u, y, na=range(1, 5), nb=range(1, 5), nk=range(1, 11), *,
         aic = m * (math.log(2 * math.pi * v) - 2 * math.log(cy)) + m + 2 * p if v > 0 else -math.inf
         fpe = v * (1 + p / m) / (1 - p / m) / cy / cy
         fit = 100.0 * (1.0 - math.sqrt(sol.rss / sst))
-        vfit = _validation_fit(sol.theta, a, b, k, step, uv * cu, yv * cy) if validate is not None else None
+        vfit = (_validation_fit(sol.theta, a, b, k, step, uv * cu,
+                                yv * cy) if validate is not None else None)
         found.append(Candidate(a, b, k, p, 0.5 * v / cy / cy, aic, fpe, fit, vfit))
     if not found:
         raise UnidentifiableError("no structure of the search could be identified: "
@@ -173,7 +179,8 @@ def structure_search(u, y, na=range(1, 5), nb=range(1, 5), nk=range(1, 11), *,
 
 def _validation_fit(theta, na, nb, nk, dt, u, y) -> float | None:
     """Free-run fit (%) of the ARX [na nb nk] with coefficients θ on (u, y); None if unstable."""
-    model = PolynomialModel(np.concatenate([[1.0], theta[:na]]), np.concatenate([np.zeros(nk), theta[na:]]), nk,
+    model = PolynomialModel(np.concatenate([[1.0], theta[:na]]),
+                            np.concatenate([np.zeros(nk), theta[na:]]), nk,
                             dt=dt, structure="arx")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # an unstable candidate simply ranks last
@@ -181,8 +188,11 @@ def _validation_fit(theta, na, nb, nk, dt, u, y) -> float | None:
 
 
 def _warn_edge(best: Candidate, ranges: dict) -> None:
-    edges = [f"{name} = {getattr(best, name)} (searched {min(r)}:{max(r)})" for name, r in ranges.items()
+    edges = [f"{name} = {getattr(best, name)} (searched "
+             f"{min(r)}:{max(r)})" for name, r in ranges.items()
              if len(set(r)) >= 3 and getattr(best, name) in (min(r), max(r))]
     if edges:
-        emit_warning(f"structure search: the best structure lies on the edge of the searched range: "
-                     f"{', '.join(edges)}; the best may lie outside it, widen the range", GripkitWarning)
+        emit_warning("structure search: the best structure lies on the edge of the "
+                     "searched range: "
+                     f"{', '.join(edges)}; the best may lie outside it, "
+                     "widen the range", GripkitWarning)

@@ -155,14 +155,17 @@ def subspace_factor(u, y, *, horizon: int, method: str) -> SubspaceFactor:
     j = N - 2 * horizon + 1
     q = 2 * horizon * (m + p)
     if j < 2 * q:
-        raise DataError(f"data: {N} samples of {m} input(s) and {p} output(s) with horizon k = {horizon} give "
-                        f"{max(j, 0)} Hankel columns, fewer than the {2 * q} needed (2 × 2k(m + p)); "
+        raise DataError(f"data: {N} samples of {m} input(s) and {p} output(s) with horizon k = "
+                        f"{horizon} give "
+                        f"{max(j, 0)} Hankel columns, fewer than the {2 * q} needed "
+                        "(2 × 2k(m + p)); "
                         f"at least {2 * q + 2 * horizon - 1} samples are required",
                         hint="use a longer record, fewer outputs or a smaller --order/horizon")
     for name, x in (("input", u), ("output", y)):
         rms = np.sqrt(np.mean(x * x, axis=0))
         if np.any(rms == 0):
-            raise DataError(f"{name} channel {int(np.argmin(rms))} is identically zero: it carries no information",
+            raise DataError(f"{name} channel {int(np.argmin(rms))} is identically zero: it "
+                            "carries no information",
                             hint="drop that column or check the data")
     return SubspaceFactor(u, y, horizon, method)
 
@@ -184,12 +187,14 @@ def select_order(s: np.ndarray, n_max: int) -> int:
 def _check_supported(fac: SubspaceFactor, n: int) -> None:
     kp = fac.s.size
     if n >= kp:
-        raise IdentificationError(f"order: {n} states need a horizon k with k·p > {n}; the horizon k = {fac.k} "
+        raise IdentificationError(f"order: {n} states need a horizon k with k·p > {n}; the "
+                                  f"horizon k = {fac.k} "
                                   f"with p = {fac.p} output(s) supports at most {kp - 1}",
                                   hint="lower --order or pass a larger horizon")
     if fac.s[n - 1] <= 1e-10 * fac.s[0]:
         r = int(np.sum(fac.s > 1e-10 * fac.s[0]))
-        raise IdentificationError(f"order: the data support at most {r} state(s) (singular value {n} is "
+        raise IdentificationError(f"order: the data support at most {r} state(s) "
+                                  f"(singular value {n} is "
                                   f"{fac.s[n - 1] / fac.s[0]:.2g} of the first), found order = {n}",
                                   hint=f"use --order {r} or less, or excite the system more richly")
 
@@ -272,7 +277,8 @@ def _bdx_least_squares(A, C, u, y, feedthrough: bool) -> np.ndarray:
     n, m, p = A.shape[0], u.shape[1], C.shape[0]
     cols = n * m + (p * m if feedthrough else 0) + n
     G, rhs = np.empty((cols, cols)), np.empty(cols)
-    _bdx_normal_equations(np.ascontiguousarray(A), np.ascontiguousarray(C), u, y, feedthrough, G, rhs)
+    _bdx_normal_equations(np.ascontiguousarray(A), np.ascontiguousarray(C), u, y, feedthrough, G,
+                          rhs)
     col = np.sqrt(np.diag(G)).copy()
     col[col == 0] = 1.0
     Gs = G / np.outer(col, col)
@@ -296,7 +302,8 @@ def _kalman_gain(A, C, Q, S, R):
     return K, 0.5 * (Lam + Lam.T)
 
 
-def from_factor(fac: SubspaceFactor, n: int, *, dt: float, feedthrough: bool = False, stable: bool = True,
+def from_factor(fac: SubspaceFactor, n: int, *, dt: float, feedthrough: bool = False,
+                stable: bool = True,
                 signals: dict | None = None, meta: dict | None = None) -> LinearModel:
     """The order-n model from a factored data set (see the module docstring)."""
     p, m = fac.p, fac.m
@@ -324,7 +331,8 @@ def from_factor(fac: SubspaceFactor, n: int, *, dt: float, feedthrough: bool = F
     Q, S, R = w.T @ w / nw, w.T @ v / nw, v.T @ v / nw
     Ks, Lam = _kalman_gain(A, C, Q, S, R)
     if Ks is None:
-        info["noise_model"] = "Riccati equation without a stabilising solution: K = 0 (output-error form)"
+        info["noise_model"] = ("Riccati equation without a stabilising solution: K = 0 "
+                               "(output-error form)")
         Ks, Lam = np.zeros((n, p)), R
     # back to physical units
     su, sy = fac.su, fac.sy
@@ -416,7 +424,8 @@ def _orders(order, max_order) -> tuple:
 
 def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int | None = None,
           dt: float | None = None, feedthrough: bool = False, stable: bool = True,
-          max_order: int = DEFAULT_MAX_ORDER, inputs=None, outputs=None, input_units=None, output_units=None,
+          max_order: int = DEFAULT_MAX_ORDER, inputs=None, outputs=None, input_units=None,
+          output_units=None,
           u_offset=None, y_offset=None) -> LinearModel:
     """Subspace identification of a discrete MIMO state-space model in innovation form.
 
@@ -469,9 +478,11 @@ def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int
     k = default_horizon(n_max, p) if horizon is None else int(horizon)
     fac = subspace_factor(u, y, horizon=k, method=method)
     n = order if order is not None else select_order(fac.s, min(n_max, fac.s.size - 1))
-    signals = dict(inputs=inputs, outputs=outputs, input_units=input_units, output_units=output_units)
+    signals = (dict(inputs=inputs, outputs=outputs, input_units=input_units,
+                    output_units=output_units))
     model = from_factor(fac, n, dt=step, feedthrough=feedthrough, stable=stable, signals=signals)
-    model.info["order_selection"] = "given" if order is not None else "singular values above the noise floor"
+    model.info["order_selection"] = ("given" if order is not None
+                                     else "singular values above the noise floor")
     warn_if_stabilised(model)
     return model.replace(u_offset=u_offset, y_offset=y_offset)
 
@@ -566,7 +577,8 @@ def from_records_factor(fac: RecordsFactor, n: int, *, dt: float, feedthrough: b
     """:func:`from_factor` for several records: A, C from the pooled factor; B, D shared and one
     x0 per record by least squares over all records; the noise model from the state sequences of
     every record. ``fit_percent``: the free run of all records per output, each from its own x0
-    (:func:`~gripkit.sysid.linear.validation.records_fit`); ``info['records']``: each record's samples,
+    (:func:`~gripkit.sysid.linear.validation.records_fit`); ``info['records']``: each record's
+    samples,
     free-run fit and x0 (the model's ``x0`` is the first record's)."""
     p, m = fac.p, fac.m
 

@@ -2,7 +2,8 @@
 
     G(s) = (b_0 s^nz + … + b_nz) / (s^np + a_1 s^{np−1} + … + a_np),   θ = [a_1 … a_np, b_0 … b_nz].
 
-* From an FRF (:class:`~gripkit.sysid.linear.frf.FRF` with σ per line): Sanathanan-Koerner iterations
+* From an FRF (:class:`~gripkit.sysid.linear.frf.FRF` with σ per line): Sanathanan-Koerner
+iterations
   (linear least squares of ``(A(jω)Ĥ − B(jω))/(A_prev(jω) σ)``, frequency scaled to 1 for
   conditioning) give the start; then weighted nonlinear least squares of
   ``(Ĥ_k − G(jω_k))/σ_k`` with the exact Jacobian ``∂G/∂b_i = s^{nz−i}/A``,
@@ -41,7 +42,8 @@ def _check_orders(n_poles, n_zeros):
     n_poles = check_order(n_poles, "poles", 1)
     n_zeros = check_order(n_zeros, "zeros", 0)
     if n_zeros > n_poles:
-        raise DataError(f"zeros: expected at most as many zeros as poles ({n_poles}), found {n_zeros}",
+        raise DataError(f"zeros: expected at most as many zeros as poles ({n_poles}), "
+                        f"found {n_zeros}",
                         hint="an improper transfer function cannot be simulated")
     return n_poles, n_zeros
 
@@ -60,7 +62,8 @@ def _sk(s, H, wgt, npo, nz, iterations=20):
     theta = None
     for _ in range(iterations):
         # A(s) H − B(s) = 0 → Σ a_i s^{np−i} H − Σ b_i s^{nz−i} = −s^np H
-        cols = [s ** (npo - i) * H for i in range(1, npo + 1)] + [-s ** (nz - i) for i in range(nz + 1)]
+        cols = ([s ** (npo - i) * H for i in range(1, npo + 1)]
+                + [-s ** (nz - i) for i in range(nz + 1)])
         M = np.column_stack(cols) * (wgt / np.abs(Aprev))[:, None]
         rhs = -s ** npo * H * wgt / np.abs(Aprev)
         Mr = np.vstack([M.real, M.imag])
@@ -117,21 +120,26 @@ def _covariance(J, s2, what, hint):
     error); a Jacobian that is singular to working precision (a flat direction) is refused."""
     _, sv, vt = np.linalg.svd(J, full_matrices=False)
     if sv[-1] <= max(J.shape) * np.finfo(float).eps * sv[0]:
-        raise IdentificationError(f"tfest: {what} do not determine the coefficients (singular Jacobian, "
+        raise IdentificationError(f"tfest: {what} do not determine the coefficients "
+                                  "(singular Jacobian, "
                                   f"condition number {sv[0] / max(sv[-1], 1e-300):.3g})", hint=hint)
     return s2 * (vt.T / sv ** 2) @ vt
 
 
-def _model(theta, cov, npo, nz, *, fit, structure, info, signals, u_offset=None, y_offset=None, n=None):
+def _model(theta, cov, npo, nz, *, fit, structure, info, signals, u_offset=None, y_offset=None,
+           n=None):
     num = np.concatenate([np.zeros(npo - nz), theta[npo:]])
     den = np.concatenate([[1.0], theta[:npo]])
-    names = [f"den[{i}]" for i in range(1, npo + 1)] + [f"num[{npo - nz + i}]" for i in range(nz + 1)]
+    names = ([f"den[{i}]" for i in range(1, npo + 1)]
+             + [f"num[{npo - nz + i}]" for i in range(nz + 1)])
     g = TransferFunction(num, den, **signals).with_covariance(cov, names)
     wn, z, swn, sz = modal_parameters(den, cov[:npo, :npo])
-    info = {**info, "natural_frequency_hz": wn / (2 * np.pi), "natural_frequency_hz_std": swn / (2 * np.pi),
+    info = {**info, "natural_frequency_hz": wn / (2 * np.pi),
+            "natural_frequency_hz_std": swn / (2 * np.pi),
             "damping_ratio": z, "damping_ratio_std": sz, "num_std": np.sqrt(np.diag(cov))[npo:],
             "den_std": np.concatenate([[0.0], np.sqrt(np.diag(cov))[:npo]])}
-    return LinearModel(g, structure, fit_percent=fit, u_offset=u_offset, y_offset=y_offset, n_samples=n, info=info)
+    return (LinearModel(g, structure, fit_percent=fit, u_offset=u_offset, y_offset=y_offset,
+                        n_samples=n, info=info))
 
 
 def tfest_frf(response: FRF, n_poles: int, n_zeros: int, *, dt: float | None = None,
@@ -147,7 +155,8 @@ def tfest_frf(response: FRF, n_poles: int, n_zeros: int, *, dt: float | None = N
         raise DataError("tfest: the FRF must be single-input single-output")
     H = response.H[:, 0, 0]
     sd = response.H_std[:, 0, 0]
-    ok = np.isfinite(H) & np.isfinite(sd) & (response.frequency_hz > 0)  # σ = 0: noise-free lines (floor below)
+    # σ = 0: noise-free lines (floor below)
+    ok = np.isfinite(H) & np.isfinite(sd) & (response.frequency_hz > 0)
     w = response.w[ok]
     # weights 1/σ with a 0.1 % relative floor: noise-free data have σ ≈ 0 on some lines, and the
     # estimate's own systematic errors (leakage, the hold) are not in σ
@@ -168,13 +177,15 @@ def tfest_frf(response: FRF, n_poles: int, n_zeros: int, *, dt: float | None = N
     def jac(theta):
         A, B = _eval(theta, s, npo, nz)
         G = B / A
-        cols = [G * s ** (npo - i) / A for i in range(1, npo + 1)] + [-s ** (nz - i) / A for i in range(nz + 1)]
+        cols = ([G * s ** (npo - i) / A for i in range(1, npo + 1)]
+                + [-s ** (nz - i) / A for i in range(nz + 1)])
         J = np.column_stack(cols) / sd[:, None]
         return np.vstack([J.real, J.imag])
 
     sol = optimize.least_squares(res, th, jac=jac, method="lm", xtol=1e-12, ftol=1e-12)
     T = np.diag(_unscale(np.ones(k), ws, npo, nz))
-    if dt is not None:  # through the zero-order hold, in the scaled coordinates (finite differences)
+    # through the zero-order hold, in the scaled coordinates (finite differences)
+    if dt is not None:
         z = np.exp(1j * w * float(dt))
 
         def res_zoh(theta):
@@ -182,7 +193,8 @@ def tfest_frf(response: FRF, n_poles: int, n_zeros: int, *, dt: float | None = N
             if np.any(np.roots(np.concatenate([[1.0], th_[:npo]])).real >= 0):
                 return np.full(2 * w.size, 1e6)
             Ad, Bd, Cd, Dd = _simulate_ct(th_, npo, nz, None, float(dt))
-            G = (Cd @ np.linalg.solve(z[:, None, None] * np.eye(npo) - Ad, np.broadcast_to(Bd, (z.size,) + Bd.shape)))
+            G = (Cd @ np.linalg.solve(z[:, None, None] * np.eye(npo) - Ad,
+                                      np.broadcast_to(Bd, (z.size,) + Bd.shape)))
             r = (H - (G[:, 0, 0] + Dd[0, 0])) / sd
             return np.concatenate([r.real, r.imag])
 
@@ -261,17 +273,20 @@ def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None,
     u = as_io_matrix(u, "input u")
     y = as_io_matrix(y, "output y", u.shape[0])
     if u.shape[1] != 1 or y.shape[1] != 1:
-        raise DataError(f"tfest: expected one input and one output, found {u.shape[1]} and {y.shape[1]}",
+        raise DataError(f"tfest: expected one input and one output, found {u.shape[1]} "
+                        f"and {y.shape[1]}",
                         hint="estimate one input-output pair at a time, or use gripkit identify ss")
     step = check_dt(dt)
     N = u.shape[0]
     k = npo + nz + 1
     if N < 10 * k + 64:
-        raise DataError(f"tfest: {N} samples are too few for {k} coefficients (need at least {10 * k + 64})",
+        raise DataError(f"tfest: {N} samples are too few for {k} coefficients (need at "
+                        f"least {10 * k + 64})",
                         hint="use a longer record or fewer poles/zeros")
     check_persistent_excitation(u[:, 0], k, f"tfest ({npo} poles, {nz} zeros: {k} coefficients)")
     start = tfest_frf(frf(u, y, dt=step, nperseg=max(64, min(N // 4, 2048))), npo, nz, dt=step)
-    th0 = _stabilise(np.concatenate([start.system.denominator()[1:], start.system.numerator()[-(nz + 1):]]), npo)
+    th0 = (_stabilise(np.concatenate([start.system.denominator()[1:],
+                                      start.system.numerator()[-(nz + 1):]]), npo))
     uu, yy = u, y[:, 0]
     scale = np.abs(th0) + 1e-8
 
@@ -282,7 +297,8 @@ def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None,
         Ad, Bd, Cd, Dd = _simulate_ct(theta, npo, nz, uu, step)
         return yy - free_run(Ad, Bd, Cd, Dd, uu)[:, 0]
 
-    sol = optimize.least_squares(res, th0 / scale, method="trf", x_scale="jac", xtol=1e-10, ftol=1e-10)
+    sol = (optimize.least_squares(res, th0 / scale, method="trf", x_scale="jac", xtol=1e-10,
+                                  ftol=1e-10))
     theta = sol.x * scale
     J = sol.jac / scale[None, :]
     dof = N - k
@@ -291,9 +307,11 @@ def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None,
     Ad, Bd, Cd, Dd = _simulate_ct(theta, npo, nz, uu, step)
     x0 = estimate_x0(Ad, Bd, Cd, Dd, uu, y)
     fit = fit_per_output(y, free_run(Ad, Bd, Cd, Dd, uu, x0))
-    signals = dict(inputs=inputs, outputs=outputs, input_units=input_units, output_units=output_units)
+    signals = (dict(inputs=inputs, outputs=outputs, input_units=input_units,
+                    output_units=output_units))
     return _model(theta, 0.5 * (cov + cov.T), npo, nz, fit=fit, structure="tfest",
-                  info={"source": "time domain (zero-order hold, output error from rest)", "nfev": int(sol.nfev)},
+                  info={"source": "time domain (zero-order hold, output "
+                                  "error from rest)", "nfev": int(sol.nfev)},
                   signals=signals, u_offset=u_offset, y_offset=y_offset, n=N)
 
 

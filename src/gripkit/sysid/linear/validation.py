@@ -108,12 +108,14 @@ def compare(model, u, y, *, initial: str = "estimate") -> Comparison:
     n_y = a.size - 1
     t0 = max(n_y, model.B.size - 1)
     if y.size < t0 + max(n_y, 1) + 2:
-        raise DataError(f"validation of {model.label} needs at least {t0 + max(n_y, 1) + 2} samples, "
+        raise DataError(f"validation of {model.label} needs at least "
+                        f"{t0 + max(n_y, 1) + 2} samples, "
                         f"found {y.size}")
     stable = model.stable
     if not stable:
         pmax = float(np.max(np.abs(model.poles())))
-        emit_warning(f"{model.label} is unstable (largest pole magnitude {pmax:.4g} > 1): its free-run "
+        emit_warning(f"{model.label} is unstable (largest pole magnitude {pmax:.4g} > "
+                     "1): its free-run "
                      f"simulation diverges, so no simulation fit is reported", StabilityWarning)
     u_past = u[:t0]
     if initial == "past":
@@ -122,7 +124,8 @@ def compare(model, u, y, *, initial: str = "estimate") -> Comparison:
         y_past = np.zeros(n_y)
         u_past = np.zeros(t0)
     else:
-        y_past = _estimate_past(model, u[t0:], y[t0:], u_past, n_y) if stable else y[t0 - n_y:t0].copy()
+        y_past = (_estimate_past(model, u[t0:], y[t0:], u_past,
+                                 n_y) if stable else y[t0 - n_y:t0].copy())
     with np.errstate(over="ignore", invalid="ignore"):
         ys = model.simulate(u[t0:], initial="given", y_past=y_past, u_past=u_past)
     y_sim = np.concatenate([y[:t0], ys])
@@ -142,7 +145,8 @@ def _estimate_past(model, u, y, u_past, n_y: int) -> np.ndarray:
     for k in range(n_y):
         e = np.zeros(n_y)
         e[k] = 1.0
-        basis[:, k] = model.simulate(zero_u, initial="given", y_past=e, u_past=np.zeros(model.B.size))
+        basis[:, k] = (model.simulate(zero_u, initial="given", y_past=e,
+                                      u_past=np.zeros(model.B.size)))
     z = np.linalg.lstsq(basis, y - forced, rcond=None)[0]
     return z
 
@@ -191,7 +195,8 @@ class ResidualTests:
     def to_dict(self) -> dict:
         return dict(lags=self.lags.tolist(), autocorr=self.autocorr.tolist(),
                     crosscorr=self.crosscorr.tolist(), bound=self.bound, alpha=self.alpha,
-                    whiteness_stat=self.whiteness_stat, whiteness_p=self.whiteness_p, white=self.white,
+                    whiteness_stat=self.whiteness_stat, whiteness_p=self.whiteness_p,
+                    white=self.white,
                     independence_stat=self.independence_stat, independence_p=self.independence_p,
                     independent=self.independent, independence_dof=self.independence_dof, n=self.n)
 
@@ -238,7 +243,8 @@ def residual_tests(e, u, *, lags: int = 25, alpha: float = 0.01) -> ResidualTest
     s = float(m * np.sum(proj ** 2 / w[keep]))
     dof = int(keep.sum())
     p_ind = float(stats.chi2.sf(s, dof))
-    return ResidualTests(np.arange(lags + 1), re, reu, bound, float(alpha), q, p_white, p_white >= alpha,
+    return ResidualTests(np.arange(lags + 1), re, reu, bound, float(alpha), q, p_white,
+                         p_white >= alpha,
                          s, p_ind, p_ind >= alpha, dof, m)
 
 
@@ -278,12 +284,14 @@ class Validation:
     def to_dict(self) -> dict:
         tests = None if self.tests is None else {k: v for k, v in self.tests.to_dict().items()
                                                  if k not in ("lags", "autocorr", "crosscorr")}
-        return dict(fit_percent=self.fit_percent, prediction_fit_percent=self.prediction_fit_percent,
+        return dict(fit_percent=self.fit_percent,
+                    prediction_fit_percent=self.prediction_fit_percent,
                     loss=self.loss, initial=self.simulation.initial, stable=self.simulation.stable,
                     residual_tests=tests)
 
 
-def validate(model, u, y, *, initial: str = "estimate", lags: int = 25, alpha: float = 0.01) -> Validation:
+def validate(model, u, y, *, initial: str = "estimate", lags: int = 25,
+             alpha: float = 0.01) -> Validation:
     """Validate ``model`` on (u, y) (deviation units, same sampling as the estimation data):
     free-run simulation fit, one-step prediction fit, residual whiteness and independence."""
     u, y = check_io(u, y)

@@ -562,7 +562,8 @@ def load_narx(path) -> NARXModel:
                          f"objects deeper than Python's recursion limit; a model file nests a few "
                          f"levels") from None
     except ValueError as exc:  # an integer beyond Python's limit on digits read from text
-        raise ModelError(f"narx model file {str(p)!r} cannot be read: {str(exc).split(';')[0]}") from None
+        raise ModelError(f"narx model file {str(p)!r} cannot be read: "
+                         f"{str(exc).split(';')[0]}") from None
     schema = doc.get("schema") if isinstance(doc, dict) else None
     if schema != SCHEMA:
         raise ModelError(f"{str(p)!r} has schema {schema!r}, expected {SCHEMA!r}; load other model "

@@ -13,7 +13,8 @@ C, D, E, F, kind 6 for the output offset y₀ᵣ (c = 0). Its sensitivity s = �
     s[t+1] = (A + E ∂ζ/∂x) s[t] + f_θ[t],     ∂ŷ[t] = (C + F ∂η/∂x) s[t] + g_θ[t]
 
 with f_θ = e_r x_c, e_r ũ_c, e_r ζ_c for A, B, E and g_θ = e_r x_c, e_r ũ_c, e_r η_c for C, D, F
-and g_θ = e_r for y₀ᵣ: the form of the linear PEM sensitivities of :mod:`gripkit.sysid.linear.pem_ss`,
+and g_θ = e_r for y₀ᵣ: the form of the linear PEM sensitivities of
+:mod:`gripkit.sysid.linear.pem_ss`,
 with the Jacobian of the state map in place of A. The initial state of each window gives n more
 directions (s = I at the window's first sample). The columns of S advance together (rows contiguous,
 :func:`~gripkit.sysid.linear.blocked_gram.row_product`), and blocks of 16 rows of J are added to the

@@ -3,7 +3,8 @@ D(s), the first two steps of ``001_0b92a7da96e7aa46.txt`` §IV.
 
 1. **Static Bouc-Wen parameters** (§IV-C1, Fig. 9): d_p, λ, β, γ of y = d_p U − H, eq 3, from a
    quasi-static voltage sweep (the seed: 0.1 Hz, 100 V) by nonlinear least squares on the
-   simulation error (:mod:`gripkit.sysid.physical.greybox` on :class:`~gripkit.models.hysteresis.BoucWen`),
+   simulation error (:mod:`gripkit.sysid.physical.greybox` on
+   :class:`~gripkit.models.hysteresis.BoucWen`),
    validated on internal loops by the maximal error relative to the loop's peak-to-peak output
    (Fig. 9b: < 5 % external, < 10 % internal). :func:`identify_bouc_wen`.
 2. **D(s) = 1/(a s² + b s + 1)** (§IV-C2, Fig. 10) from a voltage step, the static part held at
@@ -30,7 +31,8 @@ from ...signals.trajectory import Trajectory
 from ..checks import check_dimension
 from .greybox import GreyboxResult, fit
 
-__all__ = ["BoucWenResult", "DynamicsResult", "identify_bouc_wen", "loop_error", "identify_actuator_dynamics",
+__all__ = ["BoucWenResult", "DynamicsResult", "identify_bouc_wen", "loop_error",
+           "identify_actuator_dynamics",
            "step_initial_guess"]
 
 _KEYS = (("d_p", "d_p"), ("lambda", "lam"), ("beta", "beta"), ("gamma", "gamma"))
@@ -56,15 +58,20 @@ class BoucWenResult:
         return loop_error(y, self.predict(U))
 
     def to_dict(self) -> dict:
-        return {"params": dict(self.params), "std": dict(self.std), "relative_error": self.relative_error,
+        return {"params": dict(self.params), "std": dict(self.std),
+                "relative_error": self.relative_error,
                 "fit_percent": float(self.fit.fit_percent[0]), "n_samples": self.fit.n_samples,
-                "identifiability": str(self.fit.identifiability), "units": {"d_p": "m/V", "lambda": "m/V",
-                                                                             "beta": "1/V", "gamma": "1/V"}}
+                "identifiability": str(self.fit.identifiability),
+                "units": {"d_p": "m/V", "lambda": "m/V",
+                                                                             "beta": "1/V",
+                                                                             "gamma": "1/V"}}
 
     def summary(self) -> str:
         p, s = self.params, self.std
-        return (f"Bouc-Wen: d_p = {p['d_p'] * 1e6:.5g} ± {s['d_p'] * 1e6:.2g} µm/V, λ = {p['lambda'] * 1e6:.5g} ± "
-                f"{s['lambda'] * 1e6:.2g} µm/V, β = {p['beta']:.5g} ± {s['beta']:.2g} 1/V, γ = {p['gamma']:.5g} ± "
+        return (f"Bouc-Wen: d_p = {p['d_p'] * 1e6:.5g} ± {s['d_p'] * 1e6:.2g} µm/V, λ = "
+                f"{p['lambda'] * 1e6:.5g} ± "
+                f"{s['lambda'] * 1e6:.2g} µm/V, β = {p['beta']:.5g} ± {s['beta']:.2g} 1/V, γ = "
+                f"{p['gamma']:.5g} ± "
                 f"{s['gamma']:.2g} 1/V; max error {100 * self.relative_error:.3g} % of the loop")
 
 
@@ -122,7 +129,8 @@ def identify_bouc_wen(data: Trajectory, input: str = "U", output: str = "y", *,
     check_dimension(input, data.unit(input), {"a voltage": "V"}, "input (voltage)")
     check_dimension(output, data.unit(output), {"a length": "m"}, "output (displacement)")
     if np.ptp(U) <= 0:
-        raise DataError(f"column {input!r} (voltage) is constant: a hysteresis needs a voltage sweep")
+        raise DataError(f"column {input!r} (voltage) is constant: a hysteresis needs "
+                        "a voltage sweep")
     if not (np.isfinite(delay) and delay >= 0):
         raise DataError(f"delay: expected a lag >= 0 s, found {delay!r}")
     if delay > 0:
@@ -137,10 +145,12 @@ def identify_bouc_wen(data: Trajectory, input: str = "U", output: str = "y", *,
         hs = abs(gap) / 2 if math.isfinite(gap) and gap != 0 else 0.02 * abs(d0) * np.ptp(U)
         c0 = 10.0 / np.ptp(U)
         initial = {"d_p": abs(d0), "lambda": hs * c0, "beta": 0.9 * c0, "gamma": 0.1 * c0}
-    model = BoucWen(bouc_wen_parameters(initial["d_p"], initial["lambda"], initial["beta"], initial["gamma"],
+    model = BoucWen(bouc_wen_parameters(initial["d_p"], initial["lambda"], initial["beta"],
+                                        initial["gamma"],
                                         source="starting value"), check=False)
     tr = Trajectory(data.t, {"U": U, "y": y}, {"U": "V", "y": "m"}, {**data.meta, "dt": data.dt})
-    res = fit(model, tr, outputs=["y"], x0=np.array([H0, U[0]]), multistart=multistart, burn_in=burn_in,
+    res = fit(model, tr, outputs=["y"], x0=np.array([H0, U[0]]), multistart=multistart,
+              burn_in=burn_in,
               progress=progress)
     params = {k: res.value(n) for k, n in _KEYS}
     std = {k: res.stdev(n) for k, n in _KEYS}
@@ -169,14 +179,16 @@ class DynamicsResult:
 
     def to_dict(self) -> dict:
         return {"a": self.a, "b": self.b, "a_std": self.a_std, "b_std": self.b_std,
-                "natural_frequency_hz": self.natural_frequency_hz, "damping_ratio": self.damping_ratio,
+                "natural_frequency_hz": self.natural_frequency_hz,
+                "damping_ratio": self.damping_ratio,
                 "fit_percent": float(self.fit.fit_percent[0])}
 
 
 def step_initial_guess(t: np.ndarray, y: np.ndarray) -> tuple[float, float]:
     """(a, b) of D(s) from the overshoot and peak time of a (rising) step response."""
     y = np.asarray(y, dtype=np.float64)
-    i0 = int(np.argmax(np.abs(np.diff(y)) > 0.05 * np.max(np.abs(np.diff(y))))) if np.ptp(y) > 0 else 0
+    i0 = (int(np.argmax(np.abs(np.diff(y)) > 0.05 * np.max(np.abs(np.diff(y))))) if np.ptp(y) > 0
+          else 0)
     y0 = y[:max(i0, 1)].mean()
     yf = y[-max(len(y) // 10, 1):].mean()
     if yf == y0:
@@ -196,7 +208,8 @@ def step_initial_guess(t: np.ndarray, y: np.ndarray) -> tuple[float, float]:
     return 1.0 / wn**2, 2.0 * zeta / wn
 
 
-def identify_actuator_dynamics(data: Trajectory, static: BoucWenResult | dict, input: str = "U", output: str = "y",
+def identify_actuator_dynamics(data: Trajectory, static: BoucWenResult | dict, input: str = "U",
+                               output: str = "y",
                                *, free=("a", "b"), initial: tuple[float, float] | None = None,
                                progress: bool = True) -> DynamicsResult:
     """a and b of D(s) (eq 4) from a voltage step measured at the same point as ``static``
@@ -205,10 +218,12 @@ def identify_actuator_dynamics(data: Trajectory, static: BoucWenResult | dict, i
     U = np.asarray(data[input], dtype=np.float64)
     y = np.asarray(data[output], dtype=np.float64)
     a0, b0 = step_initial_guess(data.t, y) if initial is None else initial
-    params = actuator_parameters(sp["d_p"], 1e-3, sp["lambda"], sp["beta"], sp["gamma"], a0, b0, 1e-2,
+    params = actuator_parameters(sp["d_p"], 1e-3, sp["lambda"], sp["beta"], sp["gamma"], a0, b0,
+                                 1e-2,
                                  source="identified (static) / starting value (a, b)")
     model = PiezoActuator(params, loads=False, check=False)
-    tr = Trajectory(data.t, {"U": U, "y_A": y}, {"U": "V", "y_A": "m"}, {**data.meta, "dt": data.dt})
+    tr = (Trajectory(data.t, {"U": U, "y_A": y}, {"U": "V", "y_A": "m"},
+                     {**data.meta, "dt": data.dt}))
     res = fit(model, tr, outputs=["y_A"], free=list(free), progress=progress)
     _warn_if_poor(res, "D(s) identification")
     return DynamicsResult(res.value("a"), res.value("b"), res.stdev("a"), res.stdev("b"), res)
@@ -216,4 +231,5 @@ def identify_actuator_dynamics(data: Trajectory, static: BoucWenResult | dict, i
 
 def _warn_if_poor(res: GreyboxResult, what: str) -> None:
     if res.fit_percent[0] < 90:
-        emit_warning(f"{what}: the model reproduces only {res.fit_percent[0]:.3g} % of the data", AccuracyWarning)
+        emit_warning(f"{what}: the model reproduces only "
+                     f"{res.fit_percent[0]:.3g} % of the data", AccuracyWarning)

@@ -59,7 +59,8 @@ class Identifiability:
     def __str__(self) -> str:
         if self.ok and not self.strongly_correlated:
             return f"identifiable (condition number {self.condition_number:.3g})"
-        parts = [f"cannot tell apart {{{', '.join(g)}}} from this experiment (only a combination is "
+        parts = [f"cannot tell apart {{{', '.join(g)}}} from this experiment (only a "
+                 "combination is "
                  f"determined)" if len(g) > 1 else f"{g[0]} is not determined by this experiment"
                  for g in self.unidentifiable]
         parts += [f"{a} and {b} correlated at {c:+.4f}" for a, b, c in self.strongly_correlated]
@@ -137,7 +138,8 @@ def _random_starts(theta0, lo, hi, n, rng) -> list[np.ndarray]:
                 else:
                     th[i] = rng.uniform(a, b)
             else:
-                th[i] = np.clip(t0 * math.exp(rng.normal(0.0, 0.5)) if t0 != 0 else rng.normal(0.0, 1.0), a, b)
+                th[i] = (np.clip(t0 * math.exp(rng.normal(0.0, 0.5)) if t0 != 0
+                                 else rng.normal(0.0, 1.0), a, b))
         starts.append(th)
     return starts
 
@@ -175,12 +177,14 @@ def _parameters_to_fit(model, initial, free) -> tuple[ParameterSet, tuple[str, .
     (default: the non-fixed ones); unknown names raise a ParameterError naming them."""
     params = model.parameters
     if initial is not None:
-        params = params.replace(**({n: initial.value(n) for n in initial} if isinstance(initial, ParameterSet) else dict(initial)))
+        params = (params.replace(**({n: initial.value(n) for n in initial}
+                                    if isinstance(initial, ParameterSet) else dict(initial))))
     free = tuple(params.free_names if free is None else free)
     for n in free:
         params[n]  # raises a clear ParameterError for unknown names
     if not free:
-        raise ParameterError("no free parameters to identify", hint="pass free=[...] or unfix some parameters")
+        raise ParameterError("no free parameters to identify", hint="pass free=[...] or unfix "
+                                                                    "some parameters")
     return params, free
 
 
@@ -190,7 +194,8 @@ def _input_columns(model, data: Trajectory, inputs: Mapping[str, str] | None) ->
     missing = [c for c in in_map.values() if c not in data]
     if missing:
         raise DataError(f"data has no column {missing[0]!r} for the input of {model.name}",
-                        hint=f"map it with inputs={{model_input: column}}; columns: {', '.join(data.names)}")
+                        hint=f"map it with inputs={{model_input: column}}; columns: "
+                             f"{', '.join(data.names)}")
     return np.column_stack([data[c] for c in in_map.values()])
 
 
@@ -209,11 +214,13 @@ def _output_map(model, data: Trajectory, outputs) -> dict[str, str]:
         out_map = {o: o for o in outputs}
     for o in out_map:
         if o not in model_out:
-            raise DataError(f"{o!r} is not an output of {model.name}", hint=f"outputs: {', '.join(model_out)}")
+            raise DataError(f"{o!r} is not an output "
+                            f"of {model.name}", hint=f"outputs: {', '.join(model_out)}")
     return out_map
 
 
-def _fit_columns(model, data: Trajectory, *, inputs, outputs, n_free: int, burn_in, output_scale) -> _Columns:
+def _fit_columns(model, data: Trajectory, *, inputs, outputs, n_free: int, burn_in,
+                 output_scale) -> _Columns:
     """Read and check the inputs, the outputs and their weights w_j (default: the standard
     deviation of each measured output after the burn-in)."""
     u = _input_columns(model, data, inputs)
@@ -224,11 +231,13 @@ def _fit_columns(model, data: Trajectory, *, inputs, outputs, n_free: int, burn_
     burn_in = int(burn_in)
     if burn_in < 0:
         raise DataError(f"burn_in: expected a number of samples >= 0, found {burn_in}")
-    data.require_samples(burn_in + 2 * n_free + 1, f"fitting {n_free} parameters after {burn_in} burn-in samples")
+    data.require_samples(burn_in + 2 * n_free + 1, f"fitting {n_free} parameters after {burn_in} "
+                                                   "burn-in samples")
     w = (np.asarray(output_scale, dtype=np.float64) if output_scale is not None
          else y[burn_in:].std(axis=0))
     if w.shape != (y.shape[1],) or not np.all(w > 0):
-        raise DataError(f"output scale: expected {y.shape[1]} positive weights (a measured output may be "
+        raise DataError(f"output scale: expected {y.shape[1]} positive weights (a "
+                        "measured output may be "
                         f"constant), found {w}", hint="pass output_scale=[...] explicitly")
     # the fitted samples (y_model, residuals and n_samples refer to these)
     return _Columns(u, y[burn_in:], w, out_map, out_idx, burn_in)
@@ -240,7 +249,8 @@ class _OutputError:
     positive parameters use z = log(θ/s)), and its forward-difference Jacobian dr/dz computed in
     one batch simulation of all perturbed parameter vectors. ``nfev`` counts the simulations."""
 
-    def __init__(self, model, params: ParameterSet, free: tuple[str, ...], cols: _Columns, dt: float,
+    def __init__(self, model, params: ParameterSet, free: tuple[str, ...], cols: _Columns,
+                 dt: float,
                  x0, method: str):
         names = params.names
         self.model, self.cols, self.dt = model, cols, dt
@@ -272,20 +282,23 @@ class _OutputError:
         self.nfev += T.shape[0]
         self._substeps = max(self._substeps, self.model.substeps(self.dt, T))
         c = self.cols
-        return self.model.simulate_batch(T, c.u, self.dt, self.x0, substeps=self._substeps)[:, c.burn_in:, c.out_idx]
+        return (self.model.simulate_batch(T, c.u, self.dt, self.x0,
+                                          substeps=self._substeps)[:, c.burn_in:, c.out_idx])
 
     def residual(self, z):
         key = z.tobytes()
         if key not in self._cache:
             self._cache.clear()
-            self._cache[key] = ((self.simulate_rows(z[None, :])[0] - self.cols.y) / self.cols.w).ravel()
+            self._cache[key] = ((self.simulate_rows(z[None,
+                                                      :])[0] - self.cols.y) / self.cols.w).ravel()
         return self._cache[key]
 
     def jacobian(self, z):
         r0 = self.residual(z)
         n_free = z.size
         h = np.sqrt(np.finfo(float).eps) * np.maximum(np.abs(z), 1.0)
-        step = np.where(self.logvar | (z + h <= self.hi / self.s), h, -h)  # step away from an upper bound
+        # step away from an upper bound
+        step = np.where(self.logvar | (z + h <= self.hi / self.s), h, -h)
         Z = np.repeat(z[None, :], n_free, axis=0) + np.diag(step)
         R = (self.simulate_rows(Z) - self.cols.y[None, :, :]) / self.cols.w
         return ((R.reshape(n_free, -1) - r0[None, :]) / step[:, None]).T
@@ -299,17 +312,21 @@ def _best_of_starts(problem: _OutputError, opts: _SolverOptions):
     """Run ``least_squares`` from θ₀ and ``opts.multistart`` random starts; returns the solution
     of least cost and every start's (cost, θ)."""
     rng = np.random.default_rng(opts.seed)
-    starts = [problem.theta0] + _random_starts(problem.theta0, problem.lo, problem.hi, opts.multistart, rng)
+    starts = ([problem.theta0] + _random_starts(problem.theta0, problem.lo, problem.hi,
+                                                opts.multistart, rng))
     best = None
     tried = []
-    for th in track(starts, description="grey-box starts", enabled=opts.progress and len(starts) > 1):
+    for th in track(starts, description="grey-box starts",
+                    enabled=opts.progress and len(starts) > 1):
         z0 = np.clip(problem.to_z(th), problem.bounds[0], problem.bounds[1])
         try:
             sol = least_squares(problem.residual, z0, jac=problem.jacobian, bounds=problem.bounds,
-                                method=opts.method, loss=opts.loss, max_nfev=opts.max_nfev, x_scale="jac")
+                                method=opts.method, loss=opts.loss, max_nfev=opts.max_nfev,
+                                x_scale="jac")
         except ParameterError as exc:
             raise IdentificationError(f"the fit left the parameters' physical range: {exc}",
-                                      hint="use method='trf' to enforce the bounds, or better starting values") from None
+                                      hint="use method='trf' to enforce the bounds, or better "
+                                           "starting values") from None
         except ValueError as exc:
             raise IdentificationError(f"least squares failed to start: {exc}") from None
         tried.append((float(sol.cost), problem.to_theta(sol.x)))
@@ -323,7 +340,8 @@ def _check_inside_bounds(theta, problem: _OutputError, free, method: str) -> Non
     lo, hi = problem.lo, problem.hi
     if method == "lm" and ((theta < lo) | (theta > hi)).any():
         j = int(np.argmax((theta < lo) | (theta > hi)))
-        raise IdentificationError(f"Levenberg-Marquardt converged outside the bounds: {free[j]} = {theta[j]:g}",
+        raise IdentificationError("Levenberg-Marquardt converged outside the bounds: "
+                                  f"{free[j]} = {theta[j]:g}",
                                   hint="use method='trf' to enforce the bounds")
 
 
@@ -380,7 +398,8 @@ def _uncertainty(J, r, s, free, rcond: float, max_rel_std: float):
     return cov, std, corr, ident
 
 
-def _result(params: ParameterSet, free, theta, cov, std, corr, ident: Identifiability, problem: _OutputError,
+def _result(params: ParameterSet, free, theta, cov, std, corr, ident: Identifiability,
+            problem: _OutputError,
             best, r, tried, *, source: str) -> GreyboxResult:
     """The :class:`GreyboxResult` of the best start: the modelled outputs ŷ = y + r·w, their
     residuals and fit percentages, and the parameters with their σ."""
@@ -396,7 +415,8 @@ def _result(params: ParameterSet, free, theta, cov, std, corr, ident: Identifiab
 
 
 @entry_point
-def fit(model, data: Trajectory | Sequence[Trajectory], *, outputs: Sequence[str] | Mapping[str, str] | None = None,
+def fit(model, data: Trajectory | Sequence[Trajectory], *,
+        outputs: Sequence[str] | Mapping[str, str] | None = None,
         inputs: Mapping[str, str] | None = None, free: Sequence[str] | None = None,
         initial: ParameterSet | Mapping[str, float] | None = None, x0: np.ndarray | None = None,
         output_scale: Sequence[float] | None = None, multistart: int = 0, seed: int = 0,
@@ -453,15 +473,18 @@ def fit(model, data: Trajectory | Sequence[Trajectory], *, outputs: Sequence[str
         raise DataError(f"data: expected a Trajectory, found {type(data).__name__}")
     dt = data.require_uniform(why="grey-box identification")
     params, free = _parameters_to_fit(model, initial, free)
-    cols = _fit_columns(model, data, inputs=inputs, outputs=outputs, n_free=len(free), burn_in=burn_in,
+    cols = _fit_columns(model, data, inputs=inputs, outputs=outputs, n_free=len(free),
+                        burn_in=burn_in,
                         output_scale=output_scale)
     problem = _OutputError(model, params, free, cols, dt, x0, method)
-    best, tried = _best_of_starts(problem, _SolverOptions(method, loss, max_nfev, multistart, seed, progress))
+    best, tried = (_best_of_starts(problem, _SolverOptions(method, loss, max_nfev, multistart, seed,
+                                                           progress)))
     z = best.x
     theta = problem.to_theta(z)
     _check_inside_bounds(theta, problem, free, method)
     r = problem.residual(z)
-    cov, std, corr, ident = _uncertainty(problem.jacobian_theta(z, theta), r, problem.s, free, rcond, max_rel_std)
+    cov, std, corr, ident = (_uncertainty(problem.jacobian_theta(z, theta), r, problem.s, free,
+                                          rcond, max_rel_std))
     if not ident.ok:
         emit_warning(f"{model.name}: {ident}; their standard deviations are reported as infinite",
                      AccuracyWarning)

@@ -12,7 +12,8 @@ A free vibration of a lightly damped mode is y(t) = A e^{−σ t} cos(ω_d t + �
   spectrum of a decaying exponential is a Lorentzian of half-width σ/2π). Exact when the record
   outlasts the decay; a truncated record widens the peak.
 * **Hilbert envelope**: |analytic signal| decays as A e^{−σ t}: a straight-line fit to its log
-  (where it stands 5× above the noise, ends excluded) gives σ; the unwrapped phase's slope gives ω_d.
+  (where it stands 5× above the noise, ends excluded) gives σ; the unwrapped phase's slope gives
+  ω_d.
 * **log decrement**: δ = ln(a_i / a_{i+k})/k over the peaks a_i of the signal upsampled 16× by
   band-limited (polyphase) interpolation — needed because 20 kHz samples an 8.52 kHz ringing only
   2.3 times per period — and ζ = δ/√(4π² + δ²).
@@ -67,11 +68,13 @@ class ModalResult:
         return asdict(self)
 
     def summary(self) -> str:
-        lines = [f"free vibration: f_n = {self.natural_frequency_hz:.6g} ± {self.natural_frequency_std_hz:.2g} Hz, "
+        lines = [f"free vibration: f_n = {self.natural_frequency_hz:.6g} ± "
+                 f"{self.natural_frequency_std_hz:.2g} Hz, "
                  f"ζ = {self.damping_ratio:.5g} ± {self.damping_ratio_std:.2g} "
                  f"({self.n_samples} samples every {self.dt:g} s from t = {self.start_time:.6g} s)"]
         for k, v in self.methods.items():
-            lines.append(f"  {k}: " + ", ".join(f"{a} = {b:.6g}" for a, b in v.items() if isinstance(b, float)))
+            lines.append(f"  {k}: " + ", ".join(f"{a} = {b:.6g}" for a, b in v.items()
+                                                if isinstance(b, float)))
         return "\n".join(lines)
 
 
@@ -119,7 +122,8 @@ def _checked_signal(y, dt: float) -> np.ndarray:
     sample_interval(dt)
     if not np.isfinite(y).all():
         bad = int(np.argmax(~np.isfinite(y)))
-        raise DataError(f"the signal has {int((~np.isfinite(y)).sum())} NaN/inf values (first at sample {bad})",
+        raise DataError(f"the signal has {int((~np.isfinite(y)).sum())} NaN/inf values (first "
+                        f"at sample {bad})",
                         hint="drop or interpolate them (CLI: --fill)")
     if y.size < 64:
         raise DataError(f"free-vibration analysis needs at least 64 samples, found {y.size}")
@@ -133,7 +137,8 @@ def _release_segment(y: np.ndarray, start: int | None, end: int | None) -> tuple
     i1 = y.size if end is None else int(end)
     seg = y[i0:i1]
     if seg.size < 64:
-        raise DataError(f"only {seg.size} samples after the release (sample {i0}); need at least 64",
+        raise DataError(f"only {seg.size} samples after the release (sample {i0}); "
+                        "need at least 64",
                         hint="record longer, or pass start=")
     return i0, seg
 
@@ -144,11 +149,13 @@ def _spectral_peak(x: np.ndarray, rate: float):
     f_fft, f, X, k = _fft_peak(x, rate)
     floor = float(np.median(X))
     if X[k] < 10.0 * floor:
-        raise DataError(f"no oscillation stands out of the noise: the spectral peak at {f_fft:.6g} Hz is only "
+        raise DataError("no oscillation stands out of the noise: the spectral peak at "
+                        f"{f_fft:.6g} Hz is only "
                         f"{X[k] / floor:.3g}× the median of the spectrum",
                         hint="check the signal column and that the record holds a free vibration")
     if f_fft > 0.98 * rate / 2:
-        raise DataError(f"the peak at {f_fft:.6g} Hz lies at the Nyquist frequency {rate / 2:g} Hz: the mode is "
+        raise DataError(f"the peak at {f_fft:.6g} Hz lies at the Nyquist frequency {rate / 2:g} "
+                        "Hz: the mode is "
                         f"aliased or unresolved", hint="sample faster")
     return f_fft, f, X, k
 
@@ -171,10 +178,12 @@ def _hilbert_estimate(x: np.ndarray, t: np.ndarray, per: int, noise: float) -> d
     wd = np.polyfit(t[lu], ph, 1)[0]
     sigma_h = -sl
     wn_h = math.hypot(wd, sigma_h)
-    return {"natural_frequency_hz": wn_h / (2 * math.pi), "damping_ratio": sigma_h / wn_h, "amplitude": math.exp(ic)}
+    return ({"natural_frequency_hz": wn_h / (2 * math.pi), "damping_ratio": sigma_h / wn_h,
+             "amplitude": math.exp(ic)})
 
 
-def _log_decrement_estimate(x: np.ndarray, rate: float, f_d: float, per: int, noise: float) -> dict | None:
+def _log_decrement_estimate(x: np.ndarray, rate: float, f_d: float, per: int,
+                            noise: float) -> dict | None:
     """δ = ln(a_i / a_{i+k})/k from a straight line through the log of the peaks of ``x``
     upsampled 16× (band-limited), those 5× above ``noise`` and three periods from the ends;
     ζ = δ/√(4π² + δ²). None with fewer than 3 such peaks."""
@@ -206,7 +215,8 @@ class _DampedSine:
     residual_variance: float
 
 
-def _fit_damped_sine(x: np.ndarray, t: np.ndarray, f_d: float, per: int, zeta0: float) -> _DampedSine:
+def _fit_damped_sine(x: np.ndarray, t: np.ndarray, f_d: float, per: int,
+                     zeta0: float) -> _DampedSine:
     """The five-parameter damped-sine least squares (module doc), started from f_d and ζ₀ with the
     amplitude and phase of the linear fit x ≈ e^{−σt}(p cos + q sin) at those (σ, ω_d)."""
     zeta0 = min(max(zeta0, 1e-4), 0.5)
@@ -224,7 +234,8 @@ def _fit_damped_sine(x: np.ndarray, t: np.ndarray, f_d: float, per: int, zeta0: 
         A, s, w, ph, c = p * scale
         return (A * np.exp(-s * t) * np.cos(w * t + ph) + c - x) / A0
 
-    sol = least_squares(resid, np.array([1.0, sig0 / wd0, 1.0, phi0, 0.0]), method="lm", x_scale="jac")
+    sol = (least_squares(resid, np.array([1.0, sig0 / wd0, 1.0, phi0, 0.0]), method="lm",
+                         x_scale="jac"))
     A, s, w, ph, c = sol.x * scale
     if not sol.success or not np.isfinite(sol.x).all():
         raise IdentificationError(f"the damped-sine fit did not converge: {sol.message}")
@@ -237,7 +248,8 @@ def _fit_damped_sine(x: np.ndarray, t: np.ndarray, f_d: float, per: int, zeta0: 
     try:
         cov = np.linalg.inv(J.T @ J) * s2
     except np.linalg.LinAlgError:
-        raise IdentificationError("the damped-sine fit is singular (no decay or no oscillation in the record)") from None
+        raise IdentificationError("the damped-sine fit is singular (no decay or no "
+                                  "oscillation in the record)") from None
     return _DampedSine(A, s, w, ph, c, cov, s2)
 
 
@@ -280,7 +292,8 @@ def _check_decay(zeta: float, z_std: float, sigma_t: float) -> None:
                      AccuracyWarning)
 
 
-def _warn_doubtful(methods: dict, f_fft: float, omega_d: float, fn: float, zeta: float, f_std: float,
+def _warn_doubtful(methods: dict, f_fft: float, omega_d: float, fn: float, zeta: float,
+                   f_std: float,
                    z_std: float) -> None:
     """AccuracyWarnings (attributed to the caller of :func:`free_vibration`): a
     method's ζ further from the fit's than its expected scatter, an FFT peak away from the fitted
@@ -288,10 +301,13 @@ def _warn_doubtful(methods: dict, f_fft: float, omega_d: float, fn: float, zeta:
     for name, v in methods.items():
         if name in ("hilbert", "half_power", "log_decrement") and "damping_ratio" in v:
             if abs(v["damping_ratio"] - zeta) > max(0.3 * zeta, 10 * z_std):
-                emit_warning(f"free vibration: the {name.replace('_', ' ')} damping ratio {v['damping_ratio']:.4g} "
-                             f"disagrees with the least-squares fit {zeta:.4g} ± {z_std:.2g}", AccuracyWarning)
+                emit_warning(f"free vibration: the {name.replace('_', ' ')} damping ratio "
+                             f"{v['damping_ratio']:.4g} "
+                             "disagrees with the least-squares fit "
+                             f"{zeta:.4g} ± {z_std:.2g}", AccuracyWarning)
     if abs(f_fft - omega_d / (2 * math.pi)) > max(0.01 * fn, 20 * f_std):
-        emit_warning(f"free vibration: the FFT peak {f_fft:.6g} Hz disagrees with the fitted damped frequency "
+        emit_warning(f"free vibration: the FFT peak {f_fft:.6g} Hz disagrees with the fitted "
+                     "damped frequency "
                      f"{omega_d / (2 * math.pi):.6g} Hz", AccuracyWarning)
 
 
@@ -303,7 +319,8 @@ def free_vibration(y, *, dt: float, start: int | None = None, end: int | None = 
     Parameters
     ----------
     y
-        The signal (any unit, e.g. the force sensor's reading), shape (N,), one sample every ``dt`` s.
+        The signal (any unit, e.g. the force sensor's reading), shape (N,), one sample every ``dt``
+        s.
     start, end
         Sample range to analyse; ``start`` defaults to the release (the first large step, so a
         record may begin with the preload plateau), ``end`` to the end of the record.
@@ -320,7 +337,8 @@ def free_vibration(y, *, dt: float, start: int | None = None, end: int | None = 
     """
     y = _checked_signal(y, dt)
     rate = 1.0 / dt
-    # work at unit size (an exact power of two: any scale, 1e-300 … 1e300); amplitudes mapped back below
+    # work at unit size (an exact power of two: any scale, 1e-300 … 1e300); amplitudes mapped back
+    # below
     cy = unit_scale(y)
     y = y * cy
     noise_std = None if noise_std is None else float(noise_std) * cy
@@ -352,5 +370,7 @@ def free_vibration(y, *, dt: float, start: int | None = None, end: int | None = 
                                   "natural_frequency_std_hz": f_std, "damping_ratio_std": z_std}
     if "hilbert" in methods:
         methods["hilbert"]["amplitude"] /= cy
-    return ModalResult(fn, zeta, f_std, z_std, float(sine.amplitude) / cy, float(sine.offset + c0) / cy,
-                       float(i0 / rate), int(seg.size), float(dt), math.sqrt(sine.residual_variance) / cy, methods)
+    return ModalResult(fn, zeta, f_std, z_std, float(sine.amplitude) / cy,
+                       float(sine.offset + c0) / cy,
+                       float(i0 / rate), int(seg.size), float(dt),
+                       math.sqrt(sine.residual_variance) / cy, methods)

@@ -16,7 +16,8 @@ Procedure (:func:`identify_step`):
    and ζ = −Re s/|s|, its static gain (b₁ + b₂)/(1 + a₁ + a₂) gives K. When the ARX poles are not
    a stable pair (heavy noise), the step's levels and its 63 % time are used instead.
 2. Output-error least squares on (K, ω_n, ζ, y₀) with the grey-box engine
-   (:func:`gripkit.sysid.physical.greybox.fit`): Levenberg-Marquardt by default (``method='lm'``: ω_n and ζ
+   (:func:`gripkit.sysid.physical.greybox.fit`): Levenberg-Marquardt by default (``method='lm'``:
+   ω_n and ζ
    in log space, so they stay positive), or the bounded trust-region reflective method
    (``method='trf'``, CLI ``--method trf``), which keeps every parameter within its bounds.
 3. Uncertainty: the asymptotic covariance σ̂²(JᵀJ)⁻¹ of the grey-box engine; σ(f_n) = σ(ω_n)/2π.
@@ -40,7 +41,8 @@ from ...signals.trajectory import Trajectory
 from ...units import ratio_unit
 from .greybox import GreyboxResult, fit
 
-__all__ = ["StepResponseResult", "identify_step", "step_metrics", "second_order_metrics", "STEP_METHODS"]
+__all__ = (["StepResponseResult", "identify_step", "step_metrics", "second_order_metrics",
+            "STEP_METHODS"])
 
 
 @dataclass(frozen=True)
@@ -83,8 +85,10 @@ class StepResponseResult:
         return np.array([self.gain * w * w]), np.array([1.0, 2 * self.damping_ratio * w, w * w])
 
     def to_dict(self) -> dict:
-        keys = ("gain", "gain_std", "natural_frequency_hz", "natural_frequency_hz_std", "damping_ratio",
-                "damping_ratio_std", "offset", "offset_std", "input_offset", "gain_unit", "fit_percent",
+        keys = ("gain", "gain_std", "natural_frequency_hz", "natural_frequency_hz_std",
+                "damping_ratio",
+                "damping_ratio_std", "offset", "offset_std", "input_offset", "gain_unit",
+                "fit_percent",
                 "residual_std", "n_samples", "dt", "overshoot_percent", "peak_time", "rise_time",
                 "settling_time")
         d = {k: getattr(self, k) for k in keys}
@@ -95,11 +99,14 @@ class StepResponseResult:
         return d
 
     def summary(self) -> str:
-        return (f"second-order step fit ({self.n_samples} samples every {self.dt:g} s, fit {self.fit_percent:.2f} %):\n"
+        return (f"second-order step fit ({self.n_samples} samples every {self.dt:g} s, fit "
+                f"{self.fit_percent:.2f} %):\n"
                 f"  gain K = {self.gain:.6g} ± {self.gain_std:.2g} {self.gain_unit}\n"
-                f"  natural frequency f_n = {self.natural_frequency_hz:.6g} ± {self.natural_frequency_hz_std:.2g} Hz\n"
+                f"  natural frequency f_n = {self.natural_frequency_hz:.6g} ± "
+                f"{self.natural_frequency_hz_std:.2g} Hz\n"
                 f"  damping ratio ζ = {self.damping_ratio:.5g} ± {self.damping_ratio_std:.2g}\n"
-                f"  predicted step: overshoot {self.overshoot_percent:.3g} %, peak {self.peak_time:.4g} s, "
+                f"  predicted step: overshoot {self.overshoot_percent:.3g} %, peak "
+                f"{self.peak_time:.4g} s, "
                 f"rise (10-90 %) {self.rise_time:.4g} s, settling (2 %) {self.settling_time:.4g} s")
 
 
@@ -175,13 +182,15 @@ def step_metrics(t, y, *, t_step: float | None = None, y_initial: float | None =
     t = np.asarray(t, dtype=np.float64)
     y = np.asarray(y, dtype=np.float64)
     if t.shape != y.shape or t.ndim != 1 or t.size < 3:
-        raise DataError(f"step_metrics: expected two 1-D arrays of equal length ≥ 3, found shapes {t.shape}, {y.shape}")
+        raise DataError("step_metrics: expected two 1-D arrays of equal length ≥ 3, found shapes "
+                        f"{t.shape}, {y.shape}")
     if not (np.isfinite(t).all() and np.isfinite(y).all()):
         raise DataError("step_metrics: t or y contains NaN or inf")
     t0 = float(t[0]) if t_step is None else float(t_step)
     after = t >= t0
     if after.sum() < 2:
-        raise DataError(f"step_metrics: no samples after t_step = {t0:g} s (record ends at {t[-1]:g} s)")
+        raise DataError(f"step_metrics: no samples after t_step = {t0:g} s (record ends "
+                        f"at {t[-1]:g} s)")
     if y_initial is None:
         before = ~after
         y_initial = float(y[before].mean()) if before.any() else float(y[0])
@@ -207,8 +216,10 @@ def step_metrics(t, y, *, t_step: float | None = None, y_initial: float | None =
         settling = math.inf
     else:
         settling = float(ta[outside[-1] + 1] - t0)
-    return dict(overshoot_percent=float(overshoot), undershoot_percent=max(0.0, float(-norm.min()) * 100.0),
-                peak=float(ya[ip]), peak_time=float(ta[ip] - t0), rise_time=rise, settling_time=settling,
+    return dict(overshoot_percent=float(overshoot),
+                undershoot_percent=max(0.0, float(-norm.min()) * 100.0),
+                peak=float(ya[ip]), peak_time=float(ta[ip] - t0), rise_time=rise,
+                settling_time=settling,
                 steady_state_error_percent=float(abs(ya[-1] - y_final) / abs(amp) * 100.0),
                 y_initial=float(y_initial), y_final=float(y_final))
 
@@ -267,7 +278,8 @@ def _step_signals(data: Trajectory, input: str, output: str):
 
 
 @entry_point
-def identify_step(data: Trajectory, *, input: str, output: str, multistart: int = 0, method: str = "lm",
+def identify_step(data: Trajectory, *, input: str, output: str, multistart: int = 0,
+                  method: str = "lm",
                   progress: bool = False) -> StepResponseResult:
     """Identify K, ω_n, ζ (and the output offset) of a second-order response (module docstring).
 
@@ -295,7 +307,8 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
         raise DataError(f"data: expected a Trajectory, found {type(data).__name__}")
     if method not in STEP_METHODS:
         raise DataError(f"method: expected one of {', '.join(STEP_METHODS)}, found {method!r}",
-                        hint="'lm' (Levenberg-Marquardt) or 'trf' (bounded trust-region; CLI: --method trf)")
+                        hint="'lm' (Levenberg-Marquardt) or 'trf' (bounded trust-region; "
+                             "CLI: --method trf)")
     dt = data.require_uniform(why="step-response identification")
     nyquist_w = math.pi / dt  # rad/s
     data.require_samples(20, "step-response identification")
@@ -310,7 +323,8 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
     K0, wn0, z0 = start
     wn0 = min(wn0, 0.9 * nyquist_w)
     z0 = min(max(z0, 1e-3), 5.0)
-    model = SecondOrderSystem(gain=K0, wn=wn0, zeta=z0, y0=0.0, u0=0.0, input_name="u", output_name="y")
+    model = (SecondOrderSystem(gain=K0, wn=wn0, zeta=z0, y0=0.0, u0=0.0, input_name="u",
+                               output_name="y"))
     sub = Trajectory(data.t, {"u": un, "y": yn}, meta=data.meta)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", AccuracyWarning)  # re-issued below with the step's names
@@ -325,19 +339,23 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
             raise
         except SimulationError:
             raise IdentificationError(
-                f"the response of {output!r} to {input!r} is not a second-order response resolved at "
-                f"dt = {dt:g} s: the fit diverged", hint="check the columns, or record at a higher sampling rate") from None
+                f"the response of {output!r} to {input!r} is not a second-order "
+                "response resolved at "
+                f"dt = {dt:g} s: the fit diverged", hint="check the columns, or record at a "
+                                                         "higher sampling rate") from None
     Kn, wn, zeta, y0n = (res.value(n) for n in ("gain", "wn", "zeta", "y0"))
     if wn >= nyquist_w:
         raise IdentificationError(
-            f"the fitted natural frequency {wn / (2 * math.pi):.4g} Hz is above the Nyquist frequency "
+            f"the fitted natural frequency {wn / (2 * math.pi):.4g} Hz is above the "
+            "Nyquist frequency "
             f"{0.5 / dt:.4g} Hz of the data", hint="record at a higher sampling rate")
     if not res.identifiability.ok:
         emit_warning(f"step-response fit of {output!r}: {res.identifiability}", AccuracyWarning)
     K = Kn * y_scale / u_scale
     y0 = y_ref + y0n * y_scale
     jd = np.array([y_scale / u_scale, 1.0 / (2 * math.pi), 1.0, y_scale])
-    with np.errstate(over="ignore", under="ignore"):  # variances of data at 1e300 do not fit in float64
+    # variances of data at 1e300 do not fit in float64
+    with np.errstate(over="ignore", under="ignore"):
         cov = res.covariance * jd[:, None] * jd[None, :]
     std_n = np.sqrt(np.clip(np.diag(res.covariance), 0, None))  # σ and correlation without squaring
     std = np.where(np.isfinite(res.std), std_n * jd, np.inf)  # the scales: finite at any data scale
@@ -346,7 +364,8 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
     m = second_order_metrics(wn, zeta)
     if m["settling_time"] > data.duration:
         emit_warning(f"step-response fit of {output!r}: the fitted response settles in "
-                     f"{m['settling_time']:.3g} s, longer than the {data.duration:.3g} s record; the gain "
+                     f"{m['settling_time']:.3g} s, longer than the {data.duration:.3g} s "
+                     "record; the gain "
                      f"is extrapolated", AccuracyWarning)
 
     gunit = ratio_unit(data.unit(output), data.unit(input))
@@ -356,5 +375,6 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
         offset=y0, offset_std=float(std[3]), input_offset=float(u[0]), gain_unit=gunit,
         covariance=cov, correlation=corr, fit_percent=float(res.fit_percent[0]),
         residual_std=float(res.residual_std[0]), n_samples=int(data.n), dt=float(dt),
-        overshoot_percent=m["overshoot_percent"], peak_time=m["peak_time"], rise_time=m["rise_time"],
+        overshoot_percent=m["overshoot_percent"], peak_time=m["peak_time"],
+        rise_time=m["rise_time"],
         settling_time=m["settling_time"], y_model=y_ref + res.y_model[:, 0] * y_scale, greybox=res)

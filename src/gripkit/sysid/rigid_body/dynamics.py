@@ -29,7 +29,8 @@ Cov = σ̂² (XᵀWX)⁻¹, σ̂² = rᵀWr/(N_rows − p) (``covariance="ols"``
 covariance of :func:`gripkit.sysid.regression.hac_covariance` for filtered, differentiated or
 decimated logs (``covariance="hac"``).
 
-**Physical consistency** (:mod:`gripkit.sysid.rigid_body.dynamics_projection`, where it is derived). A
+**Physical consistency** (:mod:`gripkit.sysid.rigid_body.dynamics_projection`, where it is
+derived). A
 base-parameter estimate is physically consistent when some standard parameters reproduce it with
 every link's pseudo-inertia
 
@@ -72,7 +73,8 @@ from .dynamics_file import float_array, read_dynamics_document, save_dynamics_mo
 from .dynamics_projection import project_consistent
 from ..regression import hac_covariance
 
-__all__ = ["identify_dynamics", "DynamicsResult", "base_structure", "BaseStructure", "load_dynamics_model"]
+__all__ = (["identify_dynamics", "DynamicsResult", "base_structure", "BaseStructure",
+            "load_dynamics_model"])
 
 FRICTION_MODELS = {"none": (), "coulomb-viscous": ("coulomb", "viscous"),
                    "coulomb-viscous-offset": ("coulomb", "viscous", "offset")}
@@ -109,7 +111,8 @@ def _combination_name(names, i, dep, beta_row) -> str:
     return s
 
 
-def base_structure(chain, *, armature: bool = False, seed: int = 0, tol: float = 1e-9) -> BaseStructure:
+def base_structure(chain, *, armature: bool = False, seed: int = 0,
+                   tol: float = 1e-9) -> BaseStructure:
     """Base parameters of ``chain`` from its regressor on random states (module doc); with
     ``armature`` a rotor-inertia column per actuated joint joins the standard parameters."""
     rng = np.random.default_rng(seed)
@@ -126,7 +129,8 @@ def base_structure(chain, *, armature: bool = False, seed: int = 0, tol: float =
     # greedy in a fixed order (module doc): a column is independent when it is not in the span of
     # the columns before it, |R_kk| of the QR in that order against its norm
     link = np.array([k // 10 if k < 10 * (p // 10) else -1 for k in range(p)])
-    order = np.array(sorted(range(p), key=lambda k: (link[k], -(k % 10)) if link[k] >= 0 else (p, k)))
+    order = (np.array(sorted(range(p), key=lambda k: (link[k],
+                                                      -(k % 10)) if link[k] >= 0 else (p, k))))
     norms = np.linalg.norm(X, axis=0)
     R = qr(X[:, order], mode="r")[0]
     d = np.abs(np.diag(R))
@@ -136,11 +140,14 @@ def base_structure(chain, *, armature: bool = False, seed: int = 0, tol: float =
     dp = np.abs(np.diag(Rp))
     rank = int(np.sum(dp > tol * dp[0])) if dp.size and dp[0] > 0 else 0
     if rank == 0:
-        raise UnidentifiableError(f"{chain.name}: the regressor is zero: no inertial parameter acts on the joints")
-    if int(is_ind.sum()) != rank:  # the fixed order disagrees with the pivoted rank: take the pivots
+        raise UnidentifiableError(f"{chain.name}: the regressor is zero: no inertial parameter "
+                                  "acts on the joints")
+    # the fixed order disagrees with the pivoted rank: take the pivots
+    if int(is_ind.sum()) != rank:
         is_ind = np.isin(order, piv[:rank])
     ind, dep = order[is_ind], order[~is_ind]
-    beta = np.linalg.lstsq(X[:, ind], X[:, dep], rcond=None)[0] if dep.size else np.zeros((ind.size, 0))
+    beta = (np.linalg.lstsq(X[:, ind], X[:, dep],
+                            rcond=None)[0] if dep.size else np.zeros((ind.size, 0)))
     beta[np.abs(beta) < 1e-8] = 0.0
     keep = np.argsort(ind)  # the standard order
     ind, beta = ind[keep], beta[keep]
@@ -166,7 +173,8 @@ def friction_columns(qd, kinds) -> np.ndarray:
     for j in range(m):
         for c, kind in enumerate(kinds):
             col = j * len(kinds) + c
-            F[:, j, col] = np.sign(qd[:, j]) if kind == "coulomb" else qd[:, j] if kind == "viscous" else 1.0
+            F[:, j, col] = (np.sign(qd[:, j]) if kind == "coulomb" else qd[:, j]
+                            if kind == "viscous" else 1.0)
     return F
 
 
@@ -210,11 +218,13 @@ class Consistency:
         if self.consistent:
             return f"physically consistent within the noise: {where}"
         links = ", ".join(self.failing_links) or "(no single part)"
-        return (f"physically inconsistent: no standard parameters with positive-definite pseudo-inertia reproduce "
+        return ("physically inconsistent: no standard parameters with positive-definite "
+                "pseudo-inertia reproduce "
                 f"the base parameters within the noise: {where}; on the boundary: {links}")
 
     def to_dict(self) -> dict:
-        return dict(consistent=self.consistent, distance_sigma=self.distance, failing_links=list(self.failing_links),
+        return dict(consistent=self.consistent, distance_sigma=self.distance,
+                    failing_links=list(self.failing_links),
                     dof=self.dof, bound_sigma=self.bound, level=self.level, p_value=self.p_value,
                     estimate_consistent=self.inside, solver=self.solver, converged=self.converged,
                     iterations=self.iterations, message=self.message())
@@ -292,7 +302,8 @@ class DynamicsResult:
     @property
     def friction(self) -> dict:
         kinds = FRICTION_MODELS[self.friction_model]
-        return self._per_joint(len(self.names) - self.chain.dof * len(kinds), kinds) if kinds else {}
+        return (self._per_joint(len(self.names) - self.chain.dof * len(kinds),
+                                kinds) if kinds else {})
 
     @property
     def armature(self) -> dict:
@@ -303,7 +314,8 @@ class DynamicsResult:
     def regressor(self, q, qd, qdd) -> np.ndarray:
         """The identified model's regressor X (B, m, n_params): τ = X θ."""
         q, qd, qdd = (np.atleast_2d(np.asarray(a, dtype=np.float64)) for a in (q, qd, qdd))
-        Y = _inertial_columns(self.chain, q, qd, qdd, self.armature_identified)[:, :, self.structure.independent]
+        Y = (_inertial_columns(self.chain, q, qd, qdd,
+                               self.armature_identified)[:, :, self.structure.independent])
         kinds = FRICTION_MODELS[self.friction_model]
         return np.concatenate([Y, friction_columns(qd, kinds)], axis=2) if kinds else Y
 
@@ -317,8 +329,10 @@ class DynamicsResult:
         d = dict(base_parameters=self.base_parameters, base_parameters_std=self.base_parameters_std,
                  friction=self.friction, friction_model=self.friction_model,
                  residual_std=self.residual_std, relative_error_percent=self.relative_error_percent,
-                 condition_number=self.condition_number, n_samples=self.n_samples, constrained=self.constrained,
-                 joints=list(self.chain.coordinate_names), n_standard_parameters=len(self.structure.standard_names),
+                 condition_number=self.condition_number, n_samples=self.n_samples,
+                 constrained=self.constrained,
+                 joints=list(self.chain.coordinate_names),
+                 n_standard_parameters=len(self.structure.standard_names),
                  n_base_parameters=self.n_base, warnings=list(self.warnings))
         if self.consistency is not None:
             d["consistency"] = self.consistency.to_dict()
@@ -326,10 +340,12 @@ class DynamicsResult:
 
 
 def _joint_states(q, qd, qdd, tau, names):
-    """q, q̇, q̈, τ as checked (N, m) arrays of one length N (:func:`~gripkit.sysid.checks.as_io_matrix`)."""
+    """q, q̇, q̈, τ as checked (N, m) arrays of one length N
+    (:func:`~gripkit.sysid.checks.as_io_matrix`)."""
     q = as_io_matrix(q, "q", None, names, "joint")
     N = q.shape[0]
-    return (q, as_io_matrix(qd, "qd", N, names, "joint"), as_io_matrix(qdd, "qdd", N, names, "joint"),
+    return (q, as_io_matrix(qd, "qd", N, names, "joint"),
+            as_io_matrix(qdd, "qdd", N, names, "joint"),
             as_io_matrix(tau, "tau", N, names, "joint"))
 
 
@@ -337,7 +353,8 @@ def _check_choices(friction: str, covariance: str) -> None:
     """DataError unless ``friction`` is a key of :data:`FRICTION_MODELS` and ``covariance`` is
     'ols' or 'hac'."""
     if friction not in FRICTION_MODELS:
-        raise DataError(f"friction: expected one of {', '.join(FRICTION_MODELS)}, found {friction!r}")
+        raise DataError(f"friction: expected one of {', '.join(FRICTION_MODELS)}, "
+                        f"found {friction!r}")
     if covariance not in ("ols", "hac"):
         raise DataError(f"covariance: expected 'ols' or 'hac', found {covariance!r}")
 
@@ -351,7 +368,8 @@ def _row_weights(weights, N: int, m: int) -> np.ndarray:
     if w.ndim == 1:
         w = np.repeat(w[:, None], m, axis=1)
     if w.shape != (N, m) or not np.isfinite(w).all() or (w < 0).any():
-        raise DataError(f"weights: expected (N,) or (N, {m}) finite non-negative values, found shape {np.shape(weights)}")
+        raise DataError(f"weights: expected (N,) or (N, {m}) finite non-negative values, found "
+                        f"shape {np.shape(weights)}")
     return w
 
 
@@ -387,7 +405,8 @@ class _JointNormalEquations:
         if cnd < 1e6:
             th = np.linalg.solve(Gs, (jw @ self.bj) / self.scale)
         else:
-            th = np.linalg.lstsq(self._scaled_rows(jw), (self.tau * np.sqrt(self.rows_w * jw)).reshape(-1),
+            th = np.linalg.lstsq(self._scaled_rows(jw),
+                                 (self.tau * np.sqrt(self.rows_w * jw)).reshape(-1),
                                  rcond=None)[0]
         return Gs, th / self.scale, cnd, V
 
@@ -399,7 +418,8 @@ class _JointNormalEquations:
 
     def rss(self, th):
         """Weighted residual sum of squares of each joint."""
-        return np.maximum(self.yy - 2 * self.bj @ th + np.einsum("i,jik,k->j", th, self.Gj, th), 0.0)
+        return (np.maximum(self.yy - 2 * self.bj @ th + np.einsum("i,jik,k->j", th, self.Gj, th),
+                           0.0))
 
     def covariance(self, theta, jw, Gs, kind: str, r2) -> np.ndarray:
         """Cov(θ̂): σ̂² (XᵀWX)⁻¹ with σ̂² = rᵀWr/(N_rows − P) (``'ols'``), or the Newey-West
@@ -420,7 +440,8 @@ def _normal_equations(X3, tau, rows_w, names) -> _JointNormalEquations:
     P = X3.shape[2]
     n_rows = int((rows_w > 0).sum())
     if n_rows < 2 * P:
-        raise DataError(f"{n_rows} weighted rows are too few for {P} parameters (need at least {2 * P})",
+        raise DataError(f"{n_rows} weighted rows are too few for {P} parameters (need "
+                        f"at least {2 * P})",
                         hint="log a longer run")
     ne = _JointNormalEquations(X3, tau, rows_w, n_rows)
     weak = np.flatnonzero(ne.scale == 0)
@@ -441,7 +462,8 @@ def _solve_joint_weighted(ne: _JointNormalEquations, names, joint_weighting: boo
     if cond > 1e10:
         v = V[:, 0] / ne.scale
         top = np.argsort(-np.abs(v / np.max(np.abs(v))))[:3]
-        raise UnidentifiableError(f"the data do not excite every base parameter (condition number {cond:.3g}); "
+        raise UnidentifiableError("the data do not excite every base parameter (condition "
+                                  f"number {cond:.3g}); "
                                   f"the weakest direction mixes {', '.join(names[k] for k in top)}",
                                   hint="use a richer excitation (gripkit.sysid.fourier_trajectory)")
     if joint_weighting and m > 1:
@@ -456,7 +478,8 @@ def _solve_joint_weighted(ne: _JointNormalEquations, names, joint_weighting: boo
 @entry_point
 def identify_dynamics(chain, q, qd, qdd, tau, *, friction: str = "coulomb-viscous", weights=None,
                       armature: bool = False, covariance: str = "ols", constrained: bool = False,
-                      check_consistency: bool = True, joint_weighting: bool = True) -> DynamicsResult:
+                      check_consistency: bool = True,
+                      joint_weighting: bool = True) -> DynamicsResult:
     """Identify a chain's base inertial parameters and per-joint friction from joint states and
     efforts (module doc).
 
@@ -499,7 +522,8 @@ def identify_dynamics(chain, q, qd, qdd, tau, *, friction: str = "coulomb-viscou
     r2 = ne.rss(theta)
     C = ne.covariance(theta, jw, Gs, covariance, r2)
     wsum = rows_w.sum(axis=0)
-    res_std = {j: float(np.sqrt(r2[k] / wsum[k])) if wsum[k] > 0 else float("nan") for k, j in enumerate(jn)}
+    res_std = ({j: float(np.sqrt(r2[k] / wsum[k])) if wsum[k] > 0 else float("nan")
+                for k, j in enumerate(jn)})
     rel = float(100.0 * np.sqrt(r2.sum() / max(ne.yy.sum(), 1e-300)))
     notes = []
     if cond > 1e5:
@@ -512,7 +536,8 @@ def identify_dynamics(chain, q, qd, qdd, tau, *, friction: str = "coulomb-viscou
             notes.append(cons.message())
         if constrained:
             theta = cons.theta
-    return DynamicsResult(chain, st, friction, armature, names, theta, C, res_std, rel, cond, N, cons,
+    return DynamicsResult(chain, st, friction, armature, names, theta, C, res_std, rel, cond, N,
+                          cons,
                           constrained, theta_u, notes)
 
 
@@ -528,7 +553,8 @@ def _j_to_phi() -> np.ndarray:
         J = J.reshape(4, 4)
         Sigma = J[:3, :3]
         Io = np.trace(Sigma) * np.eye(3) - Sigma
-        A[:, e] = [J[3, 3], J[0, 3], J[1, 3], J[2, 3], Io[0, 0], Io[0, 1], Io[1, 1], Io[0, 2], Io[1, 2], Io[2, 2]]
+        A[:, e] = ([J[3, 3], J[0, 3], J[1, 3], J[2, 3], Io[0, 0], Io[0, 1], Io[1, 1], Io[0, 2],
+                    Io[1, 2], Io[2, 2]])
     return A
 
 
@@ -629,7 +655,8 @@ def _failing_parts(chain, phi_p, x, theta, std, kinds, n_arm: int, nb: int,
 def _consistency(chain, st: BaseStructure, theta, C, kinds, m, armature,
                  level: float = 0.95) -> Consistency:
     """Physical consistency of the estimate θ̂ with covariance C
-    (:mod:`gripkit.sysid.rigid_body.dynamics_projection`): first the least-change standard parameters,
+    (:mod:`gripkit.sysid.rigid_body.dynamics_projection`): first the least-change standard
+    parameters,
     consistent there means consistent (d = 0, no search); else the projection of θ̂ onto the
     consistent set in the metric C⁻¹, its distance d and the χ² test of level 1 − ``level``
     with n = dim θ − (offsets) degrees of freedom."""
@@ -647,12 +674,14 @@ def _consistency(chain, st: BaseStructure, theta, C, kinds, m, armature,
     try:
         Ci = np.linalg.cholesky(np.linalg.inv(C))
     except np.linalg.LinAlgError:
-        raise IdentificationError("the covariance of the estimate is not positive definite") from None
+        raise IdentificationError("the covariance of the estimate is not "
+                                  "positive definite") from None
     std = np.sqrt(np.diag(C))
     phi_nom = np.concatenate([phi0, np.zeros(n_arm)]) if n_arm else phi0.copy()
     phi_p, reproduces = _least_change_parameters(phi_nom, K, theta[:nb], n_links, p_std)
     links_ok = all(_psd(pseudo_inertia(phi_p[10 * k:10 * k + 10])) for k in range(n_links))
-    fr_ok = all(theta[nb + j * len(kinds) + c] >= 0 for j in range(m) for c, kind in enumerate(kinds)
+    fr_ok = all(theta[nb + j * len(kinds) + c] >= 0 for j in range(m)
+                for c, kind in enumerate(kinds)
                 if kind in ("coulomb", "viscous"))
     if reproduces and links_ok and fr_ok and (not n_arm or (phi_p[p_std:] >= 0).all()):
         return Consistency(True, 0.0, (), phi_p, theta.copy(), dof=dof, bound=bound, level=level,
@@ -681,11 +710,13 @@ def _consistency(chain, st: BaseStructure, theta, C, kinds, m, armature,
 
 
 def load_dynamics_model(path) -> DynamicsResult:
-    """Read a model written by ``result.save(path)`` (:mod:`gripkit.sysid.rigid_body.dynamics_file`): a
+    """Read a model written by ``result.save(path)``
+    (:mod:`gripkit.sysid.rigid_body.dynamics_file`): a
     :class:`DynamicsResult` with ``predict``, ``base_parameters``, ``base_parameters_std``,
     ``friction``, ``covariance``, ... as identified.
 
-    Raises DataError for a missing file, a file that is not JSON, of another ``schema`` or of a newer
+    Raises DataError for a missing file, a file that is not JSON, of another ``schema`` or of a
+    newer
     ``schema_version``; ModelError for missing or malformed fields; warns (AccuracyWarning) when
     the content hash does not match (the file was edited after it was saved).
     """
@@ -695,11 +726,13 @@ def load_dynamics_model(path) -> DynamicsResult:
         urdf = doc["urdf"]
         text = urdf["text"]
         if hashlib.sha256(text.encode()).hexdigest() != urdf.get("sha256"):
-            emit_warning(f"dynamics model file {where}: the URDF text does not match its sha256", AccuracyWarning)
+            emit_warning(f"dynamics model file {where}: the URDF text does not "
+                         "match its sha256", AccuracyWarning)
         chain = from_urdf(text, base_link=urdf.get("base_link"), tip_link=urdf.get("tip_link"),
                           gravity=float_array(doc["gravity"], "gravity", where, (3,)))
         if list(chain.coordinate_names) != list(doc["joints"]):
-            raise ModelError(f"dynamics model file {where}: the URDF's joints {list(chain.coordinate_names)} "
+            raise ModelError(f"dynamics model file {where}: the URDF's joints "
+                             f"{list(chain.coordinate_names)} "
                              f"disagree with the file's {doc['joints']}")
         s = doc["structure"]
         ind = np.asarray(s["independent"], dtype=np.intp)
@@ -725,11 +758,15 @@ def load_dynamics_model(path) -> DynamicsResult:
         data = doc.get("data") or {}
         return DynamicsResult(
             chain, structure, doc["friction_model"], bool(doc["armature"]), names, theta, cov,
-            {k: float(v) for k, v in doc["residual_std"].items()}, float(doc["relative_error_percent"]),
-            float(doc["condition_number"]), int(doc["n_samples"]), consistency, bool(doc["constrained"]),
-            float_array(doc["unconstrained_values"], "unconstrained_values", where, (n,)), list(doc.get("warnings", [])),
+            {k: float(v) for k, v in doc["residual_std"].items()},
+            float(doc["relative_error_percent"]),
+            float(doc["condition_number"]), int(doc["n_samples"]), consistency,
+            bool(doc["constrained"]),
+            float_array(doc["unconstrained_values"], "unconstrained_values", where, (n,)),
+            list(doc.get("warnings", [])),
             urdf_text=text, base_link=urdf.get("base_link"), tip_link=urdf.get("tip_link"),
             data_file=data.get("file"), data_hash=data.get("sha256"))
     except (KeyError, TypeError, ValueError) as exc:
-        raise ModelError(f"dynamics model file {where}: a required field is missing or malformed ({exc})",
+        raise ModelError(f"dynamics model file {where}: a required field is missing or "
+                         f"malformed ({exc})",
                          hint="regenerate the file with gripkit identify dynamics --out") from None

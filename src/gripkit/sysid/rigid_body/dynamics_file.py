@@ -11,7 +11,8 @@ models of :mod:`gripkit.sysid.model_file`)::
      "friction_model": "coulomb-viscous", "armature": false,
      "structure": {"standard_names": […], "independent": […], "dependent": […], "beta": [[…]]},
      "parameters": {"names": […], "values": […], "std": […], "covariance": [[…]]},
-     "base_parameters": {name: {"value": v, "std": σ}}, "friction": {joint: {"coulomb": …, "coulomb_std": …}},
+     "base_parameters": {name: {"value": v, "std": σ}}, "friction": {joint: {"coulomb": …,
+     "coulomb_std": …}},
      "residual_std": {joint: σ}, "relative_error_percent": …, "condition_number": …, "n_samples": N,
      "constrained": false, "unconstrained_values": […],
      "consistency": {"consistent": …, "distance_sigma": …, "failing_links": […],
@@ -23,8 +24,10 @@ models of :mod:`gripkit.sysid.model_file`)::
      "content_sha256": "…"}
 
 The URDF text makes the file self-contained: the chain is rebuilt from it with the stored links
-and gravity; the base structure (K of φ_b = K φ, :class:`~gripkit.sysid.rigid_body.dynamics.BaseStructure`)
-is stored rather than found again, so that the loaded model predicts τ = X(q, q̇, q̈) θ with the very
+and gravity; the base structure (K of φ_b = K φ,
+:class:`~gripkit.sysid.rigid_body.dynamics.BaseStructure`)
+is stored rather than found again, so that the loaded model predicts τ = X(q, q̇, q̈) θ with the
+very
 columns and parameters it was identified with. ``base_parameters`` and ``friction`` repeat
 ``parameters`` for a reader of the file; the loader uses ``parameters``.
 """
@@ -76,24 +79,28 @@ def dynamics_document(result) -> dict:
            "base_parameters": {n: {"value": v, "std": result.base_parameters_std[n]}
                                for n, v in result.base_parameters.items()},
            "friction": result.friction, "residual_std": result.residual_std,
-           "relative_error_percent": result.relative_error_percent, "condition_number": result.condition_number,
+           "relative_error_percent": result.relative_error_percent,
+           "condition_number": result.condition_number,
            "n_samples": result.n_samples, "constrained": result.constrained,
            "unconstrained_values": result.unconstrained_theta,
            "consistency": None if cons is None else {
-               "consistent": cons.consistent, "distance_sigma": cons.distance, "failing_links": cons.failing_links,
+               "consistent": cons.consistent, "distance_sigma": cons.distance,
+               "failing_links": cons.failing_links,
                "standard_parameters": cons.standard_parameters, "values": cons.theta,
                "dof": cons.dof, "bound_sigma": cons.bound, "level": cons.level,
                "p_value": cons.p_value, "estimate_consistent": cons.inside, "solver": cons.solver,
                "converged": cons.converged, "iterations": cons.iterations},
            "warnings": list(result.warnings),
-           "data": None if result.data_file is None else {"file": result.data_file, "sha256": result.data_hash}}
+           "data": None if result.data_file is None else {"file": result.data_file,
+                                                          "sha256": result.data_hash}}
     doc = plain(doc)
     doc["content_sha256"] = content_hash(doc)
     return doc
 
 
 def save_dynamics_model(result, path) -> None:
-    """Write ``result`` (a :class:`~gripkit.sysid.rigid_body.dynamics.DynamicsResult`) to ``path`` (.json)."""
+    """Write ``result`` (a :class:`~gripkit.sysid.rigid_body.dynamics.DynamicsResult`) to ``path``
+    (.json)."""
     path = Path(path)
     if path.suffix.lower() != ".json":
         raise DataError(f"dynamics model file: expected a .json path, found {str(path)!r}")
@@ -105,9 +112,11 @@ def float_array(x, name, where, shape=None) -> np.ndarray:
     try:
         a = np.asarray(x, dtype=np.float64)  # null (a non-finite number when saved) reads as NaN
     except (TypeError, ValueError):
-        raise ModelError(f"dynamics model file {where}: field {name!r} is not an array of numbers") from None
+        raise ModelError(f"dynamics model file {where}: field {name!r} is not an "
+                         "array of numbers") from None
     if shape is not None and a.shape != shape:
-        raise ModelError(f"dynamics model file {where}: field {name!r} has shape {a.shape}, expected {shape}")
+        raise ModelError(f"dynamics model file {where}: field {name!r} has shape {a.shape}, "
+                         f"expected {shape}")
     return a
 
 
@@ -118,5 +127,6 @@ def read_dynamics_document(path) -> dict:
     ``schema_version``, and an AccuracyWarning when the content hash does not match (the file was
     edited after it was saved); :func:`gripkit.sysid.model_file.read_document` does the checks."""
     return read_document(path, SCHEMA, SCHEMA_VERSION, what="dynamics model file",
-                         hint="give a file written by gripkit identify dynamics --out or result.save(); "
+                         hint="give a file written by gripkit identify dynamics --out or "
+                              "result.save(); "
                               "gripkit.sysid.load_model reads gripkit.linear-model files")

@@ -3,7 +3,8 @@ its own covariance, and the χ² test built on that distance (:func:`gripkit.sys
 ``check_consistency`` and ``constrained``).
 
 **What is measured, and in which metric.** The data determine only the identified parameters
-θ = [φ_b, f]: the r base parameters φ_b = K φ (:class:`~gripkit.sysid.rigid_body.dynamics.BaseStructure`,
+θ = [φ_b, f]: the r base parameters φ_b = K φ
+(:class:`~gripkit.sysid.rigid_body.dynamics.BaseStructure`,
 rotor inertias included when identified) and the friction coefficients f. Their estimate θ̂ has
 the covariance C; the standard parameters φ (10 per link) do not have one, since the data say
 nothing about the directions of null(K), so a distance measured in φ is arbitrary. A
@@ -39,7 +40,8 @@ P(χ²_n > d²), an upper bound of the true one for the same reason. d = 0 means
 itself is consistent.
 
 **The constrained estimate is never further from the truth.** θ_c is the projection of θ̂ onto
-the closed convex set S_T (S bounded, see *The bound T*) in the norm ‖v‖ = √(vᵀ C⁻¹ v). A projection onto a convex set containing
+the closed convex set S_T (S bounded, see *The bound T*) in the norm ‖v‖ = √(vᵀ C⁻¹ v). A
+projection onto a convex set containing
 θ* is non-expansive towards it: ‖θ_c − θ*‖² ≤ ‖θ̂ − θ*‖² − ‖θ̂ − θ_c‖² (the obtuse-angle
 property of projections), for every data set, not only in expectation.
 

@@ -33,7 +33,8 @@ def parameter_unit(name: str) -> str:
 
 def _residual_figure(t, r, joints, rms):
     plt = pyplot()
-    fig, axes = plt.subplots(len(joints), 1, figsize=(10, 2.2 * len(joints)), squeeze=False, sharex=True)
+    fig, axes = (plt.subplots(len(joints), 1, figsize=(10, 2.2 * len(joints)), squeeze=False,
+                              sharex=True))
     for j, name in enumerate(joints):
         ax = axes[j, 0]
         ax.plot(t, r[:, j], lw=0.8)
@@ -49,7 +50,8 @@ def _residual_figure(t, r, joints, rms):
 def dynamics_report(result, t, q, qd, qdd, tau, *, weights=None, data_name: str = "data",
                     warnings_list=()) -> Report:
     """Build the :class:`~gripkit.report.html.Report` of ``result`` on the samples it was fitted to
-    (``t`` (N,) s; ``q``, ``qd``, ``qdd``, ``tau`` (N, m); ``weights`` (N, m), > 0 for the rows used)."""
+    (``t`` (N,) s; ``q``, ``qd``, ``qdd``, ``tau`` (N, m); ``weights`` (N, m), > 0 for the rows
+    used)."""
     joints = list(result.chain.coordinate_names)
     t = np.asarray(t, dtype=np.float64)
     t = t - t[0]
@@ -61,21 +63,27 @@ def dynamics_report(result, t, q, qd, qdd, tau, *, weights=None, data_name: str 
                     for j in range(len(joints))])
     rep = Report(f"gripkit dynamics report: {result.chain.name}",
                  f"data {data_name}: {result.n_samples} samples, {result.n_base} base parameters "
-                 f"(of {len(result.structure.standard_names)} standard), friction {result.friction_model}")
+                 f"(of {len(result.structure.standard_names)} standard), friction "
+                 f"{result.friction_model}")
     sec = rep.section("Measured and predicted efforts",
-                      "Effort of each joint (N·m, N for prismatic joints) measured and predicted by the identified "
+                      "Effort of each joint (N·m, N for prismatic joints) measured and predicted "
+                      "by the identified "
                       "model, τ̂ = X(q, q̇, q̈) θ̂, on the filtered, decimated samples of the fit.")
     for j, name in enumerate(joints):
         sec.figure(measured_vs_model(t, tau[:, j], {"model": pred[:, j]}, ylabel=f"{name} effort",
-                                     title=f"{name}: residual RMS {rms[j]:.3g}"), name, name=f"effort-{j}")
-    sec = rep.section("Residuals", "τ − τ̂ per joint; the RMS is over the rows the fit kept (away from velocity "
-                      "reversals and standstill), the residual std over those rows weighted as in the fit.")
+                                     title=f"{name}: residual "
+                                           f"RMS {rms[j]:.3g}"), name, name=f"effort-{j}")
+    sec = rep.section("Residuals", "τ − τ̂ per joint; the RMS is over the rows the fit kept "
+                                   "(away from velocity "
+                      "reversals and standstill), the residual std over those rows "
+                      "weighted as in the fit.")
     sec.table(["joint", "residual RMS", "residual std"],
               [[name, f"{rms[j]:.4g}", f"{result.residual_std[name]:.4g}"]
                for j, name in enumerate(joints)])
     sec.figure(_residual_figure(t, r, joints, rms), "residuals", name="residuals")
     std = result.base_parameters_std
-    rep.section("Base parameters", "Each base parameter is the combination of standard parameters it is named "
+    rep.section("Base parameters", "Each base parameter is the combination of standard "
+                                   "parameters it is named "
                 "after (SI units of its leading term).").table(
         ["base parameter", "value", "σ", "unit"],
         [[n, f"{v:.6g}", f"{std[n]:.3g}", parameter_unit(n)]
@@ -85,7 +93,8 @@ def dynamics_report(result, t, q, qd, qdd, tau, *, weights=None, data_name: str 
         kinds = [k for k in next(iter(result.friction.values())) if not k.endswith("_std")]
         sec.table(["joint", *kinds], [[j, *(f"{f[k]:.4g} ± {f[k + '_std']:.2g}" for k in kinds)]
                                       for j, f in result.friction.items()],
-                  caption="value ± σ: Coulomb and offset N·m, viscous N·m·s/rad (N, N·s/m for prismatic joints)")
+                  caption="value ± σ: Coulomb and offset N·m, viscous N·m·s/rad (N, N·s/m for "
+                          "prismatic joints)")
     else:
         sec.text("not identified (friction model none)")
     cons = result.consistency
@@ -104,7 +113,8 @@ def dynamics_report(result, t, q, qd, qdd, tau, *, weights=None, data_name: str 
     return rep
 
 
-def write_dynamics_report(result, t, q, qd, qdd, tau, out_dir, *, weights=None, data_name: str = "data",
+def write_dynamics_report(result, t, q, qd, qdd, tau, out_dir, *, weights=None,
+                          data_name: str = "data",
                           warnings_list=()) -> Path:
     """Write ``out_dir/index.html`` (self-contained: figures inline); returns its path."""
     return dynamics_report(result, t, q, qd, qdd, tau, weights=weights, data_name=data_name,

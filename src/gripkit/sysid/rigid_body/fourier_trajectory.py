@@ -96,11 +96,14 @@ class FourierTrajectory:
         return path
 
     def to_dict(self) -> dict:
-        return dict(f0_hz=self.f0, dt_s=self.dt, harmonics=int(self.a.shape[1]), joints=list(self.joint_names),
-                    q0=self.q0.tolist(), a=self.a.tolist(), b=self.b.tolist(), n_samples=int(self.t.size),
+        return dict(f0_hz=self.f0, dt_s=self.dt, harmonics=int(self.a.shape[1]),
+                    joints=list(self.joint_names),
+                    q0=self.q0.tolist(), a=self.a.tolist(), b=self.b.tolist(),
+                    n_samples=int(self.t.size),
                     duration_s=float(self.t.size * self.dt), condition_number=self.condition_number,
                     initial_condition_number=self.initial_condition_number,
-                    limits={k: np.asarray(v).tolist() for k, v in self.limits.items()}, info=self.info)
+                    limits={k: np.asarray(v).tolist() for k, v in self.limits.items()},
+                    info=self.info)
 
 
 def _limit(name, given, from_chain, m, default):
@@ -116,11 +119,14 @@ def _limit(name, given, from_chain, m, default):
 def _check_design(f0: float, dt: float, harmonics, periods) -> None:
     """DataError unless f0 > 0, dt > 0 samples the highest harmonic above twice its frequency, and
     ``harmonics`` and ``periods`` are positive integers."""
-    if not (math.isfinite(f0) and f0 > 0) or not (math.isfinite(dt) and dt > 0 and 1.0 / dt > 2 * f0 * harmonics):
-        raise DataError(f"f0 = {f0!r} Hz and dt = {dt!r} s: need f0 > 0 and a sampling rate 1/dt above twice the "
+    if not (math.isfinite(f0) and f0 > 0) or not (math.isfinite(dt) and dt > 0 and 1.0 / dt > 2
+                                                  * f0 * harmonics):
+        raise DataError(f"f0 = {f0!r} Hz and dt = {dt!r} s: need f0 > 0 and a sampling rate 1/dt "
+                        "above twice the "
                         f"highest harmonic {f0 * harmonics:g} Hz")
     if int(harmonics) != harmonics or harmonics < 1 or int(periods) != periods or periods < 1:
-        raise DataError(f"harmonics and periods: expected positive integers, found {harmonics!r}, {periods!r}")
+        raise DataError("harmonics and periods: expected positive integers, found "
+                        f"{harmonics!r}, {periods!r}")
 
 
 def _position_limits(position_limits, chain_limits, m: int) -> tuple[np.ndarray, np.ndarray]:
@@ -132,10 +138,13 @@ def _position_limits(position_limits, chain_limits, m: int) -> tuple[np.ndarray,
         lo = np.broadcast_to(np.asarray(position_limits[0], dtype=np.float64), (m,)).copy()
         hi = np.broadcast_to(np.asarray(position_limits[1], dtype=np.float64), (m,)).copy()
     else:
-        lo = np.where(np.isfinite(lo_c), lo_c, -math.pi / 2) if lo_c is not None else np.full(m, -math.pi / 2)
-        hi = np.where(np.isfinite(hi_c), hi_c, math.pi / 2) if hi_c is not None else np.full(m, math.pi / 2)
+        lo = (np.where(np.isfinite(lo_c), lo_c,
+                       -math.pi / 2) if lo_c is not None else np.full(m, -math.pi / 2))
+        hi = (np.where(np.isfinite(hi_c), hi_c,
+                       math.pi / 2) if hi_c is not None else np.full(m, math.pi / 2))
     if not (np.isfinite(lo).all() and np.isfinite(hi).all() and (hi > lo).all()):
-        raise DataError(f"position_limits: expected finite lower < upper per joint, found {lo.tolist()}, {hi.tolist()}")
+        raise DataError("position_limits: expected finite lower < upper per joint, found "
+                        f"{lo.tolist()}, {hi.tolist()}")
     return lo, hi
 
 
@@ -145,8 +154,10 @@ class _Design:
     the margins of the conservative bounds (≥ 0 inside the limits), random feasible starts and
     the projection of a solution back inside the bounds."""
 
-    def __init__(self, chain, st, q0, half, vmax, amax, f0: float, H: int, friction: bool, samples_per_period: int):
-        self.chain, self.st, self.q0, self.f0, self.H, self.friction = chain, st, q0, f0, H, friction
+    def __init__(self, chain, st, q0, half, vmax, amax, f0: float, H: int, friction: bool,
+                 samples_per_period: int):
+        self.chain, self.st, self.q0, self.f0, self.H, self.friction = (chain, st, q0, f0, H,
+                                                                        friction)
         self.half, self.vmax, self.amax = half, vmax, amax
         self.m = q0.size
         self.w = 2 * math.pi * f0 * np.arange(1, H + 1)
@@ -172,12 +183,14 @@ class _Design:
     def bounds_margin(self, x):
         a, b = self.unpack(x)
         c = np.sqrt(a ** 2 + b ** 2 + 1e-30)
-        return np.concatenate([self.half - c @ (1 / self.w), self.vmax - c.sum(axis=1), self.amax - c @ self.w])
+        return (np.concatenate([self.half - c @ (1 / self.w), self.vmax - c.sum(axis=1),
+                                self.amax - c @ self.w]))
 
     def _joint_factors(self, c):
         """Per joint, the factor that scales amplitudes c (m, H) onto the tightest bound."""
         w = self.w
-        return np.min(np.column_stack([self.half / (c @ (1 / w)), self.vmax / c.sum(axis=1), self.amax / (c @ w)]), axis=1)
+        return (np.min(np.column_stack([self.half / (c @ (1 / w)), self.vmax / c.sum(axis=1),
+                                        self.amax / (c @ w)]), axis=1))
 
     def start(self, rng):
         """Random coefficients, each joint scaled into its limits with a margin (80 %)."""
@@ -353,7 +366,8 @@ def _best_design(design: _Design, restarts: int, max_iterations: int, seed: int,
         f_start = design.objective(x0)
         first_cond = 10 ** f_start if first_cond is None else first_cond
         callback = _Progress(design, k + 1, starts, int(max_iterations)) if progress else None
-        sol = minimize(design.objective, x0, method="SLSQP", constraints=[{"type": "ineq", "fun": design.bounds_margin}],
+        sol = minimize(design.objective, x0, method="SLSQP",
+                       constraints=[{"type": "ineq", "fun": design.bounds_margin}],
                        options=dict(maxiter=int(max_iterations), ftol=1e-6), callback=callback)
         x = design.shrink(sol.x) if np.isfinite(sol.x).all() else x0
         f = design.objective(x)
@@ -365,7 +379,8 @@ def _best_design(design: _Design, restarts: int, max_iterations: int, seed: int,
 
 
 @entry_point
-def fourier_trajectory(chain, *, f0: float = 0.1, harmonics: int = 5, dt: float = 0.01, periods: int = 1,
+def fourier_trajectory(chain, *, f0: float = 0.1, harmonics: int = 5, dt: float = 0.01,
+                       periods: int = 1,
                        position_limits=None, velocity_limits=None, acceleration_limits=None,
                        q0=None, friction: bool = True, samples_per_period: int = 200, seed: int = 0,
                        restarts: int = 0, max_iterations: int = 200,
@@ -412,13 +427,16 @@ def fourier_trajectory(chain, *, f0: float = 0.1, harmonics: int = 5, dt: float 
     lim = getattr(chain, "limits", None)
     lo, hi = _position_limits(position_limits, lim, m)
     v_c = getattr(lim, "velocity", None)
-    vmax = _limit("velocity_limits", velocity_limits, None if v_c is None else np.where(np.isfinite(v_c), v_c, 2.0), m, 2.0)
+    vmax = (_limit("velocity_limits", velocity_limits,
+                   None if v_c is None else np.where(np.isfinite(v_c), v_c, 2.0), m, 2.0))
     amax = _limit("acceleration_limits", acceleration_limits, None, m, 10.0)
-    q0 = 0.5 * (lo + hi) if q0 is None else np.broadcast_to(np.asarray(q0, dtype=np.float64), (m,)).copy()
+    q0 = (0.5 * (lo + hi) if q0 is None else np.broadcast_to(np.asarray(q0, dtype=np.float64),
+                                                             (m,)).copy())
     if ((q0 <= lo) | (q0 >= hi)).any():
         raise DataError(f"q0: the centre {q0.tolist()} must lie inside the position limits")
     st = base_structure(chain)
-    design = _Design(chain, st, q0, np.minimum(q0 - lo, hi - q0), vmax, amax, f0, H, friction, samples_per_period)
+    design = (_Design(chain, st, q0, np.minimum(q0 - lo, hi - q0), vmax, amax, f0, H, friction,
+                      samples_per_period))
     t_eval, t_max = _measured_estimate(design, int(seed), int(restarts), int(max_iterations), limit)
     n_eval = _evaluations(m, H, int(restarts), int(max_iterations))
     if t_max > limit:
@@ -431,13 +449,16 @@ def fourier_trajectory(chain, *, f0: float = 0.1, harmonics: int = 5, dt: float 
                f"(at most {_duration(t_max)}; usually far fewer)")
     f, x, first_cond = _best_design(design, restarts, max_iterations, seed, progress=progress)
     if not math.isfinite(f) or f >= 3:
-        raise IdentificationError(f"no excitation found that excites every base parameter of {getattr(chain, 'name', 'the chain')} "
+        raise IdentificationError("no excitation found that excites every base parameter of "
+                                  f"{getattr(chain, 'name', 'the chain')} "
                                   f"within the limits (best condition number {10 ** f:.3g})",
                                   hint="widen the limits, add harmonics or lower f0")
     a, b = design.unpack(x)
     t = np.arange(int(round(periods / (f0 * dt)))) * dt
     q, qd, qdd = fourier_states(a, b, q0, f0, t)
-    return FourierTrajectory(t, q, qd, qdd, a, b, q0, float(f0), float(dt), names, float(10 ** f), float(first_cond),
+    return FourierTrajectory(t, q, qd, qdd, a, b, q0, float(f0), float(dt), names, float(10 ** f),
+                             float(first_cond),
                              dict(lower=lo, upper=hi, velocity=vmax, acceleration=amax),
-                             dict(n_base_parameters=int(st.independent.size), friction_columns=bool(friction),
+                             dict(n_base_parameters=int(st.independent.size),
+                                  friction_columns=bool(friction),
                                   restarts=int(restarts), seed=int(seed)))

@@ -63,7 +63,8 @@ def _same_length(**named) -> list[np.ndarray]:
     for name, a in zip(named, arrays):
         bad = ~np.isfinite(a)
         if bad.any():
-            raise DataError(f"{name} has {int(bad.sum())} non-finite values (first at sample {int(np.argmax(bad))})")
+            raise DataError(f"{name} has {int(bad.sum())} non-finite values (first at sample "
+                            f"{int(np.argmax(bad))})")
     return arrays
 
 
@@ -138,7 +139,8 @@ def detect_breakaway(pwm, velocity, position=None, *, velocity_threshold: float 
         seg = u[a:b]
         if np.ptp(seg) != 0:
             raise DataError(f"pulse at samples {a}..{b} does not hold a constant PWM "
-                            f"({seg.min():g}..{seg.max():g})", hint="give the raw command, one pulse per step")
+                            f"({seg.min():g}..{seg.max():g})", hint="give the raw command, "
+                                                                    "one pulse per step")
         nmov = int((np.abs(v[a:b]) > velocity_threshold).sum())
         pulses.append(Pulse(a, b, float(seg[0]), nmov > min_moving_samples, float(x[a]), nmov))
     if not pulses:
@@ -148,7 +150,8 @@ def detect_breakaway(pwm, velocity, position=None, *, velocity_threshold: float 
     found = False
     still = math.nan
     for pl in pulses:
-        new_series = prev is None or abs(pl.pwm) <= abs(prev.pwm) or np.sign(pl.pwm) != np.sign(prev.pwm)
+        new_series = (prev is None or abs(pl.pwm) <= abs(prev.pwm)
+                      or np.sign(pl.pwm) != np.sign(prev.pwm))
         if new_series:
             found = False
             still = math.nan
@@ -194,7 +197,8 @@ class ConstantVelocityPoint:
 
 
 def constant_velocity_friction(pwm, velocity, *, motor_torque: Callable[[float, float], float],
-                               load: Callable[[int], float] | None = None, inertia: float | None = None,
+                               load: Callable[[int], float] | None = None,
+                               inertia: float | None = None,
                                dt: float | None = None, plateau: float = 0.05,
                                min_samples: int = 10) -> list[ConstantVelocityPoint]:
     """One friction point per constant-PWM run (Appendix D).
@@ -202,7 +206,8 @@ def constant_velocity_friction(pwm, velocity, *, motor_torque: Callable[[float, 
     The plateau of each run is the set of samples whose velocity lies within ``plateau``
     (relative) of the run's peak speed; friction = ``motor_torque(pwm, v)`` − ``load(i)`` at the
     plateau's mean velocity. A short run (the joint reaches its end stop) may still be speeding up
-    on its plateau: given the joint's ``inertia`` and the sample interval ``dt`` (s), the inertial torque
+    on its plateau: given the joint's ``inertia`` and the sample interval ``dt`` (s), the inertial
+    torque
     J·a (a from a line fitted to the plateau's velocity) is subtracted too. The friction std
     propagates the plateau's velocity scatter through the motor's torque-speed slope.
     """
@@ -226,18 +231,21 @@ def constant_velocity_friction(pwm, velocity, *, motor_torque: Callable[[float, 
               else float(np.mean([load(i) for i in range(a, b)][::max(1, (b - a) // 20)])))
         if inertia is not None:
             if dt is None:
-                raise DataError("constant_velocity_friction: give dt (the sample interval in s) with inertia")
+                raise DataError("constant_velocity_friction: give dt (the sample interval in "
+                                "s) with inertia")
             idx = np.flatnonzero(sel)
             acc = float(np.polyfit(idx * dt, vv, 1)[0]) if idx.size > 2 else 0.0
             ld += inertia * acc
-        pts.append(ConstantVelocityPoint(float(u[a]), vm, vs, tau - ld, abs(slope) * vs, int(sel.sum())))
+        pts.append(ConstantVelocityPoint(float(u[a]), vm, vs, tau - ld, abs(slope) * vs,
+                                         int(sel.sum())))
     if len(pts) < 2:
         raise IdentificationError(f"only {len(pts)} constant-PWM runs reached a plateau",
                                   hint="log longer runs, or lower min_samples")
     return pts
 
 
-def table_from_points(points: Sequence[ConstantVelocityPoint], name: str = "identified friction") -> FrictionTable:
+def table_from_points(points: Sequence[ConstantVelocityPoint],
+                      name: str = "identified friction") -> FrictionTable:
     """A lookup table (§6.3) from constant-velocity points, sorted by velocity; points at equal
     velocity are averaged."""
     v = np.array([p.velocity for p in points])
@@ -285,7 +293,8 @@ def fit_stribeck(velocity, friction, *, weights=None, fixed: dict | None = None,
 
     v, f = _same_length(velocity=velocity, friction=friction)
     if (v == 0).any():
-        raise DataError("friction at zero velocity is stiction, not kinetic friction; drop those points")
+        raise DataError("friction at zero velocity is stiction, not kinetic friction; "
+                        "drop those points")
     fixed = dict(fixed or {})
     unknown = set(fixed) - set(_STRIBECK)
     if unknown:
@@ -312,9 +321,12 @@ def fit_stribeck(velocity, friction, *, weights=None, fixed: dict | None = None,
         return np.sign(v) * mag + p["sigma"] * v + p["cubic"] * v ** 3
 
     lb = {"fc": 0.0, "fs": 0.0, "vs": 1e-6 * vmax, "delta": 0.2, "sigma": -np.inf, "cubic": -np.inf}
-    ub = {"fc": np.inf, "fs": np.inf, "vs": 10 * vmax, "delta": 10.0, "sigma": np.inf, "cubic": np.inf}
-    res = least_squares(lambda z: (model(unpack(z)) - f) * w, np.array([start[n] for n in free]) / scale,
-                        bounds=(np.array([lb[n] for n in free]) / scale, np.array([ub[n] for n in free]) / scale),
+    ub = ({"fc": np.inf, "fs": np.inf, "vs": 10 * vmax, "delta": 10.0, "sigma": np.inf,
+           "cubic": np.inf})
+    res = least_squares(lambda z: (model(unpack(z)) - f) * w,
+                        np.array([start[n] for n in free]) / scale,
+                        bounds=(np.array([lb[n] for n in free]) / scale,
+                                np.array([ub[n] for n in free]) / scale),
                         x_scale="jac")
     p = {k: float(val) for k, val in unpack(res.x).items()}
     J = res.jac / scale  # d r / d θ
@@ -354,8 +366,10 @@ class IdimResult:
     notes: list = field(default_factory=list)
 
     def to_dict(self) -> dict:
-        return dict(params=self.params, std=self.std, relative_error_percent=self.relative_error_percent,
-                    n_samples=self.n_samples, dt=self.dt, cutoff_hz=self.cutoff, decimation=self.decimation,
+        return dict(params=self.params, std=self.std,
+                    relative_error_percent=self.relative_error_percent,
+                    n_samples=self.n_samples, dt=self.dt, cutoff_hz=self.cutoff,
+                    decimation=self.decimation,
                     condition_number=self.condition_number, residual_std=self.residual_std,
                     covariance=self.covariance.tolist(), notes=list(self.notes))
 
@@ -397,19 +411,22 @@ def idim_samples(position, effort, *, dt: float, cutoff: float | None = None, or
     rate = 1.0 / sample_interval(dt)
     cutoff = rate / 50.0 if cutoff is None else float(cutoff)
     if not 0 < cutoff < rate / 2:
-        raise DataError(f"cutoff {cutoff:g} Hz must lie between 0 and the Nyquist frequency {rate / 2:g} Hz")
+        raise DataError(f"cutoff {cutoff:g} Hz must lie between 0 and the Nyquist frequency "
+                        f"{rate / 2:g} Hz")
     q = decimation if decimation is not None else max(1, int(rate / (2 * 2.5 * cutoff)))
     if int(q) != q or q < 1:
         raise DataError(f"decimation: expected a positive integer, found {decimation!r}")
     q = int(q)
     notes = []
     if rate / (2 * q) < cutoff:
-        notes.append(f"decimation {q} puts the new Nyquist frequency {rate / (2 * q):g} Hz below the "
+        notes.append(f"decimation {q} puts the new Nyquist frequency "
+                     f"{rate / (2 * q):g} Hz below the "
                      f"cutoff {cutoff:g} Hz: the decimated rows alias")
     n = x.shape[0]
     edge = int(math.ceil(3 * rate / cutoff))
     if n < 2 * edge + 50 * q:
-        raise DataError(f"{n} samples are too few for IDIM-LS at dt = {dt:g} s with a {cutoff:g} Hz "
+        raise DataError(f"{n} samples are too few for IDIM-LS at dt = {dt:g} s with "
+                        f"a {cutoff:g} Hz "
                         f"filter (need more than {2 * edge + 50 * q})", hint="log a longer run")
     sos = butter_sos(order, cutoff, dt=dt)
     xf = apply_sos(sos, x, zero_phase=True)
@@ -430,7 +447,8 @@ def idim_samples(position, effort, *, dt: float, cutoff: float | None = None, or
             np.add.at(cover, hi, -1)
             near[:, j] = np.cumsum(cover[:-1]) > 0
     sl = slice(edge, n - edge, q)
-    return IdimSamples(xf[sl], vel[sl], acc[sl], ef[sl], near[sl], float(dt), cutoff, q, tuple(notes))
+    return (IdimSamples(xf[sl], vel[sl], acc[sl], ef[sl], near[sl], float(dt), cutoff, q,
+                        tuple(notes)))
 
 
 @entry_point
@@ -447,7 +465,8 @@ def idim_ls(position, effort, *, dt: float, effort_scale: float = 1.0, cutoff: f
         Effort column; the effort is ``effort_scale × effort`` (e.g. a current in A times the
         torque constant and gear ratio, or a PWM count times N·m per count).
     cutoff
-        Low-pass cutoff (Hz) of the zero-phase Butterworth filter; default 1/(50 dt) (20 Hz at 1 kHz).
+        Low-pass cutoff (Hz) of the zero-phase Butterworth filter; default 1/(50 dt) (20 Hz at 1
+        kHz).
         Choose 5–10 times the bandwidth of the motion: higher lets the position noise into q̈.
     order
         Filter order (the zero-phase filter has twice this order).
@@ -468,12 +487,15 @@ def idim_ls(position, effort, *, dt: float, effort_scale: float = 1.0, cutoff: f
     x, e = x * cx, e * ce
     if velocity_threshold is not None:
         velocity_threshold = float(velocity_threshold) * cx
-    st = idim_samples(x, e * effort_scale, dt=dt, cutoff=cutoff, order=order, decimation=decimation, guard=guard)
-    vel, acc, y, near = st.velocity[:, 0], st.acceleration[:, 0], st.effort[:, 0], st.near_reversal[:, 0]
+    st = (idim_samples(x, e * effort_scale, dt=dt, cutoff=cutoff, order=order,
+                       decimation=decimation, guard=guard))
+    vel, acc, y, near = (st.velocity[:, 0], st.acceleration[:, 0], st.effort[:, 0],
+                         st.near_reversal[:, 0])
     cutoff, q, notes = st.cutoff, st.decimation, list(st.notes)
     vmax = float(np.max(np.abs(vel)))
     if vmax == 0:
-        raise UnidentifiableError("the position never changes: the data cannot identify friction or inertia")
+        raise UnidentifiableError("the position never changes: the data cannot identify "
+                                  "friction or inertia")
     thr = 0.02 * vmax if velocity_threshold is None else float(velocity_threshold)
     keep = (np.abs(vel) > thr) & ~near
     if keep.sum() < 20:
@@ -499,9 +521,11 @@ def idim_ls(position, effort, *, dt: float, effort_scale: float = 1.0, cutoff: f
     sv = np.linalg.svd(Xs, compute_uv=False)
     cond = float(sv[0] / max(sv[-1], 1e-300))
     if cond > 1e8:
-        raise UnidentifiableError(f"the regressor is ill-conditioned (condition number {cond:.3g}): the "
+        raise UnidentifiableError("the regressor is ill-conditioned (condition number "
+                                  f"{cond:.3g}): the "
                                   f"motion does not separate inertia, viscous and Coulomb friction",
-                                  hint="use a richer excitation (several frequencies, both directions)")
+                                  hint="use a richer excitation (several frequencies, "
+                                       "both directions)")
     theta_s, *_ = np.linalg.lstsq(Xs, y, rcond=None)
     theta = theta_s / colscale
     r = y - X @ theta
@@ -519,4 +543,5 @@ def idim_ls(position, effort, *, dt: float, effort_scale: float = 1.0, cutoff: f
     with np.errstate(over="ignore", under="ignore"):
         theta, std, cov = theta * d, std * d, cov * d[:, None] * d[None, :]
     return IdimResult(dict(zip(_IDIM, map(float, theta))), dict(zip(_IDIM, map(float, std))), cov,
-                      rel, int(n), float(dt), float(cutoff), q, cond, float(math.sqrt(s2)) / ce, notes)
+                      rel, int(n), float(dt), float(cutoff), q, cond, float(math.sqrt(s2)) / ce,
+                      notes)

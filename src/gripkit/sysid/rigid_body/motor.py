@@ -43,7 +43,8 @@ def _check(name, a, n=None):
         raise DataError(f"{name}: expected {n} samples (like pwm), found {a.size}")
     bad = ~np.isfinite(a)
     if bad.any():
-        raise DataError(f"{name} has {int(bad.sum())} non-finite values (first at sample {int(np.argmax(bad))})")
+        raise DataError(f"{name} has {int(bad.sum())} non-finite values (first at sample "
+                        f"{int(np.argmax(bad))})")
     return a
 
 
@@ -51,11 +52,13 @@ def _lstsq(X, y, names):
     """LS with covariance σ̂²(XᵀX)⁻¹; raises when X is rank deficient."""
     sc = np.sqrt(np.mean(X ** 2, axis=0))
     if (sc == 0).any():
-        raise UnidentifiableError(f"the data do not excite {', '.join(n for n, s in zip(names, sc) if s == 0)}")
+        raise UnidentifiableError("the data do not excite "
+                                  f"{', '.join(n for n, s in zip(names, sc) if s == 0)}")
     sv = np.linalg.svd(X / sc, compute_uv=False)
     cond = float(sv[0] / max(sv[-1], 1e-300))
     if cond > 1e10:
-        raise UnidentifiableError(f"the regressors of {', '.join(names)} are collinear (condition {cond:.3g})",
+        raise UnidentifiableError(f"the regressors of {', '.join(names)} are collinear "
+                                  f"(condition {cond:.3g})",
                                   hint="vary PWM and speed independently")
     theta, *_ = np.linalg.lstsq(X, y, rcond=None)
     r = y - X @ theta
@@ -101,7 +104,8 @@ def fit_motor(pwm, speed, torque, temperature=None, *, T_ref: float | None = Non
         T = _check("temperature", temperature, u.size)[keep]
     u, w, tau = u[keep], w[keep], tau[keep]
     if u.size < 6:
-        raise DataError(f"only {u.size} usable samples (non-zero PWM); a motor fit needs at least 6")
+        raise DataError(f"only {u.size} usable samples (non-zero PWM); a motor fit "
+                        "needs at least 6")
     X = np.column_stack([u, np.abs(u) * w, w])
     names = ("c_pwm", "b_pwm", "b_0")
     theta, cov, r = _lstsq(X, tau, names)
@@ -125,7 +129,8 @@ def fit_motor(pwm, speed, torque, temperature=None, *, T_ref: float | None = Non
     s2 = float(sol.fun @ sol.fun / dof)
     sv = np.linalg.svd(J, compute_uv=False)
     if sv[-1] < 1e-12 * sv[0]:
-        raise UnidentifiableError("temperature and speed effects cannot be told apart in these data")
+        raise UnidentifiableError("temperature and speed effects cannot be told "
+                                  "apart in these data")
     cov = s2 * np.linalg.inv(J.T @ J)
     est = sol.x * scale
     names4 = ("c_pwm", "b_pwm", "b_0", "alpha_ref")
@@ -182,7 +187,8 @@ def characterize_motor(stall_pwm, stall_torque, runs: Sequence[tuple]) -> MotorC
     (c,), cov, _ = _lstsq(u[:, None], t, ("c_pwm",))
     c_std = float(math.sqrt(cov[0, 0]))
     if len(runs) < 3:
-        raise DataError(f"eq 5.8 needs torque-speed runs at three or more PWM values, found {len(runs)}")
+        raise DataError("eq 5.8 needs torque-speed runs at three or more PWM values, "
+                        f"found {len(runs)}")
     rows = []
     for i, run in enumerate(runs):
         try:
@@ -199,7 +205,8 @@ def characterize_motor(stall_pwm, stall_torque, runs: Sequence[tuple]) -> MotorC
     B = np.array([r[1] for r in rows])
     S = np.array([r[2] for r in rows])
     if np.ptp(P) == 0:
-        raise UnidentifiableError("all torque-speed runs have the same PWM: eq 5.8's PWM term is undetermined")
+        raise UnidentifiableError("all torque-speed runs have the same PWM: eq 5.8's PWM term "
+                                  "is undetermined")
     Wt = 1.0 / np.maximum(S, 1e-300) ** 2
     X = np.column_stack([P, np.ones_like(P)])
     A = X.T @ (Wt[:, None] * X)

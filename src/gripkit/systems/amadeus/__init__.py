@@ -49,10 +49,15 @@ from .slip import stick_slip_rate as stick_slip_rate
 from .strain_gauge_sensor import StrainGaugeSensor as StrainGaugeSensor
 from .valve import ProportionalValve as ProportionalValve
 
-__all__ = ["amadeus_hand", "AmadeusHand", "AmadeusHandSystem", "BellowsFinger", "calibrate_force_sensor",
-           "calibrate_speed", "estimate_force", "false_alarm_rate", "finger_force_model", "FingerForcePlant",
-           "FingerGraspResult", "ForceDynamics", "ForceEstimate", "ForceKalmanFilter", "GraspScenario",
+__all__ = ["amadeus_hand", "AmadeusHand", "AmadeusHandSystem", "BellowsFinger",
+           "calibrate_force_sensor",
+           "calibrate_speed", "estimate_force", "false_alarm_rate", "finger_force_model",
+           "FingerForcePlant",
+           "FingerGraspResult", "ForceDynamics", "ForceEstimate", "ForceKalmanFilter",
+           "GraspScenario",
            "KalmanResult", "ProportionalValve", "ReferenceModel", "SensorCalibration",
-           "simulate_finger_grasp", "SlipDetection", "SlipDetector", "SlipEvent", "SlipReflex", "SlipStream",
-           "SlipTestbed", "spectral_features", "SpeedCalibration", "stick_slip_rate", "StickSlipContact",
+           "simulate_finger_grasp", "SlipDetection", "SlipDetector", "SlipEvent", "SlipReflex",
+           "SlipStream",
+           "SlipTestbed", "spectral_features", "SpeedCalibration", "stick_slip_rate",
+           "StickSlipContact",
            "StrainGaugeSensor"]

@@ -100,7 +100,8 @@ _SIN60 = math.sqrt(3.0) / 2.0
 
 def bellows_parameters(*, pcd: float = 0.030, tube_area: float | None = None, length: float = 0.125,
                        bending_stiffness: float | None = None, tip_length: float = 0.035,
-                       p_min: float = 7.5 * BAR, p_max: float = 30.0 * BAR, p_operating: float = 12.0 * BAR,
+                       p_min: float = 7.5 * BAR, p_max: float = 30.0 * BAR,
+                       p_operating: float = 12.0 * BAR,
                        max_deflection: float = 0.020, source_k: str = "") -> ParameterSet:
     """The finger's ParameterSet (SI). Defaults are the AMADEUS phase-I values (seed §II)."""
     if tube_area is None:
@@ -115,26 +116,32 @@ def bellows_parameters(*, pcd: float = 0.030, tube_area: float | None = None, le
                   source=f"{_SEED} §II-A (PCD 30 mm)", display_unit="mm"),
         Parameter("tube_area", tube_area, "m**2", "effective pressure area of one bellows",
                   bounds=(1e-8, 1e-2),
-                  source="assumed: π/16 (OD + ID)² with OD 14.3 mm (§II-A) and an assumed ID of 9.0 mm",
+                  source="assumed: π/16 (OD + ID)² with OD 14.3 mm (§II-A) and an "
+                         "assumed ID of 9.0 mm",
                   display_unit="mm**2"),
         Parameter("length", length, "m", "unpressurised bellows length L₀", bounds=(1e-3, 2.0),
                   source=f"{_SEED} §II-A (125 mm bellows)", display_unit="mm"),
         Parameter("bending_stiffness", bending_stiffness, "N*m/rad",
                   "bending stiffness k_b = M₀/θ of the bellows triad (k_ax = k_b / (1.5 r²))",
                   bounds=(1e-6, None),
-                  source=source_k or "calibrated: 20 mm maximum deflection (Fig. 2(c)) in the operating range",
+                  source=source_k or "calibrated: 20 mm maximum deflection (Fig. 2(c)) in the "
+                                     "operating range",
                   ),
         Parameter("tip_length", tip_length, "m", "fingertip length beyond the end plate",
-                  bounds=(0.0, 0.5), source="assumed: detachable fingertip of Fig. 4 (length not given)",
+                  bounds=(0.0, 0.5), source="assumed: detachable fingertip of Fig. 4 "
+                                            "(length not given)",
                   display_unit="mm"),
         Parameter("p_min", p_min, "Pa", "lowest pressure a valve can deliver (leakage)",
                   bounds=(0.0, None), source=f"{_SEED} §II-D (7.5 bar)", display_unit="bar"),
         Parameter("p_max", p_max, "Pa", "supply pressure (highest tube pressure)",
-                  bounds=(0.0, None), source=f"{_SEED} §II-D (30 bar system pressure)", display_unit="bar"),
+                  bounds=(0.0, None), source=f"{_SEED} §II-D (30 bar "
+                                             "system pressure)", display_unit="bar"),
         Parameter("p_operating", p_operating, "Pa", "lowest pressure of the valves' linear region",
-                  bounds=(0.0, None), source=f"{_SEED} §II-D (operated above 12 bar)", display_unit="bar"),
+                  bounds=(0.0, None), source=f"{_SEED} §II-D (operated above 12 bar)",
+                  display_unit="bar"),
         Parameter("max_deflection", max_deflection, "m", "largest allowed tip deflection",
-                  bounds=(0.0, None), source=f"{_SEED} Fig. 2(c) and §II-B (20 mm)", display_unit="mm"),
+                  bounds=(0.0, None), source=f"{_SEED} Fig. 2(c) "
+                                             "and §II-B (20 mm)", display_unit="mm"),
     ], "bellows-finger")
 
 
@@ -156,7 +163,8 @@ def stiffness_for_max_deflection(*, pcd: float, tube_area: float, length: float,
         return float(_arc(s, m0 / k)[1]) - max_deflection
 
     if not (max_deflection > 0 and m0 > 0):
-        raise ParameterError("max_deflection and the pressure range must be positive to calibrate k_b")
+        raise ParameterError("max_deflection and the pressure range must be positive "
+                             "to calibrate k_b")
     return math.exp(brentq(f, math.log(m0 / 1.5), math.log(m0 * 1e6), xtol=1e-14))
 
 
@@ -234,7 +242,8 @@ class BellowsFinger:
                                  f"{p.value('p_max') / BAR:g} bar")
         if not p.value("p_min") <= p.value("p_operating") < p.value("p_max"):
             raise ParameterError(f"p_operating = {p.value('p_operating') / BAR:g} bar must lie in "
-                                 f"[p_min, p_max) = [{p.value('p_min') / BAR:g}, {p.value('p_max') / BAR:g}) bar")
+                                 f"[p_min, p_max) = [{p.value('p_min') / BAR:g}, "
+                                 f"{p.value('p_max') / BAR:g}) bar")
         if check:
             warn_inconsistent(self.consistency_checks())
 
@@ -268,7 +277,8 @@ class BellowsFinger:
         if check_limits:
             lo, hi = self.parameters.value("p_min"), self.parameters.value("p_max")
             if (p < lo - 1e-6).any() or (p > hi + 1e-6).any():
-                raise DataError(f"pressures outside the valve range [{lo / BAR:g}, {hi / BAR:g}] bar: "
+                raise DataError(f"pressures outside the valve range [{lo / BAR:g}, "
+                                f"{hi / BAR:g}] bar: "
                                 f"min {p.min() / BAR:.4g}, max {p.max() / BAR:.4g} bar")
         return p
 
@@ -280,7 +290,8 @@ class BellowsFinger:
         return m1 - 0.5 * m2 - 0.5 * m3, _SIN60 * (m3 - m2)
 
     def plane_moments(self, pressures, direction) -> tuple[np.ndarray, np.ndarray]:
-        """Eqs 5–6 about a trial plane ψ: (Σ M_ci, Σ M_bi) = (A r Σ P_i cos(θ_i−ψ), A r Σ P_i sin(θ_i−ψ)).
+        """Eqs 5–6 about a trial plane ψ: (Σ M_ci, Σ M_bi) = (A r Σ P_i cos(θ_i−ψ), A r Σ P_i
+        sin(θ_i−ψ)).
 
         The first is the resultant along ψ (eq 7's M_r when ψ is the bending direction), the second
         the part across it, which vanishes at the bending direction."""
@@ -316,18 +327,21 @@ class BellowsFinger:
         lo = pr.value("p_operating") if p_low is None else float(p_low)
         hi = pr.value("p_max") if p_high is None else float(p_high)
         if lo < pr.value("p_min") - 1e-9 or hi > pr.value("p_max") + 1e-9 or lo >= hi:
-            raise DataError(f"pressure limits [{lo / BAR:g}, {hi / BAR:g}] bar must lie inside the valve "
+            raise DataError(f"pressure limits [{lo / BAR:g}, {hi / BAR:g}] bar must lie "
+                            "inside the valve "
                             f"range [{pr.value('p_min') / BAR:g}, {pr.value('p_max') / BAR:g}] bar")
         return lo, hi
 
-    def _pressures_for_moment(self, direction: float, moment: float, variant: str, lo: float, hi: float):
+    def _pressures_for_moment(self, direction: float, moment: float, variant: str, lo: float,
+                              hi: float):
         unit = self.parameters.value("tube_area") * self.radius
         p0 = (2.0 / 3.0) * (moment / unit) * np.cos(TUBE_PUSH_ANGLES - direction)
         if variant == "min":
             return p0 + (lo - p0.min())
         return p0 + (hi - p0.max())
 
-    def max_moment(self, direction: float, p_low: float | None = None, p_high: float | None = None) -> float:
+    def max_moment(self, direction: float, p_low: float | None = None,
+                   p_high: float | None = None) -> float:
         """Largest resultant moment (N·m) in ``direction`` with every tube in [p_low, p_high]
         (defaults: 12 bar operating floor, 30 bar supply)."""
         lo, hi = self._limits(p_low, p_high)
@@ -339,7 +353,8 @@ class BellowsFinger:
         """Largest end-plate deflection (m) reachable in ``direction`` within the limits."""
         lo, hi = self._limits(p_low, p_high)
         m = self.max_moment(direction, lo, hi)
-        return float(self.bending(self._pressures_for_moment(float(direction), m, variant, lo, hi)).deflection)
+        return (float(self.bending(self._pressures_for_moment(float(direction), m, variant, lo,
+                                                              hi)).deflection))
 
     def pressures_for(self, direction, deflection, variant: str = "min", p_low: float | None = None,
                       p_high: float | None = None) -> np.ndarray:
@@ -354,7 +369,8 @@ class BellowsFinger:
         from scipy.optimize import brentq
 
         if variant not in ("min", "max"):
-            raise DataError(f"variant: expected 'min' (lowest total pressure) or 'max' (highest), found {variant!r}")
+            raise DataError("variant: expected 'min' (lowest total pressure) or 'max' (highest), "
+                            f"found {variant!r}")
         psi = float(direction)
         d = float(deflection)
         if not (math.isfinite(psi) and math.isfinite(d)) or d < 0:
@@ -362,7 +378,8 @@ class BellowsFinger:
         lo, hi = self._limits(p_low, p_high)
         dmax_spec = self.parameters.value("max_deflection")
         if d > dmax_spec + 1e-12:
-            raise ModelError(f"deflection {d * 1e3:.3g} mm exceeds the finger's {dmax_spec * 1e3:.3g} mm limit",
+            raise ModelError(f"deflection {d * 1e3:.3g} mm exceeds the finger's "
+                             f"{dmax_spec * 1e3:.3g} mm limit",
                              hint="larger deflections damage the phosphor-bronze bellows (§II-B)")
         if d == 0.0:
             mid = lo if variant == "min" else hi
@@ -370,13 +387,16 @@ class BellowsFinger:
         mmax = self.max_moment(psi, lo, hi)
 
         def f(m):
-            return float(self.bending(self._pressures_for_moment(psi, m, variant, lo, hi)).deflection) - d
+            return (float(self.bending(self._pressures_for_moment(psi, m, variant, lo,
+                                                                  hi)).deflection) - d)
 
         top = f(mmax)
         if top < 0:
             raise ModelError(
-                f"deflection {d * 1e3:.4g} mm toward {math.degrees(psi):.4g}° is out of reach: at most "
-                f"{(top + d) * 1e3:.4g} mm within [{lo / BAR:g}, {hi / BAR:g}] bar ({variant!r} variant)",
+                f"deflection {d * 1e3:.4g} mm toward {math.degrees(psi):.4g}° is out of "
+                "reach: at most "
+                f"{(top + d) * 1e3:.4g} mm within [{lo / BAR:g}, {hi / BAR:g}] bar "
+                f"({variant!r} variant)",
                 hint="ask for less, widen the pressure limits, or use the knuckle (§II-B)")
         m = brentq(f, 0.0, mmax, xtol=1e-14, rtol=1e-13)
         return self._pressures_for_moment(psi, m, variant, lo, hi)
@@ -390,9 +410,11 @@ class BellowsFinger:
                     what="2h/3 of the equilateral triangle (eqs 5-6 lever)", unit="m",
                     used="r = PCD/2", source=f"{_SEED} Fig. 7, eqs 5-6; PCD §II-A"),
         ]
-        dmax = max(self.max_deflection(psi, "max", pr.value("p_operating")) for psi in PRINCIPAL_DIRECTIONS)
+        dmax = (max(self.max_deflection(psi, "max",
+                                        pr.value("p_operating")) for psi in PRINCIPAL_DIRECTIONS))
         out.append(compare(
-            "max-deflection", self.name, computed=dmax, stated=pr.value("max_deflection"), rtol=0.02,
+            "max-deflection", self.name, computed=dmax, stated=pr.value("max_deflection"),
+            rtol=0.02,
             what=f"largest deflection with tubes in [{pr.value('p_operating') / BAR:g}, "
                  f"{pr.value('p_max') / BAR:g}] bar from k_b", unit="m",
             used="k_b as given; recalibrate with calibrate_bending_stiffness()",
@@ -413,17 +435,20 @@ def calibrate_bending_stiffness(pressures, deflections, finger: BellowsFinger | 
     p = np.asarray(pressures, dtype=np.float64)
     d = np.asarray(deflections, dtype=np.float64).reshape(-1)
     if p.ndim != 2 or p.shape != (d.size, 3):
-        raise DataError(f"expected pressures (n, 3) and deflections (n,), found {p.shape} and {d.shape}")
+        raise DataError("expected pressures (n, 3) and deflections (n,), found "
+                        f"{p.shape} and {d.shape}")
     if d.size < 2:
         raise DataError("calibrate_bending_stiffness needs at least 2 measurements")
     if not (np.isfinite(p).all() and np.isfinite(d).all()):
         raise DataError("calibration data contain NaN or inf")
     if np.ptp(p, axis=1).max() <= 0:
-        raise DataError("every measurement has equal tube pressures: nothing bends, k_b is unidentifiable",
+        raise DataError("every measurement has equal tube pressures: nothing bends, k_b "
+                        "is unidentifiable",
                         hint="apply pressure differences")
 
     def model(logk):
-        f = BellowsFinger(finger.parameters.replace(bending_stiffness=float(np.exp(logk[0]))), check=False)
+        f = (BellowsFinger(finger.parameters.replace(bending_stiffness=float(np.exp(logk[0]))),
+                           check=False))
         return f.bending(p).deflection
 
     k0 = finger.parameters.value("bending_stiffness")

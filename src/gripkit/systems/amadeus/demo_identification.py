@@ -2,7 +2,8 @@
 repeated on simulated data.
 
 The "true finger" is the zoo plant (Table II ``[2 2 2]``, SI units, see
-:mod:`gripkit.systems.amadeus.force_dynamics`), driven by the paper's excitations S1 (multisine 1–10 Hz, 400 samples)
+:mod:`gripkit.systems.amadeus.force_dynamics`), driven by the paper's excitations S1 (multisine
+1–10 Hz, 400 samples)
 and S2 (band-limited noise 0.3–10 Hz, 4000 samples) between 600 and 1100 mA, with white
 measurement noise on the force. Three ways of processing the data are compared:
 
@@ -85,7 +86,8 @@ def _simulate_study() -> _Study:
     measurement noise of :data:`NOISE_UNITS` sensor units on the force."""
     plant = build_plant()
     s1 = multisine(range(1, 11), 2.0, dt=DT, operating_point=0.850, limits=(0.600, 1.100), unit="A")
-    s2 = bandlimited_noise(0.3, 10.0, 20.0, dt=DT, operating_point=0.850, limits=(0.600, 1.100), seed=7, unit="A")
+    s2 = (bandlimited_noise(0.3, 10.0, 20.0, dt=DT, operating_point=0.850, limits=(0.600, 1.100),
+                            seed=7, unit="A"))
     noise_std = NOISE_UNITS * FORCE_SCALE  # N
     rec = {"S1": plant.simulate(s1.u, noise_std=noise_std, seed=1),
            "S2": plant.simulate(s2.u, noise_std=noise_std, seed=2)}
@@ -97,14 +99,21 @@ def _intro(report, study: _Study):
     return report.section(
         "AMADEUS finger force identification (§V)",
         "The study of §V of 000_8f66dcc7ab06470c.txt on simulated data. True finger: the Table II "
-        "[2 2 2] model (valve current deviation from 850 mA in A → force in N; the seed prints B in sensor "
-        f"units per mA and gives no force unit: gripkit assumes {FORCE_SCALE:.4f} N per unit, from the "
-        "15.45 N peak force of Fig. 2(c) over the 500 mA valve span). Excitations as in §V-E: S1, a "
+        "[2 2 2] model (valve current deviation from 850 mA in A → force in N; the seed "
+        "prints B in sensor "
+        f"units per mA and gives no force unit: gripkit assumes {FORCE_SCALE:.4f} N per "
+        "unit, from the "
+        "15.45 N peak force of Fig. 2(c) over the 500 mA valve span). Excitations as "
+        "in §V-E: S1, a "
         "1–10 Hz multisine, 400 samples at 200 Hz (crest factor "
-        f"{study.s1.crest_factor:.2f}); S2, band-limited noise 0.3–10 Hz, 4000 samples; both between 600 and "
-        f"1100 mA. White measurement noise of {study.noise_std:.3g} N ({NOISE_UNITS:g} sensor units) on the force. Three processings: raw; "
-        "'filtered y', the paper's 9 Hz Butterworth on the force only (§V-E, not part of the model); and "
-        "'prefiltered u, y', the same filter on input and output, which keeps the input-output relation.")
+        f"{study.s1.crest_factor:.2f}); S2, band-limited noise 0.3–10 Hz, 4000 samples; both "
+        "between 600 and "
+        f"1100 mA. White measurement noise of {study.noise_std:.3g} N ({NOISE_UNITS:g} sensor "
+        "units) on the force. Three processings: raw; "
+        "'filtered y', the paper's 9 Hz Butterworth on the force only (§V-E, not part of "
+        "the model); and "
+        "'prefiltered u, y', the same filter on input and output, which keeps the "
+        "input-output relation.")
 
 
 def _ls_table(sec, study: _Study) -> dict:
@@ -133,7 +142,8 @@ def _ls_table(sec, study: _Study) -> dict:
                 rows.append(row)
     sec.table(["structure", "data", "V_N raw", "V_N filtered y (§V-E)", "V_N prefiltered u, y",
                "free-run fit % on the other record (prefiltered)", "Table II V_N"], rows,
-              caption="LS (QR) over the structures of Table II. Loss V_N of eq (29) on the estimation record, "
+              caption="LS (QR) over the structures of Table II. Loss V_N of eq (29) on the "
+                      "estimation record, "
                       "in the seed's force-sensor units² (V_N in N² divided by force_scale²).")
     return fits
 
@@ -151,13 +161,18 @@ def _winners(sec, fits: dict) -> dict:
         "Which structure wins (S1): on loss, "
         + ", ".join(f"{v} {list(w[0])}" for v, w in winners.items()) + "; on AIC, "
         + ", ".join(f"{v} {list(w[1])}" for v, w in winners.items())
-        + ". As in Table II, more coefficients always lower the loss. The loss ratio [2 2 2]/[4 4 2] is "
+        + ". As in Table II, more coefficients always lower the loss. The loss ratio [2 "
+          "2 2]/[4 4 2] is "
         + ", ".join(f"{ratio[v]:.3g} ({v})" for v in VARIANTS)
         + ": with the force filtered but not the input (the paper's procedure) the model must also "
-        "describe the filter's two poles, which only the higher orders can. That the largest structure "
-        "also wins on AIC does not make the finger fourth order: the true plant here is [2 2 2], but an "
-        "ARX model's noise model 1/A cannot describe measurement noise, so extra coefficients absorb its "
-        "colour. The [2 2 2] model on prefiltered data and the output-error model below recover the "
+        "describe the filter's two poles, which only the higher orders can. That the "
+        "largest structure "
+        "also wins on AIC does not make the finger fourth order: the true plant here is "
+        "[2 2 2], but an "
+        "ARX model's noise model 1/A cannot describe measurement noise, so extra "
+        "coefficients absorb its "
+        "colour. The [2 2 2] model on prefiltered data and the output-error model "
+        "below recover the "
         "true coefficients.")
     return winners
 
@@ -177,14 +192,21 @@ def _zeros(sec, study: _Study, fits: dict) -> dict:
                           "minimum phase" if abs(z) < 1 else "NON-minimum phase"])
     for r in (reference("II", 2, 2, 2), reference("II", 2, 2, 10)):
         z = float(r.model().zeros()[0].real)
-        zrows.append([r.label, "Table II (paper, S1)", f"{z:.4g}", "minimum phase" if abs(z) < 1 else "NON-minimum phase"])
-    zrows.append(["[2 2 2]", "true plant", f"{study.truth.zeros()[0].real:.4g}", "NON-minimum phase"])
+        zrows.append([r.label, "Table II (paper, S1)", f"{z:.4g}",
+                      "minimum phase" if abs(z) < 1 else "NON-minimum phase"])
+    zrows.append(["[2 2 2]", "true plant", f"{study.truth.zeros()[0].real:.4g}",
+                  "NON-minimum phase"])
     sec.table(["structure", "estimated on", "zero z (±σ)", "phase"], zrows,
-              caption="Zeros of B(z) (prefiltered u, y). σ by first-order propagation of the parameter covariance.")
-    sec.text("§V-F: the [2 2 2] model is non-minimum phase (zero outside the unit circle, so pole-zero "
-             "cancelling controllers are risky), while the model with a ten-sample delay has its zero "
-             "inside. On the simulated finger the [2 2 2] estimate recovers the true zero at z = 1.167 "
-             "within its σ; the [2 2 10] model, which has the wrong delay for this plant, again puts its "
+              caption="Zeros of B(z) (prefiltered u, y). σ by first-order propagation of the "
+                      "parameter covariance.")
+    sec.text("§V-F: the [2 2 2] model is non-minimum phase (zero outside the unit "
+             "circle, so pole-zero "
+             "cancelling controllers are risky), while the model with a ten-sample "
+             "delay has its zero "
+             "inside. On the simulated finger the [2 2 2] estimate recovers the true "
+             "zero at z = 1.167 "
+             "within its σ; the [2 2 10] model, which has the wrong delay for this plant, "
+             "again puts its "
              "zero inside the unit circle.")
     m222 = fits[("S2", (2, 2, 2), "prefiltered u, y")]
     m2210 = fits[("S2", (2, 2, 10), "prefiltered u, y")]
@@ -194,8 +216,10 @@ def _zeros(sec, study: _Study, fits: dict) -> dict:
                                     "[2 2 2] Table II": (r222.poles(), r222.zeros()),
                                     "[2 2 10] Table II": (r2210.poles(), r2210.zeros())},
                                    title="Pole-zero map (cf. Figs. 20b and 21b)"),
-               "Poles (×, +, ⋎, ✱) and zeros (open ○, □, ◇, △), one shape and size per model so coincident "
-               "markers nest: the [2 2 2] zero lies outside the unit circle, the [2 2 10] zero inside.",
+               "Poles (×, +, ⋎, ✱) and zeros (open ○, □, ◇, △), one shape and size per "
+               "model so coincident "
+               "markers nest: the [2 2 2] zero lies outside the unit circle, the [2 2 "
+               "10] zero inside.",
                name="amadeus-pole-zero")
     return zsum
 
@@ -205,7 +229,8 @@ def _output_error(sec, study: _Study, fits: dict):
     ARX's, the residual tests, the free runs on S1 and the Bode plot. Returns the validations of
     the raw ARX and the OE models on S1."""
     u2, y2 = study.signals("S2", "raw")
-    moe = oe(u2, y2, 2, 2, 2, dt=DT, input_name="current", output_name="force", input_unit="A", output_unit="N")
+    moe = (oe(u2, y2, 2, 2, 2, dt=DT, input_name="current", output_name="force", input_unit="A",
+              output_unit="N"))
     marx = fits[("S2", (2, 2, 2), "raw")]
     m222 = fits[("S2", (2, 2, 2), "prefiltered u, y")]
     names = ["a1 / f1", "a2 / f2", "b2 [N/mA]", "b3 [N/mA]"]
@@ -216,9 +241,11 @@ def _output_error(sec, study: _Study, fits: dict):
         prow.append([n, f"{tr_theta[i]:.4g}",
                      _fmt_pm(marx.theta[i] * scale[i], marx.theta_std[i] * scale[i]),
                      _fmt_pm(m222.theta[i] * scale[i], m222.theta_std[i] * scale[i]),
-                     _fmt_pm(moe.theta[[2, 3, 0, 1][i]] * scale[i], moe.theta_std[[2, 3, 0, 1][i]] * scale[i])])
+                     _fmt_pm(moe.theta[[2, 3, 0, 1][i]] * scale[i],
+                             moe.theta_std[[2, 3, 0, 1][i]] * scale[i])])
     sec.table(["parameter", "true", "ARX raw (S2)", "ARX prefiltered (S2)", "OE raw (S2)"], prow,
-              caption="[2 2 2] estimates ± σ. Output (measurement) noise biases ARX; the output-error "
+              caption="[2 2 2] estimates ± σ. Output (measurement) noise biases ARX; "
+                      "the output-error "
                       "model is consistent for it. b2, b3 in N/mA: " + FORCE_SCALE_NOTE)
     u1r, y1r = study.signals("S1", "raw")
     val_arx = marx.validate(u1r, y1r)
@@ -231,26 +258,34 @@ def _validation_figures(sec, study: _Study, fits: dict, moe, val_arx, val_oe, y1
     """Residual tests, measured vs modelled force on S1 (cf. Figs. 19–22) and the Bode plot of the
     true plant and the estimated models."""
     marx = fits[("S2", (2, 2, 2), "raw")]
-    sec.figure(plots.residual_correlation({"ARX [2 2 2]": val_arx.tests, "OE [2 2 2]": val_oe.tests},
-                                          title="Residual tests on the S1 record (models estimated on S2, raw data)"),
-               "Residual autocorrelation and input-residual cross-correlation with 99 % bands: the ARX "
-               "residuals (equation error under output noise) are coloured and correlated with the input; "
+    sec.figure(plots.residual_correlation({"ARX [2 2 2]": val_arx.tests,
+                                           "OE [2 2 2]": val_oe.tests},
+                                          title="Residual tests on the S1 record (models estimated "
+                                                "on S2, raw data)"),
+               "Residual autocorrelation and input-residual cross-correlation with 99 % "
+               "bands: the ARX "
+               "residuals (equation error under output noise) are coloured and correlated "
+               "with the input; "
                "the OE residuals pass.", name="amadeus-residuals")
     t = study.rec["S1"].t
     sec.figure(plots.measured_vs_model(
         t, y1r, {f"OE [2 2 2] free run (fit {val_oe.fit_percent:.1f} %)": val_oe.simulation.y_sim,
-                 f"ARX [2 2 2] free run (fit {val_arx.fit_percent:.1f} %)": val_arx.simulation.y_sim},
+                 "ARX [2 2 2] free run (fit "
+                 f"{val_arx.fit_percent:.1f} %)": val_arx.simulation.y_sim},
         extra={"noise-free force": study.rec["S1"]["force_true"]}, ylabel="force deviation [N]",
-        title="Measured and modelled force on S1 (models estimated on S2; initial conditions estimated)"),
+        title="Measured and modelled force on S1 (models estimated on S2; initial "
+              "conditions estimated)"),
         "Measured (grey) and modelled (dashed) force, cf. Figs. 19–22. " + FORCE_SCALE_NOTE,
         name="amadeus-measured-vs-model")
-    sec.figure(plots.bode({"true plant [2 2 2]": study.truth, "OE [2 2 2] raw": moe, "ARX [2 2 2] raw": marx,
+    sec.figure(plots.bode({"true plant [2 2 2]": study.truth, "OE [2 2 2] raw": moe,
+                           "ARX [2 2 2] raw": marx,
                            "ARX [2 2 2] prefiltered": fits[("S2", (2, 2, 2), "prefiltered u, y")],
                            "ARX [4 4 2] filtered y": fits[("S2", (4, 4, 2), "filtered y")],
                            "9 Hz prefilter (×1000)": _scaled_filter(study.plant, 1000.0)},
                           title="Frequency responses (current → force)", magnitude_unit="re 1 N/A",
                           reference="true plant [2 2 2]"),
-               "Bode plot (true plant: wide grey band): the [4 4 2] model of the force-only filtered data contains "
+               "Bode plot (true plant: wide grey band): the [4 4 2] model of the force-only "
+               "filtered data contains "
                "the filter's roll-off. " + FORCE_SCALE_NOTE,
                name="amadeus-bode")
 
@@ -264,19 +299,25 @@ def _rls(sec, study: _Study) -> None:
         u, y = study.signals("S1", var)
         res = rls(u, y, ref.na, ref.nb, ref.nk, forgetting=1.0, p0=1e6, dt=DT)
         bscale = 1e-3 / FORCE_SCALE  # N/A -> sensor units per mA, the seed's scale
-        th = ", ".join(_fmt_pm(v * (1 if n[0] == "a" else bscale), s * (1 if n[0] == "a" else bscale))
+        th = ", ".join(_fmt_pm(v * (1 if n[0] == "a" else bscale),
+                               s * (1 if n[0] == "a" else bscale))
                        for n, v, s in zip(res.names, res.theta_final, res.theta_std_final))
-        rrows.append([ref.label, "9 Hz" if ref.filtered else "no", th, res.loss / FORCE_SCALE**2, ref.loss])
+        rrows.append([ref.label, "9 Hz" if ref.filtered else "no", th, res.loss / FORCE_SCALE**2,
+                      ref.loss])
     sec.table(["structure", "filter", "final θ ± σ (b in sensor units/mA, as Table III)",
                "V_N (a-priori errors, units²)", "Table III V_N"],
-              rrows, caption="RLS (λ = 1, P0 = 10⁶·I) over the structures of Table III on S1 (400 samples).")
+              rrows, caption="RLS (λ = 1, P0 = 10⁶·I) over the structures of Table III on "
+                             "S1 (400 samples).")
     u, y = study.signals("S2", "prefiltered u, y")
     res = rls(u, y, 2, 2, 2, forgetting=1.0, p0=1e6, dt=DT)
     sc = np.array([1, 1, 1e-3, 1e-3])
     sec.figure(plots.parameter_convergence(study.rec["S2"].t, res.theta * sc, res.theta_std * sc,
-                                           ["a1", "a2", "b2 [N/mA]", "b3 [N/mA]"], truth=study.truth.theta * sc,
-                                           title="RLS [2 2 2] on S2 (prefiltered): convergence with ±2σ"),
-               "Recursive estimates with ±2σ bands and the true values (dashed).", name="amadeus-rls-convergence")
+                                           ["a1", "a2", "b2 [N/mA]", "b3 [N/mA]"],
+                                           truth=study.truth.theta * sc,
+                                           title="RLS [2 2 2] on S2 (prefiltered): "
+                                                 "convergence with ±2σ"),
+               "Recursive estimates with ±2σ bands and the true "
+               "values (dashed).", name="amadeus-rls-convergence")
 
 
 def _fig14(sec, study):
@@ -319,7 +360,8 @@ def run(report, *, quick: bool = False) -> dict:
             "winner_on_aic_prefiltered": list(winners["prefiltered u, y"][1]),
             "zero_222": z222, "zero_222_std": z222s, "non_minimum_phase_222": bool(abs(z222) > 1),
             "zero_2210": z2210, "minimum_phase_2210": bool(abs(z2210) < 1),
-            "oe_validation_fit_percent": val_oe.fit_percent, "arx_validation_fit_percent": val_arx.fit_percent,
+            "oe_validation_fit_percent": val_oe.fit_percent,
+            "arx_validation_fit_percent": val_arx.fit_percent,
             "seconds": round(time.perf_counter() - t_start, 2)}
 
 

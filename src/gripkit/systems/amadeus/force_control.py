@@ -17,7 +17,8 @@ trades a 0.19 s rise time against a 7 % undershoot and keeps 60° of phase margi
 
 Grasping a compliant object
 ---------------------------
-:func:`simulate_finger_grasp` closes the loop around the whole finger: the valve's static characteristic
+:func:`simulate_finger_grasp` closes the loop around the whole finger: the valve's static
+characteristic
 (hysteresis, leakage floor, supply), the identified force dynamics as the *blocked* force of the
 finger, an object at a gap with stiffness k_o in series with the finger's lateral stiffness k_f
 (contact force = k_o/(k_f + k_o) · max(0, F_blocked − k_f·gap)), the six-bridge force sensor with
@@ -111,14 +112,18 @@ class FingerGraspResult:
     max_force: float
 
 
-def simulate_finger_grasp(controller: RSTController, plant=None, scenario: GraspScenario | None = None, *,
-                          valve=None, sensor=None, contact=None, detector=None, kalman_q: float = 400.0,
+def simulate_finger_grasp(controller: RSTController, plant=None,
+                          scenario: GraspScenario | None = None, *,
+                          valve=None, sensor=None, contact=None, detector=None,
+                          kalman_q: float = 400.0,
                           rng=None) -> FingerGraspResult:
     """Closed-loop grasp with a guarded approach, force control, force sensing and the slip reflex.
 
     ``controller`` is an :class:`RSTController` for ``plant`` (valve current deviation in A →
-    blocked force in N); ``valve`` a :class:`~gripkit.systems.amadeus.valve.ProportionalValve` (static
-    characteristic used), ``sensor`` a :class:`~gripkit.systems.amadeus.strain_gauge_sensor.StrainGaugeSensor`
+    blocked force in N); ``valve`` a :class:`~gripkit.systems.amadeus.valve.ProportionalValve`
+    (static
+    characteristic used), ``sensor`` a
+    :class:`~gripkit.systems.amadeus.strain_gauge_sensor.StrainGaugeSensor`
     (``None`` and ``scenario.sensor_noise=False``: the controller sees the true force),
     ``contact`` a :class:`~gripkit.systems.amadeus.pvdf.StickSlipContact`, ``detector`` a calibrated
     :class:`~gripkit.systems.amadeus.slip.SlipDetector` (required when ``scenario.slip``).
@@ -132,7 +137,8 @@ def simulate_finger_grasp(controller: RSTController, plant=None, scenario: Grasp
     finger = _ValveFinger(p, valve or ProportionalValve(check=False), sc)
     sensing = _ForceSensing(sc, sensor, kalman_q, h)
     slip = _SlipChannel(sc, contact, detector, h, N, rng) if sc.slip else None
-    supervisor = _Supervisor(sc, controller, SlipReflex(step=sc.reflex_step, rate=sc.reflex_rate, max_force=cap),
+    supervisor = _Supervisor(sc, controller, SlipReflex(step=sc.reflex_step, rate=sc.reflex_rate,
+                                                        max_force=cap),
                              cap, finger.i_start, h)
     lt, lv = np.array([x[0] for x in sc.load]), np.array([x[1] for x in sc.load])
     out = {k: np.zeros(N) for k in ("force", "force_est", "force_std", "ref", "current", "mode",
@@ -154,9 +160,12 @@ def simulate_finger_grasp(controller: RSTController, plant=None, scenario: Grasp
         out["load"][k] = load
     pv = slip.pv if slip is not None else np.zeros(0)
     alarms = slip.alarms if slip is not None else []
-    return FingerGraspResult(np.arange(N) * h, out["force"], out["force_est"], out["force_std"], out["ref"],
-                             out["current"], out["mode"], out["slipping"], out["slip_alarm"], out["load"],
-                             out["x_obj"], pv, sc.pvdf_rate, alarms, supervisor.contact_t, float(out["force"].max()))
+    return FingerGraspResult(np.arange(N) * h, out["force"], out["force_est"], out["force_std"],
+                             out["ref"],
+                             out["current"], out["mode"], out["slipping"], out["slip_alarm"],
+                             out["load"],
+                             out["x_obj"], pv, sc.pvdf_rate, alarms, supervisor.contact_t,
+                             float(out["force"].max()))
 
 
 def _check_grasp(p, sc: GraspScenario, detector) -> int:
@@ -165,9 +174,11 @@ def _check_grasp(p, sc: GraspScenario, detector) -> int:
     if N < 10:
         raise SimulationError(f"duration {sc.duration} s is shorter than 10 control samples")
     if p.relative_degree() < 1:
-        raise ModelError("simulate_finger_grasp needs a plant with at least one sample of input delay (nk >= 1)")
+        raise ModelError("simulate_finger_grasp needs a plant with at least one sample of input "
+                         "delay (nk >= 1)")
     if sc.force_limit <= sc.force_target:
-        raise DataError(f"force_limit {sc.force_limit} N must exceed force_target {sc.force_target} N")
+        raise DataError(f"force_limit {sc.force_limit} N must exceed force_target "
+                        f"{sc.force_target} N")
     if sc.slip and (detector is None or detector.threshold is None):
         raise DataError("scenario.slip needs a calibrated SlipDetector (detector=...)")
     return N
@@ -191,8 +202,10 @@ class _ValveFinger:
         self.play = self.i_start
         self.valve = valve
         self.hw = valve.parameters.value("hysteresis")
-        self.i_lo, self.p_min, self.kv = valve.parameters.value("i_lo"), valve.parameters.value("p_min"), valve.gain
-        self.fb0 = -G0 * (ie0 - sc.i_op) if sc.blocked_force_at_op is None else sc.blocked_force_at_op
+        self.i_lo, self.p_min, self.kv = (valve.parameters.value("i_lo"),
+                                          valve.parameters.value("p_min"), valve.gain)
+        self.fb0 = (-G0 * (ie0 - sc.i_op) if sc.blocked_force_at_op is None
+                    else sc.blocked_force_at_op)
         self.g_obj = 1.0 if math.isinf(sc.k_object) else sc.k_object / (sc.k_finger + sc.k_object)
 
     def force(self) -> tuple[float, float]:
@@ -223,7 +236,8 @@ class _ForceSensing:
         self.kf = None
         if sc.sensor_noise:
             self.sensor = sensor if sensor is not None else StrainGaugeSensor()
-            self.kf = ForceKalmanFilter(self.sensor, ForceDynamics.random_walk([50.0, 50.0, kalman_q], h),
+            self.kf = ForceKalmanFilter(self.sensor,
+                                        ForceDynamics.random_walk([50.0, 50.0, kalman_q], h),
                                         x0=np.zeros(3), P0=np.eye(3) * 0.01)
 
     def measure(self, F: float, Ft: float, rng) -> tuple[float, float]:
@@ -256,7 +270,8 @@ class _SlipChannel:
         object position and alarms, and let the supervisor's slip reflex act on them. Returns the
         tangential force at the period's end."""
         n, h = self.n_sub, self.h
-        yc = self.contact.advance(self.state, np.full(n, F), np.full(n, load), h / n, self.ns_contact)
+        yc = (self.contact.advance(self.state, np.full(n, F), np.full(n, load), h / n,
+                                   self.ns_contact))
         seg = yc[:, 0] + self.noise[k * n:(k + 1) * n]
         self.pv[k * n:(k + 1) * n] = seg
         out["slipping"][k] = yc[:, 2].mean()
@@ -270,7 +285,8 @@ class _SlipChannel:
 
 class _Supervisor:
     """Guarded approach (close at ``approach_rate`` until the measured force passes
-    ``contact_force``), then force control on a rate-limited reference, raised by the slip reflex."""
+    ``contact_force``), then force control on a rate-limited reference, raised by the slip
+    reflex."""
 
     def __init__(self, sc: GraspScenario, controller: RSTController, reflex: SlipReflex, cap: float,
                  i_start: float, h: float):

@@ -27,7 +27,8 @@ the full 500 mA valve span moves the reading by 617 units. The one force scale t
 is the fingertip's 15.45 N peak force (Fig. 2(c)) over that span: **one sensor unit = 0.0250 N**
 (``force_scale``, assumed). The plant is in SI: input = valve current deviation from 850 mA in A,
 output = force deviation in N (the force was AC-coupled, §V-F), so
-``B_SI = 1000 × force_scale × B_printed`` N/A. Losses in the seed's units are ``V_N / force_scale²``.
+``B_SI = 1000 × force_scale × B_printed`` N/A. Losses in the seed's units are ``V_N /
+force_scale²``.
 """
 
 from __future__ import annotations
@@ -46,7 +47,8 @@ from ...sysid.checks import as_signal
 from ...sysid.linear.polynomial import PolynomialModel
 
 __all__ = ["ReferenceModel", "TABLE_II", "TABLE_III", "FingerForcePlant", "finger_force_model",
-           "seed_checks", "SEED", "DT", "PREFILTER_ORDER", "PREFILTER_CUTOFF", "FORCE_SCALE", "PEAK_FORCE",
+           "seed_checks", "SEED", "DT", "PREFILTER_ORDER", "PREFILTER_CUTOFF", "FORCE_SCALE",
+           "PEAK_FORCE",
            "FORCE_SCALE_DERIVATION", "FORCE_SCALE_NOTE", "force_scale_parameter",
            "FIG14_FREQUENCIES",
            "SteppedSine", "stepped_sine_experiment", "fig14_finding"]
@@ -88,7 +90,8 @@ class ReferenceModel:
 
     @property
     def source(self) -> str:
-        return f"{SEED}, Table {self.table}, {self.label}" + (", 9 Hz filter" if self.filtered else "")
+        return (f"{SEED}, Table {self.table}, {self.label}"
+                + (", 9 Hz filter" if self.filtered else ""))
 
     def model(self, dt: float = DT):
         """A :class:`~gripkit.sysid.PolynomialModel` with these coefficients (paper units)."""
@@ -124,7 +127,8 @@ TABLE_III: tuple[ReferenceModel, ...] = (
     _r("III", "RLS", "S1", False, 1, 1, 3, (-0.667,), (-0.4869,), 1.875e4, (0.0348,), (0.0962,)),
     _r("III", "RLS", "S1", False, 2, 2, 1, (-0.4469, -0.2186), (2.9475, -3.3422), 1.671e4,
        (0.0479, 0.0458), (0.5260, 0.5306),
-       reading="A and B columns swapped in the extraction (a0 = 0, b0 = 1 printed); read by σ size"),
+       reading="A and B columns swapped in the extraction (a0 = 0, b0 = 1 "
+               "printed); read by σ size"),
     _r("III", "RLS", "S1", False, 2, 2, 2, (-0.4151, -0.1994), (3.1914, -3.7282), 1.62e4,
        (0.0480, 0.0454), (0.5451, 0.5565)),
     _r("III", "RLS", "S1", False, 2, 2, 3, (-0.3817, -0.1754), (3.1750, -3.8776), 1.577e4,
@@ -135,10 +139,12 @@ TABLE_III: tuple[ReferenceModel, ...] = (
        (0.0124, 0.0122), (0.0231, 0.0238)),
     _r("III", "RLS", "S1", True, 3, 2, 3, (-2.4448, 2.0240, -0.5668), (0.0993, -0.1234), 16.35,
        (0.0387, 0.0731, 0.0359), (0.0189, 0.0198)),
-    _r("III", "RLS", "S1", True, 3, 3, 3, (-2.3841, 1.9541, -0.5522), (-0.4609, 1.0338, -0.6237), 15.39,
+    _r("III", "RLS", "S1", True, 3, 3, 3, (-2.3841, 1.9541, -0.5522), (-0.4609, 1.0338, -0.6237),
+       15.39,
        (0.0395, 0.0723, 0.0723), (0.1123, 0.2294, 0.1231),
        reading="σ(a3) printed equal to σ(a2) = 0.0723; kept as printed"),
-    _r("III", "RLS", "S1", True, 4, 3, 3, (-2.8094, 3.3652, -2.1399, 0.6059), (-0.3287, 0.7788, -0.4961),
+    _r("III", "RLS", "S1", True, 4, 3, 3, (-2.8094, 3.3652, -2.1399, 0.6059),
+       (-0.3287, 0.7788, -0.4961),
        8.222, (0.0368, 0.0926, 0.0893, 0.0327), (0.0824, 0.1683, 0.0903)),
 )
 
@@ -157,10 +163,12 @@ FORCE_SCALE = PEAK_FORCE / (abs(_GAIN) * _SPAN_MA)
 FORCE_SCALE_DERIVATION = (
     f"assumed: the 500 mA valve span (§V-E, 600-1100 mA) moves the fingertip force over its "
     f"{PEAK_FORCE} N peak ({SEED} Fig. 2(c)); Table II [2 2 2] static gain |B(1)/A(1)| = "
-    f"{abs(_B1):.4f}/{_A1:.4f} = {abs(_GAIN):.4g} units/mA, so {PEAK_FORCE} N / ({abs(_GAIN):.4g} units/mA × "
+    f"{abs(_B1):.4f}/{_A1:.4f} = {abs(_GAIN):.4g} units/mA, so {PEAK_FORCE} N / "
+    f"({abs(_GAIN):.4g} units/mA × "
     f"{_SPAN_MA:.0f} mA) = {FORCE_SCALE:.4f} N/unit")
 #: caption note for every demo force in N that rests on the assumed force scale
-FORCE_SCALE_NOTE = ("Forces in N rest on the assumed force scale (newtons per sensor unit, not stated in the "
+FORCE_SCALE_NOTE = ("Forces in N rest on the assumed force scale (newtons per sensor unit, "
+                    "not stated in the "
                     "seed; derived from the 15.45 N peak of Fig. 2(c) over the 500 mA valve span; "
                     "settable as force_scale).")
 
@@ -169,16 +177,21 @@ def force_scale_parameter(value: float = FORCE_SCALE) -> Parameter:
     """The ``force_scale`` calibration (N per force-sensor unit of Tables II/III) as a
     :class:`~gripkit.params.Parameter`; a value that is not a positive finite number raises
     :class:`~gripkit.errors.ParameterError`."""
-    p = Parameter("force_scale", value, "N", "newtons per force-sensor unit of Tables II/III (calibration)",
+    p = Parameter("force_scale", value, "N", "newtons per force-sensor unit of Tables "
+                                             "II/III (calibration)",
                   bounds=(0.0, None), source=FORCE_SCALE_DERIVATION if value == FORCE_SCALE
-                  else f"set by the user (default {FORCE_SCALE:.4f} N/unit, {FORCE_SCALE_DERIVATION})")
+                  else f"set by the user (default {FORCE_SCALE:.4f} N/unit, "
+                       f"{FORCE_SCALE_DERIVATION})")
     if not p.value > 0.0:
-        raise ParameterError(f"force_scale: expected a positive number of newtons per sensor unit, found {value!r}",
-                             hint=f"the default {FORCE_SCALE:.4f} N/unit is {FORCE_SCALE_DERIVATION}")
+        raise ParameterError("force_scale: expected a positive number of newtons per sensor unit, "
+                             f"found {value!r}",
+                             hint=f"the default {FORCE_SCALE:.4f} N/unit is "
+                                  f"{FORCE_SCALE_DERIVATION}")
     return p
 
 
-def reference(table: str, na: int, nb: int, nk: int, *, filtered: bool = True, data: str = "S1") -> ReferenceModel:
+def reference(table: str, na: int, nb: int, nk: int, *, filtered: bool = True,
+              data: str = "S1") -> ReferenceModel:
     """Look up a row: ``reference("II", 2, 2, 2)``."""
     rows = TABLE_II if table == "II" else TABLE_III
     for r in rows:
@@ -214,8 +227,10 @@ class FingerForcePlant:
     """
 
     name = "amadeus-finger-force"
-    description = ("AMADEUS finger: valve current (A, deviation from 850 mA) to fingertip force (N, "
-                   "AC-coupled), ARX [2 2 2] of Table II (9 Hz-filtered data), 200 Hz, 2-sample delay")
+    description = ("AMADEUS finger: valve current (A, deviation from 850 mA) to "
+                   "fingertip force (N, "
+                   "AC-coupled), ARX [2 2 2] of Table II (9 Hz-filtered data), 200 "
+                   "Hz, 2-sample delay")
 
     input_name, input_unit, output_name, output_unit = "current", "A", "force", "N"
 
@@ -228,8 +243,10 @@ class FingerForcePlant:
         k = 1e3 * scale.value  # printed B is sensor units per mA (see module docstring)
         P = Parameter
         self.parameters = ParameterSet([
-            P("a1", row.A[1], "1", "coefficient of q^-1 in A(q)", source=f"{src}; {srcs}", std=sig.A_std[1]),
-            P("a2", row.A[2], "1", "coefficient of q^-2 in A(q)", source=f"{src}; {srcs}", std=sig.A_std[2]),
+            P("a1", row.A[1], "1", "coefficient of q^-1 in A(q)", source=f"{src}; {srcs}",
+              std=sig.A_std[1]),
+            P("a2", row.A[2], "1", "coefficient of q^-2 in A(q)", source=f"{src}; {srcs}",
+              std=sig.A_std[2]),
             P("b2", k * row.B[2], "N/A", "coefficient of q^-2 in B(q) (current to force)",
               source=f"{src} (printed in units/mA; × force_scale); {srcs}", std=k * sig.B_std[2],
               display_unit="N/mA"),
@@ -240,11 +257,14 @@ class FingerForcePlant:
             P("dt", DT, "s", "sample interval (200 Hz)", bounds=(0, None), source=f"{SEED}, §V-C"),
             P("delay", float(row.nk), "1", "valve transport delay in samples (about 0.01 s)",
               bounds=(0, None), source=f"{SEED}, §V-C, Fig. 15"),
-            P("prefilter_order", float(PREFILTER_ORDER), "1", "order of the Butterworth low-pass on force",
+            P("prefilter_order", float(PREFILTER_ORDER), "1", "order of the Butterworth "
+                                                              "low-pass on force",
               source=f"{SEED}, §V-D"),
-            P("prefilter_cutoff", PREFILTER_CUTOFF, "Hz", "cutoff of the Butterworth low-pass on force",
+            P("prefilter_cutoff", PREFILTER_CUTOFF, "Hz", "cutoff of the Butterworth "
+                                                          "low-pass on force",
               bounds=(0, 0.5 / DT), source=f"{SEED}, §V-D"),
-            P("operating_point", OPERATING_POINT, "A", "valve current the model is linearised around",
+            P("operating_point", OPERATING_POINT, "A", "valve current the model is "
+                                                       "linearised around",
               source=f"{SEED}, §V-E", display_unit="mA"),
             P("current_min", CURRENT_LIMITS[0], "A", "lowest valve current of the excitation",
               source=f"{SEED}, §V-E", display_unit="mA"),
@@ -254,7 +274,8 @@ class FingerForcePlant:
         ps = self.parameters
         self.model = PolynomialModel.from_coefficients(
             [1.0, ps.value("a1"), ps.value("a2")], [0.0, 0.0, ps.value("b2"), ps.value("b3")], nk=2,
-            dt=DT, std={"A": [0.0, ps["a1"].std, ps["a2"].std], "B": [0, 0, ps["b2"].std, ps["b3"].std]},
+            dt=DT, std={"A": [0.0, ps["a1"].std, ps["a2"].std],
+                        "B": [0, 0, ps["b2"].std, ps["b3"].std]},
             input_name="current", output_name="force", input_unit="A", output_unit="N",
             u_offset=OPERATING_POINT, info={"source": src})
         # building warns about the plant's own numbers only; the seed's statements about them
@@ -300,7 +321,8 @@ class FingerForcePlant:
         """The §V-D Butterworth (2nd order, 9 Hz at 200 Hz) as second-order sections."""
         return butter_sos(PREFILTER_ORDER, PREFILTER_CUTOFF, dt=DT)
 
-    def simulate(self, current, *, noise_std: float = 0.0, seed: int | None = None, prefilter: bool = False,
+    def simulate(self, current, *, noise_std: float = 0.0, seed: int | None = None,
+                 prefilter: bool = False,
                  initial: str = "rest", force_past=None, current_past=None):
         """Simulate the force for a valve current record.
 
@@ -327,11 +349,15 @@ class FingerForcePlant:
             ``force_true`` (N, noise-free) and optionally ``force_filtered`` (N).
         """
         i = as_signal(current, "current")
-        up = None if current_past is None else np.asarray(current_past, dtype=np.float64) - OPERATING_POINT
-        f_true = self.model.simulate(i - OPERATING_POINT, initial=initial, y_past=force_past, u_past=up)
+        up = (None if current_past is None else np.asarray(current_past,
+                                                           dtype=np.float64) - OPERATING_POINT)
+        f_true = (self.model.simulate(i - OPERATING_POINT, initial=initial, y_past=force_past,
+                                      u_past=up))
         if not (math.isfinite(noise_std) and noise_std >= 0):
-            raise DataError(f"noise_std: expected a standard deviation >= 0 in N, found {noise_std!r}")
-        f = f_true + noise_std * np.random.default_rng(seed).standard_normal(i.size) if noise_std else f_true
+            raise DataError("noise_std: expected a standard deviation >= 0 in N, "
+                            f"found {noise_std!r}")
+        f = (f_true + noise_std * np.random.default_rng(seed).standard_normal(i.size) if noise_std
+             else f_true)
         ch = {"current": i, "force": f, "force_true": f_true}
         if prefilter:
             ch["force_filtered"] = apply_sos(self.prefilter_sos(), f)
@@ -364,33 +390,45 @@ class FingerForcePlant:
         z222 = reference("II", 2, 2, 2).model().zeros()
         out.append(Finding("nmp-zero-222", subj, bool(np.all(np.abs(z222) > 1)),
                            f"Table II [2 2 2] zero at z = {z222[0].real:.4f}: "
-                           f"{'outside' if abs(z222[0]) > 1 else 'inside'} the unit circle; §V-F states "
+                           f"{'outside' if abs(z222[0]) > 1 else 'inside'} the unit "
+                           "circle; §V-F states "
                            f"the [2 2 2] system is non-minimum phase", computed=float(abs(z222[0])),
                            source=f"{SEED}, §V-F, Table II"))
         z2210 = reference("II", 2, 2, 10).model().zeros()
         out.append(Finding("minphase-zero-2210", subj, bool(np.all(np.abs(z2210) < 1)),
                            f"Table II [2 2 10] zero at z = {z2210[0].real:.4f}: "
-                           f"{'inside' if abs(z2210[0]) < 1 else 'outside'} the unit circle; §V-F states "
-                           f"the ten-sample-delay model is minimum phase", computed=float(abs(z2210[0])),
+                           f"{'inside' if abs(z2210[0]) < 1 else 'outside'} the unit "
+                           "circle; §V-F states "
+                           "the ten-sample-delay model "
+                           "is minimum phase", computed=float(abs(z2210[0])),
                            source=f"{SEED}, §V-F, Table II"))
         _, p, _ = butter_zpk(PREFILTER_ORDER, PREFILTER_CUTOFF, dt=DT)
         pp = p[np.argmax(p.imag)]
-        out.append(compare("prefilter-pole-real", subj, computed=float(pp.real), stated=0.8021, rtol=1e-3,
-                           what="real part of the 9 Hz/200 Hz Butterworth poles", source=f"{SEED}, §V-D"))
-        out.append(compare("prefilter-pole-imag", subj, computed=float(pp.imag), stated=0.1648, rtol=1e-3,
-                           what="imaginary part of the 9 Hz/200 Hz Butterworth poles", source=f"{SEED}, §V-D"))
-        out.append(compare("valve-delay", subj, computed=self.model.nk * DT, stated=0.01, rtol=0.05, unit="s",
+        out.append(compare("prefilter-pole-real", subj, computed=float(pp.real), stated=0.8021,
+                           rtol=1e-3,
+                           what="real part of the 9 Hz/200 Hz "
+                                "Butterworth poles", source=f"{SEED}, §V-D"))
+        out.append(compare("prefilter-pole-imag", subj, computed=float(pp.imag), stated=0.1648,
+                           rtol=1e-3,
+                           what="imaginary part of the 9 Hz/200 Hz "
+                                "Butterworth poles", source=f"{SEED}, §V-D"))
+        out.append(compare("valve-delay", subj, computed=self.model.nk * DT, stated=0.01, rtol=0.05,
+                           unit="s",
                            what="nk·dt of the [2 2 2] model", source=f"{SEED}, §V-C, Fig. 15"))
         ls, rl = reference("II", 2, 2, 2), reference("III", 2, 2, 2)
-        diff = float(max(np.max(np.abs(np.subtract(ls.A, rl.A))), np.max(np.abs(np.subtract(ls.B, rl.B)))))
+        diff = (float(max(np.max(np.abs(np.subtract(ls.A, rl.A))),
+                          np.max(np.abs(np.subtract(ls.B, rl.B))))))
         out.append(Finding("rls-equals-ls-222", subj, diff == 0.0,
-                           f"Table III [2,2,2] 9 Hz RLS coefficients differ from Table II [2 2 2] LS by at "
-                           f"most {diff:g}; §V-F states RLS identifies the same parameters (σ taken from "
+                           "Table III [2,2,2] 9 Hz RLS coefficients differ from Table II "
+                           "[2 2 2] LS by at "
+                           f"most {diff:g}; §V-F states RLS identifies the same "
+                           "parameters (σ taken from "
                            f"Table III)", computed=diff, stated=0.0, source=f"{SEED}, §V-F"))
         out.append(Finding("stable-222", subj, self.model.stable,
                            f"poles {', '.join(f'{z:.4f}' for z in self.model.poles())} (|p| = "
                            f"{np.max(np.abs(self.model.poles())):.4f}) inside the unit circle",
-                           computed=float(np.max(np.abs(self.model.poles()))), source=f"{SEED}, Table II"))
+                           computed=float(np.max(np.abs(self.model.poles()))),
+                           source=f"{SEED}, Table II"))
         return out
 
     def __repr__(self) -> str:
@@ -530,12 +568,16 @@ def seed_checks() -> list[Finding]:
                        what="mean σ(a) ratio unfiltered/filtered, [2,2,2]", source=src))
     out.append(compare("filter-sigma-factor-B", subj, computed=rb, stated=4.0, rtol=0.15,
                        what="mean σ(b) ratio unfiltered/filtered, [2,2,2]", source=src,
-                       used="gripkit uses the printed σ of each row; the text's factor 4 holds for A only"))
-    out.append(compare("filter-loss-factor", subj, computed=math.log10(raw.loss / filt.loss), stated=3.0,
-                       rtol=0.1, what=f"log10 of the loss ratio {raw.loss:g}/{filt.loss:g}", source=src))
+                       used="gripkit uses the printed σ of each row; the text's factor 4 "
+                            "holds for A only"))
+    out.append(compare("filter-loss-factor", subj, computed=math.log10(raw.loss / filt.loss),
+                       stated=3.0,
+                       rtol=0.1, what="log10 of the loss ratio "
+                                      f"{raw.loss:g}/{filt.loss:g}", source=src))
     s1 = sorted((r for r in TABLE_II if r.data == "S1" and r.nk == 2), key=lambda r: r.na + r.nb)
     mono = all(a.loss > b.loss for a, b in zip(s1, s1[1:]))
     out.append(Finding("loss-decreases-with-order", subj, mono,
                        "Table II (S1, nk = 2) loss by number of coefficients: "
-                       + ", ".join(f"{r.label} {r.loss:g}" for r in s1), source=f"{SEED}, §V-E, Table II"))
+                       + ", ".join(f"{r.label} {r.loss:g}" for r in s1),
+                       source=f"{SEED}, §V-E, Table II"))
     return out

@@ -46,7 +46,8 @@ __all__ = [
 ]
 
 # structural zeros of H (eqs 9-14): (bridge, component) pairs that must not respond
-_STRUCT_ZERO = np.array([[1, 1, 0], [1, 1, 0], [1, 1, 0], [0, 0, 1], [0, 0, 1], [1, 0, 1]], dtype=bool)
+_STRUCT_ZERO = (np.array([[1, 1, 0], [1, 1, 0], [1, 1, 0], [0, 0, 1], [0, 0, 1], [1, 0, 1]],
+                         dtype=bool))
 
 
 # ----------------------------------------------------------------------------------- calibration
@@ -57,7 +58,8 @@ class SensorCalibration:
     Attributes
     ----------
     sensor
-        A :class:`StrainGaugeSensor` carrying the calibrated constants (with ``std``) and noise model.
+        A :class:`StrainGaugeSensor` carrying the calibrated constants (with ``std``) and noise
+        model.
     K, K_std
         (6,) calibration constants K₁..K₆ (V/(N·m)) and standard errors.
     phi, phi_std
@@ -102,7 +104,8 @@ class SensorCalibration:
         return rows
 
 
-def _variance_model(pred: np.ndarray, resid: np.ndarray, proportional: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _variance_model(pred: np.ndarray, resid: np.ndarray,
+                    proportional: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Maximum-likelihood fit of σ_j² = a_j + b_j R̂² per bridge to residuals (Gaussian,
     heteroscedastic: minimise Σ log σ² + r²/σ² over log a, log b); returns (a (6,), b (6,),
     std of b (6,)) with the std from the Fisher information ½ Σ (∂σ²/∂θ)²/σ⁴."""
@@ -132,7 +135,8 @@ def _variance_model(pred: np.ndarray, resid: np.ndarray, proportional: bool) -> 
             return f, np.array([float(np.sum(dv) * ea), float(np.sum(dv * p2) * eb)])
 
         sol = minimize(nll, [math.log(a0), math.log(b0)], jac=True, method="L-BFGS-B",
-                       bounds=[(math.log(a0) - 40, math.log(a0) + 40), (math.log(b0) - 40, math.log(b0) + 40)])
+                       bounds=[(math.log(a0) - 40, math.log(a0) + 40),
+                               (math.log(b0) - 40, math.log(b0) + 40)])
         a[j], b[j] = math.exp(sol.x[0]), math.exp(sol.x[1])
         v = a[j] + b[j] * p2
         J = np.column_stack([np.ones(n), p2]) / v[:, None]
@@ -152,10 +156,12 @@ def _calibration_data(loads, readings, beam_length, phi, offsets, noise):
     if F.ndim != 2 or F.shape[1] != 3:
         raise DataError(f"loads: expected shape (n, 3) [f_x, f_y, f_z], found {F.shape}")
     if R.ndim != 2 or R.shape != (F.shape[0], 6):
-        raise DataError(f"readings: expected shape ({F.shape[0]}, 6) to match the loads, found {R.shape}")
+        raise DataError(f"readings: expected shape ({F.shape[0]}, 6) to match the loads, "
+                        f"found {R.shape}")
     if not (np.isfinite(F).all() and np.isfinite(R).all()):
         bad = ~(np.isfinite(F).all(1) & np.isfinite(R).all(1))
-        raise DataError(f"calibration data have NaN or inf in {int(bad.sum())} rows (first row {int(np.argmax(bad))})",
+        raise DataError(f"calibration data have NaN or inf in {int(bad.sum())} rows (first row "
+                        f"{int(np.argmax(bad))})",
                         hint="drop those load cases")
     if noise not in ("proportional", "constant"):
         raise DataError(f"noise: expected 'proportional' or 'constant', found {noise!r}")
@@ -164,7 +170,8 @@ def _calibration_data(loads, readings, beam_length, phi, offsets, noise):
     n = F.shape[0]
     n_par = 6 + (0 if phi is not None else 2) + (6 if offsets else 0)
     if 6 * n <= n_par + 12:
-        raise DataError(f"calibration needs more load cases: {n} give {6 * n} readings for {n_par} constants "
+        raise DataError(f"calibration needs more load cases: {n} give {6 * n} readings for "
+                        f"{n_par} constants "
                         "and the noise model", hint="apply at least 10 loads spanning x, y and z")
     Fc = np.column_stack([F, np.ones(n)]) if offsets else F
     sv = np.linalg.svd(Fc / np.maximum(np.abs(Fc).max(0), 1e-300), compute_uv=False)
@@ -189,7 +196,8 @@ def _free_rows(Fc, R, offsets, noise):
             sw = np.sqrt(W[:, j])
             rows[j] = np.linalg.lstsq(Fc * sw[:, None], R[:, j] * sw, rcond=None)[0]
         pred = Fc @ rows.T
-        a, b, _ = _variance_model(pred - (rows[:, 3] if offsets else 0.0), R - pred, noise == "proportional")
+        a, b, _ = (_variance_model(pred - (rows[:, 3] if offsets else 0.0), R - pred,
+                                   noise == "proportional"))
         W = 1.0 / np.maximum(a + b * (pred - (rows[:, 3] if offsets else 0.0)) ** 2, 1e-30)
     cross = np.zeros((6, 3))
     for j in range(6):
@@ -228,7 +236,8 @@ def _start_values(rows, l, phi, offsets, initial_phi):
 
 
 def calibrate(loads, readings, *, beam_length: float, phi: tuple[float, float] | None = None,
-              offsets: bool = True, noise: str = "proportional", initial_phi=(0.4, 0.7)) -> SensorCalibration:
+              offsets: bool = True, noise: str = "proportional",
+              initial_phi=(0.4, 0.7)) -> SensorCalibration:
     """Calibrate the six-bridge sensor from readings under known loads (eqs 9–14, 19).
 
     Parameters
@@ -271,7 +280,8 @@ def calibrate(loads, readings, *, beam_length: float, phi: tuple[float, float] |
 
     sig = np.sqrt(1.0 / W)
     for _ in range(2):
-        sol = least_squares(lambda x: ((model(x) - R) / sig).ravel(), np.asarray(x0, dtype=np.float64),
+        sol = least_squares(lambda x: ((model(x) - R) / sig).ravel(),
+                            np.asarray(x0, dtype=np.float64),
                             method="lm", x_scale="jac")
         x0 = sol.x
         K, q1, q2, off = unpack(sol.x)
@@ -287,13 +297,15 @@ def calibrate(loads, readings, *, beam_length: float, phi: tuple[float, float] |
     try:
         jtj_inv = np.linalg.inv(J.T @ J)
     except np.linalg.LinAlgError:
-        raise UnidentifiableError("the calibration Jacobian is singular: the loads do not determine "
+        raise UnidentifiableError("the calibration Jacobian is singular: the loads "
+                                  "do not determine "
                                   f"all of {', '.join(names)}") from None
     cov = jtj_inv * max(chi2, 1.0) if noise == "constant" else jtj_inv * chi2
     std = np.sqrt(np.diag(cov))
     K, q1, q2, off = unpack(sol.x)
     if (K <= 0).any():
-        raise IdentificationError(f"calibration gave non-positive constants K = {np.round(K, 6).tolist()}",
+        raise IdentificationError("calibration gave non-positive constants K = "
+                                  f"{np.round(K, 6).tolist()}",
                                   hint="check the sign convention of the readings and of the loads")
     K_std = std[:6]
     if phi is None:
@@ -304,14 +316,16 @@ def calibrate(loads, readings, *, beam_length: float, phi: tuple[float, float] |
         off_std = std[6:12] if offsets else np.zeros(6)
     if np.abs(cross).max() > 5.0:
         j, c = np.unravel_index(np.argmax(np.abs(cross)), cross.shape)
-        emit_warning(f"bridge R{j + 1} responds to f_{'xyz'[c]} (z = {cross[j, c]:.1f}), which eqs 9-14 say it "
+        emit_warning(f"bridge R{j + 1} responds to f_{'xyz'[c]} (z = {cross[j, c]:.1f}), which "
+                     "eqs 9-14 say it "
                      "must not: cross-talk or a mislabelled axis", AccuracyWarning)
     floor = np.sqrt(a)
     q1n = (q1 + math.pi) % (2 * math.pi) - math.pi
     q2n = (q2 + math.pi) % (2 * math.pi) - math.pi
     params = sensor_parameters(K=K, phi1=q1n, phi2=q2n, beam_length=l, sigma_n2=b,
                                floor=float(np.sqrt(np.mean(a))), k_std=K_std, phi_std=phi_std,
-                               source=f"calibrated from {n} known loads (gripkit.systems.amadeus.force_sensor.calibrate)")
+                               source=f"calibrated from {n} known loads "
+                                      "(gripkit.systems.amadeus.force_sensor.calibrate)")
     return SensorCalibration(StrainGaugeSensor(params), K, K_std, (q1n, q2n), phi_std,
                              off, off_std, names, cov, b, sb, floor, chi2, cross, n)
 
@@ -345,14 +359,17 @@ class ForceEstimate:
     dof: int = 3
 
 
-def _sensor_arrays(sensor: StrainGaugeSensor, offsets) -> tuple[np.ndarray, np.ndarray, float, np.ndarray]:
+def _sensor_arrays(sensor: StrainGaugeSensor,
+                   offsets) -> tuple[np.ndarray, np.ndarray, float, np.ndarray]:
     if not isinstance(sensor, StrainGaugeSensor):
-        raise ModelError(f"sensor: expected a StrainGaugeSensor (or a SensorCalibration), found {type(sensor).__name__}")
+        raise ModelError("sensor: expected a StrainGaugeSensor (or a SensorCalibration), found "
+                         f"{type(sensor).__name__}")
     off = np.zeros(6) if offsets is None else np.asarray(offsets, dtype=np.float64).reshape(6)
     return sensor.H, sensor.sigma_n2, sensor.noise_floor, off
 
 
-def estimate_force(readings, sensor, *, variances=None, iterations: int = 2, offsets=None) -> ForceEstimate:
+def estimate_force(readings, sensor, *, variances=None, iterations: int = 2,
+                   offsets=None) -> ForceEstimate:
     """Weighted-least-squares force from six bridge readings at every sample.
 
     Parameters
@@ -378,7 +395,8 @@ def estimate_force(readings, sensor, *, variances=None, iterations: int = 2, off
         raise DataError(f"readings: expected shape (N, 6) for R1..R6, found {np.shape(readings)}")
     if not np.isfinite(R).all():
         bad = ~np.isfinite(R).all(1)
-        raise DataError(f"readings have NaN or inf in {int(bad.sum())} samples (first at sample {int(np.argmax(bad))})",
+        raise DataError(f"readings have NaN or inf in {int(bad.sum())} samples (first at sample "
+                        f"{int(np.argmax(bad))})",
                         hint="drop or interpolate those samples")
     R = R - off
     if int(iterations) != iterations or iterations < 1:
@@ -391,7 +409,8 @@ def estimate_force(readings, sensor, *, variances=None, iterations: int = 2, off
     else:
         passes = None
     if passes is None and floor == 0 and (R == 0).any():
-        raise DataError("a reading is exactly zero and the sensor has no noise floor: eq 19 gives it zero "
+        raise DataError("a reading is exactly zero and the sensor has no noise floor: eq "
+                        "19 gives it zero "
                         "variance (infinite weight)", hint="give the sensor a noise_floor > 0")
     ref = R
     for it in range(1 if passes else int(iterations)):
@@ -402,7 +421,8 @@ def estimate_force(readings, sensor, *, variances=None, iterations: int = 2, off
         try:
             f = np.linalg.solve(M, rhs[..., None])[..., 0]
         except np.linalg.LinAlgError:
-            raise DataError("the weighted normal equations are singular (all readings of an axis have "
+            raise DataError("the weighted normal equations are singular (all readings "
+                            "of an axis have "
                             "infinite variance)") from None
         ref = f @ H.T
     cov = np.linalg.inv(M)
@@ -439,8 +459,10 @@ class ForceDynamics:
         C = np.ascontiguousarray(self.C, dtype=np.float64)
         Q = np.ascontiguousarray(self.Q, dtype=np.float64)
         if A.shape != (n, n) or C.shape != (3, n) or Q.shape != (n, n):
-            raise ModelError(f"ForceDynamics: need A (n, n), C (3, n), Q (n, n); found {A.shape}, {C.shape}, {Q.shape}")
-        if not (np.isfinite(A).all() and np.isfinite(B).all() and np.isfinite(C).all() and np.isfinite(Q).all()):
+            raise ModelError(f"ForceDynamics: need A (n, n), C (3, n), Q (n, n); found {A.shape}, "
+                             f"{C.shape}, {Q.shape}")
+        if not (np.isfinite(A).all() and np.isfinite(B).all() and np.isfinite(C).all()
+                and np.isfinite(Q).all()):
             raise ModelError("ForceDynamics matrices contain NaN or inf")
         if np.linalg.eigvalsh(0.5 * (Q + Q.T)).min() < -1e-12 * max(1.0, np.abs(Q).max()):
             raise ModelError("ForceDynamics: Q must be positive semi-definite")
@@ -492,8 +514,10 @@ class ForceDynamics:
         Q[npl, npl] = q_disturbance * p.dt
         Q[npl + 1, npl + 1] = q_other * p.dt
         Q[npl + 2, npl + 2] = q_other * p.dt
-        names = tuple(f"plant{i}" for i in range(npl)) + (f"d_{'xyz'[axis]}",) + tuple(f"f_{'xyz'[k]}" for k in others)
-        return cls(A, B, C, Q, p.dt, f"identified plant on {'xyz'[axis]} + random-walk disturbance", names)
+        names = (tuple(f"plant{i}" for i in range(npl)) + (f"d_{'xyz'[axis]}",)
+                 + tuple(f"f_{'xyz'[k]}" for k in others))
+        return cls(A, B, C, Q, p.dt, f"identified plant on {'xyz'[axis]} + "
+                                     "random-walk disturbance", names)
 
 
 #: the filter's model as :func:`_kf_run` takes it: dynamics A, B, force map C and process noise
@@ -621,7 +645,8 @@ class ForceKalmanFilter:
         H, sn2, floor, off = _sensor_arrays(sensor, offsets)
         if dynamics is None:
             if dt is None:
-                raise ModelError("give dynamics= or the sample time dt= for the default random walk")
+                raise ModelError("give dynamics= or the sample time dt= for the "
+                                 "default random walk")
             dynamics = ForceDynamics.random_walk(10.0, dt)
         self.sensor = sensor
         self.dynamics = dynamics
@@ -630,7 +655,8 @@ class ForceKalmanFilter:
         self._sn2 = np.ascontiguousarray(sn2)
         self._floor2 = float(floor) ** 2
         if self._floor2 == 0.0:
-            raise ModelError("the Kalman filter needs a sensor noise floor > 0 (eq 19 alone gives zero "
+            raise ModelError("the Kalman filter needs a sensor noise floor > 0 (eq 19 "
+                             "alone gives zero "
                              "variance at zero force)")
         n = dynamics.n_states
         self.x = np.zeros(n) if x0 is None else np.array(x0, dtype=np.float64).reshape(n)
@@ -650,17 +676,20 @@ class ForceKalmanFilter:
             return np.zeros((N, m))
         U = np.asarray(u, dtype=np.float64).reshape(N, -1)
         if U.shape[1] != m or not np.isfinite(U).all():
-            raise DataError(f"u: expected {N} finite samples of {m} input(s), found shape {np.shape(u)}")
+            raise DataError(f"u: expected {N} finite samples of {m} input(s), found "
+                            f"shape {np.shape(u)}")
         return np.ascontiguousarray(U)
 
     def run(self, readings, u=None) -> KalmanResult:
-        """Filter a record: readings (N, 6) V, inputs u (N, m) (the valve command for a plant model).
+        """Filter a record: readings (N, 6) V, inputs u (N, m) (the valve command for a plant
+        model).
         Continues from the filter's current state."""
         Z = np.atleast_2d(np.asarray(readings, dtype=np.float64))
         if Z.ndim != 2 or Z.shape[1] != 6:
             raise DataError(f"readings: expected shape (N, 6), found {np.shape(readings)}")
         if not np.isfinite(Z).all():
-            raise DataError(f"readings contain NaN or inf (first at sample {int(np.argmax(~np.isfinite(Z).all(1)))})")
+            raise DataError("readings contain NaN or inf (first at sample "
+                            f"{int(np.argmax(~np.isfinite(Z).all(1)))})")
         Z = np.ascontiguousarray(Z - self.offsets)
         N = Z.shape[0]
         U = self._inputs(u, N)

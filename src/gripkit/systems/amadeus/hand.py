@@ -56,22 +56,29 @@ FINGER_AZIMUTHS = np.deg2rad([90.0, 210.0, 330.0])
 
 def hand_parameters(*, palm_radius: float = 0.0756, knuckle_offset: float = 0.015,
                     knuckle_range: float = math.radians(20.0), pad_radius: float = 0.008,
-                    pot_gain: float = 2.0 / math.radians(20.0), pot_offset: float = 2.5) -> ParameterSet:
+                    pot_gain: float = 2.0 / math.radians(20.0),
+                    pot_offset: float = 2.5) -> ParameterSet:
     """Palm, knuckle and potentiometer parameters (SI)."""
     return ParameterSet([
-        Parameter("palm_radius", palm_radius, "m", "radius of the knuckle pivots' circle on the palm",
+        Parameter("palm_radius", palm_radius, "m", "radius of the knuckle pivots' "
+                                                   "circle on the palm",
                   bounds=(0.0, 1.0),
-                  source=f"derived: at -20° the pads just touch a ∅10 mm object ({_SEED} §II-B), with the "
+                  source=f"derived: at -20° the pads just touch a ∅10 mm object ({_SEED} "
+                         "§II-B), with the "
                          "assumed finger reach; AmadeusHand.palm_radius_for() recomputes it",
                   display_unit="mm"),
         Parameter("knuckle_offset", knuckle_offset, "m", "from knuckle pivot to the bellows base",
-                  bounds=(0.0, 1.0), source="assumed: knuckle manifold (Fig. 2(b))", display_unit="mm"),
-        Parameter("knuckle_range", knuckle_range, "rad", "knuckle travel either side of parallel fingers",
-                  bounds=(0.0, math.pi / 2), source=f"{_SEED} Fig. 2(c) (±20°), §II-B (40° rotation)",
+                  bounds=(0.0, 1.0), source="assumed: knuckle "
+                                            "manifold (Fig. 2(b))", display_unit="mm"),
+        Parameter("knuckle_range", knuckle_range, "rad", "knuckle travel either side of "
+                                                         "parallel fingers",
+                  bounds=(0.0, math.pi / 2), source=f"{_SEED} Fig. 2(c) (±20°), "
+                                                    "§II-B (40° rotation)",
                   display_unit="deg"),
         Parameter("pad_radius", pad_radius, "m", "radius of the fingertip's contact surface",
                   bounds=(0.0, 0.1), source="assumed: fingertip of Fig. 4", display_unit="mm"),
-        Parameter("pot_gain", pot_gain, "V/rad", "knuckle potentiometer sensitivity (rack and pinion)",
+        Parameter("pot_gain", pot_gain, "V/rad", "knuckle potentiometer sensitivity "
+                                                 "(rack and pinion)",
                   bounds=(1e-6, None), source="assumed: ±2 V over ±20° (§II-C gives no scale)"),
         Parameter("pot_offset", pot_offset, "V", "potentiometer voltage with parallel fingers",
                   source="assumed: mid-range of a 0-5 V potentiometer"),
@@ -98,7 +105,8 @@ def _tangents(n):
     return t1, np.cross(n, t1)
 
 
-def force_closure(points, normals, mu: float, *, n_edges: int = 8, torque_scale: float | None = None) -> ForceClosure:
+def force_closure(points, normals, mu: float, *, n_edges: int = 8,
+                  torque_scale: float | None = None) -> ForceClosure:
     """Force-closure test for point contacts with friction (see the module docstring).
 
     Parameters
@@ -132,7 +140,8 @@ def force_closure(points, normals, mu: float, *, n_edges: int = 8, torque_scale:
         raise DataError("a contact normal is zero")
     Nn = Nn / norms[:, None]
     c = P.mean(0)
-    rho = torque_scale if torque_scale is not None else max(float(np.linalg.norm(P - c, axis=1).max()), 1e-12)
+    rho = (torque_scale if torque_scale is not None
+           else max(float(np.linalg.norm(P - c, axis=1).max()), 1e-12))
     cols = []
     ph = 2 * np.pi * np.arange(int(n_edges)) / int(n_edges)
     for p, n in zip(P, Nn):
@@ -172,7 +181,8 @@ class AmadeusHand:
     name = "amadeus-hand"
     description = "AMADEUS three-finger hand: palm, knuckles, fingertip kinematics, force closure"
 
-    def __init__(self, finger: BellowsFinger | None = None, parameters: ParameterSet | None = None, *,
+    def __init__(self, finger: BellowsFinger | None = None, parameters: ParameterSet | None = None,
+                 *,
                  check: bool = True, **kw):
         self.finger = finger if finger is not None else BellowsFinger(check=False)
         if parameters is None and "palm_radius" not in kw:
@@ -214,7 +224,8 @@ class AmadeusHand:
         a = float(angle)
         lim = self._hp("knuckle_range")
         if not math.isfinite(a) or abs(a) > lim + 1e-12:
-            raise DataError(f"knuckle angle {math.degrees(a):.4g}° is outside ±{math.degrees(lim):.3g}°")
+            raise DataError(f"knuckle angle {math.degrees(a):.4g}° is outside "
+                            f"±{math.degrees(lim):.3g}°")
         return a
 
     def finger_frames(self, angle: float) -> list[tuple[np.ndarray, np.ndarray]]:
@@ -293,7 +304,8 @@ class AmadeusHand:
     def consistency_checks(self) -> list[Finding]:
         lim = self._hp("knuckle_range")
         L = self.reach()
-        out = [compare("knuckle-travel-40deg", self.name, computed=math.degrees(2 * lim), stated=40.0,
+        out = [compare("knuckle-travel-40deg", self.name, computed=math.degrees(2 * lim),
+                       stated=40.0,
                        rtol=1e-9, what="total knuckle travel 2 x range", unit="deg", used="±range",
                        source=f"{_SEED} §II-B (40° of angular rotation) vs Fig. 2(c) (±20°)")]
         for d in (0.010, 0.150):

@@ -62,10 +62,12 @@ _SEED = "000_8f66dcc7ab06470c.txt"
 def pvdf_parameters(*, gain: float = 2.0e3, tau: float = 0.01) -> ParameterSet:
     """PVDF film: sensitivity g (V/m of deformation) and charge-decay time constant τ (s)."""
     return ParameterSet([
-        Parameter("gain", gain, "V/m", "film output per unit deformation (before decay)", bounds=(0.0, None),
+        Parameter("gain", gain, "V/m", "film output per unit "
+                                       "deformation (before decay)", bounds=(0.0, None),
                   source="assumed: 52 µm PVDF film (§IV-B); gives ~10-100 mV slip signals"),
         Parameter("tau", tau, "s", "charge decay time constant R·C of film and amplifier",
-                  bounds=(1e-6, 100.0), source="assumed: 16 Hz high-pass corner ('quickly decays', §IV-B)",
+                  bounds=(1e-6, 100.0), source="assumed: 16 Hz high-pass corner ('quickly "
+                                               "decays', §IV-B)",
                   display_unit="ms"),
     ], "pvdf")
 
@@ -85,7 +87,8 @@ def _pvdf_batch(thetas, u, dt, x0, y):  # pragma: no cover - compiled
 
 
 class PVDFFilm(Model):
-    """PVDF film: deformation d (m) → voltage v (V), dv/dt = −v/τ + g dd/dt (exact for ZOH input)."""
+    """PVDF film: deformation d (m) → voltage v (V), dv/dt = −v/τ + g dd/dt (exact for ZOH
+    input)."""
 
     name = "pvdf-film"
     description = "PVDF film: high-pass of the deformation rate (charge decays)"
@@ -95,7 +98,8 @@ class PVDFFilm(Model):
     integrator = "zoh"
 
     def __init__(self, parameters: ParameterSet | None = None, *, check: bool = True, **kw):
-        super().__init__(parameters if parameters is not None else pvdf_parameters(**kw), check=check)
+        super().__init__(parameters if parameters is not None else pvdf_parameters(**kw),
+                         check=check)
 
     def initial_state(self, theta):
         return np.array([0.0, np.nan])
@@ -118,30 +122,43 @@ PadObject = namedtuple("PadObject", "m M co muk mus vs")
 GRASP, TESTBED = 0, 1
 
 
-def contact_parameters(*, m_pad: float = 2.0e-3, k_t: float = 5.0e3, c_t: float = 1.5, mu_s: float = 0.6,
-                       mu_k: float = 0.45, v_stribeck: float = 5e-3, m_obj: float = 0.2, c_obj: float = 15.0,
+def contact_parameters(*, m_pad: float = 2.0e-3, k_t: float = 5.0e3, c_t: float = 1.5,
+                       mu_s: float = 0.6,
+                       mu_k: float = 0.45, v_stribeck: float = 5e-3, m_obj: float = 0.2,
+                       c_obj: float = 15.0,
                        k_n: float = 2.0e4, texture: float = 2e-6, wavelength: float = 0.5e-3,
-                       shear_coupling: float = 0.3, gain: float = 2.0e3, tau: float = 0.01) -> ParameterSet:
+                       shear_coupling: float = 0.3, gain: float = 2.0e3,
+                       tau: float = 0.01) -> ParameterSet:
     """Stick-slip fingertip contact plus PVDF film parameters (SI). All assumed (see module doc)."""
     a = "assumed: phase-I fingertip scale (the seed prints no contact parameters)"
     pv = pvdf_parameters(gain=gain, tau=tau)
     return ParameterSet([
-        Parameter("m_pad", m_pad, "kg", "effective mass of the fingertip pad surface", bounds=(1e-9, None),
+        Parameter("m_pad", m_pad, "kg", "effective mass of the "
+                                        "fingertip pad surface", bounds=(1e-9, None),
                   source=a, display_unit="g"),
-        Parameter("k_t", k_t, "N/m", "tangential stiffness of the elastomer pad", bounds=(1e-6, None), source=a),
-        Parameter("c_t", c_t, "N*s/m", "tangential damping of the pad", bounds=(0.0, None), source=a),
-        Parameter("mu_s", mu_s, "1", "static friction coefficient pad/object", bounds=(0.0, 5.0), source=a),
-        Parameter("mu_k", mu_k, "1", "kinetic friction coefficient at high speed", bounds=(0.0, 5.0), source=a),
-        Parameter("v_stribeck", v_stribeck, "m/s", "Stribeck velocity of the friction drop", bounds=(1e-9, None),
+        Parameter("k_t", k_t, "N/m", "tangential stiffness of "
+                                     "the elastomer pad", bounds=(1e-6, None), source=a),
+        Parameter("c_t", c_t, "N*s/m", "tangential damping of the pad", bounds=(0.0, None),
+                  source=a),
+        Parameter("mu_s", mu_s, "1", "static friction coefficient pad/object", bounds=(0.0, 5.0),
+                  source=a),
+        Parameter("mu_k", mu_k, "1", "kinetic friction "
+                                     "coefficient at high speed", bounds=(0.0, 5.0), source=a),
+        Parameter("v_stribeck", v_stribeck, "m/s", "Stribeck velocity of "
+                                                   "the friction drop", bounds=(1e-9, None),
                   source=a, display_unit="mm/s"),
-        Parameter("m_obj", m_obj, "kg", "mass of the grasped object (per finger)", bounds=(1e-9, None), source=a),
+        Parameter("m_obj", m_obj, "kg", "mass of the grasped "
+                                        "object (per finger)", bounds=(1e-9, None), source=a),
         Parameter("c_obj", c_obj, "N*s/m", "damping of the object's motion relative to the hand",
                   bounds=(0.0, None), source=a),
-        Parameter("k_n", k_n, "N/m", "normal stiffness of the elastomer over the film", bounds=(1e-6, None),
+        Parameter("k_n", k_n, "N/m", "normal stiffness of the "
+                                     "elastomer over the film", bounds=(1e-6, None),
                   source=a),
-        Parameter("texture", texture, "m", "amplitude of the object's surface texture", bounds=(0.0, None),
+        Parameter("texture", texture, "m", "amplitude of the object's "
+                                           "surface texture", bounds=(0.0, None),
                   source=a, display_unit="um"),
-        Parameter("wavelength", wavelength, "m", "main wavelength of the surface texture", bounds=(1e-9, None),
+        Parameter("wavelength", wavelength, "m", "main wavelength of the "
+                                                 "surface texture", bounds=(1e-9, None),
                   source=a, display_unit="mm"),
         Parameter("shear_coupling", shear_coupling, "1", "film deformation per unit pad shear",
                   bounds=(0.0, None), source=a),
@@ -157,7 +174,8 @@ def _texture(s, a, lam):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _testbed_substep(m, Fs, muk, mus, vs, Fn, spring, v_surface, h, vp, vo, stuck):  # pragma: no cover - compiled
+def _testbed_substep(m, Fs, muk, mus, vs, Fn, spring, v_surface, h, vp, vo,
+                     stuck):  # pragma: no cover - compiled
     """One substep of the testbed drive (mode 1): the surface moves at ``v_surface``. A stuck pad
     moves with it while the friction that takes, m·a − spring, stays within μ_s F_n (``Fs``); a
     slipping pad feels the Stribeck friction μ(v) F_n and sticks again when the relative
@@ -252,7 +270,8 @@ def contact_step(th, mode, u, dt, substeps, st, y):  # pragma: no cover - compil
             Fs = mus * Fn
             spring = -k * xp - c * vp
             if mode == TESTBED:
-                vp, vo, stuck, F = _testbed_substep(m, Fs, muk, mus, vs, Fn, spring, drive, h, vp, vo, stuck)
+                vp, vo, stuck, F = (_testbed_substep(m, Fs, muk, mus, vs, Fn, spring, drive, h, vp,
+                                                     vo, stuck))
             else:
                 vp, vo, stuck, F = _grasp_substep(po, Fs, Fn, spring, drive, h, vp, vo, stuck)
             xo += vo * h
@@ -295,12 +314,15 @@ class StickSlipContact(Model):
 
     name = "stick-slip-contact"
     description = "fingertip pad with stick-slip friction and an embedded PVDF film"
-    inputs = (Signal("F_n", "N", "normal grip force"), Signal("F_load", "N", "tangential load on the object"))
+    inputs = (Signal("F_n", "N", "normal grip force"),
+              Signal("F_load", "N", "tangential load on the object"))
     outputs = (Signal("v_pvdf", "V", "PVDF film voltage"), Signal("v_slip", "m/s", "slip velocity"),
                Signal("slipping", "1", "fraction of the sample spent slipping"),
-               Signal("x_pad", "m", "pad shear displacement"), Signal("x_obj", "m", "object position"),
+               Signal("x_pad", "m", "pad shear displacement"),
+               Signal("x_obj", "m", "object position"),
                Signal("F_t", "N", "friction force on the pad"))
-    states = (Signal("x_pad", "m"), Signal("v_pad", "m/s"), Signal("x_obj", "m"), Signal("v_obj", "m/s"),
+    states = (Signal("x_pad", "m"), Signal("v_pad", "m/s"), Signal("x_obj", "m"),
+              Signal("v_obj", "m/s"),
               Signal("stuck", "1"), Signal("s", "m", "sliding distance"), Signal("v_film", "V"),
               Signal("d_prev", "m"))
     integrator = "semi-implicit"
@@ -310,7 +332,8 @@ class StickSlipContact(Model):
     def __init__(self, parameters: ParameterSet | None = None, *, check: bool = True, **kw):
         params = parameters if parameters is not None else contact_parameters(**kw)
         if tuple(params.names) != _CONTACT_NAMES:
-            raise DataError(f"contact parameters must be {_CONTACT_NAMES} in this order, found {params.names}")
+            raise DataError(f"contact parameters must be {_CONTACT_NAMES} in this order, "
+                            f"found {params.names}")
         if params.value("mu_k") > params.value("mu_s"):
             raise DataError(f"mu_k = {params.value('mu_k')} exceeds mu_s = {params.value('mu_s')}",
                             hint="kinetic friction cannot exceed static friction")
@@ -342,7 +365,8 @@ class StickSlipContact(Model):
         """A fresh state vector for :meth:`advance` (stuck, at rest)."""
         return self.initial_state(self.theta())
 
-    def advance(self, state: np.ndarray, F_n, drive, dt: float, substeps: int | None = None) -> np.ndarray:
+    def advance(self, state: np.ndarray, F_n, drive, dt: float,
+                substeps: int | None = None) -> np.ndarray:
         """Advance ``state`` (updated in place) over the samples of ``F_n``/``drive`` (arrays of one
         length, step ``dt``); returns the outputs (N, 6) as in :meth:`simulate`."""
         fn = np.atleast_1d(np.asarray(F_n, dtype=np.float64))
@@ -363,7 +387,8 @@ class SlipTestbed(StickSlipContact):
     Inputs ``F_n`` (N) and ``v_surface`` (m/s); outputs as :class:`StickSlipContact`."""
 
     name = "slip-testbed"
-    description = "PVDF slip sensor on a test rig: surface driven at a prescribed speed (Fig. 12(b))"
+    description = ("PVDF slip sensor on a test rig: surface driven at a prescribed "
+                   "speed (Fig. 12(b))")
     inputs = (Signal("F_n", "N", "normal force"), Signal("v_surface", "m/s", "surface speed"))
     _mode = TESTBED
 
@@ -383,14 +408,17 @@ def pvdf_noise(n: int, *, dt: float, rng=None, white: float = 2e-3, ripple: floa
     wander = 1.0 + 0.3 * np.sin(2 * np.pi * 0.05 * t + rng.uniform(0, 2 * np.pi))
     for k in range(1, ripple_harmonics + 1):
         if k * ripple_hz < rate / 2:
-            x += (ripple / k) * wander * np.sin(2 * np.pi * k * ripple_hz * t + rng.uniform(0, 2 * np.pi))
+            x += (ripple / k) * wander * np.sin(2 * np.pi * k * ripple_hz * t
+                                                + rng.uniform(0, 2 * np.pi))
     return x
 
 
 def nonslip_grasp_inputs(duration: float, *, dt: float, rng=None, normal_force: float = 2.0,
                          load: float = 0.4, load_std: float = 0.12, grip_std: float = 0.05,
-                         tap_rate: float = 0.5, tap_amplitude=(0.1, 0.3), tap_duration=(0.004, 0.02),
-                         grip_step_rate: float = 0.2, grip_step: float = 0.3, min_normal: float = 1.6) -> np.ndarray:
+                         tap_rate: float = 0.5, tap_amplitude=(0.1, 0.3),
+                         tap_duration=(0.004, 0.02),
+                         grip_step_rate: float = 0.2, grip_step: float = 0.3,
+                         min_normal: float = 1.6) -> np.ndarray:
     """(N, 2) inputs [F_n, F_load] (N) of a held object that does not slip: a slowly wandering
     tangential load (3 Hz band-limited, std ``load_std``) and grip force, handling taps (half-cosine
     load pulses, Poisson ``tap_rate`` per s) and grip-force steps of the controller (10 ms ramps).

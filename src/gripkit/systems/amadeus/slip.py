@@ -151,7 +151,8 @@ class SlipEvent:
     """One detected slip: ``onset`` (s, first sample of the above-threshold run), ``alarm`` (s,
     when the detector declared it), ``end`` (s, or None when still slipping at the end), the
     stick-slip ``rate`` (Hz, dominant frequency over the first ``feature_window`` after onset) and
-    a ``speed`` indication (m/s) with its ``speed_std`` when the detector has a speed calibration."""
+    a ``speed`` indication (m/s) with its ``speed_std`` when the detector has a speed
+    calibration."""
 
     onset: float
     alarm: float
@@ -206,7 +207,8 @@ def _signal(x, what="signal") -> np.ndarray:
         raise DataError(f"{what} is empty")
     if not np.isfinite(a).all():
         i = int(np.argmax(~np.isfinite(a)))
-        raise DataError(f"{what} has {int((~np.isfinite(a)).sum())} NaN/inf samples (first at sample {i})",
+        raise DataError(f"{what} has {int((~np.isfinite(a)).sum())} NaN/inf samples "
+                        f"(first at sample {i})",
                         hint="interpolate or cut out the bad stretch before slip detection")
     return a
 
@@ -283,7 +285,8 @@ def stick_slip_rate(signal, *, dt: float, band=(20.0, 400.0), frame: float | Non
     f = ftr.freqs
     inb = np.flatnonzero((f >= band[0]) & (f <= band[1]))
     if inb.size < 3:
-        raise DataError(f"the band {band} Hz holds fewer than 3 frequency bins at this frame length",
+        raise DataError(f"the band {band} Hz holds fewer than 3 frequency bins at "
+                        "this frame length",
                         hint="use a longer record or a wider band")
     i = inb[np.argmax(P[inb])]
     if i <= 0 or i >= f.size - 1:
@@ -359,7 +362,8 @@ class SlipDetector:
         zi = np.ascontiguousarray(sg.sosfilt_zi(self.sos) * x0)
         return zi, np.zeros(self.window), np.zeros(3)
 
-    def calibrate(self, nonslip_signal, *, quantile: float = 0.9999, margin: float = 2.0) -> "SlipDetector":
+    def calibrate(self, nonslip_signal, *, quantile: float = 0.9999,
+                  margin: float = 2.0) -> "SlipDetector":
         """Set θ = ``margin`` × the ``quantile`` of the band energy of a record without slip."""
         E = self.energy(nonslip_signal)
         skip = min(E.size - 1, 4 * self.window)
@@ -386,14 +390,18 @@ class SlipDetector:
         x = _signal(signal)
         E = self.energy(x)
         state = np.zeros(E.size)
-        max_ev = E.size // (self.n_on + self.n_off) + 2  # an event needs n_on samples up and n_off down
+        # an event needs n_on samples up and n_off down
+        max_ev = E.size // (self.n_on + self.n_off) + 2
         ev = np.zeros((max_ev, 3))
         st = np.zeros(5)
-        ne = _slip_state(E, self.threshold, self.release, float(self.n_on), float(self.n_off), st, state, ev, max_ev)
+        ne = (_slip_state(E, self.threshold, self.release, float(self.n_on), float(self.n_off), st,
+                          state, ev, max_ev))
         if ne > max_ev:  # cannot happen (see max_ev); kept as a guard against silent truncation
             raise DataError(f"more than {max_ev} slip events in {E.size} samples")
         t = t0 + np.arange(E.size) * self.dt
-        fn = None if normal_force is None else np.broadcast_to(np.asarray(normal_force, dtype=np.float64), x.shape)
+        fn = (None if normal_force is None else np.broadcast_to(np.asarray(normal_force,
+                                                                           dtype=np.float64),
+                                                                           x.shape))
         events = [self._event(x, ev[i], t0, fn) for i in range(ne)]
         return SlipDetection(t, E, state > 0.5, self.threshold, events, self.dt)
 
@@ -408,7 +416,8 @@ class SlipDetector:
         cal = self.speed_calibration
         if cal is not None and np.isfinite(rate) and (fn is not None or not cal.uses_force):
             sp, ss = cal.predict(rate, None if fn is None else float(np.mean(fn[on:on + nfw])))
-        return SlipEvent(t0 + on * self.dt, t0 + al * self.dt, None if en < 0 else t0 + en * self.dt, rate, sp, ss)
+        return (SlipEvent(t0 + on * self.dt, t0 + al * self.dt,
+                          None if en < 0 else t0 + en * self.dt, rate, sp, ss))
 
     def stream(self) -> "SlipStream":
         """A causal, chunk-by-chunk detector with the same settings (for control loops)."""
@@ -438,7 +447,8 @@ class SlipStream:
         _band_energy(x, self.det.sos, self._zi, self._ring, self._rpos, E)
         state = np.zeros(E.size)
         ev = np.zeros((max(8, E.size), 3))
-        ne = _slip_state(E, self.det.threshold, self.det.release, float(self.det.n_on), float(self.det.n_off),
+        ne = _slip_state(E, self.det.threshold, self.det.release, float(self.det.n_on),
+                         float(self.det.n_off),
                          self._st, state, ev, ev.shape[0])
         alarms = []
         dt = self.det.dt
@@ -479,7 +489,8 @@ class SlipReflex:
         return self.boost
 
     def on_slip(self, speed: float | None = None) -> float:
-        inc = self.step + (self.speed_gain * speed if (speed is not None and np.isfinite(speed)) else 0.0)
+        inc = (self.step + (self.speed_gain * speed if (speed is not None and np.isfinite(speed))
+                            else 0.0))
         self.boost += max(inc, 0.0)
         self.n_events += 1
         return self.boost
@@ -510,18 +521,22 @@ def calibrate_speed(records, speeds, *, dt: float, normal_forces=None, skip: flo
         fn = np.broadcast_to(np.asarray(normal_forces, dtype=np.float64), sp.shape)
         if (fn <= 0).any():
             raise DataError("normal_forces must be positive (N)")
-    rates = np.array([stick_slip_rate(_signal(r, "speed-calibration record")[int(round(skip / dt)):], dt=dt, band=band)
+    rates = np.array([stick_slip_rate(_signal(r,
+                                              "speed-calibration record")[int(round(skip / dt)):],
+                                              dt=dt, band=band)
                       for r in records])
     x = rates * fn if normal_forces is not None else rates
     X = np.column_stack([np.ones_like(x), x])
     if np.linalg.matrix_rank(X) < 2:
-        raise IdentificationError("the records all give the same stick-slip rate: speed is not identifiable")
+        raise IdentificationError("the records all give the same stick-slip rate: speed is "
+                                  "not identifiable")
     coef, *_ = np.linalg.lstsq(X, sp, rcond=None)
     res = sp - X @ coef
     dof = max(sp.size - 2, 1)
     s2 = float(res @ res) / dof
     cov = np.linalg.inv(X.T @ X) * s2
-    return SpeedCalibration(float(coef[0]), float(coef[1]), cov, math.sqrt(s2), normal_forces is not None,
+    return SpeedCalibration(float(coef[0]), float(coef[1]), cov, math.sqrt(s2),
+                            normal_forces is not None,
                             (float(sp.min()), float(sp.max())), sp, x)
 
 
@@ -545,5 +560,6 @@ def false_alarm_rate(slipping, truth, *, dt: float, frame: float = 0.01) -> dict
     fa = df & neg
     runs = int(np.count_nonzero(np.diff(np.concatenate([[0], fa.astype(np.int8)])) == 1))
     minutes = d.size * dt / 60.0
-    return dict(rate=float(fa.sum() / max(neg.sum(), 1)), n_frames=int(neg.sum()), n_false=int(fa.sum()),
+    return dict(rate=float(fa.sum() / max(neg.sum(), 1)), n_frames=int(neg.sum()),
+                n_false=int(fa.sum()),
                 per_minute=runs / minutes if minutes > 0 else math.nan)

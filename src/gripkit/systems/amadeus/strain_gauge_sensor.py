@@ -35,7 +35,8 @@ from ...consistency import Finding
 from ...errors import DataError, ModelError
 from ...params import Parameter, ParameterSet
 
-__all__ = ["StrainGaugeSensor", "sensor_parameters", "sensitivity_matrix", "single_bridge_estimates"]
+__all__ = (["StrainGaugeSensor", "sensor_parameters", "sensitivity_matrix",
+            "single_bridge_estimates"])
 
 _SEED = "000_8f66dcc7ab06470c.txt"
 
@@ -71,13 +72,16 @@ def sensor_parameters(*, K=(12.0, 9.0, 6.0, 10.0, 8.0, 7.0), phi1: float = math.
     src_k = source or "assumed: the seed prints no calibration constants"
     ks = [None] * 6 if k_std is None else [float(s) for s in k_std]
     ps = [None, None] if phi_std is None else [float(s) for s in phi_std]
-    params = [Parameter(f"K{j + 1}", float(K[j]), "V/(N*m)", f"calibration constant of bridge R{j + 1}",
+    params = [Parameter(f"K{j + 1}", float(K[j]), "V/(N*m)", "calibration constant of "
+                                                             f"bridge R{j + 1}",
                         bounds=(0.0, None), source=src_k, std=ks[j]) for j in range(6)]
     params += [
-        Parameter("phi1", phi1, "rad", "beam angle φ₁ relative to the sensor base", bounds=(-math.pi, math.pi),
+        Parameter("phi1", phi1, "rad", "beam angle φ₁ relative to "
+                                       "the sensor base", bounds=(-math.pi, math.pi),
                   source=source or "assumed: Fig. 9(c) angles not given numerically", std=ps[0],
                   display_unit="deg"),
-        Parameter("phi2", phi2, "rad", "beam angle φ₂ relative to the sensor base", bounds=(-math.pi, math.pi),
+        Parameter("phi2", phi2, "rad", "beam angle φ₂ relative to "
+                                       "the sensor base", bounds=(-math.pi, math.pi),
                   source=source or "assumed: Fig. 9(c) angles not given numerically", std=ps[1],
                   display_unit="deg"),
         Parameter("beam_length", beam_length, "m", "length l of each beam", bounds=(1e-5, 1.0),
@@ -85,11 +89,15 @@ def sensor_parameters(*, K=(12.0, 9.0, 6.0, 10.0, 8.0, 7.0), phi1: float = math.
     ]
     for j in range(6):
         params.append(Parameter(f"sigma_n2_{j + 1}", float(sn[j]), "1",
-                                f"normalised noise variance of single-bridge estimate from R{j + 1} (eq 19)",
+                                "normalised noise variance of single-bridge estimate from "
+                                f"R{j + 1} (eq 19)",
                                 bounds=(0.0, None),
-                                source=(f"{_SEED} Table I (ε_N{j % 3 + 1}, actual); mapping to bridges assumed")))
-    params.append(Parameter("noise_floor", floor, "V", "electronics noise std of each bridge at zero load",
-                            bounds=(0.0, None), source="assumed: Fig. 16 shows load-independent noise",
+                                source=(f"{_SEED} Table I (ε_N{j % 3 + 1}, actual); mapping to "
+                                        "bridges assumed")))
+    params.append(Parameter("noise_floor", floor, "V", "electronics noise std of each "
+                                                       "bridge at zero load",
+                            bounds=(0.0, None), source="assumed: Fig. 16 shows "
+                                                       "load-independent noise",
                             display_unit="mV"))
     return ParameterSet(params, "strain-gauge-sensor")
 
@@ -120,7 +128,8 @@ class StrainGaugeSensor:
         H = self.H
         if np.linalg.matrix_rank(H, tol=1e-12 * np.abs(H).max()) < 3:
             raise ModelError("the sensor cannot observe all three force components",
-                             hint="f_x needs sin φ₁ or sin φ₂ nonzero, and the (R4, R5) pair must not be "
+                             hint="f_x needs sin φ₁ or sin φ₂ nonzero, and the (R4, R5) "
+                                  "pair must not be "
                                   "degenerate")
 
     @property
@@ -149,7 +158,8 @@ class StrainGaugeSensor:
         return sensitivity_matrix(self.K, *self.phi, self.beam_length)
 
     def readings(self, force) -> np.ndarray:
-        """Noise-free bridge readings R₁..R₆ (V), shape (..., 6), for forces (..., 3) N (eqs 9–14)."""
+        """Noise-free bridge readings R₁..R₆ (V), shape (..., 6), for forces (..., 3) N (eqs
+        9–14)."""
         f = np.asarray(force, dtype=np.float64)
         if f.shape[-1:] != (3,):
             raise DataError(f"force: expected shape (..., 3) for [f_x, f_y, f_z], found {f.shape}")

@@ -13,7 +13,8 @@ operation is within the central linear portion". gripkit uses a smooth clamp of 
 
 linear with slope k_v between the elbows at i_lo and i_hi and flattening to p_min and p_sup with
 elbow width w. The local slope is k_v σ((i − i_lo)/w); it reaches 95 % of k_v where
-(i − i_lo)/w = ln 19, at P = p_min + k_v w ln 20. Requiring that point to be the 12 bar of §II-D gives
+(i − i_lo)/w = ln 19, at P = p_min + k_v w ln 20. Requiring that point to be the 12 bar of §II-D
+gives
 w = (12 bar − p_min) / (k_v ln 20) — :func:`valve_parameters` derives w this way and
 :meth:`ProportionalValve.consistency_checks` verifies it. The current range 0.5–1.1 A is an
 assumption anchored on §V-E (the valve was driven over 600–1100 mA around 850 mA).
@@ -67,31 +68,38 @@ _NAMES = ("p_min", "p_supply", "i_lo", "i_hi", "elbow", "hysteresis", "delay", "
 
 def valve_parameters(*, p_min: float = 7.5 * BAR, p_supply: float = 30.0 * BAR, i_lo: float = 0.5,
                      i_hi: float = 1.1, p_linear: float = 12.0 * BAR, elbow: float | None = None,
-                     hysteresis: float = 0.015, delay: float = 0.01, tau: float = 0.025) -> ParameterSet:
+                     hysteresis: float = 0.015, delay: float = 0.01,
+                     tau: float = 0.025) -> ParameterSet:
     """The valve's ParameterSet (SI: Pa, A, s). ``elbow`` defaults to the width that puts the
     start of the linear region (95 % of the central slope) at ``p_linear`` (12 bar, §II-D)."""
     if elbow is None:
         kv = (p_supply - p_min) / (i_hi - i_lo)
         elbow = (p_linear - p_min) / (kv * _LN20)
     return ParameterSet([
-        Parameter("p_min", p_min, "Pa", "lowest deliverable pressure (valve leakage)", bounds=(0.0, None),
+        Parameter("p_min", p_min, "Pa", "lowest deliverable pressure "
+                                        "(valve leakage)", bounds=(0.0, None),
                   source=f"{_SEED} §II-D (7.5 bar)", display_unit="bar"),
         Parameter("p_supply", p_supply, "Pa", "supply pressure (upper end of the static curve)",
                   bounds=(0.0, None), source=f"{_SEED} §II-D (30 bar)", display_unit="bar"),
         Parameter("i_lo", i_lo, "A", "current where the linear region extrapolates to p_min",
-                  bounds=(0.0, None), source="assumed: anchored on the 600-1100 mA drive range of §V-E",
+                  bounds=(0.0, None), source="assumed: anchored on the 600-1100 mA "
+                                             "drive range of §V-E",
                   display_unit="mA"),
         Parameter("i_hi", i_hi, "A", "current where the linear region reaches the supply pressure",
                   bounds=(0.0, None), source="assumed: 1100 mA, the 'held constant' level of §V-E",
                   display_unit="mA"),
         Parameter("elbow", elbow, "A", "width w of the smooth elbows of the static curve",
                   bounds=(1e-9, None),
-                  source=f"derived: linear (95 % slope) from 12 bar, {_SEED} §II-D", display_unit="mA"),
-        Parameter("hysteresis", hysteresis, "A", "half-width h of the play operator (loop width 2h)",
+                  source="derived: linear (95 % slope) from 12 "
+                         f"bar, {_SEED} §II-D", display_unit="mA"),
+        Parameter("hysteresis", hysteresis, "A", "half-width h of the play operator "
+                                                 "(loop width 2h)",
                   bounds=(0.0, None), source="assumed: Fig. 5 loop width not in the extracted text",
                   display_unit="mA"),
-        Parameter("delay", delay, "s", "transport delay from current to pressure", bounds=(0.0, 1.0),
-                  source=f"{_SEED} §V-C, Fig. 15 (about 0.01 s, two samples at 200 Hz)", display_unit="ms"),
+        Parameter("delay", delay, "s", "transport delay from "
+                                       "current to pressure", bounds=(0.0, 1.0),
+                  source=f"{_SEED} §V-C, Fig. 15 (about 0.01 s, two "
+                         "samples at 200 Hz)", display_unit="ms"),
         Parameter("tau", tau, "s", "first-order pressure time constant", bounds=(1e-6, 10.0),
                   source="assumed: 6.4 Hz corner, above the 5.5 Hz finger response of Fig. 2(c)",
                   display_unit="ms"),
@@ -178,7 +186,8 @@ class ProportionalValve(Model):
     name = "proportional-valve"
     description = "proportional pressure valve: hysteresis, leakage floor, delay, first-order lag"
     inputs = (Signal("i", "A", "solenoid current"),)
-    outputs = (Signal("p", "Pa", "tube pressure"), Signal("p_static", "Pa", "static (quasi-steady) pressure"))
+    outputs = (Signal("p", "Pa", "tube pressure"),
+               Signal("p_static", "Pa", "static (quasi-steady) pressure"))
     states = (Signal("play", "A", "play-operator output"), Signal("p", "Pa", "tube pressure"))
     integrator = "zoh"
 
@@ -186,7 +195,8 @@ class ProportionalValve(Model):
         params = parameters if parameters is not None else valve_parameters(**kw)
         missing = [n for n in _NAMES if n not in params]
         if missing or tuple(params.names) != _NAMES:
-            raise DataError(f"valve parameters must be {_NAMES} in this order, found {params.names}")
+            raise DataError(f"valve parameters must be {_NAMES} in this order, "
+                            f"found {params.names}")
         if (params.value("i_hi") <= params.value("i_lo")
                 or params.value("p_supply") <= params.value("p_min")):
             raise DataError("valve: need i_hi > i_lo and p_supply > p_min")
@@ -234,13 +244,16 @@ class ProportionalValve(Model):
         return self.static_pressure(x)
 
     def current_for(self, pressure) -> np.ndarray:
-        """Inverse of the static curve (no hysteresis): current (A) for a pressure in (p_min, p_supply)."""
+        """Inverse of the static curve (no hysteresis): current (A) for a pressure in (p_min,
+        p_supply)."""
         p = np.asarray(pressure, dtype=np.float64)
         lo, hi = self._p("p_min"), self._p("p_supply")
         if ((p <= lo) | (p >= hi)).any():
             raise DataError(f"pressure must lie strictly between p_min = {lo / BAR:g} bar and "
-                            f"p_supply = {hi / BAR:g} bar, found {p.min() / BAR:.4g}..{p.max() / BAR:.4g} bar",
-                            hint="the valve cannot deliver pressures outside its leakage floor and supply")
+                            f"p_supply = {hi / BAR:g} bar, found "
+                            f"{p.min() / BAR:.4g}..{p.max() / BAR:.4g} bar",
+                            hint="the valve cannot deliver pressures outside its leakage "
+                                 "floor and supply")
         # monotone: Newton from the linear-region guess, safeguarded by bisection bounds
         kv = self.gain
         i = self._p("i_lo") + (p - lo) / kv
@@ -281,9 +294,12 @@ class ProportionalValve(Model):
         p95 = self._p("p_min") + kv * w * _LN20
         return [
             compare("linear-from-12-bar", self.name, computed=p95, stated=12.0 * BAR, rtol=0.02,
-                    what="pressure where the static slope reaches 95 % of the central slope", unit="Pa",
-                    used="the elbow width as given", source=f"{_SEED} §II-D ('operated above 12 bar')"),
-            compare("delay-samples-200Hz", self.name, computed=self._p("delay") * 200.0, stated=2.0, rtol=0.05,
+                    what="pressure where the static slope reaches 95 % of "
+                         "the central slope", unit="Pa",
+                    used="the elbow width as given",
+                    source=f"{_SEED} §II-D ('operated above 12 bar')"),
+            compare("delay-samples-200Hz", self.name, computed=self._p("delay") * 200.0, stated=2.0,
+                    rtol=0.05,
                     what="transport delay x 200 Hz", unit="samples", used="the delay as given",
                     source=f"{_SEED} §V-C (two time steps at 200 Hz)"),
         ]
@@ -296,5 +312,7 @@ def pressure_to_force_plant(force_plant, valve: ProportionalValve):
     :meth:`gripkit.control.DiscretePlant.from_model` accepts."""
     plant = DiscretePlant.from_model(force_plant)
     return DiscretePlant(plant.A, np.asarray(plant.B) / valve.gain, plant.dt, input_name="p_demand",
-                         input_unit="Pa", output_name=plant.output_name, output_unit=plant.output_unit,
-                         source=f"{plant.source}; per unit pressure demand (÷ k_v = {valve.gain:.4g} Pa/A)")
+                         input_unit="Pa", output_name=plant.output_name,
+                         output_unit=plant.output_unit,
+                         source=f"{plant.source}; per unit pressure demand (÷ k_v = "
+                                f"{valve.gain:.4g} Pa/A)")

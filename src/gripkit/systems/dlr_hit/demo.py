@@ -42,9 +42,11 @@ def run(report, *, quick: bool = False) -> dict:
     sec = report.section(
         "DLR/HIT Hand II finger: motor, friction, dynamics, identification and control",
         "The complete finger of the thesis (ch. 7, Fig. 7.1): PWM → BLDC motor (eq 5.10 with the "
-        "Appendix E guard) → timing belts and 100:1 harmonic drive → Appendix G friction tables with "
+        "Appendix E guard) → timing belts and 100:1 harmonic drive → Appendix G "
+        "friction tables with "
         "Karnopp stick-slip → coupled Newton-Euler dynamics (Craig DH, θ4 = θ3, ±45° bevel "
-        "differential, rotor inertia Im·N²), compliant end stops for the belt elasticity. Where the "
+        "differential, rotor inertia Im·N²), compliant end stops for the belt "
+        "elasticity. Where the "
         "thesis's printed numbers disagree, gripkit derives the value it uses and reports the "
         "contradiction:")
     rep = check(f)
@@ -77,19 +79,24 @@ def _motor_maps(sec, summary, quick):
     ax[1].set(xlabel="speed [rpm]", ylabel="torque [Ncm]", title="torque vs speed (eq 5.10, guard)")
     ax[0].legend(fontsize=8)
     ax[1].legend(fontsize=8)
-    sec.figure(fig, "Motor maps: eq 5.7 at stall (and the cold motor through eq 5.5), eq 5.10 over speed; "
-                    "the torque drops to zero where Appendix E's guard lets the speed term win.", "dlr-motor-maps")
+    sec.figure(fig, "Motor maps: eq 5.7 at stall (and the cold motor through eq 5.5), eq "
+                    "5.10 over speed; "
+                    "the torque drops to zero where Appendix E's guard lets the "
+                    "speed term win.", "dlr-motor-maps")
     tb = MotorTestBed(check=False)
     dur = 60 if quick else 120
-    tr = tb.simulate(np.column_stack([np.full(dur * 10 + 1, 4000.0), np.zeros(dur * 10 + 1)]), dt=0.1)
+    tr = (tb.simulate(np.column_stack([np.full(dur * 10 + 1, 4000.0), np.zeros(dur * 10 + 1)]),
+                      dt=0.1))
     fig, ax = _fig(1, 6.0, 3.2)
     ax[0].plot(tr.t, tr["torque"] / NCM, "b-")
     ax[0].set(xlabel="time [s]", ylabel="torque [Ncm]", title="PWM 4000 at stall (Fig. 5.7)")
     a2 = ax[0].twinx()
     a2.plot(tr.t, tr["temperature"] - 273.15, "r--")
     a2.set_ylabel("winding temperature [°C]", color="r")
-    sec.figure(fig, f"Fig. 5.7 reproduced by the thermal model: {tr['torque'][0] / NCM:.2f} Ncm cold, "
-                    f"{tr['torque'][-1] / NCM:.2f} Ncm at {tr['temperature'][-1] - 273.15:.0f} °C after {dur} s.",
+    sec.figure(fig, "Fig. 5.7 reproduced by the thermal model: "
+                    f"{tr['torque'][0] / NCM:.2f} Ncm cold, "
+                    f"{tr['torque'][-1] / NCM:.2f} Ncm at {tr['temperature'][-1] - 273.15:.0f} "
+                    f"°C after {dur} s.",
                "dlr-fig57")
     summary["fig57_torque_ncm"] = [float(tr["torque"][0] / NCM), float(tr["torque"][-1] / NCM)]
     rng = np.random.default_rng(1)
@@ -98,16 +105,20 @@ def _motor_maps(sec, summary, quick):
     for p in (2000, 2500, 3000, 3500, 4000):
         w = np.repeat(np.arange(0, 2501, 500.0), 40) * RPM
         runs.append((p, w, motor.torque(p, w) + rng.normal(0, 0.005 * NCM, w.size)))
-    mc = characterize_motor(stall, motor.torque(stall, 0.0) + rng.normal(0, 0.005 * NCM, stall.size), runs)
+    mc = (characterize_motor(stall, motor.torque(stall, 0.0) + rng.normal(0, 0.005 * NCM,
+                                                                          stall.size), runs))
     k = RPM / NCM
     sec.table(["quantity", "identified", "± std", "thesis"],
               [["c (eq 5.7) [Ncm/PWM]", mc.c / NCM, mc.c_std / NCM, 1.43e-4],
                ["b1 (eq 5.8) [Ncm/(rpm·PWM)]", mc.b1 * k, mc.b1_std * k, 1.215e-8],
                ["b0 (eq 5.8) [Ncm/rpm]", mc.b0 * k, mc.b0_std * k, -7.711e-5]]
-              + [[f"slope at PWM {int(p)} [Ncm/rpm]", b, s, SLOPES_5_4_2.get(int(p), "not printed (§5.4.2 lists 2000-3500)")]
+              + [[f"slope at PWM {int(p)} [Ncm/rpm]", b, s,
+                  SLOPES_5_4_2.get(int(p), "not printed (§5.4.2 lists 2000-3500)")]
                  for p, b, s in mc.table()],
-              caption="Two-stage motor characterisation (§5.4) on simulated test-bed data (sensor noise "
-                      "0.005 Ncm): eq 5.7 and eq 5.8 are recovered; the printed slopes differ from eq 5.8 "
+              caption="Two-stage motor characterisation (§5.4) on simulated test-bed "
+                      "data (sensor noise "
+                      "0.005 Ncm): eq 5.7 and eq 5.8 are recovered; the printed slopes "
+                      "differ from eq 5.8 "
                       "by up to 4.9 %.")
     return rng
 
@@ -130,21 +141,28 @@ def _friction(sec, f):
         out = tab.outliers()
         if out:
             idx = [i for i, _ in out]
-            ax[a_i].plot(v[idx] / DEG, tab.values[idx], "ro", mfc="none", ms=9, label="outlying point")
+            ax[a_i].plot(v[idx] / DEG, tab.values[idx], "ro", mfc="none", ms=9,
+                         label="outlying point")
         ax[a_i].axhline(0.36, color="gray", ls=":")
         ax[a_i].axhline(-0.36, color="gray", ls=":", label="stiction ±0.36 N·m")
-        ax[a_i].set(xlabel="velocity [°/s]", ylabel="friction [N·m]", title=f"{name} (Figs 6.4–6.6)")
+        ax[a_i].set(xlabel="velocity [°/s]", ylabel="friction [N·m]",
+                    title=f"{name} (Figs 6.4–6.6)")
         ax[a_i].legend(fontsize=7)
-    sec.figure(fig, "Appendix G's friction tables, recovered from the interleaved extraction, with Stribeck + "
-                    "cubic fits (F_s = 0.36 N·m, v_s = 0.1 rad/s fixed); circles: points 50 % off their "
+    sec.figure(fig, "Appendix G's friction tables, recovered from the interleaved extraction, "
+                    "with Stribeck + "
+                    "cubic fits (F_s = 0.36 N·m, v_s = 0.1 rad/s fixed); circles: points "
+                    "50 % off their "
                     "neighbours.", "dlr-friction")
-    sec.table(["table", "F_c [N·m]", "±", "σ [N·m·s/rad]", "±", "σ₃ [N·m·s³/rad³]", "±", "rms [N·m]"], fits,
-              caption="Stribeck + cubic fits of the tables (the data hold no point below 20 °/s, so v_s is fixed).")
+    sec.table(["table", "F_c [N·m]", "±", "σ [N·m·s/rad]", "±", "σ₃ [N·m·s³/rad³]", "±",
+               "rms [N·m]"], fits,
+              caption="Stribeck + cubic fits of the tables (the data hold no point below 20 °/s, "
+                      "so v_s is fixed).")
 
 
 def _velocity_responses(sec, f, summary):
     """Velocity responses of the finger (Figs 7.3-7.5)."""
-    start = {"distal": (0.0, 0.0, 0.0), "base1": (30 * DEG, 0.0, 0.0), "base2": (-30 * DEG, 0.0, 0.0)}
+    start = ({"distal": (0.0, 0.0, 0.0), "base1": (30 * DEG, 0.0, 0.0),
+              "base2": (-30 * DEG, 0.0, 0.0)})
     fig, ax = _fig(3, 12.0, 3.3)
     rows = []
     steady = {}
@@ -162,12 +180,18 @@ def _velocity_responses(sec, f, summary):
         ax[i].set(xlabel="time [s]", ylabel="velocity [°/s]", title={"distal": "distal (Fig. 7.3)",
                   "base1": "base 1 (Fig. 7.4)", "base2": "base 2 (Fig. 7.5)"}[a])
         ax[i].legend(fontsize=7)
-    sec.figure(fig, "Velocity responses from one end of the travel to the other: acceleration, plateau "
-                    "(dashed: eq 5.10 against the table, no gravity), and braking on the belt-elastic end "
-                    "stop with a rebound (the thesis's simulation drops to zero vertically).", "dlr-velocity")
-    sec.table(["actuator", "PWM", "steady velocity, no gravity [°/s]", "peak, palm down [°/s]"], rows,
-              caption="Velocities gripkit predicts (Figs 7.3–7.5 show 100–300 °/s, distal fastest). Base 2 "
-                      "at PWM 4000 settles on Appendix G's outlying point at 172 °/s without gravity.")
+    sec.figure(fig, "Velocity responses from one end of the travel to the other: "
+                    "acceleration, plateau "
+                    "(dashed: eq 5.10 against the table, no gravity), and braking on the "
+                    "belt-elastic end "
+                    "stop with a rebound (the thesis's simulation drops to "
+                    "zero vertically).", "dlr-velocity")
+    sec.table(["actuator", "PWM", "steady velocity, "
+                                  "no gravity [°/s]", "peak, palm down [°/s]"], rows,
+              caption="Velocities gripkit predicts (Figs 7.3–7.5 show 100–300 °/s, distal "
+                      "fastest). Base 2 "
+                      "at PWM 4000 settles on Appendix G's outlying point at 172 °/s "
+                      "without gravity.")
     summary["steady_velocity_deg_s"] = steady
 
 
@@ -208,13 +232,17 @@ def _stiction_and_idim(sec, summary, quick, rng):
     truth = dict(inertia=J, viscous=0.05, coulomb=0.19, offset=0.0)
     sec.table(["parameter", "true", "IDIM-LS", "± std", "error [%]"],
               [[k, truth[k], res.params[k], res.std[k],
-                100 * (res.params[k] - truth[k]) / truth[k] if truth[k] else "true value 0 (absolute error in ± std)"]
+                100 * (res.params[k] - truth[k]) / truth[k] if truth[k]
+                else "true value 0 (absolute error in ± std)"]
                for k in truth],
-              caption=f"IDIM-LS (zero-phase Butterworth {res.cutoff:g} Hz, differentiation, decimation by "
-                      f"{res.decimation}) on {N / 1000:g} s of closed-loop excitation of the distal drive; "
+              caption=f"IDIM-LS (zero-phase Butterworth {res.cutoff:g} Hz, "
+                      "differentiation, decimation by "
+                      f"{res.decimation}) on {N / 1000:g} s of closed-loop excitation of "
+                      "the distal drive; "
                       f"position quantised to 0.1° (§2.8), torque noise 5 mN·m; relative error "
                       f"{res.relative_error_percent:.2f} %.")
-    summary["idim_error_percent"] = {k: 100 * (res.params[k] - truth[k]) / truth[k] for k in ("inertia", "viscous", "coulomb")}
+    summary["idim_error_percent"] = ({k: 100 * (res.params[k] - truth[k]) / truth[k]
+                                      for k in ("inertia", "viscous", "coulomb")})
 
 
 def _adaptation(sec, f, summary, quick):
@@ -225,25 +253,32 @@ def _adaptation(sec, f, summary, quick):
     drift = dict(scale_distal=1.3, scale_base1=1.2, scale_base2=1.25 * 0.9)
     f2 = finger(check=False, **drift)
     a = simulate_impedance(f, c, ref[:n])
-    x1 = f2.state(q=[a[j][-1] for j in ("abd", "flex", "prox")], qd=[a[f"{j}_vel"][-1] for j in ("abd", "flex", "prox")])
+    x1 = (f2.state(q=[a[j][-1] for j in ("abd", "flex", "prox")],
+                   qd=[a[f"{j}_vel"][-1] for j in ("abd", "flex", "prox")]))
     b = simulate_impedance(f2, c, ref[n:], x0=x1)
-    names = ("abd", "flex", "prox", "abd_vel", "flex_vel", "prox_vel", "pwm_base1", "pwm_base2", "pwm_distal")
+    names = ("abd", "flex", "prox", "abd_vel", "flex_vel", "prox_vel", "pwm_base1", "pwm_base2",
+             "pwm_distal")
     log = Trajectory.uniform(dt=1e-3, **{k_: np.concatenate([a[k_], b[k_]]) for k_ in names})
     ad, ares = adapt_finger_friction(f, log, forgetting=0.999)
     true_after = (1.2, 0.9, 1.3)
     fig, ax = _fig(1, 8.0, 3.2)
     for k_, name in enumerate(ACTUATORS):
         line, = ax[0].plot(ares.t, ares.scale[:, k_], label=name)
-        ax[0].plot([0, n / 1000, n / 1000, 2 * n / 1000], [1, 1, true_after[k_], true_after[k_]], ":",
+        ax[0].plot([0, n / 1000, n / 1000, 2 * n / 1000], [1, 1, true_after[k_], true_after[k_]],
+                   ":",
                    color=line.get_color())
-    ax[0].set(xlabel="time [s]", ylabel="friction scale", title="online friction adaptation (RLS, λ = 0.999)")
+    ax[0].set(xlabel="time [s]", ylabel="friction scale", title="online friction adaptation "
+                                                                "(RLS, λ = 0.999)")
     ax[0].legend(fontsize=8)
-    sec.figure(fig, f"Friction drifts at t = {n / 1000:g} s (distal +30 %, base 1 +20 %, base 2 −10 %) while the "
+    sec.figure(fig, f"Friction drifts at t = {n / 1000:g} s (distal +30 %, base 1 +20 %, base 2 "
+                    "−10 %) while the "
                     "finger tracks a periodic reference; dotted: true scales.", "dlr-adaptation")
     settle = [ares.settling_time(k_, true_after[k_], n / 1000) for k_ in range(3)]
     sec.table(["actuator", "settling to 5 % [s]", "final scale", "true"],
-              [[name, settle[k_], float(ares.scale[-1, k_]), true_after[k_]] for k_, name in enumerate(ACTUATORS)],
-              caption=f"Stated convergence time dt·ln 20/(−ln λ) = {ad.convergence_time():.2f} s of sliding.")
+              [[name, settle[k_], float(ares.scale[-1, k_]),
+                true_after[k_]] for k_, name in enumerate(ACTUATORS)],
+              caption="Stated convergence time dt·ln 20/(−ln λ) = "
+                      f"{ad.convergence_time():.2f} s of sliding.")
     summary["adaptation_settling_s"] = settle
     summary["adaptation_stated_s"] = ad.convergence_time()
 
@@ -261,8 +296,10 @@ def _loop_adaptation(sec, f, summary):
         ax[0].plot(tr.t, tr[f"drift_scale_{a}"], ":", color="k", lw=1.5)
         ax[1].plot(tr.t, tr[f"offset_hat_{a}"], "-", lw=1, color=line.get_color(), label=a)
         ax[1].plot(tr.t, tr[f"drift_offset_{a}"], ":", color="k", lw=1.5)
-    ax[0].set(xlabel="time [s]", ylabel="friction scale", ylim=(0.6, 1.8), title="scale ŝ (dotted: plant)")
-    ax[1].set(xlabel="time [s]", ylabel="offset [N·m]", ylim=(-0.1, 0.25), title="offset ô (dotted: plant)")
+    ax[0].set(xlabel="time [s]", ylabel="friction scale", ylim=(0.6, 1.8),
+              title="scale ŝ (dotted: plant)")
+    ax[1].set(xlabel="time [s]", ylabel="offset [N·m]", ylim=(-0.1, 0.25),
+              title="offset ô (dotted: plant)")
     ax[0].legend(fontsize=7)
     # 10 s windows hold whole periods of the 0.4, 0.5 and 0.7 Hz reference
     win = np.ones(10_000) / 10_000
@@ -276,10 +313,14 @@ def _loop_adaptation(sec, f, summary):
     ax[2].axvline(t_step, color="gray", lw=0.6)
     ax[2].set(xlabel="time [s]", ylabel="RMS joint error, 10 s window [°]", title="tracking error")
     ax[2].legend(fontsize=7)
-    sec.figure(fig, "Online friction adaptation inside the joint impedance loop (RLS step in the 1 kHz control "
-                    "kernel, compensation ŝ·F_table + ô·sign v). The plant warms up like Fig. 5.7 (friction "
-                    "1.5× at room temperature, assumed, decaying with the 39.6 s thermal time constant) and "
-                    f"its stiction and Coulomb level step up by 0.09 N·m at {t_step:g} s; the controller is not "
+    sec.figure(fig, "Online friction adaptation inside the joint impedance loop (RLS step in "
+                    "the 1 kHz control "
+                    "kernel, compensation ŝ·F_table + ô·sign v). The plant warms up like "
+                    "Fig. 5.7 (friction "
+                    "1.5× at room temperature, assumed, decaying with the 39.6 s thermal "
+                    "time constant) and "
+                    f"its stiction and Coulomb level step up by 0.09 N·m at {t_step:g} s; the "
+                    "controller is not "
                     "told.", "dlr-loop-adaptation")
     rows = [[f"{mode}, {plant} plant", cmp.rms[mode, plant] / DEG, cmp.max[mode, plant] / DEG]
             for mode in ("fixed", "adaptive") for plant in ("nominal", "drift")]
@@ -341,7 +382,8 @@ def _impedance(sec, f, summary):
         trj = simulate_impedance(f, cj, ref)
         e = np.column_stack([trj["flex"] - ref[:, 1], trj["prox"] - ref[:, 2]])[1000:]
         track[comp] = float(np.sqrt(np.mean(e ** 2)) / DEG)
-        ax[0].plot(trj.t, (trj["prox"] - ref[:, 2]) / DEG, style, label=f"compensation {'on' if comp else 'off'}")
+        ax[0].plot(trj.t, (trj["prox"] - ref[:, 2]) / DEG, style,
+                   label=f"compensation {'on' if comp else 'off'}")
     ax[0].set(xlabel="time [s]", ylabel="proximal error [°]", title="joint impedance, free motion")
     ax[0].legend(fontsize=8)
     q0 = (0.0, 30 * DEG, 45 * DEG)
@@ -362,25 +404,36 @@ def _impedance(sec, f, summary):
         force[comp] = float(trc["force_z"][-1])
         ax[1].plot(trc.t, trc["force_z"], style, label=f"compensation {'on' if comp else 'off'}")
     ax[1].axhline(expect, color="gray", ls=":", label="K·k_w/(K+k_w)·δ")
-    ax[1].set(xlabel="time [s]", ylabel="contact force [N]", title="Cartesian impedance against a wall")
+    ax[1].set(xlabel="time [s]", ylabel="contact force [N]",
+              title="Cartesian impedance against a wall")
     ax[1].legend(fontsize=8)
-    sec.figure(fig, "Impedance control (eq 3.1) with gravity and friction compensation: tracking a 0.5 Hz "
-                    f"motion, and pressing on a {kw:g} N/m wall with K = {K:g} N/m, set point {1e3 * depth:g} mm "
+    sec.figure(fig, "Impedance control (eq 3.1) with gravity and friction compensation: "
+                    "tracking a 0.5 Hz "
+                    f"motion, and pressing on a {kw:g} N/m wall with K = {K:g} N/m, set point "
+                    f"{1e3 * depth:g} mm "
                     "behind it.", "dlr-impedance")
-    free = impedance_margins(f, ImpedanceController("joint", (5, 5, 5), (0.5, 0.5, 0.5)), q=(0.0, 30 * DEG, 30 * DEG))
-    cont = impedance_margins(f, ImpedanceController("cartesian", (K, K, K), (1.4 * math.sqrt(K * 4.4),) * 3,
-                                                    actuator_damping=(0.3, 0.3, 0.3)), q=q0, wall=wall)
+    free = (impedance_margins(f, ImpedanceController("joint", (5, 5, 5), (0.5, 0.5, 0.5)),
+                              q=(0.0, 30 * DEG, 30 * DEG)))
+    cont = impedance_margins(f, ImpedanceController("cartesian", (K, K, K),
+                                                    (1.4 * math.sqrt(K * 4.4),) * 3,
+                                                    actuator_damping=(0.3, 0.3, 0.3)), q=q0,
+                                                    wall=wall)
     sec.table(["case", "actuator", "gain margin", "phase margin [°]", "crossover [Hz]", "stable"],
-              [["joint, free", m["actuator"], m["gain_margin"], m["phase_margin_deg"], m["gain_crossover_hz"], m["stable"]]
+              [["joint, free", m["actuator"], m["gain_margin"], m["phase_margin_deg"],
+                m["gain_crossover_hz"], m["stable"]]
                for m in free]
-              + [["Cartesian, wall", m["actuator"], m["gain_margin"], m["phase_margin_deg"], m["gain_crossover_hz"],
+              + [["Cartesian, wall", m["actuator"], m["gain_margin"], m["phase_margin_deg"],
+                  m["gain_crossover_hz"],
                   m["stable"]] for m in cont],
-              caption="Stability margins of the linearised loops (ZOH at 1 kHz, one sample of delay).")
+              caption="Stability margins of the linearised loops (ZOH at 1 kHz, one "
+                      "sample of delay).")
     sec.table(["experiment", "compensation on", "compensation off"],
               [["RMS tracking error [°]", track[True], track[False]],
                [f"contact force [N] (expected {expect:.2f})", force[True], force[False]],
-               ["force error [%]", 100 * (force[True] - expect) / expect, 100 * (force[False] - expect) / expect]],
-              caption="Friction compensation on vs off: stiction (0.36 N·m per drive) stops the uncompensated "
+               ["force error [%]", 100 * (force[True] - expect) / expect,
+                100 * (force[False] - expect) / expect]],
+              caption="Friction compensation on vs off: stiction (0.36 N·m per drive) stops "
+                      "the uncompensated "
                       "finger before it reaches the wall.")
     summary["tracking_rms_deg"] = track
     summary["contact_force_N"] = {"expected": expect, "on": force[True], "off": force[False]}
@@ -396,9 +449,13 @@ def _hand(sec, summary):
     for name, p in tips.items():
         ax[0].plot(1e3 * p[:, 0], 1e3 * p[:, 1], "-", label=name)
         ax[0].plot(1e3 * p[-1, 0], 1e3 * p[-1, 1], "k.")
-    ax[0].set(xlabel="palm x [mm]", ylabel="palm y [mm]", title="five fingers closing (PWM 3000)", aspect="equal")
+    ax[0].set(xlabel="palm x [mm]", ylabel="palm y [mm]", title="five fingers closing (PWM 3000)",
+              aspect="equal")
     ax[0].legend(fontsize=7)
-    sec.figure(fig, "The hand (§3.1): five fingers from the finger model on assumed palm frames, the thumb fixed "
-                    "in an opposing orientation; the thumb's distal friction is 30 % above, the little "
-                    "finger's 20 % below the measured finger (§6.3: friction differs from finger to finger).",
+    sec.figure(fig, "The hand (§3.1): five fingers from the finger model on assumed palm frames, "
+                    "the thumb fixed "
+                    "in an opposing orientation; the thumb's distal friction is 30 % "
+                    "above, the little "
+                    "finger's 20 % below the measured finger (§6.3: friction differs from "
+                    "finger to finger).",
                "dlr-hand")

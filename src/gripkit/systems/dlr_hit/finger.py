@@ -69,7 +69,8 @@ __all__ = ["FINGER_PARAMETERS", "ACTUATORS", "JOINTS", "FRICTION_MODES", "DLRFin
            "finger_step", "finger_step_rk4", "finger_setup", "finger_context", "finger_run",
            "finger_loop", "run_open_loop"]
 
-#: parameter names in kernel order (see gripkit.systems.dlr_hit.parameters.thesis_finger_parameters for meaning/units)
+# : parameter names in kernel order (see
+# gripkit.systems.dlr_hit.parameters.thesis_finger_parameters for meaning/units)
 FINGER_PARAMETERS = (
     "l1", "l2", "l3", "m1", "m2", "m3",
     "pc1_x", "pc1_y", "pc1_z", "pc2_x", "pc2_y", "pc2_z", "pc3_x", "pc3_y", "pc3_z",
@@ -79,7 +80,8 @@ FINGER_PARAMETERS = (
     "c_pwm", "b_pwm", "b_0", "pwm_max", "T_ref", "T_amb", "alpha_R", "k_t", "R_0", "R_th", "C_th",
     "fs_base1", "fs_base2", "fs_distal", "scale_base1", "scale_base2", "scale_distal",
     "fc_base1", "fc_base2", "fc_distal", "visc_base1", "visc_base2", "visc_distal",
-    "cubic_base1", "cubic_base2", "cubic_distal", "v_s", "delta", "sigma0", "sigma1", "ripple_amp", "ripple_cycles", "v_stick",
+    "cubic_base1", "cubic_base2", "cubic_distal", "v_s", "delta", "sigma0", "sigma1", "ripple_amp",
+    "ripple_cycles", "v_stick",
     "abd_min", "abd_max", "flex_min", "flex_max", "prox_min", "prox_max", "k_stop", "d_stop",
 )
 NTH = len(FINGER_PARAMETERS)
@@ -110,7 +112,8 @@ LOOP_OUTPUT_BLOCKS = ("angle", "velocity", "tip", "tip_velocity", "force", "pwm"
 YL = namedtuple("LoopOutputIndex", LOOP_OUTPUT_BLOCKS)(*range(0, 3 * len(LOOP_OUTPUT_BLOCKS), 3))
 #: the same for the 18 open-loop outputs of one finger (DLRFinger.outputs), from column ycol on
 FINGER_OUTPUT_BLOCKS = ("angle", "velocity", "actuator_velocity", "tau", "fric", "temperature")
-YF = namedtuple("FingerOutputIndex", FINGER_OUTPUT_BLOCKS)(*range(0, 3 * len(FINGER_OUTPUT_BLOCKS), 3))
+YF = (namedtuple("FingerOutputIndex", FINGER_OUTPUT_BLOCKS)(*range(0, 3 * len(FINGER_OUTPUT_BLOCKS),
+                                                                   3)))
 
 # Named records of arrays the kernels take (namedtuples: numba resolves each field at compile
 # time, and without NRT taking an array out of one costs nothing; docs/performance.md).
@@ -142,7 +145,8 @@ StepWork = namedtuple("StepWork", "chain solve acc tshaft p0 v0 ka ps vs taum2 t
 #: commanded torques, gravity torques, RNEA work, zeros, the state at t_n, the PWM, external and
 #: motor torques, friction, the bias torques of the friction estimator, the friction feed-forward
 #: and the wall's contact force
-LoopWork = namedtuple("LoopWork", "q qd R P T J Jp tip tipd tauq gp work zq xs pwm ext taum fric hb "
+LoopWork = namedtuple("LoopWork", "q qd R P T J Jp tip tipd tauq gp work zq xs pwm "
+                                  "ext taum fric hb "
                                   "ff force")
 #: a closed loop: ``ctrl`` (0 open loop, 1 joint, 2 Cartesian impedance), its gains vector, the
 #: friction tables it compensates with (TableArrays), the reference and its velocity (N, 3), the
@@ -229,7 +233,8 @@ def finger_setup(th, fc):  # pragma: no cover - compiled
 def _kinetic(th, k, v, p, mode, tab):  # pragma: no cover - compiled
     """Kinetic friction of actuator k at velocity v (never 0 for v ≠ 0)."""
     if mode == TABLE:
-        f = th[IX.scale_base1 + k] * table_friction(v, tab.velocity[k], tab.values[k], tab.length[k],
+        f = th[IX.scale_base1 + k] * table_friction(v, tab.velocity[k], tab.values[k],
+                                                    tab.length[k],
                                                     tab.ipos[k])
     else:
         f = (stribeck(v, th[IX.fc_base1 + k], th[IX.fs_base1 + k], th[IX.v_s], th[IX.delta],
@@ -246,7 +251,8 @@ def _drive_torques(th, thermal, ratio, T, pwm, pd, taum, tshaft):  # pragma: no 
         rho = 1.0
         if thermal:
             rho = temperature_factor(T[k], th[IX.T_ref], th[IX.T_amb], th[IX.alpha_R])
-        ts = bldc_torque(pwm[k], ratio[k] * pd[k], th[IX.c_pwm], th[IX.b_pwm], th[IX.b_0], th[IX.pwm_max],
+        ts = bldc_torque(pwm[k], ratio[k] * pd[k], th[IX.c_pwm], th[IX.b_pwm], th[IX.b_0],
+                         th[IX.pwm_max],
                          rho)
         tshaft[k] = ts
         taum[k] = transmit_torque(ts, pd[k], ratio[k], th[IX.eta])
@@ -372,7 +378,8 @@ def _forces(th, n_stuck_iter, mode, thermal, fc, tab, st, pwm, ext, out, cw,
     if mode >= LUGRE:  # LuGre or none: no stick-slip constraint
         for k in range(m):
             if mode == LUGRE:
-                f = (lugre_force(z[k], pd[k], th[IX.fc_base1 + k], th[IX.fs_base1 + k], th[IX.v_s], th[IX.sigma0],
+                f = (lugre_force(z[k], pd[k], th[IX.fc_base1 + k], th[IX.fs_base1 + k], th[IX.v_s],
+                                 th[IX.sigma0],
                                  th[IX.sigma1], th[IX.visc_base1 + k])
                      + ripple(p[k], pd[k], th[IX.ripple_amp], th[IX.ripple_cycles], 0.0))
             else:
@@ -413,11 +420,13 @@ def _slow_states(th, mode, thermal, x, v0, tshaft, h):  # pragma: no cover - com
     """Motor temperatures (explicit step) and LuGre bristles (exact for v held over the step)."""
     if thermal:
         for k in range(3):
-            x[6 + k] = motor_heat_step(x[6 + k], tshaft[k], h, th[IX.T_amb], th[IX.alpha_R], th[IX.R_0],
+            x[6 + k] = motor_heat_step(x[6 + k], tshaft[k], h, th[IX.T_amb], th[IX.alpha_R],
+                                       th[IX.R_0],
                                        th[IX.k_t], th[IX.R_th], th[IX.C_th])
     if mode == LUGRE:
         for k in range(3):
-            x[9 + k] = lugre_update(x[9 + k], v0[k], h, th[IX.fc_base1 + k], th[IX.fs_base1 + k], th[IX.v_s],
+            x[9 + k] = lugre_update(x[9 + k], v0[k], h, th[IX.fc_base1 + k], th[IX.fs_base1 + k],
+                                    th[IX.v_s],
                                     th[IX.sigma0])
 
 
@@ -521,7 +530,8 @@ def finger_outputs(G, q0, x, taum, fric, y, yrow, ycol):  # pragma: no cover - c
         y[yrow, ycol + YF.temperature + k] = x[6 + k]
 
 
-# --- impedance control (used by gripkit.systems.dlr_hit.impedance) ----------------------------------------
+# --- impedance control (used by gripkit.systems.dlr_hit.impedance)
+# ----------------------------------------
 
 @hot
 def _tip(fc, th, q, R, P, T, J, Jp, tip):  # pragma: no cover - compiled
@@ -576,7 +586,8 @@ def _impedance(th, fc, cs, x, n, loop, fhat):  # pragma: no cover - compiled
     torques stay in ``cs.tauq``, the friction feed-forward in ``cs.ff`` (see
     gripkit.systems.dlr_hit.impedance)."""
     G, ratio, grav = fc.G, fc.ratio, fc.g
-    q, qd, R, P, Jp, tip, tipd, tauq, zq = cs.q, cs.qd, cs.R, cs.P, cs.Jp, cs.tip, cs.tipd, cs.tauq, cs.zq
+    q, qd, R, P, Jp, tip, tipd, tauq, zq = (cs.q, cs.qd, cs.R, cs.P, cs.Jp, cs.tip, cs.tipd,
+                                            cs.tauq, cs.zq)
     ctrl, gains, ref, refd, ctab = loop.ctrl, loop.gains, loop.ref, loop.refd, loop.tables
     joints_from_actuators(4, 3, G, fc.q0, x[0:3], q)
     joints_from_actuators(4, 3, G, zq, x[3:6], qd)
@@ -644,7 +655,8 @@ def _wall(th, fc, cs, x, wall):  # pragma: no cover - compiled
         return
     joints_from_actuators(4, 3, fc.G, fc.q0, x[0:3], cs.q)
     _tip(fc, th, cs.q, cs.R, cs.P, cs.T, cs.J, cs.Jp, cs.tip)
-    pen = -(wall[0] * (tip[0] - wall[3]) + wall[1] * (tip[1] - wall[4]) + wall[2] * (tip[2] - wall[5]))
+    pen = (-(wall[0] * (tip[0] - wall[3]) + wall[1] * (tip[1] - wall[4]) + wall[2]
+             * (tip[2] - wall[5])))
     if pen <= 0.0:
         return
     vn = 0.0
@@ -686,7 +698,8 @@ def _adapt_friction(th, fc, cs, x, ctab, est, sensor, y, n):  # pragma: no cover
     motor torque from the PWM just commanded and the measured speed through eq 5.10 times the
     thermal observer's torque factor ρ̂ = ``sensor[k, 4]`` (1: eq 5.10 at T_ref) and the
     transmission, bias torque Γᵀ(C(q, q̇)q̇ + G(q)) by RNEA; writes the estimates and each
-    sample's status into the blocks YL.scale_hat, YL.offset_hat, YL.adapt_status of y[n]. While ``sensor[k, 5]`` ≠ 0 (the observer's torque factor
+    sample's status into the blocks YL.scale_hat, YL.offset_hat, YL.adapt_status of y[n]. While
+    ``sensor[k, 5]`` ≠ 0 (the observer's torque factor
     is too uncertain: a torque loss and a friction change cannot be told apart) the filters run
     but θ, P and σ̂² keep their values (status 0, frozen)."""
     G, ratio, grav, pwm, hb = fc.G, fc.ratio, fc.g, cs.pwm, cs.hb
@@ -792,7 +805,8 @@ def finger_loop(th, mode, thermal, fc, ws, cs, tab, run, x, loop, plant,
     ``loop.ctrl = 0``: PWM from u[:, ucol:], outputs as DLRFinger.outputs at
     y[:, ycol:ycol+18]; ``loop.ctrl = 1/2``:
     joint/Cartesian impedance (:data:`ImpedanceLoop`), closed-loop outputs (the blocks of
-    :data:`YL`, named in gripkit.systems.dlr_hit.impedance.LOOP_OUTPUTS). ``plant`` (:data:`PlantDrift`): the plant's friction drift
+    :data:`YL`, named in gripkit.systems.dlr_hit.impedance.LOOP_OUTPUTS). ``plant``
+    (:data:`PlantDrift`): the plant's friction drift
     (:func:`_drift_friction`); ``est`` (:data:`FrictionEstimator`): the online friction
     estimator, run when gains[G_ADAPT] ≠ 0; the controller sees the state through
     :func:`_measure` when gains[G_QUANTUM] > 0 and corrects eq 5.10 by its thermal observer
@@ -910,7 +924,8 @@ def _open_loop_records():
     return (ImpedanceLoop(OPEN_LOOP, np.zeros(N_GAINS), tables, np.zeros((1, 3)), np.zeros((1, 3)),
                           np.zeros(9), np.zeros((3, 7)), np.zeros(NX)),
             PlantDrift(np.zeros((0, 6)), np.zeros(NTH), np.zeros((3, 1))),
-            FrictionEstimator(np.zeros(10), np.ones(3), theta, np.zeros((3, 2, 2)), np.zeros((3, 5)),
+            FrictionEstimator(np.zeros(10), np.ones(3), theta, np.zeros((3, 2, 2)),
+                              np.zeros((3, 5)),
                               np.zeros(3)))
 
 
@@ -990,8 +1005,10 @@ class DLRFinger(Model):
     outputs = (tuple(Signal(j, "rad", f"joint angle {j}") for j in JOINTS)
                + tuple(Signal(f"{j}_vel", "rad/s", f"joint velocity {j}") for j in JOINTS)
                + tuple(Signal(f"{a}_vel", "rad/s", f"{a} actuator velocity") for a in ACTUATORS)
-               + tuple(Signal(f"tau_{a}", "N*m", f"{a} motor torque at the actuator output") for a in ACTUATORS)
-               + tuple(Signal(f"fric_{a}", "N*m", f"{a} friction torque (opposing)") for a in ACTUATORS)
+               + tuple(Signal(f"tau_{a}", "N*m", f"{a} motor torque at the "
+                                                 "actuator output") for a in ACTUATORS)
+               + tuple(Signal(f"fric_{a}", "N*m",
+                              f"{a} friction torque (opposing)") for a in ACTUATORS)
                + tuple(Signal(f"T_{a}", "K", f"{a} winding temperature") for a in ACTUATORS))
     states = (tuple(Signal(f"p_{a}", "rad") for a in ACTUATORS)
               + tuple(Signal(f"v_{a}", "rad/s") for a in ACTUATORS)
@@ -1003,13 +1020,15 @@ class DLRFinger(Model):
                  integrator: str = "semi-implicit", thermal: bool = False, check: bool = True,
                  name: str | None = None):
         if not isinstance(parameters, ParameterSet):
-            raise ModelError(f"DLRFinger: expected a ParameterSet, found {type(parameters).__name__}")
+            raise ModelError("DLRFinger: expected a ParameterSet, found "
+                             f"{type(parameters).__name__}")
         if parameters.names != FINGER_PARAMETERS:
             missing = [n for n in FINGER_PARAMETERS if n not in parameters.names]
             raise ModelError("DLRFinger: the parameter set must hold FINGER_PARAMETERS in order",
                              hint=f"missing: {missing}" if missing else "reorder the set")
         if friction not in FRICTION_MODES:
-            raise ModelError(f"friction: expected one of {sorted(FRICTION_MODES)}, found {friction!r}")
+            raise ModelError(f"friction: expected one of {sorted(FRICTION_MODES)}, "
+                             f"found {friction!r}")
         if integrator not in INTEGRATORS:
             raise ModelError(f"integrator: expected 'semi-implicit' or 'rk4', found {integrator!r}")
         if tables is None and friction == "table":
@@ -1053,18 +1072,21 @@ class DLRFinger(Model):
         return CoupledChain(ch, cp, name=self.name)
 
     def ratios(self, params: ParameterSet | None = None) -> np.ndarray:
-        """Reductions (base1, base2, distal): N_belt·N_hd·N_belt_base for the base, N_belt·N_hd distal."""
+        """Reductions (base1, base2, distal): N_belt·N_hd·N_belt_base for the base, N_belt·N_hd
+        distal."""
         v = (params or self.parameters).value
         nd = v("N_hd") * v("N_belt")
         return np.array([nd * v("N_belt_base"), nd * v("N_belt_base"), nd])
 
-    def state(self, q=(0.0, 0.0, 0.0), qd=(0.0, 0.0, 0.0), T=None, *, degrees: bool = False) -> np.ndarray:
+    def state(self, q=(0.0, 0.0, 0.0), qd=(0.0, 0.0, 0.0), T=None, *,
+              degrees: bool = False) -> np.ndarray:
         """Initial state vector (15) from joint angles (abd, flex, prox) and velocities; motors at
         ``T`` (K, default T_ref); at rest → held by stiction."""
         q = np.asarray(q, dtype=np.float64)
         qd = np.asarray(qd, dtype=np.float64)
         if q.shape != (3,) or qd.shape != (3,):
-            raise SimulationError(f"q and qd: expected 3 joint values (abd, flex, prox), found {q.shape}, {qd.shape}")
+            raise SimulationError("q and qd: expected 3 joint values (abd, flex, prox), found "
+                                  f"{q.shape}, {qd.shape}")
         if degrees:
             q, qd = np.radians(q), np.radians(qd)
         G = self.chain().coupling.matrix[:3]
@@ -1088,8 +1110,10 @@ class DLRFinger(Model):
                         self._tab, FRICTION_MODES[self.friction], INTEGRATORS[self.integrator],
                         self.thermal, parallel=P >= 4)
         if fail.any():
-            raise SimulationError(f"{self.name}: the mass matrix lost positive definiteness at sample "
-                                  f"{int(fail[fail > 0][0]) - 1}", hint="check the inertial parameters")
+            raise SimulationError(f"{self.name}: the mass matrix lost positive "
+                                  "definiteness at sample "
+                                  f"{int(fail[fail > 0][0]) - 1}",
+                                  hint="check the inertial parameters")
 
     def modes(self, theta):
         """End-stop contact mode (belt elasticity on the rotor inertia), LuGre bristles, and the
@@ -1101,7 +1125,8 @@ class DLRFinger(Model):
         if v["k_stop"] > 0:
             out.append((math.sqrt(v["k_stop"] / J), v["d_stop"] / (2 * math.sqrt(v["k_stop"] * J))))
         if self.friction == "lugre":
-            out.append((math.sqrt(v["sigma0"] / J), (v["sigma1"] + v["visc_distal"]) / (2 * math.sqrt(v["sigma0"] * J))))
+            out.append((math.sqrt(v["sigma0"] / J),
+                        (v["sigma1"] + v["visc_distal"]) / (2 * math.sqrt(v["sigma0"] * J))))
         # back-EMF damping of eq 5.8 reflected: |b(0)|·N²
         out.append((abs(v["b_0"]) * nd * nd / J, 1.0))
         return out
@@ -1126,7 +1151,8 @@ class DLRFinger(Model):
         k = ACTUATORS.index(actuator)
         N = self.ratios()[k]
         ps = ParameterSet([self.parameters[n] for n in ("c_pwm", "b_pwm", "b_0", "pwm_max", "T_ref",
-                                                         "T_amb", "alpha_R", "k_t", "R_0", "R_th", "C_th")])
+                                                         "T_amb", "alpha_R", "k_t", "R_0", "R_th",
+                                                         "C_th")])
         tau = BLDCMotor(ps).torque(pwm, N * np.asarray(v, dtype=np.float64), T)
         eta = self.parameters.value("eta")
         drive = tau * np.asarray(v) >= 0
@@ -1141,7 +1167,8 @@ class DLRFinger(Model):
 
         k = ACTUATORS.index(actuator)
         sgn = 1.0 if pwm >= 0 else -1.0
-        if abs(self.motor_torque(actuator, pwm, 0.0) - load) <= self.parameters.value(f"fs_{actuator}"):
+        if abs(self.motor_torque(actuator, pwm,
+                                 0.0) - load) <= self.parameters.value(f"fs_{actuator}"):
             return 0.0
         N = self.ratios()[k]
         p = self.parameters.value

@@ -53,12 +53,14 @@ def adapt_finger_friction(finger, trajectory, *, forgetting: float = 0.999, filt
     p = np.linalg.solve(G, q.T).T
     pd = np.linalg.solve(G, qd.T).T
     pwm = np.column_stack([trajectory[f"pwm_{a}"] for a in ACTUATORS])
-    tau = np.column_stack([finger.motor_torque(a, pwm[:, k], pd[:, k]) for k, a in enumerate(ACTUATORS)])
+    tau = (np.column_stack([finger.motor_torque(a, pwm[:, k],
+                                                pd[:, k]) for k, a in enumerate(ACTUATORS)]))
     h = ch.bias(p, pd)
     if adapter is None:
         J = np.diag(ch.mass_matrix(np.median(p, axis=0)))
         tabs = tables if tables is not None else tuple(
-            t.scaled(finger.parameters.value(f"scale_{a}")) for t, a in zip(finger.tables, ACTUATORS))
+            t.scaled(finger.parameters.value(f"scale_{a}")) for t, a in zip(finger.tables,
+                                                                            ACTUATORS))
         adapter = FrictionAdapter(tabs, J, dt, forgetting=forgetting, filter_hz=filter_hz,
                                   v_min=v_min, names=ACTUATORS)
     return adapter, adapter.update(tau, h, pd, nonfinite=nonfinite)
@@ -69,7 +71,8 @@ def tracking_reference(duration: float, dt: float = 1e-3) -> np.ndarray:
     10° at 0.4 Hz, flexion 40 ± 30° at 0.5 Hz, proximal 45 ± 35° at 0.7 Hz (inside the joint
     ranges, speeds up to ≈ 150 °/s as in Figs 7.3–7.5)."""
     if not (math.isfinite(duration) and duration > 0 and math.isfinite(dt) and 0 < dt < duration):
-        raise ModelError(f"duration and dt: expected 0 < dt < duration (s), found {duration!r}, {dt!r}")
+        raise ModelError("duration and dt: expected 0 < dt < duration (s), found "
+                         f"{duration!r}, {dt!r}")
     t = np.arange(int(round(duration / dt))) * dt
     deg = math.pi / 180
     return np.column_stack([10 * deg * np.sin(2 * np.pi * 0.4 * t),
@@ -113,7 +116,8 @@ class LoopComparison:
         """Fraction of the error the drift adds (fixed compensation, RMS) that adaptation removes:
         (e_fixed − e_adaptive)/(e_fixed − e_nominal), nominal = fixed compensation without drift."""
         added = self.rms["fixed", "drift"] - self.rms["fixed", "nominal"]
-        return (self.rms["fixed", "drift"] - self.rms["adaptive", "drift"]) / added if added > 0 else math.nan
+        return ((self.rms["fixed", "drift"] - self.rms["adaptive",
+                                                       "drift"]) / added if added > 0 else math.nan)
 
 
 def compare_adaptation(finger, controller: ImpedanceController, reference, drift: FrictionDrift, *,
@@ -124,7 +128,8 @@ def compare_adaptation(finger, controller: ImpedanceController, reference, drift
     plant and on the plant whose friction follows ``drift``; errors after ``t_skip`` s (the
     initial transient)."""
     if controller.kind != "joint":
-        raise ModelError("compare_adaptation: expected a joint impedance controller (errors are joint errors)")
+        raise ModelError("compare_adaptation: expected a joint impedance controller (errors "
+                         "are joint errors)")
     if not isinstance(drift, FrictionDrift):
         raise ModelError(f"drift: expected a FrictionDrift, found {type(drift).__name__}")
     skip = int(round(t_skip / dt))

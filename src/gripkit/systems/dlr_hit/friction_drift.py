@@ -49,7 +49,8 @@ def _per_actuator(name, a, K):
     if a.ndim == 1 and a.shape == (K,):
         a = np.repeat(a[:, None], 3, axis=1)
     if a.shape != (K, 3) or not np.isfinite(a).all():
-        raise ModelError(f"{name}: expected {K} finite values (one per time) or ({K}, 3) (per actuator "
+        raise ModelError(f"{name}: expected {K} finite values (one per time) or ({K}, "
+                         "3) (per actuator "
                          f"{', '.join(ACTUATORS)}), found shape {a.shape}")
     return a
 
@@ -76,14 +77,16 @@ class FrictionDrift:
     def __post_init__(self):
         t = np.asarray(self.times, dtype=np.float64)
         if t.ndim != 1 or t.size < 1 or not np.isfinite(t).all() or (np.diff(t) < 0).any():
-            raise ModelError(f"times: expected a non-decreasing, finite 1-D array in s, found {self.times!r}")
+            raise ModelError("times: expected a non-decreasing, finite 1-D array in s, "
+                             f"found {self.times!r}")
         d = np.diff(t)
         if ((d[1:] == 0) & (d[:-1] == 0)).any():
             raise ModelError("times: a time may appear at most twice (a step)")
         s = _per_actuator("scale", self.scale, t.size)
         if (s < 0).any():
             raise ModelError(f"scale: friction scales must be >= 0, found min {s.min():g}")
-        o = _per_actuator("offset", np.zeros(t.size) if self.offset is None else self.offset, t.size)
+        o = (_per_actuator("offset", np.zeros(t.size) if self.offset is None else self.offset,
+                           t.size))
         object.__setattr__(self, "times", t)
         object.__setattr__(self, "scale", s)
         object.__setattr__(self, "offset", o)
@@ -119,7 +122,8 @@ class FrictionDrift:
                     times.append(u)
                     rows.append(row)
         r = np.array(rows)
-        return FrictionDrift(np.array(times), r[:, :3], r[:, 3:], name=f"{self.name} + {other.name}")
+        return (FrictionDrift(np.array(times), r[:, :3], r[:, 3:],
+                              name=f"{self.name} + {other.name}"))
 
 
 def warmup_drift(duration: float, *, cold_scale: float = 1.5, time_constant: float = 7.2 * 5.5,
@@ -131,14 +135,16 @@ def warmup_drift(duration: float, *, cold_scale: float = 1.5, time_constant: flo
     if not (math.isfinite(duration) and duration > 0):
         raise ModelError(f"duration: expected a positive time in s, found {duration!r}")
     if not (math.isfinite(cold_scale) and cold_scale >= 0):
-        raise ModelError(f"cold_scale: expected a non-negative friction scale, found {cold_scale!r}")
+        raise ModelError("cold_scale: expected a non-negative friction scale, "
+                         f"found {cold_scale!r}")
     if not (math.isfinite(time_constant) and time_constant > 0):
         raise ModelError(f"time_constant: expected a positive time in s, found {time_constant!r}")
     if int(points) != points or points < 2:
         raise ModelError(f"points: expected an integer >= 2, found {points!r}")
     t = np.linspace(0.0, duration, int(points))
     return FrictionDrift(t, 1.0 + (cold_scale - 1.0) * np.exp(-t / time_constant),
-                         name=f"warm-up (Fig. 5.7, cold ×{cold_scale:g}, τ = {time_constant:.3g} s)")
+                         name=f"warm-up (Fig. 5.7, cold ×{cold_scale:g}, τ = "
+                              f"{time_constant:.3g} s)")
 
 
 def stiction_step(time: float, delta: float = STICTION_STEP, actuators=ACTUATORS) -> FrictionDrift:

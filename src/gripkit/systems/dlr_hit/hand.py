@@ -30,7 +30,8 @@ def palm_frames() -> np.ndarray:
     palm geometry.
     """
     T = np.tile(np.eye(4), (5, 1, 1))
-    for i, (y, x) in enumerate(((0.033, 0.090), (0.011, 0.095), (-0.011, 0.090), (-0.033, 0.082)), start=1):
+    for i, (y, x) in enumerate(((0.033, 0.090), (0.011, 0.095), (-0.011, 0.090), (-0.033, 0.082)),
+                               start=1):
         T[i, :3, 3] = (x, y, 0.0)
     x0 = np.array([0.9, 0.3, -0.3])
     x0 /= np.linalg.norm(x0)
@@ -52,16 +53,19 @@ def _hand_parameters(finger_ps: ParameterSet, scales: dict | None) -> ParameterS
         for a in ACTUATORS:
             base = finger_ps.value(f"scale_{a}")
             val = (scales or {}).get(f, {}).get(a, 1.0) * base
-            ps.append(Parameter(f"{f}_scale_{a}", val, "1", f"friction factor, {f} finger, {a} drive",
+            ps.append(Parameter(f"{f}_scale_{a}", val, "1", f"friction factor, {f} "
+                                                            f"finger, {a} drive",
                                 bounds=(0, None),
-                                source=f"{SEED}, §6.3 (friction differs from finger to finger); default: the measured finger"))
+                                source=f"{SEED}, §6.3 (friction differs from finger to finger); "
+                                       "default: the measured finger"))
     return ParameterSet(ps, "dlr-hit-hand")
 
 
 class DLRHand(Model):
     """Five DLR/HIT II fingers on a palm (§3.1): four fingers and a thumb fixed in its
     orientation, each with its own friction factors (§6.3). Every finger is a
-    :class:`~gripkit.systems.dlr_hit.finger.DLRFinger`; gravity is given in the palm frame and rotated
+    :class:`~gripkit.systems.dlr_hit.finger.DLRFinger`; gravity is given in the palm frame and
+    rotated
     into each finger's base frame (:func:`palm_frames`).
 
     Inputs: 15 PWM counts, finger-major (``thumb_pwm_base1``, ..., ``little_pwm_distal``);
@@ -70,18 +74,24 @@ class DLRHand(Model):
 
     name = "dlr-hit-hand"
     description = "DLR/HIT Hand II: five identical modular fingers (thumb fixed) on a palm"
-    inputs = tuple(Signal(f"{f}_{s.name}", s.unit, s.doc) for f in FINGERS for s in DLRFinger.inputs)
-    outputs = tuple(Signal(f"{f}_{s.name}", s.unit, s.doc) for f in FINGERS for s in DLRFinger.outputs)
-    states = tuple(Signal(f"{f}_{s.name}", s.unit, s.doc) for f in FINGERS for s in DLRFinger.states)
+    inputs = (tuple(Signal(f"{f}_{s.name}", s.unit,
+                           s.doc) for f in FINGERS for s in DLRFinger.inputs))
+    outputs = (tuple(Signal(f"{f}_{s.name}", s.unit,
+                            s.doc) for f in FINGERS for s in DLRFinger.outputs))
+    states = (tuple(Signal(f"{f}_{s.name}", s.unit,
+                           s.doc) for f in FINGERS for s in DLRFinger.states))
 
     def __init__(self, parameters: ParameterSet | None = None, *, friction: str = "table",
                  integrator: str = "semi-implicit", thermal: bool = False, check: bool = True,
                  scales: dict | None = None):
-        ps = parameters if parameters is not None else _hand_parameters(thesis_finger_parameters(), scales)
+        ps = (parameters if parameters is not None else _hand_parameters(thesis_finger_parameters(),
+                                                                         scales))
         if ps.names[:NTH] != FINGER_PARAMETERS or len(ps) != NTH + 15:
-            raise ModelError("DLRHand: expected the finger parameters followed by 15 friction factors")
+            raise ModelError("DLRHand: expected the finger parameters followed by 15 "
+                             "friction factors")
         self.frames = palm_frames()
-        self._finger = DLRHITFinger(ParameterSet([ps[n] for n in FINGER_PARAMETERS], "dlr-hit-finger"),
+        self._finger = DLRHITFinger(ParameterSet([ps[n] for n in FINGER_PARAMETERS],
+                                                 "dlr-hit-finger"),
                                     finger_tables(), friction=friction, integrator=integrator,
                                     thermal=thermal, check=False)
         self.friction = friction
@@ -90,19 +100,22 @@ class DLRHand(Model):
         super().__init__(ps, check=check)
 
     def finger_model(self, which: str) -> DLRHITFinger:
-        """The finger ``which`` as a stand-alone model (its friction factors and gravity applied)."""
+        """The finger ``which`` as a stand-alone model (its friction factors and gravity
+        applied)."""
         i = FINGERS.index(which)
         p = self.parameters.value
         g = self.frames[i, :3, :3].T @ np.array([p("g_x"), p("g_y"), p("g_z")])
         ov = {f"scale_{a}": p(f"{which}_scale_{a}") for a in ACTUATORS}
         ov.update(g_x=g[0], g_y=g[1], g_z=g[2])
-        fp = ParameterSet([self.parameters[n] for n in FINGER_PARAMETERS], "dlr-hit-finger").replace(**ov)
+        fp = (ParameterSet([self.parameters[n] for n in FINGER_PARAMETERS],
+                           "dlr-hit-finger").replace(**ov))
         return DLRHITFinger(fp, finger_tables(), friction=self.friction, integrator=self.integrator,
                             thermal=self.thermal, check=False, name=f"dlr-hit-{which}")
 
     def state(self, q=None, **kw) -> np.ndarray:
         """Initial state (75): ``q`` maps finger names to joint angles (abd, flex, prox)."""
-        x = np.concatenate([self._finger.state(q=(q or {}).get(f, (0.0, 0.0, 0.0)), **kw) for f in FINGERS])
+        x = (np.concatenate([self._finger.state(q=(q or {}).get(f, (0.0, 0.0, 0.0)),
+                                                **kw) for f in FINGERS]))
         return x
 
     def initial_state(self, theta):
@@ -155,4 +168,5 @@ def hand(*, friction: str = "table", integrator: str = "semi-implicit", thermal:
          check: bool = True, scales: dict | None = None) -> DLRHand:
     """The five-finger DLR/HIT Hand II; ``scales`` = {finger: {actuator: factor}} sets per-finger
     friction relative to the measured finger."""
-    return DLRHand(friction=friction, integrator=integrator, thermal=thermal, check=check, scales=scales)
+    return (DLRHand(friction=friction, integrator=integrator, thermal=thermal, check=check,
+                    scales=scales))

@@ -210,16 +210,19 @@ class ImpedanceController:
         for name in ("stiffness", "damping", "actuator_damping"):
             v = np.asarray(getattr(self, name), dtype=np.float64)
             if v.shape != (3,) or not np.isfinite(v).all() or (v < 0).any():
-                raise ModelError(f"{name}: expected three non-negative gains, found {getattr(self, name)!r}")
+                raise ModelError(f"{name}: expected three non-negative gains, found "
+                                 f"{getattr(self, name)!r}")
             object.__setattr__(self, name, tuple(float(x) for x in v))
         if self.friction_tables is not None and (len(self.friction_tables) != 3 or not all(
                 isinstance(t, FrictionTable) for t in self.friction_tables)):
-            raise ModelError("friction_tables: expected three FrictionTables (base1, base2, distal)")
+            raise ModelError("friction_tables: expected three FrictionTables "
+                             "(base1, base2, distal)")
         if self.adaptation is not None and not isinstance(self.adaptation, AdaptationSettings):
             raise ModelError(f"adaptation: expected AdaptationSettings or None, found "
                              f"{type(self.adaptation).__name__}")
         if self.adaptation is not None and not self.friction_compensation:
-            raise ModelError("adaptation needs friction_compensation=True (the estimate is used there)")
+            raise ModelError("adaptation needs friction_compensation=True (the "
+                             "estimate is used there)")
         if not self.velocity_deadband > 0 or not self.smoothing > 0:
             raise ModelError(f"velocity_deadband (rad/s) and smoothing (N·m) must be > 0, found "
                              f"{self.velocity_deadband!r}, {self.smoothing!r}")
@@ -252,7 +255,8 @@ class Wall:
             raise ModelError(f"wall point: expected a 3-vector, found {self.point!r}")
         object.__setattr__(self, "point", tuple(p))
         if not (self.stiffness > 0 and self.damping >= 0):
-            raise ModelError(f"wall stiffness must be > 0 and damping >= 0, found {self.stiffness!r}, {self.damping!r}")
+            raise ModelError("wall stiffness must be > 0 and damping >= 0, found "
+                             f"{self.stiffness!r}, {self.damping!r}")
 
 
 def model_friction_tables(finger: DLRFinger, v_max: float = 8.0, n: int = 200) -> tuple:
@@ -264,7 +268,8 @@ def model_friction_tables(finger: DLRFinger, v_max: float = 8.0, n: int = 200) -
                      for t, a in zip(finger.tables, ACTUATORS))
     v = np.geomspace(v_max / n, v_max, n)
     v = np.r_[-v[::-1], v]
-    return tuple(FrictionTable(v, finger.kinetic_friction(a, v), name=f"{finger.friction} friction, {a}")
+    return tuple(FrictionTable(v, finger.kinetic_friction(a, v),
+                               name=f"{finger.friction} friction, {a}")
                  for a in ACTUATORS)
 
 
@@ -319,7 +324,8 @@ def simulate_impedance(finger: DLRFinger, controller: ImpedanceController, refer
     (``fric_ff_*``, N·m), the references (``ref_*``) and, with a drift, the plant's friction
     scale and offset (``drift_scale_*``, ``drift_offset_*``).
     """
-    ref, refd, x = _checked_loop_inputs(finger, controller, reference, reference_velocity, dt, x0, substeps)
+    ref, refd, x = (_checked_loop_inputs(finger, controller, reference, reference_velocity, dt, x0,
+                                         substeps))
     th = finger.theta()
     tables = controller.friction_tables or model_friction_tables(finger)
     N = ref.shape[0]
@@ -341,7 +347,8 @@ def simulate_impedance(finger: DLRFinger, controller: ImpedanceController, refer
     ctrl = CARTESIAN_IMPEDANCE if controller.kind == "cartesian" else JOINT_IMPEDANCE
     loop = ImpedanceLoop(ctrl, gains, table_arrays(tables), ref, refd, _wall_vector(wall), sensor,
                          np.zeros(NX))
-    fail = finger_run(th, FRICTION_MODES[finger.friction], finger.thermal, finger._tab, np.zeros((1, 3)), 0,
+    fail = finger_run(th, FRICTION_MODES[finger.friction], finger.thermal, finger._tab,
+                      np.zeros((1, 3)), 0,
                       float(dt), int(substeps), x, y, 0, loop, plant, estimator)
     if fail or not np.isfinite(y).all():
         raise SimulationError(f"closed loop diverged at sample {max(int(fail) - 1, 0)}",
@@ -389,7 +396,8 @@ def _checked_loop_inputs(finger, controller, reference, reference_velocity, dt, 
     if not isinstance(finger, DLRFinger):
         raise ModelError(f"finger: expected a DLRFinger, found {type(finger).__name__}")
     if finger.integrator != "semi-implicit":
-        raise SimulationError("closed-loop simulation integrates the finger with semi-implicit Euler",
+        raise SimulationError("closed-loop simulation integrates the finger with "
+                              "semi-implicit Euler",
                               hint="build the finger with integrator='semi-implicit'")
     ref = np.ascontiguousarray(np.asarray(reference, dtype=np.float64))
     if ref.ndim != 2 or ref.shape[1] != 3 or ref.shape[0] < 2:
@@ -397,7 +405,8 @@ def _checked_loop_inputs(finger, controller, reference, reference_velocity, dt, 
     if not np.isfinite(ref).all():
         raise SimulationError("reference contains NaN or inf")
     if not (math.isfinite(dt) and dt > 0) or int(substeps) != substeps or substeps < 1:
-        raise SimulationError(f"dt must be > 0 s and substeps a positive integer; found {dt!r}, {substeps!r}")
+        raise SimulationError("dt must be > 0 s and substeps a positive integer; found "
+                              f"{dt!r}, {substeps!r}")
     refd = (np.gradient(ref, dt, axis=0) if reference_velocity is None
             else np.asarray(reference_velocity, dtype=np.float64))
     if refd.shape != ref.shape or not np.isfinite(refd).all():
@@ -427,7 +436,8 @@ def _drift_schedule(finger, friction_drift, t) -> np.ndarray:
     if friction_drift is None:
         return np.zeros((0, 6))
     if not isinstance(friction_drift, FrictionDrift):
-        raise SimulationError(f"friction_drift: expected a FrictionDrift, found {type(friction_drift).__name__}")
+        raise SimulationError("friction_drift: expected a FrictionDrift, found "
+                              f"{type(friction_drift).__name__}")
     if finger.friction == "none":
         raise SimulationError("friction_drift: the finger has no friction to drift",
                               hint="build it with friction='table', 'stribeck' or 'lugre'")
@@ -505,7 +515,8 @@ def stability_margins(J: float, K: float, D: float, dt: float, *, viscous: float
     if cross.size:
         i = cross[0]
         w180 = w[i]
-        out.update(gain_margin=1.0 / float(np.interp(w180, w, mag)), phase_crossover_hz=w180 / (2 * math.pi))
+        out.update(gain_margin=1.0 / float(np.interp(w180, w, mag)),
+                   phase_crossover_hz=w180 / (2 * math.pi))
     return out
 
 

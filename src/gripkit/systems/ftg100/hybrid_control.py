@@ -28,7 +28,8 @@ linearises the quadratic actuator (eq 5) exactly:
   back-calculation.
 
 Kernels: :func:`hybrid_step` (one sample, scalar numba, parameters ``cp`` and state ``cs`` as
-float arrays) and the closed-loop grasp simulation on :class:`gripkit.systems.ftg100.model.FTG100Plant`
+float arrays) and the closed-loop grasp simulation on
+:class:`gripkit.systems.ftg100.model.FTG100Plant`
 (:func:`simulate_hybrid_grasp`, :func:`grasp_batch`): the controller sees the force sensor reading
 k2·x_b plus white noise of σ = 50 nN (the seed's resolution) and the tip position plus white noise
 (σ = 1 nm, an interferometer as in the seed's experiments, assumed). Metrics per grasp: contact
@@ -54,7 +55,8 @@ from ...signals.trajectory import Trajectory
 from ...sim.noise import normal_draw
 from .model import PO, FTG100Plant, advance_plant, plant_outputs, plant_parameters as _pp
 
-__all__ = ["HybridForcePosition", "HybridController", "hybrid_step", "simulate_hybrid_grasp", "grasp_batch",
+__all__ = ["HybridForcePosition", "HybridController", "hybrid_step", "simulate_hybrid_grasp",
+           "grasp_batch",
            "HybridGraspResult", "GraspBatch", "METRICS", "impact_speed_limit"]
 
 # controller parameter layout
@@ -69,7 +71,8 @@ _VF, _XPREV, _STARTED, _XREF, _FREF, _COUNT, _UPREV, _KSW, _K, _FREF1 = range(9,
 _NCS = 19
 
 #: names of the columns of :attr:`GraspBatch.metrics`
-METRICS = ("t_contact", "t_switch", "peak_force", "overshoot_percent", "settling_time", "final_error",
+METRICS = ("t_contact", "t_switch", "peak_force", "overshoot_percent", "settling_time",
+           "final_error",
            "max_voltage", "damage", "detected", "sat_fraction")
 #: index of each metric in a row of ``met`` (``met[MX.peak_force]``), generated from METRICS
 MX = namedtuple("MetricIndex", METRICS)(*range(len(METRICS)))
@@ -197,22 +200,29 @@ class HybridForcePosition:
         for k, v in asdict(self).items():
             if not isinstance(v, (int, float)) or not math.isfinite(v):
                 raise ConfigError(f"hybrid controller {k}: expected a finite number, found {v!r}")
-        for k in ("dt", "approach_speed", "x_limit", "contact_threshold", "lever", "c_e", "v_max", "tf_v",
+        for k in ("dt", "approach_speed", "x_limit", "contact_threshold", "lever", "c_e", "v_max",
+                  "tf_v",
                   "k_contact"):
             if getattr(self, k) <= 0:
-                raise ConfigError(f"hybrid controller {k}: expected a positive value, found {getattr(self, k)!r}")
+                raise ConfigError(f"hybrid controller {k}: expected a positive value, found "
+                                  f"{getattr(self, k)!r}")
         if not 0 <= self.v_min < self.v_max:
-            raise ConfigError(f"hybrid controller voltage range: expected 0 <= v_min < v_max, found "
+            raise ConfigError("hybrid controller voltage range: expected 0 <= v_min "
+                              "< v_max, found "
                               f"[{self.v_min:g}, {self.v_max:g}] V")
         if self.confirm < 1 or int(self.confirm) != self.confirm:
-            raise ConfigError(f"hybrid controller confirm: expected a positive integer, found {self.confirm!r}")
+            raise ConfigError("hybrid controller confirm: expected a positive integer, found "
+                              f"{self.confirm!r}")
 
     @classmethod
-    def for_plant(cls, plant_parameters: ParameterSet | None = None, **overrides) -> "HybridForcePosition":
+    def for_plant(cls, plant_parameters: ParameterSet | None = None,
+                  **overrides) -> "HybridForcePosition":
         """Tuned defaults with the actuator model (D_a, K_sa, K₃, c_e, V_max) taken from an
-        :class:`~gripkit.systems.ftg100.model.FTG100Plant` parameter set (the nominal one by default)."""
+        :class:`~gripkit.systems.ftg100.model.FTG100Plant` parameter set (the nominal one by
+        default)."""
         ps = plant_parameters if plant_parameters is not None else _pp()
-        base = dict(lever=ps.value("D_a"), k1=ps.value("K_sa"), k3=ps.value("K3_a"), c_e=ps.value("c_e"),
+        base = dict(lever=ps.value("D_a"), k1=ps.value("K_sa"), k3=ps.value("K3_a"),
+                    c_e=ps.value("c_e"),
                     v_max=ps.value("V_max"), k_contact=ps.value("K_sb") / ps.value("D_b") ** 2)
         base.update(overrides)
         return cls(**base)
@@ -229,8 +239,10 @@ class HybridForcePosition:
         """The parameter array of :func:`hybrid_step`."""
         lo, hi = self.force_limit
         tt = None if self.anti_windup else math.inf
-        px = PID(self.kp_x, self.ki_x, self.kd_x, dt=self.dt, tf=self.tf_x, b=1.0, c=1.0, tt=tt, u_min=lo, u_max=hi)
-        pf = PID(self.kp_f, self.ki_f, self.kd_f, dt=self.dt, b=1.0, c=0.0, tt=tt, u_min=lo, u_max=hi)
+        px = (PID(self.kp_x, self.ki_x, self.kd_x, dt=self.dt, tf=self.tf_x, b=1.0, c=1.0, tt=tt,
+                  u_min=lo, u_max=hi))
+        pf = (PID(self.kp_f, self.ki_f, self.kd_f, dt=self.dt, b=1.0, c=0.0, tt=tt, u_min=lo,
+                  u_max=hi))
         cp = np.empty(_NCP)
         cp[_TS] = self.dt
         cp[_PX:_PX + PID_NPARAM] = px.params
@@ -259,7 +271,8 @@ class HybridForcePosition:
 
 
 class HybridController:
-    """Sample-by-sample use of :class:`HybridForcePosition`: ``V = c.step(x_meas, f_meas, f_cmd)``."""
+    """Sample-by-sample use of :class:`HybridForcePosition`: ``V = c.step(x_meas, f_meas,
+    f_cmd)``."""
 
     def __init__(self, design: HybridForcePosition):
         self.design = design
@@ -422,7 +435,8 @@ class GraspBatch:
     def rows(self) -> list[dict]:
         out = []
         for i in range(len(self)):
-            d = dict(force=float(self.force[i]), k0=float(self.k0[i]), gap=float(self.gap[i]), seed=int(self.seed[i]))
+            d = (dict(force=float(self.force[i]), k0=float(self.k0[i]), gap=float(self.gap[i]),
+                      seed=int(self.seed[i])))
             d.update({k: float(v) for k, v in zip(METRICS, self.metrics[i])})
             d["damage"] = bool(d["damage"])
             d["detected"] = bool(d["detected"])
@@ -440,7 +454,8 @@ def _prepare(controller, plant, force, k0, gap, seed, noise_force, noise_positio
     ctrls = list(controller) if isinstance(controller, (list, tuple)) else [controller]
     for c in ctrls:
         if not isinstance(c, HybridForcePosition):
-            raise ConfigError(f"controller: expected a HybridForcePosition, found {type(c).__name__}")
+            raise ConfigError("controller: expected a HybridForcePosition, found "
+                              f"{type(c).__name__}")
     base = plant.theta()
     names = plant.parameters.names
     arrs = np.broadcast_arrays(
@@ -459,7 +474,8 @@ def _prepare(controller, plant, force, k0, gap, seed, noise_force, noise_positio
         raise ConfigError("noise: expected standard deviations >= 0")
     if not np.issubdtype(S.dtype, np.integer) or (S < 0).any():
         raise ConfigError("seed: expected non-negative integers")
-    dmg = np.broadcast_to(1.5 * F if damage_threshold is None else np.asarray(damage_threshold, float), F.shape)
+    dmg = (np.broadcast_to(1.5 * F if damage_threshold is None else np.asarray(damage_threshold,
+                                                                               float), F.shape))
     dmg = np.ascontiguousarray(dmg, dtype=float)
     P = F.size
     thetas = np.repeat(base[None, :], P, axis=0)
@@ -477,7 +493,8 @@ def _prepare(controller, plant, force, k0, gap, seed, noise_force, noise_positio
     return plant, thetas, cps, F, K0, G, S.astype(np.int64), NF, NX, dmg, dt, n_steps, substeps
 
 
-def grasp_batch(controller: HybridForcePosition | list | None = None, plant=None, *, force=20e-6, k0=None,
+def grasp_batch(controller: HybridForcePosition | list | None = None, plant=None, *, force=20e-6,
+                k0=None,
                 gap=None, seed=0, duration: float = 0.1, noise_force=50e-9, noise_position=1e-9,
                 damage_threshold=None, band: float = 0.02, record: bool = False,
                 progress: bool = True) -> GraspBatch:
@@ -490,8 +507,10 @@ def grasp_batch(controller: HybridForcePosition | list | None = None, plant=None
     approach (gap / approach_speed) plus the grasp.
     """
     plant, thetas, cps, F, K0, G, S, NF, NX, dmg, dt, n_steps, sub = _prepare(
-        controller, plant, force, k0, gap, seed, noise_force, noise_position, damage_threshold, duration)
-    met, traj = _run(thetas, cps, np.ascontiguousarray(F[:, None]), NF, NX, S, dt, sub, band, dmg, n_steps,
+        controller, plant, force, k0, gap, seed, noise_force, noise_position, damage_threshold,
+        duration)
+    met, traj = _run(thetas, cps, np.ascontiguousarray(F[:, None]), NF, NX, S, dt, sub, band, dmg,
+                     n_steps,
                      record, progress)
     return GraspBatch(met, F, K0, G, S, dmg, dt, traj if record else None)
 
@@ -504,15 +523,18 @@ def _run(thetas, cps, fprofs, NF, NX, S, dt, sub, band, dmg, n_steps, record, pr
     traj = np.empty((P, n_steps if record else 1, 7))
     chunk = 256
     run = GraspRun(dt, sub, float(band), n_steps, bool(record))
-    for a in track(range(0, P, chunk), description="grasp simulations", enabled=progress and P > 2 * chunk):
+    for a in track(range(0, P, chunk), description="grasp simulations",
+                   enabled=progress and P > 2 * chunk):
         b = min(P, a + chunk)
         _grasp_batch(thetas[a:b], cps[a:b], fprofs[a:b], NF[a:b], NX[a:b], S[a:b], dmg[a:b], run,
                      traj[a:b], met[a:b])
     return met, traj
 
 
-def simulate_hybrid_grasp(controller: HybridForcePosition | None = None, plant=None, *, force: float = 20e-6,
-                          k0: float | None = None, gap: float | None = None, seed: int = 0, duration: float = 0.1,
+def simulate_hybrid_grasp(controller: HybridForcePosition | None = None, plant=None, *,
+                          force: float = 20e-6,
+                          k0: float | None = None, gap: float | None = None, seed: int = 0,
+                          duration: float = 0.1,
                           noise_force: float = 50e-9, noise_position: float = 1e-9,
                           damage_threshold: float | None = None, band: float = 0.02,
                           force_profile=None) -> HybridGraspResult:
@@ -521,26 +543,32 @@ def simulate_hybrid_grasp(controller: HybridForcePosition | None = None, plant=N
     replaces the constant command; the metrics then refer to its last value."""
     for name, v in (("force", force), ("k0", k0), ("gap", gap)):
         if v is not None and np.ndim(v) != 0:
-            raise ConfigError(f"{name}: expected one number for simulate_hybrid_grasp (use grasp_batch for arrays)")
+            raise ConfigError(f"{name}: expected one number for simulate_hybrid_grasp (use "
+                              "grasp_batch for arrays)")
     plant, thetas, cps, F, K0, G, S, NF, NX, dmg, dt, n_steps, sub = _prepare(
-        controller, plant, force, k0, gap, seed, noise_force, noise_position, damage_threshold, duration)
+        controller, plant, force, k0, gap, seed, noise_force, noise_position, damage_threshold,
+        duration)
     prof = F[:, None]
     if force_profile is not None:
         prof = np.asarray(force_profile, dtype=np.float64)
         if prof.shape != (n_steps,) or not np.isfinite(prof).all() or (prof <= 0).any():
-            raise ConfigError(f"force_profile: expected {n_steps} positive forces (one per {dt:g} s sample over "
+            raise ConfigError(f"force_profile: expected {n_steps} positive forces (one per "
+                              f"{dt:g} s sample over "
                               f"{duration:g} s), found shape {prof.shape}")
         prof = prof[None, :]
         F = prof[:, -1].copy()
         dmg = np.full(1, 1.5 * F[0]) if damage_threshold is None else dmg
-    met, tr = _run(thetas, cps, np.ascontiguousarray(prof), NF, NX, S, dt, sub, band, dmg, n_steps, True, False)
+    met, tr = (_run(thetas, cps, np.ascontiguousarray(prof), NF, NX, S, dt, sub, band, dmg, n_steps,
+                    True, False))
     b = GraspBatch(met, F, K0, G, S, dmg, dt, tr)
     tr = tr[0]
-    traj = Trajectory(tr[:, 0], {"x_a": tr[:, 1], "x_b": tr[:, 2], "F_c": tr[:, 3], "F_meas": tr[:, 4],
+    traj = Trajectory(tr[:, 0], {"x_a": tr[:, 1], "x_b": tr[:, 2], "F_c": tr[:, 3],
+                                 "F_meas": tr[:, 4],
                                  "V": tr[:, 5], "mode": tr[:, 6]},
                       {"x_a": "m", "x_b": "m", "F_c": "N", "F_meas": "N", "V": "V", "mode": "1"},
                       {"dt": dt, "model": "ftg100-plant + hybrid force/position"})
-    return HybridGraspResult(traj, b.rows()[0], float(F[0]), float(dmg[0]), float(K0[0]), float(G[0]))
+    return (HybridGraspResult(traj, b.rows()[0], float(F[0]), float(dmg[0]), float(K0[0]),
+                              float(G[0])))
 
 
 def impact_speed_limit(force: float, k0: float, plant_parameters: ParameterSet | None = None,

@@ -1,5 +1,6 @@
 """The FemtoTools FT-G100 microgripper (seed ``003_abd62b560633beaf.txt``): the seed's
-identification experiments (simulated) and their Levenberg-Marquardt identification (§III-B, §III-D).
+identification experiments (simulated) and their Levenberg-Marquardt identification (§III-B,
+§III-D).
 
 §III-B: "the electrostatic actuator has been excited with a 10V step voltage around the operating
 point while the object seizure was happening ... p = [M_a K_fa k0]ᵀ which minimize a quadratic
@@ -40,8 +41,10 @@ def _noise(y: np.ndarray, sigma: float, seed: int) -> np.ndarray:
     return y + sigma * np.random.default_rng(seed).standard_normal(y.shape)
 
 
-def step_experiment(model: FTG100Actuated | None = None, *, dt: float = 5e-05, duration: float = 0.02,
-                    t_step: float = 1e-3, step: float = 10.0, period: float | None = None, noise: float = 0.01,
+def step_experiment(model: FTG100Actuated | None = None, *, dt: float = 5e-05,
+                    duration: float = 0.02,
+                    t_step: float = 1e-3, step: float = 10.0, period: float | None = None,
+                    noise: float = 0.01,
                     seed: int = 0) -> Trajectory:
     """The §III-B experiment, simulated: V_in steps from V₀ to V₀ + ``step`` at ``t_step`` with the
     object grasped (and, with ``period``, back and forth as a square wave of that period); x_a (m,
@@ -51,7 +54,8 @@ def step_experiment(model: FTG100Actuated | None = None, *, dt: float = 5e-05, d
     m = model if model is not None else FTG100Actuated(check=False)
     n = int(round(duration * rate))
     if n < 20 or not 0 <= t_step < duration:
-        raise DataError(f"step_experiment: expected duration ≥ 20 samples and 0 ≤ t_step < duration, found "
+        raise DataError("step_experiment: expected duration ≥ 20 samples and 0 ≤ t_step < "
+                        "duration, found "
                         f"duration={duration!r} s, t_step={t_step!r} s")
     V0 = m.parameters.value("V0")
     t = np.arange(n) / rate
@@ -64,11 +68,13 @@ def step_experiment(model: FTG100Actuated | None = None, *, dt: float = 5e-05, d
     y = m.simulate({"V_in": V}, dt=dt)["x_a"]
     sigma = noise * abs(m.dc_gain() * step)
     return Trajectory(t, {"V_in": V, "x_a": _noise(y, sigma, seed)}, {"V_in": "V", "x_a": "m"},
-                      {"dt": dt, "source": f"simulated §III-B step ({noise:.3g} noise, seed {seed})",
+                      {"dt": dt, "source": f"simulated §III-B step ({noise:.3g} "
+                                           f"noise, seed {seed})",
                        "noise_std": sigma})
 
 
-def release_experiment(model: FTG100Sensing | None = None, *, thrust: float = 27e-6, dt: float = 5e-05,
+def release_experiment(model: FTG100Sensing | None = None, *, thrust: float = 27e-6,
+                       dt: float = 5e-05,
                        duration: float = 0.01, t_release: float = 1e-3, noise: float = 0.01,
                        seed: int = 0) -> Trajectory:
     """The §III-D experiment (Fig. 9), simulated: the sensing arm is held at ``thrust`` (m) by a
@@ -79,19 +85,23 @@ def release_experiment(model: FTG100Sensing | None = None, *, thrust: float = 27
     m = model if model is not None else FTG100Sensing(check=False)
     n = int(round(duration * rate))
     if n < 20 or not 0 <= t_release < duration or not thrust > 0:
-        raise DataError("release_experiment: expected thrust > 0, ≥ 20 samples and 0 ≤ t_release < duration")
+        raise DataError("release_experiment: expected thrust > 0, ≥ 20 samples and 0 ≤ "
+                        "t_release < duration")
     F0 = thrust * m.stiffness()
     t = np.arange(n) / rate
     F = np.where(t < t_release, F0, 0.0)
     y = m.simulate({"F_c": F}, dt=dt, x0=np.array([thrust, 0.0]))["x_b"]
-    return Trajectory(t, {"F_c": F, "x_b": _noise(y, noise * thrust, seed)}, {"F_c": "N", "x_b": "m"},
-                      {"dt": dt, "source": f"simulated §III-D release ({noise:.3g} noise, seed {seed})",
+    return Trajectory(t, {"F_c": F, "x_b": _noise(y, noise * thrust, seed)},
+                      {"F_c": "N", "x_b": "m"},
+                      {"dt": dt, "source": f"simulated §III-D release ({noise:.3g} "
+                                           f"noise, seed {seed})",
                        "noise_std": noise * thrust})
 
 
 def _quiet_build(cls, **kw):
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", ConsistencyWarning)  # eq-17 findings are reported by `zoo check`
+        # eq-17 findings are reported by `zoo check`
+        warnings.simplefilter("ignore", ConsistencyWarning)
         return cls(**kw)
 
 
@@ -122,8 +132,10 @@ def identify_actuated(data: Trajectory, *, input: str = "V_in", output: str = "x
     k = _pre_step(u)
     V0 = float(u[:k].mean())
     if not 0 < V0 <= 200:
-        raise DataError(f"input {input!r}: the operating voltage before the step is {V0:g} V; expected "
-                        f"(0, 200] V", hint="give the absolute actuation voltage, not its deviation")
+        raise DataError(f"input {input!r}: the operating voltage before the step is "
+                        f"{V0:g} V; expected "
+                        f"(0, 200] V", hint="give the absolute actuation voltage, "
+                                            "not its deviation")
     off0 = float(y[:k].mean())
     y = y - off0
     base = model if model is not None else _quiet_build(FTG100Actuated, check=False)
@@ -133,18 +145,22 @@ def identify_actuated(data: Trajectory, *, input: str = "V_in", output: str = "x
     p = base.parameters
     gain = p.value("D_a") * p.value("N_a") * p.value("eps") * p.value("h") * V0 / p.value("g")
     if not st.gain > 0:
-        raise IdentificationError(f"the step response has a non-positive static gain ({st.gain:.3g} m/V): the "
-                                  f"arm must close with increasing voltage", hint="check the sign of the output")
+        raise IdentificationError("the step response has a non-positive static gain "
+                                  f"({st.gain:.3g} m/V): the "
+                                  "arm must close with "
+                                  "increasing voltage", hint="check the sign of the output")
     wn = st.natural_frequency
     k_tot = gain / st.gain
     M = k_tot / wn ** 2
     kk = (k_tot - p.value("K_sa")) / p.value("D_a") ** 2
     k2 = p.value("k2")
     k0 = kk * k2 / (k2 - kk) if 0 < kk < 0.999 * k2 else (1e5 if kk >= 0.999 * k2 else 1.0)
-    start = {"M_a": M, "K_fa": 2 * st.damping_ratio * wn * M, "k0": min(max(k0, 1.0), 1e6), "x_off": 0.0}
+    start = ({"M_a": M, "K_fa": 2 * st.damping_ratio * wn * M, "k0": min(max(k0, 1.0), 1e6),
+              "x_off": 0.0})
     free = tuple(free) + (("x_off",) if "x_off" not in free else ())
     start = {n: v for n, v in start.items() if n in free}
-    res = fit(base, data, outputs=["x_a"], free=list(free), initial=start, method="lm", progress=progress)
+    res = (fit(base, data, outputs=["x_a"], free=list(free), initial=start, method="lm",
+               progress=progress))
     return _shift_offset(res, off0)
 
 
@@ -165,9 +181,11 @@ def identify_sensing(data: Trajectory, *, input: str = "F_c", output: str = "x_b
     p = base.parameters
     x_start = u[:k].mean() * p.value("D_b") ** 2 / p.value("K_sb")
     y_start = float(y[:k].mean())
-    if "K_sb" not in free and "D_b" not in free and (x_start == 0 or abs(y_start / x_start - 1) > 0.05):
+    if "K_sb" not in free and "D_b" not in free and (x_start == 0
+                                                     or abs(y_start / x_start - 1) > 0.05):
         raise DataError(
-            f"the deflection before release, {y_start * 1e6:.4g} µm, does not match the applied force: "
+            f"the deflection before release, {y_start * 1e6:.4g} µm, does not match the "
+            "applied force: "
             f"F₀ D_b²/K_sb = {x_start * 1e6:.4g} µm",
             hint="give the force in N and the deflection from rest in m, or free K_sb")
     data = Trajectory(data.t, {"F_c": u, "x_b": y}, {"F_c": "N", "x_b": "m"}, data.meta)
@@ -191,7 +209,8 @@ def identify_sensing(data: Trajectory, *, input: str = "F_c", output: str = "x_b
 def _shift_offset(res: GreyboxResult, off0: float) -> GreyboxResult:
     """The result with the fitted sensor zero expressed in the data's own zero (+ ``off0``)."""
     off = res.parameters["x_off"]
-    ps = res.parameters.from_vector(np.array([off.value + off0]), ["x_off"], std=np.array([off.std]),
+    ps = res.parameters.from_vector(np.array([off.value + off0]), ["x_off"],
+                                    std=np.array([off.std]),
                                     source=off.source)
     theta = np.array([ps.value(n) for n in res.free])
     return dataclasses.replace(res, parameters=ps, theta=theta)

@@ -225,7 +225,8 @@ def seed_state_space(eq: dict) -> StateSpace:
                       ("N" if eq["input_unit"] == "uN" else "V",), ("m",), {"source": eq["source"]})
 
 
-def _canonical_findings(subject: str, computed: StateSpace, eq: dict, pole_tol: float, dc_tol: float,
+def _canonical_findings(subject: str, computed: StateSpace, eq: dict, pole_tol: float,
+                        dc_tol: float,
                         used: str) -> list[Finding]:
     seed = seed_state_space(eq)
     pc = np.sort_complex(computed.poles())
@@ -234,14 +235,17 @@ def _canonical_findings(subject: str, computed: StateSpace, eq: dict, pole_tol: 
     rel = float(np.max(np.abs(pc - ps) / np.abs(ps)))
     name = eq["source"].split(", ")[-1]
     out = [Finding(f"{name.replace(' ', '')}-poles", subject, rel <= pole_tol,
-                   f"discrete poles from the parameters {_fmt_poles(pc)} vs {name} {_fmt_poles(ps)}: "
-                   f"{100 * rel:.3g} % apart (tolerance {100 * pole_tol:.3g} %); continuous equivalents "
+                   f"discrete poles from the parameters {_fmt_poles(pc)} vs {name} "
+                   f"{_fmt_poles(ps)}: "
+                   f"{100 * rel:.3g} % apart (tolerance {100 * pole_tol:.3g} %); "
+                   "continuous equivalents "
                    f"{_fmt_modes(pc, computed.dt)} vs {_fmt_modes(ps, seed.dt)}",
                    used, float(abs(pc[0])), float(abs(ps[0])), rel, pole_tol, eq["source"])]
     dc_c = float(computed.dc_gain()[0, 0])
     dc_s = float(seed.dc_gain()[0, 0])
     unit = "m/V" if eq["input_unit"] == "V" else "m/N"
-    out.append(compare(f"{name.replace(' ', '')}-dc-gain", subject, computed=dc_c, stated=dc_s, rtol=dc_tol,
+    out.append(compare(f"{name.replace(' ', '')}-dc-gain", subject, computed=dc_c, stated=dc_s,
+                       rtol=dc_tol,
                        what=f"DC gain C(I−A)⁻¹B from the parameters vs the printed {name} matrices",
                        unit=unit, used=used, source=eq["source"]))
     return out
@@ -295,7 +299,8 @@ class _SecondOrderFTG(Model):
         m, c, k, gain, _, _ = self._coefficients(self.theta()[None, :])[0]
         A = [[0.0, 1.0], [-k / m, -c / m]]
         B = [[0.0], [gain / m]]
-        return StateSpace(A, B, [[1.0, 0.0]], None, None, (self.inputs[0].name,), (self.outputs[0].name,),
+        return StateSpace(A, B, [[1.0, 0.0]], None, None, (self.inputs[0].name,),
+                          (self.outputs[0].name,),
                           (self.inputs[0].unit,), (self.outputs[0].unit,), {"model": self.name})
 
     def transfer_function(self) -> tuple[np.ndarray, np.ndarray]:
@@ -304,7 +309,8 @@ class _SecondOrderFTG(Model):
         return np.array([gain]), np.array([m, c, k])
 
     def discrete(self, dt: float = DT, form: str = "canonical") -> StateSpace:
-        """ZOH discretisation every ``dt`` s: ``form='canonical'`` is the controllable canonical form
+        """ZOH discretisation every ``dt`` s: ``form='canonical'`` is the controllable canonical
+        form
         the seed prints (eqs 10, 17; balancing scale chosen in the seed's units), ``'physical'``
         keeps the states [y, ẏ]."""
         dt = sample_interval(dt, ModelError)
@@ -363,22 +369,28 @@ class FTG100Actuated(_SecondOrderFTG):
         gv = geo.value
         sub = self.name
         out = [
-            compare("K_sa-eq4", sub, computed=clamped_clamped_stiffness(gv("E"), gv("h"), gv("w"), gv("L1")),
+            compare("K_sa-eq4", sub, computed=clamped_clamped_stiffness(gv("E"), gv("h"), gv("w"),
+                                                                        gv("L1")),
                     stated=p.value("K_sa"), rtol=0.005, unit="N/m", what="32 E h w³/L₁³ (eq 4)",
                     used="the stated K_sa", source=_S + "§III-A"),
-            compare("D_a-eq3", sub, computed=amplification_ratio(gv("H"), gv("l"), gv("a")), stated=p.value("D_a"),
-                    rtol=0.01, what="(H − l/2)/(a + l/2) (eq 3, signs reconstructed)", used="the stated D_a = 4.7",
+            compare("D_a-eq3", sub, computed=amplification_ratio(gv("H"), gv("l"), gv("a")),
+                    stated=p.value("D_a"),
+                    rtol=0.01, what="(H − l/2)/(a + l/2) (eq 3, "
+                                    "signs reconstructed)", used="the stated D_a = 4.7",
                     source=_S + "§III-A"),
         ]
         # damping unit: the pole radius of eq 10 is exp(−K_fa/(2 M_a)·T) only if K_fa is in N·s/m
         T = SEED_EQ10["dt"]
         radius = math.exp(-p.value("K_fa") / (2.0 * p.value("M_a")) * T)
-        out.append(compare("damping-unit", sub, computed=radius, stated=math.sqrt(0.9536), rtol=0.002,
-                           what="pole radius exp(−K_fa T/(2 M_a)) with K_fa = 1.3 mN·s/m (the printed "
+        out.append(compare("damping-unit", sub, computed=radius, stated=math.sqrt(0.9536),
+                           rtol=0.002,
+                           what="pole radius exp(−K_fa T/(2 M_a)) with K_fa = 1.3 "
+                                "mN·s/m (the printed "
                                 "'mNs²/m' is not a damping unit)",
                            used="K_fa in mN·s/m", source=_S + "§III-B, eq 10"))
         out += _canonical_findings(sub, self.discrete(SEED_EQ10["dt"]), SEED_EQ10, pole_tol=0.003,
-                                   dc_tol=0.015, used="the parameters (the printed matrices are rounded)")
+                                   dc_tol=0.015, used="the parameters (the printed "
+                                                      "matrices are rounded)")
         return out
 
 
@@ -390,7 +402,8 @@ class FTG100Sensing(_SecondOrderFTG):
     """
 
     name = "ftg100-sensing"
-    description = "FT-G100 sensing subsystem, gripping force to sensing-arm tip deflection (eqs 14-17)"
+    description = ("FT-G100 sensing subsystem, gripping force to sensing-arm tip "
+                   "deflection (eqs 14-17)")
     inputs = (Signal("F_c", "N", "gripping force at the sensing-arm tip"),)
     outputs = (Signal("x_b", "m", "sensing-arm tip deflection"),)
     states = (Signal("x_b", "m", "tip deflection"), Signal("v_b", "m/s", "tip velocity"))
@@ -416,18 +429,23 @@ class FTG100Sensing(_SecondOrderFTG):
         gv = ftg100_geometry().value
         sub = self.name
         out = [
-            compare("K_sb-eq13", sub, computed=clamped_clamped_stiffness(gv("E"), gv("h"), gv("w"), gv("L2")),
+            compare("K_sb-eq13", sub, computed=clamped_clamped_stiffness(gv("E"), gv("h"), gv("w"),
+                                                                         gv("L2")),
                     stated=p.value("K_sb"), rtol=0.01, unit="N/m",
                     what="32 E h w³/L₂³ (eq 13; L₂ = 871.2 µm gives the printed value)",
                     used="the stated K_sb = 235.36 N/m", source=_S + "§III-C"),
-            compare("D_b-eq12", sub, computed=amplification_ratio(gv("H"), gv("l"), gv("b")), stated=p.value("D_b"),
-                    rtol=0.01, what="(H − l/2)/(b + l/2) (eq 12, signs reconstructed)", used="the stated D_b = 6.05",
+            compare("D_b-eq12", sub, computed=amplification_ratio(gv("H"), gv("l"), gv("b")),
+                    stated=p.value("D_b"),
+                    rtol=0.01, what="(H − l/2)/(b + l/2) (eq 12, "
+                                    "signs reconstructed)", used="the stated D_b = 6.05",
                     source=_S + "§III-C"),
             compare("k2-eq16", sub, computed=self.stiffness(),
                     stated=ftg100_parameters().value("k2"),
                     rtol=0.01, unit="N/m",
-                    what="K_sb/D_b² (eq 16)", used="k2 = 6.45 N/m where k2 appears", source=_S + "§III-C"),
-            compare("k2-measured", sub, computed=self.stiffness(), stated=ftg100_geometry().value("k2_measured"),
+                    what="K_sb/D_b² (eq 16)", used="k2 = 6.45 N/m where k2 appears",
+                    source=_S + "§III-C"),
+            compare("k2-measured", sub, computed=self.stiffness(),
+                    stated=ftg100_geometry().value("k2_measured"),
                     rtol=0.01, unit="N/m", what="K_sb/D_b² (eq 16) vs the Fig. 10 slope",
                     used="k2 = 6.45 N/m", source=_S + "§III-D, Fig. 10"),
         ]
@@ -437,7 +455,8 @@ class FTG100Sensing(_SecondOrderFTG):
     def _eq17_findings(self) -> list[Finding]:
         """Eq 17 against the stated M_b, K_fb, K_sb, D_b — and the M_b its poles imply."""
         sub = self.name
-        used = "the stated M_b = 0.5 mg (the identified value in the text); the printed A_c is not used"
+        used = ("the stated M_b = 0.5 mg (the identified value in the text); the printed "
+                "A_c is not used")
         out = _canonical_findings(sub, self.discrete(SEED_EQ17["dt"]), SEED_EQ17, pole_tol=0.003,
                                   dc_tol=0.015, used=used)
         seed = seed_state_space(SEED_EQ17)
@@ -446,9 +465,12 @@ class FTG100Sensing(_SecondOrderFTG):
         p = self.parameters
         m_from_k = p.value("K_sb") / wn ** 2
         m_from_c = p.value("K_fb") / (2.0 * sigma)
-        out.append(compare("eq17-implied-M_b", sub, computed=m_from_k, stated=p.value("M_b"), rtol=0.02, unit="kg",
-                           what=(f"the mass the printed A_c implies, K_sb/ω_n² with ω_n = 2π·{wn / (2 * math.pi):.5g} Hz "
-                                 f"(K_fb/(2σ) gives {m_from_c * 1e6:.4g} mg, {100 * abs(m_from_c / m_from_k - 1):.2g} % "
+        out.append(compare("eq17-implied-M_b", sub, computed=m_from_k, stated=p.value("M_b"),
+                           rtol=0.02, unit="kg",
+                           what=("the mass the printed A_c implies, K_sb/ω_n² with ω_n = "
+                                 f"2π·{wn / (2 * math.pi):.5g} Hz "
+                                 f"(K_fb/(2σ) gives {m_from_c * 1e6:.4g} mg, "
+                                 f"{100 * abs(m_from_c / m_from_k - 1):.2g} % "
                                  f"from it)"),
                            used=used, source=_S + "§III-D, eq 17"))
         return out
@@ -458,7 +480,8 @@ class FTG100Coupled(Model):
     """Coupled gripper model (eq 18), continuous form: the actuated subsystem (eq 9) drives the
     sensing subsystem (eq 15) through F_c = k_k x̃_a (eq 7); the readout gives V_out = k2 x_b / r.
 
-    States [x̃_a, ẋ̃_a, x_b, ẋ_b]; input ``V_in`` (V); outputs ``x_a`` (m), ``x_b`` (m), ``F_c`` (N),
+    States [x̃_a, ẋ̃_a, x_b, ẋ_b]; input ``V_in`` (V); outputs ``x_a`` (m), ``x_b`` (m), ``F_c``
+    (N),
     ``V_out`` (V). :meth:`discrete_eq18` builds the seed's discrete block form from the two
     discretised subsystems; :meth:`simulate` uses the exact ZOH of the continuous cascade.
     """
@@ -467,7 +490,8 @@ class FTG100Coupled(Model):
     description = "FT-G100 coupled actuated/sensing model through the object stiffness (eq 18)"
     inputs = (Signal("V_in", "V", "actuation voltage (absolute)"),)
     outputs = (Signal("x_a", "m", "actuated tip displacement from the operating point"),
-               Signal("x_b", "m", "sensing tip deflection"), Signal("F_c", "N", "gripping force k_k x_a"),
+               Signal("x_b", "m", "sensing tip deflection"),
+               Signal("F_c", "N", "gripping force k_k x_a"),
                Signal("V_out", "V", "force-sensor readout voltage k2 x_b / r"))
     states = (Signal("x_a", "m"), Signal("v_a", "m/s"), Signal("x_b", "m"), Signal("v_b", "m/s"))
     integrator = "zoh"
@@ -496,7 +520,8 @@ class FTG100Coupled(Model):
 
         kk = ps.value("k0") * ps.value("k2") / (ps.value("k0") + ps.value("k2"))
         return (FTG100Actuated(pick(FTG100Actuated._names), check=False),
-                FTG100Sensing(pick(FTG100Sensing._names), check=False), kk, ps.value("k2") / ps.value("r"))
+                FTG100Sensing(pick(FTG100Sensing._names), check=False), kk,
+                ps.value("k2") / ps.value("r"))
 
     @staticmethod
     def _cascade(a: StateSpace, b: StateSpace, kk: float, readout: float):
@@ -522,14 +547,16 @@ class FTG100Coupled(Model):
 
     def state_space(self) -> StateSpace:
         A, B, C, _ = self._matrices(self.theta())
-        return StateSpace(A, B, C, None, None, ("V_in",), tuple(s.name for s in self.outputs), ("V",),
+        return StateSpace(A, B, C, None, None, ("V_in",), tuple(s.name for s in self.outputs),
+                          ("V",),
                           tuple(s.unit for s in self.outputs), {"model": self.name})
 
     def _simulate_batch(self, thetas, u, dt, substeps, x0, y):
         for p in range(thetas.shape[0]):
             A, B, C, V0 = self._matrices(thetas[p])
             Ad, Bd = c2d_zoh(A, B, dt)
-            simulate_discrete(Ad, Bd, C, np.zeros((4, 1)), np.ascontiguousarray(u[:, :1] - V0), x0[p].copy(), y[p])
+            simulate_discrete(Ad, Bd, C, np.zeros((4, 1)), np.ascontiguousarray(u[:, :1] - V0),
+                              x0[p].copy(), y[p])
 
     def modes(self, theta):
         A, _, _, _ = self._matrices(theta)
@@ -537,7 +564,8 @@ class FTG100Coupled(Model):
         return [(abs(v), -v.real / abs(v)) for v in lam if v.imag >= 0]
 
     def discrete(self, dt: float = DT, form: str = "canonical") -> StateSpace:
-        """``form='canonical'``: the seed's eq 18 block form (:meth:`discrete_eq18`); ``'physical'``:
+        """``form='canonical'``: the seed's eq 18 block form (:meth:`discrete_eq18`);
+        ``'physical'``:
         the exact zero-order hold of the continuous cascade (states [x̃_a, ẋ̃_a, x_b, ẋ_b])."""
         if form == "canonical":
             return self.discrete_eq18(dt)
@@ -547,27 +575,33 @@ class FTG100Coupled(Model):
         return self.state_space().c2d(dt)
 
     def discrete_eq18(self, dt: float = DT) -> StateSpace:
-        """The seed's eq 18: [[A_a, 0], [B_c k_k C_a, A_c]] from the canonical subsystems (eqs 10, 17);
+        """The seed's eq 18: [[A_a, 0], [B_c k_k C_a, A_c]] from the canonical subsystems (eqs 10,
+        17);
         outputs x_a, x_b, F_c, V_out (SI). The sensing subsystem sees F_c = k_k x_a held over each
         sample (a ZOH approximation of the continuous cascade; the DC gain is exact)."""
         act, sen, kk, readout = self._parts(self.parameters)
         A, B, C = self._cascade(act.discrete(dt), sen.discrete(dt), kk, readout)
         return StateSpace(A, B, C, None, dt, ("V_in",), tuple(s.name for s in self.outputs), ("V",),
-                          tuple(s.unit for s in self.outputs), {"model": self.name, "form": "eq 18 block form"})
+                          tuple(s.unit for s in self.outputs),
+                          {"model": self.name, "form": "eq 18 block form"})
 
     def consistency_checks(self) -> list[Finding]:
         ps = self.parameters
         out = self.actuated().consistency_checks() + self.sensing().consistency_checks()
-        out = [Finding(f.check, self.name, f.consistent, f.message, f.used, f.computed, f.stated, f.rel_error,
+        out = [Finding(f.check, self.name, f.consistent, f.message, f.used, f.computed, f.stated,
+                       f.rel_error,
                        f.tolerance, f.source) for f in out]
         full_scale = ftg100_geometry().value("force_range")
         printed_r = 50.0  # N/V as printed
         out.append(Finding(
             "readout-sensitivity-unit", self.name, False,
-            f"eq 18 prints r = 50 N/V: the {full_scale * 1e6:.0f} µN range of Fig. 10 would then be "
-            f"{full_scale / printed_r * 1e6:.3g} µV at the MS3110 readout, which outputs volts; in the seed's "
+            f"eq 18 prints r = 50 N/V: the {full_scale * 1e6:.0f} µN range of Fig. "
+            "10 would then be "
+            f"{full_scale / printed_r * 1e6:.3g} µV at the MS3110 readout, which outputs "
+            "volts; in the seed's "
             f"µm/µN/V units r = 50 µN/V gives {full_scale / ps.value('r'):.3g} V",
-            f"r = {ps.value('r') * 1e6:.3g} µN/V", full_scale / printed_r, full_scale / ps.value("r"),
+            f"r = {ps.value('r') * 1e6:.3g} µN/V", full_scale / printed_r,
+            full_scale / ps.value("r"),
             math.nan, math.nan, _S + "eq 18, Fig. 10"))
         return out
 
@@ -615,7 +649,8 @@ def static_force_factor(parameters: ParameterSet | None = None, *, voltage: floa
     if not (math.isfinite(V) and V > 0):
         raise ParameterError(f"voltage: expected a positive voltage in V, found {voltage!r}")
     if not (math.isfinite(x) and x > 0):
-        raise ParameterError(f"tip_displacement: expected a positive displacement in m, found {tip_displacement!r}",
+        raise ParameterError("tip_displacement: expected a positive displacement in m, found "
+                             f"{tip_displacement!r}",
                              hint="give metres, e.g. 20e-6 for 20 µm")
     xe = x / p("D_a")
     return (p("K_sa") * xe + p("K3_a") * xe ** 3) / (p("c_e") * V * V)
@@ -653,21 +688,25 @@ def plant_parameters(*, force_factor: float | str = 1.0, suspension: str = "line
     """
     calibrate = isinstance(force_factor, str)
     if calibrate and force_factor != "static-70V":
-        raise ParameterError(f"force_factor: expected a positive number or 'static-70V', found {force_factor!r}")
+        raise ParameterError("force_factor: expected a positive number or 'static-70V', found "
+                             f"{force_factor!r}")
     if not calibrate:
         try:
             kappa = float(force_factor)
         except (TypeError, ValueError):
             kappa = math.nan
         if not (math.isfinite(kappa) and kappa > 0):
-            raise ParameterError(f"force_factor: expected a positive number or 'static-70V', found {force_factor!r}",
-                                 hint="1 is eq 5 as printed; 'static-70V' fits the seed's 20 µm at 70 V")
+            raise ParameterError("force_factor: expected a positive number or 'static-70V', found "
+                                 f"{force_factor!r}",
+                                 hint="1 is eq 5 as printed; 'static-70V' fits the "
+                                      "seed's 20 µm at 70 V")
     if suspension not in _SUSPENSIONS:
         raise ParameterError(f"suspension: expected 'linear' or 'stretching', found {suspension!r}",
                              hint="'linear' is eqs 4 and 8-10; 'stretching' adds the π⁴/128 "
                                   "stiffening")
     if "c_e" in values and (calibrate or kappa != 1.0):
-        raise ParameterError(f"c_e and force_factor={force_factor!r} both set the comb-drive coefficient",
+        raise ParameterError(f"c_e and force_factor={force_factor!r} both set the "
+                             "comb-drive coefficient",
                              hint="give one of them: c_e in N/V², or force_factor relative to eq 5")
     full, own = ftg100_parameters(), plant_table()
     P = Parameter
@@ -680,7 +719,8 @@ def plant_parameters(*, force_factor: float | str = 1.0, suspension: str = "line
           "N/m**3", "cubic stiffening of the actuator suspension (beam stretching)", (0, None),
           source=_SUSPENSIONS[suspension], display_unit="N/um**3"),
         full["D_a"],
-        P("c_e", ce, "N/V**2", "comb-drive force coefficient N_a ε h/(2g)", (0, None), source=_S + "eq 5",
+        P("c_e", ce, "N/V**2", "comb-drive force "
+                               "coefficient N_a ε h/(2g)", (0, None), source=_S + "eq 5",
           display_unit="nN/V**2"),
         full["M_b"], full["K_fb"], full["K_sb"], own["K3_b"], full["D_b"], full["k0"],
         own["c0"], own["gap"], own["V_max"],
@@ -690,10 +730,12 @@ def plant_parameters(*, force_factor: float | str = 1.0, suspension: str = "line
     if calibrate:
         kappa = static_force_factor(ps)
     if kappa != 1.0:
-        how = ("fitted to the free tip's 20 µm at 70 V (§III-A, after Fig. 4; static_force_factor)" if calibrate
+        how = ("fitted to the free tip's 20 µm at 70 V (§III-A, after Fig. 4; "
+               "static_force_factor)" if calibrate
                else "set by the user (force_factor)")
         ps = ParameterSet([P("c_e", kappa * ce, "N/V**2",
-                             f"effective comb-drive force coefficient κ N_a ε h/(2g), κ = {kappa:.4g}", (0, None),
+                             "effective comb-drive force coefficient κ N_a ε h/(2g), "
+                             f"κ = {kappa:.4g}", (0, None),
                              source=_S + f"eq 5 × κ, {how}", display_unit="nN/V**2")
                            if n == "c_e" else ps[n] for n in ps.names], ps.name)
     return ps
@@ -710,8 +752,10 @@ def _plant_rhs(th, xa, va, xb, vb, V, contact):  # pragma: no cover - compiled
         if fc < 0.0 and th[PX.c0] > 0.0:  # a Kelvin-Voigt contact cannot pull
             fc = 0.0
     fx = th[PX.c_e] * V * V
-    aa = (fx - th[PX.K_fa] * va - th[PX.K_sa] * xa - th[PX.K3_a] * xa * xa * xa - th[PX.D_a] * fc) / th[PX.M_a]
-    ab = (th[PX.D_b] * fc - th[PX.K_fb] * vb - th[PX.K_sb] * xb - th[PX.K3_b] * xb * xb * xb) / th[PX.M_b]
+    aa = ((fx - th[PX.K_fa] * va - th[PX.K_sa] * xa - th[PX.K3_a] * xa * xa * xa - th[PX.D_a] * fc)
+          / th[PX.M_a])
+    ab = ((th[PX.D_b] * fc - th[PX.K_fb] * vb - th[PX.K_sb] * xb - th[PX.K3_b] * xb * xb * xb)
+          / th[PX.M_b])
     return va, aa, vb, ab
 
 
@@ -719,12 +763,17 @@ def _plant_rhs(th, xa, va, xb, vb, V, contact):  # pragma: no cover - compiled
 def _plant_rk4(th, s0, s1, s2, s3, V, mode, h):  # pragma: no cover - compiled
     k1a, k1b, k1c, k1d = _plant_rhs(th, s0, s1, s2, s3, V, mode)
     hh = 0.5 * h
-    k2a, k2b, k2c, k2d = _plant_rhs(th, s0 + hh * k1a, s1 + hh * k1b, s2 + hh * k1c, s3 + hh * k1d, V, mode)
-    k3a, k3b, k3c, k3d = _plant_rhs(th, s0 + hh * k2a, s1 + hh * k2b, s2 + hh * k2c, s3 + hh * k2d, V, mode)
-    k4a, k4b, k4c, k4d = _plant_rhs(th, s0 + h * k3a, s1 + h * k3b, s2 + h * k3c, s3 + h * k3d, V, mode)
+    k2a, k2b, k2c, k2d = (_plant_rhs(th, s0 + hh * k1a, s1 + hh * k1b, s2 + hh * k1c, s3 + hh * k1d,
+                                     V, mode))
+    k3a, k3b, k3c, k3d = (_plant_rhs(th, s0 + hh * k2a, s1 + hh * k2b, s2 + hh * k2c, s3 + hh * k2d,
+                                     V, mode))
+    k4a, k4b, k4c, k4d = (_plant_rhs(th, s0 + h * k3a, s1 + h * k3b, s2 + h * k3c, s3 + h * k3d, V,
+                                     mode))
     h6 = h / 6.0
-    return (s0 + h6 * (k1a + 2.0 * k2a + 2.0 * k3a + k4a), s1 + h6 * (k1b + 2.0 * k2b + 2.0 * k3b + k4b),
-            s2 + h6 * (k1c + 2.0 * k2c + 2.0 * k3c + k4c), s3 + h6 * (k1d + 2.0 * k2d + 2.0 * k3d + k4d))
+    return (s0 + h6 * (k1a + 2.0 * k2a + 2.0 * k3a + k4a),
+            s1 + h6 * (k1b + 2.0 * k2b + 2.0 * k3b + k4b),
+            s2 + h6 * (k1c + 2.0 * k2c + 2.0 * k3c + k4c),
+            s3 + h6 * (k1d + 2.0 * k2d + 2.0 * k3d + k4d))
 
 
 @numba.njit(cache=True)
@@ -740,7 +789,8 @@ def advance_plant(th, s, mode, V, h, substeps):  # pragma: no cover - compiled
     Contact events: when the gap function δ = D_a x_ea − D_b x_eb − gap changes sign over a step
     (δ > 0 while free, δ < 0 while touching), the crossing fraction θ of the step is found by the
     Illinois (modified regula falsi) method on RK4 steps of θh from the step's start, the state is
-    advanced to the event, the mode switches, and the rest of the step is integrated in the new mode.
+    advanced to the event, the mode switches, and the rest of the step is integrated in the new
+    mode.
     This keeps RK4's order across contact instead of smearing the kink over a step.
     """
     if th[PX.k0] <= 0.0:
@@ -791,7 +841,8 @@ def advance_plant(th, s, mode, V, h, substeps):  # pragma: no cover - compiled
             s0, s1, s2, s3 = n0, n1, n2, n3
             if it == 0:  # no event in this step
                 break
-            mode = 1 - mode  # (if not located after 41 iterations, the last iterate is the best estimate)
+            # (if not located after 41 iterations, the last iterate is the best estimate)
+            mode = 1 - mode
             rem -= theta * rem
             events += 1
             if rem <= 1e-15 * h:
@@ -810,7 +861,8 @@ def plant_outputs(th, s, mode, out):  # pragma: no cover - compiled
     xb = th[PX.D_b] * s[2]
     fc = 0.0
     if mode == 1 and th[PX.k0] > 0.0:
-        fc = th[PX.k0] * (xa - xb - th[PX.gap]) + th[PX.c0] * (th[PX.D_a] * s[1] - th[PX.D_b] * s[3])
+        fc = (th[PX.k0] * (xa - xb - th[PX.gap]) + th[PX.c0]
+              * (th[PX.D_a] * s[1] - th[PX.D_b] * s[3]))
         if fc < 0.0:
             fc = 0.0
     out[PO.x_a] = xa
@@ -854,8 +906,10 @@ class FTG100Plant(Model):
                    "actuation, "
                    "object contact")
     inputs = (Signal("V", "V", "actuation voltage (clipped to [0, V_max])"),)
-    outputs = (Signal("x_a", "m", "actuated tip displacement"), Signal("x_b", "m", "sensing tip deflection"),
-               Signal("F_c", "N", "contact force on the object"), Signal("F_s", "N", "force sensor reading"))
+    outputs = (Signal("x_a", "m", "actuated tip displacement"),
+               Signal("x_b", "m", "sensing tip deflection"),
+               Signal("F_c", "N", "contact force on the object"),
+               Signal("F_s", "N", "force sensor reading"))
     states = (Signal("x_ea", "m", "actuator electrode displacement"), Signal("v_ea", "m/s"),
               Signal("x_eb", "m", "sensor electrode displacement"), Signal("v_eb", "m/s"))
     integrator = "rk4"
@@ -897,7 +951,8 @@ class FTG100Plant(Model):
         if f == 0.0 or k3 == 0.0:
             return f / k1
         hi = abs(f) / k1
-        return math.copysign(brentq(lambda x: k1 * x + k3 * x ** 3 - abs(f), 0.0, hi, xtol=1e-18, rtol=1e-14), f)
+        return (math.copysign(brentq(lambda x: k1 * x + k3 * x ** 3 - abs(f), 0.0, hi, xtol=1e-18,
+                                     rtol=1e-14), f))
 
     def equilibrium(self, V: float, theta=None) -> dict:
         """Static equilibrium at voltage ``V``: electrode and tip displacements, contact force, and
@@ -940,10 +995,12 @@ class FTG100Plant(Model):
         A[3, 2] = -(kb + on * Db * Db * k0) / Mb
         A[3, 3] = -(p["K_fb"] + on * Db * Db * c0) / Mb
         B = np.array([[0.0], [2 * p["c_e"] * eq["V"] / Ma], [0.0], [0.0]])
-        C = np.array([[Da, 0, 0, 0], [0, 0, Db, 0], [on * k0 * Da, on * c0 * Da, -on * k0 * Db, -on * c0 * Db],
+        C = np.array([[Da, 0, 0, 0], [0, 0, Db, 0],
+                      [on * k0 * Da, on * c0 * Da, -on * k0 * Db, -on * c0 * Db],
                       [0, 0, p["K_sb"] / Db, 0]], float)
         return StateSpace(A, B, C, None, None, ("V",), ("x_a", "x_b", "F_c", "F_s"), ("V",),
-                          ("m", "m", "N", "N"), {"model": self.name, "V0": eq["V"], "contact": bool(eq["contact"])})
+                          ("m", "m", "N", "N"),
+                          {"model": self.name, "V0": eq["V"], "contact": bool(eq["contact"])})
 
     def resonance(self, V: float, theta=None) -> tuple[float, float]:
         """(f_n Hz, ζ) of the slowest mode of the small-signal model at ``V``."""
@@ -986,7 +1043,8 @@ class FTG100Plant(Model):
         free = self.with_parameters(check=False, k0=0.0)
         x70 = free.equilibrium(V0)["x_a"]
         lin70 = p("D_a") * p("c_e") * V0 ** 2 / p("K_sa")
-        # the printed numbers alone: eq 5 force, stated K_sa and D_a, linear suspensions (eq 2 at rest)
+        # the printed numbers alone: eq 5 force, stated K_sa and D_a, linear suspensions (eq 2 at
+        # rest)
         printed = ftg100_parameters().value
         ce5 = _eq5_coefficient()
         x_eq5 = printed("D_a") * ce5 * V0 ** 2 / printed("K_sa")
@@ -994,8 +1052,10 @@ class FTG100Plant(Model):
         kappa = p("c_e") / ce5
         kappa_free = kappa * static_force_factor(self.parameters)  # × eq 5 for 20 µm free
         return [
-            compare("static-70V-eq5", self.name, computed=x_eq5, stated=x70_stated, rtol=0.1, unit="m",
-                    what=(f"free tip displacement at 70 V from the printed numbers, D_a N_a ε h V²/(2g K_sa) "
+            compare("static-70V-eq5", self.name, computed=x_eq5, stated=x70_stated, rtol=0.1,
+                    unit="m",
+                    what=("free tip displacement at 70 V from the printed numbers, D_a N_a ε "
+                          "h V²/(2g K_sa) "
                           f"(eqs 2-5, F_x = {ce5 * V0 ** 2 * 1e6:.4g} µN; small-signal gain of eq "
                           "8 with "
                           f"k_k = 0: {gain_eq8 * 1e6:.4g} µm/V where 20 µm at 70 V with F ∝ V² "
@@ -1022,8 +1082,10 @@ class FTG100Plant(Model):
             self._grasp_finding(V0, x70_stated),
             self._eq10_finding(V0),
             self._full_close_finding(),
-            compare("eq5-force-factor", self.name, computed=p("c_e"), stated=ce5, rtol=1e-3, unit="N/V**2",
-                    what=(f"comb-drive coefficient c_e of this plant (κ = {kappa:.4g}) vs N_a ε h/(2g) of eq 5; "
+            compare("eq5-force-factor", self.name, computed=p("c_e"), stated=ce5, rtol=1e-3,
+                    unit="N/V**2",
+                    what=(f"comb-drive coefficient c_e of this plant (κ = {kappa:.4g}) vs N_a ε "
+                          "h/(2g) of eq 5; "
                           f"its small-signal gains at 70 V are κ × those of eqs 8-10"),
                     used=f"c_e = {kappa:.4g} × eq 5", source=_S + "eq 5"),
         ]

@@ -35,6 +35,8 @@ from .stiffness_study import table_iii_study as table_iii_study
 from .tip_position import TipPositionEstimator as TipPositionEstimator
 
 __all__ = ["estimate_micropart", "FingerIdentification", "GraspSettings", "identify_finger",
-           "MicropartEstimate", "simulate_two_finger_grasp", "StiffnessComparison", "table_iii_study",
-           "TableIIIStudy", "TipPositionEstimator", "TSFMFinger", "TSFMFingerContact", "TSFMGripper",
+           "MicropartEstimate", "simulate_two_finger_grasp", "StiffnessComparison",
+           "table_iii_study",
+           "TableIIIStudy", "TipPositionEstimator", "TSFMFinger", "TSFMFingerContact",
+           "TSFMGripper",
            "TwoFingerGrasp", "TwoFingerGraspResult"]

@@ -24,7 +24,8 @@ that is exact for its W term and its inertia term, and for the force term when t
 B (eq 15's experiment), which is how the seed uses it.
 
 The strain gauges measure the sensor's bending, so the force the sensor reports is
-F_m = k_s (y_D − y_C); in statics F_m = F_g, dynamically it also shows the 8.52 kHz ringing (Fig. 8).
+F_m = k_s (y_D − y_C); in statics F_m = F_g, dynamically it also shows the 8.52 kHz ringing (Fig.
+8).
 """
 
 from __future__ import annotations
@@ -38,7 +39,8 @@ from ...errors import DataError
 from ...params import Parameter, ParameterSet
 from ...lti import StateSpace
 
-__all__ = ["LeverCoefficients", "lever_coefficients", "sensor_state_space", "end_effector_parameters",
+__all__ = ["LeverCoefficients", "lever_coefficients", "sensor_state_space",
+           "end_effector_parameters",
            "sensor_parameters"]
 
 
@@ -77,20 +79,27 @@ def end_effector_parameters(m_s: float, b_s: float, k_s: float, L_r: float, L_s:
                             source: str = "", length_source: str = "") -> list[Parameter]:
     """The sensor (m_s, b_s, k_s) and lever (L_r, L_s) parameters, SI."""
     return [
-        Parameter("m_s", m_s, "kg", "force-sensor effective mass (eq 8)", bounds=(1e-15, None), source=source,
+        Parameter("m_s", m_s, "kg", "force-sensor effective mass (eq 8)", bounds=(1e-15, None),
+                  source=source,
                   display_unit="mg"),
-        Parameter("b_s", b_s, "N*s/m", "force-sensor damping (eq 8)", bounds=(0.0, None), source=source),
-        Parameter("k_s", k_s, "N/m", "force-sensor stiffness (eq 8)", bounds=(1e-9, None), source=source),
-        Parameter("L_r", L_r, "m", "rigid socket length, actuator tip A to B (Fig. 7)", bounds=(0.0, None),
+        Parameter("b_s", b_s, "N*s/m", "force-sensor damping (eq 8)", bounds=(0.0, None),
+                  source=source),
+        Parameter("k_s", k_s, "N/m", "force-sensor stiffness (eq 8)", bounds=(1e-9, None),
+                  source=source),
+        Parameter("L_r", L_r, "m", "rigid socket length, actuator tip "
+                                   "A to B (Fig. 7)", bounds=(0.0, None),
                   fixed=True, source=length_source or source, display_unit="mm"),
-        Parameter("L_s", L_s, "m", "force-sensor length, B to C (Fig. 7)", bounds=(0.0, None), fixed=True,
+        Parameter("L_s", L_s, "m", "force-sensor length, "
+                                   "B to C (Fig. 7)", bounds=(0.0, None), fixed=True,
                   source=length_source or source, display_unit="mm"),
     ]
 
 
-def sensor_parameters(f0_hz: float, zeta: float, *, k_s: float | None = None, m_s: float | None = None,
+def sensor_parameters(f0_hz: float, zeta: float, *, k_s: float | None = None,
+                      m_s: float | None = None,
                       b_s: float | None = None, f0_std: float = 0.0, zeta_std: float = 0.0,
-                      known_std: float = 0.0, source: str = "identified from free vibration") -> ParameterSet:
+                      known_std: float = 0.0,
+                      source: str = "identified from free vibration") -> ParameterSet:
     """m_s, b_s, k_s of the force sensor (eq 8) from its natural frequency ``f0_hz``, damping ratio
     ``zeta`` and exactly one of them known (with its std ``known_std``), §IV-B:
 
@@ -121,13 +130,17 @@ def sensor_parameters(f0_hz: float, zeta: float, *, k_s: float | None = None, m_
         b = val
         m = b / (2.0 * zeta * w)
         k = m * w**2
-        sb, sm, sk = known_std, m * math.sqrt(rk**2 + rz**2 + rw**2), k * math.sqrt(rk**2 + rz**2 + rw**2)
+        sb, sm, sk = (known_std, m * math.sqrt(rk**2 + rz**2 + rw**2),
+                      k * math.sqrt(rk**2 + rz**2 + rw**2))
     src = f"{source} (f0 = {f0_hz:.6g} Hz, ζ = {zeta:.4g}, {name} given)"
     return ParameterSet([
-        Parameter("m_s", m, "kg", "force-sensor effective mass (eq 8)", (0.0, None), source=src if name != "m_s" else "given",
+        Parameter("m_s", m, "kg", "force-sensor effective mass (eq 8)", (0.0, None),
+                  source=src if name != "m_s" else "given",
                   std=sm, display_unit="mg"),
-        Parameter("b_s", b, "N*s/m", "force-sensor damping (eq 8)", (0.0, None), source=src if name != "b_s" else "given",
+        Parameter("b_s", b, "N*s/m", "force-sensor damping (eq 8)", (0.0, None),
+                  source=src if name != "b_s" else "given",
                   std=sb),
-        Parameter("k_s", k, "N/m", "force-sensor stiffness (eq 8)", (0.0, None), source=src if name != "k_s" else "given",
+        Parameter("k_s", k, "N/m", "force-sensor stiffness (eq 8)", (0.0, None),
+                  source=src if name != "k_s" else "given",
                   std=sk),
     ], "force-sensor")

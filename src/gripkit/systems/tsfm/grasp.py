@@ -14,7 +14,8 @@ contact yet." The strategy, per finger, sample by sample at 20 kHz:
 3. **squeeze**: with both in contact, both close under force control to ``grip_force``: the
    force error (ramped reference) moves the position reference, r ← r + dt ω_f (F_ref − F)/k̂,
    with k̂ the contact stiffness seen so far, (F − F_contact)/(ŷ − ŷ_contact) from the position
-   estimates (clipped to [k_min, k_max]) — so the loop speed does not depend on how soft the part is.
+   estimates (clipped to [k_min, k_max]) — so the loop speed does not depend on how soft the part
+   is.
 
 The inner position loop is an integral controller, U̇ = ω_p (r − ŷ)/g, g the finger's static
 gain (m/V), with the voltage clipped to the actuator's range. ``wait_for_other=False`` gives the
@@ -44,7 +45,8 @@ from .gripper import (TSFMGripper, GripperState, gripper_advance, gripper_measur
 from .micropart import MicropartEstimate, estimate_micropart
 from .tip_position import estimator_arrays, estimator_step
 
-__all__ = ["GraspSettings", "TwoFingerGrasp", "TwoFingerGraspResult", "simulate_two_finger_grasp", "grasp_step",
+__all__ = ["GraspSettings", "TwoFingerGrasp", "TwoFingerGraspResult", "simulate_two_finger_grasp",
+           "grasp_step",
            "Estimators", "GraspLoop"]
 
 # controller state columns (per finger)
@@ -139,7 +141,8 @@ def grasp_step(F1, F2, loop, e, cp):  # pragma: no cover - compiled
         if ph == APPROACH:
             if cs[i, _REF] < cp[SX.max_closing]:
                 cs[i, _REF] += cp[SX.approach_speed] * dt
-        elif ph == HOLD and c < 0.5:                   # lost it before the other touched: close again
+        # lost it before the other touched: close again
+        elif ph == HOLD and c < 0.5:
             cs[i, _PHASE] = APPROACH
             cs[i, _CONTACT_T] = -1.0
     both_now = cs[0, _CONTACT_T] >= 0.0 and cs[1, _CONTACT_T] >= 0.0
@@ -151,7 +154,8 @@ def grasp_step(F1, F2, loop, e, cp):  # pragma: no cover - compiled
         y = out[i, 1]
         if cs[i, _PHASE] == SQUEEZE:
             # (conditional expressions, not builtin max/min: numba.cuda cannot compile those in an
-            # @njit callee, and gripkit.systems.tsfm.grasp_gpu runs this step on the GPU; same values)
+            # @njit callee, and gripkit.systems.tsfm.grasp_gpu runs this step on the GPU; same
+            # values)
             ramp = cp[SX.force_ramp_time]
             step = (cp[SX.grip_force] - cs[i, _FREF]) * dt / (dt if dt > ramp else ramp)
             if abs(cp[SX.grip_force] - cs[i, _FREF]) <= abs(step):
@@ -179,12 +183,14 @@ def grasp_step(F1, F2, loop, e, cp):  # pragma: no cover - compiled
 def _init_state(n_window: int) -> GraspLoop:
     cs = np.zeros((2, 7))
     cs[:, _CONTACT_T] = -1.0
-    return GraspLoop(np.zeros((2, 5)), np.zeros((2, n_window)), np.zeros((2, 6)), cs, np.empty(4), np.zeros((2, 5)))
+    return (GraspLoop(np.zeros((2, 5)), np.zeros((2, n_window)), np.zeros((2, 6)), cs, np.empty(4),
+                      np.zeros((2, 5))))
 
 
 def _est_stack(fingers, dt) -> tuple[Estimators, list]:
     arrs = [estimator_arrays(f, dt) for f in fingers]
-    return Estimators(*(np.ascontiguousarray(np.stack([a[k] for a in arrs])) for k in Estimators._fields)), arrs
+    return (Estimators(*(np.ascontiguousarray(np.stack([a[k] for a in arrs]))
+                         for k in Estimators._fields)), arrs)
 
 
 def _static_gain(values) -> float:
@@ -272,8 +278,10 @@ def _grasp_run(model, x0, noise, loop, e, cp, rec, work):  # pragma: no cover - 
         gripper_advance(out[0, 0], out[1, 0], state, model, work)
 
 
-_COLUMNS = (("U1", "V"), ("U2", "V"), ("y_C1", "m"), ("y_C2", "m"), ("y_hat1", "m"), ("y_hat2", "m"),
-            ("F_g1", "N"), ("F_g2", "N"), ("F_meas1", "N"), ("F_meas2", "N"), ("X_p", "m"), ("phase1", "1"),
+_COLUMNS = (("U1", "V"), ("U2", "V"), ("y_C1", "m"), ("y_C2", "m"), ("y_hat1", "m"),
+            ("y_hat2", "m"),
+            ("F_g1", "N"), ("F_g2", "N"), ("F_meas1", "N"), ("F_meas2", "N"), ("X_p", "m"),
+            ("phase1", "1"),
             ("phase2", "1"), ("contact1", "1"), ("contact2", "1"))
 
 
@@ -308,7 +316,8 @@ class TwoFingerGraspResult:
         return {**self.summary(), "settings": asdict(self.settings)}
 
 
-def simulate_two_finger_grasp(gripper: TSFMGripper, *, estimator_fingers=None, settings: GraspSettings = GraspSettings(),
+def simulate_two_finger_grasp(gripper: TSFMGripper, *, estimator_fingers=None,
+                              settings: GraspSettings = GraspSettings(),
                               duration: float = 4.0, dt: float = 5e-05, noise_std: float = 2e-6,
                               seed: int = 0) -> TwoFingerGraspResult:
     """Close the grasp loop on the gripper model (see the module docstring).
@@ -335,18 +344,21 @@ def simulate_two_finger_grasp(gripper: TSFMGripper, *, estimator_fingers=None, s
     x0 = np.zeros((3, d["Phi"].shape[-1]))
     x0[2, 0] = th[gripper.parameters.names.index("X_p")]
     rec = np.empty((N, len(_COLUMNS)))
-    _grasp_run(gripper_model(d, 0), x0, noise, loop, e, cp, rec, gripper_work(d["Phi"].shape[-1], d["C"].shape[-2]))
+    _grasp_run(gripper_model(d, 0), x0, noise, loop, e, cp, rec,
+               gripper_work(d["Phi"].shape[-1], d["C"].shape[-2]))
     if not np.isfinite(rec).all():
         raise SimulationError("the grasp simulation diverged", hint="lower the loop bandwidths")
     t = np.arange(N) * dt
-    tr = Trajectory(t, {n: rec[:, i] for i, (n, _) in enumerate(_COLUMNS)}, dict(_COLUMNS), {"dt": dt})
+    tr = (Trajectory(t, {n: rec[:, i] for i, (n, _) in enumerate(_COLUMNS)}, dict(_COLUMNS),
+                     {"dt": dt}))
     ct = []
     for i in (13, 14):
         hit = np.flatnonzero(rec[:, i] > 0.5)
         ct.append(float(t[hit[0]]) if hit.size else math.nan)
     gap = th[gripper.parameters.names.index("gap")]
     try:
-        est_mp = estimate_micropart(rec[:, 4], rec[:, 8], rec[:, 5], rec[:, 9], gap, threshold=settings.threshold,
+        est_mp = estimate_micropart(rec[:, 4], rec[:, 8], rec[:, 5], rec[:, 9], gap,
+                                    threshold=settings.threshold,
                                     window=settings.window)
     except (DataError, IdentificationError):  # not grasped (no squeeze with both fingers)
         est_mp = None

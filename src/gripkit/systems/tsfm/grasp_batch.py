@@ -13,9 +13,11 @@ code as the single grasp (:func:`~gripkit.systems.tsfm.grasp.grasp_step` and
 2000 samples would otherwise be 2.4 GB.
 
 Per-job setup. Only the contact mode of each finger depends on the part (k_side = 2 k_e,
-c_side = 2 c_e per side, pull-off F_po/k_side, see :class:`~gripkit.systems.tsfm.gripper.TSFMGripper`):
+c_side = 2 c_e per side, pull-off F_po/k_side, see
+:class:`~gripkit.systems.tsfm.gripper.TSFMGripper`):
 its ZOH matrices (13 dyadic levels) are recomputed per job in numba (:func:`_job_setup`: two
-9×9 matrix exponentials per finger, a small part of a grasp's cost: docs/performance.md); the free mode, the estimators and
+9×9 matrix exponentials per finger, a small part of a grasp's cost: docs/performance.md); the free
+mode, the estimators and
 the fingers' hysteresis come from one template per gripper. The contact mode is built exactly as
 :func:`~gripkit.systems.tsfm.gripper.finger_hybrid` builds it (A + b_F kᵀ, [B_W, −k b_F]), so a job
 reproduces the single-grasp simulation bit for bit (tested).
@@ -59,26 +61,32 @@ from .grasp_kernels import (_NM, _SQUEEZE, METRICS, GraspTemplate, _default_grip
                             _template)
 from .gripper import TSFMGripper
 
-__all__ = ["METRICS", "FAST_GRASP", "tsfm_grasp_batch", "record_metrics", "tsfm_grasp", "GraspTemplate",
+__all__ = ["METRICS", "FAST_GRASP", "tsfm_grasp_batch", "record_metrics", "tsfm_grasp",
+           "GraspTemplate",
            "POPULATION_NAMES"]
 
 #: per-job parameters a population may vary (with ``offset`` as an alternative to ``X_p``)
-POPULATION_NAMES = ("k_e", "w", "X_p", "offset", "c_e", "F_po", "F_stick", "approach_speed", "noise_std")
-#: their SI units (those of the part parameters of :class:`~gripkit.systems.tsfm.gripper.TSFMGripper`); ``gap`` too
-POPULATION_UNITS = {"k_e": "N/m", "w": "m", "X_p": "m", "offset": "m", "c_e": "N*s/m", "F_po": "N", "F_stick": "N",
+POPULATION_NAMES = ("k_e", "w", "X_p", "offset", "c_e", "F_po", "F_stick", "approach_speed",
+                    "noise_std")
+# : their SI units (those of the part parameters of
+# :class:`~gripkit.systems.tsfm.gripper.TSFMGripper`); ``gap`` too
+POPULATION_UNITS = {"k_e": "N/m", "w": "m", "X_p": "m", "offset": "m", "c_e": "N*s/m", "F_po": "N",
+                    "F_stick": "N",
                     "approach_speed": "m/s", "noise_std": "N", "gap": "m"}
 
 #: a grasp that finishes in ~0.1 s (1 mm/s approach, 10 ms force ramp, 40 Hz force loop), used by
 #: the batch scenario unless told otherwise; the single-grasp defaults (40 µm/s, 0.3 s) take seconds
 FAST_GRASP = GraspSettings(approach_speed=1e-3, force_ramp_time=0.01, force_bandwidth_hz=40.0)
 
-def _jobs(tpl: GraspTemplate, settings: GraspSettings, n_jobs: int, arrays: dict, noise_seed: int, job_ids):
+def _jobs(tpl: GraspTemplate, settings: GraspSettings, n_jobs: int, arrays: dict, noise_seed: int,
+          job_ids):
     """Per-job part vectors, controller vectors, noise std and seeds; ConfigError on a bad job."""
     P = n_jobs
 
     def col(name, default):
         v = arrays.get(name)
-        out = np.full(P, float(default)) if v is None else np.asarray(v, dtype=np.float64).reshape(-1)
+        out = (np.full(P, float(default)) if v is None
+               else np.asarray(v, dtype=np.float64).reshape(-1))
         if out.shape != (P,):
             raise ConfigError(f"{name}: expected one value or {P}, found shape {np.shape(v)}")
         if not np.isfinite(out).all():
@@ -92,7 +100,8 @@ def _jobs(tpl: GraspTemplate, settings: GraspSettings, n_jobs: int, arrays: dict
     F_po = col("F_po", tpl.value("F_po"))
     F_stick = col("F_stick", tpl.value("F_stick"))
     if arrays.get("X_p") is not None and arrays.get("offset") is not None:
-        raise ConfigError("give the part's position as X_p or as offset (from the centre), not both")
+        raise ConfigError("give the part's position as X_p or as offset (from the "
+                          "centre), not both")
     X_p = col("X_p", 0.0) if arrays.get("X_p") is not None else gap / 2 + col("offset", 0.0)
     speed = col("approach_speed", settings.approach_speed)
     nstd = col("noise_std", arrays.get("_noise_default", 2e-6))
@@ -105,24 +114,32 @@ def _jobs(tpl: GraspTemplate, settings: GraspSettings, n_jobs: int, arrays: dict
     bad = (w >= gap) | (X_p < w / 2) | (X_p > gap - w / 2)
     if bad.any():
         i = int(np.argmax(bad))
-        raise ConfigError(f"part {i}: width {w[i] * 1e6:.4g} µm at X_p = {X_p[i] * 1e6:.4g} µm does not fit between "
-                          f"the fingers (gap {gap[i] * 1e6:.4g} µm)", hint="keep w/2 <= X_p <= gap - w/2")
+        raise ConfigError(f"part {i}: width {w[i] * 1e6:.4g} µm at X_p = {X_p[i] * 1e6:.4g} µm "
+                          "does not fit between "
+                          "the fingers (gap "
+                          f"{gap[i] * 1e6:.4g} µm)", hint="keep w/2 <= X_p <= gap - w/2")
     parts = np.ascontiguousarray(np.column_stack([w, gap, 2 * k_e, 2 * c_e, F_po, F_stick, X_p]))
     cp0 = settings.vector(tpl.gains, tpl.dt)
     cps = np.repeat(cp0[None, :], P, axis=0)
     cps[:, 0] = speed
-    ids = np.arange(P, dtype=np.int64) if job_ids is None else np.asarray(job_ids, dtype=np.int64).reshape(-1)
+    ids = (np.arange(P, dtype=np.int64) if job_ids is None
+           else np.asarray(job_ids, dtype=np.int64).reshape(-1))
     seeds = (ids + np.int64(noise_seed) * np.int64(1_000_003)).astype(np.int64)
-    cols = dict(k_e=k_e, w=w, X_p=X_p, c_e=c_e, F_po=F_po, F_stick=F_stick, gap=gap, approach_speed=speed,
+    cols = dict(k_e=k_e, w=w, X_p=X_p, c_e=c_e, F_po=F_po, F_stick=F_stick, gap=gap,
+                approach_speed=speed,
                 noise_std=nstd)
     return parts, np.ascontiguousarray(cps), np.ascontiguousarray(nstd), seeds, cols
 
 
 def tsfm_grasp_batch(gripper=None, *, settings: GraspSettings = FAST_GRASP, duration: float = 0.1,
-                     dt: float = 5e-05, k_e=None, w=None, X_p=None, offset=None, c_e=None, F_po=None,
-                     F_stick=None, gap=None, approach_speed=None, noise_std=2e-6, noise_seed: int = 0,
-                     job_ids=None, noise=None, damage_force: float | None = None, lost_displacement: float = 10e-6,
-                     band: float = 0.05, estimator_fingers=None, backend: str = "cpu", serial: bool = False,
+                     dt: float = 5e-05, k_e=None, w=None, X_p=None, offset=None, c_e=None,
+                     F_po=None,
+                     F_stick=None, gap=None, approach_speed=None, noise_std=2e-6,
+                     noise_seed: int = 0,
+                     job_ids=None, noise=None, damage_force: float | None = None,
+                     lost_displacement: float = 10e-6,
+                     band: float = 0.05, estimator_fingers=None, backend: str = "cpu",
+                     serial: bool = False,
                      progress: bool = False) -> dict[str, np.ndarray]:
     """Simulate many grasps of the two-finger loop on ``gripper`` (default: the zoo's
     ``tsfm-gripper``) and return their :data:`METRICS` and the per-job parameters as columns.
@@ -149,9 +166,11 @@ def tsfm_grasp_batch(gripper=None, *, settings: GraspSettings = FAST_GRASP, dura
     given = dict(k_e=k_e, w=w, X_p=X_p, offset=offset, c_e=c_e, F_po=F_po, F_stick=F_stick, gap=gap,
                  approach_speed=approach_speed, noise_std=noise_std)
     present = {k: np.asarray(v, dtype=np.float64) for k, v in given.items() if v is not None}
-    shape = np.broadcast_shapes(*(v.shape for v in present.values()), () if job_ids is None else np.shape(job_ids))
+    shape = (np.broadcast_shapes(*(v.shape for v in present.values()),
+                                 () if job_ids is None else np.shape(job_ids)))
     P = int(np.prod(shape)) if shape else 1
-    arrays = {k: np.broadcast_to(v, shape).reshape(-1) if shape else v.reshape(1) for k, v in present.items()}
+    arrays = ({k: np.broadcast_to(v, shape).reshape(-1) if shape else v.reshape(1)
+               for k, v in present.items()})
     parts, cps, nstd, seeds, cols = _jobs(tpl, settings, P, arrays, noise_seed, job_ids)
     dmg = 1.25 * settings.grip_force if damage_force is None else float(damage_force)
     if not (dmg > 0 and lost_displacement > 0):
@@ -162,21 +181,24 @@ def tsfm_grasp_batch(gripper=None, *, settings: GraspSettings = FAST_GRASP, dura
     else:
         nz = np.ascontiguousarray(np.asarray(noise, dtype=np.float64))
         if nz.shape != (P, n_steps, 2) or not np.isfinite(nz).all():
-            raise ConfigError(f"noise: expected finite values of shape ({P}, {n_steps}, 2), found {nz.shape}")
+            raise ConfigError(f"noise: expected finite values of shape ({P}, {n_steps}, 2), "
+                              f"found {nz.shape}")
     met = np.empty((P, _NM))
     if backend == "cuda":
         from .grasp_gpu import run_cuda
 
         run_cuda(tpl, parts, nz, nstd, seeds, n_steps, settings.window, cps, mset, met)
     elif backend == "cpu":
-        _run_cpu(tpl, parts, nz, nstd, seeds, n_steps, settings.window, cps, mset, met, 1 if serial else None,
+        _run_cpu(tpl, parts, nz, nstd, seeds, n_steps, settings.window, cps, mset, met,
+                 1 if serial else None,
                  progress)
     else:
         raise ConfigError(f"backend: expected 'cpu' or 'cuda', found {backend!r}")
     return {**cols, **{m: met[:, i] for i, m in enumerate(METRICS)}}
 
 
-def _run_cpu(tpl, parts, nz, nstd, seeds, n_steps, window, cps, mset, met, threads=None, progress=False):
+def _run_cpu(tpl, parts, nz, nstd, seeds, n_steps, window, cps, mset, met, threads=None,
+             progress=False):
     """Slices of the jobs on ``threads`` threads (default numba's thread count, 1 in a pinned
     worker process) running the nogil kernel :func:`_grasp_jobs`; the results land in ``met``."""
     P = parts.shape[0]
@@ -185,7 +207,8 @@ def _run_cpu(tpl, parts, nz, nstd, seeds, n_steps, window, cps, mset, met, threa
 
     def run(a):
         b = min(P, a + size)
-        _grasp_jobs(tpl.kernel_args(), parts[a:b], nz if nz.shape[0] == 1 else nz[a:b], nstd[a:b], seeds[a:b],
+        _grasp_jobs(tpl.kernel_args(), parts[a:b], nz if nz.shape[0] == 1 else nz[a:b], nstd[a:b],
+                    seeds[a:b],
                     n_steps, window, cps[a:b], mset, met[a:b])
         return b - a
 
@@ -197,7 +220,8 @@ def _run_cpu(tpl, parts, nz, nstd, seeds, n_steps, window, cps, mset, met, threa
                                 enabled=progress and P > 256), maxlen=0)
 
 
-def record_metrics(result, *, gap: float | None = None, width: float | None = None, stiffness: float | None = None,
+def record_metrics(result, *, gap: float | None = None, width: float | None = None,
+                   stiffness: float | None = None,
                    damage_force: float | None = None, lost_displacement: float = 10e-6,
                    band: float = 0.05) -> dict[str, float]:
     """The :data:`METRICS` of one recorded grasp (a
@@ -220,7 +244,8 @@ def record_metrics(result, *, gap: float | None = None, width: float | None = No
     sq = first(tr["phase1"] == _SQUEEZE)
     peak = float(max(F1.max(), F2.max(), 0.0))
     maxd = float(np.abs(tr["X_p"] - tr["X_p"][0]).max())
-    grasped = bool(tr["contact1"][-1] == 1 and tr["contact2"][-1] == 1 and tr["phase1"][-1] == _SQUEEZE
+    grasped = bool(tr["contact1"][-1] == 1 and tr["contact2"][-1] == 1
+                   and tr["phase1"][-1] == _SQUEEZE
                    and tr["phase2"][-1] == _SQUEEZE)
     fbar = 0.5 * (F1 + F2)
     settle = math.inf
@@ -232,17 +257,20 @@ def record_metrics(result, *, gap: float | None = None, width: float | None = No
     nan = math.nan
     m = dict(t_contact1=c1 * dt if c1 >= 0 else nan, t_contact2=c2 * dt if c2 >= 0 else nan,
              t_squeeze=sq * dt if sq >= 0 else nan, peak_force=peak, damage=float(peak > dmg),
-             max_displacement=maxd, grasped=float(grasped), lost=float((not grasped) or maxd > lost_displacement),
+             max_displacement=maxd, grasped=float(grasped),
+             lost=float((not grasped) or maxd > lost_displacement),
              settling_time=settle, final_error=float((fbar[tail].mean() - fcmd) / fcmd),
              final_force=float(fbar[tail].mean()), width_error=nan, stiffness_error=nan)
-    i1, i2 = (first(ContactDetector(s.threshold, window=s.window, release=s.release).run(tr[f"F_meas{i}"])[0])
+    i1, i2 = (first(ContactDetector(s.threshold, window=s.window,
+                                    release=s.release).run(tr[f"F_meas{i}"])[0])
               for i in (1, 2))
     if i1 >= 0 and i2 >= 0 and gap is not None and width is not None:
         ysum = float(tr["y_hat1"][i1] + tr["y_hat2"][i2])
         m["width_error"] = gap - ysum - width
         delta = float((tr["y_hat1"] + tr["y_hat2"])[tail].mean()) - ysum
         if grasped and delta > 0 and stiffness is not None:
-            m["stiffness_error"] = float((0.5 * (tr["F_meas1"] + tr["F_meas2"]))[tail].mean()) / delta / stiffness - 1
+            m["stiffness_error"] = (float((0.5 * (tr["F_meas1"] + tr["F_meas2"]))[tail].mean())
+                                    / delta / stiffness - 1)
     return m
 
 
@@ -251,16 +279,20 @@ def record_metrics(result, *, gap: float | None = None, width: float | None = No
 # ------------------------------------------------------------------------------------------------
 
 _SETTING_KEYS = {"grip_force": "N", "approach_speed": "m/s", "position_bandwidth_hz": "Hz",
-                 "force_bandwidth_hz": "Hz", "force_ramp_time": "s", "threshold": "N", "release": "N",
-                 "window": "1", "u_min": "V", "u_max": "V", "max_closing": "m", "k_min": "N/m", "k_max": "N/m",
+                 "force_bandwidth_hz": "Hz", "force_ramp_time": "s", "threshold": "N",
+                 "release": "N",
+                 "window": "1", "u_min": "V", "u_max": "V", "max_closing": "m", "k_min": "N/m",
+                 "k_max": "N/m",
                  "wait_for_other": "bool"}
-_OTHER_KEYS = ("duration", "fs", "damage_force", "lost_displacement", "band", "noise_std", "noise_seed", "backend")
+_OTHER_KEYS = ("duration", "fs", "damage_force", "lost_displacement", "band", "noise_std",
+               "noise_seed", "backend")
 
 
 def _settings_schema() -> dict:
     kinds = {"bool": Setting("bool"), "1": Setting("int", low=1)}
     return {**{k: kinds.get(u, Setting(u)) for k, u in _SETTING_KEYS.items()},
-            "duration": POSITIVE_TIME, "fs": POSITIVE_RATE, "damage_force": Setting("N", low=0.0, strict=True),
+            "duration": POSITIVE_TIME, "fs": POSITIVE_RATE,
+            "damage_force": Setting("N", low=0.0, strict=True),
             "lost_displacement": Setting("m", low=0.0, strict=True), "band": FRACTION,
             "noise_std": Setting("N", low=0.0), "noise_seed": Setting("int", low=0),
             "backend": Setting("str", choices=("cpu", "cuda"))}
@@ -277,27 +309,32 @@ def settings_from_table(table: dict) -> tuple[GraspSettings, dict]:
 
 def _interface(model, settings: dict):
     if model is not None and not isinstance(model, TSFMGripper):
-        raise ConfigError(f"scenario 'tsfm-grasp' needs a TSFM gripper model, found {type(model).__name__}",
+        raise ConfigError("scenario 'tsfm-grasp' needs a TSFM gripper model, found "
+                          f"{type(model).__name__}",
                           hint='model = "tsfm-gripper"')
     positive, non_negative = (np.finfo(float).tiny, None), (0.0, None)  # as _jobs checks them
     bounds = {**{k: positive for k in ("k_e", "w", "approach_speed", "gap")},
               **{k: non_negative for k in ("c_e", "F_po", "F_stick", "noise_std")}}
-    return Interface(parameters=POPULATION_UNITS, settings=read_settings(settings, _settings_schema(), "tsfm-grasp"),
+    return Interface(parameters=POPULATION_UNITS,
+                     settings=read_settings(settings, _settings_schema(), "tsfm-grasp"),
                      metrics=METRICS, bytes_per_job=8 * (_NM + 64), bounds=bounds)
 
 
 def tsfm_grasp(model, params: dict[str, np.ndarray], settings: dict) -> dict[str, np.ndarray]:
     """Sweep scenario ``tsfm-grasp``: one TSFM grasp per job (see the module docstring).
-    ``model``: a :class:`~gripkit.systems.tsfm.gripper.TSFMGripper` (``model = "tsfm-gripper"``) or None
+    ``model``: a :class:`~gripkit.systems.tsfm.gripper.TSFMGripper` (``model = "tsfm-gripper"``) or
+    None
     (the zoo's). Parameters: any of :data:`POPULATION_NAMES`; ``[scenario]``: the
     :class:`GraspSettings` fields and duration, fs, damage_force, lost_displacement, band,
     noise_std (when not a parameter), noise_seed, backend ('cpu' | 'cuda')."""
     if model is not None and not isinstance(model, TSFMGripper):
-        raise ConfigError(f"scenario 'tsfm-grasp' needs a TSFM gripper model, found {type(model).__name__}",
+        raise ConfigError("scenario 'tsfm-grasp' needs a TSFM gripper model, found "
+                          f"{type(model).__name__}",
                           hint='model = "tsfm-gripper"')
     unknown = [k for k in params if k not in POPULATION_NAMES and k not in ("job_id", "gap")]
     if unknown:
-        raise ConfigError(f"tsfm-grasp: unknown parameters {unknown}", hint=f"allowed: {', '.join(POPULATION_NAMES)}")
+        raise ConfigError("tsfm-grasp: unknown "
+                          f"parameters {unknown}", hint=f"allowed: {', '.join(POPULATION_NAMES)}")
     gs, opts = settings_from_table(settings)
     kw = {k: v for k, v in params.items() if k != "job_id"}
     if "noise_std" not in kw:
@@ -306,7 +343,8 @@ def tsfm_grasp(model, params: dict[str, np.ndarray], settings: dict) -> dict[str
                            dt=1.0 / opts.get("fs", 20000.0),  # the sweep file gives a rate in Hz
                            job_ids=params.get("job_id"), noise_seed=int(opts.get("noise_seed", 0)),
                            damage_force=opts.get("damage_force"),
-                           lost_displacement=opts.get("lost_displacement", 10e-6), band=float(opts.get("band", 0.05)),
+                           lost_displacement=opts.get("lost_displacement", 10e-6),
+                           band=float(opts.get("band", 0.05)),
                            backend=str(opts.get("backend", "cpu")), **kw)
     return {m: res[m] for m in METRICS}
 

@@ -1,5 +1,6 @@
 """The TSFM grasp batch on a CUDA GPU (optional): the same scalar kernel as the CPU path,
-:func:`gripkit.systems.tsfm.grasp_kernels._grasp_core`, compiled by ``numba.cuda`` — one grasp per thread.
+:func:`gripkit.systems.tsfm.grasp_kernels._grasp_core`, compiled by ``numba.cuda`` — one grasp per
+thread.
 
 numba compiles an ``@njit`` function called from a CUDA kernel for the device (with every njit
 function it calls: ``grasp_step``, ``gripper_advance``, ``pwa_step``, ``bouc_wen_advance``, the
@@ -50,7 +51,8 @@ DeviceShared = namedtuple("DeviceShared", "bw G target ng K n_steps mset")
 DeviceJobs = namedtuple("DeviceJobs", "Phi Gam C D Hg parts noise nstd seeds cps")
 #: every job's work arrays on the device, leading index: job (the fields of GraspLoop,
 #: GripperState and GripperWork, and the random-number state), allocated by :func:`run_cuda`
-DeviceWork = namedtuple("DeviceWork", "det buf est cs X modes hyst ps ext out ua xt ev_frac ev_to yout rng")
+DeviceWork = namedtuple("DeviceWork", "det buf est cs X modes hyst ps ext out ua xt "
+                                      "ev_frac ev_to yout rng")
 
 
 def _kernel_py(shared, estimators, jobs, work, met):  # pragma: no cover - runs on the device
@@ -60,13 +62,15 @@ def _kernel_py(shared, estimators, jobs, work, met):  # pragma: no cover - runs 
     if p < jobs.parts.shape[0]:
         q = p if jobs.noise.shape[0] > 1 else 0
         w = work
-        _grasp_core(GripperModel(shared.bw, jobs.Phi[p], jobs.Gam[p], jobs.C[p], jobs.D[p], shared.G, jobs.Hg[p],
+        _grasp_core(GripperModel(shared.bw, jobs.Phi[p], jobs.Gam[p], jobs.C[p], jobs.D[p],
+                                 shared.G, jobs.Hg[p],
                                  shared.target, shared.ng, shared.K, jobs.parts[p]),
                     SensorNoise(jobs.noise[q], jobs.nstd[p], jobs.seeds[p]), shared.n_steps,
                     estimators, jobs.cps[p], shared.mset,
                     GraspLoop(w.det[p], w.buf[p], w.est[p], w.cs[p], w.ext[p], w.out[p]),
                     GripperState(w.X[p], w.modes[p], w.hyst[p], w.ps[p]),
-                    GripperWork(w.ua[p], w.xt[p], w.ev_frac[p], w.ev_to[p], w.yout[p]), w.rng[p], met[p])
+                    GripperWork(w.ua[p], w.xt[p], w.ev_frac[p], w.ev_to[p], w.yout[p]), w.rng[p],
+                    met[p])
 
 
 _KERNEL = []
@@ -81,7 +85,8 @@ def _kernel():
 def _host_arrays(tpl, parts):
     """The jobs' matrices with their contact modes (computed on the CPU), leading index: job."""
     P = parts.shape[0]
-    stack = [np.ascontiguousarray(np.broadcast_to(a, (P,) + a.shape)) for a in (tpl.Phi, tpl.Gam, tpl.C, tpl.D, tpl.H)]
+    stack = ([np.ascontiguousarray(np.broadcast_to(a, (P,) + a.shape))
+              for a in (tpl.Phi, tpl.Gam, tpl.C, tpl.D, tpl.H)])
     Phi, Gam, C, D, Hg = (s.copy() for s in stack)
     _setup_jobs(tpl.kernel_args(), parts, tpl.dt, Phi, Gam, C, D, Hg)
     return Phi, Gam, C, D, Hg
@@ -92,7 +97,8 @@ def run_cuda(tpl, parts, nz, nstd, seeds, n_steps, window, cps, mset, met, batch
     """Run the jobs on the GPU (see the module docstring); fills ``met`` (P, len(METRICS))."""
     if not cuda_available():
         raise ConfigError("backend 'cuda': no CUDA device is available to numba",
-                          hint="use backend='cpu' (the default), or install the NVIDIA driver and CUDA toolkit")
+                          hint="use backend='cpu' (the default), or install the NVIDIA driver "
+                               "and CUDA toolkit")
     kern = _kernel()
     n = tpl.A.shape[1]
     P = parts.shape[0]
@@ -102,19 +108,23 @@ def run_cuda(tpl, parts, nz, nstd, seeds, n_steps, window, cps, mset, met, batch
         Phi, Gam, C, D, Hg = _host_arrays(tpl, np.ascontiguousarray(parts[a:b]))
         d = cuda.to_device
         work = DeviceWork(*(cuda.device_array(s, dtype=dt) for s, dt in (
-            ((m, 2, 5), np.float64), ((m, 2, window), np.float64), ((m, 2, 6), np.float64), ((m, 2, 7), np.float64),
+            ((m, 2, 5), np.float64), ((m, 2, window), np.float64), ((m, 2, 6), np.float64),
+            ((m, 2, 7), np.float64),
             ((m, 2, n), np.float64), ((m, 2), np.int64), ((m, 4), np.float64), ((m, 1), np.float64),
-            ((m, 4), np.float64), ((m, 2, 5), np.float64), ((m, 3), np.float64), ((m, n), np.float64),
+            ((m, 4), np.float64), ((m, 2, 5), np.float64), ((m, 3), np.float64),
+            ((m, n), np.float64),
             ((m, MAX_EVENTS_PER_STEP), np.float64), ((m, MAX_EVENTS_PER_STEP), np.int64),
             ((m, 2, tpl.C.shape[2]), np.float64), ((m, 1), np.uint64))))
         out = cuda.device_array((m, met.shape[1]), dtype=np.float64)
         noise = nz if nz.shape[0] == 1 else nz[a:b]
         blocks = (m + threads_per_block - 1) // threads_per_block
-        shared = DeviceShared(d(tpl.bw), d(tpl.G), d(tpl.target), d(tpl.ng), tpl.K, n_steps, d(mset))
+        shared = (DeviceShared(d(tpl.bw), d(tpl.G), d(tpl.target), d(tpl.ng), tpl.K, n_steps,
+                               d(mset)))
         jobs = DeviceJobs(d(Phi), d(Gam), d(C), d(D), d(Hg), d(np.ascontiguousarray(parts[a:b])),
                           d(np.ascontiguousarray(noise)), d(nstd[a:b]), d(seeds[a:b]),
                           d(np.ascontiguousarray(cps[a:b])))
-        kern[blocks, threads_per_block](shared, Estimators(*(d(e) for e in tpl.est)), jobs, work, out)
+        kern[blocks, threads_per_block](shared, Estimators(*(d(e) for e in tpl.est)), jobs, work,
+                                        out)
         met[a:b] = out.copy_to_host()
 
 
@@ -136,10 +146,13 @@ def compile_ptx(cc: tuple[int, int] = (8, 0)) -> str:
     def record(cls, *types):
         return numba.types.NamedTuple(types, cls)
 
-    args = (record(DeviceShared, typeof(tpl.bw), typeof(tpl.G), typeof(tpl.target), typeof(tpl.ng), i8, i8, arr(1)),
+    args = (record(DeviceShared, typeof(tpl.bw), typeof(tpl.G), typeof(tpl.target), typeof(tpl.ng),
+                   i8, i8, arr(1)),
             record(Estimators, *(typeof(e) for e in tpl.est)),
-            record(DeviceJobs, arr(6), arr(6), arr(5), arr(5), arr(5), arr(2), arr(3), arr(1), arr(1, i8), arr(2)),
-            record(DeviceWork, arr(3), arr(3), arr(3), arr(3), arr(3), arr(2, i8), arr(2), arr(2), arr(2), arr(3),
+            record(DeviceJobs, arr(6), arr(6), arr(5), arr(5), arr(5), arr(2), arr(3), arr(1),
+                   arr(1, i8), arr(2)),
+            record(DeviceWork, arr(3), arr(3), arr(3), arr(3), arr(3), arr(2, i8), arr(2), arr(2),
+                   arr(2), arr(3),
                    arr(2), arr(2), arr(2), arr(2, i8), arr(3), arr(2, numba.uint64)),
             arr(2))
 

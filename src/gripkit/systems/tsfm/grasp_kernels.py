@@ -19,10 +19,12 @@ from ...sim.integrators import zoh_levels_into
 from ...sim.noise import normal_draw
 from . import parameters as z
 from .grasp import SX, GraspLoop, _est_stack, _static_gain, _values, grasp_step
-from .gripper import (FINGER_NAMES, GripperModel, GripperState, GripperWork, finger_state_space, gripper_advance,
+from .gripper import (FINGER_NAMES, GripperModel, GripperState, GripperWork, finger_state_space,
+                      gripper_advance,
                       gripper_measure)
 
-METRICS = ("t_contact1", "t_contact2", "t_squeeze", "peak_force", "damage", "max_displacement", "grasped",
+METRICS = ("t_contact1", "t_contact2", "t_squeeze", "peak_force", "damage", "max_displacement",
+           "grasped",
            "lost", "settling_time", "final_error", "final_force", "width_error", "stiffness_error")
 _NM = len(METRICS)
 #: index of each metric in a row of ``met``: ``met[MX.peak_force]`` (generated from METRICS)
@@ -57,7 +59,8 @@ def _job_setup(tpl, part, dt, Phi, Gam, C, D, Hg, cw):  # pragma: no cover - com
     c_side, F_po, F_stick] into Phi (2, 2, K+1, n, n), Gam (2, 2, K+1, n, 3), C (2, 2, 4, n),
     D (2, 2, 4, 3), Hg (2, 2, J, 3); the free mode (index 0) is left as it is. ``tpl``: the
     :class:`JobTemplate` (A, B0, bF, iy, K used); ``cw``: :class:`ContactWork`. Mirrors
-    :func:`gripkit.systems.tsfm.gripper.finger_hybrid`: A_c = A + b_F kᵀ (k = k_side at y_C, c_side at
+    :func:`gripkit.systems.tsfm.gripper.finger_hybrid`: A_c = A + b_F kᵀ (k = k_side at y_C, c_side
+    at
     ẏ_C), B_c = [B_W, −k_side b_F, 0], F_g = kᵀ x − k_side x_face, release at −F_po/k_side."""
     A, B0, bF, iy, K = tpl.A, tpl.B0, tpl.bF, tpl.iy, tpl.K
     Ac, Bc, PhiC, GamC = cw.Ac, cw.Bc, cw.PhiC, cw.GamC
@@ -125,7 +128,8 @@ def _settling_time(t_sq, last_out, n_steps, dt):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, _nrt=False, inline="always")
-def _stiffness_metrics(met, part, detected, grasped, y_contact, y_sum, f_mean):  # pragma: no cover - compiled
+def _stiffness_metrics(met, part, detected, grasped, y_contact, y_sum,
+                       f_mean):  # pragma: no cover - compiled
     """``width_error`` (the part width from the two detected contact positions) and
     ``stiffness_error``: k̂_e/k − 1 with k̂_e = F_g/δ (eq 16 of ``001_0b92a7da96e7aa46.txt``) from
     the tail's mean force and squeeze beyond contact, k the two sides in series (k_side/2); NaN
@@ -224,7 +228,8 @@ def _grasp_core(model, sensor, n_steps, e, cp, mset, loop, state, work, rng,
             sum_s += out[0, 1] + out[1, 1]
             n_tail += 1
         if k == n_steps - 1:
-            grasped = modes[0] == 1 and modes[1] == 1 and out[0, 4] == _SQUEEZE and out[1, 4] == _SQUEEZE
+            grasped = (modes[0] == 1 and modes[1] == 1 and out[0, 4] == _SQUEEZE
+                       and out[1, 4] == _SQUEEZE)
         gripper_advance(out[0, 0], out[1, 0], state, model, work)
     met[MX.t_contact1] = t_c1 if t_c1 >= 0.0 else math.nan
     met[MX.t_contact2] = t_c2 if t_c2 >= 0.0 else math.nan
@@ -237,11 +242,13 @@ def _grasp_core(model, sensor, n_steps, e, cp, mset, loop, state, work, rng,
     met[MX.settling_time] = _settling_time(t_sq, last_out, n_steps, dt)
     met[MX.final_error] = (sum_f / n_tail - fcmd) / fcmd
     met[MX.final_force] = sum_f / n_tail
-    _stiffness_metrics(met, part, det1 and det2, grasped, y1c + y2c, sum_s / n_tail, sum_fm / n_tail)
+    _stiffness_metrics(met, part, det1 and det2, grasped, y1c + y2c, sum_s / n_tail,
+                       sum_fm / n_tail)
 
 
 @numba.njit(cache=True, nogil=True)
-def _grasp_jobs(tpl, parts, noise, nstd, seeds, n_steps, window, cps, mset, met):  # pragma: no cover - compiled
+def _grasp_jobs(tpl, parts, noise, nstd, seeds, n_steps, window, cps, mset,
+                met):  # pragma: no cover - compiled
     """Jobs one after another on this core (rows of parts, cps, nstd, seeds, met): for each, the
     template's (:class:`JobTemplate`) matrices with the contact mode of its part
     (:func:`_job_setup`), then :func:`_grasp_core`. ``noise`` (P, N, 2) explicit noise per job, or
@@ -257,8 +264,10 @@ def _grasp_jobs(tpl, parts, noise, nstd, seeds, n_steps, window, cps, mset, met)
     C = tpl.C.copy()
     D = tpl.D.copy()
     Hg = tpl.H.copy()
-    cw = ContactWork(np.empty((2, n, n)), np.empty((2, n, 3)), np.empty((2, L, n, n)), np.empty((2, L, n, 3)))
-    loop = GraspLoop(np.empty((2, 5)), np.empty((2, window)), np.empty((2, 6)), np.empty((2, 7)), np.empty(4),
+    cw = (ContactWork(np.empty((2, n, n)), np.empty((2, n, 3)), np.empty((2, L, n, n)),
+                      np.empty((2, L, n, 3))))
+    loop = GraspLoop(np.empty((2, 5)), np.empty((2, window)), np.empty((2, 6)), np.empty((2, 7)),
+                     np.empty(4),
                      np.empty((2, 5)))
     state = GripperState(np.empty((2, n)), np.empty(2, dtype=np.int64), np.empty(4), np.empty(1))
     work = GripperWork(np.empty(3), np.empty(n), np.empty(MAX_EVENTS_PER_STEP),
@@ -322,7 +331,8 @@ class GraspTemplate:
         return float(self.theta[self.names.index(name)])
 
     def kernel_args(self) -> JobTemplate:
-        return JobTemplate(self.A, self.B0, self.bF, self.iy, self.Phi, self.Gam, self.C, self.D, self.G, self.H,
+        return JobTemplate(self.A, self.B0, self.bF, self.iy, self.Phi, self.Gam, self.C, self.D,
+                           self.G, self.H,
                            self.target, self.ng, self.K, self.bw, self.est)
 
 

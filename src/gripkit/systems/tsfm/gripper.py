@@ -66,9 +66,11 @@ from ...sim.model import Model, Signal
 from .end_effector import (end_effector_parameters, lever_coefficients, sensor_parameters,
                            sensor_state_space)
 
-__all__ = ["FINGER_NAMES", "finger_parameter_set", "finger_state_space", "finger_minimal_state_space",
+__all__ = ["FINGER_NAMES", "finger_parameter_set", "finger_state_space",
+           "finger_minimal_state_space",
            "finger_coefficients", "finger_transfer_functions", "finger_hybrid",
-           "micropart_parameters", "finger_checks", "TSFMFinger", "TSFMFingerContact", "TSFMGripper",
+           "micropart_parameters", "finger_checks", "TSFMFinger", "TSFMFingerContact",
+           "TSFMGripper",
            "gripper_measure", "gripper_advance", "gripper_work", "gripper_model", "GripperModel",
            "GripperState", "GripperWork", "RANGES", "check_ranges"]
 
@@ -110,15 +112,18 @@ def check_ranges(trajectory, positions: tuple[str, ...], forces: tuple[str, ...]
     return trajectory.with_channels(**clipped) if clipped else trajectory
 
 
-FINGER_NAMES = ("d_p", "s_p", "lam", "beta", "gamma", "a", "b", "m_s", "b_s", "k_s", "L_r", "L_s", "L_a",
+FINGER_NAMES = ("d_p", "s_p", "lam", "beta", "gamma", "a", "b", "m_s", "b_s", "k_s", "L_r", "L_s",
+                "L_a",
                 "sensitivity")
 CONTACT_NAMES = ("x_w", "k_e", "c_e", "F_po")
 PART_NAMES = ("w", "k_e", "c_e", "F_po", "F_stick", "X_p", "gap")
 
 
-def finger_parameter_set(*, d_p: float, s_p: float, lam: float, beta: float, gamma: float, a: float, b: float,
+def finger_parameter_set(*, d_p: float, s_p: float, lam: float, beta: float, gamma: float, a: float,
+                         b: float,
                          m_s: float, b_s: float, k_s: float, L_r: float, L_s: float, L_a: float,
-                         sensitivity: float = 5e3, source: str = "", sources: Mapping[str, str] | None = None,
+                         sensitivity: float = 5e3, source: str = "",
+                         sources: Mapping[str, str] | None = None,
                          name: str = "tsfm-finger") -> ParameterSet:
     """ParameterSet of one finger (SI). ``sources`` overrides ``source`` per parameter.
 
@@ -127,18 +132,21 @@ def finger_parameter_set(*, d_p: float, s_p: float, lam: float, beta: float, gam
     """
     act = actuator_parameters(d_p, s_p, lam, beta, gamma, a, b, L_a, source=source)
     ee = end_effector_parameters(m_s, b_s, k_s, L_r, L_s, source=source)
-    sens = Parameter("sensitivity", sensitivity, "V/N", "force-sensor read-out sensitivity (volts per newton)",
+    sens = Parameter("sensitivity", sensitivity, "V/N", "force-sensor read-out sensitivity "
+                                                        "(volts per newton)",
                      bounds=(0.0, None), fixed=True, source=source, display_unit="mV/uN")
     by_name = {p.name: p for p in [*act.values(), *ee, sens]}
     for n, src in (sources or {}).items():
         if n not in by_name:
-            raise ParameterError(f"sources: no finger parameter {n!r}", hint=f"parameters: {', '.join(FINGER_NAMES)}")
+            raise ParameterError("sources: no finger "
+                                 f"parameter {n!r}", hint=f"parameters: {', '.join(FINGER_NAMES)}")
         by_name[n] = dataclasses.replace(by_name[n], source=src)
     return ParameterSet([by_name[n] for n in FINGER_NAMES], name)
 
 
 def _v(p) -> dict[str, float]:
-    """Parameter values as a dict from a ParameterSet, a mapping or a vector in FINGER_NAMES order."""
+    """Parameter values as a dict from a ParameterSet, a mapping or a vector in FINGER_NAMES
+    order."""
     if isinstance(p, ParameterSet):
         return {n: p.value(n) for n in p}
     if isinstance(p, Mapping):
@@ -154,7 +162,8 @@ def finger_state_space(p) -> StateSpace:
     L = v["L_r"] + v["L_s"]
     act = actuator_state_space(v["s_p"], v["a"], v["b"], v["L_a"])   # inputs W, F_A, M_A
     sen = sensor_state_space(v["m_s"], v["b_s"], v["k_s"])           # inputs y_D, v_D, F_g
-    lever = np.array([[1.0, 0.0, L, 0.0], [0.0, 1.0, 0.0, L]])        # [y_D, v_D] = lever x_a (eq 6)
+    # [y_D, v_D] = lever x_a (eq 6)
+    lever = np.array([[1.0, 0.0, L, 0.0], [0.0, 1.0, 0.0, L]])
     # eq 1: F_A = reaction of the sensor on the lever (sensor output 1), M_A = L F_g
     FA_xs, FA_in = sen.C[1], sen.D[1]
     A = np.zeros((6, 6))
@@ -172,7 +181,8 @@ def finger_state_space(p) -> StateSpace:
     C[2, 0], C[2, 2] = 1.0, L                       # y_D
     C[3, 0] = 1.0                                   # y_A
     C[4, 0], C[4, 2], C[4, 4] = v["k_s"], v["k_s"] * L, -v["k_s"]   # F_m = k_s (y_D − y_C)
-    return StateSpace(A, B, C, np.zeros((5, 2)), inputs=("W", "F_g"), outputs=("y_C", "y_B", "y_D", "y_A", "F_m"),
+    return StateSpace(A, B, C, np.zeros((5, 2)), inputs=("W", "F_g"),
+                      outputs=("y_C", "y_B", "y_D", "y_A", "F_m"),
                       input_units=("m", "N"), output_units=("m", "m", "m", "m", "N"))
 
 
@@ -236,7 +246,8 @@ def d_bandwidth_hz(a: float, b: float) -> float:
 
 # ---- consistency ---------------------------------------------------------------------------------
 
-def finger_checks(values: Mapping[str, float], reference: Mapping[str, tuple[float, str]], subject: str,
+def finger_checks(values: Mapping[str, float], reference: Mapping[str, tuple[float, str]],
+                  subject: str,
                   *, printed: bool = False) -> list[Finding]:
     """Compare a finger's parameter values with stated measurements.
 
@@ -254,12 +265,16 @@ def finger_checks(values: Mapping[str, float], reference: Mapping[str, tuple[flo
         rad = abs(math.sqrt(k / m) - f0) / f0 < 0.03
         what = "√(k_s/m_s)/2π"
         if rad:
-            what += f" (√(k_s/m_s) = {math.sqrt(k / m):.5g} rad/s matches {f0:g} taken as rad/s: 2π dropped)"
+            what += (f" (√(k_s/m_s) = {math.sqrt(k / m):.5g} rad/s matches {f0:g} taken as "
+                     "rad/s: 2π dropped)")
         m_fix = sensor_parameters(f0, 0.0, k_s=k).value("m_s")
-        used = (f"gripkit keeps k_s = {k:g} N/m and the measured f0 = {f0:g} Hz: m_s = k_s/(2π f0)² = {m_fix:.4g} kg"
-                if printed else f"simulated with the model's own m_s, k_s ({f:.4g} Hz); m_s = {m_fix:.4g} kg "
+        used = (f"gripkit keeps k_s = {k:g} N/m and the measured f0 = {f0:g} Hz: m_s = k_s/(2π "
+                f"f0)² = {m_fix:.4g} kg"
+                if printed else f"simulated with the model's own m_s, k_s ({f:.4g} Hz); m_s = "
+                                f"{m_fix:.4g} kg "
                                 f"would give {f0:g} Hz")
-        out.append(compare("sensor-natural-frequency", subject, computed=f, stated=f0, rtol=0.02, what=what,
+        out.append(compare("sensor-natural-frequency", subject, computed=f, stated=f0, rtol=0.02,
+                           what=what,
                            unit="Hz", used=used, source=src))
     if "sensor_zeta" in reference:
         z0, src = reference["sensor_zeta"]
@@ -274,18 +289,23 @@ def finger_checks(values: Mapping[str, float], reference: Mapping[str, tuple[flo
                            what="b_s/(2√(k_s m_s))", used=used, source=src))
     if "sensor_stiffness" in reference:
         s0, src = reference["sensor_stiffness"]
-        out.append(compare("sensor-stiffness", subject, computed=k, stated=s0, rtol=0.10, what="k_s",
+        out.append(compare("sensor-stiffness", subject, computed=k, stated=s0, rtol=0.10,
+                           what="k_s",
                            unit="N/m", used="k_s of the finger's parameter set", source=src))
     if "actuator_stiffness" in reference:
         s0, src = reference["actuator_stiffness"]
-        out.append(compare("actuator-stiffness", subject, computed=1.0 / v["s_p"], stated=s0, rtol=0.10,
-                           what="1/s_p (stiffness at tip A)", unit="N/m", used="s_p of the finger's parameter set",
+        out.append(compare("actuator-stiffness", subject, computed=1.0 / v["s_p"], stated=s0,
+                           rtol=0.10,
+                           what="1/s_p (stiffness at tip A)", unit="N/m",
+                           used="s_p of the finger's parameter set",
                            source=src))
     if "sensitivity_uN_per_V" in reference and v.get("sensitivity", 0) > 0:
         s0, src = reference["sensitivity_uN_per_V"]
-        out.append(compare("sensor-sensitivity", subject, computed=1e6 / v["sensitivity"], stated=s0, rtol=0.10,
+        out.append(compare("sensor-sensitivity", subject, computed=1e6 / v["sensitivity"],
+                           stated=s0, rtol=0.10,
                            what="1/sensitivity", unit="uN/V",
-                           used="the finger's own sensitivity (per-finger calibration); the stated value is nominal",
+                           used="the finger's own sensitivity (per-finger calibration); the stated "
+                                "value is nominal",
                            source=src))
     if "actuation_bandwidth_hz" in reference:
         s0, src = reference["actuation_bandwidth_hz"]
@@ -293,7 +313,8 @@ def finger_checks(values: Mapping[str, float], reference: Mapping[str, tuple[flo
         ok = bw >= s0
         out.append(Finding("actuation-bandwidth", subject, ok,
                            f"−3 dB bandwidth of D(s) = {bw:.5g} Hz, stated > {s0:g} Hz",
-                           used="" if ok else "a and b of the parameter set", computed=bw, stated=s0,
+                           used="" if ok else "a and b of the parameter set", computed=bw,
+                           stated=s0,
                            rel_error=abs(bw - s0) / s0, tolerance=0.0, source=src))
     return out
 
@@ -304,8 +325,10 @@ def eq13_a2_finding(values: Mapping[str, float], subject: str) -> Finding:
     pr = finger_coefficients(values, "printed")["a2"]
     rel = abs(pr - d) / abs(d)
     return Finding("eq13-a2", subject, False,
-                   f"eq 13 prints a2 with (1 + 3L/2L_a) b_s m_s s_p (unit kg·s; a2 needs kg); the derivation "
-                   f"from eqs 7 and 10 gives (1 + 3L/2L_a) k_s m_s s_p: a2 = {d:.6g} kg, printed {pr:.6g} "
+                   "eq 13 prints a2 with (1 + 3L/2L_a) b_s m_s s_p (unit kg·s; a2 needs kg); "
+                   "the derivation "
+                   f"from eqs 7 and 10 gives (1 + 3L/2L_a) k_s m_s s_p: a2 = {d:.6g} kg, "
+                   f"printed {pr:.6g} "
                    f"({100 * rel:.3g} % apart)",
                    used="gripkit uses the derived a2 (it agrees with the component-wise model)",
                    computed=d, stated=pr, rel_error=rel, tolerance=0.0,
@@ -336,13 +359,17 @@ class TSFMFinger(Model):
     integrator = "zoh"
     _out_rows = (0, 1, 4)
 
-    def __init__(self, parameters: ParameterSet, *, reference: Mapping[str, tuple[float, str]] | None = None,
+    def __init__(self, parameters: ParameterSet, *,
+                 reference: Mapping[str, tuple[float, str]] | None = None,
                  printed: ParameterSet | None = None, name: str | None = None, check: bool = True):
         missing = [n for n in FINGER_NAMES if n not in parameters]
         if missing:
-            raise ParameterError(f"TSFM finger parameters: missing {missing}", hint="build them with finger_parameter_set(...)")
+            raise ParameterError("TSFM finger parameters: "
+                                 f"missing {missing}",
+                                 hint="build them with finger_parameter_set(...)")
         parameters = ParameterSet([parameters[n] for n in FINGER_NAMES]
-                                  + [parameters[n] for n in parameters if n not in FINGER_NAMES], parameters.name)
+                                  + [parameters[n] for n in parameters if n not in FINGER_NAMES],
+                                  parameters.name)
         self.reference = dict(reference or {})
         self.printed = printed
         if name:
@@ -396,20 +423,23 @@ class TSFMFinger(Model):
         seen = {}
         if self.printed is not None and self.reference:
             pv = {n: self.printed.value(n) for n in self.printed}
-            for f in finger_checks(pv, self.reference, f"{self.name} (Table II as printed)", printed=True):
+            for f in finger_checks(pv, self.reference, f"{self.name} (Table II as printed)",
+                                   printed=True):
                 seen[f.check] = f.computed
                 out.append(f)
             out.append(eq13_a2_finding(pv, f"{self.name} (Table II as printed)"))
         if self.reference:
             # the model's own values; a check whose numbers equal the printed ones is not repeated
-            out += [f for f in finger_checks(v, self.reference, self.name) if seen.get(f.check) != f.computed]
+            out += ([f for f in finger_checks(v, self.reference,
+                                              self.name) if seen.get(f.check) != f.computed])
         return out
 
     def contact(self, *, x_w: float, k_e: float, c_e: float = 0.0, F_po: float = 0.0,
                 source: str = "", realisation: str = "component") -> "TSFMFingerContact":
         """This finger pressing on a part whose face is ``x_w`` (m) from the tip's rest position
         (``realisation='minimal'``: eq 11's four states, output y_D instead of y_B)."""
-        return TSFMFingerContact(self.parameters.merged(contact_parameters(x_w, k_e, c_e, F_po, source=source)),
+        return TSFMFingerContact(self.parameters.merged(contact_parameters(x_w, k_e, c_e, F_po,
+                                                                           source=source)),
                                  reference=self.reference, printed=self.printed, check=False,
                                  finger_name=self.name, realisation=realisation)
 
@@ -418,17 +448,21 @@ def contact_parameters(x_w: float, k_e: float, c_e: float = 0.0, F_po: float = 0
                        source: str = "") -> ParameterSet:
     """The contact of one finger with a part face (SI)."""
     return ParameterSet([
-        Parameter("x_w", x_w, "m", "position of the part face from the tip's rest position", source=source,
+        Parameter("x_w", x_w, "m", "position of the part face from the "
+                                   "tip's rest position", source=source,
                   display_unit="um"),
-        Parameter("k_e", k_e, "N/m", "contact stiffness (part stiffness seen by this finger)", bounds=(1e-12, None),
+        Parameter("k_e", k_e, "N/m", "contact stiffness (part stiffness seen "
+                                     "by this finger)", bounds=(1e-12, None),
                   source=source),
         Parameter("c_e", c_e, "N*s/m", "contact damping", bounds=(0.0, None), source=source),
-        Parameter("F_po", F_po, "N", "pull-off (adhesion) force: contact ends at penetration −F_po/k_e",
+        Parameter("F_po", F_po, "N", "pull-off (adhesion) force: contact ends at "
+                                     "penetration −F_po/k_e",
                   bounds=(0.0, None), source=source, display_unit="uN"),
     ], "contact")
 
 
-def micropart_parameters(width: float, stiffness: float, *, damping: float = 0.0, pull_off: float = 0.0,
+def micropart_parameters(width: float, stiffness: float, *, damping: float = 0.0,
+                         pull_off: float = 0.0,
                          friction: float = 20e-6, centre: float | None = None, gap: float = 400e-6,
                          source: str = "") -> ParameterSet:
     """A micropart between the two fingers (SI): ``width`` (m), ``stiffness`` k_e (N/m, eq 16),
@@ -436,21 +470,28 @@ def micropart_parameters(width: float, stiffness: float, *, damping: float = 0.0
     finger 1's rest tip; default mid-gap) and the initial ``gap`` between the fingers (m, §V-C)."""
     centre = gap / 2.0 if centre is None else centre
     if not 0.0 < width < gap:
-        raise ParameterError(f"micropart width {width:g} m must lie between 0 and the gap {gap:g} m")
+        raise ParameterError(f"micropart width {width:g} m must lie between 0 and "
+                             f"the gap {gap:g} m")
     if not (width / 2 <= centre <= gap - width / 2):
         raise ParameterError(f"micropart centre {centre:g} m puts the part inside a finger "
-                             f"(faces at {centre - width / 2:g} and {centre + width / 2:g} m, gap {gap:g} m)")
+                             f"(faces at {centre - width / 2:g} and {centre + width / 2:g} "
+                             f"m, gap {gap:g} m)")
     return ParameterSet([
-        Parameter("w", width, "m", "micropart width", bounds=(0.0, None), source=source, display_unit="um"),
-        Parameter("k_e", stiffness, "N/m", "micropart stiffness (eq 16)", bounds=(1e-12, None), source=source),
+        Parameter("w", width, "m", "micropart width", bounds=(0.0, None), source=source,
+                  display_unit="um"),
+        Parameter("k_e", stiffness, "N/m", "micropart stiffness (eq 16)", bounds=(1e-12, None),
+                  source=source),
         Parameter("c_e", damping, "N*s/m", "micropart damping", bounds=(0.0, None), source=source),
-        Parameter("F_po", pull_off, "N", "pull-off (adhesion) force of a contact", bounds=(0.0, None),
+        Parameter("F_po", pull_off, "N", "pull-off (adhesion) "
+                                         "force of a contact", bounds=(0.0, None),
                   source=source, display_unit="uN"),
         Parameter("F_stick", friction, "N", "static friction holding the part on the substrate",
                   bounds=(0.0, None), source=source, display_unit="uN"),
-        Parameter("X_p", centre, "m", "part centre, from finger 1's rest tip towards finger 2", source=source,
+        Parameter("X_p", centre, "m", "part centre, from finger 1's rest tip "
+                                      "towards finger 2", source=source,
                   display_unit="um"),
-        Parameter("gap", gap, "m", "initial gap between the finger tips", bounds=(0.0, None), source=source,
+        Parameter("gap", gap, "m", "initial gap between "
+                                   "the finger tips", bounds=(0.0, None), source=source,
                   display_unit="um"),
     ], "micropart")
 
@@ -492,8 +533,10 @@ def finger_hybrid(values, k_e: float, c_e: float = 0.0, F_po: float = 0.0,
     guards = [Guard("free", "contact", G=-e_y, H=[0.0, 1.0], name="gap closes"),
               Guard("contact", "free", G=e_y, H=[0.0, -1.0], c=F_po / k_e, name="pull-off")]
     second = "y_B" if realisation == "component" else "y_D"
-    return HybridSystem([free, contact], guards, inputs=("W", "x_face"), outputs=("y_C", second, "F_g", "F_m"),
-                        units={"W": "m", "x_face": "m", "y_C": "m", second: "m", "F_g": "N", "F_m": "N"},
+    return HybridSystem([free, contact], guards, inputs=("W", "x_face"),
+                        outputs=("y_C", second, "F_g", "F_m"),
+                        units={"W": "m", "x_face": "m", "y_C": "m", second: "m", "F_g": "N",
+                               "F_m": "N"},
                         name="tsfm-finger-contact")
 
 
@@ -504,7 +547,8 @@ def _hybrid_arrays(rows, dt, levels, realisation="component"):
     B = np.array([s.B for s in systems])
     Phi, Gam = zoh_levels(A, B, dt, levels)
     s0 = systems[0]
-    return dict(Phi=Phi, Gam=Gam, C=np.array([s.C for s in systems]), D=np.array([s.D for s in systems]),
+    return dict(Phi=Phi, Gam=Gam, C=np.array([s.C for s in systems]),
+                D=np.array([s.D for s in systems]),
                 G=np.array([s.G for s in systems]), H=np.array([s.H for s in systems]),
                 target=s0.target, ng=s0.n_guards)
 
@@ -589,18 +633,22 @@ class TSFMFingerContact(Model):
     description = "TSFM finger with a contact (hybrid, exact ZOH with in-step event location)"
     inputs = (Signal("U", "V", "actuator voltage"),)
     outputs = (Signal("y_C", "m", "sensor tip C"), Signal("y_B", "m", "socket tip B"),
-               Signal("F_g", "N", "contact force"), Signal("F_m", "N", "force reported by the sensor"),
+               Signal("F_g", "N", "contact force"),
+               Signal("F_m", "N", "force reported by the sensor"),
                Signal("contact", "1", "0 free, 1 in contact"))
     states = TSFMFinger.states + (Signal("mode", "1", "0 free, 1 contact"),)
     integrator = "zoh"
     levels = DEFAULT_LEVELS
 
-    def __init__(self, parameters: ParameterSet, *, reference=None, printed=None, check: bool = True,
+    def __init__(self, parameters: ParameterSet, *, reference=None, printed=None,
+                 check: bool = True,
                  finger_name: str | None = None, realisation: str = "component"):
         if realisation not in ("component", "minimal"):
-            raise ModelError(f"realisation: expected 'component' or 'minimal', found {realisation!r}")
+            raise ModelError("realisation: expected 'component' or 'minimal', found "
+                             f"{realisation!r}")
         self.realisation = realisation
-        if realisation == "minimal":  # eq 11's four states: y_D replaces y_B, states y_D, v_D, y_C, v_C
+        # eq 11's four states: y_D replaces y_B, states y_D, v_D, y_C, v_C
+        if realisation == "minimal":
             self.outputs = (self.outputs[0], Signal("y_D", "m", "lever tip D"), *self.outputs[2:])
             self.states = TSFMFinger.states[:2] + (Signal("y_D", "m", ""), Signal("v_D", "m/s", ""),
                                                    Signal("y_C", "m", ""), Signal("v_C", "m/s", ""),
@@ -609,9 +657,12 @@ class TSFMFingerContact(Model):
         if missing:
             raise ParameterError(f"{self.name}: missing parameters {missing}",
                                  hint="use TSFMFinger(...).contact(x_w=..., k_e=...)")
-        self.finger = TSFMFinger(ParameterSet([parameters[n] for n in FINGER_NAMES], parameters.name),
-                                 reference=reference, printed=printed, check=False, name=finger_name)
-        super().__init__(ParameterSet([parameters[n] for n in FINGER_NAMES + CONTACT_NAMES], parameters.name),
+        self.finger = TSFMFinger(ParameterSet([parameters[n] for n in FINGER_NAMES],
+                                              parameters.name),
+                                 reference=reference, printed=printed, check=False,
+                                 name=finger_name)
+        super().__init__(ParameterSet([parameters[n] for n in FINGER_NAMES + CONTACT_NAMES],
+                                      parameters.name),
                          check=check)
 
     def consistency_checks(self):
@@ -635,7 +686,8 @@ class TSFMFingerContact(Model):
         d = _hybrid_arrays(rows, dt, self.levels, self.realisation)
         bw = np.ascontiguousarray(thetas[:, [0, 2, 3, 4]])
         xw = np.ascontiguousarray(thetas[:, nf])
-        if len(thetas) == 1:  # one row: skip the parallel region (its thread wake-up costs more than it gives)
+        # one row: skip the parallel region (its thread wake-up costs more than it gives)
+        if len(thetas) == 1:
             guards = PWAGuards(d["G"][0], d["H"][0], d["target"], d["ng"])
             _bw_pwa_row(bw[0], d["Phi"][0], d["Gam"][0], d["C"][0], d["D"][0], guards, self.levels,
                         xw[0], u, x0[0], y[0])
@@ -655,7 +707,8 @@ def _face(i, Xp, part):  # pragma: no cover - compiled
 
 
 #: one gripper's discretised model for the step kernels (:func:`gripper_model`): Bouc-Wen
-#: parameters ``bw`` (2, 4) [d_p, A, β, γ]; each finger's mode stacks ``Phi``, ``Gam``, ``C``, ``D``,
+# : parameters ``bw`` (2, 4) [d_p, A, β, γ]; each finger's mode stacks ``Phi``, ``Gam``, ``C``,
+# ``D``,
 #: ``G``, ``Hg`` (leading index: finger, see :meth:`TSFMGripper.arrays`); the hybrid step's
 #: ``target``, ``ng`` and ``K`` levels; ``part`` = [w, gap, k_side, c_side, F_po, F_stick] (the
 #: batch's jobs append the part's initial X_p)
@@ -669,7 +722,8 @@ GripperWork = namedtuple("GripperWork", "ua xt ev_frac ev_to yout")
 
 def gripper_model(d: dict, row: int) -> GripperModel:
     """Row ``row`` of :meth:`TSFMGripper.arrays` as the record the kernels take."""
-    return GripperModel(d["bw"][row], d["Phi"][row], d["Gam"][row], d["C"][row], d["D"][row], d["G"][row],
+    return GripperModel(d["bw"][row], d["Phi"][row], d["Gam"][row], d["C"][row], d["D"][row],
+                        d["G"][row],
                         d["H"][row], d["target"], d["ng"], d["K"], d["part"][row])
 
 
@@ -708,7 +762,8 @@ def gripper_advance(U1, U2, state, model, work):  # pragma: no cover - compiled
         hyst[2 + i] = U
         ua[0] = bw[i, 0] * U - hyst[i]
         ua[1] = _face(i, Xp, part)
-        q, _nev = pwa_step(X[i], modes[i], ua, model.Phi[i], model.Gam[i], model.G[i], model.Hg[i], model.target,
+        q, _nev = pwa_step(X[i], modes[i], ua, model.Phi[i], model.Gam[i], model.G[i], model.Hg[i],
+                           model.target,
                            model.ng, model.K, work)
         modes[i] = q
     gripper_measure(state, model, work)
@@ -772,7 +827,8 @@ class TSFMGripper(Model):
     name = "tsfm-gripper"
     description = "two TSFM fingers and a micropart (hybrid contacts, substrate friction)"
     inputs = (Signal("U1", "V", "finger 1 voltage"), Signal("U2", "V", "finger 2 voltage"))
-    outputs = (Signal("y_C1", "m", ""), Signal("y_C2", "m", ""), Signal("F_g1", "N", ""), Signal("F_g2", "N", ""),
+    outputs = (Signal("y_C1", "m", ""), Signal("y_C2", "m", ""), Signal("F_g1", "N", ""),
+               Signal("F_g2", "N", ""),
                Signal("F_m1", "N", ""), Signal("F_m2", "N", ""), Signal("X_p", "m", "part centre"),
                Signal("contact1", "1", ""), Signal("contact2", "1", ""))
     integrator = "zoh"
@@ -780,20 +836,24 @@ class TSFMGripper(Model):
 
     def __init__(self, finger1: ParameterSet | TSFMFinger, finger2: ParameterSet | TSFMFinger,
                  part: ParameterSet, *, check: bool = True):
-        self.fingers = tuple(f if isinstance(f, TSFMFinger) else TSFMFinger(f, check=False) for f in (finger1, finger2))
+        self.fingers = (tuple(f if isinstance(f, TSFMFinger) else TSFMFinger(f, check=False)
+                              for f in (finger1, finger2)))
         params = []
         for i, f in enumerate(self.fingers, 1):
             for n in FINGER_NAMES:
                 p = f.parameters[n]
-                params.append(Parameter(f"f{i}_{n}", p.value, p.unit, f"finger {i}: {p.doc}", p.bounds, True,
+                params.append(Parameter(f"f{i}_{n}", p.value, p.unit, f"finger {i}: {p.doc}",
+                                        p.bounds, True,
                                         p.source, None, p.display_unit))
         missing = [n for n in PART_NAMES if n not in part]
         if missing:
-            raise ParameterError(f"micropart parameters: missing {missing}", hint="use micropart_parameters(...)")
+            raise ParameterError("micropart parameters: "
+                                 f"missing {missing}", hint="use micropart_parameters(...)")
         params += [part[n] for n in PART_NAMES]
         sts = []
         for i in (1, 2):
-            sts += [Signal(f"{s.name}{i}", s.unit, s.doc) for s in TSFMFinger.states] + [Signal(f"mode{i}", "1", "")]
+            sts += ([Signal(f"{s.name}{i}", s.unit,
+                            s.doc) for s in TSFMFinger.states] + [Signal(f"mode{i}", "1", "")])
         self.states = tuple(sts) + (Signal("X_p", "m", "part centre"),)
         super().__init__(ParameterSet(params, "tsfm-gripper"), check=check)
 
@@ -810,7 +870,8 @@ class TSFMGripper(Model):
 
     def modes(self, theta):
         nf = len(FINGER_NAMES)
-        return lti_modes(finger_state_space(theta[:nf]).A) + lti_modes(finger_state_space(theta[nf:2 * nf]).A)
+        return (lti_modes(finger_state_space(theta[:nf]).A)
+                + lti_modes(finger_state_space(theta[nf:2 * nf]).A))
 
     def arrays(self, thetas: np.ndarray, dt: float) -> dict:
         """Discretised fingers and part vectors for :func:`gripper_advance` (leading index: row)."""
@@ -823,12 +884,15 @@ class TSFMGripper(Model):
             c_side = 2.0 * th[ix["c_e"]]
             for i in range(2):
                 rows.append((th[i * nf:(i + 1) * nf], k_side, c_side, th[ix["F_po"]]))
-            part.append([th[ix["w"]], th[ix["gap"]], k_side, c_side, th[ix["F_po"]], th[ix["F_stick"]]])
+            part.append([th[ix["w"]], th[ix["gap"]], k_side, c_side, th[ix["F_po"]],
+                         th[ix["F_stick"]]])
             bw.append([th[[i * nf + j for j in (0, 2, 3, 4)]] for i in range(2)])
         d = _hybrid_arrays(rows, dt, self.levels)
         P = len(thetas)
-        out = {k: np.ascontiguousarray(v.reshape((P, 2) + v.shape[1:])) for k, v in d.items() if k not in ("target", "ng")}
-        out.update(target=d["target"], ng=d["ng"], part=np.array(part), bw=np.array(bw), K=self.levels)
+        out = ({k: np.ascontiguousarray(v.reshape((P, 2) + v.shape[1:])) for k, v in d.items()
+                if k not in ("target", "ng")})
+        out.update(target=d["target"], ng=d["ng"], part=np.array(part), bw=np.array(bw),
+                   K=self.levels)
         return out
 
     def simulate(self, u, **kwargs):

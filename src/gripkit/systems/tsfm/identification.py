@@ -37,7 +37,8 @@ from ...sysid.physical.modal import free_vibration
 from .end_effector import lever_coefficients, sensor_parameters
 from .gripper import TSFMFinger, finger_parameter_set
 
-__all__ = ["ComplianceResult", "identify_compliance", "to_tip_a", "FingerIdentification", "identify_finger"]
+__all__ = (["ComplianceResult", "identify_compliance", "to_tip_a", "FingerIdentification",
+            "identify_finger"])
 
 
 @dataclass(frozen=True)
@@ -68,14 +69,16 @@ def identify_compliance(F, y, *, L_r: float | None = None, L_a: float | None = N
     F = np.asarray(F, dtype=np.float64).ravel()
     y = np.asarray(y, dtype=np.float64).ravel()
     if F.shape != y.shape:
-        raise DataError(f"force and displacement must have the same length, found {F.size} and {y.size}")
+        raise DataError("force and displacement must have the same length, found "
+                        f"{F.size} and {y.size}")
     if not (np.isfinite(F).all() and np.isfinite(y).all()):
         raise DataError("force or displacement contains NaN or inf")
     keep = np.abs(F) >= (min_force or 0.0)
     F, y = F[keep], y[keep]
     if F.size < 3 or np.ptp(F) <= 0:
         raise DataError(f"eq 15 needs at least 3 samples at different forces, found {F.size} "
-                        f"(spread {np.ptp(F) if F.size else 0:g} N)", hint="load the tip over a range of forces")
+                        f"(spread {np.ptp(F) if F.size else 0:g} N)", hint="load the tip over a "
+                                                                           "range of forces")
     M = np.column_stack([np.ones_like(F), -F])
     coef, *_ = np.linalg.lstsq(M, y, rcond=None)
     r = y - M @ coef
@@ -83,8 +86,10 @@ def identify_compliance(F, y, *, L_r: float | None = None, L_a: float | None = N
     cov = s2 * np.linalg.inv(M.T @ M)
     c, c_std = float(coef[1]), math.sqrt(cov[1, 1])
     if c <= 0:
-        raise IdentificationError(f"the tip moves with the force, not against it (compliance {c:g} m/N)",
-                                  hint="check the sign convention: F is the force pressing on the tip")
+        raise IdentificationError("the tip moves with the force, not against it "
+                                  f"(compliance {c:g} m/N)",
+                                  hint="check the sign convention: F is the force "
+                                       "pressing on the tip")
     s_p = s_p_std = None
     if L_r is not None and L_a is not None:
         af = lever_coefficients(L_r, L_a).alpha_f
@@ -98,7 +103,8 @@ def to_tip_a(values: dict, L_r: float, L_a: float, stds: dict | None = None) -> 
     lc = lever_coefficients(L_r, L_a)
     out, sd = {}, {}
     for k, v in values.items():
-        f = lc.alpha_u if k in ("d_p", "lambda", "lam") else (lc.alpha_f if k in ("compliance", "s_p") else 1.0)
+        f = (lc.alpha_u if k in ("d_p", "lambda",
+                                 "lam") else (lc.alpha_f if k in ("compliance", "s_p") else 1.0))
         out["s_p" if k == "compliance" else k] = v / f
         if stds and k in stds:
             sd["s_p" if k == "compliance" else k] = stds[k] / f
@@ -121,9 +127,11 @@ class FingerIdentification:
         return self.finger.parameters.table()
 
 
-def identify_finger(loops: Trajectory, step: Trajectory, compliance: Trajectory, vibration: Trajectory, *,
+def identify_finger(loops: Trajectory, step: Trajectory, compliance: Trajectory,
+                    vibration: Trajectory, *,
                     k_s: float, k_s_std: float = 0.0, L_r: float, L_s: float, L_a: float,
-                    dac_dt: float = 5e-5, sensitivity: float = 5e3, voltage: str = "U", displacement: str = "y_B",
+                    dac_dt: float = 5e-5, sensitivity: float = 5e3, voltage: str = "U",
+                    displacement: str = "y_B",
                     force: str = "F", progress: bool = False):
     """The identification procedure of §IV for one finger, from four records:
 
@@ -136,40 +144,53 @@ def identify_finger(loops: Trajectory, step: Trajectory, compliance: Trajectory,
     """
     bw = identify_bouc_wen(loops, voltage, displacement, progress=progress)
     dyn = identify_actuator_dynamics(step, bw, voltage, displacement, progress=progress)
-    bw = identify_bouc_wen(loops, voltage, displacement, delay=dyn.b + 0.5 * dac_dt, progress=progress,
+    bw = identify_bouc_wen(loops, voltage, displacement, delay=dyn.b + 0.5 * dac_dt,
+                           progress=progress,
                            initial=bw.params)
-    dyn = identify_actuator_dynamics(step, bw, voltage, displacement, progress=progress, initial=(dyn.a, dyn.b))
-    comp = identify_compliance(compliance[force], compliance[displacement], L_r=L_r, L_a=L_a, min_force=5e-6)
+    dyn = (identify_actuator_dynamics(step, bw, voltage, displacement, progress=progress,
+                                      initial=(dyn.a, dyn.b)))
+    comp = (identify_compliance(compliance[force], compliance[displacement], L_r=L_r, L_a=L_a,
+                                min_force=5e-6))
     vib = free_vibration(vibration[force], dt=vibration.dt)
-    sensor = sensor_parameters(vib.natural_frequency_hz, vib.damping_ratio, k_s=k_s, f0_std=vib.natural_frequency_std_hz,
+    sensor = sensor_parameters(vib.natural_frequency_hz, vib.damping_ratio, k_s=k_s,
+                               f0_std=vib.natural_frequency_std_hz,
                                zeta_std=vib.damping_ratio_std, known_std=k_s_std)
     at_a, sd_a = to_tip_a({"d_p": bw.params["d_p"], "lambda": bw.params["lambda"]}, L_r, L_a,
                           {"d_p": bw.std["d_p"], "lambda": bw.std["lambda"]})
     src = {"d_p": "identified: hysteresis loops (Fig. 9), converted to A with eq 14",
            "lam": "identified: hysteresis loops (Fig. 9), converted to A with eq 14",
-           "beta": "identified: hysteresis loops (Fig. 9)", "gamma": "identified: hysteresis loops (Fig. 9)",
+           "beta": "identified: hysteresis loops (Fig. 9)",
+           "gamma": "identified: hysteresis loops (Fig. 9)",
            "a": "identified: step response (Fig. 10), whole-finger model",
            "b": "identified: step response (Fig. 10), whole-finger model",
            "s_p": "identified: force-displacement at B (eq 15, Fig. 11)",
-           "m_s": "identified: free vibration (Fig. 8) and k_s", "b_s": "identified: free vibration (Fig. 8) and k_s",
+           "m_s": "identified: free vibration "
+                  "(Fig. 8) and k_s", "b_s": "identified: free vibration (Fig. 8) and k_s",
            "k_s": "given (sensor calibration)", "L_r": "given", "L_s": "given", "L_a": "given",
            "sensitivity": "given (nominal 200 µN/V, 001_0b92a7da96e7aa46.txt §IV-B)"}
-    params = finger_parameter_set(d_p=at_a["d_p"], s_p=comp.s_p, lam=at_a["lambda"], beta=bw.params["beta"],
-                                  gamma=bw.params["gamma"], a=dyn.a, b=dyn.b, m_s=sensor.value("m_s"),
+    params = finger_parameter_set(d_p=at_a["d_p"], s_p=comp.s_p, lam=at_a["lambda"],
+                                  beta=bw.params["beta"],
+                                  gamma=bw.params["gamma"], a=dyn.a, b=dyn.b,
+                                  m_s=sensor.value("m_s"),
                                   b_s=sensor.value("b_s"), k_s=k_s, L_r=L_r, L_s=L_s, L_a=L_a,
                                   sensitivity=sensitivity, sources=src, name="identified finger")
-    stds = {"d_p": sd_a["d_p"], "lam": sd_a["lambda"], "beta": bw.std["beta"], "gamma": bw.std["gamma"],
+    stds = {"d_p": sd_a["d_p"], "lam": sd_a["lambda"], "beta": bw.std["beta"],
+            "gamma": bw.std["gamma"],
             "a": dyn.a_std, "b": dyn.b_std, "s_p": comp.s_p_std, "m_s": sensor["m_s"].std,
             "b_s": sensor["b_s"].std, "k_s": k_s_std}
     # last: a, b again, now through the whole finger — the step at B also carries the sensor's
-    # inertia on the actuator (0.3 % on a with Table II), which the bare actuator model absorbs into a
+    # inertia on the actuator (0.3 % on a with Table II), which the bare actuator model absorbs
+    # into a
     whole = TSFMFinger(params, name="identified finger", check=False)
-    st = Trajectory(step.t, {"U": step[voltage], "F_g": np.zeros(step.n), "y_B": step[displacement]},
+    st = Trajectory(step.t, {"U": step[voltage], "F_g": np.zeros(step.n),
+                             "y_B": step[displacement]},
                     {"U": "V", "F_g": "N", "y_B": "m"}, {**step.meta, "dt": step.dt})
     ab = fit(whole, st, outputs=["y_B"], free=["a", "b"], progress=progress)
     dyn = DynamicsResult(ab.value("a"), ab.value("b"), ab.stdev("a"), ab.stdev("b"), ab)
     params = params.replace(a=dyn.a, b=dyn.b)
     stds.update(a=dyn.a_std, b=dyn.b_std)
-    params = ParameterSet([p if p.name not in stds else p.with_value(p.value, std=stds[p.name], source=p.source)
+    params = ParameterSet([p if p.name not in stds else p.with_value(p.value, std=stds[p.name],
+                                                                     source=p.source)
                            for p in params.values()], params.name)
-    return FingerIdentification(TSFMFinger(params, name="identified finger", check=False), bw, dyn, comp, vib, sensor)
+    return (FingerIdentification(TSFMFinger(params, name="identified finger", check=False), bw, dyn,
+                                 comp, vib, sensor))

@@ -67,7 +67,8 @@ class MicropartEstimate:
 
 
 def estimate_micropart(y1, F1, y2, F2, gap: float, *, threshold: float = 5e-6, window: int = 8,
-                       block: int = 20, min_force: float | None = None, instrument_lag: int = 0) -> MicropartEstimate:
+                       block: int = 20, min_force: float | None = None,
+                       instrument_lag: int = 0) -> MicropartEstimate:
     """Estimate a grasped part's location, width and stiffness (see the module docstring).
 
     Parameters
@@ -104,7 +105,8 @@ def estimate_micropart(y1, F1, y2, F2, gap: float, *, threshold: float = 5e-6, w
     c2, _ = ContactDetector(threshold, window=window).run(F2)
     if not c1.any() or not c2.any():
         which = "finger 1" if not c1.any() else "finger 2"
-        raise DataError(f"{which} never touches the part: its force never exceeds {threshold * 1e6:g} µN",
+        raise DataError(f"{which} never touches the part: its force never exceeds "
+                        f"{threshold * 1e6:g} µN",
                         hint="the record must include the contact of both fingers")
     i1, i2 = int(np.argmax(c1)), int(np.argmax(c2))
     y1c, y2c = float(y1[i1]), float(y2[i2])
@@ -117,7 +119,8 @@ def estimate_micropart(y1, F1, y2, F2, gap: float, *, threshold: float = 5e-6, w
     idx = np.flatnonzero(both & (Fm > fmin))
     nb = idx.size // block
     if nb < 3:
-        raise DataError(f"only {idx.size} samples squeeze the part with both fingers above {fmin * 1e6:g} µN; "
+        raise DataError(f"only {idx.size} samples squeeze the part with both fingers above "
+                        f"{fmin * 1e6:g} µN; "
                         f"need at least {3 * block}", hint="squeeze longer or harder")
     idx = idx[: nb * block].reshape(nb, block)
     Fb = Fm[idx].mean(axis=1)
@@ -130,10 +133,12 @@ def estimate_micropart(y1, F1, y2, F2, gap: float, *, threshold: float = 5e-6, w
         nb = Fb.size
     lag = int(instrument_lag)
     if lag < 0 or nb - lag < 3:
-        raise DataError(f"instrument_lag: expected 0 <= lag <= {max(nb - 3, 0)} (the loading line has {nb} blocks), "
+        raise DataError(f"instrument_lag: expected 0 <= lag <= {max(nb - 3, 0)} (the loading line "
+                        f"has {nb} blocks), "
                         f"found {instrument_lag!r}")
     if np.ptp(sb) <= 0:
-        raise IdentificationError("the fingers did not move while squeezing: δ is constant, eq 16 is undefined")
+        raise IdentificationError("the fingers did not move while squeezing: δ is constant, eq "
+                                  "16 is undefined")
     M = np.column_stack([sb[lag:], np.ones(nb - lag)])
     Fb = Fb[lag:]
     Z = np.column_stack([sb[: nb - lag], np.ones(nb - lag)])
@@ -156,4 +161,5 @@ def estimate_micropart(y1, F1, y2, F2, gap: float, *, threshold: float = 5e-6, w
     # faces from the refined contact sum, split as the threshold contacts split it
     shift = (s0 - (y1c + y2c)) / 2.0
     faces = (y1c + shift, gap - (y2c + shift))
-    return MicropartEstimate(width, s0_std, k, math.sqrt(cov[0, 0]), w_thr, k_ratio, faces, (y1c, y2c), (i1, i2), nb)
+    return (MicropartEstimate(width, s0_std, k, math.sqrt(cov[0, 0]), w_thr, k_ratio, faces,
+                              (y1c, y2c), (i1, i2), nb))

@@ -42,7 +42,8 @@ from .end_effector import sensor_parameters
 from .gripper import (RANGES, TSFMFinger, TSFMFingerContact, TSFMGripper, finger_coefficients,
                       finger_parameter_set, micropart_parameters)
 
-__all__ = ["TABLE_II", "REFERENCE", "ASSUMED_LENGTHS", "TABLE_III", "table_iii_findings", "left_finger",
+__all__ = ["TABLE_II", "REFERENCE", "ASSUMED_LENGTHS", "TABLE_III", "table_iii_findings",
+           "left_finger",
            "right_finger", "finger_contact", "FIG13_PART", "gripper", "table_ii", "finger",
            "hysteresis_experiment", "step_experiment", "compliance_experiment",
            "sensor_calibration_experiment", "free_vibration_experiment",
@@ -56,7 +57,8 @@ _T2 = f"{SEED}, Table II (p. 7)"
 TABLE_II = {
     "left": dict(d_p=0.77e-6, s_p=9.1e-4, lam=0.43e-6, beta=10.8e-2, gamma=7.5e-3, a=2.5e-8, b=8e-5,
                  m_s=1.8e-6, b_s=7e-4, k_s=128.0, sensitivity=6e-3 * 1e6),
-    "right": dict(d_p=0.78e-6, s_p=8.5e-4, lam=0.39e-6, beta=11.1e-2, gamma=3.5e-3, a=2.5e-8, b=8e-5,
+    "right": dict(d_p=0.78e-6, s_p=8.5e-4, lam=0.39e-6, beta=11.1e-2, gamma=3.5e-3, a=2.5e-8,
+                  b=8e-5,
                   m_s=1.79e-6, b_s=6.98e-4, k_s=130.8, sensitivity=5.1e-3 * 1e6),
 }
 
@@ -72,9 +74,11 @@ REFERENCE = {
 
 ASSUMED_LENGTHS = dict(L_r=7e-3, L_s=1e-3, L_a=15e-3)
 _LEN_SRC = {
-    "L_a": "assumed: 15 mm PZT bimorph (1/s_p = 1100 N/m of Table I fits a 15 × 2 × 0.5 mm bimorph); the seed gives none",
+    "L_a": "assumed: 15 mm PZT bimorph (1/s_p = 1100 N/m of Table I fits a 15 × 2 × 0.5 mm "
+           "bimorph); the seed gives none",
     "L_s": f"{SEED} §II: force sensor 1 mm long",
-    "L_r": "assumed: 7 mm socket, so that L = 8 mm puts tip C at 62.4 µm at 44 V (Fig. 13, §V-C: 62.42 µm)",
+    "L_r": "assumed: 7 mm socket, so that L = 8 mm puts tip C at 62.4 µm at 44 V (Fig. 13, "
+           "§V-C: 62.42 µm)",
 }
 
 _PART_ASSUMED = {
@@ -96,8 +100,10 @@ def table_iii_findings() -> list[Finding]:
     tolerance of 0.005/p. (The recomputed errors are 3.31, 2.00 and 5.00 %.)"""
     out = []
     for i, (meas, est, err) in enumerate(TABLE_III, 1):
-        out.append(compare(f"table-iii-error-{i}", "Table III", computed=abs(est - meas) / meas, stated=err,
-                           rtol=0.005 / err, what=f"micropart {i}: |{est:g} − {meas:g}|/{meas:g} (error printed in whole %)",
+        out.append(compare(f"table-iii-error-{i}", "Table III", computed=abs(est - meas) / meas,
+                           stated=err,
+                           rtol=0.005 / err, what=f"micropart {i}: |{est:g} − {meas:g}|/{meas:g} "
+                                                  "(error printed in whole %)",
                            used="Table III's measured and estimated stiffnesses as printed",
                            source=f"{SEED} Table III, micropart {i}"))
     return out
@@ -110,7 +116,8 @@ def table_ii(side: str = "left") -> ParameterSet:
     v = TABLE_II[side]
     sources = {n: f"{_T2}, {side} finger" for n in v}
     sources.update(_LEN_SRC)
-    return finger_parameter_set(**v, **ASSUMED_LENGTHS, sources=sources, name=f"tsfm-{side} (Table II)")
+    return (finger_parameter_set(**v, **ASSUMED_LENGTHS, sources=sources,
+                                 name=f"tsfm-{side} (Table II)"))
 
 
 def finger(side: str = "left", *, as_printed: bool = False, check: bool = True) -> TSFMFinger:
@@ -126,10 +133,12 @@ def finger(side: str = "left", *, as_printed: bool = False, check: bool = True) 
         params = ParameterSet([
             p if p.name not in ("m_s", "b_s") else p.with_value(
                 m if p.name == "m_s" else b,
-                source=f"derived: {'k_s/(2π f0)²' if p.name == 'm_s' else '2ζ√(k_s m_s)'} with f0 = 8520 Hz, "
+                source=f"derived: {'k_s/(2π f0)²' if p.name == 'm_s' else '2ζ√(k_s m_s)'} "
+                       "with f0 = 8520 Hz, "
                        f"ζ = 0.006 ({SEED} §IV-B); Table II prints {printed.value(p.name):g}")
             for p in printed.values()], f"tsfm-{side}")
-    return TSFMFinger(params, reference=REFERENCE, printed=printed, name=f"tsfm-{side}", check=check)
+    return (TSFMFinger(params, reference=REFERENCE, printed=printed, name=f"tsfm-{side}",
+                       check=check))
 
 
 def left_finger(*, as_printed: bool = False, check: bool = True) -> TSFMFinger:
@@ -314,8 +323,10 @@ def gripper(stiffness: float = 72.5, width: float = 300e-6, centre: float | None
     """Both fingers (finger 1 = left, finger 2 = right) and a micropart (default: 300 µm wide,
     Table III's 72.5 N/m, centred in the 400 µm gap)."""
     part = micropart_parameters(width, stiffness, centre=centre,
-                                source=f"{SEED} §V-C (400 µm gap, 300 µm part), Table III (stiffness)")
-    part = ParameterSet([p if p.name not in _PART_ASSUMED else dataclasses.replace(p, source=_PART_ASSUMED[p.name])
+                                source=f"{SEED} §V-C (400 µm gap, 300 µm part), Table "
+                                       "III (stiffness)")
+    part = ParameterSet([p if p.name not in _PART_ASSUMED
+                         else dataclasses.replace(p, source=_PART_ASSUMED[p.name])
                          for p in part.values()], part.name)
     g = _Gripper(finger("left", check=False), finger("right", check=False), part, check=check)
     g.name = "tsfm-gripper"
@@ -329,8 +340,10 @@ def _noise(rng, n, std):
     return std * rng.standard_normal(n) if std > 0 else np.zeros(n)
 
 
-def hysteresis_experiment(finger: TSFMFinger, amplitudes=(100.0, 60.0, 30.0), *, frequency: float = 0.1,
-                          dt: float = 5e-05, decimate: int = 10, noise: float = 20e-9, seed: int = 0) -> Trajectory:
+def hysteresis_experiment(finger: TSFMFinger, amplitudes=(100.0, 60.0, 30.0), *,
+                          frequency: float = 0.1,
+                          dt: float = 5e-05, decimate: int = 10, noise: float = 20e-9,
+                          seed: int = 0) -> Trajectory:
     """§IV-C1 / Fig. 9: sines of the given amplitudes (V) at ``frequency`` one after another, tip B
     measured by the laser (``noise`` m, 20 nm resolution) every ``dt`` s, kept every ``decimate``-th
     sample. Channels U (V), y_B (m), loop (index of the amplitude)."""
@@ -342,11 +355,14 @@ def hysteresis_experiment(finger: TSFMFinger, amplitudes=(100.0, 60.0, 30.0), *,
     k = slice(None, None, decimate)
     y = tr["y_B"][k]
     loop = np.repeat(np.arange(len(amplitudes), dtype=float), t.size)[k]
-    return Trajectory.uniform(dt=dt * decimate, U=U[k], y_B=y + _noise(rng, y.size, noise), loop=loop,
-                              units={"U": "V", "y_B": "m"}, meta={"source": "simulated Fig. 9 experiment"})
+    return Trajectory.uniform(dt=dt * decimate, U=U[k], y_B=y + _noise(rng, y.size, noise),
+                              loop=loop,
+                              units={"U": "V", "y_B": "m"},
+                              meta={"source": "simulated Fig. 9 experiment"})
 
 
-def step_experiment(finger: TSFMFinger, amplitude: float = 50.0, *, dt: float = 5e-05, duration: float = 0.02,
+def step_experiment(finger: TSFMFinger, amplitude: float = 50.0, *, dt: float = 5e-05,
+                    duration: float = 0.02,
                     delay: float = 1e-3, noise: float = 20e-9, seed: int = 1) -> Trajectory:
     """§IV-C2 / Fig. 10: a voltage step, tip B measured every ``dt`` s."""
     rate = 1.0 / dt
@@ -355,18 +371,22 @@ def step_experiment(finger: TSFMFinger, amplitude: float = 50.0, *, dt: float = 
     U = np.where(t >= delay, amplitude, 0.0)
     tr = finger.simulate({"U": U, "F_g": np.zeros(n)}, dt=dt)
     rng = np.random.default_rng(seed)
-    return Trajectory.uniform(dt=dt, U=U, y_B=tr["y_B"] + _noise(rng, n, noise), units={"U": "V", "y_B": "m"},
+    return Trajectory.uniform(dt=dt, U=U, y_B=tr["y_B"] + _noise(rng, n, noise),
+                              units={"U": "V", "y_B": "m"},
                               meta={"source": "simulated Fig. 10 experiment"})
 
 
-def compliance_experiment(finger: TSFMFinger, max_force: float = 1e-3, *, dt: float = 0.001, duration: float = 2.0,
-                          noise: float = 20e-9, force_noise: float = 0.4e-6, seed: int = 2) -> Trajectory:
+def compliance_experiment(finger: TSFMFinger, max_force: float = 1e-3, *, dt: float = 0.001,
+                          duration: float = 2.0,
+                          noise: float = 20e-9, force_noise: float = 0.4e-6,
+                          seed: int = 2) -> Trajectory:
     """§IV-C3 / Fig. 11: the FemtoTools probe (resolution 0.4 µN) pushes on the tip B with a slow
     force ramp, no voltage; the actuator (eq 4 with F_A = F, M_A = L_r F) responds dynamically,
     the laser (20 nm) reads y_B. Channels F (N, measured), y_B (m)."""
     rate = 1.0 / dt
     v = finger.values()
-    act = PiezoActuator(ParameterSet([finger.parameters[n] for n in ("d_p", "s_p", "lam", "beta", "gamma", "a", "b",
+    act = PiezoActuator(ParameterSet([finger.parameters[n] for n in ("d_p", "s_p", "lam", "beta",
+                                                                     "gamma", "a", "b",
                                                                      "L_a")]), check=False)
     n = int(round(duration * rate))
     F = max_force * np.clip(np.arange(n) / (0.8 * n), 0.0, 1.0)
@@ -377,15 +397,20 @@ def compliance_experiment(finger: TSFMFinger, max_force: float = 1e-3, *, dt: fl
     # y_B[k] biased s_p by +6e-4, +1.3σ, on the 1 ms samples of this ramp)
     F_now = np.concatenate([[0.0], F[:-1]])
     rng = np.random.default_rng(seed)
-    return Trajectory.uniform(dt=dt, F=F_now + _noise(rng, n, force_noise), y_B=yB + _noise(rng, n, noise),
-                              units={"F": "N", "y_B": "m"}, meta={"source": "simulated Fig. 11 experiment"})
+    return Trajectory.uniform(dt=dt, F=F_now + _noise(rng, n, force_noise),
+                              y_B=yB + _noise(rng, n, noise),
+                              units={"F": "N", "y_B": "m"},
+                              meta={"source": "simulated Fig. 11 experiment"})
 
 
-def sensor_calibration_experiment(finger: TSFMFinger, max_force: float = 1.5e-3, *, dt: float = 0.001,
-                                  duration: float = 2.0, stage_noise: float = 1e-9, force_noise: float = 0.4e-6,
+def sensor_calibration_experiment(finger: TSFMFinger, max_force: float = 1.5e-3, *,
+                                  dt: float = 0.001,
+                                  duration: float = 2.0, stage_noise: float = 1e-9,
+                                  force_noise: float = 0.4e-6,
                                   seed: int = 5) -> Trajectory:
     """§IV-A/B: the force sensor alone (before integration) is calibrated against the FemtoTools
-    reference sensor (resolution 0.4 µN) that the NanoCube stage (1 nm resolution) pushes on its tip:
+    reference sensor (resolution 0.4 µN) that the NanoCube stage (1 nm resolution) pushes on its
+    tip:
     a slow ramp to ``max_force``, quasi-static, so the tip deflects by x = F/k_s (eq 8 without
     motion). Channels F (N, reference reading) and x (m, stage position = tip deflection), each with
     its white noise. k_s follows from eq 15's straight-line fit with c = 1/k_s
@@ -395,8 +420,10 @@ def sensor_calibration_experiment(finger: TSFMFinger, max_force: float = 1.5e-3,
     n = int(round(duration * rate))
     F = max_force * np.clip(np.arange(n) / (0.8 * n), 0.0, 1.0)
     rng = np.random.default_rng(seed)
-    return Trajectory.uniform(dt=dt, F=F + _noise(rng, n, force_noise), x=F / k + _noise(rng, n, stage_noise),
-                              units={"F": "N", "x": "m"}, meta={"source": "simulated sensor calibration (§IV-A/B)"})
+    return Trajectory.uniform(dt=dt, F=F + _noise(rng, n, force_noise),
+                              x=F / k + _noise(rng, n, stage_noise),
+                              units={"F": "N", "x": "m"}, meta={"source": "simulated sensor "
+                                                                          "calibration (§IV-A/B)"})
 
 
 def free_vibration_experiment(finger: TSFMFinger, preload: float = 150e-6, *, dt: float = 5e-05,
@@ -427,7 +454,8 @@ def contact_voltage(finger: TSFMFinger, voltage: float = 44.0) -> float:
 
 
 def contact_experiment(finger: TSFMFinger, stiffness: float = 72.5, *, contact_at: float = 44.0,
-                       peak: float = 50.0, frequency: float = 0.1, dt: float = 5e-05, pull_off: float = 0.0,
+                       peak: float = 50.0, frequency: float = 0.1, dt: float = 5e-05,
+                       pull_off: float = 0.0,
                        noise: float = 2e-6, seed: int = 4) -> Trajectory:
     """§V-B / Fig. 13: U = peak (1 − cos 2π f t)/2 for one period; the part face placed where tip C
     is at ``contact_at`` V, so the contact starts there. Channels U, y_C (true), F_g (true contact
@@ -439,6 +467,8 @@ def contact_experiment(finger: TSFMFinger, stiffness: float = 72.5, *, contact_a
     U = 0.5 * peak * (1.0 - np.cos(2 * np.pi * frequency * t))
     tr = m.simulate(U, dt=dt)
     rng = np.random.default_rng(seed)
-    return Trajectory.uniform(dt=dt, U=U, y_C=tr["y_C"], F_g=tr["F_g"], F_meas=tr["F_m"] + _noise(rng, t.size, noise),
-                              contact=tr["contact"], units={"U": "V", "y_C": "m", "F_g": "N", "F_meas": "N"},
+    return Trajectory.uniform(dt=dt, U=U, y_C=tr["y_C"], F_g=tr["F_g"],
+                              F_meas=tr["F_m"] + _noise(rng, t.size, noise),
+                              contact=tr["contact"],
+                              units={"U": "V", "y_C": "m", "F_g": "N", "F_meas": "N"},
                               meta={"source": "simulated Fig. 13 experiment", "x_w": x_w})

@@ -33,7 +33,8 @@ from ...batch.sweep import sweep
 from ...errors import ConfigError, DataError
 from ...units import to_si
 
-__all__ = ["DEFAULT_POPULATION", "DEFAULT_SETTINGS", "RobustnessResult", "robustness_study", "analyse"]
+__all__ = (["DEFAULT_POPULATION", "DEFAULT_SETTINGS", "RobustnessResult", "robustness_study",
+            "analyse"])
 
 #: parts between the TSFM fingers (400 µm gap): stiffness over Table III's range and beyond,
 #: widths leaving 10-80 µm of travel, off-centre by up to 10 µm, contact timing through the
@@ -45,7 +46,8 @@ DEFAULT_POPULATION = {
     "approach_speed": {"uniform": ["1 mm/s", "2 mm/s"]},
     "noise_std": {"uniform": ["0.5 uN", "3 uN"]},
 }
-#: the controller (:data:`gripkit.systems.tsfm.grasp_batch.FAST_GRASP`, 200 µN) and the pass criteria
+# : the controller (:data:`gripkit.systems.tsfm.grasp_batch.FAST_GRASP`, 200 µN) and the pass
+# criteria
 DEFAULT_SETTINGS = {"duration": 0.15, "grip_force": "200 uN", "damage_force": "250 uN",
                     "lost_displacement": "10 um", "band": 0.05}
 
@@ -76,10 +78,14 @@ class RobustnessResult:
         def est(e):
             return None if e is None else {"value": e.value, "low": e.low, "high": e.high, "n": e.n}
 
-        return {"n": self.n, "n_failed": self.n_failed, "p_damage": est(self.p_damage), "p_lost": est(self.p_lost),
-                "p_not_settled": est(self.p_not_settled), "settling_median_s": est(self.settling_median),
-                "settling_q90_s": est(self.settling_q90), "peak_force_median_N": est(self.peak_median),
-                "damage_vs_stiffness": self.damage_vs_stiffness, "lost_vs_stiffness": self.lost_vs_stiffness,
+        return {"n": self.n, "n_failed": self.n_failed, "p_damage": est(self.p_damage),
+                "p_lost": est(self.p_lost),
+                "p_not_settled": est(self.p_not_settled),
+                "settling_median_s": est(self.settling_median),
+                "settling_q90_s": est(self.settling_q90),
+                "peak_force_median_N": est(self.peak_median),
+                "damage_vs_stiffness": self.damage_vs_stiffness,
+                "lost_vs_stiffness": self.lost_vs_stiffness,
                 "seconds": self.seconds, "backend": self.backend}
 
     def report(self, report, title: str = "Monte Carlo grasp robustness", intro: str = "",
@@ -97,7 +103,8 @@ class RobustnessResult:
                  ["settling time, median", _fmt_t(self.settling_median)],
                  ["settling time, 90 % quantile", _fmt_t(self.settling_q90)],
                  ["peak contact force, median", f"{self.peak_median.value * 1e6:.1f} µN "
-                                                f"[{self.peak_median.low * 1e6:.1f}, {self.peak_median.high * 1e6:.1f}]"]]
+                                                f"[{self.peak_median.low * 1e6:.1f}, "
+                                                f"{self.peak_median.high * 1e6:.1f}]"]]
         sec.table(["quantity", f"estimate [{100 * self.p_damage.confidence:.0f} % CI]"], rows,
                   caption=f"{self.n} grasps ({self.n_failed} failed jobs excluded)")
         c = self.columns
@@ -106,7 +113,8 @@ class RobustnessResult:
         peak = c["peak_force"][ok] * 1e6
         ax[0].hist(peak, bins=40, color="C0", alpha=0.8)
         if self.damage_force is not None:
-            ax[0].axvline(self.damage_force * 1e6, color="C3", label=f"damage ({self.damage_force * 1e6:.0f} µN)")
+            ax[0].axvline(self.damage_force * 1e6, color="C3",
+                          label=f"damage ({self.damage_force * 1e6:.0f} µN)")
             ax[0].legend()
         ax[0].set_xlabel("peak contact force (µN)")
         ax[0].set_ylabel("grasps")
@@ -114,12 +122,15 @@ class RobustnessResult:
         fin = st[np.isfinite(st)] * 1e3
         ax[1].hist(fin, bins=40, color="C2", alpha=0.8,
                    label=f"settled ({fin.size}); never: {int(np.isinf(st).sum())}")
-        for e, label, ls in ((self.settling_median, "median", "-"), (self.settling_q90, "90 %", "--")):
+        for e, label, ls in ((self.settling_median, "median", "-"),
+                             (self.settling_q90, "90 %", "--")):
             if math.isfinite(e.value):
-                ax[1].axvline(e.value * 1e3, color="k", ls=ls, label=f"{label} {e.value * 1e3:.1f} ms")
+                ax[1].axvline(e.value * 1e3, color="k", ls=ls,
+                              label=f"{label} {e.value * 1e3:.1f} ms")
         ax[1].set_xlabel("settling time of the grip force (ms)")
         ax[1].legend(fontsize=8)
-        for rows_, label, col in ((self.damage_vs_stiffness, "P(damage)", "C3"), (self.lost_vs_stiffness, "P(lost)", "C1")):
+        for rows_, label, col in ((self.damage_vs_stiffness, "P(damage)", "C3"),
+                                  (self.lost_vs_stiffness, "P(lost)", "C1")):
             if not rows_:
                 continue
             x = np.array([math.sqrt(r["low"] * r["high"]) for r in rows_])
@@ -127,7 +138,8 @@ class RobustnessResult:
             lo = np.array([r["p_low"] for r in rows_])
             hi = np.array([r["p_high"] for r in rows_])
             ax[2].fill_between(x, lo, hi, color=col, alpha=0.2)
-            ax[2].plot(x, p, "o-", color=col, label=f"{label} ({100 * self.p_damage.confidence:.0f} % band)")
+            ax[2].plot(x, p, "o-", color=col,
+                       label=f"{label} ({100 * self.p_damage.confidence:.0f} % band)")
         ax[2].set_xscale("log")
         from matplotlib.ticker import NullFormatter
 
@@ -137,7 +149,8 @@ class RobustnessResult:
         ax[2].set_ylabel("probability")
         ax[2].legend(fontsize=8)
         fig.tight_layout()
-        sec.figure(fig, "Peak contact force and settling time over the population; probabilities against the "
+        sec.figure(fig, "Peak contact force and settling time over the population; "
+                        "probabilities against the "
                         "object's stiffness (Wilson intervals per bin)", name=name)
         return sec
 
@@ -161,12 +174,14 @@ def _ok(c: dict) -> np.ndarray:
     return ok & np.isfinite(c["peak_force"])
 
 
-def analyse(columns: dict | str | Path, *, stiffness: str | None = None, bins=None, confidence: float = 0.95,
+def analyse(columns: dict | str | Path, *, stiffness: str | None = None, bins=None,
+            confidence: float = 0.95,
             damage_force: float | None = None) -> RobustnessResult:
     """Robustness statistics from a sweep's table (a dict of columns, a :class:`SweepResult`, or
     the output folder of ``gripkit sweep``). Needs the metrics ``damage``, ``peak_force`` and
     ``settling_time``; ``lost`` when present. ``stiffness``: the column to bin by (default
-    ``k_e``, or ``k0`` for the FT-G100); ``bins``: edges (default 6 log-spaced bins over its range)."""
+    ``k_e``, or ``k0`` for the FT-G100); ``bins``: edges (default 6 log-spaced bins over its
+    range)."""
     if isinstance(columns, (str, Path)):
         columns = ResultStore(columns).read()
     elif hasattr(columns, "columns") and not isinstance(columns, dict):
@@ -186,11 +201,13 @@ def analyse(columns: dict | str | Path, *, stiffness: str | None = None, bins=No
     res_bins: tuple[list, list] = ([], [])
     if stiffness is not None:
         if stiffness not in c:
-            raise DataError(f"robustness analysis: no column {stiffness!r}", hint=f"columns: {', '.join(c)}")
+            raise DataError("robustness analysis: no "
+                            f"column {stiffness!r}", hint=f"columns: {', '.join(c)}")
         k = c[stiffness][ok].astype(float)
         if bins is None:
             lo, hi = float(k.min()), float(k.max())
-            bins = np.geomspace(lo, hi * (1 + 1e-12), 7) if lo > 0 and hi > lo else np.array([lo, hi + 1.0])
+            bins = (np.geomspace(lo, hi * (1 + 1e-12),
+                                 7) if lo > 0 and hi > lo else np.array([lo, hi + 1.0]))
         res_bins = (binned_probability(k, c["damage"][ok], bins, confidence),
                     binned_probability(k, c["lost"][ok], bins, confidence) if "lost" in c else [])
     return RobustnessResult(
@@ -205,24 +222,30 @@ def analyse(columns: dict | str | Path, *, stiffness: str | None = None, bins=No
 
 @entry_point
 def robustness_study(population: dict | None = None, *, settings: dict | None = None, n: int = 600,
-                     seed: int = 1, model: str | None = "tsfm-gripper", scenario: str = "tsfm-grasp",
-                     backend: str = "in-process", workers: int | None = None, scheduler: str | None = None,
+                     seed: int = 1, model: str | None = "tsfm-gripper",
+                     scenario: str = "tsfm-grasp",
+                     backend: str = "in-process", workers: int | None = None,
+                     scheduler: str | None = None,
                      out=None, resume: bool = False, bins=None, confidence: float = 0.95,
                      progress: bool = True, name: str = "grasp-robustness",
                      allow_code: bool = False) -> RobustnessResult:
     """Run ``n`` grasps of ``scenario`` on ``model`` for objects drawn from ``population`` (sweep
     ``[parameters]`` entries; default :data:`DEFAULT_POPULATION`) with the controller and pass
     criteria ``settings`` (the sweep's ``[scenario]`` table; default :data:`DEFAULT_SETTINGS`), and
-    analyse them (:func:`analyse`). ``backend``, ``allow_code`` etc. as in :func:`gripkit.batch.sweep`."""
+    analyse them (:func:`analyse`). ``backend``, ``allow_code`` etc. as in
+    :func:`gripkit.batch.sweep`."""
     if n < 1:
         raise ConfigError(f"n: expected a positive number of grasps, found {n}")
     pop = dict(DEFAULT_POPULATION if population is None else population)
-    sett = dict(DEFAULT_SETTINGS if settings is None and scenario == "tsfm-grasp" else (settings or {}))
-    spec = SweepSpec.from_dict({"sweep": {"name": name, "scenario": scenario, "model": model, "samples": int(n),
+    sett = (dict(DEFAULT_SETTINGS if settings is None and scenario == "tsfm-grasp"
+                 else (settings or {})))
+    spec = SweepSpec.from_dict({"sweep": {"name": name, "scenario": scenario, "model": model,
+                                          "samples": int(n),
                                           "seed": int(seed)},
                                 "parameters": pop, "scenario": sett})
     if len(spec.jobs()["job_id"]) != n:
-        raise ConfigError("population: use random draws (uniform, normal, loguniform) only: grids would multiply n")
+        raise ConfigError("population: use random draws (uniform, normal, loguniform) only: grids "
+                          "would multiply n")
     res = sweep(spec, backend=backend, workers=workers, scheduler=scheduler, out=out, resume=resume,
                 progress=progress, allow_code=allow_code)
     dmg = sett.get("damage_force", sett.get("damage_threshold"))

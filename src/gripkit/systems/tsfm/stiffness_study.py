@@ -15,7 +15,8 @@ the parts):
 2. **§V-D: grasp each part** of Table III (k_e = the "Measured" stiffness; 300 µm wide like the part
    of §V-C, 30 µm off-centre, squeezed to 200 µN — the seed gives neither width nor force for these
    parts) in closed loop on the true gripper, the controller's tip estimates coming from the
-   *identified* fingers (:func:`.grasp.simulate_two_finger_grasp`), 2 µN force noise per sensor (§V-C).
+   *identified* fingers (:func:`.grasp.simulate_two_finger_grasp`), 2 µN force noise per sensor
+   (§V-C).
 3. **Eq 16** from the record: the tips re-estimated offline by eq 11 with the identified fingers
    (:class:`.tip_position.TipPositionEstimator`), then k̂ = F_g/δ as the slope of the loading line
    (:func:`.micropart.estimate_micropart`).
@@ -64,23 +65,30 @@ from .end_effector import lever_coefficients
 from .grasp import GraspSettings, TwoFingerGraspResult, simulate_two_finger_grasp
 from .identification import FingerIdentification, identify_compliance, identify_finger
 from .micropart import MicropartEstimate, estimate_micropart
-from .parameters import (ASSUMED_LENGTHS, SEED, TABLE_III, compliance_experiment, finger, free_vibration_experiment,
-                         gripper, hysteresis_experiment, sensor_calibration_experiment, step_experiment,
+from .parameters import (ASSUMED_LENGTHS, SEED, TABLE_III, compliance_experiment, finger,
+                         free_vibration_experiment,
+                         gripper, hysteresis_experiment, sensor_calibration_experiment,
+                         step_experiment,
                          table_iii_findings)
 from .tip_position import TipPositionEstimator
 
-__all__ = ["MEASUREMENT_NOISE", "FORCE_CUTOFF_HZ", "BLOCK", "INSTRUMENT_LAG", "StiffnessComparison", "TableIIIStudy",
+__all__ = ["MEASUREMENT_NOISE", "FORCE_CUTOFF_HZ", "BLOCK", "INSTRUMENT_LAG", "StiffnessComparison",
+           "TableIIIStudy",
            "identify_fingers", "table_iii_study"]
 
 #: white measurement noise of the simulated experiments (standard deviations, SI), with sources
 MEASUREMENT_NOISE = {
-    "laser_m": (20e-9, f"{SEED} §IV-A: Keyence laser sensors, 20 nm resolution (tips B, Figs 9, 10, 11)"),
-    "reference_force_N": (0.4e-6, f"{SEED} §IV-A: FemtoTools FT-S270 reference sensor, 0.4 µN resolution"),
+    "laser_m": (20e-9, f"{SEED} §IV-A: Keyence laser sensors, 20 nm resolution (tips B, "
+                       "Figs 9, 10, 11)"),
+    "reference_force_N": (0.4e-6, f"{SEED} §IV-A: FemtoTools FT-S270 reference sensor, "
+                                  "0.4 µN resolution"),
     "stage_m": (1e-9, f"{SEED} §IV-A: P-611.3 NanoCube stage, 1 nm resolution"),
-    "vibration_relative": (0.01, "assumed: 1 % of the 150 µN preload on the free-vibration record (Fig. 8)"),
+    "vibration_relative": (0.01, "assumed: 1 % of the 150 µN preload on the free-vibration "
+                                 "record (Fig. 8)"),
     "sensor_force_N": (2e-6, f"{SEED} §V-C: integrated force sensors, noise below 2 µN"),
 }
-#: low-pass (Hz) of the force fed to eq 11 when the tips are re-estimated offline (see the module docstring)
+# : low-pass (Hz) of the force fed to eq 11 when the tips are re-estimated offline (see the module
+# docstring)
 FORCE_CUTOFF_HZ = 100.0
 #: samples per point of the loading line (10 ms at 20 kHz)
 BLOCK = 200
@@ -138,7 +146,8 @@ class StiffnessComparison:
     def to_dict(self) -> dict:
         return {"part": self.part, "true": self.true, "seed_estimate": self.seed_estimate,
                 "seed_error_printed": self.seed_error_printed, "seed_error": self.seed_error,
-                "estimate": self.estimate, "std": self.std, "std_noise": self.std_noise, "std_model": self.std_model,
+                "estimate": self.estimate, "std": self.std, "std_noise": self.std_noise,
+                "std_model": self.std_model,
                 "error": self.error, "z": self.z, "k_s_sensitivity": self.k_s_sensitivity,
                 "k_s_error_for_seed_error": self.k_s_error_for_seed_error,
                 "width": self.estimate_detail.width, "width_std": self.estimate_detail.width_std}
@@ -167,9 +176,11 @@ class TableIIIStudy:
                 "identified": {side: ident.table() for side, ident in self.identified.items()}}
 
 
-def identify_fingers(*, seed: int = 0, noise: dict = MEASUREMENT_NOISE, progress: bool = False) -> dict:
+def identify_fingers(*, seed: int = 0, noise: dict = MEASUREMENT_NOISE,
+                     progress: bool = False) -> dict:
     """Step 1: both fingers of Table II identified as in §IV from simulated records (module
-    docstring); returns ``{'left': FingerIdentification, 'right': ...}``. ``seed`` draws the noise."""
+    docstring); returns ``{'left': FingerIdentification, 'right': ...}``. ``seed`` draws the
+    noise."""
     out = {}
     for i, side in enumerate(("left", "right")):
         f = finger(side, check=False)
@@ -180,10 +191,12 @@ def identify_fingers(*, seed: int = 0, noise: dict = MEASUREMENT_NOISE, progress
         k_s, k_s_std = 1.0 / c.compliance, c.compliance_std / c.compliance**2
         loops = hysteresis_experiment(f, (100.0,), noise=noise["laser_m"][0], seed=s + 1)
         step = step_experiment(f, noise=noise["laser_m"][0], seed=s + 2)
-        comp = compliance_experiment(f, noise=noise["laser_m"][0], force_noise=noise["reference_force_N"][0],
+        comp = compliance_experiment(f, noise=noise["laser_m"][0],
+                                     force_noise=noise["reference_force_N"][0],
                                      seed=s + 3)
         vib = free_vibration_experiment(f, noise=noise["vibration_relative"][0], seed=s + 4)
-        out[side] = identify_finger(loops, step, comp, vib, k_s=k_s, k_s_std=k_s_std, **ASSUMED_LENGTHS,
+        out[side] = identify_finger(loops, step, comp, vib, k_s=k_s, k_s_std=k_s_std,
+                                    **ASSUMED_LENGTHS,
                                     progress=progress)
     return out
 
@@ -221,7 +234,8 @@ def _estimate(record, values: tuple[dict, dict], gap: float) -> MicropartEstimat
                               instrument_lag=INSTRUMENT_LAG)
 
 
-def _compare(part: int, row: tuple, grasp: TwoFingerGraspResult, ident: dict, gap: float) -> StiffnessComparison:
+def _compare(part: int, row: tuple, grasp: TwoFingerGraspResult, ident: dict,
+             gap: float) -> StiffnessComparison:
     true, seed_est, seed_err = row
     base = (ident["left"].finger.values(), ident["right"].finger.values())
     est = _estimate(grasp.trajectory, base, gap)
@@ -242,7 +256,8 @@ def _compare(part: int, row: tuple, grasp: TwoFingerGraspResult, ident: dict, ga
         grads.append(grad[_PROPAGATED.index("k_s")] * base[j]["k_s"])
     sens = sum(grads) / est.stiffness
     std = math.hypot(est.stiffness_std, math.sqrt(var_model))
-    return StiffnessComparison(part, true, seed_est, seed_err, est.stiffness, std, est.stiffness_std,
+    return StiffnessComparison(part, true, seed_est, seed_err, est.stiffness, std,
+                               est.stiffness_std,
                                math.sqrt(var_model), sens, est)
 
 
@@ -258,7 +273,8 @@ def table_iii_study(*, seed: int = 0, identified: dict | None = None, duration: 
     seed
         Draws every noise record (identification and grasps); one seed, one repetition.
     identified
-        ``{'left': FingerIdentification, 'right': ...}`` to reuse (default: :func:`identify_fingers`).
+        ``{'left': FingerIdentification, 'right': ...}`` to reuse (default:
+        :func:`identify_fingers`).
     duration
         Seconds of each grasp at 20 kHz (approach, hold, squeeze; 3 s covers all three parts).
     grip_force
@@ -273,19 +289,25 @@ def table_iii_study(*, seed: int = 0, identified: dict | None = None, duration: 
     """
     missing = sorted(set(MEASUREMENT_NOISE) - set(noise))
     if missing:
-        raise DataError(f"noise: entries {missing} missing", hint=f"give all of {sorted(MEASUREMENT_NOISE)}")
+        raise DataError(f"noise: entries {missing} missing",
+                        hint=f"give all of {sorted(MEASUREMENT_NOISE)}")
     if not (np.isfinite(duration) and duration > 0 and np.isfinite(grip_force) and grip_force > 0):
-        raise DataError(f"duration and grip_force: expected positive numbers, found {duration!r} s, {grip_force!r} N")
-    ident = identify_fingers(seed=seed, noise=noise, progress=progress) if identified is None else identified
+        raise DataError(f"duration and grip_force: expected positive numbers, found {duration!r} "
+                        f"s, {grip_force!r} N")
+    ident = (identify_fingers(seed=seed, noise=noise,
+                              progress=progress) if identified is None else identified)
     if set(ident) != {"left", "right"}:
         raise DataError(f"identified: expected the keys 'left' and 'right', found {sorted(ident)}")
     fingers = (ident["left"].finger, ident["right"].finger)
     settings = GraspSettings(grip_force=grip_force, approach_speed=60e-6)
     rows, grasps = [], {}
-    for part, row in track(list(enumerate(TABLE_III, 1)), description="Table III parts", enabled=progress):
+    for part, row in track(list(enumerate(TABLE_III, 1)), description="Table III parts",
+                           enabled=progress):
         g = gripper(stiffness=row[0], width=_PART_WIDTH, centre=_PART_CENTRE, check=False)
-        gr = simulate_two_finger_grasp(g, estimator_fingers=fingers, settings=settings, duration=duration,
-                                       noise_std=noise["sensor_force_N"][0], seed=1000 * seed + part)
+        gr = simulate_two_finger_grasp(g, estimator_fingers=fingers, settings=settings,
+                                       duration=duration,
+                                       noise_std=noise["sensor_force_N"][0],
+                                       seed=1000 * seed + part)
         if gr.estimate is None:
             raise DataError(f"part {part} ({row[0]:g} N/m) was not grasped within {duration:g} s",
                             hint="give a longer duration")

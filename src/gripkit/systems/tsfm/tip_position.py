@@ -6,7 +6,8 @@
 The TSFM has no position sensor: the model itself, driven by the applied voltage and by the force
 the integrated sensor measures, is the estimator. :class:`TipPositionEstimator` runs it one sample
 at a time — exact Bouc-Wen update, then the minimal 4-state realisation of eq 11
-(:func:`gripkit.systems.tsfm.gripper.finger_minimal_state_space`) discretised exactly (ZOH) at the loop's
+(:func:`gripkit.systems.tsfm.gripper.finger_minimal_state_space`) discretised exactly (ZOH) at the
+loop's
 sample time — in a numba step (:func:`estimator_step`) that a control loop can call at 20 kHz
 (its cost per call, from Python and inside a numba loop: docs/performance.md).
 
@@ -112,16 +113,19 @@ class TipPositionEstimator:
         return float(self._a["cy"] @ self.state[2:])
 
     def update(self, U: float, F: float) -> float:
-        """Estimate y_C (m) now; then take U (V) and the measured force F (N) for the next sample."""
+        """Estimate y_C (m) now; then take U (V) and the measured force F (N) for the next
+        sample."""
         a = self._a
-        return estimator_step(self.state, a["bw"], a["Phi"], a["Gam"], a["cy"], float(U), float(F), self._xt)
+        return (estimator_step(self.state, a["bw"], a["Phi"], a["Gam"], a["cy"], float(U), float(F),
+                               self._xt))
 
     def run(self, U, F) -> np.ndarray:
         """Estimates for whole records U (V) and F (N) (continuing from the current state)."""
         U = np.ascontiguousarray(U, dtype=np.float64)
         F = np.ascontiguousarray(F, dtype=np.float64)
         if U.shape != F.shape or U.ndim != 1:
-            raise DataError(f"U and F: expected two 1-D records of the same length, found {U.shape} and {F.shape}")
+            raise DataError("U and F: expected two 1-D records of the same length, found "
+                            f"{U.shape} and {F.shape}")
         if not (np.isfinite(U).all() and np.isfinite(F).all()):
             raise DataError("U or F contains NaN or inf")
         out = np.empty(U.size)
