@@ -34,9 +34,11 @@ demo: install
 	$(VENV)/bin/gripkit demo --out report
 
 test: install
+	$(PY) -m ruff check src tests benchmarks examples scripts
 	$(PY) -m pytest -n $(JOBS)
 
 test-all: install
+	$(PY) -m ruff check src tests benchmarks examples scripts
 	$(PY) -m pytest -n $(JOBS) -m ""
 
 bench: install
