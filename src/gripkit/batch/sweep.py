@@ -217,6 +217,50 @@ def _in_flight(executor: Executor | None, backend: str, workers: int | None,
     return 1 if backend == "in-process" else int(workers or os.cpu_count() or 1)
 
 
+def _checked_spec(spec: SweepSpec | dict | str | Path, *, backend: str, workers: int | None,
+                  scheduler: str | None, out: str | Path | None, resume: bool,
+                  executor: Executor | None) -> SweepSpec:
+    """The first step of :func:`sweep`: the description as a :class:`SweepSpec` (read from a
+    dict or a TOML file), after checking the arguments that need no scenario: ``resume`` needs
+    ``out``, ``backend`` is one of the four names, ``workers`` a positive integer (ConfigError)."""
+    if not isinstance(spec, SweepSpec):
+        spec = SweepSpec.from_dict(spec) if isinstance(spec, dict) else SweepSpec.from_toml(spec)
+    if resume and out is None:
+        raise ConfigError("resume needs the output folder of the interrupted sweep (out=...)")
+    if executor is None and not scheduler and backend not in ("auto", "in-process", "process",
+                                                              "dask"):
+        raise ConfigError("backend: expected 'auto', 'in-process', 'process' or 'dask', "
+                          f"found {backend!r}")
+    if workers is not None and (isinstance(workers,
+                                           bool) or not isinstance(workers, int) or workers < 1):
+        raise ConfigError(f"workers: expected a positive number, found {workers!r}")
+    return spec
+
+
+def _run_tasks(ex: Executor, own: bool, tasks: list, jobs: dict, store: ResultStore | None,
+               mem: dict[int, dict], chunk_size: int, n_jobs: int, name: str,
+               progress: bool) -> None:
+    """The running step of :func:`sweep`: run the chunks' ``tasks`` on ``ex`` and put each
+    chunk's results in ``store`` (or, without one, in ``mem`` by chunk number); a chunk whose task
+    failed as a whole records its error for each of its jobs. Closes ``ex`` at the end if
+    ``own``."""
+    try:
+        for c, ok, value in track(ex.map_unordered(tasks), total=len(tasks),
+                                  description=f"{name} ({ex.name}, {chunk_size} jobs/chunk)",
+                                  enabled=progress):
+            if not ok:
+                r = chunk_range(c, chunk_size, n_jobs)
+                value = ({"job_id": jobs["job_id"][r.start:r.stop],
+                          "error": np.full(len(r), value, dtype=object)})
+            if store is not None:
+                store.write_chunk(c, value)
+            else:
+                mem[c] = value
+    finally:
+        if own:
+            ex.close()
+
+
 @entry_point
 def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "auto", workers: int | None = None,
           scheduler: str | None = None, out: str | Path | None = None, resume: bool = False,
@@ -233,17 +277,8 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "auto", workers
     files you trust as you would a script. ``memory_limit``: bytes (or ``"8 GB"``) the sweep may
     use; default half the memory available. A sweep that would not fit is refused up front with
     the estimate. Jobs that fail are recorded (``result.failures``), not raised."""
-    if not isinstance(spec, SweepSpec):
-        spec = SweepSpec.from_dict(spec) if isinstance(spec, dict) else SweepSpec.from_toml(spec)
-    if resume and out is None:
-        raise ConfigError("resume needs the output folder of the interrupted sweep (out=...)")
-    if executor is None and not scheduler and backend not in ("auto", "in-process", "process",
-                                                              "dask"):
-        raise ConfigError("backend: expected 'auto', 'in-process', 'process' or 'dask', "
-                          f"found {backend!r}")
-    if workers is not None and (isinstance(workers,
-                                           bool) or not isinstance(workers, int) or workers < 1):
-        raise ConfigError(f"workers: expected a positive number, found {workers!r}")
+    spec = _checked_spec(spec, backend=backend, workers=workers, scheduler=scheduler, out=out,
+                         resume=resume, executor=executor)
     prep = prepare(spec, allow_code)
     n_jobs = spec.n_jobs()
     limit, limit_text = _memory_limit(memory_limit)
@@ -286,7 +321,7 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "auto", workers
     record["sweep"]["chunk_size"] = chunk_size
     n_chunks = math.ceil(n_jobs / chunk_size)
     done: set[int] = set()
-    mem: dict[int, dict] = {}
+    mem: dict[int, dict] = {}  # the chunks' results when there is no store
     own = executor is None
     # the executor first: a scheduler that cannot be reached leaves the output folder untouched
     ex = executor or make_executor(backend, workers, scheduler)
@@ -306,21 +341,7 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "auto", workers
     t0 = time.perf_counter()
     if done:
         status(f"resuming {spec.name}: {len(done)} of {n_chunks} chunks already on disk")
-    try:
-        for c, ok, value in track(ex.map_unordered(tasks), total=len(tasks),
-                                  description=f"{spec.name} ({ex.name}, {chunk_size} jobs/chunk)",
-                                  enabled=progress):
-            if not ok:
-                r = chunk_range(c, chunk_size, n_jobs)
-                value = ({"job_id": jobs["job_id"][r.start:r.stop],
-                          "error": np.full(len(r), value, dtype=object)})
-            if store is not None:
-                store.write_chunk(c, value)
-            else:
-                mem[c] = value
-    finally:
-        if own:
-            ex.close()
+    _run_tasks(ex, own, tasks, jobs, store, mem, chunk_size, n_jobs, spec.name, progress)
     seconds = time.perf_counter() - t0
     parts = (store.read_parts(chunk_size, n_jobs,
                               spec.metrics) if store is not None else mem.values())

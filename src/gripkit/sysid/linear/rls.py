@@ -351,18 +351,16 @@ def _rls_run(s, u, y, theta_out, std_out, yhat_out, err_out, size):
     compiles (and caches) one kernel per model structure, with unrolled p-loops and constant
     regressor indices (faster: docs/performance.md, "RLS"); :meth:`RLS.run` uses it for records of
     at least :data:`SPECIALISE_ABOVE` samples, where the extra compilation (once) pays off. The
-    first
-    ``t0`` samples go through :func:`_rls_step` (their regressors need the buffered past); the rest
-    take the regressor straight from ``u`` and ``y`` with θ and P in local arrays. Both call
-    :func:`_core`, so streaming and batch results are bit-identical.
+    first ``t0`` samples go through :func:`_rls_step` (their regressors need the buffered past);
+    the rest take the regressor straight from ``u`` and ``y`` with θ and P in local arrays. Both
+    call :func:`_core`, so streaming and batch results are bit-identical.
     """
     n = u.shape[0]
     if len(size[0]) > 0:  # the orders are known to the compiler: constant regressor indices
         na, nb, nk = len(size[1]), len(size[2]), len(size[3])
     else:
         na, nb, nk = int(s[_NA]), int(s[_NB]), int(s[_NK])
-    p = na + nb
-    nu = nk + nb
+    p, nu = na + nb, nk + nb
     oth = _HDR + na + nu
     op = oth + p
     store = theta_out.shape[0] == n
@@ -389,14 +387,8 @@ def _rls_run(s, u, y, theta_out, std_out, yhat_out, err_out, size):
         w[bth + i] = s[oth + i]
     for i in range(p * p):
         w[bP + i] = s[op + i]
-    lam = s[_LAM]
-    mode = int(s[_MODE])
-    maxtr = s[_MAXTR]
-    trace = s[_TRACE]
-    V = s[_V]
-    w1 = s[_W1]
-    w2 = s[_W2]
-    nupd = s[_NUPD]
+    lam, mode, maxtr, trace = s[_LAM], int(s[_MODE]), s[_MAXTR], s[_TRACE]
+    V, w1, w2, nupd = s[_V], s[_W1], s[_W2], s[_NUPD]
     f = np.nan
     for t in range(nstart, n):
         for i in range(na):

@@ -69,9 +69,9 @@ def _pc(k):
             3: (6.1007977e-03, -8.3348211e-04, 1.7728256e-03)}[k]
 
 
-def thesis_finger_parameters(**overrides) -> ParameterSet:
-    """The finger's parameters (every name of :data:`FINGER_PARAMETERS`) with provenance;
-    ``overrides`` replace values (SI, or strings with units)."""
+def _link_parameters() -> list[Parameter]:
+    """The phalanges' lengths, masses, centres of mass and inertias (Appendix F), in
+    :data:`FINGER_PARAMETERS` order."""
     F = f"{SEED}, Appendix F"
     masses = (4.4370598e-02, 2.7110192e-02, 1.8179709e-02)
     ps = [
@@ -106,7 +106,13 @@ def thesis_finger_parameters(**overrides) -> ParameterSet:
                Parameter(f"I{k + 1}_zz", I, "kg*m^2", f"phalanx {k + 1} inertia "
                                                       "⟂ axis, z (COM)", bounds=(0, None),
                                                       source=src)]
-    ps += [
+    return ps
+
+
+def _drive_parameters() -> list[Parameter]:
+    """The rotor inertia, motor angle, gravity and transmission ratios (Appendices A, E, F;
+    Fig. 7.2), in :data:`FINGER_PARAMETERS` order."""
+    return [
         Parameter("I_m", 5.1e-7, "kg*m^2", "motor rotor inertia", bounds=(0, None),
                   source=f"{SEED}, Appendix A (Im1m = 5.1e-07)"),
         Parameter("beta", math.pi / 4, "rad", "angle of the base motors to "
@@ -130,8 +136,12 @@ def thesis_finger_parameters(**overrides) -> ParameterSet:
                                    "friction tables)", bounds=(0.05, 1.0),
                   source=f"{SEED}, Appendix E (no losses)"),
     ]
-    ps += list(motor_parameters().values())
-    fric = [
+
+
+def _friction_parameters() -> list[Parameter]:
+    """The drives' friction: stiction, table factors, Stribeck, LuGre, ripple and Karnopp
+    (Appendices F, G; §3.2.2, §6.3), in :data:`FINGER_PARAMETERS` order."""
+    return [
         Parameter("fs_base1", 0.36, "N*m", "stiction of base drive 1", bounds=(0, None),
                   source=f"{SEED}, Appendix F (stiction = 0.36)"),
         Parameter("fs_base2", 0.36, "N*m", "stiction of base drive 2", bounds=(0, None),
@@ -196,6 +206,13 @@ def thesis_finger_parameters(**overrides) -> ParameterSet:
                   bounds=(0, None), source="assumed: two per wave-generator turn, 100:1"),
         Parameter("v_stick", 1e-5, "rad/s", "Karnopp zero-velocity band", bounds=(0, None),
                   source="assumed"),
+    ]
+
+
+def _limit_parameters() -> list[Parameter]:
+    """The joint limits and the end stops' stiffness and damping (§7.1), in
+    :data:`FINGER_PARAMETERS` order."""
+    return [
         Parameter("abd_min", -30 * DEG, "rad", "abduction limit, lower",
                   source="assumed (range not printed)", display_unit="deg"),
         Parameter("abd_max", 30 * DEG, "rad", "abduction limit, upper",
@@ -214,7 +231,13 @@ def thesis_finger_parameters(**overrides) -> ParameterSet:
         Parameter("d_stop", 0.45, "N*m*s/rad", "end-stop damping", bounds=(0, None),
                   source="assumed: damping ratio ~0.2, 'resilience ... after the braking' (§7.1)"),
     ]
-    ps += fric
+
+
+def thesis_finger_parameters(**overrides) -> ParameterSet:
+    """The finger's parameters (every name of :data:`FINGER_PARAMETERS`) with provenance;
+    ``overrides`` replace values (SI, or strings with units)."""
+    ps = (_link_parameters() + _drive_parameters() + list(motor_parameters().values())
+          + _friction_parameters() + _limit_parameters())
     pset = ParameterSet(ps, "dlr-hit-finger")
     if tuple(pset.names) != FINGER_PARAMETERS:
         raise ModelError("internal: finger parameter order does not match FINGER_PARAMETERS")
