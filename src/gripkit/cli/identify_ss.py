@@ -74,14 +74,7 @@ def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
     record (``records``: each file's free-run fit), with the order search, --focus and --report
     (one page per file) as for one file; --validate then checks the model, the search ranks by
     Akaike's criterion over the records."""
-    from ..errors import DataError
-
-    if form not in ("oe", "innovation"):
-        raise DataError(f"--form: expected oe or innovation, found {form!r}")
-    if focus not in ("simulation", "prediction"):
-        raise DataError(f"--focus: expected simulation or prediction, found {focus!r}")
-    if max_iterations < 1:
-        raise DataError(f"--max-iterations: expected a positive integer, found {max_iterations}")
+    _check_ss_options(form, focus, max_iterations)
     several = len(data) > 1
     check_outputs(out, report)
     with warnings.catch_warnings(record=True) as caught:
@@ -93,6 +86,31 @@ def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
                                       detrend=detrend, **options)
         save_and_report(model, tr, data, out, report)
         val = validation(model, vtr, validate)
+    res = _ss_result(model, val, data, method, no_refine, out)
+    res["warnings"] = report_warnings(caught)
+    if json_out:
+        emit_json(res)
+        return
+    _echo_ss(model, val, res, focus, out)
+
+
+def _check_ss_options(form: str, focus: str, max_iterations: int) -> None:
+    """Validate the options that the identification itself does not check (--form, --focus,
+    --max-iterations); a DataError names the option, what it expects and what it found."""
+    from ..errors import DataError
+
+    if form not in ("oe", "innovation"):
+        raise DataError(f"--form: expected oe or innovation, found {form!r}")
+    if focus not in ("simulation", "prediction"):
+        raise DataError(f"--focus: expected simulation or prediction, found {focus!r}")
+    if max_iterations < 1:
+        raise DataError(f"--max-iterations: expected a positive integer, found {max_iterations}")
+
+
+def _ss_result(model, val, data: list[Path], method: str, no_refine: bool, out: Path) -> dict:
+    """The JSON result of ``identify ss`` (without ``warnings``): the model's fields, the data
+    files, the per-record fits (several files), the validation, order search and focus."""
+    several = len(data) > 1
     res = model.to_dict()
     res["info"] = {k: v for k, v in res["info"].items()  # the search is given at the top level
                    if k not in ("search", "search_criterion", "validation_fit_percent")}
@@ -111,10 +129,12 @@ def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
         res["search_criterion"] = model.info["search_criterion"]
     if "focus" in model.info:
         res["focus"] = model.info["focus"]
-    res["warnings"] = report_warnings(caught)
-    if json_out:
-        emit_json(res)
-        return
+    return res
+
+
+def _echo_ss(model, val, res: dict, focus: str, out: Path) -> None:
+    """The text output of ``identify ss``: structure, singular values, free-run fits (per
+    record for several files), focus decision, order search, validation, poles (± σ)."""
     ss = model.system
     typer.echo(f"{model.structure}: order {ss.n_states}, {ss.n_inputs} input(s) "
                f"{list(ss.inputs)} → "
@@ -133,6 +153,7 @@ def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
         typer.echo(f"focus {fo['criterion']} ({fo['data']} data): subspace "
                    f"{fo['subspace_percent']:.2f} %, "
                    f"PEM {fo['refined_percent']:.2f} %; kept the {fo['kept']} model")
+    search = res.get("search")
     if search is not None:
         _echo_search(search, res["search_criterion"], focus)
     if val is not None and val.fit_percent is not None:

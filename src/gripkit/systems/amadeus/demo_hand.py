@@ -235,31 +235,8 @@ def _slip(report, z, rng, summary, quick):
     cal_sig = (c.simulate(cal_in, dt=DT_PVDF, x0=c.equilibrium_state(cal_in[0, 1]))["v_pvdf"]
                + pvdf_noise(cal_in.shape[0], dt=DT_PVDF, rng=rng))
     det = SlipDetector(dt=DT_PVDF).calibrate(cal_sig)
-    # speed calibration on the test rig (Fig. 12(b))
-    tb = SlipTestbed(check=False)
-    recs, sp, fn, show = [], [], [], {}
-    for v in (0.004, 0.008, 0.012, 0.016, 0.020):
-        for F in (1.5, 2.5):
-            n = int(0.6 * PVDF_RATE)
-            u = np.column_stack([np.full(n, F), np.full(n, v)])
-            x = tb.simulate(u, dt=DT_PVDF)["v_pvdf"] + pvdf_noise(n, dt=DT_PVDF, rng=rng)
-            recs.append(x)
-            sp.append(v)
-            fn.append(F)
-            if F == 2.5:
-                show[v] = x
-    det.speed_calibration = calibrate_speed(recs, sp, dt=DT_PVDF, normal_forces=fn)
+    _slip_speed_calibration(sec, det, rng)
     sc = det.speed_calibration
-    fig, axes = subplots(len(show), 1, figsize=(9, 6), sharex=True)
-    for ax, (v, x) in zip(axes, show.items()):
-        tt = np.arange(x.size) / PVDF_RATE
-        ax.plot(tt, x * 1e3, lw=0.7)
-        ax.set_ylabel(f"{v * 1e3:.0f} mm/s", fontsize=8)
-    axes[-1].set_xlabel("time (s)")
-    fig.suptitle("PVDF signal on the test rig at different slip speeds (mV), F_n = 2.5 N")
-    sec.figure(fig, "Test-rig slip signals at five speeds (cf. Fig. 12(b)); the stick-slip rate "
-                    "grows with speed.",
-               name="amadeus-slip-speeds")
     # a slip event during a grasp
     u = slip_onset_inputs(1.2, dt=DT_PVDF, normal_force=2.0, load0=0.6, start=0.3, rate=3.0)
     tr = c.simulate(u, dt=DT_PVDF, x0=c.equilibrium_state(u[0, 1]))
@@ -322,6 +299,35 @@ def _slip(report, z, rng, summary, quick):
     summary.update(slip_latency_ms=1e3 * (ev.alarm - t_on), false_alarm_rate=fa["rate"],
                    nonslip_seconds=T)
     return det
+
+
+def _slip_speed_calibration(sec, det, rng):
+    """Speed calibration on the test rig (Fig. 12(b)): 0.6 s of slip at five speeds (4-20 mm/s)
+    and two normal forces (1.5, 2.5 N) with film noise drawn from ``rng``, fitted into
+    ``det.speed_calibration``; the figure shows the 2.5 N signals."""
+    tb = SlipTestbed(check=False)
+    recs, sp, fn, show = [], [], [], {}
+    for v in (0.004, 0.008, 0.012, 0.016, 0.020):
+        for F in (1.5, 2.5):
+            n = int(0.6 * PVDF_RATE)
+            u = np.column_stack([np.full(n, F), np.full(n, v)])
+            x = tb.simulate(u, dt=DT_PVDF)["v_pvdf"] + pvdf_noise(n, dt=DT_PVDF, rng=rng)
+            recs.append(x)
+            sp.append(v)
+            fn.append(F)
+            if F == 2.5:
+                show[v] = x
+    det.speed_calibration = calibrate_speed(recs, sp, dt=DT_PVDF, normal_forces=fn)
+    fig, axes = subplots(len(show), 1, figsize=(9, 6), sharex=True)
+    for ax, (v, x) in zip(axes, show.items()):
+        tt = np.arange(x.size) / PVDF_RATE
+        ax.plot(tt, x * 1e3, lw=0.7)
+        ax.set_ylabel(f"{v * 1e3:.0f} mm/s", fontsize=8)
+    axes[-1].set_xlabel("time (s)")
+    fig.suptitle("PVDF signal on the test rig at different slip speeds (mV), F_n = 2.5 N")
+    sec.figure(fig, "Test-rig slip signals at five speeds (cf. Fig. 12(b)); the stick-slip rate "
+                    "grows with speed.",
+               name="amadeus-slip-speeds")
 
 
 def _control(report, z, det, rng, summary, quick):

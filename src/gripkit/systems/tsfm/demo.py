@@ -360,8 +360,14 @@ def _microparts(report, z, summary, quick):
     sec.table(["finger", "parameter", "true", "identified ± σ", "error %", "unit"], id_rows,
               caption="The identified fingers the stiffness estimates rest on (SI)")
     grasps = {r.true: study.grasps[r.part] for r in study.rows}
-    r = grasps[72.5]
-    tr = r.trajectory
+    _micropart_figure(sec, grasps[72.5].trajectory, study.rows[1])
+    return grasps, study.identified
+
+
+def _micropart_figure(sec, tr, row):
+    """Figure of the 72.5 N/m part's grasp (trajectory ``tr``, Table III row ``row``): tips true
+    and estimated (µm), measured and true forces (µN), and the loading line of eq 16: 1 ms block
+    averages of the squeeze (both fingers in phase 2) against k̂ δ."""
     fig, axes = subplots(1, 3, figsize=(15, 4))
     axes[0].plot(tr.t, tr["y_C1"] * 1e6, label="finger 1 true")
     axes[0].plot(tr.t, tr["y_hat1"] * 1e6, "--", label="finger 1 estimate")
@@ -378,7 +384,6 @@ def _microparts(report, z, summary, quick):
     blk = m[: nb * 20].reshape(nb, 20)
     s = (tr["y_hat1"] + tr["y_hat2"])[blk].mean(axis=1)
     Fb = 0.5 * (tr["F_meas1"] + tr["F_meas2"])[blk].mean(axis=1)
-    row = study.rows[1]
     s0 = 400e-6 - row.estimate_detail.width
     axes[2].plot((s - s0) * 1e6, Fb * 1e6, ".", ms=2, alpha=0.5,
                  label="1 ms averages (online estimates)")
@@ -395,7 +400,6 @@ def _microparts(report, z, summary, quick):
     sec.figure(fig, "Grasp of the 72.5 N/m part: tips (true and estimated), forces, and the "
                     "loading line of eq 16",
                name="tsfm-micropart")
-    return grasps, study.identified
 
 
 def _strategy(report, z, ident, grasps, summary, quick):
