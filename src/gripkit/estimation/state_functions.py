@@ -76,6 +76,7 @@ variance) so that the unscented filter's covariance stays positive definite.
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import weakref
 from typing import NamedTuple
@@ -143,11 +144,9 @@ def _build(model, dt):
         return hit[2]
     built = _build_new(model, dt)
     if key[1] is not None:
-        try:
+        with contextlib.suppress(TypeError):  # no weak references to this kind: not cached
             ref = weakref.ref(model, lambda _, k=id(model): _CACHE.pop(k, None))
             _CACHE[id(model)] = (ref, key, built)
-        except TypeError:  # no weak references to this kind of object: not cached
-            pass
     return built
 
 

@@ -1101,8 +1101,8 @@ def hammerstein_wiener(u, y=None, *, input_nonlinearity=None, output_nonlinearit
     o = _choose_orders(search, orders)
     cands = _fit_candidates(search, structures, o, auto)
     refit = _refit_dynamics(search, cands, o, dyn, searched)
-    for _ in bar:
-        pass
+    for _ in bar:  # the bar's remaining steps (orders not searched), so that it ends at 100 %
+        continue
     cands = sorted(cands + refit, key=lambda c: -c[0])
     best = _pick(cands, validation is not None)
     best.criterion = _criterion(best, nb is None or nf is None or nk is None, auto,
