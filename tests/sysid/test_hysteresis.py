@@ -384,7 +384,7 @@ def test_cli_identify_hysteresis_json_compare_simulate(tmp_path, capsys):
 def test_hostile_model_files_are_named(tmp_path):
     m = PrandtlIshlinskiiModel(PI_R, PI_W, offset=0.2)
     doc = m.to_dict()
-    cases = {"not JSON": ("{", "is not a JSON model"),
+    cases = {"not JSON": ("{", "is not JSON"),
              "version": (json.dumps({**doc, "version": 9}), "of version 9"),
              "kind": (json.dumps({**doc, "model": "preisach"}), "unknown hysteresis model"),
              "lengths": (json.dumps({**doc, "weights": [1.0]}), "a malformed"),

@@ -20,9 +20,10 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import write_text
-from ..errors import AccuracyWarning, DataError, ModelError, emit_warning
+from ..errors import AccuracyWarning, DataError, ModelError, PathError, emit_warning
 
-__all__ = ["file_sha256", "plain", "write_document", "read_document", "SCHEMA", "SCHEMA_VERSION"]
+__all__ = ["file_sha256", "plain", "write_document", "read_document", "read_family_document",
+           "SCHEMA", "SCHEMA_VERSION"]
 
 SCHEMA = "gripkit.linear-model"
 SCHEMA_VERSION = 2
@@ -132,4 +133,39 @@ def read_document(path, schema: str = SCHEMA, newest: int = SCHEMA_VERSION, *,
         emit_warning(f"{what} {where}: content hash mismatch (the file was edited after "
                      "it was saved); "
                      f"using it as it is", AccuracyWarning)
+    return doc
+
+
+def read_family_document(path, schema: str, version: int, *, family: str, writer: str,
+                         version_key: str = "version") -> dict:
+    """The JSON document of a nonlinear family's model file ``path`` (``family``: 'narx', 'hw',
+    …; ``writer``: what writes such a file), checked: readable JSON, its ``schema`` and its
+    ``version_key`` equal to ``version``. PathError for a missing or unreadable file, ModelError
+    for anything else."""
+    p = Path(path)
+    what = f"{family} model file {str(p)!r}"
+    try:
+        doc = json.loads(p.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise PathError(f"{what} does not exist; give the path of a file written by "
+                        f"{writer}") from None
+    except OSError as exc:
+        raise PathError(f"{what} cannot be read ({exc.strerror or exc}); give the path of a "
+                        "readable file") from None
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise ModelError(f"{what} is not JSON ({exc}); expected a file of schema "
+                         f"{schema!r}") from None
+    except RecursionError:
+        raise ModelError(f"{what} cannot be read: its JSON nests lists or objects deeper than "
+                         "Python's recursion limit; a model file nests a few levels") from None
+    except ValueError as exc:  # an integer beyond Python's limit on digits read from text
+        raise ModelError(f"{what} cannot be read: {str(exc).split(';')[0]}") from None
+    found = doc.get("schema") if isinstance(doc, dict) else None
+    if found != schema:
+        raise ModelError(f"{str(p)!r} has schema {found!r}, expected {schema!r}; load other "
+                         "model files with gripkit.sysid.load_model")
+    if doc.get(version_key) != version:
+        raise ModelError(f"{str(p)!r} is a {schema} of {version_key} "
+                         f"{doc.get(version_key)!r}; this gripkit reads {version_key} {version}",
+                         hint=f"write it again with this gripkit ({writer})")
     return doc

@@ -85,10 +85,11 @@ import numpy as np
 
 from ...atomic import write_text
 from ...errors import (AccuracyWarning, ArgumentError, DataError, IdentificationError, ModelError,
-                       PathError, StabilityWarning, emit_warning)
+                       StabilityWarning, emit_warning)
 from ...params import Parameter, ParameterSet
 from ...progress import track
 from ...signals.trajectory import Trajectory
+from ..model_file import read_family_document
 from ..model_protocol import ModelFit
 from . import hw_kernels as K
 
@@ -666,31 +667,9 @@ def _signal(x, name: str) -> np.ndarray:
 def load_hw(path) -> HWModel:
     """Read a model written by :meth:`HWModel.save`; any other schema is refused."""
     p = Path(path)
-    try:
-        doc = json.loads(p.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise PathError(f"hw model file {str(p)!r} does not exist; give the path of a file "
-                        "written by HWModel.save or `gripkit identify hw --out`") from None
-    except OSError as exc:
-        raise PathError(f"hw model file {str(p)!r} cannot be read ({exc.strerror or exc}); give "
-                        "the path of a readable file") from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise ModelError(f"hw model file {str(p)!r} is not JSON ({exc}); expected a file of schema "
-                         f"{SCHEMA!r}") from None
-    except RecursionError:
-        raise ModelError(f"hw model file {str(p)!r} cannot be read: its JSON nests lists or "
-                         "objects deeper than Python's recursion limit") from None
-    except ValueError as exc:
-        raise ModelError(f"hw model file {str(p)!r} cannot be read: "
-                         f"{str(exc).split(';')[0]}") from None
-    schema = doc.get("schema") if isinstance(doc, dict) else None
-    if schema != SCHEMA:
-        raise ModelError(f"{str(p)!r} has schema {schema!r}, expected {SCHEMA!r}; load other model "
-                         "files with gripkit.sysid.load_model")
-    if doc.get("schema_version") != VERSION:
-        raise ModelError(f"{str(p)!r} is a {SCHEMA} of schema_version "
-                         f"{doc.get('schema_version')!r}; this gripkit reads version {VERSION}",
-                         hint="write it again with this gripkit's HWModel.save")
+    doc = read_family_document(p, SCHEMA, VERSION, family="hw",
+                               writer="HWModel.save or `gripkit identify hw --out`",
+                               version_key="schema_version")
     try:
         nls = []
         for key in ("input_nonlinearity", "output_nonlinearity"):

@@ -56,10 +56,11 @@ import numpy as np
 
 from ...atomic import write_text
 from ...errors import (AccuracyWarning, ArgumentError, DataError, IdentificationError, ModelError,
-                       PathError, StabilityWarning, emit_warning)
+                       StabilityWarning, emit_warning)
 from ...params import Parameter, ParameterSet
 from ...progress import track
 from ...signals.trajectory import Trajectory
+from ..model_file import read_family_document
 from ..model_protocol import ModelFit
 from . import hysteresis_kernels as K
 
@@ -1049,25 +1050,8 @@ def load_hysteresis(path):
     :class:`BoucWenOscillatorModel` or :class:`PrandtlIshlinskiiModel`; the same type comes
     back."""
     p = Path(path)
-    try:
-        doc = json.loads(p.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise PathError(f"hysteresis model file {str(p)!r} does not exist; give the path of a "
-                        "file written by model.save or `gripkit identify hysteresis --out`"
-                        ) from None
-    except OSError as exc:
-        raise PathError(f"hysteresis model file {str(p)!r} cannot be read "
-                        f"({exc.strerror or exc}); give the path of a readable file") from None
-    except (ValueError, RecursionError) as exc:
-        raise ModelError(f"hysteresis model file {str(p)!r} is not a JSON model "
-                         f"({type(exc).__name__}); expected a file of schema {SCHEMA!r}") from None
-    schema = doc.get("schema") if isinstance(doc, dict) else None
-    if schema != SCHEMA:
-        raise ModelError(f"{str(p)!r} has schema {schema!r}, expected {SCHEMA!r}; load other "
-                         "model files with gripkit.sysid.load_model")
-    if doc.get("version") != VERSION:
-        raise ModelError(f"{str(p)!r} is a {SCHEMA} of version {doc.get('version')!r}; this "
-                         f"gripkit reads version {VERSION}")
+    doc = read_family_document(p, SCHEMA, VERSION, family="hysteresis",
+                               writer="model.save or `gripkit identify hysteresis --out`")
     kind = doc.get("model")
     common = {k: doc.get(k) for k in ("dt", "fit_percent", "validation_fit_percent",
                                       "criterion")}

@@ -45,14 +45,15 @@ import numpy as np
 from numba import njit
 
 from ...atomic import write_text
-from ...errors import (ArgumentError, DataError, IdentificationError, ModelError, PathError,
-                       StabilityWarning, emit_warning)
+from ...errors import (ArgumentError, DataError, IdentificationError, ModelError, StabilityWarning,
+                       emit_warning)
 from ...params import Parameter, ParameterSet
 from ...signals.trajectory import Trajectory
+from ..model_file import read_family_document
 from ..model_protocol import ModelFit
 from ...progress import status, track
 
-__all__ = ["SCHEMA", "NARX_FIT", "NARXModel", "narx", "load_narx", "file_schema", "candidate_terms",
+__all__ = ["SCHEMA", "NARX_FIT", "NARXModel", "narx", "load_narx", "candidate_terms",
            "frols", "REFINE"]
 
 SCHEMA = "gripkit.narx-model"
@@ -534,43 +535,11 @@ class NARXModel:
         return write_text(path, json.dumps(self.to_dict(), indent=1) + "\n", what="NARX model")
 
 
-def file_schema(path) -> str | None:
-    """The ``schema`` field of a JSON model file, None when it has none or cannot be read."""
-    try:
-        doc = json.loads(Path(path).read_text(encoding="utf-8"))
-    except (OSError, ValueError, RecursionError):  # the model file readers name what is wrong
-        return None
-    return doc.get("schema") if isinstance(doc, dict) else None
-
-
 def load_narx(path) -> NARXModel:
     """Read a model written by :meth:`NARXModel.save`; any other schema is refused."""
     p = Path(path)
-    try:
-        doc = json.loads(p.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise PathError(f"narx model file {str(p)!r} does not exist; give the path of a file "
-                        "written by NARXModel.save or `gripkit identify narx --out`") from None
-    except OSError as exc:
-        raise PathError(f"narx model file {str(p)!r} cannot be read ({exc.strerror or exc}); give "
-                        "the path of a readable file") from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise ModelError(f"narx model file {str(p)!r} is not JSON ({exc}); expected a file of "
-                         f"schema {SCHEMA!r}") from None
-    except RecursionError:
-        raise ModelError(f"narx model file {str(p)!r} cannot be read: its JSON nests lists or "
-                         f"objects deeper than Python's recursion limit; a model file nests a few "
-                         f"levels") from None
-    except ValueError as exc:  # an integer beyond Python's limit on digits read from text
-        raise ModelError(f"narx model file {str(p)!r} cannot be read: "
-                         f"{str(exc).split(';')[0]}") from None
-    schema = doc.get("schema") if isinstance(doc, dict) else None
-    if schema != SCHEMA:
-        raise ModelError(f"{str(p)!r} has schema {schema!r}, expected {SCHEMA!r}; load other model "
-                         "files with gripkit.sysid.load_model")
-    if doc.get("version") != VERSION:
-        raise ModelError(f"{str(p)!r} is a {SCHEMA} of version {doc.get('version')!r}; this "
-                         f"gripkit reads version {VERSION}")
+    doc = read_family_document(p, SCHEMA, VERSION, family="narx",
+                               writer="NARXModel.save or `gripkit identify narx --out`")
     try:
         bases = np.array(doc["bases"], dtype=np.int64).reshape(-1, 2)
         rows = np.array(doc["rows"], dtype=np.int64).reshape(len(doc["rows"]), int(doc["degree"]))

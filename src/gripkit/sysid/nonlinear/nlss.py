@@ -69,7 +69,8 @@ import scipy.linalg as sla
 
 from ...atomic import write_text
 from ...errors import (AccuracyWarning, ArgumentError, DataError, IdentificationError,
-                       ModelError, PathError, StabilityWarning, emit_warning)
+                       ModelError, StabilityWarning, emit_warning)
+from ..model_file import read_family_document
 from ..model_protocol import ModelFit
 from . import nlss_kernels as K
 from ...params import Parameter, ParameterSet
@@ -393,31 +394,8 @@ class NLSSModel:
 def load_nlss(path) -> NLSSModel:
     """Read a model written by :meth:`NLSSModel.save`; any other schema is refused."""
     p = Path(path)
-    try:
-        doc = json.loads(p.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise PathError(f"nlss model file {str(p)!r} does not exist; give the path of a file "
-                        "written by NLSSModel.save or `gripkit identify nlss --out`") from None
-    except OSError as exc:
-        raise PathError(f"nlss model file {str(p)!r} cannot be read ({exc.strerror or exc}); "
-                        "give the path of a readable file") from None
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise ModelError(f"nlss model file {str(p)!r} is not JSON ({exc}); expected a file of "
-                         f"schema {SCHEMA!r}") from None
-    except RecursionError:
-        raise ModelError(f"nlss model file {str(p)!r} cannot be read: its JSON nests lists or "
-                         "objects deeper than Python's recursion limit; a model file nests a few "
-                         "levels") from None
-    except ValueError as exc:  # an integer beyond Python's limit on digits read from text
-        raise ModelError(f"nlss model file {str(p)!r} cannot be read: "
-                         f"{str(exc).split(';')[0]}") from None
-    schema = doc.get("schema") if isinstance(doc, dict) else None
-    if schema != SCHEMA:
-        raise ModelError(f"{str(p)!r} has schema {schema!r}, expected {SCHEMA!r}; load other "
-                         "model files with gripkit.sysid.load_model")
-    if doc.get("version") != VERSION:
-        raise ModelError(f"{str(p)!r} is a {SCHEMA} of version {doc.get('version')!r}; this "
-                         f"gripkit reads version {VERSION}")
+    doc = read_family_document(p, SCHEMA, VERSION, family="nlss",
+                               writer="NLSSModel.save or `gripkit identify nlss --out`")
     try:
         n, m, p_ = int(doc["order"]), len(doc["inputs"]), len(doc["outputs"])
         f64 = lambda k, *shape: np.array(doc[k], dtype=np.float64).reshape(shape)  # noqa: E731
