@@ -157,8 +157,9 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     if detrend == "mean":
         refit = lambda: identify_ss(  # noqa: E731
             data, input=input, output=output, order=model.order, method=method, form=form,
-            refine=refine, detrend="none", horizon=horizon, feedthrough=feedthrough)[0]
-        _warn_if_detrending_hurt(model, refit, d.u.shape[0], d.dt, "identify ss")
+            refine=False, detrend="none", horizon=horizon, feedthrough=feedthrough)[0]
+        _warn_if_detrending_hurt(model, refit, d.u.shape[0], d.dt, "identify ss",
+                                 without="without (subspace model, not refined)")
     if vd is not None:
         extras["validation_fit_percent"] = _validation_fit(model, vd)
     return model, extras
@@ -389,12 +390,15 @@ def _never_lose(start, refined, focus: str, d: IOData, estimation: bool, max_ite
     return start
 
 
-def _warn_if_detrending_hurt(model, refit, n: int, dt: float, command: str) -> None:
+def _warn_if_detrending_hurt(model, refit, n: int, dt: float, command: str,
+                             without: str = "without") -> None:
     """Mean detrending assumes the record's means are an operating point (an equilibrium). A mode
     that does not settle within the record (its envelope falls by less than e⁻⁵ over the N
     samples: a near-integrator, a drift) breaks that assumption; then ``refit()`` fits the same
     structure without detrending, and a warning names ``--detrend none`` when that fits the data
-    better by more than 10 points (free run)."""
+    better by more than 10 points (free run). For ``identify ss`` the refit is the subspace model
+    alone (no PEM): a lower bound on what the data without detrending give, at a fraction of the
+    cost of a second refinement; ``without`` names what was refitted in the warning."""
     poles = model.system.poles()
     if not poles.size:
         return
@@ -417,7 +421,7 @@ def _warn_if_detrending_hurt(model, refit, n: int, dt: float, command: str) -> N
            f"{command}: removing the means (detrend 'mean', the default) hurt this fit: the "
            f"slowest mode (time constant {1 / slowest:.4g} s) does not settle within the "
            f"{n * dt:.4g} s record, so the output drifts and its mean is no operating point; "
-           f"free-run fit {mean_fit:.4g} % with the means removed, {none_fit:.4g} % without; "
+           f"free-run fit {mean_fit:.4g} % with the means removed, {none_fit:.4g} % {without}; "
            f"use --detrend none (Python: detrend='none')", AccuracyWarning)
 
 
