@@ -32,7 +32,8 @@ from pathlib import Path
 
 import numpy as np
 
-FIXTURE_README = Path(__file__).resolve().parents[1] / "tests" / "fixtures" / "silverbox" / "README.md"
+FIXTURES = Path(__file__).resolve().parents[1] / "tests" / "fixtures"
+FIXTURE_README = FIXTURES / "silverbox" / "README.md"
 SHA256 = "ae62d5a91230c10f76e6dd02c8a4fac3c9d4d8a95fbf50e87cb0c4885003e0f1"
 TRAIN = {"fixture": (40960, 49152), "official": (40650, 105712)}
 TESTS = (("multisine", 105712, 127400), ("arrow full", 100, 40575),
