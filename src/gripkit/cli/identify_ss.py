@@ -21,13 +21,10 @@ import typer
 
 from .app import identify_app
 from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data, report_warnings
-from .identify_common import (ModelOutOpt, ReportOpt, ValidateOpt, check_outputs, data_field,
-                              run_identify, save_and_report, validation)
+from .identify_common import (DataArg, DataArgs, ModelOutOpt, ReportOpt, ValidateOpt,
+                              check_outputs, data_field, run_identify, save_and_report,
+                              validation)
 
-DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
-DataArgs = typer.Argument(..., help="Data file(s) (.csv, .parquet, .h5); several: one model of "
-                                    "all the records, each with its own initial state.",
-                          metavar="DATA", show_default=False)
 InputsOpt = typer.Option(..., "--input", help="Input column(s), comma-separated (e.g. a,b).")
 OutputsOpt = typer.Option(..., "--output", help="Output column(s), comma-separated (e.g. c,d).")
 DetrendOpt = typer.Option("mean", "--detrend", help="Operating-point removal before "
