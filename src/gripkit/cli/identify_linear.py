@@ -22,8 +22,7 @@ import typer
 from .app import identify_app
 from ..errors import emit_warning
 from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_choice, check_data_options,
-                     check_number,
-                     collected_warnings, emit_json, report_warnings)
+                     check_number, collected_warnings, emit_json, finish_json, report_warnings)
 from .identify_common import (DataArg, DataArgs, ModelOutOpt, ReportOpt, ValidateOpt,
                               check_outputs, data_field, records_field, run_identify,
                               save_and_report, validation)
@@ -88,9 +87,7 @@ def _siso(method: str, data: list[Path], input: str, output: str, fs, time, fill
         if len(data) > 1:
             out["records"] = records_field(data, model.info["records"])
         val = _validation_fields(out, model, vtr, validate, detrend)
-    out["warnings"] = report_warnings(caught)
-    if json_out:
-        emit_json(out)
+    if finish_json(out, caught, json_out):
         return
     _print_model(model, None if val is None else val.one_step, out.get("validation_fit_percent"))
     _echo_records(out.get("records"))
@@ -178,9 +175,7 @@ def _mimo_arx(data: list[Path], input: str, output: str, na: int, nb: int, nk: i
                          "the unit circle): "
                          "no free-run fit is reported", StabilityWarning)
         _validation_fields(res, model, vtr, validate)
-    res["warnings"] = report_warnings(caught)
-    if json_out:
-        emit_json(res)
+    if finish_json(res, caught, json_out):
         return
     typer.echo(f"ARX [{na} {nb} {nk}]: {len(model.inputs)} input(s) {list(model.inputs)} → "
                f"{len(model.outputs)} "

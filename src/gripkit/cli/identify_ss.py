@@ -20,7 +20,8 @@ import numpy as np
 import typer
 
 from .app import identify_app
-from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data, report_warnings
+from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, finish_json, load_data,
+                     report_warnings)
 from .identify_common import (DataArg, DataArgs, ModelOutOpt, ReportOpt, ValidateOpt,
                               check_outputs, data_field, run_identify, save_and_report,
                               validation)
@@ -84,9 +85,7 @@ def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
         save_and_report(model, tr, data, out, report)
         val = validation(model, vtr, validate)
     res = _ss_result(model, val, data, method, no_refine, out)
-    res["warnings"] = report_warnings(caught)
-    if json_out:
-        emit_json(res)
+    if finish_json(res, caught, json_out):
         return
     _echo_ss(model, val, res, focus, out)
 
