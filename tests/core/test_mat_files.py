@@ -15,6 +15,7 @@ from scipy import signal
 from gripkit.cli import main
 from gripkit.errors import DataError
 from gripkit.io import load
+from gripkit.io.mat_reader import MAT73_SIGNATURE
 
 N = 400
 T = np.arange(N) * 0.01
@@ -98,6 +99,16 @@ def test_sizes_are_checked_before_reading_and_bad_files_are_named(tmp_path):
     bad = tmp_path / "bad.mat"
     bad.write_bytes(b"MATLAB 5.0 MAT-file" + b"\0" * 40)
     with pytest.raises(DataError, match="bad.mat: not a readable MAT-file"):
+        load(bad, fs=100.0)
+
+
+def test_a_corrupt_v73_file_is_named_with_its_format(tmp_path):
+    """A 7.3 signature in front of bytes HDF5 cannot read: the one-line error of io.hdf5_open,
+    naming the file and the format it claims."""
+    bad = tmp_path / "bad73.mat"
+    bad.write_bytes(MAT73_SIGNATURE.ljust(512, b" ") + b"\0" * 512)
+    with pytest.raises(DataError, match=r"bad73.mat: not a readable MAT-file 7.3 \(truncated or "
+                                        r"corrupt\?\)"):
         load(bad, fs=100.0)
 
 

@@ -37,6 +37,10 @@ def test_siso_and_mimo_from_one_constructor():
     with pytest.raises(ArgumentError, match=r"IOData.u1: the SISO view needs one input and one "
                                             r"output, found 2 input\(s\) \['a', 'b'\]"):
         mimo.u1
+    np.testing.assert_array_equal(siso.y1, tr["c"] - tr["c"].mean())
+    for name in ("y1", "input", "output", "input_unit", "output_unit"):  # each names itself
+        with pytest.raises(ArgumentError, match=rf"IOData.{name}: the SISO view needs one input"):
+            getattr(mimo, name)
 
 
 def test_siso_identify_is_the_array_fit_of_the_deviations():

@@ -15,7 +15,7 @@ import typer
 from ..sysid.model_file import plain
 
 __all__ = ["emit_json", "is_mcap", "load_data", "collected_warnings", "report_warnings",
-           "check_data_options", "check_choice", "check_number", "complex_pairs",
+           "finish_json", "check_data_options", "check_choice", "check_number", "complex_pairs",
            "FsOpt", "TimeOpt", "FillOpt", "JsonOpt", "ModelReportOpt", "write_model_page"]
 
 FsOpt = typer.Option(None, "--fs", help="Sampling rate in Hz, when the file has no time column "
@@ -135,6 +135,17 @@ def report_warnings(caught) -> list[str]:
     for line in lines:
         print(f"warning: {line}", file=sys.stderr)
     return lines
+
+
+def finish_json(result: dict, caught, json_out: bool) -> bool:
+    """The end of a command with a JSON result: the recorded warnings printed
+    (:func:`report_warnings`) and listed in ``result['warnings']``; with ``--json``
+    (``json_out``) ``result`` printed as one JSON object. Returns ``json_out``: True when the
+    command has printed its result."""
+    result["warnings"] = report_warnings(caught)
+    if json_out:
+        emit_json(result)
+    return json_out
 
 
 def write_model_page(model, record, folder: Path, data_path: Path) -> str:

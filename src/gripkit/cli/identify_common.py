@@ -12,6 +12,11 @@ import typer
 
 from .common import load_data, write_model_page
 
+DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
+#: DATA of the commands that fit one model of several records
+DataArgs = typer.Argument(..., help="Data file(s) (.csv, .parquet, .h5); several: one model of all "
+                                    "the records, each with its own initial conditions.",
+                          metavar="DATA", show_default=False)
 ValidateOpt = typer.Option(None, "--validate", help="Second record (same columns): the one "
                                                     "validation fit, as gripkit compare gives it.")
 ModelOutOpt = typer.Option(None, "--out", help="Write the identified model to this JSON file.")

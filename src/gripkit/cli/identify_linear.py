@@ -22,15 +22,11 @@ import typer
 from .app import identify_app
 from ..errors import emit_warning
 from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_choice, check_data_options,
-                     check_number,
-                     collected_warnings, emit_json, report_warnings)
-from .identify_common import (ModelOutOpt, ReportOpt, ValidateOpt, check_outputs, data_field,
-                              records_field, run_identify, save_and_report, validation)
+                     check_number, collected_warnings, emit_json, finish_json, report_warnings)
+from .identify_common import (DataArg, DataArgs, ModelOutOpt, ReportOpt, ValidateOpt,
+                              check_outputs, data_field, records_field, run_identify,
+                              save_and_report, validation)
 
-DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
-DataArgs = typer.Argument(..., help="Data file(s) (.csv, .parquet, .h5); several: one model of all "
-                                    "the records, each with its own initial conditions.",
-                          metavar="DATA", show_default=False)
 InputOpt = typer.Option(..., "--input", help="Input column (e.g. the valve current).")
 OutputOpt = typer.Option(..., "--output", help="Output column (e.g. the force).")
 DetrendOpt = typer.Option("mean", "--detrend",
@@ -90,17 +86,22 @@ def _siso(method: str, data: list[Path], input: str, output: str, fs, time, fill
         out.update(data=data_field(data), detrend=detrend)
         if len(data) > 1:
             out["records"] = records_field(data, model.info["records"])
-        val = validation(model, vtr, validate, detrend)
-        if val is not None:
-            out["validation_fit_percent"] = val.fit_percent
-            out["validation"] = val.to_dict()
-    out["warnings"] = report_warnings(caught)
-    if json_out:
-        emit_json(out)
+        val = _validation_fields(out, model, vtr, validate, detrend)
+    if finish_json(out, caught, json_out):
         return
     _print_model(model, None if val is None else val.one_step, out.get("validation_fit_percent"))
     _echo_records(out.get("records"))
     _echo_written(out_file, report)
+
+
+def _validation_fields(res: dict, model, vtr, validate: Path | None, detrend: str = "mean"):
+    """``--validate``: the validation of ``model`` on the record ``vtr`` (None without one), its
+    JSON fields ``validation_fit_percent`` and ``validation`` put into ``res``."""
+    val = validation(model, vtr, validate, detrend)
+    if val is not None:
+        res["validation_fit_percent"] = val.fit_percent
+        res["validation"] = val.to_dict()
+    return val
 
 
 def _echo_written(out_file: Path | None, report: Path | None) -> None:
@@ -173,13 +174,8 @@ def _mimo_arx(data: list[Path], input: str, output: str, na: int, nb: int, nk: i
             emit_warning("arx: the identified model is unstable (a pole on or outside "
                          "the unit circle): "
                          "no free-run fit is reported", StabilityWarning)
-        val = validation(model, vtr, validate)
-        if val is not None:
-            res["validation_fit_percent"] = val.fit_percent
-            res["validation"] = val.to_dict()
-    res["warnings"] = report_warnings(caught)
-    if json_out:
-        emit_json(res)
+        _validation_fields(res, model, vtr, validate)
+    if finish_json(res, caught, json_out):
         return
     typer.echo(f"ARX [{na} {nb} {nk}]: {len(model.inputs)} input(s) {list(model.inputs)} → "
                f"{len(model.outputs)} "

@@ -20,14 +20,12 @@ import numpy as np
 import typer
 
 from .app import identify_app
-from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data, report_warnings
-from .identify_common import (ModelOutOpt, ReportOpt, ValidateOpt, check_outputs, data_field,
-                              run_identify, save_and_report, validation)
+from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, finish_json, load_data,
+                     report_warnings)
+from .identify_common import (DataArg, DataArgs, ModelOutOpt, ReportOpt, ValidateOpt,
+                              check_outputs, data_field, run_identify, save_and_report,
+                              validation)
 
-DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
-DataArgs = typer.Argument(..., help="Data file(s) (.csv, .parquet, .h5); several: one model of "
-                                    "all the records, each with its own initial state.",
-                          metavar="DATA", show_default=False)
 InputsOpt = typer.Option(..., "--input", help="Input column(s), comma-separated (e.g. a,b).")
 OutputsOpt = typer.Option(..., "--output", help="Output column(s), comma-separated (e.g. c,d).")
 DetrendOpt = typer.Option("mean", "--detrend", help="Operating-point removal before "
@@ -87,9 +85,7 @@ def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
         save_and_report(model, tr, data, out, report)
         val = validation(model, vtr, validate)
     res = _ss_result(model, val, data, method, no_refine, out)
-    res["warnings"] = report_warnings(caught)
-    if json_out:
-        emit_json(res)
+    if finish_json(res, caught, json_out):
         return
     _echo_ss(model, val, res, focus, out)
 

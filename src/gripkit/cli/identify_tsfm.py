@@ -21,8 +21,7 @@ import typer
 from .app import identify_app
 from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, check_number,
                      collected_warnings, emit_json, load_data, report_warnings)
-
-DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
+from .identify_common import DataArg
 
 
 @identify_app.command("modal")

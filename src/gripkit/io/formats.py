@@ -37,7 +37,7 @@ from ..atomic import atomic_write
 from ..errors import ArgumentError, DataError, DataWarning, emit_warning
 from ..signals.trajectory import Trajectory
 from ..units import convert, same_dimension
-from .hdf5_links import check_dataset, hdf5_get, hdf5_text
+from .hdf5_links import check_dataset, hdf5_get, hdf5_open, hdf5_text
 from .mat_reader import read_mat
 from .table import (by_position, check_fill, check_fs, check_size, columns_to_trajectory,
                     is_time_name, split_header)
@@ -553,12 +553,7 @@ def _read_hdf5(path: Path, key=None, delimiter=None, *, wanted=None, limit=None,
 
     wanted = wanted or _Wanted(None, None)
     limit = float("inf") if limit is None else limit
-    try:
-        fh = h5py.File(path, "r")
-    except OSError as exc:
-        raise DataError(f"{path.name}: not a readable HDF5 file (truncated or "
-                        f"corrupt?): {exc}") from None
-    with fh:
+    with hdf5_open(path, "HDF5 file") as fh:
         node = fh if key is None else hdf5_get(fh, key, path.name, allow_external)
         if node is None:
             raise DataError(f"{path.name}: no group or dataset {key!r}",

@@ -7,7 +7,19 @@ from __future__ import annotations
 
 from ..errors import DataError
 
-__all__ = ["EXTERNAL_HINT", "check_dataset", "hdf5_get", "hdf5_text"]
+__all__ = ["EXTERNAL_HINT", "check_dataset", "hdf5_get", "hdf5_open", "hdf5_text"]
+
+
+def hdf5_open(path, what: str):
+    """The file ``path`` opened read-only by h5py; one h5py cannot open (truncated, corrupt, not
+    HDF5) is a DataError naming the file and ``what`` it should be (``'HDF5 file'``)."""
+    import h5py
+
+    try:
+        return h5py.File(path, "r")
+    except OSError as exc:
+        raise DataError(f"{path.name}: not a readable {what} (truncated or "
+                        f"corrupt?): {exc}") from None
 
 
 def hdf5_text(x) -> str:

@@ -28,7 +28,7 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import DataError
-from .hdf5_links import check_dataset, hdf5_text
+from .hdf5_links import check_dataset, hdf5_open, hdf5_text
 from .table import check_size
 
 __all__ = ["read_mat", "MAT73_SIGNATURE"]
@@ -116,12 +116,7 @@ def _read_v5(path: Path, wanted, limit: float):
 def _read_v73(path: Path, wanted, limit: float, allow_external: bool):
     import h5py
 
-    try:
-        fh = h5py.File(path, "r")
-    except OSError as exc:
-        raise DataError(f"{path.name}: not a readable MAT-file 7.3 (truncated or "
-                        f"corrupt?): {exc}") from None
-    with fh:
+    with hdf5_open(path, "MAT-file 7.3") as fh:
         variables = {}
         for name in fh.keys():
             link = fh.get(name, getlink=True)

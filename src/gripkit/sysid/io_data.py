@@ -56,6 +56,27 @@ def parse_names(x, what: str) -> tuple[str, ...]:
     return tuple(names)
 
 
+class _SisoView:
+    """An attribute of :class:`IOData`'s SISO view: the one entry of the field ``source`` (the
+    column of ``u`` or ``y`` as a 1-D array, the name or unit of the one input or output); an
+    ArgumentError naming the attribute when the data have several inputs or outputs."""
+
+    def __init__(self, source: str):
+        self.source = source
+        self.__doc__ = (f"The one column of ``{source}`` as a 1-D array (SISO view)."
+                        if source in ("u", "y") else f"The one entry of ``{source}`` (SISO view).")
+
+    def __set_name__(self, owner, name: str) -> None:
+        self.name = name
+
+    def __get__(self, obj, owner=None):
+        if obj is None:
+            return self
+        obj._siso(self.name)
+        value = getattr(obj, self.source)
+        return value[:, 0] if isinstance(value, np.ndarray) else value[0]
+
+
 @dataclass(frozen=True)
 class IOData:
     """Inputs ``u`` (N, m) and outputs ``y`` (N, p) in deviation units (the offsets removed), with
@@ -148,37 +169,9 @@ class IOData:
                                 f"{len(self.outputs)} output(s) {list(self.outputs)}",
                                 hint="read u (N, m) and y (N, p) instead")
 
-    @property
-    def u1(self) -> np.ndarray:
-        """The one input as a 1-D array (SISO view)."""
-        self._siso("u1")
-        return self.u[:, 0]
-
-    @property
-    def y1(self) -> np.ndarray:
-        """The one output as a 1-D array (SISO view)."""
-        self._siso("y1")
-        return self.y[:, 0]
-
-    @property
-    def input(self) -> str:
-        self._siso("input")
-        return self.inputs[0]
-
-    @property
-    def output(self) -> str:
-        self._siso("output")
-        return self.outputs[0]
-
-    @property
-    def input_unit(self) -> str:
-        self._siso("input_unit")
-        return self.input_units[0]
-
-    @property
-    def output_unit(self) -> str:
-        self._siso("output_unit")
-        return self.output_units[0]
+    #: the SISO view: the one input and output as 1-D arrays, their names and units
+    u1, y1, input, output, input_unit, output_unit = (
+        _SisoView(f) for f in ("u", "y", "inputs", "outputs", "input_units", "output_units"))
 
     @property
     def keywords(self) -> dict:
