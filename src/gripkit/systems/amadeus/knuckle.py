@@ -174,25 +174,22 @@ class KnuckleResponse:
 #: the kernel's outputs, one row per sample: time (s), stroke (m), angle (rad), reading (V),
 #: command and spool position (-1, 0, 1)
 KnuckleRecord = namedtuple("KnuckleRecord", "t stroke angle reading command spool")
+#: the constants :func:`_knuckle_loop` runs with, by name: pin offset e (m), half stroke (m),
+#: extension and retraction speeds (m/s), the valve's switching delay (s), the potentiometer's
+#: gain (V/rad) and offset (V), the ADC quantum (V)
+KnuckleConstants = namedtuple("KnuckleConstants", "e_pin half v_ext v_ret t_s kpot v0 q")
 
 
 @numba.njit(cache=True)
 def _knuckle_loop(target, x0, prm, dead_band, closed_loop, open_cmd, dt, n_sub,
                   rec):  # pragma: no cover
-    """prm: [e, half stroke, v_ext, v_ret, switch delay, pot gain, pot offset, adc quantum].
+    """``prm`` a :data:`KnuckleConstants`.
     Piston speed from the orifice model (constant per spool position and load), end stops,
     spool = command delayed by the switching delay, bang-bang with dead band on the reading;
     ``rec`` a :data:`KnuckleRecord`."""
     t_out, x_out, th_out, meas_out, cmd_out, spool_out = (rec.t, rec.stroke, rec.angle,
                                                           rec.reading, rec.command, rec.spool)
-    e_pin = prm[0]
-    half = prm[1]
-    v_ext = prm[2]
-    v_ret = prm[3]
-    t_s = prm[4]
-    kpot = prm[5]
-    v0 = prm[6]
-    q = prm[7]
+    e_pin, half, v_ext, v_ret, t_s, kpot, v0, q = prm
     n = target.shape[0]
     h = dt / n_sub
     x = x0
@@ -356,9 +353,10 @@ class KnuckleDrive:
                          "control period and the valve's switching delay, plus the reading's "
                          "quantum): the valve may chatter", StabilityWarning)
         v_ext, v_ret = self.speeds(load)
-        prm = np.array([self._p("pin_offset"), 0.5 * self.stroke, v_ext, v_ret,
-                        self._p("switch_delay"),
-                        self._p("pot_gain"), self._p("pot_offset"), self._p("adc_quantum")])
+        prm = KnuckleConstants(
+            float(self._p("pin_offset")), float(0.5 * self.stroke), float(v_ext), float(v_ret),
+            float(self._p("switch_delay")), float(self._p("pot_gain")),
+            float(self._p("pot_offset")), float(self._p("adc_quantum")))
         out = [np.empty(n) for _ in range(4)]
         cmd_out = np.empty(n, dtype=np.int64)
         spool = np.empty(n, dtype=np.int64)

@@ -68,7 +68,7 @@ import numpy as np
 
 from ...errors import AccuracyWarning, DataError, ModelError, ParameterError, emit_warning
 from .bellows_finger import BAR, TUBE_PUSH_ANGLES, BellowsFinger
-from .valve import ProportionalValve, valve_static
+from .valve import VX, ProportionalValve, valve_static
 
 __all__ = ["FingerPositionController", "PositionResponse", "tip_inverse"]
 
@@ -177,13 +177,13 @@ def _position_loop(p_ref, i_ff, p0, vpar, loops, rec):  # pragma: no cover - com
     kp, ki, kv, i_min, i_max = loops.kp, loops.ki, loops.kv, loops.i_min, loops.i_max
     quantum, dt, n, tau_c, td_c = loops.quantum, loops.dt, loops.n, loops.tau_c, loops.td_c
     pres_out, meas_out, cur_out = rec.pressure, rec.measured, rec.current
-    p_min = vpar[0]
-    p_sup = vpar[1]
-    i_lo = vpar[2]
-    i_hi = vpar[3]
-    w = vpar[4]
-    h = vpar[5]
-    m, a1, a2 = _delay_and_lag(vpar[6], vpar[7], dt)
+    p_min = vpar[VX.p_min]
+    p_sup = vpar[VX.p_supply]
+    i_lo = vpar[VX.i_lo]
+    i_hi = vpar[VX.i_hi]
+    w = vpar[VX.elbow]
+    h = vpar[VX.hysteresis]
+    m, a1, a2 = _delay_and_lag(vpar[VX.delay], vpar[VX.tau], dt)
     nb = m + 2
     # the controller's valve model (delay td_c, lag tau_c) predicts the pressure of the step
     mc, c1, c2 = _delay_and_lag(td_c, tau_c, dt)

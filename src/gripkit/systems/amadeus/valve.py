@@ -47,6 +47,7 @@ appear. :func:`pressure_to_force_plant` expresses the identified model per unit 
 from __future__ import annotations
 
 import math
+from collections import namedtuple
 
 import numba
 import numpy as np
@@ -64,6 +65,9 @@ _SEED = "000_8f66dcc7ab06470c.txt"
 BAR = 1.0e5
 _LN20 = math.log(20.0)
 _NAMES = ("p_min", "p_supply", "i_lo", "i_hi", "elbow", "hysteresis", "delay", "tau")
+#: the index of each valve parameter in the vectors the kernels take, by name
+#: (``thetas[p, VX.i_lo]``), generated from the names: numba folds these module-level ints
+VX = namedtuple("ValveParameterIndex", _NAMES)(*range(len(_NAMES)))
 
 
 def valve_parameters(*, p_min: float = 7.5 * BAR, p_supply: float = 30.0 * BAR, i_lo: float = 0.5,
@@ -138,14 +142,14 @@ def _valve_batch(thetas, u, dt, x0, y):  # pragma: no cover - compiled
     P = thetas.shape[0]
     N = u.shape[0]
     for p in prange(P):
-        p_min = thetas[p, 0]
-        p_sup = thetas[p, 1]
-        i_lo = thetas[p, 2]
-        i_hi = thetas[p, 3]
-        w = thetas[p, 4]
-        h = thetas[p, 5]
-        d = thetas[p, 6] / dt
-        tau = thetas[p, 7]
+        p_min = thetas[p, VX.p_min]
+        p_sup = thetas[p, VX.p_supply]
+        i_lo = thetas[p, VX.i_lo]
+        i_hi = thetas[p, VX.i_hi]
+        w = thetas[p, VX.elbow]
+        h = thetas[p, VX.hysteresis]
+        d = thetas[p, VX.delay] / dt
+        tau = thetas[p, VX.tau]
         m = int(math.floor(d + 1e-9))
         f = d - m
         if f < 1e-9:
