@@ -6,11 +6,12 @@ report). The commands only parse options and print."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import typer
 
-from .common import load_data, write_model_page
+from .common import keyword_or_number, load_data, write_model_page
 
 ValidateOpt = typer.Option(None, "--validate", help="Second record (same columns): the one "
                                                     "validation fit, as gripkit compare gives it.")
@@ -20,6 +21,31 @@ ReportOpt = typer.Option(None, "--report", help="Write an HTML report of the mod
 #: ``--validate`` and ``--out`` of the nonlinear commands (hw, hysteresis, narx, nlss)
 RecordValidateOpt = typer.Option(None, "--validate", help="Validation record (same columns).")
 ModelJsonOpt = typer.Option(None, "--out", help="Write the model (JSON).")
+
+
+@dataclass(frozen=True)
+class KeywordOrNumber:
+    """An option that is a keyword or a number (``--terms auto|N``, ``--exponent free|N``),
+    declared once: :meth:`option` is its typer option, :meth:`parse` its value, the keyword or a
+    ``kind`` in [``low``, ``high``], else a DataError "FLAG: expected EXPECTED, found …" with
+    ``hint``."""
+
+    flag: str
+    default: str
+    keyword: str
+    kind: type
+    low: float
+    high: float
+    expected: str
+    help: str
+    hint: str
+
+    def option(self):
+        return typer.Option(self.default, self.flag, help=self.help)
+
+    def parse(self, value: str):
+        return keyword_or_number(value, self.flag, self.keyword, self.kind, self.low, self.high,
+                                 self.expected, self.hint)
 
 
 def columns(inputs, outputs) -> list[str]:

@@ -13,19 +13,17 @@ import typer
 
 from .app import identify_app
 from .common import (FillOpt, FsOpt, JsonOpt, ModelReportOpt, TimeOpt, check_choice,
-                     check_data_options, collected_warnings, emit_json, keyword_or_number,
-                     report_warnings)
-from .identify_common import (ModelJsonOpt, RecordValidateOpt, data_field, first_record,
-                              records_field, run_identify, save_and_page)
+                     check_data_options, collected_warnings, emit_json, report_warnings)
+from .identify_common import (KeywordOrNumber, ModelJsonOpt, RecordValidateOpt, data_field,
+                              first_record, records_field, run_identify, save_and_page)
 from .identify_linear import DataArgs, _echo_records
 from .paths import output_folder
 
 
-def _exponent(value: str):
-    """``free`` or a number in [1, 10]."""
-    return keyword_or_number(value, "--exponent", "free", float, 1.0, 10.0,
-                             "'free' or a number in [1, 10]",
-                             "--exponent 1 is the seed's Bouc-Wen (eq 3); free estimates it")
+EXPONENT = KeywordOrNumber("--exponent", "1", "free", float, 1.0, 10.0,
+                           "'free' or a number in [1, 10]", "Bouc-Wen exponent n (1 = eq 3 of "
+                           "the seed), or free.", "--exponent 1 is the seed's Bouc-Wen (eq 3); "
+                           "free estimates it")
 
 
 @identify_app.command("hysteresis")
@@ -39,9 +37,7 @@ def identify_hysteresis(data: list[Path] = DataArgs,
                         form: str = typer.Option("actuator", "--form",
                                                  help="Bouc-Wen form: actuator (y = d u − h) "
                                                       "or oscillator (force on a mass)."),
-                        exponent: str = typer.Option("1", "--exponent",
-                                                     help="Bouc-Wen exponent n (1 = eq 3 of the "
-                                                          "seed), or free."),
+                        exponent: str = EXPONENT.option(),
                         operators: int = typer.Option(10, "--operators",
                                                       help="Prandtl-Ishlinskii: number of plays."),
                         burn_in: int = typer.Option(0, "--burn-in",
@@ -58,7 +54,7 @@ def identify_hysteresis(data: list[Path] = DataArgs,
 
     check_choice(model, "--model", MODELS)
     check_choice(form, "--form", FORMS)
-    n = _exponent(exponent)
+    n = EXPONENT.parse(exponent)
     check_data_options(fs, fill)
     output_folder(report, "--report")
     with collected_warnings() as caught:

@@ -1,7 +1,6 @@
 """``gripkit identify nlss DATA --input U[,U2…] --output Y[,Y2…] [--order N] [--degree D]
-[--validate DATA2] [--out MODEL.json] [--report DIR] [--json]``: polynomial nonlinear
-state-space model, through ``gripkit.sysid.identify(data, "nlss", ...)``
-(:func:`gripkit.sysid.nlss`)."""
+[--validate DATA2] [--out MODEL.json] [--json]``: polynomial nonlinear state-space model, through
+``gripkit.sysid.identify(data, "nlss", ...)`` (:func:`gripkit.sysid.nlss`)."""
 
 from __future__ import annotations
 
@@ -11,12 +10,11 @@ from typing import Optional
 import typer
 
 from .app import identify_app
-from .common import (FillOpt, FsOpt, JsonOpt, ModelReportOpt, TimeOpt, check_data_options,
-                     collected_warnings, emit_json, report_warnings)
-from .identify_common import (ModelJsonOpt, RecordValidateOpt, data_field, first_record,
-                              records_field, run_identify, save_and_page)
+from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, collected_warnings,
+                     emit_json, report_warnings)
+from .identify_common import (ModelJsonOpt, RecordValidateOpt, data_field, records_field,
+                              run_identify)
 from .identify_linear import DataArgs, _echo_records
-from .paths import output_folder
 
 
 def _names(value: str, option: str) -> list[str]:
@@ -70,7 +68,6 @@ def identify_nlss(data: list[Path] = DataArgs,
                                                             "window (default 10 time constants)."),
                   validate: Optional[Path] = RecordValidateOpt,
                   out: Optional[Path] = ModelJsonOpt,
-                  report: Optional[Path] = ModelReportOpt,
                   fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
                   json_out: bool = JsonOpt):
     """Polynomial nonlinear state space (PNLSS) from the subspace start, simulation error, σ.
@@ -78,13 +75,13 @@ def identify_nlss(data: list[Path] = DataArgs,
     (``records``: each file's fit)."""
     ins, outs = _names(input_cols, "--input"), _names(output_cols, "--output")
     check_data_options(fs, fill)
-    output_folder(report, "--report")
     with collected_warnings() as caught:
         # several files: one model of every file's record, each with its own initial state
-        m, tr, tv = run_identify(data, "nlss", ins, outs, fs=fs, time=time, fill=fill,
-                                 validate=validate, fit_validate=True, detrend="none",
-                                 order=order, degree=degree, max_order=max_order, window=window)
-        page = save_and_page(m, out, report, first_record(tr), tv, data[0], validate)
+        m = run_identify(data, "nlss", ins, outs, fs=fs, time=time, fill=fill, validate=validate,
+                         fit_validate=True, detrend="none", order=order, degree=degree,
+                         max_order=max_order, window=window)[0]
+        if out is not None:
+            m.save(out)
     lines = report_warnings(caught)
     if json_out:
         params = [{"name": p.name, "value": p.value, "std": p.std, "unit": p.unit,
@@ -104,8 +101,7 @@ def identify_nlss(data: list[Path] = DataArgs,
                             if k not in ("linear_start", "records")},
                    **({"records": records_field(data, m.info["records"])}
                       if len(data) > 1 else {}),
-                   "model": None if out is None else str(out), "report": page,
-                   "warnings": lines})
+                   "model": None if out is None else str(out), "warnings": lines})
     else:
         typer.echo(_summary(m))
         if len(data) > 1:
