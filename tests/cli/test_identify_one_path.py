@@ -106,3 +106,45 @@ def test_rls_help_says_why_it_has_no_out(capsys):
     assert code == 0
     assert "No --out, --report or --validate: the result is a parameter trajectory" in \
         " ".join(capsys.readouterr().out.split())
+
+
+@pytest.mark.parametrize("method, args, options", [
+    # --nb and --nk given, nf not: the fit chooses it (the true system has nb = nf = nk = 1)
+    ("hw", ["--output-nonlinearity", "poly:2", "--nb", "1", "--nk", "1"],
+     dict(output_nonlinearity="poly:2", nb=1, nk=1)),
+    ("nlss", ["--order", "1", "--degree", "2"], dict(order=1, degree=2)),
+    ("hysteresis", ["--model", "prandtl-ishlinskii", "--operators", "4"],
+     dict(model="prandtl-ishlinskii", operators=4)),
+])
+def test_nonlinear_cli_is_the_python_fit(files, capsys, method, args, options):
+    """``identify hw|nlss|hysteresis`` on one file with --validate: the parameters, the fits and
+    the structure are those of ``identify(load(est), method, validate=load(val))``, bit for
+    bit, and the page of --report (hw, hysteresis) is ``model.report`` on the validation
+    record."""
+    report = [] if method == "nlss" else ["--report", files["dir"] / f"rep-{method}"]
+    res = _json(capsys, "identify", method, files["est"], "--input", "u", "--output", "y", *args,
+                "--validate", files["val"], *report)
+    py = identify(load(files["est"]), method, input="u", output="y",
+                  validate=load(files["val"]), **options)
+    assert [p["value"] for p in res["parameters"]] == [p.value for p in py.parameters.values()] \
+        if method != "hw" else [p["value"] for p in res["parameters"]] == py.theta.tolist()
+    assert res["fit_percent"] == py.fit_percent
+    assert res["validation"]["fit_percent"] == py.validation_fit_percent
+    assert res["structure"]["criterion"] == py.criterion
+    if report:
+        page = (files["dir"] / f"rep-{method}" / "index.html").read_text(encoding="utf-8")
+        fit = py.compare(load(files["val"])).fit_percent[0]
+        assert "data val.csv" in page and f"<td>{fit:.2f} %</td>" in page
+    if method == "hw":  # nf chosen, as in Python: the true order
+        assert (res["structure"]["nb"], res["structure"]["nf"], res["structure"]["nk"]) == (1, 1, 1)
+
+
+def test_identify_hw_chooses_the_orders_not_given(files):
+    """``identify(tr, 'hw')`` without orders chooses nb, nf, nk (by BIC without ``validate``):
+    the true [1 1 1] of y = 0.4 q⁻¹/(1 − 0.7 q⁻¹) u, where the linear defaults [2 2 1] were
+    taken before; with ``nb=2`` given, nb stays 2."""
+    tr = load(files["est"])
+    m = identify(tr, "hw", input="u", output="y", output_nonlinearity="poly:2")
+    assert (m.nb, m.nf, m.nk) == (1, 1, 1) and "by BIC" in m.criterion
+    m = identify(tr, "hw", input="u", output="y", output_nonlinearity="poly:2", nb=2)
+    assert m.nb == 2

@@ -1,16 +1,17 @@
 """The shell of every ``gripkit identify`` command that yields a model: read the data files into
 trajectories, one call of :func:`gripkit.sysid.identify`, one call of
 :func:`gripkit.sysid.identify_results.validate_model` for ``--validate``, then ``--out`` (the model
-file: every model saves itself) and ``--report`` (the HTML model
+file: every model saves itself) and ``--report`` (``model.report``: every model writes its HTML
 report). The commands only parse options and print."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 
 import typer
 
-from .common import load_data, write_model_page
+from .common import keyword_or_number, load_data, write_model_page
 
 DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
 #: DATA of the commands that fit one model of several records
@@ -25,6 +26,31 @@ ReportOpt = typer.Option(None, "--report", help="Write an HTML report of the mod
 #: ``--validate`` and ``--out`` of the nonlinear commands (hw, hysteresis, narx, nlss)
 RecordValidateOpt = typer.Option(None, "--validate", help="Validation record (same columns).")
 ModelJsonOpt = typer.Option(None, "--out", help="Write the model (JSON).")
+
+
+@dataclass(frozen=True)
+class KeywordOrNumber:
+    """An option that is a keyword or a number (``--terms auto|N``, ``--exponent free|N``),
+    declared once: :meth:`option` is its typer option, :meth:`parse` its value, the keyword or a
+    ``kind`` in [``low``, ``high``], else a DataError "FLAG: expected EXPECTED, found …" with
+    ``hint``."""
+
+    flag: str
+    default: str
+    keyword: str
+    kind: type
+    low: float
+    high: float
+    expected: str
+    help: str
+    hint: str
+
+    def option(self):
+        return typer.Option(self.default, self.flag, help=self.help)
+
+    def parse(self, value: str):
+        return keyword_or_number(value, self.flag, self.keyword, self.kind, self.low, self.high,
+                                 self.expected, self.hint)
 
 
 def columns(inputs, outputs) -> list[str]:
@@ -47,8 +73,8 @@ def run_identify(data: list[Path], method: str, input, output, *, fs, time, fill
     """Load ``data`` (one file: a trajectory; several: one model of all the records) and
     ``validate``, and call :func:`gripkit.sysid.identify` once (``fit_validate``: with the
     validation record as its ``validate`` option, for the methods that rank or select by it:
-    ss, search, narx); errors about ``data[i]`` name the file. Returns ``(model, trajectory or
-    list of them, validation trajectory or None)``."""
+    ss, search, narx, hw, nlss, hysteresis); errors about ``data[i]`` name the file. Returns
+    ``(model, trajectory or list of them, validation trajectory or None)``."""
     from ..errors import GripkitError
     from ..sysid import identify
 
@@ -95,15 +121,13 @@ def save_and_report(model, tr, data: list[Path], out: Path | None, report: Path 
         fm.save(out)
     if report is None:
         return
-    from ..sysid.model_report import write_model_report
-
     if len(data) == 1:
-        write_model_report(fm, tr, report, data_name=Path(data[0]).name)
+        fm.report(tr, report, data_name=Path(data[0]).name)
         return
     stems = [Path(p).stem for p in data]
     for i, (path, record) in enumerate(zip(data, tr)):
         folder = stems[i] if stems.count(stems[i]) == 1 else f"{i + 1}-{stems[i]}"
-        write_model_report(fm, record, Path(report) / folder, data_name=Path(path).name)
+        fm.report(record, Path(report) / folder, data_name=Path(path).name)
 
 
 def save_and_page(model, out: Path | None, report: Path | None, record, vrecord,
@@ -117,6 +141,11 @@ def save_and_page(model, out: Path | None, report: Path | None, record, vrecord,
         return None
     return write_model_page(model, record if vrecord is None else vrecord, report,
                             data_path if validate is None else validate)
+
+
+def first_record(tr):
+    """The record of the one file, or the first of several (what ``run_identify`` loaded)."""
+    return tr if not isinstance(tr, list) else tr[0]
 
 
 def data_field(data: list[Path]) -> str | list[str]:

@@ -1,7 +1,7 @@
 """``gripkit identify hw DATA --input U --output Y [--input-nonlinearity KIND[:N]]
 [--output-nonlinearity KIND[:N]] [--nb NB --nf NF --nk NK] [--validate DATA2] [--out MODEL.json]
-[--json]``: Hammerstein, Wiener and Hammerstein–Wiener models
-(:func:`gripkit.sysid.hammerstein_wiener`)."""
+[--json]``: Hammerstein, Wiener and Hammerstein–Wiener models, through
+``gripkit.sysid.identify(data, "hw", ...)`` (:func:`gripkit.sysid.hammerstein_wiener`)."""
 
 from __future__ import annotations
 
@@ -11,11 +11,11 @@ from typing import Optional
 import typer
 
 from .app import identify_app
-from .identify_common import (ModelJsonOpt, RecordValidateOpt, data_field, records_field,
-                              run_identify, save_and_page)
+from .identify_common import (ModelJsonOpt, RecordValidateOpt, data_field, first_record,
+                              records_field, run_identify, save_and_page)
 from .identify_linear import DataArgs, _echo_records
 from .common import (FillOpt, FsOpt, JsonOpt, ModelReportOpt, TimeOpt, check_data_options,
-                     collected_warnings, emit_json, load_data, report_warnings)
+                     collected_warnings, emit_json, report_warnings)
 from .paths import output_folder
 
 
@@ -51,9 +51,7 @@ def identify_hw(data: list[Path] = DataArgs,
     """Hammerstein / Wiener / Hammerstein–Wiener: static nonlinearities around B/F, PEM, σ.
     Several DATA files: one model of all the records, each from its own steady state
     (``records``: each file's fit and w₋)."""
-    import numpy as np
-
-    from ..sysid.nonlinear.hammerstein_wiener import hammerstein_wiener, parse_nonlinearity
+    from ..sysid.nonlinear.hammerstein_wiener import parse_nonlinearity
 
     for spec, name in ((input_nl, "--input-nonlinearity"), (output_nl, "--output-nonlinearity")):
         if spec is not None:
@@ -61,21 +59,12 @@ def identify_hw(data: list[Path] = DataArgs,
     check_data_options(fs, fill)
     output_folder(report, "--report")
     with collected_warnings() as caught:
-        tr = load_data(data[0], [input_col, output_col], fs, time, fill)
-        val = tv = None
-        if validate is not None:
-            tv = load_data(validate, [input_col, output_col], fs, time, fill)
-            val = (np.asarray(tv[input_col]), np.asarray(tv[output_col]))
-        if len(data) > 1:  # one model of every file's record, each from its own steady state
-            m = run_identify(data, "hw", input_col, output_col, fs=fs, time=time, fill=fill,
-                             detrend="none", nb=nb, nf=nf, nk=nk, input_nonlinearity=input_nl,
-                             output_nonlinearity=output_nl, validate=val, progress=True)[0]
-        else:
-            m = hammerstein_wiener(np.asarray(tr[input_col]), np.asarray(tr[output_col]),
-                                   input_nonlinearity=input_nl, output_nonlinearity=output_nl,
-                                   nb=nb, nf=nf, nk=nk, dt=tr.dt, validate=val, progress=True)
-        m.input_name, m.output_name = input_col, output_col
-        page = save_and_page(m, out, report, tr, tv, data[0], validate)
+        # several files: one model of every file's record, each from its own steady state
+        m, tr, tv = run_identify(data, "hw", input_col, output_col, fs=fs, time=time, fill=fill,
+                                 validate=validate, fit_validate=True, detrend="none", nb=nb,
+                                 nf=nf, nk=nk, input_nonlinearity=input_nl,
+                                 output_nonlinearity=output_nl, progress=True)
+        page = save_and_page(m, out, report, first_record(tr), tv, data[0], validate)
     lines = report_warnings(caught)
     if json_out:
         emit_json({"data": data_field(data),

@@ -1,7 +1,8 @@
 """``gripkit identify hysteresis DATA --input U --output Y [--model bouc-wen|prandtl-ishlinskii]
 [--form actuator|oscillator] [--exponent N|free] [--operators M] [--validate DATA2]
 [--out MODEL.json] [--json]``: a generic Bouc-Wen (actuator or oscillator form) or
-Prandtl–Ishlinskii hysteresis from a record (:func:`gripkit.sysid.hysteresis`)."""
+Prandtl–Ishlinskii hysteresis from a record, through ``gripkit.sysid.identify(data,
+"hysteresis", ...)`` (:func:`gripkit.sysid.hysteresis`)."""
 
 from __future__ import annotations
 
@@ -12,19 +13,17 @@ import typer
 
 from .app import identify_app
 from .common import (FillOpt, FsOpt, JsonOpt, ModelReportOpt, TimeOpt, check_choice,
-                     check_data_options, collected_warnings, emit_json, keyword_or_number,
-                     load_data, report_warnings)
-from .identify_common import (ModelJsonOpt, RecordValidateOpt, data_field, records_field,
-                              run_identify, save_and_page)
+                     check_data_options, collected_warnings, emit_json, report_warnings)
+from .identify_common import (KeywordOrNumber, ModelJsonOpt, RecordValidateOpt, data_field,
+                              first_record, records_field, run_identify, save_and_page)
 from .identify_linear import DataArgs, _echo_records
 from .paths import output_folder
 
 
-def _exponent(value: str):
-    """``free`` or a number in [1, 10]."""
-    return keyword_or_number(value, "--exponent", "free", float, 1.0, 10.0,
-                             "'free' or a number in [1, 10]",
-                             "--exponent 1 is the seed's Bouc-Wen (eq 3); free estimates it")
+EXPONENT = KeywordOrNumber("--exponent", "1", "free", float, 1.0, 10.0,
+                           "'free' or a number in [1, 10]", "Bouc-Wen exponent n (1 = eq 3 of "
+                           "the seed), or free.", "--exponent 1 is the seed's Bouc-Wen (eq 3); "
+                           "free estimates it")
 
 
 @identify_app.command("hysteresis")
@@ -38,9 +37,7 @@ def identify_hysteresis(data: list[Path] = DataArgs,
                         form: str = typer.Option("actuator", "--form",
                                                  help="Bouc-Wen form: actuator (y = d u − h) "
                                                       "or oscillator (force on a mass)."),
-                        exponent: str = typer.Option("1", "--exponent",
-                                                     help="Bouc-Wen exponent n (1 = eq 3 of the "
-                                                          "seed), or free."),
+                        exponent: str = EXPONENT.option(),
                         operators: int = typer.Option(10, "--operators",
                                                       help="Prandtl-Ishlinskii: number of plays."),
                         burn_in: int = typer.Option(0, "--burn-in",
@@ -53,26 +50,20 @@ def identify_hysteresis(data: list[Path] = DataArgs,
     """Hysteresis (Bouc-Wen or Prandtl-Ishlinskii): parameters with σ, free-run fit. Several
     DATA files: one model of all the records, each from its own relaxed state (``records``:
     each file's fit)."""
-    from ..sysid.nonlinear.hysteresis import FORMS, MODELS, hysteresis
+    from ..sysid.nonlinear.hysteresis import FORMS, MODELS
 
     check_choice(model, "--model", MODELS)
     check_choice(form, "--form", FORMS)
-    n = _exponent(exponent)
+    n = EXPONENT.parse(exponent)
     check_data_options(fs, fill)
     output_folder(report, "--report")
     with collected_warnings() as caught:
-        tr = load_data(data[0], [input_col, output_col], fs, time, fill)
-        val = None
-        if validate is not None:
-            val = load_data(validate, [input_col, output_col], fs, time, fill)
-        opts = dict(form=form, exponent=n, operators=operators, burn_in=burn_in, validate=val,
-                    progress=not json_out)
-        if len(data) > 1:  # one model of every file's record, each from its own relaxed state
-            m = run_identify(data, "hysteresis", input_col, output_col, fs=fs, time=time,
-                             fill=fill, detrend="none", model=model, **opts)[0]
-        else:
-            m = hysteresis(tr, model, input=input_col, output=output_col, **opts)
-        page = save_and_page(m, out, report, tr, val, data[0], validate)
+        # several files: one model of every file's record, each from its own relaxed state
+        m, tr, val = run_identify(data, "hysteresis", input_col, output_col, fs=fs, time=time,
+                                  fill=fill, validate=validate, fit_validate=True,
+                                  detrend="none", model=model, form=form, exponent=n,
+                                  operators=operators, burn_in=burn_in, progress=not json_out)
+        page = save_and_page(m, out, report, first_record(tr), val, data[0], validate)
     lines = report_warnings(caught)
     if json_out:
         structure = ({"model": model, "form": form, "exponent": m.n,

@@ -13,17 +13,15 @@ import typer
 
 from .app import identify_app
 from .common import (FillOpt, FsOpt, JsonOpt, ModelReportOpt, TimeOpt, check_data_options,
-                     collected_warnings, emit_json, keyword_or_number, report_warnings,
-                     write_model_page)
-from .identify_common import (ModelJsonOpt, RecordValidateOpt, check_outputs, run_identify,
-                              validation)
+                     collected_warnings, emit_json, report_warnings)
+from .identify_common import (KeywordOrNumber, ModelJsonOpt, RecordValidateOpt, check_outputs,
+                              run_identify, save_and_page, validation)
 
 
-def _terms(value: str):
-    """``auto`` or a positive integer."""
-    return keyword_or_number(value, "--terms", "auto", int, 1, math.inf,
-                             "'auto' or a positive integer",
-                             "--terms auto chooses the number by BIC (or by --validate's fit)")
+TERMS = KeywordOrNumber("--terms", "auto", "auto", int, 1, math.inf,
+                        "'auto' or a positive integer", "Number of terms, or auto (BIC; with "
+                        "--validate the free-run validation fit).", "--terms auto chooses the "
+                        "number by BIC (or by --validate's fit)")
 
 
 def _summary(m) -> str:
@@ -47,9 +45,7 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
                   lags: int = typer.Option(2, "--lags", help="Output and input lags."),
                   ylags: Optional[int] = typer.Option(None, "--ylags", help="Output lags."),
                   ulags: Optional[int] = typer.Option(None, "--ulags", help="Input lags."),
-                  terms: str = typer.Option("auto", "--terms",
-                                            help="Number of terms, or auto (BIC; with --validate "
-                                                 "the free-run validation fit)."),
+                  terms: str = TERMS.option(),
                   refine: str = typer.Option("none", "--refine",
                                              help="none (one-step least squares) or simulation "
                                                   "(θ refined on the free-run error)."),
@@ -58,10 +54,9 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
                   report: Optional[Path] = ModelReportOpt,
                   fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
                   json_out: bool = JsonOpt):
-    """Polynomial NARX: terms by error reduction ratio (FROLS), θ with σ, pruning, free-run fit.
-    No --report: the model report draws the frequency response, poles and residuals of a linear
-    model, which a NARX model has not; gripkit compare MODEL.json DATA gives its free-run fit."""
-    n_terms = _terms(terms)
+    """Polynomial NARX: terms by error reduction ratio (FROLS), θ with σ, pruning, free-run fit;
+    --report: the model's page on the --validate record (else on the record)."""
+    n_terms = TERMS.parse(terms)
     if refine not in ("none", "simulation"):
         from ..errors import DataError
 
@@ -74,11 +69,8 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
                                   fill=fill, validate=validate, fit_validate=True, degree=degree,
                                   lags=lags, ylags=ylags, ulags=ulags, terms=n_terms,
                                   refine=None if refine == "none" else refine, progress=True)
-        if out is not None:
-            m.save(out)
         val = validation(m, vtr, validate)
-        page = None if report is None else write_model_page(
-            m, tr if vtr is None else vtr, report, data if validate is None else validate)
+        page = save_and_page(m, out, report, tr, vtr, data, validate)
     lines = report_warnings(caught)
     if json_out:
         emit_json({"data": str(data), "input": input_col, "output": output_col,

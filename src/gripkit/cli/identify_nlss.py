@@ -1,6 +1,6 @@
 """``gripkit identify nlss DATA --input U[,U2…] --output Y[,Y2…] [--order N] [--degree D]
-[--validate DATA2] [--out MODEL.json] [--json]``: polynomial nonlinear state-space model
-(:func:`gripkit.sysid.nlss`)."""
+[--validate DATA2] [--out MODEL.json] [--json]``: polynomial nonlinear state-space model, through
+``gripkit.sysid.identify(data, "nlss", ...)`` (:func:`gripkit.sysid.nlss`)."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import typer
 
 from .app import identify_app
 from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, collected_warnings,
-                     emit_json, load_data, report_warnings)
+                     emit_json, report_warnings)
 from .identify_common import (ModelJsonOpt, RecordValidateOpt, data_field, records_field,
                               run_identify)
 from .identify_linear import DataArgs, _echo_records
@@ -73,19 +73,13 @@ def identify_nlss(data: list[Path] = DataArgs,
     """Polynomial nonlinear state space (PNLSS) from the subspace start, simulation error, σ.
     Several DATA files: one model of all the records, each with its own initial state
     (``records``: each file's fit)."""
-    from ..sysid.nonlinear.nlss import nlss
-
     ins, outs = _names(input_cols, "--input"), _names(output_cols, "--output")
     check_data_options(fs, fill)
     with collected_warnings() as caught:
-        tv = None if validate is None else load_data(validate, ins + outs, fs, time, fill)
-        opts = dict(order=order, degree=degree, max_order=max_order, window=window, validate=tv)
-        if len(data) > 1:  # one model of every file's record, each with its own initial state
-            m = run_identify(data, "nlss", ins, outs, fs=fs, time=time, fill=fill, detrend="none",
-                             **opts)[0]
-        else:
-            tr = load_data(data[0], ins + outs, fs, time, fill)
-            m = nlss(tr, input=ins, output=outs, **opts)
+        # several files: one model of every file's record, each with its own initial state
+        m = run_identify(data, "nlss", ins, outs, fs=fs, time=time, fill=fill, validate=validate,
+                         fit_validate=True, detrend="none", order=order, degree=degree,
+                         max_order=max_order, window=window)[0]
         if out is not None:
             m.save(out)
     lines = report_warnings(caught)

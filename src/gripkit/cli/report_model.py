@@ -1,6 +1,6 @@
 """``gripkit report MODEL.json DATA --out DIR``: one self-contained HTML page of a saved model on a
-record: a linear model by :mod:`gripkit.sysid.model_report` (poles, Bode), every other family
-through the model protocol by :mod:`gripkit.sysid.protocol_report`."""
+record, ``model.report(data, out)`` (:class:`gripkit.sysid.model_protocol.ReportMixin`): a linear
+model's poles and Bode, every other family's page through the model protocol."""
 
 from __future__ import annotations
 
@@ -25,23 +25,13 @@ def report_model(model: Path = typer.Argument(..., help="Model file written by "
                  json_out: bool = JsonOpt):
     """HTML report: measured vs simulated per output, residual correlations, parameters with σ;
     for linear models also poles and Bode with σ."""
-    from ..sysid.model_protocol import file_schema
     from .compare import _model_and_data
 
-    # a file without a readable schema goes to the linear reader, which names what is wrong
-    linear = file_schema(model) in (None, "gripkit.linear-model")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         m, tr = _model_and_data(model, data, fs, time, fill, outputs=True)
-        if linear:  # poles, Bode and innovation residuals (gripkit.sysid.model_report)
-            from ..sysid.model_report import write_model_report
-
-            index = write_model_report(m, tr, out, data_name=Path(data).name)
-            fit = None
-        else:  # any other family, through the model protocol alone
-            from ..sysid.protocol_report import write_protocol_report
-
-            index, fit = write_protocol_report(m, tr, out, data_name=Path(data).name)
+        index = m.report(tr, out, data_name=Path(data).name)
+        fit = m.compare(tr) if json_out else None
     res = {"model": str(model), "data": str(data), "report": str(index)}
     if fit is not None:
         res.update(structure=m.structure, outputs=list(m.outputs),

@@ -131,10 +131,20 @@ def method_options(method: str) -> list[str]:
     return names
 
 
+#: the orders of the linear methods (arx, armax, oe, rls, search) that are not given
+LINEAR_ORDERS = {"na": 2, "nb": 2, "nk": 1, "nc": 1}
+
+
+def _linear_orders(na, nb, nk, nc) -> tuple:
+    """(na, nb, nk, nc) with each one not given (None) at its :data:`LINEAR_ORDERS` value."""
+    return tuple(LINEAR_ORDERS[k] if v is None else v
+                 for k, v in zip(("na", "nb", "nk", "nc"), (na, nb, nk, nc)))
+
+
 @entry_point
-def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, na: int = 2,
-             nb: int = 2,
-             nk: int = 1, nc: int = 1, nf: int | None = None, detrend: str = "mean", **options):
+def identify(data: Trajectory, method: str = "arx", *, input: str, output: str,
+             na: int | None = None, nb: int | None = None, nk: int | None = None,
+             nc: int | None = None, nf: int | None = None, detrend: str = "mean", **options):
     """Identify a linear model of ``output`` driven by ``input`` from a trajectory.
 
     Parameters
@@ -154,8 +164,9 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
         function, options ``poles``, ``zeros``); ``'narx'`` (polynomial NARX on the data as they
         are, its constant term in place of detrending; options of
         :func:`gripkit.sysid.narx`: ``degree``, ``lags``, ``terms``, ``validate`` …); ``'hw'``
-        (Hammerstein–Wiener on the data as they are, with this function's ``nb``, ``nk`` and
-        ``nf`` (default ``nb``); the array function searches the orders; options of
+        (Hammerstein–Wiener on the data as they are, with this function's ``nb``, ``nf``, ``nk``:
+        each one not given is chosen by the array function, by the free-run fit on ``validate``
+        (a trajectory or ``(u, y)``) or by BIC; options of
         :func:`gripkit.sysid.hammerstein_wiener`: ``input_nonlinearity``,
         ``output_nonlinearity``, ``validate`` …); ``'hysteresis'`` (Bouc-Wen or Prandtl–Ishlinskii,
         options of
@@ -165,6 +176,9 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str, 
         several columns (``'a,b'`` or a list).
     input, output
         Column names.
+    na, nb, nk, nc, nf
+        Orders. Not given (None): for arx, armax, oe, rls and search ``na = nb = 2``, ``nk = 1``,
+        ``nc = 1`` (:data:`LINEAR_ORDERS`) and ``nf = na``; for hw chosen by the fit.
     detrend
         ``'mean'`` (default), ``'linear'`` or ``'none'``; see :func:`io_data`.
     **options
@@ -212,8 +226,8 @@ def with_provenance(model, provenance: dict):
     return model
 
 
-def _dispatch(data, method: str, *, input, output, na: int, nb: int, nk: int, nc: int,
-              nf: int | None, detrend: str, **options):
+def _dispatch(data, method: str, *, input, output, na: int | None, nb: int | None,
+              nk: int | None, nc: int | None, nf: int | None, detrend: str, **options):
     """The fit of :func:`identify`, its arguments checked."""
     if isinstance(data, (list, tuple)):  # several records, one model
         return identify_records(data, method, input=input, output=output, na=na, nb=nb, nk=nk,
@@ -230,27 +244,26 @@ def _dispatch(data, method: str, *, input, output, na: int, nb: int, nk: int, nc
         # a model file saved from it shows its columns in the data file's units (force [mN])
         return out.with_display_units(data) if hasattr(out, "with_display_units") else out
     if method == "arx" and identify_mimo.several(input, output):  # matrix-polynomial ARX
+        na, nb, nk, _ = _linear_orders(na, nb, nk, nc)
         return identify_mimo.identify_arx(data, input=input, output=output, na=na, nb=nb, nk=nk,
                                           detrend=detrend).with_display_units(data)
     if method == "nlss":  # the model carries the operating point (input and output means)
         return nonlinear.nlss(data, input=input, output=output, **options)
     if method == "narx":  # the model's constant term carries the operating point
         io = io_data(data, input=input, output=output, detrend="none", why="NARX identification")
-        if isinstance(options.get("validate"), Trajectory):  # the record as it is, as estimation
-            vd = validation_data(options["validate"], io)
-            options = {**options, "validate": (vd.u1, vd.y1)}
-        model = nonlinear.narx(io.u1, io.y1, dt=io.dt, **options)
+        model = nonlinear.narx(io.u1, io.y1, dt=io.dt, **_validation_arrays(options, io))
         model.input_name, model.output_name = input, output
         return model
-    if method == "hw":  # the offset y0 carries the operating point; orders as given here
+    if method == "hw":  # the offset y0 carries the operating point; orders not given: chosen
         io = io_data(data, input=input, output=output, detrend="none",
                      why="Hammerstein-Wiener identification")
-        model = nonlinear.hammerstein_wiener(io.u1, io.y1, nb=nb, nf=nb if nf is None else nf,
-                                             nk=nk, dt=io.dt, **options)
+        model = nonlinear.hammerstein_wiener(io.u1, io.y1, nb=nb, nf=nf, nk=nk, dt=io.dt,
+                                             **_validation_arrays(options, io))
         model.input_name, model.output_name = input, output
         return model
     if method == "hysteresis":  # rate independent, its offset a parameter: the data as they are
         return nonlinear.hysteresis(data, input=input, output=output, **options)
+    na, nb, nk, nc = _linear_orders(na, nb, nk, nc)
     io = (io_data(data, input=input, output=output, detrend=detrend,
                   why=f"{method.upper()} identification"))
     if method in ("arx", "armax", "oe"):
@@ -340,9 +353,9 @@ def _per_record(i: int, fn, *args, **kw):
         raise type(exc)(f"data[{i}]: {exc.message}", hint=exc.hint) from None
 
 
-def identify_records(data, method: str = "arx", *, input, output, na: int = 2, nb: int = 2,
-                     nk: int = 1, nc: int = 1, nf: int | None = None, detrend: str = "mean",
-                     **options):
+def identify_records(data, method: str = "arx", *, input, output, na: int | None = None,
+                     nb: int | None = None, nk: int | None = None, nc: int | None = None,
+                     nf: int | None = None, detrend: str = "mean", **options):
     """One model from several records (a list of :class:`~gripkit.signals.Trajectory` with the
     same columns, sample interval and units), each with its own initial conditions; σ from all
     of them: ARX (:func:`gripkit.sysid.arx_records`; with several columns
@@ -358,7 +371,8 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
     (:func:`gripkit.sysid.narx` on the records as they are, its constant term in place of
     ``detrend``; ``options`` of that function), Hammerstein–Wiener (each record from its own
     steady state: :func:`gripkit.sysid.hammerstein_wiener` on the records as they are, with
-    this function's ``nb``, ``nf`` (default ``nb``), ``nk``), hysteresis (each record from its
+    this function's ``nb``, ``nf``, ``nk``, each one not given chosen), hysteresis (each record
+    from its
     own relaxed state: :func:`gripkit.sysid.hysteresis`) and nonlinear state space (each record
     its own initial state: :func:`gripkit.sysid.nlss`; ``input``/``output`` may name several
     columns); these three ignore ``detrend`` (their models carry the operating point). This is what
@@ -368,27 +382,13 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
     together (each channel's samples pooled), stored as ``u_offset``/``y_offset``;
     ``detrend='none'`` keeps the data as they are. ``'linear'`` is refused: each record's own
     line would give each record its own operating point, which one model cannot have.
-    ``fit_percent`` per record is in ``info['records']``.
+    ``fit_percent`` per record is in ``info['records']``. Orders not given: as
+    :func:`identify`.
     """
-    if method not in RECORD_METHODS:
-        raise ArgumentError(f"identify(): several records (a list of {len(data)} trajectories) are "
-                            f"fitted by method {', '.join(map(repr, RECORD_METHODS))} only, found "
-                            f"method {method!r}",
-                            hint=f"pass one trajectory, or use method {', '.join(RECORD_METHODS)}")
-    if not data:
-        raise DataError("data: expected a trajectory or a non-empty list of them, found an empty "
-                        "list")
-    for i, d in enumerate(data):
-        if not isinstance(d, Trajectory):
-            raise DataError(f"data[{i}]: expected a gripkit Trajectory, found {type(d).__name__}",
-                            hint="use gripkit.io.load(path) or "
-                                 "Trajectory.uniform(dt=..., u=..., y=...)")
-    if detrend not in ("mean", "none"):
-        raise DataError(f"detrend: with several records expected 'mean' (one operating point: the "
-                        f"mean of all records) or 'none', found {detrend!r}",
-                        hint="detrend 'linear' would give every record its own operating point; "
-                             "detrend the records before, or use 'mean'")
+    _check_records(data, method, detrend)
     why = f"{method.upper()} identification"
+    hw_orders = dict(nb=nb, nf=nf, nk=nk)  # each one not given is chosen by the fit
+    na, nb, nk, nc = _linear_orders(na, nb, nk, nc)
     if method == "nlss":  # the model carries the operating point; input/output may be several
         for i, d in enumerate(data):
             _per_record(i, identify_mimo.mimo_data, d, input, output, "none", why=why)
@@ -420,13 +420,12 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
            for i, d in enumerate(data)]
     _same_sampling([(io.dt, (io.input_unit, io.output_unit)) for io in ios],
                    (ios[0].input, ios[0].output))
-    if method == "narx":  # the data as they are: the model's constant carries the operating point
-        model = _as_data(nonlinear.narx, [(io.u1, io.y1) for io in ios], dt=ios[0].dt, **options)
-        model.input_name, model.output_name = input, output
-        return model
-    if method == "hw":  # each record from its own steady state, the offset y0 shared
-        model = _as_data(nonlinear.hammerstein_wiener, [(io.u1, io.y1) for io in ios], nb=nb,
-                         nf=nb if nf is None else nf, nk=nk, dt=ios[0].dt, **options)
+    if method in ("narx", "hw"):  # the data as they are: NARX's constant, HW's y0 (shared; each
+        # record from its own steady state) carry the operating point
+        fit, orders = ((nonlinear.narx, {}) if method == "narx" else
+                       (nonlinear.hammerstein_wiener, hw_orders))
+        model = _as_data(fit, [(io.u1, io.y1) for io in ios], dt=ios[0].dt, **orders,
+                         **_validation_arrays(options, ios[0]))
         model.input_name, model.output_name = input, output
         return model
     if method == "hysteresis":  # each record from its own relaxed state, the data as they are
@@ -440,6 +439,38 @@ def identify_records(data, method: str = "arx", *, input, output, na: int = 2, n
     if method == "armax":
         return _as_data(armax_records, records, na, nb, nc, nk, **meta)
     return _as_data(oe_records, records, nb, na if nf is None else nf, nk, **meta)
+
+
+def _check_records(data, method: str, detrend: str) -> None:
+    """The arguments of :func:`identify_records` that need no record read, or an error."""
+    if method not in RECORD_METHODS:
+        raise ArgumentError(f"identify(): several records (a list of {len(data)} trajectories) are "
+                            f"fitted by method {', '.join(map(repr, RECORD_METHODS))} only, found "
+                            f"method {method!r}",
+                            hint=f"pass one trajectory, or use method {', '.join(RECORD_METHODS)}")
+    if not data:
+        raise DataError("data: expected a trajectory or a non-empty list of them, found an empty "
+                        "list")
+    for i, d in enumerate(data):
+        if not isinstance(d, Trajectory):
+            raise DataError(f"data[{i}]: expected a gripkit Trajectory, found {type(d).__name__}",
+                            hint="use gripkit.io.load(path) or "
+                                 "Trajectory.uniform(dt=..., u=..., y=...)")
+    if detrend not in ("mean", "none"):
+        raise DataError(f"detrend: with several records expected 'mean' (one operating point: the "
+                        f"mean of all records) or 'none', found {detrend!r}",
+                        hint="detrend 'linear' would give every record its own operating point; "
+                             "detrend the records before, or use 'mean'")
+
+
+def _validation_arrays(options: dict, io: IOData) -> dict:
+    """``options`` with a trajectory ``validate`` given as the arrays ``(u, y)`` of its columns,
+    as they are (``io`` the estimation record, read without detrending): what narx and
+    hammerstein_wiener take."""
+    if not isinstance(options.get("validate"), Trajectory):
+        return options
+    vd = validation_data(options["validate"], io)
+    return {**options, "validate": (vd.u1, vd.y1)}
 
 
 def _as_data(fit, records, *args, **kw):

@@ -11,19 +11,29 @@ Hammerstein–Wiener, nonlinear state space, hysteresis) is an object with these
     m.simulate(data)             # free run on data's input columns -> (N, ny), in the file's units
     m.compare(data)              # ModelFit: the fit (%) per output by m.fit_definition
     m.save(path)                 # atomic JSON; load_model(path) gives the same type back
+    m.report(data, out)          # out/index.html: the HTML report gripkit report writes
 
 The linear families (:class:`~gripkit.sysid.linear.linear_model.IdentifiedLinearModel`: state
 space, transfer function, ARX/ARMAX/OE) and NARX also give ``m.fit_definition`` (how ``compare``
 scores), ``m.predict(data, horizon=1)``, ``m.residuals(data)``; the linear ones ``m.to_ss()``,
-``m.to_tf()``, ``m.to_control()`` (and their HTML report is
-:func:`gripkit.sysid.model_report.write_model_report`). Optional: ``m.initial_state``, how
+``m.to_tf()``, ``m.to_control()``. Optional: ``m.initial_state``, how
 ``compare`` starts the free run (``'estimated'`` for the linear models, ``'measured'`` for NARX;
 ``gripkit compare --json`` states it when the model has it), and
 ``m.display_units`` / ``m.system.output_units`` for :func:`simulated_trajectory`.
 
+``report`` is written once, on :class:`ReportMixin`, the base of every model class: it names
+the page its family gets (``_report_page``: ``'linear'``, the poles, Bode with σ and innovation
+residuals of :mod:`gripkit.sysid.model_report`; ``'protocol'``, the page of any family built on
+these names alone, :mod:`gripkit.sysid.protocol_report`) and finds the writer through the table
+:data:`MODEL_REPORTS` (page → module of this package and the writer's name), imported when a
+report is written. So the report modules, which import the linear models, stay above every
+model module, and no model module imports them: the table names them, as :data:`MODEL_FILES`
+names the readers.
+
 A model family registers its JSON schema in :data:`MODEL_FILES` (schema → module of this package
 and the name of its reader); `load_model` reads the schema and hands the file to that reader.
-A new family goes into ``sysid/nonlinear/`` (or ``sysid/linear/``) and adds one line here.
+A new family goes into ``sysid/nonlinear/`` (or ``sysid/linear/``), derives its model class from
+:class:`ReportMixin` and adds one line here.
 """
 
 from __future__ import annotations
@@ -36,11 +46,11 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from ..errors import ModelError, PathError
+from ..errors import ArgumentError, DataError, ModelError, PathError
 from ..signals.trajectory import Trajectory
 
-__all__ = ["IdentifiedModel", "ModelFit", "MODEL_FILES", "file_schema", "load_model",
-           "simulated_trajectory"]
+__all__ = ["IdentifiedModel", "ModelFit", "MODEL_FILES", "MODEL_REPORTS", "ReportMixin",
+           "file_schema", "load_model", "report_record", "simulated_trajectory"]
 
 
 @dataclass(frozen=True)
@@ -73,6 +83,8 @@ class IdentifiedModel(Protocol):
 
     def save(self, path) -> object: ...
 
+    def report(self, data, out, *args, **kwargs) -> Path: ...
+
 
 # schema -> (module of gripkit.sysid, reader function); one line per model family
 MODEL_FILES: dict[str, tuple[str, str]] = {
@@ -82,6 +94,81 @@ MODEL_FILES: dict[str, tuple[str, str]] = {
     "gripkit.hysteresis-model": ("nonlinear.hysteresis", "load_hysteresis"),
     "gripkit.nlss-model": ("nonlinear.nlss", "load_nlss"),
 }
+
+# report page -> (module of gripkit.sysid, writer function): the writer of a model's HTML report,
+# ``writer(model, trajectory, out, data_name=..., warnings_list=...)`` -> the path of index.html
+MODEL_REPORTS: dict[str, tuple[str, str]] = {
+    "linear": ("model_report", "write_model_report"),
+    "protocol": ("protocol_report", "write_protocol_page"),
+}
+
+
+class ReportMixin:
+    """The one :meth:`report` of every identified model class (module docstring); a class names
+    its page of :data:`MODEL_REPORTS` in ``_report_page``."""
+
+    _report_page = "protocol"
+
+    def report(self, data, out, y=None, *, dt: float | None = None, data_name: str = "data",
+               warnings_list=()) -> Path:
+        """Write the HTML report of this model on ``data`` to ``out/index.html`` (atomically,
+        figures inline and in ``out/figures/``) and return that path: the page ``gripkit report
+        MODEL DATA --out DIR`` writes, its fit ``self.compare(data)``. ``data``: a
+        :class:`~gripkit.signals.Trajectory` with the model's columns, or the arrays ``compare``
+        takes (``u`` and ``y``, a pair ``(u, y)``, or the columns side by side) sampled every
+        ``dt`` (default the model's; a linear model's arrays in deviation units);
+        ``data_name``: how the page names the record; ``warnings_list``: lines raised before,
+        listed on the page. The warnings raised on the way are emitted as well."""
+        record = report_record(self, data, y, dt)
+        module, writer = MODEL_REPORTS[self._report_page]
+        write = getattr(importlib.import_module(f"{__package__}.{module}"), writer)
+        return write(self, record, out, data_name=data_name, warnings_list=warnings_list)
+
+    def _record_offsets(self) -> tuple:
+        """The levels (inputs, outputs) that arrays given to :meth:`report` are deviations from
+        (none here; a linear model's offsets)."""
+        return 0.0, 0.0
+
+
+def _matrix(x, what: str, width: int, n: int | None = None) -> np.ndarray:
+    a = np.asarray(x, dtype=np.float64)
+    a = a.reshape(-1, 1) if a.ndim == 1 else a
+    if a.ndim != 2 or a.shape[1] != width or (n is not None and a.shape[0] != n):
+        expected = f"({n if n is not None else 'N'}, {width})"
+        raise DataError(f"report: {what} must have shape {expected} (one column per model "
+                        f"{what}), found {np.shape(x)}",
+                        hint="give a trajectory with the model's columns, or arrays u, y")
+    return a
+
+
+def report_record(model, data, y=None, dt: float | None = None) -> Trajectory:
+    """``data`` as the trajectory a report is written on: a Trajectory as it is; arrays (``u``
+    and ``y``, a pair ``(u, y)``, or one array with the input then the output columns) as a
+    trajectory of the model's columns sampled every ``dt`` (default ``model.dt``), the model's
+    offsets (:meth:`ReportMixin._record_offsets`) added back."""
+    if isinstance(data, Trajectory):
+        return data
+    m, p = len(model.inputs), len(model.outputs)
+    if y is None and isinstance(data, (tuple, list)) and len(data) == 2:
+        data, y = data
+    if y is None:
+        both = np.asarray(data, dtype=np.float64)
+        if both.ndim != 2 or both.shape[1] != m + p:
+            raise ArgumentError(f"report: give a trajectory, or the arrays u and y (found one "
+                                f"array of shape {both.shape})",
+                                hint="model.report(data, out) or model.report(u, out, y=y)")
+        data, y = both[:, :m], both[:, m:]
+    u = _matrix(data, "input", m)
+    yy = _matrix(y, "output", p, u.shape[0])
+    step = dt if dt is not None else getattr(model, "dt", None)
+    if step is None:
+        raise ArgumentError("report: the model is continuous and the arrays carry no sample time",
+                            hint="give dt=… (s), or a trajectory")
+    uo, yo = (np.broadcast_to(np.asarray(o, dtype=np.float64).ravel(), (k,))
+              for o, k in zip(model._record_offsets(), (m, p)))
+    cols = {n: u[:, i] + uo[i] for i, n in enumerate(model.inputs)}
+    cols |= {n: yy[:, i] + yo[i] for i, n in enumerate(model.outputs)}
+    return Trajectory(np.arange(u.shape[0]) * float(step), cols, None, {"dt": float(step)})
 
 
 def file_schema(path) -> str | None:

@@ -1,5 +1,6 @@
 """One self-contained HTML report of an identified linear model on a data record
-(``gripkit report MODEL.json DATA --out DIR``, ``gripkit identify … --report DIR``).
+(``model.report(data, out)`` of a linear model, which ``gripkit report MODEL.json DATA --out DIR``
+and ``gripkit identify … --report DIR`` call).
 
 Sections: measured against simulated output per output (free run, x0 estimated); residual
 auto-correlation per output and cross-correlation with each input, with the ±1.96/√N band of

@@ -1,7 +1,8 @@
 """One self-contained HTML report of any identified model on a data record, built on the model
-protocol alone (:mod:`gripkit.sysid.model_protocol`): ``gripkit report MODEL.json DATA --out DIR``
-for the families without a linear system to draw (NARX, Hammerstein–Wiener, hysteresis, ...), and
-``gripkit identify narx|hw|hysteresis … --report DIR``.
+protocol alone (:mod:`gripkit.sysid.model_protocol`): ``model.report(data, out)`` of the families
+without a linear system to draw (NARX, Hammerstein–Wiener, nonlinear state space, hysteresis),
+which ``gripkit report MODEL.json DATA --out DIR`` and ``gripkit identify narx|hw|hysteresis …
+--report DIR`` call.
 
 Sections:
 
@@ -36,7 +37,7 @@ from .linear.validation import residual_tests
 from .model_protocol import ModelFit
 from .model_report import _residual_figure
 
-__all__ = ["protocol_report", "write_protocol_report", "RESIDUAL_ALPHA"]
+__all__ = ["protocol_report", "write_protocol_report", "write_protocol_page", "RESIDUAL_ALPHA"]
 
 #: significance of the residual tests and of the bands drawn (99 %)
 RESIDUAL_ALPHA = 0.01
@@ -184,3 +185,12 @@ def write_protocol_report(model, data, out_dir, *, data_name: str = "data",
     fit it shows."""
     rep, fit = protocol_report(model, data, data_name=data_name, warnings_list=warnings_list)
     return rep.write(Path(out_dir)), fit
+
+
+def write_protocol_page(model, data, out_dir, *, data_name: str = "data",
+                        warnings_list=()) -> Path:
+    """The page of :func:`write_protocol_report`, its path only: the writer of
+    ``model.report(data, out_dir)`` for every family but the linear ones
+    (:data:`gripkit.sysid.model_protocol.MODEL_REPORTS`)."""
+    return write_protocol_report(model, data, out_dir, data_name=data_name,
+                                 warnings_list=warnings_list)[0]

@@ -12,8 +12,9 @@ Discrete innovation form (the subspace and PEM models)::
 The identified linear models form one small hierarchy on the protocol of
 :mod:`gripkit.sysid.model_protocol`: :class:`IdentifiedLinearModel` holds every protocol method
 (``simulate``, ``predict``, ``compare``, ``residuals``, ``save``, ``to_ss``, ``to_tf``,
-``to_control``, ``stable``, ``parameters``), written once on the model's ``system``; the HTML
-report of any of them is :func:`gripkit.sysid.model_report.write_model_report`;
+``to_control``, ``stable``, ``parameters``), written once on the model's ``system``, and
+``report`` (:class:`~gripkit.sysid.model_protocol.ReportMixin`: the page of
+:mod:`gripkit.sysid.model_report`, poles and Bode with σ);
 :class:`LinearModel` (state space, transfer function) and
 :class:`~gripkit.sysid.linear.polynomial.PolynomialModel` (ARX, ARMAX, OE, with the polynomial
 views ``A``, ``B``, ``C``, ``F`` and their σ) derive from it. Frequencies are in rad/s everywhere
@@ -39,7 +40,7 @@ from ...signals.trajectory import Trajectory
 from ...units import convert, dimension_of, same_dimension
 from ..checks import as_io_matrix
 from ..model_file import SCHEMA, SCHEMA_VERSION, read_document, write_document
-from ..model_protocol import ModelFit
+from ..model_protocol import ModelFit, ReportMixin
 
 __all__ = ["VALIDATION_FIT", "IdentifiedLinearModel", "LinearModel", "as_io_matrix", "estimate_x0",
            "free_run", "fit_per_output", "k_step_prediction", "model_document",
@@ -184,7 +185,7 @@ def _horizon(horizon) -> int:
     return int(horizon)
 
 
-class IdentifiedLinearModel:
+class IdentifiedLinearModel(ReportMixin):
     """The protocol of every identified linear model (:mod:`gripkit.sysid.model_protocol`),
     written once on what a subclass holds: ``system`` (a :mod:`gripkit.lti` system with names,
     units, dt and parameter covariance), ``structure``, ``dt``, ``u_offset`` and ``y_offset``.
@@ -197,6 +198,8 @@ class IdentifiedLinearModel:
     #: how :meth:`compare` scores a model, and how it starts the free run
     fit_definition = VALIDATION_FIT
     initial_state = "estimated"
+    #: its HTML report: poles, Bode with σ, innovation residuals (gripkit.sysid.model_report)
+    _report_page = "linear"
 
     @property
     def inputs(self) -> tuple[str, ...]:
@@ -219,6 +222,8 @@ class IdentifiedLinearModel:
     def _offsets(self) -> tuple[np.ndarray, np.ndarray]:
         return (np.atleast_1d(np.asarray(self.u_offset, dtype=np.float64)),
                 np.atleast_1d(np.asarray(self.y_offset, dtype=np.float64)))
+
+    _record_offsets = _offsets  # arrays given to report() are deviations from the offsets
 
     def with_display_units(self, data) -> IdentifiedLinearModel:
         """This model with the display units of its inputs and outputs taken from the trajectory

@@ -90,7 +90,7 @@ from ...params import Parameter, ParameterSet
 from ...progress import track
 from ...signals.trajectory import Trajectory
 from ..model_file import read_family_document
-from ..model_protocol import ModelFit
+from ..model_protocol import ModelFit, ReportMixin
 from . import hw_kernels as K
 
 __all__ = ["SCHEMA", "HW_FIT", "HWModel", "Nonlinearity", "hammerstein_wiener", "load_hw",
@@ -430,7 +430,7 @@ def _arx_start(recs, nb, nf, nk):
 
 
 @dataclass
-class HWModel:
+class HWModel(ReportMixin):
     """A Hammerstein–Wiener model ``ŷ = g(B/F f(u)) + y0`` (see the module docstring).
 
     ``theta`` = [input-nonlinearity parameters, b1…b_nb, f1…f_nf, output-nonlinearity

@@ -61,7 +61,7 @@ from ...params import Parameter, ParameterSet
 from ...progress import track
 from ...signals.trajectory import Trajectory
 from ..model_file import read_family_document
-from ..model_protocol import ModelFit
+from ..model_protocol import ModelFit, ReportMixin
 from . import hysteresis_kernels as K
 
 __all__ = ["SCHEMA", "HYSTERESIS_FIT", "MODELS", "FORMS", "BoucWenModel",
@@ -175,7 +175,7 @@ def _output_std(G: np.ndarray, cov: np.ndarray) -> np.ndarray:
     return np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", G, cov, G), 0.0))
 
 
-class _HysteresisModel:
+class _HysteresisModel(ReportMixin):
     """What both hysteresis families share: the protocol's names, compare, save."""
 
     structure = ""

@@ -50,7 +50,7 @@ from ...errors import (ArgumentError, DataError, IdentificationError, ModelError
 from ...params import Parameter, ParameterSet
 from ...signals.trajectory import Trajectory
 from ..model_file import read_family_document
-from ..model_protocol import ModelFit
+from ..model_protocol import ModelFit, ReportMixin
 from ...progress import status, track
 
 __all__ = ["SCHEMA", "NARX_FIT", "NARXModel", "narx", "load_narx", "candidate_terms",
@@ -332,7 +332,7 @@ def _fit(y, yhat) -> float:
 
 
 @dataclass
-class NARXModel:
+class NARXModel(ReportMixin):
     """A polynomial NARX model: ``y(t) = Σ θ_k · terms[k](t)``.
 
     ``terms`` (readable names such as ``"y(t-1)*u(t-2)"``), ``theta``, ``theta_std`` (1σ from

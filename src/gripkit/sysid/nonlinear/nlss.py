@@ -71,7 +71,7 @@ from ...atomic import write_text
 from ...errors import (AccuracyWarning, ArgumentError, DataError, IdentificationError,
                        ModelError, StabilityWarning, emit_warning)
 from ..model_file import read_family_document
-from ..model_protocol import ModelFit
+from ..model_protocol import ModelFit, ReportMixin
 from . import nlss_kernels as K
 from ...params import Parameter, ParameterSet
 from ...progress import status, track
@@ -144,7 +144,7 @@ def _fits(y: np.ndarray, yhat: np.ndarray) -> list[float]:
 
 
 @dataclass
-class NLSSModel:
+class NLSSModel(ReportMixin):
     """A polynomial nonlinear state-space model (module docstring).
 
     Matrices ``A`` (n, n), ``B`` (n, m), ``C`` (p, n), ``D`` (p, m), ``E`` (n, Mζ), ``F`` (p, Mη)
