@@ -92,6 +92,7 @@ from ...signals.trajectory import Trajectory
 from ..model_file import read_family_document
 from ..model_protocol import ModelFit
 from . import hw_kernels as K
+from .levenberg_marquardt import levenberg_marquardt
 
 __all__ = ["SCHEMA", "HW_FIT", "HWModel", "Nonlinearity", "hammerstein_wiener", "load_hw",
            "parse_nonlinearity"]
@@ -345,40 +346,31 @@ def _lm(prob: _Problem, y, th0, maxiter: int = 200):
     if prob.run(th, True) >= 0:
         return th, math.inf, None, 0
     r, rc = np.empty(len(y)), np.empty(len(y))
-    sse = K.residual(y, prob.yhat, r)
     n = len(y)
     H, g = np.empty((len(th), len(th))), np.empty(len(th))
-    lam = 1e-3
-    it = 0
-    for it in range(1, maxiter + 1):
+    stale = False  # J is of an earlier θ: the run of the θ accepted last was without J
+
+    def normal_equations():
+        nonlocal stale
+        if stale:
+            prob.run(th, True)
+            stale = False
         K.gram(prob.jac, r, H, g)
-        d = np.sqrt(np.maximum(np.diag(H), 0.0))
-        d[d == 0] = 1.0
-        Hs = H / np.outer(d, d)
-        gs = g / d
-        improved = False
-        while lam <= 1e16:
-            try:
-                step = np.linalg.solve(Hs + lam * np.eye(len(th)), gs) / d
-            except np.linalg.LinAlgError:
-                lam *= 10.0
-                continue
-            cand = th + step
-            if prob.admissible(cand) and prob.run(cand, False) < 0:
-                sc = K.residual(y, prob.yhat, rc)
-                if sc < sse:
-                    improved = True
-                    break
-            lam *= 10.0
-        if not improved:
-            break
-        gain = sse - sc
-        th, sse = cand, sc
-        r, rc = rc, r
-        lam = max(lam / 10.0, 1e-12)
-        if gain < 1e-4 * sse / n:
-            break
-        prob.run(th, True)
+        return H, g
+
+    def trial(cand):
+        if prob.admissible(cand) and prob.run(cand, False) < 0:
+            return K.residual(y, prob.yhat, rc)
+        return None
+
+    def accept(cand):
+        nonlocal th, r, rc, stale
+        th, (r, rc), stale = cand, (rc, r), True
+
+    _, _, it = levenberg_marquardt(th, K.residual(y, prob.yhat, r),
+                                   normal_equations=normal_equations, trial=trial,
+                                   accept=accept, max_iter=maxiter,
+                                   converged=lambda old, new: old - new < 1e-4 * new / n)
     prob.run(th, True)
     return th, K.residual(y, prob.yhat, r), prob.jac.copy(), it
 

@@ -51,6 +51,7 @@ from ...params import Parameter, ParameterSet
 from ...signals.trajectory import Trajectory
 from ..model_file import read_family_document
 from ..model_protocol import ModelFit
+from .levenberg_marquardt import Damping, levenberg_marquardt
 from ...progress import status, track
 
 __all__ = ["SCHEMA", "NARX_FIT", "NARXModel", "narx", "load_narx", "candidate_terms",
@@ -622,6 +623,8 @@ def _fit_records(model: NARXModel, records, warn: bool = True) -> float | None:
 
 #: choices of ``refine``
 REFINE = (None, "simulation")
+#: λ ÷ 3 after a step taken, × 4 after one refused, tried below 1e12
+_DAMPING = Damping(shrink=3.0, grow=4.0, ceiling=float(np.nextafter(1e12, 0.0)))
 
 
 def _refine_simulation(model: NARXModel, records, max_iter: int, tol: float = 1e-9):
@@ -644,36 +647,24 @@ def _refine_simulation(model: NARXModel, records, max_iter: int, tol: float = 1e
             Js.append(J[m:])
         return np.concatenate(es), np.concatenate(Js)
 
-    theta = model.theta.copy()
-    cur = run(theta)
+    cur = run(model.theta)
     if cur is None:
         return None
     e, J = cur
-    cost = float(e @ e)
-    lam, it = 1e-3, 0
-    for it in range(1, max_iter + 1):
-        A = J.T @ J
-        g = J.T @ e
-        d = np.sqrt(np.maximum(np.diag(A), 1e-300))
-        As, gs = A / np.outer(d, d), g / d
-        improved = False
-        while lam < 1e12:
-            try:
-                step = np.linalg.solve(As + lam * np.eye(len(d)), gs) / d
-            except np.linalg.LinAlgError:
-                lam *= 10.0
-                continue
-            new = run(theta + step)
-            if new is not None and float(new[0] @ new[0]) < cost:
-                improved = True
-                theta = theta + step
-                e, J = new
-                old, cost = cost, float(e @ e)
-                lam = max(lam / 3.0, 1e-12)
-                break
-            lam *= 4.0
-        if not improved or old - cost <= tol * old:
-            break
+    tried = []
+
+    def trial(theta):
+        tried[:] = [run(theta)]
+        return None if tried[0] is None else float(tried[0][0] @ tried[0][0])
+
+    def accept(theta):
+        nonlocal e, J
+        e, J = tried[0]
+
+    theta, cost, it = levenberg_marquardt(
+        model.theta.copy(), float(e @ e), normal_equations=lambda: (J.T @ J, J.T @ e),
+        trial=trial, accept=accept, converged=lambda old, new: old - new <= tol * old,
+        max_iter=max_iter, damping=_DAMPING)
     n, k = J.shape
     A = J.T @ J
     d = np.sqrt(np.maximum(np.diag(A), 1e-300))
