@@ -93,6 +93,7 @@ from ..model_file import read_family_document
 from ..model_protocol import ModelFit
 from . import hw_kernels as K
 from .levenberg_marquardt import levenberg_marquardt
+from .single_channel import SingleChannel, fit_percent, one_signal
 
 __all__ = ["SCHEMA", "HW_FIT", "HWModel", "Nonlinearity", "hammerstein_wiener", "load_hw",
            "parse_nonlinearity"]
@@ -215,11 +216,7 @@ def _limit_starts(nl: Nonlinearity, v: np.ndarray) -> list[np.ndarray]:
 
 
 def _fit_value(y, yhat) -> float:
-    den = float(np.linalg.norm(y - y.mean()))
-    if den == 0.0:
-        raise DataError("hammerstein_wiener: the fit is undefined for a constant output "
-                        "(‖y − ȳ‖ = 0)")
-    return 100.0 * (1.0 - float(np.linalg.norm(y - yhat)) / den)
+    return fit_percent(y, yhat, "hammerstein_wiener")
 
 
 class _RunOutput:
@@ -422,7 +419,7 @@ def _arx_start(recs, nb, nf, nk):
 
 
 @dataclass
-class HWModel:
+class HWModel(SingleChannel):
     """A Hammerstein–Wiener model ``ŷ = g(B/F f(u)) + y0`` (see the module docstring).
 
     ``theta`` = [input-nonlinearity parameters, b1…b_nb, f1…f_nf, output-nonlinearity
@@ -456,14 +453,6 @@ class HWModel:
     fit_definition: str = HW_FIT
 
     # -- names and blocks -------------------------------------------------------------------
-    @property
-    def inputs(self) -> tuple[str, ...]:
-        return (self.input_name,)
-
-    @property
-    def outputs(self) -> tuple[str, ...]:
-        return (self.output_name,)
-
     @property
     def kind(self) -> str:
         """``'linear'``, ``'hammerstein'``, ``'wiener'`` or ``'hammerstein-wiener'``."""
@@ -644,16 +633,7 @@ class HWModel:
 
 
 def _signal(x, name: str) -> np.ndarray:
-    a = np.asarray(x, dtype=np.float64)
-    if a.ndim == 2 and 1 in a.shape:
-        a = a.ravel()
-    if a.ndim != 1:
-        raise DataError(f"hw: {name} must be one signal (shape (N,)), found shape {a.shape}; "
-                        "pass one column")
-    if not np.all(np.isfinite(a)):
-        raise DataError(f"hw: {name} has {int(np.sum(~np.isfinite(a)))} non-finite samples; "
-                        "remove or interpolate them first")
-    return np.ascontiguousarray(a)
+    return np.ascontiguousarray(one_signal(x, name, "hw"))
 
 
 def load_hw(path) -> HWModel:

@@ -95,6 +95,19 @@ def bw_simulate(u, d, alpha, beta, gamma, n, offset, h0, u0, y):  # pragma: no c
     return -1
 
 
+@njit(cache=True, inline="always")
+def _play_step(z, x, r):  # pragma: no cover - compiled
+    """The play operator of threshold r at one sample: its last output z held within
+    [x − r, x + r]."""
+    lo = x - r
+    hi = x + r
+    if z < lo:
+        return lo
+    if z > hi:
+        return hi
+    return z
+
+
 @njit(cache=True)
 def play_matrix(x, r, out):  # pragma: no cover - compiled
     """out[k, i] = play operator of threshold r[i] on x, each relaxed at x[0] (z = x[0])."""
@@ -102,12 +115,7 @@ def play_matrix(x, r, out):  # pragma: no cover - compiled
         z = x[0]
         ri = r[i]
         for k in range(x.shape[0]):
-            lo = x[k] - ri
-            hi = x[k] + ri
-            if z < lo:
-                z = lo
-            elif z > hi:
-                z = hi
+            z = _play_step(z, x[k], ri)
             out[k, i] = z
 
 
@@ -122,12 +130,7 @@ def pi_simulate(x, r, w, offset, y):  # pragma: no cover - compiled
         ri = r[i]
         wi = w[i]
         for k in range(x.shape[0]):
-            lo = x[k] - ri
-            hi = x[k] + ri
-            if z < lo:
-                z = lo
-            elif z > hi:
-                z = hi
+            z = _play_step(z, x[k], ri)
             y[k] += wi * z
 
 

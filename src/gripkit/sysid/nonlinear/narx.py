@@ -52,6 +52,7 @@ from ...signals.trajectory import Trajectory
 from ..model_file import read_family_document
 from ..model_protocol import ModelFit
 from .levenberg_marquardt import Damping, levenberg_marquardt
+from .single_channel import SingleChannel, fit_percent, one_signal
 from ...progress import status, track
 
 __all__ = ["SCHEMA", "NARX_FIT", "NARXModel", "narx", "load_narx", "candidate_terms",
@@ -313,27 +314,15 @@ def _sensitivity_kernel(kinds, lags, rows, theta, u, y, start, limit_lo, limit_h
 
 
 def _as_signal(x, name: str) -> np.ndarray:
-    a = np.asarray(x, dtype=np.float64)
-    if a.ndim == 2 and 1 in a.shape:
-        a = a.ravel()
-    if a.ndim != 1:
-        raise DataError(f"narx: {name} must be one signal (shape (N,)), found shape {a.shape}; "
-                        "pass one column")
-    if not np.all(np.isfinite(a)):
-        raise DataError(f"narx: {name} has {int(np.sum(~np.isfinite(a)))} non-finite samples; "
-                        "remove or interpolate them first")
-    return a
+    return one_signal(x, name, "narx")
 
 
 def _fit(y, yhat) -> float:
-    den = float(np.linalg.norm(y - y.mean()))
-    if den == 0.0:
-        raise DataError("narx: the fit is undefined for a constant output (‖y − ȳ‖ = 0)")
-    return 100.0 * (1.0 - float(np.linalg.norm(y - yhat)) / den)
+    return fit_percent(y, yhat, "narx")
 
 
 @dataclass
-class NARXModel:
+class NARXModel(SingleChannel):
     """A polynomial NARX model: ``y(t) = Σ θ_k · terms[k](t)``.
 
     ``terms`` (readable names such as ``"y(t-1)*u(t-2)"``), ``theta``, ``theta_std`` (1σ from
@@ -374,14 +363,6 @@ class NARXModel:
     frols_terms: list = field(default_factory=list)
     input_name: str = "u"
     output_name: str = "y"
-
-    @property
-    def inputs(self) -> tuple[str, ...]:
-        return (self.input_name,)
-
-    @property
-    def outputs(self) -> tuple[str, ...]:
-        return (self.output_name,)
 
     @property
     def parameters(self) -> ParameterSet:
