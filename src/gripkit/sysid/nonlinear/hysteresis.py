@@ -225,6 +225,14 @@ class _HysteresisModel(SingleChannel):
                     criterion=self.criterion, fit_definition=HYSTERESIS_FIT,
                     **({"records": list(self.records)} if self.records else {}))
 
+    def _parameter_set(self, docs: dict) -> ParameterSet:
+        """The parameters ``docs`` names (name → (description, unit)), in its order, the ones
+        not in ``free`` fixed, the free ones with their σ."""
+        sd = self.std
+        return ParameterSet([_parameter(k, getattr(self, k), unit, doc, sd.get(k),
+                                        fixed=k not in self.free)
+                             for k, (doc, unit) in docs.items()], self.structure)
+
     def _summary(self, head: str) -> str:
         """``head`` and a line per parameter: value ± σ (or fixed) and unit."""
         sd = self.std
@@ -282,16 +290,13 @@ class BoucWenModel(_HysteresisModel):
     def parameters(self) -> ParameterSet:
         uu, yu = self.input_unit, self.output_unit
         shape = _ratio("1", uu) if self.n == 1.0 else f"1/({uu}*{yu}^{self.n - 1:g})"
-        sd = self.std
-        docs = {"d": ("gain: output per unit input without hysteresis", _ratio(yu, uu)),
-                "alpha": ("α: amplitude of the hysteresis (λ = α d in eq 3)", "1"),
-                "beta": ("β: shape of the hysteresis (eq 3)", shape),
-                "gamma": ("γ: shape of the hysteresis (eq 3)", shape),
-                "n": ("exponent n of |h| (n = 1: eq 3)", "1"),
-                "offset": ("output offset c", yu if not _unitless(yu) else "1")}
-        return ParameterSet([_parameter(k, getattr(self, k), docs[k][1], docs[k][0], sd.get(k),
-                                        fixed=k not in self.free) for k in _BW_NAMES],
-                            "bouc-wen")
+        return self._parameter_set({
+            "d": ("gain: output per unit input without hysteresis", _ratio(yu, uu)),
+            "alpha": ("α: amplitude of the hysteresis (λ = α d in eq 3)", "1"),
+            "beta": ("β: shape of the hysteresis (eq 3)", shape),
+            "gamma": ("γ: shape of the hysteresis (eq 3)", shape),
+            "n": ("exponent n of |h| (n = 1: eq 3)", "1"),
+            "offset": ("output offset c", yu if not _unitless(yu) else "1")})
 
     def _run(self, u: np.ndarray, theta: dict | None = None) -> tuple[np.ndarray, int]:
         p = self.values() if theta is None else theta
@@ -472,18 +477,15 @@ class BoucWenOscillatorModel(_HysteresisModel):
         uu, yu = self.input_unit, self.output_unit
         k_unit = _ratio(uu, yu)
         shape = _ratio("1", yu) if self.n == 1.0 else f"1/{yu}^{self.n:g}"
-        sd = self.std
-        docs = {"mass": ("mass: input per unit acceleration", f"{k_unit}*s^2"),
-                "damping": ("viscous damping: input per unit velocity", f"{k_unit}*s"),
-                "k_e": ("elastic stiffness k_e (a k of Wen's form)", k_unit),
-                "k_h": ("hysteretic stiffness k_h ((1 − a) k of Wen's form)", k_unit),
-                "beta": ("β: shape of the hysteresis (A = 1)", shape),
-                "gamma": ("γ: shape of the hysteresis (A = 1)", shape),
-                "n": ("exponent n of |z|", "1"),
-                "offset": ("output offset", yu if not _unitless(yu) else "1")}
-        return ParameterSet([_parameter(k, getattr(self, k), docs[k][1], docs[k][0], sd.get(k),
-                                        fixed=k not in self.free) for k in _BWO_NAMES],
-                            "bouc-wen-oscillator")
+        return self._parameter_set({
+            "mass": ("mass: input per unit acceleration", f"{k_unit}*s^2"),
+            "damping": ("viscous damping: input per unit velocity", f"{k_unit}*s"),
+            "k_e": ("elastic stiffness k_e (a k of Wen's form)", k_unit),
+            "k_h": ("hysteretic stiffness k_h ((1 − a) k of Wen's form)", k_unit),
+            "beta": ("β: shape of the hysteresis (A = 1)", shape),
+            "gamma": ("γ: shape of the hysteresis (A = 1)", shape),
+            "n": ("exponent n of |z|", "1"),
+            "offset": ("output offset", yu if not _unitless(yu) else "1")})
 
     def _input(self, data) -> np.ndarray:
         if isinstance(data, Trajectory) and data.n > 1 and not math.isclose(
