@@ -93,14 +93,13 @@ from ..model_file import read_family_document
 from ..model_protocol import ModelFit
 from . import hw_kernels as K
 from .levenberg_marquardt import levenberg_marquardt
-from .single_channel import SingleChannel, fit_percent, one_signal
+from .single_channel import DIVERGENCE_FACTOR, FreeRunModel, fit_percent, one_signal
 
 __all__ = ["SCHEMA", "HW_FIT", "HWModel", "Nonlinearity", "hammerstein_wiener", "load_hw",
            "parse_nonlinearity"]
 
 SCHEMA = "gripkit.hw-model"
 VERSION = 1
-DIVERGENCE_FACTOR = 1e3
 HW_FIT = ("free run from a steady state of the linear block whose constant input w₋ is fitted "
           "to the record (least squares), fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) over all samples")
 KINDS = {"none": K.NONE, "saturation": K.SATURATION, "deadzone": K.DEADZONE, "poly": K.POLY,
@@ -419,7 +418,7 @@ def _arx_start(recs, nb, nf, nk):
 
 
 @dataclass
-class HWModel(SingleChannel):
+class HWModel(FreeRunModel):
     """A Hammerstein–Wiener model ``ŷ = g(B/F f(u)) + y0`` (see the module docstring).
 
     ``theta`` = [input-nonlinearity parameters, b1…b_nb, f1…f_nf, output-nonlinearity
@@ -439,16 +438,9 @@ class HWModel(SingleChannel):
     theta: np.ndarray
     theta_std: np.ndarray
     covariance: np.ndarray
-    dt: float = 1.0
-    y_range: tuple = (-np.inf, np.inf)
-    fit_percent: float | None = None
-    validation_fit_percent: float | None = None
-    criterion: str = ""
     candidates: list = field(default_factory=list)
     initial_input: float | None = None
     records: list = field(default_factory=list)
-    input_name: str = "u"
-    output_name: str = "y"
     structure: str = "hw"
     fit_definition: str = HW_FIT
 
@@ -514,12 +506,6 @@ class HWModel(SingleChannel):
         return ParameterSet(ps, name=f"hw {self.input_nl.label}/{self.output_nl.label}")
 
     # -- simulation -------------------------------------------------------------------------
-    def _limits(self):
-        lo, hi = self.y_range
-        span = max(hi - lo, 1e-12)
-        mid = 0.5 * (hi + lo)
-        return mid - DIVERGENCE_FACTOR * span, mid + DIVERGENCE_FACTOR * span
-
     def _problem(self, u) -> _Problem:
         return _Problem(u, self.input_nl, self.output_nl, self.nb, self.nf, self.nk)
 

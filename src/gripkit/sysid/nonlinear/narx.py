@@ -52,7 +52,7 @@ from ...signals.trajectory import Trajectory
 from ..model_file import read_family_document
 from ..model_protocol import ModelFit
 from .levenberg_marquardt import Damping, levenberg_marquardt
-from .single_channel import SingleChannel, fit_percent, one_signal
+from .single_channel import DIVERGENCE_FACTOR, FreeRunModel, fit_percent, one_signal
 from ...progress import status, track
 
 __all__ = ["SCHEMA", "NARX_FIT", "NARXModel", "narx", "load_narx", "candidate_terms",
@@ -60,8 +60,6 @@ __all__ = ["SCHEMA", "NARX_FIT", "NARXModel", "narx", "load_narx", "candidate_te
 
 SCHEMA = "gripkit.narx-model"
 VERSION = 1
-#: a free run beyond this many times the data's range (about its mean) counts as diverged
-DIVERGENCE_FACTOR = 1e3
 #: how a NARX model's free-run fit is taken (``gripkit compare`` prints it)
 NARX_FIT = ("free run started from the first max_lag measured outputs, "
             "fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) over the samples after them")
@@ -322,7 +320,7 @@ def _fit(y, yhat) -> float:
 
 
 @dataclass
-class NARXModel(SingleChannel):
+class NARXModel(FreeRunModel):
     """A polynomial NARX model: ``y(t) = Σ θ_k · terms[k](t)``.
 
     ``terms`` (readable names such as ``"y(t-1)*u(t-2)"``), ``theta``, ``theta_std`` (1σ from
@@ -353,16 +351,9 @@ class NARXModel(SingleChannel):
     theta: np.ndarray
     theta_std: np.ndarray
     covariance: np.ndarray
-    dt: float = 1.0
-    y_range: tuple = (-np.inf, np.inf)
-    fit_percent: float | None = None
     prediction_fit_percent: float | None = None
-    validation_fit_percent: float | None = None
-    criterion: str = ""
     err: list = field(default_factory=list)
     frols_terms: list = field(default_factory=list)
-    input_name: str = "u"
-    output_name: str = "y"
 
     @property
     def parameters(self) -> ParameterSet:
@@ -399,12 +390,6 @@ class NARXModel(SingleChannel):
     @property
     def max_lag(self) -> int:
         return int(max(self.ylags, self.ulags, 1))
-
-    def _limits(self):
-        lo, hi = self.y_range
-        span = max(hi - lo, 1e-12)
-        mid = 0.5 * (hi + lo)
-        return mid - DIVERGENCE_FACTOR * span, mid + DIVERGENCE_FACTOR * span
 
     def simulate(self, data, y0=None, *, warn: bool = True, std: bool = False):
         """Free run on the input of ``data`` (a trajectory: (N, 1)) or on the input ``u`` (N,):
