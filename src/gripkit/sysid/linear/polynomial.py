@@ -91,6 +91,12 @@ def _coeffs(x, name: str, monic: bool) -> np.ndarray:
     return a
 
 
+def _std_property(which: str, fixed: str) -> property:
+    """The read-only 1σ of each entry of the polynomial ``which`` (0 for ``fixed``)."""
+    return property(lambda self: self._std_layout(which),
+                    doc=f"One-sigma uncertainty of each entry of ``{which}`` (0 for {fixed}).")
+
+
 @dataclass(frozen=True, eq=False)
 class PolynomialModel(IdentifiedLinearModel):
     """A discrete-time polynomial model with its uncertainty and fit diagnostics, on the
@@ -448,18 +454,10 @@ class PolynomialModel(IdentifiedLinearModel):
             i += n
         raise KeyError(which)
 
-    A_std = property(lambda self: self._std_layout("A"),
-                     doc="One-sigma uncertainty of each entry of ``A`` (0 for the "
-                         "fixed leading 1).")
-    B_std = property(lambda self: self._std_layout("B"),
-                     doc="One-sigma uncertainty of each entry of ``B`` (0 for the ``nk`` fixed "
-                         "leading zeros).")
-    C_std = property(lambda self: self._std_layout("C"),
-                     doc="One-sigma uncertainty of each entry of ``C`` (0 for the "
-                         "fixed leading 1).")
-    F_std = property(lambda self: self._std_layout("F"),
-                     doc="One-sigma uncertainty of each entry of ``F`` (0 for the "
-                         "fixed leading 1).")
+    A_std = _std_property("A", "the fixed leading 1")
+    B_std = _std_property("B", "the ``nk`` fixed leading zeros")
+    C_std = _std_property("C", "the fixed leading 1")
+    F_std = _std_property("F", "the fixed leading 1")
 
     @property
     def parameters(self):

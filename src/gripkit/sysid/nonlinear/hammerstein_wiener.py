@@ -90,15 +90,16 @@ from ...params import Parameter, ParameterSet
 from ...progress import track
 from ...signals.trajectory import Trajectory
 from ..model_file import read_family_document
-from ..model_protocol import ModelFit, ReportMixin
+from ..model_protocol import ModelFit
 from . import hw_kernels as K
+from .levenberg_marquardt import levenberg_marquardt
+from .single_channel import DIVERGENCE_FACTOR, FreeRunModel, fit_percent, one_signal
 
 __all__ = ["SCHEMA", "HW_FIT", "HWModel", "Nonlinearity", "hammerstein_wiener", "load_hw",
            "parse_nonlinearity"]
 
 SCHEMA = "gripkit.hw-model"
 VERSION = 1
-DIVERGENCE_FACTOR = 1e3
 HW_FIT = ("free run from a steady state of the linear block whose constant input w₋ is fitted "
           "to the record (least squares), fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) over all samples")
 KINDS = {"none": K.NONE, "saturation": K.SATURATION, "deadzone": K.DEADZONE, "poly": K.POLY,
@@ -214,11 +215,7 @@ def _limit_starts(nl: Nonlinearity, v: np.ndarray) -> list[np.ndarray]:
 
 
 def _fit_value(y, yhat) -> float:
-    den = float(np.linalg.norm(y - y.mean()))
-    if den == 0.0:
-        raise DataError("hammerstein_wiener: the fit is undefined for a constant output "
-                        "(‖y − ȳ‖ = 0)")
-    return 100.0 * (1.0 - float(np.linalg.norm(y - yhat)) / den)
+    return fit_percent(y, yhat, "hammerstein_wiener")
 
 
 class _RunOutput:
@@ -345,40 +342,31 @@ def _lm(prob: _Problem, y, th0, maxiter: int = 200):
     if prob.run(th, True) >= 0:
         return th, math.inf, None, 0
     r, rc = np.empty(len(y)), np.empty(len(y))
-    sse = K.residual(y, prob.yhat, r)
     n = len(y)
     H, g = np.empty((len(th), len(th))), np.empty(len(th))
-    lam = 1e-3
-    it = 0
-    for it in range(1, maxiter + 1):
+    stale = False  # J is of an earlier θ: the run of the θ accepted last was without J
+
+    def normal_equations():
+        nonlocal stale
+        if stale:
+            prob.run(th, True)
+            stale = False
         K.gram(prob.jac, r, H, g)
-        d = np.sqrt(np.maximum(np.diag(H), 0.0))
-        d[d == 0] = 1.0
-        Hs = H / np.outer(d, d)
-        gs = g / d
-        improved = False
-        while lam <= 1e16:
-            try:
-                step = np.linalg.solve(Hs + lam * np.eye(len(th)), gs) / d
-            except np.linalg.LinAlgError:
-                lam *= 10.0
-                continue
-            cand = th + step
-            if prob.admissible(cand) and prob.run(cand, False) < 0:
-                sc = K.residual(y, prob.yhat, rc)
-                if sc < sse:
-                    improved = True
-                    break
-            lam *= 10.0
-        if not improved:
-            break
-        gain = sse - sc
-        th, sse = cand, sc
-        r, rc = rc, r
-        lam = max(lam / 10.0, 1e-12)
-        if gain < 1e-4 * sse / n:
-            break
-        prob.run(th, True)
+        return H, g
+
+    def trial(cand):
+        if prob.admissible(cand) and prob.run(cand, False) < 0:
+            return K.residual(y, prob.yhat, rc)
+        return None
+
+    def accept(cand):
+        nonlocal th, r, rc, stale
+        th, (r, rc), stale = cand, (rc, r), True
+
+    _, _, it = levenberg_marquardt(th, K.residual(y, prob.yhat, r),
+                                   normal_equations=normal_equations, trial=trial,
+                                   accept=accept, max_iter=maxiter,
+                                   converged=lambda old, new: old - new < 1e-4 * new / n)
     prob.run(th, True)
     return th, K.residual(y, prob.yhat, r), prob.jac.copy(), it
 
@@ -430,7 +418,7 @@ def _arx_start(recs, nb, nf, nk):
 
 
 @dataclass
-class HWModel(ReportMixin):
+class HWModel(FreeRunModel):
     """A Hammerstein–Wiener model ``ŷ = g(B/F f(u)) + y0`` (see the module docstring).
 
     ``theta`` = [input-nonlinearity parameters, b1…b_nb, f1…f_nf, output-nonlinearity
@@ -450,28 +438,13 @@ class HWModel(ReportMixin):
     theta: np.ndarray
     theta_std: np.ndarray
     covariance: np.ndarray
-    dt: float = 1.0
-    y_range: tuple = (-np.inf, np.inf)
-    fit_percent: float | None = None
-    validation_fit_percent: float | None = None
-    criterion: str = ""
     candidates: list = field(default_factory=list)
     initial_input: float | None = None
     records: list = field(default_factory=list)
-    input_name: str = "u"
-    output_name: str = "y"
     structure: str = "hw"
     fit_definition: str = HW_FIT
 
     # -- names and blocks -------------------------------------------------------------------
-    @property
-    def inputs(self) -> tuple[str, ...]:
-        return (self.input_name,)
-
-    @property
-    def outputs(self) -> tuple[str, ...]:
-        return (self.output_name,)
-
     @property
     def kind(self) -> str:
         """``'linear'``, ``'hammerstein'``, ``'wiener'`` or ``'hammerstein-wiener'``."""
@@ -533,12 +506,6 @@ class HWModel(ReportMixin):
         return ParameterSet(ps, name=f"hw {self.input_nl.label}/{self.output_nl.label}")
 
     # -- simulation -------------------------------------------------------------------------
-    def _limits(self):
-        lo, hi = self.y_range
-        span = max(hi - lo, 1e-12)
-        mid = 0.5 * (hi + lo)
-        return mid - DIVERGENCE_FACTOR * span, mid + DIVERGENCE_FACTOR * span
-
     def _problem(self, u) -> _Problem:
         return _Problem(u, self.input_nl, self.output_nl, self.nb, self.nf, self.nk)
 
@@ -652,16 +619,7 @@ class HWModel(ReportMixin):
 
 
 def _signal(x, name: str) -> np.ndarray:
-    a = np.asarray(x, dtype=np.float64)
-    if a.ndim == 2 and 1 in a.shape:
-        a = a.ravel()
-    if a.ndim != 1:
-        raise DataError(f"hw: {name} must be one signal (shape (N,)), found shape {a.shape}; "
-                        "pass one column")
-    if not np.all(np.isfinite(a)):
-        raise DataError(f"hw: {name} has {int(np.sum(~np.isfinite(a)))} non-finite samples; "
-                        "remove or interpolate them first")
-    return np.ascontiguousarray(a)
+    return np.ascontiguousarray(one_signal(x, name, "hw"))
 
 
 def load_hw(path) -> HWModel:

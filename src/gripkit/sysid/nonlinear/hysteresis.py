@@ -61,8 +61,9 @@ from ...params import Parameter, ParameterSet
 from ...progress import track
 from ...signals.trajectory import Trajectory
 from ..model_file import read_family_document
-from ..model_protocol import ModelFit, ReportMixin
+from ..model_protocol import ModelFit
 from . import hysteresis_kernels as K
+from .single_channel import SingleChannel, fit_percent, one_signal
 
 __all__ = ["SCHEMA", "HYSTERESIS_FIT", "MODELS", "FORMS", "BoucWenModel",
            "BoucWenOscillatorModel", "PrandtlIshlinskiiModel", "hysteresis", "load_hysteresis",
@@ -97,25 +98,11 @@ def _ratio(num: str, den: str) -> str:
 
 
 def _as_signal(x, name: str) -> np.ndarray:
-    a = np.asarray(x, dtype=np.float64)
-    if a.ndim == 2 and 1 in a.shape:
-        a = a.ravel()
-    if a.ndim != 1:
-        raise DataError(f"hysteresis: {name} must be one signal (shape (N,)), found shape "
-                        f"{a.shape}; pass one column")
-    if not np.all(np.isfinite(a)):
-        raise DataError(f"hysteresis: {name} has {int(np.sum(~np.isfinite(a)))} non-finite "
-                        "samples; remove or interpolate them first")
-    return a
+    return one_signal(x, name, "hysteresis")
 
 
 def _fit_percent(y: np.ndarray, yhat: np.ndarray) -> float | None:
-    if not np.all(np.isfinite(yhat)):
-        return None
-    den = float(np.linalg.norm(y - y.mean()))
-    if den == 0.0:
-        raise DataError("hysteresis: the fit is undefined for a constant output (‖y − ȳ‖ = 0)")
-    return 100.0 * (1.0 - float(np.linalg.norm(y - yhat)) / den)
+    return fit_percent(y, yhat, "hysteresis") if np.all(np.isfinite(yhat)) else None
 
 
 def _record(data, input, output, what: str, need_output: bool = True):
@@ -175,21 +162,25 @@ def _output_std(G: np.ndarray, cov: np.ndarray) -> np.ndarray:
     return np.sqrt(np.maximum(np.einsum("ij,jk,ik->i", G, cov, G), 0.0))
 
 
-class _HysteresisModel(ReportMixin):
-    """What both hysteresis families share: the protocol's names, compare, save."""
+@dataclass(kw_only=True)
+class _HysteresisModel(SingleChannel):
+    """What the hysteresis models share: the protocol's names, the fields below (keyword-only),
+    compare, save and the common part of the model file."""
+
+    covariance: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    input_name: str = "u"
+    output_name: str = "y"
+    input_unit: str = "1"
+    output_unit: str = "1"
+    fit_percent: float | None = None
+    validation_fit_percent: float | None = None
+    burn_in: int = 0
+    criterion: str = ""
 
     structure = ""
     fit_definition = HYSTERESIS_FIT
     #: with several estimation records: each one's ``n_samples`` and free-run ``fit_percent``
     records = ()
-
-    @property
-    def inputs(self) -> tuple[str, ...]:
-        return (self.input_name,)
-
-    @property
-    def outputs(self) -> tuple[str, ...]:
-        return (self.output_name,)
 
     def _input(self, data) -> np.ndarray:
         return _record(data, self.input_name, None, f"{self.structure}.simulate",
@@ -223,6 +214,34 @@ class _HysteresisModel(ReportMixin):
         yhat = self.simulate(u, warn=warn)
         return ModelFit(self.outputs, [_fit_percent(y, yhat[:, 0])], yhat, HYSTERESIS_FIT)
 
+    def _document(self, **own) -> dict:
+        """The model file: the schema, the model's ``own`` entries, then what every hysteresis
+        model writes."""
+        return dict(schema=SCHEMA, version=VERSION, model=self.structure, **own, dt=self.dt,
+                    input_name=self.input_name, output_name=self.output_name,
+                    input_unit=self.input_unit, output_unit=self.output_unit,
+                    fit_percent=self.fit_percent,
+                    validation_fit_percent=self.validation_fit_percent, burn_in=self.burn_in,
+                    criterion=self.criterion, fit_definition=HYSTERESIS_FIT,
+                    **({"records": list(self.records)} if self.records else {}))
+
+    def _parameter_set(self, docs: dict) -> ParameterSet:
+        """The parameters ``docs`` names (name → (description, unit)), in its order, the ones
+        not in ``free`` fixed, the free ones with their σ."""
+        sd = self.std
+        return ParameterSet([_parameter(k, getattr(self, k), unit, doc, sd.get(k),
+                                        fixed=k not in self.free)
+                             for k, (doc, unit) in docs.items()], self.structure)
+
+    def _summary(self, head: str) -> str:
+        """``head`` and a line per parameter: value ± σ (or fixed) and unit."""
+        sd = self.std
+        rows = [head]
+        for p in self.parameters.values():
+            s = f" ± {sd[p.name]:.3g}" if p.name in sd else " (fixed)"
+            rows.append(f"  {p.name:<7s} {p.value: .6g}{s} {p.unit}")
+        return "\n".join(rows)
+
     def save(self, path) -> Path:
         """Write the model as JSON (schema ``gripkit.hysteresis-model``), atomically."""
         return write_text(path, json.dumps(self.to_dict(), indent=1) + "\n",
@@ -250,16 +269,7 @@ class BoucWenModel(_HysteresisModel):
     n: float = 1.0
     offset: float = 0.0
     free: tuple = ("d", "alpha", "beta", "gamma", "offset")
-    covariance: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     dt: float | None = None
-    input_name: str = "u"
-    output_name: str = "y"
-    input_unit: str = "1"
-    output_unit: str = "1"
-    fit_percent: float | None = None
-    validation_fit_percent: float | None = None
-    burn_in: int = 0
-    criterion: str = ""
 
     structure = "bouc-wen"
 
@@ -280,16 +290,13 @@ class BoucWenModel(_HysteresisModel):
     def parameters(self) -> ParameterSet:
         uu, yu = self.input_unit, self.output_unit
         shape = _ratio("1", uu) if self.n == 1.0 else f"1/({uu}*{yu}^{self.n - 1:g})"
-        sd = self.std
-        docs = {"d": ("gain: output per unit input without hysteresis", _ratio(yu, uu)),
-                "alpha": ("α: amplitude of the hysteresis (λ = α d in eq 3)", "1"),
-                "beta": ("β: shape of the hysteresis (eq 3)", shape),
-                "gamma": ("γ: shape of the hysteresis (eq 3)", shape),
-                "n": ("exponent n of |h| (n = 1: eq 3)", "1"),
-                "offset": ("output offset c", yu if not _unitless(yu) else "1")}
-        return ParameterSet([_parameter(k, getattr(self, k), docs[k][1], docs[k][0], sd.get(k),
-                                        fixed=k not in self.free) for k in _BW_NAMES],
-                            "bouc-wen")
+        return self._parameter_set({
+            "d": ("gain: output per unit input without hysteresis", _ratio(yu, uu)),
+            "alpha": ("α: amplitude of the hysteresis (λ = α d in eq 3)", "1"),
+            "beta": ("β: shape of the hysteresis (eq 3)", shape),
+            "gamma": ("γ: shape of the hysteresis (eq 3)", shape),
+            "n": ("exponent n of |h| (n = 1: eq 3)", "1"),
+            "offset": ("output offset c", yu if not _unitless(yu) else "1")})
 
     def _run(self, u: np.ndarray, theta: dict | None = None) -> tuple[np.ndarray, int]:
         p = self.values() if theta is None else theta
@@ -313,24 +320,27 @@ class BoucWenModel(_HysteresisModel):
         return y[:, None], self._fd_std(u)[:, None]
 
     def to_dict(self) -> dict:
-        return dict(schema=SCHEMA, version=VERSION, model=self.structure, **self.values(),
-                    free=list(self.free), covariance=np.asarray(self.covariance).tolist(),
-                    std=self.std, dt=self.dt, input_name=self.input_name,
-                    output_name=self.output_name, input_unit=self.input_unit,
-                    output_unit=self.output_unit, fit_percent=self.fit_percent,
-                    validation_fit_percent=self.validation_fit_percent, burn_in=self.burn_in,
-                    criterion=self.criterion, fit_definition=HYSTERESIS_FIT,
-                    **({"records": list(self.records)} if self.records else {}))
+        return self._document(**self.values(), free=list(self.free),
+                              covariance=np.asarray(self.covariance).tolist(), std=self.std)
 
     def summary(self) -> str:
-        sd = self.std
         how = " estimated" if "n" in self.free else ""
-        rows = [f"Bouc-Wen (actuator form, n = {self.n:g}{how}): y = d u − h + c  "
-                f"({self.criterion})"]
-        for p in self.parameters.values():
-            s = f" ± {sd[p.name]:.3g}" if p.name in sd else " (fixed)"
-            rows.append(f"  {p.name:<7s} {p.value: .6g}{s} {p.unit}")
-        return "\n".join(rows)
+        return self._summary(f"Bouc-Wen (actuator form, n = {self.n:g}{how}): y = d u − h + c  "
+                             f"({self.criterion})")
+
+
+def _free_run_covariance(res, n_scored: int, family: str) -> np.ndarray:
+    """``cov θ = s² (JᵀJ)⁺``, ``s² = SSE/(N − p)``, of a ``scipy.optimize.least_squares`` result
+    on ``n_scored`` residuals (J of the free run at the optimum); an AccuracyWarning when JᵀJ is
+    singular to working precision."""
+    dof = max(n_scored - len(res.x), 1)
+    s2 = 2.0 * res.cost / dof
+    JtJ = res.jac.T @ res.jac
+    if np.linalg.cond(JtJ) > 1e14:
+        emit_warning(f"{family}: the parameters are nearly unidentifiable from this record (JᵀJ "
+                     "singular to working precision); their σ are unreliable: excite loops of "
+                     "several amplitudes", AccuracyWarning)
+    return s2 * np.linalg.pinv(JtJ)
 
 
 def _scaled_bw(theta_s, names, fixed, su, sy):
@@ -419,14 +429,7 @@ def _fit_bouc_wen(recs, *, exponent, offset, burn_in, multistart, progress):
     if best is None or not np.isfinite(best.cost):
         raise IdentificationError("bouc-wen: no starting point gave a finite free run; check that "
                                   "the output follows the input")
-    dof = max(len(target) - len(names), 1)
-    s2 = 2.0 * best.cost / dof
-    J = best.jac
-    cov_s = s2 * np.linalg.pinv(J.T @ J)
-    if np.linalg.cond(J.T @ J) > 1e14:
-        emit_warning("bouc-wen: the parameters are nearly unidentifiable from this record (JᵀJ "
-                     "singular to working precision); their σ are unreliable: excite loops of "
-                     "several amplitudes", AccuracyWarning)
+    cov_s = _free_run_covariance(best, len(target), "bouc-wen")
     T = _bw_transform_jacobian(best.x, names, fixed, su, sy)
     phys = _scaled_bw(best.x, names, fixed, su, sy)
     return phys, tuple(names), T @ cov_s @ T.T
@@ -463,15 +466,6 @@ class BoucWenOscillatorModel(_HysteresisModel):
     dt: float = 1.0
     substeps: int = 4
     free: tuple = ("mass", "damping", "k_e", "k_h", "beta", "gamma", "offset")
-    covariance: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
-    input_name: str = "u"
-    output_name: str = "y"
-    input_unit: str = "1"
-    output_unit: str = "1"
-    fit_percent: float | None = None
-    validation_fit_percent: float | None = None
-    burn_in: int = 0
-    criterion: str = ""
 
     structure = "bouc-wen-oscillator"
 
@@ -483,18 +477,15 @@ class BoucWenOscillatorModel(_HysteresisModel):
         uu, yu = self.input_unit, self.output_unit
         k_unit = _ratio(uu, yu)
         shape = _ratio("1", yu) if self.n == 1.0 else f"1/{yu}^{self.n:g}"
-        sd = self.std
-        docs = {"mass": ("mass: input per unit acceleration", f"{k_unit}*s^2"),
-                "damping": ("viscous damping: input per unit velocity", f"{k_unit}*s"),
-                "k_e": ("elastic stiffness k_e (a k of Wen's form)", k_unit),
-                "k_h": ("hysteretic stiffness k_h ((1 − a) k of Wen's form)", k_unit),
-                "beta": ("β: shape of the hysteresis (A = 1)", shape),
-                "gamma": ("γ: shape of the hysteresis (A = 1)", shape),
-                "n": ("exponent n of |z|", "1"),
-                "offset": ("output offset", yu if not _unitless(yu) else "1")}
-        return ParameterSet([_parameter(k, getattr(self, k), docs[k][1], docs[k][0], sd.get(k),
-                                        fixed=k not in self.free) for k in _BWO_NAMES],
-                            "bouc-wen-oscillator")
+        return self._parameter_set({
+            "mass": ("mass: input per unit acceleration", f"{k_unit}*s^2"),
+            "damping": ("viscous damping: input per unit velocity", f"{k_unit}*s"),
+            "k_e": ("elastic stiffness k_e (a k of Wen's form)", k_unit),
+            "k_h": ("hysteretic stiffness k_h ((1 − a) k of Wen's form)", k_unit),
+            "beta": ("β: shape of the hysteresis (A = 1)", shape),
+            "gamma": ("γ: shape of the hysteresis (A = 1)", shape),
+            "n": ("exponent n of |z|", "1"),
+            "offset": ("output offset", yu if not _unitless(yu) else "1")})
 
     def _input(self, data) -> np.ndarray:
         if isinstance(data, Trajectory) and data.n > 1 and not math.isclose(
@@ -525,24 +516,12 @@ class BoucWenOscillatorModel(_HysteresisModel):
         return y[:, None], self._fd_std(u)[:, None]
 
     def to_dict(self) -> dict:
-        return dict(schema=SCHEMA, version=VERSION, model=self.structure, **self.values(),
-                    substeps=int(self.substeps), free=list(self.free),
-                    covariance=np.asarray(self.covariance).tolist(), std=self.std, dt=self.dt,
-                    input_name=self.input_name, output_name=self.output_name,
-                    input_unit=self.input_unit, output_unit=self.output_unit,
-                    fit_percent=self.fit_percent,
-                    validation_fit_percent=self.validation_fit_percent, burn_in=self.burn_in,
-                    criterion=self.criterion, fit_definition=HYSTERESIS_FIT,
-                    **({"records": list(self.records)} if self.records else {}))
+        return self._document(**self.values(), substeps=int(self.substeps), free=list(self.free),
+                              covariance=np.asarray(self.covariance).tolist(), std=self.std)
 
     def summary(self) -> str:
-        sd = self.std
-        rows = [f"Bouc-Wen oscillator (n = {self.n:g}, A = 1): mass x'' + damping x' + k_e x + "
-                f"k_h z = u  ({self.criterion})"]
-        for p in self.parameters.values():
-            s = f" ± {sd[p.name]:.3g}" if p.name in sd else " (fixed)"
-            rows.append(f"  {p.name:<7s} {p.value: .6g}{s} {p.unit}")
-        return "\n".join(rows)
+        return self._summary(f"Bouc-Wen oscillator (n = {self.n:g}, A = 1): mass x'' + damping "
+                             f"x' + k_e x + k_h z = u  ({self.criterion})")
 
 
 def _linear_start(u, y, dt):
@@ -623,14 +602,7 @@ def _fit_bouc_wen_oscillator(u, y, dt, *, exponent, offset, burn_in, multistart,
             break
     if end < len(us):
         best = least_squares(resid, best.x, **opts)
-    dof = max(len(target) - len(names), 1)
-    s2 = 2.0 * best.cost / dof
-    JtJ = best.jac.T @ best.jac
-    if np.linalg.cond(JtJ) > 1e14:
-        emit_warning("bouc-wen-oscillator: the parameters are nearly unidentifiable from this "
-                     "record (JᵀJ singular to working precision); their σ are unreliable: excite "
-                     "loops of several amplitudes", AccuracyWarning)
-    cov_s = s2 * np.linalg.pinv(JtJ)
+    cov_s = _free_run_covariance(best, len(target), "bouc-wen-oscillator")
     p = dict(fixed)
     p.update(zip(names, best.x))
     n = p["n"]
@@ -685,17 +657,8 @@ class PrandtlIshlinskiiModel(_HysteresisModel):
     weights: np.ndarray
     offset: float = 0.0
     input_offset: float = 0.0
-    covariance: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
     fit_offset: bool = True
     dt: float | None = None
-    input_name: str = "u"
-    output_name: str = "y"
-    input_unit: str = "1"
-    output_unit: str = "1"
-    fit_percent: float | None = None
-    validation_fit_percent: float | None = None
-    burn_in: int = 0
-    criterion: str = ""
 
     structure = "prandtl-ishlinskii"
 
@@ -758,20 +721,13 @@ class PrandtlIshlinskiiModel(_HysteresisModel):
                                       criterion=f"inverse (Kuhnen 2003) of: {self.criterion}")
 
     def to_dict(self) -> dict:
-        return dict(schema=SCHEMA, version=VERSION, model=self.structure,
-                    thresholds=np.asarray(self.thresholds).tolist(),
-                    weights=np.asarray(self.weights).tolist(),
-                    weights_std=[None if not np.isfinite(s) else float(s)
-                                 for s in self.weights_std],
-                    offset=float(self.offset), input_offset=float(self.input_offset),
-                    fit_offset=bool(self.fit_offset),
-                    covariance=np.asarray(self.covariance).tolist(), dt=self.dt,
-                    input_name=self.input_name, output_name=self.output_name,
-                    input_unit=self.input_unit, output_unit=self.output_unit,
-                    fit_percent=self.fit_percent,
-                    validation_fit_percent=self.validation_fit_percent, burn_in=self.burn_in,
-                    criterion=self.criterion, fit_definition=HYSTERESIS_FIT,
-                    **({"records": list(self.records)} if self.records else {}))
+        return self._document(thresholds=np.asarray(self.thresholds).tolist(),
+                              weights=np.asarray(self.weights).tolist(),
+                              weights_std=[None if not np.isfinite(s) else float(s)
+                                           for s in self.weights_std],
+                              offset=float(self.offset), input_offset=float(self.input_offset),
+                              fit_offset=bool(self.fit_offset),
+                              covariance=np.asarray(self.covariance).tolist())
 
     def summary(self) -> str:
         rows = [f"Prandtl-Ishlinskii, {len(self.weights)} play operators ({self.criterion})"]
@@ -1045,6 +1001,14 @@ def hysteresis(data, model: str = "bouc-wen", *, input: str | None = None,
 # reading a model file
 
 
+def _free_and_covariance(doc: dict, names: tuple) -> tuple[tuple, np.ndarray]:
+    """The free parameters (each one of ``names``) and their covariance of a model file."""
+    free = tuple(str(k) for k in doc["free"])
+    if not set(free) <= set(names):
+        raise ValueError(f"unknown free parameter in {free}")
+    return free, np.array(doc["covariance"], dtype=np.float64).reshape(len(free), len(free))
+
+
 def load_hysteresis(path):
     """Read a model written by ``save`` of :class:`BoucWenModel`,
     :class:`BoucWenOscillatorModel` or :class:`PrandtlIshlinskiiModel`; the same type comes
@@ -1061,17 +1025,11 @@ def load_hysteresis(path):
                       burn_in=int(doc.get("burn_in", 0)))
         common["criterion"] = str(common["criterion"] or "")
         if kind == "bouc-wen":
-            free = tuple(str(k) for k in doc["free"])
-            if not set(free) <= set(_BW_NAMES):
-                raise ValueError(f"unknown free parameter in {free}")
-            cov = np.array(doc["covariance"], dtype=np.float64).reshape(len(free), len(free))
+            free, cov = _free_and_covariance(doc, _BW_NAMES)
             return BoucWenModel(**{k: float(doc[k]) for k in _BW_NAMES}, free=free,
                                 covariance=cov, **common)
         if kind == "bouc-wen-oscillator":
-            free = tuple(str(k) for k in doc["free"])
-            if not set(free) <= set(_BWO_NAMES):
-                raise ValueError(f"unknown free parameter in {free}")
-            cov = np.array(doc["covariance"], dtype=np.float64).reshape(len(free), len(free))
+            free, cov = _free_and_covariance(doc, _BWO_NAMES)
             common["dt"] = float(common["dt"])
             if not (common["dt"] > 0 and int(doc["substeps"]) >= 1):
                 raise ValueError("dt must be > 0 and substeps ≥ 1")

@@ -25,8 +25,8 @@ from numba import njit
 
 from ...models.hysteresis import bouc_wen_advance
 
-__all__ = ["RK4_STEP", "bw_advance_rk4", "bw_simulate", "bwo_simulate", "count_reversals",
-           "play_matrix", "pi_simulate"]
+__all__ = ["RK4_STEP", "bw_advance_rk4", "bw_simulate", "bwo_sample", "bwo_simulate",
+           "count_reversals", "play_matrix", "pi_simulate"]
 
 #: largest (local rate × input sub-step) of the Runge-Kutta integration (local error ~ step⁵/120)
 RK4_STEP = 0.02
@@ -95,6 +95,19 @@ def bw_simulate(u, d, alpha, beta, gamma, n, offset, h0, u0, y):  # pragma: no c
     return -1
 
 
+@njit(cache=True, inline="always")
+def _play_step(z, x, r):  # pragma: no cover - compiled
+    """The play operator of threshold r at one sample: its last output z held within
+    [x − r, x + r]."""
+    lo = x - r
+    hi = x + r
+    if z < lo:
+        return lo
+    if z > hi:
+        return hi
+    return z
+
+
 @njit(cache=True)
 def play_matrix(x, r, out):  # pragma: no cover - compiled
     """out[k, i] = play operator of threshold r[i] on x, each relaxed at x[0] (z = x[0])."""
@@ -102,12 +115,7 @@ def play_matrix(x, r, out):  # pragma: no cover - compiled
         z = x[0]
         ri = r[i]
         for k in range(x.shape[0]):
-            lo = x[k] - ri
-            hi = x[k] + ri
-            if z < lo:
-                z = lo
-            elif z > hi:
-                z = hi
+            z = _play_step(z, x[k], ri)
             out[k, i] = z
 
 
@@ -122,12 +130,7 @@ def pi_simulate(x, r, w, offset, y):  # pragma: no cover - compiled
         ri = r[i]
         wi = w[i]
         for k in range(x.shape[0]):
-            lo = x[k] - ri
-            hi = x[k] + ri
-            if z < lo:
-                z = lo
-            elif z > hi:
-                z = hi
+            z = _play_step(z, x[k], ri)
             y[k] += wi * z
 
 
@@ -177,6 +180,25 @@ def bwo_rates(x, v, z, u, m, c, ke, kh, beta, gamma, n):  # pragma: no cover - c
 
 
 @njit(cache=True)
+def bwo_sample(x, v, z, u, h, substeps, p):  # pragma: no cover - compiled
+    """(x, ẋ, z) of the Bouc-Wen oscillator one sample on: ``substeps`` classical RK4 steps of
+    length h with the input u held; p = (m, c, k_e, k_h, β, γ, n) as in :func:`bwo_rates`."""
+    m, c, ke, kh, beta, gamma, n = p
+    for _ in range(substeps):
+        a1, b1, c1 = bwo_rates(x, v, z, u, m, c, ke, kh, beta, gamma, n)
+        a2, b2, c2 = bwo_rates(x + 0.5 * h * a1, v + 0.5 * h * b1, z + 0.5 * h * c1, u,
+                                m, c, ke, kh, beta, gamma, n)
+        a3, b3, c3 = bwo_rates(x + 0.5 * h * a2, v + 0.5 * h * b2, z + 0.5 * h * c2, u,
+                                m, c, ke, kh, beta, gamma, n)
+        a4, b4, c4 = bwo_rates(x + h * a3, v + h * b3, z + h * c3, u,
+                                m, c, ke, kh, beta, gamma, n)
+        x += h * (a1 + 2.0 * a2 + 2.0 * a3 + a4) / 6.0
+        v += h * (b1 + 2.0 * b2 + 2.0 * b3 + b4) / 6.0
+        z += h * (c1 + 2.0 * c2 + 2.0 * c3 + c4) / 6.0
+    return x, v, z
+
+
+@njit(cache=True)
 def bwo_simulate(u, dt, substeps, m, c, ke, kh, beta, gamma, n, offset, y):  # pragma: no cover
     """Bouc-Wen oscillator from rest (x = ẋ = z = 0 at the first sample), the input held over
     each sample, ``substeps`` RK4 steps per sample: y[k] = x(t_k) + offset. Returns the first
@@ -185,21 +207,11 @@ def bwo_simulate(u, dt, substeps, m, c, ke, kh, beta, gamma, n, offset, y):  # p
     v = 0.0
     z = 0.0
     h = dt / substeps
+    p = (m, c, ke, kh, beta, gamma, n)
     N = u.shape[0]
     y[0] = offset
     for k in range(N - 1):
-        uk = u[k]
-        for _ in range(substeps):
-            a1, b1, c1 = bwo_rates(x, v, z, uk, m, c, ke, kh, beta, gamma, n)
-            a2, b2, c2 = bwo_rates(x + 0.5 * h * a1, v + 0.5 * h * b1, z + 0.5 * h * c1, uk,
-                                    m, c, ke, kh, beta, gamma, n)
-            a3, b3, c3 = bwo_rates(x + 0.5 * h * a2, v + 0.5 * h * b2, z + 0.5 * h * c2, uk,
-                                    m, c, ke, kh, beta, gamma, n)
-            a4, b4, c4 = bwo_rates(x + h * a3, v + h * b3, z + h * c3, uk,
-                                    m, c, ke, kh, beta, gamma, n)
-            x += h * (a1 + 2.0 * a2 + 2.0 * a3 + a4) / 6.0
-            v += h * (b1 + 2.0 * b2 + 2.0 * b3 + b4) / 6.0
-            z += h * (c1 + 2.0 * c2 + 2.0 * c3 + c4) / 6.0
+        x, v, z = bwo_sample(x, v, z, u[k], h, substeps, p)
         val = x + offset
         y[k + 1] = val
         if not (math.isfinite(val) and math.isfinite(v) and math.isfinite(z)):

@@ -50,7 +50,9 @@ from ...errors import (ArgumentError, DataError, IdentificationError, ModelError
 from ...params import Parameter, ParameterSet
 from ...signals.trajectory import Trajectory
 from ..model_file import read_family_document
-from ..model_protocol import ModelFit, ReportMixin
+from ..model_protocol import ModelFit
+from .levenberg_marquardt import Damping, levenberg_marquardt
+from .single_channel import DIVERGENCE_FACTOR, FreeRunModel, fit_percent, one_signal
 from ...progress import status, track
 
 __all__ = ["SCHEMA", "NARX_FIT", "NARXModel", "narx", "load_narx", "candidate_terms",
@@ -58,8 +60,6 @@ __all__ = ["SCHEMA", "NARX_FIT", "NARXModel", "narx", "load_narx", "candidate_te
 
 SCHEMA = "gripkit.narx-model"
 VERSION = 1
-#: a free run beyond this many times the data's range (about its mean) counts as diverged
-DIVERGENCE_FACTOR = 1e3
 #: how a NARX model's free-run fit is taken (``gripkit compare`` prints it)
 NARX_FIT = ("free run started from the first max_lag measured outputs, "
             "fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) over the samples after them")
@@ -312,27 +312,15 @@ def _sensitivity_kernel(kinds, lags, rows, theta, u, y, start, limit_lo, limit_h
 
 
 def _as_signal(x, name: str) -> np.ndarray:
-    a = np.asarray(x, dtype=np.float64)
-    if a.ndim == 2 and 1 in a.shape:
-        a = a.ravel()
-    if a.ndim != 1:
-        raise DataError(f"narx: {name} must be one signal (shape (N,)), found shape {a.shape}; "
-                        "pass one column")
-    if not np.all(np.isfinite(a)):
-        raise DataError(f"narx: {name} has {int(np.sum(~np.isfinite(a)))} non-finite samples; "
-                        "remove or interpolate them first")
-    return a
+    return one_signal(x, name, "narx")
 
 
 def _fit(y, yhat) -> float:
-    den = float(np.linalg.norm(y - y.mean()))
-    if den == 0.0:
-        raise DataError("narx: the fit is undefined for a constant output (‖y − ȳ‖ = 0)")
-    return 100.0 * (1.0 - float(np.linalg.norm(y - yhat)) / den)
+    return fit_percent(y, yhat, "narx")
 
 
 @dataclass
-class NARXModel(ReportMixin):
+class NARXModel(FreeRunModel):
     """A polynomial NARX model: ``y(t) = Σ θ_k · terms[k](t)``.
 
     ``terms`` (readable names such as ``"y(t-1)*u(t-2)"``), ``theta``, ``theta_std`` (1σ from
@@ -363,24 +351,9 @@ class NARXModel(ReportMixin):
     theta: np.ndarray
     theta_std: np.ndarray
     covariance: np.ndarray
-    dt: float = 1.0
-    y_range: tuple = (-np.inf, np.inf)
-    fit_percent: float | None = None
     prediction_fit_percent: float | None = None
-    validation_fit_percent: float | None = None
-    criterion: str = ""
     err: list = field(default_factory=list)
     frols_terms: list = field(default_factory=list)
-    input_name: str = "u"
-    output_name: str = "y"
-
-    @property
-    def inputs(self) -> tuple[str, ...]:
-        return (self.input_name,)
-
-    @property
-    def outputs(self) -> tuple[str, ...]:
-        return (self.output_name,)
 
     @property
     def parameters(self) -> ParameterSet:
@@ -417,12 +390,6 @@ class NARXModel(ReportMixin):
     @property
     def max_lag(self) -> int:
         return int(max(self.ylags, self.ulags, 1))
-
-    def _limits(self):
-        lo, hi = self.y_range
-        span = max(hi - lo, 1e-12)
-        mid = 0.5 * (hi + lo)
-        return mid - DIVERGENCE_FACTOR * span, mid + DIVERGENCE_FACTOR * span
 
     def simulate(self, data, y0=None, *, warn: bool = True, std: bool = False):
         """Free run on the input of ``data`` (a trajectory: (N, 1)) or on the input ``u`` (N,):
@@ -622,6 +589,8 @@ def _fit_records(model: NARXModel, records, warn: bool = True) -> float | None:
 
 #: choices of ``refine``
 REFINE = (None, "simulation")
+#: λ ÷ 3 after a step taken, × 4 after one refused, tried below 1e12
+_DAMPING = Damping(shrink=3.0, grow=4.0, ceiling=float(np.nextafter(1e12, 0.0)))
 
 
 def _refine_simulation(model: NARXModel, records, max_iter: int, tol: float = 1e-9):
@@ -644,36 +613,24 @@ def _refine_simulation(model: NARXModel, records, max_iter: int, tol: float = 1e
             Js.append(J[m:])
         return np.concatenate(es), np.concatenate(Js)
 
-    theta = model.theta.copy()
-    cur = run(theta)
+    cur = run(model.theta)
     if cur is None:
         return None
     e, J = cur
-    cost = float(e @ e)
-    lam, it = 1e-3, 0
-    for it in range(1, max_iter + 1):
-        A = J.T @ J
-        g = J.T @ e
-        d = np.sqrt(np.maximum(np.diag(A), 1e-300))
-        As, gs = A / np.outer(d, d), g / d
-        improved = False
-        while lam < 1e12:
-            try:
-                step = np.linalg.solve(As + lam * np.eye(len(d)), gs) / d
-            except np.linalg.LinAlgError:
-                lam *= 10.0
-                continue
-            new = run(theta + step)
-            if new is not None and float(new[0] @ new[0]) < cost:
-                improved = True
-                theta = theta + step
-                e, J = new
-                old, cost = cost, float(e @ e)
-                lam = max(lam / 3.0, 1e-12)
-                break
-            lam *= 4.0
-        if not improved or old - cost <= tol * old:
-            break
+    tried = []
+
+    def trial(theta):
+        tried[:] = [run(theta)]
+        return None if tried[0] is None else float(tried[0][0] @ tried[0][0])
+
+    def accept(theta):
+        nonlocal e, J
+        e, J = tried[0]
+
+    theta, cost, it = levenberg_marquardt(
+        model.theta.copy(), float(e @ e), normal_equations=lambda: (J.T @ J, J.T @ e),
+        trial=trial, accept=accept, converged=lambda old, new: old - new <= tol * old,
+        max_iter=max_iter, damping=_DAMPING)
     n, k = J.shape
     A = J.T @ J
     d = np.sqrt(np.maximum(np.diag(A), 1e-300))

@@ -1,0 +1,84 @@
+"""What the single-input single-output nonlinear families share about their records: the
+protocol's channel names (:class:`SingleChannel`), the fields of a model fitted on its free run
+and the limits beyond which that run counts as diverged (:class:`FreeRunModel`), the check of one
+signal (:func:`one_signal`) and the free-run fit ``100 (1 − ‖y − ŷ‖/‖y − ȳ‖)``
+(:func:`fit_percent`, the definition of :mod:`gripkit.sysid.model_protocol`), each error message
+headed by the family's name."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ...errors import DataError
+from ..model_protocol import ReportMixin
+
+__all__ = ["DIVERGENCE_FACTOR", "FreeRunModel", "SingleChannel", "fit_percent", "one_signal"]
+
+#: a free run beyond this many times the estimation output's range (about its middle) counts as
+#: diverged
+DIVERGENCE_FACTOR = 1e3
+
+
+class SingleChannel(ReportMixin):
+    """The protocol's ``inputs`` and ``outputs`` of a model of one input and one output column,
+    named by its attributes ``input_name`` and ``output_name``."""
+
+    input_name: str
+    output_name: str
+
+    @property
+    def inputs(self) -> tuple[str, ...]:
+        return (self.input_name,)
+
+    @property
+    def outputs(self) -> tuple[str, ...]:
+        return (self.output_name,)
+
+
+@dataclass(kw_only=True)
+class FreeRunModel(SingleChannel):
+    """The fields (keyword-only) of a single-channel model fitted on its free run: sample time
+    ``dt`` (s), ``y_range`` (the estimation output's (min, max)), ``fit_percent`` (free run on
+    the estimation record), ``validation_fit_percent`` (on ``validate=``; None when diverged or
+    none given), ``criterion`` (how the structure was chosen), the column names."""
+
+    dt: float = 1.0
+    y_range: tuple = (-np.inf, np.inf)
+    fit_percent: float | None = None
+    validation_fit_percent: float | None = None
+    criterion: str = ""
+    input_name: str = "u"
+    output_name: str = "y"
+
+    def _limits(self) -> tuple[float, float]:
+        """The band of a free run that has not diverged: :data:`DIVERGENCE_FACTOR` times the
+        span of ``y_range`` either side of its middle."""
+        lo, hi = self.y_range
+        span = max(hi - lo, 1e-12)
+        mid = 0.5 * (hi + lo)
+        return mid - DIVERGENCE_FACTOR * span, mid + DIVERGENCE_FACTOR * span
+
+
+def one_signal(x, name: str, family: str) -> np.ndarray:
+    """``x`` as one finite float signal (N,) (a column (N, 1) or row (1, N) is flattened);
+    a DataError headed ``family`` names ``name`` otherwise."""
+    a = np.asarray(x, dtype=np.float64)
+    if a.ndim == 2 and 1 in a.shape:
+        a = a.ravel()
+    if a.ndim != 1:
+        raise DataError(f"{family}: {name} must be one signal (shape (N,)), found shape "
+                        f"{a.shape}; pass one column")
+    if not np.all(np.isfinite(a)):
+        raise DataError(f"{family}: {name} has {int(np.sum(~np.isfinite(a)))} non-finite "
+                        "samples; remove or interpolate them first")
+    return a
+
+
+def fit_percent(y: np.ndarray, yhat: np.ndarray, family: str) -> float:
+    """``100 (1 − ‖y − ŷ‖/‖y − ȳ‖)``; a DataError headed ``family`` for a constant ``y``."""
+    den = float(np.linalg.norm(y - y.mean()))
+    if den == 0.0:
+        raise DataError(f"{family}: the fit is undefined for a constant output (‖y − ȳ‖ = 0)")
+    return 100.0 * (1.0 - float(np.linalg.norm(y - yhat)) / den)
