@@ -146,6 +146,40 @@ def test_lagged_sums_route_equals_qr_of_the_regressor(na, nb, nk, n, monkeypatch
                                rtol=1e-8)
 
 
+@pytest.mark.parametrize("na, nb, nk, n", [(2, 2, 2, 10_000), (4, 4, 2, 8000), (2, 3, 1, 20_000),
+                                           (1, 1, 1, 30_000), (0, 3, 1, 12_000)])
+def test_blas_normal_equations_route_equals_qr_of_the_regressor(na, nb, nk, n):
+    """Regressors of 2^15 … 2^18 elements (N ≈ 10⁴) are solved from the normal equations of the
+    BLAS Gram matrix when the column-scaled κ ≤ blas_gram_cond_limit(m) (κ²·m·u ≤ 1e-8: an
+    uncompensated sum of m products errs by m·u), else by QR; θ, σ, loss, fit and the residuals
+    equal the QR route's within the derived bound κ²·m·u."""
+    arx_mod = importlib.import_module("gripkit.sysid.linear.arx")
+    from gripkit.sysid.regression import NUMPY_QR_MAX_ELEMENTS, arx_regression, qr_solve
+
+    u, y = simulate_arx(n, noise=0.5, seed=13)
+    X = arx_regression(u, y, na, nb, nk)
+    assert NUMPY_QR_MAX_ELEMENTS < X.size <= arx_mod.QR_MAX_ELEMENTS
+    m = arx(u, y, na, nb, nk)
+    rows = X.shape[0]
+    blas = m.info["method"].startswith("least squares (normal equations of the BLAS Gram")
+    # the over-parameterised [4 4 2] of this second-order system is near-collinear: QR then
+    assert blas == (m.info["cond"] <= arx_mod.blas_gram_cond_limit(rows)) == ((na, nb) != (4, 4))
+    ref = qr_solve(X, tuple(f"p{i}" for i in range(na + nb)))
+    tol = max(m.info["cond"] ** 2 * rows * 2**-53, 1e-12)
+    np.testing.assert_allclose(m.theta, ref.theta, rtol=0, atol=tol * np.max(np.abs(ref.theta)))
+    e = X[:, -1] - X[:, :-1] @ ref.theta
+    scale = np.max(np.abs(X) @ np.append(np.abs(ref.theta), 1.0))  # max Σ|x_j θ_j| over rows
+    np.testing.assert_allclose(m.estimation_residuals, e, rtol=0, atol=2 * tol * scale)
+    assert m.loss == pytest.approx(0.5 * (e @ e) / rows, rel=1e-9)
+    assert m.fit_percent == pytest.approx(
+        100 * (1 - np.linalg.norm(e) / np.linalg.norm(X[:, -1] - X[:, -1].mean())), rel=1e-9)
+    np.testing.assert_allclose(m.theta_std,
+                               np.sqrt(np.diag(ref.cov_unscaled) * (e @ e) / (rows - na - nb)),
+                               rtol=4 * tol)
+    np.testing.assert_allclose(m.covariance, ref.cov_unscaled * (e @ e) / (rows - na - nb),
+                               rtol=4 * tol, atol=4 * tol * np.max(np.abs(m.covariance)))
+
+
 def test_small_problem_takes_the_qr_route_without_numba():
     """2000 samples of [2 2 2] (2000·5 regressor elements, below QR_MAX_ELEMENTS) are solved by QR
     in a fresh process without importing numba, and give the lagged-sums route's estimate."""

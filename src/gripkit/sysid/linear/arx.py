@@ -25,7 +25,9 @@ from .arx_mimo import arx_mimo
 from ..checks import (check_dt, check_excitation, check_identifiable, check_io, check_order,
                      check_output_varies, checked_problem_peaks, require_samples)
 from .polynomial import PolynomialModel, channel_meta
-from ..regression import arx_regression, arx_start, qr_solve, solve_upper, triangular_solve
+from ..regression import (NUMPY_QR_MAX_ELEMENTS, QRSolution, arx_regression, arx_start, qr_solve,
+                          solve_upper, triangular_solve,
+                          warn_if_weakly_determined)
 from .validation import fit_percent, records_fit
 
 __all__ = ["arx", "arx_records"]
@@ -126,14 +128,25 @@ def _arx(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int, step: float, *
     names = tuple(f"a{i}" for i in range(1, na + 1)) + tuple(f"b{nk + j}" for j in range(nb))
     m = y.size - t0
     small = m * (p + 1) <= QR_MAX_ELEMENTS
-    gram = None if small else _normal_equations(u, y, na, nb, nk, t0, names, warn, keep_residuals)
+    X = gram = None
+    if not small:
+        gram = _normal_equations(u, y, na, nb, nk, t0, names, warn, keep_residuals)
+    elif m * (p + 1) > NUMPY_QR_MAX_ELEMENTS:  # scipy.linalg's range: BLAS normal equations
+        X = arx_regression(u, y, na, nb, nk)
+        gram = _blas_normal_equations(X, names, warn)
     if gram is None:  # small, or ill-conditioned: QR of the materialised [Φ | Y]
-        sol = qr_solve(arx_regression(u, y, na, nb, nk), names, overwrite=True, warn=warn)
+        X = arx_regression(u, y, na, nb, nk) if X is None else X
+        sol = qr_solve(X, names, overwrite=True, warn=warn)
         method = "least squares (QR of [Φ | Y])"
         A, B = _polynomials(sol.theta, na, nk)
         # PolynomialModel.prediction_errors of an ARX model, on the same arrays
         e = np.convolve(y, A)[t0:y.size] - np.convolve(u, B)[t0:u.size]
         see, fit = float(e @ e), fit_percent(y[t0:], y[t0:] - e)
+    elif X is not None:
+        method = "least squares (normal equations of the BLAS Gram matrix, Cholesky)"
+        sol, e, see, syy = gram
+        A, B = _polynomials(sol.theta, na, nk)
+        fit = 100.0 * (1.0 - math.sqrt(see / syy))
     else:
         method = "least squares (normal equations from compensated lagged sums, Cholesky)"
         sol, e, see, syy = gram
@@ -185,6 +198,56 @@ def _normal_equations(u, y, na, nb, nk, t0, names, warn, keep_residuals):
     R[p, p] = np.sqrt(see)
     return (triangular_solve(R, names, y.size - t0, warn, stacklevel=5, condition=condition),
             e, see, syy)
+
+
+def blas_gram_cond_limit(m: int) -> float:
+    """Largest column-scaled κ of Φ (m rows) for which :func:`_blas_normal_equations` is used:
+    an uncompensated BLAS sum of m products errs by at most ``m·u`` relative to ``Σ|x z|``, and
+    the normal equations turn a relative error ε of the Gram matrix into up to ``κ²ε`` in θ; the
+    limit keeps ``κ²·m·u`` at 1e-8 (the lagged sums' bound, with m for their ``BLOCK``)."""
+    return math.sqrt(1e-8 / (m * 2.0**-53))
+
+
+def _blas_normal_equations(X: np.ndarray, names: tuple, warn: bool):
+    """``(sol, e, Σe², Σ(y − ȳ)²)`` from the normal equations of the materialised ``X = [Φ | Y]``
+    (one BLAS product ``Xᵀ Φ``, Cholesky), the residuals ``e = X·[−θ; 1] = Y − Φθ`` in one more
+    pass over X; or None when Φ is not positive definite or its column-scaled κ exceeds
+    :func:`blas_gram_cond_limit` (then QR is used). At N ≈ 10⁴ ``geqrf`` alone costs more than
+    this whole route. ``(ΦᵀΦ)⁻¹`` for the covariance comes from the Cholesky factor
+    (``dtrtri``), not from another solve; the LAPACK routines are called directly (numpy's and
+    scipy's wrappers cost more than these p×p problems)."""
+    from scipy.linalg import lapack  # loaded at these sizes anyway (qr_r's geqrf)
+
+    m, q = X.shape
+    p = q - 1
+    G = X.T @ X[:, :p]  # (q, p): ΦᵀΦ over YᵀΦ; a gemm (numpy's X.T @ X is a syrk, 5× slower here)
+    r1, info = lapack.dpotrf(G[:p], lower=0, clean=1)
+    if info != 0:
+        return None
+    col = np.sqrt(G.diagonal())  # column norms of Φ
+    sv, vt = lapack.dgesdd(r1 / col)[1:3]
+    # κ ≤ the limit (< COND_LIMIT) also means no column is zero: check_determined passes
+    cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else math.inf
+    if not cond <= blas_gram_cond_limit(m):  # NaN too
+        return None
+    r = lapack.dtrtrs(r1, G[p], lower=0, trans=1)[0]  # R1ᵀ r = ΦᵀY
+    theta = lapack.dtrtrs(r1, r, lower=0)[0]
+    w = np.empty(q)
+    np.negative(theta, out=w[:p])
+    w[p] = 1.0
+    e = X @ w
+    see = float(e.dot(e))
+    yt = X[:, p]
+    d = yt - float(np.add.reduce(yt)) / m
+    syy = float(d.dot(d))
+    if syy == 0.0:
+        raise DataError("the fit is undefined for a constant output (‖y − ȳ‖ = 0)")
+    rinv = lapack.dtrtri(r1, lower=0)[0]
+    cov = rinv @ rinv.T
+    condition = (cond, sv, vt, col)
+    if warn:
+        warn_if_weakly_determined(condition, names, theta, r, math.sqrt(see), cov, m)
+    return QRSolution(theta, see, r1, 0.5 * (cov + cov.T), cond, m), e, see, syy
 
 
 def checked_records(records, what: str) -> list:
