@@ -15,6 +15,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -25,8 +26,8 @@ from .arx_mimo import arx_mimo
 from ..checks import (check_dt, check_excitation, check_identifiable, check_io, check_order,
                      check_output_varies, checked_problem_peaks, require_samples)
 from .polynomial import PolynomialModel, channel_meta
-from ..regression import (NUMPY_QR_MAX_ELEMENTS, QRSolution, arx_regression, arx_start, qr_solve,
-                          solve_upper, triangular_solve,
+from ..regression import (COND_NOTABLE, NUMPY_QR_MAX_ELEMENTS, QRSolution, arx_regression,
+                          arx_start, qr_solve, solve_upper, triangular_solve,
                           warn_if_weakly_determined)
 from .validation import fit_percent, records_fit
 
@@ -125,7 +126,7 @@ def _arx(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int, step: float, *
     t0 = arx_start(na, nb, nk)
     check_identifiable(u, y, t0 + p + 1,
                        f"ARX [{na} {nb} {nk}] ({p} parameters, {t0} initial samples)", peaks)
-    names = tuple(f"a{i}" for i in range(1, na + 1)) + tuple(f"b{nk + j}" for j in range(nb))
+    names = parameter_names(na, nb, nk)
     m = y.size - t0
     small = m * (p + 1) <= QR_MAX_ELEMENTS
     X = gram = None
@@ -164,9 +165,18 @@ def _arx(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int, step: float, *
 
 def _polynomials(theta, na, nk) -> tuple[np.ndarray, np.ndarray]:
     """``A = [1, a…]`` and ``B = [0]*nk + [b…]`` (MATLAB layout) from θ."""
-    A = np.concatenate([[1.0], theta[:na]])
-    B = np.concatenate([np.zeros(nk), theta[na:]])
+    A = np.empty(na + 1)
+    A[0] = 1.0
+    A[1:] = theta[:na]
+    B = np.zeros(nk + theta.size - na)
+    B[nk:] = theta[na:]
     return A, B
+
+
+@functools.lru_cache(maxsize=256)
+def parameter_names(na: int, nb: int, nk: int) -> tuple[str, ...]:
+    """``('a1', …, 'a<na>', 'b<nk>', …, 'b<nk+nb−1>')``, θ's order (one tuple per structure)."""
+    return tuple(f"a{i}" for i in range(1, na + 1)) + tuple(f"b{nk + j}" for j in range(nb))
 
 
 def _model(theta, na, nk, step, n, meta) -> PolynomialModel:
@@ -208,6 +218,15 @@ def blas_gram_cond_limit(m: int) -> float:
     return math.sqrt(1e-8 / (m * 2.0**-53))
 
 
+@functools.cache
+def _lapack():
+    """scipy's LAPACK wrappers, imported on first use (scipy.linalg: ~0.2 s of a fresh process;
+    the regressors that take this route are large enough to load it anyway for QR)."""
+    from scipy.linalg import lapack
+
+    return lapack
+
+
 def _blas_normal_equations(X: np.ndarray, names: tuple, warn: bool):
     """``(sol, e, Σe², Σ(y − ȳ)²)`` from the normal equations of the materialised ``X = [Φ | Y]``
     (one BLAS product ``Xᵀ Φ``, Cholesky), the residuals ``e = X·[−θ; 1] = Y − Φθ`` in one more
@@ -216,8 +235,7 @@ def _blas_normal_equations(X: np.ndarray, names: tuple, warn: bool):
     this whole route. ``(ΦᵀΦ)⁻¹`` for the covariance comes from the Cholesky factor
     (``dtrtri``), not from another solve; the LAPACK routines are called directly (numpy's and
     scipy's wrappers cost more than these p×p problems)."""
-    from scipy.linalg import lapack  # loaded at these sizes anyway (qr_r's geqrf)
-
+    lapack = _lapack()
     m, q = X.shape
     p = q - 1
     G = X.T @ X[:, :p]  # (q, p): ΦᵀΦ over YᵀΦ; a gemm (numpy's X.T @ X is a syrk, 5× slower here)
@@ -237,17 +255,35 @@ def _blas_normal_equations(X: np.ndarray, names: tuple, warn: bool):
     w[p] = 1.0
     e = X @ w
     see = float(e.dot(e))
-    yt = X[:, p]
-    d = yt - float(np.add.reduce(yt)) / m
-    syy = float(d.dot(d))
+    syy = _centred_sum_of_squares(X[:, p])
     if syy == 0.0:
         raise DataError("the fit is undefined for a constant output (‖y − ȳ‖ = 0)")
-    rinv = lapack.dtrtri(r1, lower=0)[0]
-    cov = rinv @ rinv.T
-    condition = (cond, sv, vt, col)
-    if warn:
-        warn_if_weakly_determined(condition, names, theta, r, math.sqrt(see), cov, m)
-    return QRSolution(theta, see, r1, 0.5 * (cov + cov.T), cond, m), e, see, syy
+    # (R1ᵀR1)⁻¹ = R1⁻¹R1⁻ᵀ from the factor (dpotri: its upper triangle), mirrored
+    c = lapack.dpotri(r1, lower=0)[0]
+    cov = np.where(_upper(p), c, c.T)
+    if warn and cond > COND_NOTABLE:  # warn_threshold is never below COND_NOTABLE
+        warn_if_weakly_determined((cond, sv, vt, col), names, theta, r, math.sqrt(see), cov, m)
+    return QRSolution(theta, see, r1, cov, cond, m), e, see, syy
+
+
+@functools.lru_cache(maxsize=64)
+def _upper(p: int) -> np.ndarray:
+    """(p, p) mask, True on and above the diagonal (the mirror is its transpose)."""
+    return np.triu(np.ones((p, p), dtype=bool))
+
+
+def _centred_sum_of_squares(y: np.ndarray) -> float:
+    """``Σ(y − ȳ)²``: as ``Σy² − (Σy)²/m`` (no N-sample temporary) when the mean is at most the
+    spread (``(Σy)²/m ≤ Σy²/2``), where the rounding of both sums (≤ m·u each, relative to Σy²)
+    costs at most ``3·m·u·Σy² ≤ 6·m·u`` of the result (2e-11 relative at m = 3·10⁴); otherwise
+    from the centred samples."""
+    s = float(np.add.reduce(y))
+    yy = float(y.dot(y))
+    mean_sq = s * (s / y.size)
+    if mean_sq <= 0.5 * yy:
+        return yy - mean_sq
+    d = y - s / y.size
+    return float(d.dot(d))
 
 
 def checked_records(records, what: str) -> list:
@@ -358,7 +394,7 @@ def arx_records(records, na: int, nb: int, nk: int = 1, *, dt: float | None = No
     m = sum(y.size - t0 for _, y in recs)
     require_samples(m + t0, t0 + p + 1, what)
     scaled, cu, cy = scaled_records(recs, skip_within=_NO_SCALING_WITHIN)
-    names = tuple(f"a{i}" for i in range(1, na + 1)) + tuple(f"b{nk + j}" for j in range(nb))
+    names = parameter_names(na, nb, nk)
     sol = theta = R = None
     if m * (p + 1) > QR_MAX_ELEMENTS:  # the records' Gram matrices summed (O(p²) memory)
         import scipy.linalg as sla

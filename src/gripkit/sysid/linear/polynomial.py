@@ -78,7 +78,14 @@ class _Residuals:
         model.__dict__["_residuals"] = value
 
 
+#: The default C and F: read-only, shared by every model without a C or F polynomial.
+_ONE = np.ones(1)
+_ONE.flags.writeable = False
+
+
 def _coeffs(x, name: str, monic: bool) -> np.ndarray:
+    if x is _ONE:
+        return x
     a = np.array(x, dtype=np.float64, copy=True).ravel()
     if a.size == 0:
         raise ModelError(f"{name}: expected at least one coefficient")
@@ -149,8 +156,8 @@ class PolynomialModel(IdentifiedLinearModel):
     A: np.ndarray
     B: np.ndarray
     nk: int
-    C: np.ndarray = field(default_factory=lambda: np.ones(1))
-    F: np.ndarray = field(default_factory=lambda: np.ones(1))
+    C: np.ndarray = field(default_factory=lambda: _ONE)
+    F: np.ndarray = field(default_factory=lambda: _ONE)
     dt: float = 1.0
     structure: str = "arx"
     covariance: np.ndarray | None = None
