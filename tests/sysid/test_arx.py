@@ -180,6 +180,48 @@ def test_blas_normal_equations_route_equals_qr_of_the_regressor(na, nb, nk, n):
                                rtol=4 * tol, atol=4 * tol * np.max(np.abs(m.covariance)))
 
 
+@pytest.mark.parametrize("qr_max", [None, 0])
+def test_model_built_without_post_init_equals_the_checked_constructor(qr_max, monkeypatch):
+    """``arx`` builds its model by ``PolynomialModel._estimated`` (no second copy and check of
+    the arrays it made): every field equals the one the checked constructor gives from the same
+    values, and the arrays are read-only as the constructor leaves them (BLAS normal-equations
+    route at N = 10⁴; with ``QR_MAX_ELEMENTS = 0`` the lagged-sums route, residuals on demand)."""
+    import dataclasses
+
+    from gripkit.sysid.linear.polynomial import PolynomialModel
+
+    if qr_max is not None:
+        monkeypatch.setattr(importlib.import_module("gripkit.sysid.linear.arx"),
+                            "QR_MAX_ELEMENTS", qr_max)
+    u, y = simulate_arx(10_000, noise=0.5, seed=17)
+    m = arx(u, y, 2, 2, 2, dt=0.01, input_name="i", output_unit="N")
+    names = [f.name for f in dataclasses.fields(PolynomialModel)]
+    ref = PolynomialModel(**{k: getattr(m, k) for k in names})
+    for k in names:
+        a, b = getattr(m, k), getattr(ref, k)
+        if isinstance(b, np.ndarray):
+            np.testing.assert_array_equal(a, b)
+            assert a.dtype == b.dtype and not a.flags.writeable and not b.flags.writeable, k
+        else:
+            assert a == b and type(a) is type(b), k
+    assert (m.dt, m.input_name, m.output_unit, m.output_name) == (0.01, "i", "N", "y")
+
+
+@pytest.mark.parametrize("offset", [0.0, 0.3, 5.0, -1e6])
+def test_centred_sum_of_squares_within_its_bound(offset):
+    """Σ(y − ȳ)² by ``Σy² − (Σy)²/m`` (mean at most the spread) or from the centred samples
+    (larger means) agrees with an exactly rounded sum (math.fsum of the centred squares, the
+    mean itself by fsum) within the stated 6·m·u."""
+    from fractions import Fraction
+
+    from gripkit.sysid.linear.arx import _centred_sum_of_squares
+
+    y = np.random.default_rng(4).standard_normal(20_000) + offset
+    mean = Fraction(math.fsum(y)) / y.size
+    exact = float(sum((Fraction(v) - mean) ** 2 for v in y.tolist()))
+    assert abs(_centred_sum_of_squares(y) - exact) <= 6 * y.size * 2**-53 * exact
+
+
 def test_small_problem_takes_the_qr_route_without_numba():
     """2000 samples of [2 2 2] (2000·5 regressor elements, below QR_MAX_ELEMENTS) are solved by QR
     in a fresh process without importing numba, and give the lagged-sums route's estimate."""

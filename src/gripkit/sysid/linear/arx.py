@@ -156,11 +156,13 @@ def _arx(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int, step: float, *
     sigma2 = see / (m - p)
     if e is not None:
         e.flags.writeable = False  # handed to the model without a copy
-    return PolynomialModel(A, B, nk, dt=step, structure="arx", n_samples=int(y.size),
-                           covariance=sigma2 * sol.cov_unscaled, noise_variance=sigma2,
-                           loss=0.5 * see / m, fit_percent=fit, n_used=m, estimation_residuals=e,
-                           estimation_data=record if e is None else None,
-                           info={"method": method, "cond": sol.cond}, **meta)
+    # every array is fresh and checked here (θ finite: Σe² is): no copies nor checks again
+    build = PolynomialModel._estimated if math.isfinite(see) else PolynomialModel
+    return build(A, B, nk, dt=step, structure="arx", n_samples=int(y.size),
+                 covariance=sigma2 * sol.cov_unscaled, noise_variance=sigma2, loss=0.5 * see / m,
+                 fit_percent=fit, n_used=m, estimation_residuals=e,
+                 estimation_data=record if e is None else None,
+                 info={"method": method, "cond": sol.cond}, **meta)
 
 
 def _polynomials(theta, na, nk) -> tuple[np.ndarray, np.ndarray]:

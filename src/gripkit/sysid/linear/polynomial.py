@@ -78,6 +78,17 @@ class _Residuals:
         model.__dict__["_residuals"] = value
 
 
+@functools.lru_cache(maxsize=8)
+def _field_defaults(cls) -> tuple:
+    """``(name, default, default_factory or None)`` of every field of the dataclass ``cls`` with
+    a default, but ``estimation_residuals`` (a descriptor: set through ``_residuals``)."""
+    return tuple((f.name, f.default, None if f.default_factory is dataclasses.MISSING
+                  else f.default_factory) for f in dataclasses.fields(cls)
+                 if f.name != "estimation_residuals"
+                 and (f.default is not dataclasses.MISSING
+                      or f.default_factory is not dataclasses.MISSING))
+
+
 #: The default C and F: read-only, shared by every model without a C or F polynomial.
 _ONE = np.ones(1)
 _ONE.flags.writeable = False
@@ -275,6 +286,26 @@ class PolynomialModel(IdentifiedLinearModel):
         set_(self, "display_units", _checked_display_units(self, dict(self.display_units or {})))
 
     # ------------------------------------------------------------------ construction
+    @classmethod
+    def _estimated(cls, A: np.ndarray, B: np.ndarray, nk: int, covariance: np.ndarray,
+                   estimation_residuals: np.ndarray | None, **fields) -> "PolynomialModel":
+        """The model ``cls(A, B, nk, covariance=…, estimation_residuals=…, **fields)`` of a SISO
+        estimator that built every array itself: ``A``, ``B`` fresh finite float64 vectors with
+        ``A[0] = 1`` and ``nk`` leading zeros in ``B``, ``covariance`` a fresh (p, p) float64
+        array, the residuals read-only float64 (or None), ``dt`` checked, no ``display_units``.
+        The same fields, without :meth:`__post_init__`'s checks and copies of those arrays (a
+        fixed cost of every fit that counts in order searches and sliding windows at N ≈ 10⁴);
+        the arrays are made read-only here, as ``__post_init__`` makes its copies."""
+        obj = object.__new__(cls)
+        d = obj.__dict__
+        for name, value, factory in _field_defaults(cls):
+            d[name] = factory() if factory is not None else value
+        for x in (A, B, covariance):
+            x.flags.writeable = False
+        d.update(A=A, B=B, nk=int(nk), covariance=covariance, **fields)
+        d["_residuals"] = estimation_residuals  # the estimation_residuals descriptor's slot
+        return obj
+
     @classmethod
     def from_coefficients(cls, A, B, *, nk: int | None = None, C=(1.0,), F=(1.0,), dt: float = 1.0,
                           structure: str | None = None, std: dict | None = None,
