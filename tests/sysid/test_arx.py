@@ -180,6 +180,38 @@ def test_blas_normal_equations_route_equals_qr_of_the_regressor(na, nb, nk, n):
                                rtol=4 * tol, atol=4 * tol * np.max(np.abs(m.covariance)))
 
 
+def test_blas_route_warns_as_the_qr_route(monkeypatch):
+    """A barely excited [1 6 1] fit (a sine plus 1.5 % noise, κ ≈ 111, within the BLAS route's
+    limit at m = 4594) warns from the normal equations as from QR: an AccuracyWarning naming the
+    same poorly determined parameters, at the same condition number (to 3 digits)."""
+    import re
+    import warnings
+
+    from scipy.signal import lfilter
+
+    from gripkit.errors import AccuracyWarning
+
+    arx_mod = importlib.import_module("gripkit.sysid.linear.arx")
+    rng = np.random.default_rng(1)
+    n = 4600
+    u = np.sin(0.3 * np.arange(n)) + 0.015 * rng.standard_normal(n)
+    y = lfilter([0, 1, 0.5, 0.2], [1, -0.5], u) + rng.standard_normal(n)
+    fits = []
+    for limit in (arx_mod.blas_gram_cond_limit, lambda m: 0.0):  # then QR
+        monkeypatch.setattr(arx_mod, "blas_gram_cond_limit", limit)
+        with warnings.catch_warnings(record=True) as w:
+            warnings.simplefilter("always")
+            m = arx(u, y, 1, 6, 1)
+        (msg,) = [str(x.message) for x in w if issubclass(x.category, AccuracyWarning)]
+        fits.append((m, re.findall(r"(\w+) \(σ/", msg), re.search(r"number (\S+) >", msg)[1]))
+    (blas, names_blas, k_blas), (qr, names_qr, k_qr) = fits
+    assert blas.info["method"].startswith("least squares (normal equations of the BLAS Gram")
+    assert qr.info["method"] == "least squares (QR of [Φ | Y])"
+    assert names_blas == names_qr and len(names_blas) >= 2 and k_blas == k_qr
+    tol = blas.info["cond"] ** 2 * (n - 6) * 2**-53
+    np.testing.assert_allclose(blas.theta, qr.theta, rtol=0, atol=tol * np.max(np.abs(qr.theta)))
+
+
 @pytest.mark.parametrize("qr_max", [None, 0])
 def test_model_built_without_post_init_equals_the_checked_constructor(qr_max, monkeypatch):
     """``arx`` builds its model by ``PolynomialModel._estimated`` (no second copy and check of

@@ -87,7 +87,7 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
     The signals are scaled to unit size internally (exact powers of two, :mod:`.scaling`), so data
     at any scale (1e-300 … 1e300) are identified; the model is in the units of ``u`` and ``y``.
     """
-    several = any(np.ndim(x) == 2 and np.shape(x)[1] > 1 for x in (u, y))
+    several = (np.ndim(u) == 2 and np.shape(u)[1] > 1) or (np.ndim(y) == 2 and np.shape(y)[1] > 1)
     meta = channel_meta(meta, arx, not several)
     if several:  # several inputs or outputs: matrix polynomials
         return arx_mimo(u, y, na, nb, nk, dt=dt, **meta)
@@ -245,13 +245,12 @@ def _blas_normal_equations(X: np.ndarray, names: tuple, warn: bool):
     if info != 0:
         return None
     col = np.sqrt(G.diagonal())  # column norms of Φ
-    sv, vt = lapack.dgesdd(r1 / col)[1:3]
+    sv = lapack.dgesdd(r1 / col, compute_uv=0)[1]  # singular vectors only for a warning
     # κ ≤ the limit (< COND_LIMIT) also means no column is zero: check_determined passes
     cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else math.inf
     if not cond <= blas_gram_cond_limit(m):  # NaN too
         return None
-    r = lapack.dtrtrs(r1, G[p], lower=0, trans=1)[0]  # R1ᵀ r = ΦᵀY
-    theta = lapack.dtrtrs(r1, r, lower=0)[0]
+    theta = lapack.dpotrs(r1, G[p], lower=0)[0]  # R1ᵀ r = ΦᵀY, then R1 θ = r
     w = np.empty(q)
     np.negative(theta, out=w[:p])
     w[p] = 1.0
@@ -264,6 +263,8 @@ def _blas_normal_equations(X: np.ndarray, names: tuple, warn: bool):
     c = lapack.dpotri(r1, lower=0)[0]
     cov = np.where(_upper(p), c, c.T)
     if warn and cond > COND_NOTABLE:  # warn_threshold is never below COND_NOTABLE
+        sv, vt = lapack.dgesdd(r1 / col)[1:3]
+        r = lapack.dtrtrs(r1, G[p], lower=0, trans=1)[0]  # R1ᵀ r = ΦᵀY
         warn_if_weakly_determined((cond, sv, vt, col), names, theta, r, math.sqrt(see), cov, m)
     return QRSolution(theta, see, r1, cov, cond, m), e, see, syy
 

@@ -79,14 +79,13 @@ class _Residuals:
 
 
 @functools.lru_cache(maxsize=8)
-def _field_defaults(cls) -> tuple:
-    """``(name, default, default_factory or None)`` of every field of the dataclass ``cls`` with
-    a default, but ``estimation_residuals`` (a descriptor: set through ``_residuals``)."""
-    return tuple((f.name, f.default, None if f.default_factory is dataclasses.MISSING
-                  else f.default_factory) for f in dataclasses.fields(cls)
-                 if f.name != "estimation_residuals"
-                 and (f.default is not dataclasses.MISSING
-                      or f.default_factory is not dataclasses.MISSING))
+def _field_defaults(cls) -> tuple[dict, tuple]:
+    """``({name: default}, ((name, default_factory), …))`` of the fields of the dataclass ``cls``
+    that have one, but ``estimation_residuals`` (a descriptor: set through ``_residuals``)."""
+    fields = [f for f in dataclasses.fields(cls) if f.name != "estimation_residuals"]
+    return ({f.name: f.default for f in fields if f.default is not dataclasses.MISSING},
+            tuple((f.name, f.default_factory) for f in fields
+                  if f.default_factory is not dataclasses.MISSING))
 
 
 #: The default C and F: read-only, shared by every model without a C or F polynomial.
@@ -298,8 +297,10 @@ class PolynomialModel(IdentifiedLinearModel):
         the arrays are made read-only here, as ``__post_init__`` makes its copies."""
         obj = object.__new__(cls)
         d = obj.__dict__
-        for name, value, factory in _field_defaults(cls):
-            d[name] = factory() if factory is not None else value
+        defaults, factories = _field_defaults(cls)
+        d.update(defaults)
+        for name, factory in factories:
+            d[name] = factory()
         for x in (A, B, covariance):
             x.flags.writeable = False
         d.update(A=A, B=B, nk=int(nk), covariance=covariance, **fields)
