@@ -1083,6 +1083,8 @@ def channel_meta(meta: dict, fn, siso: bool) -> dict:
     """``meta`` with ``inputs``, ``outputs``, ``input_units``, ``output_units`` turned into the
     model's fields (:data:`CHANNEL_KEYS`; a list of one taken as its entry for a SISO model),
     then checked (:func:`check_meta`); an ArgumentError when both spellings are given."""
+    if not meta:  # the common call: nothing to translate or check
+        return {}
     out = dict(meta)
     for lti_key, field_ in CHANNEL_KEYS.items():
         if lti_key not in out:
