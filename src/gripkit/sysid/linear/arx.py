@@ -33,9 +33,11 @@ from .validation import fit_percent, records_fit
 
 __all__ = ["arx", "arx_records"]
 
-#: Regressors up to this many elements (``m·(p+1)``, 2 MiB of float64) are materialised and
-#: solved by QR: a few milliseconds at most, and no numba import or kernel load (0.45 s of a
-#: fresh process). Larger ones take the one-pass compensated lagged sums (O(p²) memory).
+#: Regressors up to this many elements (``m·(p+1)``, 2 MiB of float64) are materialised: a few
+#: milliseconds at most, and no numba import or kernel load (0.45 s of a fresh process). Up to
+#: ``regression.NUMPY_QR_MAX_ELEMENTS`` they are solved by QR (no scipy.linalg import), above it
+#: by the normal equations of their BLAS Gram matrix where κ allows (:func:`blas_gram_cond_limit`,
+#: else QR). Larger ones take the one-pass compensated lagged sums (O(p²) memory).
 QR_MAX_ELEMENTS = 2**18
 
 
@@ -235,7 +237,7 @@ def _blas_normal_equations(X: np.ndarray, names: tuple, warn: bool):
     pass over X; or None when Φ is not positive definite or its column-scaled κ exceeds
     :func:`blas_gram_cond_limit` (then QR is used). At N ≈ 10⁴ ``geqrf`` alone costs more than
     this whole route. ``(ΦᵀΦ)⁻¹`` for the covariance comes from the Cholesky factor
-    (``dtrtri``), not from another solve; the LAPACK routines are called directly (numpy's and
+    (``dpotri``), not from another solve; the LAPACK routines are called directly (numpy's and
     scipy's wrappers cost more than these p×p problems)."""
     lapack = _lapack()
     m, q = X.shape
