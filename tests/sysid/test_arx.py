@@ -146,6 +146,114 @@ def test_lagged_sums_route_equals_qr_of_the_regressor(na, nb, nk, n, monkeypatch
                                rtol=1e-8)
 
 
+@pytest.mark.parametrize("na, nb, nk, n", [(2, 2, 2, 10_000), (4, 4, 2, 8000), (2, 3, 1, 20_000),
+                                           (1, 1, 1, 30_000), (0, 3, 1, 12_000)])
+def test_blas_normal_equations_route_equals_qr_of_the_regressor(na, nb, nk, n):
+    """Regressors of 2^15 … 2^18 elements (N ≈ 10⁴) are solved from the normal equations of the
+    BLAS Gram matrix when the column-scaled κ ≤ blas_gram_cond_limit(m) (κ²·m·u ≤ 1e-8: an
+    uncompensated sum of m products errs by m·u), else by QR; θ, σ, loss, fit and the residuals
+    equal the QR route's within the derived bound κ²·m·u."""
+    arx_mod = importlib.import_module("gripkit.sysid.linear.arx")
+    from gripkit.sysid.regression import NUMPY_QR_MAX_ELEMENTS, arx_regression, qr_solve
+
+    u, y = simulate_arx(n, noise=0.5, seed=13)
+    X = arx_regression(u, y, na, nb, nk)
+    assert NUMPY_QR_MAX_ELEMENTS < X.size <= arx_mod.QR_MAX_ELEMENTS
+    m = arx(u, y, na, nb, nk)
+    rows = X.shape[0]
+    blas = m.info["method"].startswith("least squares (normal equations of the BLAS Gram")
+    # the over-parameterised [4 4 2] of this second-order system is near-collinear: QR then
+    assert blas == (m.info["cond"] <= arx_mod.blas_gram_cond_limit(rows)) == ((na, nb) != (4, 4))
+    ref = qr_solve(X, tuple(f"p{i}" for i in range(na + nb)))
+    tol = max(m.info["cond"] ** 2 * rows * 2**-53, 1e-12)
+    np.testing.assert_allclose(m.theta, ref.theta, rtol=0, atol=tol * np.max(np.abs(ref.theta)))
+    e = X[:, -1] - X[:, :-1] @ ref.theta
+    scale = np.max(np.abs(X) @ np.append(np.abs(ref.theta), 1.0))  # max Σ|x_j θ_j| over rows
+    np.testing.assert_allclose(m.estimation_residuals, e, rtol=0, atol=2 * tol * scale)
+    assert m.loss == pytest.approx(0.5 * (e @ e) / rows, rel=1e-9)
+    assert m.fit_percent == pytest.approx(
+        100 * (1 - np.linalg.norm(e) / np.linalg.norm(X[:, -1] - X[:, -1].mean())), rel=1e-9)
+    np.testing.assert_allclose(m.theta_std,
+                               np.sqrt(np.diag(ref.cov_unscaled) * (e @ e) / (rows - na - nb)),
+                               rtol=4 * tol)
+    np.testing.assert_allclose(m.covariance, ref.cov_unscaled * (e @ e) / (rows - na - nb),
+                               rtol=4 * tol, atol=4 * tol * np.max(np.abs(m.covariance)))
+
+
+def test_blas_route_warns_as_the_qr_route(monkeypatch):
+    """A barely excited [1 6 1] fit (a sine plus 1.5 % noise, κ ≈ 111, within the BLAS route's
+    limit at m = 4594) warns from the normal equations as from QR: an AccuracyWarning naming the
+    same poorly determined parameters, at the same condition number (to 3 digits)."""
+    import re
+    import warnings
+
+    from scipy.signal import lfilter
+
+    from gripkit.errors import AccuracyWarning
+
+    arx_mod = importlib.import_module("gripkit.sysid.linear.arx")
+    rng = np.random.default_rng(1)
+    n = 4600
+    u = np.sin(0.3 * np.arange(n)) + 0.015 * rng.standard_normal(n)
+    y = lfilter([0, 1, 0.5, 0.2], [1, -0.5], u) + rng.standard_normal(n)
+    fits = []
+    for limit in (arx_mod.blas_gram_cond_limit, lambda m: 0.0):  # then QR
+        monkeypatch.setattr(arx_mod, "blas_gram_cond_limit", limit)
+        with warnings.catch_warnings(record=True) as w:
+            warnings.simplefilter("always")
+            m = arx(u, y, 1, 6, 1)
+        (msg,) = [str(x.message) for x in w if issubclass(x.category, AccuracyWarning)]
+        fits.append((m, re.findall(r"(\w+) \(σ/", msg), re.search(r"number (\S+) >", msg)[1]))
+    (blas, names_blas, k_blas), (qr, names_qr, k_qr) = fits
+    assert blas.info["method"].startswith("least squares (normal equations of the BLAS Gram")
+    assert qr.info["method"] == "least squares (QR of [Φ | Y])"
+    assert names_blas == names_qr and len(names_blas) >= 2 and k_blas == k_qr
+    tol = blas.info["cond"] ** 2 * (n - 6) * 2**-53
+    np.testing.assert_allclose(blas.theta, qr.theta, rtol=0, atol=tol * np.max(np.abs(qr.theta)))
+
+
+@pytest.mark.parametrize("qr_max", [None, 0])
+def test_model_built_without_post_init_equals_the_checked_constructor(qr_max, monkeypatch):
+    """``arx`` builds its model by ``PolynomialModel._estimated`` (no second copy and check of
+    the arrays it made): every field equals the one the checked constructor gives from the same
+    values, and the arrays are read-only as the constructor leaves them (BLAS normal-equations
+    route at N = 10⁴; with ``QR_MAX_ELEMENTS = 0`` the lagged-sums route, residuals on demand)."""
+    import dataclasses
+
+    from gripkit.sysid.linear.polynomial import PolynomialModel
+
+    if qr_max is not None:
+        monkeypatch.setattr(importlib.import_module("gripkit.sysid.linear.arx"),
+                            "QR_MAX_ELEMENTS", qr_max)
+    u, y = simulate_arx(10_000, noise=0.5, seed=17)
+    m = arx(u, y, 2, 2, 2, dt=0.01, input_name="i", output_unit="N")
+    names = [f.name for f in dataclasses.fields(PolynomialModel)]
+    ref = PolynomialModel(**{k: getattr(m, k) for k in names})
+    for k in names:
+        a, b = getattr(m, k), getattr(ref, k)
+        if isinstance(b, np.ndarray):
+            np.testing.assert_array_equal(a, b)
+            assert a.dtype == b.dtype and not a.flags.writeable and not b.flags.writeable, k
+        else:
+            assert a == b and type(a) is type(b), k
+    assert (m.dt, m.input_name, m.output_unit, m.output_name) == (0.01, "i", "N", "y")
+
+
+@pytest.mark.parametrize("offset", [0.0, 0.3, 5.0, -1e6])
+def test_centred_sum_of_squares_within_its_bound(offset):
+    """Σ(y − ȳ)² by ``Σy² − (Σy)²/m`` (mean at most the spread) or from the centred samples
+    (larger means) agrees with an exactly rounded sum (math.fsum of the centred squares, the
+    mean itself by fsum) within the stated 6·m·u."""
+    from fractions import Fraction
+
+    from gripkit.sysid.linear.arx import _centred_sum_of_squares
+
+    y = np.random.default_rng(4).standard_normal(20_000) + offset
+    mean = Fraction(math.fsum(y)) / y.size
+    exact = float(sum((Fraction(v) - mean) ** 2 for v in y.tolist()))
+    assert abs(_centred_sum_of_squares(y) - exact) <= 6 * y.size * 2**-53 * exact
+
+
 def test_small_problem_takes_the_qr_route_without_numba():
     """2000 samples of [2 2 2] (2000·5 regressor elements, below QR_MAX_ELEMENTS) are solved by QR
     in a fresh process without importing numba, and give the lagged-sums route's estimate."""

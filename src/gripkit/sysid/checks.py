@@ -44,7 +44,8 @@ def signal_with_peaks(x, name: str) -> tuple[np.ndarray, float, float]:
                         hint="pass one channel at a time (single-input single-output models)")
     if a.size == 0:
         raise DataError(f"{name}: the signal holds no samples")
-    lo, hi = float(a.min()), float(a.max())
+    # the ufuncs' reductions themselves (the same as a.min(), a.max(), without their wrappers)
+    lo, hi = float(np.minimum.reduce(a)), float(np.maximum.reduce(a))
     if not (math.isfinite(lo) and math.isfinite(hi)):  # min and max carry a NaN or an inf through
         for label, mask in (("NaN", np.isnan(a)), ("infinite", np.isinf(a))):
             if mask.any():

@@ -204,7 +204,23 @@ def triangular_solve(R: np.ndarray, names: tuple[str, ...], m: int, warn: bool =
     :func:`scaled_condition` of ``R[:p, :p]`` when the caller has it already."""
     p = R.shape[0] - 1
     r1 = R[:p, :p]
-    cond, sv, vt, col = scaled_condition(r1) if condition is None else condition
+    condition = scaled_condition(r1) if condition is None else condition
+    check_determined(condition, names)
+    r = R[:p, p]
+    theta = solve_upper(r1, r)
+    rinv = solve_upper(r1, np.eye(p))
+    cov = rinv @ rinv.T
+    if warn:
+        warn_if_weakly_determined(condition, names, theta, r, float(R[p, p]), cov, m, values)
+    return QRSolution(theta, float(R[p, p] ** 2), r1.copy(), 0.5 * (cov + cov.T), condition[0],
+                      m)
+
+
+def check_determined(condition: tuple, names: tuple[str, ...]) -> None:
+    """An :class:`UnidentifiableError` naming the parameters when a column of Φ is zero or the
+    column-scaled condition number (``condition``: :func:`scaled_condition`) exceeds
+    :data:`COND_LIMIT`."""
+    cond, _, vt, col = condition
     zero = col <= 1e-300
     if zero.any():
         bad = [names[i] for i in np.flatnonzero(zero)]
@@ -218,20 +234,26 @@ def triangular_solve(R: np.ndarray, names: tuple[str, ...], m: int, warn: bool =
             f"{COND_LIMIT:.0e}); the poorly determined combination involves {', '.join(involved)}",
             hint="excite the system more richly (more frequencies than parameters) or "
                  "lower the orders")
-    r = R[:p, p]
-    theta = solve_upper(r1, r)
-    rinv = solve_upper(r1, np.eye(p))
-    cov = rinv @ rinv.T
-    rss = float(R[p, p] ** 2)
+
+
+def warn_if_weakly_determined(condition: tuple, names: tuple[str, ...], theta: np.ndarray,
+                              r: np.ndarray, rho: float, cov: np.ndarray, m: int,
+                              values: np.ndarray | None = None) -> None:
+    """The :class:`~gripkit.errors.AccuracyWarning` of :func:`qr_solve` when κ exceeds
+    :func:`warn_threshold`: ``r``, ``rho`` the last column of R (``R1ᵀr = ΦᵀY``, ρ² the residual
+    sum of squares), ``cov`` ``(ΦᵀΦ)⁻¹``."""
+    cond, sv, vt, col = condition
+    p = theta.size
+    rss = rho**2
     val = np.abs(theta if values is None else np.asarray(values, dtype=np.float64))
     vc = val * col
     size = math.sqrt(vc.dot(vc))  # np.linalg.norm of a vector (the same dot), without its dispatch
     sigma_rel = math.sqrt(rss / (m - p)) / (float(sv[0]) * size) if size > 0 else math.inf
     rk = r.ravel(order="K")  # contiguous, as np.linalg.norm makes it
     fitted = math.sqrt(rk.dot(rk))
-    tan_phi = (abs(float(R[p, p])) / fitted if fitted > 0 else math.inf) if values is None else None
+    tan_phi = (abs(rho) / fitted if fitted > 0 else math.inf) if values is None else None
     limit = warn_threshold(sigma_rel, tan_phi)
-    if warn and cond > limit:
+    if cond > limit:
         std = np.sqrt(rss / (m - p) * np.clip(np.diag(cov), 0.0, None))
         with np.errstate(divide="ignore"):
             rel = ", ".join(f"{names[i]} (σ/|{names[i]}| = {std[i] / val[i]:.2g})"
@@ -245,7 +267,6 @@ def triangular_solve(R: np.ndarray, names: tuple[str, ...], m: int, warn: bool =
            "their values may be far from the truth; excite the system more richly "
            "(more frequencies "
            f"than parameters) or lower the orders", AccuracyWarning)
-    return QRSolution(theta, rss, r1.copy(), 0.5 * (cov + cov.T), cond, m)
 
 
 def hac_covariance(X: np.ndarray, r: np.ndarray, lags: int | None = None) -> np.ndarray:

@@ -15,6 +15,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -25,14 +26,18 @@ from .arx_mimo import arx_mimo
 from ..checks import (check_dt, check_excitation, check_identifiable, check_io, check_order,
                      check_output_varies, checked_problem_peaks, require_samples)
 from .polynomial import PolynomialModel, channel_meta
-from ..regression import arx_regression, arx_start, qr_solve, solve_upper, triangular_solve
+from ..regression import (COND_NOTABLE, NUMPY_QR_MAX_ELEMENTS, QRSolution, arx_regression,
+                          arx_start, qr_solve, solve_upper, triangular_solve,
+                          warn_if_weakly_determined)
 from .validation import fit_percent, records_fit
 
 __all__ = ["arx", "arx_records"]
 
-#: Regressors up to this many elements (``m·(p+1)``, 2 MiB of float64) are materialised and
-#: solved by QR: a few milliseconds at most, and no numba import or kernel load (0.45 s of a
-#: fresh process). Larger ones take the one-pass compensated lagged sums (O(p²) memory).
+#: Regressors up to this many elements (``m·(p+1)``, 2 MiB of float64) are materialised: a few
+#: milliseconds at most, and no numba import or kernel load (0.45 s of a fresh process). Up to
+#: ``regression.NUMPY_QR_MAX_ELEMENTS`` they are solved by QR (no scipy.linalg import), above it
+#: by the normal equations of their BLAS Gram matrix where κ allows (:func:`blas_gram_cond_limit`,
+#: else QR). Larger ones take the one-pass compensated lagged sums (O(p²) memory).
 QR_MAX_ELEMENTS = 2**18
 
 
@@ -84,7 +89,7 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
     The signals are scaled to unit size internally (exact powers of two, :mod:`.scaling`), so data
     at any scale (1e-300 … 1e300) are identified; the model is in the units of ``u`` and ``y``.
     """
-    several = any(np.ndim(x) == 2 and np.shape(x)[1] > 1 for x in (u, y))
+    several = (np.ndim(u) == 2 and np.shape(u)[1] > 1) or (np.ndim(y) == 2 and np.shape(y)[1] > 1)
     meta = channel_meta(meta, arx, not several)
     if several:  # several inputs or outputs: matrix polynomials
         return arx_mimo(u, y, na, nb, nk, dt=dt, **meta)
@@ -123,17 +128,28 @@ def _arx(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int, step: float, *
     t0 = arx_start(na, nb, nk)
     check_identifiable(u, y, t0 + p + 1,
                        f"ARX [{na} {nb} {nk}] ({p} parameters, {t0} initial samples)", peaks)
-    names = tuple(f"a{i}" for i in range(1, na + 1)) + tuple(f"b{nk + j}" for j in range(nb))
+    names = parameter_names(na, nb, nk)
     m = y.size - t0
     small = m * (p + 1) <= QR_MAX_ELEMENTS
-    gram = None if small else _normal_equations(u, y, na, nb, nk, t0, names, warn, keep_residuals)
+    X = gram = None
+    if not small:
+        gram = _normal_equations(u, y, na, nb, nk, t0, names, warn, keep_residuals)
+    elif m * (p + 1) > NUMPY_QR_MAX_ELEMENTS:  # scipy.linalg's range: BLAS normal equations
+        X = arx_regression(u, y, na, nb, nk)
+        gram = _blas_normal_equations(X, names, warn)
     if gram is None:  # small, or ill-conditioned: QR of the materialised [Φ | Y]
-        sol = qr_solve(arx_regression(u, y, na, nb, nk), names, overwrite=True, warn=warn)
+        X = arx_regression(u, y, na, nb, nk) if X is None else X
+        sol = qr_solve(X, names, overwrite=True, warn=warn)
         method = "least squares (QR of [Φ | Y])"
         A, B = _polynomials(sol.theta, na, nk)
         # PolynomialModel.prediction_errors of an ARX model, on the same arrays
         e = np.convolve(y, A)[t0:y.size] - np.convolve(u, B)[t0:u.size]
         see, fit = float(e @ e), fit_percent(y[t0:], y[t0:] - e)
+    elif X is not None:
+        method = "least squares (normal equations of the BLAS Gram matrix, Cholesky)"
+        sol, e, see, syy = gram
+        A, B = _polynomials(sol.theta, na, nk)
+        fit = 100.0 * (1.0 - math.sqrt(see / syy))
     else:
         method = "least squares (normal equations from compensated lagged sums, Cholesky)"
         sol, e, see, syy = gram
@@ -142,18 +158,29 @@ def _arx(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int, step: float, *
     sigma2 = see / (m - p)
     if e is not None:
         e.flags.writeable = False  # handed to the model without a copy
-    return PolynomialModel(A, B, nk, dt=step, structure="arx", n_samples=int(y.size),
-                           covariance=sigma2 * sol.cov_unscaled, noise_variance=sigma2,
-                           loss=0.5 * see / m, fit_percent=fit, n_used=m, estimation_residuals=e,
-                           estimation_data=record if e is None else None,
-                           info={"method": method, "cond": sol.cond}, **meta)
+    # every array is fresh and checked here (θ finite: Σe² is): no copies nor checks again
+    build = PolynomialModel._estimated if math.isfinite(see) else PolynomialModel
+    return build(A, B, nk, dt=step, structure="arx", n_samples=int(y.size),
+                 covariance=sigma2 * sol.cov_unscaled, noise_variance=sigma2, loss=0.5 * see / m,
+                 fit_percent=fit, n_used=m, estimation_residuals=e,
+                 estimation_data=record if e is None else None,
+                 info={"method": method, "cond": sol.cond}, **meta)
 
 
 def _polynomials(theta, na, nk) -> tuple[np.ndarray, np.ndarray]:
     """``A = [1, a…]`` and ``B = [0]*nk + [b…]`` (MATLAB layout) from θ."""
-    A = np.concatenate([[1.0], theta[:na]])
-    B = np.concatenate([np.zeros(nk), theta[na:]])
+    A = np.empty(na + 1)
+    A[0] = 1.0
+    A[1:] = theta[:na]
+    B = np.zeros(nk + theta.size - na)
+    B[nk:] = theta[na:]
     return A, B
+
+
+@functools.lru_cache(maxsize=256)
+def parameter_names(na: int, nb: int, nk: int) -> tuple[str, ...]:
+    """``('a1', …, 'a<na>', 'b<nk>', …, 'b<nk+nb−1>')``, θ's order (one tuple per structure)."""
+    return tuple(f"a{i}" for i in range(1, na + 1)) + tuple(f"b{nk + j}" for j in range(nb))
 
 
 def _model(theta, na, nk, step, n, meta) -> PolynomialModel:
@@ -185,6 +212,83 @@ def _normal_equations(u, y, na, nb, nk, t0, names, warn, keep_residuals):
     R[p, p] = np.sqrt(see)
     return (triangular_solve(R, names, y.size - t0, warn, stacklevel=5, condition=condition),
             e, see, syy)
+
+
+def blas_gram_cond_limit(m: int) -> float:
+    """Largest column-scaled κ of Φ (m rows) for which :func:`_blas_normal_equations` is used:
+    an uncompensated BLAS sum of m products errs by at most ``m·u`` relative to ``Σ|x z|``, and
+    the normal equations turn a relative error ε of the Gram matrix into up to ``κ²ε`` in θ; the
+    limit keeps ``κ²·m·u`` at 1e-8 (the lagged sums' bound, with m for their ``BLOCK``)."""
+    return math.sqrt(1e-8 / (m * 2.0**-53))
+
+
+@functools.cache
+def _lapack():
+    """scipy's LAPACK wrappers, imported on first use (scipy.linalg: ~0.2 s of a fresh process;
+    the regressors that take this route are large enough to load it anyway for QR)."""
+    from scipy.linalg import lapack
+
+    return lapack
+
+
+def _blas_normal_equations(X: np.ndarray, names: tuple, warn: bool):
+    """``(sol, e, Σe², Σ(y − ȳ)²)`` from the normal equations of the materialised ``X = [Φ | Y]``
+    (one BLAS product ``Xᵀ Φ``, Cholesky), the residuals ``e = X·[−θ; 1] = Y − Φθ`` in one more
+    pass over X; or None when Φ is not positive definite or its column-scaled κ exceeds
+    :func:`blas_gram_cond_limit` (then QR is used). At N ≈ 10⁴ ``geqrf`` alone costs more than
+    this whole route. ``(ΦᵀΦ)⁻¹`` for the covariance comes from the Cholesky factor
+    (``dpotri``), not from another solve; the LAPACK routines are called directly (numpy's and
+    scipy's wrappers cost more than these p×p problems)."""
+    lapack = _lapack()
+    m, q = X.shape
+    p = q - 1
+    G = X.T @ X[:, :p]  # (q, p): ΦᵀΦ over YᵀΦ; a gemm (numpy's X.T @ X is a syrk, 5× slower here)
+    r1, info = lapack.dpotrf(G[:p], lower=0, clean=1)
+    if info != 0:
+        return None
+    col = np.sqrt(G.diagonal())  # column norms of Φ
+    sv = lapack.dgesdd(r1 / col, compute_uv=0)[1]  # singular vectors only for a warning
+    # κ ≤ the limit (< COND_LIMIT) also means no column is zero: check_determined passes
+    cond = float(sv[0] / sv[-1]) if sv[-1] > 0 else math.inf
+    if not cond <= blas_gram_cond_limit(m):  # NaN too
+        return None
+    theta = lapack.dpotrs(r1, G[p], lower=0)[0]  # R1ᵀ r = ΦᵀY, then R1 θ = r
+    w = np.empty(q)
+    np.negative(theta, out=w[:p])
+    w[p] = 1.0
+    e = X @ w
+    see = float(e.dot(e))
+    syy = _centred_sum_of_squares(X[:, p])
+    if syy == 0.0:
+        raise DataError("the fit is undefined for a constant output (‖y − ȳ‖ = 0)")
+    # (R1ᵀR1)⁻¹ = R1⁻¹R1⁻ᵀ from the factor (dpotri: its upper triangle), mirrored
+    c = lapack.dpotri(r1, lower=0)[0]
+    cov = np.where(_upper(p), c, c.T)
+    if warn and cond > COND_NOTABLE:  # warn_threshold is never below COND_NOTABLE
+        sv, vt = lapack.dgesdd(r1 / col)[1:3]
+        r = lapack.dtrtrs(r1, G[p], lower=0, trans=1)[0]  # R1ᵀ r = ΦᵀY
+        warn_if_weakly_determined((cond, sv, vt, col), names, theta, r, math.sqrt(see), cov, m)
+    return QRSolution(theta, see, r1, cov, cond, m), e, see, syy
+
+
+@functools.lru_cache(maxsize=64)
+def _upper(p: int) -> np.ndarray:
+    """(p, p) mask, True on and above the diagonal (the mirror is its transpose)."""
+    return np.triu(np.ones((p, p), dtype=bool))
+
+
+def _centred_sum_of_squares(y: np.ndarray) -> float:
+    """``Σ(y − ȳ)²``: as ``Σy² − (Σy)²/m`` (no N-sample temporary) when the mean is at most the
+    spread (``(Σy)²/m ≤ Σy²/2``), where the rounding of both sums (≤ m·u each, relative to Σy²)
+    costs at most ``3·m·u·Σy² ≤ 6·m·u`` of the result (2e-11 relative at m = 3·10⁴); otherwise
+    from the centred samples."""
+    s = float(np.add.reduce(y))
+    yy = float(y.dot(y))
+    mean_sq = s * (s / y.size)
+    if mean_sq <= 0.5 * yy:
+        return yy - mean_sq
+    d = y - s / y.size
+    return float(d.dot(d))
 
 
 def checked_records(records, what: str) -> list:
@@ -295,7 +399,7 @@ def arx_records(records, na: int, nb: int, nk: int = 1, *, dt: float | None = No
     m = sum(y.size - t0 for _, y in recs)
     require_samples(m + t0, t0 + p + 1, what)
     scaled, cu, cy = scaled_records(recs, skip_within=_NO_SCALING_WITHIN)
-    names = tuple(f"a{i}" for i in range(1, na + 1)) + tuple(f"b{nk + j}" for j in range(nb))
+    names = parameter_names(na, nb, nk)
     sol = theta = R = None
     if m * (p + 1) > QR_MAX_ELEMENTS:  # the records' Gram matrices summed (O(p²) memory)
         import scipy.linalg as sla

@@ -78,7 +78,24 @@ class _Residuals:
         model.__dict__["_residuals"] = value
 
 
+@functools.lru_cache(maxsize=8)
+def _field_defaults(cls) -> tuple[dict, tuple]:
+    """``({name: default}, ((name, default_factory), …))`` of the fields of the dataclass ``cls``
+    that have one, but ``estimation_residuals`` (a descriptor: set through ``_residuals``)."""
+    fields = [f for f in dataclasses.fields(cls) if f.name != "estimation_residuals"]
+    return ({f.name: f.default for f in fields if f.default is not dataclasses.MISSING},
+            tuple((f.name, f.default_factory) for f in fields
+                  if f.default_factory is not dataclasses.MISSING))
+
+
+#: The default C and F: read-only, shared by every model without a C or F polynomial.
+_ONE = np.ones(1)
+_ONE.flags.writeable = False
+
+
 def _coeffs(x, name: str, monic: bool) -> np.ndarray:
+    if x is _ONE:
+        return x
     a = np.array(x, dtype=np.float64, copy=True).ravel()
     if a.size == 0:
         raise ModelError(f"{name}: expected at least one coefficient")
@@ -155,8 +172,8 @@ class PolynomialModel(IdentifiedLinearModel):
     A: np.ndarray
     B: np.ndarray
     nk: int
-    C: np.ndarray = field(default_factory=lambda: np.ones(1))
-    F: np.ndarray = field(default_factory=lambda: np.ones(1))
+    C: np.ndarray = field(default_factory=lambda: _ONE)
+    F: np.ndarray = field(default_factory=lambda: _ONE)
     dt: float = 1.0
     structure: str = "arx"
     covariance: np.ndarray | None = None
@@ -274,6 +291,28 @@ class PolynomialModel(IdentifiedLinearModel):
         set_(self, "display_units", _checked_display_units(self, dict(self.display_units or {})))
 
     # ------------------------------------------------------------------ construction
+    @classmethod
+    def _estimated(cls, A: np.ndarray, B: np.ndarray, nk: int, covariance: np.ndarray,
+                   estimation_residuals: np.ndarray | None, **fields) -> "PolynomialModel":
+        """The model ``cls(A, B, nk, covariance=…, estimation_residuals=…, **fields)`` of a SISO
+        estimator that built every array itself: ``A``, ``B`` fresh finite float64 vectors with
+        ``A[0] = 1`` and ``nk`` leading zeros in ``B``, ``covariance`` a fresh (p, p) float64
+        array, the residuals read-only float64 (or None), ``dt`` checked, no ``display_units``.
+        The same fields, without :meth:`__post_init__`'s checks and copies of those arrays (a
+        fixed cost of every fit that counts in order searches and sliding windows at N ≈ 10⁴);
+        the arrays are made read-only here, as ``__post_init__`` makes its copies."""
+        obj = object.__new__(cls)
+        d = obj.__dict__
+        defaults, factories = _field_defaults(cls)
+        d.update(defaults)
+        for name, factory in factories:
+            d[name] = factory()
+        for x in (A, B, covariance):
+            x.flags.writeable = False
+        d.update(A=A, B=B, nk=int(nk), covariance=covariance, **fields)
+        d["_residuals"] = estimation_residuals  # the estimation_residuals descriptor's slot
+        return obj
+
     @classmethod
     def from_coefficients(cls, A, B, *, nk: int | None = None, C=(1.0,), F=(1.0,), dt: float = 1.0,
                           structure: str | None = None, std: dict | None = None,
@@ -1042,6 +1081,8 @@ def channel_meta(meta: dict, fn, siso: bool) -> dict:
     """``meta`` with ``inputs``, ``outputs``, ``input_units``, ``output_units`` turned into the
     model's fields (:data:`CHANNEL_KEYS`; a list of one taken as its entry for a SISO model),
     then checked (:func:`check_meta`); an ArgumentError when both spellings are given."""
+    if not meta:  # the common call: nothing to translate or check
+        return {}
     out = dict(meta)
     for lti_key, field_ in CHANNEL_KEYS.items():
         if lti_key not in out:
