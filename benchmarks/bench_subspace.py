@@ -157,8 +157,28 @@ def _nfoursid_rows(g, uv, yv, u, y, ours, model) -> list[dict]:
     return rows
 
 
+def _scaling_rows(g, quick: bool) -> list[dict]:
+    """N4SID 2×2 order 8 at N = 1e4, 1e5 and 1e6 (issue 24: linear in N): the time per 10⁴
+    samples of each size beside that of N = 1e4 (the peer column; ratio ≈ 1 means linear).
+    ``quick``: 1e4 and 1e5 only."""
+    sizes = (10_000, 100_000) if quick else (10_000, 100_000, 1_000_000)
+    per = {}
+    for n in sizes:
+        u, y = _record(g, n, 1)
+        per[n] = measure(_gripkit_n4sid(u, y), budget_s=30.0)
+        del u, y
+    unit = {n: per[n] * (1e4 / n) for n in sizes}
+    return [row("subspace", f"n4sid 2×2, order 8, N={n:.0e}, time per 1e4 samples", unit[n],
+                "the same at N=1e4", unit[sizes[0]],
+                target="linear in N from 1e4 to 1e6 (ratio ≈ 1)",
+                notes=f"whole call {float(per[n]):.3g} s (min {per[n].min:.3g} s, "
+                      f"{per[n].runs} runs); N=1e4: {float(per[sizes[0]]) * 1e3:.3g} ms")
+            for n in sizes[1:]]
+
+
 def run(quick: bool) -> list[dict]:
-    """All rows; ``quick`` changes nothing (the problem sizes are the issue's targets)."""
+    """All rows; ``quick`` changes nothing (the problem sizes are the issue's targets) except
+    the scaling rows (:func:`_scaling_rows`)."""
     from gripkit.sysid import frf, pem
 
     g = _system()
@@ -194,6 +214,7 @@ def run(quick: bool) -> list[dict]:
                         peer_accuracy=_fit_text(_val_fit(*call(), uv, yv)),
                         notes="same order and horizon; validation = free run, x0 estimated"))
     rows += _nfoursid_rows(g, uv, yv, u, y, *ours["n4sid"])
+    rows += _scaling_rows(g, quick)
     start = ours["n4sid"][1]
     for form in ("innovation", "oe"):
         call = lambda: pem(start, u=u, y=y, form=form)  # noqa: E731
