@@ -106,6 +106,63 @@ def test_sensitivity_gram_matches_finite_differences():
     assert np.all(np.linalg.eigvalsh(Htt) > -1e-9 * np.abs(Htt).max())   # JᵀJ ⪰ 0
 
 
+def _windowed_outputs(model, Z, starts, u):
+    """The free run of every window j from Z[j] (simulate_kernel), stacked (N, p)."""
+    from gripkit.sysid.nonlinear.nlss import _arrays
+
+    Y = np.empty((u.shape[0], model.C.shape[0]))
+    for j in range(len(starts) - 1):
+        a, b = starts[j], starts[j + 1]
+        K.simulate_kernel(_arrays(model), Z[j].copy(), np.ascontiguousarray(u[a:b]), Y[a:b],
+                          np.empty((0, model.A.shape[0])), 1e6)
+    return Y
+
+
+def test_gram_matrix_equals_the_finite_difference_jacobian():
+    """JᵀJ of the kernel (the blocked two-rows-of-G sums of _add_rows) equals DᵀD with D the
+    weighted central-difference Jacobian of the windowed free run (step 1e-6), for a parameter
+    count Q = 7 (odd: the last row of G on its own) and windows of 101, 121 and 78 samples (blocks
+    of 16 rows with 5, 9 and 14 left over: the rows past the last group of four)."""
+    from gripkit.sysid.nonlinear.nlss import _apply
+
+    rng = np.random.default_rng(7)
+    m = _random_model(rng)
+    u = np.ascontiguousarray(0.5 * rng.normal(size=(300, 1)))
+    y = np.ascontiguousarray(rng.normal(size=(300, 1)))
+    w = np.array([0.7])
+    starts = np.array([0, 101, 222, 300], dtype=np.int64)
+    Z = 0.1 * rng.normal(size=(3, 2))
+    dirs = np.array([(0, 1, 0), (1, 0, 0), (2, 0, 1), (4, 0, 2), (5, 0, 6)], dtype=np.int64)
+    P = len(dirs)
+    out = K.NLSSGram(np.empty((P, P)), np.empty(P), np.empty((3, P, 2)), np.empty((3, 2, 2)),
+                     np.empty((3, 2)))
+    K.window_gram(K.NLSSArrays(m.A, m.B, m.C, m.D, m.E, m.F, m.y_offset, m.exz, m.exe), dirs,
+                  K.NLSSWindows(Z, starts, u, y, w), 1e6, out)
+    h = 1e-6
+    D = np.empty((300, P + 6))
+    for q in range(P):
+        d = np.zeros(P)
+        d[q] = h
+        D[:, q] = (_windowed_outputs(_apply(m, dirs, d), Z, starts, u)
+                   - _windowed_outputs(_apply(m, dirs, -d), Z, starts, u))[:, 0] / (2 * h)
+    for j in range(3):
+        for c in range(2):
+            dZ = np.zeros_like(Z)
+            dZ[j, c] = h
+            D[:, P + 2 * j + c] = (_windowed_outputs(m, Z + dZ, starts, u)
+                                   - _windowed_outputs(m, Z - dZ, starts, u))[:, 0] / (2 * h)
+    D *= w[0]
+    H = D.T @ D
+    scale = np.abs(H).max()
+    np.testing.assert_allclose(out.Htt, H[:P, :P], rtol=1e-6, atol=1e-8 * scale)
+    for j in range(3):
+        zj = slice(P + 2 * j, P + 2 * j + 2)
+        np.testing.assert_allclose(out.Htz[j], H[:P, zj], rtol=1e-6, atol=1e-8 * scale)
+        np.testing.assert_allclose(out.Hzz[j], H[zj, zj], rtol=1e-6, atol=1e-8 * scale)
+    # the windows' initial states do not couple: the cross blocks of D vanish
+    assert np.abs(H[P:P + 2, P + 2:]).max() == 0.0
+
+
 def test_recovers_a_duffing_oscillator(duffing_fit):
     """The order (2) wins the validation fit among 1, 2, 3; the free run on a fresh
     input matches the noise-free truth to > 97 % while the linear start stays below 70 %; the
