@@ -4,6 +4,7 @@ kernel against finite differences, recovery of a known discrete Duffing oscillat
 
 import json
 import warnings
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -163,6 +164,47 @@ def test_gram_matrix_equals_the_finite_difference_jacobian():
     assert np.abs(H[P:P + 2, P + 2:]).max() == 0.0
 
 
+def test_a_first_part_model_that_runs_away_later_is_not_kept(monkeypatch):
+    """Stage 3 of a long record (first part Ns = 300 of N = 600, input 20× larger after it): a
+    stage-2 model whose cubic term runs away beyond the first part (at sample 305) is fitted on
+    the first part from the linear start with steps that keep the free run over all samples in
+    range; the polish (here 1 iteration) starts from whichever of that model and the linear one
+    fits all samples better, so the result is finite and no worse than the linear restart's one
+    iteration (equal here: the small first-part input does not determine x1² well)."""
+    import importlib
+
+    mod = importlib.import_module("gripkit.sysid.nonlinear.nlss")
+    exz, exe = monomial_exponents(2, 1, 3), monomial_exponents(2, 1, 3, inputs=False)
+    k2, k3 = (next(i for i, e in enumerate(exz) if tuple(e) == t) for t in ((2, 0, 0), (3, 0, 0)))
+    base = NLSSModel(A=np.array([[0.8, 0.2], [-0.2, 0.7]]), B=np.array([[1.0], [0.5]]),
+                     C=np.array([[1.0, 0.3]]), D=np.zeros((1, 1)), E=np.zeros((2, len(exz))),
+                     F=np.zeros((1, len(exe))), exz=exz, exe=exe, u_offset=np.zeros(1),
+                     u_scale=np.ones(1), y_offset=np.zeros(1),
+                     dirs=np.zeros((0, 3), dtype=np.int64), covariance=np.zeros((0, 0)),
+                     x0=np.zeros(2), state_limit=1e3)
+    E = base.E.copy()
+    E[1, k2] = 0.05
+    truth = replace(base, E=E)
+    rng = np.random.default_rng(0)
+    u = rng.normal(size=(600, 1))
+    u[:300] *= 0.05
+    u = np.ascontiguousarray(u)
+    y = truth.simulate(u) + 0.01 * rng.normal(size=(600, 1))
+    E[0, k3] = 0.3
+    runaway = replace(base, E=E.copy())
+    with pytest.warns(StabilityWarning, match="diverges at sample 305"):
+        runaway.simulate(u)
+    dirs = np.array([(4, 0, k3), (4, 1, k2), (2, 0, 1)], dtype=np.int64)
+    w, everything = np.ones(1), np.array([0, 600], dtype=np.int64)
+    monkeypatch.setattr(mod, "_POLISH_ITERATIONS", 1)
+    model, Z, its, _ = mod._whole_record(runaway, base, dirs, np.zeros((1, 2)), np.zeros(2), u,
+                                         y, w, 300, 30, lambda: None)
+    V = mod._loss(model, Z, everything, u, y, w)
+    restart = mod._lm(base, dirs, np.zeros((1, 2)), everything, u, y, w, 1, None)[2]
+    assert its[0] > 0 and np.isfinite(V)
+    assert V <= restart * (1 + 1e-9)
+
+
 def test_recovers_a_duffing_oscillator(duffing_fit):
     """The order (2) wins the validation fit among 1, 2, 3; the free run on a fresh
     input matches the noise-free truth to > 97 % while the linear start stays below 70 %; the
@@ -186,6 +228,31 @@ def test_sigma_of_the_simulated_output_covers_the_truth(duffing_fit):
     assert sd.shape == yh.shape and np.all(sd[50:] > 0)
     inside = np.abs(yh[50:, 0] - y0[50:]) < 3 * sd[50:, 0]
     assert inside.mean() >= 0.9
+
+
+def test_progress_bar_reaches_its_end_when_the_stages_stop_early(monkeypatch):
+    """Each Levenberg-Marquardt stage owns max_iterations steps of the bar; one that stops early
+    (here after far fewer) completes its share, so the bar ends at its total, not part-way."""
+    import importlib
+
+    mod = importlib.import_module("gripkit.sysid.nonlinear.nlss")
+    seen = []
+
+    def track(iterable, description="", enabled=True, **kw):
+        items = list(iterable)
+        seen.append([len(items), 0])
+        for item in items:
+            seen[-1][1] += 1
+            yield item
+
+    monkeypatch.setattr(mod, "track", track)
+    monkeypatch.setattr(mod, "status", lambda msg: None)
+    rng = np.random.default_rng(3)
+    u = _input(rng, 1500)
+    y = duffing(u) + rng.normal(0.0, 0.01, 1500)
+    m = nlss((u, y), order=2, max_iterations=40, progress=True)
+    assert m.info["iterations_windows"] + m.info["iterations_whole"] < 40
+    assert seen == [[80, 80]]
 
 
 def test_save_load_round_trip(duffing_fit, tmp_path):

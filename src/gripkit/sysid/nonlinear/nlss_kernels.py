@@ -130,30 +130,29 @@ def _monomial_jacobian(ex, x, u, t, out):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, inline="always")
+def _equation_row(M0, M1, M2, x, u, t, v, i):  # pragma: no cover - compiled
+    """(M0 x + M1 u[t] + M2 v)_i: row i of the state or the output equation."""
+    acc = 0.0
+    for j in range(M0.shape[1]):
+        acc += M0[i, j] * x[j]
+    for j in range(M1.shape[1]):
+        acc += M1[i, j] * u[t, j]
+    for k in range(M2.shape[1]):
+        acc += M2[i, k] * v[k]
+    return acc
+
+
+@numba.njit(cache=True, inline="always")
 def state_update(A, B, E, x, u, t, zeta, xn):  # pragma: no cover - compiled
     """xn = A x + B u[t] + E ζ."""
     for r in range(A.shape[0]):
-        acc = 0.0
-        for j in range(A.shape[1]):
-            acc += A[r, j] * x[j]
-        for j in range(B.shape[1]):
-            acc += B[r, j] * u[t, j]
-        for k in range(E.shape[1]):
-            acc += E[r, k] * zeta[k]
-        xn[r] = acc
+        xn[r] = _equation_row(A, B, E, x, u, t, zeta, r)
 
 
 @numba.njit(cache=True, inline="always")
 def output_row(C, D, F, y0, x, u, t, eta, i):  # pragma: no cover - compiled
     """ŷ_i = y₀_i + (C x + D u[t] + F η)_i."""
-    acc = y0[i]
-    for j in range(C.shape[1]):
-        acc += C[i, j] * x[j]
-    for j in range(D.shape[1]):
-        acc += D[i, j] * u[t, j]
-    for k in range(F.shape[1]):
-        acc += F[i, k] * eta[k]
-    return acc
+    return y0[i] + _equation_row(C, D, F, x, u, t, eta, i)
 
 
 #: the direction kinds (kind, r, c) that enter the output equation directly: C (∂ŷ_r/∂θ = x_c),
