@@ -81,7 +81,8 @@ def run(quick: bool) -> list[dict]:
         m, wall, cpu, load = _timed(fit)
         val = m.validation_fit_percent
         acc = (f"order {m.order}, fit {m.fit_percent[0]:.2f} %"
-               + ("" if val is None else f", validation {val[0]}")
+               + ("" if val is None else ", validation "
+                  + ("diverged" if val[0] is None else f"{val[0]:.2f} %"))
                + f", iterations {m.info['iterations_windows']} + {m.info['iterations_whole']}")
         rows.append(row("nlss", task, wall, "", None, target=TARGET, gripkit_accuracy=acc,
                         notes=f"CPU {cpu:.1f} s, load average {load:.1f} at the start; {notes}",

@@ -162,13 +162,15 @@ _STATE_KINDS = (0, 1, 4, -1)
 
 
 @numba.njit(cache=True, inline="always")
-def _sensitivity_rows(M0, M1, ex, kinds, dirs, x, u, t, S, vals, Jac, Mx,
+def _sensitivity_rows(M0, M1, ex, kinds, dirs, x, u, t, S, work,
                       rows):  # pragma: no cover - compiled
     """The sensitivity of one equation of the model, v = M0 x + M1 μ(x, ũ) + (direct terms),
-    at sample t: the monomials μ (``vals``) and their Jacobian, Mx = M0 + M1 ∂μ/∂x, and
-    rows = Mx S plus the direct terms of the directions ``dirs`` whose kind is one of ``kinds``
-    (for the entry (r, c): x_c, ũ_c, μ_c, 1). The output equation: (C, F, exe, _OUTPUT_KINDS),
-    rows ∂ŷ/∂θ; the state equation: (A, E, exz, _STATE_KINDS), the next sensitivity."""
+    at sample t: into ``work`` = (vals, Jac, Mx) the monomials μ, their Jacobian and
+    Mx = M0 + M1 ∂μ/∂x, and rows = Mx S plus the direct terms of the directions ``dirs`` whose
+    kind is one of ``kinds`` (for the entry (r, c): x_c, ũ_c, μ_c, 1). The output equation:
+    (C, F, exe, _OUTPUT_KINDS), rows ∂ŷ/∂θ; the state equation: (A, E, exz, _STATE_KINDS), the
+    next sensitivity."""
+    vals, Jac, Mx = work
     n = x.shape[0]
     monomials(ex, x, u, t, vals)
     _monomial_jacobian(ex, x, u, t, Jac)
@@ -293,7 +295,7 @@ def _sensitivity_buffers(m, Q):  # pragma: no cover - compiled
 @numba.njit(cache=True, inline="always")
 def _advance(m, dirs, x, u, t, S, Sn, zeta, Jz, Fx, xn):  # pragma: no cover - compiled
     """One step of the state and of its sensitivity S (carried, tiny entries flushed)."""
-    _sensitivity_rows(m.A, m.E, m.exz, _STATE_KINDS, dirs, x, u, t, S, zeta, Jz, Fx, Sn)
+    _sensitivity_rows(m.A, m.E, m.exz, _STATE_KINDS, dirs, x, u, t, S, (zeta, Jz, Fx), Sn)
     _carry(Sn, S)
     state_update(m.A, m.B, m.E, x, u, t, zeta, xn)
     for r in range(x.shape[0]):
@@ -335,7 +337,7 @@ def window_gram(m, dirs, win, limit, out):  # pragma: no cover - compiled
             for r in range(n):
                 if not (abs(x[r]) <= limit):
                     return np.inf
-            _sensitivity_rows(C, F, exe, _OUTPUT_KINDS, dirs, x, u, t, S, eta, Je, Gx, rows)
+            _sensitivity_rows(C, F, exe, _OUTPUT_KINDS, dirs, x, u, t, S, (eta, Je, Gx), rows)
             for i in range(p):
                 wi = w[i]
                 e = wi * (y[t, i] - output_row(C, D, F, y0, x, u, t, eta, i))
@@ -367,7 +369,7 @@ def output_variance(m, dirs, x0, u, L, out):  # pragma: no cover - compiled
     tmp = np.empty(L.shape[1])
     N = u.shape[0]
     for t in range(N):
-        _sensitivity_rows(C, F, exe, _OUTPUT_KINDS, dirs, x, u, t, S, eta, Je, Gx, rows)
+        _sensitivity_rows(C, F, exe, _OUTPUT_KINDS, dirs, x, u, t, S, (eta, Je, Gx), rows)
         for i in range(C.shape[0]):  # ‖Lᵀ r‖²
             ri = rows[i]
             for b in range(L.shape[1]):
