@@ -231,7 +231,8 @@ def test_sigma_of_the_simulated_output_covers_the_truth(duffing_fit):
 
 
 def test_progress_bar_reaches_its_end_when_the_stages_stop_early(monkeypatch):
-    """Each Levenberg-Marquardt stage owns max_iterations steps of the bar; one that stops early
+    """Each Levenberg-Marquardt stage owns max_iterations steps of the bar (the polish over all
+    samples of a long record its 10 iterations, weighted by their cost); one that stops early
     (here after far fewer) completes its share, so the bar ends at its total, not part-way."""
     import importlib
 
@@ -253,6 +254,12 @@ def test_progress_bar_reaches_its_end_when_the_stages_stop_early(monkeypatch):
     m = nlss((u, y), order=2, max_iterations=40, progress=True)
     assert m.info["iterations_windows"] + m.info["iterations_whole"] < 40
     assert seen == [[80, 80]]
+    # a record longer than the 8000-sample first part: each polish iteration over all 9000
+    # samples is ⌈9000/8000⌉ = 2 steps, at most 10 of them: 2·20 + 2·10 = 60
+    u = _input(rng, 9000)
+    y = duffing(u) + rng.normal(0.0, 0.01, 9000)
+    nlss((u, y), order=2, max_iterations=20, progress=True)
+    assert seen[1] == [60, 60]
 
 
 def test_save_load_round_trip(duffing_fit, tmp_path):

@@ -1022,6 +1022,12 @@ def _parameter_covariance(H, V, dof: int, P: int):
     return cov, Hs
 
 
+def _polish_steps(N: int, Ns: int) -> int:
+    """Progress-bar steps of one iteration over all N samples, one step being an iteration over
+    the first Ns: the bar advances with the work, and its ETA holds."""
+    return -(-N // Ns)
+
+
 def _whole_record(model, base, dirs, Z, x0, ut, y, w, Ns, max_iterations, tick):
     """Stage 3 of one record: Levenberg-Marquardt on the whole record from one initial state,
     first on its warm-start part (``Ns`` samples) when shorter, taking there only steps whose
@@ -1044,12 +1050,16 @@ def _whole_record(model, base, dirs, Z, x0, ut, y, w, Ns, max_iterations, tick):
             # (a part's model extrapolating badly): restart there from the linear one
             model, Z0 = base, xl
         cap = max_iterations if M_ == Ns else min(max_iterations, _POLISH_ITERATIONS)
-        guard = None
+        guard, step = None, tick
         if M_ < N:
             if not stays(model, Z0):
                 model, Z0 = base, xl
             guard = stays
-        model, Z, V2, it2, conv2 = _lm(model, dirs, Z0, whole, ut[:M_], y[:M_], w, cap, tick,
+        elif Ns < N:
+            def step():
+                for _ in range(_polish_steps(N, Ns)):
+                    tick()
+        model, Z, V2, it2, conv2 = _lm(model, dirs, Z0, whole, ut[:M_], y[:M_], w, cap, step,
                                        bounded=guard)
         its.append(it2)
         if not np.isfinite(V2):
@@ -1100,7 +1110,8 @@ def _fit_order(lin, ut, y, u_off, sd_u, y_off, degree, feedthrough, window, max_
         starts = starts[:-1]
     starts = np.append(starts, Ns)
     Z = np.ascontiguousarray(X[starts[:-1]])
-    total = 2 * max_iterations + (0 if Ns == N else min(max_iterations, _POLISH_ITERATIONS))
+    total = 2 * max_iterations + (0 if Ns == N else _polish_steps(N, Ns)
+                                  * min(max_iterations, _POLISH_ITERATIONS))
     bar = track(range(total), description=f"nlss order {n}",
                 enabled=progress)
     t_start = time.perf_counter()
