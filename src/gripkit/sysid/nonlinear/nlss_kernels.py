@@ -51,11 +51,13 @@ _FLUSH = 1e-150
 _ROWS = 16
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=True, fastmath={"contract"})
 def _add_rows(R, eb, fill, G, g):  # pragma: no cover - compiled
     """G += Σ_k r_k r_kᵀ (upper triangle only) and g += Σ_k r_k e_k for the first ``fill`` rows
-    r_k of R (_ROWS, Q): each row of G is loaded once per block and updated by the block's rows
-    in turn (contiguous inner loops)."""
+    r_k of R (_ROWS, Q): two rows a, a + 1 of G at a time, four rows of R per pass over them, so
+    that each r_k[b] loaded serves both (contiguous inner loops, fused multiply-adds; not inlined,
+    so that its fastmath flag holds). This is where :func:`window_gram` spends its time (Q²/2
+    multiply-adds per row of J against n·Q for the sensitivities)."""
     Q = R.shape[1]
     for k in range(fill):
         rk = R[k]
@@ -63,18 +65,27 @@ def _add_rows(R, eb, fill, G, g):  # pragma: no cover - compiled
         for a in range(Q):
             g[a] += rk[a] * ek
     k4 = fill - fill % 4
-    for a in range(Q):
-        Ga = G[a]
-        for k in range(0, k4, 4):  # four rows per pass over G's row: fewer loads and stores
+    for a in range(0, Q - 1, 2):
+        Ga, Gb = G[a], G[a + 1]
+        for k in range(0, k4, 4):
             r0, r1, r2, r3 = R[k], R[k + 1], R[k + 2], R[k + 3]
             c0, c1, c2, c3 = r0[a], r1[a], r2[a], r3[a]
-            for b in range(a, Q):
-                Ga[b] += c0 * r0[b] + c1 * r1[b] + c2 * r2[b] + c3 * r3[b]
+            d0, d1, d2, d3 = r0[a + 1], r1[a + 1], r2[a + 1], r3[a + 1]
+            Ga[a] += c0 * c0 + c1 * c1 + c2 * c2 + c3 * c3
+            for b in range(a + 1, Q):
+                x0, x1, x2, x3 = r0[b], r1[b], r2[b], r3[b]
+                Ga[b] += c0 * x0 + c1 * x1 + c2 * x2 + c3 * x3
+                Gb[b] += d0 * x0 + d1 * x1 + d2 * x2 + d3 * x3
         for k in range(k4, fill):
             rk = R[k]
-            rka = rk[a]
-            for b in range(a, Q):
-                Ga[b] += rka * rk[b]
+            ca, cb = rk[a], rk[a + 1]
+            Ga[a] += ca * ca
+            for b in range(a + 1, Q):
+                Ga[b] += ca * rk[b]
+                Gb[b] += cb * rk[b]
+    if Q % 2:  # the last row of G when Q is odd
+        for k in range(fill):
+            G[Q - 1, Q - 1] += R[k, Q - 1] * R[k, Q - 1]
 
 
 @numba.njit(cache=True, inline="always")
@@ -119,85 +130,68 @@ def _monomial_jacobian(ex, x, u, t, out):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, inline="always")
+def _equation_row(M0, M1, M2, x, u, t, v, i):  # pragma: no cover - compiled
+    """(M0 x + M1 u[t] + M2 v)_i: row i of the state or the output equation."""
+    acc = 0.0
+    for j in range(M0.shape[1]):
+        acc += M0[i, j] * x[j]
+    for j in range(M1.shape[1]):
+        acc += M1[i, j] * u[t, j]
+    for k in range(M2.shape[1]):
+        acc += M2[i, k] * v[k]
+    return acc
+
+
+@numba.njit(cache=True, inline="always")
 def state_update(A, B, E, x, u, t, zeta, xn):  # pragma: no cover - compiled
     """xn = A x + B u[t] + E ζ."""
     for r in range(A.shape[0]):
-        acc = 0.0
-        for j in range(A.shape[1]):
-            acc += A[r, j] * x[j]
-        for j in range(B.shape[1]):
-            acc += B[r, j] * u[t, j]
-        for k in range(E.shape[1]):
-            acc += E[r, k] * zeta[k]
-        xn[r] = acc
+        xn[r] = _equation_row(A, B, E, x, u, t, zeta, r)
 
 
 @numba.njit(cache=True, inline="always")
 def output_row(C, D, F, y0, x, u, t, eta, i):  # pragma: no cover - compiled
     """ŷ_i = y₀_i + (C x + D u[t] + F η)_i."""
-    acc = y0[i]
-    for j in range(C.shape[1]):
-        acc += C[i, j] * x[j]
-    for j in range(D.shape[1]):
-        acc += D[i, j] * u[t, j]
-    for k in range(F.shape[1]):
-        acc += F[i, k] * eta[k]
-    return acc
+    return y0[i] + _equation_row(C, D, F, x, u, t, eta, i)
+
+
+#: the direction kinds (kind, r, c) that enter the output equation directly: C (∂ŷ_r/∂θ = x_c),
+#: D (ũ_c), F (η_c) and y₀ (1); and the state equation: A (x_c), B (ũ_c), E (ζ_c), none constant
+_OUTPUT_KINDS = (2, 3, 5, 6)
+_STATE_KINDS = (0, 1, 4, -1)
 
 
 @numba.njit(cache=True, inline="always")
-def _output_rows(m, dirs, x, u, t, S, eta, Je, Gx, rows):  # pragma: no cover - compiled
-    """η and its Jacobian at sample t, and the rows ∂ŷ_i/∂θ of the output sensitivity:
-    rows = (C + F ∂η/∂x) S plus the direct terms of C, D, F and y₀ (directions ``dirs``)."""
-    C, F = m.C, m.F
+def _sensitivity_rows(M0, M1, ex, kinds, dirs, x, u, t, S, work,
+                      rows):  # pragma: no cover - compiled
+    """The sensitivity of one equation of the model, v = M0 x + M1 μ(x, ũ) + (direct terms),
+    at sample t: into ``work`` = (vals, Jac, Mx) the monomials μ, their Jacobian and
+    Mx = M0 + M1 ∂μ/∂x, and rows = Mx S plus the direct terms of the directions ``dirs`` whose
+    kind is one of ``kinds`` (for the entry (r, c): x_c, ũ_c, μ_c, 1). The output equation:
+    (C, F, exe, _OUTPUT_KINDS), rows ∂ŷ/∂θ; the state equation: (A, E, exz, _STATE_KINDS), the
+    next sensitivity."""
+    vals, Jac, Mx = work
     n = x.shape[0]
-    p = C.shape[0]
-    monomials(m.exe, x, u, t, eta)
-    _monomial_jacobian(m.exe, x, u, t, Je)
-    for i in range(p):  # Gx = C + F ∂η/∂x
+    monomials(ex, x, u, t, vals)
+    _monomial_jacobian(ex, x, u, t, Jac)
+    for i in range(M0.shape[0]):
         for c in range(n):
-            acc = C[i, c]
-            for k in range(F.shape[1]):
-                acc += F[i, k] * Je[k, c]
-            Gx[i, c] = acc
-    for i in range(p):
-        row_product(Gx, i, S, rows[i])
-    for q in range(dirs.shape[0]):  # direct terms of the output equation
+            acc = M0[i, c]
+            for k in range(M1.shape[1]):
+                acc += M1[i, k] * Jac[k, c]
+            Mx[i, c] = acc
+        row_product(Mx, i, S, rows[i])
+    k_x, k_u, k_v, k_1 = kinds
+    for q in range(dirs.shape[0]):
         kind, r, c = dirs[q, 0], dirs[q, 1], dirs[q, 2]
-        if kind == 2:
+        if kind == k_x:
             rows[r, q] += x[c]
-        elif kind == 3:
+        elif kind == k_u:
             rows[r, q] += u[t, c]
-        elif kind == 5:
-            rows[r, q] += eta[c]
-        elif kind == 6:
+        elif kind == k_v:
+            rows[r, q] += vals[c]
+        elif kind == k_1:
             rows[r, q] += 1.0
-
-
-@numba.njit(cache=True, inline="always")
-def _state_rows(m, dirs, x, u, t, S, zeta, Jz, Fx, Sn):  # pragma: no cover - compiled
-    """ζ and its Jacobian at sample t, and the next sensitivity Sn = (A + E ∂ζ/∂x) S plus the
-    direct terms of A, B and E (directions ``dirs``)."""
-    A, E = m.A, m.E
-    n = x.shape[0]
-    monomials(m.exz, x, u, t, zeta)
-    _monomial_jacobian(m.exz, x, u, t, Jz)
-    for r in range(n):  # Fx = A + E ∂ζ/∂x
-        for c in range(n):
-            acc = A[r, c]
-            for k in range(E.shape[1]):
-                acc += E[r, k] * Jz[k, c]
-            Fx[r, c] = acc
-    for r in range(n):
-        row_product(Fx, r, S, Sn[r])
-    for q in range(dirs.shape[0]):  # direct terms of the state equation
-        kind, r, c = dirs[q, 0], dirs[q, 1], dirs[q, 2]
-        if kind == 0:
-            Sn[r, q] += x[c]
-        elif kind == 1:
-            Sn[r, q] += u[t, c]
-        elif kind == 4:
-            Sn[r, q] += zeta[c]
 
 
 @numba.njit(cache=True, inline="always")
@@ -287,6 +281,28 @@ def window_loss(m, win, limit):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
+def _sensitivity_buffers(m, Q):  # pragma: no cover - compiled
+    """The buffers of a sensitivity pass of ``m`` over Q directions: S (n, Q) = 0 and its next
+    value Sn, the output rows (p, Q), the state x and its next value xn, ζ, η, their Jacobians
+    (Mζ, n), (Mη, n) and the linearised state and output matrices Fx (n, n), Gx (p, n)."""
+    n, p = m.A.shape[0], m.C.shape[0]
+    nz, ne = m.exz.shape[0], m.exe.shape[0]
+    return (np.zeros((n, Q)), np.empty((n, Q)), np.zeros((p, Q)), np.empty(n), np.empty(n),
+            np.empty(nz), np.empty(ne), np.empty((nz, n)), np.empty((ne, n)), np.empty((n, n)),
+            np.empty((p, n)))
+
+
+@numba.njit(cache=True, inline="always")
+def _advance(m, dirs, x, u, t, S, Sn, zeta, Jz, Fx, xn):  # pragma: no cover - compiled
+    """One step of the state and of its sensitivity S (carried, tiny entries flushed)."""
+    _sensitivity_rows(m.A, m.E, m.exz, _STATE_KINDS, dirs, x, u, t, S, (zeta, Jz, Fx), Sn)
+    _carry(Sn, S)
+    state_update(m.A, m.B, m.E, x, u, t, zeta, xn)
+    for r in range(x.shape[0]):
+        x[r] = xn[r]
+
+
+@numba.njit(cache=True)
 def window_gram(m, dirs, win, limit, out):  # pragma: no cover - compiled
     """Gauss-Newton sums of the windowed simulation error (module docstring) of the model ``m``
     (:data:`NLSSArrays`) over the windows ``win`` (:data:`NLSSWindows`): for the P parameter
@@ -294,27 +310,17 @@ def window_gram(m, dirs, win, limit, out):  # pragma: no cover - compiled
     (:data:`NLSSGram`): Htt = Σ JθᵀJθ (P, P), gt = Σ Jθᵀe, Htz[j] = Σ Jθᵀ Jz_j (P, n), Hzz[j] =
     Σ Jz_jᵀJz_j, gz[j] = Σ Jz_jᵀ e, rows weighted by w (per output). Returns the loss Σ (w e)²,
     inf when a state leaves [−limit, limit] (the sums are then incomplete)."""
-    A, B, C, D, E, F, y0, exz, exe = m
+    C, D, F, y0, exe = m.C, m.D, m.F, m.y0, m.exe
     Z, starts, u, y, w = win
-    n = A.shape[0]
+    n = m.A.shape[0]
     p = C.shape[0]
     P = dirs.shape[0]
     Q = P + n
-    S = np.zeros((n, Q))
-    Sn = np.empty((n, Q))
+    S, Sn, rows, x, xn, zeta, eta, Jz, Je, Fx, Gx = _sensitivity_buffers(m, Q)
     G = np.zeros((Q, Q))
     g = np.zeros(Q)
-    rows = np.zeros((p, Q))
     RT = np.zeros((_ROWS, Q))
     eb = np.zeros(_ROWS)
-    x = np.empty(n)
-    xn = np.empty(n)
-    zeta = np.empty(exz.shape[0])
-    eta = np.empty(exe.shape[0])
-    Jz = np.empty((exz.shape[0], n))
-    Je = np.empty((exe.shape[0], n))
-    Fx = np.empty((n, n))
-    Gx = np.empty((p, n))
     out.Htt[:, :] = 0.0
     out.gt[:] = 0.0
     V = 0.0
@@ -331,7 +337,7 @@ def window_gram(m, dirs, win, limit, out):  # pragma: no cover - compiled
             for r in range(n):
                 if not (abs(x[r]) <= limit):
                     return np.inf
-            _output_rows(m, dirs, x, u, t, S, eta, Je, Gx, rows)
+            _sensitivity_rows(C, F, exe, _OUTPUT_KINDS, dirs, x, u, t, S, (eta, Je, Gx), rows)
             for i in range(p):
                 wi = w[i]
                 e = wi * (y[t, i] - output_row(C, D, F, y0, x, u, t, eta, i))
@@ -344,11 +350,7 @@ def window_gram(m, dirs, win, limit, out):  # pragma: no cover - compiled
                 if fill == _ROWS:
                     _add_rows(RT, eb, fill, G, g)
                     fill = 0
-            _state_rows(m, dirs, x, u, t, S, zeta, Jz, Fx, Sn)
-            _carry(Sn, S)
-            state_update(A, B, E, x, u, t, zeta, xn)
-            for r in range(n):
-                x[r] = xn[r]
+            _advance(m, dirs, x, u, t, S, Sn, zeta, Jz, Fx, xn)
         if fill:
             _add_rows(RT, eb, fill, G, g)
         _window_sums(G, g, P, j, out)
@@ -360,26 +362,15 @@ def output_variance(m, dirs, x0, u, L, out):  # pragma: no cover - compiled
     """out[t, i] = ‖Lᵀ ∂ŷ_i[t]/∂θ‖² for the free run of ``m`` (:data:`NLSSArrays`) from x0 (x0
     held): the variance of the simulated output by linearised propagation of cov θ = L Lᵀ
     (directions ``dirs``)."""
-    A, B, C, D, E, F, y0, exz, exe = m
-    n = A.shape[0]
-    p = C.shape[0]
+    C, F, exe = m.C, m.F, m.exe
     P = dirs.shape[0]
-    S = np.zeros((n, P))
-    Sn = np.empty((n, P))
-    rows = np.zeros((p, P))
+    S, Sn, rows, x, xn, zeta, eta, Jz, Je, Fx, Gx = _sensitivity_buffers(m, P)
+    x[:] = x0
     tmp = np.empty(L.shape[1])
-    x = x0.copy()
-    xn = np.empty(n)
-    zeta = np.empty(exz.shape[0])
-    eta = np.empty(exe.shape[0])
-    Jz = np.empty((exz.shape[0], n))
-    Je = np.empty((exe.shape[0], n))
-    Fx = np.empty((n, n))
-    Gx = np.empty((p, n))
     N = u.shape[0]
     for t in range(N):
-        _output_rows(m, dirs, x, u, t, S, eta, Je, Gx, rows)
-        for i in range(p):  # ‖Lᵀ r‖²
+        _sensitivity_rows(C, F, exe, _OUTPUT_KINDS, dirs, x, u, t, S, (eta, Je, Gx), rows)
+        for i in range(C.shape[0]):  # ‖Lᵀ r‖²
             ri = rows[i]
             for b in range(L.shape[1]):
                 tmp[b] = 0.0
@@ -394,8 +385,4 @@ def output_variance(m, dirs, x0, u, L, out):  # pragma: no cover - compiled
             for b in range(L.shape[1]):
                 acc += tmp[b] * tmp[b]
             out[t, i] = acc
-        _state_rows(m, dirs, x, u, t, S, zeta, Jz, Fx, Sn)
-        _carry(Sn, S)
-        state_update(A, B, E, x, u, t, zeta, xn)
-        for r in range(n):
-            x[r] = xn[r]
+        _advance(m, dirs, x, u, t, S, Sn, zeta, Jz, Fx, xn)
