@@ -39,7 +39,7 @@ def main(n: int = 20_000, runs: int = 15) -> dict:
     ps = [np.ascontiguousarray(x) for x in rng.normal(size=(n, 3))]
     qs = [np.ascontiguousarray(G @ x) for x in ps]
     M = np.empty((3, 3))
-    buf, _, shape = ch._one or ch._one_state()
+    buf, _, shape, _ = ch._one or ch._one_state()
 
     def pin_crba():
         for q in qs:
