@@ -822,7 +822,7 @@ def _first_absurd(x, peak, factor):
                 m2 = a2 if a2 > m2 else m2
                 m3 = a3 if a3 > m3 else m3
             m = max(max(m0, m1), max(m2, m3))
-            if m <= factor * peak:  # (NaN compares False: the sample loop)
+            if m <= factor * peak:  # (the maxima skip NaN, as the sample loop does)
                 if m > peak:
                     peak = m
                 continue
