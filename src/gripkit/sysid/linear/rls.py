@@ -764,8 +764,10 @@ class RLS:
         rows = n if store else 0
         theta = np.empty((rows, p))
         std = np.empty((rows, p))
-        yhat = np.empty(n)
-        e = np.empty(n)
+        # ŷ and e as the two rows of one block: glibc keeps a freed block of up to 16 MB (N = 10⁶)
+        # on its heap for the next call, where two 8 MB arrays were often handed back to the
+        # system and faulted in again (docs/performance.md, "Issue 24: RLS with history")
+        yhat, e = np.empty((2, n))
         n0 = self.n_updates
         _rls_run(self._s, u, y, theta, std, yhat, e, self._kernel_size(n))
         self._s[_PU], self._s[_PY] = peaks
