@@ -9,7 +9,11 @@ alternating, min and median of 15 runs:
 * ``chain.mass_matrix(p)`` (a new 3×3 array per call) and ``chain.mass_matrix(p, out=M)``;
 * the compiled kernel ``mass_matrix_one(buf, p, M)`` alone, into one array and into a new
   ``np.empty`` per call: the difference of the last two is the price of a fresh result array,
-  the difference to ``chain.mass_matrix`` the Python method's.
+  the difference to ``chain.mass_matrix`` the Python method's;
+* the same through the kernel's numba entry point (``onestate.mass_matrix_entry``, no
+  dispatcher), which ``chain.mass_matrix(p)`` calls for an exact 1-D float64 state;
+* the entry point into one array after an unused ``np.empty``: the allocation alone slows the
+  kernel that follows it.
 """
 
 import sys
@@ -39,7 +43,7 @@ def main(n: int = 20_000, runs: int = 15) -> dict:
     ps = [np.ascontiguousarray(x) for x in rng.normal(size=(n, 3))]
     qs = [np.ascontiguousarray(G @ x) for x in ps]
     M = np.empty((3, 3))
-    buf, _, shape = ch._one or ch._one_state()
+    buf, _, shape, entry = ch._one or ch._one_state()
 
     def pin_crba():
         for q in qs:
@@ -61,9 +65,25 @@ def main(n: int = 20_000, runs: int = 15) -> dict:
         for p in ps:
             mass_matrix_one(buf, p, np.empty(shape))
 
+    def entry_into_one_array():
+        for p in ps:
+            entry(buf, p, M)
+
+    def entry_into_new_array():
+        for p in ps:
+            entry(buf, p, np.empty(shape))
+
+    def entry_after_unused_empty():
+        for p in ps:
+            np.empty(shape)
+            entry(buf, p, M)
+
     fns = {"pin.crba": pin_crba, "mass_matrix(p)": mass_matrix,
            "mass_matrix(p, out=M)": mass_matrix_out, "kernel, one array": kernel_into_one_array,
-           "kernel, np.empty per call": kernel_into_new_array}
+           "kernel, np.empty per call": kernel_into_new_array,
+           "entry point, one array": entry_into_one_array,
+           "entry point, np.empty per call": entry_into_new_array,
+           "entry point, unused np.empty": entry_after_unused_empty}
     for fn in fns.values():
         fn()
     times = {k: [] for k in fns}
@@ -76,7 +96,7 @@ def main(n: int = 20_000, runs: int = 15) -> dict:
     out = {}
     for k, v in times.items():
         out[k] = (min(v), float(np.median(v)))
-        print(f"{k:26s} min {min(v) * 1e9:6.0f} ns  median {np.median(v) * 1e9:6.0f} ns  "
+        print(f"{k:31s} min {min(v) * 1e9:6.0f} ns  median {np.median(v) * 1e9:6.0f} ns  "
               f"min / pin.crba min {min(v) / ref:.2f}")
     return out
 

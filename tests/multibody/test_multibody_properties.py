@@ -190,3 +190,29 @@ def test_bad_states_and_couplings_are_refused():
         CoupledChain(ch, Coupling(np.eye(2), np.zeros(2), np.zeros(2), ("a", "b")))
     with pytest.raises(SimulationError, match="method"):
         ch.simulate_free(np.zeros(3), np.zeros(3), np.zeros((2, 3)), 1e-3, method="euler")
+
+
+def test_one_state_mass_matrix_entry_point_takes_only_exact_float64_vectors():
+    """The unchecked entry point (onestate.mass_matrix_entry) gets only an exact 1-D float64
+    ndarray of stride 8: states that numba would misread there (int64 items of the same size, a
+    (3, 1) array, big-endian, a subclass) go through the validating path and give the float64
+    answer; each call returns a new array (no result is shared between calls)."""
+    ch = finger(check=False).chain()
+    q = np.array([0.1, -0.2, 0.3])
+    ref = ch.mass_matrix(q)
+    a, b = ch.mass_matrix(q), ch.mass_matrix(np.array([1.0, 0.5, -0.5]))
+    assert a is not b and not np.shares_memory(a, b)
+    np.testing.assert_array_equal(a, ref)
+    qi = np.array([1, -2, 3])
+    np.testing.assert_array_equal(ch.mass_matrix(qi), ch.mass_matrix(qi.astype(float)))
+    np.testing.assert_array_equal(ch.mass_matrix(q.astype(">f8")), ref)
+    np.testing.assert_array_equal(ch.mass_matrix(q.view(_Sub)), ref)
+    with pytest.raises(ModelError, match="expected shape"):
+        ch.mass_matrix(q[:, None])
+    ro = q.copy()
+    ro.flags.writeable = False
+    np.testing.assert_array_equal(ch.mass_matrix(ro), ref)
+
+
+class _Sub(np.ndarray):
+    """An ndarray subclass (the entry point's test wants the exact type)."""

@@ -123,6 +123,62 @@ def test_forgetting_tracks_a_step_change_in_parameters():
     assert np.any(np.abs(r1.theta[4000] - new) > 3 * r1.theta_std[4000])
 
 
+@pytest.mark.parametrize("windup", ["none", "trace", "directional"])
+def test_specialised_batch_kernel_equals_the_generic_one(monkeypatch, windup):
+    """A record of SPECIALISE_ABOVE samples runs through the kernel compiled for its structure
+    (orders as compile-time sizes, one sample loop per windup mode); with the threshold raised
+    the same record runs through the generic kernel, whose arithmetic is the textbook-checked
+    one above: θ and σ histories, predictions, errors and the final P agree bit for bit, with
+    λ = 0.995 (forgetting) and the trace bound reached (p0 = 1e4, max_trace = 1e3)."""
+    from gripkit.sysid.linear import rls as rls_module
+
+    n = rls_module.SPECIALISE_ABOVE
+    u, y = simulate_arx(n, noise=0.5, seed=31)
+    kw = dict(forgetting=0.995, p0=1e4, windup=windup, max_trace=1e3)
+    fast = rls(u, y, 2, 2, 2, **kw)
+    monkeypatch.setattr(rls_module, "SPECIALISE_ABOVE", n + 1)
+    generic = rls(u, y, 2, 2, 2, **kw)
+    for name in ("theta", "theta_std", "y_pred", "errors", "P_final"):
+        np.testing.assert_array_equal(getattr(fast, name), getattr(generic, name), err_msg=name)
+    assert fast.loss == generic.loss
+
+
+def _first_absurd_reference(x, peak, factor):
+    """The corrupt-sample rule of RLS.update, sample by sample."""
+    for i, v in enumerate(x):
+        if abs(v) > peak:
+            if peak > 0.0 and abs(v) > factor * peak:
+                return i, peak
+            peak = abs(v)
+    return -1, peak
+
+
+def test_blockwise_corrupt_sample_scan_equals_the_sample_rule():
+    """The batch scan for corrupt samples skips blocks of 256 whose peak cannot break the rule;
+    on 400 random records (leading zeros, spikes of 10⁵…10¹⁵ times the signal, NaN and inf,
+    several start peaks and factors) it returns the sample-by-sample rule's index and peak."""
+    from gripkit.sysid.linear.rls import _first_absurd
+
+    rng = np.random.default_rng(41)
+    hits = 0
+    for _ in range(400):
+        n = int(rng.integers(0, 1500))
+        x = rng.standard_normal(n) * 10.0 ** rng.uniform(-5, 5)
+        if n and rng.random() < 0.5:
+            x[:int(rng.integers(0, n))] = 0.0
+        if n and rng.random() < 0.6:
+            j = int(rng.integers(0, n))
+            x[j] *= 10.0 ** rng.uniform(5, 15)
+        if n and rng.random() < 0.1:
+            x[int(rng.integers(0, n))] = rng.choice([np.nan, np.inf])
+        peak = float(rng.choice([0.0, 1e-3, 1.0]))
+        factor = float(rng.choice([1e10, 10.0]))
+        ref = _first_absurd_reference(x, peak, factor)
+        assert _first_absurd(x, peak, factor) == ref
+        hits += ref[0] >= 0
+    assert 50 < hits < 350  # both outcomes are exercised
+
+
 @pytest.mark.parametrize("windup", ["trace", "directional"])
 def test_ten_million_samples_of_periodic_excitation_stay_finite_and_pd(windup):
     """10⁷ samples of a single sine (periodic, exciting only 2 of the 6 directions of φ) with

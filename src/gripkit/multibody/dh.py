@@ -28,6 +28,13 @@ from .regressor import kernel_parameters, parameter_names, regressor
 
 __all__ = ["DHChain", "Dynamics"]
 
+# the one-state mass matrix's test for its unchecked entry point, and np.empty without the
+# module lookup (per call: docs/performance.md, "One-state RNEA and CRBA")
+_NDARRAY = np.ndarray
+_F8 = np.dtype(np.float64)
+_STRIDE_1D = (8,)
+_empty = np.empty
+
 def _as_transform(T, what: str) -> np.ndarray:
     if T is None:
         return np.eye(4)
@@ -72,7 +79,7 @@ class Dynamics:
         of :mod:`gripkit.multibody.onestate`. ``out``: a float64 array of τ's shape to write
         into (a controller loop's workspace, as Pinocchio's ``data``); returned."""
         if gravity:
-            buf, m, _ = self._one or self._one_state()
+            buf, m = (self._one or self._one_state())[:2]
             res = np.empty(m) if out is None else out
             try:  # try/except costs nothing on this hot path, unlike a context manager
                 done = rnea_one(buf, q, qd, qdd, res)
@@ -120,10 +127,16 @@ class Dynamics:
         the low-overhead path of :mod:`gripkit.multibody.onestate`. ``out``: a float64 array of
         M's shape to write into (a controller loop's workspace, as Pinocchio's ``data``);
         returned."""
-        buf, _, shape = self._one or self._one_state()
-        res = np.empty(shape) if out is None else out
+        one = self._one or self._one_state()
+        if out is None and type(q) is _NDARRAY and q.strides == _STRIDE_1D and q.dtype is _F8:
+            # an exact 1-D float64 ndarray: the kernel's unchecked entry point (onestate
+            # .mass_matrix_entry) into a fresh array; False (wrong length, NaN): the checks below
+            res = _empty(one[2])
+            if one[3](one[0], q, res):
+                return res
+        res = _empty(one[2]) if out is None else out
         try:
-            done = mass_matrix_one(buf, q, res)
+            done = mass_matrix_one(one[0], q, res)
         # not a 1-D float64 state or a C-contiguous float64 out: the validating way
         except TypeError:
             done = False

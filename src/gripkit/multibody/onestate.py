@@ -9,8 +9,10 @@ for float64 arrays only, with three (mass matrix) or five (RNEA) arguments: unbo
 is most of the cost of a call. Other argument types raise TypeError
 at the call, and the kernel reports a state of the wrong length or with NaN/inf: the caller then
 takes the validating path, which raises the error. The scratch is shared by the calls on one
-chain, which is safe because the kernel holds the GIL. The mass matrix (:func:`mass_matrix_one`,
-CRBA) takes the same path. Measured in ``benchmarks/bench_urdf.py`` and
+chain, which is safe because the kernels hold the GIL (compiled without ``nogil``): calls from
+several threads run one after the other. The buffer is for these two kernels only; the batched
+and ``prange`` kernels take their own scratch per state, never this buffer. The mass matrix
+(:func:`mass_matrix_one`, CRBA) takes the same path. Measured in ``benchmarks/bench_urdf.py`` and
 ``benchmarks/bench_multibody.py`` against one ``pinocchio.rnea`` / ``pinocchio.crba`` call.
 """
 
@@ -24,7 +26,7 @@ import numpy as np
 from .kernels import (WORK_PER_LINK, ChainArrays, chain_links, crba, hot_inline, links_of,
                       project_mass, rnea_pass)
 
-__all__ = ["mass_matrix_one", "pack", "prepare", "rnea_one"]
+__all__ = ["mass_matrix_entry", "mass_matrix_one", "pack", "prepare", "rnea_one"]
 
 #: header of the packed buffer: n, m, dh width, then the offsets of dh, mass, com, inertia,
 #: arm_q, Γ, q₀, arm_p, gravity, joint types and the scratch
@@ -145,8 +147,22 @@ def mass_matrix_one(buf, q, out):  # pragma: no cover - compiled
     return True
 
 
+def mass_matrix_entry():
+    """The compiled :func:`mass_matrix_one`'s own CPython wrapper (numba's ``entry_point`` for its
+    one signature): it unboxes its three arguments as the declared types without the
+    dispatcher's type resolution (~130 ns of a ~600 ns call). It does not check them: numba reads
+    any array with 8-byte items as float64 and an array of more dimensions past the declared ones,
+    so only :meth:`~gripkit.multibody.dh.Dynamics.mass_matrix` calls it, with the chain's packed
+    buffer, a fresh C-contiguous (m, m) float64 array, and a state that is an exact 1-D float64
+    ndarray of stride 8 (checked in Python first). The dispatcher where numba has no
+    ``entry_point``."""
+    sig = next(iter(mass_matrix_one.overloads))
+    return getattr(mass_matrix_one.overloads[sig], "entry_point", mass_matrix_one)
+
+
 def prepare(system):
-    """(packed buffer, m, (m, m)) of ``system`` for ``Dynamics.rnea`` and ``Dynamics.mass_matrix``
-    (the shape tuple made once: building it per call is a measurable part of a call)."""
+    """(packed buffer, m, (m, m), :func:`mass_matrix_entry`) of ``system`` for ``Dynamics.rnea``
+    and ``Dynamics.mass_matrix`` (the shape tuple made once: building it per call is a
+    measurable part of a call)."""
     m = system.dof
-    return pack(system.kernel_arrays()), m, (m, m)
+    return pack(system.kernel_arrays()), m, (m, m), mass_matrix_entry()

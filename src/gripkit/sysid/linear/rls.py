@@ -340,6 +340,44 @@ def _var_factor(s, p):
     return s[_V] / (w1 - p) * (s[_W2] / w1)
 
 
+@njit(cache=True, inline="always")
+def _batch_loop(w, size, io, run, state, mode):
+    """The sample loop of :func:`_rls_run` from sample ``nstart`` on, for one windup ``mode`` (a
+    literal: :func:`_rls_run` calls it once per mode, so each loop holds one copy of
+    :func:`_core` instead of three behind a branch per sample). ``io``: u, y and the four output
+    arrays; ``run``: the buffer offsets, (p, na, nb, nk), λ, the trace bound, ``nstart`` and the
+    store / predict flags; ``state``: (trace, V, w₁, w₂, updates, σ factor of the last step),
+    returned updated."""
+    u, y, theta_out, std_out, yhat_out, err_out = io
+    at, dims, lam, maxtr, nstart, store, pred = run
+    trace, V, w1, w2, nupd, f = state
+    bth = at[1]
+    if len(size[0]) > 0:  # the orders are known to the compiler: constant regressor indices
+        p, na, nb, nk = len(size[0]), len(size[1]), len(size[2]), len(size[3])
+    else:
+        p, na, nb, nk = dims
+    for t in range(nstart, u.shape[0]):
+        for i in range(na):
+            w[at[2] + i] = -y[t - 1 - i]
+        for j in range(nb):
+            w[at[2] + na + j] = u[t - nk - j]
+        tprev = t - 1 if (store and t > nstart) else -1  # σ of step t − 1 (:func:`_core`)
+        e, r, trace = _core(w, at, p, size[0], lam, mode, maxtr, trace, y[t], std_out, tprev, f)
+        V = lam * (V + e * e / (lam + r))
+        w1 = lam * w1 + 1.0
+        w2 = lam * lam * w2 + 1.0
+        nupd += 1.0
+        if pred:
+            yh = y[t] - e
+            yhat_out[t] = yh
+            err_out[t] = y[t] - yh  # y − ŷ as stored (bit-identical to the arrays' difference)
+        if store:
+            f = V / (w1 - p) * (w2 / w1) if (nupd > p and w1 > p) else np.nan
+            for i in range(p):
+                theta_out[t, i] = w[bth + i]
+    return trace, V, w1, w2, nupd, f
+
+
 @njit(cache=True)
 def _rls_run(s, u, y, theta_out, std_out, yhat_out, err_out, size):
     """Batch RLS: updates ``s`` over the record; writes θ and σ at every step when their arrays
@@ -389,34 +427,16 @@ def _rls_run(s, u, y, theta_out, std_out, yhat_out, err_out, size):
         w[bP + i] = s[op + i]
     lam, mode, maxtr, trace = s[_LAM], int(s[_MODE]), s[_MAXTR], s[_TRACE]
     V, w1, w2, nupd = s[_V], s[_W1], s[_W2], s[_NUPD]
-    f = np.nan
-    for t in range(nstart, n):
-        for i in range(na):
-            w[bph + i] = -y[t - 1 - i]
-        for j in range(nb):
-            w[bph + na + j] = u[t - nk - j]
-        tprev = t - 1 if (store and t > nstart) else -1  # σ of step t − 1 (:func:`_core`)
-        if mode == 0:  # the mode as a literal: its branches fold away in each copy
-            e, r, trace = _core(w, (bP, bth, bph, bq), p, size[0], lam, 0, maxtr, trace, y[t],
-                                std_out, tprev, f)
-        elif mode == 1:
-            e, r, trace = _core(w, (bP, bth, bph, bq), p, size[0], lam, 1, maxtr, trace, y[t],
-                                std_out, tprev, f)
-        else:
-            e, r, trace = _core(w, (bP, bth, bph, bq), p, size[0], lam, 2, maxtr, trace, y[t],
-                                std_out, tprev, f)
-        V = lam * (V + e * e / (lam + r))
-        w1 = lam * w1 + 1.0
-        w2 = lam * lam * w2 + 1.0
-        nupd += 1.0
-        if pred:
-            yh = y[t] - e
-            yhat_out[t] = yh
-            err_out[t] = y[t] - yh  # y − ŷ as stored (bit-identical to the arrays' difference)
-        if store:
-            f = V / (w1 - p) * (w2 / w1) if (nupd > p and w1 > p) else np.nan
-            for i in range(p):
-                theta_out[t, i] = w[bth + i]
+    state = (trace, V, w1, w2, nupd, np.nan)
+    io = (u, y, theta_out, std_out, yhat_out, err_out)
+    run = ((bP, bth, bph, bq), (p, na, nb, nk), lam, maxtr, nstart, store, pred)
+    if mode == 0:  # the mode as a literal: one compact loop per mode (docs/performance.md)
+        state = _batch_loop(w, size, io, run, state, 0)
+    elif mode == 1:
+        state = _batch_loop(w, size, io, run, state, 1)
+    else:
+        state = _batch_loop(w, size, io, run, state, 2)
+    trace, V, w1, w2, nupd, f = state
     if store:  # σ of the last step
         for i in range(p):
             std_out[n - 1, i] = math.sqrt(f * w[bP + i * p + i])
@@ -744,8 +764,10 @@ class RLS:
         rows = n if store else 0
         theta = np.empty((rows, p))
         std = np.empty((rows, p))
-        yhat = np.empty(n)
-        e = np.empty(n)
+        # ŷ and e as the two rows of one block: glibc keeps a freed block of up to 16 MB (N = 10⁶)
+        # on its heap for the next call, where two 8 MB arrays were often handed back to the
+        # system and faulted in again (docs/performance.md, "Issue 24: RLS with history")
+        yhat, e = np.empty((2, n))
         n0 = self.n_updates
         _rls_run(self._s, u, y, theta, std, yhat, e, self._kernel_size(n))
         self._s[_PU], self._s[_PY] = peaks
@@ -773,17 +795,45 @@ def _absurd_sample(where: str, name: str, value: float, peak: float, state: str,
         f"which would throw θ far off for good; {state}", hint=hint)
 
 
+#: samples per block of :func:`_first_absurd` (a multiple of 4)
+_ABSURD_BLOCK = 256
+
+
 @njit(cache=True)
 def _first_absurd(x, peak, factor):
     """(index of the first sample of ``x`` above ``factor`` times the largest |x| before it, or −1;
     the largest |x| up to there), from the running peak ``peak`` on (the test of
-    :func:`_rls_step`)."""
-    for i in range(x.shape[0]):
-        a = abs(x[i])
-        if a > peak:
-            if peak > 0.0 and a > factor * peak:
-                return i, peak
-            peak = a
+    :func:`_rls_step`).
+
+    By blocks: while ``peak > 0``, a block whose largest |x| is at most ``factor·peak`` holds no
+    such sample (every later running peak is at least ``peak``), and its largest |x| updates the
+    peak; that maximum takes four independent running maxima, without a branch per sample. Other
+    blocks go sample by sample. The same index and peak as the plain sample loop."""
+    n = x.shape[0]
+    for i in range(0, n, _ABSURD_BLOCK):
+        stop = min(i + _ABSURD_BLOCK, n)
+        if peak > 0.0 and stop - i == _ABSURD_BLOCK:
+            m0 = m1 = m2 = m3 = 0.0
+            for k in range(i, stop, 4):
+                a0 = abs(x[k])
+                a1 = abs(x[k + 1])
+                a2 = abs(x[k + 2])
+                a3 = abs(x[k + 3])
+                m0 = a0 if a0 > m0 else m0
+                m1 = a1 if a1 > m1 else m1
+                m2 = a2 if a2 > m2 else m2
+                m3 = a3 if a3 > m3 else m3
+            m = max(max(m0, m1), max(m2, m3))
+            if m <= factor * peak:  # (the maxima skip NaN, as the sample loop does)
+                if m > peak:
+                    peak = m
+                continue
+        for k in range(i, stop):
+            a = abs(x[k])
+            if a > peak:
+                if peak > 0.0 and a > factor * peak:
+                    return k, peak
+                peak = a
     return -1, peak
 
 
