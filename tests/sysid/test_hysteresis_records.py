@@ -191,7 +191,7 @@ def osc_fit():
 
 def test_oscillator_three_records_equal_least_squares_over_each_records_run_from_rest(osc_fit):
     """One θ for three records, each simulated from rest at its own first sample: the same
-    optimum (within 0.01σ) and σ (within 0.1 %) as scipy's least squares on the stacked residuals
+    optimum (within 0.001σ) and σ (within 0.1 %) as scipy's least squares on the stacked residuals
     of each record's free run by BoucWenOscillatorModel.simulate, cov = s² (JᵀJ)⁻¹ with J over
     all records; the truth within 3σ (≥ 6 of 7, all within 4σ); the fit at the noise floor on
     every record."""
@@ -209,7 +209,7 @@ def test_oscillator_three_records_equal_least_squares_over_each_records_run_from
     s2 = 2 * ref.cost / (len(ref.fun) - len(names))
     ref_std = np.sqrt(np.diag(s2 * np.linalg.inv(ref.jac.T @ ref.jac))) * scale
     for k, r, sd in zip(names, ref.x * scale, ref_std):
-        assert abs(getattr(m, k) - r) < 1e-2 * m.std[k], k
+        assert abs(getattr(m, k) - r) < 1e-3 * m.std[k], k
         assert m.std[k] == pytest.approx(sd, rel=1e-3), k
     z = [abs(getattr(m, k) - OSC[k]) / m.std[k] for k in names]
     assert sum(v < 3 for v in z) >= 6 and max(z) < 4, z  # (gamma here 3.1σ; 20 runs: slow test)
@@ -221,11 +221,12 @@ def test_oscillator_three_records_equal_least_squares_over_each_records_run_from
 
 
 def test_oscillator_sigma_shrinks_with_records(osc_fit):
-    """σ from all three records is below σ from the first record alone, for every parameter."""
+    """σ from all three records is below 0.65 σ from the first record alone (1/√3 = 0.58 for
+    three like records), for every parameter."""
     recs, m = osc_fit
     one = hysteresis(recs[0], form="oscillator", dt=OSC_DT, progress=False)
     for k in m.free:
-        assert m.std[k] < 0.8 * one.std[k], k
+        assert m.std[k] < 0.65 * one.std[k], k  # 0.38–0.59
 
 
 def test_oscillator_joined_record_is_biased_and_worse_at_the_seam(osc_fit):
@@ -237,11 +238,11 @@ def test_oscillator_joined_record_is_biased_and_worse_at_the_seam(osc_fit):
     u, y = np.concatenate([r[0] for r in recs]), np.concatenate([r[1] for r in recs])
     joined = hysteresis((u, y), form="oscillator", dt=OSC_DT, progress=False)
     bias = [abs(getattr(joined, k) - OSC[k]) / m.std[k] for k in m.free]
-    assert sum(b > 5 for b in bias) >= 4, bias
+    assert sum(b > 5 for b in bias) >= 5, bias  # 6.7–69σ
     assert joined.fit_percent < m.fit_percent - 3
     e_joined = (y - joined.simulate(u)[:, 0])[1000:1100]
     e_rec = recs[1][1][:100] - m.simulate(recs[1][0])[:100, 0]
-    assert np.sqrt(np.mean(e_joined**2)) > 3 * OSC_NOISE
+    assert np.sqrt(np.mean(e_joined**2)) > 5 * OSC_NOISE  # 1.3 mm
     assert np.sqrt(np.mean(e_rec**2)) < 1.3 * OSC_NOISE
 
 
