@@ -23,8 +23,8 @@ mass with a hysteretic spring, ``m ẍ + c_v ẋ + k_e x + k_h z = u``,
 ``ż = ẋ − β |ẋ| z |z|^(n−1) − γ ẋ |z|^n`` (A = 1 fixes the scale of z), rate dependent,
 simulated from rest with the input held over each sample (RK4 sub-steps) and fitted on the free
 run like the actuator form, from the second-order ARX model nearest the data (the starting
-points tried on the first :data:`WARM_SAMPLES` samples, the best then refined on the whole
-record).
+points tried on the first :data:`WARM_SAMPLES` samples, shared out among the records, the best
+then refined on the whole records). Several records: each run from rest at its own first sample.
 
 **Prandtl–Ishlinskii**: ``y = c + Σ_i w_i F_{r_i}[u − a]`` with the play operators
 ``F_r[x](k) = max(x(k) − r, min(x(k) + r, F_r[x](k−1)))``, each relaxed at the first sample
@@ -524,11 +524,14 @@ class BoucWenOscillatorModel(_HysteresisModel):
                              f"x' + k_e x + k_h z = u  ({self.criterion})")
 
 
-def _linear_start(u, y, dt):
-    """(mass, damping, k) of the second-order model nearest the data: a least-squares ARX
-    [2 2 1] with a constant, its poles mapped to s = ln z / dt and its static gain to 1/k."""
-    A = np.column_stack([y[1:-1], y[:-2], u[1:-1], u[:-2], np.ones(len(y) - 2)])
-    a1, a2, b1, b2, _ = np.linalg.lstsq(A, y[2:], rcond=None)[0]
+def _linear_start(recs, dt):
+    """(mass, damping, k) of the second-order model nearest the records ``recs`` (a list of
+    ``(u, y)``): a least-squares ARX [2 2 1] with a constant over every record's own rows (none
+    spans two records), its poles mapped to s = ln z / dt and its static gain to 1/k."""
+    A = np.vstack([np.column_stack([y[1:-1], y[:-2], u[1:-1], u[:-2], np.ones(len(y) - 2)])
+                   for u, y in recs])
+    a1, a2, b1, b2, _ = np.linalg.lstsq(A, np.concatenate([y[2:] for _, y in recs]),
+                                        rcond=None)[0]
     roots = np.roots([1.0, -a1, -a2]).astype(complex)
     gain = (b1 + b2) / (1.0 - a1 - a2) if a1 + a2 != 1.0 else 0.0
     if np.all(np.abs(roots) < 1) and np.all(np.abs(roots) > 0) and gain > 0:
@@ -538,18 +541,17 @@ def _linear_start(u, y, dt):
         if w2 > 0 and two_zw > 0:
             k = 1.0 / gain
             return k / w2, two_zw * k / w2, k
-    k = float(np.ptp(u) / np.ptp(y))  # fallback: a tenth of Nyquist, ζ = 0.2
-    w = 0.1 * math.pi / dt
+    u = np.concatenate([r[0] for r in recs])
+    k = float(np.ptp(u) / np.ptp(np.concatenate([r[1] for r in recs])))
+    w = 0.1 * math.pi / dt  # fallback: a tenth of Nyquist, ζ = 0.2
     return k / w**2, 0.4 * k / w, k
 
 
-def _fit_bouc_wen_oscillator(u, y, dt, *, exponent, offset, burn_in, multistart, substeps,
-                             progress):
-    from scipy.optimize import least_squares
-
-    su = 0.5 * float(np.ptp(u))
-    sy = 0.5 * float(np.ptp(y))
-    us, ys = u / su, y / sy
+def _oscillator_starts(recs, dt, exponent, offset, multistart):
+    """The oscillator's free names, held values, bounds and ``multistart`` starting points (each
+    inside the bounds) on the scaled records ``recs``: the second-order model nearest the data
+    split into elastic and hysteretic stiffness, z saturating at a fraction of the output's
+    amplitude."""
     n_free = exponent == "free"
     n0 = 1.0 if n_free else float(exponent)
     names = ["mass", "damping", "k_e", "k_h", "beta", "gamma"] + (["n"] if n_free else []) + (
@@ -558,65 +560,96 @@ def _fit_bouc_wen_oscillator(u, y, dt, *, exponent, offset, burn_in, multistart,
     lo = {"mass": 0.0, "damping": 0.0, "k_e": -np.inf, "k_h": -np.inf, "beta": 0.0,
           "gamma": -np.inf, "n": 1.0, "offset": -np.inf}
     hi = {k: np.inf for k in lo} | {"n": 10.0}
-    m0, c0, k0 = _linear_start(us, ys, dt)
-    y_amp = 0.5 * float(np.ptp(ys))
+    m0, c0, k0 = _linear_start(recs, dt)
+    y_amp = 0.5 * float(np.ptp(np.concatenate([y for _, y in recs])))
     starts = []
     for frac, q in ((0.5, 0.1), (0.8, 0.1), (0.5, 0.02), (0.8, 0.3), (0.3, 0.05)):
         bg = (1.0 / (q * y_amp)) ** n0  # z saturates at (1/(β+γ))^(1/n) = q × the amplitude
         p0 = {"mass": m0, "damping": c0, "k_e": frac * k0, "k_h": (1 - frac) * k0,
               "beta": bg / 1.3, "gamma": 0.3 * bg / 1.3, "n": n0,
-              "offset": float(ys[0]) if offset else 0.0}
+              "offset": float(recs[0][1][0]) if offset else 0.0}
         starts.append(np.array([p0[k] for k in names]))
-    starts = starts[:max(1, int(multistart))]
-    target = ys[burn_in:]
-    buf = np.empty(len(us))
-
-    def resid(th, end=len(us)):
-        p = dict(fixed)
-        p.update(zip(names, th))
-        K.bwo_simulate(us[:end], dt, substeps, p["mass"], p["damping"], p["k_e"], p["k_h"],
-                       p["beta"], p["gamma"], p["n"], p["offset"], buf[:end])
-        r = buf[burn_in:end] - ys[burn_in:end]
-        return np.clip(np.where(np.isfinite(r), r, 1e3), -1e3, 1e3)
-
-    # the starts in order of their initial cost, each to convergence on the first
-    # WARM_SAMPLES samples, until one reproduces them to a fit of 90 % (a free run of a
-    # rate-dependent model is costly, and a long record makes a poor start crawl); then the
-    # best one refined on the whole record
     lb = np.array([lo[k] for k in names])
     ub = np.array([hi[k] for k in names])
     starts = [np.clip(x0, np.where(np.isfinite(lb), lb + 1e-9, -np.inf),
-                      np.where(np.isfinite(ub), ub - 1e-9, np.inf)) for x0 in starts]
-    end = min(len(us), burn_in + WARM_SAMPLES)
-    starts.sort(key=lambda x0: float(np.sum(resid(x0, end) ** 2)))
-    short = ys[burn_in:end]
-    good = 0.01 * float(np.sum((short - short.mean()) ** 2))
-    opts = dict(bounds=(lb, ub), x_scale="jac", method="trf", xtol=1e-10, ftol=1e-10,
-                gtol=1e-10, max_nfev=100 * len(names))
-    best = None
-    for x0 in track(starts, description="bouc-wen oscillator fit", enabled=progress):
-        res = least_squares(resid, x0, args=(end,), **opts)
-        if best is None or res.cost < best.cost:
-            best = res
-        if 2.0 * best.cost < good:
-            break
-    if end < len(us):
-        best = least_squares(resid, best.x, **opts)
-    cov_s = _free_run_covariance(best, len(target), "bouc-wen-oscillator")
+                      np.where(np.isfinite(ub), ub - 1e-9, np.inf))
+              for x0 in starts[:max(1, int(multistart))]]
+    return names, fixed, (lb, ub), starts
+
+
+def _oscillator_physical(theta_s, names, fixed, cov_s, su, sy):
+    """The oscillator's physical parameters and their covariance from the scaled fit (u/su,
+    y/sy): force-like parameters scale by sy/su, β and γ by sy^−n, the offset by sy."""
     p = dict(fixed)
-    p.update(zip(names, best.x))
+    p.update(zip(names, theta_s))
     n = p["n"]
-    g = sy / su  # force-like parameters scale by sy/su, β and γ by sy^−n, offset by sy
+    g = sy / su
     phys = {"mass": p["mass"] / g, "damping": p["damping"] / g, "k_e": p["k_e"] / g,
             "k_h": p["k_h"] / g, "beta": p["beta"] * sy ** -n, "gamma": p["gamma"] * sy ** -n,
             "n": n, "offset": p["offset"] * sy}
     diag = {"mass": 1 / g, "damping": 1 / g, "k_e": 1 / g, "k_h": 1 / g, "beta": sy ** -n,
             "gamma": sy ** -n, "n": 1.0, "offset": sy}
     T = np.diag([diag[k] for k in names])
-    if n_free:
+    if "n" in names:
         for k in ("beta", "gamma"):
             T[names.index(k), names.index("n")] = -phys[k] * math.log(sy)
-    return phys, tuple(names), T @ cov_s @ T.T
+    return phys, T @ cov_s @ T.T
+
+
+def _fit_bouc_wen_oscillator(recs, dt, *, exponent, offset, burn_in, multistart, substeps,
+                             progress):
+    """The Bouc-Wen oscillator on the records ``recs`` (a list of ``(u, y)``), each run from rest
+    at its own first sample, its first ``burn_in`` samples not scored; one least squares over
+    all of them (σ from the Jacobian over all)."""
+    from scipy.optimize import least_squares
+
+    u = np.concatenate([r[0] for r in recs])
+    y = np.concatenate([r[1] for r in recs])
+    su = 0.5 * float(np.ptp(u))
+    sy = 0.5 * float(np.ptp(y))
+    us, ys = u / su, y / sy
+    first = np.cumsum([0] + [len(r[0]) for r in recs])[:-1]
+    lengths = [len(r[0]) for r in recs]
+    names, fixed, bounds, starts = _oscillator_starts(
+        [(us[a:a + n], ys[a:a + n]) for a, n in zip(first, lengths)], dt, exponent, offset,
+        multistart)
+    buf = np.empty(len(us))
+
+    def scored(ends):  # every record's samples burn_in … end − 1
+        return np.concatenate([np.arange(a + burn_in, a + e) for a, e in zip(first, ends)])
+
+    def resid(th, ends=lengths, idx=scored(lengths)):
+        p = dict(fixed)
+        p.update(zip(names, th))
+        for a, e in zip(first, ends):  # every record from rest at its own first sample
+            K.bwo_simulate(us[a:a + e], dt, substeps, p["mass"], p["damping"], p["k_e"],
+                           p["k_h"], p["beta"], p["gamma"], p["n"], p["offset"], buf[a:a + e])
+        r = buf[idx] - ys[idx]
+        return np.clip(np.where(np.isfinite(r), r, 1e3), -1e3, 1e3)
+
+    # the starts in order of their initial cost, each to convergence on the first
+    # WARM_SAMPLES samples (shared out among the records), until one reproduces them to a fit of
+    # 90 % (a free run of a rate-dependent model is costly, and a long record makes a poor start
+    # crawl); then the best one refined on the whole records
+    ends = [min(n, burn_in + WARM_SAMPLES // len(recs)) for n in lengths]
+    warm = (ends, scored(ends))
+    starts.sort(key=lambda x0: float(np.sum(resid(x0, *warm) ** 2)))
+    short = ys[warm[1]]
+    good = 0.01 * float(np.sum((short - short.mean()) ** 2))
+    opts = dict(bounds=bounds, x_scale="jac", method="trf", xtol=1e-10, ftol=1e-10,
+                gtol=1e-10, max_nfev=100 * len(names))
+    best = None
+    for x0 in track(starts, description="bouc-wen oscillator fit", enabled=progress):
+        res = least_squares(resid, x0, args=warm, **opts)
+        if best is None or res.cost < best.cost:
+            best = res
+        if 2.0 * best.cost < good:
+            break
+    if ends != lengths:
+        best = least_squares(resid, best.x, **opts)
+    cov_s = _free_run_covariance(best, len(y) - burn_in * len(recs), "bouc-wen-oscillator")
+    phys, cov = _oscillator_physical(best.x, names, fixed, cov_s, su, sy)
+    return phys, tuple(names), cov
 
 
 # ---------------------------------------------------------------------------------------------
@@ -869,18 +902,13 @@ def _bouc_wen_settings(form, exponent, multistart):
 
 def _oscillator(recs, dt, exponent, offset, burn_in, multistart, substeps, progress, common,
                 how) -> BoucWenOscillatorModel:
-    """The Bouc-Wen oscillator fitted to one record (``common``: the model's other fields)."""
-    if len(recs) > 1:
-        raise ArgumentError(f"hysteresis: the Bouc-Wen oscillator is fitted to one record, "
-                            f"found {len(recs)}",
-                            hint="fit the actuator form or Prandtl-Ishlinskii to several "
-                                 "records, or pass one record")
-    u, y = recs[0]
+    """The Bouc-Wen oscillator fitted to the records ``recs``, each from rest at its first sample
+    (``common``: the model's other fields)."""
     substeps = _check_int(substeps, "substeps", 1)
     if dt is None:
         raise ArgumentError("hysteresis: the Bouc-Wen oscillator is rate dependent: give the "
                             "sample time dt= (or a Trajectory, which has one)")
-    phys, names, cov = _fit_bouc_wen_oscillator(u, y, float(dt), exponent=exponent,
+    phys, names, cov = _fit_bouc_wen_oscillator(recs, float(dt), exponent=exponent,
                                                 offset=offset, burn_in=burn_in,
                                                 multistart=multistart, substeps=substeps,
                                                 progress=progress)
@@ -942,11 +970,11 @@ def hysteresis(data, model: str = "bouc-wen", *, input: str | None = None,
     """Identify a hysteresis model of ``output`` driven by ``input``.
 
     ``data``: a Trajectory (columns ``input``, ``output``) or a pair of arrays ``(u, y)``, or a
-    list of them: several records fitted by one model (Bouc-Wen actuator form and
+    list of them: several records fitted by one model (Bouc-Wen, either form, and
     Prandtl–Ishlinskii), each run from its own relaxed state (h = 0, every play at its first
-    input) with its own first ``burn_in`` samples unscored, one least squares over all of them
-    (σ from all); ``fit_percent`` over all scored samples together, each record's in
-    ``records``.
+    input, the oscillator at rest: x = ẋ = z = 0) with its own first ``burn_in`` samples
+    unscored, all at one sample time, one least squares over all of them (σ from all);
+    ``fit_percent`` over all scored samples together, each record's in ``records``.
     ``model``: ``"bouc-wen"`` (actuator form; ``exponent`` n ≥ 1, default 1 = the seed's eq 3, or
     ``"free"`` to estimate it; ``multistart`` starting points; ``form="oscillator"``: the
     rate-dependent Bouc-Wen oscillator :class:`BoucWenOscillatorModel`, from rest, ``substeps``
