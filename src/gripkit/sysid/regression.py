@@ -105,7 +105,7 @@ def solve_upper(r1: np.ndarray, b: np.ndarray, trans: int = 0) -> np.ndarray:
 
 
 #: Regressors up to this many elements are factored by numpy's LAPACK (``np.linalg.qr``), which
-#: needs no scipy.linalg import (~0.2 s of a fresh process: a small CLI fit); larger ones by
+#: needs no scipy.linalg import (start-up a small CLI fit does without); larger ones by
 #: scipy's ``geqrf`` in place (numpy copies the matrix twice). Both call OpenBLAS's ``dgeqrf``.
 NUMPY_QR_MAX_ELEMENTS = 2**15
 

@@ -34,7 +34,8 @@ from .validation import fit_percent, records_fit
 __all__ = ["arx", "arx_records"]
 
 #: Regressors up to this many elements (``m·(p+1)``, 2 MiB of float64) are materialised: a few
-#: milliseconds at most, and no numba import or kernel load (0.45 s of a fresh process). Up to
+#: milliseconds at most, and no numba import or kernel load (the start-up it would add to a small
+#: CLI fit: docs/performance.md, "Start-up"). Up to
 #: ``regression.NUMPY_QR_MAX_ELEMENTS`` they are solved by QR (no scipy.linalg import), above it
 #: by the normal equations of their BLAS Gram matrix where κ allows (:func:`blas_gram_cond_limit`,
 #: else QR). Larger ones take the one-pass compensated lagged sums (O(p²) memory).
@@ -224,8 +225,9 @@ def blas_gram_cond_limit(m: int) -> float:
 
 @functools.cache
 def _lapack():
-    """scipy's LAPACK wrappers, imported on first use (scipy.linalg: ~0.2 s of a fresh process;
-    the regressors that take this route are large enough to load it anyway for QR)."""
+    """scipy's LAPACK wrappers, imported on first use (scipy.linalg is a noticeable part of a
+    fresh process's start-up; the regressors that take this route are large enough to load it
+    anyway for QR)."""
     from scipy.linalg import lapack
 
     return lapack
@@ -242,7 +244,7 @@ def _blas_normal_equations(X: np.ndarray, names: tuple, warn: bool):
     lapack = _lapack()
     m, q = X.shape
     p = q - 1
-    G = X.T @ X[:, :p]  # (q, p): ΦᵀΦ over YᵀΦ; a gemm (numpy's X.T @ X is a syrk, 5× slower here)
+    G = X.T @ X[:, :p]  # (q, p): ΦᵀΦ over YᵀΦ; a gemm (numpy's X.T @ X, a syrk, is slower here)
     r1, info = lapack.dpotrf(G[:p], lower=0, clean=1)
     if info != 0:
         return None
