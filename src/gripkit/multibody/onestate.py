@@ -150,7 +150,7 @@ def mass_matrix_one(buf, q, out):  # pragma: no cover - compiled
 def mass_matrix_entry():
     """The compiled :func:`mass_matrix_one`'s own CPython wrapper (numba's ``entry_point`` for its
     one signature): it unboxes its three arguments as the declared types without the
-    dispatcher's type resolution (~130 ns of a ~600 ns call). It does not check them: numba reads
+    dispatcher's type resolution (docs/performance.md, CRBA). It does not check them: numba reads
     any array with 8-byte items as float64 and an array of more dimensions past the declared ones,
     so only :meth:`~gripkit.multibody.dh.Dynamics.mass_matrix` calls it, with the chain's packed
     buffer, a fresh C-contiguous (m, m) float64 array, and a state that is an exact 1-D float64
