@@ -1,7 +1,9 @@
 """Where the batch RLS time goes on this machine: gripkit's compiled batch kernel alone (no ŷ/e,
-ŷ/e into reused arrays, into a new (2, N) block), the plain numba RLS of ``bench_rls``, the cost
-of a new (2, N) block (page faults and writes) and the whole ``RLS.run(store=False)``; [3 3 1],
-N = 1e6, λ = 0.999, windup 'none', 9 alternating runs each, wall and thread CPU time.
+ŷ/e into reused arrays, into a new (2, N) block), the plain numba RLS of ``bench_rls`` and two
+layouts of it (P, θ, φ and q in one buffer at constant offsets, as gripkit's kernel keeps them;
+P as a flat array of its own), the cost of a new (2, N) block (page faults and writes) and the
+whole ``RLS.run(store=False)``; [3 3 1], N = 1e6, λ = 0.999, windup 'none', 9 alternating runs
+each, wall and thread CPU time.
 
     PYTHONPATH=src python benchmarks/ab_rls_kernel.py
 """
@@ -17,6 +19,84 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
 import bench_rls as B  # noqa: E402
 import numpy as np  # noqa: E402
 from common import measure_alternating  # noqa: E402
+from numba import njit  # noqa: E402
+
+P6 = 6
+
+
+@njit(cache=True)
+def _plain_flat(u, y, lam, p0):  # pragma: no cover - compiled
+    """The plain RLS with P (row-major), θ, φ and q in one local buffer at constant offsets (the
+    layout of gripkit's batch kernel); final θ only."""
+    n = u.shape[0]
+    oP, oth, oph, oq = 0, 36, 42, 48
+    w = np.zeros(54)
+    for i in range(P6):
+        w[oP + i * P6 + i] = p0
+    for t in range(3, n):
+        for i in range(3):
+            w[oph + i] = -y[t - 1 - i]
+            w[oph + 3 + i] = u[t - 1 - i]
+        e = y[t]
+        for i in range(P6):
+            acc = 0.0
+            for j in range(P6):
+                acc += w[oP + i * P6 + j] * w[oph + j]
+            w[oq + i] = acc
+            e -= w[oph + i] * w[oth + i]
+        r = 0.0
+        for i in range(P6):
+            r += w[oph + i] * w[oq + i]
+        inv = 1.0 / (lam + r)
+        g = e * inv
+        for i in range(P6):
+            w[oth + i] += w[oq + i] * g
+        scale = 1.0 / lam
+        for i in range(P6):
+            qi = -inv * w[oq + i]
+            for j in range(i, P6):
+                v = (w[oP + i * P6 + j] + qi * w[oq + j]) * scale
+                w[oP + i * P6 + j] = v
+                w[oP + j * P6 + i] = v
+    return w[oth:oth + P6].copy()
+
+
+@njit(cache=True)
+def _plain_split(u, y, lam, p0):  # pragma: no cover - compiled
+    """The plain RLS with P as a flat row-major array of its own and θ, φ, q separate."""
+    n = u.shape[0]
+    P = np.zeros(36)
+    th = np.zeros(P6)
+    phi = np.zeros(P6)
+    q = np.zeros(P6)
+    for i in range(P6):
+        P[i * P6 + i] = p0
+    for t in range(3, n):
+        for i in range(3):
+            phi[i] = -y[t - 1 - i]
+            phi[3 + i] = u[t - 1 - i]
+        e = y[t]
+        for i in range(P6):
+            acc = 0.0
+            for j in range(P6):
+                acc += P[i * P6 + j] * phi[j]
+            q[i] = acc
+            e -= phi[i] * th[i]
+        r = 0.0
+        for i in range(P6):
+            r += phi[i] * q[i]
+        inv = 1.0 / (lam + r)
+        g = e * inv
+        for i in range(P6):
+            th[i] += q[i] * g
+        scale = 1.0 / lam
+        for i in range(P6):
+            qi = -inv * q[i]
+            for j in range(i, P6):
+                v = (P[i * P6 + j] + qi * q[j]) * scale
+                P[i * P6 + j] = v
+                P[j * P6 + i] = v
+    return th.copy()
 
 
 def main() -> None:
@@ -40,9 +120,15 @@ def main() -> None:
                lambda: _rls_run(s0.copy(), u, y, none, none, keep[0], keep[1], size),
            "kernel, ŷ/e into a new (2,N) block": fresh,
            "plain numba RLS": lambda: B._plain_rls(u, y, B.LAM, B.P0, none, none),
+           "plain, one buffer at constant offsets": lambda: _plain_flat(u, y, B.LAM, B.P0),
+           "plain, P a flat array of its own": lambda: _plain_split(u, y, B.LAM, B.P0),
            "new (2,N) block filled (page faults + writes)": lambda: np.empty((2, n)).fill(1.0),
            "RLS.run(store=False)": lambda: RLS(3, 3, 1, forgetting=B.LAM, p0=B.P0,
                                                windup="none").run(u, y, store=False)}
+    th = B._plain_rls(u, y, B.LAM, B.P0, none, none)[0]
+    print("max |θ| difference of the layouts:",
+          max(np.max(np.abs(_plain_flat(u, y, B.LAM, B.P0) - th)),
+              np.max(np.abs(_plain_split(u, y, B.LAM, B.P0) - th))))
     for clock, label in ((time.perf_counter, "wall"), (time.thread_time, "thread cpu")):
         times = measure_alternating(list(fns.values()), runs=9, clock=clock)
         print(f"--- {label}, median (min) ms")
