@@ -137,8 +137,7 @@ def warn_inconsistent(findings: Iterable[Finding], stacklevel: int | None = None
     A finding is warned once: building the same model again (same subject, check and message)
     stays silent until the warning filters are reset (a new ``warnings.catch_warnings()`` context,
     e.g. ``pytest.warns``, shows them again). ``stacklevel`` (as for ``warnings.warn``) overrides
-    the
-    default, which is the first frame outside gripkit.
+    the default, which is the first frame outside gripkit.
     """
     global _shown_under
     if warnings.filters is not _shown_under:  # catch_warnings() entered or left: a fresh context

@@ -8,8 +8,7 @@ installs the module-level ``__getattr__`` and ``__dir__`` made here::
     __getattr__, __dir__ = lazy_exports(__name__, _LAZY)
 
 A name of the table that is also a submodule's name (``gripkit.sysid.linear.arx``, the function, in
-the
-module ``gripkit/sysid/arx.py``) stays the public object: the import system's binding of the
+the module ``gripkit/sysid/arx.py``) stays the public object: the import system's binding of the
 submodule to the package, on its first import, is not kept.
 """
 

@@ -55,8 +55,8 @@ def _one_line(text: str) -> str:
 
 def user_error(exc: BaseException):
     """The gripkit error a user should see for ``exc`` (an error of the environment, not of
-    gripkit),
-    or ``None`` when ``exc`` is a bug. OS errors on a path become :class:`~gripkit.errors.PathError`
+    gripkit), or ``None`` when ``exc`` is a bug. OS errors on a path become
+    :class:`~gripkit.errors.PathError`
     saying what is wrong with the path; undecodable text a :class:`~gripkit.errors.DataError`."""
     from ..errors import DataError, GripkitError, PathError
 

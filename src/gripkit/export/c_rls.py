@@ -9,8 +9,7 @@ statistics V, w₁, w₂. The arithmetic and its order are those of the numba st
 ``_apply``, ``_rls_step``), so θ, P and e equal Python's (bit for bit with gcc -O2 on x86-64; to
 1e-12 relative in any case). Like ``update``, a sample that is not finite (status 1), a corrupt one
 above :data:`~gripkit.sysid.linear.rls.ABSURD_JUMP` times its signal's running peak (status 4), or
-an
-update that would make θ or P non-finite (2) or overflow φᵀPφ (3) returns NaN and leaves the
+an update that would make θ or P non-finite (2) or overflow φᵀPφ (3) returns NaN and leaves the
 estimator as it was (``s->status`` says why); Python raises there instead.
 
 State layout (``NAME_state``): ``theta[NP]`` = [a1..a_na, b_nk..], ``P[NP*NP]`` row-major, the

@@ -161,8 +161,7 @@ def _check_fs_against_time(source: str, tname: str, t: np.ndarray, fs: float) ->
     ``t[0] + k/fs`` at every sample k: each stamp is then nearest to its own grid point, so both
     label the same samples with the same times. Rounding of the stamps (a few digits written to the
     file) and clock jitter far below a sample pass; a different rate drifts by more than half a
-    sample
-    over a record of N samples as soon as the rates differ by more than 1/(2N), relative.
+    sample over a record of N samples as soon as the rates differ by more than 1/(2N), relative.
     """
     k = np.flatnonzero(np.isfinite(t))
     if k.size < 2:

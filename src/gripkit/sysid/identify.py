@@ -70,8 +70,7 @@ def _free_run_fit(model, u: np.ndarray, y: np.ndarray) -> float:
 
 def warn_if_mean_detrending_hurt(model, io: IOData, raw, refit) -> None:
     """The SISO form of :func:`gripkit.sysid.linear.identify_mimo._warn_if_detrending_hurt`: when a
-    pole
-    of ``model`` (fitted on the mean-detrended ``io``) does not settle within the record
+    pole of ``model`` (fitted on the mean-detrended ``io``) does not settle within the record
     (|z|^N > e⁻⁵), fit the same structure (``refit(raw())``) on the data as they are (``raw()``:
     their :class:`IOData` without detrending) and warn, naming ``--detrend none``, when its free
     run from rest fits better by more than 10 points than the detrended model's."""
@@ -364,17 +363,15 @@ def identify_records(data, method: str = "arx", *, input, output, na: int | None
     (:func:`gripkit.sysid.linear.oe.oe_records`; ``nf``
     defaults to ``na``), ``options`` ``maxiter``, ``tol`` for the last two; state space
     (``options`` of :data:`gripkit.sysid.linear.identify_mimo.SS_RECORD_OPTIONS`: subspace, then
-    PEM,
-    see :func:`gripkit.sysid.linear.identify_mimo.identify_ss_records`),
+    PEM, see :func:`gripkit.sysid.linear.identify_mimo.identify_ss_records`),
     continuous-time transfer functions (``poles``, ``zeros``:
     :func:`gripkit.sysid.linear.tfest.tfest_records`) and polynomial NARX
     (:func:`gripkit.sysid.narx` on the records as they are, its constant term in place of
     ``detrend``; ``options`` of that function), Hammerstein–Wiener (each record from its own
     steady state: :func:`gripkit.sysid.hammerstein_wiener` on the records as they are, with
     this function's ``nb``, ``nf``, ``nk``, each one not given chosen), hysteresis (each record
-    from its
-    own relaxed state: :func:`gripkit.sysid.hysteresis`) and nonlinear state space (each record
-    its own initial state: :func:`gripkit.sysid.nlss`; ``input``/``output`` may name several
+    from its own relaxed state: :func:`gripkit.sysid.hysteresis`) and nonlinear state space (each
+    record its own initial state: :func:`gripkit.sysid.nlss`; ``input``/``output`` may name several
     columns); these three ignore ``detrend`` (their models carry the operating point). This is what
     ``identify([tr1, tr2], method, ...)`` and ``gripkit identify METHOD DATA1 DATA2 ...`` do.
 

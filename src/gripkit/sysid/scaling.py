@@ -11,8 +11,7 @@ With ``u' = c_u u`` and ``y' = c_y y``, ``A y = B u + C e`` becomes ``A y' = (c_
 e``:
 A, C and F are unchanged, ``B = B' c_u/c_y``, the errors are ``e = e'/c_y``, the noise variance and
 the loss (squares of e) are divided by ``c_y²``, and the covariance of θ is ``D Cov' D`` with D =
-c_u/c_y
-on the B entries and 1 elsewhere.
+c_u/c_y on the B entries and 1 elsewhere.
 """
 
 from __future__ import annotations

@@ -370,10 +370,8 @@ def arx_records(records, na: int, nb: int, nk: int = 1, *, dt: float | None = No
     M_i = N_i − start. The covariance is σ²(ΦᵀΦ)⁻¹ of the stacked Φ. With one record the result
     is that of :func:`arx` (same rows). ``fit_percent`` is the one-step fit of all the records,
     each about its own mean (:func:`~gripkit.sysid.linear.validation.records_fit`);
-    ``info['records']``
-    gives each record's samples and one-step fit; ``estimation_residuals`` are the records'
-    one-step errors
-    one after another (``info['record_starts']``: where each begins).
+    ``info['records']`` gives each record's samples and one-step fit; ``estimation_residuals`` are
+    the records' one-step errors one after another (``info['record_starts']``: where each begins).
 
     Examples
     --------

@@ -1,9 +1,8 @@
 """Numba steps shared by the kernels that accumulate normal equations without forming their
 regressor (:func:`gripkit.sysid.linear.subspace._bdx_normal_equations`,
 :func:`gripkit.sysid.linear.pem_ss._sensitivity_gram`): the state matrix their responses are
-carried in,
-a row of a small matrix product over contiguous columns, the copy of the next state into the
-carried one (entries below 1e-280 flushed to zero, :func:`gripkit.lti.flush_tiny`: the free
+carried in, a row of a small matrix product over contiguous columns, the copy of the next state into
+the carried one (entries below 1e-280 flushed to zero, :func:`gripkit.lti.flush_tiny`: the free
 responses of the initial-state columns decay into the subnormal range otherwise), and a block of
 collected rows added to ΦᵀΦ and Φᵀy by BLAS."""
 

@@ -562,8 +562,7 @@ def pem_records(model: LinearModel, records, *, form: str = "innovation",
     record has its own initial state, estimated with them (started from
     ``model.info['records'][i]['x0']`` where the model has them, as from
     :func:`gripkit.sysid.linear.subspace.n4sid_records`, else the starting model's least-squares x0
-    of
-    each record); the prediction errors of all records,
+    of each record); the prediction errors of all records,
     each predictor started at its own first sample, are minimised together by Levenberg-Marquardt.
     The covariance of the identifiable directions is σ²(JᵀJ)⁻¹ with σ² over Σ N_i·p − d − R·n
     degrees of freedom. ``fit_percent``: the free run of all records (each from its own x0);

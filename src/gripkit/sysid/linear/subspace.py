@@ -578,8 +578,7 @@ def from_records_factor(fac: RecordsFactor, n: int, *, dt: float, feedthrough: b
     x0 per record by least squares over all records; the noise model from the state sequences of
     every record. ``fit_percent``: the free run of all records per output, each from its own x0
     (:func:`~gripkit.sysid.linear.validation.records_fit`); ``info['records']``: each record's
-    samples,
-    free-run fit and x0 (the model's ``x0`` is the first record's)."""
+    samples, free-run fit and x0 (the model's ``x0`` is the first record's)."""
     p, m = fac.p, fac.m
 
     def unstable_fit(A, C):

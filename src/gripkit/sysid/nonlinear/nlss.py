@@ -18,8 +18,7 @@ Estimation (:func:`nlss`):
 1. The linear start: :func:`gripkit.sysid.n4sid` on the centred data (order n at the largest
    gap of the singular values, at most ``max_order``, and n + 1; the model of lower BIC is kept,
    or with a validation record the best validation fit among n − 1, n, n + 1), E = F = 0 — the
-   model's best linear
-   approximation, from which Paduart et al. start too.
+   model's best linear approximation, from which Paduart et al. start too.
 2. Truncated simulation windows: the record is cut into windows of ``window`` samples (default
    10 time constants of the slowest linear pole, at least 50 samples and at most 200 windows);
    each window is simulated from its own initial state, estimated with the parameters, and the
@@ -51,8 +50,7 @@ Parameters and the state basis: a similarity transform x → T x gives the same 
 behaviour, so n² entries of (A, B, C) are held at their values of the linear start: the
 d = nm + pn free ones are those whose unit directions complement the similarity orbit best
 (pivoted QR, the choice of :mod:`gripkit.sysid.linear.pem_ss`), and the other n² entries fix the
-state
-basis. The σ of the free parameters are those of σ²(JᵀJ)⁻¹ at the optimum (J of the weighted
+state basis. The σ of the free parameters are those of σ²(JᵀJ)⁻¹ at the optimum (J of the weighted
 simulation errors, the initial state a parameter too, σ² over N·p − P − n degrees of freedom).
 They are σ *in that fixed basis*: y₀ and D do not depend on the basis, and the output equation
 (C, F) says how the output depends on the states of this basis; A, B, E and C, F of another

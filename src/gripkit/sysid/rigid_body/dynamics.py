@@ -30,9 +30,8 @@ covariance of :func:`gripkit.sysid.regression.hac_covariance` for filtered, diff
 decimated logs (``covariance="hac"``).
 
 **Physical consistency** (:mod:`gripkit.sysid.rigid_body.dynamics_projection`, where it is
-derived). A
-base-parameter estimate is physically consistent when some standard parameters reproduce it with
-every link's pseudo-inertia
+derived). A base-parameter estimate is physically consistent when some standard parameters reproduce
+it with every link's pseudo-inertia
 
     J = [[½tr(I_o)·1 − I_o, h], [hᵀ, m]]   positive semidefinite
 

@@ -27,8 +27,7 @@ The URDF text makes the file self-contained: the chain is rebuilt from it with t
 and gravity; the base structure (K of φ_b = K φ,
 :class:`~gripkit.sysid.rigid_body.dynamics.BaseStructure`)
 is stored rather than found again, so that the loaded model predicts τ = X(q, q̇, q̈) θ with the
-very
-columns and parameters it was identified with. ``base_parameters`` and ``friction`` repeat
+very columns and parameters it was identified with. ``base_parameters`` and ``friction`` repeat
 ``parameters`` for a reader of the file; the loader uses ``parameters``.
 """
 

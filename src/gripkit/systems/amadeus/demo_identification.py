@@ -3,9 +3,8 @@ repeated on simulated data.
 
 The "true finger" is the zoo plant (Table II ``[2 2 2]``, SI units, see
 :mod:`gripkit.systems.amadeus.force_dynamics`), driven by the paper's excitations S1 (multisine
-1–10 Hz, 400 samples)
-and S2 (band-limited noise 0.3–10 Hz, 4000 samples) between 600 and 1100 mA, with white
-measurement noise on the force. Three ways of processing the data are compared:
+1–10 Hz, 400 samples) and S2 (band-limited noise 0.3–10 Hz, 4000 samples) between 600 and 1100 mA,
+with white measurement noise on the force. Three ways of processing the data are compared:
 
 * ``raw``: no filter;
 * ``filtered y`` (the paper's §V-E): the 9 Hz Butterworth on the force only, not part of the

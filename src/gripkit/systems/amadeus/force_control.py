@@ -121,8 +121,7 @@ def simulate_finger_grasp(controller: RSTController, plant=None,
 
     ``controller`` is an :class:`RSTController` for ``plant`` (valve current deviation in A →
     blocked force in N); ``valve`` a :class:`~gripkit.systems.amadeus.valve.ProportionalValve`
-    (static
-    characteristic used), ``sensor`` a
+    (static characteristic used), ``sensor`` a
     :class:`~gripkit.systems.amadeus.strain_gauge_sensor.StrainGaugeSensor`
     (``None`` and ``scenario.sensor_noise=False``: the controller sees the true force),
     ``contact`` a :class:`~gripkit.systems.amadeus.pvdf.StickSlipContact`, ``detector`` a calibrated

@@ -353,9 +353,9 @@ def _karnopp(th, n_stuck_iter, mode, tab, p, pd, stuck, out, sw):  # pragma: no 
 def _forces(th, n_stuck_iter, mode, thermal, fc, tab, st, pwm, ext, out, cw,
             sw):  # pragma: no cover - compiled
     """Accelerations ``out.acc`` for the state ``st`` (:data:`FingerState`: p, ṗ, T, z) with the
-    stuck set ``st.stuck``; fills
-    the motor torques (output side and shaft) and friction of ``out`` (:data:`Forces`). ``fc`` is
-    the finger's :data:`FingerChain`, ``tab`` its friction tables, ``cw``/``sw`` scratch
+    stuck set ``st.stuck``; fills the motor torques (output side and shaft) and friction of ``out``
+    (:data:`Forces`). ``fc`` is the finger's :data:`FingerChain`, ``tab`` its friction tables,
+    ``cw``/``sw`` scratch
     (:data:`ChainWork`, :data:`SolveWork`). With ``n_stuck_iter > 0`` actuators at rest are
     flagged and those whose holding torque exceeds stiction are released (the flags change in
     place, ``sw.dirn`` records the breakaway direction); ``n_stuck_iter = 0`` keeps the set

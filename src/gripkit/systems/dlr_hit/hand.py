@@ -65,8 +65,7 @@ class DLRHand(Model):
     """Five DLR/HIT II fingers on a palm (§3.1): four fingers and a thumb fixed in its
     orientation, each with its own friction factors (§6.3). Every finger is a
     :class:`~gripkit.systems.dlr_hit.finger.DLRFinger`; gravity is given in the palm frame and
-    rotated
-    into each finger's base frame (:func:`palm_frames`).
+    rotated into each finger's base frame (:func:`palm_frames`).
 
     Inputs: 15 PWM counts, finger-major (``thumb_pwm_base1``, ..., ``little_pwm_distal``);
     outputs: the 18 finger outputs per finger, prefixed with the finger name; states: 15 per finger.

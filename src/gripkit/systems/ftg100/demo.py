@@ -357,8 +357,7 @@ def _identification_section(report, summary, quick):
 
 def _hybrid_section(report, summary, plant, quick):
     """Hybrid force/position control of a grasp on the nonlinear plant, anti-windup, bumpless
-    switch,
-    sensitivities."""
+    switch, sensitivities."""
     ctrl = HybridForcePosition.for_plant(plant.parameters)
     sec = report.section(
         "FT-G100: hybrid force/position control of a grasp",

@@ -310,9 +310,8 @@ class _SecondOrderFTG(Model):
 
     def discrete(self, dt: float = DT, form: str = "canonical") -> StateSpace:
         """ZOH discretisation every ``dt`` s: ``form='canonical'`` is the controllable canonical
-        form
-        the seed prints (eqs 10, 17; balancing scale chosen in the seed's units), ``'physical'``
-        keeps the states [y, ẏ]."""
+        form the seed prints (eqs 10, 17; balancing scale chosen in the seed's units),
+        ``'physical'`` keeps the states [y, ẏ]."""
         dt = sample_interval(dt, ModelError)
         d = self.state_space().c2d(dt)
         if form == "physical":

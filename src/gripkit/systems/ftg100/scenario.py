@@ -55,8 +55,7 @@ def ftg100_grasp(model, params: dict[str, np.ndarray], settings: dict) -> dict[s
     (N), ``noise_position`` (m). ``[scenario]``: ``duration`` (s, default 0.06),
     ``damage_threshold`` (N, default 1.5 × force), ``band`` (settling band, default 0.02),
     ``noise_seed``, and any :class:`~gripkit.systems.ftg100.hybrid_control.HybridForcePosition`
-    field (gains,
-    approach_speed, ...). ``model``: None (the nominal plant) or an
+    field (gains, approach_speed, ...). ``model``: None (the nominal plant) or an
     :class:`~gripkit.systems.ftg100.model.FTG100Plant` factory (``"module:factory"``, with
     ``allow_code``). Metrics: :data:`gripkit.systems.ftg100.hybrid_control.METRICS`."""
     s = _interface(model, settings).settings

@@ -17,8 +17,8 @@ c_side = 2 c_e per side, pull-off F_po/k_side, see
 :class:`~gripkit.systems.tsfm.gripper.TSFMGripper`):
 its ZOH matrices (13 dyadic levels) are recomputed per job in numba (:func:`_job_setup`: two
 9×9 matrix exponentials per finger, a small part of a grasp's cost: docs/performance.md); the free
-mode, the estimators and
-the fingers' hysteresis come from one template per gripper. The contact mode is built exactly as
+mode, the estimators and the fingers' hysteresis come from one template per gripper. The contact
+mode is built exactly as
 :func:`~gripkit.systems.tsfm.gripper.finger_hybrid` builds it (A + b_F kᵀ, [B_W, −k b_F]), so a job
 reproduces the single-grasp simulation bit for bit (tested).
 

@@ -7,8 +7,7 @@ The TSFM has no position sensor: the model itself, driven by the applied voltage
 the integrated sensor measures, is the estimator. :class:`TipPositionEstimator` runs it one sample
 at a time — exact Bouc-Wen update, then the minimal 4-state realisation of eq 11
 (:func:`gripkit.systems.tsfm.gripper.finger_minimal_state_space`) discretised exactly (ZOH) at the
-loop's
-sample time — in a numba step (:func:`estimator_step`) that a control loop can call at 20 kHz
+loop's sample time — in a numba step (:func:`estimator_step`) that a control loop can call at 20 kHz
 (its cost per call, from Python and inside a numba loop: docs/performance.md).
 
 Timing convention (the same as the simulators'): ``update(U, F)`` returns the estimate at the
