@@ -36,37 +36,61 @@ import numpy as np
 
 from ..errors import ArgumentError, DataError, ModelError
 from ..estimation import KalmanFilter
-from ..estimation.kalman import (kf_filtered_state, kf_par_offsets, kf_predicted_state,
-                                 kf_st_offsets)
 from .linear_quadratic import lqr
 
 __all__ = ["LQG", "lqg_step"]
 
 
+def _blocks(sizes):
+    out, o = {}, 0
+    for name, size in sizes:
+        out[name] = o
+        o += size
+    return out, o
+
+
 @numba.njit(cache=True, inline="always")
-def _lqg_offsets(n, m, p):  # pragma: no cover - compiled
-    """Offsets of K, M_x, M_u after the steady Kalman filter's parameters, and of r − y0, x_r,
-    u after its state vector (:func:`~gripkit.estimation.kalman.kf_par_offsets`,
-    :func:`~gripkit.estimation.kalman.kf_st_offsets`); the last of each is the vector's size."""
-    oK = kf_par_offsets(n, m, p)[12] + p * p
-    sdr = kf_st_offsets(n, m, p)[13] + n
-    return oK, oK + m * n, oK + m * n + n * p, sdr, sdr + p, sdr + p + n, sdr + p + n + m
+def _par_offsets(n, m, p):  # pragma: no cover - compiled
+    """Offsets of A, B, C, K_f, K_p, K, M_x, M_u, u0, y0 in the parameter vector."""
+    oB = n * n
+    oC = oB + n * m
+    oKf = oC + p * n
+    oKp = oKf + n * p
+    oK = oKp + n * p
+    oMx = oK + m * n
+    oMu = oMx + n * p
+    ou0 = oMu + m * p
+    return 0, oB, oC, oKf, oKp, oK, oMx, oMu, ou0, ou0 + m
+
+
+@numba.njit(cache=True, inline="always")
+def _st_offsets(n, m, p):  # pragma: no cover - compiled
+    """Offsets of x_p, x_f, e, r − y0, x_r, du, x_next, u in the state vector."""
+    sxf = n
+    se = sxf + n
+    sdr = se + p
+    sxr = sdr + p
+    sdu = sxr + n
+    sxn = sdu + m
+    return 0, sxf, se, sdr, sxr, sdu, sxn, sxn + n
 
 
 @numba.njit(cache=True, inline="always")
 def _estimate(n, m, p, par, st, y, r):  # pragma: no cover - compiled
     """e, x_f = x_p + K_f e, r − y0 and x_r = M_x (r − y0)."""
-    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = kf_par_offsets(n, m, p)
-    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = kf_st_offsets(n, m, p)
-    oK, oMx, oMu, sdr, sxr, su, size = _lqg_offsets(n, m, p)
+    oA, oB, oC, oKf, oKp, oK, oMx, oMu, ou0, oy0 = _par_offsets(n, m, p)
+    sxp, sxf, se, sdr, sxr, sdu, sxn, su = _st_offsets(n, m, p)
     for i in range(p):
         acc = y[i] - par[oy0 + i]
         for j in range(n):
             acc -= par[oC + i * n + j] * st[sxp + j]
         st[se + i] = acc
         st[sdr + i] = r[i] - par[oy0 + i]
-    kf_filtered_state(n, m, p, st, par, oKf)
     for i in range(n):
+        acc = st[sxp + i]
+        for j in range(p):
+            acc += par[oKf + i * p + j] * st[se + j]
+        st[sxf + i] = acc
         acc = 0.0
         for j in range(p):
             acc += par[oMx + i * p + j] * st[sdr + j]
@@ -81,9 +105,8 @@ def lqg_step(dims, par, st, y, r):  # pragma: no cover - compiled
     n, m, p, filtered = dims[0], dims[1], dims[2], dims[3]
     if y.shape[0] != p or r.shape[0] != p:
         return 3
-    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = kf_par_offsets(n, m, p)
-    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = kf_st_offsets(n, m, p)
-    oK, oMx, oMu, sdr, sxr, su, size = _lqg_offsets(n, m, p)
+    oA, oB, oC, oKf, oKp, oK, oMx, oMu, ou0, oy0 = _par_offsets(n, m, p)
+    sxp, sxf, se, sdr, sxr, sdu, sxn, su = _st_offsets(n, m, p)
     _estimate(n, m, p, par, st, y, r)
     sx = sxf if filtered else sxp
     for i in range(m):  # du = u_r − K (x̂ − x_r)
@@ -94,7 +117,17 @@ def lqg_step(dims, par, st, y, r):  # pragma: no cover - compiled
             acc -= par[oK + i * n + j] * (st[sx + j] - st[sxr + j])
         st[sdu + i] = acc
         st[su + i] = acc + par[ou0 + i]
-    kf_predicted_state(n, m, p, par, st, par, oKp)  # x_p ← A x_p + B du + K_p e
+    for i in range(n):  # x_p ← A x_p + B du + K_p e
+        acc = 0.0
+        for j in range(n):
+            acc += par[oA + i * n + j] * st[sxp + j]
+        for j in range(m):
+            acc += par[oB + i * m + j] * st[sdu + j]
+        for j in range(p):
+            acc += par[oKp + i * p + j] * st[se + j]
+        st[sxn + i] = acc
+    for i in range(n):
+        st[sxp + i] = st[sxn + i]
     return 0
 
 
@@ -152,11 +185,14 @@ class LQG:
         self._u0 = np.asarray(model.u_offset, dtype=np.float64).reshape(m)
         self._y0 = np.asarray(model.y_offset, dtype=np.float64).reshape(p)
         self._dims = np.array([n, m, p, int(estimate == "filtered")], dtype=np.int64)
-        self._par = np.concatenate([kf._par, self.K.ravel(), Mx.ravel(), Mu.ravel()])
-        su, size = _lqg_offsets(n, m, p)[5:]
+        self._par = np.concatenate([M.ravel() for M in (A, B, C, self.filter_gain,
+                                                        self.predictor_gain, self.K, Mx, Mu,
+                                                        self._u0, self._y0)])
+        lay, size = _blocks((("xp", n), ("xf", n), ("e", p), ("dr", p), ("xr", n), ("du", m),
+                             ("xn", n), ("u", m)))
         self._st = np.zeros(size)
-        self.x_pred = self._st[:n]
-        self._u = self._st[su:su + m]
+        self.x_pred = self._st[lay["xp"]:lay["xp"] + n]
+        self._u = self._st[lay["u"]:lay["u"] + m]
         self._u_out = self._u.view()
         self._u_out.flags.writeable = False
         self.poles = np.concatenate([np.linalg.eigvals(A - B @ self.K),

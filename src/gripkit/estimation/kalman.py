@@ -91,8 +91,11 @@ def _cholesky(S):  # pragma: no cover - compiled
 # st:  x_p (n), P_p (n×n), x_f (n), P_f (n×n), du (m), y − y0 (p), e (p), Σ (p×p),
 #      work: P_p Cᵀ (n×p), M (n×p), K_f (n×p), K_p (n×p), A P_p (n×n), x_next (n)
 
-def _layout(sizes):
-    """Offsets of the blocks ``(name, size)`` laid one after another, and the total size."""
+def _par_layout(n, m, p):
+    """Offsets of the parameter vector's blocks (names as in the comment above), and its size."""
+    sizes = (("A", n * n), ("B", n * m), ("C", p * n), ("D", p * m), ("Q", n * n), ("R", p * p),
+             ("S", n * p), ("u0", m), ("y0", p), ("Kf", n * p), ("Kp", n * p), ("Pf", n * n),
+             ("Sig", p * p))
     out, o = {}, 0
     for name, size in sizes:
         out[name] = o
@@ -100,18 +103,16 @@ def _layout(sizes):
     return out, o
 
 
-def _par_layout(n, m, p):
-    """Offsets of the parameter vector's blocks (names as in the comment above), and its size."""
-    return _layout((("A", n * n), ("B", n * m), ("C", p * n), ("D", p * m), ("Q", n * n),
-                    ("R", p * p), ("S", n * p), ("u0", m), ("y0", p), ("Kf", n * p),
-                    ("Kp", n * p), ("Pf", n * n), ("Sig", p * p)))
-
-
 def _st_layout(n, m, p):
     """Offsets of the state vector's blocks, and its size."""
-    return _layout((("xp", n), ("Pp", n * n), ("xf", n), ("Pf", n * n), ("du", m), ("yy", p),
-                    ("e", p), ("Sig", p * p), ("PCt", n * p), ("M", n * p), ("Kf", n * p),
-                    ("Kp", n * p), ("T", n * n), ("xn", n)))
+    sizes = (("xp", n), ("Pp", n * n), ("xf", n), ("Pf", n * n), ("du", m), ("yy", p), ("e", p),
+             ("Sig", p * p), ("PCt", n * p), ("M", n * p), ("Kf", n * p), ("Kp", n * p),
+             ("T", n * n), ("xn", n))
+    out, o = {}, 0
+    for name, size in sizes:
+        out[name] = o
+        o += size
+    return out, o
 
 
 @numba.njit(cache=True, inline="always")
@@ -152,7 +153,7 @@ def _flat_solve_rows(a, oL, p, ob, ox, rows):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, inline="always")
-def kf_par_offsets(n, m, p):  # pragma: no cover - compiled
+def _par_offsets(n, m, p):  # pragma: no cover - compiled
     """Offsets of A, B, C, D, Q, R, S, u0, y0, K_f, K_p, P_f, Σ in the parameter vector."""
     oB = n * n
     oC = oB + n * m
@@ -169,7 +170,7 @@ def kf_par_offsets(n, m, p):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, inline="always")
-def kf_st_offsets(n, m, p):  # pragma: no cover - compiled
+def _st_offsets(n, m, p):  # pragma: no cover - compiled
     """Offsets of x_p, P_p, x_f, P_f, du, y − y0, e, Σ, P_p Cᵀ, M, K_f, K_p, T, x_next in the
     state vector."""
     sPp = n
@@ -190,8 +191,8 @@ def kf_st_offsets(n, m, p):  # pragma: no cover - compiled
 @numba.njit(cache=True, inline="always")
 def _kf_innovation(n, m, p, par, st, u, y):  # pragma: no cover - compiled
     """du = u − u0, y − y0, e = y − y0 − C x_p − D du."""
-    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = kf_par_offsets(n, m, p)
-    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = kf_st_offsets(n, m, p)
+    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = _par_offsets(n, m, p)
+    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
     for j in range(m):
         st[sdu + j] = u[j] - par[ou0 + j]
     for i in range(p):
@@ -221,8 +222,8 @@ def _flat_mul_add(c, oc, a, oa, b, ob, out, oo, rows, cols, inner):  # pragma: n
 def _kf_gains(n, m, p, par, st):  # pragma: no cover - compiled
     """The time-varying gains: P_p Cᵀ, Σ = R + C P_p Cᵀ (factored), M = S + A P_p Cᵀ,
     K_f = P_p Cᵀ Σ⁻¹, K_p = M Σ⁻¹. False if Σ is not positive definite."""
-    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = kf_par_offsets(n, m, p)
-    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = kf_st_offsets(n, m, p)
+    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = _par_offsets(n, m, p)
+    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
     for i in range(n):  # P_p Cᵀ
         for j in range(p):
             acc = 0.0
@@ -239,23 +240,16 @@ def _kf_gains(n, m, p, par, st):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, inline="always")
-def kf_filtered_state(n, m, p, st, g, ogf):  # pragma: no cover - compiled
-    """x_f = x_p + K_f e on the state vector ``st``; the gain K_f is the block of ``g`` at
-    ``ogf``."""
-    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = kf_st_offsets(n, m, p)
+def _kf_states(n, m, p, par, st, g, ogf, ogp):  # pragma: no cover - compiled
+    """x_f = x_p + K_f e, x_p ← A x_p + B du + K_p e (through x_next); the gains K_f, K_p are
+    the blocks of ``g`` at ``ogf``, ``ogp``."""
+    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = _par_offsets(n, m, p)
+    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
     for i in range(n):
         acc = st[sxp + i]
         for j in range(p):
             acc += g[ogf + i * p + j] * st[se + j]
         st[sxf + i] = acc
-
-
-@numba.njit(cache=True, inline="always")
-def kf_predicted_state(n, m, p, par, st, g, ogp):  # pragma: no cover - compiled
-    """x_p ← A x_p + B du + K_p e (through x_next) on the state vector ``st``; the gain K_p is
-    the block of ``g`` at ``ogp``."""
-    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = kf_par_offsets(n, m, p)
-    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = kf_st_offsets(n, m, p)
     for i in range(n):
         acc = 0.0
         for j in range(n):
@@ -273,8 +267,8 @@ def kf_predicted_state(n, m, p, par, st, g, ogp):  # pragma: no cover - compiled
 def _kf_covariances(n, m, p, par, st):  # pragma: no cover - compiled
     """P_f = P_p − K_f (P_p Cᵀ)ᵀ, P_p ← Q + A P_p Aᵀ − K_p Mᵀ (symmetric parts), and Σ rebuilt
     from its Cholesky factor."""
-    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = kf_par_offsets(n, m, p)
-    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = kf_st_offsets(n, m, p)
+    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = _par_offsets(n, m, p)
+    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
     for i in range(n):
         for j in range(n):
             acc = st[sPp + i * n + j]
@@ -323,12 +317,11 @@ def kf_step_packed(dims, par, st, u, y):  # pragma: no cover - compiled
         return 2
     if y.shape[0] != p:
         return 3
-    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = kf_par_offsets(n, m, p)
-    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = kf_st_offsets(n, m, p)
+    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = _par_offsets(n, m, p)
+    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
     _kf_innovation(n, m, p, par, st, u, y)
     if steady:  # fixed gains and covariances
-        kf_filtered_state(n, m, p, st, par, oKf)
-        kf_predicted_state(n, m, p, par, st, par, oKp)
+        _kf_states(n, m, p, par, st, par, oKf, oKp)
         for i in range(n * n):
             st[sPf + i] = par[oPs + i]
         for i in range(p * p):
@@ -337,8 +330,7 @@ def kf_step_packed(dims, par, st, u, y):  # pragma: no cover - compiled
     if not _kf_gains(n, m, p, par, st):
         return 1
     _kf_covariances(n, m, p, par, st)  # reads P_p before the states step overwrites x only
-    kf_filtered_state(n, m, p, st, st, sKf)
-    kf_predicted_state(n, m, p, par, st, st, sKp)
+    _kf_states(n, m, p, par, st, st, sKf, sKp)
     return 0
 
 
@@ -348,7 +340,7 @@ def kf_run_packed(dims, par, st, U, Y, xs, Ps, es, Ss):  # pragma: no cover - co
     covariances, the innovations and their covariances into xs, Ps, es, Ss. Returns
     (code, k): the first failing sample's code and index, or (0, N)."""
     n, m, p = dims[0], dims[1], dims[2]
-    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = kf_st_offsets(n, m, p)
+    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
     for k in range(U.shape[0]):
         code = kf_step_packed(dims, par, st, U[k], Y[k])
         if code:
