@@ -231,7 +231,7 @@ def _jac_given(Jf, x, u, J):  # pragma: no cover - compiled
     return True
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _linearised(fn, Jfn, x, u, J, xt, size, code):  # pragma: no cover - compiled
     """``(fn(x, u), 0)`` with its Jacobian at x in ``J`` (``Jfn`` None: central differences;
     numba prunes the other branch); ``(v, code)`` when fn returns other than ``size`` values,
@@ -301,7 +301,7 @@ def _sigma_points(x, P, c, L, X):  # pragma: no cover - compiled
     return True
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _weighted_mean(W, Z, out):  # pragma: no cover - compiled
     """``out[j] = Σ_i W[i] Z[i, j]`` (the sigma points' weighted mean), summed in order of i."""
     for j in range(out.shape[0]):
