@@ -86,3 +86,10 @@ def test_interconnection_checks():
         feedback(g, 1.0, sign=2)
     with pytest.raises(ModelError, match="at least two systems"):
         series(g)
+    two_inputs = StateSpace(np.eye(1), np.ones((1, 2)), np.ones((1, 1)))
+    with pytest.raises(ModelError, match=r"parallel: g2 must be 1×1 \(the shape of g1\), "
+                                         "found 1×2"):
+        parallel(g, two_inputs)
+    with pytest.raises(ModelError, match=r"feedback: the controller must be 2×1 \(plant "
+                                         r"outputs → plant inputs\), found 1×1"):
+        feedback(two_inputs, TransferFunction([1.0], [1.0, 1.0]))

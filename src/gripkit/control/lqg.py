@@ -36,17 +36,10 @@ import numpy as np
 
 from ..errors import ArgumentError, DataError, ModelError
 from ..estimation import KalmanFilter
+from ..estimation.kalman import block_offsets, predicted_state
 from .linear_quadratic import lqr
 
 __all__ = ["LQG", "lqg_step"]
-
-
-def _blocks(sizes):
-    out, o = {}, 0
-    for name, size in sizes:
-        out[name] = o
-        o += size
-    return out, o
 
 
 @numba.njit(cache=True, inline="always")
@@ -117,17 +110,7 @@ def lqg_step(dims, par, st, y, r):  # pragma: no cover - compiled
             acc -= par[oK + i * n + j] * (st[sx + j] - st[sxr + j])
         st[sdu + i] = acc
         st[su + i] = acc + par[ou0 + i]
-    for i in range(n):  # x_p ← A x_p + B du + K_p e
-        acc = 0.0
-        for j in range(n):
-            acc += par[oA + i * n + j] * st[sxp + j]
-        for j in range(m):
-            acc += par[oB + i * m + j] * st[sdu + j]
-        for j in range(p):
-            acc += par[oKp + i * p + j] * st[se + j]
-        st[sxn + i] = acc
-    for i in range(n):
-        st[sxp + i] = st[sxn + i]
+    predicted_state(n, m, p, par, oA, oB, par, oKp, st, (sxp, sdu, se, sxn))
     return 0
 
 
@@ -188,7 +171,7 @@ class LQG:
         self._par = np.concatenate([M.ravel() for M in (A, B, C, self.filter_gain,
                                                         self.predictor_gain, self.K, Mx, Mu,
                                                         self._u0, self._y0)])
-        lay, size = _blocks((("xp", n), ("xf", n), ("e", p), ("dr", p), ("xr", n), ("du", m),
+        lay, size = block_offsets((("xp", n), ("xf", n), ("e", p), ("dr", p), ("xr", n), ("du", m),
                              ("xn", n), ("u", m)))
         self._st = np.zeros(size)
         self.x_pred = self._st[lay["xp"]:lay["xp"] + n]

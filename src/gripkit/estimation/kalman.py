@@ -91,28 +91,28 @@ def _cholesky(S):  # pragma: no cover - compiled
 # st:  x_p (n), P_p (n×n), x_f (n), P_f (n×n), du (m), y − y0 (p), e (p), Σ (p×p),
 #      work: P_p Cᵀ (n×p), M (n×p), K_f (n×p), K_p (n×p), A P_p (n×n), x_next (n)
 
-def _par_layout(n, m, p):
-    """Offsets of the parameter vector's blocks (names as in the comment above), and its size."""
-    sizes = (("A", n * n), ("B", n * m), ("C", p * n), ("D", p * m), ("Q", n * n), ("R", p * p),
-             ("S", n * p), ("u0", m), ("y0", p), ("Kf", n * p), ("Kp", n * p), ("Pf", n * n),
-             ("Sig", p * p))
+def block_offsets(sizes) -> tuple[dict, int]:
+    """Offsets of the blocks ``(name, size)`` of a packed vector, laid one after another, and
+    the vector's size (the layouts of the filter's and the LQG controller's vectors)."""
     out, o = {}, 0
     for name, size in sizes:
         out[name] = o
         o += size
     return out, o
+
+
+def _par_layout(n, m, p):
+    """Offsets of the parameter vector's blocks (names as in the comment above), and its size."""
+    return block_offsets((("A", n * n), ("B", n * m), ("C", p * n), ("D", p * m), ("Q", n * n),
+                          ("R", p * p), ("S", n * p), ("u0", m), ("y0", p), ("Kf", n * p),
+                          ("Kp", n * p), ("Pf", n * n), ("Sig", p * p)))
 
 
 def _st_layout(n, m, p):
     """Offsets of the state vector's blocks, and its size."""
-    sizes = (("xp", n), ("Pp", n * n), ("xf", n), ("Pf", n * n), ("du", m), ("yy", p), ("e", p),
-             ("Sig", p * p), ("PCt", n * p), ("M", n * p), ("Kf", n * p), ("Kp", n * p),
-             ("T", n * n), ("xn", n))
-    out, o = {}, 0
-    for name, size in sizes:
-        out[name] = o
-        o += size
-    return out, o
+    return block_offsets((("xp", n), ("Pp", n * n), ("xf", n), ("Pf", n * n), ("du", m),
+                          ("yy", p), ("e", p), ("Sig", p * p), ("PCt", n * p), ("M", n * p),
+                          ("Kf", n * p), ("Kp", n * p), ("T", n * n), ("xn", n)))
 
 
 @numba.njit(cache=True, inline="always")
@@ -250,6 +250,15 @@ def _kf_states(n, m, p, par, st, g, ogf, ogp):  # pragma: no cover - compiled
         for j in range(p):
             acc += g[ogf + i * p + j] * st[se + j]
         st[sxf + i] = acc
+    predicted_state(n, m, p, par, oA, oB, g, ogp, st, (sxp, sdu, se, sxn))
+
+
+@numba.njit(cache=True, inline="always")
+def predicted_state(n, m, p, par, oA, oB, g, ogp, st, so):  # pragma: no cover - compiled
+    """x_p ← A x_p + B du + K_p e (through x_next) on a packed state vector ``st`` whose x_p, du,
+    e, x_next blocks start at ``so``; A, B are the blocks of ``par`` at ``oA``, ``oB``, K_p the
+    block of ``g`` at ``ogp`` (row-major; each sum in ascending order)."""
+    sxp, sdu, se, sxn = so
     for i in range(n):
         acc = 0.0
         for j in range(n):

@@ -231,28 +231,34 @@ def _jac_given(Jf, x, u, J):  # pragma: no cover - compiled
     return True
 
 
+@numba.njit(cache=True, inline="always")
+def _linearised(fn, Jfn, x, u, J, xt, size, code):  # pragma: no cover - compiled
+    """``(fn(x, u), 0)`` with its Jacobian at x in ``J`` (``Jfn`` None: central differences;
+    numba prunes the other branch); ``(v, code)`` when fn returns other than ``size`` values,
+    ``(v, 6)`` when ``Jfn`` returns the wrong shape."""
+    v = fn(x, u)
+    if v.shape[0] != size:
+        return v, code
+    if Jfn is None:
+        _jac_central(fn, x, u, J, xt)
+    elif not _jac_given(Jfn, x, u, J):
+        return v, 6
+    return v, 0
+
+
 @numba.njit(cache=True)
 def _ekf_step_jit(f, h, Fj, Hj, noise, u, y, s, w):  # pragma: no cover - compiled
-    """One EKF step calling numba ``f``, ``h`` and ``Fj``, ``Hj`` (None: central differences;
-    numba prunes the other branch). 0 done, 1 Σ not positive definite (the prediction is then
-    left as it was), 4 ``f`` or 5 ``h`` returned the wrong length, 6 a Jacobian the wrong
-    shape."""
-    hx = h(s.xp, u)
-    if hx.shape[0] != noise.R.shape[0]:
-        return 5
-    if Hj is None:
-        _jac_central(h, s.xp, u, w.H, w.xt)
-    elif not _jac_given(Hj, s.xp, u, w.H):
-        return 6
+    """One EKF step calling numba ``f``, ``h`` and ``Fj``, ``Hj`` (None: central differences).
+    0 done, 1 Σ not positive definite (the prediction is then left as it was), 4 ``f`` or 5
+    ``h`` returned the wrong length, 6 a Jacobian the wrong shape."""
+    hx, code = _linearised(h, Hj, s.xp, u, w.H, w.xt, noise.R.shape[0], 5)
+    if code:
+        return code
     if not _ekf_update(s, w, hx, noise.R, y):
         return 1
-    fx = f(s.xf, u)
-    if fx.shape[0] != s.xp.shape[0]:
-        return 4
-    if Fj is None:
-        _jac_central(f, s.xf, u, w.F, w.xt)
-    elif not _jac_given(Fj, s.xf, u, w.F):
-        return 6
+    fx, code = _linearised(f, Fj, s.xf, u, w.F, w.xt, s.xp.shape[0], 4)
+    if code:
+        return code
     for i in range(s.xp.shape[0]):
         s.xp[i] = fx[i]
     _ekf_predict(s, w, noise.Q)
@@ -295,16 +301,22 @@ def _sigma_points(x, P, c, L, X):  # pragma: no cover - compiled
     return True
 
 
+@numba.njit(cache=True, inline="always")
+def _weighted_mean(W, Z, out):  # pragma: no cover - compiled
+    """``out[j] = Σ_i W[i] Z[i, j]`` (the sigma points' weighted mean), summed in order of i."""
+    for j in range(out.shape[0]):
+        acc = 0.0
+        for i in range(Z.shape[0]):
+            acc += W[i] * Z[i, j]
+        out[j] = acc
+
+
 @numba.njit(cache=True)
 def _ukf_update(s, w, R, y):  # pragma: no cover - compiled
     """The UKF measurement update (module docstring) from the sigma points ``w.X`` and their
     images ``w.Yp[i] = h(X[i], u)``."""
     n, p, ns = s.xp.shape[0], R.shape[0], w.X.shape[0]
-    for j in range(p):
-        acc = 0.0
-        for i in range(ns):
-            acc += w.Wm[i] * w.Yp[i, j]
-        w.yhat[j] = acc
+    _weighted_mean(w.Wm, w.Yp, w.yhat)
     for a in range(p):
         for b in range(p):
             acc = R[a, b]
@@ -324,11 +336,7 @@ def _ukf_update(s, w, R, y):  # pragma: no cover - compiled
 def _ukf_predict(s, w, Q):  # pragma: no cover - compiled
     """x_p = Σ W^m_i Xn_i, P_p = Σ W^c_i (Xn_i − x_p)(·)ᵀ + Q."""
     n, ns = s.xp.shape[0], w.Xn.shape[0]
-    for j in range(n):
-        acc = 0.0
-        for i in range(ns):
-            acc += w.Wm[i] * w.Xn[i, j]
-        s.xp[j] = acc
+    _weighted_mean(w.Wm, w.Xn, s.xp)
     for a in range(n):
         for b in range(a, n):
             acc = Q[a, b]
@@ -549,7 +557,9 @@ def _model_functions(filt, model, x0, dt):
 
 class _NonlinearFilter:
     """What the EKF and UKF share: the state record, the checks, the ``step``/``run`` plumbing.
-    ``x_pred``, ``P_pred``, ``x``, ``P`` are the arrays of the state record."""
+    ``x_pred``, ``P_pred``, ``x``, ``P`` are the arrays of the state record. A subclass defines
+    ``_step_python(u, y)``, one sample with Python-called ``f`` and ``h``, returning 0 or a
+    failure code of ``_FAIL``."""
 
     _name = "filter"
     _FAIL = {1: "the innovation covariance is not positive definite",
@@ -604,7 +614,14 @@ class _NonlinearFilter:
         """The last step's innovation ``e`` (p,) (a copy)."""
         return self._s.e.copy()
 
-    def _out(self, code, copy):
+    def step(self, u, y, *, copy: bool = True):
+        """One sample: ``(x[t|t], P[t|t])`` (copies; ``copy=False``: the filter's own arrays,
+        overwritten by the next step)."""
+        u, y = self._sample(u, y)
+        if self._jit:
+            code = self._kernels[0](self._dims, self._buf, u, y)
+        else:
+            code = self._step_python(u, y)
         if code:
             self._raise(code, "step")
         if copy:
@@ -732,22 +749,17 @@ class ExtendedKalmanFilter(_NonlinearFilter):
             self._raise(code, "step")
         return v
 
-    def step(self, u, y, *, copy: bool = True):
-        """One sample: ``(x[t|t], P[t|t])`` (copies; ``copy=False``: the filter's own arrays,
-        overwritten by the next step)."""
-        u, y = self._sample(u, y)
+    def _step_python(self, u, y) -> int:
         s, w = self._s, self._w
-        if self._jit:
-            return self._out(self._kernels[0](self._dims, self._buf, u, y), copy)
         hx = self._fn(self.h, s.xp, u, self.p, 5)
         self._jacobian(self.h, w.H, s.xp, u, self.Hj)
         if not _ekf_update(s, w, hx, self.noise.R, y):
-            return self._out(1, copy)
+            return 1
         fx = self._fn(self.f, s.xf, u, self.n, 4)
         self._jacobian(self.f, w.F, s.xf, u, self.Fj)
         s.xp[:] = fx
         _ekf_predict(s, w, self.noise.Q)
-        return self._out(0, copy)
+        return 0
 
 
 
@@ -768,10 +780,14 @@ class UnscentedKalmanFilter(_NonlinearFilter):
 
     Examples
     --------
-    >>> ukf = UnscentedKalmanFilter(lambda x, u: 0.9 * x + u, lambda x, u: x, Q=[[0.1]],
-    ...                             R=[[1.0]], P0=[[1.0]])
-    >>> x, P = ukf.step([0.0], [2.0]); x.round(6).tolist(), P.round(6).tolist()
-    ([1.0], [[0.5]])
+    A measurement y = x² of x ~ N(1, 0.1): the sigma points carry its mean E[x²] = 1 + 0.1
+    exactly, so the innovation of y = 1.2 is 0.1 (a linearisation at x = 1 predicts 1, and 0.2).
+
+    >>> ukf = UnscentedKalmanFilter(lambda x, u: x, lambda x, u: x ** 2, Q=[[0.01]], R=[[0.1]],
+    ...                             x0=[1.0], P0=[[0.1]])
+    >>> x, P = ukf.step([0.0], [1.2])
+    >>> ukf.innovation.round(6).tolist(), x.round(6).tolist()
+    ([0.1], [1.038462])
     """
 
     _name = "UnscentedKalmanFilter"
@@ -814,20 +830,15 @@ class UnscentedKalmanFilter(_NonlinearFilter):
                 self._raise(code, "step")
             out[i] = v
 
-    def step(self, u, y, *, copy: bool = True):
-        """One sample: ``(x[t|t], P[t|t])`` (copies; ``copy=False``: the filter's own arrays,
-        overwritten by the next step)."""
-        u, y = self._sample(u, y)
+    def _step_python(self, u, y) -> int:
         s, w = self._s, self._w
-        if self._jit:
-            return self._out(self._kernels[0](self._dims, self._buf, u, y), copy)
         if not _sigma_points(s.xp, s.Pp, self.c, w.L, w.X):
-            return self._out(1, copy)
+            return 1
         self._through(self.h, w.X, u, w.Yp, 5)
         if not _ukf_update(s, w, self.noise.R, y):
-            return self._out(2, copy)
+            return 2
         if not _sigma_points(s.xf, s.Pf, self.c, w.L, w.X):
-            return self._out(3, copy)
+            return 3
         self._through(self.f, w.X, u, w.Xn, 4)
         _ukf_predict(s, w, self.noise.Q)
-        return self._out(0, copy)
+        return 0

@@ -282,6 +282,30 @@ class LinearSystem:
             cov[bad] = np.inf
         return lam, cov
 
+    def frequency_response(self, w) -> np.ndarray:
+        """G at angular frequencies ``w`` (rad/s), shape (len(w), p, m), at s = jω, or
+        z = e^{jω dt} when discrete: ``C (sI − A)⁻¹ B + D`` for a :class:`StateSpace`,
+        num(s)/den(s) for a :class:`TransferFunction` (ModelError when s is a pole).
+
+        Parameters
+        ----------
+        w
+            Angular frequencies (rad/s), shape (N,).
+
+        Returns
+        -------
+        ndarray of complex, shape (N, p, m)
+
+        Examples
+        --------
+        >>> from gripkit.lti import StateSpace, TransferFunction
+        >>> StateSpace([[-1.0]], [[1.0]], [[1.0]]).frequency_response([1.0])[0, 0, 0]
+        np.complex128(0.5-0.5j)
+        >>> TransferFunction([1.0], [1.0, 1.0]).frequency_response([1.0])[0, 0, 0]
+        np.complex128(0.5-0.5j)
+        """
+        return self._response(self._s(w))
+
     def frequency_response_covariance(self, w) -> np.ndarray:
         """Covariance of (Re G, Im G) at each ω (rad/s), shape (len(w), p, m, 2, 2), to first
         order in the parameters (see :class:`Uncertainty`).
@@ -318,6 +342,42 @@ class LinearSystem:
         return Bode(w, H, cov)
 
     # ------------------------------------------------------------------ time responses
+    def simulate(self, u, x0=None) -> np.ndarray:
+        """Outputs y (N, p) of a discrete system for inputs ``u`` (N, m) (or (N,) with one
+        input) from state ``x0`` (default rest). A :class:`StateSpace` runs the recursion
+        x[k+1] = A x[k] + B u[k], y[k] = C x[k] + D u[k] (a numba kernel,
+        :func:`gripkit.lti.simulate_ss`); a :class:`TransferFunction` runs its observable
+        canonical realisation (:meth:`TransferFunction.to_ss` with ``minimal=False``), a SISO
+        one by ``scipy.signal.lfilter``, whose state (transposed direct form II) is that
+        realisation's: O(n) per sample.
+
+        Parameters
+        ----------
+        u
+            Inputs, shape (N, m) in the units of ``input_units``.
+        x0
+            Initial state: a StateSpace's, shape (n,); a TransferFunction's observable
+            realisation's (its size is the sum of the entries' degrees; see
+            :meth:`TransferFunction.initial_state`). Default zero.
+
+        Returns
+        -------
+        ndarray, shape (N, p)
+
+        Examples
+        --------
+        >>> from gripkit.lti import StateSpace, TransferFunction
+        >>> StateSpace([[0.5]], [[1.0]], [[1.0]], dt=1.0).simulate([1.0, 0.0, 0.0])[:, 0].tolist()
+        [0.0, 1.0, 0.5]
+        >>> TransferFunction.from_polynomials([1, -0.5], [0, 1.0],
+        ...                                   dt=1.0).simulate([1.0, 0, 0])[:, 0].tolist()
+        [0.0, 1.0, 0.5]
+        """
+        if not self.is_discrete:
+            raise ModelError("simulate: the system is continuous; it needs a sample time",
+                             hint="discretise it first: sys.c2d(dt)")
+        return self._simulate(as_input_array(u, self.n_inputs), x0)
+
     def _time_grid(self, t) -> tuple[int, float]:
         if self.is_discrete:
             if np.ndim(t) == 0:
@@ -358,6 +418,7 @@ class LinearSystem:
         Returns
         -------
         ndarray, shape (N, p, m)
+            ``[k, i, j]``: output i at sample k after the step on input j.
 
         Examples
         --------
@@ -366,13 +427,8 @@ class LinearSystem:
         >>> y[:, 0, 0].tolist()
         [0.0, 0.5, 0.75, 0.875]
         """
-        N, h = self._time_grid(t)
-        A, B, C, D = self._sampled(h)
-        out = np.empty((N, C.shape[0], B.shape[1]))
-        for j in range(B.shape[1]):
-            out[:, :, j] = (_simulate_arrays(A, B[:, j:j + 1], C, D[:, j:j + 1], np.ones((N, 1)),
-                                             None))
-        return out
+        return self._input_responses(t, lambda A, B, C, D, N, j: _simulate_arrays(
+            A, B[:, j:j + 1], C, D[:, j:j + 1], np.ones((N, 1)), None))
 
     def impulse(self, t) -> np.ndarray:
         """Impulse responses from rest, shape (N, p, m). Discrete: the response to a unit pulse
@@ -386,7 +442,8 @@ class LinearSystem:
 
         Returns
         -------
-        ndarray, shape (N, p, m)
+        ndarray
+            As for :meth:`step`, the impulse in place of the step.
 
         Examples
         --------
@@ -394,18 +451,25 @@ class LinearSystem:
         >>> TransferFunction([0.5], [1.0, -0.5], dt=1.0).impulse(3)[:, 0, 0].tolist()
         [0.0, 0.5, 0.25]
         """
+        return self._input_responses(t, self._impulse_column)
+
+    def _impulse_column(self, A, B, C, D, N, j):
+        """The response (N, p) to an impulse on input j (see :meth:`impulse`)."""
+        if self.is_discrete:
+            u = np.zeros((N, 1))
+            u[0] = 1.0
+            return _simulate_arrays(A, B[:, j:j + 1], C, D[:, j:j + 1], u, None)
+        return _simulate_arrays(A, np.zeros((A.shape[0], 1)), C, np.zeros((C.shape[0], 1)),
+                                np.zeros((N, 1)), self.to_ss(minimal=False).B[:, j])
+
+    def _input_responses(self, t, column):
+        """(N, p, m) on the time grid ``t``: ``[:, :, j] = column(A, B, C, D, N, j)``, with
+        (A, B, C, D) the realisation sampled at the grid's step (:meth:`_sampled`)."""
         N, h = self._time_grid(t)
         A, B, C, D = self._sampled(h)
         out = np.empty((N, C.shape[0], B.shape[1]))
         for j in range(B.shape[1]):
-            if self.is_discrete:
-                u = np.zeros((N, 1))
-                u[0] = 1.0
-                out[:, :, j] = _simulate_arrays(A, B[:, j:j + 1], C, D[:, j:j + 1], u, None)
-            else:
-                out[:, :, j] = _simulate_arrays(A, np.zeros((A.shape[0], 1)), C,
-                                                np.zeros((C.shape[0], 1)),
-                                                np.zeros((N, 1)), self.to_ss(minimal=False).B[:, j])
+            out[:, :, j] = column(A, B, C, D, N, j)
         return out
 
     # ------------------------------------------------------------------ discretisation
@@ -486,9 +550,9 @@ class LinearSystem:
         Examples
         --------
         >>> from gripkit.lti import TransferFunction
-        >>> TransferFunction([1.0], [1.0, 1.0]).series(
-        ...     TransferFunction([3.0], [1.0, 3.0])).dc_gain().tolist()
-        [[1.0]]
+        >>> g = TransferFunction([1.0], [1.0, 1.0])
+        >>> g.series(TransferFunction([3.0], [1.0, 3.0])).denominator().tolist()
+        [1.0, 4.0, 3.0]
         """
         return series(self, other)
 
@@ -498,9 +562,8 @@ class LinearSystem:
         Examples
         --------
         >>> from gripkit.lti import TransferFunction
-        >>> TransferFunction([1.0], [1.0, 1.0]).parallel(
-        ...     TransferFunction([3.0], [1.0, 3.0])).dc_gain().tolist()
-        [[2.0]]
+        >>> TransferFunction([1.0], [1.0, 1.0]).parallel(2.0).dc_gain().tolist()  # a static gain
+        [[3.0]]
         """
         return parallel(self, other)
 
@@ -846,26 +909,9 @@ class StateSpace(LinearSystem):
             return self.C @ np.linalg.solve(M, self.B) + self.D
         return self.D.copy()
 
-    def frequency_response(self, w) -> np.ndarray:
-        """G at angular frequencies ``w`` (rad/s), shape (len(w), p, m):
-        ``C (sI − A)⁻¹ B + D`` with s = jω, or z = e^{jω dt} when discrete.
-
-        Parameters
-        ----------
-        w
-            Angular frequencies (rad/s), shape (N,).
-
-        Returns
-        -------
-        ndarray of complex, shape (N, p, m)
-
-        Examples
-        --------
-        >>> from gripkit.lti import StateSpace
-        >>> StateSpace([[-1.0]], [[1.0]], [[1.0]]).frequency_response([1.0])[0, 0, 0]
-        np.complex128(0.5-0.5j)
-        """
-        return _ss_frequency(self.A, self.B, self.C, self.D, self._s(w))[0]
+    def _response(self, s):
+        """``C (sI − A)⁻¹ B + D`` at each s."""
+        return _ss_frequency(self.A, self.B, self.C, self.D, s)[0]
 
     def _frequency_jacobian(self, s):
         _, X, Y = _ss_frequency(self.A, self.B, self.C, self.D, s)
@@ -874,33 +920,10 @@ class StateSpace(LinearSystem):
                 + np.einsum("kpn,fnm->kfpm", dC, X) + dD[:, None])
 
     # ------------------------------------------------------------------ simulation
-    def simulate(self, u, x0=None) -> np.ndarray:
-        """Outputs y (N, p) of a discrete system for inputs ``u`` (N, m) (or (N,) with one
-        input) from state ``x0`` (default 0), by the recursion of the class docstring (a numba
-        kernel, :func:`gripkit.lti.simulate_ss`).
-
-        Parameters
-        ----------
-        u
-            Inputs, shape (N, m) in the units of ``input_units``.
-        x0
-            Initial state, shape (n,); default zero.
-
-        Returns
-        -------
-        ndarray, shape (N, p)
-
-        Examples
-        --------
-        >>> from gripkit.lti import StateSpace
-        >>> StateSpace([[0.5]], [[1.0]], [[1.0]], dt=1.0).simulate([1.0, 0.0, 0.0])[:, 0].tolist()
-        [0.0, 1.0, 0.5]
-        """
-        if not self.is_discrete:
-            raise ModelError("simulate: the system is continuous; it needs a sample time",
-                             hint="discretise it first: sys.c2d(dt)")
-        return (_simulate_arrays(self.A, self.B, self.C, self.D, as_input_array(u, self.n_inputs),
-                                 x0))
+    def _simulate(self, u, x0):
+        """The recursion of the class docstring (a numba kernel,
+        :func:`gripkit.lti.simulate_ss`)."""
+        return _simulate_arrays(self.A, self.B, self.C, self.D, u, x0)
 
     # ------------------------------------------------------------------ conversions
     def to_ss(self, minimal: bool = False) -> StateSpace:
@@ -1379,26 +1402,8 @@ class TransferFunction(LinearSystem):
         bound = self.num.shape[2] * _EPS * _polyval(np.abs(self.den), np.abs(s))
         return _polyval(self.num, s), _polyval(self.den, s), bound
 
-    def frequency_response(self, w) -> np.ndarray:
-        """G at angular frequencies ``w`` (rad/s), shape (len(w), p, m): num(s)/den(s) at
-        s = jω, or z = e^{jω dt} when discrete.
-
-        Parameters
-        ----------
-        w
-            Angular frequencies (rad/s), shape (N,).
-
-        Returns
-        -------
-        ndarray of complex, shape (N, p, m)
-
-        Examples
-        --------
-        >>> from gripkit.lti import TransferFunction
-        >>> TransferFunction([1.0], [1.0, 1.0]).frequency_response([1.0])[0, 0, 0]
-        np.complex128(0.5-0.5j)
-        """
-        s = self._s(w)
+    def _response(self, s):
+        """num(s)/den(s) of every entry at each s; ModelError at a pole."""
         nu, de, bound = self._eval(s)
         bad = np.abs(de) <= bound  # a pole on the evaluation contour
         if np.any(bad):
@@ -1463,35 +1468,10 @@ class TransferFunction(LinearSystem):
         from scipy import signal
         return signal.lfiltic(nu, de, yp[::-1][:de.size - 1], up[::-1][:de.size - 1])
 
-    def simulate(self, u, x0=None) -> np.ndarray:
-        """Outputs y (N, p) for inputs ``u`` (N, m) (or (N,)) of a discrete system, through its
-        observable canonical realisation (:meth:`to_ss` with ``minimal=False``), from ``x0``
-        (default rest; see :meth:`initial_state`). A SISO system runs ``scipy.signal.lfilter``,
-        whose state (transposed direct form II) is that realisation's: O(n) per sample.
-
-        Parameters
-        ----------
-        u
-            Inputs, shape (N, m).
-        x0
-            Initial state of the observable realisation (its size is the sum of the entries'
-            degrees); default rest.
-
-        Returns
-        -------
-        ndarray, shape (N, p)
-
-        Examples
-        --------
-        >>> from gripkit.lti import TransferFunction
-        >>> TransferFunction.from_polynomials([1, -0.5], [0, 1.0],
-        ...                                   dt=1.0).simulate([1.0, 0, 0])[:, 0].tolist()
-        [0.0, 1.0, 0.5]
-        """
-        if not self.is_discrete:
-            raise ModelError("simulate: the system is continuous; it needs a sample time",
-                             hint="discretise it first: sys.c2d(dt)")
-        u = as_input_array(u, self.n_inputs)
+    def _simulate(self, u, x0):
+        """Through the observable canonical realisation (:meth:`to_ss` with ``minimal=False``);
+        a SISO system runs ``scipy.signal.lfilter``, whose state (transposed direct form II) is
+        that realisation's: O(n) per sample."""
         if self.is_siso:
             nu, de = self._entry(0, 0)
             if de.size == 1:
@@ -1626,6 +1606,17 @@ def _as_system(x, like: LinearSystem, n_in: int, n_out: int):
                        dt=like.dt))
 
 
+def _operand(x, like: LinearSystem, n_out: int, n_in: int, what: str, role: str, why: str):
+    """``x`` (a system, or a static gain made one) checked to share ``like``'s time base and to
+    have ``n_out`` outputs and ``n_in`` inputs: (system, dt)."""
+    g = _as_system(x, like, n_in, n_out)
+    dt = same_dt(like.dt, g.dt, what)
+    if (g.n_outputs, g.n_inputs) != (n_out, n_in):
+        raise ModelError(f"{what}: {role} must be {n_out}×{n_in} ({why}), found "
+                         f"{g.n_outputs}×{g.n_inputs}")
+    return g, dt
+
+
 def series(*systems: LinearSystem) -> LinearSystem:
     """u → G₁ → G₂ → … → y: ``G = G_k ⋯ G₂ G₁`` (the first system acts first).
 
@@ -1644,6 +1635,7 @@ def series(*systems: LinearSystem) -> LinearSystem:
     Returns
     -------
     LinearSystem
+        Inputs named and united as the first system's, outputs as the last's.
 
     Examples
     --------
@@ -1666,13 +1658,20 @@ def _series2(g1, g2):
         raise ModelError(f"series: the first system has {g1.n_outputs} outputs but the second "
                          f"{g2.n_inputs} inputs")
     _check_units(g1.output_units, g2.input_units, "series")
-    sig = dict(dt=dt, inputs=g1.inputs, outputs=g2.outputs, input_units=g1.input_units,
-               output_units=g2.output_units, meta={})
+    return _connected(g1, g2, dict(dt=dt, inputs=g1.inputs, outputs=g2.outputs,
+                                   input_units=g1.input_units, output_units=g2.output_units,
+                                   meta={}), _connect.tf_series, _connect.ss_series)
+
+
+def _connected(g1, g2, sig, tf_op, ss_op):
+    """The interconnection of ``g1`` and ``g2`` with signals ``sig``: a SISO transfer function
+    by ``tf_op`` on their (num, den) when both are SISO transfer functions, else a state space
+    by ``ss_op`` on their realisations' arrays (state [x₁; x₂]); the covariance pushed
+    through either map."""
     if _both_siso_tf(g1, g2):
-        return _siso_tf_op(_connect.tf_series, g1, g2, sig)
+        return _siso_tf_op(tf_op, g1, g2, sig)
     s1, s2 = g1.to_ss(minimal=False), g2.to_ss(minimal=False)
-    arrs, unc = (push(_connect.ss_series, [s1._arrays(), s2._arrays()],
-                      [s1.uncertainty, s2.uncertainty]))
+    arrs, unc = push(ss_op, [s1._arrays(), s2._arrays()], [s1.uncertainty, s2.uncertainty])
     return StateSpace(*arrs, **sig, states=_joined(s1.states, s2.states), uncertainty=unc)
 
 
@@ -1709,6 +1708,7 @@ def parallel(g1: LinearSystem, g2: LinearSystem) -> LinearSystem:
     Returns
     -------
     LinearSystem
+        Inputs and outputs named and united as ``g1``'s.
 
     Examples
     --------
@@ -1717,21 +1717,11 @@ def parallel(g1: LinearSystem, g2: LinearSystem) -> LinearSystem:
     >>> g.numerator().tolist(), g.denominator().tolist()
     ([2.0, 3.0], [1.0, 3.0, 2.0])
     """
-    g2 = _as_system(g2, g1, g1.n_inputs, g1.n_outputs)
-    dt = same_dt(g1.dt, g2.dt, "parallel")
-    if (g1.n_outputs, g1.n_inputs) != (g2.n_outputs, g2.n_inputs):
-        raise ModelError(f"parallel: shapes differ, {g1.n_outputs}×{g1.n_inputs} and "
-                         f"{g2.n_outputs}×{g2.n_inputs}")
+    g2, dt = _operand(g2, g1, g1.n_outputs, g1.n_inputs, "parallel", "g2", "the shape of g1")
     _check_units(g1.input_units, g2.input_units, "parallel inputs")
     _check_units(g2.output_units, g1.output_units, "parallel outputs")
-    sig = dict(dt=dt, inputs=g1.inputs, outputs=g1.outputs, input_units=g1.input_units,
-               output_units=g1.output_units, meta={})
-    if _both_siso_tf(g1, g2):
-        return _siso_tf_op(_connect.tf_parallel, g1, g2, sig)
-    s1, s2 = g1.to_ss(minimal=False), g2.to_ss(minimal=False)
-    arrs, unc = (push(_connect.ss_parallel, [s1._arrays(), s2._arrays()],
-                      [s1.uncertainty, s2.uncertainty]))
-    return StateSpace(*arrs, **sig, states=_joined(s1.states, s2.states), uncertainty=unc)
+    return _connected(g1, g2, g1._signals(dt=dt, meta={}), _connect.tf_parallel,
+                      _connect.ss_parallel)
 
 
 def feedback(plant: LinearSystem, controller=1.0, sign: float = -1.0) -> LinearSystem:
@@ -1765,18 +1755,9 @@ def feedback(plant: LinearSystem, controller=1.0, sign: float = -1.0) -> LinearS
     """
     if sign not in (1, -1, 1.0, -1.0):
         raise ModelError(f"sign: expected -1 (negative feedback) or +1, found {sign!r}")
-    K = _as_system(controller, plant, plant.n_outputs, plant.n_inputs)
-    dt = same_dt(plant.dt, K.dt, "feedback")
-    if (K.n_inputs, K.n_outputs) != (plant.n_outputs, plant.n_inputs):
-        raise ModelError(f"feedback: the controller must be {plant.n_inputs}×{plant.n_outputs} "
-                         f"(plant outputs → plant inputs), found {K.n_outputs}×{K.n_inputs}")
+    K, dt = _operand(controller, plant, plant.n_inputs, plant.n_outputs, "feedback",
+                     "the controller", "plant outputs → plant inputs")
     _check_units(plant.output_units, K.input_units, "feedback")
-    sig = dict(dt=dt, inputs=plant.inputs, outputs=plant.outputs, input_units=plant.input_units,
-               output_units=plant.output_units, meta={})
-    if _both_siso_tf(plant, K):
-        return (_siso_tf_op(lambda n, d, nk, dk: _connect.tf_feedback(n, d, nk, dk, sign), plant, K,
-                            sig))
-    s1, s2 = plant.to_ss(minimal=False), K.to_ss(minimal=False)
-    arrs, unc = push(lambda *a: _connect.ss_feedback(*a, sign=sign), [s1._arrays(), s2._arrays()],
-                     [s1.uncertainty, s2.uncertainty])
-    return StateSpace(*arrs, **sig, states=_joined(s1.states, s2.states), uncertainty=unc)
+    return _connected(plant, K, plant._signals(dt=dt, meta={}),
+                      lambda n, d, nk, dk: _connect.tf_feedback(n, d, nk, dk, sign),
+                      lambda *a: _connect.ss_feedback(*a, sign=sign))
