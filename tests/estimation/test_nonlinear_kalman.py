@@ -226,3 +226,27 @@ def test_bad_functions_and_arguments_are_refused():
         UnscentedKalmanFilter(f_nb, h_nb, Q, R).step(U0, [1.0])
     with pytest.raises(ModelError, match="x0 must hold 3 values"):
         UnscentedKalmanFilter(f_py, h_py, Q, R, x0=[0.0])
+
+
+def test_kernels_that_take_model_functions_are_not_disk_cached():
+    """numba keys a cache entry of a kernel with function arguments by those functions' types: a
+    model's functions are new objects in every process, so such entries can never be hit, and the
+    index they grow by one per process fails to load after a while ("ReferenceError: underlying
+    object has vanished", numba issues #2956, #9348; seen here after many test runs). Those
+    kernels compile per process; the ones without function arguments stay cached."""
+    import inspect
+
+    from numba.core.caching import NullCache
+
+    from gripkit.estimation import nonlinear_kalman as nk
+
+    takes_functions = {"f", "h", "fn", "Jf", "Jfn", "Fj", "Hj"}
+    kernels = {name: obj for name, obj in vars(nk).items()
+               if isinstance(obj, numba.core.registry.CPUDispatcher)}
+    with_functions = {name for name, k in kernels.items()
+                      if takes_functions & set(inspect.signature(k.py_func).parameters)}
+    assert {"_ekf_step_jit", "_ukf_run_jit", "_jac_central"} <= with_functions
+    for name in with_functions:
+        assert isinstance(kernels[name]._cache, NullCache), name
+    assert any(not isinstance(k._cache, NullCache) for name, k in kernels.items()
+               if name not in with_functions)

@@ -39,6 +39,13 @@ filter. When ``f`` and ``h`` (and ``F``, ``H`` if given) are ``numba.njit`` func
 and ``run`` call them from inside one kernel (``run``: the whole record in one call); Python
 callables are called from Python between the kernels. What ``f`` and ``h`` allocate (their
 returned arrays) is theirs.
+
+**Caching.** The kernels that take ``f``, ``h`` (or their Jacobians) as arguments are compiled
+once per process and per set of model functions and not written to numba's disk cache: numba
+keys such an entry by the function objects' types, a model's functions are new objects in every
+process (closures over its parameters), so the cache could never be hit, and its index grew by
+one entry per process until loading it failed with ``ReferenceError: underlying object has
+vanished`` (numba issues #2956 and #9348). The kernels without function arguments stay cached.
 """
 
 from __future__ import annotations
@@ -201,7 +208,7 @@ def _ekf_predict(s, w, Q):  # pragma: no cover - compiled
     _symmetrise(s.Pp)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=False)  # takes model functions: see the module docstring, "Caching"
 def _jac_central(fn, x, u, J, xt):  # pragma: no cover - compiled
     """J[:, j] = (fn(x + δ_j e_j, u) − fn(x − δ_j e_j, u)) / (2 δ_j),
     δ_j = ε^(1/3) max(1, |x_j|)."""
@@ -219,7 +226,7 @@ def _jac_central(fn, x, u, J, xt):  # pragma: no cover - compiled
             J[i, j] = (J[i, j] - lo[i]) / (2.0 * d)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=False)  # takes model functions: see the module docstring, "Caching"
 def _jac_given(Jf, x, u, J):  # pragma: no cover - compiled
     """J = Jf(x, u); False if it has the wrong shape."""
     M = Jf(x, u)
@@ -231,7 +238,7 @@ def _jac_given(Jf, x, u, J):  # pragma: no cover - compiled
     return True
 
 
-@numba.njit(cache=True, inline="always")
+@numba.njit(cache=False, inline="always")  # takes model functions (module docstring)
 def _linearised(fn, Jfn, x, u, J, xt, size, code):  # pragma: no cover - compiled
     """``(fn(x, u), 0)`` with its Jacobian at x in ``J`` (``Jfn`` None: central differences;
     numba prunes the other branch); ``(v, code)`` when fn returns other than ``size`` values,
@@ -246,7 +253,7 @@ def _linearised(fn, Jfn, x, u, J, xt, size, code):  # pragma: no cover - compile
     return v, 0
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=False)  # takes model functions: see the module docstring, "Caching"
 def _ekf_step_jit(f, h, Fj, Hj, noise, u, y, s, w):  # pragma: no cover - compiled
     """One EKF step calling numba ``f``, ``h`` and ``Fj``, ``Hj`` (None: central differences).
     0 done, 1 Σ not positive definite (the prediction is then left as it was), 4 ``f`` or 5
@@ -265,7 +272,7 @@ def _ekf_step_jit(f, h, Fj, Hj, noise, u, y, s, w):  # pragma: no cover - compil
     return 0
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=False)  # takes model functions: see the module docstring, "Caching"
 def _ekf_run_jit(f, h, Fj, Hj, noise, U, Y, s, w, out):  # pragma: no cover - compiled
     """:func:`_ekf_step_jit` over the rows of U, Y into ``out``: (code, k) of the first failure
     or (0, N)."""
@@ -346,7 +353,7 @@ def _ukf_predict(s, w, Q):  # pragma: no cover - compiled
             s.Pp[b, a] = acc
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=False)  # takes model functions: see the module docstring, "Caching"
 def _through_jit(fn, X, u, out):  # pragma: no cover - compiled
     """``out[i] = fn(X[i], u)`` for each sigma point; False if ``fn`` returns other than
     ``out.shape[1]`` values."""
@@ -359,7 +366,7 @@ def _through_jit(fn, X, u, out):  # pragma: no cover - compiled
     return True
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=False)  # takes model functions: see the module docstring, "Caching"
 def _ukf_step_jit(f, h, c, noise, u, y, s, w):  # pragma: no cover - compiled
     """One UKF step with numba ``f``, ``h``: 0 done, 1 P_p or 2 Σ or 3 P_f not positive
     definite (the prediction is then left as it was), 4 ``f`` or 5 ``h`` returned the wrong
@@ -378,7 +385,7 @@ def _ukf_step_jit(f, h, c, noise, u, y, s, w):  # pragma: no cover - compiled
     return 0
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=False)  # takes model functions: see the module docstring, "Caching"
 def _ukf_run_jit(f, h, c, noise, U, Y, s, w, out):  # pragma: no cover - compiled
     """:func:`_ukf_step_jit` over the rows of U, Y into ``out``: (code, k) of the first failure
     or (0, N)."""
