@@ -421,7 +421,7 @@ def _bw(model):
 
 
 def _bwo(model, dt):
-    from ..sysid.nonlinear.hysteresis_kernels import bwo_rates
+    from ..sysid.nonlinear.hysteresis_kernels import bwo_sample
 
     if dt is not None and not np.isclose(dt, model.dt, rtol=1e-6):
         raise ModelError(f"state_functions: the Bouc-Wen oscillator is sampled every "
@@ -435,18 +435,7 @@ def _bwo(model, dt):
 
     @numba.njit
     def f(s, u):  # pragma: no cover - compiled
-        x, v, z, uk = s[0], s[1], s[2], u[0]
-        for _ in range(sub):
-            a1, b1, c1 = bwo_rates(x, v, z, uk, m, c, ke, kh, beta, gamma, nexp)
-            a2, b2, c2 = bwo_rates(x + 0.5 * hs * a1, v + 0.5 * hs * b1, z + 0.5 * hs * c1, uk,
-                                    m, c, ke, kh, beta, gamma, nexp)
-            a3, b3, c3 = bwo_rates(x + 0.5 * hs * a2, v + 0.5 * hs * b2, z + 0.5 * hs * c2, uk,
-                                    m, c, ke, kh, beta, gamma, nexp)
-            a4, b4, c4 = bwo_rates(x + hs * a3, v + hs * b3, z + hs * c3, uk,
-                                    m, c, ke, kh, beta, gamma, nexp)
-            x += hs * (a1 + 2.0 * a2 + 2.0 * a3 + a4) / 6.0
-            v += hs * (b1 + 2.0 * b2 + 2.0 * b3 + b4) / 6.0
-            z += hs * (c1 + 2.0 * c2 + 2.0 * c3 + c4) / 6.0
+        x, v, z = bwo_sample(s[0], s[1], s[2], u[0], hs, sub, (m, c, ke, kh, beta, gamma, nexp))
         out = np.empty(3)
         out[0] = x
         out[1] = v
