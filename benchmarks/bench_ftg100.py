@@ -49,6 +49,7 @@ def _scipy_grasp(duration: float, gap: float, noise: bool = True, seed: int = 0)
                       p["K_sb"] / p["D_b"] ** 2 * xb + sf * rng.standard_normal(), 20e-6))
         V = min(max(V, 0.0), p["V_max"])
         t, t1 = k * ts, (k + 1) * ts
+        stalled = 0
         while t < t1:
             # the mode from the state: penetration, or at the surface the relative velocity (an
             # event located on the wrong side of the surface would otherwise be missed)
@@ -57,6 +58,10 @@ def _scipy_grasp(duration: float, gap: float, noise: bool = True, seed: int = 0)
             sol = solve_ivp(rhs, (t, t1), s, args=(V, contact), events=event(contact), rtol=1e-9,
                             atol=1e-18,
                             max_step=ts / 20)
+            stalled = stalled + 1 if sol.t[-1] == t else 0
+            if stalled > 3:  # the event fires again at once, in either mode: a grazing touch
+                raise RuntimeError(f"the scipy peer stalls at a grazing contact (t = {t:.9g} s: "
+                                   "the contact event fires where it starts, in either mode)")
             s, t = sol.y[:, -1], sol.t[-1]
         F.append(p["k0"] * max(p["D_a"] * s[0] - p["D_b"] * s[2] - p["gap"], 0.0))
     return np.array(F)
@@ -77,14 +82,17 @@ def run(quick: bool) -> list[dict]:
     # sample, the scipy loop after it: shift by one)
     a = (simulate_hybrid_grasp(gap=5e-6, duration=dur, noise_force=0.0,
                                noise_position=0.0).trajectory["F_c"][1:])
-    b = _scipy_grasp(dur, 5e-6, noise=False)[:-1]
-    err = float(np.max(np.abs(a - b)) / 20e-6)
+    try:
+        b = _scipy_grasp(dur, 5e-6, noise=False)[:-1]
+        agree = (f"same controller, no noise: contact force agrees within "
+                 f"{100 * float(np.max(np.abs(a - b)) / 20e-6):.2g} % of the command at every "
+                 "sample")
+    except RuntimeError as exc:
+        agree = f"same controller; the noise-free agreement is not checked: {exc}"
     rows.append(row("ftg100", f"closed-loop grasp, {dur * 1e3:.0f} ms at 20 kHz (plant with "
                               "contact events + hybrid controller)",
                     g, "scipy solve_ivp RK45 + events, once per sample "
-                       "in a Python loop", p, pure_python_peer=True,
-                    notes=f"same controller, no noise: contact force agrees within {100 * err:.2g} "
-                          "% of the command at every sample"))
+                       "in a Python loop", p, pure_python_peer=True, notes=agree))
     # 2. LM identification of M_a, K_fa, k0 (+ sensor zero)
     data = step_experiment(duration=1.0 if quick else 2.0, period=0.05, seed=1)
     identify_actuated(data)
