@@ -6,7 +6,7 @@ kernels), against the joined record, and σ of the simulated output (basis invar
 
 import numpy as np
 import pytest
-from scipy.signal import lfilter
+from test_nlss import _input, duffing  # the Duffing oscillator and input of the one-record tests
 
 from gripkit import Trajectory
 from gripkit.errors import DataError
@@ -14,21 +14,6 @@ from gripkit.sysid import identify, nlss
 from gripkit.sysid.nonlinear.nlss import _apply
 
 N = 1500
-
-
-def duffing(u):
-    """The discrete Duffing oscillator of test_nlss.py (order 2, degree 3)."""
-    x = v = 0.0
-    y = np.empty(len(u))
-    for t in range(len(u)):
-        y[t] = x
-        v = v + 0.2 * (-x - 0.3 * v - 2.0 * x ** 3 + u[t])
-        x = x + 0.2 * v
-    return y
-
-
-def _input(rng, n):
-    return lfilter([0.3], [1.0, -0.7], rng.normal(0.0, 1.0, n))
 
 
 @pytest.fixture(scope="module")
