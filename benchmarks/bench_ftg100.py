@@ -62,6 +62,12 @@ def _scipy_grasp(duration: float, gap: float, noise: bool = True, seed: int = 0)
             if stalled > 3:  # the event fires again at once, in either mode: a grazing touch
                 raise RuntimeError(f"the scipy peer stalls at a grazing contact (t = {t:.9g} s: "
                                    "the contact event fires where it starts, in either mode)")
+            if stalled == 2:  # grazing: one short step in the mode the relative velocity gives,
+                # without the event, then events again
+                rel = p["D_a"] * s[1] - p["D_b"] * s[3]
+                tg = min(t + ts / 1000.0, t1)
+                sol = solve_ivp(rhs, (t, tg), s, args=(V, rel > 0.0), rtol=1e-9, atol=1e-18)
+                stalled = 0
             s, t = sol.y[:, -1], sol.t[-1]
         F.append(p["k0"] * max(p["D_a"] * s[0] - p["D_b"] * s[2] - p["gap"], 0.0))
     return np.array(F)
