@@ -35,7 +35,7 @@ import numpy as np  # noqa: E402
 sys.path.insert(0, str(Path(__file__).parent))
 sys.path.insert(0, str(Path(__file__).parents[1] / "src"))
 
-from bench_rls import LAM, P0, _data, _plain_rls, _plain_step  # noqa: E402
+from bench_rls import LAM, P0, _data, _plain_rls, streaming_calls  # noqa: E402
 
 CLOCKS = {"wall": time.perf_counter, "cpu": time.thread_time}
 
@@ -102,18 +102,7 @@ def rls_rows(n_rounds: int) -> list[str]:
     th, _ = _plain_rls(u, y, LAM, P0, *hist)
     none = np.empty((0, 6))
     k = 200_000
-    us, ys = u[:k].tolist(), y[:k].tolist()
-    upd = RLS(3, 3, 1, forgetting=LAM, p0=P0, windup="none").update
-    st = np.zeros(60)
-    st[6:42] = P0 * np.eye(6).ravel()
-
-    def stream():
-        for a, b in zip(us, ys):
-            upd(a, b)
-
-    def plain_stream():
-        for a, b in zip(us, ys):
-            _plain_step(st, a, b, LAM)
+    stream, plain_stream = streaming_calls(u, y, k)
 
     batch = {"rls() with θ, σ history": lambda: rls(u, y, 3, 3, 1, forgetting=LAM, p0=P0,
                                                       windup="none"),

@@ -114,6 +114,27 @@ def _plain_step(s, u, y, lam):  # pragma: no cover - compiled
     return e
 
 
+def streaming_calls(u, y, k: int):
+    """(gripkit's ``RLS.update``, the plain numba step) over the first ``k`` samples, each one
+    call per sample from a Python loop (the plain step compiled first)."""
+    from gripkit.sysid import RLS
+
+    us, ys = u[:k].tolist(), y[:k].tolist()
+    upd = RLS(3, 3, 1, forgetting=LAM, p0=P0, windup="none").update
+    st = np.zeros(60)
+    st[6:42] = P0 * np.eye(6).ravel()
+    _plain_step(st, 0.0, 0.0, LAM)
+
+    def stream():
+        for a, b in zip(us, ys):
+            upd(a, b)
+
+    def plain_stream():
+        for a, b in zip(us, ys):
+            _plain_step(st, a, b, LAM)
+    return stream, plain_stream
+
+
 def run(quick: bool) -> list[dict]:
     """The three rows; ``quick``: N = 1e5 and 2·10⁴ streaming calls (else 1e6 and 2·10⁵)."""
     from gripkit.sysid import RLS, rls
@@ -149,20 +170,7 @@ def run(quick: bool) -> list[dict]:
                 target=target, gripkit_accuracy=acc, notes="RLS(...).run(u, y, store=False)",
                 extra=cpu_note(2, 3))]
     k = 20_000 if quick else 200_000
-    us, ys = u[:k].tolist(), y[:k].tolist()
-    est = RLS(3, 3, 1, forgetting=LAM, p0=P0, windup="none")
-    upd = est.update
-    st = np.zeros(60)
-    st[6:42] = P0 * np.eye(6).ravel()
-    _plain_step(st, 0.0, 0.0, LAM)
-
-    def stream():
-        for a, b in zip(us, ys):
-            upd(a, b)
-
-    def plain_stream():
-        for a, b in zip(us, ys):
-            _plain_step(st, a, b, LAM)
+    stream, plain_stream = streaming_calls(u, y, k)
     t_s, t_ps = measure_alternating([stream, plain_stream])
     c_s, c_ps = measure_alternating([stream, plain_stream], clock=time.thread_time)
     rows.append(row("rls", "streaming RLS.update(u, y), [3 3 1] (per call)", t_s / k,

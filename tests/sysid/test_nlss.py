@@ -71,24 +71,33 @@ def _random_model(rng, n=2, m=1, p=1, degree=3):
                      x0=np.zeros(n), state_limit=1e6)
 
 
-def test_sensitivity_gram_matches_finite_differences():
-    """g = Σ Jᵀ(w e) of the kernel equals −½ ∂V/∂θ by central differences (V the windowed loss,
-    three windows), for entries of A, B, C, E, F and each window's initial state."""
-    rng = np.random.default_rng(4)
+def _window_problem(seed, w, starts, dirs):
+    """A random order-2 model, 300 samples of input and output, the initial states of the three
+    windows ``starts`` cuts, and the kernel's sums for the directions ``dirs`` with weight ``w``:
+    (model, u, y, Z, NLSSGram, V of window_gram, V of window_loss)."""
+    rng = np.random.default_rng(seed)
     m = _random_model(rng)
     u = np.ascontiguousarray(0.5 * rng.normal(size=(300, 1)))
     y = np.ascontiguousarray(rng.normal(size=(300, 1)))
-    w = np.array([1.3])
-    starts = np.array([0, 100, 220, 300], dtype=np.int64)
     Z = 0.1 * rng.normal(size=(3, 2))
-    dirs = np.array([(0, 0, 1), (1, 1, 0), (2, 0, 0), (4, 1, 5), (5, 0, 3)], dtype=np.int64)
     P = len(dirs)
-    Htt, gt = np.empty((P, P)), np.empty(P)
-    Htz, Hzz, gz = np.empty((3, P, 2)), np.empty((3, 2, 2)), np.empty((3, 2))
+    out = K.NLSSGram(np.empty((P, P)), np.empty(P), np.empty((3, P, 2)), np.empty((3, 2, 2)),
+                     np.empty((3, 2)))
     arrays = K.NLSSArrays(m.A, m.B, m.C, m.D, m.E, m.F, m.y_offset, m.exz, m.exe)
     win = K.NLSSWindows(Z, starts, u, y, w)
-    V = K.window_gram(arrays, dirs, win, 1e6, K.NLSSGram(Htt, gt, Htz, Hzz, gz))
-    assert V == pytest.approx(K.window_loss(arrays, win, 1e6), rel=1e-12)
+    return (m, u, y, Z, out, K.window_gram(arrays, dirs, win, 1e6, out),
+            K.window_loss(arrays, win, 1e6))
+
+
+def test_sensitivity_gram_matches_finite_differences():
+    """g = Σ Jᵀ(w e) of the kernel equals −½ ∂V/∂θ by central differences (V the windowed loss,
+    three windows), for entries of A, B, C, E, F and each window's initial state."""
+    w = np.array([1.3])
+    starts = np.array([0, 100, 220, 300], dtype=np.int64)
+    dirs = np.array([(0, 0, 1), (1, 1, 0), (2, 0, 0), (4, 1, 5), (5, 0, 3)], dtype=np.int64)
+    m, u, y, Z, out, V, loss = _window_problem(4, w, starts, dirs)
+    P, Htt, gt, gz = len(dirs), out.Htt, out.gt, out.gz
+    assert V == pytest.approx(loss, rel=1e-12)
     h = 1e-6
     from gripkit.sysid.nonlinear.nlss import _apply, _loss
 
@@ -126,19 +135,11 @@ def test_gram_matrix_equals_the_finite_difference_jacobian():
     of 16 rows with 5, 9 and 14 left over: the rows past the last group of four)."""
     from gripkit.sysid.nonlinear.nlss import _apply
 
-    rng = np.random.default_rng(7)
-    m = _random_model(rng)
-    u = np.ascontiguousarray(0.5 * rng.normal(size=(300, 1)))
-    y = np.ascontiguousarray(rng.normal(size=(300, 1)))
     w = np.array([0.7])
     starts = np.array([0, 101, 222, 300], dtype=np.int64)
-    Z = 0.1 * rng.normal(size=(3, 2))
     dirs = np.array([(0, 1, 0), (1, 0, 0), (2, 0, 1), (4, 0, 2), (5, 0, 6)], dtype=np.int64)
+    m, u, _, Z, out, _, _ = _window_problem(7, w, starts, dirs)
     P = len(dirs)
-    out = K.NLSSGram(np.empty((P, P)), np.empty(P), np.empty((3, P, 2)), np.empty((3, 2, 2)),
-                     np.empty((3, 2)))
-    K.window_gram(K.NLSSArrays(m.A, m.B, m.C, m.D, m.E, m.F, m.y_offset, m.exz, m.exe), dirs,
-                  K.NLSSWindows(Z, starts, u, y, w), 1e6, out)
     h = 1e-6
     D = np.empty((300, P + 6))
     for q in range(P):
