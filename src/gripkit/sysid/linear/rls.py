@@ -79,9 +79,9 @@ _SAFE_BOUND = 1e300
 
 
 @njit(cache=True, inline="always")
-def _gain(Pb, thb, phb, qb, at, p, size, lam, mode, trace, y, guard):
-    """The first half of :func:`_core` (``at`` = the offsets ``(oP, oth, oph, oq)``, a tuple: the
-    kernel is inlined): the a-priori error e, q = Pφ (into ``qb[oq:oq + p]``),
+def _gain(wb, at, p, size, lam, mode, trace, y, guard):
+    """The first half of one RLS update (``at`` = the offsets ``(oP, oth, oph, oq)`` of P, θ, φ and
+    q in the one buffer ``wb``, a tuple: the kernel is inlined): the a-priori error e, q = Pφ,
     r = φᵀPφ and the coefficients of the update. With ``guard`` (a literal) also a bound on every
     value the second half (:func:`_apply`) will write: ``safe`` is True when e and r are finite
     and all new entries of θ and P stay below :data:`_SAFE_BOUND`/p, so that the update cannot
@@ -92,23 +92,22 @@ def _gain(Pb, thb, phb, qb, at, p, size, lam, mode, trace, y, guard):
         p = len(size)
     yhat = 0.0
     tm = 0.0
-    for i in range(p):
-        yhat += phb[oph + i] * thb[oth + i]
-        if guard:
-            tm = max(tm, abs(thb[oth + i]))
-    e = y - yhat
     pm = 0.0
     for i in range(p):  # q = Pφ, row i of P (= its column: P is exactly symmetric), j ascending
         row = oP + i * p
         acc = 0.0
         for j in range(p):
-            acc += Pb[row + j] * phb[oph + j]
+            acc += wb[row + j] * wb[oph + j]
             if guard:
-                pm = max(pm, abs(Pb[row + j]))
-        qb[oq + i] = acc
+                pm = max(pm, abs(wb[row + j]))
+        wb[oq + i] = acc
+        yhat += wb[oph + i] * wb[oth + i]
+        if guard:
+            tm = max(tm, abs(wb[oth + i]))
+    e = y - yhat
     r = 0.0
     for i in range(p):
-        r += phb[oph + i] * qb[oq + i]
+        r += wb[oph + i] * wb[oq + i]
     if mode == 2 and r <= 1e-12 * trace:  # directional, no new direction: no forgetting
         inv = 1.0 / (1.0 + r)
         coef, scale = -inv, 1.0
@@ -123,7 +122,7 @@ def _gain(Pb, thb, phb, qb, at, p, size, lam, mode, trace, y, guard):
     if guard and math.isfinite(e) and math.isfinite(r):
         qm = 0.0
         for i in range(p):
-            qm = max(qm, abs(qb[oq + i]))
+            qm = max(qm, abs(wb[oq + i]))
         # NaN or inf in a bound compares False: not safe
         safe = ((pm + abs(coef) * qm * qm) * scale * p < _SAFE_BOUND
                 and tm + qm * abs(g) < _SAFE_BOUND)
@@ -131,97 +130,68 @@ def _gain(Pb, thb, phb, qb, at, p, size, lam, mode, trace, y, guard):
 
 
 @njit(cache=True, inline="always")
-def _apply(Pb, thb, qb, at, p, size, mode, maxtr, coef, scale, g):
-    """The second half of :func:`_core`: θ ← θ + q·g and P ← (P + coef·q qᵀ)·scale on the upper
+def _apply(wb, at, p, size, mode, maxtr, coef, scale, g):
+    """The second half of one RLS update: θ ← θ + q·g and P ← (P + coef·q qᵀ)·scale on the upper
     triangle, mirrored, then the trace bound; returns trace P."""
     oP, oth, oph, oq = at
     if len(size) > 0:
         p = len(size)
     for i in range(p):
-        thb[oth + i] += qb[oq + i] * g
+        wb[oth + i] += wb[oq + i] * g
     tr = 0.0
     for i in range(p):  # P stays exactly symmetric: update the upper triangle, mirror it
-        qi = coef * qb[oq + i]
+        qi = coef * wb[oq + i]
         row = oP + i * p
         for j in range(i, p):
-            v = (Pb[row + j] + qi * qb[oq + j]) * scale
-            Pb[row + j] = v
-            Pb[oP + j * p + i] = v
-        tr += Pb[row + i]
+            v = (wb[row + j] + qi * wb[oq + j]) * scale
+            wb[row + j] = v
+            wb[oP + j * p + i] = v
+        tr += wb[row + i]
     if mode == 1 and tr > maxtr:  # bounded trace
         f = maxtr / tr
         for k in range(p * p):
-            Pb[oP + k] *= f
+            wb[oP + k] *= f
         tr = maxtr
     return tr
 
 
 @njit(cache=True, inline="always")
-def _core(wb, at, p, size, lam, mode, maxtr, trace, y, std_out, tprev, fprev):
-    """One RLS update of θ (``wb[oth:oth + p]``) and P (``wb[oP:oP + p·p]``, row-major) for the
-    regressor ``wb[oph:oph + p]`` and output ``y``; ``wb[oq:oq + p]`` is work space. Returns
-    (a-priori error, r = φᵀPφ, trace). The batch kernel passes its one local buffer with constant
-    offsets (the compiler then sees that the vectors do not overlap).
-
-    ``size``: an empty tuple (p at run time) or a tuple of p zeros (p known to the compiler, loops
-    unrolled). The covariance update is ``P ← (P + coef·q qᵀ)·scale`` with ``q = Pφ`` (see the
-    module docstring for ``coef``, ``scale`` and the three ``windup`` modes). :func:`_gain`, then
-    :func:`_apply`: the streaming step runs the same two halves with a check between them.
-
-    Between the halves, when ``tprev >= 0``, σ of the previous step goes into row ``tprev`` of
-    ``std_out``: ``√(fprev·P_ii)`` from P before this update, i.e. after the previous one, the
-    numbers the end of that step would write. There the square roots overlap with this update
-    (the measurements: docs/performance.md, "Issue 24 follow-up").
-    """
-    e, r, coef, scale, g, _ = _gain(wb, wb, wb, wb, at, p, size, lam, mode,
-                                    trace, y, False)
-    if tprev >= 0:
-        oP = at[0]
-        if len(size) > 0:
-            p = len(size)
-        for i in range(p):
-            std_out[tprev, i] = math.sqrt(fprev * wb[oP + i * p + i])
-    tr = _apply(wb, wb, wb, at, p, size, mode, maxtr, coef, scale, g)
-    return e, r, tr
-
-
-@njit(cache=True, inline="always")
-def _step_update(Pb, thb, phb, qb, bb, at, ob, p, size, s, y):
-    """The guarded update of :func:`_rls_step` (θ and P in ``thb``/``Pb``, a backup area at
-    ``bb[ob:ob + p + p·p]``); returns (e, r, trace, status): status 0 = done, 2 = P or θ would
-    no longer be finite, 3 = φᵀPφ overflowed; on 2 and 3 θ and P are as they were."""
+def _step_update(s, at, ob, p, size, y):
+    """The guarded update of :func:`_rls_step` (θ and P in the state vector ``s`` at the offsets
+    ``at``, a backup area at ``s[ob:ob + p + p·p]``); returns (e, r, trace, status): status 0 =
+    done, 2 = P or θ would no longer be finite, 3 = φᵀPφ overflowed; on 2 and 3 θ and P are as
+    they were."""
     oP, oth, oph, oq = at
     if len(size) > 0:
         p = len(size)
     lam = s[_LAM]
     mode = int(s[_MODE])
-    e, r, coef, scale, g, safe = _gain(Pb, thb, phb, qb, at, p, size, lam, mode,
-                                       s[_TRACE], y, True)
+    e, r, coef, scale, g, safe = _gain(s, at, p, size, lam, mode, s[_TRACE], y, True)
     if safe:  # no value can overflow: update in place, nothing to back up
-        tr = _apply(Pb, thb, qb, at, p, size, mode, s[_MAXTR], coef, scale, g)
+        tr = _apply(s, at, p, size, mode, s[_MAXTR], coef, scale, g)
         return e, r, tr, 0
     for i in range(p):  # rare (huge values or a non-finite e or r): back up, update, check
-        bb[ob + i] = thb[oth + i]
+        s[ob + i] = s[oth + i]
     for i in range(p * p):
-        bb[ob + p + i] = Pb[oP + i]
-    tr = _apply(Pb, thb, qb, at, p, size, mode, s[_MAXTR], coef, scale, g)
+        s[ob + p + i] = s[oP + i]
+    tr = _apply(s, at, p, size, mode, s[_MAXTR], coef, scale, g)
     ok = math.isfinite(tr) and math.isfinite(e)
     for i in range(p):
-        ok = ok and math.isfinite(thb[oth + i])
+        ok = ok and math.isfinite(s[oth + i])
     if ok and math.isfinite(r):
         return e, r, tr, 0
     for i in range(p):
-        thb[oth + i] = bb[ob + i]
+        s[oth + i] = s[ob + i]
     for i in range(p * p):
-        Pb[oP + i] = bb[ob + p + i]
+        s[oP + i] = s[ob + p + i]
     return e, r, tr, 2 if math.isfinite(r) else 3
 
 
 @njit(cache=True)
 def _rls_step(s, u, y, size):
     """One RLS update in place on the state vector ``s``; returns the a-priori error (0 while
-    the regressor is not yet filled). Same arithmetic as :func:`_rls_run` (both run the halves
-    of :func:`_core`).
+    the regressor is not yet filled). Same arithmetic as :func:`_rls_run` (:func:`_gain` and
+    :func:`_apply`, which its loop writes out).
 
     A failed update returns NaN and leaves ``s`` as it was, with the reason in ``s[_STATUS]``:
     1 = ``u`` or ``y`` not finite, 2 = P or θ no longer finite (divergence), 3 = φᵀPφ overflowed
@@ -230,9 +200,8 @@ def _rls_step(s, u, y, size):
     value can overflow (:func:`_gain`), else from a backup (``s[ob:]``) that is restored on
     failure.
 
-    ``size``: as for :func:`_rls_run`. With the orders known to the compiler (tuple lengths) the
-    offsets are constants and θ, P, φ and q are addressed in ``s`` itself (one base pointer,
-    constant offsets: the compiler sees they do not overlap); the generic step passes views.
+    ``size``: as for :func:`_rls_run`. θ, P, φ and q are addressed in ``s`` itself (one base
+    pointer); with the orders known to the compiler (tuple lengths) their offsets are constants.
     """
     if not (math.isfinite(u) and math.isfinite(y)):
         s[_STATUS] = 1.0
@@ -263,11 +232,7 @@ def _rls_step(s, u, y, size):
             s[oph + i] = -s[oy + i]
         for j in range(nb):  # u(t-nk-j): the buffer is shifted only once the update succeeded
             s[oph + na + j] = u if nk + j == 0 else s[ou + nk + j - 1]
-        if len(size[0]) > 0:
-            e, r, tr, status = _step_update(s, s, s, s, s, (op, oth, oph, oq), ob, p, size[0], s, y)
-        else:
-            e, r, tr, status = _step_update(s[op:oph], s[oth:op], s[oph:oq], s[oq:ob], s[ob:],
-                                            (0, 0, 0, 0), 0, p, size[0], s, y)
+        e, r, tr, status = _step_update(s, (op, oth, oph, oq), ob, p, size[0], y)
         if status != 0:
             s[_STATUS] = float(status)
             return np.nan
@@ -343,26 +308,72 @@ def _var_factor(s, p):
 @njit(cache=True, inline="always")
 def _batch_loop(w, size, io, run, state, mode):
     """The sample loop of :func:`_rls_run` from sample ``nstart`` on, for one windup ``mode`` (a
-    literal: :func:`_rls_run` calls it once per mode, so each loop holds one copy of
-    :func:`_core` instead of three behind a branch per sample). ``io``: u, y and the four output
-    arrays; ``run``: the buffer offsets, (p, na, nb, nk), λ, the trace bound, ``nstart`` and the
-    store / predict flags; ``state``: (trace, V, w₁, w₂, updates, σ factor of the last step),
-    returned updated."""
+    literal: :func:`_rls_run` calls it once per mode, so each loop holds one update instead of
+    three behind a branch per sample). ``io``: u, y and the four output arrays; ``run``: the
+    buffer offsets, (p, na, nb, nk), λ, the trace bound, ``nstart`` and the store / predict flags;
+    ``state``: (trace, V, w₁, w₂, updates, σ factor of the last step), returned updated.
+
+    The update is :func:`_gain` then :func:`_apply` (the streaming step's halves) written out in
+    the loop, with the same arithmetic in the same order, so batch and streaming results stay
+    bit-identical. Written out, not called: through the inlined halves the compiled loop ran
+    1.6–1.9× slower on an Intel Xeon (the same speed on an AMD EPYC; measured with
+    ``benchmarks/ab_rls_strip.py``, docs/performance.md). Between the halves σ of step t − 1
+    goes into ``std_out``, from P before this update (the square roots overlap with it).
+    """
     u, y, theta_out, std_out, yhat_out, err_out = io
     at, dims, lam, maxtr, nstart, store, pred = run
     trace, V, w1, w2, nupd, f = state
-    bth = at[1]
+    oP, oth, oph, oq = at
     if len(size[0]) > 0:  # the orders are known to the compiler: constant regressor indices
         p, na, nb, nk = len(size[0]), len(size[1]), len(size[2]), len(size[3])
     else:
         p, na, nb, nk = dims
     for t in range(nstart, u.shape[0]):
         for i in range(na):
-            w[at[2] + i] = -y[t - 1 - i]
+            w[oph + i] = -y[t - 1 - i]
         for j in range(nb):
-            w[at[2] + na + j] = u[t - nk - j]
-        tprev = t - 1 if (store and t > nstart) else -1  # σ of step t − 1 (:func:`_core`)
-        e, r, trace = _core(w, at, p, size[0], lam, mode, maxtr, trace, y[t], std_out, tprev, f)
+            w[oph + na + j] = u[t - nk - j]
+        yh = 0.0
+        for i in range(p):  # q = Pφ and ŷ = φᵀθ (:func:`_gain`)
+            row = oP + i * p
+            acc = 0.0
+            for j in range(p):
+                acc += w[row + j] * w[oph + j]
+            w[oq + i] = acc
+            yh += w[oph + i] * w[oth + i]
+        e = y[t] - yh
+        r = 0.0
+        for i in range(p):
+            r += w[oph + i] * w[oq + i]
+        if mode == 2 and r <= 1e-12 * trace:
+            inv = 1.0 / (1.0 + r)
+            coef, scale = -inv, 1.0
+        elif mode == 2:
+            inv = 1.0 / (lam + r)
+            coef, scale = (1.0 - lam - r) / r * inv, 1.0
+        else:
+            inv = 1.0 / (lam + r)
+            coef, scale = -inv, 1.0 / lam
+        g = e * inv
+        if store and t > nstart:  # σ of step t − 1
+            for i in range(p):
+                std_out[t - 1, i] = math.sqrt(f * w[oP + i * p + i])
+        for i in range(p):  # θ and P (:func:`_apply`)
+            w[oth + i] += w[oq + i] * g
+        trace = 0.0
+        for i in range(p):
+            qi = coef * w[oq + i]
+            row = oP + i * p
+            for j in range(i, p):
+                v = (w[row + j] + qi * w[oq + j]) * scale
+                w[row + j] = v
+                w[oP + j * p + i] = v
+            trace += w[row + i]
+        if mode == 1 and trace > maxtr:
+            c = maxtr / trace
+            for k in range(p * p):
+                w[oP + k] *= c
+            trace = maxtr
         V = lam * (V + e * e / (lam + r))
         w1 = lam * w1 + 1.0
         w2 = lam * lam * w2 + 1.0
@@ -374,7 +385,7 @@ def _batch_loop(w, size, io, run, state, mode):
         if store:
             f = V / (w1 - p) * (w2 / w1) if (nupd > p and w1 > p) else np.nan
             for i in range(p):
-                theta_out[t, i] = w[bth + i]
+                theta_out[t, i] = w[oth + i]
     return trace, V, w1, w2, nupd, f
 
 
@@ -390,8 +401,8 @@ def _rls_run(s, u, y, theta_out, std_out, yhat_out, err_out, size):
     regressor indices (faster: docs/performance.md, "RLS"); :meth:`RLS.run` uses it for records of
     at least :data:`SPECIALISE_ABOVE` samples, where the extra compilation (once) pays off. The
     first ``t0`` samples go through :func:`_rls_step` (their regressors need the buffered past);
-    the rest take the regressor straight from ``u`` and ``y`` with θ and P in local arrays. Both
-    call :func:`_core`, so streaming and batch results are bit-identical.
+    the rest take the regressor straight from ``u`` and ``y`` with θ and P in local arrays
+    (:func:`_batch_loop`: the same arithmetic, so streaming and batch results are bit-identical).
     """
     n = u.shape[0]
     if len(size[0]) > 0:  # the orders are known to the compiler: constant regressor indices
