@@ -79,6 +79,7 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass, field
+from operator import attrgetter
 from pathlib import Path
 
 import numpy as np
@@ -222,13 +223,8 @@ def _fit_value(y, yhat) -> float:
 class _RunOutput:
     """``yhat`` and ``jac``: the last run's ŷ and J, views of ``self.out`` (a ``K.HWOut``)."""
 
-    @property
-    def yhat(self) -> np.ndarray:
-        return self.out.yhat
-
-    @property
-    def jac(self) -> np.ndarray:
-        return self.out.jac
+    yhat = property(attrgetter("out.yhat"))
+    jac = property(attrgetter("out.jac"))
 
 
 class _Problem(_RunOutput):
