@@ -8,7 +8,7 @@ import pytest
 from gripkit.errors import DataError
 from gripkit.sysid import HWModel, NARXModel
 from gripkit.sysid.nonlinear.single_channel import (DIVERGENCE_FACTOR, FreeRunModel, fit_percent,
-                                                    one_signal)
+                                                    not_constant, one_signal)
 
 
 def test_divergence_band_is_1000_spans_about_the_middle():
@@ -27,6 +27,16 @@ def test_one_signal_flattens_a_column_and_names_bad_input():
         one_signal(np.ones((2, 2)), "y", "hw")
     with pytest.raises(DataError, match="hysteresis: u has 1 non-finite samples"):
         one_signal([0.0, np.nan], "u", "hysteresis")
+
+
+def test_not_constant_names_the_value_the_length_and_the_fix():
+    """A signal of one value is refused with its value and length; one that moves by 1e-300
+    (np.ptp > 0) passes."""
+    with pytest.raises(DataError, match=r"^hysteresis: the input 'V' is constant \(2\.5 in all 4 "
+                                        r"samples\); a hysteresis needs an input sweep$"):
+        not_constant(np.full(4, 2.5), "the input 'V'", "hysteresis",
+                     "a hysteresis needs an input sweep")
+    assert not_constant(np.array([0.0, 1e-300]), "the output", "narx", "fix") is None
 
 
 def test_fit_percent_of_a_known_error_and_of_a_constant_output():

@@ -50,6 +50,7 @@ vanished`` (numba issues #2956 and #9348). The kernels without function argument
 
 from __future__ import annotations
 
+from operator import attrgetter
 from typing import NamedTuple
 
 import numba
@@ -592,13 +593,9 @@ class _NonlinearFilter:
         self.x_pred, self.P_pred, self.x, self.P = self._s[:4]
         return v
 
-    @property
-    def Q(self) -> np.ndarray:
-        return self.noise.Q
-
-    @property
-    def R(self) -> np.ndarray:
-        return self.noise.R
+    # the noise covariances, views of the filter's buffer
+    Q = property(attrgetter("noise.Q"))
+    R = property(attrgetter("noise.R"))
 
     def _raise(self, code, where):
         raise ModelError(f"{self._name}.{where}: {self._FAIL[code]}",

@@ -26,33 +26,33 @@ What the state is, family by family:
   discretised exactly by the same ``zoh_levels`` matrices as its simulate; state ``[H, U, y_A,
   v_A, α_A, w_A]``; ``dt`` required. A model fitted by ``gripkit.sysid.fit_greybox`` is the
   model class with the fitted parameters: ``type(model)(result.parameters)``.
-* **Hammerstein–Wiener** (:class:`~gripkit.sysid.nonlinear.HWModel`): the states of the linear
+* **Hammerstein–Wiener** (:class:`~gripkit.sysid.HWModel`): the states of the linear
   block ``B(q)/F(q)`` in the controllable canonical realisation (as ``scipy.signal.tf2ss``), fed
   with ``w = f_in(u)``; ``h`` applies the output nonlinearity and ``y0`` to the block's output.
   ``x0`` = 0: the block at rest (``HWModel.simulate(..., initial_input=0)``). numba.
-* **Bouc-Wen** (:class:`~gripkit.sysid.nonlinear.BoucWenModel`): state ``[h, u_prev]`` (the
+* **Bouc-Wen** (:class:`~gripkit.sysid.BoucWenModel`): state ``[h, u_prev]`` (the
   hysteresis variable after the previous sample and the input then), ``h(x, u) = d u −
   h⁺ + offset`` with ``h⁺`` the step of the model's own kernel (exact for n = 1, RK4 in the input
   otherwise) and ``f(x, u) = [h⁺, u]``; ``x0`` = [0, 0] (virgin state at zero input); its
   simulate starts at ``[0, u(0)]``, which is ``x0=[0, u[0]]`` given to the filter. numba.
-* **Bouc-Wen oscillator** (:class:`~gripkit.sysid.nonlinear.BoucWenOscillatorModel`): state
+* **Bouc-Wen oscillator** (:class:`~gripkit.sysid.BoucWenOscillatorModel`): state
   ``[x, ẋ, z]``, ``f`` the model's ``substeps`` RK4 steps over its ``dt`` with the input held,
   ``h = x + offset``; ``x0`` = rest. numba.
-* **NARX** (:class:`~gripkit.sysid.nonlinear.NARXModel`): state ``[s(t−1) … s(t−ly), u(t−1) …
+* **NARX** (:class:`~gripkit.sysid.NARXModel`): state ``[s(t−1) … s(t−ly), u(t−1) …
   u(t−lu)]``, the window of past noise-free outputs ``s`` (and of past inputs, which the
   polynomial needs); ``h(x, u) = s(t) = Σ θ_k m_k`` evaluated on that window and ``u(t)``,
   ``f`` shifts ``s(t)`` and ``u(t)`` in. This is the *output-error* reading of the NARX model:
   the measured output is ``y = s + v`` (noise enters through the measurement, R), and the
   equation error of the fit enters as process noise on ``s(t−1)`` (Q[0, 0]); the model's own
   one-step predictor instead feeds the noisy measured outputs back. ``x0`` = 0. numba.
-* **Nonlinear state space** (:class:`~gripkit.sysid.nonlinear.NLSSModel`): its own states (the
+* **Nonlinear state space** (:class:`~gripkit.sysid.NLSSModel`): its own states (the
   model's basis, scaled to unit standard deviation on the estimation record), ``f(x, u) = A x +
   B ũ + E ζ(x, ũ)`` and ``h(x, u) = y₀ + C x + D ũ + F η(x, ũ)`` with the model's normalised
   input ``ũ = (u − u_offset)/u_scale`` (u in the model's units, as its ``simulate`` takes it),
   by the monomial kernels of its own free run. ``x0`` = 0, the equilibrium of the mean input
   (``NLSSModel.simulate``'s default start). ``f`` does not stop at the model's state limit (the
   free run's divergence check). numba.
-* **Prandtl–Ishlinskii** (:class:`~gripkit.sysid.nonlinear.PrandtlIshlinskiiModel`): state the
+* **Prandtl–Ishlinskii** (:class:`~gripkit.sysid.PrandtlIshlinskiiModel`): state the
   m play outputs ``z_i = F_{r_i}[u − a]`` after the previous sample; ``f`` applies each play to
   the new input, ``z_i⁺ = min(u − a + r_i, max(u − a − r_i, z_i))``, and ``h = c + Σ w_i z_i⁺``.
   ``x0`` = 0: every play relaxed at the input offset ``a``; its simulate relaxes them at the

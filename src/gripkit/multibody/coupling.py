@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from operator import attrgetter
 
 import numpy as np
 
@@ -146,25 +147,12 @@ class CoupledChain(Dynamics):
         self.name = name or f"{chain.name} (coupled)"
         self._arrays = None
 
-    @property
-    def chain(self) -> DHChain:
-        return self._chain
-
-    @property
-    def dof(self) -> int:
-        return self.coupling.n_actuators
-
-    @property
-    def coordinate_names(self) -> tuple[str, ...]:
-        return self.coupling.names
-
-    @property
-    def base(self) -> np.ndarray:
-        return self._chain.base
-
-    @property
-    def tool(self) -> np.ndarray:
-        return self._chain.tool
+    # the Dynamics interface, read through to the chain (DHChain) and the coupling
+    chain = property(attrgetter("_chain"))
+    dof = property(attrgetter("coupling.n_actuators"))
+    coordinate_names = property(attrgetter("coupling.names"))
+    base = property(attrgetter("_chain.base"))
+    tool = property(attrgetter("_chain.tool"))
 
     def kernel_arrays(self):
         if self._arrays is None:

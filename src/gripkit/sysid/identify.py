@@ -32,7 +32,6 @@ import numpy as np
 from ..arguments import check_keywords, entry_point, keyword_names
 from ..errors import AccuracyWarning, ArgumentError, DataError, GripkitError, emit_warning
 from ..signals.trajectory import Trajectory
-from . import nonlinear
 from .io_data import IOData, io_data, records_provenance, validation_data
 from .linear import identify_mimo
 from .linear.armax import armax, armax_records
@@ -103,14 +102,23 @@ def _method_function(method: str):
         from .linear.rls import rls  # numba (0.4 s): loaded only for an RLS fit
 
         return rls
-    if method == "narx":  # numba: nonlinear.narx loads its module on first use
-        return nonlinear.narx
+    # numba kernels: a nonlinear family's module is loaded by its first fit
+    if method == "narx":
+        from .nonlinear.narx import narx
+
+        return narx
     if method == "hw":
-        return nonlinear.hammerstein_wiener
+        from .nonlinear.hammerstein_wiener import hammerstein_wiener
+
+        return hammerstein_wiener
     if method == "hysteresis":
-        return nonlinear.hysteresis
+        from .nonlinear.hysteresis import hysteresis
+
+        return hysteresis
     if method == "nlss":
-        return nonlinear.nlss
+        from .nonlinear.nlss import nlss
+
+        return nlss
     return {"arx": arx, "armax": armax, "oe": oe, "ss": identify_mimo.identify_ss, "frf": frf,
             "tf": identify_mimo.identify_tf}.get(method, structure_search)
 
@@ -247,21 +255,21 @@ def _dispatch(data, method: str, *, input, output, na: int | None, nb: int | Non
         return identify_mimo.identify_arx(data, input=input, output=output, na=na, nb=nb, nk=nk,
                                           detrend=detrend).with_display_units(data)
     if method == "nlss":  # the model carries the operating point (input and output means)
-        return nonlinear.nlss(data, input=input, output=output, **options)
+        return _method_function(method)(data, input=input, output=output, **options)
     if method == "narx":  # the model's constant term carries the operating point
         io = io_data(data, input=input, output=output, detrend="none", why="NARX identification")
-        model = nonlinear.narx(io.u1, io.y1, dt=io.dt, **_validation_arrays(options, io))
+        model = _method_function(method)(io.u1, io.y1, dt=io.dt, **_validation_arrays(options, io))
         model.input_name, model.output_name = input, output
         return model
     if method == "hw":  # the offset y0 carries the operating point; orders not given: chosen
         io = io_data(data, input=input, output=output, detrend="none",
                      why="Hammerstein-Wiener identification")
-        model = nonlinear.hammerstein_wiener(io.u1, io.y1, nb=nb, nf=nf, nk=nk, dt=io.dt,
-                                             **_validation_arrays(options, io))
+        model = _method_function(method)(io.u1, io.y1, nb=nb, nf=nf, nk=nk, dt=io.dt,
+                                         **_validation_arrays(options, io))
         model.input_name, model.output_name = input, output
         return model
     if method == "hysteresis":  # rate independent, its offset a parameter: the data as they are
-        return nonlinear.hysteresis(data, input=input, output=output, **options)
+        return _method_function(method)(data, input=input, output=output, **options)
     na, nb, nk, nc = _linear_orders(na, nb, nk, nc)
     io = (io_data(data, input=input, output=output, detrend=detrend,
                   why=f"{method.upper()} identification"))
@@ -389,7 +397,7 @@ def identify_records(data, method: str = "arx", *, input, output, na: int | None
     if method == "nlss":  # the model carries the operating point; input/output may be several
         for i, d in enumerate(data):
             _per_record(i, identify_mimo.mimo_data, d, input, output, "none", why=why)
-        return nonlinear.nlss(list(data), input=input, output=output, **options)
+        return _method_function(method)(list(data), input=input, output=output, **options)
     if identify_mimo.several(input, output) or method in ("ss", "tf"):
         if method not in ("arx", "ss", "tf"):
             raise ArgumentError(f"identify(): several input or output columns with several records "
@@ -419,14 +427,13 @@ def identify_records(data, method: str = "arx", *, input, output, na: int | None
                    (ios[0].input, ios[0].output))
     if method in ("narx", "hw"):  # the data as they are: NARX's constant, HW's y0 (shared; each
         # record from its own steady state) carry the operating point
-        fit, orders = ((nonlinear.narx, {}) if method == "narx" else
-                       (nonlinear.hammerstein_wiener, hw_orders))
+        fit, orders = _method_function(method), ({} if method == "narx" else hw_orders)
         model = _as_data(fit, [(io.u1, io.y1) for io in ios], dt=ios[0].dt, **orders,
                          **_validation_arrays(options, ios[0]))
         model.input_name, model.output_name = input, output
         return model
     if method == "hysteresis":  # each record from its own relaxed state, the data as they are
-        return nonlinear.hysteresis(list(data), input=input, output=output, **options)
+        return _method_function(method)(list(data), input=input, output=output, **options)
     u0 = float(_pooled_mean([io.u1 for io in ios])) if detrend == "mean" else 0.0
     y0 = float(_pooled_mean([io.y1 for io in ios])) if detrend == "mean" else 0.0
     meta = dict(ios[0].keywords, u_offset=u0, y_offset=y0, dt=ios[0].dt, **options)

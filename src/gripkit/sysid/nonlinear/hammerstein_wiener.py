@@ -79,6 +79,7 @@ from __future__ import annotations
 import json
 import math
 from dataclasses import dataclass, field
+from operator import attrgetter
 from pathlib import Path
 
 import numpy as np
@@ -93,7 +94,8 @@ from ..model_file import read_family_document
 from ..model_protocol import ModelFit
 from . import hw_kernels as K
 from .levenberg_marquardt import levenberg_marquardt
-from .single_channel import DIVERGENCE_FACTOR, FreeRunModel, fit_percent, one_signal
+from .single_channel import (DIVERGENCE_FACTOR, FreeRunModel, fit_percent, not_constant,
+                             one_signal)
 
 __all__ = ["SCHEMA", "HW_FIT", "HWModel", "Nonlinearity", "hammerstein_wiener", "load_hw",
            "parse_nonlinearity"]
@@ -221,13 +223,8 @@ def _fit_value(y, yhat) -> float:
 class _RunOutput:
     """``yhat`` and ``jac``: the last run's ŷ and J, views of ``self.out`` (a ``K.HWOut``)."""
 
-    @property
-    def yhat(self) -> np.ndarray:
-        return self.out.yhat
-
-    @property
-    def jac(self) -> np.ndarray:
-        return self.out.jac
+    yhat = property(attrgetter("out.yhat"))
+    jac = property(attrgetter("out.jac"))
 
 
 class _Problem(_RunOutput):
@@ -755,12 +752,9 @@ def _check_data(u, y, dt, maxiter):
     if len(u) != len(y):
         raise DataError(f"hammerstein_wiener: u has {len(u)} samples but y has {len(y)}; pass a "
                         "pair of equal length")
-    if np.ptp(y) == 0.0:
-        raise DataError(f"hammerstein_wiener: the output is constant ({y[0]:g} in all {len(y)} "
-                        "samples); there is nothing to identify: check the output column")
-    if np.ptp(u) == 0.0:
-        raise DataError(f"hammerstein_wiener: the input is constant ({u[0]:g} in all {len(u)} "
-                        "samples); it excites nothing: check the input column")
+    not_constant(y, "the output", "hammerstein_wiener",
+                 "there is nothing to identify: check the output column")
+    not_constant(u, "the input", "hammerstein_wiener", "it excites nothing: check the input column")
     if dt is not None and not (isinstance(dt, (int, float, np.floating)) and np.isfinite(dt)
                                and dt > 0):
         raise ArgumentError(f"hammerstein_wiener: dt must be a positive sample interval in s, "

@@ -63,7 +63,7 @@ from ...signals.trajectory import Trajectory
 from ..model_file import read_family_document
 from ..model_protocol import ModelFit
 from . import hysteresis_kernels as K
-from .single_channel import SingleChannel, fit_percent, one_signal
+from .single_channel import SingleChannel, fit_percent, not_constant, one_signal
 
 __all__ = ["SCHEMA", "HYSTERESIS_FIT", "MODELS", "FORMS", "BoucWenModel",
            "BoucWenOscillatorModel", "PrandtlIshlinskiiModel", "hysteresis", "load_hysteresis",
@@ -137,12 +137,8 @@ def _record(data, input, output, what: str, need_output: bool = True):
 def _check_excited(u: np.ndarray, y: np.ndarray, input: str, output: str) -> None:
     if len(u) < 10:
         raise DataError(f"hysteresis: {len(u)} samples; a loop needs at least 10")
-    if np.ptp(u) == 0.0:
-        raise DataError(f"hysteresis: the input {input!r} is constant ({u[0]:g}); a hysteresis "
-                        "needs an input sweep")
-    if np.ptp(y) == 0.0:
-        raise DataError(f"hysteresis: the output {output!r} is constant ({y[0]:g}); check the "
-                        "output column")
+    not_constant(u, f"the input {input!r}", "hysteresis", "a hysteresis needs an input sweep")
+    not_constant(y, f"the output {output!r}", "hysteresis", "check the output column")
     if K.count_reversals(u, REVERSAL_BAND * float(np.ptp(u))) < 1:
         raise DataError(f"hysteresis not excited: the input {input!r} never reverses (it "
                         f"never turns back by more than {100 * REVERSAL_BAND:g} % of its "

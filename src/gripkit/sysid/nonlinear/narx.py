@@ -52,7 +52,8 @@ from ...signals.trajectory import Trajectory
 from ..model_file import read_family_document
 from ..model_protocol import ModelFit
 from .levenberg_marquardt import Damping, levenberg_marquardt
-from .single_channel import DIVERGENCE_FACTOR, FreeRunModel, fit_percent, one_signal
+from .single_channel import (DIVERGENCE_FACTOR, FreeRunModel, fit_percent, not_constant,
+                             one_signal)
 from ...progress import status, track
 
 __all__ = ["SCHEMA", "NARX_FIT", "NARXModel", "narx", "load_narx", "candidate_terms",
@@ -774,9 +775,8 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
         raise ArgumentError(f"narx: refine must be None or 'simulation', found {refine!r}")
     max_iter = _positive_int(max_iter, "max_iter")
     yall = np.concatenate([r[1] for r in records])
-    if np.ptp(yall) == 0.0:
-        raise DataError(f"narx: the output is constant ({yall[0]:g} in all {len(yall)} samples); "
-                        "there is nothing to identify: check the output column")
+    not_constant(yall, "the output", "narx",
+                 "there is nothing to identify: check the output column")
     degree = _positive_int(degree, "degree")
     ly = _positive_int(ylags if ylags is not None else lags, "ylags", 0)
     lu = _positive_int(ulags if ulags is not None else lags, "ulags", 0)

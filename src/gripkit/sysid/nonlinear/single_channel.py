@@ -1,9 +1,9 @@
 """What the single-input single-output nonlinear families share about their records: the
 protocol's channel names (:class:`SingleChannel`), the fields of a model fitted on its free run
-and the limits beyond which that run counts as diverged (:class:`FreeRunModel`), the check of one
-signal (:func:`one_signal`) and the free-run fit ``100 (1 − ‖y − ŷ‖/‖y − ȳ‖)``
-(:func:`fit_percent`, the definition of :mod:`gripkit.sysid.model_protocol`), each error message
-headed by the family's name."""
+and the limits beyond which that run counts as diverged (:class:`FreeRunModel`), the checks of
+one signal (:func:`one_signal`, :func:`not_constant`) and the free-run fit
+``100 (1 − ‖y − ŷ‖/‖y − ȳ‖)`` (:func:`fit_percent`, the definition of
+:mod:`gripkit.sysid.model_protocol`), each error message headed by the family's name."""
 
 from __future__ import annotations
 
@@ -14,7 +14,8 @@ import numpy as np
 from ...errors import DataError
 from ..model_protocol import ReportMixin
 
-__all__ = ["DIVERGENCE_FACTOR", "FreeRunModel", "SingleChannel", "fit_percent", "one_signal"]
+__all__ = ["DIVERGENCE_FACTOR", "FreeRunModel", "SingleChannel", "fit_percent", "not_constant",
+           "one_signal"]
 
 #: a free run beyond this many times the estimation output's range (about its middle) counts as
 #: diverged
@@ -74,6 +75,13 @@ def one_signal(x, name: str, family: str) -> np.ndarray:
         raise DataError(f"{family}: {name} has {int(np.sum(~np.isfinite(a)))} non-finite "
                         "samples; remove or interpolate them first")
     return a
+
+
+def not_constant(x: np.ndarray, what: str, family: str, fix: str) -> None:
+    """A DataError headed ``family`` when the signal ``x`` (``what``: "the output") is constant:
+    its value, its length and ``fix`` (why it cannot be fitted, what to do)."""
+    if np.ptp(x) == 0.0:
+        raise DataError(f"{family}: {what} is constant ({x[0]:g} in all {len(x)} samples); {fix}")
 
 
 def fit_percent(y: np.ndarray, yhat: np.ndarray, family: str) -> float:

@@ -589,17 +589,15 @@ def _bw_pwa_row(bw, Phi, Gam, C, D, guards, K, xw, u, x0, y):  # pragma: no cove
         ua[0] = d_p * U - H
         # outputs y = C x + D u; the sizes of the finger (4 outputs, 4 or 6 states) get loops with
         # constant trip counts (unrolled by LLVM), as in pwa_step
-        if n == 4 and p_out == 4:
+        if (n == 4 or n == 6) and p_out == 4:
             for i in range(4):
                 acc = D[mode, i, 0] * ua[0] + dc[mode, i]
-                for j in range(4):
-                    acc += C[mode, i, j] * x[j]
-                y[k, i] = acc
-        elif n == 6 and p_out == 4:
-            for i in range(4):
-                acc = D[mode, i, 0] * ua[0] + dc[mode, i]
-                for j in range(6):
-                    acc += C[mode, i, j] * x[j]
+                if n == 4:
+                    for j in range(4):
+                        acc += C[mode, i, j] * x[j]
+                else:
+                    for j in range(6):
+                        acc += C[mode, i, j] * x[j]
                 y[k, i] = acc
         else:
             pwa_output(C, D, mode, x, ua, yk)
