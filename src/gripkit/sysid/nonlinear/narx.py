@@ -228,25 +228,36 @@ def _fit_pruned(reg: _Regression, cols: list[int], threshold: float = 2.0):
 
 
 @njit(cache=True)
+def narx_output(rows, theta, z, u0):  # pragma: no cover - compiled
+    """``Σ_k θ_k Π_d z[rows[k, d]]``: a polynomial NARX model's output at time t from ``z``, the
+    values there of the lagged signals its terms multiply (``rows[k]``: term ``k``'s indices into
+    ``z``, −1 padded); an index past the end of ``z`` stands for ``u0``, the input u(t). The one
+    evaluation of the model: the free run (:func:`_simulate_kernel`, ``z`` one value per base)
+    and the NARX state model of :func:`gripkit.estimation.state_functions` (``z`` the state
+    ``[y(t−1) … y(t−ly), u(t−1) … u(t−lu)]``)."""
+    nz = z.shape[0]
+    acc = 0.0
+    for k in range(rows.shape[0]):
+        v = theta[k]
+        for d in range(rows.shape[1]):
+            b = rows[k, d]
+            if b < 0:
+                break
+            v *= z[b] if b < nz else u0
+        acc += v
+    return acc
+
+
+@njit(cache=True)
 def _simulate_kernel(kinds, lags, rows, theta, u, y, start, limit_lo, limit_hi):
     """Free run in place: ``y[start:]`` from ``y[:start]`` and ``u``. Returns the first sample
     where the run left [limit_lo, limit_hi] or became non-finite, −1 if none."""
     n = y.shape[0]
-    nt = rows.shape[0]
-    deg = rows.shape[1]
+    z = np.empty(kinds.shape[0])  # the bases' values at t
     for t in range(start, n):
-        acc = 0.0
-        for k in range(nt):
-            v = theta[k]
-            for d in range(deg):
-                b = rows[k, d]
-                if b < 0:
-                    break
-                if kinds[b] == 0:
-                    v *= y[t - lags[b]]
-                else:
-                    v *= u[t - lags[b]]
-            acc += v
+        for b in range(kinds.shape[0]):
+            z[b] = y[t - lags[b]] if kinds[b] == 0 else u[t - lags[b]]
+        acc = narx_output(rows, theta, z, u[t])
         y[t] = acc
         if not (acc >= limit_lo and acc <= limit_hi):
             for s in range(t + 1, n):
@@ -274,7 +285,7 @@ def _sensitivity_kernel(kinds, lags, rows, theta, u, y, start, limit_lo, limit_h
         acc = 0.0
         for k in range(nt):
             m = 1.0
-            v = theta[k]  # the same order of products as _simulate_kernel: the same run
+            v = theta[k]  # the same order of products as narx_output: the same run
             for d in range(deg):
                 b = rows[k, d]
                 if b < 0:
