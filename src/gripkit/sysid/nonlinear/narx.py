@@ -37,19 +37,17 @@ of None.
 from __future__ import annotations
 
 import itertools
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 from numba import njit
 
-from ...atomic import write_text
 from ...errors import (ArgumentError, DataError, IdentificationError, ModelError, StabilityWarning,
                        emit_warning)
 from ...params import Parameter, ParameterSet
 from ...signals.trajectory import Trajectory
-from ..model_file import read_family_document
+from ..model_file import FamilyFile, read_family_document
 from ..model_protocol import ModelFit
 from .levenberg_marquardt import Damping, levenberg_marquardt
 from .single_channel import DIVERGENCE_FACTOR, FreeRunModel, fit_percent, one_signal
@@ -331,7 +329,7 @@ def _fit(y, yhat) -> float:
 
 
 @dataclass
-class NARXModel(FreeRunModel):
+class NARXModel(FreeRunModel, FamilyFile):
     """A polynomial NARX model: ``y(t) = Σ θ_k · terms[k](t)``.
 
     ``terms`` (readable names such as ``"y(t-1)*u(t-2)"``), ``theta``, ``theta_std`` (1σ from
@@ -350,6 +348,7 @@ class NARXModel(FreeRunModel):
 
     structure = "narx"
     fit_definition = NARX_FIT
+    _file_what = "NARX model"
     #: how :meth:`compare` starts the free run: from the first ``max_lag`` measured outputs
     initial_state = "measured"
 
@@ -507,10 +506,6 @@ class NARXModel(FreeRunModel):
                     validation_fit_percent=self.validation_fit_percent, criterion=self.criterion,
                     err=[float(v) for v in self.err], frols_terms=list(self.frols_terms),
                     input_name=self.input_name, output_name=self.output_name)
-
-    def save(self, path) -> Path:
-        """Write the model as JSON (schema ``gripkit.narx-model``), atomically."""
-        return write_text(path, json.dumps(self.to_dict(), indent=1) + "\n", what="NARX model")
 
 
 def load_narx(path) -> NARXModel:
