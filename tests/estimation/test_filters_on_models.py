@@ -198,6 +198,25 @@ def test_state_functions_reproduce_each_models_simulation():
     np.testing.assert_allclose(_free_run(f, h, x0, u)[:, 0], ref, rtol=0, atol=1e-12)
 
 
+def test_narx_state_model_is_its_free_run_bit_for_bit():
+    """The NARX state functions and the free run evaluate the polynomial with one function
+    (``narx.narx_output``): the state model run from the free run's first two outputs gives the
+    same numbers to the bit, also with a direct input term u(t), which the state does not hold."""
+    u = _input(200)
+    # y(t) = 1.2 y(t−1) − 0.5 y(t−2) + 0.5 u(t) + 0.2 u(t−1) − 0.05 y(t−1)³ + 0.05 y(t−1) u(t)
+    bases = np.array([[0, 1], [0, 2], [1, 0], [1, 1]])
+    rows = np.array([[0, -1, -1], [1, -1, -1], [2, -1, -1], [3, -1, -1], [0, 0, 0], [0, 2, -1]])
+    direct = NARXModel(2, 1, 3, True, bases, rows, np.array([1.2, -0.5, 0.5, 0.2, -0.05, 0.05]),
+                       np.zeros(6), np.zeros((6, 6)), dt=DT, y_range=(-10.0, 10.0))
+    assert direct.terms[2] == "u(t)" and direct.terms[5] == "y(t-1)*u(t)"
+    for m in (narx(), direct):
+        f, h, x0, nx = state_functions(m)
+        ref = m.simulate(u[:, 0])  # y[:2] = 0, then the free run
+        assert nx == 3 and np.ptp(ref) > 1.0
+        x = np.array([ref[1], ref[0], u[1, 0]])
+        np.testing.assert_array_equal(_free_run(f, h, x, u[2:])[:, 0], ref[2:])
+
+
 # ---------------------------------------------------------------- (2) filters on noisy models
 
 # family: (model, dt for state_functions, Q, R, P0, hidden state indices for NEES)

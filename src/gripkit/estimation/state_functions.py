@@ -452,6 +452,8 @@ def _bwo(model, dt):
 
 
 def _narx(model):
+    from ..sysid.nonlinear.narx import narx_output
+
     ly, lu = int(model.ylags), int(model.ulags)
     if ly < 1:
         raise ModelError(f"state_functions: the NARX model has no output lags (ylags={ly}), so "
@@ -460,26 +462,14 @@ def _narx(model):
     lags = np.ascontiguousarray(model.bases[:, 1], dtype=np.int64)
     rows = np.ascontiguousarray(model.rows, dtype=np.int64)
     theta = np.ascontiguousarray(model.theta, dtype=np.float64)
-    nt, deg, n = rows.shape[0], rows.shape[1], ly + lu
+    n = ly + lu
+    # each base's place in the state: y(t−lag) at lag−1, u(t−lag) at ly+lag−1, u(t) past the end
+    at = np.where(kinds == 0, lags - 1, np.where(lags == 0, n, ly + lags - 1))
+    rows = np.where(rows < 0, -1, at[rows])
 
     @numba.njit
     def output(x, u):  # pragma: no cover - compiled
-        acc = 0.0
-        for k in range(nt):
-            v = theta[k]
-            for j in range(deg):
-                b = rows[k, j]
-                if b < 0:
-                    break
-                lag = lags[b]
-                if kinds[b] == 0:
-                    v *= x[lag - 1]
-                elif lag == 0:
-                    v *= u[0]
-                else:
-                    v *= x[ly + lag - 1]
-            acc += v
-        return acc
+        return narx_output(rows, theta, x, u[0])
 
     @numba.njit
     def f(x, u):  # pragma: no cover - compiled

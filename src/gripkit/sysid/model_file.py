@@ -23,7 +23,7 @@ from ..atomic import write_text
 from ..errors import AccuracyWarning, DataError, ModelError, PathError, emit_warning
 
 __all__ = ["file_sha256", "plain", "write_document", "read_document", "read_family_document",
-           "SCHEMA", "SCHEMA_VERSION"]
+           "FamilyFile", "SCHEMA", "SCHEMA_VERSION"]
 
 SCHEMA = "gripkit.linear-model"
 SCHEMA_VERSION = 2
@@ -73,6 +73,23 @@ def write_document(doc: dict, path) -> None:
     doc = plain(doc)
     doc["content_sha256"] = content_hash(doc)
     write_text(path, json.dumps(doc, indent=1, allow_nan=False) + "\n", what="model file")
+
+
+class FamilyFile:
+    """The one ``save`` of the nonlinear families' models (NARX, Hammerstein–Wiener, NLSS,
+    hysteresis), whose readers check the file with :func:`read_family_document`. A class names
+    its file in ``_file_what`` (for the write's errors) and sets ``_file_allow_nan = False``
+    where its :meth:`to_dict` writes non-finite numbers as null (a NaN left is then refused)."""
+
+    _file_what = "model"
+    _file_allow_nan = True
+
+    def save(self, path) -> Path:
+        """Write the model as JSON (the document of :meth:`to_dict`, its ``schema`` naming the
+        family), atomically."""
+        return write_text(path, json.dumps(self.to_dict(), indent=1,
+                                           allow_nan=self._file_allow_nan) + "\n",
+                          what=self._file_what)
 
 
 #: the deepest nesting of lists and objects a model file may hold (gripkit writes at most 4 levels)

@@ -76,7 +76,6 @@ fit None with a :class:`StabilityWarning`.
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field
 from operator import attrgetter
@@ -84,13 +83,12 @@ from pathlib import Path
 
 import numpy as np
 
-from ...atomic import write_text
 from ...errors import (AccuracyWarning, ArgumentError, DataError, IdentificationError, ModelError,
                        StabilityWarning, emit_warning)
 from ...params import Parameter, ParameterSet
 from ...progress import track
 from ...signals.trajectory import Trajectory
-from ..model_file import read_family_document
+from ..model_file import FamilyFile, read_family_document
 from ..model_protocol import ModelFit
 from . import hw_kernels as K
 from .levenberg_marquardt import levenberg_marquardt
@@ -415,7 +413,7 @@ def _arx_start(recs, nb, nf, nk):
 
 
 @dataclass
-class HWModel(FreeRunModel):
+class HWModel(FreeRunModel, FamilyFile):
     """A Hammerstein–Wiener model ``ŷ = g(B/F f(u)) + y0`` (see the module docstring).
 
     ``theta`` = [input-nonlinearity parameters, b1…b_nb, f1…f_nf, output-nonlinearity
@@ -440,6 +438,8 @@ class HWModel(FreeRunModel):
     records: list = field(default_factory=list)
     structure: str = "hw"
     fit_definition: str = HW_FIT
+    _file_what = "Hammerstein-Wiener model"
+    _file_allow_nan = False  # to_dict writes non-finite σ as null
 
     # -- names and blocks -------------------------------------------------------------------
     @property
@@ -608,11 +608,6 @@ class HWModel(FreeRunModel):
             fit_percent=self.fit_percent, validation_fit_percent=self.validation_fit_percent,
             criterion=self.criterion, input_name=self.input_name, output_name=self.output_name,
             fit_definition=HW_FIT, **({"records": self.records} if self.records else {}))
-
-    def save(self, path) -> Path:
-        """Write the model as JSON (schema ``gripkit.hw-model``), atomically."""
-        return write_text(path, json.dumps(self.to_dict(), indent=1, allow_nan=False) + "\n",
-                          what="Hammerstein-Wiener model")
 
 
 def _signal(x, name: str) -> np.ndarray:

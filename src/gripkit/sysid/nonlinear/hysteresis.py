@@ -47,20 +47,18 @@ hysteresis and is refused with a DataError that says so.
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
-from ...atomic import write_text
 from ...errors import (AccuracyWarning, ArgumentError, DataError, IdentificationError, ModelError,
                        StabilityWarning, emit_warning)
 from ...params import Parameter, ParameterSet
 from ...progress import track
 from ...signals.trajectory import Trajectory
-from ..model_file import read_family_document
+from ..model_file import FamilyFile, read_family_document
 from ..model_protocol import ModelFit
 from . import hysteresis_kernels as K
 from .single_channel import SingleChannel, fit_percent, not_constant, one_signal
@@ -159,7 +157,7 @@ def _output_std(G: np.ndarray, cov: np.ndarray) -> np.ndarray:
 
 
 @dataclass(kw_only=True)
-class _HysteresisModel(SingleChannel):
+class _HysteresisModel(SingleChannel, FamilyFile):
     """What the hysteresis models share: the protocol's names, the fields below (keyword-only),
     compare, save and the common part of the model file."""
 
@@ -175,6 +173,7 @@ class _HysteresisModel(SingleChannel):
 
     structure = ""
     fit_definition = HYSTERESIS_FIT
+    _file_what = "hysteresis model"
     #: with several estimation records: each one's ``n_samples`` and free-run ``fit_percent``
     records = ()
 
@@ -237,11 +236,6 @@ class _HysteresisModel(SingleChannel):
             s = f" ± {sd[p.name]:.3g}" if p.name in sd else " (fixed)"
             rows.append(f"  {p.name:<7s} {p.value: .6g}{s} {p.unit}")
         return "\n".join(rows)
-
-    def save(self, path) -> Path:
-        """Write the model as JSON (schema ``gripkit.hysteresis-model``), atomically."""
-        return write_text(path, json.dumps(self.to_dict(), indent=1) + "\n",
-                          what="hysteresis model")
 
 
 # ---------------------------------------------------------------------------------------------

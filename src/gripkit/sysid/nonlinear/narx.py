@@ -37,19 +37,17 @@ of None.
 from __future__ import annotations
 
 import itertools
-import json
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 from numba import njit
 
-from ...atomic import write_text
 from ...errors import (ArgumentError, DataError, IdentificationError, ModelError, StabilityWarning,
                        emit_warning)
 from ...params import Parameter, ParameterSet
 from ...signals.trajectory import Trajectory
-from ..model_file import read_family_document
+from ..model_file import FamilyFile, read_family_document
 from ..model_protocol import ModelFit
 from .levenberg_marquardt import Damping, levenberg_marquardt
 from .single_channel import (DIVERGENCE_FACTOR, FreeRunModel, fit_percent, not_constant,
@@ -229,25 +227,36 @@ def _fit_pruned(reg: _Regression, cols: list[int], threshold: float = 2.0):
 
 
 @njit(cache=True)
+def narx_output(rows, theta, z, u0):  # pragma: no cover - compiled
+    """``Σ_k θ_k Π_d z[rows[k, d]]``: a polynomial NARX model's output at time t from ``z``, the
+    values there of the lagged signals its terms multiply (``rows[k]``: term ``k``'s indices into
+    ``z``, −1 padded); an index past the end of ``z`` stands for ``u0``, the input u(t). The one
+    evaluation of the model: the free run (:func:`_simulate_kernel`, ``z`` one value per base)
+    and the NARX state model of :func:`gripkit.estimation.state_functions` (``z`` the state
+    ``[y(t−1) … y(t−ly), u(t−1) … u(t−lu)]``)."""
+    nz = z.shape[0]
+    acc = 0.0
+    for k in range(rows.shape[0]):
+        v = theta[k]
+        for d in range(rows.shape[1]):
+            b = rows[k, d]
+            if b < 0:
+                break
+            v *= z[b] if b < nz else u0
+        acc += v
+    return acc
+
+
+@njit(cache=True)
 def _simulate_kernel(kinds, lags, rows, theta, u, y, start, limit_lo, limit_hi):
     """Free run in place: ``y[start:]`` from ``y[:start]`` and ``u``. Returns the first sample
     where the run left [limit_lo, limit_hi] or became non-finite, −1 if none."""
     n = y.shape[0]
-    nt = rows.shape[0]
-    deg = rows.shape[1]
+    z = np.empty(kinds.shape[0])  # the bases' values at t
     for t in range(start, n):
-        acc = 0.0
-        for k in range(nt):
-            v = theta[k]
-            for d in range(deg):
-                b = rows[k, d]
-                if b < 0:
-                    break
-                if kinds[b] == 0:
-                    v *= y[t - lags[b]]
-                else:
-                    v *= u[t - lags[b]]
-            acc += v
+        for b in range(kinds.shape[0]):
+            z[b] = y[t - lags[b]] if kinds[b] == 0 else u[t - lags[b]]
+        acc = narx_output(rows, theta, z, u[t])
         y[t] = acc
         if not (acc >= limit_lo and acc <= limit_hi):
             for s in range(t + 1, n):
@@ -275,7 +284,7 @@ def _sensitivity_kernel(kinds, lags, rows, theta, u, y, start, limit_lo, limit_h
         acc = 0.0
         for k in range(nt):
             m = 1.0
-            v = theta[k]  # the same order of products as _simulate_kernel: the same run
+            v = theta[k]  # the same order of products as narx_output: the same run
             for d in range(deg):
                 b = rows[k, d]
                 if b < 0:
@@ -321,7 +330,7 @@ def _fit(y, yhat) -> float:
 
 
 @dataclass
-class NARXModel(FreeRunModel):
+class NARXModel(FreeRunModel, FamilyFile):
     """A polynomial NARX model: ``y(t) = Σ θ_k · terms[k](t)``.
 
     ``terms`` (readable names such as ``"y(t-1)*u(t-2)"``), ``theta``, ``theta_std`` (1σ from
@@ -340,6 +349,7 @@ class NARXModel(FreeRunModel):
 
     structure = "narx"
     fit_definition = NARX_FIT
+    _file_what = "NARX model"
     #: how :meth:`compare` starts the free run: from the first ``max_lag`` measured outputs
     initial_state = "measured"
 
@@ -497,10 +507,6 @@ class NARXModel(FreeRunModel):
                     validation_fit_percent=self.validation_fit_percent, criterion=self.criterion,
                     err=[float(v) for v in self.err], frols_terms=list(self.frols_terms),
                     input_name=self.input_name, output_name=self.output_name)
-
-    def save(self, path) -> Path:
-        """Write the model as JSON (schema ``gripkit.narx-model``), atomically."""
-        return write_text(path, json.dumps(self.to_dict(), indent=1) + "\n", what="NARX model")
 
 
 def load_narx(path) -> NARXModel:

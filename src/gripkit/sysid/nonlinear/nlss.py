@@ -63,7 +63,6 @@ finds the noise-free output within 3σ at 399 of 400 checks).
 from __future__ import annotations
 
 import itertools
-import json
 import math
 import time
 import warnings
@@ -73,10 +72,9 @@ from pathlib import Path
 import numpy as np
 import scipy.linalg as sla
 
-from ...atomic import write_text
 from ...errors import (AccuracyWarning, ArgumentError, DataError, IdentificationError,
                        ModelError, StabilityWarning, emit_warning)
-from ..model_file import read_family_document
+from ..model_file import FamilyFile, read_family_document
 from ..model_protocol import ModelFit, ReportMixin
 from . import nlss_kernels as K
 from ...params import Parameter, ParameterSet
@@ -169,7 +167,7 @@ def _trajectory_columns(data: Trajectory, names, kind: str, what: str) -> np.nda
 
 
 @dataclass
-class NLSSModel(ReportMixin):
+class NLSSModel(ReportMixin, FamilyFile):
     """A polynomial nonlinear state-space model (module docstring).
 
     Matrices ``A`` (n, n), ``B`` (n, m), ``C`` (p, n), ``D`` (p, m), ``E`` (n, Mζ), ``F`` (p, Mη)
@@ -210,6 +208,7 @@ class NLSSModel(ReportMixin):
 
     structure = "nlss"
     fit_definition = NLSS_FIT
+    _file_what = "NLSS model"
 
     # ----------------------------------------------------------------- protocol
     @property
@@ -400,10 +399,6 @@ class NLSSModel(ReportMixin):
                     criterion=self.criterion, fit_definition=NLSS_FIT,
                     info={k: v for k, v in self.info.items()
                           if isinstance(v, (int, float, str, bool, type(None)))})
-
-    def save(self, path) -> Path:
-        """Write the model as JSON (schema ``gripkit.nlss-model``), atomically."""
-        return write_text(path, json.dumps(self.to_dict(), indent=1) + "\n", what="NLSS model")
 
 
 def load_nlss(path) -> NLSSModel:
