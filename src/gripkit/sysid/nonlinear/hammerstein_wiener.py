@@ -1,6 +1,6 @@
 """Hammerstein, Wiener and Hammerstein–Wiener models: static nonlinearities
-around an output-error linear block, refined by prediction-error minimisation of the simulation
-error, with σ of every parameter.
+around an output-error or a state-space linear block, refined by prediction-error minimisation of
+the simulation error, with σ of every parameter.
 
 The model (one input ``u``, one output ``y``)::
 
@@ -8,6 +8,33 @@ The model (one input ``u``, one output ``y``)::
     x(t) = B(q)/F(q) w(t)                            linear block, output-error form
     ŷ(t) = g(x(t)) + y0                              output nonlinearity (static) and offset
     B(q) = b1 q^-nk + … + b_nb q^-(nk+nb-1),   F(q) = 1 + f1 q^-1 + … + f_nf q^-nf
+
+**State-space linear block** (``linear='ss'``, ``order = n``): in place of B/F ::
+
+    ξ(t+1) = A ξ(t) + b w(t − m),   x(t) = C ξ(t) + d w(t),   m = max(nk − 1, 0)
+    A = [[−a1, 1, 0, …, 0], [−a2, 0, 1, …, 0], …, [−a_n, 0, …, 0]],   C = [1, 0, …, 0]
+
+(observer canonical form; ``d`` is estimated only when ``nk = 0``, else 0). A full ``(A, b, C,
+d)`` would not be identifiable: ``(T A T⁻¹, T b, C T⁻¹, d)`` gives the same output for every
+invertible ``T``, a null space of ``n²`` directions in which σ is infinite. The canonical form
+keeps ``2n (+1)`` parameters, one per coefficient of the transfer function ::
+
+    G(q) = d + (b1 q⁻¹ + … + b_n q⁻ⁿ)/(1 + a1 q⁻¹ + … + a_n q⁻ⁿ)  (times q^-m)
+
+so the parameters are determined as long as that fraction has no common factor (the same
+condition as for B/F); the poles are the roots of ``zⁿ + a1 zⁿ⁻¹ + … + a_n`` (the eigenvalues
+of A). The gain normalisation below puts the chain's gain in ``b`` (and ``d``). Its start is
+gripkit's subspace estimate of the best linear approximation
+(:func:`gripkit.sysid.linear.subspace.n4sid`, order ``n``, the input delayed by ``m``, with
+``D`` when ``nk = 0``), brought to this form through its transfer function, its poles pulled
+inside ``|z| = 0.98``; then everything below is the same as for B/F: the linear PEM, the
+nonlinear fits from it, the order ``n`` chosen in 1, 2, 3 (and ``nk`` in 0, 1, 2) as ``(nb,
+nf)`` are, the free run from the steady state ``ξ(0) = (I − A)⁻¹ b w₋``, a step that puts an
+eigenvalue of A on or outside the unit circle refused. The forward sensitivities
+``∂ξ(t+1)/∂θ = A ∂ξ(t)/∂θ + b ∂w(t−m)/∂θ + (∂A/∂θ) ξ(t) + (∂b/∂θ) w(t−m)`` run beside the
+free run in one numba kernel (:func:`.hw_kernels.ss_run`). The state-space block represents
+exactly the transfer functions of B/F with ``nf = n`` and ``nb = n`` (``nk ≥ 1``) or
+``nb = n + 1`` (``nk = 0``); the two reach the same fit on such data.
 
 ``f = none`` gives a Wiener model, ``g = none`` a Hammerstein model, both ``none`` the linear
 output-error model with an offset. The nonlinearities (``KIND[:N]``):
@@ -844,25 +871,27 @@ def load_hw(path) -> HWModel:
     return m
 
 
-def _linear_orders(linear, order, nb, nf, nk) -> tuple:
+def linear_orders(linear, order, nb, nf, nk, flag: str = "") -> tuple:
     """``linear`` and its orders checked → ``(nb, nf, nk)`` (each None where searched; for
-    ``'ss'`` ``nb = nf = order``)."""
+    ``'ss'`` ``nb = nf = order``). ``flag``: ``'--'`` names them as the CLI's options."""
+    nm = {k: flag + k for k in ("linear", "order", "nb", "nf", "nk")}
     if not isinstance(linear, str) or linear not in LINEAR:
-        raise ArgumentError(f"hammerstein_wiener: linear must be 'oe' (the output-error block "
-                            f"B/F) or 'ss' (the state-space block), found {linear!r:.40}")
-    nk = None if nk is None else _order(nk, "nk", 0)
+        raise ArgumentError(f"hammerstein_wiener: {nm['linear']} must be 'oe' (the output-error "
+                            f"block B/F) or 'ss' (the state-space block), found {linear!r:.40}")
+    nk = None if nk is None else _order(nk, nm["nk"], 0)
     if linear == "oe":
         if order is not None:
-            raise ArgumentError(f"hammerstein_wiener: order={order!r:.20} is the state dimension "
-                                "of the state-space block; with linear='oe' give nb and nf, or "
-                                "pass linear='ss'")
-        return (None if nb is None else _order(nb, "nb", 1),
-                None if nf is None else _order(nf, "nf", 0), nk)
+            raise ArgumentError(f"hammerstein_wiener: {nm['order']} {order!r:.20} is the state "
+                                f"dimension of the state-space block; with {nm['linear']} oe "
+                                f"give {nm['nb']} and {nm['nf']}, or choose {nm['linear']} ss")
+        return (None if nb is None else _order(nb, nm["nb"], 1),
+                None if nf is None else _order(nf, nm["nf"], 0), nk)
     if nb is not None or nf is not None:
-        raise ArgumentError(f"hammerstein_wiener: nb/nf (found {nb!r:.20}/{nf!r:.20}) are the "
-                            "orders of the output-error block; with linear='ss' give order (the "
-                            "state dimension), or pass linear='oe'")
-    n = None if order is None else _order(order, "order", 1)
+        raise ArgumentError(f"hammerstein_wiener: {nm['nb']}/{nm['nf']} (found {nb!r:.20}/"
+                            f"{nf!r:.20}) are the orders of the output-error block; with "
+                            f"{nm['linear']} ss give {nm['order']} (the state dimension), or "
+                            f"choose {nm['linear']} oe")
+    n = None if order is None else _order(order, nm["order"], 1)
     return n, n, nk
 
 
@@ -1249,7 +1278,7 @@ def hammerstein_wiener(u, y=None, *, input_nonlinearity=None, output_nonlinearit
     structures = ([(parse_nonlinearity(a), parse_nonlinearity(b)) for a, b in AUTO_STRUCTURES]
                   if auto else [(parse_nonlinearity(input_nonlinearity, "input_nonlinearity"),
                                  parse_nonlinearity(output_nonlinearity, "output_nonlinearity"))])
-    nb, nf, nk = _linear_orders(linear, order, nb, nf, nk)
+    nb, nf, nk = linear_orders(linear, order, nb, nf, nk)
     validation = _check_validation(validate)
     orders = _order_candidates(nb, nf, nk)
     searched = nb is None or nf is None
