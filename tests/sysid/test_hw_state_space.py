@@ -194,6 +194,13 @@ def test_state_space_model_save_load_round_trip(tmp_path):
     assert m2.compare(tr).fit_percent[0] == m.compare(tr).fit_percent[0]
     assert m2.compare(tr).fit_percent[0] == pytest.approx(m.validation_fit_percent, abs=1e-9)
     assert m2.parameters["a1"].std == m.theta_std[0]
+    with pytest.raises(ModelError, match="of schema_version 2; this gripkit reads "
+                                         "schema_version 1;"):   # a reader of the B/F files
+        HW.read_family_document(path, HW.SCHEMA, 1, family="hw", writer="HWModel.save",
+                                version_key="schema_version")
+    (tmp_path / "v3.json").write_text(json.dumps({**doc, "schema_version": 3}))
+    with pytest.raises(ModelError, match="this gripkit reads schema_version 1 or 2"):
+        load_hw(tmp_path / "v3.json")
     doc.pop("linear")
     (tmp_path / "bad.json").write_text(json.dumps(doc))
     with pytest.raises(ModelError, match="a malformed gripkit.hw-model"):

@@ -111,12 +111,13 @@ from pathlib import Path
 import numpy as np
 
 from ...atomic import write_text
-from ...errors import (AccuracyWarning, ArgumentError, DataError, IdentificationError, ModelError,
-                       StabilityWarning, emit_warning)
+from ...errors import (AccuracyWarning, ArgumentError, DataError, GripkitError,
+                       IdentificationError, ModelError, StabilityWarning, emit_warning)
 from ...params import Parameter, ParameterSet
 from ...progress import track
 from ...signals.trajectory import Trajectory
 from ..model_file import read_family_document
+from ..linear.subspace import n4sid, n4sid_records
 from ..model_protocol import ModelFit
 from . import hw_kernels as K
 from .levenberg_marquardt import levenberg_marquardt
@@ -538,9 +539,6 @@ def _ss_start(recs, n, nk):
     record for its horizon) the least-squares ARX start of the same transfer function is
     used."""
     from scipy.signal import ss2tf
-
-    from ...errors import GripkitError
-    from ..linear.subspace import n4sid, n4sid_records
 
     m = max(nk - 1, 0)
     shifted = [(u[:len(u) - m], y[m:]) for u, y in recs]
