@@ -283,3 +283,24 @@ def test_python_bad_linear_block():
         hammerstein_wiener(u, y, order=3)
     with pytest.raises(ArgumentError, match="with linear ss give order"):
         hammerstein_wiener(u, y, linear="ss", nf=2)
+
+
+@pytest.mark.parametrize("nk", [0, 2])
+def test_state_functions_of_a_state_space_model_run_as_simulate(nk):
+    """The estimation filters' state functions of an ss model (built from its transfer function
+    B/F) give the model's own free run from rest (``simulate(initial_input=0)``)."""
+    from gripkit.estimation.state_functions import state_functions
+
+    lin = [-1.2, 0.6, -0.1, 0.4, 0.2, -0.1] + [0.3] * (nk == 0)
+    theta = np.r_[-0.8, 0.8, lin, 0.1, -0.05, 0.3]
+    P = len(theta)
+    m = HWModel(HW.parse_nonlinearity("saturation"), HW.parse_nonlinearity("poly:3"), 3, 3, nk,
+                theta, np.zeros(P), np.zeros((P, P)), linear="ss", y_range=(-10.0, 10.0))
+    u = np.random.default_rng(2).uniform(-1.5, 1.5, 200)
+    f, h, x, nx = state_functions(m)
+    assert nx == 3 + max(nk - 1, 0)
+    run = np.empty(len(u))
+    for t, ut in enumerate(u):
+        run[t] = h(x, np.array([ut]))[0]
+        x = f(x, np.array([ut]))
+    np.testing.assert_allclose(run, m.simulate(u, initial_input=0.0)[:, 0], rtol=0, atol=1e-12)
