@@ -799,7 +799,8 @@ class HWModel(FreeRunModel):
         ss = {"linear": "ss", "order": self.order} if self.linear == "ss" else {}
         return dict(schema=SCHEMA, schema_version=SS_VERSION if ss else VERSION, kind=self.kind,
             input_nonlinearity=nl(self.input_nl), output_nonlinearity=nl(self.output_nl),
-            **ss, nb=self.nb, nf=self.nf, nk=self.nk, dt=self.dt, y_range=[float(v) for v in self.y_range], names=self.names,
+            **ss, nb=self.nb, nf=self.nf, nk=self.nk, dt=self.dt,
+            y_range=[float(v) for v in self.y_range], names=self.names,
             theta=[float(v) for v in self.theta], theta_std=[fin(v) for v in self.theta_std],
             covariance=[[fin(v) for v in row] for row in self.covariance],
             fit_percent=self.fit_percent, validation_fit_percent=self.validation_fit_percent,
