@@ -227,7 +227,8 @@ def _cli(capsys, *args):
 def test_cli_identify_hw_linear_ss(tmp_path, capsys):
     """``gripkit identify hw … --linear ss --order 3 --nk 1 --json``: fit_percent,
     validation.fit_percent equal to the Python call's, every parameter with a finite σ and the
-    truth within 4σ; ``compare`` on the saved model gives the validation number again."""
+    truth within 4σ; ``compare`` and ``report`` on the saved model give the validation number
+    again."""
     u, y, _ = wiener_ss(np.random.default_rng(30))
     uv, yv, _ = wiener_ss(np.random.default_rng(31), n=400)
     est, val, model = tmp_path / "est.csv", tmp_path / "val.csv", tmp_path / "hw.json"
@@ -250,10 +251,11 @@ def test_cli_identify_hw_linear_ss(tmp_path, capsys):
                             validate=(uv, yv))
     assert d["fit_percent"] == pytest.approx(py.fit_percent, abs=1e-6)
     assert d["validation"]["fit_percent"] == pytest.approx(py.validation_fit_percent, abs=1e-6)
-    code, out, err = _cli(capsys, "compare", model, val, "--fs", 100, "--json")
-    assert code == 0, err
-    assert json.loads(out)["fit_percent"][0] == pytest.approx(d["validation"]["fit_percent"],
-                                                             abs=1e-6)
+    for cmd in (("compare", model, val), ("report", model, val, "--out", tmp_path / "rep")):
+        code, out, err = _cli(capsys, *cmd, "--fs", 100, "--json")
+        assert code == 0, err
+        assert json.loads(out)["fit_percent"][0] == pytest.approx(
+            d["validation"]["fit_percent"], abs=1e-6)
 
 
 @pytest.mark.parametrize("args, phrase", [

@@ -105,6 +105,7 @@ from __future__ import annotations
 
 import json
 import math
+import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -543,10 +544,12 @@ def _ss_start(recs, n, nk):
     m = max(nk - 1, 0)
     shifted = [(u[:len(u) - m], y[m:]) for u, y in recs]
     try:
-        if len(recs) == 1:
-            lm = n4sid(*shifted[0], n, feedthrough=nk == 0)
-        else:
-            lm = n4sid_records(shifted, n, feedthrough=nk == 0)
+        with warnings.catch_warnings():  # a start only: the final model's diagnostics speak
+            warnings.simplefilter("ignore")
+            if len(recs) == 1:
+                lm = n4sid(*shifted[0], n, feedthrough=nk == 0)
+            else:
+                lm = n4sid_records(shifted, n, feedthrough=nk == 0)
         sysm = lm.system
         num, den = ss2tf(sysm.A, sysm.B, sysm.C, sysm.D)
         num, a = np.real(num[0]), np.real(den[1:])
