@@ -1,6 +1,7 @@
 """``gripkit identify hw DATA --input U --output Y [--input-nonlinearity KIND[:N]]
-[--output-nonlinearity KIND[:N]] [--nb NB --nf NF --nk NK] [--validate DATA2] [--out MODEL.json]
-[--json]``: Hammerstein, Wiener and Hammerstein–Wiener models, through
+[--output-nonlinearity KIND[:N]] [--linear oe|ss] [--nb NB --nf NF | --order N] [--nk NK]
+[--validate DATA2] [--out MODEL.json] [--json]``: Hammerstein, Wiener and Hammerstein–Wiener
+models around an output-error (B/F) or a state-space linear block, through
 ``gripkit.sysid.identify(data, "hw", ...)`` (:func:`gripkit.sysid.hammerstein_wiener`)."""
 
 from __future__ import annotations
@@ -21,8 +22,10 @@ from .paths import output_folder
 
 def _summary(m) -> str:
     fmt = lambda v: "diverged" if v is None else f"{v:.2f} %"  # noqa: E731
+    block = (f"state-space order {m.order}, nk = {m.nk}" if m.linear == "ss" else
+             f"[nb nf nk] = [{m.nb} {m.nf} {m.nk}]")
     lines = [f"{m.kind} model: input {m.input_nl.label}, output {m.output_nl.label}, "
-             f"[nb nf nk] = [{m.nb} {m.nf} {m.nk}] ({m.criterion})"]
+             f"{block} ({m.criterion})"]
     lines += [f"  {n:<10s} {v: .6g} ± {s:.3g}" for n, v, s in zip(m.names, m.theta, m.theta_std)]
     lines.append(f"free-run fit (estimation): {fmt(m.fit_percent)}")
     if m.validation_fit_percent is not None or "validation" in m.criterion:
@@ -42,27 +45,36 @@ def identify_hw(data: list[Path] = DataArgs,
                     None, "--output-nonlinearity", help="As --input-nonlinearity, after B/F."),
                 nb: Optional[int] = typer.Option(None, "--nb", help="B coefficients (searched)."),
                 nf: Optional[int] = typer.Option(None, "--nf", help="F coefficients (searched)."),
-                nk: Optional[int] = typer.Option(None, "--nk", help="Input delay (searched)."),
+                nk: Optional[int] = typer.Option(None, "--nk", help="Input delay (searched); "
+                                                 "with --linear ss 0 gives a feedthrough."),
+                linear: str = typer.Option(
+                    "oe", "--linear", help="Linear block: oe (B/F) or ss (state space in "
+                                           "observer canonical form, from the subspace estimate)."),
+                order: Optional[int] = typer.Option(
+                    None, "--order", help="State dimension of --linear ss (searched: 1, 2, 3)."),
                 validate: Optional[Path] = RecordValidateOpt,
                 out: Optional[Path] = ModelJsonOpt,
                 report: Optional[Path] = ModelReportOpt,
                 fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
                 json_out: bool = JsonOpt):
-    """Hammerstein / Wiener / Hammerstein–Wiener: static nonlinearities around B/F, PEM, σ.
+    """Hammerstein / Wiener / Hammerstein–Wiener: static nonlinearities around B/F or a state-space
+    block, PEM, σ.
     Several DATA files: one model of all the records, each from its own steady state
     (``records``: each file's fit and w₋)."""
-    from ..sysid.nonlinear.hammerstein_wiener import parse_nonlinearity
+    from ..sysid.nonlinear.hammerstein_wiener import linear_orders, parse_nonlinearity
 
     for spec, name in ((input_nl, "--input-nonlinearity"), (output_nl, "--output-nonlinearity")):
         if spec is not None:
             parse_nonlinearity(spec, name)
+    linear_orders(linear, order, nb, nf, nk, flag="--")
     check_data_options(fs, fill)
     output_folder(report, "--report")
     with collected_warnings() as caught:
         # several files: one model of every file's record, each from its own steady state
         m, tr, tv = run_identify(data, "hw", input_col, output_col, fs=fs, time=time, fill=fill,
                                  validate=validate, fit_validate=True, detrend="none", nb=nb,
-                                 nf=nf, nk=nk, input_nonlinearity=input_nl,
+                                 nf=nf, nk=nk, linear=linear, order=order,
+                                 input_nonlinearity=input_nl,
                                  output_nonlinearity=output_nl, progress=True)
         page = save_and_page(m, out, report, first_record(tr), tv, data[0], validate)
     lines = report_warnings(caught)
@@ -70,10 +82,13 @@ def identify_hw(data: list[Path] = DataArgs,
         emit_json({"data": data_field(data),
                    "input": input_col, "output": output_col,
                    "structure": {"kind": m.kind, "input_nonlinearity": m.input_nl.label,
-                                 "output_nonlinearity": m.output_nl.label, "nb": m.nb,
-                                 "nf": m.nf, "nk": m.nk, "criterion": m.criterion,
+                                 "output_nonlinearity": m.output_nl.label, "linear": m.linear,
+                                 "order": m.order, "nb": m.nb, "nf": m.nf, "nk": m.nk,
+                                 "criterion": m.criterion,
                                  "gain_normalisation": "unit slope of every nonlinearity in its "
-                                                       "linear part; the gain is in B"},
+                                                       "linear part; the gain is in "
+                                                       + ("b (and d)" if m.linear == "ss"
+                                                          else "B")},
                    "parameters": [{"name": n, "value": float(v), "std": float(s)}
                                   for n, v, s in zip(m.names, m.theta, m.theta_std)],
                    "poles": [[float(z.real), float(z.imag)] for z in m.poles],

@@ -175,7 +175,8 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str,
         each one not given is chosen by the array function, by the free-run fit on ``validate``
         (a trajectory or ``(u, y)``) or by BIC; options of
         :func:`gripkit.sysid.hammerstein_wiener`: ``input_nonlinearity``,
-        ``output_nonlinearity``, ``validate`` …); ``'hysteresis'`` (Bouc-Wen or Prandtl–Ishlinskii,
+        ``output_nonlinearity``, ``linear`` (``'oe'`` B/F or ``'ss'`` state space, with its
+        ``order``), ``validate`` …); ``'hysteresis'`` (Bouc-Wen or Prandtl–Ishlinskii,
         options of
         :func:`gripkit.sysid.hysteresis`: ``model``, ``exponent``, ``operators`` …); ``'nlss'``
         (polynomial nonlinear state space, options of :func:`gripkit.sysid.nlss`: ``order``,

@@ -153,12 +153,13 @@ def read_document(path, schema: str = SCHEMA, newest: int = SCHEMA_VERSION, *,
     return doc
 
 
-def read_family_document(path, schema: str, version: int, *, family: str, writer: str,
+def read_family_document(path, schema: str, version, *, family: str, writer: str,
                          version_key: str = "version") -> dict:
     """The JSON document of a nonlinear family's model file ``path`` (``family``: 'narx', 'hw',
     …; ``writer``: what writes such a file), checked: readable JSON, its ``schema`` and its
-    ``version_key`` equal to ``version``. PathError for a missing or unreadable file, ModelError
-    for anything else."""
+    ``version_key`` equal to ``version`` (an int, or a tuple of the versions read). PathError for
+    a missing or unreadable file, ModelError for anything else."""
+    versions = version if isinstance(version, tuple) else (version,)
     p = Path(path)
     what = f"{family} model file {str(p)!r}"
     try:
@@ -181,8 +182,9 @@ def read_family_document(path, schema: str, version: int, *, family: str, writer
     if found != schema:
         raise ModelError(f"{str(p)!r} has schema {found!r}, expected {schema!r}; load other "
                          "model files with gripkit.sysid.load_model")
-    if doc.get(version_key) != version:
-        raise ModelError(f"{str(p)!r} is a {schema} of {version_key} "
-                         f"{doc.get(version_key)!r}; this gripkit reads {version_key} {version}",
+    found = doc.get(version_key)
+    if isinstance(found, bool) or found not in versions:
+        raise ModelError(f"{str(p)!r} is a {schema} of {version_key} {found!r}; this gripkit "
+                         f"reads {version_key} {' or '.join(map(str, versions))}",
                          hint=f"write it again with this gripkit ({writer})")
     return doc

@@ -1,6 +1,6 @@
 """Hammerstein, Wiener and Hammerstein–Wiener models: static nonlinearities
-around an output-error linear block, refined by prediction-error minimisation of the simulation
-error, with σ of every parameter.
+around an output-error or a state-space linear block, refined by prediction-error minimisation of
+the simulation error, with σ of every parameter.
 
 The model (one input ``u``, one output ``y``)::
 
@@ -8,6 +8,33 @@ The model (one input ``u``, one output ``y``)::
     x(t) = B(q)/F(q) w(t)                            linear block, output-error form
     ŷ(t) = g(x(t)) + y0                              output nonlinearity (static) and offset
     B(q) = b1 q^-nk + … + b_nb q^-(nk+nb-1),   F(q) = 1 + f1 q^-1 + … + f_nf q^-nf
+
+**State-space linear block** (``linear='ss'``, ``order = n``): in place of B/F ::
+
+    ξ(t+1) = A ξ(t) + b w(t − m),   x(t) = C ξ(t) + d w(t),   m = max(nk − 1, 0)
+    A = [[−a1, 1, 0, …, 0], [−a2, 0, 1, …, 0], …, [−a_n, 0, …, 0]],   C = [1, 0, …, 0]
+
+(observer canonical form; ``d`` is estimated only when ``nk = 0``, else 0). A full ``(A, b, C,
+d)`` would not be identifiable: ``(T A T⁻¹, T b, C T⁻¹, d)`` gives the same output for every
+invertible ``T``, a null space of ``n²`` directions in which σ is infinite. The canonical form
+keeps ``2n (+1)`` parameters, one per coefficient of the transfer function ::
+
+    G(q) = d + (b1 q⁻¹ + … + b_n q⁻ⁿ)/(1 + a1 q⁻¹ + … + a_n q⁻ⁿ)  (times q^-m)
+
+so the parameters are determined as long as that fraction has no common factor (the same
+condition as for B/F); the poles are the roots of ``zⁿ + a1 zⁿ⁻¹ + … + a_n`` (the eigenvalues
+of A). The gain normalisation below puts the chain's gain in ``b`` (and ``d``). Its start is
+gripkit's subspace estimate of the best linear approximation
+(:func:`gripkit.sysid.linear.subspace.n4sid`, order ``n``, the input delayed by ``m``, with
+``D`` when ``nk = 0``), brought to this form through its transfer function, its poles pulled
+inside ``|z| = 0.98``; then everything below is the same as for B/F: the linear PEM, the
+nonlinear fits from it, the order ``n`` chosen in 1, 2, 3 (and ``nk`` in 0, 1, 2) as ``(nb,
+nf)`` are, the free run from the steady state ``ξ(0) = (I − A)⁻¹ b w₋``, a step that puts an
+eigenvalue of A on or outside the unit circle refused. The forward sensitivities
+``∂ξ(t+1)/∂θ = A ∂ξ(t)/∂θ + b ∂w(t−m)/∂θ + (∂A/∂θ) ξ(t) + (∂b/∂θ) w(t−m)`` run beside the
+free run in one numba kernel (:func:`.hw_kernels.ss_run`). The state-space block represents
+exactly the transfer functions of B/F with ``nf = n`` and ``nb = n`` (``nk ≥ 1``) or
+``nb = n + 1`` (``nk = 0``); the two reach the same fit on such data.
 
 ``f = none`` gives a Wiener model, ``g = none`` a Hammerstein model, both ``none`` the linear
 output-error model with an offset. The nonlinearities (``KIND[:N]``):
@@ -77,17 +104,19 @@ fit None with a :class:`StabilityWarning`.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass, field
 from operator import attrgetter
 from pathlib import Path
 
 import numpy as np
 
-from ...errors import (AccuracyWarning, ArgumentError, DataError, IdentificationError, ModelError,
-                       StabilityWarning, emit_warning)
+from ...errors import (AccuracyWarning, ArgumentError, DataError, GripkitError,
+                       IdentificationError, ModelError, StabilityWarning, emit_warning)
 from ...params import Parameter, ParameterSet
 from ...progress import track
 from ...signals.trajectory import Trajectory
+from ..linear.subspace import n4sid, n4sid_records
 from ..model_file import FamilyFile, read_family_document
 from ..model_protocol import ModelFit
 from . import hw_kernels as K
@@ -99,7 +128,14 @@ __all__ = ["SCHEMA", "HW_FIT", "HWModel", "Nonlinearity", "hammerstein_wiener", 
            "parse_nonlinearity"]
 
 SCHEMA = "gripkit.hw-model"
+#: the file version of a model with the output-error block (the files written before the
+#: state-space block, read as they are)
 VERSION = 1
+#: the file version of a model with the state-space block (``linear``, ``order``): a reader of
+#: version 1 alone refuses it instead of reading its a, b as B/F
+SS_VERSION = 2
+#: the linear blocks
+LINEAR = ("oe", "ss")
 HW_FIT = ("free run from a steady state of the linear block whose constant input w₋ is fitted "
           "to the record (least squares), fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) over all samples")
 KINDS = {"none": K.NONE, "saturation": K.SATURATION, "deadzone": K.DEADZONE, "poly": K.POLY,
@@ -228,10 +264,13 @@ class _RunOutput:
 class _Problem(_RunOutput):
     """One structure on one record: work arrays for the kernel, ŷ and J."""
 
+    linear = "oe"
+
     def __init__(self, u, fin: Nonlinearity, fout: Nonlinearity, nb, nf, nk):
         self.u, self.fin, self.fout = u, fin, fout
         self.nb, self.nf, self.nk = nb, nf, nk
         self.ni, self.no = fin.n_params, fout.n_params
+        self.L = nb + nf  # parameters of the linear block
         self.P = self.ni + nb + nf + self.no + 1
         n, m = len(u), nk + nb + nf
         self.work = K.HWWork(np.empty(n + m), np.empty(n + m), np.zeros((n + m, self.ni + 1)),
@@ -270,12 +309,65 @@ class _Problem(_RunOutput):
         pin, _, f, pout, _ = self.split(the[:self.P])
         if len(f) and np.max(np.abs(np.roots(np.r_[1.0, f]))) >= 1.0 - 1e-9:
             return False
-        for nl, p in ((self.fin, pin), (self.fout, pout)):
-            if nl.kind == "saturation" and not p[0] < p[1]:
-                return False
-            if nl.kind == "deadzone" and not p[0] <= p[1]:
-                return False
-        return True
+        return _limits_ordered(self.fin, pin) and _limits_ordered(self.fout, pout)
+
+
+class _SSProblem(_RunOutput):
+    """:class:`_Problem` with the state-space linear block of order ``n`` in observer canonical
+    form (module docstring; :func:`.hw_kernels.ss_run`): ``the = [θ, w₋]`` with
+    ``θ = [input block, a1…a_n, b1…b_n, d (nk = 0 only), output block, y0]``."""
+
+    linear = "ss"
+
+    def __init__(self, u, fin: Nonlinearity, fout: Nonlinearity, n, nk):
+        self.u, self.fin, self.fout = u, fin, fout
+        self.nb = self.nf = n
+        self.nk = nk
+        self.ni, self.no = fin.n_params, fout.n_params
+        self.L = 2 * n + (nk == 0)
+        self.P = self.ni + self.L + self.no + 1
+        N, m = len(u), max(nk - 1, 0)
+        self.work = K.SSWork(np.empty(N + m), np.empty(N), np.zeros((N + m, self.ni + 1)),
+                             np.zeros(n), np.zeros((n, self.ni + self.L + 1)))
+        self.gin, self.gout = np.zeros(max(self.ni, 2)), np.zeros(max(self.no, 2))
+        self.cin = np.asarray(fin.consts or (0.0,), dtype=np.float64)
+        self.cout = np.asarray(fout.consts or (0.0,), dtype=np.float64)
+        self.out = K.HWOut(np.empty(N), np.empty((N, self.P + 1)))
+
+    @property
+    def inner(self) -> np.ndarray:
+        """The linear block's output of the last run."""
+        return self.work.x
+
+    def split(self, th):
+        """``(input block, a, b, d, output block, y0)`` of θ."""
+        ni, n, L, no = self.ni, self.nb, self.L, self.no
+        return (th[:ni], th[ni:ni + n], th[ni + n:ni + 2 * n], th[ni + 2 * n:ni + L],
+                th[ni + L:ni + L + no], th[ni + L + no])
+
+    def run(self, the, want_j: bool):
+        """Free run (and J) for ``the = [θ, w₋]``."""
+        the = np.ascontiguousarray(the, dtype=np.float64)
+        pin, a, b, d, pout, y0 = self.split(the[:-1])
+        return K.ss_run(self.u, K.HWBlock(self.fin.code, pin, self.cin, self.gin),
+                        K.SSLinear(a, b, d, self.nk), K.HWBlock(self.fout.code, pout, self.cout,
+                                                                self.gout),
+                        float(y0), float(the[-1]), want_j, self.work, self.out)
+
+    def admissible(self, the) -> bool:
+        pin, a, _, _, pout, _ = self.split(the[:self.P])
+        if np.max(np.abs(np.roots(np.r_[1.0, a]))) >= 1.0 - 1e-9:
+            return False
+        return _limits_ordered(self.fin, pin) and _limits_ordered(self.fout, pout)
+
+
+def _limits_ordered(nl: Nonlinearity, p) -> bool:
+    """The limits of a saturation ordered (``lo < hi``), of a dead zone ``lo ≤ hi``."""
+    if nl.kind == "saturation":
+        return bool(p[0] < p[1])
+    if nl.kind == "deadzone":
+        return bool(p[0] <= p[1])
+    return True
 
 
 class _Records(_RunOutput):
@@ -283,10 +375,11 @@ class _Records(_RunOutput):
     from its own steady state, ``the = [θ, w₋ of record 1, …, w₋ of record R]``; ŷ and J are the
     records' stacked (a record's rows are zero in the other records' w₋ columns)."""
 
-    def __init__(self, us, fin: Nonlinearity, fout: Nonlinearity, nb, nf, nk):
-        self.parts = [_Problem(u, fin, fout, nb, nf, nk) for u in us]
+    def __init__(self, us, fin: Nonlinearity, fout: Nonlinearity, nb, nf, nk, linear="oe"):
+        self.parts = [_problem([u], fin, fout, nb, nf, nk, linear) for u in us]
         p = self.parts[0]
         self.fin, self.fout, self.nb, self.nf, self.nk = fin, fout, nb, nf, nk
+        self.linear, self.L = linear, p.L
         self.ni, self.no, self.P, self.R = p.ni, p.no, p.P, len(us)
         self.bounds = np.cumsum([0] + [len(u) for u in us])
         n = int(self.bounds[-1])
@@ -320,10 +413,14 @@ class _Records(_RunOutput):
         return self.parts[0].admissible(the)
 
 
-def _problem(us, fin: Nonlinearity, fout: Nonlinearity, nb, nf, nk):
-    """:class:`_Problem` for one record, :class:`_Records` for several (``us``: their inputs)."""
-    return _Problem(us[0], fin, fout, nb, nf, nk) if len(us) == 1 else _Records(
-        us, fin, fout, nb, nf, nk)
+def _problem(us, fin: Nonlinearity, fout: Nonlinearity, nb, nf, nk, linear="oe"):
+    """:class:`_Problem` (``linear='oe'``) or :class:`_SSProblem` (``'ss'``, order ``nb = nf``)
+    for one record, :class:`_Records` for several (``us``: their inputs)."""
+    if len(us) > 1:
+        return _Records(us, fin, fout, nb, nf, nk, linear)
+    if linear == "ss":
+        return _SSProblem(us[0], fin, fout, nb, nk)
+    return _Problem(us[0], fin, fout, nb, nf, nk)
 
 
 def _lm(prob: _Problem, y, th0, maxiter: int = 200):
@@ -388,36 +485,86 @@ def _covariance(J: np.ndarray, sse: float):
     return cov, std
 
 
-def _arx_start(recs, nb, nf, nk):
-    """Least-squares ARX ``F y = B q^-nk u + c`` on demeaned signals (``recs``: the records
-    ``(u, y)``, each one's regressors from its own samples only), F stabilised; θ = [b, f]."""
+def _check_length(recs, nb, nf, nk, what=None):
+    """A DataError when a record has fewer than ``nk + nb + nf + 4 (nb + nf + 1)`` samples (too
+    few for the least-squares start of B/F; ``what`` names the orders, default nb, nf, nk)."""
     m = nk + nb + nf
-    rows, target = [], []
     for u, y in recs:
         n = len(y)
         if n - m < 4 * (nb + nf + 1):
             raise DataError(f"hammerstein_wiener: {n} samples{' in a record' * (len(recs) > 1)} "
-                            f"for orders nb={nb}, nf={nf}, nk={nk}; need at least "
+                            f"for {what or f'orders nb={nb}, nf={nf}, nk={nk}'}; need at least "
                             f"{m + 4 * (nb + nf + 1)}: lower the orders or give more data")
+
+
+def _arx_start(recs, nb, nf, nk):
+    """Least-squares ARX ``F y = B q^-nk u + c`` on demeaned signals (``recs``: the records
+    ``(u, y)``, each one's regressors from its own samples only), F stabilised; θ = [b, f]."""
+    _check_length(recs, nb, nf, nk)
+    m = nk + nb + nf
+    rows, target = [], []
+    for u, y in recs:
+        n = len(y)
         cols = [-y[m - j:n - j] for j in range(1, nf + 1)]
         cols += [u[m - nk - i:n - nk - i] for i in range(nb)]
         rows.append(np.column_stack(cols + [np.ones(n - m)]))
         target.append(y[m:])
     th = np.linalg.lstsq(np.vstack(rows), np.concatenate(target), rcond=None)[0]
     f, b = th[:nf], th[nf:nf + nb]
-    if nf:
-        z = np.roots(np.r_[1.0, f])
-        z = np.where(np.abs(z) >= 0.98, 0.98 * z / np.maximum(np.abs(z), 1e-300), z)
-        f = np.real(np.poly(z))[1:]
-    return b, f
+    return b, _stabilised(f)
+
+
+def _stabilised(f: np.ndarray) -> np.ndarray:
+    """``F = [1, f]`` with every root of modulus ≥ 0.98 pulled onto the circle of radius 0.98
+    (same angle); returns the new ``f``."""
+    if not len(f):
+        return f
+    z = np.roots(np.r_[1.0, f])
+    z = np.where(np.abs(z) >= 0.98, 0.98 * z / np.maximum(np.abs(z), 1e-300), z)
+    return np.real(np.poly(z))[1:]
+
+
+def _ss_start(recs, n, nk):
+    """The observer canonical ``[a, b, d]`` (``d`` when ``nk = 0``) of the order-``n`` subspace
+    estimate (:func:`gripkit.sysid.linear.subspace.n4sid`, N4SID weighting; several records:
+    ``n4sid_records``) of the best linear approximation on demeaned signals (``recs``: the
+    records ``(u, y)``), the input delayed by ``nk − 1`` samples, with a feedthrough when
+    ``nk = 0``; the characteristic polynomial stabilised. The transfer function ``C(zI − A)⁻¹B +
+    D = (d + (b1 + d a1) z⁻¹ + … + (b_n + d a_n) z⁻ⁿ)/(1 + a1 z⁻¹ + … + a_n z⁻ⁿ)`` gives ``a``
+    (the coefficients of ``det(zI − A)``) and ``b``. When the subspace step fails (too short a
+    record for its horizon) the least-squares ARX start of the same transfer function is
+    used."""
+    from scipy.signal import ss2tf
+
+    m = max(nk - 1, 0)
+    shifted = [(u[:len(u) - m], y[m:]) for u, y in recs]
+    try:
+        with warnings.catch_warnings():  # a start only: the final model's diagnostics speak
+            warnings.simplefilter("ignore")
+            if len(recs) == 1:
+                lm = n4sid(*shifted[0], n, feedthrough=nk == 0)
+            else:
+                lm = n4sid_records(shifted, n, feedthrough=nk == 0)
+        sysm = lm.system
+        num, den = ss2tf(sysm.A, sysm.B, sysm.C, sysm.D)
+        num, a = np.real(num[0]), np.real(den[1:])
+    except (GripkitError, np.linalg.LinAlgError, ValueError):
+        bo, a = _arx_start(recs, n + (nk == 0), n, nk)
+        num = np.r_[0.0, bo] if nk else bo
+    a = _stabilised(a)
+    d = num[0] if nk == 0 else 0.0
+    return np.r_[a, num[1:] - d * a, [d] if nk == 0 else []]
 
 
 @dataclass
 class HWModel(FreeRunModel, FamilyFile):
     """A Hammerstein–Wiener model ``ŷ = g(B/F f(u)) + y0`` (see the module docstring).
 
-    ``theta`` = [input-nonlinearity parameters, b1…b_nb, f1…f_nf, output-nonlinearity
-    parameters, y0] (names in ``names``), ``theta_std`` (1σ, inf where the data do not determine
+    ``linear``: ``'oe'`` (the linear block B/F) or ``'ss'`` (the observer canonical state-space
+    block of order ``order``; ``nb = nf = order`` count its ``b`` and ``a``, ``nk = 0`` gives it
+    the feedthrough ``d``). ``theta`` = [input-nonlinearity parameters, b1…b_nb, f1…f_nf (for
+    ``'ss'``: a1…a_n, b1…b_n, d when nk = 0), output-nonlinearity parameters, y0] (names in
+    ``names``), ``theta_std`` (1σ, inf where the data do not determine
     it), ``covariance``; ``fit_percent`` (free run, estimation record), ``validation_fit_percent``
     (free run on ``validate=``, None when diverged or none given), ``criterion`` (how structure
     and orders were chosen), ``candidates`` (every structure tried with its score),
@@ -436,6 +583,7 @@ class HWModel(FreeRunModel, FamilyFile):
     candidates: list = field(default_factory=list)
     initial_input: float | None = None
     records: list = field(default_factory=list)
+    linear: str = "oe"
     structure: str = "hw"
     fit_definition: str = HW_FIT
     _file_what = "Hammerstein-Wiener model"
@@ -450,26 +598,69 @@ class HWModel(FreeRunModel, FamilyFile):
             (i, o), "hammerstein-wiener")
 
     @property
+    def order(self) -> int | None:
+        """The state dimension of the state-space linear block (None for ``linear='oe'``)."""
+        return self.nf if self.linear == "ss" else None
+
+    @property
+    def _n_linear(self) -> int:
+        """Parameters of the linear block."""
+        return self.nb + self.nf + (self.linear == "ss" and self.nk == 0)
+
+    @property
     def names(self) -> list[str]:
-        return (self.input_nl.param_names("in") + [f"b{i}" for i in range(1, self.nb + 1)]
-                + [f"f{j}" for j in range(1, self.nf + 1)] + self.output_nl.param_names("out")
+        if self.linear == "ss":
+            lin = ([f"a{i}" for i in range(1, self.nf + 1)]
+                   + [f"b{i}" for i in range(1, self.nb + 1)] + ["d"] * (self.nk == 0))
+        else:
+            lin = ([f"b{i}" for i in range(1, self.nb + 1)]
+                   + [f"f{j}" for j in range(1, self.nf + 1)])
+        return (self.input_nl.param_names("in") + lin + self.output_nl.param_names("out")
                 + ["y0"])
 
     def _part(self, which: str) -> np.ndarray:
-        ni, no = self.input_nl.n_params, self.output_nl.n_params
-        s = {"in": slice(0, ni), "b": slice(ni, ni + self.nb),
-             "f": slice(ni + self.nb, ni + self.nb + self.nf),
-             "out": slice(ni + self.nb + self.nf, ni + self.nb + self.nf + no)}[which]
+        """``'in'``, ``'out'``: the nonlinearities' parameters; ``'b'``, ``'f'``: B/F's (for
+        ``linear='ss'``: ``'b'`` the input vector b, ``'f'`` (or ``'a'``) the coefficients a of
+        ``det(zI − A)`` and ``'d'`` the feedthrough, empty when ``nk ≥ 1``)."""
+        ni, no, L = self.input_nl.n_params, self.output_nl.n_params, self._n_linear
+        if self.linear == "ss":
+            n = self.nf
+            lin = {"f": slice(ni, ni + n), "a": slice(ni, ni + n),
+                   "b": slice(ni + n, ni + 2 * n), "d": slice(ni + 2 * n, ni + L)}
+        else:
+            lin = {"b": slice(ni, ni + self.nb), "f": slice(ni + self.nb, ni + L)}
+        s = {"in": slice(0, ni), "out": slice(ni + L, ni + L + no), **lin}[which]
         return self.theta[s]
 
     @property
     def B(self) -> np.ndarray:
-        """B(q) coefficients from q⁰ (``nk`` leading zeros), as in gripkit's polynomial models."""
+        """B(q) coefficients from q⁰ (``nk`` leading zeros), as in gripkit's polynomial models;
+        for ``linear='ss'`` the numerator of its transfer function ``d + C(qI − A)⁻¹b q^-m``
+        (``nk = 0``: ``[d, b1 + d a1, …, b_n + d a_n]``; else ``nk`` zeros then ``b``)."""
+        if self.linear == "ss" and self.nk == 0:
+            d = self._part("d")[0]
+            return np.r_[d, self._part("b") + d * self._part("a")]
         return np.r_[np.zeros(self.nk), self._part("b")]
 
     @property
     def F(self) -> np.ndarray:
+        """F(q) coefficients from q⁰ (for ``linear='ss'``: ``det(qI − A)/qⁿ``)."""
         return np.r_[1.0, self._part("f")]
+
+    @property
+    def state_space(self):
+        """``(A, b, C, d)`` of the state-space linear block (observer canonical form, module
+        docstring; the input delayed by ``max(nk − 1, 0)`` samples before it); None for
+        ``linear='oe'``."""
+        if self.linear != "ss":
+            return None
+        n = self.nf
+        A = np.eye(n, k=1)
+        A[:, 0] = -self._part("a")
+        C = np.zeros((1, n))
+        C[0, 0] = 1.0
+        d = self._part("d")
+        return A, self._part("b")[:, None].copy(), C, np.array([[d[0] if d.size else 0.0]])
 
     @property
     def poles(self) -> np.ndarray:
@@ -489,6 +680,10 @@ class HWModel(FreeRunModel, FamilyFile):
         docs = {"b": "numerator coefficient of B(q) (carries the chain's gain)",
                 "f": "denominator coefficient of F(q)",
                 "y0": "output offset, in the output's unit"}
+        if self.linear == "ss":
+            docs.update(a="coefficient of det(zI − A), A in observer canonical form",
+                        b="entry of the input vector b (carries the chain's gain)",
+                        d="feedthrough of the linear block")
         ps = []
         for name, v, s in zip(self.names, self.theta, self.theta_std):
             if name.startswith(("in_", "out_")):
@@ -504,7 +699,8 @@ class HWModel(FreeRunModel, FamilyFile):
 
     # -- simulation -------------------------------------------------------------------------
     def _problem(self, u) -> _Problem:
-        return _Problem(u, self.input_nl, self.output_nl, self.nb, self.nf, self.nk)
+        return _problem([u], self.input_nl, self.output_nl, self.nb, self.nf, self.nk,
+                        self.linear)
 
     def _columns(self, data, need_output: bool):
         if isinstance(data, Trajectory):
@@ -600,14 +796,19 @@ class HWModel(FreeRunModel, FamilyFile):
     def to_dict(self) -> dict:
         fin = lambda v: float(v) if np.isfinite(v) else None  # noqa: E731
         nl = lambda n: {"kind": n.kind, "n": n.n, "consts": list(n.consts)}  # noqa: E731
-        return dict(schema=SCHEMA, schema_version=VERSION, kind=self.kind, input_nonlinearity=nl(
-            self.input_nl), output_nonlinearity=nl(self.output_nl), nb=self.nb, nf=self.nf,
-            nk=self.nk, dt=self.dt, y_range=[float(v) for v in self.y_range], names=self.names,
+        ss = {"linear": "ss", "order": self.order} if self.linear == "ss" else {}
+        return dict(schema=SCHEMA, schema_version=SS_VERSION if ss else VERSION, kind=self.kind,
+            input_nonlinearity=nl(self.input_nl), output_nonlinearity=nl(self.output_nl),
+            **ss, nb=self.nb, nf=self.nf, nk=self.nk, dt=self.dt,
+            y_range=[float(v) for v in self.y_range], names=self.names,
             theta=[float(v) for v in self.theta], theta_std=[fin(v) for v in self.theta_std],
             covariance=[[fin(v) for v in row] for row in self.covariance],
             fit_percent=self.fit_percent, validation_fit_percent=self.validation_fit_percent,
             criterion=self.criterion, input_name=self.input_name, output_name=self.output_name,
-            fit_definition=HW_FIT, **({"records": self.records} if self.records else {}))
+            fit_definition=HW_FIT, initial_input=self.initial_input,
+            candidates=[{k: (fin(v) if isinstance(v, float) else v) for k, v in c.items()}
+                        for c in self.candidates],
+            **({"records": self.records} if self.records else {}))
 
 
 def _signal(x, name: str) -> np.ndarray:
@@ -617,7 +818,7 @@ def _signal(x, name: str) -> np.ndarray:
 def load_hw(path) -> HWModel:
     """Read a model written by :meth:`HWModel.save`; any other schema is refused."""
     p = Path(path)
-    doc = read_family_document(p, SCHEMA, VERSION, family="hw",
+    doc = read_family_document(p, SCHEMA, (VERSION, SS_VERSION), family="hw",
                                writer="HWModel.save or `gripkit identify hw --out`",
                                version_key="schema_version")
     try:
@@ -632,13 +833,25 @@ def load_hw(path) -> HWModel:
         nan = lambda v: np.nan if v is None else v  # noqa: E731
         std = np.array([np.inf if v is None else v for v in doc["theta_std"]], dtype=np.float64)
         cov = np.array([[nan(v) for v in row] for row in doc["covariance"]], dtype=np.float64)
+        linear = doc.get("linear", "oe")
+        if (linear == "ss") != (doc["schema_version"] == SS_VERSION) or linear not in LINEAR:
+            raise ValueError(f"linear block {linear!r} in a file of schema_version "
+                             f"{doc['schema_version']}")
+        if linear == "ss" and not int(doc["nb"]) == int(doc["nf"]) == int(doc["order"]):
+            raise ValueError(f"a state-space block of order {doc['order']!r} with nb = "
+                             f"{doc['nb']!r}, nf = {doc['nf']!r}")
         m = HWModel(nls[0], nls[1], int(doc["nb"]), int(doc["nf"]), int(doc["nk"]), theta, std,
-                    cov.reshape(P, P), dt=float(doc["dt"]), y_range=tuple(doc["y_range"]),
+                    cov.reshape(P, P), linear=linear, dt=float(doc["dt"]),
+                    y_range=tuple(doc["y_range"]),
                     fit_percent=doc.get("fit_percent"),
                     validation_fit_percent=doc.get("validation_fit_percent"),
                     criterion=str(doc.get("criterion", "")),
                     input_name=str(doc.get("input_name", "u")),
-                    output_name=str(doc.get("output_name", "y")))
+                    output_name=str(doc.get("output_name", "y")),
+                    initial_input=(None if doc.get("initial_input") is None
+                                   else float(doc["initial_input"])),
+                    candidates=[dict(c) for c in doc.get("candidates", [])],
+                    records=[dict(r) for r in doc.get("records", [])])
     except (KeyError, TypeError, ValueError, ArgumentError) as exc:
         raise ModelError(f"{str(p)!r}: a malformed {SCHEMA} ({type(exc).__name__}: {exc}); write "
                          "it again with HWModel.save") from None
@@ -652,6 +865,30 @@ def load_hw(path) -> HWModel:
     return m
 
 
+def linear_orders(linear, order, nb, nf, nk, flag: str = "") -> tuple:
+    """``linear`` and its orders checked → ``(nb, nf, nk)`` (each None where searched; for
+    ``'ss'`` ``nb = nf = order``). ``flag``: ``'--'`` names them as the CLI's options."""
+    nm = {k: flag + k for k in ("linear", "order", "nb", "nf", "nk")}
+    if not isinstance(linear, str) or linear not in LINEAR:
+        raise ArgumentError(f"hammerstein_wiener: {nm['linear']} must be 'oe' (the output-error "
+                            f"block B/F) or 'ss' (the state-space block), found {linear!r:.40}")
+    nk = None if nk is None else _order(nk, nm["nk"], 0)
+    if linear == "oe":
+        if order is not None:
+            raise ArgumentError(f"hammerstein_wiener: {nm['order']} {order!r:.20} is the state "
+                                f"dimension of the state-space block; with {nm['linear']} oe "
+                                f"give {nm['nb']} and {nm['nf']}, or choose {nm['linear']} ss")
+        return (None if nb is None else _order(nb, nm["nb"], 1),
+                None if nf is None else _order(nf, nm["nf"], 0), nk)
+    if nb is not None or nf is not None:
+        raise ArgumentError(f"hammerstein_wiener: {nm['nb']}/{nm['nf']} (found {nb!r:.20}/"
+                            f"{nf!r:.20}) are the orders of the output-error block; with "
+                            f"{nm['linear']} ss give {nm['order']} (the state dimension), or "
+                            f"choose {nm['linear']} oe")
+    n = None if order is None else _order(order, nm["order"], 1)
+    return n, n, nk
+
+
 def _order(v, name: str, lo: int) -> int:
     if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not lo <= v <= 20:
         raise ArgumentError(f"hammerstein_wiener: {name} must be an integer from {lo} to 20, "
@@ -659,33 +896,43 @@ def _order(v, name: str, lo: int) -> int:
     return int(v)
 
 
-def _fit_structure(recs, fin, fout, nb, nf, nk, lin_start=None, maxiter=200):
-    """Fit one structure (orders given) to the records ``recs`` (a list of ``(u, y)``) from the
-    linear start ``[b, f, y0, w₋ of each record]``; several limit starts, the best kept. Returns
+def _fit_structure(recs, fin, fout, nb, nf, nk, lin_start=None, maxiter=200, linear="oe"):
+    """Fit one structure (orders given; ``linear='ss'``: the state-space block of order
+    ``nb = nf``) to the records ``recs`` (a list of ``(u, y)``) from the linear start
+    ``[linear block, y0, w₋ of each record]`` (without one: the linear model from the ARX or,
+    for ``'ss'``, the subspace start); several limit starts, the best kept. Returns
     (``[θ, w₋ …]``, SSE, J, problem)."""
     us = [r[0] for r in recs]
     u, y = np.concatenate(us), np.concatenate([r[1] for r in recs])
     if lin_start is None:
-        b, f = _arx_start([(ur - u.mean(), yr - y.mean()) for ur, yr in recs], nb, nf, nk)
-        prob = _problem(us, Nonlinearity(), Nonlinearity(), nb, nf, nk)
-        th0 = np.r_[b, f, y.mean() - b.sum() / (1 + f.sum()) * u.mean(), [ur[0] for ur in us]]
+        demeaned = [(ur - u.mean(), yr - y.mean()) for ur, yr in recs]
+        if linear == "ss":
+            _check_length(demeaned, nb + (nk == 0), nf, nk, f"order={nb}, nk={nk}")
+            lin0 = _ss_start(demeaned, nb, nk)
+            a, bd = lin0[:nb], lin0[nb:]
+            gain = (bd[:nb].sum() + (bd[nb] * (1 + a.sum()) if nk == 0 else 0.0)) / (1 + a.sum())
+        else:
+            b, f = _arx_start(demeaned, nb, nf, nk)
+            lin0, gain = np.r_[b, f], b.sum() / (1 + f.sum())
+        prob = _problem(us, Nonlinearity(), Nonlinearity(), nb, nf, nk, linear)
+        th0 = np.r_[lin0, y.mean() - gain * u.mean(), [ur[0] for ur in us]]
         th, sse, J, _ = _lm(prob, y, th0, maxiter)
         if fin.kind == "none" and fout.kind == "none":
             return th, sse, J, prob
         lin_start = th
-    b, f, y0, wpre = (lin_start[:nb], lin_start[nb:nb + nf], lin_start[nb + nf],
-                      lin_start[nb + nf + 1:])
     # the signal entering each block under the linear start
-    lin = _problem(us, Nonlinearity(), Nonlinearity(), nb, nf, nk)
+    lin = _problem(us, Nonlinearity(), Nonlinearity(), nb, nf, nk, linear)
+    L = lin.L
+    lpar, y0, wpre = lin_start[:L], lin_start[L], lin_start[L + 1:]
     lin.run(lin_start, False)
     xlin = lin.inner.copy()
     fin = _with_consts(fin, u)
     fout = _with_consts(fout, xlin)
-    prob = _problem(us, fin, fout, nb, nf, nk)
+    prob = _problem(us, fin, fout, nb, nf, nk, linear)
     best = None
     for pin in _limit_starts(fin, u):
         for pout in _limit_starts(fout, xlin):
-            th0 = np.r_[pin, b, f, pout, y0, wpre]
+            th0 = np.r_[pin, lpar, pout, y0, wpre]
             if not prob.admissible(th0):
                 continue
             th, sse, J, _ = _lm(prob, y, th0, maxiter)
@@ -706,7 +953,8 @@ def _excitation_check(model: HWModel, us: list):
         if where == "input":
             v = np.concatenate(us)
         else:
-            prob = _problem(us, model.input_nl, model.output_nl, model.nb, model.nf, model.nk)
+            prob = _problem(us, model.input_nl, model.output_nl, model.nb, model.nf, model.nk,
+                            model.linear)
             w0 = ([r["initial_input"] for r in model.records] if model.records
                   else [model.initial_input])
             prob.run(np.r_[model.theta, w0], False)
@@ -791,8 +1039,8 @@ class _Search:
     and the progress bar; builds candidate models and scores them (validation free-run fit, or
     −BIC)."""
 
-    def __init__(self, recs, validation, dt, maxiter, bar):
-        self.recs = recs
+    def __init__(self, recs, validation, dt, maxiter, bar, linear="oe"):
+        self.recs, self.linear = recs, linear
         self.us = [r[0] for r in recs]
         self.u, self.y = np.concatenate(self.us), np.concatenate([r[1] for r in recs])
         y = self.y
@@ -819,7 +1067,7 @@ class _Search:
         cov, std = _covariance(J, sse)
         P = len(the) - self.R
         m = HWModel(fin, fout, o[0], o[1], o[2], the[:P], std[:P], cov[:P, :P], dt=self.dt,
-                    y_range=self.y_range)
+                    y_range=self.y_range, linear=self.linear)
         m.initial_input = float(the[P])
         if self.R > 1:
             m.records = [{"n_samples": len(ur), "initial_input": float(w)}
@@ -842,7 +1090,8 @@ class _Search:
             fin_c, fout_c = fin, fout
         else:
             th, sse, J, prob = _fit_structure(self.recs, fin, fout, *o,
-                                              lin_start=self.lin_fits[o][0], maxiter=self.maxiter)
+                                              lin_start=self.lin_fits[o][0], maxiter=self.maxiter,
+                                              linear=self.linear)
             fin_c, fout_c = prob.fin, prob.fout
         m = self.make(fin_c, fout_c, o, th, sse, J)
         return self.score(m, sse), m, (fin, fout)
@@ -857,7 +1106,7 @@ def _choose_orders(search: _Search, orders: list) -> tuple:
     for o in orders:
         search.step()
         th, sse, J, _ = _fit_structure(search.recs, Nonlinearity(), Nonlinearity(), *o,
-                                       maxiter=screen)
+                                       maxiter=screen, linear=search.linear)
         if J is None:
             continue
         lin_fits[o] = (th, sse, J)
@@ -868,8 +1117,8 @@ def _choose_orders(search: _Search, orders: list) -> tuple:
         search.make(Nonlinearity(), Nonlinearity(), o, *lin_fits[o]), lin_fits[o][1]))
     o = ranked[0]
     if screen < maxiter:  # the chosen orders' linear model to convergence
-        th, sse, J, _ = _lm(_problem(search.us, Nonlinearity(), Nonlinearity(), *o), search.y,
-                            lin_fits[o][0], maxiter)
+        th, sse, J, _ = _lm(_problem(search.us, Nonlinearity(), Nonlinearity(), *o,
+                                     search.linear), search.y, lin_fits[o][0], maxiter)
         lin_fits[o] = (th, sse, J)
     return o
 
@@ -917,7 +1166,8 @@ def _pick(cands: list, validated: bool) -> HWModel:
         best = min((c for c in cands if c[0] >= cands[0][0] - PARSIMONY_POINTS),
                    key=lambda c: (not np.all(np.isfinite(c[1].theta_std)), len(c[1].theta)))[1]
     best.candidates = [{"input": c[1].input_nl.label, "output": c[1].output_nl.label,
-                        "nb": c[1].nb, "nf": c[1].nf, "nk": c[1].nk,
+                        **({"linear": "ss", "order": c[1].order} if c[1].linear == "ss" else
+                           {"nb": c[1].nb, "nf": c[1].nf}), "nk": c[1].nk,
                         ("validation_fit_percent" if validated else "bic"):
                         (c[0] if validated else -c[0])} for c in cands]
     return best
@@ -927,7 +1177,10 @@ def _criterion(best: HWModel, orders_chosen: bool, auto: bool, chosen_by: str,
                n_structures: int, n_joined: int, refit: bool) -> str:
     """One line on how the orders and the structure of ``best`` were chosen."""
     what = []
-    if orders_chosen:
+    if orders_chosen and best.linear == "ss":
+        what.append(f"state-space order {best.order}, nk = {best.nk} by {chosen_by} (the delay "
+                    f"on the linear model{'; the order again for the structure' * refit})")
+    elif orders_chosen:
         what.append(f"orders [nb nf nk] = [{best.nb} {best.nf} {best.nk}] by {chosen_by} (the "
                     f"delay on the linear model"
                     f"{'; nb and nf again for the structure' if refit else ''})")
@@ -983,6 +1236,7 @@ def _records(u, y) -> list:
 
 def hammerstein_wiener(u, y=None, *, input_nonlinearity=None, output_nonlinearity=None,
                        nb: int | None = None, nf: int | None = None, nk: int | None = None,
+                       linear: str = "oe", order: int | None = None,
                        dt: float | None = None, validate=None, maxiter: int = 200,
                        progress: bool = False) -> HWModel:
     """Hammerstein, Wiener or Hammerstein–Wiener model of ``y`` driven by ``u`` (see the module
@@ -995,7 +1249,10 @@ def hammerstein_wiener(u, y=None, *, input_nonlinearity=None, output_nonlinearit
     ``'deadzone'``, ``'poly[:N]'``, ``'pwl[:N]'``, ``'sigmoid[:N]'``; when both are None the
     structure is chosen among :data:`AUTO_STRUCTURES` (one None with the other given means
     ``'none'``). ``nb``, ``nf``, ``nk``: orders of B/F; each None is chosen (``(nb, nf)`` in
-    (1,1), (2,2), (3,3); ``nk`` in 0, 1, 2) on the linear model. Choice by free-run fit on
+    (1,1), (2,2), (3,3); ``nk`` in 0, 1, 2) on the linear model. ``linear``: ``'oe'`` (B/F,
+    default) or ``'ss'`` (the state-space block in observer canonical form, module docstring;
+    ``order`` its state dimension, None: chosen in 1, 2, 3 as ``(nb, nf)`` are; ``nk`` its
+    delay, 0 with a feedthrough ``d``; ``nb``, ``nf`` are not taken). Choice by free-run fit on
     ``validate=(u2, y2)`` when given, else by BIC. ``dt``: sample interval (s), default 1.
     ``progress``: a progress bar on stderr (one step per structure and start).
     """
@@ -1012,9 +1269,7 @@ def hammerstein_wiener(u, y=None, *, input_nonlinearity=None, output_nonlinearit
     structures = ([(parse_nonlinearity(a), parse_nonlinearity(b)) for a, b in AUTO_STRUCTURES]
                   if auto else [(parse_nonlinearity(input_nonlinearity, "input_nonlinearity"),
                                  parse_nonlinearity(output_nonlinearity, "output_nonlinearity"))])
-    nb = None if nb is None else _order(nb, "nb", 1)
-    nf = None if nf is None else _order(nf, "nf", 0)
-    nk = None if nk is None else _order(nk, "nk", 0)
+    nb, nf, nk = linear_orders(linear, order, nb, nf, nk)
     validation = _check_validation(validate)
     orders = _order_candidates(nb, nf, nk)
     searched = nb is None or nf is None
@@ -1023,7 +1278,7 @@ def hammerstein_wiener(u, y=None, *, input_nonlinearity=None, output_nonlinearit
     steps = (len(orders) + len(structures) + (N_JOINED**2 if auto else 0)
              + (len(dyn) - 1 if searched else 0))
     bar = iter(track(range(steps), total=steps, description="hw fit", enabled=progress))
-    search = _Search(recs, validation, dt, maxiter, bar)
+    search = _Search(recs, validation, dt, maxiter, bar, linear)
     o = _choose_orders(search, orders)
     cands = _fit_candidates(search, structures, o, auto)
     refit = _refit_dynamics(search, cands, o, dyn, searched)

@@ -1,7 +1,8 @@
 """Numba kernels of the Hammerstein–Wiener family (:mod:`.hammerstein_wiener`): the static
-nonlinearities with their derivatives, and the free run of ``y = g(B/F f(u)) + y0`` with the
-forward sensitivities of ŷ to every parameter (scalar, allocation-free loops; the caller owns every
-work array)."""
+nonlinearities with their derivatives, and the free run of ``y = g(B/F f(u)) + y0`` (output-error
+linear block, :func:`hw_run`) or of ``y = g(G f(u)) + y0`` with ``G`` a state-space block in
+observer canonical form (:func:`ss_run`), each with the forward sensitivities of ŷ to every
+parameter (scalar, allocation-free loops; the caller owns every work array)."""
 
 from __future__ import annotations
 
@@ -22,6 +23,13 @@ HWLinear = namedtuple("HWLinear", "b f nk")
 #: scratch of the free run: ``w``, ``x`` (N + M) and their sensitivities ``dw`` (N + M, ni + 1),
 #: ``dx`` (N + M, ni + nb + nf + 1), ``M = nk + nb + nf`` the rows before the record
 HWWork = namedtuple("HWWork", "w x dw dx")
+#: the state-space linear block in observer canonical form (:func:`ss_run`): ``a1…a_n``, ``b1…b_n``,
+#: ``d`` (one element: the feedthrough, when ``nk = 0``; else empty) and the delay ``nk``
+SSLinear = namedtuple("SSLinear", "a b d nk")
+#: scratch of the state-space free run: ``w`` (N + M) and ``dw`` (N + M, ni + 1) as in
+#: :data:`HWWork` (``M = max(nk − 1, 0)`` rows before the record), ``x`` (N) the block's output,
+#: the state ``xi`` (n) and its sensitivities ``dxi`` (n, ni + 2n + nd + 1)
+SSWork = namedtuple("SSWork", "w x dw xi dxi")
 #: what the free run writes: ``yhat`` (N) and, when asked, ``jac`` (N, P + 1)
 HWOut = namedtuple("HWOut", "yhat jac")
 
@@ -173,6 +181,124 @@ def hw_run(u, fin, lin, fout, y0, wpre, want_j, work, out):
                 jac[r, nl + k] = gout[k]
             jac[r, nl + no] = 1.0
             jac[r, nl + no + 1] = gd * dx[t, nl]
+    return bad
+
+
+@njit(cache=True, _nrt=False)
+def ss_run(u, fin, lin, fout, y0, wpre, want_j, work, out):
+    """Free run of ``w = f(u)``, the observer canonical state-space block ::
+
+        ξ(t+1) = A ξ(t) + b w(t − m),   x(t) = ξ_1(t) + d w(t),   m = max(nk − 1, 0)
+        A = [[−a1, 1, 0, …], [−a2, 0, 1, …], …, [−a_n, 0, …, 0]]
+
+    (``d`` only when ``nk = 0``), and ``ŷ = g(x) + y0``, from the block's steady state under the
+    constant input ``wpre`` (``w(t<0) = wpre``, ``ξ(0) = (I − A)⁻¹ b wpre``: ``ξ_1 = Σb/(1 + Σa)
+    wpre``, ``ξ_i = Σ_{k≥i} (b_k wpre − a_k ξ_1)``).
+
+    ``fin``, ``fout``: :data:`HWBlock`, ``lin``: :data:`SSLinear`, ``work``: :data:`SSWork`,
+    ``out``: :data:`HWOut`. With ``want_j`` the rows of ``out.jac`` (N, P + 1) receive
+    ∂ŷ(t)/∂θ for ``θ = [fin.p, a, b, d, fout.p, y0, wpre]``, from the sensitivities
+    ``∂ξ(t+1)/∂θ = A ∂ξ(t)/∂θ + b ∂w/∂θ + (∂A/∂θ) ξ(t) + (∂b/∂θ) w``. Returns the first sample
+    where ŷ is not finite, −1 if none."""
+    a, b, d, nk = lin.a, lin.b, lin.d, lin.nk
+    w, x, dw, xi, dxi = work.w, work.x, work.dw, work.xi, work.dxi
+    gin, gout, yhat, jac = fin.grad, fout.grad, out.yhat, out.jac
+    n = u.shape[0]
+    ni = fin.p.shape[0]
+    ns = a.shape[0]
+    nd = d.shape[0]
+    no = fout.p.shape[0]
+    ca = ni                   # columns of a, b, d and wpre in dxi (and in jac, but wpre)
+    cb = ni + ns
+    cd = ni + 2 * ns
+    nl = cd + nd
+    cw = nl
+    m = nk - 1 if nk > 0 else 0
+    dd = d[0] if nd > 0 else 0.0
+    sa = 1.0
+    sb = 0.0
+    for i in range(ns):
+        sa += a[i]
+        sb += b[i]
+    x1 = sb / sa * wpre
+    acc = 0.0
+    for i in range(ns - 1, -1, -1):
+        acc += b[i] * wpre - a[i] * x1
+        xi[i] = acc
+    for t in range(m):
+        w[t] = wpre
+    if want_j:
+        for t in range(m):
+            for k in range(ni):
+                dw[t, k] = 0.0
+            dw[t, ni] = 1.0
+        for k in range(nl + 1):
+            d1 = 0.0          # ∂ξ_1(0)/∂θ_k
+            if ca <= k < cb:
+                d1 = -x1 / sa
+            elif cb <= k < cd:
+                d1 = wpre / sa
+            elif k == cw:
+                d1 = sb / sa
+            acc = 0.0
+            for i in range(ns - 1, -1, -1):
+                acc -= a[i] * d1
+                if k == cb + i:
+                    acc += wpre
+                if k == ca + i:
+                    acc -= x1
+                if k == cw:
+                    acc += b[i]
+                dxi[i, k] = acc
+    bad = -1
+    for r in range(n):
+        t = r + m
+        wt, _ = nl_eval(fin.kind, fin.p, fin.c, u[r], gin)
+        w[t] = wt
+        wi = w[t - m]
+        v = xi[0] + dd * wi
+        x[r] = v
+        g, gd = nl_eval(fout.kind, fout.p, fout.c, v, gout)
+        yt = g + y0
+        yhat[r] = yt
+        if bad < 0 and not np.isfinite(yt):
+            bad = r
+        if want_j:
+            for k in range(ni):
+                dw[t, k] = gin[k]
+            dw[t, ni] = 0.0
+            for k in range(nl + 1):
+                dwi = 0.0     # ∂w(t − m)/∂θ_k
+                if k < ni:
+                    dwi = dw[t - m, k]
+                elif k == cw:
+                    dwi = dw[t - m, ni]
+                dv = dxi[0, k] + dd * dwi
+                if nd > 0 and k == cd:
+                    dv += wi
+                if k < nl:
+                    jac[r, k] = gd * dv
+                else:
+                    jac[r, nl + no + 1] = gd * dv
+                d1 = dxi[0, k]
+                for i in range(ns):
+                    s = -a[i] * d1 + b[i] * dwi
+                    if i + 1 < ns:
+                        s += dxi[i + 1, k]
+                    if k == ca + i:
+                        s -= xi[0]
+                    if k == cb + i:
+                        s += wi
+                    dxi[i, k] = s
+            for k in range(no):
+                jac[r, nl + k] = gout[k]
+            jac[r, nl + no] = 1.0
+        x1 = xi[0]
+        for i in range(ns):
+            s = -a[i] * x1 + b[i] * wi
+            if i + 1 < ns:
+                s += xi[i + 1]
+            xi[i] = s
     return bad
 
 
