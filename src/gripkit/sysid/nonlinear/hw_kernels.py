@@ -185,36 +185,19 @@ def hw_run(u, fin, lin, fout, y0, wpre, want_j, work, out):
 
 
 @njit(cache=True, _nrt=False)
-def ss_run(u, fin, lin, fout, y0, wpre, want_j, work, out):
-    """Free run of ``w = f(u)``, the observer canonical state-space block ::
-
-        ξ(t+1) = A ξ(t) + b w(t − m),   x(t) = ξ_1(t) + d w(t),   m = max(nk − 1, 0)
-        A = [[−a1, 1, 0, …], [−a2, 0, 1, …], …, [−a_n, 0, …, 0]]
-
-    (``d`` only when ``nk = 0``), and ``ŷ = g(x) + y0``, from the block's steady state under the
-    constant input ``wpre`` (``w(t<0) = wpre``, ``ξ(0) = (I − A)⁻¹ b wpre``: ``ξ_1 = Σb/(1 + Σa)
-    wpre``, ``ξ_i = Σ_{k≥i} (b_k wpre − a_k ξ_1)``).
-
-    ``fin``, ``fout``: :data:`HWBlock`, ``lin``: :data:`SSLinear`, ``work``: :data:`SSWork`,
-    ``out``: :data:`HWOut`. With ``want_j`` the rows of ``out.jac`` (N, P + 1) receive
-    ∂ŷ(t)/∂θ for ``θ = [fin.p, a, b, d, fout.p, y0, wpre]``, from the sensitivities
-    ``∂ξ(t+1)/∂θ = A ∂ξ(t)/∂θ + b ∂w/∂θ + (∂A/∂θ) ξ(t) + (∂b/∂θ) w``. Returns the first sample
-    where ŷ is not finite, −1 if none."""
-    a, b, d, nk = lin.a, lin.b, lin.d, lin.nk
-    w, x, dw, xi, dxi = work.w, work.x, work.dw, work.xi, work.dxi
-    gin, gout, yhat, jac = fin.grad, fout.grad, out.yhat, out.jac
-    n = u.shape[0]
-    ni = fin.p.shape[0]
+def _ss_start(lin, wpre, want_j, work, ni, m):
+    """The start of :func:`ss_run`: the block's steady state under the constant input ``wpre``
+    (``ξ_1 = Σb/(1 + Σa)·wpre``, ``ξ_i = Σ_{k≥i} (b_k wpre − a_k ξ_1)``) into ``work.xi``, the
+    ``m`` delayed inputs ``w(t<0) = wpre`` and, with ``want_j``, their derivatives by θ (``ni``
+    columns of the input nonlinearity first, as in :func:`ss_run`)."""
+    a, b, d = lin.a, lin.b, lin.d
+    w, dw, xi, dxi = work.w, work.dw, work.xi, work.dxi
     ns = a.shape[0]
-    nd = d.shape[0]
-    no = fout.p.shape[0]
-    ca = ni                   # columns of a, b, d and wpre in dxi (and in jac, but wpre)
+    ca = ni
     cb = ni + ns
     cd = ni + 2 * ns
-    nl = cd + nd
+    nl = cd + d.shape[0]
     cw = nl
-    m = nk - 1 if nk > 0 else 0
-    dd = d[0] if nd > 0 else 0.0
     sa = 1.0
     sb = 0.0
     for i in range(ns):
@@ -250,6 +233,40 @@ def ss_run(u, fin, lin, fout, y0, wpre, want_j, work, out):
                 if k == cw:
                     acc += b[i]
                 dxi[i, k] = acc
+
+
+@njit(cache=True, _nrt=False)
+def ss_run(u, fin, lin, fout, y0, wpre, want_j, work, out):
+    """Free run of ``w = f(u)``, the observer canonical state-space block ::
+
+        ξ(t+1) = A ξ(t) + b w(t − m),   x(t) = ξ_1(t) + d w(t),   m = max(nk − 1, 0)
+        A = [[−a1, 1, 0, …], [−a2, 0, 1, …], …, [−a_n, 0, …, 0]]
+
+    (``d`` only when ``nk = 0``), and ``ŷ = g(x) + y0``, from the block's steady state under the
+    constant input ``wpre`` (``w(t<0) = wpre``, ``ξ(0) = (I − A)⁻¹ b wpre``: ``ξ_1 = Σb/(1 + Σa)
+    wpre``, ``ξ_i = Σ_{k≥i} (b_k wpre − a_k ξ_1)``).
+
+    ``fin``, ``fout``: :data:`HWBlock`, ``lin``: :data:`SSLinear`, ``work``: :data:`SSWork`,
+    ``out``: :data:`HWOut`. With ``want_j`` the rows of ``out.jac`` (N, P + 1) receive
+    ∂ŷ(t)/∂θ for ``θ = [fin.p, a, b, d, fout.p, y0, wpre]``, from the sensitivities
+    ``∂ξ(t+1)/∂θ = A ∂ξ(t)/∂θ + b ∂w/∂θ + (∂A/∂θ) ξ(t) + (∂b/∂θ) w``. Returns the first sample
+    where ŷ is not finite, −1 if none."""
+    a, b, d, nk = lin.a, lin.b, lin.d, lin.nk
+    w, x, dw, xi, dxi = work.w, work.x, work.dw, work.xi, work.dxi
+    gin, gout, yhat, jac = fin.grad, fout.grad, out.yhat, out.jac
+    n = u.shape[0]
+    ni = fin.p.shape[0]
+    ns = a.shape[0]
+    nd = d.shape[0]
+    no = fout.p.shape[0]
+    ca = ni                   # columns of a, b, d and wpre in dxi (and in jac, but wpre)
+    cb = ni + ns
+    cd = ni + 2 * ns
+    nl = cd + nd
+    cw = nl
+    m = nk - 1 if nk > 0 else 0
+    dd = d[0] if nd > 0 else 0.0
+    _ss_start(lin, wpre, want_j, work, ni, m)
     bad = -1
     for r in range(n):
         t = r + m
