@@ -70,6 +70,7 @@ def _fit_data(seed=0):
 
 def _kernel_time(m, th, U, fs):
     """The numba row kernel alone, on arrays prepared once (what a loop calling it would pay)."""
+    from gripkit.sim.hybrid import PWAGuards
     from gripkit.systems.tsfm import gripper as T
 
     nf = len(T.FINGER_NAMES)
@@ -79,10 +80,9 @@ def _kernel_time(m, th, U, fs):
     bw = np.ascontiguousarray(th[0, [0, 2, 3, 4]])
     y = np.empty((U.shape[0], len(m.outputs)))
     x0 = np.zeros(len(m.states))
+    guards = PWAGuards(d["G"][0], d["H"][0], d["target"], d["ng"])
     return measure(lambda: T._bw_pwa_row(bw, d["Phi"][0], d["Gam"][0], d["C"][0], d["D"][0],
-                                         d["G"][0], d["H"][0],
-                                           d["target"], d["ng"], m.levels, th[0, nf], U, x0.copy(),
-                                           y))
+                                         guards, m.levels, th[0, nf], U, x0.copy(), y))
 
 
 FREE = ("d_p", "lam", "beta", "a", "b")
