@@ -6,9 +6,12 @@ passes 17 arrays to the kernel (the figures: docs/performance.md, "One-state RNE
 This path packs the model and its scratch memory once into one float64 array
 (:func:`pack`) kept with the chain, so a call is one ``np.empty`` and one call of a kernel compiled
 for float64 arrays only, with three (mass matrix) or five (RNEA) arguments: unboxing an argument
-is most of the cost of a call. Other argument types raise TypeError
-at the call, and the kernel reports a state of the wrong length or with NaN/inf: the caller then
-takes the validating path, which raises the error. The scratch is shared by the calls on one
+is most of the cost of a call. Inside, the model's 2-D views are built in place
+(:func:`_rows`) and the link transforms, CRBA and Γ projection are compiled inline
+(:func:`_inline_twins`): one function without calls into numba's runtime or between kernels.
+Other argument types raise TypeError at the call, and the kernel reports a state of the wrong
+length, a strided state or one with NaN/inf: the caller then takes the validating path, which
+converts it or raises the error. The scratch is shared by the calls on one
 chain, which is safe because the kernels hold the GIL (compiled without ``nogil``): calls from
 several threads run one after the other. The buffer is for these two kernels only; the batched
 and ``prange`` kernels take their own scratch per state, never this buffer. The mass matrix
