@@ -59,7 +59,7 @@ def pack(arrays) -> np.ndarray:
 @intrinsic
 def _rows(typingctx, a, start, rows, cols):  # pragma: no cover - compiled
     """``a[start:start + rows·cols]`` as a C-contiguous (rows, cols) array, built in place: numba's
-    ``reshape`` calls a C helper of its runtime on each view, five of them the bulk of the
+    ``reshape`` calls a C helper of its runtime for each view, six per call here, most of the
     packed-model views' cost (docs/performance.md, CRBA). No bounds check: the offsets and sizes
     come from :func:`pack`, which sized the buffer for them."""
     ret = nbtypes.Array(a.dtype, 2, "C")
@@ -85,18 +85,19 @@ def _inline_twins(*names):
     compiled ``inline="always"`` into the one-state kernels, the calls among the named functions
     going to the twins too. The one-state mass matrix is then one function, without compiled
     calls that pass each array as its nine fields (docs/performance.md, CRBA); the batched
-    kernels keep their compiled calls. Same operations in the same order: bit-identical."""
+    kernels keep their compiled calls. Same operations in the same order: bit-identical.
+    Returns {name: twin}."""
     ns = dict(vars(kernels))
     for name in names:
         fn = getattr(kernels, name).py_func
         ns[name] = numba.njit(error_model="numpy", _nrt=False, inline="always")(
             types.FunctionType(fn.__code__, ns, name, fn.__defaults__, fn.__closure__))
-    return tuple(ns[name] for name in names)
+    return {name: ns[name] for name in names}
 
 
-_chain_links, _crba, _project_mass = _inline_twins(
-    "chain_links", "crba", "project_mass", "dh_link", "placement_links", "_link_inertias",
-    "_composite_inertias", "_mass_matrix_columns")[:3]
+_TWINS = _inline_twins("chain_links", "crba", "project_mass", "dh_link", "placement_links",
+                       "_link_inertias", "_composite_inertias", "_mass_matrix_columns")
+_chain_links, _crba, _project_mass = (_TWINS[k] for k in ("chain_links", "crba", "project_mass"))
 
 
 @hot_inline
