@@ -5,7 +5,8 @@
 the DLR/HIT finger (4 joints, 3 actuators), in thread CPU time (steady on a loaded machine),
 alternating, min and median of 15 runs:
 
-* ``pin.crba(model, data, q)`` (writes into its ``data``, returns a view of it);
+* ``pin.crba(model, data, q)`` (fills ``data.M`` and returns a new array copied from it, in
+  Pinocchio 4.1: printed below as checked);
 * ``chain.mass_matrix(p)`` (a new 3×3 array per call) and ``chain.mass_matrix(p, out=M)``;
 * the compiled kernel ``mass_matrix_one(buf, p, M)`` alone, into one array and into a new
   ``np.empty`` per call: the difference of the last two is the price of a fresh result array,
@@ -78,6 +79,10 @@ def main(n: int = 20_000, runs: int = 15) -> dict:
             np.empty(shape)
             entry(buf, p, M)
 
+    r = pin.crba(model, data, qs[0])
+    print("pin.crba returns " + ("a new array (owns its data, shares no memory with data.M)"
+                                 if r.flags.owndata and not np.shares_memory(r, data.M)
+                                 else "a view of data.M"))
     fns = {"pin.crba": pin_crba, "mass_matrix(p)": mass_matrix,
            "mass_matrix(p, out=M)": mass_matrix_out, "kernel, one array": kernel_into_one_array,
            "kernel, np.empty per call": kernel_into_new_array,

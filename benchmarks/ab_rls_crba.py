@@ -4,8 +4,9 @@
   (``RLS.run(store=False)``), and the streaming ``RLS.update``, beside the plain numba RLS of
   ``bench_rls.py`` (target: peer time / gripkit time ≥ 0.9);
 * the one-state mass matrix of the DLR/HIT finger without ``out=`` (``chain.mass_matrix(p)``, a
-  new array per call) and with it, beside ``pin.crba`` (target: gripkit / pin ≤ 1.1), and the
-  wrapper as it was before issue 24's follow-up (numba's dispatcher, ``np.empty`` per call).
+  new array per call) and with it, beside ``pin.crba`` (fills ``data.M`` and returns a new array
+  copied from it; target: gripkit / pin ≤ 1.1), and the kernel through numba's dispatcher into
+  an ``np.empty`` per call (the wrapper before issue 24's follow-up).
 
 ``python benchmarks/ab_rls_crba.py [rounds]``: every round runs each callable once in turn (after
 one warm-up call each, garbage collection off, BLAS on one thread), timed by the wall clock and

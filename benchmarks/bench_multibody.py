@@ -15,10 +15,11 @@ Numba compile time is excluded (warm-up call), as everywhere in the benchmarks.
 from __future__ import annotations
 
 import math
+import time
 import warnings
 
 import numpy as np
-from common import measure, row
+from common import measure, measure_alternating, row
 
 
 def _setup():
@@ -97,7 +98,8 @@ def run(quick: bool = False) -> list[dict]:
                     "pin.crba in a Python loop", t_pin_m, target="ratio >= 1",
                     notes=f"batch of {B}"))
 
-    # one state per public call, as a controller calls it each step, against single pin calls
+    # one state per public call, as a controller calls it each step, against single pin calls;
+    # the three callables of each row alternate (median of 15 runs, thread CPU time)
     n_one = 2_000
     p1, pd1, pdd1 = ([np.ascontiguousarray(a[i]) for i in range(n_one)] for a in (p, pd, pdd))
     q1, qd1, qdd1 = ([np.ascontiguousarray(a[i]) for i in range(n_one)] for a in (q, qd, qdd))
@@ -105,62 +107,68 @@ def run(quick: bool = False) -> list[dict]:
                                        - (G.T @ pin.rnea(model, data, q1[i], qd1[i],
                                                          qdd1[i]) + arm * pdd1[i]))))
                    for i in range(20))
+    # what pin.crba / pin.rnea hand back: Pinocchio computes into its Data (data.M, data.tau)
+    # and its Python binding returns a new array copied from it (Pinocchio 3-4 / eigenpy), or
+    # a view of it; the labels say which, as checked here
+    r_m, r_t = pin.crba(model, data, q1[0]), pin.rnea(model, data, q1[0], qd1[0], qdd1[0])
+    pin_new = (r_m.flags.owndata and not np.shares_memory(r_m, data.M)
+               and r_t.flags.owndata and not np.shares_memory(r_t, data.tau))
+    pin_returns = ("fills its data, returns a new array copied from it" if pin_new
+                   else "fills its data, returns a view of it")
+    tau_ws, M_ws = np.empty(3), np.empty((3, 3))
 
     def gk_one():
         for i in range(n_one):
             ch.rnea(p1[i], pd1[i], pdd1[i])
 
+    def gk_one_out():
+        for i in range(n_one):
+            ch.rnea(p1[i], pd1[i], pdd1[i], out=tau_ws)
+
     def pin_one():
         for i in range(n_one):
             pin.rnea(model, data, q1[i], qd1[i], qdd1[i])
-
-    rows.append(row("multibody", "RNEA, one state per public call (a "
-                                 "controller step)", measure(gk_one) / n_one,
-                    "pin.rnea, one call per state", measure(pin_one) / n_one,
-                    target="ratio ≥ 0.67 (≤ 1.5×)",
-                    gripkit_accuracy=f"max |τ − (Γᵀ τ_pin + arm·p̈)| = "
-                                     f"{rnea_err:.1e} N·m",
-                    notes="both called from a Python loop; gripkit checks its inputs on every "
-                          "call and includes Γ"))
 
     def gk_one_m():
         for i in range(n_one):
             ch.mass_matrix(p1[i])
 
-    def pin_one_m():
-        for i in range(n_one):
-            pin.crba(model, data, q1[i])
-
-    rows.append(row("multibody", "mass matrix (CRBA), one state "
-                                 "per public call", measure(gk_one_m) / n_one,
-                    "pin.crba, one call per state", measure(pin_one_m) / n_one,
-                    target="ratio ≥ 0.91 (≤ 1.1×, issue 24)",
-                    notes="both called from a Python loop and both return a new array; gripkit "
-                          "projects through Γ (3×3), Pinocchio returns 4×4"))
-
-    # the same with the caller's workspace, as Pinocchio writes into its preallocated `data`
-    tau_ws, M_ws = np.empty(3), np.empty((3, 3))
-
-    def gk_one_out():
-        for i in range(n_one):
-            ch.rnea(p1[i], pd1[i], pdd1[i], out=tau_ws)
-
     def gk_one_m_out():
         for i in range(n_one):
             ch.mass_matrix(p1[i], out=M_ws)
 
-    rows.append(row("multibody", "RNEA, one state per public call, out= workspace",
-                    measure(gk_one_out) / n_one,
-                    "pin.rnea, one call per state (into its data)", measure(pin_one) / n_one,
-                    target="ratio ≥ 0.67 (≤ 1.5×)",
-                    gripkit_accuracy=f"max |τ − (Γᵀ τ_pin + arm·p̈)| = {rnea_err:.1e} N·m",
-                    notes="rnea(..., out=τ): no allocation per call; same checks of the state "
-                          "as without out"))
+    def pin_one_m():
+        for i in range(n_one):
+            pin.crba(model, data, q1[i])
+
+    one_state = [gk_one, gk_one_out, pin_one, gk_one_m, gk_one_m_out, pin_one_m]
+    t_r, t_r_out, t_pr, t_m, t_m_out, t_pm = (
+        t / n_one for t in measure_alternating(one_state, runs=15, clock=time.thread_time))
+    rnea_acc = f"max |τ − (Γᵀ τ_pin + arm·p̈)| = {rnea_err:.1e} N·m"
+    rows.append(row("multibody", "RNEA, one state per public call (a "
+                                 "controller step)", t_r,
+                    f"pin.rnea, one call per state ({pin_returns})", t_pr,
+                    target="ratio ≥ 0.67 (≤ 1.5×)", gripkit_accuracy=rnea_acc,
+                    notes="gripkit returns a new array per call, the caller's to keep; both "
+                          "called from a Python loop; gripkit checks its inputs on every call "
+                          "and includes Γ; thread CPU time, alternating"))
+    rows.append(row("multibody", "mass matrix (CRBA), one state "
+                                 "per public call", t_m,
+                    f"pin.crba, one call per state ({pin_returns})", t_pm,
+                    target="ratio ≥ 0.91 (≤ 1.1×, issue 24)",
+                    notes="gripkit returns a new array per call, the caller's to keep; both "
+                          "called from a Python loop; gripkit projects through Γ (3×3), "
+                          "Pinocchio returns 4×4; thread CPU time, alternating"))
+    rows.append(row("multibody", "RNEA, one state per public call, out= workspace", t_r_out,
+                    f"pin.rnea, one call per state ({pin_returns})", t_pr,
+                    target="ratio ≥ 0.67 (≤ 1.5×)", gripkit_accuracy=rnea_acc,
+                    notes="rnea(..., out=τ): written into the caller's array, no allocation per "
+                          "call; same checks of the state as without out"))
     rows.append(row("multibody", "mass matrix (CRBA), one state per public call, out= workspace",
-                    measure(gk_one_m_out) / n_one, "pin.crba, one call per state (into its data)",
-                    measure(pin_one_m) / n_one, target="ratio ≥ 0.67 (≤ 1.5×)",
-                    notes="mass_matrix(q, out=M): no allocation per call; gripkit projects "
-                          "through Γ (3×3)"))
+                    t_m_out, f"pin.crba, one call per state ({pin_returns})", t_pm,
+                    target="ratio ≥ 0.67 (≤ 1.5×)",
+                    notes="mass_matrix(q, out=M): written into the caller's array, no "
+                          "allocation per call; gripkit projects through Γ (3×3)"))
 
     T = 2.0 if quick else 10.0
     N = int(T * 1000)

@@ -93,6 +93,9 @@ def test_one_state_out_workspace():
     M, tau = np.full((3, 3), np.nan), np.full(3, np.nan)
     assert ch.mass_matrix(q, out=M) is M and ch.rnea(q, qd, qdd, out=tau) is tau
     np.testing.assert_array_equal(M, ch.mass_matrix(q))
+    M2 = np.full((3, 3), np.nan)  # out by position (the parameter is not keyword-only)
+    assert ch.mass_matrix(q, M2) is M2
+    np.testing.assert_array_equal(M2, M)
     np.testing.assert_array_equal(tau, ch.rnea(q, qd, qdd))
     strided = np.zeros((3, 6))[:, ::2]
     np.testing.assert_array_equal(ch.mass_matrix(q, out=strided), M)
@@ -194,9 +197,10 @@ def test_bad_states_and_couplings_are_refused():
 
 def test_one_state_mass_matrix_entry_point_takes_only_exact_float64_vectors():
     """The unchecked entry point (onestate.mass_matrix_entry) gets only an exact 1-D float64
-    ndarray of stride 8: states that numba would misread there (int64 items of the same size, a
-    (3, 1) array, big-endian, a subclass) go through the validating path and give the float64
-    answer; each call returns a new array (no result is shared between calls)."""
+    ndarray (type, ndim, dtype checked in Python): states that numba would misread there (int64
+    items of the same size, a (3, 1) array, big-endian, a subclass) go through the validating
+    path and give the float64 answer; 1-D views of another stride reach it and its kernel
+    refuses them; each call returns a new array (no result is shared between calls)."""
     ch = finger(check=False).chain()
     q = np.array([0.1, -0.2, 0.3])
     ref = ch.mass_matrix(q)
@@ -212,6 +216,18 @@ def test_one_state_mass_matrix_entry_point_takes_only_exact_float64_vectors():
     ro = q.copy()
     ro.flags.writeable = False
     np.testing.assert_array_equal(ch.mass_matrix(ro), ref)
+    # 1-D float64 views of stride −8 and 16 reach the entry point, whose kernel refuses them
+    # (it would read them as contiguous) and leaves its output untouched
+    rev = np.array([0.3, -0.2, 0.1])[::-1]
+    wide = np.array([0.1, 9.0, -0.2, 9.0, 0.3])[::2]
+    buf, _, _, entry = ch._one
+    for view in (rev, wide):
+        np.testing.assert_array_equal(ch.mass_matrix(view), ref)
+        M = np.full((3, 3), 7.0)
+        assert not entry(buf, view, M) and (M == 7.0).all()
+    M = np.full((3, 3), 7.0)
+    assert entry(buf, q, M)
+    np.testing.assert_array_equal(M, ref)
 
 
 class _Sub(np.ndarray):

@@ -32,8 +32,8 @@ __all__ = ["DHChain", "Dynamics"]
 # module lookup (per call: docs/performance.md, "One-state RNEA and CRBA")
 _NDARRAY = np.ndarray
 _F8 = np.dtype(np.float64)
-_STRIDE_1D = (8,)
 _empty = np.empty
+
 
 def _as_transform(T, what: str) -> np.ndarray:
     if T is None:
@@ -122,15 +122,17 @@ class Dynamics:
         Gm = G.reshape(dh.shape[0], -1)
         return Gm.T @ (arm_q[:, None] * Gm) + np.diag(arm_p)
 
-    def mass_matrix(self, q, *, out: np.ndarray | None = None) -> np.ndarray:
+    def mass_matrix(self, q, out: np.ndarray | None = None) -> np.ndarray:
         """M(q), including reflected rotor inertia (CRBA, eqs 4.14–4.16); one float64 state takes
         the low-overhead path of :mod:`gripkit.multibody.onestate`. ``out``: a float64 array of
         M's shape to write into (a controller loop's workspace, as Pinocchio's ``data``);
-        returned."""
+        returned. (``out`` may be given by position: a keyword-only parameter takes CPython's
+        slower call path, ~40 ns per call, docs/performance.md.)"""
         one = self._one or self._one_state()
-        if out is None and type(q) is _NDARRAY and q.strides == _STRIDE_1D and q.dtype is _F8:
+        if out is None and type(q) is _NDARRAY and q.ndim == 1 and q.dtype is _F8:
             # an exact 1-D float64 ndarray: the kernel's unchecked entry point (onestate
-            # .mass_matrix_entry) into a fresh array; False (wrong length, NaN): the checks below
+            # .mass_matrix_entry) into a fresh array; False (wrong length, stride, NaN): the
+            # checks below
             res = _empty(one[2])
             if one[3](one[0], q, res):
                 return res

@@ -450,7 +450,11 @@ def coupled_mass_bias(n, m, lk, G, arm_p, cw, qd, gx, gy, gz, Mp, hp):  # pragma
 @hot
 def project_mass(n, m, Mq, G, arm_p, Mp):  # pragma: no cover - compiled
     """Mp (m×m) = Γᵀ Mq Γ + diag(arm_p): a joint-space mass matrix seen by the actuators (Γ is
-    n×m, row-major flat)."""
+    n×m, row-major flat). The sizes are taken unsigned, and so the indices made from them:
+    numba then adds no negative-index wraparound to each read of Mq and G (docs/performance.md,
+    CRBA)."""
+    n = np.uint64(n)
+    m = np.uint64(m)
     for i in range(m):
         for j in range(i, m):
             s = 0.0

@@ -6,9 +6,12 @@ passes 17 arrays to the kernel (the figures: docs/performance.md, "One-state RNE
 This path packs the model and its scratch memory once into one float64 array
 (:func:`pack`) kept with the chain, so a call is one ``np.empty`` and one call of a kernel compiled
 for float64 arrays only, with three (mass matrix) or five (RNEA) arguments: unboxing an argument
-is most of the cost of a call. Other argument types raise TypeError
-at the call, and the kernel reports a state of the wrong length or with NaN/inf: the caller then
-takes the validating path, which raises the error. The scratch is shared by the calls on one
+is most of the cost of a call. Inside, the model's 2-D views are built in place
+(:func:`_rows`) and the link transforms, CRBA and Γ projection are compiled inline
+(:func:`_inline_twins`): one function without calls into numba's runtime or between kernels.
+Other argument types raise TypeError at the call, and the kernel reports a state of the wrong
+length, a strided state or one with NaN/inf: the caller then takes the validating path, which
+converts it or raises the error. The scratch is shared by the calls on one
 chain, which is safe because the kernels hold the GIL (compiled without ``nogil``): calls from
 several threads run one after the other. The buffer is for these two kernels only; the batched
 and ``prange`` kernels take their own scratch per state, never this buffer. The mass matrix
@@ -19,12 +22,18 @@ and ``prange`` kernels take their own scratch per state, never this buffer. The 
 from __future__ import annotations
 
 import math
+import types
 
 import numba
 import numpy as np
+from numba.core import cgutils
+from numba.core import types as nbtypes
+from numba.core.imputils import impl_ret_borrowed
+from numba.extending import intrinsic
+from numba.np.arrayobj import make_array, populate_array
 
-from .kernels import (WORK_PER_LINK, ChainArrays, chain_links, crba, hot_inline, links_of,
-                      project_mass, rnea_pass)
+from . import kernels
+from .kernels import WORK_PER_LINK, ChainArrays, hot_inline, links_of, rnea_pass
 
 __all__ = ["mass_matrix_entry", "mass_matrix_one", "pack", "prepare", "rnea_one"]
 
@@ -47,6 +56,48 @@ def pack(arrays) -> np.ndarray:
     return np.concatenate([[n, m, w], offsets[:11], *parts]).astype(np.float64)
 
 
+@intrinsic
+def _rows(typingctx, a, start, rows, cols):  # pragma: no cover - compiled
+    """``a[start:start + rows·cols]`` as a C-contiguous (rows, cols) array, built in place: numba's
+    ``reshape`` calls a C helper of its runtime for each view, six per call here, most of the
+    packed-model views' cost (docs/performance.md, CRBA). No bounds check: the offsets and sizes
+    come from :func:`pack`, which sized the buffer for them."""
+    ret = nbtypes.Array(a.dtype, 2, "C")
+
+    def codegen(context, builder, sig, args):
+        ary = make_array(sig.args[0])(context, builder, args[0])
+        view = make_array(ret)(context, builder)
+        start, r, c = (context.cast(builder, v, t, nbtypes.intp)
+                       for v, t in zip(args[1:], sig.args[1:]))
+        item = context.get_constant(nbtypes.intp, context.get_abi_sizeof(
+            context.get_data_type(a.dtype)))
+        populate_array(view, data=builder.gep(ary.data, [start]),
+                       shape=cgutils.pack_array(builder, [r, c]),
+                       strides=cgutils.pack_array(builder, [builder.mul(c, item), item]),
+                       itemsize=ary.itemsize, meminfo=ary.meminfo, parent=ary.parent)
+        return impl_ret_borrowed(context, builder, ret, view._getvalue())
+
+    return ret(a, start, rows, cols), codegen
+
+
+def _inline_twins(*names):
+    """Twins of the named :mod:`~gripkit.multibody.kernels` functions: the same code object,
+    compiled ``inline="always"`` into the one-state kernels, the calls among the named functions
+    going to the twins too. The one-state mass matrix is then one function, without compiled
+    calls that pass each array as its nine fields (docs/performance.md, CRBA); the batched
+    kernels keep their compiled calls. Same operations in the same order: bit-identical.
+    Returns {name: twin}."""
+    ns = dict(vars(kernels))
+    for name in names:
+        fn = getattr(kernels, name).py_func
+        ns[name] = numba.njit(error_model="numpy", _nrt=False, inline="always")(
+            types.FunctionType(fn.__code__, ns, name, fn.__defaults__, fn.__closure__))
+    return {name: ns[name] for name in names}
+
+
+_TWINS = _inline_twins("chain_links", "crba", "project_mass", "dh_link", "placement_links",
+                       "_link_inertias", "_composite_inertias", "_mass_matrix_columns")
+_chain_links, _crba, _project_mass = (_TWINS[k] for k in ("chain_links", "crba", "project_mass"))
 
 
 @hot_inline
@@ -57,10 +108,10 @@ def _model(buf):  # pragma: no cover - compiled
     m = int(buf[1])
     w = int(buf[2])
     o = buf[3:_HEADER]
-    dh = buf[int(o[0]):int(o[0]) + n * w].reshape((n, w))
+    dh = _rows(buf, int(o[0]), n, w)
     mass = buf[int(o[1]):int(o[1]) + n]
-    com = buf[int(o[2]):int(o[2]) + 3 * n].reshape((n, 3))
-    inertia = buf[int(o[3]):int(o[3]) + 6 * n].reshape((n, 6))
+    com = _rows(buf, int(o[2]), n, 3)
+    inertia = _rows(buf, int(o[3]), n, 6)
     arm_q = buf[int(o[4]):int(o[4]) + n]
     G = buf[int(o[5]):int(o[5]) + n * m]
     q0 = buf[int(o[6]):int(o[6]) + n]
@@ -73,7 +124,9 @@ def _model(buf):  # pragma: no cover - compiled
 
 @hot_inline
 def _finite(m, q):  # pragma: no cover - compiled
-    if q.shape[0] != m:
+    """q has length m, stride 8 (numba's entry point reads a strided view as if contiguous)
+    and no NaN or inf."""
+    if q.shape[0] != m or q.strides[0] != 8:
         return False
     for i in range(m):
         if not math.isfinite(q[i]):
@@ -85,15 +138,15 @@ def _finite(m, q):  # pragma: no cover - compiled
 def _links(n, m, ch, q, work):  # pragma: no cover - compiled
     """Joint positions Γ p + q₀ into the scratch and the link transforms R, P for them."""
     G, q0 = ch.G, ch.q0
-    R = work[0:9 * n].reshape((n, 9))
-    P = work[9 * n:12 * n].reshape((n, 3))
+    R = _rows(work, 0, n, 9)
+    P = _rows(work, 9 * n, n, 3)
     qq = work[12 * n + WORK_PER_LINK * n:13 * n + WORK_PER_LINK * n]
     for k in range(n):
         s = q0[k]
         for a in range(m):
             s += G[k * m + a] * q[a]
         qq[k] = s
-    chain_links(n, ch.links, ch.jtype, qq, R, P)
+    _chain_links(n, ch.links, ch.jtype, qq, R, P)
     return R, P
 
 
@@ -141,9 +194,9 @@ def mass_matrix_one(buf, q, out):  # pragma: no cover - compiled
         return False
     R, P = _links(n, m, ch, q, work)
     b = 12 * n + WORK_PER_LINK * n
-    Mq = work[b + 4 * n:b + 4 * n + n * n].reshape((n, n))
-    crba(n, links_of(ch), R, P, Mq, work[12 * n:b])
-    project_mass(n, m, Mq, ch.G, ch.arm_p, out)
+    Mq = _rows(work, b + 4 * n, n, n)
+    _crba(n, links_of(ch), R, P, Mq, work[12 * n:b])
+    _project_mass(n, m, Mq, ch.G, ch.arm_p, out)
     return True
 
 
@@ -151,11 +204,11 @@ def mass_matrix_entry():
     """The compiled :func:`mass_matrix_one`'s own CPython wrapper (numba's ``entry_point`` for its
     one signature): it unboxes its three arguments as the declared types without the
     dispatcher's type resolution (docs/performance.md, CRBA). It does not check them: numba reads
-    any array with 8-byte items as float64 and an array of more dimensions past the declared ones,
-    so only :meth:`~gripkit.multibody.dh.Dynamics.mass_matrix` calls it, with the chain's packed
-    buffer, a fresh C-contiguous (m, m) float64 array, and a state that is an exact 1-D float64
-    ndarray of stride 8 (checked in Python first). The dispatcher where numba has no
-    ``entry_point``."""
+    any array with 8-byte items as float64 and writes an array of more dimensions past the
+    declared ones, so only :meth:`~gripkit.multibody.dh.Dynamics.mass_matrix` calls it, with the
+    chain's packed buffer, a fresh C-contiguous (m, m) float64 array, and a state that is an
+    exact 1-D float64 ndarray (type, ``ndim`` and dtype checked in Python first; the kernel
+    refuses a stride other than 8). The dispatcher where numba has no ``entry_point``."""
     sig = next(iter(mass_matrix_one.overloads))
     return getattr(mass_matrix_one.overloads[sig], "entry_point", mass_matrix_one)
 
