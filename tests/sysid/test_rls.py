@@ -156,25 +156,32 @@ def _first_absurd_reference(x, peak, factor):
 def test_blockwise_corrupt_sample_scan_equals_the_sample_rule():
     """The batch scan for corrupt samples skips blocks of 256 whose peak cannot break the rule;
     on 400 random records (leading zeros, spikes of 10⁵…10¹⁵ times the signal, NaN and inf,
-    several start peaks and factors) it returns the sample-by-sample rule's index and peak."""
-    from gripkit.sysid.linear.rls import _first_absurd
+    several start peaks and factors) it returns the sample-by-sample rule's index and peak, and
+    where it finds none numpy's min and max and whether every sample is finite (its one pass
+    replaces those three)."""
+    from gripkit.sysid.linear.rls import _scan_signal
 
     rng = np.random.default_rng(41)
     hits = 0
     for _ in range(400):
-        n = int(rng.integers(0, 1500))
+        n = int(rng.integers(1, 1500))
         x = rng.standard_normal(n) * 10.0 ** rng.uniform(-5, 5)
-        if n and rng.random() < 0.5:
+        if rng.random() < 0.5:
             x[:int(rng.integers(0, n))] = 0.0
-        if n and rng.random() < 0.6:
+        if rng.random() < 0.6:
             j = int(rng.integers(0, n))
             x[j] *= 10.0 ** rng.uniform(5, 15)
-        if n and rng.random() < 0.1:
-            x[int(rng.integers(0, n))] = rng.choice([np.nan, np.inf])
+        if rng.random() < 0.1:
+            x[int(rng.integers(0, n))] = rng.choice([np.nan, np.inf, -np.inf])
         peak = float(rng.choice([0.0, 1e-3, 1.0]))
         factor = float(rng.choice([1e10, 10.0]))
         ref = _first_absurd_reference(x, peak, factor)
-        assert _first_absurd(x, peak, factor) == ref
+        bad, end_peak, lo, hi, finite = _scan_signal(x, peak, factor)
+        assert (bad, end_peak) == ref
+        if bad < 0:
+            assert finite == bool(np.isfinite(x).all())
+            if finite:
+                assert (lo, hi) == (x.min(), x.max())
         hits += ref[0] >= 0
     assert 50 < hits < 350  # both outcomes are exercised
 

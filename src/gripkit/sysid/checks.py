@@ -15,8 +15,9 @@ from ..errors import DataError, UnidentifiableError
 from ..units import dimension_of, same_dimension
 from .regression import COND_LIMIT, qr_r, scaled_condition
 
-__all__ = ["as_signal", "signal_with_peaks", "as_io_matrix", "io_records", "check_io",
-           "check_io_peaks", "check_order", "check_dt", "require_samples", "check_excitation",
+__all__ = ["as_signal", "signal_array", "signal_with_peaks", "as_io_matrix", "io_records",
+           "check_io", "check_io_peaks", "check_io_arrays", "check_order", "check_dt",
+           "require_samples", "check_excitation",
            "check_output_varies", "checked_problem", "checked_problem_peaks", "check_identifiable",
            "check_persistent_excitation", "check_dimension", "LENGTH_OR_ANGLE", "FORCE_OR_TORQUE"]
 
@@ -30,10 +31,9 @@ def as_signal(x, name: str) -> np.ndarray:
     return signal_with_peaks(x, name)[0]
 
 
-def signal_with_peaks(x, name: str) -> tuple[np.ndarray, float, float]:
-    """:func:`as_signal` with the signal's minimum and maximum ``(a, lo, hi)``, which the
-    finiteness check computes anyway: the excitation checks and the scaling take them from here
-    instead of two more passes each (``peaks=(lo, hi)``)."""
+def signal_array(x, name: str) -> np.ndarray:
+    """``x`` as a non-empty 1-D float64 array, or a :class:`DataError` naming ``name`` (its values
+    are not looked at: :func:`signal_with_peaks` checks them)."""
     try:
         a = np.asarray(x, dtype=np.float64)
     except (TypeError, ValueError):
@@ -44,6 +44,14 @@ def signal_with_peaks(x, name: str) -> tuple[np.ndarray, float, float]:
                         hint="pass one channel at a time (single-input single-output models)")
     if a.size == 0:
         raise DataError(f"{name}: the signal holds no samples")
+    return a
+
+
+def signal_with_peaks(x, name: str) -> tuple[np.ndarray, float, float]:
+    """:func:`as_signal` with the signal's minimum and maximum ``(a, lo, hi)``, which the
+    finiteness check computes anyway: the excitation checks and the scaling take them from here
+    instead of two more passes each (``peaks=(lo, hi)``)."""
+    a = signal_array(x, name)
     # the ufuncs' reductions themselves (the same as a.min(), a.max(), without their wrappers)
     lo, hi = float(np.minimum.reduce(a)), float(np.maximum.reduce(a))
     if not (math.isfinite(lo) and math.isfinite(hi)):  # min and max carry a NaN or an inf through
@@ -122,10 +130,22 @@ def check_io_peaks(u, y) -> tuple[np.ndarray, np.ndarray, tuple]:
     """:func:`check_io` with ``((min u, max u), (min y, max y))`` (:func:`signal_with_peaks`)."""
     u, ulo, uhi = signal_with_peaks(u, "input u")
     y, ylo, yhi = signal_with_peaks(y, "output y")
+    _same_length(u, y)
+    return u, y, ((ulo, uhi), (ylo, yhi))
+
+
+def check_io_arrays(u, y) -> tuple[np.ndarray, np.ndarray]:
+    """Input and output as non-empty 1-D float64 arrays of equal length (:func:`signal_array`:
+    their values not yet checked, for a caller that scans them in its own pass)."""
+    u, y = signal_array(u, "input u"), signal_array(y, "output y")
+    _same_length(u, y)
+    return u, y
+
+
+def _same_length(u: np.ndarray, y: np.ndarray) -> None:
     if u.shape != y.shape:
         raise DataError("input u and output y must have the same length, found "
                         f"{u.size} and {y.size}")
-    return u, y, ((ulo, uhi), (ylo, yhi))
 
 
 def check_order(value, name: str, minimum: int = 0) -> int:

@@ -54,7 +54,8 @@ from numba.core.errors import TypingError
 from ...arguments import entry_point
 from ...errors import DataError, IdentificationError
 from ...signals.trajectory import Trajectory
-from ..checks import check_dt, check_excitation, check_io_peaks, check_order, require_samples
+from ..checks import (check_dt, check_excitation, check_io_arrays, check_order, require_samples,
+                      signal_with_peaks)
 from .polynomial import PolynomialModel
 
 __all__ = ["RLS", "RLSResult", "rls"]
@@ -693,8 +694,8 @@ class RLS:
     def run(self, u, y, *, store: bool = True) -> "RLSResult":
         """Process a whole record from the current state (batch kernel); returns θ and σ at every
         step when ``store`` (else only the final values)."""
-        u, y, peaks = check_io_peaks(u, y)
-        return self._run(u, y, store, peaks)
+        u, y, scans = self._scanned(u, y)
+        return self._run(u, y, store, scans)
 
     def _check_scale(self, u: np.ndarray, y: np.ndarray, peaks: tuple | None = None) -> None:
         """Refuse signals whose scale the recursion cannot represent next to the current P:
@@ -708,9 +709,10 @@ class RLS:
         p = self.n_params
         P = self.P
         tr = float(np.trace(P))
-        pu, py = (None, None) if peaks is None else peaks
-        stats = {"input u": _peak_and_norm(u, pu), "output y": _peak_and_norm(y, py)}
-        peak = max(stats["input u"][0], stats["output y"][0])
+        minmax = {"input u": (None if peaks is None else peaks[0]),
+                  "output y": (None if peaks is None else peaks[1])}
+        stats = {label: _peak(x, minmax[label]) for label, x in (("input u", u), ("output y", y))}
+        peak = max(stats.values())
         if peak > 0 and math.log10(p) + 2 * math.log10(peak) + math.log10(tr) > 307.0:
             raise DataError(
                 f"RLS [{self.na} {self.nb} {self.nk}]: values up to {peak:.3g} in u "
@@ -721,14 +723,16 @@ class RLS:
         for label, x, idx in (("output y", y, range(self.na)), ("input u", u, range(self.na, p))):
             if not len(idx):
                 continue
-            mx, norm = stats[label]
+            mx = stats[label]
             if mx == 0.0:
                 raise IdentificationError(
                     f"RLS [{self.na} {self.nb} {self.nk}]: the {label} is zero throughout, so "
                     f"{', '.join(self.names[i] for i in idx)} cannot be estimated",
                     hint="check that the columns are the measured input and output")
-            log_energy = 2 * math.log10(norm)
             prior = float(np.max(np.diag(P)[list(idx)]))
+            if 2 * math.log10(mx) + math.log10(prior) >= 0.0:
+                continue  # Σx² ≥ max x²: the energy test below passes without the norm's pass
+            log_energy = 2 * math.log10(_peak_and_norm(x, minmax[label])[1])
             if log_energy + math.log10(prior) < 0.0:
                 names = ", ".join(self.names[i] for i in idx)
                 raise IdentificationError(
@@ -740,21 +744,22 @@ class RLS:
                     hint="scale u and y to order 1 (other units), or raise p0 above "
                          f"1/Σ{label[-1]}²")
 
-    def _check_corrupt(self, u: np.ndarray, y: np.ndarray) -> tuple[float, float]:
+    def _scanned(self, u, y) -> tuple:
+        """:func:`_scan_record` from the estimator's running peaks on."""
+        return _scan_record(u, y, self._s[_PU], self._s[_PY])
+
+    def _check_corrupt(self, u: np.ndarray, y: np.ndarray, scans: tuple) -> tuple[float, float]:
         """Refuse a record with a corrupt sample by the rule of :meth:`update` (a magnitude above
         :data:`ABSURD_JUMP` times every earlier one of its signal, from the estimator's running
-        peaks on), so that ``run`` and a loop of ``update`` refuse the same records; returns the
-        peaks of |u| and |y| at the end of the record."""
-        peaks = []
-        for name, x, slot in (("u", u, _PU), ("y", y, _PY)):
-            i, peak = _first_absurd(x, self._s[slot], ABSURD_JUMP)
+        peaks on: ``scans`` of :meth:`_scanned`), so that ``run`` and a loop of ``update`` refuse
+        the same records; returns the peaks of |u| and |y| at the end of the record."""
+        for name, x, (i, peak, _, _, _) in (("u", u, scans[0]), ("y", y, scans[1])):
             if i >= 0:
                 where = f"RLS [{self.na} {self.nb} {self.nk}]: sample {self.n_samples + i}"
                 raise _absurd_sample(where, name, float(x[i]), peak, "the record was not processed",
                                      "drop or repair the sample (gripkit.signals.outliers."
                                      "corrupt_samples finds such values) and run again")
-            peaks.append(peak)
-        return peaks[0], peaks[1]
+        return scans[0][1], scans[1][1]
 
     def _kernel_size(self, n: int) -> tuple:
         """The ``size`` argument of :func:`_rls_run`: the orders as tuple lengths (one compiled
@@ -764,12 +769,11 @@ class RLS:
             return (), (), (), ()
         return (0.0,) * self.n_params, (0.0,) * self.na, (0.0,) * self.nb, (0.0,) * self.nk
 
-    def _run(self, u: np.ndarray, y: np.ndarray, store: bool,
-             minmax: tuple | None = None) -> "RLSResult":
-        """:meth:`run` on checked float64 arrays; ``minmax``: ``((min u, max u), (min y, max y))``
-        from the checks (:func:`~gripkit.sysid.checks.check_io_peaks`), one pass less each."""
-        peaks = self._check_corrupt(u, y)
-        self._check_scale(u, y, minmax)
+    def _run(self, u: np.ndarray, y: np.ndarray, store: bool, scans: tuple) -> "RLSResult":
+        """:meth:`run` on the arrays and ``scans`` of :meth:`_scanned` (their corrupt-sample
+        index, peaks, min and max: no more passes over the data before the kernel's)."""
+        peaks = self._check_corrupt(u, y, scans)
+        self._check_scale(u, y, tuple((sc[2], sc[3]) for sc in scans))
         n = u.size
         p = self.n_params
         rows = n if store else 0
@@ -806,46 +810,88 @@ def _absurd_sample(where: str, name: str, value: float, peak: float, state: str,
         f"which would throw θ far off for good; {state}", hint=hint)
 
 
-#: samples per block of :func:`_first_absurd` (a multiple of 4)
+#: samples per block of :func:`_scan_signal` (a multiple of 4)
 _ABSURD_BLOCK = 256
 
 
 @njit(cache=True)
-def _first_absurd(x, peak, factor):
-    """(index of the first sample of ``x`` above ``factor`` times the largest |x| before it, or −1;
-    the largest |x| up to there), from the running peak ``peak`` on (the test of
-    :func:`_rls_step`).
+def _scan_signal(x, peak, factor):
+    """One pass over a non-empty signal for :meth:`RLS.run`: ``(bad, peak, lo, hi, finite)``: the
+    index of the first sample above ``factor`` times the largest |x| before it (from the running
+    peak ``peak`` on: the test of :func:`_rls_step`) or −1, the largest |x| up to there, min and
+    max of x, and whether every sample is finite (min, max and ``finite`` cover the whole signal
+    only when ``bad`` is −1: the scan stops at a corrupt sample).
 
-    By blocks: while ``peak > 0``, a block whose largest |x| is at most ``factor·peak`` holds no
-    such sample (every later running peak is at least ``peak``), and its largest |x| updates the
-    peak; that maximum takes four independent running maxima, without a branch per sample. Other
-    blocks go sample by sample. The same index and peak as the plain sample loop."""
+    By blocks, in four lanes: min, max, the largest |x| and Σ x·0 (NaN where a sample is NaN or
+    ±inf; the comparisons skip NaN, as the sample rule does). While ``peak > 0``, a block whose
+    largest |x| is at most ``factor·peak`` holds no corrupt sample (every later running peak is at
+    least ``peak``) and its largest |x| updates the peak; other blocks go sample by sample. The
+    same index and peak as the plain sample loop, in one pass instead of three (numpy's min and
+    max, then the corrupt-sample scan)."""
     n = x.shape[0]
+    lo = x[0]
+    hi = x[0]
+    probe = 0.0
     for i in range(0, n, _ABSURD_BLOCK):
         stop = min(i + _ABSURD_BLOCK, n)
-        if peak > 0.0 and stop - i == _ABSURD_BLOCK:
+        if stop - i == _ABSURD_BLOCK:
             m0 = m1 = m2 = m3 = 0.0
+            l0 = l1 = l2 = l3 = lo
+            h0 = h1 = h2 = h3 = hi
+            p0 = p1 = p2 = p3 = 0.0
             for k in range(i, stop, 4):
-                a0 = abs(x[k])
-                a1 = abs(x[k + 1])
-                a2 = abs(x[k + 2])
-                a3 = abs(x[k + 3])
+                v0, v1, v2, v3 = x[k], x[k + 1], x[k + 2], x[k + 3]
+                a0, a1, a2, a3 = abs(v0), abs(v1), abs(v2), abs(v3)
                 m0 = a0 if a0 > m0 else m0
                 m1 = a1 if a1 > m1 else m1
                 m2 = a2 if a2 > m2 else m2
                 m3 = a3 if a3 > m3 else m3
+                l0 = v0 if v0 < l0 else l0
+                l1 = v1 if v1 < l1 else l1
+                l2 = v2 if v2 < l2 else l2
+                l3 = v3 if v3 < l3 else l3
+                h0 = v0 if v0 > h0 else h0
+                h1 = v1 if v1 > h1 else h1
+                h2 = v2 if v2 > h2 else h2
+                h3 = v3 if v3 > h3 else h3
+                p0 += v0 * 0.0
+                p1 += v1 * 0.0
+                p2 += v2 * 0.0
+                p3 += v3 * 0.0
             m = max(max(m0, m1), max(m2, m3))
-            if m <= factor * peak:  # (the maxima skip NaN, as the sample loop does)
-                if m > peak:
-                    peak = m
-                continue
+            lo = min(min(l0, l1), min(l2, l3))
+            hi = max(max(h0, h1), max(h2, h3))
+            probe += (p0 + p1) + (p2 + p3)
+        else:  # a short last block: its extremes, then sample by sample
+            m = np.inf
+            for k in range(i, stop):
+                v = x[k]
+                lo = v if v < lo else lo
+                hi = v if v > hi else hi
+                probe += v * 0.0
+        if peak > 0.0 and m <= factor * peak:  # (NaN never reaches m)
+            if m > peak:
+                peak = m
+            continue
         for k in range(i, stop):
             a = abs(x[k])
             if a > peak:
                 if peak > 0.0 and a > factor * peak:
-                    return k, peak
+                    return k, peak, lo, hi, False
                 peak = a
-    return -1, peak
+    return -1, peak, lo, hi, probe == 0.0
+
+
+def _scan_record(u, y, pu: float, py: float) -> tuple:
+    """``u`` and ``y`` as 1-D float64 arrays of one length, finite (else the
+    :func:`~gripkit.sysid.checks.signal_with_peaks` error), with their :func:`_scan_signal` from
+    the running peaks ``pu`` and ``py`` on: ``(u, y, (scan of u, scan of y))``."""
+    u, y = check_io_arrays(u, y)
+    scans = (_scan_signal(u, pu, ABSURD_JUMP), _scan_signal(y, py, ABSURD_JUMP))
+    for x, name, scan in ((u, "input u", scans[0]), (y, "output y", scans[1])):
+        if not scan[4]:  # not finite, or the scan stopped at a corrupt sample
+            signal_with_peaks(x, name)  # raises for a NaN or an inf anywhere
+    return u, y, scans
 
 
 #: peaks within these bounds square and sum without overflow (N·peak² < 1e290 for N < 1e10)
@@ -853,15 +899,22 @@ def _first_absurd(x, peak, factor):
 _PLAIN_NORM_RANGE = (1e-140, 1e140)
 
 
+def _peak(x, minmax: tuple[float, float] | None = None) -> float:
+    """max |x| (from ``minmax`` = (min, max) when known)."""
+    if x.size == 0:
+        return 0.0
+    lo, hi = (float(x.min()), float(x.max())) if minmax is None else minmax
+    return max(hi, -lo)
+
+
 def _peak_and_norm(x, minmax: tuple[float, float] | None = None):
     """(max |x|, ‖x‖₂) without temporaries: max/min and a BLAS dot (fast) when the peak lies in
     :data:`_PLAIN_NORM_RANGE`, else :func:`_peak_and_norm_scaled` (one pass scaled by the running
     peak). The dot sums in another order than the scaled pass: the norms agree to a few ulps,
     which only feed the order-of-magnitude checks of :meth:`RLS._check_scale`."""
-    if x.size == 0:
+    peak = _peak(x, minmax)
+    if peak == 0.0:
         return 0.0, 0.0
-    lo, hi = (float(x.min()), float(x.max())) if minmax is None else minmax
-    peak = max(hi, -lo)
     if _PLAIN_NORM_RANGE[0] < peak < _PLAIN_NORM_RANGE[1]:
         return peak, math.sqrt(float(np.dot(x, x)))
     return _peak_and_norm_scaled(x)
@@ -972,11 +1025,12 @@ def rls(u, y, na: int, nb: int, nk: int = 1, *, forgetting: float = 1.0, p0: flo
     Parameters as :class:`RLS`; ``u``, ``y`` of shape (N,). Raises :class:`DataError` for bad
     data or too few samples and :class:`~gripkit.errors.UnidentifiableError` for a constant input.
     """
-    u, y, peaks = check_io_peaks(u, y)  # one min and max per signal for all the checks
+    u, y, scans = _scan_record(u, y, 0.0, 0.0)  # one pass per signal for all the checks
     est = RLS(na, nb, nk, forgetting=forgetting, p0=p0, theta0=theta0, windup=windup,
               max_trace=max_trace, dt=check_dt(dt))
     t0 = max(est.na, est.nk + est.nb - 1)
     p = est.n_params
     require_samples(u.size, t0 + p + 1, f"RLS ARX [{est.na} {est.nb} {est.nk}] ({p} parameters)")
-    check_excitation(u, peaks=peaks[0])
-    return est._run(u, y, store, peaks)
+    if scans[0][0] < 0:  # (else min and max stop at the corrupt sample: that error comes first)
+        check_excitation(u, peaks=scans[0][2:4])
+    return est._run(u, y, store, scans)
