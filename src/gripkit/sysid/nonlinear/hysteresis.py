@@ -701,11 +701,17 @@ def _fit_bouc_wen_oscillator(recs, dt, *, exponent, offset, burn_in, multistart,
         multistart)
     npar = len(names)
     est = initial_state == "estimate"
-    if est:  # each start with each record's initial state from its first samples
-        off0 = starts[0][names.index("offset")] if "offset" in names else 0.0
+    s0 = np.zeros(0)
+    if est:  # the output offset from the mean static line, each record's state from its start
+        if "offset" in names:
+            k0 = np.mean([x0[names.index("k_e")] + x0[names.index("k_h")] for x0 in starts])
+            off0 = float(np.mean(ys) - np.mean(us) / k0)
+            for x0 in starts:
+                x0[names.index("offset")] = off0
+        else:
+            off0 = 0.0
         s0 = np.concatenate([_initial_state_start(us[a:a + n], ys[a:a + n], dt, off0)
                              for a, n in zip(first, lengths)])
-        starts = [np.concatenate([x0, s0]) for x0 in starts]
         lb = np.concatenate([lb, np.full(len(s0), -np.inf)])
         ub = np.concatenate([ub, np.full(len(s0), np.inf)])
     buf = np.empty(len(us))
@@ -717,7 +723,9 @@ def _fit_bouc_wen_oscillator(recs, dt, *, exponent, offset, burn_in, multistart,
 
     def run(i, p, th, e):  # record i from its initial state, its residual on burn_in … e − 1
         a = first[i]
-        x0, v0, z0 = th[npar + 3 * i:npar + 3 * i + 3] if est else (0.0, 0.0, 0.0)
+        k = npar + 3 * i
+        x0, v0, z0 = (th[k:k + 3] if len(th) > npar else s0[3 * i:3 * i + 3]) if est else (
+            0.0, 0.0, 0.0)
         K.bwo_simulate(us[a:a + e], dt, substeps, p["mass"], p["damping"], p["k_e"], p["k_h"],
                        p["beta"], p["gamma"], p["n"], p["offset"], x0, v0, z0, buf[a:a + e])
         r = buf[a + burn_in:a + e] - ys[a + burn_in:a + e]
@@ -758,14 +766,16 @@ def _fit_bouc_wen_oscillator(recs, dt, *, exponent, offset, burn_in, multistart,
     # the starts in order of their initial cost, each to convergence on the first
     # WARM_SAMPLES samples (shared out among the records), until one reproduces them to a fit of
     # 90 % (a free run of a rate-dependent model is costly, and a long record makes a poor start
-    # crawl); then the best one refined on the whole records
+    # crawl); then the best one refined on the whole records. With initial states estimated the
+    # starts are tried with each record's state held at its start (the value and slope of its
+    # first samples, z = 0), then θ and every state refined together
     ends = [min(n, burn_in + WARM_SAMPLES // len(recs)) for n in lengths]
     warm = (ends,)
     starts.sort(key=lambda x0: float(np.sum(resid(x0, *warm) ** 2)))
     short = np.concatenate([ys[a + burn_in:a + e] for a, e in zip(first, ends)])
     good = 0.01 * float(np.sum((short - short.mean()) ** 2))
-    opts = dict(jac=jac, bounds=(lb, ub), x_scale="jac", method="trf", xtol=1e-10, ftol=1e-10,
-                gtol=1e-10, max_nfev=100 * len(starts[0]))
+    opts = dict(jac=jac, bounds=(lb[:npar], ub[:npar]), x_scale="jac", method="trf",
+                xtol=1e-10, ftol=1e-10, gtol=1e-10, max_nfev=100 * npar)
     best = None
     for x0 in track(starts, description="bouc-wen oscillator fit", enabled=progress):
         res = least_squares(resid, x0, args=warm, **opts)
@@ -773,7 +783,10 @@ def _fit_bouc_wen_oscillator(recs, dt, *, exponent, offset, burn_in, multistart,
             best = res
         if 2.0 * best.cost < good:
             break
-    if ends != lengths:
+    if est:  # θ and every record's initial state together, on the whole records
+        best = least_squares(resid, np.concatenate([best.x, s0]),
+                             **(opts | dict(bounds=(lb, ub), max_nfev=100 * len(lb))))
+    elif ends != lengths:
         best = least_squares(resid, best.x, **opts)
     cov_s = _free_run_covariance(best, len(y) - burn_in * len(recs), "bouc-wen-oscillator")
     phys, cov = _oscillator_physical(best.x, names, fixed, cov_s, su, sy)
