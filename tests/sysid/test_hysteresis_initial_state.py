@@ -187,7 +187,8 @@ def test_bad_initial_state_option(tmp_path, capsys):
 def test_cli_initial_states_of_two_files(tmp_path, capsys):
     """`gripkit identify hysteresis A.csv B.csv --form oscillator --json`: the structure says
     the initial states were estimated, ``initial_states`` gives each file's (x0, ẋ0, z0) with σ
-    as the Python call (within 10⁻³σ: the files' time column), the truth within 3σ; ``--initial-state zero`` gives none."""
+    as the Python call (within 10⁻³σ: the files' time column), the truth within 3σ;
+    ``--initial-state zero`` gives none."""
     from gripkit.cli import main
 
     recs = _moving_records(1000, 2, 4)

@@ -1,8 +1,10 @@
 """``gripkit identify hysteresis DATA --input U --output Y [--model bouc-wen|prandtl-ishlinskii]
 [--form actuator|oscillator] [--exponent N|free] [--operators M]
-[--initial-state estimate|zero] [--validate DATA2] [--out MODEL.json] [--json]``: a generic Bouc-Wen (actuator or oscillator form) or
-Prandtl–Ishlinskii hysteresis from a record, through ``gripkit.sysid.identify(data,
-"hysteresis", ...)`` (:func:`gripkit.sysid.hysteresis`)."""
+[--initial-state estimate|zero] [--validate DATA2] [--out MODEL.json] [--json]``: a generic
+Bouc-Wen (actuator or oscillator form) or Prandtl–Ishlinskii hysteresis from a record, through
+``gripkit.sysid.identify(data, "hysteresis", ...)`` (:func:`gripkit.sysid.hysteresis`). The
+oscillator's JSON has ``initial_states``: each file's state (x0, ẋ0, z0) at its first sample
+with σ (none with ``--initial-state zero``)."""
 
 from __future__ import annotations
 
