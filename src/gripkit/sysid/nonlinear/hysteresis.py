@@ -84,7 +84,8 @@ FORMS = ("actuator", "oscillator")
 HYSTERESIS_FIT = ("free run from the relaxed state at the first input sample (Bouc-Wen: h = 0; "
                   "Prandtl-Ishlinskii: every play at the first input), "
                   "fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) over the record (at identification: the "
-                  "samples after burn_in)")
+                  "samples after burn_in, the Bouc-Wen oscillator's estimation records from "
+                  "their estimated initial states where initial_state='estimate')")
 #: an input turning back by less than this fraction of its range is no reversal (noise)
 REVERSAL_BAND = 0.01
 
