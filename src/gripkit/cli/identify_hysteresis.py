@@ -111,8 +111,9 @@ def identify_hysteresis(data: list[Path] = DataArgs,
 
 def _initial_states(data: list[Path], m) -> list[dict]:
     """The JSON ``initial_states`` of an oscillator: each estimation file's state (x, x', z) at
-    its first sample with σ and units (empty when every record started at rest)."""
+    its first scored sample (``sample``: --burn-in) with σ and units (empty when every record
+    started at rest)."""
     yu = m.output_unit
     units = {"x0": yu, "v0": f"{yu}/s" if yu not in ("", "1") else "1/s", "z0": yu}
     return [{"data": str(p), **{k: s[k] for k in ("x0", "v0", "z0")}, "std": dict(s["std"]),
-             "units": units} for p, s in zip(data, m.initial_states)]
+             "units": units, "sample": s["sample"]} for p, s in zip(data, m.initial_states)]

@@ -26,7 +26,8 @@ run like the actuator form, from the second-order ARX model nearest the data (th
 points tried on the first :data:`WARM_SAMPLES` samples, shared out among the records, the best
 then refined on the whole records). Several records: each run from its own first sample. A
 record may start in motion: by default (``initial_state='estimate'``) each record's state
-(x, ẋ, z) at its first sample is estimated with θ, three nuisance parameters a record whose
+(x, ẋ, z) at its first sample (at sample ``burn_in``, the samples before it dropped, when one is
+given) is estimated with θ, three nuisance parameters a record whose
 Jacobian columns come from the same forward differences as θ's (a run of that record alone);
 cov θ is the θ block of s² (JᵀJ)⁻¹ over θ and every initial state. ``initial_state='zero'``
 runs every record from rest (x = ẋ = z = 0), right only for a record known to start at rest: a
@@ -466,12 +467,12 @@ class BoucWenOscillatorModel(_HysteresisModel):
     held over each sample of ``dt``, ``substeps`` Runge-Kutta steps per sample.
 
     ``initial_state_option``: how the estimation records started (``'zero'``: each from rest;
-    ``'estimate'``: each record's (x, ẋ, z) at its first sample estimated with θ).
+    ``'estimate'``: each record's (x, ẋ, z) at its first scored sample estimated with θ).
     ``initial_states``: with ``'estimate'``, one entry per estimation record, ``{"x0": x,
-    "v0": ẋ, "z0": z, "std": {"x0": σ, …}}`` (x, z in the output's unit without the offset, ẋ in
-    that unit per second): nuisance parameters of those records, not in :attr:`parameters` and
-    not used on other data (``simulate(record_input, x0=m.initial_states[i])`` replays record
-    i)."""
+    "v0": ẋ, "z0": z, "std": {"x0": σ, …}, "sample": k}`` (x, z in the output's unit without the
+    offset, ẋ in that unit per second; the state at sample k = ``burn_in`` of the record):
+    nuisance parameters of those records, not in :attr:`parameters` and not used on other data
+    (``simulate(record_input[k:], x0=m.initial_states[i])`` replays record i)."""
 
     mass: float
     damping: float
@@ -569,10 +570,13 @@ class BoucWenOscillatorModel(_HysteresisModel):
                              f"x' + k_e x + k_h z = u  ({self.criterion})")
         yu = "" if _unitless(self.output_unit) else f" {self.output_unit}"
         vu = _ratio(self.output_unit, "s")
-        rows = [f"  record {i}: x0 = {s['x0']:.6g} ± {s['std']['x0']:.3g}{yu}, "
-                f"x'0 = {s['v0']:.6g} ± {s['std']['v0']:.3g} {vu}, "
-                f"z0 = {s['z0']:.6g} ± {s['std']['z0']:.3g}{yu}"
-                for i, s in enumerate(self.initial_states)]
+        rows = []
+        for i, s in enumerate(self.initial_states):
+            at = f" at sample {s['sample']}" if s.get("sample") else ""
+            sd = s["std"]
+            rows.append(f"  record {i}{at}: x0 = {s['x0']:.6g} ± {sd['x0']:.3g}{yu}, "
+                        f"x'0 = {s['v0']:.6g} ± {sd['v0']:.3g} {vu}, "
+                        f"z0 = {s['z0']:.6g} ± {sd['z0']:.3g}{yu}")
         if rows:
             rows.insert(0, "initial state of each estimation record (nuisance, not parameters):")
         return "\n".join([text, *rows])
@@ -1069,16 +1073,21 @@ def _check_initial_state(initial_state, oscillator: bool) -> str:
 
 def _oscillator(recs, dt, exponent, offset, burn_in, multistart, substeps, progress, common,
                 how, initial_state) -> BoucWenOscillatorModel:
-    """The Bouc-Wen oscillator fitted to the records ``recs``, each from rest or from its
-    estimated initial state at its first sample (``common``: the model's other fields)."""
+    """The Bouc-Wen oscillator fitted to the records ``recs``, each from rest at its first
+    sample or from its state estimated at its first scored sample (sample ``burn_in``: the
+    samples before it are dropped, a state they alone would show is not identifiable) (``common``:
+    the model's other fields)."""
     substeps = _check_int(substeps, "substeps", 1)
     if dt is None:
         raise ArgumentError("hysteresis: the Bouc-Wen oscillator is rate dependent: give the "
                             "sample time dt= (or a Trajectory, which has one)")
+    est = initial_state == "estimate"
     phys, names, cov, states = _fit_bouc_wen_oscillator(
-        recs, float(dt), exponent=exponent, offset=offset, burn_in=burn_in,
-        multistart=multistart, substeps=substeps, progress=progress,
-        initial_state=initial_state)
+        [(u[burn_in:], y[burn_in:]) for u, y in recs] if est else recs, float(dt),
+        exponent=exponent, offset=offset, burn_in=0 if est else burn_in, multistart=multistart,
+        substeps=substeps, progress=progress, initial_state=initial_state)
+    for st in states:
+        st["sample"] = burn_in
     common["dt"] = float(dt)
     how += (", each record's initial state (x, x', z) estimated" if initial_state == "estimate"
             else ", each record from rest")
@@ -1121,7 +1130,8 @@ def _score_records(m, recs, burn_in: int) -> None:
     record from its own relaxed state (the oscillator's from its estimated initial state, where
     estimated), the fit over all of them together and each one's in ``m.records``."""
     states = getattr(m, "initial_states", None) or [None] * len(recs)
-    runs = [(m.simulate(ur) if s is None else m.simulate(ur, x0=s))[burn_in:, 0]
+    runs = [m.simulate(ur)[burn_in:, 0] if s is None else  # a state at sample burn_in
+            m.simulate(ur[s["sample"]:], x0=s)[burn_in - s["sample"]:, 0]
             for (ur, _), s in zip(recs, states)]
     if len(recs) == 1:
         m.fit_percent = _fit_percent(recs[0][1][burn_in:], runs[0])
@@ -1156,7 +1166,8 @@ def hysteresis(data, model: str = "bouc-wen", *, input: str | None = None,
     the estimation record (:data:`HYSTERESIS_FIT`).
     ``initial_state`` (the oscillator form; the other models start relaxed, ``"zero"``):
     ``"estimate"`` (the oscillator's default) estimates each record's
-    state (x, ẋ, z) at its first sample jointly with θ, three nuisance parameters a record with
+    state (x, ẋ, z) at its first sample jointly with θ (at sample ``burn_in`` when one is given:
+    the samples before it are dropped), three nuisance parameters a record with
     σ (``model.initial_states``; θ's σ accounts for them), and the fit runs each record from
     its own; ``"zero"`` runs every record from rest (for records known to start at rest: a
     record that starts in motion biases θ). The validation record and new data are run from
@@ -1244,7 +1255,8 @@ def load_hysteresis(path):
             if option not in INITIAL_STATES:
                 raise ValueError(f"initial_state {option!r} is none of {INITIAL_STATES}")
             states = [{**{k: float(s[k]) for k in STATE_NAMES},
-                       "std": {k: float(s["std"][k]) for k in STATE_NAMES}}
+                       "std": {k: float(s["std"][k]) for k in STATE_NAMES},
+                       "sample": int(s.get("sample", 0))}
                       for s in doc.get("initial_states", [])]
             return BoucWenOscillatorModel(**{k: float(doc[k]) for k in _BWO_NAMES},
                                           substeps=int(doc["substeps"]), free=free,
