@@ -186,7 +186,8 @@ def _osc_records(n, count, seed):
 @pytest.fixture(scope="module")
 def osc_fit():
     recs = _osc_records(1000, 3, 5)
-    return recs, hysteresis(recs, form="oscillator", dt=OSC_DT, progress=False)
+    return recs, hysteresis(recs, form="oscillator", dt=OSC_DT, initial_state="zero",
+                            progress=False)
 
 
 def test_oscillator_three_records_equal_least_squares_over_each_records_run_from_rest(osc_fit):
@@ -224,7 +225,8 @@ def test_oscillator_sigma_shrinks_with_records(osc_fit):
     """σ from all three records is below 0.65 σ from the first record alone (1/√3 = 0.58 for
     three like records), for every parameter."""
     recs, m = osc_fit
-    one = hysteresis(recs[0], form="oscillator", dt=OSC_DT, progress=False)
+    one = hysteresis(recs[0], form="oscillator", dt=OSC_DT, initial_state="zero",
+                     progress=False)
     for k in m.free:
         assert m.std[k] < 0.65 * one.std[k], k  # 0.38–0.59
 

@@ -1,8 +1,10 @@
 """``gripkit identify hysteresis DATA --input U --output Y [--model bouc-wen|prandtl-ishlinskii]
-[--form actuator|oscillator] [--exponent N|free] [--operators M] [--validate DATA2]
-[--out MODEL.json] [--json]``: a generic Bouc-Wen (actuator or oscillator form) or
-Prandtl–Ishlinskii hysteresis from a record, through ``gripkit.sysid.identify(data,
-"hysteresis", ...)`` (:func:`gripkit.sysid.hysteresis`)."""
+[--form actuator|oscillator] [--exponent N|free] [--operators M]
+[--initial-state estimate|zero] [--validate DATA2] [--out MODEL.json] [--json]``: a generic
+Bouc-Wen (actuator or oscillator form) or Prandtl–Ishlinskii hysteresis from a record, through
+``gripkit.sysid.identify(data, "hysteresis", ...)`` (:func:`gripkit.sysid.hysteresis`). The
+oscillator's JSON has ``initial_states``: each file's state (x0, ẋ0, z0) at its first sample
+with σ (none with ``--initial-state zero``)."""
 
 from __future__ import annotations
 
@@ -42,6 +44,11 @@ def identify_hysteresis(data: list[Path] = DataArgs,
                                                       help="Prandtl-Ishlinskii: number of plays."),
                         burn_in: int = typer.Option(0, "--burn-in",
                                                     help="Samples simulated but not scored."),
+                        initial_state: Optional[str] = typer.Option(
+                            None, "--initial-state",
+                            help="Oscillator form: estimate each record's state (x, x', z) at "
+                                 "its first sample with the parameters (estimate, the default), "
+                                 "or start every record at rest (zero)."),
                         validate: Optional[Path] = RecordValidateOpt,
                         out: Optional[Path] = ModelJsonOpt,
                         report: Optional[Path] = ModelReportOpt,
@@ -50,10 +57,12 @@ def identify_hysteresis(data: list[Path] = DataArgs,
     """Hysteresis (Bouc-Wen or Prandtl-Ishlinskii): parameters with σ, free-run fit. Several
     DATA files: one model of all the records, each from its own relaxed state (``records``:
     each file's fit)."""
-    from ..sysid.nonlinear.hysteresis import FORMS, MODELS
+    from ..sysid.nonlinear.hysteresis import FORMS, INITIAL_STATES, MODELS
 
     check_choice(model, "--model", MODELS)
     check_choice(form, "--form", FORMS)
+    if initial_state is not None:
+        check_choice(initial_state, "--initial-state", INITIAL_STATES)
     n = EXPONENT.parse(exponent)
     check_data_options(fs, fill)
     output_folder(report, "--report")
@@ -62,7 +71,9 @@ def identify_hysteresis(data: list[Path] = DataArgs,
         m, tr, val = run_identify(data, "hysteresis", input_col, output_col, fs=fs, time=time,
                                   fill=fill, validate=validate, fit_validate=True,
                                   detrend="none", model=model, form=form, exponent=n,
-                                  operators=operators, burn_in=burn_in, progress=not json_out)
+                                  operators=operators, burn_in=burn_in, progress=not json_out,
+                                  **({} if initial_state is None
+                                     else {"initial_state": initial_state}))
         page = save_and_page(m, out, report, first_record(tr), val, data[0], validate)
     lines = report_warnings(caught)
     if json_out:
@@ -72,6 +83,9 @@ def identify_hysteresis(data: list[Path] = DataArgs,
                      {"model": m.structure, "operators": len(m.thresholds),
                       "thresholds": [float(r) for r in m.thresholds]})
         structure["criterion"] = m.criterion
+        oscillator = m.structure == "bouc-wen-oscillator"
+        if oscillator:
+            structure["initial_state"] = m.initial_state_option
         emit_json({"data": data_field(data),
                    "input": input_col, "output": output_col,
                    "structure": structure,
@@ -82,6 +96,7 @@ def identify_hysteresis(data: list[Path] = DataArgs,
                    "validation": None if validate is None else
                    {"data": str(validate), "fit_percent": m.validation_fit_percent},
                    **({"records": records_field(data, m.records)} if len(data) > 1 else {}),
+                   **({"initial_states": _initial_states(data, m)} if oscillator else {}),
                    "model": None if out is None else str(out), "report": page,
                    "warnings": lines})
     else:
@@ -92,3 +107,13 @@ def identify_hysteresis(data: list[Path] = DataArgs,
             typer.echo(f"free-run fit (validation): {fmt(m.validation_fit_percent)}")
         if len(data) > 1:
             _echo_records(records_field(data, m.records), free_run=True)
+
+
+def _initial_states(data: list[Path], m) -> list[dict]:
+    """The JSON ``initial_states`` of an oscillator: each estimation file's state (x, x', z) at
+    its first scored sample (``sample``: --burn-in) with σ and units (empty when every record
+    started at rest)."""
+    yu = m.output_unit
+    units = {"x0": yu, "v0": f"{yu}/s" if yu not in ("", "1") else "1/s", "z0": yu}
+    return [{"data": str(p), **{k: s[k] for k in ("x0", "v0", "z0")}, "std": dict(s["std"]),
+             "units": units, "sample": s["sample"]} for p, s in zip(data, m.initial_states)]

@@ -24,7 +24,14 @@ mass with a hysteretic spring, ``m ẍ + c_v ẋ + k_e x + k_h z = u``,
 simulated from rest with the input held over each sample (RK4 sub-steps) and fitted on the free
 run like the actuator form, from the second-order ARX model nearest the data (the starting
 points tried on the first :data:`WARM_SAMPLES` samples, shared out among the records, the best
-then refined on the whole records). Several records: each run from rest at its own first sample.
+then refined on the whole records). Several records: each run from its own first sample. A
+record may start in motion: by default (``initial_state='estimate'``) each record's state
+(x, ẋ, z) at its first sample (at sample ``burn_in``, the samples before it dropped, when one is
+given) is estimated with θ, three nuisance parameters a record whose
+Jacobian columns come from the same forward differences as θ's (a run of that record alone);
+cov θ is the θ block of s² (JᵀJ)⁻¹ over θ and every initial state. ``initial_state='zero'``
+runs every record from rest (x = ẋ = z = 0), right only for a record known to start at rest: a
+record in motion at its first sample then biases θ.
 
 **Prandtl–Ishlinskii**: ``y = c + Σ_i w_i F_{r_i}[u − a]`` with the play operators
 ``F_r[x](k) = max(x(k) − r, min(x(k) + r, F_r[x](k−1)))``, each relaxed at the first sample
@@ -76,7 +83,8 @@ FORMS = ("actuator", "oscillator")
 HYSTERESIS_FIT = ("free run from the relaxed state at the first input sample (Bouc-Wen: h = 0; "
                   "Prandtl-Ishlinskii: every play at the first input), "
                   "fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) over the record (at identification: the "
-                  "samples after burn_in)")
+                  "samples after burn_in, the Bouc-Wen oscillator's estimation records from "
+                  "their estimated initial states where initial_state='estimate')")
 #: an input turning back by less than this fraction of its range is no reversal (noise)
 REVERSAL_BAND = 0.01
 
@@ -181,9 +189,10 @@ class _HysteresisModel(SingleChannel, FamilyFile):
         return _record(data, self.input_name, None, f"{self.structure}.simulate",
                        need_output=False)[0]
 
-    def _fd_std(self, u: np.ndarray) -> np.ndarray:
+    def _fd_std(self, u: np.ndarray, **run) -> np.ndarray:
         """σ of the free run (N,), the parameter covariance propagated through the Jacobian of
-        the run by central differences (step 10⁻³ σ of each free parameter)."""
+        the run by central differences (step 10⁻³ σ of each free parameter); ``run``: more
+        arguments of ``_run`` (the oscillator's initial state, held)."""
         base, sd = self.values(), self.std
         G = np.zeros((len(u), len(self.free)))
         for j, k in enumerate(self.free):
@@ -191,7 +200,7 @@ class _HysteresisModel(SingleChannel, FamilyFile):
             hi, lo = dict(base), dict(base)
             hi[k] += h
             lo[k] -= h
-            G[:, j] = (self._run(u, hi)[0] - self._run(u, lo)[0]) / (2 * h)
+            G[:, j] = (self._run(u, hi, **run)[0] - self._run(u, lo, **run)[0]) / (2 * h)
         return _output_std(G, self.covariance)
 
     @property
@@ -430,6 +439,8 @@ def _fit_bouc_wen(recs, *, exponent, offset, burn_in, multistart, progress):
 
 
 _BWO_NAMES = ("mass", "damping", "k_e", "k_h", "beta", "gamma", "n", "offset")
+#: the oscillator's state at a record's first sample: x, ẋ, z (``initial_states`` entries)
+STATE_NAMES = ("x0", "v0", "z0")
 #: the oscillator's starting points are fitted on this many samples first (then the whole record)
 WARM_SAMPLES = 5000
 
@@ -442,8 +453,16 @@ class BoucWenOscillatorModel(_HysteresisModel):
 
     output y = x + offset; u a force, x a displacement, z the hysteretic displacement (unit of
     x), k_e the elastic and k_h the hysteretic stiffness (k_e = a k, k_h = (1 − a) k of Wen's
-    α-form). Rate dependent: simulated from rest with the input held over each sample of ``dt``,
-    ``substeps`` Runge-Kutta steps per sample."""
+    α-form). Rate dependent: simulated from rest (or from a given state ``x0``) with the input
+    held over each sample of ``dt``, ``substeps`` Runge-Kutta steps per sample.
+
+    ``initial_state_option``: how the estimation records started (``'zero'``: each from rest;
+    ``'estimate'``: each record's (x, ẋ, z) at its first scored sample estimated with θ).
+    ``initial_states``: with ``'estimate'``, one entry per estimation record, ``{"x0": x,
+    "v0": ẋ, "z0": z, "std": {"x0": σ, …}, "sample": k}`` (x, z in the output's unit without the
+    offset, ẋ in that unit per second; the state at sample k = ``burn_in`` of the record):
+    nuisance parameters of those records, not in :attr:`parameters` and not used on other data
+    (``simulate(record_input[k:], x0=m.initial_states[i])`` replays record i)."""
 
     mass: float
     damping: float
@@ -456,6 +475,8 @@ class BoucWenOscillatorModel(_HysteresisModel):
     dt: float = 1.0
     substeps: int = 4
     free: tuple = ("mass", "damping", "k_e", "k_h", "beta", "gamma", "offset")
+    initial_state_option: str = "zero"
+    initial_states: list = field(default_factory=list)
 
     structure = "bouc-wen-oscillator"
 
@@ -485,33 +506,70 @@ class BoucWenOscillatorModel(_HysteresisModel):
                             "same sample time", hint="resample the record to the model's dt")
         return super()._input(data)
 
-    def _run(self, u: np.ndarray, theta: dict | None = None) -> tuple[np.ndarray, int]:
+    def _run(self, u: np.ndarray, theta: dict | None = None,
+             x0=(0.0, 0.0, 0.0)) -> tuple[np.ndarray, int]:
         p = self.values() if theta is None else theta
         y = np.empty(len(u))
         at = K.bwo_simulate(u, float(self.dt), int(self.substeps), p["mass"], p["damping"],
-                            p["k_e"], p["k_h"], p["beta"], p["gamma"], p["n"], p["offset"], y)
+                            p["k_e"], p["k_h"], p["beta"], p["gamma"], p["n"], p["offset"],
+                            *x0, y)
         return y, at
 
-    def simulate(self, data, *, std: bool = False, warn: bool = True):
+    @staticmethod
+    def _state(x0) -> tuple[float, float, float]:
+        """``x0`` as (x, ẋ, z): rest for None; a sequence of three numbers, or a mapping with
+        ``x0``, ``v0``, ``z0`` (an entry of ``initial_states``)."""
+        if x0 is None:
+            return 0.0, 0.0, 0.0
+        try:
+            v = [x0[k] for k in STATE_NAMES] if isinstance(x0, dict) else list(x0)
+            v = [float(q) for q in v]
+        except (KeyError, TypeError, ValueError):
+            v = None
+        if v is None or len(v) != 3 or not all(math.isfinite(q) for q in v):
+            raise ArgumentError(f"bouc-wen-oscillator.simulate: x0 must be the state (x, ẋ, z) "
+                                f"at the first sample, three finite numbers or a mapping with "
+                                f"x0, v0, z0 (an entry of initial_states), found {x0!r}")
+        return v[0], v[1], v[2]
+
+    def simulate(self, data, x0=None, *, std: bool = False, warn: bool = True):
         """Free run (N, 1) on the input column of ``data`` (a Trajectory sampled at the model's
-        dt, or an array (N,)), from rest. ``std=True`` also returns σ of ŷ (N, 1), propagated
-        from the parameter covariance (central differences, step 10⁻³ σ)."""
+        dt, or an array (N,)), from rest, or from ``x0`` = (x, ẋ, z) at the first sample (x and
+        z in the output's unit without the offset, ẋ per second; or an entry of
+        ``initial_states``). ``std=True`` also returns σ of ŷ (N, 1), propagated from the
+        parameter covariance (central differences, step 10⁻³ σ; x0 held)."""
         u = self._input(data)
-        y, at = self._run(u)
+        x0 = self._state(x0)
+        y, at = self._run(u, x0=x0)
         if at >= 0 and warn:
             emit_warning(f"bouc-wen-oscillator: the free run diverges at sample {at}; the model "
                          "is unstable on this input", StabilityWarning)
         if not std:
             return y[:, None]
-        return y[:, None], self._fd_std(u)[:, None]
+        return y[:, None], self._fd_std(u, x0=x0)[:, None]
 
     def to_dict(self) -> dict:
         return self._document(**self.values(), substeps=int(self.substeps), free=list(self.free),
-                              covariance=np.asarray(self.covariance).tolist(), std=self.std)
+                              covariance=np.asarray(self.covariance).tolist(), std=self.std,
+                              initial_state=self.initial_state_option,
+                              initial_states=[dict(s, std=dict(s["std"]))
+                                              for s in self.initial_states])
 
     def summary(self) -> str:
-        return self._summary(f"Bouc-Wen oscillator (n = {self.n:g}, A = 1): mass x'' + damping "
+        text = self._summary(f"Bouc-Wen oscillator (n = {self.n:g}, A = 1): mass x'' + damping "
                              f"x' + k_e x + k_h z = u  ({self.criterion})")
+        yu = "" if _unitless(self.output_unit) else f" {self.output_unit}"
+        vu = _ratio(self.output_unit, "s")
+        rows = []
+        for i, s in enumerate(self.initial_states):
+            at = f" at sample {s['sample']}" if s.get("sample") else ""
+            sd = s["std"]
+            rows.append(f"  record {i}{at}: x0 = {s['x0']:.6g} ± {sd['x0']:.3g}{yu}, "
+                        f"x'0 = {s['v0']:.6g} ± {sd['v0']:.3g} {vu}, "
+                        f"z0 = {s['z0']:.6g} ± {sd['z0']:.3g}{yu}")
+        if rows:
+            rows.insert(0, "initial state of each estimation record (nuisance, not parameters):")
+        return "\n".join([text, *rows])
 
 
 def _linear_start(recs, dt):
@@ -568,8 +626,9 @@ def _oscillator_starts(recs, dt, exponent, offset, multistart):
 
 
 def _oscillator_physical(theta_s, names, fixed, cov_s, su, sy):
-    """The oscillator's physical parameters and their covariance from the scaled fit (u/su,
-    y/sy): force-like parameters scale by sy/su, β and γ by sy^−n, the offset by sy."""
+    """The oscillator's physical parameters and the covariance of the whole vector from the
+    scaled fit (u/su, y/sy): force-like parameters scale by sy/su, β and γ by sy^−n, the offset
+    by sy; entries past ``names`` (the records' initial states x0, ẋ0, z0) by sy."""
     p = dict(fixed)
     p.update(zip(names, theta_s))
     n = p["n"]
@@ -579,18 +638,50 @@ def _oscillator_physical(theta_s, names, fixed, cov_s, su, sy):
             "n": n, "offset": p["offset"] * sy}
     diag = {"mass": 1 / g, "damping": 1 / g, "k_e": 1 / g, "k_h": 1 / g, "beta": sy ** -n,
             "gamma": sy ** -n, "n": 1.0, "offset": sy}
-    T = np.diag([diag[k] for k in names])
+    T = np.diag([diag[k] for k in names] + [sy] * (len(cov_s) - len(names)))
     if "n" in names:
         for k in ("beta", "gamma"):
             T[names.index(k), names.index("n")] = -phys[k] * math.log(sy)
     return phys, T @ cov_s @ T.T
 
 
+#: the options of the oscillator's initial state at each record's first sample
+INITIAL_STATES = ("estimate", "zero")
+#: the samples whose quadratic gives the start of a record's (x0, ẋ0) when they are estimated
+X0_SAMPLES = 15
+
+
+def _initial_state_start(u, y, dt, offset0):
+    """(x0, ẋ0, z0) to start the estimate of a scaled record's initial state from: value and
+    slope at the first sample of the quadratic through its first :data:`X0_SAMPLES` outputs,
+    z0 = 0."""
+    k = min(X0_SAMPLES, len(y))
+    c = np.polyfit(np.arange(k) * dt, y[:k], 2)
+    return np.array([c[2] - offset0, c[1], 0.0])
+
+
+def _fd_step(x: float, lo: float, hi: float) -> float:
+    """The forward-difference step of ``scipy.optimize.least_squares``' '2-point' Jacobian:
+    √ε sign(x) max(1, |x|), turned back where it would leave [lo, hi]; the step as represented
+    ((x + h) − x)."""
+    h = math.sqrt(np.finfo(float).eps) * (1.0 if x >= 0 else -1.0) * max(1.0, abs(x))
+    if not lo <= x + h <= hi:
+        h = -h
+    return (x + h) - x
+
+
 def _fit_bouc_wen_oscillator(recs, dt, *, exponent, offset, burn_in, multistart, substeps,
-                             progress):
-    """The Bouc-Wen oscillator on the records ``recs`` (a list of ``(u, y)``), each run from rest
-    at its own first sample, its first ``burn_in`` samples not scored; one least squares over
-    all of them (σ from the Jacobian over all)."""
+                             progress, initial_state="zero"):
+    """The Bouc-Wen oscillator on the records ``recs`` (a list of ``(u, y)``), each run from its
+    own first sample, its first ``burn_in`` samples not scored; one least squares over all of
+    them (σ from the Jacobian over all). ``initial_state='zero'``: every record from rest;
+    ``'estimate'``: each record's (x0, ẋ0, z0) at its first sample estimated with θ (three
+    nuisance parameters a record, their columns of the Jacobian by the same forward differences
+    as θ's, each from a run of its own record only).
+
+    Returns (physical θ, free names, cov θ, initial states): the last a list per record of
+    ``{"x0", "v0", "z0", "std": {…}}`` (empty for ``'zero'``); cov θ is the θ block of the
+    covariance of θ and the initial states together."""
     from scipy.optimize import least_squares
 
     u = np.concatenate([r[0] for r in recs])
@@ -600,34 +691,86 @@ def _fit_bouc_wen_oscillator(recs, dt, *, exponent, offset, burn_in, multistart,
     us, ys = u / su, y / sy
     first = np.cumsum([0] + [len(r[0]) for r in recs])[:-1]
     lengths = [len(r[0]) for r in recs]
-    names, fixed, bounds, starts = _oscillator_starts(
+    names, fixed, (lb, ub), starts = _oscillator_starts(
         [(us[a:a + n], ys[a:a + n]) for a, n in zip(first, lengths)], dt, exponent, offset,
         multistart)
+    npar = len(names)
+    est = initial_state == "estimate"
+    s0 = np.zeros(0)
+    if est:  # the output offset from the mean static line, each record's state from its start
+        if "offset" in names:
+            k0 = np.mean([x0[names.index("k_e")] + x0[names.index("k_h")] for x0 in starts])
+            off0 = float(np.mean(ys) - np.mean(us) / k0)
+            for x0 in starts:
+                x0[names.index("offset")] = off0
+        else:
+            off0 = 0.0
+        s0 = np.concatenate([_initial_state_start(us[a:a + n], ys[a:a + n], dt, off0)
+                             for a, n in zip(first, lengths)])
+        lb = np.concatenate([lb, np.full(len(s0), -np.inf)])
+        ub = np.concatenate([ub, np.full(len(s0), np.inf)])
     buf = np.empty(len(us))
 
-    def scored(ends):  # every record's samples burn_in … end − 1
-        return np.concatenate([np.arange(a + burn_in, a + e) for a, e in zip(first, ends)])
-
-    def resid(th, ends=lengths, idx=scored(lengths)):
+    def params(th):
         p = dict(fixed)
-        p.update(zip(names, th))
-        for a, e in zip(first, ends):  # every record from rest at its own first sample
-            K.bwo_simulate(us[a:a + e], dt, substeps, p["mass"], p["damping"], p["k_e"],
-                           p["k_h"], p["beta"], p["gamma"], p["n"], p["offset"], buf[a:a + e])
-        r = buf[idx] - ys[idx]
+        p.update(zip(names, th[:npar]))
+        return p
+
+    def run(i, p, th, e):  # record i from its initial state, its residual on burn_in … e − 1
+        a = first[i]
+        k = npar + 3 * i
+        x0, v0, z0 = (th[k:k + 3] if len(th) > npar else s0[3 * i:3 * i + 3]) if est else (
+            0.0, 0.0, 0.0)
+        K.bwo_simulate(us[a:a + e], dt, substeps, p["mass"], p["damping"], p["k_e"], p["k_h"],
+                       p["beta"], p["gamma"], p["n"], p["offset"], x0, v0, z0, buf[a:a + e])
+        r = buf[a + burn_in:a + e] - ys[a + burn_in:a + e]
         return np.clip(np.where(np.isfinite(r), r, 1e3), -1e3, 1e3)
+
+    last = {}
+
+    def resid(th, ends=lengths):
+        key = (th.tobytes(), tuple(ends))
+        if key not in last:
+            p = params(th)
+            last.clear()
+            last[key] = np.concatenate([run(i, p, th, e) for i, e in enumerate(ends)])
+        return last[key].copy()
+
+    def jac(th, ends=lengths):
+        """Forward differences (scipy's '2-point' steps): a θ column from a run of every
+        record, a record's initial-state column from a run of that record alone (zero on the
+        other records' rows)."""
+        f0 = resid(th, ends)
+        rows = np.cumsum([0] + [e - burn_in for e in ends])
+        J = np.zeros((len(f0), len(th)))
+        p0 = params(th)
+        for j in range(len(th)):
+            t = th.copy()
+            h = _fd_step(th[j], lb[j], ub[j])
+            t[j] += h
+            if j < npar:
+                p = params(t)
+                J[:, j] = (np.concatenate([run(i, p, t, e) for i, e in enumerate(ends)])
+                           - f0) / h
+            else:
+                i = (j - npar) // 3
+                r = slice(rows[i], rows[i + 1])
+                J[r, j] = (run(i, p0, t, ends[i]) - f0[r]) / h
+        return J
 
     # the starts in order of their initial cost, each to convergence on the first
     # WARM_SAMPLES samples (shared out among the records), until one reproduces them to a fit of
     # 90 % (a free run of a rate-dependent model is costly, and a long record makes a poor start
-    # crawl); then the best one refined on the whole records
+    # crawl); then the best one refined on the whole records. With initial states estimated the
+    # starts are tried with each record's state held at its start (the value and slope of its
+    # first samples, z = 0), then θ and every state refined together
     ends = [min(n, burn_in + WARM_SAMPLES // len(recs)) for n in lengths]
-    warm = (ends, scored(ends))
+    warm = (ends,)
     starts.sort(key=lambda x0: float(np.sum(resid(x0, *warm) ** 2)))
-    short = ys[warm[1]]
+    short = np.concatenate([ys[a + burn_in:a + e] for a, e in zip(first, ends)])
     good = 0.01 * float(np.sum((short - short.mean()) ** 2))
-    opts = dict(bounds=bounds, x_scale="jac", method="trf", xtol=1e-10, ftol=1e-10,
-                gtol=1e-10, max_nfev=100 * len(names))
+    opts = dict(jac=jac, bounds=(lb[:npar], ub[:npar]), x_scale="jac", method="trf",
+                xtol=1e-10, ftol=1e-10, gtol=1e-10, max_nfev=100 * npar)
     best = None
     for x0 in track(starts, description="bouc-wen oscillator fit", enabled=progress):
         res = least_squares(resid, x0, args=warm, **opts)
@@ -635,11 +778,20 @@ def _fit_bouc_wen_oscillator(recs, dt, *, exponent, offset, burn_in, multistart,
             best = res
         if 2.0 * best.cost < good:
             break
-    if ends != lengths:
+    if est:  # θ and every record's initial state together, on the whole records
+        best = least_squares(resid, np.concatenate([best.x, s0]),
+                             **(opts | dict(bounds=(lb, ub), max_nfev=100 * len(lb))))
+    elif ends != lengths:
         best = least_squares(resid, best.x, **opts)
     cov_s = _free_run_covariance(best, len(y) - burn_in * len(recs), "bouc-wen-oscillator")
     phys, cov = _oscillator_physical(best.x, names, fixed, cov_s, su, sy)
-    return phys, tuple(names), cov
+    states = []
+    for i in range(len(recs) if est else 0):
+        k = npar + 3 * i
+        sd = np.sqrt(np.maximum(np.diag(cov)[k:k + 3], 0.0))
+        states.append({**{q: float(sy * best.x[k + j]) for j, q in enumerate(STATE_NAMES)},
+                       "std": {q: float(sd[j]) for j, q in enumerate(STATE_NAMES)}})
+    return phys, tuple(names), cov[:npar, :npar], states
 
 
 # ---------------------------------------------------------------------------------------------
@@ -890,20 +1042,47 @@ def _bouc_wen_settings(form, exponent, multistart):
     return multistart, how
 
 
+def _check_initial_state(initial_state, oscillator: bool) -> str:
+    """``initial_state`` checked; None → 'estimate' for the oscillator, 'zero' otherwise (the
+    other models start from their relaxed state, which is not estimated)."""
+    if initial_state is None:
+        return "estimate" if oscillator else "zero"
+    if not (isinstance(initial_state, str) and initial_state in INITIAL_STATES):
+        raise ArgumentError(f"hysteresis: initial_state must be one of "
+                            f"{', '.join(INITIAL_STATES)} (the oscillator's state at each "
+                            f"record's first sample), found {initial_state!r}",
+                            hint="'estimate' for records that may start in motion, 'zero' for "
+                                 "records known to start at rest")
+    if initial_state == "estimate" and not oscillator:
+        raise ArgumentError("hysteresis: initial_state='estimate' is for the Bouc-Wen "
+                            "oscillator (form='oscillator'); the actuator form and "
+                            "Prandtl-Ishlinskii start from their relaxed state",
+                            hint="drop initial_state, or give form='oscillator'")
+    return initial_state
+
+
 def _oscillator(recs, dt, exponent, offset, burn_in, multistart, substeps, progress, common,
-                how) -> BoucWenOscillatorModel:
-    """The Bouc-Wen oscillator fitted to the records ``recs``, each from rest at its first sample
-    (``common``: the model's other fields)."""
+                how, initial_state) -> BoucWenOscillatorModel:
+    """The Bouc-Wen oscillator fitted to the records ``recs``, each from rest at its first
+    sample or from its state estimated at its first scored sample (sample ``burn_in``: the
+    samples before it are dropped, a state they alone would show is not identifiable) (``common``:
+    the model's other fields)."""
     substeps = _check_int(substeps, "substeps", 1)
     if dt is None:
         raise ArgumentError("hysteresis: the Bouc-Wen oscillator is rate dependent: give the "
                             "sample time dt= (or a Trajectory, which has one)")
-    phys, names, cov = _fit_bouc_wen_oscillator(recs, float(dt), exponent=exponent,
-                                                offset=offset, burn_in=burn_in,
-                                                multistart=multistart, substeps=substeps,
-                                                progress=progress)
+    est = initial_state == "estimate"
+    phys, names, cov, states = _fit_bouc_wen_oscillator(
+        [(u[burn_in:], y[burn_in:]) for u, y in recs] if est else recs, float(dt),
+        exponent=exponent, offset=offset, burn_in=0 if est else burn_in, multistart=multistart,
+        substeps=substeps, progress=progress, initial_state=initial_state)
+    for st in states:
+        st["sample"] = burn_in
     common["dt"] = float(dt)
+    how += (", each record's initial state (x, x', z) estimated" if initial_state == "estimate"
+            else ", each record from rest")
     return BoucWenOscillatorModel(**phys, substeps=substeps, free=names, covariance=cov,
+                                  initial_state_option=initial_state, initial_states=states,
                                   **common, criterion=how)
 
 
@@ -938,14 +1117,15 @@ def _prandtl_ishlinskii(recs, u, operators, thresholds, offset, burn_in, iname,
 
 def _score_records(m, recs, burn_in: int) -> None:
     """``m.fit_percent`` of the free run over the scored samples; with several records each
-    record from its own relaxed state, the fit over all of them together and each one's in
-    ``m.records``."""
+    record from its own relaxed state (the oscillator's from its estimated initial state, where
+    estimated), the fit over all of them together and each one's in ``m.records``."""
+    states = getattr(m, "initial_states", None) or [None] * len(recs)
+    runs = [m.simulate(ur)[burn_in:, 0] if s is None else  # a state at sample burn_in
+            m.simulate(ur[s["sample"]:], x0=s)[burn_in - s["sample"]:, 0]
+            for (ur, _), s in zip(recs, states)]
     if len(recs) == 1:
-        u, y = recs[0]
-        yhat = m.simulate(u)[:, 0]
-        m.fit_percent = _fit_percent(y[burn_in:], yhat[burn_in:])
+        m.fit_percent = _fit_percent(recs[0][1][burn_in:], runs[0])
         return
-    runs = [m.simulate(ur)[burn_in:, 0] for ur, _ in recs]
     m.records = [{"n_samples": len(ur), "fit_percent": _fit_percent(yr[burn_in:], s)}
                  for (ur, yr), s in zip(recs, runs)]
     m.fit_percent = _fit_percent(np.concatenate([yr[burn_in:] for _, yr in recs]),
@@ -956,7 +1136,7 @@ def hysteresis(data, model: str = "bouc-wen", *, input: str | None = None,
                output: str | None = None, form: str = "actuator", exponent=1.0,
                operators: int = 10, thresholds=None, offset: bool = True, burn_in: int = 0,
                validate=None, multistart: int = 4, substeps: int = 4, dt: float | None = None,
-               progress: bool = True):
+               initial_state: str | None = None, progress: bool = True):
     """Identify a hysteresis model of ``output`` driven by ``input``.
 
     ``data``: a Trajectory (columns ``input``, ``output``) or a pair of arrays ``(u, y)``, or a
@@ -974,6 +1154,14 @@ def hysteresis(data, model: str = "bouc-wen", *, input: str | None = None,
     not scored (a record that starts mid-loop). ``validate``: a second record (Trajectory or
     pair) scored by the free run, ``validation_fit_percent``. The model's ``fit_percent`` is on
     the estimation record (:data:`HYSTERESIS_FIT`).
+    ``initial_state`` (the oscillator form; the other models start relaxed, ``"zero"``):
+    ``"estimate"`` (the oscillator's default) estimates each record's
+    state (x, ẋ, z) at its first sample jointly with θ (at sample ``burn_in`` when one is given:
+    the samples before it are dropped), three nuisance parameters a record with
+    σ (``model.initial_states``; θ's σ accounts for them), and the fit runs each record from
+    its own; ``"zero"`` runs every record from rest (for records known to start at rest: a
+    record that starts in motion biases θ). The validation record and new data are run from
+    rest (``simulate(..., x0=...)`` for a known state), as ``compare`` does.
 
     Raises DataError when the input never reverses (the hysteresis is not excited).
     """
@@ -997,11 +1185,13 @@ def hysteresis(data, model: str = "bouc-wen", *, input: str | None = None,
         uv, yv, *_ = _record(validate, iname, oname, "hysteresis validate")
     common = dict(dt=dt, input_name=iname, output_name=oname, input_unit=iunit,
                   output_unit=ounit, burn_in=burn_in)
+    initial_state = _check_initial_state(initial_state, model == "bouc-wen"
+                                         and form == "oscillator")
     if model == "bouc-wen":
         multistart, how = _bouc_wen_settings(form, exponent, multistart)
     if model == "bouc-wen" and form == "oscillator":
         m = _oscillator(recs, dt, exponent, offset, burn_in, multistart, substeps, progress,
-                        common, how)
+                        common, how, initial_state)
     elif model == "bouc-wen":
         phys, names, cov = _fit_bouc_wen(recs, exponent=exponent, offset=offset,
                                          burn_in=burn_in, multistart=multistart,
@@ -1051,9 +1241,17 @@ def load_hysteresis(path):
             common["dt"] = float(common["dt"])
             if not (common["dt"] > 0 and int(doc["substeps"]) >= 1):
                 raise ValueError("dt must be > 0 and substeps ≥ 1")
+            option = str(doc.get("initial_state", "zero"))
+            if option not in INITIAL_STATES:
+                raise ValueError(f"initial_state {option!r} is none of {INITIAL_STATES}")
+            states = [{**{k: float(s[k]) for k in STATE_NAMES},
+                       "std": {k: float(s["std"][k]) for k in STATE_NAMES},
+                       "sample": int(s.get("sample", 0))}
+                      for s in doc.get("initial_states", [])]
             return BoucWenOscillatorModel(**{k: float(doc[k]) for k in _BWO_NAMES},
                                           substeps=int(doc["substeps"]), free=free,
-                                          covariance=cov, **common)
+                                          covariance=cov, initial_state_option=option,
+                                          initial_states=states, **common)
         if kind == "prandtl-ishlinskii":
             r = np.array(doc["thresholds"], dtype=np.float64)
             w = np.array(doc["weights"], dtype=np.float64)
