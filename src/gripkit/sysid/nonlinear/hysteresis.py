@@ -510,9 +510,8 @@ class BoucWenOscillatorModel(_HysteresisModel):
              x0=(0.0, 0.0, 0.0)) -> tuple[np.ndarray, int]:
         p = self.values() if theta is None else theta
         y = np.empty(len(u))
-        at = K.bwo_simulate(u, float(self.dt), int(self.substeps), p["mass"], p["damping"],
-                            p["k_e"], p["k_h"], p["beta"], p["gamma"], p["n"], p["offset"],
-                            *x0, y)
+        at = K.bwo_simulate(u, float(self.dt), int(self.substeps), _bwo_tuple(p), p["offset"],
+                            (float(x0[0]), float(x0[1]), float(x0[2])), y)
         return y, at
 
     @staticmethod
@@ -697,16 +696,8 @@ def _fit_bouc_wen_oscillator(recs, dt, *, exponent, offset, burn_in, multistart,
     npar = len(names)
     est = initial_state == "estimate"
     s0 = np.zeros(0)
-    if est:  # the output offset from the mean static line, each record's state from its start
-        if "offset" in names:
-            k0 = np.mean([x0[names.index("k_e")] + x0[names.index("k_h")] for x0 in starts])
-            off0 = float(np.mean(ys) - np.mean(us) / k0)
-            for x0 in starts:
-                x0[names.index("offset")] = off0
-        else:
-            off0 = 0.0
-        s0 = np.concatenate([_initial_state_start(us[a:a + n], ys[a:a + n], dt, off0)
-                             for a, n in zip(first, lengths)])
+    if est:
+        s0 = _initial_state_guesses(us, ys, first, lengths, dt, names, starts)
         lb = np.concatenate([lb, np.full(len(s0), -np.inf)])
         ub = np.concatenate([ub, np.full(len(s0), np.inf)])
     buf = np.empty(len(us))
@@ -721,8 +712,8 @@ def _fit_bouc_wen_oscillator(recs, dt, *, exponent, offset, burn_in, multistart,
         k = npar + 3 * i
         x0, v0, z0 = (th[k:k + 3] if len(th) > npar else s0[3 * i:3 * i + 3]) if est else (
             0.0, 0.0, 0.0)
-        K.bwo_simulate(us[a:a + e], dt, substeps, p["mass"], p["damping"], p["k_e"], p["k_h"],
-                       p["beta"], p["gamma"], p["n"], p["offset"], x0, v0, z0, buf[a:a + e])
+        K.bwo_simulate(us[a:a + e], dt, substeps, _bwo_tuple(p), p["offset"],
+                       (float(x0), float(v0), float(z0)), buf[a:a + e])
         r = buf[a + burn_in:a + e] - ys[a + burn_in:a + e]
         return np.clip(np.where(np.isfinite(r), r, 1e3), -1e3, 1e3)
 
@@ -737,26 +728,8 @@ def _fit_bouc_wen_oscillator(recs, dt, *, exponent, offset, burn_in, multistart,
         return last[key].copy()
 
     def jac(th, ends=lengths):
-        """Forward differences (scipy's '2-point' steps): a θ column from a run of every
-        record, a record's initial-state column from a run of that record alone (zero on the
-        other records' rows)."""
-        f0 = resid(th, ends)
-        rows = np.cumsum([0] + [e - burn_in for e in ends])
-        J = np.zeros((len(f0), len(th)))
-        p0 = params(th)
-        for j in range(len(th)):
-            t = th.copy()
-            h = _fd_step(th[j], lb[j], ub[j])
-            t[j] += h
-            if j < npar:
-                p = params(t)
-                J[:, j] = (np.concatenate([run(i, p, t, e) for i, e in enumerate(ends)])
-                           - f0) / h
-            else:
-                i = (j - npar) // 3
-                r = slice(rows[i], rows[i + 1])
-                J[r, j] = (run(i, p0, t, ends[i]) - f0[r]) / h
-        return J
+        return _oscillator_jacobian(resid(th, ends), th, ends, (run, params), (lb, ub), npar,
+                                    burn_in)
 
     # the starts in order of their initial cost, each to convergence on the first
     # WARM_SAMPLES samples (shared out among the records), until one reproduces them to a fit of
@@ -771,13 +744,7 @@ def _fit_bouc_wen_oscillator(recs, dt, *, exponent, offset, burn_in, multistart,
     good = 0.01 * float(np.sum((short - short.mean()) ** 2))
     opts = dict(jac=jac, bounds=(lb[:npar], ub[:npar]), x_scale="jac", method="trf",
                 xtol=1e-10, ftol=1e-10, gtol=1e-10, max_nfev=100 * npar)
-    best = None
-    for x0 in track(starts, description="bouc-wen oscillator fit", enabled=progress):
-        res = least_squares(resid, x0, args=warm, **opts)
-        if best is None or res.cost < best.cost:
-            best = res
-        if 2.0 * best.cost < good:
-            break
+    best = _first_good_fit(resid, starts, warm, opts, good, progress)
     if est:  # θ and every record's initial state together, on the whole records
         best = least_squares(resid, np.concatenate([best.x, s0]),
                              **(opts | dict(bounds=(lb, ub), max_nfev=100 * len(lb))))
@@ -785,13 +752,74 @@ def _fit_bouc_wen_oscillator(recs, dt, *, exponent, offset, burn_in, multistart,
         best = least_squares(resid, best.x, **opts)
     cov_s = _free_run_covariance(best, len(y) - burn_in * len(recs), "bouc-wen-oscillator")
     phys, cov = _oscillator_physical(best.x, names, fixed, cov_s, su, sy)
-    states = []
-    for i in range(len(recs) if est else 0):
-        k = npar + 3 * i
-        sd = np.sqrt(np.maximum(np.diag(cov)[k:k + 3], 0.0))
-        states.append({**{q: float(sy * best.x[k + j]) for j, q in enumerate(STATE_NAMES)},
-                       "std": {q: float(sd[j]) for j, q in enumerate(STATE_NAMES)}})
+    states = [_state_entry(best.x, cov, npar + 3 * i, sy) for i in range(len(recs) if est else 0)]
     return phys, tuple(names), cov[:npar, :npar], states
+
+
+def _oscillator_jacobian(f0, th, ends, fns, bounds, npar: int, burn_in: int) -> np.ndarray:
+    """Forward differences of the oscillator's residuals ``f0`` at ``th`` (scipy's '2-point'
+    steps, :func:`_fd_step`): a θ column from a run of every record, a record's initial-state
+    column from a run of that record alone (zero on the other records' rows). ``fns``: the fit's
+    ``run(i, p, th, end)`` and ``params(th)``; ``bounds``: (lb, ub)."""
+    run, params = fns
+    lb, ub = bounds
+    rows = np.cumsum([0] + [e - burn_in for e in ends])
+    J = np.zeros((len(f0), len(th)))
+    p0 = params(th)
+    for j in range(len(th)):
+        t = th.copy()
+        h = _fd_step(th[j], lb[j], ub[j])
+        t[j] += h
+        if j < npar:
+            p = params(t)
+            J[:, j] = (np.concatenate([run(i, p, t, e) for i, e in enumerate(ends)]) - f0) / h
+        else:
+            i = (j - npar) // 3
+            r = slice(rows[i], rows[i + 1])
+            J[r, j] = (run(i, p0, t, ends[i]) - f0[r]) / h
+    return J
+
+
+def _initial_state_guesses(us, ys, first, lengths, dt, names, starts) -> np.ndarray:
+    """The oscillator's scaled initial states to start from, three a record
+    (:func:`_initial_state_start`), with the output offset of every start in ``starts`` set from
+    the mean static line (in place) when the offset is free."""
+    off0 = 0.0
+    if "offset" in names:
+        k0 = np.mean([x0[names.index("k_e")] + x0[names.index("k_h")] for x0 in starts])
+        off0 = float(np.mean(ys) - np.mean(us) / k0)
+        for x0 in starts:
+            x0[names.index("offset")] = off0
+    return np.concatenate([_initial_state_start(us[a:a + n], ys[a:a + n], dt, off0)
+                           for a, n in zip(first, lengths)])
+
+
+def _first_good_fit(resid, starts, warm, opts, good, progress):
+    """``least_squares`` from each start in turn (on the ``warm`` samples) until one's cost is
+    below ``good``/2; the best result."""
+    from scipy.optimize import least_squares
+
+    best = None
+    for x0 in track(starts, description="bouc-wen oscillator fit", enabled=progress):
+        res = least_squares(resid, x0, args=warm, **opts)
+        if best is None or res.cost < best.cost:
+            best = res
+        if 2.0 * best.cost < good:
+            break
+    return best
+
+
+def _state_entry(x, cov, k: int, sy: float) -> dict:
+    """One record's initial state (x, ẋ, z) from the scaled estimate ``x[k:k + 3]`` with σ from
+    the physical covariance ``cov``."""
+    sd = np.sqrt(np.maximum(np.diag(cov)[k:k + 3], 0.0))
+    return {**{q: float(sy * x[k + j]) for j, q in enumerate(STATE_NAMES)},
+            "std": {q: float(sd[j]) for j, q in enumerate(STATE_NAMES)}}
+
+
+def _bwo_tuple(p) -> tuple:
+    """The oscillator's parameters as its kernels take them: (m, c, k_e, k_h, β, γ, n)."""
+    return tuple(float(p[k]) for k in _BWO_NAMES[:7])
 
 
 # ---------------------------------------------------------------------------------------------

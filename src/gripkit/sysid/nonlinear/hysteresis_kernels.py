@@ -199,18 +199,15 @@ def bwo_sample(x, v, z, u, h, substeps, p):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def bwo_simulate(u, dt, substeps, m, c, ke, kh, beta, gamma, n, offset, x0, v0, z0,
-                 y):  # pragma: no cover - compiled
-    """Bouc-Wen oscillator from (x, ẋ, z) = (x0, v0, z0) at the first sample (0, 0, 0: from
-    rest), the input held over each sample, ``substeps`` RK4 steps per sample: y[k] = x(t_k) +
-    offset. Returns the first sample where y is not finite, −1 if none (the rest is NaN)."""
-    x = x0
-    v = v0
-    z = z0
+def bwo_simulate(u, dt, substeps, p, offset, start, y):  # pragma: no cover - compiled
+    """Bouc-Wen oscillator with ``p = (m, c, k_e, k_h, β, γ, n)`` from (x, ẋ, z) = ``start`` at
+    the first sample ((0, 0, 0): from rest), the input held over each sample, ``substeps`` RK4
+    steps per sample: y[k] = x(t_k) + offset. Returns the first sample where y is not finite, −1
+    if none (the rest is NaN)."""
+    x, v, z = start
     h = dt / substeps
-    p = (m, c, ke, kh, beta, gamma, n)
     N = u.shape[0]
-    y[0] = x0 + offset
+    y[0] = x + offset
     for k in range(N - 1):
         x, v, z = bwo_sample(x, v, z, u[k], h, substeps, p)
         val = x + offset
