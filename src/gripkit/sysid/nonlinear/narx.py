@@ -162,16 +162,26 @@ class _Regression:
     samples), the target, and their Gram matrix, from which every least-squares fit on a subset
     of the columns is taken (:meth:`fit`)."""
 
-    def __init__(self, P, target):
+    def __init__(self, P, target, weights=None):
         self.P, self.target = P, target
         self.G, self.g, self.yy = _gram(P, target)
+        self.weights = weights
+        if weights is not None:  # ΦᵀWΦ, ΦᵀWy and ΦᵀW²Φ of every candidate, one pass each
+            r = np.sqrt(weights)
+            Pw = np.asfortranarray(P * r[:, None])
+            self.Gw, self.gw, _ = _gram(Pw, target * r)
+            Pw *= r[:, None]
+            self.Bw = Pw.T @ Pw
 
     def fit(self, cols):
         """θ, cov θ = σ² (ΦᵀΦ)⁻¹ and SSE of the least squares on ``cols``: Cholesky of the
         column-scaled Gram matrix (the semi-normal equations) and one step of iterative
         refinement on the actual residual, which brings θ to the accuracy of a QR solution for
-        any ``cond(Φ)`` below about 1e7; beyond that (or a failed Cholesky) a QR of ``Φ``."""
+        any ``cond(Φ)`` below about 1e7; beyond that (or a failed Cholesky) a QR of ``Φ``.
+        With row weights (``forgetting``): :func:`_weighted_lstsq_cov`."""
         cols = list(cols)
+        if self.weights is not None:
+            return self._fit_weighted(cols)
         G = self.G[np.ix_(cols, cols)]
         d = np.sqrt(np.diag(G))
         d[d == 0] = 1.0
@@ -196,6 +206,42 @@ class _Regression:
         Linv = np.linalg.solve(L, np.eye(k))
         cov = sse / max(n - k, 1) * (Linv.T @ Linv) / np.outer(d, d)
         return theta, cov, sse
+
+
+    def _fit_weighted(self, cols):
+        """The exponentially weighted least squares ``min Σ w_i e_i²`` on ``cols`` (Cholesky of
+        the column-scaled ``A = ΦᵀWΦ`` and one refinement step on the residual, as :meth:`fit`)
+        → θ, its covariance for white noise of one variance σ², and the unweighted SSE. The
+        weights are a forgetting profile, not the inverse noise variance, so the covariance is
+        the sandwich ``σ² A⁻¹ (ΦᵀW²Φ) A⁻¹`` with ``σ² = Σ w e² / (Σ w − tr(A⁻¹ ΦᵀW²Φ))``,
+        unbiased (``E[eᵀWe] = σ² (tr W − tr(A⁻¹ΦᵀW²Φ))``; for ``W = I``: ``SSE/(N − k)``)."""
+        from scipy.linalg import cho_solve
+
+        w = self.weights
+        G = self.Gw[np.ix_(cols, cols)]
+        d = np.sqrt(np.diag(G))
+        d[d == 0] = 1.0
+        try:
+            L = np.linalg.cholesky(G / np.outer(d, d))
+        except np.linalg.LinAlgError:
+            L = None
+        if L is None or np.min(np.diag(L)) ** 2 <= 1e-14 * len(cols):
+            raise IdentificationError(
+                f"narx: the weighted regressors of {len(cols)} terms are singular (the rows "
+                "the forgetting factor keeps do not excite them); give a forgetting factor "
+                "closer to 1 or fewer terms")
+        Phi = self.P[:, cols]
+        z = cho_solve((L, True), self.gw[cols] / d)
+        e = self.target - Phi @ (z / d)
+        z += cho_solve((L, True), (Phi.T @ (w * e)) / d)  # one refinement step
+        theta = z / d
+        e = self.target - Phi @ theta
+        Ainv = cho_solve((L, True), np.eye(len(cols)))
+        AB = Ainv @ (self.Bw[np.ix_(cols, cols)] / np.outer(d, d))
+        dof = float(w.sum() - np.trace(AB))
+        sigma2 = float(w @ (e * e)) / max(dof, 1e-300)
+        cov = sigma2 * (AB @ Ainv) / np.outer(d, d)
+        return theta, 0.5 * (cov + cov.T), float(e @ e)
 
 
 def _lstsq_cov(Phi: np.ndarray, y: np.ndarray):
@@ -751,7 +797,7 @@ def _refine_and_prune(model, records, rows, P, target, prune: bool, max_iter: in
 def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None = None,
          ulags: int | None = None, terms="auto", dt: float | None = None, validate=None,
          direct: bool = False, prune: bool = True, refine: str | None = None,
-         max_iter: int = 50, progress: bool = False) -> NARXModel:
+         forgetting: float = 1.0, max_iter: int = 50, progress: bool = False) -> NARXModel:
     """Polynomial NARX model of ``y`` driven by ``u`` (1-D arrays of equal length), or of
     several records: ``narx([(u1, y1), (u2, y2), …])`` (each record's first ``max_lag``
     samples are its own past; one regression over all of them, σ from all).
@@ -766,6 +812,12 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
     chosen, θ refined by Levenberg–Marquardt on the free-run (simulation) error, at most
     ``max_iter`` iterations, σ from its Gauss–Newton Hessian (the estimate to use when the
     noise is measurement noise on the output, which biases the one-step estimate).
+    ``forgetting``: λ in (0, 1]; below 1, θ is the exponentially weighted least squares
+    ``min Σ λ^age(t) e(t)²`` (age: rows before the last row of the last record, records taken
+    in time order; the batch form of recursive least squares with forgetting factor λ), for a
+    system that drifts slowly: the terms are still chosen by FROLS on every row unweighted,
+    θ and σ (the sandwich covariance for white noise) weight the recent rows, the memory
+    ``Σ λ^age ≈ 1/(1 − λ)`` rows; at most half the memory in terms; not with ``refine``.
     ``progress``: each stage on stderr, a bar over the validation candidates.
     """
     say = status if progress else (lambda message: None)
@@ -773,6 +825,7 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
     if refine not in REFINE:
         raise ArgumentError(f"narx: refine must be None or 'simulation', found {refine!r}")
     max_iter = _positive_int(max_iter, "max_iter")
+    forgetting = _forgetting(forgetting, refine)
     yall = np.concatenate([r[1] for r in records])
     if np.ptp(yall) == 0.0:
         raise DataError(f"narx: the output is constant ({yall[0]:g} in all {len(yall)} samples); "
@@ -791,8 +844,12 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
     n = P.shape[0]
     val = _validation_records(validate, start)
     kmax = _max_terms(terms, len(rows))
+    weights = None
+    if forgetting < 1.0:
+        weights = forgetting ** np.arange(n - 1, -1, -1, dtype=np.float64)
+        kmax = _memory_terms(terms, kmax, float(weights.sum()), forgetting)
     say(f"narx: FROLS over {len(rows)} candidate terms, {n} rows")
-    reg = _Regression(P, target)
+    reg = _Regression(P, target, weights)
     order, errs, sse = _frols_gram(reg.G, reg.g, reg.yy, kmax)
     if not order:
         raise IdentificationError("narx: no candidate term explains the output (all columns zero)")
@@ -818,6 +875,9 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
 
     model, sse_k, how = _choose_terms(build, terms, len(order), sse, n, val, progress)
     model.criterion = how + (", terms with |θ|/σ < 2 pruned" if prune_ls else "")
+    if weights is not None:
+        model.criterion += (f"; θ by exponentially weighted least squares (forgetting "
+                            f"{forgetting:g}, memory {weights.sum():.0f} rows)")
     spread = float(np.linalg.norm(target - target.mean()))
     if spread == 0.0:
         raise DataError("narx: the fit is undefined for a constant output (‖y − ȳ‖ = 0)")
@@ -829,6 +889,33 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
     if val is not None:
         model.validation_fit_percent = _fit_records(model, val)
     return model
+
+
+def _forgetting(forgetting, refine) -> float:
+    """The checked forgetting factor λ in (0, 1]."""
+    if isinstance(forgetting, bool) or not isinstance(forgetting, (int, float, np.floating)) \
+            or not 0.0 < forgetting <= 1.0:
+        raise ArgumentError(f"narx: forgetting must be a number in (0, 1], found {forgetting!r}",
+                            hint="1 (default) weighs every row alike; 0.98 remembers about 50 "
+                                 "rows")
+    if forgetting < 1.0 and refine is not None:
+        raise ArgumentError(f"narx: forgetting = {forgetting!r} applies to the least-squares "
+                            f"estimate, not to refine={refine!r}; give one of them",
+                            hint="refine=None with forgetting < 1, or forgetting=1 with refine")
+    return float(forgetting)
+
+
+def _memory_terms(terms, kmax: int, memory: float, forgetting: float) -> int:
+    """The most terms a forgetting memory of ``memory`` rows carries: half of it."""
+    most = int(round(memory, 6) // 2)
+    if most < 1:
+        raise ArgumentError(f"narx: forgetting = {forgetting:g} remembers {memory:.1f} rows, "
+                            "too few for one term; give a forgetting factor closer to 1")
+    if terms != "auto" and kmax > most:
+        raise ArgumentError(f"narx: terms = {kmax} but forgetting = {forgetting:g} remembers "
+                            f"{memory:.0f} rows, enough for at most {most} terms; give fewer "
+                            "terms or a forgetting factor closer to 1")
+    return min(kmax, most)
 
 
 def _row_index(rows, row) -> int:
