@@ -56,6 +56,12 @@ def test_dc_motor_forgetting_reaches_sysidentpy_best_published_fit(dc_motor):
     assert chosen.validation_fit_percent >= SYSIDENTPY_BEST
     plain = narx(ue, ye, degree=3, lags=2, validate=(uv, yv))
     assert chosen.validation_fit_percent > plain.validation_fit_percent + 3.0
+    # why: the model of the validation half explains the estimation half's first 100 samples at
+    # 46 % and its samples 300–499 at 97.6 % and 98.1 % (measured)
+    later = narx(uv, yv, degree=3, lags=2)
+    assert later.compare(ue[:100], ye[:100]).fit_percent[0] < 60.0
+    for a in (300, 400):
+        assert later.compare(ue[a:a + 100], ye[a:a + 100]).fit_percent[0] > 96.0
 
 
 def test_unit_weights_give_the_least_squares_fit_and_sigma():

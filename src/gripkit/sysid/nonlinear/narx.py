@@ -20,6 +20,11 @@ After selection the parameters are the least-squares solution on the chosen term
 of iterative refinement on the residual); terms with ``|θ|/σ_θ < 2`` are removed one at a time
 (the weakest first) and the model is refitted.
 
+With ``forgetting=λ < 1`` θ is the exponentially weighted least squares ``min Σ λ^age e²`` (the
+batch form of recursive least squares with a forgetting factor, for a slowly drifting system; the
+terms still chosen by FROLS on every row), σ from the sandwich covariance
+(:meth:`_Regression._fit_weighted`).
+
 With ``refine="simulation"`` θ is then refined by Levenberg–Marquardt on the free-run error, the
 free run and its sensitivities ``∂ŷ/∂θ`` from one numba kernel (:func:`_sensitivity_kernel`),
 ``cov θ`` from the Gauss–Newton Hessian, and the pruning done on that σ. The same sensitivities
