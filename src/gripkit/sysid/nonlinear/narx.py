@@ -41,6 +41,7 @@ of None.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import json
 from dataclasses import dataclass, field
@@ -774,23 +775,30 @@ def _choose_terms(build, terms, n_selected: int, sse, n: int, val, progress: boo
 def _refine_and_prune(model, records, rows, P, target, prune: bool, max_iter: int) -> None:
     """θ refined on the free-run error (:func:`_refine_simulation`), then with ``prune`` the
     weakest term with |θ|/σ < 2 dropped and θ refined again, one at a time; the criterion and
-    the one-step fit of the refined θ updated."""
+    the one-step fit of the refined θ updated. A term whose removal makes the free run
+    diverge (the start of the next refinement) stays, and the pruning stops there."""
     iters = _refine_simulation(model, records, max_iter)
-    dropped = 0
+    dropped, kept = 0, ""
     while prune and iters is not None and len(model.theta) > 1:
         t = np.abs(model.theta) / np.where(model.theta_std > 0, model.theta_std, np.inf)
         weakest = int(np.argmin(t))
         if not t[weakest] < 2.0:
             break
+        before = (model.rows, model.theta, model.covariance, model.theta_std)
         keep = np.arange(len(model.theta)) != weakest
         model.rows, model.theta = model.rows[keep], model.theta[keep]
-        dropped += 1
         more = _refine_simulation(model, records, max_iter)
-        iters = None if more is None else iters + more
+        if more is None:  # without it the free run diverges: keep it, stop pruning
+            model.rows, model.theta, model.covariance, model.theta_std = before
+            kept = (f"; {_term_name(before[0][weakest], model.bases)} kept (|θ|/σ = "
+                    f"{t[weakest]:.2g}): without it the free run diverges")
+            break
+        dropped += 1
+        iters += more
     model.criterion += ("; θ refined on the free-run error (Levenberg–Marquardt, "
                         f"{iters} iterations, σ from its Gauss–Newton Hessian"
                         + (f", then {dropped} term(s) with |θ|/σ < 2 pruned one by one)"
-                           if dropped else ")")
+                           if dropped else ")") + kept
                         if iters is not None else
                         "; not refined: the least-squares model's free run diverges")
     if iters is not None:  # the one-step fit of the refined θ
@@ -889,11 +897,30 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
     model.prediction_fit_percent = 100.0 * (1.0 - np.sqrt(sse_k) / spread)
     if refine == "simulation":
         say(f"narx: refining {len(model.theta)} parameters on the free-run error")
+        least_squares = dataclasses.replace(model)
         _refine_and_prune(model, records, rows, P, target, prune, max_iter)
+        if val is not None and "not refined" not in model.criterion:
+            model = _better_on_validation(model, least_squares, val)
     model.fit_percent = _fit_records(model, records)
     if val is not None:
         model.validation_fit_percent = _fit_records(model, val)
     return model
+
+
+def _better_on_validation(refined: NARXModel, least_squares: NARXModel, val) -> NARXModel:
+    """With a validation record the refinement is one more candidate of the structure search:
+    the refined model is kept when its free-run validation fit is at least the least-squares
+    model's (the one whose number of terms that fit chose), else the least-squares model is
+    returned, the criterion saying both fits."""
+    f_ref = _fit_records(refined, val, warn=False)
+    f_ls = _fit_records(least_squares, val, warn=False)
+    if f_ls is None or (f_ref is not None and f_ref >= f_ls):
+        return refined
+    least_squares.criterion += (
+        "; the θ refined on the free-run error was not kept: its validation free-run fit "
+        + ("diverges" if f_ref is None else f"is {f_ref:.2f} %") + f" against {f_ls:.2f} % "
+        "for least squares")
+    return least_squares
 
 
 def _forgetting(forgetting, refine) -> float:
