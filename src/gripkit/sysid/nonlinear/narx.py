@@ -824,7 +824,9 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
     estimate when the noise enters the equation) or ``"simulation"``: after the structure is
     chosen, θ refined by Levenberg–Marquardt on the free-run (simulation) error, at most
     ``max_iter`` iterations, σ from its Gauss–Newton Hessian (the estimate to use when the
-    noise is measurement noise on the output, which biases the one-step estimate).
+    noise is measurement noise on the output, which biases the one-step estimate). With
+    ``validate=`` the refined θ is kept only when its free-run validation fit is at least the
+    least-squares one (the criterion says both fits otherwise).
     ``forgetting``: λ in (0, 1]; below 1, θ is the exponentially weighted least squares
     ``min Σ λ^age(t) e(t)²`` (age: rows before the last row of the last record, records taken
     in time order; the batch form of recursive least squares with forgetting factor λ), for a
