@@ -27,7 +27,12 @@ Rows (both sides through ``common.measure``: same warm-up call and number of run
   BIC, recursive least squares) beside gripkit's refined linear model: different model classes;
   it shows what a nonlinear model gains on this system;
 * polynomial NARX, degree 3, lags 2, BIC on both sides: gripkit ``narx`` beside sysidentpy ``FROLS``
-  (least squares).
+  (least squares);
+* the same with θ weighted to the recent rows (:func:`_narx_forgetting_rows`): gripkit
+  ``narx(forgetting=0.98)`` (exponentially weighted least squares) beside sysidentpy ``FROLS``
+  with ``RecursiveLeastSquares()`` (its default forgetting factor 0.98), degree 3 lags 2 and its
+  own example's degree 2 lags 5, BIC on both sides; alone:
+  ``python benchmarks/bench_measured.py dc_narx OUT_DIR``.
 
 NARX rows (:func:`narx_rows`; alone: ``python benchmarks/bench_measured.py narx OUT_DIR``):
 
@@ -188,6 +193,7 @@ def run(quick: bool) -> list[dict]:
                           "different time "
                           "constants, which a polynomial NARX captures and a linear model cannot"))
     rows.append(_narx_row(ue, ye, uv, yv))
+    rows.extend(_narx_forgetting_rows(ue, ye, uv, yv))
     rows.extend(narx_rows())
     for rec in CORPUS:
         rows.extend(_corpus_rows(rec))
@@ -212,6 +218,34 @@ def _narx_row(ue, ye, uv, yv) -> dict:
                notes="same model class; gripkit: FROLS + BIC + pruning of |θ|/σ < 2, fit over the "
                      "samples after the first max_lag; sysidentpy: its predict, fit "
                      "over every sample")
+
+
+def _narx_forgetting_rows(ue, ye, uv, yv) -> list[dict]:
+    """Polynomial NARX with θ weighted to the recent rows, BIC on both sides: gripkit's
+    exponentially weighted least squares (λ = 0.98) beside sysidentpy's recursive least squares
+    (its default λ = 0.98), degree 3 lags 2 and sysidentpy's example (degree 2, lags 5)."""
+    from gripkit.sysid import narx as gripkit_narx
+
+    rows = []
+    for degree, lags in ((3, 2), (2, 5)):
+        ours = lambda: gripkit_narx(ue, ye, degree=degree, lags=lags, forgetting=0.98)  # noqa: E731
+        g = ours()
+        peer = _sysidentpy(degree, lags, True, ue, ye)
+        m = peer()
+        rows.append(row(
+            "measured", f"polynomial NARX, degree {degree}, lags {lags}, BIC, θ weighted to the "
+                        f"recent rows (forgetting 0.98), {DATA}", measure(ours),
+            f"sysidentpy FROLS degree {degree}, RecursiveLeastSquares (λ = 0.98)", measure(peer),
+            gripkit_accuracy=(_fit_text(g.compare(uv, yv).fit_percent[0])
+                              + f" ({len(g.terms)} terms; estimation record "
+                                f"{g.fit_percent:.1f} %)"),
+            peer_accuracy=_fit_text(_fit(yv, m.predict(X=uv[:, None], y=yv[:, None])))
+            + f" ({m.final_model.shape[0]} terms)",
+            notes="same structure search (FROLS, BIC, unweighted) and the same forgetting "
+                  "factor; gripkit: batch weighted least squares with the sandwich σ, pruning "
+                  "of |θ|/σ < 2, fit over the samples after the first max_lag; sysidentpy: "
+                  "its predict, fit over every sample"))
+    return rows
 
 
 # ------------------------------------------------------------------------------ NARX rows
@@ -511,7 +545,7 @@ if __name__ == "__main__":
     import json
     import sys
 
-    if sys.argv[1:2] == ["narx"]:  # the NARX rows alone, written as run.py writes its results
+    if sys.argv[1:2] in (["narx"], ["dc_narx"]):  # NARX rows alone, written as run.py does
         import os
 
         if os.environ.get("OPENBLAS_NUM_THREADS") != "1":
@@ -520,7 +554,10 @@ if __name__ == "__main__":
 
         out = Path(sys.argv[2])
         out.mkdir(parents=True, exist_ok=True)
-        results = {"machine": runner.machine(), "quick": False, "rows": narx_rows(), "errors": {}}
+        rows = (narx_rows() if sys.argv[1] == "narx" else
+                [_narx_row(*_halves()[0], *_halves()[1]),
+                 *_narx_forgetting_rows(*_halves()[0], *_halves()[1])])
+        results = {"machine": runner.machine(), "quick": False, "rows": rows, "errors": {}}
         (out / "results.json").write_text(json.dumps(results, indent=2, default=str))
         (out / "results.md").write_text(runner.to_markdown(results))
     else:

@@ -1,5 +1,6 @@
 """``gripkit identify narx DATA --input U --output Y [--degree D] [--lags L | --ylags LY --ulags LU]
-[--terms N|auto] [--refine none|simulation] [--validate DATA2] [--out MODEL.json] [--json]``:
+[--terms N|auto] [--refine none|simulation] [--forgetting λ] [--validate DATA2] [--out MODEL.json]
+[--json]``:
 polynomial NARX by forward regression with the error reduction ratio
 (:func:`gripkit.sysid.narx`)."""
 
@@ -49,6 +50,10 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
                   refine: str = typer.Option("none", "--refine",
                                              help="none (one-step least squares) or simulation "
                                                   "(θ refined on the free-run error)."),
+                  forgetting: float = typer.Option(1.0, "--forgetting",
+                                                   help="λ in (0, 1]: below 1, θ by exponentially "
+                                                        "weighted least squares (memory about "
+                                                        "1/(1 − λ) rows) for a drifting system."),
                   validate: Optional[Path] = RecordValidateOpt,
                   out: Optional[Path] = ModelJsonOpt,
                   report: Optional[Path] = ModelReportOpt,
@@ -68,7 +73,8 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
         m, tr, vtr = run_identify([data], "narx", input_col, output_col, fs=fs, time=time,
                                   fill=fill, validate=validate, fit_validate=True, degree=degree,
                                   lags=lags, ylags=ylags, ulags=ulags, terms=n_terms,
-                                  refine=None if refine == "none" else refine, progress=True)
+                                  refine=None if refine == "none" else refine,
+                                  forgetting=forgetting, progress=True)
         val = validation(m, vtr, validate)
         page = save_and_page(m, out, report, tr, vtr, data, validate)
     lines = report_warnings(caught)
@@ -76,7 +82,7 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
         emit_json({"data": str(data), "input": input_col, "output": output_col,
                    "structure": {"degree": m.degree, "ylags": m.ylags, "ulags": m.ulags,
                                  "terms": m.terms, "criterion": m.criterion,
-                                 "refine": refine},
+                                 "refine": refine, "forgetting": forgetting},
                    "parameters": [{"term": t, "value": float(v), "std": float(s)}
                                   for t, v, s in zip(m.terms, m.theta, m.theta_std)],
                    "fit_percent": m.fit_percent, "prediction_fit_percent": m.prediction_fit_percent,

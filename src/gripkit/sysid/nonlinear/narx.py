@@ -20,6 +20,11 @@ After selection the parameters are the least-squares solution on the chosen term
 of iterative refinement on the residual); terms with ``|θ|/σ_θ < 2`` are removed one at a time
 (the weakest first) and the model is refitted.
 
+With ``forgetting=λ < 1`` θ is the exponentially weighted least squares ``min Σ λ^age e²`` (the
+batch form of recursive least squares with a forgetting factor, for a slowly drifting system; the
+terms still chosen by FROLS on every row), σ from the sandwich covariance
+(:meth:`_Regression._fit_weighted`).
+
 With ``refine="simulation"`` θ is then refined by Levenberg–Marquardt on the free-run error, the
 free run and its sensitivities ``∂ŷ/∂θ`` from one numba kernel (:func:`_sensitivity_kernel`),
 ``cov θ`` from the Gauss–Newton Hessian, and the pruning done on that σ. The same sensitivities
@@ -36,6 +41,7 @@ of None.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -161,16 +167,26 @@ class _Regression:
     samples), the target, and their Gram matrix, from which every least-squares fit on a subset
     of the columns is taken (:meth:`fit`)."""
 
-    def __init__(self, P, target):
+    def __init__(self, P, target, weights=None):
         self.P, self.target = P, target
         self.G, self.g, self.yy = _gram(P, target)
+        self.weights = weights
+        if weights is not None:  # ΦᵀWΦ, ΦᵀWy and ΦᵀW²Φ of every candidate, one pass each
+            r = np.sqrt(weights)
+            Pw = np.asfortranarray(P * r[:, None])
+            self.Gw, self.gw, _ = _gram(Pw, target * r)
+            Pw *= r[:, None]
+            self.Bw = Pw.T @ Pw
 
     def fit(self, cols):
         """θ, cov θ = σ² (ΦᵀΦ)⁻¹ and SSE of the least squares on ``cols``: Cholesky of the
         column-scaled Gram matrix (the semi-normal equations) and one step of iterative
         refinement on the actual residual, which brings θ to the accuracy of a QR solution for
-        any ``cond(Φ)`` below about 1e7; beyond that (or a failed Cholesky) a QR of ``Φ``."""
+        any ``cond(Φ)`` below about 1e7; beyond that (or a failed Cholesky) a QR of ``Φ``.
+        With row weights (``forgetting``): :func:`_weighted_lstsq_cov`."""
         cols = list(cols)
+        if self.weights is not None:
+            return self._fit_weighted(cols)
         G = self.G[np.ix_(cols, cols)]
         d = np.sqrt(np.diag(G))
         d[d == 0] = 1.0
@@ -195,6 +211,42 @@ class _Regression:
         Linv = np.linalg.solve(L, np.eye(k))
         cov = sse / max(n - k, 1) * (Linv.T @ Linv) / np.outer(d, d)
         return theta, cov, sse
+
+
+    def _fit_weighted(self, cols):
+        """The exponentially weighted least squares ``min Σ w_i e_i²`` on ``cols`` (Cholesky of
+        the column-scaled ``A = ΦᵀWΦ`` and one refinement step on the residual, as :meth:`fit`)
+        → θ, its covariance for white noise of one variance σ², and the unweighted SSE. The
+        weights are a forgetting profile, not the inverse noise variance, so the covariance is
+        the sandwich ``σ² A⁻¹ (ΦᵀW²Φ) A⁻¹`` with ``σ² = Σ w e² / (Σ w − tr(A⁻¹ ΦᵀW²Φ))``,
+        unbiased (``E[eᵀWe] = σ² (tr W − tr(A⁻¹ΦᵀW²Φ))``; for ``W = I``: ``SSE/(N − k)``)."""
+        from scipy.linalg import cho_solve
+
+        w = self.weights
+        G = self.Gw[np.ix_(cols, cols)]
+        d = np.sqrt(np.diag(G))
+        d[d == 0] = 1.0
+        try:
+            L = np.linalg.cholesky(G / np.outer(d, d))
+        except np.linalg.LinAlgError:
+            L = None
+        if L is None or np.min(np.diag(L)) ** 2 <= 1e-14 * len(cols):
+            raise IdentificationError(
+                f"narx: the weighted regressors of {len(cols)} terms are singular (the rows "
+                "the forgetting factor keeps do not excite them); give a forgetting factor "
+                "closer to 1 or fewer terms")
+        Phi = self.P[:, cols]
+        z = cho_solve((L, True), self.gw[cols] / d)
+        e = self.target - Phi @ (z / d)
+        z += cho_solve((L, True), (Phi.T @ (w * e)) / d)  # one refinement step
+        theta = z / d
+        e = self.target - Phi @ theta
+        Ainv = cho_solve((L, True), np.eye(len(cols)))
+        AB = Ainv @ (self.Bw[np.ix_(cols, cols)] / np.outer(d, d))
+        dof = float(w.sum() - np.trace(AB))
+        sigma2 = float(w @ (e * e)) / max(dof, 1e-300)
+        cov = sigma2 * (AB @ Ainv) / np.outer(d, d)
+        return theta, 0.5 * (cov + cov.T), float(e @ e)
 
 
 def _lstsq_cov(Phi: np.ndarray, y: np.ndarray):
@@ -730,23 +782,30 @@ def _choose_terms(build, terms, n_selected: int, sse, n: int, val, progress: boo
 def _refine_and_prune(model, records, rows, P, target, prune: bool, max_iter: int) -> None:
     """θ refined on the free-run error (:func:`_refine_simulation`), then with ``prune`` the
     weakest term with |θ|/σ < 2 dropped and θ refined again, one at a time; the criterion and
-    the one-step fit of the refined θ updated."""
+    the one-step fit of the refined θ updated. A term whose removal makes the free run
+    diverge (the start of the next refinement) stays, and the pruning stops there."""
     iters = _refine_simulation(model, records, max_iter)
-    dropped = 0
+    dropped, kept = 0, ""
     while prune and iters is not None and len(model.theta) > 1:
         t = np.abs(model.theta) / np.where(model.theta_std > 0, model.theta_std, np.inf)
         weakest = int(np.argmin(t))
         if not t[weakest] < 2.0:
             break
+        before = (model.rows, model.theta, model.covariance, model.theta_std)
         keep = np.arange(len(model.theta)) != weakest
         model.rows, model.theta = model.rows[keep], model.theta[keep]
-        dropped += 1
         more = _refine_simulation(model, records, max_iter)
-        iters = None if more is None else iters + more
+        if more is None:  # without it the free run diverges: keep it, stop pruning
+            model.rows, model.theta, model.covariance, model.theta_std = before
+            kept = (f"; {_term_name(before[0][weakest], model.bases)} kept (|θ|/σ = "
+                    f"{t[weakest]:.2g}): without it the free run diverges")
+            break
+        dropped += 1
+        iters += more
     model.criterion += ("; θ refined on the free-run error (Levenberg–Marquardt, "
                         f"{iters} iterations, σ from its Gauss–Newton Hessian"
                         + (f", then {dropped} term(s) with |θ|/σ < 2 pruned one by one)"
-                           if dropped else ")")
+                           if dropped else ")") + kept
                         if iters is not None else
                         "; not refined: the least-squares model's free run diverges")
     if iters is not None:  # the one-step fit of the refined θ
@@ -758,7 +817,7 @@ def _refine_and_prune(model, records, rows, P, target, prune: bool, max_iter: in
 def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None = None,
          ulags: int | None = None, terms="auto", dt: float | None = None, validate=None,
          direct: bool = False, prune: bool = True, refine: str | None = None,
-         max_iter: int = 50, progress: bool = False) -> NARXModel:
+         forgetting: float = 1.0, max_iter: int = 50, progress: bool = False) -> NARXModel:
     """Polynomial NARX model of ``y`` driven by ``u`` (1-D arrays of equal length), or of
     several records: ``narx([(u1, y1), (u2, y2), …])`` (each record's first ``max_lag``
     samples are its own past; one regression over all of them, σ from all).
@@ -772,7 +831,15 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
     estimate when the noise enters the equation) or ``"simulation"``: after the structure is
     chosen, θ refined by Levenberg–Marquardt on the free-run (simulation) error, at most
     ``max_iter`` iterations, σ from its Gauss–Newton Hessian (the estimate to use when the
-    noise is measurement noise on the output, which biases the one-step estimate).
+    noise is measurement noise on the output, which biases the one-step estimate). With
+    ``validate=`` the refined θ is kept only when its free-run validation fit is at least the
+    least-squares one (the criterion says both fits otherwise).
+    ``forgetting``: λ in (0, 1]; below 1, θ is the exponentially weighted least squares
+    ``min Σ λ^age(t) e(t)²`` (age: rows before the last row of the last record, records taken
+    in time order; the batch form of recursive least squares with forgetting factor λ), for a
+    system that drifts slowly: the terms are still chosen by FROLS on every row unweighted,
+    θ and σ (the sandwich covariance for white noise) weight the recent rows, the memory
+    ``Σ λ^age ≈ 1/(1 − λ)`` rows; at most half the memory in terms; not with ``refine``.
     ``progress``: each stage on stderr, a bar over the validation candidates.
     """
     say = status if progress else (lambda message: None)
@@ -780,6 +847,7 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
     if refine not in REFINE:
         raise ArgumentError(f"narx: refine must be None or 'simulation', found {refine!r}")
     max_iter = _positive_int(max_iter, "max_iter")
+    forgetting = _forgetting(forgetting, refine)
     yall = np.concatenate([r[1] for r in records])
     not_constant(yall, "the output", "narx",
                  "there is nothing to identify: check the output column")
@@ -797,8 +865,12 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
     n = P.shape[0]
     val = _validation_records(validate, start)
     kmax = _max_terms(terms, len(rows))
+    weights = None
+    if forgetting < 1.0:
+        weights = forgetting ** np.arange(n - 1, -1, -1, dtype=np.float64)
+        kmax = _memory_terms(terms, kmax, float(weights.sum()), forgetting)
     say(f"narx: FROLS over {len(rows)} candidate terms, {n} rows")
-    reg = _Regression(P, target)
+    reg = _Regression(P, target, weights)
     order, errs, sse = _frols_gram(reg.G, reg.g, reg.yy, kmax)
     if not order:
         raise IdentificationError("narx: no candidate term explains the output (all columns zero)")
@@ -824,17 +896,66 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
 
     model, sse_k, how = _choose_terms(build, terms, len(order), sse, n, val, progress)
     model.criterion = how + (", terms with |θ|/σ < 2 pruned" if prune_ls else "")
+    if weights is not None:
+        model.criterion += (f"; θ by exponentially weighted least squares (forgetting "
+                            f"{forgetting:g}, memory {weights.sum():.0f} rows)")
     spread = float(np.linalg.norm(target - target.mean()))
     if spread == 0.0:
         raise DataError("narx: the fit is undefined for a constant output (‖y − ȳ‖ = 0)")
     model.prediction_fit_percent = 100.0 * (1.0 - np.sqrt(sse_k) / spread)
     if refine == "simulation":
         say(f"narx: refining {len(model.theta)} parameters on the free-run error")
+        least_squares = dataclasses.replace(model)
         _refine_and_prune(model, records, rows, P, target, prune, max_iter)
+        if val is not None and "not refined" not in model.criterion:
+            model = _better_on_validation(model, least_squares, val)
     model.fit_percent = _fit_records(model, records)
     if val is not None:
         model.validation_fit_percent = _fit_records(model, val)
     return model
+
+
+def _better_on_validation(refined: NARXModel, least_squares: NARXModel, val) -> NARXModel:
+    """With a validation record the refinement is one more candidate of the structure search:
+    the refined model is kept when its free-run validation fit is at least the least-squares
+    model's (the one whose number of terms that fit chose), else the least-squares model is
+    returned, the criterion saying both fits."""
+    f_ref = _fit_records(refined, val, warn=False)
+    f_ls = _fit_records(least_squares, val, warn=False)
+    if f_ls is None or (f_ref is not None and f_ref >= f_ls):
+        return refined
+    least_squares.criterion += (
+        "; the θ refined on the free-run error was not kept: its validation free-run fit "
+        + ("diverges" if f_ref is None else f"is {f_ref:.2f} %") + f" against {f_ls:.2f} % "
+        "for least squares")
+    return least_squares
+
+
+def _forgetting(forgetting, refine) -> float:
+    """The checked forgetting factor λ in (0, 1]."""
+    if isinstance(forgetting, bool) or not isinstance(forgetting, (int, float, np.floating)) \
+            or not 0.0 < forgetting <= 1.0:
+        raise ArgumentError(f"narx: forgetting must be a number in (0, 1], found {forgetting!r}",
+                            hint="1 (default) weighs every row alike; 0.98 remembers about 50 "
+                                 "rows")
+    if forgetting < 1.0 and refine is not None:
+        raise ArgumentError(f"narx: forgetting = {forgetting!r} applies to the least-squares "
+                            f"estimate, not to refine={refine!r}; give one of them",
+                            hint="refine=None with forgetting < 1, or forgetting=1 with refine")
+    return float(forgetting)
+
+
+def _memory_terms(terms, kmax: int, memory: float, forgetting: float) -> int:
+    """The most terms a forgetting memory of ``memory`` rows carries: half of it."""
+    most = int(round(memory, 6) // 2)
+    if most < 1:
+        raise ArgumentError(f"narx: forgetting = {forgetting:g} remembers {memory:.1f} rows, "
+                            "too few for one term; give a forgetting factor closer to 1")
+    if terms != "auto" and kmax > most:
+        raise ArgumentError(f"narx: terms = {kmax} but forgetting = {forgetting:g} remembers "
+                            f"{memory:.0f} rows, enough for at most {most} terms; give fewer "
+                            "terms or a forgetting factor closer to 1")
+    return min(kmax, most)
 
 
 def _row_index(rows, row) -> int:
