@@ -232,3 +232,35 @@ def test_one_state_mass_matrix_entry_point_takes_only_exact_float64_vectors():
 
 class _Sub(np.ndarray):
     """An ndarray subclass (the entry point's test wants the exact type)."""
+
+
+def test_one_state_path_runs_with_numba_jit_disabled():
+    """Under NUMBA_DISABLE_JIT=1 (a user stepping through the kernels in a debugger) the
+    one-state mass matrix and RNEA run as Python (no compiled entry point, the packed views by
+    slicing) and give the compiled results (to rounding: Python has no fused multiply-add)."""
+    import json
+    import os
+    import subprocess
+    import sys
+
+    code = (
+        "import json, numpy as np\n"
+        "from gripkit.multibody.dh import DHChain\n"
+        "rng = np.random.default_rng(1); n = 3\n"
+        "c = DHChain(alpha=rng.uniform(-3, 3, n), a=rng.uniform(0, 0.3, n),\n"
+        "            d=rng.uniform(0, 0.3, n), mass=rng.uniform(0.1, 2, n),\n"
+        "            com=rng.uniform(-0.1, 0.1, (n, 3)),\n"
+        "            inertia=np.tile(np.eye(3) * 0.01, (n, 1, 1)))\n"
+        "q = rng.standard_normal(n)\n"
+        "print(json.dumps([c.mass_matrix(q).tolist(), c.rnea(q, q, q).tolist()]))\n")
+    env = dict(os.environ, NUMBA_DISABLE_JIT="1")
+    proc = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    M_py, tau_py = json.loads(proc.stdout)
+    scope: dict = {}
+    exec(code.replace("print(json.dumps([c.mass_matrix(q).tolist(), c.rnea(q, q, q).tolist()]))",
+                      "out = (c.mass_matrix(q), c.rnea(q, q, q))"), scope)
+    M, tau = scope["out"]
+    np.testing.assert_allclose(M_py, M, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(tau_py, tau, rtol=1e-12, atol=1e-15)

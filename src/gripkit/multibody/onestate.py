@@ -80,6 +80,11 @@ def _rows(typingctx, a, start, rows, cols):  # pragma: no cover - compiled
     return ret(a, start, rows, cols), codegen
 
 
+if numba.config.DISABLE_JIT:  # the kernels run as Python: the view the intrinsic builds
+    def _rows(a, start, rows, cols):  # noqa: F811
+        return a[start:start + rows * cols].reshape(rows, cols)
+
+
 def _inline_twins(*names):
     """Twins of the named :mod:`~gripkit.multibody.kernels` functions: the same code object,
     compiled ``inline="always"`` into the one-state kernels, the calls among the named functions
@@ -89,7 +94,8 @@ def _inline_twins(*names):
     Returns {name: twin}."""
     ns = dict(vars(kernels))
     for name in names:
-        fn = getattr(kernels, name).py_func
+        fn = getattr(kernels, name)
+        fn = getattr(fn, "py_func", fn)  # (a plain function under NUMBA_DISABLE_JIT)
         ns[name] = numba.njit(error_model="numpy", _nrt=False, inline="always")(
             types.FunctionType(fn.__code__, ns, name, fn.__defaults__, fn.__closure__))
     return {name: ns[name] for name in names}
@@ -209,8 +215,9 @@ def mass_matrix_entry():
     chain's packed buffer, a fresh C-contiguous (m, m) float64 array, and a state that is an
     exact 1-D float64 ndarray (type, ``ndim`` and dtype checked in Python first; the kernel
     refuses a stride other than 8). The dispatcher where numba has no ``entry_point``."""
-    sig = next(iter(mass_matrix_one.overloads))
-    return getattr(mass_matrix_one.overloads[sig], "entry_point", mass_matrix_one)
+    overloads = getattr(mass_matrix_one, "overloads", {})  # (none under NUMBA_DISABLE_JIT)
+    sig = next(iter(overloads), None)
+    return getattr(overloads.get(sig), "entry_point", mass_matrix_one)
 
 
 def prepare(system):
