@@ -212,7 +212,6 @@ class _Regression:
         cov = sse / max(n - k, 1) * (Linv.T @ Linv) / np.outer(d, d)
         return theta, cov, sse
 
-
     def _fit_weighted(self, cols):
         """The exponentially weighted least squares ``min Σ w_i e_i²`` on ``cols`` (Cholesky of
         the column-scaled ``A = ΦᵀWΦ`` and one refinement step on the residual, as :meth:`fit`)
