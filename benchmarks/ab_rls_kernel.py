@@ -11,14 +11,13 @@ each, wall and thread CPU time.
 from __future__ import annotations
 
 import os
-import time
 
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_var] = "1"
 
 import bench_rls as B  # noqa: E402
 import numpy as np  # noqa: E402
-from common import measure_alternating  # noqa: E402
+from common import print_alternating  # noqa: E402
 from numba import njit  # noqa: E402
 
 P6 = 6
@@ -129,11 +128,7 @@ def main() -> None:
     print("max |θ| difference of the layouts:",
           max(np.max(np.abs(_plain_flat(u, y, B.LAM, B.P0) - th)),
               np.max(np.abs(_plain_split(u, y, B.LAM, B.P0) - th))))
-    for clock, label in ((time.perf_counter, "wall"), (time.thread_time, "thread cpu")):
-        times = measure_alternating(list(fns.values()), runs=9, clock=clock)
-        print(f"--- {label}, median (min) ms")
-        for name, t in zip(fns, times):
-            print(f"{name:50s} {float(t) * 1e3:8.2f} ({t.min * 1e3:8.2f})")
+    print_alternating(fns)
 
 
 if __name__ == "__main__":

@@ -21,14 +21,13 @@ from __future__ import annotations
 
 import math
 import os
-import time
 
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_var] = "1"
 
 import bench_rls as B  # noqa: E402
 import numpy as np  # noqa: E402
-from common import measure_alternating  # noqa: E402
+from common import print_alternating  # noqa: E402
 from numba import njit  # noqa: E402
 
 P6 = 6
@@ -274,11 +273,7 @@ def main() -> None:
     ref = gripkit_kernel(est._kernel_size(n))
     for name, fn in fns.items():
         print(f"max |θ − gripkit| {name:42s} {np.max(np.abs(fn() - ref)):.3g}")
-    for clock, label in ((time.perf_counter, "wall"), (time.thread_time, "thread cpu")):
-        times = measure_alternating(list(fns.values()), runs=9, clock=clock)
-        print(f"--- {label}, median (min) ms")
-        for name, t in zip(fns, times):
-            print(f"{name:50s} {float(t) * 1e3:8.2f} ({t.min * 1e3:8.2f})")
+    print_alternating(fns)
 
 
 if __name__ == "__main__":

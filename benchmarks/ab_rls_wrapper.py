@@ -13,14 +13,13 @@ and thread CPU time.
 from __future__ import annotations
 
 import os
-import time
 
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_var] = "1"
 
 import bench_rls as B  # noqa: E402
 import numpy as np  # noqa: E402
-from common import measure_alternating  # noqa: E402
+from common import print_alternating  # noqa: E402
 
 
 def main() -> None:
@@ -59,11 +58,7 @@ def main() -> None:
         "RLS.run(store=False), whole call": lambda: fresh().run(u, y, store=False),
         "plain numba RLS, final θ and σ": lambda: B._plain_rls(u, y, B.LAM, B.P0, none, none),
     }
-    for clock, label in ((time.perf_counter, "wall"), (time.thread_time, "thread cpu")):
-        times = measure_alternating(list(fns.values()), runs=9, clock=clock)
-        print(f"--- {label}, median (min) ms")
-        for name, t in zip(fns, times):
-            print(f"{name:50s} {float(t) * 1e3:8.2f} ({t.min * 1e3:8.2f})")
+    print_alternating(fns)
 
 
 if __name__ == "__main__":

@@ -124,3 +124,13 @@ def measure_alternating(fns: list[Callable[[], object]], runs: int = REPEAT,
     finally:
         gc.enable()
     return [Timing(statistics.median(t), min(t), runs) for t in times]
+
+
+def print_alternating(fns: dict[str, Callable[[], object]], runs: int = 9) -> None:
+    """:func:`measure_alternating` of the named callables twice, by wall clock and by this
+    thread's CPU time, printed as one table each: name, median (min) in ms."""
+    for clock, label in ((time.perf_counter, "wall"), (time.thread_time, "thread cpu")):
+        times = measure_alternating(list(fns.values()), runs=runs, clock=clock)
+        print(f"--- {label}, median (min) ms")
+        for name, t in zip(fns, times):
+            print(f"{name:50s} {float(t) * 1e3:8.2f} ({t.min * 1e3:8.2f})")
