@@ -16,48 +16,12 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_var] = "1"
 
 import bench_rls as B  # noqa: E402
+from ab_rls_strip import make_variant  # noqa: E402
 import numpy as np  # noqa: E402
 from common import print_alternating  # noqa: E402
 from numba import njit  # noqa: E402
 
 P6 = 6
-
-
-@njit(cache=True)
-def _plain_flat(u, y, lam, p0):  # pragma: no cover - compiled
-    """The plain RLS with P (row-major), θ, φ and q in one local buffer at constant offsets (the
-    layout of gripkit's batch kernel); final θ only."""
-    n = u.shape[0]
-    oP, oth, oph, oq = 0, 36, 42, 48
-    w = np.zeros(54)
-    for i in range(P6):
-        w[oP + i * P6 + i] = p0
-    for t in range(3, n):
-        for i in range(3):
-            w[oph + i] = -y[t - 1 - i]
-            w[oph + 3 + i] = u[t - 1 - i]
-        e = y[t]
-        for i in range(P6):
-            acc = 0.0
-            for j in range(P6):
-                acc += w[oP + i * P6 + j] * w[oph + j]
-            w[oq + i] = acc
-            e -= w[oph + i] * w[oth + i]
-        r = 0.0
-        for i in range(P6):
-            r += w[oph + i] * w[oq + i]
-        inv = 1.0 / (lam + r)
-        g = e * inv
-        for i in range(P6):
-            w[oth + i] += w[oq + i] * g
-        scale = 1.0 / lam
-        for i in range(P6):
-            qi = -inv * w[oq + i]
-            for j in range(i, P6):
-                v = (w[oP + i * P6 + j] + qi * w[oq + j]) * scale
-                w[oP + i * P6 + j] = v
-                w[oP + j * P6 + i] = v
-    return w[oth:oth + P6].copy()
 
 
 @njit(cache=True)
@@ -99,6 +63,7 @@ def _plain_split(u, y, lam, p0):  # pragma: no cover - compiled
 
 
 def main() -> None:
+    _plain_flat = make_variant("plain", stats=False, trace=False)  # one buffer, constant offsets
     from gripkit.sysid import RLS
     from gripkit.sysid.linear.rls import _rls_run
 
