@@ -408,21 +408,30 @@ def rational_narx(records, *, ylags: int, ulags: int, degree: int, den_degree, d
     kmax = _max_terms(terms, M + L)
     say(f"narx: FROLS over {M} numerator and {L} denominator candidates, {n} rows")
     reg = _Regression(X, target)
-    order, errs, sse = _frols_gram(reg.G, reg.g, reg.yy, kmax)
-    if not order:
-        raise IdentificationError("narx: no candidate term explains the output (all columns zero)")
+    QQ, Q1 = Q.T @ Q, Q.sum(axis=0)
     yall = np.concatenate([r[1] for r in records])
     y_range = (float(yall.min()), float(yall.max()))
     names = ([f"num: {_term_name(r, bases)}" for r in rows]
              + [f"den: {_term_name(r, bases)}" for r in drows])
     prune_pe = prune and refine is None
 
-    def build(k):
-        """The model of the first k FROLS terms, θ refined on the one-step error (and pruned on
-        its σ) → (model, SSE, iterations, terms pruned), or (None, row, min D, 0) when the
-        least-squares start's denominator crosses zero on the estimation rows."""
+    def select(s2: float):
+        """FROLS on the Gram matrix with the noise's share removed for the noise variance
+        ``s2`` (:func:`_corrected_gram`) → (G, g, order, ERR, SSE)."""
+        G, g = _corrected_gram(reg.G, reg.g, M, QQ, Q1, s2)
+        order, errs, sse = _frols_gram(G, g, reg.yy, kmax)
+        if not order:
+            raise IdentificationError("narx: no candidate term explains the output (all columns "
+                                      "zero)")
+        return G, g, order, errs, sse
+
+    def build(k, prune_now=True):
+        """The model of the first k FROLS terms, θ refined on the one-step error (and, with
+        ``prune_now`` and ``prune``, pruned on its σ) → (model, SSE, iterations, terms pruned),
+        or (None, row, min D, 0) when the least-squares start's denominator crosses zero on the
+        estimation rows."""
         cols = order[:k]
-        theta_ls = reg.fit(cols)[0]
+        theta_ls = _solve(G, g, cols) if s2 > 0.0 else reg.fit(cols)[0]
         nc = [c for c in cols if c < M]
         dc = [c - M for c in cols if c >= M]
         theta = np.concatenate([theta_ls[[i for i, c in enumerate(cols) if c < M]],
@@ -437,7 +446,7 @@ def rational_narx(records, *, ylags: int, ulags: int, degree: int, den_degree, d
             last = (list(nc), list(dc), *res, dropped)
             theta, cov, _, it = res
             iters += it
-            if not prune_pe or len(theta) == 1:
+            if not (prune_pe and prune_now) or len(theta) == 1:
                 break
             std = np.sqrt(np.maximum(np.diag(cov), 0.0))
             t = np.abs(theta) / np.where(std > 0, std, np.inf)
@@ -458,12 +467,50 @@ def rational_narx(records, *, ylags: int, ulags: int, degree: int, den_degree, d
             frols_terms=[names[c] for c in cols], den_degree=dd, den_rows=drows[dc])
         return mod, cost, iters, dropped
 
+    def bic_terms():
+        """The number of FROLS terms whose one-step-error model (unpruned) has the lowest
+        ``BIC = N ln(SSE/N) + k ln N``, the search stopped :data:`BIC_PATIENCE` numbers past
+        the best → (k, its model's SSE), or (None, None) when every start's D crosses zero."""
+        best, since = None, 0
+        for k in range(1, len(order) + 1):
+            cand = build(k, prune_now=False)
+            since += 1
+            if cand[0] is not None:
+                b = n * np.log(max(cand[1], 1e-300) / n) + k * np.log(n)
+                if best is None or b < best[0]:
+                    best, since = (b, k, cand[1]), 0
+            if since >= BIC_PATIENCE:
+                break
+        return (None, None) if best is None else best[1:]
+
+    # extended least squares (Billings & Zhu 1991): the columns −y(t) q_j hold −e(t) q_j, which
+    # adds σ² QᵀQ to their Gram block and −σ² Qᵀ1 to their product with y; FROLS and the least
+    # squares are run again with that share removed, σ² from the last model's one-step error,
+    # until the terms chosen repeat (at most PASSES times)
+    s2, passes, chosen, k_bic = 0.0, 0, None, None
+    for passes in range(1, PASSES + 1):
+        G, g, order, errs, sse = select(s2)
+        if terms != "auto":
+            k, cost = len(order), build(len(order), prune_now=False)[1]
+            cost = cost if isinstance(cost, float) else None
+        else:
+            k, cost = bic_terms()
+        if k is None or cost is None or sorted(order[:k]) == chosen:
+            break
+        chosen, k_bic = sorted(order[:k]), k
+        new = cost / max(n - k, 1)
+        if passes > 1 and abs(new - s2) <= 0.01 * s2:
+            break
+        s2 = new
+    G, g, order, errs, sse = select(s2)
+    els = (f"FROLS and least squares with the noise share σ² = {s2:.3g} removed (extended "
+           f"least squares, {passes} passes)")
     if terms != "auto":
-        k, how = len(order), f"terms={len(order)}"
+        k, how = len(order), f"terms={len(order)}, {els}"
     elif val is None:
-        bic = [n * np.log(max(s, 1e-300) / n) + (j + 1) * np.log(n) for j, s in enumerate(sse)]
-        k = int(np.argmin(bic)) + 1
-        how = f"BIC minimum of the linear-in-parameters form y·D = N at {k} FROLS terms"
+        k = k_bic if k_bic is not None and sorted(order[:k_bic]) == chosen else bic_terms()[0]
+        k = len(order) if k is None else k
+        how = f"BIC of the one-step error y − N/D minimal at {k} FROLS terms, {els}"
     else:
         best = None
         for j in track(range(1, len(order) + 1), description="narx: validation free runs",
@@ -476,7 +523,7 @@ def rational_narx(records, *, ylags: int, ulags: int, degree: int, den_degree, d
                 best = (f, j)
         k = len(order) if best is None else best[1]
         how = ("validation fit (every candidate diverged)" if best is None else
-               f"validation free-run fit best at {k} FROLS terms")
+               f"validation free-run fit best at {k} FROLS terms") + f", {els}"
     model, *rest = build(k)
     if model is None:
         raise IdentificationError(
@@ -505,6 +552,33 @@ def rational_narx(records, *, ylags: int, ulags: int, degree: int, den_degree, d
     if val is not None:
         model.validation_fit_percent = _fit_records(model, val)
     return model
+
+
+#: most passes of the extended least squares (FROLS with the noise share removed)
+PASSES = 4
+#: the BIC search over the number of terms stops this many numbers past the best
+BIC_PATIENCE = 5
+
+
+def _corrected_gram(G, g, M: int, QQ, Q1, s2: float):
+    """``G`` and ``g`` of the regression ``[P_N, −y·Q]`` with the noise's share removed: the
+    denominator block ``G[M:, M:] − σ² QᵀQ``, ``g[M:] + σ² Qᵀ1`` (the expectation of the Gram
+    matrix of the noise-free columns −(y − e) q_j, for white ``e`` of variance ``s2``)."""
+    if s2 <= 0.0:
+        return G, g
+    G = G.copy()
+    g = g.copy()
+    G[M:, M:] -= s2 * QQ
+    g[M:] += s2 * Q1
+    return G, g
+
+
+def _solve(G, g, cols):
+    """θ of the normal equations ``G[cols, cols] θ = g[cols]`` (column-scaled; a pseudo-inverse
+    where the corrected matrix is not positive definite)."""
+    A = G[np.ix_(cols, cols)]
+    d = np.sqrt(np.maximum(np.abs(np.diag(A)), 1e-300))
+    return np.linalg.pinv(A / np.outer(d, d), rcond=1e-12) @ (g[cols] / d) / d
 
 
 def _residual(model, rows, drows, Pn, Q, target):
