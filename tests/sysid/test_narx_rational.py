@@ -229,3 +229,21 @@ def test_bad_input_and_a_denominator_crossing_zero_are_named():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         assert m.compare(uv, yv).fit_percent[0] is not None      # the identified D stays > 0
+
+
+def test_state_functions_of_a_rational_model_reproduce_its_free_run():
+    """The filters' state model of a rational NARX (state [y(t−1), y(t−2), u(t−1), u(t−2)]):
+    ``h`` is N/D, ``f`` shifts the lags; run forward it equals ``simulate`` to 1e-12."""
+    from gripkit.estimation.state_functions import state_functions
+
+    u, y = _system(np.random.default_rng(51))
+    m = narx(u, y, degree=2, lags=2, basis="rational")
+    f, h, x0, nx = state_functions(m)
+    assert nx == 4
+    uv = np.random.default_rng(52).uniform(-1.0, 1.0, 200)
+    ref = m.simulate(uv)
+    x, out = np.array([ref[1], ref[0], uv[1], uv[0]]), []
+    for k in range(2, len(uv)):
+        out.append(h(x, uv[k:k + 1])[0])
+        x = np.array(f(x, uv[k:k + 1]))
+    np.testing.assert_allclose(out, ref[2:], rtol=0, atol=1e-12)
