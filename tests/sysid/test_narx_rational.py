@@ -5,6 +5,7 @@ and Zhu, Int. J. Control 54(3), 1991; Billings, Nonlinear System Identification,
 
 import json
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -13,6 +14,8 @@ from gripkit.errors import ArgumentError, StabilityWarning
 from gripkit.sysid import narx
 from gripkit.sysid.nonlinear.narx import load_narx
 from gripkit.sysid.nonlinear.narx_rational import RationalNARXModel
+
+FIXTURE = Path(__file__).resolve().parents[1] / "fixtures" / "dc_motor" / "dc_motor.csv"
 
 #: the rational system of the tests, in the form of Billings (2013) §3.7's examples:
 #: y(t) = (0.3 y(t−1) + 0.7 u(t−1)) / (1 + y(t−1)²) + e(t)
@@ -79,6 +82,19 @@ def test_rational_beats_polynomial_on_free_run_validation():
         assert fit > cubic.compare(uv, yv).fit_percent[0] + 0.3
         assert fit > quadratic.compare(uv, yv).fit_percent[0] + 5.0
         assert fit > 99.0
+
+
+def test_rational_on_the_measured_dc_motor():
+    """DC motor (first 500 samples to fit, the rest to validate), degree 2, lags 2, BIC: the
+    rational model (13 terms) validates at 94.33 %, the quadratic polynomial NARX (12 terms) at
+    91.96 %, the cubic (18 terms) at 94.03 % (measured)."""
+    d = np.loadtxt(FIXTURE, delimiter=",", skiprows=1)
+    ue, ye, uv, yv = d[:500, 0], d[:500, 1], d[500:, 0], d[500:, 1]
+    r = narx(ue, ye, degree=2, lags=2, basis="rational")
+    quadratic = narx(ue, ye, degree=2, lags=2)
+    fit = r.compare(uv, yv).fit_percent[0]
+    assert r.denominator_terms and fit > quadratic.compare(uv, yv).fit_percent[0] + 2.0
+    assert fit > 94.0
 
 
 def test_free_run_equals_the_defining_recursion_and_sensitivities_central_differences():
