@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gripkit.errors import ArgumentError, StabilityWarning
+from gripkit.errors import ArgumentError, IdentificationError, StabilityWarning
 from gripkit.sysid import narx
 from gripkit.sysid.nonlinear.narx import load_narx
 from gripkit.sysid.nonlinear.narx_rational import RationalNARXModel
@@ -87,7 +87,8 @@ def test_rational_beats_polynomial_on_free_run_validation():
 def test_rational_on_the_measured_dc_motor():
     """DC motor (first 500 samples to fit, the rest to validate), degree 2, lags 2, BIC: the
     rational model (13 terms) validates at 94.33 %, the quadratic polynomial NARX (12 terms) at
-    91.96 %, the cubic (18 terms) at 94.03 % (measured)."""
+    91.96 %, the cubic (18 terms) at 94.03 % (measured). With terms=20 forced, the start's
+    denominator crosses zero on the estimation rows: a named IdentificationError."""
     d = np.loadtxt(FIXTURE, delimiter=",", skiprows=1)
     ue, ye, uv, yv = d[:500, 0], d[:500, 1], d[500:, 0], d[500:, 1]
     r = narx(ue, ye, degree=2, lags=2, basis="rational")
@@ -95,6 +96,9 @@ def test_rational_on_the_measured_dc_motor():
     fit = r.compare(uv, yv).fit_percent[0]
     assert r.denominator_terms and fit > quadratic.compare(uv, yv).fit_percent[0] + 2.0
     assert fit > 94.0
+    with pytest.raises(IdentificationError, match="denominator D that crosses zero on the "
+                                                  "estimation data"):
+        narx(ue, ye, degree=2, lags=2, basis="rational", terms=20)   # measured: D = −0.75
 
 
 def test_free_run_equals_the_defining_recursion_and_sensitivities_central_differences():

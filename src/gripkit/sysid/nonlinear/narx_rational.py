@@ -9,10 +9,16 @@ Identification: NARMAX Methods*, Wiley 2013, §3.7):
 1. *Structure* by FROLS on the linear-in-parameters form ``y(t) D = N + D e``, i.e.
    ``y(t) = Σ n_k p_k(φ) − Σ d_j y(t) q_j(φ) + D e(t)``: the candidates are the numerator
    monomials ``p_k`` (degree ``degree``) and the products ``−y(t) q_j`` of the output with the
-   denominator monomials (degree ``den_degree``, no constant); the number of terms by the BIC
-   of that regression (or ``terms=``, or the validation free-run fit).
-2. That least-squares estimate is biased (the regressors ``y(t) q_j`` hold ``e(t)``, and the
-   noise ``D e`` is not white), so θ = (n, d) is then refined by Levenberg–Marquardt on the
+   denominator monomials (degree ``den_degree``, no constant). Those products hold
+   ``−e(t) q_j``: their Gram block carries ``σ² QᵀQ`` and their product with ``y`` ``−σ² Qᵀ1``
+   that noise-free columns would not; FROLS and the least-squares start are run on the Gram
+   matrix with that share removed (the extended least squares of Billings & Zhu), σ² from the
+   one-step error of the previous pass's model (the first pass uncorrected), until the chosen
+   terms repeat (at most :data:`PASSES` passes). The number of terms is the BIC minimum of the
+   one-step error ``y − N/D`` of the refined models (or ``terms=``, or the validation free-run
+   fit).
+2. The least-squares estimate of the linear form is biased even so (the noise ``D e`` is not
+   white, and σ² is estimated), so θ = (n, d) is then refined by Levenberg–Marquardt on the
    one-step prediction error ``e(t) = y(t) − N(φ)/D(φ)`` on the measured φ (the nonlinear least
    squares, maximum likelihood for white Gaussian ``e``), Jacobian ``∂(N/D)/∂n_k = p_k/D``,
    ``∂(N/D)/∂d_j = −(N/D) q_j / D``; ``cov θ = σ² (JᵀJ)⁻¹``, ``σ² = SSE/(N − k)``. With
