@@ -86,6 +86,7 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
                   fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
                   json_out: bool = JsonOpt):
     """Polynomial NARX: terms by error reduction ratio (FROLS), θ with σ, pruning, free-run fit;
+    --basis rational: y = N/D (D = 1 + …), FROLS on y·D = N, θ refined on the one-step error;
     --report: the model's page on the --validate record (else on the record)."""
     n_terms = TERMS.parse(terms)
     if refine not in ("none", "simulation"):
