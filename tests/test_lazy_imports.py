@@ -67,6 +67,10 @@ LAZY_MODULES = {
         "numba kernels of the nonlinear families: `import gripkit.estimation` loads none",
     ("estimation/state_functions.py", "..sysid.nonlinear.hysteresis"): "as the line above",
     ("estimation/state_functions.py", "..sysid.nonlinear.narx"): "as the line above",
+    ("estimation/state_functions.py", "..sysid.nonlinear.narx_rational"): "as the line above",
+    ("sysid/nonlinear/narx.py", ".narx_rational"): "the rational NARX imports narx's kernels and "
+                                                   "helpers (circular at the top); its numba "
+                                                   "kernels load for basis='rational' only",
     ("estimation/state_functions.py", "..sysid.nonlinear.nlss"): "as the line above",
     ("estimation/state_functions.py", "..models.hysteresis"): "numba kernels of the grey-box "
                                                                "models, for their filters only",

@@ -1,7 +1,7 @@
 """``gripkit identify narx DATA --input U --output Y [--degree D] [--lags L | --ylags LY --ulags LU]
-[--terms N|auto] [--refine none|simulation] [--forgetting λ] [--validate DATA2] [--out MODEL.json]
-[--json]``:
-polynomial NARX by forward regression with the error reduction ratio
+[--terms N|auto] [--refine none|simulation] [--forgetting λ] [--basis polynomial|rational
+[--den-degree DD]] [--validate DATA2] [--out MODEL.json] [--json]``:
+polynomial or rational NARX by forward regression with the error reduction ratio
 (:func:`gripkit.sysid.narx`)."""
 
 from __future__ import annotations
@@ -26,7 +26,9 @@ TERMS = KeywordOrNumber("--terms", "auto", "auto", int, 1, math.inf,
 
 
 def _summary(m) -> str:
-    lines = [f"NARX degree {m.degree}, ylags {m.ylags}, ulags {m.ulags}: {len(m.terms)} terms "
+    head = ("NARX" if m.basis != "rational" else
+            f"rational NARX y = N/D (D = 1 + …, degree {m.den_degree}), numerator")
+    lines = [f"{head} degree {m.degree}, ylags {m.ylags}, ulags {m.ulags}: {len(m.terms)} terms "
              f"({m.criterion})"]
     lines += [f"  {name:<28s} {th: .6g} ± {sd:.3g}"
               for name, th, sd in zip(m.terms, m.theta, m.theta_std)]
@@ -36,6 +38,24 @@ def _summary(m) -> str:
     if m.validation_fit_percent is not None or m.criterion.startswith("validation"):
         lines.append(f"free-run fit (validation): {fmt(m.validation_fit_percent)}")
     return "\n".join(lines)
+
+
+def _rational_structure(m) -> dict:
+    """The JSON ``structure`` entries of a rational model (none for a polynomial one)."""
+    if m.basis != "rational":
+        return {}
+    return {"basis": "rational", "den_degree": m.den_degree,
+            "numerator_terms": m.numerator_terms, "denominator_terms": m.denominator_terms}
+
+
+def _parameters(m) -> list:
+    """The JSON ``parameters``: term, value, σ (and for a rational model its name and part)."""
+    out = [{"term": t, "value": float(v), "std": float(s)}
+           for t, v, s in zip(m.terms, m.theta, m.theta_std)]
+    if m.basis == "rational":
+        for p, name in zip(out, m.parameters.names):
+            p.update(name=name, part="numerator" if name.startswith("num") else "denominator")
+    return out
 
 
 @identify_app.command("narx")
@@ -54,12 +74,19 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
                                                    help="λ in (0, 1]: below 1, θ by exponentially "
                                                         "weighted least squares (memory about "
                                                         "1/(1 − λ) rows) for a drifting system."),
+                  basis: str = typer.Option("polynomial", "--basis",
+                                            help="polynomial (y = Σ θ·terms) or rational "
+                                                 "(y = N/D, D = 1 + Σ d·terms)."),
+                  den_degree: Optional[int] = typer.Option(None, "--den-degree",
+                                                           help="Degree of the rational "
+                                                                "denominator (default --degree)."),
                   validate: Optional[Path] = RecordValidateOpt,
                   out: Optional[Path] = ModelJsonOpt,
                   report: Optional[Path] = ModelReportOpt,
                   fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
                   json_out: bool = JsonOpt):
     """Polynomial NARX: terms by error reduction ratio (FROLS), θ with σ, pruning, free-run fit;
+    --basis rational: y = N/D (D = 1 + …), FROLS on y·D = N, θ refined on the one-step error;
     --report: the model's page on the --validate record (else on the record)."""
     n_terms = TERMS.parse(terms)
     if refine not in ("none", "simulation"):
@@ -67,6 +94,18 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
 
         raise DataError(f"--refine: expected 'none' or 'simulation', found {refine!r}",
                         hint="--refine simulation fits θ to the free run (output-error noise)")
+    if basis not in ("polynomial", "rational"):
+        from ..errors import DataError
+
+        raise DataError(f"--basis: expected 'polynomial' or 'rational', found {basis!r}",
+                        hint="--basis rational fits y = N/D")
+    if den_degree is not None and basis != "rational":
+        from ..errors import DataError
+
+        raise DataError(f"--den-degree {den_degree} is the degree of a rational model's "
+                        f"denominator, but --basis is {basis!r}",
+                        hint="add --basis rational or leave --den-degree out")
+    extra = {} if basis == "polynomial" else {"basis": basis, "den_degree": den_degree}
     check_data_options(fs, fill)
     check_outputs(out, report)
     with collected_warnings() as caught:
@@ -74,7 +113,7 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
                                   fill=fill, validate=validate, fit_validate=True, degree=degree,
                                   lags=lags, ylags=ylags, ulags=ulags, terms=n_terms,
                                   refine=None if refine == "none" else refine,
-                                  forgetting=forgetting, progress=True)
+                                  forgetting=forgetting, progress=True, **extra)
         val = validation(m, vtr, validate)
         page = save_and_page(m, out, report, tr, vtr, data, validate)
     lines = report_warnings(caught)
@@ -82,9 +121,9 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
         emit_json({"data": str(data), "input": input_col, "output": output_col,
                    "structure": {"degree": m.degree, "ylags": m.ylags, "ulags": m.ulags,
                                  "terms": m.terms, "criterion": m.criterion,
-                                 "refine": refine, "forgetting": forgetting},
-                   "parameters": [{"term": t, "value": float(v), "std": float(s)}
-                                  for t, v, s in zip(m.terms, m.theta, m.theta_std)],
+                                 "refine": refine, "forgetting": forgetting,
+                                 **_rational_structure(m)},
+                   "parameters": _parameters(m),
                    "fit_percent": m.fit_percent, "prediction_fit_percent": m.prediction_fit_percent,
                    "validation": None if val is None else val.to_dict(),
                    "model": None if out is None else str(out), "report": page,

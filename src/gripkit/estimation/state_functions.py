@@ -466,10 +466,20 @@ def _narx(model):
     # each base's place in the state: y(t−lag) at lag−1, u(t−lag) at ly+lag−1, u(t) past the end
     at = np.where(kinds == 0, lags - 1, np.where(lags == 0, n, ly + lags - 1))
     rows = np.where(rows < 0, -1, at[rows])
+    if getattr(model, "basis", "polynomial") == "rational":  # y = N/D, D = 1 + Σ d_j q_j
+        from ..sysid.nonlinear.narx_rational import rational_output
 
-    @numba.njit
-    def output(x, u):  # pragma: no cover - compiled
-        return narx_output(rows, theta, x, u[0])
+        den_rows = np.ascontiguousarray(model.den_rows, dtype=np.int64)
+        den_rows = np.where(den_rows < 0, -1, at[den_rows])
+
+        @numba.njit
+        def output(x, u):  # pragma: no cover - compiled
+            num, den = rational_output(rows, den_rows, theta, x, u[0])
+            return num / den
+    else:
+        @numba.njit
+        def output(x, u):  # pragma: no cover - compiled
+            return narx_output(rows, theta, x, u[0])
 
     @numba.njit
     def f(x, u):  # pragma: no cover - compiled

@@ -170,7 +170,8 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str,
         response, options of :func:`gripkit.sysid.linear.frf`), ``'tf'`` (continuous-time transfer
         function, options ``poles``, ``zeros``); ``'narx'`` (polynomial NARX on the data as they
         are, its constant term in place of detrending; options of
-        :func:`gripkit.sysid.narx`: ``degree``, ``lags``, ``terms``, ``validate`` …); ``'hw'``
+        :func:`gripkit.sysid.narx`: ``degree``, ``lags``, ``terms``, ``validate``, ``basis``
+        (``'rational'``: y = N/D) …); ``'hw'``
         (Hammerstein–Wiener on the data as they are, with this function's ``nb``, ``nf``, ``nk``:
         each one not given is chosen by the array function, by the free-run fit on ``validate``
         (a trajectory or ``(u, y)``) or by BIC; options of

@@ -65,6 +65,9 @@ __all__ = ["SCHEMA", "NARX_FIT", "NARXModel", "narx", "load_narx", "candidate_te
 
 SCHEMA = "gripkit.narx-model"
 VERSION = 1
+#: the version of a rational NARX model's file (a polynomial model's file stays version 1; a
+#: gripkit that reads version 1 only refuses a rational file instead of misreading it)
+RATIONAL_VERSION = 2
 #: how a NARX model's free-run fit is taken (``gripkit compare`` prints it)
 NARX_FIT = ("free run started from the first max_lag measured outputs, "
             "fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) over the samples after them")
@@ -399,6 +402,8 @@ class NARXModel(FreeRunModel, FamilyFile):
     results (N, 1)) or the signals ``u``, ``y`` (N,)."""
 
     structure = "narx"
+    #: the basis of the terms (:class:`~.narx_rational.RationalNARXModel`: 'rational')
+    basis = "polynomial"
     fit_definition = NARX_FIT
     _file_what = "NARX model"
     #: how :meth:`compare` starts the free run: from the first ``max_lag`` measured outputs
@@ -487,14 +492,33 @@ class NARXModel(FreeRunModel, FamilyFile):
             if at >= 0:
                 sy[at:] = np.nan
         else:
-            at = _simulate_kernel(self.bases[:, 0].copy(), self.bases[:, 1].copy(), self.rows,
-                                  self.theta, u, y, m, lo, hi)
+            at = self._run(u, y, lo, hi)
         if at >= 0 and warn:
-            emit_warning(f"narx: the free run diverges at sample {at} (beyond "
-                         f"{DIVERGENCE_FACTOR:g}× the estimation output's range); the model is "
-                         "unstable on this input",
-                         StabilityWarning)
+            emit_warning(self._stop_message(at), StabilityWarning)
         return (y, sy) if std else y
+
+    def _run(self, u, y, lo: float, hi: float) -> int:
+        """Free run into ``y`` (its first ``max_lag`` entries given) → the sample where it
+        left [lo, hi], −1 if none."""
+        return _simulate_kernel(self.bases[:, 0].copy(), self.bases[:, 1].copy(), self.rows,
+                                self.theta, u, y, self.max_lag, lo, hi)
+
+    def _stop_message(self, at: int) -> str:
+        """The StabilityWarning of a free run that stopped at sample ``at``."""
+        return (f"narx: the free run diverges at sample {at} (beyond {DIVERGENCE_FACTOR:g}× the "
+                "estimation output's range); the model is unstable on this input")
+
+    def _structure_state(self) -> tuple:
+        """The terms and θ with its σ, to put back with :meth:`_restore_structure`."""
+        return self.rows, self.theta, self.covariance, self.theta_std
+
+    def _restore_structure(self, state: tuple) -> None:
+        self.rows, self.theta, self.covariance, self.theta_std = state
+
+    def _drop_term(self, j: int) -> None:
+        """Remove term ``j`` (index into :attr:`theta`) and its parameter."""
+        keep = np.arange(len(self.theta)) != j
+        self.rows, self.theta = self.rows[keep], self.theta[keep]
 
     def _sensitivities(self, u, y, theta):
         """Free run into ``y`` (its first ``max_lag`` entries given) with parameters ``theta``,
@@ -563,26 +587,15 @@ class NARXModel(FreeRunModel, FamilyFile):
 def load_narx(path) -> NARXModel:
     """Read a model written by :meth:`NARXModel.save`; any other schema is refused."""
     p = Path(path)
-    doc = read_family_document(p, SCHEMA, VERSION, family="narx",
+    doc = read_family_document(p, SCHEMA, (VERSION, RATIONAL_VERSION), family="narx",
                                writer="NARXModel.save or `gripkit identify narx --out`")
+    if doc.get("version") == RATIONAL_VERSION:
+        from .narx_rational import load_rational
+
+        return load_rational(p, doc)
     try:
-        bases = np.array(doc["bases"], dtype=np.int64).reshape(-1, 2)
-        rows = np.array(doc["rows"], dtype=np.int64).reshape(len(doc["rows"]), int(doc["degree"]))
-        theta = np.array(doc["theta"], dtype=np.float64)
-        m = NARXModel(ylags=int(doc["ylags"]), ulags=int(doc["ulags"]), degree=int(doc["degree"]),
-                      direct=bool(doc["direct"]), bases=bases, rows=rows, theta=theta,
-                      theta_std=np.array(doc["theta_std"], dtype=np.float64),
-                      covariance=np.array(doc["covariance"], dtype=np.float64).reshape(
-                          len(theta), len(theta)),
-                      dt=float(doc["dt"]), y_range=tuple(doc["y_range"]),
-                      fit_percent=doc.get("fit_percent"),
-                      prediction_fit_percent=doc.get("prediction_fit_percent"),
-                      validation_fit_percent=doc.get("validation_fit_percent"),
-                      criterion=str(doc.get("criterion", "")),
-                      err=[float(v) for v in doc.get("err", [])],
-                      frols_terms=[str(t) for t in doc.get("frols_terms", [])],
-                      input_name=str(doc.get("input_name", "u")),
-                      output_name=str(doc.get("output_name", "y")))
+        m = NARXModel(**_model_fields(doc))
+        bases, rows, theta = m.bases, m.rows, m.theta
     except (KeyError, TypeError, ValueError) as exc:
         raise ModelError(f"{str(p)!r}: a malformed {SCHEMA} ({type(exc).__name__}: {exc}); "
                          "write it again with NARXModel.save") from None
@@ -590,6 +603,28 @@ def load_narx(path) -> NARXModel:
         raise ModelError(f"{str(p)!r}: {len(rows)} terms but {len(theta)} parameters, or a term "
                          "naming a missing lagged signal; write it again with NARXModel.save")
     return m
+
+
+def _model_fields(doc: dict) -> dict:
+    """The fields of a NARX model file's document (both bases); raises KeyError, TypeError or
+    ValueError for a malformed one."""
+    bases = np.array(doc["bases"], dtype=np.int64).reshape(-1, 2)
+    rows = np.array(doc["rows"], dtype=np.int64).reshape(len(doc["rows"]), int(doc["degree"]))
+    theta = np.array(doc["theta"], dtype=np.float64)
+    return dict(ylags=int(doc["ylags"]), ulags=int(doc["ulags"]), degree=int(doc["degree"]),
+                direct=bool(doc["direct"]), bases=bases, rows=rows, theta=theta,
+                theta_std=np.array(doc["theta_std"], dtype=np.float64),
+                covariance=np.array(doc["covariance"], dtype=np.float64).reshape(
+                    len(theta), len(theta)),
+                dt=float(doc["dt"]), y_range=tuple(doc["y_range"]),
+                fit_percent=doc.get("fit_percent"),
+                prediction_fit_percent=doc.get("prediction_fit_percent"),
+                validation_fit_percent=doc.get("validation_fit_percent"),
+                criterion=str(doc.get("criterion", "")),
+                err=[float(v) for v in doc.get("err", [])],
+                frols_terms=[str(t) for t in doc.get("frols_terms", [])],
+                input_name=str(doc.get("input_name", "u")),
+                output_name=str(doc.get("output_name", "y")))
 
 
 def _positive_int(v, name: str, lo: int = 1) -> int:
@@ -647,6 +682,8 @@ def _fit_records(model: NARXModel, records, warn: bool = True) -> float | None:
 
 #: choices of ``refine``
 REFINE = (None, "simulation")
+#: choices of ``basis``
+BASES = ("polynomial", "rational")
 #: λ ÷ 3 after a step taken, × 4 after one refused, tried below 1e12
 _DAMPING = Damping(shrink=3.0, grow=4.0, ceiling=float(np.nextafter(1e12, 0.0)))
 
@@ -778,11 +815,14 @@ def _choose_terms(build, terms, n_selected: int, sse, n: int, val, progress: boo
     return best[2], best[3], f"validation free-run fit best at {best[1]} FROLS terms"
 
 
-def _refine_and_prune(model, records, rows, P, target, prune: bool, max_iter: int) -> None:
+def _refine_and_prune(model, records, rows, P, target, prune: bool, max_iter: int,
+                      one_step=None) -> None:
     """θ refined on the free-run error (:func:`_refine_simulation`), then with ``prune`` the
     weakest term with |θ|/σ < 2 dropped and θ refined again, one at a time; the criterion and
     the one-step fit of the refined θ updated. A term whose removal makes the free run
-    diverge (the start of the next refinement) stays, and the pruning stops there."""
+    diverge (the start of the next refinement) stays, and the pruning stops there.
+    ``one_step(model)``: the one-step fit (%) of the refined model, when not that of the
+    polynomial terms on the columns of ``P``."""
     iters = _refine_simulation(model, records, max_iter)
     dropped, kept = 0, ""
     while prune and iters is not None and len(model.theta) > 1:
@@ -790,14 +830,13 @@ def _refine_and_prune(model, records, rows, P, target, prune: bool, max_iter: in
         weakest = int(np.argmin(t))
         if not t[weakest] < 2.0:
             break
-        before = (model.rows, model.theta, model.covariance, model.theta_std)
-        keep = np.arange(len(model.theta)) != weakest
-        model.rows, model.theta = model.rows[keep], model.theta[keep]
+        before, name = model._structure_state(), model.terms[weakest]
+        model._drop_term(weakest)
         more = _refine_simulation(model, records, max_iter)
         if more is None:  # without it the free run diverges: keep it, stop pruning
-            model.rows, model.theta, model.covariance, model.theta_std = before
-            kept = (f"; {_term_name(before[0][weakest], model.bases)} kept (|θ|/σ = "
-                    f"{t[weakest]:.2g}): without it the free run diverges")
+            model._restore_structure(before)
+            kept = (f"; {name} kept (|θ|/σ = {t[weakest]:.2g}): without it the free run "
+                    "diverges")
             break
         dropped += 1
         iters += more
@@ -807,7 +846,9 @@ def _refine_and_prune(model, records, rows, P, target, prune: bool, max_iter: in
                            if dropped else ")") + kept
                         if iters is not None else
                         "; not refined: the least-squares model's free run diverges")
-    if iters is not None:  # the one-step fit of the refined θ
+    if iters is not None and one_step is not None:
+        model.prediction_fit_percent = one_step(model)
+    elif iters is not None:  # the one-step fit of the refined θ
         cols = [_row_index(rows, r) for r in model.rows]
         e = target - P[:, cols] @ model.theta
         model.prediction_fit_percent = _fit(target, target - e)
@@ -816,7 +857,8 @@ def _refine_and_prune(model, records, rows, P, target, prune: bool, max_iter: in
 def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None = None,
          ulags: int | None = None, terms="auto", dt: float | None = None, validate=None,
          direct: bool = False, prune: bool = True, refine: str | None = None,
-         forgetting: float = 1.0, max_iter: int = 50, progress: bool = False) -> NARXModel:
+         forgetting: float = 1.0, max_iter: int = 50, progress: bool = False,
+         basis: str = "polynomial", den_degree: int | None = None) -> NARXModel:
     """Polynomial NARX model of ``y`` driven by ``u`` (1-D arrays of equal length), or of
     several records: ``narx([(u1, y1), (u2, y2), …])`` (each record's first ``max_lag``
     samples are its own past; one regression over all of them, σ from all).
@@ -840,8 +882,19 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
     θ and σ (the sandwich covariance for white noise) weight the recent rows, the memory
     ``Σ λ^age ≈ 1/(1 − λ)`` rows; at most half the memory in terms; not with ``refine``.
     ``progress``: each stage on stderr, a bar over the validation candidates.
+    ``basis``: ``"polynomial"`` (default) or ``"rational"``: ``y(t) = N(φ)/D(φ) + e(t)`` with
+    ``N`` of degree ``degree`` and ``D = 1 + Σ d_j q_j(φ)`` of degree ``den_degree`` (default
+    ``degree``), a :class:`~gripkit.sysid.nonlinear.narx_rational.RationalNARXModel`
+    (:func:`~gripkit.sysid.nonlinear.narx_rational.rational_narx`).
     """
     say = status if progress else (lambda message: None)
+    if basis not in BASES:
+        raise ArgumentError(f"narx: basis must be one of {', '.join(map(repr, BASES))}, found "
+                            f"{basis!r}", hint="basis='rational' fits y = N(φ)/D(φ)")
+    if den_degree is not None and basis != "rational":
+        raise ArgumentError(f"narx: den_degree = {den_degree!r} is the degree of a rational "
+                            f"model's denominator, but basis = {basis!r}",
+                            hint="give basis='rational' or leave den_degree out")
     records = _narx_records(u, y)
     if refine not in REFINE:
         raise ArgumentError(f"narx: refine must be None or 'simulation', found {refine!r}")
@@ -858,6 +911,16 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
         raise ArgumentError(f"narx: dt must be a positive sample interval in s, found {dt!r}")
     if ly + lu == 0 and not direct:
         raise ArgumentError("narx: no lagged signal (ylags = ulags = 0); give lags ≥ 1")
+    if basis == "rational":
+        from .narx_rational import rational_narx
+
+        if forgetting < 1.0:
+            raise ArgumentError(f"narx: forgetting = {forgetting!r} applies to the polynomial "
+                                "least squares, not to basis='rational'",
+                                hint="forgetting=1 with basis='rational'")
+        return rational_narx(records, ylags=ly, ulags=lu, degree=degree, den_degree=den_degree,
+                             direct=direct, terms=terms, dt=dt, validate=validate, prune=prune,
+                             refine=refine, max_iter=max_iter, progress=progress)
     bases, rows = candidate_terms(ly, lu, degree, direct)
     start = max(ly, lu, 1)
     P, target = _regression_matrix(bases, rows, records, start)
