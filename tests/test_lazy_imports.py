@@ -39,7 +39,7 @@ LAZY_MODULES = {
     ("sysid/linear/arx.py", ".lagged_sums"): "numba kernels: a small ARX is solved by QR without "
                                              "loading numba (0.45 s)",
     ("sysid/identify.py", ".linear.rls"): "numba (0.4 s): `gripkit identify arx` does not load it",
-    ("sysid/identify.py", ".nonlinear.narx"): "numba kernels: a nonlinear family's module loads "
+    ("sysid/identify.py", ".nonlinear.narx_entry"): "numba kernels: a nonlinear family's module loads "
                                                "with its first fit",
     ("sysid/identify.py", ".nonlinear.hammerstein_wiener"): "as the line above",
     ("sysid/identify.py", ".nonlinear.hysteresis"): "as the line above",
@@ -68,9 +68,8 @@ LAZY_MODULES = {
     ("estimation/state_functions.py", "..sysid.nonlinear.hysteresis"): "as the line above",
     ("estimation/state_functions.py", "..sysid.nonlinear.narx"): "as the line above",
     ("estimation/state_functions.py", "..sysid.nonlinear.narx_rational"): "as the line above",
-    ("sysid/nonlinear/narx.py", ".narx_rational"): "the rational NARX imports narx's kernels and "
-                                                   "helpers (circular at the top); its numba "
-                                                   "kernels load for basis='rational' only",
+    ("sysid/nonlinear/narx_entry.py", ".narx_rational"): "the rational NARX's numba kernels "
+                                                         "load for basis='rational' only",
     ("estimation/state_functions.py", "..sysid.nonlinear.nlss"): "as the line above",
     ("estimation/state_functions.py", "..models.hysteresis"): "numba kernels of the grey-box "
                                                                "models, for their filters only",

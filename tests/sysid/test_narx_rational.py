@@ -10,8 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from gripkit.errors import ArgumentError, IdentificationError, StabilityWarning
-from gripkit.sysid import narx
+from gripkit.errors import ArgumentError, IdentificationError, ModelError, StabilityWarning
+from gripkit.sysid import load_model, narx
 from gripkit.sysid.nonlinear.narx import load_narx
 from gripkit.sysid.nonlinear.narx_rational import RationalNARXModel
 
@@ -134,18 +134,21 @@ def test_free_run_equals_the_defining_recursion_and_sensitivities_central_differ
 
 
 def test_save_load_round_trip_and_parameters(tmp_path):
-    """The saved file says what it is (version 2, basis 'rational', numerator and denominator
-    terms named); load_narx gives a RationalNARXModel with the same attributes and the same
-    compare number; ``parameters`` names num_k and den_j; a polynomial model still saves as
-    version 1 and loads as NARXModel."""
+    """The saved file says what it is (its own schema, basis 'rational', numerator and
+    denominator terms named); sysid.load_model gives a RationalNARXModel with the same attributes
+    and the same compare number, and the polynomial reader refuses the file; ``parameters``
+    names num_k and den_j; a polynomial model still saves as a version-1 NARX file and loads as
+    NARXModel."""
     u, y = _system(np.random.default_rng(11))
     uv, yv = _system(np.random.default_rng(12), noise=0.0)
     m = narx(u, y, degree=2, lags=2, basis="rational", validate=(uv, yv))
     path = m.save(tmp_path / "r.json")
     doc = json.loads(path.read_text())
-    assert doc["schema"] == "gripkit.narx-model" and doc["version"] == 2
+    assert doc["schema"] == "gripkit.rational-narx-model" and doc["version"] == 1
     assert doc["basis"] == "rational" and doc["denominator_terms"] == ["y(t-1)*y(t-1)"]
-    m2 = load_narx(path)
+    with pytest.raises(ModelError, match="rational-narx-model"):
+        load_narx(path)
+    m2 = load_model(path)
     assert type(m2) is RationalNARXModel and m2.structure == "rational-narx"
     for name in ("terms", "numerator_terms", "denominator_terms", "criterion", "frols_terms",
                  "fit_percent", "validation_fit_percent", "prediction_fit_percent", "degree",

@@ -70,9 +70,11 @@ _LAZY = {
     "load_dynamics_model": ("rigid_body.dynamics", "load_dynamics_model"),
     "fourier_trajectory": ("rigid_body.fourier_trajectory", "fourier_trajectory"),
     "FourierTrajectory": ("rigid_body.fourier_trajectory", "FourierTrajectory"),
-    "narx": ("nonlinear.narx", "narx"),
+    "narx": ("nonlinear.narx_entry", "narx"),
     "NARXModel": ("nonlinear.narx", "NARXModel"),
     "load_narx": ("nonlinear.narx", "load_narx"),
+    "RationalNARXModel": ("nonlinear.narx_rational", "RationalNARXModel"),
+    "load_rational_narx": ("nonlinear.narx_rational", "load_rational_narx"),
     "hammerstein_wiener": ("nonlinear.hammerstein_wiener", "hammerstein_wiener"),
     "HWModel": ("nonlinear.hammerstein_wiener", "HWModel"),
     "load_hw": ("nonlinear.hammerstein_wiener", "load_hw"),
@@ -142,7 +144,9 @@ if TYPE_CHECKING:  # static readers see the same names, imported eagerly
     from .nonlinear.hammerstein_wiener import load_hw as load_hw
     from .nonlinear.narx import NARXModel as NARXModel
     from .nonlinear.narx import load_narx as load_narx
-    from .nonlinear.narx import narx as narx
+    from .nonlinear.narx_entry import narx as narx
+    from .nonlinear.narx_rational import RationalNARXModel as RationalNARXModel
+    from .nonlinear.narx_rational import load_rational_narx as load_rational_narx
     from .nonlinear.hysteresis import BoucWenModel as BoucWenModel
     from .nonlinear.hysteresis import BoucWenOscillatorModel as BoucWenOscillatorModel
     from .nonlinear.hysteresis import PrandtlIshlinskiiModel as PrandtlIshlinskiiModel

@@ -104,7 +104,7 @@ def _method_function(method: str):
         return rls
     # numba kernels: a nonlinear family's module is loaded by its first fit
     if method == "narx":
-        from .nonlinear.narx import narx
+        from .nonlinear.narx_entry import narx
 
         return narx
     if method == "hw":

@@ -90,6 +90,7 @@ class IdentifiedModel(Protocol):
 MODEL_FILES: dict[str, tuple[str, str]] = {
     "gripkit.linear-model": ("linear.polynomial", "load_linear_model"),
     "gripkit.narx-model": ("nonlinear.narx", "load_narx"),
+    "gripkit.rational-narx-model": ("nonlinear.narx_rational", "load_rational_narx"),
     "gripkit.hw-model": ("nonlinear.hammerstein_wiener", "load_hw"),
     "gripkit.hysteresis-model": ("nonlinear.hysteresis", "load_hysteresis"),
     "gripkit.nlss-model": ("nonlinear.nlss", "load_nlss"),

@@ -60,14 +60,11 @@ from .single_channel import (DIVERGENCE_FACTOR, FreeRunModel, fit_percent, not_c
                              one_signal)
 from ...progress import status, track
 
-__all__ = ["SCHEMA", "NARX_FIT", "NARXModel", "narx", "load_narx", "candidate_terms",
-           "frols", "REFINE"]
+__all__ = ["SCHEMA", "NARX_FIT", "NARXModel", "polynomial_narx", "load_narx", "candidate_terms",
+           "frols", "REFINE", "checked_arguments"]
 
 SCHEMA = "gripkit.narx-model"
 VERSION = 1
-#: the version of a rational NARX model's file (a polynomial model's file stays version 1; a
-#: gripkit that reads version 1 only refuses a rational file instead of misreading it)
-RATIONAL_VERSION = 2
 #: how a NARX model's free-run fit is taken (``gripkit compare`` prints it)
 NARX_FIT = ("free run started from the first max_lag measured outputs, "
             "fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) over the samples after them")
@@ -587,12 +584,8 @@ class NARXModel(FreeRunModel, FamilyFile):
 def load_narx(path) -> NARXModel:
     """Read a model written by :meth:`NARXModel.save`; any other schema is refused."""
     p = Path(path)
-    doc = read_family_document(p, SCHEMA, (VERSION, RATIONAL_VERSION), family="narx",
+    doc = read_family_document(p, SCHEMA, VERSION, family="narx",
                                writer="NARXModel.save or `gripkit identify narx --out`")
-    if doc.get("version") == RATIONAL_VERSION:
-        from .narx_rational import load_rational
-
-        return load_rational(p, doc)
     try:
         m = NARXModel(**_model_fields(doc))
         bases, rows, theta = m.bases, m.rows, m.theta
@@ -683,7 +676,6 @@ def _fit_records(model: NARXModel, records, warn: bool = True) -> float | None:
 #: choices of ``refine``
 REFINE = (None, "simulation")
 #: choices of ``basis``
-BASES = ("polynomial", "rational")
 #: λ ÷ 3 after a step taken, × 4 after one refused, tried below 1e12
 _DAMPING = Damping(shrink=3.0, grow=4.0, ceiling=float(np.nextafter(1e12, 0.0)))
 
@@ -854,14 +846,37 @@ def _refine_and_prune(model, records, rows, P, target, prune: bool, max_iter: in
         model.prediction_fit_percent = _fit(target, target - e)
 
 
-def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None = None,
-         ulags: int | None = None, terms="auto", dt: float | None = None, validate=None,
-         direct: bool = False, prune: bool = True, refine: str | None = None,
-         forgetting: float = 1.0, max_iter: int = 50, progress: bool = False,
-         basis: str = "polynomial", den_degree: int | None = None) -> NARXModel:
+def checked_arguments(u, y, *, degree, lags, ylags, ulags, dt, direct, refine, max_iter):
+    """The checks every NARX basis makes of its data and structure: ``(records, all outputs,
+    degree, ylags, ulags, max_iter)``, or the one-line error naming the argument."""
+    records = _narx_records(u, y)
+    if refine not in REFINE:
+        raise ArgumentError(f"narx: refine must be None or 'simulation', found {refine!r}")
+    max_iter = _positive_int(max_iter, "max_iter")
+    yall = np.concatenate([r[1] for r in records])
+    not_constant(yall, "the output", "narx",
+                 "there is nothing to identify: check the output column")
+    degree = _positive_int(degree, "degree")
+    ly = _positive_int(ylags if ylags is not None else lags, "ylags", 0)
+    lu = _positive_int(ulags if ulags is not None else lags, "ulags", 0)
+    if dt is not None and not (isinstance(dt, (int, float, np.floating)) and np.isfinite(dt)
+                               and dt > 0):
+        raise ArgumentError(f"narx: dt must be a positive sample interval in s, found {dt!r}")
+    if ly + lu == 0 and not direct:
+        raise ArgumentError("narx: no lagged signal (ylags = ulags = 0); give lags ≥ 1")
+    return records, yall, degree, ly, lu, max_iter
+
+
+def polynomial_narx(u, y=None, *, degree: int = 2, lags: int | None = 2,
+                    ylags: int | None = None, ulags: int | None = None, terms="auto",
+                    dt: float | None = None, validate=None, direct: bool = False,
+                    prune: bool = True, refine: str | None = None, forgetting: float = 1.0,
+                    max_iter: int = 50, progress: bool = False) -> NARXModel:
     """Polynomial NARX model of ``y`` driven by ``u`` (1-D arrays of equal length), or of
     several records: ``narx([(u1, y1), (u2, y2), …])`` (each record's first ``max_lag``
-    samples are its own past; one regression over all of them, σ from all).
+    samples are its own past; one regression over all of them, σ from all). The public entry
+    is :func:`gripkit.sysid.narx` (:mod:`.narx_entry`), whose ``basis`` chooses this or the
+    rational NARX.
 
     ``degree``: highest total degree of a term. ``lags``: output and input lags (``ylags`` /
     ``ulags`` set them apart). ``terms``: ``"auto"`` (BIC, or the validation fit with
@@ -882,45 +897,12 @@ def narx(u, y=None, *, degree: int = 2, lags: int | None = 2, ylags: int | None 
     θ and σ (the sandwich covariance for white noise) weight the recent rows, the memory
     ``Σ λ^age ≈ 1/(1 − λ)`` rows; at most half the memory in terms; not with ``refine``.
     ``progress``: each stage on stderr, a bar over the validation candidates.
-    ``basis``: ``"polynomial"`` (default) or ``"rational"``: ``y(t) = N(φ)/D(φ) + e(t)`` with
-    ``N`` of degree ``degree`` and ``D = 1 + Σ d_j q_j(φ)`` of degree ``den_degree`` (default
-    ``degree``), a :class:`~gripkit.sysid.nonlinear.narx_rational.RationalNARXModel`
-    (:func:`~gripkit.sysid.nonlinear.narx_rational.rational_narx`).
     """
     say = status if progress else (lambda message: None)
-    if basis not in BASES:
-        raise ArgumentError(f"narx: basis must be one of {', '.join(map(repr, BASES))}, found "
-                            f"{basis!r}", hint="basis='rational' fits y = N(φ)/D(φ)")
-    if den_degree is not None and basis != "rational":
-        raise ArgumentError(f"narx: den_degree = {den_degree!r} is the degree of a rational "
-                            f"model's denominator, but basis = {basis!r}",
-                            hint="give basis='rational' or leave den_degree out")
-    records = _narx_records(u, y)
-    if refine not in REFINE:
-        raise ArgumentError(f"narx: refine must be None or 'simulation', found {refine!r}")
-    max_iter = _positive_int(max_iter, "max_iter")
+    records, yall, degree, ly, lu, max_iter = checked_arguments(
+        u, y, degree=degree, lags=lags, ylags=ylags, ulags=ulags, dt=dt, direct=direct,
+        refine=refine, max_iter=max_iter)
     forgetting = _forgetting(forgetting, refine)
-    yall = np.concatenate([r[1] for r in records])
-    not_constant(yall, "the output", "narx",
-                 "there is nothing to identify: check the output column")
-    degree = _positive_int(degree, "degree")
-    ly = _positive_int(ylags if ylags is not None else lags, "ylags", 0)
-    lu = _positive_int(ulags if ulags is not None else lags, "ulags", 0)
-    if dt is not None and not (isinstance(dt, (int, float, np.floating)) and np.isfinite(dt)
-                               and dt > 0):
-        raise ArgumentError(f"narx: dt must be a positive sample interval in s, found {dt!r}")
-    if ly + lu == 0 and not direct:
-        raise ArgumentError("narx: no lagged signal (ylags = ulags = 0); give lags ≥ 1")
-    if basis == "rational":
-        from .narx_rational import rational_narx
-
-        if forgetting < 1.0:
-            raise ArgumentError(f"narx: forgetting = {forgetting!r} applies to the polynomial "
-                                "least squares, not to basis='rational'",
-                                hint="forgetting=1 with basis='rational'")
-        return rational_narx(records, ylags=ly, ulags=lu, degree=degree, den_degree=den_degree,
-                             direct=direct, terms=terms, dt=dt, validate=validate, prune=prune,
-                             refine=refine, max_iter=max_iter, progress=progress)
     bases, rows = candidate_terms(ly, lu, degree, direct)
     start = max(ly, lu, 1)
     P, target = _regression_matrix(bases, rows, records, start)

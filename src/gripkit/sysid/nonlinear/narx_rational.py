@@ -38,7 +38,10 @@ an :class:`~gripkit.errors.IdentificationError` naming it.
 from __future__ import annotations
 
 import dataclasses
+from collections import namedtuple
 from dataclasses import dataclass, field
+
+from pathlib import Path
 
 import numpy as np
 from numba import njit
@@ -48,15 +51,28 @@ from ...errors import (ArgumentError, DataError, IdentificationError, ModelError
 from ...params import Parameter, ParameterSet
 from ...progress import status, track
 from ...signals.trajectory import Trajectory
+from ..model_file import read_family_document
 from .levenberg_marquardt import levenberg_marquardt
-from .narx import (_DAMPING, NARX_FIT, RATIONAL_VERSION, SCHEMA, NARXModel, _as_signal,
+from .narx import (_DAMPING, NARX_FIT, NARXModel, _as_signal,
                    _better_on_validation, _fit, _fit_records, _frols_gram, _max_terms,
                    _model_fields, _positive_int, _Regression, _refine_and_prune,
                    _regression_matrix, _regressors, _row_index, _term_name, _validation_records,
                    candidate_terms, narx_output)
 from .single_channel import DIVERGENCE_FACTOR
 
-__all__ = ["RationalNARXModel", "rational_narx", "rational_output", "DEN_FLOOR"]
+__all__ = ["RationalNARXModel", "rational_narx", "rational_output", "load_rational_narx",
+           "DEN_FLOOR", "SCHEMA"]
+
+#: a rational NARX model's file: a schema of its own, so that a reader of polynomial NARX files
+#: refuses it instead of reading its numerator alone
+SCHEMA = "gripkit.rational-narx-model"
+VERSION = 1
+#: what the rational kernels read of a model's structure: each base's kind (0 output, 1 input) and
+#: lag, and the numerator's and denominator's terms (indices into the bases, −1 padded)
+RationalTerms = namedtuple("RationalTerms", "kinds lags rows den_rows")
+#: scratch of the sensitivity kernel: the bases' values ``z`` and ∂N/∂y, ∂D/∂y per base, and
+#: ``why`` (one int: why a free run stopped)
+RationalWork = namedtuple("RationalWork", "z dndy dddy why")
 
 #: a denominator at or below this on the data is taken as crossing zero (D = 1 at φ = 0)
 DEN_FLOOR = 1e-6
@@ -87,12 +103,14 @@ def _stop(y, J, t):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _simulate_kernel(kinds, lags, rows, den_rows, theta, u, y, start, limit_lo, limit_hi,
-                     floor, z, why):  # pragma: no cover - compiled
-    """Free run in place: ``y[start:]`` from ``y[:start]`` and ``u``; ``z`` scratch of one
+def _simulate_kernel(terms, theta, u, y, start, limits, z, why):  # pragma: no cover - compiled
+    """Free run in place: ``y[start:]`` from ``y[:start]`` and ``u`` (``terms``:
+    :data:`RationalTerms`; ``limits``: ``(limit_lo, limit_hi, floor)``); ``z`` scratch of one
     entry per base. Returns the first sample where ``D ≤ floor`` (``why[0] = 1``; that sample
     and the rest NaN) or the output left [limit_lo, limit_hi] or became non-finite
     (``why[0] = 2``; the rest NaN), −1 if none."""
+    kinds, lags, rows, den_rows = terms
+    limit_lo, limit_hi, floor = limits
     n = y.shape[0]
     why[0] = 0
     for t in range(start, n):
@@ -145,13 +163,17 @@ def _add_dy(rows, k, coef, kinds, z, out):  # pragma: no cover - compiled
 
 
 @njit(cache=True)
-def _sensitivity_kernel(kinds, lags, rows, den_rows, theta, u, y, start, limit_lo, limit_hi,
-                        floor, J, z, dndy, dddy, why):  # pragma: no cover - compiled
+def _sensitivity_kernel(terms, theta, u, y, start, limits, J,
+                        work):  # pragma: no cover - compiled
     """Free run in place (as :func:`_simulate_kernel`) and in the same pass
     ``J[t, j] = ∂ŷ(t)/∂θ_j``: with ``ŷ = N/D``, ``J[t] = ∂ŷ/∂θ|_φ + Σ_b g_b J[t − lag_b]`` over
     the output bases ``b``, ``g_b = (∂N/∂y_b − ŷ ∂D/∂y_b)/D``, ``∂ŷ/∂n_k = p_k/D`` and
-    ``∂ŷ/∂d_j = −ŷ q_j/D``; ``J[t] = 0`` for the given outputs. ``z``, ``dndy``, ``dddy``:
-    scratch of one entry per base. Returns as :func:`_simulate_kernel` (J zero from the stop)."""
+    ``∂ŷ/∂d_j = −ŷ q_j/D``; ``J[t] = 0`` for the given outputs. ``work``:
+    :data:`RationalWork` (``z``, ``dndy``, ``dddy``: one entry per base). Returns as
+    :func:`_simulate_kernel` (J zero from the stop)."""
+    kinds, lags, rows, den_rows = terms
+    limit_lo, limit_hi, floor = limits
+    z, dndy, dddy, why = work
     n = y.shape[0]
     nn = rows.shape[0]
     nd = den_rows.shape[0]
@@ -245,15 +267,15 @@ class RationalNARXModel(NARXModel):
                              for nm, v, s, doc in zip(names, self.theta, self.theta_std, docs)],
                             name="rational-narx")
 
-    def _kernel_args(self):
-        return (self.bases[:, 0].copy(), self.bases[:, 1].copy(),
-                np.ascontiguousarray(self.rows, dtype=np.int64),
-                np.ascontiguousarray(self.den_rows, dtype=np.int64))
+    def _terms(self) -> "RationalTerms":
+        return RationalTerms(self.bases[:, 0].copy(), self.bases[:, 1].copy(),
+                             np.ascontiguousarray(self.rows, dtype=np.int64),
+                             np.ascontiguousarray(self.den_rows, dtype=np.int64))
 
     def _run(self, u, y, lo: float, hi: float) -> int:
         why = np.zeros(1, dtype=np.int64)
-        at = _simulate_kernel(*self._kernel_args(), self.theta, u, y, self.max_lag, lo, hi,
-                              DEN_FLOOR, np.empty(len(self.bases)), why)
+        at = _simulate_kernel(self._terms(), self.theta, u, y, self.max_lag,
+                              (float(lo), float(hi), DEN_FLOOR), np.empty(len(self.bases)), why)
         self._why = int(why[0])
         return at
 
@@ -261,12 +283,10 @@ class RationalNARXModel(NARXModel):
         lo, hi = self._limits()
         J = np.empty((len(u), len(theta)))
         nb = len(self.bases)
-        why = np.zeros(1, dtype=np.int64)
-        at = _sensitivity_kernel(*self._kernel_args(),
-                                 np.ascontiguousarray(theta, dtype=np.float64), u, y,
-                                 self.max_lag, lo, hi, DEN_FLOOR, J, np.empty(nb), np.empty(nb),
-                                 np.empty(nb), why)
-        self._why = int(why[0])
+        work = RationalWork(np.empty(nb), np.empty(nb), np.empty(nb), np.zeros(1, dtype=np.int64))
+        at = _sensitivity_kernel(self._terms(), np.ascontiguousarray(theta, dtype=np.float64),
+                                 u, y, self.max_lag, (float(lo), float(hi), DEN_FLOOR), J, work)
+        self._why = int(work.why[0])
         return at, J
 
     def _stop_message(self, at: int) -> str:
@@ -315,18 +335,21 @@ class RationalNARXModel(NARXModel):
 
     def to_dict(self) -> dict:
         doc = super().to_dict()
-        doc.update(version=RATIONAL_VERSION, basis="rational", den_degree=self.den_degree,
+        doc.update(schema=SCHEMA, version=VERSION, basis="rational", den_degree=self.den_degree,
                    den_rows=self.den_rows.tolist(), numerator_terms=self.numerator_terms,
                    denominator_terms=self.denominator_terms)
         return doc
 
 
-def load_rational(p, doc: dict) -> RationalNARXModel:
-    """The rational model of a version-2 NARX model file's document ``doc`` (read from ``p``)."""
+def load_rational_narx(path) -> RationalNARXModel:
+    """Read a model written by :meth:`RationalNARXModel.save`; any other schema is refused."""
+    p = Path(path)
+    doc = read_family_document(p, SCHEMA, VERSION, family="rational-narx",
+                               writer="RationalNARXModel.save or `gripkit identify narx "
+                                      "--basis rational --out`")
     if doc.get("basis") != "rational":
-        raise ModelError(f"{str(p)!r}: a {SCHEMA} of version {RATIONAL_VERSION} must have basis "
-                         f"'rational', found {doc.get('basis')!r}; write it again with "
-                         "NARXModel.save")
+        raise ModelError(f"{str(p)!r}: a {SCHEMA} must have basis 'rational', found "
+                         f"{doc.get('basis')!r}; write it again with RationalNARXModel.save")
     try:
         fields = _model_fields(doc)
         dd = int(doc["den_degree"])
@@ -334,12 +357,12 @@ def load_rational(p, doc: dict) -> RationalNARXModel:
         m = RationalNARXModel(**fields, den_degree=dd, den_rows=den_rows)
     except (KeyError, TypeError, ValueError) as exc:
         raise ModelError(f"{str(p)!r}: a malformed rational {SCHEMA} ({type(exc).__name__}: "
-                         f"{exc}); write it again with NARXModel.save") from None
+                         f"{exc}); write it again with RationalNARXModel.save") from None
     if (len(m.rows) + len(den_rows) != len(m.theta) or (m.rows >= len(m.bases)).any()
             or (den_rows >= len(m.bases)).any()):
         raise ModelError(f"{str(p)!r}: {len(m.rows)} numerator and {len(den_rows)} denominator "
                          f"terms but {len(m.theta)} parameters, or a term naming a missing lagged "
-                         "signal; write it again with NARXModel.save")
+                         "signal; write it again with RationalNARXModel.save")
     return m
 
 
@@ -394,29 +417,16 @@ def rational_narx(records, *, ylags: int, ulags: int, degree: int, den_degree, d
     by :func:`gripkit.sysid.narx` with ``basis="rational"``, whose arguments these are."""
     say = status if progress else (lambda message: None)
     dd = degree if den_degree is None else _positive_int(den_degree, "den_degree")
-    ly, lu = ylags, ulags
-    bases, rows = candidate_terms(ly, lu, degree, direct)
-    drows = candidate_terms(ly, lu, dd, direct)[1][1:]        # D's constant is fixed to 1
-    M, L = len(rows), len(drows)
-    start = max(ly, lu, 1)
-    total = sum(len(yr) - start for _, yr in records)
-    if total < 2 * (M + L):
-        raise DataError(f"narx: {total} regression rows for {M} numerator and {L} denominator "
-                        f"candidate terms; need at least {2 * (M + L)}: lower degree, den_degree "
-                        "or lags, or give more data")
-    Pn, target = _regression_matrix(bases, rows, records, start)
-    Q = np.concatenate([_regressors(bases, drows, ur, yr, start) for ur, yr in records])
-    n = len(target)
-    X = np.empty((n, M + L), order="F")
-    X[:, :M] = Pn
-    np.multiply(Q, -target[:, None], out=X[:, M:])            # the columns −y(t) q_j(φ)
+    ly, lu, start = ylags, ulags, max(ylags, ulags, 1)
+    bases, rows, drows, Pn, Q, X, target = _linear_form(records, ly, lu, (degree, dd), direct,
+                                                        start)
+    M, L, n = len(rows), len(drows), len(target)
     val = _validation_records(validate, start)
     kmax = _max_terms(terms, M + L)
     say(f"narx: FROLS over {M} numerator and {L} denominator candidates, {n} rows")
     reg = _Regression(X, target)
     QQ, Q1 = Q.T @ Q, Q.sum(axis=0)
-    yall = np.concatenate([r[1] for r in records])
-    y_range = (float(yall.min()), float(yall.max()))
+    y_range = (min(float(r[1].min()) for r in records), max(float(r[1].max()) for r in records))
     names = ([f"num: {_term_name(r, bases)}" for r in rows]
              + [f"den: {_term_name(r, bases)}" for r in drows])
     prune_pe = prune and refine is None
@@ -442,29 +452,10 @@ def rational_narx(records, *, ylags: int, ulags: int, degree: int, den_degree, d
         dc = [c - M for c in cols if c >= M]
         theta = np.concatenate([theta_ls[[i for i, c in enumerate(cols) if c < M]],
                                 theta_ls[[i for i, c in enumerate(cols) if c >= M]]])
-        iters, dropped, last = 0, 0, None
-        while True:
-            res = _prediction_refine(theta, Pn[:, nc], Q[:, dc], target, max_iter)
-            if res[0] is None:
-                if last is None:
-                    return None, res[1], res[2], 0
-                break          # without the term dropped last D crosses zero: keep it, stop
-            last = (list(nc), list(dc), *res, dropped)
-            theta, cov, _, it = res
-            iters += it
-            if not (prune_pe and prune_now) or len(theta) == 1:
-                break
-            std = np.sqrt(np.maximum(np.diag(cov), 0.0))
-            t = np.abs(theta) / np.where(std > 0, std, np.inf)
-            w = int(np.argmin(t))
-            if not t[w] < 2.0:
-                break
-            if w < len(nc):
-                del nc[w]
-            else:
-                del dc[w - len(nc)]
-            theta = np.delete(theta, w)
-            dropped += 1
+        last, iters = _refine_pruning(theta, nc, dc, (Pn, Q, target), max_iter,
+                                      prune_pe and prune_now)
+        if last[0] is None:
+            return last
         nc, dc, theta, cov, cost, _, dropped = last
         mod = RationalNARXModel(
             ylags=ly, ulags=lu, degree=degree, direct=direct, bases=bases, rows=rows[nc],
@@ -474,25 +465,11 @@ def rational_narx(records, *, ylags: int, ulags: int, degree: int, den_degree, d
         return mod, cost, iters, dropped
 
     def bic_terms():
-        """The number of FROLS terms whose one-step-error model (unpruned) has the lowest
-        ``BIC = N ln(SSE/N) + k ln N``, the search stopped :data:`BIC_PATIENCE` numbers past
-        the best → (k, its model's SSE), or (None, None) when every start's D crosses zero."""
-        best, since = None, 0
-        for k in range(1, len(order) + 1):
-            cand = build(k, prune_now=False)
-            since += 1
-            if cand[0] is not None:
-                b = n * np.log(max(cand[1], 1e-300) / n) + k * np.log(n)
-                if best is None or b < best[0]:
-                    best, since = (b, k, cand[1]), 0
-            if since >= BIC_PATIENCE:
-                break
-        return (None, None) if best is None else best[1:]
+        return _bic_terms(build, len(order), n)
 
-    # extended least squares (Billings & Zhu 1991): the columns −y(t) q_j hold −e(t) q_j, which
-    # adds σ² QᵀQ to their Gram block and −σ² Qᵀ1 to their product with y; FROLS and the least
-    # squares are run again with that share removed, σ² from the last model's one-step error,
-    # until the terms chosen repeat (at most PASSES times)
+    # extended least squares (Billings & Zhu 1991): the columns −y q_j hold −e q_j (σ² QᵀQ in
+    # their Gram block, −σ² Qᵀ1 in their product with y); FROLS and least squares run again with
+    # that removed, σ² from the last one-step error, until the terms repeat (≤ PASSES times)
     s2, passes, chosen, k_bic = 0.0, 0, None, None
     for passes in range(1, PASSES + 1):
         G, g, order, errs, sse = select(s2)
@@ -518,45 +495,144 @@ def rational_narx(records, *, ylags: int, ulags: int, degree: int, den_degree, d
         k = len(order) if k is None else k
         how = f"BIC of the one-step error y − N/D minimal at {k} FROLS terms, {els}"
     else:
-        best = None
-        for j in track(range(1, len(order) + 1), description="narx: validation free runs",
-                       enabled=progress):
-            cand = build(j)
-            if cand[0] is None:
-                continue
-            f = _fit_records(cand[0], val, warn=False)
-            if f is not None and (best is None or f > best[0] + 1e-9):
-                best = (f, j)
+        best = _validation_best(build, len(order), val, progress)
         k = len(order) if best is None else best[1]
         how = ("validation fit (every candidate diverged)" if best is None else
                f"validation free-run fit best at {k} FROLS terms") + f", {els}"
-    model, *rest = build(k)
+    model = _final_model(build(k), k, how)
+    model.prediction_fit_percent = _fit(target, target - _residual(model, rows, drows, Pn, Q,
+                                                                   target))
+    if refine == "simulation":
+        say(f"narx: refining {len(model.theta)} parameters on the free-run error")
+        model = _refined_on_free_run(model, records, (rows, drows, Pn, Q, target), prune,
+                                     max_iter, val)
+    model.fit_percent = _fit_records(model, records)
+    if val is not None:
+        model.validation_fit_percent = _fit_records(model, val)
+    return model
+
+
+def _linear_form(records, ly: int, lu: int, degrees, direct: bool, start: int):
+    """The candidates and the regression of the linear form ``y·D = N``: the bases, the
+    numerator's and the denominator's candidate terms (``degrees``: theirs; D's constant fixed
+    to 1), the numerator regressors ``Pn``, the denominator monomials ``Q``, ``X = [Pn, −y·Q]``
+    and the target y, over every record's rows from ``start`` on; a DataError when there are
+    fewer than twice as many rows as candidates."""
+    bases, rows = candidate_terms(ly, lu, degrees[0], direct)
+    drows = candidate_terms(ly, lu, degrees[1], direct)[1][1:]
+    M, L = len(rows), len(drows)
+    total = sum(len(yr) - start for _, yr in records)
+    if total < 2 * (M + L):
+        raise DataError(f"narx: {total} regression rows for {M} numerator and {L} denominator "
+                        f"candidate terms; need at least {2 * (M + L)}: lower degree, den_degree "
+                        "or lags, or give more data")
+    Pn, target = _regression_matrix(bases, rows, records, start)
+    Q = np.concatenate([_regressors(bases, drows, ur, yr, start) for ur, yr in records])
+    X = np.empty((len(target), M + L), order="F")
+    X[:, :M] = Pn
+    np.multiply(Q, -target[:, None], out=X[:, M:])            # the columns −y(t) q_j(φ)
+    return bases, rows, drows, Pn, Q, X, target
+
+
+def _refined_on_free_run(model, records, problem, prune: bool, max_iter: int, val):
+    """``model`` refined on the free-run error (:func:`~.narx._refine_and_prune`, its one-step
+    fit from ``problem`` = (numerator terms, denominator terms, Pn, Q, target)); with the
+    validation records ``val`` the one-step model instead when it validates better."""
+    rows, drows, Pn, Q, target = problem
+    one_step = dataclasses.replace(model)
+
+    def one_step_fit(m):
+        return _fit(target, target - _residual(m, rows, drows, Pn, Q, target))
+
+    _refine_and_prune(model, records, None, None, None, prune, max_iter, one_step_fit)
+    if val is not None and "not refined" not in model.criterion:
+        model = _better_on_validation(model, one_step, val)
+    return model
+
+
+def _refine_pruning(theta, nc, dc, problem, max_iter: int, prune: bool):
+    """θ of the numerator terms ``nc`` and denominator terms ``dc`` refined on the one-step
+    error (:func:`_prediction_refine`; ``problem``: the numerator and denominator regressors and
+    the target), then with ``prune`` the weakest term with |θ|/σ < 2 dropped and θ refined
+    again, one at a time → ((terms, θ, cov, cost, iterations, terms pruned), total iterations),
+    or ((None, row, min D, 0), 0) when the start's denominator crosses zero on the estimation
+    rows. A term whose removal makes D cross zero stays, and the pruning stops there."""
+    Pn, Q, target = problem
+    nc, dc = list(nc), list(dc)
+    iters, dropped, last = 0, 0, None
+    while True:
+        res = _prediction_refine(theta, Pn[:, nc], Q[:, dc], target, max_iter)
+        if res[0] is None:
+            if last is None:
+                return (None, res[1], res[2], 0), 0
+            break          # without the term dropped last D crosses zero: keep it, stop
+        last = (list(nc), list(dc), *res, dropped)
+        theta, cov, _, it = res
+        iters += it
+        if not prune or len(theta) == 1:
+            break
+        std = np.sqrt(np.maximum(np.diag(cov), 0.0))
+        t = np.abs(theta) / np.where(std > 0, std, np.inf)
+        w = int(np.argmin(t))
+        if not t[w] < 2.0:
+            break
+        if w < len(nc):
+            del nc[w]
+        else:
+            del dc[w - len(nc)]
+        theta = np.delete(theta, w)
+        dropped += 1
+    return last, iters
+
+
+def _bic_terms(build, n_order: int, n: int):
+    """The number of FROLS terms whose one-step-error model (``build(k, prune_now=False)``,
+    unpruned) has the lowest ``BIC = N ln(SSE/N) + k ln N``, the search stopped
+    :data:`BIC_PATIENCE` numbers past the best → (k, its model's SSE), or (None, None) when every
+    start's D crosses zero."""
+    best, since = None, 0
+    for k in range(1, n_order + 1):
+        cand = build(k, prune_now=False)
+        since += 1
+        if cand[0] is not None:
+            b = n * np.log(max(cand[1], 1e-300) / n) + k * np.log(n)
+            if best is None or b < best[0]:
+                best, since = (b, k, cand[1]), 0
+        if since >= BIC_PATIENCE:
+            break
+    return (None, None) if best is None else best[1:]
+
+
+def _validation_best(build, n_order: int, val, progress: bool):
+    """(free-run validation fit, k) of the best of the models of the first k FROLS terms, None
+    when every one diverges or its denominator crosses zero."""
+    best = None
+    for j in track(range(1, n_order + 1), description="narx: validation free runs",
+                   enabled=progress):
+        cand = build(j)
+        if cand[0] is None:
+            continue
+        f = _fit_records(cand[0], val, warn=False)
+        if f is not None and (best is None or f > best[0] + 1e-9):
+            best = (f, j)
+    return best
+
+
+def _final_model(built, k: int, how: str) -> RationalNARXModel:
+    """The chosen model of ``build(k)`` with its criterion, or the named error when its
+    least-squares start's denominator crosses zero on the estimation data."""
+    model, *rest = built
     if model is None:
         raise IdentificationError(
             f"narx: the rational model's least-squares start of {k} FROLS terms has a "
             f"denominator D that crosses zero on the estimation data (D = {rest[1]:.3g} at "
             f"regression row {rest[0]}); θ is undefined there",
             hint="give fewer terms, a lower den_degree, or basis='polynomial'")
-    cost, iters, dropped = rest
+    _, iters, dropped = rest
     model.criterion = (how + "; θ refined on the one-step prediction error y − N/D "
                        f"(Levenberg–Marquardt, {iters} iterations, σ from its Gauss–Newton "
                        "Hessian" + (f", {dropped} term(s) with |θ|/σ < 2 pruned one by one)"
                                     if dropped else ")"))
-    model.prediction_fit_percent = _fit(target, target - _residual(model, rows, drows, Pn, Q,
-                                                                   target))
-    if refine == "simulation":
-        say(f"narx: refining {len(model.theta)} parameters on the free-run error")
-        one_step = dataclasses.replace(model)
-
-        def one_step_fit(m):
-            return _fit(target, target - _residual(m, rows, drows, Pn, Q, target))
-
-        _refine_and_prune(model, records, None, None, None, prune, max_iter, one_step_fit)
-        if val is not None and "not refined" not in model.criterion:
-            model = _better_on_validation(model, one_step, val)
-    model.fit_percent = _fit_records(model, records)
-    if val is not None:
-        model.validation_fit_percent = _fit_records(model, val)
     return model
 
 
