@@ -86,3 +86,37 @@ def levenberg_marquardt(theta: np.ndarray, cost: float, *,
         if converged(old, cost):
             break
     return theta, cost, it
+
+
+def fit_residuals(run: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray] | None],
+                  theta: np.ndarray, *, tol: float, max_iter: int,
+                  damping: Damping = Damping()) -> tuple | None:
+    """:func:`levenberg_marquardt` on a residual function: ``run(θ)`` gives ``(e, J)``, the
+    residual ``e = y − ŷ(θ)`` and ``J = ∂ŷ/∂θ``, or None where θ is refused (a diverging run, a
+    denominator through zero). From ``theta`` until a step lowers ``e·e`` by at most ``tol``
+    of it → ``(θ, cov θ, e·e, iterations)`` with ``cov θ = σ² (JᵀJ)⁻¹`` at the optimum (the
+    Gauss–Newton Hessian, a column-scaled pseudo-inverse), ``σ² = e·e/(N − k)``; None when
+    ``run(theta)`` is None."""
+    cur = run(theta)
+    if cur is None:
+        return None
+    e, J = cur
+    tried = []
+
+    def trial(th):
+        tried[:] = [run(th)]
+        return None if tried[0] is None else float(tried[0][0] @ tried[0][0])
+
+    def accept(th):
+        nonlocal e, J
+        e, J = tried[0]
+
+    theta, cost, it = levenberg_marquardt(
+        theta.copy(), float(e @ e), normal_equations=lambda: (J.T @ J, J.T @ e), trial=trial,
+        accept=accept, converged=lambda old, new: old - new <= tol * old, max_iter=max_iter,
+        damping=damping)
+    n, k = J.shape
+    A = J.T @ J
+    d = np.sqrt(np.maximum(np.diag(A), 1e-300))
+    cov = cost / max(n - k, 1) * np.linalg.pinv(A / np.outer(d, d)) / np.outer(d, d)
+    return theta, cov, cost, it

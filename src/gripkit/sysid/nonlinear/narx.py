@@ -55,7 +55,7 @@ from ...params import Parameter, ParameterSet
 from ...signals.trajectory import Trajectory
 from ..model_file import FamilyFile, read_family_document
 from ..model_protocol import ModelFit
-from .levenberg_marquardt import Damping, levenberg_marquardt
+from .levenberg_marquardt import Damping, fit_residuals
 from .single_channel import (DIVERGENCE_FACTOR, FreeRunModel, fit_percent, not_constant,
                              one_signal)
 from ...progress import status, track
@@ -700,28 +700,10 @@ def _refine_simulation(model: NARXModel, records, max_iter: int, tol: float = 1e
             Js.append(J[m:])
         return np.concatenate(es), np.concatenate(Js)
 
-    cur = run(model.theta)
-    if cur is None:
+    res = fit_residuals(run, model.theta, tol=tol, max_iter=max_iter, damping=_DAMPING)
+    if res is None:
         return None
-    e, J = cur
-    tried = []
-
-    def trial(theta):
-        tried[:] = [run(theta)]
-        return None if tried[0] is None else float(tried[0][0] @ tried[0][0])
-
-    def accept(theta):
-        nonlocal e, J
-        e, J = tried[0]
-
-    theta, cost, it = levenberg_marquardt(
-        model.theta.copy(), float(e @ e), normal_equations=lambda: (J.T @ J, J.T @ e),
-        trial=trial, accept=accept, converged=lambda old, new: old - new <= tol * old,
-        max_iter=max_iter, damping=_DAMPING)
-    n, k = J.shape
-    A = J.T @ J
-    d = np.sqrt(np.maximum(np.diag(A), 1e-300))
-    cov = cost / max(n - k, 1) * np.linalg.pinv(A / np.outer(d, d)) / np.outer(d, d)
+    theta, cov, _, it = res
     model.theta = theta
     model.covariance = cov
     model.theta_std = np.sqrt(np.maximum(np.diag(cov), 0.0))

@@ -52,7 +52,7 @@ from ...params import Parameter, ParameterSet
 from ...progress import status, track
 from ...signals.trajectory import Trajectory
 from ..model_file import read_family_document
-from .levenberg_marquardt import levenberg_marquardt
+from .levenberg_marquardt import fit_residuals
 from .narx import (_DAMPING, NARX_FIT, NARXModel, _as_signal,
                    _better_on_validation, _fit, _fit_records, _frols_gram, _max_terms,
                    _model_fields, _positive_int, _Regression, _refine_and_prune,
@@ -384,30 +384,11 @@ def _prediction_refine(theta, A, B, target, max_iter: int, tol: float = 1e-10):
         J[:, nn:] = B * (-(yh / D))[:, None]
         return target - yh, J
 
-    cur = run(theta)
-    if cur is None:
+    res = fit_residuals(run, theta, tol=tol, max_iter=max_iter, damping=_DAMPING)
+    if res is None:
         D = 1.0 + B @ theta[nn:]
         return None, int(np.argmin(D)), float(np.min(D))
-    e, J = cur
-    tried = []
-
-    def trial(th):
-        tried[:] = [run(th)]
-        return None if tried[0] is None else float(tried[0][0] @ tried[0][0])
-
-    def accept(th):
-        nonlocal e, J
-        e, J = tried[0]
-
-    theta, cost, it = levenberg_marquardt(
-        theta.copy(), float(e @ e), normal_equations=lambda: (J.T @ J, J.T @ e), trial=trial,
-        accept=accept, converged=lambda old, new: old - new <= tol * old, max_iter=max_iter,
-        damping=_DAMPING)
-    n, k = J.shape
-    H = J.T @ J
-    d = np.sqrt(np.maximum(np.diag(H), 1e-300))
-    cov = cost / max(n - k, 1) * np.linalg.pinv(H / np.outer(d, d)) / np.outer(d, d)
-    return theta, cov, cost, it
+    return res
 
 
 def rational_narx(records, *, ylags: int, ulags: int, degree: int, den_degree, direct: bool,
