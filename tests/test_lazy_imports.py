@@ -39,8 +39,8 @@ LAZY_MODULES = {
     ("sysid/linear/arx.py", ".lagged_sums"): "numba kernels: a small ARX is solved by QR without "
                                              "loading numba (0.45 s)",
     ("sysid/identify.py", ".linear.rls"): "numba (0.4 s): `gripkit identify arx` does not load it",
-    ("sysid/identify.py", ".nonlinear.narx_entry"): "numba kernels: a nonlinear family's module loads "
-                                               "with its first fit",
+    ("sysid/identify.py", ".nonlinear.narx_entry"):
+        "numba kernels: a nonlinear family's module loads with its first fit",
     ("sysid/identify.py", ".nonlinear.hammerstein_wiener"): "as the line above",
     ("sysid/identify.py", ".nonlinear.hysteresis"): "as the line above",
     ("sysid/identify.py", ".nonlinear.nlss"): "as the line above",

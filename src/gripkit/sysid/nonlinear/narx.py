@@ -540,6 +540,11 @@ class NARXModel(FreeRunModel, FamilyFile):
         if len(u) != len(y):
             raise DataError(f"narx.predict: u has {len(u)} samples but y has {len(y)}; pass a pair "
                             "of equal length")
+        return self._one_step(u, y)
+
+    def _one_step(self, u: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """``Σ θ_k terms_k(t)`` on checked measured signals, the first ``max_lag`` samples the
+        measured ones."""
         m = self.max_lag
         P = _regressors(self.bases, self.rows, u, y, m)
         return np.concatenate([y[:m], P @ self.theta])

@@ -40,24 +40,20 @@ from __future__ import annotations
 import dataclasses
 from collections import namedtuple
 from dataclasses import dataclass, field
-
 from pathlib import Path
 
 import numpy as np
 from numba import njit
 
-from ...errors import (ArgumentError, DataError, IdentificationError, ModelError,
-                       StabilityWarning, emit_warning)
+from ...errors import DataError, IdentificationError, ModelError, StabilityWarning, emit_warning
 from ...params import Parameter, ParameterSet
 from ...progress import status, track
-from ...signals.trajectory import Trajectory
 from ..model_file import read_family_document
 from .levenberg_marquardt import fit_residuals
-from .narx import (_DAMPING, NARX_FIT, NARXModel, _as_signal,
-                   _better_on_validation, _fit, _fit_records, _frols_gram, _max_terms,
-                   _model_fields, _positive_int, _Regression, _refine_and_prune,
-                   _regression_matrix, _regressors, _row_index, _term_name, _validation_records,
-                   candidate_terms, narx_output)
+from .narx import (_DAMPING, NARX_FIT, NARXModel, _better_on_validation, _fit, _fit_records,
+                   _frols_gram, _max_terms, _model_fields, _positive_int, _Regression,
+                   _refine_and_prune, _regression_matrix, _regressors, _row_index, _term_name,
+                   _validation_records, candidate_terms, narx_output)
 from .single_channel import DIVERGENCE_FACTOR
 
 __all__ = ["RationalNARXModel", "rational_narx", "rational_output", "load_rational_narx",
@@ -297,18 +293,9 @@ class RationalNARXModel(NARXModel):
         return (f"narx: the free run diverges at sample {at} (beyond {DIVERGENCE_FACTOR:g}× the "
                 "estimation output's range); the model is unstable on this input")
 
-    def predict(self, data, y=None, horizon: int = 1) -> np.ndarray:
-        """One-step-ahead prediction ``N/D`` on measured ``u`` and ``y`` (as
-        :meth:`NARXModel.predict`); NaN, with a StabilityWarning, where D ≤ :data:`DEN_FLOOR`."""
-        if horizon != 1:
-            raise ArgumentError(f"narx.predict: horizon must be 1 for a NARX model, found "
-                                f"{horizon!r}", hint="simulate(u, y0) runs the model freely")
-        if isinstance(data, Trajectory):
-            return self.predict(*self._signals(data, y, "predict")).reshape(-1, 1)
-        u, y = _as_signal(data, "u"), _as_signal(y, "y")
-        if len(u) != len(y):
-            raise DataError(f"narx.predict: u has {len(u)} samples but y has {len(y)}; pass a pair "
-                            "of equal length")
+    def _one_step(self, u: np.ndarray, y: np.ndarray) -> np.ndarray:
+        """The one-step prediction ``N/D`` on checked measured signals (:meth:`NARXModel.predict`);
+        NaN, with a StabilityWarning, where D ≤ :data:`DEN_FLOOR`."""
         m, nn = self.max_lag, len(self.rows)
         num = _regressors(self.bases, self.rows, u, y, m) @ self.theta[:nn]
         den = 1.0 + _regressors(self.bases, self.den_rows, u, y, m) @ self.theta[nn:]
