@@ -29,8 +29,9 @@ from .stiffness_study import table_iii_study
 from .tip_position import TipPositionEstimator
 
 
-def _consistency(report, z, summary):
-    sec = report.section(
+#: each section of the report: its title and its prose (the code below fills in the numbers)
+SECTIONS = {
+    "consistency": (
         "TSFM: the printed parameters and their contradictions",
         "Table II (p. 7) identifies both fingers; §IV-B measured the force sensor's free "
         "vibration at 8.52 kHz with ζ = 0.006. The two disagree: Table II's k_s = 128 N/m and "
@@ -40,7 +41,81 @@ def _consistency(report, z, summary):
         "a2 with b_s where the derivation gives k_s (a unit error), and the left sensor's "
         "sensitivity (6e-3 V/µN) disagrees with §IV-B's 200 µN/V. The lengths L_r, L_a are not "
         "in the seed: L_a = 15 mm, L_r = 7 mm, L_s = 1 mm are assumed (L = 8 mm puts the tip C "
-        "at 62.4 µm at 44 V, where Fig. 13 / §V-C locate the contact: 62.42 µm).")
+        "at 62.4 µm at 44 V, where Fig. 13 / §V-C locate the contact: 62.42 µm)."),
+    "loops": (
+        "Hysteresis loops at 0.1 Hz (Fig. 9b)",
+        "The tip B of each finger (laser, 20 nm resolution) under 100, 60 and 30 V sines at 0.1 "
+        "Hz, one after the other, simulated at 20 kHz with the whole-finger model (Bouc-Wen eq "
+        "3, D(s), lever, sensor) and kept at 2 kHz. Bouc-Wen's loop is rate independent; at 0.1 "
+        "Hz D(s) adds only its lag b."),
+    "identify": (
+        "Identification back from simulated measurements (§IV)",
+        "Each finger identified as in §IV from noisy simulated records: Bouc-Wen from the 100 V "
+        "external loop (Fig. 9), D(s) from a 50 V step at B (Fig. 10), Bouc-Wen again with the "
+        "lag b + dt/2 of D(s) and the DAC (the lag otherwise biases γ by ~2 %), s_p from a "
+        "force ramp on the tip B (FemtoTools probe, 0.4 µN, eq 15), f0 and ζ of the sensor from "
+        "its free vibration (Fig. 8, 1 % noise) and m_s, b_s from them with k_s from the sensor "
+        "calibration; a and b refined last through the whole-finger model. The point-B values "
+        "are converted to the tip A with the (assumed) lengths. Validation: Fig. 9b's maximal "
+        "error relative to each loop's peak-to-peak (< 5 % external, < 10 % internal in the "
+        "seed)."),
+    "sines": (
+        "Sine responses at 10, 50, 100 and 500 Hz (Fig. 12)",
+        "100 V sines on the left finger, tip B: the 'measurement' (true model, 20 nm noise) "
+        "against the identified model. The loops open with frequency: D(s)'s phase lag adds to "
+        "the static hysteresis (rate-dependent hysteresis = static Bouc-Wen followed by D(s), "
+        "eq 2)."),
+    "contact": (
+        "The contact experiment of Fig. 13",
+        "The left finger driven by U = 25 (1 − cos 2π 0.1 t) V (0 → 50 → 0 V) against a part "
+        "(72.5 N/m) whose face stands where the tip C is at 44 V: the finger moves freely, "
+        "touches at 44 V, presses until 50 V, and separates on the way down. The tip position "
+        "is estimated by eq 11 (identified model, streaming, 20 kHz) from the voltage and the "
+        "force the sensor measures (2 µN noise); the contact is detected at 5 µN (§V-C). What "
+        "is reproduced and what is put in: the contact at 44 V and the tip at 62.42 µm are "
+        "produced by construction, not predicted — the part face is placed where the tip is at "
+        "44 V (the seed gives no part position) and the assumed L_r = 7 mm was chosen to put "
+        "the tip there at 62.4 µm (the seed gives no lengths); neither can be derived from the "
+        "seed independently. The separation voltage is a prediction: Table II's hysteresis "
+        "alone gives 36.4 V against the seed's 35 V (finding fig13-separation-voltage, with the "
+        "adhesion that would explain the difference). The same assumed lever puts the tip at "
+        "151 µm at 100 V, the amplitude of Figs 9 and 12, beyond Table I's 100 µm stroke "
+        "(finding stroke-100V): gripkit's simulations warn beyond the stroke and clip the "
+        "sensor reading at its 2 mN range (gripkit.systems.tsfm.gripper.RANGES)."),
+    "microparts": (
+        "Table III reproduced: micropart stiffness by the seed's protocol (§IV, §V-C, §V-D, eq 16)",
+        "The whole protocol on simulated experiments, the truth being Table II's fingers and "
+        'Table III\'s "Measured" stiffnesses '
+        "(gripkit.systems.tsfm.stiffness_study.table_iii_study): both fingers identified as in "
+        "§IV with the noise the seed states (laser 20 nm, FemtoTools reference 0.4 µN, NanoCube "
+        "1 nm; k_s calibrated against the reference); each part (300 µm, 30 µm off-centre in "
+        "the 400 µm gap, 20 µN substrate friction) grasped in closed loop — the estimators use "
+        "the identified fingers, the first finger to touch holds until the other touches, both "
+        "squeeze to 200 µN, 2 µN force noise per sensor (§V-C); k̂ = F_g/δ (eq 16) as the slope "
+        "of the loading line (tips re-estimated by eq 11 from the 100 Hz low-passed force, 10 "
+        "ms blocks, instrumental variables against the closed-loop bias). σ = √(σ²_noise + "
+        "σ²_model): the regression's, and the identified parameters' covariance propagated "
+        "through the estimator. The study recovers the simulated truth, not the seed's "
+        '"Estimated" column: the seed\'s errors are 16-120σ beyond what its stated noise '
+        "explains, and no fixed calibration error reproduces them. A stiff part is where a "
+        "sensor-stiffness calibration error shows (∂ln k̂/∂ln k_s = −k (1/k_s,1 + 1/k_s,2)), "
+        "but a single k_s error would need 17.7, 1.8 and 0.69 % for the three parts; any fixed "
+        "scale error of gain, compliance, k_s or force sensitivity gives an error monotonic in "
+        "k, while the printed −3.31, −2.00, −5.00 % rise then fall (finding "
+        "table-iii-calibration-pattern). gripkit found no protocol that reproduces the printed "
+        "errors; 71.05 and 445.55 are exactly 72.5 × 0.98 and 469 × 0.95, as if the estimates "
+        "were derived from rounded errors."),
+    "strategy": (
+        "The two-finger grasp of §I: hold the first contact, or push the part away",
+        "The same 72.5 N/m part, 30 µm off-centre, with the naive strategy (both fingers keep "
+        "closing until both touch): the first finger pushes the part along the substrate (20 µN "
+        "friction) for tens of µm — at the microscale, where adhesion and inertia are tiny, the "
+        "part is lost or misplaced. The §I strategy stops the finger that touches first."),
+}
+
+
+def _consistency(report, z, summary):
+    sec = report.section(*SECTIONS["consistency"])
     for side in ("left", "right"):
         rep = check(z.finger(side, check=False))
         sec.findings(rep)
@@ -58,12 +133,7 @@ def _consistency(report, z, summary):
 
 def _loops(report, z, fingers, summary, quick):
     amps = (100.0, 60.0, 30.0)
-    sec = report.section(
-        "Hysteresis loops at 0.1 Hz (Fig. 9b)",
-        "The tip B of each finger (laser, 20 nm resolution) under 100, 60 and 30 V sines at 0.1 "
-        "Hz, one after the other, simulated at 20 kHz with the whole-finger model (Bouc-Wen eq "
-        "3, D(s), lever, sensor) and kept at 2 kHz. Bouc-Wen's loop is rate independent; at 0.1 "
-        "Hz D(s) adds only its lag b.")
+    sec = report.section(*SECTIONS["loops"])
     data = ({side: z.hysteresis_experiment(fingers[side], amps,
                                            seed=10 + i) for i, side in enumerate(fingers)})
     fig, axes = subplots(1, 2, figsize=(11, 4.2))
@@ -81,17 +151,7 @@ def _loops(report, z, fingers, summary, quick):
 
 
 def _identify(report, z, fingers, loops, summary, quick):
-    sec = report.section(
-        "Identification back from simulated measurements (§IV)",
-        "Each finger identified as in §IV from noisy simulated records: Bouc-Wen from the 100 V "
-        "external loop (Fig. 9), D(s) from a 50 V step at B (Fig. 10), Bouc-Wen again with the "
-        "lag b + dt/2 of D(s) and the DAC (the lag otherwise biases γ by ~2 %), s_p from a "
-        "force ramp on the tip B (FemtoTools probe, 0.4 µN, eq 15), f0 and ζ of the sensor from "
-        "its free vibration (Fig. 8, 1 % noise) and m_s, b_s from them with k_s from the sensor "
-        "calibration; a and b refined last through the whole-finger model. The point-B values "
-        "are converted to the tip A with the (assumed) lengths. Validation: Fig. 9b's maximal "
-        "error relative to each loop's peak-to-peak (< 5 % external, < 10 % internal in the "
-        "seed).")
+    sec = report.section(*SECTIONS["identify"])
     rows, ident, val_rows = [], {}, []
     for i, (side, f) in enumerate(fingers.items()):
         tr = loops[side]
@@ -165,12 +225,7 @@ def _identify(report, z, fingers, loops, summary, quick):
 
 
 def _sines(report, z, fingers, ident, summary, quick):
-    sec = report.section(
-        "Sine responses at 10, 50, 100 and 500 Hz (Fig. 12)",
-        "100 V sines on the left finger, tip B: the 'measurement' (true model, 20 nm noise) "
-        "against the identified model. The loops open with frequency: D(s)'s phase lag adds to "
-        "the static hysteresis (rate-dependent hysteresis = static Bouc-Wen followed by D(s), "
-        "eq 2).")
+    sec = report.section(*SECTIONS["sines"])
     f, fi = fingers["left"], ident["left"].finger
     dt = 5e-05  # s (20 kHz)
     rng = np.random.default_rng(50)
@@ -201,23 +256,7 @@ def _sines(report, z, fingers, ident, summary, quick):
 
 
 def _contact(report, z, fingers, ident, summary, quick):
-    sec = report.section(
-        "The contact experiment of Fig. 13",
-        "The left finger driven by U = 25 (1 − cos 2π 0.1 t) V (0 → 50 → 0 V) against a part "
-        "(72.5 N/m) whose face stands where the tip C is at 44 V: the finger moves freely, "
-        "touches at 44 V, presses until 50 V, and separates on the way down. The tip position "
-        "is estimated by eq 11 (identified model, streaming, 20 kHz) from the voltage and the "
-        "force the sensor measures (2 µN noise); the contact is detected at 5 µN (§V-C). What "
-        "is reproduced and what is put in: the contact at 44 V and the tip at 62.42 µm are "
-        "produced by construction, not predicted — the part face is placed where the tip is at "
-        "44 V (the seed gives no part position) and the assumed L_r = 7 mm was chosen to put "
-        "the tip there at 62.4 µm (the seed gives no lengths); neither can be derived from the "
-        "seed independently. The separation voltage is a prediction: Table II's hysteresis "
-        "alone gives 36.4 V against the seed's 35 V (finding fig13-separation-voltage, with the "
-        "adhesion that would explain the difference). The same assumed lever puts the tip at "
-        "151 µm at 100 V, the amplitude of Figs 9 and 12, beyond Table I's 100 µm stroke "
-        "(finding stroke-100V): gripkit's simulations warn beyond the stroke and clip the "
-        "sensor reading at its 2 mN range (gripkit.systems.tsfm.gripper.RANGES).")
+    sec = report.section(*SECTIONS["contact"])
     f = fingers["left"]
     tr = z.contact_experiment(f, 72.5, seed=60)
     est = TipPositionEstimator(ident["left"].finger, tr.dt)
@@ -274,29 +313,7 @@ def _pm(value: float, std: float) -> str:
 
 
 def _microparts(report, z, summary, quick):
-    sec = report.section(
-        "Table III reproduced: micropart stiffness by the seed's protocol (§IV, §V-C, §V-D, eq 16)",
-        "The whole protocol on simulated experiments, the truth being Table II's fingers and "
-        'Table III\'s "Measured" stiffnesses '
-        "(gripkit.systems.tsfm.stiffness_study.table_iii_study): both fingers identified as in "
-        "§IV with the noise the seed states (laser 20 nm, FemtoTools reference 0.4 µN, NanoCube "
-        "1 nm; k_s calibrated against the reference); each part (300 µm, 30 µm off-centre in "
-        "the 400 µm gap, 20 µN substrate friction) grasped in closed loop — the estimators use "
-        "the identified fingers, the first finger to touch holds until the other touches, both "
-        "squeeze to 200 µN, 2 µN force noise per sensor (§V-C); k̂ = F_g/δ (eq 16) as the slope "
-        "of the loading line (tips re-estimated by eq 11 from the 100 Hz low-passed force, 10 "
-        "ms blocks, instrumental variables against the closed-loop bias). σ = √(σ²_noise + "
-        "σ²_model): the regression's, and the identified parameters' covariance propagated "
-        "through the estimator. The study recovers the simulated truth, not the seed's "
-        '"Estimated" column: the seed\'s errors are 16-120σ beyond what its stated noise '
-        "explains, and no fixed calibration error reproduces them. A stiff part is where a "
-        "sensor-stiffness calibration error shows (∂ln k̂/∂ln k_s = −k (1/k_s,1 + 1/k_s,2)), "
-        "but a single k_s error would need 17.7, 1.8 and 0.69 % for the three parts; any fixed "
-        "scale error of gain, compliance, k_s or force sensitivity gives an error monotonic in "
-        "k, while the printed −3.31, −2.00, −5.00 % rise then fall (finding "
-        "table-iii-calibration-pattern). gripkit found no protocol that reproduces the printed "
-        "errors; 71.05 and 445.55 are exactly 72.5 × 0.98 and 469 × 0.95, as if the estimates "
-        "were derived from rounded errors.")
+    sec = report.section(*SECTIONS["microparts"])
     study = table_iii_study(seed=0)
     sec.findings(ConsistencyReport(study.findings + (z.table_iii_pattern_finding(),), "Table III"))
     rows = []
@@ -370,12 +387,7 @@ def _micropart_figure(sec, tr, row):
 
 
 def _strategy(report, z, ident, grasps, summary, quick):
-    sec = report.section(
-        "The two-finger grasp of §I: hold the first contact, or push the part away",
-        "The same 72.5 N/m part, 30 µm off-centre, with the naive strategy (both fingers keep "
-        "closing until both touch): the first finger pushes the part along the substrate (20 µN "
-        "friction) for tens of µm — at the microscale, where adhesion and inertia are tiny, the "
-        "part is lost or misplaced. The §I strategy stops the finger that touches first.")
+    sec = report.section(*SECTIONS["strategy"])
     fi = (ident["left"].finger, ident["right"].finger)
     g = z.gripper(stiffness=72.5, centre=170e-6, check=False)
     naive = simulate_two_finger_grasp(g, estimator_fingers=fi, duration=2.0 if quick else 3.0,
