@@ -1,7 +1,7 @@
 """``gripkit identify hw DATA --input U --output Y [--input-nonlinearity KIND[:N]]
 [--output-nonlinearity KIND[:N]] [--linear oe|ss] [--nb NB --nf NF | --order N] [--nk NK]
-[--validate DATA2] [--out MODEL.json] [--json]``: Hammerstein, Wiener and Hammerstein–Wiener
-models around an output-error (B/F) or a state-space linear block, through
+[--periods P] [--validate DATA2] [--out MODEL.json] [--json]``: Hammerstein, Wiener and
+Hammerstein–Wiener models around an output-error (B/F) or a state-space linear block, through
 ``gripkit.sysid.identify(data, "hw", ...)`` (:func:`gripkit.sysid.hammerstein_wiener`)."""
 
 from __future__ import annotations
@@ -52,6 +52,11 @@ def identify_hw(data: list[Path] = DataArgs,
                                            "observer canonical form, from the subspace estimate)."),
                 order: Optional[int] = typer.Option(
                     None, "--order", help="State dimension of --linear ss (searched: 1, 2, 3)."),
+                periods: Optional[int] = typer.Option(
+                    None, "--periods", help="The record is P (≥ 3) whole periods of a periodic "
+                                            "input: the linear block starts from the fit of its "
+                                            "FRF (best linear approximation, the first period "
+                                            "dropped)."),
                 validate: Optional[Path] = RecordValidateOpt,
                 out: Optional[Path] = ModelJsonOpt,
                 report: Optional[Path] = ModelReportOpt,
@@ -61,19 +66,22 @@ def identify_hw(data: list[Path] = DataArgs,
     block, PEM, σ.
     Several DATA files: one model of all the records, each from its own steady state
     (``records``: each file's fit and w₋)."""
-    from ..sysid.nonlinear.hammerstein_wiener import linear_orders, parse_nonlinearity
+    from ..sysid.nonlinear.hammerstein_wiener import (check_periods, linear_orders,
+                                                      parse_nonlinearity)
 
     for spec, name in ((input_nl, "--input-nonlinearity"), (output_nl, "--output-nonlinearity")):
         if spec is not None:
             parse_nonlinearity(spec, name)
     linear_orders(linear, order, nb, nf, nk, flag="--")
+    if periods is not None:
+        check_periods(periods, len(data), flag="--")
     check_data_options(fs, fill)
     output_folder(report, "--report")
     with collected_warnings() as caught:
         # several files: one model of every file's record, each from its own steady state
         m, tr, tv = run_identify(data, "hw", input_col, output_col, fs=fs, time=time, fill=fill,
                                  validate=validate, fit_validate=True, detrend="none", nb=nb,
-                                 nf=nf, nk=nk, linear=linear, order=order,
+                                 nf=nf, nk=nk, linear=linear, order=order, periods=periods,
                                  input_nonlinearity=input_nl,
                                  output_nonlinearity=output_nl, progress=True)
         page = save_and_page(m, out, report, first_record(tr), tv, data[0], validate)

@@ -116,6 +116,7 @@ from ...errors import (AccuracyWarning, ArgumentError, DataError, GripkitError,
 from ...params import Parameter, ParameterSet
 from ...progress import track
 from ...signals.trajectory import Trajectory
+from ..linear.frf import frf
 from ..linear.subspace import n4sid, n4sid_records
 from ..model_file import FamilyFile, read_family_document
 from ..model_protocol import ModelFit
@@ -154,6 +155,9 @@ AUTO_NK = (0, 1, 2)
 _EIG_FLOOR = 1e-10
 #: LM iterations of each linear fit while the orders are screened (the chosen one then converges)
 SCREEN_ITERATIONS = 30
+#: lines over which the FRF's σ² is averaged for the weights of the BLA fit (a σ² from a few
+#: periods scatters like χ² with 2(P − 2) degrees of freedom; the noise spectrum is smooth)
+BLA_SMOOTH = 9
 
 
 @dataclass(frozen=True)
@@ -522,6 +526,88 @@ def _stabilised(f: np.ndarray) -> np.ndarray:
     z = np.roots(np.r_[1.0, f])
     z = np.where(np.abs(z) >= 0.98, 0.98 * z / np.maximum(np.abs(z), 1e-300), z)
     return np.real(np.poly(z))[1:]
+
+
+def check_periods(periods, n_records: int, flag: str = "") -> int:
+    """``periods`` as an integer ≥ 3 on one record (the first period is dropped as transient and
+    the FRF's σ needs two more), or an ArgumentError naming ``flag + 'periods'``."""
+    name = f"{flag}periods"
+    if (isinstance(periods, bool) or not isinstance(periods, (int, np.integer))
+            or periods < 3):
+        raise ArgumentError(f"hammerstein_wiener: {name} must be an integer ≥ 3 (the whole "
+                            "periods of a periodic input in the record: the first is dropped as "
+                            f"transient, the FRF's σ needs two more), found {periods!r:.20}")
+    if n_records != 1:
+        raise ArgumentError(f"hammerstein_wiener: {name} takes one record (its FRF gives the "
+                            f"linear start), found {n_records}; fit one periodic record, or "
+                            f"leave out {name}")
+    return int(periods)
+
+
+def _bla(u, y, periods: int):
+    """The nonparametric best linear approximation of a periodic record (``periods`` whole
+    periods, the first dropped as transient: :func:`gripkit.sysid.linear.frf.frf`, which refuses
+    a record that is not ``periods`` periods of one input) → ``(z⁻¹ = e^{−jω}, G, σ_G)`` on the
+    excited lines (ω in rad/sample). σ is floored at ``1e-6 max|G|`` (noise-free data)."""
+    try:
+        r = frf(u, y, periods=periods, method="periodic")
+    except DataError as exc:
+        raise DataError(f"hammerstein_wiener: {exc.message}", hint=exc.hint) from None
+    G, var = r.H[:, 0, 0], r.H_std[:, 0, 0] ** 2
+    k = min(BLA_SMOOTH, len(G))
+    sd = np.sqrt(np.convolve(var, np.ones(k), "same") / np.convolve(np.ones(len(G)), np.ones(k),
+                                                                    "same"))
+    sd = np.maximum(sd, 1e-6 * float(np.max(np.abs(G))))
+    return np.exp(-2j * np.pi * r.frequency_hz), G, sd
+
+
+def _bla_fit(bla, nb, nf, nk):
+    """``(b, f)`` of ``B(q)/F(q)`` fitted to the best linear approximation ``bla`` (from
+    :func:`_bla`) with weights ``1/σ_G``: Sanathanan–Koerner iterations (linear least squares of
+    ``(F G − B)/(F_prev σ_G)``), then Levenberg–Marquardt on ``(G − B/F)/σ_G``; F stabilised
+    like the ARX start (:func:`_stabilised`)."""
+    from scipy.optimize import least_squares
+
+    zi, G, sd = bla
+    if 2 * len(G) < nb + nf:
+        raise DataError(f"hammerstein_wiener: the periodic input excites {len(G)} frequency "
+                        f"lines, too few for the {nb + nf} coefficients of B/F (nb={nb}, "
+                        f"nf={nf}); excite more lines or lower the orders")
+    Bz = np.column_stack([zi ** (nk + i) for i in range(nb)])
+    Fz = np.column_stack([zi ** j for j in range(1, nf + 1)]) if nf else np.zeros((len(G), 0))
+    M = np.column_stack([Bz, -Fz * G[:, None]])
+    den, th = np.ones_like(G), None
+    for _ in range(30):
+        s = 1.0 / (sd * np.abs(den))
+        Ms, rs = M * s[:, None], G * s
+        new = np.linalg.lstsq(np.vstack([Ms.real, Ms.imag]), np.r_[rs.real, rs.imag],
+                              rcond=None)[0]
+        den = 1.0 + Fz @ new[nb:]
+        done = th is not None and np.allclose(new, th, rtol=1e-10, atol=1e-12)
+        th = new
+        if done or not nf:
+            break
+
+    def res(t):
+        e = (G - (Bz @ t[:nb]) / (1.0 + Fz @ t[nb:])) / sd
+        return np.r_[e.real, e.imag]
+
+    if nf:
+        with np.errstate(all="ignore"):
+            ref = least_squares(res, th, method="lm")
+        if np.all(np.isfinite(ref.x)) and ref.cost <= 0.5 * float(res(th) @ res(th)):
+            th = ref.x
+    return th[:nb], _stabilised(th[nb:])
+
+
+def _bla_ss_start(bla, n, nk):
+    """``[a, b, d]`` of the state-space block (``d`` when ``nk = 0``) from the B/F fit of the best
+    linear approximation with the same transfer function (``nb = n``, or ``n + 1`` with
+    ``nk = 0``; module docstring)."""
+    bo, a = _bla_fit(bla, n + (nk == 0), n, nk)
+    num = np.r_[0.0, bo] if nk else bo
+    d = num[0] if nk == 0 else 0.0
+    return np.r_[a, num[1:] - d * a, [d] if nk == 0 else []]
 
 
 def _ss_start(recs, n, nk):
@@ -896,24 +982,37 @@ def _order(v, name: str, lo: int) -> int:
     return int(v)
 
 
-def _fit_structure(recs, fin, fout, nb, nf, nk, lin_start=None, maxiter=200, linear="oe"):
+def _linear_start(demeaned, nb, nf, nk, linear, bla=None):
+    """The linear block's start ``(parameters, static gain)`` on the demeaned records: the ARX
+    (``'oe'``) or subspace (``'ss'``) start, or with ``bla`` (:func:`_bla`, a periodic record)
+    the weighted frequency-domain fit of the best linear approximation."""
+    if linear == "ss":
+        _check_length(demeaned, nb + (nk == 0), nf, nk, f"order={nb}, nk={nk}")
+        lin0 = _ss_start(demeaned, nb, nk) if bla is None else _bla_ss_start(bla, nb, nk)
+        a, bd = lin0[:nb], lin0[nb:]
+        gain = (bd[:nb].sum() + (bd[nb] * (1 + a.sum()) if nk == 0 else 0.0)) / (1 + a.sum())
+        return lin0, gain
+    if bla is None:
+        b, f = _arx_start(demeaned, nb, nf, nk)
+    else:
+        _check_length(demeaned, nb, nf, nk)
+        b, f = _bla_fit(bla, nb, nf, nk)
+    return np.r_[b, f], b.sum() / (1 + f.sum())
+
+
+def _fit_structure(recs, fin, fout, nb, nf, nk, lin_start=None, maxiter=200, linear="oe",
+                   bla=None):
     """Fit one structure (orders given; ``linear='ss'``: the state-space block of order
     ``nb = nf``) to the records ``recs`` (a list of ``(u, y)``) from the linear start
     ``[linear block, y0, w₋ of each record]`` (without one: the linear model from the ARX or,
-    for ``'ss'``, the subspace start); several limit starts, the best kept. Returns
+    for ``'ss'``, the subspace start, or with ``bla`` from the best linear approximation's
+    frequency-domain fit: :func:`_linear_start`); several limit starts, the best kept. Returns
     (``[θ, w₋ …]``, SSE, J, problem)."""
     us = [r[0] for r in recs]
     u, y = np.concatenate(us), np.concatenate([r[1] for r in recs])
     if lin_start is None:
         demeaned = [(ur - u.mean(), yr - y.mean()) for ur, yr in recs]
-        if linear == "ss":
-            _check_length(demeaned, nb + (nk == 0), nf, nk, f"order={nb}, nk={nk}")
-            lin0 = _ss_start(demeaned, nb, nk)
-            a, bd = lin0[:nb], lin0[nb:]
-            gain = (bd[:nb].sum() + (bd[nb] * (1 + a.sum()) if nk == 0 else 0.0)) / (1 + a.sum())
-        else:
-            b, f = _arx_start(demeaned, nb, nf, nk)
-            lin0, gain = np.r_[b, f], b.sum() / (1 + f.sum())
+        lin0, gain = _linear_start(demeaned, nb, nf, nk, linear, bla)
         prob = _problem(us, Nonlinearity(), Nonlinearity(), nb, nf, nk, linear)
         th0 = np.r_[lin0, y.mean() - gain * u.mean(), [ur[0] for ur in us]]
         th, sse, J, _ = _lm(prob, y, th0, maxiter)
@@ -1039,8 +1138,8 @@ class _Search:
     and the progress bar; builds candidate models and scores them (validation free-run fit, or
     −BIC)."""
 
-    def __init__(self, recs, validation, dt, maxiter, bar, linear="oe"):
-        self.recs, self.linear = recs, linear
+    def __init__(self, recs, validation, dt, maxiter, bar, linear="oe", bla=None):
+        self.recs, self.linear, self.bla = recs, linear, bla
         self.us = [r[0] for r in recs]
         self.u, self.y = np.concatenate(self.us), np.concatenate([r[1] for r in recs])
         y = self.y
@@ -1106,7 +1205,7 @@ def _choose_orders(search: _Search, orders: list) -> tuple:
     for o in orders:
         search.step()
         th, sse, J, _ = _fit_structure(search.recs, Nonlinearity(), Nonlinearity(), *o,
-                                       maxiter=screen, linear=search.linear)
+                                       maxiter=screen, linear=search.linear, bla=search.bla)
         if J is None:
             continue
         lin_fits[o] = (th, sse, J)
@@ -1238,7 +1337,7 @@ def hammerstein_wiener(u, y=None, *, input_nonlinearity=None, output_nonlinearit
                        nb: int | None = None, nf: int | None = None, nk: int | None = None,
                        linear: str = "oe", order: int | None = None,
                        dt: float | None = None, validate=None, maxiter: int = 200,
-                       progress: bool = False) -> HWModel:
+                       periods: int | None = None, progress: bool = False) -> HWModel:
     """Hammerstein, Wiener or Hammerstein–Wiener model of ``y`` driven by ``u`` (see the module
     docstring), or of several records: ``hammerstein_wiener([(u1, y1), (u2, y2), …])`` (each
     record's free run from its own steady state, its own ``w₋`` estimated with θ; one SSE over
@@ -1254,6 +1353,9 @@ def hammerstein_wiener(u, y=None, *, input_nonlinearity=None, output_nonlinearit
     ``order`` its state dimension, None: chosen in 1, 2, 3 as ``(nb, nf)`` are; ``nk`` its
     delay, 0 with a feedthrough ``d``; ``nb``, ``nf`` are not taken). Choice by free-run fit on
     ``validate=(u2, y2)`` when given, else by BIC. ``dt``: sample interval (s), default 1.
+    ``periods``: the record is that many (≥ 3) whole periods of a periodic input (a multisine):
+    the linear block starts from the weighted fit of its best linear approximation, the FRF with
+    σ (module docstring, "Estimation"), in place of the ARX / subspace start; one record only.
     ``progress``: a progress bar on stderr (one step per structure and start).
     """
     recs = _records(u, y)
@@ -1271,6 +1373,7 @@ def hammerstein_wiener(u, y=None, *, input_nonlinearity=None, output_nonlinearit
                                  parse_nonlinearity(output_nonlinearity, "output_nonlinearity"))])
     nb, nf, nk = linear_orders(linear, order, nb, nf, nk)
     validation = _check_validation(validate)
+    bla = None if periods is None else _bla(*recs[0], check_periods(periods, len(recs)))
     orders = _order_candidates(nb, nf, nk)
     searched = nb is None or nf is None
     dyn = list(dict.fromkeys((nb if nb is not None else b_, nf if nf is not None else f_)
@@ -1278,7 +1381,7 @@ def hammerstein_wiener(u, y=None, *, input_nonlinearity=None, output_nonlinearit
     steps = (len(orders) + len(structures) + (N_JOINED**2 if auto else 0)
              + (len(dyn) - 1 if searched else 0))
     bar = iter(track(range(steps), total=steps, description="hw fit", enabled=progress))
-    search = _Search(recs, validation, dt, maxiter, bar, linear)
+    search = _Search(recs, validation, dt, maxiter, bar, linear, bla)
     o = _choose_orders(search, orders)
     cands = _fit_candidates(search, structures, o, auto)
     refit = _refit_dynamics(search, cands, o, dyn, searched)
@@ -1289,4 +1392,7 @@ def hammerstein_wiener(u, y=None, *, input_nonlinearity=None, output_nonlinearit
     best.criterion = _criterion(best, nb is None or nf is None or nk is None, auto,
                                 search.chosen_by, len(structures),
                                 len(cands) - len(structures) - len(refit), bool(refit))
+    if bla is not None:
+        best.criterion += (f"; linear start from the best linear approximation (FRF of "
+                           f"{periods} periods, the first dropped)")
     return _finish(best, search)
