@@ -62,6 +62,18 @@ block (``u`` for the input block; ``x``, the output's unit before ``g``, for the
 unless given, each by a linear output-error fit (the best linear approximation: least-squares
 ARX, unstable poles reflected into the unit circle, then the PEM of (3) with both blocks
 ``none``; at most 30 iterations per candidate while screening, the chosen one to convergence).
+**Periodic excitation** (``periods=P``, ``--periods P``: the record is P ≥ 3 whole periods of a
+periodic input such as a random-phase multisine; one record): the linear block starts instead
+from the nonparametric best linear approximation ``G_BLA(e^{jω})`` and its σ on the excited
+lines (:func:`gripkit.sysid.linear.frf.frf`, ``periods=P``, the first period dropped as
+transient; it refuses a record that is not P periods of one input), σ² averaged over
+:data:`BLA_SMOOTH` neighbouring lines (from P − 1 periods alone it scatters like χ² with few
+degrees of freedom). ``B/F`` (or, for ``linear='ss'``, the same transfer function, then ``a``,
+``b``, ``d``) is fitted to it with weights ``1/σ_G``: Sanathanan–Koerner iterations (linear
+least squares of ``(F G_BLA − B)/(F_prev σ_G)``) then Levenberg–Marquardt on
+``(G_BLA − B/F)/σ_G``, F stabilised as the ARX start's; the PEM of (3) with both blocks
+``none`` follows as above (orders chosen the same way). For a Wiener system under a Gaussian-like
+input ``G_BLA = E[g'(x)] B/F`` (Bussgang): the start has the true poles, the gain scaled.
 (2) Nonlinear fits from that linear model with the nonlinearities at identity (``c = d = a = 0``)
 and, for saturation and dead zone, limits started at quantiles of the signal entering the block
 (a few starts, the best kept). When the orders were searched and the best structure is
