@@ -177,9 +177,10 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str,
         (a trajectory or ``(u, y)``) or by BIC; options of
         :func:`gripkit.sysid.hammerstein_wiener`: ``input_nonlinearity``,
         ``output_nonlinearity``, ``linear`` (``'oe'`` B/F or ``'ss'`` state space, with its
-        ``order``), ``validate`` …); ``'hysteresis'`` (Bouc-Wen or Prandtl–Ishlinskii,
-        options of
-        :func:`gripkit.sysid.hysteresis`: ``model``, ``exponent``, ``operators`` …); ``'nlss'``
+        ``order``), ``periods`` (the linear start from the FRF of a periodic input),
+        ``validate`` …); ``'hysteresis'`` (Bouc-Wen or Prandtl–Ishlinskii, options of
+        :func:`gripkit.sysid.hysteresis`: ``model``, ``form``, ``initial_state``, ``exponent``,
+        ``operators`` …); ``'nlss'``
         (polynomial nonlinear state space, options of :func:`gripkit.sysid.nlss`: ``order``,
         ``degree``, ``validate`` …). For ss, frf, tf and nlss ``input``/``output`` may name
         several columns (``'a,b'`` or a list).
