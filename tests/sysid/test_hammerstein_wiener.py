@@ -85,6 +85,18 @@ def test_pwl_and_sigmoid_bases_have_unit_slope_in_the_middle():
                                rtol=1e-12)
 
 
+def assert_jacobian_matches_central_differences(prob, the):
+    """The free run's Jacobian ``prob.jac`` at ``the`` equals central differences of
+    ``prob.yhat`` (steps 1e-6·max(1, |θ_k|); 1e-6 absolute, 1e-5 relative)."""
+    prob.run(the, True)
+    J = prob.jac.copy()
+    for k in range(len(the)):
+        h = 1e-6 * max(1.0, abs(the[k]))
+        yp = (prob.run(the + h * np.eye(len(the))[k], False), prob.yhat.copy())[1]
+        ym = (prob.run(the - h * np.eye(len(the))[k], False), prob.yhat.copy())[1]
+        np.testing.assert_allclose(J[:, k], (yp - ym) / (2 * h), atol=1e-6, rtol=1e-5)
+
+
 @pytest.mark.parametrize("fin, fout", [("saturation", "poly:3"), ("pwl:3", "sigmoid:2"),
                                        ("deadzone", "none")])
 def test_jacobian_of_the_free_run_is_exact(fin, fout):
@@ -97,14 +109,7 @@ def test_jacobian_of_the_free_run_is_exact(fin, fout):
     pin = {"saturation": [-1.1, 0.9], "pwl": [0.3, -0.2, 0.4], "deadzone": [-0.35, 0.25]}[nin.kind]
     pout = {"poly": [0.1, -0.05], "sigmoid": [0.2, -0.1], "none": []}[nout.kind]
     the = np.r_[pin, 0.4, 0.2, -0.9, 0.3, pout, 0.1, 0.7]
-    prob = HW._Problem(u, nin, nout, 2, 2, 1)
-    prob.run(the, True)
-    J = prob.jac.copy()
-    for k in range(len(the)):
-        h = 1e-6 * max(1.0, abs(the[k]))
-        yp = (prob.run(the + h * np.eye(len(the))[k], False), prob.yhat.copy())[1]
-        ym = (prob.run(the - h * np.eye(len(the))[k], False), prob.yhat.copy())[1]
-        np.testing.assert_allclose(J[:, k], (yp - ym) / (2 * h), atol=1e-6, rtol=1e-5)
+    assert_jacobian_matches_central_differences(HW._Problem(u, nin, nout, 2, 2, 1), the)
 
 
 def test_recovery_monte_carlo_parameters_within_3_sigma():

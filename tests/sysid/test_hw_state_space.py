@@ -14,6 +14,7 @@ from scipy.signal import lfilter, ss2tf
 
 from gripkit.errors import ArgumentError, ModelError
 from gripkit.sysid import HWModel, hammerstein_wiener, load_hw, load_model
+from test_hammerstein_wiener import assert_jacobian_matches_central_differences
 
 HW = importlib.import_module("gripkit.sysid.nonlinear.hammerstein_wiener")
 
@@ -64,13 +65,7 @@ def test_state_space_free_run_jacobian_is_exact_and_equals_bf(nk):
     lin = [-1.2, 0.6, -0.1, 0.4, 0.2, -0.1] + [0.3] * (nk == 0)
     the = np.r_[-1.1, 0.9, lin, 0.2, -0.1, 0.1, 0.7]
     prob = HW._SSProblem(u, fin, fout, 3, nk)
-    prob.run(the, True)
-    J = prob.jac.copy()
-    for k in range(len(the)):
-        h = 1e-6 * max(1.0, abs(the[k]))
-        yp = (prob.run(the + h * np.eye(len(the))[k], False), prob.yhat.copy())[1]
-        ym = (prob.run(the - h * np.eye(len(the))[k], False), prob.yhat.copy())[1]
-        np.testing.assert_allclose(J[:, k], (yp - ym) / (2 * h), atol=1e-6, rtol=1e-5)
+    assert_jacobian_matches_central_differences(prob, the)
     P = len(the) - 1
     m = HWModel(fin, fout, 3, 3, nk, the[:P], np.zeros(P), np.zeros((P, P)), linear="ss")
     B, F = m.B, m.F
