@@ -64,3 +64,28 @@ def record_tools():
     """RECORD_RTOL and record_of, for tests of the check (a test module cannot import this file by
     name: several test folders have a conftest.py)."""
     return SimpleNamespace(rtol=RECORD_RTOL, record_of=record_of)
+
+
+@pytest.fixture
+def traced_peak():
+    """``run(setup, measured, *args) → (result, peak bytes)``: Python code in a process of its own
+    (``sys.argv[1:]`` = ``args``), ``setup`` first, then ``measured`` (which sets ``result``, a
+    JSON value) under tracemalloc, then the peak of the traced memory. The process exits without
+    ``tracemalloc.stop()``: stopping it while another thread of a test worker (Arrow's, numba's)
+    frees a tracked block can crash CPython 3.11 (a race fixed upstream in 3.12/3.13), and did
+    once in CI."""
+    import json
+    import subprocess
+    import sys
+
+    def run(setup: str, measured: str, *args):
+        code = "\n".join([setup, "import json, os, sys, tracemalloc", "tracemalloc.start()",
+                          measured, "peak = tracemalloc.get_traced_memory()[1]",
+                          "sys.stdout.write(json.dumps([result, peak]))", "sys.stdout.flush()",
+                          "os._exit(0)"])
+        proc = subprocess.run([sys.executable, "-c", code, *map(str, args)], capture_output=True,
+                              text=True, timeout=300)
+        assert proc.returncode == 0, proc.stderr[-2000:]
+        return json.loads(proc.stdout)
+
+    return run
