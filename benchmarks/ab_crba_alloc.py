@@ -26,6 +26,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "src"))
 
+from common import finger_crba_calls  # noqa: E402
+
 from gripkit.errors import ConsistencyWarning  # noqa: E402
 from gripkit.multibody.onestate import mass_matrix_one  # noqa: E402
 from gripkit.multibody.pinocchio import to_pinocchio  # noqa: E402
@@ -39,24 +41,11 @@ def main(n: int = 20_000, runs: int = 15) -> dict:
         warnings.simplefilter("ignore", ConsistencyWarning)
         ch = finger().chain()
     model, data = to_pinocchio(ch.chain)
-    G = ch.coupling.matrix
     rng = np.random.default_rng(0)
     ps = [np.ascontiguousarray(x) for x in rng.normal(size=(n, 3))]
-    qs = [np.ascontiguousarray(G @ x) for x in ps]
     M = np.empty((3, 3))
+    qs, calls = finger_crba_calls(ch, (model, data), ps, M)
     buf, _, shape, entry = ch._one or ch._one_state()
-
-    def pin_crba():
-        for q in qs:
-            pin.crba(model, data, q)
-
-    def mass_matrix():
-        for p in ps:
-            ch.mass_matrix(p)
-
-    def mass_matrix_out():
-        for p in ps:
-            ch.mass_matrix(p, out=M)
 
     def kernel_into_one_array():
         for p in ps:
@@ -83,8 +72,9 @@ def main(n: int = 20_000, runs: int = 15) -> dict:
     print("pin.crba returns " + ("a new array (owns its data, shares no memory with data.M)"
                                  if r.flags.owndata and not np.shares_memory(r, data.M)
                                  else "a view of data.M"))
-    fns = {"pin.crba": pin_crba, "mass_matrix(p)": mass_matrix,
-           "mass_matrix(p, out=M)": mass_matrix_out, "kernel, one array": kernel_into_one_array,
+    fns = {"pin.crba": calls["pin_crba"], "mass_matrix(p)": calls["mass_matrix"],
+           "mass_matrix(p, out=M)": calls["mass_matrix_out"],
+           "kernel, one array": kernel_into_one_array,
            "kernel, np.empty per call": kernel_into_new_array,
            "entry point, one array": entry_into_one_array,
            "entry point, np.empty per call": entry_into_new_array,

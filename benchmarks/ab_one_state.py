@@ -35,6 +35,8 @@ from gripkit.multibody import from_urdf, to_urdf  # noqa: E402
 from gripkit.multibody.pinocchio import to_pinocchio  # noqa: E402
 from gripkit.systems.dlr_hit.parameters import finger  # noqa: E402
 
+from common import finger_crba_calls  # noqa: E402
+
 
 def _rounds(fns: dict, n_rounds: int, per_call: int) -> dict:
     for fn in fns.values():
@@ -67,23 +69,12 @@ def main(n_rounds: int = 9, n: int = 20_000) -> dict:
     G = ch.coupling.matrix
     rng = np.random.default_rng(0)
     ps, pds, pdds = ([np.ascontiguousarray(x) for x in rng.normal(size=(n, 3))] for _ in range(3))
-    qs, qds, qdds = ([np.ascontiguousarray(G @ x) for x in a] for a in (ps, pds, pdds))
     us = [[np.ascontiguousarray(x) for x in rng.normal(size=(n, urdf.dof))] for _ in range(3)]
     M, tau = np.empty((3, 3)), np.empty(3)
+    qs, calls = finger_crba_calls(ch, (model, data), ps, M)
+    qds, qdds = ([np.ascontiguousarray(G @ x) for x in a] for a in (pds, pdds))
     r = pin.crba(model, data, qs[0])
     pin_new = bool(r.flags.owndata and not np.shares_memory(r, data.M))
-
-    def pin_crba():
-        for q in qs:
-            pin.crba(model, data, q)
-
-    def mass_matrix():
-        for p in ps:
-            ch.mass_matrix(p)
-
-    def mass_matrix_out():
-        for p in ps:
-            ch.mass_matrix(p, out=M)
 
     def pin_rnea():
         for q, qd, qdd in zip(qs, qds, qdds):
@@ -105,8 +96,7 @@ def main(n_rounds: int = 9, n: int = 20_000) -> dict:
         for a in us[0]:
             urdf.mass_matrix(a)
 
-    t = _rounds(dict(pin_crba=pin_crba, mass_matrix=mass_matrix, mass_matrix_out=mass_matrix_out,
-                     pin_rnea=pin_rnea, rnea=rnea, rnea_out=rnea_out, urdf_rnea=urdf_rnea,
+    t = _rounds(dict(**calls, pin_rnea=pin_rnea, rnea=rnea, rnea_out=rnea_out, urdf_rnea=urdf_rnea,
                      urdf_mass_matrix=urdf_mass_matrix), n_rounds, n)
     ratio = {k: statistics.median(a / b for a, b in zip(t[k], t[ref]))
              for k, ref in (("mass_matrix", "pin_crba"), ("mass_matrix_out", "pin_crba"),

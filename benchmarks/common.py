@@ -134,3 +134,31 @@ def print_alternating(fns: dict[str, Callable[[], object]], runs: int = 9) -> No
         print(f"--- {label}, median (min) ms")
         for name, t in zip(fns, times):
             print(f"{name:50s} {float(t) * 1e3:8.2f} ({t.min * 1e3:8.2f})")
+
+
+def finger_crba_calls(ch, pin_model, ps, M) -> tuple[list, dict[str, Callable[[], object]]]:
+    """The DLR/HIT finger's mass-matrix calls timed beside ``pin.crba``: the joint states
+    ``G·p`` of the actuator states ``ps``, and ``{"pin_crba": …, "mass_matrix": …,
+    "mass_matrix_out": …}``, each a loop over the states: ``pin.crba(model, data, q)``,
+    ``ch.mass_matrix(p)`` (a new array per call) and ``ch.mass_matrix(p, out=M)``.
+    ``pin_model``: ``(model, data)`` of :func:`gripkit.multibody.pinocchio.to_pinocchio`."""
+    import numpy as np
+    import pinocchio as pin
+
+    model, data = pin_model
+    qs = [np.ascontiguousarray(ch.coupling.matrix @ p) for p in ps]
+
+    def pin_crba():
+        for q in qs:
+            pin.crba(model, data, q)
+
+    def mass_matrix():
+        for p in ps:
+            ch.mass_matrix(p)
+
+    def mass_matrix_out():
+        for p in ps:
+            ch.mass_matrix(p, out=M)
+
+    return qs, {"pin_crba": pin_crba, "mass_matrix": mass_matrix,
+                "mass_matrix_out": mass_matrix_out}

@@ -71,9 +71,9 @@ def traced_peak():
     """``run(setup, measured, *args) → (result, peak bytes)``: Python code in a process of its own
     (``sys.argv[1:]`` = ``args``), ``setup`` first, then ``measured`` (which sets ``result``, a
     JSON value) under tracemalloc, then the peak of the traced memory. The process exits without
-    ``tracemalloc.stop()``: stopping it while another thread of a test worker (Arrow's, numba's)
-    frees a tracked block can crash CPython 3.11 (a race fixed upstream in 3.12/3.13), and did
-    once in CI."""
+    ``tracemalloc.stop()``: a CI run crashed once (a segfault in a thread without a Python frame)
+    while a test worker stopped it, most likely a race between stopping tracemalloc and another
+    thread (Arrow's, numba's) freeing a tracked block."""
     import json
     import subprocess
     import sys

@@ -11,6 +11,7 @@ import pytest
 from gripkit.errors import ArgumentError
 from gripkit.sysid import narx
 from gripkit.sysid.nonlinear.narx import _Regression, candidate_terms, _regression_matrix
+from test_narx import TRUE, _true_system  # Billings' example (Billings 2013)
 
 FIXTURE = Path(__file__).resolve().parents[1] / "fixtures" / "dc_motor" / "dc_motor.csv"
 
@@ -19,21 +20,6 @@ FIXTURE = Path(__file__).resolve().parents[1] / "fixtures" / "dc_motor" / "dc_mo
 #: wilsonrljr/sysidentpy at 76b75e4: MetaMSS, degree 2, lags 5, RecursiveLeastSquares(lam=0.95),
 #: "Free-run RRSE: 0.031354" on the last 500 samples after max_lag), as a fit: 100 (1 − RRSE)
 SYSIDENTPY_BEST = 100.0 * (1.0 - 0.031354)
-
-#: Billings' example (test_narx.py): y(t) = −0.605 y(t−1) − 0.163 y(t−2)² + 0.588 u(t−1)
-#: − 0.240 u(t−2) + e(t)
-TRUE = {"y(t-1)": -0.605, "y(t-2)*y(t-2)": -0.163, "u(t-1)": 0.588, "u(t-2)": -0.240}
-
-
-def _billings(rng, n=1000, noise=0.05):
-    u = rng.uniform(-1.0, 1.0, n)
-    e = rng.normal(0.0, noise, n)
-    y = np.zeros(n)
-    for t in range(2, n):
-        y[t] = (-0.605 * y[t - 1] - 0.163 * y[t - 2] ** 2 + 0.588 * u[t - 1] - 0.240 * u[t - 2]
-                + e[t])
-    return u, y
-
 
 @pytest.fixture(scope="module")
 def dc_motor():
@@ -67,7 +53,7 @@ def test_dc_motor_forgetting_reaches_sysidentpy_best_published_fit(dc_motor):
 def test_unit_weights_give_the_least_squares_fit_and_sigma():
     """With every weight 1 the weighted path (sandwich covariance, σ² = Σwe²/(Σw − tr A⁻¹B))
     is the ordinary least squares with σ² (ΦᵀΦ)⁻¹, σ² = SSE/(N − k)."""
-    u, y = _billings(np.random.default_rng(3))
+    u, y = _true_system(np.random.default_rng(3))
     bases, rows = candidate_terms(2, 2, 2)
     P, target = _regression_matrix(bases, rows, [(u, y)], 2)
     cols = [1, 3, 4, 9, 12]
@@ -86,7 +72,7 @@ def test_forgetting_theta_is_weighted_lstsq_and_sigma_matches_monte_carlo():
     that of λ = 1 (measured 1.6–2.5; √(998 (1 − λ)/(1 + λ)) = 2.2 for a memory of 100 rows)."""
     est, sds, plain = [], [], []
     for i in range(120):
-        u, y = _billings(np.random.default_rng(500 + i))
+        u, y = _true_system(np.random.default_rng(500 + i))
         m = narx(u, y, degree=2, lags=2, terms=4, prune=False, forgetting=0.99)
         assert set(m.terms) == set(TRUE)
         order = [m.terms.index(k) for k in TRUE]
@@ -126,7 +112,7 @@ def test_forgetting_tracks_a_drifting_coefficient():
 
 
 def test_forgetting_argument_is_checked():
-    u, y = _billings(np.random.default_rng(1), n=300)
+    u, y = _true_system(np.random.default_rng(1), n=300)
     for bad in (0.0, 1.5, -0.5, True, "0.9", float("nan")):
         with pytest.raises(ArgumentError, match=r"forgetting must be a number in \(0, 1\]"):
             narx(u, y, forgetting=bad)

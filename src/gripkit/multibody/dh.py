@@ -127,7 +127,7 @@ class Dynamics:
         the low-overhead path of :mod:`gripkit.multibody.onestate`. ``out``: a float64 array of
         M's shape to write into (a controller loop's workspace, as Pinocchio's ``data``);
         returned. (``out`` may be given by position: a keyword-only parameter takes CPython's
-        slower call path, ~40 ns per call, docs/performance.md.)"""
+        slower call path; docs/performance.md, CRBA.)"""
         one = self._one or self._one_state()
         if out is None and type(q) is _NDARRAY and q.ndim == 1 and q.dtype is _F8:
             # an exact 1-D float64 ndarray: the kernel's unchecked entry point (onestate

@@ -317,8 +317,8 @@ def _batch_loop(w, size, io, run, state, mode):
     The update is :func:`_gain` then :func:`_apply` (the streaming step's halves) written out in
     the loop, with the same arithmetic in the same order, so batch and streaming results stay
     bit-identical. Written out, not called: through the inlined halves the compiled loop ran
-    1.6–1.9× slower on an Intel Xeon (the same speed on an AMD EPYC; measured with
-    ``benchmarks/ab_rls_strip.py``, docs/performance.md). Between the halves σ of step t − 1
+    slower on Intel cores (``benchmarks/ab_rls_strip.py``; the figures in docs/performance.md,
+    "Third pass"). Between the halves σ of step t − 1
     goes into ``std_out``, from P before this update (the square roots overlap with it).
     """
     u, y, theta_out, std_out, yhat_out, err_out = io
