@@ -7,8 +7,9 @@ README.md, pyproject.toml, Makefile) outside the statement that defines it, outs
 lists and outside the re-exports of package ``__init__`` files (their imports and lazy tables:
 a re-export is not a use). It is *documented public API*, and so never reported, when a package
 ``__init__`` of its module lists it in ``__all__`` (a method: when it lists the method's class).
-Functions with a decorator that registers them (``@app.command()`` and the like: an attribute
-called with arguments, other than numba's) are used by that registration.
+Functions with a decorator that registers them (``@app.command()``, ``@record_command("hw")``
+and the like: a decorator called with arguments, other than numba's and the standard library's
+wrappers) are used by that registration.
 
 The search is by words in text, so a name quoted in a string, a docstring or a document counts
 as used: the list errs towards keeping a name. Nothing is imported; files are read with ``ast``.
@@ -55,9 +56,10 @@ def _decorator_name(d: ast.expr) -> str:
 
 
 def _registers(node) -> bool:
-    """A decorator like ``@app.command()``: an attribute, called, not a known wrapper."""
-    return any(isinstance(d, ast.Call) and isinstance(d.func, ast.Attribute)
-               and _decorator_name(d) not in WRAPPERS for d in node.decorator_list)
+    """A decorator like ``@app.command()`` or ``@record_command("hw")``: called, not a known
+    wrapper."""
+    return any(isinstance(d, ast.Call) and _decorator_name(d) not in WRAPPERS
+               for d in node.decorator_list)
 
 
 def _targets(node) -> list[str]:

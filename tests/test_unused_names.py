@@ -32,8 +32,10 @@ def _write(root: Path, files: dict) -> None:
 def test_the_script_reports_what_nothing_uses(tmp_path):
     """Reported: a function only re-exported by an ``__init__`` without listing it in __all__, a
     constant named only in its module's __all__, a method of a class no package exports.
+    A class under a wrapping decorator (``@dataclass(...)``) is reported too.
     Not reported: names in a package's __all__ (with their class's methods), names used in
-    tests or docs, private names, a function registered by a decorator, names in _LAZY."""
+    tests or docs, private names, a function registered by a decorator (``@app.command()``,
+    ``@register("x")``), names in _LAZY."""
     _write(tmp_path, {
         "src/gripkit/__init__.py": '__all__ = ["Public"]\n',
         "src/gripkit/pkg/__init__.py": (
@@ -49,6 +51,8 @@ def test_the_script_reports_what_nothing_uses(tmp_path):
             'def in_tests():\n    pass\n\n'
             'def in_docs():\n    pass\n\n'
             '@app.command()\ndef cli_command():\n    pass\n\n'
+            '@register("x")\ndef registered():\n    pass\n\n'
+            '@dataclass(frozen=True)\nclass Frozen:\n    pass\n\n'
             'class Public:\n    def method(self):\n        pass\n\n'
             'class Hidden:\n    def unused_method(self):\n        pass\n\n'
             '    def used_method(self):\n        pass\n\n'
@@ -58,7 +62,8 @@ def test_the_script_reports_what_nothing_uses(tmp_path):
     })
     found = _script().unused_names(tmp_path)
     assert [(Path(p).name, n) for p, _, n in found] == [
-        ("mod.py", "LIMIT"), ("mod.py", "dead"), ("mod.py", "Hidden.unused_method")]
+        ("mod.py", "LIMIT"), ("mod.py", "dead"), ("mod.py", "Frozen"),
+        ("mod.py", "Hidden.unused_method")]
     run = subprocess.run([sys.executable, str(SCRIPT), str(tmp_path)], capture_output=True,
                          text=True)
     assert run.returncode == 1 and "mod.py:2 LIMIT" in run.stdout

@@ -119,9 +119,8 @@ def test_rls_help_says_why_it_has_no_out(capsys):
 def test_nonlinear_cli_is_the_python_fit(files, capsys, method, args, options):
     """``identify hw|nlss|hysteresis`` on one file with --validate: the parameters, the fits and
     the structure are those of ``identify(load(est), method, validate=load(val))``, bit for
-    bit, and the page of --report (hw, hysteresis) is ``model.report`` on the validation
-    record."""
-    report = [] if method == "nlss" else ["--report", files["dir"] / f"rep-{method}"]
+    bit, and the page of --report is ``model.report`` on the validation record."""
+    report = ["--report", files["dir"] / f"rep-{method}"]
     res = _json(capsys, "identify", method, files["est"], "--input", "u", "--output", "y", *args,
                 "--validate", files["val"], *report)
     py = identify(load(files["est"]), method, input="u", output="y",
@@ -137,6 +136,25 @@ def test_nonlinear_cli_is_the_python_fit(files, capsys, method, args, options):
         assert "data val.csv" in page and f"<td>{fit:.2f} %</td>" in page
     if method == "hw":  # nf chosen, as in Python: the true order
         assert (res["structure"]["nb"], res["structure"]["nf"], res["structure"]["nk"]) == (1, 1, 1)
+
+
+@pytest.mark.parametrize("method", ["hw", "hysteresis", "narx", "nlss"])
+@pytest.mark.parametrize("option, value, message", [
+    ("--out", "a-file/model.json", "a-file' is not a folder"),
+    ("--out", "model.txt", "expected a .json file"),
+    ("--report", "a-file", "is a file, expected a folder"),
+])
+def test_nonlinear_cli_refuses_outputs_before_reading(tmp_path, capsys, method, option, value,
+                                                      message):
+    """Every nonlinear command checks --out and --report (the shared options of
+    ``record_command``) before it reads a file: DATA does not exist here, and the error is the
+    output's, in one line."""
+    (tmp_path / "a-file").write_text("x", encoding="utf-8")
+    code = main(["identify", method, str(tmp_path / "missing.csv"), "--input", "u", "--output",
+                 "y", option, str(tmp_path / value)])
+    err = capsys.readouterr().err.strip()
+    assert code != 0 and message in err and option in err and len(err.splitlines()) == 1
+    assert not (tmp_path / "model.txt").exists()
 
 
 def test_identify_hw_chooses_the_orders_not_given(files):

@@ -149,7 +149,7 @@ def finish_json(result: dict, caught, json_out: bool) -> bool:
 
 
 def write_model_page(model, record, folder: Path, data_path: Path) -> str:
-    """``identify narx|hw|hysteresis --report DIR``: the report of ``model`` on ``record`` (the
+    """``identify narx|hw|nlss|hysteresis --report DIR``: the report of ``model`` on ``record`` (the
     validation record when one is given, else the estimation record) through the model protocol
     (:mod:`gripkit.sysid.protocol_report`), the page ``gripkit report MODEL DATA --out DIR``
     writes; returns the page's path."""

@@ -6,12 +6,17 @@ report). The commands only parse options and print."""
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import functools
+import inspect
+from dataclasses import dataclass, fields
 from pathlib import Path
+from typing import Optional
 
 import typer
 
-from .common import keyword_or_number, load_data, write_model_page
+from .app import identify_app
+from .common import (FillOpt, FsOpt, JsonOpt, ModelReportOpt, TimeOpt, check_data_options,
+                     keyword_or_number, load_data, write_model_page)
 
 DataArg = typer.Argument(..., help="Data file (.csv, .parquet, .h5).", show_default=False)
 #: DATA of the commands that fit one model of several records
@@ -23,9 +28,6 @@ ValidateOpt = typer.Option(None, "--validate", help="Second record (same columns
 ModelOutOpt = typer.Option(None, "--out", help="Write the identified model to this JSON file.")
 ReportOpt = typer.Option(None, "--report", help="Write an HTML report of the model on the data "
                                                 "to this folder.")
-#: ``--validate`` and ``--out`` of the nonlinear commands (hw, hysteresis, narx, nlss)
-RecordValidateOpt = typer.Option(None, "--validate", help="Validation record (same columns).")
-ModelJsonOpt = typer.Option(None, "--out", help="Write the model (JSON).")
 
 
 @dataclass(frozen=True)
@@ -158,3 +160,69 @@ def records_field(data: list[Path], records: list[dict]) -> list[dict]:
     out)."""
     return [{"data": str(p), **{k: v for k, v in r.items() if k != "x0"}}
             for p, r in zip(data, records)]
+
+
+@dataclass(frozen=True)
+class RecordOptions:
+    """The options every nonlinear identify command (hw, hysteresis, narx, nlss) shares, declared
+    once by :func:`record_command`: ``--validate`` (a second record: the validation fit, and the
+    record the report shows), ``--out`` (model JSON), ``--report`` (folder), ``--fs``,
+    ``--time``, ``--fill`` and ``--json``."""
+
+    validate: Optional[Path]
+    out: Optional[Path]
+    report: Optional[Path]
+    fs: Optional[float]
+    time: Optional[str]
+    fill: Optional[str]
+    json_out: bool
+
+    def identify(self, data: list[Path], method: str, input, output, **options):
+        """:func:`run_identify` with these options, the validation record passed to the fit
+        (it ranks structures by it)."""
+        return run_identify(data, method, input, output, fs=self.fs, time=self.time,
+                            fill=self.fill, validate=self.validate, fit_validate=True, **options)
+
+    def save(self, model, tr, vtr, data: list[Path]):
+        """``--out`` and ``--report`` (:func:`save_and_page`) for what :meth:`identify` returned;
+        the page's path, None without ``--report``."""
+        return save_and_page(model, self.out, self.report, first_record(tr), vtr, data[0],
+                             self.validate)
+
+
+#: (parameter, type, typer option) of RecordOptions' fields, in its order
+_RECORD_PARAMETERS = (
+    ("validate", Optional[Path], typer.Option(None, "--validate",
+                                              help="Validation record (same columns).")),
+    ("out", Optional[Path], typer.Option(None, "--out", help="Write the model (JSON).")),
+    ("report", Optional[Path], ModelReportOpt),
+    ("fs", Optional[float], FsOpt),
+    ("time", Optional[str], TimeOpt),
+    ("fill", Optional[str], FillOpt),
+    ("json_out", bool, JsonOpt),
+)
+
+
+def record_command(name: str):
+    """Register the decorated function as ``gripkit identify NAME`` with the options of
+    :class:`RecordOptions` after its own, checked (``--fs``, ``--fill``, ``--out``, ``--report``)
+    before it runs; it receives them as its keyword ``opts``."""
+    shared = [inspect.Parameter(n, inspect.Parameter.POSITIONAL_OR_KEYWORD, default=opt,
+                                annotation=kind) for n, kind, opt in _RECORD_PARAMETERS]
+    names = [f.name for f in fields(RecordOptions)]
+
+    def register(func):
+        signature = inspect.signature(func)
+        own = [p for p in signature.parameters.values() if p.name != "opts"]
+
+        @functools.wraps(func)
+        def command(**kw):
+            opts = RecordOptions(**{n: kw.pop(n) for n in names})
+            check_data_options(opts.fs, opts.fill)
+            check_outputs(opts.out, opts.report)
+            return func(**kw, opts=opts)
+
+        command.__signature__ = signature.replace(parameters=own + shared)
+        return identify_app.command(name)(command)
+
+    return register

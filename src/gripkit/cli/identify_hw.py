@@ -11,13 +11,9 @@ from typing import Optional
 
 import typer
 
-from .app import identify_app
-from .identify_common import (ModelJsonOpt, RecordValidateOpt, data_field, first_record,
-                              records_field, run_identify, save_and_page)
+from .common import collected_warnings, emit_json, report_warnings
+from .identify_common import RecordOptions, data_field, record_command, records_field
 from .identify_linear import DataArgs, _echo_records
-from .common import (FillOpt, FsOpt, JsonOpt, ModelReportOpt, TimeOpt, check_data_options,
-                     collected_warnings, emit_json, report_warnings)
-from .paths import output_folder
 
 
 def _summary(m) -> str:
@@ -33,7 +29,7 @@ def _summary(m) -> str:
     return "\n".join(lines)
 
 
-@identify_app.command("hw")
+@record_command("hw")
 def identify_hw(data: list[Path] = DataArgs,
                 input_col: str = typer.Option(..., "--input", help="Input column."),
                 output_col: str = typer.Option(..., "--output", help="Output column."),
@@ -57,11 +53,7 @@ def identify_hw(data: list[Path] = DataArgs,
                                             "input: the linear block starts from the fit of its "
                                             "FRF (best linear approximation, the first period "
                                             "dropped)."),
-                validate: Optional[Path] = RecordValidateOpt,
-                out: Optional[Path] = ModelJsonOpt,
-                report: Optional[Path] = ModelReportOpt,
-                fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
-                json_out: bool = JsonOpt):
+                *, opts: RecordOptions):
     """Hammerstein / Wiener / Hammerstein–Wiener: static nonlinearities around B/F or a state-space
     block, PEM, σ.
     Several DATA files: one model of all the records, each from its own steady state
@@ -75,18 +67,15 @@ def identify_hw(data: list[Path] = DataArgs,
     linear_orders(linear, order, nb, nf, nk, flag="--")
     if periods is not None:
         check_periods(periods, len(data), flag="--")
-    check_data_options(fs, fill)
-    output_folder(report, "--report")
     with collected_warnings() as caught:
         # several files: one model of every file's record, each from its own steady state
-        m, tr, tv = run_identify(data, "hw", input_col, output_col, fs=fs, time=time, fill=fill,
-                                 validate=validate, fit_validate=True, detrend="none", nb=nb,
-                                 nf=nf, nk=nk, linear=linear, order=order, periods=periods,
-                                 input_nonlinearity=input_nl,
-                                 output_nonlinearity=output_nl, progress=True)
-        page = save_and_page(m, out, report, first_record(tr), tv, data[0], validate)
+        m, tr, tv = opts.identify(data, "hw", input_col, output_col, detrend="none", nb=nb,
+                                  nf=nf, nk=nk, linear=linear, order=order, periods=periods,
+                                  input_nonlinearity=input_nl, output_nonlinearity=output_nl,
+                                  progress=True)
+        page = opts.save(m, tr, tv, data)
     lines = report_warnings(caught)
-    if json_out:
+    if opts.json_out:
         emit_json({"data": data_field(data),
                    "input": input_col, "output": output_col,
                    "structure": {"kind": m.kind, "input_nonlinearity": m.input_nl.label,
@@ -101,12 +90,12 @@ def identify_hw(data: list[Path] = DataArgs,
                                   for n, v, s in zip(m.names, m.theta, m.theta_std)],
                    "poles": [[float(z.real), float(z.imag)] for z in m.poles],
                    "fit_percent": m.fit_percent, "fit_definition": m.fit_definition,
-                   "validation": None if validate is None else
-                   {"data": str(validate), "fit_percent": m.validation_fit_percent,
+                   "validation": None if opts.validate is None else
+                   {"data": str(opts.validate), "fit_percent": m.validation_fit_percent,
                     "definition": m.fit_definition},
                    "candidates": m.candidates,
                    **({"records": records_field(data, m.records)} if len(data) > 1 else {}),
-                   "model": None if out is None else str(out), "report": page,
+                   "model": None if opts.out is None else str(opts.out), "report": page,
                    "warnings": lines})
     else:
         typer.echo(_summary(m))

@@ -13,13 +13,10 @@ from typing import Optional
 
 import typer
 
-from .app import identify_app
-from .common import (FillOpt, FsOpt, JsonOpt, ModelReportOpt, TimeOpt, check_choice,
-                     check_data_options, collected_warnings, emit_json, report_warnings)
-from .identify_common import (KeywordOrNumber, ModelJsonOpt, RecordValidateOpt, data_field,
-                              first_record, records_field, run_identify, save_and_page)
+from .common import check_choice, collected_warnings, emit_json, report_warnings
+from .identify_common import (KeywordOrNumber, RecordOptions, data_field, record_command,
+                              records_field)
 from .identify_linear import DataArgs, _echo_records
-from .paths import output_folder
 
 
 EXPONENT = KeywordOrNumber("--exponent", "1", "free", float, 1.0, 10.0,
@@ -28,7 +25,7 @@ EXPONENT = KeywordOrNumber("--exponent", "1", "free", float, 1.0, 10.0,
                            "free estimates it")
 
 
-@identify_app.command("hysteresis")
+@record_command("hysteresis")
 def identify_hysteresis(data: list[Path] = DataArgs,
                         input_col: str = typer.Option(..., "--input", help="Input column "
                                                                            "(voltage, force)."),
@@ -49,11 +46,7 @@ def identify_hysteresis(data: list[Path] = DataArgs,
                             help="Oscillator form: estimate each record's state (x, x', z) at "
                                  "its first sample with the parameters (estimate, the default), "
                                  "or start every record at rest (zero)."),
-                        validate: Optional[Path] = RecordValidateOpt,
-                        out: Optional[Path] = ModelJsonOpt,
-                        report: Optional[Path] = ModelReportOpt,
-                        fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
-                        json_out: bool = JsonOpt):
+                        *, opts: RecordOptions):
     """Hysteresis (Bouc-Wen or Prandtl-Ishlinskii): parameters with σ, free-run fit. Several
     DATA files: one model of all the records, each from its own relaxed state (``records``:
     each file's fit)."""
@@ -64,19 +57,16 @@ def identify_hysteresis(data: list[Path] = DataArgs,
     if initial_state is not None:
         check_choice(initial_state, "--initial-state", INITIAL_STATES)
     n = EXPONENT.parse(exponent)
-    check_data_options(fs, fill)
-    output_folder(report, "--report")
     with collected_warnings() as caught:
         # several files: one model of every file's record, each from its own relaxed state
-        m, tr, val = run_identify(data, "hysteresis", input_col, output_col, fs=fs, time=time,
-                                  fill=fill, validate=validate, fit_validate=True,
-                                  detrend="none", model=model, form=form, exponent=n,
-                                  operators=operators, burn_in=burn_in, progress=not json_out,
-                                  **({} if initial_state is None
-                                     else {"initial_state": initial_state}))
-        page = save_and_page(m, out, report, first_record(tr), val, data[0], validate)
+        m, tr, val = opts.identify(data, "hysteresis", input_col, output_col, detrend="none",
+                                   model=model, form=form, exponent=n, operators=operators,
+                                   burn_in=burn_in, progress=not opts.json_out,
+                                   **({} if initial_state is None
+                                      else {"initial_state": initial_state}))
+        page = opts.save(m, tr, val, data)
     lines = report_warnings(caught)
-    if json_out:
+    if opts.json_out:
         structure = ({"model": model, "form": form, "exponent": m.n,
                       "exponent_estimated": "n" in m.free}
                      if model == "bouc-wen" else
@@ -93,17 +83,17 @@ def identify_hysteresis(data: list[Path] = DataArgs,
                                    "unit": p.unit, "fixed": p.fixed}
                                   for p in m.parameters.values()],
                    "fit_percent": m.fit_percent, "definition": m.fit_definition,
-                   "validation": None if validate is None else
-                   {"data": str(validate), "fit_percent": m.validation_fit_percent},
+                   "validation": None if opts.validate is None else
+                   {"data": str(opts.validate), "fit_percent": m.validation_fit_percent},
                    **({"records": records_field(data, m.records)} if len(data) > 1 else {}),
                    **({"initial_states": _initial_states(data, m)} if oscillator else {}),
-                   "model": None if out is None else str(out), "report": page,
+                   "model": None if opts.out is None else str(opts.out), "report": page,
                    "warnings": lines})
     else:
         typer.echo(m.summary())
         fmt = lambda v: "diverged" if v is None else f"{v:.2f} %"  # noqa: E731
         typer.echo(f"free-run fit (estimation): {fmt(m.fit_percent)}")
-        if validate is not None:
+        if opts.validate is not None:
             typer.echo(f"free-run fit (validation): {fmt(m.validation_fit_percent)}")
         if len(data) > 1:
             _echo_records(records_field(data, m.records), free_run=True)

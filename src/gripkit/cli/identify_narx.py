@@ -12,11 +12,8 @@ from typing import Optional
 
 import typer
 
-from .app import identify_app
-from .common import (FillOpt, FsOpt, JsonOpt, ModelReportOpt, TimeOpt, check_data_options,
-                     collected_warnings, emit_json, report_warnings)
-from .identify_common import (KeywordOrNumber, ModelJsonOpt, RecordValidateOpt, check_outputs,
-                              run_identify, save_and_page, validation)
+from .common import collected_warnings, emit_json, report_warnings
+from .identify_common import KeywordOrNumber, RecordOptions, record_command, validation
 
 
 TERMS = KeywordOrNumber("--terms", "auto", "auto", int, 1, math.inf,
@@ -58,7 +55,7 @@ def _parameters(m) -> list:
     return out
 
 
-@identify_app.command("narx")
+@record_command("narx")
 def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 file, the record."),
                   input_col: str = typer.Option(..., "--input", help="Input column."),
                   output_col: str = typer.Option(..., "--output", help="Output column."),
@@ -80,11 +77,7 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
                   den_degree: Optional[int] = typer.Option(None, "--den-degree",
                                                            help="Degree of the rational "
                                                                 "denominator (default --degree)."),
-                  validate: Optional[Path] = RecordValidateOpt,
-                  out: Optional[Path] = ModelJsonOpt,
-                  report: Optional[Path] = ModelReportOpt,
-                  fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
-                  json_out: bool = JsonOpt):
+                  *, opts: RecordOptions):
     """Polynomial NARX: terms by error reduction ratio (FROLS), θ with σ, pruning, free-run fit;
     --basis rational: y = N/D (D = 1 + …), FROLS on y·D = N, θ refined on the one-step error;
     --report: the model's page on the --validate record (else on the record)."""
@@ -106,18 +99,15 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
                         f"denominator, but --basis is {basis!r}",
                         hint="add --basis rational or leave --den-degree out")
     extra = {} if basis == "polynomial" else {"basis": basis, "den_degree": den_degree}
-    check_data_options(fs, fill)
-    check_outputs(out, report)
     with collected_warnings() as caught:
-        m, tr, vtr = run_identify([data], "narx", input_col, output_col, fs=fs, time=time,
-                                  fill=fill, validate=validate, fit_validate=True, degree=degree,
-                                  lags=lags, ylags=ylags, ulags=ulags, terms=n_terms,
-                                  refine=None if refine == "none" else refine,
-                                  forgetting=forgetting, progress=True, **extra)
-        val = validation(m, vtr, validate)
-        page = save_and_page(m, out, report, tr, vtr, data, validate)
+        m, tr, vtr = opts.identify([data], "narx", input_col, output_col, degree=degree,
+                                   lags=lags, ylags=ylags, ulags=ulags, terms=n_terms,
+                                   refine=None if refine == "none" else refine,
+                                   forgetting=forgetting, progress=True, **extra)
+        val = validation(m, vtr, opts.validate)
+        page = opts.save(m, tr, vtr, [data])
     lines = report_warnings(caught)
-    if json_out:
+    if opts.json_out:
         emit_json({"data": str(data), "input": input_col, "output": output_col,
                    "structure": {"degree": m.degree, "ylags": m.ylags, "ulags": m.ulags,
                                  "terms": m.terms, "criterion": m.criterion,
@@ -126,7 +116,7 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
                    "parameters": _parameters(m),
                    "fit_percent": m.fit_percent, "prediction_fit_percent": m.prediction_fit_percent,
                    "validation": None if val is None else val.to_dict(),
-                   "model": None if out is None else str(out), "report": page,
+                   "model": None if opts.out is None else str(opts.out), "report": page,
                    "warnings": lines})
     else:
         typer.echo(_summary(m))

@@ -1,6 +1,7 @@
 """``gripkit identify nlss DATA --input U[,U2…] --output Y[,Y2…] [--order N] [--degree D]
-[--validate DATA2] [--out MODEL.json] [--json]``: polynomial nonlinear state-space model, through
-``gripkit.sysid.identify(data, "nlss", ...)`` (:func:`gripkit.sysid.nlss`)."""
+[--validate DATA2] [--out MODEL.json] [--report DIR] [--json]``: polynomial nonlinear
+state-space model, through ``gripkit.sysid.identify(data, "nlss", ...)``
+(:func:`gripkit.sysid.nlss`)."""
 
 from __future__ import annotations
 
@@ -9,11 +10,8 @@ from typing import Optional
 
 import typer
 
-from .app import identify_app
-from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, collected_warnings,
-                     emit_json, report_warnings)
-from .identify_common import (ModelJsonOpt, RecordValidateOpt, data_field, records_field,
-                              run_identify)
+from .common import collected_warnings, emit_json, report_warnings
+from .identify_common import RecordOptions, data_field, record_command, records_field
 from .identify_linear import DataArgs, _echo_records
 
 
@@ -51,7 +49,7 @@ def _summary(m) -> str:
     return "\n".join(lines)
 
 
-@identify_app.command("nlss")
+@record_command("nlss")
 def identify_nlss(data: list[Path] = DataArgs,
                   input_cols: str = typer.Option(..., "--input", help="Input column(s), U or "
                                                  "U1,U2."),
@@ -66,24 +64,18 @@ def identify_nlss(data: list[Path] = DataArgs,
                   window: Optional[int] = typer.Option(None, "--window",
                                                        help="Samples per truncated simulation "
                                                             "window (default 10 time constants)."),
-                  validate: Optional[Path] = RecordValidateOpt,
-                  out: Optional[Path] = ModelJsonOpt,
-                  fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
-                  json_out: bool = JsonOpt):
+                  *, opts: RecordOptions):
     """Polynomial nonlinear state space (PNLSS) from the subspace start, simulation error, σ.
     Several DATA files: one model of all the records, each with its own initial state
     (``records``: each file's fit)."""
     ins, outs = _names(input_cols, "--input"), _names(output_cols, "--output")
-    check_data_options(fs, fill)
     with collected_warnings() as caught:
         # several files: one model of every file's record, each with its own initial state
-        m = run_identify(data, "nlss", ins, outs, fs=fs, time=time, fill=fill, validate=validate,
-                         fit_validate=True, detrend="none", order=order, degree=degree,
-                         max_order=max_order, window=window)[0]
-        if out is not None:
-            m.save(out)
+        m, tr, vtr = opts.identify(data, "nlss", ins, outs, detrend="none", order=order,
+                                   degree=degree, max_order=max_order, window=window)
+        page = opts.save(m, tr, vtr, data)
     lines = report_warnings(caught)
-    if json_out:
+    if opts.json_out:
         params = [{"name": p.name, "value": p.value, "std": p.std, "unit": p.unit,
                    "fixed": p.fixed, "meaning": p.doc} for p in m.parameters.values()]
         emit_json({"data": data_field(data),
@@ -94,14 +86,15 @@ def identify_nlss(data: list[Path] = DataArgs,
                    "parameters": params, "fit_percent": m.fit_percent,
                    "linear_fit_percent": m.linear_fit_percent,
                    "fit_definition": m.fit_definition,
-                   "validation": None if validate is None else
-                   {"data": str(validate), "fit_percent": m.validation_fit_percent,
+                   "validation": None if opts.validate is None else
+                   {"data": str(opts.validate), "fit_percent": m.validation_fit_percent,
                     "linear_fit_percent": m.linear_validation_fit_percent},
                    "info": {k: v for k, v in m.info.items()
                             if k not in ("linear_start", "records")},
                    **({"records": records_field(data, m.info["records"])}
                       if len(data) > 1 else {}),
-                   "model": None if out is None else str(out), "warnings": lines})
+                   "model": None if opts.out is None else str(opts.out), "report": page,
+                   "warnings": lines})
     else:
         typer.echo(_summary(m))
         if len(data) > 1:

@@ -1,7 +1,7 @@
 """One self-contained HTML report of any identified model on a data record, built on the model
 protocol alone (:mod:`gripkit.sysid.model_protocol`): ``model.report(data, out)`` of the families
 without a linear system to draw (NARX, Hammerstein–Wiener, nonlinear state space, hysteresis),
-which ``gripkit report MODEL.json DATA --out DIR`` and ``gripkit identify narx|hw|hysteresis …
+which ``gripkit report MODEL.json DATA --out DIR`` and ``gripkit identify narx|hw|nlss|hysteresis …
 --report DIR`` call.
 
 Sections:
