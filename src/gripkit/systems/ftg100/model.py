@@ -161,6 +161,41 @@ def amplification_ratio(H: float, l: float, arm: float) -> float:
     return (H - l / 2.0) / (arm + l / 2.0)
 
 
+#: the two flexure arms: actuation (§III-A, eqs 3-4) and sensing (§III-C, eqs 12-13). Each
+#: arm's stiffness is 32 E h w³/L³ with its beam length ``L`` and its amplification
+#: (H − l/2)/(lever + l/2) with its lever arm; the stated values they are checked against, the
+#: equations, the stiffness tolerance and what the text says of the stated values
+_ARMS = {
+    "a": dict(L="L1", L_sym="L₁", lever="a", K="K_sa", D="D_a", eq_K="4", eq_D="3",
+              rtol_K=0.005, note_K="", used_K="the stated K_sa", used_D="the stated D_a = 4.7",
+              section="§III-A"),
+    "b": dict(L="L2", L_sym="L₂", lever="b", K="K_sb", D="D_b", eq_K="13", eq_D="12",
+              rtol_K=0.01, note_K="; L₂ = 871.2 µm gives the printed value",
+              used_K="the stated K_sb = 235.36 N/m", used_D="the stated D_b = 6.05",
+              section="§III-C"),
+}
+
+
+def _arm_findings(sub: str, p: ParameterSet, arm: str) -> list[Finding]:
+    """One arm's stiffness (eq 4 / eq 13) and amplification (eq 3 / eq 12) from the geometry
+    against the stated values in ``p`` (:data:`_ARMS`)."""
+    a = _ARMS[arm]
+    gv = ftg100_geometry().value
+    source = _S + a["section"]
+    return [
+        compare(f"{a['K']}-eq{a['eq_K']}", sub,
+                computed=clamped_clamped_stiffness(gv("E"), gv("h"), gv("w"), gv(a["L"])),
+                stated=p.value(a["K"]), rtol=a["rtol_K"], unit="N/m",
+                what=f"32 E h w³/{a['L_sym']}³ (eq {a['eq_K']}{a['note_K']})", used=a["used_K"],
+                source=source),
+        compare(f"{a['D']}-eq{a['eq_D']}", sub,
+                computed=amplification_ratio(gv("H"), gv("l"), gv(a["lever"])),
+                stated=p.value(a["D"]), rtol=0.01,
+                what=f"(H − l/2)/({a['lever']} + l/2) (eq {a['eq_D']}, signs reconstructed)",
+                used=a["used_D"], source=source),
+    ]
+
+
 # ------------------------------------------------------------------------------------------------
 # discrete canonical forms
 # ------------------------------------------------------------------------------------------------
@@ -364,20 +399,8 @@ class FTG100Actuated(_SecondOrderFTG):
 
     def consistency_checks(self) -> list[Finding]:
         p = self.parameters
-        geo = ftg100_geometry()
-        gv = geo.value
         sub = self.name
-        out = [
-            compare("K_sa-eq4", sub, computed=clamped_clamped_stiffness(gv("E"), gv("h"), gv("w"),
-                                                                        gv("L1")),
-                    stated=p.value("K_sa"), rtol=0.005, unit="N/m", what="32 E h w³/L₁³ (eq 4)",
-                    used="the stated K_sa", source=_S + "§III-A"),
-            compare("D_a-eq3", sub, computed=amplification_ratio(gv("H"), gv("l"), gv("a")),
-                    stated=p.value("D_a"),
-                    rtol=0.01, what="(H − l/2)/(a + l/2) (eq 3, "
-                                    "signs reconstructed)", used="the stated D_a = 4.7",
-                    source=_S + "§III-A"),
-        ]
+        out = _arm_findings(sub, p, "a")
         # damping unit: the pole radius of eq 10 is exp(−K_fa/(2 M_a)·T) only if K_fa is in N·s/m
         T = SEED_EQ10["dt"]
         radius = math.exp(-p.value("K_fa") / (2.0 * p.value("M_a")) * T)
@@ -425,19 +448,8 @@ class FTG100Sensing(_SecondOrderFTG):
 
     def consistency_checks(self) -> list[Finding]:
         p = self.parameters
-        gv = ftg100_geometry().value
         sub = self.name
-        out = [
-            compare("K_sb-eq13", sub, computed=clamped_clamped_stiffness(gv("E"), gv("h"), gv("w"),
-                                                                         gv("L2")),
-                    stated=p.value("K_sb"), rtol=0.01, unit="N/m",
-                    what="32 E h w³/L₂³ (eq 13; L₂ = 871.2 µm gives the printed value)",
-                    used="the stated K_sb = 235.36 N/m", source=_S + "§III-C"),
-            compare("D_b-eq12", sub, computed=amplification_ratio(gv("H"), gv("l"), gv("b")),
-                    stated=p.value("D_b"),
-                    rtol=0.01, what="(H − l/2)/(b + l/2) (eq 12, "
-                                    "signs reconstructed)", used="the stated D_b = 6.05",
-                    source=_S + "§III-C"),
+        out = _arm_findings(sub, p, "b") + [
             compare("k2-eq16", sub, computed=self.stiffness(),
                     stated=ftg100_parameters().value("k2"),
                     rtol=0.01, unit="N/m",
