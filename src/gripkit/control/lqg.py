@@ -36,43 +36,36 @@ import numpy as np
 
 from ..errors import ArgumentError, DataError, ModelError
 from ..estimation import KalmanFilter
-from ..estimation.kalman import block_offsets, predicted_state
+from ..estimation.kalman import predicted_state
+from ..estimation.packed import block_offsets, block_starts
 from .linear_quadratic import lqr
 
 __all__ = ["LQG", "lqg_step"]
 
 
-@numba.njit(cache=True, inline="always")
-def _par_offsets(n, m, p):  # pragma: no cover - compiled
-    """Offsets of A, B, C, K_f, K_p, K, M_x, M_u, u0, y0 in the parameter vector."""
-    oB = n * n
-    oC = oB + n * m
-    oKf = oC + p * n
-    oKp = oKf + n * p
-    oK = oKp + n * p
-    oMx = oK + m * n
-    oMu = oMx + n * p
-    ou0 = oMu + m * p
-    return 0, oB, oC, oKf, oKp, oK, oMx, oMu, ou0, ou0 + m
+#: blocks of the controller's parameter vector and of its state vector (:mod:`.packed
+#: <gripkit.estimation.packed>`), with their sizes below
+PAR_BLOCKS = ("A", "B", "C", "Kf", "Kp", "K", "Mx", "Mu", "u0", "y0")
+ST_BLOCKS = ("xp", "xf", "e", "dr", "xr", "du", "xn", "u")
 
 
 @numba.njit(cache=True, inline="always")
-def _st_offsets(n, m, p):  # pragma: no cover - compiled
-    """Offsets of x_p, x_f, e, r − y0, x_r, du, x_next, u in the state vector."""
-    sxf = n
-    se = sxf + n
-    sdr = se + p
-    sxr = sdr + p
-    sdu = sxr + n
-    sxn = sdu + m
-    return 0, sxf, se, sdr, sxr, sdu, sxn, sxn + n
+def _par_sizes(n, m, p):  # pragma: no cover - compiled
+    """Sizes of A, B, C, K_f, K_p, K, M_x, M_u, u0, y0 in the parameter vector."""
+    return (n * n, n * m, p * n, n * p, n * p, m * n, n * p, m * p, m, p)
+
+
+@numba.njit(cache=True, inline="always")
+def _st_sizes(n, m, p):  # pragma: no cover - compiled
+    """Sizes of x_p, x_f, e, r − y0, x_r, du, x_next, u in the state vector."""
+    return (n, n, p, p, n, m, n, m)
 
 
 @numba.njit(cache=True, inline="always")
 def _estimate(n, m, p, par, st, y, r):  # pragma: no cover - compiled
     """e, x_f = x_p + K_f e, r − y0 and x_r = M_x (r − y0)."""
-    oA, oB, oC, oKf, oKp, oK, oMx, oMu, ou0, oy0 = _par_offsets(n, m, p)
-    sxp, sxf, se, sdr, sxr, sdu, sxn, su = _st_offsets(n, m, p)
+    oA, oB, oC, oKf, oKp, oK, oMx, oMu, ou0, oy0 = block_starts(_par_sizes(n, m, p))[0]
+    sxp, sxf, se, sdr, sxr, sdu, sxn, su = block_starts(_st_sizes(n, m, p))[0]
     for i in range(p):
         acc = y[i] - par[oy0 + i]
         for j in range(n):
@@ -98,8 +91,8 @@ def lqg_step(dims, par, st, y, r):  # pragma: no cover - compiled
     n, m, p, filtered = dims[0], dims[1], dims[2], dims[3]
     if y.shape[0] != p or r.shape[0] != p:
         return 3
-    oA, oB, oC, oKf, oKp, oK, oMx, oMu, ou0, oy0 = _par_offsets(n, m, p)
-    sxp, sxf, se, sdr, sxr, sdu, sxn, su = _st_offsets(n, m, p)
+    oA, oB, oC, oKf, oKp, oK, oMx, oMu, ou0, oy0 = block_starts(_par_sizes(n, m, p))[0]
+    sxp, sxf, se, sdr, sxr, sdu, sxn, su = block_starts(_st_sizes(n, m, p))[0]
     _estimate(n, m, p, par, st, y, r)
     sx = sxf if filtered else sxp
     for i in range(m):  # du = u_r − K (x̂ − x_r)
@@ -168,11 +161,10 @@ class LQG:
         self._u0 = np.asarray(model.u_offset, dtype=np.float64).reshape(m)
         self._y0 = np.asarray(model.y_offset, dtype=np.float64).reshape(p)
         self._dims = np.array([n, m, p, int(estimate == "filtered")], dtype=np.int64)
-        self._par = np.concatenate([M.ravel() for M in (A, B, C, self.filter_gain,
-                                                        self.predictor_gain, self.K, Mx, Mu,
-                                                        self._u0, self._y0)])
-        lay, size = block_offsets((("xp", n), ("xf", n), ("e", p), ("dr", p), ("xr", n), ("du", m),
-                             ("xn", n), ("u", m)))
+        blocks = dict(A=A, B=B, C=C, Kf=self.filter_gain, Kp=self.predictor_gain, K=self.K,
+                      Mx=Mx, Mu=Mu, u0=self._u0, y0=self._y0)
+        self._par = np.concatenate([blocks[k].ravel() for k in PAR_BLOCKS])
+        lay, size = block_offsets(ST_BLOCKS, _st_sizes(n, m, p))
         self._st = np.zeros(size)
         self.x_pred = self._st[lay["xp"]:lay["xp"] + n]
         self._u = self._st[lay["u"]:lay["u"] + m]

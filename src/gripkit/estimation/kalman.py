@@ -32,6 +32,7 @@ import numpy as np
 from scipy.linalg import solve_discrete_are
 
 from ..errors import DataError, ModelError
+from .packed import block_offsets, block_starts
 
 __all__ = ["KalmanFilter", "KalmanRun"]
 
@@ -82,37 +83,37 @@ def _cholesky(S):  # pragma: no cover - compiled
     return True
 
 
-# --- packed buffers: one parameter vector and one state vector per filter, in flat row-major
-# indexing with offsets (no views: making array views inside a kernel costs more than a small
-# filter's arithmetic), so that a step is one numba call with five array arguments.
+# --- packed buffers (:mod:`gripkit.estimation.packed`): one parameter vector and one state
+# vector per filter, so that a step is one numba call with five array arguments.
 #
 # par: A (n×n), B (n×m), C (p×n), D (p×m), Q (n×n), R (p×p), S (n×p), u0 (m), y0 (p),
 #      K_f (n×p), K_p (n×p), P_f steady (n×n), Σ steady (p×p)
 # st:  x_p (n), P_p (n×n), x_f (n), P_f (n×n), du (m), y − y0 (p), e (p), Σ (p×p),
 #      work: P_p Cᵀ (n×p), M (n×p), K_f (n×p), K_p (n×p), A P_p (n×n), x_next (n)
+PAR_BLOCKS = ("A", "B", "C", "D", "Q", "R", "S", "u0", "y0", "Kf", "Kp", "Pf", "Sig")
+ST_BLOCKS = ("xp", "Pp", "xf", "Pf", "du", "yy", "e", "Sig", "PCt", "M", "Kf", "Kp", "T", "xn")
 
-def block_offsets(sizes) -> tuple[dict, int]:
-    """Offsets of the blocks ``(name, size)`` of a packed vector, laid one after another, and
-    the vector's size (the layouts of the filter's and the LQG controller's vectors)."""
-    out, o = {}, 0
-    for name, size in sizes:
-        out[name] = o
-        o += size
-    return out, o
+
+@numba.njit(cache=True, inline="always")
+def _par_sizes(n, m, p):  # pragma: no cover - compiled
+    """Sizes of the parameter vector's blocks (:data:`PAR_BLOCKS`)."""
+    return (n * n, n * m, p * n, p * m, n * n, p * p, n * p, m, p, n * p, n * p, n * n, p * p)
+
+
+@numba.njit(cache=True, inline="always")
+def _st_sizes(n, m, p):  # pragma: no cover - compiled
+    """Sizes of the state vector's blocks (:data:`ST_BLOCKS`)."""
+    return (n, n * n, n, n * n, m, p, p, p * p, n * p, n * p, n * p, n * p, n * n, n)
 
 
 def _par_layout(n, m, p):
-    """Offsets of the parameter vector's blocks (names as in the comment above), and its size."""
-    return block_offsets((("A", n * n), ("B", n * m), ("C", p * n), ("D", p * m), ("Q", n * n),
-                          ("R", p * p), ("S", n * p), ("u0", m), ("y0", p), ("Kf", n * p),
-                          ("Kp", n * p), ("Pf", n * n), ("Sig", p * p)))
+    """Offsets of the parameter vector's blocks, and its size."""
+    return block_offsets(PAR_BLOCKS, _par_sizes(n, m, p))
 
 
 def _st_layout(n, m, p):
     """Offsets of the state vector's blocks, and its size."""
-    return block_offsets((("xp", n), ("Pp", n * n), ("xf", n), ("Pf", n * n), ("du", m),
-                          ("yy", p), ("e", p), ("Sig", p * p), ("PCt", n * p), ("M", n * p),
-                          ("Kf", n * p), ("Kp", n * p), ("T", n * n), ("xn", n)))
+    return block_offsets(ST_BLOCKS, _st_sizes(n, m, p))
 
 
 @numba.njit(cache=True, inline="always")
@@ -155,37 +156,14 @@ def _flat_solve_rows(a, oL, p, ob, ox, rows):  # pragma: no cover - compiled
 @numba.njit(cache=True, inline="always")
 def _par_offsets(n, m, p):  # pragma: no cover - compiled
     """Offsets of A, B, C, D, Q, R, S, u0, y0, K_f, K_p, P_f, Σ in the parameter vector."""
-    oB = n * n
-    oC = oB + n * m
-    oD = oC + p * n
-    oQ = oD + p * m
-    oR = oQ + n * n
-    oS = oR + p * p
-    ou0 = oS + n * p
-    oy0 = ou0 + m
-    oKf = oy0 + p
-    oKp = oKf + n * p
-    oPs = oKp + n * p
-    return 0, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oPs + n * n
+    return block_starts(_par_sizes(n, m, p))[0]
 
 
 @numba.njit(cache=True, inline="always")
 def _st_offsets(n, m, p):  # pragma: no cover - compiled
     """Offsets of x_p, P_p, x_f, P_f, du, y − y0, e, Σ, P_p Cᵀ, M, K_f, K_p, T, x_next in the
     state vector."""
-    sPp = n
-    sxf = sPp + n * n
-    sPf = sxf + n
-    sdu = sPf + n * n
-    syy = sdu + m
-    se = syy + p
-    sSe = se + p
-    sPC = sSe + p * p
-    sM = sPC + n * p
-    sKf = sM + n * p
-    sKp = sKf + n * p
-    sT = sKp + n * p
-    return 0, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sT + n * n
+    return block_starts(_st_sizes(n, m, p))[0]
 
 
 @numba.njit(cache=True, inline="always")
