@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# The issue-24 rows not yet measured on the lent machines' Intel Xeon, in one device call:
+#
+#   run(command="bash benchmarks/intel_pending.sh", carry=[".whl", ".pinocchio"], timeout_s=540)
+#
+# .whl holds the peers' pure-Python wheels (pint, sippy, control, …), .pinocchio the bundle that
+# benchmarks/pinocchio_bundle.sh builds for the target's Python. Writes into $OUT (else a new
+# temporary folder): machine.txt (CPU, versions, which Pinocchio was imported), rls/results.md
+# and .json (`run.py --only rls`: batch RLS with and without history, streaming update, against
+# a plain numba RLS), ab_rls_wrapper.txt (the pieces of RLS.run(store=False)) and
+# ab_one_state.txt (three processes of benchmarks/ab_one_state.py: one-state CRBA and RNEA
+# against pin.crba and pin.rnea). Every step runs even if one before it fails.
+set -u
+OUT="${OUT:-$(mktemp -d)}"
+mkdir -p "$OUT"
+cd "$(dirname "$0")/.."
+export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 MKL_NUM_THREADS=1
+py="${PYTHON:-python}"
+ver="$("$py" -c 'import sys; print(f"{sys.version_info[0]}.{sys.version_info[1]}")')"
+site="$(mktemp -d)"
+if ls .whl/*.whl > /dev/null 2>&1; then
+    "$py" -m pip install --no-deps --target "$site" -q .whl/*.whl
+fi
+bundle=".pinocchio/pinocchio-cp${ver/./}.tar.xz"
+pinsite=""
+if [ -f "$bundle" ]; then
+    tar -C "$site" -xJf "$bundle" && pinsite=":$site/cmeel.prefix/lib/python$ver/site-packages"
+else
+    echo "no $bundle: the CRBA rows need it (bash benchmarks/pinocchio_bundle.sh $ver)" >&2
+fi
+# the bundle first: it must be the Pinocchio imported, not one installed beside this Python
+export PYTHONPATH="$PWD/src:$PWD/benchmarks${pinsite}:$site"
+{
+    lscpu | grep -E 'Model name|^CPU\(s\)|Flags' | cut -c1-200
+    "$py" -c 'import sys, numpy, scipy, numba; print(sys.version.split()[0], "numpy",
+numpy.__version__, "scipy", scipy.__version__, "numba", numba.__version__)'
+    "$py" -c 'import pinocchio; print("pinocchio", pinocchio.__version__, pinocchio.__file__)'
+    uptime
+} > "$OUT/machine.txt" 2>&1
+"$py" benchmarks/run.py --only rls --out "$OUT/rls"
+"$py" benchmarks/ab_rls_wrapper.py > "$OUT/ab_rls_wrapper.txt" 2>&1
+for i in 1 2 3; do
+    "$py" benchmarks/ab_one_state.py . 9
+done > "$OUT/ab_one_state.txt" 2>&1
+cat "$OUT/machine.txt" "$OUT/rls/results.md" "$OUT/ab_rls_wrapper.txt" "$OUT/ab_one_state.txt"
