@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from itertools import accumulate
 
+from numba.core import types
 from numba.extending import overload
 
 __all__ = ["block_starts", "block_offsets"]
@@ -31,13 +32,16 @@ def block_starts(sizes: tuple) -> tuple[tuple, int]:
 @overload(block_starts, inline="always")
 def _block_starts_compiled(sizes):
     """The compiled :func:`block_starts` for a tuple of ``len(sizes)`` ints: ``o0 = 0``,
-    ``o(i+1) = o(i) + sizes[i]``, one line per block."""
+    ``o(i+1) = o(i) + sizes[i]``, one line per block (the source is built from the length
+    alone)."""
+    if not isinstance(sizes, types.BaseTuple):
+        return None
     k = len(sizes)
     lines = ["def block_starts(sizes):", "    o0 = 0"]
     lines += [f"    o{i + 1} = o{i} + sizes[{i}]" for i in range(k)]
     lines.append(f"    return ({''.join(f'o{i}, ' for i in range(k))}), o{k}")
     scope = {}
-    exec("\n".join(lines), scope)  # noqa: S102 - our own source text, from a length only
+    exec("\n".join(lines), scope)
     return scope["block_starts"]
 
 
