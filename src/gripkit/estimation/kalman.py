@@ -32,6 +32,7 @@ import numpy as np
 from scipy.linalg import solve_discrete_are
 
 from ..errors import DataError, ModelError
+from ..lti import flush_tiny
 from .packed import block_offsets, block_starts
 
 __all__ = ["KalmanFilter", "KalmanRun"]
@@ -235,7 +236,9 @@ def _kf_states(n, m, p, par, st, g, ogf, ogp):  # pragma: no cover - compiled
 def predicted_state(n, m, p, par, oA, oB, g, ogp, st, so):  # pragma: no cover - compiled
     """x_p ← A x_p + B du + K_p e (through x_next) on a packed state vector ``st`` whose x_p, du,
     e, x_next blocks start at ``so``; A, B are the blocks of ``par`` at ``oA``, ``oB``, K_p the
-    block of ``g`` at ``ogp`` (row-major; each sum in ascending order)."""
+    block of ``g`` at ``ogp`` (row-major; each sum in ascending order). Entries below
+    ``FLUSH_BELOW`` are carried as zero (:func:`gripkit.lti.flush_tiny`: a state that decays
+    under zero input and zero innovations never reaches the subnormal range)."""
     sxp, sdu, se, sxn = so
     for i in range(n):
         acc = 0.0
@@ -247,13 +250,13 @@ def predicted_state(n, m, p, par, oA, oB, g, ogp, st, so):  # pragma: no cover -
             acc += g[ogp + i * p + j] * st[se + j]
         st[sxn + i] = acc
     for i in range(n):
-        st[sxp + i] = st[sxn + i]
+        st[sxp + i] = flush_tiny(st[sxn + i])
 
 
 @numba.njit(cache=True, inline="always")
 def _kf_covariances(n, m, p, par, st):  # pragma: no cover - compiled
-    """P_f = P_p − K_f (P_p Cᵀ)ᵀ, P_p ← Q + A P_p Aᵀ − K_p Mᵀ (symmetric parts), and Σ rebuilt
-    from its Cholesky factor."""
+    """P_f = P_p − K_f (P_p Cᵀ)ᵀ, P_p ← Q + A P_p Aᵀ − K_p Mᵀ (symmetric parts; entries below
+    ``FLUSH_BELOW`` carried as zero), and Σ rebuilt from its Cholesky factor."""
     oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = _par_offsets(n, m, p)
     sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
     for i in range(n):
@@ -275,7 +278,7 @@ def _kf_covariances(n, m, p, par, st):  # pragma: no cover - compiled
                 acc += st[sT + i * n + k] * par[oA + j * n + k]
             for k in range(p):
                 acc -= st[sKp + i * p + k] * st[sM + j * p + k]
-            st[sPp + i * n + j] = acc
+            st[sPp + i * n + j] = flush_tiny(acc)   # P_p decays where Q = 0
     for i in range(n):
         for j in range(i + 1, n):
             a = 0.5 * (st[sPp + i * n + j] + st[sPp + j * n + i])
