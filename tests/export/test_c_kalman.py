@@ -72,6 +72,21 @@ def test_the_c_filter_gives_the_python_filters_states(tmp_path, noise):
 
 
 @needs_gcc
+def test_the_c_filter_carries_no_subnormal_state(tmp_path):
+    """A record whose readings go to exact zeros after 200 samples (a sensor at rest, offsets
+    removed): x_p decays, and the C filter carries entries below 1e-280 as zero, as the Python
+    filter does; after 12 000 samples no state is subnormal and both are the same."""
+    m = innovation_model()
+    u, y = recorded(m, N=12_000)
+    u[200:], y[200:] = np.asarray(m.u_offset), np.asarray(m.y_offset)
+    x_c = build_and_run(tmp_path, kalman_c_sources(m, "gkz"), "gkz", u, y)
+    x_py = KalmanFilter(m, steady_state=True).run_arrays(u, y).x
+    tiny = np.finfo(np.float64).tiny
+    assert not np.any((x_c[-1] != 0) & (np.abs(x_c[-1]) < tiny))
+    assert np.array_equal(x_c[-1], x_py[-1]) and np.all(np.abs(x_py[-1]) < 1e-270)
+
+
+@needs_gcc
 def test_the_cli_writes_the_filter_with_the_noise_files_covariances(tmp_path, capsys):
     p = tmp_path / "grip.json"
     innovation_model().save(p)
