@@ -15,7 +15,7 @@ OUT="${OUT:-$(mktemp -d)}"
 mkdir -p "$OUT"
 cd "$(dirname "$0")/.."
 export OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 MKL_NUM_THREADS=1
-py="${PYTHON:-python}"
+py="${PYTHON:-$(command -v python3 || command -v python)}"
 ver="$("$py" -c 'import sys; print(f"{sys.version_info[0]}.{sys.version_info[1]}")')"
 site="$(mktemp -d)"
 if ls .whl/*.whl > /dev/null 2>&1; then
@@ -36,10 +36,15 @@ export PYTHONPATH="$PWD/src:$PWD/benchmarks${pinsite}:$site"
 numpy.__version__, "scipy", scipy.__version__, "numba", numba.__version__)'
     "$py" -c 'import pinocchio; print("pinocchio", pinocchio.__version__, pinocchio.__file__)'
     uptime
+    echo "source: $(git rev-parse HEAD 2> /dev/null || echo 'not a git checkout')"
 } > "$OUT/machine.txt" 2>&1
+cpu="$(lscpu | sed -n 's/^Model name: *//p')"
 "$py" benchmarks/run.py --only rls --out "$OUT/rls"
-"$py" benchmarks/ab_rls_wrapper.py > "$OUT/ab_rls_wrapper.txt" 2>&1
-for i in 1 2 3; do
-    "$py" benchmarks/ab_one_state.py . 9
-done > "$OUT/ab_one_state.txt" 2>&1
+{ echo "# CPU: $cpu"; "$py" benchmarks/ab_rls_wrapper.py; } > "$OUT/ab_rls_wrapper.txt" 2>&1
+{
+    echo "# CPU: $cpu; three processes of benchmarks/ab_one_state.py, 9 rounds each"
+    for i in 1 2 3; do
+        "$py" benchmarks/ab_one_state.py . 9
+    done
+} > "$OUT/ab_one_state.txt" 2>&1
 cat "$OUT/machine.txt" "$OUT/rls/results.md" "$OUT/ab_rls_wrapper.txt" "$OUT/ab_one_state.txt"

@@ -29,10 +29,19 @@ out="$work/bundle/cmeel.prefix"
 mkdir -p "$out/lib/python$ver"
 cp -r "$prefix/$site" "$out/lib/python$ver/"
 find "$out" -name __pycache__ -prune -exec rm -rf {} +
-# the libraries the extensions load, found as the target's loader would (RUNPATH $ORIGIN/../lib)
-for ext in $(find "$prefix/$site" -name '*.so'); do
+# the libraries the extensions load (found as the target's loader would: RUNPATH
+# $ORIGIN/../lib): every one from the wheels, and from the system all but the C and C++
+# runtimes every Linux with CPython and numpy has (libgomp, OpenMP, is not always there)
+deps="$(for ext in $(find "$prefix/$site" -name '*.so'); do
     LD_LIBRARY_PATH="$prefix/lib:$prefix/lib64" ldd "$ext"
-done | awk '{print $3}' | grep -F "$prefix" | sort -u | while read -r lib; do
+done)"
+if grep -q "not found" <<< "$deps"; then
+    echo "pinocchio_bundle: a library the extensions need is missing:" >&2
+    grep "not found" <<< "$deps" | sort -u >&2
+    exit 1
+fi
+system='/(libc|libm|libdl|libpthread|librt|libstdc\+\+|libgcc_s|ld-linux[^/]*)\.so'
+awk '$2 == "=>" {print $3}' <<< "$deps" | sort -u | grep -Ev "$system" | while read -r lib; do
     cp -L "$lib" "$out/lib/$(basename "$lib")"
 done
 mkdir -p "$root/$folder"
