@@ -178,7 +178,8 @@ def test_nonlinear_cli_shows_the_units_and_its_file_the_provenance(files, capsys
     """``identify narx|hw|hysteresis|nlss --json`` shows the columns' units under the keys of
     ``identify arx`` (``input_unit``/``output_unit``; nlss, of several columns, the lists
     ``input_units``/``output_units`` of the MIMO commands): 'V' and 'N'; the model file of
-    ``--out`` carries the data file's name and SHA-256, as the ARX model file does."""
+    ``--out`` carries the data file's name and SHA-256, as the ARX model file does, so
+    ``gripkit compare`` knows its estimation data (and not the validation record)."""
     d = files["dir"]
     lin = _json(capsys, "identify", "arx", files["est"], "--input", "u", "--output", "y",
                 "--na", "1", "--nb", "1", "--nk", "1", "--out", d / "units-arx.json")
@@ -193,3 +194,5 @@ def test_nonlinear_cli_shows_the_units_and_its_file_the_provenance(files, capsys
     arx_file, m = load_model(d / "units-arx.json"), load_model(d / f"units-{method}.json")
     assert (m.data_file, m.data_hash) == (arx_file.data_file, arx_file.data_hash) == (
         "est.csv", hashlib.sha256(files["est"].read_bytes()).hexdigest())
+    for data, same in ((files["est"], True), (files["val"], False)):
+        assert _json(capsys, "compare", d / f"units-{method}.json", data)["estimation_data"] is same

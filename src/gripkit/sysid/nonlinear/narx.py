@@ -423,7 +423,7 @@ class NARXModel(FreeRunModel, FamilyFile):
     def parameters(self) -> ParameterSet:
         """θ as a :class:`~gripkit.params.ParameterSet` (``theta_0`` … in term order, each
         documented by its term, with its 1σ); in the units of the record the model was fitted
-        on ('1': a NARX model keeps no units)."""
+        on (``input_unit``, ``output_unit``), shown as '1': a term's unit is not derived."""
         return ParameterSet([Parameter(f"theta_{k}", float(v), "1", f"coefficient of {t}",
                                        source=f"identified (narx, {self.criterion or 'FROLS'})",
                                        std=float(s))
