@@ -166,3 +166,33 @@ def test_identify_hw_chooses_the_orders_not_given(files):
     assert (m.nb, m.nf, m.nk) == (1, 1, 1) and "by BIC" in m.criterion
     m = identify(tr, "hw", input="u", output="y", output_nonlinearity="poly:2", nb=2)
     assert m.nb == 2
+
+
+@pytest.mark.parametrize("method, args", [
+    ("narx", ["--degree", "1", "--lags", "1", "--terms", "2"]),
+    ("hw", ["--output-nonlinearity", "poly:2", "--nb", "1", "--nf", "1", "--nk", "1"]),
+    ("hysteresis", ["--model", "prandtl-ishlinskii", "--operators", "4"]),
+    ("nlss", ["--order", "1", "--degree", "2"]),
+])
+def test_nonlinear_cli_shows_the_units_and_its_file_the_provenance(files, capsys, method, args):
+    """``identify narx|hw|hysteresis|nlss --json`` shows the columns' units under the keys of
+    ``identify arx`` (``input_unit``/``output_unit``; nlss, of several columns, the lists
+    ``input_units``/``output_units`` of the MIMO commands): 'V' and 'N'; the model file of
+    ``--out`` carries the data file's name and SHA-256, as the ARX model file does, so
+    ``gripkit compare`` knows its estimation data (and not the validation record)."""
+    d = files["dir"]
+    lin = _json(capsys, "identify", "arx", files["est"], "--input", "u", "--output", "y",
+                "--na", "1", "--nb", "1", "--nk", "1", "--out", d / "units-arx.json")
+    assert (lin["input_unit"], lin["output_unit"]) == ("V", "N")
+    res = _json(capsys, "identify", method, files["est"], "--input", "u", "--output", "y", *args,
+                "--out", d / f"units-{method}.json")
+    if method == "nlss":
+        assert (res["input_units"], res["output_units"]) == ([lin["input_unit"]],
+                                                            [lin["output_unit"]])
+    else:
+        assert (res["input_unit"], res["output_unit"]) == (lin["input_unit"], lin["output_unit"])
+    arx_file, m = load_model(d / "units-arx.json"), load_model(d / f"units-{method}.json")
+    assert (m.data_file, m.data_hash) == (arx_file.data_file, arx_file.data_hash) == (
+        "est.csv", hashlib.sha256(files["est"].read_bytes()).hexdigest())
+    for data, same in ((files["est"], True), (files["val"], False)):
+        assert _json(capsys, "compare", d / f"units-{method}.json", data)["estimation_data"] is same

@@ -78,6 +78,7 @@ def identify_hw(data: list[Path] = DataArgs,
     if opts.json_out:
         emit_json({"data": data_field(data),
                    "input": input_col, "output": output_col,
+                   "input_unit": m.input_unit, "output_unit": m.output_unit,
                    "structure": {"kind": m.kind, "input_nonlinearity": m.input_nl.label,
                                  "output_nonlinearity": m.output_nl.label, "linear": m.linear,
                                  "order": m.order, "nb": m.nb, "nf": m.nf, "nk": m.nk,

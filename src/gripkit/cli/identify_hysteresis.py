@@ -78,6 +78,7 @@ def identify_hysteresis(data: list[Path] = DataArgs,
             structure["initial_state"] = m.initial_state_option
         emit_json({"data": data_field(data),
                    "input": input_col, "output": output_col,
+                   "input_unit": m.input_unit, "output_unit": m.output_unit,
                    "structure": structure,
                    "parameters": [{"name": p.name, "value": p.value, "std": p.std,
                                    "unit": p.unit, "fixed": p.fixed}

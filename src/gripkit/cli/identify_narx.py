@@ -109,6 +109,7 @@ def identify_narx(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
     lines = report_warnings(caught)
     if opts.json_out:
         emit_json({"data": str(data), "input": input_col, "output": output_col,
+                   "input_unit": m.input_unit, "output_unit": m.output_unit,
                    "structure": {"degree": m.degree, "ylags": m.ylags, "ulags": m.ulags,
                                  "terms": m.terms, "criterion": m.criterion,
                                  "refine": refine, "forgetting": forgetting,

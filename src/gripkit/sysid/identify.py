@@ -24,6 +24,7 @@ would otherwise bias every coefficient).
 
 from __future__ import annotations
 
+import copy
 import math
 import warnings
 
@@ -225,12 +226,18 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str,
 
 
 def with_provenance(model, provenance: dict):
-    """``model`` with ``data_file``/``data_hash`` set from ``provenance`` (a LinearModel's fields,
-    a PolynomialModel's ``info``); other results, and data built in memory, as they are."""
+    """``model`` with ``data_file``/``data_hash`` set from ``provenance`` (the fields of a
+    LinearModel and a PolynomialModel, through their ``replace``; of a nonlinear family's model,
+    :class:`~gripkit.sysid.model_file.FamilyFile`, on a shallow copy), or in the ``info`` of a
+    result that keeps it there; other results, and data built in memory, as they are."""
     if provenance.get("data_file") is None:
         return model
-    if hasattr(model, "data_file"):
+    if hasattr(model, "data_file") and hasattr(model, "replace"):
         return model.replace(**provenance)
+    if hasattr(model, "data_file"):  # a copy keeps what the fit set besides the fields (records)
+        out = copy.copy(model)
+        out.data_file, out.data_hash = provenance["data_file"], provenance["data_hash"]
+        return out
     if isinstance(getattr(model, "info", None), dict) and hasattr(model, "replace"):
         return model.replace(info={**model.info, **provenance})
     return model
@@ -262,15 +269,13 @@ def _dispatch(data, method: str, *, input, output, na: int | None, nb: int | Non
     if method == "narx":  # the model's constant term carries the operating point
         io = io_data(data, input=input, output=output, detrend="none", why="NARX identification")
         model = _method_function(method)(io.u1, io.y1, dt=io.dt, **_validation_arrays(options, io))
-        model.input_name, model.output_name = input, output
-        return model
+        return _with_channels(model, io)
     if method == "hw":  # the offset y0 carries the operating point; orders not given: chosen
         io = io_data(data, input=input, output=output, detrend="none",
                      why="Hammerstein-Wiener identification")
         model = _method_function(method)(io.u1, io.y1, nb=nb, nf=nf, nk=nk, dt=io.dt,
                                          **_validation_arrays(options, io))
-        model.input_name, model.output_name = input, output
-        return model
+        return _with_channels(model, io)
     if method == "hysteresis":  # rate independent, its offset a parameter: the data as they are
         return _method_function(method)(data, input=input, output=output, **options)
     na, nb, nk, nc = _linear_orders(na, nb, nk, nc)
@@ -433,8 +438,7 @@ def identify_records(data, method: str = "arx", *, input, output, na: int | None
         fit, orders = _method_function(method), ({} if method == "narx" else hw_orders)
         model = _as_data(fit, [(io.u1, io.y1) for io in ios], dt=ios[0].dt, **orders,
                          **_validation_arrays(options, ios[0]))
-        model.input_name, model.output_name = input, output
-        return model
+        return _with_channels(model, ios[0])
     if method == "hysteresis":  # each record from its own relaxed state, the data as they are
         return _method_function(method)(list(data), input=input, output=output, **options)
     u0 = float(_pooled_mean([io.u1 for io in ios])) if detrend == "mean" else 0.0
@@ -468,6 +472,14 @@ def _check_records(data, method: str, detrend: str) -> None:
                         f"mean of all records) or 'none', found {detrend!r}",
                         hint="detrend 'linear' would give every record its own operating point; "
                              "detrend the records before, or use 'mean'")
+
+
+def _with_channels(model, io: IOData):
+    """The NARX or Hammerstein–Wiener ``model`` fitted on the arrays of ``io`` (its SISO view),
+    given the record's column names and units."""
+    model.input_name, model.output_name = io.input, io.output
+    model.input_unit, model.output_unit = io.input_unit, io.output_unit
+    return model
 
 
 def _validation_arrays(options: dict, io: IOData) -> dict:

@@ -15,6 +15,7 @@ from __future__ import annotations
 import hashlib
 import json
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -23,7 +24,7 @@ from ..atomic import write_text
 from ..errors import AccuracyWarning, DataError, ModelError, PathError, emit_warning
 
 __all__ = ["file_sha256", "plain", "write_document", "read_document", "read_family_document",
-           "FamilyFile", "SCHEMA", "SCHEMA_VERSION"]
+           "FamilyFile", "file_provenance", "SCHEMA", "SCHEMA_VERSION"]
 
 SCHEMA = "gripkit.linear-model"
 SCHEMA_VERSION = 2
@@ -75,21 +76,59 @@ def write_document(doc: dict, path) -> None:
     write_text(path, json.dumps(doc, indent=1, allow_nan=False) + "\n", what="model file")
 
 
+@dataclass(kw_only=True)
 class FamilyFile:
     """The one ``save`` of the nonlinear families' models (NARX, Hammerstein–Wiener, NLSS,
     hysteresis), whose readers check the file with :func:`read_family_document`. A class names
     its file in ``_file_what`` (for the write's errors) and sets ``_file_allow_nan = False``
-    where its :meth:`to_dict` writes non-finite numbers as null (a NaN left is then refused)."""
+    where its :meth:`to_dict` writes non-finite numbers as null (a NaN left is then refused).
+
+    The provenance of the estimation data, the fields (keyword-only) and meaning of a linear
+    model's (:class:`~gripkit.sysid.LinearModel`): ``data_file`` (the file's name, of several
+    records the names joined by ``', '``) and ``data_hash`` (the SHA-256 of its bytes; None for
+    several records), None for data built in memory; set by :func:`gripkit.sysid.identify`,
+    written by :meth:`save` as the linear model file writes them (``data``: ``{"file",
+    "sha256"}`` or null) and read back by :func:`file_provenance` (None from a file written
+    before they were)."""
+
+    data_file: str | None = None
+    data_hash: str | None = None
 
     _file_what = "model"
     _file_allow_nan = True
 
     def save(self, path) -> Path:
         """Write the model as JSON (the document of :meth:`to_dict`, its ``schema`` naming the
-        family), atomically."""
-        return write_text(path, json.dumps(self.to_dict(), indent=1,
-                                           allow_nan=self._file_allow_nan) + "\n",
+        family, and the provenance ``data``), atomically."""
+        doc = {**self.to_dict(), **self.provenance_document()}
+        return write_text(path, json.dumps(doc, indent=1, allow_nan=self._file_allow_nan) + "\n",
                           what=self._file_what)
+
+    def provenance_document(self) -> dict:
+        """The provenance entry of the model file: ``{"data": {"file": data_file, "sha256":
+        data_hash}}``, ``{"data": None}`` without a data file (the linear model file's form)."""
+        return {"data": None if self.data_file is None else {"file": self.data_file,
+                                                             "sha256": self.data_hash}}
+
+
+def file_provenance(doc: dict) -> dict:
+    """``data_file`` and ``data_hash`` of a nonlinear family's model file document (written by
+    :meth:`FamilyFile.save`, checked by :func:`read_family_document`), None where the file has
+    none (written before the entry was, or of data built in memory)."""
+    data = doc.get("data") or {}
+    return dict(data_file=data.get("file"), data_hash=data.get("sha256"))
+
+
+def _check_provenance(doc: dict, what: str) -> None:
+    """A ModelError naming ``what`` when the document's ``data`` is neither null (or absent) nor
+    ``{"file": name, "sha256": hash or null}``."""
+    data = doc.get("data")
+    if data is None or (isinstance(data, dict) and isinstance(data.get("file"), str)
+                        and isinstance(data.get("sha256"), (str, type(None)))):
+        return
+    raise ModelError(f"{what}: the entry 'data' must be null or {{\"file\": name, \"sha256\": "
+                     f"hash or null}}, found {json.dumps(data)[:80]}",
+                     hint="write the file again with model.save")
 
 
 #: the deepest nesting of lists and objects a model file may hold (gripkit writes at most 4 levels)
@@ -157,8 +196,9 @@ def read_family_document(path, schema: str, version, *, family: str, writer: str
                          version_key: str = "version") -> dict:
     """The JSON document of a nonlinear family's model file ``path`` (``family``: 'narx', 'hw',
     …; ``writer``: what writes such a file), checked: readable JSON, its ``schema`` and its
-    ``version_key`` equal to ``version`` (an int, or a tuple of the versions read). PathError for
-    a missing or unreadable file, ModelError for anything else."""
+    ``version_key`` equal to ``version`` (an int, or a tuple of the versions read), its provenance
+    ``data`` null, absent or a file's name and hash (:func:`file_provenance`). PathError for a
+    missing or unreadable file, ModelError for anything else."""
     versions = version if isinstance(version, tuple) else (version,)
     p = Path(path)
     what = f"{family} model file {str(p)!r}"
@@ -187,4 +227,5 @@ def read_family_document(path, schema: str, version, *, family: str, writer: str
         raise ModelError(f"{str(p)!r} is a {schema} of {version_key} {found!r}; this gripkit "
                          f"reads {version_key} {' or '.join(map(str, versions))}",
                          hint=f"write it again with this gripkit ({writer})")
+    _check_provenance(doc, what)
     return doc

@@ -130,12 +130,12 @@ from ...progress import track
 from ...signals.trajectory import Trajectory
 from ..linear.frf import frf
 from ..linear.subspace import n4sid, n4sid_records
-from ..model_file import FamilyFile, read_family_document
+from ..model_file import FamilyFile, file_provenance, read_family_document
 from ..model_protocol import ModelFit
 from . import hw_kernels as K
 from .levenberg_marquardt import levenberg_marquardt
-from .single_channel import (DIVERGENCE_FACTOR, FreeRunModel, fit_percent, not_constant,
-                             one_signal)
+from .single_channel import (DIVERGENCE_FACTOR, FreeRunModel, channel_fields, fit_percent,
+                             not_constant, one_signal)
 
 __all__ = ["SCHEMA", "HW_FIT", "HWModel", "Nonlinearity", "hammerstein_wiener", "load_hw",
            "parse_nonlinearity"]
@@ -902,8 +902,8 @@ class HWModel(FreeRunModel, FamilyFile):
             theta=[float(v) for v in self.theta], theta_std=[fin(v) for v in self.theta_std],
             covariance=[[fin(v) for v in row] for row in self.covariance],
             fit_percent=self.fit_percent, validation_fit_percent=self.validation_fit_percent,
-            criterion=self.criterion, input_name=self.input_name, output_name=self.output_name,
-            fit_definition=HW_FIT, initial_input=self.initial_input,
+            criterion=self.criterion, **self.channel_document(), fit_definition=HW_FIT,
+            initial_input=self.initial_input,
             candidates=[{k: (fin(v) if isinstance(v, float) else v) for k, v in c.items()}
                         for c in self.candidates],
             **({"records": self.records} if self.records else {}))
@@ -944,8 +944,7 @@ def load_hw(path) -> HWModel:
                     fit_percent=doc.get("fit_percent"),
                     validation_fit_percent=doc.get("validation_fit_percent"),
                     criterion=str(doc.get("criterion", "")),
-                    input_name=str(doc.get("input_name", "u")),
-                    output_name=str(doc.get("output_name", "y")),
+                    **channel_fields(doc), **file_provenance(doc),
                     initial_input=(None if doc.get("initial_input") is None
                                    else float(doc["initial_input"])),
                     candidates=[dict(c) for c in doc.get("candidates", [])],

@@ -65,7 +65,7 @@ from ...errors import (AccuracyWarning, ArgumentError, DataError, Identification
 from ...params import Parameter, ParameterSet
 from ...progress import track
 from ...signals.trajectory import Trajectory
-from ..model_file import FamilyFile, read_family_document
+from ..model_file import FamilyFile, file_provenance, read_family_document
 from ..model_protocol import ModelFit
 from . import hysteresis_kernels as K
 from .single_channel import SingleChannel, fit_percent, not_constant, one_signal
@@ -920,7 +920,8 @@ class PrandtlIshlinskiiModel(_HysteresisModel):
                                       input_offset=float(self.offset), fit_offset=False,
                                       dt=self.dt, input_name=self.output_name,
                                       output_name=self.input_name, input_unit=self.output_unit,
-                                      output_unit=self.input_unit,
+                                      output_unit=self.input_unit, data_file=self.data_file,
+                                      data_hash=self.data_hash,
                                       criterion=f"inverse (Kuhnen 2003) of: {self.criterion}")
 
     def to_dict(self) -> dict:
@@ -1258,7 +1259,7 @@ def load_hysteresis(path):
     try:
         common.update(input_name=str(doc["input_name"]), output_name=str(doc["output_name"]),
                       input_unit=str(doc["input_unit"]), output_unit=str(doc["output_unit"]),
-                      burn_in=int(doc.get("burn_in", 0)))
+                      burn_in=int(doc.get("burn_in", 0)), **file_provenance(doc))
         common["criterion"] = str(common["criterion"] or "")
         if kind == "bouc-wen":
             free, cov = _free_and_covariance(doc, _BW_NAMES)

@@ -53,11 +53,11 @@ from ...errors import (ArgumentError, DataError, IdentificationError, ModelError
                        emit_warning)
 from ...params import Parameter, ParameterSet
 from ...signals.trajectory import Trajectory
-from ..model_file import FamilyFile, read_family_document
+from ..model_file import FamilyFile, file_provenance, read_family_document
 from ..model_protocol import ModelFit
 from .levenberg_marquardt import Damping, fit_residuals
-from .single_channel import (DIVERGENCE_FACTOR, FreeRunModel, fit_percent, not_constant,
-                             one_signal)
+from .single_channel import (DIVERGENCE_FACTOR, FreeRunModel, channel_fields, fit_percent,
+                             not_constant, one_signal)
 from ...progress import status, track
 
 __all__ = ["SCHEMA", "NARX_FIT", "NARXModel", "polynomial_narx", "load_narx", "candidate_terms",
@@ -423,7 +423,7 @@ class NARXModel(FreeRunModel, FamilyFile):
     def parameters(self) -> ParameterSet:
         """θ as a :class:`~gripkit.params.ParameterSet` (``theta_0`` … in term order, each
         documented by its term, with its 1σ); in the units of the record the model was fitted
-        on ('1': a NARX model keeps no units)."""
+        on (``input_unit``, ``output_unit``), shown as '1': a term's unit is not derived."""
         return ParameterSet([Parameter(f"theta_{k}", float(v), "1", f"coefficient of {t}",
                                        source=f"identified (narx, {self.criterion or 'FROLS'})",
                                        std=float(s))
@@ -583,7 +583,7 @@ class NARXModel(FreeRunModel, FamilyFile):
                     prediction_fit_percent=self.prediction_fit_percent,
                     validation_fit_percent=self.validation_fit_percent, criterion=self.criterion,
                     err=[float(v) for v in self.err], frols_terms=list(self.frols_terms),
-                    input_name=self.input_name, output_name=self.output_name)
+                    **self.channel_document())
 
 
 def load_narx(path) -> NARXModel:
@@ -621,8 +621,7 @@ def _model_fields(doc: dict) -> dict:
                 criterion=str(doc.get("criterion", "")),
                 err=[float(v) for v in doc.get("err", [])],
                 frols_terms=[str(t) for t in doc.get("frols_terms", [])],
-                input_name=str(doc.get("input_name", "u")),
-                output_name=str(doc.get("output_name", "y")))
+                **channel_fields(doc), **file_provenance(doc))
 
 
 def _positive_int(v, name: str, lo: int = 1) -> int:

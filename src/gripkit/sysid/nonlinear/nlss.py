@@ -74,7 +74,7 @@ import scipy.linalg as sla
 
 from ...errors import (AccuracyWarning, ArgumentError, DataError, IdentificationError,
                        ModelError, StabilityWarning, emit_warning)
-from ..model_file import FamilyFile, read_family_document
+from ..model_file import FamilyFile, file_provenance, read_family_document
 from ..model_protocol import ModelFit, ReportMixin
 from . import nlss_kernels as K
 from ...params import Parameter, ParameterSet
@@ -428,7 +428,8 @@ def load_nlss(path) -> NLSSModel:
             validation_fit_percent=doc.get("validation_fit_percent"),
             linear_fit_percent=doc.get("linear_fit_percent"),
             linear_validation_fit_percent=doc.get("linear_validation_fit_percent"),
-            criterion=str(doc.get("criterion", "")), info=dict(doc.get("info") or {}))
+            criterion=str(doc.get("criterion", "")), info=dict(doc.get("info") or {}),
+            **file_provenance(doc))
     except (KeyError, TypeError, ValueError, AttributeError) as exc:
         raise ModelError(f"{str(p)!r}: a malformed {SCHEMA} ({type(exc).__name__}: {exc}); "
                          "write it again with NLSSModel.save") from None

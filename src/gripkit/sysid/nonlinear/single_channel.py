@@ -1,7 +1,9 @@
 """What the single-input single-output nonlinear families share about their records: the
 protocol's channel names (:class:`SingleChannel`), the fields of a model fitted on its free run
-and the limits beyond which that run counts as diverged (:class:`FreeRunModel`), the checks of
-one signal (:func:`one_signal`, :func:`not_constant`) and the free-run fit
+and the limits beyond which that run counts as diverged (:class:`FreeRunModel`; the names and
+units of its columns written and read by :meth:`FreeRunModel.channel_document` and
+:func:`channel_fields`), the checks of one signal (:func:`one_signal`, :func:`not_constant`)
+and the free-run fit
 ``100 (1 − ‖y − ŷ‖/‖y − ȳ‖)`` (:func:`fit_percent`, the definition of
 :mod:`gripkit.sysid.model_protocol`), each error message headed by the family's name."""
 
@@ -14,8 +16,8 @@ import numpy as np
 from ...errors import DataError
 from ..model_protocol import ReportMixin
 
-__all__ = ["DIVERGENCE_FACTOR", "FreeRunModel", "SingleChannel", "fit_percent", "not_constant",
-           "one_signal"]
+__all__ = ["DIVERGENCE_FACTOR", "FreeRunModel", "SingleChannel", "channel_fields", "fit_percent",
+           "not_constant", "one_signal"]
 
 #: a free run beyond this many times the estimation output's range (about its middle) counts as
 #: diverged
@@ -43,7 +45,8 @@ class FreeRunModel(SingleChannel):
     """The fields (keyword-only) of a single-channel model fitted on its free run: sample time
     ``dt`` (s), ``y_range`` (the estimation output's (min, max)), ``fit_percent`` (free run on
     the estimation record), ``validation_fit_percent`` (on ``validate=``; None when diverged or
-    none given), ``criterion`` (how the structure was chosen), the column names."""
+    none given), ``criterion`` (how the structure was chosen), the column names and their units
+    (those of the record fitted, '1' where it had none)."""
 
     dt: float = 1.0
     y_range: tuple = (-np.inf, np.inf)
@@ -52,6 +55,15 @@ class FreeRunModel(SingleChannel):
     criterion: str = ""
     input_name: str = "u"
     output_name: str = "y"
+    input_unit: str = "1"
+    output_unit: str = "1"
+
+    def channel_document(self) -> dict:
+        """The column names and units as the model file writes them (the keys of the
+        hysteresis models' file): ``input_name``, ``output_name``, ``input_unit``,
+        ``output_unit``."""
+        return dict(input_name=self.input_name, output_name=self.output_name,
+                    input_unit=self.input_unit, output_unit=self.output_unit)
 
     def _limits(self) -> tuple[float, float]:
         """The band of a free run that has not diverged: :data:`DIVERGENCE_FACTOR` times the
@@ -60,6 +72,16 @@ class FreeRunModel(SingleChannel):
         span = max(hi - lo, 1e-12)
         mid = 0.5 * (hi + lo)
         return mid - DIVERGENCE_FACTOR * span, mid + DIVERGENCE_FACTOR * span
+
+
+def channel_fields(doc: dict) -> dict:
+    """The column names and units of a model file document (:meth:`FreeRunModel.channel_document`),
+    each one missing at its default ('u', 'y', and '1' for the units of a file written before
+    the units were)."""
+    return dict(input_name=str(doc.get("input_name", "u")),
+                output_name=str(doc.get("output_name", "y")),
+                input_unit=str(doc.get("input_unit", "1")),
+                output_unit=str(doc.get("output_unit", "1")))
 
 
 def one_signal(x, name: str, family: str) -> np.ndarray:
