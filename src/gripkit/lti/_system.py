@@ -178,13 +178,14 @@ class LinearSystem:
         return np.exp(1j * w * self.dt) if self.is_discrete else 1j * w
 
     # ------------------------------------------------------------------ analysis
-    def is_stable(self) -> bool:
+    @property
+    def stable(self) -> bool:
         """Asymptotic stability: every pole with Re p < 0 (continuous) or |p| < 1 (discrete).
 
         Examples
         --------
         >>> from gripkit.lti import TransferFunction
-        >>> TransferFunction([1.0], [1.0, -0.5], dt=0.1).is_stable()
+        >>> TransferFunction([1.0], [1.0, -0.5], dt=0.1).stable
         True
         """
         p = self.poles()
