@@ -1478,7 +1478,7 @@ class TransferFunction(LinearSystem):
             if de.size == 1:
                 _initial_state(x0, 0)
                 return nu[0] * u
-            from scipy import signal  # imported on first use (0.6 s)
+            from scipy import signal  # imported on first use (import cost: docs/performance.md)
 
             return (signal.lfilter(nu, de, u[:, 0],
                                    zi=_initial_state(x0, de.size - 1))[0].reshape(-1, 1))

@@ -99,7 +99,7 @@ def warn_if_mean_detrending_hurt(model, io: IOData, raw, refit) -> None:
 
 def _method_function(method: str):
     if method == "rls":
-        from .linear.rls import rls  # numba (0.4 s): loaded only for an RLS fit
+        from .linear.rls import rls  # numba: loaded only for an RLS fit
 
         return rls
     # numba kernels: a nonlinear family's module is loaded by its first fit
@@ -307,7 +307,7 @@ def _dispatch(data, method: str, *, input, output, na: int | None, nb: int | Non
             warn_if_mean_detrending_hurt(model, io, raw, refit)
         return model
     if method == "rls":
-        from .linear.rls import rls  # numba (0.4 s): loaded only for an RLS fit
+        from .linear.rls import rls  # numba: loaded only for an RLS fit
 
         return rls(io.u1, io.y1, na, nb, nk, dt=io.dt, **options)
     if isinstance(options.get("validate"), Trajectory):  # around the estimation operating point
