@@ -420,7 +420,8 @@ def test_identify_unknown_keyword(traj, method, options, phrase):
         identify(traj, method, input="u", output="y", **options)
     msg = str(info.value)
     assert (phrase in msg
-            and "identify accepts data, method, input, output, na, nb, nk, nc, nf, detrend" in msg)
+            and "identify accepts data, method, inputs, outputs, input, output, na, nb, nk, nc, "
+            "nf, detrend" in msg)
 
 
 def test_identify_wrong_types_and_missing_arguments(traj):
@@ -429,9 +430,14 @@ def test_identify_wrong_types_and_missing_arguments(traj):
     with pytest.raises(ArgumentError, match="input must be a column name .str., found int "
                                             "3; columns: u, y"):
         identify(traj, "arx", input=3, output="y")
-    with pytest.raises(ArgumentError, match="missing a required argument: 'output'; identify "
-                                            "accepts data, method"):
+    with pytest.raises(ArgumentError, match="missing a required argument: 'outputs' .or its "
+                                            "alias 'output'.; identify accepts data, method"):
         identify(traj, "arx", input="u")
+    with pytest.raises(ArgumentError, match="inputs= and its alias input= both given "
+                                            r"\(inputs='u', input='y'\); give the column"):
+        identify(traj, "arx", inputs="u", input="y", output="y")
+    with pytest.raises(ArgumentError, match="outputs= and its alias output= both given"):
+        identify(traj, "arx", inputs="u", outputs="y", output="y")
     with pytest.raises(DataError, match="method: expected one of arx, armax, oe, rls, search"):
         identify(traj, ["arx"], input="u", output="y")
 
@@ -445,6 +451,11 @@ def test_identify_known_options_still_work(traj):
     np.testing.assert_allclose(r.theta_final, [-1.5, 0.7, 1.0, 0.5], atol=0.02)
     m = identify(traj, "arx", input="u", output="y", na=2, nb=2, nk=1)
     np.testing.assert_allclose(m.A, [1.0, -1.5, 0.7], atol=0.01)
+    # inputs=/outputs= (the documented names) and their aliases input=/output=: the same fit
+    for kw in ({"inputs": "u", "outputs": "y"}, {"inputs": "u", "output": "y"}):
+        same = identify(traj, "arx", na=2, nb=2, nk=1, **kw)
+        assert np.array_equal(same.A, m.A) and np.array_equal(same.B, m.B)
+        assert (same.input_name, same.output_name) == ("u", "y")
 
 
 @pytest.mark.parametrize("fn, args", [("arx", (2, 2, 1)), ("armax", (2, 2, 1, 1)),

@@ -22,7 +22,9 @@ def test_linear_region_equals_transfer_function():
     pid = PID(2.0, 150.0, 0.01, dt=TS, tf=0.004, c=1.0)
     e = np.r_[0.0, np.random.default_rng(0).standard_normal(500)]
     u = pid.run(e, np.zeros_like(e))
-    num, den = pid.transfer_function()
+    g = pid.transfer_function()
+    assert g.dt == TS and g.inputs == ("e",) and g.outputs == ("u",)
+    num, den = g.numerator(), g.denominator()
     # The integrator's pole at z = 1 keeps every rounding: after N samples each recursion is off by
     # at most about N·ε·Σ|num|·Σ|den|·max|e| (a first-order bound, each step adding one rounding
     # of each product), which is 100× the difference actually seen.

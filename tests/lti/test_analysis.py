@@ -30,8 +30,8 @@ def test_second_order_poles_and_dc_gain_analytic(wn, zeta):
     upper = p[np.argmax(p.imag)]
     assert abs(upper - expect) <= 10 * EPS * wn**2 / wn * max(1.0, wn)
     assert s.dc_gain()[0, 0] == pytest.approx(3.0, rel=10 * EPS * np.linalg.cond(s.A))
-    assert s.is_stable()
-    assert not StateSpace([[0.0, 1.0], [-wn**2, +0.1]], [[0.0], [1.0]], [[1.0, 0.0]]).is_stable()
+    assert s.stable
+    assert not StateSpace([[0.0, 1.0], [-wn**2, +0.1]], [[0.0], [1.0]], [[1.0, 0.0]]).stable
 
 
 def test_frequency_response_matches_python_control_mimo():

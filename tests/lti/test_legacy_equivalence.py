@@ -58,7 +58,7 @@ def test_sensor_state_space_matches_scipy():
     _, (ys,) = signal.dstep((Ad, Bd, ref.C, ref.D, 5e-5), n=400)
     np.testing.assert_allclose(d.step(400)[:, 0, 0], ys[:, 0], rtol=1e-9,
                                atol=1e-12 * np.abs(ys).max())
-    assert d.is_stable() and old.is_stable()
+    assert d.stable and old.stable
 
 
 def test_sim_array_kernels_delegate_to_lti():
@@ -175,12 +175,12 @@ def test_discrete_plant_is_a_view_of_its_transfer_function():
     np.testing.assert_allclose(np.sort_complex(p.poles()), p_ref, rtol=1e-12)
     np.testing.assert_allclose(p.zeros(), z_ref, rtol=1e-12)
     assert p.dc_gain() == pytest.approx((0.1950 - 0.2276) / (1 - 1.8732 + 0.8996), rel=1e-12)
-    assert p.is_stable() and not p.is_minimum_phase()
+    assert p.stable and not p.is_minimum_phase()
     u = np.ones(200)
     np.testing.assert_allclose(p.simulate(u, y_offset=2.0), signal.lfilter(B222, A222, u) + 2.0,
                                rtol=1e-12)
     np.testing.assert_allclose(p.scaled(3.0).B, 3.0 * np.array(B222), rtol=1e-15)
-    ss = p.to_state_space()
+    ss = p.to_ss()
     assert isinstance(ss, lti.StateSpace) and ss.inputs == ("i",) and ss.output_units == ("N",)
     for X, Y in zip(ss._arrays(), signal.tf2ss(B222, A222 + [0.0])):
         np.testing.assert_array_equal(X, Y)

@@ -28,7 +28,7 @@ def test_discrete_step_settles_at_dc_gain(wn, zeta, dt):
     sys = StateSpace(A, [[0.0], [wn**2]], [[1.0, 0.0]], [[0.0]])
     d = sys.c2d(dt)
     np.testing.assert_allclose(d.dc_gain(), sys.dc_gain(), rtol=1e-8)
-    assert d.is_stable() and sys.is_stable()
+    assert d.stable and sys.stable
 
 
 def test_simulate_matches_scipy_dlsim():

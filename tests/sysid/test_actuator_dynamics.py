@@ -9,7 +9,8 @@ import pytest
 from gripkit import Trajectory
 from gripkit.errors import DataError
 from gripkit.models import PiezoActuator
-from gripkit.sysid.physical.bouc_wen import identify_actuator_dynamics, loop_error
+from gripkit.sysid.physical.bouc_wen import (ActuatorDynamicsResult, identify_actuator_dynamics,
+                                             loop_error)
 
 STATIC = dict(d_p=1.2e-6, lam=0.2e-6, beta=0.05, gamma=0.01)
 A, B = 4e-8, 1.2e-4  # ω_n = 5000 rad/s, ζ = 0.3
@@ -24,8 +25,12 @@ def test_d_s_recovered_from_a_noise_free_step():
     static = {"d_p": STATIC["d_p"], "lambda": STATIC["lam"], "beta": STATIC["beta"],
               "gamma": STATIC["gamma"]}  # the keys of a BoucWenResult's params
     res = identify_actuator_dynamics(data, static, "U", "y", progress=False)
+    assert type(res) is ActuatorDynamicsResult
     assert res.a == pytest.approx(A, rel=1e-5)
     assert res.b == pytest.approx(B, rel=1e-5)
+    # D(s) = 1/(a s² + b s + 1): ω_n = 1/√a = 5000 rad/s, ζ = b/(2√a) = 0.3
+    assert res.natural_frequency_hz == pytest.approx(5000 / (2 * np.pi), rel=1e-5)
+    assert res.damping_ratio == pytest.approx(0.3, rel=1e-5)
 
 
 def test_loop_error_is_the_largest_gap_over_the_range():

@@ -9,6 +9,7 @@ from scipy import signal
 
 from gripkit import Trajectory
 from gripkit.errors import AccuracyWarning, DataError
+from gripkit.lti import TransferFunction
 from gripkit.models.second_order import second_order_step
 from gripkit.sysid.physical.step_response import identify_step, second_order_metrics, step_metrics
 
@@ -57,6 +58,18 @@ def test_recovers_gain_frequency_damping_within_3_sigma():
     assert r.offset == pytest.approx(3e-6, abs=5 * r.offset_std)
     np.testing.assert_allclose(r.covariance, r.covariance.T)
     assert np.all(np.linalg.eigvalsh(r.covariance) > -1e-30)
+
+
+def test_transfer_function_is_the_fitted_second_order_system():
+    """transfer_function() is an lti.TransferFunction K ω_n²/(s² + 2ζω_n s + ω_n²): its DC gain is
+    K and its poles have the fitted ω_n and ζ (analytic: s = −ζω_n ± jω_n√(1−ζ²))."""
+    r = identify_step(record(1), input="V", output="x")
+    g = r.transfer_function()
+    assert type(g) is TransferFunction and not g.is_discrete and g.meta["gain_unit"] == "m/V"
+    assert float(g.dc_gain()[0, 0]) == pytest.approx(r.gain, rel=1e-12)
+    d = g.damping()
+    np.testing.assert_allclose(d.wn, r.natural_frequency, rtol=1e-12)
+    np.testing.assert_allclose(d.zeta, r.damping_ratio, rtol=1e-9)
 
 
 def test_sigma_agrees_with_monte_carlo():

@@ -34,6 +34,7 @@ import numba
 import numpy as np
 
 from ..errors import ConfigError
+from ..lti import TransferFunction
 
 __all__ = ["PID", "pid_step", "pid_transfer", "pid_run", "PID_NPARAM", "PID_NSTATE"]
 
@@ -217,12 +218,13 @@ class PID:
         return u
 
 
-    def transfer_function(self) -> tuple[np.ndarray, np.ndarray]:
-        """(num, den) of U(z)/E(z) in powers of z (linear region, b = c = 1)."""
+    def transfer_function(self) -> TransferFunction:
+        """U(z)/E(z) (linear region, b = c = 1): a discrete :class:`gripkit.lti.TransferFunction`
+        at ``dt`` from the error ``e`` to the output ``u``."""
         kp, ki, kd, tf, dt = self.kp, self.ki, self.kd, self.tf, self.dt
         a = np.array([tf + dt, -tf])      # (T_f + Δt) z − T_f
         zm1 = np.array([1.0, -1.0])       # z − 1
         num = (kp * np.polymul(zm1, a) + ki * dt * np.concatenate([[0.0],
                                                                    a]) + kd * np.polymul(zm1, zm1))
         den = np.polymul(zm1, a)
-        return num / den[0], den / den[0]
+        return TransferFunction(num / den[0], den / den[0], dt=dt, inputs="e", outputs="u")

@@ -47,8 +47,8 @@ def controller_transfer_function(controller) -> tuple[np.ndarray, np.ndarray, fl
     """(num, den, dt) of the controller's feedback path C(z) in descending powers of z."""
 
     if isinstance(controller, PID):
-        num, den = controller.transfer_function()
-        return np.asarray(num, float), np.asarray(den, float), controller.dt
+        num, den = _tf_z(controller.transfer_function())
+        return num, den, controller.dt
     if isinstance(controller, RSTController):
         n = max(controller.R.size, controller.S.size)
         num = np.pad(np.asarray(controller.S, float), (0, n - controller.S.size))

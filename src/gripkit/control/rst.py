@@ -157,8 +157,10 @@ class DiscretePlant:
         """B(1)/A(1); ModelError at a pole at z = 1."""
         return float(self.lti.dc_gain()[0, 0])
 
-    def is_stable(self) -> bool:
-        return self.lti.is_stable()
+    @property
+    def stable(self) -> bool:
+        """Every pole of :attr:`lti` strictly inside the unit circle."""
+        return self.lti.stable
 
     def is_minimum_phase(self) -> bool:
         return self.lti.is_minimum_phase()
@@ -177,7 +179,7 @@ class DiscretePlant:
         y += y_offset
         return y
 
-    def to_state_space(self) -> StateSpace:
+    def to_ss(self) -> StateSpace:
         """Controllable canonical :class:`gripkit.lti.StateSpace` at ``dt`` (scipy's ``tf2ss``
         realisation, delay states included)."""
         return self.lti.to_ss(minimal=False, form="controllable")

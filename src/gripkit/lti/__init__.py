@@ -4,7 +4,7 @@ discrete, MIMO, with signal names and units, and optional parameter covariance.
 >>> from gripkit.lti import TransferFunction
 >>> g = TransferFunction([4.0], [1.0, 0.8, 4.0], inputs="V", outputs="x", output_units="m")
 >>> gd = g.c2d(0.05)                      # zero-order hold
->>> round(float(gd.dc_gain()[0, 0]), 12), gd.is_stable()
+>>> round(float(gd.dc_gain()[0, 0]), 12), gd.stable
 (1.0, True)
 
 Views: :class:`StateSpace` (A, B, C, D) and :class:`TransferFunction` (num/den per entry,

@@ -178,13 +178,14 @@ class LinearSystem:
         return np.exp(1j * w * self.dt) if self.is_discrete else 1j * w
 
     # ------------------------------------------------------------------ analysis
-    def is_stable(self) -> bool:
+    @property
+    def stable(self) -> bool:
         """Asymptotic stability: every pole with Re p < 0 (continuous) or |p| < 1 (discrete).
 
         Examples
         --------
         >>> from gripkit.lti import TransferFunction
-        >>> TransferFunction([1.0], [1.0, -0.5], dt=0.1).is_stable()
+        >>> TransferFunction([1.0], [1.0, -0.5], dt=0.1).stable
         True
         """
         p = self.poles()
@@ -1477,7 +1478,7 @@ class TransferFunction(LinearSystem):
             if de.size == 1:
                 _initial_state(x0, 0)
                 return nu[0] * u
-            from scipy import signal  # imported on first use (0.6 s)
+            from scipy import signal  # imported on first use (import cost: docs/performance.md)
 
             return (signal.lfilter(nu, de, u[:, 0],
                                    zi=_initial_state(x0, de.size - 1))[0].reshape(-1, 1))

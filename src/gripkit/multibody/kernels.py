@@ -60,8 +60,8 @@ ChainArrays = namedtuple("ChainArrays", "links jtype mass com inertia arm_q G q0
 #: the links' part of a chain record, what :func:`rnea_pass`, :func:`crba` and
 #: :func:`coupled_mass_bias` read (:func:`links_of` takes it out of a :data:`ChainArrays`-like
 #: record): joint types, masses, centres of mass, inertias and joint armatures. A record passed to a
-#: compiled call travels as all its arrays' fields; the five it needs keep the call as cheap as
-#: before records (the whole chain record made the DLR/HIT finger's step 13 % slower)
+#: compiled call travels as all its arrays' fields, so these kernels take only the five they need
+#: (the whole chain record slows the DLR/HIT finger's step: docs/performance.md)
 LinkArrays = namedtuple("LinkArrays", "jtype mass com inertia arm_q")
 #: scratch of the batched dynamics kernels (n links, m coordinates): link rotations and positions,
 #: RNEA/CRBA work, joint positions, rates, accelerations, zeros, joint-space mass matrix and

@@ -100,7 +100,7 @@ def warn_if_mean_detrending_hurt(model, io: IOData, raw, refit) -> None:
 
 def _method_function(method: str):
     if method == "rls":
-        from .linear.rls import rls  # numba (0.4 s): loaded only for an RLS fit
+        from .linear.rls import rls  # numba: loaded only for an RLS fit
 
         return rls
     # numba kernels: a nonlinear family's module is loaded by its first fit
@@ -149,11 +149,29 @@ def _linear_orders(na, nb, nk, nc) -> tuple:
                  for k, v in zip(("na", "nb", "nk", "nc"), (na, nb, nk, nc)))
 
 
+def _column_argument(given: dict):
+    """The one column argument in ``given`` ({'inputs': …, 'input': …}: the documented name and
+    its alias, None where not given) for :func:`identify`."""
+    (name, value), (alias, old) = given.items()
+    if value is not None and old is not None:
+        raise ArgumentError(f"identify(): {name}= and its alias {alias}= both given "
+                            f"({name}={value!r:.40}, {alias}={old!r:.40})",
+                            hint=f"give the column(s) once, as {name}=")
+    if value is None and old is None:
+        raise ArgumentError(f"identify(): missing a required argument: '{name}' (or its alias "
+                            f"'{alias}')",
+                            hint=f"identify accepts {', '.join(keyword_names(identify))}")
+    return old if value is None else value
+
+
 @entry_point
-def identify(data: Trajectory, method: str = "arx", *, input: str, output: str,
+def identify(data: Trajectory, method: str = "arx", *, inputs: str | list[str] | None = None,
+             outputs: str | list[str] | None = None, input: str | list[str] | None = None,
+             output: str | list[str] | None = None,
              na: int | None = None, nb: int | None = None, nk: int | None = None,
              nc: int | None = None, nf: int | None = None, detrend: str = "mean", **options):
-    """Identify a linear model of ``output`` driven by ``input`` from a trajectory.
+    """Identify a model of the ``outputs`` column(s) driven by the ``inputs`` column(s) from a
+    trajectory.
 
     Parameters
     ----------
@@ -183,10 +201,11 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str,
         :func:`gripkit.sysid.hysteresis`: ``model``, ``form``, ``initial_state``, ``exponent``,
         ``operators`` …); ``'nlss'``
         (polynomial nonlinear state space, options of :func:`gripkit.sysid.nlss`: ``order``,
-        ``degree``, ``validate`` …). For ss, frf, tf and nlss ``input``/``output`` may name
-        several columns (``'a,b'`` or a list).
-    input, output
-        Column names.
+        ``degree``, ``validate`` …). For ss, frf, tf, nlss (and arx, matrix-polynomial)
+        ``inputs``/``outputs`` may name several columns (``'a,b'`` or a list).
+    inputs, outputs
+        Column names (required). ``input``/``output`` are equal aliases; giving a name and its
+        alias together is an :class:`~gripkit.errors.ArgumentError`.
     na, nb, nk, nc, nf
         Orders. Not given (None): for arx, armax, oe, rls and search ``na = nb = 2``, ``nk = 1``,
         ``nc = 1`` (:data:`LINEAR_ORDERS`) and ``nf = na``; for hw chosen by the fit.
@@ -205,6 +224,8 @@ def identify(data: Trajectory, method: str = "arx", *, input: str, output: str,
     :func:`gripkit.io.load` put in the trajectory's meta (its ``data_file``, ``data_hash``); of
     several records the names joined, no hash.
     """
+    input = _column_argument({"inputs": inputs, "input": input})
+    output = _column_argument({"outputs": outputs, "output": output})
     if not isinstance(method, str) or method not in METHODS:
         raise DataError(f"method: expected one of {', '.join(METHODS)}, found {method!r}")
     opts = method_options(method)
@@ -291,7 +312,7 @@ def _dispatch(data, method: str, *, input, output, na: int | None, nb: int | Non
             warn_if_mean_detrending_hurt(model, io, raw, refit)
         return model
     if method == "rls":
-        from .linear.rls import rls  # numba (0.4 s): loaded only for an RLS fit
+        from .linear.rls import rls  # numba: loaded only for an RLS fit
 
         return rls(io.u1, io.y1, na, nb, nk, dt=io.dt, **options)
     if isinstance(options.get("validate"), Trajectory):  # around the estimation operating point

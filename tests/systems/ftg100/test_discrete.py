@@ -55,7 +55,10 @@ def test_canonical_form_matches_scipy_and_control(act):
     """The canonical form's transfer function equals scipy's ZOH of G_a(s) (eq 9), and
     python-control's
     c2d gives the same poles."""
-    num, den = act.transfer_function()
+    g = act.transfer_function()
+    assert g.inputs == ("V_in",) and g.outputs == ("x_a",) and g.output_units == ("m",)
+    assert float(g.dc_gain()[0, 0]) == pytest.approx(act.dc_gain(), rel=1e-12)
+    num, den = g.numerator(), g.denominator()
     nd, dd, _ = signal.cont2discrete((num, den), 1 / FS, method="zoh")
     d = act.discrete(1 / FS)
     n2, d2 = signal.ss2tf(d.A, d.B, d.C, d.D)

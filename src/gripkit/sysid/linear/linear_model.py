@@ -217,7 +217,7 @@ class IdentifiedLinearModel(ReportMixin):
     @property
     def stable(self) -> bool:
         """All poles strictly inside the unit circle (discrete) or left half-plane (continuous)."""
-        return self.system.is_stable()
+        return self.system.stable
 
     def _offsets(self) -> tuple[np.ndarray, np.ndarray]:
         return (np.atleast_1d(np.asarray(self.u_offset, dtype=np.float64)),
@@ -325,7 +325,7 @@ class IdentifiedLinearModel(ReportMixin):
         ``simulated``)."""
         u, yy, dt, yo = self._io(data, y, "comparison of an identified model", dt=dt)
         ss = self.to_ss(dt)
-        if not ss.is_stable():
+        if not ss.stable:
             ys = free_run(ss.A, ss.B, ss.C, ss.D, u)
             fit = [None] * ss.n_outputs
         else:

@@ -31,7 +31,7 @@ from ...signals.trajectory import Trajectory
 from ..checks import check_dimension
 from .greybox import GreyboxResult, fit
 
-__all__ = ["BoucWenResult", "DynamicsResult", "identify_bouc_wen", "loop_error",
+__all__ = ["BoucWenResult", "ActuatorDynamicsResult", "identify_bouc_wen", "loop_error",
            "identify_actuator_dynamics",
            "step_initial_guess"]
 
@@ -160,8 +160,9 @@ def identify_bouc_wen(data: Trajectory, input: str = "U", output: str = "y", *,
 
 
 @dataclass(frozen=True)
-class DynamicsResult:
-    """a (s²), b (s) of D(s) with standard deviations, and what they mean."""
+class ActuatorDynamicsResult:
+    """The piezo actuator's dynamics D(s) = 1/(a s² + b s + 1) (eq 4, §IV-C2): a (s²), b (s)
+    with standard deviations, and what they mean (natural frequency, damping ratio)."""
 
     a: float
     b: float
@@ -211,7 +212,7 @@ def step_initial_guess(t: np.ndarray, y: np.ndarray) -> tuple[float, float]:
 def identify_actuator_dynamics(data: Trajectory, static: BoucWenResult | dict, input: str = "U",
                                output: str = "y",
                                *, free=("a", "b"), initial: tuple[float, float] | None = None,
-                               progress: bool = True) -> DynamicsResult:
+                               progress: bool = True) -> ActuatorDynamicsResult:
     """a and b of D(s) (eq 4) from a voltage step measured at the same point as ``static``
     (§IV-C2, Fig. 10): a grey-box fit of Bouc-Wen (held at ``static``) followed by D(s)."""
     sp = static.params if isinstance(static, BoucWenResult) else dict(static)
@@ -226,7 +227,8 @@ def identify_actuator_dynamics(data: Trajectory, static: BoucWenResult | dict, i
                      {**data.meta, "dt": data.dt}))
     res = fit(model, tr, outputs=["y_A"], free=list(free), progress=progress)
     _warn_if_poor(res, "D(s) identification")
-    return DynamicsResult(res.value("a"), res.value("b"), res.stdev("a"), res.stdev("b"), res)
+    return ActuatorDynamicsResult(res.value("a"), res.value("b"), res.stdev("a"), res.stdev("b"),
+                                  res)
 
 
 def _warn_if_poor(res: GreyboxResult, what: str) -> None:

@@ -36,6 +36,7 @@ import numpy as np
 
 from ...arguments import entry_point
 from ...errors import AccuracyWarning, DataError, IdentificationError, SimulationError, emit_warning
+from ...lti import TransferFunction
 from ...models.second_order import SecondOrderSystem, second_order_step
 from ...signals.trajectory import Trajectory
 from ...units import ratio_unit
@@ -79,10 +80,12 @@ class StepResponseResult:
         """ω_n in rad/s."""
         return 2 * math.pi * self.natural_frequency_hz
 
-    def transfer_function(self) -> tuple[np.ndarray, np.ndarray]:
-        """(num, den) of K ω_n²/(s² + 2ζω_n s + ω_n²)."""
+    def transfer_function(self) -> TransferFunction:
+        """G(s) = K ω_n²/(s² + 2ζω_n s + ω_n²), a continuous :class:`gripkit.lti.TransferFunction`
+        (the result keeps only the gain's unit, not the channels' names and units)."""
         w = self.natural_frequency
-        return np.array([self.gain * w * w]), np.array([1.0, 2 * self.damping_ratio * w, w * w])
+        return TransferFunction([self.gain * w * w], [1.0, 2 * self.damping_ratio * w, w * w],
+                                meta={"gain_unit": self.gain_unit})
 
     def to_dict(self) -> dict:
         keys = ("gain", "gain_std", "natural_frequency_hz", "natural_frequency_hz_std",

@@ -38,8 +38,9 @@ model (:mod:`gripkit.models.bldc`; gripkit's, calibrated on Fig. 5.7) from the i
 in the state.
 
 Integration. Fixed steps (``substeps`` per sample): semi-implicit Euler (default; one
-force evaluation per step, ≥ 1000× real time at 1 kHz) or RK4 (``integrator='rk4'``) with the
-stick/slip set held over a step and events detected at step boundaries.
+force evaluation per step; its speed is in docs/performance.md) or RK4
+(``integrator='rk4'``) with the stick/slip set held over a step and events detected at step
+boundaries.
 """
 
 from __future__ import annotations

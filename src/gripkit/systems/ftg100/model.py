@@ -132,7 +132,7 @@ from ...models.beams import STRETCHING_BETA, clamped_clamped_stiffness
 from ...models.comb_drive import comb_drive_coefficient
 from ...models.second_order import second_order_batch
 from ...params import Parameter, ParameterSet
-from ...lti import StateSpace
+from ...lti import StateSpace, TransferFunction
 from ...sim.linear import c2d_zoh, simulate_discrete
 from ...sim.model import Model, Signal
 from .parameters import (DT, R_SENSITIVITY, SEED, SEED_EQ10, SEED_EQ17, STATIC_70V, ftg100_geometry,
@@ -338,10 +338,14 @@ class _SecondOrderFTG(Model):
                           (self.outputs[0].name,),
                           (self.inputs[0].unit,), (self.outputs[0].unit,), {"model": self.name})
 
-    def transfer_function(self) -> tuple[np.ndarray, np.ndarray]:
-        """(num, den) of G(s) in SI, highest power first (eqs 9, 15)."""
+    def transfer_function(self) -> TransferFunction:
+        """G(s) = gain/(m s² + c s + k) in SI (eqs 9, 15), a continuous
+        :class:`gripkit.lti.TransferFunction` with the model's input and output names and units
+        (stored monic: divided by m)."""
         m, c, k, gain, _, _ = self._coefficients(self.theta()[None, :])[0]
-        return np.array([gain]), np.array([m, c, k])
+        return TransferFunction([gain], [m, c, k], None, (self.inputs[0].name,),
+                                (self.outputs[0].name,), (self.inputs[0].unit,),
+                                (self.outputs[0].unit,), {"model": self.name})
 
     def discrete(self, dt: float = DT, form: str = "canonical") -> StateSpace:
         """ZOH discretisation every ``dt`` s: ``form='canonical'`` is the controllable canonical
@@ -394,8 +398,8 @@ class FTG100Actuated(_SecondOrderFTG):
 
     def dc_gain(self) -> float:
         """Static gain x̃_a/Ṽ_in [m/V] of eq 9."""
-        num, den = self.transfer_function()
-        return float(num[0] / den[2])
+        _, _, k, gain, _, _ = self._coefficients(self.theta()[None, :])[0]
+        return float(gain / k)
 
     def consistency_checks(self) -> list[Finding]:
         p = self.parameters

@@ -255,8 +255,8 @@ def _grasp_jobs(tpl, parts, noise, nstd, seeds, n_steps, window, cps, mset,
     (1, 0, 2) for generated noise. ``nogil``: :func:`tsfm_grasp_batch` runs slices of the jobs on
     several threads.
 
-    Compile time (measured, cold cache): one level of calls above :func:`_grasp_core` — each
-    extra level, and a ``prange`` variant (+15 s), re-optimises the whole linked grasp step."""
+    One level of calls above :func:`_grasp_core`, for compile time: each extra level, and a
+    ``prange`` variant, re-optimises the whole linked grasp step (docs/performance.md)."""
     n = tpl.A.shape[1]
     L = tpl.K + 1
     Phi = tpl.Phi.copy()

@@ -30,8 +30,8 @@ import numpy as np
 from ...errors import DataError, IdentificationError
 from ...params import ParameterSet
 from ...signals.trajectory import Trajectory
-from ...sysid.physical.bouc_wen import (BoucWenResult, DynamicsResult, identify_actuator_dynamics,
-                               identify_bouc_wen)
+from ...sysid.physical.bouc_wen import (ActuatorDynamicsResult, BoucWenResult,
+                                        identify_actuator_dynamics, identify_bouc_wen)
 from ...sysid.physical.greybox import fit
 from ...sysid.physical.modal import free_vibration
 from .end_effector import lever_coefficients, sensor_parameters
@@ -118,7 +118,7 @@ class FingerIdentification:
 
     finger: object
     bouc_wen: BoucWenResult
-    dynamics: DynamicsResult
+    dynamics: ActuatorDynamicsResult
     compliance: ComplianceResult
     modal: object
     sensor: ParameterSet
@@ -186,7 +186,7 @@ def identify_finger(loops: Trajectory, step: Trajectory, compliance: Trajectory,
                              "y_B": step[displacement]},
                     {"U": "V", "F_g": "N", "y_B": "m"}, {**step.meta, "dt": step.dt})
     ab = fit(whole, st, outputs=["y_B"], free=["a", "b"], progress=progress)
-    dyn = DynamicsResult(ab.value("a"), ab.value("b"), ab.stdev("a"), ab.stdev("b"), ab)
+    dyn = ActuatorDynamicsResult(ab.value("a"), ab.value("b"), ab.stdev("a"), ab.stdev("b"), ab)
     params = params.replace(a=dyn.a, b=dyn.b)
     stds.update(a=dyn.a_std, b=dyn.b_std)
     params = ParameterSet([p if p.name not in stds else p.with_value(p.value, std=stds[p.name],
