@@ -156,9 +156,9 @@ def test_continuous_integrators_carry_no_subnormals(method):
 
 def test_kalman_and_lqg_states_end_normal():
     """The general Kalman filter (x_p, and P_p where Q = 0 lets it decay from P0 = I) and the LQG
-    controller's predicted state, run from x0 = (1, …, 1) on 30 000 zero samples (a sensor at rest with its
-    offset removed reads exact zeros): no carried entry ends subnormal, and x_p stays within the
-    flushing bound of the vanishing exact response."""
+    controller's predicted state, run from x0 = (1, …, 1) on 30 000 zero samples (a sensor at
+    rest with its offset removed reads exact zeros): no carried entry ends subnormal, and x_p
+    stays within the flushing bound of the vanishing exact response."""
     from gripkit.control.lqg import LQG
     from gripkit.estimation import KalmanFilter
     from gripkit.lti import StateSpace
