@@ -123,7 +123,7 @@ def test_discrete_plant_is_the_q_inverse_view_of_its_transfer_function():
     np.testing.assert_allclose(p.zeros(), [1.2], rtol=1e-12)
     np.testing.assert_allclose(np.sort_complex(p.poles()), np.sort_complex(np.roots(A)), rtol=1e-12)
     assert p.dc_gain() == pytest.approx(-0.5, rel=1e-12)
-    assert p.stable and not p.is_minimum_phase()
+    assert p.stable and not p.minimum_phase
     u = np.sin(0.3 * np.arange(150)) + (np.arange(150) > 40)
     ref = lfilter(B, A, u)
     np.testing.assert_allclose(p.simulate(u), ref, atol=1e-12)

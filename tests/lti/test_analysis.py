@@ -192,6 +192,6 @@ def test_names_and_units_survive_conversions():
 
 def test_minimum_phase():
     """(s − 1)/(s + 2)² is not minimum phase, (s + 1)/(s + 2)² is (analytic)."""
-    assert not TransferFunction([1.0, -1.0], [1.0, 4.0, 4.0]).is_minimum_phase()
-    assert TransferFunction([1.0, 1.0], [1.0, 4.0, 4.0]).is_minimum_phase()
-    assert TransferFunction([1.0, 1.0], [1.0, 4.0, 4.0]).to_ss().is_minimum_phase()
+    assert not TransferFunction([1.0, -1.0], [1.0, 4.0, 4.0]).minimum_phase
+    assert TransferFunction([1.0, 1.0], [1.0, 4.0, 4.0]).minimum_phase
+    assert TransferFunction([1.0, 1.0], [1.0, 4.0, 4.0]).to_ss().minimum_phase

@@ -175,7 +175,7 @@ def test_discrete_plant_is_a_view_of_its_transfer_function():
     np.testing.assert_allclose(np.sort_complex(p.poles()), p_ref, rtol=1e-12)
     np.testing.assert_allclose(p.zeros(), z_ref, rtol=1e-12)
     assert p.dc_gain() == pytest.approx((0.1950 - 0.2276) / (1 - 1.8732 + 0.8996), rel=1e-12)
-    assert p.stable and not p.is_minimum_phase()
+    assert p.stable and not p.minimum_phase
     u = np.ones(200)
     np.testing.assert_allclose(p.simulate(u, y_offset=2.0), signal.lfilter(B222, A222, u) + 2.0,
                                rtol=1e-12)

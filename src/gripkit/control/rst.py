@@ -162,8 +162,10 @@ class DiscretePlant:
         """Every pole of :attr:`lti` strictly inside the unit circle."""
         return self.lti.stable
 
-    def is_minimum_phase(self) -> bool:
-        return self.lti.is_minimum_phase()
+    @property
+    def minimum_phase(self) -> bool:
+        """Every zero of :attr:`lti` strictly inside the unit circle."""
+        return self.lti.minimum_phase
 
     def scaled(self, gain: float, **kw) -> "DiscretePlant":
         """The plant with B multiplied by ``gain`` (unit changes, contact compliance)."""

@@ -191,7 +191,8 @@ class LinearSystem:
         p = self.poles()
         return bool(np.all(np.abs(p) < 1.0)) if self.is_discrete else bool(np.all(p.real < 0.0))
 
-    def is_minimum_phase(self) -> bool:
+    @property
+    def minimum_phase(self) -> bool:
         """Every (transmission) zero with Re z < 0 (continuous) or |z| < 1 (discrete).
 
         Examples
@@ -199,7 +200,7 @@ class LinearSystem:
         >>> from gripkit.lti import TransferFunction
         >>> g = TransferFunction.from_polynomials([1, -1.8732, 0.8996], [0, 0, 0.1950, -0.2276],
         ...                                       dt=0.005)
-        >>> g.is_minimum_phase()     # zero at z = 1.167 (000_8f66dcc7ab06470c.txt §V-F)
+        >>> g.minimum_phase     # zero at z = 1.167 (000_8f66dcc7ab06470c.txt §V-F)
         False
         """
         z = self.zeros()

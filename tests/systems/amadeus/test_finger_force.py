@@ -32,7 +32,7 @@ def test_table2_plant_is_nonminimum_phase():
     delay, stable complex poles; the SI scaling keeps poles and zeros."""
     assert RAW.nk == 2
     np.testing.assert_allclose(RAW.zeros(), [0.2276 / 0.1950], rtol=1e-12)
-    assert not RAW.is_minimum_phase() and RAW.stable
+    assert not RAW.minimum_phase and RAW.stable
     assert RAW.dc_gain() == pytest.approx((0.1950 - 0.2276) / (1 - 1.8732 + 0.8996))
     np.testing.assert_allclose(PLANT.zeros(), RAW.zeros())
     assert PLANT.dc_gain() == pytest.approx(-15.45 / 0.5)

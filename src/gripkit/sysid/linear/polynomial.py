@@ -616,7 +616,7 @@ class PolynomialModel(IdentifiedLinearModel):
     def minimum_phase(self) -> bool:
         """All zeros strictly inside the unit circle (the [2 2 2] model of Table II is not: its
         zero lies at z ≈ 1.167, §V-F)."""
-        return self.system.is_minimum_phase()
+        return self.system.minimum_phase
 
     @property
     def dc_gain(self) -> float | np.ndarray:
