@@ -28,8 +28,8 @@ from ...errors import ArgumentError, DataError, ModelError, StabilityWarning, em
 from ..checks import check_io
 from ..model_protocol import ModelFit
 
-__all__ = ["fit_percent", "records_fit", "loss_vn", "Comparison", "compare", "ResidualTests",
-           "residual_tests", "Validation", "validate"]
+__all__ = ["fit_percent", "records_fit", "loss_vn", "compare", "ResidualTests", "residual_tests",
+           "Validation", "validate"]
 
 
 def loss_vn(e: np.ndarray) -> float:
@@ -65,11 +65,6 @@ def records_fit(ys: list, yhats: list) -> np.ndarray:
         raise DataError("the fit is undefined for an output constant in every record "
                         "(Σ‖y − ȳ‖² = 0)")
     return 100.0 * (1.0 - np.sqrt(num) / np.sqrt(den))
-
-
-#: The result of :func:`compare`: the :class:`~gripkit.sysid.ModelFit` of ``model.compare``
-#: (one definition of the validation fit, not a second class).
-Comparison = ModelFit
 
 
 def _check_initial(initial: str) -> None:
