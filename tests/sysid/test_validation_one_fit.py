@@ -8,7 +8,7 @@ import pytest
 from arx_cases import A222, B222, simulate_arx
 from scipy.signal import lfilter
 
-from gripkit.errors import ModelError
+from gripkit.errors import ArgumentError, ModelError
 from gripkit.sysid import (ModelFit, PolynomialModel, armax, arx, compare, fit_percent, n4sid, oe,
                            residual_tests, validate)
 
@@ -87,3 +87,10 @@ def test_compare_two_by_two_state_space():
     np.testing.assert_allclose(got.fit_percent, ceiling, atol=0.1)
     with pytest.raises(ModelError, match="validate takes one of each"):
         validate(m, u[2000:, 0], y[2000:, 0])
+
+
+def test_compare_refuses_what_is_not_a_model():
+    """An array where the model belongs: ArgumentError naming the argument and what it expects."""
+    u, y = simulate_arx(100, seed=233)
+    with pytest.raises(ArgumentError, match="model: expected an identified model, found ndarray"):
+        compare(np.array([1.0, -0.5]), u, y)

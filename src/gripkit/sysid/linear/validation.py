@@ -79,7 +79,8 @@ def compare(model, u, y, *, initial: str = "estimate") -> ModelFit:
     transfer function) on the deviation arrays ``u``, ``y`` (``(N,)`` or ``(N, m)``, ``(N, p)``):
     exactly ``model.compare(u, y)`` (free run from the initial state estimated by least squares,
     every sample scored). Warns :class:`StabilityWarning` for an unstable model, whose
-    ``fit_percent`` is None per output."""
+    ``fit_percent`` is None per output. ``initial`` takes only ``'estimate'`` (a free run from
+    rest is ``model.simulate(u)``, never a validation fit)."""
     _check_initial(initial)
     if not callable(getattr(model, "compare", None)):
         raise ArgumentError(f"compare(): model: expected an identified model, found "
