@@ -10,9 +10,10 @@ import numpy as np
 import pytest
 from scipy import signal
 
-from gripkit import Trajectory
+from gripkit import Trajectory, sysid
 from gripkit.cli import main
-from gripkit.io import save
+from gripkit.io import load, save
+from gripkit.sysid import load_model
 from gripkit.sysid.linear.linear_model import VALIDATION_FIT
 
 
@@ -65,3 +66,12 @@ def test_validate_reports_what_compare_reports(records, capsys, command):
     assert res["validation"]["definition"] == cmp["definition"] == VALIDATION_FIT
     # the bias of 0.05 N on y1 costs fit: the model's operating point is used, not the record's mean
     assert 50.0 < cmp["fit_percent"][0] < 99.0
+    # the Python doors give that number exactly: model.compare on the record, and
+    # sysid.compare / sysid.validate on its deviations from the model's operating point
+    m, val = load_model(model), load(records["val"])
+    assert m.compare(val).fit_percent == cmp["fit_percent"]
+    u = val.as_array(*m.inputs) - m.u_offset
+    y = val.as_array(*m.outputs) - m.y_offset
+    assert sysid.compare(m, u, y).fit_percent == cmp["fit_percent"]
+    if len(m.inputs) == len(m.outputs) == 1:
+        assert sysid.validate(m, u[:, 0], y[:, 0]).fit_percent == cmp["fit_percent"][0]

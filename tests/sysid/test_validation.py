@@ -7,7 +7,7 @@ from arx_cases import A222, B222, simulate_arx
 from scipy.signal import lfilter
 
 from gripkit import DataError
-from gripkit.errors import StabilityWarning
+from gripkit.errors import ArgumentError, StabilityWarning
 from gripkit.sysid import PolynomialModel, arx, compare, fit_percent, residual_tests
 
 TRUE = PolynomialModel.from_coefficients(A222, B222, dt=0.005)  # Table II [2 2 2]
@@ -23,18 +23,20 @@ def test_fit_percent_definition():
 
 
 def test_initial_conditions_estimated_not_zero():
-    """A record that starts in the middle of a response: free run from zero initial conditions
-    misses the start; estimated initial conditions (default) and the record's past fit exactly."""
+    """A record that starts in the middle of a response: compare() is model.compare (initial
+    state estimated by least squares) and fits exactly; a free run from rest misses the start,
+    and compare() refuses to start from rest (initial='zero')."""
     u = 100 * np.random.default_rng(30).standard_normal(3000)
     y_all = lfilter(B222, A222, u)
     u2, y2 = u[1000:1400], y_all[1000:1400]
     est = compare(TRUE, u2, y2)
-    assert est.initial == "estimate" and est.fit_percent == pytest.approx(100.0, abs=1e-6)
-    # t0 = 3: the estimated past is y(1), y(2) of the record, in time order
-    np.testing.assert_allclose(est.y_past, y_all[1001:1003], rtol=1e-6)
-    assert compare(TRUE, u2, y2, initial="past").fit_percent == pytest.approx(100.0, abs=1e-6)
-    zero = compare(TRUE, u2, y2, initial="zero").fit_percent
+    assert est.fit_percent == TRUE.compare(u2, y2).fit_percent
+    assert est.fit_percent[0] == pytest.approx(100.0, abs=1e-6)
+    np.testing.assert_allclose(est.simulated[:, 0], y2, rtol=1e-6, atol=1e-6 * np.abs(y2).max())
+    zero = fit_percent(y2, TRUE.simulate(u2))
     assert zero < 99.0  # the slow poles (|p| = 0.948) carry the start-up error for ~60 samples
+    with pytest.raises(ArgumentError, match="initial: expected 'estimate'"):
+        compare(TRUE, u2, y2, initial="zero")
 
 
 def test_unstable_model_warns_and_reports_no_fit():
@@ -43,10 +45,11 @@ def test_unstable_model_warns_and_reports_no_fit():
     u, y = simulate_arx(500, noise=1.0, seed=31)
     with pytest.warns(StabilityWarning, match="unstable.*no simulation fit"):
         c = compare(unstable, u, y)
-    assert c.fit_percent is None and not c.stable
+    assert c.fit_percent == [None] and not unstable.stable
     with pytest.warns(StabilityWarning):
         v = unstable.validate(u, y)
-    assert v.fit_percent is None and np.isfinite(v.prediction_fit_percent)  # ARX predictor is FIR
+    assert v.fit_percent is None and not v.stable
+    assert np.isfinite(v.prediction_fit_percent)  # the ARX predictor is FIR
     unstable_oe = PolynomialModel.from_coefficients([1.0], [0.0, 0.0, 0.2], F=[1.0, -2.1, 1.1])
     with pytest.warns(StabilityWarning):
         v = unstable_oe.validate(u, y)  # its predictor is the diverging simulation itself

@@ -35,7 +35,6 @@ _LAZY = {
     "rls": ("linear.rls", "rls"),
     "SearchResult": ("linear.search", "SearchResult"),
     "structure_search": ("linear.search", "structure_search"),
-    "Comparison": ("linear.validation", "Comparison"),
     "ResidualTests": ("linear.validation", "ResidualTests"),
     "Validation": ("linear.validation", "Validation"),
     "compare": ("linear.validation", "compare"),
@@ -104,7 +103,6 @@ if TYPE_CHECKING:  # static readers see the same names, imported eagerly
     from .linear.rls import rls as rls
     from .linear.search import SearchResult as SearchResult
     from .linear.search import structure_search as structure_search
-    from .linear.validation import Comparison as Comparison
     from .linear.validation import ResidualTests as ResidualTests
     from .linear.validation import Validation as Validation
     from .linear.validation import compare as compare

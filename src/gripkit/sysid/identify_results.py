@@ -19,7 +19,7 @@ import numpy as np
 from ..errors import ArgumentError, DataError
 from ..signals.trajectory import Trajectory
 from .io_data import IOData, provenance_of
-from .linear.linear_model import VALIDATION_FIT, LinearModel
+from .linear.linear_model import LinearModel
 from .linear.polynomial import PolynomialModel
 
 __all__ = ["ValidationResult", "validate_model", "NARX_VALIDATION_FIT"]
@@ -31,14 +31,17 @@ NARX_VALIDATION_FIT = ("free run of the NARX model on the record as it is, start
 
 @dataclass(frozen=True)
 class ValidationResult:
-    """The validation of one model on one record.
+    """The validation of one model on one record, built from the
+    :class:`~gripkit.sysid.ModelFit` of ``model.compare(data)``.
 
-    ``fit_percent``: the free-run fit (%), a number for a SISO polynomial or NARX model, else a
+    ``fit_percent``: that free-run fit (%), a number for a SISO polynomial or NARX model, else a
     list per output; None for a model whose free run diverges. ``definition``: how it is
-    computed. ``data_file``: the record's file name (None for data built in memory).
+    computed (the ModelFit's). ``data_file``: the record's file name (None for data built in
+    memory).
     ``initial_state``: 'estimated' (least squares) or 'measured' (NARX: its first outputs).
     ``one_step``: the :class:`~gripkit.sysid.Validation` of a SISO polynomial model (one-step
-    fit, residual tests), else None."""
+    fit, residual tests; its free-run fit is ``model.compare`` of the same deviations), else
+    None."""
 
     fit_percent: float | list[float] | None
     definition: str
@@ -75,22 +78,24 @@ def validate_model(model, data: Trajectory, *, detrend: str = "mean") -> Validat
                             np.asarray(data[model.output_name])).fit_percent[0]
         return ValidationResult(fit, NARX_VALIDATION_FIT, name, initial_state="measured")
     if isinstance(model, LinearModel) or getattr(model, "multivariable", False):
-        return ValidationResult(_free_run_fit(model, data), VALIDATION_FIT, name)
+        return ValidationResult(*_free_run_fit(model, data), name)
     if not isinstance(model, PolynomialModel):
         raise ArgumentError(f"validate_model(): expected a LinearModel, PolynomialModel or "
                             f"NARXModel, found {type(model).__name__}")
-    vfit = _free_run_fit(model, data)
+    vfit, definition = _free_run_fit(model, data)
     vd = IOData.from_trajectory(data, model.input_name, model.output_name,
                                 detrend="linear" if detrend == "linear" else "none",
                                 why="validation", checks=False)
     u, y = vd.u1, vd.y1
     if detrend != "linear":  # around the model's operating point, as the fit above
         u, y = u - model.u_offset, y - model.y_offset
-    return ValidationResult(None if vfit is None else vfit[0], VALIDATION_FIT, name,
+    return ValidationResult(None if vfit is None else vfit[0], definition, name,
                             model.validate(u, y))
 
 
-def _free_run_fit(model, data) -> list[float] | None:
-    """The one validation fit per output (``model.compare(data)``), None for an unstable model,
-    whose free run diverges."""
-    return model.compare(data).fit_percent if model.stable else None
+def _free_run_fit(model, data) -> tuple[list[float] | None, str]:
+    """The one validation fit per output and its definition, those of the
+    :class:`~gripkit.sysid.ModelFit` of ``model.compare(data)``; the fit None for an unstable
+    model, whose free run diverges."""
+    fitted = model.compare(data)
+    return (fitted.fit_percent if model.stable else None), fitted.definition

@@ -184,7 +184,7 @@ def _validation_fit(theta, na, nb, nk, dt, u, y) -> float | None:
                             dt=dt, structure="arx")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # an unstable candidate simply ranks last
-        return compare(model, u, y).fit_percent
+        return compare(model, u, y).fit_percent[0]
 
 
 def _warn_edge(best: Candidate, ranges: dict) -> None:

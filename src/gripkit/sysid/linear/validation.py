@@ -2,12 +2,11 @@
 
 * Loss (eq 29 of ``000_8f66dcc7ab06470c.txt``): ``V_N = (1/N) Σ ½ e²(t)``.
 * Fit: ``100 (1 − ‖y − ŷ‖ / ‖y − ȳ‖)`` (100 % is perfect, 0 % is as good as the mean).
-* Free-run simulation ``ŷ = B/(A F) u`` on a separate record needs the model's state at the start
-  of the record. gripkit never sets it silently to zero: ``initial='estimate'`` (default) takes the
-  past inputs from the record and estimates the ``n = len(A F) − 1`` past outputs by least squares
-  (the output is affine in them); ``initial='past'`` takes the first samples of the record as the
-  past; ``initial='zero'`` must be asked for. The fit is computed from sample ``t0`` on, where
-  ``t0 = max(len(A F), len(B)) − 1`` samples serve as the past.
+* The validation fit of a model on a record is one number, ``model.compare(u, y)``
+  (:data:`~gripkit.sysid.linear.linear_model.VALIDATION_FIT`: free run from the initial state
+  estimated by least squares, every sample scored); :func:`compare` returns exactly it (a
+  :class:`~gripkit.sysid.ModelFit`) for every linear model, and :func:`validate` reports it as
+  its ``fit_percent``. gripkit never starts a validation free run silently from rest.
 * An unstable model diverges in free run: :func:`compare` warns (:class:`StabilityWarning`) and
   reports no simulation fit instead of a meaningless number.
 * Residual tests (Ljung, *System Identification*, 2nd ed., §16.6): the normalised
@@ -25,11 +24,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ...errors import DataError, StabilityWarning, emit_warning
+from ...errors import ArgumentError, DataError, ModelError, StabilityWarning, emit_warning
 from ..checks import check_io
+from ..model_protocol import ModelFit
 
-__all__ = ["fit_percent", "records_fit", "loss_vn", "Comparison", "compare", "ResidualTests",
-           "residual_tests", "Validation", "validate"]
+__all__ = ["fit_percent", "records_fit", "loss_vn", "compare", "ResidualTests", "residual_tests",
+           "Validation", "validate"]
 
 
 def loss_vn(e: np.ndarray) -> float:
@@ -67,88 +67,31 @@ def records_fit(ys: list, yhats: list) -> np.ndarray:
     return 100.0 * (1.0 - np.sqrt(num) / np.sqrt(den))
 
 
-@dataclass(frozen=True)
-class Comparison:
-    """Free-run simulation of a model against measured data.
-
-    Attributes
-    ----------
-    y_sim
-        Simulated output, shape (N,); the first ``t0`` samples are the record's own (the past).
-    t0
-        First compared sample.
-    fit_percent
-        Simulation fit on samples ``t0`` … N−1, or None when the model is unstable.
-    initial
-        How the initial conditions were obtained ('estimate', 'past' or 'zero').
-    y_past
-        The past outputs used (estimated or measured), most recent last.
-    stable
-        Whether the model's poles lie inside the unit circle.
-    """
-
-    y_sim: np.ndarray
-    t0: int
-    fit_percent: float | None
-    initial: str
-    y_past: np.ndarray
-    stable: bool
+def _check_initial(initial: str) -> None:
+    if initial != "estimate":
+        raise ArgumentError(f"initial: expected 'estimate' (the initial state estimated by least "
+                            f"squares, as model.compare), found {initial!r}",
+                            hint="a free run from rest: fit_percent(y, model.simulate(u))")
 
 
-def compare(model, u, y, *, initial: str = "estimate") -> Comparison:
-    """Simulate ``model`` in free run on the record (u, y) (deviation units) and compute the fit.
-
-    See the module docstring for ``initial``. Warns :class:`StabilityWarning` and returns
-    ``fit_percent=None`` when the model is unstable.
-    """
-    u, y = check_io(u, y)
-    if initial not in ("estimate", "past", "zero"):
-        raise DataError(f"initial: expected 'estimate', 'past' or 'zero', found {initial!r}")
-    a = model.denominator
-    n_y = a.size - 1
-    t0 = max(n_y, model.B.size - 1)
-    if y.size < t0 + max(n_y, 1) + 2:
-        raise DataError(f"validation of {model.label} needs at least "
-                        f"{t0 + max(n_y, 1) + 2} samples, "
-                        f"found {y.size}")
-    stable = model.stable
-    if not stable:
-        pmax = float(np.max(np.abs(model.poles())))
-        emit_warning(f"{model.label} is unstable (largest pole magnitude {pmax:.4g} > "
-                     "1): its free-run "
+def compare(model, u, y, *, initial: str = "estimate") -> ModelFit:
+    """The validation fit of ``model`` (any identified linear model: ARX, ARMAX, OE, state space,
+    transfer function) on the deviation arrays ``u``, ``y`` (``(N,)`` or ``(N, m)``, ``(N, p)``):
+    exactly ``model.compare(u, y)`` (free run from the initial state estimated by least squares,
+    every sample scored). Warns :class:`StabilityWarning` for an unstable model, whose
+    ``fit_percent`` is None per output. ``initial`` takes only ``'estimate'`` (a free run from
+    rest is ``model.simulate(u)``, never a validation fit)."""
+    _check_initial(initial)
+    if not callable(getattr(model, "compare", None)):
+        raise ArgumentError(f"compare(): model: expected an identified model, found "
+                            f"{type(model).__name__}", hint="gripkit.sysid.identify(...)")
+    if not getattr(model, "stable", True):
+        pmax = float(np.max(np.abs(model.system.poles())))
+        name = getattr(model, "label", model.structure)
+        emit_warning(f"{name} is unstable (largest pole magnitude {pmax:.4g} > 1): its free-run "
                      f"simulation diverges, so no simulation fit is reported", StabilityWarning)
-    u_past = u[:t0]
-    if initial == "past":
-        y_past = y[t0 - n_y:t0].copy() if n_y else np.zeros(0)
-    elif initial == "zero":
-        y_past = np.zeros(n_y)
-        u_past = np.zeros(t0)
-    else:
-        y_past = (_estimate_past(model, u[t0:], y[t0:], u_past,
-                                 n_y) if stable else y[t0 - n_y:t0].copy())
     with np.errstate(over="ignore", invalid="ignore"):
-        ys = model.simulate(u[t0:], initial="given", y_past=y_past, u_past=u_past)
-    y_sim = np.concatenate([y[:t0], ys])
-    fit = None
-    if stable and np.isfinite(ys).all():
-        fit = fit_percent(y[t0:], ys)
-    return Comparison(y_sim, t0, fit, initial, np.asarray(y_past), stable)
-
-
-def _estimate_past(model, u, y, u_past, n_y: int) -> np.ndarray:
-    """Least-squares estimate of the ``n_y`` past outputs (the output is affine in them)."""
-    forced = model.simulate(u, initial="given", y_past=np.zeros(n_y), u_past=u_past)
-    if n_y == 0:
-        return np.zeros(0)
-    zero_u = np.zeros_like(u)
-    basis = np.empty((y.size, n_y))
-    for k in range(n_y):
-        e = np.zeros(n_y)
-        e[k] = 1.0
-        basis[:, k] = (model.simulate(zero_u, initial="given", y_past=e,
-                                      u_past=np.zeros(model.B.size)))
-    z = np.linalg.lstsq(basis, y - forced, rcond=None)[0]
-    return z
+        return model.compare(u, y)
 
 
 @dataclass(frozen=True)
@@ -250,59 +193,81 @@ def residual_tests(e, u, *, lags: int = 25, alpha: float = 0.01) -> ResidualTest
 
 @dataclass(frozen=True)
 class Validation:
-    """Validation of a model on a separate record (:func:`validate`).
+    """Validation of a SISO model on a separate record (:func:`validate`).
 
     Attributes
     ----------
     simulation
-        :class:`Comparison` (free run; ``fit_percent`` None for an unstable model).
+        The :class:`~gripkit.sysid.ModelFit` of ``model.compare(u, y)`` (free run; its
+        ``fit_percent`` None for an unstable model).
     prediction_fit_percent
-        One-step-ahead prediction fit (None when the predictor 1/(C F) is unstable, e.g. an
-        unstable OE model, whose predictor is its diverging simulation).
+        One-step-ahead prediction fit (None when the predictor diverges: 1/(C F) unstable, e.g.
+        an unstable OE model, whose predictor is its diverging simulation).
     y_pred
         One-step prediction, shape (N,).
     residuals
-        One-step prediction errors from ``model.start`` on.
+        One-step prediction errors from ``model.start`` on (0 for a state-space model).
     loss
         V_N (eq 29) of those errors (None when they diverge).
     tests
         :class:`ResidualTests` of the errors against the input (None when they diverge).
+    stable
+        Whether the model's poles lie inside the unit circle.
     """
 
-    simulation: Comparison
+    simulation: ModelFit
     prediction_fit_percent: float | None
     y_pred: np.ndarray
     residuals: np.ndarray
     loss: float | None
     tests: ResidualTests | None
+    stable: bool
 
     @property
     def fit_percent(self) -> float | None:
-        """Free-run simulation fit (None for an unstable model)."""
-        return self.simulation.fit_percent
+        """Free-run simulation fit, ``model.compare(u, y).fit_percent[0]`` (None for an unstable
+        model)."""
+        return self.simulation.fit_percent[0]
 
     def to_dict(self) -> dict:
         tests = None if self.tests is None else {k: v for k, v in self.tests.to_dict().items()
                                                  if k not in ("lags", "autocorr", "crosscorr")}
         return dict(fit_percent=self.fit_percent,
                     prediction_fit_percent=self.prediction_fit_percent,
-                    loss=self.loss, initial=self.simulation.initial, stable=self.simulation.stable,
+                    loss=self.loss, initial="estimate", stable=self.stable,
                     residual_tests=tests)
 
 
 def validate(model, u, y, *, initial: str = "estimate", lags: int = 25,
              alpha: float = 0.01) -> Validation:
-    """Validate ``model`` on (u, y) (deviation units, same sampling as the estimation data):
-    free-run simulation fit, one-step prediction fit, residual whiteness and independence."""
+    """Validate the one-input, one-output ``model`` (ARX, ARMAX, OE or state space) on (u, y)
+    (deviation units, same sampling as the estimation data): the free-run fit of
+    :func:`compare` (``model.compare(u, y)``), the one-step prediction fit, residual whiteness
+    and independence."""
+    _check_initial(initial)
+    if len(model.inputs) != 1 or len(model.outputs) != 1:
+        raise ModelError(f"validate: the model has {len(model.inputs)} inputs and "
+                         f"{len(model.outputs)} outputs; validate takes one of each",
+                         hint="use model.compare(data) and model.residuals(data)")
     u, y = check_io(u, y)
-    sim = compare(model, u, y, initial=initial)
+    sim = compare(model, u, y)
     with np.errstate(over="ignore", invalid="ignore"):
-        e = model.prediction_errors(u, y)
-    t0 = model.start
+        e, t0, predictor_poles = _one_step(model, u, y)
     yp = y.copy()
     yp[t0:] = y[t0:] - e
-    cf = np.convolve(model.C, model.F)  # the predictor filters by 1/(C F)
-    if cf.size > 1 and np.any(np.abs(np.roots(cf)) >= 1.0) or not np.isfinite(e).all():
-        return Validation(sim, None, yp, e, None, None)  # diverging predictor: no numbers
+    if np.any(np.abs(predictor_poles) >= 1.0) or not np.isfinite(e).all():
+        return Validation(sim, None, yp, e, None, None, model.stable)  # no numbers
     return Validation(sim, fit_percent(y[t0:], yp[t0:]), yp, e, loss_vn(e),
-                      residual_tests(e, u[t0:], lags=lags, alpha=alpha))
+                      residual_tests(e, u[t0:], lags=lags, alpha=alpha), model.stable)
+
+
+def _one_step(model, u, y) -> tuple[np.ndarray, int, np.ndarray]:
+    """(one-step errors, first sample they start at, poles of the predictor)."""
+    if hasattr(model, "prediction_errors"):  # a polynomial model: its exact predictor
+        cf = np.convolve(model.C, model.F)  # the predictor filters by 1/(C F)
+        return (model.prediction_errors(u, y), model.start,
+                np.roots(cf) if cf.size > 1 else np.zeros(0))
+    ss = model.to_ss()  # innovation form: the predictor's poles are those of A − K C
+    K = getattr(model, "K", None)
+    a = ss.A if K is None else ss.A - K @ ss.C
+    return model.residuals(u, y)[:, 0], 0, np.linalg.eigvals(a)

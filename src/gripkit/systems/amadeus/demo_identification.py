@@ -268,9 +268,10 @@ def _validation_figures(sec, study: _Study, fits: dict, moe, val_arx, val_oe, y1
                "the OE residuals pass.", name="amadeus-residuals")
     t = study.rec["S1"].t
     sec.figure(plots.measured_vs_model(
-        t, y1r, {f"OE [2 2 2] free run (fit {val_oe.fit_percent:.1f} %)": val_oe.simulation.y_sim,
+        t, y1r, {f"OE [2 2 2] free run (fit {val_oe.fit_percent:.1f} %)":
+                 val_oe.simulation.simulated[:, 0],
                  "ARX [2 2 2] free run (fit "
-                 f"{val_arx.fit_percent:.1f} %)": val_arx.simulation.y_sim},
+                 f"{val_arx.fit_percent:.1f} %)": val_arx.simulation.simulated[:, 0]},
         extra={"noise-free force": study.rec["S1"]["force_true"]}, ylabel="force deviation [N]",
         title="Measured and modelled force on S1 (models estimated on S2; initial "
               "conditions estimated)"),
