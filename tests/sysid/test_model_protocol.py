@@ -262,6 +262,10 @@ def test_output_error_families_predict_by_their_free_run(family):
     np.testing.assert_array_equal(arrays[0].reshape(-1, 1), free)
     with pytest.raises(ArgumentError, match="horizon: expected a whole number of samples ≥ 1"):
         m.predict(tr, horizon=0)
+    for name in ("predict", "residuals"):
+        with pytest.raises(ArgumentError, match=f"{m.structure}.{name}: the record has no "
+                                                "measured output"):
+            getattr(m, name)(u)
 
 
 NAMED = {"narx": "a NARX model", "rational narx": "a rational NARX model",

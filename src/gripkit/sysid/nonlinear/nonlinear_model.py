@@ -74,6 +74,14 @@ class OutputErrorPrediction:
         """``compare`` on a trajectory, or on the arrays ``u``, ``y``."""
         return self.compare(data, y)
 
+    def _need_output(self, data, y, what: str) -> None:
+        """An ArgumentError for one input signal without its measured output."""
+        if y is None and not isinstance(data, (Trajectory, tuple, list)) and np.ndim(data) == 1:
+            raise ArgumentError(f"{self.structure}.{what}: the record has no measured output "
+                                f"(one signal of shape {np.shape(data)} given)",
+                                hint=f"{what}(trajectory) or {what}(u, y); simulate(u) runs "
+                                     "the model on an input alone")
+
     def _shaped(self, data, a: np.ndarray) -> np.ndarray:
         if self._signal_arrays and not isinstance(data, Trajectory):
             return a[:, 0]
@@ -85,11 +93,13 @@ class OutputErrorPrediction:
         scores, for every horizon ≥ 1 (an output-error predictor uses no past outputs; module
         docstring). NaN from where the run diverges, after a StabilityWarning."""
         _horizon(horizon)
+        self._need_output(data, y, "predict")
         return self._shaped(data, self._scored_run(data, y).simulated)
 
     def residuals(self, data, y=None) -> np.ndarray:
         """Prediction errors ``y − ŷ`` (:meth:`predict`) over every sample: (N, p) for a
         trajectory, (N,) for the arrays of a single-channel model."""
+        self._need_output(data, y, "residuals")
         measured = np.asarray(self._measured(data, y), dtype=np.float64)
         predicted = self._scored_run(data, y).simulated
         return self._shaped(data, measured.reshape(predicted.shape) - predicted)
