@@ -1,11 +1,14 @@
 """Issue 23, item 1: every identified model family on one protocol (gripkit.sysid.model_protocol).
 
-For each family (ARX SISO, MISO and MIMO, ARMAX, OE, N4SID, PEM, tfest, NARX): the model is an
-IdentifiedModel, save → load_model gives back the same type with the same public attributes
-(walked by :func:`assert_same_public`) and bit-identical simulate() and compare(); a model file of
+For each family (ARX SISO, MISO and MIMO, ARMAX, OE, N4SID, PEM, tfest, NARX, rational NARX,
+Hammerstein–Wiener, nonlinear state space, Bouc-Wen actuator and oscillator, Prandtl–Ishlinskii):
+the model is an IdentifiedModel, save → load_model gives back the same type with the same
+public attributes (walked by :func:`assert_same_public`) and bit-identical simulate() and
+compare(); a model file of
 schema gripkit.linear-model version 1 (written by gripkit 0.1.0 before this change, kept in
 tests/sysid/data/model_v1) loads, migrated; and the one validation fit, prediction and residuals
-agree with their definitions."""
+agree with their definitions; the output-error families predict by the free run that compare
+scores, and no nonlinear family converts to a linear system."""
 
 import json
 
@@ -13,13 +16,14 @@ import numpy as np
 import pytest
 
 from gripkit import Trajectory
-from gripkit.errors import ArgumentError
+from gripkit.errors import ArgumentError, ModelError
 from gripkit.io import load
-from gripkit.lti import LinearSystem
+from gripkit.lti import LinearSystem, TransferFunction
 from gripkit.params import ParameterSet
-from gripkit.sysid import (IdentifiedLinearModel, IdentifiedModel, LinearModel, ModelFit,
-                           PolynomialModel, armax, arx, load_model, n4sid, narx, oe,
-                           pem, tfest)
+from gripkit.sysid import (BoucWenModel, BoucWenOscillatorModel, IdentifiedLinearModel,
+                           IdentifiedModel, LinearModel, ModelFit, PolynomialModel,
+                           PrandtlIshlinskiiModel, armax, arx, hammerstein_wiener, hysteresis,
+                           load_model, n4sid, narx, nlss, oe, pem, tfest)
 
 from mimo_systems import oe_data, two_by_two
 from pathlib import Path
@@ -98,17 +102,79 @@ def _families():
     }
 
 
-FAMILIES = _families()
+def _nonlinear_records(n=400, seed=0):
+    """Small records (400 samples, noise σ in ``NOISE``) of known nonlinear systems: a saturated
+    input into the ARX [2 2 1] of :func:`_siso` (Hammerstein), a rational first-order system, a
+    second-order state space with a quadratic state term; the seed's piezo actuator for Bouc-Wen
+    (tests/sysid/test_hysteresis.py SEED), 8 plays for Prandtl–Ishlinskii, a Bouc-Wen
+    oscillator sampled every 1 ms."""
+    rng = np.random.default_rng(seed)
+    u = rng.standard_normal(n)
+    w = np.clip(u, -0.8, 0.8)
+    yh, yr, yn, x = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(2)
+    for t in range(n):
+        if t >= 2:
+            yh[t] = 1.2 * yh[t - 1] - 0.5 * yh[t - 2] + 0.8 * w[t - 1] + 0.3 * w[t - 2]
+        if t >= 1:
+            yr[t] = (0.6 * yr[t - 1] + 0.8 * u[t - 1]) / (1 + 0.3 * yr[t - 1] ** 2)
+        yn[t] = x[0]
+        x = np.array([0.7 * x[0] + 0.5 * u[t] + 0.2 * x[1] ** 2, 0.5 * x[1] + 0.4 * u[t]])
+    T = np.linspace(0.0, 1.0, n)
+    up = 50.0 + 50.0 * np.sin(2 * np.pi * 4 * T - np.pi / 2) * (1 - 0.7 * T)
+    seed_bw = dict(d=0.77e-6, alpha=0.43 / 0.77, beta=0.108, gamma=7.5e-3, offset=0.0)
+    ui = 0.85 * np.sin(2 * np.pi * 5 * T) * (1 - 0.8 * T) + 0.05
+    pi = PrandtlIshlinskiiModel(np.arange(8) * 0.1, np.array([0.5, 0.3, 0.2, 0.15, 0.1, 0.08,
+                                                              0.05, 0.03]), offset=0.2)
+    osc = BoucWenOscillatorModel(mass=1.0, damping=6.0, k_e=2000.0, k_h=2000.0, beta=300.0,
+                                 gamma=100.0, offset=0.0, dt=1e-3)
+    to = np.arange(600) * 1e-3
+    uo = 15 * np.sin(2 * np.pi * 2 * to) * (1 - 0.6 * to / to[-1])
+    uo += 5 * np.sin(2 * np.pi * 5.3 * to)
+    clean = {"hw": (u, yh), "rational narx": (u, yr), "nlss": (u, yn),
+             "bouc-wen": (up, BoucWenModel(**seed_bw).simulate(up)[:, 0]),
+             "prandtl-ishlinskii": (ui, pi.simulate(ui)[:, 0]),
+             "bouc-wen oscillator": (uo, osc.simulate(uo)[:, 0])}
+    return {k: (ui_, y + NOISE[k] * rng.standard_normal(y.size))
+            for k, (ui_, y) in clean.items()}
+
+
+#: the noise σ of each nonlinear record (in the output's unit)
+NOISE = {"hw": 0.01, "rational narx": 0.01, "nlss": 0.005, "bouc-wen": 0.2e-6,
+         "prandtl-ishlinskii": 0.005, "bouc-wen oscillator": 1e-4}
+
+
+def _nonlinear_families():
+    r = _nonlinear_records()
+    hw = hammerstein_wiener(*r["hw"], input_nonlinearity="saturation", nb=2, nf=2, nk=1, dt=0.01)
+    models = {
+        "rational narx": narx(*r["rational narx"], degree=2, lags=1, dt=0.01, basis="rational"),
+        "hw": hw,
+        "nlss": nlss(r["nlss"], order=2, degree=2, dt=0.01, progress=False),
+        "bouc-wen": hysteresis(r["bouc-wen"], dt=0.01, progress=False),
+        "prandtl-ishlinskii": hysteresis(r["prandtl-ishlinskii"], "prandtl-ishlinskii",
+                                         operators=8, dt=0.01, progress=False),
+        "bouc-wen oscillator": hysteresis(r["bouc-wen oscillator"], form="oscillator", dt=1e-3,
+                                          progress=False)}
+    return {k: (m, list(m.inputs), *r[k]) for k, m in models.items()}
+
+
+FAMILIES = _families() | _nonlinear_families()
+#: the nonlinear families; the output-error ones predict by their free run
+NONLINEAR = ("narx", "rational narx", "hw", "nlss", "bouc-wen", "prandtl-ishlinskii",
+             "bouc-wen oscillator")
+OUTPUT_ERROR = NONLINEAR[2:]
 
 
 def _record(m, u, y):
-    """A trajectory with the model's columns (offsets added back where the model has them)."""
+    """A trajectory with the model's columns sampled every ``m.dt`` (a linear model's offsets
+    added back: its arrays are deviations)."""
     u, y = np.asarray(u).reshape(len(u), -1), np.asarray(y).reshape(len(y), -1)
-    uo = np.atleast_1d(getattr(m, "u_offset", 0.0)) * np.ones(u.shape[1])
-    yo = np.atleast_1d(getattr(m, "y_offset", 0.0)) * np.ones(y.shape[1])
+    linear = isinstance(m, IdentifiedLinearModel)
+    uo = np.atleast_1d(m.u_offset if linear else 0.0) * np.ones(u.shape[1])
+    yo = np.atleast_1d(m.y_offset if linear else 0.0) * np.ones(y.shape[1])
     cols = {n: u[:, i] + uo[i] for i, n in enumerate(m.inputs)}
     cols |= {n: y[:, i] + yo[i] for i, n in enumerate(m.outputs)}
-    return Trajectory.uniform(dt=0.01, **cols)
+    return Trajectory.uniform(dt=m.dt or 0.01, **cols)
 
 
 @pytest.mark.parametrize("family", list(FAMILIES))
@@ -142,7 +208,7 @@ def test_linear_families_share_one_hierarchy_and_one_validation_fit():
     from gripkit.sysid.linear.linear_model import VALIDATION_FIT
 
     for k, (m, *_rest) in FAMILIES.items():
-        if k != "narx":
+        if k not in NONLINEAR:
             assert isinstance(m, IdentifiedLinearModel) and m.fit_definition == VALIDATION_FIT
     m, _, u, y = FAMILIES["arx siso"]
     tr = _record(m, u, y)
@@ -158,6 +224,77 @@ def test_narx_states_its_free_run_from_measured_outputs():
     assert m.compare(u, y).fit_percent == [m.fit_percent]   # the estimation fit, same definition
     p = m.parameters
     assert len(p) == len(m.terms) and [q.std for q in p.values()] == m.theta_std.tolist()
+
+
+def _free_run(m, tr):
+    """The free run that ``compare`` scores, from each family's own names: Hammerstein–Wiener from
+    the initial steady state fitted to the record, nonlinear state space from the estimated x0,
+    hysteresis from its relaxed state."""
+    u, y = tr[m.inputs[0]], tr[m.outputs[0]]
+    if m.structure == "hw":
+        return m.simulate(tr, initial_input=m.fit_initial_input(u, y))
+    if m.structure == "nlss":
+        return m.simulate(tr, x0=m.estimate_x0(tr))
+    return m.simulate(tr)
+
+
+@pytest.mark.parametrize("family", OUTPUT_ERROR)
+def test_output_error_families_predict_by_their_free_run(family):
+    """Hammerstein–Wiener, NLSS and the hysteresis models are output-error models: ŷ(t | t − k)
+    is the free run for every k (predict(tr, 1) and predict(tr, 7) are bit for bit the free run
+    compare scores), the residuals are y − ŷ over all N samples, their RMS is between 0.8 and 1.4
+    times the record's noise σ (the models fit the known systems: 0.96–1.04 σ, Hammerstein–Wiener
+    1.28 σ on its 400 samples), and the arrays of a single-channel model give one signal (N,),
+    of the NLSS model (N, p), as the linear state-space models."""
+    m, _, u, y = FAMILIES[family]
+    tr = _record(m, u, y)
+    free = _free_run(m, tr)
+    np.testing.assert_array_equal(m.predict(tr, horizon=1), free)
+    np.testing.assert_array_equal(m.predict(tr, horizon=7), free)
+    np.testing.assert_array_equal(m.compare(tr).simulated, free)
+    e = m.residuals(tr)
+    assert e.shape == (len(u), 1)
+    np.testing.assert_array_equal(e, y.reshape(-1, 1) - free)
+    assert 0.8 * NOISE[family] < np.sqrt(np.mean(e ** 2)) < 1.4 * NOISE[family]
+    arrays = (m.predict(u, y), m.residuals(u, y))
+    want = (len(u), 1) if family == "nlss" else (len(u),)
+    assert arrays[0].shape == arrays[1].shape == want
+    np.testing.assert_array_equal(arrays[0].reshape(-1, 1), free)
+    with pytest.raises(ArgumentError, match="horizon: expected a whole number of samples ≥ 1"):
+        m.predict(tr, horizon=0)
+    for name in ("predict", "residuals"):
+        with pytest.raises(ArgumentError, match=f"{m.structure}.{name}: the record has no "
+                                                "measured output"):
+            getattr(m, name)(u)
+
+
+NAMED = {"narx": "a NARX model", "rational narx": "a rational NARX model",
+         "hw": "a Hammerstein–Wiener model", "nlss": "a nonlinear state-space model",
+         "bouc-wen": "a Bouc-Wen hysteresis model", "prandtl-ishlinskii":
+         "a Prandtl–Ishlinskii model", "bouc-wen oscillator": "a Bouc-Wen oscillator model"}
+
+
+@pytest.mark.parametrize("family", NONLINEAR)
+def test_nonlinear_families_have_no_linear_system_to_convert(family):
+    """to_ss, to_tf and to_control of every nonlinear family raise a ModelError naming the
+    method and the family, with a hint where a linear view is."""
+    m = FAMILIES[family][0]
+    for name in ("to_ss", "to_tf", "to_control"):
+        with pytest.raises(ModelError, match=f"{name}: {NAMED[family]} has no linear system to "
+                                             "convert") as err:
+            getattr(m, name)()
+        assert err.value.hint and ("identify(data, 'arx'" in err.value.hint or family == "hw")
+
+
+def test_hw_hint_gives_its_linear_block():
+    """The hint of a Hammerstein–Wiener model's to_tf is true: TransferFunction.from_polynomials
+    of its B and F is its linear block, gain B(1)/F(1) at z = 1."""
+    m = FAMILIES["hw"][0]
+    with pytest.raises(ModelError) as err:
+        m.to_tf()
+    assert "TransferFunction.from_polynomials([1.0], model.B, F=model.F" in err.value.hint
+    g = TransferFunction.from_polynomials([1.0], m.B, F=m.F, dt=m.dt)
+    assert float(g.dc_gain()[0, 0]) == pytest.approx(np.sum(m.B) / np.sum(m.F), rel=1e-12)
 
 
 def test_v1_files_load_migrated():

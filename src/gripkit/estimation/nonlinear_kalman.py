@@ -541,7 +541,9 @@ def _vector(v) -> np.ndarray:
 
 
 def _is_linear(model) -> bool:
-    return hasattr(model, "to_ss") and hasattr(model, "u_offset")
+    """An identified linear model: its lti ``system`` (a nonlinear one, NLSS with its
+    ``u_offset`` included, has ``to_ss`` that refuses and no ``system``)."""
+    return hasattr(model, "to_ss") and hasattr(model, "u_offset") and hasattr(model, "system")
 
 
 def _names(model, kind: str) -> list:

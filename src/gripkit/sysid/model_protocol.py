@@ -8,17 +8,24 @@ Hammerstein–Wiener, nonlinear state space, hysteresis) is an object with these
     m.inputs, m.outputs          # column names, in the model's order
     m.dt                         # sample time [s] (None for a continuous-time model)
     m.parameters                 # ParameterSet: every free parameter with its unit and 1σ
+    m.fit_definition             # how compare scores
     m.simulate(data)             # free run on data's input columns -> (N, ny), in the file's units
+    m.predict(data, horizon=1)   # ŷ(t | t − horizon) on a record with the output columns
     m.compare(data)              # ModelFit: the fit (%) per output by m.fit_definition
+    m.residuals(data)            # y − ŷ of predict
     m.save(path)                 # atomic JSON; load_model(path) gives the same type back
     m.report(data, out)          # out/index.html: the HTML report gripkit report writes
+    m.to_ss(), m.to_tf(), m.to_control()   # the linear system (lti, python-control)
 
-The linear families (:class:`~gripkit.sysid.linear.linear_model.IdentifiedLinearModel`: state
-space, transfer function, ARX/ARMAX/OE) and NARX also give ``m.fit_definition`` (how ``compare``
-scores), ``m.predict(data, horizon=1)``, ``m.residuals(data)``; the linear ones ``m.to_ss()``,
-``m.to_tf()``, ``m.to_control()``. Optional: ``m.initial_state``, how
-``compare`` starts the free run (``'estimated'`` for the linear models, ``'measured'`` for NARX;
-``gripkit compare --json`` states it when the model has it), and
+``predict`` is each family's own predictor: the innovation-form predictor of a linear model
+(:class:`~gripkit.sysid.linear.linear_model.IdentifiedLinearModel`: state space, transfer
+function, ARX/ARMAX/OE), the one-step predictor of NARX (horizon 1 only), and for the
+output-error families (Hammerstein–Wiener, nonlinear state space, hysteresis) the free run that
+``compare`` scores, whatever the horizon (:mod:`gripkit.sysid.nonlinear.nonlinear_model`).
+``to_ss``, ``to_tf`` and ``to_control`` convert a linear model; a nonlinear one has no linear
+system and raises a ModelError naming its family and where a linear view is. Optional:
+``m.initial_state``, how ``compare`` starts the free run (``'estimated'`` for the linear
+models, ``'measured'`` for NARX; ``gripkit compare --json`` states it when the model has it), and
 ``m.display_units`` / ``m.system.output_units`` for :func:`simulated_trajectory`.
 
 ``report`` is written once, on :class:`ReportMixin`, the base of every model class: it names
@@ -66,7 +73,8 @@ class ModelFit:
 
 @runtime_checkable
 class IdentifiedModel(Protocol):
-    """What every identified model offers (see the module docstring)."""
+    """What every identified model offers, linear and nonlinear (see the module docstring; a
+    nonlinear model's ``to_*`` raise a ModelError)."""
 
     structure: str
     fit_definition: str
@@ -77,13 +85,29 @@ class IdentifiedModel(Protocol):
     @property
     def outputs(self) -> tuple[str, ...]: ...
 
+    @property
+    def dt(self) -> float | None: ...
+
+    @property
+    def parameters(self): ...
+
     def simulate(self, data, *args, **kwargs) -> np.ndarray: ...
 
+    def predict(self, data, *args, **kwargs) -> np.ndarray: ...
+
     def compare(self, data, *args, **kwargs) -> ModelFit: ...
+
+    def residuals(self, data, *args, **kwargs) -> np.ndarray: ...
 
     def save(self, path) -> object: ...
 
     def report(self, data, out, *args, **kwargs) -> Path: ...
+
+    def to_ss(self, *args, **kwargs): ...
+
+    def to_tf(self): ...
+
+    def to_control(self): ...
 
 
 # schema -> (module of gripkit.sysid, reader function); one line per model family

@@ -134,6 +134,7 @@ from ..model_file import FamilyFile, file_provenance, read_family_document
 from ..model_protocol import ModelFit
 from . import hw_kernels as K
 from .levenberg_marquardt import levenberg_marquardt
+from .nonlinear_model import OutputErrorPrediction
 from .single_channel import (DIVERGENCE_FACTOR, FreeRunModel, channel_fields, fit_percent,
                              not_constant, one_signal)
 
@@ -655,7 +656,7 @@ def _ss_start(recs, n, nk):
 
 
 @dataclass
-class HWModel(FreeRunModel, FamilyFile):
+class HWModel(OutputErrorPrediction, FreeRunModel, FamilyFile):
     """A Hammerstein–Wiener model ``ŷ = g(B/F f(u)) + y0`` (see the module docstring).
 
     ``linear``: ``'oe'`` (the linear block B/F) or ``'ss'`` (the observer canonical state-space
@@ -686,6 +687,10 @@ class HWModel(FreeRunModel, FamilyFile):
     fit_definition: str = HW_FIT
     _file_what = "Hammerstein-Wiener model"
     _file_allow_nan = False  # to_dict writes non-finite σ as null
+    _family = "a Hammerstein–Wiener model"
+    _linear_hint = ("its linear block B(q)/F(q) is model.B, model.F: "
+                    "lti.TransferFunction.from_polynomials([1.0], model.B, F=model.F, "
+                    "dt=model.dt) gives it as a system")
 
     # -- names and blocks -------------------------------------------------------------------
     @property
@@ -889,6 +894,10 @@ class HWModel(FreeRunModel, FamilyFile):
         ys = self.simulate(u, warn=warn, initial_input=self.fit_initial_input(u, yv))
         fit = _fit_value(yv, ys[:, 0]) if np.all(np.isfinite(ys)) else None
         return ModelFit(self.outputs, [fit], ys, HW_FIT)
+
+    def _measured(self, data, y) -> np.ndarray:
+        """The record's output, as :meth:`compare` reads it (for ``residuals``)."""
+        return _signal(y, "y") if y is not None else self._columns(data, True)[1]
 
     # -- files ------------------------------------------------------------------------------
     def to_dict(self) -> dict:

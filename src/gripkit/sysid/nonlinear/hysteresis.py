@@ -68,6 +68,7 @@ from ...signals.trajectory import Trajectory
 from ..model_file import FamilyFile, file_provenance, read_family_document
 from ..model_protocol import ModelFit
 from . import hysteresis_kernels as K
+from .nonlinear_model import OutputErrorPrediction
 from .single_channel import SingleChannel, fit_percent, not_constant, one_signal
 
 __all__ = ["SCHEMA", "HYSTERESIS_FIT", "MODELS", "FORMS", "BoucWenModel",
@@ -165,7 +166,7 @@ def _output_std(G: np.ndarray, cov: np.ndarray) -> np.ndarray:
 
 
 @dataclass(kw_only=True)
-class _HysteresisModel(SingleChannel, FamilyFile):
+class _HysteresisModel(OutputErrorPrediction, SingleChannel, FamilyFile):
     """What the hysteresis models share: the protocol's names, the fields below (keyword-only),
     compare, save and the common part of the model file."""
 
@@ -217,6 +218,15 @@ class _HysteresisModel(SingleChannel, FamilyFile):
             u = self._input(data)  # the family's checks of a record (the oscillator's dt)
         yhat = self.simulate(u, warn=warn)
         return ModelFit(self.outputs, [_fit_percent(y, yhat[:, 0])], yhat, HYSTERESIS_FIT)
+
+    def _scored_run(self, data, y) -> ModelFit:
+        """:meth:`compare` on a record, or on the pair ``(u, y)`` (for ``predict``)."""
+        return self.compare(data if y is None else (data, y))
+
+    def _measured(self, data, y) -> np.ndarray:
+        """The record's output, as :meth:`compare` reads it (for ``residuals``)."""
+        return _record(data if y is None else (data, y), self.input_name, self.output_name,
+                       f"{self.structure}.residuals")[1]
 
     def _document(self, **own) -> dict:
         """The model file: the schema, the model's ``own`` entries, then what every hysteresis
@@ -271,6 +281,7 @@ class BoucWenModel(_HysteresisModel):
     dt: float | None = None
 
     structure = "bouc-wen"
+    _family = "a Bouc-Wen hysteresis model"
 
     def values(self) -> dict:
         return {k: float(getattr(self, k)) for k in _BW_NAMES}
@@ -479,6 +490,7 @@ class BoucWenOscillatorModel(_HysteresisModel):
     initial_states: list = field(default_factory=list)
 
     structure = "bouc-wen-oscillator"
+    _family = "a Bouc-Wen oscillator model"
 
     def values(self) -> dict:
         return {k: float(getattr(self, k)) for k in _BWO_NAMES}
@@ -864,6 +876,7 @@ class PrandtlIshlinskiiModel(_HysteresisModel):
     dt: float | None = None
 
     structure = "prandtl-ishlinskii"
+    _family = "a Prandtl–Ishlinskii model"
 
     @property
     def weights_std(self) -> np.ndarray:
@@ -887,6 +900,12 @@ class PrandtlIshlinskiiModel(_HysteresisModel):
                              fixed=osd is None))
         ps.append(_parameter("input_offset", self.input_offset, uu, "input offset a", fixed=True))
         return ParameterSet(ps, "prandtl-ishlinskii")
+
+    @property
+    def std(self) -> dict:
+        """1σ of each fitted parameter by its name in :attr:`parameters` (``w_i``, ``offset``
+        when fitted); empty for a model without covariance (an inverse)."""
+        return {p.name: p.std for p in self.parameters.values() if p.std is not None}
 
     def _play_matrix(self, u: np.ndarray) -> np.ndarray:
         P = np.empty((len(u), len(self.thresholds)))

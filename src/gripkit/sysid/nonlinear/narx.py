@@ -403,6 +403,7 @@ class NARXModel(FreeRunModel, FamilyFile):
     basis = "polynomial"
     fit_definition = NARX_FIT
     _file_what = "NARX model"
+    _family = "a NARX model"
     #: how :meth:`compare` starts the free run: from the first ``max_lag`` measured outputs
     initial_state = "measured"
 

@@ -230,6 +230,7 @@ class RationalNARXModel(NARXModel):
     basis = "rational"
     fit_definition = RATIONAL_FIT
     _file_what = "rational NARX model"
+    _family = "a rational NARX model"
 
     den_degree: int = 1
     den_rows: np.ndarray = field(default_factory=lambda: np.zeros((0, 1), dtype=np.int64))

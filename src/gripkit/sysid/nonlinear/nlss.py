@@ -75,8 +75,9 @@ import scipy.linalg as sla
 from ...errors import (AccuracyWarning, ArgumentError, DataError, IdentificationError,
                        ModelError, StabilityWarning, emit_warning)
 from ..model_file import FamilyFile, file_provenance, read_family_document
-from ..model_protocol import ModelFit, ReportMixin
+from ..model_protocol import ModelFit
 from . import nlss_kernels as K
+from .nonlinear_model import NonlinearModel, OutputErrorPrediction
 from ...params import Parameter, ParameterSet
 from ...progress import status, track
 from ...signals.trajectory import Trajectory
@@ -167,7 +168,7 @@ def _trajectory_columns(data: Trajectory, names, kind: str, what: str) -> np.nda
 
 
 @dataclass
-class NLSSModel(ReportMixin, FamilyFile):
+class NLSSModel(OutputErrorPrediction, NonlinearModel, FamilyFile):
     """A polynomial nonlinear state-space model (module docstring).
 
     Matrices ``A`` (n, n), ``B`` (n, m), ``C`` (p, n), ``D`` (p, m), ``E`` (n, Mζ), ``F`` (p, Mη)
@@ -209,6 +210,8 @@ class NLSSModel(ReportMixin, FamilyFile):
     structure = "nlss"
     fit_definition = NLSS_FIT
     _file_what = "NLSS model"
+    _family = "a nonlinear state-space model"
+    _signal_arrays = False  # arrays in, (N, p) out, as the linear state-space models
 
     # ----------------------------------------------------------------- protocol
     @property
@@ -378,6 +381,11 @@ class NLSSModel(ReportMixin, FamilyFile):
         else:
             fit = _fits(yy, Y)
         return ModelFit(self.outputs, fit, Y, NLSS_FIT)
+
+    def _measured(self, data, y) -> np.ndarray:
+        """The record's outputs (N, p), as :meth:`compare` reads them (for ``residuals``)."""
+        n = self._inputs_of(data, "residuals").shape[0]
+        return self._outputs_of(data, y, n, "residuals")
 
     # ----------------------------------------------------------------- file
     def to_dict(self) -> dict:

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import DataError
-from ..model_protocol import ReportMixin
+from .nonlinear_model import NonlinearModel
 
 __all__ = ["DIVERGENCE_FACTOR", "FreeRunModel", "SingleChannel", "channel_fields", "fit_percent",
            "not_constant", "one_signal"]
@@ -24,9 +24,10 @@ __all__ = ["DIVERGENCE_FACTOR", "FreeRunModel", "SingleChannel", "channel_fields
 DIVERGENCE_FACTOR = 1e3
 
 
-class SingleChannel(ReportMixin):
+class SingleChannel(NonlinearModel):
     """The protocol's ``inputs`` and ``outputs`` of a model of one input and one output column,
-    named by its attributes ``input_name`` and ``output_name``."""
+    named by its attributes ``input_name`` and ``output_name`` (and, as every
+    :class:`~.nonlinear_model.NonlinearModel`, no linear system to convert)."""
 
     input_name: str
     output_name: str

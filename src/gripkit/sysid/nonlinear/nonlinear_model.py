@@ -1,0 +1,105 @@
+"""What every nonlinear family answers to the names of the model protocol
+(:mod:`gripkit.sysid.model_protocol`) that a linear model answers with its system.
+
+:class:`NonlinearModel`, the base of every nonlinear model class (through
+:class:`~.single_channel.SingleChannel` or directly): ``to_ss()``, ``to_tf()`` and
+``to_control()`` raise a ModelError that names the family (``_family``) and says where a linear
+view is (``_linear_hint``): a nonlinear model has no linear system to convert.
+
+:class:`OutputErrorPrediction`, the ``predict`` and ``residuals`` of the output-error families
+(Hammerstein–Wiener, nonlinear state space, hysteresis): their noise enters at the output, so
+the k-step predictor ``ŷ(t | t − k)`` is the free run for every horizon k ≥ 1 (Ljung,
+System Identification, 1999, §4.2: the output-error predictor uses no past outputs), started as
+``compare`` starts it (from the initial state it fits to the record, where it fits one), and
+the residuals are ``y − ŷ`` over every sample.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...errors import ArgumentError, ModelError
+from ...signals.trajectory import Trajectory
+from ..model_protocol import ModelFit, ReportMixin
+
+__all__ = ["NonlinearModel", "OutputErrorPrediction"]
+
+#: the identification methods that give a linear model, named in the hints
+LINEAR_METHODS = "identify(data, 'arx', …) or identify(data, 'ss', …)"
+
+
+class NonlinearModel(ReportMixin):
+    """The protocol's conversions of a nonlinear model: each raises a ModelError headed by the
+    family (``_family``: "a NARX model") with the class's ``_linear_hint``."""
+
+    _family = "a nonlinear model"
+    _linear_hint = f"identify a linear model ({LINEAR_METHODS}) for a linear approximation"
+
+    def _no_linear_system(self, name: str) -> ModelError:
+        return ModelError(f"{name}: {self._family} has no linear system to convert (only "
+                          "ARX, ARMAX, OE, state-space and transfer-function models have one)",
+                          hint=self._linear_hint)
+
+    def to_ss(self, dt: float | None = None):
+        """Refused: a ModelError (module docstring)."""
+        raise self._no_linear_system("to_ss")
+
+    def to_tf(self):
+        """Refused: a ModelError (module docstring)."""
+        raise self._no_linear_system("to_tf")
+
+    def to_control(self):
+        """Refused: a ModelError (module docstring)."""
+        raise self._no_linear_system("to_control")
+
+
+def _horizon(horizon) -> int:
+    """``horizon`` as a whole number of samples ≥ 1 (as the linear families take it)."""
+    if isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer)) or horizon < 1:
+        raise ArgumentError(f"horizon: expected a whole number of samples ≥ 1, found {horizon!r}",
+                            hint="horizon=1 is the one-step-ahead prediction")
+    return int(horizon)
+
+
+class OutputErrorPrediction:
+    """``predict`` and ``residuals`` of an output-error model (module docstring) from its
+    ``compare``; a family gives ``_measured(data, y)`` (the record's measured output, as its
+    ``compare`` reads it) and :meth:`_scored_run` where its ``compare`` takes the record
+    differently. ``_signal_arrays``: arrays in, one signal (N,) out (the
+    single-channel families; else (N, p), as the state-space models)."""
+
+    _signal_arrays = True
+
+    def _scored_run(self, data, y) -> ModelFit:
+        """``compare`` on a trajectory, or on the arrays ``u``, ``y``."""
+        return self.compare(data, y)
+
+    def _need_output(self, data, y, what: str) -> None:
+        """An ArgumentError for one input signal without its measured output."""
+        if y is None and not isinstance(data, (Trajectory, tuple, list)) and np.ndim(data) == 1:
+            raise ArgumentError(f"{self.structure}.{what}: the record has no measured output "
+                                f"(one signal of shape {np.shape(data)} given)",
+                                hint=f"{what}(trajectory) or {what}(u, y); simulate(u) runs "
+                                     "the model on an input alone")
+
+    def _shaped(self, data, a: np.ndarray) -> np.ndarray:
+        if self._signal_arrays and not isinstance(data, Trajectory):
+            return a[:, 0]
+        return a
+
+    def predict(self, data, y=None, horizon: int = 1) -> np.ndarray:
+        """``ŷ(t | t − horizon)`` on a trajectory with the model's columns ((N, p), its units)
+        or on the arrays ``u``, ``y`` ((N,) for one output): the free run that ``compare``
+        scores, for every horizon ≥ 1 (an output-error predictor uses no past outputs; module
+        docstring). NaN from where the run diverges, after a StabilityWarning."""
+        _horizon(horizon)
+        self._need_output(data, y, "predict")
+        return self._shaped(data, self._scored_run(data, y).simulated)
+
+    def residuals(self, data, y=None) -> np.ndarray:
+        """Prediction errors ``y − ŷ`` (:meth:`predict`) over every sample: (N, p) for a
+        trajectory, (N,) for the arrays of a single-channel model."""
+        self._need_output(data, y, "residuals")
+        measured = np.asarray(self._measured(data, y), dtype=np.float64)
+        predicted = self._scored_run(data, y).simulated
+        return self._shaped(data, measured.reshape(predicted.shape) - predicted)
