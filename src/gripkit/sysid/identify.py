@@ -45,8 +45,8 @@ from .linear.search import parse_range, structure_search
 __all__ = ["IOData", "io_data", "identify", "identify_records", "method_options", "METHODS",
            "with_provenance"]
 
-METHODS = ("arx", "armax", "oe", "rls", "search", "ss", "frf", "tf", "narx", "hw", "hysteresis",
-           "nlss")
+METHODS = ("arx", "armax", "oe", "rls", "search", "ss", "frf", "tf", "step", "narx", "hw",
+           "hysteresis", "nlss")
 
 
 def _polynomial_fit(method: str, io: IOData, orders: tuple, options: dict):
@@ -120,6 +120,10 @@ def _method_function(method: str):
         from .nonlinear.nlss import nlss
 
         return nlss
+    if method == "step":
+        from .physical.step_response import identify_step_model
+
+        return identify_step_model
     return {"arx": arx, "armax": armax, "oe": oe, "ss": identify_mimo.identify_ss, "frf": frf,
             "tf": identify_mimo.identify_tf}.get(method, structure_search)
 
@@ -136,6 +140,8 @@ def method_options(method: str) -> list[str]:
     names = keyword_names(_method_function(method), exclude=_SUPPLIED)
     if method == "ss":
         names = [n for n in names if n not in ("data", "method")] + ["weighting"]
+    if method == "step":
+        names = [n for n in names if n != "data"]
     return names
 
 
@@ -187,8 +193,13 @@ def identify(data: Trajectory, method: str = "arx", *, inputs: str | list[str] |
         such as ``'1:4'``; option ``criterion``); ``'ss'`` (state space by subspace + PEM,
         options of :func:`gripkit.sysid.linear.identify_mimo.identify_ss`), ``'frf'`` (frequency
         response, options of :func:`gripkit.sysid.linear.frf`), ``'tf'`` (continuous-time transfer
-        function, options ``poles``, ``zeros``); ``'narx'`` (polynomial NARX on the data as they
-        are, its constant term in place of detrending; options of
+        function, options ``poles``, ``zeros``); ``'step'`` (second-order step response
+        K ω_n²/(s² + 2ζω_n s + ω_n²) of a record at rest at its start, a continuous transfer
+        function with the record's offsets u₀, y₀ and its coefficients' covariance; options
+        ``solver`` (``'lm'`` or ``'trf'``), ``multistart``, ``progress`` of
+        :func:`gripkit.sysid.physical.step_response.identify_step_model`; ``detrend`` is not
+        used: the model carries its operating point); ``'narx'`` (polynomial NARX on the data as
+        they are, its constant term in place of detrending; options of
         :func:`gripkit.sysid.narx`: ``degree``, ``lags``, ``terms``, ``validate``, ``basis``
         (``'rational'``: y = N/D) …); ``'hw'``
         (Hammerstein–Wiener on the data as they are, with this function's ``nb``, ``nf``, ``nk``:
@@ -299,6 +310,9 @@ def _dispatch(data, method: str, *, input, output, na: int | None, nb: int | Non
         return _with_channels(model, io)
     if method == "hysteresis":  # rate independent, its offset a parameter: the data as they are
         return _method_function(method)(data, input=input, output=output, **options)
+    if method == "step":  # the model's u₀ (the record's start) and y₀ (fitted): the operating point
+        model = _method_function(method)(data, input=input, output=output, **options)
+        return model.with_display_units(data)
     na, nb, nk, nc = _linear_orders(na, nb, nk, nc)
     io = (io_data(data, input=input, output=output, detrend=detrend,
                   why=f"{method.upper()} identification"))

@@ -22,6 +22,13 @@ Procedure (:func:`identify_step`):
    (``method='trf'``, CLI ``--method trf``), which keeps every parameter within its bounds.
 3. Uncertainty: the asymptotic covariance σ̂²(JᵀJ)⁻¹ of the grey-box engine; σ(f_n) = σ(ω_n)/2π.
 
+As an identified model of the one protocol (:func:`identify_step_model`, what
+``identify(data, "step")`` and ``gripkit identify step`` return): a
+:class:`~gripkit.sysid.LinearModel` of structure ``'step'`` holding G(s) as a continuous
+:class:`gripkit.lti.TransferFunction` with the record's names and units, ``u_offset`` = u₀ and
+``y_offset`` = y₀, and the covariance of G's coefficients propagated from that of (K, ω_n, ζ)
+(:func:`step_model`).
+
 The result also carries the step metrics the fitted model predicts (overshoot, peak, rise and 2 %
 settling times) and :func:`step_metrics` measures them on any response (used for controllers).
 """
@@ -40,10 +47,12 @@ from ...lti import TransferFunction
 from ...models.second_order import SecondOrderSystem, second_order_step
 from ...signals.trajectory import Trajectory
 from ...units import ratio_unit
+from ..linear.linear_model import LinearModel
+from ..model_file import plain
 from .greybox import GreyboxResult, fit
 
-__all__ = (["StepResponseResult", "identify_step", "step_metrics", "second_order_metrics",
-            "STEP_METHODS"])
+__all__ = (["StepResponseResult", "identify_step", "identify_step_model", "step_model",
+            "step_summary", "step_metrics", "second_order_metrics", "STEP_METHODS"])
 
 
 @dataclass(frozen=True)
@@ -102,15 +111,22 @@ class StepResponseResult:
         return d
 
     def summary(self) -> str:
-        return (f"second-order step fit ({self.n_samples} samples every {self.dt:g} s, fit "
-                f"{self.fit_percent:.2f} %):\n"
-                f"  gain K = {self.gain:.6g} ± {self.gain_std:.2g} {self.gain_unit}\n"
-                f"  natural frequency f_n = {self.natural_frequency_hz:.6g} ± "
-                f"{self.natural_frequency_hz_std:.2g} Hz\n"
-                f"  damping ratio ζ = {self.damping_ratio:.5g} ± {self.damping_ratio_std:.2g}\n"
-                f"  predicted step: overshoot {self.overshoot_percent:.3g} %, peak "
-                f"{self.peak_time:.4g} s, "
-                f"rise (10-90 %) {self.rise_time:.4g} s, settling (2 %) {self.settling_time:.4g} s")
+        return step_summary(self.to_dict())
+
+
+def step_summary(d: dict) -> str:
+    """The text of a step fit from its :meth:`StepResponseResult.to_dict` ``d`` (as a model's
+    ``info["step"]`` keeps it: a number that is None is infinite, as the model file writes it)."""
+    d = {k: math.inf if v is None else v for k, v in d.items()}
+    return (f"second-order step fit ({d['n_samples']} samples every {d['dt']:g} s, fit "
+            f"{d['fit_percent']:.2f} %):\n"
+            f"  gain K = {d['gain']:.6g} ± {d['gain_std']:.2g} {d['gain_unit']}\n"
+            f"  natural frequency f_n = {d['natural_frequency_hz']:.6g} ± "
+            f"{d['natural_frequency_hz_std']:.2g} Hz\n"
+            f"  damping ratio ζ = {d['damping_ratio']:.5g} ± {d['damping_ratio_std']:.2g}\n"
+            f"  predicted step: overshoot {d['overshoot_percent']:.3g} %, peak "
+            f"{d['peak_time']:.4g} s, "
+            f"rise (10-90 %) {d['rise_time']:.4g} s, settling (2 %) {d['settling_time']:.4g} s")
 
 
 def _arx_start(u: np.ndarray, y: np.ndarray, dt: float):
@@ -381,3 +397,66 @@ def identify_step(data: Trajectory, *, input: str, output: str, multistart: int 
         overshoot_percent=m["overshoot_percent"], peak_time=m["peak_time"],
         rise_time=m["rise_time"],
         settling_time=m["settling_time"], y_model=y_ref + res.y_model[:, 0] * y_scale, greybox=res)
+
+
+#: the names of G's coefficients in the model's covariance, as tfest names them (den[0] = 1 fixed)
+STEP_COEFFICIENTS = ("den[1]", "den[2]", "num[2]")
+
+
+def step_model(res: StepResponseResult, *, input: str, output: str, input_unit: str | None,
+               output_unit: str | None) -> LinearModel:
+    """The :class:`~gripkit.sysid.LinearModel` (structure ``'step'``) of the step fit ``res`` of
+    column ``output`` driven by column ``input`` (in ``input_unit``, ``output_unit``):
+
+    * ``system``: G(s) = K ω_n² / (s² + 2ζω_n s + ω_n²), a continuous
+      :class:`~gripkit.lti.TransferFunction` carrying the names and units;
+    * ``u_offset`` = u₀ (the input at the record's start), ``y_offset`` = y₀ (the fitted output
+      offset): the model's free run from rest on the record is the step fit's ``y_model``;
+    * the covariance of G's free coefficients θ = (2ζω_n, ω_n², K ω_n²), named ``den[1]``,
+      ``den[2]``, ``num[2]`` as :func:`gripkit.sysid.linear.tfest` names them, is J Σ Jᵀ with Σ
+      the covariance of (K, ω_n, ζ) (``res.covariance`` over (K, f_n, ζ, y₀), f_n scaled by 2π)
+      and J = ∂θ/∂(K, ω_n, ζ) = [[0, 2ζ, 2ω_n], [0, 2ω_n, 0], [ω_n², 2Kω_n, 0]] (first-order
+      propagation);
+    * ``info["step"]``: ``res.to_dict()`` (K, f_n, ζ, y₀ with σ, the step metrics, the fit from
+      rest; non-finite numbers as None, as the model file writes them), and, as tfest's info,
+      ``natural_frequency_hz``, ``damping_ratio`` with their ``_std`` (one mode) and
+      ``num_std``/``den_std``;
+    * ``fit_percent``: left to the caller (:func:`identify_step_model` sets the validation fit on
+      the record, ``model.compare(data)``).
+    """
+    K, w, z = res.gain, res.natural_frequency, res.damping_ratio
+    to_w = np.diag([1.0, 2 * math.pi, 1.0])  # (K, f_n, ζ) → (K, ω_n, ζ)
+    sigma = to_w @ np.asarray(res.covariance)[:3, :3] @ to_w
+    J = np.array([[0.0, 2 * z, 2 * w], [0.0, 2 * w, 0.0], [w * w, 2 * K * w, 0.0]])
+    cov = J @ sigma @ J.T
+    cov = 0.5 * (cov + cov.T)
+    g = TransferFunction([0.0, 0.0, K * w * w], [1.0, 2 * z * w, w * w], inputs=[input],
+                         outputs=[output], input_units=[input_unit], output_units=[output_unit])
+    g = g.with_covariance(cov, list(STEP_COEFFICIENTS))
+    sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    info = {"step": plain(res.to_dict()),
+            "natural_frequency_hz": [res.natural_frequency_hz],
+            "natural_frequency_hz_std": [res.natural_frequency_hz_std],
+            "damping_ratio": [z], "damping_ratio_std": [res.damping_ratio_std],
+            "num_std": [0.0, 0.0, float(sd[2])], "den_std": [0.0, float(sd[0]), float(sd[1])]}
+    return LinearModel(g, "step", u_offset=(res.input_offset,), y_offset=(res.offset,),
+                       n_samples=res.n_samples, info=info)
+
+
+def identify_step_model(data: Trajectory, *, input: str, output: str, solver: str = "lm",
+                        multistart: int = 0, progress: bool = False) -> LinearModel:
+    """:func:`identify_step` as an identified model of the one protocol (:func:`step_model`),
+    what ``identify(data, "step", inputs=…, outputs=…, solver=…)`` returns: ``solver`` is
+    identify_step's ``method`` (``'lm'`` or ``'trf'``; identify's own ``method`` is ``'step'``).
+    The model's ``fit_percent`` is the validation fit on ``data`` (``model.compare(data)``: the
+    free run from the initial state estimated by least squares, which for a record at rest is
+    close to, and never below, the fit from rest in ``info["step"]["fit_percent"]``)."""
+    if solver not in STEP_METHODS:
+        raise DataError(f"solver: expected one of {', '.join(STEP_METHODS)}, found {solver!r}",
+                        hint="'lm' (Levenberg-Marquardt) or 'trf' (bounded trust-region; "
+                             "CLI: --method trf)")
+    res = identify_step(data, input=input, output=output, multistart=multistart, method=solver,
+                        progress=progress)
+    model = step_model(res, input=input, output=output, input_unit=data.unit(input),
+                       output_unit=data.unit(output))
+    return model.replace(fit_percent=model.compare(data).fit_percent)
