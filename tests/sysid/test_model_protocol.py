@@ -1,6 +1,7 @@
 """Issue 23, item 1: every identified model family on one protocol (gripkit.sysid.model_protocol).
 
-For each family (ARX SISO, MISO and MIMO, ARMAX, OE, N4SID, PEM, tfest, NARX, rational NARX,
+For each family (ARX SISO, MISO and MIMO, ARMAX, OE, N4SID, PEM, tfest, step response (a
+continuous second-order transfer function from ``identify(data, "step")``), NARX, rational NARX,
 Hammerstein–Wiener, nonlinear state space, Bouc-Wen actuator and oscillator, Prandtl–Ishlinskii):
 the model is an IdentifiedModel, save → load_model gives back the same type with the same
 public attributes (walked by :func:`assert_same_public`) and bit-identical simulate() and
@@ -23,7 +24,7 @@ from gripkit.params import ParameterSet
 from gripkit.sysid import (BoucWenModel, BoucWenOscillatorModel, IdentifiedLinearModel,
                            IdentifiedModel, LinearModel, ModelFit, PolynomialModel,
                            PrandtlIshlinskiiModel, armax, arx, hammerstein_wiener, hysteresis,
-                           load_model, n4sid, narx, nlss, oe, pem, tfest)
+                           identify, load_model, n4sid, narx, nlss, oe, pem, tfest)
 
 from mimo_systems import oe_data, two_by_two
 from pathlib import Path
@@ -99,7 +100,21 @@ def _families():
         "tfest": (tfest(u, y, 2, 1, dt=0.01, inputs=["current"], outputs=["force"]),
                   ["current"], u, y),
         "narx": (narx(u, y, degree=2, lags=2, dt=0.01), ["u"], u, y),
+        "step": _step_family(),
     }
+
+
+def _step_family():
+    """The step-response model of a second-order system (K = 1.5 N/A, ω_n = 12 rad/s, ζ = 0.4),
+    its input stepping from 0.5 A to 1.5 A at sample 20 of 300 (every 0.01 s), output noise
+    σ = 0.005 N; with the record's deviations from the model's offsets (what _record takes)."""
+    u = np.where(np.arange(300) >= 20, 1.5, 0.5)
+    w = 12.0
+    y = TransferFunction([1.5 * w * w], [1.0, 2 * 0.4 * w, w * w]).c2d(0.01).simulate(u - 0.5)
+    y = 1.0 + y[:, 0] + 0.005 * np.random.default_rng(3).standard_normal(300)
+    tr = Trajectory.uniform(dt=0.01, current=u, force=y, units={"current": "A", "force": "N"})
+    m = identify(tr, "step", inputs="current", outputs="force")
+    return m, ["current"], u - m.u_offset[0], y - m.y_offset[0]
 
 
 def _nonlinear_records(n=400, seed=0):
