@@ -388,15 +388,16 @@ class IdentifiedLinearModel(ReportMixin):
 @dataclass(frozen=True, eq=False)
 class LinearModel(IdentifiedLinearModel):
     """An identified linear model in state-space or transfer-function form (subspace, PEM,
-    tfest); the protocol is :class:`IdentifiedLinearModel`'s.
+    tfest, second-order step response); the protocol is :class:`IdentifiedLinearModel`'s.
 
     Attributes
     ----------
     system
         The :mod:`gripkit.lti` system (``StateSpace`` for subspace/PEM models, continuous
-        ``TransferFunction`` for tfest), with names, units, dt and parameter covariance.
+        ``TransferFunction`` for tfest and step), with names, units, dt and parameter covariance.
     structure
-        ``'n4sid'``, ``'moesp'``, ``'cva'``, ``'pem-oe'``, ``'pem-innovation'``, ``'tfest'``.
+        ``'n4sid'``, ``'moesp'``, ``'cva'``, ``'pem-oe'``, ``'pem-innovation'``, ``'tfest'``,
+        ``'step'`` (:func:`gripkit.sysid.physical.step_response.step_model`).
     K
         Innovation gain (n, p) or None (output-error form).
     x0
