@@ -44,6 +44,8 @@ LAZY_MODULES = {
     ("sysid/identify.py", ".nonlinear.hammerstein_wiener"): "as the line above",
     ("sysid/identify.py", ".nonlinear.hysteresis"): "as the line above",
     ("sysid/identify.py", ".nonlinear.nlss"): "as the line above",
+    ("sysid/identify.py", ".physical.step_response"):
+        "the grey-box engine's scipy.optimize (0.3 s), loaded by the first step fit",
     ("sysid/linear/identify_mimo.py", ".pem_ss"): "numba kernels: only state-space "
                                                   "identification loads them",
     ("sysid/linear/identify_mimo.py", ".subspace"): "numba kernels: only state-space "

@@ -99,33 +99,24 @@ def warn_if_mean_detrending_hurt(model, io: IOData, raw, refit) -> None:
 
 
 def _method_function(method: str):
+    # numba kernels (and scipy.optimize for the step fit): a family's module is loaded by its
+    # first fit, so that `gripkit identify arx` loads none of them
     if method == "rls":
-        from .linear.rls import rls  # numba: loaded only for an RLS fit
-
-        return rls
-    # numba kernels: a nonlinear family's module is loaded by its first fit
-    if method == "narx":
-        from .nonlinear.narx_entry import narx
-
-        return narx
-    if method == "hw":
-        from .nonlinear.hammerstein_wiener import hammerstein_wiener
-
-        return hammerstein_wiener
-    if method == "hysteresis":
-        from .nonlinear.hysteresis import hysteresis
-
-        return hysteresis
-    if method == "nlss":
-        from .nonlinear.nlss import nlss
-
-        return nlss
-    if method == "step":
-        from .physical.step_response import identify_step_model
-
-        return identify_step_model
-    return {"arx": arx, "armax": armax, "oe": oe, "ss": identify_mimo.identify_ss, "frf": frf,
-            "tf": identify_mimo.identify_tf}.get(method, structure_search)
+        from .linear.rls import rls as fit
+    elif method == "narx":
+        from .nonlinear.narx_entry import narx as fit
+    elif method == "hw":
+        from .nonlinear.hammerstein_wiener import hammerstein_wiener as fit
+    elif method == "hysteresis":
+        from .nonlinear.hysteresis import hysteresis as fit
+    elif method == "nlss":
+        from .nonlinear.nlss import nlss as fit
+    elif method == "step":
+        from .physical.step_response import identify_step_model as fit
+    else:
+        fit = {"arx": arx, "armax": armax, "oe": oe, "ss": identify_mimo.identify_ss, "frf": frf,
+               "tf": identify_mimo.identify_tf}.get(method, structure_search)
+    return fit
 
 
 #: what identify() itself passes to the method's function (not accepted as an option)

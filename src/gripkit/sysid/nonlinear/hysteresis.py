@@ -204,6 +204,10 @@ class _HysteresisModel(OutputErrorPrediction, SingleChannel, FamilyFile):
             G[:, j] = (self._run(u, hi, **run)[0] - self._run(u, lo, **run)[0]) / (2 * h)
         return _output_std(G, self.covariance)
 
+    def values(self) -> dict:
+        """Every parameter of the Bouc-Wen forms by name (``_value_names``), as floats."""
+        return {k: float(getattr(self, k)) for k in self._value_names}
+
     @property
     def std(self) -> dict:
         """1σ of each free parameter (from ``covariance``)."""
@@ -282,9 +286,7 @@ class BoucWenModel(_HysteresisModel):
 
     structure = "bouc-wen"
     _family = "a Bouc-Wen hysteresis model"
-
-    def values(self) -> dict:
-        return {k: float(getattr(self, k)) for k in _BW_NAMES}
+    _value_names = _BW_NAMES
 
     @property
     def lam(self) -> float:
@@ -491,9 +493,7 @@ class BoucWenOscillatorModel(_HysteresisModel):
 
     structure = "bouc-wen-oscillator"
     _family = "a Bouc-Wen oscillator model"
-
-    def values(self) -> dict:
-        return {k: float(getattr(self, k)) for k in _BWO_NAMES}
+    _value_names = _BWO_NAMES
 
     @property
     def parameters(self) -> ParameterSet:
