@@ -19,8 +19,8 @@ import sys
 
 from .errors import ParameterError
 
-__all__ = ["to_si", "si_factor", "ratio_unit", "si_unit", "convert", "format_quantity",
-           "same_dimension", "dimension_of"]
+__all__ = ["to_si", "si_factor", "ratio_unit", "product_unit", "si_unit", "convert",
+           "format_quantity", "same_dimension", "dimension_of"]
 
 # Unit strings gripkit uses, spelled for pint; "1" is dimensionless.
 _ALIASES = {
@@ -229,6 +229,28 @@ def ratio_unit(num: str, den: str) -> str:
         return num or "1"
     wrap = lambda u: u if all(c not in u for c in "*/ ") else f"({u})"  # noqa: E731
     return f"{wrap(num or '1')}/{wrap(den)}"
+
+
+def product_unit(*factors: tuple[str, int]) -> str:
+    """The unit of a product of integer powers of units: ``(('m', 1), ('V', -1))`` → ``'m/V'``,
+    ``(('m', 1), ('m', -1), ('V', -1))`` → ``'1/V'``, ``(('V', -2),)`` → ``'1/V^2'``. Powers of
+    the same spelling are added; dimensionless units ('1', '') and zero powers drop out; a
+    compound unit raised to a power or multiplied is parenthesised (``'(N*m)^2'``); nothing left
+    is '1'."""
+    powers: dict[str, int] = {}
+    for unit, power in factors:
+        unit = (unit or "1").strip()
+        if unit not in ("1", "") and power:
+            powers[unit] = powers.get(unit, 0) + int(power)
+    wrap = lambda u: u if all(c not in u for c in "*/ ") else f"({u})"  # noqa: E731
+
+    def side(sign: int) -> str:
+        got = [(u, p * sign) for u, p in powers.items() if p * sign > 0]
+        return "*".join(u if p == 1 and len(got) == 1 else wrap(u) if p == 1 else f"{wrap(u)}^{p}"
+                        for u, p in got)
+
+    num, den = side(1), side(-1)
+    return ratio_unit(num or "1", den or "1")
 
 
 def si_unit(unit: str) -> str:

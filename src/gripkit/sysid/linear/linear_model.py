@@ -37,7 +37,7 @@ from ...errors import (ArgumentError, DataError, DataWarning, ModelError, Parame
 from ...lti import LinearSystem, StateSpace, TransferFunction
 from ...params import Parameter, ParameterSet
 from ...signals.trajectory import Trajectory
-from ...units import convert, dimension_of, same_dimension
+from ...units import convert, dimension_of, product_unit, same_dimension
 from ..checks import as_io_matrix
 from ..model_file import SCHEMA, SCHEMA_VERSION, read_document, write_document
 from ..model_protocol import ModelFit, ReportMixin
@@ -142,6 +142,42 @@ def _checked_display_units(model, shown: dict) -> dict:
                              f"quantity as the model's {si!r}",
                              hint=f"give a unit of {name!r} in {si!r} or its multiples, or none")
     return shown
+
+
+def _coefficient_unit(s: LinearSystem, name: str, idx: tuple) -> tuple[str, str]:
+    """(unit, note for its description) of entry ``idx`` of array ``name`` of the system ``s``
+    (``'1'`` for an undeclared signal unit; time in s).
+
+    Transfer function ``num``/``den`` (p, m, L), entry (i, j) of denominator degree n: a
+    coefficient of z^k is dimensionless in the denominator and in y_i/u_j in the numerator; one
+    of s^k has s^(k−n) more (``a_1`` of ``s^n + a_1 s^(n−1) + …`` in 1/s, the numerator's constant
+    in (y_i/u_j)/s^n, so that num/den at s = 0 is in y_i/u_j). State space: ``D`` in y_i/u_j;
+    ``A``, ``B``, ``C`` in the declared state units (``x' = Ax + Bu``: A in x_i/x_j, B in
+    x_i/u_j, times 1/s for a continuous system; C in y_i/x_j), or, when the identified state basis
+    carries none, with the state taken dimensionless (and that said in the note)."""
+    def unit(units, k):
+        return (units[k] if units is not None and k < len(units) else "") or "1"
+
+    per_time = 0 if s.is_discrete else -1
+    if isinstance(s, TransferFunction):
+        i, j, k = idx
+        den = np.asarray(s.den[i, j])
+        power = (den.size - 1 - k) - (den.size - 1 - int(np.flatnonzero(den)[0]))
+        time = ("s", 0 if s.is_discrete else power)
+        if name == "den":
+            return product_unit(time), ""
+        return product_unit((unit(s.output_units, i), 1), (unit(s.input_units, j), -1),
+                            time), ""
+    i, j = idx
+    declared = any(s.state_units or ())
+    x_i, x_j = unit(s.state_units, i), unit(s.state_units, j)
+    u_j, y_i = unit(s.input_units, j), unit(s.output_units, i)
+    factors = {"A": ((x_i, 1), (x_j, -1), ("s", per_time)),
+               "B": ((x_i, 1), (u_j, -1), ("s", per_time)),
+               "C": ((y_i, 1), (x_j, -1)), "D": ((y_i, 1), (u_j, -1))}[name]
+    note = ("" if declared or name == "D" else
+            "; the identified state basis carries no unit (the state is taken dimensionless)")
+    return product_unit(*factors), note
 
 
 #: gripkit's one definition of a validation fit, used by ``identify --validate``, ``compare``,
@@ -358,7 +394,7 @@ class IdentifiedLinearModel(ReportMixin):
         """The entries of the system's arrays (``A_0_1`` for A[0, 1]; ``num``/``den`` of a
         transfer function) that the identification estimated (a non-zero tangent in the
         parameter covariance; every entry when the model has none), with their 1σ propagated
-        from that covariance. Units are those of the realisation's coordinates ('1')."""
+        from that covariance, each in its unit (:func:`_coefficient_unit`)."""
         s = self.system
         named = ([("A", s.A), ("B", s.B), ("C", s.C), ("D", s.D)] if isinstance(s, StateSpace)
                  else [("num", s.num), ("den", s.den)])
@@ -374,8 +410,9 @@ class IdentifiedLinearModel(ReportMixin):
                 free = np.any(T != 0.0, axis=0)
             for j in np.flatnonzero(free):
                 idx = np.unravel_index(j, np.shape(arr))
-                params.append(Parameter(f"{name}_{'_'.join(map(str, idx))}", float(flat[j]), "1",
-                                        f"entry {tuple(int(i) for i in idx)} of {name}",
+                unit, note = _coefficient_unit(s, name, tuple(int(i) for i in idx))
+                params.append(Parameter(f"{name}_{'_'.join(map(str, idx))}", float(flat[j]), unit,
+                                        f"entry {tuple(int(i) for i in idx)} of {name}{note}",
                                         source=src, std=None if std is None else float(std[j])))
         return ParameterSet(params, name=self.structure)
 

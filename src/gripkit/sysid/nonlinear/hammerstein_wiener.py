@@ -128,6 +128,7 @@ from ...errors import (AccuracyWarning, ArgumentError, DataError, GripkitError,
 from ...params import Parameter, ParameterSet
 from ...progress import track
 from ...signals.trajectory import Trajectory
+from ...units import product_unit
 from ..linear.frf import frf
 from ..linear.subspace import n4sid, n4sid_records
 from ..model_file import FamilyFile, file_provenance, read_family_document
@@ -796,9 +797,29 @@ class HWModel(OutputErrorPrediction, FreeRunModel, FamilyFile):
                       f"(signal {sig})"
             else:
                 doc = docs["y0" if name == "y0" else name[0]]
-            ps.append(Parameter(name, float(v), "1", doc, std=float(s),
+            ps.append(Parameter(name, float(v), self._unit(name), doc, std=float(s),
                                 source="identified (hammerstein_wiener)"))
         return ParameterSet(ps, name=f"hw {self.input_nl.label}/{self.output_nl.label}")
+
+    def _unit(self, name: str) -> str:
+        """The unit of parameter ``name`` under the gain normalisation (module docstring): ``w``
+        carries the input's unit and ``x`` the output's, so B/F's ``b`` (and the state-space
+        block's ``b``, ``d``) are in output unit per input unit and ``f``, ``a`` dimensionless;
+        a nonlinearity's limits and thresholds (``lo``, ``hi``) and sigmoid weights ``a_k`` are
+        in the unit of the signal entering it (u, or x), a polynomial's ``c_k`` in that unit to
+        the power 1 − k, the slope changes ``d_k`` of pwl dimensionless; ``y0`` in the output's
+        unit."""
+        y, u = self.output_unit, self.input_unit
+        if name == "y0":
+            return product_unit((y, 1))
+        blk, _, sub = name.partition("_")
+        if blk not in ("in", "out"):
+            return product_unit((y, 1), (u, -1)) if name[0] in "bd" else "1"
+        sig = u if blk == "in" else y
+        kind = (self.input_nl if blk == "in" else self.output_nl).kind
+        if kind == "poly":
+            return product_unit((sig, 1 - int(sub[1:])))
+        return "1" if kind == "pwl" else product_unit((sig, 1))
 
     # -- simulation -------------------------------------------------------------------------
     def _problem(self, u) -> _Problem:

@@ -53,6 +53,7 @@ from ...errors import (ArgumentError, DataError, IdentificationError, ModelError
                        emit_warning)
 from ...params import Parameter, ParameterSet
 from ...signals.trajectory import Trajectory
+from ...units import product_unit
 from ..model_file import FamilyFile, file_provenance, read_family_document
 from ..model_protocol import ModelFit
 from .levenberg_marquardt import Damping, fit_residuals
@@ -423,13 +424,26 @@ class NARXModel(FreeRunModel, FamilyFile):
     @property
     def parameters(self) -> ParameterSet:
         """θ as a :class:`~gripkit.params.ParameterSet` (``theta_0`` … in term order, each
-        documented by its term, with its 1σ); in the units of the record the model was fitted
-        on (``input_unit``, ``output_unit``), shown as '1': a term's unit is not derived."""
-        return ParameterSet([Parameter(f"theta_{k}", float(v), "1", f"coefficient of {t}",
+        documented by its term, with its 1σ); each in the output unit over its term's unit
+        (:meth:`term_unit`: 'm/V' for ``u(t-1)``, '1' for ``y(t-1)``, 'm' for the constant),
+        in the units of the record the model was fitted on (``input_unit``, ``output_unit``)."""
+        return ParameterSet([Parameter(f"theta_{k}", float(v), self.term_unit(r, 1),
+                                       f"coefficient of {t}",
                                        source=f"identified (narx, {self.criterion or 'FROLS'})",
                                        std=float(s))
-                             for k, (v, s, t) in enumerate(zip(self.theta, self.theta_std,
-                                                               self.terms))], name="narx")
+                             for k, (v, s, t, r) in enumerate(zip(self.theta, self.theta_std,
+                                                                  self.terms, self.rows))],
+                            name="narx")
+
+    def term_unit(self, row, output_power: int) -> str:
+        """The unit of the coefficient of the monomial ``row`` (base indices, −1 padded) in a sum
+        of unit ``output_unit^output_power``: that unit over the product of the factors' units
+        (``y`` in ``output_unit``, ``u`` in ``input_unit``); ``output_power`` 1 for a term of
+        the output (or of a rational model's numerator), 0 for one of a dimensionless sum (a
+        rational model's denominator)."""
+        kinds = [int(self.bases[b, 0]) for b in row if b >= 0]
+        return product_unit((self.output_unit, output_power - kinds.count(0)),
+                            (self.input_unit, -kinds.count(1)))
 
     def _signals(self, data, y, why: str, outputs: bool = True):
         """``(u, y)`` of a trajectory's columns by name, or of the signals given."""

@@ -251,17 +251,21 @@ class RationalNARXModel(NARXModel):
     @property
     def parameters(self) -> ParameterSet:
         """θ as a :class:`~gripkit.params.ParameterSet`: ``num_0`` … (the numerator's
-        coefficients) then ``den_1`` … (the denominator's; its constant is 1), each documented
-        by its term, with its 1σ."""
+        coefficients, in the output unit over their term's unit) then ``den_1`` … (the
+        denominator's, D dimensionless: one over their term's unit; its constant is 1), each
+        documented by its term, with its 1σ (units: :meth:`~.narx.NARXModel.term_unit`)."""
         nn = len(self.rows)
         names = [f"num_{k}" for k in range(nn)] + [f"den_{j + 1}"
                                                    for j in range(len(self.den_rows))]
         docs = ([f"coefficient of {t} in the numerator N" for t in self.numerator_terms]
                 + [f"coefficient of {t} in the denominator D = 1 + …"
                    for t in self.denominator_terms])
+        units = ([self.term_unit(r, 1) for r in self.rows]
+                 + [self.term_unit(r, 0) for r in self.den_rows])
         src = f"identified (rational narx, {self.criterion or 'FROLS'})"
-        return ParameterSet([Parameter(nm, float(v), "1", doc, source=src, std=float(s))
-                             for nm, v, s, doc in zip(names, self.theta, self.theta_std, docs)],
+        return ParameterSet([Parameter(nm, float(v), unit, doc, source=src, std=float(s))
+                             for nm, v, s, doc, unit in zip(names, self.theta, self.theta_std,
+                                                            docs, units)],
                             name="rational-narx")
 
     def _terms(self) -> "RationalTerms":
