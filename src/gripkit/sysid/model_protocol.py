@@ -26,7 +26,8 @@ output-error families (Hammerstein–Wiener, nonlinear state space, hysteresis) 
 system and raises a ModelError naming its family and where a linear view is. Optional:
 ``m.initial_state``, how ``compare`` starts the free run (``'estimated'`` for the linear
 models, ``'measured'`` for NARX; ``gripkit compare --json`` states it when the model has it), and
-``m.display_units`` / ``m.system.output_units`` for :func:`simulated_trajectory`.
+``m.display_units`` for :func:`simulated_trajectory`. Every family has ``m.input_units`` and
+``m.output_units``: the SI unit of each input and output column (tuples, one per channel).
 
 ``report`` is written once, on :class:`ReportMixin`, the base of every model class: it names
 the page its family gets (``_report_page``: ``'linear'``, the poles, Bode with σ and innovation
@@ -84,6 +85,12 @@ class IdentifiedModel(Protocol):
 
     @property
     def outputs(self) -> tuple[str, ...]: ...
+
+    @property
+    def input_units(self) -> tuple[str, ...]: ...
+
+    @property
+    def output_units(self) -> tuple[str, ...]: ...
 
     @property
     def dt(self) -> float | None: ...
@@ -229,14 +236,12 @@ def simulated_trajectory(model, data):
     """The free run of any identified model on the input columns of the trajectory ``data``
     (``model.simulate(data)``: by name, offsets applied, from rest) as a
     :class:`~gripkit.signals.Trajectory` on ``data``'s time base: one column per output, SI
-    values and units where the model has them (``model.system.output_units``), its display units
-    in ``meta['display_units']`` (so ``gripkit.io.save(sim, path, units="display")`` writes
-    ``force [mN]`` where the estimation file did). What ``gripkit simulate MODEL.json --data
-    DATA`` writes."""
+    values in the model's ``output_units`` (every family has them), its display units (where
+    the family keeps them: the linear models' ``display_units``) in ``meta['display_units']``
+    (so ``gripkit.io.save(sim, path, units="display")`` writes ``force [mN]`` where the
+    estimation file did). What ``gripkit simulate MODEL.json --data DATA`` writes."""
     ys = np.asarray(model.simulate(data), dtype=np.float64).reshape(data.t.size, -1)
-    system = getattr(model, "system", None)
-    units = {} if system is None else {n: u for n, u in zip(model.outputs, system.output_units)
-                                       if u}
+    units = {n: u for n, u in zip(model.outputs, model.output_units) if u}
     display = getattr(model, "display_units", None) or {}
     shown = {n: display[n] for n in model.outputs if n in display}
     return Trajectory(data.t, {n: ys[:, i] for i, n in enumerate(model.outputs)}, units,

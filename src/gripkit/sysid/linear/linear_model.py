@@ -144,6 +144,12 @@ def _checked_display_units(model, shown: dict) -> dict:
     return shown
 
 
+def _declared(units, n: int) -> tuple[str, ...]:
+    """``n`` unit strings of a system's ``units`` (None, or '' for one not declared: '1')."""
+    units = tuple(units or ())
+    return tuple((units[k] if k < len(units) else "") or "1" for k in range(n))
+
+
 def _coefficient_unit(s: LinearSystem, name: str, idx: tuple) -> tuple[str, str]:
     """(unit, note for its description) of entry ``idx`` of array ``name`` of the system ``s``
     (``'1'`` for an undeclared signal unit; time in s).
@@ -244,6 +250,16 @@ class IdentifiedLinearModel(ReportMixin):
     @property
     def outputs(self) -> tuple[str, ...]:
         return self.system.outputs
+
+    @property
+    def input_units(self) -> tuple[str, ...]:
+        """The SI unit of each input, from ``system`` ('1' where it declares none)."""
+        return _declared(self.system.input_units, len(self.inputs))
+
+    @property
+    def output_units(self) -> tuple[str, ...]:
+        """The SI unit of each output, from ``system`` ('1' where it declares none)."""
+        return _declared(self.system.output_units, len(self.outputs))
 
     @property
     def order(self) -> int:

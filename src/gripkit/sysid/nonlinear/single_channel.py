@@ -26,11 +26,15 @@ DIVERGENCE_FACTOR = 1e3
 
 class SingleChannel(NonlinearModel):
     """The protocol's ``inputs`` and ``outputs`` of a model of one input and one output column,
-    named by its attributes ``input_name`` and ``output_name`` (and, as every
+    named by its attributes ``input_name`` and ``output_name``, and their SI units
+    ``input_units`` and ``output_units`` (one-element tuples, as every family has them) from its
+    attributes ``input_unit`` and ``output_unit`` (and, as every
     :class:`~.nonlinear_model.NonlinearModel`, no linear system to convert)."""
 
     input_name: str
     output_name: str
+    input_unit: str
+    output_unit: str
 
     @property
     def inputs(self) -> tuple[str, ...]:
@@ -39,6 +43,14 @@ class SingleChannel(NonlinearModel):
     @property
     def outputs(self) -> tuple[str, ...]:
         return (self.output_name,)
+
+    @property
+    def input_units(self) -> tuple[str, ...]:
+        return (self.input_unit or "1",)
+
+    @property
+    def output_units(self) -> tuple[str, ...]:
+        return (self.output_unit or "1",)
 
 
 @dataclass(kw_only=True)
