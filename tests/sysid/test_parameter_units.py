@@ -85,7 +85,6 @@ def test_rational_narx_numerator_and_denominator_units(record):
         assert units[f"num_{k}"] == NARX_UNITS[t]
     for j, t in enumerate(m.denominator_terms):
         assert units[f"den_{j + 1}"] == DEN_UNITS[t]
-    bases, _ = candidate_terms(2, 2, 2)
     assert [m.term_unit(r, 0) for r in ([0, 0], [0, 2], [2, 3])] == \
         ["1/m^2", "1/(m*V)", "1/V^2"]
     assert m.term_unit([-1, -1], 0) == "1" and m.term_unit([-1, -1], 1) == "m"
