@@ -140,7 +140,9 @@ def _record(data, input, output, what: str, need_output: bool = True):
         return u, y, None, input or "u", output or "y", "1", "1"
     if need_output:
         raise ArgumentError(f"{what}: data must be a Trajectory or a pair (u, y), found "
-                            f"{type(data).__name__}")
+                            f"{type(data).__name__}",
+                            hint="give the record as a Trajectory, or its input and output "
+                                 "arrays u, y (the record's values)")
     return _as_signal(data, "u"), None, None, input or "u", output or "y", "1", "1"
 
 
