@@ -11,7 +11,9 @@ tests/sysid/data/model_v1) loads, migrated; and the one validation fit, predicti
 agree with their definitions; the output-error families predict by the free run that compare
 scores, and no nonlinear family converts to a linear system."""
 
+import inspect
 import json
+import re
 
 import numpy as np
 import pytest
@@ -23,8 +25,9 @@ from gripkit.lti import LinearSystem, TransferFunction
 from gripkit.params import ParameterSet
 from gripkit.sysid import (BoucWenModel, BoucWenOscillatorModel, IdentifiedLinearModel,
                            IdentifiedModel, LinearModel, ModelFit, PolynomialModel,
-                           PrandtlIshlinskiiModel, armax, arx, hammerstein_wiener, hysteresis,
-                           identify, load_model, n4sid, narx, nlss, oe, pem, tfest)
+                           PrandtlIshlinskiiModel, armax, arx, compare, hammerstein_wiener,
+                           hysteresis, identify, load_model, n4sid, narx, nlss, oe, pem, tfest,
+                           validate)
 
 from mimo_systems import oe_data, two_by_two
 from pathlib import Path
@@ -456,3 +459,108 @@ def test_mimo_arx_aic_and_names():
     s = arx(u, y, 2, 2, 1, inputs=["current"], outputs=["force"], input_units=["A"])
     assert (s.input_name, s.output_name, s.input_unit) == ("current", "force", "A")
     np.testing.assert_array_equal(s.A, arx(u, y, 2, 2, 1).A)
+
+
+#: the linear families of continuous time (tfest, step response): their arrays need dt=
+CONTINUOUS = ("tfest", "step")
+
+
+@pytest.mark.parametrize("family", list(FAMILIES))
+def test_sysid_compare_on_arrays_is_model_compare_on_the_record(family):
+    """The protocol's arrays: a linear model's deviations from its offsets, a nonlinear model's
+    record values (NLSS's u_offset/y_offset normalise inside it). On such arrays
+    sysid.compare(m, u, y) gives the fit of m.compare(trajectory), to the rounding of the
+    offsets added and removed (bit for bit for the nonlinear families), and its free run less
+    the output offsets; the arrays of a continuous model need dt= (else an ArgumentError says
+    so). The other convention does not pass: the ARX model on its raw values (u_offset 0.5,
+    y_offset 1.0) fits 58.6 % against 99.0 %."""
+    m, _, u, y = FAMILIES[family]
+    want = m.compare(_record(m, u, y))
+    timed = {}
+    if family in CONTINUOUS:
+        with pytest.raises(ArgumentError, match="the model is continuous and the arrays carry no "
+                                                "sample time"):
+            compare(m, u, y)
+        timed = {"dt": m.dt or 0.01}
+    got = compare(m, u, y, **timed)
+    assert isinstance(got, ModelFit) and got.definition == want.definition
+    if family in NONLINEAR:
+        assert got.fit_percent == want.fit_percent
+        np.testing.assert_array_equal(got.simulated, want.simulated)
+        return
+    np.testing.assert_allclose(got.fit_percent, want.fit_percent, rtol=1e-12)
+    np.testing.assert_allclose(got.simulated + np.atleast_1d(m.y_offset), want.simulated,
+                               rtol=1e-12, atol=1e-12)
+    if family == "arx siso":
+        raw = compare(m, u + m.u_offset, y + m.y_offset).fit_percent[0]
+        assert raw < want.fit_percent[0] - 30.0
+
+
+def test_every_family_simulates_with_x0_none():
+    """simulate(data, x0=None) is every family's free run of simulate(data)."""
+    for family, (m, _, u, y) in FAMILIES.items():
+        assert inspect.signature(m.simulate).parameters["x0"].default is None, family
+    m, _, u, y = FAMILIES["bouc-wen oscillator"]
+    tr = _record(m, u, y)
+    np.testing.assert_array_equal(m.simulate(tr, x0=None), m.simulate(tr))
+
+
+#: what the free run of a family without a settable initial state starts from
+STARTS = {"hw": "the steady state of its linear block under the constant input initial_input",
+          "bouc-wen": "the relaxed state h = 0 at the first input sample",
+          "prandtl-ishlinskii": "every play relaxed at the first input sample"}
+
+
+@pytest.mark.parametrize("family", list(STARTS))
+def test_families_without_an_initial_state_refuse_x0(family):
+    """Hammerstein–Wiener and the rate-independent hysteresis models have no settable initial
+    state: x0=None is their free run, a given x0 an ArgumentError naming the family and what the
+    run starts from, with a hint."""
+    m, _, u, y = FAMILIES[family]
+    tr = _record(m, u, y)
+    np.testing.assert_array_equal(m.simulate(tr, x0=None), m.simulate(tr))
+    head = (f"{m.structure}.simulate: x0: {NAMED[family]} has no settable initial state; its "
+            f"free run starts from {STARTS[family]}")
+    with pytest.raises(ArgumentError, match=re.escape(head)) as err:
+        m.simulate(tr, x0=np.zeros(2))
+    assert err.value.hint
+
+
+def test_narx_x0_is_its_first_outputs():
+    """NARX's initial state is its first max_lag outputs: simulate(u, x0=y[:2]) is the free run
+    compare scores (from the measured outputs), y0= (its older name) gives the same run, and
+    both at once are refused."""
+    m, _, u, y = FAMILIES["narx"]
+    first = y[:m.max_lag]
+    run = m.simulate(u, x0=first)
+    np.testing.assert_array_equal(run, m.compare(u, y).simulated[:, 0])
+    np.testing.assert_array_equal(m.simulate(u, y0=first), run)
+    assert not np.array_equal(m.simulate(u), run)
+    with pytest.raises(ArgumentError, match="narx.simulate: x0 and y0 both given"):
+        m.simulate(u, x0=first, y0=first)
+
+
+@pytest.mark.parametrize("family", ["narx", "hw", "nlss", "bouc-wen"])
+def test_validate_refuses_a_nonlinear_model(family):
+    """sysid.validate is the residual-test report of a linear model: a nonlinear one is refused
+    with a ModelError naming the family and pointing to compare and residuals; sysid.compare
+    takes no dt for it (it runs on samples)."""
+    m, _, u, y = FAMILIES[family]
+    with pytest.raises(ModelError, match=f"validate: {NAMED[family]} is not a linear model; "
+                                         "validate is the residual-test report") as err:
+        validate(m, u, y)
+    assert "model.compare(data)" in err.value.hint and "model.residuals(data)" in err.value.hint
+    with pytest.raises(ArgumentError, match="dt= is the arrays' sample time of a linear model"):
+        compare(m, u, y, dt=0.01)
+
+
+def test_state_space_model_validates_as_sysid_validate():
+    """LinearModel.validate is sysid.validate: a SISO state-space model of the ARX [2 2 1] record
+    reports the fit of compare and the residual tests of its one-step errors."""
+    u, y = _siso(800)
+    m = n4sid(u[:400], y[:400], 2, dt=0.01)
+    assert type(m) is LinearModel
+    v = m.validate(u[400:], y[400:])
+    assert v.to_dict() == validate(m, u[400:], y[400:]).to_dict()
+    assert v.fit_percent == m.compare(u[400:], y[400:]).fit_percent[0] > 95.0
+    np.testing.assert_array_equal(v.residuals, m.residuals(u[400:], y[400:])[:, 0])

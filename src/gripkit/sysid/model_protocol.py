@@ -9,7 +9,7 @@ Hammerstein–Wiener, nonlinear state space, hysteresis) is an object with these
     m.dt                         # sample time [s] (None for a continuous-time model)
     m.parameters                 # ParameterSet: every free parameter with its unit and 1σ
     m.fit_definition             # how compare scores
-    m.simulate(data)             # free run on data's input columns -> (N, ny), in the file's units
+    m.simulate(data, x0=None)    # free run on data's input columns -> (N, ny), in the file's units
     m.predict(data, horizon=1)   # ŷ(t | t − horizon) on a record with the output columns
     m.compare(data)              # ModelFit: the fit (%) per output by m.fit_definition
     m.residuals(data)            # y − ŷ of predict
@@ -28,6 +28,16 @@ system and raises a ModelError naming its family and where a linear view is. Opt
 models, ``'measured'`` for NARX; ``gripkit compare --json`` states it when the model has it), and
 ``m.display_units`` for :func:`simulated_trajectory`. Every family has ``m.input_units`` and
 ``m.output_units``: the SI unit of each input and output column (tuples, one per channel).
+
+``data`` is a Trajectory (columns by name, units converted, a linear model's offsets removed
+and added back) or arrays: a linear model's deviations from its offsets (``u − u_offset``,
+``y − y_offset``); a nonlinear model's record values (NLSS's ``u_offset``/``y_offset`` normalise
+internally). So ``sysid.compare(m, u, y)`` is ``m.compare(u, y)`` for every family, and equals
+``m.compare(trajectory)`` on arrays of that convention. ``x0`` where the family has an initial
+state: a linear model's state, NARX's first ``max_lag`` outputs, NLSS's x(0), the Bouc-Wen
+oscillator's (x, ẋ, z); Hammerstein–Wiener (the steady state of its initial input), Bouc-Wen
+(h = 0) and Prandtl–Ishlinskii (relaxed plays) refuse a given ``x0`` with an ArgumentError
+saying what their free run starts from.
 
 ``report`` is written once, on :class:`ReportMixin`, the base of every model class: it names
 the page its family gets (``_report_page``: ``'linear'``, the poles, Bode with σ and innovation
@@ -75,7 +85,8 @@ class ModelFit:
 @runtime_checkable
 class IdentifiedModel(Protocol):
     """What every identified model offers, linear and nonlinear (see the module docstring; a
-    nonlinear model's ``to_*`` raise a ModelError)."""
+    nonlinear model's ``to_*`` raise a ModelError). Arrays: a linear model's deviations from
+    its offsets; a nonlinear model's record values."""
 
     structure: str
     fit_definition: str

@@ -405,6 +405,14 @@ class IdentifiedLinearModel(ReportMixin):
         u, yy, dt, _ = self._io(data, y, "residuals of an identified model", dt=dt)
         return yy - k_step_prediction(*self._state_space(dt), u, yy, 1)
 
+    def validate(self, u, y, **kw):
+        """Free-run and one-step validation of a one-input, one-output model on the deviation
+        arrays ``u``, ``y`` of a separate record: :func:`gripkit.sysid.validate` (several
+        channels: :meth:`compare` and :meth:`residuals`)."""
+        from .validation import validate
+
+        return validate(self, u, y, **kw)
+
     @property
     def parameters(self) -> ParameterSet:
         """The entries of the system's arrays (``A_0_1`` for A[0, 1]; ``num``/``den`` of a

@@ -661,7 +661,8 @@ class PolynomialModel(IdentifiedLinearModel):
         Parameters
         ----------
         data
-            A trajectory, or the input samples u(0) … u(N−1), shape (N,).
+            A trajectory, or the input samples u(0) … u(N−1) as deviations ``u − u_offset``,
+            shape (N,).
         x0
             Initial state of :attr:`system` (default rest); or ``initial='given'``.
         initial

@@ -5,8 +5,9 @@
 * The validation fit of a model on a record is one number, ``model.compare(u, y)``
   (:data:`~gripkit.sysid.linear.linear_model.VALIDATION_FIT`: free run from the initial state
   estimated by least squares, every sample scored); :func:`compare` returns exactly it (a
-  :class:`~gripkit.sysid.ModelFit`) for every linear model, and :func:`validate` reports it as
-  its ``fit_percent``. gripkit never starts a validation free run silently from rest.
+  :class:`~gripkit.sysid.ModelFit`) for every identified model, linear or nonlinear (each by
+  its own ``fit_definition``), and :func:`validate`, for a linear model only, reports it as its
+  ``fit_percent``. gripkit never starts a validation free run silently from rest.
 * An unstable model diverges in free run: :func:`compare` warns (:class:`StabilityWarning`) and
   reports no simulation fit instead of a meaningless number.
 * Residual tests (Ljung, *System Identification*, 2nd ed., §16.6): the normalised
@@ -25,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import ArgumentError, DataError, ModelError, StabilityWarning, emit_warning
+from ...lti import LinearSystem
 from ..checks import check_io
 from ..model_protocol import ModelFit
 
@@ -74,13 +76,17 @@ def _check_initial(initial: str) -> None:
                             hint="a free run from rest: fit_percent(y, model.simulate(u))")
 
 
-def compare(model, u, y, *, initial: str = "estimate") -> ModelFit:
-    """The validation fit of ``model`` (any identified linear model: ARX, ARMAX, OE, state space,
-    transfer function) on the deviation arrays ``u``, ``y`` (``(N,)`` or ``(N, m)``, ``(N, p)``):
-    exactly ``model.compare(u, y)`` (free run from the initial state estimated by least squares,
-    every sample scored). Warns :class:`StabilityWarning` for an unstable model, whose
-    ``fit_percent`` is None per output. ``initial`` takes only ``'estimate'`` (a free run from
-    rest is ``model.simulate(u)``, never a validation fit)."""
+def compare(model, u, y, *, initial: str = "estimate", dt: float | None = None) -> ModelFit:
+    """The validation fit of any identified ``model`` on the arrays ``u``, ``y`` (``(N,)`` or
+    ``(N, m)``, ``(N, p)``): exactly ``model.compare(u, y)``, the fit by the model's
+    ``fit_definition`` (a linear model: ARX, ARMAX, OE, state space, transfer function, its free
+    run from the initial state estimated by least squares, every sample scored, the arrays
+    deviations from its offsets; a nonlinear model: NARX, Hammerstein–Wiener, nonlinear state
+    space, hysteresis, the arrays the record's values). Warns :class:`StabilityWarning` for an
+    unstable linear model, whose ``fit_percent`` is None per output. ``initial`` takes only
+    ``'estimate'`` (a free run from rest is ``model.simulate(u)``, never a validation fit).
+    ``dt``: the arrays' sample time, which a continuous linear model needs (else an
+    ArgumentError); a discrete model is checked against it."""
     _check_initial(initial)
     if not callable(getattr(model, "compare", None)):
         raise ArgumentError(f"compare(): model: expected an identified model, found "
@@ -90,8 +96,15 @@ def compare(model, u, y, *, initial: str = "estimate") -> ModelFit:
         name = getattr(model, "label", model.structure)
         emit_warning(f"{name} is unstable (largest pole magnitude {pmax:.4g} > 1): its free-run "
                      f"simulation diverges, so no simulation fit is reported", StabilityWarning)
+    timed = {}
+    if dt is not None:
+        if not isinstance(getattr(model, "system", None), LinearSystem):
+            raise ArgumentError(f"compare(): dt: {getattr(model, '_family', 'this model')} "
+                                "runs on samples; dt= is the arrays' sample time of a linear "
+                                "model", hint="leave dt out")
+        timed = {"dt": dt}
     with np.errstate(over="ignore", invalid="ignore"):
-        return model.compare(u, y)
+        return model.compare(u, y, **timed)
 
 
 @dataclass(frozen=True)
@@ -240,11 +253,19 @@ class Validation:
 
 def validate(model, u, y, *, initial: str = "estimate", lags: int = 25,
              alpha: float = 0.01) -> Validation:
-    """Validate the one-input, one-output ``model`` (ARX, ARMAX, OE or state space) on (u, y)
-    (deviation units, same sampling as the estimation data): the free-run fit of
-    :func:`compare` (``model.compare(u, y)``), the one-step prediction fit, residual whiteness
-    and independence."""
+    """Validate the one-input, one-output linear ``model`` (ARX, ARMAX, OE, state space or
+    transfer function) on (u, y) (deviations from its offsets, same sampling as the estimation
+    data): the free-run fit of :func:`compare` (``model.compare(u, y)``), the one-step
+    prediction fit, residual whiteness and independence. A nonlinear model (no linear
+    ``system``) is refused with a ModelError: its fit is ``model.compare``, its prediction
+    errors ``model.residuals``."""
     _check_initial(initial)
+    if not isinstance(getattr(model, "system", None), LinearSystem):
+        what = getattr(model, "_family", None) or f"a {type(model).__name__}"
+        raise ModelError(f"validate: {what} is not a linear model; validate is the residual-test "
+                         "report of a linear one (ARX, ARMAX, OE, state space, transfer "
+                         "function)", hint="use model.compare(data) for its fit and "
+                                           "model.residuals(data) for its prediction errors")
     if len(model.inputs) != 1 or len(model.outputs) != 1:
         raise ModelError(f"validate: the model has {len(model.inputs)} inputs and "
                          f"{len(model.outputs)} outputs; validate takes one of each",

@@ -844,13 +844,19 @@ class HWModel(OutputErrorPrediction, FreeRunModel, FamilyFile):
                             f"{a.shape}")
         return [_signal(a, "u")]
 
-    def simulate(self, data, *, std: bool = False, warn: bool = True, initial_input=None):
+    def simulate(self, data, x0=None, *, std: bool = False, warn: bool = True,
+                 initial_input=None):
         """Free run on ``data``'s input (a Trajectory with the model's input column, or an array
-        (N,)) → (N, 1), from the linear block's steady state under the constant input
-        ``initial_input`` (w₋; default ``f(u(0))``, the steady state at the first input sample).
+        (N,) of the record's values) → (N, 1), from the linear block's steady state under the
+        constant input ``initial_input`` (w₋; default ``f(u(0))``, the steady state at the first
+        input sample); a given ``x0`` is refused (the start is set by ``initial_input``).
         With ``std=True`` also its 1σ (N, 1) from the parameter covariance (linearised, module
         docstring). A diverging run is NaN from where it left the range, after a
         StabilityWarning."""
+        self._refuse_x0(x0, "the steady state of its linear block under the constant input "
+                            "initial_input (default f(u(0)), its first input sample)",
+                        "give initial_input=… (the input level before the record; "
+                        "model.fit_initial_input(u, y) fits it to a record)")
         u = self._columns(data, False)[0]
         if initial_input is None:
             initial_input = float(self.input_nonlinearity(u[:1])[0])
@@ -902,7 +908,8 @@ class HWModel(OutputErrorPrediction, FreeRunModel, FamilyFile):
 
     def compare(self, data, y=None, *, warn: bool = True) -> ModelFit:
         """Free-run fit (%) on a record (:data:`HW_FIT`): a Trajectory with the input and output
-        columns, an array (N, 2) of [u, y], or ``compare(u, y)``; the initial steady state is
+        columns, an array (N, 2) of [u, y], or ``compare(u, y)`` (arrays in the record's values,
+        no offset removed); the initial steady state is
         fitted to the record (:meth:`fit_initial_input`). None (with a StabilityWarning) when the
         run diverges."""
         if y is not None:

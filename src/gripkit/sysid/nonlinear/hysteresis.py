@@ -86,6 +86,9 @@ HYSTERESIS_FIT = ("free run from the relaxed state at the first input sample (Bo
                   "fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) over the record (at identification: the "
                   "samples after burn_in, the Bouc-Wen oscillator's estimation records from "
                   "their estimated initial states where initial_state='estimate')")
+#: the hint of a rate-independent model given x0: the path of the input sets its state
+_HISTORY_HINT = ("prepend the input's history to the record (the path of u sets the state), "
+                 "or call simulate(data) from the relaxed state")
 #: an input turning back by less than this fraction of its range is no reversal (noise)
 REVERSAL_BAND = 0.01
 
@@ -137,7 +140,9 @@ def _record(data, input, output, what: str, need_output: bool = True):
         return u, y, None, input or "u", output or "y", "1", "1"
     if need_output:
         raise ArgumentError(f"{what}: data must be a Trajectory or a pair (u, y), found "
-                            f"{type(data).__name__}")
+                            f"{type(data).__name__}",
+                            hint="give the record as a Trajectory, or its input and output "
+                                 "arrays u, y (the record's values)")
     return _as_signal(data, "u"), None, None, input or "u", output or "y", "1", "1"
 
 
@@ -214,18 +219,16 @@ class _HysteresisModel(OutputErrorPrediction, SingleChannel, FamilyFile):
         sd = np.sqrt(np.maximum(np.diag(self.covariance), 0.0)) if len(self.free) else []
         return {k: float(s) for k, s in zip(self.free, sd)}
 
-    def compare(self, data, *, warn: bool = True) -> ModelFit:
-        """Free-run fit (%) on a record holding the model's input and output columns (a
-        Trajectory, or a pair (u, y)); None (with a StabilityWarning) when the run diverges."""
-        u, y, *_ = _record(data, self.input_name, self.output_name, f"{self.structure}.compare")
+    def compare(self, data, y=None, *, warn: bool = True) -> ModelFit:
+        """Free-run fit (%) on a record holding the model's input and output columns: a
+        Trajectory, the arrays ``compare(u, y)`` or a pair ``(u, y)``, arrays in the record's
+        values (no offset is removed); None (with a StabilityWarning) when the run diverges."""
+        u, y, *_ = _record(data if y is None else (data, y), self.input_name, self.output_name,
+                           f"{self.structure}.compare")
         if isinstance(data, Trajectory):
             u = self._input(data)  # the family's checks of a record (the oscillator's dt)
         yhat = self.simulate(u, warn=warn)
         return ModelFit(self.outputs, [_fit_percent(y, yhat[:, 0])], yhat, HYSTERESIS_FIT)
-
-    def _scored_run(self, data, y) -> ModelFit:
-        """:meth:`compare` on a record, or on the pair ``(u, y)`` (for ``predict``)."""
-        return self.compare(data if y is None else (data, y))
 
     def _measured(self, data, y) -> np.ndarray:
         """The record's output, as :meth:`compare` reads it (for ``residuals``)."""
@@ -317,10 +320,13 @@ class BoucWenModel(_HysteresisModel):
                            0.0, float(u[0]), y)
         return y, at
 
-    def simulate(self, data, *, std: bool = False, warn: bool = True):
-        """Free run (N, 1) on the input column of ``data`` (a Trajectory, or an array (N,)), from
-        h = 0 at the first sample. ``std=True`` also returns σ of ŷ (N, 1), propagated from the
-        parameter covariance through the Jacobian of the run (central differences, step 10⁻³ σ)."""
+    def simulate(self, data, x0=None, *, std: bool = False, warn: bool = True):
+        """Free run (N, 1) on the input column of ``data`` (a Trajectory, or an array (N,) of the
+        record's values), from h = 0 at the first sample (a given ``x0`` is refused: the model
+        has no settable initial state). ``std=True`` also returns σ of ŷ (N, 1), propagated
+        from the parameter covariance through the Jacobian of the run (central differences,
+        step 10⁻³ σ)."""
+        self._refuse_x0(x0, "the relaxed state h = 0 at the first input sample", _HISTORY_HINT)
         u = self._input(data)
         y, at = self._run(u)
         if at >= 0 and warn:
@@ -545,7 +551,8 @@ class BoucWenOscillatorModel(_HysteresisModel):
 
     def simulate(self, data, x0=None, *, std: bool = False, warn: bool = True):
         """Free run (N, 1) on the input column of ``data`` (a Trajectory sampled at the model's
-        dt, or an array (N,)), from rest, or from ``x0`` = (x, ẋ, z) at the first sample (x and
+        dt, or an array (N,) of the record's values), from rest (what ``compare`` scores), or
+        from ``x0`` = (x, ẋ, z) at the first sample (x and
         z in the output's unit without the offset, ẋ per second; or an entry of
         ``initial_states``). ``std=True`` also returns σ of ŷ (N, 1), propagated from the
         parameter covariance (central differences, step 10⁻³ σ; x0 held)."""
@@ -912,10 +919,13 @@ class PrandtlIshlinskiiModel(_HysteresisModel):
         K.play_matrix(u - self.input_offset, np.asarray(self.thresholds, dtype=np.float64), P)
         return P
 
-    def simulate(self, data, *, std: bool = False, warn: bool = True):
-        """Output (N, 1) for the input column of ``data`` (a Trajectory or an array (N,)), every
-        play relaxed at the first sample. ``std=True`` also returns σ of ŷ (N, 1) from the
-        covariance of the weights (and offset): the model is linear in them, so it is exact."""
+    def simulate(self, data, x0=None, *, std: bool = False, warn: bool = True):
+        """Output (N, 1) for the input column of ``data`` (a Trajectory or an array (N,) of the
+        record's values), every play relaxed at the first sample (a given ``x0`` is refused).
+        ``std=True`` also returns σ of ŷ (N, 1) from the covariance of the weights (and
+        offset): the model is linear in them, so it is exact."""
+        self._refuse_x0(x0, "every play relaxed at the first input sample (F_r = u(0) − a)",
+                        _HISTORY_HINT)
         u = self._input(data)
         y = np.empty(len(u))
         K.pi_simulate(u - self.input_offset, np.asarray(self.thresholds, dtype=np.float64),

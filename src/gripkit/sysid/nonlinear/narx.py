@@ -470,17 +470,23 @@ class NARXModel(FreeRunModel, FamilyFile):
     def max_lag(self) -> int:
         return int(max(self.ylags, self.ulags, 1))
 
-    def simulate(self, data, y0=None, *, warn: bool = True, std: bool = False):
-        """Free run on the input of ``data`` (a trajectory: (N, 1)) or on the input ``u`` (N,):
-        the first ``max_lag`` outputs are ``y0`` (zeros by default), the rest simulated. A
-        diverging run ends in NaN after a StabilityWarning.
+    def simulate(self, data, x0=None, *, y0=None, warn: bool = True, std: bool = False):
+        """Free run on the input of ``data`` (a trajectory: (N, 1)) or on the input ``u`` (N,),
+        the record's values: the first ``max_lag`` outputs are the initial state ``x0`` (zeros
+        by default; ``y0=`` is the same, its older name), the rest simulated. A diverging run
+        ends in NaN after a StabilityWarning.
 
         ``std=True``: also the 1σ of the simulated output from the parameter covariance,
         ``σ_ŷ(t)² = J(t) cov θ J(t)ᵀ`` with ``J(t) = ∂ŷ(t)/∂θ`` propagated through the free run
         (linearised; 0 for the given first outputs); returns ``(y, σ_y)``."""
+        if y0 is not None:
+            if x0 is not None:
+                raise ArgumentError("narx.simulate: x0 and y0 both given; they are the same "
+                                    "first max_lag outputs", hint="give x0=… only")
+            x0 = y0
         if isinstance(data, Trajectory):
             u, _ = self._signals(data, None, "simulate", outputs=False)
-            out = self.simulate(u, y0, warn=warn, std=std)
+            out = self.simulate(u, x0, warn=warn, std=std)
             if std:
                 return out[0].reshape(-1, 1), out[1].reshape(-1, 1)
             return out.reshape(-1, 1)
@@ -489,12 +495,12 @@ class NARXModel(FreeRunModel, FamilyFile):
         if len(u) <= m:
             raise DataError(f"narx.simulate: u has {len(u)} samples, needs more than max_lag = {m}")
         y = np.zeros(len(u))
-        if y0 is not None:
-            y0 = np.atleast_1d(np.asarray(y0, dtype=np.float64))
-            if y0.shape != (m,):
-                raise ArgumentError(f"narx.simulate: y0 must hold the first max_lag = {m} outputs, "
-                                    f"found shape {y0.shape}")
-            y[:m] = y0
+        if x0 is not None:
+            x0 = np.atleast_1d(np.asarray(x0, dtype=np.float64))
+            if x0.shape != (m,):
+                raise ArgumentError(f"narx.simulate: x0 must hold the first max_lag = {m} outputs, "
+                                    f"found shape {x0.shape}")
+            y[:m] = x0
         lo, hi = self._limits()
         if std:
             at, J = self._sensitivities(u, y, self.theta)
@@ -545,10 +551,10 @@ class NARXModel(FreeRunModel, FamilyFile):
     def predict(self, data, y=None, horizon: int = 1) -> np.ndarray:
         """One-step-ahead prediction from measured ``u`` and ``y`` (or a trajectory: (N, 1));
         the first ``max_lag`` samples are the measured ones. ``horizon`` must be 1 (a NARX
-        k-step predictor is a free run of k steps; use :meth:`simulate` with ``y0``)."""
+        k-step predictor is a free run of k steps; use :meth:`simulate` with ``x0``)."""
         if horizon != 1:
             raise ArgumentError(f"narx.predict: horizon must be 1 for a NARX model, found "
-                                f"{horizon!r}", hint="simulate(u, y0) runs the model freely")
+                                f"{horizon!r}", hint="simulate(u, x0) runs the model freely")
         if isinstance(data, Trajectory):
             return self.predict(*self._signals(data, y, "predict")).reshape(-1, 1)
         u, y = _as_signal(data, "u"), _as_signal(y, "y")
@@ -573,9 +579,10 @@ class NARXModel(FreeRunModel, FamilyFile):
         return e.reshape(-1, 1) if isinstance(data, Trajectory) else e
 
     def compare(self, data, y=None, *, warn: bool = True) -> ModelFit:
-        """The free-run fit (:data:`NARX_FIT`) on a trajectory or on ``(u, y)``: the run started
-        from the first ``max_lag`` measured outputs and scored on the samples after them;
-        ``fit_percent`` [None] (with a warning) if it diverges; ``simulated`` (N, 1)."""
+        """The free-run fit (:data:`NARX_FIT`) on a trajectory or on the arrays ``u``, ``y`` (the
+        record's values, no offset removed): the run started from the first ``max_lag``
+        measured outputs and scored on the samples after them; ``fit_percent`` [None] (with a
+        warning) if it diverges; ``simulated`` (N, 1)."""
         u, yy = self._signals(data, y, "compare")
         fit, ys = self._free_run_fit(u, yy, warn)
         return ModelFit(self.outputs, [fit], ys.reshape(-1, 1), self.fit_definition)

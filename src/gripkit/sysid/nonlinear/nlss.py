@@ -173,7 +173,9 @@ class NLSSModel(OutputErrorPrediction, NonlinearModel, FamilyFile):
 
     Matrices ``A`` (n, n), ``B`` (n, m), ``C`` (p, n), ``D`` (p, m), ``E`` (n, Mζ), ``F`` (p, Mη)
     on the normalised input ``(u − u_offset)/u_scale`` and the output offset ``y_offset`` (the
-    output at the equilibrium x = 0 of the mean input, estimated);
+    output at the equilibrium x = 0 of the mean input, estimated): an internal normalisation,
+    not a linear model's operating point, so arrays given to :meth:`simulate` and
+    :meth:`compare` are the record's values, as a Trajectory's columns;
     ``exz``/``exe``: the exponent tables of ζ and η; ``dirs``: the free entries (kind 0 … 5 for
     A … F, row, column) in the order of ``covariance``; ``x0``: the initial state of the
     estimation record; fits in % per output (None where the free run diverged)."""
@@ -322,7 +324,8 @@ class NLSSModel(OutputErrorPrediction, NonlinearModel, FamilyFile):
 
     def simulate(self, data, x0=None, *, std: bool = False, warn: bool = True):
         """Free run on the input of ``data`` (a Trajectory with the input columns by name, or an
-        array (N,) / (N, m)) from ``x0`` (default 0: rest at the mean estimation input) → (N, p).
+        array (N,) / (N, m) of the record's values: ``u_offset`` is removed inside) from ``x0``
+        (default 0: rest at the mean estimation input) → (N, p), the record's values.
         ``std=True`` also returns σ of the simulated output (N, p): the parameter covariance
         propagated through the free run's sensitivities (linearised, x0 held). A run whose state
         leaves the range of the estimation states by 1000× ends in NaN after a
@@ -367,7 +370,8 @@ class NLSSModel(OutputErrorPrediction, NonlinearModel, FamilyFile):
     def compare(self, data, y=None, *, warn: bool = True) -> ModelFit:
         """Fit (%) per output of the free run from the estimated initial state
         (:attr:`fit_definition`) on a Trajectory with the model's columns, or on arrays
-        ``compare(u, y)``; None for an output whose free run diverged (with a StabilityWarning)."""
+        ``compare(u, y)`` of the record's values (the offsets normalise inside the model, as for
+        a Trajectory); None for an output whose free run diverged (with a StabilityWarning)."""
         ut = self._inputs_of(data, "compare")
         yy = self._outputs_of(data, y, ut.shape[0], "compare")
         x0 = self._x0(ut, yy, 30)

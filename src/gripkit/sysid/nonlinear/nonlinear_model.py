@@ -4,7 +4,12 @@
 :class:`NonlinearModel`, the base of every nonlinear model class (through
 :class:`~.single_channel.SingleChannel` or directly): ``to_ss()``, ``to_tf()`` and
 ``to_control()`` raise a ModelError that names the family (``_family``) and says where a linear
-view is (``_linear_hint``): a nonlinear model has no linear system to convert.
+view is (``_linear_hint``): a nonlinear model has no linear system to convert. Every family's
+``simulate(data, x0=None)`` takes ``x0`` where it has an initial state (NARX: its first
+``max_lag`` outputs; nonlinear state space: x(0); the Bouc-Wen oscillator: (x, ẋ, z)); the
+others refuse a given one with an ArgumentError saying what their free run starts from
+(``_refuse_x0``). Arrays given to a nonlinear model are the record's values (no offset is
+removed; the nonlinear state space's ``u_offset``/``y_offset`` normalise inside the model).
 
 :class:`OutputErrorPrediction`, the ``predict`` and ``residuals`` of the output-error families
 (Hammerstein–Wiener, nonlinear state space, hysteresis): their noise enters at the output, so
@@ -20,7 +25,7 @@ import numpy as np
 
 from ...errors import ArgumentError, ModelError
 from ...signals.trajectory import Trajectory
-from ..model_protocol import ModelFit, ReportMixin
+from ..model_protocol import ReportMixin
 
 __all__ = ["NonlinearModel", "OutputErrorPrediction"]
 
@@ -39,6 +44,14 @@ class NonlinearModel(ReportMixin):
         return ModelError(f"{name}: {self._family} has no linear system to convert (only "
                           "ARX, ARMAX, OE, state-space and transfer-function models have one)",
                           hint=self._linear_hint)
+
+    def _refuse_x0(self, x0, starts: str, hint: str) -> None:
+        """An ArgumentError for a given ``x0`` of a family without a settable initial state:
+        ``starts`` says what its free run starts from."""
+        if x0 is not None:
+            raise ArgumentError(f"{self.structure}.simulate: x0: {self._family} has no settable "
+                                f"initial state; its free run starts from {starts} (found x0 of "
+                                f"shape {np.shape(x0)})", hint=hint)
 
     def to_ss(self, dt: float | None = None):
         """Refused: a ModelError (module docstring)."""
@@ -63,16 +76,11 @@ def _horizon(horizon) -> int:
 
 class OutputErrorPrediction:
     """``predict`` and ``residuals`` of an output-error model (module docstring) from its
-    ``compare``; a family gives ``_measured(data, y)`` (the record's measured output, as its
-    ``compare`` reads it) and :meth:`_scored_run` where its ``compare`` takes the record
-    differently. ``_signal_arrays``: arrays in, one signal (N,) out (the
+    ``compare(data, y)``; a family gives ``_measured(data, y)`` (the record's measured output,
+    as its ``compare`` reads it). ``_signal_arrays``: arrays in, one signal (N,) out (the
     single-channel families; else (N, p), as the state-space models)."""
 
     _signal_arrays = True
-
-    def _scored_run(self, data, y) -> ModelFit:
-        """``compare`` on a trajectory, or on the arrays ``u``, ``y``."""
-        return self.compare(data, y)
 
     def _need_output(self, data, y, what: str) -> None:
         """An ArgumentError for one input signal without its measured output."""
@@ -94,12 +102,12 @@ class OutputErrorPrediction:
         docstring). NaN from where the run diverges, after a StabilityWarning."""
         _horizon(horizon)
         self._need_output(data, y, "predict")
-        return self._shaped(data, self._scored_run(data, y).simulated)
+        return self._shaped(data, self.compare(data, y).simulated)
 
     def residuals(self, data, y=None) -> np.ndarray:
         """Prediction errors ``y − ŷ`` (:meth:`predict`) over every sample: (N, p) for a
         trajectory, (N,) for the arrays of a single-channel model."""
         self._need_output(data, y, "residuals")
         measured = np.asarray(self._measured(data, y), dtype=np.float64)
-        predicted = self._scored_run(data, y).simulated
+        predicted = self.compare(data, y).simulated
         return self._shaped(data, measured.reshape(predicted.shape) - predicted)
