@@ -41,6 +41,7 @@ from ...units import convert, dimension_of, product_unit, same_dimension
 from ..checks import as_io_matrix
 from ..model_file import SCHEMA, SCHEMA_VERSION, read_document, write_document
 from ..model_protocol import ModelFit, ReportMixin
+from .validation import validate
 
 __all__ = ["VALIDATION_FIT", "IdentifiedLinearModel", "LinearModel", "as_io_matrix", "estimate_x0",
            "free_run", "fit_per_output", "k_step_prediction", "model_document",
@@ -409,8 +410,6 @@ class IdentifiedLinearModel(ReportMixin):
         """Free-run and one-step validation of a one-input, one-output model on the deviation
         arrays ``u``, ``y`` of a separate record: :func:`gripkit.sysid.validate` (several
         channels: :meth:`compare` and :meth:`residuals`)."""
-        from .validation import validate
-
         return validate(self, u, y, **kw)
 
     @property
