@@ -105,9 +105,10 @@ def arx_args(path, *extra):
     (("identify", "rls", "io.csv", "--input", "u", "--output", "y", "--na", 2, "--nb", 2, "--nk", 1,
       "--forgetting", "high"), "invalid value for '--forgetting'"),
     (("identify", "search", "io.csv", "--input", "u", "--output", "y", "--top", "ten"), "'--top'"),
-    (("identify", "armax", "io.csv", "--input", "u", "--output", "y", "--na", 2, "--nb", 2, "--nk",
-      1),
-     "missing option '--nc'"),
+    # (the orders have the library's defaults, gripkit.sysid.checks.LINEAR_ORDERS, so a missing
+    # option is a column: --output)
+    (("identify", "armax", "io.csv", "--input", "u", "--na", 2, "--nb", 2, "--nk", 1),
+     "missing option '--output'"),
     (("identify", "oe", "io.csv", "--input", "u", "--output", "y", "--nb", 2, "--nf", "x", "--nk",
       1), "'--nf'"),
     (("identify", "step", "io.csv", "--input", "u", "--output", "y", "--fs", "fast"), "'--fs'"),
@@ -125,8 +126,10 @@ def test_unknown_option_names_the_command_help(cli, files):
     # click may add its guesses here
     assert_user_error(res, "UsageError", "no such option: --bogus")
     assert res.error_lines[0].endswith("see 'gripkit identify arx --help'")
-    res = cli(*arx_args(files / "io.csv")[:-2])  # no --nk
-    assert_user_error(res, "UsageError", "missing option '--nk'")
+    # no --output (not --nk: the orders are optional since they take gripkit.sysid.identify's
+    # defaults, gripkit.sysid.checks.LINEAR_ORDERS; tests/cli/test_identify_default_orders.py)
+    res = cli("identify", "arx", files / "io.csv", "--input", "u")
+    assert_user_error(res, "UsageError", "missing option '--output'")
     res = (cli("identify", "arx", files / "io.csv", "--input", "u", "--output", "y", "--na", "two",
                "--nb", 2, "--nk", 1))
     assert_user_error(res, "UsageError", "invalid value for '--na'")

@@ -155,8 +155,8 @@ def _warm_seconds(args: tuple) -> float:
 def _per_job_seconds(t_one: float, t_k: float, k: int) -> float:
     """Seconds per job from the warm times of a 1-job chunk (``t_one``) and a k-job chunk
     (``t_k``): the slope (t_k − t_one)/(k − 1). It leaves out what every chunk pays once — the
-    model's set-up, the launch of numba's parallel threads (5–7 ms on a loaded machine) — which
-    t_k/k counts k times over (docs/performance.md, sweeps). Clamped to
+    model's set-up, the launch of numba's parallel threads (several ms on a loaded machine:
+    docs/performance.md, ``sweep(backend="auto")``) — which t_k/k counts k times over. Clamped to
     [1e-7, t_k/k]: timing noise may make the slope negative, and t_k/k includes the fixed cost."""
     if k <= 1:
         return max(t_k, 1e-7)

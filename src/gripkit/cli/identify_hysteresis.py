@@ -47,9 +47,13 @@ def identify_hysteresis(data: list[Path] = DataArgs,
                                  "its first sample with the parameters (estimate, the default), "
                                  "or start every record at rest (zero)."),
                         *, opts: RecordOptions):
-    """Hysteresis (Bouc-Wen or Prandtl-Ishlinskii): parameters with σ, free-run fit. Several
-    DATA files: one model of all the records, each from its own relaxed state (``records``:
-    each file's fit)."""
+    """Hysteresis (Bouc-Wen or Prandtl-Ishlinskii): parameters with σ, free-run fit.
+    The generic family through gripkit.sysid.identify (several records, the oscillator form,
+    Prandtl-Ishlinskii, --validate, --out, --report): use it for a model to save, validate or
+    simulate; identify bouc-wen is the TSFM seed's static step (§IV-C1) of one quasi-static sweep.
+
+    Several DATA files: one model of all the records, each from its own relaxed state
+    (``records``: each file's fit)."""
     from ..sysid.nonlinear.hysteresis import FORMS, INITIAL_STATES, MODELS
 
     check_choice(model, "--model", MODELS)

@@ -21,6 +21,7 @@ import typer
 
 from .app import identify_app
 from ..errors import emit_warning
+from ..sysid.checks import LINEAR_ORDERS
 from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_choice, check_data_options,
                      check_number, collected_warnings, emit_json, finish_json, report_warnings)
 from .identify_common import (DataArg, DataArgs, ModelOutOpt, ReportOpt, ValidateOpt,
@@ -31,9 +32,17 @@ InputOpt = typer.Option(..., "--input", help="Input column (e.g. the valve curre
 OutputOpt = typer.Option(..., "--output", help="Output column (e.g. the force).")
 DetrendOpt = typer.Option("mean", "--detrend",
                           help="Operating-point removal before fitting: mean, linear or none.")
-NaOpt = typer.Option(..., "--na", help="Number of A coefficients (after the leading 1).")
-NbOpt = typer.Option(..., "--nb", help="Number of B coefficients.")
-NkOpt = typer.Option(..., "--nk", help="Input delay in samples (B's leading zeros).")
+# the orders not given are gripkit.sysid.identify's (its table LINEAR_ORDERS), so a command and
+# its Python call give one model; typer's help shows each default
+_LIBRARY = "the default of gripkit.sysid.identify"
+NaOpt = typer.Option(LINEAR_ORDERS["na"], "--na",
+                     help=f"Number of A coefficients (after the leading 1); {_LIBRARY}.")
+NbOpt = typer.Option(LINEAR_ORDERS["nb"], "--nb", help=f"Number of B coefficients; {_LIBRARY}.")
+NkOpt = typer.Option(LINEAR_ORDERS["nk"], "--nk",
+                     help=f"Input delay in samples (B's leading zeros); {_LIBRARY}.")
+NcOpt = typer.Option(LINEAR_ORDERS["nc"], "--nc", help=f"Number of C coefficients; {_LIBRARY}.")
+NfOpt = typer.Option(LINEAR_ORDERS["na"], "--nf", "--na",
+                     help=f"Number of F (denominator) coefficients; {_LIBRARY} (nf = na).")
 InputsOpt = typer.Option(..., "--input", help="Input column, or several comma-separated "
                                               "(a,b: MIMO ARX).")
 OutputsOpt = typer.Option(..., "--output", help="Output column, or several comma-separated "
@@ -243,7 +252,7 @@ def identify_arx(data: list[Path] = DataArgs, input: str = InputsOpt, output: st
 def identify_armax(data: list[Path] = DataArgs, input: str = InputOpt, output: str = OutputOpt,
                    na: int = NaOpt,
                    nb: int = NbOpt,
-                   nc: int = typer.Option(..., "--nc", help="Number of C coefficients."),
+                   nc: int = NcOpt,
                    nk: int = NkOpt,
                    fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
                    detrend: str = DetrendOpt,
@@ -259,8 +268,7 @@ def identify_armax(data: list[Path] = DataArgs, input: str = InputOpt, output: s
 @identify_app.command("oe")
 def identify_oe(data: list[Path] = DataArgs, input: str = InputOpt, output: str = OutputOpt,
                 nb: int = NbOpt,
-                nf: int = typer.Option(..., "--nf", "--na",
-                                       help="Number of F (denominator) coefficients."),
+                nf: int = NfOpt,
                 nk: int = NkOpt,
                 fs: float = FsOpt, time: str = TimeOpt, fill: str = FillOpt,
                 detrend: str = DetrendOpt,

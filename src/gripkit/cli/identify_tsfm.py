@@ -71,7 +71,10 @@ def identify_bouc_wen_cmd(data: Path = DataArg,
                                                                            "the fit (a record "
                                                                           "starting mid-loop)."),
                           json_out: bool = JsonOpt):
-    """Static Bouc-Wen parameters (eq 3) from a quasi-static voltage/displacement sweep."""
+    """Static Bouc-Wen parameters (eq 3) from a quasi-static voltage/displacement sweep.
+    The TSFM seed's step §IV-C1 (d_p, λ, β, γ of one sweep, --delay for the actuator's lag, no
+    model file): use it to follow the seed's piezo procedure; for a hysteresis model to save,
+    validate or simulate use identify hysteresis."""
     from ..sysid.physical.bouc_wen import identify_bouc_wen
 
     check_data_options(fs, fill)

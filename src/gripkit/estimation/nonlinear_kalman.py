@@ -486,8 +486,9 @@ _SPECIALISED: dict = {}
 
 def _ekf_kernels(f, h, Fj, Hj):
     """``(step(dims, buf, u, y), run(dims, buf, U, Y, out))`` calling ``f``, ``h``, ``Fj``,
-    ``Hj`` as compile-time constants (a numba function passed as an argument costs ~15 µs per
-    call to type)."""
+    ``Hj`` as compile-time constants (a numba function passed as an argument is typed again at
+    every call, which costs more than the filter step itself: docs/performance.md, "Issue 24
+    follow-up", Kalman filter from Python)."""
     key = ("ekf", f, h, Fj, Hj)
     if key not in _SPECIALISED:
         @numba.njit

@@ -19,7 +19,13 @@ __all__ = ["as_signal", "signal_array", "signal_with_peaks", "as_io_matrix", "io
            "check_io", "check_io_peaks", "check_io_arrays", "check_order", "check_dt",
            "require_samples", "check_excitation",
            "check_output_varies", "checked_problem", "checked_problem_peaks", "check_identifiable",
-           "check_persistent_excitation", "check_dimension", "LENGTH_OR_ANGLE", "FORCE_OR_TORQUE"]
+           "check_persistent_excitation", "check_dimension", "LENGTH_OR_ANGLE", "FORCE_OR_TORQUE",
+           "LINEAR_ORDERS"]
+
+#: the orders of the linear methods (arx, armax, oe, rls, search) that are not given (OE's nf:
+#: na's); :func:`gripkit.sysid.identify` and ``gripkit identify arx|armax|oe|rls`` use it, the
+#: CLI from here as this module loads without the fitting code (``gripkit --help`` stays fast)
+LINEAR_ORDERS = {"na": 2, "nb": 2, "nk": 1, "nc": 1}
 
 #: Expected dimensions for :func:`check_dimension`: a description and a reference unit each.
 LENGTH_OR_ANGLE = {"a length": "m", "an angle": "rad"}

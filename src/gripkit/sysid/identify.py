@@ -33,6 +33,7 @@ import numpy as np
 from ..arguments import check_keywords, entry_point, keyword_names
 from ..errors import AccuracyWarning, ArgumentError, DataError, GripkitError, emit_warning
 from ..signals.trajectory import Trajectory
+from .checks import LINEAR_ORDERS
 from .io_data import IOData, io_data, records_provenance, validation_data
 from .linear import identify_mimo
 from .linear.armax import armax, armax_records
@@ -134,10 +135,6 @@ def method_options(method: str) -> list[str]:
     if method == "step":
         names = [n for n in names if n != "data"]
     return names
-
-
-#: the orders of the linear methods (arx, armax, oe, rls, search) that are not given
-LINEAR_ORDERS = {"na": 2, "nb": 2, "nk": 1, "nc": 1}
 
 
 def _linear_orders(na, nb, nk, nc) -> tuple:

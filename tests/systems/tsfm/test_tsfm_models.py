@@ -22,21 +22,39 @@ def test_three_forms_of_the_finger_agree(left):
     component-wise model (eqs 1, 4, 6, 8) have the same frequency responses to 1e-10 from
     1 Hz to 30 kHz; the seed's printed a2 does not (it differs by a few % near the resonances)."""
     v = left.values()
-    tf = finger_transfer_functions(v)
+    tf = left.transfer_functions()
     f = np.logspace(0, 4.5, 200)
     s = 2j * np.pi * f
-    Gu = np.polyval(*[tf["G_u"][0]], s) / np.polyval(tf["G_u"][1], s)
-    Gf = np.polyval(tf["force"][0], s) / np.polyval(tf["force"][1], s)
-    # the printed G_f is c(s)/(b1 s + b0): G_u G_f is the force path (eq 11 with the bracket)
-    GuGf = Gu * np.polyval(tf["G_f"][0], s) / np.polyval(tf["G_f"][1], s)
+    Gu = tf["G_u"].frequency_response(2 * np.pi * f)[:, 0, 0]  # rad/s
+    Gf = tf["force"].frequency_response(2 * np.pi * f)[:, 0, 0]
+    # the printed G_f is c(s)/(b1 s + b0) (improper: eq 13's coefficients, not a
+    # TransferFunction): G_u G_f is the force path (eq 11 with the bracket)
+    c = finger_coefficients(v)
+    GuGf = Gu * np.polyval([c["c2"], c["c1"], c["c0"]], s) / np.polyval([c["b1"], c["b0"]], s)
     np.testing.assert_allclose(GuGf, Gf, rtol=1e-12)
     for ss in (finger_state_space(v), finger_minimal_state_space(v)):
         H = ss.frequency_response(2 * np.pi * f)  # rad/s
         np.testing.assert_allclose(H[:, 0, 0], Gu, rtol=1e-10)
         np.testing.assert_allclose(H[:, 0, 1], -Gf, rtol=1e-10)
     tfp = finger_transfer_functions(v, a2="printed")
-    Gup = np.polyval(tfp["G_u"][0], s) / np.polyval(tfp["G_u"][1], s)
+    Gup = tfp["G_u"].frequency_response(2 * np.pi * f)[:, 0, 0]
     assert np.max(np.abs(Gup / Gu - 1)) > 1e-3
+
+
+def test_transfer_functions_name_their_signals_and_units(left):
+    """G_u: W (m) → y_C (m), the force path: F_g (N) → y_C (m), continuous, the state space's
+    names and units (eq 7's inputs W, F_g; eq 9's output y_C); G_u(0) = b0/a0 = 1 + 2L/L_a
+    (eq 13) through the object's dc_gain."""
+    tf = left.transfer_functions()
+    assert set(tf) == {"G_u", "force"}
+    assert (tf["G_u"].inputs, tf["G_u"].outputs, tf["G_u"].input_units,
+            tf["G_u"].output_units, tf["G_u"].dt) == (("W",), ("y_C",), ("m",), ("m",), None)
+    assert (tf["force"].inputs, tf["force"].outputs, tf["force"].input_units,
+            tf["force"].output_units) == (("F_g",), ("y_C",), ("N",), ("m",))
+    assert tf["G_u"].meta["model"] == left.name and tf["force"].meta["a2"] == "derived"
+    v = left.values()
+    L = v["L_r"] + v["L_s"]
+    assert float(tf["G_u"].dc_gain()[0, 0]) == pytest.approx(1 + 2 * L / v["L_a"], rel=1e-12)
 
 
 def test_static_gains_from_eq_13(left):
@@ -67,8 +85,8 @@ def test_component_wise_simulation_equals_eq_11_simulated_by_scipy(left):
     y = left.simulate({"U": U, "F_g": F}, dt=1 / fs)["y_C"]
     W = v["d_p"] * U - bouc_wen_response(U, v["d_p"], v["lam"], v["beta"], v["gamma"])[1]
     tf = finger_transfer_functions(v)
-    sys = signal.StateSpace(*signal.tf2ss(tf["G_u"][0], tf["G_u"][1]))
-    sysf = signal.StateSpace(*signal.tf2ss(-tf["force"][0], tf["force"][1]))
+    sys = signal.StateSpace(*signal.tf2ss(tf["G_u"].numerator(), tf["G_u"].denominator()))
+    sysf = signal.StateSpace(*signal.tf2ss(-tf["force"].numerator(), tf["force"].denominator()))
     yu = signal.dlsim(sys.to_discrete(1 / fs, method="zoh"), W)[1][:, 0]
     yf = signal.dlsim(sysf.to_discrete(1 / fs, method="zoh"), F)[1][:, 0]
     np.testing.assert_allclose(y, yu + yf, atol=1e-6 * np.ptp(y))

@@ -19,7 +19,8 @@ with the Jacobian of the state map in place of A. The initial state of each wind
 directions (s = I at the window's first sample). The columns of S advance together (rows contiguous,
 :func:`~gripkit.sysid.linear.blocked_gram.row_product`), and blocks of 16 rows of J are added to the
 upper triangle of JᵀJ in the kernel itself (:func:`_add_rows`): no BLAS call, so no BLAS
-threads, which on a loaded 2-core machine made the Gram sums up to 6× slower than one thread.
+threads, which on a loaded 2-core machine made the Gram sums several times slower than one thread
+(docs/performance.md, "Nonlinear state space").
 """
 
 from __future__ import annotations

@@ -15,7 +15,8 @@ Three equivalent forms of the linear part of a finger, cross-checked in the test
       m_s ÿ_C = −F_g − b_s (ẏ_C − ẏ_D) − k_s (y_C − y_D),
 
   with W = d_p U − H. Its transfer functions are eq 11.
-* **transfer functions** (:func:`finger_transfer_functions`): eqs 11–13.
+* **transfer functions** (:func:`finger_transfer_functions`): eqs 11–13, as
+  :class:`gripkit.lti.TransferFunction` objects.
 
 Derivation of eqs 11–13 and what the seed prints. Multiplying eq 10 by (m_s s² + b_s s + k_s),
 inserting eq 7 and multiplying by (a s² + b s + 1):
@@ -61,7 +62,7 @@ from ...params import Parameter, ParameterSet
 from ...sim.hybrid import (DEFAULT_LEVELS, MAX_EVENTS_PER_STEP, EventWork, Guard, HybridSystem,
                            Mode, PWAGuards, pwa_output, pwa_step)
 from ...sim.integrators import zoh_levels
-from ...lti import StateSpace
+from ...lti import StateSpace, TransferFunction
 from ...sim.model import Model, Signal
 from .end_effector import (end_effector_parameters, lever_coefficients, sensor_parameters,
                            sensor_state_space)
@@ -226,14 +227,24 @@ def finger_coefficients(p, a2: str = "derived") -> dict[str, float]:
         alpha_u=au, alpha_f=af, alpha_m=am)
 
 
-def finger_transfer_functions(p, a2: str = "derived") -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Eq 12: ``G_u`` and ``G_f`` as printed, and ``force`` = G_u G_f (the whole force path,
-    Y_C = G_u W − force · F_g). Polynomials highest power first, SI units."""
+def finger_transfer_functions(p, a2: str = "derived",
+                              meta: dict | None = None) -> dict[str, TransferFunction]:
+    """Eqs 11–13 as continuous :class:`gripkit.lti.TransferFunction` objects (SI units, stored
+    monic): ``G_u`` = (b1 s + b0)/den(s) from the stroke W = d_p U − H (m) to y_C (m), and
+    ``force`` = G_u G_f = c(s)/den(s) from the grip force F_g (N) to y_C (m), with the seed's
+    sign: Y_C = G_u W − force · F_g (eq 11 with its bracket). The printed G_f = c(s)/(b1 s + b0)
+    alone is improper (no TransferFunction): its coefficients are :func:`finger_coefficients`'
+    c2, c1, c0, b1, b0. ``meta`` is added to each one's ``meta``."""
     c = finger_coefficients(p, a2)
     den = np.array([c["a4"], c["a3"], c["a2"], c["a1"], c["a0"]])
     num_u = np.array([c["b1"], c["b0"]])
     num_c = np.array([c["c2"], c["c1"], c["c0"]])
-    return {"G_u": (num_u, den), "G_f": (num_c, num_u), "force": (num_c, den)}
+    info = {"a2": a2, **(meta or {})}
+    return {"G_u": TransferFunction(num_u, den, None, ("W",), ("y_C",), ("m",), ("m",),
+                                    {"equation": "eq 12 G_u", **info}),
+            "force": TransferFunction(num_c, den, None, ("F_g",), ("y_C",), ("N",), ("m",),
+                                      {"equation": "eq 12 G_u G_f, entering eq 11 with −",
+                                       **info})}
 
 
 def d_bandwidth_hz(a: float, b: float) -> float:
@@ -386,8 +397,10 @@ class TSFMFinger(Model):
     def minimal_state_space(self) -> StateSpace:
         return finger_minimal_state_space(self.values())
 
-    def transfer_functions(self, a2: str = "derived"):
-        return finger_transfer_functions(self.values(), a2)
+    def transfer_functions(self, a2: str = "derived") -> dict[str, TransferFunction]:
+        """:func:`finger_transfer_functions` of this finger (``G_u``, ``force``), each one's
+        ``meta`` naming the model."""
+        return finger_transfer_functions(self.values(), a2, {"model": self.name})
 
     def modes(self, theta):
         return lti_modes(finger_state_space(theta[:len(FINGER_NAMES)]).A)
