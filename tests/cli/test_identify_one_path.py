@@ -99,6 +99,9 @@ def test_narx_validation_is_the_library_one(files, capsys):
                   validate=load(files["val"]))
     assert res["validation"]["fit_percent"] == py.validation_fit_percent
     assert res["validation"]["initial_state"] == "measured"
+    fitted = py.compare(load(files["val"]))   # the one fit, with its one definition
+    assert res["validation"]["definition"] == fitted.definition
+    assert res["validation"]["fit_percent"] == fitted.fit_percent[0]
 
 
 def test_rls_help_says_why_it_has_no_out(capsys):

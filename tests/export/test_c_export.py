@@ -206,3 +206,24 @@ def test_a_continuous_model_needs_dt_and_is_sampled_with_a_zero_order_hold(tmp_p
     y_c = build_and_run(tmp_path, c_sources(m, "msd", dt=0.01), "msd", tr["current"][:, None])
     y_py = m.simulate(tr)
     np.testing.assert_allclose(y_c, y_py, rtol=1e-12, atol=1e-12 * np.max(np.abs(y_py)))
+
+
+@pytest.mark.parametrize("kind", ["model", "kalman"])
+def test_a_nonlinear_model_file_is_refused_in_one_line(tmp_path, capsys, kind):
+    """``export c`` reads a model through the protocol's ``to_ss``: a NARX model file (no linear
+    system) is refused with the family's ModelError in one line, and nothing is written (it
+    crashed on ``model.system`` before)."""
+    from gripkit.sysid import identify
+
+    rng = np.random.default_rng(3)
+    u = rng.standard_normal(400)
+    y = lfilter([0.0, 0.3], [1.0, -0.6], u) + 0.05 * lfilter([0.0, 1.0], [1.0, -0.6], u * u)
+    tr = Trajectory(np.arange(400) * 0.01, {"u": u, "y": y})
+    p = tmp_path / "narx.json"
+    identify(tr, "narx", inputs="u", outputs="y").save(p)
+    code = main(["export", "c", str(p), "--out", str(tmp_path / "c"),
+                 *(["--kind", "kalman"] if kind == "kalman" else [])])
+    err = capsys.readouterr().err.strip()
+    assert code == 1 and len(err.splitlines()) == 1
+    assert err.startswith("error: ModelError: export c: to_ss: a NARX model has no linear system")
+    assert not (tmp_path / "c").exists() or not any((tmp_path / "c").iterdir())

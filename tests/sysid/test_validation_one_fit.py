@@ -94,3 +94,30 @@ def test_compare_refuses_what_is_not_a_model():
     u, y = simulate_arx(100, seed=233)
     with pytest.raises(ArgumentError, match="model: expected an identified model, found ndarray"):
         compare(np.array([1.0, -0.5]), u, y)
+
+
+def test_a_continuous_model_validates_with_the_arrays_sample_time():
+    """A continuous transfer function (tfest) of 25/(s² + 4 s + 25), sampled at 100 Hz with
+    output noise: ``validate(..., dt=)`` and ``model.validate(..., dt=)`` give exactly
+    ``model.compare(u, y, dt=)``'s fit, its residuals are ``model.residuals``; without ``dt``
+    the arrays carry no sample time and the call is refused in one line."""
+    from scipy import signal
+
+    from gripkit import Trajectory
+    from gripkit.sysid import identify
+
+    rng = np.random.default_rng(1)
+    N, dt = 1500, 0.01
+    t = np.arange(N) * dt
+    u = rng.standard_normal(N)
+    y = signal.lsim(signal.TransferFunction([25.0], [1.0, 4.0, 25.0]), u, t)[1]
+    y = y + 0.01 * rng.standard_normal(N)
+    m = identify(Trajectory(t, {"u": u, "y": y}), "tf", inputs="u", outputs="y", poles=2,
+                 zeros=0)
+    uu, yy = u - np.ravel(m.u_offset)[0], y - np.ravel(m.y_offset)[0]
+    fit = m.compare(uu, yy, dt=dt).fit_percent[0]
+    v = validate(m, uu, yy, dt=dt)
+    assert v.fit_percent == fit == m.validate(uu, yy, dt=dt).fit_percent and fit > 90.0
+    np.testing.assert_array_equal(v.residuals, m.residuals(uu, yy, dt=dt)[:, 0])
+    with pytest.raises(ArgumentError, match="the model is continuous"):
+        validate(m, uu, yy)

@@ -100,7 +100,7 @@ def export_c(model: Path = typer.Argument(None, show_default=False,
     res = {"model": str(model), "kind": kind, "files": [str(p) for p in paths], "name": name,
            "float32": float32,
            "inputs": list(m.inputs), "outputs": list(m.outputs),
-           "units": {"inputs": list(m.system.input_units), "outputs": list(m.system.output_units)},
+           "units": {"inputs": list(m.input_units), "outputs": list(m.output_units)},
            "float32_error_bound": bound, "warnings": report_warnings(caught)}
     if json_out:
         emit_json(res)

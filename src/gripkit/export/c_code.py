@@ -62,12 +62,16 @@ def _comment(text) -> str:
 
 
 def _realisation(model, dt: float | None):
-    s = model.system
-    if s.dt is None and dt is None:
+    """The model's discrete state-space realisation (at ``dt`` for a continuous one) and its
+    arrays, through the protocol's ``to_ss`` (a nonlinear model refuses it: ModelError)."""
+    try:
+        ss = model.to_ss(model.dt if dt is None else float(dt))
+    except ModelError as exc:
+        raise ModelError(f"export c: {exc.message}", hint=exc.hint) from None
+    if ss.dt is None:
         raise ArgumentError("dt: the model is continuous (a tfest model); the C step needs a "
                             "sample time",
                             hint="give the loop's period: --dt 0.001")
-    ss = model.to_ss(s.dt if dt is None else float(dt))
     A, B, C, D = (np.asarray(M, dtype=np.float64) for M in (ss.A, ss.B, ss.C, ss.D))
     off = np.concatenate([np.atleast_1d(model.u_offset), np.atleast_1d(model.y_offset)])
     if not all(np.all(np.isfinite(M)) for M in (A, B, C, D, off)):

@@ -7,7 +7,7 @@ The validation fit is the one of :data:`gripkit.sysid.linear.linear_model.VALIDA
 run from the model's operating point, its stored offsets; initial state estimated), the number
 ``gripkit compare`` and the model report give; a SISO polynomial model (ARX, ARMAX, OE) adds its
 one-step prediction fit and the residual tests (:func:`gripkit.sysid.validate`) on the same
-deviations; a NARX model is judged by its own free run (:data:`NARX_VALIDATION_FIT`).
+deviations; a NARX model is judged by its own free run (its ``compare``, with its definition).
 """
 
 from __future__ import annotations
@@ -22,11 +22,7 @@ from .io_data import IOData, provenance_of
 from .linear.linear_model import LinearModel
 from .linear.polynomial import PolynomialModel
 
-__all__ = ["ValidationResult", "validate_model", "NARX_VALIDATION_FIT"]
-
-#: the validation fit of a NARX model (it has no operating point and no state to estimate)
-NARX_VALIDATION_FIT = ("free run of the NARX model on the record as it is, started from its first "
-                       "max_lag measured outputs, fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) after them")
+__all__ = ["ValidationResult", "validate_model"]
 
 
 @dataclass(frozen=True)
@@ -74,9 +70,10 @@ def validate_model(model, data: Trajectory, *, detrend: str = "mean") -> Validat
                         f"{1 / mdt:g} Hz",
                         hint="resample the validation record to the model's interval")
     if hasattr(model, "max_lag"):  # NARX: the data as they are, its constant term the offset
-        fit = model.compare(np.asarray(data[model.input_name]),
-                            np.asarray(data[model.output_name])).fit_percent[0]
-        return ValidationResult(fit, NARX_VALIDATION_FIT, name, initial_state="measured")
+        fitted = model.compare(np.asarray(data[model.input_name]),
+                               np.asarray(data[model.output_name]))
+        return ValidationResult(fitted.fit_percent[0], fitted.definition, name,
+                                initial_state="measured")
     if isinstance(model, LinearModel) or getattr(model, "multivariable", False):
         return ValidationResult(*_free_run_fit(model, data), name)
     if not isinstance(model, PolynomialModel):

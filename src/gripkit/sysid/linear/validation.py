@@ -251,13 +251,14 @@ class Validation:
                     residual_tests=tests)
 
 
-def validate(model, u, y, *, initial: str = "estimate", lags: int = 25,
-             alpha: float = 0.01) -> Validation:
+def validate(model, u, y, *, initial: str = "estimate", lags: int = 25, alpha: float = 0.01,
+             dt: float | None = None) -> Validation:
     """Validate the one-input, one-output linear ``model`` (ARX, ARMAX, OE, state space or
     transfer function) on (u, y) (deviations from its offsets, same sampling as the estimation
     data): the free-run fit of :func:`compare` (``model.compare(u, y)``), the one-step
-    prediction fit, residual whiteness and independence. A nonlinear model (no linear
-    ``system``) is refused with a ModelError: its fit is ``model.compare``, its prediction
+    prediction fit, residual whiteness and independence. ``dt``: the arrays' sample time, which a
+    continuous model (tfest, step response) needs, as in :func:`compare`. A nonlinear model (no
+    linear ``system``) is refused with a ModelError: its fit is ``model.compare``, its prediction
     errors ``model.residuals``."""
     _check_initial(initial)
     if not isinstance(getattr(model, "system", None), LinearSystem):
@@ -271,9 +272,9 @@ def validate(model, u, y, *, initial: str = "estimate", lags: int = 25,
                          f"{len(model.outputs)} outputs; validate takes one of each",
                          hint="use model.compare(data) and model.residuals(data)")
     u, y = check_io(u, y)
-    sim = compare(model, u, y)
+    sim = compare(model, u, y, dt=dt)
     with np.errstate(over="ignore", invalid="ignore"):
-        e, t0, predictor_poles = _one_step(model, u, y)
+        e, t0, predictor_poles = _one_step(model, u, y, dt)
     yp = y.copy()
     yp[t0:] = y[t0:] - e
     if np.any(np.abs(predictor_poles) >= 1.0) or not np.isfinite(e).all():
@@ -282,13 +283,13 @@ def validate(model, u, y, *, initial: str = "estimate", lags: int = 25,
                       residual_tests(e, u[t0:], lags=lags, alpha=alpha), model.stable)
 
 
-def _one_step(model, u, y) -> tuple[np.ndarray, int, np.ndarray]:
+def _one_step(model, u, y, dt) -> tuple[np.ndarray, int, np.ndarray]:
     """(one-step errors, first sample they start at, poles of the predictor)."""
     if hasattr(model, "prediction_errors"):  # a polynomial model: its exact predictor
         cf = np.convolve(model.C, model.F)  # the predictor filters by 1/(C F)
         return (model.prediction_errors(u, y), model.start,
                 np.roots(cf) if cf.size > 1 else np.zeros(0))
-    ss = model.to_ss()  # innovation form: the predictor's poles are those of A − K C
+    ss = model.to_ss(dt)  # innovation form: the predictor's poles are those of A − K C
     K = getattr(model, "K", None)
     a = ss.A if K is None else ss.A - K @ ss.C
-    return model.residuals(u, y)[:, 0], 0, np.linalg.eigvals(a)
+    return model.residuals(u, y, dt=dt)[:, 0], 0, np.linalg.eigvals(a)
