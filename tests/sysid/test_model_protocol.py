@@ -544,14 +544,16 @@ def test_narx_x0_is_its_first_outputs():
 def test_validate_refuses_a_nonlinear_model(family):
     """sysid.validate is the residual-test report of a linear model: a nonlinear one is refused
     with a ModelError naming the family and pointing to compare and residuals; sysid.compare
-    takes no dt for it (it runs on samples)."""
+    takes its own sample time as dt (it runs on its samples) and refuses another."""
     m, _, u, y = FAMILIES[family]
     with pytest.raises(ModelError, match=f"validate: {NAMED[family]} is not a linear model; "
                                          "validate is the residual-test report") as err:
         validate(m, u, y)
     assert "model.compare(data)" in err.value.hint and "model.residuals(data)" in err.value.hint
-    with pytest.raises(ArgumentError, match="dt= is the arrays' sample time of a linear model"):
-        compare(m, u, y, dt=0.01)
+    assert m.dt is not None
+    assert compare(m, u, y, dt=m.dt).fit_percent == compare(m, u, y).fit_percent
+    with pytest.raises(ArgumentError, match="runs on its samples, every"):
+        compare(m, u, y, dt=2 * m.dt)
 
 
 def test_state_space_model_validates_as_sysid_validate():

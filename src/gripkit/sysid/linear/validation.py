@@ -99,12 +99,22 @@ def compare(model, u, y, *, initial: str = "estimate", dt: float | None = None) 
     timed = {}
     if dt is not None:
         if not isinstance(getattr(model, "system", None), LinearSystem):
-            raise ArgumentError(f"compare(): dt: {getattr(model, '_family', 'this model')} "
-                                "runs on samples; dt= is the arrays' sample time of a linear "
-                                "model", hint="leave dt out")
-        timed = {"dt": dt}
+            _check_sample_time(model, dt)  # a nonlinear model runs on its own samples
+        else:
+            timed = {"dt": dt}
     with np.errstate(over="ignore", invalid="ignore"):
         return model.compare(u, y, **timed)
+
+
+def _check_sample_time(model, dt) -> None:
+    """A nonlinear model's arrays are its samples: ``dt`` may only confirm its sample time."""
+    mdt = getattr(model, "dt", None)
+    family = getattr(model, "_family", "this model")
+    if mdt is None or not math.isclose(float(dt), float(mdt), rel_tol=1e-9):
+        raise ArgumentError(f"compare(): dt: {family} runs on its samples, every "
+                            f"{mdt if mdt is not None else '(unknown)'} s; the arrays' dt= "
+                            f"{dt!r} s differs", hint="resample the record to the model's "
+                                                     "interval, or leave dt out")
 
 
 @dataclass(frozen=True)
