@@ -145,10 +145,14 @@ def _checked_display_units(model, shown: dict) -> dict:
     return shown
 
 
+def _unit_of(units, k: int) -> str:
+    """Unit ``k`` of a system's ``units`` (None, or '' for one not declared: '1')."""
+    return (units[k] if units is not None and k < len(units) else "") or "1"
+
+
 def _declared(units, n: int) -> tuple[str, ...]:
-    """``n`` unit strings of a system's ``units`` (None, or '' for one not declared: '1')."""
-    units = tuple(units or ())
-    return tuple((units[k] if k < len(units) else "") or "1" for k in range(n))
+    """The ``n`` unit strings of a system's ``units`` (:func:`_unit_of`)."""
+    return tuple(_unit_of(units, k) for k in range(n))
 
 
 def _coefficient_unit(s: LinearSystem, name: str, idx: tuple) -> tuple[str, str]:
@@ -162,9 +166,7 @@ def _coefficient_unit(s: LinearSystem, name: str, idx: tuple) -> tuple[str, str]
     ``A``, ``B``, ``C`` in the declared state units (``x' = Ax + Bu``: A in x_i/x_j, B in
     x_i/u_j, times 1/s for a continuous system; C in y_i/x_j), or, when the identified state basis
     carries none, with the state taken dimensionless (and that said in the note)."""
-    def unit(units, k):
-        return (units[k] if units is not None and k < len(units) else "") or "1"
-
+    unit = _unit_of
     per_time = 0 if s.is_discrete else -1
     if isinstance(s, TransferFunction):
         i, j, k = idx

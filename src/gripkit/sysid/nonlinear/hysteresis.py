@@ -239,8 +239,7 @@ class _HysteresisModel(OutputErrorPrediction, SingleChannel, FamilyFile):
         """The model file: the schema, the model's ``own`` entries, then what every hysteresis
         model writes."""
         return dict(schema=SCHEMA, version=VERSION, model=self.structure, **own, dt=self.dt,
-                    input_name=self.input_name, output_name=self.output_name,
-                    input_unit=self.input_unit, output_unit=self.output_unit,
+                    **self.channel_document(),
                     fit_percent=self.fit_percent,
                     validation_fit_percent=self.validation_fit_percent, burn_in=self.burn_in,
                     criterion=self.criterion, fit_definition=HYSTERESIS_FIT,

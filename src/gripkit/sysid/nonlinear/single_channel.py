@@ -1,7 +1,7 @@
 """What the single-input single-output nonlinear families share about their records: the
 protocol's channel names (:class:`SingleChannel`), the fields of a model fitted on its free run
 and the limits beyond which that run counts as diverged (:class:`FreeRunModel`; the names and
-units of its columns written and read by :meth:`FreeRunModel.channel_document` and
+units of the columns written and read by :meth:`SingleChannel.channel_document` and
 :func:`channel_fields`), the checks of one signal (:func:`one_signal`, :func:`not_constant`)
 and the free-run fit
 ``100 (1 − ‖y − ŷ‖/‖y − ȳ‖)`` (:func:`fit_percent`, the definition of
@@ -52,6 +52,12 @@ class SingleChannel(NonlinearModel):
     def output_units(self) -> tuple[str, ...]:
         return (self.output_unit or "1",)
 
+    def channel_document(self) -> dict:
+        """The column names and units as the model files write them: ``input_name``,
+        ``output_name``, ``input_unit``, ``output_unit`` (read back by :func:`channel_fields`)."""
+        return dict(input_name=self.input_name, output_name=self.output_name,
+                    input_unit=self.input_unit, output_unit=self.output_unit)
+
 
 @dataclass(kw_only=True)
 class FreeRunModel(SingleChannel):
@@ -71,13 +77,6 @@ class FreeRunModel(SingleChannel):
     input_unit: str = "1"
     output_unit: str = "1"
 
-    def channel_document(self) -> dict:
-        """The column names and units as the model file writes them (the keys of the
-        hysteresis models' file): ``input_name``, ``output_name``, ``input_unit``,
-        ``output_unit``."""
-        return dict(input_name=self.input_name, output_name=self.output_name,
-                    input_unit=self.input_unit, output_unit=self.output_unit)
-
     def _limits(self) -> tuple[float, float]:
         """The band of a free run that has not diverged: :data:`DIVERGENCE_FACTOR` times the
         span of ``y_range`` either side of its middle."""
@@ -88,7 +87,7 @@ class FreeRunModel(SingleChannel):
 
 
 def channel_fields(doc: dict) -> dict:
-    """The column names and units of a model file document (:meth:`FreeRunModel.channel_document`),
+    """The column names and units of a model file document (:meth:`SingleChannel.channel_document`),
     each one missing at its default ('u', 'y', and '1' for the units of a file written before
     the units were)."""
     return dict(input_name=str(doc.get("input_name", "u")),
