@@ -13,6 +13,7 @@ from common import measure_alternating, row
 def run(quick: bool) -> list[dict]:
     """Rows for 4000 and 8000 jobs (``quick``: 4000 only); 9 alternating runs each."""
     from gripkit.batch import SweepSpec, sweep
+    from gripkit.batch.budget import usable_cores
 
     rows = []
     for n in (4000,) if quick else (4000, 8000):
@@ -31,8 +32,9 @@ def run(quick: bool) -> list[dict]:
         rows.append(row("batch: sweep auto", f"sweep of {n} short jobs, backend auto, end to end",
                         t_auto, "in-process", t_in,
                         target="ratio ≥ 1 (never slower than in-process)",
-                        notes=f"load average {load:.1f} on {os.cpu_count()} cores; the pool chosen "
-                              f"in {pooled} of {len(choices)} runs; last choice: {choices[-1]}"))
+                        notes=f"load average {load:.1f}; {usable_cores()} usable of "
+                              f"{os.cpu_count()} cores; the pool chosen in {pooled} "
+                              f"of {len(choices)} runs; last choice: {choices[-1]}"))
     return rows
 
 

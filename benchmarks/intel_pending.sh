@@ -7,9 +7,13 @@
 # benchmarks/pinocchio_bundle.sh builds for the target's Python. Writes into $OUT (else a new
 # temporary folder): machine.txt (CPU, versions, which Pinocchio was imported), rls/results.md
 # and .json (`run.py --only rls`: batch RLS with and without history, streaming update, against
-# a plain numba RLS), ab_rls_wrapper.txt (the pieces of RLS.run(store=False)) and
-# ab_one_state.txt (three processes of benchmarks/ab_one_state.py: one-state CRBA and RNEA
-# against pin.crba and pin.rnea). Every step runs even if one before it fails.
+# a plain numba RLS), ab_rls_wrapper.txt (the pieces of RLS.run(store=False)), ab_one_state.txt
+# (three processes of benchmarks/ab_one_state.py: one-state CRBA and RNEA against pin.crba and
+# pin.rnea), cli_identify_arx.txt (benchmarks/cli_identify_arx.py) and sweep_loaded.txt
+# (benchmarks/bench_sweep_auto.py on a loaded 2-core machine: the sweep and three busy loops
+# share cores 2 and 3, NUMBA_NUM_THREADS=2). The single-thread rows run on core 8, away from the
+# busy loops, which start first so that the 1-minute load average has built up by the sweep.
+# Every step runs even if one before it fails.
 set -u
 OUT="${OUT:-$(mktemp -d)}"
 mkdir -p "$OUT"
@@ -39,12 +43,30 @@ numpy.__version__, "scipy", scipy.__version__, "numba", numba.__version__)'
     echo "source: $(git rev-parse HEAD 2> /dev/null || echo 'not a git checkout')"
 } > "$OUT/machine.txt" 2>&1
 cpu="$(lscpu | sed -n 's/^Model name: *//p')"
-"$py" benchmarks/run.py --only rls --out "$OUT/rls"
-{ echo "# CPU: $cpu"; "$py" benchmarks/ab_rls_wrapper.py; } > "$OUT/ab_rls_wrapper.txt" 2>&1
+# cores: ONE_CORE for the single-thread rows, PAIR for the loaded sweep (defaults 8 and 2,3)
+one="taskset -c ${ONE_CORE:-8}" pair="taskset -c ${PAIR:-2,3}"
+command -v taskset > /dev/null || { one="" pair=""; echo "no taskset: rows not pinned" >&2; }
+hogs=()
+for i in 1 2 3; do
+    $pair bash -c 'while :; do :; done' &
+    hogs+=($!)
+done
+trap 'kill "${hogs[@]}" 2> /dev/null' EXIT
+$one "$py" benchmarks/run.py --only rls --out "$OUT/rls"
+{ echo "# CPU: $cpu"; $one "$py" benchmarks/ab_rls_wrapper.py; } > "$OUT/ab_rls_wrapper.txt" 2>&1
 {
     echo "# CPU: $cpu; three processes of benchmarks/ab_one_state.py, 9 rounds each"
     for i in 1 2 3; do
-        "$py" benchmarks/ab_one_state.py . 9
+        $one "$py" benchmarks/ab_one_state.py . 9
     done
 } > "$OUT/ab_one_state.txt" 2>&1
-cat "$OUT/machine.txt" "$OUT/rls/results.md" "$OUT/ab_rls_wrapper.txt" "$OUT/ab_one_state.txt"
+$one "$py" benchmarks/cli_identify_arx.py 9 > "$OUT/cli_identify_arx.txt" 2>&1
+{
+    echo "# CPU: $cpu; cores ${PAIR:-2,3} shared with 3 busy loops; before: $(uptime)"
+    NUMBA_NUM_THREADS=2 $pair "$py" benchmarks/bench_sweep_auto.py 2> "$OUT/sweep.err"
+    echo "# after: $(uptime)"
+    tail -n 3 "$OUT/sweep.err"
+} > "$OUT/sweep_loaded.txt" 2>&1
+rm -f "$OUT/sweep.err"
+cat "$OUT/machine.txt" "$OUT/rls/results.md" "$OUT/ab_rls_wrapper.txt" "$OUT/ab_one_state.txt" \
+    "$OUT/cli_identify_arx.txt" "$OUT/sweep_loaded.txt"

@@ -232,3 +232,25 @@ def test_many_tiny_tasks_never_stall_the_pool():
     th.join(120)
     assert not th.is_alive(), "the process pool stalled"
     assert out["res"] == sorted(i * i for i in range(400))
+
+
+def test_step_metrics_rows_warn_once_per_kind_with_the_count():
+    """Three unsettled responses (a ramp never settles) give one AccuracyWarning naming the count,
+    not one per row (a sweep of thousands of jobs would print thousands); a settled row adds
+    none."""
+    import warnings
+
+    from gripkit.batch.scenarios import step_metrics_rows
+    from gripkit.errors import AccuracyWarning
+
+    t = np.linspace(0.0, 1.0, 200)
+    settled = 1.0 - np.exp(-t / 0.02)
+    y = np.vstack([t, 2 * t, 3 * t, settled])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        rows = step_metrics_rows(t, y)
+    accuracy = [w for w in caught if issubclass(w.category, AccuracyWarning)]
+    assert len(accuracy) == 1
+    assert str(accuracy[0].message).startswith("3 of 4 responses gave this warning; the first: ")
+    assert "not settled" in str(accuracy[0].message)
+    np.testing.assert_allclose(rows["final"][3], 1.0, atol=1e-6)

@@ -22,6 +22,7 @@ def test_script_parses(name):
 def test_device_script_runs_existing_benchmarks():
     text = (BENCH / "intel_pending.sh").read_text(encoding="utf-8")
     called = set(re.findall(r"benchmarks/([a-z_]+\.(?:py|sh))", text))
-    assert {"run.py", "ab_rls_wrapper.py", "ab_one_state.py", "pinocchio_bundle.sh"} <= called
+    assert {"run.py", "ab_rls_wrapper.py", "ab_one_state.py", "pinocchio_bundle.sh",
+            "cli_identify_arx.py", "bench_sweep_auto.py"} <= called
     assert all((BENCH / f).is_file() for f in called)
     assert "--only rls" in text and (BENCH / "bench_rls.py").is_file()

@@ -25,7 +25,8 @@ from pathlib import Path
 
 from ..errors import ConfigError
 
-__all__ = ["available_memory", "parse_bytes", "format_bytes", "MemoryEstimate", "memory_limit"]
+__all__ = ["available_memory", "usable_cores", "parse_bytes", "format_bytes", "MemoryEstimate",
+           "memory_limit"]
 
 #: metrics assumed for a scenario that declares none and a sweep that records none
 UNDECLARED_METRICS = 8
@@ -46,6 +47,37 @@ def _cgroup_room() -> int | None:
         if limit.isdigit() and int(limit) < 2**60:
             return max(int(limit) - used, 0)
     return None
+
+
+def _cgroup_cpus(root: Path) -> float | None:
+    """CPUs a cgroup's quota allows (v2 ``cpu.max``, v1 ``cpu.cfs_quota_us``), None where unset."""
+    for quota_file, period_file in (("cpu.max", None),
+                                    ("cpu/cpu.cfs_quota_us", "cpu/cpu.cfs_period_us")):
+        try:
+            fields = (root / quota_file).read_text().split()
+            if period_file is not None:
+                fields.append((root / period_file).read_text().strip())
+            quota, period = fields[0], float(fields[1])
+        except (OSError, ValueError, IndexError):
+            continue
+        if quota.lstrip("-").isdigit() and int(quota) > 0 and period > 0:
+            return int(quota) / period
+        return None  # "max" or -1: no quota
+    return None
+
+
+def usable_cores(cgroup_root: str | Path = "/sys/fs/cgroup") -> int:
+    """Cores this process may run on: those of its CPU affinity (``taskset``, a container's
+    cpuset), fewer where a cgroup's CPU quota (``docker --cpus``) allows fewer, at least 1.
+    ``os.cpu_count()`` counts the host's cores, which a pool of that many processes would share."""
+    try:
+        cores = len(os.sched_getaffinity(0))
+    except (AttributeError, OSError):  # no affinity on this platform
+        cores = os.cpu_count() or 1
+    quota = _cgroup_cpus(Path(cgroup_root))
+    if quota is not None:
+        cores = min(cores, max(int(quota), 1))
+    return max(cores, 1)
 
 
 def available_memory() -> int:

@@ -36,6 +36,7 @@ from collections.abc import Callable, Iterable, Iterator, Sequence
 import cloudpickle
 
 from ..errors import ConfigError
+from .budget import usable_cores
 from .worker import PIN_ENV, read_frame, write_frame
 
 __all__ = ["Executor", "InProcessExecutor", "ProcessExecutor", "DaskExecutor", "make_executor",
@@ -120,12 +121,13 @@ class _Worker:
 
 
 class ProcessExecutor(Executor):
-    """A pool of ``workers`` subprocesses (default: the number of cores)."""
+    """A pool of ``workers`` subprocesses (default: the cores this process may use,
+    :func:`~gripkit.batch.budget.usable_cores`)."""
 
     name = "process"
 
     def __init__(self, workers: int | None = None, max_attempts: int = 3):
-        n = (os.cpu_count() or 1) if workers is None else int(workers)
+        n = usable_cores() if workers is None else int(workers)
         if n < 1:
             raise ConfigError(f"workers: expected a positive number, found {workers!r}")
         self.workers = n
@@ -239,7 +241,7 @@ class DaskExecutor(Executor):
                 raise ConfigError(f"cannot reach the Dask scheduler at {address!r}: {exc}",
                                   hint="give its address as tcp://host:8786") from None
         else:
-            n = workers or os.cpu_count() or 1
+            n = workers or usable_cores()
             self._cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
                                          dashboard_address=None, env=dict(PIN_ENV))
             self.client = Client(self._cluster)

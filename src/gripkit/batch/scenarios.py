@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .. import zoo
-from ..errors import ConfigError, ConsistencyWarning, GripkitError
+from ..errors import ConfigError, ConsistencyWarning, GripkitError, emit_warning
 from ..sim.model import Model
 from ..sysid.physical.step_response import step_metrics
 from .spec import quantity
@@ -240,11 +240,27 @@ def prepare(spec, allow_code: bool = False) -> Prepared:
     return Prepared(fn, model, iface)
 
 
+def _summarise_warnings(caught: list, n: int, what: str) -> None:
+    """Re-issue ``caught`` warnings once per category: the first one's text, with the count."""
+    first: dict[type, tuple[str, int]] = {}
+    for w in caught:
+        text, count = first.get(w.category, (str(w.message), 0))
+        first[w.category] = (text, count + 1)
+    for category, (text, count) in first.items():
+        emit_warning(text if count == 1 else
+                     f"{count} of {n} {what} gave this warning; the first: {text}", category)
+
+
 def step_metrics_rows(t: np.ndarray, y: np.ndarray, band: float = 0.02) -> dict[str, np.ndarray]:
     """Step-response metrics of each row of ``y`` (P, N) from rest: final value (mean of the last
     10 %), peak, overshoot %, 10–90 % rise time and settling time into ±``band``
-    (:func:`gripkit.sysid.physical.step_response.step_metrics` per row)."""
-    rows = [step_metrics(t, yi, y_initial=0.0, band=band) for yi in np.atleast_2d(y)]
+    (:func:`gripkit.sysid.physical.step_response.step_metrics` per row). The rows' warnings
+    (an unsettled response) come as one per kind, with how many rows gave it: a sweep of
+    thousands of jobs would otherwise print one per job."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        rows = [step_metrics(t, yi, y_initial=0.0, band=band) for yi in np.atleast_2d(y)]
+    _summarise_warnings(caught, len(rows), "responses")
     return {"final": np.array([r["y_final"] for r in rows]),
             "peak": np.array([r["peak"] for r in rows]),
             **{k: np.array([r[k] for r in rows]) for k in ("overshoot_percent", "rise_time",

@@ -34,7 +34,7 @@ import numpy as np
 from ..arguments import entry_point
 from ..errors import ConfigError
 from ..progress import status, track
-from .budget import UNDECLARED_METRICS, MemoryEstimate, memory_limit as _memory_limit
+from .budget import UNDECLARED_METRICS, MemoryEstimate, memory_limit as _memory_limit, usable_cores
 from .executors import Executor, make_executor
 from .scenarios import build_model, prepare, resolve
 from .spec import SweepSpec
@@ -192,10 +192,10 @@ def _auto_backend(work_s: float, workers: int, busy: float = 0.0,
                   cores: int | None = None) -> tuple[str, str]:
     """'in-process' when the estimated work cannot win back the pool's start-up
     (``work ≤ startup + work / w``), else 'process'; with the reason for the summary. ``w``, the
-    pool's speed-up, is the number of workers, but at most the cores (default ``os.cpu_count()``)
+    pool's speed-up, is the number of workers, but at most the cores (default :func:`usable_cores`)
     that other processes leave free (``busy``: their load, :func:`_busy_cores`), and at least 1:
     on a loaded machine a pool runs no faster than one process."""
-    cores = int(cores or os.cpu_count() or 1)
+    cores = int(cores or usable_cores())
     w = max(1.0, min(float(workers), cores - busy))
     load = f", {busy:.1f} of {cores} cores busy" if busy > 0 else ""
     if workers <= 1 or work_s <= POOL_STARTUP_S + work_s / w:
@@ -214,7 +214,7 @@ def _in_flight(executor: Executor | None, backend: str, workers: int | None,
         return 0 if executor.name == "dask" and scheduler else max(int(executor.workers), 1)
     if scheduler:
         return 0
-    return 1 if backend == "in-process" else int(workers or os.cpu_count() or 1)
+    return 1 if backend == "in-process" else int(workers or usable_cores())
 
 
 def _checked_spec(spec: SweepSpec | dict | str | Path, *, backend: str, workers: int | None,
@@ -309,7 +309,7 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "auto", workers
     # per job without a chunk's fixed cost (model set-up, parallel thread launch)
     per_job = _seconds_per_job(chunk_args, n_jobs) if (chunk_size is None or auto) else None
     if auto:
-        backend, choice = _auto_backend(per_job * n_jobs, int(workers or os.cpu_count() or 1),
+        backend, choice = _auto_backend(per_job * n_jobs, int(workers or usable_cores()),
                                         _busy_cores())
         in_flight = _in_flight(None, backend, workers, None)
     if chunk_size is None:
