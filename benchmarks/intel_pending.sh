@@ -13,7 +13,8 @@
 # (benchmarks/bench_sweep_auto.py on a loaded 2-core machine: the sweep and three busy loops
 # share cores 2 and 3, NUMBA_NUM_THREADS=2). The single-thread rows run on core 8, away from the
 # busy loops, which start first so that the 1-minute load average has built up by the sweep.
-# Every step runs even if one before it fails.
+# import_time.txt: where `import gripkit` spends its time there. STEPS="crba import" (say) runs
+# only those rows. Every step runs even if one before it fails.
 set -u
 OUT="${OUT:-$(mktemp -d)}"
 mkdir -p "$OUT"
@@ -43,30 +44,61 @@ numpy.__version__, "scipy", scipy.__version__, "numba", numba.__version__)'
     echo "source: $(git rev-parse HEAD 2> /dev/null || echo 'not a git checkout')"
 } > "$OUT/machine.txt" 2>&1
 cpu="$(lscpu | sed -n 's/^Model name: *//p')"
+# STEPS: which rows to run (default all): rls wrapper crba cli import sweep
+want() { [[ " ${STEPS:-rls wrapper crba cli import sweep} " == *" $1 "* ]]; }
 # cores: ONE_CORE for the single-thread rows, PAIR for the loaded sweep (defaults 8 and 2,3)
 one="taskset -c ${ONE_CORE:-8}" pair="taskset -c ${PAIR:-2,3}"
 command -v taskset > /dev/null || { one="" pair=""; echo "no taskset: rows not pinned" >&2; }
 hogs=()
-for i in 1 2 3; do
-    $pair bash -c 'while :; do :; done' &
-    hogs+=($!)
-done
-trap 'kill "${hogs[@]}" 2> /dev/null' EXIT
-$one "$py" benchmarks/run.py --only rls --out "$OUT/rls"
-{ echo "# CPU: $cpu"; $one "$py" benchmarks/ab_rls_wrapper.py; } > "$OUT/ab_rls_wrapper.txt" 2>&1
-{
-    echo "# CPU: $cpu; three processes of benchmarks/ab_one_state.py, 9 rounds each"
+if want sweep; then
     for i in 1 2 3; do
-        $one "$py" benchmarks/ab_one_state.py . 9
+        $pair bash -c 'while :; do :; done' &
+        hogs+=($!)
     done
-} > "$OUT/ab_one_state.txt" 2>&1
-$one "$py" benchmarks/cli_identify_arx.py 9 > "$OUT/cli_identify_arx.txt" 2>&1
-{
-    echo "# CPU: $cpu; cores ${PAIR:-2,3} shared with 3 busy loops; before: $(uptime)"
-    NUMBA_NUM_THREADS=2 $pair "$py" benchmarks/bench_sweep_auto.py 2> "$OUT/sweep.err"
-    echo "# after: $(uptime)"
-    tail -n 3 "$OUT/sweep.err"
-} > "$OUT/sweep_loaded.txt" 2>&1
-rm -f "$OUT/sweep.err"
-cat "$OUT/machine.txt" "$OUT/rls/results.md" "$OUT/ab_rls_wrapper.txt" "$OUT/ab_one_state.txt" \
-    "$OUT/cli_identify_arx.txt" "$OUT/sweep_loaded.txt"
+fi
+trap '[ ${#hogs[@]} -eq 0 ] || kill "${hogs[@]}" 2> /dev/null' EXIT
+reports=("$OUT/machine.txt")
+if want rls; then
+    $one "$py" benchmarks/run.py --only rls --out "$OUT/rls"
+    reports+=("$OUT/rls/results.md")
+fi
+if want wrapper; then
+    { echo "# CPU: $cpu"; $one "$py" benchmarks/ab_rls_wrapper.py; } > "$OUT/ab_rls_wrapper.txt" 2>&1
+    reports+=("$OUT/ab_rls_wrapper.txt")
+fi
+if want crba; then
+    {
+        echo "# CPU: $cpu; three processes of benchmarks/ab_one_state.py, 9 rounds each; $(uptime)"
+        for i in 1 2 3; do
+            $one "$py" benchmarks/ab_one_state.py . 9
+        done
+    } > "$OUT/ab_one_state.txt" 2>&1
+    reports+=("$OUT/ab_one_state.txt")
+fi
+if want cli; then
+    $one "$py" benchmarks/cli_identify_arx.py 9 > "$OUT/cli_identify_arx.txt" 2>&1
+    reports+=("$OUT/cli_identify_arx.txt")
+fi
+if want import; then
+    # where `import gripkit` spends its time here: the 25 largest cumulative entries
+    {
+        echo "# CPU: $cpu; python -X importtime -c 'import gripkit' (second run), us"
+        $one "$py" -X importtime -c 'import gripkit' 2> /dev/null
+        $one "$py" -X importtime -c 'import gripkit' 2>&1 | sort -t'|' -k2 -n -r | head -25
+        for mod in numpy scipy numba gripkit; do
+            /usr/bin/time -f "import $mod: %e s wall" $one "$py" -c "import $mod"
+        done
+    } > "$OUT/import_time.txt" 2>&1
+    reports+=("$OUT/import_time.txt")
+fi
+if want sweep; then
+    {
+        echo "# CPU: $cpu; cores ${PAIR:-2,3} shared with 3 busy loops; before: $(uptime)"
+        NUMBA_NUM_THREADS=2 $pair "$py" benchmarks/bench_sweep_auto.py 2> "$OUT/sweep.err"
+        echo "# after: $(uptime)"
+        tail -n 3 "$OUT/sweep.err"
+    } > "$OUT/sweep_loaded.txt" 2>&1
+    rm -f "$OUT/sweep.err"
+    reports+=("$OUT/sweep_loaded.txt")
+fi
+cat "${reports[@]}"
