@@ -41,7 +41,8 @@ export PYTHONPATH="$PWD/src:$PWD/benchmarks${pinsite}:$site"
 numpy.__version__, "scipy", scipy.__version__, "numba", numba.__version__)'
     "$py" -c 'import pinocchio; print("pinocchio", pinocchio.__version__, pinocchio.__file__)'
     uptime
-    echo "source: $(git rev-parse HEAD 2> /dev/null || echo 'not a git checkout')"
+    # SOURCE: the commit sent, given in the command (the device copy's .git may lag the tree)
+    echo "source: ${SOURCE:-$(git rev-parse HEAD 2> /dev/null || echo "not a git checkout")}"
 } > "$OUT/machine.txt" 2>&1
 cpu="$(lscpu | sed -n 's/^Model name: *//p')"
 # STEPS: which rows to run (default all): rls wrapper crba cli import sweep
@@ -68,8 +69,9 @@ if want wrapper; then
 fi
 if want crba; then
     {
-        echo "# CPU: $cpu; three processes of benchmarks/ab_one_state.py, 9 rounds each; $(uptime)"
-        for i in 1 2 3; do
+        echo "# CPU: $cpu; ${CRBA_RUNS:-3} processes of benchmarks/ab_one_state.py, 9 rounds each;" \
+            "$(uptime)"
+        for ((i = 0; i < ${CRBA_RUNS:-3}; i++)); do
             $one "$py" benchmarks/ab_one_state.py . 9
         done
     } > "$OUT/ab_one_state.txt" 2>&1

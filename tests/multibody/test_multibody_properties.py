@@ -196,11 +196,13 @@ def test_bad_states_and_couplings_are_refused():
 
 
 def test_one_state_mass_matrix_entry_point_takes_only_exact_float64_vectors():
-    """The unchecked entry point (onestate.mass_matrix_entry) gets only an exact 1-D float64
-    ndarray (type, ndim, dtype checked in Python): states that numba would misread there (int64
-    items of the same size, a (3, 1) array, big-endian, a subclass) go through the validating
-    path and give the float64 answer; 1-D views of another stride reach it and its kernel
-    refuses them; each call returns a new array (no result is shared between calls)."""
+    """The unchecked entry point (onestate.mass_matrix_entry) gets only a 1-D native float64
+    array (ndim, dtype checked in Python): states that numba would misread there (int64 items of
+    the same size, a (3, 1) array, big-endian) go through the validating path and give the
+    float64 answer; an object with a float64 dtype that is not an ndarray (the entry point's
+    TypeError) and a list take that path too; an ndarray subclass reaches it and gives the same
+    numbers; 1-D views of another stride reach it and its kernel refuses them; each call returns
+    a new array (no result is shared between calls)."""
     ch = finger(check=False).chain()
     q = np.array([0.1, -0.2, 0.3])
     ref = ch.mass_matrix(q)
@@ -211,6 +213,8 @@ def test_one_state_mass_matrix_entry_point_takes_only_exact_float64_vectors():
     np.testing.assert_array_equal(ch.mass_matrix(qi), ch.mass_matrix(qi.astype(float)))
     np.testing.assert_array_equal(ch.mass_matrix(q.astype(">f8")), ref)
     np.testing.assert_array_equal(ch.mass_matrix(q.view(_Sub)), ref)
+    np.testing.assert_array_equal(ch.mass_matrix(_ArrayLike(q)), ref)
+    np.testing.assert_array_equal(ch.mass_matrix(list(q)), ref)
     with pytest.raises(ModelError, match="expected shape"):
         ch.mass_matrix(q[:, None])
     ro = q.copy()
@@ -231,7 +235,20 @@ def test_one_state_mass_matrix_entry_point_takes_only_exact_float64_vectors():
 
 
 class _Sub(np.ndarray):
-    """An ndarray subclass (the entry point's test wants the exact type)."""
+    """An ndarray subclass."""
+
+
+class _ArrayLike:
+    """Not an ndarray, with the float64 dtype and ndim of one (a pandas Series, say)."""
+
+    ndim = 1
+    dtype = np.dtype(np.float64)
+
+    def __init__(self, values):
+        self._values = values
+
+    def __array__(self, dtype=None, copy=None):
+        return np.asarray(self._values, dtype=dtype)
 
 
 def test_one_state_path_runs_with_numba_jit_disabled():

@@ -30,7 +30,6 @@ __all__ = ["DHChain", "Dynamics"]
 
 # the one-state mass matrix's test for its unchecked entry point, and np.empty without the
 # module lookup (per call: docs/performance.md, "One-state RNEA and CRBA")
-_NDARRAY = np.ndarray
 _F8 = np.dtype(np.float64)
 _empty = np.empty
 
@@ -129,13 +128,18 @@ class Dynamics:
         returned. (``out`` may be given by position: a keyword-only parameter takes CPython's
         slower call path; docs/performance.md, CRBA.)"""
         one = self._one or self._one_state()
-        if out is None and type(q) is _NDARRAY and q.ndim == 1 and q.dtype is _F8:
-            # an exact 1-D float64 ndarray: the kernel's unchecked entry point (onestate
-            # .mass_matrix_entry) into a fresh array; False (wrong length, stride, NaN): the
-            # checks below
-            res = _empty(one[2])
-            if one[3](one[0], q, res):
-                return res
+        if out is None:
+            # a 1-D float64 array: the kernel's unchecked entry point (onestate
+            # .mass_matrix_entry) into a fresh array. False (wrong length, stride, NaN), or
+            # TypeError (an object with a float64 dtype that is not an ndarray) or
+            # AttributeError (no dtype: a list): the checks below
+            try:
+                if q.dtype is _F8 and q.ndim == 1:
+                    res = _empty(one[2])
+                    if one[3](one[0], q, res):
+                        return res
+            except (AttributeError, TypeError):
+                pass
         res = _empty(one[2]) if out is None else out
         try:
             done = mass_matrix_one(one[0], q, res)
