@@ -59,14 +59,7 @@ if want sweep; then
 fi
 trap '[ ${#hogs[@]} -eq 0 ] || kill "${hogs[@]}" 2> /dev/null' EXIT
 reports=("$OUT/machine.txt")
-if want rls; then
-    $one "$py" benchmarks/run.py --only rls --out "$OUT/rls"
-    reports+=("$OUT/rls/results.md")
-fi
-if want wrapper; then
-    { echo "# CPU: $cpu"; $one "$py" benchmarks/ab_rls_wrapper.py; } > "$OUT/ab_rls_wrapper.txt" 2>&1
-    reports+=("$OUT/ab_rls_wrapper.txt")
-fi
+# CRBA first: its minute also lets a freshly started machine settle before the RLS rows
 if want crba; then
     {
         echo "# CPU: $cpu; ${CRBA_RUNS:-3} processes of benchmarks/ab_one_state.py, 9 rounds each;" \
@@ -76,6 +69,21 @@ if want crba; then
         done
     } > "$OUT/ab_one_state.txt" 2>&1
     reports+=("$OUT/ab_one_state.txt")
+fi
+if want rls; then  # RLS_RUNS runs (default 1): rls/results.md and .json, then rls-2.md, …
+    for ((i = 1; i <= ${RLS_RUNS:-1}; i++)); do
+        $one "$py" benchmarks/run.py --only rls --out "$OUT/rls-run"
+        if [ "$i" -eq 1 ]; then
+            mv "$OUT/rls-run" "$OUT/rls" && reports+=("$OUT/rls/results.md")
+        else
+            mv "$OUT/rls-run/results.md" "$OUT/rls-$i.md" && reports+=("$OUT/rls-$i.md")
+            rm -rf "$OUT/rls-run"
+        fi
+    done
+fi
+if want wrapper; then
+    { echo "# CPU: $cpu"; $one "$py" benchmarks/ab_rls_wrapper.py; } > "$OUT/ab_rls_wrapper.txt" 2>&1
+    reports+=("$OUT/ab_rls_wrapper.txt")
 fi
 if want cli; then
     $one "$py" benchmarks/cli_identify_arx.py 9 > "$OUT/cli_identify_arx.txt" 2>&1
