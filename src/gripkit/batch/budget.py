@@ -68,7 +68,7 @@ def _cgroup_cpus(root: Path) -> float | None:
 
 def usable_cores(cgroup_root: str | Path = "/sys/fs/cgroup") -> int:
     """Cores this process may run on: those of its CPU affinity (``taskset``, a container's
-    cpuset), fewer where a cgroup's CPU quota (``docker --cpus``) allows fewer, at least 1.
+    cpuset), fewer where a cgroup's CPU quota (a container's CPU limit) allows fewer, at least 1.
     ``os.cpu_count()`` counts the host's cores, which a pool of that many processes would share."""
     try:
         cores = len(os.sched_getaffinity(0))

@@ -212,9 +212,10 @@ def mass_matrix_entry():
     dispatcher's type resolution (docs/performance.md, CRBA). It does not check them: numba reads
     any array with 8-byte items as float64 and writes an array of more dimensions past the
     declared ones, so only :meth:`~gripkit.multibody.dh.Dynamics.mass_matrix` calls it, with the
-    chain's packed buffer, a fresh C-contiguous (m, m) float64 array, and a state that is an
-    exact 1-D float64 ndarray (type, ``ndim`` and dtype checked in Python first; the kernel
-    refuses a stride other than 8). The dispatcher where numba has no ``entry_point``."""
+    chain's packed buffer, a fresh C-contiguous (m, m) float64 array, and a state with the
+    native float64 dtype and one dimension (checked in Python first; an object that is not an
+    ndarray raises TypeError here, and the kernel refuses a stride other than 8). The dispatcher
+    where numba has no ``entry_point``."""
     overloads = getattr(mass_matrix_one, "overloads", {})  # (none under NUMBA_DISABLE_JIT)
     sig = next(iter(overloads), None)
     return getattr(overloads.get(sig), "entry_point", mass_matrix_one)
