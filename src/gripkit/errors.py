@@ -118,13 +118,15 @@ class DataWarning(GripkitWarning):
     outside the rest of its channel (a corrupt value). The data are used as read; check them."""
 
 
-def emit_warning(message: str, category: type[Warning] = GripkitWarning,
+def emit_warning(message: str | Warning, category: type[Warning] = GripkitWarning,
                  stacklevel: int | None = None) -> None:
     """Issue ``category(message)`` attributed to the first stack frame outside gripkit: the user's
     line that called into gripkit, whatever the depth of the call inside (what Python 3.12's
     ``warnings.warn(skip_file_prefixes=...)`` does), so the printed location and ``-W`` filters by
     module point at the user's code, never into gripkit. ``stacklevel`` (counted from the caller,
-    as for ``warnings.warn``) overrides the search. Every warning of gripkit goes through here."""
+    as for ``warnings.warn``) overrides the search. Every warning of gripkit goes through here.
+    ``message`` may be a warning instance (its class is then the category, as for
+    ``warnings.warn``)."""
     if stacklevel is not None:
         warnings.warn(message, category, stacklevel=stacklevel + 1)
         return

@@ -254,3 +254,31 @@ def test_step_metrics_rows_warn_once_per_kind_with_the_count():
     assert str(accuracy[0].message).startswith("3 of 4 responses gave this warning; the first: ")
     assert "not settled" in str(accuracy[0].message)
     np.testing.assert_allclose(rows["final"][3], 1.0, atol=1e-6)
+
+
+@pytest.mark.parametrize("backend", ["in-process", "process"])
+def test_a_sweep_reports_its_jobs_warnings_once_per_kind(backend):
+    """200 step responses too short to settle (ζ ≈ 0.1–0.3, 6 s): one AccuracyWarning for the
+    whole sweep with the count of jobs, in-process and from a pool's workers alike (whose
+    warnings were printed nowhere), not one per job or per chunk, and none from the timing
+    probes of backend 'auto'."""
+    import warnings
+
+    from gripkit.batch import SweepSpec, sweep
+    from gripkit.errors import AccuracyWarning
+
+    spec = SweepSpec.from_dict({
+        "sweep": {"scenario": "step-response", "model": "mass-spring-damper", "samples": 200,
+                  "name": "short"},
+        "parameters": {"k": {"uniform": [1.0, 8.0]}, "b": {"uniform": [0.5, 1.0]}},
+        "scenario": {"duration": 6.0, "fs": 20.0, "amplitude": 2.0}})
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = sweep(spec, backend=backend, workers=2, progress=False, target_task_s=0.001)
+    accuracy = [str(w.message) for w in caught if issubclass(w.category, AccuracyWarning)]
+    assert len(accuracy) == 1, accuracy
+    n = int(accuracy[0].split(": ")[1].split(" of ")[0])
+    assert accuracy[0].startswith("sweep 'short': ") and " of 200 jobs gave this" in accuracy[0]
+    assert "not settled" in accuracy[0]
+    assert 150 <= n <= 200
+    assert result.n_jobs == 200 and not result.failed.any()

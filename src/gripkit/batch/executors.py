@@ -118,6 +118,7 @@ class _Worker:
         except subprocess.TimeoutExpired:
             self.proc.kill()
             self.proc.wait()
+        self.proc.stdout.close()  # (left open, it is a ResourceWarning when collected)
 
 
 class ProcessExecutor(Executor):

@@ -241,14 +241,18 @@ def prepare(spec, allow_code: bool = False) -> Prepared:
 
 
 def _summarise_warnings(caught: list, n: int, what: str) -> None:
-    """Re-issue ``caught`` warnings once per category: the first one's text, with the count."""
+    """Re-issue ``caught`` warnings once per category: the first one's text, with the count. The
+    warning carries ``count``, ``total`` and ``first`` (the first text), so that a sweep can sum
+    them over its chunks (:func:`gripkit.batch.sweep.run_chunk`)."""
     first: dict[type, tuple[str, int]] = {}
     for w in caught:
         text, count = first.get(w.category, (str(w.message), 0))
         first[w.category] = (text, count + 1)
     for category, (text, count) in first.items():
-        emit_warning(text if count == 1 else
-                     f"{count} of {n} {what} gave this warning; the first: {text}", category)
+        warning = category(text if count == 1 else
+                           f"{count} of {n} {what} gave this warning; the first: {text}")
+        warning.count, warning.total, warning.first = count, n, text
+        emit_warning(warning, category)
 
 
 def step_metrics_rows(t: np.ndarray, y: np.ndarray, band: float = 0.02) -> dict[str, np.ndarray]:

@@ -26,13 +26,14 @@ from __future__ import annotations
 import math
 import os
 import time
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
 from ..arguments import entry_point
-from ..errors import ConfigError
+from ..errors import ConfigError, emit_warning
 from ..progress import status, track
 from .budget import UNDECLARED_METRICS, MemoryEstimate, memory_limit as _memory_limit, usable_cores
 from .executors import Executor, make_executor
@@ -45,8 +46,24 @@ __all__ = ["sweep", "run_chunk", "SweepResult"]
 
 def run_chunk(scenario, model_ref: str | None, settings: dict, job_ids: np.ndarray,
               params: dict[str, np.ndarray], metrics: tuple[str, ...] | None,
-              allow_code: bool = False) -> dict[str, np.ndarray]:
-    """Compute one chunk: the scenario on every job, failures recorded per job."""
+              allow_code: bool = False) -> dict:
+    """Compute one chunk: the scenario on every job, failures recorded per job, and the
+    warnings its jobs gave under ``"warnings"`` (category, first text, count, jobs counted or
+    None; :func:`sweep` sums them over the chunks and reports each kind once)."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        res = _chunk_results(scenario, model_ref, settings, job_ids, params, metrics, allow_code)
+    res["warnings"] = [(w.category, getattr(w.message, "first", str(w.message)),
+                        getattr(w.message, "count", 1), getattr(w.message, "total", None))
+                       for w in caught]
+    return res
+
+
+def _chunk_results(scenario, model_ref: str | None, settings: dict, job_ids: np.ndarray,
+                   params: dict[str, np.ndarray], metrics: tuple[str, ...] | None,
+                   allow_code: bool) -> dict[str, np.ndarray]:
+    """:func:`run_chunk` without its warnings: a chunk that fails as a whole is run again job by
+    job to find the failing ones."""
     fn = resolve(scenario, allow_code)
     model = build_model(model_ref, allow_code)
     n = len(job_ids)
@@ -69,8 +86,9 @@ def run_chunk(scenario, model_ref: str | None, settings: dict, job_ids: np.ndarr
         else:  # find the failing jobs one by one
             rows = []
             for i in range(n):
-                part = run_chunk(scenario, model_ref, settings, job_ids[i:i + 1],
-                                 {k: v[i:i + 1] for k, v in params.items()}, metrics, allow_code)
+                part = _chunk_results(scenario, model_ref, settings, job_ids[i:i + 1],
+                                      {k: v[i:i + 1] for k, v in params.items()}, metrics,
+                                      allow_code)
                 rows.append(part)
                 errors[i] = part["error"][0]
             keys = sorted({k for r in rows for k in r if k not in ("job_id", "error")})
@@ -239,16 +257,19 @@ def _checked_spec(spec: SweepSpec | dict | str | Path, *, backend: str, workers:
 
 def _run_tasks(ex: Executor, own: bool, tasks: list, jobs: dict, store: ResultStore | None,
                mem: dict[int, dict], chunk_size: int, n_jobs: int, name: str,
-               progress: bool) -> None:
+               progress: bool) -> list:
     """The running step of :func:`sweep`: run the chunks' ``tasks`` on ``ex`` and put each
     chunk's results in ``store`` (or, without one, in ``mem`` by chunk number); a chunk whose task
     failed as a whole records its error for each of its jobs. Closes ``ex`` at the end if
-    ``own``."""
+    ``own``. Returns the chunks' warning records (:func:`run_chunk`)."""
+    found: list = []
     try:
         for c, ok, value in track(ex.map_unordered(tasks), total=len(tasks),
                                   description=f"{name} ({ex.name}, {chunk_size} jobs/chunk)",
                                   enabled=progress):
-            if not ok:
+            if ok:
+                found.extend(value.pop("warnings", ()))
+            else:
                 r = chunk_range(c, chunk_size, n_jobs)
                 value = ({"job_id": jobs["job_id"][r.start:r.stop],
                           "error": np.full(len(r), value, dtype=object)})
@@ -259,6 +280,20 @@ def _run_tasks(ex: Executor, own: bool, tasks: list, jobs: dict, store: ResultSt
     finally:
         if own:
             ex.close()
+    return found
+
+
+def _report_job_warnings(name: str, found: list) -> None:
+    """One warning per kind for the whole sweep (its jobs' warnings, summed over the chunks, in
+    every backend: a process pool's workers would otherwise print them nowhere), not one per job
+    or per chunk."""
+    kinds: dict[type, tuple[str, int, int | None]] = {}
+    for category, text, count, total in found:
+        first, n, of = kinds.get(category, (text, 0, 0))
+        kinds[category] = (first, n + count, None if of is None or total is None else of + total)
+    for category, (first, n, of) in kinds.items():
+        counted = f"{n} of {of} jobs gave" if of is not None else f"its jobs gave {n} warnings like"
+        emit_warning(f"sweep {name!r}: {counted} this; the first: {first}", category)
 
 
 @entry_point
@@ -341,8 +376,9 @@ def sweep(spec: SweepSpec | dict | str | Path, *, backend: str = "auto", workers
     t0 = time.perf_counter()
     if done:
         status(f"resuming {spec.name}: {len(done)} of {n_chunks} chunks already on disk")
-    _run_tasks(ex, own, tasks, jobs, store, mem, chunk_size, n_jobs, spec.name, progress)
+    found = _run_tasks(ex, own, tasks, jobs, store, mem, chunk_size, n_jobs, spec.name, progress)
     seconds = time.perf_counter() - t0
+    _report_job_warnings(spec.name, found)
     parts = (store.read_parts(chunk_size, n_jobs,
                               spec.metrics) if store is not None else mem.values())
     cols = collect(jobs, parts)  # raises unless each job is there exactly once
