@@ -227,3 +227,26 @@ def test_a_nonlinear_model_file_is_refused_in_one_line(tmp_path, capsys, kind):
     assert code == 1 and len(err.splitlines()) == 1
     assert err.startswith("error: ModelError: export c: to_ss: a NARX model has no linear system")
     assert not (tmp_path / "c").exists() or not any((tmp_path / "c").iterdir())
+
+
+def test_float32_gain_series_in_blocks_equals_the_term_by_term_sum():
+    """Σ_j ‖C A^j‖_∞ of float32_error_bound, summed 256 powers per numpy call: the geometric
+    series 1/(1 − a) for a scalar a = 0.9995 (~7·10⁴ terms), and the one-product-per-term sum
+    for a lightly damped 4-state A (relative 1e-12), stopping at the same term."""
+    from gripkit.export.c_code import _power_norm_sum
+
+    a = 0.9995
+    np.testing.assert_allclose(_power_norm_sum(np.array([[1.0]]), np.array([[a]])),
+                               1.0 / (1.0 - a), rtol=1e-11)
+    rng = np.random.default_rng(3)
+    Q, _ = np.linalg.qr(rng.standard_normal((4, 4)))
+    A = Q @ np.diag([0.999, -0.99, 0.9, 0.5]) @ Q.T
+    C = rng.standard_normal((2, 4))
+    total, M = 0.0, C.copy()
+    for _ in range(1_000_000):
+        term = float(np.max(np.sum(np.abs(M), axis=1)))
+        total += term
+        if term <= 1e-17 * total:
+            break
+        M = M @ A
+    np.testing.assert_allclose(_power_norm_sum(C, A), total, rtol=1e-12)
