@@ -118,16 +118,45 @@ def test_armax_and_oe_pem_progress_when_asked(capsys):
 def test_arx_structure_search_widens_past_the_edge():
     """identify 'search' over na 1:3 for an ARX system with na = 4 (the 4th-order A above, nb = 2,
     nk = 1): the best na sits on the edge 3, the range grows to 4 and 5, and the search returns
-    [4 2 1] without an edge warning."""
+    [4 2 1] without an edge warning; one warning says that the search went past the asked
+    range, and how far."""
     rng = np.random.default_rng(7)
     u = rng.standard_normal(4000)
     y = signal.lfilter([0, 0.5, 0.3], DEN, u) + signal.lfilter([1.0], DEN,
                                                                 0.05 * rng.standard_normal(4000))
     tr = Trajectory.uniform(dt=0.01, u=u, y=y)
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", GripkitWarning)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
         res = identify(tr, "search", input="u", output="y", na="1:3", nb="1:3", nk="1:2",
                        progress=False)
+    said = [str(w.message) for w in caught if issubclass(w.category, GripkitWarning)]
+    assert said == ["structure search: the best structure sat on the edge of the asked ranges, "
+                    "so the search went past it: na to 1:5 (asked 1:3)"]
     best = res.best
     assert (best.na, best.nb, best.nk) == (4, 2, 1)
     assert sorted({c.na for c in res.candidates}) == [1, 2, 3, 4, 5]
+
+
+def test_arx_structure_search_says_when_the_data_cannot_tell_the_delay_apart():
+    """One sine drives the input: u(t − k) for any k is a combination of u(t − 1) and u(t − 2),
+    so [na 2 nk] fits the same for every nk. The search says so (AccuracyWarning) and names the
+    tied delays; a white-noise input gives no such warning."""
+    from gripkit.errors import AccuracyWarning
+
+    n = 2000
+    t = np.arange(n) * 0.01
+    u = np.sin(2 * np.pi * 1.3 * t)
+    noise = 1e-3 * np.random.default_rng(2).standard_normal(n)
+    y = signal.lfilter([0, 0.5, 0.3], [1.0, -0.9], u) + noise
+    tr = Trajectory.uniform(dt=0.01, u=u, y=y)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        identify(tr, "search", input="u", output="y", na="1:2", nb="2", nk="1:3", progress=False)
+    ties = [str(w.message) for w in caught if issubclass(w.category, AccuracyWarning)
+            and "cannot tell the delay apart" in str(w.message)]
+    assert len(ties) == 1 and "nk = 1, 2, 3" in ties[0]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        identify(_record(4), "search", input="u", output="y", na="1:2", nb="2", nk="1:3",
+                 progress=False)
+    assert not [w for w in caught if "cannot tell the delay apart" in str(w.message)]

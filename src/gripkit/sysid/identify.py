@@ -31,7 +31,8 @@ import warnings
 import numpy as np
 
 from ..arguments import check_keywords, entry_point, keyword_names
-from ..errors import AccuracyWarning, ArgumentError, DataError, GripkitError, emit_warning
+from ..errors import (AccuracyWarning, ArgumentError, DataError, GripkitError, GripkitWarning,
+                      emit_warning)
 from ..signals.trajectory import Trajectory
 from .checks import LINEAR_ORDERS
 from .io_data import IOData, io_data, records_provenance, validation_data
@@ -337,7 +338,9 @@ def search_widened(io: IOData, na, nb, nk, options: dict):
     largest structure) and the search runs again. Only the last search's warnings are emitted
     (its edge warning, when the best still sits on an edge, names the ranges searched)."""
     ranges = {"na": parse_range(na, "na"), "nb": parse_range(nb, "nb"), "nk": parse_range(nk, "nk")}
+    asked = {k: (min(r), max(r)) for k, r in ranges.items()}
     for step in range(SEARCH_WIDEN_STEPS + 1):
+        searched = {k: (min(r), max(r)) for k, r in ranges.items()}
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             res = structure_search(io.u1, io.y1, ranges["na"], ranges["nb"], ranges["nk"],
@@ -345,9 +348,28 @@ def search_widened(io: IOData, na, nb, nk, options: dict):
         grown = _grow_ranges(res.best, ranges) if options.get("criterion") != "loss" else False
         if not grown or step == SEARCH_WIDEN_STEPS:
             break
+    widened = [f"{k} to {lo}:{hi} (asked {asked[k][0]}:{asked[k][1]})"
+               for k, (lo, hi) in searched.items() if (lo, hi) != asked[k]]
+    if widened:
+        emit_warning("structure search: the best structure sat on the edge of the asked ranges, "
+                     f"so the search went past it: {', '.join(widened)}", GripkitWarning)
     for w in caught:
         emit_warning(str(w.message), w.category)
+    _warn_delay_ties(res)
     return res
+
+
+def _warn_delay_ties(res) -> None:
+    """Warn when the best structure's loss is matched (to 1e-9) by the same na and nb with
+    other delays: the data cannot tell those nk apart (too little excitation, e.g. one sine)."""
+    best = res.best
+    tied = sorted({c.nk for c in res.candidates if (c.na, c.nb) == (best.na, best.nb)
+                   and abs(c.loss - best.loss) <= 1e-9 * abs(best.loss)})
+    if len(tied) > 1:
+        emit_warning(f"structure search: na = {best.na}, nb = {best.nb} gives the same loss for "
+                     f"nk = {', '.join(map(str, tied))}: these data cannot tell the delay apart "
+                     "(the input excites too few frequencies); the ranking among them is "
+                     "arbitrary", AccuracyWarning)
 
 
 def _grow_ranges(best, ranges: dict) -> bool:
