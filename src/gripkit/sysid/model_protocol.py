@@ -68,7 +68,17 @@ from ..errors import ArgumentError, DataError, ModelError, PathError
 from ..signals.trajectory import Trajectory
 
 __all__ = ["IdentifiedModel", "ModelFit", "MODEL_FILES", "MODEL_REPORTS", "ReportMixin",
-           "file_schema", "load_model", "report_record", "simulated_trajectory"]
+           "check_sample_time", "file_schema", "load_model", "report_record",
+           "simulated_trajectory"]
+
+
+def check_sample_time(dt: float, model_dt: float) -> None:
+    """The check of every discrete model, linear and nonlinear, that runs on its own samples:
+    data sampled every ``dt`` s fit a model sampled every ``model_dt`` s only at the same
+    interval (to 10⁻⁹ relative); a DataError naming both intervals otherwise."""
+    if abs(dt - model_dt) > 1e-9 * model_dt:
+        raise DataError(f"data: sampled every {dt:g} s, the model every {model_dt:g} s",
+                        hint="resample the data to the model's rate")
 
 
 @dataclass(frozen=True)

@@ -828,6 +828,7 @@ class HWModel(OutputErrorPrediction, FreeRunModel, FamilyFile):
 
     def _columns(self, data, need_output: bool):
         if isinstance(data, Trajectory):
+            self._check_rate(data, "hw.compare" if need_output else "hw.simulate")
             cols = [self.input_name] + ([self.output_name] if need_output else [])
             missing = [c for c in cols if c not in data.names]
             if missing:

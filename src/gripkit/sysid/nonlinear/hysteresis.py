@@ -192,6 +192,7 @@ class _HysteresisModel(OutputErrorPrediction, SingleChannel, FamilyFile):
     records = ()
 
     def _input(self, data) -> np.ndarray:
+        self._check_rate(data, f"{self.structure}.simulate")
         return _record(data, self.input_name, None, f"{self.structure}.simulate",
                        need_output=False)[0]
 
@@ -288,6 +289,7 @@ class BoucWenModel(_HysteresisModel):
 
     structure = "bouc-wen"
     _family = "a Bouc-Wen hysteresis model"
+    _rate_dependent = False  # only the path of u matters (module docstring)
     _value_names = _BW_NAMES
 
     @property
@@ -514,14 +516,6 @@ class BoucWenOscillatorModel(_HysteresisModel):
             "gamma": ("γ: shape of the hysteresis (A = 1)", shape),
             "n": ("exponent n of |z|", "1"),
             "offset": ("output offset", yu if not _unitless(yu) else "1")})
-
-    def _input(self, data) -> np.ndarray:
-        if isinstance(data, Trajectory) and data.n > 1 and not math.isclose(
-                data.dt, self.dt, rel_tol=1e-6):
-            raise DataError(f"bouc-wen-oscillator: the data are sampled every {data.dt:g} s but "
-                            f"the model every {self.dt:g} s; a rate-dependent model needs the "
-                            "same sample time", hint="resample the record to the model's dt")
-        return super()._input(data)
 
     def _run(self, u: np.ndarray, theta: dict | None = None,
              x0=(0.0, 0.0, 0.0)) -> tuple[np.ndarray, int]:
@@ -883,6 +877,7 @@ class PrandtlIshlinskiiModel(_HysteresisModel):
 
     structure = "prandtl-ishlinskii"
     _family = "a Prandtl–Ishlinskii model"
+    _rate_dependent = False  # the play operators see the path of u only
 
     @property
     def weights_std(self) -> np.ndarray:

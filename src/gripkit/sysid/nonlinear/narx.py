@@ -448,6 +448,7 @@ class NARXModel(FreeRunModel, FamilyFile):
     def _signals(self, data, y, why: str, outputs: bool = True):
         """``(u, y)`` of a trajectory's columns by name, or of the signals given."""
         if isinstance(data, Trajectory):
+            self._check_rate(data, f"narx.{why}")
             cols = [self.input_name] + ([self.output_name] if outputs else [])
             missing = [c for c in cols if c not in data.names]
             if missing:

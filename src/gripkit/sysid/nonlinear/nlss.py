@@ -283,6 +283,7 @@ class NLSSModel(OutputErrorPrediction, NonlinearModel, FamilyFile):
         """Normalised input (N, m) from a Trajectory (columns by name) or an array."""
         m = len(self.input_names)
         if isinstance(data, Trajectory):
+            self._check_rate(data, f"nlss.{what}")
             u = _trajectory_columns(data, self.input_names, "input", what)
         else:
             u = np.asarray(data, dtype=np.float64)

@@ -25,7 +25,7 @@ import numpy as np
 
 from ...errors import ArgumentError, ModelError
 from ...signals.trajectory import Trajectory
-from ..model_protocol import ReportMixin
+from ..model_protocol import ReportMixin, check_sample_time
 
 __all__ = ["NonlinearModel", "OutputErrorPrediction"]
 
@@ -39,6 +39,25 @@ class NonlinearModel(ReportMixin):
 
     _family = "a nonlinear model"
     _linear_hint = f"identify a linear model ({LINEAR_METHODS}) for a linear approximation"
+
+    #: False for a rate-independent family (Bouc-Wen actuator form, Prandtl–Ishlinskii): its
+    #: output depends on the path of the input only, so data at any sample time fit it
+    _rate_dependent = True
+
+    def _check_dt(self, dt: float) -> None:
+        """The linear models' check (:func:`~gripkit.sysid.model_protocol.check_sample_time`)
+        of data sampled every ``dt`` s against the model's ``dt``: a DataError when they
+        differ (none for a rate-independent family)."""
+        mdt = getattr(self, "dt", None)
+        if self._rate_dependent and mdt is not None:
+            check_sample_time(float(dt), float(mdt))
+
+    def _check_rate(self, data, why: str) -> None:
+        """:meth:`_check_dt` of a :class:`~gripkit.signals.Trajectory` ``data`` (uniformly
+        sampled, else a DataError naming ``why``); arrays carry no sample time and are taken as
+        the model's samples."""
+        if isinstance(data, Trajectory) and data.n > 1 and self._rate_dependent:
+            self._check_dt(data.require_uniform(why=why))
 
     def _no_linear_system(self, name: str) -> ModelError:
         return ModelError(f"{name}: {self._family} has no linear system to convert (only "

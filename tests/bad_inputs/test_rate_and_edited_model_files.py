@@ -1,0 +1,182 @@
+"""Silent wrong answers of the model files and the nonlinear families (audit of 27 Nov):
+
+1. every rate-dependent nonlinear family (NARX, Hammerstein–Wiener, nonlinear state space, the
+   Bouc-Wen oscillator) refuses data sampled at another interval than the model's, with the
+   linear models' DataError (one shared check), in Python and in the CLI; arrays (no time)
+   and the rate-independent hysteresis forms keep working;
+2. an edited model file whose copies of a value disagree, or whose field is out of its
+   domain, is refused on load with a one-line malformed-file ModelError naming the field.
+
+Every model is identified on a short synthetic record built here (a saturated input into the
+ARX [2 2 1] y(t) = 1.2 y(t−1) − 0.5 y(t−2) + 0.8 w(t−1) + 0.3 w(t−2), noise σ = 0.01)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+from corpus import assert_user_error
+
+from gripkit import Trajectory
+from gripkit.errors import DataError, ModelError
+from gripkit.sysid import (BoucWenModel, BoucWenOscillatorModel, arx, compare, hammerstein_wiener,
+                           load_model, narx, nlss)
+
+DT = 0.01
+
+
+def _record(n: int = 400, seed: int = 0):
+    rng = np.random.default_rng(seed)
+    u = rng.standard_normal(n)
+    w = np.clip(u, -0.8, 0.8)
+    y = np.zeros(n)
+    for t in range(2, n):
+        y[t] = 1.2 * y[t - 1] - 0.5 * y[t - 2] + 0.8 * w[t - 1] + 0.3 * w[t - 2]
+    return u, y + 0.01 * rng.standard_normal(n)
+
+
+U, Y = _record()
+OSC = BoucWenOscillatorModel(mass=1.0, damping=6.0, k_e=2000.0, k_h=2000.0, beta=300.0,
+                             gamma=100.0, offset=0.0, dt=1e-3)
+
+
+def _models() -> dict:
+    return {"narx": narx(U, Y, degree=2, lags=2, dt=DT),
+            "hw": hammerstein_wiener(U, Y, input_nonlinearity="saturation", nb=2, nf=2, nk=1,
+                                     dt=DT),
+            "nlss": nlss((U, Y), order=2, degree=2, dt=DT, progress=False),
+            "bouc-wen oscillator": OSC}
+
+
+MODELS = _models()
+
+
+def _trajectory(m, dt: float) -> Trajectory:
+    return Trajectory.uniform(dt=dt, **{m.inputs[0]: U, m.outputs[0]: Y})
+
+
+@pytest.mark.filterwarnings("ignore")
+@pytest.mark.parametrize("family", list(MODELS))
+def test_nonlinear_family_refuses_data_at_another_rate(family):
+    """Item 1: compare, simulate and sysid.compare refuse a record at twice the model's interval
+    with the message of the linear models (an ARX model says the same words); at the model's
+    interval the fit is that of the bare arrays, which carry no time and keep working."""
+    m = MODELS[family]
+    wrong = _trajectory(m, 2 * m.dt)
+    phrase = f"data: sampled every {2 * m.dt:g} s, the model every {m.dt:g} s"
+    for call in (lambda: m.compare(wrong), lambda: m.simulate(wrong),
+                 lambda: compare(m, wrong, None), lambda: compare(m, U, Y, dt=2 * m.dt)):
+        with pytest.raises(DataError) as err:
+            call()
+        assert phrase in err.value.message
+    lin = arx(U, Y, 2, 2, 1, dt=m.dt, input_name=m.inputs[0], output_name=m.outputs[0])
+    with pytest.raises(DataError) as err:
+        lin.compare(_trajectory(lin, 2 * m.dt))
+    assert phrase in err.value.message
+    assert m.compare(_trajectory(m, m.dt)).fit_percent == m.compare(U, Y).fit_percent
+
+
+def test_rate_independent_hysteresis_takes_any_rate():
+    """Item 1, the hysteresis forms: the actuator-form Bouc-Wen (its output a function of the
+    input's path only) gives the same run at any sample interval."""
+    m = BoucWenModel(d=0.5, alpha=1.0, beta=0.5, gamma=0.2, dt=DT)
+    u = np.sin(np.linspace(0.0, 6 * np.pi, 300))
+    tr = Trajectory.uniform(dt=DT, u=u)
+    np.testing.assert_array_equal(m.simulate(Trajectory.uniform(dt=5 * DT, u=u)), m.simulate(tr))
+
+
+def test_cli_compare_and_simulate_refuse_another_rate(cli, tmp_path):
+    """Item 1 in the CLI: a NARX model identified at 100 Hz compared with (or run on) a record
+    read at --fs 50 is one DataError line; at --fs 100 the fit is the model's on the arrays."""
+    m = MODELS["narx"]
+    path = m.save(tmp_path / "narx.json") or tmp_path / "narx.json"
+    data = tmp_path / "rec.csv"
+    np.savetxt(data, np.column_stack([U, Y]), delimiter=",", header="u,y", comments="",
+               fmt="%.17g")
+    for args in (("compare", path, data), ("simulate", path, "--data", data)):
+        assert_user_error(cli(*args, "--fs", 50), "DataError",
+                          "data: sampled every 0.02 s, the model every 0.01 s")
+    res = cli("compare", path, data, "--fs", 100, "--json")
+    assert res.code == 0, res.err
+    assert res.json()["fit_percent"][0] == pytest.approx(m.compare(U, Y).fit_percent[0],
+                                                         rel=1e-12)
+
+
+def _edited(tmp_path, path, edit, name="edited.json"):
+    """A copy of the model file ``path`` with ``edit(doc)`` applied (its content hash left
+    stale, as a hand edit leaves it)."""
+    doc = json.loads(path.read_text())
+    edit(doc)
+    out = tmp_path / name
+    out.write_text(json.dumps(doc))
+    return out
+
+
+@pytest.fixture
+def arx_file(tmp_path):
+    """An ARX [2 2 1] model of the record (current [A] → force [N], offsets 0.5 A and 1 N),
+    saved; with its fit on the record."""
+    m = arx(U + 0.5, Y + 1.0, 2, 2, 1, dt=DT, input_name="current", output_name="force",
+            input_unit="A", output_unit="N", u_offset=0.5, y_offset=1.0)
+    path = tmp_path / "arx.json"
+    m.save(path)
+    return path, m.compare(U, Y).fit_percent
+
+
+def _set(keys, value):
+    def edit(doc):
+        d = doc
+        for k in keys[:-1]:
+            d = d[k]
+        d[keys[-1]] = value
+    return edit
+
+
+@pytest.mark.filterwarnings("ignore::gripkit.errors.AccuracyWarning")
+@pytest.mark.parametrize("keys, value, phrase", [
+    (("system", "den", 0, 0, 1), -1.4, "'system.den' and the 'polynomial' section disagree"),
+    (("system", "den", 0, 0, 2), 1.5, "'system.den' and the 'polynomial' section disagree"),
+    (("polynomial", "A", 1), -1.4, "'info.A' and the 'polynomial' section disagree"),
+    (("info", "B", 1), 0.5, "'info.B' and the 'polynomial' section disagree"),
+])
+def test_arx_file_copies_that_disagree_are_refused(arx_file, tmp_path, cli, keys, value, phrase):
+    """Item 2a: the system (B/(A F), the copy for readers without polynomials) edited alone, made
+    unstable, or the polynomial edited alone: a malformed-file ModelError naming both fields,
+    in Python and as the CLI's one line, never a fit from the other copy."""
+    path, _ = arx_file
+    bad = _edited(tmp_path, path, _set(keys, value))
+    with pytest.raises(ModelError, match="malformed") as err:
+        load_model(bad)
+    assert phrase in err.value.message
+    assert_user_error(cli("export", "c", bad, "--out", tmp_path / "c"), "ModelError", phrase)
+
+
+@pytest.mark.filterwarnings("ignore::gripkit.errors.AccuracyWarning")
+@pytest.mark.parametrize("keys, value, phrase", [
+    (("dt",), 0.5, "'dt' is 0.5 but 'system.dt' is 0.01"),
+    (("outputs", 0, "offset"), "x", "'outputs[0].offset' must be a finite number, found 'x'"),
+    (("inputs", 0, "offset"), None, "'inputs[0].offset' must be a finite number, found 'None'"),
+    (("outputs", 0, "unit"), "m", "'outputs[0].unit' is 'm' but 'system.output_units[0]' is 'N'"),
+])
+def test_arx_file_fields_that_contradict_the_system_are_refused(arx_file, tmp_path, cli, keys,
+                                                                value, phrase):
+    """Items 2b and 2c: a top-level dt or unit contradicting the system's, an offset that is no
+    number: one malformed-file ModelError line naming the field (not an unexpected ValueError)."""
+    path, _ = arx_file
+    bad = _edited(tmp_path, path, _set(keys, value))
+    with pytest.raises(ModelError, match="malformed") as err:
+        load_model(bad)
+    assert phrase in err.value.message
+    data = tmp_path / "rec.csv"
+    np.savetxt(data, np.column_stack([U + 0.5, Y + 1.0]), delimiter=",",
+               header="current [A],force [N]", comments="", fmt="%.17g")
+    assert_user_error(cli("compare", bad, data, "--fs", 100), "ModelError", phrase)
+
+
+def test_untouched_arx_file_loads_with_the_same_fit(arx_file, recwarn):
+    """An untouched file loads without a warning and gives the fit of the model that wrote it."""
+    path, fit = arx_file
+    back = load_model(path)
+    assert back.compare(U, Y).fit_percent == fit
+    assert not [w for w in recwarn if "edited" in str(w.message)]
