@@ -37,8 +37,10 @@ def _record(n: int = 400, seed: int = 0):
 
 
 U, Y = _record()
+#: the Bouc-Wen forms built from known parameters (none estimated: ``free=()``)
 OSC = BoucWenOscillatorModel(mass=1.0, damping=6.0, k_e=2000.0, k_h=2000.0, beta=300.0,
-                             gamma=100.0, offset=0.0, dt=1e-3)
+                             gamma=100.0, offset=0.0, dt=1e-3, free=())
+BW = dict(d=0.5, alpha=1.0, beta=0.5, gamma=0.2, dt=DT, free=())
 
 
 def _models() -> dict:
@@ -80,7 +82,7 @@ def test_nonlinear_family_refuses_data_at_another_rate(family):
 def test_rate_independent_hysteresis_takes_any_rate():
     """Item 1, the hysteresis forms: the actuator-form Bouc-Wen (its output a function of the
     input's path only) gives the same run at any sample interval."""
-    m = BoucWenModel(d=0.5, alpha=1.0, beta=0.5, gamma=0.2, dt=DT)
+    m = BoucWenModel(**BW)
     u = np.sin(np.linspace(0.0, 6 * np.pi, 300))
     tr = Trajectory.uniform(dt=DT, u=u)
     np.testing.assert_array_equal(m.simulate(Trajectory.uniform(dt=5 * DT, u=u)), m.simulate(tr))
@@ -180,3 +182,69 @@ def test_untouched_arx_file_loads_with_the_same_fit(arx_file, recwarn):
     back = load_model(path)
     assert back.compare(U, Y).fit_percent == fit
     assert not [w for w in recwarn if "edited" in str(w.message)]
+
+
+#: (family, field path, edited value, key phrase of the malformed-file ModelError)
+NONLINEAR_EDITS = [
+    ("narx", ("output_unit",), "zorkmid", "'output_unit' must be a unit gripkit can read"),
+    ("narx", ("degree",), -3, "'degree' must be a whole number ≥ 1, found -3"),
+    ("narx", ("dt",), 0, "'dt' must be a finite number > 0, found 0"),
+    ("hw", ("theta", 0), None, "'theta[0]' must be a finite number, found null"),
+    ("hw", ("dt",), -0.01, "'dt' must be a finite number > 0, found -0.01"),
+    ("nlss", ("A", 0, 0), None, "'A[0][0]' must be a finite number, found null"),
+    ("nlss", ("output_units", 0), 7, "'output_units[0]' must be a unit gripkit can read"),
+    ("bouc-wen", ("n",), -1, "'n' must be a finite number in [1, 10], found -1"),
+    ("bouc-wen oscillator", ("dt",), 0, "'dt' must be a finite number > 0, found 0"),
+]
+
+
+def _saved(family: str, tmp_path):
+    m = (BoucWenModel(**BW) if family == "bouc-wen"
+         else MODELS[family])
+    path = tmp_path / f"{family.replace(' ', '_')}.json"
+    m.save(path)
+    return m, path
+
+
+@pytest.mark.parametrize("family, keys, value, phrase", NONLINEAR_EDITS)
+def test_nonlinear_file_field_out_of_domain_is_refused(family, keys, value, phrase, tmp_path,
+                                                       cli):
+    """Item 2d: a unit gripkit cannot read, a degree below 1, a sample time ≤ 0, a null
+    parameter, a Bouc-Wen exponent outside [1, 10] (where hysteresis() fits it): refused on load
+    with a malformed-file ModelError naming the field (not accepted, not "diverged"), in Python
+    and as the CLI's one line."""
+    _, path = _saved(family, tmp_path)
+    bad = _edited(tmp_path, path, _set(keys, value))
+    with pytest.raises(ModelError, match="malformed") as err:
+        load_model(bad)
+    assert phrase in err.value.message
+    data = tmp_path / "rec.csv"
+    np.savetxt(data, np.column_stack([U, Y]), delimiter=",", header="u,y", comments="",
+               fmt="%.17g")
+    assert_user_error(cli("compare", bad, data, "--fs", 100), "ModelError", phrase)
+
+
+@pytest.mark.filterwarnings("ignore")
+@pytest.mark.parametrize("family", ["narx", "hw", "nlss", "bouc-wen", "bouc-wen oscillator"])
+def test_untouched_nonlinear_file_gives_the_same_fit(family, tmp_path):
+    """The files written by the families load as before: the same fit on the record."""
+    m, path = _saved(family, tmp_path)
+    assert load_model(path).compare(U, Y).fit_percent == m.compare(U, Y).fit_percent
+
+
+def test_nonlinear_model_reads_the_data_in_its_units(tmp_path):
+    """Item 2d, a readable unit of another quantity: a NARX file whose output_unit says
+    'furlong' (a length) compared with a record whose output is in V is refused with the linear
+    models' DataError; a record in the model's units (V → m) fits as the arrays do."""
+    m, path = _saved("narx", tmp_path)
+    doc = json.loads(path.read_text())
+    doc.update(input_unit="V", output_unit="furlong")
+    path.write_text(json.dumps(doc))
+    back = load_model(path)
+    volts = Trajectory.uniform(dt=DT, u=U, y=Y, units={"u": "V", "y": "V"})
+    with pytest.raises(DataError, match="a different physical quantity"):
+        back.compare(volts)
+    doc.update(output_unit="m")
+    path.write_text(json.dumps(doc))
+    metres = Trajectory.uniform(dt=DT, u=U, y=Y, units={"u": "V", "y": "m"})
+    assert load_model(path).compare(metres).fit_percent == m.compare(U, Y).fit_percent

@@ -32,15 +32,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ... import __version__
-from ...errors import (ArgumentError, DataError, DataWarning, ModelError, ParameterError,
-                       emit_warning)
+from ...errors import ArgumentError, DataError, ModelError
 from ...lti import LinearSystem, StateSpace, TransferFunction
 from ...params import Parameter, ParameterSet
 from ...signals.trajectory import Trajectory
-from ...units import convert, dimension_of, product_unit, same_dimension
+from ...units import product_unit, same_dimension
 from ..checks import as_io_matrix
 from ..model_file import SCHEMA, SCHEMA_VERSION, read_document, write_document
-from ..model_protocol import ModelFit, ReportMixin, check_sample_time
+from ..model_protocol import ModelFit, ReportMixin, check_sample_time, column_in_unit
 from .validation import validate
 
 __all__ = ["VALIDATION_FIT", "IdentifiedLinearModel", "LinearModel", "as_io_matrix", "estimate_x0",
@@ -95,30 +94,6 @@ def fit_per_output(y, yhat) -> list[float]:
             raise DataError(f"output {i}: the fit is undefined for a constant output (‖y − ȳ‖ = 0)")
         out.append(100.0 * (1.0 - float(np.linalg.norm(y[:, i] - yhat[:, i])) / den))
     return out
-
-
-def _in_unit(data, name: str, unit: str | None, what: str) -> np.ndarray:
-    """Column ``name`` of ``data`` in the model's ``unit``: converted when the data give another
-    unit of the same dimension, a :class:`DataError` when they give another dimension (a model of
-    u [A] compared with u [V]). Either side without a unit ('1' or none) is taken as it is."""
-    x = np.asarray(data[name], dtype=np.float64)
-    have = data.unit(name)
-    if unit in (None, "", "1") or have in (None, "", "1") or have == unit:
-        return x
-    try:
-        same = same_dimension(have, unit)
-    except ParameterError:  # a unit that is not one (a hand-edited or foreign model file)
-        emit_warning(f"data: cannot compare the units of the {what} column {name!r}: {have!r} in "
-                     f"the data, {unit!r} in the model, and one is not a unit gripkit can read; "
-                     f"the values are taken as they are", DataWarning)
-        return x
-    if not same:
-        raise DataError(f"data: {what} column {name!r} is in {have!r} (dimension "
-                        f"{dimension_of(have)}), but the model's {what} {name!r} is in {unit!r} "
-                        f"(dimension {dimension_of(unit)}): a different physical quantity",
-                        hint="check that the record holds the signals the model was identified "
-                             "from")
-    return convert(x, have, unit)
 
 
 def _checked_display_units(model, shown: dict) -> dict:
@@ -328,7 +303,7 @@ class IdentifiedLinearModel(ReportMixin):
                             f"are missing; the data have {', '.join(map(repr, data.names))}",
                             hint="rename the columns or identify the model from matching data")
         units = self.system.input_units if what == "input" else self.system.output_units
-        return np.column_stack([_in_unit(data, n, u, what) - o
+        return np.column_stack([column_in_unit(data, n, u, what) - o
                                 for n, u, o in zip(names, units, offsets)])
 
     def _io(self, data, y, why: str, outputs: bool = True, dt: float | None = None):

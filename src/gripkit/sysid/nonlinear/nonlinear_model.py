@@ -10,6 +10,11 @@ view is (``_linear_hint``): a nonlinear model has no linear system to convert. E
 others refuse a given one with an ArgumentError saying what their free run starts from
 (``_refuse_x0``). Arrays given to a nonlinear model are the record's values (no offset is
 removed; the nonlinear state space's ``u_offset``/``y_offset`` normalise inside the model).
+A trajectory given to a rate-dependent family (every one but the Bouc-Wen actuator form and
+Prandtl–Ishlinskii) must be sampled at the model's ``dt``: ``_check_rate`` refuses another
+interval with the linear models' DataError
+(:func:`~gripkit.sysid.model_protocol.check_sample_time`); arrays carry no time and are taken
+as the model's samples.
 
 :class:`OutputErrorPrediction`, the ``predict`` and ``residuals`` of the output-error families
 (Hammerstein–Wiener, nonlinear state space, hysteresis): their noise enters at the output, so
