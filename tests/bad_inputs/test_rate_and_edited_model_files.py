@@ -248,3 +248,18 @@ def test_nonlinear_model_reads_the_data_in_its_units(tmp_path):
     path.write_text(json.dumps(doc))
     metres = Trajectory.uniform(dt=DT, u=U, y=Y, units={"u": "V", "y": "m"})
     assert load_model(path).compare(metres).fit_percent == m.compare(U, Y).fit_percent
+
+
+@pytest.mark.filterwarnings("ignore::gripkit.errors.AccuracyWarning")
+def test_arx_polynomial_edited_with_its_info_copy_is_refused(arx_file, tmp_path):
+    """Item 2a: a1 edited in the polynomial section and in info alike (the system left): the
+    system the file shows is not the model's, so the file is refused, naming 'system.den'."""
+    path, _ = arx_file
+
+    def edit(doc):
+        doc["polynomial"]["A"][1] = doc["info"]["A"][1] = -1.4
+
+    with pytest.raises(ModelError, match="malformed") as err:
+        load_model(_edited(tmp_path, path, edit))
+    assert "'system.den' and the 'polynomial' section disagree" in err.value.message
+    assert "is -1.2" in err.value.message and "-1.4 by 'polynomial'" in err.value.message
