@@ -169,7 +169,7 @@ def test_bouc_wen_oscillator_recovery_and_round_trip(tmp_path):
     assert type(m2) is BoucWenOscillatorModel and m2.parameters == m.parameters
     np.testing.assert_array_equal(m2.simulate(tr), m.simulate(tr))
     assert m.parameters["k_e"].unit == "N/m"
-    with pytest.raises(DataError, match="sampled every 0.002 s but the model every 0.001 s"):
+    with pytest.raises(DataError, match="sampled every 0.002 s, the model every 0.001 s"):
         m.simulate(Trajectory(OSC_T * 2, {"F": OSC_F}))
     with pytest.raises(DataError, match="sampled every 0.002 s"):
         m.compare(Trajectory(OSC_T * 2, {"F": OSC_F, "x": y0}))

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import sys
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,10 +22,13 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import write_text
-from ..errors import AccuracyWarning, DataError, ModelError, PathError, emit_warning
+from ..errors import (AccuracyWarning, DataError, ModelError, ParameterError, PathError,
+                      emit_warning)
+from ..units import si_factor
 
 __all__ = ["file_sha256", "plain", "write_document", "read_document", "read_family_document",
-           "FamilyFile", "file_provenance", "SCHEMA", "SCHEMA_VERSION"]
+           "FamilyFile", "file_provenance", "Domain", "check_family_fields", "SAMPLE_TIME",
+           "SCHEMA", "SCHEMA_VERSION"]
 
 SCHEMA = "gripkit.linear-model"
 SCHEMA_VERSION = 2
@@ -229,3 +233,83 @@ def read_family_document(path, schema: str, version, *, family: str, writer: str
                          hint=f"write it again with this gripkit ({writer})")
     _check_provenance(doc, what)
     return doc
+
+
+@dataclass(frozen=True)
+class Domain:
+    """Where a number of a model file may lie: from ``lo`` (excluded with ``strict``) to
+    ``hi``, a whole number with ``integer``, null allowed with ``optional``."""
+
+    lo: float = -math.inf
+    hi: float = math.inf
+    strict: bool = False
+    integer: bool = False
+    optional: bool = False
+
+    def holds(self, v) -> bool:
+        if v is None:
+            return self.optional
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
+            return False
+        if self.integer and v != int(v):
+            return False
+        return (v > self.lo if self.strict else v >= self.lo) and v <= self.hi
+
+    def describe(self) -> str:
+        kind = "a whole number" if self.integer else "a finite number"
+        if self.lo > -math.inf and self.hi < math.inf:
+            kind += f" in {'(' if self.strict else '['}{self.lo:g}, {self.hi:g}]"
+        elif self.lo > -math.inf:
+            kind += f" {'>' if self.strict else '≥'} {self.lo:g}"
+        return kind + (" or null" if self.optional else "")
+
+
+#: a sample time (s) of a discrete model
+SAMPLE_TIME = Domain(0.0, strict=True)
+
+
+def _first_not_finite(x):
+    """The first index (a tuple) of a non-finite entry of the nested list ``x`` (null counts as
+    one); None when every entry is finite or ``x`` is not an array of numbers (the family's
+    reader then names what is wrong)."""
+    try:
+        a = np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError):
+        return None
+    bad = np.argwhere(~np.isfinite(a))
+    return tuple(int(i) for i in bad[0]) if bad.size else None
+
+
+def check_family_fields(doc: dict, what: str, writer: str, *, numbers: dict | None = None,
+                        finite=(), units=()) -> None:
+    """The fields of a nonlinear family's model file document (``what``: how the errors name
+    the file; ``writer``: what writes one), checked on load as a linear model file's system is
+    when it is built: each number of ``numbers`` ({key: :class:`Domain`}) in its domain, each
+    array of ``finite`` without a null or non-finite entry, each unit (or list of units) of
+    ``units`` one gripkit can read. A malformed-file ModelError naming the field otherwise; a
+    field missing is left to the family's reader."""
+    def bad(field_: str, expected: str, found) -> ModelError:
+        shown = "null" if found is None else repr(found)[:40]
+        return ModelError(f"{what}: malformed: {field_!r} must be {expected}, found {shown}",
+                          hint=f"write it again with {writer}")
+
+    for key, dom in (numbers or {}).items():
+        if key in doc and not dom.holds(doc[key]):
+            raise bad(key, dom.describe(), doc[key])
+    for key in finite:
+        idx = _first_not_finite(doc[key]) if key in doc else None
+        if idx is not None:
+            v = np.asarray(doc[key], dtype=np.float64)[idx]
+            raise bad(f"{key}[{']['.join(map(str, idx))}]", "a finite number",
+                      None if math.isnan(v) else float(v))
+    for key in units:
+        values = doc.get(key, [])
+        for i, u in enumerate(values if isinstance(values, list) else [values]):
+            name = key if not isinstance(values, list) else f"{key}[{i}]"
+            try:
+                if not isinstance(u, str):
+                    raise ParameterError("not a string")
+                si_factor(u)
+            except ParameterError:
+                raise bad(name, "a unit gripkit can read (an SI spelling such as 'm', 'N', "
+                                "'V', '1')", u) from None

@@ -64,11 +64,47 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from ..errors import ArgumentError, DataError, ModelError, PathError
+from ..errors import (ArgumentError, DataError, DataWarning, ModelError, ParameterError, PathError,
+                      emit_warning)
+from ..units import convert, dimension_of, same_dimension
 from ..signals.trajectory import Trajectory
 
 __all__ = ["IdentifiedModel", "ModelFit", "MODEL_FILES", "MODEL_REPORTS", "ReportMixin",
-           "file_schema", "load_model", "report_record", "simulated_trajectory"]
+           "check_sample_time", "column_in_unit", "file_schema", "load_model", "report_record",
+           "simulated_trajectory"]
+
+
+def column_in_unit(data, name: str, unit: str | None, what: str) -> np.ndarray:
+    """Column ``name`` of ``data`` in the model's ``unit``: converted when the data give another
+    unit of the same dimension, a :class:`DataError` when they give another dimension (a model of
+    u [A] compared with u [V]). Either side without a unit ('1' or none) is taken as it is."""
+    x = np.asarray(data[name], dtype=np.float64)
+    have = data.unit(name)
+    if unit in (None, "", "1") or have in (None, "", "1") or have == unit:
+        return x
+    try:
+        same = same_dimension(have, unit)
+    except ParameterError:  # a unit that is not one (a hand-edited or foreign model file)
+        emit_warning(f"data: cannot compare the units of the {what} column {name!r}: {have!r} in "
+                     f"the data, {unit!r} in the model, and one is not a unit gripkit can read; "
+                     f"the values are taken as they are", DataWarning)
+        return x
+    if not same:
+        raise DataError(f"data: {what} column {name!r} is in {have!r} (dimension "
+                        f"{dimension_of(have)}), but the model's {what} {name!r} is in {unit!r} "
+                        f"(dimension {dimension_of(unit)}): a different physical quantity",
+                        hint="check that the record holds the signals the model was identified "
+                             "from")
+    return convert(x, have, unit)
+
+
+def check_sample_time(dt: float, model_dt: float) -> None:
+    """The check of every discrete model, linear and nonlinear, that runs on its own samples:
+    data sampled every ``dt`` s fit a model sampled every ``model_dt`` s only at the same
+    interval (to 10⁻⁹ relative); a DataError naming both intervals otherwise."""
+    if abs(dt - model_dt) > 1e-9 * model_dt:
+        raise DataError(f"data: sampled every {dt:g} s, the model every {model_dt:g} s",
+                        hint="resample the data to the model's rate")
 
 
 @dataclass(frozen=True)

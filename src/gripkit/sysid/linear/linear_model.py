@@ -32,15 +32,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ... import __version__
-from ...errors import (ArgumentError, DataError, DataWarning, ModelError, ParameterError,
-                       emit_warning)
+from ...errors import ArgumentError, DataError, ModelError
 from ...lti import LinearSystem, StateSpace, TransferFunction
 from ...params import Parameter, ParameterSet
 from ...signals.trajectory import Trajectory
-from ...units import convert, dimension_of, product_unit, same_dimension
+from ...units import product_unit, same_dimension
 from ..checks import as_io_matrix
 from ..model_file import SCHEMA, SCHEMA_VERSION, read_document, write_document
-from ..model_protocol import ModelFit, ReportMixin
+from ..model_protocol import ModelFit, ReportMixin, check_sample_time, column_in_unit
 from .validation import validate
 
 __all__ = ["VALIDATION_FIT", "IdentifiedLinearModel", "LinearModel", "as_io_matrix", "estimate_x0",
@@ -95,30 +94,6 @@ def fit_per_output(y, yhat) -> list[float]:
             raise DataError(f"output {i}: the fit is undefined for a constant output (‖y − ȳ‖ = 0)")
         out.append(100.0 * (1.0 - float(np.linalg.norm(y[:, i] - yhat[:, i])) / den))
     return out
-
-
-def _in_unit(data, name: str, unit: str | None, what: str) -> np.ndarray:
-    """Column ``name`` of ``data`` in the model's ``unit``: converted when the data give another
-    unit of the same dimension, a :class:`DataError` when they give another dimension (a model of
-    u [A] compared with u [V]). Either side without a unit ('1' or none) is taken as it is."""
-    x = np.asarray(data[name], dtype=np.float64)
-    have = data.unit(name)
-    if unit in (None, "", "1") or have in (None, "", "1") or have == unit:
-        return x
-    try:
-        same = same_dimension(have, unit)
-    except ParameterError:  # a unit that is not one (a hand-edited or foreign model file)
-        emit_warning(f"data: cannot compare the units of the {what} column {name!r}: {have!r} in "
-                     f"the data, {unit!r} in the model, and one is not a unit gripkit can read; "
-                     f"the values are taken as they are", DataWarning)
-        return x
-    if not same:
-        raise DataError(f"data: {what} column {name!r} is in {have!r} (dimension "
-                        f"{dimension_of(have)}), but the model's {what} {name!r} is in {unit!r} "
-                        f"(dimension {dimension_of(unit)}): a different physical quantity",
-                        hint="check that the record holds the signals the model was identified "
-                             "from")
-    return convert(x, have, unit)
 
 
 def _checked_display_units(model, shown: dict) -> dict:
@@ -306,9 +281,7 @@ class IdentifiedLinearModel(ReportMixin):
         if dt is None:
             return ss
         if ss.is_discrete:
-            if abs(ss.dt - dt) > 1e-9 * dt:
-                raise DataError(f"data: sampled every {dt:g} s, the model every {ss.dt:g} s",
-                                hint="resample the data to the model's rate")
+            check_sample_time(dt, ss.dt)
             return ss
         return ss.c2d(dt)
 
@@ -330,7 +303,7 @@ class IdentifiedLinearModel(ReportMixin):
                             f"are missing; the data have {', '.join(map(repr, data.names))}",
                             hint="rename the columns or identify the model from matching data")
         units = self.system.input_units if what == "input" else self.system.output_units
-        return np.column_stack([_in_unit(data, n, u, what) - o
+        return np.column_stack([column_in_unit(data, n, u, what) - o
                                 for n, u, o in zip(names, units, offsets)])
 
     def _io(self, data, y, why: str, outputs: bool = True, dt: float | None = None):
@@ -649,14 +622,15 @@ def _read(path):
                                                                              for d in outs]:
             raise ModelError(f"model file {where}: the inputs/outputs lists disagree with "
                              "the system's names")
+        _check_copies(doc, system, where)
         inn = doc.get("innovation") or {}
         K, x0, lam = (None if inn.get(k) is None else _arr(inn[k], k, where)
                       for k in ("K", "x0", "noise_covariance"))
         data = doc.get("data") or {}
         sv = doc.get("singular_values")
         lm = LinearModel(system, doc["structure"], K=K, x0=x0, noise_covariance=lam,
-                           u_offset=[d["offset"] for d in ins],
-                           y_offset=[d["offset"] for d in outs],
+                           u_offset=_offsets(ins, "inputs", where),
+                           y_offset=_offsets(outs, "outputs", where),
                            fit_percent=doc.get("fit_percent"),
                            singular_values=None if sv is None else np.asarray(sv),
                            n_samples=doc.get("n_samples"), data_file=data.get("file"),
@@ -672,6 +646,51 @@ def _read(path):
         if not exc.message.startswith("display unit"):
             raise
         raise ModelError(f"model file {where}: {exc.message}", hint=exc.hint) from None
+
+
+def malformed(where: str, what: str) -> ModelError:
+    """The ModelError of a model file (``where``: its quoted path) whose field is wrong or whose
+    two copies of a value disagree (``what`` names the fields and what was found)."""
+    return ModelError(f"model file {where}: malformed: {what}",
+                      hint="regenerate the file with gripkit identify --out (a hand edit must "
+                           "change every copy of a value alike)")
+
+
+def _offsets(entries, kind: str, where: str) -> list[float]:
+    """The ``offset`` of each entry of the document's ``inputs`` or ``outputs`` (``kind``): a
+    finite number each, else a malformed-file ModelError naming the entry."""
+    out = []
+    for i, d in enumerate(entries):
+        v = d["offset"]
+        if isinstance(v, bool) or not isinstance(v, (int, float)) or not np.isfinite(v):
+            raise malformed(where, f"'{kind}[{i}].offset' must be a finite number, found "
+                                   f"{str(v)[:40]!r}")
+        out.append(float(v))
+    return out
+
+
+def _same_dt(a, b) -> bool:
+    """Two sample times (s) alike: both continuous (None or 0), or equal numbers to 10⁻¹²."""
+    if a in (None, 0) or b in (None, 0):
+        return a in (None, 0) and b in (None, 0) and not isinstance(a, bool)
+    return (isinstance(a, (int, float)) and not isinstance(a, bool)
+            and abs(a - b) <= 1e-12 * abs(b))
+
+
+def _check_copies(doc: dict, system: LinearSystem, where: str) -> None:
+    """The document's top-level ``dt`` and the ``unit`` of its ``inputs``/``outputs`` entries,
+    copies of the system's own (the model runs on the system's), must agree with them: a
+    malformed-file ModelError naming both fields otherwise."""
+    top = doc.get("dt", system.dt)
+    if not _same_dt(top, system.dt):
+        raise malformed(where, f"'dt' is {str(top)[:40]} but 'system.dt' is {system.dt}; "
+                               "they are two copies of the sample time and must agree")
+    for kind, units in (("inputs", system.input_units), ("outputs", system.output_units)):
+        for i, (d, u) in enumerate(zip(doc[kind], units)):
+            if (d.get("unit") or "") != (u or ""):
+                raise malformed(where, f"'{kind}[{i}].unit' is {str(d.get('unit'))[:40]!r} but "
+                                       f"'system.{kind[:-1]}_units[{i}]' is {u!r}; they are two "
+                                       "copies of the unit and must agree")
 
 
 def polynomial_document(doc: dict) -> bool:

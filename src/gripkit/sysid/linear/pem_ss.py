@@ -40,6 +40,7 @@ from ...progress import status, track
 from ...lti import StateSpace, Uncertainty, affine_row, flush_tiny
 from .blocked_gram import add_rows, carried_states, carry, row_product, start_sums
 from ..checks import io_records
+from ..model_protocol import check_sample_time
 from .linear_model import LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run
 from .validation import records_fit
 
@@ -412,8 +413,7 @@ def _pem_data(model: LinearModel, data, u, y) -> tuple[np.ndarray, np.ndarray]:
     ss = model.system
     if data is not None:
         dt = data.require_uniform(why="PEM refinement")
-        if abs(dt - ss.dt) > 1e-9 * ss.dt:
-            raise DataError(f"data: sampled every {dt:g} s, the model every {ss.dt:g} s")
+        check_sample_time(dt, ss.dt)
         u = model._columns(data, model.inputs, model.u_offset, "input")
         y = model._columns(data, model.outputs, model.y_offset, "output")
     u = as_io_matrix(u, "input u")

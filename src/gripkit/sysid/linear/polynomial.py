@@ -50,7 +50,9 @@ from ...signals.trajectory import Trajectory
 from ...units import ratio_unit
 from . import matrix_polynomial as mp
 from .linear_model import (IdentifiedLinearModel, LinearModel, _checked_display_units, _horizon,
-                           as_io_matrix, k_step_prediction, polynomial_document, read_linear_model)
+                           as_io_matrix, k_step_prediction, malformed, polynomial_document,
+                           read_linear_model)
+from ..model_protocol import check_sample_time
 from .validation import validate
 
 __all__ = ["PolynomialModel", "load_linear_model"]
@@ -774,9 +776,8 @@ class PolynomialModel(IdentifiedLinearModel):
         return A, Bt[:, :1], Ct, Dt[:, :1], Bt[:, 1:]
 
     def _state_space(self, dt):
-        if dt is not None and abs(dt - self.dt) > 1e-9 * self.dt:
-            raise DataError(f"data: sampled every {dt:g} s, the model every {self.dt:g} s",
-                            hint="resample the data to the model's rate")
+        if dt is not None:
+            check_sample_time(dt, self.dt)
         return self.innovation_form()
 
     def validate(self, u, y, **kw):
@@ -858,20 +859,25 @@ class PolynomialModel(IdentifiedLinearModel):
                 info.pop(k, None)
             poly["info"] = info
         try:
-            return cls(A=poly["A"], B=poly["B"], nk=int(poly["nk"]), C=poly["C"], F=poly["F"],
-                       dt=lm.dt, structure=lm.structure, covariance=poly.get("covariance"),
-                       noise_variance=poly.get("noise_variance"), loss=poly.get("loss"),
-                       fit_percent=poly.get("fit_percent"), n_samples=lm.n_samples,
-                       n_used=poly.get("n_used"), input_name=lm.inputs[0],
-                       output_name=lm.outputs[0], input_unit=lm.system.input_units[0],
-                       output_unit=lm.system.output_units[0], u_offset=lm.u_offset[0],
-                       y_offset=lm.y_offset[0], info=dict(poly.get("info") or {}),
-                       data_file=lm.data_file, data_hash=lm.data_hash,
-                       display_units=lm.display_units)
+            model = cls(A=poly["A"], B=poly["B"], nk=int(poly["nk"]), C=poly["C"], F=poly["F"],
+                        dt=lm.dt, structure=lm.structure, covariance=poly.get("covariance"),
+                        noise_variance=poly.get("noise_variance"), loss=poly.get("loss"),
+                        fit_percent=poly.get("fit_percent"), n_samples=lm.n_samples,
+                        n_used=poly.get("n_used"), input_name=lm.inputs[0],
+                        output_name=lm.outputs[0], input_unit=lm.system.input_units[0],
+                        output_unit=lm.system.output_units[0], u_offset=lm.u_offset[0],
+                        y_offset=lm.y_offset[0], info=dict(poly.get("info") or {}),
+                        data_file=lm.data_file, data_hash=lm.data_hash,
+                        display_units=lm.display_units)
         except (ModelError, ValueError, TypeError) as exc:
             msg = exc.message if isinstance(exc, ModelError) else str(exc)
             raise ModelError(f"model file {where}: its polynomial section is malformed ({msg})",
                              hint="regenerate the file with gripkit identify --out") from None
+        section = "polynomial" if "polynomial" in doc else "info"
+        if section == "polynomial":
+            _check_info_copy(doc, where)
+        check_system_copy(model.system, lm.system, section, where)
+        return model
 
     @classmethod
     def _from_matrix_document(cls, poly: dict, lm: LinearModel, where: str) -> "PolynomialModel":
@@ -879,11 +885,12 @@ class PolynomialModel(IdentifiedLinearModel):
         without one (gripkit before the matrix polynomials moved here wrote a MIMO ARX model as
         a state-space ``LinearModel`` with ``A_poly``, ``B_poly`` in ``info`` and the
         covariance of θ in its system's: :func:`_matrix_section` migrates it)."""
+        section = "info" if poly is None else "polynomial"
         if poly is None:
             poly = _matrix_section(lm)
         s = lm.system
         try:
-            return cls(A=poly["A"], B=poly["B"], nk=int(poly["nk"]), dt=lm.dt, structure="arx",
+            model = cls(A=poly["A"], B=poly["B"], nk=int(poly["nk"]), dt=lm.dt, structure="arx",
                        covariance=poly.get("covariance"),
                        noise_variance=poly.get("noise_variance"), loss=poly.get("loss"),
                        fit_percent=poly.get("fit_percent"), n_samples=lm.n_samples,
@@ -896,6 +903,8 @@ class PolynomialModel(IdentifiedLinearModel):
             msg = exc.message if isinstance(exc, ModelError) else str(exc)
             raise ModelError(f"model file {where}: its polynomial section is malformed ({msg})",
                              hint="regenerate the file with gripkit identify --out") from None
+        check_system_copy(model.system, s, section, where)
+        return model
 
     def to_dict(self) -> dict:
         """JSON-ready summary (complex numbers as ``[re, im]`` pairs)."""
@@ -1047,6 +1056,69 @@ def load_linear_model(path) -> IdentifiedLinearModel:
     if "polynomial" in doc or polynomial_document(doc) or _matrix_document(doc):
         return PolynomialModel.from_document(doc, lm, where)
     return lm
+
+
+def _first_difference(a: np.ndarray, b: np.ndarray):
+    """The first index where the arrays ``a`` and ``b`` differ beyond rounding (10⁻⁹ of their
+    largest magnitude; NaN equal to NaN), ``()`` when their shapes differ, None when alike."""
+    if a.shape != b.shape:
+        return ()
+    scale = max(float(np.max(np.abs(np.nan_to_num(a)), initial=0.0)),
+                float(np.max(np.abs(np.nan_to_num(b)), initial=0.0)))
+    bad = ~((np.abs(a - b) <= 1e-9 * scale) | (np.isnan(a) & np.isnan(b)))
+    if not bad.any():
+        return None
+    return tuple(int(i) for i in np.argwhere(bad)[0])
+
+
+def _numbers(x) -> np.ndarray:
+    try:
+        return np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError):
+        return np.full(1, np.nan)
+
+
+def _disagree(where: str, field_: str, idx: tuple, a, b, section: str) -> ModelError:
+    if idx:
+        at = f"[{', '.join(map(str, idx))}] is {a[idx]:.10g}, {b[idx]:.10g} by {section!r}"
+    else:
+        at = f" has shape {a.shape}, {b.shape} by {section!r}"
+    return malformed(where, f"{field_!r} and the {section!r} section disagree ({field_}{at}); "
+                            f"the model is built from {section!r}, and {field_!r} is its copy: "
+                            "one was edited without the other")
+
+
+def check_system_copy(built, read, section: str, where: str) -> None:
+    """The model file's ``system`` (``read``: the copy for readers without polynomials) must be
+    the system of the coefficients in its ``section`` ('polynomial', or 'info' of a version-1
+    file), ``built``, which the model is built from: arrays and parameter covariance alike to
+    rounding (:func:`_first_difference`), else a malformed-file ModelError naming both."""
+    b, r = built.to_dict(), read.to_dict()
+    if b["type"] != r["type"]:
+        raise malformed(where, f"'system' is a {r['type']} but the {section!r} section gives "
+                               f"a {b['type']}")
+    keys = ("A", "B", "C", "D") if b["type"] == "StateSpace" else ("num", "den")
+    pairs = [(f"system.{k}", r[k], b[k]) for k in keys]
+    if r["uncertainty"] is not None and b["uncertainty"] is not None:
+        pairs.append(("system.uncertainty.covariance", r["uncertainty"]["covariance"],
+                      b["uncertainty"]["covariance"]))
+    for name, x, y in pairs:
+        x, y = _numbers(x), _numbers(y)
+        idx = _first_difference(x, y)
+        if idx is not None:
+            raise _disagree(where, name, idx, x, y, section)
+
+
+def _check_info_copy(doc: dict, where: str) -> None:
+    """A version-2 file's ``info`` repeats the coefficients of its ``polynomial`` section (A, B,
+    C, F, nk, for readers of version 1): where it holds them they must agree."""
+    info, poly = doc.get("info") or {}, doc["polynomial"]
+    for k in ("A", "B", "C", "F", "nk"):
+        if k in info and k in poly:
+            x, y = _numbers(info[k]), _numbers(poly[k])
+            idx = _first_difference(x, y)
+            if idx is not None:
+                raise _disagree(where, f"info.{k}", idx, x, y, "polynomial")
 
 
 def _matrix_document(doc: dict) -> bool:

@@ -28,7 +28,7 @@ import numpy as np
 from ...errors import ArgumentError, DataError, ModelError, StabilityWarning, emit_warning
 from ...lti import LinearSystem
 from ..checks import check_io
-from ..model_protocol import ModelFit
+from ..model_protocol import ModelFit, check_sample_time
 
 __all__ = ["fit_percent", "records_fit", "loss_vn", "compare", "ResidualTests", "residual_tests",
            "Validation", "validate"]
@@ -107,14 +107,20 @@ def compare(model, u, y, *, initial: str = "estimate", dt: float | None = None) 
 
 
 def _check_sample_time(model, dt) -> None:
-    """A nonlinear model's arrays are its samples: ``dt`` may only confirm its sample time."""
+    """A nonlinear model's arrays are its samples: ``dt`` may only confirm its sample time (the
+    linear models' check, :func:`~gripkit.sysid.model_protocol.check_sample_time`: a
+    DataError; any ``dt`` for a rate-independent family), and a model of unknown sample time
+    takes none."""
     mdt = getattr(model, "dt", None)
     family = getattr(model, "_family", "this model")
-    if mdt is None or not math.isclose(float(dt), float(mdt), rel_tol=1e-9):
-        raise ArgumentError(f"compare(): dt: {family} runs on its samples, every "
-                            f"{mdt if mdt is not None else '(unknown)'} s; the arrays' dt= "
-                            f"{dt!r} s differs", hint="resample the record to the model's "
-                                                     "interval, or leave dt out")
+    if mdt is None:
+        raise ArgumentError(f"compare(): dt: {family} has no sample time to check the arrays' "
+                            f"dt={dt!r} s against", hint="leave dt out")
+    check = getattr(model, "_check_dt", None)
+    if check is not None:
+        check(float(dt))
+    else:
+        check_sample_time(float(dt), float(mdt))
 
 
 @dataclass(frozen=True)

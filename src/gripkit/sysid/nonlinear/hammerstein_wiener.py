@@ -131,7 +131,8 @@ from ...signals.trajectory import Trajectory
 from ...units import product_unit
 from ..linear.frf import frf
 from ..linear.subspace import n4sid, n4sid_records
-from ..model_file import FamilyFile, file_provenance, read_family_document
+from ..model_file import (SAMPLE_TIME, Domain, FamilyFile, check_family_fields, file_provenance,
+                          read_family_document)
 from ..model_protocol import ModelFit
 from . import hw_kernels as K
 from .levenberg_marquardt import levenberg_marquardt
@@ -828,13 +829,14 @@ class HWModel(OutputErrorPrediction, FreeRunModel, FamilyFile):
 
     def _columns(self, data, need_output: bool):
         if isinstance(data, Trajectory):
+            self._check_rate(data, "hw.compare" if need_output else "hw.simulate")
             cols = [self.input_name] + ([self.output_name] if need_output else [])
             missing = [c for c in cols if c not in data.names]
             if missing:
                 raise DataError(f"hw: the data have no column {missing[0]!r} (the model's "
                                 f"{'input' if missing[0] == self.input_name else 'output'}); "
                                 f"they have {', '.join(map(repr, data.names))}")
-            return [_signal(data[c], c) for c in cols]
+            return [_signal(self._column(data, r), c) for c, r in zip(cols, ("input", "output"))]
         a = np.asarray(data, dtype=np.float64)
         if a.ndim == 2 and a.shape[1] == (2 if need_output else 1) and a.shape[0] > 2:
             return [_signal(a[:, i], n) for i, n in enumerate(("u", "y")[:a.shape[1]])]
@@ -953,9 +955,14 @@ def _signal(x, name: str) -> np.ndarray:
 def load_hw(path) -> HWModel:
     """Read a model written by :meth:`HWModel.save`; any other schema is refused."""
     p = Path(path)
-    doc = read_family_document(p, SCHEMA, (VERSION, SS_VERSION), family="hw",
-                               writer="HWModel.save or `gripkit identify hw --out`",
+    writer = "HWModel.save or `gripkit identify hw --out`"
+    doc = read_family_document(p, SCHEMA, (VERSION, SS_VERSION), family="hw", writer=writer,
                                version_key="schema_version")
+    order = Domain(0, integer=True)
+    check_family_fields(doc, f"hw model file {str(p)!r}", writer,
+                        numbers={"dt": SAMPLE_TIME, "nb": Domain(1, integer=True), "nf": order,
+                                 "nk": order, "initial_input": Domain(optional=True)},
+                        finite=("theta",), units=("input_unit", "output_unit"))
     try:
         nls = []
         for key in ("input_nonlinearity", "output_nonlinearity"):

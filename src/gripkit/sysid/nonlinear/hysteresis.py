@@ -65,7 +65,8 @@ from ...errors import (AccuracyWarning, ArgumentError, DataError, Identification
 from ...params import Parameter, ParameterSet
 from ...progress import track
 from ...signals.trajectory import Trajectory
-from ..model_file import FamilyFile, file_provenance, read_family_document
+from ..model_file import (SAMPLE_TIME, Domain, FamilyFile, check_family_fields, file_provenance,
+                          read_family_document)
 from ..model_protocol import ModelFit
 from . import hysteresis_kernels as K
 from .nonlinear_model import OutputErrorPrediction
@@ -192,8 +193,10 @@ class _HysteresisModel(OutputErrorPrediction, SingleChannel, FamilyFile):
     records = ()
 
     def _input(self, data) -> np.ndarray:
-        return _record(data, self.input_name, None, f"{self.structure}.simulate",
-                       need_output=False)[0]
+        self._check_rate(data, f"{self.structure}.simulate")
+        u = _record(data, self.input_name, None, f"{self.structure}.simulate",
+                    need_output=False)[0]
+        return self._column(data, "input") if isinstance(data, Trajectory) else u
 
     def _fd_std(self, u: np.ndarray, **run) -> np.ndarray:
         """σ of the free run (N,), the parameter covariance propagated through the Jacobian of
@@ -225,15 +228,16 @@ class _HysteresisModel(OutputErrorPrediction, SingleChannel, FamilyFile):
         values (no offset is removed); None (with a StabilityWarning) when the run diverges."""
         u, y, *_ = _record(data if y is None else (data, y), self.input_name, self.output_name,
                            f"{self.structure}.compare")
-        if isinstance(data, Trajectory):
-            u = self._input(data)  # the family's checks of a record (the oscillator's dt)
+        if isinstance(data, Trajectory):  # the checks of a record: its rate, its units
+            u, y = self._input(data), self._column(data, "output")
         yhat = self.simulate(u, warn=warn)
         return ModelFit(self.outputs, [_fit_percent(y, yhat[:, 0])], yhat, HYSTERESIS_FIT)
 
     def _measured(self, data, y) -> np.ndarray:
         """The record's output, as :meth:`compare` reads it (for ``residuals``)."""
-        return _record(data if y is None else (data, y), self.input_name, self.output_name,
-                       f"{self.structure}.residuals")[1]
+        y_ = _record(data if y is None else (data, y), self.input_name, self.output_name,
+                     f"{self.structure}.residuals")[1]
+        return self._column(data, "output") if isinstance(data, Trajectory) else y_
 
     def _document(self, **own) -> dict:
         """The model file: the schema, the model's ``own`` entries, then what every hysteresis
@@ -288,6 +292,7 @@ class BoucWenModel(_HysteresisModel):
 
     structure = "bouc-wen"
     _family = "a Bouc-Wen hysteresis model"
+    _rate_dependent = False  # only the path of u matters (module docstring)
     _value_names = _BW_NAMES
 
     @property
@@ -514,14 +519,6 @@ class BoucWenOscillatorModel(_HysteresisModel):
             "gamma": ("γ: shape of the hysteresis (A = 1)", shape),
             "n": ("exponent n of |z|", "1"),
             "offset": ("output offset", yu if not _unitless(yu) else "1")})
-
-    def _input(self, data) -> np.ndarray:
-        if isinstance(data, Trajectory) and data.n > 1 and not math.isclose(
-                data.dt, self.dt, rel_tol=1e-6):
-            raise DataError(f"bouc-wen-oscillator: the data are sampled every {data.dt:g} s but "
-                            f"the model every {self.dt:g} s; a rate-dependent model needs the "
-                            "same sample time", hint="resample the record to the model's dt")
-        return super()._input(data)
 
     def _run(self, u: np.ndarray, theta: dict | None = None,
              x0=(0.0, 0.0, 0.0)) -> tuple[np.ndarray, int]:
@@ -883,6 +880,7 @@ class PrandtlIshlinskiiModel(_HysteresisModel):
 
     structure = "prandtl-ishlinskii"
     _family = "a Prandtl–Ishlinskii model"
+    _rate_dependent = False  # the play operators see the path of u only
 
     @property
     def weights_std(self) -> np.ndarray:
@@ -1266,6 +1264,19 @@ def hysteresis(data, model: str = "bouc-wen", *, input: str | None = None,
 # reading a model file
 
 
+#: the numbers of each hysteresis model's file and their domains (the exponent n of the
+#: Bouc-Wen forms: [1, 10], as :func:`hysteresis` fits it; the actuator form may have no dt)
+_FINITE = Domain()
+HYSTERESIS_NUMBERS = {
+    "bouc-wen": {"dt": Domain(0.0, strict=True, optional=True), "n": Domain(1.0, 10.0),
+                 **{k: _FINITE for k in ("d", "alpha", "beta", "gamma", "offset")}},
+    "bouc-wen-oscillator": {"dt": SAMPLE_TIME, "n": Domain(1.0, 10.0),
+                            "substeps": Domain(1, integer=True),
+                            **{k: _FINITE for k in _BWO_NAMES if k != "n"}},
+    "prandtl-ishlinskii": {"dt": Domain(0.0, strict=True, optional=True), "offset": _FINITE,
+                           "input_offset": _FINITE}}
+
+
 def _free_and_covariance(doc: dict, names: tuple) -> tuple[tuple, np.ndarray]:
     """The free parameters (each one of ``names``) and their covariance of a model file."""
     free = tuple(str(k) for k in doc["free"])
@@ -1279,9 +1290,12 @@ def load_hysteresis(path):
     :class:`BoucWenOscillatorModel` or :class:`PrandtlIshlinskiiModel`; the same type comes
     back."""
     p = Path(path)
-    doc = read_family_document(p, SCHEMA, VERSION, family="hysteresis",
-                               writer="model.save or `gripkit identify hysteresis --out`")
+    writer = "model.save or `gripkit identify hysteresis --out`"
+    doc = read_family_document(p, SCHEMA, VERSION, family="hysteresis", writer=writer)
     kind = doc.get("model")
+    check_family_fields(doc, f"hysteresis model file {str(p)!r}", writer,
+                        numbers=HYSTERESIS_NUMBERS.get(kind, {}),
+                        finite=("thresholds", "weights"), units=("input_unit", "output_unit"))
     common = {k: doc.get(k) for k in ("dt", "fit_percent", "validation_fit_percent",
                                       "criterion")}
     try:

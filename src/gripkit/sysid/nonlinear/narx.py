@@ -54,7 +54,8 @@ from ...errors import (ArgumentError, DataError, IdentificationError, ModelError
 from ...params import Parameter, ParameterSet
 from ...signals.trajectory import Trajectory
 from ...units import product_unit
-from ..model_file import FamilyFile, file_provenance, read_family_document
+from ..model_file import (SAMPLE_TIME, Domain, FamilyFile, check_family_fields, file_provenance,
+                          read_family_document)
 from ..model_protocol import ModelFit
 from .levenberg_marquardt import Damping, fit_residuals
 from .single_channel import (DIVERGENCE_FACTOR, FreeRunModel, channel_fields, fit_percent,
@@ -448,6 +449,7 @@ class NARXModel(FreeRunModel, FamilyFile):
     def _signals(self, data, y, why: str, outputs: bool = True):
         """``(u, y)`` of a trajectory's columns by name, or of the signals given."""
         if isinstance(data, Trajectory):
+            self._check_rate(data, f"narx.{why}")
             cols = [self.input_name] + ([self.output_name] if outputs else [])
             missing = [c for c in cols if c not in data.names]
             if missing:
@@ -455,8 +457,8 @@ class NARXModel(FreeRunModel, FamilyFile):
                                 f"are missing; the data have {', '.join(map(repr, data.names))}",
                                 hint="rename the columns or identify the model from matching "
                                      "data")
-            return (np.asarray(data[self.input_name], dtype=np.float64),
-                    np.asarray(data[self.output_name], dtype=np.float64) if outputs else None)
+            return (self._column(data, "input"),
+                    self._column(data, "output") if outputs else None)
         if outputs and y is None:
             raise ArgumentError(f"narx.{why}: give a trajectory, or the signals u and y",
                                 hint=f"model.{why}(data) or model.{why}(u, y)")
@@ -611,8 +613,9 @@ class NARXModel(FreeRunModel, FamilyFile):
 def load_narx(path) -> NARXModel:
     """Read a model written by :meth:`NARXModel.save`; any other schema is refused."""
     p = Path(path)
-    doc = read_family_document(p, SCHEMA, VERSION, family="narx",
-                               writer="NARXModel.save or `gripkit identify narx --out`")
+    writer = "NARXModel.save or `gripkit identify narx --out`"
+    doc = read_family_document(p, SCHEMA, VERSION, family="narx", writer=writer)
+    check_narx_fields(doc, f"narx model file {str(p)!r}", writer)
     try:
         m = NARXModel(**_model_fields(doc))
         bases, rows, theta = m.bases, m.rows, m.theta
@@ -623,6 +626,19 @@ def load_narx(path) -> NARXModel:
         raise ModelError(f"{str(p)!r}: {len(rows)} terms but {len(theta)} parameters, or a term "
                          "naming a missing lagged signal; write it again with NARXModel.save")
     return m
+
+
+#: the numbers of a NARX model file and their domains (:func:`check_narx_fields`)
+NARX_NUMBERS = {"dt": SAMPLE_TIME, "degree": Domain(1, integer=True),
+                "ylags": Domain(0, integer=True), "ulags": Domain(0, integer=True)}
+
+
+def check_narx_fields(doc: dict, what: str, writer: str) -> None:
+    """The fields of a (polynomial or rational) NARX model file checked on load
+    (:func:`~gripkit.sysid.model_file.check_family_fields`): sample time, degree and lags in
+    their domains, θ finite, the units readable."""
+    check_family_fields(doc, what, writer, numbers=NARX_NUMBERS, finite=("theta",),
+                        units=("input_unit", "output_unit"))
 
 
 def _model_fields(doc: dict) -> dict:

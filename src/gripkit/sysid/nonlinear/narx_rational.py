@@ -53,7 +53,7 @@ from .levenberg_marquardt import fit_residuals
 from .narx import (_DAMPING, NARX_FIT, NARXModel, _better_on_validation, _fit, _fit_records,
                    _frols_gram, _max_terms, _model_fields, _positive_int, _Regression,
                    _refine_and_prune, _regression_matrix, _regressors, _row_index, _term_name,
-                   _validation_records, candidate_terms, narx_output)
+                   _validation_records, candidate_terms, check_narx_fields, narx_output)
 from .single_channel import DIVERGENCE_FACTOR
 
 __all__ = ["RationalNARXModel", "rational_narx", "rational_output", "load_rational_narx",
@@ -336,9 +336,9 @@ class RationalNARXModel(NARXModel):
 def load_rational_narx(path) -> RationalNARXModel:
     """Read a model written by :meth:`RationalNARXModel.save`; any other schema is refused."""
     p = Path(path)
-    doc = read_family_document(p, SCHEMA, VERSION, family="rational-narx",
-                               writer="RationalNARXModel.save or `gripkit identify narx "
-                                      "--basis rational --out`")
+    writer = "RationalNARXModel.save or `gripkit identify narx --basis rational --out`"
+    doc = read_family_document(p, SCHEMA, VERSION, family="rational-narx", writer=writer)
+    check_narx_fields(doc, f"rational-narx model file {str(p)!r}", writer)
     if doc.get("basis") != "rational":
         raise ModelError(f"{str(p)!r}: a {SCHEMA} must have basis 'rational', found "
                          f"{doc.get('basis')!r}; write it again with RationalNARXModel.save")

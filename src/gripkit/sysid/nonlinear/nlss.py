@@ -74,8 +74,9 @@ import scipy.linalg as sla
 
 from ...errors import (AccuracyWarning, ArgumentError, DataError, IdentificationError,
                        ModelError, StabilityWarning, emit_warning)
-from ..model_file import FamilyFile, file_provenance, read_family_document
-from ..model_protocol import ModelFit
+from ..model_file import (SAMPLE_TIME, Domain, FamilyFile, check_family_fields, file_provenance,
+                          read_family_document)
+from ..model_protocol import ModelFit, column_in_unit
 from . import nlss_kernels as K
 from .nonlinear_model import NonlinearModel, OutputErrorPrediction
 from ...params import Parameter, ParameterSet
@@ -156,14 +157,18 @@ def _fits(y: np.ndarray, yhat: np.ndarray) -> list[float]:
     return out
 
 
-def _trajectory_columns(data: Trajectory, names, kind: str, what: str) -> np.ndarray:
+def _trajectory_columns(data: Trajectory, names, kind: str, what: str,
+                        units=None) -> np.ndarray:
     """The columns ``names`` of ``data`` as an array (N, k); a missing one is named (``kind``:
-    "input" or "output", ``what``: the method)."""
+    "input" or "output", ``what``: the method); with the model's ``units``, each in its unit
+    (:func:`~gripkit.sysid.model_protocol.column_in_unit`)."""
     missing = [c for c in names if c not in data.names]
     if missing:
         raise DataError(f"nlss.{what}: the data lack the model's {kind} column(s) "
                         f"{', '.join(map(repr, missing))}; they have "
                         f"{', '.join(map(repr, data.names))}")
+    if units is not None:
+        return np.column_stack([column_in_unit(data, c, u, kind) for c, u in zip(names, units)])
     return np.column_stack([np.asarray(data[c], dtype=np.float64) for c in names])
 
 
@@ -283,7 +288,8 @@ class NLSSModel(OutputErrorPrediction, NonlinearModel, FamilyFile):
         """Normalised input (N, m) from a Trajectory (columns by name) or an array."""
         m = len(self.input_names)
         if isinstance(data, Trajectory):
-            u = _trajectory_columns(data, self.input_names, "input", what)
+            self._check_rate(data, f"nlss.{what}")
+            u = _trajectory_columns(data, self.input_names, "input", what, self.input_units)
         else:
             u = np.asarray(data, dtype=np.float64)
             if u.ndim == 1:
@@ -303,7 +309,7 @@ class NLSSModel(OutputErrorPrediction, NonlinearModel, FamilyFile):
             if not isinstance(data, Trajectory):
                 raise ArgumentError(f"nlss.{what}: give the measured output: {what}(trajectory) "
                                     f"or {what}(u, y)")
-            y = _trajectory_columns(data, self.output_names, "output", what)
+            y = _trajectory_columns(data, self.output_names, "output", what, self.output_units)
         y = np.asarray(y, dtype=np.float64)
         if y.ndim == 1:
             y = y[:, None]
@@ -416,8 +422,15 @@ class NLSSModel(OutputErrorPrediction, NonlinearModel, FamilyFile):
 def load_nlss(path) -> NLSSModel:
     """Read a model written by :meth:`NLSSModel.save`; any other schema is refused."""
     p = Path(path)
-    doc = read_family_document(p, SCHEMA, VERSION, family="nlss",
-                               writer="NLSSModel.save or `gripkit identify nlss --out`")
+    writer = "NLSSModel.save or `gripkit identify nlss --out`"
+    doc = read_family_document(p, SCHEMA, VERSION, family="nlss", writer=writer)
+    check_family_fields(doc, f"nlss model file {str(p)!r}", writer,
+                        numbers={"dt": SAMPLE_TIME, "order": Domain(1, integer=True),
+                                 "degree": Domain(1, integer=True),
+                                 "state_limit": Domain(0.0, strict=True)},
+                        finite=("A", "B", "C", "D", "E", "F", "u_offset", "u_scale", "y_offset",
+                                "x0"),
+                        units=("input_units", "output_units"))
     try:
         n, m, p_ = int(doc["order"]), len(doc["inputs"]), len(doc["outputs"])
         f64 = lambda k, *shape: np.array(doc[k], dtype=np.float64).reshape(shape)  # noqa: E731

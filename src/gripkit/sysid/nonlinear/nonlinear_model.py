@@ -10,6 +10,11 @@ view is (``_linear_hint``): a nonlinear model has no linear system to convert. E
 others refuse a given one with an ArgumentError saying what their free run starts from
 (``_refuse_x0``). Arrays given to a nonlinear model are the record's values (no offset is
 removed; the nonlinear state space's ``u_offset``/``y_offset`` normalise inside the model).
+A trajectory given to a rate-dependent family (every one but the Bouc-Wen actuator form and
+Prandtl–Ishlinskii) must be sampled at the model's ``dt``: ``_check_rate`` refuses another
+interval with the linear models' DataError
+(:func:`~gripkit.sysid.model_protocol.check_sample_time`); arrays carry no time and are taken
+as the model's samples.
 
 :class:`OutputErrorPrediction`, the ``predict`` and ``residuals`` of the output-error families
 (Hammerstein–Wiener, nonlinear state space, hysteresis): their noise enters at the output, so
@@ -25,7 +30,7 @@ import numpy as np
 
 from ...errors import ArgumentError, ModelError
 from ...signals.trajectory import Trajectory
-from ..model_protocol import ReportMixin
+from ..model_protocol import ReportMixin, check_sample_time
 
 __all__ = ["NonlinearModel", "OutputErrorPrediction"]
 
@@ -39,6 +44,25 @@ class NonlinearModel(ReportMixin):
 
     _family = "a nonlinear model"
     _linear_hint = f"identify a linear model ({LINEAR_METHODS}) for a linear approximation"
+
+    #: False for a rate-independent family (Bouc-Wen actuator form, Prandtl–Ishlinskii): its
+    #: output depends on the path of the input only, so data at any sample time fit it
+    _rate_dependent = True
+
+    def _check_dt(self, dt: float) -> None:
+        """The linear models' check (:func:`~gripkit.sysid.model_protocol.check_sample_time`)
+        of data sampled every ``dt`` s against the model's ``dt``: a DataError when they
+        differ (none for a rate-independent family)."""
+        mdt = getattr(self, "dt", None)
+        if self._rate_dependent and mdt is not None:
+            check_sample_time(float(dt), float(mdt))
+
+    def _check_rate(self, data, why: str) -> None:
+        """:meth:`_check_dt` of a :class:`~gripkit.signals.Trajectory` ``data`` (uniformly
+        sampled, else a DataError naming ``why``); arrays carry no sample time and are taken as
+        the model's samples."""
+        if isinstance(data, Trajectory) and data.n > 1 and self._rate_dependent:
+            self._check_dt(data.require_uniform(why=why))
 
     def _no_linear_system(self, name: str) -> ModelError:
         return ModelError(f"{name}: {self._family} has no linear system to convert (only "

@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ...errors import DataError
+from ..model_protocol import column_in_unit
 from .nonlinear_model import NonlinearModel
 
 __all__ = ["DIVERGENCE_FACTOR", "FreeRunModel", "SingleChannel", "channel_fields", "fit_percent",
@@ -51,6 +52,15 @@ class SingleChannel(NonlinearModel):
     @property
     def output_units(self) -> tuple[str, ...]:
         return (self.output_unit or "1",)
+
+    def _column(self, data, role: str) -> np.ndarray:
+        """The model's ``role`` ('input' or 'output') column of the trajectory ``data`` in the
+        model's unit, as a linear model reads it (:func:`~gripkit.sysid.model_protocol
+        .column_in_unit`: converted from another unit of the same dimension, a DataError for
+        another physical quantity)."""
+        name, unit = ((self.input_name, self.input_unit) if role == "input"
+                      else (self.output_name, self.output_unit))
+        return column_in_unit(data, name, unit, role)
 
     def channel_document(self) -> dict:
         """The column names and units as the model files write them: ``input_name``,
