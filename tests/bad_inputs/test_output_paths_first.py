@@ -267,3 +267,14 @@ def test_atomic_write_hint_by_cause(code, phrase):
     from gripkit.atomic import write_hint
 
     assert phrase in write_hint(OSError(code, os.strerror(code)))
+
+
+def test_save_unknown_suffix_names_what_save_writes(tmp_path):
+    """gripkit.io.save: the hint names the written formats, not the read-only .mcap and .mat."""
+    from gripkit.errors import DataError
+
+    tr = Trajectory.uniform(dt=0.1, x=np.zeros(3))
+    with pytest.raises(DataError, match=r"from its suffix '\.xyz'; use \.csv, \.parquet or \.h5, "
+                                        r"or pass format='csv'") as err:
+        save(tr, tmp_path / "s.xyz")
+    assert ".mcap" not in str(err.value) and os.listdir(tmp_path) == []
