@@ -7,7 +7,9 @@ auto-correlation per output and cross-correlation with each input, with the ±1.
 white, independent residuals (Ljung 2nd ed. §16.6); pole-zero map with the 1σ ellipse of each
 pole (from the parameter covariance); Bode magnitude and phase with ±2σ bands, and the data's
 Welch H1 estimate (with its ±2σ) beside them when the data allow; the subspace singular values
-with the chosen order; the warnings raised on the way.
+with the chosen order; the parameter table (:func:`parameters_section`: ``model.parameters``
+with value, 1σ and unit, a step model's K, f_n, ζ and offset first); the warnings raised on the
+way.
 
 Measured records: the residuals are those of the model's predictor from the initial
 state estimated by least squares over the record (:func:`residual_analysis`; innovation models:
