@@ -278,3 +278,12 @@ def test_save_unknown_suffix_names_what_save_writes(tmp_path):
                                         r"or pass format='csv'") as err:
         save(tr, tmp_path / "s.xyz")
     assert ".mcap" not in str(err.value) and os.listdir(tmp_path) == []
+
+
+def test_report_figure_that_is_a_folder_is_named_first(tmp_path):
+    (tmp_path / "figures" / "line.png").mkdir(parents=True)
+    (tmp_path / "index.html").write_text("old page")
+    with pytest.raises(PathError, match="report figure .*line.png' is a folder"):
+        _report().write(tmp_path)
+    assert (tmp_path / "index.html").read_text() == "old page"
+    assert sorted(os.listdir(tmp_path)) == ["figures", "index.html"]

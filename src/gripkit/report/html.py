@@ -173,13 +173,16 @@ class Report:
         """Write ``out_dir/index.html`` (and ``out_dir/figures/*.png``); returns the HTML path.
 
         The report is written whole into a temporary folder first and then moved into place: a
-        new ``out_dir`` by one rename, into an existing one figure by figure and the page last.
-        A failure raises :class:`~gripkit.errors.PathError` and leaves nothing behind (no
-        figures without their page, no temporary folder, no folder made for it); what is in
-        the way (a folder named index.html, a file named figures) is named before anything is
-        written."""
+        new ``out_dir`` by one rename, into an existing one by a rename per figure and the page
+        last. A failure while it is written (a full disk, Ctrl-C) raises
+        :class:`~gripkit.errors.PathError` and leaves nothing behind (no figures without their
+        page, no temporary folder, no folder made for it); what would stop the renames (a
+        folder named index.html, a file named figures) is named before anything is written.
+        Only a rename failing for another reason midway leaves new figures beside the old
+        page."""
         out = Path(out_dir)
-        _check_targets(out)
+        figures = [item for sec in self.sections for kind, item in sec.items if kind == "figure"]
+        _check_targets(out, [item.slug for item in figures])
         made = _first_missing(out)
         try:
             (out if made is None else out.parent).mkdir(parents=True, exist_ok=True)
@@ -194,8 +197,6 @@ class Report:
             raise PathError(f"report folder {str(out)!r} cannot be made "
                             f"({exc.strerror or exc})", hint=write_hint(exc)) from None
         try:
-            figures = [item for sec in self.sections for kind, item in sec.items
-                       if kind == "figure"]
             (stage / "figures").mkdir()
             for item in figures:
                 write_bytes(stage / "figures" / f"{item.slug}.png", item.png,
@@ -224,10 +225,10 @@ class Report:
         return out / "index.html"
 
 
-def _check_targets(out: Path) -> None:
+def _check_targets(out: Path, slugs) -> None:
     """A :class:`PathError` when something is in the way of the report in ``out``: a file named
-    like the folder, a folder named index.html, a file named figures, a folder named like a
-    figure."""
+    like the folder, a folder named index.html, a file named figures, a folder named like one of
+    the figures ``slugs``."""
     index, figs = out / "index.html", out / "figures"
     if out.exists() and not out.is_dir():
         raise PathError(f"report folder {str(out)!r} is a file",
@@ -238,6 +239,10 @@ def _check_targets(out: Path) -> None:
     if figs.exists() and not figs.is_dir():
         raise PathError(f"report figures folder {str(figs)!r} is a file",
                         hint="remove that file, or choose another report folder")
+    for slug in slugs:
+        if (figs / f"{slug}.png").is_dir():
+            raise PathError(f"report figure {str(figs / f'{slug}.png')!r} is a folder",
+                            hint="remove that folder, or choose another report folder")
 
 
 def _first_missing(out: Path) -> Path | None:
