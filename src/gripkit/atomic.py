@@ -23,6 +23,7 @@ job tables and chunks all go through :func:`atomic_write`.
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import tempfile
 from collections.abc import Callable
@@ -30,7 +31,7 @@ from pathlib import Path
 
 from .errors import GripkitError, PathError
 
-__all__ = ["atomic_write", "write_bytes", "write_text", "TEMP_SUFFIX"]
+__all__ = ["atomic_write", "write_bytes", "write_text", "write_hint", "TEMP_SUFFIX"]
 
 #: the suffix of the temporary files (``.<name>.<random>.tmp`` next to the target)
 TEMP_SUFFIX = ".tmp"
@@ -56,6 +57,21 @@ def _sync_folder(folder: Path) -> None:
         pass  # some file systems do not sync folders; the rename itself is still atomic
     finally:
         os.close(fd)
+
+
+def write_hint(exc: OSError) -> str:
+    """The hint of a write that failed with ``exc``, by its cause: disk space only for a full
+    disk (or quota, or file-size limit); a folder or file in the way; no permission."""
+    code = getattr(exc, "errno", None)
+    if code in (errno.ENOSPC, getattr(errno, "EDQUOT", errno.ENOSPC), errno.EFBIG):
+        return "free disk space or choose another path, then write it again"
+    if code in (errno.EISDIR, errno.ENOTEMPTY, errno.EEXIST):
+        return "a folder is in the way of the file: remove it or choose another path"
+    if code == errno.ENOTDIR:
+        return "a file is in the way of a folder: remove it or choose another path"
+    if code in (errno.EACCES, errno.EPERM, errno.EROFS):
+        return "choose a path in a folder you may write to"
+    return "choose another path, then write it again"
 
 
 def atomic_write(path, write: Callable[[str], object], *, what: str = "file",
@@ -103,8 +119,7 @@ def atomic_write(path, write: Callable[[str], object], *, what: str = "file",
         if isinstance(exc, OSError) and not isinstance(exc, GripkitError):
             reason = exc.strerror or str(exc) or type(exc).__name__
             raise PathError(f"{what} {str(path)!r} could not be written ({reason}); {kept}",
-                            hint="free disk space or choose another path, "
-                                 "then write it again") from exc
+                            hint=write_hint(exc)) from exc
         raise
     if sync:
         _sync_folder(path.parent)

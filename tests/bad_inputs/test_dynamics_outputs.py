@@ -37,8 +37,19 @@ def test_report_under_a_file(cli, inputs, tmp_path):
 
 
 def test_report_is_a_file(cli, inputs, tmp_path):
-    res = cli("identify", "dynamics", *inputs, *OK, "--report", inputs[1])
+    (tmp_path / "notes.txt").write_text("x")
+    res = cli("identify", "dynamics", *inputs, *OK, "--report", tmp_path / "notes.txt")
     assert_user_error(res, "PathError", "is a file, expected a folder")
+
+
+def test_report_or_out_is_an_input(cli, inputs, tmp_path):
+    """The log given as the report folder: named as the input it is; the URDF as --out likewise
+    (before its suffix is looked at)."""
+    res = cli("identify", "dynamics", *inputs, *OK, "--report", inputs[1])
+    assert_user_error(res, "PathError", f"--report {str(inputs[1])!r} is the input file")
+    res = cli("identify", "dynamics", *inputs, *OK, "--out", inputs[0])
+    assert_user_error(res, "PathError", f"--out {str(inputs[0])!r} is the input file")
+    assert inputs[0].read_text().startswith("<robot")
 
 
 def test_paths_checked_before_the_work(cli, tmp_path):

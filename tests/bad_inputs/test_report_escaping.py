@@ -291,3 +291,39 @@ def test_each_piece_alone_in_a_title(tmp_path, bad):
     assert page.title == bad
     assert [t for t, _ in page.tags if t not in BUILDER_TAGS] == []
     assert "".join(page.text).count(bad) >= 4  # title, h1, nav, h2 / th / td
+
+
+# ---------------------------------------------------------------------------------------------
+# the parameter table of a linear model's report: names and units from the model file
+
+
+def test_step_model_parameter_table_from_a_hostile_file(cli, tmp_path):
+    """A step model's file with a hostile gain unit and output unit: the parameter rows (K from
+    ``info.step``, the coefficients from ``model.parameters``) show them as text."""
+    from gripkit.lti import TransferFunction
+
+    u = np.where(np.arange(600) >= 50, 2.0, 0.0)
+    w = 2 * np.pi * 10.0
+    y = TransferFunction([0.003 * w * w], [1.0, 2 * 0.2 * w, w * w]).c2d(1e-3).simulate(u)[:, 0]
+    data = tmp_path / "step.csv"
+    with open(data, "w", newline="") as f:
+        csv.writer(f).writerows([["t", "v [V]", "x [m]"], *zip(np.arange(600) * 1e-3, u, y)])
+    res = cli("identify", "step", data, "--input", "v", "--output", "x", "--out",
+              tmp_path / "m.json")
+    assert res.code == 0, res.err
+    m = json.loads((tmp_path / "m.json").read_text())
+    m["info"]["step"]["gain_unit"] = HOSTILE
+    m["system"]["output_units"][0] = "unit" + HOSTILE
+    (tmp_path / "m2.json").write_text(json.dumps(m))
+    res = cli("report", tmp_path / "m2.json", data, "--out", tmp_path / "rep")
+    assert res.code == 0, res.err
+    html = (tmp_path / "rep" / "index.html").read_text()
+    assert_no_markup_from_data(html, 4, "gripkit model report: step")
+    from markupsafe import escape
+
+    step = m["info"]["step"]
+    # the rows: symbol, value, σ (4 significant digits), unit (escaped), meaning
+    assert (f'<td class="txt">K</td><td>{step["gain"]:.4g}</td><td>{step["gain_std"]:.4g}</td>'
+            f'<td class="txt">{escape(HOSTILE)}</td><td class="txt">static gain</td>') in html
+    assert (f'<td class="txt">{escape("unit" + HOSTILE)}</td>'
+            '<td class="txt">output offset (level before the step)</td>') in html

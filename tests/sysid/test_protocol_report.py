@@ -199,7 +199,11 @@ def test_identify_report_without_validation_uses_the_estimation_record(tmp_path)
     d = json.loads(out)
     html = (tmp_path / "rep" / "index.html").read_text(encoding="utf-8")
     assert "data est.csv" in html and f"<td>{d['fit_percent']:.2f} %</td>" in html
-    code, out, err = _cli(*args, "--report", est)
+    code, out, err = _cli(*args, "--report", est)  # the data file itself: named as the input
+    assert code != 0 and err.startswith("error: PathError: --report") and "is the input" in err
+    assert len(err.strip().splitlines()) == 1
+    (tmp_path / "notes.txt").write_text("x")
+    code, out, err = _cli(*args, "--report", tmp_path / "notes.txt")
     assert code != 0 and err.startswith("error: PathError: --report") and "is a file" in err
     assert len(err.strip().splitlines()) == 1
 

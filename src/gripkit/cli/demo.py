@@ -20,9 +20,9 @@ def demo(out: Path = typer.Option(Path("report"), "--out",
          json_out: bool = typer.Option(False, "--json", help="Print the summary as JSON.")):
     """Run the demo study and write OUT/index.html."""
     from ..demos import run_demo
-    from .paths import output_folder
+    from .paths import report_folder
 
-    output_folder(out, "--out")
+    report_folder(out, "--out")
     path, summary = run_demo(out, section or None, quick)
     if json_out:
         emit_json({"report": str(path), "sections": summary})

@@ -54,7 +54,7 @@ def excitation_fourier(
     from ..progress import status
     from .paths import output_file
 
-    output_file(out, "--out")
+    output_file(out, "--out", [urdf])
     chain = from_urdf(urdf, base_link=base_link, tip_link=tip_link)
     status(f"optimising {2 * chain.dof * harmonics} Fourier coefficients of {chain.name} ...")
     tr = fourier_trajectory(chain, f0=f0, harmonics=harmonics, dt=1.0 / fs, periods=periods,

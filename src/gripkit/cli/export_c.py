@@ -58,8 +58,10 @@ def export_c(model: Path = typer.Argument(None, show_default=False,
     pid|rst|lqr a controller's step, with --rls the RLS update (docs/deploy.md)."""
     from ..errors import ArgumentError
     from .common import check_choice
+    from .paths import output_folder
 
     check_choice(kind, "--kind", ("model", "kalman", "pid", "rst", "lqr"))
+    output_folder(out, "--out", [model, noise])
     if rls or kind in ("pid", "rst", "lqr"):
         from .export_c_controllers import export_command
 

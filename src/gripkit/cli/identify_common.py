@@ -62,12 +62,14 @@ def columns(inputs, outputs) -> list[str]:
     return list(parse_names(inputs, "--input")) + list(parse_names(outputs, "--output"))
 
 
-def check_outputs(out: Path | None, report: Path | None) -> None:
-    """``--out`` and ``--report`` checked before any work."""
-    from .paths import output_folder, output_json
+def check_outputs(out: Path | None, report: Path | None, inputs=()) -> None:
+    """``--out`` (a model file) and ``--report`` (a report folder) checked before any work, both
+    (:mod:`gripkit.cli.paths`: writable, and none of ``inputs``, the command's input files)."""
+    from .paths import output_json, report_folder
 
-    output_json(out, "--out")
-    output_folder(report, "--report")
+    inputs = list(inputs)
+    output_json(out, "--out", inputs)
+    report_folder(report, "--report", inputs)
 
 
 def run_identify(data: list[Path], method: str, input, output, *, fs, time, fill,
@@ -219,7 +221,9 @@ def record_command(name: str):
         def command(**kw):
             opts = RecordOptions(**{n: kw.pop(n) for n in names})
             check_data_options(opts.fs, opts.fill)
-            check_outputs(opts.out, opts.report)
+            data = kw.get("data")
+            inputs = [*(data if isinstance(data, (list, tuple)) else [data]), opts.validate]
+            check_outputs(opts.out, opts.report, inputs)
             return func(**kw, opts=opts)
 
         command.__signature__ = signature.replace(parameters=own + shared)

@@ -27,7 +27,7 @@ import typer
 
 from .app import identify_app
 from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data, report_warnings
-from .identify_common import ModelOutOpt, ReportOpt
+from .identify_common import ModelOutOpt, ReportOpt, check_outputs
 
 
 def _columns(option: str, text: str | None, joints) -> list[str] | None:
@@ -143,10 +143,8 @@ def identify_dynamics_cmd(
     from ..sysid.io_data import records_provenance
     from ..sysid.rigid_body.dynamics import identify_dynamics
     from ..sysid.rigid_body.dynamics_data import dynamics_data
-    from .paths import output_folder, output_json
 
-    output_json(out, "--out")
-    output_folder(report, "--report")
+    check_outputs(out, report, [urdf, data])
     if not (np.isfinite(effort_scale) and effort_scale != 0):
         raise DataError("--effort-scale: expected a finite non-zero factor, found "
                         f"{effort_scale!r}")

@@ -83,7 +83,7 @@ def _siso(method: str, data: list[Path], input: str, output: str, fs, time, fill
     """ARX, ARMAX or OE of one input and one output, of one file or of several (one model of
     all the records: ``data`` the list of files, ``fit_percent`` the one-step fit of all records
     and ``records`` each file's): one call of gripkit.sysid.identify, one validation, print."""
-    check_outputs(out_file, report)
+    check_outputs(out_file, report, [*data, validate])
     _several_files_detrend(data, detrend)
     if method in ("armax", "oe") and len(data) == 1:  # PEM: its iterations on stderr
         orders["progress"] = True
@@ -165,7 +165,7 @@ def _mimo_arx(data: list[Path], input: str, output: str, na: int, nb: int, nk: i
         raise DataError("--detrend: 'linear' is for one input and one output; with several "
                         "columns expected "
                         "mean or none", hint="use --detrend mean, or detrend the columns before")
-    check_outputs(out_file, report)
+    check_outputs(out_file, report, [*data, validate])
     with collected_warnings() as caught:
         model, tr, vtr = run_identify(data, "arx", input, output, fs=fs, time=time, fill=fill,
                                       validate=validate, detrend=detrend, na=na, nb=nb, nk=nk)
@@ -306,7 +306,7 @@ def identify_rls(data: Path = DataArg, input: str = InputOpt, output: str = Outp
     _check_options(fs, fill, detrend)
     # checks the orders and the options
     RLS(na, nb, nk, forgetting=forgetting, p0=p0, windup=windup)
-    output_file(trajectory, "--trajectory")
+    output_file(trajectory, "--trajectory", [data])
     with collected_warnings() as caught:
         res = run_identify([data], "rls", input, output, fs=fs, time=time, fill=fill,
                            detrend=detrend, na=na, nb=nb, nk=nk, forgetting=forgetting, p0=p0,
@@ -359,7 +359,7 @@ def identify_search(data: Path = DataArg, input: str = InputOpt, output: str = O
     check_number(top, "--top", minimum=1, integer=True)
     for name, text in (("--na", na), ("--nb", nb), ("--nk", nk)):
         parse_range(text, name)
-    check_outputs(out, report)
+    check_outputs(out, report, [data, validate])
     with collected_warnings() as caught:
         res, tr, vtr = run_identify([data], "search", input, output, fs=fs, time=time, fill=fill,
                                     validate=validate, fit_validate=True, detrend=detrend,

@@ -74,7 +74,7 @@ def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
     Akaike's criterion over the records."""
     _check_ss_options(form, focus, max_iterations)
     several = len(data) > 1
-    check_outputs(out, report)
+    check_outputs(out, report, [*data, validate])
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         options = dict(order=order, refine=not no_refine, form=form, max_iterations=max_iterations,
@@ -234,7 +234,7 @@ def identify_tf_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
     """Continuous-time transfer function (zero-order hold between samples) with σ. Several DATA
     files: one model of all the records, each from its own initial state."""
     several = len(data) > 1
-    check_outputs(out, report)
+    check_outputs(out, report, [*data, validate])
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         model, tr, vtr = run_identify(data, "tf", input, output, fs=fs, time=time, fill=fill,

@@ -48,7 +48,7 @@ def identify_step(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
         raise DataError(f"--method: expected one of {', '.join(STEP_METHODS)}, found {method!r}",
                         hint="lm (Levenberg-Marquardt) or trf (bounded trust-region reflective)")
     check_data_options(fs, fill)
-    check_outputs(out, report)
+    check_outputs(out, report, [data, validate])
     with collected_warnings() as caught:
         model, tr, vtr = run_identify([data], "step", input_col, output_col, fs=fs, time=time,
                                       fill=fill, validate=validate, solver=method)

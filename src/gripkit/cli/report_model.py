@@ -26,7 +26,9 @@ def report_model(model: Path = typer.Argument(..., help="Model file written by "
     """HTML report: measured vs simulated per output, residual correlations, parameters with σ;
     for linear models also poles and Bode with σ."""
     from .compare import _model_and_data
+    from .paths import report_folder
 
+    report_folder(out, "--out", [model, data])
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         m, tr = _model_and_data(model, data, fs, time, fill, outputs=True)

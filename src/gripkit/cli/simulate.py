@@ -30,7 +30,9 @@ def simulate(model: Path = typer.Argument(..., help="Model description (.toml) o
 
     if model.suffix.lower() == ".json":
         from .compare import simulate_model_file
+        from .paths import output_file
 
+        output_file(out, "--out", [model, data])
         return simulate_model_file(model, data, out, fs, time, fill, json_out)
 
     import numpy as np
@@ -40,12 +42,14 @@ def simulate(model: Path = typer.Argument(..., help="Model description (.toml) o
     from ..description import load_description
     from .paths import output_file
 
-    output_file(out, "--out")
+    output_file(out, "--out", [model])
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         d = load_description(model)
+        inputs = [model, *_input_files(d, model)]  # the description's input files, known now
+        output_file(out, "--out", inputs)
         if out is None:
-            output_file(d.output, f"[output] file of {model.name}")
+            output_file(d.output, f"[output] file of {model.name}", inputs)
         status(f"simulating {d.model.name}: {d.inputs.n} samples at {1.0 / d.inputs.dt:g} Hz")
         tr = d.model.simulate(d.inputs)
     lines = report_warnings(caught)
@@ -66,3 +70,14 @@ def simulate(model: Path = typer.Argument(..., help="Model description (.toml) o
     for n, s in summary.items():
         typer.echo(f"  {n} [{s['unit']}]: min {s['min']:.6g}, max {s['max']:.6g}, final "
                    f"{s['final']:.6g}")
+
+
+def _input_files(description, path: Path) -> list[Path]:
+    """The files the inputs of kind 'file' of the description ``path`` read (relative to its
+    folder)."""
+    files = []
+    for spec in (description.raw.get("inputs") or {}).values():
+        if isinstance(spec, dict) and spec.get("kind") == "file" and isinstance(spec.get("path"),
+                                                                                 str):
+            files.append(path.parent / spec["path"])
+    return files

@@ -46,7 +46,7 @@ def sweep(spec: Path = typer.Argument(..., help="Sweep specification (TOML)."),
     from ..batch import sweep as run
     from .paths import output_folder
 
-    output_folder(out, "--out")
+    output_folder(out, "--out", [spec])
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         s = SweepSpec.from_toml(spec)

@@ -55,7 +55,9 @@ FORMATS = {".csv": "csv", ".txt": "csv", ".tsv": "csv", ".parquet": "parquet", "
            ".h5": "hdf5", ".hdf5": "hdf5", ".hdf": "hdf5", ".mcap": "mcap", ".mat": "mat"}
 
 
-def _format(path: Path, fmt: str | None) -> str:
+def _format(path: Path, fmt: str | None, writing: bool = False) -> str:
+    """The format of ``path`` (``fmt`` when given); ``writing``: the hint names the suffixes
+    :func:`save` writes, not the read-only .mcap and .mat."""
     if fmt is not None:
         if fmt not in set(FORMATS.values()):
             raise DataError(f"format: expected one of csv, parquet, hdf5, mcap, mat, found {fmt!r}")
@@ -64,7 +66,9 @@ def _format(path: Path, fmt: str | None) -> str:
         return FORMATS[path.suffix.lower()]
     except KeyError:
         raise DataError(f"cannot tell the format of {str(path)!r} from its suffix {path.suffix!r}",
-                        hint="use .csv, .parquet, .h5, .mcap or .mat, or pass format=") from None
+                        hint=("use .csv, .parquet or .h5, or pass format='csv', 'parquet' or "
+                              "'hdf5'") if writing else
+                        "use .csv, .parquet, .h5, .mcap or .mat, or pass format=") from None
 
 
 @entry_point
@@ -637,7 +641,7 @@ def save(tr: Trajectory, path, *, format: str | None = None, key: str = "/",
                             hint="'display' writes each channel in the unit its file used")
     check_path(path, "path", "save()")
     path = Path(path)
-    fmt = _format(path, format)
+    fmt = _format(path, format, writing=True)
     if fmt == "mcap":
         raise DataError("gripkit reads MCAP logs but writes CSV, "
                         "Parquet or HDF5", hint="save as .parquet")

@@ -34,13 +34,16 @@ import functools
 import io
 import math
 import numbers
+import os
 import re
+import shutil
+import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from markupsafe import Markup
 
-from ..atomic import write_bytes
+from ..atomic import TEMP_SUFFIX, write_bytes, write_hint
 from ..errors import PathError
 from .plots import plain_math_fallback
 
@@ -168,22 +171,94 @@ class Report:
 
     def write(self, out_dir) -> Path:
         """Write ``out_dir/index.html`` (and ``out_dir/figures/*.png``); returns the HTML path.
-        Each file is written atomically (:func:`gripkit.atomic.write_bytes`): a failure leaves the
-        previous file as it was and raises :class:`~gripkit.errors.PathError`."""
+
+        The report is written whole into a temporary folder first and then moved into place: a
+        new ``out_dir`` by one rename, into an existing one by a rename per figure and the page
+        last. A failure while it is written (a full disk, Ctrl-C) raises
+        :class:`~gripkit.errors.PathError` and leaves nothing behind (no figures without their
+        page, no temporary folder, no folder made for it); what would stop the renames (a
+        folder named index.html, a file named figures) is named before anything is written.
+        Only a rename failing for another reason midway leaves new figures beside the old
+        page."""
         out = Path(out_dir)
-        figs = out / "figures"
+        figures = [item for sec in self.sections for kind, item in sec.items if kind == "figure"]
+        _check_targets(out, [item.slug for item in figures])
+        made = _first_missing(out)
         try:
-            figs.mkdir(parents=True, exist_ok=True)
+            (out if made is None else out.parent).mkdir(parents=True, exist_ok=True)
+            stage = Path(tempfile.mkdtemp(dir=out if made is None else out.parent,
+                                          prefix=f".{out.name or 'report'}.", suffix=TEMP_SUFFIX))
+            if made is not None:  # it becomes the report folder: a folder's usual permissions
+                umask = os.umask(0)
+                os.umask(umask)
+                os.chmod(stage, 0o777 & ~umask)
         except OSError as exc:
-            raise PathError(f"report folder {str(figs)!r} cannot be made ({exc.strerror or exc})",
-                            hint="choose a folder you may write to") from None
-        for sec in self.sections:
-            for kind, item in sec.items:
-                if kind == "figure":
-                    write_bytes(figs / f"{item.slug}.png", item.png, what="report figure")
-        index = out / "index.html"
-        write_bytes(index, self.render().encode(), what="report page")
-        return index
+            _remove_made(made)
+            raise PathError(f"report folder {str(out)!r} cannot be made "
+                            f"({exc.strerror or exc})", hint=write_hint(exc)) from None
+        try:
+            (stage / "figures").mkdir()
+            for item in figures:
+                write_bytes(stage / "figures" / f"{item.slug}.png", item.png,
+                            what="report figure")
+            write_bytes(stage / "index.html", self.render().encode(), what="report page")
+            if made is not None:
+                os.rename(stage, out)
+                return out / "index.html"
+            (out / "figures").mkdir(exist_ok=True)
+            for item in figures:
+                name = f"{item.slug}.png"
+                os.replace(stage / "figures" / name, out / "figures" / name)
+            os.replace(stage / "index.html", out / "index.html")
+        except BaseException as exc:
+            shutil.rmtree(stage, ignore_errors=True)
+            _remove_made(made)
+            if isinstance(exc, PathError):  # named by where it was going, not the temporary folder
+                raise PathError(exc.message.replace(str(stage), str(out)),
+                                hint=exc.hint) from exc
+            if isinstance(exc, OSError):
+                raise PathError(f"report {str(out / 'index.html')!r} could not be written "
+                                f"({exc.strerror or exc}); no report was written",
+                                hint=write_hint(exc)) from exc
+            raise
+        shutil.rmtree(stage, ignore_errors=True)
+        return out / "index.html"
+
+
+def _check_targets(out: Path, slugs) -> None:
+    """A :class:`PathError` when something is in the way of the report in ``out``: a file named
+    like the folder, a folder named index.html, a file named figures, a folder named like one of
+    the figures ``slugs``."""
+    index, figs = out / "index.html", out / "figures"
+    if out.exists() and not out.is_dir():
+        raise PathError(f"report folder {str(out)!r} is a file",
+                        hint="choose a folder (it is created if missing)")
+    if index.is_dir():
+        raise PathError(f"report page {str(index)!r} is a folder",
+                        hint="remove that folder, or choose another report folder")
+    if figs.exists() and not figs.is_dir():
+        raise PathError(f"report figures folder {str(figs)!r} is a file",
+                        hint="remove that file, or choose another report folder")
+    for slug in slugs:
+        if (figs / f"{slug}.png").is_dir():
+            raise PathError(f"report figure {str(figs / f'{slug}.png')!r} is a folder",
+                            hint="remove that folder, or choose another report folder")
+
+
+def _first_missing(out: Path) -> Path | None:
+    """The outermost folder of ``out`` (itself included) that does not exist yet (the report
+    makes it, and removes it again on failure), None when ``out`` exists."""
+    missing = None
+    for p in (out, *out.parents):
+        if p.exists() or p.is_symlink():
+            return missing
+        missing = p
+    return missing
+
+
+def _remove_made(made: Path | None) -> None:
+    if made is not None:
+        shutil.rmtree(made, ignore_errors=True)
 
 
 def _text(v) -> str:

@@ -7,7 +7,9 @@ auto-correlation per output and cross-correlation with each input, with the ±1.
 white, independent residuals (Ljung 2nd ed. §16.6); pole-zero map with the 1σ ellipse of each
 pole (from the parameter covariance); Bode magnitude and phase with ±2σ bands, and the data's
 Welch H1 estimate (with its ±2σ) beside them when the data allow; the subspace singular values
-with the chosen order; the warnings raised on the way.
+with the chosen order; the parameter table (:func:`parameters_section`: ``model.parameters``
+with value, 1σ and unit, a step model's K, f_n, ζ and offset first); the warnings raised on the
+way.
 
 Measured records: the residuals are those of the model's predictor from the initial
 state estimated by least squares over the record (:func:`residual_analysis`; innovation models:
@@ -22,6 +24,7 @@ something (:func:`meaningful_lines`: input power, σ below |H|), at most
 from __future__ import annotations
 
 import math
+import numbers
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,7 +38,8 @@ from .linear.frf import frf
 from .linear.linear_model import VALIDATION_FIT, fit_per_output
 from .linear.pem_ss import predictor_x0
 
-__all__ = ["write_model_report", "model_report", "residual_analysis", "predictor_x0",
+__all__ = ["write_model_report", "model_report", "parameters_section", "residual_analysis",
+           "predictor_x0",
            "meaningful_lines", "bode_figure", "Residuals", "ESTIMATE_MARGIN_DECADES",
            "MIN_INPUT_POWER"]
 
@@ -317,6 +321,54 @@ def singular_value_figure(sv, order):
     return fig
 
 
+def _sigma(sd):
+    """A σ cell: the number, "inf (…)" where the data do not determine it, None (shown "not
+    given") where the model has no covariance."""
+    if isinstance(sd, numbers.Real) and not math.isfinite(sd):
+        return "inf (not determined by the data)"
+    return sd
+
+
+#: the step fit's own parameters (``info["step"]`` of a step model): symbol, key, meaning, unit
+#: (None: the key ``gain_unit``; "output": the output's SI unit)
+_STEP_PARAMETERS = (("K", "gain", "static gain", None),
+                    ("f_n", "natural_frequency_hz", "natural frequency", "Hz"),
+                    ("ζ", "damping_ratio", "damping ratio", "1"),
+                    ("y₀", "offset", "output offset (level before the step)", "output"))
+
+
+def _step_rows(model, step: dict) -> list[list]:
+    """The rows of the step fit K ω_n²/(s² + 2ζω_n s + ω_n²): K, f_n, ζ and y₀ with their σ (a
+    None value in the file is infinite, as the model file writes it)."""
+    rows = []
+    for symbol, key, meaning, unit in _STEP_PARAMETERS:
+        unit = (step.get("gain_unit") if unit is None else
+                (list(model.output_units) or ["—"])[0] if unit == "output" else unit)
+        value, sd = step.get(key), step.get(f"{key}_std")
+        rows.append([symbol, math.inf if value is None else value,
+                     _sigma(math.inf if sd is None else sd), unit or "—", meaning])
+    return rows
+
+
+def parameters_section(rep: Report, model) -> None:
+    """The section "Parameters": every parameter of ``model.parameters`` (the model protocol)
+    with its value, 1σ, unit and meaning; for a second-order step model first its own
+    parameters K, f_n, ζ and the offset (``info["step"]``)."""
+    sec = rep.section("Parameters", "Identified parameters with their 1σ (from the parameter "
+                      "covariance of the fit), in SI units or '1' for coefficients of the "
+                      "record's own units.")
+    headers = ["parameter", "value", "σ", "unit", "meaning"]
+    info = getattr(model, "info", None)
+    step = info.get("step") if isinstance(info, dict) else None
+    if isinstance(step, dict):
+        sec.table(headers, _step_rows(model, step),
+                  caption="The step fit K ω_n²/(s² + 2ζω_n s + ω_n²) + y₀ (ω_n = 2π f_n):")
+    rows = [[r["name"], r["value"], _sigma(r["std"]), r["unit"], r["doc"]]
+            for r in model.parameters.table()]
+    sec.table(headers, rows, caption="The coefficients of the model (model.parameters):"
+              if isinstance(step, dict) else "")
+
+
 def model_report(model, data, *, data_name: str = "data", warnings_list=(),
                  sections=()) -> Report:
     """Build the :class:`~gripkit.report.html.Report` of ``model`` (any identified linear
@@ -325,6 +377,7 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=(),
     ``sections``: callables ``f(report)`` that add sections after the frequency response (e.g.
     ``lambda rep: gripkit.control.robustness_section(rep, result)``, the robustness of a loop
     closed around the model)."""
+    original = model  # its parameters: an ARX model's a1, b1, … rather than its record's
     if hasattr(model, "linear_record"):
         model = model.linear_record()
     if not hasattr(model, "system"):
@@ -396,6 +449,7 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=(),
                         "where they drop.").figure(
                 singular_value_figure(np.asarray(model.singular_values), ss.n_states),
                 "singular values", name="sv")
+        parameters_section(rep, original)
     for w in caught:  # the caller sees them too (the CLI prints them and lists them in --json)
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     lines = caught_lines + [f"{w.category.__name__}: {w.message}" for w in caught]

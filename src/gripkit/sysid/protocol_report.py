@@ -24,7 +24,6 @@ innovation residuals); this module shares its residual figure.
 from __future__ import annotations
 
 import inspect
-import math
 import warnings
 from pathlib import Path
 
@@ -35,7 +34,7 @@ from ..report.html import Report
 from ..report.plots import measured_vs_model
 from .linear.validation import residual_tests
 from .model_protocol import ModelFit
-from .model_report import _residual_figure
+from .model_report import _residual_figure, parameters_section
 
 __all__ = ["protocol_report", "write_protocol_report", "write_protocol_page", "RESIDUAL_ALPHA"]
 
@@ -135,19 +134,6 @@ def _residuals_section(rep: Report, model, data, fit: ModelFit, y: np.ndarray) -
                name="residuals")
 
 
-def _parameters_section(rep: Report, model) -> None:
-    """Every parameter with its value, 1σ, unit and meaning (``model.parameters``)."""
-    rows = []
-    for r in model.parameters.table():
-        sd = r["std"]
-        if sd is not None and not math.isfinite(sd):
-            sd = "inf (not determined by the data)"
-        rows.append([r["name"], r["value"], sd, r["unit"], r["doc"]])
-    rep.section("Parameters", "Identified parameters with their 1σ (from the parameter "
-                "covariance of the fit), in SI units or '1' for coefficients of the record's "
-                "own units.").table(["parameter", "value", "σ", "unit", "meaning"], rows)
-
-
 def protocol_report(model, data, *, data_name: str = "data",
                     warnings_list=()) -> tuple[Report, ModelFit]:
     """The :class:`~gripkit.report.html.Report` of ``model`` (any object of the model protocol)
@@ -163,7 +149,7 @@ def protocol_report(model, data, *, data_name: str = "data",
         y = _columns(data, model.outputs)
         _outputs_section(rep, model, data, fit, y)
         _residuals_section(rep, model, data, fit, y)
-        _parameters_section(rep, model)
+        parameters_section(rep, model)
     for w in caught:  # the caller sees them too (the CLI prints them and lists them in --json)
         warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     lines += [f"{w.category.__name__}: {w.message}" for w in caught]
