@@ -263,3 +263,21 @@ def test_arx_polynomial_edited_with_its_info_copy_is_refused(arx_file, tmp_path)
         load_model(_edited(tmp_path, path, edit))
     assert "'system.den' and the 'polynomial' section disagree" in err.value.message
     assert "is -1.2" in err.value.message and "-1.4 by 'polynomial'" in err.value.message
+
+
+def test_a_model_runs_on_the_record_it_was_identified_from_at_any_rate():
+    """fs = 610.35 Hz: the identified model keeps dt = 1/fs to 9 significant digits (2.6·10⁻⁹
+    relative from the record's); compare on that very record is no rate mismatch (it was refused
+    at a 10⁻⁹ tolerance), while a record at 610 Hz still is."""
+    from gripkit.sysid import identify
+
+    rng = np.random.default_rng(5)
+    u = rng.standard_normal(600)
+    y = np.convolve(u, [0.0, 0.5, 0.25])[:600] + 0.01 * rng.standard_normal(600)
+    tr = Trajectory.uniform(dt=1 / 610.35, u=u, y=y)
+    model = identify(tr, "arx", input="u", output="y", na=1, nb=2, nk=1)
+    assert model.dt != tr.dt and abs(model.dt - tr.dt) < 1e-8 * tr.dt
+    assert model.compare(tr).fit_percent[0] > 90.0
+    assert compare(model, tr, None).fit_percent[0] == model.compare(tr).fit_percent[0]
+    with pytest.raises(DataError, match="sampled every"):
+        model.compare(Trajectory.uniform(dt=1 / 610.0, u=u, y=y))
