@@ -11,14 +11,21 @@ A sample is flagged when both hold:
       s = (x_(N−1−m) − x_(m)) / (2 z_p),   z_p = Φ⁻¹(1 − p),  p = (m + ½)/N,
       m = max(MAX_RUN + 1, ⌈10⁻³ N⌉),
 
-  which equals σ for Gaussian data and is not moved by up to ``m`` corrupt values;
+  which equals σ for Gaussian data and is not moved by up to ``m`` corrupt values; when the
+  median absolute deviation (MAD) of the channel is not zero, the smaller of that scale and
+  ``1.4826·MAD`` (also σ for Gaussian data, and not moved by corrupt values in up to half of the
+  samples) is used, so that more than ``m`` corrupt values cannot widen the scale and hide
+  themselves;
 * it belongs to a run of at most :data:`MAX_RUN` consecutive such samples, and the run jumps away
   from the samples next to it by more than ``K·s`` as well. A step, a longer pulse or a decaying
   transient lasts longer than that or joins the rest of the record smoothly; a corrupt value does
   neither.
 
 More than ``2m`` such samples are a property of the signal (a trigger or pulse train), not
-corruption, and are not reported.
+corruption, and are not reported, unless every one of them lies more than :data:`GROSS` times
+further out than that (``|x_i − med(x)| > GROSS·K·s``, with ``s`` from the MAD): values a
+thousand times beyond the eight-σ bound of a channel with spread are sentinels or bit flips, not
+pulses of the signal, however many there are (up to a quarter of the samples).
 
 Whole signals at extreme but valid scales (1e300, 1e-300) are never flagged: the test is
 scale-free.
@@ -31,7 +38,7 @@ from statistics import NormalDist
 
 import numpy as np
 
-__all__ = ["corrupt_samples", "THRESHOLD", "MAX_RUN"]
+__all__ = ["corrupt_samples", "THRESHOLD", "MAX_RUN", "GROSS"]
 
 #: K, in robust standard deviations. For Gaussian data the chance that any of N samples lies beyond
 #: K·σ is N·2Φ(−K); with N up to 1e9 samples per channel and a false-alarm probability of 1e-6 per
@@ -40,6 +47,11 @@ __all__ = ["corrupt_samples", "THRESHOLD", "MAX_RUN"]
 THRESHOLD = -NormalDist().inv_cdf(1e-6 / (2.0 * 1e9))
 #: Longest run of consecutive outlying samples still reported as corrupt samples.
 MAX_RUN = 3
+#: Factor beyond the K·s bound (s from the MAD) past which many outlying samples (more than 2m)
+#: are still reported as corrupt: three orders of magnitude beyond eight σ.
+GROSS = 1e3
+#: 1/Φ⁻¹(3/4): the MAD of Gaussian data times this is σ.
+_MAD_TO_SIGMA = 1.0 / NormalDist().inv_cdf(0.75)
 
 
 def corrupt_samples(x: np.ndarray) -> np.ndarray:
@@ -54,24 +66,39 @@ def corrupt_samples(x: np.ndarray) -> np.ndarray:
     lo, mid, hi = np.partition(x, [m, n // 2, n - 1 - m])[[m, n // 2, n - 1 - m]]
     z = -NormalDist().inv_cdf((m + 0.5) / n)
     with np.errstate(over="ignore", invalid="ignore"):
+        dev = np.abs(x - mid)
+        mad = _MAD_TO_SIGMA * float(np.partition(dev, n // 2)[n // 2])
         scale = (hi - lo) / (2.0 * z)
-        out = np.abs(x - mid) > THRESHOLD * scale
+        if mad > 0.0:
+            scale = min(scale, mad)
+        out = dev > THRESHOLD * scale
     if not out.any():
         return np.empty(0, dtype=np.intp)
-    # keep short runs that jump away from their neighbours (not the tail of a fast transient)
-    bound = THRESHOLD * scale
+    keep = _isolated_runs(x, out, THRESHOLD * scale)
+    # more than the scale estimate sets aside: pulses of the signal, not corruption, unless all
+    # of them are gross (a channel with spread, and values a thousand times past its bound)
+    if len(keep) > 2 * m:
+        gross = mad > 0.0 and len(keep) <= n // 4 and bool(
+            (dev[keep] > GROSS * THRESHOLD * mad).all())
+        if not gross:
+            return np.empty(0, dtype=np.intp)
+    return np.asarray(keep, dtype=np.intp)
+
+
+def _isolated_runs(x: np.ndarray, out: np.ndarray, bound: float) -> list[int]:
+    """The indices of the runs of ``out`` of at most :data:`MAX_RUN` samples that jump away from
+    their neighbours by more than ``bound`` (not the tail of a fast transient)."""
+    n = x.size
     edges = np.diff(np.concatenate([[0], out.astype(np.int8), [0]]))
     starts, stops = np.flatnonzero(edges == 1), np.flatnonzero(edges == -1)
-    keep = []
-    for a, b in zip(starts, stops):
-        if b - a > MAX_RUN:
-            continue
-        if a > 0 and not abs(x[a] - x[a - 1]) > bound:
-            continue
-        if b < n and not abs(x[b - 1] - x[b]) > bound:
-            continue
-        keep.extend(range(a, b))
-    # more than the scale estimate sets aside: pulses of the signal, not corruption
-    if len(keep) > 2 * m:
-        return np.empty(0, dtype=np.intp)
-    return np.asarray(keep, dtype=np.intp)
+    keep: list[int] = []
+    with np.errstate(over="ignore", invalid="ignore"):
+        for a, b in zip(starts, stops):
+            if b - a > MAX_RUN:
+                continue
+            if a > 0 and not abs(x[a] - x[a - 1]) > bound:
+                continue
+            if b < n and not abs(x[b - 1] - x[b]) > bound:
+                continue
+            keep.extend(range(a, b))
+    return keep
