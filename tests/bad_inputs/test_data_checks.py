@@ -14,7 +14,7 @@ import pytest
 from gripkit import DataWarning
 from gripkit.io import load
 from gripkit.signals.outliers import GROSS, THRESHOLD, corrupt_samples
-from corpus import assert_warned
+from corpus import assert_user_error, assert_warned
 
 FS = 100.0
 FIXTURES = Path(__file__).resolve().parents[1] / "fixtures"
@@ -97,3 +97,136 @@ def test_many_moderate_pulses_on_noise_are_a_pulse_train_not_corruption():
     x[::100] += 20.0
     assert 20.0 < GROSS * THRESHOLD
     assert corrupt_samples(x).size == 0
+
+
+# ---------------------------------------------------------------- 2. extreme scales
+NONLINEAR = [("narx", "NARX"), ("hw", "Hammerstein-Wiener"), ("nlss", "NLSS"),
+             ("hysteresis", "hysteresis")]
+
+
+@pytest.mark.parametrize("scale", [1e300, 1e-300])
+@pytest.mark.parametrize("family,work", NONLINEAR)
+def test_cli_nonlinear_families_at_extreme_scales_name_the_scale(cli, tmp_path, family, work,
+                                                                 scale):
+    """Was: fit nan % and a model file (narx), an unexpected LinAlgError (hw), 'input channel 0
+    is identically zero' (nlss), 'constant output' (narx, hysteresis at 1e-300). Now the check of
+    state space (peak between 1e-100 and 1e+100), before any fit."""
+    u, y = record()
+    out = tmp_path / "m.json"
+    res = cli("identify", family, write(tmp_path / "s.csv", u * scale, y * scale), *IO,
+              "--out", out)
+    assert_user_error(res, "DataError", f"input column 'current' has values up to {scale:.3g}: "
+                                        f"{work} identification forms sums of squares")
+    assert "between 1e-100 and 1e+100" in res.error_lines[0]
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("family,work", NONLINEAR)
+def test_cli_one_1e300_sample_is_refused_by_the_scale_check_after_the_spike_warning(
+        cli, tmp_path, family, work):
+    u, y = record()
+    y[100] = 1e300
+    out = tmp_path / "m.json"
+    res = cli("identify", family, write(tmp_path / "huge.csv", u, y), *IO, "--out", out)
+    assert_user_error(res, "DataError", f"output column 'force' has values up to 1e+300: "
+                                        f"{work} identification")
+    assert "column 'force' has 1 sample far outside" in res.err
+    assert "RuntimeWarning" not in res.err
+    assert not out.exists()
+
+
+def test_api_narx_at_1e300_refuses_naming_the_signal():
+    from gripkit import DataError
+    from gripkit.sysid import narx
+
+    u, y = record()
+    with pytest.raises(DataError, match=r"output column 'y' has values up to 1e\+300"):
+        narx(u, y * 1e300 / np.abs(y).max())
+
+
+@pytest.mark.parametrize("bad", [("fit_percent", float("nan")), ("theta_std", "inf")])
+def test_a_failed_fit_is_not_written_to_a_model_file(tmp_path, bad):
+    """A model whose fit is NaN or whose σ is infinite is refused by ``save``, with no file."""
+    import dataclasses
+
+    from gripkit.errors import ModelError
+    from gripkit.sysid import narx
+
+    u, y = record()
+    m = narx(u, y, degree=1, lags=2)
+    field, value = bad
+    if value == "inf":
+        value = np.array(m.theta_std, dtype=float)
+        value[0] = np.inf
+    broken = dataclasses.replace(m, **{field: value})
+    out = tmp_path / "m.json"
+    with pytest.raises(ModelError, match="m.json: not written: .*the fit failed"):
+        broken.save(out)
+    assert not out.exists()
+    m.save(out)  # the fit itself is written
+    assert out.exists()
+
+
+# ---------------------------------------------------------------- 3. a record given twice
+@pytest.mark.parametrize("method", ["arx", "oe", "nlss", "hysteresis"])
+def test_cli_the_same_record_twice_is_refused_naming_both(cli, tmp_path, method):
+    """Was: θ unchanged and theta_std × 0.705 (1/√2), silently. The copy under another name is
+    found by the content of its input and output columns, not by its file name."""
+    u, y = record()
+    a = write(tmp_path / "run.csv", u, y)
+    b = write(tmp_path / "copy.csv", u, y)
+    res = cli("identify", method, a, b, *IO, "--json")
+    assert_user_error(res, "DataError", f"'{a}' and '{b}' hold the same samples of 'current', "
+                                        "'force'")
+    assert "σ too small" in res.error_lines[0]
+
+
+def test_api_identify_records_refuses_a_duplicate_and_takes_distinct_records():
+    from gripkit import DataError, Trajectory
+    from gripkit.sysid import identify
+
+    u1, y1 = record(seed=1)
+    u2, y2 = record(seed=2)
+    tr1 = Trajectory.uniform(dt=0.01, u=u1, y=y1)
+    tr2 = Trajectory.uniform(dt=0.01, u=u2, y=y2)
+    shifted = Trajectory(tr1.t + 5.0, {"u": u1, "y": y1})  # the same samples, later in time
+    with pytest.raises(DataError, match=r"data\[0\] and data\[2\] hold the same samples of "
+                                        r"'u', 'y'"):
+        identify([tr1, tr2, shifted], "arx", input="u", output="y", na=2, nb=1, nk=1)
+    one = identify([tr1], "arx", input="u", output="y", na=2, nb=1, nk=1)
+    two = identify([tr1, tr2], "arx", input="u", output="y", na=2, nb=1, nk=1)
+    assert two.theta_std.max() < one.theta_std.max()  # real new evidence still narrows σ
+
+
+# ---------------------------------------------------------------- 4. interpolated samples
+def _with_gaps(tmp_path, missing: int, lead: bool = False) -> Path:
+    """The record with ``missing`` force samples blanked (every third from sample 20 on; and the
+    first one when ``lead``)."""
+    u, y = record()
+    y[20:20 + 3 * missing:3][:missing - lead] = np.nan
+    if lead:
+        y[0] = np.nan
+    return write(tmp_path / "gaps.csv", u, y)
+
+
+def test_cli_interpolated_samples_warn_with_count_and_fraction(cli, tmp_path):
+    """Was: the fit reported with warnings []."""
+    res = cli("identify", "arx", _with_gaps(tmp_path, 40, lead=True), *IO, "--fill",
+              "interpolate", "--json")
+    assert res.code == 0, res.err
+    assert_warned(res, "column 'force': 40 of 400 samples (10 %) were missing and were made up "
+                       "by linear interpolation, 1 of them before the first or after the last "
+                       "measured value, copied from the nearest one")
+
+
+def test_cli_more_than_a_fifth_interpolated_is_refused(cli, tmp_path):
+    """81 of 400 (20.25 %) is over the documented MAX_FILL_FRACTION = 0.2; 80 (20 %) is not."""
+    from gripkit.io.table import MAX_FILL_FRACTION
+
+    assert MAX_FILL_FRACTION == 0.2
+    res = cli("identify", "arx", _with_gaps(tmp_path, 81), *IO, "--fill", "interpolate")
+    assert_user_error(res, "DataError", "column 'force' has 81 of 400 samples (20.2 %) missing; "
+                                        "interpolation fills at most 20 % of a channel")
+    assert "--fill drop" in res.error_lines[0]
+    with pytest.warns(DataWarning, match=r"80 of 400 samples \(20 %\) were missing"):
+        load(_with_gaps(tmp_path, 80), fill="interpolate")
