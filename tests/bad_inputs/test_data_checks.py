@@ -5,15 +5,19 @@ one-line message, or the warning; the records are synthetic (built here in ``tmp
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from gripkit import DataWarning
+from gripkit import DataError, DataWarning, Trajectory
+from gripkit.errors import ModelError
 from gripkit.io import load
+from gripkit.io.table import MAX_FILL_FRACTION
 from gripkit.signals.outliers import GROSS, THRESHOLD, corrupt_samples
+from gripkit.sysid import identify, narx
 from corpus import assert_user_error, assert_warned
 
 FS = 100.0
@@ -136,9 +140,6 @@ def test_cli_one_1e300_sample_is_refused_by_the_scale_check_after_the_spike_warn
 
 
 def test_api_narx_at_1e300_refuses_naming_the_signal():
-    from gripkit import DataError
-    from gripkit.sysid import narx
-
     u, y = record()
     with pytest.raises(DataError, match=r"output column 'y' has values up to 1e\+300"):
         narx(u, y * 1e300 / np.abs(y).max())
@@ -147,11 +148,6 @@ def test_api_narx_at_1e300_refuses_naming_the_signal():
 @pytest.mark.parametrize("bad", [("fit_percent", float("nan")), ("theta_std", "inf")])
 def test_a_failed_fit_is_not_written_to_a_model_file(tmp_path, bad):
     """A model whose fit is NaN or whose σ is infinite is refused by ``save``, with no file."""
-    import dataclasses
-
-    from gripkit.errors import ModelError
-    from gripkit.sysid import narx
-
     u, y = record()
     m = narx(u, y, degree=1, lags=2)
     field, value = bad
@@ -182,9 +178,6 @@ def test_cli_the_same_record_twice_is_refused_naming_both(cli, tmp_path, method)
 
 
 def test_api_identify_records_refuses_a_duplicate_and_takes_distinct_records():
-    from gripkit import DataError, Trajectory
-    from gripkit.sysid import identify
-
     u1, y1 = record(seed=1)
     u2, y2 = record(seed=2)
     tr1 = Trajectory.uniform(dt=0.01, u=u1, y=y1)
@@ -221,8 +214,6 @@ def test_cli_interpolated_samples_warn_with_count_and_fraction(cli, tmp_path):
 
 def test_cli_more_than_a_fifth_interpolated_is_refused(cli, tmp_path):
     """81 of 400 (20.25 %) is over the documented MAX_FILL_FRACTION = 0.2; 80 (20 %) is not."""
-    from gripkit.io.table import MAX_FILL_FRACTION
-
     assert MAX_FILL_FRACTION == 0.2
     res = cli("identify", "arx", _with_gaps(tmp_path, 81), *IO, "--fill", "interpolate")
     assert_user_error(res, "DataError", "column 'force' has 81 of 400 samples (20.2 %) missing; "

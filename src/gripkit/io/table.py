@@ -20,7 +20,10 @@ Rules shared by every reader:
   or of integers from 1e17 up is in nanoseconds; other stamps from 1e12 up (milliseconds or
   microseconds since 1970?) are refused until their unit is given. Any other integer column beyond
   2**53 is refused;
-* ``columns=`` selects channels by name; ``fill='drop'|'interpolate'`` handles missing values;
+* ``columns=`` selects channels by name; ``fill='drop'|'interpolate'`` handles missing values:
+  ``'interpolate'`` fills them linearly (the ends with the nearest value) with a
+  :class:`~gripkit.errors.DataWarning` giving their count and fraction per channel, and refuses a
+  channel with more than :data:`MAX_FILL_FRACTION` (20 %) of its samples missing;
 * a CSV file without a header (every field of its first line a number) has its columns named by
   their 1-based position, ``'1'``, ``'2'``, …: none is taken as the time column unless named
   with ``time='1'`` (or ``fs=`` is given), and ``meta['header']`` says so.

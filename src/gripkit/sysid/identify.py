@@ -512,16 +512,18 @@ def _check_records(data, method: str, detrend: str) -> None:
 
 def _no_duplicate_records(data, input, output) -> None:
     """A DataError naming the two records when two of ``data`` hold the same samples (the same
-    SHA-256 of their ``input`` and ``output`` columns, at the same sample interval; a shifted
-    time axis does not matter): a record given twice counts its evidence twice, so the fit's σ
+    SHA-256 of their ``input`` and ``output`` columns, at the same sample interval and in the
+    same units; a shifted time axis does not matter): a record given twice counts its evidence twice, so the fit's σ
     would come out too small (by √2 for two copies) with the same θ."""
     names = (*parse_names(input, "input"), *parse_names(output, "output"))
     seen: dict[bytes, int] = {}
     for i, d in enumerate(data):
         if d.n < 2 or not all(n in d for n in names):
             continue  # the per-record checks name the missing column or the short record
-        digest = hashlib.sha256(f"{d.dt:.9g}".encode())  # another interval: that error first
+        # another interval or unit is another error, reported after this check
+        digest = hashlib.sha256(f"{d.dt:.9g}".encode())
         for n in names:
+            digest.update(f"{n} [{d.unit(n)}]".encode())
             digest.update(np.ascontiguousarray(d[n], dtype=np.float64).tobytes())
         key = digest.digest()
         if key in seen:
