@@ -95,12 +95,18 @@ def test_spike_rule_is_silent_on_the_fixture_records(name):
 
 
 def test_many_moderate_pulses_on_noise_are_a_pulse_train_not_corruption():
-    """50 one-sample pulses of 20 σ on Gaussian noise (more than the 2m = 10 a corruption may
-    touch, and far below GROSS·K·σ): a property of the signal, not reported."""
-    x = np.random.default_rng(3).standard_normal(5000)
+    """50 one-sample pulses of 20 σ on Gaussian noise, and 50 trigger pulses of 5 V logged by a
+    16-bit converter over ±10 V (noise ±2 LSB = ±0.6 mV): more than the 2m = 10 a corruption may
+    touch, and closer than GROSS = 1e4 ranges of the other samples: pulses of the signal."""
+    rng = np.random.default_rng(3)
+    x = rng.standard_normal(5000)
     x[::100] += 20.0
-    assert 20.0 < GROSS * THRESHOLD
-    assert corrupt_samples(x).size == 0
+    lsb = 20.0 / 2**16
+    trigger = lsb * rng.integers(-2, 3, 5000)
+    trigger[::100] += 5.0
+    assert 5.0 / np.ptp(trigger[trigger < 1]) < GROSS
+    assert corrupt_samples(x).size == 0 and corrupt_samples(trigger).size == 0
+    assert THRESHOLD * np.std(x) < 20.0  # each pulse alone would be flagged
 
 
 # ---------------------------------------------------------------- 2. extreme scales

@@ -513,8 +513,8 @@ def _check_records(data, method: str, detrend: str) -> None:
 def _no_duplicate_records(data, input, output) -> None:
     """A DataError naming the two records when two of ``data`` hold the same samples (the same
     SHA-256 of their ``input`` and ``output`` columns, at the same sample interval and in the
-    same units; a shifted time axis does not matter): a record given twice counts its evidence twice, so the fit's σ
-    would come out too small (by √2 for two copies) with the same θ."""
+    same units; a shifted time axis does not matter): a record given twice counts its evidence
+    twice, so the fit's σ would come out too small (by √2 for two copies) with the same θ."""
     names = (*parse_names(input, "input"), *parse_names(output, "output"))
     seen: dict[bytes, int] = {}
     for i, d in enumerate(data):
