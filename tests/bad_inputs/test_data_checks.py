@@ -68,14 +68,19 @@ def test_cli_five_spikes_warn_before_the_fit(cli, tmp_path):
     assert_warned(res, "column 'force' has 5 samples far outside the rest of the channel")
 
 
-def test_cli_five_spikes_of_1e300_give_the_spike_warning_with_the_error(cli, tmp_path):
-    """The fit on 1e300 samples cannot succeed; the warning that explains why is printed with
-    the error, not only 'covariance has non-finite entries'."""
+@pytest.mark.parametrize("method,label", [("arx", "ARX [2 2 1]"), ("oe", "OE [2 2 1]")])
+def test_cli_five_spikes_of_1e300_give_the_spike_warning_with_the_error(cli, tmp_path, method,
+                                                                        label):
+    """The fit on 1e300 samples cannot succeed (σ = inf); was only 'ModelError: covariance has
+    non-finite entries'. Now the spike warning, then an IdentificationError saying why."""
     u, y = record()
     y[SPIKES] = 1e300
-    res = cli("identify", "arx", write(tmp_path / "spk5_300.csv", u, y), *IO)
+    res = cli("identify", method, write(tmp_path / "spk5_300.csv", u, y), *IO)
     assert "column 'force' has 5 samples far outside" in res.err, res.err
     assert "look corrupt: 1e+300 N at t=0.1 s" in res.err, res.err
+    assert_user_error(res, "IdentificationError", f"{label}: the fit gives parameters or σ that "
+                                                  "are not finite")
+    assert "drop or repair the samples that the corrupt-sample warning names" in res.err
 
 
 def test_spike_rule_is_silent_on_the_clean_record(tmp_path):

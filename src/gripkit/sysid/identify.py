@@ -32,7 +32,8 @@ import warnings
 import numpy as np
 
 from ..arguments import check_keywords, entry_point, keyword_names
-from ..errors import AccuracyWarning, ArgumentError, DataError, GripkitError, emit_warning
+from ..errors import (AccuracyWarning, ArgumentError, DataError, GripkitError,
+                      IdentificationError, emit_warning)
 from ..signals.trajectory import Trajectory
 from .checks import LINEAR_ORDERS
 from .io_data import (IOData, check_scale, io_data, parse_names, records_provenance,
@@ -60,6 +61,22 @@ def _polynomial_fit(method: str, io: IOData, orders: tuple, options: dict):
     if method == "armax":
         return armax(io.u1, io.y1, na, nb, nc, nk, dt=io.dt, **io.keywords, **options)
     return oe(io.u1, io.y1, nb, nf, nk, dt=io.dt, **io.keywords, **options)
+
+
+def _finite_fit(model):
+    """``model`` (ARX, ARMAX, OE) when its θ and σ are finite, else the IdentificationError: such
+    a fit comes from samples the estimator cannot square (a corrupt value of 1e300 among values
+    of order one), not from the system."""
+    theta = np.asarray(model.theta, dtype=np.float64)
+    std = np.asarray(model.theta_std, dtype=np.float64)
+    if np.isfinite(theta).all() and np.isfinite(std).all():
+        return model
+    raise IdentificationError(
+        f"{model.label}: the fit gives parameters or σ that are not finite (θ up to "
+        f"{np.nanmax(np.abs(theta)):.3g}, σ up to {np.nanmax(std):.3g}): the record holds values "
+        "far beyond the rest of its channel, which no linear model fits",
+        hint="drop or repair the samples that the corrupt-sample warning names (or that are far "
+             "beyond the rest) and identify again")
 
 
 def _free_run_fit(model, u: np.ndarray, y: np.ndarray) -> float:
@@ -310,7 +327,7 @@ def _dispatch(data, method: str, *, input, output, na: int | None, nb: int | Non
                   why=f"{method.upper()} identification"))
     if method in ("arx", "armax", "oe"):
         orders = (na, nb, nc, na if nf is None else nf, nk)
-        model = _polynomial_fit(method, io, orders, options)
+        model = _finite_fit(_polynomial_fit(method, io, orders, options))
         if detrend == "mean":
             raw = lambda: io_data(data, input=input, output=output, detrend="none")  # noqa: E731
             quiet = {k: v for k, v in options.items() if k != "progress"}  # one bar: the fit's
