@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy.signal import lfilter
 
-from gripkit import DataError
+from gripkit import DataError, DataWarning
 from gripkit.cli import main
 from gripkit.io import load
 
@@ -46,10 +46,11 @@ def test_headerless_semicolon_file_with_decimal_commas(tmp_path):
 
 def test_missing_value_in_the_first_row_keeps_the_row(tmp_path):
     p = tmp_path / "gap.csv"
-    p.write_text("0,,1\n1,2,3\n2,4,5\n")
-    tr = load(p, time="1", fill="interpolate")
-    np.testing.assert_array_equal(tr["2"], [2.0, 2.0, 4.0])  # np.interp holds the end value
-    np.testing.assert_array_equal(tr["3"], [1.0, 3.0, 5.0])
+    p.write_text("0,,1\n1,2,3\n2,4,5\n3,6,7\n4,8,9\n5,10,11\n")
+    with pytest.warns(DataWarning, match="1 of them before the first .* copied from the nearest"):
+        tr = load(p, time="1", fill="interpolate")
+    np.testing.assert_array_equal(tr["2"], [2.0, 2.0, 4.0, 6.0, 8.0, 10.0])  # the end value held
+    np.testing.assert_array_equal(tr["3"], [1.0, 3.0, 5.0, 7.0, 9.0, 11.0])
 
 
 def test_one_word_in_the_first_line_makes_it_a_header(tmp_path):

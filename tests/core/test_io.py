@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from gripkit import DataError, Trajectory
+from gripkit import DataError, DataWarning, Trajectory
 from gripkit.io import load, save
 
 
@@ -77,11 +77,12 @@ def test_corrupt_binary(tmp_path, traj, suffix):
 
 def test_nan_and_fill(tmp_path):
     p = tmp_path / "d.csv"
-    p.write_text("t,y\n0,1\n1,\n2,3\n")
+    p.write_text("t,y\n0,1\n1,\n2,3\n3,4\n4,5\n5,6\n")
     with pytest.raises(DataError, match="1 NaN values"):
         load(p)
-    assert load(p, fill="interpolate")["y"][1] == 2.0
-    assert load(p, fill="drop").n == 2
+    with pytest.warns(DataWarning, match=r"column 'y': 1 of 6 samples \(16.7 %\) was missing"):
+        assert load(p, fill="interpolate")["y"][1] == 2.0
+    assert load(p, fill="drop").n == 5
 
 
 def test_missing_file_and_unknown_suffix(tmp_path):

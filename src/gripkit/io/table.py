@@ -20,7 +20,10 @@ Rules shared by every reader:
   or of integers from 1e17 up is in nanoseconds; other stamps from 1e12 up (milliseconds or
   microseconds since 1970?) are refused until their unit is given. Any other integer column beyond
   2**53 is refused;
-* ``columns=`` selects channels by name; ``fill='drop'|'interpolate'`` handles missing values;
+* ``columns=`` selects channels by name; ``fill='drop'|'interpolate'`` handles missing values:
+  ``'interpolate'`` fills them linearly (the ends with the nearest value) with a
+  :class:`~gripkit.errors.DataWarning` giving their count and fraction per channel, and refuses a
+  channel with more than :data:`MAX_FILL_FRACTION` (20 %) of its samples missing;
 * a CSV file without a header (every field of its first line a number) has its columns named by
   their 1-based position, ``'1'``, ``'2'``, …: none is taken as the time column unless named
   with ``time='1'`` (or ``fs=`` is given), and ``meta['header']`` says so.
@@ -114,6 +117,9 @@ def _numeric(name: str, values, row_offset: int = 0) -> np.ndarray:
 
 
 FILL_CHOICES = ("drop", "interpolate")
+#: Largest fraction of a channel's samples that ``fill='interpolate'`` makes up; a channel with
+#: more missing samples is refused (the record would be more interpolation than measurement).
+MAX_FILL_FRACTION = 0.2
 
 
 def check_fill(fill) -> None:
@@ -243,7 +249,7 @@ def _warn_corrupt(source: str, t: np.ndarray, data: dict[str, np.ndarray],
            f"the file (drop or repair those rows) unless the spike is real", DataWarning)
 
 
-def _fill(t: np.ndarray, data: dict[str, np.ndarray], fill: str | None):
+def _fill(t: np.ndarray, data: dict[str, np.ndarray], fill: str | None, source: str = "data"):
     check_fill(fill)
     if fill is None:
         return t, data
@@ -261,10 +267,35 @@ def _fill(t: np.ndarray, data: dict[str, np.ndarray], fill: str | None):
             bad = ~np.isfinite(v)
             if bad.all():
                 raise DataError(f"column {k!r} has no finite values to interpolate from")
-            v = v.copy()
-            v[bad] = np.interp(t[bad], t[~bad], v[~bad])
+            if bad.any():
+                _check_filled(source, k, bad)
+                v = v.copy()
+                v[bad] = np.interp(t[bad], t[~bad], v[~bad])
             out[k] = v
         return t, out
+
+
+def _check_filled(source: str, name: str, bad: np.ndarray) -> None:
+    """The record's ``fill='interpolate'`` of the missing samples ``bad`` of column ``name``: a
+    DataError above :data:`MAX_FILL_FRACTION` of the channel, else a DataWarning with their
+    count and fraction (and how many at the ends were copied from the nearest value)."""
+    n, k = bad.size, int(bad.sum())
+    share = f"{k} of {n} samples ({100.0 * k / n:.3g} %)"
+    if k > MAX_FILL_FRACTION * n:
+        raise DataError(
+            f"{source}: column {name!r} has {share} missing; interpolation fills at most "
+            f"{100 * MAX_FILL_FRACTION:g} % of a channel, beyond that the record is more made up "
+            "than measured",
+            hint="repair the record or cut it to the stretch that holds data; fill='drop' "
+                 "(--fill drop) keeps only the complete rows")
+    good = np.flatnonzero(~bad)
+    ends = int(good[0] + (n - 1 - good[-1]))
+    edge = (f", {ends} of them before the first or after the last measured value, copied "
+            "from the nearest one" if ends else "")
+    were = "was" if k == 1 else "were"
+    emit_warning(f"{source}: column {name!r}: {share} {were} missing and {were} made up by "
+                 f"linear interpolation{edge}; what is computed from the record treats them as "
+                 "measured", DataWarning)
 
 
 def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
@@ -349,7 +380,7 @@ def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
     shown = {c: cols[c][1] for c in names if cols[c][1] is not None and cols[c][1] != su[c]}
     if shown:  # the units the file wrote, for outputs in them (Trajectory.display_unit)
         meta["display_units"] = shown
-    t, data = _fill(t, data, fill)
+    t, data = _fill(t, data, fill, source)
     _warn_corrupt(source, t, data, su)
     if tname is not None:
         bad = ~np.isfinite(t)

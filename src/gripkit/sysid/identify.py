@@ -25,6 +25,7 @@ would otherwise bias every coefficient).
 from __future__ import annotations
 
 import copy
+import hashlib
 import math
 import warnings
 
@@ -32,10 +33,11 @@ import numpy as np
 
 from ..arguments import check_keywords, entry_point, keyword_names
 from ..errors import (AccuracyWarning, ArgumentError, DataError, GripkitError, GripkitWarning,
-                      emit_warning)
+                      IdentificationError, emit_warning)
 from ..signals.trajectory import Trajectory
 from .checks import LINEAR_ORDERS
-from .io_data import IOData, io_data, records_provenance, validation_data
+from .io_data import (IOData, check_scale, io_data, parse_names, records_provenance,
+                      validation_data)
 from .linear import identify_mimo
 from .linear.armax import armax, armax_records
 from .linear.arx import arx, arx_records
@@ -59,6 +61,22 @@ def _polynomial_fit(method: str, io: IOData, orders: tuple, options: dict):
     if method == "armax":
         return armax(io.u1, io.y1, na, nb, nc, nk, dt=io.dt, **io.keywords, **options)
     return oe(io.u1, io.y1, nb, nf, nk, dt=io.dt, **io.keywords, **options)
+
+
+def _finite_fit(model):
+    """``model`` (ARX, ARMAX, OE) when its θ and σ are finite, else the IdentificationError: such
+    a fit comes from samples the estimator cannot square (a corrupt value of 1e300 among values
+    of order one), not from the system."""
+    theta = np.asarray(model.theta, dtype=np.float64)
+    std = np.asarray(model.theta_std, dtype=np.float64)
+    if np.isfinite(theta).all() and np.isfinite(std).all():
+        return model
+    raise IdentificationError(
+        f"{model.label}: the fit gives parameters or σ that are not finite (θ up to "
+        f"{np.nanmax(np.abs(theta)):.3g}, σ up to {np.nanmax(std):.3g}): the record holds values "
+        "far beyond the rest of its channel, which no linear model fits",
+        hint="drop or repair the samples that the corrupt-sample warning names (or that are far "
+             "beyond the rest) and identify again")
 
 
 def _free_run_fit(model, u: np.ndarray, y: np.ndarray) -> float:
@@ -288,12 +306,14 @@ def _dispatch(data, method: str, *, input, output, na: int | None, nb: int | Non
     if method == "nlss":  # the model carries the operating point (input and output means)
         return _method_function(method)(data, input=input, output=output, **options)
     if method == "narx":  # the model's constant term carries the operating point
-        io = io_data(data, input=input, output=output, detrend="none", why="NARX identification")
+        io = _in_scale(io_data(data, input=input, output=output, detrend="none",
+                               why="NARX identification"), "NARX identification")
         model = _method_function(method)(io.u1, io.y1, dt=io.dt, **_validation_arrays(options, io))
         return _with_channels(model, io)
     if method == "hw":  # the offset y0 carries the operating point; orders not given: chosen
-        io = io_data(data, input=input, output=output, detrend="none",
-                     why="Hammerstein-Wiener identification")
+        io = _in_scale(io_data(data, input=input, output=output, detrend="none",
+                               why="Hammerstein-Wiener identification"),
+                       "Hammerstein-Wiener identification")
         model = _method_function(method)(io.u1, io.y1, nb=nb, nf=nf, nk=nk, dt=io.dt,
                                          **_validation_arrays(options, io))
         return _with_channels(model, io)
@@ -307,7 +327,7 @@ def _dispatch(data, method: str, *, input, output, na: int | None, nb: int | Non
                   why=f"{method.upper()} identification"))
     if method in ("arx", "armax", "oe"):
         orders = (na, nb, nc, na if nf is None else nf, nk)
-        model = _polynomial_fit(method, io, orders, options)
+        model = _finite_fit(_polynomial_fit(method, io, orders, options))
         if detrend == "mean":
             raw = lambda: io_data(data, input=input, output=output, detrend="none")  # noqa: E731
             quiet = {k: v for k, v in options.items() if k != "progress"}  # one bar: the fit's
@@ -401,6 +421,14 @@ def _with_extras(model, extras: dict):
     return model.replace(info=info)
 
 
+def _in_scale(io: IOData, why: str) -> IOData:
+    """``io`` once its columns pass :func:`~gripkit.sysid.io_data.check_scale` (the nonlinear
+    families form unscaled sums of squares, like state space), named as in the data file."""
+    check_scale(io.inputs, io.u, "input", why)
+    check_scale(io.outputs, io.y, "output", why)
+    return io
+
+
 #: the methods that fit one model to several records (``identify([tr1, tr2], ...)``)
 RECORD_METHODS = ("arx", "armax", "oe", "ss", "tf", "narx", "hw", "hysteresis", "nlss")
 
@@ -444,6 +472,7 @@ def identify_records(data, method: str = "arx", *, input, output, na: int | None
     :func:`identify`.
     """
     _check_records(data, method, detrend)
+    _no_duplicate_records(data, input, output)
     why = f"{method.upper()} identification"
     hw_orders = dict(nb=nb, nf=nf, nk=nk)  # each one not given is chosen by the fit
     na, nb, nk, nc = _linear_orders(na, nb, nk, nc)
@@ -517,6 +546,32 @@ def _check_records(data, method: str, detrend: str) -> None:
                         f"mean of all records) or 'none', found {detrend!r}",
                         hint="detrend 'linear' would give every record its own operating point; "
                              "detrend the records before, or use 'mean'")
+
+
+def _no_duplicate_records(data, input, output) -> None:
+    """A DataError naming the two records when two of ``data`` hold the same samples (the same
+    SHA-256 of their ``input`` and ``output`` columns, at the same sample interval and in the
+    same units; a shifted time axis does not matter): a record given twice counts its evidence
+    twice, so the fit's σ would come out too small (by √2 for two copies) with the same θ."""
+    names = (*parse_names(input, "input"), *parse_names(output, "output"))
+    seen: dict[bytes, int] = {}
+    for i, d in enumerate(data):
+        if d.n < 2 or not all(n in d for n in names):
+            continue  # the per-record checks name the missing column or the short record
+        # another interval or unit is another error, reported after this check
+        digest = hashlib.sha256(f"{d.dt:.9g}".encode())
+        for n in names:
+            digest.update(f"{n} [{d.unit(n)}]".encode())
+            digest.update(np.ascontiguousarray(d[n], dtype=np.float64).tobytes())
+        key = digest.digest()
+        if key in seen:
+            j = seen[key]
+            raise DataError(
+                f"data[{j}] and data[{i}] hold the same samples of "
+                f"{', '.join(map(repr, names))}: a record given twice counts as two independent "
+                "records and would make the parameters' σ too small (by √2 for two copies)",
+                hint="give each record once")
+        seen[key] = i
 
 
 def _with_channels(model, io: IOData):

@@ -32,7 +32,7 @@ from ..signals.processing import detrend as detrend_signals
 from ..signals.trajectory import Trajectory
 
 __all__ = ["IOData", "io_data", "parse_names", "validation_data", "provenance_of",
-           "records_provenance", "SCALE_LIMITS", "DETRENDS"]
+           "records_provenance", "SCALE_LIMITS", "DETRENDS", "check_scale"]
 
 #: the operating-point removals: each column's mean, a least-squares line, nothing
 DETRENDS = ("mean", "linear", "none")
@@ -125,8 +125,8 @@ class IOData:
         if checks:
             _check_constant(ins, u, "input")
             _check_constant(outs, y, "output")
-            _check_scale(ins, u, "input", why)
-            _check_scale(outs, y, "output", why)
+            check_scale(ins, u, "input", why)
+            check_scale(outs, y, "output", why)
         # each column's own mean (pairwise summation of the contiguous column): one column has
         # the same offset whatever other columns are named with it
         u0 = np.array([u[:, j].mean() for j in range(u.shape[1])])
@@ -249,10 +249,13 @@ def _check_constant(names, x: np.ndarray, what: str) -> None:
                         hint="drop it from --input/--output or check the data")
 
 
-def _check_scale(names, x: np.ndarray, what: str, why: str) -> None:
-    """Refuse a column whose values are too large or too small for the estimators' sums of squares
-    (the SISO polynomial estimators scale internally; these do not)."""
-    peak = np.max(np.abs(x), axis=0)
+def check_scale(names, x: np.ndarray, what: str, why: str) -> None:
+    """Refuse a column (of ``x``, one per name of ``names``; a 1-D ``x`` is one column) whose
+    values are too large or too small for the estimators' sums of squares (the SISO polynomial
+    estimators scale internally; state space, FRF, transfer functions and the nonlinear families
+    do not). ``what``: 'input' or 'output'; ``why``: the work, 'NARX identification'."""
+    x = np.asarray(x, dtype=np.float64)
+    peak = np.max(np.abs(x.reshape(x.shape[0], -1)), axis=0)
     lo, hi = SCALE_LIMITS
     bad = (peak > hi) | (peak < lo)
     if bad.any():

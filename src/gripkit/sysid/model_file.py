@@ -103,7 +103,9 @@ class FamilyFile:
 
     def save(self, path) -> Path:
         """Write the model as JSON (the document of :meth:`to_dict`, its ``schema`` naming the
-        family, and the provenance ``data``), atomically."""
+        family, and the provenance ``data``), atomically. A ModelError, and no file, for a
+        model whose fit is NaN or ±inf or one of whose σ is infinite (a failed fit)."""
+        _check_usable(self, path)
         doc = {**self.to_dict(), **self.provenance_document()}
         return write_text(path, json.dumps(doc, indent=1, allow_nan=self._file_allow_nan) + "\n",
                           what=self._file_what)
@@ -113,6 +115,23 @@ class FamilyFile:
         data_hash}}``, ``{"data": None}`` without a data file (the linear model file's form)."""
         return {"data": None if self.data_file is None else {"file": self.data_file,
                                                              "sha256": self.data_hash}}
+
+
+def _check_usable(model, path) -> None:
+    """Refuse to save ``model`` (to ``path``) when its ``fit_percent`` is not finite or a
+    ``theta_std`` entry is infinite: the numbers of a fit that failed, not a model."""
+    fit = getattr(model, "fit_percent", None)
+    std = getattr(model, "theta_std", None)
+    bad = None
+    if isinstance(fit, (float, np.floating)) and not np.isfinite(fit):
+        bad = f"its fit is {fit} %"
+    elif std is not None and np.isinf(np.asarray(std, dtype=np.float64)).any():
+        bad = "a parameter's σ is infinite"
+    if bad is not None:
+        raise ModelError(f"{Path(path).name}: not written: {bad}, so the fit failed (often data "
+                         "at an extreme scale or with corrupt samples)",
+                         hint="check the data (the warnings above), rescale or repair it and "
+                              "identify again")
 
 
 def file_provenance(doc: dict) -> dict:

@@ -131,6 +131,7 @@ from ...signals.trajectory import Trajectory
 from ...units import product_unit
 from ..linear.frf import frf
 from ..linear.subspace import n4sid, n4sid_records
+from ..io_data import check_scale
 from ..model_file import (SAMPLE_TIME, Domain, FamilyFile, check_family_fields, file_provenance,
                           read_family_document)
 from ..model_protocol import ModelFit
@@ -1149,6 +1150,8 @@ def _check_data(u, y, dt, maxiter):
     if len(u) != len(y):
         raise DataError(f"hammerstein_wiener: u has {len(u)} samples but y has {len(y)}; pass a "
                         "pair of equal length")
+    check_scale(("u",), u, "input", "Hammerstein-Wiener identification")
+    check_scale(("y",), y, "output", "Hammerstein-Wiener identification")
     not_constant(y, "the output", "hammerstein_wiener",
                  "there is nothing to identify: check the output column")
     not_constant(u, "the input", "hammerstein_wiener", "it excites nothing: check the input column")

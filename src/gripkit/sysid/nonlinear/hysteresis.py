@@ -65,6 +65,7 @@ from ...errors import (AccuracyWarning, ArgumentError, DataError, Identification
 from ...params import Parameter, ParameterSet
 from ...progress import track
 from ...signals.trajectory import Trajectory
+from ..io_data import check_scale
 from ..model_file import (SAMPLE_TIME, Domain, FamilyFile, check_family_fields, file_provenance,
                           read_family_document)
 from ..model_protocol import ModelFit
@@ -150,6 +151,8 @@ def _record(data, input, output, what: str, need_output: bool = True):
 def _check_excited(u: np.ndarray, y: np.ndarray, input: str, output: str) -> None:
     if len(u) < 10:
         raise DataError(f"hysteresis: {len(u)} samples; a loop needs at least 10")
+    check_scale((input,), u, "input", "hysteresis identification")
+    check_scale((output,), y, "output", "hysteresis identification")
     not_constant(u, f"the input {input!r}", "hysteresis", "a hysteresis needs an input sweep")
     not_constant(y, f"the output {output!r}", "hysteresis", "check the output column")
     if K.count_reversals(u, REVERSAL_BAND * float(np.ptp(u))) < 1:

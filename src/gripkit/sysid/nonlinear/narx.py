@@ -54,6 +54,7 @@ from ...errors import (ArgumentError, DataError, IdentificationError, ModelError
 from ...params import Parameter, ParameterSet
 from ...signals.trajectory import Trajectory
 from ...units import product_unit
+from ..io_data import check_scale
 from ..model_file import (SAMPLE_TIME, Domain, FamilyFile, check_family_fields, file_provenance,
                           read_family_document)
 from ..model_protocol import ModelFit
@@ -878,6 +879,8 @@ def checked_arguments(u, y, *, degree, lags, ylags, ulags, dt, direct, refine, m
         raise ArgumentError(f"narx: refine must be None or 'simulation', found {refine!r}")
     max_iter = _positive_int(max_iter, "max_iter")
     yall = np.concatenate([r[1] for r in records])
+    check_scale(("u",), np.concatenate([r[0] for r in records]), "input", "NARX identification")
+    check_scale(("y",), yall, "output", "NARX identification")
     not_constant(yall, "the output", "narx",
                  "there is nothing to identify: check the output column")
     degree = _positive_int(degree, "degree")

@@ -74,6 +74,7 @@ import scipy.linalg as sla
 
 from ...errors import (AccuracyWarning, ArgumentError, DataError, IdentificationError,
                        ModelError, StabilityWarning, emit_warning)
+from ..io_data import check_scale
 from ..model_file import (SAMPLE_TIME, Domain, FamilyFile, check_family_fields, file_provenance,
                           read_family_document)
 from ..model_protocol import ModelFit, column_in_unit
@@ -893,6 +894,8 @@ def nlss(data, *, input=None, output=None, order: int | None = None, degree: int
     """
     recs, u, y, tr_dt, names, bounds = _read_data(data, input, output)
     ins, outs, iunits, ounits = names
+    check_scale(ins, u, "input", "NLSS identification")
+    check_scale(outs, y, "output", "NLSS identification")
     several = len(recs) > 1
     N, m = u.shape
     p = y.shape[1]
