@@ -314,6 +314,7 @@ def test_step_model_parameter_table_from_a_hostile_file(cli, tmp_path):
     m = json.loads((tmp_path / "m.json").read_text())
     m["info"]["step"]["gain_unit"] = HOSTILE
     m["system"]["output_units"][0] = "unit" + HOSTILE
+    m["outputs"][0]["unit"] = "unit" + HOSTILE  # both copies (a file whose copies differ: refused)
     (tmp_path / "m2.json").write_text(json.dumps(m))
     res = cli("report", tmp_path / "m2.json", data, "--out", tmp_path / "rep")
     assert res.code == 0, res.err
