@@ -69,6 +69,13 @@ def _free_run_fit(model, u: np.ndarray, y: np.ndarray) -> float:
         return float(100.0 * (1.0 - np.linalg.norm(y - yhat) / np.linalg.norm(y - y.mean())))
 
 
+def _compare_fit(model, data) -> float:
+    """The fit of ``gripkit compare`` (:meth:`compare`: the model's offsets, x0 by least squares)
+    of ``model`` on the trajectory ``data``; −inf for an unstable model (no fit)."""
+    fit = model.compare(data).fit_percent[0]
+    return -math.inf if fit is None else float(fit)
+
+
 def warn_if_mean_detrending_hurt(model, io: IOData, raw, refit) -> None:
     """The SISO form of :func:`gripkit.sysid.linear.identify_mimo._warn_if_detrending_hurt`: when a
     pole of ``model`` (fitted on the mean-detrended ``io``) does not settle within the record
@@ -311,6 +318,10 @@ def _dispatch(data, method: str, *, input, output, na: int | None, nb: int | Non
             raw = lambda: io_data(data, input=input, output=output, detrend="none")  # noqa: E731
             quiet = {k: v for k, v in options.items() if k != "progress"}  # one bar: the fit's
             refit = lambda r: _polynomial_fit(method, r, orders, quiet)  # noqa: E731
+            if identify_mimo.step_like(io.u1 + io.u_offset[0]):  # a step is never at its mean
+                return identify_mimo.keep_better_without_detrending(
+                    model, lambda: refit(raw()), f"identify {method}",
+                    lambda m: _compare_fit(m, data))
             warn_if_mean_detrending_hurt(model, io, raw, refit)
         return model
     if method == "rls":
