@@ -96,7 +96,7 @@ def _siso(method: str, data: list[Path], input: str, output: str, fs, time, fill
         if len(data) > 1:
             out["records"] = records_field(data, model.info["records"])
         else:  # the fit of `gripkit compare` on this record (fit_percent: the one-step fit)
-            out["free_run_fit_percent"] = model.compare(tr).fit_percent[0]
+            out["free_run_fit_percent"] = _compare_fit(model, tr)
         val = _validation_fields(out, model, vtr, validate, detrend)
     if finish_json(out, caught, json_out):
         return
@@ -104,6 +104,17 @@ def _siso(method: str, data: list[Path], input: str, output: str, fs, time, fill
                  out.get("free_run_fit_percent", False))
     _echo_records(out.get("records"))
     _echo_written(out_file, report)
+
+
+def _compare_fit(model, tr) -> float | None:
+    """The free-run fit of ``gripkit compare`` of ``model`` on its estimation record ``tr``; None
+    where compare has none (an unstable model; a record whose ‖y − ȳ‖ underflows to 0)."""
+    from ..errors import DataError
+
+    try:
+        return model.compare(tr).fit_percent[0]
+    except DataError:
+        return None
 
 
 def _validation_fields(res: dict, model, vtr, validate: Path | None, detrend: str = "mean"):
@@ -140,7 +151,8 @@ def _print_model(model, val, vfit: float | None = None, free: float | None | boo
               f"AIC = {model.aic:.6g}   FPE = {model.fpe:.6g}")
     if free is not False:  # one record: the fit `gripkit compare` reports on it
         con.print("free-run fit (estimation data, as gripkit compare) = "
-                  + ("— (unstable model)" if free is None else f"{free:.2f} %"))
+                  + (f"{free:.2f} %" if free is not None else "— (unstable model)"
+                     if not model.stable else "— (undefined: ‖y − ȳ‖ underflows)"))
     fmt = lambda z: ", ".join(f"{v.real:.4g}{v.imag:+.4g}j" for v in z) or "none"  # noqa: E731
     con.print(f"poles: {fmt(model.poles())}   ({'stable' if model.stable else 'UNSTABLE'})")
     con.print(f"zeros: {fmt(model.zeros())}   "

@@ -216,7 +216,10 @@ def identify(data: Trajectory, method: str = "arx", *, inputs: str | list[str] |
         Orders. Not given (None): for arx, armax, oe, rls and search ``na = nb = 2``, ``nk = 1``,
         ``nc = 1`` (:data:`LINEAR_ORDERS`) and ``nf = na``; for hw chosen by the fit.
     detrend
-        ``'mean'`` (default), ``'linear'`` or ``'none'``; see :func:`io_data`.
+        ``'mean'`` (default), ``'linear'`` or ``'none'``; see :func:`io_data`. A step input
+        (:func:`~gripkit.sysid.linear.identify_mimo.step_like`) is never at its mean: with
+        ``'mean'``, tf, arx, armax and oe of one record refit it without detrending and return
+        the model of the higher free-run fit (an AccuracyWarning when that is the refit).
     **options
         Passed to the method's function: for 'armax' and 'oe' ``maxiter``, ``tol``; for 'rls'
         ``forgetting``, ``p0``, ``theta0``, ``windup``, ``max_trace``, ``store``; for 'search'
