@@ -94,3 +94,30 @@ def test_cli_tf_on_a_step_warns_in_the_json_warnings(cli, tmp_path):
     assert_warned(res, f"AccuracyWarning: identify tf: {STEP_WARNING}")
     assert_warned(res, "the model fitted without detrending is returned")
     assert res.json()["damping_ratio"][0] == pytest.approx(ZETA, abs=0.005)
+
+
+def test_mimo_arx_default_on_two_steps_keeps_the_model_without_detrending():
+    """Matrix-polynomial ARX of two step inputs (2 V at 0.1 s into the record's system; 1 V at
+    0.4 s into y2(t) = 0.9 y2(t−1) + 0.1 u2(t−1)): the returned model is the one fitted without
+    detrending, and its mean compare fit beats that of the model fitted with the means removed
+    (arx_mimo on the same columns, the means as its offsets)."""
+    from gripkit.sysid.linear.arx_mimo import arx_mimo
+    from gripkit.sysid.linear.identify_mimo import compare_score, mimo_data
+
+    n = 1000
+    base = step_record(n)
+    u2 = np.where(np.arange(n) >= 400, 1.0, 0.0)
+    y2 = signal.lfilter([0.0, 0.1], [1.0, -0.9], u2)
+    y2 = y2 + 0.002 * np.random.default_rng(3).standard_normal(n)
+    tr = Trajectory(base.t, {"voltage": base["voltage"], "position": base["position"], "u2": u2,
+                             "y2": y2},
+                    {"voltage": "V", "position": "mm", "u2": "V", "y2": "mm"}, {"dt": DT})
+    cols = dict(input="voltage,u2", output="position,y2")
+    with pytest.warns(AccuracyWarning, match=r"identify arx: the input is a step"):
+        m = identify(tr, "arx", **cols, na=2, nb=2, nk=1)
+    none = identify(tr, "arx", **cols, na=2, nb=2, nk=1, detrend="none")
+    np.testing.assert_array_equal(m.theta, none.theta)
+    d = mimo_data(tr, cols["input"], cols["output"], "mean")
+    mean = arx_mimo(d.u, d.y, 2, 2, 1, dt=d.dt, u_offset=d.u_offset, y_offset=d.y_offset,
+                    **d.signals)
+    assert compare_score(m, tr) > compare_score(mean, tr)

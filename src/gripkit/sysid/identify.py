@@ -69,13 +69,6 @@ def _free_run_fit(model, u: np.ndarray, y: np.ndarray) -> float:
         return float(100.0 * (1.0 - np.linalg.norm(y - yhat) / np.linalg.norm(y - y.mean())))
 
 
-def _compare_fit(model, data) -> float:
-    """The fit of ``gripkit compare`` (:meth:`compare`: the model's offsets, x0 by least squares)
-    of ``model`` on the trajectory ``data``; −inf for an unstable model (no fit)."""
-    fit = model.compare(data).fit_percent[0]
-    return -math.inf if fit is None else float(fit)
-
-
 def warn_if_mean_detrending_hurt(model, io: IOData, raw, refit) -> None:
     """The SISO form of :func:`gripkit.sysid.linear.identify_mimo._warn_if_detrending_hurt`: when a
     pole of ``model`` (fitted on the mean-detrended ``io``) does not settle within the record
@@ -218,8 +211,9 @@ def identify(data: Trajectory, method: str = "arx", *, inputs: str | list[str] |
     detrend
         ``'mean'`` (default), ``'linear'`` or ``'none'``; see :func:`io_data`. A step input
         (:func:`~gripkit.sysid.linear.identify_mimo.step_like`) is never at its mean: with
-        ``'mean'``, tf, arx, armax and oe of one record refit it without detrending and return
-        the model of the higher free-run fit (an AccuracyWarning when that is the refit).
+        ``'mean'``, tf, arx (one or several columns), armax and oe of one record refit it
+        without detrending and return the model of the higher free-run fit (an
+        AccuracyWarning when that is the refit).
     **options
         Passed to the method's function: for 'armax' and 'oe' ``maxiter``, ``tol``; for 'rls'
         ``forgetting``, ``p0``, ``theta0``, ``windup``, ``max_trace``, ``store``; for 'search'
@@ -324,7 +318,7 @@ def _dispatch(data, method: str, *, input, output, na: int | None, nb: int | Non
             if identify_mimo.step_like(io.u1 + io.u_offset[0]):  # a step is never at its mean
                 return identify_mimo.keep_better_without_detrending(
                     model, lambda: refit(raw()), f"identify {method}",
-                    lambda m: _compare_fit(m, data))
+                    lambda m: identify_mimo.compare_score(m, data))
             warn_if_mean_detrending_hurt(model, io, raw, refit)
         return model
     if method == "rls":

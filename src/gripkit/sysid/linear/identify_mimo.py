@@ -505,8 +505,25 @@ def identify_arx(data: Trajectory, *, input, output, na: int, nb: int, nk: int =
     """MIMO ARX of the named columns (:func:`gripkit.sysid.linear.arx_mimo.arx_mimo`): a
     :class:`~gripkit.sysid.PolynomialModel` of matrix polynomials."""
     d = mimo_data(data, input, output, detrend, why="ARX identification")
-    return (arx_mimo(d.u, d.y, na, nb, nk, dt=d.dt, u_offset=d.u_offset, y_offset=d.y_offset,
-                     **d.signals))
+    model = arx_mimo(d.u, d.y, na, nb, nk, dt=d.dt, u_offset=d.u_offset, y_offset=d.y_offset,
+                     **d.signals)
+    if detrend == "mean" and step_like(d.u + np.asarray(d.u_offset)):  # never at its mean
+        refit = lambda: identify_arx(data, input=input, output=output, na=na,  # noqa: E731
+                                     nb=nb, nk=nk, detrend="none")
+        return keep_better_without_detrending(model, refit, "identify arx",
+                                              lambda m: compare_score(m, data))
+    return model
+
+
+def compare_score(model, data) -> float:
+    """The mean over the outputs of the fit of ``gripkit compare`` (:meth:`compare`: the model's
+    offsets, x0 by least squares) of ``model`` on the trajectory ``data``; −inf where it has
+    none (an unstable model, a record whose ‖y − ȳ‖ underflows)."""
+    try:
+        fits = model.compare(data).fit_percent
+    except DataError:
+        return -math.inf
+    return -math.inf if any(f is None for f in fits) else float(np.mean(fits))
 
 
 #: the options of method 'ss' with several records (``weighting``: the subspace method, n4sid,
