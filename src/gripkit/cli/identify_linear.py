@@ -95,12 +95,26 @@ def _siso(method: str, data: list[Path], input: str, output: str, fs, time, fill
         out.update(data=data_field(data), detrend=detrend)
         if len(data) > 1:
             out["records"] = records_field(data, model.info["records"])
+        else:  # the fit of `gripkit compare` on this record (fit_percent: the one-step fit)
+            out["free_run_fit_percent"] = _compare_fit(model, tr)
         val = _validation_fields(out, model, vtr, validate, detrend)
     if finish_json(out, caught, json_out):
         return
-    _print_model(model, None if val is None else val.one_step, out.get("validation_fit_percent"))
+    _print_model(model, None if val is None else val.one_step, out.get("validation_fit_percent"),
+                 out.get("free_run_fit_percent", False))
     _echo_records(out.get("records"))
     _echo_written(out_file, report)
+
+
+def _compare_fit(model, tr) -> float | None:
+    """The free-run fit of ``gripkit compare`` of ``model`` on its estimation record ``tr``; None
+    where compare has none (an unstable model; a record whose ‖y − ȳ‖ underflows to 0)."""
+    from ..errors import DataError
+
+    try:
+        return model.compare(tr).fit_percent[0]
+    except DataError:
+        return None
 
 
 def _validation_fields(res: dict, model, vtr, validate: Path | None, detrend: str = "mean"):
@@ -120,7 +134,7 @@ def _echo_written(out_file: Path | None, report: Path | None) -> None:
         typer.echo(f"report written to {report}")
 
 
-def _print_model(model, val, vfit: float | None = None) -> None:
+def _print_model(model, val, vfit: float | None = None, free: float | None | bool = False) -> None:
     from rich.console import Console
     from rich.table import Table
 
@@ -135,6 +149,10 @@ def _print_model(model, val, vfit: float | None = None) -> None:
     con.print(t)
     con.print(f"loss V_N (eq 29) = {model.loss:.6g}   fit (1-step) = {model.fit_percent:.2f} %   "
               f"AIC = {model.aic:.6g}   FPE = {model.fpe:.6g}")
+    if free is not False:  # one record: the fit `gripkit compare` reports on it
+        con.print("free-run fit (estimation data, as gripkit compare) = "
+                  + (f"{free:.2f} %" if free is not None else "— (unstable model)"
+                     if not model.stable else "— (undefined: ‖y − ȳ‖ underflows)"))
     fmt = lambda z: ", ".join(f"{v.real:.4g}{v.imag:+.4g}j" for v in z) or "none"  # noqa: E731
     con.print(f"poles: {fmt(model.poles())}   ({'stable' if model.stable else 'UNSTABLE'})")
     con.print(f"zeros: {fmt(model.zeros())}   "

@@ -228,7 +228,11 @@ def identify(data: Trajectory, method: str = "arx", *, inputs: str | list[str] |
         Orders. Not given (None): for arx, armax, oe, rls and search ``na = nb = 2``, ``nk = 1``,
         ``nc = 1`` (:data:`LINEAR_ORDERS`) and ``nf = na``; for hw chosen by the fit.
     detrend
-        ``'mean'`` (default), ``'linear'`` or ``'none'``; see :func:`io_data`.
+        ``'mean'`` (default), ``'linear'`` or ``'none'``; see :func:`io_data`. A step input
+        (:func:`~gripkit.sysid.linear.identify_mimo.step_like`) is never at its mean: with
+        ``'mean'``, tf, arx (one or several columns), armax and oe of one record refit it
+        without detrending and return the model of the higher free-run fit (an
+        AccuracyWarning when that is the refit).
     **options
         Passed to the method's function: for 'armax' and 'oe' ``maxiter``, ``tol``; for 'rls'
         ``forgetting``, ``p0``, ``theta0``, ``windup``, ``max_trace``, ``store``; for 'search'
@@ -332,6 +336,10 @@ def _dispatch(data, method: str, *, input, output, na: int | None, nb: int | Non
             raw = lambda: io_data(data, input=input, output=output, detrend="none")  # noqa: E731
             quiet = {k: v for k, v in options.items() if k != "progress"}  # one bar: the fit's
             refit = lambda r: _polynomial_fit(method, r, orders, quiet)  # noqa: E731
+            if identify_mimo.step_like(io.u1 + io.u_offset[0]):  # a step is never at its mean
+                return identify_mimo.keep_better_without_detrending(
+                    model, lambda: refit(raw()), f"identify {method}",
+                    lambda m: identify_mimo.compare_score(m, data))
             warn_if_mean_detrending_hurt(model, io, raw, refit)
         return model
     if method == "rls":

@@ -159,7 +159,8 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
             data, input=input, output=output, order=model.order, method=method, form=form,
             refine=False, detrend="none", horizon=horizon, feedthrough=feedthrough)[0]
         _warn_if_detrending_hurt(model, refit, d.u.shape[0], d.dt, "identify ss",
-                                 without="without (subspace model, not refined)")
+                                 without="without (subspace model, not refined)",
+                                 step=step_like(d.u + np.asarray(d.u_offset)))
     if vd is not None:
         extras["validation_fit_percent"] = _validation_fit(model, vd)
     return model, extras
@@ -391,14 +392,16 @@ def _never_lose(start, refined, focus: str, d: IOData, estimation: bool, max_ite
 
 
 def _warn_if_detrending_hurt(model, refit, n: int, dt: float, command: str,
-                             without: str = "without") -> None:
+                             without: str = "without", step: bool = False) -> None:
     """Mean detrending assumes the record's means are an operating point (an equilibrium). A mode
     that does not settle within the record (its envelope falls by less than e⁻⁵ over the N
     samples: a near-integrator, a drift) breaks that assumption; then ``refit()`` fits the same
     structure without detrending, and a warning names ``--detrend none`` when that fits the data
     better by more than 10 points (free run). For ``identify ss`` the refit is the subspace model
     alone (no PEM): a lower bound on what the data without detrending give, at a fraction of the
-    cost of a second refinement; ``without`` names what was refitted in the warning."""
+    cost of a second refinement; ``without`` names what was refitted in the warning. ``step``
+    (a step input, :func:`step_like`, whose mean is no operating point either): refit whatever
+    the modes."""
     poles = model.system.poles()
     if not poles.size:
         return
@@ -407,7 +410,7 @@ def _warn_if_detrending_hurt(model, refit, n: int, dt: float, command: str,
     else:
         rate = -poles.real
     slowest = float(np.min(rate))
-    if not 0.0 < slowest * n * dt < 5.0:
+    if not step and not 0.0 < slowest * n * dt < 5.0:
         return
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -417,12 +420,55 @@ def _warn_if_detrending_hurt(model, refit, n: int, dt: float, command: str,
             return
     mean_fit, none_fit = float(np.mean(model.fit_percent)), float(np.mean(other.fit_percent))
     if none_fit > mean_fit + 10.0:
+        why = (f"the input is a step (piecewise constant, at most {STEP_CHANGES} level "
+               "changes), whose mean is no operating point" if step else
+               f"the slowest mode (time constant {1 / slowest:.4g} s) does not settle within the "
+               f"{n * dt:.4g} s record, so the output drifts and its mean is no operating point")
         emit_warning(
-           f"{command}: removing the means (detrend 'mean', the default) hurt this fit: the "
-           f"slowest mode (time constant {1 / slowest:.4g} s) does not settle within the "
-           f"{n * dt:.4g} s record, so the output drifts and its mean is no operating point; "
+           f"{command}: removing the means (detrend 'mean', the default) hurt this fit: {why}; "
            f"free-run fit {mean_fit:.4g} % with the means removed, {none_fit:.4g} % {without}; "
            f"use --detrend none (Python: detrend='none')", AccuracyWarning)
+
+
+#: level changes an input column may make and still count as a step (a step, a few held steps)
+STEP_CHANGES = 4
+
+
+def step_like(u) -> bool:
+    """Whether every column of the input ``u`` (as recorded, (N,) or (N, m)) is piecewise
+    constant with at most :data:`STEP_CHANGES` level changes, and one column at least changes: a
+    step record. Its mean is no operating point: the record sits at one level, then at another,
+    never at the mean, so with the means removed a record that starts at rest starts away from
+    rest (a measured, noisy step is not detected)."""
+    u = np.asarray(u, dtype=np.float64).reshape(len(u), -1)
+    span = np.ptp(u, axis=0)
+    if not u.shape[0] or not np.any(span > 0):
+        return False
+    changes = np.count_nonzero(np.abs(np.diff(u, axis=0)) > 1e-9 * span, axis=0)
+    return bool(np.all(changes <= STEP_CHANGES))
+
+
+def keep_better_without_detrending(model, refit, command: str, score):
+    """``model`` was fitted on the mean-detrended data of a step input (:func:`step_like`):
+    ``refit()`` fits the same structure on the data as they are, and the one with the higher
+    free-run fit ``score(model)`` (the fit of :meth:`LinearModel.compare`, initial state by least
+    squares) is returned; an :class:`AccuracyWarning` says so when that is the refit."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            other = refit()
+        except GripkitError:
+            return model
+    mean_fit, none_fit = score(model), score(other)
+    if not none_fit > mean_fit:
+        return model
+    emit_warning(
+        f"{command}: the input is a step (piecewise constant, at most {STEP_CHANGES} level "
+        f"changes): its mean is no operating point, and removing the means (detrend 'mean', the "
+        f"default) biased this fit: free-run fit {mean_fit:.4g} % with the means removed, "
+        f"{none_fit:.4g} % without; the model fitted without detrending is returned "
+        f"(--detrend none, Python: detrend='none', fits it directly)", AccuracyWarning)
+    return other
 
 
 def identify_frf(data: Trajectory, *, input, output, detrend: str = "mean", **options):
@@ -442,6 +488,9 @@ def identify_tf(data: Trajectory, *, input, output, poles: int, zeros: int, detr
     if detrend == "mean":
         refit = lambda: identify_tf(data, input=input, output=output, poles=poles,  # noqa: E731
                                     zeros=zeros, detrend="none")
+        if step_like(d.u + np.asarray(d.u_offset)):  # a step is never at its mean
+            return keep_better_without_detrending(model, refit, "identify tf",
+                                                  lambda m: float(np.mean(m.fit_percent)))
         _warn_if_detrending_hurt(model, refit, d.u.shape[0], d.dt, "identify tf")
     return model
 
@@ -456,8 +505,25 @@ def identify_arx(data: Trajectory, *, input, output, na: int, nb: int, nk: int =
     """MIMO ARX of the named columns (:func:`gripkit.sysid.linear.arx_mimo.arx_mimo`): a
     :class:`~gripkit.sysid.PolynomialModel` of matrix polynomials."""
     d = mimo_data(data, input, output, detrend, why="ARX identification")
-    return (arx_mimo(d.u, d.y, na, nb, nk, dt=d.dt, u_offset=d.u_offset, y_offset=d.y_offset,
-                     **d.signals))
+    model = arx_mimo(d.u, d.y, na, nb, nk, dt=d.dt, u_offset=d.u_offset, y_offset=d.y_offset,
+                     **d.signals)
+    if detrend == "mean" and step_like(d.u + np.asarray(d.u_offset)):  # never at its mean
+        refit = lambda: identify_arx(data, input=input, output=output, na=na,  # noqa: E731
+                                     nb=nb, nk=nk, detrend="none")
+        return keep_better_without_detrending(model, refit, "identify arx",
+                                              lambda m: compare_score(m, data))
+    return model
+
+
+def compare_score(model, data) -> float:
+    """The mean over the outputs of the fit of ``gripkit compare`` (:meth:`compare`: the model's
+    offsets, x0 by least squares) of ``model`` on the trajectory ``data``; −inf where it has
+    none (an unstable model, a record whose ‖y − ȳ‖ underflows)."""
+    try:
+        fits = model.compare(data).fit_percent
+    except DataError:
+        return -math.inf
+    return -math.inf if any(f is None for f in fits) else float(np.mean(fits))
 
 
 #: the options of method 'ss' with several records (``weighting``: the subspace method, n4sid,

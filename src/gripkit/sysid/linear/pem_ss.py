@@ -403,8 +403,15 @@ def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovatio
                                   "feedthrough": feedthrough}}
     return model.replace(system=sysn, structure=f"pem-{form}", K=K if innovation else None, x0=x0,
                          noise_covariance=e.T @ e / N,
-                         fit_percent=fit_per_output(y, free_run(A, B, C, D, u, x0)),
+                         fit_percent=_free_run_fit(A, B, C, D, u, y),
                          n_samples=N, info=info)
+
+
+def _free_run_fit(A, B, C, D, u, y) -> list[float]:
+    """The fit of :meth:`LinearModel.compare` (issue 23): the free run from the initial state
+    estimated by least squares for that free run, not the predictor's x0 (in innovation form the
+    predictor's x0 fits the one-step error and can leave the free run far off)."""
+    return fit_per_output(y, free_run(A, B, C, D, u, estimate_x0(A, B, C, D, u, y)))
 
 
 def _pem_data(model: LinearModel, data, u, y) -> tuple[np.ndarray, np.ndarray]:
@@ -628,7 +635,8 @@ def pem_records(model: LinearModel, records, *, form: str = "innovation",
     sysn = StateSpace(A, B, C, D, **ss._signals(meta={**ss.meta, "refined_by": f"pem-{form}"}),
                       states=ss.states, state_units=ss.state_units, uncertainty=unc)
     ys = [y for _, y in data]
-    yhats = [free_run(A, B, C, D, u, x0) for u, x0 in zip(us, x0s)]
+    # the free run from each record's least-squares x0 (the predictor's x0s serve the loss)
+    yhats = [free_run(A, B, C, D, u, estimate_x0(A, B, C, D, u, y)) for u, y in data]
     recs = [{"n_samples": int(y.shape[0]), "fit_percent": fit_per_output(y, yh), "x0": x0}
             for y, yh, x0 in zip(ys, yhats, x0s)]
     info = {**model.info, "records": recs, "n_records": R,

@@ -12,14 +12,18 @@ iterations
   delay would bias a continuous fit by several σ).
 * From time-domain data (``tfest(u, y, ...)``): the model is sampled with a zero-order hold
   between samples (the assumption of MATLAB's iddata, ``InterSample='zoh'``) and the output error
-  ``y − ŷ(θ)`` from rest is minimised, starting from the FRF fit of an H1 estimate of the data
-  (through the hold: from the better of the stabilised continuous fit and the d2c map of a
-  discrete Sanathanan-Koerner fit in z = e^{jωT}, which is exact on noise-free data).
+  ``y − ŷ(θ, x0)`` is minimised, x0 the least-squares initial state for the current θ (variable
+  projection, as :func:`tfest_records`; a record that starts away from rest, such as a step
+  record with its means removed, is not forced to start from rest), starting from the FRF fit
+  of an H1 estimate of the data (through the hold: from the better of the stabilised continuous
+  fit and the d2c map of a discrete Sanathanan-Koerner fit in z = e^{jωT}, which is exact on
+  noise-free data).
 
-Covariance ``σ̂² (JᵀJ)⁻¹`` (σ̂² = residual sum of squares / (N − dim θ)); σ of each coefficient and,
-for every complex pole pair p = −ζω_n ± jω_n√(1−ζ²), of the natural frequency ω_n = |p| and
-damping ζ = −Re p/|p|, by linearisation (the roots' derivatives with respect to θ by the implicit
-function theorem: ``∂p/∂a_i = −p^{np−i}/A'(p)``).
+Covariance ``σ̂² (JᵀJ)⁻¹`` (σ̂² = residual sum of squares / (N − dim θ − n_poles), the
+initial state counted); σ of each coefficient and, for every complex pole pair
+p = −ζω_n ± jω_n√(1−ζ²), of the natural frequency ω_n = |p| and damping ζ = −Re p/|p|, by
+linearisation (the roots' derivatives with respect to θ by the implicit function theorem:
+``∂p/∂a_i = −p^{np−i}/A'(p)``).
 """
 
 from __future__ import annotations
@@ -295,13 +299,13 @@ def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None,
         if np.any(np.roots(np.concatenate([[1.0], theta[:npo]])).real >= 0):
             return np.full(N, 1e3 * (np.abs(yy).max() + 1.0))
         Ad, Bd, Cd, Dd = _simulate_ct(theta, npo, nz, uu, step)
-        return yy - free_run(Ad, Bd, Cd, Dd, uu)[:, 0]
+        return yy - free_run(Ad, Bd, Cd, Dd, uu, estimate_x0(Ad, Bd, Cd, Dd, uu, y))[:, 0]
 
     sol = (optimize.least_squares(res, th0 / scale, method="trf", x_scale="jac", xtol=1e-10,
                                   ftol=1e-10))
     theta = sol.x * scale
     J = sol.jac / scale[None, :]
-    dof = N - k
+    dof = N - k - npo
     s2 = 2 * sol.cost / dof
     cov = _covariance(J, s2, "the data", "fewer poles/zeros or a richer input")
     Ad, Bd, Cd, Dd = _simulate_ct(theta, npo, nz, uu, step)
@@ -310,8 +314,8 @@ def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None,
     signals = (dict(inputs=inputs, outputs=outputs, input_units=input_units,
                     output_units=output_units))
     return _model(theta, 0.5 * (cov + cov.T), npo, nz, fit=fit, structure="tfest",
-                  info={"source": "time domain (zero-order hold, output "
-                                  "error from rest)", "nfev": int(sol.nfev)},
+                  info={"source": "time domain (zero-order hold, output error from the "
+                                  "least-squares initial state)", "nfev": int(sol.nfev)},
                   signals=signals, u_offset=u_offset, y_offset=y_offset, n=N)
 
 
