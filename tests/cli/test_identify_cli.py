@@ -158,7 +158,8 @@ def _csv(path, t, u, y):
     ("decreasing", r"DataError: time stamps must increase strictly; found decreasing time"),
     ("nonuniform", r"DataError: ARX identification needs uniform sampling"),
     ("short", r"DataError: ARX \[2 2 2\] .* needs at least 8 samples, found 6"),
-    ("constant", r"UnidentifiableError: input u is constant .* a constant input cannot identify B"),
+    ("constant", r"UnidentifiableError: input column .current. is constant \(0.85 for all 200 "
+                 r"samples\): a constant input cannot identify B"),
 ])
 def test_bad_data_is_one_line(capsys, tmp_path, case, pattern):
     n = 6 if case == "short" else 200

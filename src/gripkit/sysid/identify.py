@@ -33,7 +33,7 @@ import numpy as np
 from ..arguments import check_keywords, entry_point, keyword_names
 from ..errors import AccuracyWarning, ArgumentError, DataError, GripkitError, emit_warning
 from ..signals.trajectory import Trajectory
-from .checks import LINEAR_ORDERS
+from .checks import LINEAR_ORDERS, check_channels_vary
 from .io_data import IOData, io_data, records_provenance, validation_data
 from .linear import identify_mimo
 from .linear.armax import armax, armax_records
@@ -316,6 +316,7 @@ def _dispatch(data, method: str, *, input, output, na: int | None, nb: int | Non
     if method == "rls":
         from .linear.rls import rls  # numba: loaded only for an RLS fit
 
+        check_channels_vary(io.u1, io.y1, io.keywords)  # a constant column named, in its unit
         return rls(io.u1, io.y1, na, nb, nk, dt=io.dt, **options)
     if isinstance(options.get("validate"), Trajectory):  # around the estimation operating point
         vd = validation_data(options["validate"], io, detrend=detrend)

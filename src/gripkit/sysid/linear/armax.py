@@ -23,7 +23,7 @@ from ._pem import covariance, is_stable_poly, levenberg_marquardt, stabilize
 from ..scaling import in_user_units, unit_scale
 from .arx import (_arx, arx, arx_records, check_record_lengths, checked_records, records_summary,
                   scaled_records)
-from ..checks import check_dt, check_identifiable, check_order, checked_problem, require_samples
+from ..checks import check_channels_vary, check_dt, check_identifiable, check_order, checked_problem, require_samples
 from .polynomial import PolynomialModel, check_meta
 from ..regression import qr_solve
 from .validation import fit_percent, loss_vn
@@ -83,6 +83,7 @@ def armax(u, y, na: int, nb: int, nc: int, nk: int = 1, *, dt: float | None = No
     """
     check_meta(meta, armax)
     u, y, step, na, nb, nc, nk = checked_problem(u, y, dt, na=na, nb=nb, nc=nc, nk=nk)
+    check_channels_vary(u, y, meta)  # named in the user's units, before any scaling
     if nc == 0:
         return arx(u, y, na, nb, nk, dt=step, **meta)
     cu, cy = unit_scale(u), unit_scale(y)

@@ -1,0 +1,54 @@
+"""The command line's messages in the user's terms (an audit of its output): a constant column
+named with its value and unit, parameter names that the model has, significance statements that
+match their numbers, export hints that name the model family and the CLI's option, units in the
+printed summaries. Each case builds a small synthetic record in tmp_path."""
+
+import json
+
+import numpy as np
+import pytest
+
+from gripkit.cli import main
+
+
+def run(capsys, *args):
+    code = main([str(a) for a in args])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def _record(path, u, y, dt=0.01, header="time [s],current [A],force [N]", delimiter=","):
+    t = np.arange(len(u)) * dt
+    np.savetxt(path, np.column_stack([t, u, y]), delimiter=delimiter, header=header, comments="")
+    return path
+
+
+def _arx_data(n=400, seed=0):
+    """y(t) = 1.5 y(t-1) - 0.7 y(t-2) + 0.5 u(t-1) + 0.3 u(t-2) + e: an ARX [2 2 1] plant."""
+    rng = np.random.default_rng(seed)
+    u = rng.standard_normal(n)
+    y = np.zeros(n)
+    for k in range(2, n):
+        y[k] = 1.5 * y[k - 1] - 0.7 * y[k - 2] + 0.5 * u[k - 1] + 0.3 * u[k - 2]
+    return u, y + 0.01 * rng.standard_normal(n)
+
+
+@pytest.mark.parametrize("method", ["arx", "armax", "oe", "rls"])
+def test_constant_input_is_named_with_its_value_and_unit(capsys, tmp_path, method):
+    """current = 1 A throughout: the message names the column and gives 1 A (the mean that
+    detrending takes off added back), not 'input u ... 0'."""
+    _, y = _arx_data()
+    path = _record(tmp_path / "const.csv", np.ones(400), y)
+    code, out, err = run(capsys, "identify", method, path, "--input", "current",
+                         "--output", "force")
+    assert code != 0 and out == ""
+    assert "error: UnidentifiableError: input column 'current' is constant (1 A for all 400 " \
+           "samples)" in err
+
+
+def test_constant_output_is_named_with_its_value_and_unit(capsys, tmp_path):
+    u, _ = _arx_data()
+    path = _record(tmp_path / "const.csv", u, np.full(400, -2.5))
+    code, _, err = run(capsys, "identify", "arx", path, "--input", "current", "--output", "force")
+    assert code != 0
+    assert "output column 'force' is constant (-2.5 N for all 400 samples)" in err
