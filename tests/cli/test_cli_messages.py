@@ -3,8 +3,6 @@ named with its value and unit, parameter names that the model has, significance 
 match their numbers, export hints that name the model family and the CLI's option, units in the
 printed summaries. Each case builds a small synthetic record in tmp_path."""
 
-import json
-
 import numpy as np
 import pytest
 
@@ -52,3 +50,43 @@ def test_constant_output_is_named_with_its_value_and_unit(capsys, tmp_path):
     code, _, err = run(capsys, "identify", "arx", path, "--input", "current", "--output", "force")
     assert code != 0
     assert "output column 'force' is constant (-2.5 N for all 400 samples)" in err
+
+
+def _two_sines(n=2000, dt=0.01):
+    """A sum of two sines: persistently exciting of order 4 only (Ljung 1999, §13.2)."""
+    t = np.arange(n) * dt
+    return np.sin(2 * np.pi * 1.3 * t) + 0.5 * np.sin(2 * np.pi * 3.1 * t)
+
+
+@pytest.mark.parametrize("method,orders,label", [
+    ("armax", ("--na", 6, "--nb", 6), "ARMAX [6 6 1 1]"),
+    ("oe", ("--nf", 6, "--nb", 6), "OE [6 6 1]")])
+def test_poor_excitation_names_the_model_not_its_start(capsys, tmp_path, method, orders, label):
+    """Two sines cannot determine 6 B coefficients: the message names the model's structure and
+    the input column, not parameters of the internal start fit (ARMAX's long ARX has b1 … b39)."""
+    u = _two_sines()
+    y = np.convolve(u, [0.0, 0.5, 0.3])[:u.size] + 0.01 * np.random.default_rng(1).standard_normal(
+        u.size)
+    path = _record(tmp_path / "sines.csv", u, y)
+    code, _, err = run(capsys, "identify", method, path, "--input", "current", "--output", "force",
+                       *orders)
+    assert code != 0
+    assert f"UnidentifiableError: {label} (6 B coefficients): input column 'current' is not " \
+           f"persistently exciting of order 6" in err
+    assert "b39" not in err and "b7" not in err
+
+
+def test_armax_start_failure_names_the_model_and_the_stage(capsys, tmp_path):
+    """One sine excites order 2: ARMAX [2 2 1 1] passes the order check but its Hannan-Rissanen
+    start (a long ARX [15 15 1]) is not determined; the message says so, in the model's terms."""
+    t = np.arange(2000) * 0.01
+    u = np.sin(2 * np.pi * 1.3 * t)
+    y = np.convolve(u, [0.0, 0.5, 0.3])[:u.size] + 0.01 * np.random.default_rng(2).standard_normal(
+        u.size)
+    path = _record(tmp_path / "sine.csv", u, y)
+    code, _, err = run(capsys, "identify", "armax", path, "--input", "current", "--output",
+                       "force")
+    assert code != 0
+    assert "ARMAX [2 2 1 1]: the data do not determine the start values: the long ARX " \
+           "[15 15 1]" in err
+    assert "b15" not in err

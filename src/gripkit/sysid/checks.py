@@ -17,7 +17,7 @@ from .regression import COND_LIMIT, qr_r, scaled_condition
 
 __all__ = ["as_signal", "signal_array", "signal_with_peaks", "as_io_matrix", "io_records",
            "check_io", "check_io_peaks", "check_io_arrays", "check_order", "check_dt",
-           "require_samples", "check_excitation", "check_channels_vary",
+           "require_samples", "check_excitation", "check_channels_vary", "channel_of",
            "check_output_varies", "checked_problem", "checked_problem_peaks", "check_identifiable",
            "check_persistent_excitation", "check_dimension", "LENGTH_OR_ANGLE", "FORCE_OR_TORQUE",
            "LINEAR_ORDERS"]
@@ -228,7 +228,8 @@ def check_persistent_excitation(u: np.ndarray, order: int, what: str,
             f"{what}: {name} is not persistently exciting of order {order}: {order} copies of it "
             f"delayed by {tau} sample(s) are linearly dependent (condition number {cond:.3g} > "
             f"{COND_LIMIT:.0e}; a single sine determines only 2 parameters, m sines 2m); "
-            f"the {order} parameters of the model cannot all be determined; no estimate returned",
+            f"the data cannot determine {order} coefficients of the input-output dynamics; "
+            f"no estimate returned",
             hint="excite the system more richly (more frequencies than parameters: multisine, "
                  "PRBS, noise: gripkit.excitation) or use fewer poles/zeros")
 
@@ -264,7 +265,7 @@ def check_output_varies(y: np.ndarray, name: str = "output y",
                                   hint="check that the output column is the measured response")
 
 
-def _channel(meta: dict, role: str, symbol: str) -> tuple[str, float, str | None]:
+def channel_of(meta: dict, role: str, symbol: str) -> tuple[str, float, str | None]:
     """The label, offset and unit of the ``role`` (``'input'``/``'output'``) channel in the model
     keywords ``meta`` (``input_name``, ``u_offset``, ``input_unit`` …, or the lti spelling
     ``inputs``, ``input_units``); ``'input u'`` and no offset or unit when ``meta`` has none."""
@@ -287,9 +288,9 @@ def check_channels_vary(u: np.ndarray, y: np.ndarray, meta: dict,
     unscaled signals, the channels named by its model keywords ``meta``: a constant column is
     reported by its name, with its value (the detrending offset added back) in its unit.
     ``peaks``: ``((min u, max u), (min y, max y))`` when known."""
-    label, offset, unit = _channel(meta, "input", "u")
+    label, offset, unit = channel_of(meta, "input", "u")
     check_excitation(u, label, None if peaks is None else peaks[0], offset=offset, unit=unit)
-    label, offset, unit = _channel(meta, "output", "y")
+    label, offset, unit = channel_of(meta, "output", "y")
     check_output_varies(y, label, None if peaks is None else peaks[1], offset=offset, unit=unit)
 
 
