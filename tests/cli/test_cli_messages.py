@@ -3,6 +3,8 @@ named with its value and unit, parameter names that the model has, significance 
 match their numbers, export hints that name the model family and the CLI's option, units in the
 printed summaries. Each case builds a small synthetic record in tmp_path."""
 
+import re
+
 import numpy as np
 import pytest
 
@@ -90,3 +92,24 @@ def test_armax_start_failure_names_the_model_and_the_stage(capsys, tmp_path):
     assert "ARMAX [2 2 1 1]: the data do not determine the start values: the long ARX " \
            "[15 15 1]" in err
     assert "b15" not in err
+
+
+def test_growing_oscillation_is_called_growing_not_undamped(capsys, tmp_path):
+    """x = e^{+σt} cos(2π·10 t), ζ = -0.005, over 1 s: the envelope ends at e^{0.005·2π·10} =
+    136.9 % of its start. ζ lies far below 0 (by many σ): the message says that it grows and is
+    negative, not that it 'does not differ from 0'."""
+    t = np.arange(0.0, 1.0, 1e-3)
+    zeta, wn = -0.005, 2 * np.pi * 10
+    x = np.exp(-zeta * wn * t) * np.cos(wn * np.sqrt(1 - zeta**2) * t)
+    x += 1e-4 * np.random.default_rng(3).standard_normal(t.size)
+    path = tmp_path / "grow.csv"
+    np.savetxt(path, np.column_stack([t, x]), delimiter=",", header="time [s],position [um]",
+               comments="")
+    code, _, err = run(capsys, "identify", "modal", path, "--signal", "position")
+    assert code != 0
+    m = re.search(r"IdentificationError: free vibration: the envelope grows \(to ([\d.]+) % of its "
+                  r"start\): the fitted damping ratio ζ = (-[\d.e-]+) ± ([\d.e+-]+) ", err)
+    assert m, err
+    assert float(m[1]) == pytest.approx(136.9, abs=0.5)
+    assert float(m[2]) == pytest.approx(zeta, rel=0.01) and float(m[3]) < 0.01 * abs(zeta)
+    assert "is negative" in err and "does not differ" not in err
