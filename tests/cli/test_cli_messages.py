@@ -113,3 +113,22 @@ def test_growing_oscillation_is_called_growing_not_undamped(capsys, tmp_path):
     assert float(m[1]) == pytest.approx(136.9, abs=0.5)
     assert float(m[2]) == pytest.approx(zeta, rel=0.01) and float(m[3]) < 0.01 * abs(zeta)
     assert "is negative" in err and "does not differ" not in err
+
+
+@pytest.mark.parametrize("method,family", [
+    ("arx", "the ARX model carries no innovation gain K"),
+    ("oe", "the OE model has no noise model (an output-error model")])
+def test_kalman_export_without_k_names_the_family_and_the_noise_option(capsys, tmp_path, method,
+                                                                       family):
+    """An ARX is no output-error model: the message names the family, the sizes of Q and R
+    (the [2 2 1] model has 2 states, 1 output) and the CLI's option --noise, not the Python call."""
+    u, y = _arx_data()
+    data = _record(tmp_path / "d.csv", u, y)
+    model = tmp_path / f"{method}.json"
+    assert run(capsys, "identify", method, data, "--input", "current", "--output", "force",
+               "--out", model)[0] == 0
+    code, _, err = run(capsys, "export", "c", model, "--kind", "kalman", "--out", tmp_path / "c")
+    assert code != 0
+    assert f"error: ModelError: export c --kind kalman: {family}" in err
+    assert "noise covariances Q (2×2) and R (1×1); give them in a JSON file: --noise" in err
+    assert "KalmanFilter(" not in err
