@@ -132,3 +132,30 @@ def test_kalman_export_without_k_names_the_family_and_the_noise_option(capsys, t
     assert f"error: ModelError: export c --kind kalman: {family}" in err
     assert "noise covariances Q (2×2) and R (1×1); give them in a JSON file: --noise" in err
     assert "KalmanFilter(" not in err
+
+
+def _two_channel_record(path):
+    u, y = _arx_data()
+    rng = np.random.default_rng(5)
+    t = np.arange(u.size) * 0.01
+    np.savetxt(path, np.column_stack([t, u, rng.standard_normal(u.size), y, y + 0.1 * u]),
+               delimiter=",", header="time [s],current [A],voltage [V],force [N],force2 [N]",
+               comments="")
+    return path
+
+
+@pytest.mark.parametrize("method,ins,outs,found", [
+    ("oe", "current,voltage", "force", "2 input(s) 'current', 'voltage' and 1 output(s) 'force'"),
+    ("narx", "current,voltage", "force", "2 input(s) 'current', 'voltage'"),
+    ("armax", "current", "force,force2", "1 input(s) 'current' and 2 output(s) 'force', 'force2'"),
+    ("hysteresis", "current", "force,force2", "2 output(s) 'force', 'force2'")])
+def test_single_channel_family_given_two_columns(capsys, tmp_path, method, ins, outs, found):
+    """A family of one input and one output says so, with the columns given (not the internal
+    'IOData.u1: the SISO view', not "no column 'force,force2'")."""
+    path = _two_channel_record(tmp_path / "two.csv")
+    code, _, err = run(capsys, "identify", method, path, "--input", ins, "--output", outs)
+    assert code != 0
+    assert f"error: ArgumentError: identify {method}: this family takes one input and one " \
+           f"output column, found" in err and found in err
+    assert "the families that take several: ss, frf, tf, arx, nlss" in err
+    assert "SISO view" not in err and "no column" not in err

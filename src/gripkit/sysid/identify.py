@@ -34,7 +34,7 @@ from ..arguments import check_keywords, entry_point, keyword_names
 from ..errors import AccuracyWarning, ArgumentError, DataError, GripkitError, emit_warning
 from ..signals.trajectory import Trajectory
 from .checks import LINEAR_ORDERS, check_channels_vary
-from .io_data import IOData, io_data, records_provenance, validation_data
+from .io_data import IOData, io_data, parse_names, records_provenance, validation_data
 from .linear import identify_mimo
 from .linear.armax import armax, armax_records
 from .linear.arx import arx, arx_records
@@ -240,9 +240,32 @@ def identify(data: Trajectory, method: str = "arx", *, inputs: str | list[str] |
                                 f"{type(col).__name__} "
                                 f"{col!r:.40}", hint=f"columns: {', '.join(data.names)}"
                                 if isinstance(data, Trajectory) else None)
+    _check_single_channel(data, method, input, output)
     model = _dispatch(data, method, input=input, output=output, na=na, nb=nb, nk=nk, nc=nc, nf=nf,
                       detrend=detrend, **options)
     return with_provenance(model, records_provenance(data))
+
+
+#: the methods that take several input and output columns; the others take one of each
+SEVERAL_CHANNELS = ("ss", "frf", "tf", "arx", "nlss")
+
+
+def _check_single_channel(data, method: str, input, output) -> None:
+    """An ArgumentError, in the user's terms, when a method of one input and one output is given
+    several columns (``'a,b'``; a column whose own name holds the comma is left to the method)."""
+    if method in SEVERAL_CHANNELS:
+        return
+    first = data[0] if isinstance(data, (list, tuple)) and data else data
+    names = set(first.names) if isinstance(first, Trajectory) else set()
+    ins, outs = ((parse_names(c, role) if c not in names else (c,))
+                 for c, role in ((input, "input"), (output, "output")))
+    if len(ins) > 1 or len(outs) > 1:
+        raise ArgumentError(
+            f"identify {method}: this family takes one input and one output column, found "
+            f"{len(ins)} input(s) {', '.join(map(repr, ins))} and {len(outs)} output(s) "
+            f"{', '.join(map(repr, outs))}",
+            hint=f"give one column each to --input and --output; the families that take "
+                 f"several: {', '.join(SEVERAL_CHANNELS)}")
 
 
 def with_provenance(model, provenance: dict):
