@@ -3,6 +3,7 @@ named with its value and unit, parameter names that the model has, significance 
 match their numbers, export hints that name the model family and the CLI's option, units in the
 printed summaries. Each case builds a small synthetic record in tmp_path."""
 
+import json
 import re
 
 import numpy as np
@@ -159,3 +160,58 @@ def test_single_channel_family_given_two_columns(capsys, tmp_path, method, ins, 
            f"output column, found" in err and found in err
     assert "the families that take several: ss, frf, tf, arx, nlss" in err
     assert "SISO view" not in err and "no column" not in err
+
+
+def _good(path, n=300):
+    u, y = _arx_data(n)
+    return _record(path, u, y)
+
+
+def test_nan_in_a_second_record_or_the_validation_file_names_that_file(capsys, tmp_path):
+    good = _good(tmp_path / "good.csv")
+    u, y = _arx_data(300, seed=1)
+    y[50] = np.nan
+    bad = _record(tmp_path / "second.csv", u, y)
+    expected = "error: DataError: second.csv: column 'force' has 1 NaN values (first at t=0.5 s)"
+    for args in ((good, bad), (good, "--validate", bad)):
+        code, _, err = run(capsys, "identify", "arx", *args, "--input", "current",
+                           "--output", "force")
+        assert code != 0 and expected in err, err
+
+
+def test_text_cell_is_located_by_the_file_line_counting_the_header_and_comments(capsys, tmp_path):
+    """Data row 50 (0-based) lies on line 53: the header is line 1 and a comment line (skipped
+    by the reader) comes before it."""
+    lines = ["# logged by a test", "time [s],current [A],force [N]"]
+    lines += [f"{0.01 * k:.2f},1.0,{'abc' if k == 50 else k}" for k in range(100)]
+    path = tmp_path / "text.csv"
+    path.write_text("\n".join(lines) + "\n")
+    code, _, err = run(capsys, "identify", "arx", path, "--input", "current", "--output", "force")
+    assert code != 0
+    assert "column 'force' mixes numbers and text: line 53 of text.csv holds 'abc'" in err
+
+
+def test_undecodable_byte_is_named_at_its_offset_in_the_file(capsys, tmp_path):
+    """A Latin-1 'µ' (byte 0xb5) at offset 31 of the file (the end of the header line), which the
+    decoder's own message put at offset 10 (its place in the field 'force [N] µ')."""
+    path = tmp_path / "latin1.csv"
+    path.write_bytes(b"time [s],current [A],force [N] \xb5\n0.0,1.0,2.0\n0.01,2.0,3.0\n")
+    code, _, err = run(capsys, "identify", "arx", path, "--input", "current", "--output", "force")
+    assert code != 0
+    assert "error: DataError: latin1.csv: not UTF-8 text: byte 0xb5 at offset 31 (line 1)" in err
+
+
+def test_tab_separated_file_named_csv_is_read(capsys, tmp_path):
+    """A tab-separated file named .csv reads as a TSV: the same model as the comma file."""
+    u, y = _arx_data()
+    tab = _record(tmp_path / "tab.csv", u, y, header="time [s]\tcurrent [A]\tforce [N]",
+                  delimiter="\t")
+    comma = _record(tmp_path / "comma.csv", u, y)
+    fits = []
+    for path in (tab, comma):
+        code, out, err = run(capsys, "identify", "arx", path, "--input", "current", "--output",
+                             "force", "--json")
+        assert code == 0, err
+        fits.append(json.loads(out)["theta"])
+    assert fits[0] == fits[1]
+    assert fits[0] == pytest.approx([-1.5, 0.7, 0.5, 0.3], abs=0.01)  # _arx_data's plant
