@@ -215,3 +215,22 @@ def test_tab_separated_file_named_csv_is_read(capsys, tmp_path):
         fits.append(json.loads(out)["theta"])
     assert fits[0] == fits[1]
     assert fits[0] == pytest.approx([-1.5, 0.7, 0.5, 0.3], abs=0.01)  # _arx_data's plant
+
+
+@pytest.mark.parametrize("body,phrase", [
+    ('<link name="base"/><link name="l1"><inertial><mass value="abc"/></inertial></link>'
+     '<joint name="j" type="revolute"><parent link="base"/><child link="l1"/>'
+     '<axis xyz="0 0 1"/></joint>', "link 'l1' <mass>: value='abc' is not a number"),
+    ('<link name="base"', "the URDF is not well-formed XML")])
+def test_bad_urdf_names_the_file(capsys, tmp_path, body, phrase):
+    urdf = tmp_path / "finger.urdf"
+    urdf.write_text(f'<robot name="x">{body}</robot>' if body.endswith(">") else
+                    f'<robot name="x">{body}')
+    u, y = _arx_data(100)
+    log = tmp_path / "log.csv"
+    np.savetxt(log, np.column_stack([np.arange(100) * 0.01, u, y]), delimiter=",",
+               header="time [s],pos0 [rad],tau0 [N*m]", comments="")
+    code, _, err = run(capsys, "identify", "dynamics", urdf, log, "--position", "pos0",
+                       "--effort", "tau0")
+    assert code != 0
+    assert f"error: ModelError: URDF file 'finger.urdf': {phrase}" in err
