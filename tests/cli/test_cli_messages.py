@@ -234,3 +234,60 @@ def test_bad_urdf_names_the_file(capsys, tmp_path, body, phrase):
                        "--effort", "tau0")
     assert code != 0
     assert f"error: ModelError: URDF file 'finger.urdf': {phrase}" in err
+
+
+def _friction_log(path, J=2e-3, Fv=0.01, Fc=0.02, n=4000, dt=1e-3):
+    """q = 0.5 sin(2π·1.5 t) + 0.3 sin(2π·4 t) rad driven by τ = J q̈ + Fv q̇ + Fc sign(q̇)."""
+    t = np.arange(n) * dt
+    w1, w2 = 2 * np.pi * 1.5, 2 * np.pi * 4.0
+    q = 0.5 * np.sin(w1 * t) + 0.3 * np.sin(w2 * t)
+    qd = 0.5 * w1 * np.cos(w1 * t) + 0.3 * w2 * np.cos(w2 * t)
+    qdd = -0.5 * w1**2 * np.sin(w1 * t) - 0.3 * w2**2 * np.sin(w2 * t)
+    tau = J * qdd + Fv * qd + Fc * np.sign(qd)
+    np.savetxt(path, np.column_stack([t, q, tau]), delimiter=",",
+               header="time [s],q [rad],tau [N*m]", comments="")
+    return path
+
+
+@pytest.mark.parametrize("scale", ["-1", "0"])
+def test_non_positive_effort_scale_is_refused(capsys, tmp_path, scale):
+    """-1 printed units '(-1 N*s^2)/m' and a negative inertia, with no warning: refused now."""
+    path = _friction_log(tmp_path / "f.csv")
+    code, out, err = run(capsys, "identify", "friction", path, "--position", "q", "--effort",
+                         "tau", "--effort-scale", scale)
+    assert code != 0 and out == ""
+    assert f"error: DataError: --effort-scale: expected a finite positive factor, found " \
+           f"{float(scale)!r}" in err
+    assert "negate that column in the file" in err
+
+
+@pytest.mark.parametrize("method", ["arx", "armax", "oe"])
+def test_parameter_table_and_loss_carry_units(capsys, tmp_path, method):
+    """current [A] → force [N]: the b coefficients in N/A, a, c, f dimensionless ('1'), the loss
+    V_N and the FPE (mean squared errors of the output) in N^2."""
+    u, y = _arx_data()
+    path = _record(tmp_path / "d.csv", u, y)
+    code, out, err = run(capsys, "identify", method, path, "--input", "current", "--output",
+                         "force")
+    assert code == 0, err
+    rows = {cells[0]: cells for cells in
+            ([c.strip() for c in line.split("│")[1:-1]] for line in out.splitlines()
+             if line.startswith("│"))}
+    assert rows["b1"][3] == "N/A" and rows["b2"][3] == "N/A"
+    other = "a1" if method != "oe" else "f1"
+    assert rows[other][3] == "1"
+    assert re.search(r"loss V_N \(eq 29\) = [\d.e-]+ N\^2 .*FPE = [\d.e-]+ N\^2", out, re.S), out
+
+
+def test_transfer_function_coefficients_carry_units(capsys, tmp_path):
+    """G(s) = (n1 s + n0)/(s² + d1 s + d0) from current [A] to force [N]: n1 in N/(A*s), n0 in
+    N/(A*s^2), d1 in 1/s, d0 in 1/s^2, the monic 1 without a unit."""
+    u, y = _arx_data()
+    path = _record(tmp_path / "d.csv", u, y)
+    code, out, err = run(capsys, "identify", "tf", path, "--input", "current", "--output",
+                         "force", "--poles", 2, "--zeros", 1)
+    assert code == 0, err
+    assert re.search(r"num: [\d.e+-]+±[\d.e+-]+ N/\(A\*s\), [\d.e+-]+±[\d.e+-]+ N/\(A\*s\^2\)$",
+                     out, re.M), out
+    assert re.search(r"den: 1±0, [\d.e+-]+±[\d.e+-]+ 1/s, [\d.e+-]+±[\d.e+-]+ 1/s\^2$", out,
+                     re.M), out

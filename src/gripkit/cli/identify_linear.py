@@ -22,6 +22,7 @@ import typer
 from .app import identify_app
 from ..errors import emit_warning
 from ..sysid.checks import LINEAR_ORDERS
+from ..units import product_unit
 from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_choice, check_data_options,
                      check_number, collected_warnings, emit_json, finish_json, report_warnings)
 from .identify_common import (DataArg, DataArgs, ModelOutOpt, ReportOpt, ValidateOpt,
@@ -120,21 +121,28 @@ def _echo_written(out_file: Path | None, report: Path | None) -> None:
         typer.echo(f"report written to {report}")
 
 
+def _unit_suffix(unit: str | None) -> str:
+    """``' N^2'`` after a printed value, nothing for a dimensionless one."""
+    return "" if unit in (None, "", "1") else f" {unit}"
+
+
 def _print_model(model, val, vfit: float | None = None) -> None:
     from rich.console import Console
     from rich.table import Table
 
     con = Console()
-    t = Table("parameter", "value", "σ", title=f"{model.label}  ({model.input_name} → "
-                                               f"{model.output_name}, "
-                                               f"fs = {1.0 / model.dt:g} Hz, N = "
-                                               f"{model.n_samples})")
+    t = Table("parameter", "value", "σ", "unit", title=f"{model.label}  ({model.input_name} → "
+                                                       f"{model.output_name}, "
+                                                       f"fs = {1.0 / model.dt:g} Hz, N = "
+                                                       f"{model.n_samples})")
     std = model.theta_std
+    units = {n: p.unit for n, p in model.parameters.items()}  # SI, as the values are
     for i, (n, v) in enumerate(zip(model.parameter_names, model.theta)):
-        t.add_row(n, f"{v:.6g}", "—" if std is None else f"{std[i]:.3g}")
+        t.add_row(n, f"{v:.6g}", "—" if std is None else f"{std[i]:.3g}", units.get(n, ""))
     con.print(t)
-    con.print(f"loss V_N (eq 29) = {model.loss:.6g}   fit (1-step) = {model.fit_percent:.2f} %   "
-              f"AIC = {model.aic:.6g}   FPE = {model.fpe:.6g}")
+    squared = _unit_suffix(product_unit((model.output_unit, 2)))  # mean squared errors
+    con.print(f"loss V_N (eq 29) = {model.loss:.6g}{squared}   fit (1-step) = "
+              f"{model.fit_percent:.2f} %   AIC = {model.aic:.6g}   FPE = {model.fpe:.6g}{squared}")
     fmt = lambda z: ", ".join(f"{v.real:.4g}{v.imag:+.4g}j" for v in z) or "none"  # noqa: E731
     con.print(f"poles: {fmt(model.poles())}   ({'stable' if model.stable else 'UNSTABLE'})")
     con.print(f"zeros: {fmt(model.zeros())}   "
