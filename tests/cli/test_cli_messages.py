@@ -291,3 +291,23 @@ def test_transfer_function_coefficients_carry_units(capsys, tmp_path):
                      out, re.M), out
     assert re.search(r"den: 1±0, [\d.e+-]+±[\d.e+-]+ 1/s, [\d.e+-]+±[\d.e+-]+ 1/s\^2$", out,
                      re.M), out
+
+
+def test_rls_without_sigma_says_why(capsys, tmp_path):
+    """λ = 0.5 keeps 1/(1 − λ) = 2 effective samples, fewer than the 4 parameters of ARX [2 2 1]:
+    σ̂² = V/(w₁ − p) is undefined; the summary and the JSON say so, and that λ > 1 − 1/4 = 0.75
+    gives σ (λ = 0.8: 5 effective samples, σ shown)."""
+    u, y = _arx_data()
+    path = _record(tmp_path / "d.csv", u, y)
+    args = ("identify", "rls", path, "--input", "current", "--output", "force", "--forgetting")
+    code, out, err = run(capsys, *args, 0.5)
+    assert code == 0, err
+    assert "σ —: the forgetting factor λ = 0.5 keeps about 2 effective samples" in \
+        " ".join(out.split())
+    assert "choose --forgetting above 0.75 for σ" in " ".join(out.split())
+    code, out, _ = run(capsys, *args, 0.5, "--json")
+    d = json.loads(out)
+    assert d["theta_std_final"] is None and "not more than the 4 parameters" in d["theta_std_note"]
+    code, out, _ = run(capsys, *args, 0.8, "--json")
+    d = json.loads(out)
+    assert len(d["theta_std_final"]) == 4 and "theta_std_note" not in d

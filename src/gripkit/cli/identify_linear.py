@@ -325,6 +325,8 @@ def identify_rls(data: Path = DataArg, input: str = InputOpt, output: str = Outp
     out.update(data=str(data), detrend=detrend, input=input, output=output,
                trajectory=None if trajectory is None else str(trajectory),
                warnings=report_warnings(caught))
+    if res.theta_std_final is None:
+        out["theta_std_note"] = _no_sigma_reason(res, forgetting)
     if json_out:
         emit_json(out)
         return
@@ -340,8 +342,26 @@ def identify_rls(data: Path = DataArg, input: str = InputOpt, output: str = Outp
     con = Console()
     con.print(t)
     con.print(f"loss V_N of the a-priori errors (eq 29) = {res.loss:.6g}")
+    if std is None:
+        con.print(out["theta_std_note"], markup=False, highlight=False)
     if trajectory is not None:
         con.print(f"parameter trajectory written to {trajectory}")
+
+
+def _no_sigma_reason(res, forgetting: float) -> str:
+    """Why an RLS result has no σ: σ̂² divides the weighted squared errors by w₁ − p, w₁ the
+    effective sample count (λ^k-weighted updates, 1/(1 − λ) in the limit), so it needs w₁ > p."""
+    p = len(res.names)
+    updates = res.n_samples - res.first_update
+    lam = float(forgetting)
+    w1 = updates if lam == 1.0 else (1.0 - lam ** updates) / (1.0 - lam)
+    text = (f"σ —: the forgetting factor λ = {lam:g} keeps about {w1:.3g} effective samples "
+            f"(1/(1 − λ)), not more than the {p} parameters: too few to estimate the noise "
+            f"variance that σ rests on")
+    if lam < 1.0 and 1.0 / (1.0 - lam) <= p:
+        return f"{text}; choose --forgetting above {1.0 - 1.0 / p:.4g} for σ"
+    return (f"σ —: {updates} update(s), about {w1:.3g} effective samples, not more than the {p} "
+            f"parameters: too few to estimate the noise variance that σ rests on")
 
 
 @identify_app.command("search")
