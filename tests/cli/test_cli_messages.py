@@ -34,7 +34,7 @@ def _arx_data(n=400, seed=0):
     return u, y + 0.01 * rng.standard_normal(n)
 
 
-@pytest.mark.parametrize("method", ["arx", "armax", "oe", "rls"])
+@pytest.mark.parametrize("method", ["arx", "armax", "oe", "rls", "narx", "hw"])
 def test_constant_input_is_named_with_its_value_and_unit(capsys, tmp_path, method):
     """current = 1 A throughout: the message names the column and gives 1 A (the mean that
     detrending takes off added back), not 'input u ... 0'."""

@@ -311,11 +311,13 @@ def _dispatch(data, method: str, *, input, output, na: int | None, nb: int | Non
         return _method_function(method)(data, input=input, output=output, **options)
     if method == "narx":  # the model's constant term carries the operating point
         io = io_data(data, input=input, output=output, detrend="none", why="NARX identification")
+        check_channels_vary(io.u1, io.y1, io.keywords)  # a constant column named, in its unit
         model = _method_function(method)(io.u1, io.y1, dt=io.dt, **_validation_arrays(options, io))
         return _with_channels(model, io)
     if method == "hw":  # the offset y0 carries the operating point; orders not given: chosen
         io = io_data(data, input=input, output=output, detrend="none",
                      why="Hammerstein-Wiener identification")
+        check_channels_vary(io.u1, io.y1, io.keywords)
         model = _method_function(method)(io.u1, io.y1, nb=nb, nf=nf, nk=nk, dt=io.dt,
                                          **_validation_arrays(options, io))
         return _with_channels(model, io)
