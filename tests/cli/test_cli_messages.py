@@ -261,10 +261,10 @@ def test_non_positive_effort_scale_is_refused(capsys, tmp_path, scale):
     assert "negate that column in the file" in err
 
 
-@pytest.mark.parametrize("method", ["arx", "armax", "oe"])
+@pytest.mark.parametrize("method", ["arx", "armax", "oe", "rls"])
 def test_parameter_table_and_loss_carry_units(capsys, tmp_path, method):
     """current [A] → force [N]: the b coefficients in N/A, a, c, f dimensionless ('1'), the loss
-    V_N and the FPE (mean squared errors of the output) in N^2."""
+    V_N and the FPE (mean squared errors of the output) in N^2 (RLS: no FPE)."""
     u, y = _arx_data()
     path = _record(tmp_path / "d.csv", u, y)
     code, out, err = run(capsys, "identify", method, path, "--input", "current", "--output",
@@ -276,6 +276,10 @@ def test_parameter_table_and_loss_carry_units(capsys, tmp_path, method):
     assert rows["b1"][3] == "N/A" and rows["b2"][3] == "N/A"
     other = "a1" if method != "oe" else "f1"
     assert rows[other][3] == "1"
+    if method == "rls":
+        assert re.search(r"loss V_N of the a-priori errors \(eq 29\) = [\d.e-]+ N\^2$", out,
+                         re.M), out
+        return
     assert re.search(r"loss V_N \(eq 29\) = [\d.e-]+ N\^2 .*FPE = [\d.e-]+ N\^2", out, re.S), out
 
 

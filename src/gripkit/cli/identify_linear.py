@@ -333,15 +333,18 @@ def identify_rls(data: Path = DataArg, input: str = InputOpt, output: str = Outp
     from rich.console import Console
     from rich.table import Table
 
-    t = Table("parameter", "final value", "σ", title=f"RLS ARX [{na} {nb} {nk}], λ = "
-                                                     f"{forgetting:g}, "
-                                                      f"N = {res.n_samples}")
+    t = Table("parameter", "final value", "σ", "unit", title=f"RLS ARX [{na} {nb} {nk}], λ = "
+                                                             f"{forgetting:g}, "
+                                                             f"N = {res.n_samples}")
     std = res.theta_std_final
+    units = {n: p.unit for n, p in res.model.parameters.items()}
     for i, n in enumerate(res.names):
-        t.add_row(n, f"{res.theta_final[i]:.6g}", "—" if std is None else f"{std[i]:.3g}")
+        t.add_row(n, f"{res.theta_final[i]:.6g}", "—" if std is None else f"{std[i]:.3g}",
+                  units.get(n, ""))
     con = Console()
     con.print(t)
-    con.print(f"loss V_N of the a-priori errors (eq 29) = {res.loss:.6g}")
+    squared = _unit_suffix(product_unit((res.model.output_unit, 2)))
+    con.print(f"loss V_N of the a-priori errors (eq 29) = {res.loss:.6g}{squared}")
     if std is None:
         con.print(out["theta_std_note"], markup=False, highlight=False)
     if trajectory is not None:

@@ -25,6 +25,7 @@ would otherwise bias every coefficient).
 from __future__ import annotations
 
 import copy
+import dataclasses
 import math
 import warnings
 
@@ -342,7 +343,9 @@ def _dispatch(data, method: str, *, input, output, na: int | None, nb: int | Non
         from .linear.rls import rls  # numba: loaded only for an RLS fit
 
         check_channels_vary(io.u1, io.y1, io.keywords)  # a constant column named, in its unit
-        return rls(io.u1, io.y1, na, nb, nk, dt=io.dt, **options)
+        res = rls(io.u1, io.y1, na, nb, nk, dt=io.dt, **options)
+        named = {k: v for k, v in io.keywords.items() if not k.endswith("_offset")}
+        return dataclasses.replace(res, model=res.model.replace(**named))  # the units of θ
     if isinstance(options.get("validate"), Trajectory):  # around the estimation operating point
         vd = validation_data(options["validate"], io, detrend=detrend)
         options = {**options, "validate": (vd.u1, vd.y1)}
