@@ -74,7 +74,7 @@ def test_missing_urdf(cli, tmp_path):
      "--velocity: 1 column(s)"),
     (OK + ["--gravity", "0,0"], "ConfigError", "--gravity: expected three comma-separated numbers"),
     (OK + ["--effort-scale", "0"], "DataError", "--effort-scale: expected a finite "
-                                                "non-zero factor"),
+                                                "positive factor, found 0.0"),
     (OK + ["--friction", "lugre"], "DataError", "friction: expected one of none, coulomb-viscous"),
     (OK + ["--cutoff", "900"], "DataError", "cutoff 900 Hz must lie between 0 and the Nyquist "
                                             "frequency 500 Hz"),

@@ -165,7 +165,7 @@ def test_cli_fill_banana_on_clean_data_is_refused(cli, clean_csv):
     (("friction", "--position", "u", "--effort", "y", "--cutoff", -5), "--cutoff: expected a "
                                                                        "finite number > 0"),
     (("friction", "--position", "u", "--effort", "y", "--effort-scale", 0),
-     "--effort-scale: expected a finite number, not zero"),
+     "--effort-scale: expected a finite positive factor, found 0.0"),
 ])
 def test_cli_every_identify_option_is_checked_before_the_data(cli, tmp_path, args, phrase):
     """The data file does not exist: the option error must come first (it would otherwise be

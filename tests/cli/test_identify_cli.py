@@ -153,12 +153,14 @@ def _csv(path, t, u, y):
 
 
 @pytest.mark.parametrize("case,pattern", [
-    ("nan", r"DataError: column 'force' has 1 NaN values \(first at t=0.05 s\)"),
-    ("repeated", r"DataError: time stamps must increase strictly; found repeated time"),
-    ("decreasing", r"DataError: time stamps must increase strictly; found decreasing time"),
+    ("nan", r"DataError: nan.csv: column .force. has 1 NaN values \(first at t=0.05 s\)"),
+    ("repeated", r"DataError: repeated.csv: time stamps must increase strictly; found repeated"),
+    ("decreasing", r"DataError: decreasing.csv: time stamps must increase strictly; found "
+                   r"decreasing time"),
     ("nonuniform", r"DataError: ARX identification needs uniform sampling"),
     ("short", r"DataError: ARX \[2 2 2\] .* needs at least 8 samples, found 6"),
-    ("constant", r"UnidentifiableError: input u is constant .* a constant input cannot identify B"),
+    ("constant", r"UnidentifiableError: input column .current. is constant \(0.85 for all 200 "
+                 r"samples\): a constant input cannot identify B"),
 ])
 def test_bad_data_is_one_line(capsys, tmp_path, case, pattern):
     n = 6 if case == "short" else 200

@@ -53,7 +53,9 @@ def test_missing_column_lists_available(tmp_path, traj):
 def test_mixed_types(tmp_path):
     p = tmp_path / "d.csv"
     p.write_text("t,y\n0,1\n1,abc\n2,3\n")
-    with pytest.raises(DataError, match="column 'y' mixes numbers and text: row 1 holds 'abc'"):
+    # the cell's line in the file, the header counted (line 3, not data row 1)
+    with pytest.raises(DataError, match="column 'y' mixes numbers and text: line 3 of d.csv "
+                                        "holds 'abc'"):
         load(p)
 
 

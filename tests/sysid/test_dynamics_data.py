@@ -44,5 +44,5 @@ def test_bad_logs_are_refused():
     with pytest.raises(DataError, match=r"position: 1 column\(s\) \['p0'\] for the 2 actuated "
                                         r"joints j0, j1"):
         dynamics_data(_log(), ["j0", "j1"], ["p0"], ["e0", "e1"])
-    with pytest.raises(DataError, match="effort_scale: expected a finite non-zero factor"):
+    with pytest.raises(DataError, match="effort_scale: expected a finite positive factor"):
         dynamics_data(_log(), ["j0", "j1"], ["p0", "p1"], ["e0", "e1"], effort_scale=0.0)

@@ -166,8 +166,8 @@ def test_cli_bad_urdf_one_line(tmp_path, capsys):
                    '<parent link="a"/><child link="b"/></joint></robot>')
     code = main(["excitation", "fourier", str(bad), "--out", str(tmp_path / "x.csv")])
     err = capsys.readouterr().err.strip().splitlines()
-    assert code == 1 and err == ["error: ModelError: joint 'j' has type 'floating', which gripkit "
-                                 "does not support"
+    assert code == 1 and err == ["error: ModelError: URDF file 'bad.urdf': joint 'j' has type "
+                                 "'floating', which gripkit does not support"
                                  "; gripkit builds serial chains of revolute, continuous, "
                                  "prismatic and fixed joints"]
 

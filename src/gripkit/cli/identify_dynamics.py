@@ -26,7 +26,8 @@ import numpy as np
 import typer
 
 from .app import identify_app
-from .common import FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, load_data, report_warnings
+from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_effort_scale, emit_json, load_data,
+                     report_warnings)
 from .identify_common import ModelOutOpt, ReportOpt, check_outputs
 
 
@@ -138,16 +139,13 @@ def identify_dynamics_cmd(
     report: Path = ReportOpt,
 ):
     """Identify the base inertial parameters and the friction of every joint of a URDF chain."""
-    from ..errors import DataError
     from ..multibody import from_urdf
     from ..sysid.io_data import records_provenance
     from ..sysid.rigid_body.dynamics import identify_dynamics
     from ..sysid.rigid_body.dynamics_data import dynamics_data
 
     check_outputs(out, report, [urdf, data])
-    if not (np.isfinite(effort_scale) and effort_scale != 0):
-        raise DataError("--effort-scale: expected a finite non-zero factor, found "
-                        f"{effort_scale!r}")
+    check_effort_scale(effort_scale)
     chain = (from_urdf(urdf, base_link=base_link, tip_link=tip_link,
                        gravity=_vector("--gravity", gravity)))
     joints = chain.joint_names

@@ -16,7 +16,8 @@ from pathlib import Path
 import typer
 
 from .app import identify_app
-from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, check_number,
+from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, check_effort_scale,
+                     check_number,
                      collected_warnings, emit_json, load_data, report_warnings)
 
 
@@ -64,7 +65,7 @@ def identify_friction(
     from ..sysid.rigid_body.friction import idim_ls
 
     check_data_options(fs, fill)
-    check_number(effort_scale, "--effort-scale", nonzero=True)
+    check_effort_scale(effort_scale)
     check_number(cutoff, "--cutoff", above=0)
     check_number(decimate, "--decimate", minimum=1, integer=True)
     check_number(velocity_threshold, "--velocity-threshold", minimum=0)

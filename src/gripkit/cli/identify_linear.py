@@ -22,6 +22,7 @@ import typer
 from .app import identify_app
 from ..errors import emit_warning
 from ..sysid.checks import LINEAR_ORDERS
+from ..units import product_unit
 from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_choice, check_data_options,
                      check_number, collected_warnings, emit_json, finish_json, report_warnings)
 from .identify_common import (DataArg, DataArgs, ModelOutOpt, ReportOpt, ValidateOpt,
@@ -134,21 +135,28 @@ def _echo_written(out_file: Path | None, report: Path | None) -> None:
         typer.echo(f"report written to {report}")
 
 
+def _unit_suffix(unit: str | None) -> str:
+    """``' N^2'`` after a printed value, nothing for a dimensionless one."""
+    return "" if unit in (None, "", "1") else f" {unit}"
+
+
 def _print_model(model, val, vfit: float | None = None, free: float | None | bool = False) -> None:
     from rich.console import Console
     from rich.table import Table
 
     con = Console()
-    t = Table("parameter", "value", "σ", title=f"{model.label}  ({model.input_name} → "
-                                               f"{model.output_name}, "
-                                               f"fs = {1.0 / model.dt:g} Hz, N = "
-                                               f"{model.n_samples})")
+    t = Table("parameter", "value", "σ", "unit", title=f"{model.label}  ({model.input_name} → "
+                                                       f"{model.output_name}, "
+                                                       f"fs = {1.0 / model.dt:g} Hz, N = "
+                                                       f"{model.n_samples})")
     std = model.theta_std
+    units = {n: p.unit for n, p in model.parameters.items()}  # SI, as the values are
     for i, (n, v) in enumerate(zip(model.parameter_names, model.theta)):
-        t.add_row(n, f"{v:.6g}", "—" if std is None else f"{std[i]:.3g}")
+        t.add_row(n, f"{v:.6g}", "—" if std is None else f"{std[i]:.3g}", units.get(n, ""))
     con.print(t)
-    con.print(f"loss V_N (eq 29) = {model.loss:.6g}   fit (1-step) = {model.fit_percent:.2f} %   "
-              f"AIC = {model.aic:.6g}   FPE = {model.fpe:.6g}")
+    squared = _unit_suffix(product_unit((model.output_unit, 2)))  # mean squared errors
+    con.print(f"loss V_N (eq 29) = {model.loss:.6g}{squared}   fit (1-step) = "
+              f"{model.fit_percent:.2f} %   AIC = {model.aic:.6g}   FPE = {model.fpe:.6g}{squared}")
     if free is not False:  # one record: the fit `gripkit compare` reports on it
         con.print("free-run fit (estimation data, as gripkit compare) = "
                   + (f"{free:.2f} %" if free is not None else "— (unstable model)"
@@ -335,23 +343,46 @@ def identify_rls(data: Path = DataArg, input: str = InputOpt, output: str = Outp
     out.update(data=str(data), detrend=detrend, input=input, output=output,
                trajectory=None if trajectory is None else str(trajectory),
                warnings=report_warnings(caught))
+    if res.theta_std_final is None:
+        out["theta_std_note"] = _no_sigma_reason(res, forgetting)
     if json_out:
         emit_json(out)
         return
     from rich.console import Console
     from rich.table import Table
 
-    t = Table("parameter", "final value", "σ", title=f"RLS ARX [{na} {nb} {nk}], λ = "
-                                                     f"{forgetting:g}, "
-                                                      f"N = {res.n_samples}")
+    t = Table("parameter", "final value", "σ", "unit", title=f"RLS ARX [{na} {nb} {nk}], λ = "
+                                                             f"{forgetting:g}, "
+                                                             f"N = {res.n_samples}")
     std = res.theta_std_final
+    units = {n: p.unit for n, p in res.model.parameters.items()}
     for i, n in enumerate(res.names):
-        t.add_row(n, f"{res.theta_final[i]:.6g}", "—" if std is None else f"{std[i]:.3g}")
+        t.add_row(n, f"{res.theta_final[i]:.6g}", "—" if std is None else f"{std[i]:.3g}",
+                  units.get(n, ""))
     con = Console()
     con.print(t)
-    con.print(f"loss V_N of the a-priori errors (eq 29) = {res.loss:.6g}")
+    squared = _unit_suffix(product_unit((res.model.output_unit, 2)))
+    con.print(f"loss V_N of the a-priori errors (eq 29) = {res.loss:.6g}{squared}")
+    if std is None:
+        con.print(out["theta_std_note"], markup=False, highlight=False)
     if trajectory is not None:
         con.print(f"parameter trajectory written to {trajectory}")
+
+
+def _no_sigma_reason(res, forgetting: float) -> str:
+    """Why an RLS result has no σ: σ̂² divides the weighted squared errors by w₁ − p, w₁ the
+    effective sample count (λ^k-weighted updates, 1/(1 − λ) in the limit), so it needs w₁ > p."""
+    p = len(res.names)
+    updates = res.n_samples - res.first_update
+    lam = float(forgetting)
+    w1 = updates if lam == 1.0 else (1.0 - lam ** updates) / (1.0 - lam)
+    text = (f"σ —: the forgetting factor λ = {lam:g} keeps about {w1:.3g} effective samples "
+            f"(1/(1 − λ)), not more than the {p} parameters: too few to estimate the noise "
+            f"variance that σ rests on")
+    if lam < 1.0 and 1.0 / (1.0 - lam) <= p:
+        return f"{text}; choose --forgetting above {1.0 - 1.0 / p:.4g} for σ"
+    return (f"σ —: {updates} update(s), about {w1:.3g} effective samples, not more than the {p} "
+            f"parameters: too few to estimate the noise variance that σ rests on")
 
 
 @identify_app.command("search")

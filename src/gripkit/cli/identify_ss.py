@@ -222,6 +222,20 @@ def identify_frf_cmd(data: Path = DataArg, input: str = InputsOpt, output: str =
                    f"phase {np.degrees(np.angle(h)):7.1f}°  σ {s:.2g}")
 
 
+def _coefficients(model, which: str, values, stds, poles: int) -> str:
+    """``'9.25±0.28 N/(A*s), …'``: the coefficients of ``which`` (``'num'``/``'den'``, highest
+    power of s first; the numerator's leading zeros left out) with their σ and SI unit, from the
+    model's parameters (``num_0_0_k``: the coefficient of s^(poles−k)); none on a dimensionless
+    one (the monic denominator's 1)."""
+    units = {n: p.unit for n, p in model.parameters.items()}
+    first = poles + 1 - len(values)
+    out = []
+    for i, (v, s) in enumerate(zip(values, stds)):
+        unit = units.get(f"{which}_0_0_{first + i}", "1")
+        out.append(f"{v:.6g}±{s:.2g}" + ("" if unit in ("", "1") else f" {unit}"))
+    return ", ".join(out)
+
+
 @identify_app.command("tf")
 def identify_tf_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output: str = OutputsOpt,
                     poles: int = typer.Option(..., "--poles", help="Number of poles."),
@@ -260,11 +274,10 @@ def identify_tf_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
     if json_out:
         emit_json(res)
         return
-    fmt = lambda v, s: " ".join(f"{a:.6g}±{b:.2g}" for a, b in zip(v, s))  # noqa: E731
     typer.echo(f"G(s) = num/den, {poles} pole(s), {zeros} zero(s); free-run fit "
                f"{model.fit_percent[0]:.2f} %")
-    typer.echo(f"  num: {fmt(res['num'], res['num_std'])}")
-    typer.echo(f"  den: {fmt(res['den'], res['den_std'])}")
+    typer.echo(f"  num: {_coefficients(model, 'num', res['num'], res['num_std'], poles)}")
+    typer.echo(f"  den: {_coefficients(model, 'den', res['den'], res['den_std'], poles)}")
     for f, sf, z, sz in zip(res["natural_frequency_hz"], res["natural_frequency_hz_std"],
                             res["damping_ratio"],
                             res["damping_ratio_std"]):

@@ -36,7 +36,7 @@ import numpy as np
 
 from ..errors import ArgumentError, DataError, ModelError
 from ..estimation import KalmanFilter
-from ..estimation.kalman import predicted_state
+from ..estimation.kalman import predicted_state, without_innovation_gain
 from ..estimation.packed import block_offsets, block_starts
 from .linear_quadratic import lqr
 
@@ -144,8 +144,8 @@ class LQG:
             raise ArgumentError(f"LQG: estimate must be 'filtered' or 'predicted', found "
                                 f"{estimate!r}")
         if Qn is None and Rn is None and getattr(model, "K", None) is None:
-            raise ModelError("LQG: the model has no innovation gain K (an output-error model); "
-                             "give the noise covariances Qn and Rn",
+            raise ModelError(f"LQG: {without_innovation_gain(model)}; give the noise "
+                             f"covariances Qn and Rn",
                              hint="LQG(model, Q, R, Qn=Qn, Rn=Rn)")
         kf = KalmanFilter(model, Q=Qn, R=Rn, steady_state=True, dt=dt)
         A, B, C, D = (np.array(M) for M in (kf.A, kf.B, kf.C, kf.D))

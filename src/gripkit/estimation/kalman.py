@@ -346,6 +346,22 @@ def kf_run_packed(dims, par, st, U, Y, xs, Ps, es, Ss):  # pragma: no cover - co
     return 0, U.shape[0]
 
 
+#: the families whose model has no noise model at all (y = G u + e)
+_OUTPUT_ERROR = ("oe", "pem-oe", "tfest", "step")
+
+
+def without_innovation_gain(model) -> str:
+    """Why ``model`` (whose ``K`` is None) gives the filter no noise model, naming its family:
+    an output-error family has none; another (ARX, ARMAX, a subspace model saved without K)
+    keeps only its input-output part B/A in the state-space form that the filter uses."""
+    family = str(getattr(model, "structure", None) or getattr(model, "method", "") or "linear")
+    label = family.upper() if family in ("arx", "armax", "oe") else family
+    if family in _OUTPUT_ERROR:
+        return f"the {label} model has no noise model (an output-error model: no innovation gain K)"
+    return (f"the {label} model carries no innovation gain K in the state-space form that the "
+            f"filter uses (that form holds its input-output dynamics only)")
+
+
 class KalmanFilter:
     """The Kalman filter of an identified linear model (module docstring).
 
@@ -432,8 +448,8 @@ class KalmanFilter:
         """(Q, R, S) as given, or the innovation form's ``K Λ Kᵀ, Λ, K Λ``."""
         if Q is None and R is None:
             if getattr(model, "K", None) is None:
-                raise ModelError("KalmanFilter: the model has no innovation gain K (an "
-                                 "output-error model); give the noise covariances Q and R",
+                raise ModelError(f"KalmanFilter: {without_innovation_gain(model)}; give the "
+                                 f"noise covariances Q and R",
                                  hint="KalmanFilter(model, Q=Q, R=R)")
             lam = (np.eye(p) if getattr(model, "noise_covariance", None) is None
                    else np.asarray(model.noise_covariance, float))

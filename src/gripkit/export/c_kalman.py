@@ -29,6 +29,7 @@ import numpy as np
 
 from ..errors import DataError, ModelError, PathError
 from ..estimation import KalmanFilter
+from ..estimation.kalman import without_innovation_gain
 from .c_code import (FLUSH_DOUBLE, _array, _describe, _realisation, _write_sources,
                      check_c_name)
 
@@ -137,6 +138,12 @@ def kalman_c_sources(model, name: str = "model", Q=None, R=None, S=None, *,
         raise ModelError(f"export c --kind kalman: the C filter needs states and inputs; the "
                          f"model has {ss.n_states} state(s) and {ss.n_inputs} input(s)",
                          hint="export the model itself: --kind model")
+    if Q is None and R is None and getattr(model, "K", None) is None:
+        raise ModelError(f"export c --kind kalman: {without_innovation_gain(model)}; the filter "
+                         f"needs the noise covariances Q ({ss.n_states}×{ss.n_states}) and R "
+                         f"({ss.n_outputs}×{ss.n_outputs})",
+                         hint='give them in a JSON file: --noise NOISE.json, with '
+                              '{"Q": …, "R": …} (matrices, or numbers meaning q·I)')
     kf = kalman_filter_of(model, Q, R, S, dt=dt)
     Kf, Kp = np.asarray(kf.filter_gain), np.asarray(kf.predictor_gain)
     if not (np.all(np.isfinite(Kf)) and np.all(np.isfinite(Kp))):

@@ -133,9 +133,10 @@ def load(path, *, columns: Sequence[str] | None = None, time: str | None = None,
     -----
     CSV files: lines that start with ``#`` are comments and are skipped; a file whose header is
     separated by ``;`` is read with ``;`` as separator, and with ``,`` as decimal point when its
-    numbers are written so (``0,25``). Integer time stamps in nanoseconds (a column named
-    ``stamp``, ``time_ns`` and the like or ``*_ns`` given as ``time=``, with the unit ``[ns]``, or
-    integers of 1e17 and more) are read exactly, relative to the first stamp
+    numbers are written so (``0,25``); one whose header holds tabs and neither ``,`` nor ``;``
+    is read as tab-separated (as a ``.tsv`` file is). Integer time stamps in nanoseconds (a
+    column named ``stamp``, ``time_ns`` and the like or ``*_ns`` given as ``time=``, with the
+    unit ``[ns]``, or integers of 1e17 and more) are read exactly, relative to the first stamp
     (``meta['time_origin']``). A file without a header (every field of its first line a
     number) is read from its first line, its columns named by 1-based position (``'1'``, ``'2'``,
     …; ``columns=["2", "3"]``, ``time="1"``), and ``meta['header']`` says so.
@@ -181,9 +182,31 @@ def _read(path: Path, fmt: str, *, columns, time, fs, units, fill, key, delimite
     reader = {"csv": _read_csv, "parquet": _read_parquet, "hdf5": _read_hdf5, "mat": read_mat}[fmt]
     raw, meta_units = reader(path, key=key, delimiter=delimiter, wanted=_Wanted(columns, time),
                              limit=limit, allow_external=allow_external)
-    return columns_to_trajectory(raw, source=path.name, columns=columns, time=time, fs=fs,
-                                 units=units, meta_units=meta_units, fill=fill,
-                                 headerless=fmt == "csv" and by_position(raw))
+    headerless = fmt == "csv" and by_position(raw)
+    row = (lambda i: f"line {_data_line(path, i, headerless)} of {path.name}") if fmt == "csv" \
+        else None
+    try:
+        return columns_to_trajectory(raw, source=path.name, columns=columns, time=time, fs=fs,
+                                     units=units, meta_units=meta_units, fill=fill,
+                                     headerless=headerless, row=row)
+    except DataError as exc:  # a message about a column's values names the file too
+        if exc.message.startswith(f"{path.name}:") or path.name in exc.message:
+            raise
+        raise type(exc)(f"{path.name}: {exc.message}", hint=exc.hint) from None
+
+
+def _data_line(path: Path, i: int, headerless: bool) -> int | str:
+    """The 1-based line of ``path`` (a CSV file) that holds data row ``i`` (0-based): blank and
+    comment lines skipped, as the reader skips them, and the header counted ('?' past the end)."""
+    k = -1 if headerless else -2  # the header is the first counted line
+    with path.open("rb") as f:
+        for line_no, line in enumerate(f, start=1):
+            if not line.strip() or _is_comment(line):
+                continue
+            k += 1
+            if k == i:
+                return line_no
+    return "?"
 
 
 def file_sha256(path) -> str:
@@ -270,12 +293,31 @@ def _read_csv(path: Path, key=None, delimiter=None, *, wanted=None, limit=None,
             parse_options=pacsv.ParseOptions(delimiter=delimiter),
             convert_options=pacsv.ConvertOptions(strings_can_be_null=True, decimal_point=decimal,
                                                  null_values=["", "NaN", "nan", "NA", "null"]))
-    except (pa.ArrowInvalid, pa.ArrowTypeError, UnicodeDecodeError) as exc:
+        columns = _arrow_columns(table, path.name)
+    except UnicodeDecodeError:  # its offset is within a field, not the file: find the byte
+        raise _not_utf8(path) from None
+    except (pa.ArrowInvalid, pa.ArrowTypeError) as exc:
         _refuse_ragged_line(path, delimiter)
         raise DataError(f"{path.name}: not a readable CSV file (truncated or corrupt?): "
                         f"{str(exc).splitlines()[0]}") from None
     _warn_unterminated(path)
-    return _arrow_columns(table, path.name), {}
+    return columns, {}
+
+
+def _not_utf8(path: Path) -> DataError:
+    """The DataError of a CSV file that is not UTF-8 text, naming the file, the first byte that
+    does not decode, its offset in the file and its line (the decoding error's own offset counts
+    from the start of the field that holds it)."""
+    data = path.read_bytes()
+    try:
+        data.decode("utf-8")
+        where = "somewhere"
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        where = f"byte 0x{data[exc.start]:02x} at offset {exc.start} (line {line})"
+    return DataError(f"{path.name}: not UTF-8 text: {where} cannot be decoded as UTF-8",
+                     hint="save the file as UTF-8 (e.g. a 'µ' written in Latin-1 is the single "
+                          "byte 0xb5), or check that the path names the right file")
 
 
 def _refuse_utf16(path: Path, data: bytes) -> None:
@@ -353,11 +395,14 @@ def _sniff_separator(data: bytes) -> tuple[str, str]:
     """The separator and decimal point of a CSV file read without ``delimiter=``: ``,`` and
     ``.``, unless the header holds ``;`` and no ``,`` (a European spreadsheet's export), or the
     file has no header and its first line is numbers separated by ``;`` (``0,25;1,5``): then
-    ``;``, with ``,`` as decimal point when the data rows write their numbers so (``0,25``)."""
+    ``;``, with ``,`` as decimal point when the data rows write their numbers so (``0,25``); a
+    tab when the first line holds tabs and neither ``,`` nor ``;`` (a TSV file named ``.csv``)."""
     lines = data[:65536].decode("utf-8", errors="replace").splitlines()
     if len(data) > 65536:
         lines = lines[:-1]  # cut short
     header = next((line for line in lines if line.strip()), "")
+    if "\t" in header and "," not in header and ";" not in header:  # tab-separated (.csv named)
+        return "\t", "."
     numbers = all(_NUMBER.match(f.strip().encode()) for f in header.split(";"))
     if ";" not in header or ("," in header and not numbers):
         return ",", "."

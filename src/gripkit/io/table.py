@@ -85,8 +85,9 @@ def _to_si(name: str, values: np.ndarray, unit: str | None) -> tuple[np.ndarray,
     return values * scale + offset, si
 
 
-def _numeric(name: str, values, row_offset: int = 0) -> np.ndarray:
-    """Float64 array, or a DataError naming the first non-numeric cell."""
+def _numeric(name: str, values, row=None) -> np.ndarray:
+    """Float64 array, or a DataError naming the first non-numeric cell (``row``: the cell's
+    place from its 0-based data-row index, as the file counts it; default ``'row i'``)."""
     a = np.asarray(values)
     if a.dtype == bool:
         return a.astype(np.float64)
@@ -109,11 +110,16 @@ def _numeric(name: str, values, row_offset: int = 0) -> np.ndarray:
             out[i] = float(v)
         except (TypeError, ValueError):
             raise DataError(
-                f"column {name!r} mixes numbers and text: row {i + row_offset} holds "
+                f"column {name!r} mixes numbers and text: {_place(row, i)} holds "
                 f"{str(v)[:40]!r}",
                 hint="fix or remove that cell, or leave it empty to be treated as missing",
             ) from None
     return out
+
+
+def _place(row, i: int) -> str:
+    """Where data row ``i`` (0-based) is: ``row(i)`` (``'line 52 of f.csv'``) or ``'row i'``."""
+    return f"row {i}" if row is None else row(i)
 
 
 FILL_CHOICES = ("drop", "interpolate")
@@ -302,9 +308,12 @@ def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
                           columns: Sequence[str] | None = None, time: str | None = None,
                           fs: float | None = None, units: Mapping[str, str] | None = None,
                           meta_units: Mapping[str, str] | None = None,
-                          fill: str | None = None, headerless: bool = False) -> Trajectory:
+                          fill: str | None = None, headerless: bool = False,
+                          row=None) -> Trajectory:
     """Build a Trajectory from raw columns ``{header: values}``; ``headerless``: the columns of a
-    CSV file without a header, named ``'1'``, ``'2'``, … by position (the messages say so)."""
+    CSV file without a header, named ``'1'``, ``'2'``, … by position (the messages say so);
+    ``row``: a data row's place in the file from its 0-based index (a text file's line), for
+    the messages."""
     units = dict(units or {})
     meta_units = dict(meta_units or {})
     cols: dict[str, tuple[object, str | None]] = {}
@@ -357,7 +366,7 @@ def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
     su: dict[str, str] = {}
     for c in names:
         vals, unit = cols[c]
-        arr = _numeric(c, vals)
+        arr = _numeric(c, vals, row)
         data[c], su[c] = _to_si(c, arr, unit)
         n = arr.shape[0]
     if n == 0:
@@ -388,5 +397,6 @@ def columns_to_trajectory(raw: Mapping[str, object], *, source: str,
             i = int(np.argmax(bad))
             raise DataError(f"{source}: time column {tname!r} has {int(bad.sum())} "
                             "missing or non-finite "
-                            f"values (first at row {i})", hint="drop those rows (fill='drop')")
+                            f"values (first at {_place(row, i)})",
+                            hint="drop those rows (fill='drop')")
     return Trajectory(t, data, su, meta)

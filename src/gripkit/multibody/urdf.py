@@ -476,7 +476,24 @@ def from_urdf(source, *, base_link: str | None = None, tip_link: str | None = No
     JointChain
         ``rnea``, ``mass_matrix``, ``forward_dynamics``, ``gravity``, ``regressor``, ...
         in the actuated joints' coordinates (``joint_names``), limits in ``limits``.
+
+    Raises
+    ------
+    ModelError
+        A file that is no URDF of a chain; the message starts with the file's name.
     """
+    text = str(source)
+    try:
+        return _chain_of(source, base_link, tip_link, gravity)
+    except ModelError as exc:  # name the file (XML text given as such has none)
+        name = None if text.lstrip().startswith("<") else Path(text).name
+        if name is None or name in exc.message:
+            raise
+        raise type(exc)(f"URDF file {name!r}: {exc.message}", hint=exc.hint) from None
+
+
+def _chain_of(source, base_link, tip_link, gravity) -> JointChain:
+    """:func:`from_urdf`'s chain, its errors not yet naming the file."""
     robot = _read_root(source)
     tree = _Tree(robot)
     base_link = _base_link(tree, base_link)

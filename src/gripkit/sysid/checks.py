@@ -17,7 +17,7 @@ from .regression import COND_LIMIT, qr_r, scaled_condition
 
 __all__ = ["as_signal", "signal_array", "signal_with_peaks", "as_io_matrix", "io_records",
            "check_io", "check_io_peaks", "check_io_arrays", "check_order", "check_dt",
-           "require_samples", "check_excitation",
+           "require_samples", "check_excitation", "check_channels_vary", "channel_of",
            "check_output_varies", "checked_problem", "checked_problem_peaks", "check_identifiable",
            "check_persistent_excitation", "check_dimension", "LENGTH_OR_ANGLE", "FORCE_OR_TORQUE",
            "LINEAR_ORDERS"]
@@ -180,16 +180,27 @@ def require_samples(n: int, n_min: int, what: str) -> None:
                         hint="use a longer record or a smaller model")
 
 
+def _level(x: np.ndarray, offset: float, unit: str | None) -> str:
+    """The constant value of ``x`` in the user's terms: ``offset`` (the mean that detrending took
+    off) added back, with ``unit`` when it has one (``'1 A'``)."""
+    value = f"{float(x[0]) + offset:.6g}"
+    return f"{value} {unit}" if unit not in (None, "", "1") else value
+
+
 def check_excitation(u: np.ndarray, name: str = "input u",
-                     peaks: tuple[float, float] | None = None) -> None:
+                     peaks: tuple[float, float] | None = None, *, offset: float = 0.0,
+                     unit: str | None = None) -> None:
     """Refuse a constant input: it cannot identify the numerator B (the input-output dynamics).
-    ``peaks``: ``(min, max)`` of ``u`` when known (:func:`signal_with_peaks`)."""
+    ``peaks``: ``(min, max)`` of ``u`` when known (:func:`signal_with_peaks`); ``offset`` and
+    ``unit``: what the message adds to the value and prints after it (:func:`check_channels_vary`).
+    """
     lo, hi = (float(np.min(u)), float(np.max(u))) if peaks is None else peaks
     span = hi - lo
     scale = max(hi, -lo, 1e-300)  # max|u| without an N-sized temporary
     if span <= 1e-12 * scale or span == 0.0:
         raise UnidentifiableError(
-            f"{name} is constant ({u[0]:.6g} for all {u.size} samples): a constant input cannot "
+            f"{name} is constant ({_level(u, offset, unit)} for all {u.size} samples): a constant "
+            f"input cannot "
             f"identify B, the input-output dynamics; no estimate returned",
             hint="record data with a varying input (multisine, PRBS, noise: gripkit.excitation)")
 
@@ -217,7 +228,8 @@ def check_persistent_excitation(u: np.ndarray, order: int, what: str,
             f"{what}: {name} is not persistently exciting of order {order}: {order} copies of it "
             f"delayed by {tau} sample(s) are linearly dependent (condition number {cond:.3g} > "
             f"{COND_LIMIT:.0e}; a single sine determines only 2 parameters, m sines 2m); "
-            f"the {order} parameters of the model cannot all be determined; no estimate returned",
+            f"the data cannot determine {order} coefficients of the input-output dynamics; "
+            f"no estimate returned",
             hint="excite the system more richly (more frequencies than parameters: multisine, "
                  "PRBS, noise: gripkit.excitation) or use fewer poles/zeros")
 
@@ -240,14 +252,46 @@ def check_dimension(column: str, unit: str | None, expected: dict[str, str], rol
 
 
 def check_output_varies(y: np.ndarray, name: str = "output y",
-                        peaks: tuple[float, float] | None = None) -> None:
+                        peaks: tuple[float, float] | None = None, *, offset: float = 0.0,
+                        unit: str | None = None) -> None:
     """Refuse a constant output: there is nothing to fit (and the fit % is undefined).
-    ``peaks``: ``(min, max)`` of ``y`` when known (:func:`signal_with_peaks`)."""
+    ``peaks``: ``(min, max)`` of ``y`` when known (:func:`signal_with_peaks`); ``offset``, ``unit``
+    as :func:`check_excitation`'s."""
     lo, hi = (float(np.min(y)), float(np.max(y))) if peaks is None else peaks
     if hi - lo <= 1e-12 * max(hi, -lo, 1e-300):
-        raise UnidentifiableError(f"{name} is constant ({y[0]:.6g} for all {y.size} samples): "
+        raise UnidentifiableError(f"{name} is constant ({_level(y, offset, unit)} for all "
+                                  f"{y.size} samples): "
                                   f"there are no dynamics to identify; no estimate returned",
                                   hint="check that the output column is the measured response")
+
+
+def channel_of(meta: dict, role: str, symbol: str) -> tuple[str, float, str | None]:
+    """The label, offset and unit of the ``role`` (``'input'``/``'output'``) channel in the model
+    keywords ``meta`` (``input_name``, ``u_offset``, ``input_unit`` …, or the lti spelling
+    ``inputs``, ``input_units``); ``'input u'`` and no offset or unit when ``meta`` has none."""
+    def one(key: str, plural: str):
+        value = meta.get(key, meta.get(plural))
+        if isinstance(value, (list, tuple)):
+            value = value[0] if len(value) == 1 else None
+        return value
+    name = one(f"{role}_name", f"{role}s")
+    offset = one(f"{symbol}_offset", f"{symbol}_offsets")
+    unit = one(f"{role}_unit", f"{role}_units")
+    label = f"{role} column {name!r}" if isinstance(name, str) else f"{role} {symbol}"
+    off = float(offset) if isinstance(offset, (int, float, np.number)) else 0.0
+    return label, off if math.isfinite(off) else 0.0, unit if isinstance(unit, str) else None
+
+
+def check_channels_vary(u: np.ndarray, y: np.ndarray, meta: dict,
+                        peaks: tuple | None = None) -> None:
+    """:func:`check_excitation` and :func:`check_output_varies` on a SISO estimator's checked,
+    unscaled signals, the channels named by its model keywords ``meta``: a constant column is
+    reported by its name, with its value (the detrending offset added back) in its unit.
+    ``peaks``: ``((min u, max u), (min y, max y))`` when known."""
+    label, offset, unit = channel_of(meta, "input", "u")
+    check_excitation(u, label, None if peaks is None else peaks[0], offset=offset, unit=unit)
+    label, offset, unit = channel_of(meta, "output", "y")
+    check_output_varies(y, label, None if peaks is None else peaks[1], offset=offset, unit=unit)
 
 
 def checked_problem(u, y, dt: float | None, **orders):

@@ -25,6 +25,7 @@ would otherwise bias every coefficient).
 from __future__ import annotations
 
 import copy
+import dataclasses
 import hashlib
 import math
 import warnings
@@ -35,7 +36,7 @@ from ..arguments import check_keywords, entry_point, keyword_names
 from ..errors import (AccuracyWarning, ArgumentError, DataError, GripkitError, GripkitWarning,
                       IdentificationError, emit_warning)
 from ..signals.trajectory import Trajectory
-from .checks import LINEAR_ORDERS
+from .checks import LINEAR_ORDERS, check_channels_vary
 from .io_data import (IOData, check_scale, io_data, parse_names, records_provenance,
                       validation_data)
 from .linear import identify_mimo
@@ -263,9 +264,32 @@ def identify(data: Trajectory, method: str = "arx", *, inputs: str | list[str] |
                                 f"{type(col).__name__} "
                                 f"{col!r:.40}", hint=f"columns: {', '.join(data.names)}"
                                 if isinstance(data, Trajectory) else None)
+    _check_single_channel(data, method, input, output)
     model = _dispatch(data, method, input=input, output=output, na=na, nb=nb, nk=nk, nc=nc, nf=nf,
                       detrend=detrend, **options)
     return with_provenance(model, records_provenance(data))
+
+
+#: the methods that take several input and output columns; the others take one of each
+SEVERAL_CHANNELS = ("ss", "frf", "tf", "arx", "nlss")
+
+
+def _check_single_channel(data, method: str, input, output) -> None:
+    """An ArgumentError, in the user's terms, when a method of one input and one output is given
+    several columns (``'a,b'``; a column whose own name holds the comma is left to the method)."""
+    if method in SEVERAL_CHANNELS:
+        return
+    first = data[0] if isinstance(data, (list, tuple)) and data else data
+    names = set(first.names) if isinstance(first, Trajectory) else set()
+    ins, outs = ((parse_names(c, role) if c not in names else (c,))
+                 for c, role in ((input, "input"), (output, "output")))
+    if len(ins) > 1 or len(outs) > 1:
+        raise ArgumentError(
+            f"identify {method}: this family takes one input and one output column, found "
+            f"{len(ins)} input(s) {', '.join(map(repr, ins))} and {len(outs)} output(s) "
+            f"{', '.join(map(repr, outs))}",
+            hint=f"give one column each to --input and --output; the families that take "
+                 f"several: {', '.join(SEVERAL_CHANNELS)}")
 
 
 def with_provenance(model, provenance: dict):
@@ -312,12 +336,14 @@ def _dispatch(data, method: str, *, input, output, na: int | None, nb: int | Non
     if method == "narx":  # the model's constant term carries the operating point
         io = _in_scale(io_data(data, input=input, output=output, detrend="none",
                                why="NARX identification"), "NARX identification")
+        check_channels_vary(io.u1, io.y1, io.keywords)  # a constant column named, in its unit
         model = _method_function(method)(io.u1, io.y1, dt=io.dt, **_validation_arrays(options, io))
         return _with_channels(model, io)
     if method == "hw":  # the offset y0 carries the operating point; orders not given: chosen
         io = _in_scale(io_data(data, input=input, output=output, detrend="none",
                                why="Hammerstein-Wiener identification"),
                        "Hammerstein-Wiener identification")
+        check_channels_vary(io.u1, io.y1, io.keywords)
         model = _method_function(method)(io.u1, io.y1, nb=nb, nf=nf, nk=nk, dt=io.dt,
                                          **_validation_arrays(options, io))
         return _with_channels(model, io)
@@ -345,7 +371,10 @@ def _dispatch(data, method: str, *, input, output, na: int | None, nb: int | Non
     if method == "rls":
         from .linear.rls import rls  # numba: loaded only for an RLS fit
 
-        return rls(io.u1, io.y1, na, nb, nk, dt=io.dt, **options)
+        check_channels_vary(io.u1, io.y1, io.keywords)  # a constant column named, in its unit
+        res = rls(io.u1, io.y1, na, nb, nk, dt=io.dt, **options)
+        named = {k: v for k, v in io.keywords.items() if not k.endswith("_offset")}
+        return dataclasses.replace(res, model=res.model.replace(**named))  # the units of θ
     if isinstance(options.get("validate"), Trajectory):  # around the estimation operating point
         vd = validation_data(options["validate"], io, detrend=detrend)
         options = {**options, "validate": (vd.u1, vd.y1)}

@@ -19,11 +19,15 @@ import warnings
 
 import numpy as np
 
+from ...errors import UnidentifiableError
+
 from ._pem import covariance, is_stable_poly, levenberg_marquardt, stabilize
 from ..scaling import in_user_units, unit_scale
 from .arx import (_arx, arx, arx_records, check_record_lengths, checked_records, records_summary,
                   scaled_records)
-from ..checks import check_dt, check_identifiable, check_order, checked_problem, require_samples
+from ..checks import (check_channels_vary, check_dt, check_identifiable, check_order,
+                      check_persistent_excitation, checked_problem, channel_of,
+                      require_samples)
 from .polynomial import PolynomialModel, check_meta
 from ..regression import qr_solve
 from .validation import fit_percent, loss_vn
@@ -47,7 +51,16 @@ def _hannan_rissanen(u, y, na, nb, nc, nk) -> np.ndarray:
     n = y.size
     nh = int(min(max(3 * (na + nb + nc), 10), max((n - nk) // 10, nc + 1)))
     ehat = np.zeros(n)
-    ehat[max(nh, nk + nh - 1):] = _arx(u, y, nh, nh, nk, 1.0, warn=False).estimation_residuals
+    try:
+        long = _arx(u, y, nh, nh, nk, 1.0, warn=False)
+    except UnidentifiableError as exc:  # its message would name its parameters (b27 …), not ours
+        raise UnidentifiableError(
+            f"ARMAX [{na} {nb} {nc} {nk}]: the data do not determine the start values: the long "
+            f"ARX [{nh} {nh} {nk}] that estimates the noise sequence e (Hannan-Rissanen) is not "
+            f"determined ({exc.message.split(';')[0]}); the input excites too few frequencies",
+            hint="excite the system more richly (multisine, PRBS, noise: gripkit.excitation), "
+                 "or fit ARX or OE (no noise model to start)") from None
+    ehat[max(nh, nk + nh - 1):] = long.estimation_residuals
     t0 = max(na, nk + nb - 1, nc) + max(nh, nk + nh - 1)
     X = _hr_rows(u, y, ehat, na, nb, nc, nk, t0)
     names = tuple(f"p{i}" for i in range(na + nb + nc))
@@ -83,6 +96,7 @@ def armax(u, y, na: int, nb: int, nc: int, nk: int = 1, *, dt: float | None = No
     """
     check_meta(meta, armax)
     u, y, step, na, nb, nc, nk = checked_problem(u, y, dt, na=na, nb=nb, nc=nc, nk=nk)
+    check_channels_vary(u, y, meta)  # named in the user's units, before any scaling
     if nc == 0:
         return arx(u, y, na, nb, nk, dt=step, **meta)
     cu, cy = unit_scale(u), unit_scale(y)
@@ -98,6 +112,8 @@ def _armax(u, y, na, nb, nc, nk, step, maxiter, tol, meta, progress=False) -> Po
     t0 = max(na, nk + nb - 1)
     label = f"ARMAX [{na} {nb} {nc} {nk}]"
     check_identifiable(u, y, t0 + 10 * p, f"{label} ({p} parameters)")
+    check_persistent_excitation(u, nb, f"{label} ({nb} B coefficients)",
+                                channel_of(meta, "input", "u")[0])
     theta0 = _hannan_rissanen(u, y, na, nb, nc, nk)
     theta0[na + nb:] = stabilize(np.concatenate([[1.0], theta0[na + nb:]]))[1:]
 

@@ -23,8 +23,9 @@ import numpy as np
 from ...errors import DataError
 from ..scaling import in_user_units, unit_scale
 from .arx_mimo import arx_mimo
-from ..checks import (check_dt, check_excitation, check_identifiable, check_io, check_order,
-                     check_output_varies, checked_problem_peaks, require_samples)
+from ..checks import (check_channels_vary, check_dt, check_excitation, check_identifiable,
+                      check_io, check_order, check_output_varies, checked_problem_peaks,
+                      require_samples)
 from .polynomial import PolynomialModel, channel_meta
 from ..regression import (COND_NOTABLE, NUMPY_QR_MAX_ELEMENTS, QRSolution, arx_regression,
                           arx_start, qr_solve, solve_upper, triangular_solve,
@@ -96,6 +97,7 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
         return arx_mimo(u, y, na, nb, nk, dt=dt, **meta)
     # one min and max per signal (the finiteness check's) serve the excitation checks and scaling
     u, y, step, na, nb, nk, (pu, py) = checked_problem_peaks(u, y, dt, na=na, nb=nb, nk=nk)
+    check_channels_vary(u, y, meta, (pu, py))  # named in the user's units, before any scaling
     cu, cy = unit_scale(u, pu), unit_scale(y, py)
     if max(abs(math.log2(cu)), abs(math.log2(cy))) <= _NO_SCALING_WITHIN:
         # scaling by powers of two is exact: skip the two copies where it changes nothing

@@ -20,11 +20,15 @@ import warnings
 
 import numpy as np
 
+from ...errors import UnidentifiableError
+
 from ._pem import covariance, is_stable_poly, levenberg_marquardt, stabilize
 from ..scaling import in_user_units, unit_scale
 from .arx import (_arx, arx_records, check_record_lengths, checked_records, records_summary,
                   scaled_records)
-from ..checks import check_dt, check_identifiable, check_order, checked_problem, require_samples
+from ..checks import (check_channels_vary, check_dt, check_identifiable, check_order,
+                      check_persistent_excitation, checked_problem, channel_of,
+                      require_samples)
 from .polynomial import PolynomialModel, check_meta
 from .validation import fit_percent, loss_vn
 
@@ -67,6 +71,7 @@ def oe(u, y, nb: int, nf: int, nk: int = 1, *, dt: float | None = None,
     """
     check_meta(meta, oe)
     u, y, step, nb, nf, nk = checked_problem(u, y, dt, nb=nb, nf=nf, nk=nk)
+    check_channels_vary(u, y, meta)  # named in the user's units, before any scaling
     cu, cy = unit_scale(u), unit_scale(y)
     return in_user_units(_oe(u * cu, y * cy, nb, nf, nk, step, maxiter, tol, meta, progress),
                          cu, cy)
@@ -80,7 +85,16 @@ def _oe(u, y, nb, nf, nk, step, maxiter, tol, meta, progress=False) -> Polynomia
     t0 = max(nf, nk + nb - 1)
     label = f"OE [{nb} {nf} {nk}]"
     check_identifiable(u, y, t0 + 10 * p, f"{label} ({p} parameters)")
-    theta0 = np.concatenate([_iv_start(u, y, nb, nf, nk, t0), y[t0 - nf:t0][::-1]])
+    check_persistent_excitation(u, nb, f"{label} ({nb} B coefficients)",
+                                channel_of(meta, "input", "u")[0])
+    try:
+        start = _iv_start(u, y, nb, nf, nk, t0)
+    except UnidentifiableError as exc:  # the start's ARX names its a1 … (our f1 …)
+        raise UnidentifiableError(
+            f"{label}: the data do not determine the start values: the ARX [{nf} {nb} {nk}] that "
+            f"starts the fit is not determined ({exc.message.split(';')[0]}, its a_k standing "
+            f"for F's f_k)", hint=exc.hint) from None
+    theta0 = np.concatenate([start, y[t0 - nf:t0][::-1]])
     n = y.size
     ub = np.column_stack([u[t0 - nk - j:n - nk - j] for j in range(nb)])
     yt = y[t0:]

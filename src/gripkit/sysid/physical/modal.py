@@ -272,11 +272,20 @@ _MIN_DECAY = 0.05
 
 
 def _check_decay(zeta: float, z_std: float, sigma_t: float) -> None:
-    """Refuse a record whose envelope does not decay (ζ within 2σ of 0, or below): a forced or
-    self-sustained oscillation, whose damped-sine fit returns ζ ≈ 0 with a σ that looks precise;
+    """Refuse a record whose envelope does not decay (ζ within 2σ of 0) or grows (ζ below −2σ): a
+    forced or self-sustained oscillation, whose damped-sine fit returns ζ ≈ 0 with a σ that looks
+    precise, or a growing one (negative damping);
     warn when it decays by less than :data:`_MIN_DECAY` over the record. ``sigma_t``: σ·T, the
     fitted decay rate times the record's duration."""
     kept = math.exp(-sigma_t) if sigma_t > -700 else math.inf
+    if zeta < -2 * z_std:  # significantly negative: the envelope grows
+        raise IdentificationError(
+            f"free vibration: the envelope grows (to {100 * kept:.4g} % of its start): the fitted "
+            f"damping ratio ζ = {zeta:.3g} ± {z_std:.2g} is negative, as in a self-excited "
+            f"oscillation or an unstable loop, not a free vibration; its damping cannot be "
+            f"measured from it",
+            hint="analyse the free response after a release or an impulse, with no excitation "
+                 "during the record (CLI: --start at the release)")
     if not zeta > 2 * z_std:
         raise IdentificationError(
             f"free vibration: the fitted damping ratio ζ = {zeta:.3g} ± {z_std:.2g} does not "

@@ -451,6 +451,11 @@ def idim_samples(position, effort, *, dt: float, cutoff: float | None = None, or
                         tuple(notes)))
 
 
+#: what to do instead of a non-positive effort scale (the CLI's --effort-scale too)
+EFFORT_SCALE_HINT = ("give its magnitude (e.g. k_t·N for a current); for an effort column whose "
+                     "sign is opposite to the position's, negate that column in the file")
+
+
 @entry_point
 def idim_ls(position, effort, *, dt: float, effort_scale: float = 1.0, cutoff: float | None = None,
             order: int = 4, decimation: int | None = None,
@@ -479,8 +484,10 @@ def idim_ls(position, effort, *, dt: float, effort_scale: float = 1.0, cutoff: f
         filtered Coulomb step does not follow sign(q̇).
     """
     x, e = _same_length(position=position, effort=effort)
-    if not (np.isfinite(effort_scale) and effort_scale != 0):
-        raise DataError(f"effort scale: expected a finite non-zero factor, found {effort_scale!r}")
+    if not (np.isfinite(effort_scale) and effort_scale > 0):
+        raise DataError(f"effort scale: expected a finite positive factor, found {effort_scale!r}"
+                        f" (a negative one turns the effort's sign: negative inertia and "
+                        f"friction)", hint=EFFORT_SCALE_HINT)
     # work at unit size (exact powers of two: data at any scale); q' = cx·q, τ' = ce·τ give
     # J' = J·ce/cx, F_v' = F_v·ce/cx, F_c' = F_c·ce, τ₀' = τ₀·ce, mapped back at the end
     cx, ce = unit_scale(x), unit_scale(e * effort_scale)
