@@ -96,7 +96,8 @@ def _siso(method: str, data: list[Path], input: str, output: str, fs, time, fill
         out.update(data=data_field(data), detrend=detrend)
         if len(data) > 1:
             out["records"] = records_field(data, model.info["records"])
-        else:  # the fit of `gripkit compare` on this record (fit_percent: the one-step fit)
+        elif method != "arx":  # the fit of `gripkit compare` (fit_percent: the one-step fit);
+            # not for ARX, whose command loads no numba (its start-up: docs/performance.md)
             out["free_run_fit_percent"] = _compare_fit(model, tr)
         val = _validation_fields(out, model, vtr, validate, detrend)
     if finish_json(out, caught, json_out):
