@@ -232,3 +232,22 @@ def test_cli_more_than_a_fifth_interpolated_is_refused(cli, tmp_path):
     assert "--fill drop" in res.error_lines[0]
     with pytest.warns(DataWarning, match=r"80 of 400 samples \(20 %\) were missing"):
         load(_with_gaps(tmp_path, 80), fill="interpolate")
+
+
+def test_a_two_level_channel_s_chatter_is_no_corrupt_sample():
+    """A contact force: 1e-12 N of noise while free, then pressing at 0.4 mN with a short
+    ±1e-10 N chatter at the contact (a stiff contact simulated, Fig. 13 of the TSFM seed's
+    scenario): the MAD (the free level's noise) puts the chatter 10 MADs out, but it lies within
+    what the channel holds, so nothing is flagged; five 1 N spikes beyond its range still are."""
+    from gripkit.signals.outliers import corrupt_samples
+
+    rng = np.random.default_rng(11)
+    n = 20000
+    f = 1e-12 * rng.standard_normal(n)
+    f[12000:] += 4e-4 * (1 - np.exp(-np.arange(n - 12000) / 50.0))
+    f[11990:11998] = 1.1e-10 * np.array([-1, 1, -1, 1, -1, 1, -1, 1.0])
+    assert corrupt_samples(f).size == 0
+    spiky = f.copy()
+    at = [1000, 3000, 5000, 15000, 17000]
+    spiky[at] = 1.0
+    assert corrupt_samples(spiky).tolist() == at

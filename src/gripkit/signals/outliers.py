@@ -15,7 +15,9 @@ A sample is flagged when both hold:
   median absolute deviation (MAD) of the channel is not zero, the smaller of that scale and
   ``1.4826·MAD`` (also σ for Gaussian data, and not moved by corrupt values in up to half of the
   samples) is tried first, so that more than ``m`` corrupt values cannot widen the scale and hide
-  themselves; when it flags nothing (or a pulse train, below) the order-statistic scale decides;
+  themselves, for samples that also lie beyond the range of all the others by more than ``K·s``
+  (on a channel of two levels the MAD is the quiet level's noise alone); when it flags nothing (or
+  a pulse train, below) the order-statistic scale decides;
 * it belongs to a run of at most :data:`MAX_RUN` consecutive such samples, and the run jumps away
   from the samples next to it by more than ``K·s`` as well. A step, a longer pulse or a decaying
   transient lasts longer than that or joins the rest of the record smoothly; a corrupt value does
@@ -74,9 +76,24 @@ def corrupt_samples(x: np.ndarray) -> np.ndarray:
     scales = [mad, scale] if 0.0 < mad < scale else [scale]
     for s in scales:
         keep = _flagged(x, dev, THRESHOLD * s, m)
+        if keep.size and s == mad and s != scale:
+            keep = _beyond_the_rest(x, keep, THRESHOLD * s)
         if keep.size:
             return keep
     return keep
+
+
+def _beyond_the_rest(x: np.ndarray, keep: np.ndarray, bound: float) -> np.ndarray:
+    """The samples of ``keep`` that lie beyond the range of all the other samples by more than
+    ``bound``. The MAD measures the noise of the level where most samples sit; on a channel of two
+    levels (a contact force: zero, then pressing) the small chatter around the quiet level lies
+    many MADs out but within what the channel holds; a corrupt value lies outside it."""
+    rest = np.ones(x.size, dtype=bool)
+    rest[keep] = False
+    lo, hi = float(np.min(x[rest])), float(np.max(x[rest]))
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = (x[keep] > hi + bound) | (x[keep] < lo - bound)
+    return keep[out]
 
 
 def _flagged(x: np.ndarray, dev: np.ndarray, bound: float, m: int) -> np.ndarray:
