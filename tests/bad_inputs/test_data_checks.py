@@ -236,8 +236,8 @@ def test_cli_more_than_a_fifth_interpolated_is_refused(cli, tmp_path):
 
 def test_a_two_level_channel_s_chatter_is_no_corrupt_sample():
     """A contact force: 1e-12 N of noise while free, then pressing at 0.4 mN with a short
-    ±1e-10 N chatter at the contact (a stiff contact simulated, Fig. 13 of the TSFM seed's
-    scenario): the MAD (the free level's noise) puts the chatter 10 MADs out, but it lies within
+    ±1e-10 N chatter at the contact (as the simulated contact of 001_0b92a7da96e7aa46.txt Fig. 13
+    gives): the MAD (the free level's noise) puts the chatter 10 MADs out, but it lies within
     what the channel holds, so nothing is flagged; five 1 N spikes beyond its range still are."""
     from gripkit.signals.outliers import corrupt_samples
 
