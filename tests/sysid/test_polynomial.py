@@ -97,3 +97,42 @@ def test_parameters_carry_units_and_std():
     assert ps["b1"].std == pytest.approx(0.2)
     d = m.to_dict()
     assert d["poles"] == [[0.5, 0.0]] and d["A_std"] == [0.0, 0.01]
+
+
+def _arx_with_zero(b, noise, seed=0, n=4000):
+    """ARX [1 2 1] fit of y = B/A u + e with A = 1 − 0.8 q⁻¹ and B = b (two coefficients)."""
+    from gripkit.sysid import arx
+
+    rng = np.random.default_rng(seed)
+    u = rng.standard_normal(n)
+    y = signal.lfilter([0.0, *b], [1.0, -0.8], u) + noise * rng.standard_normal(n)
+    return arx(u, y, 1, 2, 1)
+
+
+def test_zero_moduli_sigma_is_the_delta_method_of_the_b_covariance():
+    """B = b1 z + b2 has the zero −b2/b1: |z| = |b2/b1|, σ² = (b2/b1²)² σ₁² + (1/b1)² σ₂²
+    − 2 (b2/b1³) σ₁₂ (the gradient of |b2/b1| through the B block of the θ covariance), and a
+    Monte Carlo draw of b from that covariance gives the same σ (small σ: the linear regime)."""
+    m = _arx_with_zero([0.2, 0.5], noise=0.05)
+    modulus, std = m.zero_moduli()
+    b1, b2 = m.B[1], m.B[2]
+    C = m.covariance[1:3, 1:3]
+    g = np.array([-b2 / b1**2, 1.0 / b1]) * np.sign(b2 / b1)
+    np.testing.assert_allclose(modulus, [abs(b2 / b1)], rtol=1e-12)
+    np.testing.assert_allclose(std, [np.sqrt(g @ C @ g)], rtol=1e-9)
+    draws = np.random.default_rng(1).multivariate_normal([b1, b2], C, size=20000)
+    np.testing.assert_allclose(np.std(np.abs(draws[:, 1] / draws[:, 0])), std[0], rtol=0.05)
+
+
+def test_phase_note_says_when_the_data_do_not_decide_minimum_phase():
+    """A zero at −2.5 from B = [0.2, 0.5] with little noise lies many σ beyond the unit circle:
+    NON-minimum phase. A leading coefficient of 0.002 buried in noise puts the zero at ≈ 250
+    but with a σ of the same size: the note says the data do not decide (OE on the cascaded
+    tanks printed 'NON-minimum phase' from b1 = −0.0012 ± 0.0046)."""
+    assert _arx_with_zero([0.2, 0.5], noise=0.01).phase_note == "NON-minimum phase"
+    m = _arx_with_zero([0.002, 0.5], noise=1.0, n=600)
+    assert not m.minimum_phase
+    assert m.phase_note.startswith("a zero outside the unit circle, |z| = ")
+    assert "these data do not decide minimum phase" in m.phase_note
+    assert "these data do not decide" in m.summary()
+    assert _arx_with_zero([0.5, 0.2], noise=0.01).phase_note == "minimum phase"

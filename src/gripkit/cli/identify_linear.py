@@ -164,8 +164,7 @@ def _print_model(model, val, vfit: float | None = None, free: float | None | boo
                      if not model.stable else "— (undefined: ‖y − ȳ‖ underflows)"))
     fmt = lambda z: ", ".join(f"{v.real:.4g}{v.imag:+.4g}j" for v in z) or "none"  # noqa: E731
     con.print(f"poles: {fmt(model.poles())}   ({'stable' if model.stable else 'UNSTABLE'})")
-    con.print(f"zeros: {fmt(model.zeros())}   "
-              f"({'minimum' if model.minimum_phase else 'NON-minimum'} phase)")
+    con.print(f"zeros: {fmt(model.zeros())}   ({model.phase_note})")
     if val is not None:
         fit = "— (unstable model)" if vfit is None else f"{vfit:.2f} %"
         tt = val.tests

@@ -621,6 +621,42 @@ class PolynomialModel(IdentifiedLinearModel):
         return self.system.minimum_phase
 
     @property
+    def phase_note(self) -> str:
+        """``'minimum phase'``, ``'NON-minimum phase'``, or, when every zero outside the unit
+        circle lies less than 2σ of its modulus beyond it (:meth:`zero_moduli`), that these data
+        do not decide it: a zero pushed out by a coefficient that does not differ from 0."""
+        if self.minimum_phase:
+            return "minimum phase"
+        found = self.zero_moduli()
+        if found is None:
+            return "NON-minimum phase"
+        modulus, std = found
+        out = modulus >= 1.0
+        if np.any(modulus[out] - 1.0 > 2.0 * std[out]):
+            return "NON-minimum phase"
+        k = int(np.argmax(np.where(out, modulus, -np.inf)))
+        return (f"a zero outside the unit circle, |z| = {modulus[k]:.4g} ± {std[k]:.2g}: less "
+                "than 2σ beyond it, so these data do not decide minimum phase")
+
+    def zero_moduli(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """|z| of the zeros of B (one input, one output) and its 1σ by the delta method from the
+        covariance of ``b_nk …`` (∂z/∂b_j = −z^(m−j)/B'(z), B of degree m in z); None without a
+        covariance, with several channels, or with fewer than two B coefficients."""
+        if self.multivariable or self.covariance is None:
+            return None
+        b = np.asarray(self.B[self.nk:], dtype=np.float64)
+        if b.size < 2 or b[0] == 0.0 or b[-1] == 0.0:
+            return None
+        z = np.roots(b)
+        slope = np.polyval(np.polyder(b), z)
+        dz = -(z[:, None] ** np.arange(b.size - 1, -1, -1)[None, :]) / slope[:, None]
+        grad = np.real(np.conj(z)[:, None] / np.abs(z)[:, None] * dz)  # ∂|z_i|/∂b_j
+        cov = np.asarray(self.covariance, dtype=np.float64)[self.na:self.na + b.size,
+                                                            self.na:self.na + b.size]
+        var = np.einsum("ij,jk,ik->i", grad, cov, grad)
+        return np.abs(z), np.sqrt(np.clip(var, 0.0, None))
+
+    @property
     def dc_gain(self) -> float | np.ndarray:
         """Static gain B(1)/(A(1)F(1)) (±inf with an integrator); with several inputs or
         outputs the (p, m) matrix A(1)⁻¹ B(1)."""
@@ -974,8 +1010,7 @@ class PolynomialModel(IdentifiedLinearModel):
                          f"AIC = {self.aic:.5g}, N = {self.n_samples}")
         fmt = lambda z: ", ".join(f"{v.real:.4g}{v.imag:+.4g}j" for v in z) or "none"  # noqa: E731
         lines.append(f"  poles: {fmt(self.poles())}")
-        lines.append(f"  zeros: {fmt(self.zeros())} "
-                     f"({'minimum' if self.minimum_phase else 'NON-minimum'} phase)")
+        lines.append(f"  zeros: {fmt(self.zeros())} ({self.phase_note})")
         return "\n".join(lines)
 
     def _matrix_summary(self) -> str:
