@@ -232,3 +232,13 @@ def test_subprocess_entry_point(data):
                          timeout=120)
     assert (bad.returncode == 1 and bad.stderr.count("\n") == 1
             and "column 'nope' not found" in bad.stderr)
+
+
+def test_tables_printed_into_a_pipe_keep_their_numbers_whole(capsys, data):
+    """stdout captured (no terminal, as in a pipe or a file): the search table is laid out for
+    120 columns, not rich's default 80, which cut the loss and FPE to '4.8232e…'."""
+    code, out, err = run(capsys, "identify", "search", data["est"], "--input", "current",
+                         "--output", "force", "--na", "1:2", "--nb", "1:2", "--nk", "1:2")
+    assert code == 0, err
+    assert "ranked by AIC" in out and "…" not in out
+    assert max(len(line) for line in out.splitlines()) <= 120

@@ -117,6 +117,21 @@ def keyword_or_number(value: str, option: str, keyword: str, kind, low: float, h
     return n
 
 
+#: columns of a printed table when stdout is a pipe or a file (rich would take 80 and cut numbers)
+PIPE_WIDTH = 120
+
+
+def table_console():
+    """A rich Console for the commands' tables: the terminal's width, or :data:`PIPE_WIDTH`
+    columns when stdout is no terminal (a pipe, a file), where rich's default of 80 cut values
+    to ``4.8232e…``."""
+    import sys
+
+    from rich.console import Console
+
+    return Console() if sys.stdout.isatty() else Console(width=PIPE_WIDTH)
+
+
 def emit_json(obj) -> None:
     """Write ``obj`` as one JSON object on stdout (NaN/inf become null)."""
     sys.stdout.write(json.dumps(plain(obj), allow_nan=False) + "\n")

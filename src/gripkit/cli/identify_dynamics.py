@@ -27,7 +27,7 @@ import typer
 
 from .app import identify_app
 from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_effort_scale, emit_json, load_data,
-                     report_warnings)
+                     report_warnings, table_console)
 from .identify_common import ModelOutOpt, ReportOpt, check_outputs
 
 
@@ -77,10 +77,9 @@ def _write_model_and_report(res, dd, lines, *, urdf: Path, data: Path, provenanc
 def _print_tables(res, chain, data: Path, notes) -> None:
     """The base parameters and the friction as tables on stdout; the consistency and the notes
     on stderr."""
-    from rich.console import Console
     from rich.table import Table
 
-    con = Console()
+    con = table_console()
     t = Table("base parameter (combination of standard parameters)", "value", "std",
               title=f"{chain.name} from {data.name}: {res.n_samples} samples, {res.n_base} "
                     "base parameters "

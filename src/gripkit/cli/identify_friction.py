@@ -17,8 +17,8 @@ import typer
 
 from .app import identify_app
 from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, check_effort_scale,
-                     check_number,
-                     collected_warnings, emit_json, load_data, report_warnings)
+                     check_number, collected_warnings, emit_json, load_data, report_warnings,
+                     table_console)
 
 
 def friction_units(position: str, effort: str, scale: float = 1.0) -> dict[str, str]:
@@ -86,7 +86,6 @@ def identify_friction(
     if json_out:
         emit_json(out)
         return
-    from rich.console import Console
     from rich.table import Table
 
     t = Table("parameter", "value", "std", "unit",
@@ -94,6 +93,6 @@ def identify_friction(
                     f"{res.relative_error_percent:.2f} %")
     for k in ("inertia", "viscous", "coulomb", "offset"):
         t.add_row(k, f"{res.params[k]:.6g}", f"{res.std[k]:.2g}", units[k])
-    Console().print(t)
+    table_console().print(t)
     for n in res.notes:
         typer.echo(f"note: {n}", err=True)

@@ -24,7 +24,8 @@ from ..errors import emit_warning
 from ..sysid.checks import LINEAR_ORDERS
 from ..units import product_unit
 from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_choice, check_data_options,
-                     check_number, collected_warnings, emit_json, finish_json, report_warnings)
+                     check_number, collected_warnings, emit_json, finish_json, report_warnings,
+                     table_console)
 from .identify_common import (DataArg, DataArgs, ModelOutOpt, ReportOpt, ValidateOpt,
                               check_outputs, data_field, records_field, run_identify,
                               save_and_report, validation)
@@ -142,10 +143,9 @@ def _unit_suffix(unit: str | None) -> str:
 
 
 def _print_model(model, val, vfit: float | None = None, free: float | None | bool = False) -> None:
-    from rich.console import Console
     from rich.table import Table
 
-    con = Console()
+    con = table_console()
     t = Table("parameter", "value", "σ", "unit", title=f"{model.label}  ({model.input_name} → "
                                                        f"{model.output_name}, "
                                                        f"fs = {1.0 / model.dt:g} Hz, N = "
@@ -348,7 +348,6 @@ def identify_rls(data: Path = DataArg, input: str = InputOpt, output: str = Outp
     if json_out:
         emit_json(out)
         return
-    from rich.console import Console
     from rich.table import Table
 
     t = Table("parameter", "final value", "σ", "unit", title=f"RLS ARX [{na} {nb} {nk}], λ = "
@@ -359,7 +358,7 @@ def identify_rls(data: Path = DataArg, input: str = InputOpt, output: str = Outp
     for i, n in enumerate(res.names):
         t.add_row(n, f"{res.theta_final[i]:.6g}", "—" if std is None else f"{std[i]:.3g}",
                   units.get(n, ""))
-    con = Console()
+    con = table_console()
     con.print(t)
     squared = _unit_suffix(product_unit((res.model.output_unit, 2)))
     con.print(f"loss V_N of the a-priori errors (eq 29) = {res.loss:.6g}{squared}")
@@ -425,7 +424,6 @@ def identify_search(data: Path = DataArg, input: str = InputOpt, output: str = O
     if json_out:
         emit_json(res.to_list())
         return
-    from rich.console import Console
     from rich.table import Table
 
     t = Table("rank", "na", "nb", "nk", "loss V_N", "AIC", "FPE", "1-step fit %",
@@ -436,7 +434,7 @@ def identify_search(data: Path = DataArg, input: str = InputOpt, output: str = O
         t.add_row(str(i), str(c.na), str(c.nb), str(c.nk), f"{c.loss:.5g}", f"{c.aic:.6g}",
                   f"{c.fpe:.5g}",
                   f"{c.fit_percent:.2f}", "—" if v is None else f"{v:.2f}")
-    Console().print(t)
+    table_console().print(t)
     if res.skipped:
         typer.echo(f"{len(res.skipped)} structure(s) skipped (not identifiable "
                    "from these data)", err=True)

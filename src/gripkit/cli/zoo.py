@@ -7,7 +7,7 @@ import warnings
 import typer
 
 from .app import zoo_app
-from .common import JsonOpt, emit_json
+from .common import JsonOpt, emit_json, table_console
 
 
 def _build(name: str):
@@ -38,9 +38,7 @@ def zoo_list(json_out: bool = JsonOpt):
 
 
 def _print(renderable):
-    from rich.console import Console
-
-    Console().print(renderable)
+    table_console().print(renderable)
 
 
 @zoo_app.command("show")
