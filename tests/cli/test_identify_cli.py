@@ -242,3 +242,16 @@ def test_tables_printed_into_a_pipe_keep_their_numbers_whole(capsys, data):
     assert code == 0, err
     assert "ranked by AIC" in out and "…" not in out
     assert max(len(line) for line in out.splitlines()) <= 120
+
+
+@pytest.mark.parametrize("command", [["ss", "--order", "2"],
+                                     ["tf", "--poles", "2", "--zeros", "1"]])
+def test_identify_says_what_out_and_report_wrote(capsys, data, tmp_path, command):
+    """The text summary ends with the files written (`identify ss` and `tf` said nothing of
+    --report)."""
+    model, report = tmp_path / "m.json", tmp_path / "rep"
+    code, out, err = run(capsys, "identify", *command[:1], data["est"], *command[1:], "--input",
+                         "current", "--output", "force", "--out", model, "--report", report)
+    assert code == 0, err
+    assert f"model written to {model}" in out and f"report written to {report}" in out
+    assert (report / "index.html").is_file() and model.is_file()

@@ -134,6 +134,14 @@ def save_and_report(model, tr, data: list[Path], out: Path | None, report: Path 
         fm.report(record, Path(report) / folder, data_name=Path(path).name)
 
 
+def echo_written(out: Path | None, report: Path | None) -> None:
+    """Say what ``--out`` and ``--report`` wrote (the text summary's last lines)."""
+    if out is not None:
+        typer.echo(f"model written to {out}")
+    if report is not None:
+        typer.echo(f"report written to {report}")
+
+
 def save_and_page(model, out: Path | None, report: Path | None, record, vrecord,
                   data_path: Path, validate: Path | None):
     """``--out``: ``model.save(out)``; ``--report``: the model page (:func:`write_model_page`)

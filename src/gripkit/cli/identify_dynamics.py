@@ -28,7 +28,7 @@ import typer
 from .app import identify_app
 from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_effort_scale, emit_json, load_data,
                      report_warnings, table_console)
-from .identify_common import ModelOutOpt, ReportOpt, check_outputs
+from .identify_common import ModelOutOpt, ReportOpt, check_outputs, echo_written
 
 
 def _columns(option: str, text: str | None, joints) -> list[str] | None:
@@ -174,3 +174,4 @@ def identify_dynamics_cmd(
         emit_json(summary)
         return
     _print_tables(res, chain, data, notes)
+    echo_written(out, report)

@@ -26,8 +26,8 @@ from ..units import product_unit
 from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_choice, check_data_options,
                      check_number, collected_warnings, emit_json, finish_json, report_warnings,
                      table_console)
-from .identify_common import (DataArg, DataArgs, ModelOutOpt, ReportOpt, ValidateOpt,
-                              check_outputs, data_field, records_field, run_identify,
+from .identify_common import (DataArg, DataArgs, ModelOutOpt, ReportOpt, ValidateOpt, check_outputs,
+                              data_field, echo_written, records_field, run_identify,
                               save_and_report, validation)
 
 InputOpt = typer.Option(..., "--input", help="Input column (e.g. the valve current).")
@@ -106,7 +106,7 @@ def _siso(method: str, data: list[Path], input: str, output: str, fs, time, fill
     _print_model(model, None if val is None else val.one_step, out.get("validation_fit_percent"),
                  out.get("free_run_fit_percent", False))
     _echo_records(out.get("records"))
-    _echo_written(out_file, report)
+    echo_written(out_file, report)
 
 
 def _compare_fit(model, tr) -> float | None:
@@ -128,13 +128,6 @@ def _validation_fields(res: dict, model, vtr, validate: Path | None, detrend: st
         res["validation_fit_percent"] = val.fit_percent
         res["validation"] = val.to_dict()
     return val
-
-
-def _echo_written(out_file: Path | None, report: Path | None) -> None:
-    if out_file is not None:
-        typer.echo(f"model written to {out_file}")
-    if report is not None:
-        typer.echo(f"report written to {report}")
 
 
 def _unit_suffix(unit: str | None) -> str:
@@ -230,7 +223,7 @@ def _mimo_arx(data: list[Path], input: str, output: str, na: int, nb: int, nk: i
             line += f", validation free run {res['validation_fit_percent'][i]:.2f} %"
         typer.echo(line)
     _echo_records(res.get("records"))
-    _echo_written(out_file, report)
+    echo_written(out_file, report)
 
 
 def _echo_records(records: list[dict] | None, free_run: bool = False) -> None:

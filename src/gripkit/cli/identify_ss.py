@@ -22,9 +22,8 @@ import typer
 from .app import identify_app
 from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, emit_json, finish_json, load_data,
                      report_warnings)
-from .identify_common import (DataArg, DataArgs, ModelOutOpt, ReportOpt, ValidateOpt,
-                              check_outputs, data_field, run_identify, save_and_report,
-                              validation)
+from .identify_common import (DataArg, DataArgs, ModelOutOpt, ReportOpt, ValidateOpt, check_outputs,
+                              data_field, echo_written, run_identify, save_and_report, validation)
 
 InputsOpt = typer.Option(..., "--input", help="Input column(s), comma-separated (e.g. a,b).")
 OutputsOpt = typer.Option(..., "--output", help="Output column(s), comma-separated (e.g. c,d).")
@@ -87,7 +86,7 @@ def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
     res = _ss_result(model, val, data, method, no_refine, out)
     if finish_json(res, caught, json_out):
         return
-    _echo_ss(model, val, res, focus, out)
+    _echo_ss(model, val, res, focus, out, report)
 
 
 def _check_ss_options(form: str, focus: str, max_iterations: int) -> None:
@@ -128,7 +127,8 @@ def _ss_result(model, val, data: list[Path], method: str, no_refine: bool, out: 
     return res
 
 
-def _echo_ss(model, val, res: dict, focus: str, out: Path) -> None:
+def _echo_ss(model, val, res: dict, focus: str, out: Path | None,
+             report: Path | None = None) -> None:
     """The text output of ``identify ss``: structure, singular values, free-run fits (per
     record for several files), focus decision, order search, validation, poles (± σ)."""
     ss = model.system
@@ -160,8 +160,7 @@ def _echo_ss(model, val, res: dict, focus: str, out: Path) -> None:
     for i, z in enumerate(p):
         sd = "" if cov is None else f" ± ({np.sqrt(cov[i, 0, 0]):.2g}, {np.sqrt(cov[i, 1, 1]):.2g})"
         typer.echo(f"  pole {z.real:.6g}{z.imag:+.6g}j{sd}")
-    if out is not None:
-        typer.echo(f"model written to {out}")
+    echo_written(out, report)
 
 
 def _echo_search(rows: list[dict], criterion: str, focus: str) -> None:
@@ -285,5 +284,4 @@ def identify_tf_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
     if val is not None:
         fit = "—" if val.fit_percent is None else ", ".join(f"{v:.2f}" for v in val.fit_percent)
         typer.echo(f"validation free-run fit: {fit} % ({val.definition})")
-    if out is not None:
-        typer.echo(f"model written to {out}")
+    echo_written(out, report)

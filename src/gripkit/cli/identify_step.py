@@ -20,8 +20,8 @@ import typer
 from .app import identify_app
 from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, collected_warnings,
                      emit_json, report_warnings)
-from .identify_common import (ModelOutOpt, ReportOpt, ValidateOpt, check_outputs, run_identify,
-                              save_and_report, validation)
+from .identify_common import (ModelOutOpt, ReportOpt, ValidateOpt, check_outputs, echo_written,
+                              run_identify, save_and_report, validation)
 
 
 @identify_app.command("step")
@@ -68,5 +68,4 @@ def identify_step(data: Path = typer.Argument(..., help="CSV, Parquet or HDF5 fi
     if val is not None:
         fit = "—" if val.fit_percent is None else ", ".join(f"{v:.2f}" for v in val.fit_percent)
         typer.echo(f"validation free-run fit: {fit} % ({val.definition})")
-    if out is not None:
-        typer.echo(f"model written to {out}")
+    echo_written(out, report)
