@@ -397,3 +397,28 @@ def test_hostile_model_files_are_named(tmp_path):
             load_hysteresis(p)
     with pytest.raises(PathError, match="does not exist"):
         load_hysteresis(tmp_path / "missing.json")
+
+
+def test_prandtl_ishlinskii_weights_the_record_does_not_determine_have_no_sigma():
+    """A binary input (±1 A, held for a few samples: a PRBS) moves every play of threshold
+    below 1 between the same two levels, so the ten play operators are collinear: the weights'
+    Gram matrix is singular to working precision, and the pseudo-inverse left some variances at
+    0 or below by rounding, printed as "± 0" beside σ of 10⁵–10⁶. Those weights now have no σ
+    (NaN; null in JSON; "not determined" in the summary), the others keep theirs, and a
+    well-excited record (the recovery test's) has every σ finite and positive."""
+    rng = np.random.default_rng(0)
+    u = np.repeat(np.sign(rng.standard_normal(100)), 4)
+    y = np.convolve(u, [0.0, 0.5, 0.3])[:400] + 0.01 * rng.standard_normal(400)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        m = hysteresis((u, y), "prandtl-ishlinskii", operators=10)
+    var = np.diag(m.covariance)[:10]
+    sd = m.weights_std
+    assert np.array_equal(np.isnan(sd), var <= 0.0) and np.isnan(sd).any()
+    np.testing.assert_allclose(sd[var > 0], np.sqrt(var[var > 0]))
+    assert "not determined by this record" in m.summary()
+    assert all(s is None for s, v in zip(m.to_dict()["weights_std"], var) if v <= 0.0)
+    good = hysteresis((U_PI, np.asarray(PrandtlIshlinskiiModel(PI_R, PI_W).simulate(U_PI))[:, 0]
+                       + 1e-3 * np.random.default_rng(1).standard_normal(len(U_PI))),
+                      "prandtl-ishlinskii", thresholds=PI_R)
+    assert np.all(np.isfinite(good.weights_std)) and np.all(good.weights_std > 0)

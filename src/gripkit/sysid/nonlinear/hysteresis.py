@@ -887,10 +887,18 @@ class PrandtlIshlinskiiModel(_HysteresisModel):
 
     @property
     def weights_std(self) -> np.ndarray:
+        """1σ of each weight; NaN (not determined) where the covariance's diagonal is not
+        positive: with collinear play operators the pseudo-inverse leaves some variances at
+        zero or below by rounding, which a "± 0" would report as exact (an all-zero covariance,
+        a noiseless fit, gives 0)."""
         m = len(self.weights)
         if self.covariance.shape[0] < m:
             return np.full(m, np.nan)
-        return np.sqrt(np.maximum(np.diag(self.covariance)[:m], 0.0))
+        var = np.diag(self.covariance)[:m]
+        if not np.any(self.covariance):
+            return np.zeros(m)
+        with np.errstate(invalid="ignore"):
+            return np.where(var > 0.0, np.sqrt(np.abs(var)), np.nan)
 
     @property
     def parameters(self) -> ParameterSet:
@@ -965,10 +973,13 @@ class PrandtlIshlinskiiModel(_HysteresisModel):
     def summary(self) -> str:
         rows = [f"Prandtl-Ishlinskii, {len(self.weights)} play operators ({self.criterion})"]
         sd = self.weights_std
+        undetermined = " ± — (not determined by this record)" if self.covariance.size else ""
         for i, (r, w) in enumerate(zip(self.thresholds, self.weights)):
-            s = f" ± {sd[i]:.3g}" if np.isfinite(sd[i]) else ""
+            s = f" ± {sd[i]:.3g}" if np.isfinite(sd[i]) else undetermined
             rows.append(f"  r_{i:<3d} {r: .6g} {self.input_unit:<6s} w_{i:<3d} {w: .6g}{s}")
-        rows.append(f"  offset {self.offset: .6g} {self.output_unit}")
+        osd = self.std.get("offset")
+        rows.append(f"  offset {self.offset: .6g}" + (f" ± {osd:.3g}" if osd is not None else "")
+                    + f" {self.output_unit}")
         return "\n".join(rows)
 
 
