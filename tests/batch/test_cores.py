@@ -11,7 +11,8 @@ import pytest
 from gripkit.batch.budget import usable_cores
 from gripkit.batch.executors import ProcessExecutor
 
-pytestmark = pytest.mark.skipif(not hasattr(os, "sched_getaffinity"), reason="Linux affinity")
+pytestmark = pytest.mark.skipif(not hasattr(os, "sched_getaffinity"),
+                                reason="os.sched_getaffinity exists on Linux only")
 
 
 def _cgroup(tmp_path, v2=None, v1=None):
