@@ -130,16 +130,16 @@ class Dynamics:
         one = self._one or self._one_state()
         if out is None:
             # a 1-D float64 array: the kernel's unchecked entry point (onestate
-            # .mass_matrix_entry) into a fresh array. False (wrong length, stride, NaN), or
-            # TypeError (an object with a float64 dtype that is not an ndarray) or
-            # AttributeError (no dtype: a list): the checks below
+            # .mass_matrix_entry) into a fresh array; False (wrong length, stride, NaN): the
+            # checks below. TypeError (an object with a float64 dtype that is not an ndarray) or
+            # AttributeError (no dtype: a list): the validating way at once
             try:
                 if q.dtype is _F8 and q.ndim == 1:
                     res = _empty(one[2])
                     if one[3](one[0], q, res):
                         return res
             except (AttributeError, TypeError):
-                pass
+                return _dyn.mass_matrix(self, q)
         res = _empty(one[2]) if out is None else out
         try:
             done = mass_matrix_one(one[0], q, res)
