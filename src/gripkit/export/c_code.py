@@ -253,7 +253,8 @@ def _power_norm_sum(C: np.ndarray, A: np.ndarray, block: int = 256,
                     most: int = 1_000_000) -> float:
     """``Σ_j ‖C A^j‖_∞`` for a stable A, up to the first term below 1e-17 of the sum (at most
     ``most`` terms), ``block`` terms per numpy call: ``C A^(kb) · A^i`` for i < b. One product per
-    term made a lightly damped model (ρ(A) near 1: ~10⁵ terms) take seconds."""
+    term made a lightly damped model take seconds (docs/performance.md, the float32
+    bound)."""
     n = A.shape[0]
     powers = np.empty((block, n, n))
     powers[0] = np.eye(n)
