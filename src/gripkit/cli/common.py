@@ -125,8 +125,6 @@ def table_console():
     """A rich Console for the commands' tables: the terminal's width, or :data:`PIPE_WIDTH`
     columns when stdout is no terminal (a pipe, a file), where rich's default of 80 cut values
     to ``4.8232e…``."""
-    import sys
-
     from rich.console import Console
 
     return Console() if sys.stdout.isatty() else Console(width=PIPE_WIDTH)

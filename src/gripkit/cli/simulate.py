@@ -42,12 +42,12 @@ def simulate(model: Path = typer.Argument(..., help="Model description (.toml) o
     from ..description import load_description
     from .paths import output_file
 
-    output_file(out, "--out", [model])
+    output_file(out, "--out", [model])  # before loading the description (it builds the model)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         d = load_description(model)
         inputs = [model, *_input_files(d, model)]  # the description's input files, known now
-        output_file(out, "--out", inputs)
+        output_file(out, "--out", inputs)  # again: --out must not be one of those files
         if out is None:
             output_file(d.output, f"[output] file of {model.name}", inputs)
         status(f"simulating {d.model.name}: {d.inputs.n} samples at {1.0 / d.inputs.dt:g} Hz")

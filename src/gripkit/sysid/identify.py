@@ -362,7 +362,7 @@ def _dispatch(data, method: str, *, input, output, na: int | None, nb: int | Non
             raw = lambda: io_data(data, input=input, output=output, detrend="none")  # noqa: E731
             quiet = {k: v for k, v in options.items() if k != "progress"}  # one bar: the fit's
             refit = lambda r: _polynomial_fit(method, r, orders, quiet)  # noqa: E731
-            if identify_mimo.step_like(io.u1 + io.u_offset[0]):  # a step is never at its mean
+            if identify_mimo.step_like(io.u1):  # a step is never at its mean
                 return identify_mimo.keep_better_without_detrending(
                     model, lambda: refit(raw()), f"identify {method}",
                     lambda m: identify_mimo.compare_score(m, data))

@@ -70,8 +70,8 @@ from ..units import convert, dimension_of, same_dimension
 from ..signals.trajectory import Trajectory
 
 __all__ = ["IdentifiedModel", "ModelFit", "MODEL_FILES", "MODEL_REPORTS", "ReportMixin",
-           "check_sample_time", "column_in_unit", "file_schema", "load_model", "report_record",
-           "simulated_trajectory"]
+           "check_horizon", "check_sample_time", "column_in_unit", "file_schema", "load_model",
+           "report_record", "simulated_trajectory"]
 
 
 def column_in_unit(data, name: str, unit: str | None, what: str) -> np.ndarray:
@@ -96,6 +96,14 @@ def column_in_unit(data, name: str, unit: str | None, what: str) -> np.ndarray:
                         hint="check that the record holds the signals the model was identified "
                              "from")
     return convert(x, have, unit)
+
+
+def check_horizon(horizon) -> int:
+    """``horizon`` of ``predict`` as a whole number of samples ≥ 1 (every family takes it so)."""
+    if isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer)) or horizon < 1:
+        raise ArgumentError(f"horizon: expected a whole number of samples ≥ 1, found {horizon!r}",
+                            hint="horizon=1 is the one-step-ahead prediction")
+    return int(horizon)
 
 
 def check_sample_time(dt: float, model_dt: float) -> None:

@@ -160,7 +160,7 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
             refine=False, detrend="none", horizon=horizon, feedthrough=feedthrough)[0]
         _warn_if_detrending_hurt(model, refit, d.u.shape[0], d.dt, "identify ss",
                                  without="without (subspace model, not refined)",
-                                 step=step_like(d.u + np.asarray(d.u_offset)))
+                                 step=step_like(d.u))
     if vd is not None:
         extras["validation_fit_percent"] = _validation_fit(model, vd)
     return model, extras
@@ -435,7 +435,8 @@ STEP_CHANGES = 4
 
 
 def step_like(u) -> bool:
-    """Whether every column of the input ``u`` (as recorded, (N,) or (N, m)) is piecewise
+    """Whether every column of the input ``u`` ((N,) or (N, m); as recorded or with its mean
+    removed: a shift changes neither its span nor its steps) is piecewise
     constant with at most :data:`STEP_CHANGES` level changes, and one column at least changes: a
     step record. Its mean is no operating point: the record sits at one level, then at another,
     never at the mean, so with the means removed a record that starts at rest starts away from
@@ -488,7 +489,7 @@ def identify_tf(data: Trajectory, *, input, output, poles: int, zeros: int, detr
     if detrend == "mean":
         refit = lambda: identify_tf(data, input=input, output=output, poles=poles,  # noqa: E731
                                     zeros=zeros, detrend="none")
-        if step_like(d.u + np.asarray(d.u_offset)):  # a step is never at its mean
+        if step_like(d.u):  # a step is never at its mean
             return keep_better_without_detrending(model, refit, "identify tf",
                                                   lambda m: float(np.mean(m.fit_percent)))
         _warn_if_detrending_hurt(model, refit, d.u.shape[0], d.dt, "identify tf")
@@ -507,7 +508,7 @@ def identify_arx(data: Trajectory, *, input, output, na: int, nb: int, nk: int =
     d = mimo_data(data, input, output, detrend, why="ARX identification")
     model = arx_mimo(d.u, d.y, na, nb, nk, dt=d.dt, u_offset=d.u_offset, y_offset=d.y_offset,
                      **d.signals)
-    if detrend == "mean" and step_like(d.u + np.asarray(d.u_offset)):  # never at its mean
+    if detrend == "mean" and step_like(d.u):  # never at its mean
         refit = lambda: identify_arx(data, input=input, output=output, na=na,  # noqa: E731
                                      nb=nb, nk=nk, detrend="none")
         return keep_better_without_detrending(model, refit, "identify arx",

@@ -39,7 +39,8 @@ from ...signals.trajectory import Trajectory
 from ...units import product_unit, same_dimension
 from ..checks import as_io_matrix
 from ..model_file import SCHEMA, SCHEMA_VERSION, read_document, write_document
-from ..model_protocol import ModelFit, ReportMixin, check_sample_time, column_in_unit
+from ..model_protocol import (ModelFit, ReportMixin, check_horizon, check_sample_time,
+                              column_in_unit)
 from .validation import validate
 
 __all__ = ["VALIDATION_FIT", "IdentifiedLinearModel", "LinearModel", "as_io_matrix", "estimate_x0",
@@ -196,13 +197,6 @@ def k_step_prediction(A, B, C, D, K, u, y, horizon: int) -> np.ndarray:
         Z = Z @ A.T + u[j:j + rows] @ B.T
     out[horizon - 1:] = Z @ C.T + u[horizon - 1:] @ D.T
     return out
-
-
-def _horizon(horizon) -> int:
-    if isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer)) or horizon < 1:
-        raise ArgumentError(f"horizon: expected a whole number of samples ≥ 1, found {horizon!r}",
-                            hint="horizon=1 is the one-step-ahead prediction")
-    return int(horizon)
 
 
 class IdentifiedLinearModel(ReportMixin):
@@ -367,7 +361,7 @@ class IdentifiedLinearModel(ReportMixin):
         """``ŷ(t | t − horizon)`` (N, p) on a trajectory or deviation arrays ``u``, ``y``: the
         model's predictor (innovation gain K; without K the prediction is the free run) from
         the initial state estimated by least squares (:func:`k_step_prediction`)."""
-        h = _horizon(horizon)
+        h = check_horizon(horizon)
         u, yy, dt, yo = self._io(data, y, "prediction of an identified model", dt=dt)
         yh = self._prediction(u, yy, dt, h)
         return yh if yo is None else yh + yo

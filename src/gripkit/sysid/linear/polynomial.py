@@ -49,10 +49,10 @@ from ...params import Parameter, ParameterSet
 from ...signals.trajectory import Trajectory
 from ...units import ratio_unit
 from . import matrix_polynomial as mp
-from .linear_model import (IdentifiedLinearModel, LinearModel, _checked_display_units, _horizon,
+from .linear_model import (IdentifiedLinearModel, LinearModel, _checked_display_units,
                            as_io_matrix, k_step_prediction, malformed, polynomial_document,
                            read_linear_model)
-from ..model_protocol import check_sample_time
+from ..model_protocol import check_horizon, check_sample_time
 from .validation import validate
 
 __all__ = ["PolynomialModel", "load_linear_model"]
@@ -768,7 +768,7 @@ class PolynomialModel(IdentifiedLinearModel):
         if isinstance(data, Trajectory) or self.multivariable:
             return super().predict(data, y, horizon=horizon)
         u, y = np.asarray(data, dtype=np.float64), np.asarray(y, dtype=np.float64)
-        h = _horizon(horizon)
+        h = check_horizon(horizon)
         return self._prediction(u.reshape(-1, 1), y.reshape(-1, 1), self.dt, h)[:, 0]
 
     def _prediction(self, u, y, dt, horizon: int) -> np.ndarray:

@@ -30,7 +30,7 @@ import numpy as np
 
 from ...errors import ArgumentError, ModelError
 from ...signals.trajectory import Trajectory
-from ..model_protocol import ReportMixin, check_sample_time
+from ..model_protocol import ReportMixin, check_horizon, check_sample_time
 
 __all__ = ["NonlinearModel", "OutputErrorPrediction"]
 
@@ -90,14 +90,6 @@ class NonlinearModel(ReportMixin):
         raise self._no_linear_system("to_control")
 
 
-def _horizon(horizon) -> int:
-    """``horizon`` as a whole number of samples ≥ 1 (as the linear families take it)."""
-    if isinstance(horizon, bool) or not isinstance(horizon, (int, np.integer)) or horizon < 1:
-        raise ArgumentError(f"horizon: expected a whole number of samples ≥ 1, found {horizon!r}",
-                            hint="horizon=1 is the one-step-ahead prediction")
-    return int(horizon)
-
-
 class OutputErrorPrediction:
     """``predict`` and ``residuals`` of an output-error model (module docstring) from its
     ``compare(data, y)``; a family gives ``_measured(data, y)`` (the record's measured output,
@@ -124,7 +116,7 @@ class OutputErrorPrediction:
         or on the arrays ``u``, ``y`` ((N,) for one output): the free run that ``compare``
         scores, for every horizon ≥ 1 (an output-error predictor uses no past outputs; module
         docstring). NaN from where the run diverges, after a StabilityWarning."""
-        _horizon(horizon)
+        check_horizon(horizon)
         self._need_output(data, y, "predict")
         return self._shaped(data, self.compare(data, y).simulated)
 
