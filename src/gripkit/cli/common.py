@@ -88,16 +88,11 @@ def check_number(value, option: str, *, minimum: float | None = None, above: flo
 
 
 def check_effort_scale(value: float) -> None:
-    """``--effort-scale`` (effort = K × column): a finite positive factor; a negative one would
-    turn the efforts' sign (negative inertia and friction, units like '(-1 N*s^2)/m')."""
-    from ..errors import DataError
+    """``--effort-scale``: :func:`gripkit.sysid.rigid_body.friction.check_effort_scale`, before
+    the data are read."""
+    from ..sysid.rigid_body.friction import check_effort_scale as check
 
-    if not (math.isfinite(value) and value > 0):
-        raise DataError(f"--effort-scale: expected a finite positive factor, found {value!r}"
-                        f"{' (a negative one turns the effort sign)' if value < 0 else ''}",
-                        hint="give its magnitude (e.g. k_t·N for a current); for an effort "
-                             "column whose sign is opposite to the position's, negate that "
-                             "column in the file")
+    check(value, "--effort-scale")
 
 
 def keyword_or_number(value: str, option: str, keyword: str, kind, low: float, high: float,

@@ -21,7 +21,7 @@ import numpy as np
 
 from ...errors import DataError, UnidentifiableError
 from ...signals.trajectory import Trajectory
-from .friction import EFFORT_SCALE_HINT, IdimSamples, idim_samples
+from .friction import IdimSamples, check_effort_scale, idim_samples
 
 __all__ = ["DynamicsData", "dynamics_data", "SLOW_FRACTION"]
 
@@ -69,10 +69,7 @@ def dynamics_data(data: Trajectory, joints, position, effort, velocity=None, *,
             raise DataError(f"{what}: {len(cols)} column(s) {list(cols)} for the {len(joints)} "
                             f"actuated joints {', '.join(joints)}",
                             hint="give one column per joint, in that order")
-    if not (np.isfinite(effort_scale) and effort_scale > 0):
-        raise DataError(f"effort_scale: expected a finite positive factor, found {effort_scale!r}"
-                        f" (a negative one turns the efforts' sign: negative inertias and "
-                        f"friction)", hint=EFFORT_SCALE_HINT)
+    check_effort_scale(effort_scale, "effort_scale")
     dt = data.require_uniform(why="inverse-dynamics identification (filtering and "
                                   "differentiation)")
     P = np.column_stack([data[c] for c in position])

@@ -456,6 +456,17 @@ EFFORT_SCALE_HINT = ("give its magnitude (e.g. k_t·N for a current); for an eff
                      "sign is opposite to the position's, negate that column in the file")
 
 
+def check_effort_scale(value, name: str = "effort scale") -> None:
+    """The effort factor K (effort = K × column): finite and positive, else a DataError naming
+    ``name`` (the argument or CLI option); a negative K would turn the efforts' sign (negative
+    inertia and friction, units like '(-1 N*s^2)/m')."""
+    if not (np.isfinite(value) and value > 0):
+        turned = (" (a negative one turns the efforts' sign: negative inertia and friction)"
+                  if value < 0 else "")
+        raise DataError(f"{name}: expected a finite positive factor, found {value!r}{turned}",
+                        hint=EFFORT_SCALE_HINT)
+
+
 @entry_point
 def idim_ls(position, effort, *, dt: float, effort_scale: float = 1.0, cutoff: float | None = None,
             order: int = 4, decimation: int | None = None,
@@ -484,10 +495,7 @@ def idim_ls(position, effort, *, dt: float, effort_scale: float = 1.0, cutoff: f
         filtered Coulomb step does not follow sign(q̇).
     """
     x, e = _same_length(position=position, effort=effort)
-    if not (np.isfinite(effort_scale) and effort_scale > 0):
-        raise DataError(f"effort scale: expected a finite positive factor, found {effort_scale!r}"
-                        f" (a negative one turns the effort's sign: negative inertia and "
-                        f"friction)", hint=EFFORT_SCALE_HINT)
+    check_effort_scale(effort_scale)
     # work at unit size (exact powers of two: data at any scale); q' = cx·q, τ' = ce·τ give
     # J' = J·ce/cx, F_v' = F_v·ce/cx, F_c' = F_c·ce, τ₀' = τ₀·ce, mapped back at the end
     cx, ce = unit_scale(x), unit_scale(e * effort_scale)
