@@ -189,7 +189,7 @@ def make_halves_kernel():
     def loop(w, size, io, run, state, mode):  # pragma: no cover - compiled
         u, y, theta_out, std_out, yhat_out, err_out = io
         at, dims, lam, maxtr, nstart, store, pred = run
-        trace, V, w1, w2, nupd, f = state
+        trace, V, w1, w2, nupd, f, loss = state
         p, na, nb, nk = len(size[0]), len(size[1]), len(size[2]), len(size[3])
         for t in range(nstart, u.shape[0]):
             for i in range(na):
@@ -205,14 +205,16 @@ def make_halves_kernel():
             w1 = lam * w1 + 1.0
             w2 = lam * lam * w2 + 1.0
             nupd += 1.0
+            yh = y[t] - e
+            loss += (y[t] - yh) * (y[t] - yh)
             if pred:
-                yhat_out[t] = y[t] - e
-                err_out[t] = e
+                yhat_out[t] = yh
+                err_out[t] = y[t] - yh
             if store:
                 f = V / (w1 - p) * (w2 / w1) if (nupd > p and w1 > p) else np.nan
                 for i in range(p):
                     theta_out[t, i] = w[at[1] + i]
-        return trace, V, w1, w2, nupd, f
+        return trace, V, w1, w2, nupd, f, loss
 
     glb = dict(rls._rls_run.py_func.__globals__, _batch_loop=loop)
     return njit(types.FunctionType(rls._rls_run.py_func.__code__, glb, "_rls_run_halves"))

@@ -3,7 +3,8 @@ piece: the input checks as they were (numpy's min and max of each signal for fin
 peaks) beside the one scan per signal that now does them and the corrupt-sample test, the scale
 check, the batch
 kernel with and without the a-priori prediction ŷ and error e (into reused arrays and into a new
-(2, N) block), the loss e·e and the whole call; beside them the plain numba RLS of ``bench_rls``
+(2, N) block), a second pass for the loss e·e (which the kernel now sums as it goes) and the
+whole call; beside them the plain numba RLS of ``bench_rls``
 (final θ and σ only). [3 3 1], N = 1e6, λ = 0.999, windup 'none', 9 alternating runs each, wall
 and thread CPU time.
 
@@ -54,7 +55,7 @@ def main() -> None:
         "kernel, ŷ/e into reused arrays":
             lambda: _rls_run(s0.copy(), u, y, none, none, block[0], block[1], size),
         "kernel, ŷ/e into a new (2,N) block": new_block,
-        "loss e·e": lambda: float(block[1] @ block[1]),
+        "loss e·e as a second pass (now in the kernel)": lambda: float(block[1] @ block[1]),
         "RLS.run(store=False), whole call": lambda: fresh().run(u, y, store=False),
         "plain numba RLS, final θ and σ": lambda: B._plain_rls(u, y, B.LAM, B.P0, none, none),
     }

@@ -249,3 +249,18 @@ def test_trajectory_export():
     assert {"a1", "b3", "a1_std", "y_pred", "error"} <= set(tr.names)
     assert tr.dt == pytest.approx(0.005)
     np.testing.assert_allclose(tr["a1"][-1], r.theta_final[0])
+
+
+def test_loss_summed_in_the_kernel_is_eq29_of_the_stored_errors():
+    """The batch kernel sums e² as it goes (no second pass over e): the loss is ½·e·e/updates of
+    the stored a-priori errors (eq (29)) to rounding, on a first record and on a second one run
+    from the first's state (whose first samples go through the streaming step, with updates)."""
+    u, y = simulate_arx(3000, noise=0.3, seed=5)
+    est = RLS(2, 2, 2, forgetting=0.999)
+    first = est.run(u[:2000], y[:2000])
+    second = est.run(u[2000:], y[2000:])
+    for res, nupd in ((first, 2000 - 3), (second, 1000)):
+        e = res.errors[res.first_update:]
+        assert e.size == nupd
+        np.testing.assert_allclose(res.loss, 0.5 * float(e @ e) / nupd, rtol=1e-12)
+        assert np.all(res.errors[:res.first_update] == 0.0)

@@ -312,7 +312,9 @@ def _batch_loop(w, size, io, run, state, mode):
     literal: :func:`_rls_run` calls it once per mode, so each loop holds one update instead of
     three behind a branch per sample). ``io``: u, y and the four output arrays; ``run``: the
     buffer offsets, (p, na, nb, nk), λ, the trace bound, ``nstart`` and the store / predict flags;
-    ``state``: (trace, V, w₁, w₂, updates, σ factor of the last step), returned updated.
+    ``state``: (trace, V, w₁, w₂, updates, σ factor of the last step, Σe²), returned updated
+    (Σe² over the a-priori errors as stored: the loss of :meth:`RLS.run`, summed here rather than
+    in a second pass over e).
 
     The update is :func:`_gain` then :func:`_apply` (the streaming step's halves) written out in
     the loop, with the same arithmetic in the same order, so batch and streaming results stay
@@ -323,7 +325,7 @@ def _batch_loop(w, size, io, run, state, mode):
     """
     u, y, theta_out, std_out, yhat_out, err_out = io
     at, dims, lam, maxtr, nstart, store, pred = run
-    trace, V, w1, w2, nupd, f = state
+    trace, V, w1, w2, nupd, f, loss = state
     oP, oth, oph, oq = at
     if len(size[0]) > 0:  # the orders are known to the compiler: constant regressor indices
         p, na, nb, nk = len(size[0]), len(size[1]), len(size[2]), len(size[3])
@@ -379,22 +381,25 @@ def _batch_loop(w, size, io, run, state, mode):
         w1 = lam * w1 + 1.0
         w2 = lam * lam * w2 + 1.0
         nupd += 1.0
+        yh = y[t] - e
+        err = y[t] - yh  # y − ŷ as stored (bit-identical to the arrays' difference)
+        loss += err * err
         if pred:
-            yh = y[t] - e
             yhat_out[t] = yh
-            err_out[t] = y[t] - yh  # y − ŷ as stored (bit-identical to the arrays' difference)
+            err_out[t] = err
         if store:
             f = V / (w1 - p) * (w2 / w1) if (nupd > p and w1 > p) else np.nan
             for i in range(p):
                 theta_out[t, i] = w[oth + i]
-    return trace, V, w1, w2, nupd, f
+    return trace, V, w1, w2, nupd, f, loss
 
 
 @njit(cache=True)
 def _rls_run(s, u, y, theta_out, std_out, yhat_out, err_out, size):
     """Batch RLS: updates ``s`` over the record; writes θ and σ at every step when their arrays
     have N rows (pass arrays with 0 rows to skip storing), and the a-priori prediction ŷ and error
-    y − ŷ (``err_out``, computed from the stored ŷ) when ``yhat_out`` has N rows.
+    y − ŷ (``err_out``, computed from the stored ŷ) when ``yhat_out`` has N rows. Returns Σe² over
+    the record (e = 0 where no update was made).
 
     ``size``: four empty tuples (generic kernel, orders read from ``s`` at run time) or tuples of
     p, na, nb and nk zeros (:meth:`RLS._kernel_size`), whose lengths numba knows at compile time: it
@@ -417,19 +422,22 @@ def _rls_run(s, u, y, theta_out, std_out, yhat_out, err_out, size):
     pred = yhat_out.shape[0] == n
     t0 = na if na > nk + nb - 1 else nk + nb - 1
     nstart = t0 if t0 < n else n
+    loss = 0.0
     for t in range(nstart):
         e = _rls_step(s, u[t], y[t], size)
+        yh = y[t] - e
+        err = y[t] - yh  # y − ŷ as stored (bit-identical to the arrays' difference)
+        loss += err * err
         if pred:
-            yh = y[t] - e
             yhat_out[t] = yh
-            err_out[t] = y[t] - yh  # y − ŷ as stored (bit-identical to the arrays' difference)
+            err_out[t] = err
         if store:
             f = _var_factor(s, p)
             for i in range(p):
                 theta_out[t, i] = s[oth + i]
                 std_out[t, i] = math.sqrt(f * s[op + i * p + i])
     if n <= nstart:
-        return
+        return loss
     # P, θ, φ and q in one local buffer at constant offsets (for the compiler: no aliasing)
     bP, bth, bph, bq = 0, p * p, p * p + p, p * p + 2 * p
     w = np.empty(p * p + 3 * p)
@@ -439,7 +447,7 @@ def _rls_run(s, u, y, theta_out, std_out, yhat_out, err_out, size):
         w[bP + i] = s[op + i]
     lam, mode, maxtr, trace = s[_LAM], int(s[_MODE]), s[_MAXTR], s[_TRACE]
     V, w1, w2, nupd = s[_V], s[_W1], s[_W2], s[_NUPD]
-    state = (trace, V, w1, w2, nupd, np.nan)
+    state = (trace, V, w1, w2, nupd, np.nan, loss)
     io = (u, y, theta_out, std_out, yhat_out, err_out)
     run = ((bP, bth, bph, bq), (p, na, nb, nk), lam, maxtr, nstart, store, pred)
     if mode == 0:  # the mode as a literal: one compact loop per mode (docs/performance.md)
@@ -448,7 +456,7 @@ def _rls_run(s, u, y, theta_out, std_out, yhat_out, err_out, size):
         state = _batch_loop(w, size, io, run, state, 1)
     else:
         state = _batch_loop(w, size, io, run, state, 2)
-    trace, V, w1, w2, nupd, f = state
+    trace, V, w1, w2, nupd, f, loss = state
     if store:  # σ of the last step
         for i in range(p):
             std_out[n - 1, i] = math.sqrt(f * w[bP + i * p + i])
@@ -466,6 +474,7 @@ def _rls_run(s, u, y, theta_out, std_out, yhat_out, err_out, size):
         s[_HDR + i] = y[n - 1 - i]
     for i in range(nu):
         s[_HDR + na + i] = u[n - 1 - i]
+    return loss
 
 
 class RLS:
@@ -784,7 +793,7 @@ class RLS:
         # system and faulted in again (docs/performance.md, "Issue 24: RLS with history")
         yhat, e = np.empty((2, n))
         n0 = self.n_updates
-        _rls_run(self._s, u, y, theta, std, yhat, e, self._kernel_size(n))
+        sum_e2 = _rls_run(self._s, u, y, theta, std, yhat, e, self._kernel_size(n))
         self._s[_PU], self._s[_PY] = peaks
         if not (np.isfinite(self.P).all() and np.isfinite(self.theta).all()):
             raise self._diverged(f"after {self.n_updates} updates")
@@ -792,7 +801,7 @@ class RLS:
         if nupd == 0:
             raise DataError(f"RLS [{self.na} {self.nb} {self.nk}] made no update on {n} samples",
                             hint="give a record longer than the model's initial samples")
-        loss = 0.5 * float(e[n - nupd:] @ e[n - nupd:]) / nupd
+        loss = 0.5 * sum_e2 / nupd
         return RLSResult(names=self.names, na=self.na, nb=self.nb, nk=self.nk, dt=self.dt,
                          forgetting=self.forgetting, windup=self.windup,
                          theta=theta if store else None, theta_std=std if store else None,
