@@ -45,7 +45,10 @@ IO = dict(input="current", output="force")
 FAMILIES = {
     "arx": lambda: identify(TR, "arx", na=2, nb=2, nk=1, **IO),
     "narx": lambda: identify(TR, "narx", degree=2, lags=2, **IO),
+    "rational narx": lambda: identify(TR, "narx", basis="rational", degree=1, den_degree=1,
+                                      lags=2, **IO),
     "hw": lambda: identify(TR, "hw", input_nonlinearity="saturation", nb=2, nf=2, nk=1, **IO),
+    "nlss": lambda: identify(TR, "nlss", order=2, degree=2, progress=False, **IO),
     "bouc-wen oscillator": lambda: BoucWenOscillatorModel(
         mass=1.0, damping=6.0, k_e=2000.0, k_h=2000.0, beta=300.0, gamma=100.0, offset=0.0,
         dt=1e-3, free=(), input_name="current", output_name="force", input_unit="A",
@@ -110,11 +113,12 @@ def _first_number_path(doc, keys):
 
 
 #: a number of each family's file that no other field repeats
-NUMBER = {"narx": ("theta", 0), "hw": ("theta", 0), "bouc-wen oscillator": ("k_e",)}
+NUMBER = {"narx": ("theta", 0), "rational narx": ("theta", 0), "hw": ("theta", 0),
+          "nlss": ("A", 0, 0), "bouc-wen oscillator": ("k_e",)}
 
 
 def test_a_number_edited_warns_or_is_refused(saved):
-    """One number edited: the families' parameter (θ₀, k_e) loads with the warning and the
+    """One number edited: the families' parameter (θ₀, A₀₀, k_e) loads with the warning and the
     edited value; in an ARX file the denominator edited in the system alone is the malformed
     file's ModelError (its two copies disagree), as before."""
     family, path = saved
@@ -199,3 +203,17 @@ def test_cli_shows_the_warning_as_one_line(cli, tmp_path):
         res = cli(*args, "--json")
         assert res.code == 0, res.err
         assert_warned(res, PHRASE)
+
+
+def test_canonical_text_is_the_documented_one():
+    """The digest's text, written out by hand for a small document: keys sorted at every level,
+    no spaces, non-ASCII escaped, each float as its shortest round-trip form (0.1, 1e-300, 1.0
+    kept distinct from 1), the entry content_sha256 left out; dict order does not matter."""
+    from gripkit.sysid.model_file import content_hash
+
+    doc = {"units": {"y": "µN", "u": "A"}, "dt": 0.1, "a": [1.0, 1, -0.0, 1e-300, 2.5e17],
+           "content_sha256": "anything"}
+    text = ('{"a":[1.0,1,-0.0,1e-300,2.5e+17],"dt":0.1,'
+            '"units":{"u":"A","y":"\\u00b5N"}}')
+    assert content_hash(doc) == hashlib.sha256(text.encode("ascii")).hexdigest()
+    assert content_hash(dict(reversed(list(doc.items())))) == content_hash(doc)
