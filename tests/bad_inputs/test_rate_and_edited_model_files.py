@@ -136,6 +136,7 @@ def _set(keys, value):
 
 
 @pytest.mark.filterwarnings("ignore::gripkit.errors.AccuracyWarning")
+@pytest.mark.filterwarnings("ignore::gripkit.errors.DataWarning")  # edited: content differs
 @pytest.mark.parametrize("keys, value, phrase", [
     (("system", "den", 0, 0, 1), -1.4, "'system.den' and the 'polynomial' section disagree"),
     (("system", "den", 0, 0, 2), 1.5, "'system.den' and the 'polynomial' section disagree"),
@@ -155,6 +156,7 @@ def test_arx_file_copies_that_disagree_are_refused(arx_file, tmp_path, cli, keys
 
 
 @pytest.mark.filterwarnings("ignore::gripkit.errors.AccuracyWarning")
+@pytest.mark.filterwarnings("ignore::gripkit.errors.DataWarning")  # edited: content differs
 @pytest.mark.parametrize("keys, value, phrase", [
     (("dt",), 0.5, "'dt' is 0.5 but 'system.dt' is 0.01"),
     (("outputs", 0, "offset"), "x", "'outputs[0].offset' must be a finite number, found 'x'"),
@@ -206,6 +208,7 @@ def _saved(family: str, tmp_path):
     return m, path
 
 
+@pytest.mark.filterwarnings("ignore::gripkit.errors.DataWarning")  # edited: content differs
 @pytest.mark.parametrize("family, keys, value, phrase", NONLINEAR_EDITS)
 def test_nonlinear_file_field_out_of_domain_is_refused(family, keys, value, phrase, tmp_path,
                                                        cli):
@@ -232,6 +235,7 @@ def test_untouched_nonlinear_file_gives_the_same_fit(family, tmp_path):
     assert load_model(path).compare(U, Y).fit_percent == m.compare(U, Y).fit_percent
 
 
+@pytest.mark.filterwarnings("ignore::gripkit.errors.DataWarning")  # edited: content differs
 def test_nonlinear_model_reads_the_data_in_its_units(tmp_path):
     """Item 2d, a readable unit of another quantity: a NARX file whose output_unit says
     'furlong' (a length) compared with a record whose output is in V is refused with the linear
@@ -251,6 +255,7 @@ def test_nonlinear_model_reads_the_data_in_its_units(tmp_path):
 
 
 @pytest.mark.filterwarnings("ignore::gripkit.errors.AccuracyWarning")
+@pytest.mark.filterwarnings("ignore::gripkit.errors.DataWarning")  # edited: content differs
 def test_arx_polynomial_edited_with_its_info_copy_is_refused(arx_file, tmp_path):
     """Item 2a: a1 edited in the polynomial section and in info alike (the system left): the
     system the file shows is not the model's, so the file is refused, naming 'system.den'."""

@@ -13,7 +13,7 @@ import pytest
 from test_identify_dynamics import fourier_states, torques
 
 from gripkit.cli import main
-from gripkit.errors import AccuracyWarning, ModelError
+from gripkit.errors import DataWarning, ModelError
 from gripkit.multibody import from_urdf, to_urdf
 from gripkit.sysid import identify_dynamics, load_dynamics_model
 
@@ -82,9 +82,21 @@ def test_tampered_file_warns(saved):
     doc = json.loads(saved.read_text())
     doc["parameters"]["values"][0] *= 1.5
     saved.write_text(json.dumps(doc))
-    with pytest.warns(AccuracyWarning, match="content hash mismatch"):
+    with pytest.warns(DataWarning, match="its content differs from what gripkit wrote"):
         m = load_dynamics_model(saved)
     assert m.theta[0] == doc["parameters"]["values"][0]
+
+
+def test_file_without_digest_loads_silently(saved):
+    """The content digest removed: the file loads without a warning (nothing says it was
+    edited), with the parameters saved."""
+    doc = json.loads(saved.read_text())
+    del doc["content_sha256"]
+    saved.write_text(json.dumps(doc))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DataWarning)
+        m = load_dynamics_model(saved)
+    assert list(m.theta) == doc["parameters"]["values"]
 
 
 @pytest.mark.parametrize("change, phrase", [

@@ -7,7 +7,7 @@ import warnings
 import numpy as np
 import pytest
 
-from gripkit.errors import AccuracyWarning, ModelError
+from gripkit.errors import DataWarning, ModelError
 from gripkit.lti import from_control
 from gripkit.sysid import load_model, n4sid, pem, tfest
 
@@ -65,7 +65,7 @@ def test_edited_file_warns_hash_mismatch(model, tmp_path):
     doc = json.loads(p.read_text())
     doc["system"]["A"][0][0] += 1e-3
     p.write_text(json.dumps(doc))
-    with pytest.warns(AccuracyWarning, match="hash mismatch"):
+    with pytest.warns(DataWarning, match="its content differs from what gripkit wrote"):
         load_model(p)
 
 

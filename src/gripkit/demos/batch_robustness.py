@@ -15,8 +15,8 @@ from ..systems.tsfm.robustness import DEFAULT_POPULATION, DEFAULT_SETTINGS, robu
 def run(report, *, quick: bool = False) -> dict:
     n = 120 if quick else 400
     t0 = time.perf_counter()
-    hold = robustness_study(n=n, seed=1, backend="in-process", progress=False, name="demo-hold")
-    naive = robustness_study(n=n, seed=1, backend="in-process", progress=False, name="demo-naive",
+    hold = robustness_study(n=n, seed=1, backend="in-process", progress=True, name="demo-hold")
+    naive = robustness_study(n=n, seed=1, backend="in-process", progress=True, name="demo-naive",
                              settings={**DEFAULT_SETTINGS, "wait_for_other": False})
     seconds = time.perf_counter() - t0
     pop = "; ".join(f"{k} {next(iter(v))} "

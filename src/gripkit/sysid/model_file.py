@@ -5,9 +5,14 @@ The models themselves (:class:`~gripkit.sysid.LinearModel`: ``model.save(path)``
 
 The linear-model document is described at :func:`gripkit.sysid.linear.linear_model.model_document`.
 
-``content_sha256`` is the SHA-256 of the canonical JSON (sorted keys, no spaces) of everything
-else; :func:`load_model` warns when it does not match (the file was edited by hand) and refuses a
-file of another schema or a newer version.
+Every model file gripkit writes (linear, dynamics and the nonlinear families') ends with
+``content_sha256``, the digest of its content (:func:`content_hash`): the SHA-256 of the canonical
+JSON of every other entry of the document (schema and versions, names, units, sample time,
+coefficients, σ, covariance, offsets, fit, provenance), written atomically with the rest. On load
+a digest that does not match is one DataWarning (:func:`check_content_hash`): the file was edited
+after gripkit wrote it, and is used as it now stands. A file without the entry (a nonlinear
+family's file written before gripkit wrote one) loads silently. :func:`load_model` refuses a file
+of another schema or a newer version.
 """
 
 from __future__ import annotations
@@ -22,13 +27,12 @@ from pathlib import Path
 import numpy as np
 
 from ..atomic import write_text
-from ..errors import (AccuracyWarning, DataError, ModelError, ParameterError, PathError,
-                      emit_warning)
+from ..errors import DataError, DataWarning, ModelError, ParameterError, PathError, emit_warning
 from ..units import si_factor
 
 __all__ = ["file_sha256", "plain", "write_document", "read_document", "read_family_document",
            "FamilyFile", "file_provenance", "Domain", "check_family_fields", "SAMPLE_TIME",
-           "SCHEMA", "SCHEMA_VERSION"]
+           "SCHEMA", "SCHEMA_VERSION", "content_hash", "check_content_hash", "RESAVE"]
 
 SCHEMA = "gripkit.linear-model"
 SCHEMA_VERSION = 2
@@ -64,10 +68,33 @@ def plain(x):
 
 
 def content_hash(doc: dict) -> str:
-    """SHA-256 of the canonical JSON (sorted keys, no spaces) of ``doc`` less ``content_sha256``."""
+    """The content digest of a model file's document ``doc`` (as JSON reads it back): the SHA-256
+    (hex) of the UTF-8 bytes of ``json.dumps(body, sort_keys=True, separators=(",", ":"),
+    ensure_ascii=True)``, ``body`` being ``doc`` less its ``content_sha256``. Keys sorted at every
+    level, no spaces, non-ASCII text escaped, each number as Python writes it (the shortest text
+    that reads back the same double; NaN for a family that writes NaN), so the digest depends on
+    neither the file's indentation and key order nor the platform; a number spelled otherwise
+    but equal ("1.50", "15e-1") gives the same digest."""
     body = {k: v for k, v in doc.items() if k != "content_sha256"}
-    return (hashlib.sha256(json.dumps(body, sort_keys=True,
-                                      separators=(",", ":")).encode()).hexdigest())
+    text = json.dumps(body, sort_keys=True, separators=(",", ":"), ensure_ascii=True)
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+#: how to write a model file again (the hint of :func:`check_content_hash`'s warning)
+RESAVE = "gripkit.sysid.load_model(path).save(path)"
+
+
+def check_content_hash(doc: dict, what: str, resave: str = RESAVE) -> None:
+    """One DataWarning when the document ``doc`` of the model file ``what`` (how the message
+    names it) holds a ``content_sha256`` that is not its :func:`content_hash`: the file was
+    edited after gripkit wrote it (a hand edit stays possible: the file is used as it stands);
+    ``resave`` says how to write it again. Silent for a document without the entry (a nonlinear
+    family's file written before gripkit wrote one): nothing says it was edited."""
+    if "content_sha256" in doc and doc["content_sha256"] != content_hash(doc):
+        emit_warning(f"{what}: its content differs from what gripkit wrote (content_sha256 does "
+                     "not match: edited after it was saved), so its numbers and units are used "
+                     f"as they now stand; if the edit is meant, write it again to drop this "
+                     f"warning: {resave}", DataWarning)
 
 
 def write_document(doc: dict, path) -> None:
@@ -103,10 +130,14 @@ class FamilyFile:
 
     def save(self, path) -> Path:
         """Write the model as JSON (the document of :meth:`to_dict`, its ``schema`` naming the
-        family, and the provenance ``data``), atomically. A ModelError, and no file, for a
+        family, the provenance ``data`` and the content digest ``content_sha256``:
+        :func:`content_hash`), atomically. A ModelError, and no file, for a
         model whose fit is NaN or ±inf or one of whose σ is infinite (a failed fit)."""
         _check_usable(self, path)
-        doc = {**self.to_dict(), **self.provenance_document()}
+        text = json.dumps({**self.to_dict(), **self.provenance_document()},
+                          allow_nan=self._file_allow_nan)
+        doc = json.loads(text)  # the digest of the document as the reader will see it
+        doc["content_sha256"] = content_hash(doc)
         return write_text(path, json.dumps(doc, indent=1, allow_nan=self._file_allow_nan) + "\n",
                           what=self._file_what)
 
@@ -176,10 +207,11 @@ def _nesting(doc) -> int:
 def read_document(path, schema: str = SCHEMA, newest: int = SCHEMA_VERSION, *,
                   what: str = "model file",
                   hint: str = "give a file written by gripkit identify --out "
-                              "or model.save()") -> dict:
+                              "or model.save()", resave: str = RESAVE) -> dict:
     """The JSON document of the model file ``path``, checked: ``schema`` and a ``schema_version``
-    from 1 to ``newest`` (ModelError otherwise), and its content hash (AccuracyWarning when the
-    file was edited after it was saved)."""
+    from 1 to ``newest`` (ModelError otherwise), and its content digest
+    (:func:`check_content_hash`: a DataWarning, whose hint is ``resave``, when the file was
+    edited after it was saved)."""
     path = Path(path)
     try:
         doc = json.loads(path.read_text())
@@ -208,10 +240,7 @@ def read_document(path, schema: str = SCHEMA, newest: int = SCHEMA_VERSION, *,
     if not isinstance(ver, int) or ver < 1 or ver > newest:
         raise ModelError(f"{what} {where}: expected schema_version 1 … {newest}, found {ver!r}",
                          hint="upgrade gripkit to read files written by a newer version")
-    if doc.get("content_sha256") != content_hash(doc):
-        emit_warning(f"{what} {where}: content hash mismatch (the file was edited after "
-                     "it was saved); "
-                     f"using it as it is", AccuracyWarning)
+    check_content_hash(doc, f"{what} {where}", resave)
     return doc
 
 
@@ -220,8 +249,9 @@ def read_family_document(path, schema: str, version, *, family: str, writer: str
     """The JSON document of a nonlinear family's model file ``path`` (``family``: 'narx', 'hw',
     …; ``writer``: what writes such a file), checked: readable JSON, its ``schema`` and its
     ``version_key`` equal to ``version`` (an int, or a tuple of the versions read), its provenance
-    ``data`` null, absent or a file's name and hash (:func:`file_provenance`). PathError for a
-    missing or unreadable file, ModelError for anything else."""
+    ``data`` null, absent or a file's name and hash (:func:`file_provenance`), its content digest
+    (:func:`check_content_hash`: a DataWarning for a file edited after it was saved). PathError
+    for a missing or unreadable file, ModelError for anything else."""
     versions = version if isinstance(version, tuple) else (version,)
     p = Path(path)
     what = f"{family} model file {str(p)!r}"
@@ -250,7 +280,11 @@ def read_family_document(path, schema: str, version, *, family: str, writer: str
         raise ModelError(f"{str(p)!r} is a {schema} of {version_key} {found!r}; this gripkit "
                          f"reads {version_key} {' or '.join(map(str, versions))}",
                          hint=f"write it again with this gripkit ({writer})")
+    if _nesting(doc) > MAX_NESTING:  # before writing or hashing any part of it
+        raise ModelError(f"{what}: its JSON nests lists or objects more than {MAX_NESTING} deep; "
+                         "a model file nests a few levels")
     _check_provenance(doc, what)
+    check_content_hash(doc, what)
     return doc
 
 

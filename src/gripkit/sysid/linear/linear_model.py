@@ -588,7 +588,7 @@ def read_linear_model(path) -> tuple[dict, LinearModel, str]:
     ``polynomial`` section, is :func:`gripkit.sysid.linear.polynomial.load_linear_model`.
 
     Raises ModelError for a file that is not a gripkit model (wrong ``schema``), of a newer
-    ``schema_version``, or with missing fields; warns (AccuracyWarning) when the content hash does
+    ``schema_version``, or with missing fields; warns (DataWarning) when the content digest does
     not match (the file was edited after it was saved).
 
     Examples

@@ -716,8 +716,8 @@ def load_dynamics_model(path) -> DynamicsResult:
 
     Raises DataError for a missing file, a file that is not JSON, of another ``schema`` or of a
     newer
-    ``schema_version``; ModelError for missing or malformed fields; warns (AccuracyWarning) when
-    the content hash does not match (the file was edited after it was saved).
+    ``schema_version``; ModelError for missing or malformed fields; warns (DataWarning) when
+    the content digest does not match (the file was edited after it was saved).
     """
     doc = read_dynamics_document(path)
     where = repr(str(Path(path)))

@@ -27,6 +27,7 @@ import numpy as np
 
 from ...consistency import ConsistencyReport, check
 from ...excitation import bandlimited_noise, multisine
+from ...progress import status
 from ...report import plots
 from ...signals.filters import apply_sos
 from ...sysid import arx, oe, rls
@@ -343,13 +344,19 @@ def run(report, *, quick: bool = False) -> dict:
     (400 and 4000 samples), so the section takes a few seconds once numba's RLS kernel is compiled
     (about 10 s the first time); ``quick`` changes nothing."""
     t_start = time.perf_counter()
+    status("  amadeus-identification: simulated records (§V-E)")
     study = _simulate_study()
     sec = _intro(report, study)
+    status("  amadeus-identification: least squares over Table II's structures")
     fits = _ls_table(sec, study)        # LS over Table II's structures
     winners = _winners(sec, fits)
+    status("  amadeus-identification: zeros (§V-F)")
     zsum = _zeros(sec, study, fits)     # non-minimum-phase [2 2 2], minimum-phase [2 2 10]
+    status("  amadeus-identification: output error and residual tests")
     val_arx, val_oe = _output_error(sec, study, fits)  # OE removes the ARX bias; residual tests
+    status("  amadeus-identification: RLS over Table III's structures")
     _rls(sec, study)                    # RLS over Table III's structures
+    status("  amadeus-identification: stepped sine (Fig. 14)")
     _fig14(sec, study)                  # the stepped-sine experiment against Table II [2 2 2]
     # `gripkit zoo check amadeus-finger-force`: the plant's numbers, Fig. 14 and the §V-F statements
     sec.findings(ConsistencyReport(check(study.plant), "amadeus-finger-force (zoo check), with the "

@@ -13,6 +13,7 @@ import numpy as np
 from ...consistency import check
 from ...errors import ConsistencyWarning
 from ...models.bldc import RPM, SLOPES_5_4_2, BLDCMotor, MotorTestBed
+from ...progress import status
 from ...report.plots import subplots
 from ...signals import Trajectory
 from ...sysid.rigid_body.friction import detect_breakaway, fit_stribeck, idim_ls
@@ -49,17 +50,25 @@ def run(report, *, quick: bool = False) -> dict:
         "elasticity. Where the "
         "thesis's printed numbers disagree, gripkit derives the value it uses and reports the "
         "contradiction:")
+    status("  dlr-hit: consistency")
     rep = check(f)
     sec.findings(rep)
     summary["inconsistent_checks"] = [x.check for x in rep.inconsistent]
+    status("  dlr-hit: motor maps and identification (§5.4)")
     rng = _motor_maps(sec, summary, quick)
+    status("  dlr-hit: friction tables (Appendix G)")
     _friction(sec, f)
+    status("  dlr-hit: velocity responses (Figs 7.3-7.5)")
     _velocity_responses(sec, f, summary)
+    status("  dlr-hit: breakaway and IDIM-LS friction identification")
     _stiction_and_idim(sec, summary, quick, rng)
+    status("  dlr-hit: friction adaptation")
     _adaptation(sec, f, summary, quick)
     _loop_adaptation(sec, f, summary)
     _thermal_adaptation(sec, summary)
+    status("  dlr-hit: impedance control")
     _impedance(sec, f, summary)
+    status("  dlr-hit: five-finger hand")
     _hand(sec, summary)
     return summary
 

@@ -14,6 +14,7 @@ from ...consistency import ConsistencyReport, check
 from ...errors import AccuracyWarning, ConsistencyWarning
 from ...models.beams import clamped_clamped_stiffness
 from ...models.comb_drive import comb_drive_force, comb_drive_gain
+from ...progress import status
 from ...report.plots import subplots
 from ...signals.trajectory import Trajectory
 from ...sysid.physical.step_response import identify_step
@@ -43,11 +44,17 @@ def run(report, *, quick: bool = False) -> dict:
         calibrated = FTG100Plant(plant_parameters(force_factor="static-70V"))
         stretching = FTG100Plant(plant_parameters(suspension="stretching"))
     dt = 5e-05  # s: the seed's 20 kHz
+    status("  ftg100: model and printed numbers (eqs 3-18)")
     _model_section(report, summary, act, sen, cpl, plant, dt)
+    status("  ftg100: static deflection at 70 V")
     _static_section(report, summary, act, plant, calibrated, stretching)
+    status("  ftg100: step responses")
     free = _step_section(report, act, sen, stretching, dt)
+    status("  ftg100: resonance vs actuation voltage (Fig. 5)")
     _resonance_section(report, summary, free, dt, quick)
+    status("  ftg100: identification (§III-B)")
     _identification_section(report, summary, quick)
+    status("  ftg100: hybrid force/position control")
     _hybrid_section(report, summary, plant, quick)
     return summary
 
