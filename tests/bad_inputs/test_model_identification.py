@@ -91,7 +91,8 @@ def test_simulate_data_missing_an_input_column(cli, files, tmp_path):
 
 def test_constant_input_column(cli, files):
     res = cli("identify", "ss", files / "flat_b.csv", "--input", "a,b", "--output", "c,d")
-    assert_user_error(res, "DataError", "input column 'b' is constant")
+    assert_user_error(res, "UnidentifiableError", "input column 'b' is constant (0.85 for all 3000 "
+                                                  "samples): a constant input cannot identify B")
 
 
 def test_bad_order_text(cli, files):

@@ -282,3 +282,23 @@ def test_a_sweep_reports_its_jobs_warnings_once_per_kind(backend):
     assert "not settled" in accuracy[0]
     assert 150 <= n <= 200
     assert result.n_jobs == 200 and not result.failed.any()
+
+
+def test_job_warnings_are_summed_over_chunks_once_per_kind():
+    """The sweep's one summary per kind (batch.scenarios.summarise_warnings, as for the rows of
+    step_metrics_rows): counts and totals of the chunks' records summed (2 + 3 of 4 + 5 jobs),
+    the first text kept; a record of unknown total (a job's own warning) makes it a count of
+    warnings."""
+    import warnings
+
+    from gripkit.batch.sweep import _report_job_warnings
+    from gripkit.errors import AccuracyWarning, DataWarning
+
+    found = [(AccuracyWarning, "first", 2, 4), (DataWarning, "own", 1, None),
+             (AccuracyWarning, "second", 3, 5), (DataWarning, "own again", 1, None)]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        _report_job_warnings("s", found)
+    assert [(w.category, str(w.message)) for w in caught] == [
+        (AccuracyWarning, "sweep 's': 5 of 9 jobs gave this; the first: first"),
+        (DataWarning, "sweep 's': its jobs gave 2 warnings like this; the first: own")]

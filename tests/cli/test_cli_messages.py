@@ -34,14 +34,17 @@ def _arx_data(n=400, seed=0):
     return u, y + 0.01 * rng.standard_normal(n)
 
 
-@pytest.mark.parametrize("method", ["arx", "armax", "oe", "rls", "narx", "hw"])
+@pytest.mark.parametrize("method", ["arx", "armax", "oe", "rls", "narx", "hw", "ss", "frf",
+                                    "tf"])
 def test_constant_input_is_named_with_its_value_and_unit(capsys, tmp_path, method):
     """current = 1 A throughout: the message names the column and gives 1 A (the mean that
-    detrending takes off added back), not 'input u ... 0'."""
+    detrending takes off added back), not 'input u ... 0'; ss, frf and tf (whose data are checked
+    before detrending) give the same message."""
     _, y = _arx_data()
     path = _record(tmp_path / "const.csv", np.ones(400), y)
+    orders = ["--poles", "2", "--zeros", "0"] if method == "tf" else []
     code, out, err = run(capsys, "identify", method, path, "--input", "current",
-                         "--output", "force")
+                         "--output", "force", *orders)
     assert code != 0 and out == ""
     assert "error: UnidentifiableError: input column 'current' is constant (1 A for all 400 " \
            "samples)" in err

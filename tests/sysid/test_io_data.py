@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from gripkit import Trajectory
-from gripkit.errors import ArgumentError, DataError
+from gripkit.errors import ArgumentError, DataError, UnidentifiableError
 from gripkit.sysid import IOData, arx, identify, io_data
 from gripkit.sysid.io_data import validation_data
 from gripkit.sysid.linear.identify_mimo import mimo_data
@@ -72,8 +72,10 @@ def test_none_keeps_the_data_and_zero_offsets():
 
 def test_checks_of_state_space_data():
     tr = _record().with_channels(b=np.full(400, 4.5))
-    with pytest.raises(DataError,
-                       match=r"input column 'b' is constant \(4.5 for all 400 samples\)"):
+    # the estimators' own check and message (checks.check_excitation): the value in its unit
+    with pytest.raises(UnidentifiableError,
+                       match=r"^input column 'b' is constant \(4.5 V for all 400 samples\): a "
+                             r"constant input cannot identify B"):
         IOData.from_trajectory(tr, "a,b", "c")
     big = _record().with_channels(a=_record()["a"] * 1e120)
     with pytest.raises(DataError, match=r"input column 'a' has values up to .*accepts peak values "

@@ -4,7 +4,7 @@ data, the innovation model, x0, and agreement with SIPPY's N4SID on the same dat
 import numpy as np
 import pytest
 
-from gripkit.errors import DataError, IdentificationError
+from gripkit.errors import DataError, IdentificationError, UnidentifiableError
 from gripkit.lti import StateSpace
 from gripkit.sysid import moesp, n4sid, pem
 
@@ -111,6 +111,20 @@ def test_too_few_samples_for_the_outputs():
     rng = np.random.default_rng(0)
     with pytest.raises(DataError, match="samples"):
         n4sid(rng.standard_normal((50, 2)), rng.standard_normal((50, 2)), 2)
+
+
+def test_a_zero_channel_is_refused_with_the_estimators_constant_message():
+    """A direct n4sid call: an identically zero column is refused by the check and message that
+    ``identify`` gives a constant column (checks.check_excitation / check_output_varies)."""
+    rng = np.random.default_rng(0)
+    u, y = rng.standard_normal((2000, 2)), rng.standard_normal((2000, 1))
+    u[:, 1] = 0.0
+    with pytest.raises(UnidentifiableError, match=r"^input channel 1 is constant \(0 for all "
+                                                  r"2000 samples\): a constant input cannot"):
+        n4sid(u, y, 2)
+    with pytest.raises(UnidentifiableError, match=r"^output channel 0 is constant \(0 for all "
+                                                  r"2000 samples\): there are no dynamics"):
+        n4sid(rng.standard_normal((2000, 2)), np.zeros((2000, 1)), 2)
 
 
 def test_names_units_and_dt_carried(data):

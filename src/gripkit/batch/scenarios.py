@@ -33,7 +33,7 @@ from .spec import quantity
 
 __all__ = ["SCENARIOS", "Setting", "Interface", "Prepared", "read_settings", "resolve",
            "build_model", "prepare", "step_response", "step_metrics_rows", "POSITIVE_TIME",
-           "POSITIVE_RATE", "FRACTION"]
+           "POSITIVE_RATE", "FRACTION", "summarise_warnings"]
 
 SCENARIOS: dict[str, str] = {
     "step-response": "gripkit.batch.scenarios:step_response",
@@ -240,18 +240,24 @@ def prepare(spec, allow_code: bool = False) -> Prepared:
     return Prepared(fn, model, iface)
 
 
-def _summarise_warnings(caught: list, n: int, what: str) -> None:
-    """Re-issue ``caught`` warnings once per category: the first one's text, with the count. The
-    warning carries ``count``, ``total`` and ``first`` (the first text), so that a sweep can sum
-    them over its chunks (:func:`gripkit.batch.sweep.run_chunk`)."""
-    first: dict[type, tuple[str, int]] = {}
-    for w in caught:
-        text, count = first.get(w.category, (str(w.message), 0))
-        first[w.category] = (text, count + 1)
-    for category, (text, count) in first.items():
-        warning = category(text if count == 1 else
-                           f"{count} of {n} {what} gave this warning; the first: {text}")
-        warning.count, warning.total, warning.first = count, n, text
+def summarise_warnings(records, text_of: Callable, total: int | None = None) -> None:
+    """Issue one warning per category of ``records``, ``(category, text, count, of)`` tuples (a
+    warning's text, how many warnings it stands for, out of how many items, None where unknown):
+    the first text, the counts summed and the ``of`` summed (None once one is unknown), or
+    ``total`` where given (the records are the single warnings of ``total`` items);
+    ``text_of(first, count, of)`` is the message. The warning carries ``count``, ``total`` (the
+    ``of``) and ``first``, so that they can be summed again: the rows of
+    :func:`step_metrics_rows` in a chunk, the chunks of a sweep
+    (:func:`gripkit.batch.sweep.run_chunk`)."""
+    kinds: dict[type, tuple[str, int, int | None]] = {}
+    for category, text, count, of in records:
+        first, n, so_far = kinds.get(category, (text, 0, 0))
+        kinds[category] = (first, n + count,
+                           None if so_far is None or of is None else so_far + of)
+    for category, (first, n, of) in kinds.items():
+        of = of if total is None else total
+        warning = category(text_of(first, n, of))
+        warning.count, warning.total, warning.first = n, of, first
         emit_warning(warning, category)
 
 
@@ -264,7 +270,10 @@ def step_metrics_rows(t: np.ndarray, y: np.ndarray, band: float = 0.02) -> dict[
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         rows = [step_metrics(t, yi, y_initial=0.0, band=band) for yi in np.atleast_2d(y)]
-    _summarise_warnings(caught, len(rows), "responses")
+    summarise_warnings([(w.category, str(w.message), 1, None) for w in caught],
+                       lambda first, count, of: first if count == 1 else
+                       f"{count} of {of} responses gave this warning; the first: {first}",
+                       total=len(rows))
     return {"final": np.array([r["y_final"] for r in rows]),
             "peak": np.array([r["peak"] for r in rows]),
             **{k: np.array([r[k] for r in rows]) for k in ("overshoot_percent", "rise_time",

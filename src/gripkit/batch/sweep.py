@@ -33,11 +33,11 @@ from pathlib import Path
 import numpy as np
 
 from ..arguments import entry_point
-from ..errors import ConfigError, emit_warning
+from ..errors import ConfigError
 from ..progress import status, track
 from .budget import UNDECLARED_METRICS, MemoryEstimate, memory_limit as _memory_limit, usable_cores
 from .executors import Executor, make_executor
-from .scenarios import build_model, prepare, resolve
+from .scenarios import build_model, prepare, resolve, summarise_warnings
 from .spec import SweepSpec
 from .store import ResultStore, chunk_range, collect
 
@@ -287,13 +287,9 @@ def _report_job_warnings(name: str, found: list) -> None:
     """One warning per kind for the whole sweep (its jobs' warnings, summed over the chunks, in
     every backend: a process pool's workers would otherwise print them nowhere), not one per job
     or per chunk."""
-    kinds: dict[type, tuple[str, int, int | None]] = {}
-    for category, text, count, total in found:
-        first, n, of = kinds.get(category, (text, 0, 0))
-        kinds[category] = (first, n + count, None if of is None or total is None else of + total)
-    for category, (first, n, of) in kinds.items():
-        counted = f"{n} of {of} jobs gave" if of is not None else f"its jobs gave {n} warnings like"
-        emit_warning(f"sweep {name!r}: {counted} this; the first: {first}", category)
+    summarise_warnings(found, lambda first, n, of: (
+        f"sweep {name!r}: {n} of {of} jobs gave" if of is not None else
+        f"sweep {name!r}: its jobs gave {n} warnings like") + f" this; the first: {first}")
 
 
 @entry_point

@@ -12,6 +12,7 @@ from pathlib import Path
 import numpy as np
 import typer
 
+from ..signals.trajectory import MAX_FILL_FRACTION
 from ..sysid.model_file import plain
 
 __all__ = ["emit_json", "is_mcap", "load_data", "collected_warnings", "report_warnings",
@@ -22,8 +23,8 @@ FsOpt = typer.Option(None, "--fs", help="Sampling rate in Hz, when the file has 
                                          "(with one, it must agree with the time stamps).")
 TimeOpt = typer.Option(None, "--time", help="Name of the time column (default: t/time/timestamp).")
 FillOpt = typer.Option(None, "--fill", help="Missing values: 'drop' rows or 'interpolate' "
-                                            "(at most 20 % of a channel, with a warning; "
-                                            "default: error).")
+                                            f"(at most {100 * MAX_FILL_FRACTION:g} % of a channel, "
+                                            "with a warning; default: error).")
 JsonOpt = typer.Option(False, "--json", help="Print one JSON object on stdout.")
 ModelReportOpt = typer.Option(None, "--report", help="Write an HTML report of the model on the "
                                                      "--validate record (else on the record) "

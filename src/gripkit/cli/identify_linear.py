@@ -15,6 +15,7 @@ file's samples and fit.
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 import typer
@@ -110,14 +111,14 @@ def _siso(method: str, data: list[Path], input: str, output: str, fs, time, fill
 
 
 def _compare_fit(model, tr) -> float | None:
-    """The free-run fit of ``gripkit compare`` of ``model`` on its estimation record ``tr``; None
-    where compare has none (an unstable model; a record whose ‖y − ȳ‖ underflows to 0)."""
-    from ..errors import DataError
+    """The free-run fit of ``gripkit compare`` of the SISO ``model`` on its estimation record
+    ``tr`` (:func:`~gripkit.sysid.linear.identify_mimo.compare_score`, loaded already by the
+    fit); None for the JSON where compare has none (its −inf for ranking: an unstable model; a
+    record whose ‖y − ȳ‖ underflows to 0)."""
+    from ..sysid.linear.identify_mimo import compare_score
 
-    try:
-        return model.compare(tr).fit_percent[0]
-    except DataError:
-        return None
+    fit = compare_score(model, tr)
+    return None if fit == -math.inf else fit
 
 
 def _validation_fields(res: dict, model, vtr, validate: Path | None, detrend: str = "mean"):

@@ -39,7 +39,7 @@ import numpy as np
 
 from ..errors import DataError, DataWarning, emit_warning
 from ..signals.outliers import corrupt_samples
-from ..signals.trajectory import Trajectory
+from ..signals.trajectory import MAX_FILL_FRACTION, Trajectory
 from ..units import si_factor
 
 __all__ = ["columns_to_trajectory", "split_header", "by_position", "check_fill", "check_fs",
@@ -123,9 +123,6 @@ def _place(row, i: int) -> str:
 
 
 FILL_CHOICES = ("drop", "interpolate")
-#: Largest fraction of a channel's samples that ``fill='interpolate'`` makes up; a channel with
-#: more missing samples is refused (the record would be more interpolation than measurement).
-MAX_FILL_FRACTION = 0.2
 
 
 def check_fill(fill) -> None:

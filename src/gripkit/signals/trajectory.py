@@ -20,7 +20,13 @@ import numpy as np
 from ..arguments import sample_interval
 from ..errors import DataError
 
-__all__ = ["Trajectory"]
+__all__ = ["Trajectory", "MAX_FILL_FRACTION"]
+
+#: Largest fraction of a channel's samples that ``fill='interpolate'`` makes up when a record is
+#: read (:mod:`gripkit.io.table`; a channel with more missing samples is refused: the record would
+#: be more interpolation than measurement). Here, in a module every command loads, so that the
+#: CLI's ``--fill`` help states it without loading the readers.
+MAX_FILL_FRACTION = 0.2
 
 
 def _median(d: np.ndarray) -> float:

@@ -362,11 +362,10 @@ def _dispatch(data, method: str, *, input, output, na: int | None, nb: int | Non
             raw = lambda: io_data(data, input=input, output=output, detrend="none")  # noqa: E731
             quiet = {k: v for k, v in options.items() if k != "progress"}  # one bar: the fit's
             refit = lambda r: _polynomial_fit(method, r, orders, quiet)  # noqa: E731
-            if identify_mimo.step_like(io.u1):  # a step is never at its mean
-                return identify_mimo.keep_better_without_detrending(
-                    model, lambda: refit(raw()), f"identify {method}",
-                    lambda m: identify_mimo.compare_score(m, data))
-            warn_if_mean_detrending_hurt(model, io, raw, refit)
+            return identify_mimo.after_mean_detrending(
+                model, io.u1, lambda: refit(raw()), f"identify {method}",
+                lambda m: identify_mimo.compare_score(m, data),
+                lambda _: warn_if_mean_detrending_hurt(model, io, raw, refit))
         return model
     if method == "rls":
         from .linear.rls import rls  # numba: loaded only for an RLS fit

@@ -30,6 +30,7 @@ import numpy as np
 from ..errors import ArgumentError, DataError
 from ..signals.processing import detrend as detrend_signals
 from ..signals.trajectory import Trajectory
+from .checks import check_excitation, check_output_varies
 
 __all__ = ["IOData", "io_data", "parse_names", "validation_data", "provenance_of",
            "records_provenance", "SCALE_LIMITS", "DETRENDS", "check_scale"]
@@ -106,8 +107,9 @@ class IOData:
         """The ``input`` and ``output`` columns (a name, ``'a,b'`` or a list) of the uniformly
         sampled trajectory ``data``. ``detrend``: ``'mean'`` removes each column's mean (stored as
         the offsets), ``'linear'`` a least-squares line against time (the offsets are then the
-        means), ``'none'`` keeps the data as they are. ``checks``: refuse a constant column and
-        one outside :data:`SCALE_LIMITS` (state space, FRF and transfer functions form unscaled
+        means), ``'none'`` keeps the data as they are. ``checks``: refuse a constant column (an
+        :class:`~gripkit.errors.UnidentifiableError`, the estimators' own message) and one
+        outside :data:`SCALE_LIMITS` (state space, FRF and transfer functions form unscaled
         sums of squares; the SISO polynomial estimators scale internally and name a constant
         input themselves, so they pass ``checks=False``). ``why`` names the work in the
         uniform-sampling error."""
@@ -123,8 +125,8 @@ class IOData:
         u = np.column_stack([np.array(data[n], dtype=np.float64) for n in ins])
         y = np.column_stack([np.array(data[n], dtype=np.float64) for n in outs])
         if checks:
-            _check_constant(ins, u, "input")
-            _check_constant(outs, y, "output")
+            _check_constant(data, ins, u, "input")
+            _check_constant(data, outs, y, "output")
             check_scale(ins, u, "input", why)
             check_scale(outs, y, "output", why)
         # each column's own mean (pairwise summation of the contiguous column): one column has
@@ -240,13 +242,14 @@ def _check_columns(data: Trajectory, ins: tuple, outs: tuple) -> None:
         data.column(n)  # a missing column: "column 'x' not found", with the columns there
 
 
-def _check_constant(names, x: np.ndarray, what: str) -> None:
-    flat = np.ptp(x, axis=0) <= 1e-12 * np.maximum(np.max(np.abs(x), axis=0), 1e-300)
-    if flat.any():
-        i = int(np.argmax(flat))
-        raise DataError(f"{what} column {names[i]!r} is constant ({x[0, i]:.6g} for all "
-                        f"{x.shape[0]} samples): it carries no information",
-                        hint="drop it from --input/--output or check the data")
+def _check_constant(data: Trajectory, names, x: np.ndarray, what: str) -> None:
+    """Refuse a constant column of ``x`` (one per name of ``names``, ``what`` 'input' or
+    'output', the data as recorded): the estimators' own check (:func:`check_excitation`,
+    :func:`check_output_varies`), so that ``identify`` and a direct call say the same, the column
+    named with its value in its unit."""
+    check = check_excitation if what == "input" else check_output_varies
+    for i, name in enumerate(names):
+        check(x[:, i], f"{what} column {name!r}", unit=data.unit(name))
 
 
 def check_scale(names, x: np.ndarray, what: str, why: str) -> None:

@@ -158,9 +158,9 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
         refit = lambda: identify_ss(  # noqa: E731
             data, input=input, output=output, order=model.order, method=method, form=form,
             refine=False, detrend="none", horizon=horizon, feedthrough=feedthrough)[0]
-        _warn_if_detrending_hurt(model, refit, d.u.shape[0], d.dt, "identify ss",
-                                 without="without (subspace model, not refined)",
-                                 step=step_like(d.u))
+        model = after_mean_detrending(model, d.u, refit, "identify ss", drift=lambda step: (
+            _warn_if_detrending_hurt(model, refit, d.u.shape[0], d.dt, "identify ss",
+                                     without="without (subspace model, not refined)", step=step)))
     if vd is not None:
         extras["validation_fit_percent"] = _validation_fit(model, vd)
     return model, extras
@@ -472,6 +472,22 @@ def keep_better_without_detrending(model, refit, command: str, score):
     return other
 
 
+def after_mean_detrending(model, u, refit, command: str, score=None, drift=None):
+    """The one rule for ``model`` fitted with the means removed (detrend 'mean') from the input
+    ``u``: a step input (:func:`step_like`) is never at its mean, so ``refit()`` (the same
+    structure on the data as they are) is ranked against ``model`` by ``score`` and the better is
+    returned (:func:`keep_better_without_detrending`); any other input gets ``drift(False)``, the
+    family's warning for a mode that does not settle, where it has one. A family without
+    ``score`` (ss: its refit is the subspace model alone, no peer to rank) keeps ``model`` and
+    hands a step to ``drift(True)``, which then warns whatever the modes."""
+    step = step_like(u)
+    if step and score is not None:
+        return keep_better_without_detrending(model, refit, command, score)
+    if drift is not None:
+        drift(step)
+    return model
+
+
 def identify_frf(data: Trajectory, *, input, output, detrend: str = "mean", **options):
     """Frequency response of the named columns (:func:`gripkit.sysid.linear.frf` options)."""
     d = mimo_data(data, input, output, detrend, why="frequency-response estimation")
@@ -489,10 +505,9 @@ def identify_tf(data: Trajectory, *, input, output, poles: int, zeros: int, detr
     if detrend == "mean":
         refit = lambda: identify_tf(data, input=input, output=output, poles=poles,  # noqa: E731
                                     zeros=zeros, detrend="none")
-        if step_like(d.u):  # a step is never at its mean
-            return keep_better_without_detrending(model, refit, "identify tf",
-                                                  lambda m: float(np.mean(m.fit_percent)))
-        _warn_if_detrending_hurt(model, refit, d.u.shape[0], d.dt, "identify tf")
+        return after_mean_detrending(
+            model, d.u, refit, "identify tf", lambda m: float(np.mean(m.fit_percent)),
+            lambda _: _warn_if_detrending_hurt(model, refit, d.u.shape[0], d.dt, "identify tf"))
     return model
 
 
@@ -508,11 +523,11 @@ def identify_arx(data: Trajectory, *, input, output, na: int, nb: int, nk: int =
     d = mimo_data(data, input, output, detrend, why="ARX identification")
     model = arx_mimo(d.u, d.y, na, nb, nk, dt=d.dt, u_offset=d.u_offset, y_offset=d.y_offset,
                      **d.signals)
-    if detrend == "mean" and step_like(d.u):  # never at its mean
+    if detrend == "mean":
         refit = lambda: identify_arx(data, input=input, output=output, na=na,  # noqa: E731
                                      nb=nb, nk=nk, detrend="none")
-        return keep_better_without_detrending(model, refit, "identify arx",
-                                              lambda m: compare_score(m, data))
+        return after_mean_detrending(model, d.u, refit, "identify arx",
+                                     lambda m: compare_score(m, data))
     return model
 
 

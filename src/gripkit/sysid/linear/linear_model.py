@@ -45,7 +45,7 @@ from .validation import validate
 
 __all__ = ["VALIDATION_FIT", "IdentifiedLinearModel", "LinearModel", "as_io_matrix", "estimate_x0",
            "free_run", "fit_per_output", "k_step_prediction", "model_document",
-           "polynomial_document", "read_linear_model"]
+           "polynomial_document", "read_linear_model", "x0_residual"]
 
 
 def _sim(A, B, C, D, u, x0):
@@ -76,14 +76,29 @@ def observability_regressor(A, C, N: int) -> np.ndarray:
     return O
 
 
+def _x0_least_squares(A, B, C, D, u, y):
+    """(x0, the output error from rest ``y − G u`` flattened, ``O`` as an (N·p, n) matrix)."""
+    r = (y - free_run(A, B, C, D, u)).reshape(-1)
+    O = observability_regressor(A, C, y.shape[0]).reshape(-1, A.shape[0])
+    return np.linalg.lstsq(O, r, rcond=None)[0], r, O
+
+
 def estimate_x0(A, B, C, D, u, y) -> np.ndarray:
     """Least-squares initial state: ``argmin ‖y − G u − O x0‖`` (``O[t] = C A^t``)."""
-    n = A.shape[0]
-    if n == 0:
+    if A.shape[0] == 0:
         return np.zeros(0)
-    r = y - free_run(A, B, C, D, u)
-    O = observability_regressor(A, C, y.shape[0]).reshape(-1, n)
-    return np.linalg.lstsq(O, r.reshape(-1), rcond=None)[0]
+    return _x0_least_squares(A, B, C, D, u, y)[0]
+
+
+def x0_residual(A, B, C, D, u, y) -> np.ndarray:
+    """Output error (N, p) of the free run from the least-squares initial state
+    (:func:`estimate_x0`), from the one simulation that state needs: the output is linear in x0,
+    so ``y − ŷ(x0) = (y − G u) − O x0`` (what ``y − free_run(..., estimate_x0(...))`` gives, to
+    round-off, without simulating again)."""
+    if A.shape[0] == 0:
+        return y - free_run(A, B, C, D, u)
+    x0, r, O = _x0_least_squares(A, B, C, D, u, y)
+    return (r - O @ x0).reshape(y.shape)
 
 
 def fit_per_output(y, yhat) -> list[float]:

@@ -42,7 +42,7 @@ import scipy.linalg as sla
 from ...errors import DataError, IdentificationError, StabilityWarning, emit_warning
 from ...lti import StateSpace
 from .blocked_gram import add_rows, carried_states, carry, row_product, start_sums
-from ..checks import check_dt, io_records
+from ..checks import check_dt, check_excitation, check_output_varies, io_records
 from .linear_model import (LinearModel, as_io_matrix, fit_per_output, free_run,
                            observability_regressor)
 from ..regression import qr_r
@@ -161,12 +161,9 @@ def subspace_factor(u, y, *, horizon: int, method: str) -> SubspaceFactor:
                         "(2 × 2k(m + p)); "
                         f"at least {2 * q + 2 * horizon - 1} samples are required",
                         hint="use a longer record, fewer outputs or a smaller --order/horizon")
-    for name, x in (("input", u), ("output", y)):
-        rms = np.sqrt(np.mean(x * x, axis=0))
-        if np.any(rms == 0):
-            raise DataError(f"{name} channel {int(np.argmin(rms))} is identically zero: it "
-                            "carries no information",
-                            hint="drop that column or check the data")
+    for name, x, check in (("input", u, check_excitation), ("output", y, check_output_varies)):
+        for i in np.flatnonzero(~np.any(x, axis=0)):  # identically zero: refused as a constant
+            check(x[:, i], f"{name} channel {i}")
     return SubspaceFactor(u, y, horizon, method)
 
 

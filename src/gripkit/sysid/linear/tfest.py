@@ -36,7 +36,8 @@ from ...errors import DataError, IdentificationError, ModelError
 from ...lti import StateSpace, TransferFunction
 from ..checks import check_dt, check_order, check_persistent_excitation, io_records
 from .frf import FRF, frf
-from .linear_model import LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run
+from .linear_model import (LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run,
+                           x0_residual)
 from .validation import records_fit
 
 __all__ = ["tfest", "tfest_records", "tfest_frf", "modal_parameters"]
@@ -299,7 +300,7 @@ def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None,
         if np.any(np.roots(np.concatenate([[1.0], theta[:npo]])).real >= 0):
             return np.full(N, 1e3 * (np.abs(yy).max() + 1.0))
         Ad, Bd, Cd, Dd = _simulate_ct(theta, npo, nz, uu, step)
-        return yy - free_run(Ad, Bd, Cd, Dd, uu, estimate_x0(Ad, Bd, Cd, Dd, uu, y))[:, 0]
+        return x0_residual(Ad, Bd, Cd, Dd, uu, y)[:, 0]
 
     sol = (optimize.least_squares(res, th0 / scale, method="trf", x_scale="jac", xtol=1e-10,
                                   ftol=1e-10))
@@ -363,8 +364,8 @@ def tfest_records(records, n_poles: int, n_zeros: int, *, dt: float | None = Non
         theta = z * scale
         if np.any(np.roots(np.concatenate([[1.0], theta[:npo]])).real >= 0):
             return np.full(N, 1e3 * (peak + 1.0))
-        yh, _ = runs(theta)
-        return np.concatenate([y[:, 0] - h for (_, y), h in zip(recs, yh)])
+        Ad, Bd, Cd, Dd = _simulate_ct(theta, npo, nz, None, step)
+        return np.concatenate([x0_residual(Ad, Bd, Cd, Dd, u, y)[:, 0] for u, y in recs])
 
     sol = optimize.least_squares(res, th0 / scale, method="trf", x_scale="jac", xtol=1e-10,
                                  ftol=1e-10)
