@@ -160,7 +160,7 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
             REFINE_TOP if vd is not None else 1)
     elif refine:
         report(f"PEM refinement ({form} form) of the order-{model.order} model")
-        model, refine = _refine(model, d, vd, form, focus, max_iterations, progress)
+        model = _refine(model, d, vd, form, focus, max_iterations, progress)[0]
     if ranked is not None:
         extras["search"] = [r for r, _ in ranked]
     if refine and model.structure == method:  # the subspace start kept: σ by bootstrap

@@ -143,7 +143,9 @@ def _aligned(refit: StateSpace, O: np.ndarray, w: np.ndarray, feedthrough: bool)
 
 def _replicates(model, u, y, refit, replicates: int, seed: int, demean: bool, feedthrough: bool,
                 progress: bool):
-    """The aligned entries of each replicate that refits (rows) and the number that failed."""
+    """The aligned entries of each replicate that refits (rows), the number that failed and the
+    number tried: all of ``replicates``, unless more than half of those tried (after
+    :data:`MIN_REPLICATES` / 3 at least) have failed, which stops the loop (no σ comes of it)."""
     ss = model.system
     x0 = np.zeros(ss.n_states) if model.x0 is None else np.asarray(model.x0, dtype=np.float64)
     y_det = ss.simulate(u, x0)
@@ -152,8 +154,11 @@ def _replicates(model, u, y, refit, replicates: int, seed: int, demean: bool, fe
     w = 1.0 / np.where(sy > 0, sy, 1.0)
     O = _observability(ss.A, ss.C, w)
     rng = np.random.default_rng(seed)
-    rows, failed = [], 0
+    rows, failed, tried = [], 0, 0
     for _ in track(range(replicates), description="bootstrap σ", enabled=progress):
+        if tried >= MIN_REPLICATES // 3 and 2 * failed > tried:
+            break
+        tried += 1
         yb = y_det + _disturbance(coefs, eps, rng)
         if demean:
             yb = yb - yb.mean(axis=0)
@@ -169,7 +174,7 @@ def _replicates(model, u, y, refit, replicates: int, seed: int, demean: bool, fe
             failed += 1
             continue
         rows.append(theta)
-    return rows, failed
+    return rows, failed, tried
 
 
 def bootstrap_covariance(model, u, y, refit, *, estimator: str, replicates: int | None = None,
@@ -183,20 +188,26 @@ def bootstrap_covariance(model, u, y, refit, *, estimator: str, replicates: int 
     ``refit(u, y)`` is the subspace estimation that gave ``model`` (same order and options);
     ``estimator`` names it in ``info``; ``replicates`` default :func:`bootstrap_replicates`;
     ``demean``: remove each simulated output's mean as the estimation removed the record's
-    (detrend 'mean'); ``feedthrough``: D is estimated, and carries σ. With fewer than
-    :data:`MIN_REPLICATES` / 3 usable replicates the model is returned without covariance, with
-    an :class:`AccuracyWarning`; more than :data:`FAILED_FRACTION` failed is warned about too.
+    (detrend 'mean'); ``feedthrough``: D is estimated, and carries σ. When more than half of the
+    replicates fail (a refit error, such as an order the replicate's data do not support, or a
+    refit whose states do not map onto the model's: an order above what the data determine),
+    the model is returned without covariance, with an :class:`AccuracyWarning` (the loop stops
+    as soon as more than half of those tried have failed, after :data:`MIN_REPLICATES` / 3
+    tried at least); more than
+    :data:`FAILED_FRACTION` failed is warned about too.
     """
     u = np.ascontiguousarray(u, dtype=np.float64)
     y = np.ascontiguousarray(y, dtype=np.float64)
     B = bootstrap_replicates(u.shape[0]) if replicates is None else int(replicates)
-    rows, failed = _replicates(model, u, y, refit, B, seed, demean, feedthrough, progress)
+    rows, failed, tried = _replicates(model, u, y, refit, B, seed, demean, feedthrough,
+                                      progress)
     info = {"method": "parametric bootstrap", "replicates": len(rows), "failed": failed,
             "seed": int(seed), "estimator": estimator}
-    if len(rows) < max(MIN_REPLICATES // 3, 2):
-        emit_warning(f"bootstrap σ of the {estimator} model: only {len(rows)} of {B} replicates "
-                     "could be refitted and brought to the model's states; the model is returned "
-                     "without covariance (lower the order)", AccuracyWarning)
+    if 2 * failed > tried or len(rows) < 2:
+        emit_warning(f"bootstrap σ of the {estimator} model: {failed} of the {tried} replicates "
+                     f"tried (of {B}) could not be refitted or brought to the model's states; "
+                     "the model is returned without covariance (lower the order)",
+                     AccuracyWarning)
         return model
     if failed > FAILED_FRACTION * B:
         emit_warning(f"bootstrap σ of the {estimator} model: {failed} of {B} replicates could not "
