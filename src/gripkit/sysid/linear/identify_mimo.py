@@ -28,6 +28,7 @@ from ...progress import status, track
 from ...signals.trajectory import Trajectory
 from .arx_mimo import arx_mimo
 from .frf import frf
+from .ss_bootstrap import BOOTSTRAP_SEED, MIN_REPLICATES, bootstrap_covariance
 from ..io_data import IOData, parse_names, validation_data
 
 __all__ = ["mimo_data", "identify_ss", "identify_frf", "identify_tf", "identify_arx", "several",
@@ -88,7 +89,7 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
                 refine: bool = True, validate: Trajectory | None = None, detrend: str = "mean",
                 horizon: int | None = None, feedthrough: bool = False, progress: bool = False,
                 focus: str = "simulation", max_iterations: int = 50,
-                bootstrap_replicates: int | None = None, bootstrap_seed: int = 0):
+                bootstrap_replicates: int | None = None, bootstrap_seed: int = BOOTSTRAP_SEED):
     """State-space model of the named columns: subspace (``method``), then PEM in ``form``
     unless ``refine=False``. Returns ``(model, extras)``; ``extras`` holds ``search`` (the ranked
     orders of a range), ``validation_fit_percent`` (per output, with ``validate``) and
@@ -182,8 +183,6 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
 def _check_bootstrap(replicates, seed) -> None:
     """``bootstrap_replicates`` None or an integer >= MIN_REPLICATES / 3 (fewer give no σ worth
     reporting), ``bootstrap_seed`` a non-negative integer (numpy's default_rng)."""
-    from .ss_bootstrap import MIN_REPLICATES
-
     lo = MIN_REPLICATES // 3
     if replicates is not None and (isinstance(replicates, bool)
                                    or not isinstance(replicates, (int, np.integer))
@@ -199,17 +198,13 @@ def _bootstrap_sigma(model, d: IOData, k: int, method: str, feedthrough: bool, d
     """The kept subspace ``model`` with the σ of a parametric bootstrap of the same estimation
     (order, ``method``, horizon ``k``, ``feedthrough``, ``detrend``) on the deviation data ``d``;
     ``options``: (replicates or None, seed)."""
-    from .ss_bootstrap import bootstrap_covariance, bootstrap_replicates
     from .subspace import from_factor, subspace_factor
 
     n = model.order
     replicates, seed = options
-    B = bootstrap_replicates(d.u.shape[0]) if replicates is None else int(replicates)
-    if progress:
-        status(f"σ of the kept {method} model: parametric bootstrap, {B} replicates (seed {seed})")
     refit = lambda u, y: from_factor(  # noqa: E731
         subspace_factor(u, y, horizon=k, method=method), n, dt=d.dt, feedthrough=feedthrough)
-    return bootstrap_covariance(model, d.u, d.y, refit, replicates=B, seed=seed,
+    return bootstrap_covariance(model, d.u, d.y, refit, replicates=replicates, seed=seed,
                                 estimator=f"{method} (order {n}, horizon {k})",
                                 demean=detrend == "mean", feedthrough=feedthrough,
                                 progress=progress)

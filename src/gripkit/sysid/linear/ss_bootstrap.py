@@ -41,11 +41,10 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
-from scipy.signal import lfilter
 
 from ...errors import AccuracyWarning, GripkitError, emit_warning
 from ...lti import StateSpace
-from ...progress import track
+from ...progress import status, track
 
 __all__ = ["BOOTSTRAP_SEED", "MAX_REPLICATES", "MIN_REPLICATES", "bootstrap_replicates",
            "bootstrap_covariance", "covariance_method"]
@@ -96,6 +95,8 @@ def _levinson(r: np.ndarray, n_samples: int) -> np.ndarray:
 def _noise_model(v: np.ndarray) -> tuple[list[np.ndarray], np.ndarray]:
     """Per output, the AR coefficients of the free-run residuals ``v`` (N, p) (order by Akaike's
     criterion, at most min(20, N/20)), and the whitened residuals (N, p), centred."""
+    from scipy.signal import lfilter
+
     N, p = v.shape
     q_max = int(min(20, N // 20))
     coefs, eps = [], np.empty_like(v)
@@ -112,6 +113,8 @@ def _disturbance(coefs: list, eps: np.ndarray, rng) -> np.ndarray:
     """A disturbance record like the residuals: rows of ``eps`` drawn with replacement (the
     outputs' cross correlation kept), each output filtered by its AR model, after a burn-in of
     100 + q samples (the filter's start-up transient dropped)."""
+    from scipy.signal import lfilter
+
     N, p = eps.shape
     burn = 100 + max(a.size for a in coefs)
     draw = eps[rng.integers(0, N, N + burn)]
@@ -186,7 +189,8 @@ def bootstrap_covariance(model, u, y, refit, *, estimator: str, replicates: int 
     """``model`` (a subspace :class:`~gripkit.sysid.LinearModel` of the deviation data ``u``
     (N, m), ``y`` (N, p)) with the covariance of its entries from a parametric bootstrap (module
     docstring) in ``system.uncertainty`` and ``info['covariance']`` saying how it was obtained
-    (``method``, ``replicates`` used, ``failed``, ``seed``, ``estimator``).
+    (``method``, ``replicates`` used, ``failed``, ``seed``, ``estimator``). ``progress``: a
+    line on stderr saying what runs, then a progress bar of the replicates.
 
     ``refit(u, y)`` is the subspace estimation that gave ``model`` (same order and options);
     ``estimator`` names it in ``info``; ``replicates`` default :func:`bootstrap_replicates`;
@@ -202,6 +206,8 @@ def bootstrap_covariance(model, u, y, refit, *, estimator: str, replicates: int 
     u = np.ascontiguousarray(u, dtype=np.float64)
     y = np.ascontiguousarray(y, dtype=np.float64)
     B = bootstrap_replicates(u.shape[0]) if replicates is None else int(replicates)
+    if progress:
+        status(f"σ of the {estimator} model: parametric bootstrap, {B} replicates (seed {seed})")
     rows, failed, tried = _replicates(model, u, y, refit, B, seed, demean, feedthrough,
                                       progress)
     info = {"method": "parametric bootstrap", "replicates": len(rows), "failed": failed,
