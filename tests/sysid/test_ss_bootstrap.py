@@ -130,10 +130,11 @@ def test_bad_bootstrap_options():
 
 
 def test_cli_prints_and_writes_the_bootstrap_sigma(tmp_path, capsys, monkeypatch):
-    """`gripkit identify ss` with a refinement that loses: the text gives the σ method and every
-    pole with its σ; the JSON carries poles_std (those of the Python call on the same file),
-    covariance_method and info.covariance, and the warning names the bootstrap. Run twice:
-    the same output (the default seed). A refinement that wins: σ from PEM, said so."""
+    """`gripkit identify ss` with a refinement that loses: the text and the report give the σ
+    method, the text every pole with its σ; the JSON carries poles_std (those of the Python call
+    on the same file), covariance_method and info.covariance, and the warning names the
+    bootstrap. Run twice: the same output (the default seed). A refinement that wins: σ from
+    PEM, said so."""
     from gripkit.io import load, save
 
     path = tmp_path / "est.csv"
@@ -141,8 +142,12 @@ def test_cli_prints_and_writes_the_bootstrap_sigma(tmp_path, capsys, monkeypatch
     args = ["identify", "ss", str(path), "--input", "u", "--output", "y", "--order", "2"]
     real = pem_ss.pem
     monkeypatch.setattr(pem_ss, "pem", _losing_pem)
-    assert main(args) == 0
+    assert main(args + ["--report", str(tmp_path / "rep")]) == 0
     text = capsys.readouterr().out
+    assert ("The covariance is that of a parametric bootstrap of the n4sid (order 2, horizon 6) "
+            "estimate, B = 100 replicates, seed 0: the subspace model was kept in place of the "
+            "PEM refinement, and this is no PEM covariance.") \
+        in (tmp_path / "rep" / "index.html").read_text()
     assert "σ: parametric bootstrap of the n4sid (order 2, horizon 6) estimate, B = 100 " \
            "replicates, seed 0" in text
     poles = [ln for ln in text.splitlines() if ln.strip().startswith("pole ")]
