@@ -37,7 +37,7 @@ from ..report.plots import measured_vs_model, plain, pyplot
 from .linear.frf import frf
 from .linear.linear_model import VALIDATION_FIT, fit_per_output
 from .linear.pem_ss import predictor_x0
-from .linear.ss_bootstrap import covariance_method
+from .linear.ss_bootstrap import bootstrapped, covariance_method
 
 __all__ = ["write_model_report", "model_report", "parameters_section", "residual_analysis",
            "predictor_x0",
@@ -419,8 +419,7 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=(),
                       [[n, ff, f1] for n, ff, f1 in zip(model.outputs, fit, res.fit_percent)])
         sec.figure(_residual_figure(res.e, u, model.outputs, model.inputs), "residual correlations",
                    name="residuals")
-        boot = (getattr(model, "info", None) or {}).get("covariance")
-        how = ("" if boot is None or model.system.uncertainty is None else
+        how = ("" if not bootstrapped(model) else
                f" The covariance is that of a {covariance_method(model)}: the subspace model "
                "was kept in place of the PEM refinement, and this is no PEM covariance.")
         rep.section("Poles and zeros", "Poles (×), transmission zeros (○) and the 1σ "

@@ -107,7 +107,7 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     A subspace model returned in place of the refinement (it scored higher, or PEM failed) carries
     the σ of a parametric bootstrap of the subspace estimate
     (:func:`~gripkit.sysid.linear.ss_bootstrap.bootstrap_covariance`: ``bootstrap_replicates``
-    records simulated from the model with its own resampled innovations and refitted alike,
+    records, the model's free run plus disturbances drawn like its residuals, refitted alike;
     default by the record's length, 100 up to 20 000 samples; ``bootstrap_seed``, default
     :data:`~gripkit.sysid.linear.ss_bootstrap.BOOTSTRAP_SEED`, seeds the draws),
     with ``info['covariance']`` saying so, where a refined model carries PEM's covariance."""
@@ -364,8 +364,8 @@ def _refine(start, d: IOData, vd: IOData | None, form: str, focus: str, max_iter
     except IdentificationError as exc:  # an order the data do not support in full
         emit_warning(f"PEM refinement of the order-{start.order} {start.structure} model failed "
                      f"({exc.message}); the subspace model is returned, with σ from a "
-                     f"parametric bootstrap of the subspace estimate, not PEM's covariance "
-                     f"(lower the order, or --no-refine to skip PEM)",
+                     f"parametric bootstrap of the subspace estimate where its replicates allow, "
+                     f"not PEM's covariance (lower the order, or --no-refine to skip PEM)",
                      AccuracyWarning)
         return start, False
     oe = None

@@ -47,7 +47,7 @@ from ...lti import StateSpace
 from ...progress import status, track
 
 __all__ = ["BOOTSTRAP_SEED", "MAX_REPLICATES", "MIN_REPLICATES", "bootstrap_replicates",
-           "bootstrap_covariance", "covariance_method"]
+           "bootstrap_covariance", "bootstrapped", "covariance_method"]
 
 #: the default seed of the bootstrap's draws (numpy.random.default_rng)
 BOOTSTRAP_SEED = 0
@@ -230,13 +230,21 @@ def bootstrap_covariance(model, u, y, refit, *, estimator: str, replicates: int 
                          info={**model.info, "covariance": info})
 
 
+def bootstrapped(model) -> bool:
+    """Whether the σ that ``model.system`` carries comes from :func:`bootstrap_covariance`
+    (its ``info['covariance']``; any model with ``info`` and ``system``)."""
+    cov = (getattr(model, "info", None) or {}).get("covariance")
+    return (model.system.uncertainty is not None and isinstance(cov, dict)
+            and cov.get("method") == "parametric bootstrap")
+
+
 def covariance_method(model) -> str | None:
     """How the σ that the state-space ``model.system`` carries was obtained, in words: the
     bootstrap of :func:`bootstrap_covariance` or PEM's (None without σ)."""
     if model.system.uncertainty is None:
         return None
-    cov = model.info.get("covariance") or {}
-    if cov.get("method") == "parametric bootstrap":
+    if bootstrapped(model):
+        cov = model.info["covariance"]
         return (f"parametric bootstrap of the {cov['estimator']} estimate, B = "
                 f"{cov['replicates']} replicates, seed {cov['seed']}")
     return "PEM: σ² (JᵀJ)⁻¹ at its optimum"
