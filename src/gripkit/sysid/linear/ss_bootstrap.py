@@ -200,8 +200,7 @@ def bootstrap_covariance(model, u, y, refit, *, estimator: str, replicates: int 
     refit whose states do not map onto the model's: an order above what the data determine),
     the model is returned without covariance, with an :class:`AccuracyWarning` (the loop stops
     as soon as more than half of those tried have failed, after :data:`MIN_REPLICATES` / 3
-    tried at least); more than
-    :data:`FAILED_FRACTION` failed is warned about too.
+    tried at least); more than :data:`FAILED_FRACTION` failed is warned about too.
     """
     u = np.ascontiguousarray(u, dtype=np.float64)
     y = np.ascontiguousarray(y, dtype=np.float64)
