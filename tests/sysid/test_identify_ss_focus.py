@@ -44,7 +44,7 @@ def test_a_refinement_that_scores_lower_is_not_returned(monkeypatch):
     with pytest.warns(AccuracyWarning, match="lowered the mean simulation fit on the "
                                              "estimation data"):
         model, _ = identify_ss(tr, input="u", output="y", order=2)
-    assert model.structure == "n4sid"
+    assert model.structure == "n4sid" and model.info["covariance"]["replicates"] == 100
     fo = model.info["focus"]
     assert fo["kept"] == "subspace" and fo["subspace_percent"] > fo["refined_percent"]
     d = mimo_data(tr, "u", "y")
@@ -114,7 +114,10 @@ def test_pem_on_an_order_the_data_do_not_support_returns_the_subspace_model():
     for a second-order plant): JᵀJ at PEM's optimum is so ill-conditioned that its computed
     inverse is indefinite (an eigenvalue of −2e4), which used to stop identify ss with a
     ModelError about the covariance. Now PEM reports the undetermined directions and the
-    subspace model comes back with a warning saying why."""
+    subspace model comes back with a warning saying why. Its bootstrap σ fails as well (the
+    replicates' data support at most 6 states, or their 9 states do not map onto the model's):
+    after 10 failed replicates it stops, and the model comes without covariance, with a
+    warning saying so."""
     from gripkit.excitation import periodic_multisine
     from gripkit.lti import TransferFunction
 
@@ -123,6 +126,10 @@ def test_pem_on_an_order_the_data_do_not_support_returns_the_subspace_model():
     y = y + 0.01 * np.random.default_rng(0).standard_normal(y.size)
     tr = Trajectory.uniform(dt=0.05, v=ex.u, x=y)
     with pytest.warns(AccuracyWarning, match="PEM refinement of the order-9 n4sid model failed .*"
-                                             "the data do not determine the model"):
+                                             "the data do not determine the model") as caught:
         model, _ = identify_ss(tr, input="v", output="x")
     assert model.structure == "n4sid"
+    assert any(str(w.message).startswith("bootstrap σ of the n4sid (order 9, horizon 22) model: "
+                                         "10 of the 10 replicates tried (of 100) could not be "
+                                         "refitted") for w in caught)
+    assert model.system.uncertainty is None and "covariance" not in model.info

@@ -4,8 +4,10 @@ continuous-time transfer function from a data file, with ``--out MODEL.json`` an
 JSON fields (exact, other tools read them):
 
 * ``ss``: ``A``, ``B``, ``C``, ``D``, ``K``, ``dt``, ``order``, ``singular_values``, ``stable``,
-  ``fit_percent`` (list per output, in ``--output`` order) and, with ``--validate``,
-  ``validation.fit_percent`` (list per output, free run, estimated initial state);
+  ``fit_percent`` (list per output, in ``--output`` order), ``poles`` and ``poles_std`` ((Re, Im)
+  of each), ``covariance_method`` (how σ was obtained: PEM's covariance, or for a kept subspace
+  model a parametric bootstrap, detailed in ``info.covariance``; null without σ) and, with
+  ``--validate``, ``validation.fit_percent`` (list per output, free run, estimated initial state);
 * ``frf``: ``frequency_hz``, ``H_real``, ``H_imag``, ``H_std``, ``coherence`` (where defined);
 * ``tf``: ``num``, ``den`` (continuous time, descending powers of s), ``num_std``, ``den_std``,
   ``natural_frequency_hz``, ``damping_ratio`` (complex poles), ``fit_percent``.
@@ -105,6 +107,8 @@ def _check_ss_options(form: str, focus: str, max_iterations: int) -> None:
 def _ss_result(model, val, data: list[Path], method: str, no_refine: bool, out: Path) -> dict:
     """The JSON result of ``identify ss`` (without ``warnings``): the model's fields, the data
     files, the per-record fits (several files), the validation, order search and focus."""
+    from ..sysid.linear.ss_bootstrap import covariance_method
+
     several = len(data) > 1
     res = model.to_dict()
     res["info"] = {k: v for k, v in res["info"].items()  # the search is given at the top level
@@ -124,13 +128,15 @@ def _ss_result(model, val, data: list[Path], method: str, no_refine: bool, out: 
         res["search_criterion"] = model.info["search_criterion"]
     if "focus" in model.info:
         res["focus"] = model.info["focus"]
+    res["covariance_method"] = covariance_method(model)
     return res
 
 
 def _echo_ss(model, val, res: dict, focus: str, out: Path | None,
              report: Path | None = None) -> None:
     """The text output of ``identify ss``: structure, singular values, free-run fits (per
-    record for several files), focus decision, order search, validation, poles (± σ)."""
+    record for several files), focus decision, order search, validation, how σ was obtained and
+    the poles (± σ)."""
     ss = model.system
     typer.echo(f"{model.structure}: order {ss.n_states}, {ss.n_inputs} input(s) "
                f"{list(ss.inputs)} → "
@@ -157,6 +163,8 @@ def _echo_ss(model, val, res: dict, focus: str, out: Path | None,
                                                            zip(ss.outputs, val.fit_percent)))
         typer.echo(f"  ({val.definition})")
     p, cov = (ss.pole_covariance() if ss.uncertainty is not None else (ss.poles(), None))
+    if res["covariance_method"] is not None:
+        typer.echo(f"σ: {res['covariance_method']}")
     for i, z in enumerate(p):
         sd = "" if cov is None else f" ± ({np.sqrt(cov[i, 0, 0]):.2g}, {np.sqrt(cov[i, 1, 1]):.2g})"
         typer.echo(f"  pole {z.real:.6g}{z.imag:+.6g}j{sd}")

@@ -37,6 +37,7 @@ from ..report.plots import measured_vs_model, plain, pyplot
 from .linear.frf import frf
 from .linear.linear_model import VALIDATION_FIT, fit_per_output
 from .linear.pem_ss import predictor_x0
+from .linear.ss_bootstrap import bootstrapped, covariance_method
 
 __all__ = ["write_model_report", "model_report", "parameters_section", "residual_analysis",
            "predictor_x0",
@@ -418,11 +419,14 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=(),
                       [[n, ff, f1] for n, ff, f1 in zip(model.outputs, fit, res.fit_percent)])
         sec.figure(_residual_figure(res.e, u, model.outputs, model.inputs), "residual correlations",
                    name="residuals")
+        how = ("" if not bootstrapped(model) else
+               f" The covariance is that of a {covariance_method(model)}: the subspace model "
+               "was kept in place of the PEM refinement, and this is no PEM covariance.")
         rep.section("Poles and zeros", "Poles (×), transmission zeros (○) and the 1σ "
                                        "ellipse of each pole, "
                     "by linearisation of the "
-                    "parameter covariance.").figure(_pz_figure(model.system), "pole-zero map",
-                                                                            name="pz")
+                    "parameter covariance." + how).figure(_pz_figure(model.system),
+                                                          "pole-zero map", name="pz")
         est, keep, shown = None, None, ""
         if u.shape[0] >= 256 * (u.shape[1] + 1):
             try:

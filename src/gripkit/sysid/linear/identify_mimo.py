@@ -28,6 +28,7 @@ from ...progress import status, track
 from ...signals.trajectory import Trajectory
 from .arx_mimo import arx_mimo
 from .frf import frf
+from .ss_bootstrap import BOOTSTRAP_SEED, MIN_REPLICATES, bootstrap_covariance
 from ..io_data import IOData, parse_names, validation_data
 
 __all__ = ["mimo_data", "identify_ss", "identify_frf", "identify_tf", "identify_arx", "several",
@@ -87,7 +88,8 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
                 form: str = "innovation",
                 refine: bool = True, validate: Trajectory | None = None, detrend: str = "mean",
                 horizon: int | None = None, feedthrough: bool = False, progress: bool = False,
-                focus: str = "simulation", max_iterations: int = 50):
+                focus: str = "simulation", max_iterations: int = 50,
+                bootstrap_replicates: int | None = None, bootstrap_seed: int = BOOTSTRAP_SEED):
     """State-space model of the named columns: subspace (``method``), then PEM in ``form``
     unless ``refine=False``. Returns ``(model, extras)``; ``extras`` holds ``search`` (the ranked
     orders of a range), ``validation_fit_percent`` (per output, with ``validate``) and
@@ -100,7 +102,15 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     is what a model used for simulation and control design is judged by) or ``'prediction'`` (the
     one-step-ahead fit, PEM's own criterion, as MATLAB's default ``Focus``). When the refined model
     scores lower, the subspace model is returned with an :class:`AccuracyWarning` giving both
-    scores. PEM stopping after ``max_iterations`` without converging is warned about too."""
+    scores. PEM stopping after ``max_iterations`` without converging is warned about too.
+
+    A subspace model returned in place of the refinement (it scored higher, or PEM failed) carries
+    the σ of a parametric bootstrap of the subspace estimate
+    (:func:`~gripkit.sysid.linear.ss_bootstrap.bootstrap_covariance`: ``bootstrap_replicates``
+    records, the model's free run plus disturbances drawn like its residuals, refitted alike;
+    default by the record's length, 100 up to 20 000 samples; ``bootstrap_seed``, default
+    :data:`~gripkit.sysid.linear.ss_bootstrap.BOOTSTRAP_SEED`, seeds the draws),
+    with ``info['covariance']`` saying so, where a refined model carries PEM's covariance."""
     from .subspace import (
         DEFAULT_MAX_ORDER,
         SUBSPACE_METHODS,
@@ -113,6 +123,7 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
 
     if method not in SUBSPACE_METHODS:
         raise DataError(f"method: expected one of {', '.join(SUBSPACE_METHODS)}, found {method!r}")
+    _check_bootstrap(bootstrap_replicates, bootstrap_seed)
     d = mimo_data(data, input, output, detrend, why="state-space identification")
     vd = None if validate is None else validation_data(validate, d)
     rng = parse_order(order)
@@ -150,9 +161,12 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
             REFINE_TOP if vd is not None else 1)
     elif refine:
         report(f"PEM refinement ({form} form) of the order-{model.order} model")
-        model, refine = _refine(model, d, vd, form, focus, max_iterations, progress)
+        model = _refine(model, d, vd, form, focus, max_iterations, progress)[0]
     if ranked is not None:
         extras["search"] = [r for r, _ in ranked]
+    if refine and model.structure == method:  # the subspace start kept: σ by bootstrap
+        model = _bootstrap_sigma(model, d, k, method, feedthrough, detrend,
+                                 (bootstrap_replicates, bootstrap_seed), progress)
     warn_if_stabilised(model)
     if detrend == "mean":
         refit = lambda: identify_ss(  # noqa: E731
@@ -164,6 +178,36 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     if vd is not None:
         extras["validation_fit_percent"] = _validation_fit(model, vd)
     return model, extras
+
+
+def _check_bootstrap(replicates, seed) -> None:
+    """``bootstrap_replicates`` None or an integer >= MIN_REPLICATES / 3 (fewer give no σ worth
+    reporting), ``bootstrap_seed`` a non-negative integer (numpy's default_rng)."""
+    lo = MIN_REPLICATES // 3
+    if replicates is not None and (isinstance(replicates, bool)
+                                   or not isinstance(replicates, (int, np.integer))
+                                   or replicates < lo):
+        raise DataError(f"bootstrap_replicates: expected None (by the record's length) or an "
+                        f"integer >= {lo}, found {replicates!r}")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise DataError(f"bootstrap_seed: expected a non-negative integer, found {seed!r}")
+
+
+def _bootstrap_sigma(model, d: IOData, k: int, method: str, feedthrough: bool, detrend: str,
+                     options: tuple, progress: bool):
+    """The kept subspace ``model`` with the σ of a parametric bootstrap of the same estimation
+    (order, ``method``, horizon ``k``, ``feedthrough``, ``detrend``) on the deviation data ``d``;
+    ``options``: (replicates or None, seed)."""
+    from .subspace import from_factor, subspace_factor
+
+    n = model.order
+    replicates, seed = options
+    refit = lambda u, y: from_factor(  # noqa: E731
+        subspace_factor(u, y, horizon=k, method=method), n, dt=d.dt, feedthrough=feedthrough)
+    return bootstrap_covariance(model, d.u, d.y, refit, replicates=replicates, seed=seed,
+                                estimator=f"{method} (order {n}, horizon {k})",
+                                demean=detrend == "mean", feedthrough=feedthrough,
+                                progress=progress)
 
 
 #: orders an order search adds past an edge of its range where the best order sits
@@ -319,8 +363,9 @@ def _refine(start, d: IOData, vd: IOData | None, form: str, focus: str, max_iter
                     progress=progress)
     except IdentificationError as exc:  # an order the data do not support in full
         emit_warning(f"PEM refinement of the order-{start.order} {start.structure} model failed "
-                     f"({exc.message}); the subspace model is returned, without parameter "
-                     f"covariance (lower the order, or --no-refine to skip PEM)",
+                     f"({exc.message}); the subspace model is returned, with σ from a "
+                     f"parametric bootstrap of the subspace estimate where its replicates allow, "
+                     f"not PEM's covariance (lower the order, or --no-refine to skip PEM)",
                      AccuracyWarning)
         return start, False
     oe = None
@@ -383,8 +428,8 @@ def _never_lose(start, refined, focus: str, d: IOData, estimation: bool, max_ite
     emit_warning(f"PEM refinement lowered the mean {focus} fit on the {where} data from "
                  f"{before:.2f} % to "
                  f"{', '.join(f'{name} {fit:.2f} %' for name, fit in tried)}: the "
-                 "subspace model is returned, without parameter covariance (--focus "
-                 f"{other} judges "
+                 "subspace model is returned, with σ from a parametric bootstrap of the "
+                 f"subspace estimate, not PEM's covariance (--focus {other} judges "
                  f"by the other criterion; --no-refine skips PEM)", AccuracyWarning)
     start.info["focus"] = {**record, "refined_percent": tried[0][1], "kept": "subspace"}
     start.info["pem_rejected"] = refined.info.get("pem", {})
