@@ -12,7 +12,9 @@ parameters then agree to about those tolerances (measured: ≤ 2e-10 for tfest, 
 others), checked at rtol 1e-6. σ comes from the optimiser's forward-difference Jacobian (step
 √eps ≈ 1.5e-8 of each scaled parameter): the rounding of the residuals, ~eps/1.5e-8 ≈ 1e-8 of each
 entry, is amplified by the conditioning of JᵀJ (measured: ≤ 6e-8 for fit_motor and fit_stribeck,
-checked at 1e-6; ≤ 2.3e-6 for tfest's resonance, checked at 1e-5)."""
+checked at 1e-6; ≤ 2.3e-6 for tfest's resonance, checked at 1e-5).
+
+The base-parameter structure of a chain with 30 µm links keeps its L² regrouping terms."""
 
 import numpy as np
 import pytest
@@ -130,3 +132,34 @@ def test_fit_stribeck_is_scale_invariant(Kv):
             assert fit.std[k] / s == pytest.approx(ref.std[k], rel=1e-6), (K, k)
             # the truth (in units of K and Kv) within 3σ: the fit left its start values
             assert abs(fit.values[k] / s - truth[k]) < 3 * fit.std[k] / s, (K, k)
+
+
+def _micro_chain_base_error(L):
+    """max |Y₁ (K φ) − Y φ| / max |Y φ| of a planar three-link chain (horizontal: inertial
+    torques only) with links of length L, and the smallest regrouping coefficient."""
+    from gripkit.multibody import DHChain
+    from gripkit.sysid.rigid_body.dynamics import base_structure
+
+    m = np.full(3, 2.3e3 * L ** 3)  # silicon cubes of side L
+    inertia = np.array([np.diag([0.2, 1.0, 1.0]) * mk * L * L / 6 for mk in m])
+    chain = DHChain([0, 0, 0], [0, L, L], [0, 0, 0], mass=m, com=np.tile([L / 2, 0, 0], (3, 1)),
+                    inertia=inertia, gravity=(0, 0, -9.81))
+    st = base_structure(chain)
+    rng = np.random.default_rng(1)
+    q, qd, qdd = rng.uniform(-3, 3, (50, 3)), rng.normal(size=(50, 3)), rng.normal(size=(50, 3))
+    Y = chain.regressor(q, qd, qdd)
+    phi = chain.standard_parameters()
+    full = Y @ phi
+    base = Y[:, :, st.independent] @ (st.matrix @ phi)
+    return np.abs(base - full).max() / np.abs(full).max(), np.abs(st.beta[st.beta != 0]).min()
+
+
+def test_base_structure_of_a_micro_chain_reproduces_the_regressor():
+    """Base parameters: Y φ = Y₁ (K φ) exactly (module doc of rigid_body.dynamics), for links of
+    10 cm and of 30 µm (a MEMS gripper). The regrouping coefficients are L and L²
+    (``Izz_link1 + L²·m_link2 + …``); for 30 µm links L² = 9e-10 used to be zeroed as rounding
+    (an absolute threshold of 1e-8 on β), and Y₁ K φ missed 36 % of the torque."""
+    for L in (0.1, 3e-5):
+        err, smallest = _micro_chain_base_error(L)
+        assert err < 1e-12, L
+        assert smallest == pytest.approx(L * L, rel=1e-9), L
