@@ -35,6 +35,7 @@ from scipy import signal as _signal
 from ...errors import DataError, IdentificationError, ModelError
 from ...lti import StateSpace, TransferFunction
 from ..checks import check_dt, check_order, check_persistent_excitation, io_records
+from ..scaling import unit_scale
 from .frf import FRF, frf
 from .linear_model import (LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run,
                            x0_residual)
@@ -87,6 +88,16 @@ def _unscale(theta, ws, npo, nz):
     a = theta[:npo] * ws ** np.arange(1, npo + 1)
     b = theta[npo:] * ws ** (npo - nz + np.arange(nz + 1))
     return np.concatenate([a, b])
+
+
+def _coefficient_scale(theta, npo):
+    """The size of each coefficient for the optimiser's variables ``z = θ/scale``: ``|θ|`` floored
+    at 1e-8 of the largest of its group (denominator, numerator), so that the scale follows the
+    data's units (the numerator of an output in metres is tiny) and a coefficient near 0 keeps a
+    usable one."""
+    a = np.abs(np.asarray(theta, dtype=np.float64))
+    den, num = a[:npo], a[npo:]
+    return np.concatenate([den + 1e-8 * den.max(initial=0.0), num + 1e-8 * num.max(initial=0.0)])
 
 
 def _stabilise(theta, npo):
@@ -250,6 +261,17 @@ def _simulate_ct(theta, npo, nz, u, dt, x0=None):
     return d.A, d.B, d.C, d.D
 
 
+def _scaled_output_error(res, z0, cy):
+    """``least_squares`` of the output error ``res(z)`` multiplied by ``cy`` (the power of two
+    :func:`~gripkit.sysid.scaling.unit_scale` of the output: exact), its result (``fun``, ``jac``,
+    ``cost``) given back for ``res`` itself. scipy's ``gtol`` is absolute (on ‖Jᵀr‖∞): on the
+    raw residuals of an output of ~1e-8 (a tip in metres) it ended the fit at its start."""
+    sol = optimize.least_squares(lambda z: cy * res(z), z0, method="trf", x_scale="jac",
+                                 xtol=1e-10, ftol=1e-10)
+    sol.fun, sol.jac, sol.cost = sol.fun / cy, sol.jac / cy, sol.cost / cy / cy
+    return sol
+
+
 def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None,
           inputs=None, outputs=None, input_units=None, output_units=None, u_offset=None,
           y_offset=None) -> LinearModel:
@@ -293,7 +315,8 @@ def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None,
     th0 = (_stabilise(np.concatenate([start.system.denominator()[1:],
                                       start.system.numerator()[-(nz + 1):]]), npo))
     uu, yy = u, y[:, 0]
-    scale = np.abs(th0) + 1e-8
+    scale = _coefficient_scale(th0, npo)
+    cy = unit_scale(yy)  # residuals of unit size (see _scaled_output_error)
 
     def res(z):
         theta = z * scale
@@ -302,8 +325,7 @@ def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None,
         Ad, Bd, Cd, Dd = _simulate_ct(theta, npo, nz, uu, step)
         return x0_residual(Ad, Bd, Cd, Dd, uu, y)[:, 0]
 
-    sol = (optimize.least_squares(res, th0 / scale, method="trf", x_scale="jac", xtol=1e-10,
-                                  ftol=1e-10))
+    sol = _scaled_output_error(res, th0 / scale, cy)
     theta = sol.x * scale
     J = sol.jac / scale[None, :]
     dof = N - k - npo
@@ -352,8 +374,9 @@ def tfest_records(records, n_poles: int, n_zeros: int, *, dt: float | None = Non
                       dt=step)
     th0 = _stabilise(np.concatenate([start.system.denominator()[1:],
                                      start.system.numerator()[-(nz + 1):]]), npo)
-    scale = np.abs(th0) + 1e-8
+    scale = _coefficient_scale(th0, npo)
     peak = max(float(np.abs(y).max()) for _, y in recs)
+    cy = unit_scale(np.array([peak]))  # residuals of unit size (see _scaled_output_error)
 
     def runs(theta):
         Ad, Bd, Cd, Dd = _simulate_ct(theta, npo, nz, None, step)
@@ -367,8 +390,7 @@ def tfest_records(records, n_poles: int, n_zeros: int, *, dt: float | None = Non
         Ad, Bd, Cd, Dd = _simulate_ct(theta, npo, nz, None, step)
         return np.concatenate([x0_residual(Ad, Bd, Cd, Dd, u, y)[:, 0] for u, y in recs])
 
-    sol = optimize.least_squares(res, th0 / scale, method="trf", x_scale="jac", xtol=1e-10,
-                                 ftol=1e-10)
+    sol = _scaled_output_error(res, th0 / scale, cy)
     theta = sol.x * scale
     J = sol.jac / scale[None, :]
     dof = N - k - len(recs) * npo

@@ -147,7 +147,11 @@ def base_structure(chain, *, armature: bool = False, seed: int = 0,
     ind, dep = order[is_ind], order[~is_ind]
     beta = (np.linalg.lstsq(X[:, ind], X[:, dep],
                             rcond=None)[0] if dep.size else np.zeros((ind.size, 0)))
-    beta[np.abs(beta) < 1e-8] = 0.0
+    # rounding: a term whose share of its dependent column is below 1e-8 (relative: β has units,
+    # and the β = L² ≈ 1e-9 m² of a MEMS chain's 30 µm links is real), and every term of a
+    # column that is zero but for rounding (not live)
+    small = np.abs(beta) * norms[ind][:, None] < 1e-8 * norms[dep][None, :]
+    beta[small | (norms[dep] <= 1e-10 * norms.max())[None, :]] = 0.0
     keep = np.argsort(ind)  # the standard order
     ind, beta = ind[keep], beta[keep]
     base_names = tuple(_combination_name(names, i, dep, beta[k]) for k, i in enumerate(ind))

@@ -308,8 +308,15 @@ def fit_stribeck(velocity, friction, *, weights=None, fixed: dict | None = None,
     if v.size <= len(free):
         raise DataError(f"{v.size} points cannot determine {len(free)} parameters {free}")
     w = np.ones_like(v) if weights is None else np.asarray(weights, dtype=np.float64)
-    scale = np.array([max(abs(start[n]), 1e-3) for n in free])
     vmax = float(np.max(np.abs(v)))
+    # a scale-free problem (scipy's gtol on Jᵀr is absolute: friction of ~1e-6 N used to end the
+    # fit at its start): z = θ/scale, each parameter's start floored at 1e-3 of its natural size
+    # in the data's units (F = 1/cf a power of two of the size of |f|, vmax), and the residual
+    # times the power of two cr that brings (f·w) to unit size (exact)
+    cf, cr = unit_scale(f), unit_scale(f * w)
+    size = dict(fc=1 / cf, fs=1 / cf, vs=vmax, delta=1.0, sigma=1 / cf / vmax,
+                cubic=1 / cf / vmax ** 3)
+    scale = np.array([max(abs(start[n]), 1e-3 * size[n]) for n in free])
 
     def unpack(z):
         p = dict(start)
@@ -323,11 +330,12 @@ def fit_stribeck(velocity, friction, *, weights=None, fixed: dict | None = None,
     lb = {"fc": 0.0, "fs": 0.0, "vs": 1e-6 * vmax, "delta": 0.2, "sigma": -np.inf, "cubic": -np.inf}
     ub = ({"fc": np.inf, "fs": np.inf, "vs": 10 * vmax, "delta": 10.0, "sigma": np.inf,
            "cubic": np.inf})
-    res = least_squares(lambda z: (model(unpack(z)) - f) * w,
+    res = least_squares(lambda z: (model(unpack(z)) - f) * w * cr,
                         np.array([start[n] for n in free]) / scale,
                         bounds=(np.array([lb[n] for n in free]) / scale,
                                 np.array([ub[n] for n in free]) / scale),
                         x_scale="jac")
+    res.fun, res.jac = res.fun / cr, res.jac / cr
     p = {k: float(val) for k, val in unpack(res.x).items()}
     J = res.jac / scale  # d r / d θ
     dof = v.size - len(free)
