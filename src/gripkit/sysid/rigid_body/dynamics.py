@@ -124,7 +124,10 @@ def base_structure(chain, *, armature: bool = False, seed: int = 0,
     q = rng.uniform(-math.pi, math.pi, (B, m))
     qd = rng.normal(size=(B, m))
     qdd = rng.normal(size=(B, m))
-    X = _inertial_columns(chain, q, qd, qdd, armature).reshape(B * m, p)
+    # columns in comparable units: parameter k times Lᵏ (k = 0 mass, 1 first moment, 2 inertia,
+    # armature) with L the chain's size, so the rank tests below hold for 30 µm links as for 1 m
+    scale = _column_scale(chain, p)
+    X = _inertial_columns(chain, q, qd, qdd, armature).reshape(B * m, p) * scale
     # greedy in a fixed order (module doc): a column is independent when it is not in the span of
     # the columns before it, |R_kk| of the QR in that order against its norm
     link = np.array([k // 10 if k < 10 * (p // 10) else -1 for k in range(p)])
@@ -152,10 +155,27 @@ def base_structure(chain, *, armature: bool = False, seed: int = 0,
     # column that is zero but for rounding (not live)
     small = np.abs(beta) * norms[ind][:, None] < 1e-8 * norms[dep][None, :]
     beta[small | (norms[dep] <= 1e-10 * norms.max())[None, :]] = 0.0
+    beta = beta * scale[ind][:, None] / scale[dep][None, :]  # back to the parameters' units
     keep = np.argsort(ind)  # the standard order
     ind, beta = ind[keep], beta[keep]
     base_names = tuple(_combination_name(names, i, dep, beta[k]) for k, i in enumerate(ind))
     return BaseStructure(ind, dep, beta, base_names, tuple(names))
+
+
+def _column_scale(chain, p: int) -> np.ndarray:
+    """Lᵏ per standard parameter (k = 0 for m, 1 for m·c, 2 for the inertias and a rotor
+    inertia), L = the median radius of gyration about the link frames, √(tr I / 2m), of the
+    chain's links with mass (1 m when none has one, or when the chain object gives no standard
+    parameters): the columns of Y·diag(Lᵏ) are of one size whatever the chain's scale."""
+    nominal = getattr(chain, "standard_parameters", None)
+    phi = (np.zeros((0, 10)) if nominal is None
+           else np.asarray(nominal(), dtype=np.float64).reshape(-1, 10))
+    mass, trace = phi[:, 0], phi[:, 4] + phi[:, 6] + phi[:, 9]
+    ok = (mass > 0) & (trace > 0)
+    length = float(np.sqrt(np.median(trace[ok] / (2 * mass[ok])))) if ok.any() else 1.0
+    power = np.full(p, 2.0)  # the rotor inertias after the links' columns
+    power[:phi.size] = np.tile([0, 1, 1, 1, 2, 2, 2, 2, 2, 2], phi.shape[0])
+    return length ** power
 
 
 def _inertial_columns(chain, q, qd, qdd, armature: bool) -> np.ndarray:
