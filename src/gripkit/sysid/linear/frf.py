@@ -145,10 +145,24 @@ def _periodic(u, y, dt, periods, keep_transient):
                                                      "transient_dropped": not keep_transient}
 
 
+def _h1_min_samples(m: int) -> int:
+    """The shortest record whose default segments (N // 8 within 16 … 4096 samples, half
+    overlapping) number more than ``m``: 16 + 8 m for m < 14."""
+    N = 16
+    while 1 + (N - (L := max(min(N // 8, 4096), 16))) // (L // 2) <= m:
+        N += 1
+    return N
+
+
 def _h1(u, y, dt, nperseg):
     N, m = u.shape
     p = y.shape[1]
     L = int(nperseg) if nperseg else max(min(N // 8, 4096), 16)
+    if not nperseg and (L > N or 1 + (N - L) // (L // 2) <= m):
+        raise DataError(f"data: a record of {N} sample(s) is too short for an H1 FRF with "
+                        f"{m} input(s): it needs at least {_h1_min_samples(m)} (Hann "
+                        f"segments of at least 16 samples, half overlapping, more than {m})",
+                        hint="use a longer record")
     if L < 8 or L > N:
         raise DataError(f"nperseg: expected 8 … {N} samples per segment, found {L}")
     step = L // 2
