@@ -36,6 +36,7 @@ from __future__ import annotations
 import math
 import os
 import xml.etree.ElementTree as ET
+from xml.parsers import expat
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -272,8 +273,6 @@ def _refuse_dtd(xml, name: str | None) -> None:
     entities), read with expat up to the root element only: a URDF needs none, and refusing
     it keeps a file from reaching outside itself (external entities) or expanding without
     bound (nested entities)."""
-    from xml.parsers import expat
-
     def doctype(doctype_name, system_id, public_id, has_internal_subset):
         raise _Declared("a DTD (<!DOCTYPE " + doctype_name + (" SYSTEM ..." if system_id else "")
                         + ">)")

@@ -475,7 +475,8 @@ def keep_better_without_detrending(model, refit, command: str, score):
 def identify_frf(data: Trajectory, *, input, output, detrend: str = "mean", **options):
     """Frequency response of the named columns (:func:`gripkit.sysid.linear.frf` options)."""
     d = mimo_data(data, input, output, detrend, why="frequency-response estimation")
-    return frf(d.u, d.y, dt=d.dt, inputs=d.inputs, outputs=d.outputs, **options)
+    return frf(d.u, d.y, dt=d.dt, inputs=d.inputs, outputs=d.outputs,
+               input_units=d.input_units, output_units=d.output_units, **options)
 
 
 def identify_tf(data: Trajectory, *, input, output, poles: int, zeros: int, detrend: str = "mean"):
