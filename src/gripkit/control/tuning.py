@@ -35,6 +35,14 @@ time (:meth:`gripkit.lti.LinearSystem.d2c`, exact for a ZOH-sampled system), lea
 * h/2 is added to θ for the sample-and-hold of the digital controller (the paper's §3.1 remark
   on digital implementation).
 
+A pole is the integrator when it lies within 3σ of z = 1 for a model that carries its
+covariance (an identified one: its estimate 1 ± σ cannot be told from 1, and the notes say it
+was so taken), or within 1e-9 of 1 otherwise. Numerator taps beyond A's order (a pure delay
+q⁻ᵏ, or no lag at all once the integrator is taken out) would put poles at z = 0 in the ZOH
+realisation, which no continuous pole samples to: they become a delay instead, matching the
+taps' first moment (exact for a single tap ``b q⁻ᵏ``: θ₀ = (k − 1) h), the lags' time constants
+kept exact.
+
 Oscillatory (complex) or unstable poles, and complex zeros, have no place in these rules: a
 ModelError says so, and :class:`LowOrderModel` can be given directly instead (roots within
 :data:`REAL_TOL` of the real axis count as real: a repeated real root splits so by rounding).
