@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from gripkit import DataError, UnidentifiableError
-from gripkit.sysid import arx, frf, hysteresis, n4sid, nlss
+from gripkit.sysid import arx, frf, hysteresis, n4sid, nlss, oe
 from gripkit.sysid.linear.frf import _h1_min_samples
 
 RNG = np.random.default_rng(0)
@@ -27,6 +27,22 @@ def test_frf_on_a_short_record_says_how_many_samples_it_needs(n):
     with pytest.raises(DataError, match=r"nperseg: expected 8 … 100 samples per segment, found "
                                         r"200"):
         frf(U[:100], Y[:100], nperseg=200)  # a user's own nperseg is still the one named
+
+
+def test_spa_on_a_short_record_says_how_many_samples_it_needs():
+    """The default lag window N/10 needs 2 lags: 20 samples (it blamed lag_window, never
+    passed)."""
+    with pytest.raises(DataError, match=r"a record of 19 sample\(s\) is too short for an SPA "
+                                        r"FRF: it needs at least 20"):
+        frf(U[:19], Y[:19], method="spa")
+    assert frf(U[:20], Y[:20], method="spa").H.shape[1:] == (1, 1)
+
+
+def test_a_row_given_to_a_single_channel_estimator_is_called_transposed():
+    with pytest.raises(DataError, match=r"input u: expected a 1-D array of samples, found shape "
+                                        r"\(1, 300\) \(one row: it looks transposed\); pass "
+                                        r"x.ravel\(\)"):
+        oe(U[None, :], Y[None, :], 2, 2, 1)
 
 
 def test_hysteresis_on_a_short_record_asks_for_more_data_not_a_lower_burn_in():

@@ -47,8 +47,11 @@ def signal_array(x, name: str) -> np.ndarray:
         raise DataError(f"{name}: expected a 1-D array of numbers, found "
                         f"{type(x).__name__}") from None
     if a.ndim != 1:
-        raise DataError(f"{name}: expected a 1-D array of samples, found shape {a.shape}",
-                        hint="pass one channel at a time (single-input single-output models)")
+        row = a.ndim == 2 and a.shape[0] == 1 and a.shape[1] > 1
+        raise DataError(f"{name}: expected a 1-D array of samples, found shape {a.shape}"
+                        + (" (one row: it looks transposed)" if row else ""),
+                        hint="pass x.ravel()" if row else
+                        "pass one channel at a time (single-input single-output models)")
     if a.size == 0:
         raise DataError(f"{name}: the signal holds no samples")
     return a

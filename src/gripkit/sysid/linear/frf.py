@@ -272,6 +272,9 @@ def _spa(u, y, dt, lag_window, n_lines):
         raise DataError("spa: the smoothed ETFE is single-input; found "
                         f"{u.shape[1]} input(s)", hint="use the h1 method for several inputs")
     M = int(lag_window) if lag_window else int(min(30, N // 10))
+    if not lag_window and M < 2:
+        raise DataError(f"data: a record of {N} sample(s) is too short for an SPA FRF: it needs "
+                        "at least 20 (a lag window of N/10 ≥ 2 lags)", hint="use a longer record")
     if M < 2 or M >= N // 2:
         raise DataError(f"lag_window: expected 2 … {N // 2 - 1}, found {M}")
     uu, yy = u[:, 0], y[:, 0]
