@@ -211,3 +211,15 @@ def test_unknown_pid_options_name_the_valid_ones():
         tune_pid(_foptd(), limits=(-1.0, 1.0))
     pid = tune_pid(_foptd(), u_min=-1.0, u_max=1.0, b=0.5)
     assert pid.limits == (-1.0, 1.0) and float(pid._p[PIDX.b]) == 0.5
+
+
+def test_taps_beyond_a_second_order_lag_are_their_extra_mean_delay():
+    """1/((s + 1)(0.5 s + 1)) ZOH-sampled at h = 0.1 s, its numerator convolved with
+    (1 + q⁻¹)/2 (a two-tap average: half a sample of mean delay, and a tap more than A's order):
+    the time constants 1 and 0.5 s come back exact, k = 1, and θ = h/2 (the taps' first moment
+    beyond the lag's own ZOH taps) + h/2 (the controller's hold); second order: τ₂ = 0.5 s."""
+    h = 0.1
+    g = TransferFunction([1.0], np.polymul([1.0, 1.0], [0.5, 1.0])).c2d(h)
+    A, B = g.den_zinv(), np.convolve(g.num_zinv(), [0.5, 0.5])
+    m = reduce_model(TransferFunction.from_polynomials(A, B, dt=h), 2)
+    np.testing.assert_allclose([m.k, m.tau1, m.tau2, m.theta], [1.0, 1.0, 0.5, h], rtol=1e-9)
