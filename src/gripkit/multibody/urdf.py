@@ -274,8 +274,8 @@ def _refuse_dtd(xml, name: str | None) -> None:
     it keeps a file from reaching outside itself (external entities) or expanding without
     bound (nested entities)."""
     def doctype(doctype_name, system_id, public_id, has_internal_subset):
-        raise _Declared("a DTD (<!DOCTYPE " + doctype_name + (" SYSTEM ..." if system_id else "")
-                        + ">)")
+        raise _Declared("a DTD (<!DOCTYPE " + doctype_name[:40]
+                        + (" SYSTEM ..." if system_id else "") + ">)")
 
     def root(*_):
         raise _RootReached()
@@ -293,8 +293,8 @@ def _refuse_dtd(xml, name: str | None) -> None:
                          "none, and a file must not reach outside itself)",
                          hint="remove the <!DOCTYPE ...> declaration and write the values out"
                          ) from None
-    except expat.ExpatError:
-        return  # ElementTree reports it, with its position
+    except expat.ExpatError as exc:  # in the prolog: fail closed, never parse it further
+        raise ModelError(f"the URDF is not well-formed XML: {exc}") from None
 
 
 def _read_root(source):
