@@ -53,6 +53,8 @@ OK = ["--position", "p0,p1", "--effort", "e0,e1"]
     (_arm(JOINT.format("jx", "base", "l2")), "link 'l2' is the child of joints 'j1' and 'jx'"),
     (_arm().replace('velocity="2"', 'velocity="fast"', 1), "joint 'j0' <limit>: velocity='fast' "
                                                            "is not a number"),
+    ('<!DOCTYPE robot [<!ENTITY m SYSTEM "file:///etc/hostname">]>' + _arm(),
+     "URDF file 'bad.urdf' declares a DTD (<!DOCTYPE robot>): gripkit reads no DTDs"),
 ])
 def test_bad_urdf(cli, tmp_path, xml, phrase):
     p = tmp_path / "bad.urdf"

@@ -124,6 +124,9 @@ def test_identify_frf_json(capsys, files):
     code, out, err = (run(capsys, "identify", "frf", files["siso"], "--input", "v", "--output", "x",
                           "--json"))
     assert "coherence" in json.loads(out)
+    assert json.loads(out)["H_unit"] == "m/V"  # x [m] per v [V] of the data file
+    code, out, err = run(capsys, "identify", "frf", files["siso"], "--input", "v", "--output", "x")
+    assert code == 0 and "['v'] → ['x'], H in m/V" in out and " m/V  phase" in out
 
 
 def test_identify_tf_json(capsys, files):

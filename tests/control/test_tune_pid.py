@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from gripkit.control import LowOrderModel, reduce_model, robustness, tune_pid
+from gripkit.control.pid import PIDX
 from gripkit.errors import ArgumentError, ModelError
 from gripkit.lti import TransferFunction
 
@@ -121,3 +122,104 @@ def test_an_integrating_model_keeps_its_integrator():
     Kc, ti = 1 / (250.0 * 2 * m.theta), 8 * m.theta
     assert pid.ki == pytest.approx(Kc / ti, rel=1e-9) and pid.kd == pytest.approx(Kc * m.tau2,
                                                                                  rel=1e-9)
+
+
+def _closed_loop_step(A, B, pid, n=1500):
+    """The sampled loop y = B/A u, u = pid(r = 1, y): the output at every sample."""
+    y, u = np.zeros(n), np.zeros(n)
+    for t in range(n):
+        y[t] = (-sum(A[i] * y[t - i] for i in range(1, len(A)) if t >= i)
+                + sum(B[j] * u[t - j] for j in range(1, len(B)) if t >= j))
+        u[t] = pid.step(1.0, y[t])
+    return y
+
+
+def test_an_exact_integrator_with_delay_tunes_to_simc_margins():
+    """0.05 q⁻³/(1 − q⁻¹) at h = 0.01 s (audit: d2c refused the pole at z = 0 of the realisation
+    of 0.05 q⁻¹ left after the integrator): k′ = 0.05/h = 5 /s, θ = 2h + h/2 (the delay, not a
+    lag). τ_c = θ on k′e^{−θs}/s gives L = e^{−θs}(1 + 1/(8θs))/(2θs): gain margin 2.963 and
+    phase margin 46.86° (solved from L; Skogestad's §4.3 'about 3 and 47°', the promise of the
+    module docstring); the discrete loop is within 2 % and 0.5° of that, and its simulated step
+    response settles at the setpoint."""
+    h = 0.01
+    g = TransferFunction.from_polynomials([1.0, -1.0], [0.0, 0.0, 0.0, 0.05], dt=h)
+    m = reduce_model(g, 2)
+    assert m.integrating and m.k == pytest.approx(5.0, rel=1e-12)
+    assert (m.tau1, m.tau2) == (0.0, 0.0) and m.theta == pytest.approx(2.5 * h, rel=1e-12)
+    pid = tune_pid(g)
+    assert pid.kp == pytest.approx(1 / (5.0 * 2 * 0.025), rel=1e-12) and pid.kd == 0.0
+    r = robustness(g, pid, n=0)
+    assert r.stable
+    assert r.nominal["gain_margin"] == pytest.approx(2.963, rel=0.02)
+    assert r.nominal["phase_margin_deg"] == pytest.approx(46.86, abs=0.5)
+    y = _closed_loop_step([1.0, -1.0], [0.0, 0.0, 0.0, 0.05], pid)
+    assert np.all(np.abs(y) < 2.0) and np.max(np.abs(y[-200:] - 1.0)) < 1e-6
+
+
+def test_an_estimated_integrator_within_its_sigma_is_one():
+    """ARX on 0.05 q⁻²/(1 − q⁻¹) with noise 1e-3: the pole is estimated at 1 + 8.7e-8, σ 1.05e-5
+    (beyond the 1e-9 rule, so it was refused as unstable): within 3σ of 1 it is the integrator,
+    and the result's notes say so; k′ = b/h within 0.1 %."""
+    from scipy.signal import lfilter
+
+    from gripkit import sysid
+
+    rng = np.random.default_rng(0)
+    u = rng.standard_normal(3000)
+    y = lfilter([0.0, 0.0, 0.05], [1.0, -1.0], u) + 1e-3 * rng.standard_normal(3000)
+    est = sysid.arx(u, y, 1, 1, 2, dt=0.01)
+    assert 1.0 + 1e-9 < -est.A[1] < 1.0 + est.A_std[1]
+    pid = tune_pid(est)
+    notes = pid.design["model"]["notes"]
+    assert pid.design["model"]["integrating"] and pid.design["model"]["k"] == pytest.approx(
+        5.0, rel=1e-3)
+    assert any("within 3σ of 1: taken as an integrator" in n for n in notes)
+
+
+def test_a_truly_unstable_estimated_pole_is_still_refused():
+    """A pole at 1.05 estimated with σ ≈ 6e-7 lies ~1e5 σ beyond 1: refused, the σ shown."""
+    from scipy.signal import lfilter
+
+    from gripkit import sysid
+
+    rng = np.random.default_rng(0)
+    u = rng.standard_normal(200)
+    y = lfilter([0.0, 0.05], [1.0, -1.05], u) + 1e-3 * rng.standard_normal(200)
+    with pytest.raises(ModelError, match=r"poles \[1\.05 ± .*\] outside \(0, 1\) \(unstable"):
+        tune_pid(sysid.arx(u, y, 1, 1, 1, dt=0.01))
+
+
+def test_numerator_taps_beyond_the_lag_order_are_a_delay():
+    """0.05 (q⁻² + q⁻³)/(1 − 0.9 q⁻¹) (nb > na: the realisation's pole at z = 0 has no
+    continuous equivalent): τ₁ = −h/ln 0.9 exact, k = B(1)/A(1) = 1, and the taps' first moment
+    (half a sample; the ZOH lag's own single tap has moment 0) adds h/2 to θ = (nk − 1) h + h/2.
+    A pure delay (no lag at all) reaches SIMC's 'integral controller' refusal, not d2c."""
+    h = 0.01
+    tau = -h / math.log(0.9)
+    m = reduce_model(TransferFunction.from_polynomials([1.0, -0.9], [0, 0, 0.05, 0.05], dt=h), 1)
+    assert m.k == pytest.approx(1.0, rel=1e-12) and m.tau1 == pytest.approx(tau, rel=1e-9)
+    assert m.theta == pytest.approx(h + 0.5 * h + h / 2, rel=1e-9)
+    assert "taken as a delay of 0.005 s (first moment)" in m.notes[0]
+    with pytest.raises(ModelError, match="no lag left \\(a pure delay\\)"):
+        tune_pid(TransferFunction.from_polynomials([1.0], [0.0, 0.0, 0.3], dt=h))
+
+
+def test_unknown_pid_options_name_the_valid_ones():
+    """The docstring said '(limits, tf, b, c)'; limits= raised a bare TypeError from PID."""
+    with pytest.raises(ArgumentError, match=r"unknown option\(s\) limits; the PID options are "
+                                            r"u_min, u_max, tf, b, c, tt"):
+        tune_pid(_foptd(), limits=(-1.0, 1.0))
+    pid = tune_pid(_foptd(), u_min=-1.0, u_max=1.0, b=0.5)
+    assert pid.limits == (-1.0, 1.0) and float(pid._p[PIDX.b]) == 0.5
+
+
+def test_taps_beyond_a_second_order_lag_are_their_extra_mean_delay():
+    """1/((s + 1)(0.5 s + 1)) ZOH-sampled at h = 0.1 s, its numerator convolved with
+    (1 + q⁻¹)/2 (a two-tap average: half a sample of mean delay, and a tap more than A's order):
+    the time constants 1 and 0.5 s come back exact, k = 1, and θ = h/2 (the taps' first moment
+    beyond the lag's own ZOH taps) + h/2 (the controller's hold); second order: τ₂ = 0.5 s."""
+    h = 0.1
+    g = TransferFunction([1.0], np.polymul([1.0, 1.0], [0.5, 1.0])).c2d(h)
+    A, B = g.den_zinv(), np.convolve(g.num_zinv(), [0.5, 0.5])
+    m = reduce_model(TransferFunction.from_polynomials(A, B, dt=h), 2)
+    np.testing.assert_allclose([m.k, m.tau1, m.tau2, m.theta], [1.0, 1.0, 0.5, h], rtol=1e-9)

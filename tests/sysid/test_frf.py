@@ -105,3 +105,27 @@ def test_non_periodic_input_refused():
     u = np.random.default_rng(0).standard_normal(3000)
     with pytest.raises(DataError, match="not periodic"):
         frf(u, u, dt=0.01, periods=3)
+
+
+def test_the_frf_carries_output_per_input_units():
+    """identify(traj, 'frf') kept the columns' names but dropped their units: H of x [m] over
+    v [V] is in m/V (its repr and to_dict say so); arrays without units leave it unlabelled, and
+    a MIMO FRF labels each entry. The estimate itself is unchanged: H = 0.5 at every line."""
+    from gripkit import Trajectory
+    from gripkit.errors import ArgumentError
+    from gripkit.sysid import identify
+
+    u = np.random.default_rng(0).standard_normal(4000)
+    y = 0.5 * np.concatenate([[0.0], u[:-1]])
+    tr = Trajectory(np.arange(4000) * 1e-3, {"v": u, "x": y}, {"v": "V", "x": "m"})
+    r = identify(tr, "frf", input="v", output="x", nperseg=256)
+    assert r.input_units == ("V",) and r.output_units == ("m",) and r.H_units == [["m/V"]]
+    assert r.to_dict()["H_unit"] == "m/V" and repr(r).endswith("['v'] → ['x'], H in m/V)")
+    np.testing.assert_allclose(np.abs(r.H[1:, 0, 0]), 0.5, atol=0.01)
+    bare = frf(u, y, dt=1e-3)
+    assert bare.H_units == [[""]] and "H in" not in repr(bare)
+    two = frf(np.column_stack([u, u[::-1]]), y, input_units=["V", "A"], output_units="m")
+    assert two.H_units == [["m/V", "m/A"]]
+    with pytest.raises(ArgumentError, match=r"input_units: expected 1 unit string\(s\), one per "
+                                            r"channel, found \('V', 'A'\)"):
+        frf(u, y, input_units=("V", "A"))

@@ -235,6 +235,30 @@ def test_emps_idim_ls_matches_the_published_estimates(capsys):
     for k, (value, sigma) in EMPS_PUBLISHED.items():
         assert abs(res["params"][k] - value) <= 2.5 * math.hypot(res["std"][k], sigma), k
     assert res["relative_error_percent"] < 4.08
+    assert res["units"] == {"inertia": "(N*s^2)/m", "viscous": "(N*s)/m", "coulomb": "N",
+                            "offset": "N"}
+
+
+def test_emps_idim_ls_result_carries_the_units_of_its_parameters():
+    """The Python call gave values and σ without units: with the columns' units (README:
+    position [m], force [N]) M is in N·s²/m = kg, Fv in N·s/m, Fc and the offset in N, shown by
+    str() next to each value (M = 94.99 ± 0.21 kg, Fv = 202.6 ± 7.6 N·s/m, Fc = 20.43 ± 0.58 N,
+    the EMPS reference values within their σ); without units the table says they are unknown."""
+    from gripkit.sysid import idim_ls
+    from gripkit.units import same_dimension
+
+    est = load(FIXTURES / "emps" / "emps_est.csv")
+    r = idim_ls(est["position"], est["force"], dt=est.dt, position_unit=est.unit("position"),
+                effort_unit=est.unit("force"))
+    assert same_dimension(r.units["inertia"], "kg") and r.units["viscous"] == "(N*s)/m"
+    assert r.units["coulomb"] == r.units["offset"] == "N" and r.to_dict()["units"] == r.units
+    for k, want in (("inertia", 95.0), ("viscous", 202.6), ("coulomb", 20.4)):
+        assert abs(r.params[k] - want) < r.std[k]
+    rows = str(r).splitlines()
+    assert rows[1].split() == ["inertia", f"{r.params['inertia']:.6g}", "±",
+                               f"{r.std['inertia']:.2g}", "(N*s^2)/m"]
+    bare = idim_ls(est["position"], est["force"], dt=est.dt)
+    assert bare.units == {} and "units unknown: give idim_ls position_unit=" in str(bare)
 
 
 def test_unstable_subspace_estimate_whose_regressor_overflows_is_stabilised():

@@ -22,21 +22,10 @@ from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, check
 
 
 def friction_units(position: str, effort: str, scale: float = 1.0) -> dict[str, str]:
-    """Units of IDIM-LS's parameters from the position and effort units: inertia effort·s²/position,
-    viscous effort·s/position, Coulomb and offset in effort units, where the effort is
-    ``scale × effort`` (a factor other than 1 leads the effort unit: ``0.5 A``). A '1' (no unit)
-    drops out of products and quotients: 'N*m*s^2/rad', 's^2' rather than '(1)*s^2/1'."""
-    from ..units import ratio_unit
+    """Units of IDIM-LS's parameters (:func:`gripkit.sysid.rigid_body.friction.idim_units`)."""
+    from ..sysid.rigid_body.friction import idim_units
 
-    def times(a: str, b: str) -> str:
-        a, b = a or "1", b or "1"
-        return b if a == "1" else a if b == "1" else f"{a}*{b}"
-
-    eu = effort or "1"
-    if scale != 1.0:
-        eu = f"{scale:g}" if eu == "1" else f"{scale:g} {eu}"
-    return {"inertia": ratio_unit(times(eu, "s^2"), position or "1"),
-            "viscous": ratio_unit(times(eu, "s"), position or "1"), "coulomb": eu, "offset": eu}
+    return idim_units(position, effort, scale)
 
 
 @identify_app.command("friction")
@@ -76,8 +65,9 @@ def identify_friction(
             check_dimension(effort, tr.unit(effort), FORCE_OR_TORQUE, "effort")
         dt = tr.require_uniform(why="IDIM-LS (filtering and differentiation)")
         res = idim_ls(tr[position], tr[effort], dt=dt, effort_scale=effort_scale, cutoff=cutoff,
-                      decimation=decimate, velocity_threshold=velocity_threshold)
-    units = friction_units(tr.unit(position), tr.unit(effort), effort_scale)
+                      decimation=decimate, velocity_threshold=velocity_threshold,
+                      position_unit=tr.unit(position) or "1", effort_unit=tr.unit(effort) or "1")
+    units = res.units
     out = {"params": res.params, "std": res.std,
            "relative_error_percent": res.relative_error_percent,
            "units": units, "n_samples": res.n_samples, "fs": 1.0 / res.dt, "cutoff_hz": res.cutoff,

@@ -220,13 +220,15 @@ def identify_frf_cmd(data: Path = DataArg, input: str = InputsOpt, output: str =
     if json_out:
         emit_json(res)
         return
+    unit = r.H_units[0][0]
     typer.echo(f"FRF ({r.method}): {r.frequency_hz.size} lines, {list(r.inputs)} → "
-               f"{list(r.outputs)}")
+               f"{list(r.outputs)}" + (f", H in {unit}" if unit else ""))
     step = max(1, r.frequency_hz.size // 20)
+    unit = f" {unit}" if unit else ""
     for k in range(0, r.frequency_hz.size, step):
         h, s = r.H[k, 0, 0], r.H_std[k, 0, 0]
-        typer.echo(f"  {r.frequency_hz[k]:10.4g} Hz  |H| {abs(h):.4g}  "
-                   f"phase {np.degrees(np.angle(h)):7.1f}°  σ {s:.2g}")
+        typer.echo(f"  {r.frequency_hz[k]:10.4g} Hz  |H| {abs(h):.4g}{unit}  "
+                   f"phase {np.degrees(np.angle(h)):7.1f}°  σ {s:.2g}{unit}")
 
 
 def _coefficients(model, which: str, values, stds, poles: int) -> str:

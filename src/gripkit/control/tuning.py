@@ -35,6 +35,14 @@ time (:meth:`gripkit.lti.LinearSystem.d2c`, exact for a ZOH-sampled system), lea
 * h/2 is added to θ for the sample-and-hold of the digital controller (the paper's §3.1 remark
   on digital implementation).
 
+A pole is the integrator when it lies within 3σ of z = 1 for a model that carries its
+covariance (an identified one: its estimate 1 ± σ cannot be told from 1, and the notes say it
+was so taken), or within 1e-9 of 1 otherwise. Numerator taps beyond A's order (a pure delay
+q⁻ᵏ, or no lag at all once the integrator is taken out) would put poles at z = 0 in the ZOH
+realisation, which no continuous pole samples to: they become a delay instead, matching the
+taps' first moment (exact for a single tap ``b q⁻ᵏ``: θ₀ = (k − 1) h), the lags' time constants
+kept exact.
+
 Oscillatory (complex) or unstable poles, and complex zeros, have no place in these rules: a
 ModelError says so, and :class:`LowOrderModel` can be given directly instead (roots within
 :data:`REAL_TOL` of the real axis count as real: a repeated real root splits so by rounding).
@@ -43,9 +51,12 @@ ModelError says so, and :class:`LowOrderModel` can be given directly instead (ro
 from __future__ import annotations
 
 import math
+import warnings
+
 import numpy as np
 
-from ..errors import ArgumentError, ModelError
+from ..errors import AccuracyWarning, ArgumentError, ModelError
+from ..lti import TransferFunction
 from .pid import PID
 from .rst import as_plant
 
@@ -55,6 +66,12 @@ __all__ = ["LowOrderModel", "reduce_model", "simc_settings", "tune_pid"]
 #: splits a repeated real root of multiplicity m by about ε^(1/m) (a triple pole of a sampled
 #: model by ~1e-4), and the rules take the real part
 REAL_TOL = 1e-3
+#: a pole of a model that carries a covariance is an integrator when it lies within this many
+#: one-sigma of z = 1 (the data do not tell it from one); any pole within INTEGRATOR_TOL of 1 is
+INTEGRATOR_SIGMAS = 3.0
+INTEGRATOR_TOL = 1e-9
+#: the keyword options of tune_pid that go on to PID (the gains and dt come from the design)
+PID_OPTIONS = ("u_min", "u_max", "tf", "b", "c", "tt")
 
 
 class LowOrderModel:
@@ -108,6 +125,80 @@ def _cancel_lhp_zero(T0: float, taus: list, theta: float) -> tuple[float, list, 
     return tt / tau0, rest + [tt - T0], "R3"
 
 
+def _pole_sigmas(g, zp: np.ndarray) -> np.ndarray:
+    """One-sigma of each real pole in ``zp`` from the covariance ``g`` carries (an identified
+    model's), NaN where it carries none or the first-order σ is undefined (a repeated pole)."""
+    sig = np.full(zp.size, np.nan)
+    if getattr(g, "uncertainty", None) is None or zp.size == 0:
+        return sig
+    with warnings.catch_warnings():  # a repeated pole's σ is inf: unknown here, no warning
+        warnings.simplefilter("ignore", AccuracyWarning)
+        lam, cov = g.pole_covariance()
+    for i, p in enumerate(zp):
+        v = cov[int(np.argmin(np.abs(lam - p))), 0, 0]
+        sig[i] = math.sqrt(v) if math.isfinite(v) and v >= 0 else np.nan
+    return sig
+
+
+def _integrators(g, zp: np.ndarray) -> tuple[np.ndarray, list]:
+    """Which poles are an integrator: within :data:`INTEGRATOR_SIGMAS` σ of z = 1 where the model
+    carries σ, within :data:`INTEGRATOR_TOL` of it otherwise (or as well); the notes say which
+    were taken so on their σ. A ModelError for any other pole outside (0, 1)."""
+    sig = _pole_sigmas(g, zp)
+    dist = np.abs(zp - 1.0)
+    exact = dist < INTEGRATOR_TOL
+    by_sigma = ~exact & np.isfinite(sig) & (dist <= INTEGRATOR_SIGMAS * np.nan_to_num(sig))
+    integ = exact | by_sigma
+    notes = [f"pole at z = {p:.9g} ± {s:.2g} is within {INTEGRATOR_SIGMAS:g}σ of 1: taken as "
+             f"an integrator" for p, s in zip(zp[by_sigma], sig[by_sigma])]
+    if int(integ.sum()) > 1:
+        raise ModelError("tune_pid: the model has more than one integrator (a pole at z = 1)")
+    bad = ~integ & ((zp >= 1.0) | (zp <= 0.0))
+    if np.any(bad):
+        shown = [f"{p:.6g}" + (f" ± {s:.2g}" if math.isfinite(s) else "")
+                 for p, s in zip(zp[bad], sig[bad])]
+        raise ModelError(f"tune_pid: the model has poles [{', '.join(shown)}] outside "
+                         f"(0, 1) (unstable, or with no continuous-time equivalent)",
+                         hint="SIMC needs a stable (or integrating) model with real poles")
+    return integ, notes
+
+
+def _lag_part(A: np.ndarray, taps: np.ndarray, h: float) -> tuple[float, list, np.ndarray,
+                                                                   float, list]:
+    """The lag part ``q⁻¹ (b₀ + b₁ q⁻¹ + …)/A(q⁻¹)`` (``taps`` = b₀, b₁, …; A's roots real in
+    (0, 1)) in continuous time: (DC gain, time constants, zeros in s, extra delay θ₁ in s, notes).
+
+    Taps within A's order: the ZOH realisation has A's poles only and d2c is exact. More taps
+    (a pure delay beyond nk, or no lag at all: A = 1) would put poles at z = 0 in the realisation,
+    which no continuous pole samples to: the time constants are then A's own (τ = −h/ln p), the
+    DC gain B(1)/A(1) is kept, and the taps become a delay matching the first moment: θ₁ = h
+    (μ_B − μ₀), μ_B = Σ j b_j/Σ b_j and μ₀ the same of the ZOH sample of the lags alone (0 when
+    there are none), so ``b q^{−k}`` is exactly a delay of (k − 1) h."""
+    n = A.size - 1
+    if taps.size <= n:
+        gc = TransferFunction.from_polynomials(A, np.r_[0.0, taps], dt=h).to_ss(
+            minimal=False).d2c()  # the state-space route keeps high orders accurate
+        return float(gc.dc_gain()[0, 0]), [-1.0 / p.real for p in gc.poles()], gc.zeros(), \
+            0.0, []
+    if taps.sum() == 0.0:
+        raise ModelError("tune_pid: the model's DC gain is zero (its B coefficients sum to 0): "
+                         "a step of the input does not move the output")
+    taus = [-h / math.log(p) for p in np.roots(A).real] if n else []
+    mu = lambda b: float(np.arange(b.size) @ b / b.sum())  # noqa: E731
+    mu0 = 0.0
+    if taus:
+        den = np.array([1.0])
+        for t in taus:
+            den = np.polymul(den, [t, 1.0])
+        mu0 = mu(TransferFunction([1.0], den).c2d(h).num_zinv()[1:])
+    theta1 = h * (mu(taps) - mu0)
+    notes = [f"{taps.size - 1} numerator tap(s) beyond the first taken as a delay of "
+             f"{max(theta1, 0.0):.4g} s (first moment)"] if taps.size > 1 else []
+    if theta1 < 0:
+        notes.append("a lead of the taps ignored (the delay kept at its lower bound)")
+    return float(taps.sum() / A.sum()), taus, np.zeros(0), max(theta1, 0.0), notes
+
+
 def reduce_model(model, order: int = 1) -> LowOrderModel:
     """First- (``order=1``) or second-order-plus-delay approximation of a discrete SISO model
     (anything :func:`gripkit.control.as_plant` reads) by the half rule (module docstring)."""
@@ -126,30 +217,22 @@ def reduce_model(model, order: int = 1) -> LowOrderModel:
                          f"(an oscillatory mode), which the half rule does not reduce",
                          hint="give a LowOrderModel(k, tau1, theta, tau2, dt=...) fitted by hand")
     zp = zp.real
-    integ = np.abs(zp - 1.0) < 1e-9
-    if int(integ.sum()) > 1:
-        raise ModelError("tune_pid: the model has more than one integrator (a pole at z = 1)")
-    if np.any(zp[~integ] >= 1.0) or np.any(zp[~integ] <= 0.0):
-        raise ModelError(f"tune_pid: the model has poles {np.round(zp, 6).tolist()} outside "
-                         f"(0, 1) (unstable, or with no continuous-time equivalent)",
-                         hint="SIMC needs a stable (or integrating) model with real poles")
-    notes = []
+    integ, notes = _integrators(g, zp)
     theta = (nk - 1) * h
     if integ.any():  # 1/s kept apart: k' from the rest, the half rule on the remaining lags
-        A = np.real(np.poly(zp[~integ]))
+        A = np.atleast_1d(np.real(np.poly(zp[~integ])))
         h_int = h
     else:
         h_int = None
-    gd = type(g).from_polynomials(A, np.concatenate([[0.0], B[nk:]]), dt=h)
-    gc = gd.to_ss(minimal=False).d2c()  # the state-space route keeps high orders accurate
-    taus = sorted((-1.0 / p.real for p in gc.poles()), reverse=True)
-    zc = gc.zeros()
+    k, taus, zc, theta1, lag_notes = _lag_part(A, np.trim_zeros(B[nk:], "b"), h)
+    theta += theta1
+    notes += lag_notes
+    taus = sorted(taus, reverse=True)
     if np.any(np.abs(zc.imag) > REAL_TOL * np.maximum(1.0, np.abs(zc))):
         raise ModelError(f"tune_pid: the model has complex zeros {np.round(zc, 6).tolist()}, "
                          f"which the half rule does not reduce",
                          hint="identify a model with fewer B coefficients, or give a "
                               "LowOrderModel directly")
-    k = float(gc.dc_gain()[0, 0])
     if h_int is not None:
         k /= h_int  # ZOH of k'/s is k' h/(z − 1): the lags' DC gain B(1)/A(1) is k' h
         notes.append("integrator kept as 1/s")
@@ -215,11 +298,20 @@ def tune_pid(model, method: str = "simc", *, tau_c: float | None = None, order: 
     ``model``: an identified discrete SISO model (anything :func:`as_plant` reads) or a
     :class:`LowOrderModel`. ``order``: 1 (PI on the first-order approximation) or 2 (PID on the
     second-order one, the default; a PI where the model has one lag only). ``tau_c``:
-    closed-loop time constant in s (default θ). ``pid_options`` go to :class:`PID` (limits, tf,
-    b, c). The PID runs at the model's dt; ``pid.design`` records the reduction and settings.
+    closed-loop time constant in s (default θ). ``pid_options`` go to :class:`PID`: ``u_min``,
+    ``u_max`` (output limits), ``tf`` (derivative filter time constant, s), ``b``, ``c``
+    (setpoint weights of P and D), ``tt`` (anti-windup tracking time constant, s); any other name
+    is an ArgumentError. The PID runs at the model's dt; ``pid.design`` records the reduction and
+    settings (its ``model["notes"]`` say, e.g., that a pole within 3σ of 1 was taken as an
+    integrator).
     """
     if method != "simc":
         raise ArgumentError(f"method: expected 'simc' (Skogestad's rules), found {method!r}")
+    unknown = sorted(set(pid_options) - set(PID_OPTIONS))
+    if unknown:
+        raise ArgumentError(f"tune_pid: unknown option(s) {', '.join(unknown)}; the PID options "
+                            f"are {', '.join(PID_OPTIONS)}",
+                            hint="output limits are u_min=..., u_max=... (not limits=(lo, hi))")
     if isinstance(model, LowOrderModel):
         m = model
     else:

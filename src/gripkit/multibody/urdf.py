@@ -19,7 +19,9 @@ Reading (standard library ``xml.etree.ElementTree``; URDF as specified at wiki.r
 
 Errors name the element: a link with two parents (a closed loop), several roots without
 ``base_link``, a branching chain without ``tip_link``, a moving link without ``<inertial>``, an
-unsupported joint type (floating, planar), malformed numbers, mimic joints off the chain.
+unsupported joint type (floating, planar), malformed numbers, mimic joints off the chain. A
+document that declares a DTD (``<!DOCTYPE``, where entities live) is refused before anything is
+expanded or fetched: a URDF needs none, and a file must not reach outside itself.
 
 Writing: each joint of a DH chain becomes a URDF joint whose origin is Craig's fixed transform
 Rx(α)·Dx(a)·Rz(θ₀)·Dz(d) and whose axis is z, with the link's inertial in the DH frame; a coupled
@@ -34,6 +36,7 @@ from __future__ import annotations
 import math
 import os
 import xml.etree.ElementTree as ET
+from xml.parsers import expat
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -240,15 +243,79 @@ class _Tree:
                                   "and fixed joints")
 
 
-def _read_root(source):
-    text = str(source)
-    try:
+class _Declared(Exception):
+    """Raised by the pre-scan at a DTD: what the document declares."""
+
+
+class _RootReached(Exception):
+    """Raised by the pre-scan at the root element: no DTD can follow."""
+
+
+def _xml_text(source) -> str | bytes | None:
+    """``source`` as XML to parse (bytes as given, decoded by the parser as XML says; a string
+    without a leading byte-order mark), or None where it is a path."""
+    if isinstance(source, (bytes, bytearray, memoryview)):
+        return bytes(source)
+    if isinstance(source, str):
+        text = source.lstrip("\ufeff")
         if text.lstrip().startswith("<"):
-            root = ET.fromstring(text)
-        else:
-            if not Path(text).is_file():
-                raise ModelError(f"URDF file {text!r} does not exist")
-            root = ET.parse(text).getroot()
+            return text
+    return None
+
+
+def _path_like(text: str) -> bool:
+    """Whether a string that is not XML may be a file name (the messages name it then)."""
+    return not ("<" in text or "\n" in text or len(text) > 255)
+
+
+def _refuse_dtd(xml, name: str | None) -> None:
+    """A ModelError where the document declares a DTD (internal or external, with or without
+    entities), read with expat up to the root element only: a URDF needs none, and refusing
+    it keeps a file from reaching outside itself (external entities) or expanding without
+    bound (nested entities)."""
+    def doctype(doctype_name, system_id, public_id, has_internal_subset):
+        raise _Declared("a DTD (<!DOCTYPE " + doctype_name[:40]
+                        + (" SYSTEM ..." if system_id else "") + ">)")
+
+    def root(*_):
+        raise _RootReached()
+
+    p = expat.ParserCreate()
+    p.StartDoctypeDeclHandler = doctype  # entities are declared inside a DTD only
+    p.StartElementHandler = root
+    try:
+        p.Parse(xml, True)
+    except _RootReached:
+        return
+    except _Declared as d:
+        where = f"URDF file {name!r}" if name else "the URDF"
+        raise ModelError(f"{where} declares {d}: gripkit reads no DTDs or entities (a URDF needs "
+                         "none, and a file must not reach outside itself)",
+                         hint="remove the <!DOCTYPE ...> declaration and write the values out"
+                         ) from None
+    except expat.ExpatError as exc:  # in the prolog: fail closed, never parse it further
+        raise ModelError(f"the URDF is not well-formed XML: {exc}") from None
+
+
+def _read_root(source):
+    xml = _xml_text(source)
+    name = None
+    if xml is None:
+        text = os.fspath(source) if isinstance(source, os.PathLike) else str(source)
+        try:
+            found = Path(text).is_file()
+        except (OSError, ValueError):  # a name too long, or with a NUL, is no file
+            found = False
+        if not found:
+            if not _path_like(text):
+                raise ModelError(f"source: neither an existing file nor XML text (which starts "
+                                 f"with '<'): {text[:40]!r}…",
+                                 hint="pass the path of a .urdf file or the XML itself")
+            raise ModelError(f"URDF file {text!r} does not exist")
+        name, xml = Path(text).name, Path(text).read_bytes()
+    _refuse_dtd(xml, name)
+    try:
+        root = ET.fromstring(xml)
     except ET.ParseError as exc:
         raise ModelError(f"the URDF is not well-formed XML: {exc}") from None
     if root.tag != "robot":
@@ -465,7 +532,9 @@ def from_urdf(source, *, base_link: str | None = None, tip_link: str | None = No
     Parameters
     ----------
     source
-        Path of a ``.urdf`` file, or the XML text itself.
+        Path of a ``.urdf`` file, or the XML text itself (a string starting with ``<`` after
+        any byte-order mark and blanks, or bytes, decoded as their XML declaration says). A
+        document that declares a DTD or entities is refused (ModelError): a URDF needs none.
     base_link, tip_link
         Link names; defaults: the tree's only root, and the end of its only chain of moving joints.
     gravity
@@ -482,11 +551,11 @@ def from_urdf(source, *, base_link: str | None = None, tip_link: str | None = No
     ModelError
         A file that is no URDF of a chain; the message starts with the file's name.
     """
-    text = str(source)
     try:
         return _chain_of(source, base_link, tip_link, gravity)
     except ModelError as exc:  # name the file (XML text given as such has none)
-        name = None if text.lstrip().startswith("<") else Path(text).name
+        path = None if _xml_text(source) is not None else str(source)
+        name = Path(path).name if path is not None and _path_like(path) else None
         if name is None or name in exc.message:
             raise
         raise type(exc)(f"URDF file {name!r}: {exc.message}", hint=exc.hint) from None

@@ -15,7 +15,8 @@ from ..errors import DataError, UnidentifiableError
 from ..units import dimension_of, same_dimension
 from .regression import COND_LIMIT, qr_r, scaled_condition
 
-__all__ = ["as_signal", "signal_array", "signal_with_peaks", "as_io_matrix", "io_records",
+__all__ = ["as_signal", "signal_array", "signal_with_peaks", "as_io_matrix", "check_not_transposed",
+           "io_records",
            "check_io", "check_io_peaks", "check_io_arrays", "check_order", "check_dt",
            "require_samples", "check_excitation", "check_channels_vary", "channel_of",
            "check_output_varies", "checked_problem", "checked_problem_peaks", "check_identifiable",
@@ -46,8 +47,11 @@ def signal_array(x, name: str) -> np.ndarray:
         raise DataError(f"{name}: expected a 1-D array of numbers, found "
                         f"{type(x).__name__}") from None
     if a.ndim != 1:
-        raise DataError(f"{name}: expected a 1-D array of samples, found shape {a.shape}",
-                        hint="pass one channel at a time (single-input single-output models)")
+        row = a.ndim == 2 and a.shape[0] == 1 and a.shape[1] > 1
+        raise DataError(f"{name}: expected a 1-D array of samples, found shape {a.shape}"
+                        + (" (one row: it looks transposed)" if row else ""),
+                        hint="pass x.ravel()" if row else
+                        "pass one channel at a time (single-input single-output models)")
     if a.size == 0:
         raise DataError(f"{name}: the signal holds no samples")
     return a
@@ -80,6 +84,7 @@ def as_io_matrix(x, name: str, n: int | None = None, channels: tuple[str, ...] |
         raise DataError(f"{name}: expected an array of numbers, found {type(x).__name__}") from None
     if a.ndim == 1:
         a = a[:, None]
+    check_not_transposed(a, name)
     if channels is not None and (a.ndim != 2 or a.shape[1] != len(channels)):
         raise DataError(f"{name}: expected shape (N, {len(channels)}) for the {kind}s "
                         f"{', '.join(channels)}, "
@@ -96,6 +101,15 @@ def as_io_matrix(x, name: str, n: int | None = None, channels: tuple[str, ...] |
                         f"{channels[c] if channels is not None else c})",
                         hint="drop or interpolate them before identification (CLI: --fill)")
     return np.ascontiguousarray(a)
+
+
+def check_not_transposed(a: np.ndarray, name: str) -> None:
+    """A DataError when the 2-D ``a`` has far fewer rows (samples) than columns (channels): at
+    least 10 columns and 10 per row, as a (1, N) record passed for an (N, 1) one is."""
+    if a.ndim == 2 and a.shape[0] > 0 and a.shape[1] >= max(10, 10 * a.shape[0]):
+        raise DataError(f"{name}: shape {a.shape} is {a.shape[0]} sample(s) of {a.shape[1]} "
+                        "channels: it looks transposed",
+                        hint="samples go in rows: pass x.T, or a 1-D array for one channel")
 
 
 def io_records(records, *, siso: bool = False) -> list[tuple[np.ndarray, np.ndarray]]:

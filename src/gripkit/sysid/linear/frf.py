@@ -30,7 +30,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.lib.stride_tricks import sliding_window_view
 
-from ...errors import AccuracyWarning, DataError, emit_warning
+from ...errors import AccuracyWarning, ArgumentError, DataError, emit_warning
+from ...units import ratio_unit
 from ..checks import check_dt
 from .linear_model import as_io_matrix
 
@@ -55,6 +56,9 @@ class FRF:
         One-sigma of the complex H per line (F, p, m); inf where a line has no excitation.
     coherence
         Multiple coherence per output (F, p) (H1, SPA), or None (periodic).
+    input_units, output_units
+        The channels' units ('' where unknown: arrays given without them); H is in output unit
+        per input unit (:attr:`H_units`), σ too.
     """
 
     frequency_hz: np.ndarray
@@ -65,10 +69,30 @@ class FRF:
     inputs: tuple[str, ...] = ("u",)
     outputs: tuple[str, ...] = ("y",)
     info: dict = field(default_factory=dict)
+    input_units: tuple[str, ...] = ()
+    output_units: tuple[str, ...] = ()
 
     @property
     def w(self) -> np.ndarray:
         return 2 * np.pi * self.frequency_hz
+
+    @property
+    def H_units(self) -> list[list[str]]:
+        """The unit of each H[:, i, j]: output i's unit per input j's ('m/V'); '' where either
+        is unknown."""
+        m, p = len(self.inputs), len(self.outputs)
+        ins = self.input_units if len(self.input_units) == m else ("",) * m
+        outs = self.output_units if len(self.output_units) == p else ("",) * p
+        return [[ratio_unit(o or "1", i or "1") if (o and i) else "" for i in ins] for o in outs]
+
+    def __repr__(self) -> str:
+        f = self.frequency_hz
+        band = f" {f[0]:.4g} … {f[-1]:.4g} Hz" if f.size else ""
+        units = {u for row in self.H_units for u in row}
+        shown = (f", H in {units.pop()}" if len(units) == 1 and "" not in units else
+                 f", H in {self.H_units}" if units - {""} else "")
+        return (f"FRF({self.method}: {f.size} lines{band}, {list(self.inputs)} → "
+                f"{list(self.outputs)}{shown})")
 
     def to_dict(self) -> dict:
         """JSON fields: ``frequency_hz``, ``H_real``, ``H_imag``, ``H_std`` and ``coherence``;
@@ -76,6 +100,7 @@ class FRF:
         siso = self.H.shape[1:] == (1, 1)
         sq = (lambda a: a[:, 0, 0]) if siso else (lambda a: a)
         out = {"method": self.method, "inputs": list(self.inputs), "outputs": list(self.outputs),
+               "H_unit": self.H_units[0][0] if siso else self.H_units,
                "frequency_hz": self.frequency_hz, "H_real": sq(self.H.real),
                "H_imag": sq(self.H.imag),
                "H_std": sq(self.H_std)}
@@ -145,10 +170,24 @@ def _periodic(u, y, dt, periods, keep_transient):
                                                      "transient_dropped": not keep_transient}
 
 
+def _h1_min_samples(m: int) -> int:
+    """The shortest record whose default segments (N // 8 within 16 … 4096 samples, half
+    overlapping) number more than ``m``: 16 + 8 m for m < 14."""
+    N = 16
+    while 1 + (N - (L := max(min(N // 8, 4096), 16))) // (L // 2) <= m:
+        N += 1
+    return N
+
+
 def _h1(u, y, dt, nperseg):
     N, m = u.shape
     p = y.shape[1]
     L = int(nperseg) if nperseg else max(min(N // 8, 4096), 16)
+    if not nperseg and (L > N or 1 + (N - L) // (L // 2) <= m):
+        raise DataError(f"data: a record of {N} sample(s) is too short for an H1 FRF with "
+                        f"{m} input(s): it needs at least {_h1_min_samples(m)} (Hann "
+                        f"segments of at least 16 samples, half overlapping, more than {m})",
+                        hint="use a longer record")
     if L < 8 or L > N:
         raise DataError(f"nperseg: expected 8 … {N} samples per segment, found {L}")
     step = L // 2
@@ -233,6 +272,9 @@ def _spa(u, y, dt, lag_window, n_lines):
         raise DataError("spa: the smoothed ETFE is single-input; found "
                         f"{u.shape[1]} input(s)", hint="use the h1 method for several inputs")
     M = int(lag_window) if lag_window else int(min(30, N // 10))
+    if not lag_window and M < 2:
+        raise DataError(f"data: a record of {N} sample(s) is too short for an SPA FRF: it needs "
+                        "at least 20 (a lag window of N/10 ≥ 2 lags)", hint="use a longer record")
     if M < 2 or M >= N // 2:
         raise DataError(f"lag_window: expected 2 … {N // 2 - 1}, found {M}")
     uu, yy = u[:, 0], y[:, 0]
@@ -262,8 +304,11 @@ def _spa(u, y, dt, lag_window, n_lines):
 
 def frf(u, y, *, dt: float | None = None, method: str = "auto", periods: int | None = None,
         keep_transient: bool = False, nperseg: int | None = None, lag_window: int | None = None,
-        n_lines: int = 128, inputs=None, outputs=None) -> FRF:
-    """Estimate the frequency response from input ``u`` (N, m) to output ``y`` (N, p).
+        n_lines: int = 128, inputs=None, outputs=None, input_units=None,
+        output_units=None) -> FRF:
+    """Estimate the frequency response from input ``u`` (N, m) to output ``y`` (N, p);
+    ``inputs``/``outputs`` name the channels, ``input_units``/``output_units`` give their units
+    (H is then labelled output unit per input unit: :attr:`FRF.H_units`).
 
     ``method='auto'``: ``'periodic'`` when ``periods`` is given, else ``'h1'``. See the module
     docstring for the estimators and their σ.
@@ -297,4 +342,16 @@ def frf(u, y, *, dt: float | None = None, method: str = "auto", periods: int | N
     m, p = u.shape[1], y.shape[1]
     ins = tuple(inputs) if inputs else tuple(f"u{i}" if m > 1 else "u" for i in range(m))
     outs = tuple(outputs) if outputs else tuple(f"y{i}" if p > 1 else "y" for i in range(p))
-    return FRF(f, H, std, coh, "spa" if method == "etfe" else method, ins, outs, info)
+    return FRF(f, H, std, coh, "spa" if method == "etfe" else method, ins, outs, info,
+               _units(input_units, m, "input_units"), _units(output_units, p, "output_units"))
+
+
+def _units(units, k: int, name: str) -> tuple[str, ...]:
+    """``units`` (None, one string for one channel, or one per channel) as a k-tuple."""
+    if units is None:
+        return ("",) * k
+    units = (units,) if isinstance(units, str) else tuple(units)
+    if len(units) != k or not all(u is None or isinstance(u, str) for u in units):
+        raise ArgumentError(f"{name}: expected {k} unit string(s), one per channel, found "
+                            f"{units!r:.80}")
+    return tuple(u or "" for u in units)

@@ -536,7 +536,8 @@ def after_mean_detrending(model, u, refit, command: str, score=None, drift=None)
 def identify_frf(data: Trajectory, *, input, output, detrend: str = "mean", **options):
     """Frequency response of the named columns (:func:`gripkit.sysid.linear.frf` options)."""
     d = mimo_data(data, input, output, detrend, why="frequency-response estimation")
-    return frf(d.u, d.y, dt=d.dt, inputs=d.inputs, outputs=d.outputs, **options)
+    return frf(d.u, d.y, dt=d.dt, inputs=d.inputs, outputs=d.outputs,
+               input_units=d.input_units, output_units=d.output_units, **options)
 
 
 def identify_tf(data: Trajectory, *, input, output, poles: int, zeros: int, detrend: str = "mean"):

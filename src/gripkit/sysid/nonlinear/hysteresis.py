@@ -150,7 +150,8 @@ def _record(data, input, output, what: str, need_output: bool = True):
 
 def _check_excited(u: np.ndarray, y: np.ndarray, input: str, output: str) -> None:
     if len(u) < 10:
-        raise DataError(f"hysteresis: {len(u)} samples; a loop needs at least 10")
+        raise DataError(f"hysteresis: {len(u)} samples; a loop needs at least 10",
+                        hint="more data are needed: record a longer sweep")
     check_scale((input,), u, "input", "hysteresis identification")
     check_scale((output,), y, "output", "hysteresis identification")
     not_constant(u, f"the input {input!r}", "hysteresis", "a hysteresis needs an input sweep")
@@ -1247,9 +1248,9 @@ def hysteresis(data, model: str = "bouc-wen", *, input: str | None = None,
     if dt is not None and not (isinstance(dt, (int, float, np.floating)) and math.isfinite(dt)
                                and dt > 0):
         raise ArgumentError(f"hysteresis: dt must be a positive sample interval in s, found {dt!r}")
-    burn_in = _check_burn_in(burn_in, recs)
-    if len(recs) == 1:
+    if len(recs) == 1:  # too few samples is the data's fault whatever burn_in is
         _check_excited(*recs[0], iname, oname)
+    burn_in = _check_burn_in(burn_in, recs)
     if validate is not None:
         uv, yv, *_ = _record(validate, iname, oname, "hysteresis validate")
     common = dict(dt=dt, input_name=iname, output_name=oname, input_unit=iunit,

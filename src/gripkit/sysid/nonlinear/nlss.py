@@ -74,6 +74,7 @@ import scipy.linalg as sla
 
 from ...errors import (AccuracyWarning, ArgumentError, DataError, IdentificationError,
                        ModelError, StabilityWarning, emit_warning)
+from ..checks import check_not_transposed
 from ..io_data import check_scale
 from ..model_file import (SAMPLE_TIME, Domain, FamilyFile, check_family_fields, file_provenance,
                           read_family_document)
@@ -647,6 +648,8 @@ def _io(data, input, output, what: str):
     y = np.asarray(y, dtype=np.float64)
     u = u[:, None] if u.ndim == 1 else u
     y = y[:, None] if y.ndim == 1 else y
+    check_not_transposed(u, f"nlss: {what}: u")
+    check_not_transposed(y, f"nlss: {what}: y")
     if u.ndim != 2 or y.ndim != 2:
         raise DataError(f"nlss: {what}: u and y must be arrays (N,) or (N, k), found shapes "
                         f"{u.shape} and {y.shape}")

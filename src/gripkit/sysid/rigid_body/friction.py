@@ -42,15 +42,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ...arguments import entry_point, sample_interval
-from ...errors import DataError, IdentificationError, UnidentifiableError
+from ...errors import ArgumentError, DataError, IdentificationError, UnidentifiableError
 from ...models.friction import FrictionTable
 from ...signals.filters import apply_sos, butter_sos
+from ...units import ratio_unit
 from ..scaling import unit_scale
 from ..regression import hac_covariance
 
 __all__ = ["Pulse", "BreakawayResult", "detect_breakaway", "ConstantVelocityPoint",
            "constant_velocity_friction", "table_from_points", "StribeckFit", "fit_stribeck",
-           "IdimResult", "IdimSamples", "idim_samples", "idim_ls"]
+           "IdimResult", "IdimSamples", "idim_samples", "idim_ls", "idim_units"]
 
 
 def _same_length(**named) -> list[np.ndarray]:
@@ -359,7 +360,9 @@ def fit_stribeck(velocity, friction, *, weights=None, fixed: dict | None = None,
 @dataclass(frozen=True)
 class IdimResult:
     """Single-axis IDIM-LS result: ``params`` and ``std`` hold ``inertia`` (kg·m² or kg),
-    ``viscous`` (N·m·s/rad or N·s/m), ``coulomb`` and ``offset`` (N·m or N)."""
+    ``viscous`` (N·m·s/rad or N·s/m), ``coulomb`` and ``offset`` (N·m or N); ``units`` the unit
+    of each (:func:`idim_units` of the position and effort units given to :func:`idim_ls`; empty
+    when none were given). ``str()`` is a table of value ± σ and unit."""
 
     params: dict
     std: dict
@@ -372,9 +375,19 @@ class IdimResult:
     condition_number: float
     residual_std: float
     notes: list = field(default_factory=list)
+    units: dict = field(default_factory=dict)
+
+    def __str__(self) -> str:
+        rows = [f"IDIM-LS: {self.n_samples} samples, relative error "
+                f"{self.relative_error_percent:.2f} %"]
+        rows += [f"  {k:<8} {self.params[k]:12.6g} ± {self.std[k]:<9.2g} "
+                 f"{self.units.get(k, '')}".rstrip() for k in _IDIM]
+        if not self.units:
+            rows.append("  (units unknown: give idim_ls position_unit= and effort_unit=)")
+        return "\n".join(rows + [f"note: {n}" for n in self.notes])
 
     def to_dict(self) -> dict:
-        return dict(params=self.params, std=self.std,
+        return dict(params=self.params, std=self.std, units=dict(self.units),
                     relative_error_percent=self.relative_error_percent,
                     n_samples=self.n_samples, dt=self.dt, cutoff_hz=self.cutoff,
                     decimation=self.decimation,
@@ -383,6 +396,28 @@ class IdimResult:
 
 
 _IDIM = ("inertia", "viscous", "coulomb", "offset")
+
+
+def idim_units(position: str | None, effort: str | None, scale: float = 1.0) -> dict[str, str]:
+    """Units of IDIM-LS's parameters from the position and effort units: inertia effort·s²/position,
+    viscous effort·s/position, Coulomb and offset in effort units, where the effort is
+    ``scale × effort`` (a factor other than 1 leads the effort unit: ``0.5 A``). A '1' (no unit)
+    drops out of products and quotients: 'N*m*s^2/rad', 's^2' rather than '(1)*s^2/1'.
+
+    Examples
+    --------
+    >>> idim_units("m", "N")
+    {'inertia': '(N*s^2)/m', 'viscous': '(N*s)/m', 'coulomb': 'N', 'offset': 'N'}
+    """
+    def times(a: str, b: str) -> str:
+        a, b = a or "1", b or "1"
+        return b if a == "1" else a if b == "1" else f"{a}*{b}"
+
+    eu = effort or "1"
+    if scale != 1.0:
+        eu = f"{scale:g}" if eu == "1" else f"{scale:g} {eu}"
+    return {"inertia": ratio_unit(times(eu, "s^2"), position or "1"),
+            "viscous": ratio_unit(times(eu, "s"), position or "1"), "coulomb": eu, "offset": eu}
 
 
 @dataclass(frozen=True)
@@ -478,8 +513,12 @@ def check_effort_scale(value, name: str = "effort scale") -> None:
 @entry_point
 def idim_ls(position, effort, *, dt: float, effort_scale: float = 1.0, cutoff: float | None = None,
             order: int = 4, decimation: int | None = None,
-            velocity_threshold: float | None = None, guard: float = 1.0) -> IdimResult:
+            velocity_threshold: float | None = None, guard: float = 1.0,
+            position_unit: str | None = None, effort_unit: str | None = None) -> IdimResult:
     """Identify τ = J q̈ + F_v q̇ + F_c sign(q̇) + τ₀ from position and effort logs (module doc).
+    With ``position_unit`` and ``effort_unit`` (the columns' units, e.g. 'm' and 'N'; the effort
+    column's unit before ``effort_scale``) the result carries its parameters' units
+    (:func:`idim_units`).
 
     Parameters
     ----------
@@ -567,4 +606,15 @@ def idim_ls(position, effort, *, dt: float, effort_scale: float = 1.0, cutoff: f
         theta, std, cov = theta * d, std * d, cov * d[:, None] * d[None, :]
     return IdimResult(dict(zip(_IDIM, map(float, theta))), dict(zip(_IDIM, map(float, std))), cov,
                       rel, int(n), float(dt), float(cutoff), q, cond, float(math.sqrt(s2)) / ce,
-                      notes)
+                      notes, _result_units(position_unit, effort_unit, effort_scale))
+
+
+def _result_units(position_unit, effort_unit, effort_scale) -> dict:
+    """:func:`idim_units` where a unit was given, else none."""
+    for name, u in (("position_unit", position_unit), ("effort_unit", effort_unit)):
+        if u is not None and not isinstance(u, str):
+            raise ArgumentError(f"idim_ls {name}: expected a unit string such as 'm' or 'N', "
+                                f"found {type(u).__name__}")
+    if position_unit is None and effort_unit is None:
+        return {}
+    return idim_units(position_unit, effort_unit, effort_scale)
