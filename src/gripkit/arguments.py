@@ -20,9 +20,12 @@ import numbers
 import os
 from collections.abc import Callable, Iterable, Mapping
 
+import numpy as np
+
 from .errors import ArgumentError, DataError
 
-__all__ = ["entry_point", "check_keywords", "check_path", "keyword_names", "sample_interval"]
+__all__ = ["entry_point", "check_keywords", "check_path", "keyword_names", "sample_interval",
+           "real_array"]
 
 _VARIADIC = (inspect.Parameter.VAR_POSITIONAL, inspect.Parameter.VAR_KEYWORD)
 
@@ -38,6 +41,33 @@ def sample_interval(dt, error: type = DataError) -> float:
                                               numbers.Real) or not (math.isfinite(dt) and dt > 0):
         raise error(f"dt: expected a positive, finite sample interval in s, found {dt!r}")
     return float(dt)
+
+
+def real_array(x, name: str, expected: str = "an array of numbers") -> np.ndarray:
+    """``x`` as a float64 array (no copy when it is one), or a :class:`DataError` naming ``name``:
+    for complex numbers (which numpy would cast with a ComplexWarning, dropping the imaginary
+    part) and for anything that is not numbers (``expected`` says what was). The shared
+    conversion of the identification's and the signal functions' arrays.
+
+    >>> real_array([1, 2.5], "u").tolist()
+    [1.0, 2.5]
+    >>> real_array([1 + 2j], "u")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    gripkit.errors.DataError: u: expected real numbers, found complex (complex128); pass x.real...
+    """
+    if type(x) is np.ndarray and x.dtype == np.float64:
+        return x
+    try:
+        a = np.asarray(x)
+        complex_ = a.dtype.kind == "c" or (a.dtype == object and any(
+            isinstance(v, complex) for v in a.ravel()))
+        if not complex_:
+            return np.asarray(a, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise DataError(f"{name}: expected {expected}, found {type(x).__name__}") from None
+    raise DataError(f"{name}: expected real numbers, found complex ({a.dtype})",
+                    hint="pass x.real or abs(x) explicitly")
 
 
 def keyword_names(fn: Callable, exclude: Iterable[str] = ()) -> list[str]:

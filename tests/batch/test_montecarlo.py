@@ -8,6 +8,7 @@ import pytest
 from scipy import stats
 
 from gripkit.batch.montecarlo import binned_probability, probability, quantile
+from gripkit.errors import ArgumentError, DataError
 
 
 @pytest.mark.parametrize("p", [0.02, 0.2, 0.5])
@@ -60,3 +61,45 @@ def test_binned_probability_recovers_a_known_dose_response():
         inside += r["p_low"] <= truth <= r["p_high"]
     assert inside >= 5   # each interval misses with probability 5 %
     assert rows[0]["p"] < 0.05 and rows[-1]["p"] > 0.9
+
+
+@pytest.mark.parametrize("flags, phrase", [
+    ([0.3, 0.7, 0.2], r"found 3 other values \(first 0.3 at index 0\)"),
+    ([-1, 1, 1], r"found 1 other values \(first -1 at index 0\)"),
+    ([2, 2, 2], r"first 2 at index 0"),
+    ([1.0, np.nan, 0.5], r"found 1 other values \(first 0.5 at index 2\)"),
+    (["yes", "no"], "found text values"),
+    ([1j, 0], "found complex values"),
+])
+def test_probability_needs_outcomes_of_trials(flags, phrase):
+    """A Wilson interval is for k successes in n trials: anything but True/False, 1/0 (or NaN,
+    a run without an outcome) is refused instead of summed (−1 + 1 + 1 = 1 "success" in 3)."""
+    with pytest.raises(DataError, match=r"^flags: expected outcomes True/False or 1/0.*" + phrase):
+        probability(flags)
+
+
+@pytest.mark.parametrize("call, phrase", [
+    (lambda: probability([True, False], confidence=1.5), "confidence: .* strictly between 0 and 1"
+                                                         ", found 1.5"),
+    (lambda: probability([True, False], confidence=95), "found 95; a level, not a percentage"),
+    (lambda: probability([True], confidence=math.nan), "found nan"),
+    (lambda: quantile([1.0, 2.0], 0.5, confidence=2), "confidence: .*found 2"),
+    (lambda: quantile([1.0, 2.0], 1.5), "q: expected a number from 0 to 1, found 1.5"),
+    (lambda: quantile([1.0, 2.0], -0.1), "q: .*found -0.1"),
+    (lambda: quantile([1.0, 2.0], True), "q: .*found True"),
+])
+def test_levels_are_checked(call, phrase):
+    with pytest.raises(ArgumentError, match=phrase):
+        call()
+
+
+def test_quantile_levels_zero_and_one_and_the_interval_label():
+    """q = 0 and q = 1 are the least and the greatest value; the population's lie beyond them,
+    so the intervals reach −inf and +inf (binomial(n, 0) and binomial(n, 1) order statistics).
+    The label gives the confidence as a percentage with its decimals."""
+    x = np.arange(10.0)
+    least, greatest = quantile(x, 0.0), quantile(x, 1.0)
+    assert (least.value, least.low, least.high) == (0, -math.inf, 0)
+    assert (greatest.value, greatest.low, greatest.high) == (9, 9, math.inf)
+    assert "(99.5 % CI, n=4)" in str(probability([1, 0, 1, 1], confidence=0.995))
+    assert probability([True, False, np.nan, 1.0]).n == 3  # NaN: a run without an outcome

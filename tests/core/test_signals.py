@@ -1,11 +1,13 @@
 """Filters and processing: seed numbers (§V-D) and analytic properties."""
 
+import re
+
 import numpy as np
 import pytest
 
 from gripkit import DataError, Trajectory
-from gripkit.signals import (ac_couple, butter_zpk, decimate, detrend, lowpass, resample, split,
-                             to_uniform)
+from gripkit.signals import (ac_couple, butter_zpk, decimate, detrend, highpass, lowpass, resample,
+                             split, to_uniform)
 
 
 def test_amadeus_butterworth_poles_and_zeros():
@@ -33,6 +35,44 @@ def test_lowpass_on_trajectory_and_errors():
     assert out.n == 500
     with pytest.raises(DataError, match="between 0 and the Nyquist frequency"):
         lowpass(tr, 150.0)
+
+
+def test_filters_refuse_nan_and_name_the_first_sample():
+    """One NaN would spread over every later sample (a causal filter) or all of them (its first
+    sample's steady state): a DataError with the count, the first sample and the hint."""
+    x = np.sin(np.arange(100) * 0.1)
+    bad = x.copy()
+    bad[[50, 70]] = np.nan
+    with pytest.raises(DataError, match=r"x has 2 NaN or infinite values \(first at sample 50\)"
+                                        r".*interpolate them before filtering"):
+        lowpass(bad, 1.0, dt=0.1)
+    bad = x.copy()
+    bad[0] = np.inf
+    with pytest.raises(DataError, match=r"1 NaN or infinite values \(first at sample 0\)"):
+        highpass(bad, 1.0, dt=0.1, zero_phase=True)
+    two = np.column_stack([x, x])
+    two[30, 1] = np.nan
+    with pytest.raises(DataError, match=r"first at sample 30"):
+        lowpass(two, 1.0, dt=0.1)
+
+
+def test_filters_refuse_empty_complex_and_too_low_cutoffs():
+    """No samples, complex samples: a DataError naming x. A cut-off whose sections round to
+    nonsense (order 8, cut-off × dt = 1e-10: scipy's steady state is singular) is refused with
+    the lowest cut-off that works; filtering a constant at that cut-off keeps it (gain 1)."""
+    with pytest.raises(DataError, match="x: the signal holds no samples"):
+        lowpass(np.array([]), 1.0, dt=0.1)
+    with pytest.raises(DataError, match="x: expected real numbers, found complex"):
+        lowpass(np.ones(10) * (1 + 1j), 1.0, dt=0.1)
+    with pytest.raises(DataError, match=r"too low for an order-8 Butterworth at dt = 0.1 s") as e:
+        lowpass(np.ones(100), 1e-9, dt=0.1, order=8)
+    assert "below 1/(N dt) = 0.1 Hz" in str(e.value)
+    lo = float(re.search(r"from about ([0-9.e+-]+) Hz up to the Nyquist frequency 5 Hz",
+                         str(e.value)).group(1))
+    assert 1e-9 < lo < 1e-4
+    assert np.allclose(lowpass(np.full(100, 2.0), lo, dt=0.1, order=8), 2.0, rtol=1e-3)
+    with pytest.raises(DataError, match=r"highpass cut-off 1e-09 Hz is too low .*poles round"):
+        highpass(np.ones(100), 1e-9, dt=0.1, order=4)
 
 
 def test_ac_couple_with_reference():

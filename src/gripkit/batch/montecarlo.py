@@ -13,12 +13,14 @@ ranks given by the binomial(n, q) distribution's (α/2, 1−α/2) quantiles.
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
 from scipy import stats
 
-from ..errors import DataError
+from ..arguments import real_array
+from ..errors import ArgumentError, DataError
 
 __all__ = ["Estimate", "probability", "quantile", "binned_probability"]
 
@@ -34,14 +36,47 @@ class Estimate:
     confidence: float
 
     def __str__(self) -> str:
-        return (f"{self.value:.4g} [{self.low:.4g}, {self.high:.4g}] ({100 * self.confidence:.0f} "
+        return (f"{self.value:.4g} [{self.low:.4g}, {self.high:.4g}] ({100 * self.confidence:.4g} "
                 f"% CI, n={self.n})")
 
 
+def _level(value, name: str, closed: bool = False) -> float:
+    """``value`` as a float strictly between 0 and 1 (``closed``: 0 and 1 included), or an
+    ArgumentError naming ``name``."""
+    ok = (not isinstance(value, bool) and isinstance(value, numbers.Real)
+          and (0 <= value <= 1 if closed else 0 < value < 1))
+    if not ok:
+        span = "from 0 to 1" if closed else "strictly between 0 and 1"
+        raise ArgumentError(f"{name}: expected a number {span}, found {value!r}",
+                            hint="a level, not a percentage: 0.95 for a 95 % interval, 0.9 for "
+                                 "the 90th percentile")
+    return float(value)
+
+
+def _outcomes(flags) -> np.ndarray:
+    """``flags`` as the float 0/1 outcomes that are not NaN (a run without one), or a DataError:
+    anything but booleans, 0, 1 or NaN is not the outcome of a trial."""
+    a = np.asarray(flags)
+    if a.dtype.kind not in "biuf":
+        kind = {"c": "complex", "U": "text", "S": "text"}.get(a.dtype.kind, str(a.dtype))
+        raise DataError(f"flags: expected outcomes True/False or 1/0, found {kind} values")
+    a = a.astype(np.float64).ravel()
+    keep = ~np.isnan(a)
+    bad = keep & (a != 0.0) & (a != 1.0)
+    if bad.any():
+        i = int(np.argmax(bad))
+        raise DataError(f"flags: expected outcomes True/False or 1/0 (NaN for a run without one), "
+                        f"found {int(bad.sum())} other values (first {a[i]:g} at index {i})",
+                        hint="pass the event as booleans, e.g. probability(x > limit); for the "
+                             "distribution of values use quantile")
+    return a[keep]
+
+
 def probability(flags, confidence: float = 0.95) -> Estimate:
-    """Probability that ``flags`` is True, with the Wilson interval. NaN entries are excluded."""
-    f = np.asarray(flags, dtype=np.float64)
-    f = f[np.isfinite(f)]
+    """Probability that ``flags`` is True, with the Wilson interval. ``flags``: booleans or 0/1
+    (NaN entries, runs without an outcome, are excluded); ``confidence`` in (0, 1)."""
+    confidence = _level(confidence, "confidence")
+    f = _outcomes(flags)
     n = f.size
     if n == 0:
         raise DataError("probability of an event needs at least one finite outcome")
@@ -56,14 +91,15 @@ def probability(flags, confidence: float = 0.95) -> Estimate:
 def quantile(x, q: float, confidence: float = 0.95) -> Estimate:
     """The ``q`` quantile of ``x`` with an order-statistic confidence interval. NaN entries are
     excluded; +inf is kept as a value larger than all others (e.g. "never settled"), so a quantile
-    or a bound that falls on such entries is inf."""
-    x = np.asarray(x, dtype=np.float64)
-    v = np.sort(x[~np.isnan(x)])
+    or a bound that falls on such entries is inf. ``q`` in [0, 1] (0: the least value, whose
+    interval reaches −inf; 1: the greatest, up to +inf), ``confidence`` in (0, 1)."""
+    q = _level(q, "q", closed=True)
+    confidence = _level(confidence, "confidence")
+    x = real_array(x, "x")
+    v = np.sort(x[~np.isnan(x)].ravel())
     n = v.size
     if n == 0:
         raise DataError("a quantile needs at least one finite value")
-    if not 0 < q < 1:
-        raise DataError(f"q: expected 0 < q < 1, found {q}")
     a = (1 - confidence) / 2
     lo_rank = int(stats.binom.ppf(a, n, q))
     hi_rank = int(stats.binom.ppf(1 - a, n, q)) + 1

@@ -21,7 +21,12 @@ solution is ``P_p = 0`` and predictor gain ``K``: the model's own steady-state p
 
 The step is one call of a numba kernel (:func:`kf_step_packed`) in scalar loops that allocates
 nothing: the filter's matrices and its state and work arrays are two flat float64 buffers made
-once, with the filter. ``run`` filters a whole record in one kernel call (:func:`kf_run_packed`)."""
+once, with the filter. ``run`` filters a whole record in one kernel call (:func:`kf_run_packed`).
+
+A NaN in ``y`` is a missing measurement (a dropout): the step updates with the measured outputs
+only (C's rows, R's rows and columns of the finite ones; none: the time update alone), and
+``run`` warns once and marks them (``KalmanRun.missing``). A NaN or ±inf in ``u``, or a ±inf in
+``y``, is a DataError naming the sample and the channel, the filter left as it was."""
 
 from __future__ import annotations
 
@@ -31,7 +36,7 @@ import numba
 import numpy as np
 from scipy.linalg import solve_discrete_are
 
-from ..errors import DataError, ModelError
+from ..errors import DataError, DataWarning, ModelError, emit_warning
 from ..lti import flush_tiny
 from .packed import block_offsets, block_starts
 
@@ -40,12 +45,29 @@ __all__ = ["KalmanFilter", "KalmanRun"]
 
 class KalmanRun(NamedTuple):
     """What :meth:`KalmanFilter.run` returns: filtered states ``x`` (N, n), their covariances
-    ``P`` (N, n, n), innovations ``e`` (N, p) and their covariances ``S`` (N, p, p)."""
+    ``P`` (N, n, n), innovations ``e`` (N, p) and their covariances ``S`` (N, p, p), and
+    ``missing`` (N, p): True where the measurement was NaN, a missing one (its innovation and
+    the innovation covariance's row and column are then NaN; ``missing.any(axis=1)``: the
+    samples updated with fewer outputs, or not at all)."""
 
     x: np.ndarray
     P: np.ndarray
     e: np.ndarray
     S: np.ndarray
+    missing: np.ndarray
+
+
+def warn_missing(where: str, missing: np.ndarray) -> None:
+    """One DataWarning for the samples of a record with missing (NaN) measurements, if any:
+    their count and the first one's index (``missing``: (N, p) booleans)."""
+    rows = missing.any(axis=1)
+    if rows.any():
+        k = int(np.argmax(rows))
+        emit_warning(DataWarning(
+            f"{where}: {int(rows.sum())} of {rows.size} samples have missing (NaN) measurements "
+            f"({int(missing.sum())} values; first at sample {k}, output "
+            f"{int(np.argmax(missing[k]))}); they were updated with their measured outputs only "
+            "(none: the time update alone); run.missing marks them"))
 
 
 @numba.njit(cache=True)
@@ -88,17 +110,18 @@ def _cholesky(S):  # pragma: no cover - compiled
 # vector per filter, so that a step is one numba call with five array arguments.
 #
 # par: A (n×n), B (n×m), C (p×n), D (p×m), Q (n×n), R (p×p), S (n×p), u0 (m), y0 (p),
-#      K_f (n×p), K_p (n×p), P_f steady (n×n), Σ steady (p×p)
+#      K_f (n×p), K_p (n×p), P_f steady (n×n), Σ steady (p×p), P_p steady (n×n)
 # st:  x_p (n), P_p (n×n), x_f (n), P_f (n×n), du (m), y − y0 (p), e (p), Σ (p×p),
 #      work: P_p Cᵀ (n×p), M (n×p), K_f (n×p), K_p (n×p), A P_p (n×n), x_next (n)
-PAR_BLOCKS = ("A", "B", "C", "D", "Q", "R", "S", "u0", "y0", "Kf", "Kp", "Pf", "Sig")
+PAR_BLOCKS = ("A", "B", "C", "D", "Q", "R", "S", "u0", "y0", "Kf", "Kp", "Pf", "Sig", "Pp")
 ST_BLOCKS = ("xp", "Pp", "xf", "Pf", "du", "yy", "e", "Sig", "PCt", "M", "Kf", "Kp", "T", "xn")
 
 
 @numba.njit(cache=True, inline="always")
 def _par_sizes(n, m, p):  # pragma: no cover - compiled
     """Sizes of the parameter vector's blocks (:data:`PAR_BLOCKS`)."""
-    return (n * n, n * m, p * n, p * m, n * n, p * p, n * p, m, p, n * p, n * p, n * n, p * p)
+    return (n * n, n * m, p * n, p * m, n * n, p * p, n * p, m, p, n * p, n * p, n * n, p * p,
+            n * n)
 
 
 @numba.njit(cache=True, inline="always")
@@ -156,7 +179,7 @@ def _flat_solve_rows(a, oL, p, ob, ox, rows):  # pragma: no cover - compiled
 
 @numba.njit(cache=True, inline="always")
 def _par_offsets(n, m, p):  # pragma: no cover - compiled
-    """Offsets of A, B, C, D, Q, R, S, u0, y0, K_f, K_p, P_f, Σ in the parameter vector."""
+    """Offsets of A, B, C, D, Q, R, S, u0, y0, K_f, K_p, P_f, Σ, P_p in the parameter vector."""
     return block_starts(_par_sizes(n, m, p))[0]
 
 
@@ -167,10 +190,38 @@ def _st_offsets(n, m, p):  # pragma: no cover - compiled
     return block_starts(_st_sizes(n, m, p))[0]
 
 
+@numba.njit(cache=True)
+def bad_sample(u, y):  # pragma: no cover - compiled
+    """0 when every ``u`` is finite and no ``y`` is ±inf (a NaN in ``y`` is a missing
+    measurement, which the filters update without); 1 for a NaN or ±inf in ``u``, 2 for a ±inf
+    in ``y``. :func:`bad_channel` then names the channel."""
+    for j in range(u.shape[0]):
+        if not np.isfinite(u[j]):
+            return 1
+    for i in range(y.shape[0]):
+        if np.isinf(y[i]):
+            return 2
+    return 0
+
+
+def bad_channel(filt: str, where: str, which: int, u, y, k=None) -> DataError:
+    """The DataError for a :func:`bad_sample` code ``which`` (1: ``u``, 2: ``y``) of the sample
+    ``u``, ``y`` (row ``k`` of a record, or None for one step), naming the channel."""
+    arr = np.asarray(u if which == 1 else y, dtype=np.float64).reshape(-1)
+    ch = int(np.flatnonzero(~np.isfinite(arr) if which == 1 else np.isinf(arr))[0])
+    name = ("u" if which == 1 else "y") + (f"[{k}, {ch}]" if k is not None else f"[{ch}]")
+    want = ("the inputs must be finite" if which == 1 else
+            "a measurement must be finite, or NaN for a missing one")
+    return DataError(f"{filt}.{where}: {name} is {arr[ch]} ({'input' if which == 1 else 'output'}"
+                     f" channel {ch}{'' if k is None else f', sample {k}'}); {want}",
+                     hint="fill or interpolate the gap, or drop those samples")
+
+
 @numba.njit(cache=True, inline="always")
 def _kf_innovation(n, m, p, par, st, u, y):  # pragma: no cover - compiled
-    """du = u − u0, y − y0, e = y − y0 − C x_p − D du."""
-    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = _par_offsets(n, m, p)
+    """du = u − u0, y − y0, e = y − y0 − C x_p − D du; a missing (NaN) y_i keeps its NaN in
+    y − y0 (the mark the gains read) and gets e_i = 0. Returns the number of missing y_i."""
+    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs, oPp = _par_offsets(n, m, p)
     sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
     for j in range(m):
         st[sdu + j] = u[j] - par[ou0 + j]
@@ -182,6 +233,45 @@ def _kf_innovation(n, m, p, par, st, u, y):  # pragma: no cover - compiled
         for j in range(m):
             acc -= par[oD + i * m + j] * st[sdu + j]
         st[se + i] = acc
+    missing = 0
+    for i in range(p):
+        if st[syy + i] != st[syy + i]:
+            st[se + i] = 0.0
+            missing += 1
+    return missing
+
+
+@numba.njit(cache=True, inline="always")
+def _drop_missing(n, p, st, so):  # pragma: no cover - compiled
+    """The update with the measured outputs only: for each missing y_i (NaN in the y − y0 block
+    at ``so[0]``), column i of P_p Cᵀ and M (blocks at ``so[1]``, ``so[2]``) is zero and Σ's
+    row and column i (at ``so[3]``) those of the identity, so that the gains' column i is zero
+    and the other columns are those of the filter with C's row i and R's row and column i
+    struck out (Σ block diagonal)."""
+    syy, sPC, sM, sSe = so
+    for i in range(p):
+        if st[syy + i] == st[syy + i]:
+            continue
+        for r in range(n):
+            st[sPC + r * p + i] = 0.0
+            st[sM + r * p + i] = 0.0
+        for j in range(p):
+            st[sSe + i * p + j] = 0.0
+            st[sSe + j * p + i] = 0.0
+        st[sSe + i * p + i] = 1.0
+
+
+@numba.njit(cache=True, inline="always")
+def _mark_missing(p, st, syy, se, sSe):  # pragma: no cover - compiled
+    """After the step: a missing y_i's innovation and Σ's row and column i are NaN (none was
+    measured)."""
+    for i in range(p):
+        if st[syy + i] == st[syy + i]:
+            continue
+        st[se + i] = np.nan
+        for j in range(p):
+            st[sSe + i * p + j] = np.nan
+            st[sSe + j * p + i] = np.nan
 
 
 @numba.njit(cache=True, inline="always")
@@ -198,19 +288,21 @@ def _flat_mul_add(c, oc, a, oa, b, ob, out, oo, rows, cols, inner):  # pragma: n
 
 
 @numba.njit(cache=True, inline="always")
-def _kf_gains(n, m, p, par, st):  # pragma: no cover - compiled
+def _kf_gains(n, m, p, par, st, src, oP):  # pragma: no cover - compiled
     """The time-varying gains: P_p Cᵀ, Σ = R + C P_p Cᵀ (factored), M = S + A P_p Cᵀ,
-    K_f = P_p Cᵀ Σ⁻¹, K_p = M Σ⁻¹. False if Σ is not positive definite."""
-    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = _par_offsets(n, m, p)
+    K_f = P_p Cᵀ Σ⁻¹, K_p = M Σ⁻¹, with P_p the block of ``src`` at ``oP``, and the missing
+    outputs left out (:func:`_drop_missing`). False if Σ is not positive definite."""
+    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs, oPp = _par_offsets(n, m, p)
     sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
     for i in range(n):  # P_p Cᵀ
         for j in range(p):
             acc = 0.0
             for k in range(n):
-                acc += st[sPp + i * n + k] * par[oC + j * n + k]
+                acc += src[oP + i * n + k] * par[oC + j * n + k]
             st[sPC + i * p + j] = acc
     _flat_mul_add(par, oR, par, oC, st, sPC, st, sSe, p, p, n)  # Σ = R + C (P_p Cᵀ)
     _flat_mul_add(par, oS, par, oA, st, sPC, st, sM, n, p, n)  # M = S + A (P_p Cᵀ)
+    _drop_missing(n, p, st, (syy, sPC, sM, sSe))
     if not _flat_cholesky(st, sSe, p):
         return False
     _flat_solve_rows(st, sSe, p, sPC, sKf, n)
@@ -222,7 +314,7 @@ def _kf_gains(n, m, p, par, st):  # pragma: no cover - compiled
 def _kf_states(n, m, p, par, st, g, ogf, ogp):  # pragma: no cover - compiled
     """x_f = x_p + K_f e, x_p ← A x_p + B du + K_p e (through x_next); the gains K_f, K_p are
     the blocks of ``g`` at ``ogf``, ``ogp``."""
-    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = _par_offsets(n, m, p)
+    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs, oPp = _par_offsets(n, m, p)
     sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
     for i in range(n):
         acc = st[sxp + i]
@@ -254,17 +346,40 @@ def predicted_state(n, m, p, par, oA, oB, g, ogp, st, so):  # pragma: no cover -
 
 
 @numba.njit(cache=True, inline="always")
-def _kf_covariances(n, m, p, par, st):  # pragma: no cover - compiled
-    """P_f = P_p − K_f (P_p Cᵀ)ᵀ, P_p ← Q + A P_p Aᵀ − K_p Mᵀ (symmetric parts; entries below
-    ``FLUSH_BELOW`` carried as zero), and Σ rebuilt from its Cholesky factor."""
-    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = _par_offsets(n, m, p)
+def _kf_covariances(n, m, p, par, st, src, oP, predict):  # pragma: no cover - compiled
+    """P_f = P_p − K_f (P_p Cᵀ)ᵀ with P_p the block of ``src`` at ``oP``; with ``predict``,
+    P_p ← Q + A P_p Aᵀ − K_p Mᵀ (symmetric parts; entries below ``FLUSH_BELOW`` carried as
+    zero); Σ rebuilt from its Cholesky factor."""
+    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs, oPp = _par_offsets(n, m, p)
     sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
     for i in range(n):
         for j in range(n):
-            acc = st[sPp + i * n + j]
+            acc = src[oP + i * n + j]
             for k in range(p):
                 acc -= st[sKf + i * p + k] * st[sPC + j * p + k]
             st[sPf + i * n + j] = acc
+    for i in range(n):
+        for j in range(i + 1, n):
+            b = 0.5 * (st[sPf + i * n + j] + st[sPf + j * n + i])
+            st[sPf + i * n + j] = b
+            st[sPf + j * n + i] = b
+    if predict:
+        _kf_predicted_covariance(n, m, p, par, st)
+    for i in range(p):
+        for j in range(i + 1):
+            acc = 0.0
+            for k in range(j + 1):
+                acc += st[sSe + i * p + k] * st[sSe + j * p + k]
+            st[sSe + i * p + j] = acc
+            st[sSe + j * p + i] = acc
+
+
+@numba.njit(cache=True, inline="always")
+def _kf_predicted_covariance(n, m, p, par, st):  # pragma: no cover - compiled
+    """P_p ← Q + A P_p Aᵀ − K_p Mᵀ (symmetric part; entries below ``FLUSH_BELOW`` carried as
+    zero)."""
+    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs, oPp = _par_offsets(n, m, p)
+    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
     for i in range(n):  # T = A P_p
         for j in range(n):
             acc = 0.0
@@ -284,32 +399,33 @@ def _kf_covariances(n, m, p, par, st):  # pragma: no cover - compiled
             a = 0.5 * (st[sPp + i * n + j] + st[sPp + j * n + i])
             st[sPp + i * n + j] = a
             st[sPp + j * n + i] = a
-            b = 0.5 * (st[sPf + i * n + j] + st[sPf + j * n + i])
-            st[sPf + i * n + j] = b
-            st[sPf + j * n + i] = b
-    for i in range(p):
-        for j in range(i + 1):
-            acc = 0.0
-            for k in range(j + 1):
-                acc += st[sSe + i * p + k] * st[sSe + j * p + k]
-            st[sSe + i * p + j] = acc
-            st[sSe + j * p + i] = acc
 
 
 @numba.njit(cache=True)
 def kf_step_packed(dims, par, st, u, y):  # pragma: no cover - compiled
     """One Kalman step (module docstring) on the packed buffers; ``dims`` = (n, m, p, steady).
     Returns 0 done, 1 Σ not positive definite (``x_p``, ``P_p`` unchanged), 2 ``u`` or 3 ``y``
-    of the wrong length. Every row sum runs over its index ascending, as
-    :mod:`gripkit.export.c_kalman`'s C step does."""
+    of the wrong length, 4 a NaN or ±inf in ``u``, 5 a ±inf in ``y`` (the filter unchanged).
+    Every row sum runs over its index ascending, as :mod:`gripkit.export.c_kalman`'s C step
+    does.
+
+    A NaN y_i is a missing measurement: the update uses the other outputs only (C's rows and
+    R's rows and columns of the measured ones; none: the time update alone), its innovation and
+    Σ's row and column are NaN. The steady-state filter then takes that sample's gains from the
+    steady prediction covariance with the measured outputs only (its P stays the steady one)."""
     n, m, p, steady = dims[0], dims[1], dims[2], dims[3]
     if u.shape[0] != m:
         return 2
     if y.shape[0] != p:
         return 3
-    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs = _par_offsets(n, m, p)
+    bad = bad_sample(u, y)
+    if bad:
+        return 3 + bad
+    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs, oPp = _par_offsets(n, m, p)
     sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
-    _kf_innovation(n, m, p, par, st, u, y)
+    missing = _kf_innovation(n, m, p, par, st, u, y)
+    if missing:
+        return _kf_update_missing(n, m, p, par, st, steady)
     if steady:  # fixed gains and covariances
         _kf_states(n, m, p, par, st, par, oKf, oKp)
         for i in range(n * n):
@@ -317,10 +433,26 @@ def kf_step_packed(dims, par, st, u, y):  # pragma: no cover - compiled
         for i in range(p * p):
             st[sSe + i] = par[oSs + i]
         return 0
-    if not _kf_gains(n, m, p, par, st):
+    if not _kf_gains(n, m, p, par, st, st, sPp):
         return 1
-    _kf_covariances(n, m, p, par, st)  # reads P_p before the states step overwrites x only
+    _kf_covariances(n, m, p, par, st, st, sPp, True)  # reads P_p before the states step
     _kf_states(n, m, p, par, st, st, sKf, sKp)
+    return 0
+
+
+@numba.njit(cache=True, inline="always")
+def _kf_update_missing(n, m, p, par, st, steady):  # pragma: no cover - compiled
+    """The step of a sample with missing outputs (:func:`kf_step_packed`): gains from P_p (the
+    steady one of ``par`` when ``steady``, whose P_p then stays) with the measured outputs only;
+    0, or 1 if Σ is not positive definite."""
+    oA, oB, oC, oD, oQ, oR, oS, ou0, oy0, oKf, oKp, oPs, oSs, oPp = _par_offsets(n, m, p)
+    sxp, sPp, sxf, sPf, sdu, syy, se, sSe, sPC, sM, sKf, sKp, sT, sxn = _st_offsets(n, m, p)
+    src, oP = (par, oPp) if steady else (st, sPp)
+    if not _kf_gains(n, m, p, par, st, src, oP):
+        return 1
+    _kf_covariances(n, m, p, par, st, src, oP, not steady)
+    _kf_states(n, m, p, par, st, st, sKf, sKp)
+    _mark_missing(p, st, syy, se, sSe)
     return 0
 
 
@@ -416,7 +548,7 @@ class KalmanFilter:
         self._dims = np.array([n, m, p, int(self.steady_state)], dtype=np.int64)
         lp, _ = _par_layout(n, m, p)
         self._par = np.concatenate([M.ravel() for M in (A, B, C, D, Q, R, S, u0, y0, Kf, Kp, Pf,
-                                                        Sss)])
+                                                        Sss, Pp)])
         ls, size = _st_layout(n, m, p)
         self._st = np.zeros(size)
 
@@ -486,7 +618,9 @@ class KalmanFilter:
         Kp = np.linalg.solve(Se, (A @ Pp @ C.T + S).T).T
         return Kf, Kp, Pp, Pp - Kf @ C @ Pp
 
-    def _fail(self, code, what):
+    def _fail(self, code, what, u=None, y=None, k=None):
+        if code in (4, 5):
+            raise bad_channel("KalmanFilter", what, code - 3, u, y, k)
         if code == 1:
             raise ModelError(f"KalmanFilter.{what}: the innovation covariance C P Cᵀ + R is not "
                              "positive definite", hint="check R and the filter's covariance P")
@@ -508,7 +642,7 @@ class KalmanFilter:
             y = np.ascontiguousarray(y, dtype=np.float64).reshape(-1)
         code = kf_step_packed(self._dims, self._par, self._st, u, y)
         if code:
-            self._fail(code, "step")
+            self._fail(code, "step", u, y)
         if copy:
             return self.x.copy(), self.P.copy()
         return self._x_out, self._P_out
@@ -531,7 +665,10 @@ class KalmanFilter:
 
     def run_arrays(self, u, y) -> KalmanRun:
         """Filter inputs ``u`` (N, m) and outputs ``y`` (N, p), SI, offsets not removed: one
-        call of the numba kernel :func:`kf_run_packed`."""
+        call of the numba kernel :func:`kf_run_packed`. A NaN in ``y`` is a missing measurement
+        (:func:`kf_step_packed`; one DataWarning gives their count and the first, and
+        ``missing`` marks them); a NaN or ±inf in ``u``, or a ±inf in ``y``, is a DataError
+        naming the sample and the channel."""
         n, m, p = (int(v) for v in self._dims[:3])
         u = np.ascontiguousarray(np.asarray(u, dtype=np.float64).reshape(-1, m) if m == 1 else
                                  np.atleast_2d(np.asarray(u, dtype=np.float64)))
@@ -546,5 +683,7 @@ class KalmanFilter:
         es, Ss = np.empty((N, p)), np.empty((N, p, p))
         code, k = kf_run_packed(self._dims, self._par, self._st, u, y, xs, Ps, es, Ss)
         if code:
-            self._fail(code, f"run (sample {k})")
-        return KalmanRun(xs, Ps, es, Ss)
+            self._fail(code, f"run (sample {k})", *((u[k], y[k], k) if code > 3 else ()))
+        missing = np.isnan(y)
+        warn_missing("KalmanFilter.run_arrays", missing)
+        return KalmanRun(xs, Ps, es, Ss, missing)

@@ -34,6 +34,11 @@ points of ``(x_f, P_f)`` through ``f``: ``x_p = Σ W^m_i f(X_i)``,
 ``P_p = Σ W^c_i (f(X_i) − x_p)(·)ᵀ + Q``. Defaults α = 1, β = 2, κ = 0 (all weights but
 ``W^c_0`` positive). On a linear model both filters are the Kalman filter.
 
+Missing measurements and bad data as :class:`~gripkit.estimation.KalmanFilter`: a NaN ``y_i`` is
+left out of the update (h's row, R's row and column), a NaN or ±inf in ``u`` or a ±inf in ``y``
+is a DataError. A NaN or ±inf from ``f`` or ``h`` (or a Jacobian) is a ModelError naming the
+function and the sample, raised before the prediction ``x_pred``, ``P_pred`` changes.
+
 The filters' own arithmetic is numba kernels in scalar loops on work arrays made once with the
 filter. When ``f`` and ``h`` (and ``F``, ``H`` if given) are ``numba.njit`` functions, ``step``
 and ``run`` call them from inside one kernel (``run``: the whole record in one call); Python
@@ -57,7 +62,8 @@ import numba
 import numpy as np
 
 from ..errors import ArgumentError, DataError, ModelError
-from .kalman import KalmanFilter, KalmanRun, _cholesky, _chol_solve_rows
+from .kalman import (KalmanFilter, KalmanRun, _cholesky, _chol_solve_rows, bad_channel,
+                     bad_sample, warn_missing)
 from .state_functions import state_functions
 
 __all__ = ["ExtendedKalmanFilter", "UnscentedKalmanFilter"]
@@ -125,10 +131,26 @@ class UKFWork(NamedTuple):
 def _gain_update(s, yhat, Pxy, K, y):  # pragma: no cover - compiled
     """``e = y − ŷ``; ``K = P_xy Σ⁻¹`` (``s.Se`` = Σ factored in place, rebuilt before return);
     ``x_f = x_p + K e``; ``P_f = P_p − K P_xyᵀ`` (= P_p − K Σ Kᵀ; P_xy = P_p Hᵀ for the EKF).
-    False if Σ is not positive definite."""
+    False if Σ is not positive definite.
+
+    A NaN y_i is a missing measurement: column i of P_xy is zero and Σ's row and column i those
+    of the identity, so that K's column i is zero and the update is that of the measured outputs
+    alone (h's rows and R's rows and columns struck out; none measured: x_f = x_p, P_f = P_p);
+    its innovation and Σ's row and column are NaN after the update."""
     n, p = s.xp.shape[0], y.shape[0]
+    missing = False
     for i in range(p):
-        s.e[i] = y[i] - yhat[i]
+        if y[i] == y[i]:
+            s.e[i] = y[i] - yhat[i]
+            continue
+        missing = True
+        s.e[i] = 0.0
+        for r in range(n):
+            Pxy[r, i] = 0.0
+        for j in range(p):
+            s.Se[i, j] = 0.0
+            s.Se[j, i] = 0.0
+        s.Se[i, i] = 1.0
     if not _cholesky(s.Se):
         return False
     _chol_solve_rows(s.Se, Pxy, K)
@@ -150,6 +172,29 @@ def _gain_update(s, yhat, Pxy, K, y):  # pragma: no cover - compiled
                 acc += s.Se[i, k] * s.Se[j, k]
             s.Se[i, j] = acc
             s.Se[j, i] = acc
+    if missing:
+        _mark_missing(s, y)
+    return True
+
+
+@numba.njit(cache=True, inline="always")
+def _mark_missing(s, y):  # pragma: no cover - compiled
+    """The innovation and Σ's row and column of each missing (NaN) y_i: NaN."""
+    p = y.shape[0]
+    for i in range(p):
+        if y[i] != y[i]:
+            s.e[i] = np.nan
+            for j in range(p):
+                s.Se[i, j] = np.nan
+                s.Se[j, i] = np.nan
+
+
+@numba.njit(cache=True, inline="always")
+def _finite(a):  # pragma: no cover - compiled
+    """True when no entry of the 1-D array ``a`` is NaN or ±inf."""
+    for i in range(a.shape[0]):
+        if not np.isfinite(a[i]):
+            return False
     return True
 
 
@@ -243,14 +288,20 @@ def _jac_given(Jf, x, u, J):  # pragma: no cover - compiled
 def _linearised(fn, Jfn, x, u, J, xt, size, code):  # pragma: no cover - compiled
     """``(fn(x, u), 0)`` with its Jacobian at x in ``J`` (``Jfn`` None: central differences;
     numba prunes the other branch); ``(v, code)`` when fn returns other than ``size`` values,
-    ``(v, 6)`` when ``Jfn`` returns the wrong shape."""
+    ``(v, 6)`` when ``Jfn`` returns the wrong shape, ``(v, code + 3)`` when ``fn`` or the
+    Jacobian has a NaN or ±inf."""
     v = fn(x, u)
     if v.shape[0] != size:
         return v, code
+    if not _finite(v):
+        return v, code + 3
     if Jfn is None:
         _jac_central(fn, x, u, J, xt)
     elif not _jac_given(Jfn, x, u, J):
         return v, 6
+    for i in range(J.shape[0]):
+        if not _finite(J[i]):
+            return v, code + 3
     return v, 0
 
 
@@ -258,7 +309,12 @@ def _linearised(fn, Jfn, x, u, J, xt, size, code):  # pragma: no cover - compile
 def _ekf_step_jit(f, h, Fj, Hj, noise, u, y, s, w):  # pragma: no cover - compiled
     """One EKF step calling numba ``f``, ``h`` and ``Fj``, ``Hj`` (None: central differences).
     0 done, 1 Σ not positive definite (the prediction is then left as it was), 4 ``f`` or 5
-    ``h`` returned the wrong length, 6 a Jacobian the wrong shape."""
+    ``h`` returned the wrong length, 6 a Jacobian the wrong shape, 7 ``f`` or 8 ``h`` (or its
+    Jacobian) a NaN or ±inf, 9 a NaN or ±inf in ``u``, 10 a ±inf in ``y`` (the prediction left
+    as it was in each case)."""
+    bad = bad_sample(u, y)
+    if bad:
+        return 8 + bad
     hx, code = _linearised(h, Hj, s.xp, u, w.H, w.xt, noise.R.shape[0], 5)
     if code:
         return code
@@ -356,32 +412,40 @@ def _ukf_predict(s, w, Q):  # pragma: no cover - compiled
 
 @numba.njit(cache=False)  # takes model functions: see the module docstring, "Caching"
 def _through_jit(fn, X, u, out):  # pragma: no cover - compiled
-    """``out[i] = fn(X[i], u)`` for each sigma point; False if ``fn`` returns other than
-    ``out.shape[1]`` values."""
+    """``out[i] = fn(X[i], u)`` for each sigma point: 0, or 1 if ``fn`` returns other than
+    ``out.shape[1]`` values, 2 if one is NaN or ±inf."""
     for i in range(X.shape[0]):
         v = fn(X[i], u)
         if v.shape[0] != out.shape[1]:
-            return False
+            return 1
         for j in range(out.shape[1]):
+            if not np.isfinite(v[j]):
+                return 2
             out[i, j] = v[j]
-    return True
+    return 0
 
 
 @numba.njit(cache=False)  # takes model functions: see the module docstring, "Caching"
 def _ukf_step_jit(f, h, c, noise, u, y, s, w):  # pragma: no cover - compiled
     """One UKF step with numba ``f``, ``h``: 0 done, 1 P_p or 2 Σ or 3 P_f not positive
     definite (the prediction is then left as it was), 4 ``f`` or 5 ``h`` returned the wrong
-    length."""
+    length, 7 ``f`` or 8 ``h`` a NaN or ±inf, 9 a NaN or ±inf in ``u``, 10 a ±inf in ``y``
+    (the prediction left as it was)."""
+    bad = bad_sample(u, y)
+    if bad:
+        return 8 + bad
     if not _sigma_points(s.xp, s.Pp, c, w.L, w.X):
         return 1
-    if not _through_jit(h, w.X, u, w.Yp):
-        return 5
+    code = _through_jit(h, w.X, u, w.Yp)
+    if code:
+        return 5 if code == 1 else 8
     if not _ukf_update(s, w, noise.R, y):
         return 2
     if not _sigma_points(s.xf, s.Pf, c, w.L, w.X):
         return 3
-    if not _through_jit(f, w.X, u, w.Xn):
-        return 4
+    code = _through_jit(f, w.X, u, w.Xn)
+    if code:
+        return 4 if code == 1 else 7
     _ukf_predict(s, w, noise.Q)
     return 0
 
@@ -576,7 +640,9 @@ class _NonlinearFilter:
     _FAIL = {1: "the innovation covariance is not positive definite",
              4: "f(x, u) returned the wrong number of values (expected n, Q's size)",
              5: "h(x, u) returned the wrong number of values (expected p, R's size)",
-             6: "a Jacobian returned the wrong shape (expected F: n×n, H: p×n)"}
+             6: "a Jacobian returned the wrong shape (expected F: n×n, H: p×n)",
+             7: "f(x, u) returned a NaN or ±inf at the filtered state (or in its Jacobian)",
+             8: "h(x, u) returned a NaN or ±inf at the predicted state (or in its Jacobian)"}
 
     def _setup(self, Q, R, x0, P0, kind):
         """Checks, the buffer (:func:`_allocate`) and its records; returns the dict of views."""
@@ -600,7 +666,16 @@ class _NonlinearFilter:
     Q = property(attrgetter("noise.Q"))
     R = property(attrgetter("noise.R"))
 
-    def _raise(self, code, where):
+    _AT = {7: "f at the filtered state x", 8: "h at the predicted state x_pred"}
+
+    def _raise(self, code, where, u=None, y=None, k=None):
+        if code in (9, 10):
+            raise bad_channel(self._name, where, code - 8, u, y, k)
+        if code in (7, 8):
+            raise ModelError(f"{self._name}.{where}: {self._FAIL[code]}; the prediction x_pred, "
+                             "P_pred is left as it was",
+                             hint=f"check {self._AT[code]} for a division by zero, a root or log "
+                                  "of a negative number, or an overflow")
         raise ModelError(f"{self._name}.{where}: {self._FAIL[code]}",
                          hint="check f, h, Q, R, P0 and the model's scaling")
 
@@ -630,7 +705,7 @@ class _NonlinearFilter:
         else:
             code = self._step_python(u, y)
         if code:
-            self._raise(code, "step")
+            self._raise(code, "step", u, y)
         if copy:
             return self.x.copy(), self.P.copy()
         return self.x, self.P
@@ -653,7 +728,10 @@ class _NonlinearFilter:
 
     def run_arrays(self, u, y) -> KalmanRun:
         """Filter inputs ``u`` (N, m) and outputs ``y`` (N, p): one numba call over the record
-        when the model's functions are numba functions, else :meth:`step` per row."""
+        when the model's functions are numba functions, else the Python step per row. A NaN in
+        ``y`` is a missing measurement (:func:`_gain_update`; one DataWarning gives their count
+        and the first, and ``missing`` marks them); a NaN or ±inf in ``u``, a ±inf in ``y``, or
+        a NaN or ±inf from ``f`` or ``h`` is an error naming the sample."""
         y = np.ascontiguousarray(np.asarray(y, dtype=np.float64).reshape(len(y), -1))
         u = np.ascontiguousarray(np.asarray(u, dtype=np.float64).reshape(len(u), -1))
         if y.shape[1] != self.p or u.shape[0] != y.shape[0]:
@@ -661,15 +739,19 @@ class _NonlinearFilter:
                             f"with the same N, found {u.shape} and {y.shape}")
         N = y.shape[0]
         out = KalmanRun(np.empty((N, self.n)), np.empty((N, self.n, self.n)),
-                        np.empty((N, self.p)), np.empty((N, self.p, self.p)))
+                        np.empty((N, self.p)), np.empty((N, self.p, self.p)), np.isnan(y))
         if self._jit:
             code, k = self._kernels[1](self._dims, self._buf, u, y, out)
             if code:
-                self._raise(code, f"run (sample {k})")
-            return out
-        for k in range(N):
-            out.x[k], out.P[k] = self.step(u[k], y[k], copy=False)
-            out.e[k], out.S[k] = self._s.e, self._s.Se
+                self._raise(code, f"run (sample {k})", u[k], y[k], k)
+        else:
+            s = self._s
+            for k in range(N):
+                code = self._step_python(u[k], y[k])
+                if code:
+                    self._raise(code, f"run (sample {k})", u[k], y[k], k)
+                out.x[k], out.P[k], out.e[k], out.S[k] = s.xf, s.Pf, s.e, s.Se
+        warn_missing(f"{self._name}.run_arrays", out.missing)
         return out
 
 
@@ -728,11 +810,13 @@ class ExtendedKalmanFilter(_NonlinearFilter):
                      and (F is None or (_is_jit(F) and _is_jit(H))))
         self._kernels = _ekf_kernels(f, h, F, H) if self._jit else None
 
-    def _jacobian(self, fn, J, x, u, given):
+    def _jacobian(self, fn, J, x, u, given, code) -> int:
+        """J at x (given, complex step or central differences): 0, 6 the wrong shape, or
+        ``code + 3`` a NaN or ±inf in it."""
         if given is not None:
             M = np.asarray(given(x, u), dtype=np.float64)
             if M.shape != J.shape:
-                self._raise(6, "step")
+                return 6
             J[:] = M
         elif self.jacobian == "complex":
             d = 1e-30
@@ -749,21 +833,32 @@ class ExtendedKalmanFilter(_NonlinearFilter):
                 hi = np.array(fn(xt, u), dtype=np.float64)  # a copy: fn may return xt
                 xt[j] = x[j] - dj
                 J[:, j] = (hi - np.asarray(fn(xt, u), dtype=np.float64)) / (2 * dj)
+        return 0 if np.isfinite(J).all() else code + 3
 
-    def _fn(self, fn, x, u, size, code):
+    @staticmethod
+    def _fn(fn, x, u, size, code):
+        """``(fn(x, u), 0)``, or ``(…, code)`` for the wrong length, ``code + 3`` a NaN/±inf."""
         v = np.asarray(fn(x, u), dtype=np.float64).reshape(-1)
         if v.shape != (size,):
-            self._raise(code, "step")
-        return v
+            return v, code
+        return v, (0 if _finite(v) else code + 3)
 
     def _step_python(self, u, y) -> int:
+        """One step calling ``f``, ``h`` from Python: 0 or a code of :func:`_ekf_step_jit`."""
         s, w = self._s, self._w
-        hx = self._fn(self.h, s.xp, u, self.p, 5)
-        self._jacobian(self.h, w.H, s.xp, u, self.Hj)
+        bad = bad_sample(u, y)
+        if bad:
+            return 8 + bad
+        hx, code = self._fn(self.h, s.xp, u, self.p, 5)
+        code = code or self._jacobian(self.h, w.H, s.xp, u, self.Hj, 5)
+        if code:
+            return code
         if not _ekf_update(s, w, hx, self.noise.R, y):
             return 1
-        fx = self._fn(self.f, s.xf, u, self.n, 4)
-        self._jacobian(self.f, w.F, s.xf, u, self.Fj)
+        fx, code = self._fn(self.f, s.xf, u, self.n, 4)
+        code = code or self._jacobian(self.f, w.F, s.xf, u, self.Fj, 4)
+        if code:
+            return code
         s.xp[:] = fx
         _ekf_predict(s, w, self.noise.Q)
         return 0
@@ -830,22 +925,35 @@ class UnscentedKalmanFilter(_NonlinearFilter):
         self._jit = _is_jit(f) and _is_jit(h)
         self._kernels = _ukf_kernels(f, h) if self._jit else None
 
-    def _through(self, fn, X, u, out, code):
+    @staticmethod
+    def _through(fn, X, u, out, code) -> int:
+        """``out[i] = fn(X[i], u)``: 0, ``code`` for the wrong length, ``code + 3`` a NaN/±inf."""
         for i in range(X.shape[0]):
             v = np.asarray(fn(X[i], u), dtype=np.float64).reshape(-1)
             if v.shape != (out.shape[1],):
-                self._raise(code, "step")
+                return code
+            if not _finite(v):
+                return code + 3
             out[i] = v
+        return 0
 
     def _step_python(self, u, y) -> int:
+        """One step calling ``f``, ``h`` from Python: 0 or a code of :func:`_ukf_step_jit`."""
         s, w = self._s, self._w
+        bad = bad_sample(u, y)
+        if bad:
+            return 8 + bad
         if not _sigma_points(s.xp, s.Pp, self.c, w.L, w.X):
             return 1
-        self._through(self.h, w.X, u, w.Yp, 5)
+        code = self._through(self.h, w.X, u, w.Yp, 5)
+        if code:
+            return code
         if not _ukf_update(s, w, self.noise.R, y):
             return 2
         if not _sigma_points(s.xf, s.Pf, self.c, w.L, w.X):
             return 3
-        self._through(self.f, w.X, u, w.Xn, 4)
+        code = self._through(self.f, w.X, u, w.Xn, 4)
+        if code:
+            return code
         _ukf_predict(s, w, self.noise.Q)
         return 0

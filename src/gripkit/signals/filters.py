@@ -11,11 +11,12 @@ must be uniformly sampled). Cutoff frequencies are in Hz.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 
 import numpy as np
 
-from ..arguments import sample_interval
+from ..arguments import real_array, sample_interval
 from ..errors import DataError
 from .trajectory import Trajectory
 
@@ -74,16 +75,78 @@ def butter_ba(order: int, cutoff, *, dt: float, btype: str = "lowpass"):
                              output="ba"))
 
 
-def apply_sos(sos: np.ndarray, x: np.ndarray, zero_phase: bool = False) -> np.ndarray:
+def samples(x, name: str = "x") -> np.ndarray:
+    """``x`` as a finite, non-empty float64 array of shape (N,) or (N, C), or a DataError naming
+    ``name``: complex numbers, no samples, NaN or ±inf (count and first sample; a filter would
+    spread each over every sample after it)."""
+    a = real_array(x, name, "an array of samples")
+    if a.ndim not in (1, 2):
+        raise DataError(f"{name}: expected samples of shape (N,) or (N, C), found {a.shape}")
+    if a.shape[0] == 0 or a.size == 0:
+        raise DataError(f"{name}: the signal holds no samples (shape {a.shape})")
+    if not (np.isfinite(a.min()) and np.isfinite(a.max())):  # min and max carry NaN and inf
+        bad = ~np.isfinite(a)
+        rows = bad if a.ndim == 1 else bad.any(axis=1)
+        raise DataError(f"{name} has {int(bad.sum())} NaN or infinite values (first at sample "
+                        f"{int(np.argmax(rows))}); a filter spreads each over every sample after "
+                        "it", hint="drop or interpolate them before filtering (CLI: --fill)")
+    return a
+
+
+def _check_sections(sos, btype: str, order: int, cutoff, dt: float, n: int) -> None:
+    """A DataError when the cut-off is too low for the order at this sample rate: the sections'
+    coefficients round so that the pass-band gain (at DC for a low-pass, at Nyquist for a
+    high-pass) is off by more than 1e-3, or the steady state for the first sample is singular.
+    The message gives the lowest cut-off that works at this order (searched in quarter decades
+    upward)."""
+    def gain(s):
+        z = 1.0 if btype == "lowpass" else -1.0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return float(np.prod([(b0 + b1 * z + b2) / (a0 + a1 * z + a2)
+                                  for b0, b1, b2, a0, a1, a2 in s]))
+
+    def fault(s):
+        """Why the sections are unusable, or None."""
+        if btype in ("lowpass", "highpass") and not abs(gain(s) - 1.0) <= 1e-3:
+            return f"its sections round to a pass-band gain of {gain(s):.6g} instead of 1"
+        try:
+            if np.isfinite(_signal().sosfilt_zi(s)).all():
+                return None
+        except np.linalg.LinAlgError:
+            pass
+        return "its poles round to z = 1 (the steady state for the first sample is singular)"
+
+    why = fault(sos)
+    if why is None:
+        return
+    nyq, fc, lo = 0.5 / dt, float(np.max(cutoff)), None
+    for k in range(1, 80):
+        trial = fc * 10 ** (k / 4)
+        if trial >= nyq:
+            break
+        with warnings.catch_warnings():  # scipy's BadCoefficients for the trials below it
+            warnings.simplefilter("ignore")
+            if fault(_signal().butter(order, trial, btype=btype, fs=1 / dt, output="sos")) is None:
+                lo = trial
+                break
+    works = (f"a cut-off from about {lo:.3g} Hz up to the Nyquist frequency {nyq:g} Hz works at "
+             f"this order" if lo else "no cut-off works at this order")
+    raise DataError(f"{btype} cut-off {np.squeeze(cutoff)} Hz is too low for an order-{order} "
+                    f"Butterworth at dt = {dt:g} s (cut-off × dt = {fc * dt:.2g}): {why}; {works}",
+                    hint=f"raise the cut-off, lower the order or decimate the record first; below "
+                         f"1/(N dt) = {1 / (n * dt):.3g} Hz a cut-off lies under the lowest "
+                         f"frequency that these {n} samples resolve")
+
+
+def apply_sos(sos: np.ndarray, x: np.ndarray, zero_phase: bool = False,
+              name: str = "x") -> np.ndarray:
     """Filter ``x`` (shape (N,) or (N, C), along time) with second-order sections.
 
     Causal filtering starts from the filter's steady state for the first sample, so a DC offset
     does not ring. ``zero_phase`` runs forward and backward (squared magnitude, no phase lag,
-    not causal).
+    not causal). ``x`` must be finite (:func:`samples`; ``name`` in its errors).
     """
-    x = np.asarray(x, dtype=np.float64)
-    if x.ndim not in (1, 2):
-        raise DataError(f"expected samples of shape (N,) or (N, C), found {x.shape}")
+    x = samples(x, name)
     if zero_phase:
         padlen = 3 * (2 * sos.shape[0] + 1)
         if x.shape[0] <= padlen:
@@ -102,11 +165,16 @@ def _filter(x, btype, order, cutoff, dt, zero_phase, channels):
         if dt is not None and abs(dt - dt_tr) > 1e-9 * dt_tr:
             raise DataError(f"dt={dt:g} s given, but the trajectory is sampled every {dt_tr:g} s")
         sos = butter_sos(order, cutoff, dt=dt_tr, btype=btype)
+        _check_sections(sos, btype, int(order), cutoff, dt_tr, x.n)
         names = channels if channels is not None else x.names
-        return x.with_channels(**{n: apply_sos(sos, x[n], zero_phase) for n in names})
+        return x.with_channels(**{n: apply_sos(sos, x[n], zero_phase, f"column {n!r}")
+                                  for n in names})
     if dt is None:
         raise DataError("dt (the sample interval in s) is required to filter a plain array")
-    return apply_sos(butter_sos(order, cutoff, dt=dt, btype=btype), x, zero_phase)
+    x = samples(x)
+    sos = butter_sos(order, cutoff, dt=dt, btype=btype)
+    _check_sections(sos, btype, int(order), cutoff, dt, x.shape[0])
+    return apply_sos(sos, x, zero_phase)
 
 
 def lowpass(x, cutoff: float, *, dt: float | None = None, order: int = 2, zero_phase: bool = False,

@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from ..arguments import sample_interval
+from ..arguments import real_array, sample_interval
 from ..errors import DataError, UnidentifiableError
 from ..units import dimension_of, same_dimension
 from .regression import COND_LIMIT, qr_r, scaled_condition
@@ -41,11 +41,7 @@ def as_signal(x, name: str) -> np.ndarray:
 def signal_array(x, name: str) -> np.ndarray:
     """``x`` as a non-empty 1-D float64 array, or a :class:`DataError` naming ``name`` (its values
     are not looked at: :func:`signal_with_peaks` checks them)."""
-    try:
-        a = np.asarray(x, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise DataError(f"{name}: expected a 1-D array of numbers, found "
-                        f"{type(x).__name__}") from None
+    a = real_array(x, name, "a 1-D array of numbers")
     if a.ndim != 1:
         row = a.ndim == 2 and a.shape[0] == 1 and a.shape[1] > 1
         raise DataError(f"{name}: expected a 1-D array of samples, found shape {a.shape}"
@@ -78,10 +74,7 @@ def as_io_matrix(x, name: str, n: int | None = None, channels: tuple[str, ...] |
                  kind: str = "channel") -> np.ndarray:
     """``x`` as a finite (N, k) float64 array (a 1-D signal is one column); ``n`` samples when
     given; with ``channels``, k = len(channels) and the errors name the channel (of ``kind``)."""
-    try:
-        a = np.asarray(x, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise DataError(f"{name}: expected an array of numbers, found {type(x).__name__}") from None
+    a = real_array(x, name)
     if a.ndim == 1:
         a = a[:, None]
     check_not_transposed(a, name)

@@ -258,6 +258,9 @@ def check_scale(names, x: np.ndarray, what: str, why: str) -> None:
     estimators scale internally; state space, FRF, transfer functions and the nonlinear families
     do not). ``what``: 'input' or 'output'; ``why``: the work, 'NARX identification'."""
     x = np.asarray(x, dtype=np.float64)
+    if x.size == 0:
+        raise DataError(f"{what} column(s) {', '.join(map(repr, names))}: no samples; {why} "
+                        "needs a record")
     peak = np.max(np.abs(x.reshape(x.shape[0], -1)), axis=0)
     lo, hi = SCALE_LIMITS
     bad = (peak > hi) | (peak < lo)

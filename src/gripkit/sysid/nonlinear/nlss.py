@@ -72,6 +72,7 @@ from pathlib import Path
 import numpy as np
 import scipy.linalg as sla
 
+from ...arguments import real_array
 from ...errors import (AccuracyWarning, ArgumentError, DataError, IdentificationError,
                        ModelError, StabilityWarning, emit_warning)
 from ..checks import check_not_transposed
@@ -644,8 +645,7 @@ def _io(data, input, output, what: str):
     except (TypeError, ValueError):
         raise ArgumentError(f"nlss: {what} must be a Trajectory or a pair (u, y) of arrays, "
                             f"found {type(data).__name__}") from None
-    u = np.asarray(u, dtype=np.float64)
-    y = np.asarray(y, dtype=np.float64)
+    u, y = real_array(u, f"nlss: {what}: u"), real_array(y, f"nlss: {what}: y")
     u = u[:, None] if u.ndim == 1 else u
     y = y[:, None] if y.ndim == 1 else y
     check_not_transposed(u, f"nlss: {what}: u")
@@ -653,6 +653,8 @@ def _io(data, input, output, what: str):
     if u.ndim != 2 or y.ndim != 2:
         raise DataError(f"nlss: {what}: u and y must be arrays (N,) or (N, k), found shapes "
                         f"{u.shape} and {y.shape}")
+    if u.size == 0 or y.size == 0:
+        raise DataError(f"nlss: {what}: the signals hold no samples (u {u.shape}, y {y.shape})")
     m, p = u.shape[1], y.shape[1]
     ins = tuple(_columns(input, "input")) if input is not None else \
         tuple(f"u{i + 1}" if m > 1 else "u" for i in range(m))

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ...arguments import real_array
 from ...errors import DataError
 from ..model_protocol import column_in_unit
 from .nonlinear_model import NonlinearModel
@@ -108,13 +109,16 @@ def channel_fields(doc: dict) -> dict:
 
 def one_signal(x, name: str, family: str) -> np.ndarray:
     """``x`` as one finite float signal (N,) (a column (N, 1) or row (1, N) is flattened);
-    a DataError headed ``family`` names ``name`` otherwise."""
-    a = np.asarray(x, dtype=np.float64)
+    a DataError headed ``family`` names ``name`` otherwise (complex numbers, no samples, NaN or
+    ±inf)."""
+    a = real_array(x, f"{family}: {name}")
     if a.ndim == 2 and 1 in a.shape:
         a = a.ravel()
     if a.ndim != 1:
         raise DataError(f"{family}: {name} must be one signal (shape (N,)), found shape "
                         f"{a.shape}; pass one column")
+    if a.size == 0:
+        raise DataError(f"{family}: {name} holds no samples (shape {np.shape(x)})")
     if not np.all(np.isfinite(a)):
         raise DataError(f"{family}: {name} has {int(np.sum(~np.isfinite(a)))} non-finite "
                         "samples; remove or interpolate them first")
