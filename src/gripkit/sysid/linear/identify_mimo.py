@@ -28,6 +28,7 @@ from ...progress import status, track
 from ...signals.trajectory import Trajectory
 from .arx_mimo import arx_mimo
 from .frf import frf
+from .linear_model import deviation_compare
 from ..io_data import IOData, parse_names, validation_data
 
 __all__ = ["mimo_data", "identify_ss", "identify_frf", "identify_tf", "identify_arx", "several",
@@ -65,7 +66,7 @@ def mimo_data(data: Trajectory, inputs, outputs, detrend: str = "mean",
 def _validation_fit(model, vd: IOData) -> list[float] | None:
     if not model.stable:
         return None
-    return model.compare(vd.u, vd.y, dt=vd.dt).fit_percent
+    return deviation_compare(model, vd.u, vd.y, vd.dt).fit_percent
 
 
 def _aic(model, d: IOData) -> float:
@@ -293,7 +294,7 @@ def focus_score(model, focus: str, d: IOData) -> float:
     if focus == "simulation":
         if not model.stable:
             return -math.inf
-        return float(np.mean(model.compare(d.u, d.y, dt=d.dt).fit_percent))
+        return float(np.mean(deviation_compare(model, d.u, d.y, d.dt).fit_percent))
     from .pem_ss import predictor_x0
 
     ss = model.system

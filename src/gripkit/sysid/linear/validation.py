@@ -27,8 +27,9 @@ import numpy as np
 
 from ...errors import ArgumentError, DataError, ModelError, StabilityWarning, emit_warning
 from ...lti import LinearSystem
+from ...signals.trajectory import Trajectory
 from ..checks import check_io
-from ..model_protocol import ModelFit, check_sample_time
+from ..model_protocol import ModelFit, check_sample_time, column_in_unit
 
 __all__ = ["fit_percent", "records_fit", "loss_vn", "compare", "ResidualTests", "residual_tests",
            "Validation", "validate"]
@@ -267,15 +268,17 @@ class Validation:
                     residual_tests=tests)
 
 
-def validate(model, u, y, *, initial: str = "estimate", lags: int = 25, alpha: float = 0.01,
-             dt: float | None = None) -> Validation:
+def validate(model, u, y=None, *, initial: str = "estimate", lags: int = 25,
+             alpha: float = 0.01, dt: float | None = None) -> Validation:
     """Validate the one-input, one-output linear ``model`` (ARX, ARMAX, OE, state space or
-    transfer function) on (u, y) (deviations from its offsets, same sampling as the estimation
-    data): the free-run fit of :func:`compare` (``model.compare(u, y)``), the one-step
-    prediction fit, residual whiteness and independence. ``dt``: the arrays' sample time, which a
-    continuous model (tfest, step response) needs, as in :func:`compare`. A nonlinear model (no
-    linear ``system``) is refused with a ModelError: its fit is ``model.compare``, its prediction
-    errors ``model.residuals``."""
+    transfer function) on a separate record: a :class:`~gripkit.signals.Trajectory` with the
+    model's columns (as ``model.compare(data)`` reads it), or the arrays ``u``, ``y`` in the
+    units of the data the model was fitted on (the model's offsets applied, as to a trajectory;
+    same sampling as the estimation data): the free-run fit of :func:`compare`
+    (``model.compare(u, y)``), the one-step prediction fit, residual whiteness and independence.
+    ``dt``: the arrays' sample time, which a continuous model (tfest, step response) needs, as
+    in :func:`compare`. A nonlinear model (no linear ``system``) is refused with a ModelError:
+    its fit is ``model.compare``, its prediction errors ``model.residuals``."""
     _check_initial(initial)
     if not isinstance(getattr(model, "system", None), LinearSystem):
         what = getattr(model, "_family", None) or f"a {type(model).__name__}"
@@ -287,7 +290,7 @@ def validate(model, u, y, *, initial: str = "estimate", lags: int = 25, alpha: f
         raise ModelError(f"validate: the model has {len(model.inputs)} inputs and "
                          f"{len(model.outputs)} outputs; validate takes one of each",
                          hint="use model.compare(data) and model.residuals(data)")
-    u, y = check_io(u, y)
+    u, y, dt = _record_arrays(model, u, y, dt)
     sim = compare(model, u, y, dt=dt)
     with np.errstate(over="ignore", invalid="ignore"):
         e, t0, predictor_poles = _one_step(model, u, y, dt)
@@ -299,11 +302,41 @@ def validate(model, u, y, *, initial: str = "estimate", lags: int = 25, alpha: f
                       residual_tests(e, u[t0:], lags=lags, alpha=alpha), model.stable)
 
 
+def _record_arrays(model, data, y, dt) -> tuple[np.ndarray, np.ndarray, float | None]:
+    """``(u, y, dt)`` of what :func:`validate` was given: a trajectory's input and output columns
+    in the model's units (and its sample time), or the arrays ``u``, ``y`` checked."""
+    if not isinstance(data, Trajectory):
+        if y is None:
+            raise ArgumentError("validate: give a trajectory with the model's columns, or the "
+                                "arrays u and y", hint="model.validate(data) or "
+                                                       "model.validate(u, y)")
+        u, y = check_io(data, y)
+        return u, y, dt
+    if y is not None or dt is not None:
+        raise ArgumentError("validate: a trajectory carries its outputs and sample time; give "
+                            "no y or dt with it", hint="model.validate(data)")
+    step = data.require_uniform(why="validation of an identified model")
+    u, y = (_column(data, name, unit, what) for name, unit, what in
+            ((model.inputs[0], model.input_units[0], "input"),
+             (model.outputs[0], model.output_units[0], "output")))
+    return *check_io(u, y), step
+
+
+def _column(data, name: str, unit: str, what: str) -> np.ndarray:
+    """Column ``name`` of the trajectory ``data`` in the model's ``unit``."""
+    if name not in data.names:
+        raise DataError(f"data: the model's {what} column {name!r} is missing; the data have "
+                        f"{', '.join(map(repr, data.names))}",
+                        hint="rename the column or validate on a record with the model's columns")
+    return column_in_unit(data, name, unit, what)
+
+
 def _one_step(model, u, y, dt) -> tuple[np.ndarray, int, np.ndarray]:
-    """(one-step errors, first sample they start at, poles of the predictor)."""
+    """(one-step errors, first sample they start at, poles of the predictor) on the arrays
+    ``u``, ``y`` (the model's offsets applied)."""
     if hasattr(model, "prediction_errors"):  # a polynomial model: its exact predictor
         cf = np.convolve(model.C, model.F)  # the predictor filters by 1/(C F)
-        return (model.prediction_errors(u, y), model.start,
+        return (model.residuals(u, y), model.start,
                 np.roots(cf) if cf.size > 1 else np.zeros(0))
     ss = model.to_ss(dt)  # innovation form: the predictor's poles are those of A − K C
     K = getattr(model, "K", None)
