@@ -34,8 +34,8 @@ record's values in the units of the data the model was fitted on: a linear model
 offsets (``u_offset``, ``y_offset``, the operating point ``identify`` detrended; zero for a model
 fitted on arrays) from either and adds them back to its outputs (NLSS's ``u_offset``/``y_offset``
 normalise internally). So ``sysid.compare(m, u, y)`` is ``m.compare(u, y)`` for every family, and
-equals ``m.compare(trajectory)`` on that trajectory's columns. ``x0`` where the family has an initial
-state: a linear model's state, NARX's first ``max_lag`` outputs, NLSS's x(0), the Bouc-Wen
+equals ``m.compare(trajectory)`` on that trajectory's columns. ``x0`` where the family has an
+initial state: a linear model's state, NARX's first ``max_lag`` outputs, NLSS's x(0), the Bouc-Wen
 oscillator's (x, ẋ, z); Hammerstein–Wiener (the steady state of its initial input), Bouc-Wen
 (h = 0) and Prandtl–Ishlinskii (relaxed plays) refuse a given ``x0`` with an ArgumentError
 saying what their free run starts from.

@@ -46,8 +46,8 @@ from ..model_protocol import (ModelFit, ReportMixin, check_horizon, check_sample
 from .validation import validate
 
 __all__ = ["VALIDATION_FIT", "IdentifiedLinearModel", "LinearModel", "as_io_matrix",
-           "deviation_compare", "estimate_x0", "free_run", "fit_per_output", "k_step_prediction", "model_document",
-           "polynomial_document", "read_linear_model"]
+           "deviation_compare", "estimate_x0", "free_run", "fit_per_output", "k_step_prediction",
+           "model_document", "polynomial_document", "read_linear_model"]
 
 
 def _sim(A, B, C, D, u, x0):
@@ -225,10 +225,21 @@ class IdentifiedLinearModel(ReportMixin):
     ``data`` is a :class:`~gripkit.signals.Trajectory` (columns by name, converted to the
     model's units) or arrays in the units of the data the model was fitted on (``u`` (N, m)
     and, where needed, ``y`` (N, p)); either way the model's offsets are removed and added back:
-    results in the data's units. Frequencies are in rad/s (:meth:`gripkit.lti.LinearSystem.frequency_response`)."""
+    results in the data's units. Frequencies are in rad/s
+    (:meth:`gripkit.lti.LinearSystem.frequency_response`)."""
 
     #: how :meth:`compare` scores a model, and how it starts the free run
     fit_definition = VALIDATION_FIT
+    #: what the model's own ``fit_percent`` is: here the fit of :meth:`compare` on the
+    #: estimation data (ARX and ARMAX: the one-step prediction fit, see PolynomialModel)
+    fit_percent_definition = f"{VALIDATION_FIT}, on the estimation data"
+
+    @property
+    def simulation_fit_percent(self) -> list | None:
+        """The free-run fit (:data:`VALIDATION_FIT`, what :meth:`compare` gives) on the
+        estimation data, a list per output: the figure to rank models of every family by. A
+        state-space or transfer-function model's ``fit_percent`` is it."""
+        return self.fit_percent
     initial_state = "estimated"
     #: its HTML report: poles, Bode with σ, innovation residuals (gripkit.sysid.model_report)
     _report_page = "linear"
@@ -362,9 +373,9 @@ class IdentifiedLinearModel(ReportMixin):
 
     def compare(self, data, y=None, dt: float | None = None) -> ModelFit:
         """The validation fit (:data:`VALIDATION_FIT`) per output on a trajectory, or on
-        the arrays ``u``, ``y`` (offsets applied as to a trajectory): free run from the initial state estimated by least squares.
-        ``fit_percent`` is None per output for an unstable model (its free run, from rest, is
-        ``simulated``)."""
+        the arrays ``u``, ``y`` (offsets applied as to a trajectory): free run from the initial
+        state estimated by least squares. ``fit_percent`` is None per output for an unstable
+        model (its free run, from rest, is ``simulated``)."""
         u, yy, dt, yo = self._io(data, y, "comparison of an identified model", dt=dt)
         return deviation_compare(self, u, yy, dt, yo)
 

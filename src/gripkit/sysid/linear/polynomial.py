@@ -50,8 +50,8 @@ from ...signals.trajectory import Trajectory
 from ...units import ratio_unit
 from . import matrix_polynomial as mp
 from .linear_model import (IdentifiedLinearModel, LinearModel, _checked_display_units,
-                           as_io_matrix, k_step_prediction, malformed, polynomial_document,
-                           read_linear_model)
+                           as_io_matrix, deviation_compare, k_step_prediction, malformed,
+                           polynomial_document, read_linear_model)
 from ..model_protocol import check_horizon, check_sample_time
 from .validation import validate
 
@@ -147,7 +147,10 @@ class PolynomialModel(IdentifiedLinearModel):
     loss
         V_N of eq (29): ``(1/M) Σ ½ e²(t)`` over the M one-step prediction errors.
     fit_percent
-        One-step-ahead prediction fit on the estimation data, ``100 (1 − ‖y − ŷ‖/‖y − ȳ‖)``.
+        One-step-ahead prediction fit on the estimation data, ``100 (1 − ‖y − ŷ‖/‖y − ȳ‖)``
+        (``fit_percent_definition`` says so; also ``prediction_fit_percent``). Not the free-run
+        fit of :meth:`compare` that a state-space, transfer-function or NARX model's
+        ``fit_percent`` is: compare families by ``simulation_fit_percent``.
     n_samples
         Samples in the estimation record (N); ``n_used`` = M = N − start prediction errors.
     estimation_residuals
@@ -155,8 +158,10 @@ class PolynomialModel(IdentifiedLinearModel):
         :func:`gripkit.sysid.linear.arx` computes them on first access from ``estimation_data``.
         (``residuals(data)`` computes them on any record.) Not written to the model file.
     estimation_data
-        ``(u, y)``, references to the record the model was fitted on (no copy), or None: the
-        source of ``estimation_residuals`` when the estimator did not keep them. Changing those
+        ``(u, y)``, references to the record the model was fitted on (no copy; ``arx``,
+        ``armax`` and ``oe`` of one record keep it), or None: the source of
+        ``estimation_residuals`` when the estimator did not keep them, and of
+        ``simulation_fit_percent``. Changing those
         arrays in place after the fit makes ``estimation_residuals`` raise a DataError. Not
         written to the model file.
     input_name, output_name, input_unit, output_unit
@@ -531,6 +536,39 @@ class PolynomialModel(IdentifiedLinearModel):
                                     std=None if std is None else float(std[k])))
         return ParameterSet(params, name=self.label)
 
+    # ------------------------------------------------------------------ fits
+    @property
+    def fit_percent_definition(self) -> str:
+        """What ``fit_percent`` is: ARX and ARMAX, the one-step-ahead prediction fit on the
+        estimation data (not the free run of :meth:`compare`: that is
+        ``simulation_fit_percent``); OE, whose noise model is white, the fit of its one-step
+        predictor, the free run from the estimated initial conditions."""
+        which = ("its one-step-ahead predictor, the free run B/F u from the estimated initial "
+                 "conditions" if self.structure == "oe" else "one-step-ahead prediction ŷ(t|t−1)")
+        return (f"{which} on the estimation data, fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) over samples "
+                f"start … N−1 (the free run of compare: simulation_fit_percent)")
+
+    @property
+    def prediction_fit_percent(self):
+        """The one-step-ahead prediction fit on the estimation data: ``fit_percent`` (a number,
+        a list per output with several outputs)."""
+        return self.fit_percent
+
+    @functools.cached_property
+    def simulation_fit_percent(self) -> list | None:
+        """The free-run fit of :meth:`compare` (:data:`~.linear_model.VALIDATION_FIT`) on the
+        estimation data, a list per output, as every linear family's (and the figure to rank
+        ARX against OE, state space or NARX by); None where the model holds no estimation record
+        (one read from a file with one output, or a fit of several records), [None] for an
+        unstable model. Computed on first access (the free-run kernel is numba's)."""
+        if self.multivariable:
+            return self.info.get("free_run_fit_percent")
+        rec = self.estimation_data
+        if not isinstance(rec, tuple) or len(rec) != 2:
+            return None
+        u, y = (np.asarray(x, dtype=np.float64).reshape(-1, 1) for x in rec)
+        return deviation_compare(self, u, y, self.dt).fit_percent
+
     # ------------------------------------------------------------------ criteria
     @property
     def start(self) -> int:
@@ -769,10 +807,10 @@ class PolynomialModel(IdentifiedLinearModel):
 
     def predict(self, data, y=None, horizon: int = 1) -> np.ndarray:
         """``ŷ(t | t − horizon)``: of a trajectory (N, 1) in its units, of the arrays ``u``,
-        ``y`` (offsets applied, as to a trajectory) shape (N,). ``horizon = 1``: the exact one-step predictor of the
-        polynomials, the first ``start`` samples being the record's own values (the predictor's
-        initial conditions); ``horizon > 1``: :func:`~.linear_model.k_step_prediction` on
-        :meth:`innovation_form`."""
+        ``y`` (offsets applied, as to a trajectory) shape (N,). ``horizon = 1``: the exact
+        one-step predictor of the polynomials, the first ``start`` samples being the record's
+        own values (the predictor's initial conditions); ``horizon > 1``:
+        :func:`~.linear_model.k_step_prediction` on :meth:`innovation_form`."""
         if isinstance(data, Trajectory) or self.multivariable:
             return super().predict(data, y, horizon=horizon)
         u = np.asarray(data, dtype=np.float64) - self.u_offset
@@ -1016,7 +1054,7 @@ class PolynomialModel(IdentifiedLinearModel):
                      for v, s in zip(arr, std if std is not None else np.zeros(arr.size))]
             lines.append(f"  {name} = [{', '.join(terms)}]")
         if self.loss is not None:
-            lines.append(f"  loss V_N = {self.loss:.5g}, fit = {self.fit_percent:.2f} %, "
+            lines.append(f"  loss V_N = {self.loss:.5g}, one-step fit = {self.fit_percent:.2f} %, "
                          f"AIC = {self.aic:.5g}, N = {self.n_samples}")
         fmt = lambda z: ", ".join(f"{v.real:.4g}{v.imag:+.4g}j" for v in z) or "none"  # noqa: E731
         lines.append(f"  poles: {fmt(self.poles())}")

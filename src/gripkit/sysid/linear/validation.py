@@ -77,18 +77,28 @@ def _check_initial(initial: str) -> None:
                             hint="a free run from rest: fit_percent(y, model.simulate(u))")
 
 
-def compare(model, u, y, *, initial: str = "estimate", dt: float | None = None) -> ModelFit:
-    """The validation fit of any identified ``model`` on the arrays ``u``, ``y`` (``(N,)`` or
-    ``(N, m)``, ``(N, p)``): exactly ``model.compare(u, y)``, the fit by the model's
-    ``fit_definition`` (a linear model: ARX, ARMAX, OE, state space, transfer function, its free
-    run from the initial state estimated by least squares, every sample scored, the arrays
-    deviations from its offsets; a nonlinear model: NARX, Hammerstein–Wiener, nonlinear state
-    space, hysteresis, the arrays the record's values). Warns :class:`StabilityWarning` for an
-    unstable linear model, whose ``fit_percent`` is None per output. ``initial`` takes only
+def compare(model, u, y=None, *, initial: str = "estimate",
+            dt: float | None = None) -> ModelFit:
+    """The validation fit of any identified ``model`` on a :class:`~gripkit.signals.Trajectory`
+    ``u`` with its columns (``y`` and ``dt`` not given: the trajectory carries them), or on the
+    arrays ``u``, ``y`` (``(N,)`` or ``(N, m)``, ``(N, p)``, the record's values in the units
+    of the data the model was fitted on): exactly ``model.compare(u, y)``, the fit by the
+    model's ``fit_definition`` (a linear model: ARX, ARMAX, OE, state space, transfer function,
+    its free run from the initial state estimated by least squares, every sample scored, its
+    offsets removed from the arrays as from a trajectory; a nonlinear model: NARX,
+    Hammerstein–Wiener, nonlinear state space, hysteresis). Warns :class:`StabilityWarning` for
+    an unstable linear model, whose ``fit_percent`` is None per output. ``initial`` takes only
     ``'estimate'`` (a free run from rest is ``model.simulate(u)``, never a validation fit).
     ``dt``: the arrays' sample time, which a continuous linear model needs (else an
     ArgumentError); a discrete model is checked against it."""
     _check_initial(initial)
+    if isinstance(u, Trajectory) and (y is not None or dt is not None):
+        raise ArgumentError("compare(): a trajectory carries its outputs and sample time; give "
+                            "no y or dt with it", hint="gripkit.sysid.compare(model, data)")
+    if not isinstance(u, Trajectory) and y is None:
+        raise ArgumentError("compare(): give a trajectory with the model's columns, or the "
+                            "arrays u and y", hint="gripkit.sysid.compare(model, data) or "
+                                                   "gripkit.sysid.compare(model, u, y)")
     if not callable(getattr(model, "compare", None)):
         raise ArgumentError(f"compare(): model: expected an identified model, found "
                             f"{type(model).__name__}", hint="gripkit.sysid.identify(...)")
@@ -104,7 +114,7 @@ def compare(model, u, y, *, initial: str = "estimate", dt: float | None = None) 
         else:
             timed = {"dt": dt}
     with np.errstate(over="ignore", invalid="ignore"):
-        return model.compare(u, y, **timed)
+        return model.compare(u) if y is None else model.compare(u, y, **timed)
 
 
 def _check_sample_time(model, dt) -> None:
