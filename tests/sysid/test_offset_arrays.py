@@ -11,6 +11,7 @@
 
 Fits are recomputed by the formula of issue 2: fit % = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖)."""
 
+import json
 import warnings
 from pathlib import Path
 
@@ -18,6 +19,7 @@ import numpy as np
 import pytest
 from scipy.signal import lfilter
 
+from gripkit.cli import main
 from gripkit.errors import ArgumentError, DataError, DataWarning, ModelError
 from gripkit.io import load
 from gripkit.sysid import armax, arx, compare, identify, n4sid, oe, tfest, validate
@@ -130,6 +132,19 @@ def test_fit_percent_says_what_it_is_and_simulation_fit_ranks_like_with_like(tan
     assert a.fit_percent > ms["oe"].fit_percent  # the one-step figure: ARX looks better
     best = max(ms, key=lambda k: ms[k].simulation_fit_percent[0])
     assert best == "oe"
+
+
+def test_cli_json_keeps_fit_percent_and_states_its_definition(capsys):
+    """gripkit identify arx --json keeps issue 2's keys (fit_percent the one-step fit, 97.79 %
+    on the cascaded tanks) and states which fit it is."""
+    code = main(["identify", "arx", str(FIX / "cascaded_tanks_est.csv"), "--input", "pump",
+                 "--output", "level", "--na", "2", "--nb", "2", "--nk", "1", "--json"])
+    out = json.loads(capsys.readouterr().out)
+    assert code == 0
+    assert {"structure", "na", "nb", "nk", "A", "B", "A_std", "B_std", "loss", "fit_percent",
+            "poles", "zeros", "minimum_phase", "n_samples"} <= set(out)
+    assert out["fit_percent"] == pytest.approx(97.79, abs=0.01)
+    assert out["fit_percent_definition"].startswith("one-step-ahead prediction")
 
 
 def test_narx_simulation_fit_is_its_free_run_fit(tanks):
