@@ -340,11 +340,13 @@ def step_like(u) -> bool:
 OPERATING_POINT_Z = 5.0
 #: relative change of the static gain the constant term must make to matter
 OPERATING_POINT_GAIN_CHANGE = 0.1
-#: a signal's mean within this many standard deviations of zero: centred, nothing to check
-CENTRED = 0.05
+#: a signal's mean within this fraction of its span (max − min) of zero: centred, nothing to
+#: check (about 0.1 σ of a Gaussian record of 10³–10⁶ samples)
+CENTRED = 0.01
 
 
-def warn_if_operating_point(u, y, na: int, nb: int, nk: int, what: str) -> None:
+def warn_if_operating_point(u, y, na: int, nb: int, nk: int, what: str,
+                            peaks: tuple | None = None) -> None:
     """Warn (:class:`~gripkit.errors.DataWarning`) when the one-input, one-output arrays ``u``,
     ``y`` that a linear estimator (``what``: "oe [2 2 1]") takes as deviations sit around an
     operating point: the model ``A y = B u`` has no constant, so a level ȳ ≠ G(1) ū biases every
@@ -353,12 +355,14 @@ def warn_if_operating_point(u, y, na: int, nb: int, nk: int, what: str) -> None:
     ``y(t) + a₁ y(t−1) + … = b u(t−nk) + … + c``; it warns when c is significant
     (|c|/σ_c > :data:`OPERATING_POINT_Z`) and changes the static gain ``Σb/(1 + Σa)`` by more
     than :data:`OPERATING_POINT_GAIN_CHANGE`. Data centred on zero (both means within
-    :data:`CENTRED` σ: what ``identify`` fits after removing the means) are not checked; a
+    :data:`CENTRED` of their spans, ``peaks`` ``((min u, max u), (min y, max y))`` when the
+    caller knows them: what ``identify`` fits after removing the means) are not checked; a
     step from rest fits without a constant (c ≈ 0) and passes; a step input with an offset is
     told to subtract its starting steady state, not its mean (:func:`step_like`)."""
     u, y = np.ravel(u), np.ravel(y)
     ubar, ybar = float(u.mean()), float(y.mean())
-    if abs(ubar) <= CENTRED * float(u.std()) and abs(ybar) <= CENTRED * float(y.std()):
+    (ulo, uhi), (ylo, yhi) = peaks or ((u.min(), u.max()), (y.min(), y.max()))
+    if abs(ubar) <= CENTRED * (uhi - ulo) and abs(ybar) <= CENTRED * (yhi - ylo):
         return
     X = arx_regression(u, y, na, nb, nk)
     m, p = X.shape[0], na + nb

@@ -98,7 +98,7 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
     # one min and max per signal (the finiteness check's) serve the excitation checks and scaling
     u, y, step, na, nb, nk, (pu, py) = checked_problem_peaks(u, y, dt, na=na, nb=nb, nk=nk)
     check_channels_vary(u, y, meta, (pu, py))  # named in the user's units, before any scaling
-    warn_if_operating_point(u, y, na, nb, nk, f"arx [{na} {nb} {nk}]")
+    warn_if_operating_point(u, y, na, nb, nk, f"arx [{na} {nb} {nk}]", (pu, py))
     cu, cy = unit_scale(u, pu), unit_scale(y, py)
     if max(abs(math.log2(cu)), abs(math.log2(cy))) <= _NO_SCALING_WITHIN:
         # scaling by powers of two is exact: skip the two copies where it changes nothing

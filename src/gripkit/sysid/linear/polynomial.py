@@ -1012,7 +1012,8 @@ class PolynomialModel(IdentifiedLinearModel):
             d.update(F=lst(self.F), F_std=lst(self.F_std))
         d.update(parameter_names=list(self.parameter_names), theta=lst(self.theta),
                  theta_std=lst(self.theta_std), loss=self.loss, fit_percent=self.fit_percent,
-                 fit_percent_definition=self.fit_percent_definition, aic=self.aic, fpe=self.fpe, noise_variance=self.noise_variance,
+                 fit_percent_definition=self.fit_percent_definition, aic=self.aic,
+                 fpe=self.fpe, noise_variance=self.noise_variance,
                  poles=pairs(self.poles()), zeros=pairs(self.zeros()),
                  minimum_phase=self.minimum_phase, stable=self.stable, dc_gain=self.dc_gain,
                  n_samples=self.n_samples, dt=self.dt,
