@@ -9,6 +9,8 @@ Hammerstein–Wiener, nonlinear state space, hysteresis) is an object with these
     m.dt                         # sample time [s] (None for a continuous-time model)
     m.parameters                 # ParameterSet: every free parameter with its unit and 1σ
     m.fit_definition             # how compare scores
+    m.fit_percent_definition     # what m.fit_percent is (ARX/ARMAX: the one-step prediction fit)
+    m.simulation_fit_percent     # compare's free-run fit on the estimation data, list per output
     m.simulate(data, x0=None)    # free run on data's input columns -> (N, ny), in the file's units
     m.predict(data, horizon=1)   # ŷ(t | t − horizon) on a record with the output columns
     m.compare(data)              # ModelFit: the fit (%) per output by m.fit_definition
@@ -133,11 +135,15 @@ class ModelFit:
 @runtime_checkable
 class IdentifiedModel(Protocol):
     """What every identified model offers, linear and nonlinear (see the module docstring; a
-    nonlinear model's ``to_*`` raise a ModelError). Arrays: a linear model's deviations from
-    its offsets; a nonlinear model's record values."""
+    nonlinear model's ``to_*`` raise a ModelError). Arrays: the record's values, in the units of
+    the data the model was fitted on (a linear model applies its offsets to them)."""
 
     structure: str
     fit_definition: str
+    fit_percent_definition: str
+
+    @property
+    def simulation_fit_percent(self) -> list | None: ...
 
     @property
     def inputs(self) -> tuple[str, ...]: ...
