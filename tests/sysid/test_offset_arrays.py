@@ -196,6 +196,11 @@ def test_centred_data_and_a_step_from_rest_do_not_warn():
                lambda: n4sid(step, ys, 2)):
         _, caught = _operating_point_warnings(fn)
         assert not caught
+    # the same step with the output 3 above rest: c = 3·0.2 = 0.6 (0.67), and the fix named is
+    # the steady state before the step, not the mean of a step record
+    with pytest.warns(DataWarning, match=r"subtract the steady state before the step "
+                                         r"\(u = 0, y = 3\.02\)"):
+        arx(step, ys + 3.0, 2, 2, 1)
 
 
 @pytest.mark.parametrize("method, orders", [
