@@ -67,11 +67,11 @@ def test_validate_reports_what_compare_reports(records, capsys, command):
     # the bias of 0.05 N on y1 costs fit: the model's operating point is used, not the record's mean
     assert 50.0 < cmp["fit_percent"][0] < 99.0
     # the Python doors give that number exactly: model.compare on the record, and
-    # sysid.compare / sysid.validate on its deviations from the model's operating point
+    # sysid.compare / sysid.validate on its columns (the model's operating point removed inside)
     m, val = load_model(model), load(records["val"])
     assert m.compare(val).fit_percent == cmp["fit_percent"]
-    u = val.as_array(*m.inputs) - m.u_offset
-    y = val.as_array(*m.outputs) - m.y_offset
+    u, y = val.as_array(*m.inputs), val.as_array(*m.outputs)
     assert sysid.compare(m, u, y).fit_percent == cmp["fit_percent"]
     if len(m.inputs) == len(m.outputs) == 1:
         assert sysid.validate(m, u[:, 0], y[:, 0]).fit_percent == cmp["fit_percent"][0]
+        assert m.validate(val).fit_percent == cmp["fit_percent"][0]

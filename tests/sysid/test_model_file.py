@@ -110,7 +110,11 @@ def test_simulate_and_compare_data_by_name(model):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         sim = model.simulate(tr)
-    assert np.allclose(sim, model.simulate(u, dt=0.01) + [3.0, -1.0])
+    # the arrays of the record's inputs: the model's u_offset (1, 0) removed, y_offset (3, −1)
+    # added, as for the trajectory; the deviations' free run plus the output offsets
+    assert np.allclose(sim, model.simulate(u + [1.0, 0.0], dt=0.01))
+    at_zero = model.replace(u_offset=(0.0, 0.0), y_offset=(0.0, 0.0))
+    assert np.allclose(sim, at_zero.simulate(u, dt=0.01) + [3.0, -1.0])
 
 
 def test_polynomial_model_saves_as_model_file(tmp_path, arx_data):

@@ -123,12 +123,14 @@ def test_loaded_model_writes_the_same_page(family, tmp_path):
 
 
 def test_arrays_give_the_page_of_their_trajectory(tmp_path):
-    """An ARX model's deviation arrays (u − u_offset, y − y_offset), as ``compare(u, y)`` takes
-    them: the page shows ``compare(u, y)``'s fit, the fit of the trajectory they came from
-    (to the table's 4 digits); a NARX model's signals as the pair (u, y)."""
+    """An ARX model's arrays, the record's columns as ``compare(u, y)`` takes them (the model's
+    offsets removed inside, as from a trajectory): the page shows ``compare(u, y)``'s fit, the
+    fit of the trajectory they came from (to the table's 4 digits); a NARX model's signals as
+    the pair (u, y)."""
     tr = _linear_record()
     m = identify(tr, "arx", input="u", output="y", na=2, nb=2, nk=1)
-    u, y = np.asarray(tr["u"]) - m.u_offset, np.asarray(tr["y"]) - m.y_offset
+    assert m.u_offset != 0.0 and m.y_offset != 0.0  # the record sits at an operating point
+    u, y = np.asarray(tr["u"]), np.asarray(tr["y"])
     fit = m.compare(u, y).fit_percent[0]
     assert fit == pytest.approx(m.compare(tr).fit_percent[0], abs=1e-9)
     html = m.report(u, tmp_path / "arrays", y=y).read_text(encoding="utf-8")

@@ -50,8 +50,9 @@ def test_simulate_from_rest_and_with_given_past(plant):
     f = tr["force"]
     assert tr.unit("force") == "N" and tr.unit("current") == "A" and tr.dt == 0.005
     assert f[0] == f[1] == 0.0  # two-sample delay, at rest before t = 0
-    # force = B/A (i − 0.850 A): the same as the model's own simulation and the state space
-    np.testing.assert_allclose(f, plant.model.simulate(s1.u - 0.850))
+    # force = B/A (i − 0.850 A): the same as the model's own simulation of the currents (its
+    # u_offset 0.850 A removed inside) and the state space
+    np.testing.assert_allclose(f, plant.model.simulate(s1.u))
     ss = plant.to_ss()
     Ad, Bd, Cd, Dd = ss.A, ss.B, ss.C, ss.D
     x = np.zeros(Ad.shape[0])

@@ -11,9 +11,9 @@ import math
 import numpy as np
 
 from ..arguments import real_array, sample_interval
-from ..errors import DataError, UnidentifiableError
+from ..errors import DataError, DataWarning, UnidentifiableError, emit_warning
 from ..units import dimension_of, same_dimension
-from .regression import COND_LIMIT, qr_r, scaled_condition
+from .regression import COND_LIMIT, arx_regression, qr_r, scaled_condition
 
 __all__ = ["as_signal", "signal_array", "signal_with_peaks", "as_io_matrix", "check_not_transposed",
            "io_records",
@@ -322,3 +322,77 @@ def check_identifiable(u: np.ndarray, y: np.ndarray, n_min: int, what: str,
     require_samples(y.size, n_min, what)
     check_excitation(u, peaks=None if peaks is None else peaks[0])
     check_output_varies(y, peaks=None if peaks is None else peaks[1])
+
+
+#: level changes an input column may make and still count as a step (a step, a few held steps)
+STEP_CHANGES = 4
+
+
+def step_like(u) -> bool:
+    """Whether every column of the input ``u`` ((N,) or (N, m); as recorded or with its mean
+    removed: a shift changes neither its span nor its steps) is piecewise
+    constant with at most :data:`STEP_CHANGES` level changes, and one column at least changes: a
+    step record. Its mean is no operating point: the record sits at one level, then at another,
+    never at the mean, so with the means removed a record that starts at rest starts away from
+    rest (a measured, noisy step is not detected)."""
+    u = np.asarray(u, dtype=np.float64).reshape(len(u), -1)
+    span = np.ptp(u, axis=0)
+    if not u.shape[0] or not np.any(span > 0):
+        return False
+    changes = np.count_nonzero(np.abs(np.diff(u, axis=0)) > 1e-9 * span, axis=0)
+    return bool(np.all(changes <= STEP_CHANGES))
+
+
+#: |c|/σ_c above which :func:`warn_if_operating_point` finds the constant term significant
+OPERATING_POINT_Z = 5.0
+#: relative change of the static gain the constant term must make to matter
+OPERATING_POINT_GAIN_CHANGE = 0.1
+#: a signal's mean within this fraction of its span (max − min) of zero: centred, nothing to
+#: check (about 0.1 σ of a Gaussian record of 10³–10⁶ samples)
+CENTRED = 0.01
+
+
+def warn_if_operating_point(u, y, na: int, nb: int, nk: int, what: str,
+                            peaks: tuple | None = None) -> None:
+    """Warn (:class:`~gripkit.errors.DataWarning`) when the one-input, one-output arrays ``u``,
+    ``y`` that a linear estimator (``what``: "oe [2 2 1]") takes as deviations sit around an
+    operating point: the model ``A y = B u`` has no constant, so a level ȳ ≠ G(1) ū biases every
+    coefficient (σ that exclude the truth), silently. The check: the ARX least squares of the
+    same orders ``na``, ``nb``, ``nk`` with and without a constant regressor c,
+    ``y(t) + a₁ y(t−1) + … = b u(t−nk) + … + c``; it warns when c is significant
+    (|c|/σ_c > :data:`OPERATING_POINT_Z`) and changes the static gain ``Σb/(1 + Σa)`` by more
+    than :data:`OPERATING_POINT_GAIN_CHANGE`. Data centred on zero (both means within
+    :data:`CENTRED` of their spans, ``peaks`` ``((min u, max u), (min y, max y))`` when the
+    caller knows them: what ``identify`` fits after removing the means) are not checked; a
+    step from rest fits without a constant (c ≈ 0) and passes; a step input with an offset is
+    told to subtract its starting steady state, not its mean (:func:`step_like`)."""
+    u, y = np.ravel(u), np.ravel(y)
+    ubar, ybar = float(u.mean()), float(y.mean())
+    (ulo, uhi), (ylo, yhi) = peaks or ((u.min(), u.max()), (y.min(), y.max()))
+    if abs(ubar) <= CENTRED * (uhi - ulo) and abs(ybar) <= CENTRED * (yhi - ylo):
+        return
+    X = arx_regression(u, y, na, nb, nk)
+    m, p = X.shape[0], na + nb
+    if m <= p + 2:
+        return
+    phi, target = X[:, :p], X[:, p]
+    plain = np.linalg.lstsq(phi, target, rcond=None)[0]
+    q, r = np.linalg.qr(np.column_stack([phi, np.ones(m)]))
+    theta = np.linalg.solve(r, q.T @ target)
+    e = target - q @ (q.T @ target)
+    rinv_last = np.linalg.solve(r, np.eye(p + 1)[:, p])  # the last column of R⁻¹
+    sigma_c = math.sqrt(float(e @ e) / (m - p - 1) * float(rinv_last @ rinv_last))
+    c = float(theta[p])
+    g0, g1 = (float(np.sum(t[na:p]) / (1.0 + np.sum(t[:na]))) for t in (plain, theta))
+    if not (math.isfinite(g0) and math.isfinite(g1)) or abs(c) <= OPERATING_POINT_Z * sigma_c \
+            or abs(g0 - g1) <= OPERATING_POINT_GAIN_CHANGE * max(abs(g1), 1e-300):
+        return
+    fix = (f"subtract the steady state before the step (u = {u[0]:.4g}, y = {y[0]:.4g}) from "
+           "u and y" if step_like(u) else "subtract the means from u and y")
+    emit_warning(
+        f"{what}: the data sit around an operating point (mean u = {ubar:.4g}, mean y = "
+        f"{ybar:.4g}) that the model has no term for: the ARX fit of the same orders with a "
+        f"constant term finds c = {c:.4g} (|c|/σ_c = {abs(c) / sigma_c:.3g}) and a static gain "
+        f"of {g1:.4g} against {g0:.4g} without it, so this model is biased and its σ do not "
+        f"cover that; {fix} before fitting (pass them as u_offset=, y_offset=), or use "
+        "gripkit.sysid.identify, which removes the means", DataWarning)

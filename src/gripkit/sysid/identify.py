@@ -81,9 +81,10 @@ def _finite_fit(model):
 
 
 def _free_run_fit(model, u: np.ndarray, y: np.ndarray) -> float:
-    """100 (1 − ‖y − ŷ‖/‖y − ȳ‖) of the model simulated from rest (−inf if its run overflows)."""
+    """100 (1 − ‖y − ŷ‖/‖y − ȳ‖) of the model simulated from rest on the deviations ``u``, ``y``
+    from its offsets (−inf if its run overflows)."""
     with np.errstate(over="ignore", invalid="ignore"):
-        yhat = model.simulate(u)
+        yhat = model.system.simulate(u)[:, 0]
         if not np.isfinite(yhat).all():
             return -np.inf
         return float(100.0 * (1.0 - np.linalg.norm(y - yhat) / np.linalg.norm(y - y.mean())))

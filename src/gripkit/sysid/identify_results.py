@@ -83,11 +83,10 @@ def validate_model(model, data: Trajectory, *, detrend: str = "mean") -> Validat
     vd = IOData.from_trajectory(data, model.input_name, model.output_name,
                                 detrend="linear" if detrend == "linear" else "none",
                                 why="validation", checks=False)
-    u, y = vd.u1, vd.y1
-    if detrend != "linear":  # around the model's operating point, as the fit above
-        u, y = u - model.u_offset, y - model.y_offset
+    if detrend == "linear":  # the record's own line off: no operating point left to remove
+        model = model.replace(u_offset=0.0, y_offset=0.0)
     return ValidationResult(None if vfit is None else vfit[0], definition, name,
-                            model.validate(u, y))
+                            model.validate(vd.u1, vd.y1))
 
 
 def _free_run_fit(model, data) -> tuple[list[float] | None, str]:

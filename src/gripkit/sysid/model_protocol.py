@@ -9,6 +9,8 @@ Hammerstein–Wiener, nonlinear state space, hysteresis) is an object with these
     m.dt                         # sample time [s] (None for a continuous-time model)
     m.parameters                 # ParameterSet: every free parameter with its unit and 1σ
     m.fit_definition             # how compare scores
+    m.fit_percent_definition     # what m.fit_percent is (ARX/ARMAX: the one-step prediction fit)
+    m.simulation_fit_percent     # compare's free-run fit on the estimation data, list per output
     m.simulate(data, x0=None)    # free run on data's input columns -> (N, ny), in the file's units
     m.predict(data, horizon=1)   # ŷ(t | t − horizon) on a record with the output columns
     m.compare(data)              # ModelFit: the fit (%) per output by m.fit_definition
@@ -29,12 +31,13 @@ models, ``'measured'`` for NARX; ``gripkit compare --json`` states it when the m
 ``m.display_units`` for :func:`simulated_trajectory`. Every family has ``m.input_units`` and
 ``m.output_units``: the SI unit of each input and output column (tuples, one per channel).
 
-``data`` is a Trajectory (columns by name, units converted, a linear model's offsets removed
-and added back) or arrays: a linear model's deviations from its offsets (``u − u_offset``,
-``y − y_offset``); a nonlinear model's record values (NLSS's ``u_offset``/``y_offset`` normalise
-internally). So ``sysid.compare(m, u, y)`` is ``m.compare(u, y)`` for every family, and equals
-``m.compare(trajectory)`` on arrays of that convention. ``x0`` where the family has an initial
-state: a linear model's state, NARX's first ``max_lag`` outputs, NLSS's x(0), the Bouc-Wen
+``data`` is a Trajectory (columns by name, units converted) or arrays, for every family the
+record's values in the units of the data the model was fitted on: a linear model removes its
+offsets (``u_offset``, ``y_offset``, the operating point ``identify`` detrended; zero for a model
+fitted on arrays) from either and adds them back to its outputs (NLSS's ``u_offset``/``y_offset``
+normalise internally). So ``sysid.compare(m, u, y)`` is ``m.compare(u, y)`` for every family, and
+equals ``m.compare(trajectory)`` on that trajectory's columns. ``x0`` where the family has an
+initial state: a linear model's state, NARX's first ``max_lag`` outputs, NLSS's x(0), the Bouc-Wen
 oscillator's (x, ẋ, z); Hammerstein–Wiener (the steady state of its initial input), Bouc-Wen
 (h = 0) and Prandtl–Ishlinskii (relaxed plays) refuse a given ``x0`` with an ArgumentError
 saying what their free run starts from.
@@ -132,11 +135,15 @@ class ModelFit:
 @runtime_checkable
 class IdentifiedModel(Protocol):
     """What every identified model offers, linear and nonlinear (see the module docstring; a
-    nonlinear model's ``to_*`` raise a ModelError). Arrays: a linear model's deviations from
-    its offsets; a nonlinear model's record values."""
+    nonlinear model's ``to_*`` raise a ModelError). Arrays: the record's values, in the units of
+    the data the model was fitted on (a linear model applies its offsets to them)."""
 
     structure: str
     fit_definition: str
+    fit_percent_definition: str
+
+    @property
+    def simulation_fit_percent(self) -> list | None: ...
 
     @property
     def inputs(self) -> tuple[str, ...]: ...
@@ -206,18 +213,13 @@ class ReportMixin:
         MODEL DATA --out DIR`` writes, its fit ``self.compare(data)``. ``data``: a
         :class:`~gripkit.signals.Trajectory` with the model's columns, or the arrays ``compare``
         takes (``u`` and ``y``, a pair ``(u, y)``, or the columns side by side) sampled every
-        ``dt`` (default the model's; a linear model's arrays in deviation units);
+        ``dt`` (default the model's), in the units of the data the model was fitted on;
         ``data_name``: how the page names the record; ``warnings_list``: lines raised before,
         listed on the page. The warnings raised on the way are emitted as well."""
         record = report_record(self, data, y, dt)
         module, writer = MODEL_REPORTS[self._report_page]
         write = getattr(importlib.import_module(f"{__package__}.{module}"), writer)
         return write(self, record, out, data_name=data_name, warnings_list=warnings_list)
-
-    def _record_offsets(self) -> tuple:
-        """The levels (inputs, outputs) that arrays given to :meth:`report` are deviations from
-        (none here; a linear model's offsets)."""
-        return 0.0, 0.0
 
 
 def _matrix(x, what: str, width: int, n: int | None = None) -> np.ndarray:
@@ -234,8 +236,8 @@ def _matrix(x, what: str, width: int, n: int | None = None) -> np.ndarray:
 def report_record(model, data, y=None, dt: float | None = None) -> Trajectory:
     """``data`` as the trajectory a report is written on: a Trajectory as it is; arrays (``u``
     and ``y``, a pair ``(u, y)``, or one array with the input then the output columns) as a
-    trajectory of the model's columns sampled every ``dt`` (default ``model.dt``), the model's
-    offsets (:meth:`ReportMixin._record_offsets`) added back."""
+    trajectory of the model's columns sampled every ``dt`` (default ``model.dt``), their values
+    as they are (the record's, as :meth:`compare` takes them)."""
     if isinstance(data, Trajectory):
         return data
     m, p = len(model.inputs), len(model.outputs)
@@ -254,10 +256,8 @@ def report_record(model, data, y=None, dt: float | None = None) -> Trajectory:
     if step is None:
         raise ArgumentError("report: the model is continuous and the arrays carry no sample time",
                             hint="give dt=… (s), or a trajectory")
-    uo, yo = (np.broadcast_to(np.asarray(o, dtype=np.float64).ravel(), (k,))
-              for o, k in zip(model._record_offsets(), (m, p)))
-    cols = {n: u[:, i] + uo[i] for i, n in enumerate(model.inputs)}
-    cols |= {n: yy[:, i] + yo[i] for i, n in enumerate(model.outputs)}
+    cols = {n: u[:, i] for i, n in enumerate(model.inputs)}
+    cols |= {n: yy[:, i] for i, n in enumerate(model.outputs)}
     return Trajectory(np.arange(u.shape[0]) * float(step), cols, None, {"dt": float(step)})
 
 

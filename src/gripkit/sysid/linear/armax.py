@@ -25,9 +25,9 @@ from ._pem import covariance, is_stable_poly, levenberg_marquardt, stabilize
 from ..scaling import in_user_units, unit_scale
 from .arx import (_arx, arx, arx_records, check_record_lengths, checked_records, records_summary,
                   scaled_records)
-from ..checks import (check_channels_vary, check_dt, check_identifiable, check_order,
-                      check_persistent_excitation, checked_problem, channel_of,
-                      require_samples)
+from ..checks import (channel_of, check_channels_vary, check_dt, check_identifiable, check_order,
+                      check_persistent_excitation, checked_problem, require_samples,
+                      warn_if_operating_point)
 from .polynomial import PolynomialModel, check_meta
 from ..regression import qr_solve
 from .validation import fit_percent, loss_vn
@@ -99,9 +99,11 @@ def armax(u, y, na: int, nb: int, nc: int, nk: int = 1, *, dt: float | None = No
     check_channels_vary(u, y, meta)  # named in the user's units, before any scaling
     if nc == 0:
         return arx(u, y, na, nb, nk, dt=step, **meta)
+    warn_if_operating_point(u, y, na, nb, nk, f"armax [{na} {nb} {nc} {nk}]")
     cu, cy = unit_scale(u), unit_scale(y)
-    return in_user_units(_armax(u * cu, y * cy, na, nb, nc, nk, step, maxiter, tol, meta,
-                                progress), cu, cy)
+    model = in_user_units(_armax(u * cu, y * cy, na, nb, nc, nk, step, maxiter, tol, meta,
+                                 progress), cu, cy)
+    return model.replace(estimation_data=(u, y))  # its simulation_fit_percent, on demand
 
 
 def _armax(u, y, na, nb, nc, nk, step, maxiter, tol, meta, progress=False) -> PolynomialModel:

@@ -23,9 +23,9 @@ import numpy as np
 from ...errors import DataError
 from ..scaling import in_user_units, unit_scale
 from .arx_mimo import arx_mimo
-from ..checks import (check_channels_vary, check_dt, check_excitation, check_identifiable,
-                      check_io, check_order, check_output_varies, checked_problem_peaks,
-                      require_samples)
+from ..checks import (check_channels_vary, check_dt, check_excitation, check_identifiable, check_io,
+                      check_order, check_output_varies, checked_problem_peaks, require_samples,
+                      warn_if_operating_point)
 from .polynomial import PolynomialModel, channel_meta
 from ..regression import (COND_NOTABLE, NUMPY_QR_MAX_ELEMENTS, QRSolution, arx_regression,
                           arx_start, qr_solve, solve_upper, triangular_solve,
@@ -98,6 +98,7 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
     # one min and max per signal (the finiteness check's) serve the excitation checks and scaling
     u, y, step, na, nb, nk, (pu, py) = checked_problem_peaks(u, y, dt, na=na, nb=nb, nk=nk)
     check_channels_vary(u, y, meta, (pu, py))  # named in the user's units, before any scaling
+    warn_if_operating_point(u, y, na, nb, nk, f"arx [{na} {nb} {nk}]", (pu, py))
     cu, cy = unit_scale(u, pu), unit_scale(y, py)
     if max(abs(math.log2(cu)), abs(math.log2(cy))) <= _NO_SCALING_WITHIN:
         # scaling by powers of two is exact: skip the two copies where it changes nothing
@@ -166,7 +167,7 @@ def _arx(u: np.ndarray, y: np.ndarray, na: int, nb: int, nk: int, step: float, *
     return build(A, B, nk, dt=step, structure="arx", n_samples=int(y.size),
                  covariance=sigma2 * sol.cov_unscaled, noise_variance=sigma2, loss=0.5 * see / m,
                  fit_percent=fit, n_used=m, estimation_residuals=e,
-                 estimation_data=record if e is None else None,
+                 estimation_data=record,  # also the source of simulation_fit_percent
                  info={"method": method, "cond": sol.cond}, **meta)
 
 

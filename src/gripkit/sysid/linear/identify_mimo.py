@@ -28,7 +28,9 @@ from ...progress import status, track
 from ...signals.trajectory import Trajectory
 from .arx_mimo import arx_mimo
 from .frf import frf
+from .linear_model import deviation_compare
 from .ss_bootstrap import BOOTSTRAP_SEED, MIN_REPLICATES, bootstrap_covariance
+from ..checks import STEP_CHANGES, step_like
 from ..io_data import IOData, parse_names, validation_data
 
 __all__ = ["mimo_data", "identify_ss", "identify_frf", "identify_tf", "identify_arx", "several",
@@ -66,7 +68,7 @@ def mimo_data(data: Trajectory, inputs, outputs, detrend: str = "mean",
 def _validation_fit(model, vd: IOData) -> list[float] | None:
     if not model.stable:
         return None
-    return model.compare(vd.u, vd.y, dt=vd.dt).fit_percent
+    return deviation_compare(model, vd.u, vd.y, vd.dt).fit_percent
 
 
 def _aic(model, d: IOData) -> float:
@@ -337,7 +339,7 @@ def focus_score(model, focus: str, d: IOData) -> float:
     if focus == "simulation":
         if not model.stable:
             return -math.inf
-        return float(np.mean(model.compare(d.u, d.y, dt=d.dt).fit_percent))
+        return float(np.mean(deviation_compare(model, d.u, d.y, d.dt).fit_percent))
     from .pem_ss import predictor_x0
 
     ss = model.system
@@ -473,25 +475,6 @@ def _warn_if_detrending_hurt(model, refit, n: int, dt: float, command: str,
            f"{command}: removing the means (detrend 'mean', the default) hurt this fit: {why}; "
            f"free-run fit {mean_fit:.4g} % with the means removed, {none_fit:.4g} % {without}; "
            f"use --detrend none (Python: detrend='none')", AccuracyWarning)
-
-
-#: level changes an input column may make and still count as a step (a step, a few held steps)
-STEP_CHANGES = 4
-
-
-def step_like(u) -> bool:
-    """Whether every column of the input ``u`` ((N,) or (N, m); as recorded or with its mean
-    removed: a shift changes neither its span nor its steps) is piecewise
-    constant with at most :data:`STEP_CHANGES` level changes, and one column at least changes: a
-    step record. Its mean is no operating point: the record sits at one level, then at another,
-    never at the mean, so with the means removed a record that starts at rest starts away from
-    rest (a measured, noisy step is not detected)."""
-    u = np.asarray(u, dtype=np.float64).reshape(len(u), -1)
-    span = np.ptp(u, axis=0)
-    if not u.shape[0] or not np.any(span > 0):
-        return False
-    changes = np.count_nonzero(np.abs(np.diff(u, axis=0)) > 1e-9 * span, axis=0)
-    return bool(np.all(changes <= STEP_CHANGES))
 
 
 def keep_better_without_detrending(model, refit, command: str, score):

@@ -5,9 +5,11 @@ Discrete innovation form (the subspace and PEM models)::
 
     x[t+1] = A x[t] + B u[t] + K e[t],   y[t] = C x[t] + D u[t] + e[t],   e white, cov Λ.
 
-``K = 0`` is the output-error form. Arrays are in deviation units; a
-:class:`~gripkit.signals.Trajectory` is read by column name, the model's ``u_offset`` and
-``y_offset`` (one per input and output, the operating point removed before fitting) applied.
+``K = 0`` is the output-error form. A :class:`~gripkit.signals.Trajectory` is read by column
+name; arrays are in the units of the data the model was fitted on. Either way the model's
+``u_offset`` and ``y_offset`` (one per input and output, the operating point removed before
+fitting; zero for a model fitted on arrays) are removed from the data and added back to outputs,
+so ``m.compare(u, y)`` on a record's columns is ``m.compare(record)``.
 
 The identified linear models form one small hierarchy on the protocol of
 :mod:`gripkit.sysid.model_protocol`: :class:`IdentifiedLinearModel` holds every protocol method
@@ -43,9 +45,9 @@ from ..model_protocol import (ModelFit, ReportMixin, check_horizon, check_sample
                               column_in_unit)
 from .validation import validate
 
-__all__ = ["VALIDATION_FIT", "IdentifiedLinearModel", "LinearModel", "as_io_matrix", "estimate_x0",
-           "free_run", "fit_per_output", "k_step_prediction", "model_document",
-           "polynomial_document", "read_linear_model", "x0_residual"]
+__all__ = ["VALIDATION_FIT", "IdentifiedLinearModel", "LinearModel", "as_io_matrix",
+           "deviation_compare", "estimate_x0", "free_run", "fit_per_output", "k_step_prediction",
+           "model_document", "polynomial_document", "read_linear_model", "x0_residual"]
 
 
 def _sim(A, B, C, D, u, x0):
@@ -214,18 +216,45 @@ def k_step_prediction(A, B, C, D, K, u, y, horizon: int) -> np.ndarray:
     return out
 
 
+def deviation_compare(model, u, y, dt, y_offset=0.0) -> ModelFit:
+    """The validation fit (:data:`VALIDATION_FIT`) of the identified linear ``model`` on the
+    deviations ``u`` (N, m), ``y`` (N, p) from its offsets (what the estimators and the order
+    searches hold), its simulated output plus ``y_offset``; :meth:`IdentifiedLinearModel.compare`
+    on the record's values removes the offsets and calls this."""
+    ss = model.to_ss(dt)
+    if not ss.stable:
+        ys = free_run(ss.A, ss.B, ss.C, ss.D, u)
+        fit = [None] * ss.n_outputs
+    else:
+        x0 = estimate_x0(ss.A, ss.B, ss.C, ss.D, u, y)
+        ys = free_run(ss.A, ss.B, ss.C, ss.D, u, x0)
+        fit = fit_per_output(y, ys)
+    return ModelFit(tuple(model.outputs), fit, ys + y_offset, model.fit_definition)
+
+
 class IdentifiedLinearModel(ReportMixin):
     """The protocol of every identified linear model (:mod:`gripkit.sysid.model_protocol`),
     written once on what a subclass holds: ``system`` (a :mod:`gripkit.lti` system with names,
     units, dt and parameter covariance), ``structure``, ``dt``, ``u_offset`` and ``y_offset``.
 
     ``data`` is a :class:`~gripkit.signals.Trajectory` (columns by name, converted to the
-    model's units, the model's offsets removed and added back: results in the data's units) or
-    arrays in deviation units (``u`` (N, m) and, where needed, ``y`` (N, p)). Frequencies are in
-    rad/s (:meth:`gripkit.lti.LinearSystem.frequency_response`)."""
+    model's units) or arrays in the units of the data the model was fitted on (``u`` (N, m)
+    and, where needed, ``y`` (N, p)); either way the model's offsets are removed and added back:
+    results in the data's units. Frequencies are in rad/s
+    (:meth:`gripkit.lti.LinearSystem.frequency_response`)."""
 
     #: how :meth:`compare` scores a model, and how it starts the free run
     fit_definition = VALIDATION_FIT
+    #: what the model's own ``fit_percent`` is: here the fit of :meth:`compare` on the
+    #: estimation data (ARX and ARMAX: the one-step prediction fit, see PolynomialModel)
+    fit_percent_definition = f"{VALIDATION_FIT}, on the estimation data"
+
+    @property
+    def simulation_fit_percent(self) -> list | None:
+        """The free-run fit (:data:`VALIDATION_FIT`, what :meth:`compare` gives) on the
+        estimation data, a list per output: the figure to rank models of every family by. A
+        state-space or transfer-function model's ``fit_percent`` is it."""
+        return self.fit_percent
     initial_state = "estimated"
     #: its HTML report: poles, Bode with σ, innovation residuals (gripkit.sysid.model_report)
     _report_page = "linear"
@@ -261,8 +290,6 @@ class IdentifiedLinearModel(ReportMixin):
     def _offsets(self) -> tuple[np.ndarray, np.ndarray]:
         return (np.atleast_1d(np.asarray(self.u_offset, dtype=np.float64)),
                 np.atleast_1d(np.asarray(self.y_offset, dtype=np.float64)))
-
-    _record_offsets = _offsets  # arrays given to report() are deviations from the offsets
 
     def with_display_units(self, data) -> IdentifiedLinearModel:
         """This model with the display units of its inputs and outputs taken from the trajectory
@@ -316,8 +343,9 @@ class IdentifiedLinearModel(ReportMixin):
                                 for n, u, o in zip(names, units, offsets)])
 
     def _io(self, data, y, why: str, outputs: bool = True, dt: float | None = None):
-        """``(u, y, dt, y_offset)``: deviation arrays of a trajectory (y_offset to add back) or
-        of the arrays given (y_offset None)."""
+        """``(u, y, dt, y_offset)``: the deviations from the model's offsets of a trajectory's
+        columns or of the arrays given (in the units of the data the model was fitted on), and
+        the y_offset to add back."""
         uo, yo = self._offsets()
         if isinstance(data, Trajectory):
             dt = data.require_uniform(why=why)
@@ -325,6 +353,8 @@ class IdentifiedLinearModel(ReportMixin):
             yy = self._columns(data, self.outputs, yo, "output") if outputs else None
             return u, yy, dt, yo
         u = as_io_matrix(data, "u")
+        if u.shape[1] == uo.size:  # a wrong column count: the caller's DataError, not numpy's
+            u = u - uo
         dt = dt or self.dt
         if dt is None:
             raise ArgumentError(f"{why}: the model is continuous and the arrays carry no sample "
@@ -334,7 +364,8 @@ class IdentifiedLinearModel(ReportMixin):
                 raise ArgumentError(f"{why}: give a trajectory, or the arrays u and y",
                                     hint="model.compare(data) or model.compare(u, y)")
             y = as_io_matrix(y, "y", u.shape[0])
-        return u, y, dt, None
+            y = y - yo if y.shape[1] == yo.size else y
+        return u, y, dt, yo
 
     def _state_space(self, dt):
         """(A, B, C, D, K) of the model's innovation form at ``dt`` (K = 0: output error)."""
@@ -346,8 +377,8 @@ class IdentifiedLinearModel(ReportMixin):
     # ------------------------------------------------------------------ the protocol
     def simulate(self, data, x0=None, dt: float | None = None) -> np.ndarray:
         """Free run (N, p) from ``x0`` (default: rest) on the inputs of ``data``: a trajectory
-        (offsets applied, result in its units) or deviation inputs ``u`` (N, m) sampled every
-        ``dt`` (default the model's)."""
+        or the inputs ``u`` (N, m) sampled every ``dt`` (default the model's); offsets applied,
+        the result in the data's units (from rest: from the model's operating point)."""
         u, _, step, yo = self._io(data, None, "simulation of an identified model", False, dt)
         ss = self.to_ss(step)
         if u.shape[1] != ss.n_inputs:
@@ -357,23 +388,14 @@ class IdentifiedLinearModel(ReportMixin):
 
     def compare(self, data, y=None, dt: float | None = None) -> ModelFit:
         """The validation fit (:data:`VALIDATION_FIT`) per output on a trajectory, or on
-        deviation arrays ``u``, ``y``: free run from the initial state estimated by least squares.
-        ``fit_percent`` is None per output for an unstable model (its free run, from rest, is
-        ``simulated``)."""
+        the arrays ``u``, ``y`` (offsets applied as to a trajectory): free run from the initial
+        state estimated by least squares. ``fit_percent`` is None per output for an unstable
+        model (its free run, from rest, is ``simulated``)."""
         u, yy, dt, yo = self._io(data, y, "comparison of an identified model", dt=dt)
-        ss = self.to_ss(dt)
-        if not ss.stable:
-            ys = free_run(ss.A, ss.B, ss.C, ss.D, u)
-            fit = [None] * ss.n_outputs
-        else:
-            x0 = estimate_x0(ss.A, ss.B, ss.C, ss.D, u, yy)
-            ys = free_run(ss.A, ss.B, ss.C, ss.D, u, x0)
-            fit = fit_per_output(yy, ys)
-        return ModelFit(tuple(self.outputs), fit, ys if yo is None else ys + yo,
-                        self.fit_definition)
+        return deviation_compare(self, u, yy, dt, yo)
 
     def predict(self, data, y=None, horizon: int = 1, dt: float | None = None) -> np.ndarray:
-        """``ŷ(t | t − horizon)`` (N, p) on a trajectory or deviation arrays ``u``, ``y``: the
+        """``ŷ(t | t − horizon)`` (N, p) on a trajectory or the arrays ``u``, ``y``: the
         model's predictor (innovation gain K; without K the prediction is the free run) from
         the initial state estimated by least squares (:func:`k_step_prediction`)."""
         h = check_horizon(horizon)
@@ -386,15 +408,16 @@ class IdentifiedLinearModel(ReportMixin):
 
     def residuals(self, data, y=None, dt: float | None = None) -> np.ndarray:
         """One-step prediction errors ``y − ŷ(t | t − 1)`` (N, p) on a trajectory or on
-        deviation arrays ``u``, ``y`` (:meth:`predict`)."""
+        the arrays ``u``, ``y`` (:meth:`predict`)."""
         u, yy, dt, _ = self._io(data, y, "residuals of an identified model", dt=dt)
         return yy - k_step_prediction(*self._state_space(dt), u, yy, 1)
 
-    def validate(self, u, y, **kw):
-        """Free-run and one-step validation of a one-input, one-output model on the deviation
-        arrays ``u``, ``y`` of a separate record: :func:`gripkit.sysid.validate` (several
-        channels: :meth:`compare` and :meth:`residuals`)."""
-        return validate(self, u, y, **kw)
+    def validate(self, data, y=None, **kw):
+        """Free-run and one-step validation of a one-input, one-output model on a separate
+        record, a trajectory or the arrays ``u``, ``y`` (the model's offsets applied to either):
+        :func:`gripkit.sysid.validate` (several channels: :meth:`compare` and
+        :meth:`residuals`)."""
+        return validate(self, data, y, **kw)
 
     @property
     def parameters(self) -> ParameterSet:

@@ -26,9 +26,9 @@ from ._pem import covariance, is_stable_poly, levenberg_marquardt, stabilize
 from ..scaling import in_user_units, unit_scale
 from .arx import (_arx, arx_records, check_record_lengths, checked_records, records_summary,
                   scaled_records)
-from ..checks import (check_channels_vary, check_dt, check_identifiable, check_order,
-                      check_persistent_excitation, checked_problem, channel_of,
-                      require_samples)
+from ..checks import (channel_of, check_channels_vary, check_dt, check_identifiable, check_order,
+                      check_persistent_excitation, checked_problem, require_samples,
+                      warn_if_operating_point)
 from .polynomial import PolynomialModel, check_meta
 from .validation import fit_percent, loss_vn
 
@@ -72,9 +72,11 @@ def oe(u, y, nb: int, nf: int, nk: int = 1, *, dt: float | None = None,
     check_meta(meta, oe)
     u, y, step, nb, nf, nk = checked_problem(u, y, dt, nb=nb, nf=nf, nk=nk)
     check_channels_vary(u, y, meta)  # named in the user's units, before any scaling
+    warn_if_operating_point(u, y, nf, nb, nk, f"oe [{nb} {nf} {nk}]")  # as ARX, na = nf
     cu, cy = unit_scale(u), unit_scale(y)
-    return in_user_units(_oe(u * cu, y * cy, nb, nf, nk, step, maxiter, tol, meta, progress),
-                         cu, cy)
+    model = in_user_units(_oe(u * cu, y * cy, nb, nf, nk, step, maxiter, tol, meta, progress),
+                          cu, cy)
+    return model.replace(estimation_data=(u, y))  # its simulation_fit_percent, on demand
 
 
 def _oe(u, y, nb, nf, nk, step, maxiter, tol, meta, progress=False) -> PolynomialModel:

@@ -50,8 +50,8 @@ from ...signals.trajectory import Trajectory
 from ...units import ratio_unit
 from . import matrix_polynomial as mp
 from .linear_model import (IdentifiedLinearModel, LinearModel, _checked_display_units,
-                           as_io_matrix, k_step_prediction, malformed, polynomial_document,
-                           read_linear_model)
+                           as_io_matrix, deviation_compare, k_step_prediction, malformed,
+                           polynomial_document, read_linear_model)
 from ..model_protocol import check_horizon, check_sample_time
 from .validation import validate
 
@@ -147,7 +147,10 @@ class PolynomialModel(IdentifiedLinearModel):
     loss
         V_N of eq (29): ``(1/M) Σ ½ e²(t)`` over the M one-step prediction errors.
     fit_percent
-        One-step-ahead prediction fit on the estimation data, ``100 (1 − ‖y − ŷ‖/‖y − ȳ‖)``.
+        One-step-ahead prediction fit on the estimation data, ``100 (1 − ‖y − ŷ‖/‖y − ȳ‖)``
+        (``fit_percent_definition`` says so; also ``prediction_fit_percent``). Not the free-run
+        fit of :meth:`compare` that a state-space, transfer-function or NARX model's
+        ``fit_percent`` is: compare families by ``simulation_fit_percent``.
     n_samples
         Samples in the estimation record (N); ``n_used`` = M = N − start prediction errors.
     estimation_residuals
@@ -155,8 +158,10 @@ class PolynomialModel(IdentifiedLinearModel):
         :func:`gripkit.sysid.linear.arx` computes them on first access from ``estimation_data``.
         (``residuals(data)`` computes them on any record.) Not written to the model file.
     estimation_data
-        ``(u, y)``, references to the record the model was fitted on (no copy), or None: the
-        source of ``estimation_residuals`` when the estimator did not keep them. Changing those
+        ``(u, y)``, references to the record the model was fitted on (no copy; ``arx``,
+        ``armax`` and ``oe`` of one record keep it), or None: the source of
+        ``estimation_residuals`` when the estimator did not keep them, and of
+        ``simulation_fit_percent``. Changing those
         arrays in place after the fit makes ``estimation_residuals`` raise a DataError. Not
         written to the model file.
     input_name, output_name, input_unit, output_unit
@@ -531,6 +536,39 @@ class PolynomialModel(IdentifiedLinearModel):
                                     std=None if std is None else float(std[k])))
         return ParameterSet(params, name=self.label)
 
+    # ------------------------------------------------------------------ fits
+    @property
+    def fit_percent_definition(self) -> str:
+        """What ``fit_percent`` is: ARX and ARMAX, the one-step-ahead prediction fit on the
+        estimation data (not the free run of :meth:`compare`: that is
+        ``simulation_fit_percent``); OE, whose noise model is white, the fit of its one-step
+        predictor, the free run from the estimated initial conditions."""
+        which = ("its one-step-ahead predictor, the free run B/F u from the estimated initial "
+                 "conditions" if self.structure == "oe" else "one-step-ahead prediction ŷ(t|t−1)")
+        return (f"{which} on the estimation data, fit = 100 (1 − ‖y − ŷ‖/‖y − ȳ‖) over samples "
+                f"start … N−1 (the free run of compare: simulation_fit_percent)")
+
+    @property
+    def prediction_fit_percent(self):
+        """The one-step-ahead prediction fit on the estimation data: ``fit_percent`` (a number,
+        a list per output with several outputs)."""
+        return self.fit_percent
+
+    @functools.cached_property
+    def simulation_fit_percent(self) -> list | None:
+        """The free-run fit of :meth:`compare` (:data:`~.linear_model.VALIDATION_FIT`) on the
+        estimation data, a list per output, as every linear family's (and the figure to rank
+        ARX against OE, state space or NARX by); None where the model holds no estimation record
+        (one read from a file with one output, or a fit of several records), [None] for an
+        unstable model. Computed on first access (the free-run kernel is numba's)."""
+        if self.multivariable:
+            return self.info.get("free_run_fit_percent")
+        rec = self.estimation_data
+        if not isinstance(rec, tuple) or len(rec) != 2:
+            return None
+        u, y = (np.asarray(x, dtype=np.float64).reshape(-1, 1) for x in rec)
+        return deviation_compare(self, u, y, self.dt).fit_percent
+
     # ------------------------------------------------------------------ criteria
     @property
     def start(self) -> int:
@@ -692,43 +730,51 @@ class PolynomialModel(IdentifiedLinearModel):
     # ------------------------------------------------------------------ simulation and prediction
     def simulate(self, data, x0=None, *, initial: str = "rest", y_past=None,
                  u_past=None) -> np.ndarray:
-        """Free-run output ``ŷ = B/(A F) u`` (no noise): of a trajectory, (N, 1) in its units
-        (:meth:`IdentifiedLinearModel.simulate`); of deviation inputs ``u``, shape (N,)
-        (:meth:`gripkit.lti.TransferFunction.simulate`).
+        """Free-run output ``ŷ = B/(A F) u`` (no noise) plus ``y_offset``: of a trajectory,
+        (N, 1) in its units (:meth:`IdentifiedLinearModel.simulate`); of the inputs ``u``,
+        shape (N,) (:meth:`gripkit.lti.TransferFunction.simulate` of ``u − u_offset``).
 
         Parameters
         ----------
         data
-            A trajectory, or the input samples u(0) … u(N−1) as deviations ``u − u_offset``,
-            shape (N,).
+            A trajectory, or the input samples u(0) … u(N−1) in the units of the data the
+            model was fitted on (the model's ``u_offset`` is removed), shape (N,).
         x0
             Initial state of :attr:`system` (default rest); or ``initial='given'``.
         initial
             ``'rest'``: zero past inputs and outputs (say so explicitly: gripkit never assumes
             it silently in validation). ``'given'``: use ``y_past`` and ``u_past``.
         y_past, u_past
-            The samples before u(0), in time order (most recent last); at least
-            ``len(A F) − 1`` outputs and ``len(B) − 1`` inputs are used (missing ones count 0).
+            The samples before u(0), in time order (most recent last), in the units of ``u``
+            and of the output; at least ``len(A F) − 1`` outputs and ``len(B) − 1`` inputs are
+            used (missing ones count as the operating point).
         """
         if isinstance(data, Trajectory) or self.multivariable:
             if initial != "rest":
-                raise DataError("initial='given' takes deviation arrays of one input and one "
+                raise DataError("initial='given' takes the arrays of one input and one "
                                 "output, not a trajectory or several columns")
             return super().simulate(data, x0)
-        u = data
-        if initial == "rest":
-            if y_past is not None or u_past is not None:
-                raise DataError("initial='rest' takes no y_past/u_past; use initial='given'")
-            return self.system.simulate(u, x0)[:, 0]
-        if initial != "given":
+        if initial == "rest" and (y_past is not None or u_past is not None):
+            raise DataError("initial='rest' takes no y_past/u_past; use initial='given'")
+        if initial not in ("rest", "given"):
             raise DataError(f"initial: expected 'rest' or 'given', found {initial!r}")
+        uo, yo = self.u_offset, self.y_offset
+        u = as_io_matrix(data, "u") - uo
+        if initial == "rest":
+            return self.system.simulate(u, x0)[:, 0] + yo
+        past = [np.zeros(0) if p is None else np.asarray(p, dtype=np.float64) - o
+                for p, o in ((u_past, uo), (y_past, yo))]
+        return self._run_from_past(u, *past) + yo
+
+    def _run_from_past(self, u, u_past, y_past) -> np.ndarray:
+        """The free run (N,) on the deviations ``u`` from the model's operating point, from the
+        state that the deviation pasts ``u_past``, ``y_past`` give."""
         g = self.system
-        x0 = (g.initial_state(np.zeros(0) if u_past is None else u_past,
-                              np.zeros(0) if y_past is None else y_past))
-        return g.simulate(u, x0)[:, 0]
+        return g.simulate(u, g.initial_state(u_past, y_past))[:, 0]
 
     def prediction_errors(self, u, y) -> np.ndarray:
-        """One-step prediction errors e(t), t = ``start`` … N−1 (``u``, ``y`` in deviation units).
+        """One-step prediction errors e(t), t = ``start`` … N−1 (``u``, ``y`` the deviations from
+        the model's offsets; :meth:`residuals` takes the record's values).
 
         ARX/ARMAX: ``C(q) e(t) = A(q) y(t) − B(q) u(t)`` with e(t) = 0 before ``start``.
         OE: ``e = y − B/F u`` with the filter's past outputs taken from the measured y.
@@ -750,7 +796,7 @@ class PolynomialModel(IdentifiedLinearModel):
             raise DataError(f"one-step prediction with {self.label} needs more than {t0} "
                             f"samples, found {y.size}")
         if self.structure == "oe":
-            return y[t0:] - self.simulate(u[t0:], initial="given", y_past=y[:t0], u_past=u[:t0])
+            return y[t0:] - self._run_from_past(u[t0:], u[:t0], y[:t0])
         # the FIR parts by np.convolve: scipy.signal's import is 0.9 s of a fresh ARX process
         v = np.convolve(y, self.A)[t0:y.size] - np.convolve(u, self.B)[t0:u.size]
         if not self.nc:
@@ -760,16 +806,18 @@ class PolynomialModel(IdentifiedLinearModel):
         return _sig.lfilter([1.0], self.C, v)
 
     def predict(self, data, y=None, horizon: int = 1) -> np.ndarray:
-        """``ŷ(t | t − horizon)``: of a trajectory (N, 1) in its units, of deviation arrays
-        ``u``, ``y`` shape (N,). ``horizon = 1``: the exact one-step predictor of the
-        polynomials, the first ``start`` samples being the record's own values (the predictor's
-        initial conditions); ``horizon > 1``: :func:`~.linear_model.k_step_prediction` on
-        :meth:`innovation_form`."""
+        """``ŷ(t | t − horizon)``: of a trajectory (N, 1) in its units, of the arrays ``u``,
+        ``y`` (offsets applied, as to a trajectory) shape (N,). ``horizon = 1``: the exact
+        one-step predictor of the polynomials, the first ``start`` samples being the record's
+        own values (the predictor's initial conditions); ``horizon > 1``:
+        :func:`~.linear_model.k_step_prediction` on :meth:`innovation_form`."""
         if isinstance(data, Trajectory) or self.multivariable:
             return super().predict(data, y, horizon=horizon)
-        u, y = np.asarray(data, dtype=np.float64), np.asarray(y, dtype=np.float64)
+        u = np.asarray(data, dtype=np.float64) - self.u_offset
+        y = np.asarray(y, dtype=np.float64) - self.y_offset
         h = check_horizon(horizon)
-        return self._prediction(u.reshape(-1, 1), y.reshape(-1, 1), self.dt, h)[:, 0]
+        return self._prediction(u.reshape(-1, 1), y.reshape(-1, 1), self.dt, h)[:, 0] \
+            + self.y_offset
 
     def _prediction(self, u, y, dt, horizon: int) -> np.ndarray:
         if horizon > 1:
@@ -784,13 +832,13 @@ class PolynomialModel(IdentifiedLinearModel):
 
     def residuals(self, data, y=None) -> np.ndarray:
         """One-step prediction errors :meth:`prediction_errors` from sample ``start`` on: of a
-        trajectory (N − start, 1), of deviation arrays ``u``, ``y`` shape (N − start,)."""
-        if isinstance(data, Trajectory):
-            u, yy, _, _ = self._io(data, None, "residuals of an identified model")
-            if self.multivariable:
-                return self.prediction_errors(u, yy)
-            return self.prediction_errors(u[:, 0], yy[:, 0]).reshape(-1, 1)
-        return self.prediction_errors(data, y)
+        trajectory (N − start, 1), of the arrays ``u``, ``y`` (offsets applied, as to a
+        trajectory) shape (N − start,), (N − start, p) with several outputs."""
+        u, yy, _, _ = self._io(data, y, "residuals of an identified model")
+        if self.multivariable:
+            return self.prediction_errors(u, yy)
+        e = self.prediction_errors(u[:, 0], yy[:, 0])
+        return e.reshape(-1, 1) if isinstance(data, Trajectory) else e
 
     def innovation_form(self) -> tuple[np.ndarray, ...]:
         """``(A, B, C, D, K)`` of ``y = B/(A F) u + C/A e`` in innovation form,
@@ -816,15 +864,15 @@ class PolynomialModel(IdentifiedLinearModel):
             check_sample_time(dt, self.dt)
         return self.innovation_form()
 
-    def validate(self, u, y, **kw):
-        """Free-run and one-step validation on a separate record; see
-        :func:`gripkit.sysid.validate` (one input and one output; a MIMO model: :meth:`compare`
-        and :meth:`residuals`)."""
+    def validate(self, data, y=None, **kw):
+        """Free-run and one-step validation on a separate record, a trajectory or the arrays
+        ``u``, ``y``; see :func:`gripkit.sysid.validate` (one input and one output; a MIMO
+        model: :meth:`compare` and :meth:`residuals`)."""
         if self.multivariable:
             raise ModelError(f"validate: {self.label} has {self.n_inputs} inputs and "
                              f"{self.n_outputs} outputs; validate takes one of each",
                              hint="use model.compare(data) and model.residuals(data)")
-        return validate(self, u, y, **kw)
+        return validate(self, data, y, **kw)
 
     # ------------------------------------------------------------------ exports
     def to_scipy(self):
@@ -964,7 +1012,8 @@ class PolynomialModel(IdentifiedLinearModel):
             d.update(F=lst(self.F), F_std=lst(self.F_std))
         d.update(parameter_names=list(self.parameter_names), theta=lst(self.theta),
                  theta_std=lst(self.theta_std), loss=self.loss, fit_percent=self.fit_percent,
-                 aic=self.aic, fpe=self.fpe, noise_variance=self.noise_variance,
+                 fit_percent_definition=self.fit_percent_definition, aic=self.aic,
+                 fpe=self.fpe, noise_variance=self.noise_variance,
                  poles=pairs(self.poles()), zeros=pairs(self.zeros()),
                  minimum_phase=self.minimum_phase, stable=self.stable, dc_gain=self.dc_gain,
                  n_samples=self.n_samples, dt=self.dt,
@@ -1006,7 +1055,7 @@ class PolynomialModel(IdentifiedLinearModel):
                      for v, s in zip(arr, std if std is not None else np.zeros(arr.size))]
             lines.append(f"  {name} = [{', '.join(terms)}]")
         if self.loss is not None:
-            lines.append(f"  loss V_N = {self.loss:.5g}, fit = {self.fit_percent:.2f} %, "
+            lines.append(f"  loss V_N = {self.loss:.5g}, one-step fit = {self.fit_percent:.2f} %, "
                          f"AIC = {self.aic:.5g}, N = {self.n_samples}")
         fmt = lambda z: ", ".join(f"{v.real:.4g}{v.imag:+.4g}j" for v in z) or "none"  # noqa: E731
         lines.append(f"  poles: {fmt(self.poles())}")

@@ -42,7 +42,8 @@ import scipy.linalg as sla
 from ...errors import DataError, IdentificationError, StabilityWarning, emit_warning
 from ...lti import StateSpace
 from .blocked_gram import add_rows, carried_states, carry, row_product, start_sums
-from ..checks import check_dt, check_excitation, check_output_varies, io_records
+from ..checks import (check_dt, check_excitation, check_output_varies, io_records,
+                      warn_if_operating_point)
 from .linear_model import (LinearModel, as_io_matrix, fit_per_output, free_run,
                            observability_regressor)
 from ..regression import qr_r
@@ -475,6 +476,9 @@ def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int
     k = default_horizon(n_max, p) if horizon is None else int(horizon)
     fac = subspace_factor(u, y, horizon=k, method=method)
     n = order if order is not None else select_order(fac.s, min(n_max, fac.s.size - 1))
+    if u.shape[1] == y.shape[1] == 1 and n > 0:  # as ARX [n n nk] with a constant term
+        warn_if_operating_point(u[:, 0], y[:, 0], n, n, 0 if feedthrough else 1,
+                                f"{method} (order {n})")
     signals = (dict(inputs=inputs, outputs=outputs, input_units=input_units,
                     output_units=output_units))
     model = from_factor(fac, n, dt=step, feedthrough=feedthrough, stable=stable, signals=signals)

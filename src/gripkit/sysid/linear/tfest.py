@@ -34,7 +34,8 @@ from scipy import signal as _signal
 
 from ...errors import DataError, IdentificationError, ModelError
 from ...lti import StateSpace, TransferFunction
-from ..checks import check_dt, check_order, check_persistent_excitation, io_records
+from ..checks import (check_dt, check_order, check_persistent_excitation, io_records,
+                      warn_if_operating_point)
 from ..scaling import unit_scale
 from .frf import FRF, frf
 from .linear_model import (LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run,
@@ -311,6 +312,8 @@ def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None,
                         f"least {10 * k + 64})",
                         hint="use a longer record or fewer poles/zeros")
     check_persistent_excitation(u[:, 0], k, f"tfest ({npo} poles, {nz} zeros: {k} coefficients)")
+    if npo > 0:  # its zero-order-hold equivalent is an ARX [npo npo 1] with a constant term
+        warn_if_operating_point(u[:, 0], y[:, 0], npo, npo, 1, f"tfest ({npo} poles, {nz} zeros)")
     start = tfest_frf(frf(u, y, dt=step, nperseg=max(64, min(N // 4, 2048))), npo, nz, dt=step)
     th0 = (_stabilise(np.concatenate([start.system.denominator()[1:],
                                       start.system.numerator()[-(nz + 1):]]), npo))

@@ -27,8 +27,9 @@ import numpy as np
 
 from ...errors import ArgumentError, DataError, ModelError, StabilityWarning, emit_warning
 from ...lti import LinearSystem
+from ...signals.trajectory import Trajectory
 from ..checks import check_io
-from ..model_protocol import ModelFit, check_sample_time
+from ..model_protocol import ModelFit, check_sample_time, column_in_unit
 
 __all__ = ["fit_percent", "records_fit", "loss_vn", "compare", "ResidualTests", "residual_tests",
            "Validation", "validate"]
@@ -76,18 +77,28 @@ def _check_initial(initial: str) -> None:
                             hint="a free run from rest: fit_percent(y, model.simulate(u))")
 
 
-def compare(model, u, y, *, initial: str = "estimate", dt: float | None = None) -> ModelFit:
-    """The validation fit of any identified ``model`` on the arrays ``u``, ``y`` (``(N,)`` or
-    ``(N, m)``, ``(N, p)``): exactly ``model.compare(u, y)``, the fit by the model's
-    ``fit_definition`` (a linear model: ARX, ARMAX, OE, state space, transfer function, its free
-    run from the initial state estimated by least squares, every sample scored, the arrays
-    deviations from its offsets; a nonlinear model: NARX, Hammerstein–Wiener, nonlinear state
-    space, hysteresis, the arrays the record's values). Warns :class:`StabilityWarning` for an
-    unstable linear model, whose ``fit_percent`` is None per output. ``initial`` takes only
+def compare(model, u, y=None, *, initial: str = "estimate",
+            dt: float | None = None) -> ModelFit:
+    """The validation fit of any identified ``model`` on a :class:`~gripkit.signals.Trajectory`
+    ``u`` with its columns (``y`` and ``dt`` not given: the trajectory carries them), or on the
+    arrays ``u``, ``y`` (``(N,)`` or ``(N, m)``, ``(N, p)``, the record's values in the units
+    of the data the model was fitted on): exactly ``model.compare(u, y)``, the fit by the
+    model's ``fit_definition`` (a linear model: ARX, ARMAX, OE, state space, transfer function,
+    its free run from the initial state estimated by least squares, every sample scored, its
+    offsets removed from the arrays as from a trajectory; a nonlinear model: NARX,
+    Hammerstein–Wiener, nonlinear state space, hysteresis). Warns :class:`StabilityWarning` for
+    an unstable linear model, whose ``fit_percent`` is None per output. ``initial`` takes only
     ``'estimate'`` (a free run from rest is ``model.simulate(u)``, never a validation fit).
     ``dt``: the arrays' sample time, which a continuous linear model needs (else an
     ArgumentError); a discrete model is checked against it."""
     _check_initial(initial)
+    if isinstance(u, Trajectory) and (y is not None or dt is not None):
+        raise ArgumentError("compare(): a trajectory carries its outputs and sample time; give "
+                            "no y or dt with it", hint="gripkit.sysid.compare(model, data)")
+    if not isinstance(u, Trajectory) and y is None:
+        raise ArgumentError("compare(): give a trajectory with the model's columns, or the "
+                            "arrays u and y", hint="gripkit.sysid.compare(model, data) or "
+                                                   "gripkit.sysid.compare(model, u, y)")
     if not callable(getattr(model, "compare", None)):
         raise ArgumentError(f"compare(): model: expected an identified model, found "
                             f"{type(model).__name__}", hint="gripkit.sysid.identify(...)")
@@ -103,7 +114,7 @@ def compare(model, u, y, *, initial: str = "estimate", dt: float | None = None) 
         else:
             timed = {"dt": dt}
     with np.errstate(over="ignore", invalid="ignore"):
-        return model.compare(u, y, **timed)
+        return model.compare(u) if y is None else model.compare(u, y, **timed)
 
 
 def _check_sample_time(model, dt) -> None:
@@ -267,15 +278,17 @@ class Validation:
                     residual_tests=tests)
 
 
-def validate(model, u, y, *, initial: str = "estimate", lags: int = 25, alpha: float = 0.01,
-             dt: float | None = None) -> Validation:
+def validate(model, u, y=None, *, initial: str = "estimate", lags: int = 25,
+             alpha: float = 0.01, dt: float | None = None) -> Validation:
     """Validate the one-input, one-output linear ``model`` (ARX, ARMAX, OE, state space or
-    transfer function) on (u, y) (deviations from its offsets, same sampling as the estimation
-    data): the free-run fit of :func:`compare` (``model.compare(u, y)``), the one-step
-    prediction fit, residual whiteness and independence. ``dt``: the arrays' sample time, which a
-    continuous model (tfest, step response) needs, as in :func:`compare`. A nonlinear model (no
-    linear ``system``) is refused with a ModelError: its fit is ``model.compare``, its prediction
-    errors ``model.residuals``."""
+    transfer function) on a separate record: a :class:`~gripkit.signals.Trajectory` with the
+    model's columns (as ``model.compare(data)`` reads it), or the arrays ``u``, ``y`` in the
+    units of the data the model was fitted on (the model's offsets applied, as to a trajectory;
+    same sampling as the estimation data): the free-run fit of :func:`compare`
+    (``model.compare(u, y)``), the one-step prediction fit, residual whiteness and independence.
+    ``dt``: the arrays' sample time, which a continuous model (tfest, step response) needs, as
+    in :func:`compare`. A nonlinear model (no linear ``system``) is refused with a ModelError:
+    its fit is ``model.compare``, its prediction errors ``model.residuals``."""
     _check_initial(initial)
     if not isinstance(getattr(model, "system", None), LinearSystem):
         what = getattr(model, "_family", None) or f"a {type(model).__name__}"
@@ -287,7 +300,7 @@ def validate(model, u, y, *, initial: str = "estimate", lags: int = 25, alpha: f
         raise ModelError(f"validate: the model has {len(model.inputs)} inputs and "
                          f"{len(model.outputs)} outputs; validate takes one of each",
                          hint="use model.compare(data) and model.residuals(data)")
-    u, y = check_io(u, y)
+    u, y, dt = _record_arrays(model, u, y, dt)
     sim = compare(model, u, y, dt=dt)
     with np.errstate(over="ignore", invalid="ignore"):
         e, t0, predictor_poles = _one_step(model, u, y, dt)
@@ -299,11 +312,41 @@ def validate(model, u, y, *, initial: str = "estimate", lags: int = 25, alpha: f
                       residual_tests(e, u[t0:], lags=lags, alpha=alpha), model.stable)
 
 
+def _record_arrays(model, data, y, dt) -> tuple[np.ndarray, np.ndarray, float | None]:
+    """``(u, y, dt)`` of what :func:`validate` was given: a trajectory's input and output columns
+    in the model's units (and its sample time), or the arrays ``u``, ``y`` checked."""
+    if not isinstance(data, Trajectory):
+        if y is None:
+            raise ArgumentError("validate: give a trajectory with the model's columns, or the "
+                                "arrays u and y", hint="model.validate(data) or "
+                                                       "model.validate(u, y)")
+        u, y = check_io(data, y)
+        return u, y, dt
+    if y is not None or dt is not None:
+        raise ArgumentError("validate: a trajectory carries its outputs and sample time; give "
+                            "no y or dt with it", hint="model.validate(data)")
+    step = data.require_uniform(why="validation of an identified model")
+    u, y = (_column(data, name, unit, what) for name, unit, what in
+            ((model.inputs[0], model.input_units[0], "input"),
+             (model.outputs[0], model.output_units[0], "output")))
+    return *check_io(u, y), step
+
+
+def _column(data, name: str, unit: str, what: str) -> np.ndarray:
+    """Column ``name`` of the trajectory ``data`` in the model's ``unit``."""
+    if name not in data.names:
+        raise DataError(f"data: the model's {what} column {name!r} is missing; the data have "
+                        f"{', '.join(map(repr, data.names))}",
+                        hint="rename the column or validate on a record with the model's columns")
+    return column_in_unit(data, name, unit, what)
+
+
 def _one_step(model, u, y, dt) -> tuple[np.ndarray, int, np.ndarray]:
-    """(one-step errors, first sample they start at, poles of the predictor)."""
+    """(one-step errors, first sample they start at, poles of the predictor) on the arrays
+    ``u``, ``y`` (the model's offsets applied)."""
     if hasattr(model, "prediction_errors"):  # a polynomial model: its exact predictor
         cf = np.convolve(model.C, model.F)  # the predictor filters by 1/(C F)
-        return (model.prediction_errors(u, y), model.start,
+        return (model.residuals(u, y), model.start,
                 np.roots(cf) if cf.size > 1 else np.zeros(0))
     ss = model.to_ss(dt)  # innovation form: the predictor's poles are those of A − K C
     K = getattr(model, "K", None)

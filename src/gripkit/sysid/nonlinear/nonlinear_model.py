@@ -30,6 +30,7 @@ import numpy as np
 
 from ...errors import ArgumentError, ModelError
 from ...signals.trajectory import Trajectory
+from ..linear.validation import validate
 from ..model_protocol import ReportMixin, check_horizon, check_sample_time
 
 __all__ = ["NonlinearModel", "OutputErrorPrediction"]
@@ -76,6 +77,28 @@ class NonlinearModel(ReportMixin):
             raise ArgumentError(f"{self.structure}.simulate: x0: {self._family} has no settable "
                                 f"initial state; its free run starts from {starts} (found x0 of "
                                 f"shape {np.shape(x0)})", hint=hint)
+
+    @property
+    def fit_percent_definition(self) -> str:
+        """What ``fit_percent`` is: the fit of :meth:`compare` (``fit_definition``, a free run)
+        on the estimation data, as a state-space model's."""
+        return f"{self.fit_definition}, on the estimation data"
+
+    @property
+    def simulation_fit_percent(self) -> list | None:
+        """The free-run fit on the estimation data as a list per output, as every family has it
+        (a linear model's: :attr:`IdentifiedLinearModel.simulation_fit_percent`): the figure to
+        rank models of different families by. A nonlinear model's ``fit_percent`` is that fit."""
+        fit = getattr(self, "fit_percent", None)
+        if fit is None:
+            return None
+        return [None if f is None else float(f) for f in np.ravel(np.asarray(fit, dtype=object))]
+
+    def validate(self, data, y=None, **kw):
+        """Refused with a ModelError that names what to use: the residual-test report
+        (:func:`gripkit.sysid.validate`) is a linear model's; a nonlinear model's fit on a
+        separate record is :meth:`compare`, its prediction errors :meth:`residuals`."""
+        return validate(self, data, y, **kw)
 
     def to_ss(self, dt: float | None = None):
         """Refused: a ModelError (module docstring)."""

@@ -349,10 +349,8 @@ class FingerForcePlant:
             ``force_true`` (N, noise-free) and optionally ``force_filtered`` (N).
         """
         i = as_signal(current, "current")
-        up = (None if current_past is None else np.asarray(current_past,
-                                                           dtype=np.float64) - OPERATING_POINT)
-        f_true = (self.model.simulate(i - OPERATING_POINT, initial=initial, y_past=force_past,
-                                      u_past=up))
+        # the model's u_offset is the operating point: it takes the absolute currents
+        f_true = self.model.simulate(i, initial=initial, y_past=force_past, u_past=current_past)
         if not (math.isfinite(noise_std) and noise_std >= 0):
             raise DataError("noise_std: expected a standard deviation >= 0 in N, "
                             f"found {noise_std!r}")
