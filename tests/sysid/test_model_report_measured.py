@@ -103,7 +103,7 @@ def test_measured_residuals_from_estimated_x0(measured):
     free-run fit (about half explained, README)."""
     _, m, _, val = measured
     u, y = _deviations(m, val)
-    free = m.compare(u, y, dt=1.0).fit_percent
+    free = m.compare(u + m.u_offset, y + m.y_offset, dt=1.0).fit_percent  # arrays: the record's
     res = residual_analysis(m, u, y, 1.0, free)
     assert res.kind == "one-step" and abs(res.predictor_pole) < 0.95
     assert res.fit_percent[0] >= free[0] - 1.0 and free[0] >= 45.0
@@ -123,7 +123,7 @@ def test_measured_record_report(capsys, measured):
     html = unescape((d / "rep" / "index.html").read_text())
     assert "initial state estimated by least squares" in html
     u, y = _deviations(m, whole)
-    free = m.compare(u, y, dt=1.0).fit_percent
+    free = m.compare(u + m.u_offset, y + m.y_offset, dt=1.0).fit_percent
     res = residual_analysis(m, u, y, 1.0, free)
     assert res.fit_percent[0] >= free[0] - 1.0
     assert f"<td>{free[0]:.4g}</td><td>{res.fit_percent[0]:.4g}</td>" in html.replace(" ", "")
