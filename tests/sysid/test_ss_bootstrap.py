@@ -269,3 +269,68 @@ def test_cli_several_files_print_the_bootstrap_sigma(tmp_path, capsys, monkeypat
     _, cov = model.system.pole_covariance()
     want = [[np.sqrt(c[0, 0]), np.sqrt(c[1, 1])] for c in cov]
     assert np.allclose(r["poles_std"], want, rtol=1e-9) and np.all(np.array(want) > 0)
+
+
+def test_no_refine_carries_the_bootstrap_sigma(tmp_path, capsys):
+    """`identify ss --no-refine`: the subspace model with the bootstrap σ (B = 100 by the 500
+    samples, seed 0), said in the σ line, the JSON (covariance_method, info.covariance,
+    info.refined false) and the report (PEM skipped, not 'kept in place of the refinement');
+    the same poles_std as the Python call. bootstrap_replicates=0 gives the subspace model
+    alone, without σ, and the same poles."""
+    from gripkit.io import load, save
+
+    path = tmp_path / "est.csv"
+    save(_record(6), path)
+    args = ["identify", "ss", str(path), "--input", "u", "--output", "y", "--order", "2",
+            "--no-refine"]
+    assert main(args + ["--report", str(tmp_path / "rep")]) == 0
+    text = capsys.readouterr().out
+    assert "σ: parametric bootstrap of the n4sid (order 2, horizon 6) estimate, B = 100 " \
+           "replicates, seed 0" in text
+    assert ("estimate, B = 100 replicates, seed 0: the subspace model was not refined (PEM "
+            "skipped, --no-refine), and this is no PEM covariance.") \
+        in (tmp_path / "rep" / "index.html").read_text()
+    assert main(args + ["--json"]) == 0
+    r = json.loads(capsys.readouterr().out)
+    assert r["refined"] is False and r["info"]["refined"] is False
+    assert r["covariance_method"].startswith("parametric bootstrap of the n4sid")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        model, _ = identify_ss(load(path), input="u", output="y", order=2, refine=False)
+        alone, _ = identify_ss(load(path), input="u", output="y", order=2, refine=False,
+                               bootstrap_replicates=0)
+    _, cov = model.system.pole_covariance()
+    want = [[np.sqrt(c[0, 0]), np.sqrt(c[1, 1])] for c in cov]
+    assert np.allclose(r["poles_std"], want, rtol=1e-9) and np.all(np.array(want) > 0)
+    assert alone.system.uncertainty is None and "covariance" not in alone.info
+    assert np.array_equal(alone.system.A, model.system.A)
+
+
+def test_n4sid_sigma_only_when_asked():
+    """A direct n4sid() call: without ``bootstrap`` no σ, and info['sigma'] says how to get it;
+    ``bootstrap=30`` gives the covariance that identify_ss(refine=False, detrend='none') gives
+    with 30 replicates (the same estimation and draws: equal to the last bit). PEM from a
+    bootstrapped start carries PEM's covariance and says so (the start's σ note dropped)."""
+    from gripkit.sysid import n4sid, pem
+    from gripkit.sysid.linear.identify_mimo import mimo_data
+    from gripkit.sysid.linear.subspace import NO_SIGMA
+
+    d = mimo_data(_record(7), "u", "y", detrend="none")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        plain = n4sid(d.u, d.y, 2, dt=d.dt)
+        boot = n4sid(d.u, d.y, 2, dt=d.dt, bootstrap=30, bootstrap_seed=3)
+        ref, _ = identify_ss(_record(7), input="u", output="y", order=2, refine=False,
+                             detrend="none", bootstrap_replicates=30, bootstrap_seed=3)
+    assert plain.system.uncertainty is None and plain.info["sigma"] == NO_SIGMA
+    assert "n4sid(..., bootstrap=True) gives σ" in NO_SIGMA
+    assert np.array_equal(boot.system.uncertainty.covariance, ref.system.uncertainty.covariance)
+    assert ss_bootstrap.covariance_method(boot) == ("parametric bootstrap of the n4sid (order 2, "
+                                                    "horizon 6) estimate, B = 30 replicates, "
+                                                    "seed 3")
+    refined = pem(boot, u=d.u, y=d.y)
+    assert "covariance" not in refined.info and "sigma" not in refined.info
+    assert ss_bootstrap.covariance_method(refined).startswith("PEM")
+    assert "sigma" not in pem(plain, u=d.u, y=d.y).info
+    with pytest.raises(DataError, match="bootstrap: expected True .* found 3"):
+        n4sid(d.u, d.y, 2, bootstrap=3)
