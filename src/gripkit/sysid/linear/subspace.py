@@ -46,6 +46,7 @@ from ..checks import check_dt, check_excitation, check_output_varies, io_records
 from .linear_model import (LinearModel, as_io_matrix, fit_per_output, free_run,
                            observability_regressor)
 from ..regression import qr_r
+from .ss_bootstrap import BOOTSTRAP_SEED, MIN_REPLICATES, bootstrap_covariance
 from .validation import records_fit
 
 __all__ = ["n4sid", "n4sid_records", "moesp", "SUBSPACE_METHODS", "default_horizon",
@@ -424,7 +425,7 @@ def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int
           max_order: int = DEFAULT_MAX_ORDER, inputs=None, outputs=None, input_units=None,
           output_units=None,
           u_offset=None, y_offset=None, bootstrap: bool | int = False,
-          bootstrap_seed: int = 0) -> LinearModel:
+          bootstrap_seed: int = BOOTSTRAP_SEED) -> LinearModel:
     """Subspace identification of a discrete MIMO state-space model in innovation form.
 
     Parameters
@@ -499,8 +500,6 @@ def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int
     if bootstrap is False:
         model.info["sigma"] = NO_SIGMA
         return model
-    from .ss_bootstrap import bootstrap_covariance
-
     refit = lambda uu, yy: from_factor(  # noqa: E731
         subspace_factor(uu, yy, horizon=k, method=method), n, dt=step, feedthrough=feedthrough,
         stable=stable)
@@ -515,12 +514,14 @@ NO_SIGMA = ("no σ: the subspace estimate alone (PEM skipped); n4sid(..., bootst
 
 
 def _check_bootstrap_option(bootstrap, seed) -> None:
-    """``bootstrap`` True, False or an integer >= 10; ``seed`` a non-negative integer."""
+    """``bootstrap`` True, False or an integer >= MIN_REPLICATES / 3 (as identify_ss's
+    ``bootstrap_replicates``); ``seed`` a non-negative integer."""
+    lo = MIN_REPLICATES // 3
     ok = isinstance(bootstrap, bool) or (isinstance(bootstrap, (int, np.integer))
-                                         and bootstrap >= 10)
+                                         and bootstrap >= lo)
     if not ok:
         raise DataError(f"bootstrap: expected True (replicates by the record's length), False "
-                        f"(no σ) or an integer >= 10 (replicates), found {bootstrap!r}")
+                        f"(no σ) or an integer >= {lo} (replicates), found {bootstrap!r}")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise DataError(f"bootstrap_seed: expected a non-negative integer, found {seed!r}")
 
