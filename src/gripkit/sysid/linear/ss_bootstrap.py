@@ -34,6 +34,13 @@ beyond (``SAMPLE_BUDGET // N``), never below :data:`MIN_REPLICATES` (the relativ
 bootstrap σ is about ``1/√(2(B − 1))``: 7 % at B = 100, 13 % at B = 30). The draws come from
 ``numpy.random.default_rng(seed)``, :data:`BOOTSTRAP_SEED` by default: the same record and seed
 give the same σ.
+
+Several records (:func:`bootstrap_covariance_records`, the model of
+:func:`~gripkit.sysid.linear.subspace.n4sid_records`): each replicate is every record's free run
+from its own initial state plus a disturbance drawn like that record's own residuals (its own
+sieve), the records refitted jointly by the same several-record estimation; the replicate count
+follows the samples of all records together, and ``demean`` removes the mean of all their
+samples, the one operating point of such a model.
 """
 
 from __future__ import annotations
