@@ -110,8 +110,9 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     estimate (:func:`~gripkit.sysid.linear.ss_bootstrap.bootstrap_covariance`:
     ``bootstrap_replicates`` records, the model's free run plus disturbances drawn like its
     residuals, refitted alike; default by the record's length, 100 up to 20 000 samples, 30 from
-    66 667: order 4 took 2.5 s at N = 1e4 and 5 to 6.5 s at N = 1e5 on 2 shared cores, growing
-    with N beyond; ``0``: no bootstrap, the subspace model without σ; ``bootstrap_seed``, default
+    66 667: order 4 took 0.5 s at N = 1e4 and 2 s at N = 1e5 on an AMD EPYC (2.5 s and 6.7 s
+    with its 2 cores shared and loaded), growing with N beyond; ``0``: no bootstrap, the
+    subspace model without σ; ``bootstrap_seed``, default
     :data:`~gripkit.sysid.linear.ss_bootstrap.BOOTSTRAP_SEED`, seeds the draws),
     with ``info['covariance']`` saying so, where a refined model carries PEM's covariance."""
     from .subspace import (
