@@ -5,8 +5,9 @@ JSON fields (exact, other tools read them):
 
 * ``ss``: ``A``, ``B``, ``C``, ``D``, ``K``, ``dt``, ``order``, ``singular_values``, ``stable``,
   ``fit_percent`` (list per output, in ``--output`` order), ``poles`` and ``poles_std`` ((Re, Im)
-  of each), ``covariance_method`` (how σ was obtained: PEM's covariance, or for a kept subspace
-  model a parametric bootstrap, detailed in ``info.covariance``; null without σ) and, with
+  of each), ``covariance_method`` (how σ was obtained: PEM's covariance, or for a subspace model,
+  kept in place of PEM's or with ``--no-refine`` (``info.refined`` false), a parametric
+  bootstrap, detailed in ``info.covariance``; null without σ) and, with
   ``--validate``, ``validation.fit_percent`` (list per output, free run, estimated initial state);
 * ``frf``: ``frequency_hz``, ``H_real``, ``H_imag``, ``H_std``, ``coherence`` (where defined);
 * ``tf``: ``num``, ``den`` (continuous time, descending powers of s), ``num_std``, ``den_std``,
@@ -50,7 +51,9 @@ def identify_ss_cmd(data: list[Path] = DataArgs, input: str = InputsOpt, output:
                     form: str = typer.Option("innovation", "--form",
                                              help="PEM refinement: oe or innovation."),
                     no_refine: bool = typer.Option(False, "--no-refine", help="Keep the subspace "
-                                                                              "model (no PEM)."),
+                                                                              "model (no PEM; σ "
+                                                                              "by a parametric "
+                                                                              "bootstrap of it)."),
                     focus: str = typer.Option("simulation", "--focus",
                                               help="Criterion the returned model never "
                                               "loses by (subspace start against PEM "

@@ -531,7 +531,8 @@ def identify_records(data, method: str = "arx", *, input, output, na: int | None
             u0, y0 = np.zeros_like(u0), np.zeros_like(y0)
         records = [(d.u - u0, d.y - y0) for d in ds]
         if method == "ss":
-            return _as_data(identify_mimo.identify_ss_records, records, ds[0], u0, y0, options)
+            return _as_data(identify_mimo.identify_ss_records, records, ds[0], u0, y0, options,
+                            demean=detrend == "mean")
         if method == "tf":
             return _as_data(identify_mimo.identify_tf_records, records, ds[0], u0, y0,
                             options["poles"], options["zeros"])

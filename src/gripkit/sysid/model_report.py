@@ -421,7 +421,9 @@ def model_report(model, data, *, data_name: str = "data", warnings_list=(),
                    name="residuals")
         how = ("" if not bootstrapped(model) else
                f" The covariance is that of a {covariance_method(model)}: the subspace model "
-               "was kept in place of the PEM refinement, and this is no PEM covariance.")
+               + ("was not refined (PEM skipped, --no-refine)" if model.info.get("refined") is False
+                  else "was kept in place of the PEM refinement")
+               + ", and this is no PEM covariance.")
         rep.section("Poles and zeros", "Poles (×), transmission zeros (○) and the 1σ "
                                        "ellipse of each pole, "
                     "by linearisation of the "

@@ -29,7 +29,8 @@ from ...signals.trajectory import Trajectory
 from .arx_mimo import arx_mimo
 from .frf import frf
 from .linear_model import deviation_compare
-from .ss_bootstrap import BOOTSTRAP_SEED, MIN_REPLICATES, bootstrap_covariance
+from .ss_bootstrap import (BOOTSTRAP_SEED, MIN_REPLICATES, bootstrap_covariance,
+                           bootstrap_covariance_records)
 from ..checks import STEP_CHANGES, step_like
 from ..io_data import IOData, parse_names, validation_data
 
@@ -106,11 +107,14 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     scores lower, the subspace model is returned with an :class:`AccuracyWarning` giving both
     scores. PEM stopping after ``max_iterations`` without converging is warned about too.
 
-    A subspace model returned in place of the refinement (it scored higher, or PEM failed) carries
-    the σ of a parametric bootstrap of the subspace estimate
-    (:func:`~gripkit.sysid.linear.ss_bootstrap.bootstrap_covariance`: ``bootstrap_replicates``
-    records, the model's free run plus disturbances drawn like its residuals, refitted alike;
-    default by the record's length, 100 up to 20 000 samples; ``bootstrap_seed``, default
+    A subspace model returned in place of the refinement (it scored higher, or PEM failed), and
+    the subspace model of ``refine=False``, carry the σ of a parametric bootstrap of the subspace
+    estimate (:func:`~gripkit.sysid.linear.ss_bootstrap.bootstrap_covariance`:
+    ``bootstrap_replicates`` records, the model's free run plus disturbances drawn like its
+    residuals, refitted alike; default by the record's length, 100 up to 20 000 samples, 30 from
+    66 667: order 4 took 0.5 s at N = 1e4 and 2 s at N = 1e5 on an AMD EPYC (2.5 s and 6.7 s
+    with its 2 cores shared and loaded), growing with N beyond; ``0``: no bootstrap, the
+    subspace model without σ; ``bootstrap_seed``, default
     :data:`~gripkit.sysid.linear.ss_bootstrap.BOOTSTRAP_SEED`, seeds the draws),
     with ``info['covariance']`` saying so, where a refined model carries PEM's covariance."""
     from .subspace import (
@@ -166,14 +170,15 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
         model = _refine(model, d, vd, form, focus, max_iterations, progress)[0]
     if ranked is not None:
         extras["search"] = [r for r, _ in ranked]
-    if refine and model.structure == method:  # the subspace start kept: σ by bootstrap
+    if model.structure == method and bootstrap_replicates != 0:  # subspace: σ by bootstrap
         model = _bootstrap_sigma(model, d, k, method, feedthrough, detrend,
-                                 (bootstrap_replicates, bootstrap_seed), progress)
+                                 (bootstrap_replicates, bootstrap_seed), progress, refine)
     warn_if_stabilised(model)
     if detrend == "mean":
         refit = lambda: identify_ss(  # noqa: E731
             data, input=input, output=output, order=model.order, method=method, form=form,
-            refine=False, detrend="none", horizon=horizon, feedthrough=feedthrough)[0]
+            refine=False, detrend="none", horizon=horizon, feedthrough=feedthrough,
+            bootstrap_replicates=0)[0]
         model = after_mean_detrending(model, d.u, refit, "identify ss", drift=lambda step: (
             _warn_if_detrending_hurt(model, refit, d.u.shape[0], d.dt, "identify ss",
                                      without="without (subspace model, not refined)", step=step)))
@@ -183,21 +188,23 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
 
 
 def _check_bootstrap(replicates, seed) -> None:
-    """``bootstrap_replicates`` None or an integer >= MIN_REPLICATES / 3 (fewer give no σ worth
-    reporting), ``bootstrap_seed`` a non-negative integer (numpy's default_rng)."""
+    """``bootstrap_replicates`` None, 0 (no bootstrap) or an integer >= MIN_REPLICATES / 3
+    (fewer give no σ worth reporting), ``bootstrap_seed`` a non-negative integer (numpy's
+    default_rng)."""
     lo = MIN_REPLICATES // 3
     if replicates is not None and (isinstance(replicates, bool)
                                    or not isinstance(replicates, (int, np.integer))
-                                   or replicates < lo):
-        raise DataError(f"bootstrap_replicates: expected None (by the record's length) or an "
-                        f"integer >= {lo}, found {replicates!r}")
+                                   or 0 < replicates < lo or replicates < 0):
+        raise DataError(f"bootstrap_replicates: expected None (by the record's length), 0 (no σ) "
+                        f"or an integer >= {lo}, found {replicates!r}")
     if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
         raise DataError(f"bootstrap_seed: expected a non-negative integer, found {seed!r}")
 
 
 def _bootstrap_sigma(model, d: IOData, k: int, method: str, feedthrough: bool, detrend: str,
-                     options: tuple, progress: bool):
-    """The kept subspace ``model`` with the σ of a parametric bootstrap of the same estimation
+                     options: tuple, progress: bool, refined: bool = True):
+    """The subspace ``model`` (kept in place of PEM's, or ``refined`` False: PEM skipped, which
+    ``info['refined']`` then records) with the σ of a parametric bootstrap of the same estimation
     (order, ``method``, horizon ``k``, ``feedthrough``, ``detrend``) on the deviation data ``d``;
     ``options``: (replicates or None, seed)."""
     from .subspace import from_factor, subspace_factor
@@ -206,6 +213,8 @@ def _bootstrap_sigma(model, d: IOData, k: int, method: str, feedthrough: bool, d
     replicates, seed = options
     refit = lambda u, y: from_factor(  # noqa: E731
         subspace_factor(u, y, horizon=k, method=method), n, dt=d.dt, feedthrough=feedthrough)
+    if not refined:
+        model = model.replace(info={**model.info, "refined": False})
     return bootstrap_covariance(model, d.u, d.y, refit, replicates=replicates, seed=seed,
                                 estimator=f"{method} (order {n}, horizon {k})",
                                 demean=detrend == "mean", feedthrough=feedthrough,
@@ -574,17 +583,21 @@ def compare_score(model, data) -> float:
 #: the options of method 'ss' with several records (``weighting``: the subspace method, n4sid,
 #: moesp or cva, identify()'s own ``method`` being 'ss')
 SS_RECORD_OPTIONS = ("order", "horizon", "feedthrough", "refine", "form", "max_iterations",
-                     "weighting", "focus", "progress")
+                     "weighting", "focus", "progress", "bootstrap_replicates", "bootstrap_seed")
 
 
-def identify_ss_records(records: list, d: IOData, u0, y0, options: dict):
+def identify_ss_records(records: list, d: IOData, u0, y0, options: dict, demean: bool = False):
     """The state-space model of several records: subspace
     (:func:`gripkit.sysid.linear.subspace.n4sid_records`), then, unless ``refine=False``, PEM with
     one initial state per record (:func:`gripkit.sysid.linear.pem_ss.pem_records`), kept only when
     it does not lose to its start by ``focus`` (:func:`records_score` over all records; else the
     subspace model with an AccuracyWarning giving both). ``order='LO:HI'`` searches the order as
     for one record: ranked by Akaike's criterion of the free run over all records,
-    widened past an edge, the best order refined (``info['search']``)."""
+    widened past an edge, the best order refined (``info['search']``). A subspace model returned
+    (kept, or ``refine=False``) carries the σ of a parametric bootstrap of the estimation over
+    all records (:func:`_records_sigma`; ``bootstrap_replicates``, ``bootstrap_seed`` as for
+    one record, the count by all records' samples together); ``demean``: the records are
+    deviations from the mean of all their samples (detrend 'mean'), as the replicates are."""
     from .subspace import n4sid_records
 
     other = sorted(set(options) - set(SS_RECORD_OPTIONS))
@@ -595,6 +608,8 @@ def identify_ss_records(records: list, d: IOData, u0, y0, options: dict):
     focus, progress = options.get("focus", "simulation"), options.get("progress", False)
     if focus not in FOCUS:
         raise DataError(f"focus: expected one of {', '.join(FOCUS)}, found {focus!r}")
+    _check_bootstrap(options.get("bootstrap_replicates"),
+                     options.get("bootstrap_seed", BOOTSTRAP_SEED))
     rng = parse_order(options.get("order"))
 
     def fit(n):
@@ -606,9 +621,10 @@ def identify_ss_records(records: list, d: IOData, u0, y0, options: dict):
 
     refine = lambda m: _refine_records(m, records, options, focus)  # noqa: E731
     score = lambda m: records_score(m, records, focus)  # noqa: E731
+    sigma = lambda m: _records_sigma(m, records, options, d.dt, demean)  # noqa: E731
     if rng is None or rng[0] == rng[1]:
         start = fit(None if rng is None else rng[0])
-        return refine(start) if options.get("refine", True) else start
+        return sigma(refine(start) if options.get("refine", True) else start)
     # the subspace models are ranked by their free run: the innovation gain a subspace fit of
     # several records gives is too rough to rank orders by; PEM's gains rank the refined ones
     row_of = lambda n: _records_row(fit(n), records, "simulation")  # noqa: E731
@@ -619,8 +635,31 @@ def identify_ss_records(records: list, d: IOData, u0, y0, options: dict):
                                     progress, 1)
     else:
         model = ranked[0][1]
+    model = sigma(model)
     return model.replace(info={**model.info, "search": [r for r, _ in ranked],
                                "search_criterion": criterion})
+
+
+def _records_sigma(model, records: list, options: dict, dt: float, demean: bool):
+    """``model`` with the σ of a parametric bootstrap of the subspace estimation over all
+    ``records`` (:func:`~.ss_bootstrap.bootstrap_covariance_records`: the same order, weighting,
+    horizon and feedthrough) when it is the subspace model (kept in place of PEM's, or
+    ``refine=False``, which ``info['refined']`` then records) and ``bootstrap_replicates`` is not
+    0; else ``model`` as it is."""
+    from .subspace import n4sid_records
+
+    weighting, replicates = options.get("weighting", "n4sid"), options.get("bootstrap_replicates")
+    if model.structure != weighting or replicates == 0:
+        return model
+    if not options.get("refine", True):
+        model = model.replace(info={**model.info, "refined": False})
+    n, k, feedthrough = model.order, model.info["horizon"], options.get("feedthrough", False)
+    refit = lambda us, ys: n4sid_records(  # noqa: E731
+        list(zip(us, ys)), n, method=weighting, horizon=k, feedthrough=feedthrough, dt=dt)
+    return bootstrap_covariance_records(
+        model, records, refit, estimator=f"{weighting} (order {n}, horizon {k})",
+        replicates=replicates, seed=options.get("bootstrap_seed", BOOTSTRAP_SEED), demean=demean,
+        feedthrough=feedthrough, progress=options.get("progress", False))
 
 
 def records_score(model, records: list, focus: str) -> float:
@@ -689,7 +728,8 @@ def _refine_records(start, records: list, options: dict, focus: str):
     if after < before - FOCUS_TIE:
         emit_warning(f"identify ss: PEM over the records lowered the mean {focus} fit of all "
                      f"records from {before:.4g} % (subspace) to {after:.4g} %; the subspace "
-                     f"model is returned", AccuracyWarning)
+                     f"model is returned, with σ from a parametric bootstrap of the subspace "
+                     f"estimate, not PEM's covariance", AccuracyWarning)
         return start.replace(info={**start.info, "focus": {**record, "kept": "subspace"}})
     return refined.replace(info={**refined.info, "focus": {**record, "kept": refined.structure}})
 

@@ -320,6 +320,12 @@ def _levenberg_marquardt(A, B, C, D, K, x0, u, yw, feedthrough, innovation, max_
                     lambda x, dx: x + dx, feedthrough, innovation, max_iterations, tol, progress)
 
 
+def _start_info(model) -> dict:
+    """The start's ``info`` without what describes the start's σ alone (``covariance``: its
+    bootstrap, ``sigma``: that it has none): the refined model carries PEM's covariance."""
+    return {k: v for k, v in model.info.items() if k not in ("covariance", "sigma")}
+
+
 def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovation",
         feedthrough: bool | None = None,
         max_iterations: int = 50, tol: float = 1e-7, progress: bool = False) -> LinearModel:
@@ -396,11 +402,11 @@ def pem(model: LinearModel, data=None, *, u=None, y=None, form: str = "innovatio
     sysn = StateSpace(A, B, C, D, **ss._signals(meta={**ss.meta, "refined_by": f"pem-{form}"}),
                       states=ss.states,
                       state_units=ss.state_units, uncertainty=unc)
-    info = {**model.info, "pem": {"form": form, "iterations": it_warm + it,
-                                  "iterations_warm_start": it_warm,
-                                  "converged": converged, "loss_start": V0 / N,
-                                  "loss": Vc / N, "parameters": dA.shape[0],
-                                  "feedthrough": feedthrough}}
+    info = {**_start_info(model), "pem": {"form": form, "iterations": it_warm + it,
+                                          "iterations_warm_start": it_warm,
+                                          "converged": converged, "loss_start": V0 / N,
+                                          "loss": Vc / N, "parameters": dA.shape[0],
+                                          "feedthrough": feedthrough}}
     return model.replace(system=sysn, structure=f"pem-{form}", K=K if innovation else None, x0=x0,
                          noise_covariance=e.T @ e / N,
                          fit_percent=_free_run_fit(A, B, C, D, u, y),
@@ -639,7 +645,7 @@ def pem_records(model: LinearModel, records, *, form: str = "innovation",
     yhats = [free_run(A, B, C, D, u, estimate_x0(A, B, C, D, u, y)) for u, y in data]
     recs = [{"n_samples": int(y.shape[0]), "fit_percent": fit_per_output(y, yh), "x0": x0}
             for y, yh, x0 in zip(ys, yhats, x0s)]
-    info = {**model.info, "records": recs, "n_records": R,
+    info = {**_start_info(model), "records": recs, "n_records": R,
             "pem": {"form": form, "iterations": it, "converged": converged, "loss_start": V0 / N,
                     "loss": Vc / N, "parameters": d, "feedthrough": feedthrough}}
     return model.replace(system=sysn, structure=f"pem-{form}", K=K if innovation else None,

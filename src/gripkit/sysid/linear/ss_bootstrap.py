@@ -34,6 +34,13 @@ beyond (``SAMPLE_BUDGET // N``), never below :data:`MIN_REPLICATES` (the relativ
 bootstrap σ is about ``1/√(2(B − 1))``: 7 % at B = 100, 13 % at B = 30). The draws come from
 ``numpy.random.default_rng(seed)``, :data:`BOOTSTRAP_SEED` by default: the same record and seed
 give the same σ.
+
+Several records (:func:`bootstrap_covariance_records`, the model of
+:func:`~gripkit.sysid.linear.subspace.n4sid_records`): each replicate is every record's free run
+from its own initial state plus a disturbance drawn like that record's own residuals (its own
+sieve), the records refitted jointly by the same several-record estimation; the replicate count
+follows the samples of all records together, and ``demean`` removes the mean of all their
+samples, the one operating point of such a model.
 """
 
 from __future__ import annotations
@@ -47,7 +54,8 @@ from ...lti import StateSpace
 from ...progress import status, track
 
 __all__ = ["BOOTSTRAP_SEED", "MAX_REPLICATES", "MIN_REPLICATES", "bootstrap_replicates",
-           "bootstrap_covariance", "bootstrapped", "covariance_method"]
+           "bootstrap_covariance", "bootstrap_covariance_records", "bootstrapped",
+           "covariance_method"]
 
 #: the default seed of the bootstrap's draws (numpy.random.default_rng)
 BOOTSTRAP_SEED = 0
@@ -147,16 +155,18 @@ def _aligned(refit: StateSpace, O: np.ndarray, w: np.ndarray, feedthrough: bool)
     return np.concatenate(parts)
 
 
-def _replicates(model, u, y, refit, replicates: int, seed: int, demean: bool, feedthrough: bool,
-                progress: bool):
+def _replicates(model, records, x0s, refit, replicates: int, seed: int, demean: bool,
+                feedthrough: bool, progress: bool):
     """The aligned entries of each replicate that refits (rows), the number that failed and the
     number tried: all of ``replicates``, unless more than half of those tried (after
-    :data:`MIN_REPLICATES` / 3 at least) have failed, which stops the loop (no σ comes of it)."""
+    :data:`MIN_REPLICATES` / 3 at least) have failed, which stops the loop (no σ comes of it).
+    ``records``: (u, y) pairs, each simulated from its own initial state of ``x0s`` and given
+    its own disturbance; ``refit(us, ys)`` fits them all at once."""
     ss = model.system
-    x0 = np.zeros(ss.n_states) if model.x0 is None else np.asarray(model.x0, dtype=np.float64)
-    y_det = ss.simulate(u, x0)
-    coefs, eps = _noise_model(y - y_det)
-    sy = y.std(axis=0)
+    us = [u for u, _ in records]
+    y_dets = [ss.simulate(u, x0) for u, x0 in zip(us, x0s)]
+    noises = [_noise_model(y - y_det) for (_, y), y_det in zip(records, y_dets)]
+    sy = np.vstack([y for _, y in records]).std(axis=0)
     w = 1.0 / np.where(sy > 0, sy, 1.0)
     O = _observability(ss.A, ss.C, w)
     rng = np.random.default_rng(seed)
@@ -165,13 +175,14 @@ def _replicates(model, u, y, refit, replicates: int, seed: int, demean: bool, fe
         if tried >= MIN_REPLICATES // 3 and 2 * failed > tried:
             break
         tried += 1
-        yb = y_det + _disturbance(coefs, eps, rng)
-        if demean:
-            yb = yb - yb.mean(axis=0)
+        ybs = [y_det + _disturbance(coefs, eps, rng) for y_det, (coefs, eps) in zip(y_dets, noises)]
+        if demean:  # the mean of all records' samples, as the estimation removed it
+            mean = np.vstack(ybs).mean(axis=0)
+            ybs = [yb - mean for yb in ybs]
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                fitted = refit(u, np.ascontiguousarray(yb))
+                fitted = refit(us, [np.ascontiguousarray(yb) for yb in ybs])
         except GripkitError:
             failed += 1
             continue
@@ -204,10 +215,40 @@ def bootstrap_covariance(model, u, y, refit, *, estimator: str, replicates: int 
     """
     u = np.ascontiguousarray(u, dtype=np.float64)
     y = np.ascontiguousarray(y, dtype=np.float64)
-    B = bootstrap_replicates(u.shape[0]) if replicates is None else int(replicates)
+    ss = model.system
+    x0 = np.zeros(ss.n_states) if model.x0 is None else np.asarray(model.x0, dtype=np.float64)
+    return _covariance(model, [(u, y)], [x0], lambda us, ys: refit(us[0], ys[0]),
+                       (estimator, replicates, seed, demean, feedthrough, progress))
+
+
+def bootstrap_covariance_records(model, records, refit, *, estimator: str,
+                                 replicates: int | None = None, seed: int = BOOTSTRAP_SEED,
+                                 demean: bool = False, feedthrough: bool = False,
+                                 progress: bool = False):
+    """:func:`bootstrap_covariance` of a subspace model of several records
+    (:func:`~gripkit.sysid.linear.subspace.n4sid_records`): ``records`` the (u, y) deviation
+    pairs it was fitted to, each replicate every record's free run from its own initial state
+    (``model.info['records'][i]['x0']``) plus its own disturbance drawn like that record's
+    residuals (its own AR sieve), all refitted at once by ``refit(us, ys)`` (lists, one array
+    per record); ``replicates`` default :func:`bootstrap_replicates` of all records' samples
+    together; ``demean``: the mean of all records' samples removed (one operating point), as
+    the estimation removed it. The same ``info['covariance']`` fields and warnings."""
+    recs = [(np.ascontiguousarray(u, dtype=np.float64).reshape(len(u), -1),
+             np.ascontiguousarray(y, dtype=np.float64).reshape(len(y), -1)) for u, y in records]
+    x0s = [np.asarray(r["x0"], dtype=np.float64) for r in model.info["records"]]
+    return _covariance(model, recs, x0s, refit,
+                       (estimator, replicates, seed, demean, feedthrough, progress))
+
+
+def _covariance(model, records, x0s, refit, options: tuple):
+    """The body of :func:`bootstrap_covariance` and :func:`bootstrap_covariance_records`;
+    ``options``: (estimator, replicates, seed, demean, feedthrough, progress)."""
+    estimator, replicates, seed, demean, feedthrough, progress = options
+    n_samples = sum(u.shape[0] for u, _ in records)
+    B = bootstrap_replicates(n_samples) if replicates is None else int(replicates)
     if progress:
         status(f"σ of the {estimator} model: parametric bootstrap, {B} replicates (seed {seed})")
-    rows, failed, tried = _replicates(model, u, y, refit, B, seed, demean, feedthrough,
+    rows, failed, tried = _replicates(model, records, x0s, refit, B, seed, demean, feedthrough,
                                       progress)
     info = {"method": "parametric bootstrap", "replicates": len(rows), "failed": failed,
             "seed": int(seed), "estimator": estimator}
