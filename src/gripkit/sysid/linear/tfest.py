@@ -34,7 +34,8 @@ from scipy import signal as _signal
 
 from ...errors import DataError, IdentificationError, ModelError
 from ...lti import StateSpace, TransferFunction
-from ..checks import check_dt, check_order, check_persistent_excitation, io_records
+from ..checks import (channel_of, check_dt, check_order, check_output_varies,
+                      check_persistent_excitation, io_records)
 from ..scaling import unit_scale
 from .frf import FRF, frf
 from .linear_model import (LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run,
@@ -52,6 +53,17 @@ def _check_orders(n_poles, n_zeros):
                         f"found {n_zeros}",
                         hint="an improper transfer function cannot be simulated")
     return n_poles, n_zeros
+
+
+def _check_outputs_vary(ys: list, signals: dict, y_offset) -> None:
+    """An UnidentifiableError naming the output channel (its value, the offset added back, in its
+    unit; of several records, the record) when an output of ``ys`` is constant: nothing to fit,
+    its fit % undefined, and a constant record's FRF, the start, is zero (numpy's least squares
+    then failed with 'SVD did not converge')."""
+    label, offset, unit = channel_of({**signals, "y_offset": y_offset}, "output", "y")
+    for i, y in enumerate(ys):
+        check_output_varies(y, label if len(ys) == 1 else f"records[{i}] {label}",
+                            offset=offset, unit=unit)
 
 
 def _eval(theta, s, npo, nz):
@@ -310,6 +322,9 @@ def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None,
         raise DataError(f"tfest: {N} samples are too few for {k} coefficients (need at "
                         f"least {10 * k + 64})",
                         hint="use a longer record or fewer poles/zeros")
+    signals = (dict(inputs=inputs, outputs=outputs, input_units=input_units,
+                    output_units=output_units))
+    _check_outputs_vary([y[:, 0]], signals, y_offset)
     check_persistent_excitation(u[:, 0], k, f"tfest ({npo} poles, {nz} zeros: {k} coefficients)")
     start = tfest_frf(frf(u, y, dt=step, nperseg=max(64, min(N // 4, 2048))), npo, nz, dt=step)
     th0 = (_stabilise(np.concatenate([start.system.denominator()[1:],
@@ -334,8 +349,6 @@ def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None,
     Ad, Bd, Cd, Dd = _simulate_ct(theta, npo, nz, uu, step)
     x0 = estimate_x0(Ad, Bd, Cd, Dd, uu, y)
     fit = fit_per_output(y, free_run(Ad, Bd, Cd, Dd, uu, x0))
-    signals = (dict(inputs=inputs, outputs=outputs, input_units=input_units,
-                    output_units=output_units))
     return _model(theta, 0.5 * (cov + cov.T), npo, nz, fit=fit, structure="tfest",
                   info={"source": "time domain (zero-order hold, output error from the "
                                   "least-squares initial state)", "nfev": int(sol.nfev)},
@@ -367,6 +380,9 @@ def tfest_records(records, n_poles: int, n_zeros: int, *, dt: float | None = Non
         raise DataError(f"tfest: {N} samples in all are too few for {k} coefficients and "
                         f"{len(recs)} initial states",
                         hint="use longer records or fewer poles/zeros")
+    signals = dict(inputs=inputs, outputs=outputs, input_units=input_units,
+                   output_units=output_units)
+    _check_outputs_vary([y[:, 0] for _, y in recs], signals, y_offset)
     check_persistent_excitation(np.concatenate([u[:, 0] for u, _ in recs]), k,
                                 f"tfest ({npo} poles, {nz} zeros: {k} coefficients)")
     ul, yl = max(recs, key=lambda r: r[0].shape[0])
@@ -402,8 +418,6 @@ def tfest_records(records, n_poles: int, n_zeros: int, *, dt: float | None = Non
                       "initial state)", "nfev": int(sol.nfev), "n_records": len(recs),
             "records": [{"n_samples": int(y.shape[0]), "fit_percent": fit_per_output(y, h),
                          "x0": x0} for y, h, x0 in zip(ys, yhats, x0s)]}
-    signals = dict(inputs=inputs, outputs=outputs, input_units=input_units,
-                   output_units=output_units)
     return _model(theta, 0.5 * (cov + cov.T), npo, nz, fit=records_fit(ys, yhats).tolist(),
                   structure="tfest", info=info, signals=signals, u_offset=u_offset,
                   y_offset=y_offset, n=N)
