@@ -34,7 +34,7 @@ from scipy import signal as _signal
 
 from ...errors import DataError, IdentificationError, ModelError
 from ...lti import StateSpace, TransferFunction
-from ..checks import (channel_of, check_dt, check_order, check_output_varies,
+from ..checks import (channel_of, check_dt, check_excitation, check_order, check_output_varies,
                       check_persistent_excitation, io_records)
 from ..scaling import unit_scale
 from .frf import FRF, frf
@@ -55,14 +55,20 @@ def _check_orders(n_poles, n_zeros):
     return n_poles, n_zeros
 
 
-def _check_outputs_vary(ys: list, signals: dict, y_offset) -> None:
-    """An UnidentifiableError naming the output channel (its value, the offset added back, in its
-    unit; of several records, the record) when an output of ``ys`` is constant: nothing to fit,
-    its fit % undefined, and a constant record's FRF, the start, is zero (numpy's least squares
-    then failed with 'SVD did not converge')."""
-    label, offset, unit = channel_of({**signals, "y_offset": y_offset}, "output", "y")
-    for i, y in enumerate(ys):
-        check_output_varies(y, label if len(ys) == 1 else f"records[{i}] {label}",
+def _check_channels_vary(recs: list, signals: dict, u_offset, y_offset) -> None:
+    """An UnidentifiableError naming the channel (its value, the offset added back, in its unit;
+    of several records, the record) for an input constant over all records of ``recs`` ((u, y)
+    pairs of columns) or an output constant in one of them: a constant input cannot identify G,
+    a constant output has nothing to fit and its fit % is undefined, and either one's FRF, the
+    start, is zero or undefined (numpy's least squares then failed: 'SVD did not converge')."""
+    meta = {**signals, "u_offset": u_offset, "y_offset": y_offset}
+    label, offset, unit = channel_of(meta, "input", "u")
+    u = recs[0][0][:, 0] if len(recs) == 1 else np.concatenate([u[:, 0] for u, _ in recs])
+    check_excitation(u, label if len(recs) == 1 else f"{label} of all {len(recs)} records",
+                     offset=offset, unit=unit)
+    label, offset, unit = channel_of(meta, "output", "y")
+    for i, (_, y) in enumerate(recs):
+        check_output_varies(y[:, 0], label if len(recs) == 1 else f"records[{i}] {label}",
                             offset=offset, unit=unit)
 
 
@@ -324,7 +330,7 @@ def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None,
                         hint="use a longer record or fewer poles/zeros")
     signals = (dict(inputs=inputs, outputs=outputs, input_units=input_units,
                     output_units=output_units))
-    _check_outputs_vary([y[:, 0]], signals, y_offset)
+    _check_channels_vary([(u, y)], signals, u_offset, y_offset)
     check_persistent_excitation(u[:, 0], k, f"tfest ({npo} poles, {nz} zeros: {k} coefficients)")
     start = tfest_frf(frf(u, y, dt=step, nperseg=max(64, min(N // 4, 2048))), npo, nz, dt=step)
     th0 = (_stabilise(np.concatenate([start.system.denominator()[1:],
@@ -382,7 +388,7 @@ def tfest_records(records, n_poles: int, n_zeros: int, *, dt: float | None = Non
                         hint="use longer records or fewer poles/zeros")
     signals = dict(inputs=inputs, outputs=outputs, input_units=input_units,
                    output_units=output_units)
-    _check_outputs_vary([y[:, 0] for _, y in recs], signals, y_offset)
+    _check_channels_vary(recs, signals, u_offset, y_offset)
     check_persistent_excitation(np.concatenate([u[:, 0] for u, _ in recs]), k,
                                 f"tfest ({npo} poles, {nz} zeros: {k} coefficients)")
     ul, yl = max(recs, key=lambda r: r[0].shape[0])
