@@ -5,6 +5,7 @@ loop's margins on a first-order process with delay against the analytic L = e^{�
 (τ_c = θ, τ_I = τ₁): gain margin π, phase margin 90° − (1/2 rad)."""
 
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -64,7 +65,11 @@ def test_half_rule_on_three_lags():
     m1, m2 = reduce_model(g, 1), reduce_model(g, 2)
     np.testing.assert_allclose([m1.k, m1.tau1, m1.theta], [1.0, 1.1, 0.175], rtol=1e-9)
     np.testing.assert_allclose([m2.tau1, m2.tau2, m2.theta], [1.0, 0.225, 0.05], rtol=1e-9)
-    assert tune_pid(g).kd > 0 and tune_pid(g, order=1).kd == 0.0
+    from gripkit.errors import AccuracyWarning
+
+    with pytest.warns(AccuracyWarning, match="gain margin 1.61 and phase margin 22.8°"):
+        assert tune_pid(g).kd > 0  # τ_c = θ = 0.05 s is tight for this loop (h = 0.05 s)
+    assert tune_pid(g, order=1).kd == 0.0
 
 
 def test_simc_loop_margins_on_a_first_order_process_with_delay():
@@ -193,15 +198,15 @@ def test_numerator_taps_beyond_the_lag_order_are_a_delay():
     """0.05 (q⁻² + q⁻³)/(1 − 0.9 q⁻¹) (nb > na: the realisation's pole at z = 0 has no
     continuous equivalent): τ₁ = −h/ln 0.9 exact, k = B(1)/A(1) = 1, and the taps' first moment
     (half a sample; the ZOH lag's own single tap has moment 0) adds h/2 to θ = (nk − 1) h + h/2.
-    A pure delay (no lag at all) reaches SIMC's 'integral controller' refusal, not d2c."""
+    A pure delay (no lag at all) is SIMC's integral controller, not d2c (its own tests below)."""
     h = 0.01
     tau = -h / math.log(0.9)
     m = reduce_model(TransferFunction.from_polynomials([1.0, -0.9], [0, 0, 0.05, 0.05], dt=h), 1)
     assert m.k == pytest.approx(1.0, rel=1e-12) and m.tau1 == pytest.approx(tau, rel=1e-9)
     assert m.theta == pytest.approx(h + 0.5 * h + h / 2, rel=1e-9)
     assert "taken as a delay of 0.005 s (first moment)" in m.notes[0]
-    with pytest.raises(ModelError, match="no lag left \\(a pure delay\\)"):
-        tune_pid(TransferFunction.from_polynomials([1.0], [0.0, 0.0, 0.3], dt=h))
+    pid = tune_pid(TransferFunction.from_polynomials([1.0], [0.0, 0.0, 0.3], dt=h))
+    assert pid.design["structure"] == "I" and "no lag left" in pid.design["model"]["notes"][-1]
 
 
 def test_unknown_pid_options_name_the_valid_ones():
@@ -223,3 +228,122 @@ def test_taps_beyond_a_second_order_lag_are_their_extra_mean_delay():
     A, B = g.den_zinv(), np.convolve(g.num_zinv(), [0.5, 0.5])
     m = reduce_model(TransferFunction.from_polynomials(A, B, dt=h), 2)
     np.testing.assert_allclose([m.k, m.tau1, m.tau2, m.theta], [1.0, 1.0, 0.5, h], rtol=1e-9)
+
+
+def _delay(d: int, k: float = 0.3, h: float = 0.01):
+    """The static gain with delay k q⁻ᵈ (an FIR model with one tap)."""
+    return TransferFunction.from_polynomials([1.0], np.r_[np.zeros(d), k], dt=h)
+
+
+def _python_control_margins(g, pid):
+    """Gain and phase margin of the discrete loop C G by python-control (the reference)."""
+    control = pytest.importorskip("control")
+    from gripkit.control.robustness import controller_transfer_function
+
+    num, den, dt = controller_transfer_function(pid)
+    with warnings.catch_warnings():  # its evaluation at the PID's pole z = 0 divides by zero
+        warnings.simplefilter("ignore", RuntimeWarning)
+        loop = control.tf(num, den, dt) * control.tf(g.num[0, 0], g.den[0, 0], dt)
+        return control.stability_margins(loop, method="poly")[:2]
+
+
+def test_a_pure_delay_gets_simcs_integral_controller():
+    """0.3 q⁻²¹ at h = 0.01 s (no lag: it was refused with 'use PID(0, ki) by hand'): SIMC's
+    I-controller k_i = 1/(k (τ_c + θ)), τ_c = θ, θ = 20h (the delay) + h/2 (the hold) + h (the
+    integral's own sample, k_i h/(z − 1)); k_p = k_d = 0. Its loop is L ≈ e^{−θs}/(2θs): gain
+    margin π (phase −180° at ωθ = π/2), phase margin 90° − (1/2 rad) = 61.35°; the discrete
+    loop's margins, recorded in pid.design, are python-control's to 1e-8 and within 0.1 % and
+    0.01° of those; the simulated step settles at the setpoint, and no warning."""
+    g = _delay(21)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        pid = tune_pid(g)
+    theta = 20 * 0.01 + 0.005 + 0.01
+    assert pid.design["model"]["theta"] == pytest.approx(theta, rel=1e-12)
+    assert pid.ki == pytest.approx(1.0 / (0.3 * 2 * theta), rel=1e-12)
+    assert (pid.kp, pid.kd, pid.design["structure"]) == (0.0, 0.0, "I")
+    margins = pid.design["margins"]
+    gm, pm = _python_control_margins(g, pid)
+    assert margins["gain_margin"] == pytest.approx(gm, rel=1e-8)
+    assert margins["phase_margin_deg"] == pytest.approx(pm, rel=1e-8)
+    assert margins["gain_margin"] == pytest.approx(math.pi, rel=1e-3)
+    assert margins["phase_margin_deg"] == pytest.approx(90 - math.degrees(0.5), abs=0.01)
+    assert margins["stable"] is True
+    y = _closed_loop_step([1.0], np.r_[np.zeros(21), 0.3], pid, n=1500)
+    assert np.max(y) < 1.05 and np.max(np.abs(y[-300:] - 1.0)) < 1e-6  # overshoot 4.05 %
+
+
+def test_a_one_sample_delay_gets_a_stable_integral_loop():
+    """0.3 q⁻¹: θ = h/2 + h. Without the integral's sample in θ the rule gives k_i h k = 1 and
+    the closed-loop poles z² − z + 1 = 0 on the unit circle; with it k_i h k = 1/3:
+    L = (1/3)/(z(z − 1)), poles |z| = 1/√3, gain margin 3 exactly (L = −1/3 at ωh = π/3) and
+    phase margin 90° − 3 asin(1/6) = 61.22° (|z − 1| = 1/3); the step settles."""
+    g = _delay(1)
+    pid = tune_pid(g)
+    assert pid.ki * 0.01 * 0.3 == pytest.approx(1.0 / 3.0, rel=1e-12)
+    margins = pid.design["margins"]
+    assert margins["gain_margin"] == pytest.approx(3.0, rel=1e-9)
+    assert margins["w_gain_margin"] == pytest.approx(math.pi / 3 / 0.01, rel=1e-9)
+    assert margins["phase_margin_deg"] == pytest.approx(90 - 3 * math.degrees(math.asin(1 / 6)),
+                                                        abs=1e-6)
+    r = robustness(g, pid, n=0)
+    np.testing.assert_allclose(np.sort(np.abs(r.poles)), [0.0, 3 ** -0.5, 3 ** -0.5],
+                               rtol=1e-9, atol=1e-12)  # the PID's pole at z = 0 besides
+    y = _closed_loop_step([1.0], [0.0, 0.3], pid, n=200)
+    assert np.max(np.abs(y[-50:] - 1.0)) < 1e-9
+
+
+def test_a_pure_delay_low_order_model_and_its_bad_forms():
+    """LowOrderModel(k = 2, τ₁ = 0, θ = 0.5 s) at h = 0.01 s: k_i = 1/(2 (0.5 + 0.5)) = 0.5; the
+    margins of the sampled I-controller on e^{−θs} are within 1.5 % and 0.5° of π and 61.35°
+    (the integral's half sample more), 'stable' None (no discrete poles). τ₁ = 0 with θ = 0 or
+    with τ₂ > 0 is no model the rules know: an ArgumentError."""
+    pid = tune_pid(LowOrderModel(2.0, 0.0, 0.5, dt=0.01))
+    assert (pid.kp, pid.ki, pid.kd) == (0.0, 0.5, 0.0)
+    margins = pid.design["margins"]
+    assert margins["gain_margin"] == pytest.approx(math.pi, rel=0.015)
+    assert margins["phase_margin_deg"] == pytest.approx(90 - math.degrees(0.5), abs=0.5)
+    assert margins["stable"] is None
+    for args in ((1.0, 0.0, 0.0), (1.0, 0.0, 0.1, 0.2)):
+        with pytest.raises(ArgumentError, match=r"tau1 = tau2 = 0 with theta > 0: a pure delay"):
+            LowOrderModel(*args, dt=0.01)
+
+
+def test_the_margins_are_recorded_and_simcs_promise_holds_on_a_first_order_process():
+    """The first-order process with delay of test_simc_loop_margins…: pid.design['margins']
+    holds the loop's margins (those of robustness, python-control's to 1e-8) and no warning
+    is given (π and 61°, the case SIMC is exact for)."""
+    g = _foptd()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        pid = tune_pid(g)
+    gm, pm = _python_control_margins(g, pid)
+    assert pid.design["margins"]["gain_margin"] == pytest.approx(gm, rel=1e-8)
+    assert pid.design["margins"]["phase_margin_deg"] == pytest.approx(pm, rel=1e-8)
+    assert pid.design["structure"] == "PI"
+
+
+def test_low_margins_on_a_second_order_arx_warn_with_a_tau_c_that_restores_them():
+    """(0.2 q⁻¹ + 0.15 q⁻²)/(1 − 1.5 q⁻¹ + 0.56 q⁻²) at h = 0.01 s (poles 0.8, 0.7; a zero that
+    rule R3 cancels): the SIMC PID has gain margin 1.833 and phase margin 29.1° on it
+    (python-control's to 1e-8), well below SIMC's 3 and 47°: one AccuracyWarning with the
+    numbers and the first τ_c of 2θ, 3θ … that clears 2 and 30° (τ_c = 2θ = 0.01 s: 2.8 and
+    49.6°, which tune_pid then gives without a warning)."""
+    from gripkit.errors import AccuracyWarning
+
+    g = TransferFunction.from_polynomials([1.0, -1.5, 0.56], [0.0, 0.2, 0.15], dt=0.01)
+    with pytest.warns(AccuracyWarning) as caught:
+        pid = tune_pid(g)
+    assert len(caught) == 1
+    message = str(caught[0].message)
+    gm, pm = _python_control_margins(g, pid)
+    assert pid.design["margins"]["gain_margin"] == pytest.approx(gm, rel=1e-8)
+    assert pid.design["margins"]["phase_margin_deg"] == pytest.approx(pm, rel=1e-8)
+    assert gm == pytest.approx(1.833, abs=5e-4) and pm == pytest.approx(29.14, abs=0.01)
+    assert "gain margin 1.83 and phase margin 29.1°" in message and "\n" not in message
+    assert "tau_c=0.01 s gives 2.8 and 49.6°" in message
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        again = tune_pid(g, tau_c=0.01)
+    assert again.design["margins"]["gain_margin"] == pytest.approx(2.8, abs=0.005)
+    assert again.design["margins"]["phase_margin_deg"] == pytest.approx(49.6, abs=0.05)

@@ -17,6 +17,14 @@ Schema (version 1)::
 ``design`` is provenance only (the SIMC reduction, the RST pole placement), never read back into
 the law. Files are written atomically (:mod:`gripkit.atomic`); reading checks the format tag, the
 version, the kind and every number, and a bad file is a ConfigError naming the file and field.
+
+The file ends with ``content_sha256``, the content digest every model file carries
+(:func:`gripkit.sysid.model_file.content_hash`: the SHA-256 of the canonical JSON of every other
+entry). A file whose gains, limits or sample time were edited after gripkit wrote it loads with
+one DataWarning naming the file (:func:`~gripkit.sysid.model_file.check_content_hash`; the
+edited numbers are used, so a deliberate edit stays possible, and writing the file again with
+:data:`RESAVE` drops the warning) before ``gripkit export c`` turns it into code for a target; a
+file without the entry (written before gripkit wrote one) loads silently.
 """
 
 from __future__ import annotations
@@ -29,16 +37,19 @@ import numpy as np
 
 from ..atomic import write_text
 from ..errors import ConfigError, GripkitError, PathError
+from ..sysid.model_file import check_content_hash, content_hash
 from .pid import PID
 from .rst import RSTController
 from .state_feedback import StateFeedback
 
-__all__ = ["FORMAT", "VERSION", "KINDS", "controller_to_dict", "controller_from_dict",
+__all__ = ["FORMAT", "VERSION", "KINDS", "RESAVE", "controller_to_dict", "controller_from_dict",
            "save_controller", "load_controller"]
 
 FORMAT = "gripkit.controller"
 VERSION = 1
 KINDS = ("pid", "rst", "lqr")
+#: how to write a controller file again (the hint of the edited-file warning)
+RESAVE = "gripkit.control.save_controller(gripkit.control.load_controller(path), path)"
 
 
 def _lim(v):
@@ -103,8 +114,12 @@ def controller_to_dict(controller) -> dict:
 
 
 def save_controller(controller, path) -> Path:
-    """Write ``controller`` to ``path`` (JSON, atomically); returns the path."""
-    text = json.dumps(controller_to_dict(controller), indent=2, allow_nan=False) + "\n"
+    """Write ``controller`` to ``path`` (JSON, atomically, ending with its ``content_sha256``:
+    :func:`~gripkit.sysid.model_file.content_hash` of the document as the reader sees it);
+    returns the path."""
+    doc = json.loads(json.dumps(controller_to_dict(controller), allow_nan=False))
+    doc["content_sha256"] = content_hash(doc)
+    text = json.dumps(doc, indent=2, allow_nan=False) + "\n"
     return write_text(Path(path), text, what="controller file")
 
 
@@ -193,15 +208,30 @@ def controller_from_dict(d, where: str = "controller file"):
 
 
 def load_controller(path):
-    """Read a controller file (:func:`save_controller`)."""
+    """Read a controller file (:func:`save_controller`); one DataWarning naming the file when
+    its ``content_sha256`` does not match its content (edited after it was saved: the file is
+    used as it now stands), none for a file without the entry."""
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")
     except OSError as e:
         raise PathError(f"controller file {str(path)!r}: cannot be read ({e.strerror})") from None
+    except UnicodeDecodeError:
+        raise ConfigError(f"controller file {path.name!r}: not UTF-8 text (a controller file is "
+                          "JSON)") from None
     try:
         d = json.loads(text)
     except json.JSONDecodeError as e:
         raise ConfigError(f"controller file {path.name!r}: not valid JSON (line {e.lineno}: "
                           f"{e.msg})") from None
+    except (RecursionError, ValueError):  # nesting past the recursion limit, huge integers
+        raise ConfigError(f"controller file {path.name!r}: cannot be read (its JSON nests too "
+                          "deep or holds a number of too many digits; a controller file nests "
+                          "a few levels)") from None
+    if isinstance(d, dict) and d.get("format") == FORMAT:
+        try:
+            check_content_hash(d, f"controller file {str(path)!r}", RESAVE)
+        except RecursionError:
+            raise ConfigError(f"controller file {path.name!r}: its JSON nests lists or objects "
+                              "too deep to be read; a controller file nests a few levels") from None
     return controller_from_dict(d, f"controller file {path.name!r}")

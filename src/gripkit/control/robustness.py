@@ -40,7 +40,8 @@ from .pid import PID
 from .rst import RSTController, as_plant
 from .state_feedback import StateFeedback
 
-__all__ = ["Robustness", "controller_transfer_function", "loop_margins", "robustness"]
+__all__ = ["Robustness", "controller_transfer_function", "frequency_margins", "loop_margins",
+           "robustness"]
 
 
 def controller_transfer_function(controller) -> tuple[np.ndarray, np.ndarray, float | None]:
@@ -88,6 +89,14 @@ def loop_margins(num, den, dt: float, *, n_grid: int = 4000) -> dict:
         z = np.exp(1j * np.asarray(w) * dt)
         return np.polyval(num, z) / np.polyval(den, z)
 
+    return frequency_margins(L, dt, n_grid=n_grid)
+
+
+def frequency_margins(L, dt: float, *, n_grid: int = 4000) -> dict:
+    """:func:`loop_margins` of a loop given by its frequency response ``L(ω)`` (a function of
+    ω in rad/s, an array or a scalar, returning complex values) on 0 < ω < π/dt: a sampled
+    controller on a continuous plant with delay (:func:`gripkit.control.tune_pid` on a
+    :class:`~gripkit.control.LowOrderModel`)."""
     w = _grid(dt, n_grid)
     with np.errstate(divide="ignore", invalid="ignore"):
         Lw = L(w)

@@ -4,16 +4,39 @@ Reference: S. Skogestad, "Simple analytic rules for model reduction and PID cont
 *Journal of Process Control* 13 (2003) 291–309: the half rule (§3, eqs 8–10) reduces a model to
 first or second order plus time delay, and Table 1 gives the settings of the series PID
 ``c(s) = K_c (τ_I s + 1)/(τ_I s) · (τ_D s + 1)`` with the closed-loop time constant τ_c as the
-one tuning knob (default τ_c = θ, "tight control": gain margin ≈ 3, phase margin ≈ 47° on a
-first-order process with delay, the paper's §4.3):
+one tuning knob (default τ_c = θ, "tight control"):
 
     g = k e^{−θs}/(τ₁s + 1)                 K_c = τ₁/(k (τ_c + θ)),  τ_I = min(τ₁, 4(τ_c + θ))
     g = k e^{−θs}/((τ₁s + 1)(τ₂s + 1))       the same, and τ_D = τ₂
     g = k′ e^{−θs}/s                        K_c = 1/(k′ (τ_c + θ)),  τ_I = 4(τ_c + θ)
     g = k′ e^{−θs}/(s (τ₂s + 1))             the same, and τ_D = τ₂
+    g = k e^{−θs}                           k_i = 1/(k (τ_c + θ)): an integral (I) controller
 
 The series settings become :class:`~gripkit.control.PID`'s parallel gains exactly:
-``k_p = K_c (1 + τ_D/τ_I)``, ``k_i = K_c/τ_I``, ``k_d = K_c τ_D``.
+``k_p = K_c (1 + τ_D/τ_I)``, ``k_i = K_c/τ_I``, ``k_d = K_c τ_D``. The last line is the first
+with τ₁ → 0 (K_c → 0, τ_I = τ₁ → 0, K_c/τ_I = 1/(k (τ_c + θ)) kept): SIMC's integral controller
+for a pure time-delay process (stated so by C. Grimholt and S. Skogestad, "Optimal PI-control
+and verification of the SIMC tuning rule", IFAC Conference on Advances in PID Control, PID'12,
+Brescia, 2012: the SIMC PI rule gives a pure integral controller there); a model with no lag
+left after the reduction (a static gain with delay, an FIR model) is tuned so. The PID's
+integral ``k_i h/(z − 1)`` acts a sample late, which for an I-controller delays the whole loop:
+:func:`reduce_model` adds that sample h to θ besides the hold's h/2 (on b q⁻¹ the rule without
+it gives k_i h k = 1, the closed-loop poles z² − z + 1 = 0 on the unit circle; with it
+z² − z + 1/3: gain margin 3, phase margin 61.2°, SIMC's π and 61.4°).
+
+**Margins.** SIMC's "gain margin ≈ 3, phase margin ≈ 47°" (τ_c = θ, the paper's §4.3) holds on
+the models the rules are exact for: the first-order process with delay (τ₁ ≤ 8θ: L =
+e^{−θs}/(2θs), gain margin π and phase margin 61.4°; τ₁ → ∞: 2.96 and 46.9°), the pure delay
+(L = e^{−θs}/(2θs): π and 61.4°) and the integrating process with delay (2.96, 46.9°). On any other
+model the PID acts on the model itself, not on its reduction, and its margins are whatever that
+loop has ((0.2 q⁻¹ + 0.15 q⁻²)/(1 − 1.5 q⁻¹ + 0.56 q⁻²) at h = 0.01 s, whose zero the
+reduction cancels by rule R3: 1.83 and 29.1°).
+:func:`tune_pid` therefore computes the achieved margins on the model it was given
+(:func:`~gripkit.control.robustness` of the discrete model; for a :class:`LowOrderModel`,
+:func:`~gripkit.control.robustness.frequency_margins` of the sampled PID on the continuous
+model), records them in ``pid.design["margins"]`` and warns (AccuracyWarning) when the gain
+margin is below :data:`MIN_GAIN_MARGIN` or the phase margin below :data:`MIN_PHASE_MARGIN`
+(well below SIMC's): a larger ``tau_c`` is more robust.
 
 Model reduction (:func:`reduce_model`) of a discrete SISO model with sample time h and n_k samples
 of input delay: the ZOH model without its delay beyond the first sample is taken to continuous
@@ -55,9 +78,10 @@ import warnings
 
 import numpy as np
 
-from ..errors import AccuracyWarning, ArgumentError, ModelError
+from ..errors import AccuracyWarning, ArgumentError, ModelError, emit_warning
 from ..lti import TransferFunction
 from .pid import PID
+from .robustness import controller_transfer_function, frequency_margins, robustness
 from .rst import as_plant
 
 __all__ = ["LowOrderModel", "reduce_model", "simc_settings", "tune_pid"]
@@ -72,12 +96,17 @@ INTEGRATOR_SIGMAS = 3.0
 INTEGRATOR_TOL = 1e-9
 #: the keyword options of tune_pid that go on to PID (the gains and dt come from the design)
 PID_OPTIONS = ("u_min", "u_max", "tf", "b", "c", "tt")
+#: :func:`tune_pid` warns when the achieved loop has a gain margin below this (SIMC: about 3) …
+MIN_GAIN_MARGIN = 2.0
+#: … or a phase margin below this many degrees (SIMC: about 47°)
+MIN_PHASE_MARGIN = 30.0
 
 
 class LowOrderModel:
-    """``k e^{−θs}/((τ₁s + 1)(τ₂s + 1))`` (τ₂ = 0: first order), or with ``integrating``
-    ``k e^{−θs}/(s (τ₂s + 1))`` (k is then k′, τ₁ unused), and the sample time ``dt`` (s) the
-    PID will run at. ``dt`` is not added to θ here: :func:`reduce_model` adds h/2 itself."""
+    """``k e^{−θs}/((τ₁s + 1)(τ₂s + 1))`` (τ₂ = 0: first order; τ₁ = τ₂ = 0: the pure delay
+    ``k e^{−θs}``, θ > 0), or with ``integrating`` ``k e^{−θs}/(s (τ₂s + 1))`` (k is then k′,
+    τ₁ unused), and the sample time ``dt`` (s) the PID will run at. ``dt`` is not added to θ
+    here: :func:`reduce_model` adds h/2 itself."""
 
     __slots__ = ("k", "tau1", "tau2", "theta", "integrating", "dt", "notes")
 
@@ -90,8 +119,10 @@ class LowOrderModel:
         if k == 0:
             raise ArgumentError("LowOrderModel k: the gain is zero: the input does not move the "
                                 "output")
-        if theta < 0 or tau2 < 0 or (tau1 <= 0 and not integrating) or dt <= 0:
-            raise ArgumentError(f"LowOrderModel: expected tau1 > 0, tau2 >= 0, theta >= 0 and "
+        pure_delay = tau1 == 0 and tau2 == 0 and theta > 0
+        if theta < 0 or tau2 < 0 or (tau1 <= 0 and not integrating and not pure_delay) or dt <= 0:
+            raise ArgumentError(f"LowOrderModel: expected tau1 > 0 (or tau1 = tau2 = 0 with "
+                                f"theta > 0: a pure delay), tau2 >= 0, theta >= 0 and "
                                 f"dt > 0 (s), found tau1={tau1!r}, tau2={tau2!r}, "
                                 f"theta={theta!r}, dt={dt!r}")
         self.k, self.tau1, self.tau2, self.theta = float(k), float(tau1), float(tau2), float(theta)
@@ -251,10 +282,12 @@ def reduce_model(model, order: int = 1) -> LowOrderModel:
     theta += sum(t_inv) + h / 2.0
     if h_int is not None:  # the integrator plays τ1 = ∞: the lags fill τ2 and θ
         first, lags = [], taus
+    elif not taus:  # a static gain with delay: τ1 = 0, SIMC's I-controller
+        first, lags = [], []
+        theta += h  # the I-controller's own sample: its integral k_i h/(z − 1) acts a sample late
+        notes.append("no lag left: a pure delay k e^{-θs} (SIMC: an integral controller); θ "
+                     "includes one sample for the integral, which acts a sample late")
     else:
-        if not taus:
-            raise ModelError("tune_pid: the model has no lag left (a pure delay); SIMC gives "
-                             "an integral controller there", hint="use PID(0, ki) by hand")
         first, lags = [taus[0]], taus[1:]
     n_keep = order - 1  # lags kept beyond the first (or beyond the integrator)
     kept = lags[:n_keep]
@@ -273,7 +306,8 @@ def reduce_model(model, order: int = 1) -> LowOrderModel:
 
 
 def simc_settings(m: LowOrderModel, tau_c: float | None = None) -> dict:
-    """Skogestad's Table 1 for ``m``: series K_c, τ_I, τ_D and the parallel k_p, k_i, k_d."""
+    """Skogestad's Table 1 for ``m``: series K_c, τ_I, τ_D and the parallel k_p, k_i, k_d (a pure
+    delay: the I-controller k_i = 1/(k (τ_c + θ)), K_c = τ_I = τ_D = 0, module docstring)."""
     tc = m.theta if tau_c is None else float(tau_c)
     if not (math.isfinite(tc) and tc >= 0 and tc + m.theta > 0):
         raise ArgumentError(f"tau_c: expected a closed-loop time constant >= 0 s (with tau_c + "
@@ -283,6 +317,9 @@ def simc_settings(m: LowOrderModel, tau_c: float | None = None) -> dict:
     if m.integrating:
         Kc = 1.0 / (m.k * (tc + m.theta))
         ti = 4.0 * (tc + m.theta)
+    elif m.tau1 == 0.0:  # the pure delay: τ1 → 0 in the first-order rule, K_c/τ_I kept
+        return dict(Kc=0.0, tau_I=0.0, tau_D=0.0, tau_c=tc, kp=0.0,
+                    ki=1.0 / (m.k * (tc + m.theta)), kd=0.0)
     else:
         Kc = m.tau1 / (m.k * (tc + m.theta))
         ti = min(m.tau1, 4.0 * (tc + m.theta))
@@ -303,7 +340,15 @@ def tune_pid(model, method: str = "simc", *, tau_c: float | None = None, order: 
     (setpoint weights of P and D), ``tt`` (anti-windup tracking time constant, s); any other name
     is an ArgumentError. The PID runs at the model's dt; ``pid.design`` records the reduction and
     settings (its ``model["notes"]`` say, e.g., that a pole within 3σ of 1 was taken as an
-    integrator).
+    integrator), the ``structure`` ('PID', 'PI', or 'I' on a pure delay) and the achieved
+    ``margins`` of the loop on ``model`` itself (``gain_margin``, ``gain_margin_db``,
+    ``phase_margin_deg``, their frequencies in rad/s, and ``stable``: the discrete loop's poles
+    inside the unit circle, None for a :class:`LowOrderModel`). SIMC's gain margin ≈ 3 and phase
+    margin ≈ 47° hold for the first-order process with delay (and the pure delay, the
+    integrating process) it is exact for; on another model, whose reduction is approximate, the
+    margins may be lower (module docstring): an AccuracyWarning says so when the gain margin is
+    below 2 or the phase margin below 30° (or the loop is unstable), with a larger ``tau_c`` as
+    the remedy.
     """
     if method != "simc":
         raise ArgumentError(f"method: expected 'simc' (Skogestad's rules), found {method!r}")
@@ -318,5 +363,57 @@ def tune_pid(model, method: str = "simc", *, tau_c: float | None = None, order: 
         m = reduce_model(model, 2 if order is None else order)
     s = simc_settings(m, tau_c)
     design = dict(method="SIMC (Skogestad 2003, Table 1), half-rule reduction",
-                  model=m.to_dict(), **{k: s[k] for k in ("Kc", "tau_I", "tau_D", "tau_c")})
-    return PID(s["kp"], s["ki"], s["kd"], dt=m.dt, design=design, **pid_options)
+                  model=m.to_dict(), **{k: s[k] for k in ("Kc", "tau_I", "tau_D", "tau_c")},
+                  structure="PID" if s["kd"] else ("PI" if s["kp"] else "I"))
+    pid = PID(s["kp"], s["ki"], s["kd"], dt=m.dt, design=design, **pid_options)
+    pid.design["margins"] = _achieved_margins(model, m, pid)
+    _warn_if_margins_low(model, m, pid, s["tau_c"])
+    return pid
+
+
+def _achieved_margins(model, m: LowOrderModel, pid: PID) -> dict:
+    """The margins of ``pid`` in the loop with ``model`` (:func:`robustness`, nominal), or for a
+    :class:`LowOrderModel` ``m`` of the sampled PID ``C(e^{jωh})`` on ``m``'s continuous
+    frequency response (θ carries the hold's h/2, as :func:`reduce_model` writes it)."""
+    if not isinstance(model, LowOrderModel):
+        r = robustness(model, pid, n=0)
+        return {**r.nominal, "stable": r.stable}
+    num, den, dt = controller_transfer_function(pid)
+
+    def loop(w):
+        s = 1j * np.asarray(w)
+        lag = (m.tau2 * s + 1.0) * (s if m.integrating else m.tau1 * s + 1.0)
+        return (np.polyval(num, np.exp(s * dt)) / np.polyval(den, np.exp(s * dt))
+                * m.k * np.exp(-m.theta * s) / lag)
+
+    return {**frequency_margins(loop, dt), "stable": None}
+
+
+def _warn_if_margins_low(model, m: LowOrderModel, pid: PID, tau_c: float) -> None:
+    """An AccuracyWarning when the achieved loop (``pid.design["margins"]``) is unstable or its
+    margins lie well below SIMC's (gain margin < :data:`MIN_GAIN_MARGIN`, phase margin <
+    :data:`MIN_PHASE_MARGIN`), naming the first of τ_c = 2, 3, 4, 6, 8 × max(τ_c, θ) whose loop
+    clears both, where one does."""
+    def low(margins):
+        return (margins["stable"] is False or margins["gain_margin"] < MIN_GAIN_MARGIN
+                or margins["phase_margin_deg"] < MIN_PHASE_MARGIN)
+
+    margins = pid.design["margins"]
+    if not low(margins):
+        return
+    remedy = "a larger tau_c is more robust"
+    for factor in (2.0, 3.0, 4.0, 6.0, 8.0):
+        tc = factor * max(tau_c, m.theta)
+        s = simc_settings(m, tc)
+        better = _achieved_margins(model, m, PID(s["kp"], s["ki"], s["kd"], dt=m.dt))
+        if not low(better):
+            remedy = (f"tau_c={tc:.3g} s gives {better['gain_margin']:.3g} and "
+                      f"{better['phase_margin_deg']:.3g}°")
+            break
+    gm, pm = margins["gain_margin"], margins["phase_margin_deg"]
+    state = "is unstable on the model: its " if margins["stable"] is False else "has "
+    emit_warning(f"tune_pid: the loop {state}gain margin {gm:.3g} and phase margin {pm:.3g}° "
+                 f"on the model with tau_c = {tau_c:.3g} s (SIMC gives about 3 and 47° on the "
+                 f"first-order process with delay it is exact for; this model's reduction is "
+                 f"approximate), so expect overshoot and oscillation on the plant; {remedy}",
+                 AccuracyWarning)

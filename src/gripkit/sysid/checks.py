@@ -18,7 +18,8 @@ from .regression import COND_LIMIT, arx_regression, qr_r, scaled_condition
 __all__ = ["as_signal", "signal_array", "signal_with_peaks", "as_io_matrix", "check_not_transposed",
            "io_records",
            "check_io", "check_io_peaks", "check_io_arrays", "check_order", "check_dt",
-           "require_samples", "check_excitation", "check_channels_vary", "channel_of",
+           "require_samples", "check_excitation", "check_channels_vary", "check_columns_vary",
+           "channel_of",
            "check_output_varies", "checked_problem", "checked_problem_peaks", "check_identifiable",
            "check_persistent_excitation", "check_dimension", "LENGTH_OR_ANGLE", "FORCE_OR_TORQUE",
            "LINEAR_ORDERS"]
@@ -299,6 +300,41 @@ def check_channels_vary(u: np.ndarray, y: np.ndarray, meta: dict,
     check_excitation(u, label, None if peaks is None else peaks[0], offset=offset, unit=unit)
     label, offset, unit = channel_of(meta, "output", "y")
     check_output_varies(y, label, None if peaks is None else peaks[1], offset=offset, unit=unit)
+
+
+def _nth(value, i: int, k: int):
+    """The entry of channel ``i`` of ``k`` in a model keyword's ``value``: a sequence of ``k``
+    entries, or one value for a single channel; None otherwise."""
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return value[i] if len(value) == k else None
+    return value if k == 1 else None
+
+
+def check_columns_vary(u: np.ndarray, y: np.ndarray, meta: dict | None = None) -> None:
+    """:func:`check_excitation` on every column of a MIMO estimator's checked (N, m) input ``u``
+    and :func:`check_output_varies` on every column of its (N, p) output ``y`` (the data as the
+    caller gives them, before any scaling), the columns named by the model keywords ``meta``
+    (``inputs`` or ``input_name``, ``input_units`` or ``input_unit``, ``u_offset``; the same
+    for the outputs): ``input column 'current'`` with its value, the offset added back, in its
+    unit, or ``input channel 1`` without a name. One pass for the minima and one for the maxima
+    of all columns. A record of one sample is left to the caller's length check (which says how
+    many samples it needs)."""
+    if u.shape[0] < 2:
+        return
+    meta = meta or {}
+    for role, symbol, x, check in (("input", "u", u, check_excitation),
+                                   ("output", "y", y, check_output_varies)):
+        k = x.shape[1]
+        lo, hi = np.min(x, axis=0), np.max(x, axis=0)
+        for i in range(k):
+            name, unit, offset = (_nth(meta.get(a, meta.get(b)), i, k) for a, b in (
+                (f"{role}s", f"{role}_name"), (f"{role}_units", f"{role}_unit"),
+                (f"{symbol}_offset", f"{symbol}_offsets")))
+            label = f"{role} column {name!r}" if isinstance(name, str) else f"{role} channel {i}"
+            number = isinstance(offset, (int, float, np.number)) and not isinstance(offset, bool)
+            off = float(offset) if number and math.isfinite(float(offset)) else 0.0
+            check(x[:, i], label, (float(lo[i]), float(hi[i])), offset=off,
+                  unit=unit if isinstance(unit, str) else None)
 
 
 def checked_problem(u, y, dt: float | None, **orders):

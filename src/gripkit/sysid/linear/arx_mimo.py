@@ -22,7 +22,7 @@ from __future__ import annotations
 import numpy as np
 
 from ...errors import DataError
-from ..checks import check_dt, check_order, io_records
+from ..checks import check_columns_vary, check_dt, check_order, io_records
 from .linear_model import as_io_matrix, estimate_x0, fit_per_output, free_run
 from .polynomial import PolynomialModel, channel_meta
 from ..regression import qr_solve
@@ -50,7 +50,9 @@ def arx_mimo(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
     """
     u = as_io_matrix(u, "input u")
     y = as_io_matrix(y, "output y", u.shape[0])
-    return _arx_mimo([(u, y)], na, nb, nk, dt, channel_meta(meta, arx_mimo, False))
+    meta = channel_meta(meta, arx_mimo, False)
+    check_columns_vary(u, y, meta)  # a constant column named, as identify names it
+    return _arx_mimo([(u, y)], na, nb, nk, dt, meta)
 
 
 def arx_mimo_records(records, na: int, nb: int, nk: int = 1, *, dt: float | None = None,

@@ -32,7 +32,7 @@ from numpy.lib.stride_tricks import sliding_window_view
 
 from ...errors import AccuracyWarning, ArgumentError, DataError, emit_warning
 from ...units import ratio_unit
-from ..checks import check_dt
+from ..checks import check_columns_vary, check_dt
 from .linear_model import as_io_matrix
 
 __all__ = ["FRF", "frf", "FRF_METHODS"]
@@ -325,6 +325,8 @@ def frf(u, y, *, dt: float | None = None, method: str = "auto", periods: int | N
     """
     u = as_io_matrix(u, "input u")
     y = as_io_matrix(y, "output y", u.shape[0])
+    check_columns_vary(u, y, dict(inputs=inputs, outputs=outputs, input_units=input_units,
+                                  output_units=output_units))
     step = check_dt(dt)
     if method == "auto":
         method = "periodic" if periods is not None else "h1"

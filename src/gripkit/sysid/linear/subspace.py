@@ -42,8 +42,8 @@ import scipy.linalg as sla
 from ...errors import DataError, IdentificationError, StabilityWarning, emit_warning
 from ...lti import StateSpace
 from .blocked_gram import add_rows, carried_states, carry, row_product, start_sums
-from ..checks import (check_dt, check_excitation, check_output_varies, io_records,
-                      warn_if_operating_point)
+from ..checks import (check_columns_vary, check_dt, check_excitation, check_output_varies,
+                      io_records, warn_if_operating_point)
 from .linear_model import (LinearModel, as_io_matrix, fit_per_output, free_run,
                            observability_regressor)
 from ..regression import qr_r
@@ -470,6 +470,15 @@ def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int
         ``.singular_values``, ``.fit_percent`` (free run per output), ``.info`` (horizon,
         stability note; ``covariance`` with ``bootstrap``, else ``sigma``).
 
+    Raises
+    ------
+    UnidentifiableError
+        For a constant input or output column (:func:`~gripkit.sysid.checks.check_columns_vary`,
+        the check of :func:`~gripkit.sysid.identify`), named by ``inputs``/``outputs`` or its
+        index, with its value: the data are deviation units, so a constant input is no offset
+        input of the model but a channel that carries nothing about B (drop it, or record it
+        varying), and a constant output has no dynamics to identify.
+
     Examples
     --------
     >>> import numpy as np
@@ -486,6 +495,9 @@ def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int
     _check_bootstrap_option(bootstrap, bootstrap_seed)
     u = as_io_matrix(u, "input u")
     y = as_io_matrix(y, "output y", u.shape[0])
+    signals = (dict(inputs=inputs, outputs=outputs, input_units=input_units,
+                    output_units=output_units))
+    check_columns_vary(u, y, {**signals, "u_offset": u_offset, "y_offset": y_offset})
     step = check_dt(dt)
     order, n_max = _orders(order, max_order)
     p = y.shape[1]
@@ -495,8 +507,6 @@ def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int
     if u.shape[1] == y.shape[1] == 1 and n > 0:  # as ARX [n n nk] with a constant term
         warn_if_operating_point(u[:, 0], y[:, 0], n, n, 0 if feedthrough else 1,
                                 f"{method} (order {n})")
-    signals = (dict(inputs=inputs, outputs=outputs, input_units=input_units,
-                    output_units=output_units))
     model = from_factor(fac, n, dt=step, feedthrough=feedthrough, stable=stable, signals=signals)
     model.info["order_selection"] = ("given" if order is not None
                                      else "singular values above the noise floor")

@@ -34,8 +34,8 @@ from scipy import signal as _signal
 
 from ...errors import DataError, IdentificationError, ModelError
 from ...lti import StateSpace, TransferFunction
-from ..checks import (check_dt, check_order, check_persistent_excitation, io_records,
-                      warn_if_operating_point)
+from ..checks import (channel_of, check_dt, check_excitation, check_order, check_output_varies,
+                      check_persistent_excitation, io_records, warn_if_operating_point)
 from ..scaling import unit_scale
 from .frf import FRF, frf
 from .linear_model import (LinearModel, as_io_matrix, estimate_x0, fit_per_output, free_run,
@@ -53,6 +53,23 @@ def _check_orders(n_poles, n_zeros):
                         f"found {n_zeros}",
                         hint="an improper transfer function cannot be simulated")
     return n_poles, n_zeros
+
+
+def _check_channels_vary(recs: list, signals: dict, u_offset, y_offset) -> None:
+    """An UnidentifiableError naming the channel (its value, the offset added back, in its unit;
+    of several records, the record) for an input constant over all records of ``recs`` ((u, y)
+    pairs of columns) or an output constant in one of them: a constant input cannot identify G,
+    a constant output has nothing to fit and its fit % is undefined, and either one's FRF, the
+    start, is zero or undefined (numpy's least squares then failed: 'SVD did not converge')."""
+    meta = {**signals, "u_offset": u_offset, "y_offset": y_offset}
+    label, offset, unit = channel_of(meta, "input", "u")
+    u = recs[0][0][:, 0] if len(recs) == 1 else np.concatenate([u[:, 0] for u, _ in recs])
+    check_excitation(u, label if len(recs) == 1 else f"{label} of all {len(recs)} records",
+                     offset=offset, unit=unit)
+    label, offset, unit = channel_of(meta, "output", "y")
+    for i, (_, y) in enumerate(recs):
+        check_output_varies(y[:, 0], label if len(recs) == 1 else f"records[{i}] {label}",
+                            offset=offset, unit=unit)
 
 
 def _eval(theta, s, npo, nz):
@@ -311,6 +328,9 @@ def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None,
         raise DataError(f"tfest: {N} samples are too few for {k} coefficients (need at "
                         f"least {10 * k + 64})",
                         hint="use a longer record or fewer poles/zeros")
+    signals = (dict(inputs=inputs, outputs=outputs, input_units=input_units,
+                    output_units=output_units))
+    _check_channels_vary([(u, y)], signals, u_offset, y_offset)
     check_persistent_excitation(u[:, 0], k, f"tfest ({npo} poles, {nz} zeros: {k} coefficients)")
     if npo > 0:  # its zero-order-hold equivalent is an ARX [npo npo 1] with a constant term
         warn_if_operating_point(u[:, 0], y[:, 0], npo, npo, 1, f"tfest ({npo} poles, {nz} zeros)")
@@ -337,8 +357,6 @@ def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None,
     Ad, Bd, Cd, Dd = _simulate_ct(theta, npo, nz, uu, step)
     x0 = estimate_x0(Ad, Bd, Cd, Dd, uu, y)
     fit = fit_per_output(y, free_run(Ad, Bd, Cd, Dd, uu, x0))
-    signals = (dict(inputs=inputs, outputs=outputs, input_units=input_units,
-                    output_units=output_units))
     return _model(theta, 0.5 * (cov + cov.T), npo, nz, fit=fit, structure="tfest",
                   info={"source": "time domain (zero-order hold, output error from the "
                                   "least-squares initial state)", "nfev": int(sol.nfev)},
@@ -370,6 +388,9 @@ def tfest_records(records, n_poles: int, n_zeros: int, *, dt: float | None = Non
         raise DataError(f"tfest: {N} samples in all are too few for {k} coefficients and "
                         f"{len(recs)} initial states",
                         hint="use longer records or fewer poles/zeros")
+    signals = dict(inputs=inputs, outputs=outputs, input_units=input_units,
+                   output_units=output_units)
+    _check_channels_vary(recs, signals, u_offset, y_offset)
     check_persistent_excitation(np.concatenate([u[:, 0] for u, _ in recs]), k,
                                 f"tfest ({npo} poles, {nz} zeros: {k} coefficients)")
     ul, yl = max(recs, key=lambda r: r[0].shape[0])
@@ -405,8 +426,6 @@ def tfest_records(records, n_poles: int, n_zeros: int, *, dt: float | None = Non
                       "initial state)", "nfev": int(sol.nfev), "n_records": len(recs),
             "records": [{"n_samples": int(y.shape[0]), "fit_percent": fit_per_output(y, h),
                          "x0": x0} for y, h, x0 in zip(ys, yhats, x0s)]}
-    signals = dict(inputs=inputs, outputs=outputs, input_units=input_units,
-                   output_units=output_units)
     return _model(theta, 0.5 * (cov + cov.T), npo, nz, fit=records_fit(ys, yhats).tolist(),
                   structure="tfest", info=info, signals=signals, u_offset=u_offset,
                   y_offset=y_offset, n=N)
