@@ -237,7 +237,8 @@ def _delay(d: int, k: float = 0.3, h: float = 0.01):
 
 def _python_control_margins(g, pid):
     """Gain and phase margin of the discrete loop C G by python-control (the reference)."""
-    control = pytest.importorskip("control")
+    import control  # python-control: a dependency of the project (pyproject.toml)
+
     from gripkit.control.robustness import controller_transfer_function
 
     num, den, dt = controller_transfer_function(pid)
