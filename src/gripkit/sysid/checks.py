@@ -403,7 +403,7 @@ def warn_if_operating_point(u, y, na: int, nb: int, nk: int, what: str,
     step from rest fits without a constant (c ≈ 0) and passes; a step input with an offset is
     told to subtract its starting steady state, not its mean (:func:`step_like`)."""
     u, y = np.ravel(u), np.ravel(y)
-    ubar, ybar = float(u.mean()), float(y.mean())
+    ubar, ybar = (float(np.add.reduce(x)) / x.size for x in (u, y))  # x.mean() without its wrapper
     (ulo, uhi), (ylo, yhi) = peaks or ((u.min(), u.max()), (y.min(), y.max()))
     if abs(ubar) <= CENTRED * (uhi - ulo) and abs(ybar) <= CENTRED * (yhi - ylo):
         return
