@@ -19,40 +19,8 @@ from scipy.stats import chi2
 
 from gripkit.errors import DataError, DataWarning, ModelError
 from gripkit.estimation import ExtendedKalmanFilter, KalmanFilter, UnscentedKalmanFilter
-from gripkit.lti import StateSpace
-from gripkit.sysid import LinearModel
 
-A = np.array([[0.95, 0.2, 0.0], [-0.2, 0.95, 0.1], [0.0, 0.0, 0.7]])
-B = np.array([[0.0, 1.0], [1.0, 0.0], [0.5, 0.5]])
-C = np.array([[1.0, 0.0, 0.0], [0.0, 0.3, 1.0]])
-D = np.array([[0.1, 0.0], [0.0, 0.0]])
-Q = np.diag([1e-2, 2e-2, 5e-3])
-R = np.array([[0.04, 0.01], [0.01, 0.09]])
-U0, Y0 = np.array([0.3, -1.0]), np.array([2.0, 0.5])
-P0 = np.eye(3)
-
-
-def model() -> LinearModel:
-    sys = StateSpace(A, B, C, D, dt=0.01, inputs=["u1", "u2"], outputs=["y1", "y2"])
-    return LinearModel(sys, "n4sid", u_offset=tuple(U0), y_offset=tuple(Y0))
-
-
-def f_py(x, u):
-    return A @ x + B @ (u - U0)
-
-
-def h_py(x, u):
-    return C @ x + D @ (u - U0) + Y0
-
-
-@numba.njit
-def f_nb(x, u):
-    return A @ x + B @ (u - U0)
-
-
-@numba.njit
-def h_nb(x, u):
-    return C @ x + D @ (u - U0) + Y0
+from kalman_cases import A, B, C, D, P0, Q, R, U0, Y0, f_nb, f_py, h_nb, h_py, model
 
 
 def record(N, seed, drop=0.0):

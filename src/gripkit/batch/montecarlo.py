@@ -62,11 +62,10 @@ def _outcomes(flags) -> np.ndarray:
         raise DataError(f"flags: expected outcomes True/False or 1/0, found {kind} values")
     a = a.astype(np.float64).ravel()
     keep = ~np.isnan(a)
-    bad = keep & (a != 0.0) & (a != 1.0)
-    if bad.any():
-        i = int(np.argmax(bad))
+    bad = np.flatnonzero(keep & (a != 0.0) & (a != 1.0))
+    if bad.size:
         raise DataError(f"flags: expected outcomes True/False or 1/0 (NaN for a run without one), "
-                        f"found {int(bad.sum())} other values (first {a[i]:g} at index {i})",
+                        f"found {bad.size} other values (first {a[bad[0]]:g} at index {bad[0]})",
                         hint="pass the event as booleans, e.g. probability(x > limit); for the "
                              "distribution of values use quantile")
     return a[keep]
