@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from gripkit import DataError, Trajectory
-from gripkit.signals import (ac_couple, butter_zpk, decimate, detrend, highpass, lowpass, resample,
-                             split, to_uniform)
+from gripkit.signals import (ac_couple, bandpass, butter_zpk, decimate, detrend, highpass, lowpass,
+                             resample, split, to_uniform)
 
 
 def test_amadeus_butterworth_poles_and_zeros():
@@ -105,3 +105,45 @@ def test_to_uniform_and_split():
     np.testing.assert_allclose(u["y"], 2 * u.t, atol=1e-12)
     a, b = split(u, 2)
     assert a.n + b.n == u.n
+
+
+def test_bandpass_too_low_band_is_a_data_error_with_a_scaled_band_that_works():
+    """A band whose sections round to nonsense is refused with a DataError (not scipy's
+    ValueError about Wn from a search with one cut-off): the message gives the band scaled as a
+    whole (same edge ratio, 10) to the lowest quarter decade that works. That band filters, and
+    the quarter decade below it is refused."""
+    x = np.random.default_rng(0).standard_normal(1000)
+    with pytest.raises(DataError, match=r"bandpass cut-off \[1.e-06 1.e-05\] Hz is too low for an "
+                                        r"order-4 Butterworth at dt = 0.001 s") as e:
+        bandpass(x, (1e-6, 1e-5), dt=1e-3, order=4)
+    m = re.search(r"the band scaled up to about \(([0-9.e+-]+), ([0-9.e+-]+)\) Hz \(the same "
+                  r"ratio of its edges, 10\) works at this order", str(e.value))
+    lo, hi = float(m.group(1)), float(m.group(2))
+    assert hi / lo == pytest.approx(10.0, rel=1e-2) and 1e-6 < lo < 1e-3
+    assert bandpass(x, (lo, hi), dt=1e-3, order=4).shape == x.shape
+    below = np.array([lo, hi]) / 10 ** 0.25
+    with pytest.raises(DataError, match="too low for an order-4"):
+        bandpass(x, tuple(below), dt=1e-3, order=4)
+
+
+def test_bandpass_passes_its_centre_frequency():
+    """Butterworth band-pass: gain 1 at the pre-warped centre sqrt(f1 f2) (bilinear transform,
+    2 atan(sqrt(tan(pi f1 dt) tan(pi f2 dt)))), the frequency that the section check evaluates;
+    a 10 Hz band at 1 kHz is not refused and passes its centre with amplitude 1."""
+    dt, band = 1e-3, (8.0, 12.0)
+    f0 = np.arctan(np.sqrt(np.tan(np.pi * band[0] * dt) * np.tan(np.pi * band[1] * dt)))
+    f0 /= np.pi * dt
+    t = np.arange(20000) * dt
+    y = bandpass(np.sin(2 * np.pi * f0 * t), band, dt=dt, order=4)
+    assert np.max(np.abs(y[10000:])) == pytest.approx(1.0, abs=2e-3)
+
+
+def test_filtering_a_plain_array_checks_its_samples_once(monkeypatch):
+    """samples() (a copy and a finiteness scan of every sample) runs once per plain-array call."""
+    from gripkit.signals import filters
+
+    calls = []
+    check = filters.samples
+    monkeypatch.setattr(filters, "samples", lambda *a: calls.append(1) or check(*a))
+    lowpass(np.ones(50), 1.0, dt=0.1)
+    assert len(calls) == 1

@@ -95,20 +95,24 @@ def samples(x, name: str = "x") -> np.ndarray:
 
 def _check_sections(sos, btype: str, order: int, cutoff, dt: float, n: int) -> None:
     """A DataError when the cut-off is too low for the order at this sample rate: the sections'
-    coefficients round so that the pass-band gain (at DC for a low-pass, at Nyquist for a
-    high-pass) is off by more than 1e-3, or the steady state for the first sample is singular.
-    The message gives the lowest cut-off that works at this order (searched in quarter decades
-    upward)."""
-    def gain(s):
-        z = 1.0 if btype == "lowpass" else -1.0
-        with np.errstate(divide="ignore", invalid="ignore"):
-            return float(np.prod([(b0 + b1 * z + b2) / (a0 + a1 * z + a2)
-                                  for b0, b1, b2, a0, a1, a2 in s]))
+    coefficients round so that the pass-band gain (at DC for a low-pass and a band-stop, at
+    Nyquist for a high-pass, at the band's pre-warped centre frequency for a band-pass) is off
+    by more than 1e-3, or the steady state for the first sample is singular. The message gives
+    the lowest cut-off that works at this order (searched in quarter decades upward; a band is
+    scaled as a whole, keeping the ratio of its edges)."""
+    def gain(s, wn):
+        if btype == "bandpass":  # Butterworth gain 1 at sqrt of the pre-warped edges' product
+            w = np.exp(-2j * np.arctan(np.sqrt(np.prod(np.tan(np.pi * wn * dt)))))
+        else:
+            w = -1.0 if btype == "highpass" else 1.0
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            return float(abs(np.prod([(b0 + b1 * w + b2 * w * w) / (a0 + a1 * w + a2 * w * w)
+                                      for b0, b1, b2, a0, a1, a2 in s])))
 
-    def fault(s):
+    def fault(s, wn):
         """Why the sections are unusable, or None."""
-        if btype in ("lowpass", "highpass") and not abs(gain(s) - 1.0) <= 1e-3:
-            return f"its sections round to a pass-band gain of {gain(s):.6g} instead of 1"
+        if not abs(gain(s, wn) - 1.0) <= 1e-3:
+            return f"its sections round to a pass-band gain of {gain(s, wn):.6g} instead of 1"
         try:
             if np.isfinite(_signal().sosfilt_zi(s)).all():
                 return None
@@ -116,21 +120,29 @@ def _check_sections(sos, btype: str, order: int, cutoff, dt: float, n: int) -> N
             pass
         return "its poles round to z = 1 (the steady state for the first sample is singular)"
 
-    why = fault(sos)
+    why = fault(sos, np.atleast_1d(np.asarray(cutoff, dtype=np.float64)))
     if why is None:
         return
-    nyq, fc, lo = 0.5 / dt, float(np.max(cutoff)), None
-    for k in range(1, 80):
-        trial = fc * 10 ** (k / 4)
-        if trial >= nyq:
+    nyq, wn = 0.5 / dt, np.atleast_1d(np.asarray(cutoff, dtype=np.float64))
+    fc, lo = float(wn.max()), None
+    for k in range(1, 80):  # the whole band scaled up together: its ratio stays as given
+        trial = wn * 10 ** (k / 4)
+        if trial.max() >= nyq:
             break
         with warnings.catch_warnings():  # scipy's BadCoefficients for the trials below it
             warnings.simplefilter("ignore")
-            if fault(_signal().butter(order, trial, btype=btype, fs=1 / dt, output="sos")) is None:
+            if fault(_signal().butter(order, trial if trial.size > 1 else trial[0], btype=btype,
+                                      fs=1 / dt, output="sos"), trial) is None:
                 lo = trial
                 break
-    works = (f"a cut-off from about {lo:.3g} Hz up to the Nyquist frequency {nyq:g} Hz works at "
-             f"this order" if lo else "no cut-off works at this order")
+    if lo is None:
+        works = "no cut-off works at this order"
+    elif lo.size == 1:
+        works = (f"a cut-off from about {lo[0]:.3g} Hz up to the Nyquist frequency {nyq:g} Hz "
+                 "works at this order")
+    else:
+        works = (f"the band scaled up to about ({lo[0]:.3g}, {lo[1]:.3g}) Hz (the same ratio of "
+                 f"its edges, {wn[1] / wn[0]:.3g}) works at this order")
     raise DataError(f"{btype} cut-off {np.squeeze(cutoff)} Hz is too low for an order-{order} "
                     f"Butterworth at dt = {dt:g} s (cut-off × dt = {fc * dt:.2g}): {why}; {works}",
                     hint=f"raise the cut-off, lower the order or decimate the record first; below "
@@ -146,7 +158,11 @@ def apply_sos(sos: np.ndarray, x: np.ndarray, zero_phase: bool = False,
     does not ring. ``zero_phase`` runs forward and backward (squared magnitude, no phase lag,
     not causal). ``x`` must be finite (:func:`samples`; ``name`` in its errors).
     """
-    x = samples(x, name)
+    return _run_sos(sos, samples(x, name), zero_phase)
+
+
+def _run_sos(sos: np.ndarray, x: np.ndarray, zero_phase: bool) -> np.ndarray:
+    """:func:`apply_sos` on samples already checked by :func:`samples`."""
     if zero_phase:
         padlen = 3 * (2 * sos.shape[0] + 1)
         if x.shape[0] <= padlen:
@@ -174,7 +190,7 @@ def _filter(x, btype, order, cutoff, dt, zero_phase, channels):
     x = samples(x)
     sos = butter_sos(order, cutoff, dt=dt, btype=btype)
     _check_sections(sos, btype, int(order), cutoff, dt, x.shape[0])
-    return apply_sos(sos, x, zero_phase)
+    return _run_sos(sos, x, zero_phase)  # x is checked: samples() once
 
 
 def lowpass(x, cutoff: float, *, dt: float | None = None, order: int = 2, zero_phase: bool = False,
