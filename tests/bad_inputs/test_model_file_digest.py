@@ -4,8 +4,9 @@ the user's eyes. Every model file gripkit writes (linear, dynamics, each nonline
 ends with ``content_sha256``, the SHA-256 of the canonical JSON of the rest of the document
 (:func:`gripkit.sysid.model_file.content_hash`); a file whose content no longer matches it loads
 with one DataWarning naming the file (a deliberate edit stays possible), in Python and as one
-``warning:`` line of the CLI (and in its JSON ``warnings``); a file without the entry (a nonlinear
-family's file written before it existed) loads silently.
+``warning:`` line of the CLI (and in its JSON ``warnings``); a file without the entry loads
+silently where it may predate the digest (a nonlinear family's file), with one DataWarning where
+gripkit has always written one (a linear model file).
 
 The models are identified on a short synthetic record built here (a saturated input current [A]
 into the ARX [2 2 1] force [N] y(t) = 1.2 y(t−1) − 0.5 y(t−2) + 0.8 w(t−1) + 0.3 w(t−2),
@@ -27,6 +28,7 @@ from gripkit.sysid import BoucWenOscillatorModel, identify, load_model
 
 DT = 0.01
 PHRASE = "its content differs from what gripkit wrote"
+MISSING = "its content cannot be checked against what gripkit wrote (content_sha256 is missing"
 
 
 def _record(n: int = 400, seed: int = 0) -> Trajectory:
@@ -169,18 +171,56 @@ def test_layout_and_key_order_do_not_matter(saved):
     assert caught == []
 
 
-def test_file_without_digest_loads_silently(saved, tmp_path):
-    """The entry removed (a nonlinear family's file written before gripkit wrote one): loads
-    without a warning, the model as saved (saved again, it writes the original file)."""
-    _, path = saved
+def test_file_without_digest_loads_silently_where_older_files_have_none(saved, tmp_path):
+    """The entry removed from a nonlinear family's file (such a file written before gripkit wrote
+    one has the same version): loads without a warning, the model as saved (saved again, it
+    writes the original file). A linear model file has had its digest in every version, so
+    there the missing entry is one DataWarning naming the file, and the file loads as it is."""
+    family, path = saved
     original = path.read_bytes()
     doc = json.loads(original)
     del doc["content_sha256"]
     path.write_text(json.dumps(doc, indent=1))
     back, caught = _load_quietly(path)
-    assert caught == []
+    if family == "arx":
+        assert len(caught) == 1 and MISSING in str(caught[0].message)
+        assert str(path) in str(caught[0].message)
+    else:
+        assert caught == []
     back.save(tmp_path / "again.json")
     assert (tmp_path / "again.json").read_bytes() == original
+
+
+def test_linear_file_with_dt_edited_and_digest_deleted_warns(tmp_path):
+    """Review reproducer: an ARX file whose dt was changed 0.01 → 0.02 s and whose digest was
+    deleted loaded without a word before; now one DataWarning (the missing digest, the hint to
+    save again), and the edited dt is used as it stands."""
+    path = tmp_path / "arx.json"
+    FAMILIES["arx"]().save(path)
+    doc = json.loads(path.read_text())
+    del doc["content_sha256"]
+    text = json.dumps(doc)
+    assert text.count('"dt": 0.01') >= 1
+    path.write_text(text.replace('"dt": 0.01', '"dt": 0.02'))
+    model, caught = _load_quietly(path)
+    assert len(caught) == 1
+    assert MISSING in str(caught[0].message) and "load_model(path).save(path)" in str(
+        caught[0].message)
+    assert model.system.dt == 0.02
+
+
+def test_digest_tells_an_integer_from_a_float():
+    """content_hash's documented canonical form: a float spelled otherwise (1.50, 15e-1) hashes
+    alike, but the integer 1 and the float 1.0 (and 0.0, -0.0) do not: JSON reads them as
+    different numbers, and merging them would change the digest of files already written."""
+    from gripkit.sysid.model_file import content_hash
+
+    def h(text):
+        return content_hash(json.loads(text))
+
+    assert h('{"a": 1.50}') == h('{"a": 15e-1}') == h('{"a": 1.5E0}')
+    assert h('{"a": 1}') != h('{"a": 1.0}')
+    assert h('{"a": 0.0}') != h('{"a": -0.0}')
 
 
 def test_cli_shows_the_warning_as_one_line(cli, tmp_path):

@@ -87,15 +87,23 @@ def test_tampered_file_warns(saved):
     assert m.theta[0] == doc["parameters"]["values"][0]
 
 
-def test_file_without_digest_loads_silently(saved):
-    """The content digest removed: the file loads without a warning (nothing says it was
-    edited), with the parameters saved."""
+def test_file_without_digest_warns(saved):
+    """The content digest removed: gripkit has written it in every dynamics model file (schema
+    version 1 had it from the start), so its absence is one DataWarning naming the file (edited or
+    written by another program; the hint saves it again), and the file loads with the parameters
+    as they stand."""
     doc = json.loads(saved.read_text())
     del doc["content_sha256"]
+    doc["parameters"]["values"][0] *= 1.5
     saved.write_text(json.dumps(doc))
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", DataWarning)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
         m = load_dynamics_model(saved)
+    caught = [w for w in caught if issubclass(w.category, DataWarning)]
+    assert len(caught) == 1
+    message = str(caught[0].message)
+    assert "content_sha256 is missing" in message and str(saved) in message
+    assert "load_dynamics_model(path).save(path)" in message
     assert list(m.theta) == doc["parameters"]["values"]
 
 

@@ -10,9 +10,10 @@ Every model file gripkit writes (linear, dynamics and the nonlinear families') e
 JSON of every other entry of the document (schema and versions, names, units, sample time,
 coefficients, σ, covariance, offsets, fit, provenance), written atomically with the rest. On load
 a digest that does not match is one DataWarning (:func:`check_content_hash`): the file was edited
-after gripkit wrote it, and is used as it now stands. A file without the entry (a nonlinear
-family's file written before gripkit wrote one) loads silently. :func:`load_model` refuses a file
-of another schema or a newer version.
+after gripkit wrote it, and is used as it now stands. A file without the entry warns as well
+where gripkit has always written one (linear and dynamics model files); a nonlinear family's file
+without it (written before gripkit wrote one, under the same version) loads silently.
+:func:`load_model` refuses a file of another schema or a newer version.
 """
 
 from __future__ import annotations
@@ -73,8 +74,14 @@ def content_hash(doc: dict) -> str:
     ensure_ascii=True)``, ``body`` being ``doc`` less its ``content_sha256``. Keys sorted at every
     level, no spaces, non-ASCII text escaped, each number as Python writes it (the shortest text
     that reads back the same double; NaN for a family that writes NaN), so the digest depends on
-    neither the file's indentation and key order nor the platform; a number spelled otherwise
-    but equal ("1.50", "15e-1") gives the same digest."""
+    neither the file's indentation and key order nor the platform. A number is hashed as JSON
+    reads it back, an integer as an int and anything with a fraction or exponent as a float:
+    a float spelled otherwise ("1.50", "15e-1", "1.5E0") gives the same digest, but ``1`` and
+    ``1.0`` (or ``10`` and ``1e1``, ``0.0`` and ``-0.0``) do not, so a tool that rewrites 1.0
+    as 1 (JavaScript's JSON.stringify does) makes the file read as edited. Ints and floats are
+    not merged into one form because every file written so far was hashed without it: merged,
+    the digest of each such file holding a whole-number float (``"dt": 1.0``) would change and
+    the unedited file would warn."""
     body = {k: v for k, v in doc.items() if k != "content_sha256"}
     text = json.dumps(body, sort_keys=True, separators=(",", ":"), ensure_ascii=True)
     return hashlib.sha256(text.encode()).hexdigest()
@@ -84,13 +91,25 @@ def content_hash(doc: dict) -> str:
 RESAVE = "gripkit.sysid.load_model(path).save(path)"
 
 
-def check_content_hash(doc: dict, what: str, resave: str = RESAVE) -> None:
+def check_content_hash(doc: dict, what: str, resave: str = RESAVE, *,
+                       required: bool = False) -> None:
     """One DataWarning when the document ``doc`` of the model file ``what`` (how the message
     names it) holds a ``content_sha256`` that is not its :func:`content_hash`: the file was
     edited after gripkit wrote it (a hand edit stays possible: the file is used as it stands);
-    ``resave`` says how to write it again. Silent for a document without the entry (a nonlinear
-    family's file written before gripkit wrote one): nothing says it was edited."""
-    if "content_sha256" in doc and doc["content_sha256"] != content_hash(doc):
+    ``resave`` says how to write it again. Without the entry: one DataWarning as well when
+    ``required`` (a format gripkit has always written with its digest: linear and dynamics
+    model files, so a file without it was edited or written by another program), silent
+    otherwise (a nonlinear family's or a controller file written before gripkit wrote one, of
+    the same schema version: nothing says it was edited)."""
+    if "content_sha256" not in doc:
+        if required:
+            emit_warning(f"{what}: its content cannot be checked against what gripkit wrote "
+                         "(content_sha256 is missing, and gripkit writes it in every such file: "
+                         "edited after it was saved or written by another program), so its "
+                         "numbers and units are used as they now stand; if the file is meant, "
+                         f"write it again to drop this warning: {resave}", DataWarning)
+        return
+    if doc["content_sha256"] != content_hash(doc):
         emit_warning(f"{what}: its content differs from what gripkit wrote (content_sha256 does "
                      "not match: edited after it was saved), so its numbers and units are used "
                      f"as they now stand; if the edit is meant, write it again to drop this "
@@ -211,7 +230,8 @@ def read_document(path, schema: str = SCHEMA, newest: int = SCHEMA_VERSION, *,
     """The JSON document of the model file ``path``, checked: ``schema`` and a ``schema_version``
     from 1 to ``newest`` (ModelError otherwise), and its content digest
     (:func:`check_content_hash`: a DataWarning, whose hint is ``resave``, when the file was
-    edited after it was saved)."""
+    edited after it was saved or has no digest: every version of both schemas read here, linear
+    and dynamics model files, was written with one)."""
     path = Path(path)
     try:
         doc = json.loads(path.read_text())
@@ -240,7 +260,7 @@ def read_document(path, schema: str = SCHEMA, newest: int = SCHEMA_VERSION, *,
     if not isinstance(ver, int) or ver < 1 or ver > newest:
         raise ModelError(f"{what} {where}: expected schema_version 1 … {newest}, found {ver!r}",
                          hint="upgrade gripkit to read files written by a newer version")
-    check_content_hash(doc, f"{what} {where}", resave)
+    check_content_hash(doc, f"{what} {where}", resave, required=True)
     return doc
 
 

@@ -123,8 +123,9 @@ def read_dynamics_document(path) -> dict:
     """The checked JSON document of a model written by ``result.save(path)``
     (:func:`gripkit.sysid.load_dynamics_model` builds the model from it): DataError for a missing
     file or a folder, ModelError for a file that is not JSON, of another ``schema`` or of a newer
-    ``schema_version``, and a DataWarning when the content digest does not match (the file was
-    edited after it was saved); :func:`gripkit.sysid.model_file.read_document` does the checks."""
+    ``schema_version``, and a DataWarning when the content digest does not match or is missing
+    (the file was edited after it was saved: gripkit writes the digest in every dynamics model
+    file); :func:`gripkit.sysid.model_file.read_document` does the checks."""
     return read_document(path, SCHEMA, SCHEMA_VERSION, what="dynamics model file",
                          hint="give a file written by gripkit identify dynamics --out or "
                               "result.save(); "
