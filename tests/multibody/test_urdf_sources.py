@@ -3,12 +3,14 @@ bytes decoded as their XML declaration says, a path; and what it refuses: any do
 declares a DTD (internal, external, with entities: XXE, billion laughs), in one line that says
 why, before anything is expanded or fetched."""
 
+import errno
+import os
 import time
 
 import numpy as np
 import pytest
 
-from gripkit.errors import ModelError
+from gripkit.errors import ModelError, PathError
 from gripkit.multibody import from_urdf
 
 ARM = ('<robot name="r"><link name="base"/><link name="l1"><inertial><origin xyz="0 0 0.05"/>'
@@ -75,3 +77,36 @@ def test_billion_laughs_is_refused_at_once():
     with pytest.raises(ModelError, match=REFUSED):
         from_urdf(lol + ARM.format(mass="0.1", xyz="&i;"))
     assert time.perf_counter() - t0 < 1.0
+
+
+@pytest.mark.skipif(not hasattr(os, "geteuid") or os.geteuid() == 0,
+                    reason="runs as root (or on a system without Unix file permissions): root "
+                           "may read a file whatever its permissions, so a file without read "
+                           "permission cannot be made here")
+def test_a_file_without_read_permission_is_a_path_error_naming_it(tmp_path):
+    """chmod 000: a PathError naming the file and the OS's reason, not a raw PermissionError."""
+    p = tmp_path / "arm.urdf"
+    p.write_text(PLAIN)
+    p.chmod(0)
+    try:
+        with pytest.raises(PathError, match=r"URDF file '.*arm.urdf' cannot be read "
+                                             r"\(Permission denied\)"):
+            from_urdf(p)
+    finally:
+        p.chmod(0o600)
+
+
+def test_an_unreadable_file_is_a_path_error_naming_it(tmp_path, monkeypatch):
+    """The same refusal where the OS refuses the read (simulated, so that it runs as root too):
+    a PathError with the file's path, the OS's reason and the hint to check permissions."""
+    p = tmp_path / "arm.urdf"
+    p.write_text(PLAIN)
+
+    def refused(self):
+        raise PermissionError(errno.EACCES, "Permission denied", str(self))
+
+    monkeypatch.setattr(type(p), "read_bytes", refused)
+    with pytest.raises(PathError, match=r"URDF file '.*arm.urdf' cannot be read \(Permission "
+                                         r"denied\)") as e:
+        from_urdf(str(p))
+    assert "check its permissions" in e.value.hint

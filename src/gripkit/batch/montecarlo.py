@@ -7,7 +7,8 @@ approximation): for k successes in n trials and z the normal quantile,
     p̃ = (k + z²/2)/(n + z²),   half-width = z √(k(n−k)/n + z²/4) / (n + z²).
 
 Quantile intervals use order statistics: the q-quantile lies between the order statistics of
-ranks given by the binomial(n, q) distribution's (α/2, 1−α/2) quantiles.
+ranks given by the binomial(n, q) distribution's (α/2, 1−α/2) quantiles, widened where needed to
+hold the point estimate (:func:`quantile`).
 """
 
 from __future__ import annotations

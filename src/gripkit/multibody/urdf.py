@@ -44,7 +44,7 @@ import numpy as np
 
 from ..arguments import entry_point
 from ..atomic import atomic_write
-from ..errors import GripkitWarning, ModelError, emit_warning
+from ..errors import GripkitWarning, ModelError, PathError, emit_warning
 from .coupling import CoupledChain
 from .dh import DHChain
 from .joints import JointChain, JointLimits
@@ -312,7 +312,12 @@ def _read_root(source):
                                  f"with '<'): {text[:40]!r}…",
                                  hint="pass the path of a .urdf file or the XML itself")
             raise ModelError(f"URDF file {text!r} does not exist")
-        name, xml = Path(text).name, Path(text).read_bytes()
+        try:
+            name, xml = Path(text).name, Path(text).read_bytes()
+        except OSError as exc:  # no read permission, an I/O error
+            raise PathError(f"URDF file {text!r} cannot be read ({exc.strerror or exc})",
+                            hint="give the path of a file you may read (check its permissions: "
+                                 "ls -l, chmod u+r)") from None
     _refuse_dtd(xml, name)
     try:
         root = ET.fromstring(xml)
