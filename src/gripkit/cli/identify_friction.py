@@ -21,13 +21,6 @@ from .common import (FillOpt, FsOpt, JsonOpt, TimeOpt, check_data_options, check
                      table_console)
 
 
-def friction_units(position: str, effort: str, scale: float = 1.0) -> dict[str, str]:
-    """Units of IDIM-LS's parameters (:func:`gripkit.sysid.rigid_body.friction.idim_units`)."""
-    from ..sysid.rigid_body.friction import idim_units
-
-    return idim_units(position, effort, scale)
-
-
 @identify_app.command("friction")
 def identify_friction(
     data: Path = typer.Argument(..., help="CSV/Parquet/HDF5 log with position and effort columns."),
