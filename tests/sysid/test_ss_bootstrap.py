@@ -12,9 +12,9 @@ import pytest
 import gripkit.sysid.linear.pem_ss as pem_ss
 from gripkit import Trajectory
 from gripkit.cli import main
-from gripkit.errors import AccuracyWarning, DataError
+from gripkit.errors import AccuracyWarning, ArgumentError
 from gripkit.sysid.linear import ss_bootstrap
-from gripkit.sysid import identify
+from gripkit.sysid import identify, n4sid
 from gripkit.sysid.linear.identify_mimo import identify_ss
 
 #: the plant: y[t] = 1.8 y[t−1] − 0.85 y[t−2] + 0.3 u[t−1] + 0.1 u[t−2], poles 0.9 ± 0.2j
@@ -123,16 +123,40 @@ def test_replicates_follow_the_record_length():
 
 
 def test_bad_bootstrap_options():
+    """One validation (ss_bootstrap.check_bootstrap) for identify_ss's bootstrap_replicates,
+    the records' fit and n4sid's bootstrap: an ArgumentError naming the argument."""
     tr = _record(4, n=300)
-    with pytest.raises(DataError, match="bootstrap_replicates: expected None .* or an integer "
-                                        ">= 10, found 3"):
+    with pytest.raises(ArgumentError, match="bootstrap_replicates: expected None or True .* 0 or "
+                                            "False .* or an integer >= 10 .*found 3"):
         identify_ss(tr, input="u", output="y", order=2, bootstrap_replicates=3)
-    with pytest.raises(DataError, match="bootstrap_seed: expected a non-negative integer, "
-                                        "found -1"):
+    with pytest.raises(ArgumentError, match="bootstrap_seed: expected a non-negative integer, "
+                                            "found -1"):
         identify_ss(tr, input="u", output="y", order=2, bootstrap_seed=-1)
-    with pytest.raises(DataError, match="bootstrap_replicates: .*found -1"):
+    with pytest.raises(ArgumentError, match="bootstrap_replicates: .*found -1"):
         identify([tr, _record(5, n=300)], "ss", input="u", output="y", order=2,
                  bootstrap_replicates=-1)
+    with pytest.raises(ArgumentError, match="bootstrap: expected None or True .*found 3"):
+        n4sid(np.ones(300), np.ones(300), 2, bootstrap=3)
+    with pytest.raises(ArgumentError, match="bootstrap_seed: .*found 'a'"):
+        n4sid(np.ones(300), np.ones(300), 2, bootstrap=True, bootstrap_seed="a")
+
+
+def test_zero_replicates_is_no_bootstrap_in_both():
+    """``n4sid(bootstrap=0)`` is ``bootstrap=False`` (no σ, info['sigma'] says so), as
+    ``identify_ss(bootstrap_replicates=0)`` is (it was a DataError in n4sid)."""
+    from gripkit.sysid.linear.identify_mimo import mimo_data
+    from gripkit.sysid.linear.subspace import NO_SIGMA
+
+    d = mimo_data(_record(7), "u", "y", detrend="none")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        zero = n4sid(d.u, d.y, 2, dt=d.dt, bootstrap=0)
+        false = n4sid(d.u, d.y, 2, dt=d.dt, bootstrap=False)
+        ss0, _ = identify_ss(_record(7), input="u", output="y", order=2, refine=False,
+                             detrend="none", bootstrap_replicates=0)
+    assert zero.system.uncertainty is None and zero.info["sigma"] == NO_SIGMA
+    assert np.array_equal(zero.system.A, false.system.A)
+    assert ss0.system.uncertainty is None and np.array_equal(ss0.system.A, zero.system.A)
 
 
 def test_cli_prints_and_writes_the_bootstrap_sigma(tmp_path, capsys, monkeypatch):
@@ -311,7 +335,7 @@ def test_n4sid_sigma_only_when_asked():
     ``bootstrap=30`` gives the covariance that identify_ss(refine=False, detrend='none') gives
     with 30 replicates (the same estimation and draws: equal to the last bit). PEM from a
     bootstrapped start carries PEM's covariance and says so (the start's σ note dropped)."""
-    from gripkit.sysid import n4sid, pem
+    from gripkit.sysid import pem
     from gripkit.sysid.linear.identify_mimo import mimo_data
     from gripkit.sysid.linear.subspace import NO_SIGMA
 
@@ -332,5 +356,3 @@ def test_n4sid_sigma_only_when_asked():
     assert "covariance" not in refined.info and "sigma" not in refined.info
     assert ss_bootstrap.covariance_method(refined).startswith("PEM")
     assert "sigma" not in pem(plain, u=d.u, y=d.y).info
-    with pytest.raises(DataError, match="bootstrap: expected True .* found 3"):
-        n4sid(d.u, d.y, 2, bootstrap=3)

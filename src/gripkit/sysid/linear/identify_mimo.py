@@ -29,8 +29,8 @@ from ...signals.trajectory import Trajectory
 from .arx_mimo import arx_mimo
 from .frf import frf
 from .linear_model import deviation_compare
-from .ss_bootstrap import (BOOTSTRAP_SEED, MIN_REPLICATES, bootstrap_covariance,
-                           bootstrap_covariance_records)
+from .ss_bootstrap import (BOOTSTRAP_SEED, bootstrap_covariance, bootstrap_covariance_records,
+                           check_bootstrap)
 from ..checks import STEP_CHANGES, step_like
 from ..io_data import IOData, parse_names, validation_data
 
@@ -129,7 +129,8 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
 
     if method not in SUBSPACE_METHODS:
         raise DataError(f"method: expected one of {', '.join(SUBSPACE_METHODS)}, found {method!r}")
-    _check_bootstrap(bootstrap_replicates, bootstrap_seed)
+    bootstrap_replicates = check_bootstrap(bootstrap_replicates, bootstrap_seed,
+                                           "bootstrap_replicates")
     d = mimo_data(data, input, output, detrend, why="state-space identification")
     vd = None if validate is None else validation_data(validate, d)
     rng = parse_order(order)
@@ -185,20 +186,6 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     if vd is not None:
         extras["validation_fit_percent"] = _validation_fit(model, vd)
     return model, extras
-
-
-def _check_bootstrap(replicates, seed) -> None:
-    """``bootstrap_replicates`` None, 0 (no bootstrap) or an integer >= MIN_REPLICATES / 3
-    (fewer give no σ worth reporting), ``bootstrap_seed`` a non-negative integer (numpy's
-    default_rng)."""
-    lo = MIN_REPLICATES // 3
-    if replicates is not None and (isinstance(replicates, bool)
-                                   or not isinstance(replicates, (int, np.integer))
-                                   or 0 < replicates < lo or replicates < 0):
-        raise DataError(f"bootstrap_replicates: expected None (by the record's length), 0 (no σ) "
-                        f"or an integer >= {lo}, found {replicates!r}")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise DataError(f"bootstrap_seed: expected a non-negative integer, found {seed!r}")
 
 
 def _bootstrap_sigma(model, d: IOData, k: int, method: str, feedthrough: bool, detrend: str,
@@ -608,8 +595,9 @@ def identify_ss_records(records: list, d: IOData, u0, y0, options: dict, demean:
     focus, progress = options.get("focus", "simulation"), options.get("progress", False)
     if focus not in FOCUS:
         raise DataError(f"focus: expected one of {', '.join(FOCUS)}, found {focus!r}")
-    _check_bootstrap(options.get("bootstrap_replicates"),
-                     options.get("bootstrap_seed", BOOTSTRAP_SEED))
+    options = {**options, "bootstrap_replicates": check_bootstrap(
+        options.get("bootstrap_replicates"), options.get("bootstrap_seed", BOOTSTRAP_SEED),
+        "bootstrap_replicates")}
     rng = parse_order(options.get("order"))
 
     def fit(n):

@@ -49,13 +49,13 @@ import warnings
 
 import numpy as np
 
-from ...errors import AccuracyWarning, GripkitError, emit_warning
+from ...errors import AccuracyWarning, ArgumentError, GripkitError, emit_warning
 from ...lti import StateSpace
 from ...progress import status, track
 
 __all__ = ["BOOTSTRAP_SEED", "MAX_REPLICATES", "MIN_REPLICATES", "bootstrap_replicates",
            "bootstrap_covariance", "bootstrap_covariance_records", "bootstrapped",
-           "covariance_method"]
+           "covariance_method", "check_bootstrap"]
 
 #: the default seed of the bootstrap's draws (numpy.random.default_rng)
 BOOTSTRAP_SEED = 0
@@ -80,6 +80,30 @@ def bootstrap_replicates(n_samples: int) -> int:
     (100, 50, 30)
     """
     return int(min(MAX_REPLICATES, max(MIN_REPLICATES, SAMPLE_BUDGET // max(int(n_samples), 1))))
+
+
+def check_bootstrap(value, seed, name: str) -> int | None:
+    """The replicates asked for by ``value`` (``n4sid``'s ``bootstrap``, ``identify_ss``'s
+    ``bootstrap_replicates``; ``name``: which): ``None`` (replicates by the record's length) for
+    None or True, ``0`` (no bootstrap) for 0 or False, else an integer >= ``MIN_REPLICATES / 3``
+    (fewer give no σ worth reporting); ``seed`` a non-negative integer (numpy's default_rng).
+    An :class:`~gripkit.errors.ArgumentError` otherwise."""
+    lo = MIN_REPLICATES // 3
+    if value is None or value is True:
+        replicates = None
+    elif value is False:
+        replicates = 0
+    elif isinstance(value, (int, np.integer)) and (value == 0 or value >= lo):
+        replicates = int(value)
+    else:
+        raise ArgumentError(f"{name}: expected None or True (replicates by the record's length), "
+                            f"0 or False (no bootstrap, no σ) or an integer >= {lo} "
+                            f"(replicates), found {value!r:.40}",
+                            hint=f"pass {name}={lo} or more, or {name}=0")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ArgumentError(f"bootstrap_seed: expected a non-negative integer, found {seed!r:.40}",
+                            hint="pass bootstrap_seed=0 (the default) or another integer >= 0")
+    return replicates
 
 
 def _levinson(r: np.ndarray, n_samples: int) -> np.ndarray:
