@@ -455,7 +455,8 @@ def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int
         refitted): ``True`` (replicates by the record's length), an integer >= 10 (that many
         replicates), or ``False`` (default) or 0: no σ, the subspace estimate alone, which
         ``info['sigma']`` says (the values of ``identify_ss``'s ``bootstrap_replicates``,
-        :func:`~gripkit.sysid.linear.ss_bootstrap.check_bootstrap`; others: ArgumentError). This function is a building block (the start of PEM,
+        :func:`~gripkit.sysid.linear.ss_bootstrap.check_bootstrap`; others: ArgumentError).
+        This function is a building block (the start of PEM,
         the nonlinear families' initialisation, loops over orders or data), where the
         bootstrap's cost (100 refits up to N = 20 000: 0.5 s at N = 1e4, order 4, against
         0.01 s for the estimate) would be paid for nothing;
