@@ -78,7 +78,8 @@ def test_bootstrap_sigma_matches_the_monte_carlo_spread(monte_carlo, monkeypatch
     for seed in (7, 8, 9):
         with pytest.warns(AccuracyWarning, match="the subspace model is returned, with σ from a "
                                                  "parametric bootstrap of the subspace "
-                                                 "estimate, not PEM's covariance"):
+                                                 "estimate where its replicates allow, not "
+                                                 "PEM's covariance"):
             model, _ = identify_ss(_record(seed), input="u", output="y", order=2,
                                    bootstrap_replicates=100)
         assert model.structure == "n4sid" and model.info["focus"]["kept"] == "subspace"
@@ -87,6 +88,41 @@ def test_bootstrap_sigma_matches_the_monte_carlo_spread(monte_carlo, monkeypatch
             "estimator": "n4sid (order 2, horizon 6)"}
         ratio = np.array(_mode(model)[1]) / monte_carlo
         assert np.all((ratio > 1 / 1.5) & (ratio < 1.5)), ratio
+
+
+def _pem_warnings(fn):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        model = fn()
+    return model, [str(w.message) for w in caught if "PEM refinement lowered" in str(w.message)
+                   or "PEM over the records lowered" in str(w.message)]
+
+
+def test_the_sigma_is_promised_only_to_the_model_that_has_it(monkeypatch):
+    """A refinement that loses keeps the subspace model: the warning promises the bootstrap's σ
+    when that model is returned with it, not with bootstrap_replicates=0 (no σ: the model has
+    none) and not for the candidates of an order search (they are warned about before the
+    search picks one; the one returned says its σ in info['covariance'])."""
+    monkeypatch.setattr(pem_ss, "pem", _losing_pem)
+    monkeypatch.setattr(pem_ss, "pem_records",
+                        lambda m, recs, **kw: _losing_pem(m, form=kw.get("form", "innovation")))
+    with_sigma, msgs = _pem_warnings(lambda: identify_ss(_record(7), input="u", output="y",
+                                                         order=2, bootstrap_replicates=10)[0])
+    assert with_sigma.system.uncertainty is not None
+    assert len(msgs) == 1 and "with σ from a parametric bootstrap" in msgs[0]
+    cases = {"no bootstrap": lambda: identify_ss(_record(7), input="u", output="y", order=2,
+                                                 bootstrap_replicates=0)[0],
+             "order search": lambda: identify_ss(_record(7), input="u", output="y",
+                                                 order="2:3", bootstrap_replicates=10)[0],
+             "records, no bootstrap": lambda: identify(
+                 [_record(7), _record(8)], "ss", input="u", output="y", order=2,
+                 bootstrap_replicates=0)}
+    for name, fn in cases.items():
+        model, msgs = _pem_warnings(fn)
+        assert msgs, name
+        assert all("σ from" not in m and "the subspace model is kept (without PEM's "
+                   "covariance)" in m for m in msgs), (name, msgs)
+    assert model.system.uncertainty is None  # the records' model with 0 replicates: no σ
 
 
 def test_same_seed_same_sigma_other_seed_close():
