@@ -32,7 +32,7 @@ from ..checks import check_io
 from ..model_protocol import ModelFit, check_sample_time, column_in_unit
 
 __all__ = ["fit_percent", "records_fit", "loss_vn", "compare", "ResidualTests", "residual_tests",
-           "Validation", "validate"]
+           "Validation", "validate", "model_columns"]
 
 
 def loss_vn(e: np.ndarray) -> float:
@@ -326,19 +326,23 @@ def _record_arrays(model, data, y, dt) -> tuple[np.ndarray, np.ndarray, float | 
         raise ArgumentError("validate: a trajectory carries its outputs and sample time; give "
                             "no y or dt with it", hint="model.validate(data)")
     step = data.require_uniform(why="validation of an identified model")
-    u, y = (_column(data, name, unit, what) for name, unit, what in
-            ((model.inputs[0], model.input_units[0], "input"),
-             (model.outputs[0], model.output_units[0], "output")))
+    u, y = (model_columns(data, names, units, what)[:, 0] for names, units, what in
+            ((model.inputs, model.input_units, "input"),
+             (model.outputs, model.output_units, "output")))
     return *check_io(u, y), step
 
 
-def _column(data, name: str, unit: str, what: str) -> np.ndarray:
-    """Column ``name`` of the trajectory ``data`` in the model's ``unit``."""
-    if name not in data.names:
-        raise DataError(f"data: the model's {what} column {name!r} is missing; the data have "
-                        f"{', '.join(map(repr, data.names))}",
-                        hint="rename the column or validate on a record with the model's columns")
-    return column_in_unit(data, name, unit, what)
+def model_columns(data, names, units, what: str) -> np.ndarray:
+    """The columns ``names`` (N, k) of the trajectory ``data`` in the model's ``units`` (``what``:
+    "input" or "output"), or a DataError naming the missing ones; a model's own arrays
+    (:meth:`IdentifiedLinearModel._columns <gripkit.sysid.linear.linear_model>`) and
+    :func:`validate` read a trajectory by it."""
+    missing = [n for n in names if n not in data.names]
+    if missing:
+        raise DataError(f"data: the model's {what} column(s) {', '.join(map(repr, missing))} "
+                        f"are missing; the data have {', '.join(map(repr, data.names))}",
+                        hint="rename the columns or use a record with the model's columns")
+    return np.column_stack([column_in_unit(data, n, u, what) for n, u in zip(names, units)])
 
 
 def _one_step(model, u, y, dt) -> tuple[np.ndarray, int, np.ndarray]:
