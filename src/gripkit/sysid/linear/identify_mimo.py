@@ -205,7 +205,7 @@ def _bootstrap_sigma(model, d: IOData, k: int, method: str, feedthrough: bool, d
         model = model.replace(info={**model.info, "refined": False})
     return bootstrap_covariance(model, d.u, d.y, refit, replicates=replicates, seed=seed,
                                 estimator=f"{method} (order {n}, horizon {k})",
-                                demean=detrend == "mean", feedthrough=feedthrough,
+                                detrend=detrend, feedthrough=feedthrough,
                                 progress=progress)
 
 
