@@ -42,7 +42,7 @@ from ...units import product_unit, same_dimension
 from ..checks import as_io_matrix
 from ..model_file import SCHEMA, SCHEMA_VERSION, read_document, write_document
 from ..model_protocol import (ModelFit, ReportMixin, check_horizon, check_sample_time)
-from .validation import model_columns, validate
+from .validation import checks_arrays, model_columns, validate
 
 __all__ = ["VALIDATION_FIT", "IdentifiedLinearModel", "LinearModel", "as_io_matrix",
            "deviation_compare", "estimate_x0", "free_run", "fit_per_output", "k_step_prediction",
@@ -370,10 +370,13 @@ class IdentifiedLinearModel(ReportMixin):
         return ss.A, ss.B, ss.C, ss.D, K
 
     # ------------------------------------------------------------------ the protocol
+    @checks_arrays("simulate", with_y=False)
     def simulate(self, data, x0=None, dt: float | None = None) -> np.ndarray:
         """Free run (N, p) from ``x0`` (default: rest) on the inputs of ``data``: a trajectory
         or the inputs ``u`` (N, m) sampled every ``dt`` (default the model's); offsets applied,
-        the result in the data's units (from rest: from the model's operating point)."""
+        the result in the data's units (from rest: from the model's operating point). Arrays
+        are the record's own values, not deviations (:data:`~.validation.OFFSETS_RULE`;
+        deviations with far-off offsets warn)."""
         u, _, step, yo = self._io(data, None, "simulation of an identified model", False, dt)
         ss = self.to_ss(step)
         if u.shape[1] != ss.n_inputs:
@@ -381,11 +384,14 @@ class IdentifiedLinearModel(ReportMixin):
         ys = free_run(ss.A, ss.B, ss.C, ss.D, u, x0)
         return ys + yo
 
+    @checks_arrays("compare")
     def compare(self, data, y=None, dt: float | None = None) -> ModelFit:
         """The validation fit (:data:`VALIDATION_FIT`) per output on a trajectory, or on
         the arrays ``u``, ``y`` (offsets applied as to a trajectory): free run from the initial
         state estimated by least squares. ``fit_percent`` is None per output for an unstable
-        model (its free run, from rest, is ``simulated``)."""
+        model (its free run, from rest, is ``simulated``). Arrays are the record's own values,
+        not deviations (:data:`~.validation.OFFSETS_RULE`; deviations with far-off offsets
+        warn)."""
         u, yy, dt, yo = self._io(data, y, "comparison of an identified model", dt=dt)
         return deviation_compare(self, u, yy, dt, yo)
 
@@ -403,13 +409,16 @@ class IdentifiedLinearModel(ReportMixin):
 
     def residuals(self, data, y=None, dt: float | None = None) -> np.ndarray:
         """One-step prediction errors ``y − ŷ(t | t − 1)`` (N, p) on a trajectory or on
-        the arrays ``u``, ``y`` (:meth:`predict`)."""
+        the arrays ``u``, ``y`` (:meth:`predict`; the record's own values, not deviations:
+        :data:`~.validation.OFFSETS_RULE`)."""
         u, yy, dt, _ = self._io(data, y, "residuals of an identified model", dt=dt)
         return yy - k_step_prediction(*self._state_space(dt), u, yy, 1)
 
+    @checks_arrays("validate")
     def validate(self, data, y=None, **kw):
         """Free-run and one-step validation of a one-input, one-output model on a separate
-        record, a trajectory or the arrays ``u``, ``y`` (the model's offsets applied to either):
+        record, a trajectory or the arrays ``u``, ``y`` (the model's offsets applied to either:
+        the record's own values, not deviations, :data:`~.validation.OFFSETS_RULE`):
         :func:`gripkit.sysid.validate` (several channels: :meth:`compare` and
         :meth:`residuals`)."""
         return validate(self, data, y, **kw)

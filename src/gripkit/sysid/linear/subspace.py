@@ -433,7 +433,9 @@ def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int
     ----------
     u, y
         Inputs (N, m) and outputs (N, p) (1-D: one channel), deviation units (operating point
-        removed), uniformly sampled.
+        removed), uniformly sampled. The operating point goes in ``u_offset``, ``y_offset``; the
+        model's simulate/predict/compare/residuals/validate then take the record's own values
+        (``m.compare(u + u_offset, y + y_offset)``), never these deviations.
     order
         Number of states n; None: the number of singular values above the noise floor
         (1 … ``max_order``, :func:`select_order`).
