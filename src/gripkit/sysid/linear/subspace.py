@@ -433,9 +433,8 @@ def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int
     ----------
     u, y
         Inputs (N, m) and outputs (N, p) (1-D: one channel), deviation units (operating point
-        removed), uniformly sampled. The operating point goes in ``u_offset``, ``y_offset``; the
-        model's simulate/predict/compare/residuals/validate then take the record's own values
-        (``m.compare(u + u_offset, y + y_offset)``), never these deviations.
+        removed; it goes in ``u_offset``, ``y_offset``, and the model's methods then take the
+        record's own values, ``m.compare(u + u_offset, y + y_offset)``), uniformly sampled.
     order
         Number of states n; None: the number of singular values above the noise floor
         (1 … ``max_order``, :func:`select_order`).
@@ -456,10 +455,8 @@ def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int
         (:func:`~gripkit.sysid.linear.ss_bootstrap.bootstrap_covariance`, the same estimation
         refitted): ``True`` (replicates by the record's length), an integer >= 10 (that many
         replicates), or ``False`` (default) or 0: no σ, the subspace estimate alone, which
-        ``info['sigma']`` says (the values of ``identify_ss``'s ``bootstrap_replicates``,
-        :func:`~gripkit.sysid.linear.ss_bootstrap.check_bootstrap`; others: ArgumentError).
-        This function is a building block (the start of PEM,
-        the nonlinear families' initialisation, loops over orders or data), where the
+        ``info['sigma']`` says. This function is a building block (the start of PEM, the
+        nonlinear families' initialisation, loops over orders or data), where the
         bootstrap's cost (100 refits up to N = 20 000: 0.5 s at N = 1e4, order 4, against
         0.01 s for the estimate) would be paid for nothing;
         ``gripkit.sysid.identify(data, 'ss', refine=False)`` (``gripkit identify ss
@@ -523,8 +520,7 @@ def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int
         subspace_factor(uu, yy, horizon=k, method=method), n, dt=step, feedthrough=feedthrough,
         stable=stable)
     return bootstrap_covariance(model, u, y, refit, estimator=f"{method} (order {n}, horizon {k})",
-                                replicates=replicates,
-                                seed=bootstrap_seed, feedthrough=feedthrough)
+                                replicates=replicates, seed=bootstrap_seed, feedthrough=feedthrough)
 
 
 #: what a subspace model from :func:`n4sid` without ``bootstrap`` says of its σ (``info['sigma']``)
