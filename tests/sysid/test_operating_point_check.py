@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 from scipy.signal import lfilter
 
+from gripkit.cli import main
 from gripkit.signals import Trajectory
 from gripkit.sysid import arx, identify
 from gripkit.sysid.checks import constant_term, warn_if_operating_point
@@ -97,3 +98,18 @@ def test_the_remedy_named_is_the_callers():
                            "means")
     assert "gripkit.sysid.identify" not in inside
     assert _warned(lambda: arx(u, y, 2, 2, 1))[0] == direct  # the context does not leak
+
+
+def test_the_cli_names_its_own_option(tmp_path, capsys):
+    """`gripkit identify arx --detrend none` on the record: the warning line ends with the
+    option that removes the means, --detrend mean (an option the command has)."""
+    u, y = _record()
+    path = tmp_path / "op.csv"
+    np.savetxt(path, np.column_stack([np.arange(u.size) * 0.1, u, y]), delimiter=",",
+               header="time,u,y", comments="")
+    code = main(["identify", "arx", str(path), "--input", "u", "--output", "y",
+                 "--detrend", "none"])
+    err = capsys.readouterr().err
+    assert code == 0
+    assert "warning: DataWarning: arx [2 2 1]: the data sit around an operating point" in err
+    assert "or fit with detrend='mean' (CLI: --detrend mean), which removes the means" in err
