@@ -232,7 +232,7 @@ def test_validate_and_sysid_compare_take_a_trajectory(tanks):
     with pytest.raises(ArgumentError, match="give a trajectory with the model's columns, or "
                                             "the arrays u and y"):
         m.validate(u)
-    with pytest.raises(DataError, match="column 'level' is missing"):
+    with pytest.raises(DataError, match=r"output column\(s\) 'level' are missing"):
         m.validate(val.select("pump"))
 
 

@@ -12,9 +12,9 @@ import pytest
 import gripkit.sysid.linear.pem_ss as pem_ss
 from gripkit import Trajectory
 from gripkit.cli import main
-from gripkit.errors import AccuracyWarning, DataError
+from gripkit.errors import AccuracyWarning, ArgumentError, DataError
 from gripkit.sysid.linear import ss_bootstrap
-from gripkit.sysid import identify
+from gripkit.sysid import identify, n4sid
 from gripkit.sysid.linear.identify_mimo import identify_ss
 
 #: the plant: y[t] = 1.8 y[t−1] − 0.85 y[t−2] + 0.3 u[t−1] + 0.1 u[t−2], poles 0.9 ± 0.2j
@@ -78,7 +78,8 @@ def test_bootstrap_sigma_matches_the_monte_carlo_spread(monte_carlo, monkeypatch
     for seed in (7, 8, 9):
         with pytest.warns(AccuracyWarning, match="the subspace model is returned, with σ from a "
                                                  "parametric bootstrap of the subspace "
-                                                 "estimate, not PEM's covariance"):
+                                                 "estimate where its replicates allow, not "
+                                                 "PEM's covariance"):
             model, _ = identify_ss(_record(seed), input="u", output="y", order=2,
                                    bootstrap_replicates=100)
         assert model.structure == "n4sid" and model.info["focus"]["kept"] == "subspace"
@@ -87,6 +88,41 @@ def test_bootstrap_sigma_matches_the_monte_carlo_spread(monte_carlo, monkeypatch
             "estimator": "n4sid (order 2, horizon 6)"}
         ratio = np.array(_mode(model)[1]) / monte_carlo
         assert np.all((ratio > 1 / 1.5) & (ratio < 1.5)), ratio
+
+
+def _pem_warnings(fn):
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        model = fn()
+    return model, [str(w.message) for w in caught if "PEM refinement lowered" in str(w.message)
+                   or "PEM over the records lowered" in str(w.message)]
+
+
+def test_the_sigma_is_promised_only_to_the_model_that_has_it(monkeypatch):
+    """A refinement that loses keeps the subspace model: the warning promises the bootstrap's σ
+    when that model is returned with it, not with bootstrap_replicates=0 (no σ: the model has
+    none) and not for the candidates of an order search (they are warned about before the
+    search picks one; the one returned says its σ in info['covariance'])."""
+    monkeypatch.setattr(pem_ss, "pem", _losing_pem)
+    monkeypatch.setattr(pem_ss, "pem_records",
+                        lambda m, recs, **kw: _losing_pem(m, form=kw.get("form", "innovation")))
+    with_sigma, msgs = _pem_warnings(lambda: identify_ss(_record(7), input="u", output="y",
+                                                         order=2, bootstrap_replicates=10)[0])
+    assert with_sigma.system.uncertainty is not None
+    assert len(msgs) == 1 and "with σ from a parametric bootstrap" in msgs[0]
+    cases = {"no bootstrap": lambda: identify_ss(_record(7), input="u", output="y", order=2,
+                                                 bootstrap_replicates=0)[0],
+             "order search": lambda: identify_ss(_record(7), input="u", output="y",
+                                                 order="2:3", bootstrap_replicates=10)[0],
+             "records, no bootstrap": lambda: identify(
+                 [_record(7), _record(8)], "ss", input="u", output="y", order=2,
+                 bootstrap_replicates=0)}
+    for name, fn in cases.items():
+        model, msgs = _pem_warnings(fn)
+        assert msgs, name
+        assert all("σ from" not in m and "the subspace model is kept (without PEM's "
+                   "covariance)" in m for m in msgs), (name, msgs)
+    assert model.system.uncertainty is None  # the records' model with 0 replicates: no σ
 
 
 def test_same_seed_same_sigma_other_seed_close():
@@ -123,16 +159,40 @@ def test_replicates_follow_the_record_length():
 
 
 def test_bad_bootstrap_options():
+    """One validation (ss_bootstrap.check_bootstrap) for identify_ss's bootstrap_replicates,
+    the records' fit and n4sid's bootstrap: an ArgumentError naming the argument."""
     tr = _record(4, n=300)
-    with pytest.raises(DataError, match="bootstrap_replicates: expected None .* or an integer "
-                                        ">= 10, found 3"):
+    with pytest.raises(ArgumentError, match="bootstrap_replicates: expected None or True .* 0 or "
+                                            "False .* or an integer >= 10 .*found 3"):
         identify_ss(tr, input="u", output="y", order=2, bootstrap_replicates=3)
-    with pytest.raises(DataError, match="bootstrap_seed: expected a non-negative integer, "
-                                        "found -1"):
+    with pytest.raises(ArgumentError, match="bootstrap_seed: expected a non-negative integer, "
+                                            "found -1"):
         identify_ss(tr, input="u", output="y", order=2, bootstrap_seed=-1)
-    with pytest.raises(DataError, match="bootstrap_replicates: .*found -1"):
+    with pytest.raises(ArgumentError, match="bootstrap_replicates: .*found -1"):
         identify([tr, _record(5, n=300)], "ss", input="u", output="y", order=2,
                  bootstrap_replicates=-1)
+    with pytest.raises(ArgumentError, match="bootstrap: expected None or True .*found 3"):
+        n4sid(np.ones(300), np.ones(300), 2, bootstrap=3)
+    with pytest.raises(ArgumentError, match="bootstrap_seed: .*found 'a'"):
+        n4sid(np.ones(300), np.ones(300), 2, bootstrap=True, bootstrap_seed="a")
+
+
+def test_zero_replicates_is_no_bootstrap_in_both():
+    """``n4sid(bootstrap=0)`` is ``bootstrap=False`` (no σ, info['sigma'] says so), as
+    ``identify_ss(bootstrap_replicates=0)`` is (it was a DataError in n4sid)."""
+    from gripkit.sysid.linear.identify_mimo import mimo_data
+    from gripkit.sysid.linear.subspace import NO_SIGMA
+
+    d = mimo_data(_record(7), "u", "y", detrend="none")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        zero = n4sid(d.u, d.y, 2, dt=d.dt, bootstrap=0)
+        false = n4sid(d.u, d.y, 2, dt=d.dt, bootstrap=False)
+        ss0, _ = identify_ss(_record(7), input="u", output="y", order=2, refine=False,
+                             detrend="none", bootstrap_replicates=0)
+    assert zero.system.uncertainty is None and zero.info["sigma"] == NO_SIGMA
+    assert np.array_equal(zero.system.A, false.system.A)
+    assert ss0.system.uncertainty is None and np.array_equal(ss0.system.A, zero.system.A)
 
 
 def test_cli_prints_and_writes_the_bootstrap_sigma(tmp_path, capsys, monkeypatch):
@@ -311,7 +371,7 @@ def test_n4sid_sigma_only_when_asked():
     ``bootstrap=30`` gives the covariance that identify_ss(refine=False, detrend='none') gives
     with 30 replicates (the same estimation and draws: equal to the last bit). PEM from a
     bootstrapped start carries PEM's covariance and says so (the start's σ note dropped)."""
-    from gripkit.sysid import n4sid, pem
+    from gripkit.sysid import pem
     from gripkit.sysid.linear.identify_mimo import mimo_data
     from gripkit.sysid.linear.subspace import NO_SIGMA
 
@@ -332,5 +392,77 @@ def test_n4sid_sigma_only_when_asked():
     assert "covariance" not in refined.info and "sigma" not in refined.info
     assert ss_bootstrap.covariance_method(refined).startswith("PEM")
     assert "sigma" not in pem(plain, u=d.u, y=d.y).info
-    with pytest.raises(DataError, match="bootstrap: expected True .* found 3"):
-        n4sid(d.u, d.y, 2, bootstrap=3)
+
+
+def _start_and_refit(record, detrend="mean"):
+    from gripkit.sysid.linear.identify_mimo import mimo_data
+    from gripkit.sysid.linear.subspace import from_factor, subspace_factor
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        start, _ = identify_ss(record, input="u", output="y", order=2, refine=False,
+                               detrend=detrend, bootstrap_replicates=0)
+    d = mimo_data(record, "u", "y", detrend=detrend)
+    refit = lambda u, y: from_factor(subspace_factor(u, y, horizon=6, method="n4sid"),  # noqa
+                                     2, dt=d.dt)
+    return start, d, refit
+
+
+def test_a_linalg_error_is_a_failed_replicate():
+    """A replicate whose refit raises numpy's LinAlgError (a degenerate replicate) counts as
+    failed (it aborted the whole identification): every 5th of 30 refits raising, 24 replicates
+    give σ and info['covariance']['failed'] is 6; a refit whose system is not finite (the
+    alignment's SVD does not converge) is a failed replicate too (None)."""
+    start, d, refit = _start_and_refit(_record(3))
+    calls = []
+
+    def flaky(u, y):
+        calls.append(1)
+        if len(calls) % 5 == 0:
+            raise np.linalg.LinAlgError("Singular matrix")
+        return refit(u, y)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        out = ss_bootstrap.bootstrap_covariance(start, d.u, d.y, flaky, estimator="n4sid",
+                                                replicates=30, demean=True)
+    assert out.info["covariance"]["failed"] == 6 and out.info["covariance"]["replicates"] == 24
+    assert out.system.uncertainty is not None
+    ss = start.system
+    bad = type("Refit", (), {"A": np.full_like(ss.A, np.nan), "B": ss.B, "C": ss.C, "D": ss.D})
+    w = np.ones(1)
+    assert ss_bootstrap._aligned(bad, ss_bootstrap._observability(ss.A, ss.C, w), w,
+                                 False) is None
+
+
+def test_linear_detrending_is_redone_on_every_replicate():
+    """bootstrap_covariance(detrend='linear'): the data's least-squares line was taken off before
+    the fit, so each replicate's simulated output has its line taken off too (only the 'mean'
+    was redone); every output the refit sees has a zero line (mean and slope within 1e-12 of the
+    output's span). identify_ss itself refuses detrend='linear' (a line per column leaves the
+    model no operating point), so 'mean' and 'none' are what it passes."""
+    from scipy.signal import detrend
+
+    tr = _record(5)
+    t = np.arange(500) * 0.01
+    tr = Trajectory.uniform(dt=0.01, u=np.asarray(tr["u"]), y=np.asarray(tr["y"]) + 0.8 * t + 2)
+    start, d, refit = _start_and_refit(tr, detrend="none")
+    u, y = detrend(d.u, axis=0), detrend(d.y, axis=0)
+    seen = []
+    spy = lambda uu, yy: seen.append(np.array(yy)) or refit(uu, yy)  # noqa: E731
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        out = ss_bootstrap.bootstrap_covariance(start, u, y, spy, estimator="n4sid",
+                                                replicates=10, detrend="linear")
+    assert out.info["covariance"]["replicates"] + out.info["covariance"]["failed"] == 10
+    assert len(seen) == 10
+    x = np.arange(500) - 249.5
+    for yy in seen:
+        span = np.ptp(yy)
+        assert abs(np.mean(yy)) < 1e-12 * span and abs(x @ yy[:, 0] / (x @ x)) < 1e-12 * span
+    with pytest.raises(ArgumentError, match="detrend: expected 'mean', 'linear' or 'none', "
+                                            "found 'quadratic'"):
+        ss_bootstrap.bootstrap_covariance(start, u, y, refit, estimator="n4sid",
+                                          replicates=10, detrend="quadratic")
+    with pytest.raises(DataError, match="detrend: expected 'mean' or 'none', found 'linear'"):
+        identify_ss(tr, input="u", output="y", order=2, detrend="linear")

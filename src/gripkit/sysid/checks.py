@@ -6,6 +6,8 @@ was expected and what was found (DEVELOPING.md, "Errors").
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import math
 
 import numpy as np
@@ -22,7 +24,7 @@ __all__ = ["as_signal", "signal_array", "signal_with_peaks", "as_io_matrix", "ch
            "channel_of",
            "check_output_varies", "checked_problem", "checked_problem_peaks", "check_identifiable",
            "check_persistent_excitation", "check_dimension", "LENGTH_OR_ANGLE", "FORCE_OR_TORQUE",
-           "LINEAR_ORDERS"]
+           "LINEAR_ORDERS", "warn_if_operating_point", "constant_term", "operating_point_remedy"]
 
 #: the orders of the linear methods (arx, armax, oe, rls, search) that are not given (OE's nf:
 #: na's); :func:`gripkit.sysid.identify` and ``gripkit identify arx|armax|oe|rls`` use it, the
@@ -401,7 +403,9 @@ def warn_if_operating_point(u, y, na: int, nb: int, nk: int, what: str,
     :data:`CENTRED` of their spans, ``peaks`` ``((min u, max u), (min y, max y))`` when the
     caller knows them: what ``identify`` fits after removing the means) are not checked; a
     step from rest fits without a constant (c ≈ 0) and passes; a step input with an offset is
-    told to subtract its starting steady state, not its mean (:func:`step_like`)."""
+    told to subtract its starting steady state, not its mean (:func:`step_like`). A constant
+    that the regressors already span (:func:`constant_term` is ``None``) is not checked. The
+    last remedy named is the caller's (:func:`operating_point_remedy`)."""
     u, y = np.ravel(u), np.ravel(y)
     ubar, ybar = (float(np.add.reduce(x)) / x.size for x in (u, y))  # x.mean() without its wrapper
     (ulo, uhi), (ylo, yhi) = peaks or ((u.min(), u.max()), (y.min(), y.max()))
@@ -412,12 +416,11 @@ def warn_if_operating_point(u, y, na: int, nb: int, nk: int, what: str,
     if m <= p + 2:
         return
     phi, target = X[:, :p], X[:, p]
+    fit = constant_term(phi, target)
+    if fit is None:
+        return
+    theta, sigma_c = fit
     plain = np.linalg.lstsq(phi, target, rcond=None)[0]
-    q, r = np.linalg.qr(np.column_stack([phi, np.ones(m)]))
-    theta = np.linalg.solve(r, q.T @ target)
-    e = target - q @ (q.T @ target)
-    rinv_last = np.linalg.solve(r, np.eye(p + 1)[:, p])  # the last column of R⁻¹
-    sigma_c = math.sqrt(float(e @ e) / (m - p - 1) * float(rinv_last @ rinv_last))
     c = float(theta[p])
     g0, g1 = (float(np.sum(t[na:p]) / (1.0 + np.sum(t[:na]))) for t in (plain, theta))
     if not (math.isfinite(g0) and math.isfinite(g1)) or abs(c) <= OPERATING_POINT_Z * sigma_c \
@@ -430,5 +433,48 @@ def warn_if_operating_point(u, y, na: int, nb: int, nk: int, what: str,
         f"{ybar:.4g}) that the model has no term for: the ARX fit of the same orders with a "
         f"constant term finds c = {c:.4g} (|c|/σ_c = {abs(c) / sigma_c:.3g}) and a static gain "
         f"of {g1:.4g} against {g0:.4g} without it, so this model is biased and its σ do not "
-        f"cover that; {fix} before fitting (pass them as u_offset=, y_offset=), or use "
-        "gripkit.sysid.identify, which removes the means", DataWarning)
+        f"cover that; {fix} before fitting, pass them as u_offset=, y_offset= and validate the "
+        f"model with the record's own values (m.compare(u, y), not the deviations), or "
+        f"{_OPERATING_POINT_REMEDY.get()}", DataWarning)
+
+
+def constant_term(phi: np.ndarray, target: np.ndarray):
+    """The least squares ``target ≈ [phi, 1] θ`` with a constant regressor last: ``(θ, σ_c)``,
+    σ_c the standard error of the constant, ``sqrt(s²·[(XᵀX)⁻¹]_pp)`` with
+    ``s² = e·e/(m − p − 1)``; ``None`` when the constant column lies (nearly) in the span of
+    ``phi`` (``|r_pp| ≤`` :data:`CONSTANT_APART` ``·√m``) or ``[phi, 1]``, its columns scaled to
+    unit norm, has a condition number above ``COND_LIMIT``: the constant cannot be told apart."""
+    m, p = phi.shape
+    q, r = np.linalg.qr(np.column_stack([phi, np.ones(m)]))
+    r_pp = abs(float(r[p, p]))
+    norms = np.linalg.norm(r, axis=0)  # the columns' norms: the condition whatever the units
+    if r_pp <= CONSTANT_APART * math.sqrt(m) or not np.all(norms > 0) \
+            or np.linalg.cond(r / norms) > COND_LIMIT:
+        return None
+    qt = q.T @ target
+    theta = np.linalg.solve(r, qt)
+    e = target - q @ qt
+    # Var(c) = s²·[(XᵀX)⁻¹]_pp = s²·‖row p of R⁻¹‖² = s²/r_pp² (that row of the upper-triangular
+    # R⁻¹ holds 1/r_pp alone)
+    return theta, math.sqrt(float(e @ e) / (m - p - 1)) / r_pp
+
+
+#: |r_pp| at or below this fraction of the constant column's norm: the constant lies (nearly) in
+#: the span of the regressors (an input held constant over the fitted samples)
+CONSTANT_APART = 1e-8
+#: the last remedy the operating-point warning names: a direct estimator call is told of
+#: :func:`gripkit.sysid.identify`; a fit inside ``identify(..., detrend='none')`` (set by
+#: :func:`operating_point_remedy`) of its ``detrend='mean'``
+_OPERATING_POINT_REMEDY: contextvars.ContextVar[str] = contextvars.ContextVar(
+    "operating_point_remedy", default="use gripkit.sysid.identify, which removes the means")
+
+
+@contextlib.contextmanager
+def operating_point_remedy(text: str):
+    """Within the ``with`` block the operating-point warning (:func:`warn_if_operating_point`)
+    ends with ``text`` as its last remedy (the caller's own option that removes the means)."""
+    token = _OPERATING_POINT_REMEDY.set(text)
+    try:
+        yield
+    finally:
+        _OPERATING_POINT_REMEDY.reset(token)

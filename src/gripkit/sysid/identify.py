@@ -36,7 +36,7 @@ from ..arguments import check_keywords, entry_point, keyword_names
 from ..errors import (AccuracyWarning, ArgumentError, DataError, GripkitError, GripkitWarning,
                       IdentificationError, emit_warning)
 from ..signals.trajectory import Trajectory
-from .checks import LINEAR_ORDERS, check_channels_vary
+from .checks import LINEAR_ORDERS, check_channels_vary, operating_point_remedy
 from .io_data import (IOData, check_scale, io_data, parse_names, records_provenance,
                       validation_data)
 from .linear import identify_mimo
@@ -266,9 +266,15 @@ def identify(data: Trajectory, method: str = "arx", *, inputs: str | list[str] |
                                 f"{col!r:.40}", hint=f"columns: {', '.join(data.names)}"
                                 if isinstance(data, Trajectory) else None)
     _check_single_channel(data, method, input, output)
-    model = _dispatch(data, method, input=input, output=output, na=na, nb=nb, nk=nk, nc=nc, nf=nf,
-                      detrend=detrend, **options)
+    with operating_point_remedy(IDENTIFY_REMEDY):  # the warning names identify's own option
+        model = _dispatch(data, method, input=input, output=output, na=na, nb=nb, nk=nk, nc=nc,
+                          nf=nf, detrend=detrend, **options)
     return with_provenance(model, records_provenance(data))
+
+
+#: the last remedy of the operating-point warning (:func:`~gripkit.sysid.checks.\
+#: warn_if_operating_point`) for a fit inside :func:`identify` (``detrend='none'``)
+IDENTIFY_REMEDY = "fit with detrend='mean' (CLI: --detrend mean), which removes the means"
 
 
 #: the methods that take several input and output columns; the others take one of each

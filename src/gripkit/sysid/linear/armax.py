@@ -88,7 +88,9 @@ def armax(u, y, na: int, nb: int, nc: int, nk: int = 1, *, dt: float | None = No
     """ARMAX model ``A y = B u + C e`` by prediction-error minimisation (MATLAB ``armax``
     orders ``[na nb nc nk]``).
 
-    Parameters as :func:`gripkit.sysid.linear.arx`, plus ``nc`` (number of C coefficients after the
+    Parameters as :func:`gripkit.sysid.linear.arx` (``u``, ``y`` deviations with the operating
+    point as ``u_offset=``/``y_offset=``; the model's methods take the record's own values), plus
+    ``nc`` (number of C coefficients after the
     leading 1), ``maxiter`` and ``tol`` of the Levenberg–Marquardt iteration (``progress``: a
     progress bar of its iterations on stderr, as the command line shows it). Returns a
     :class:`PolynomialModel` with ``structure='armax'``, ``C`` and ``C_std``. Warns

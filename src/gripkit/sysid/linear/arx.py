@@ -52,6 +52,9 @@ def arx(u, y, na: int, nb: int, nk: int = 1, *, dt: float | None = None,
     u, y
         Input and output samples, shape (N,), uniformly sampled, in deviation units (remove an
         operating point first: :func:`gripkit.sysid.identify` does it with ``detrend='mean'``).
+        Deviations here, the operating point passed as ``u_offset=``, ``y_offset=``; the
+        model's simulate/predict/compare/residuals/validate then take the record's own values
+        (``m.compare(u + u_offset, y + y_offset)``), never these deviations.
     na, nb, nk
         Number of A coefficients (after the leading 1), number of B coefficients, input delay in
         samples (``B`` gets ``nk`` leading zeros). Table II's ``[2 2 2]`` is ``na=2, nb=2, nk=2``.

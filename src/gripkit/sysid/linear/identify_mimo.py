@@ -29,8 +29,8 @@ from ...signals.trajectory import Trajectory
 from .arx_mimo import arx_mimo
 from .frf import frf
 from .linear_model import deviation_compare
-from .ss_bootstrap import (BOOTSTRAP_SEED, MIN_REPLICATES, bootstrap_covariance,
-                           bootstrap_covariance_records)
+from .ss_bootstrap import (BOOTSTRAP_SEED, bootstrap_covariance, bootstrap_covariance_records,
+                           check_bootstrap)
 from ..checks import STEP_CHANGES, step_like
 from ..io_data import IOData, parse_names, validation_data
 
@@ -129,7 +129,8 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
 
     if method not in SUBSPACE_METHODS:
         raise DataError(f"method: expected one of {', '.join(SUBSPACE_METHODS)}, found {method!r}")
-    _check_bootstrap(bootstrap_replicates, bootstrap_seed)
+    bootstrap_replicates = check_bootstrap(bootstrap_replicates, bootstrap_seed,
+                                           "bootstrap_replicates")
     d = mimo_data(data, input, output, detrend, why="state-space identification")
     vd = None if validate is None else validation_data(validate, d)
     rng = parse_order(order)
@@ -167,7 +168,8 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
             REFINE_TOP if vd is not None else 1)
     elif refine:
         report(f"PEM refinement ({form} form) of the order-{model.order} model")
-        model = _refine(model, d, vd, form, focus, max_iterations, progress)[0]
+        model = _refine(model, d, vd, form, focus, max_iterations, progress,
+                        sigma=bootstrap_replicates != 0)[0]
     if ranked is not None:
         extras["search"] = [r for r, _ in ranked]
     if model.structure == method and bootstrap_replicates != 0:  # subspace: σ by bootstrap
@@ -187,20 +189,6 @@ def identify_ss(data: Trajectory, *, input, output, order=None, method: str = "n
     return model, extras
 
 
-def _check_bootstrap(replicates, seed) -> None:
-    """``bootstrap_replicates`` None, 0 (no bootstrap) or an integer >= MIN_REPLICATES / 3
-    (fewer give no σ worth reporting), ``bootstrap_seed`` a non-negative integer (numpy's
-    default_rng)."""
-    lo = MIN_REPLICATES // 3
-    if replicates is not None and (isinstance(replicates, bool)
-                                   or not isinstance(replicates, (int, np.integer))
-                                   or 0 < replicates < lo or replicates < 0):
-        raise DataError(f"bootstrap_replicates: expected None (by the record's length), 0 (no σ) "
-                        f"or an integer >= {lo}, found {replicates!r}")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise DataError(f"bootstrap_seed: expected a non-negative integer, found {seed!r}")
-
-
 def _bootstrap_sigma(model, d: IOData, k: int, method: str, feedthrough: bool, detrend: str,
                      options: tuple, progress: bool, refined: bool = True):
     """The subspace ``model`` (kept in place of PEM's, or ``refined`` False: PEM skipped, which
@@ -217,7 +205,7 @@ def _bootstrap_sigma(model, d: IOData, k: int, method: str, feedthrough: bool, d
         model = model.replace(info={**model.info, "refined": False})
     return bootstrap_covariance(model, d.u, d.y, refit, replicates=replicates, seed=seed,
                                 estimator=f"{method} (order {n}, horizon {k})",
-                                demean=detrend == "mean", feedthrough=feedthrough,
+                                detrend=detrend, feedthrough=feedthrough,
                                 progress=progress)
 
 
@@ -362,11 +350,12 @@ def focus_score(model, focus: str, d: IOData) -> float:
 
 
 def _refine(start, d: IOData, vd: IOData | None, form: str, focus: str, max_iterations: int,
-            progress: bool = False):
+            progress: bool = False, sigma: bool = False):
     """PEM in ``form`` from the subspace model ``start``, kept only when it does not lose by
     ``focus`` (:func:`_never_lose`; PEM in oe form as the second candidate for the simulation
     focus); ``(model, refined?)``. A PEM that the data cannot determine returns ``start`` with a
-    warning."""
+    warning; ``sigma``: a ``start`` kept is the model returned and gets the bootstrap's σ, which
+    the warnings then name (:func:`_kept_note`)."""
     from .pem_ss import pem
 
     try:
@@ -374,10 +363,8 @@ def _refine(start, d: IOData, vd: IOData | None, form: str, focus: str, max_iter
                     progress=progress)
     except IdentificationError as exc:  # an order the data do not support in full
         emit_warning(f"PEM refinement of the order-{start.order} {start.structure} model failed "
-                     f"({exc.message}); the subspace model is returned, with σ from a "
-                     f"parametric bootstrap of the subspace estimate where its replicates allow, "
-                     f"not PEM's covariance (lower the order, or --no-refine to skip PEM)",
-                     AccuracyWarning)
+                     f"({exc.message}); {_kept_note(sigma)} (lower the order, or --no-refine "
+                     f"to skip PEM)", AccuracyWarning)
         return start, False
     oe = None
     if form == "innovation" and focus == "simulation":  # PEM in oe form minimises the free-run
@@ -388,7 +375,7 @@ def _refine(start, d: IOData, vd: IOData | None, form: str, focus: str, max_iter
             except IdentificationError:
                 return None
     return (_never_lose(start, model, focus, d if vd is None else vd, vd is None, max_iterations,
-                        oe), True)
+                        oe, sigma), True)
 
 
 #: fit points (%) within which a refined model counts as scoring as well as its start: the scores
@@ -407,8 +394,17 @@ def _warn_unconverged(model, max_iterations: int) -> None:
                      AccuracyWarning)
 
 
+def _kept_note(sigma: bool) -> str:
+    """What a warning that drops PEM's model says of the subspace model kept: its σ from the
+    bootstrap only when it is the model returned and gets that σ (``sigma``; not with
+    ``bootstrap_replicates=0``, nor for a candidate of an order search)."""
+    return ("the subspace model is returned, with σ from a parametric bootstrap of the subspace "
+            "estimate where its replicates allow, not PEM's covariance" if sigma else
+            "the subspace model is kept (without PEM's covariance)")
+
+
 def _never_lose(start, refined, focus: str, d: IOData, estimation: bool, max_iterations: int,
-                second=None):
+                second=None, sigma: bool = False):
     """The refined model, or, when it scores lower than its subspace start by ``focus`` on ``d``
     (by more than :data:`FOCUS_TIE`), the model of ``second()`` (PEM in output-error form, which
     minimises the simulation error itself) if that does not, else the subspace start; warns when
@@ -438,9 +434,8 @@ def _never_lose(start, refined, focus: str, d: IOData, estimation: bool, max_ite
     other = "prediction" if focus == "simulation" else "simulation"
     emit_warning(f"PEM refinement lowered the mean {focus} fit on the {where} data from "
                  f"{before:.2f} % to "
-                 f"{', '.join(f'{name} {fit:.2f} %' for name, fit in tried)}: the "
-                 "subspace model is returned, with σ from a parametric bootstrap of the "
-                 f"subspace estimate, not PEM's covariance (--focus {other} judges "
+                 f"{', '.join(f'{name} {fit:.2f} %' for name, fit in tried)}: "
+                 f"{_kept_note(sigma)} (--focus {other} judges "
                  f"by the other criterion; --no-refine skips PEM)", AccuracyWarning)
     start.info["focus"] = {**record, "refined_percent": tried[0][1], "kept": "subspace"}
     start.info["pem_rejected"] = refined.info.get("pem", {})
@@ -608,8 +603,9 @@ def identify_ss_records(records: list, d: IOData, u0, y0, options: dict, demean:
     focus, progress = options.get("focus", "simulation"), options.get("progress", False)
     if focus not in FOCUS:
         raise DataError(f"focus: expected one of {', '.join(FOCUS)}, found {focus!r}")
-    _check_bootstrap(options.get("bootstrap_replicates"),
-                     options.get("bootstrap_seed", BOOTSTRAP_SEED))
+    options = {**options, "bootstrap_replicates": check_bootstrap(
+        options.get("bootstrap_replicates"), options.get("bootstrap_seed", BOOTSTRAP_SEED),
+        "bootstrap_replicates")}
     rng = parse_order(options.get("order"))
 
     def fit(n):
@@ -716,6 +712,8 @@ def _refine_records(start, records: list, options: dict, focus: str):
     from .pem_ss import pem_records
 
     iters = options.get("max_iterations", 50)
+    rng = parse_order(options.get("order"))  # a candidate of an order search gets no σ here
+    sigma = options.get("bootstrap_replicates") != 0 and (rng is None or rng[0] == rng[1])
     refined = pem_records(start, records, form=options.get("form", "innovation"),
                           max_iterations=iters, progress=options.get("progress", False))
     if not refined.info["pem"]["converged"]:
@@ -727,9 +725,8 @@ def _refine_records(start, records: list, options: dict, focus: str):
               "refined_percent": after}
     if after < before - FOCUS_TIE:
         emit_warning(f"identify ss: PEM over the records lowered the mean {focus} fit of all "
-                     f"records from {before:.4g} % (subspace) to {after:.4g} %; the subspace "
-                     f"model is returned, with σ from a parametric bootstrap of the subspace "
-                     f"estimate, not PEM's covariance", AccuracyWarning)
+                     f"records from {before:.4g} % (subspace) to {after:.4g} %; "
+                     f"{_kept_note(sigma)}", AccuracyWarning)
         return start.replace(info={**start.info, "focus": {**record, "kept": "subspace"}})
     return refined.replace(info={**refined.info, "focus": {**record, "kept": refined.structure}})
 

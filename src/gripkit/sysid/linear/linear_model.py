@@ -41,9 +41,8 @@ from ...signals.trajectory import Trajectory
 from ...units import product_unit, same_dimension
 from ..checks import as_io_matrix
 from ..model_file import SCHEMA, SCHEMA_VERSION, read_document, write_document
-from ..model_protocol import (ModelFit, ReportMixin, check_horizon, check_sample_time,
-                              column_in_unit)
-from .validation import validate
+from ..model_protocol import (ModelFit, ReportMixin, check_horizon, check_sample_time)
+from .validation import checks_arrays, model_columns, validate
 
 __all__ = ["VALIDATION_FIT", "IdentifiedLinearModel", "LinearModel", "as_io_matrix",
            "deviation_compare", "estimate_x0", "free_run", "fit_per_output", "k_step_prediction",
@@ -333,14 +332,10 @@ class IdentifiedLinearModel(ReportMixin):
 
     # ------------------------------------------------------------------ data in
     def _columns(self, data, names, offsets, what):
-        missing = [n for n in names if n not in data.names]
-        if missing:
-            raise DataError(f"data: the model's {what} column(s) {', '.join(map(repr, missing))} "
-                            f"are missing; the data have {', '.join(map(repr, data.names))}",
-                            hint="rename the columns or identify the model from matching data")
+        """The trajectory's columns ``names`` (:func:`~.validation.model_columns`) less the
+        model's ``offsets``."""
         units = self.system.input_units if what == "input" else self.system.output_units
-        return np.column_stack([column_in_unit(data, n, u, what) - o
-                                for n, u, o in zip(names, units, offsets)])
+        return model_columns(data, names, units, what) - offsets
 
     def _io(self, data, y, why: str, outputs: bool = True, dt: float | None = None):
         """``(u, y, dt, y_offset)``: the deviations from the model's offsets of a trajectory's
@@ -375,22 +370,28 @@ class IdentifiedLinearModel(ReportMixin):
         return ss.A, ss.B, ss.C, ss.D, K
 
     # ------------------------------------------------------------------ the protocol
+    @checks_arrays("simulate", with_y=False)
     def simulate(self, data, x0=None, dt: float | None = None) -> np.ndarray:
         """Free run (N, p) from ``x0`` (default: rest) on the inputs of ``data``: a trajectory
         or the inputs ``u`` (N, m) sampled every ``dt`` (default the model's); offsets applied,
-        the result in the data's units (from rest: from the model's operating point)."""
+        the result in the data's units (from rest: from the model's operating point). Arrays
+        are the record's own values, not deviations (:data:`~.validation.OFFSETS_RULE`;
+        deviations with far-off offsets warn)."""
         u, _, step, yo = self._io(data, None, "simulation of an identified model", False, dt)
         ss = self.to_ss(step)
         if u.shape[1] != ss.n_inputs:
             raise DataError(f"u: expected {ss.n_inputs} input columns, found {u.shape[1]}")
         ys = free_run(ss.A, ss.B, ss.C, ss.D, u, x0)
-        return ys if yo is None else ys + yo
+        return ys + yo
 
+    @checks_arrays("compare")
     def compare(self, data, y=None, dt: float | None = None) -> ModelFit:
         """The validation fit (:data:`VALIDATION_FIT`) per output on a trajectory, or on
         the arrays ``u``, ``y`` (offsets applied as to a trajectory): free run from the initial
         state estimated by least squares. ``fit_percent`` is None per output for an unstable
-        model (its free run, from rest, is ``simulated``)."""
+        model (its free run, from rest, is ``simulated``). Arrays are the record's own values,
+        not deviations (:data:`~.validation.OFFSETS_RULE`; deviations with far-off offsets
+        warn)."""
         u, yy, dt, yo = self._io(data, y, "comparison of an identified model", dt=dt)
         return deviation_compare(self, u, yy, dt, yo)
 
@@ -401,20 +402,23 @@ class IdentifiedLinearModel(ReportMixin):
         h = check_horizon(horizon)
         u, yy, dt, yo = self._io(data, y, "prediction of an identified model", dt=dt)
         yh = self._prediction(u, yy, dt, h)
-        return yh if yo is None else yh + yo
+        return yh + yo
 
     def _prediction(self, u, y, dt, horizon: int) -> np.ndarray:
         return k_step_prediction(*self._state_space(dt), u, y, horizon)
 
     def residuals(self, data, y=None, dt: float | None = None) -> np.ndarray:
         """One-step prediction errors ``y − ŷ(t | t − 1)`` (N, p) on a trajectory or on
-        the arrays ``u``, ``y`` (:meth:`predict`)."""
+        the arrays ``u``, ``y`` (:meth:`predict`; the record's own values, not deviations:
+        :data:`~.validation.OFFSETS_RULE`)."""
         u, yy, dt, _ = self._io(data, y, "residuals of an identified model", dt=dt)
         return yy - k_step_prediction(*self._state_space(dt), u, yy, 1)
 
+    @checks_arrays("validate")
     def validate(self, data, y=None, **kw):
         """Free-run and one-step validation of a one-input, one-output model on a separate
-        record, a trajectory or the arrays ``u``, ``y`` (the model's offsets applied to either):
+        record, a trajectory or the arrays ``u``, ``y`` (the model's offsets applied to either:
+        the record's own values, not deviations, :data:`~.validation.OFFSETS_RULE`):
         :func:`gripkit.sysid.validate` (several channels: :meth:`compare` and
         :meth:`residuals`)."""
         return validate(self, data, y, **kw)

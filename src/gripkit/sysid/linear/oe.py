@@ -64,7 +64,9 @@ def oe(u, y, nb: int, nf: int, nk: int = 1, *, dt: float | None = None,
        **meta) -> PolynomialModel:
     """Output-error model ``y = B/F u + e`` by prediction-error minimisation.
 
-    Parameters as :func:`gripkit.sysid.linear.arx` with ``nf`` (number of F coefficients after the
+    Parameters as :func:`gripkit.sysid.linear.arx` (``u``, ``y`` deviations with the operating
+    point as ``u_offset=``/``y_offset=``; the model's methods take the record's own values) with
+    ``nf`` (number of F coefficients after the
     leading 1) in place of ``na``. Returns a :class:`PolynomialModel` with ``structure='oe'``,
     ``A = [1]``, ``F`` and ``F_std``; its poles are the roots of F. ``progress``: a progress
     bar of the Levenberg–Marquardt iterations on stderr.

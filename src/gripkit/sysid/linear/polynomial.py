@@ -53,7 +53,7 @@ from .linear_model import (IdentifiedLinearModel, LinearModel, _checked_display_
                            as_io_matrix, deviation_compare, k_step_prediction, malformed,
                            polynomial_document, read_linear_model)
 from ..model_protocol import check_horizon, check_sample_time
-from .validation import validate
+from .validation import checks_arrays, validate
 
 __all__ = ["PolynomialModel", "load_linear_model"]
 
@@ -728,6 +728,7 @@ class PolynomialModel(IdentifiedLinearModel):
         return w, H if self.multivariable else H[:, 0, 0]
 
     # ------------------------------------------------------------------ simulation and prediction
+    @checks_arrays("simulate", with_y=False)
     def simulate(self, data, x0=None, *, initial: str = "rest", y_past=None,
                  u_past=None) -> np.ndarray:
         """Free-run output ``ŷ = B/(A F) u`` (no noise) plus ``y_offset``: of a trajectory,
@@ -738,7 +739,9 @@ class PolynomialModel(IdentifiedLinearModel):
         ----------
         data
             A trajectory, or the input samples u(0) … u(N−1) in the units of the data the
-            model was fitted on (the model's ``u_offset`` is removed), shape (N,).
+            model was fitted on (the model's ``u_offset`` is removed), shape (N,): the record's
+            own values, not deviations (:data:`~.validation.OFFSETS_RULE`; deviations with a
+            far-off ``u_offset`` warn).
         x0
             Initial state of :attr:`system` (default rest); or ``initial='given'``.
         initial
@@ -807,7 +810,8 @@ class PolynomialModel(IdentifiedLinearModel):
 
     def predict(self, data, y=None, horizon: int = 1) -> np.ndarray:
         """``ŷ(t | t − horizon)``: of a trajectory (N, 1) in its units, of the arrays ``u``,
-        ``y`` (offsets applied, as to a trajectory) shape (N,). ``horizon = 1``: the exact
+        ``y`` (offsets applied, as to a trajectory: the record's values, not deviations) shape
+        (N,). ``horizon = 1``: the exact
         one-step predictor of the polynomials, the first ``start`` samples being the record's
         own values (the predictor's initial conditions); ``horizon > 1``:
         :func:`~.linear_model.k_step_prediction` on :meth:`innovation_form`."""
@@ -864,9 +868,11 @@ class PolynomialModel(IdentifiedLinearModel):
             check_sample_time(dt, self.dt)
         return self.innovation_form()
 
+    @checks_arrays("validate")
     def validate(self, data, y=None, **kw):
         """Free-run and one-step validation on a separate record, a trajectory or the arrays
-        ``u``, ``y``; see :func:`gripkit.sysid.validate` (one input and one output; a MIMO
+        ``u``, ``y`` (the record's own values, not deviations: :data:`~.validation.OFFSETS_RULE`);
+        see :func:`gripkit.sysid.validate` (one input and one output; a MIMO
         model: :meth:`compare` and :meth:`residuals`)."""
         if self.multivariable:
             raise ModelError(f"validate: {self.label} has {self.n_inputs} inputs and "

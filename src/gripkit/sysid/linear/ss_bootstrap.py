@@ -49,13 +49,13 @@ import warnings
 
 import numpy as np
 
-from ...errors import AccuracyWarning, GripkitError, emit_warning
+from ...errors import AccuracyWarning, ArgumentError, GripkitError, emit_warning
 from ...lti import StateSpace
 from ...progress import status, track
 
 __all__ = ["BOOTSTRAP_SEED", "MAX_REPLICATES", "MIN_REPLICATES", "bootstrap_replicates",
            "bootstrap_covariance", "bootstrap_covariance_records", "bootstrapped",
-           "covariance_method"]
+           "covariance_method", "check_bootstrap"]
 
 #: the default seed of the bootstrap's draws (numpy.random.default_rng)
 BOOTSTRAP_SEED = 0
@@ -80,6 +80,30 @@ def bootstrap_replicates(n_samples: int) -> int:
     (100, 50, 30)
     """
     return int(min(MAX_REPLICATES, max(MIN_REPLICATES, SAMPLE_BUDGET // max(int(n_samples), 1))))
+
+
+def check_bootstrap(value, seed, name: str) -> int | None:
+    """The replicates asked for by ``value`` (``n4sid``'s ``bootstrap``, ``identify_ss``'s
+    ``bootstrap_replicates``; ``name``: which): ``None`` (replicates by the record's length) for
+    None or True, ``0`` (no bootstrap) for 0 or False, else an integer >= ``MIN_REPLICATES / 3``
+    (fewer give no σ worth reporting); ``seed`` a non-negative integer (numpy's default_rng).
+    An :class:`~gripkit.errors.ArgumentError` otherwise."""
+    lo = MIN_REPLICATES // 3
+    if value is None or value is True:
+        replicates = None
+    elif value is False:
+        replicates = 0
+    elif isinstance(value, (int, np.integer)) and (value == 0 or value >= lo):
+        replicates = int(value)
+    else:
+        raise ArgumentError(f"{name}: expected None or True (replicates by the record's length), "
+                            f"0 or False (no bootstrap, no σ) or an integer >= {lo} "
+                            f"(replicates), found {value!r:.40}",
+                            hint=f"pass {name}={lo} or more, or {name}=0")
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
+        raise ArgumentError(f"bootstrap_seed: expected a non-negative integer, found {seed!r:.40}",
+                            hint="pass bootstrap_seed=0 (the default) or another integer >= 0")
+    return replicates
 
 
 def _levinson(r: np.ndarray, n_samples: int) -> np.ndarray:
@@ -143,25 +167,32 @@ def _observability(A: np.ndarray, C: np.ndarray, w: np.ndarray) -> np.ndarray:
 
 def _aligned(refit: StateSpace, O: np.ndarray, w: np.ndarray, feedthrough: bool):
     """The entries (vec A, vec B, vec C[, vec D], row-major) of ``refit`` in the model's state
-    coordinates (``O_b T ≈ O``, module docstring), or None when T is (nearly) singular."""
-    Ob = _observability(refit.A, refit.C, w)
-    T = np.linalg.lstsq(Ob, O, rcond=None)[0]
-    if not np.all(np.isfinite(T)) or np.linalg.cond(T) > 1e8:
+    coordinates (``O_b T ≈ O``, module docstring), or None when T is (nearly) singular or the
+    linear algebra fails on a degenerate replicate (numpy's LinAlgError: a failed replicate)."""
+    try:
+        Ob = _observability(refit.A, refit.C, w)
+        T = np.linalg.lstsq(Ob, O, rcond=None)[0]
+        if not np.all(np.isfinite(T)) or np.linalg.cond(T) > 1e8:
+            return None
+        A = np.linalg.solve(T, refit.A @ T)
+        B = np.linalg.solve(T, refit.B)
+    except np.linalg.LinAlgError:
         return None
-    A = np.linalg.solve(T, refit.A @ T)
-    B = np.linalg.solve(T, refit.B)
     C = refit.C @ T
     parts = [A.ravel(), B.ravel(), C.ravel()] + ([refit.D.ravel()] if feedthrough else [])
     return np.concatenate(parts)
 
 
-def _replicates(model, records, x0s, refit, replicates: int, seed: int, demean: bool,
+def _replicates(model, records, x0s, refit, replicates: int, seed: int, detrend: str,
                 feedthrough: bool, progress: bool):
     """The aligned entries of each replicate that refits (rows), the number that failed and the
     number tried: all of ``replicates``, unless more than half of those tried (after
     :data:`MIN_REPLICATES` / 3 at least) have failed, which stops the loop (no σ comes of it).
     ``records``: (u, y) pairs, each simulated from its own initial state of ``x0s`` and given
-    its own disturbance; ``refit(us, ys)`` fits them all at once."""
+    its own disturbance, then detrended as the estimate's data were (``detrend``: 'mean', the
+    mean of all records' samples; 'linear', each record's least-squares line against time;
+    'none'); ``refit(us, ys)`` fits them all at once: an error of it (a GripkitError, or
+    numpy's LinAlgError on a degenerate replicate) counts the replicate as failed."""
     ss = model.system
     us = [u for u, _ in records]
     y_dets = [ss.simulate(u, x0) for u, x0 in zip(us, x0s)]
@@ -176,14 +207,12 @@ def _replicates(model, records, x0s, refit, replicates: int, seed: int, demean: 
             break
         tried += 1
         ybs = [y_det + _disturbance(coefs, eps, rng) for y_det, (coefs, eps) in zip(y_dets, noises)]
-        if demean:  # the mean of all records' samples, as the estimation removed it
-            mean = np.vstack(ybs).mean(axis=0)
-            ybs = [yb - mean for yb in ybs]
+        ybs = _detrended(ybs, detrend)
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 fitted = refit(us, [np.ascontiguousarray(yb) for yb in ybs])
-        except GripkitError:
+        except (GripkitError, np.linalg.LinAlgError):
             failed += 1
             continue
         theta = _aligned(fitted.system, O, w, feedthrough)
@@ -194,9 +223,23 @@ def _replicates(model, records, x0s, refit, replicates: int, seed: int, demean: 
     return rows, failed, tried
 
 
+def _detrended(ys: list, detrend: str) -> list:
+    """The simulated outputs ``ys`` (one (N, p) array per record) detrended as the estimation's
+    data were (:func:`_replicates`)."""
+    if detrend == "mean":  # the mean of all records' samples, as the estimation removed it
+        mean = np.vstack(ys).mean(axis=0)
+        return [y - mean for y in ys]
+    if detrend == "linear":  # each record's own line (io_data's 'linear', uniform sampling)
+        from scipy.signal import detrend as line_off
+
+        return [line_off(y, axis=0, type="linear") for y in ys]
+    return ys
+
+
 def bootstrap_covariance(model, u, y, refit, *, estimator: str, replicates: int | None = None,
                          seed: int = BOOTSTRAP_SEED, demean: bool = False,
-                         feedthrough: bool = False, progress: bool = False):
+                         feedthrough: bool = False, progress: bool = False,
+                         detrend: str | None = None):
     """``model`` (a subspace :class:`~gripkit.sysid.LinearModel` of the deviation data ``u``
     (N, m), ``y`` (N, p)) with the covariance of its entries from a parametric bootstrap (module
     docstring) in ``system.uncertainty`` and ``info['covariance']`` saying how it was obtained
@@ -206,7 +249,10 @@ def bootstrap_covariance(model, u, y, refit, *, estimator: str, replicates: int 
     ``refit(u, y)`` is the subspace estimation that gave ``model`` (same order and options);
     ``estimator`` names it in ``info``; ``replicates`` default :func:`bootstrap_replicates`;
     ``demean``: remove each simulated output's mean as the estimation removed the record's
-    (detrend 'mean'); ``feedthrough``: D is estimated, and carries σ. When more than half of the
+    (detrend 'mean'); ``detrend``: 'mean' (``demean``), 'linear' (each simulated output's
+    least-squares line removed, as ``detrend='linear'`` removed the record's) or 'none'
+    (default: ``demean``'s); ``feedthrough``: D is estimated, and carries σ. When more than half
+    of the
     replicates fail (a refit error, such as an order the replicate's data do not support, or a
     refit whose states do not map onto the model's: an order above what the data determine),
     the model is returned without covariance, with an :class:`AccuracyWarning` (the loop stops
@@ -217,8 +263,12 @@ def bootstrap_covariance(model, u, y, refit, *, estimator: str, replicates: int 
     y = np.ascontiguousarray(y, dtype=np.float64)
     ss = model.system
     x0 = np.zeros(ss.n_states) if model.x0 is None else np.asarray(model.x0, dtype=np.float64)
+    how = detrend if detrend is not None else ("mean" if demean else "none")
+    if how not in ("mean", "linear", "none"):
+        raise ArgumentError(f"detrend: expected 'mean', 'linear' or 'none', found {how!r:.40}",
+                            hint="detrend the replicates as the estimate's data were")
     return _covariance(model, [(u, y)], [x0], lambda us, ys: refit(us[0], ys[0]),
-                       (estimator, replicates, seed, demean, feedthrough, progress))
+                       (estimator, replicates, seed, how, feedthrough, progress))
 
 
 def bootstrap_covariance_records(model, records, refit, *, estimator: str,
@@ -237,18 +287,19 @@ def bootstrap_covariance_records(model, records, refit, *, estimator: str,
              np.ascontiguousarray(y, dtype=np.float64).reshape(len(y), -1)) for u, y in records]
     x0s = [np.asarray(r["x0"], dtype=np.float64) for r in model.info["records"]]
     return _covariance(model, recs, x0s, refit,
-                       (estimator, replicates, seed, demean, feedthrough, progress))
+                       (estimator, replicates, seed, "mean" if demean else "none", feedthrough,
+                        progress))
 
 
 def _covariance(model, records, x0s, refit, options: tuple):
     """The body of :func:`bootstrap_covariance` and :func:`bootstrap_covariance_records`;
-    ``options``: (estimator, replicates, seed, demean, feedthrough, progress)."""
-    estimator, replicates, seed, demean, feedthrough, progress = options
+    ``options``: (estimator, replicates, seed, detrend, feedthrough, progress)."""
+    estimator, replicates, seed, detrend, feedthrough, progress = options
     n_samples = sum(u.shape[0] for u, _ in records)
     B = bootstrap_replicates(n_samples) if replicates is None else int(replicates)
     if progress:
         status(f"σ of the {estimator} model: parametric bootstrap, {B} replicates (seed {seed})")
-    rows, failed, tried = _replicates(model, records, x0s, refit, B, seed, demean, feedthrough,
+    rows, failed, tried = _replicates(model, records, x0s, refit, B, seed, detrend, feedthrough,
                                       progress)
     info = {"method": "parametric bootstrap", "replicates": len(rows), "failed": failed,
             "seed": int(seed), "estimator": estimator}

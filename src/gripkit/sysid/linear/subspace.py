@@ -47,7 +47,7 @@ from ..checks import (check_columns_vary, check_dt, check_excitation, check_outp
 from .linear_model import (LinearModel, as_io_matrix, fit_per_output, free_run,
                            observability_regressor)
 from ..regression import qr_r
-from .ss_bootstrap import BOOTSTRAP_SEED, MIN_REPLICATES, bootstrap_covariance
+from .ss_bootstrap import BOOTSTRAP_SEED, bootstrap_covariance, check_bootstrap
 from .validation import records_fit
 
 __all__ = ["n4sid", "n4sid_records", "moesp", "SUBSPACE_METHODS", "default_horizon",
@@ -433,7 +433,8 @@ def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int
     ----------
     u, y
         Inputs (N, m) and outputs (N, p) (1-D: one channel), deviation units (operating point
-        removed), uniformly sampled.
+        removed; it goes in ``u_offset``, ``y_offset``, and the model's methods then take the
+        record's own values, ``m.compare(u + u_offset, y + y_offset)``), uniformly sampled.
     order
         Number of states n; None: the number of singular values above the noise floor
         (1 … ``max_order``, :func:`select_order`).
@@ -453,9 +454,9 @@ def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int
         σ of the estimate by a parametric bootstrap
         (:func:`~gripkit.sysid.linear.ss_bootstrap.bootstrap_covariance`, the same estimation
         refitted): ``True`` (replicates by the record's length), an integer >= 10 (that many
-        replicates), or ``False`` (default): no σ, the subspace estimate alone, which
-        ``info['sigma']`` says. This function is a building block (the start of PEM,
-        the nonlinear families' initialisation, loops over orders or data), where the
+        replicates), or ``False`` (default) or 0: no σ, the subspace estimate alone, which
+        ``info['sigma']`` says. This function is a building block (the start of PEM, the
+        nonlinear families' initialisation, loops over orders or data), where the
         bootstrap's cost (100 refits up to N = 20 000: 0.5 s at N = 1e4, order 4, against
         0.01 s for the estimate) would be paid for nothing;
         ``gripkit.sysid.identify(data, 'ss', refine=False)`` (``gripkit identify ss
@@ -492,7 +493,7 @@ def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int
     """
     if method not in SUBSPACE_METHODS:
         raise DataError(f"method: expected one of {', '.join(SUBSPACE_METHODS)}, found {method!r}")
-    _check_bootstrap_option(bootstrap, bootstrap_seed)
+    replicates = check_bootstrap(bootstrap, bootstrap_seed, "bootstrap")
     u = as_io_matrix(u, "input u")
     y = as_io_matrix(y, "output y", u.shape[0])
     signals = (dict(inputs=inputs, outputs=outputs, input_units=input_units,
@@ -512,33 +513,19 @@ def n4sid(u, y, order: int | None = None, *, method: str = "n4sid", horizon: int
                                      else "singular values above the noise floor")
     warn_if_stabilised(model)
     model = model.replace(u_offset=u_offset, y_offset=y_offset)
-    if bootstrap is False:
+    if replicates == 0:
         model.info["sigma"] = NO_SIGMA
         return model
     refit = lambda uu, yy: from_factor(  # noqa: E731
         subspace_factor(uu, yy, horizon=k, method=method), n, dt=step, feedthrough=feedthrough,
         stable=stable)
     return bootstrap_covariance(model, u, y, refit, estimator=f"{method} (order {n}, horizon {k})",
-                                replicates=None if bootstrap is True else int(bootstrap),
-                                seed=bootstrap_seed, feedthrough=feedthrough)
+                                replicates=replicates, seed=bootstrap_seed, feedthrough=feedthrough)
 
 
 #: what a subspace model from :func:`n4sid` without ``bootstrap`` says of its σ (``info['sigma']``)
 NO_SIGMA = ("no σ: the subspace estimate alone (PEM skipped); n4sid(..., bootstrap=True) gives σ "
             "(a parametric bootstrap), as identify(data, 'ss', refine=False) does by default")
-
-
-def _check_bootstrap_option(bootstrap, seed) -> None:
-    """``bootstrap`` True, False or an integer >= MIN_REPLICATES / 3 (as identify_ss's
-    ``bootstrap_replicates``); ``seed`` a non-negative integer."""
-    lo = MIN_REPLICATES // 3
-    ok = isinstance(bootstrap, bool) or (isinstance(bootstrap, (int, np.integer))
-                                         and bootstrap >= lo)
-    if not ok:
-        raise DataError(f"bootstrap: expected True (replicates by the record's length), False "
-                        f"(no σ) or an integer >= {lo} (replicates), found {bootstrap!r}")
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0:
-        raise DataError(f"bootstrap_seed: expected a non-negative integer, found {seed!r}")
 
 
 def moesp(u, y, order: int | None = None, **options) -> LinearModel:

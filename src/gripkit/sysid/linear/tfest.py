@@ -294,7 +294,9 @@ def tfest(u, y, n_poles: int, n_zeros: int, *, dt: float | None = None,
           inputs=None, outputs=None, input_units=None, output_units=None, u_offset=None,
           y_offset=None) -> LinearModel:
     """Continuous-time G(s) with ``n_poles`` poles and ``n_zeros`` zeros from sampled data
-    (deviation units), zero-order hold between samples; see the module docstring.
+    (deviation units), zero-order hold between samples; see the module docstring. ``u``, ``y``
+    are deviations, the operating point given as ``u_offset``, ``y_offset``; the model's
+    simulate/compare/validate then take the record's own values, never these deviations.
 
     Returns a :class:`LinearModel` whose ``system`` is a continuous
     :class:`gripkit.lti.TransferFunction` with the coefficient covariance, and whose ``info`` has

@@ -20,19 +20,23 @@
 
 from __future__ import annotations
 
+import contextvars
+import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
-from ...errors import ArgumentError, DataError, ModelError, StabilityWarning, emit_warning
+from ...errors import (ArgumentError, DataError, DataWarning, ModelError, StabilityWarning,
+                       emit_warning)
 from ...lti import LinearSystem
 from ...signals.trajectory import Trajectory
 from ..checks import check_io
 from ..model_protocol import ModelFit, check_sample_time, column_in_unit
 
 __all__ = ["fit_percent", "records_fit", "loss_vn", "compare", "ResidualTests", "residual_tests",
-           "Validation", "validate"]
+           "Validation", "validate", "model_columns", "OFFSETS_RULE", "warn_if_deviations",
+           "checks_arrays"]
 
 
 def loss_vn(e: np.ndarray) -> float:
@@ -278,6 +282,90 @@ class Validation:
                     residual_tests=tests)
 
 
+#: the offsets convention, one sentence (the estimators', the models' docstrings and the warning)
+OFFSETS_RULE = ("the estimators (arx, armax, oe, n4sid, tfest) take u, y as deviations from the "
+                "operating point, with u_offset=/y_offset= as metadata, while a model's "
+                "simulate/predict/compare/residuals/validate take the record's own values and "
+                "subtract the offsets themselves")
+#: a column's mean within this fraction of its span (max − min) of zero: it looks like deviations
+DEVIATION_CENTRED = 0.05
+#: an offset farther than this fraction of its span outside a column's range lies "far outside"
+#: it: the model's operating point is none the arrays visit
+OFFSET_FAR = 0.1
+#: set while a checked entry (:func:`checks_arrays`) runs: the calls it makes do not warn again
+_ARRAYS_CHECKED: contextvars.ContextVar[bool] = contextvars.ContextVar("arrays_checked",
+                                                                      default=False)
+
+
+def _looks_like_deviations(x, offsets) -> bool | None:
+    """For the columns of ``x`` (N, k) and the model's ``offsets`` (k,): None when some column
+    is not centred on zero (:data:`DEVIATION_CENTRED`) or the shapes differ (the method's own
+    error follows), else whether some offset lies more than :data:`OFFSET_FAR` of its column's
+    span outside that column's range."""
+    try:
+        x = np.asarray(x, dtype=np.float64)
+    except (TypeError, ValueError):  # not numbers: the method's own DataError follows
+        return None
+    x = x.reshape(x.shape[0], -1) if x.ndim else x.reshape(1, 1)
+    if x.shape[1] != offsets.size or not x.shape[0] or not np.all(np.isfinite(x)):
+        return None
+    lo, hi = x.min(axis=0), x.max(axis=0)
+    span = hi - lo
+    if np.any(np.abs(x.mean(axis=0)) > DEVIATION_CENTRED * span):
+        return None
+    return bool(np.any((offsets != 0) & ((offsets > hi + OFFSET_FAR * span)
+                                         | (offsets < lo - OFFSET_FAR * span))))
+
+
+def warn_if_deviations(model, u, y, what: str) -> None:
+    """Warn (:class:`DataWarning`) when the arrays ``u`` (and ``y``, None for a simulation) given
+    to ``what`` ("compare", …) of a linear ``model`` with non-zero offsets look like deviations
+    (every column's mean within :data:`DEVIATION_CENTRED` of its span of zero) while an offset
+    lies far outside its column's range (:data:`OFFSET_FAR`): the model would subtract its
+    offsets a second time (:data:`OFFSETS_RULE`)."""
+    uo, yo = (np.atleast_1d(np.asarray(getattr(model, k, 0.0) or 0.0, dtype=np.float64))
+              for k in ("u_offset", "y_offset"))
+    if not (np.any(uo) or np.any(yo)):
+        return
+    checks = [_looks_like_deviations(u, uo)] + ([] if y is None else
+                                                [_looks_like_deviations(y, yo)])
+    if None in checks or not any(checks):
+        return
+    name = getattr(model, "label", None) or getattr(model, "structure", "the model")
+    emit_warning(f"{name}.{what}: the arrays look like deviations from the operating point "
+                 f"(their means within {DEVIATION_CENTRED:.0%} of their spans of 0) while the "
+                 f"model's offsets (u_offset = {_numbers(uo)}, y_offset = {_numbers(yo)}) lie far "
+                 f"outside their range; {OFFSETS_RULE}"
+                 f": pass the record's values (u + u_offset, y + y_offset), else the offsets are "
+                 f"subtracted twice", DataWarning)
+
+
+def _numbers(v: np.ndarray) -> str:
+    return ", ".join(f"{x:.4g}" for x in v)
+
+
+def checks_arrays(what: str, with_y: bool = True):
+    """Decorator of a model method ``(self, data, y=None, …)`` (``with_y`` False: no ``y``, a
+    simulation) that runs :func:`warn_if_deviations` on arrays (not a trajectory) once: the
+    methods it calls in turn do not check again."""
+    def wrap(fn):
+        @functools.wraps(fn)
+        def run(self, data, *args, **kw):
+            if _ARRAYS_CHECKED.get():
+                return fn(self, data, *args, **kw)
+            if not isinstance(data, Trajectory):
+                y = (args[0] if args else kw.get("y")) if with_y else None
+                warn_if_deviations(self, data, y, what)
+            token = _ARRAYS_CHECKED.set(True)
+            try:
+                return fn(self, data, *args, **kw)
+            finally:
+                _ARRAYS_CHECKED.reset(token)
+        return run
+    return wrap
+
+
+@checks_arrays("validate")
 def validate(model, u, y=None, *, initial: str = "estimate", lags: int = 25,
              alpha: float = 0.01, dt: float | None = None) -> Validation:
     """Validate the one-input, one-output linear ``model`` (ARX, ARMAX, OE, state space or
@@ -326,19 +414,23 @@ def _record_arrays(model, data, y, dt) -> tuple[np.ndarray, np.ndarray, float | 
         raise ArgumentError("validate: a trajectory carries its outputs and sample time; give "
                             "no y or dt with it", hint="model.validate(data)")
     step = data.require_uniform(why="validation of an identified model")
-    u, y = (_column(data, name, unit, what) for name, unit, what in
-            ((model.inputs[0], model.input_units[0], "input"),
-             (model.outputs[0], model.output_units[0], "output")))
+    u, y = (model_columns(data, names, units, what)[:, 0] for names, units, what in
+            ((model.inputs, model.input_units, "input"),
+             (model.outputs, model.output_units, "output")))
     return *check_io(u, y), step
 
 
-def _column(data, name: str, unit: str, what: str) -> np.ndarray:
-    """Column ``name`` of the trajectory ``data`` in the model's ``unit``."""
-    if name not in data.names:
-        raise DataError(f"data: the model's {what} column {name!r} is missing; the data have "
-                        f"{', '.join(map(repr, data.names))}",
-                        hint="rename the column or validate on a record with the model's columns")
-    return column_in_unit(data, name, unit, what)
+def model_columns(data, names, units, what: str) -> np.ndarray:
+    """The columns ``names`` (N, k) of the trajectory ``data`` in the model's ``units`` (``what``:
+    "input" or "output"), or a DataError naming the missing ones; a model's own arrays
+    (:meth:`IdentifiedLinearModel._columns <gripkit.sysid.linear.linear_model>`) and
+    :func:`validate` read a trajectory by it."""
+    missing = [n for n in names if n not in data.names]
+    if missing:
+        raise DataError(f"data: the model's {what} column(s) {', '.join(map(repr, missing))} "
+                        f"are missing; the data have {', '.join(map(repr, data.names))}",
+                        hint="rename the columns or use a record with the model's columns")
+    return np.column_stack([column_in_unit(data, n, u, what) for n, u in zip(names, units)])
 
 
 def _one_step(model, u, y, dt) -> tuple[np.ndarray, int, np.ndarray]:
