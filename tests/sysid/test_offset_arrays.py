@@ -243,3 +243,19 @@ def test_a_nonlinear_model_validate_names_compare(tanks):
                                          r"model\.compare\(data\)"):
         m.validate(val)
     assert compare(m, val).fit_percent == m.compare(val).fit_percent
+
+
+def test_one_number_is_the_operating_point_of_a_single_channel():
+    """``u_offset=2.0`` on a one-input model is ``(2.0,)`` (it raised TypeError: 'float' object is
+    not iterable); on several channels one number is refused rather than copied to each."""
+    from gripkit.lti import StateSpace
+    from gripkit.sysid import LinearModel
+
+    rng = np.random.default_rng(0)
+    u = rng.standard_normal(500)
+    y = np.convolve(u, [0.0, 1.0, 0.5])[:500] + 0.01 * rng.standard_normal(500)
+    m = n4sid(u, y, 2, u_offset=2.0, y_offset=3.0)
+    assert (m.u_offset, m.y_offset) == ((2.0,), (3.0,))
+    two = StateSpace(np.eye(1) * 0.5, np.ones((1, 2)), np.ones((1, 1)), np.zeros((1, 2)), dt=1.0)
+    with pytest.raises(ModelError, match="one number given for 2 channels"):
+        LinearModel(two, "n4sid", u_offset=1.0)

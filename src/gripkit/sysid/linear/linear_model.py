@@ -456,6 +456,22 @@ class IdentifiedLinearModel(ReportMixin):
         write_document(model_document(self), path)
 
 
+def _operating_point(value, n: int, name: str) -> tuple[float, ...]:
+    """An operating point as a tuple of ``n`` floats: None or empty (zeros), one number (for a
+    single channel only: one level for several channels is not assumed), or a sequence."""
+    if value is None or (isinstance(value, (tuple, list)) and not value):
+        return (0.0,) * n
+    if isinstance(value, (int, float, np.number)) and not isinstance(value, bool):
+        if n != 1:
+            raise ModelError(f"{name}: one number given for {n} channels; give one per channel")
+        return (float(value),)
+    try:
+        return tuple(float(v) for v in np.ravel(np.asarray(value, dtype=np.float64)))
+    except (TypeError, ValueError):
+        raise ModelError(f"{name}: expected numbers, one per channel, "
+                         f"found {value!r:.60}") from None
+
+
 @dataclass(frozen=True, eq=False)
 class LinearModel(IdentifiedLinearModel):
     """An identified linear model in state-space or transfer-function form (subspace, PEM,
@@ -511,8 +527,8 @@ class LinearModel(IdentifiedLinearModel):
         if not isinstance(s, LinearSystem):
             raise ModelError(f"system: expected a gripkit.lti system, found {type(s).__name__}")
         set_ = object.__setattr__
-        set_(self, "u_offset", tuple(float(v) for v in (self.u_offset or (0.0,) * s.n_inputs)))
-        set_(self, "y_offset", tuple(float(v) for v in (self.y_offset or (0.0,) * s.n_outputs)))
+        for name, n in (("u_offset", s.n_inputs), ("y_offset", s.n_outputs)):
+            set_(self, name, _operating_point(getattr(self, name), n, name))
         if len(self.u_offset) != s.n_inputs or len(self.y_offset) != s.n_outputs:
             raise ModelError(f"offsets: expected {s.n_inputs} input and {s.n_outputs} output "
                              "offsets, found "
