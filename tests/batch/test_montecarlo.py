@@ -159,7 +159,7 @@ def test_quantile_interval_coverage_matches_its_binomial_value(n, q, confidence)
 def test_quantile_point_lies_in_its_interval_for_any_sample():
     """Property (hypothesis): for any sample (±inf and ties included), level and confidence, the
     point estimate lies in its interval and the interval's ends are ordered."""
-    hypothesis = pytest.importorskip("hypothesis")
+    import hypothesis  # a dependency of the tests (pyproject.toml)
     st = hypothesis.strategies
 
     @hypothesis.settings(max_examples=300, deadline=None, derandomize=True)

@@ -541,13 +541,15 @@ def _float64_column(col) -> np.ndarray:
 
 def _read_parquet(path: Path, key=None, delimiter=None, *, wanted=None, limit=None,
                   allow_external=False):
-    """Read the columns ``wanted`` of a Parquet file, from an open file object (a path string
-    would be read by pyarrow as a URI or a dataset folder)."""
+    """Read the columns ``wanted`` of a Parquet file, from pyarrow's own file object (a path
+    string would be read by pyarrow as a URI or a dataset folder; a Python file object leaves
+    pyarrow's reader threads to interpreter shutdown, which aborted 1 run in 10 under load:
+    "terminate called without an active exception", apache/arrow#34314 and #50482)."""
     import pyarrow as pa
     import pyarrow.parquet as pq
 
     wanted = wanted or _Wanted(None, None)
-    with open(path, "rb") as fh:
+    with _native_file(path) as fh:
         try:
             pf = pq.ParquetFile(fh)
             meta = pf.metadata
@@ -580,6 +582,17 @@ def _read_parquet(path: Path, key=None, delimiter=None, *, wanted=None, limit=No
         if b"unit" in md:
             units[f.name] = md[b"unit"].decode()
     return _arrow_columns(table, path.name), units
+
+
+def _native_file(path: Path):
+    """``path`` opened for reading as a pyarrow ``OSFile`` (a local file, never a URI), with the
+    OS's error as the open's OSError."""
+    import pyarrow as pa
+
+    try:
+        return pa.OSFile(str(path), "rb")
+    except pa.ArrowException as exc:  # (pyarrow raises its IOError subclasses of OSError too)
+        raise OSError(str(exc).splitlines()[0]) from None
 
 
 def _check_parquet_stored(source: str, meta, names, limit: float) -> None:
