@@ -348,3 +348,38 @@ def test_low_margins_on_a_second_order_arx_warn_with_a_tau_c_that_restores_them(
         again = tune_pid(g, tau_c=0.01)
     assert again.design["margins"]["gain_margin"] == pytest.approx(2.8, abs=0.005)
     assert again.design["margins"]["phase_margin_deg"] == pytest.approx(49.6, abs=0.05)
+
+
+def test_a_phase_crossover_at_the_nyquist_frequency_counts():
+    """0.05 q⁻¹/(1 − 0.98 q⁻¹) at h = 0.01 s with SIMC's PI: L(z) = C(z) G(z) is real at z = −1
+    and negative there, the phase −180° exactly at ω = π/h (no interior crossover). The gain
+    margin is 1/|L(−1)| (C and G evaluated at z = −1 by hand: 1.704 for τ_c = 0.002 s, 1.333
+    for τ_c = 0), equal to python-control's 1/|L(e^{jπ})| from its frequency response (phase
+    −180° there); it was inf (the grid stopped short of π/h). The phase margin stays
+    python-control's stability_margins' to 1e-8; both τ_c warn (gain margin below 2), the
+    message giving the finite gain margin."""
+    import control  # python-control: a dependency of the project (pyproject.toml)
+
+    from gripkit.control.robustness import controller_transfer_function
+    from gripkit.errors import AccuracyWarning
+
+    h = 0.01
+    g = TransferFunction.from_polynomials([1.0, -0.98], [0.0, 0.05], dt=h)
+    for tau_c, expected, shown in ((0.002, 1.7044, "1.7"), (0.0, 1.33338, "1.33")):
+        with pytest.warns(AccuracyWarning) as caught:
+            pid = tune_pid(g, tau_c=tau_c)
+        num, den, _ = controller_transfer_function(pid)
+        by_hand = 1.0 / abs(np.polyval(num, -1.0) / np.polyval(den, -1.0) * 0.05 / (-1.0 - 0.98))
+        with warnings.catch_warnings():  # python-control evaluates the PID's pole z = 0
+            warnings.simplefilter("ignore", RuntimeWarning)
+            loop = control.tf(num, den, h) * control.tf([0.05], [1.0, -0.98], h)
+            mag, phase, _ = control.frequency_response(loop, [math.pi / h])
+            pm = control.stability_margins(loop, method="poly")[1]
+        margins = pid.design["margins"]
+        assert margins["gain_margin"] == pytest.approx(by_hand, rel=1e-12)
+        assert margins["gain_margin"] == pytest.approx(1.0 / float(mag[0]), rel=1e-12)
+        assert abs(abs(math.degrees(float(phase[0]))) - 180.0) < 1e-9
+        assert margins["gain_margin"] == pytest.approx(expected, abs=1e-4)
+        assert margins["w_gain_margin"] == pytest.approx(math.pi / h, rel=1e-15)
+        assert margins["phase_margin_deg"] == pytest.approx(pm, rel=1e-8)
+        assert len(caught) == 1 and f"gain margin {shown} and" in str(caught[0].message)
