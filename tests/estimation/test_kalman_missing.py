@@ -93,6 +93,22 @@ def test_missing_samples_update_with_the_measured_outputs(name):
 
 
 @pytest.mark.parametrize("name", FILTERS)
+def test_a_run_still_unpacks_to_four_arrays(name):
+    """``x, P, e, S = run`` (the four arrays it had before ``missing``) unpacks the run;
+    ``run.missing`` = isnan(y) rides outside the tuple (len 4, fields x, P, e, S)."""
+    _, us, ys = record(12, 5)
+    y = ys.copy()
+    y[3] = np.nan
+    y[7, 1] = np.nan
+    with pytest.warns(DataWarning):
+        run = FILTERS[name]().run_arrays(us, y)
+    x, P, e, S = run
+    assert (x is run.x, P is run.P, e is run.e, S is run.S) == (True,) * 4
+    assert len(run) == 4 and run._fields == ("x", "P", "e", "S")
+    assert np.array_equal(run.missing, np.isnan(y)) and run.missing.sum() == 3
+
+
+@pytest.mark.parametrize("name", FILTERS)
 def test_steps_skip_the_update_and_keep_the_state_finite(name):
     """``step`` with a whole sample missing: x[t|t] = x[t|t−1], P[t|t] = P[t|t−1]; the next
     finite step gives the reference (the NaN does not reach the state)."""

@@ -43,18 +43,31 @@ from .packed import block_offsets, block_starts
 __all__ = ["KalmanFilter", "KalmanRun"]
 
 
-class KalmanRun(NamedTuple):
-    """What :meth:`KalmanFilter.run` returns: filtered states ``x`` (N, n), their covariances
-    ``P`` (N, n, n), innovations ``e`` (N, p) and their covariances ``S`` (N, p, p), and
-    ``missing`` (N, p): True where the measurement was NaN, a missing one (its innovation and
-    the innovation covariance's row and column are then NaN; ``missing.any(axis=1)``: the
-    samples updated with fewer outputs, or not at all)."""
-
+class _KalmanArrays(NamedTuple):
     x: np.ndarray
     P: np.ndarray
     e: np.ndarray
     S: np.ndarray
-    missing: np.ndarray
+
+
+class KalmanRun(_KalmanArrays):
+    """What :meth:`KalmanFilter.run` returns: filtered states ``x`` (N, n), their covariances
+    ``P`` (N, n, n), innovations ``e`` (N, p) and their covariances ``S`` (N, p, p) — the
+    tuple, so ``x, P, e, S = run`` unpacks it — and the attribute ``missing`` (N, p), outside
+    the tuple: True where the measurement was NaN, a missing one (its innovation and the
+    innovation covariance's row and column are then NaN; ``missing.any(axis=1)``: the samples
+    updated with fewer outputs, or not at all). Without ``missing`` (a run built by hand, or
+    by ``_make``/``_replace``) it is ``isnan(e)``."""
+
+    def __new__(cls, x, P, e, S, missing=None):
+        run = super().__new__(cls, x, P, e, S)
+        run.__dict__["_missing"] = missing
+        return run
+
+    @property
+    def missing(self) -> np.ndarray:
+        m = self.__dict__.get("_missing")
+        return np.isnan(self.e) if m is None else m
 
 
 def warn_missing(where: str, missing: np.ndarray) -> None:
