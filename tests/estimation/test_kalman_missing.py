@@ -244,3 +244,24 @@ def test_non_finite_model_function_is_a_model_error(cls, jit):
     with pytest.raises(ModelError, match=r"step: h\(x, u\) returned a NaN or ±inf"):
         cls(lambda x, u: x, lambda x, u: np.full(1, np.nan), Q=[[0.1]], R=[[1.0]]).step(
             [0.0], [1.0])
+
+
+def test_the_gains_of_a_pattern_of_missing_outputs():
+    """``gains_measuring([False, True])`` of the steady filter: P_p C₂ᵀ/Σ₂₂ and A P_p C₂ᵀ/Σ₂₂
+    with C₂ the measured row, Σ₂₂ = C₂ P_p C₂ᵀ + R₂₂ (numpy, to 1e-12), column 0 zero; all
+    measured: the steady gains; a wrong length is an ArgumentError."""
+    from gripkit.errors import ArgumentError
+
+    kf = KalmanFilter(model(), Q=Q, R=R, steady_state=True)
+    Pp = kf.P_steady_pred
+    c = C[1]
+    sig = c @ Pp @ c + R[1, 1]
+    Kf, Kp = kf.gains_measuring([False, True])
+    np.testing.assert_allclose(Kf[:, 1], Pp @ c / sig, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(Kp[:, 1], A @ Pp @ c / sig, rtol=1e-12, atol=1e-15)
+    assert np.array_equal(Kf[:, 0], np.zeros(3)) and np.array_equal(Kp[:, 0], np.zeros(3))
+    Kf, Kp = kf.gains_measuring([True, True])
+    np.testing.assert_allclose(Kf, kf.filter_gain, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(Kp, kf.predictor_gain, rtol=1e-12, atol=1e-15)
+    with pytest.raises(ArgumentError, match="expected 2 booleans"):
+        kf.gains_measuring([True])

@@ -36,7 +36,7 @@ import numba
 import numpy as np
 from scipy.linalg import solve_discrete_are
 
-from ..errors import DataError, DataWarning, ModelError, emit_warning
+from ..errors import ArgumentError, DataError, DataWarning, ModelError, emit_warning
 from ..lti import flush_tiny
 from .packed import block_offsets, block_starts
 
@@ -453,6 +453,18 @@ def kf_step_packed(dims, par, st, u, y):  # pragma: no cover - compiled
     return 0
 
 
+@numba.njit(cache=True)
+def kf_gains_packed(dims, par, st):  # pragma: no cover - compiled
+    """The gains K_f, K_p (blocks of ``st``) that :func:`kf_step_packed` uses at a sample whose
+    missing outputs are the NaN of ``st``'s y − y0 block: from the steady P_p (``dims[3]``) or
+    ``st``'s own. False if Σ is not positive definite."""
+    n, m, p, steady = dims[0], dims[1], dims[2], dims[3]
+    oPp = _par_offsets(n, m, p)[13]
+    if steady:
+        return _kf_gains(n, m, p, par, st, par, oPp)
+    return _kf_gains(n, m, p, par, st, st, _st_offsets(n, m, p)[1])
+
+
 @numba.njit(cache=True, inline="always")
 def _kf_update_missing(n, m, p, par, st, steady):  # pragma: no cover - compiled
     """The step of a sample with missing outputs (:func:`kf_step_packed`): gains from P_p (the
@@ -659,6 +671,26 @@ class KalmanFilter:
         if copy:
             return self.x.copy(), self.P.copy()
         return self._x_out, self._P_out
+
+    def gains_measuring(self, measured) -> tuple[np.ndarray, np.ndarray]:
+        """``(K_f, K_p)`` (n×p each) that the next :meth:`step` uses when only the outputs
+        ``measured`` (p booleans) are measured, the others missing (NaN): the gains of C's rows
+        and R's rows and columns of the measured outputs, from the steady prediction covariance
+        (a steady-state filter) or the current one, with zero columns for the missing outputs
+        (:func:`kf_step_packed`'s own numbers). A ModelError if that Σ is not positive
+        definite."""
+        n, m, p = (int(v) for v in self._dims[:3])
+        ok = np.asarray(measured, dtype=bool).reshape(-1)
+        if ok.shape != (p,):
+            raise ArgumentError(f"measured: expected {p} booleans (one per output), found "
+                                f"shape {ok.shape}")
+        lay, _ = _st_layout(n, m, p)
+        st = self._st.copy()
+        st[lay["yy"]:lay["yy"] + p] = np.where(ok, 0.0, np.nan)
+        if not kf_gains_packed(self._dims, self._par, st):
+            self._fail(1, "gains_measuring")
+        Kf, Kp = (st[lay[k]:lay[k] + n * p].reshape(n, p).copy() for k in ("Kf", "Kp"))
+        return Kf, Kp
 
     @property
     def innovation(self) -> np.ndarray:
