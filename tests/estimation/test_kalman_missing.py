@@ -265,3 +265,17 @@ def test_the_gains_of_a_pattern_of_missing_outputs():
     np.testing.assert_allclose(Kp, kf.predictor_gain, rtol=1e-12, atol=1e-15)
     with pytest.raises(ArgumentError, match="expected 2 booleans"):
         kf.gains_measuring([True])
+
+
+def test_one_kernel_drops_and_marks_the_missing_outputs_of_every_filter():
+    """The linear filter and the EKF/UKF share kalman._drop_missing and _mark_missing (one
+    block of code, where each had its own copy): the nonlinear update calls those two and
+    blanks no Σ row itself (the filters' results: the tests above)."""
+    import inspect
+
+    from gripkit.estimation import kalman
+    from gripkit.estimation import nonlinear_kalman as nk
+
+    assert nk._drop_missing is kalman._drop_missing and nk._mark_missing is kalman._mark_missing
+    src = inspect.getsource(nk._gain_update.py_func)
+    assert "_drop_missing(" in src and "_mark_missing(" in src and "= 1.0" not in src

@@ -255,36 +255,37 @@ def _kf_innovation(n, m, p, par, st, u, y):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, inline="always")
-def _drop_missing(n, p, st, so):  # pragma: no cover - compiled
-    """The update with the measured outputs only: for each missing y_i (NaN in the y − y0 block
-    at ``so[0]``), column i of P_p Cᵀ and M (blocks at ``so[1]``, ``so[2]``) is zero and Σ's
-    row and column i (at ``so[3]``) those of the identity, so that the gains' column i is zero
-    and the other columns are those of the filter with C's row i and R's row and column i
-    struck out (Σ block diagonal)."""
-    syy, sPC, sM, sSe = so
+def _drop_missing(yy, oy, p, a, oa, ob, rows, sig, osig):  # pragma: no cover - compiled
+    """The update with the measured outputs only, shared by every filter: for each missing y_i
+    (NaN at ``yy[oy + i]``), column i of the rows×p blocks of ``a`` at ``oa`` and ``ob`` (the
+    same block twice where there is one: P_xy) is zero and Σ's row and column i (the p×p block
+    of ``sig`` at ``osig``) those of the identity, so that the gains' column i is zero and the
+    other columns are those of the filter with C's (h's) row i and R's row and column i struck
+    out (Σ block diagonal). All blocks row-major."""
     for i in range(p):
-        if st[syy + i] == st[syy + i]:
+        if yy[oy + i] == yy[oy + i]:
             continue
-        for r in range(n):
-            st[sPC + r * p + i] = 0.0
-            st[sM + r * p + i] = 0.0
+        for r in range(rows):
+            a[oa + r * p + i] = 0.0
+            a[ob + r * p + i] = 0.0
         for j in range(p):
-            st[sSe + i * p + j] = 0.0
-            st[sSe + j * p + i] = 0.0
-        st[sSe + i * p + i] = 1.0
+            sig[osig + i * p + j] = 0.0
+            sig[osig + j * p + i] = 0.0
+        sig[osig + i * p + i] = 1.0
 
 
 @numba.njit(cache=True, inline="always")
-def _mark_missing(p, st, syy, se, sSe):  # pragma: no cover - compiled
-    """After the step: a missing y_i's innovation and Σ's row and column i are NaN (none was
-    measured)."""
+def _mark_missing(yy, oy, p, e, oe, sig, osig):  # pragma: no cover - compiled
+    """After the step, shared by every filter: a missing y_i's (NaN at ``yy[oy + i]``)
+    innovation (``e[oe + i]``) and Σ's row and column i (the p×p block of ``sig`` at ``osig``)
+    are NaN (none was measured)."""
     for i in range(p):
-        if st[syy + i] == st[syy + i]:
+        if yy[oy + i] == yy[oy + i]:
             continue
-        st[se + i] = np.nan
+        e[oe + i] = np.nan
         for j in range(p):
-            st[sSe + i * p + j] = np.nan
-            st[sSe + j * p + i] = np.nan
+            sig[osig + i * p + j] = np.nan
+            sig[osig + j * p + i] = np.nan
 
 
 @numba.njit(cache=True, inline="always")
@@ -315,7 +316,7 @@ def _kf_gains(n, m, p, par, st, src, oP):  # pragma: no cover - compiled
             st[sPC + i * p + j] = acc
     _flat_mul_add(par, oR, par, oC, st, sPC, st, sSe, p, p, n)  # Σ = R + C (P_p Cᵀ)
     _flat_mul_add(par, oS, par, oA, st, sPC, st, sM, n, p, n)  # M = S + A (P_p Cᵀ)
-    _drop_missing(n, p, st, (syy, sPC, sM, sSe))
+    _drop_missing(st, syy, p, st, sPC, sM, n, st, sSe)
     if not _flat_cholesky(st, sSe, p):
         return False
     _flat_solve_rows(st, sSe, p, sPC, sKf, n)
@@ -477,7 +478,7 @@ def _kf_update_missing(n, m, p, par, st, steady):  # pragma: no cover - compiled
         return 1
     _kf_covariances(n, m, p, par, st, src, oP, not steady)
     _kf_states(n, m, p, par, st, st, sKf, sKp)
-    _mark_missing(p, st, syy, se, sSe)
+    _mark_missing(st, syy, p, st, se, st, sSe)
     return 0
 
 
