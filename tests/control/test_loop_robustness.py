@@ -97,8 +97,20 @@ def test_a_model_without_covariance_gives_the_nominal_figures_only():
 
 
 def test_loop_without_crossovers_has_infinite_margins():
-    res = loop_margins([0.1], [1.0, -0.5], 0.01)
+    """0.1 z/(z − 0.5): |L| ≤ 0.2 everywhere, L(1) = 0.2 and L(−1) = 1/15 are positive and Im L
+    ≠ 0 inside (0, π/h): no crossover of either kind."""
+    res = loop_margins([0.1, 0.0], [1.0, -0.5], 0.01)
     assert res["gain_margin"] == math.inf and res["phase_margin_deg"] == math.inf
+
+
+def test_a_phase_crossover_at_z_minus_one_is_the_gain_margin():
+    """0.1/(z − 0.5): L is real and negative only at z = −1 (L = −1/15), so the gain margin is
+    15 at ω = π/h, the gain k at which the closed-loop pole 0.5 − 0.1 k reaches −1 (it was
+    inf: the crossover at the Nyquist frequency was missed); no gain crossover (|L| < 1)."""
+    res = loop_margins([0.1], [1.0, -0.5], 0.01)
+    assert res["gain_margin"] == pytest.approx(15.0, rel=1e-12)
+    assert res["w_gain_margin"] == pytest.approx(math.pi / 0.01, rel=1e-15)
+    assert res["phase_margin_deg"] == math.inf
 
 
 def test_the_robustness_section_in_the_model_report(tmp_path):
@@ -149,7 +161,12 @@ def test_lqr_state_feedback_margins():
     L = control.ss(A, B, K, 0, 0.01)
     gm, pm = control.stability_margins(L, method="poly")[:2]
     assert res.nominal["phase_margin_deg"] == pytest.approx(pm, rel=1e-6)
-    assert res.nominal["gain_margin"] == gm == math.inf  # L never crosses the negative real axis
+    # L crosses the negative real axis only at z = −1 (python-control's poly method, which
+    # leaves z = −1 out, says inf): the gain margin is the k at which A − k B K has a pole at −1
+    gmr = res.nominal["gain_margin"]
+    assert gm == math.inf and res.nominal["w_gain_margin"] == pytest.approx(math.pi / 0.01)
+    assert np.min(np.abs(np.linalg.eigvals(A - gmr * B @ K) + 1.0)) < 1e-9
+    assert np.max(np.abs(np.linalg.eigvals(A - 0.999 * gmr * B @ K))) < 1.0
     rho = math.sqrt(R[0, 0] / (R[0, 0] + float((B.T @ S @ B)[0, 0])))
     assert res.nominal["phase_margin_deg"] >= math.degrees(2 * math.asin(rho / 2))
     assert res.probability_stable == 1.0 and np.std(res.phase_margin_deg) > 0

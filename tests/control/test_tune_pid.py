@@ -18,8 +18,9 @@ from gripkit.lti import TransferFunction
 
 def test_simc_first_order_settings_are_table_1():
     """k = 2, τ₁ = 10 s, θ = 1 s: τ_c = θ gives K_c = 10/(2·2) = 2.5, τ_I = min(10, 8) = 8 s;
-    τ_c = 3 s gives K_c = 10/(2·4) = 1.25, τ_I = min(10, 16) = 10 s (a PI: k_d = 0)."""
-    m = LowOrderModel(2.0, 10.0, 1.0, dt=0.1)
+    τ_c = 3 s gives K_c = 10/(2·4) = 1.25, τ_I = min(10, 16) = 10 s (a PI: k_d = 0). hold=True:
+    θ is the design's delay as given (tune_pid adds no h/2)."""
+    m = LowOrderModel(2.0, 10.0, 1.0, dt=0.1, hold=True)
     pid = tune_pid(m)
     assert (pid.kp, pid.ki, pid.kd, pid.dt) == (2.5, 2.5 / 8.0, 0.0, 0.1)
     assert pid.design["Kc"] == 2.5 and pid.design["tau_I"] == 8.0
@@ -30,12 +31,13 @@ def test_simc_first_order_settings_are_table_1():
 def test_simc_second_order_and_integrating_settings_are_table_1():
     """SOPTD k = 1, τ₁ = 5, τ₂ = 0.5, θ = 0.2, τ_c = 0.2: series K_c = 12.5, τ_I = 1.6,
     τ_D = 0.5, parallel k_p = K_c(1 + τ_D/τ_I), k_i = K_c/τ_I, k_d = K_c τ_D. Integrating with lag
-    k′ = 0.5, τ₂ = 0.1, θ = 0.3, τ_c = 0.3: K_c = 1/(0.5·0.6), τ_I = 2.4, τ_D = 0.1."""
-    pid = tune_pid(LowOrderModel(1.0, 5.0, 0.2, 0.5, dt=0.01), tau_c=0.2)
+    k′ = 0.5, τ₂ = 0.1, θ = 0.3, τ_c = 0.3: K_c = 1/(0.5·0.6), τ_I = 2.4, τ_D = 0.1 (hold=True:
+    θ as given)."""
+    pid = tune_pid(LowOrderModel(1.0, 5.0, 0.2, 0.5, dt=0.01, hold=True), tau_c=0.2)
     assert pid.kp == pytest.approx(12.5 * (1 + 0.5 / 1.6), rel=1e-15)
     assert pid.ki == pytest.approx(12.5 / 1.6, rel=1e-15)
     assert pid.kd == pytest.approx(6.25, rel=1e-15)
-    pid = tune_pid(LowOrderModel(0.5, 0.0, 0.3, 0.1, dt=0.01, integrating=True))
+    pid = tune_pid(LowOrderModel(0.5, 0.0, 0.3, 0.1, dt=0.01, integrating=True, hold=True))
     Kc = 1 / (0.5 * 0.6)
     assert pid.kp == pytest.approx(Kc * (1 + 0.1 / 2.4), rel=1e-15)
     assert pid.ki == pytest.approx(Kc / 2.4, rel=1e-15)
@@ -295,16 +297,25 @@ def test_a_one_sample_delay_gets_a_stable_integral_loop():
 
 
 def test_a_pure_delay_low_order_model_and_its_bad_forms():
-    """LowOrderModel(k = 2, τ₁ = 0, θ = 0.5 s) at h = 0.01 s: k_i = 1/(2 (0.5 + 0.5)) = 0.5; the
-    margins of the sampled I-controller on e^{−θs} are within 1.5 % and 0.5° of π and 61.35°
-    (the integral's half sample more), 'stable' None (no discrete poles). τ₁ = 0 with θ = 0 or
-    with τ₂ > 0 is no model the rules know: an ArgumentError."""
+    """LowOrderModel(k = 2, τ₁ = 0, θ = 0.5 s) at h = 0.01 s: θ = 0.5 + h/2 (hold) + h (the
+    integral's sample) = 0.515 s in the design, k_i = 1/(2 (2 · 0.515)); the loop on the exact
+    ZOH sample 2 z⁻⁵⁰ is L = (1/103)/(z⁵⁰ (z − 1)) (k_i h k = 1/103): phase −180° at
+    50.5 ωh = π/2, gain margin 206 sin(π/202) = 3.204 (SIMC's π on e^{−θs}/(2θs); the sample
+    2 z⁻⁵⁰ reads as 49.5 h + h/2 to the half rule, half a sample less than designed for), phase
+    margin 90° − 101 asin(1/206) = 61.91°, python-control's to 1e-8, and stable. τ₁ = 0 with
+    θ = 0 or with τ₂ > 0 is no model the rules know: an ArgumentError."""
     pid = tune_pid(LowOrderModel(2.0, 0.0, 0.5, dt=0.01))
-    assert (pid.kp, pid.ki, pid.kd) == (0.0, 0.5, 0.0)
+    assert pid.design["model"]["theta"] == pytest.approx(0.515, rel=1e-12)
+    assert (pid.kp, pid.kd) == (0.0, 0.0)
+    assert pid.ki == pytest.approx(1.0 / (2.0 * 2 * 0.515), rel=1e-12)
     margins = pid.design["margins"]
-    assert margins["gain_margin"] == pytest.approx(math.pi, rel=0.015)
-    assert margins["phase_margin_deg"] == pytest.approx(90 - math.degrees(0.5), abs=0.5)
-    assert margins["stable"] is None
+    gm, pm = _python_control_margins(_delay(50, k=2.0), pid)
+    assert margins["gain_margin"] == pytest.approx(gm, rel=1e-8)
+    assert margins["phase_margin_deg"] == pytest.approx(pm, rel=1e-8)
+    assert margins["gain_margin"] == pytest.approx(206 * math.sin(math.pi / 202), rel=1e-9)
+    assert margins["phase_margin_deg"] == pytest.approx(
+        90 - 101 * math.degrees(math.asin(1 / 206)), abs=1e-7)
+    assert margins["stable"] is True
     for args in ((1.0, 0.0, 0.0), (1.0, 0.0, 0.1, 0.2)):
         with pytest.raises(ArgumentError, match=r"tau1 = tau2 = 0 with theta > 0: a pure delay"):
             LowOrderModel(*args, dt=0.01)
@@ -348,3 +359,71 @@ def test_low_margins_on_a_second_order_arx_warn_with_a_tau_c_that_restores_them(
         again = tune_pid(g, tau_c=0.01)
     assert again.design["margins"]["gain_margin"] == pytest.approx(2.8, abs=0.005)
     assert again.design["margins"]["phase_margin_deg"] == pytest.approx(49.6, abs=0.05)
+
+
+def test_a_phase_crossover_at_the_nyquist_frequency_counts():
+    """0.05 q⁻¹/(1 − 0.98 q⁻¹) at h = 0.01 s with SIMC's PI: L(z) = C(z) G(z) is real at z = −1
+    and negative there, the phase −180° exactly at ω = π/h (no interior crossover). The gain
+    margin is 1/|L(−1)| (C and G evaluated at z = −1 by hand: 1.704 for τ_c = 0.002 s, 1.333
+    for τ_c = 0), equal to python-control's 1/|L(e^{jπ})| from its frequency response (phase
+    −180° there); it was inf (the grid stopped short of π/h). The phase margin stays
+    python-control's stability_margins' to 1e-8; both τ_c warn (gain margin below 2), the
+    message giving the finite gain margin."""
+    import control  # python-control: a dependency of the project (pyproject.toml)
+
+    from gripkit.control.robustness import controller_transfer_function
+    from gripkit.errors import AccuracyWarning
+
+    h = 0.01
+    g = TransferFunction.from_polynomials([1.0, -0.98], [0.0, 0.05], dt=h)
+    for tau_c, expected, shown in ((0.002, 1.7044, "1.7"), (0.0, 1.33338, "1.33")):
+        with pytest.warns(AccuracyWarning) as caught:
+            pid = tune_pid(g, tau_c=tau_c)
+        num, den, _ = controller_transfer_function(pid)
+        by_hand = 1.0 / abs(np.polyval(num, -1.0) / np.polyval(den, -1.0) * 0.05 / (-1.0 - 0.98))
+        with warnings.catch_warnings():  # python-control evaluates the PID's pole z = 0
+            warnings.simplefilter("ignore", RuntimeWarning)
+            loop = control.tf(num, den, h) * control.tf([0.05], [1.0, -0.98], h)
+            mag, phase, _ = control.frequency_response(loop, [math.pi / h])
+            pm = control.stability_margins(loop, method="poly")[1]
+        margins = pid.design["margins"]
+        assert margins["gain_margin"] == pytest.approx(by_hand, rel=1e-12)
+        assert margins["gain_margin"] == pytest.approx(1.0 / float(mag[0]), rel=1e-12)
+        assert abs(abs(math.degrees(float(phase[0]))) - 180.0) < 1e-9
+        assert margins["gain_margin"] == pytest.approx(expected, abs=1e-4)
+        assert margins["w_gain_margin"] == pytest.approx(math.pi / h, rel=1e-15)
+        assert margins["phase_margin_deg"] == pytest.approx(pm, rel=1e-8)
+        assert len(caught) == 1 and f"gain margin {shown} and" in str(caught[0].message)
+
+
+def test_a_hand_made_model_is_tuned_as_its_zoh_sample_is():
+    """k e^{−θ₀s}/(τs + 1) (k = 2, τ = 0.5 s, θ₀ = 0.1 s, h = 0.01 s) given as a LowOrderModel
+    gets the PI of its ZOH sample b q⁻¹¹/(1 − a q⁻¹) (identified path: θ = θ₀ + h/2): the same
+    gains (1e-9) and θ = 0.105 s; its margins are those of that discrete loop, python-control's
+    (c2d of the lag, zoh, times z⁻¹⁰) to 1e-8. The same for the pure delay 0.3 e^{−0.2s} and
+    0.3 q⁻²¹ (θ = 0.2 + h/2 + h). A fractional delay θ₀ = 0.105 s samples to
+    (b₀ z + b₁) z⁻¹¹/(z − a) with b₀ = k(1 − e^{−(h − ε)/τ}), b₀ + b₁ = k(1 − a), ε = 0.005 s."""
+    import control  # python-control: a dependency of the project (pyproject.toml)
+
+    h, a = 0.01, math.exp(-0.01 / 0.5)
+    hand = tune_pid(LowOrderModel(2.0, 0.5, 0.1, dt=h))
+    ident = tune_pid(_foptd())
+    assert hand.design["model"]["theta"] == pytest.approx(0.105, rel=1e-12)
+    np.testing.assert_allclose([hand.kp, hand.ki, hand.kd], [ident.kp, ident.ki, ident.kd],
+                               rtol=1e-9)
+    lag = control.c2d(control.tf([2.0], [0.5, 1.0]), h, "zoh")
+    gd = TransferFunction(np.asarray(lag.num[0][0], float),
+                          np.r_[np.asarray(lag.den[0][0], float), np.zeros(10)], dt=h)
+    gm, pm = _python_control_margins(gd, hand)
+    assert hand.design["margins"]["gain_margin"] == pytest.approx(gm, rel=1e-8)
+    assert hand.design["margins"]["phase_margin_deg"] == pytest.approx(pm, rel=1e-8)
+    assert hand.design["margins"]["stable"] is True
+    delay = tune_pid(LowOrderModel(0.3, 0.0, 0.2, dt=h))
+    assert delay.ki == pytest.approx(tune_pid(_delay(21)).ki, rel=1e-12)
+    gm, pm = _python_control_margins(_delay(20), delay)
+    assert delay.design["margins"]["gain_margin"] == pytest.approx(gm, rel=1e-8)
+    frac = LowOrderModel(2.0, 0.5, 0.105, dt=h).sampled_plant()
+    b0 = 2.0 * (1.0 - math.exp(-0.005 / 0.5))
+    np.testing.assert_allclose(frac.num[0, 0][-2:], [b0, 2.0 * (1.0 - a) - b0], rtol=1e-12)
+    np.testing.assert_allclose(frac.den[0, 0][:2], [1.0, -a], rtol=1e-12)
+    assert frac.relative_degree() == 11

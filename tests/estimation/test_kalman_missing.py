@@ -93,6 +93,22 @@ def test_missing_samples_update_with_the_measured_outputs(name):
 
 
 @pytest.mark.parametrize("name", FILTERS)
+def test_a_run_still_unpacks_to_four_arrays(name):
+    """``x, P, e, S = run`` (the four arrays it had before ``missing``) unpacks the run;
+    ``run.missing`` = isnan(y) rides outside the tuple (len 4, fields x, P, e, S)."""
+    _, us, ys = record(12, 5)
+    y = ys.copy()
+    y[3] = np.nan
+    y[7, 1] = np.nan
+    with pytest.warns(DataWarning):
+        run = FILTERS[name]().run_arrays(us, y)
+    x, P, e, S = run
+    assert (x is run.x, P is run.P, e is run.e, S is run.S) == (True,) * 4
+    assert len(run) == 4 and run._fields == ("x", "P", "e", "S")
+    assert np.array_equal(run.missing, np.isnan(y)) and run.missing.sum() == 3
+
+
+@pytest.mark.parametrize("name", FILTERS)
 def test_steps_skip_the_update_and_keep_the_state_finite(name):
     """``step`` with a whole sample missing: x[t|t] = x[t|t−1], P[t|t] = P[t|t−1]; the next
     finite step gives the reference (the NaN does not reach the state)."""
@@ -228,3 +244,38 @@ def test_non_finite_model_function_is_a_model_error(cls, jit):
     with pytest.raises(ModelError, match=r"step: h\(x, u\) returned a NaN or ±inf"):
         cls(lambda x, u: x, lambda x, u: np.full(1, np.nan), Q=[[0.1]], R=[[1.0]]).step(
             [0.0], [1.0])
+
+
+def test_the_gains_of_a_pattern_of_missing_outputs():
+    """``gains_measuring([False, True])`` of the steady filter: P_p C₂ᵀ/Σ₂₂ and A P_p C₂ᵀ/Σ₂₂
+    with C₂ the measured row, Σ₂₂ = C₂ P_p C₂ᵀ + R₂₂ (numpy, to 1e-12), column 0 zero; all
+    measured: the steady gains; a wrong length is an ArgumentError."""
+    from gripkit.errors import ArgumentError
+
+    kf = KalmanFilter(model(), Q=Q, R=R, steady_state=True)
+    Pp = kf.P_steady_pred
+    c = C[1]
+    sig = c @ Pp @ c + R[1, 1]
+    Kf, Kp = kf.gains_measuring([False, True])
+    np.testing.assert_allclose(Kf[:, 1], Pp @ c / sig, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(Kp[:, 1], A @ Pp @ c / sig, rtol=1e-12, atol=1e-15)
+    assert np.array_equal(Kf[:, 0], np.zeros(3)) and np.array_equal(Kp[:, 0], np.zeros(3))
+    Kf, Kp = kf.gains_measuring([True, True])
+    np.testing.assert_allclose(Kf, kf.filter_gain, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(Kp, kf.predictor_gain, rtol=1e-12, atol=1e-15)
+    with pytest.raises(ArgumentError, match="expected 2 booleans"):
+        kf.gains_measuring([True])
+
+
+def test_one_kernel_drops_and_marks_the_missing_outputs_of_every_filter():
+    """The linear filter and the EKF/UKF share kalman._drop_missing and _mark_missing (one
+    block of code, where each had its own copy): the nonlinear update calls those two and
+    blanks no Σ row itself (the filters' results: the tests above)."""
+    import inspect
+
+    from gripkit.estimation import kalman
+    from gripkit.estimation import nonlinear_kalman as nk
+
+    assert nk._drop_missing is kalman._drop_missing and nk._mark_missing is kalman._mark_missing
+    src = inspect.getsource(nk._gain_update.py_func)
+    assert "_drop_missing(" in src and "_mark_missing(" in src and "= 1.0" not in src

@@ -139,3 +139,65 @@ def test_bad_models_and_options_are_refused(tmp_path, capsys):
         assert main(["export", "c", str(p), "--out", str(tmp_path / "o"), *kind, *args]) != 0
         err = capsys.readouterr().err
         assert err.startswith(phrase) and err.count("\n") == 1, err
+
+
+def with_dropouts(y):
+    """``y`` with whole samples missing (10, 200–202) and single outputs (0 on 50–59, 1 at
+    100, 0 at 300)."""
+    y = y.copy()
+    y[10] = y[200:203] = np.nan
+    y[50:60, 0] = y[100, 1] = y[300, 0] = np.nan
+    return y
+
+
+@needs_gcc
+@pytest.mark.parametrize("noise", ["innovation form", "Q, R"])
+def test_the_c_filter_updates_with_the_measured_outputs_as_python_does(tmp_path, noise):
+    """NaN dropouts (whole samples and single outputs): the C step uses the Python filter's
+    gains of each pattern of missing outputs (none measured: the time update), so its states
+    equal KalmanFilter(steady_state=True)'s to 1e-12 and none is NaN (a NaN used to reach
+    every later state); a partly measured sample is updated (the next state differs from that
+    of the time update)."""
+    from gripkit.errors import DataWarning
+
+    m = innovation_model()
+    u, y0 = recorded(m)
+    y = with_dropouts(y0)
+    kw = {} if noise == "innovation form" else {"Q": Q, "R": R}
+    files = kalman_c_sources(m, "gkm", **kw)
+    assert "KFX[4][4][2]" in files["gkm.c"] and "isnan(y[i])" in files["gkm.c"]
+    x_c = build_and_run(tmp_path, files, "gkm", u, y)
+    with pytest.warns(DataWarning):
+        x_py = KalmanFilter(m, steady_state=True, **kw).run_arrays(u, y).x
+    assert not np.isnan(x_c).any()
+    np.testing.assert_allclose(x_c, x_py, rtol=1e-12, atol=1e-12 * np.max(np.abs(x_py)))
+    y_whole = y.copy()
+    y_whole[50] = np.nan  # sample 50 with no output at all instead of one
+    with pytest.warns(DataWarning):
+        x_time = KalmanFilter(m, steady_state=True, **kw).run_arrays(u, y_whole).x
+    assert np.max(np.abs(x_time[51] - x_py[51])) > 1e-3  # via x_p (K_f = 0 in innovation form)
+
+
+@needs_gcc
+def test_more_than_four_outputs_get_the_time_update_on_a_dropout(tmp_path):
+    """Five outputs (2^5 patterns: no tables): a sample with any missing output gets the time
+    update only in C, which is the Python filter's step on that sample with every output
+    missing (to 1e-12); the header says so."""
+    from gripkit.errors import DataWarning
+
+    rng = np.random.default_rng(5)
+    A = np.array([[0.9, 0.1], [0.0, 0.8]])
+    sys = StateSpace(A, [[1.0], [0.5]], rng.standard_normal((5, 2)), np.zeros((5, 1)), dt=0.01)
+    m = LinearModel(sys, "n4sid", K=0.1 * rng.standard_normal((2, 5)))
+    u = rng.standard_normal((80, 1))
+    y = m.simulate(u) + 0.05 * rng.standard_normal((80, 5))
+    y[7, 2] = y[30:33] = y[40, 4] = np.nan
+    files = kalman_c_sources(m, "g5")
+    assert "KFX" not in files["g5.c"] and "time update only" in files["g5.h"]
+    x_c = build_and_run(tmp_path, files, "g5", u, y)
+    y_all = y.copy()
+    y_all[np.isnan(y).any(axis=1)] = np.nan
+    with pytest.warns(DataWarning):
+        x_py = KalmanFilter(m, steady_state=True).run_arrays(u, y_all).x
+    np.testing.assert_allclose(x_c, x_py, rtol=1e-12, atol=1e-12 * np.max(np.abs(x_py)))
+    assert np.max(np.abs(x_py)) > 0.1

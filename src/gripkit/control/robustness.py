@@ -9,11 +9,14 @@ z; for a single-input :class:`~gripkit.control.StateFeedback` ``L(z) = K (zI −
 model's state space. For L:
 
 * **gain margin** (:func:`loop_margins`): 1/|L| at the phase crossovers (Im L = 0, Re L < 0) on
-  0 < ω < π/dt, the one closest to 1 in log scale; **phase margin**: arg L + 180° (wrapped to
-  (−180°, 180°]) at the gain crossovers (|L| = 1), the smallest in magnitude: the selection of
-  python-control's ``stability_margins``. Found on a grid of ``n_grid`` frequencies (log-spaced
-  from 1e-5·π/dt and linear up to π/dt) by sign changes, refined by Brent's method to 1e-14
-  relative in ω;
+  0 < ω ≤ π/dt (the Nyquist frequency counts where Im L vanishes there to
+  :data:`NYQUIST_IM_TOL` relative: a real discrete loop at z = −1 with Re L < 0, such as a PI
+  on b q⁻¹/(1 − a q⁻¹), whose phase reaches −180° exactly there), the one closest to 1 in log
+  scale; **phase margin**: arg L + 180° (wrapped to (−180°, 180°]) at the gain crossovers
+  (|L| = 1), the smallest in magnitude: the selection of python-control's
+  ``stability_margins`` (whose version 0.10 leaves z = −1 out: inf there). Found on a grid of
+  ``n_grid`` frequencies (log-spaced from 1e-5·π/dt and linear up to π/dt, π/dt included) by
+  sign changes, refined by Brent's method to 1e-14 relative in ω;
 * **closed-loop poles**: the roots of ``den_C den_G + num_C num_G``; the loop is stable when all
   lie inside the unit circle.
 
@@ -42,6 +45,9 @@ from .state_feedback import StateFeedback
 
 __all__ = ["Robustness", "controller_transfer_function", "frequency_margins", "loop_margins",
            "robustness"]
+
+#: Im L at ω = π/dt within this of |L| counts as zero there (a real loop's L(−1), rounded)
+NYQUIST_IM_TOL = 1e-9
 
 
 def controller_transfer_function(controller) -> tuple[np.ndarray, np.ndarray, float | None]:
@@ -76,7 +82,7 @@ def _grid(dt: float, n_grid: int) -> np.ndarray:
     wn = math.pi / dt
     w = np.unique(np.concatenate([np.geomspace(1e-5 * wn, wn, n_grid // 2),
                                   np.linspace(0.0, wn, n_grid // 2 + 1)[1:]]))
-    return w[w < wn]
+    return np.r_[w[w < wn], wn]
 
 
 def loop_margins(num, den, dt: float, *, n_grid: int = 4000) -> dict:
@@ -94,7 +100,7 @@ def loop_margins(num, den, dt: float, *, n_grid: int = 4000) -> dict:
 
 def frequency_margins(L, dt: float, *, n_grid: int = 4000) -> dict:
     """:func:`loop_margins` of a loop given by its frequency response ``L(ω)`` (a function of
-    ω in rad/s, an array or a scalar, returning complex values) on 0 < ω < π/dt: a sampled
+    ω in rad/s, an array or a scalar, returning complex values) on 0 < ω ≤ π/dt: a sampled
     controller on a continuous plant with delay (:func:`gripkit.control.tune_pid` on a
     :class:`~gripkit.control.LowOrderModel`)."""
     w = _grid(dt, n_grid)
@@ -111,7 +117,10 @@ def frequency_margins(L, dt: float, *, n_grid: int = 4000) -> dict:
             out.append(float(w[i]))
         return out
 
-    w180 = [x for x in roots(lambda x: float(np.imag(L(x))), np.imag(Lw)) if np.real(L(x)) <= 0]
+    im = np.imag(Lw)
+    if abs(im[-1]) <= NYQUIST_IM_TOL * abs(Lw[-1]):  # z = −1: L real there (up to rounding)
+        im[-1] = 0.0
+    w180 = [x for x in roots(lambda x: float(np.imag(L(x))), im) if np.real(L(x)) <= 0]
     wc = roots(lambda x: float(abs(L(x)) - 1.0), np.abs(Lw) - 1.0)
     gm, wg = math.inf, math.nan
     if w180:

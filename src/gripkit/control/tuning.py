@@ -32,9 +32,9 @@ model the PID acts on the model itself, not on its reduction, and its margins ar
 loop has ((0.2 q⁻¹ + 0.15 q⁻²)/(1 − 1.5 q⁻¹ + 0.56 q⁻²) at h = 0.01 s, whose zero the
 reduction cancels by rule R3: 1.83 and 29.1°).
 :func:`tune_pid` therefore computes the achieved margins on the model it was given
-(:func:`~gripkit.control.robustness` of the discrete model; for a :class:`LowOrderModel`,
-:func:`~gripkit.control.robustness.frequency_margins` of the sampled PID on the continuous
-model), records them in ``pid.design["margins"]`` and warns (AccuracyWarning) when the gain
+(:func:`~gripkit.control.robustness` of the discrete model; for a :class:`LowOrderModel`, of
+the exact ZOH sample of its continuous plant, :meth:`LowOrderModel.sampled_plant`), records
+them in ``pid.design["margins"]`` and warns (AccuracyWarning) when the gain
 margin is below :data:`MIN_GAIN_MARGIN` or the phase margin below :data:`MIN_PHASE_MARGIN`
 (well below SIMC's): a larger ``tau_c`` is more robust.
 
@@ -77,11 +77,13 @@ import math
 import warnings
 
 import numpy as np
+from scipy.linalg import expm
+from scipy.signal import ss2tf, tf2ss
 
 from ..errors import AccuracyWarning, ArgumentError, ModelError, emit_warning
 from ..lti import TransferFunction
 from .pid import PID
-from .robustness import controller_transfer_function, frequency_margins, robustness
+from .robustness import robustness
 from .rst import as_plant
 
 __all__ = ["LowOrderModel", "reduce_model", "simc_settings", "tune_pid"]
@@ -105,13 +107,18 @@ MIN_PHASE_MARGIN = 30.0
 class LowOrderModel:
     """``k e^{−θs}/((τ₁s + 1)(τ₂s + 1))`` (τ₂ = 0: first order; τ₁ = τ₂ = 0: the pure delay
     ``k e^{−θs}``, θ > 0), or with ``integrating`` ``k e^{−θs}/(s (τ₂s + 1))`` (k is then k′,
-    τ₁ unused), and the sample time ``dt`` (s) the PID will run at. ``dt`` is not added to θ
-    here: :func:`reduce_model` adds h/2 itself."""
+    τ₁ unused), and the sample time ``dt`` (s) the PID will run at.
 
-    __slots__ = ("k", "tau1", "tau2", "theta", "integrating", "dt", "notes")
+    ``hold``: whether θ already includes what sampling adds to the loop's delay — the hold's h/2
+    and, for the pure delay, the sample the I-controller's integral acts late (:func:`reduce_model`
+    returns such a model). By default (False) θ is the continuous plant's own delay and
+    :func:`tune_pid` adds them, as for an identified model, so that a hand-made model and the
+    reduction of its ZOH sample get the same design."""
+
+    __slots__ = ("k", "tau1", "tau2", "theta", "integrating", "dt", "notes", "hold")
 
     def __init__(self, k: float, tau1: float, theta: float, tau2: float = 0.0, *, dt: float,
-                 integrating: bool = False, notes: tuple = ()):
+                 integrating: bool = False, notes: tuple = (), hold: bool = False):
         vals = dict(k=k, tau1=tau1, theta=theta, tau2=tau2, dt=dt)
         for name, v in vals.items():
             if not isinstance(v, (int, float, np.floating, np.integer)) or not math.isfinite(v):
@@ -127,6 +134,7 @@ class LowOrderModel:
                                 f"theta={theta!r}, dt={dt!r}")
         self.k, self.tau1, self.tau2, self.theta = float(k), float(tau1), float(tau2), float(theta)
         self.dt, self.integrating, self.notes = float(dt), bool(integrating), tuple(notes)
+        self.hold = bool(hold)
 
     def __repr__(self) -> str:
         kind = "integrating, " if self.integrating else ""
@@ -135,7 +143,36 @@ class LowOrderModel:
 
     def to_dict(self) -> dict:
         return dict(k=self.k, tau1=self.tau1, tau2=self.tau2, theta=self.theta,
-                    integrating=self.integrating, dt=self.dt, notes=list(self.notes))
+                    integrating=self.integrating, dt=self.dt, notes=list(self.notes),
+                    hold=self.hold)
+
+    @property
+    def pure_delay(self) -> bool:
+        """``k e^{−θs}``: no lag (SIMC's I-controller)."""
+        return self.tau1 == 0 and self.tau2 == 0 and not self.integrating
+
+    def sampling_delay(self) -> float:
+        """What sampling adds to θ (s): the hold's h/2, and h for the pure delay's integral."""
+        return self.dt / 2.0 + (self.dt if self.pure_delay else 0.0)
+
+    def with_hold(self) -> LowOrderModel:
+        """This model with θ including :meth:`sampling_delay` (itself where it already does)."""
+        if self.hold:
+            return self
+        note = (f"θ includes the hold's h/2 = {self.dt / 2:.4g} s"
+                + (f" and the integral's sample h = {self.dt:.4g} s (it acts a sample late)"
+                   if self.pure_delay else "") + ", added by tune_pid")
+        return LowOrderModel(self.k, self.tau1, self.theta + self.sampling_delay(), self.tau2,
+                             dt=self.dt, integrating=self.integrating,
+                             notes=(*self.notes, note), hold=True)
+
+    def sampled_plant(self) -> TransferFunction:
+        """The exact ZOH sample at ``dt`` of the continuous plant (θ less
+        :meth:`sampling_delay` where ``hold``): with θ_p = d h + ε (0 ≤ ε < h) and the lags'
+        realisation (A, B, C, D), Φ = e^{Ah}, Γ₀ = ∫₀^{h−ε} e^{As} ds B, Γ₁ = e^{A(h−ε)}
+        ∫₀^ε e^{As} ds B: x⁺ = Φ x + Γ₀ u[k−d] + Γ₁ u[k−d−1] (Åström & Wittenmark, Computer-
+        Controlled Systems, §2.3, a delay that is not a multiple of h)."""
+        return _zoh_with_delay(self)
 
 
 def _cancel_lhp_zero(T0: float, taus: list, theta: float) -> tuple[float, list, str]:
@@ -302,7 +339,7 @@ def reduce_model(model, order: int = 1) -> LowOrderModel:
     tau1 = first[0] if first else 0.0
     tau2 = kept[0] if kept else 0.0
     return LowOrderModel(k, tau1, theta, tau2, dt=h, integrating=h_int is not None,
-                         notes=tuple(notes))
+                         notes=tuple(notes), hold=True)
 
 
 def simc_settings(m: LowOrderModel, tau_c: float | None = None) -> dict:
@@ -343,12 +380,14 @@ def tune_pid(model, method: str = "simc", *, tau_c: float | None = None, order: 
     integrator), the ``structure`` ('PID', 'PI', or 'I' on a pure delay) and the achieved
     ``margins`` of the loop on ``model`` itself (``gain_margin``, ``gain_margin_db``,
     ``phase_margin_deg``, their frequencies in rad/s, and ``stable``: the discrete loop's poles
-    inside the unit circle, None for a :class:`LowOrderModel`). SIMC's gain margin ≈ 3 and phase
-    margin ≈ 47° hold for the first-order process with delay (and the pure delay, the
-    integrating process) it is exact for; on another model, whose reduction is approximate, the
-    margins may be lower (module docstring): an AccuracyWarning says so when the gain margin is
-    below 2 or the phase margin below 30° (or the loop is unstable), with a larger ``tau_c`` as
-    the remedy.
+    inside the unit circle; for a :class:`LowOrderModel` the loop with its exact ZOH sample).
+    A hand-made :class:`LowOrderModel` (``hold=False``) is the continuous plant: its θ gets the
+    hold's h/2 (and a pure delay the integral's sample h) as an identified model's does.
+    SIMC's gain margin ≈ 3 and phase margin ≈ 47° hold for the first-order process with delay
+    (and the pure delay, the integrating process) it is exact for; on another model, whose
+    reduction is approximate, the margins may be lower (module docstring): an AccuracyWarning
+    says so when the gain margin is below 2 or the phase margin below 30° (or the loop is
+    unstable), with a larger ``tau_c`` as the remedy.
     """
     if method != "simc":
         raise ArgumentError(f"method: expected 'simc' (Skogestad's rules), found {method!r}")
@@ -358,7 +397,7 @@ def tune_pid(model, method: str = "simc", *, tau_c: float | None = None, order: 
                             f"are {', '.join(PID_OPTIONS)}",
                             hint="output limits are u_min=..., u_max=... (not limits=(lo, hi))")
     if isinstance(model, LowOrderModel):
-        m = model
+        m = model.with_hold()
     else:
         m = reduce_model(model, 2 if order is None else order)
     s = simc_settings(m, tau_c)
@@ -372,21 +411,47 @@ def tune_pid(model, method: str = "simc", *, tau_c: float | None = None, order: 
 
 
 def _achieved_margins(model, m: LowOrderModel, pid: PID) -> dict:
-    """The margins of ``pid`` in the loop with ``model`` (:func:`robustness`, nominal), or for a
-    :class:`LowOrderModel` ``m`` of the sampled PID ``C(e^{jωh})`` on ``m``'s continuous
-    frequency response (θ carries the hold's h/2, as :func:`reduce_model` writes it)."""
-    if not isinstance(model, LowOrderModel):
-        r = robustness(model, pid, n=0)
-        return {**r.nominal, "stable": r.stable}
-    num, den, dt = controller_transfer_function(pid)
+    """The margins of ``pid`` in the loop with ``model`` (:func:`robustness`, nominal); for a
+    :class:`LowOrderModel`, with the exact ZOH sample of its continuous plant
+    (:meth:`LowOrderModel.sampled_plant`), so that the hold and the integral's sample are the
+    loop's own, as on an identified model."""
+    plant = model.sampled_plant() if isinstance(model, LowOrderModel) else model
+    r = robustness(plant, pid, n=0)
+    return {**r.nominal, "stable": r.stable}
 
-    def loop(w):
-        s = 1j * np.asarray(w)
-        lag = (m.tau2 * s + 1.0) * (s if m.integrating else m.tau1 * s + 1.0)
-        return (np.polyval(num, np.exp(s * dt)) / np.polyval(den, np.exp(s * dt))
-                * m.k * np.exp(-m.theta * s) / lag)
 
-    return {**frequency_margins(loop, dt), "stable": None}
+def _zoh_with_delay(m: LowOrderModel) -> TransferFunction:
+    """:meth:`LowOrderModel.sampled_plant`."""
+    h = m.dt
+    theta = max(m.theta - (m.sampling_delay() if m.hold else 0.0), 0.0)
+    d = int(math.floor(theta / h + 1e-9))
+    eps = theta - d * h
+    eps = 0.0 if eps < 1e-9 * h else eps
+    den = np.polymul([m.tau2, 1.0], [1.0, 0.0] if m.integrating else [m.tau1, 1.0])
+    den = np.trim_zeros(den, "f")
+    if den.size == 1:  # no lag: y[k] = k u(kh − θ), the held input d (or d + 1) samples back
+        num_z, den_z = np.array([m.k / den[0]]), np.r_[1.0, np.zeros(d + (eps > 0))]
+        return TransferFunction(num_z, den_z, dt=h)
+    A, B, C, D = tf2ss([m.k], den)
+
+    def integral(t):  # ∫₀ᵗ e^{As} ds B and e^{At}, from one matrix exponential
+        n = A.shape[0]
+        E = expm(np.block([[A, B], [np.zeros((1, n + 1))]]) * t)
+        return E[:n, n:], E[:n, :n]
+
+    G0, Phi0 = integral(h - eps)
+    G1, _ = integral(eps)
+    Phi = expm(A * h)
+    a = np.poly(Phi)
+    num0 = ss2tf(Phi, G0, C, np.zeros((1, 1)))[0][0]
+    if eps == 0.0:  # (C (zI − Φ)⁻¹ Γ + D) z^{−d}
+        num_z, den_z = np.polyadd(num0, D[0, 0] * a), np.r_[a, np.zeros(d)]
+    else:  # (z C (zI − Φ)⁻¹ Γ₀ + C (zI − Φ)⁻¹ Γ₁ + D) z^{−d−1}
+        num1 = ss2tf(Phi, Phi0 @ G1, C, np.zeros((1, 1)))[0][0]
+        num_z = np.polyadd(np.polyadd(np.r_[num0, 0.0], num1), D[0, 0] * a)
+        den_z = np.r_[a, np.zeros(d + 1)]
+    return TransferFunction(np.trim_zeros(num_z, "f") if np.any(num_z) else num_z, den_z,
+                            dt=h)
 
 
 def _warn_if_margins_low(model, m: LowOrderModel, pid: PID, tau_c: float) -> None:

@@ -36,25 +36,38 @@ import numba
 import numpy as np
 from scipy.linalg import solve_discrete_are
 
-from ..errors import DataError, DataWarning, ModelError, emit_warning
+from ..errors import ArgumentError, DataError, DataWarning, ModelError, emit_warning
 from ..lti import flush_tiny
 from .packed import block_offsets, block_starts
 
 __all__ = ["KalmanFilter", "KalmanRun"]
 
 
-class KalmanRun(NamedTuple):
-    """What :meth:`KalmanFilter.run` returns: filtered states ``x`` (N, n), their covariances
-    ``P`` (N, n, n), innovations ``e`` (N, p) and their covariances ``S`` (N, p, p), and
-    ``missing`` (N, p): True where the measurement was NaN, a missing one (its innovation and
-    the innovation covariance's row and column are then NaN; ``missing.any(axis=1)``: the
-    samples updated with fewer outputs, or not at all)."""
-
+class _KalmanArrays(NamedTuple):
     x: np.ndarray
     P: np.ndarray
     e: np.ndarray
     S: np.ndarray
-    missing: np.ndarray
+
+
+class KalmanRun(_KalmanArrays):
+    """What :meth:`KalmanFilter.run` returns: filtered states ``x`` (N, n), their covariances
+    ``P`` (N, n, n), innovations ``e`` (N, p) and their covariances ``S`` (N, p, p) — the
+    tuple, so ``x, P, e, S = run`` unpacks it — and the attribute ``missing`` (N, p), outside
+    the tuple: True where the measurement was NaN, a missing one (its innovation and the
+    innovation covariance's row and column are then NaN; ``missing.any(axis=1)``: the samples
+    updated with fewer outputs, or not at all). Without ``missing`` (a run built by hand, or
+    by ``_make``/``_replace``) it is ``isnan(e)``."""
+
+    def __new__(cls, x, P, e, S, missing=None):
+        run = super().__new__(cls, x, P, e, S)
+        run.__dict__["_missing"] = missing
+        return run
+
+    @property
+    def missing(self) -> np.ndarray:
+        m = self.__dict__.get("_missing")
+        return np.isnan(self.e) if m is None else m
 
 
 def warn_missing(where: str, missing: np.ndarray) -> None:
@@ -242,36 +255,37 @@ def _kf_innovation(n, m, p, par, st, u, y):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, inline="always")
-def _drop_missing(n, p, st, so):  # pragma: no cover - compiled
-    """The update with the measured outputs only: for each missing y_i (NaN in the y − y0 block
-    at ``so[0]``), column i of P_p Cᵀ and M (blocks at ``so[1]``, ``so[2]``) is zero and Σ's
-    row and column i (at ``so[3]``) those of the identity, so that the gains' column i is zero
-    and the other columns are those of the filter with C's row i and R's row and column i
-    struck out (Σ block diagonal)."""
-    syy, sPC, sM, sSe = so
+def _drop_missing(yy, oy, p, a, oa, ob, rows, sig, osig):  # pragma: no cover - compiled
+    """The update with the measured outputs only, shared by every filter: for each missing y_i
+    (NaN at ``yy[oy + i]``), column i of the rows×p blocks of ``a`` at ``oa`` and ``ob`` (the
+    same block twice where there is one: P_xy) is zero and Σ's row and column i (the p×p block
+    of ``sig`` at ``osig``) those of the identity, so that the gains' column i is zero and the
+    other columns are those of the filter with C's (h's) row i and R's row and column i struck
+    out (Σ block diagonal). All blocks row-major."""
     for i in range(p):
-        if st[syy + i] == st[syy + i]:
+        if yy[oy + i] == yy[oy + i]:
             continue
-        for r in range(n):
-            st[sPC + r * p + i] = 0.0
-            st[sM + r * p + i] = 0.0
+        for r in range(rows):
+            a[oa + r * p + i] = 0.0
+            a[ob + r * p + i] = 0.0
         for j in range(p):
-            st[sSe + i * p + j] = 0.0
-            st[sSe + j * p + i] = 0.0
-        st[sSe + i * p + i] = 1.0
+            sig[osig + i * p + j] = 0.0
+            sig[osig + j * p + i] = 0.0
+        sig[osig + i * p + i] = 1.0
 
 
 @numba.njit(cache=True, inline="always")
-def _mark_missing(p, st, syy, se, sSe):  # pragma: no cover - compiled
-    """After the step: a missing y_i's innovation and Σ's row and column i are NaN (none was
-    measured)."""
+def _mark_missing(yy, oy, p, e, oe, sig, osig):  # pragma: no cover - compiled
+    """After the step, shared by every filter: a missing y_i's (NaN at ``yy[oy + i]``)
+    innovation (``e[oe + i]``) and Σ's row and column i (the p×p block of ``sig`` at ``osig``)
+    are NaN (none was measured)."""
     for i in range(p):
-        if st[syy + i] == st[syy + i]:
+        if yy[oy + i] == yy[oy + i]:
             continue
-        st[se + i] = np.nan
+        e[oe + i] = np.nan
         for j in range(p):
-            st[sSe + i * p + j] = np.nan
-            st[sSe + j * p + i] = np.nan
+            sig[osig + i * p + j] = np.nan
+            sig[osig + j * p + i] = np.nan
 
 
 @numba.njit(cache=True, inline="always")
@@ -302,7 +316,7 @@ def _kf_gains(n, m, p, par, st, src, oP):  # pragma: no cover - compiled
             st[sPC + i * p + j] = acc
     _flat_mul_add(par, oR, par, oC, st, sPC, st, sSe, p, p, n)  # Σ = R + C (P_p Cᵀ)
     _flat_mul_add(par, oS, par, oA, st, sPC, st, sM, n, p, n)  # M = S + A (P_p Cᵀ)
-    _drop_missing(n, p, st, (syy, sPC, sM, sSe))
+    _drop_missing(st, syy, p, st, sPC, sM, n, st, sSe)
     if not _flat_cholesky(st, sSe, p):
         return False
     _flat_solve_rows(st, sSe, p, sPC, sKf, n)
@@ -440,6 +454,18 @@ def kf_step_packed(dims, par, st, u, y):  # pragma: no cover - compiled
     return 0
 
 
+@numba.njit(cache=True)
+def kf_gains_packed(dims, par, st):  # pragma: no cover - compiled
+    """The gains K_f, K_p (blocks of ``st``) that :func:`kf_step_packed` uses at a sample whose
+    missing outputs are the NaN of ``st``'s y − y0 block: from the steady P_p (``dims[3]``) or
+    ``st``'s own. False if Σ is not positive definite."""
+    n, m, p, steady = dims[0], dims[1], dims[2], dims[3]
+    oPp = _par_offsets(n, m, p)[13]
+    if steady:
+        return _kf_gains(n, m, p, par, st, par, oPp)
+    return _kf_gains(n, m, p, par, st, st, _st_offsets(n, m, p)[1])
+
+
 @numba.njit(cache=True, inline="always")
 def _kf_update_missing(n, m, p, par, st, steady):  # pragma: no cover - compiled
     """The step of a sample with missing outputs (:func:`kf_step_packed`): gains from P_p (the
@@ -452,7 +478,7 @@ def _kf_update_missing(n, m, p, par, st, steady):  # pragma: no cover - compiled
         return 1
     _kf_covariances(n, m, p, par, st, src, oP, not steady)
     _kf_states(n, m, p, par, st, st, sKf, sKp)
-    _mark_missing(p, st, syy, se, sSe)
+    _mark_missing(st, syy, p, st, se, st, sSe)
     return 0
 
 
@@ -646,6 +672,26 @@ class KalmanFilter:
         if copy:
             return self.x.copy(), self.P.copy()
         return self._x_out, self._P_out
+
+    def gains_measuring(self, measured) -> tuple[np.ndarray, np.ndarray]:
+        """``(K_f, K_p)`` (n×p each) that the next :meth:`step` uses when only the outputs
+        ``measured`` (p booleans) are measured, the others missing (NaN): the gains of C's rows
+        and R's rows and columns of the measured outputs, from the steady prediction covariance
+        (a steady-state filter) or the current one, with zero columns for the missing outputs
+        (:func:`kf_step_packed`'s own numbers). A ModelError if that Σ is not positive
+        definite."""
+        n, m, p = (int(v) for v in self._dims[:3])
+        ok = np.asarray(measured, dtype=bool).reshape(-1)
+        if ok.shape != (p,):
+            raise ArgumentError(f"measured: expected {p} booleans (one per output), found "
+                                f"shape {ok.shape}")
+        lay, _ = _st_layout(n, m, p)
+        st = self._st.copy()
+        st[lay["yy"]:lay["yy"] + p] = np.where(ok, 0.0, np.nan)
+        if not kf_gains_packed(self._dims, self._par, st):
+            self._fail(1, "gains_measuring")
+        Kf, Kp = (st[lay[k]:lay[k] + n * p].reshape(n, p).copy() for k in ("Kf", "Kp"))
+        return Kf, Kp
 
     @property
     def innovation(self) -> np.ndarray:

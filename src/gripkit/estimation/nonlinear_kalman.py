@@ -62,8 +62,8 @@ import numba
 import numpy as np
 
 from ..errors import ArgumentError, DataError, ModelError
-from .kalman import (KalmanFilter, KalmanRun, _cholesky, _chol_solve_rows, bad_channel,
-                     bad_sample, warn_missing)
+from .kalman import (KalmanFilter, KalmanRun, _chol_solve_rows, _cholesky, _drop_missing,
+                     _mark_missing, bad_channel, bad_sample, warn_missing)
 from .state_functions import state_functions
 
 __all__ = ["ExtendedKalmanFilter", "UnscentedKalmanFilter"]
@@ -140,17 +140,11 @@ def _gain_update(s, yhat, Pxy, K, y):  # pragma: no cover - compiled
     n, p = s.xp.shape[0], y.shape[0]
     missing = False
     for i in range(p):
-        if y[i] == y[i]:
-            s.e[i] = y[i] - yhat[i]
-            continue
-        missing = True
-        s.e[i] = 0.0
-        for r in range(n):
-            Pxy[r, i] = 0.0
-        for j in range(p):
-            s.Se[i, j] = 0.0
-            s.Se[j, i] = 0.0
-        s.Se[i, i] = 1.0
+        measured = y[i] == y[i]
+        s.e[i] = y[i] - yhat[i] if measured else 0.0
+        missing = missing or not measured
+    if missing:  # the flat views share the arrays' memory (C-contiguous)
+        _drop_missing(y, 0, p, Pxy.reshape(-1), 0, 0, n, s.Se.reshape(-1), 0)
     if not _cholesky(s.Se):
         return False
     _chol_solve_rows(s.Se, Pxy, K)
@@ -173,20 +167,8 @@ def _gain_update(s, yhat, Pxy, K, y):  # pragma: no cover - compiled
             s.Se[i, j] = acc
             s.Se[j, i] = acc
     if missing:
-        _mark_missing(s, y)
+        _mark_missing(y, 0, p, s.e, 0, s.Se.reshape(-1), 0)
     return True
-
-
-@numba.njit(cache=True, inline="always")
-def _mark_missing(s, y):  # pragma: no cover - compiled
-    """The innovation and Σ's row and column of each missing (NaN) y_i: NaN."""
-    p = y.shape[0]
-    for i in range(p):
-        if y[i] != y[i]:
-            s.e[i] = np.nan
-            for j in range(p):
-                s.Se[i, j] = np.nan
-                s.Se[j, i] = np.nan
 
 
 @numba.njit(cache=True, inline="always")
