@@ -279,3 +279,16 @@ def test_one_kernel_drops_and_marks_the_missing_outputs_of_every_filter():
     assert nk._drop_missing is kalman._drop_missing and nk._mark_missing is kalman._mark_missing
     src = inspect.getsource(nk._gain_update.py_func)
     assert "_drop_missing(" in src and "_mark_missing(" in src and "= 1.0" not in src
+
+
+def test_replace_keeps_the_missing_flags():
+    """``run._replace(x=…)`` keeps ``missing`` (it fell back to isnan(e)); unknown fields are
+    refused as by any named tuple."""
+    from gripkit.estimation.kalman import KalmanRun
+
+    run = KalmanRun(np.zeros((1, 1)), np.zeros((1, 1, 1)), np.array([[1.0, np.nan]]),
+                    np.zeros((1, 2, 2)), missing=np.array([[True, True]]))
+    again = run._replace(x=np.ones((1, 1)))
+    assert again.missing.tolist() == [[True, True]] and again.x[0, 0] == 1.0 and len(again) == 4
+    with pytest.raises(ValueError, match="unexpected field"):
+        run._replace(y=1)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy.signal import lfilter
 
-from gripkit.errors import DataWarning
+from gripkit.errors import DataError, DataWarning
 from gripkit.sysid import arx, n4sid, oe, validate
 from gripkit.sysid.linear.validation import OFFSETS_RULE
 
@@ -83,3 +83,42 @@ def test_no_offsets_or_a_record_around_zero_do_not_warn():
     near = arx(u, y, 2, 1, 1, dt=0.1, u_offset=0.5, y_offset=0.3)
     _, caught = _deviation_warnings(lambda: near.compare(u + 0.5, y + 0.3))
     assert not caught
+
+
+def test_keyword_calls_empty_arrays_and_every_array_method():
+    """The deviation check binds arguments as the wrapped signature does: ``validate(model=m,
+    u=…, y=…)`` and ``validate(m, u=…, y=…)`` give the positional call's fit (they raised
+    TypeError); empty arrays reach the method's own DataError (a bare ValueError came first);
+    ``predict`` and ``residuals`` warn on deviations as ``simulate``, ``compare`` and
+    ``validate`` do, once each."""
+    from gripkit.sysid import arx, validate
+
+    rng = np.random.default_rng(0)
+    u = rng.standard_normal(800)
+    y = np.convolve(u, [0.0, 1.0, 0.5])[:800] + 0.01 * rng.standard_normal(800)
+    m = arx(u, y, 1, 2, 1, u_offset=50.0, y_offset=100.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fits = [validate(m, u + 50, y + 100).fit_percent,
+                validate(model=m, u=u + 50, y=y + 100).fit_percent,
+                validate(m, u=u + 50, y=y + 100).fit_percent]
+    assert fits[0] > 99.0 and fits[1] == fits[0] and fits[2] == fits[0]
+    with pytest.raises(DataError):
+        m.compare(np.empty(0), np.empty(0))
+    for method in ("predict", "residuals"):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            getattr(m, method)(u, y)
+        hits = [w for w in caught if "look like deviations" in str(w.message)]
+        assert len(hits) == 1 and f".{method}:" in str(hits[0].message)
+
+
+def test_text_is_no_operating_point():
+    """A state-space model's ``u_offset="2.0"`` is refused (numpy would have read the text as a
+    number)."""
+    from gripkit.errors import ModelError
+
+    rng = np.random.default_rng(1)
+    u = rng.standard_normal(300)
+    with pytest.raises(ModelError, match="found text"):
+        n4sid(u, np.convolve(u, [0.0, 1.0, 0.5])[:300], 2, u_offset="2.0")

@@ -56,8 +56,8 @@ class KalmanRun(_KalmanArrays):
     tuple, so ``x, P, e, S = run`` unpacks it — and the attribute ``missing`` (N, p), outside
     the tuple: True where the measurement was NaN, a missing one (its innovation and the
     innovation covariance's row and column are then NaN; ``missing.any(axis=1)``: the samples
-    updated with fewer outputs, or not at all). Without ``missing`` (a run built by hand, or
-    by ``_make``/``_replace``) it is ``isnan(e)``."""
+    updated with fewer outputs, or not at all). ``_replace`` keeps it; without it (a run built
+    by hand, or by ``_make``) it is ``isnan(e)``."""
 
     def __new__(cls, x, P, e, S, missing=None):
         run = super().__new__(cls, x, P, e, S)
@@ -68,6 +68,12 @@ class KalmanRun(_KalmanArrays):
     def missing(self) -> np.ndarray:
         m = self.__dict__.get("_missing")
         return np.isnan(self.e) if m is None else m
+
+    def _replace(self, **fields) -> "KalmanRun":
+        values = [fields.pop(f, getattr(self, f)) for f in self._fields]
+        if fields:
+            raise ValueError(f"Got unexpected field names: {list(fields)!r}")
+        return KalmanRun(*values, missing=self.__dict__.get("_missing"))
 
 
 def warn_missing(where: str, missing: np.ndarray) -> None:

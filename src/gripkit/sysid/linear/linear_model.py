@@ -395,6 +395,7 @@ class IdentifiedLinearModel(ReportMixin):
         u, yy, dt, yo = self._io(data, y, "comparison of an identified model", dt=dt)
         return deviation_compare(self, u, yy, dt, yo)
 
+    @checks_arrays("predict")
     def predict(self, data, y=None, horizon: int = 1, dt: float | None = None) -> np.ndarray:
         """``ŷ(t | t − horizon)`` (N, p) on a trajectory or the arrays ``u``, ``y``: the
         model's predictor (innovation gain K; without K the prediction is the free run) from
@@ -407,6 +408,7 @@ class IdentifiedLinearModel(ReportMixin):
     def _prediction(self, u, y, dt, horizon: int) -> np.ndarray:
         return k_step_prediction(*self._state_space(dt), u, y, horizon)
 
+    @checks_arrays("residuals")
     def residuals(self, data, y=None, dt: float | None = None) -> np.ndarray:
         """One-step prediction errors ``y − ŷ(t | t − 1)`` (N, p) on a trajectory or on
         the arrays ``u``, ``y`` (:meth:`predict`; the record's own values, not deviations:
@@ -461,6 +463,8 @@ def _operating_point(value, n: int, name: str) -> tuple[float, ...]:
     single channel only: one level for several channels is not assumed), or a sequence."""
     if value is None or (isinstance(value, (tuple, list)) and not value):
         return (0.0,) * n
+    if isinstance(value, (str, bytes)):
+        raise ModelError(f"{name}: expected numbers, one per channel, found text {value!r:.60}")
     if isinstance(value, (int, float, np.number)) and not isinstance(value, bool):
         if n != 1:
             raise ModelError(f"{name}: one number given for {n} channels; give one per channel")

@@ -808,6 +808,7 @@ class PolynomialModel(IdentifiedLinearModel):
 
         return _sig.lfilter([1.0], self.C, v)
 
+    @checks_arrays("predict")
     def predict(self, data, y=None, horizon: int = 1) -> np.ndarray:
         """``ŷ(t | t − horizon)``: of a trajectory (N, 1) in its units, of the arrays ``u``,
         ``y`` (offsets applied, as to a trajectory: the record's values, not deviations) shape
@@ -834,6 +835,7 @@ class PolynomialModel(IdentifiedLinearModel):
         out[self.start:, 0] = y[self.start:, 0] - self.prediction_errors(u[:, 0], y[:, 0])
         return out
 
+    @checks_arrays("residuals")
     def residuals(self, data, y=None) -> np.ndarray:
         """One-step prediction errors :meth:`prediction_errors` from sample ``start`` on: of a
         trajectory (N − start, 1), of the arrays ``u``, ``y`` (offsets applied, as to a

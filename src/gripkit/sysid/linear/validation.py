@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import contextvars
 import functools
+import inspect
 import math
 from dataclasses import dataclass
 
@@ -306,8 +307,10 @@ def _looks_like_deviations(x, offsets) -> bool | None:
         x = np.asarray(x, dtype=np.float64)
     except (TypeError, ValueError):  # not numbers: the method's own DataError follows
         return None
+    if not x.size:  # empty: the method's own DataError follows
+        return None
     x = x.reshape(x.shape[0], -1) if x.ndim else x.reshape(1, 1)
-    if x.shape[1] != offsets.size or not x.shape[0] or not np.all(np.isfinite(x)):
+    if x.shape[1] != offsets.size or not np.all(np.isfinite(x)):
         return None
     lo, hi = x.min(axis=0), x.max(axis=0)
     span = hi - lo
@@ -345,20 +348,30 @@ def _numbers(v: np.ndarray) -> str:
 
 
 def checks_arrays(what: str, with_y: bool = True):
-    """Decorator of a model method ``(self, data, y=None, …)`` (``with_y`` False: no ``y``, a
+    """Decorator of a model method or function whose first two parameters are the model and the
+    data (``(self, data, y=None, …)``, ``(model, u, y=None, …)``; ``with_y`` False: no ``y``, a
     simulation) that runs :func:`warn_if_deviations` on arrays (not a trajectory) once: the
-    methods it calls in turn do not check again."""
+    methods it calls in turn do not check again. Arguments bind as the wrapped signature says
+    (by position or by keyword)."""
     def wrap(fn):
+        sig = inspect.signature(fn)
+        model_name, data_name = list(sig.parameters)[:2]
+
         @functools.wraps(fn)
-        def run(self, data, *args, **kw):
+        def run(*args, **kw):
             if _ARRAYS_CHECKED.get():
-                return fn(self, data, *args, **kw)
-            if not isinstance(data, Trajectory):
-                y = (args[0] if args else kw.get("y")) if with_y else None
-                warn_if_deviations(self, data, y, what)
+                return fn(*args, **kw)
+            try:
+                bound = sig.bind(*args, **kw).arguments
+            except TypeError:  # the call itself is wrong: the function says so
+                return fn(*args, **kw)
+            data = bound.get(data_name)
+            if data is not None and not isinstance(data, Trajectory):
+                y = bound.get("y") if with_y else None
+                warn_if_deviations(bound[model_name], data, y, what)
             token = _ARRAYS_CHECKED.set(True)
             try:
-                return fn(self, data, *args, **kw)
+                return fn(*args, **kw)
             finally:
                 _ARRAYS_CHECKED.reset(token)
         return run
