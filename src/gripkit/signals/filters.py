@@ -114,11 +114,11 @@ def _check_sections(sos, btype: str, order: int, cutoff, dt: float, n: int) -> N
         if not abs(gain(s, wn) - 1.0) <= 1e-3:
             return f"its sections round to a pass-band gain of {gain(s, wn):.6g} instead of 1"
         try:
-            if np.isfinite(_signal().sosfilt_zi(s)).all():
-                return None
-        except np.linalg.LinAlgError:
-            pass
-        return "its poles round to z = 1 (the steady state for the first sample is singular)"
+            settled = bool(np.isfinite(_signal().sosfilt_zi(s)).all())
+        except np.linalg.LinAlgError:  # a singular steady state
+            settled = False
+        return None if settled else ("its poles round to z = 1 (the steady state for the first "
+                                     "sample is singular)")
 
     why = fault(sos, np.atleast_1d(np.asarray(cutoff, dtype=np.float64)))
     if why is None:
