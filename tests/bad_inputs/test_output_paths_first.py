@@ -97,9 +97,11 @@ def _can_make_a_file_in(folder: str) -> bool:
 def test_sys_is_refused_before_the_fit(cli, record, no_fit):
     """The audit's case, on the real /sys (Linux): no file can be made there, even as root."""
     if not os.path.isdir("/sys/kernel"):
-        pytest.skip("this system has no Linux /sys (the audit's unwritable folder)")
+        pytest.skip("needs Linux's /sys (a folder where no file can be made, even as root); the "
+                    "same refusal for any unwritable folder is tested above on every system")
     if _can_make_a_file_in("/sys"):  # pragma: no cover - a /sys that takes files
-        pytest.skip("this machine lets a file be made in /sys, so the refusal cannot be shown")
+        pytest.skip("this machine lets a file be made in /sys, so there is no refusal to show; "
+                    "the unwritable-folder tests above cover the check")
     res = cli("identify", "nlss", record[0], "--input", "current", "--output", "force", "--out",
               "/sys/m.json")
     assert_user_error(res, "PathError", "--out '/sys/m.json': cannot write in '/sys'")

@@ -12,7 +12,9 @@ from gripkit.batch.budget import usable_cores
 from gripkit.batch.executors import ProcessExecutor
 
 pytestmark = pytest.mark.skipif(not hasattr(os, "sched_getaffinity"),
-                                reason="os.sched_getaffinity exists on Linux only")
+                                reason="CPU affinity and cgroup quotas (os.sched_getaffinity) "
+                                       "exist on Linux only; elsewhere gripkit counts "
+                                       "os.cpu_count() cores")
 
 
 def _cgroup(tmp_path, v2=None, v1=None):
