@@ -40,3 +40,29 @@ def assert_warned(res: CliResult, phrase: str) -> None:
     assert phrase.lower() in res.err.lower(), res.err
     if res.out.lstrip().startswith("{"):
         assert any(phrase.lower() in w.lower() for w in res.json().get("warnings", [])), res.out
+
+
+def clipped_arx_record(n: int = 400, seed: int = 0):
+    """(u, y) of y(t) = 1.2 y(t−1) − 0.5 y(t−2) + 0.8 w(t−1) + 0.3 w(t−2), w = u clipped to ±0.8,
+    with 0.01 output noise: a record every model family fits (the files of the model-file tests)."""
+    import numpy as np
+
+    rng = np.random.default_rng(seed)
+    u = rng.standard_normal(n)
+    w = np.clip(u, -0.8, 0.8)
+    y = np.zeros(n)
+    for t in range(2, n):
+        y[t] = 1.2 * y[t - 1] - 0.5 * y[t - 2] + 0.8 * w[t - 1] + 0.3 * w[t - 2]
+    return u, y + 0.01 * rng.standard_normal(n)
+
+
+def loaded_with_data_warnings(load, path):
+    """``load(path)`` and the DataWarnings it gave."""
+    import warnings
+
+    from gripkit.errors import DataWarning
+
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        obj = load(path)
+    return obj, [w for w in caught if issubclass(w.category, DataWarning)]

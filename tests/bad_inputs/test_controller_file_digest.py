@@ -13,14 +13,12 @@ from __future__ import annotations
 
 import hashlib
 import json
-import warnings
 
 import numpy as np
 import pytest
-from corpus import assert_warned
+from corpus import assert_warned, loaded_with_data_warnings
 
 from gripkit.control import StateFeedback, design_rst, load_controller, save_controller, tune_pid
-from gripkit.errors import DataWarning
 from gripkit.lti import TransferFunction
 
 PHRASE = "its content differs from what gripkit wrote"
@@ -49,14 +47,6 @@ def saved(request, tmp_path):
     return request.param, path
 
 
-def _load(path):
-    """``load_controller(path)`` and the DataWarnings it gave."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        c = load_controller(path)
-    return c, [w for w in caught if issubclass(w.category, DataWarning)]
-
-
 def _at(doc, keys):
     node = doc["parameters"]
     for k in keys[:-1]:
@@ -75,7 +65,7 @@ def test_written_file_loads_silently_and_its_digest_is_the_documented_one(saved)
     of the document serialised as documented (sorted keys, no spaces, ASCII), recomputed here
     with hashlib from the specification."""
     _, path = saved
-    _, caught = _load(path)
+    _, caught = loaded_with_data_warnings(load_controller, path)
     assert caught == []
     doc = json.loads(path.read_text())
     body = {k: v for k, v in doc.items() if k != "content_sha256"}
@@ -95,7 +85,7 @@ def test_an_edited_gain_or_limit_warns_once_naming_the_file(saved, what):
     new = 2.0 * value if what == "gain" else 5.0
     put(new)
     path.write_text(json.dumps(doc, indent=2))
-    c, caught = _load(path)
+    c, caught = loaded_with_data_warnings(load_controller, path)
     assert len(caught) == 1
     message = str(caught[0].message)
     assert PHRASE in message and str(path) in message and RESAVE in message
@@ -109,7 +99,7 @@ def test_an_edited_gain_or_limit_warns_once_naming_the_file(saved, what):
 def test_round_trip_is_byte_for_byte(saved, tmp_path):
     """save → load → save writes the same bytes (the same digest)."""
     _, path = saved
-    c, _ = _load(path)
+    c, _ = loaded_with_data_warnings(load_controller, path)
     again = tmp_path / "again.json"
     save_controller(c, again)
     assert again.read_bytes() == path.read_bytes()
@@ -125,7 +115,7 @@ def test_layout_and_key_order_do_not_matter(saved):
         return [reverse(v) for v in x] if isinstance(x, list) else x
 
     path.write_text(json.dumps(reverse(json.loads(path.read_text())), indent=5))
-    assert _load(path)[1] == []
+    assert loaded_with_data_warnings(load_controller, path)[1] == []
 
 
 def test_file_without_digest_loads_silently(saved, tmp_path):
@@ -137,7 +127,7 @@ def test_file_without_digest_loads_silently(saved, tmp_path):
     value, put = _at(doc, GAIN[kind])
     put(2.0 * value)
     path.write_text(json.dumps(doc, indent=2))
-    c, caught = _load(path)
+    c, caught = loaded_with_data_warnings(load_controller, path)
     assert caught == [] and _gain(c, kind) == 2.0 * value
     save_controller(c, tmp_path / "again.json")
     assert "content_sha256" in json.loads((tmp_path / "again.json").read_text())

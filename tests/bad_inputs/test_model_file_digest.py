@@ -16,11 +16,10 @@ from __future__ import annotations
 
 import hashlib
 import json
-import warnings
 
 import numpy as np
 import pytest
-from corpus import assert_warned
+from corpus import assert_warned, clipped_arx_record, loaded_with_data_warnings
 
 from gripkit import Trajectory
 from gripkit.errors import DataWarning, ModelError
@@ -32,13 +31,7 @@ MISSING = "its content cannot be checked against what gripkit wrote (content_sha
 
 
 def _record(n: int = 400, seed: int = 0) -> Trajectory:
-    rng = np.random.default_rng(seed)
-    u = rng.standard_normal(n)
-    w = np.clip(u, -0.8, 0.8)
-    y = np.zeros(n)
-    for t in range(2, n):
-        y[t] = 1.2 * y[t - 1] - 0.5 * y[t - 2] + 0.8 * w[t - 1] + 0.3 * w[t - 2]
-    y += 0.01 * rng.standard_normal(n)
+    u, y = clipped_arx_record(n, seed)
     return Trajectory.uniform(dt=DT, current=u, force=y, units={"current": "A", "force": "N"})
 
 
@@ -66,20 +59,12 @@ def saved(request, tmp_path):
     return request.param, path
 
 
-def _load_quietly(path):
-    """``load_model(path)`` and the gripkit warnings it gave."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always")
-        model = load_model(path)
-    return model, [w for w in caught if issubclass(w.category, DataWarning)]
-
-
 def test_written_file_loads_without_warning_and_its_digest_is_the_documented_one(saved):
     """A file as gripkit wrote it: no warning, and its ``content_sha256`` is the SHA-256 of the
     rest of the document serialised as documented (sorted keys, no spaces, ASCII): recomputed
     here from the specification with hashlib, not with gripkit's function."""
     _, path = saved
-    _, caught = _load_quietly(path)
+    _, caught = loaded_with_data_warnings(load_model, path)
     assert caught == []
     doc = json.loads(path.read_text())
     body = {k: v for k, v in doc.items() if k != "content_sha256"}
@@ -97,7 +82,7 @@ def test_units_edited_alike_warn_once_naming_the_file(saved):
     text = path.read_text()
     assert text.count('"N"') >= 1
     path.write_text(text.replace('"N"', '"kN"'))
-    model, caught = _load_quietly(path)
+    model, caught = loaded_with_data_warnings(load_model, path)
     assert len(caught) == 1
     message = str(caught[0].message)
     assert str(path) in message and PHRASE in message and "\n" not in message
@@ -135,7 +120,7 @@ def test_a_number_edited_warns_or_is_refused(saved):
     value, put = _first_number_path(doc, NUMBER[family])
     put(2.0 * value)
     path.write_text(json.dumps(doc, indent=1))
-    model, caught = _load_quietly(path)
+    model, caught = loaded_with_data_warnings(load_model, path)
     assert len(caught) == 1 and PHRASE in str(caught[0].message)
     back = model.to_dict()
     assert _first_number_path(back, NUMBER[family])[0] == 2.0 * value
@@ -145,7 +130,7 @@ def test_round_trip_keeps_the_digest_and_the_bytes(saved, tmp_path):
     """save → load → save writes the same file byte for byte (same digest): the digest is of
     the content, stable across a round trip."""
     _, path = saved
-    model, _ = _load_quietly(path)
+    model, _ = loaded_with_data_warnings(load_model, path)
     again = tmp_path / "again.json"
     model.save(again)
     assert again.read_bytes() == path.read_bytes()
@@ -167,7 +152,7 @@ def test_layout_and_key_order_do_not_matter(saved):
     if "1.0," in text:
         text = text.replace("1.0,", "1.00e0,", 1)
     path.write_text(text)
-    _, caught = _load_quietly(path)
+    _, caught = loaded_with_data_warnings(load_model, path)
     assert caught == []
 
 
@@ -181,7 +166,7 @@ def test_file_without_digest_loads_silently_where_older_files_have_none(saved, t
     doc = json.loads(original)
     del doc["content_sha256"]
     path.write_text(json.dumps(doc, indent=1))
-    back, caught = _load_quietly(path)
+    back, caught = loaded_with_data_warnings(load_model, path)
     if family == "arx":
         assert len(caught) == 1 and MISSING in str(caught[0].message)
         assert str(path) in str(caught[0].message)
@@ -202,7 +187,7 @@ def test_linear_file_with_dt_edited_and_digest_deleted_warns(tmp_path):
     text = json.dumps(doc)
     assert text.count('"dt": 0.01') >= 1
     path.write_text(text.replace('"dt": 0.01', '"dt": 0.02'))
-    model, caught = _load_quietly(path)
+    model, caught = loaded_with_data_warnings(load_model, path)
     assert len(caught) == 1
     assert MISSING in str(caught[0].message) and "load_model(path).save(path)" in str(
         caught[0].message)

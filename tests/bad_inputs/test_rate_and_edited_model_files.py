@@ -16,7 +16,7 @@ import json
 
 import numpy as np
 import pytest
-from corpus import assert_user_error
+from corpus import assert_user_error, clipped_arx_record
 
 from gripkit import Trajectory
 from gripkit.errors import DataError, ModelError
@@ -26,17 +26,7 @@ from gripkit.sysid import (BoucWenModel, BoucWenOscillatorModel, arx, compare, h
 DT = 0.01
 
 
-def _record(n: int = 400, seed: int = 0):
-    rng = np.random.default_rng(seed)
-    u = rng.standard_normal(n)
-    w = np.clip(u, -0.8, 0.8)
-    y = np.zeros(n)
-    for t in range(2, n):
-        y[t] = 1.2 * y[t - 1] - 0.5 * y[t - 2] + 0.8 * w[t - 1] + 0.3 * w[t - 2]
-    return u, y + 0.01 * rng.standard_normal(n)
-
-
-U, Y = _record()
+U, Y = clipped_arx_record()
 #: the Bouc-Wen forms built from known parameters (none estimated: ``free=()``)
 OSC = BoucWenOscillatorModel(mass=1.0, damping=6.0, k_e=2000.0, k_h=2000.0, beta=300.0,
                              gamma=100.0, offset=0.0, dt=1e-3, free=())

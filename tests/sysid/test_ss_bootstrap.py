@@ -66,6 +66,19 @@ def monte_carlo():
     return est.std(axis=0, ddof=1)
 
 
+
+def _assert_kept_with_bootstrap_sigma(model, replicates: int, spread, factor: float) -> None:
+    """The subspace model was kept, with the covariance of ``replicates`` bootstrap replicates
+    (none failed, seed 0), and its σ of |p|, f_n and ζ lie within ``factor`` of the Monte Carlo
+    ``spread``."""
+    assert model.structure == "n4sid" and model.info["focus"]["kept"] == "subspace"
+    assert model.info["covariance"] == {
+        "method": "parametric bootstrap", "replicates": replicates, "failed": 0, "seed": 0,
+        "estimator": "n4sid (order 2, horizon 6)"}
+    ratio = np.array(_mode(model)[1]) / spread
+    assert np.all((ratio > 1 / factor) & (ratio < factor)), ratio
+
+
 def test_bootstrap_sigma_matches_the_monte_carlo_spread(monte_carlo, monkeypatch):
     """On three records, the bootstrap σ (B = 100) of |p|, f_n and ζ lies within a factor 1.5
     of the Monte Carlo spread of 100 records. The band: the Monte Carlo σ and the bootstrap σ
@@ -82,12 +95,7 @@ def test_bootstrap_sigma_matches_the_monte_carlo_spread(monte_carlo, monkeypatch
                                                  "PEM's covariance"):
             model, _ = identify_ss(_record(seed), input="u", output="y", order=2,
                                    bootstrap_replicates=100)
-        assert model.structure == "n4sid" and model.info["focus"]["kept"] == "subspace"
-        assert model.info["covariance"] == {
-            "method": "parametric bootstrap", "replicates": 100, "failed": 0, "seed": 0,
-            "estimator": "n4sid (order 2, horizon 6)"}
-        ratio = np.array(_mode(model)[1]) / monte_carlo
-        assert np.all((ratio > 1 / 1.5) & (ratio < 1.5)), ratio
+        _assert_kept_with_bootstrap_sigma(model, 100, monte_carlo, 1.5)
 
 
 def _pem_warnings(fn):
@@ -273,12 +281,7 @@ def test_records_bootstrap_sigma_matches_the_monte_carlo_spread(monkeypatch):
                                                  "bootstrap of the subspace estimate"):
             model = identify(_records(first), "ss", input="u", output="y", order=2,
                              bootstrap_replicates=40)
-        assert model.structure == "n4sid" and model.info["focus"]["kept"] == "subspace"
-        assert model.info["covariance"] == {
-            "method": "parametric bootstrap", "replicates": 40, "failed": 0, "seed": 0,
-            "estimator": "n4sid (order 2, horizon 6)"}
-        ratio = np.array(_mode(model)[1]) / spread
-        assert np.all((ratio > 1 / 1.6) & (ratio < 1.6)), ratio
+        _assert_kept_with_bootstrap_sigma(model, 40, spread, 1.6)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         runs = [identify(_records(100), "ss", input="u", output="y", order=2,
