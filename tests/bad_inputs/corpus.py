@@ -66,3 +66,14 @@ def loaded_with_data_warnings(load, path):
         warnings.simplefilter("always")
         obj = load(path)
     return obj, [w for w in caught if issubclass(w.category, DataWarning)]
+
+
+def documented_digest(doc: dict) -> str:
+    """The ``content_sha256`` of a model or controller file's document as the file format
+    specifies it, recomputed here with hashlib (not with gripkit's function): the SHA-256 of all
+    other entries serialised with sorted keys, no spaces and ASCII escapes."""
+    import hashlib
+
+    body = {k: v for k, v in doc.items() if k != "content_sha256"}
+    text = json.dumps(body, sort_keys=True, separators=(",", ":"), ensure_ascii=True)
+    return hashlib.sha256(text.encode("utf-8")).hexdigest()

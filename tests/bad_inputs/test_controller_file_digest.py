@@ -11,12 +11,11 @@ RST pole placement of it, and an LQR state feedback with limits, built here."""
 
 from __future__ import annotations
 
-import hashlib
 import json
 
 import numpy as np
 import pytest
-from corpus import assert_warned, loaded_with_data_warnings
+from corpus import assert_warned, documented_digest, loaded_with_data_warnings
 
 from gripkit.control import StateFeedback, design_rst, load_controller, save_controller, tune_pid
 from gripkit.lti import TransferFunction
@@ -68,9 +67,7 @@ def test_written_file_loads_silently_and_its_digest_is_the_documented_one(saved)
     _, caught = loaded_with_data_warnings(load_controller, path)
     assert caught == []
     doc = json.loads(path.read_text())
-    body = {k: v for k, v in doc.items() if k != "content_sha256"}
-    text = json.dumps(body, sort_keys=True, separators=(",", ":"), ensure_ascii=True)
-    assert doc["content_sha256"] == hashlib.sha256(text.encode()).hexdigest()
+    assert doc["content_sha256"] == documented_digest(doc)
     assert list(doc)[-1] == "content_sha256"
 
 

@@ -19,7 +19,7 @@ import json
 
 import numpy as np
 import pytest
-from corpus import assert_warned, clipped_arx_record, loaded_with_data_warnings
+from corpus import assert_warned, clipped_arx_record, documented_digest, loaded_with_data_warnings
 
 from gripkit import Trajectory
 from gripkit.errors import DataWarning, ModelError
@@ -67,9 +67,7 @@ def test_written_file_loads_without_warning_and_its_digest_is_the_documented_one
     _, caught = loaded_with_data_warnings(load_model, path)
     assert caught == []
     doc = json.loads(path.read_text())
-    body = {k: v for k, v in doc.items() if k != "content_sha256"}
-    text = json.dumps(body, sort_keys=True, separators=(",", ":"), ensure_ascii=True)
-    assert doc["content_sha256"] == hashlib.sha256(text.encode("utf-8")).hexdigest()
+    assert doc["content_sha256"] == documented_digest(doc)
     assert list(doc)[-1] == "content_sha256"
 
 
